@@ -1,0 +1,18 @@
+// pftrack._core: the compiled kernels. Each register_<concept>.cpp binds one header of
+// cpp/include/pftrack; this file only calls them in order.
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+void register_histogram(py::module_& m);
+void register_likelihood(py::module_& m);
+void register_resample(py::module_& m);
+void register_filter(py::module_& m);
+
+PYBIND11_MODULE(_core, m) {
+    m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
+    register_histogram(m);
+    register_likelihood(m);
+    register_resample(m);
+    register_filter(m);
+}

@@ -1,0 +1,97 @@
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+
+#include "pftrack/sis.hpp"
+
+namespace py = pybind11;
+using namespace pftrack;
+
+Kernel parse_kernel(const std::string& name, const char* fn);  // register_histogram.cpp
+
+namespace {
+
+Ar2Model make_model(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
+                    double s_min, double s_max, bool use_means) {
+    Ar2Model m;
+    m.a = a.array();
+    m.b = b.array();
+    m.sigma = sigma.array();
+    m.s_min = s_min;
+    m.s_max = s_max;
+    m.use_means = use_means;
+    return m;
+}
+
+}  // namespace
+
+void register_filter(py::module_& m) {
+    m.def(
+        "propagate",
+        [](Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<const RowMatrixXd> noise,
+           const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
+           double s_min, double s_max, bool use_means, const Eigen::Vector3d& mean_prev,
+           const Eigen::Vector3d& mean_prev2) {
+            const Ar2Model model = make_model(a, b, sigma, s_min, s_max, use_means);
+            py::gil_scoped_release nogil;  // safe: Eigen views only
+            propagate_ar2(particles, noise, model, mean_prev, mean_prev2);
+        },
+        py::arg("particles").noconvert(), py::arg("noise"), py::arg("a"), py::arg("b"),
+        py::arg("sigma"), py::arg("s_min"), py::arg("s_max"), py::arg("use_means"),
+        py::arg("mean_prev"), py::arg("mean_prev2"),
+        "AR(2) step in place; particles (N, 6) float64 C-contiguous, noise (N, 3) N(0, 1).");
+
+    m.def(
+        "estimate",
+        [](Eigen::Ref<const RowMatrixXd> particles, Eigen::Ref<const Eigen::VectorXd> weights) {
+            const char* fn = "estimate";
+            check_particles(particles, fn);
+            require(weights.size() == particles.rows(), fn, "weights size", weights.size(),
+                    particles.rows());
+            require_weights(weights, fn);
+            py::gil_scoped_release nogil;  // safe: Eigen views only
+            const Estimate e = estimate_state(particles, weights);
+            return py::make_tuple(Eigen::Vector3d(e.mean), Eigen::Vector3d(e.map), e.map_index);
+        },
+        py::arg("particles"), py::arg("weights"), "(mean (3,), map (3,), map_index).");
+
+    m.def(
+        "sis_step",
+        [](Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
+           Eigen::Ref<RowMatrixXd> means, const BinnedImage& image,
+           Eigen::Ref<const Eigen::VectorXd> ref, double w0, double h0,
+           const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
+           double s_min, double s_max, bool use_means, double lam, const std::string& kernel,
+           bool resample, std::uint64_t seed, std::uint64_t step) {
+            SisParams prm;
+            prm.model = make_model(a, b, sigma, s_min, s_max, use_means);
+            prm.lambda = lam;
+            prm.kernel = parse_kernel(kernel, "sis_step");
+            prm.w0 = w0;
+            prm.h0 = h0;
+            prm.resample = resample;
+            SisResult r;
+            {
+                py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
+                r = sis_step(particles, weights, means, image.view(), ref, prm, seed, step);
+            }
+            py::dict out;
+            out["mean"] = Eigen::Vector3d(r.estimate.mean);
+            out["map"] = Eigen::Vector3d(r.estimate.map);
+            out["map_index"] = r.estimate.map_index;
+            out["ess"] = r.ess;
+            out["rho_max"] = r.rho_max;
+            out["rho_mean"] = r.rho_mean;
+            out["fg_mean"] = r.fg_mean;
+            return out;
+        },
+        py::arg("particles").noconvert(), py::arg("weights").noconvert(),
+        py::arg("means").noconvert(), py::arg("image"), py::arg("ref"), py::arg("w0"),
+        py::arg("h0"), py::arg("a"), py::arg("b"), py::arg("sigma"), py::arg("s_min"),
+        py::arg("s_max"), py::arg("use_means"), py::arg("lam"), py::arg("kernel"),
+        py::arg("resample"), py::arg("seed"), py::arg("step"),
+        "Resample, propagate, histogram, weigh, estimate; particles (N, 6), weights (N,), "
+        "means (2, 3) updated in place.");
+}

@@ -1,0 +1,96 @@
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "arrays.hpp"
+#include "pftrack/histogram.hpp"
+#include "pftrack/hsv.hpp"
+
+namespace py = pybind11;
+using namespace pftrack;
+
+Kernel parse_kernel(const std::string& name, const char* fn) {
+    if (name == "uniform") return Kernel::kUniform;
+    if (name == "epanechnikov") return Kernel::kEpanechnikov;
+    fail(fn, "kernel is '" + name + "', expected 'uniform' or 'epanechnikov'");
+}
+
+void register_histogram(py::module_& m) {
+    py::class_<BinnedImage, std::shared_ptr<BinnedImage>>(
+        m, "BinnedImage", "A frame's colour-bin index per pixel (-1: never counted).")
+        .def(py::init([](py::array_t<std::int16_t, py::array::c_style | py::array::forcecast> bins,
+                         int n_bins) {
+                 const char* fn = "BinnedImage";
+                 require(bins.ndim() == 2, fn, "bins ndim", bins.ndim(), 2);
+                 require(bins.shape(0) > 0 && bins.shape(1) > 0, fn, "bins is empty");
+                 require(n_bins >= 1 && n_bins <= 32767, fn, "n_bins", n_bins, "in [1, 32767]");
+                 auto img = std::make_shared<BinnedImage>(bins.shape(0), bins.shape(1), n_bins);
+                 const std::int16_t* src = bins.data();
+                 for (size_t i = 0; i < img->data.size(); ++i) {
+                     require(src[i] >= -1 && src[i] < n_bins, fn, "bins value", src[i],
+                             "in [-1, n_bins)");
+                     img->data[i] = src[i];
+                 }
+                 return img;
+             }),
+             py::arg("bins"), py::arg("n_bins"))
+        .def_property_readonly("n_bins", [](const BinnedImage& b) { return b.n_bins; })
+        .def_property_readonly("shape", [](const BinnedImage& b) { return py::make_tuple(b.rows, b.cols); })
+        .def_property_readonly(
+            "bins",
+            [](py::object self) {
+                const auto& b = self.cast<const BinnedImage&>();
+                py::array_t<std::int16_t> a({b.rows, b.cols},
+                                            {static_cast<py::ssize_t>(b.cols * 2), py::ssize_t(2)},
+                                            b.data.data(), self);
+                py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+                return a;
+            },
+            "(H, W) int16 read-only view of the bins");
+
+    m.def(
+        "hsv_bins",
+        [](py::array frame, std::optional<py::array> mask, int n_h, int n_s, int n_v, double s_min,
+           double v_min) {
+            const char* fn = "hsv_bins";
+            bind::check_bgr_image(frame, fn, "frame");
+            const HsvBinning p{n_h, n_s, n_v, s_min, v_min};
+            p.validate(fn);
+            const auto rows = frame.shape(0), cols = frame.shape(1);
+            const std::uint8_t* mptr = nullptr;
+            py::ssize_t mstride = 0;
+            if (mask) {
+                bind::check_mask(*mask, rows, cols, fn);
+                mptr = static_cast<const std::uint8_t*>(mask->data());
+                mstride = mask->strides(0);
+            }
+            auto img = std::make_shared<BinnedImage>(rows, cols, p.n_bins());
+            const auto* src = static_cast<const std::uint8_t*>(frame.data());
+            const auto stride = frame.strides(0);
+            {
+                py::gil_scoped_release nogil;  // safe: raw buffers only, held alive by the caller
+                hsv_bins(src, rows, cols, stride, mptr, mstride, p, img->data.data());
+            }
+            return img;
+        },
+        py::arg("frame"), py::arg("mask") = py::none(), py::arg("n_h") = 10, py::arg("n_s") = 10,
+        py::arg("n_v") = 10, py::arg("s_min") = 0.1, py::arg("v_min") = 0.2,
+        "Bin index per pixel of a BGR uint8 frame (H, W, 3); mask (H, W) zero = background.");
+
+    m.def(
+        "box_histograms",
+        [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes, const std::string& kernel) {
+            const char* fn = "box_histograms";
+            check_boxes(boxes, fn, "boxes");
+            const Kernel k = parse_kernel(kernel, fn);
+            py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
+            return box_histograms(image.view(), boxes, k);
+        },
+        py::arg("image"), py::arg("boxes"), py::arg("kernel") = "uniform",
+        "Normalised histograms (K, B) of boxes (K, 4) = (cx, cy, w, h); empty box -> zero row.");
+}

@@ -1,0 +1,66 @@
+// Argument checks whose messages name the function, the argument, what it is and what was expected:
+//   "bhattacharyya_weights: hist cols is 99, expected 110 (one per bin)"
+// The core throws std::invalid_argument only; pybind11 turns it into ValueError.
+#pragma once
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Core>
+
+namespace pftrack {
+
+[[noreturn]] inline void fail(const char* fn, const std::string& message) {
+    throw std::invalid_argument(std::string(fn) + ": " + message);
+}
+
+template <class Got, class Want>
+inline void require(bool ok, const char* fn, const char* what, const Got& got, const Want& want) {
+    if (ok) return;
+    std::ostringstream s;
+    s << what << " is " << got << ", expected " << want;
+    fail(fn, s.str());
+}
+
+inline void require(bool ok, const char* fn, const std::string& message) {
+    if (!ok) fail(fn, message);
+}
+
+/// Every entry finite; the message gives the first bad position.
+template <class Derived>
+inline void require_finite(const Eigen::DenseBase<Derived>& a, const char* fn, const char* what) {
+    for (Eigen::Index i = 0; i < a.rows(); ++i)
+        for (Eigen::Index j = 0; j < a.cols(); ++j)
+            if (!std::isfinite(static_cast<double>(a(i, j)))) {
+                std::ostringstream s;
+                s << what << " has a non-finite value " << a(i, j) << " at [" << i;
+                if (a.cols() > 1) s << ", " << j;
+                s << "]";
+                fail(fn, s.str());
+            }
+}
+
+/// Weights: non-empty, finite, non-negative, positive sum. Returns the sum.
+template <class Derived>
+inline double require_weights(const Eigen::DenseBase<Derived>& w, const char* fn,
+                              const char* what = "weights") {
+    require(w.size() > 0, fn, std::string(what) + " is empty");
+    double sum = 0.0;
+    for (Eigen::Index i = 0; i < w.size(); ++i) {
+        const double v = w(i);
+        if (!std::isfinite(v) || v < 0.0) {
+            std::ostringstream s;
+            s << what << "[" << i << "] is " << v << ", expected a finite value >= 0";
+            fail(fn, s.str());
+        }
+        sum += v;
+    }
+    require(sum > 0.0 && std::isfinite(sum), fn,
+            std::string(what) + " sum to 0 (all weights are 0: reference histogram empty, or "
+                                "every particle outside the image?)");
+    return sum;
+}
+
+}  // namespace pftrack

@@ -1,0 +1,170 @@
+// Colour histograms of image boxes, from a precomputed bin image (hsv_bins).
+//
+// A box is (cx, cy, w, h) in pixels, pixel centres at integer coordinates. It covers columns
+// x0 = floor(cx - w/2 + 1/2) .. x1 = floor(cx + w/2 + 1/2) (half open) and likewise rows, clipped
+// to the image. Pixels with a negative bin (background) are never counted. Each histogram is
+// normalised to sum 1; a box with nothing to count (outside the image, or no foreground) gets the
+// all-zero histogram, whose Bhattacharyya coefficient with any reference is 0 (distance 1).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "check.hpp"
+#include "types.hpp"
+
+namespace pftrack {
+
+enum class Kernel { kUniform = 0, kEpanechnikov = 1 };
+
+struct PixelRange {
+    Index x0, x1, y0, y1;  // half open, clipped; empty when x0 >= x1 or y0 >= y1
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+};
+
+inline Index round_half_up(double v) { return static_cast<Index>(std::floor(v + 0.5)); }
+
+inline PixelRange box_pixels(double cx, double cy, double w, double h, Index rows, Index cols) {
+    PixelRange r;
+    r.x0 = std::max<Index>(0, round_half_up(cx - 0.5 * w));
+    r.x1 = std::min<Index>(cols, round_half_up(cx + 0.5 * w));
+    r.y0 = std::max<Index>(0, round_half_up(cy - 0.5 * h));
+    r.y1 = std::min<Index>(rows, round_half_up(cy + 0.5 * h));
+    return r;
+}
+
+inline bool box_is_sane(double cx, double cy, double w, double h) {
+    // Far outside any image is fine (empty histogram); only non-finite or negative sizes are not.
+    return std::isfinite(cx) && std::isfinite(cy) && std::isfinite(w) && std::isfinite(h) &&
+           w >= 0.0 && h >= 0.0 && std::abs(cx) < 1e9 && std::abs(cy) < 1e9 && w < 1e9 && h < 1e9;
+}
+
+/// Scratch space for one histogram. Slot 0 collects background (bin -1) so the inner loop never
+/// branches; four interleaved copies break the store-to-load dependency of runs of equal bins.
+class HistogramScratch {
+public:
+    explicit HistogramScratch(int n_bins)
+        : n_bins_(n_bins), stride_(n_bins + 1), counts_(4 * static_cast<size_t>(stride_)),
+          weights_(4 * static_cast<size_t>(stride_)) {}
+
+    /// Writes the normalised histogram of one box to `out` (n_bins values).
+    /// Returns the total counted weight (0 for an empty box).
+    double compute(const BinImage& img, double cx, double cy, double w, double h, Kernel kernel,
+                   double* out) {
+        const PixelRange r = box_pixels(cx, cy, w, h, img.rows, img.cols);
+        std::fill(out, out + n_bins_, 0.0);
+        if (r.empty()) return 0.0;
+        return kernel == Kernel::kUniform ? uniform(img, r, out) : epanechnikov(img, r, cx, cy, w, h, out);
+    }
+
+private:
+    double uniform(const BinImage& img, const PixelRange& r, double* out) {
+        std::fill(counts_.begin(), counts_.end(), 0);
+        std::int32_t* c0 = counts_.data() + 1;  // +1: bin -1 lands in slot 0
+        std::int32_t* c1 = c0 + stride_;
+        std::int32_t* c2 = c1 + stride_;
+        std::int32_t* c3 = c2 + stride_;
+        for (Index y = r.y0; y < r.y1; ++y) {
+            const std::int16_t* b = img.row(y);
+            Index x = r.x0;
+            for (; x + 4 <= r.x1; x += 4) {
+                ++c0[b[x]];
+                ++c1[b[x + 1]];
+                ++c2[b[x + 2]];
+                ++c3[b[x + 3]];
+            }
+            for (; x < r.x1; ++x) ++c0[b[x]];
+        }
+        std::int64_t total = 0;
+        for (int k = 0; k < n_bins_; ++k) {
+            const std::int64_t n = std::int64_t(c0[k]) + c1[k] + c2[k] + c3[k];
+            total += n;
+            out[k] = static_cast<double>(n);
+        }
+        if (total == 0) return 0.0;
+        const double inv = 1.0 / static_cast<double>(total);
+        for (int k = 0; k < n_bins_; ++k) out[k] *= inv;
+        return static_cast<double>(total);
+    }
+
+    // Epanechnikov profile k(r^2) = max(0, 1 - r^2), r^2 = ((x-cx)/(w/2))^2 + ((y-cy)/(h/2))^2.
+    double epanechnikov(const BinImage& img, const PixelRange& r, double cx, double cy, double w,
+                        double h, double* out) {
+        std::fill(weights_.begin(), weights_.end(), 0.0);
+        double* a0 = weights_.data() + 1;
+        double* a1 = a0 + stride_;
+        const double ix = w > 0.0 ? 2.0 / w : 0.0;
+        const double iy = h > 0.0 ? 2.0 / h : 0.0;
+        rowk_.resize(static_cast<size_t>(r.x1 - r.x0));
+        for (Index x = r.x0; x < r.x1; ++x) {
+            const double dx = (static_cast<double>(x) - cx) * ix;
+            rowk_[static_cast<size_t>(x - r.x0)] = dx * dx;
+        }
+        for (Index y = r.y0; y < r.y1; ++y) {
+            const double dy = (static_cast<double>(y) - cy) * iy;
+            const double base = 1.0 - dy * dy;
+            if (base <= 0.0) continue;
+            const std::int16_t* b = img.row(y);
+            Index x = r.x0;
+            for (; x + 2 <= r.x1; x += 2) {
+                a0[b[x]] += std::max(0.0, base - rowk_[static_cast<size_t>(x - r.x0)]);
+                a1[b[x + 1]] += std::max(0.0, base - rowk_[static_cast<size_t>(x + 1 - r.x0)]);
+            }
+            for (; x < r.x1; ++x) a0[b[x]] += std::max(0.0, base - rowk_[static_cast<size_t>(x - r.x0)]);
+        }
+        double total = 0.0;
+        for (int k = 0; k < n_bins_; ++k) {
+            out[k] = a0[k] + a1[k];
+            total += out[k];
+        }
+        if (!(total > 0.0)) {
+            std::fill(out, out + n_bins_, 0.0);
+            return 0.0;
+        }
+        const double inv = 1.0 / total;
+        for (int k = 0; k < n_bins_; ++k) out[k] *= inv;
+        return total;
+    }
+
+    int n_bins_;
+    int stride_;
+    std::vector<std::int32_t> counts_;
+    std::vector<double> weights_;
+    std::vector<double> rowk_;
+};
+
+inline void check_bin_image(const BinImage& img, const char* fn) {
+    require(img.rows > 0 && img.cols > 0, fn, "bins must be a non-empty 2-D image");
+    require(img.n_bins >= 1 && img.n_bins <= 32767, fn, "n_bins", img.n_bins, "in [1, 32767]");
+}
+
+/// Checks a (K, 4) box array: finite, w and h >= 0. The message names the first bad row.
+template <class Derived>
+inline void check_boxes(const Eigen::MatrixBase<Derived>& boxes, const char* fn, const char* what) {
+    require(boxes.cols() == 4, fn, (std::string(what) + " cols").c_str(), boxes.cols(),
+            "4 (cx, cy, w, h)");
+    for (Index i = 0; i < boxes.rows(); ++i)
+        if (!box_is_sane(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3))) {
+            std::ostringstream s;
+            s << what << "[" << i << "] is (" << boxes(i, 0) << ", " << boxes(i, 1) << ", "
+              << boxes(i, 2) << ", " << boxes(i, 3)
+              << "), expected finite (cx, cy, w, h) with w, h >= 0";
+            fail(fn, s.str());
+        }
+}
+
+/// Histograms of K boxes: (K, n_bins), each row sums to 1 (or is all zero for an empty box).
+template <class Derived>
+inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                                  Kernel kernel) {
+    RowMatrixXd out(boxes.rows(), img.n_bins);
+    HistogramScratch scratch(img.n_bins);
+    for (Index i = 0; i < boxes.rows(); ++i)
+        scratch.compute(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
+                        out.row(i).data());
+    return out;
+}
+
+}  // namespace pftrack

@@ -1,0 +1,96 @@
+// Colour likelihood: Bhattacharyya coefficient and distance between histograms, and particle
+// weights p(z | x) ~ exp(-lambda D^2) (the first paper's eq. 9-10) normalised in log space.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "check.hpp"
+#include "types.hpp"
+
+namespace pftrack {
+
+/// rho[q*, q] = sum_n sqrt(q*(n) q(n)); rows of `hists` against `ref`. `sqrt_ref` = sqrt(ref).
+inline double bhattacharyya_coefficient_row(const double* hist, const double* sqrt_ref, int n) {
+    double rho = 0.0;
+    for (int k = 0; k < n; ++k) rho += std::sqrt(hist[k]) * sqrt_ref[k];
+    return rho;
+}
+
+/// D = sqrt(1 - rho) (eq. 10), with rho clipped to [0, 1] against round-off.
+inline double bhattacharyya_distance_from_rho(double rho) {
+    return std::sqrt(std::max(0.0, 1.0 - std::min(rho, 1.0)));
+}
+
+/// Reference histogram: (B,), finite, >= 0, positive sum. Returns sqrt(ref / sum(ref)).
+template <class Derived>
+inline Eigen::VectorXd sqrt_reference(const Eigen::MatrixBase<Derived>& ref, Index n_bins,
+                                      const char* fn) {
+    require(ref.size() == n_bins, fn, "ref size", ref.size(), n_bins);
+    const double sum = require_weights(ref, fn, "ref");
+    return (ref.derived().array() / sum).sqrt().matrix();
+}
+
+/// Histogram rows: finite and >= 0.
+template <class Derived>
+inline void check_histograms(const Eigen::MatrixBase<Derived>& h, const char* fn) {
+    for (Index i = 0; i < h.rows(); ++i)
+        for (Index k = 0; k < h.cols(); ++k)
+            if (!(std::isfinite(h(i, k)) && h(i, k) >= 0.0)) {
+                std::ostringstream s;
+                s << "hists[" << i << ", " << k << "] is " << h(i, k)
+                  << ", expected a finite value >= 0";
+                fail(fn, s.str());
+            }
+}
+
+template <class Derived, class DerivedRef>
+inline Eigen::VectorXd bhattacharyya_coefficient(const Eigen::MatrixBase<Derived>& hists,
+                                                 const Eigen::MatrixBase<DerivedRef>& ref) {
+    const char* fn = "bhattacharyya_coefficient";
+    check_histograms(hists, fn);
+    const Eigen::VectorXd sq = sqrt_reference(ref, hists.cols(), fn);
+    const RowMatrixXd h = hists;  // row-major, contiguous rows
+    Eigen::VectorXd rho(h.rows());
+    for (Index i = 0; i < h.rows(); ++i)
+        rho(i) = bhattacharyya_coefficient_row(h.row(i).data(), sq.data(), static_cast<int>(h.cols()));
+    return rho;
+}
+
+/// Normalises log weights in place to weights summing to 1: w_i = exp(l_i - max l) / sum.
+/// Entries of -inf get weight 0; all -inf is an error.
+inline void normalise_log_weights(Eigen::Ref<Eigen::VectorXd> logw, const char* fn) {
+    require(logw.size() > 0, fn, "log weights are empty");
+    double mx = -std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < logw.size(); ++i) {
+        require(!std::isnan(logw(i)) && logw(i) < std::numeric_limits<double>::infinity(), fn,
+                "log_weights has NaN or +inf");
+        mx = std::max(mx, logw(i));
+    }
+    require(std::isfinite(mx), fn, "all log weights are -inf");
+    double sum = 0.0;
+    for (Index i = 0; i < logw.size(); ++i) {
+        logw(i) = std::exp(logw(i) - mx);
+        sum += logw(i);
+    }
+    logw /= sum;
+}
+
+/// Normalised weights w ~ exp(-lambda D^2) = exp(-lambda (1 - rho)) from coefficients rho.
+inline Eigen::VectorXd weights_from_rho(const Eigen::Ref<const Eigen::VectorXd>& rho, double lambda,
+                                        const char* fn) {
+    Eigen::VectorXd logw(rho.size());
+    for (Index i = 0; i < rho.size(); ++i) {
+        const double d = bhattacharyya_distance_from_rho(rho(i));
+        logw(i) = -lambda * d * d;
+    }
+    normalise_log_weights(logw, fn);
+    return logw;
+}
+
+inline void check_lambda(double lambda, const char* fn) {
+    require(std::isfinite(lambda) && lambda >= 0.0, fn, "lambda", lambda, "finite and >= 0");
+}
+
+}  // namespace pftrack

@@ -1,0 +1,99 @@
+// One fused step of a sequential-importance-sampling colour particle filter (the first paper's
+// method 1, eq. 3-4 with the dynamic model as proposal, so w_t ~ p(z_t | x_t)):
+//   resample (systematic) -> propagate (AR2) -> histogram per particle -> weigh -> estimate.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "histogram.hpp"
+#include "likelihood.hpp"
+#include "propagate.hpp"
+#include "resample.hpp"
+#include "rng.hpp"
+
+namespace pftrack {
+
+struct SisResult {
+    Estimate estimate;
+    double ess = 0.0;       // effective sample size 1 / sum w^2 of the new weights
+    double rho_max = 0.0;   // best Bhattacharyya coefficient among the particles
+    double rho_mean = 0.0;  // weight-averaged coefficient: how well the track is explained
+    double fg_mean = 0.0;   // weight-averaged counted pixels (foreground) per particle box
+};
+
+struct SisParams {
+    Ar2Model model;
+    double lambda = 20.0;
+    Kernel kernel = Kernel::kUniform;
+    double w0 = 1.0;  // base box size: box = (cx, cy, s*w0, s*h0)
+    double h0 = 1.0;
+    bool resample = true;
+};
+
+/// Advances one particle set by one frame. `particles` (N, 6), `weights` (N,) and `means` (2, 3):
+/// rows m_{t-1}, m_{t-2}) are updated in place. Draws come from CounterRng(seed, step).
+inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
+                          Eigen::Ref<RowMatrixXd> means, const BinImage& img,
+                          const Eigen::Ref<const Eigen::VectorXd>& ref, const SisParams& prm,
+                          std::uint64_t seed, std::uint64_t step) {
+    const char* fn = "sis_step";
+    check_particles(particles, fn);
+    const Index n = particles.rows();
+    require(weights.size() == n, fn, "weights size", weights.size(), n);
+    require_weights(weights, fn);
+    require(means.rows() == 2 && means.cols() == kStateDim, fn,
+            "means must be (2, 3): particle-set means at t-1 and t-2");
+    require_finite(means, fn, "means");
+    prm.model.validate(fn);
+    check_lambda(prm.lambda, fn);
+    require(std::isfinite(prm.w0) && std::isfinite(prm.h0) && prm.w0 > 0.0 && prm.h0 > 0.0, fn,
+            "base box size (w0, h0) must be finite and > 0");
+    check_bin_image(img, fn);
+    const Eigen::VectorXd sqref = sqrt_reference(ref, img.n_bins, fn);
+
+    const CounterRng rng(seed, step);
+    // 1. resample: one uniform (stream position 0 of the uniform draws, beyond the normals' range)
+    if (prm.resample) {
+        const IndexVector idx = systematic_resample(weights, rng.uniform(~std::uint64_t(0)));
+        RowMatrixXd kept(n, kParticleCols);
+        for (Index i = 0; i < n; ++i) kept.row(i) = particles.row(idx(i));
+        particles = kept;
+        weights.setConstant(1.0 / static_cast<double>(n));
+    }
+    // 2. propagate
+    const Eigen::Vector3d m1 = means.row(0).transpose();
+    const Eigen::Vector3d m2 = means.row(1).transpose();
+    double w[kStateDim];
+    for (Index i = 0; i < n; ++i) {
+        for (int d = 0; d < kStateDim; ++d)
+            w[d] = rng.normal(static_cast<std::uint64_t>(i) * kStateDim + static_cast<std::uint64_t>(d));
+        ar2_step(particles.row(i).data(), w, prm.model, m1.data(), m2.data());
+    }
+    // 3-4. histogram and weigh: log w_i = log w_i(resampled) - lambda D_i^2
+    HistogramScratch scratch(img.n_bins);
+    std::vector<double> hist(static_cast<size_t>(img.n_bins));
+    Eigen::VectorXd rho(n), counted(n), logw(n);
+    for (Index i = 0; i < n; ++i) {
+        const double s = particles(i, 2);
+        counted(i) = scratch.compute(img, particles(i, 0), particles(i, 1), s * prm.w0, s * prm.h0,
+                                     prm.kernel, hist.data());
+        rho(i) = bhattacharyya_coefficient_row(hist.data(), sqref.data(), img.n_bins);
+        const double d = bhattacharyya_distance_from_rho(rho(i));
+        logw(i) = std::log(weights(i)) - prm.lambda * d * d;
+    }
+    normalise_log_weights(logw, fn);
+    weights = logw;
+    // 5. estimate
+    SisResult r;
+    r.estimate = estimate_state(particles, weights);
+    r.ess = 1.0 / weights.squaredNorm();
+    r.rho_max = rho.maxCoeff();
+    r.rho_mean = weights.dot(rho);
+    r.fg_mean = weights.dot(counted);
+    means.row(1) = means.row(0);
+    means.row(0) = r.estimate.mean.transpose();
+    return r;
+}
+
+}  // namespace pftrack

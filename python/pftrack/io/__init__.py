@@ -1,0 +1,8 @@
+"""Input and output: MOTChallenge files, video and image folders, atomic writes."""
+
+from __future__ import annotations
+
+from pftrack.io.atomic import atomic_path, atomic_write
+from pftrack.io.mot import group_by_frame, read_mot, write_mot
+
+__all__ = ["atomic_path", "atomic_write", "group_by_frame", "read_mot", "write_mot"]

@@ -1,0 +1,127 @@
+"""MOTChallenge text files: ``frame,id,left,top,width,height,conf,x,y,z`` one box a line.
+
+Frames count from 1. Detection files use id -1. pftrack reads comma- or whitespace-separated
+files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``) and always writes 10.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack.io.atomic import atomic_write
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+#: Column indices of a MOTChallenge row.
+FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
+_DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 1.0, -1.0, -1.0, -1.0)
+
+
+def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
+    """Read a MOTChallenge file into an ``(M, 10)`` float64 array.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file. Blank lines and lines starting with ``#`` are skipped.
+    what : str
+        How errors name the file ("detection file", "ground truth", ...).
+
+    Returns
+    -------
+    (M, 10) ndarray of float64
+        Rows in file order. An empty file gives shape ``(0, 10)``.
+
+    Raises
+    ------
+    FileNotFoundError
+        If `path` does not exist.
+    ValueError
+        On a malformed line, naming the file and the 1-based line number: fewer than 6 fields,
+        a non-number, a non-finite value, a frame that is not a positive integer, or a negative
+        width or height.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"{what} not found: {p}")
+    rows: list[list[float]] = []
+    with p.open("r", encoding="utf-8", errors="replace") as fh:
+        for lineno, line in enumerate(fh, start=1):
+            text = line.strip()
+            if not text or text.startswith("#"):
+                continue
+            fields = text.replace(",", " ").split()
+            if len(fields) < 6:
+                raise ValueError(
+                    f"{p}:{lineno}: {what} line has {len(fields)} fields, expected at least 6 "
+                    f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
+                )
+            try:
+                values = [float(f) for f in fields[:10]]
+            except ValueError:
+                raise ValueError(f"{p}:{lineno}: {what} line has a non-number: {text[:80]!r}") from None
+            if not all(np.isfinite(values[:6])):
+                raise ValueError(f"{p}:{lineno}: {what} line has a non-finite value: {text[:80]!r}")
+            frame = values[FRAME]
+            if frame < 1 or frame != int(frame):
+                raise ValueError(
+                    f"{p}:{lineno}: frame is {fields[0]}, expected an integer >= 1 (frames count from 1)"
+                )
+            if values[WIDTH] < 0 or values[HEIGHT] < 0:
+                raise ValueError(f"{p}:{lineno}: negative box width or height: {text[:80]!r}")
+            values.extend(_DEFAULTS[len(values) :])
+            rows.append(values)
+    if not rows:
+        return np.zeros((0, 10))
+    return np.asarray(rows, dtype=np.float64)
+
+
+def format_mot_row(row: Iterable[float]) -> str:
+    """One MOTChallenge line (10 columns): integers where integral, else 2 decimals."""
+    r = list(row)
+    out = [str(int(r[FRAME])), str(int(r[ID]))]
+    for v in r[2:]:
+        v = float(v)
+        out.append(str(int(v)) if v == int(v) and abs(v) < 1e15 else f"{v:.2f}")
+    return ",".join(out)
+
+
+def write_mot(path: PathLike, rows: NDArray[np.float64] | Iterable[Iterable[float]]) -> None:
+    """Write rows (M, 6..10) as a MOTChallenge file, atomically, sorted by (frame, id).
+
+    Columns beyond those given get the defaults ``conf=1, x=y=z=-1``.
+    """
+    a = np.asarray(rows, dtype=np.float64)
+    if a.size == 0:
+        a = np.zeros((0, 10))
+    if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
+        raise ValueError(f"write_mot: rows must have shape (M, 6..10), got {a.shape}")
+    if a.shape[1] < 10:
+        pad = np.tile(np.asarray(_DEFAULTS[a.shape[1] :]), (a.shape[0], 1))
+        a = np.hstack([a, pad])
+    order = np.lexsort((a[:, ID], a[:, FRAME]))
+    with atomic_write(path) as fh:
+        for r in a[order]:
+            fh.write(format_mot_row(r) + "\n")
+
+
+def boxes_of_frame(rows: NDArray[np.float64], frame: int) -> NDArray[np.float64]:
+    """Rows of one frame (rows must be sorted by frame for speed; any order works)."""
+    return rows[rows[:, FRAME] == frame]
+
+
+def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
+    """Split rows by frame number: ``{frame: (k, 10) rows}``."""
+    if len(rows) == 0:
+        return {}
+    order = np.argsort(rows[:, FRAME], kind="stable")
+    r = rows[order]
+    frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
+    ends = list(starts[1:]) + [len(r)]
+    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends)}
