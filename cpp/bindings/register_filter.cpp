@@ -44,6 +44,29 @@ void register_filter(py::module_& m) {
         "AR(2) step in place; particles (N, 6) float64 C-contiguous, noise (N, 3) N(0, 1).");
 
     m.def(
+        "counter_uniforms",
+        [](std::uint64_t seed, std::uint64_t stream, std::uint64_t start, Index n) {
+            require(n >= 0, "counter_uniforms", "n", n, ">= 0");
+            const CounterRng rng(seed, stream);
+            Eigen::VectorXd u(n);
+            for (Index i = 0; i < n; ++i) u(i) = rng.uniform(start + static_cast<std::uint64_t>(i));
+            return u;
+        },
+        py::arg("seed"), py::arg("stream"), py::arg("start"), py::arg("n"),
+        "Uniforms k = start .. start+n-1 of the counter-based stream (for tests and references).");
+    m.def(
+        "counter_normals",
+        [](std::uint64_t seed, std::uint64_t stream, Index n) {
+            require(n >= 0, "counter_normals", "n", n, ">= 0");
+            const CounterRng rng(seed, stream);
+            Eigen::VectorXd z(n);
+            for (Index i = 0; i < n; ++i) z(i) = rng.normal(static_cast<std::uint64_t>(i));
+            return z;
+        },
+        py::arg("seed"), py::arg("stream"), py::arg("n"),
+        "Normals k = 0 .. n-1 of the counter-based stream (sis_step's propagation noise).");
+
+    m.def(
         "estimate",
         [](Eigen::Ref<const RowMatrixXd> particles, Eigen::Ref<const Eigen::VectorXd> weights) {
             const char* fn = "estimate";
@@ -51,8 +74,11 @@ void register_filter(py::module_& m) {
             require(weights.size() == particles.rows(), fn, "weights size", weights.size(),
                     particles.rows());
             require_weights(weights, fn);
-            py::gil_scoped_release nogil;  // safe: Eigen views only
-            const Estimate e = estimate_state(particles, weights);
+            Estimate e;
+            {
+                py::gil_scoped_release nogil;  // safe: Eigen views only
+                e = estimate_state(particles, weights);
+            }
             return py::make_tuple(Eigen::Vector3d(e.mean), Eigen::Vector3d(e.map), e.map_index);
         },
         py::arg("particles"), py::arg("weights"), "(mean (3,), map (3,), map_index).");

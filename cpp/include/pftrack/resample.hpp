@@ -32,8 +32,8 @@ inline void check_uniforms(const Eigen::Ref<const Eigen::VectorXd>& u, Index nee
         require(u(i) >= 0.0 && u(i) < 1.0, fn, "u values", u(i), "in [0, 1)");
 }
 
-/// Ordered positions p_0 < p_1 < ... in [0, 1) to indices: the first i with p <= cdf[i]
-/// (what numpy.searchsorted(cdf, p) gives), by one merge pass.
+/// Ordered positions p_0 < p_1 < ... in [0, 1) to indices: the first i with p < cdf[i]
+/// (numpy.searchsorted(cdf, p, side="right"), as filterpy's loops do), by one merge pass.
 template <class Positions>
 inline IndexVector merge_positions(const std::vector<double>& cdf, Index n_out, Positions pos) {
     const int last = static_cast<int>(cdf.size()) - 1;
@@ -41,7 +41,7 @@ inline IndexVector merge_positions(const std::vector<double>& cdf, Index n_out, 
     int j = 0;
     for (Index i = 0; i < n_out; ++i) {
         const double p = pos(i);
-        while (j < last && cdf[static_cast<size_t>(j)] < p) ++j;
+        while (j < last && cdf[static_cast<size_t>(j)] <= p) ++j;
         idx(i) = j;
     }
     return idx;
@@ -54,8 +54,8 @@ inline IndexVector systematic_resample(const Eigen::Ref<const Eigen::VectorXd>& 
     require(u0 >= 0.0 && u0 < 1.0, fn, "u0", u0, "in [0, 1)");
     const auto cdf = normalised_cdf(weights, sum);
     const Index n = weights.size();
-    const double inv = 1.0 / static_cast<double>(n);
-    return merge_positions(cdf, n, [&](Index i) { return (static_cast<double>(i) + u0) * inv; });
+    const double dn = static_cast<double>(n);
+    return merge_positions(cdf, n, [&](Index i) { return (static_cast<double>(i) + u0) / dn; });
 }
 
 /// Stratified resampling: positions (i + u_i) / N, one draw per stratum.
@@ -66,8 +66,8 @@ inline IndexVector stratified_resample(const Eigen::Ref<const Eigen::VectorXd>& 
     const Index n = weights.size();
     check_uniforms(u, n, fn);
     const auto cdf = normalised_cdf(weights, sum);
-    const double inv = 1.0 / static_cast<double>(n);
-    return merge_positions(cdf, n, [&](Index i) { return (static_cast<double>(i) + u(i)) * inv; });
+    const double dn = static_cast<double>(n);
+    return merge_positions(cdf, n, [&](Index i) { return (static_cast<double>(i) + u(i)) / dn; });
 }
 
 /// Index of the first cdf value >= p (binary search), clamped to N-1.

@@ -1,0 +1,41 @@
+"""Colour particle filters and their building blocks (resampling, dynamics, likelihood)."""
+
+from __future__ import annotations
+
+from pftrack.particle_filter.colour import (
+    BinnedImage,
+    HsvBinning,
+    bhattacharyya_coefficient,
+    bhattacharyya_distance,
+    bhattacharyya_weights,
+    box_histograms,
+    hsv_bins,
+)
+from pftrack.particle_filter.dynamics import Ar2Model, estimate, propagate
+from pftrack.particle_filter.filter import ColourParticleFilter, FilterConfig, FilterState
+from pftrack.particle_filter.resample import (
+    multinomial_resample,
+    residual_resample,
+    stratified_resample,
+    systematic_resample,
+)
+
+__all__ = [
+    "Ar2Model",
+    "BinnedImage",
+    "ColourParticleFilter",
+    "FilterConfig",
+    "FilterState",
+    "HsvBinning",
+    "bhattacharyya_coefficient",
+    "bhattacharyya_distance",
+    "bhattacharyya_weights",
+    "box_histograms",
+    "estimate",
+    "hsv_bins",
+    "multinomial_resample",
+    "propagate",
+    "residual_resample",
+    "stratified_resample",
+    "systematic_resample",
+]

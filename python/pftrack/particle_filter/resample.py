@@ -1,0 +1,132 @@
+"""Resampling schemes, drop-in replacements for ``filterpy.monte_carlo``.
+
+Each takes weights and returns the indices of the particles kept, like filterpy's functions of
+the same names, plus an explicit `rng`. Unlike filterpy, weights need not sum to 1, and round-off
+can never produce an index >= N (the CDF's last value is set to 1 and indices are clamped).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pftrack import _core
+from pftrack._typing import RngLike
+
+__all__ = [
+    "multinomial_resample",
+    "residual_resample",
+    "stratified_resample",
+    "systematic_resample",
+]
+
+
+def _weights(weights: ArrayLike) -> NDArray[np.float64]:
+    w = np.asarray(weights)
+    if w.dtype == object or not (np.issubdtype(w.dtype, np.number) or w.dtype == bool):
+        raise TypeError(f"weights must be numeric, got dtype {w.dtype}")
+    if w.ndim != 1:
+        raise ValueError(f"weights must be 1-D (N,), got shape {w.shape}")
+    return np.ascontiguousarray(w, dtype=np.float64)
+
+
+def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+    """Indices of the particles kept by systematic resampling.
+
+    One uniform offset ``u0`` places N evenly spaced positions ``(i + u0) / N`` on the CDF;
+    particle i is copied ``floor(N w_i)`` or ``ceil(N w_i)`` times. The lowest-variance scheme
+    and the default in pftrack.
+
+    Parameters
+    ----------
+    weights : (N,) array_like of float
+        Non-negative particle weights; need not sum to 1.
+    rng : numpy.random.Generator, int or None
+        Source of the single uniform offset.
+
+    Returns
+    -------
+    (N,) ndarray of int32
+        Sorted indices into the particle array.
+
+    References
+    ----------
+    .. [1] Kitagawa, G. (1996). Monte Carlo filter and smoother for non-Gaussian nonlinear
+       state space models. Journal of Computational and Graphical Statistics 5(1), 1-25.
+    """
+    w = _weights(weights)
+    return _core.systematic_resample(w, np.random.default_rng(rng).random())
+
+
+def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+    """Indices kept by stratified resampling: one uniform draw in each of N equal strata.
+
+    Parameters
+    ----------
+    weights : (N,) array_like of float
+        Non-negative particle weights; need not sum to 1.
+    rng : numpy.random.Generator, int or None
+        Source of the N uniform draws.
+
+    Returns
+    -------
+    (N,) ndarray of int32
+
+    References
+    ----------
+    .. [1] Douc, R., Cappé, O. & Moulines, E. (2005). Comparison of resampling schemes for
+       particle filtering. ISPA 2005, 64-69.
+    """
+    w = _weights(weights)
+    return _core.stratified_resample(w, np.random.default_rng(rng).random(len(w)))
+
+
+def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+    """Indices kept by multinomial resampling: N independent draws from the weights.
+
+    The indices come in the order of the draws (as in filterpy), not sorted.
+
+    Parameters
+    ----------
+    weights : (N,) array_like of float
+        Non-negative particle weights; need not sum to 1.
+    rng : numpy.random.Generator, int or None
+        Source of the N uniform draws.
+
+    Returns
+    -------
+    (N,) ndarray of int32
+
+    References
+    ----------
+    .. [1] Gordon, N., Salmond, D. & Smith, A. (1993). Novel approach to nonlinear/non-Gaussian
+       Bayesian state estimation. IEE Proceedings F 140(2), 107-113.
+    """
+    w = _weights(weights)
+    return _core.multinomial_resample(w, np.random.default_rng(rng).random(len(w)))
+
+
+def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+    """Indices kept by residual resampling.
+
+    ``floor(N w_i)`` copies of each particle, then the remaining ``R`` drawn multinomially from
+    the residuals ``N w_i - floor(N w_i)``.
+
+    Parameters
+    ----------
+    weights : (N,) array_like of float
+        Non-negative particle weights; need not sum to 1.
+    rng : numpy.random.Generator, int or None
+        Source of the uniform draws for the residual part.
+
+    Returns
+    -------
+    (N,) ndarray of int32
+
+    References
+    ----------
+    .. [1] Liu, J. S. & Chen, R. (1998). Sequential Monte Carlo methods for dynamic systems.
+       JASA 93(443), 1032-1044.
+    """
+    w = _weights(weights)
+    return _core.residual_resample(w, np.random.default_rng(rng).random(len(w)))

@@ -1,0 +1,30 @@
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+DATA = Path(os.environ.get("PFTRACK_DATA", Path(__file__).resolve().parents[1].parent / "shared" / "data"))
+
+
+def dataset(name: str) -> Path:
+    """Folder of a real sequence in ../shared/data, or skip the test."""
+    folder = DATA / name
+    if not folder.is_dir():
+        pytest.skip(f"dataset {name} not found at {folder}")
+    return folder
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(12345)
+
+
+@pytest.fixture
+def textured_frame(rng: np.random.Generator) -> np.ndarray:
+    frame = rng.integers(0, 256, (72, 96, 3), dtype=np.uint8)
+    frame[10:40, 20:40] = (30, 40, 200)  # a red block (BGR)
+    frame[40:70, 50:80] = (200, 120, 20)  # a blue block
+    return frame

@@ -1,0 +1,148 @@
+"""hsv_bins, box_histograms and the Bhattacharyya kernels against tests/reference.py."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+
+from pftrack import _core
+from pftrack.particle_filter import (
+    HsvBinning,
+    bhattacharyya_coefficient,
+    bhattacharyya_distance,
+    bhattacharyya_weights,
+    box_histograms,
+    hsv_bins,
+)
+from tests import reference as ref
+
+frames = hnp.arrays(
+    np.uint8,
+    st.tuples(st.integers(1, 24), st.integers(1, 24), st.just(3)),
+    elements=st.integers(0, 255),
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(frames, st.integers(1, 16), st.integers(1, 16), st.integers(1, 16),
+       st.floats(0, 1), st.floats(0, 1))  # fmt: skip
+def test_hsv_bins_matches_reference(frame, n_h, n_s, n_v, s_min, v_min):
+    binning = HsvBinning(n_h, n_s, n_v, s_min, v_min)
+    got = hsv_bins(frame, binning=binning)
+    assert got.n_bins == n_h * n_s + n_v
+    np.testing.assert_array_equal(got.bins, ref.hsv_bins(frame, None, n_h, n_s, n_v, s_min, v_min))
+
+
+def test_hsv_bins_every_colour_cube_corner():
+    # All 256^3 colours would be slow; a 1/5-stride lattice covers every hue sector and edge.
+    v = np.arange(0, 256, 5, dtype=np.uint8)
+    b, g, r = np.meshgrid(v, v, v, indexing="ij")
+    frame = np.stack([b, g, r], axis=-1).reshape(-1, len(v), 3)
+    np.testing.assert_array_equal(hsv_bins(frame).bins, ref.hsv_bins(frame))
+
+
+def test_hsv_bins_mask_marks_background(textured_frame, rng):
+    mask = (rng.random(textured_frame.shape[:2]) > 0.5).astype(np.uint8)
+    got = hsv_bins(textured_frame, mask).bins
+    np.testing.assert_array_equal(got, ref.hsv_bins(textured_frame, mask))
+    assert np.all(got[mask == 0] == -1) and np.all(got[mask == 1] >= 0)
+    np.testing.assert_array_equal(hsv_bins(textured_frame, mask.astype(bool)).bins, got)
+
+
+def test_hsv_bins_of_a_strided_view(textured_frame):
+    view = textured_frame[5:50, 10:70]  # rows strided, pixels packed
+    np.testing.assert_array_equal(hsv_bins(view).bins, ref.hsv_bins(view))
+    flipped = textured_frame[:, ::-1]  # pixels not packed: copied once by the wrapper
+    np.testing.assert_array_equal(hsv_bins(flipped).bins, ref.hsv_bins(flipped))
+
+
+def test_pure_colours_land_in_expected_bins():
+    frame = np.array([[[0, 0, 255], [0, 255, 0], [255, 0, 0], [0, 0, 0], [255, 255, 255]]],
+                     dtype=np.uint8)  # fmt: skip
+    bins = hsv_bins(frame).bins[0]
+    # red: hue 0 -> h bin 0, s = 1 -> s bin 9; green: 120 deg -> 3; blue: 240 deg -> 6
+    assert bins.tolist() == [9, 39, 69, 100, 109]
+
+
+def _frame():
+    rng = np.random.default_rng(5)
+    frame = rng.integers(0, 256, (72, 96, 3), dtype=np.uint8)
+    frame[10:40, 20:40] = (30, 40, 200)
+    return frame
+
+
+boxes = st.lists(
+    st.tuples(st.floats(-20, 120), st.floats(-20, 100), st.floats(0, 60), st.floats(0, 60)),
+    min_size=1, max_size=8,
+)  # fmt: skip
+
+
+@settings(max_examples=60, deadline=None)
+@given(boxes, st.sampled_from(["uniform", "epanechnikov"]), st.booleans())
+def test_box_histograms_match_reference(box_list, kernel, masked):
+    textured_frame = _frame()
+    mask = None
+    if masked:
+        mask = np.zeros(textured_frame.shape[:2], np.uint8)
+        mask[10:60, 15:70] = 1
+    image = hsv_bins(textured_frame, mask)
+    b = np.array(box_list)
+    got = box_histograms(image, b, kernel)
+    want = ref.box_histograms(image.bins, image.n_bins, b, kernel)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+    sums = got.sum(axis=1)
+    assert np.all(np.isclose(sums, 1.0) | (sums == 0.0))
+
+
+def test_empty_box_gives_zero_histogram_and_distance_one(textured_frame):
+    image = hsv_bins(textured_frame)
+    h = box_histograms(image, [[-500, -500, 20, 50], [40, 30, 0, 0]])
+    assert np.all(h == 0)
+    r = h[0] + 1.0
+    np.testing.assert_array_equal(bhattacharyya_coefficient(h, r), [0.0, 0.0])
+    np.testing.assert_array_equal(bhattacharyya_distance(h, r), [1.0, 1.0])
+
+
+def test_box_fully_in_background_is_empty(textured_frame):
+    mask = np.zeros(textured_frame.shape[:2], np.uint8)
+    mask[:, :10] = 1
+    image = hsv_bins(textured_frame, mask)
+    assert np.all(box_histograms(image, [[50, 40, 20, 20]]) == 0)
+    assert box_histograms(image, [[5, 40, 20, 20]]).sum() == pytest.approx(1.0)
+
+
+def test_bhattacharyya_kernels_match_reference(rng):
+    hists = rng.random((30, 110))
+    hists /= hists.sum(axis=1, keepdims=True)
+    r = rng.random(110) * 3  # unnormalised reference is normalised by the kernels
+    np.testing.assert_allclose(bhattacharyya_coefficient(hists, r), ref.bhattacharyya_coefficient(hists, r), rtol=1e-12)
+    np.testing.assert_allclose(bhattacharyya_distance(hists, r), ref.bhattacharyya_distance(hists, r), rtol=1e-10)
+    for lam in (0.0, 1.0, 20.0, 1e4):
+        w = bhattacharyya_weights(hists, r, lam)
+        np.testing.assert_allclose(w, ref.bhattacharyya_weights(hists, r, lam), rtol=1e-9, atol=1e-300)
+        assert w.sum() == pytest.approx(1.0)
+
+
+def test_weights_are_stable_for_huge_lambda(rng):
+    hists = rng.random((5, 10))
+    hists /= hists.sum(axis=1, keepdims=True)
+    w = bhattacharyya_weights(hists, hists[2], lam=1e8)  # exp(-1e8 D^2) underflows naively
+    assert np.all(np.isfinite(w)) and w[2] == pytest.approx(1.0)
+
+
+def test_identical_histogram_has_coefficient_one(textured_frame):
+    image = hsv_bins(textured_frame)
+    h = box_histograms(image, [[30, 25, 20, 30]])
+    assert bhattacharyya_coefficient(h, h[0])[0] == pytest.approx(1.0)
+    assert bhattacharyya_distance(h, h[0])[0] == pytest.approx(0.0, abs=1e-7)
+
+
+def test_binned_image_from_user_array():
+    bins = np.array([[0, 1, -1], [2, 2, 2]], dtype=np.int16)
+    image = _core.BinnedImage(bins, 3)
+    np.testing.assert_array_equal(image.bins, bins)
+    assert not image.bins.flags.writeable
+    np.testing.assert_allclose(box_histograms(image, [[1, 1, 4, 4]])[0], [1 / 5, 1 / 5, 3 / 5])

@@ -1,0 +1,138 @@
+"""Every bad input gives a ValueError/TypeError that names the problem (never a crash)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pftrack import _core
+from pftrack.particle_filter import (
+    Ar2Model,
+    ColourParticleFilter,
+    FilterConfig,
+    HsvBinning,
+    bhattacharyya_weights,
+    box_histograms,
+    hsv_bins,
+    multinomial_resample,
+    propagate,
+    residual_resample,
+    stratified_resample,
+    systematic_resample,
+)
+
+RESAMPLERS = [systematic_resample, stratified_resample, multinomial_resample, residual_resample]
+
+
+@pytest.mark.parametrize("fn", RESAMPLERS)
+@pytest.mark.parametrize(
+    ("weights", "match"),
+    [
+        ([], "weights is empty"),
+        ([0.5, -0.1], r"weights\[1\] is -0.1"),
+        ([0.5, np.nan], r"weights\[1\] is nan"),
+        ([0.5, np.inf], r"weights\[1\] is inf"),
+        ([0.0, 0.0], "sum to 0"),
+        ([[0.5, 0.5]], "1-D"),
+    ],
+)
+def test_resample_bad_weights(fn, weights, match):
+    with pytest.raises(ValueError, match=match):
+        fn(weights, rng=0)
+
+
+def test_resample_wrong_type():
+    with pytest.raises(TypeError, match="numeric"):
+        systematic_resample(["a", "b"])
+
+
+def test_core_u0_range():
+    with pytest.raises(ValueError, match="u0 is 1"):
+        _core.systematic_resample(np.ones(3), 1.0)
+    with pytest.raises(ValueError, match="u size is 2, expected at least N"):
+        _core.stratified_resample(np.ones(3), np.zeros(2))
+
+
+def test_hsv_bins_bad_frames():
+    with pytest.raises(TypeError, match="frame dtype is float64"):
+        hsv_bins(np.zeros((4, 4, 3)))
+    with pytest.raises(ValueError, match=r"shape \(H, W, 3\)"):
+        hsv_bins(np.zeros((4, 4), np.uint8))
+    with pytest.raises(ValueError, match="frame dtype is float32, expected uint8"):
+        _core.hsv_bins(np.zeros((4, 4, 3), np.float32))
+    with pytest.raises(ValueError, match="frame is empty"):
+        _core.hsv_bins(np.zeros((0, 4, 3), np.uint8))
+    with pytest.raises(ValueError, match="mask shape"):
+        hsv_bins(np.zeros((4, 4, 3), np.uint8), np.ones((4, 5), np.uint8))
+    with pytest.raises(ValueError, match="n_h is 0"):
+        hsv_bins(np.zeros((4, 4, 3), np.uint8), binning=HsvBinning(n_h=0))
+    with pytest.raises(ValueError, match="s_min is 2"):
+        hsv_bins(np.zeros((4, 4, 3), np.uint8), binning=HsvBinning(s_min=2.0))
+
+
+def test_box_histograms_bad_boxes():
+    image = hsv_bins(np.zeros((8, 8, 3), np.uint8))
+    with pytest.raises(ValueError, match=r"boxes\[1\] is \(1, 1, nan, 2\)"):
+        box_histograms(image, [[1, 1, 2, 2], [1, 1, np.nan, 2]])
+    with pytest.raises(ValueError, match="w, h >= 0"):
+        box_histograms(image, [[1, 1, -2, 2]])
+    with pytest.raises(ValueError, match="boxes cols is 3"):
+        box_histograms(image, [[1, 1, 2]])
+    with pytest.raises(ValueError, match="kernel is 'gauss'"):
+        box_histograms(image, [[1, 1, 2, 2]], kernel="gauss")
+
+
+def test_binned_image_rejects_out_of_range_bins():
+    with pytest.raises(ValueError, match="bins value is 7, expected in \\[-1, n_bins\\)"):
+        _core.BinnedImage(np.array([[0, 7]], np.int16), 5)
+    with pytest.raises(ValueError, match="bins value is -2"):
+        _core.BinnedImage(np.array([[0, -2]], np.int16), 5)
+
+
+def test_likelihood_bad_inputs():
+    h = np.full((2, 4), 0.25)
+    with pytest.raises(ValueError, match="ref size is 3, expected 4"):
+        bhattacharyya_weights(h, np.ones(3))
+    with pytest.raises(ValueError, match="ref sum to 0"):
+        bhattacharyya_weights(h, np.zeros(4))
+    with pytest.raises(ValueError, match=r"hists\[1, 2\] is nan"):
+        bad = h.copy()
+        bad[1, 2] = np.nan
+        bhattacharyya_weights(bad, np.ones(4))
+    with pytest.raises(ValueError, match="lambda is -1"):
+        bhattacharyya_weights(h, np.ones(4), lam=-1)
+
+
+def test_propagate_bad_inputs():
+    p = np.zeros((5, 6))
+    p[:, 2] = p[:, 5] = 1
+    with pytest.raises(ValueError, match="noise rows is 4, expected 5"):
+        propagate(p, np.zeros((4, 3)))
+    with pytest.raises(ValueError, match=r"particles has a non-finite value nan at \[0, 0\]"):
+        q = p.copy()
+        q[0, 0] = np.nan
+        propagate(q, np.zeros((5, 3)))
+    with pytest.raises(ValueError, match="C-contiguous"):
+        propagate(np.asfortranarray(p), np.zeros((5, 3)))
+    with pytest.raises(TypeError, match="float64"):
+        propagate(p.astype(np.float32), np.zeros((5, 3)))
+    with pytest.raises(ValueError, match="particles cols is 5"):
+        propagate(np.zeros((5, 5)), np.zeros((5, 3)))
+    with pytest.raises(ValueError, match="means are required"):
+        propagate(p, np.zeros((5, 3)), Ar2Model(use_means=True))
+    with pytest.raises(ValueError, match="sigma_xy is -1"):
+        Ar2Model(sigma_xy=-1)
+
+
+def test_filter_bad_inputs():
+    ref = np.ones(110)
+    with pytest.raises(ValueError, match="box is"):
+        ColourParticleFilter([0, 0, 0, 10], ref)
+    with pytest.raises(ValueError, match="reference histogram"):
+        ColourParticleFilter([5, 5, 10, 10], np.zeros(110))
+    with pytest.raises(ValueError, match="n_particles is 0"):
+        FilterConfig(n_particles=0)
+    f = ColourParticleFilter([5, 5, 4, 4], np.ones(7), rng=0)
+    image = hsv_bins(np.zeros((10, 10, 3), np.uint8))
+    with pytest.raises(ValueError, match="sis_step: ref size is 7, expected 110"):
+        f.step(image)

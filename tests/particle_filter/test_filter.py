@@ -1,0 +1,166 @@
+"""Propagation, estimates, the fused sis_step (against a NumPy composition of the same draws),
+determinism, threads, and a filter that actually tracks."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from pftrack import _core
+from pftrack.particle_filter import (
+    Ar2Model,
+    ColourParticleFilter,
+    FilterConfig,
+    box_histograms,
+    estimate,
+    hsv_bins,
+    propagate,
+)
+from tests import reference as ref
+
+
+def _particles(rng, n=64):
+    p = np.empty((n, 6))
+    p[:, :2] = rng.normal(40, 5, (n, 2))
+    p[:, 2] = rng.uniform(0.8, 1.2, n)
+    p[:, 3:5] = p[:, :2] - rng.normal(1, 1, (n, 2))
+    p[:, 5] = p[:, 2] * rng.uniform(0.95, 1.05, n)
+    return p
+
+
+@pytest.mark.parametrize("use_means", [False, True])
+def test_propagate_matches_reference(rng, use_means):
+    p = _particles(rng)
+    noise = rng.standard_normal((len(p), 3))
+    model = Ar2Model(sigma_xy=3.0, sigma_s=0.05, velocity_gain=0.7, scale_gain=1.0, s_min=0.9,
+                     s_max=1.1, use_means=use_means)  # fmt: skip
+    means = rng.normal(40, 2, (2, 3))
+    want = ref.propagate(p, noise, model.a, model.b, model.sigma, 0.9, 1.1, use_means, means[0], means[1])
+    propagate(p, noise, model, means)
+    np.testing.assert_array_equal(p, want)
+
+
+def test_constant_velocity_without_noise_moves_straight():
+    p = np.array([[10.0, 20.0, 1.0, 8.0, 21.0, 1.0]])
+    for _ in range(3):
+        propagate(p, np.zeros((1, 3)), Ar2Model())
+    np.testing.assert_allclose(p[0], [16.0, 17.0, 1.0, 14.0, 18.0, 1.0])
+
+
+def test_estimate_mean_and_map(rng):
+    p = _particles(rng, 10)
+    w = rng.random(10)
+    mean, map_ = estimate(p, w)
+    np.testing.assert_allclose(mean, (w / w.sum()) @ p[:, :3])
+    np.testing.assert_array_equal(map_, p[np.argmax(w), :3])
+
+
+@pytest.mark.parametrize("kernel", ["uniform", "epanechnikov"])
+@pytest.mark.parametrize("use_means", [False, True])
+def test_sis_step_matches_numpy_composition(textured_frame, rng, kernel, use_means):
+    mask = np.zeros(textured_frame.shape[:2], np.uint8)
+    mask[5:70, 10:90] = 1
+    image = hsv_bins(textured_frame, mask)
+    reference = box_histograms(image, [[30, 25, 20, 30]])[0] + 1e-3
+    p = _particles(rng)
+    w = rng.random(len(p))
+    means = rng.normal(40, 2, (2, 3))
+    model = Ar2Model(sigma_xy=2.0, sigma_s=0.03, use_means=use_means)
+    seed, step = 987654321, 5
+    u0 = _core.counter_uniforms(seed, step, 2**64 - 1, 1)[0]
+    normals = _core.counter_normals(seed, step, 3 * len(p)).reshape(-1, 3)
+    want_p, want_w, want_mean, _ = ref.sis_step(
+        p, w, means, image.bins, image.n_bins, reference, 20.0, 30.0, model.a, model.b,
+        model.sigma, model.s_min, model.s_max, use_means, 20.0, kernel, u0, normals,
+    )  # fmt: skip
+    m_before = means.copy()
+    out = _core.sis_step(p, w, means, image, reference, 20.0, 30.0, model.a, model.b, model.sigma,
+                         model.s_min, model.s_max, use_means, 20.0, kernel, True, seed, step)  # fmt: skip
+    np.testing.assert_allclose(p, want_p, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(w, want_w, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(out["mean"], want_mean, rtol=1e-12)
+    assert w[out["map_index"]] == pytest.approx(want_w.max(), rel=1e-9)
+    assert out["ess"] == pytest.approx(1 / np.sum(want_w**2), rel=1e-9)
+    np.testing.assert_allclose(means[0], want_mean, rtol=1e-12)
+    np.testing.assert_array_equal(means[1], m_before[0])
+
+
+def test_counter_normals_are_standard_normal():
+    z = _core.counter_normals(1, 2, 200_000)
+    assert abs(z.mean()) < 0.01 and abs(z.std() - 1) < 0.01
+    u = _core.counter_uniforms(3, 4, 0, 200_000)
+    assert u.min() >= 0 and u.max() < 1 and abs(u.mean() - 0.5) < 0.005
+
+
+def _scene(shift=0):
+    rng = np.random.default_rng(0)
+    frame = rng.integers(60, 120, (120, 160, 3), dtype=np.uint8)
+    frame[40:80, 50 + shift:70 + shift] = (20, 20, 220)  # red walker
+    frame[60:80, 50 + shift:70 + shift] = (200, 60, 20)  # blue trousers
+    return frame
+
+
+def test_filter_follows_a_moving_object():
+    frame0 = _scene()
+    image0 = hsv_bins(frame0)
+    reference = box_histograms(image0, [[60, 60, 20, 40]])[0]
+    f = ColourParticleFilter([60, 60, 20, 40], reference, FilterConfig(n_particles=200), rng=1)
+    for t in range(1, 16):
+        state = f.step(hsv_bins(_scene(shift=2 * t)))
+    assert abs(state.box_cxcywh[0] - (60 + 30)) < 4
+    assert abs(state.box_cxcywh[1] - 60) < 4
+    assert state.rho > 0.8
+
+
+def test_same_seed_same_result_and_different_seed_differs():
+    image = hsv_bins(_scene(4))
+    reference = box_histograms(hsv_bins(_scene()), [[60, 60, 20, 40]])[0]
+
+    def run(seed):
+        f = ColourParticleFilter([60, 60, 20, 40], reference, rng=seed)
+        return np.array([f.step(image).box_cxcywh for _ in range(5)]), f.particles.copy()
+
+    a, pa = run(3)
+    b, pb = run(3)
+    c, _ = run(4)
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(pa, pb)
+    assert not np.array_equal(a, c)
+
+
+def test_four_threads_equal_serial():
+    """The kernels release the GIL; results from 4 concurrent threads equal the serial ones."""
+    frames = [hsv_bins(_scene(s)) for s in range(0, 40, 2)]
+    reference = box_histograms(frames[0], [[60, 60, 20, 40]])[0]
+
+    def run(seed, out, k):
+        f = ColourParticleFilter([60, 60, 20, 40], reference, FilterConfig(n_particles=300), rng=seed)
+        out[k] = np.array([f.step(img).box_cxcywh for img in frames])
+
+    serial = [None] * 8
+    for k in range(8):
+        run(k, serial, k)
+    threaded = [None] * 8
+    threads = [threading.Thread(target=run, args=(k, threaded, k)) for k in range(8)]
+    for t in threads[:4]:
+        t.start()
+    for t in threads[:4]:
+        t.join()
+    for t in threads[4:]:
+        t.start()
+    for t in threads[4:]:
+        t.join()
+    for s, t in zip(serial, threaded):
+        np.testing.assert_array_equal(s, t)
+
+
+def test_filter_survives_an_empty_frame_region():
+    """All particles outside the image: weights stay finite (all equal), no error."""
+    image = hsv_bins(_scene())
+    reference = np.ones(image.n_bins)
+    f = ColourParticleFilter([-500, -500, 20, 40], reference, rng=0)
+    s = f.step(image)
+    assert np.isfinite(s.box_cxcywh).all() and s.rho == 0.0
+    assert np.allclose(f.weights, 1 / len(f.weights))
