@@ -61,6 +61,26 @@ public:
 
 private:
     double uniform(const BinImage& img, const PixelRange& r, double* out) {
+        const std::int64_t total = count(img, r);
+        if (total == 0) return 0.0;
+        const double inv = 1.0 / static_cast<double>(total);
+        const std::int32_t* c = counts_.data() + 1;
+        for (int k = 0; k < n_bins_; ++k) out[k] = static_cast<double>(c[k]) * inv;
+        return static_cast<double>(total);
+    }
+
+public:
+    /// Counts the box's pixels per bin (uniform kernel) into counts(); returns the total counted.
+    std::int64_t count_box(const BinImage& img, double cx, double cy, double w, double h) {
+        const PixelRange r = box_pixels(cx, cy, w, h, img.rows, img.cols);
+        if (r.empty()) return 0;
+        return count(img, r);
+    }
+    /// Per-bin counts of the last count_box (n_bins values).
+    const std::int32_t* counts() const { return counts_.data() + 1; }
+
+private:
+    std::int64_t count(const BinImage& img, const PixelRange& r) {
         std::fill(counts_.begin(), counts_.end(), 0);
         std::int32_t* c0 = counts_.data() + 1;  // +1: bin -1 lands in slot 0
         std::int32_t* c1 = c0 + stride_;
@@ -79,14 +99,10 @@ private:
         }
         std::int64_t total = 0;
         for (int k = 0; k < n_bins_; ++k) {
-            const std::int64_t n = std::int64_t(c0[k]) + c1[k] + c2[k] + c3[k];
-            total += n;
-            out[k] = static_cast<double>(n);
+            c0[k] += c1[k] + c2[k] + c3[k];
+            total += c0[k];
         }
-        if (total == 0) return 0.0;
-        const double inv = 1.0 / static_cast<double>(total);
-        for (int k = 0; k < n_bins_; ++k) out[k] *= inv;
-        return static_cast<double>(total);
+        return total;
     }
 
     // Epanechnikov profile k(r^2) = max(0, 1 - r^2), r^2 = ((x-cx)/(w/2))^2 + ((y-cy)/(h/2))^2.

@@ -1,0 +1,123 @@
+"""Kernel speed: the C++ core against the NumPy baselines (and filterpy) in the same groups.
+
+Run: pytest bench --benchmark-only --benchmark-group-by=group --benchmark-columns=mean,median,ops
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bench import numpy_baselines as npb
+from pftrack import _core
+from pftrack.particle_filter import box_histograms, hsv_bins
+
+
+def _boxes(rng, n_objects, n_particles, w, h, frame_shape):
+    rows, cols = frame_shape[:2]
+    centres = rng.uniform([w, h], [cols - w, rows - h], (n_objects, 2))
+    out = []
+    for c in centres:
+        p = np.empty((n_particles, 4))
+        p[:, :2] = c + rng.normal(0, 4, (n_particles, 2))
+        p[:, 2:] = (w, h)
+        out.append(p)
+    return np.vstack(out)
+
+
+CASES = {
+    "480x360 10x200 20x50": ("frame_480", 10, 200, 20, 50),
+    "480x360 1x10000 20x50": ("frame_480", 1, 10000, 20, 50),
+    "1280x720 10x200 60x150": ("frame_720", 10, 200, 60, 150),
+    "1280x720 1x10000 60x150": ("frame_720", 1, 10000, 60, 150),
+}
+
+
+@pytest.fixture(params=list(CASES), scope="module")
+def case(request):
+    name = request.param
+    fixture, n_obj, n_part, w, h = CASES[name]
+    frame = request.getfixturevalue(fixture)
+    rng = np.random.default_rng(1)
+    image = hsv_bins(frame)
+    boxes = _boxes(rng, n_obj, n_part, w, h, frame.shape)
+    ref = box_histograms(image, boxes[:1])[0] + 1e-6
+    return name, image, boxes, ref, n_part * n_obj * w * h
+
+
+def _core_hist_weights(image, boxes, ref):
+    return _core.bhattacharyya_weights(_core.box_histograms(image, boxes, "uniform"), ref, 20.0)
+
+
+def test_histograms_weights_core(benchmark, case):
+    name, image, boxes, ref, pixels = case
+    benchmark.group = f"histograms+weights {name}"
+    benchmark.extra_info["pixels"] = pixels
+    w = benchmark(_core_hist_weights, image, boxes, ref)
+    np.testing.assert_allclose(w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300)
+
+
+def test_histograms_weights_numpy(benchmark, case):
+    name, image, boxes, ref, pixels = case
+    benchmark.group = f"histograms+weights {name}"
+    if len(boxes) > 2000:
+        benchmark.pedantic(npb.histograms_and_weights, args=(image.bins, image.n_bins, boxes, ref), rounds=2, iterations=1)
+    else:
+        benchmark(npb.histograms_and_weights, image.bins, image.n_bins, boxes, ref)
+    benchmark.group = f"histograms+weights {name}"
+    benchmark.extra_info["pixels"] = pixels
+
+
+@pytest.mark.parametrize("size", ["frame_480", "frame_720"])
+def test_hsv_bins_core(benchmark, request, size):
+    frame = request.getfixturevalue(size)
+    benchmark.group = f"hsv bins {frame.shape[1]}x{frame.shape[0]}"
+    benchmark(_core.hsv_bins, frame)
+
+
+@pytest.mark.parametrize("size", ["frame_480", "frame_720"])
+def test_hsv_bins_opencv_numpy(benchmark, request, size):
+    frame = request.getfixturevalue(size)
+    benchmark.group = f"hsv bins {frame.shape[1]}x{frame.shape[0]}"
+    benchmark(npb.hsv_bins, frame)
+
+
+@pytest.fixture(scope="module")
+def weights_10k():
+    w = np.random.default_rng(2).random(10_000)
+    return w / w.sum()
+
+
+@pytest.mark.benchmark(group="systematic resample N=10000")
+def test_resample_core(benchmark, weights_10k):
+    benchmark(_core.systematic_resample, weights_10k, 0.37)
+
+
+@pytest.mark.benchmark(group="systematic resample N=10000")
+def test_resample_numpy(benchmark, weights_10k):
+    benchmark(npb.systematic_resample, weights_10k, 0.37)
+
+
+@pytest.mark.benchmark(group="systematic resample N=10000")
+def test_resample_filterpy(benchmark, weights_10k):
+    mc = pytest.importorskip("filterpy.monte_carlo")
+    benchmark(mc.systematic_resample, weights_10k)
+
+
+@pytest.mark.benchmark(group="sis_step 10 objects x 200 particles, 20x50, 480x360")
+def test_sis_step_10x200(benchmark, frame_480):
+    from pftrack.particle_filter import ColourParticleFilter, FilterConfig
+
+    image = hsv_bins(frame_480)
+    rng = np.random.default_rng(3)
+    boxes = _boxes(rng, 10, 1, 20, 50, frame_480.shape)
+    filters = [
+        ColourParticleFilter(b, box_histograms(image, [b])[0] + 1e-6, FilterConfig(n_particles=200), rng=k)
+        for k, b in enumerate(boxes)
+    ]
+
+    def frame_step():
+        for f in filters:
+            f.step(image)
+
+    benchmark(frame_step)
