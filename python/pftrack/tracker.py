@@ -1,0 +1,481 @@
+"""Multi-object tracking with one colour particle filter per object (the first paper's method).
+
+Each frame: detections come from the built-in background-subtraction detector or from any
+detector the caller runs; every live track advances its own SIS colour particle filter on the
+frame (foreground pixels only when a foreground mask is known); tracks and detections are paired
+by the Hungarian method over overlap, centre distance and colour similarity; a matched track's
+particles are re-seeded around its detection; a track without a detection goes on from its
+particle filter alone (through merged blobs and occlusions) for ``max_coast`` frames, then ends;
+a detection no track explains starts a new track whose reference histogram is taken from it.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linear_sum_assignment
+
+from pftrack._typing import RngLike
+from pftrack.particle_filter import (
+    Ar2Model,
+    ColourParticleFilter,
+    FilterConfig,
+    HsvBinning,
+    bhattacharyya_coefficient,
+    box_histograms,
+    hsv_bins,
+)
+
+__all__ = ["MultiObjectTracker", "Track", "TrackerConfig", "iou_matrix"]
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """Configuration of :class:`MultiObjectTracker` (defaults are rules, not per-sequence tuning).
+
+    Attributes
+    ----------
+    filter : FilterConfig
+        Particles per object, AR(2) dynamics (eq. 7, or eq. 8 with ``use_means``), λ.
+    binning : HsvBinning
+        HSV histogram layout (110 bins by default).
+    sampler : {"sis"}
+        The per-object sampler ("mh" and "rjmcmc" are the paper's comparison samplers).
+    detector : {"paper", "mog2", "knn"}
+        Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections.
+    max_coast : int
+        Frames a track goes on from its particle filter alone before it ends.
+    min_hits : int
+        Matched frames before a new track is reported (tracks born in the first `min_hits`
+        frames are reported at once).
+    min_score : float
+        Detections with a lower score are ignored.
+    match_iou : float
+        Minimum overlap (IoU) for a track-detection pair, unless the centres are close.
+    match_distance : float
+        Maximum centre distance of a pair, in track heights (grows with the time coasted).
+    colour_weight : float
+        Weight of colour dissimilarity ``1 - rho`` in the association cost.
+    reference_rate : float
+        How fast a reference histogram adapts to a matched detection (0 keeps the first one).
+    merge_ratio : float
+        A detection this many times larger than a track is a merged blob: it does not re-seed
+        the track's particles (the colour filter carries the track through the merge).
+    coast_min_rho : float
+        A coasting track is reported only while its colour match ``rho`` stays above this.
+    refine_boxes : bool
+        With external detections, also run the background model and shrink each detection box
+        to the rows and columns where its foreground is (static cameras: detector boxes are
+        often loose). A box with too little foreground is left as it is.
+    refine_fraction : float
+        A row or column belongs to the object when its foreground fraction exceeds this share of
+        the box's densest row or column.
+    """
+
+    filter: FilterConfig = field(
+        default_factory=lambda: FilterConfig(
+            n_particles=100, model=Ar2Model(sigma_xy=3.0, sigma_s=0.02, velocity_gain=0.5, scale_gain=0.0)
+        )
+    )
+    binning: HsvBinning = field(default_factory=HsvBinning)
+    sampler: str = "sis"
+    detector: str = "paper"
+    max_coast: int = 20
+    min_hits: int = 2
+    min_score: float = 0.0
+    match_iou: float = 0.1
+    match_distance: float = 0.6
+    colour_weight: float = 0.5
+    reference_rate: float = 0.05
+    merge_ratio: float = 1.8
+    coast_min_rho: float = 0.5
+    refine_boxes: bool = True
+    refine_fraction: float = 0.1
+
+    def __post_init__(self) -> None:
+        if self.sampler not in ("sis", "mh", "rjmcmc"):
+            raise ValueError(f"sampler is {self.sampler!r}, expected 'sis', 'mh' or 'rjmcmc'")
+        if self.detector not in ("paper", "mog2", "knn"):
+            raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
+        for name in ("max_coast", "min_hits"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, np.integer)) or v < 0:
+                raise ValueError(f"{name} is {v!r}, expected an integer >= 0")
+        for name in ("match_iou", "reference_rate", "coast_min_rho"):
+            v = getattr(self, name)
+            if not 0.0 <= v <= 1.0:
+                raise ValueError(f"{name} is {v}, expected a value in [0, 1]")
+
+
+@dataclass(frozen=True)
+class Track:
+    """A track as reported for one frame.
+
+    Attributes
+    ----------
+    id : int
+        Identity, unique within one tracker (from 1).
+    box_xywh : (4,) ndarray
+        Left, top, width, height in pixels.
+    score : float
+        Confidence: the matched detection's score, or the colour match ``rho`` when coasting.
+    detection_index : int or None
+        Index of the detection (in the order given to :meth:`~MultiObjectTracker.update`)
+        matched to this track, or None when it was carried by its particle filter alone.
+    age : int
+        Frames since birth.
+    time_since_update : int
+        Frames since the last matched detection (0 when matched this frame).
+    """
+
+    id: int
+    box_xywh: NDArray[np.float64]
+    score: float
+    detection_index: Optional[int]
+    age: int
+    time_since_update: int
+
+
+def iou_matrix(a_xywh: ArrayLike, b_xywh: ArrayLike) -> NDArray[np.float64]:
+    """Intersection over union of every box in `a` (M, 4) with every box in `b` (K, 4)."""
+    a = np.asarray(a_xywh, dtype=np.float64).reshape(-1, 4)
+    b = np.asarray(b_xywh, dtype=np.float64).reshape(-1, 4)
+    ax1, ay1 = a[:, 0:1], a[:, 1:2]
+    ax2, ay2 = ax1 + a[:, 2:3], ay1 + a[:, 3:4]
+    bx1, by1 = b[:, 0], b[:, 1]
+    bx2, by2 = bx1 + b[:, 2], by1 + b[:, 3]
+    iw = np.clip(np.minimum(ax2, bx2) - np.maximum(ax1, bx1), 0, None)
+    ih = np.clip(np.minimum(ay2, by2) - np.maximum(ay1, by1), 0, None)
+    inter = iw * ih
+    union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
+    return np.where(union > 0, inter / np.maximum(union, 1e-12), 0.0)
+
+
+def refine_boxes(boxes_xywh: NDArray[np.float64], mask: NDArray[np.uint8], fraction: float = 0.1,
+                 min_cover: float = 0.1) -> NDArray[np.float64]:  # fmt: skip
+    """Shrink boxes to the extent of their foreground.
+
+    Parameters
+    ----------
+    boxes_xywh : (K, 4) ndarray
+        Boxes (left, top, width, height).
+    mask : (H, W) ndarray of uint8
+        Foreground mask (non-zero = foreground).
+    fraction : float
+        Rows and columns whose foreground share is above ``fraction`` times the densest row or
+        column's are kept; the new box spans the first to the last kept one.
+    min_cover : float
+        Boxes whose foreground covers less than this share are returned unchanged (the
+        background model has not seen the object move, or it is not there).
+
+    Returns
+    -------
+    (K, 4) ndarray
+        Refined boxes.
+    """
+    out = np.array(boxes_xywh, dtype=np.float64, copy=True).reshape(-1, 4)
+    rows, cols = mask.shape
+    for k, (x, y, w, h) in enumerate(out):
+        x0, x1 = int(max(0, np.floor(x))), int(min(cols, np.ceil(x + w)))
+        y0, y1 = int(max(0, np.floor(y))), int(min(rows, np.ceil(y + h)))
+        if x1 - x0 < 3 or y1 - y0 < 3:
+            continue
+        patch = mask[y0:y1, x0:x1] > 0
+        if patch.mean() < min_cover:
+            continue
+        col, row = patch.mean(axis=0), patch.mean(axis=1)
+        cs = np.flatnonzero(col > fraction * col.max())
+        rs = np.flatnonzero(row > fraction * row.max())
+        out[k] = (x0 + cs[0], y0 + rs[0], cs[-1] + 1 - cs[0], rs[-1] + 1 - rs[0])
+    return out
+
+
+def _xywh_to_cxcywh(b: NDArray[np.float64]) -> NDArray[np.float64]:
+    b = np.asarray(b, dtype=np.float64)
+    return np.concatenate([b[..., :2] + b[..., 2:] / 2, b[..., 2:]], axis=-1)
+
+
+def _cxcywh_to_xywh(b: NDArray[np.float64]) -> NDArray[np.float64]:
+    b = np.asarray(b, dtype=np.float64)
+    return np.concatenate([b[..., :2] - b[..., 2:] / 2, b[..., 2:]], axis=-1)
+
+
+class _TrackState:
+    """A live track: its particle filter and bookkeeping (internal)."""
+
+    def __init__(self, track_id: int, box_xywh: NDArray[np.float64], reference: NDArray[np.float64],
+                 config: TrackerConfig, seed: int, score: float) -> None:  # fmt: skip
+        self.id = track_id
+        self.filter = ColourParticleFilter(_xywh_to_cxcywh(box_xywh), reference, config.filter, rng=seed)
+        self.box = box_xywh.copy()
+        self.size = box_xywh[2:].copy()  # smoothed detection size
+        self.velocity = np.zeros(2)
+        self.last_centre = box_xywh[:2] + box_xywh[2:] / 2
+        self.hits = 1
+        self.age = 1
+        self.time_since_update = 0
+        self.score = score
+        self.rho = 1.0
+        self.det_index: int | None = None
+        self.frames_since_det = 0
+
+
+class MultiObjectTracker:
+    """Track many objects with one colour particle filter each.
+
+    Parameters
+    ----------
+    config : TrackerConfig
+        All settings.
+    rng : numpy.random.Generator, int or None
+        Seed: the same seed and input give the same tracks.
+    detector : object, optional
+        Any object with ``detect(frame) -> Detections`` (see :mod:`pftrack.detection`); by
+        default the one named by ``config.detector``, created on first use.
+
+    Examples
+    --------
+    >>> tracker = MultiObjectTracker(rng=0)                       # doctest: +SKIP
+    >>> for frame in frames:                                       # doctest: +SKIP
+    ...     for t in tracker.update(frame, detections=boxes_xywh_score):
+    ...         print(t.id, t.box_xywh)
+    """
+
+    def __init__(self, config: TrackerConfig = TrackerConfig(), rng: RngLike = None,
+                 detector: Any = None) -> None:  # fmt: skip
+        self.config = config
+        self._rng = np.random.default_rng(rng)
+        self._ids = itertools.count(1)
+        self._detector = detector
+        self.tracks: list[_TrackState] = []
+        self.frame_index = 0
+        self.last_mask: NDArray[np.uint8] | None = None
+
+    # -- detections -------------------------------------------------------------------------
+    def _detect(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64], Any]:
+        if self._detector is None:
+            from pftrack.detection import make_detector
+
+            self._detector = make_detector(self.config.detector)
+        det = self._detector.detect(frame)
+        self.last_mask = det.mask
+        return np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4), np.asarray(det.scores, dtype=np.float64), det.binned
+
+    @staticmethod
+    def _check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        d = np.asarray(detections, dtype=np.float64)
+        if d.size == 0:
+            return np.zeros((0, 4)), np.zeros(0)
+        if d.ndim != 2 or d.shape[1] not in (4, 5):
+            raise ValueError(f"detections must have shape (K, 4) or (K, 5) [left, top, w, h(, score)], got {d.shape}")
+        if not np.all(np.isfinite(d)):
+            raise ValueError("detections contain NaN or inf")
+        if np.any(d[:, 2] <= 0) or np.any(d[:, 3] <= 0):
+            k = int(np.flatnonzero((d[:, 2] <= 0) | (d[:, 3] <= 0))[0])
+            raise ValueError(f"detection {k} has width or height <= 0: {d[k].tolist()}")
+        rows, cols = shape
+        outside = (d[:, 0] >= cols) | (d[:, 1] >= rows) | (d[:, 0] + d[:, 2] <= 0) | (d[:, 1] + d[:, 3] <= 0)
+        if np.any(outside):
+            k = int(np.flatnonzero(outside)[0])
+            raise ValueError(
+                f"detection {k} {d[k, :4].tolist()} lies outside the {cols}x{rows} frame "
+                "(wrong coordinate scale? PETS boxes need --det-scale 0.625)"
+            )
+        scores = d[:, 4] if d.shape[1] == 5 else np.ones(len(d))
+        return d[:, :4].copy(), scores.copy()
+
+    # -- the per-frame step -----------------------------------------------------------------
+    def update(self, frame: ArrayLike, detections: ArrayLike | None = None) -> list[Track]:
+        """Advance the tracker by one frame.
+
+        Parameters
+        ----------
+        frame : (H, W, 3) array_like of uint8
+            BGR frame.
+        detections : (K, 4) or (K, 5) array_like, optional
+            ``[left, top, width, height(, score)]`` from any detector; None runs the built-in
+            background-subtraction detector.
+
+        Returns
+        -------
+        list of Track
+            The tracks reported for this frame (confirmed, and coasting ones the colour filter
+            still holds), with the index of the detection each was matched to.
+        """
+        f = np.asarray(frame)
+        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
+            raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        cfg = self.config
+        self.frame_index += 1
+        if detections is None:
+            boxes, scores, binned = self._detect(f)
+        else:
+            boxes, scores = self._check_detections(detections, f.shape[:2])
+            binned = hsv_bins(f, None, cfg.binning)
+            if cfg.refine_boxes:
+                _, _, _ = self._detect(f)
+                if self.last_mask is not None and len(boxes):
+                    boxes = refine_boxes(boxes, self.last_mask, cfg.refine_fraction)
+        keep = scores >= cfg.min_score
+        index = np.flatnonzero(keep)
+        boxes, scores = boxes[keep], scores[keep]
+
+        # 1. every track's particle filter looks at this frame
+        for t in self.tracks:
+            state = t.filter.step(binned)
+            t.rho = state.rho
+            cx, cy = state.box_cxcywh[:2]
+            t.pf_box = np.array([cx - t.size[0] / 2, cy - t.size[1] / 2, t.size[0], t.size[1]])
+            t.box = t.pf_box
+            t.age += 1
+
+        # 2. association
+        det_hists = box_histograms(binned, _xywh_to_cxcywh(boxes), "uniform") if len(boxes) else np.zeros((0, binned.n_bins))
+        matches, unmatched_t, unmatched_d = self._associate(boxes, det_hists)
+
+        # 3. matched tracks follow their detection
+        for ti, di in matches:
+            t = self.tracks[ti]
+            b = boxes[di]
+            merged = b[2] * b[3] > cfg.merge_ratio * t.size[0] * t.size[1] and self._shared(di, boxes, ti)
+            t.score = float(scores[di])
+            t.hits += 1
+            t.time_since_update = 0
+            t.det_index = int(index[di])
+            if merged:
+                t.det_index = None
+                continue
+            centre = b[:2] + b[2:] / 2
+            t.velocity = 0.7 * t.velocity + 0.3 * (centre - t.last_centre) / max(1, t.frames_since_det)
+            t.last_centre = centre
+            t.frames_since_det = 0
+            t.size = 0.7 * t.size + 0.3 * b[2:]
+            t.box = b.copy()
+            t.filter.reinitialise(_xywh_to_cxcywh(b), velocity=t.velocity)
+            hist = det_hists[di]
+            if cfg.reference_rate > 0 and hist.sum() > 0:
+                t.filter.set_reference((1 - cfg.reference_rate) * t.filter.reference + cfg.reference_rate * hist)
+
+        for ti in unmatched_t:
+            t = self.tracks[ti]
+            t.time_since_update += 1
+            t.frames_since_det += 1
+            t.det_index = None
+            t.score = t.rho
+
+        # 4. tracks that coasted too long end; 5. unexplained detections start tracks
+        self.tracks = [t for t in self.tracks if t.time_since_update <= cfg.max_coast and not (t.hits < cfg.min_hits and t.time_since_update > 0)]
+        for di in unmatched_d:
+            hist = det_hists[di]
+            if hist.sum() <= 0:
+                continue  # no foreground colour to build a reference from
+            t = _TrackState(next(self._ids), boxes[di].copy(), hist, cfg, int(self._rng.integers(2**63)), float(scores[di]))
+            t.det_index = int(index[di])
+            t.frames_since_det = 0
+            self.tracks.append(t)
+
+        return self._report()
+
+    def _shared(self, di: int, boxes: NDArray[np.float64], ti: int) -> bool:
+        """Does detection `di` also cover another live track (a merged blob)?"""
+        others = [t.box for k, t in enumerate(self.tracks) if k != ti]
+        if not others:
+            return False
+        b = boxes[di]
+        o = np.asarray(others)
+        inside_x = (o[:, 0] + o[:, 2] / 2 > b[0]) & (o[:, 0] + o[:, 2] / 2 < b[0] + b[2])
+        inside_y = (o[:, 1] + o[:, 3] / 2 > b[1]) & (o[:, 1] + o[:, 3] / 2 < b[1] + b[3])
+        return bool(np.any(inside_x & inside_y))
+
+    def _associate(self, boxes: NDArray[np.float64], det_hists: NDArray[np.float64]
+                   ) -> tuple[list[tuple[int, int]], list[int], list[int]]:  # fmt: skip
+        cfg = self.config
+        nt, nd = len(self.tracks), len(boxes)
+        if nt == 0 or nd == 0:
+            return [], list(range(nt)), list(range(nd))
+        tboxes = np.array([t.box for t in self.tracks])
+        iou = iou_matrix(tboxes, boxes)
+        tc = tboxes[:, :2] + tboxes[:, 2:] / 2
+        dc = boxes[:, :2] + boxes[:, 2:] / 2
+        dist = np.linalg.norm(tc[:, None, :] - dc[None, :, :], axis=2)
+        heights = np.array([t.size[1] for t in self.tracks])
+        coast = np.array([t.time_since_update for t in self.tracks])
+        radius = cfg.match_distance * heights * (1.0 + 0.25 * np.minimum(coast, 8))
+        rho = np.stack([bhattacharyya_coefficient(det_hists, t.filter.reference) if det_hists.sum() > 0 else np.zeros(nd) for t in self.tracks])
+        cost = (1.0 - iou) + cfg.colour_weight * (1.0 - rho) + np.minimum(dist / radius[:, None], 2.0)
+        gate = (iou >= cfg.match_iou) | (dist <= radius[:, None])
+        big = 1e6
+        cost = np.where(gate, cost, big)
+        rows, cols = linear_sum_assignment(cost)
+        matches = [(int(r), int(c)) for r, c in zip(rows, cols) if cost[r, c] < big]
+        mt = {r for r, _ in matches}
+        md = {c for _, c in matches}
+        return matches, [i for i in range(nt) if i not in mt], [j for j in range(nd) if j not in md]
+
+    def _report(self) -> list[Track]:
+        cfg = self.config
+        early = self.frame_index <= cfg.min_hits
+        out = []
+        for t in self.tracks:
+            if t.hits < cfg.min_hits and not early:
+                continue
+            if t.time_since_update > 0 and t.rho < cfg.coast_min_rho:
+                continue
+            out.append(Track(id=t.id, box_xywh=t.box.copy(), score=float(t.score),
+                             detection_index=t.det_index, age=t.age,
+                             time_since_update=t.time_since_update))  # fmt: skip
+        return out
+
+
+class TrackWriter:
+    """Collects a run's tracks as MOTChallenge rows, deciding what coasting becomes.
+
+    A track carried by its particle filter alone (no detection) is held back: its boxes are
+    written once a detection confirms the track again, and dropped if the track ends unconfirmed.
+    So an occlusion the filter bridged is filled, and a filter that lost its object adds nothing.
+
+    Parameters
+    ----------
+    coasting : {"confirmed", "all", "none"}
+        Write held-back boxes when the track is re-detected (default), always, or never.
+    """
+
+    def __init__(self, coasting: str = "confirmed") -> None:
+        if coasting not in ("confirmed", "all", "none"):
+            raise ValueError(f"coasting is {coasting!r}, expected 'confirmed', 'all' or 'none'")
+        self.coasting = coasting
+        self.rows: list[list[float]] = []
+        self._pending: dict[int, list[list[float]]] = {}
+        self._last: dict[int, list[float]] = {}
+        import os
+        self.fill = os.environ.get("FILL", "pf")
+
+    def add(self, frame: int, tracks: list[Track]) -> None:
+        """Record the tracks reported for `frame` (1-based)."""
+        for t in tracks:
+            row = [float(frame), float(t.id), *map(float, t.box_xywh), float(t.score), -1.0, -1.0, -1.0]
+            if t.time_since_update == 0:
+                pending = self._pending.pop(t.id, [])
+                if pending and self.fill == "linear" and t.id in self._last:
+                    a, b = np.asarray(self._last[t.id]), np.asarray(row)
+                    for p in pending:
+                        u = (p[0] - a[0]) / (b[0] - a[0])
+                        p[2:6] = list((1 - u) * a[2:6] + u * b[2:6])
+                self.rows.extend(pending)
+                self.rows.append(row)
+                self._last[t.id] = row
+            elif self.coasting == "all":
+                self.rows.append(row)
+            elif self.coasting == "confirmed":
+                self._pending.setdefault(t.id, []).append(row)
+
+    def result(self) -> NDArray[np.float64]:
+        """All rows written so far, (M, 10), sorted by frame then id."""
+        if not self.rows:
+            return np.zeros((0, 10))
+        a = np.asarray(self.rows)
+        return a[np.lexsort((a[:, 1], a[:, 0]))]
