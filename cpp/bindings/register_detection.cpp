@@ -29,13 +29,14 @@ void register_detection(py::module_& m) {
         m, "BackgroundModel",
         "Adaptive background + frame difference + threshold, fused with HSV binning (one pass).")
         .def(py::init([](double alpha, double alpha_fg, double k_noise, double t_min, double t_max,
-                         double low_ratio, int n_h, int n_s, int n_v, double s_min, double v_min) {
+                         double low_ratio, double shadow_lo, double shadow_chroma, int n_h, int n_s, int n_v, double s_min, double v_min) {
                  return BackgroundModel(
-                     BackgroundConfig{alpha, alpha_fg, k_noise, t_min, t_max, low_ratio},
+                     BackgroundConfig{alpha, alpha_fg, k_noise, t_min, t_max, low_ratio, shadow_lo, shadow_chroma},
                      HsvBinning{n_h, n_s, n_v, s_min, v_min});
              }),
              py::arg("alpha") = 0.05, py::arg("alpha_fg") = 0.005, py::arg("k_noise") = 4.0,
-             py::arg("t_min") = 12.0, py::arg("t_max") = 60.0, py::arg("low_ratio") = 0.5,
+             py::arg("t_min") = 25.0, py::arg("t_max") = 60.0, py::arg("low_ratio") = 0.5,
+             py::arg("shadow_lo") = 0.5, py::arg("shadow_chroma") = 0.03,
              py::arg("n_h") = 10, py::arg("n_s") = 10, py::arg("n_v") = 10, py::arg("s_min") = 0.1,
              py::arg("v_min") = 0.2)
         .def(
@@ -114,8 +115,10 @@ void register_detection(py::module_& m) {
         .def_property_readonly("k_noise", [](const BackgroundModel& s) { return s.config().k_noise; })
         .def_property_readonly("t_min", [](const BackgroundModel& s) { return s.config().t_min; })
         .def_property_readonly("t_max", [](const BackgroundModel& s) { return s.config().t_max; })
-        .def_property_readonly("low_ratio",
-                               [](const BackgroundModel& s) { return s.config().low_ratio; });
+        .def_property_readonly("low_ratio", [](const BackgroundModel& s) { return s.config().low_ratio; })
+        .def_property_readonly("shadow_lo", [](const BackgroundModel& s) { return s.config().shadow_lo; })
+        .def_property_readonly("shadow_chroma",
+                               [](const BackgroundModel& s) { return s.config().shadow_chroma; });
 
     m.def(
         "mask_bins",

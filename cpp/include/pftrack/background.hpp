@@ -81,10 +81,15 @@ struct BackgroundConfig {
     double alpha = 0.05;      // running-average rate where the pixel is background (selective update)
     double alpha_fg = 0.005;  // slow rate where it is foreground (absorbs stopped objects; 0 = off)
     double k_noise = 4.0;     // threshold = k_noise * median background difference of the last frame
-    double t_min = 12.0;      // ... clamped to [t_min, t_max]
+    double t_min = 25.0;      // ... clamped to [t_min, t_max]
     double t_max = 60.0;
     double low_ratio = 0.5;   // a pixel that also moved (frame difference > threshold) is
                               // foreground from low_ratio * threshold on (hysteresis)
+    double shadow_lo = 0.5;   // a pixel darker than the background, with brightness ratio
+                              // sum(I) / sum(B) in [shadow_lo, 1) ...
+    double shadow_chroma = 0.03;  // ... and chromaticity |I_c / sum(I) - B_c / sum(B)| <=
+                                  // shadow_chroma for every c, is a shadow: background, not
+                                  // learnt (rate alpha_fg). shadow_lo = 1 turns this off.
 
     void validate(const char* fn) const {
         require(alpha > 0.0 && alpha <= 1.0, fn, "alpha", alpha, "in (0, 1]");
@@ -93,6 +98,9 @@ struct BackgroundConfig {
         require(t_min >= 0.0 && t_min <= 255.0, fn, "t_min", t_min, "in [0, 255]");
         require(t_max >= t_min && t_max <= 255.0, fn, "t_max", t_max, "in [t_min, 255]");
         require(low_ratio >= 0.0 && low_ratio <= 1.0, fn, "low_ratio", low_ratio, "in [0, 1]");
+        require(shadow_lo >= 0.0 && shadow_lo <= 1.0, fn, "shadow_lo", shadow_lo, "in [0, 1]");
+        require(shadow_chroma >= 0.0 && shadow_chroma <= 1.0, fn, "shadow_chroma", shadow_chroma,
+                "in [0, 1]");
     }
 };
 
@@ -100,9 +108,11 @@ struct BackgroundConfig {
 /// initialises it; every later frame goes through `apply`, which in one read of the frame
 ///   (a) bins each pixel (`hsv_bin_of`'s bins, via HsvLut),
 ///   (b) d_bg = max_c |frame_c - background_c|, d_prev = max_c |frame_c - previous_c|,
-///   (c) foreground = d_bg > T or (d_prev > T and d_bg > low_ratio * T), mask 255/0,
-///   (d) background_c += a (frame_c - background_c), a = alpha where background, alpha_fg where
-///       foreground (float32 arithmetic, in this order, so a NumPy reference matches bit for bit),
+///   (c) candidate = d_bg > T or (d_prev > T and d_bg > low_ratio * T); a candidate that is a
+///       shadow (see BackgroundConfig) is not foreground; mask 255/0,
+///   (d) background_c += a (frame_c - background_c), a = alpha where neither foreground nor
+///       shadow, alpha_fg where either (float32 arithmetic, in this order, so a NumPy reference
+///       matches bit for bit),
 ///   (e) stores the frame as the previous one, and counts floor(d_bg) in a 256-bin histogram.
 /// T for the next frame = clamp(k_noise * median(d_bg), t_min, t_max), the median read from that
 /// histogram with linear interpolation inside its bin: a robust noise level, since most pixels
@@ -165,6 +175,8 @@ public:
         const float t_low = static_cast<float>(config_.low_ratio * threshold_);
         const float a_bg = static_cast<float>(config_.alpha);
         const float a_fg = static_cast<float>(config_.alpha_fg);
+        const float s_lo = static_cast<float>(config_.shadow_lo);
+        const float s_chroma = static_cast<float>(config_.shadow_chroma);
         hist_.fill(0);
         std::int64_t* hist = hist_.data();
         for (Index y = 0; y < rows; ++y) {
@@ -184,11 +196,23 @@ public:
                 std::uint8_t* p = prev + 3 * x;
                 const int d_prev = std::max(std::abs(b - p[0]),
                                             std::max(std::abs(g - p[1]), std::abs(r - p[2])));
-                const bool fore = d_bg > t || (static_cast<float>(d_prev) > t && d_bg > t_low);
+                const bool cand = d_bg > t || (static_cast<float>(d_prev) > t && d_bg > t_low);
+                bool shadow = false;
+                if (cand) {
+                    // darker by a bounded ratio, same chromaticity: |I_c sB - B_c sI| <= k sI sB
+                    const float s_i = fb + fg + fr, s_b = q[0] + q[1] + q[2];
+                    if (s_i < s_b && s_i >= s_lo * s_b && s_i > 0.0f) {
+                        const float tol = s_chroma * s_i * s_b;
+                        shadow = std::abs(fb * s_b - q[0] * s_i) <= tol &&
+                                 std::abs(fg * s_b - q[1] * s_i) <= tol &&
+                                 std::abs(fr * s_b - q[2] * s_i) <= tol;
+                    }
+                }
+                const bool fore = cand && !shadow;
                 m[x] = fore ? 255 : 0;
                 ++hist[std::min(static_cast<int>(d_bg), 255)];
                 // background_c += a (frame_c - background_c)   (selective running average)
-                const float a = fore ? a_fg : a_bg;
+                const float a = cand ? a_fg : a_bg;
                 q[0] = q[0] + a * eb;
                 q[1] = q[1] + a * eg;
                 q[2] = q[2] + a * er;

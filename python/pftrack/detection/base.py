@@ -61,8 +61,8 @@ class BlobConfig:
         Side of the square structuring element of the opening (removes speckle). None: odd
         size ``max(3, round(H / 120))`` rounded up to odd, i.e. 3 at 360 rows, 5 at 576.
     close_size : int or None
-        Side of the closing element (fills holes, joins a body's parts). None: odd
-        ``round(H / 40)``, i.e. 9 at 360 rows, 15 at 576.
+        Side of the (elliptic) closing element (fills holes, joins a body's parts). None: odd
+        ``round(H / 72)``, i.e. 5 at 360 rows, 9 at 576.
     min_area : float
         Smallest blob, as a fraction of the frame's area (0.0015: 259 px at 480x360, about a
         third of a far pedestrian).
@@ -104,7 +104,7 @@ class BlobConfig:
     def kernel_sizes(self, rows: int) -> tuple[int, int]:
         """(open, close) element sides for a frame of `rows` rows."""
         o = self.open_size if self.open_size is not None else max(3, round(rows / 120)) | 1
-        c = self.close_size if self.close_size is not None else max(3, round(rows / 40)) | 1
+        c = self.close_size if self.close_size is not None else max(3, round(rows / 72)) | 1
         return int(o), int(c)
 
 

@@ -32,6 +32,11 @@ class PaperConfig:
     low_ratio : float
         A pixel that also moved since the previous frame (``max_c |I_c - I'_c| > T``) is
         foreground from ``low_ratio * T`` on.
+    shadow_lo, shadow_chroma : float
+        Shadow test on foreground candidates: darker than the background with brightness
+        ratio ``sum(I) / sum(B)`` in ``[shadow_lo, 1)`` and chromaticity ``I_c / sum(I)`` within
+        `shadow_chroma` of the background's, for every channel: background, not learnt.
+        ``shadow_lo=1`` turns it off.
     blobs : BlobConfig
         Morphology and blob filters.
     hsv : HsvConfig
@@ -41,9 +46,11 @@ class PaperConfig:
     alpha: float = 0.05
     alpha_fg: float = 0.005
     k_noise: float = 4.0
-    t_min: float = 12.0
+    t_min: float = 25.0
     t_max: float = 60.0
     low_ratio: float = 0.5
+    shadow_lo: float = 0.5
+    shadow_chroma: float = 0.03
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvConfig = field(default_factory=HsvConfig)
 
@@ -78,7 +85,8 @@ class PaperDetector:
         c = self.config
         self._model = _core.BackgroundModel(
             alpha=c.alpha, alpha_fg=c.alpha_fg, k_noise=c.k_noise, t_min=c.t_min, t_max=c.t_max,
-            low_ratio=c.low_ratio, **asdict(c.hsv),
+            low_ratio=c.low_ratio, shadow_lo=c.shadow_lo,
+            shadow_chroma=c.shadow_chroma, **asdict(c.hsv),
         )
         self._blobs = BlobExtractor(c.blobs)
 
