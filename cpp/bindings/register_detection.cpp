@@ -1,0 +1,140 @@
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <memory>
+#include <string>
+
+#include "arrays.hpp"
+#include "pftrack/background.hpp"
+
+namespace py = pybind11;
+using namespace pftrack;
+
+namespace {
+
+std::string shape_str(const py::array& a) {
+    std::string s = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+    return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+py::array_t<std::uint8_t> new_mask(Index rows, Index cols) {
+    return py::array_t<std::uint8_t>({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
+}
+
+}  // namespace
+
+void register_detection(py::module_& m) {
+    py::class_<BackgroundModel>(
+        m, "BackgroundModel",
+        "Adaptive background + frame difference + threshold, fused with HSV binning (one pass).")
+        .def(py::init([](double alpha, double alpha_fg, double k_noise, double t_min, double t_max,
+                         double low_ratio, double shadow_lo, double shadow_chroma, int n_h, int n_s, int n_v, double s_min, double v_min) {
+                 return BackgroundModel(
+                     BackgroundConfig{alpha, alpha_fg, k_noise, t_min, t_max, low_ratio, shadow_lo, shadow_chroma},
+                     HsvBinning{n_h, n_s, n_v, s_min, v_min});
+             }),
+             py::arg("alpha") = 0.05, py::arg("alpha_fg") = 0.005, py::arg("k_noise") = 4.0,
+             py::arg("t_min") = 25.0, py::arg("t_max") = 60.0, py::arg("low_ratio") = 0.5,
+             py::arg("shadow_lo") = 0.5, py::arg("shadow_chroma") = 0.03,
+             py::arg("n_h") = 10, py::arg("n_s") = 10, py::arg("n_v") = 10, py::arg("s_min") = 0.1,
+             py::arg("v_min") = 0.2)
+        .def(
+            "apply",
+            [](BackgroundModel& self, py::array frame) {
+                const char* fn = "BackgroundModel.apply";
+                bind::check_bgr_image(frame, fn, "frame");
+                const Index rows = frame.shape(0), cols = frame.shape(1);
+                if (self.initialized())
+                    require(rows == self.rows() && cols == self.cols(), fn,
+                            "frame shape is " + shape_str(frame) + ", expected (" +
+                                std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
+                                ", 3) as the earlier frames (call reset() before a new video)");
+                auto img = std::make_shared<BinnedImage>(rows, cols, self.binning().n_bins());
+                auto mask = new_mask(rows, cols);
+                const auto* src = static_cast<const std::uint8_t*>(frame.data());
+                const Index stride = frame.strides(0);
+                std::uint8_t* mptr = mask.mutable_data();
+                {
+                    // safe: raw buffers kept alive by the caller / owned here; the model is not
+                    // shared between threads by pftrack (one model per video)
+                    py::gil_scoped_release nogil;
+                    self.apply(src, rows, cols, stride, img->data.data(), mptr);
+                }
+                return py::make_tuple(img, mask);
+            },
+            py::arg("frame"),
+            "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8 0/255).")
+        .def(
+            "set_background",
+            [](BackgroundModel& self, py::array_t<float, py::array::c_style | py::array::forcecast> bg) {
+                const char* fn = "BackgroundModel.set_background";
+                require(bg.ndim() == 3 && bg.shape(2) == 3, fn,
+                        "background must have shape (H, W, 3), got " + shape_str(bg));
+                require(bg.shape(0) > 0 && bg.shape(1) > 0, fn, "background is empty");
+                const float* p = bg.data();
+                for (py::ssize_t i = 0; i < bg.size(); ++i)
+                    require(p[i] >= 0.0f && p[i] <= 255.0f, fn, "background value", p[i],
+                            "in [0, 255]");
+                self.set_background(p, bg.shape(0), bg.shape(1));
+            },
+            py::arg("background"),
+            "Initialise from a (H, W, 3) BGR image (e.g. a median of frames) instead of the first frame.")
+        .def("reset", &BackgroundModel::reset, "Forget the background: the next frame initialises it.")
+        .def_property_readonly("initialized", &BackgroundModel::initialized)
+        .def_property_readonly("frame_count", &BackgroundModel::frame_count)
+        .def_property_readonly("threshold", &BackgroundModel::threshold,
+                               "Threshold the next frame will use (grey levels).")
+        .def_property_readonly("n_bins", [](const BackgroundModel& s) { return s.binning().n_bins(); })
+        .def_property_readonly("shape",
+                               [](const BackgroundModel& s) -> py::object {
+                                   if (!s.initialized()) return py::none();
+                                   return py::make_tuple(s.rows(), s.cols());
+                               })
+        .def_property_readonly(
+            "background",
+            [](const BackgroundModel& s) -> py::object {
+                if (!s.initialized()) return py::none();
+                py::array_t<float> a({static_cast<py::ssize_t>(s.rows()),
+                                      static_cast<py::ssize_t>(s.cols()), py::ssize_t(3)});
+                std::copy(s.background().begin(), s.background().end(), a.mutable_data());
+                return a;
+            },
+            "Copy of the background (H, W, 3) float32 BGR, or None before the first frame.")
+        .def_property_readonly(
+            "difference_histogram",
+            [](const BackgroundModel& s) {
+                py::array_t<std::int64_t> a(256);
+                std::copy(s.difference_histogram().begin(), s.difference_histogram().end(),
+                          a.mutable_data());
+                return a;
+            },
+            "(256,) int64 counts of floor(max-channel |frame - background|) of the last frame.")
+        .def_property_readonly("alpha", [](const BackgroundModel& s) { return s.config().alpha; })
+        .def_property_readonly("alpha_fg", [](const BackgroundModel& s) { return s.config().alpha_fg; })
+        .def_property_readonly("k_noise", [](const BackgroundModel& s) { return s.config().k_noise; })
+        .def_property_readonly("t_min", [](const BackgroundModel& s) { return s.config().t_min; })
+        .def_property_readonly("t_max", [](const BackgroundModel& s) { return s.config().t_max; })
+        .def_property_readonly("low_ratio", [](const BackgroundModel& s) { return s.config().low_ratio; })
+        .def_property_readonly("shadow_lo", [](const BackgroundModel& s) { return s.config().shadow_lo; })
+        .def_property_readonly("shadow_chroma",
+                               [](const BackgroundModel& s) { return s.config().shadow_chroma; });
+
+    m.def(
+        "mask_bins",
+        [](const BinnedImage& binned, py::array mask) {
+            const char* fn = "mask_bins";
+            bind::check_mask(mask, binned.rows, binned.cols, fn);
+            auto out = std::make_shared<BinnedImage>(binned.rows, binned.cols, binned.n_bins);
+            const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
+            const Index mstride = mask.strides(0);
+            {
+                py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
+                mask_bins(binned.data.data(), binned.rows, binned.cols, mptr, mstride,
+                          out->data.data());
+            }
+            return out;
+        },
+        py::arg("binned"), py::arg("mask"),
+        "New BinnedImage with bins -1 where mask (H, W) uint8/bool is 0 (background).");
+}

@@ -1,0 +1,80 @@
+"""Moving-object detection by background subtraction: the paper's detector, MOG2, KNN.
+
+Every detector has ``detect(frame) -> Detections`` (boxes, scores, cleaned mask, foreground-only
+HSV bins) and ``reset()``. `make_detector` builds one by name from flat keyword settings.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from pftrack.detection.base import BlobConfig, Detections, Detector, HsvConfig
+from pftrack.detection.opencv_bg import KnnConfig, KnnDetector, Mog2Config, Mog2Detector
+from pftrack.detection.paper import PaperConfig, PaperDetector
+
+DETECTORS = ("paper", "mog2", "knn")
+
+__all__ = [
+    "DETECTORS",
+    "BlobConfig",
+    "Detections",
+    "Detector",
+    "HsvConfig",
+    "KnnConfig",
+    "KnnDetector",
+    "Mog2Config",
+    "Mog2Detector",
+    "PaperConfig",
+    "PaperDetector",
+    "make_detector",
+]
+
+
+def _split(cls: type, config: dict[str, Any], name: str) -> Any:
+    """Build `cls` from flat keywords: its own fields, plus those of its blobs/hsv sub-configs."""
+    own = {f.name for f in dataclasses.fields(cls)} - {"blobs", "hsv"}
+    blob_fields = {f.name for f in dataclasses.fields(BlobConfig)}
+    hsv_fields = {f.name for f in dataclasses.fields(HsvConfig)}
+    unknown = sorted(set(config) - own - blob_fields - hsv_fields - {"blobs", "hsv"})
+    if unknown:
+        raise TypeError(
+            f"make_detector: unknown setting(s) {', '.join(unknown)} for detector '{name}'; "
+            f"expected some of {', '.join(sorted(own | blob_fields | hsv_fields))}"
+        )
+    blobs = config.get("blobs") or BlobConfig(
+        **{k: v for k, v in config.items() if k in blob_fields}
+    )
+    hsv = config.get("hsv") or HsvConfig(**{k: v for k, v in config.items() if k in hsv_fields})
+    return cls(**{k: v for k, v in config.items() if k in own}, blobs=blobs, hsv=hsv)
+
+
+def make_detector(name: str, **config: Any) -> PaperDetector | Mog2Detector | KnnDetector:
+    """Build a detector by name.
+
+    Parameters
+    ----------
+    name : {"paper", "mog2", "knn"}
+        The paper's detector (C++ pass), or OpenCV's MOG2 / KNN subtractors.
+    **config
+        Fields of `PaperConfig` / `Mog2Config` / `KnnConfig`, of `BlobConfig` (``min_area`` …)
+        and of `HsvConfig` (``n_h`` …), flat; or ``blobs=`` / ``hsv=`` config objects.
+
+    Returns
+    -------
+    PaperDetector or Mog2Detector or KnnDetector
+
+    Raises
+    ------
+    ValueError
+        Unknown `name`, or a setting out of range.
+    TypeError
+        Unknown setting.
+    """
+    if name == "paper":
+        return PaperDetector(_split(PaperConfig, config, name))
+    if name == "mog2":
+        return Mog2Detector(_split(Mog2Config, config, name))
+    if name == "knn":
+        return KnnDetector(_split(KnnConfig, config, name))
+    raise ValueError(f"make_detector: name is {name!r}, expected one of {', '.join(DETECTORS)}")

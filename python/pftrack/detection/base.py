@@ -1,0 +1,197 @@
+"""Common interface of the detectors: `Detections`, the `Detector` protocol, box extraction."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack import _core
+
+
+@dataclass(frozen=True)
+class Detections:
+    """What a detector found in one frame.
+
+    Attributes
+    ----------
+    boxes : (K, 4) ndarray of float64
+        ``left, top, width, height`` in pixels, one row per detected object.
+    scores : (K,) ndarray of float64
+        Confidence in [0, 1] (fraction of foreground pixels in the box).
+    mask : (H, W) ndarray of uint8
+        Cleaned foreground mask, 255 = foreground, 0 = background.
+    binned : pftrack._core.BinnedImage
+        HSV bins of the frame with background pixels set to -1 (foreground only), for the
+        particles' colour histograms.
+    """
+
+    boxes: NDArray[np.float64]
+    scores: NDArray[np.float64]
+    mask: NDArray[np.uint8]
+    binned: _core.BinnedImage
+
+    def __len__(self) -> int:
+        return int(self.boxes.shape[0])
+
+
+@runtime_checkable
+class Detector(Protocol):
+    """Anything with ``detect(frame) -> Detections`` and ``reset()``."""
+
+    def detect(self, frame: NDArray[np.uint8]) -> Detections:
+        """Detect the moving objects of one BGR uint8 frame (H, W, 3)."""
+        ...
+
+    def reset(self) -> None:
+        """Forget the background model (before a new video)."""
+        ...
+
+
+@dataclass(frozen=True)
+class BlobConfig:
+    """Mask cleaning and blob filtering shared by all detectors.
+
+    Attributes
+    ----------
+    open_size : int or None
+        Side of the square structuring element of the opening (removes speckle). None: odd
+        size ``max(3, round(H / 120))`` rounded up to odd, i.e. 3 at 360 rows, 5 at 576.
+    close_size : int or None
+        Side of the (elliptic) closing element (fills holes, joins a body's parts). None: odd
+        ``round(H / 72)``, i.e. 5 at 360 rows, 9 at 576.
+    min_area : float
+        Smallest blob, as a fraction of the frame's area (0.0015: 259 px at 480x360, about a
+        third of a far pedestrian).
+    max_area : float
+        Largest blob, as a fraction of the frame's area (a sudden light change covers more).
+    min_aspect, max_aspect : float
+        Allowed height / width of a blob's box: 0.25 keeps groups of several people walking
+        side by side, 6 drops thin vertical streaks.
+    min_fill : float
+        Smallest fraction of foreground pixels in a blob's box.
+    """
+
+    open_size: int | None = None
+    close_size: int | None = None
+    min_area: float = 0.0015
+    max_area: float = 0.25
+    min_aspect: float = 0.25
+    max_aspect: float = 6.0
+    min_fill: float = 0.2
+
+    def __post_init__(self) -> None:
+        for name in ("open_size", "close_size"):
+            v = getattr(self, name)
+            if v is not None and not (isinstance(v, (int, np.integer)) and v >= 1):
+                raise ValueError(f"{name} is {v!r}, expected None or an int >= 1")
+        if not (0.0 <= self.min_area <= self.max_area <= 1.0):
+            raise ValueError(
+                f"min_area, max_area are {self.min_area}, {self.max_area}, "
+                "expected 0 <= min_area <= max_area <= 1"
+            )
+        if not (0.0 < self.min_aspect <= self.max_aspect):
+            raise ValueError(
+                f"min_aspect, max_aspect are {self.min_aspect}, {self.max_aspect}, "
+                "expected 0 < min_aspect <= max_aspect"
+            )
+        if not (0.0 <= self.min_fill <= 1.0):
+            raise ValueError(f"min_fill is {self.min_fill}, expected in [0, 1]")
+
+    def kernel_sizes(self, rows: int) -> tuple[int, int]:
+        """(open, close) element sides for a frame of `rows` rows."""
+        o = self.open_size if self.open_size is not None else max(3, round(rows / 120)) | 1
+        c = self.close_size if self.close_size is not None else max(3, round(rows / 72)) | 1
+        return int(o), int(c)
+
+
+def check_frame(frame: object, fn: str) -> NDArray[np.uint8]:
+    """Return `frame` as a (H, W, 3) uint8 array, or raise naming the argument."""
+    if not isinstance(frame, np.ndarray):
+        raise TypeError(f"{fn}: frame is {type(frame).__name__}, expected a numpy.ndarray")
+    if frame.dtype != np.uint8:
+        raise ValueError(f"{fn}: frame dtype is {frame.dtype}, expected uint8 (BGR)")
+    if frame.ndim != 3 or frame.shape[2] != 3 or frame.shape[0] == 0 or frame.shape[1] == 0:
+        raise ValueError(f"{fn}: frame shape is {frame.shape}, expected (H, W, 3) with H, W > 0")
+    return frame
+
+
+class BlobExtractor:
+    """Raw mask -> cleaned mask (opening, then closing) -> filtered connected components."""
+
+    def __init__(self, config: BlobConfig) -> None:
+        self.config = config
+        self._kernels: tuple[int, NDArray[np.uint8], NDArray[np.uint8]] | None = None
+
+    def _elements(self, rows: int) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
+        if self._kernels is None or self._kernels[0] != rows:
+            o, c = self.config.kernel_sizes(rows)
+            self._kernels = (
+                rows,
+                cv2.getStructuringElement(cv2.MORPH_RECT, (o, o)),
+                cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (c, c)),
+            )
+        return self._kernels[1], self._kernels[2]
+
+    def clean(self, raw: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        """Opening then closing of the raw 0/255 mask."""
+        k_open, k_close = self._elements(raw.shape[0])
+        m = cv2.morphologyEx(raw, cv2.MORPH_OPEN, k_open)
+        return cv2.morphologyEx(m, cv2.MORPH_CLOSE, k_close)
+
+    def boxes(
+        self, mask: NDArray[np.uint8]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Boxes (K, 4) left, top, w, h and scores (K,) of the blobs that pass the filters."""
+        cfg = self.config
+        _, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        s = stats[1:].astype(np.float64)  # label 0 is the background
+        frame_area = float(mask.shape[0] * mask.shape[1])
+        w, h, area = s[:, 2], s[:, 3], s[:, 4]
+        fill = area / np.maximum(w * h, 1.0)
+        aspect = h / np.maximum(w, 1.0)
+        keep = (
+            (area >= cfg.min_area * frame_area)
+            & (area <= cfg.max_area * frame_area)
+            & (aspect >= cfg.min_aspect)
+            & (aspect <= cfg.max_aspect)
+            & (fill >= cfg.min_fill)
+        )
+        return np.ascontiguousarray(s[keep, :4]), np.ascontiguousarray(fill[keep])
+
+
+@dataclass(frozen=True)
+class HsvConfig:
+    """HSV binning of the foreground (Perez et al. 2002): ``n_h * n_s`` colour + ``n_v`` grey bins.
+
+    Attributes
+    ----------
+    n_h, n_s, n_v : int
+        Hue, saturation and grey (value) bins, each in [1, 64].
+    s_min, v_min : float
+        A pixel gets a colour bin when its saturation > `s_min` and value > `v_min` (on [0, 1]).
+    """
+
+    n_h: int = 10
+    n_s: int = 10
+    n_v: int = 10
+    s_min: float = 0.1
+    v_min: float = 0.2
+
+    def __post_init__(self) -> None:
+        for name in ("n_h", "n_s", "n_v"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, np.integer)) and 1 <= v <= 64):
+                raise ValueError(f"{name} is {v!r}, expected an int in [1, 64]")
+        for name in ("s_min", "v_min"):
+            v = getattr(self, name)
+            if not (0.0 <= v <= 1.0):
+                raise ValueError(f"{name} is {v!r}, expected a value in [0, 1]")
+
+    @property
+    def n_bins(self) -> int:
+        """Number of bins, ``n_h * n_s + n_v``."""
+        return self.n_h * self.n_s + self.n_v

@@ -1,0 +1,145 @@
+"""OpenCV's background subtractors (MOG2, KNN) behind the `Detector` interface."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack import _core
+from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, HsvConfig, check_frame
+
+
+@dataclass(frozen=True)
+class Mog2Config:
+    """Settings of `Mog2Detector` (OpenCV's defaults).
+
+    Attributes
+    ----------
+    history : int
+        Frames that shape the mixture.
+    var_threshold : float
+        Squared Mahalanobis distance above which a pixel is foreground.
+    learning_rate : float
+        -1 lets OpenCV choose (1 / min(frames seen, history)).
+    blobs, hsv : BlobConfig, HsvConfig
+        As for `PaperDetector`.
+    """
+
+    history: int = 500
+    var_threshold: float = 16.0
+    learning_rate: float = -1.0
+    blobs: BlobConfig = field(default_factory=BlobConfig)
+    hsv: HsvConfig = field(default_factory=HsvConfig)
+
+
+@dataclass(frozen=True)
+class KnnConfig:
+    """Settings of `KnnDetector` (OpenCV's defaults).
+
+    Attributes
+    ----------
+    history : int
+        Frames kept as samples.
+    dist2_threshold : float
+        Squared distance under which a sample counts as near.
+    learning_rate : float
+        -1 lets OpenCV choose.
+    blobs, hsv : BlobConfig, HsvConfig
+        As for `PaperDetector`.
+    """
+
+    history: int = 500
+    dist2_threshold: float = 400.0
+    learning_rate: float = -1.0
+    blobs: BlobConfig = field(default_factory=BlobConfig)
+    hsv: HsvConfig = field(default_factory=HsvConfig)
+
+
+class _OpenCvDetector:
+    """Shared body: subtractor mask (shadows 127 -> background) -> blobs -> masked bins."""
+
+    _name = "detector"
+
+    def __init__(self, blobs: BlobConfig, hsv: HsvConfig, learning_rate: float) -> None:
+        self._blobs = BlobExtractor(blobs)
+        self._hsv = asdict(hsv)
+        self._learning_rate = float(learning_rate)
+        self._sub: Any = self._make()
+        self._shape: tuple[int, ...] | None = None
+
+    def _make(self) -> Any:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def reset(self) -> None:
+        """Forget the background model."""
+        self._sub = self._make()
+        self._shape = None
+
+    def detect(self, frame: NDArray[np.uint8]) -> Detections:
+        """Detect the moving objects of one BGR uint8 frame (H, W, 3); see `Detections`."""
+        fn = f"{type(self).__name__}.detect"
+        frame = check_frame(frame, fn)
+        if self._shape is not None and frame.shape != self._shape:
+            raise ValueError(
+                f"{fn}: frame shape is {frame.shape}, expected {self._shape} as the earlier "
+                "frames (call reset() before a new video)"
+            )
+        self._shape = frame.shape
+        raw = self._sub.apply(frame, learningRate=self._learning_rate)
+        # 255 = foreground, 127 = shadow: shadows are background.
+        raw = np.where(raw == 255, np.uint8(255), np.uint8(0))
+        mask = self._blobs.clean(raw)
+        boxes, scores = self._blobs.boxes(mask)
+        return Detections(boxes, scores, mask, _core.hsv_bins(frame, mask, **self._hsv))
+
+
+class Mog2Detector(_OpenCvDetector):
+    """OpenCV's Gaussian-mixture background subtractor (Zivkovic 2004), shadows as background.
+
+    Parameters
+    ----------
+    config : Mog2Config, optional
+
+    References
+    ----------
+    .. [1] Zivkovic, Z. (2004). Improved adaptive Gaussian mixture model for background
+       subtraction. ICPR.
+    """
+
+    def __init__(self, config: Mog2Config | None = None) -> None:
+        self.config = config if config is not None else Mog2Config()
+        super().__init__(self.config.blobs, self.config.hsv, self.config.learning_rate)
+
+    def _make(self) -> Any:
+        return cv2.createBackgroundSubtractorMOG2(
+            history=self.config.history, varThreshold=self.config.var_threshold, detectShadows=True
+        )
+
+
+class KnnDetector(_OpenCvDetector):
+    """OpenCV's k-nearest-neighbour background subtractor, shadows as background.
+
+    Parameters
+    ----------
+    config : KnnConfig, optional
+
+    References
+    ----------
+    .. [1] Zivkovic, Z., van der Heijden, F. (2006). Efficient adaptive density estimation per
+       image pixel for the task of background subtraction. Pattern Recognition Letters 27(7).
+    """
+
+    def __init__(self, config: KnnConfig | None = None) -> None:
+        self.config = config if config is not None else KnnConfig()
+        super().__init__(self.config.blobs, self.config.hsv, self.config.learning_rate)
+
+    def _make(self) -> Any:
+        return cv2.createBackgroundSubtractorKNN(
+            history=self.config.history,
+            dist2Threshold=self.config.dist2_threshold,
+            detectShadows=True,
+        )

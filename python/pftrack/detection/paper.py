@@ -1,0 +1,134 @@
+"""The paper's detector: adaptive background, frame difference, threshold, morphology, blobs."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack import _core
+from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, HsvConfig, check_frame
+
+
+@dataclass(frozen=True)
+class PaperConfig:
+    """Settings of `PaperDetector`'s per-pixel pass (thresholds in grey levels, 0-255).
+
+    Attributes
+    ----------
+    alpha : float
+        Running-average rate of the background where the pixel is background (the paper's
+        selective update): ``B += alpha (I - B)``. 0.05 forgets in about 20 frames.
+    alpha_fg : float
+        Rate where the pixel is foreground: slowly absorbs objects that stop and the ghosts
+        of objects present in the first frame (0 gives the purely selective update).
+    k_noise : float
+        Noise-adaptive threshold ``T = k_noise * median_pixels(max_c |I_c - B_c|)`` of the
+        previous frame (most pixels are background, so the median measures the noise).
+    t_min, t_max : float
+        Bounds of `T`.
+    low_ratio : float
+        A pixel that also moved since the previous frame (``max_c |I_c - I'_c| > T``) is
+        foreground from ``low_ratio * T`` on.
+    shadow_lo, shadow_chroma : float
+        Shadow test on foreground candidates: darker than the background with brightness
+        ratio ``sum(I) / sum(B)`` in ``[shadow_lo, 1)`` and chromaticity ``I_c / sum(I)`` within
+        `shadow_chroma` of the background's, for every channel: background, not learnt.
+        ``shadow_lo=1`` turns it off.
+    blobs : BlobConfig
+        Morphology and blob filters.
+    hsv : HsvConfig
+        Colour binning of the frame (done in the same pass).
+    """
+
+    alpha: float = 0.05
+    alpha_fg: float = 0.005
+    k_noise: float = 4.0
+    t_min: float = 25.0
+    t_max: float = 60.0
+    low_ratio: float = 0.5
+    shadow_lo: float = 0.5
+    shadow_chroma: float = 0.03
+    blobs: BlobConfig = field(default_factory=BlobConfig)
+    hsv: HsvConfig = field(default_factory=HsvConfig)
+
+
+class PaperDetector:
+    """Background-subtraction detector of the paper, per-pixel pass in C++.
+
+    Each frame: one C++ pass (`pftrack._core.BackgroundModel`) bins the pixels, compares them
+    with the adaptive background and the previous frame, thresholds and updates the background
+    where there is no foreground; OpenCV then opens and closes the mask and labels its
+    connected components; blobs outside the area, aspect and fill limits are dropped.
+
+    Parameters
+    ----------
+    config : PaperConfig, optional
+        Settings; the defaults are documented on `PaperConfig`.
+
+    Notes
+    -----
+    The background starts as the first frame (its first mask is empty), unless `prime` gave
+    it a median of frames. Objects present in the first frame leave ghosts that `alpha_fg`
+    absorbs over ``~1 / alpha_fg`` frames; `prime` avoids them.
+
+    References
+    ----------
+    .. [1] The detection of ``/work/shared/papers/000_f11c25999834422a.txt``: adaptive
+       background and frame differences, thresholded, cleaned by morphology.
+    """
+
+    def __init__(self, config: PaperConfig | None = None) -> None:
+        self.config = config if config is not None else PaperConfig()
+        c = self.config
+        self._model = _core.BackgroundModel(
+            alpha=c.alpha, alpha_fg=c.alpha_fg, k_noise=c.k_noise, t_min=c.t_min, t_max=c.t_max,
+            low_ratio=c.low_ratio, shadow_lo=c.shadow_lo,
+            shadow_chroma=c.shadow_chroma, **asdict(c.hsv),
+        )
+        self._blobs = BlobExtractor(c.blobs)
+
+    @property
+    def model(self) -> _core.BackgroundModel:
+        """The C++ background model (read its ``background``, ``threshold``)."""
+        return self._model
+
+    def reset(self) -> None:
+        """Forget the background; the next frame initialises it."""
+        self._model.reset()
+
+    def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
+        """Start from the per-pixel median of `frames` (e.g. frames spread over the video).
+
+        Parameters
+        ----------
+        frames : iterable of (H, W, 3) uint8 arrays
+            At least one frame; all of one size.
+        """
+        stack = [check_frame(f, "PaperDetector.prime") for f in frames]
+        if not stack:
+            raise ValueError("PaperDetector.prime: frames is empty, expected at least one frame")
+        if any(f.shape != stack[0].shape for f in stack):
+            raise ValueError("PaperDetector.prime: frames differ in shape, expected one size")
+        self._model.reset()
+        self._model.set_background(np.median(np.stack(stack), axis=0).astype(np.float32))
+
+    def detect(self, frame: NDArray[np.uint8]) -> Detections:
+        """Detect the moving objects of one frame.
+
+        Parameters
+        ----------
+        frame : (H, W, 3) ndarray of uint8
+            BGR frame, the same size as the earlier ones (call `reset` between videos).
+
+        Returns
+        -------
+        Detections
+        """
+        frame = check_frame(frame, "PaperDetector.detect")
+        binned, raw = self._model.apply(frame)
+        mask = self._blobs.clean(raw)
+        boxes, scores = self._blobs.boxes(mask)
+        return Detections(boxes, scores, mask, _core.mask_bins(binned, mask))
