@@ -40,7 +40,6 @@ from pathlib import Path
 import cv2
 import numpy as np
 from numpy.typing import NDArray
-
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.atomic import atomic_write
 from pftrack.io.mot import group_by_frame, read_mot
@@ -232,7 +231,9 @@ class Row:
     fps: float
 
 
-def run_one(step: Step, frames: list[NDArray[np.uint8]], dets: Iterable[Boxes | None]) -> tuple[NDArray[np.float64], float]:
+def run_one(
+    step: Step, frames: list[NDArray[np.uint8]], dets: Iterable[Boxes | None]
+) -> tuple[NDArray[np.float64], float]:
     rows = []
     elapsed = 0.0
     for f, (frame, boxes) in enumerate(zip(frames, dets), start=1):
@@ -251,7 +252,8 @@ def markdown(rows: list[Row]) -> str:
     for r in rows:
         m = r.metrics
         lines.append(
-            f"| {r.tracker} | {r.sequence} | {r.detector} | {100 * m.mota:.1f} | {100 * m.idf1:.1f} "
+            f"| {r.tracker} | {r.sequence} | {r.detector} "
+            f"| {100 * m.mota:.1f} | {100 * m.idf1:.1f} "
             f"| {100 * m.motp_iou:.1f} | {m.num_switches} | {m.num_fragmentations} "
             f"| {m.false_positives} | {m.misses} | {m.mostly_tracked} | {m.mostly_lost} "
             f"| {m.num_unique_objects} | {r.fps:.0f} |"
@@ -263,7 +265,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", default=None, help="folder with pets09-s2l1/ and tud-campus/")
     ap.add_argument("--seq", nargs="+", default=list(SEQUENCES), choices=list(SEQUENCES))
-    ap.add_argument("--detector", nargs="+", default=["public", "mog2"], choices=["public", "mog2"])
+    ap.add_argument(
+        "--detector", nargs="+", default=["public", "mog2"], choices=["public", "mog2"]
+    )
     ap.add_argument("--tracker", nargs="+", default=list(TRACKERS), choices=list(TRACKERS))
     ap.add_argument("--out", default=None, help="also write the markdown table here")
     args = ap.parse_args(argv)

@@ -4,7 +4,6 @@ import time
 
 import numpy as np
 import pytest
-
 from pftrack.eval import iou_xywh
 from pftrack.io.mot import read_mot
 from pftrack.io.video import FrameSource

@@ -122,7 +122,7 @@ class Scene:
             If OpenCV cannot open a writer for that file type.
         """
         p = Path(path)
-        fourcc = cv2.VideoWriter_fourcc(*("MJPG" if p.suffix.lower() == ".avi" else "mp4v"))
+        fourcc = cv2.VideoWriter.fourcc(*("MJPG" if p.suffix.lower() == ".avi" else "mp4v"))
         with atomic_path(p) as tmp:
             writer = cv2.VideoWriter(str(tmp), fourcc, self.fps, (self.width, self.height))
             if not writer.isOpened():
@@ -175,14 +175,15 @@ def _background(width: int, height: int, rng: np.random.Generator) -> NDArray[np
         img[wall_h // 4 : wall_h * 3 // 4, x : x + 20] = (60, 50, 40)
     bx, by = int(0.7 * width), int(0.45 * height)
     img[by : by + 6, bx : bx + 60] = (40, 70, 100)
-    return np.clip(img, 0, 255).astype(np.uint8)
+    out: NDArray[np.uint8] = np.clip(img, 0, 255).astype(np.uint8)
+    return out
 
 
 def _sprite(
     width: int, height: int, shirt: tuple[int, int, int], trousers: tuple[int, int, int],
     skin: tuple[int, int, int], phase: int, rng: np.random.Generator,
 ) -> tuple[NDArray[np.uint8], NDArray[np.bool_]]:
-    """A walker's (height, width) BGR image and mask: head, torso, two legs in a stride phase."""
+    """Draw a walker: (height, width) BGR image and mask of head, torso and legs in a stride."""
     img = np.zeros((height, width, 3), np.uint8)
     mask = np.zeros((height, width), np.uint8)
     head_h = max(6, height // 7)

@@ -6,7 +6,6 @@ import warnings
 
 import numpy as np
 import pytest
-
 from pftrack.cli import main
 from pftrack.eval import MotMetrics, evaluate_mot, format_metrics, iou_xywh
 from pftrack.io.mot import write_mot

@@ -11,7 +11,7 @@ from pftrack.io.mot import read_mot
 
 def add_eval_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     """Register the ``eval`` sub-command on `sub` (from ``add_subparsers``)."""
-    p = sub.add_parser(
+    p: argparse.ArgumentParser = sub.add_parser(
         "eval",
         help="score a tracking result against ground truth (MOTA, IDF1, ...)",
         description=(
@@ -38,7 +38,7 @@ def add_eval_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run_eval(args: argparse.Namespace) -> int:
-    """Handler of ``pftrack eval``: prints the table, optionally writes JSON; returns 0."""
+    """Run ``pftrack eval``: print the table, optionally write JSON; return 0."""
     gt = read_mot(args.gt, what="ground truth")
     res = read_mot(args.res, what="result file")
     size = tuple(args.image_size) if args.image_size else None
