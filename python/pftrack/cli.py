@@ -22,6 +22,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
+    from pftrack.eval.cli import add_eval_parser
+
+    add_eval_parser(sub)
     return parser
 
 

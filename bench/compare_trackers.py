@@ -1,0 +1,322 @@
+"""Compare pftrack with the trackers people use today, on the same detections, scored alike.
+
+Not a pytest benchmark: a script. Peers (``pip install -e .[peers]``): supervision's ByteTrack
+(supervision < 0.27, where ``sv.ByteTrack`` still lives), norfair, motpy, and SORT from the
+``sort-track`` package (a packaging of Bewley's ``sort.py``; install it with ``--no-deps``,
+its metadata pins an old SciPy). A peer that is not installed is skipped with a note.
+
+Detector modes
+--------------
+public
+    The sequence's ``det.txt`` (Faster R-CNN boxes published with SORT), PETS boxes scaled by
+    0.625 onto the 480x360 video. pftrack gets the same boxes.
+mog2
+    OpenCV MOG2 background subtraction on the video (shadows off), opening + closing, connected
+    components with a minimum area; every blob is a detection with score 1. pftrack runs its own
+    detector instead (``detections=None``) and is listed as detector ``own``.
+
+All results are scored by :func:`pftrack.eval.evaluate_mot` against the ground truth (scaled the
+same way) with IoU 0.5; fps counts only the trackers' update calls (not decoding or detection).
+
+Usage::
+
+    python bench/compare_trackers.py [--data ../shared/data] [--seq pets09-s2l1 tud-campus]
+        [--detector public mog2] [--tracker sort bytetrack norfair motpy pftrack] [--out t.md]
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import sys
+import time
+import warnings
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+from pftrack.eval import MotMetrics, evaluate_mot
+from pftrack.io.atomic import atomic_write
+from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.video import read_frames
+
+Boxes = NDArray[np.float64]  # (K, 5) left, top, w, h, score
+Step = Callable[[NDArray[np.uint8], "Boxes | None"], list[tuple[int, float, float, float, float]]]
+
+
+@dataclass(frozen=True)
+class Sequence:
+    name: str
+    video: str
+    scale: float  # ground truth / det.txt -> video pixels
+    fps: float
+    mog2_history: int = 500
+    mog2_var_threshold: float = 100.0
+
+
+SEQUENCES = {
+    "pets09-s2l1": Sequence("pets09-s2l1", "video.avi", 0.625, 7.0),
+    # 71 frames of people in view from frame 1: a short memory and a low threshold do best.
+    "tud-campus": Sequence("tud-campus", "video.mp4", 1.0, 25.0, 100, 16.0),
+}
+
+
+def data_root(arg: str | None) -> Path:
+    if arg:
+        return Path(arg)
+    if os.environ.get("PFTRACK_DATA"):
+        return Path(os.environ["PFTRACK_DATA"])
+    return Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+
+
+# ---- detectors -------------------------------------------------------------------------------
+
+
+def public_detections(folder: Path, seq: Sequence, n_frames: int) -> list[Boxes]:
+    det = read_mot(folder / "det.txt", what="detection file")
+    by_frame = group_by_frame(det)
+    out = []
+    for f in range(1, n_frames + 1):
+        d = by_frame.get(f, np.zeros((0, 10)))
+        boxes = d[:, 2:6] * seq.scale
+        out.append(np.c_[boxes, d[:, 6]])
+    return out
+
+
+def mog2_detections(
+    frames: list[NDArray[np.uint8]], seq: Sequence, *, min_area_frac: float = 0.002
+) -> list[Boxes]:
+    """Foreground blobs: MOG2 (no shadows) -> open 3x3 -> close 7x21 (joins a person's body
+    parts vertically) -> connected components of area >= min_area_frac of the image, not wider
+    than twice their height."""
+    h, w = frames[0].shape[:2]
+    sub = cv2.createBackgroundSubtractorMOG2(
+        history=seq.mog2_history, varThreshold=seq.mog2_var_threshold, detectShadows=False
+    )
+    k_open = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
+    k_close = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 21))
+    min_area = min_area_frac * w * h
+    out = []
+    for frame in frames:
+        fg = sub.apply(frame)
+        _, fg = cv2.threshold(fg, 127, 255, cv2.THRESH_BINARY)
+        fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, k_open)
+        fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, k_close)
+        n, _, stats, _ = cv2.connectedComponentsWithStats(fg, connectivity=8)
+        rows = [
+            (float(x), float(y), float(bw), float(bh), 1.0)
+            for x, y, bw, bh, area in stats[1:n]
+            if area >= min_area and bh >= 0.5 * bw
+        ]
+        out.append(np.asarray(rows, dtype=np.float64).reshape(-1, 5))
+    return out
+
+
+# ---- trackers: each factory returns step(frame, boxes) -> [(id, left, top, w, h)] ------------
+
+
+def make_sort(seq: Sequence) -> Step:
+    from sort.tracker import SortTracker  # sort-track: Bewley's defaults
+
+    trk = SortTracker(max_age=1, min_hits=3, iou_threshold=0.3)
+
+    def step(frame, boxes):
+        d = np.zeros((0, 6)) if boxes is None or len(boxes) == 0 else np.c_[
+            boxes[:, 0], boxes[:, 1], boxes[:, 0] + boxes[:, 2], boxes[:, 1] + boxes[:, 3],
+            boxes[:, 4], np.zeros(len(boxes))]
+        out = trk.update(d, None)
+        return [(int(r[4]), r[0], r[1], r[2] - r[0], r[3] - r[1]) for r in out]
+
+    return step
+
+
+def make_bytetrack(seq: Sequence) -> Step:
+    import supervision as sv
+
+    if not hasattr(sv, "ByteTrack"):
+        raise ImportError("supervision >= 0.27 has no ByteTrack: pip install 'supervision<0.27'")
+    trk = sv.ByteTrack(frame_rate=int(round(seq.fps)))  # documented defaults otherwise
+
+    def step(frame, boxes):
+        b = np.zeros((0, 5)) if boxes is None else boxes
+        det = sv.Detections(
+            xyxy=np.c_[b[:, 0], b[:, 1], b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]].reshape(-1, 4),
+            confidence=b[:, 4].copy(),
+            class_id=np.zeros(len(b), dtype=int),
+        )
+        out = trk.update_with_detections(det)
+        return [(int(t), x0, y0, x1 - x0, y1 - y0)
+                for (x0, y0, x1, y1), t in zip(out.xyxy, out.tracker_id)]
+
+    return step
+
+
+def make_norfair(seq: Sequence) -> Step:
+    import norfair
+
+    # norfair's bounding-box demos: IoU distance, threshold 0.7; other settings default.
+    trk = norfair.Tracker(distance_function="iou", distance_threshold=0.7)
+
+    def step(frame, boxes):
+        dets = [] if boxes is None else [
+            norfair.Detection(points=np.array([[x, y], [x + w, y + h]]), scores=np.array([s, s]))
+            for x, y, w, h, s in boxes
+        ]
+        objs = trk.update(detections=dets)
+        out = []
+        for o in objs:
+            (x0, y0), (x1, y1) = o.estimate
+            out.append((int(o.id), x0, y0, x1 - x0, y1 - y0))
+        return out
+
+    return step
+
+
+def make_motpy(seq: Sequence) -> Step:
+    from motpy import Detection, MultiObjectTracker
+
+    trk = MultiObjectTracker(dt=1.0 / seq.fps)  # defaults: constant velocity, IoU matching
+    ids: dict[str, int] = {}
+
+    def step(frame, boxes):
+        dets = [] if boxes is None else [
+            Detection(box=np.array([x, y, x + w, y + h]), score=s) for x, y, w, h, s in boxes
+        ]
+        trk.step(detections=dets)
+        out = []
+        for t in trk.active_tracks(min_steps_alive=3):
+            k = ids.setdefault(t.id, len(ids) + 1)
+            x0, y0, x1, y1 = t.box
+            out.append((k, x0, y0, x1 - x0, y1 - y0))
+        return out
+
+    return step
+
+
+def make_pftrack(seq: Sequence) -> Step:
+    from pftrack.tracker import MultiObjectTracker  # written by the lead; may be absent
+
+    trk = MultiObjectTracker()
+
+    def step(frame, boxes):
+        tracks = trk.update(frame, detections=boxes)
+        return [(int(t.id), *(float(v) for v in t.box_xywh)) for t in tracks]
+
+    return step
+
+
+TRACKERS: dict[str, Callable[[Sequence], Step]] = {
+    "sort": make_sort,
+    "bytetrack": make_bytetrack,
+    "norfair": make_norfair,
+    "motpy": make_motpy,
+    "pftrack": make_pftrack,
+}
+
+
+# ---- running ---------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Row:
+    tracker: str
+    sequence: str
+    detector: str
+    metrics: MotMetrics
+    fps: float
+
+
+def run_one(
+    step: Step, frames: list[NDArray[np.uint8]], dets: Iterable[Boxes | None]
+) -> tuple[NDArray[np.float64], float]:
+    rows = []
+    elapsed = 0.0
+    for f, (frame, boxes) in enumerate(zip(frames, dets), start=1):
+        t0 = time.perf_counter()
+        out = step(frame, boxes)
+        elapsed += time.perf_counter() - t0
+        rows += [(f, i, x, y, w, h, 1.0, -1.0, -1.0, -1.0) for i, x, y, w, h in out]
+    res = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+    return res, len(frames) / elapsed if elapsed > 0 else float("inf")
+
+
+def markdown(rows: list[Row]) -> str:
+    head = ("| tracker | sequence | detector | MOTA | IDF1 | MOTP(IoU) | IDSW | Frag | FP | FN "
+            "| MT | ML | GT | fps |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        m = r.metrics
+        lines.append(
+            f"| {r.tracker} | {r.sequence} | {r.detector} "
+            f"| {100 * m.mota:.1f} | {100 * m.idf1:.1f} "
+            f"| {100 * m.motp_iou:.1f} | {m.num_switches} | {m.num_fragmentations} "
+            f"| {m.false_positives} | {m.misses} | {m.mostly_tracked} | {m.mostly_lost} "
+            f"| {m.num_unique_objects} | {r.fps:.0f} |"
+        )
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--data", default=None, help="folder with pets09-s2l1/ and tud-campus/")
+    ap.add_argument("--seq", nargs="+", default=list(SEQUENCES), choices=list(SEQUENCES))
+    ap.add_argument(
+        "--detector", nargs="+", default=["public", "mog2"], choices=["public", "mog2"]
+    )
+    ap.add_argument("--tracker", nargs="+", default=list(TRACKERS), choices=list(TRACKERS))
+    ap.add_argument("--out", default=None, help="also write the markdown table here")
+    args = ap.parse_args(argv)
+
+    root = data_root(args.data)
+    if not root.is_dir():
+        print(f"data folder not found: {root} (set --data or PFTRACK_DATA)", file=sys.stderr)
+        return 2
+    rows: list[Row] = []
+    notes: list[str] = []
+    for name in args.seq:
+        seq = SEQUENCES[name]
+        folder = root / name
+        frames = read_frames(folder / seq.video)
+        gt = read_mot(folder / "gt.txt", what="ground truth")
+        size = (frames[0].shape[1], frames[0].shape[0])
+        for detector in args.detector:
+            dets: list[Boxes] | None = None
+            if detector == "public":
+                dets = public_detections(folder, seq, len(frames))
+            else:
+                dets = mog2_detections(frames, seq)
+            for tname in args.tracker:
+                own = tname == "pftrack" and detector == "mog2"
+                try:
+                    step = TRACKERS[tname](seq)
+                except ImportError as exc:
+                    note = f"{tname}: skipped ({exc})"
+                    if note not in notes:
+                        notes.append(note)
+                    continue
+                feed: Iterable[Boxes | None] = [None] * len(frames) if own else dets
+                with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
+                    warnings.simplefilter("ignore")
+                    res, fps = run_one(step, frames, feed)
+                m = evaluate_mot(gt, res, scale=seq.scale, image_size=size)
+                row = Row(tname, name, "own" if own else detector, m, fps)
+                rows.append(row)
+                print(markdown([row]).splitlines()[-1], flush=True)
+    table = markdown(rows)
+    print()
+    print(table)
+    for n in notes:
+        print(f"- {n}")
+    if args.out:
+        with atomic_write(args.out) as fh:
+            fh.write(table + "\n" + "".join(f"\n- {n}" for n in notes) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

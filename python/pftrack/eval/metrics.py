@@ -1,0 +1,494 @@
+"""CLEAR-MOT, identity (IDF1) and Smith et al.'s per-object measures of a tracking result.
+
+Everything works on ``(M, 10)`` MOTChallenge arrays as returned by
+:func:`pftrack.io.mot.read_mot`: ``frame, id, left, top, width, height, conf, x, y, z``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Mapping
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linear_sum_assignment
+
+from pftrack.io.mot import CONF, FRAME, ID, LEFT
+
+__all__ = ["MotMetrics", "evaluate_mot", "format_metrics", "iou_xywh"]
+
+# Cost of a forbidden pair in the per-frame assignment: larger than any sum of admissible
+# costs (each is at most 1), so the solver first maximises the number of admissible pairs.
+_FORBIDDEN = 1e6
+
+
+def iou_xywh(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """Intersection over union of every box of `a` with every box of `b`.
+
+    Parameters
+    ----------
+    a : (n, 4) array_like of float
+        Boxes ``left, top, width, height``.
+    b : (m, 4) array_like of float
+        Boxes ``left, top, width, height``.
+
+    Returns
+    -------
+    (n, m) ndarray of float64
+        IoU in [0, 1]; 0 where the union is empty.
+    """
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 4)
+    b = np.asarray(b, dtype=np.float64).reshape(-1, 4)
+    ax0, ay0 = a[:, 0:1], a[:, 1:2]
+    ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
+    bx0, by0 = b[:, 0], b[:, 1]
+    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
+    iw = np.clip(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0, None)
+    ih = np.clip(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0, None)
+    inter = iw * ih
+    union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(union > 0, inter / union, 0.0)
+    return np.asarray(out, dtype=np.float64)
+
+
+@dataclasses.dataclass(frozen=True)
+class MotMetrics:
+    """Scores of one tracking result against one ground truth.
+
+    CLEAR-MOT (Bernardin & Stiefelhagen 2008) with IoU matching, identity measures (Ristani et
+    al. 2016) and the per-object measures of Smith et al. (2005) used by the first paper.
+
+    Attributes
+    ----------
+    mota : float
+        ``1 - (FN + FP + IDSW) / num_objects`` (a fraction; can be negative).
+    motp_iou : float
+        Mean IoU of the matched pairs. This is "MOTP as overlap" (higher is better); py-motmetrics
+        reports the mean distance ``1 - IoU`` instead, i.e. ``1 - motp_iou``.
+    idf1, idp, idr : float
+        Identity F1, precision and recall after the global one-to-one assignment of ground-truth
+        trajectories to result trajectories that maximises the identity true positives.
+    idtp, idfp, idfn : int
+        Identity true positives, false positives and false negatives (boxes).
+    num_switches : int
+        Identity switches: a ground-truth object matched to a different result id than at its
+        last match.
+    num_fragmentations : int
+        Times a ground-truth trajectory goes from tracked to untracked, counted between its first
+        and last tracked frame.
+    mostly_tracked, partially_tracked, mostly_lost : int
+        Objects tracked in >= 80 %, in [20 %, 80 %), and in < 20 % of their frames.
+    false_positives, misses, num_matches : int
+        CLEAR-MOT FP, FN and matches (switches included in the matches).
+    num_objects, num_predictions : int
+        Scored ground-truth boxes and scored result boxes.
+    num_unique_objects, num_frames : int
+        Scored ground-truth ids; frames seen in either input.
+    num_ignored_gt, num_ignored_predictions : int
+        Ground-truth boxes with ``conf == 0`` (not scored) and result boxes discarded because they
+        covered one of them.
+    precision, recall : float
+        ``matches / num_predictions`` and ``matches / num_objects``.
+    success_rate : float
+        Smith et al.'s tracking success rate, mean over objects: for each ground-truth object,
+        the fraction of its frames in which its assigned result track overlaps it (IoU > 0). The
+        assigned track is the result id that overlaps the object in the most frames.
+    success_rate_strict : float
+        The same with "overlaps" meaning IoU >= `iou_threshold` (assignment by the same rule).
+    success_per_object : tuple of (int, float, float)
+        ``(gt id, success, strict success)`` per object, in id order.
+    centroid_distance_px : float
+        Mean Euclidean distance (pixels, after `scale`) between the centroid of each ground-truth
+        box and that of its assigned result track (loose assignment), over the frames where both
+        exist. NaN when no such frame.
+    centroid_distance_ratio : float
+        `centroid_distance_px` divided by the image's pixel count ``width * height`` (the first
+        paper's normalisation). NaN when the image size is not given.
+    iou_threshold, scale : float
+        The settings used.
+    """
+
+    mota: float
+    motp_iou: float
+    idf1: float
+    idp: float
+    idr: float
+    idtp: int
+    idfp: int
+    idfn: int
+    num_switches: int
+    num_fragmentations: int
+    mostly_tracked: int
+    partially_tracked: int
+    mostly_lost: int
+    false_positives: int
+    misses: int
+    num_matches: int
+    num_objects: int
+    num_predictions: int
+    num_unique_objects: int
+    num_frames: int
+    num_ignored_gt: int
+    num_ignored_predictions: int
+    precision: float
+    recall: float
+    success_rate: float
+    success_rate_strict: float
+    success_per_object: tuple[tuple[int, float, float], ...]
+    centroid_distance_px: float
+    centroid_distance_ratio: float
+    iou_threshold: float
+    scale: float
+
+    def as_dict(self) -> dict[str, object]:
+        """Plain ``dict`` (JSON-ready: NaN becomes None)."""
+        out: dict[str, object] = {}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, float) and not math.isfinite(v):
+                v = None
+            if f.name == "success_per_object":
+                v = [{"id": i, "success": s, "success_strict": t} for i, s, t in v]
+            out[f.name] = v
+        return out
+
+    def to_json(self) -> str:
+        """JSON text of :meth:`as_dict`."""
+        return json.dumps(self.as_dict(), indent=2)
+
+    def table(self) -> str:
+        """Human-readable text table (see :func:`format_metrics`)."""
+        return format_metrics(self)
+
+
+def _pct(x: float) -> str:
+    return "nan" if not math.isfinite(x) else f"{100.0 * x:.1f}"
+
+
+def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
+    """Text table of one result, or of several results keyed by name (one row each).
+
+    Percentages for MOTA, MOTP (mean IoU of matches), IDF1, IDP, IDR, precision, recall and the
+    success rates; counts for the rest.
+    """
+    rows = {"result": m} if isinstance(m, MotMetrics) else dict(m)
+    cols = [
+        ("MOTA", lambda r: _pct(r.mota)),
+        ("MOTP(IoU)", lambda r: _pct(r.motp_iou)),
+        ("IDF1", lambda r: _pct(r.idf1)),
+        ("IDP", lambda r: _pct(r.idp)),
+        ("IDR", lambda r: _pct(r.idr)),
+        ("Prec", lambda r: _pct(r.precision)),
+        ("Rec", lambda r: _pct(r.recall)),
+        ("FP", lambda r: str(r.false_positives)),
+        ("FN", lambda r: str(r.misses)),
+        ("IDSW", lambda r: str(r.num_switches)),
+        ("Frag", lambda r: str(r.num_fragmentations)),
+        ("GT", lambda r: str(r.num_unique_objects)),
+        ("MT", lambda r: str(r.mostly_tracked)),
+        ("PT", lambda r: str(r.partially_tracked)),
+        ("ML", lambda r: str(r.mostly_lost)),
+        ("Succ", lambda r: _pct(r.success_rate)),
+        ("Succ@IoU", lambda r: _pct(r.success_rate_strict)),
+        ("CD(px)", lambda r: "nan" if not math.isfinite(r.centroid_distance_px)
+         else f"{r.centroid_distance_px:.1f}"),
+        ("CD/px", lambda r: "nan" if not math.isfinite(r.centroid_distance_ratio)
+         else f"{r.centroid_distance_ratio:.2e}"),
+    ]
+    header = ["name"] + [c for c, _ in cols]
+    body = [[name] + [fn(r) for _, fn in cols] for name, r in rows.items()]
+    widths = [max(len(str(x[i])) for x in [header] + body) for i in range(len(header))]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths))]
+    lines += ["  ".join(v.rjust(w) for v, w in zip(row, widths)) for row in body]
+    first = next(iter(rows.values()))
+    lines.append(
+        f"(IoU threshold {first.iou_threshold:g}; MOTP = mean IoU of matches; "
+        f"Succ: IoU > 0 with the assigned track, Succ@IoU: IoU >= threshold; "
+        f"CD = mean centroid distance)"
+    )
+    return "\n".join(lines)
+
+
+def _check_rows(rows: ArrayLike, name: str) -> NDArray[np.float64]:
+    a = np.asarray(rows, dtype=np.float64)
+    if a.size == 0:
+        return np.zeros((0, 10))
+    if a.ndim != 2 or a.shape[1] < 6:
+        raise ValueError(f"evaluate_mot: {name} has shape {a.shape}, expected (M, 6..10) MOT rows")
+    if not np.all(np.isfinite(a[:, :6])):
+        raise ValueError(f"evaluate_mot: {name} has non-finite values in its first 6 columns")
+    if a.shape[1] < 10:
+        pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
+        a = np.hstack([a, pad])
+    return a
+
+
+def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
+    if len(rows) == 0:
+        return {}
+    order = np.lexsort((rows[:, ID], rows[:, FRAME]))
+    r = rows[order]
+    frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
+    ends = list(starts[1:]) + [len(r)]
+    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends)}
+
+
+def _assign(cost: NDArray[np.float64]) -> list[tuple[int, int]]:
+    """Min-cost pairs of a cost matrix where ``_FORBIDDEN`` marks forbidden pairs."""
+    if cost.size == 0:
+        return []
+    r, c = linear_sum_assignment(cost)
+    return [(int(i), int(j)) for i, j in zip(r, c) if cost[i, j] < _FORBIDDEN]
+
+
+def evaluate_mot(
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    iou_threshold: float = 0.5,
+    scale: float = 1.0,
+    image_size: tuple[int, int] | None = None,
+) -> MotMetrics:
+    """Score a tracking result against ground truth.
+
+    Parameters
+    ----------
+    gt : (M, 6..10) array_like of float
+        Ground truth MOT rows. Rows with ``conf == 0`` are not scored (see Notes).
+    result : (R, 6..10) array_like of float
+        Result MOT rows (one id per track; ``conf`` is ignored).
+    iou_threshold : float
+        A result box can match a ground-truth box when their IoU is >= this, in (0, 1].
+    scale : float
+        Multiplies the ground-truth boxes (left, top, width, height) before scoring, e.g. 0.625
+        for PETS09 ground truth (768x576) against a tracker run on the 480x360 video.
+    image_size : (width, height), optional
+        Image size for the centroid-distance ratio (NaN without it).
+
+    Returns
+    -------
+    MotMetrics
+
+    Notes
+    -----
+    Per-frame matching follows CLEAR-MOT as implemented by py-motmetrics: each ground-truth
+    object first keeps the result id it was last matched to if that box is present and its IoU is
+    still >= `iou_threshold`; the remaining objects and boxes are paired by the Hungarian
+    algorithm on ``1 - IoU`` among admissible pairs (maximum number of pairs first). A match to
+    a different id than the object's last match is an identity switch, however long ago.
+
+    Ground-truth rows with ``conf == 0`` (MOTChallenge's "do not score") are ignore regions:
+    in each frame the result boxes are first assigned (Hungarian on IoU >= `iou_threshold`)
+    to all ground-truth boxes, scored and ignored alike; result boxes that land on an ignored
+    box are dropped, and the ignored boxes take no further part (no FN, no FP, no IDs).
+
+    References
+    ----------
+    .. [1] Bernardin, K. & Stiefelhagen, R. (2008). Evaluating multiple object tracking
+       performance: the CLEAR MOT metrics. EURASIP J. Image and Video Processing.
+    .. [2] Ristani, E. et al. (2016). Performance measures and a data set for multi-target,
+       multi-camera tracking. ECCV workshops.
+    .. [3] Smith, K., Gatica-Perez, D., Odobez, J.-M. & Ba, S. (2005). Evaluating multi-object
+       tracking. CVPR workshop on empirical evaluation methods in computer vision.
+    """
+    if not (math.isfinite(iou_threshold) and 0.0 < iou_threshold <= 1.0):
+        raise ValueError(f"evaluate_mot: iou_threshold is {iou_threshold}, expected in (0, 1]")
+    if not (math.isfinite(scale) and scale > 0):
+        raise ValueError(f"evaluate_mot: scale is {scale}, expected a finite value > 0")
+    if image_size is not None:
+        if len(image_size) != 2 or min(image_size) <= 0:
+            raise ValueError(
+                f"evaluate_mot: image_size is {image_size!r}, expected (width, height) > 0"
+            )
+    g = _check_rows(gt, "gt").copy()
+    r = _check_rows(result, "result")
+    g[:, LEFT : LEFT + 4] *= scale
+    gt_frames = _split(g)
+    res_frames = _split(r)
+    frames = sorted(set(gt_frames) | set(res_frames))
+    empty = np.zeros((0, 10))
+
+    last_match: dict[int, int] = {}  # gt id -> result id of its latest match
+    # Per gt id: list of (tracked?) over its frames, for MT/PT/ML and fragmentations.
+    tracked: dict[int, list[bool]] = {}
+    pair_hits: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU >= thr
+    pair_touch: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU > 0
+    centroid: dict[tuple[int, int], list[float]] = {}  # (gt id, res id) -> distances
+    gt_count: dict[int, int] = {}
+    res_count: dict[int, int] = {}
+    n_fp = n_fn = n_sw = n_match = n_gt = n_res = n_ign_gt = n_ign_res = 0
+    iou_sum = 0.0
+
+    for f in frames:
+        gf = gt_frames.get(f, empty)
+        rf = res_frames.get(f, empty)
+        ignore = gf[:, CONF] == 0
+        n_ign_gt += int(ignore.sum())
+        if ignore.any() and len(rf):
+            iou_all = iou_xywh(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])
+            cost = np.where(iou_all >= iou_threshold, 1.0 - iou_all, _FORBIDDEN)
+            drop = {j for i, j in _assign(cost) if ignore[i]}
+            if drop:
+                keep = np.array([j not in drop for j in range(len(rf))])
+                n_ign_res += len(drop)
+                rf = rf[keep]
+        gf = gf[~ignore]
+        gids = gf[:, ID].astype(np.int64)
+        rids = rf[:, ID].astype(np.int64)
+        n_gt += len(gids)
+        n_res += len(rids)
+        for o in gids:
+            gt_count[int(o)] = gt_count.get(int(o), 0) + 1
+        for h in rids:
+            res_count[int(h)] = res_count.get(int(h), 0) + 1
+        iou = iou_xywh(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])
+        ok = iou >= iou_threshold
+
+        # Identity and Smith measures look at every overlapping (gt, result) pair.
+        if len(gids) and len(rids):
+            cg = gf[:, LEFT : LEFT + 2] + 0.5 * gf[:, LEFT + 2 : LEFT + 4]
+            cr = rf[:, LEFT : LEFT + 2] + 0.5 * rf[:, LEFT + 2 : LEFT + 4]
+            dist = np.hypot(cg[:, None, 0] - cr[None, :, 0], cg[:, None, 1] - cr[None, :, 1])
+            # A pair counts once per frame even if an id appears twice (ids should be unique).
+            near: dict[tuple[int, int], float] = {}
+            touch_f: set[tuple[int, int]] = set()
+            hit_f: set[tuple[int, int]] = set()
+            for i, o in enumerate(gids):
+                for j, h in enumerate(rids):
+                    key = (int(o), int(h))
+                    near[key] = min(near.get(key, math.inf), float(dist[i, j]))
+                    if iou[i, j] > 0:
+                        touch_f.add(key)
+                    if ok[i, j]:
+                        hit_f.add(key)
+            for key, d in near.items():
+                centroid.setdefault(key, []).append(d)
+            for key in touch_f:
+                pair_touch[key] = pair_touch.get(key, 0) + 1
+            for key in hit_f:
+                pair_hits[key] = pair_hits.get(key, 0) + 1
+
+        # CLEAR-MOT: 1) keep last correspondences still admissible.
+        g_used = np.zeros(len(gids), dtype=bool)
+        r_used = np.zeros(len(rids), dtype=bool)
+        matches: list[tuple[int, int]] = []
+        for i, o in enumerate(gids):
+            h = last_match.get(int(o))
+            if h is None:
+                continue
+            js = np.flatnonzero((rids == h) & ~r_used)
+            if len(js) and ok[i, js[0]]:
+                g_used[i] = r_used[js[0]] = True
+                matches.append((i, int(js[0])))
+        # 2) Hungarian on the rest.
+        gi = np.flatnonzero(~g_used)
+        rj = np.flatnonzero(~r_used)
+        if len(gi) and len(rj):
+            sub = iou[np.ix_(gi, rj)]
+            cost = np.where(sub >= iou_threshold, 1.0 - sub, _FORBIDDEN)
+            for a, b in _assign(cost):
+                i, j = int(gi[a]), int(rj[b])
+                o, h = int(gids[i]), int(rids[j])
+                if o in last_match and last_match[o] != h:
+                    n_sw += 1
+                g_used[i] = r_used[j] = True
+                matches.append((i, j))
+        for i, j in matches:
+            last_match[int(gids[i])] = int(rids[j])
+            iou_sum += float(iou[i, j])
+        for i, o in enumerate(gids):
+            tracked.setdefault(int(o), []).append(bool(g_used[i]))
+        n_match += len(matches)
+        n_fn += int((~g_used).sum())
+        n_fp += int((~r_used).sum())
+
+    # Mostly tracked / lost and fragmentations.
+    mt = pt = ml = frag = 0
+    for seq in tracked.values():
+        s = np.asarray(seq, dtype=bool)
+        ratio = s.mean()
+        if ratio >= 0.8:
+            mt += 1
+        elif ratio >= 0.2:
+            pt += 1
+        else:
+            ml += 1
+        on = np.flatnonzero(s)
+        if len(on):
+            span = s[on[0] : on[-1] + 1]
+            frag += int(np.count_nonzero(span[:-1] & ~span[1:]))
+
+    # Identity: global assignment maximising the frames where a pair overlaps >= threshold.
+    oids = sorted(gt_count)
+    hids = sorted(res_count)
+    idtp = 0
+    if oids and hids:
+        oi = {o: k for k, o in enumerate(oids)}
+        hi = {h: k for k, h in enumerate(hids)}
+        w = np.zeros((len(oids), len(hids)))
+        for (o, h), c in pair_hits.items():
+            w[oi[o], hi[h]] = c
+        a, b = linear_sum_assignment(-w)
+        idtp = int(w[a, b].sum())
+    idfn = n_gt - idtp
+    idfp = n_res - idtp
+    idf1 = 2 * idtp / (2 * idtp + idfp + idfn) if (2 * idtp + idfp + idfn) else float("nan")
+    idp = idtp / (idtp + idfp) if (idtp + idfp) else float("nan")
+    idr = idtp / (idtp + idfn) if (idtp + idfn) else float("nan")
+
+    # Smith et al.: per object, the result id overlapping it most often.
+    per_object: list[tuple[int, float, float]] = []
+    dists: list[float] = []
+    for o in oids:
+        touch = {h: c for (oo, h), c in pair_touch.items() if oo == o}
+        hits = {h: c for (oo, h), c in pair_hits.items() if oo == o}
+        loose = 0.0
+        strict = 0.0
+        if touch:
+            best = max(touch, key=lambda h: (touch[h], -h))
+            loose = touch[best] / gt_count[o]
+            dists.extend(centroid[(o, best)])
+        if hits:
+            best_s = max(hits, key=lambda h: (hits[h], -h))
+            strict = hits[best_s] / gt_count[o]
+        per_object.append((o, loose, strict))
+    cd = float(np.mean(dists)) if dists else float("nan")
+    ratio = cd / (image_size[0] * image_size[1]) if image_size is not None else float("nan")
+
+    nan = float("nan")
+    return MotMetrics(
+        mota=1.0 - (n_fn + n_fp + n_sw) / n_gt if n_gt else nan,
+        motp_iou=iou_sum / n_match if n_match else nan,
+        idf1=idf1,
+        idp=idp,
+        idr=idr,
+        idtp=idtp,
+        idfp=idfp,
+        idfn=idfn,
+        num_switches=n_sw,
+        num_fragmentations=frag,
+        mostly_tracked=mt,
+        partially_tracked=pt,
+        mostly_lost=ml,
+        false_positives=n_fp,
+        misses=n_fn,
+        num_matches=n_match,
+        num_objects=n_gt,
+        num_predictions=n_res,
+        num_unique_objects=len(oids),
+        num_frames=len(frames),
+        num_ignored_gt=n_ign_gt,
+        num_ignored_predictions=n_ign_res,
+        precision=n_match / n_res if n_res else nan,
+        recall=n_match / n_gt if n_gt else nan,
+        success_rate=float(np.mean([p[1] for p in per_object])) if per_object else nan,
+        success_rate_strict=float(np.mean([p[2] for p in per_object])) if per_object else nan,
+        success_per_object=tuple(per_object),
+        centroid_distance_px=cd,
+        centroid_distance_ratio=ratio,
+        iou_threshold=float(iou_threshold),
+        scale=float(scale),
+    )

@@ -1,0 +1,367 @@
+"""Seeded synthetic scenes of coloured walkers, with ground truth, for tests and the demo.
+
+A textured static background, people-sized two-tone walkers that enter and leave through the
+borders on gently curving paths (two of them cross), a vertical "lamp post" in front of them and
+mild per-frame sensor noise. Ground truth is a MOTChallenge array of the walkers' visible extent
+(clipped to the image, not to the occluder).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+from typing import Union
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack.io.atomic import atomic_path
+from pftrack.io.mot import write_mot
+
+__all__ = ["Scene", "Walker", "make_scene"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+# Clothing colours (BGR), far apart in hue so colour histograms can tell walkers apart.
+_SHIRTS = [
+    (40, 40, 200),  # red
+    (200, 80, 30),  # blue
+    (40, 180, 40),  # green
+    (30, 200, 230),  # yellow
+    (180, 40, 170),  # purple
+    (20, 120, 240),  # orange
+    (200, 200, 40),  # cyan
+    (230, 230, 230),  # white
+]
+_TROUSERS = [
+    (60, 40, 30),  # dark blue
+    (40, 40, 40),  # black
+    (70, 110, 150),  # khaki
+    (120, 120, 120),  # grey
+    (30, 30, 90),  # maroon
+]
+_SKIN = [(120, 160, 210), (90, 130, 180), (60, 90, 140)]
+
+
+@dataclasses.dataclass(frozen=True)
+class Walker:
+    """One walker: id, size and its (centre x, centre y) for every frame it is in the scene.
+
+    Attributes
+    ----------
+    id : int
+        Ground-truth id (from 1).
+    width, height : int
+        Body size in pixels.
+    first_frame : int
+        1-based frame of ``centres[0]``.
+    centres : (T, 2) ndarray of float64
+        Centre of the body at frames ``first_frame .. first_frame + T - 1`` (may be outside).
+    shirt, trousers : tuple of int
+        BGR clothing colours.
+    """
+
+    id: int
+    width: int
+    height: int
+    first_frame: int
+    centres: NDArray[np.float64]
+    shirt: tuple[int, int, int]
+    trousers: tuple[int, int, int]
+
+
+@dataclasses.dataclass
+class Scene:
+    """A generated sequence.
+
+    Attributes
+    ----------
+    frames : list of (H, W, 3) uint8 ndarray
+        BGR frames.
+    truth : (M, 10) ndarray of float64
+        MOTChallenge ground truth: 1-based frames, ids from 1, ``left, top, width, height`` of
+        each walker's body clipped to the image (still present while behind the occluder),
+        ``conf = 1``, ``x = y = z = -1``.
+    background : (H, W, 3) uint8 ndarray
+        The empty scene (occluder included, no sensor noise).
+    occluder : (4,) tuple of int or None
+        ``left, top, width, height`` of the lamp post, drawn in front of walkers.
+    walkers : list of Walker
+        The walkers' paths.
+    fps : float
+        Nominal frame rate (for :meth:`write_video`).
+    """
+
+    frames: list[NDArray[np.uint8]]
+    truth: NDArray[np.float64]
+    background: NDArray[np.uint8]
+    occluder: tuple[int, int, int, int] | None
+    walkers: list[Walker]
+    fps: float = 10.0
+
+    @property
+    def width(self) -> int:
+        """Frame width in pixels."""
+        return int(self.background.shape[1])
+
+    @property
+    def height(self) -> int:
+        """Frame height in pixels."""
+        return int(self.background.shape[0])
+
+    def write_video(self, path: PathLike) -> Path:
+        """Write the frames as a video file, atomically.
+
+        ``.avi`` gets MJPG, anything else (``.mp4``) mp4v. Returns the path.
+
+        Raises
+        ------
+        ValueError
+            If OpenCV cannot open a writer for that file type.
+        """
+        p = Path(path)
+        fourcc = cv2.VideoWriter.fourcc(*("MJPG" if p.suffix.lower() == ".avi" else "mp4v"))
+        with atomic_path(p) as tmp:
+            writer = cv2.VideoWriter(str(tmp), fourcc, self.fps, (self.width, self.height))
+            if not writer.isOpened():
+                raise ValueError(f"write_video: OpenCV cannot write {p.suffix!r} video to {p}")
+            try:
+                for frame in self.frames:
+                    writer.write(frame)
+            finally:
+                writer.release()
+        return p
+
+    def write_images(self, folder: PathLike, *, ext: str = ".png") -> Path:
+        """Write one image per frame (``000001.png`` ...) into `folder` (created if needed).
+
+        Each file is written atomically. Returns the folder.
+        """
+        d = Path(folder)
+        d.mkdir(parents=True, exist_ok=True)
+        for k, frame in enumerate(self.frames, start=1):
+            with atomic_path(d / f"{k:06d}{ext}") as tmp:
+                if not cv2.imwrite(str(tmp), frame):
+                    raise ValueError(f"write_images: OpenCV cannot write {ext!r} images")
+        return d
+
+    def write_truth(self, path: PathLike) -> Path:
+        """Write :attr:`truth` as a MOTChallenge ``gt.txt`` (atomically). Returns the path."""
+        write_mot(path, self.truth)
+        return Path(path)
+
+
+def _background(width: int, height: int, rng: np.random.Generator) -> NDArray[np.uint8]:
+    """Paved square: gradient, blotchy low-frequency texture, paving joints, a wall and a bench."""
+    yy, xx = np.mgrid[0:height, 0:width].astype(np.float32)
+    base = np.array([105, 120, 125], np.float32)  # greyish stone (BGR)
+    grad = (0.35 * (yy / height) - 0.15 * (xx / width))[..., None] * 60.0
+    coarse = rng.normal(0.0, 14.0, (height // 24 + 2, width // 24 + 2, 1)).astype(np.float32)
+    blotch = cv2.resize(coarse, (width, height), interpolation=cv2.INTER_CUBIC)[..., None]
+    fine = rng.normal(0.0, 5.0, (height, width, 1)).astype(np.float32)
+    img = base + grad + blotch + fine
+    # Paving joints, denser towards the top (perspective).
+    for k in range(1, 14):
+        y = int(height * (k / 14) ** 1.6)
+        img[y : y + 1] -= 18
+    for x in range(0, width, 40):
+        img[:, x : x + 1] -= 10
+    # A wall across the top with windows, and a bench.
+    wall_h = max(8, height // 7)
+    img[:wall_h] = np.array([70, 85, 150], np.float32) + fine[:wall_h] * 1.5
+    for x in range(10, width - 20, 45):
+        img[wall_h // 4 : wall_h * 3 // 4, x : x + 20] = (60, 50, 40)
+    bx, by = int(0.7 * width), int(0.45 * height)
+    img[by : by + 6, bx : bx + 60] = (40, 70, 100)
+    out: NDArray[np.uint8] = np.clip(img, 0, 255).astype(np.uint8)
+    return out
+
+
+def _sprite(
+    width: int, height: int, shirt: tuple[int, int, int], trousers: tuple[int, int, int],
+    skin: tuple[int, int, int], phase: int, rng: np.random.Generator,
+) -> tuple[NDArray[np.uint8], NDArray[np.bool_]]:
+    """Draw a walker: (height, width) BGR image and mask of head, torso and legs in a stride."""
+    img = np.zeros((height, width, 3), np.uint8)
+    mask = np.zeros((height, width), np.uint8)
+    head_h = max(6, height // 7)
+    torso_b = int(height * 0.55)
+    cx = width // 2
+    # head
+    cv2.ellipse(img, (cx, head_h // 2), (max(3, width // 5), head_h // 2), 0, 0, 360, skin, -1)
+    cv2.ellipse(mask, (cx, head_h // 2), (max(3, width // 5), head_h // 2), 0, 0, 360, 1, -1)
+    # torso (an ellipse-topped rectangle)
+    cv2.rectangle(img, (0, head_h + 2), (width - 1, torso_b), shirt, -1)
+    cv2.rectangle(mask, (0, head_h + 2), (width - 1, torso_b), 1, -1)
+    # legs: stride alternates between two phases
+    leg_w = max(3, width // 3)
+    spread = (width // 6) * (1 if phase else -1)
+    for lx in (cx - leg_w - 1 + spread, cx + 1 - spread):
+        lx = int(np.clip(lx, 0, width - leg_w))
+        cv2.rectangle(img, (lx, torso_b), (lx + leg_w - 1, height - 1), trousers, -1)
+        cv2.rectangle(mask, (lx, torso_b), (lx + leg_w - 1, height - 1), 1, -1)
+    # cloth texture: stripes on the shirt and per-pixel noise
+    stripes = ((np.arange(height)[:, None] // 4) % 2 * 14 - 7).astype(np.int16)
+    tex = rng.normal(0, 6, (height, width, 1)).astype(np.int16)
+    out = img.astype(np.int16) + tex
+    out[head_h + 2 : torso_b] += stripes[head_h + 2 : torso_b, :, None]
+    img = np.clip(out, 0, 255).astype(np.uint8)
+    return img, mask.astype(bool)
+
+
+def _path(
+    rng: np.random.Generator, width: int, height: int, w: int, h: int, n_frames: int,
+    *, left_to_right: bool, start_inside: bool, y_band: tuple[float, float],
+    start_frame: int, speed_range: tuple[float, float],
+) -> tuple[int, NDArray[np.float64]]:
+    """Quadratic Bézier from one side border to the other, walked at `speed_range` px a frame."""
+    y0 = rng.uniform(*y_band) * height
+    y1 = float(np.clip(y0 + rng.normal(0, 0.15 * height), 0.3 * height, 0.85 * height))
+    xs, xe = -w / 2.0 - 1.0, width + w / 2.0 + 1.0
+    if not left_to_right:
+        xs, xe = xe, xs
+    p0 = np.array([xs, y0])
+    p2 = np.array([xe, y1])
+    if start_inside:
+        p0 = np.array([rng.uniform(0.15, 0.3) * width, y0])
+        if not left_to_right:
+            p0[0] = width - p0[0]
+    p1 = 0.5 * (p0 + p2) + np.array([0.0, rng.normal(0, 0.12 * height)])
+    length = float(np.linalg.norm(p1 - p0) + np.linalg.norm(p2 - p1))
+    speed = rng.uniform(*speed_range) * width / 480.0
+    steps = max(2, int(length / speed))
+    t = np.linspace(0.0, 1.0, steps)[:, None]
+    pts = (1 - t) ** 2 * p0 + 2 * (1 - t) * t * p1 + t**2 * p2
+    pts += rng.normal(0, 0.3, pts.shape)  # gait sway
+    return start_frame, pts[: max(1, n_frames - start_frame + 1)]
+
+
+def make_scene(
+    n_frames: int = 120,
+    width: int = 480,
+    height: int = 360,
+    n_walkers: int = 5,
+    rng: np.random.Generator | int | None = 0,
+    occluder: bool = True,
+    *,
+    noise: float = 3.0,
+    fps: float = 10.0,
+) -> Scene:
+    """Generate a seeded scene of walkers on a textured background.
+
+    Parameters
+    ----------
+    n_frames : int
+        Number of frames (>= 1).
+    width, height : int
+        Frame size (>= 64 x 64).
+    n_walkers : int
+        Number of walkers (1 to 40). Walker 1 is inside the image from frame 1; walkers 1 and 2
+        walk in opposite directions at the same height and time, so their boxes cross; walkers
+        3, 4, ... enter through the left or right border at random times.
+    rng : numpy.random.Generator, int or None
+        Seed or generator; the same seed gives the same scene.
+    occluder : bool
+        Draw a vertical lamp post at 40 % of the width, in front of the walkers.
+    noise : float
+        Standard deviation of the per-frame sensor noise in grey levels (0 for none).
+    fps : float
+        Nominal frame rate stored in the scene.
+
+    Returns
+    -------
+    Scene
+    """
+    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
+        if not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"make_scene: {name} is {v!r}, expected an integer >= {lo}")
+    if not isinstance(n_walkers, (int, np.integer)) or not 1 <= n_walkers <= 40:
+        raise ValueError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
+    if not (np.isfinite(noise) and noise >= 0):
+        raise ValueError(f"make_scene: noise is {noise}, expected a finite value >= 0")
+    gen = np.random.default_rng(rng)
+    bg = _background(width, height, gen)
+    size_scale = height / 360.0
+
+    occ: tuple[int, int, int, int] | None = None
+    if occluder:
+        ow = max(4, int(round(0.025 * width)))
+        ox = int(0.4 * width)
+        oy = int(0.08 * height)
+        occ = (ox, oy, ow, height - oy)
+        cv2.rectangle(bg, (ox, oy), (ox + ow - 1, height - 1), (45, 50, 55), -1)
+        cv2.line(bg, (ox + 1, oy), (ox + 1, height - 1), (90, 95, 100), 1)  # highlight
+        cv2.rectangle(bg, (ox - 6, oy - 8), (ox + ow + 5, oy), (30, 35, 40), -1)  # lamp head
+
+    walkers: list[Walker] = []
+    sprites: list[tuple[tuple[NDArray[np.uint8], NDArray[np.bool_]], ...]] = []
+    shirt_order = gen.permutation(len(_SHIRTS))
+    for k in range(n_walkers):
+        w = int(round(gen.uniform(20, 40) * size_scale))
+        h = int(round(gen.uniform(50, 100) * size_scale))
+        w, h = max(w, 6), max(h, 14)
+        if k == 0:
+            start, ltr, inside, band = 1, True, True, (0.5, 0.6)
+        elif k == 1:
+            # Meets walker 1 near the middle: starts at the right border at the same time.
+            start, ltr, inside, band = 1, False, False, (0.5, 0.6)
+        else:
+            start = int(gen.integers(1, max(2, n_frames * 2 // 3)))
+            ltr, inside, band = bool(gen.integers(2)), False, (0.35, 0.75)
+        speeds = (4.0, 5.0) if k == 0 else (2.5, 4.5)  # walker 1 leaves within ~100 frames
+        first, centres = _path(gen, width, height, w, h, n_frames, left_to_right=ltr,
+                               start_inside=inside, y_band=band, start_frame=start,
+                               speed_range=speeds)
+        shirt = _SHIRTS[int(shirt_order[k % len(_SHIRTS)])]
+        trousers = _TROUSERS[int(gen.integers(len(_TROUSERS)))]
+        skin = _SKIN[int(gen.integers(len(_SKIN)))]
+        walkers.append(Walker(k + 1, w, h, first, centres, shirt, trousers))
+        sprites.append(tuple(_sprite(w, h, shirt, trousers, skin, ph, gen) for ph in (0, 1)))
+
+    # Sensor noise: a pool of noise images, each frame a random window of one of them.
+    pad = 16
+    if noise > 0:
+        pool = gen.normal(0.0, noise, (4, height + pad, width + pad, 3))
+        noise_pos = np.clip(pool, 0, 255).astype(np.uint8)
+        noise_neg = np.clip(-pool, 0, 255).astype(np.uint8)
+
+    frames: list[NDArray[np.uint8]] = []
+    truth: list[tuple[float, ...]] = []
+    for f in range(1, n_frames + 1):
+        frame = bg.copy()
+        visible = []
+        for k, wk in enumerate(walkers):
+            i = f - wk.first_frame
+            if 0 <= i < len(wk.centres):
+                cx, cy = wk.centres[i]
+                visible.append((cy + wk.height / 2.0, k, cx, cy))
+        # Nearer (lower) walkers are drawn last, in front.
+        for _, k, cx, cy in sorted(visible):
+            wk = walkers[k]
+            img, mask = sprites[k][((f - wk.first_frame) // 3) % 2]
+            x0 = int(round(cx - wk.width / 2.0))
+            y0 = int(round(cy - wk.height / 2.0))
+            xa, ya = max(x0, 0), max(y0, 0)
+            xb, yb = min(x0 + wk.width, width), min(y0 + wk.height, height)
+            if xb <= xa or yb <= ya:
+                continue
+            sub = mask[ya - y0 : yb - y0, xa - x0 : xb - x0]
+            frame[ya:yb, xa:xb][sub] = img[ya - y0 : yb - y0, xa - x0 : xb - x0][sub]
+            truth.append((f, wk.id, xa, ya, xb - xa, yb - ya, 1.0, -1.0, -1.0, -1.0))
+        if occ is not None:  # the post is in front of everyone
+            ox, oy, ow, oh = occ
+            frame[oy : oy + oh, ox : ox + ow] = bg[oy : oy + oh, ox : ox + ow]
+        if noise > 0:
+            j = int(gen.integers(4))
+            dx, dy = (int(v) for v in gen.integers(0, pad, 2))
+            win = (slice(dy, dy + height), slice(dx, dx + width))
+            cv2.add(frame, noise_pos[j][win], dst=frame)
+            cv2.subtract(frame, noise_neg[j][win], dst=frame)
+        frames.append(frame)
+
+    t = np.asarray(truth, dtype=np.float64).reshape(-1, 10)
+    if len(t):
+        t = t[np.lexsort((t[:, 1], t[:, 0]))]
+    return Scene(frames=frames, truth=t, background=bg, occluder=occ, walkers=walkers, fps=fps)

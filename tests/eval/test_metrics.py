@@ -1,0 +1,251 @@
+from __future__ import annotations
+
+import json
+import math
+import warnings
+
+import numpy as np
+import pytest
+from pftrack.cli import main
+from pftrack.eval import MotMetrics, evaluate_mot, format_metrics, iou_xywh
+from pftrack.io.mot import write_mot
+
+
+def rows(*items):
+    """(frame, id, left, top, w, h[, conf]) tuples -> (M, 10) array."""
+    out = []
+    for it in items:
+        r = list(it) + [1.0] * (7 - len(it)) + [-1.0, -1.0, -1.0]
+        out.append(r[:10])
+    return np.asarray(out, dtype=np.float64).reshape(-1, 10)
+
+
+def iou_loop(a, b):
+    """Straightforward reference IoU, one pair at a time."""
+    out = np.zeros((len(a), len(b)))
+    for i, (x0, y0, w0, h0) in enumerate(a):
+        for j, (x1, y1, w1, h1) in enumerate(b):
+            iw = max(0.0, min(x0 + w0, x1 + w1) - max(x0, x1))
+            ih = max(0.0, min(y0 + h0, y1 + h1) - max(y0, y1))
+            u = w0 * h0 + w1 * h1 - iw * ih
+            out[i, j] = iw * ih / u if u > 0 else 0.0
+    return out
+
+
+def test_iou_matches_loop():
+    rng = np.random.default_rng(3)
+    a = np.c_[rng.uniform(0, 50, (7, 2)), rng.uniform(0, 30, (7, 2))]
+    b = np.c_[rng.uniform(0, 50, (5, 2)), rng.uniform(0, 30, (5, 2))]
+    np.testing.assert_allclose(iou_xywh(a, b), iou_loop(a, b), atol=1e-12)
+    assert iou_xywh(np.zeros((0, 4)), b).shape == (0, 5)
+
+
+# Hand-made case: three ground-truth objects over 5 frames, 10x10 boxes.
+#   A (gt 1) frames 1-5 at (0,0); B (gt 2) frames 1-4 at (100,0); C (gt 3) frames 1-5 at (200,0).
+#   result 10 on A at frames 1, 2 (frame 2 shifted by 3 px in x: IoU 70/130);
+#   A has no result box at frame 3;
+#   result 11 on A at frames 4, 5 (frame 5 shifted by 2 px in y: IoU 80/120);
+#   result 20 on B at frame 1 only; C is never tracked; result 30 is a false positive at frame 2.
+HAND_GT = rows(
+    *[(f, 1, 0, 0, 10, 10) for f in range(1, 6)],
+    *[(f, 2, 100, 0, 10, 10) for f in range(1, 5)],
+    *[(f, 3, 200, 0, 10, 10) for f in range(1, 6)],
+)
+HAND_RES = rows(
+    (1, 10, 0, 0, 10, 10),
+    (2, 10, 3, 0, 10, 10),
+    (4, 11, 0, 0, 10, 10),
+    (5, 11, 0, 2, 10, 10),
+    (1, 20, 100, 0, 10, 10),
+    (2, 30, 300, 300, 10, 10),
+)
+
+
+def test_hand_computed_case():
+    m = evaluate_mot(HAND_GT, HAND_RES, image_size=(400, 300))
+    # gt boxes: 5 + 4 + 5 = 14; matches: A at 1, 2, 4, 5 and B at 1 -> 5.
+    assert m.num_objects == 14 and m.num_predictions == 6 and m.num_matches == 5
+    # FN = 14 - 5 = 9; FP = result 30 -> 1; IDSW = A goes 10 -> 11 at frame 4 -> 1.
+    assert (m.misses, m.false_positives, m.num_switches) == (9, 1, 1)
+    # MOTA = 1 - (9 + 1 + 1) / 14 = 3/14.
+    assert m.mota == pytest.approx(3 / 14)
+    # MOTP (mean IoU of matches) = (1 + 70/130 + 1 + 80/120 + 1) / 5.
+    assert m.motp_iou == pytest.approx((3 + 70 / 130 + 80 / 120) / 5)
+    # Frag: A is T T F T T -> one tracked->untracked transition; B is T F F F (no later
+    # tracked frame) -> 0; C never tracked -> 0.
+    assert m.num_fragmentations == 1
+    # Track ratios: A 4/5 = 0.8 -> MT; B 1/4 = 0.25 -> PT; C 0 -> ML.
+    assert (m.mostly_tracked, m.partially_tracked, m.mostly_lost) == (1, 1, 1)
+    # Identity: pair overlaps (1,10)=2, (1,11)=2, (2,20)=1 -> best one-to-one IDTP = 2 + 1 = 3;
+    # IDFP = 6 - 3 = 3; IDFN = 14 - 3 = 11; IDF1 = 2*3 / (2*3 + 3 + 11) = 6/20.
+    assert (m.idtp, m.idfp, m.idfn) == (3, 3, 11)
+    assert m.idf1 == pytest.approx(0.3)
+    assert m.idp == pytest.approx(0.5) and m.idr == pytest.approx(3 / 14)
+    assert m.precision == pytest.approx(5 / 6) and m.recall == pytest.approx(5 / 14)
+    # Smith: A's assigned track overlaps it in 2 of 5 frames (10 and 11 tie; 10 kept), B 1 of 4,
+    # C 0 -> mean (0.4 + 0.25 + 0) / 3; same for the strict variant here.
+    assert m.success_per_object == ((1, 0.4, 0.4), (2, 0.25, 0.25), (3, 0.0, 0.0))
+    assert m.success_rate == pytest.approx(0.65 / 3)
+    assert m.success_rate_strict == pytest.approx(0.65 / 3)
+    # Centroid distances: A-10 at frames 1, 2 -> 0, 3 px; B-20 at frame 1 -> 0 -> mean 1 px.
+    assert m.centroid_distance_px == pytest.approx(1.0)
+    assert m.centroid_distance_ratio == pytest.approx(1.0 / (400 * 300))
+    assert m.num_unique_objects == 3 and m.num_frames == 5
+
+
+def test_previous_correspondence_kept_over_better_match():
+    gt = rows((1, 1, 0, 0, 10, 10), (2, 1, 0, 0, 10, 10))
+    # Frame 2: result 5 still overlaps with IoU 70/130 >= 0.5, result 6 overlaps perfectly.
+    res = rows((1, 5, 0, 0, 10, 10), (2, 5, 3, 0, 10, 10), (2, 6, 0, 0, 10, 10))
+    m = evaluate_mot(gt, res)
+    assert m.num_switches == 0 and m.false_positives == 1 and m.num_matches == 2
+
+
+def test_switch_counted_across_gap():
+    gt = rows((1, 1, 0, 0, 10, 10), (2, 1, 0, 0, 10, 10), (3, 1, 0, 0, 10, 10))
+    res = rows((1, 5, 0, 0, 10, 10), (3, 6, 0, 0, 10, 10))
+    m = evaluate_mot(gt, res)
+    assert m.num_switches == 1 and m.num_fragmentations == 1 and m.misses == 1
+
+
+def test_ignored_ground_truth_and_scale():
+    # gt in a 2x larger frame: scale 0.5 maps it onto the result's coordinates.
+    gt = rows((1, 1, 0, 0, 20, 20), (1, 2, 100, 100, 20, 20, 0))
+    res = rows((1, 7, 0, 0, 10, 10), (1, 8, 50, 50, 10, 10), (1, 9, 150, 150, 10, 10))
+    m = evaluate_mot(gt, res, scale=0.5)
+    # Result 8 covers the conf-0 box: dropped, not an FP. Result 9 is an FP.
+    assert m.num_ignored_gt == 1 and m.num_ignored_predictions == 1
+    assert (m.num_objects, m.num_predictions, m.num_matches, m.false_positives) == (1, 2, 1, 1)
+    assert m.mota == pytest.approx(0.0)
+    unscaled = evaluate_mot(gt, res)
+    assert unscaled.num_matches == 0
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="iou_threshold"):
+        evaluate_mot(HAND_GT, HAND_RES, iou_threshold=0)
+    with pytest.raises(ValueError, match="scale"):
+        evaluate_mot(HAND_GT, HAND_RES, scale=-1)
+    with pytest.raises(ValueError, match="gt has shape"):
+        evaluate_mot(np.zeros((3, 4)), HAND_RES)
+    with pytest.raises(ValueError, match="image_size"):
+        evaluate_mot(HAND_GT, HAND_RES, image_size=(0, 10))
+
+
+def test_empty_result_and_format():
+    m = evaluate_mot(HAND_GT, np.zeros((0, 10)))
+    assert m.mota == 0.0 and m.misses == 14 and m.mostly_lost == 3
+    assert math.isnan(m.motp_iou) and m.idf1 == 0.0
+    text = format_metrics({"a": m, "b": evaluate_mot(HAND_GT, HAND_RES)})
+    assert "MOTA" in text and "IDF1" in text and text.count("\n") == 3
+    assert json.loads(m.to_json())["motp_iou"] is None
+    with pytest.raises(dataclasses_error()):
+        m.mota = 1.0  # type: ignore[misc]
+
+
+def dataclasses_error():
+    import dataclasses
+
+    return dataclasses.FrozenInstanceError
+
+
+def test_cli_eval(tmp_path, capsys):
+    write_mot(tmp_path / "gt.txt", HAND_GT)
+    write_mot(tmp_path / "res.txt", HAND_RES)
+    out = tmp_path / "m.json"
+    code = main(["eval", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt"),
+                 "--json", str(out)])
+    assert code == 0
+    assert "21.4" in capsys.readouterr().out  # MOTA 3/14 in percent
+    assert json.loads(out.read_text())["num_switches"] == 1
+    assert main(["eval", "--gt", str(tmp_path / "nope.txt"), "--res", str(out)]) == 2
+
+
+# ---- agreement with py-motmetrics on random cases -------------------------------------------
+
+
+def random_case(seed):
+    """Ground truth of walkers plus a noisy, fragmented, id-swapping result with clutter."""
+    rng = np.random.default_rng(seed)
+    n_frames = 40
+    gt, res = [], []
+    next_hid = 100
+    for oid in range(1, 8):
+        start = int(rng.integers(1, 20))
+        end = int(rng.integers(start + 3, n_frames + 1))
+        x, y = rng.uniform(0, 120, 2)
+        vx, vy = rng.normal(0, 2, 2)
+        w, h = rng.uniform(15, 30), rng.uniform(30, 60)
+        hid = next_hid
+        next_hid += 1
+        p_miss = rng.choice([0.05, 0.15, 0.5, 0.9])
+        for f in range(start, end + 1):
+            if rng.random() < 0.08:  # gt has a hole
+                continue
+            bx, by = x + vx * (f - start), y + vy * (f - start)
+            gt.append((f, oid, bx, by, w, h))
+            if rng.random() < 0.06:  # the tracker starts a new id
+                hid = next_hid
+                next_hid += 1
+            if rng.random() < p_miss:  # missed
+                continue
+            jitter = rng.normal(0, 0.12, 4) * [w, h, w, h]
+            res.append((f, hid, bx + jitter[0], by + jitter[1], w + jitter[2], h + jitter[3]))
+    for f in range(1, n_frames + 1):  # clutter near the walkers
+        for _ in range(int(rng.integers(0, 3))):
+            res.append((f, int(rng.integers(100, next_hid + 3)), *rng.uniform(0, 150, 2),
+                        rng.uniform(15, 30), rng.uniform(30, 60)))
+    # Swap two result ids over a stretch, to create identity switches.
+    res_a = rows(*res)
+    ids = np.unique(res_a[:, 1])
+    a, b = rng.choice(ids, 2, replace=False)
+    sel = (res_a[:, 0] > 15) & (res_a[:, 0] < 25)
+    ia, ib = sel & (res_a[:, 1] == a), sel & (res_a[:, 1] == b)
+    res_a[ia, 1], res_a[ib, 1] = b, a
+    # Keep ids unique within a frame (clutter may reuse one).
+    _, first = np.unique(res_a[:, :2], axis=0, return_index=True)
+    return rows(*gt), res_a[np.sort(first)]
+
+
+def motmetrics_summary(gt, res, thr=0.5):
+    mm = pytest.importorskip("motmetrics")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        acc = mm.MOTAccumulator(auto_id=False)
+        frames = sorted(set(gt[:, 0].astype(int)) | set(res[:, 0].astype(int)))
+        for f in frames:
+            g = gt[gt[:, 0] == f]
+            r = res[res[:, 0] == f]
+            d = 1.0 - iou_loop(g[:, 2:6], r[:, 2:6])
+            d = np.where(d > 1.0 - thr, np.nan, d)
+            acc.update(g[:, 1].astype(int).tolist(), r[:, 1].astype(int).tolist(), d, frameid=f)
+        names = ["mota", "motp", "idf1", "idp", "idr", "num_switches", "num_fragmentations",
+                 "mostly_tracked", "partially_tracked", "mostly_lost", "num_false_positives",
+                 "num_misses"]
+        s = mm.metrics.create().compute(acc, metrics=names, name="x")
+        return {k: float(s[k].iloc[0]) for k in names}
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_agrees_with_motmetrics(seed):
+    gt, res = random_case(seed)
+    ref = motmetrics_summary(gt, res)
+    m = evaluate_mot(gt, res)
+    assert m.num_switches > 0  # the cases do exercise switches
+    assert m.mota == pytest.approx(ref["mota"], abs=1e-12)
+    assert m.motp_iou == pytest.approx(1.0 - ref["motp"], abs=1e-12)
+    assert m.idf1 == pytest.approx(ref["idf1"], abs=1e-12)
+    assert m.idp == pytest.approx(ref["idp"], abs=1e-12)
+    assert m.idr == pytest.approx(ref["idr"], abs=1e-12)
+    assert m.num_switches == ref["num_switches"]
+    assert m.num_fragmentations == ref["num_fragmentations"]
+    assert m.mostly_tracked == ref["mostly_tracked"]
+    assert m.partially_tracked == ref["partially_tracked"]
+    assert m.mostly_lost == ref["mostly_lost"]
+    assert m.false_positives == ref["num_false_positives"]
+    assert m.misses == ref["num_misses"]
+
+
+def test_metrics_type():
+    assert isinstance(evaluate_mot(HAND_GT, HAND_GT), MotMetrics)
+    assert evaluate_mot(HAND_GT, HAND_GT).mota == 1.0

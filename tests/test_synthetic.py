@@ -1,0 +1,105 @@
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from pftrack.eval import iou_xywh
+from pftrack.io.mot import read_mot
+from pftrack.io.video import FrameSource
+from pftrack.synthetic import make_scene
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return make_scene()
+
+
+def test_deterministic(scene):
+    again = make_scene()
+    assert len(again.frames) == len(scene.frames) == 120
+    assert all(np.array_equal(a, b) for a, b in zip(scene.frames, again.frames))
+    np.testing.assert_array_equal(scene.truth, again.truth)
+    other = make_scene(rng=1)
+    assert not np.array_equal(other.frames[0], scene.frames[0])
+
+
+def test_frames_and_truth_layout(scene):
+    assert scene.frames[0].shape == (360, 480, 3) and scene.frames[0].dtype == np.uint8
+    t = scene.truth
+    assert t.shape[1] == 10 and len(t) > 0
+    assert t[:, 0].min() == 1 and t[:, 0].max() <= 120
+    assert set(np.unique(t[:, 1]).astype(int)) == set(range(1, 6))
+    left, top, w, h = t[:, 2], t[:, 3], t[:, 4], t[:, 5]
+    assert (left >= 0).all() and (top >= 0).all() and (w > 0).all() and (h > 0).all()
+    assert (left + w <= 480).all() and (top + h <= 360).all()
+    # ids unique within a frame
+    assert len(np.unique(t[:, :2], axis=0)) == len(t)
+    # someone is there from frame 1, somebody enters later and somebody leaves before the end
+    assert (t[:, 0] == 1).any()
+    firsts = [t[t[:, 1] == i, 0].min() for i in range(1, 6)]
+    lasts = [t[t[:, 1] == i, 0].max() for i in range(1, 6)]
+    assert max(firsts) > 1 and min(lasts) < 120
+    # fully visible walkers have people-like sizes
+    full = t[(left > 0) & (left + w < 480)]
+    assert 20 <= full[:, 4].min() and full[:, 4].max() <= 40
+    assert 50 <= full[:, 5].min() and full[:, 5].max() <= 100
+
+
+def test_walkers_are_drawn_where_truth_says(scene):
+    for row in scene.truth[::17]:
+        f, _, x, y, w, h = (int(v) for v in row[:6])
+        frame = scene.frames[f - 1].astype(np.int16)
+        diff = np.abs(frame - scene.background.astype(np.int16)).sum(axis=2)
+        assert (diff[y : y + h, x : x + w] > 60).mean() > 0.2
+
+
+def test_crossing_exists(scene):
+    t = scene.truth
+    crossed = False
+    for f in np.unique(t[:, 0]):
+        rows = t[t[:, 0] == f]
+        iou = iou_xywh(rows[:, 2:6], rows[:, 2:6])
+        np.fill_diagonal(iou, 0)
+        crossed |= bool((iou > 0).any())
+    assert crossed
+
+
+def test_occluder_occludes_someone(scene):
+    ox, oy, ow, oh = scene.occluder
+    t = scene.truth
+    behind = (t[:, 2] < ox) & (t[:, 2] + t[:, 4] > ox + ow)
+    assert behind.any()
+    f, _, x, y, w, h = (int(v) for v in t[np.flatnonzero(behind)[0], :6])
+    # the post's pixels are the background's there, up to sensor noise
+    post = scene.frames[f - 1][y : y + h, ox : ox + ow].astype(np.int16)
+    assert np.abs(post - scene.background[y : y + h, ox : ox + ow]).max() < 40
+    assert make_scene(n_frames=5, occluder=False).occluder is None
+
+
+def test_fast():
+    t = time.perf_counter()
+    make_scene(rng=5)
+    assert time.perf_counter() - t < 2.0  # < 1 s on a free core; slack for a busy CI
+
+
+def test_writers(tmp_path):
+    s = make_scene(n_frames=6, rng=2)
+    v = s.write_video(tmp_path / "scene.avi")
+    src = FrameSource(v)
+    assert (src.width, src.height) == (480, 360) and len(list(src)) == 6
+    folder = s.write_images(tmp_path / "img1")
+    assert sorted(p.name for p in folder.iterdir()) == [f"{k:06d}.png" for k in range(1, 7)]
+    np.testing.assert_array_equal(next(iter(FrameSource(folder))), s.frames[0])
+    s.write_truth(tmp_path / "gt.txt")
+    np.testing.assert_allclose(read_mot(tmp_path / "gt.txt"), s.truth, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [({"n_frames": 0}, "n_frames"), ({"width": 10}, "width"), ({"n_walkers": 0}, "n_walkers"),
+     ({"noise": -1.0}, "noise")],
+)
+def test_bad_arguments(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        make_scene(**kwargs)
