@@ -67,6 +67,8 @@ class TrackerConfig:
         the track's particles (the colour filter carries the track through the merge).
     coast_min_rho : float
         A coasting track is reported only while its colour match ``rho`` stays above this.
+    tentative_coast : int
+        Frames a not yet confirmed track may go without a detection before it is dropped.
     refine_boxes : bool
         With external detections, also run the background model and shrink each detection box
         to the rows and columns where its foreground is (static cameras: detector boxes are
@@ -93,6 +95,7 @@ class TrackerConfig:
     reference_rate: float = 0.05
     merge_ratio: float = 1.8
     coast_min_rho: float = 0.5
+    tentative_coast: int = 0
     refine_boxes: bool = True
     refine_fraction: float = 0.1
 
@@ -368,7 +371,10 @@ class MultiObjectTracker:
             t.score = t.rho
 
         # 4. tracks that coasted too long end; 5. unexplained detections start tracks
-        self.tracks = [t for t in self.tracks if t.time_since_update <= cfg.max_coast and not (t.hits < cfg.min_hits and t.time_since_update > 0)]
+        self.tracks = [
+            t for t in self.tracks
+            if t.time_since_update <= (cfg.max_coast if t.hits >= cfg.min_hits else min(cfg.max_coast, cfg.tentative_coast))
+        ]  # fmt: skip
         for di in unmatched_d:
             hist = det_hists[di]
             if hist.sum() <= 0:
