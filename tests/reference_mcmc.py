@@ -84,32 +84,39 @@ def mh_step(particles, bins, n_bins, ref, w0, h0, a, b, sigma, s_min, s_max, lam
 
     acc = prop = 0
     total = np.zeros(3)
-    for i, row in enumerate(particles):
-        mu = a * row[:3] + b * row[3:]
+    n = len(particles)
+    mus = a * particles[:, :3] + b * particles[:, 3:]
+    for i in range(n):
+        par = i
         base = lambda j: 4 * (i * (n_iter + 1) + j)  # noqa: E731
-        x = mu + sigma * np.array([rng.normal(base(0) + d) for d in range(3)])
+        x = mus[par] + sigma * np.array([rng.normal(base(0) + d) for d in range(3)])
         x[2] = min(max(x[2], s_min), s_max)
-        cur = loglik(x) + log_dyn(x, mu)
+        cur = loglik(x) + log_dyn(x, mus[par])
         for it in range(1, n_iter + 1):
             k = base(it)
             w = np.array([rng.normal(k + d) for d in range(3)])
-            xs = mu + sigma * w if proposal == "dynamics" else x + rw_sigma * w
-            ld = log_dyn(xs, mu)
+            if proposal == "dynamics":  # a parent j* of the whole set, then its dynamics
+                par_s = min(n - 1, int(rng.uniform(2 * (k + 3) + 1) * n))
+                xs = mus[par_s] + sigma * w
+            else:
+                par_s = par
+                xs = x + rw_sigma * w
+            ld = log_dyn(xs, mus[par_s])
             ok = False
             if np.isfinite(ld):
                 new = loglik(xs) + ld
-                # eq. 5 with q = dynamics (q(x|x*) / q(x*|x) = p(x) / p(x*)) or symmetric
+                # eq. 5 with q = dynamics mixture (q ratio = prior ratio) or a symmetric walk
                 log_a = new - cur
                 if proposal == "dynamics":
-                    log_a += log_dyn(x, mu) - ld
+                    log_a += log_dyn(x, mus[par]) - ld
                 ok = log_a >= 0 or rng.uniform(2 * (k + 3)) < math.exp(log_a)
             if ok:
-                x, cur = xs, new
+                x, cur, par = xs, new, par_s
             if it > burn_in:
                 prop += 1
                 acc += ok
                 total += x
-        out[i, 3:] = row[:3]
+        out[i, 3:] = particles[par, :3]
         out[i, :3] = x
     return out, total / prop, acc / prop
 

@@ -1,9 +1,12 @@
 // One step of a Metropolis-Hastings colour particle filter, one filter per object (the first
 // paper's method 2, algorithm 3, eq. 5):
 //   resample (systematic) -> for each particle i, a Markov chain of n_iter Metropolis-Hastings
-//   iterations whose target is the particle's posterior
-//       pi_i(x) ~ p(z | x) p(x | x_{t-1}^i)                      (colour likelihood x AR2 dynamics)
-//   started from a draw of the dynamics; each iteration proposes x* ~ q(x* | x) and accepts with
+//   iterations over (x, j), a state and the parent j in the resampled set it was predicted from,
+//   whose target is the filtering posterior with the particle approximation of the prediction
+//   (Khan, Balch & Dellaert 2005):
+//       pi(x, j) ~ p(z | x) (1/N) p(x | x_{t-1}^j)               (colour likelihood x AR2 dynamics)
+//   started at parent j = i with a draw of its dynamics; each iteration proposes x* ~ q(x* | x) and
+//   accepts with
 //       a = [p(z|x*) p(x*|x_{t-1}) q(x|x*)] / [p(z|x) p(x|x_{t-1}) q(x*|x)]        (eq. 5)
 //   (accept when u < a, u ~ U[0, 1); otherwise the chain keeps x).
 //
@@ -15,10 +18,12 @@
 // weights 1/N.
 //
 // Proposals q(x* | x):
-//   kDynamics:   x* ~ p(x* | x_{t-1}) = N(A x_{t-1} + B x_{t-2}, C^2), independent of x, so
-//                q(x | x*) = p(x | x_{t-1}) and eq. 5 reduces to p(z|x*) / p(z|x);
-//   kRandomWalk: x* = x + tau * w, w ~ N(0, I), symmetric, so eq. 5 reduces to
-//                p(z|x*) p(x*|x_{t-1}) / [p(z|x) p(x|x_{t-1})].
+//   kDynamics:   j* uniform in the resampled set, x* ~ p(x* | x_{t-1}^j*) = N(A x_{t-1}^j* +
+//                B x_{t-2}^j*, C^2), independent of (x, j), so q(x, j | x*, j*) = (1/N) p(x | x_{t-1}^j)
+//                and eq. 5 reduces to p(z|x*) / p(z|x): the chain can move to a better parent
+//                (after MCMC all weights are equal, so resampling alone would never select);
+//   kRandomWalk: x* = x + tau * w, w ~ N(0, I), same parent, symmetric, so eq. 5 reduces to
+//                p(z|x*) p(x*|x_{t-1}^j) / [p(z|x) p(x|x_{t-1}^j)].
 // Both are computed with every term of eq. 5 written out (log space), not with the reduced form.
 // The dynamics density is the Gaussian truncated to s in [s_min, s_max]: a proposal outside the
 // scale bounds has target 0 and is rejected. A component with C = 0 is deterministic.
@@ -104,7 +109,8 @@ inline MhEval mh_evaluate(HistogramScratch& scratch, std::vector<double>& hist, 
 /// Advances one particle set by one frame with per-particle MH chains. `particles` (N, 6),
 /// `weights` (N,) and `means` (2, 3) are updated in place, as in sis_step. All draws come from
 /// CounterRng(seed, step): particle i, chain position j (0 = start, 1..n_iter = proposals) uses
-/// normals 4 (i (n_iter + 1) + j) + {0, 1, 2} and the uniform of slot + 3.
+/// normals k + {0, 1, 2}, k = 4 (i (n_iter + 1) + j), the acceptance uniform 2 (k + 3) and the
+/// parent uniform 2 (k + 3) + 1 (the resampling uniform is the one of index 2^64 - 1).
 inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
                         Eigen::Ref<RowMatrixXd> means, const BinImage& img,
                         const Eigen::Ref<const Eigen::VectorXd>& ref, const MhParams& prm,
@@ -130,6 +136,16 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
         particles = kept;
     }
 
+    // Predictions mu_j = A x_{t-1}^j + B x_{t-2}^j of every (resampled) parent j   (eq. 7 / eq. 8)
+    RowMatrixXd mu(n, kStateDim);
+    const RowMatrixXd parents = particles.leftCols(kStateDim);
+    for (Index j = 0; j < n; ++j)
+        for (int d = 0; d < kStateDim; ++d) {
+            const double x1 = model.use_means ? means(0, d) : particles(j, d);
+            const double x2 = model.use_means ? means(1, d) : particles(j, kStateDim + d);
+            mu(j, d) = model.a[d] * x1 + model.b[d] * x2;
+        }
+
     HistogramScratch scratch(img.n_bins);
     std::vector<double> hist(static_cast<size_t>(img.n_bins));
     const std::uint64_t per_particle = static_cast<std::uint64_t>(prm.n_iter) + 1;
@@ -137,38 +153,35 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
     Eigen::VectorXd rho(n), counted(n), logpost(n);
     std::int64_t accepted = 0, proposed = 0;
     for (Index i = 0; i < n; ++i) {
-        double* row = particles.row(i).data();
-        // mu = A x_{t-1} + B x_{t-2}   (eq. 7; eq. 8 with the set means)
-        double mu[kStateDim];
-        for (int d = 0; d < kStateDim; ++d) {
-            const double x1 = model.use_means ? means(0, d) : row[d];
-            const double x2 = model.use_means ? means(1, d) : row[kStateDim + d];
-            mu[d] = model.a[d] * x1 + model.b[d] * x2;
-        }
         const auto slot = [&](std::uint64_t j) {
             return 4 * (static_cast<std::uint64_t>(i) * per_particle + j);
         };
-        // chain start: a draw of the dynamics (scale clamped, as in the SIS filter)
+        // chain start: parent j = i, x ~ p(x | x_{t-1}^i) (scale clamped, as in the SIS filter)
+        Index par = i;
         double x[kStateDim], xs[kStateDim];
         for (int d = 0; d < kStateDim; ++d)
-            x[d] = mu[d] + model.sigma[d] * rng.normal(slot(0) + static_cast<std::uint64_t>(d));
+            x[d] = mu(par, d) + model.sigma[d] * rng.normal(slot(0) + static_cast<std::uint64_t>(d));
         x[2] = std::clamp(x[2], model.s_min, model.s_max);
         detail::MhEval cur = detail::mh_evaluate(scratch, hist, img, sqref.data(), x, prm.base);
-        double cur_lp = ar2_log_density(x, mu, model);
+        double cur_lp = ar2_log_density(x, mu.row(par).data(), model);
         for (int it = 1; it <= prm.n_iter; ++it) {
             const std::uint64_t k = slot(static_cast<std::uint64_t>(it));
+            Index par_s = par;
+            if (prm.proposal == MhProposal::kDynamics)
+                par_s = std::min<Index>(n - 1, static_cast<Index>(rng.uniform(2 * (k + 3) + 1) *
+                                                                  static_cast<double>(n)));
             for (int d = 0; d < kStateDim; ++d) {
                 const double w = rng.normal(k + static_cast<std::uint64_t>(d));
-                xs[d] = prm.proposal == MhProposal::kDynamics ? mu[d] + model.sigma[d] * w
+                xs[d] = prm.proposal == MhProposal::kDynamics ? mu(par_s, d) + model.sigma[d] * w
                                                               : x[d] + prm.rw_sigma[d] * w;
             }
-            const double prop_lp = ar2_log_density(xs, mu, model);
+            const double prop_lp = ar2_log_density(xs, mu.row(par_s).data(), model);
             bool accept = false;
             detail::MhEval prop{};
             if (std::isfinite(prop_lp)) {
                 prop = detail::mh_evaluate(scratch, hist, img, sqref.data(), xs, prm.base);
-                // log q(x | x*) - log q(x* | x): dynamics proposal -> p(x|x_{t-1}) / p(x*|x_{t-1});
-                // random walk -> 0 (symmetric Gaussian).
+                // log q(x | x*) - log q(x* | x): dynamics proposal -> (1/N) p(x|x_{t-1}^j) /
+                // [(1/N) p(x*|x_{t-1}^j*)]; random walk -> 0 (symmetric Gaussian, same parent).
                 const double log_q_ratio =
                     prm.proposal == MhProposal::kDynamics ? cur_lp - prop_lp : 0.0;
                 // log a = log p(z|x*) + log p(x*|x_{t-1}) + log q(x|x*)
@@ -179,6 +192,7 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
             }
             if (accept) {
                 for (int d = 0; d < kStateDim; ++d) x[d] = xs[d];
+                par = par_s;
                 cur = prop;
                 cur_lp = prop_lp;
             }
@@ -188,8 +202,9 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
                 mean_sum += Eigen::Vector3d(x[0], x[1], x[2]);
             }
         }
+        double* row = particles.row(i).data();
         for (int d = 0; d < kStateDim; ++d) {
-            row[kStateDim + d] = row[d];
+            row[kStateDim + d] = parents(par, d);
             row[d] = x[d];
         }
         rho(i) = cur.rho;
