@@ -186,7 +186,8 @@ class RjReference:
                 if inter:
                     t -= p["interaction"] * inter / np.sum(masks[i] | masks[j])
         c, area = np.sum(union & self.fg), np.sum(union)
-        return t + p["coverage"] * (2.0 * c - area) / max(self.fg.sum(), 1)
+        eta = p["background_penalty"]
+        return t + p["coverage"] * (c - eta * (area - c)) / max(self.fg.sum(), 1)
 
     def birth_weight(self, slot, config):
         an = self.slots[slot]["anchor"]

@@ -159,7 +159,7 @@ void register_mcmc(py::module_& m) {
                          double p_update, double p_swap, const Eigen::Vector3d& a,
                          const Eigen::Vector3d& b, const Eigen::Vector3d& sigma, double s_min,
                          double s_max, double lam, const std::string& kernel, double interaction,
-                         double coverage, double birth_prior, double survival,
+                         double coverage, double background_penalty, double birth_prior, double survival,
                          double birth_sigma_xy, double birth_sigma_s, double birth_eps) {
                  RjParams p;
                  p.burn_in = burn_in;
@@ -177,6 +177,7 @@ void register_mcmc(py::module_& m) {
                  p.kernel = parse_kernel(kernel, "RJMCMCTracker");
                  p.interaction = interaction;
                  p.coverage = coverage;
+                 p.background_penalty = background_penalty;
                  p.birth_prior = birth_prior;
                  p.survival = survival;
                  p.birth_sigma_xy = birth_sigma_xy;
@@ -190,7 +191,7 @@ void register_mcmc(py::module_& m) {
              py::arg("b") = Eigen::Vector3d(-1.0, -1.0, -1.0),
              py::arg("sigma") = Eigen::Vector3d(4.0, 4.0, 0.02), py::arg("s_min") = 0.2,
              py::arg("s_max") = 5.0, py::arg("lam") = 20.0, py::arg("kernel") = "uniform",
-             py::arg("interaction") = 5.0, py::arg("coverage") = 10.0,
+             py::arg("interaction") = 5.0, py::arg("coverage") = 10.0, py::arg("background_penalty") = 0.25,
              py::arg("birth_prior") = 0.05, py::arg("survival") = 0.95,
              py::arg("birth_sigma_xy") = 3.0, py::arg("birth_sigma_s") = 0.05,
              py::arg("birth_eps") = 0.02)

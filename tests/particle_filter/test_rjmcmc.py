@@ -12,7 +12,7 @@ from tests import reference_mcmc as ref
 
 PARAMS = dict(burn_in=20, n_samples=150, p_birth=0.2, p_death=0.15, p_update=0.5, p_swap=0.15,
               a=(2.0, 2.0, 2.0), b=(-1.0, -1.0, -1.0), sigma=(3.0, 3.0, 0.03), s_min=0.5,
-              s_max=2.0, lam=15.0, kernel="uniform", interaction=4.0, coverage=8.0,
+              s_max=2.0, lam=15.0, kernel="uniform", interaction=4.0, coverage=8.0, background_penalty=0.4,
               birth_prior=2.0, survival=0.9, birth_sigma_xy=2.5, birth_sigma_s=0.04,
               birth_eps=0.05)
 BLOBS = [((30, 24), (200, 40, 30)), ((62, 30), (40, 200, 40)), ((90, 20), (30, 60, 220))]

@@ -9,13 +9,16 @@
 //   log pi(X) = sum_{i in X} [ -lambda D^2(q*_i, q(x_i))              colour likelihood (eq. 9-10)
 //                              + log P_i(x_i)                         predictive prior of i
 //                              + log omega_i                          prior odds that i is present
-//                              + kappa (2 fg(b_i) - |b_i|) / F ]      foreground coverage
+//                              + kappa cov(b_i) ]                     foreground coverage
 //             + sum_{i<j}  [ -gamma IoU(b_i, b_j)                     pairwise interaction prior
-//                            - kappa (2 fg(b_i & b_j) - |b_i & b_j|) / F ]   (inclusion-exclusion)
+//                            - kappa cov(b_i & b_j) ]                 (inclusion-exclusion)
+//
+//   cov(b) = [ fg(b) - eta (|b| - fg(b)) ] / F
 //
 // where fg(b) counts foreground pixels of box b (integral image of the mask), |b| its pixels,
-// F the frame's foreground pixels: the coverage term is kappa (2 C - A) / F with C the covered
-// foreground and A the covered area of the union of the boxes, exact while no three boxes overlap.
+// F the frame's foreground pixels: the coverage term is kappa [C - eta (A - C)] / F with C the
+// covered foreground and A the covered area of the union of the boxes (recall of the foreground
+// minus eta times the background covered), exact while no three boxes overlap.
 // P_i is, for an identity of the previous frame, the mixture of its AR2 predictions from the
 // previous kept samples that contain it,  P_i(x) = 1/N_i sum_n N(x; A x_n + B x'_n, C^2)
 // (Khan et al. 2005's factored predictive prior), and for a newborn of candidate k,
@@ -76,6 +79,7 @@ struct RjParams {
     Kernel kernel = Kernel::kUniform;
     double interaction = 5.0;   // gamma: log Psi = -gamma sum_{i<j} IoU
     double coverage = 10.0;     // kappa
+    double background_penalty = 0.25;  // eta
     double birth_prior = 0.05;  // beta: prior odds of a newborn
     double survival = 0.95;     // p_survive
     double birth_sigma_xy = 3.0, birth_sigma_s = 0.05;  // spread of P_k around a candidate
@@ -94,6 +98,8 @@ struct RjParams {
         check_lambda(lambda, fn);
         require(std::isfinite(interaction) && interaction >= 0.0, fn, "interaction", interaction, ">= 0");
         require(std::isfinite(coverage) && coverage >= 0.0, fn, "coverage", coverage, ">= 0");
+        require(std::isfinite(background_penalty) && background_penalty >= 0.0, fn,
+                "background_penalty", background_penalty, ">= 0");
         require(std::isfinite(birth_prior) && birth_prior > 0.0, fn, "birth_prior", birth_prior, "> 0");
         require(std::isfinite(survival) && survival > 0.0 && survival <= 1.0, fn, "survival",
                 survival, "in (0, 1]");
@@ -229,7 +235,9 @@ public:
 
     double coverage_of(const PixelRange& r) const {
         const double f = std::max(fg_.total, 1.0);
-        return prm_.coverage * (2.0 * fg_.count(r) - range_area(r)) / f;
+        const double c = fg_.count(r);
+        // cov(b) = [fg(b) - eta (|b| - fg(b))] / F
+        return prm_.coverage * (c - prm_.background_penalty * (range_area(r) - c)) / f;
     }
 
     /// The single-object term of log pi (-inf outside the scale bounds).

@@ -40,8 +40,10 @@ class RJMCMCConfig:
     interaction : float
         ``gamma``: the interaction prior is ``exp(-gamma sum_{i<j} IoU(b_i, b_j))``.
     coverage : float
-        ``kappa``: the coverage term is ``exp(kappa (2 C - A) / F)`` with C the foreground and A
-        the pixels covered by the union of the boxes, F the frame's foreground pixels.
+        ``kappa``: the coverage term is ``exp(kappa (C - eta (A - C)) / F)`` with C the foreground
+        and A the pixels covered by the union of the boxes, F the frame's foreground pixels.
+    background_penalty : float
+        ``eta``: weight of the background pixels covered, relative to the foreground.
     birth_prior : float
         ``beta``: prior odds of a newborn object.
     survival : float
@@ -70,6 +72,7 @@ class RJMCMCConfig:
     kernel: str = "uniform"
     interaction: float = 5.0
     coverage: float = 10.0
+    background_penalty: float = 0.25
     birth_prior: float = 0.05
     survival: float = 0.95
     birth_sigma_xy: float = 3.0
@@ -81,7 +84,7 @@ class RJMCMCConfig:
         """Keyword arguments of ``pftrack._core.RJMCMCTracker``."""
         out = {k: getattr(self, k) for k in (
             "burn_in", "n_samples", "p_birth", "p_death", "p_update", "p_swap", "s_min", "s_max",
-            "lam", "kernel", "interaction", "coverage", "birth_prior", "survival",
+            "lam", "kernel", "interaction", "coverage", "background_penalty", "birth_prior", "survival",
             "birth_sigma_xy", "birth_sigma_s", "birth_eps")}
         for k in ("a", "b", "sigma"):
             out[k] = np.asarray(getattr(self, k), dtype=np.float64)
