@@ -96,6 +96,31 @@ def test_rjmcmc_sequence(benchmark, seq, n_samples):
     benchmark.extra_info["frames_per_s"] = 1.0 / per_frame
 
 
+def box_iou(a, b) -> float:
+    """IoU of two (cx, cy, w, h) boxes."""
+    iw = max(0.0, min(a[0] + a[2] / 2, b[0] + b[2] / 2) - max(a[0] - a[2] / 2, b[0] - b[2] / 2))
+    ih = max(0.0, min(a[1] + a[3] / 2, b[1] + b[3] / 2) - max(a[1] - a[3] / 2, b[1] - b[3] / 2))
+    inter = iw * ih
+    return inter / (a[2] * a[3] + b[2] * b[3] - inter)
+
+
+def rjmcmc_quality(seq, first: int = FIRST, threshold: float = 0.4, **kw) -> tuple[float, float]:
+    """(recall, precision) of the RJ-MCMC estimates (existence >= 1/2) against PETS ground truth:
+    a box counts when it overlaps one of the other side with IoU >= threshold. A rough check, not
+    the experiment (the lead's evaluation uses pftrack.eval)."""
+    gt = np.loadtxt(DATA / "pets09-s2l1" / "gt.txt", delimiter=",")
+    t = _core.RJMCMCTracker(**kw)
+    hit_g = n_g = hit_e = n_e = 0
+    for k, (b, m, c) in enumerate(zip(*seq[:3])):
+        est = [e[1:5] for e in t.step(b, m, c, None, seed=1, step=k)["estimates"] if e[5] >= 0.5]
+        g = gt[gt[:, 0] == first + 1 + k, 2:6] * 0.625
+        g = [np.array([x + w / 2, y + h / 2, w, h]) for x, y, w, h in g]
+        hit_g += sum(any(box_iou(a, e) >= threshold for e in est) for a in g)
+        hit_e += sum(any(box_iou(a, e) >= threshold for a in g) for e in est)
+        n_g, n_e = n_g + len(g), n_e + len(est)
+    return hit_g / max(n_g, 1), hit_e / max(n_e, 1)
+
+
 def one_object(seq):
     binned, _, cands, _ = seq
     box = cands[0][0]
@@ -137,6 +162,10 @@ if __name__ == "__main__":
     for n_samples, burn_in in [(200, 50), (200, 0), (1000, 200)]:
         best = min(run_rjmcmc(s, n_samples, burn_in) for _ in range(3))
         print(f"| {n_samples} | {burn_in} | {1e3 * best[0]:.2f} | {1 / best[0]:.0f} | {best[1]:.2f} |")
+    if s[3] == "PETS09-S2L1":
+        for n_samples, burn_in in [(200, 50), (1000, 200)]:
+            rec, prec = rjmcmc_quality(s, n_samples=n_samples, burn_in=burn_in)
+            print(f"RJ-MCMC {n_samples}+{burn_in}: recall {rec:.2f}, precision {prec:.2f} (IoU >= 0.4)")
     b, box, ref = one_object(s)
     for kind, n, it in [("sis", 400, 1), ("mh", 200, 1), ("sis", 200, 1), ("mh", 100, 3)]:
         t0 = time.perf_counter()

@@ -190,9 +190,9 @@ void register_mcmc(py::module_& m) {
              py::arg("a") = Eigen::Vector3d(2.0, 2.0, 2.0),
              py::arg("b") = Eigen::Vector3d(-1.0, -1.0, -1.0),
              py::arg("sigma") = Eigen::Vector3d(4.0, 4.0, 0.02), py::arg("s_min") = 0.2,
-             py::arg("s_max") = 5.0, py::arg("lam") = 20.0, py::arg("kernel") = "uniform",
-             py::arg("interaction") = 5.0, py::arg("coverage") = 10.0, py::arg("background_penalty") = 0.25,
-             py::arg("birth_prior") = 0.05, py::arg("survival") = 0.95,
+             py::arg("s_max") = 5.0, py::arg("lam") = 10.0, py::arg("kernel") = "uniform",
+             py::arg("interaction") = 10.0, py::arg("coverage") = 20.0, py::arg("background_penalty") = 0.25,
+             py::arg("birth_prior") = 2.0, py::arg("survival") = 0.95,
              py::arg("birth_sigma_xy") = 3.0, py::arg("birth_sigma_s") = 0.05,
              py::arg("birth_eps") = 0.02)
         .def(

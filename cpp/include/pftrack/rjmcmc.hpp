@@ -75,12 +75,12 @@ struct RjParams {
     int n_samples = 200;
     double p_birth = 0.1, p_death = 0.1, p_update = 0.7, p_swap = 0.1;
     Ar2Model model;             // AR2 dynamics (use_means is ignored: each sample has its own past)
-    double lambda = 20.0;       // colour likelihood exp(-lambda D^2)
+    double lambda = 10.0;       // colour likelihood exp(-lambda D^2)
     Kernel kernel = Kernel::kUniform;
-    double interaction = 5.0;   // gamma: log Psi = -gamma sum_{i<j} IoU
-    double coverage = 10.0;     // kappa
+    double interaction = 10.0;  // gamma: log Psi = -gamma sum_{i<j} IoU
+    double coverage = 20.0;     // kappa
     double background_penalty = 0.25;  // eta
-    double birth_prior = 0.05;  // beta: prior odds of a newborn
+    double birth_prior = 2.0;   // beta: prior odds of a newborn
     double survival = 0.95;     // p_survive
     double birth_sigma_xy = 3.0, birth_sigma_s = 0.05;  // spread of P_k around a candidate
     double birth_eps = 0.02;    // eps of the birth weights

@@ -68,12 +68,12 @@ class RJMCMCConfig:
     sigma: tuple[float, float, float] = (4.0, 4.0, 0.02)
     s_min: float = 0.2
     s_max: float = 5.0
-    lam: float = 20.0
+    lam: float = 10.0
     kernel: str = "uniform"
-    interaction: float = 5.0
-    coverage: float = 10.0
+    interaction: float = 10.0
+    coverage: float = 20.0
     background_penalty: float = 0.25
-    birth_prior: float = 0.05
+    birth_prior: float = 2.0
     survival: float = 0.95
     birth_sigma_xy: float = 3.0
     birth_sigma_s: float = 0.05
