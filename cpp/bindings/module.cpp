@@ -9,6 +9,7 @@ void register_likelihood(py::module_& m);
 void register_resample(py::module_& m);
 void register_filter(py::module_& m);
 void register_detection(py::module_& m);
+void register_mcmc(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -17,4 +18,5 @@ PYBIND11_MODULE(_core, m) {
     register_resample(m);
     register_filter(m);
     register_detection(m);
+    register_mcmc(m);
 }

@@ -13,6 +13,8 @@ from pftrack.particle_filter.colour import (
 )
 from pftrack.particle_filter.dynamics import Ar2Model, estimate, propagate
 from pftrack.particle_filter.filter import ColourParticleFilter, FilterConfig, FilterState
+from pftrack.particle_filter.mh import MHConfig, MHParticleFilter, MHState, mh_step
+from pftrack.particle_filter.rjmcmc import RJMCMCConfig, RJMCMCFilter, RJTrack
 from pftrack.particle_filter.resample import (
     multinomial_resample,
     residual_resample,
@@ -27,12 +29,19 @@ __all__ = [
     "FilterConfig",
     "FilterState",
     "HsvBinning",
+    "MHConfig",
+    "MHParticleFilter",
+    "MHState",
+    "RJMCMCConfig",
+    "RJMCMCFilter",
+    "RJTrack",
     "bhattacharyya_coefficient",
     "bhattacharyya_distance",
     "bhattacharyya_weights",
     "box_histograms",
     "estimate",
     "hsv_bins",
+    "mh_step",
     "multinomial_resample",
     "propagate",
     "residual_resample",

@@ -1,0 +1,130 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from pftrack import _core
+from pftrack.particle_filter.mh import MHConfig, MHParticleFilter, mh_step
+from tests import reference_mcmc as ref
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(12345)
+
+
+A, B, SIGMA = [2.0, 2.0, 2.0], [-1.0, -1.0, -1.0], [4.0, 4.0, 0.02]
+
+
+def scene(rng: np.random.Generator, cx: int = 40, cy: int = 30):
+    frame = rng.integers(0, 256, (64, 96, 3), dtype=np.uint8)
+    mask = np.zeros((64, 96), np.uint8)
+    frame[cy - 10 : cy + 10, cx - 6 : cx + 6] = (30, 40, 200)
+    mask[cy - 14 : cy + 14, cx - 10 : cx + 10] = 1
+    return frame, mask
+
+
+def particles_at(n: int, cx: float, cy: float, vx: float = 0.0) -> np.ndarray:
+    return np.ascontiguousarray(np.tile([cx, cy, 1.0, cx - vx, cy, 1.0], (n, 1)))
+
+
+def call(p, w, m, img, r, seed=3, step=0, lam=20.0, n_iter=3, burn_in=1, proposal="dynamics",
+         rw=(2.0, 2.0, 0.01), sigma=SIGMA):
+    return _core.mh_step(p, w, m, img, r, 12.0, 20.0, A, B, sigma, 0.2, 5.0, False, lam, "uniform",
+                         True, seed, step, n_iter=n_iter, burn_in=burn_in, proposal=proposal,
+                         rw_sigma=np.asarray(rw, float))
+
+
+@pytest.mark.parametrize("proposal", ["dynamics", "random_walk"])
+def test_matches_numpy_reference(rng, proposal):
+    frame, mask = scene(rng)
+    img = _core.hsv_bins(frame, mask)
+    r = _core.box_histograms(img, np.array([[40.0, 30, 12, 20]]))[0]
+    p = particles_at(12, 37.0, 31.0, vx=1.0)
+    p[:, 0] += np.arange(12) * 0.5
+    w = np.full(12, 1 / 12)
+    m = np.zeros((2, 3))
+    expect, mean, acc = ref.mh_step(p, img.bins, img.n_bins, r, 12.0, 20.0, A, B, SIGMA, 0.2, 5.0,
+                                    20.0, 11, 4, 5, 2, proposal, (2.0, 2.0, 0.01))
+    out = call(p, w, m, img, r, seed=11, step=4, n_iter=5, burn_in=2, proposal=proposal)
+    np.testing.assert_allclose(p, expect, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(out["mean"], mean, atol=1e-9)
+    assert out["acceptance"] == pytest.approx(acc)
+    assert 0.0 < acc < 1.0  # the example exercises both outcomes
+    np.testing.assert_allclose(w, 1 / 12)
+    np.testing.assert_allclose(m[0], mean, atol=1e-9)
+
+
+def test_flat_likelihood_samples_the_dynamics(rng):
+    # lam = 0: the target is p(x | x_{t-1}) = N(A x1 + B x2, C^2); a random-walk chain must keep
+    # its draws distributed as that Gaussian (KS test per component).
+    frame, mask = scene(rng)
+    img = _core.hsv_bins(frame, mask)
+    r = _core.box_histograms(img, np.array([[40.0, 30, 12, 20]]))[0]
+    n = 3000
+    p = particles_at(n, 40.0, 30.0, vx=2.0)
+    sigma = [4.0, 4.0, 0.05]
+    out = call(p, np.full(n, 1 / n), np.zeros((2, 3)), img, r, lam=0.0, n_iter=20, burn_in=0,
+               proposal="random_walk", rw=(6.0, 6.0, 0.08), sigma=sigma)
+    mu = [42.0, 30.0, 1.0]
+    for d in range(3):
+        assert stats.kstest(p[:, d], "norm", args=(mu[d], sigma[d])).pvalue > 1e-3
+    assert 0.2 < out["acceptance"] < 0.9
+    # a wrong proposal ratio would not keep the law: a chain targeting a different scale fails
+    wrong = stats.kstest(p[:, 0], "norm", args=(mu[0], 1.3 * sigma[0])).pvalue
+    assert wrong < 1e-3
+
+
+def test_dynamics_proposal_with_flat_likelihood_accepts_everything(rng):
+    frame, mask = scene(rng)
+    img = _core.hsv_bins(frame, mask)
+    r = _core.box_histograms(img, np.array([[40.0, 30, 12, 20]]))[0]
+    out = call(particles_at(50, 40, 30), np.full(50, 0.02), np.zeros((2, 3)), img, r, lam=0.0)
+    assert out["acceptance"] == 1.0
+
+
+def test_fixed_seed_fixed_result(rng):
+    frame, mask = scene(rng)
+    img = _core.hsv_bins(frame, mask)
+    r = _core.box_histograms(img, np.array([[40.0, 30, 12, 20]]))[0]
+    runs = []
+    for seed in (5, 5, 6):
+        p = particles_at(40, 38, 29)
+        call(p, np.full(40, 1 / 40), np.zeros((2, 3)), img, r, seed=seed)
+        runs.append(p)
+    np.testing.assert_array_equal(runs[0], runs[1])
+    assert not np.array_equal(runs[0], runs[2])
+
+
+def test_errors(rng):
+    frame, mask = scene(rng)
+    img = _core.hsv_bins(frame, mask)
+    r = _core.box_histograms(img, np.array([[40.0, 30, 12, 20]]))[0]
+    p, w, m = particles_at(4, 40, 30), np.full(4, 0.25), np.zeros((2, 3))
+    with pytest.raises(ValueError, match="burn_in"):
+        call(p, w, m, img, r, n_iter=2, burn_in=2)
+    with pytest.raises(ValueError, match="n_iter"):
+        call(p, w, m, img, r, n_iter=0, burn_in=0)
+    with pytest.raises(ValueError, match="proposal"):
+        call(p, w, m, img, r, proposal="gibbs")
+    with pytest.raises(ValueError, match="weights size"):
+        call(p, np.full(3, 1 / 3), m, img, r)
+    with pytest.raises(ValueError, match="burn_in"):
+        MHConfig(n_iter=1, burn_in=1)
+    with pytest.raises(ValueError, match="box_cxcywh"):
+        MHParticleFilter([1, 2, 0, 4], r)
+
+
+def test_filter_follows_a_moving_object(rng):
+    cfg = MHConfig(n_particles=150, n_iter=2, burn_in=0, sigma=(3.0, 3.0, 0.01))
+    frame, _ = scene(rng, 30, 30)
+    img = _core.hsv_bins(frame)
+    r = _core.box_histograms(img, np.array([[30.0, 30, 12, 20]]))[0]
+    f = MHParticleFilter([30, 30, 12, 20], r, cfg, rng=1)
+    for t in range(1, 16):
+        cx = 30 + 2 * t
+        frame, _ = scene(np.random.default_rng(t), cx, 30)
+        state = f.step(_core.hsv_bins(frame))  # every pixel counted: shifts add clutter
+        assert 0.0 <= state.acceptance <= 1.0
+    assert abs(state.box_cxcywh[0] - cx) < 4 and abs(state.box_cxcywh[1] - 30) < 4
+    assert state.rho > 0.8

@@ -1,0 +1,210 @@
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from pftrack import _core
+from pftrack.particle_filter.rjmcmc import RJMCMCConfig, RJMCMCFilter
+from tests import reference_mcmc as ref
+
+PARAMS = dict(burn_in=20, n_samples=150, p_birth=0.2, p_death=0.15, p_update=0.5, p_swap=0.15,
+              a=(2.0, 2.0, 2.0), b=(-1.0, -1.0, -1.0), sigma=(3.0, 3.0, 0.03), s_min=0.5,
+              s_max=2.0, lam=15.0, kernel="uniform", interaction=4.0, coverage=8.0, background_penalty=0.4,
+              birth_prior=2.0, survival=0.9, birth_sigma_xy=2.5, birth_sigma_s=0.04,
+              birth_eps=0.05)
+BLOBS = [((30, 24), (200, 40, 30)), ((62, 30), (40, 200, 40)), ((90, 20), (30, 60, 220))]
+
+
+def scene(seed: int, blobs=BLOBS, shape=(48, 120)):
+    g = np.random.default_rng(seed)
+    frame = g.integers(0, 256, (*shape, 3), dtype=np.uint8)
+    mask = np.zeros(shape, np.uint8)
+    for (cx, cy), colour in blobs:
+        frame[cy - 9 : cy + 9, cx - 5 : cx + 5] = colour
+        mask[cy - 10 : cy + 10, cx - 6 : cx + 6] = 1
+    return frame, mask
+
+
+def boxes(blobs=BLOBS):
+    return np.array([[cx, cy, 10.0, 18.0] for (cx, cy), _ in blobs])
+
+
+def tracker(**kw):
+    return _core.RJMCMCTracker(**{**PARAMS, **kw})
+
+
+@pytest.fixture(scope="module")
+def model():
+    """A prepared frame with one identity from the previous frame (slot 0) and one newborn
+    candidate (slot 1), and its NumPy reference."""
+    t = tracker()
+    f0, m0 = scene(0, BLOBS[:1])
+    t.step(_core.hsv_bins(f0, m0), m0, boxes(BLOBS[:1]), seed=7, step=0)
+    assert len(t.tracks) == 1 and t.tracks[0]["existence"] > 0.5
+    f1, m1 = scene(1, BLOBS[:2])
+    img = _core.hsv_bins(f1, m1)
+    t.prepare(img, m1, boxes(BLOBS[1:2]))
+    slots = t.slots()
+    assert [s["candidate"] for s in slots] == [-1, 0]
+    return t, ref.RjReference(img.bins, img.n_bins, m1, slots, t.tracks, PARAMS)
+
+
+def positions(r: ref.RjReference, slot: int):
+    if slot == 0:
+        c = r.mu(0).mean(axis=0)
+    else:
+        an = r.slots[1]["anchor"]
+        c = np.array([an[0], an[1], 1.0])
+    return [c + d for d in ([0.0, 0.0, 0.0], [2.5, -1.5, 0.03], [-3.0, 2.0, -0.02])]
+
+
+def enumerate_states(r):
+    """At most 2 objects (slots 0, 1) on 6 shared positions: 1 + 12 + 36 states."""
+    grid = positions(r, 0) + positions(r, 1)
+    states = [()]
+    for slot in (0, 1):
+        states += [((slot, x),) for x in grid]
+    states += [((0, x), (1, y)) for x in grid for y in grid if not np.array_equal(x, y)]
+    return states
+
+
+def arrays(config):
+    slots = np.array([s for s, _ in config], dtype=np.int32)
+    states = np.array([np.concatenate([x, x]) for _, x in config]).reshape(-1, 6)
+    return slots, states
+
+
+def moves_between(x, y):
+    """(move, slot) pairs that take configuration x to y in one step."""
+    dx, dy = dict(x), dict(y)
+    if set(dy) - set(dx) and len(dy) == len(dx) + 1 and all(np.array_equal(dx[s], dy[s]) for s in dx):
+        return [("birth", (set(dy) - set(dx)).pop())]
+    if set(dx) - set(dy) and len(dx) == len(dy) + 1 and all(np.array_equal(dx[s], dy[s]) for s in dy):
+        return [("death", (set(dx) - set(dy)).pop())]
+    if set(dx) != set(dy):
+        return []
+    changed = [s for s in dx if not np.array_equal(dx[s], dy[s])]
+    out = [("update", changed[0])] if len(changed) == 1 else []
+    if len(dx) == 2 and np.array_equal(dx[0], dy[1]) and np.array_equal(dx[1], dy[0]) and changed:
+        out.append(("swap", -1))
+    return out
+
+
+def test_log_target_matches_numpy_reference(model):
+    t, r = model
+    for config in enumerate_states(r):
+        assert t.log_target(*arrays(config)) == pytest.approx(r.log_target(config), abs=1e-9)
+
+
+def test_detailed_balance_on_enumerated_states(model):
+    # pi(X) q(X'|X) min(1, r(X->X')) == pi(X') q(X|X') min(1, r(X'->X)) for every pair of the
+    # enumerated states, with pi and q from the NumPy reference and r from the C++ core.
+    t, r = model
+    states = enumerate_states(r)
+    n_checked = {"birth": 0, "death": 0, "update": 0, "swap": 0}
+    for x, y in itertools.permutations(states, 2):
+        for move, slot in moves_between(x, y):
+            reverse = {"birth": "death", "death": "birth"}.get(move, move)
+            fwd = t.log_acceptance(move, *arrays(x), *arrays(y), slot)
+            bwd = t.log_acceptance(reverse, *arrays(y), *arrays(x), slot)
+            lhs = r.log_target(x) + r.log_q(move, x, y, slot) + min(0.0, fwd)
+            rhs = r.log_target(y) + r.log_q(reverse, y, x, slot) + min(0.0, bwd)
+            assert lhs == pytest.approx(rhs, abs=1e-8), (move, x, y)
+            assert fwd == pytest.approx(-bwd, abs=1e-8)
+            n_checked[move] += 1
+    # births 12 + 2 x 30; updates 2 x 6 x 5 + 30 x 2 x 4; swaps: the 30 two-object states
+    assert n_checked == {"birth": 72, "death": 72, "update": 300, "swap": 30}
+
+
+def test_birth_then_death_returns_the_configuration(model):
+    t, r = model
+    x0 = positions(r, 0)[1]
+    start = arrays(((0, x0),))
+    born = t.propose("birth", *start, seed=3, step=1, k=0)
+    assert born is not None
+    slots, states, slot = born
+    assert slot == 1 and list(slots) == [0, 1]
+    np.testing.assert_array_equal(states[0], start[1][0])
+    for k in range(100):  # find the death draw that picks the newborn
+        back = t.propose("death", slots, states, seed=3, step=1, k=k)
+        if back[2] == slot:
+            np.testing.assert_array_equal(back[0], start[0])
+            np.testing.assert_array_equal(back[1], start[1])
+            break
+    else:
+        pytest.fail("no death draw picked the newborn")
+    assert t.propose("death", np.zeros(0, np.int32), np.zeros((0, 6)), seed=3, step=1, k=0) is None
+
+
+def test_swaps_never_duplicate_an_identity(model):
+    t, r = model
+    g = np.random.default_rng(0)
+    for k in range(200):
+        config = ((0, positions(r, 0)[k % 3] + g.normal(0, 1, 3) * [1, 1, 0]),
+                  (1, positions(r, 1)[(k // 3) % 3]))
+        slots, states = arrays(config)
+        out = t.propose("swap", slots, states, seed=11, step=2, k=k)
+        assert sorted(out[0]) == [0, 1]
+        np.testing.assert_array_equal(out[1][0], states[1])
+        np.testing.assert_array_equal(out[1][1], states[0])
+    assert t.propose("swap", slots[:1], states[:1], seed=11, step=2, k=0) is None
+
+
+def test_tracks_three_objects_with_unique_identities():
+    f = RJMCMCFilter(RJMCMCConfig(**PARAMS), rng=5)
+    for step in range(8):
+        moved = [((cx + step, cy), col) for (cx, cy), col in BLOBS]
+        frame, mask = scene(100 + step, moved)
+        out = f.step(_core.hsv_bins(frame, mask), mask, boxes(moved))
+        ids = [tr.id for tr in out]
+        assert len(ids) == len(set(ids))
+    assert len(out) == 3
+    for (cx, cy), _ in moved:
+        d = min(np.hypot(tr.box_cxcywh[0] - cx, tr.box_cxcywh[1] - cy) for tr in out)
+        assert d < 4.0
+    assert all(0.0 <= v <= 1.0 for v in f.acceptance.values() if not math.isnan(v))
+    assert f.map_estimate.shape[1] == 5
+
+
+def test_fixed_seed_fixed_result():
+    def run(seed):
+        f = RJMCMCFilter(RJMCMCConfig(**PARAMS), rng=seed)
+        out = []
+        for step in range(3):
+            frame, mask = scene(step)
+            f.step(_core.hsv_bins(frame, mask), mask, boxes())
+            out.append(f.last["estimates"])
+        return out
+
+    a, b, c = run(1), run(1), run(2)
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x, y)
+    assert any(x.shape != z.shape or not np.array_equal(x, z) for x, z in zip(a, c))
+
+
+def test_errors():
+    frame, mask = scene(0)
+    img = _core.hsv_bins(frame, mask)
+    with pytest.raises(ValueError, match="burn_in"):
+        tracker(burn_in=-1)
+    with pytest.raises(ValueError, match="p_birth and p_death"):
+        tracker(p_birth=0.0)
+    with pytest.raises(ValueError, match="sigma"):
+        tracker(sigma=(0.0, 1.0, 0.01))
+    t = tracker()
+    with pytest.raises(ValueError, match="mask"):
+        t.step(img, mask[:10], boxes(), seed=0, step=0)
+    with pytest.raises(ValueError, match="candidates"):
+        t.step(img, mask, np.array([[1.0, 2.0, -3.0, 4.0]]), seed=0, step=0)
+    with pytest.raises(ValueError, match="candidate_hists rows"):
+        t.step(img, mask, boxes(), np.ones((1, img.n_bins)), seed=0, step=0)
+    with pytest.raises(ValueError, match="prepare"):
+        t.log_target(np.zeros(0, np.int32), np.zeros((0, 6)))
+    t.prepare(img, mask, boxes())
+    with pytest.raises(ValueError, match="move"):
+        t.propose("split", np.zeros(0, np.int32), np.zeros((0, 6)), seed=0, step=0, k=0)
+    with pytest.raises(ValueError, match="distinct"):
+        t.log_target(np.array([0, 0], np.int32), np.ones((2, 6)))

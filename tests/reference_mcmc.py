@@ -1,0 +1,225 @@
+"""NumPy references for the MCMC samplers: each follows the documented semantics
+(docs/samplers.md, the comments of mh.hpp and rjmcmc.hpp), not the C++ code."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+MASK64 = (1 << 64) - 1
+
+
+# ---- counter-based random numbers (rng.hpp's documented SplitMix64 + Box-Muller) ----
+def mix64(z: int) -> int:
+    z = (z + 0x9E3779B97F4A7C15) & MASK64
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & MASK64
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK64
+    return z ^ (z >> 31)
+
+
+class CounterRng:
+    def __init__(self, seed: int, stream: int) -> None:
+        self.key = mix64(seed ^ mix64((stream + 0x5851F42D4C957F2D) & MASK64))
+
+    def uniform(self, k: int) -> float:
+        return (mix64(self.key ^ mix64(k & MASK64)) >> 11) * 2.0**-53
+
+    def normal(self, k: int) -> float:
+        u1 = 1.0 - self.uniform(2 * k)
+        u2 = self.uniform(2 * k + 1)
+        return math.sqrt(-2.0 * math.log(u1)) * math.cos(6.283185307179586 * u2)
+
+
+# ---- boxes, histograms, likelihood ----
+def box_pixels(cx, cy, w, h, rows, cols):
+    x0 = max(0, math.floor(cx - 0.5 * w + 0.5))
+    x1 = min(cols, math.floor(cx + 0.5 * w + 0.5))
+    y0 = max(0, math.floor(cy - 0.5 * h + 0.5))
+    y1 = min(rows, math.floor(cy + 0.5 * h + 0.5))
+    return x0, x1, y0, y1
+
+
+def box_mask(rng_box, shape):
+    x0, x1, y0, y1 = rng_box
+    m = np.zeros(shape, bool)
+    if x0 < x1 and y0 < y1:
+        m[y0:y1, x0:x1] = True
+    return m
+
+
+def histogram(bins, n_bins, box):
+    x0, x1, y0, y1 = box_pixels(*box, *bins.shape)
+    if x0 >= x1 or y0 >= y1:
+        return np.zeros(n_bins), 0.0
+    b = bins[y0:y1, x0:x1].ravel()
+    b = b[b >= 0]
+    h = np.bincount(b, minlength=n_bins).astype(float)
+    total = h.sum()
+    return (h / total if total > 0 else h), float(total)
+
+
+def colour_loglik(bins, n_bins, box, ref, lam):
+    h, _ = histogram(bins, n_bins, box)
+    rho = np.sum(np.sqrt(h * ref / ref.sum()))
+    return -lam * max(0.0, 1.0 - min(rho, 1.0))
+
+
+# ---- Metropolis-Hastings step (mh.hpp's documented draw layout), equal-weight input ----
+def mh_step(particles, bins, n_bins, ref, w0, h0, a, b, sigma, s_min, s_max, lam, seed, step,
+            n_iter, burn_in, proposal, rw_sigma):
+    """Returns (new particles, mean estimate, acceptance). Input weights must be equal
+    (systematic resampling then keeps every particle in order)."""
+    rng = CounterRng(seed, step)
+    out = particles.copy()
+    a, b, sigma, rw_sigma = (np.asarray(v, float) for v in (a, b, sigma, rw_sigma))
+
+    def log_dyn(x, mu):
+        if not s_min <= x[2] <= s_max:
+            return -np.inf
+        return -0.5 * np.sum(((x - mu) / sigma) ** 2)
+
+    def loglik(x):
+        return colour_loglik(bins, n_bins, (x[0], x[1], x[2] * w0, x[2] * h0), ref, lam)
+
+    acc = prop = 0
+    total = np.zeros(3)
+    n = len(particles)
+    mus = a * particles[:, :3] + b * particles[:, 3:]
+    for i in range(n):
+        par = i
+        base = lambda j: 4 * (i * (n_iter + 1) + j)  # noqa: E731
+        x = mus[par] + sigma * np.array([rng.normal(base(0) + d) for d in range(3)])
+        x[2] = min(max(x[2], s_min), s_max)
+        cur = loglik(x) + log_dyn(x, mus[par])
+        for it in range(1, n_iter + 1):
+            k = base(it)
+            w = np.array([rng.normal(k + d) for d in range(3)])
+            if proposal == "dynamics":  # a parent j* of the whole set, then its dynamics
+                par_s = min(n - 1, int(rng.uniform(2 * (k + 3) + 1) * n))
+                xs = mus[par_s] + sigma * w
+            else:
+                par_s = par
+                xs = x + rw_sigma * w
+            ld = log_dyn(xs, mus[par_s])
+            ok = False
+            if np.isfinite(ld):
+                new = loglik(xs) + ld
+                # eq. 5 with q = dynamics mixture (q ratio = prior ratio) or a symmetric walk
+                log_a = new - cur
+                if proposal == "dynamics":
+                    log_a += log_dyn(x, mus[par]) - ld
+                ok = log_a >= 0 or rng.uniform(2 * (k + 3)) < math.exp(log_a)
+            if ok:
+                x, cur, par = xs, new, par_s
+            if it > burn_in:
+                prop += 1
+                acc += ok
+                total += x
+        out[i, 3:] = particles[par, :3]
+        out[i, :3] = x
+    return out, total / prop, acc / prop
+
+
+# ---- RJ-MCMC target and proposals (rjmcmc.hpp header comment) ----
+class RjReference:
+    """The RJ-MCMC model of one frame, from its documented definition."""
+
+    def __init__(self, bins, n_bins, mask, slots, tracks, params):
+        self.bins, self.n_bins = bins, n_bins
+        self.fg = np.asarray(mask) != 0
+        self.slots, self.p = slots, params
+        self.tracks = {t["id"]: t for t in tracks}
+        self.a, self.b = np.asarray(params["a"], float), np.asarray(params["b"], float)
+        self.sigma = np.asarray(params["sigma"], float)
+
+    def box(self, slot, x):
+        s = self.slots[slot]
+        return (x[0], x[1], x[2] * s["w0"], x[2] * s["h0"])
+
+    def rng_box(self, slot, x):
+        return box_pixels(*self.box(slot, x), *self.bins.shape)
+
+    def mu(self, slot):
+        par = self.tracks[self.slots[slot]["id"]]["parents"]
+        return self.a * par[:, :3] + self.b * par[:, 3:]
+
+    def log_prior_pos(self, slot, x):
+        p = self.p
+        if not p["s_min"] <= x[2] <= p["s_max"]:
+            return -np.inf
+        s = self.slots[slot]
+        if s["candidate"] >= 0:
+            c = np.array([s["anchor"][0], s["anchor"][1], 1.0])
+            sd = np.array([p["birth_sigma_xy"], p["birth_sigma_xy"], p["birth_sigma_s"]])
+            return float(np.sum(-0.5 * ((x - c) / sd) ** 2 - np.log(sd) - 0.5 * np.log(2 * np.pi)))
+        mu = self.mu(slot)
+        comp = np.sum(-0.5 * ((x - mu) / self.sigma) ** 2 - np.log(self.sigma), axis=1)
+        comp -= 1.5 * np.log(2 * np.pi)
+        m = comp.max()
+        return float(m + np.log(np.mean(np.exp(comp - m))))
+
+    def log_omega(self, slot):
+        s = self.slots[slot]
+        if s["candidate"] >= 0:
+            return math.log(self.p["birth_prior"])
+        e = min(max(self.p["survival"] * self.tracks[s["id"]]["existence"], 1e-3), 1 - 1e-3)
+        return math.log(e / (1 - e))
+
+    def log_target(self, config):
+        p, t = self.p, 0.0
+        union = np.zeros(self.fg.shape, bool)
+        masks = []
+        for slot, x in config:
+            lp = self.log_prior_pos(slot, x)
+            if not np.isfinite(lp):
+                return -np.inf
+            ref = self.slots[slot]["ref"]
+            t += colour_loglik(self.bins, self.n_bins, self.box(slot, x), ref, p["lam"])
+            t += lp + self.log_omega(slot)
+            m = box_mask(self.rng_box(slot, x), self.fg.shape)
+            masks.append(m)
+            union |= m
+        for i in range(len(masks)):
+            for j in range(i + 1, len(masks)):
+                inter = np.sum(masks[i] & masks[j])
+                if inter:
+                    t -= p["interaction"] * inter / np.sum(masks[i] | masks[j])
+        c, area = np.sum(union & self.fg), np.sum(union)
+        eta = p["background_penalty"]
+        return t + p["coverage"] * (c - eta * (area - c)) / max(self.fg.sum(), 1)
+
+    def birth_weight(self, slot, config):
+        an = self.slots[slot]["anchor"]
+        if self.slots[slot]["candidate"] < 0:  # mean AR2 prediction, scale clamped
+            mean = self.mu(slot).mean(axis=0)
+            s = min(max(mean[2], self.p["s_min"]), self.p["s_max"])
+            an = (mean[0], mean[1], s * self.slots[slot]["w0"], s * self.slots[slot]["h0"])
+        am = box_mask(box_pixels(*an, *self.fg.shape), self.fg.shape)
+        area = am.sum()
+        if area == 0:
+            return self.p["birth_eps"]
+        share = np.sum(am & self.fg) / area
+        for s2, x in config:
+            share *= 1 - np.sum(am & box_mask(self.rng_box(s2, x), self.fg.shape)) / area
+        return self.p["birth_eps"] + share
+
+    def move_prob(self, m):
+        p = self.p
+        tot = p["p_birth"] + p["p_death"] + p["p_update"] + p["p_swap"]
+        return p["p_" + m] / tot
+
+    def log_q(self, move, config, to, slot):
+        """log q(X' | X) of one move."""
+        n = len(config)
+        if move == "birth":
+            present = {s for s, _ in config}
+            w = {s: self.birth_weight(s, config) for s in range(len(self.slots)) if s not in present}
+            x = dict(to)[slot]
+            return (math.log(self.move_prob("birth")) + math.log(w[slot] / sum(w.values()))
+                    + self.log_prior_pos(slot, x))
+        if move == "death":
+            return math.log(self.move_prob("death") / n)
+        if move == "update":
+            return math.log(self.move_prob("update") / n) + self.log_prior_pos(slot, dict(to)[slot])
+        return math.log(self.move_prob("swap") / (n * (n - 1) / 2))
