@@ -41,8 +41,10 @@ def _add_tracker_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--detector", choices=("paper", "mog2", "knn"), default="paper",
                    help="built-in detector: the paper's adaptive background (C++), or OpenCV's "
                         "MOG2/KNN (default paper)")
-    p.add_argument("--sampler", choices=("sis",), default="sis",
-                   help="per-object sampler: sequential importance sampling (default sis)")
+    p.add_argument("--sampler", choices=("sis", "mh", "rjmcmc"), default="sis",
+                   help="sis: one sequential-importance-sampling filter per object (the paper's "
+                        "method, default); mh: Metropolis-Hastings per object; rjmcmc: one joint "
+                        "RJ-MCMC chain over all objects (Smith et al. 2005)")
     p.add_argument("--dynamics", choices=("ar2", "ar2-mean"), default="ar2",
                    help="AR(2) model per particle (eq. 7) or from the particle-set means (eq. 8)")
     p.add_argument("--max-coast", type=int, default=10, metavar="FRAMES",

@@ -25,6 +25,9 @@ from pftrack.particle_filter import (
     ColourParticleFilter,
     FilterConfig,
     HsvBinning,
+    MHColourParticleFilter,
+    RJMCMCConfig,
+    RJMCMCFilter,
     bhattacharyya_coefficient,
     box_histograms,
     hsv_bins,
@@ -43,8 +46,13 @@ class TrackerConfig:
         Particles per object, AR(2) dynamics (eq. 7, or eq. 8 with ``use_means``), λ.
     binning : HsvBinning
         HSV histogram layout (110 bins by default).
-    sampler : {"sis"}
-        The per-object sampler ("mh" and "rjmcmc" are the paper's comparison samplers).
+    sampler : {"sis", "mh", "rjmcmc"}
+        Sequential importance sampling per object (the paper's method), Metropolis-Hastings per
+        object, or one joint RJ-MCMC chain over all objects (Smith et al. 2005): the paper's
+        comparison samplers.
+    rjmcmc : RJMCMCConfig
+        Settings of the joint sampler (used with ``sampler="rjmcmc"``); its sample count is
+        set from ``filter.n_particles`` so that budgets compare.
     detector : {"paper", "mog2", "knn"}
         Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections.
     max_coast : int
@@ -84,6 +92,7 @@ class TrackerConfig:
         )
     )
     binning: HsvBinning = field(default_factory=HsvBinning)
+    rjmcmc: RJMCMCConfig = field(default_factory=RJMCMCConfig)
     sampler: str = "sis"
     detector: str = "paper"
     max_coast: int = 10
@@ -213,7 +222,8 @@ class _TrackState:
     def __init__(self, track_id: int, box_xywh: NDArray[np.float64], reference: NDArray[np.float64],
                  config: TrackerConfig, seed: int, score: float) -> None:  # fmt: skip
         self.id = track_id
-        self.filter = ColourParticleFilter(_xywh_to_cxcywh(box_xywh), reference, config.filter, rng=seed)
+        cls = MHColourParticleFilter if config.sampler == "mh" else ColourParticleFilter
+        self.filter = cls(_xywh_to_cxcywh(box_xywh), reference, config.filter, rng=seed)
         self.box = box_xywh.copy()
         self.size = box_xywh[2:].copy()  # smoothed detection size
         self.velocity = np.zeros(2)
@@ -257,6 +267,7 @@ class MultiObjectTracker:
         self.tracks: list[_TrackState] = []
         self.frame_index = 0
         self.last_mask: NDArray[np.uint8] | None = None
+        self._joint: RJMCMCFilter | None = None
 
     # -- detections -------------------------------------------------------------------------
     def _detect(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64], Any]:
@@ -319,13 +330,15 @@ class MultiObjectTracker:
         else:
             boxes, scores = self._check_detections(detections, f.shape[:2])
             binned = hsv_bins(f, None, cfg.binning)
-            if cfg.refine_boxes:
+            if cfg.refine_boxes or cfg.sampler == "rjmcmc":
                 _, _, _ = self._detect(f)
-                if self.last_mask is not None and len(boxes):
+                if cfg.refine_boxes and self.last_mask is not None and len(boxes):
                     boxes = refine_boxes(boxes, self.last_mask, cfg.refine_fraction)
         keep = scores >= cfg.min_score
         index = np.flatnonzero(keep)
         boxes, scores = boxes[keep], scores[keep]
+        if cfg.sampler == "rjmcmc":
+            return self._update_joint(f, binned, boxes, scores, index)
 
         # 1. every track's particle filter looks at this frame
         for t in self.tracks:
@@ -385,6 +398,30 @@ class MultiObjectTracker:
             self.tracks.append(t)
 
         return self._report()
+
+    def _update_joint(self, frame: NDArray[np.uint8], binned: Any, boxes: NDArray[np.float64],
+                      scores: NDArray[np.float64], index: NDArray[np.intp]) -> list[Track]:  # fmt: skip
+        """One frame of the joint RJ-MCMC sampler: detections are its birth candidates."""
+        if self._joint is None:
+            from dataclasses import replace
+
+            rj = replace(self.config.rjmcmc, n_samples=self.config.filter.n_particles)
+            self._joint = RJMCMCFilter(rj, rng=self._rng)
+        mask = self.last_mask
+        if mask is None or mask.shape != frame.shape[:2]:
+            mask = np.full(frame.shape[:2], 255, np.uint8)  # no background model: all foreground
+        estimates = self._joint.step(binned, mask, _xywh_to_cxcywh(boxes))
+        out = []
+        ebox = np.array([_cxcywh_to_xywh(e.box_cxcywh) for e in estimates]).reshape(-1, 4)
+        iou = iou_matrix(ebox, boxes) if len(boxes) else np.zeros((len(estimates), 0))
+        for k, e in enumerate(estimates):
+            j = int(np.argmax(iou[k])) if iou.shape[1] else -1
+            matched = j >= 0 and iou[k, j] >= 0.5
+            out.append(Track(id=int(e.id), box_xywh=ebox[k].copy(),
+                             score=float(scores[j]) if matched else float(e.score),
+                             detection_index=int(index[j]) if matched else None,
+                             age=self.frame_index, time_since_update=0 if matched else 1))  # fmt: skip
+        return out
 
     def _shared(self, di: int, boxes: NDArray[np.float64], ti: int) -> bool:
         """Does detection `di` also cover another live track (a merged blob)?"""

@@ -13,7 +13,13 @@ from pftrack.particle_filter.colour import (
 )
 from pftrack.particle_filter.dynamics import Ar2Model, estimate, propagate
 from pftrack.particle_filter.filter import ColourParticleFilter, FilterConfig, FilterState
-from pftrack.particle_filter.mh import MHConfig, MHParticleFilter, MHState, mh_step
+from pftrack.particle_filter.mh import (
+    MHColourParticleFilter,
+    MHConfig,
+    MHParticleFilter,
+    MHState,
+    mh_step,
+)
 from pftrack.particle_filter.rjmcmc import RJMCMCConfig, RJMCMCFilter, RJTrack
 from pftrack.particle_filter.resample import (
     multinomial_resample,
@@ -29,6 +35,7 @@ __all__ = [
     "FilterConfig",
     "FilterState",
     "HsvBinning",
+    "MHColourParticleFilter",
     "MHConfig",
     "MHParticleFilter",
     "MHState",

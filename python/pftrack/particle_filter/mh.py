@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
 from pftrack._typing import RngLike
+from pftrack.particle_filter.filter import ColourParticleFilter, FilterConfig, FilterState
 
 _PROPOSALS = ("dynamics", "random_walk")
 _KERNELS = ("uniform", "epanechnikov")
@@ -234,3 +235,44 @@ class MHParticleFilter:
         box = np.array([x[0], x[1], x[2] * self.w0, x[2] * self.h0])
         return MHState(box, float(r["acceptance"]), float(r["rho_mean"]), float(r["rho_max"]),
                        float(r["ess"]), float(r["fg_mean"]))
+
+
+class MHColourParticleFilter(ColourParticleFilter):
+    """:class:`~pftrack.particle_filter.ColourParticleFilter` whose step is Metropolis-Hastings.
+
+    Same construction, re-seeding and reference handling as the SIS filter (so the tracker can
+    swap samplers), with ``_core.mh_step`` in place of ``sis_step``: resample, then for each
+    particle propose ``x*`` from the AR(2) dynamics and accept with the paper's eq. 5.
+
+    Parameters
+    ----------
+    box_cxcywh, reference, config, rng, velocity
+        As for :class:`~pftrack.particle_filter.ColourParticleFilter`.
+    n_iter : int
+        MH iterations per particle and frame.
+    """
+
+    def __init__(self, box_cxcywh: ArrayLike, reference: ArrayLike,
+                 config: FilterConfig = FilterConfig(), rng: RngLike = None,
+                 velocity: ArrayLike = (0.0, 0.0), n_iter: int = 1) -> None:  # fmt: skip
+        super().__init__(box_cxcywh, reference, config, rng, velocity)
+        self.n_iter = int(n_iter)
+        self.acceptance = float("nan")
+
+    def step(self, image: _core.BinnedImage) -> FilterState:
+        """Advance one frame with MH moves; records ``acceptance``."""
+        m = self.config.model
+        r = _core.mh_step(
+            self.particles, self.weights, self.means, image, self.reference,
+            self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+            self.config.lam, self.config.kernel, True, self._seed, self._step,
+            n_iter=self.n_iter, burn_in=0, proposal="dynamics",
+            rw_sigma=np.array([2.0, 2.0, 0.01]),
+        )  # fmt: skip
+        self._step += 1
+        self.acceptance = float(r["acceptance"])
+        cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
+        state = FilterState(np.array([cx, cy, s * self.w0, s * self.h0]), float(r["rho_mean"]),
+                            float(r["rho_max"]), float(r["ess"]), float(r["fg_mean"]))  # fmt: skip
+        self.last = state
+        return state
