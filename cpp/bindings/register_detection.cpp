@@ -97,7 +97,7 @@ void register_detection(py::module_& m) {
                 if (!s.initialized()) return py::none();
                 py::array_t<float> a({static_cast<py::ssize_t>(s.rows()),
                                       static_cast<py::ssize_t>(s.cols()), py::ssize_t(3)});
-                std::copy(s.background().begin(), s.background().end(), a.mutable_data());
+                s.background_bgr(a.mutable_data());
                 return a;
             },
             "Copy of the background (H, W, 3) float32 BGR, or None before the first frame.")
