@@ -168,3 +168,21 @@ def test_pets_smoke():
         if i == 60:
             break
     assert total > 100 and found / total > 0.6
+
+
+def test_blob_boxes_equal_connected_components():
+    """Outer contours give the boxes of cv2.connectedComponentsWithStats (8-connectivity)."""
+    from pftrack.detection.base import BlobExtractor
+
+    rng = np.random.default_rng(11)
+    ext = BlobExtractor(BlobConfig(min_area=0.0, min_aspect=1e-3, max_aspect=1e3, min_fill=0.0, max_area=1.0))
+    for _ in range(5):
+        mask = ((rng.random((60, 80)) > 0.93) * 255).astype(np.uint8)
+        mask = cv2.dilate(mask, np.ones((2, 2), np.uint8))
+        boxes, scores = ext.boxes(mask)
+        n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        # drop components nested in another's hole (RETR_EXTERNAL skips those)
+        want = {tuple(s[:4]) for s in stats[1:]}
+        got = {tuple(b) for b in boxes.astype(int)}
+        assert got <= want and len(got) >= 0.9 * len(want)
+        assert (scores > 0).all() and (scores <= 1).all()
