@@ -29,9 +29,11 @@ def hsv_bin_reference(bgr: np.ndarray, n_h=10, n_s=10, n_v=10, s_min=0.1, v_min=
 class BackgroundReference:
     """The algorithm of BackgroundModel, one NumPy step per stage, float32 like the C++."""
 
-    def __init__(self, alpha=0.05, alpha_fg=0.005, k_noise=4.0, t_min=25.0, t_max=60.0,
+    def __init__(self, alpha=0.05, alpha_fg=0.005, n_learn=30, k_noise=4.0, t_min=25.0, t_max=60.0,
                  low_ratio=0.5, shadow_lo=0.5, shadow_chroma=0.03):
         self.alpha, self.alpha_fg, self.k_noise = alpha, alpha_fg, k_noise
+        self.n_learn = n_learn
+        self.frame_count = 0
         self.t_min, self.t_max, self.low_ratio = t_min, t_max, low_ratio
         self.shadow_lo, self.shadow_chroma = shadow_lo, shadow_chroma
         self.background = None
@@ -45,6 +47,7 @@ class BackgroundReference:
             self.background = f.copy()
             self.previous = frame.copy()
             self.threshold = self.t_min
+            self.frame_count = 1
             return bins, np.zeros(frame.shape[:2], np.uint8)
         bg = self.background
         t = np.float32(self.threshold)
@@ -61,7 +64,13 @@ class BackgroundReference:
             chroma_ok &= np.abs(f[..., c] * s_b - bg[..., c] * s_i) <= tol
         shadow = cand & (s_i < s_b) & (s_i >= np.float32(self.shadow_lo) * s_b) & (s_i > 0) & chroma_ok
         fore = cand & ~shadow
-        a = np.where(cand, np.float32(self.alpha_fg), np.float32(self.alpha))[..., None]
+        k = self.frame_count + 1  # this frame's number
+        if k <= self.n_learn:
+            a_bg = a_fg = max(1.0 / k, self.alpha)
+        else:
+            a_bg, a_fg = self.alpha, self.alpha_fg
+        a = np.where(cand, np.float32(a_fg), np.float32(a_bg))[..., None]
+        self.frame_count = k
         self.background = bg + a * e
         self.previous = frame.copy()
         hist = np.bincount(np.minimum(d_bg.astype(np.int32), 255).ravel(), minlength=256)

@@ -42,7 +42,8 @@ def test_hsv_reference_matches_core_on_random_pixels():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize(
-    "kw", [{}, {"alpha": 0.3, "alpha_fg": 0.0, "k_noise": 6.0, "t_min": 8.0, "low_ratio": 0.3},
+    "kw", [{}, {"alpha": 0.3, "alpha_fg": 0.0, "k_noise": 6.0, "t_min": 8.0, "low_ratio": 0.3,
+                "n_learn": 3},
            {"shadow_lo": 1.0, "t_max": 25.0}]
 )
 def test_background_model_matches_reference(seed, kw):
@@ -63,7 +64,7 @@ def test_background_model_matches_reference(seed, kw):
 
 def test_selective_update_and_shadow_are_not_learnt():
     bg = np.full((20, 20, 3), 100, np.uint8)
-    m = _core.BackgroundModel(alpha=0.5, alpha_fg=0.0, t_min=20.0, t_max=20.0)
+    m = _core.BackgroundModel(alpha=0.5, alpha_fg=0.0, n_learn=0, t_min=20.0, t_max=20.0)
     m.apply(bg)
     f = bg.copy()
     f[:5, :5] = 200  # foreground: background stays 100 there

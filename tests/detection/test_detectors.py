@@ -149,17 +149,19 @@ def test_factory_and_errors():
 
 @pytest.mark.dataset
 def test_pets_smoke():
-    """On 60 PETS frames, most people far from others are found (a loose recall check)."""
+    """On 60 PETS frames, primed with the first 30, most people are found (a loose recall check)."""
     from pftrack.io.mot import group_by_frame, read_mot
     from pftrack.io.video import FrameSource
 
     seq = data_dir() / "pets09-s2l1"
     gt = group_by_frame(read_mot(seq / "gt.txt"))
     det = PaperDetector()
+    src = FrameSource(seq / "video.avi")
+    det.prime(f for f, _ in zip(src, range(30)))
     found = total = 0
-    for i, frame in enumerate(FrameSource(seq / "video.avi"), start=1):
+    for i, frame in enumerate(src, start=1):
         d = det.detect(frame)
-        if i > 20 and len(d):
+        if len(d):
             c = d.boxes[:, :2] + d.boxes[:, 2:] / 2
             for g in gt.get(i, np.zeros((0, 10)))[:, 2:6] * 0.625:
                 gc = g[:2] + g[2:] / 2
@@ -167,7 +169,7 @@ def test_pets_smoke():
                 found += bool((np.abs(c - gc) < g[2:] / 2).all(axis=1).any())
         if i == 60:
             break
-    assert total > 100 and found / total > 0.6
+    assert total > 200 and found / total > 0.75, (found, total)
 
 
 def test_blob_boxes_equal_connected_components():

@@ -102,6 +102,9 @@ private:
 struct BackgroundConfig {
     double alpha = 0.05;      // running-average rate where the pixel is background (selective update)
     double alpha_fg = 0.005;  // slow rate where it is foreground (absorbs stopped objects; 0 = off)
+    int n_learn = 30;         // frames 2 .. n_learn update every pixel at max(1 / k, alpha) (k-th
+                              // frame): a running mean that averages out objects of the first
+                              // frame (their "ghosts"); 0 or 1 = selective from the start
     double k_noise = 4.0;     // threshold = k_noise * median background difference of the last frame
     double t_min = 25.0;      // ... clamped to [t_min, t_max]
     double t_max = 60.0;
@@ -116,6 +119,7 @@ struct BackgroundConfig {
     void validate(const char* fn) const {
         require(alpha > 0.0 && alpha <= 1.0, fn, "alpha", alpha, "in (0, 1]");
         require(alpha_fg >= 0.0 && alpha_fg <= 1.0, fn, "alpha_fg", alpha_fg, "in [0, 1]");
+        require(n_learn >= 0, fn, "n_learn", n_learn, ">= 0");
         require(k_noise >= 0.0 && k_noise <= 1e6, fn, "k_noise", k_noise, "in [0, 1e6]");
         require(t_min >= 0.0 && t_min <= 255.0, fn, "t_min", t_min, "in [0, 255]");
         require(t_max >= t_min && t_max <= 255.0, fn, "t_max", t_max, "in [t_min, 255]");
@@ -205,8 +209,9 @@ PFTRACK_VECTOR_CLONES static void background_row_update(
 ///   (c) candidate = d_bg > T or (d_prev > T and d_bg > low_ratio * T); a candidate that is a
 ///       shadow (see BackgroundConfig) is not foreground; mask 255/0,
 ///   (d) background_c += a (frame_c - background_c), a = alpha where not a candidate, alpha_fg
-///       where a candidate (foreground or shadow) (float32 arithmetic, in this order, so a
-///       NumPy reference matches bit for bit),
+///       where a candidate (foreground or shadow); a = max(1 / k, alpha) everywhere for the
+///       k-th frame while k <= n_learn (float32 arithmetic, in this order, so a NumPy
+///       reference matches bit for bit),
 ///   (e) stores the frame as the previous one, and counts floor(d_bg) in a 256-bin histogram.
 /// T for the next frame = clamp(k_noise * median(d_bg), t_min, t_max), the median read from that
 /// histogram with linear interpolation inside its bin: a robust noise level, since most pixels
@@ -251,8 +256,10 @@ public:
     }
 
     /// Set the background (rows x cols x 3 floats, BGR); the previous frame becomes its rounding.
+    /// No learning phase follows.
     void set_background(const float* bgr, Index rows, Index cols) {
         allocate(rows, cols);
+        learning_ = false;  // a given background needs no learning phase
         for (Index y = 0; y < rows; ++y)
             for (Index x = 0; x < cols; ++x)
                 for (int c = 0; c < 3; ++c) {
@@ -277,8 +284,11 @@ public:
                     ", 3); call reset() before a new video");
         const float t = static_cast<float>(threshold_);
         const float t_low = static_cast<float>(config_.low_ratio * threshold_);
-        const float a_bg = static_cast<float>(config_.alpha);
-        const float a_fg = static_cast<float>(config_.alpha_fg);
+        // learning phase: the k-th frame (k = frame_count_ + 1 <= n_learn) updates everywhere
+        const bool learning = learning_ && frame_count_ + 1 <= config_.n_learn;
+        const double a_learn = std::max(1.0 / static_cast<double>(frame_count_ + 1), config_.alpha);
+        const float a_bg = static_cast<float>(learning ? a_learn : config_.alpha);
+        const float a_fg = static_cast<float>(learning ? a_learn : config_.alpha_fg);
         const float s_lo = static_cast<float>(config_.shadow_lo);
         const float s_chroma = static_cast<float>(config_.shadow_chroma);
         // Four interleaved histograms: consecutive pixels mostly fall in the same bin, and
@@ -356,6 +366,7 @@ private:
     void first_frame(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride,
                      std::int16_t* bins, std::uint8_t* mask) {
         allocate(rows, cols);
+        learning_ = true;
         for (Index y = 0; y < rows; ++y) {
             const std::uint8_t* px = bgr + y * row_stride;
             for (Index x = 0; x < cols; ++x) {
@@ -391,6 +402,7 @@ private:
     HsvLut lut_;
     Index rows_ = 0, cols_ = 0;
     long frame_count_ = 0;
+    bool learning_ = false;  // started from a frame (not set_background): learning phase on
     double threshold_ = 0.0;
     std::vector<float> background_;      // planar rows: [y][channel][x]
     std::vector<std::uint8_t> previous_;  // interleaved, as the frame
