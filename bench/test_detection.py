@@ -1,6 +1,6 @@
 """Detection speed: the fused C++ pass vs OpenCV's MOG2 vs the NumPy reference, same frames.
 
-    pytest bench/test_detection.py --benchmark-only --benchmark-group-by=group
+pytest bench/test_detection.py --benchmark-only --benchmark-group-by=group
 """
 
 from __future__ import annotations
@@ -15,17 +15,16 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from reference_detection import BackgroundReference  # noqa: E402
-
 from pftrack import _core  # noqa: E402
 from pftrack.detection import make_detector  # noqa: E402
+from reference_detection import BackgroundReference  # noqa: E402
 
 SIZES = {"480x360": (480, 360), "768x576": (768, 576)}
-N_FRAMES = 30
+N_FRAMES = 60
 
 
 def load_frames(size: tuple[int, int]) -> list[np.ndarray]:
-    """30 PETS09-S2L1 frames resized to `size`, or synthetic ones without the data."""
+    """60 PETS09-S2L1 frames resized to `size`, or synthetic ones without the data."""
     root = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
     video = Path(os.environ.get("PFTRACK_DATA", root)) / "pets09-s2l1" / "video.avi"
     frames = []
@@ -35,7 +34,9 @@ def load_frames(size: tuple[int, int]) -> list[np.ndarray]:
             ok, f = cap.read()
             if not ok:
                 break
-            frames.append(cv2.resize(f, size, interpolation=cv2.INTER_LINEAR) if f.shape[1::-1] != size else f)
+            frames.append(
+                cv2.resize(f, size, interpolation=cv2.INTER_LINEAR) if f.shape[1::-1] != size else f
+            )
         cap.release()
     if len(frames) < N_FRAMES:
         rng = np.random.default_rng(0)
@@ -66,7 +67,16 @@ def test_core_background_pass(benchmark, frames):
     benchmark(cycle_apply(m.apply, fr[1:]))
 
 
-def test_opencv_mog2_apply(benchmark, frames):
+@pytest.fixture(params=[1, 0], ids=["1 thread", "cv2 threads"])
+def cv2_threads(request):
+    """OpenCV on one thread (like the C++ pass) or on its default pool."""
+    before = cv2.getNumThreads()
+    cv2.setNumThreads(request.param if request.param else -1)
+    yield request.param
+    cv2.setNumThreads(before)
+
+
+def test_opencv_mog2_apply(benchmark, frames, cv2_threads):
     name, fr = frames
     benchmark.group = f"per-pixel pass {name}"
     sub = cv2.createBackgroundSubtractorMOG2(detectShadows=True)

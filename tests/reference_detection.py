@@ -29,8 +29,18 @@ def hsv_bin_reference(bgr: np.ndarray, n_h=10, n_s=10, n_v=10, s_min=0.1, v_min=
 class BackgroundReference:
     """The algorithm of BackgroundModel, one NumPy step per stage, float32 like the C++."""
 
-    def __init__(self, alpha=0.05, alpha_fg=0.005, n_learn=30, k_noise=4.0, t_min=25.0, t_max=60.0,
-                 low_ratio=0.5, shadow_lo=0.5, shadow_chroma=0.03):
+    def __init__(
+        self,
+        alpha=0.05,
+        alpha_fg=0.005,
+        n_learn=30,
+        k_noise=4.0,
+        t_min=25.0,
+        t_max=60.0,
+        low_ratio=0.5,
+        shadow_lo=0.5,
+        shadow_chroma=0.03,
+    ):
         self.alpha, self.alpha_fg, self.k_noise = alpha, alpha_fg, k_noise
         self.n_learn = n_learn
         self.frame_count = 0
@@ -62,7 +72,9 @@ class BackgroundReference:
         chroma_ok = np.ones(d_bg.shape, bool)
         for c in range(3):
             chroma_ok &= np.abs(f[..., c] * s_b - bg[..., c] * s_i) <= tol
-        shadow = cand & (s_i < s_b) & (s_i >= np.float32(self.shadow_lo) * s_b) & (s_i > 0) & chroma_ok
+        shadow = (
+            cand & (s_i < s_b) & (s_i >= np.float32(self.shadow_lo) * s_b) & (s_i > 0) & chroma_ok
+        )
         fore = cand & ~shadow
         k = self.frame_count + 1  # this frame's number
         if k <= self.n_learn:

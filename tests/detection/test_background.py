@@ -6,9 +6,8 @@ import threading
 
 import numpy as np
 import pytest
-from reference_detection import BackgroundReference, hsv_bin_reference
-
 from pftrack import _core
+from reference_detection import BackgroundReference, hsv_bin_reference
 
 
 def random_scene(rng: np.random.Generator, shape=(48, 64), steps=6) -> list[np.ndarray]:
@@ -26,7 +25,11 @@ def random_scene(rng: np.random.Generator, shape=(48, 64), steps=6) -> list[np.n
 
 def test_lut_bins_equal_hsv_bins_on_every_colour():
     v = np.arange(1 << 24, dtype=np.uint32)
-    img = np.stack([v & 255, (v >> 8) & 255, v >> 16], axis=-1).astype(np.uint8).reshape(4096, 4096, 3)
+    img = (
+        np.stack([v & 255, (v >> 8) & 255, v >> 16], axis=-1)
+        .astype(np.uint8)
+        .reshape(4096, 4096, 3)
+    )
     for kw in ({}, {"n_h": 8, "n_s": 4, "n_v": 3, "s_min": 0.25, "v_min": 0.05}):
         m = _core.BackgroundModel(**kw)
         bins, mask = m.apply(img)
@@ -42,9 +45,19 @@ def test_hsv_reference_matches_core_on_random_pixels():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize(
-    "kw", [{}, {"alpha": 0.3, "alpha_fg": 0.0, "k_noise": 6.0, "t_min": 8.0, "low_ratio": 0.3,
-                "n_learn": 3},
-           {"shadow_lo": 1.0, "t_max": 25.0}]
+    "kw",
+    [
+        {},
+        {
+            "alpha": 0.3,
+            "alpha_fg": 0.0,
+            "k_noise": 6.0,
+            "t_min": 8.0,
+            "low_ratio": 0.3,
+            "n_learn": 3,
+        },
+        {"shadow_lo": 1.0, "t_max": 25.0},
+    ],
 )
 def test_background_model_matches_reference(seed, kw):
     rng = np.random.default_rng(seed)

@@ -6,7 +6,6 @@ import cv2
 import numpy as np
 import pytest
 from conftest import data_dir
-
 from pftrack import _core
 from pftrack.detection import (
     BlobConfig,
@@ -32,7 +31,9 @@ def moving_rectangle(n=25, empty=0, seed=0):
     rng = np.random.default_rng(seed)
     bg = textured_background(seed=seed)
     for k in range(-empty, n):
-        f = np.clip(bg.astype(np.int16) + rng.integers(-3, 4, size=bg.shape), 0, 255).astype(np.uint8)
+        f = np.clip(bg.astype(np.int16) + rng.integers(-3, 4, size=bg.shape), 0, 255).astype(
+            np.uint8
+        )
         if k < 0:
             yield f, None
             continue
@@ -177,7 +178,9 @@ def test_blob_boxes_equal_connected_components():
     from pftrack.detection.base import BlobExtractor
 
     rng = np.random.default_rng(11)
-    ext = BlobExtractor(BlobConfig(min_area=0.0, min_aspect=1e-3, max_aspect=1e3, min_fill=0.0, max_area=1.0))
+    ext = BlobExtractor(
+        BlobConfig(min_area=0.0, min_aspect=1e-3, max_aspect=1e3, min_fill=0.0, max_area=1.0)
+    )
     for _ in range(5):
         mask = ((rng.random((60, 80)) > 0.93) * 255).astype(np.uint8)
         mask = cv2.dilate(mask, np.ones((2, 2), np.uint8))

@@ -124,27 +124,25 @@ class BlobExtractor:
 
     def __init__(self, config: BlobConfig) -> None:
         self.config = config
-        self._kernels: tuple[int, NDArray[np.uint8], NDArray[np.uint8]] | None = None
+        self._rows = -1
+        self._open: NDArray[np.uint8] = np.ones((1, 1), np.uint8)
+        self._close: NDArray[np.uint8] = np.ones((1, 1), np.uint8)
 
     def _elements(self, rows: int) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
-        if self._kernels is None or self._kernels[0] != rows:
+        if self._rows != rows:
             o, c = self.config.kernel_sizes(rows)
-            self._kernels = (
-                rows,
-                cv2.getStructuringElement(cv2.MORPH_RECT, (o, o)),
-                cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (c, c)),
-            )
-        return self._kernels[1], self._kernels[2]
+            self._open = np.asarray(cv2.getStructuringElement(cv2.MORPH_RECT, (o, o)), np.uint8)
+            self._close = np.asarray(cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (c, c)), np.uint8)
+            self._rows = rows
+        return self._open, self._close
 
     def clean(self, raw: NDArray[np.uint8]) -> NDArray[np.uint8]:
-        """Opening then closing of the raw 0/255 mask."""
+        """Clean the raw 0/255 mask: opening, then closing."""
         k_open, k_close = self._elements(raw.shape[0])
         m = cv2.morphologyEx(raw, cv2.MORPH_OPEN, k_open)
-        return cv2.morphologyEx(m, cv2.MORPH_CLOSE, k_close)
+        return np.asarray(cv2.morphologyEx(m, cv2.MORPH_CLOSE, k_close), np.uint8)
 
-    def boxes(
-        self, mask: NDArray[np.uint8]
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def boxes(self, mask: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Boxes (K, 4) left, top, w, h and scores (K,) of the blobs that pass the filters.
 
         A blob is an 8-connected foreground region, found by its outer border
@@ -161,7 +159,9 @@ class BlobExtractor:
         w, h = rects[:, 2], rects[:, 3]
         aspect = h / w
         keep = (
-            (w * h >= cfg.min_area * frame_area) & (aspect >= cfg.min_aspect) & (aspect <= cfg.max_aspect)
+            (w * h >= cfg.min_area * frame_area)
+            & (aspect >= cfg.min_aspect)
+            & (aspect <= cfg.max_aspect)
         )
         area = np.zeros(len(rects))
         for i in np.flatnonzero(keep):

@@ -89,9 +89,16 @@ class PaperDetector:
         self.config = config if config is not None else PaperConfig()
         c = self.config
         self._model = _core.BackgroundModel(
-            alpha=c.alpha, alpha_fg=c.alpha_fg, n_learn=c.n_learn, k_noise=c.k_noise, t_min=c.t_min, t_max=c.t_max,
-            low_ratio=c.low_ratio, shadow_lo=c.shadow_lo,
-            shadow_chroma=c.shadow_chroma, **asdict(c.hsv),
+            alpha=c.alpha,
+            alpha_fg=c.alpha_fg,
+            n_learn=c.n_learn,
+            k_noise=c.k_noise,
+            t_min=c.t_min,
+            t_max=c.t_max,
+            low_ratio=c.low_ratio,
+            shadow_lo=c.shadow_lo,
+            shadow_chroma=c.shadow_chroma,
+            **asdict(c.hsv),
         )
         self._blobs = BlobExtractor(c.blobs)
 
