@@ -28,13 +28,14 @@ void register_detection(py::module_& m) {
     py::class_<BackgroundModel>(
         m, "BackgroundModel",
         "Adaptive background + frame difference + threshold, fused with HSV binning (one pass).")
-        .def(py::init([](double alpha, double alpha_fg, double k_noise, double t_min, double t_max,
+        .def(py::init([](double alpha, double alpha_fg, int n_learn, double k_noise, double t_min, double t_max,
                          double low_ratio, double shadow_lo, double shadow_chroma, int n_h, int n_s, int n_v, double s_min, double v_min) {
                  return BackgroundModel(
-                     BackgroundConfig{alpha, alpha_fg, k_noise, t_min, t_max, low_ratio, shadow_lo, shadow_chroma},
+                     BackgroundConfig{alpha, alpha_fg, n_learn, k_noise, t_min, t_max, low_ratio, shadow_lo, shadow_chroma},
                      HsvBinning{n_h, n_s, n_v, s_min, v_min});
              }),
-             py::arg("alpha") = 0.05, py::arg("alpha_fg") = 0.005, py::arg("k_noise") = 4.0,
+             py::arg("alpha") = 0.05, py::arg("alpha_fg") = 0.005, py::arg("n_learn") = 30,
+             py::arg("k_noise") = 4.0,
              py::arg("t_min") = 25.0, py::arg("t_max") = 60.0, py::arg("low_ratio") = 0.5,
              py::arg("shadow_lo") = 0.5, py::arg("shadow_chroma") = 0.03,
              py::arg("n_h") = 10, py::arg("n_s") = 10, py::arg("n_v") = 10, py::arg("s_min") = 0.1,
@@ -97,7 +98,7 @@ void register_detection(py::module_& m) {
                 if (!s.initialized()) return py::none();
                 py::array_t<float> a({static_cast<py::ssize_t>(s.rows()),
                                       static_cast<py::ssize_t>(s.cols()), py::ssize_t(3)});
-                std::copy(s.background().begin(), s.background().end(), a.mutable_data());
+                s.background_bgr(a.mutable_data());
                 return a;
             },
             "Copy of the background (H, W, 3) float32 BGR, or None before the first frame.")
@@ -112,6 +113,7 @@ void register_detection(py::module_& m) {
             "(256,) int64 counts of floor(max-channel |frame - background|) of the last frame.")
         .def_property_readonly("alpha", [](const BackgroundModel& s) { return s.config().alpha; })
         .def_property_readonly("alpha_fg", [](const BackgroundModel& s) { return s.config().alpha_fg; })
+        .def_property_readonly("n_learn", [](const BackgroundModel& s) { return s.config().n_learn; })
         .def_property_readonly("k_noise", [](const BackgroundModel& s) { return s.config().k_noise; })
         .def_property_readonly("t_min", [](const BackgroundModel& s) { return s.config().t_min; })
         .def_property_readonly("t_max", [](const BackgroundModel& s) { return s.config().t_max; })

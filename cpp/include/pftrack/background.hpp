@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -51,9 +52,28 @@ public:
                     } else {  // max is b: num = r - g
                         h = 60.0 * num / d + 240.0;
                     }
-                    hue_[sector * kHueStride + d * 511 + num + 255] =
+                    hue_[sector * kHueStride + d * d + num + d] =
                         static_cast<std::uint8_t>(std::min(static_cast<int>(h * p.n_h / 360.0), p.n_h - 1));
                 }
+    }
+
+    /// Table indices of one pixel, branch-free (so that a loop of them vectorises):
+    /// sat = max * 256 + min, hue = sector * 65536 + d * d + num + d, grey = max.
+    static void indices(int b, int g, int r, int& sat, int& hue, int& grey) {
+        const int mx = std::max(r, std::max(g, b));
+        const int mn = std::min(r, std::min(g, b));
+        const bool is_r = mx == r, is_g = mx == g;
+        const int sector = is_r ? 0 : (is_g ? 1 : 2);
+        const int num = is_r ? g - b : (is_g ? b - r : r - g);
+        const int d = mx - mn;
+        sat = mx * 256 + mn;
+        hue = sector * kHueStride + d * d + num + d;
+        grey = mx;
+    }
+
+    int bin_at(int sat, int hue, int grey) const {
+        const int sb = sat_[static_cast<size_t>(sat)];
+        return sb >= 0 ? hue_[static_cast<size_t>(hue)] * n_s_ + sb : grey_[static_cast<size_t>(grey)];
     }
 
     int bin(int b, int g, int r) const {
@@ -63,16 +83,18 @@ public:
         const int sector = (mx == r) ? 0 : ((mx == g) ? 1 : 2);
         const int num = (mx == r) ? g - b : ((mx == g) ? b - r : r - g);
         const int sb = sat_[mx * 256 + mn];
-        const int hb = hue_[sector * kHueStride + (mx - mn) * 511 + num + 255];
+        const int d = mx - mn;
+        const int hb = hue_[sector * kHueStride + d * d + num + d];
         return sb >= 0 ? hb * n_s_ + sb : grey_[mx];
     }
 
+    static constexpr int kHueStride = 256 * 256;  // d * d + (num + d) < 256^2 for d < 256
+
 private:
-    static constexpr int kHueStride = 256 * 511;
     int n_s_;
     std::vector<std::int8_t> sat_;    // [max * 256 + min] -> saturation bin, -1 for grey pixels
     std::vector<std::int16_t> grey_;  // [max] -> grey bin
-    std::vector<std::uint8_t> hue_;   // [sector][max - min][num + 255] -> hue bin
+    std::vector<std::uint8_t> hue_;   // [sector][d * d + num + d], d = max - min -> hue bin
 };
 
 /// Settings of `BackgroundModel`. Thresholds are on the max-over-channels absolute difference,
@@ -80,6 +102,9 @@ private:
 struct BackgroundConfig {
     double alpha = 0.05;      // running-average rate where the pixel is background (selective update)
     double alpha_fg = 0.005;  // slow rate where it is foreground (absorbs stopped objects; 0 = off)
+    int n_learn = 30;         // frames 2 .. n_learn update every pixel at max(1 / k, alpha) (k-th
+                              // frame): a running mean that averages out objects of the first
+                              // frame (their "ghosts"); 0 or 1 = selective from the start
     double k_noise = 4.0;     // threshold = k_noise * median background difference of the last frame
     double t_min = 25.0;      // ... clamped to [t_min, t_max]
     double t_max = 60.0;
@@ -94,6 +119,7 @@ struct BackgroundConfig {
     void validate(const char* fn) const {
         require(alpha > 0.0 && alpha <= 1.0, fn, "alpha", alpha, "in (0, 1]");
         require(alpha_fg >= 0.0 && alpha_fg <= 1.0, fn, "alpha_fg", alpha_fg, "in [0, 1]");
+        require(n_learn >= 0, fn, "n_learn", n_learn, ">= 0");
         require(k_noise >= 0.0 && k_noise <= 1e6, fn, "k_noise", k_noise, "in [0, 1e6]");
         require(t_min >= 0.0 && t_min <= 255.0, fn, "t_min", t_min, "in [0, 255]");
         require(t_max >= t_min && t_max <= 255.0, fn, "t_max", t_max, "in [t_min, 255]");
@@ -104,19 +130,96 @@ struct BackgroundConfig {
     }
 };
 
+// The vectorisable per-row loops, compiled twice on x86-64 Linux with GCC (AVX2 and baseline),
+// the CPU picking one at load time. Neither uses FMA, so both give the same floats.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define PFTRACK_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define PFTRACK_VECTOR_CLONES
+#endif
+
+namespace detail {
+
+/// Per pixel of one row, in float (exact on these small integers), branch-free: HsvLut indices
+/// (sat, hue, grey), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
+PFTRACK_VECTOR_CLONES static void background_row_scan(
+    Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
+    const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
+    const float* __restrict dprev, float t, float t_low, std::int32_t* __restrict si,
+    std::int32_t* __restrict hi, std::int32_t* __restrict gi, std::int32_t* __restrict di,
+    float* __restrict cand) {
+    const float hue_stride = static_cast<float>(HsvLut::kHueStride);
+    for (Index x = 0; x < n; ++x) {
+        const float b = fb[x], g = fg[x], r = fr[x];
+        const float mx = std::max(r, std::max(g, b));
+        const float mn = std::min(r, std::min(g, b));
+        // sector 0 if max is r, else 1 if g, else 2; num = g - b, b - r, r - g resp. (0/1 blends)
+        const float not_r = static_cast<float>(mx != r), not_g = static_cast<float>(mx != g);
+        const float sector = not_r * (1.0f + not_g);
+        const float num =
+            (1.0f - not_r) * (g - b) + not_r * ((1.0f - not_g) * (b - r) + not_g * (r - g));
+        const float d = mx - mn;
+        si[x] = static_cast<std::int32_t>(mx * 256.0f + mn);
+        hi[x] = static_cast<std::int32_t>(sector * hue_stride + (d * d + (num + d)));
+        gi[x] = static_cast<std::int32_t>(mx);
+        const float d_bg = std::max(std::abs(b - qb[x]), std::max(std::abs(g - qg[x]), std::abs(r - qr[x])));
+        di[x] = static_cast<std::int32_t>(std::min(d_bg, 255.0f));
+        cand[x] = ((d_bg > t) | ((dprev[x] > t) & (d_bg > t_low))) ? 1.0f : 0.0f;
+    }
+}
+
+/// One row of BGR bytes (and of the previous frame) -> float planes b, g, r and
+/// d_prev = max_c |I_c - I'_c|; the row is then copied into the previous frame.
+PFTRACK_VECTOR_CLONES static void background_row_split(Index n, const std::uint8_t* __restrict px,
+                                                       std::uint8_t* __restrict prev,
+                                                       float* __restrict fb, float* __restrict fg,
+                                                       float* __restrict fr,
+                                                       float* __restrict dprev) {
+    for (Index x = 0; x < n; ++x) {
+        const int b = px[3 * x], g = px[3 * x + 1], r = px[3 * x + 2];
+        const int pb = prev[3 * x], pg = prev[3 * x + 1], pr = prev[3 * x + 2];
+        fb[x] = static_cast<float>(b);
+        fg[x] = static_cast<float>(g);
+        fr[x] = static_cast<float>(r);
+        dprev[x] = static_cast<float>(
+            std::max(std::abs(b - pb), std::max(std::abs(g - pg), std::abs(r - pr))));
+    }
+    std::memcpy(prev, px, static_cast<size_t>(3 * n));
+}
+
+/// background_c += a (frame_c - background_c), a = a_fg where cand, else a_bg.
+PFTRACK_VECTOR_CLONES static void background_row_update(
+    Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
+    float* __restrict qb, float* __restrict qg, float* __restrict qr, const float* __restrict cand,
+    float a_bg, float a_fg) {
+    for (Index x = 0; x < n; ++x) {
+        const float a = cand[x] != 0.0f ? a_fg : a_bg;
+        qb[x] = qb[x] + a * (fb[x] - qb[x]);
+        qg[x] = qg[x] + a * (fg[x] - qg[x]);
+        qr[x] = qr[x] + a * (fr[x] - qr[x]);
+    }
+}
+
+}  // namespace detail
+
 /// Adaptive background with the paper's selective update. The first frame (or `set_background`)
 /// initialises it; every later frame goes through `apply`, which in one read of the frame
 ///   (a) bins each pixel (`hsv_bin_of`'s bins, via HsvLut),
 ///   (b) d_bg = max_c |frame_c - background_c|, d_prev = max_c |frame_c - previous_c|,
 ///   (c) candidate = d_bg > T or (d_prev > T and d_bg > low_ratio * T); a candidate that is a
 ///       shadow (see BackgroundConfig) is not foreground; mask 255/0,
-///   (d) background_c += a (frame_c - background_c), a = alpha where neither foreground nor
-///       shadow, alpha_fg where either (float32 arithmetic, in this order, so a NumPy reference
-///       matches bit for bit),
+///   (d) background_c += a (frame_c - background_c), a = alpha where not a candidate, alpha_fg
+///       where a candidate (foreground or shadow); a = max(1 / k, alpha) everywhere for the
+///       k-th frame while k <= n_learn (float32 arithmetic, in this order, so a NumPy
+///       reference matches bit for bit),
 ///   (e) stores the frame as the previous one, and counts floor(d_bg) in a 256-bin histogram.
 /// T for the next frame = clamp(k_noise * median(d_bg), t_min, t_max), the median read from that
 /// histogram with linear interpolation inside its bin: a robust noise level, since most pixels
 /// are background. The first frame's threshold is t_min.
+///
+/// Layout: the background is stored planar per row (B row, G row, R row) so that the per-pixel
+/// arithmetic runs in unit-stride, branch-free loops the compiler vectorises; `background_bgr`
+/// gives it interleaved.
 class BackgroundModel {
 public:
     BackgroundModel(const BackgroundConfig& config, const HsvBinning& binning)
@@ -132,8 +235,16 @@ public:
     Index cols() const { return cols_; }
     long frame_count() const { return frame_count_; }
     double threshold() const { return threshold_; }
-    const std::vector<float>& background() const { return background_; }
     const std::array<std::int64_t, 256>& difference_histogram() const { return hist_; }
+
+    /// The background, interleaved BGR, into `out` (rows x cols x 3 floats).
+    void background_bgr(float* out) const {
+        for (Index y = 0; y < rows_; ++y)
+            for (int c = 0; c < 3; ++c) {
+                const float* plane = background_.data() + (y * 3 + c) * cols_;
+                for (Index x = 0; x < cols_; ++x) out[(y * cols_ + x) * 3 + c] = plane[x];
+            }
+    }
 
     void reset() {
         rows_ = cols_ = 0;
@@ -145,18 +256,18 @@ public:
     }
 
     /// Set the background (rows x cols x 3 floats, BGR); the previous frame becomes its rounding.
+    /// No learning phase follows.
     void set_background(const float* bgr, Index rows, Index cols) {
-        rows_ = rows;
-        cols_ = cols;
-        const size_t n = static_cast<size_t>(rows * cols * 3);
-        background_.assign(bgr, bgr + n);
-        previous_.resize(n);
-        for (size_t i = 0; i < n; ++i) {
-            const float v = std::min(std::max(background_[i], 0.0f), 255.0f);
-            previous_[i] = static_cast<std::uint8_t>(v + 0.5f);
-        }
-        threshold_ = config_.t_min;
-        hist_.fill(0);
+        allocate(rows, cols);
+        learning_ = false;  // a given background needs no learning phase
+        for (Index y = 0; y < rows; ++y)
+            for (Index x = 0; x < cols; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const float v = bgr[(y * cols + x) * 3 + c];
+                    background_[static_cast<size_t>((y * 3 + c) * cols + x)] = v;
+                    previous_[static_cast<size_t>((y * cols + x) * 3 + c)] =
+                        static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), 255.0f) + 0.5f);
+                }
     }
 
     /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols) and
@@ -173,78 +284,102 @@ public:
                     ", 3); call reset() before a new video");
         const float t = static_cast<float>(threshold_);
         const float t_low = static_cast<float>(config_.low_ratio * threshold_);
-        const float a_bg = static_cast<float>(config_.alpha);
-        const float a_fg = static_cast<float>(config_.alpha_fg);
+        // learning phase: the k-th frame (k = frame_count_ + 1 <= n_learn) updates everywhere
+        const bool learning = learning_ && frame_count_ + 1 <= config_.n_learn;
+        const double a_learn = std::max(1.0 / static_cast<double>(frame_count_ + 1), config_.alpha);
+        const float a_bg = static_cast<float>(learning ? a_learn : config_.alpha);
+        const float a_fg = static_cast<float>(learning ? a_learn : config_.alpha_fg);
         const float s_lo = static_cast<float>(config_.shadow_lo);
         const float s_chroma = static_cast<float>(config_.shadow_chroma);
-        hist_.fill(0);
-        std::int64_t* hist = hist_.data();
+        // Four interleaved histograms: consecutive pixels mostly fall in the same bin, and
+        // incrementing one counter back to back would serialise on store-to-load forwarding.
+        std::array<std::array<std::int32_t, 256>, 4> h4{};
+        const Index n3 = cols * 3;
+        const auto ns = static_cast<size_t>(cols);
+        scratch_f_.resize(5 * ns);
+        scratch_i_.resize(4 * ns);
+        float* __restrict fb = scratch_f_.data();
+        float* __restrict fg = fb + ns;
+        float* __restrict fr = fg + ns;
+        float* __restrict dprev = fr + ns;
+        float* __restrict cand = dprev + ns;
+        std::int32_t* __restrict si = scratch_i_.data();
+        std::int32_t* __restrict hi = si + ns;
+        std::int32_t* __restrict di = hi + ns;
+        std::int32_t* __restrict gi = di + ns;
+        // Each row in four loops over L1-resident row buffers: (1), (3), (5) are vectorised by
+        // the compiler; (4) does the table look-ups, the histogram and the shadow test of the
+        // few candidates, which cannot be vectorised.
         for (Index y = 0; y < rows; ++y) {
-            const std::uint8_t* px = bgr + y * row_stride;
-            float* bg = background_.data() + y * cols * 3;
-            std::uint8_t* prev = previous_.data() + y * cols * 3;
-            std::int16_t* o = bins + y * cols;
-            std::uint8_t* m = mask + y * cols;
+            const std::uint8_t* __restrict px = bgr + y * row_stride;
+            float* __restrict qb = background_.data() + y * n3;
+            float* __restrict qg = qb + cols;
+            float* __restrict qr = qg + cols;
+            std::uint8_t* __restrict prev = previous_.data() + y * n3;
+            std::int16_t* __restrict o = bins + y * cols;
+            std::uint8_t* __restrict m = mask + y * cols;
+            // (1) deinterleave into float planes, d_prev; I' <- I
+            detail::background_row_split(cols, px, prev, fb, fg, fr, dprev);
+            // (3) per pixel, vectorised: table indices, d_bg, candidates
+            detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, si, hi, gi,
+                                        di, cand);
+            // (4) bins by table look-up, histogram of floor(d_bg), shadow test on candidates
             for (Index x = 0; x < cols; ++x) {
-                const int b = px[3 * x], g = px[3 * x + 1], r = px[3 * x + 2];
-                o[x] = static_cast<std::int16_t>(lut_.bin(b, g, r));
-                const float fb = static_cast<float>(b), fg = static_cast<float>(g),
-                            fr = static_cast<float>(r);
-                float* q = bg + 3 * x;
-                const float eb = fb - q[0], eg = fg - q[1], er = fr - q[2];
-                const float d_bg = std::max(std::abs(eb), std::max(std::abs(eg), std::abs(er)));
-                std::uint8_t* p = prev + 3 * x;
-                const int d_prev = std::max(std::abs(b - p[0]),
-                                            std::max(std::abs(g - p[1]), std::abs(r - p[2])));
-                const bool cand = d_bg > t || (static_cast<float>(d_prev) > t && d_bg > t_low);
-                bool shadow = false;
-                if (cand) {
-                    // darker by a bounded ratio, same chromaticity: |I_c sB - B_c sI| <= k sI sB
-                    const float s_i = fb + fg + fr, s_b = q[0] + q[1] + q[2];
+                o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x], gi[x]));
+                ++h4[static_cast<size_t>(x & 3)][static_cast<size_t>(di[x])];
+                bool fore = false;
+                if (cand[x] != 0.0f) {
+                    // shadow: darker by a bounded ratio, same chromaticity:
+                    // |I_c sB - B_c sI| <= k sI sB for every c
+                    const float b = fb[x], g = fg[x], r = fr[x];
+                    const float s_i = b + g + r, s_b = qb[x] + qg[x] + qr[x];
+                    bool shadow = false;
                     if (s_i < s_b && s_i >= s_lo * s_b && s_i > 0.0f) {
                         const float tol = s_chroma * s_i * s_b;
-                        shadow = std::abs(fb * s_b - q[0] * s_i) <= tol &&
-                                 std::abs(fg * s_b - q[1] * s_i) <= tol &&
-                                 std::abs(fr * s_b - q[2] * s_i) <= tol;
+                        shadow = std::abs(b * s_b - qb[x] * s_i) <= tol &&
+                                 std::abs(g * s_b - qg[x] * s_i) <= tol &&
+                                 std::abs(r * s_b - qr[x] * s_i) <= tol;
                     }
+                    fore = !shadow;
                 }
-                const bool fore = cand && !shadow;
                 m[x] = fore ? 255 : 0;
-                ++hist[std::min(static_cast<int>(d_bg), 255)];
-                // background_c += a (frame_c - background_c)   (selective running average)
-                const float a = cand ? a_fg : a_bg;
-                q[0] = q[0] + a * eb;
-                q[1] = q[1] + a * eg;
-                q[2] = q[2] + a * er;
-                p[0] = static_cast<std::uint8_t>(b);
-                p[1] = static_cast<std::uint8_t>(g);
-                p[2] = static_cast<std::uint8_t>(r);
             }
+            // (5) background_c += a (frame_c - background_c), vectorised (selective update)
+            detail::background_row_update(cols, fb, fg, fr, qb, qg, qr, cand, a_bg, a_fg);
         }
+        for (size_t i = 0; i < 256; ++i)
+            hist_[i] = std::int64_t(h4[0][i]) + h4[1][i] + h4[2][i] + h4[3][i];
         threshold_ = next_threshold();
         ++frame_count_;
     }
 
 private:
-    void first_frame(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride,
-                     std::int16_t* bins, std::uint8_t* mask) {
+    void allocate(Index rows, Index cols) {
         rows_ = rows;
         cols_ = cols;
         background_.resize(static_cast<size_t>(rows * cols * 3));
         previous_.resize(static_cast<size_t>(rows * cols * 3));
-        for (Index y = 0; y < rows; ++y) {
-            const std::uint8_t* px = bgr + y * row_stride;
-            for (Index x = 0; x < cols * 3; ++x) {
-                background_[static_cast<size_t>(y * cols * 3 + x)] = static_cast<float>(px[x]);
-                previous_[static_cast<size_t>(y * cols * 3 + x)] = px[x];
-            }
-            for (Index x = 0; x < cols; ++x)
-                bins[y * cols + x] =
-                    static_cast<std::int16_t>(lut_.bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
-        }
-        std::fill(mask, mask + rows * cols, std::uint8_t(0));
         threshold_ = config_.t_min;
         hist_.fill(0);
+    }
+
+    void first_frame(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride,
+                     std::int16_t* bins, std::uint8_t* mask) {
+        allocate(rows, cols);
+        learning_ = true;
+        for (Index y = 0; y < rows; ++y) {
+            const std::uint8_t* px = bgr + y * row_stride;
+            for (Index x = 0; x < cols; ++x) {
+                for (int c = 0; c < 3; ++c) {
+                    background_[static_cast<size_t>((y * 3 + c) * cols + x)] =
+                        static_cast<float>(px[3 * x + c]);
+                    previous_[static_cast<size_t>(y * cols * 3 + 3 * x + c)] = px[3 * x + c];
+                }
+                bins[y * cols + x] =
+                    static_cast<std::int16_t>(lut_.bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
+            }
+        }
+        std::fill(mask, mask + rows * cols, std::uint8_t(0));
         ++frame_count_;
     }
 
@@ -267,10 +402,13 @@ private:
     HsvLut lut_;
     Index rows_ = 0, cols_ = 0;
     long frame_count_ = 0;
+    bool learning_ = false;  // started from a frame (not set_background): learning phase on
     double threshold_ = 0.0;
-    std::vector<float> background_;
-    std::vector<std::uint8_t> previous_;
+    std::vector<float> background_;      // planar rows: [y][channel][x]
+    std::vector<std::uint8_t> previous_;  // interleaved, as the frame
     std::array<std::int64_t, 256> hist_{};
+    std::vector<float> scratch_f_;  // row scratch: B, G, R planes, d_prev, candidate flag
+    std::vector<std::int32_t> scratch_i_;  // row scratch: table indices, histogram bins
 };
 
 /// Bins with background set to -1: out = mask == 0 ? -1 : bins.

@@ -24,6 +24,10 @@ class PaperConfig:
     alpha_fg : float
         Rate where the pixel is foreground: slowly absorbs objects that stop and the ghosts
         of objects present in the first frame (0 gives the purely selective update).
+    n_learn : int
+        Learning phase: the k-th frame, for k = 2 .. `n_learn`, updates every pixel at rate
+        ``max(1 / k, alpha)`` (a running mean of the first frames), so that objects present in
+        the first frame leave no lasting ghost. 0 or 1: the selective update from the start.
     k_noise : float
         Noise-adaptive threshold ``T = k_noise * median_pixels(max_c |I_c - B_c|)`` of the
         previous frame (most pixels are background, so the median measures the noise).
@@ -45,6 +49,7 @@ class PaperConfig:
 
     alpha: float = 0.05
     alpha_fg: float = 0.005
+    n_learn: int = 30
     k_noise: float = 4.0
     t_min: float = 25.0
     t_max: float = 60.0
@@ -84,9 +89,16 @@ class PaperDetector:
         self.config = config if config is not None else PaperConfig()
         c = self.config
         self._model = _core.BackgroundModel(
-            alpha=c.alpha, alpha_fg=c.alpha_fg, k_noise=c.k_noise, t_min=c.t_min, t_max=c.t_max,
-            low_ratio=c.low_ratio, shadow_lo=c.shadow_lo,
-            shadow_chroma=c.shadow_chroma, **asdict(c.hsv),
+            alpha=c.alpha,
+            alpha_fg=c.alpha_fg,
+            n_learn=c.n_learn,
+            k_noise=c.k_noise,
+            t_min=c.t_min,
+            t_max=c.t_max,
+            low_ratio=c.low_ratio,
+            shadow_lo=c.shadow_lo,
+            shadow_chroma=c.shadow_chroma,
+            **asdict(c.hsv),
         )
         self._blobs = BlobExtractor(c.blobs)
 

@@ -1,0 +1,103 @@
+"""Detection speed: the fused C++ pass vs OpenCV's MOG2 vs the NumPy reference, same frames.
+
+pytest bench/test_detection.py --benchmark-only --benchmark-group-by=group
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from pftrack import _core  # noqa: E402
+from pftrack.detection import make_detector  # noqa: E402
+from reference_detection import BackgroundReference  # noqa: E402
+
+SIZES = {"480x360": (480, 360), "768x576": (768, 576)}
+N_FRAMES = 60
+
+
+def load_frames(size: tuple[int, int]) -> list[np.ndarray]:
+    """60 PETS09-S2L1 frames resized to `size`, or synthetic ones without the data."""
+    root = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+    video = Path(os.environ.get("PFTRACK_DATA", root)) / "pets09-s2l1" / "video.avi"
+    frames = []
+    if video.is_file():
+        cap = cv2.VideoCapture(str(video))
+        while len(frames) < N_FRAMES:
+            ok, f = cap.read()
+            if not ok:
+                break
+            frames.append(
+                cv2.resize(f, size, interpolation=cv2.INTER_LINEAR) if f.shape[1::-1] != size else f
+            )
+        cap.release()
+    if len(frames) < N_FRAMES:
+        rng = np.random.default_rng(0)
+        bg = cv2.resize(rng.integers(0, 256, (size[1] // 8, size[0] // 8, 3), dtype=np.uint8), size)
+        frames = []
+        for k in range(N_FRAMES):
+            f = bg.copy()
+            f[100:180, 10 + 6 * k : 40 + 6 * k] = (40, 60, 200)
+            frames.append(f)
+    return frames
+
+
+@pytest.fixture(scope="module", params=list(SIZES))
+def frames(request):
+    return request.param, load_frames(SIZES[request.param])
+
+
+def cycle_apply(fn, frames):
+    it = itertools.cycle(frames)
+    return lambda: fn(next(it))
+
+
+def test_core_background_pass(benchmark, frames):
+    name, fr = frames
+    benchmark.group = f"per-pixel pass {name}"
+    m = _core.BackgroundModel()
+    m.apply(fr[0])
+    benchmark(cycle_apply(m.apply, fr[1:]))
+
+
+@pytest.fixture(params=[1, 0], ids=["1 thread", "cv2 threads"])
+def cv2_threads(request):
+    """OpenCV on one thread (like the C++ pass) or on its default pool."""
+    before = cv2.getNumThreads()
+    cv2.setNumThreads(request.param if request.param else -1)
+    yield request.param
+    cv2.setNumThreads(before)
+
+
+def test_opencv_mog2_apply(benchmark, frames, cv2_threads):
+    name, fr = frames
+    benchmark.group = f"per-pixel pass {name}"
+    sub = cv2.createBackgroundSubtractorMOG2(detectShadows=True)
+    for f in fr:
+        sub.apply(f)
+    benchmark(cycle_apply(sub.apply, fr))
+
+
+def test_numpy_reference(benchmark, frames):
+    name, fr = frames
+    benchmark.group = f"per-pixel pass {name}"
+    ref = BackgroundReference()
+    ref.apply(fr[0])
+    benchmark.pedantic(cycle_apply(ref.apply, fr[1:]), rounds=10, iterations=1)
+
+
+@pytest.mark.parametrize("detector", ["paper", "mog2", "knn"])
+def test_whole_detector(benchmark, frames, detector):
+    name, fr = frames
+    benchmark.group = f"whole detect() {name}"
+    det = make_detector(detector)
+    for f in fr:
+        det.detect(f)
+    benchmark(cycle_apply(det.detect, fr))

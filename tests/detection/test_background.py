@@ -1,0 +1,163 @@
+"""The fused C++ pass (BackgroundModel, mask_bins) against the NumPy reference."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+from pftrack import _core
+from reference_detection import BackgroundReference, hsv_bin_reference
+
+
+def random_scene(rng: np.random.Generator, shape=(48, 64), steps=6) -> list[np.ndarray]:
+    """A noisy static background with bright/dark/shadowed patches that move about."""
+    base = rng.integers(20, 236, size=(*shape, 3), dtype=np.int32)
+    frames = []
+    for k in range(steps):
+        f = base + rng.integers(-6, 7, size=base.shape)
+        y, x = 5 + 3 * k, 4 + 5 * k
+        f[y : y + 15, x : x + 10] = rng.integers(0, 256, size=3)  # an object
+        f[y + 20 : y + 28, x : x + 12] = (f[y + 20 : y + 28, x : x + 12] * 0.7).astype(np.int32)
+        frames.append(np.clip(f, 0, 255).astype(np.uint8))
+    return frames
+
+
+def test_lut_bins_equal_hsv_bins_on_every_colour():
+    v = np.arange(1 << 24, dtype=np.uint32)
+    img = (
+        np.stack([v & 255, (v >> 8) & 255, v >> 16], axis=-1)
+        .astype(np.uint8)
+        .reshape(4096, 4096, 3)
+    )
+    for kw in ({}, {"n_h": 8, "n_s": 4, "n_v": 3, "s_min": 0.25, "v_min": 0.05}):
+        m = _core.BackgroundModel(**kw)
+        bins, mask = m.apply(img)
+        np.testing.assert_array_equal(bins.bins, _core.hsv_bins(img, **kw).bins)
+        assert bins.n_bins == _core.hsv_bins(img[:1, :1], **kw).n_bins
+        assert not mask.any()  # the first frame initialises the background
+
+
+def test_hsv_reference_matches_core_on_random_pixels():
+    img = np.random.default_rng(3).integers(0, 256, size=(64, 64, 3), dtype=np.uint8)
+    np.testing.assert_array_equal(hsv_bin_reference(img), _core.hsv_bins(img).bins)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {},
+        {
+            "alpha": 0.3,
+            "alpha_fg": 0.0,
+            "k_noise": 6.0,
+            "t_min": 8.0,
+            "low_ratio": 0.3,
+            "n_learn": 3,
+        },
+        {"shadow_lo": 1.0, "t_max": 25.0},
+    ],
+)
+def test_background_model_matches_reference(seed, kw):
+    rng = np.random.default_rng(seed)
+    model, ref = _core.BackgroundModel(**kw), BackgroundReference(**kw)
+    n_fg = 0
+    for frame in random_scene(rng):
+        bins, mask = model.apply(frame)
+        rbins, rmask = ref.apply(frame)
+        np.testing.assert_array_equal(bins.bins, rbins)
+        np.testing.assert_array_equal(mask, rmask)
+        np.testing.assert_array_equal(model.background, ref.background)
+        assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
+        n_fg += int((mask > 0).sum())
+    assert n_fg > 0  # the moving patch was foreground at some point
+    assert model.frame_count == 6
+
+
+def test_selective_update_and_shadow_are_not_learnt():
+    bg = np.full((20, 20, 3), 100, np.uint8)
+    m = _core.BackgroundModel(alpha=0.5, alpha_fg=0.0, n_learn=0, t_min=20.0, t_max=20.0)
+    m.apply(bg)
+    f = bg.copy()
+    f[:5, :5] = 200  # foreground: background stays 100 there
+    f[10:15, 10:15] = 70  # a shadow: darker, same chromaticity -> background, not learnt
+    f[16:, 16:] = 110  # small change below threshold -> learnt at alpha
+    _, mask = m.apply(f)
+    assert (mask[:5, :5] == 255).all() and mask.sum() == 25 * 255
+    b = m.background
+    assert (b[:5, :5] == 100).all() and (b[10:15, 10:15] == 100).all()
+    assert (b[16:, 16:] == 105).all()
+
+
+def test_set_background_and_reset():
+    m = _core.BackgroundModel(t_min=10.0, t_max=10.0)
+    m.set_background(np.full((8, 9, 3), 50.0, np.float32))
+    assert m.shape == (8, 9) and m.initialized
+    _, mask = m.apply(np.full((8, 9, 3), 90, np.uint8))
+    assert (mask == 255).all()
+    m.reset()
+    assert m.background is None and m.shape is None and not m.initialized
+    _, mask = m.apply(np.zeros((4, 4, 3), np.uint8))  # a new size is fine after reset
+    assert not mask.any()
+
+
+def test_mask_bins():
+    rng = np.random.default_rng(5)
+    img = rng.integers(0, 256, size=(30, 40, 3), dtype=np.uint8)
+    binned = _core.hsv_bins(img)
+    mask = (rng.random((30, 40)) > 0.5).astype(np.uint8)
+    out = _core.mask_bins(binned, mask)
+    np.testing.assert_array_equal(out.bins, np.where(mask > 0, binned.bins, -1))
+    np.testing.assert_array_equal(out.bins, _core.hsv_bins(img, mask).bins)
+    np.testing.assert_array_equal(_core.mask_bins(binned, mask > 0).bins, out.bins)  # bool mask
+    wide = np.zeros((30, 80), np.uint8)
+    wide[:, :40] = mask  # a view with a row stride of 80
+    np.testing.assert_array_equal(_core.mask_bins(binned, wide[:, :40]).bins, out.bins)
+
+
+def test_bad_input():
+    m = _core.BackgroundModel()
+    with pytest.raises(ValueError, match="frame dtype is float64"):
+        m.apply(np.zeros((4, 4, 3)))
+    with pytest.raises(ValueError, match=r"frame must have shape \(H, W, 3\)"):
+        m.apply(np.zeros((4, 4), np.uint8))
+    m.apply(np.zeros((4, 4, 3), np.uint8))
+    with pytest.raises(ValueError, match=r"frame shape is \(5, 4, 3\), expected \(4, 4, 3\)"):
+        m.apply(np.zeros((5, 4, 3), np.uint8))
+    with pytest.raises(ValueError, match="alpha is 0"):
+        _core.BackgroundModel(alpha=0.0)
+    with pytest.raises(ValueError, match="t_max is 5"):
+        _core.BackgroundModel(t_min=10.0, t_max=5.0)
+    with pytest.raises(ValueError, match="n_h is 0"):
+        _core.BackgroundModel(n_h=0)
+    with pytest.raises(ValueError, match="background value"):
+        m.set_background(np.full((4, 4, 3), 300.0))
+    binned = _core.hsv_bins(np.zeros((4, 4, 3), np.uint8))
+    with pytest.raises(ValueError, match="mask must have the frame's"):
+        _core.mask_bins(binned, np.zeros((4, 5), np.uint8))
+    with pytest.raises(ValueError, match="mask dtype"):
+        _core.mask_bins(binned, np.zeros((4, 4), np.float32))
+
+
+def test_threads_give_serial_result():
+    frames = random_scene(np.random.default_rng(9), shape=(120, 160), steps=5)
+
+    def run():
+        m = _core.BackgroundModel()
+        return [m.apply(f)[1] for f in frames]
+
+    serial = run()
+    results = [None] * 4
+
+    def work(i):
+        results[i] = run()
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        for a, b in zip(r, serial):
+            np.testing.assert_array_equal(a, b)

@@ -1,0 +1,94 @@
+"""Straightforward NumPy references of the detection kernels (pftrack._core.BackgroundModel)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def hsv_bin_reference(bgr: np.ndarray, n_h=10, n_s=10, n_v=10, s_min=0.1, v_min=0.2) -> np.ndarray:
+    """hsv_bin_of, vectorised in float64: bins (H, W) int16."""
+    b, g, r = (bgr[..., i].astype(np.int64) for i in range(3))
+    mx = np.maximum(r, np.maximum(g, b))
+    mn = np.minimum(r, np.minimum(g, b))
+    v = mx / 255.0
+    s = np.where(mx > 0, (mx - mn) / np.maximum(mx, 1), 0.0)
+    d = np.maximum(mx - mn, 1).astype(np.float64)
+    with np.errstate(invalid="ignore"):
+        h_r = 60.0 * (g - b) / d
+        h_r = np.where(h_r < 0.0, h_r + 360.0, h_r)
+        h_g = 60.0 * (b - r) / d + 120.0
+        h_b = 60.0 * (r - g) / d + 240.0
+    h = np.where(mx == r, h_r, np.where(mx == g, h_g, h_b))
+    hb = np.minimum((h * n_h / 360.0).astype(np.int64), n_h - 1)
+    sb = np.minimum((s * n_s).astype(np.int64), n_s - 1)
+    vb = np.minimum((v * n_v).astype(np.int64), n_v - 1)
+    colour = (s > s_min) & (v > v_min)
+    return np.where(colour, hb * n_s + sb, n_h * n_s + vb).astype(np.int16)
+
+
+class BackgroundReference:
+    """The algorithm of BackgroundModel, one NumPy step per stage, float32 like the C++."""
+
+    def __init__(
+        self,
+        alpha=0.05,
+        alpha_fg=0.005,
+        n_learn=30,
+        k_noise=4.0,
+        t_min=25.0,
+        t_max=60.0,
+        low_ratio=0.5,
+        shadow_lo=0.5,
+        shadow_chroma=0.03,
+    ):
+        self.alpha, self.alpha_fg, self.k_noise = alpha, alpha_fg, k_noise
+        self.n_learn = n_learn
+        self.frame_count = 0
+        self.t_min, self.t_max, self.low_ratio = t_min, t_max, low_ratio
+        self.shadow_lo, self.shadow_chroma = shadow_lo, shadow_chroma
+        self.background = None
+        self.previous = None
+        self.threshold = t_min
+
+    def apply(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        bins = hsv_bin_reference(frame)
+        f = frame.astype(np.float32)
+        if self.background is None:
+            self.background = f.copy()
+            self.previous = frame.copy()
+            self.threshold = self.t_min
+            self.frame_count = 1
+            return bins, np.zeros(frame.shape[:2], np.uint8)
+        bg = self.background
+        t = np.float32(self.threshold)
+        t_low = np.float32(self.low_ratio * self.threshold)
+        e = f - bg
+        d_bg = np.abs(e).max(axis=2)
+        d_prev = np.abs(frame.astype(np.int32) - self.previous.astype(np.int32)).max(axis=2)
+        cand = (d_bg > t) | ((d_prev.astype(np.float32) > t) & (d_bg > t_low))
+        s_i = f[..., 0] + f[..., 1] + f[..., 2]
+        s_b = bg[..., 0] + bg[..., 1] + bg[..., 2]
+        tol = np.float32(self.shadow_chroma) * s_i * s_b
+        chroma_ok = np.ones(d_bg.shape, bool)
+        for c in range(3):
+            chroma_ok &= np.abs(f[..., c] * s_b - bg[..., c] * s_i) <= tol
+        shadow = (
+            cand & (s_i < s_b) & (s_i >= np.float32(self.shadow_lo) * s_b) & (s_i > 0) & chroma_ok
+        )
+        fore = cand & ~shadow
+        k = self.frame_count + 1  # this frame's number
+        if k <= self.n_learn:
+            a_bg = a_fg = max(1.0 / k, self.alpha)
+        else:
+            a_bg, a_fg = self.alpha, self.alpha_fg
+        a = np.where(cand, np.float32(a_fg), np.float32(a_bg))[..., None]
+        self.frame_count = k
+        self.background = bg + a * e
+        self.previous = frame.copy()
+        hist = np.bincount(np.minimum(d_bg.astype(np.int32), 255).ravel(), minlength=256)
+        half = 0.5 * d_bg.size
+        cum = np.concatenate([[0], np.cumsum(hist)])
+        i = int(np.searchsorted(cum[1:], half))  # first bin whose cumulative count >= half
+        median = i + (half - cum[i]) / hist[i]
+        self.threshold = min(max(self.k_noise * median, self.t_min), self.t_max)
+        return bins, np.where(fore, 255, 0).astype(np.uint8)
