@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import os
 import time
 from collections.abc import Sequence
@@ -71,6 +72,7 @@ def track_frames(
     coasting: str = "confirmed",
     fill: str = "linear",
     show_progress: bool | None = None,
+    prime_frames: int = 30,
 ) -> TrackingRun:
     """Track every frame of `source`.
 
@@ -88,6 +90,9 @@ def track_frames(
         How gaps bridged by the particle filters are written (see :class:`TrackWriter`).
     show_progress : bool, optional
         Progress bar on stderr (default: when stderr is a terminal).
+    prime_frames : int
+        Read this many frames ahead to start the background model from their median (0: learn
+        from frame 1 on).
     """
     frames = source if isinstance(source, (FrameSource, list, tuple)) else FrameSource(source)
     if detections is not None and len(detections) and max(detections) > max(len(frames), 1) > 1:
@@ -95,6 +100,8 @@ def track_frames(
             f"detections go up to frame {max(detections)} but the video has {len(frames)} frames"
         )
     tracker = MultiObjectTracker(config, rng=rng)
+    if prime_frames > 0 and (detections is None or config.refine_boxes):
+        tracker.prime(itertools.islice(iter(frames), prime_frames))
     writer = TrackWriter(coasting, fill)
     empty = np.zeros((0, 5))
     start = time.perf_counter()

@@ -12,6 +12,7 @@ a detection no track explains starts a new track whose reference histogram is ta
 from __future__ import annotations
 
 import itertools
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
@@ -270,6 +271,19 @@ class MultiObjectTracker:
         self._joint: RJMCMCFilter | None = None
 
     # -- detections -------------------------------------------------------------------------
+    def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
+        """Start the built-in detector's background from the median of `frames`.
+
+        Reading ahead (e.g. the first 30 frames) gives the background model a picture of the
+        empty scene before frame 1 is tracked; detectors without ``prime`` ignore it.
+        """
+        if self._detector is None:
+            from pftrack.detection import make_detector
+
+            self._detector = make_detector(self.config.detector)
+        if hasattr(self._detector, "prime"):
+            self._detector.prime(frames)
+
     def _detect(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64], Any]:
         if self._detector is None:
             from pftrack.detection import make_detector
