@@ -23,20 +23,18 @@ namespace pftrack {
 /// (max, min) only, the value bin on max only, the hue bin on (sector, numerator, max - min) only.
 class HsvLut {
 public:
-    explicit HsvLut(const HsvBinning& p) : n_s_(p.n_s) {
+    explicit HsvLut(const HsvBinning& p) : n_s_(p.n_s), grey0_(p.n_h * p.n_s) {
         p.validate("HsvLut");
-        sat_.assign(256 * 256, -1);
-        grey_.assign(256, 0);
+        sat_.assign(256 * 256, 0);
         for (int mx = 0; mx < 256; ++mx) {
             // Same expressions as hsv_bin_of, so the same doubles and the same truncations.
             const double v = mx / 255.0;
-            grey_[mx] = static_cast<std::int16_t>(p.n_h * p.n_s +
-                                                  std::min(static_cast<int>(v * p.n_v), p.n_v - 1));
+            const int vb = std::min(static_cast<int>(v * p.n_v), p.n_v - 1);
             for (int mn = 0; mn <= mx; ++mn) {
                 const double s = mx > 0 ? static_cast<double>(mx - mn) / mx : 0.0;
-                if (s > p.s_min && v > p.v_min)
-                    sat_[mx * 256 + mn] =
-                        static_cast<std::int8_t>(std::min(static_cast<int>(s * p.n_s), p.n_s - 1));
+                sat_[mx * 256 + mn] = static_cast<std::int8_t>(
+                    (s > p.s_min && v > p.v_min) ? std::min(static_cast<int>(s * p.n_s), p.n_s - 1)
+                                                 : -1 - vb);
             }
         }
         hue_.assign(3 * kHueStride, 0);
@@ -57,23 +55,11 @@ public:
                 }
     }
 
-    /// Table indices of one pixel, branch-free (so that a loop of them vectorises):
-    /// sat = max * 256 + min, hue = sector * 65536 + d * d + num + d, grey = max.
-    static void indices(int b, int g, int r, int& sat, int& hue, int& grey) {
-        const int mx = std::max(r, std::max(g, b));
-        const int mn = std::min(r, std::min(g, b));
-        const bool is_r = mx == r, is_g = mx == g;
-        const int sector = is_r ? 0 : (is_g ? 1 : 2);
-        const int num = is_r ? g - b : (is_g ? b - r : r - g);
-        const int d = mx - mn;
-        sat = mx * 256 + mn;
-        hue = sector * kHueStride + d * d + num + d;
-        grey = mx;
-    }
-
-    int bin_at(int sat, int hue, int grey) const {
+    /// Bin from the table indices sat = max * 256 + min and hue = sector * kHueStride + d * d +
+    /// num + d (see `bin`).
+    int bin_at(int sat, int hue) const {
         const int sb = sat_[static_cast<size_t>(sat)];
-        return sb >= 0 ? hue_[static_cast<size_t>(hue)] * n_s_ + sb : grey_[static_cast<size_t>(grey)];
+        return sb >= 0 ? hue_[static_cast<size_t>(hue)] * n_s_ + sb : grey0_ - 1 - sb;
     }
 
     int bin(int b, int g, int r) const {
@@ -82,18 +68,18 @@ public:
         // hsv_bin_of's order of tests: r first, then g, then b (ties go to the earlier one).
         const int sector = (mx == r) ? 0 : ((mx == g) ? 1 : 2);
         const int num = (mx == r) ? g - b : ((mx == g) ? b - r : r - g);
-        const int sb = sat_[mx * 256 + mn];
         const int d = mx - mn;
-        const int hb = hue_[sector * kHueStride + d * d + num + d];
-        return sb >= 0 ? hb * n_s_ + sb : grey_[mx];
+        return bin_at(mx * 256 + mn, sector * kHueStride + d * d + num + d);
     }
 
     static constexpr int kHueStride = 256 * 256;  // d * d + (num + d) < 256^2 for d < 256
 
 private:
     int n_s_;
-    std::vector<std::int8_t> sat_;    // [max * 256 + min] -> saturation bin, -1 for grey pixels
-    std::vector<std::int16_t> grey_;  // [max] -> grey bin
+    int grey0_;                     // first grey bin, n_h * n_s
+    std::vector<std::int8_t> sat_;  // [max * 256 + min] -> saturation bin if a colour pixel,
+                                    // else -1 - value bin
+
     std::vector<std::uint8_t> hue_;   // [sector][d * d + num + d], d = max - min -> hue bin
 };
 
@@ -141,12 +127,12 @@ struct BackgroundConfig {
 namespace detail {
 
 /// Per pixel of one row, in float (exact on these small integers), branch-free: HsvLut indices
-/// (sat, hue, grey), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
+/// (sat, hue), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
 PFTRACK_VECTOR_CLONES static void background_row_scan(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
     const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
     const float* __restrict dprev, float t, float t_low, std::int32_t* __restrict si,
-    std::int32_t* __restrict hi, std::int32_t* __restrict gi, std::int32_t* __restrict di,
+    std::int32_t* __restrict hi, std::int32_t* __restrict di,
     float* __restrict cand) {
     const float hue_stride = static_cast<float>(HsvLut::kHueStride);
     for (Index x = 0; x < n; ++x) {
@@ -161,7 +147,6 @@ PFTRACK_VECTOR_CLONES static void background_row_scan(
         const float d = mx - mn;
         si[x] = static_cast<std::int32_t>(mx * 256.0f + mn);
         hi[x] = static_cast<std::int32_t>(sector * hue_stride + (d * d + (num + d)));
-        gi[x] = static_cast<std::int32_t>(mx);
         const float d_bg = std::max(std::abs(b - qb[x]), std::max(std::abs(g - qg[x]), std::abs(r - qr[x])));
         di[x] = static_cast<std::int32_t>(std::min(d_bg, 255.0f));
         cand[x] = ((d_bg > t) | ((dprev[x] > t) & (d_bg > t_low))) ? 1.0f : 0.0f;
@@ -297,7 +282,7 @@ public:
         const Index n3 = cols * 3;
         const auto ns = static_cast<size_t>(cols);
         scratch_f_.resize(5 * ns);
-        scratch_i_.resize(4 * ns);
+        scratch_i_.resize(3 * ns);
         float* __restrict fb = scratch_f_.data();
         float* __restrict fg = fb + ns;
         float* __restrict fr = fg + ns;
@@ -306,7 +291,6 @@ public:
         std::int32_t* __restrict si = scratch_i_.data();
         std::int32_t* __restrict hi = si + ns;
         std::int32_t* __restrict di = hi + ns;
-        std::int32_t* __restrict gi = di + ns;
         // Each row in four loops over L1-resident row buffers: (1), (3), (5) are vectorised by
         // the compiler; (4) does the table look-ups, the histogram and the shadow test of the
         // few candidates, which cannot be vectorised.
@@ -321,11 +305,11 @@ public:
             // (1) deinterleave into float planes, d_prev; I' <- I
             detail::background_row_split(cols, px, prev, fb, fg, fr, dprev);
             // (3) per pixel, vectorised: table indices, d_bg, candidates
-            detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, si, hi, gi,
+            detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, si, hi,
                                         di, cand);
             // (4) bins by table look-up, histogram of floor(d_bg), shadow test on candidates
             for (Index x = 0; x < cols; ++x) {
-                o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x], gi[x]));
+                o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
                 ++h4[static_cast<size_t>(x & 3)][static_cast<size_t>(di[x])];
                 bool fore = false;
                 if (cand[x] != 0.0f) {
