@@ -8,6 +8,7 @@ void register_histogram(py::module_& m);
 void register_likelihood(py::module_& m);
 void register_resample(py::module_& m);
 void register_filter(py::module_& m);
+void register_bridge(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -15,4 +16,5 @@ PYBIND11_MODULE(_core, m) {
     register_likelihood(m);
     register_resample(m);
     register_filter(m);
+    register_bridge(m);
 }

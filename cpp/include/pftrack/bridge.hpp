@@ -1,0 +1,374 @@
+// Goal-directed state equation (Oh & Jung 2015, after Srinivasan et al. 2006): the mean path,
+// the per-step noise covariances and the state covariances of a linear-Gaussian process
+//   x_t = A_t x_{t-1} + w_t,  w_t ~ N(0, Q_t)                                        (eq. 1)
+// conditioned on one goal measurement y_T = H_T x_T + v_T, v_T ~ N(0, Pi_T)          (eq. 4)
+// and on the initial state x_0 ~ N(m_0, Pi_0). Three forms: general H_T (eqs. 7-10),
+// invertible H_T (11-15) and pseudo-inverse (16-18). All sums
+//   S_t = sum_{i=t..T} Phi(T,i) Q_i Phi(T,i)^T
+// come from one backward recursion, S_t = Phi(T,t) Q_t Phi(T,t)^T + S_{t+1}, with
+// Phi(T,t) = Phi(T,t+1) A_{t+1}: O(T) per gap, no matrix powers.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "pftrack/check.hpp"
+#include "pftrack/rng.hpp"
+#include "pftrack/types.hpp"
+
+namespace pftrack {
+
+using MatrixXd = Eigen::MatrixXd;
+using VectorXd = Eigen::VectorXd;
+
+enum class GdtForm { general, invertible, pseudo_inverse };
+
+/// One goal-directed problem. `A` and `Q` hold either one matrix (constant model) or one per
+/// step t = 1..T (A[t-1] = A_t).
+struct GdtProblem {
+    std::vector<MatrixXd> A;
+    std::vector<MatrixXd> Q;
+    MatrixXd H;      // H_T (m, n)
+    MatrixXd Pi_T;   // (m, m) goal covariance
+    VectorXd m0;     // (n) initial mean
+    MatrixXd Pi_0;   // (n, n) initial covariance
+    VectorXd y;      // (m) goal measurement
+    int T = 0;       // number of steps: x_T is the goal's state
+};
+
+struct GdtResult {
+    RowMatrixXd path;  // (T + 1, n): x_0 .. x_T
+    RowMatrixXd eps;   // (T, n * n): eps_1 .. eps_T, each n x n row-major
+    RowMatrixXd cov;   // (T + 1, n * n): cov of x_0 .. x_T along the path
+    VectorXd x0_mean;  // E[x_0 | y_T]
+    MatrixXd x0_cov;   // cov(x_0 | y_T)
+};
+
+namespace detail {
+
+inline const MatrixXd& step_matrix(const std::vector<MatrixXd>& v, int t) {
+    // t = 1..T; a single matrix stands for every step
+    return v.size() == 1 ? v[0] : v[static_cast<size_t>(t - 1)];
+}
+
+inline std::string shape_of(const MatrixXd& a) {
+    return "(" + std::to_string(a.rows()) + ", " + std::to_string(a.cols()) + ")";
+}
+
+inline void require_square(const MatrixXd& a, Index n, const char* fn, const std::string& what) {
+    require(a.rows() == n && a.cols() == n, fn, what.c_str(), shape_of(a),
+            "(" + std::to_string(n) + ", " + std::to_string(n) + ")");
+}
+
+/// Symmetric, finite, positive semi-definite (positive definite when `definite`).
+inline void require_covariance(const MatrixXd& c, const char* fn, const std::string& what,
+                               bool definite) {
+    require_finite(c, fn, what.c_str());
+    const double scale = c.cwiseAbs().maxCoeff();
+    require((c - c.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * (scale > 0 ? scale : 1.0), fn,
+            what + " is not symmetric");
+    Eigen::LDLT<MatrixXd> ldlt(c);
+    const VectorXd d = ldlt.vectorD();
+    const double tol = 1e-12 * (scale > 0 ? scale : 1.0);
+    bool ok = ldlt.info() == Eigen::Success;
+    for (Index i = 0; ok && i < d.size(); ++i) ok = definite ? d(i) > tol : d(i) >= -tol;
+    require(ok, fn,
+            what + (definite ? " is not positive definite (singular or indefinite)"
+                             : " is not positive semi-definite"));
+}
+
+inline MatrixXd sym(const MatrixXd& a) { return 0.5 * (a + a.transpose()); }
+
+/// Inverse of a symmetric positive definite matrix, with a message naming it when it is not.
+inline MatrixXd spd_inverse(const MatrixXd& a, const char* fn, const char* what) {
+    Eigen::LLT<MatrixXd> llt(a);
+    require(llt.info() == Eigen::Success, fn,
+            std::string(what) + " is singular or not positive definite");
+    return llt.solve(MatrixXd::Identity(a.rows(), a.cols()));
+}
+
+}  // namespace detail
+
+/// Throws std::invalid_argument naming the problem: T <= 0, mismatched dimensions, non-finite
+/// values, non-symmetric / non-PSD Q, non-PD Pi_0 or Pi_T, singular A (needed by the
+/// invertible and pseudo-inverse forms) or H unfit for the chosen form.
+inline void gdt_check(const GdtProblem& p, GdtForm form, const char* fn = "gdt_solve") {
+    using namespace detail;
+    require(p.T > 0, fn, "T", p.T, "> 0 (steps from the initial state to the goal)");
+    const Index n = p.m0.size();
+    require(n > 0, fn, "m0 is empty");
+    require(!p.A.empty() && (p.A.size() == 1 || p.A.size() == static_cast<size_t>(p.T)), fn,
+            "number of A matrices", p.A.size(), "1 or T = " + std::to_string(p.T));
+    require(!p.Q.empty() && (p.Q.size() == 1 || p.Q.size() == static_cast<size_t>(p.T)), fn,
+            "number of Q matrices", p.Q.size(), "1 or T = " + std::to_string(p.T));
+    for (size_t i = 0; i < p.A.size(); ++i) {
+        require_square(p.A[i], n, fn, "A[" + std::to_string(i) + "] shape");
+        require_finite(p.A[i], fn, "A");
+    }
+    for (size_t i = 0; i < p.Q.size(); ++i) {
+        require_square(p.Q[i], n, fn, "Q[" + std::to_string(i) + "] shape");
+        require_covariance(p.Q[i], fn, "Q[" + std::to_string(i) + "]", false);
+    }
+    require_finite(p.m0, fn, "m0");
+    require_square(p.Pi_0, n, fn, "Pi_0 shape");
+    require_covariance(p.Pi_0, fn, "Pi_0", true);
+    const Index m = p.y.size();
+    require(m > 0, fn, "y is empty");
+    require_finite(p.y, fn, "y");
+    require(p.H.rows() == m && p.H.cols() == n, fn, "H shape", shape_of(p.H),
+            "(" + std::to_string(m) + ", " + std::to_string(n) + ") = (len(y), len(m0))");
+    require_finite(p.H, fn, "H");
+    require_square(p.Pi_T, m, fn, "Pi_T shape");
+    require_covariance(p.Pi_T, fn, "Pi_T", true);
+    if (form == GdtForm::invertible) {
+        require(m == n, fn, "H must be square for the invertible form (use form='general')");
+        Eigen::FullPivLU<MatrixXd> lu(p.H);
+        require(lu.isInvertible(), fn, "H is singular (use form='general')");
+    }
+    if (form == GdtForm::pseudo_inverse) {
+        Eigen::FullPivLU<MatrixXd> lu(p.H.transpose() * p.H);
+        require(lu.isInvertible(), fn,
+                "H^T H is singular: the pseudo-inverse form needs H of full column rank "
+                "(use form='general')");
+    }
+    if (form != GdtForm::general)
+        for (size_t i = 0; i < p.A.size(); ++i) {
+            Eigen::FullPivLU<MatrixXd> lu(p.A[i]);
+            require(lu.isInvertible(), fn, "A[" + std::to_string(i) + "] is singular");
+        }
+}
+
+/// Per-step quantities of the goal-directed equation, written so that every form reduces to
+///   x_t = A_t x_{t-1} + K_t (y_T - G_t x_{t-1}),  eps_t = covariance of step t,
+/// with G_t = H_T Phi(T, t-1). The forms differ only in how K_t and eps_t are computed.
+struct GdtSteps {
+    std::vector<MatrixXd> K;    // (n, m) drift gains, t = 1..T
+    std::vector<MatrixXd> G;    // (m, n)
+    std::vector<MatrixXd> eps;  // (n, n)
+    VectorXd x0_mean;
+    MatrixXd x0_cov;
+};
+
+/// Build the per-step gains. Preconditions: gdt_check(p, form) passed.
+inline GdtSteps gdt_steps(const GdtProblem& p, GdtForm form) {
+    using namespace detail;
+    const char* fn = "gdt_solve";
+    const Index n = p.m0.size();
+    const int T = p.T;
+    GdtSteps s;
+    s.K.resize(static_cast<size_t>(T));
+    s.G.resize(static_cast<size_t>(T));
+    s.eps.resize(static_cast<size_t>(T));
+    const MatrixXd Pi0_inv = spd_inverse(p.Pi_0, fn, "Pi_0");
+
+    if (form == GdtForm::general) {
+        // Backward: Phi = Phi(T, t), S = S_t = sum_{i=t..T} Phi(T,i) Q_i Phi(T,i)^T.
+        MatrixXd Phi = MatrixXd::Identity(n, n);
+        MatrixXd S = MatrixXd::Zero(n, n);
+        MatrixXd Minv;
+        for (int t = T; t >= 1; --t) {
+            const MatrixXd& Qt = step_matrix(p.Q, t);
+            // S_t = Phi(T,t) Q_t Phi(T,t)^T + S_{t+1}
+            S.noalias() += Phi * Qt * Phi.transpose();
+            // M_t = Pi_T + H S_t H^T
+            const MatrixXd M = p.Pi_T + p.H * S * p.H.transpose();
+            Minv = spd_inverse(sym(M), fn, "Pi_T + H S H^T");
+            const MatrixXd HPhi = p.H * Phi;  // H Phi(T, t)
+            // u_t = Q_t Phi^T(T,t) H^T M_t^{-1} (y - H Phi(T,t-1) x_{t-1})   (eq. 7)
+            s.K[static_cast<size_t>(t - 1)] = Qt * HPhi.transpose() * Minv;
+            // eps_t = Q_t - Q_t Phi^T H^T M_t^{-1} H Phi Q_t^T                (eq. 8)
+            s.eps[static_cast<size_t>(t - 1)] =
+                sym(Qt - s.K[static_cast<size_t>(t - 1)] * HPhi * Qt.transpose());
+            Phi = Phi * step_matrix(p.A, t);  // Phi(T, t-1)
+            s.G[static_cast<size_t>(t - 1)] = p.H * Phi;
+        }
+        // After the loop Phi = Phi(T, 0) and Minv = M_1^{-1}.
+        const MatrixXd F = p.H * Phi;  // H Phi(T, 0)
+        // cov(x0|yT) = (Pi_0^{-1} + Phi^T(T,0) H^T M_1^{-1} H Phi(T,0))^{-1}   (eq. 9)
+        s.x0_cov = sym(spd_inverse(sym(Pi0_inv + F.transpose() * Minv * F), fn, "cov(x0|yT)^-1"));
+        // E[x0|yT] = m0 + cov Phi^T H^T M_1^{-1} (y - H Phi(T,0) m0)         (eq. 10)
+        s.x0_mean = p.m0 + s.x0_cov * F.transpose() * Minv * (p.y - F * p.m0);
+        return s;
+    }
+
+    // Invertible / pseudo-inverse forms: goal mapped to state space,
+    //   x_T = H^+ y,  cov = H^+ Pi_T H^+T   (H^+ = H^-1, or (H^T H)^-1 H^T)   (eqs. 13, 17)
+    MatrixXd Hp;
+    if (form == GdtForm::invertible) {
+        Hp = p.H.fullPivLu().inverse();
+    } else {
+        const MatrixXd HtH = p.H.transpose() * p.H;
+        Hp = HtH.fullPivLu().solve(p.H.transpose());
+    }
+    const MatrixXd goal_cov = sym(Hp * p.Pi_T * Hp.transpose());
+    const VectorXd goal_state = Hp * p.y;
+    // Backward: Psi = Phi(t, T) = A_{t+1}^{-1} Phi(t+1, T),
+    //           W_t = sum_{i=t..T} Phi(t,i) Q_i Phi(t,i)^T = Q_t + A_{t+1}^{-1} W_{t+1} A_{t+1}^{-T}.
+    MatrixXd Psi = MatrixXd::Identity(n, n);
+    MatrixXd W = MatrixXd::Zero(n, n);
+    MatrixXd PiInv;
+    MatrixXd Ainv_const;
+    if (p.A.size() == 1) Ainv_const = p.A[0].fullPivLu().inverse();
+    MatrixXd PhiT = MatrixXd::Identity(n, n);  // Phi(T, t), for G_t
+    for (int t = T; t >= 1; --t) {
+        const MatrixXd& Qt = step_matrix(p.Q, t);
+        if (t < T) {
+            const MatrixXd Ainv =
+                p.A.size() == 1 ? Ainv_const : step_matrix(p.A, t + 1).fullPivLu().inverse();
+            Psi = Ainv * Psi;
+            W = Ainv * W * Ainv.transpose();
+        }
+        W += Qt;
+        // Pi(t, T) = Phi(t,T) H^+ Pi_T H^+T Phi^T(t,T) + W_t               (eq. 13 / 17)
+        const MatrixXd Pi = sym(Psi * goal_cov * Psi.transpose() + W);
+        PiInv = spd_inverse(Pi, fn, "Pi(t, T)");
+        // u_t = Q_t Pi^{-1}(t,T) Phi(t,T) H^+ (y - H Phi(T,t-1) x_{t-1})    (eq. 11 / 16)
+        s.K[static_cast<size_t>(t - 1)] = Qt * PiInv * Psi * Hp;
+        // eps_t = Q_t - Q_t Pi^{-1}(t,T) Q_t^T                              (eq. 12)
+        s.eps[static_cast<size_t>(t - 1)] = sym(Qt - Qt * PiInv * Qt.transpose());
+        PhiT = PhiT * step_matrix(p.A, t);
+        s.G[static_cast<size_t>(t - 1)] = p.H * PhiT;
+    }
+    // Pi(0, T) = A_1^{-1} (Pi(1, T)) A_1^{-T}: one more backward step, without Q_0.
+    const MatrixXd A1inv = p.A.size() == 1 ? Ainv_const : p.A[0].fullPivLu().inverse();
+    const MatrixXd Psi0 = A1inv * Psi;
+    const MatrixXd W0 = A1inv * W * A1inv.transpose();
+    const MatrixXd Pi0T = sym(Psi0 * goal_cov * Psi0.transpose() + W0);
+    const MatrixXd Pi0T_inv = spd_inverse(Pi0T, fn, "Pi(0, T)");
+    // cov(x0|yT) = (Pi_0^{-1} + Pi^{-1}(0,T))^{-1}                           (eq. 14)
+    s.x0_cov = sym(spd_inverse(sym(Pi0_inv + Pi0T_inv), fn, "cov(x0|yT)^-1"));
+    // E[x0|yT] = cov (Pi_0^{-1} m0 + Pi^{-1}(0,T) Phi(0,T) H^+ y)           (eq. 15 / 18)
+    s.x0_mean = s.x0_cov * (Pi0_inv * p.m0 + Pi0T_inv * Psi0 * goal_state);
+    return s;
+}
+
+/// Solve one problem: mean path x_0..x_T (x_t = A_t x_{t-1} + u_t), eps_t, the state
+/// covariances along the path and the conditioned initial state. The path starts at
+/// E[x_0|y_T] (`start_conditioned`, giving E[x_t|y_T]) or at m_0 (the paper's framework: x_0 is
+/// the Kalman estimate at the end of the first segment).
+inline GdtResult gdt_solve(const GdtProblem& p, GdtForm form, bool start_conditioned) {
+    gdt_check(p, form);
+    const GdtSteps s = gdt_steps(p, form);
+    const Index n = p.m0.size();
+    const int T = p.T;
+    GdtResult r;
+    r.x0_mean = s.x0_mean;
+    r.x0_cov = s.x0_cov;
+    r.path.resize(T + 1, n);
+    r.eps.resize(T, n * n);
+    r.cov.resize(T + 1, n * n);
+    VectorXd x = start_conditioned ? s.x0_mean : p.m0;
+    MatrixXd P = start_conditioned ? s.x0_cov : p.Pi_0;
+    r.path.row(0) = x.transpose();
+    Eigen::Map<RowMatrixXd>(r.cov.row(0).data(), n, n) = P;
+    for (int t = 1; t <= T; ++t) {
+        const size_t k = static_cast<size_t>(t - 1);
+        const MatrixXd& At = detail::step_matrix(p.A, t);
+        // x_t = A_t x_{t-1} + u_t,  u_t = K_t (y - G_t x_{t-1})           (eq. 3, mean)
+        x = At * x + s.K[k] * (p.y - s.G[k] * x);
+        // cov: x_t is linear in x_{t-1} with matrix (A_t - K_t G_t), plus eps_t
+        const MatrixXd B = At - s.K[k] * s.G[k];
+        P = detail::sym(B * P * B.transpose() + s.eps[k]);
+        r.path.row(t) = x.transpose();
+        Eigen::Map<RowMatrixXd>(r.eps.row(t - 1).data(), n, n) = s.eps[k];
+        Eigen::Map<RowMatrixXd>(r.cov.row(t).data(), n, n) = P;
+    }
+    return r;
+}
+
+/// Lower Cholesky-like factor of a PSD matrix (LDLT, negative round-off pivots clamped to 0).
+inline MatrixXd psd_factor(const MatrixXd& c) {
+    Eigen::LDLT<MatrixXd> ldlt(c);
+    const VectorXd d = ldlt.vectorD().cwiseMax(0.0).cwiseSqrt();
+    MatrixXd L = ldlt.matrixL();
+    MatrixXd F = ldlt.transpositionsP().transpose() * (L * d.asDiagonal());
+    return F;
+}
+
+/// `n_samples` random paths of the goal-directed process x_t = A_t x_{t-1} + u_t + eps_t noise,
+/// x_0 ~ N(E[x0|yT], cov(x0|yT)) (or x_0 = m_0 when not `start_conditioned`). Returns
+/// (n_samples * (T + 1), n): sample s occupies rows s (T+1) .. s (T+1) + T. Draw k of sample s
+/// is CounterRng(seed, s).normal(k), so results do not depend on threads or order.
+inline RowMatrixXd gdt_sample(const GdtProblem& p, GdtForm form, bool start_conditioned,
+                              int n_samples, std::uint64_t seed) {
+    gdt_check(p, form, "gdt_sample");
+    require(n_samples > 0, "gdt_sample", "n_samples", n_samples, "> 0");
+    const GdtSteps s = gdt_steps(p, form);
+    const Index n = p.m0.size();
+    const int T = p.T;
+    std::vector<MatrixXd> F(static_cast<size_t>(T));
+    for (int t = 0; t < T; ++t) F[static_cast<size_t>(t)] = psd_factor(s.eps[static_cast<size_t>(t)]);
+    const MatrixXd F0 = psd_factor(s.x0_cov);
+    RowMatrixXd out(static_cast<Index>(n_samples) * (T + 1), n);
+    VectorXd z(n);
+    for (int smp = 0; smp < n_samples; ++smp) {
+        const CounterRng rng(seed, static_cast<std::uint64_t>(smp));
+        std::uint64_t k = 0;
+        VectorXd x = p.m0;
+        if (start_conditioned) {
+            for (Index j = 0; j < n; ++j) z(j) = rng.normal(k++);
+            x = s.x0_mean + F0 * z;
+        }
+        const Index base = static_cast<Index>(smp) * (T + 1);
+        out.row(base) = x.transpose();
+        for (int t = 1; t <= T; ++t) {
+            const size_t i = static_cast<size_t>(t - 1);
+            for (Index j = 0; j < n; ++j) z(j) = rng.normal(k++);
+            // x_t = A_t x_{t-1} + u_t + eps_t                                 (eq. 3)
+            x = detail::step_matrix(p.A, t) * x + s.K[i] * (p.y - s.G[i] * x) + F[i] * z;
+            out.row(base + t) = x.transpose();
+        }
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Kalman filtering of a segment (for the initial state of a gap, and the goal state from the
+// other side when run backwards).
+
+struct KalmanEstimate {
+    VectorXd m;
+    MatrixXd P;
+};
+
+/// Kalman filter over measurements z (K, m) with constant A, Q, H, R; the first state is
+/// m_init, P_init. Returns the filtered state after the last measurement.
+inline KalmanEstimate kalman_filter(const Eigen::Ref<const RowMatrixXd>& z, const MatrixXd& A,
+                                    const MatrixXd& Q, const MatrixXd& H, const MatrixXd& R,
+                                    const VectorXd& m_init, const MatrixXd& P_init) {
+    const char* fn = "kalman_filter";
+    const Index n = A.rows();
+    require(z.rows() > 0, fn, "z (the segment) is empty");
+    require(z.cols() == H.rows(), fn, "z cols", z.cols(), H.rows());
+    require_finite(z, fn, "z");
+    detail::require_square(A, n, fn, "A shape");
+    detail::require_square(Q, n, fn, "Q shape");
+    detail::require_square(R, H.rows(), fn, "R shape");
+    require(H.cols() == n, fn, "H cols", H.cols(), n);
+    require(m_init.size() == n, fn, "m_init size", m_init.size(), n);
+    detail::require_square(P_init, n, fn, "P_init shape");
+    detail::require_covariance(R, fn, "R", true);
+    detail::require_covariance(Q, fn, "Q", false);
+    KalmanEstimate e{m_init, P_init};
+    const MatrixXd I = MatrixXd::Identity(n, n);
+    for (Index k = 0; k < z.rows(); ++k) {
+        if (k > 0) {
+            e.m = A * e.m;
+            e.P = detail::sym(A * e.P * A.transpose() + Q);
+        }
+        const MatrixXd S = H * e.P * H.transpose() + R;
+        const MatrixXd K = e.P * H.transpose() * detail::spd_inverse(detail::sym(S), fn, "S");
+        e.m += K * (z.row(k).transpose() - H * e.m);
+        const MatrixXd IKH = I - K * H;  // Joseph form keeps P symmetric PSD
+        e.P = detail::sym(IKH * e.P * IKH.transpose() + K * R * K.transpose());
+    }
+    return e;
+}
+
+}  // namespace pftrack
