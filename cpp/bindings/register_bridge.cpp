@@ -168,4 +168,25 @@ void register_bridge(py::module_& m) {
         },
         py::arg("z"), py::arg("A"), py::arg("Q"), py::arg("H"), py::arg("R"), py::arg("m_init"),
         py::arg("P_init"), "Filtered (m (n,), P (n, n)) after the last of z (K, m).");
+    m.def(
+        "gdt_recover_batch",
+        [](Eigen::Ref<const RowMatrixXd> seg_a, Eigen::Ref<const Eigen::VectorXi> a_len,
+           Eigen::Ref<const RowMatrixXd> seg_b, Eigen::Ref<const Eigen::VectorXi> b_len,
+           const Array& A, const Array& Q, const Array& H, const Array& R, double p_init_velocity,
+           const std::string& goal, int history, bool start_conditioned) {
+            const char* fn = "gdt_recover_batch";
+            SegmentModel model{matrix2(A, fn, "A"), matrix2(Q, fn, "Q"), matrix2(H, fn, "H"),
+                               matrix2(R, fn, "R"), p_init_velocity};
+            GoalKind kind;
+            if (goal == "first_point") kind = GoalKind::first_point;
+            else if (goal == "backward_state") kind = GoalKind::backward_state;
+            else fail(fn, "goal is '" + goal + "', expected 'first_point' or 'backward_state'");
+            py::gil_scoped_release nogil;  // safe: Eigen views and C++ copies only
+            return gdt_recover_batch(seg_a, a_len, seg_b, b_len, model, kind, history,
+                                     start_conditioned);
+        },
+        py::arg("seg_a"), py::arg("a_len"), py::arg("seg_b"), py::arg("b_len"), py::arg("A"),
+        py::arg("Q"), py::arg("H"), py::arg("R"), py::arg("p_init_velocity"), py::arg("goal"),
+        py::arg("history"), py::arg("start_conditioned"),
+        "Interior positions (sum(T_g - 1), m) of every gap; segments stacked (frame, pos...).");
 }

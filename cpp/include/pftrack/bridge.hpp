@@ -75,7 +75,7 @@ inline void require_covariance(const MatrixXd& c, const char* fn, const std::str
             what + " is not symmetric");
     Eigen::LDLT<MatrixXd> ldlt(c);
     const VectorXd d = ldlt.vectorD();
-    const double tol = 1e-12 * (scale > 0 ? scale : 1.0);
+    const double tol = 1e-10 * static_cast<double>(c.rows()) * (scale > 0 ? scale : 1.0);
     bool ok = ldlt.info() == Eigen::Success;
     for (Index i = 0; ok && i < d.size(); ++i) ok = definite ? d(i) > tol : d(i) >= -tol;
     require(ok, fn,
@@ -369,6 +369,287 @@ inline KalmanEstimate kalman_filter(const Eigen::Ref<const RowMatrixXd>& z, cons
         e.P = detail::sym(IKH * e.P * IKH.transpose() + K * R * K.transpose());
     }
     return e;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Many gaps in one call: segment filtering + goal-directed path, for a (position, velocity) state.
+
+/// Model of the segments: state (p_1..p_m, v_1..v_m) (n = 2m), measurement = position.
+struct SegmentModel {
+    MatrixXd A;  // (n, n)
+    MatrixXd Q;  // (n, n)
+    MatrixXd H;  // (m, n)
+    MatrixXd R;  // (m, m)
+    double p_init_velocity = 1e2;
+};
+
+/// Goal of each gap: the first point of segment B (the paper), or the full state estimated by a
+/// Kalman filter run backwards over segment B, with its covariance as Pi_T.
+enum class GoalKind { first_point, backward_state };
+
+namespace detail {
+
+/// Rows [begin, end) of `seg` (frame, p...) restricted to the run of consecutive frames that
+/// touches the gap (the last run of A, the first run of B), at most `history` rows.
+inline void gap_run(const Eigen::Ref<const RowMatrixXd>& seg, Index begin, Index end, bool tail,
+                    int history, Index& run_begin, Index& run_end) {
+    if (tail) {
+        run_end = end;
+        run_begin = end - 1;
+        while (run_begin > begin && seg(run_begin, 0) - seg(run_begin - 1, 0) == 1.0 &&
+               run_end - run_begin < history)
+            --run_begin;
+    } else {
+        run_begin = begin;
+        run_end = begin + 1;
+        while (run_end < end && seg(run_end, 0) - seg(run_end - 1, 0) == 1.0 &&
+               run_end - run_begin < history)
+            ++run_end;
+    }
+}
+
+inline KalmanEstimate filter_run(const RowMatrixXd& z, const SegmentModel& model) {
+    const Index m = model.H.rows();
+    const Index n = model.A.rows();
+    VectorXd m_init = VectorXd::Zero(n);
+    m_init.head(m) = z.row(0).transpose();
+    if (z.rows() > 1) m_init.segment(m, m) = (z.row(1) - z.row(0)).transpose();
+    MatrixXd P_init = MatrixXd::Zero(n, n);
+    P_init.topLeftCorner(m, m) = model.R;
+    P_init.block(m, m, m, m) = MatrixXd::Identity(m, m) * model.p_init_velocity;
+    return kalman_filter(z, model.A, model.Q, model.H, model.R, m_init, P_init);
+}
+
+}  // namespace detail
+
+namespace detail {
+
+/// Fixed-size Kalman filter over rows [r0, r1) of `seg` (columns 1..M), optionally in reverse
+/// order, initialised like filter_run. Same maths as kalman_filter, without heap allocations.
+template <int N, int M>
+void kalman_run_fixed(const Eigen::Ref<const RowMatrixXd>& seg, Index r0, Index r1, bool reverse,
+                      const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<double, N, N>& Q,
+                      const Eigen::Matrix<double, M, N>& H, const Eigen::Matrix<double, M, M>& R,
+                      double p_vel, Eigen::Matrix<double, N, 1>& m,
+                      Eigen::Matrix<double, N, N>& P) {
+    using VecM = Eigen::Matrix<double, M, 1>;
+    const Index len = r1 - r0;
+    auto z = [&](Index k) -> VecM {
+        const Index r = reverse ? r1 - 1 - k : r0 + k;
+        return seg.block(r, 1, 1, M).transpose();
+    };
+    m.setZero();
+    m.template head<M>() = z(0);
+    if (len > 1) m.template tail<N - M>() = z(1) - z(0);
+    P.setZero();
+    P.template topLeftCorner<M, M>() = R;
+    P.template bottomRightCorner<N - M, N - M>().diagonal().setConstant(p_vel);
+    const Eigen::Matrix<double, N, N> I = Eigen::Matrix<double, N, N>::Identity();
+    for (Index k = 0; k < len; ++k) {
+        if (k > 0) {
+            m = A * m;
+            P = A * P * A.transpose() + Q;
+        }
+        const Eigen::Matrix<double, M, M> S = H * P * H.transpose() + R;
+        Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
+        require(llt.info() == Eigen::Success, "gdt_recover_batch",
+                "innovation covariance is not positive definite");
+        const Eigen::Matrix<double, N, M> K =
+            (llt.solve((P * H.transpose()).transpose())).transpose();
+        m += K * (z(k) - H * m);
+        const Eigen::Matrix<double, N, N> IKH = I - K * H;
+        P = IKH * P * IKH.transpose() + K * R * K.transpose();
+        P = 0.5 * (P + P.transpose()).eval();
+    }
+}
+
+/// Fixed-size goal-directed mean path (general form, eqs. 7 and 10) of one gap; writes the
+/// positions of x_1 .. x_{T-1} into out rows [row, row + T - 1).
+template <int N, int MG>
+void gdt_path_fixed(const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<double, N, N>& Q,
+                    const Eigen::Matrix<double, MG, N>& H, const Eigen::Matrix<double, MG, MG>& PiT,
+                    const Eigen::Matrix<double, N, 1>& m0, const Eigen::Matrix<double, N, N>& P0,
+                    const Eigen::Matrix<double, MG, 1>& y, int T, bool start_conditioned,
+                    std::vector<Eigen::Matrix<double, N, MG>>& K,
+                    std::vector<Eigen::Matrix<double, MG, N>>& G, RowMatrixXd& out, Index row) {
+    using MatN = Eigen::Matrix<double, N, N>;
+    using MatG = Eigen::Matrix<double, MG, MG>;
+    const char* fn = "gdt_recover_batch";
+    K.resize(static_cast<size_t>(T));
+    G.resize(static_cast<size_t>(T));
+    MatN Phi = MatN::Identity();
+    MatN S = MatN::Zero();
+    MatG Minv;
+    for (int t = T; t >= 1; --t) {
+        // S_t = Phi(T,t) Q Phi(T,t)^T + S_{t+1};  M_t = Pi_T + H S_t H^T
+        S.noalias() += Phi * Q * Phi.transpose();
+        const MatG M = PiT + H * S * H.transpose();
+        Eigen::LLT<MatG> llt(0.5 * (M + M.transpose()));
+        require(llt.info() == Eigen::Success, fn, "Pi_T + H S H^T is not positive definite");
+        Minv = llt.solve(MatG::Identity());
+        const Eigen::Matrix<double, MG, N> HPhi = H * Phi;
+        K[static_cast<size_t>(t - 1)] = Q * HPhi.transpose() * Minv;  // eq. 7
+        Phi = Phi * A;                                                  // Phi(T, t-1)
+        G[static_cast<size_t>(t - 1)] = H * Phi;
+    }
+    Eigen::Matrix<double, N, 1> x = m0;
+    if (start_conditioned) {
+        const Eigen::Matrix<double, MG, N> F = H * Phi;  // H Phi(T, 0)
+        Eigen::LLT<MatN> l0(P0);
+        require(l0.info() == Eigen::Success, fn, "Pi_0 is not positive definite");
+        const MatN info = l0.solve(MatN::Identity()) + F.transpose() * Minv * F;  // eq. 9
+        Eigen::LLT<MatN> l1(0.5 * (info + info.transpose()));
+        require(l1.info() == Eigen::Success, fn, "cov(x0|yT) is singular");
+        x = m0 + l1.solve(F.transpose() * Minv * (y - F * m0));  // eq. 10
+    }
+    for (int t = 1; t < T; ++t) {
+        const size_t k = static_cast<size_t>(t - 1);
+        x = A * x + K[k] * (y - G[k] * x);  // eq. 3 (mean)
+        out.row(row++) = x.template head<N / 2>().transpose();
+    }
+}
+
+template <int M>
+RowMatrixXd gdt_recover_batch_fixed(const Eigen::Ref<const RowMatrixXd>& seg_a,
+                                    const Eigen::Ref<const Eigen::VectorXi>& a_len,
+                                    const Eigen::Ref<const RowMatrixXd>& seg_b,
+                                    const Eigen::Ref<const Eigen::VectorXi>& b_len,
+                                    const SegmentModel& model, GoalKind goal, int history,
+                                    bool start_conditioned, const std::vector<int>& Ts,
+                                    Index total) {
+    constexpr int N = 2 * M;
+    using MatN = Eigen::Matrix<double, N, N>;
+    const MatN A = model.A, Q = model.Q;
+    const Eigen::Matrix<double, M, N> H = model.H;
+    const Eigen::Matrix<double, M, M> R = model.R;
+    MatN J = MatN::Identity();
+    J.template bottomRightCorner<M, M>() *= -1.0;  // time reversal flips velocities
+    RowMatrixXd out(total, M);
+    std::vector<Eigen::Matrix<double, N, M>> K2;
+    std::vector<Eigen::Matrix<double, M, N>> G2;
+    std::vector<Eigen::Matrix<double, N, N>> K4, G4;
+    Index ia = 0, ib = 0, row = 0;
+    for (Index g = 0; g < a_len.size(); ++g) {
+        const int T = Ts[static_cast<size_t>(g)];
+        Index r0, r1;
+        gap_run(seg_a, ia, ia + a_len(g), true, history, r0, r1);
+        Eigen::Matrix<double, N, 1> m0;
+        MatN P0;
+        kalman_run_fixed<N, M>(seg_a, r0, r1, false, A, Q, H, R, model.p_init_velocity, m0, P0);
+        if (goal == GoalKind::first_point) {
+            const Eigen::Matrix<double, M, 1> y = seg_b.block(ib, 1, 1, M).transpose();
+            gdt_path_fixed<N, M>(A, Q, H, R, m0, P0, y, T, start_conditioned, K2, G2, out, row);
+        } else {
+            gap_run(seg_b, ib, ib + b_len(g), false, history, r0, r1);
+            Eigen::Matrix<double, N, 1> mb;
+            MatN Pb;
+            kalman_run_fixed<N, M>(seg_b, r0, r1, true, A, Q, H, R, model.p_init_velocity, mb, Pb);
+            const MatN PiT = J * Pb * J;
+            gdt_path_fixed<N, N>(A, Q, MatN::Identity(), 0.5 * (PiT + PiT.transpose()), m0, P0,
+                                 J * mb, T, start_conditioned, K4, G4, out, row);
+        }
+        row += T - 1;
+        ia += a_len(g);
+        ib += b_len(g);
+    }
+    return out;
+}
+
+}  // namespace detail
+
+/// Recover every gap between consecutive pairs of segments. `seg_a` stacks the A segments
+/// (rows frame, p_1..p_m; `a_len[g]` rows each), `seg_b` the B segments likewise. Returns the
+/// mean positions of every gap's interior frames (T_g - 1 rows per gap, gaps in order).
+inline RowMatrixXd gdt_recover_batch(const Eigen::Ref<const RowMatrixXd>& seg_a,
+                                     const Eigen::Ref<const Eigen::VectorXi>& a_len,
+                                     const Eigen::Ref<const RowMatrixXd>& seg_b,
+                                     const Eigen::Ref<const Eigen::VectorXi>& b_len,
+                                     const SegmentModel& model, GoalKind goal, int history,
+                                     bool start_conditioned) {
+    const char* fn = "gdt_recover_batch";
+    const Index m = model.H.rows();
+    const Index n = model.A.rows();
+    require(m > 0 && n == 2 * m, fn, "A rows", n, "2 x measurement size (position, velocity)");
+    require(model.A.cols() == n && model.Q.rows() == n && model.Q.cols() == n &&
+                model.H.cols() == n && model.R.rows() == m && model.R.cols() == m,
+            fn, "model matrices have mismatched shapes");
+    require_finite(model.A, fn, "A");
+    require_finite(model.H, fn, "H");
+    detail::require_covariance(model.Q, fn, "Q", false);
+    detail::require_covariance(model.R, fn, "R", true);
+    require(model.p_init_velocity > 0 && std::isfinite(model.p_init_velocity), fn,
+            "p_init_velocity", model.p_init_velocity, "> 0");
+    require(seg_a.cols() == m + 1 && seg_b.cols() == m + 1, fn,
+            "segments must have columns (frame, position...)");
+    require(a_len.size() == b_len.size(), fn, "len(b_len)", b_len.size(), a_len.size());
+    require(a_len.sum() == seg_a.rows(), fn, "sum(a_len)", a_len.sum(), seg_a.rows());
+    require(b_len.sum() == seg_b.rows(), fn, "sum(b_len)", b_len.sum(), seg_b.rows());
+    require(history >= 1, fn, "history", history, ">= 1");
+    require_finite(seg_a, fn, "seg_a");
+    require_finite(seg_b, fn, "seg_b");
+    const Index G = a_len.size();
+    std::vector<int> Ts(static_cast<size_t>(G));
+    Index ia = 0, ib = 0, total = 0;
+    for (Index g = 0; g < G; ++g) {
+        const Index na = a_len(g), nb = b_len(g);
+        require(na > 0 && nb > 0, fn, "segment of gap " + std::to_string(g) + " is empty");
+        for (Index k = ia + 1; k < ia + na; ++k)
+            require(seg_a(k, 0) > seg_a(k - 1, 0), fn,
+                    "frames of segment_a of gap " + std::to_string(g) + " do not increase");
+        for (Index k = ib + 1; k < ib + nb; ++k)
+            require(seg_b(k, 0) > seg_b(k - 1, 0), fn,
+                    "frames of segment_b of gap " + std::to_string(g) + " do not increase");
+        const double fa = seg_a(ia + na - 1, 0), fb = seg_b(ib, 0);
+        require(fb > fa, fn, "segment_b of gap " + std::to_string(g) + " starts at frame " +
+                                 std::to_string(fb) + ", not after segment_a's end " +
+                                 std::to_string(fa));
+        Ts[static_cast<size_t>(g)] = static_cast<int>(fb - fa);
+        total += Ts[static_cast<size_t>(g)] - 1;
+        ia += na;
+        ib += nb;
+    }
+    if (m == 2)  // image positions: allocation-free fixed-size kernels
+        return detail::gdt_recover_batch_fixed<2>(seg_a, a_len, seg_b, b_len, model, goal, history,
+                                                  start_conditioned, Ts, total);
+    MatrixXd J = MatrixXd::Identity(n, n);
+    J.bottomRightCorner(m, m) *= -1.0;  // time reversal flips velocities
+    RowMatrixXd out(total, m);
+    Index row = 0;
+    ia = ib = 0;
+    for (Index g = 0; g < G; ++g) {
+        GdtProblem p;
+        p.T = Ts[static_cast<size_t>(g)];
+        p.A = {model.A};
+        p.Q = {model.Q};
+        Index r0, r1;
+        detail::gap_run(seg_a, ia, ia + a_len(g), true, history, r0, r1);
+        const KalmanEstimate ea = detail::filter_run(seg_a.block(r0, 1, r1 - r0, m), model);
+        p.m0 = ea.m;
+        p.Pi_0 = ea.P;
+        if (goal == GoalKind::first_point) {
+            p.H = model.H;
+            p.Pi_T = model.R;
+            p.y = seg_b.block(ib, 1, 1, m).transpose();
+        } else {
+            detail::gap_run(seg_b, ib, ib + b_len(g), false, history, r0, r1);
+            const RowMatrixXd zb = seg_b.block(r0, 1, r1 - r0, m).colwise().reverse();
+            const KalmanEstimate eb = detail::filter_run(zb, model);
+            p.H = MatrixXd::Identity(n, n);
+            p.Pi_T = detail::sym(J * eb.P * J);
+            p.y = J * eb.m;
+        }
+        const GdtSteps s = gdt_steps(p, GdtForm::general);
+        VectorXd x = start_conditioned ? s.x0_mean : p.m0;
+        for (int t = 1; t < p.T; ++t) {
+            const size_t k = static_cast<size_t>(t - 1);
+            // x_t = A x_{t-1} + K_t (y - G_t x_{t-1})                        (eqs. 3, 7)
+            x = p.A[0] * x + s.K[k] * (p.y - s.G[k] * x);
+            out.row(row++) = x.head(m).transpose();
+        }
+        ia += a_len(g);
+        ib += b_len(g);
+    }
+    return out;
 }
 
 }  // namespace pftrack

@@ -160,6 +160,7 @@ def estimate_noise(
     floor_q: float = 1e-5,
     floor_r: float = 1e-3,
     min_points: int = 4,
+    scales: Sequence[int] = (1, 2, 4, 8),
 ) -> NoiseEstimate:
     """Estimate the motion noise ``q`` and measurement noise ``r`` per axis from observed data.
 
@@ -179,6 +180,12 @@ def estimate_noise(
         Lower bounds of the estimates.
     min_points : int
         Shortest run used.
+    scales : sequence of int
+        ``"ml"`` only: the model is fitted to the runs sampled every ``s`` frames for each
+        ``s`` and, per axis, the smallest ``q`` (converted to per-frame units, ``q_s / s^3``)
+        is kept with its ``r``. White acceleration gives the same ``q`` at every scale; jitter
+        that is correlated over a few frames (gait sway, box annotation noise) inflates ``q``
+        at the finest scales and would make long predictions too wiggly.
 
     Returns
     -------
@@ -197,9 +204,26 @@ def estimate_noise(
                 runs.append(run)
     if sum(len(r) - 3 for r in runs) < 4:
         return DEFAULT_NOISE
+    if not scales or any(int(v) < 1 for v in scales):
+        raise ValueError(f"estimate_noise: scales is {scales!r}, expected integers >= 1")
     if method == "moments":
         return _moments_noise(runs, floor_q, floor_r)
-    return _ml_noise(runs, floor_q, floor_r)
+    best: list[tuple[float, float]] = [(np.inf, 0.0), (np.inf, 0.0)]
+    for s in (int(v) for v in scales):
+        sub: list[F64] = []
+        for run in runs:
+            for j in range(s):
+                part = run[j::s]
+                if len(part) >= 4:
+                    sub.append(part)
+        if sum(len(r) - 3 for r in sub) < 4:
+            continue
+        est = _ml_noise(sub, floor_q * s**3, floor_r)
+        for axis in range(2):
+            q = est.q[axis] / s**3  # per s frames -> per frame
+            if q < best[axis][0]:
+                best[axis] = (q, est.r[axis])
+    return NoiseEstimate(q=(best[0][0], best[1][0]), r=(best[0][1], best[1][1]))
 
 
 def wna_Q(q: Sequence[float], dt: float = 1.0) -> F64:  # noqa: N802
@@ -452,10 +476,9 @@ def recover_gap(
     if fr.size == 0:
         return np.zeros((0, 4 if a.shape[1] == 5 and b.shape[1] == 5 else 2))
     f0 = a[-1, 0]
-    if method == "gdt":
-        xy = _gdt_path(gdt_problem(a, b), False, fr, f0)
-    elif method == "gdt-bi":
-        xy = _gdt_path(gdt_bi_problem(a, b, noise), True, fr, f0)
+    if method in PFTRACK_METHODS:
+        full = recover_gaps([(a, b)], method, noise=noise)[0]
+        xy = full[(fr - f0 - 1).astype(int)]
     elif method == "linear":
         xy = _linear(a, b, fr)
     elif method == "cubic":
@@ -470,25 +493,71 @@ def recover_gap(
     return xy if wh is None else np.hstack([xy, wh])
 
 
+def _segment_model(method: str, noise: NoiseEstimate | None) -> tuple[Any, ...]:
+    if method == "gdt":
+        m = _PAPER
+        return (m.A, m.Q, m.H, m.R, m.p_init_velocity, "first_point", False)
+    assert noise is not None
+    H = np.hstack([np.eye(2), np.zeros((2, 2))])
+    return (constant_velocity_A(1.0), wna_Q(noise.q), H, np.diag(noise.r), 1e2,
+            "backward_state", True)
+
+
 def recover_gaps(
     gaps: Sequence[tuple[ArrayLike, ArrayLike]],
     method: str = "gdt",
     *,
     noise: NoiseEstimate | None = None,
+    history: int | None = None,
 ) -> list[F64]:
-    """Recover many gaps at once: ``[(segment_a, segment_b), ...]`` -> one ``(F, 2)`` array each
-    for all frames of each gap. The goal-directed methods solve every gap in one C++ call with
-    the GIL released."""
+    """Recover many gaps at once.
+
+    Parameters
+    ----------
+    gaps : sequence of (segment_a, segment_b)
+        Segments as in :func:`recover_gap` (only ``frame, x, y`` are used).
+    method : str
+        One of :data:`METHODS`.
+    noise : NoiseEstimate, optional
+        For ``"gdt-bi"``: noise levels shared by all gaps; default: estimated from all the
+        segments given (:func:`estimate_noise`).
+    history : int, optional
+        The Kalman filters of the goal-directed methods use at most this many points of the run
+        of consecutive frames next to the gap; default: the whole run.
+
+    Returns
+    -------
+    list of (T_g - 1, 2) ndarray
+        ``(x, y)`` of every frame inside each gap.
+
+    Notes
+    -----
+    The goal-directed methods filter the segments and solve every gap in one C++ call with the
+    GIL released (O(T) per gap).
+    """
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
     if method not in PFTRACK_METHODS:
         return [recover_gap(a, b, method=method, noise=noise)[:, :2] for a, b in gaps]
-    problems = []
-    for a_, b_ in gaps:
-        a = as_segment(a_, "segment_a")
-        b = as_segment(b_, "segment_b")
-        if b[0, 0] <= a[-1, 0]:
-            raise ValueError("recover_gaps: a segment_b starts before its segment_a ends")
-        problems.append(gdt_problem(a, b) if method == "gdt" else gdt_bi_problem(a, b, noise))
-    res = _core.gdt_solve_batch(problems, "general", method == "gdt-bi", True)
-    return [np.asarray(r["path"][1:-1, :2]) for r in res]
+    if not gaps:
+        return []
+    seg_a = [np.asarray(a, dtype=np.float64) for a, _ in gaps]
+    seg_b = [np.asarray(b, dtype=np.float64) for _, b in gaps]
+    for k, s in enumerate(seg_a + seg_b):
+        if s.ndim != 2 or s.shape[1] < 3 or s.shape[0] == 0:
+            name = "segment_a" if k < len(gaps) else "segment_b"
+            raise ValueError(
+                f"recover_gaps: {name} of gap {k % len(gaps)} must have shape (k, 3|5), "
+                f"non-empty; got {s.shape}"
+            )
+    if method == "gdt-bi" and noise is None:
+        noise = estimate_noise(seg_a + seg_b)
+    a_len = np.array([len(s) for s in seg_a], dtype=np.int32)
+    b_len = np.array([len(s) for s in seg_b], dtype=np.int32)
+    a = np.ascontiguousarray(np.concatenate(seg_a)[:, :3])
+    b = np.ascontiguousarray(np.concatenate(seg_b)[:, :3])
+    out = _core.gdt_recover_batch(a, a_len, b, b_len, *_segment_model(method, noise)[:6],
+                                  2**31 - 1 if history is None else int(history),
+                                  _segment_model(method, noise)[6])
+    T = (b[np.cumsum(b_len) - b_len, 0] - a[np.cumsum(a_len) - 1, 0]).astype(np.int64)
+    return np.split(out, np.cumsum(T - 1)[:-1])
