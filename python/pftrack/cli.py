@@ -22,6 +22,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
+    from pftrack.recovery.cli import add_experiment_parser, add_recover_parser
+
+    add_recover_parser(sub)
+    add_experiment_parser(sub)
     return parser
 
 

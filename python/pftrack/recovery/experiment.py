@@ -236,3 +236,95 @@ def draw_figure(
     cv2.putText(img, "truth (white dots: lost points)", (8, 18 + 18 * len(methods)),
                 cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
     return img
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Mask positions of a grid that meet a selection."""
+
+    positions: F64  # (K, 4) x, y, w, h
+    selection: str
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+    def representative(self) -> tuple[float, float, float, float]:
+        """The kept position nearest the centroid of all kept positions (a rule that does not
+        look at any result)."""
+        c = self.positions[:, :2].mean(axis=0)
+        i = int(np.argmin(np.hypot(*(self.positions[:, :2] - c).T)))
+        x, y, w, h = (float(v) for v in self.positions[i])
+        return x, y, w, h
+
+
+def sweep(
+    trajs: dict[int, F64],
+    size: float,
+    width: float,
+    height: float,
+    step: float,
+    n_trajectories: int | None = None,
+    n_gaps: int | None = None,
+    min_gaps: int = 1,
+) -> Sweep:
+    """Mask positions (``size`` squares on a ``step`` grid) with exactly `n_trajectories`
+    trajectories and `n_gaps` gaps when given, else with at least `min_gaps` gaps."""
+    if size <= 0 or step <= 0:
+        raise ValueError(f"sweep: size {size} and step {step} must be > 0")
+    xs, ys, nt, ng = count_gaps_grid(trajs, size, width, height, step)
+    keep = np.ones_like(nt, dtype=bool)
+    parts = []
+    if n_trajectories is not None:
+        keep &= nt == n_trajectories
+        parts.append(f"{n_trajectories} trajectories")
+    if n_gaps is not None:
+        keep &= ng == n_gaps
+        parts.append(f"{n_gaps} gaps")
+    if n_trajectories is None and n_gaps is None:
+        keep &= ng >= min_gaps
+        parts.append(f">= {min_gaps} gaps")
+    iy, ix = np.nonzero(keep)
+    pos = np.column_stack([xs[ix], ys[iy], np.full(len(ix), size), np.full(len(ix), size)])
+    return Sweep(pos.astype(np.float64), ", ".join(parts))
+
+
+@dataclass(frozen=True)
+class MedianScores:
+    """Medians over mask positions, per method, and how often each method was best."""
+
+    n_positions: int
+    median: dict[str, MethodScore]
+    wins: dict[str, int]
+
+
+def median_over(
+    trajs: dict[int, F64], sw: Sweep, methods: Sequence[str] = METHODS, max_positions: int = 0
+) -> MedianScores:
+    """Run every method at every kept position (or `max_positions` evenly spread ones) and
+    take the median of each score."""
+    pos = sw.positions
+    if max_positions and len(pos) > max_positions:
+        pos = pos[np.linspace(0, len(pos) - 1, max_positions).round().astype(int)]
+    per: dict[str, list[MethodScore]] = {m: [] for m in methods}
+    wins = {m: 0 for m in methods}
+    for p in pos:
+        r = run_mask(trajs, p, methods)
+        if not r.gaps:
+            continue
+        for m in methods:
+            per[m].append(r.scores[m])
+        wins[min(methods, key=lambda m: r.scores[m].mmae_total)] += 1
+    med = {
+        m: MethodScore(*(float(np.median([getattr(s, f) for s in v])) for f in MethodScore.__dataclass_fields__))
+        for m, v in per.items()
+        if v
+    }
+    return MedianScores(len(per[methods[0]]), med, wins)
+
+
+def format_median(ms: MedianScores) -> str:
+    """Table of the medians, plus the number of positions where each method was best."""
+    text = format_table(ms.median, f"median over {ms.n_positions} mask positions")
+    methods = list(ms.median)
+    width = max(10, *(len(m) + 2 for m in methods))
+    return text + "\n" + f"{'best at':<14}" + "".join(f"{ms.wins[m]:>{width}d}" for m in methods)
