@@ -182,10 +182,12 @@ def estimate_noise(
         Shortest run used.
     scales : sequence of int
         ``"ml"`` only: the model is fitted to the runs sampled every ``s`` frames for each
-        ``s`` and, per axis, the smallest ``q`` (converted to per-frame units, ``q_s / s^3``)
-        is kept with its ``r``. White acceleration gives the same ``q`` at every scale; jitter
-        that is correlated over a few frames (gait sway, box annotation noise) inflates ``q``
-        at the finest scales and would make long predictions too wiggly.
+        ``s``; per axis, going from fine to coarse, a scale replaces the current estimate when
+        its ``q`` (in per-frame units, ``q_s / s^3``) is less than half the current one, and
+        its ``r`` comes with it. White acceleration gives the same ``q`` at every scale (within
+        sampling error, hence the factor 2); jitter correlated over a few frames (gait sway,
+        box annotation noise) inflates ``q`` at the finest scales and would make long
+        predictions too wiggly.
 
     Returns
     -------
@@ -208,7 +210,7 @@ def estimate_noise(
         raise ValueError(f"estimate_noise: scales is {scales!r}, expected integers >= 1")
     if method == "moments":
         return _moments_noise(runs, floor_q, floor_r)
-    best: list[tuple[float, float]] = [(np.inf, 0.0), (np.inf, 0.0)]
+    best: list[tuple[float, float]] = []
     for s in (int(v) for v in scales):
         sub: list[F64] = []
         for run in runs:
@@ -221,8 +223,12 @@ def estimate_noise(
         est = _ml_noise(sub, floor_q * s**3, floor_r)
         for axis in range(2):
             q = est.q[axis] / s**3  # per s frames -> per frame
-            if q < best[axis][0]:
+            if len(best) <= axis:
+                best.append((q, est.r[axis]))
+            elif q < 0.5 * best[axis][0]:  # clearly smaller at this scale: correlated jitter
                 best[axis] = (q, est.r[axis])
+    if len(best) < 2:
+        return DEFAULT_NOISE
     return NoiseEstimate(q=(best[0][0], best[1][0]), r=(best[0][1], best[1][1]))
 
 
