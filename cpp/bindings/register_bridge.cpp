@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pftrack/bridge.hpp"
+#include "pftrack/gdt_noise.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
@@ -189,4 +190,13 @@ void register_bridge(py::module_& m) {
         py::arg("Q"), py::arg("H"), py::arg("R"), py::arg("p_init_velocity"), py::arg("goal"),
         py::arg("history"), py::arg("start_conditioned"),
         "Interior positions (sum(T_g - 1), m) of every gap; segments stacked (frame, pos...).");
+    m.def(
+        "noise_loglik_grid",
+        [](Eigen::Ref<const Eigen::VectorXd> z, Eigen::Ref<const Eigen::VectorXi> lengths,
+           Eigen::Ref<const Eigen::VectorXd> q, Eigen::Ref<const Eigen::VectorXd> r) {
+            py::gil_scoped_release nogil;  // safe: Eigen views only
+            return noise_loglik_grid(z, lengths, q, r);
+        },
+        py::arg("z"), py::arg("lengths"), py::arg("q"), py::arg("r"),
+        "Log-likelihood (G,) of runs z (stacked, lengths) under each (q, r) pair.");
 }

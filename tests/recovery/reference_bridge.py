@@ -124,3 +124,37 @@ def gdt_numpy_fast(A, Q, H, Pi_T, m0, Pi_0, y, T):
         x = A @ x + K[t - 1] @ (y - G[t - 1] @ x)
         path[t] = x
     return path
+
+
+def loglik_grid(runs, axis, q, r):
+    """NumPy reference of _core.noise_loglik_grid: CV model, white-noise acceleration."""
+    ll = np.zeros(len(q))
+    for run in runs:
+        z = run[:, 1 + axis]
+        if len(z) < 4:
+            continue
+        # condition on the first two points: x = z_1, v = z_1 - z_0
+        m0 = np.full(len(q), z[1])
+        m1 = np.full(len(q), z[1] - z[0])
+        p00 = r.copy()
+        p01 = r.copy()
+        p11 = 2.0 * r + q / 3.0
+        for zk in z[2:]:
+            # predict with x' = x + v, v' = v, Q = q [[1/3, 1/2], [1/2, 1]]
+            m0 = m0 + m1
+            a00 = p00 + 2.0 * p01 + p11 + q / 3.0
+            a01 = p01 + p11 + q / 2.0
+            a11 = p11 + q
+            s = a00 + r
+            v = zk - m0
+            ll -= 0.5 * (np.log(s) + v * v / s)
+            k0 = a00 / s
+            k1 = a01 / s
+            m0 = m0 + k0 * v
+            m1 = m1 + k1 * v
+            p00 = (1.0 - k0) * a00
+            p01 = (1.0 - k0) * a01
+            p11 = a11 - k1 * a01
+    return ll
+
+

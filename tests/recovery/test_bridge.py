@@ -238,3 +238,15 @@ def test_numpy_peer_matches():
     p = problem(rng, T=40)
     np.testing.assert_allclose(ref.gdt_numpy_fast(*as_ref(p)), goal_directed_path(**p).path,
                                rtol=1e-8, atol=1e-9)
+
+
+@pytest.mark.parametrize("n,m", [(3, 1), (5, 3), (4, 3), (6, 2)])
+def test_dynamic_size_path_matches_reference(n, m):
+    # sizes other than the fixed-size image kernels (4, 2) and (4, 4) go through dynamic Eigen
+    rng = np.random.default_rng(50 + n * m)
+    p = problem(rng, n=n, m=m, T=6, varying=True)
+    got = goal_directed_path(**p)
+    path, eps, x0m, x0c = ref.gdt_general(*as_ref(p))
+    np.testing.assert_allclose(got.path, path, rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(got.eps, eps, rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(got.x0_cov, x0c, rtol=1e-8, atol=1e-10)

@@ -147,3 +147,19 @@ def test_demo_report_runs_and_names_every_method():
     # same seed, same gaps, same errors (timings aside)
     again = demo_report(np.array(rows), rng=4).splitlines()
     assert [ln.split()[:2] for ln in again[2:]] == [ln.split()[:2] for ln in lines[2:]]
+
+
+def test_noise_loglik_grid_matches_reference():
+    from pftrack import _core
+
+    rng = np.random.default_rng(8)
+    runs = [np.column_stack([np.arange(n), np.cumsum(rng.normal(0, 1, (n, 2)), axis=0)])
+            for n in (3, 10, 25, 4)]
+    q = np.array([0.01, 0.1, 1.0, 3.0])
+    r = np.array([0.5, 0.01, 2.0, 1.0])
+    for axis in range(2):
+        z = np.concatenate([run[:, 1 + axis] for run in runs])
+        got = _core.noise_loglik_grid(z, np.array([len(x) for x in runs], np.int32), q, r)
+        np.testing.assert_allclose(got, ref.loglik_grid(runs, axis, q, r), rtol=1e-12)
+    with pytest.raises(ValueError, match="q and r must be finite and > 0"):
+        _core.noise_loglik_grid(z, np.array([len(z)], np.int32), np.array([0.0]), np.array([1.0]))

@@ -248,12 +248,90 @@ inline GdtSteps gdt_steps(const GdtProblem& p, GdtForm form) {
     return s;
 }
 
+namespace detail {
+
+/// General form (eqs. 7-10) with fixed-size matrices (state N, goal MG): no heap allocation
+/// inside the loops. Same maths, step for step, as gdt_steps + gdt_solve.
+template <int N, int MG>
+GdtResult gdt_solve_general_fixed(const GdtProblem& p, bool start_conditioned) {
+    using MatN = Eigen::Matrix<double, N, N>;
+    using MatG = Eigen::Matrix<double, MG, MG>;
+    using VecN = Eigen::Matrix<double, N, 1>;
+    const char* fn = "gdt_solve";
+    const int T = p.T;
+    std::vector<MatN> A(p.A.begin(), p.A.end()), Q(p.Q.begin(), p.Q.end());
+    auto At = [&](int t) -> const MatN& { return A.size() == 1 ? A[0] : A[static_cast<size_t>(t - 1)]; };
+    auto Qt = [&](int t) -> const MatN& { return Q.size() == 1 ? Q[0] : Q[static_cast<size_t>(t - 1)]; };
+    const Eigen::Matrix<double, MG, N> H = p.H;
+    const MatG PiT = p.Pi_T;
+    const Eigen::Matrix<double, MG, 1> y = p.y;
+    std::vector<Eigen::Matrix<double, N, MG>> K(static_cast<size_t>(T));
+    std::vector<Eigen::Matrix<double, MG, N>> G(static_cast<size_t>(T));
+    std::vector<MatN> eps(static_cast<size_t>(T));
+    MatN Phi = MatN::Identity();
+    MatN S = MatN::Zero();
+    MatG Minv;
+    for (int t = T; t >= 1; --t) {
+        const size_t k = static_cast<size_t>(t - 1);
+        // S_t = Phi(T,t) Q_t Phi(T,t)^T + S_{t+1}
+        S.noalias() += Phi * Qt(t) * Phi.transpose();
+        // M_t = Pi_T + H S_t H^T
+        const MatG M = PiT + H * S * H.transpose();
+        Eigen::LLT<MatG> llt(0.5 * (M + M.transpose()));
+        require(llt.info() == Eigen::Success, fn, "Pi_T + H S H^T is singular or not positive definite");
+        Minv = llt.solve(MatG::Identity());
+        const Eigen::Matrix<double, MG, N> HPhi = H * Phi;
+        K[k] = Qt(t) * HPhi.transpose() * Minv;                        // eq. 7
+        const MatN e = Qt(t) - K[k] * HPhi * Qt(t).transpose();        // eq. 8
+        eps[k] = 0.5 * (e + e.transpose());
+        Phi = Phi * At(t);  // Phi(T, t-1)
+        G[k] = H * Phi;
+    }
+    const Eigen::Matrix<double, MG, N> F = H * Phi;  // H Phi(T, 0)
+    Eigen::LLT<MatN> l0(p.Pi_0);
+    require(l0.info() == Eigen::Success, fn, "Pi_0 is singular or not positive definite");
+    const MatN info = l0.solve(MatN::Identity()) + F.transpose() * Minv * F;
+    Eigen::LLT<MatN> l1(0.5 * (info + info.transpose()));
+    require(l1.info() == Eigen::Success, fn, "cov(x0|yT)^-1 is singular or not positive definite");
+    MatN C0 = l1.solve(MatN::Identity());  // eq. 9
+    C0 = (0.5 * (C0 + C0.transpose())).eval();
+    const VecN m0 = p.m0;
+    const VecN x0m = m0 + C0 * F.transpose() * Minv * (y - F * m0);  // eq. 10
+    GdtResult r;
+    r.x0_mean = x0m;
+    r.x0_cov = C0;
+    r.path.resize(T + 1, N);
+    r.eps.resize(T, N * N);
+    r.cov.resize(T + 1, N * N);
+    VecN x = start_conditioned ? x0m : m0;
+    MatN P = start_conditioned ? C0 : MatN(p.Pi_0);
+    r.path.row(0) = x.transpose();
+    Eigen::Map<Eigen::Matrix<double, N, N, Eigen::RowMajor>>(r.cov.row(0).data()) = P;
+    for (int t = 1; t <= T; ++t) {
+        const size_t k = static_cast<size_t>(t - 1);
+        x = At(t) * x + K[k] * (y - G[k] * x);  // x_t = A_t x_{t-1} + u_t   (eq. 3, mean)
+        const MatN B = At(t) - K[k] * G[k];
+        P = B * P * B.transpose() + eps[k];
+        P = (0.5 * (P + P.transpose())).eval();
+        r.path.row(t) = x.transpose();
+        Eigen::Map<Eigen::Matrix<double, N, N, Eigen::RowMajor>>(r.eps.row(t - 1).data()) = eps[k];
+        Eigen::Map<Eigen::Matrix<double, N, N, Eigen::RowMajor>>(r.cov.row(t).data()) = P;
+    }
+    return r;
+}
+
+}  // namespace detail
+
 /// Solve one problem: mean path x_0..x_T (x_t = A_t x_{t-1} + u_t), eps_t, the state
 /// covariances along the path and the conditioned initial state. The path starts at
 /// E[x_0|y_T] (`start_conditioned`, giving E[x_t|y_T]) or at m_0 (the paper's framework: x_0 is
 /// the Kalman estimate at the end of the first segment).
 inline GdtResult gdt_solve(const GdtProblem& p, GdtForm form, bool start_conditioned) {
     gdt_check(p, form);
+    if (form == GdtForm::general && p.m0.size() == 4) {  // image states: fixed-size kernels
+        if (p.y.size() == 2) return detail::gdt_solve_general_fixed<4, 2>(p, start_conditioned);
+        if (p.y.size() == 4) return detail::gdt_solve_general_fixed<4, 4>(p, start_conditioned);
+    }
     const GdtSteps s = gdt_steps(p, form);
     const Index n = p.m0.size();
     const int T = p.T;

@@ -104,35 +104,11 @@ def _moments_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> N
 
 
 def _loglik_grid(runs: Sequence[F64], axis: int, q: F64, r: F64) -> F64:
-    """Kalman log-likelihood of one axis of every run, for each (q, r) pair (vectorised)."""
-    ll = np.zeros(len(q))
-    for run in runs:
-        z = run[:, 1 + axis]
-        if len(z) < 4:
-            continue
-        # condition on the first two points: x = z_1, v = z_1 - z_0
-        m0 = np.full(len(q), z[1])
-        m1 = np.full(len(q), z[1] - z[0])
-        p00 = r.copy()
-        p01 = r.copy()
-        p11 = 2.0 * r + q / 3.0
-        for zk in z[2:]:
-            # predict with x' = x + v, v' = v, Q = q [[1/3, 1/2], [1/2, 1]]
-            m0 = m0 + m1
-            a00 = p00 + 2.0 * p01 + p11 + q / 3.0
-            a01 = p01 + p11 + q / 2.0
-            a11 = p11 + q
-            s = a00 + r
-            v = zk - m0
-            ll -= 0.5 * (np.log(s) + v * v / s)
-            k0 = a00 / s
-            k1 = a01 / s
-            m0 = m0 + k0 * v
-            m1 = m1 + k1 * v
-            p00 = (1.0 - k0) * a00
-            p01 = (1.0 - k0) * a01
-            p11 = a11 - k1 * a01
-    return ll
+    """Kalman log-likelihood of one axis of every run, for each (q, r) pair (C++)."""
+    z = np.ascontiguousarray(np.concatenate([run[:, 1 + axis] for run in runs]))
+    lengths = np.array([len(run) for run in runs], dtype=np.int32)
+    out: F64 = _core.noise_loglik_grid(z, lengths, np.ascontiguousarray(q), np.ascontiguousarray(r))
+    return out
 
 
 def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseEstimate:
