@@ -188,7 +188,7 @@ def run_experiment_gaps(args: argparse.Namespace) -> int:
         img = E.draw_figure(trajs, run.gaps, run.paths, mask, (int(width), int(height)),
                             [m for m in ("gdt", "gdt-bi", "bspline") if m in methods])
         with atomic_path(args.figure) as tmp:
-            if not cv2.imwrite(str(tmp), img):
+            if not cv2.imwrite(str(tmp), img, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
                 raise ValueError(f"cannot write figure {args.figure}")
         print(f"figure: {args.figure}")
     return 0

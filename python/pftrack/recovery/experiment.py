@@ -196,44 +196,73 @@ def format_table(scores: dict[str, MethodScore], title: str = "") -> str:
     return "\n".join(rows)
 
 
+def _draw_panel(
+    trajs: dict[int, F64],
+    gaps: Sequence[Gap],
+    paths: dict[str, list[F64]],
+    mask: Sequence[float],
+    methods: Sequence[str],
+    origin: tuple[float, float],
+    scale: float,
+    size: tuple[int, int],
+) -> NDArray[np.uint8]:
+    import cv2
+
+    img = np.zeros((size[1], size[0], 3), np.uint8)
+    ox, oy = origin
+
+    def pts(xy: F64) -> NDArray[np.int32]:
+        return np.round(np.column_stack([(xy[:, 0] - ox) * scale, (xy[:, 1] - oy) * scale])
+                        * 16).astype(np.int32)
+
+    for tr in trajs.values():
+        cv2.polylines(img, [pts(tr[:, 1:3])], False, (90, 90, 90), 1, cv2.LINE_AA, 4)
+    mx, my, mw, mh = mask
+    corners = pts(np.array([[mx, my], [mx + mw, my + mh]]))
+    cv2.rectangle(img, tuple(corners[0]), tuple(corners[1]), (0, 200, 200), 1, cv2.LINE_AA, 4)
+    for k, m in enumerate(methods):
+        for g, p in zip(gaps, paths.get(m, [])):
+            full = np.vstack([g.segment_a[-1:, 1:3], p, g.segment_b[:1, 1:3]])
+            cv2.polylines(img, [pts(full)], False, _COLOURS[k % len(_COLOURS)], 1, cv2.LINE_AA, 4)
+    radius = max(1, int(round(0.6 * scale)))
+    for g in gaps:
+        for x, y in pts(g.truth[:, 1:3]):
+            cv2.circle(img, (int(x), int(y)), radius * 16, (255, 255, 255), -1, cv2.LINE_AA, 4)
+    return img
+
+
+_COLOURS = [(60, 60, 255), (0, 220, 0), (255, 160, 0), (255, 0, 255), (0, 255, 255)]
+
+
 def draw_figure(
     trajs: dict[int, F64],
     gaps: Sequence[Gap],
     paths: dict[str, list[F64]],
     mask: Sequence[float],
     size: tuple[int, int],
-    methods: Sequence[str] = ("gdt", "gdt-bi", "cubic"),
-    scale: float = 1.0,
+    methods: Sequence[str] = ("gdt", "gdt-bi", "bspline"),
+    height: int = 360,
 ) -> NDArray[np.uint8]:
-    """Ground truth (grey, observed; white dots, lost) against recovered paths, drawn with
-    OpenCV on a black canvas of `size` ``(width, height)``; the mask is a yellow rectangle."""
+    """Ground truth against recovered paths, drawn with OpenCV: the whole scene (left) and the
+    mask region enlarged (right). Grey: ground-truth trajectories; white dots: the lost
+    (ground-truth) points; coloured: recovered paths; yellow: the mask."""
     import cv2
 
     w, h = size
-    img = np.zeros((int(h * scale), int(w * scale), 3), np.uint8)
-    colours = [(0, 0, 255), (0, 200, 0), (255, 128, 0), (255, 0, 255), (0, 255, 255)]
+    s_full = height / float(h)
+    left = _draw_panel(trajs, gaps, paths, mask, methods, (0.0, 0.0), s_full,
+                       (int(round(w * s_full)), height))
     mx, my, mw, mh = mask
-
-    def pt(x: float, y: float) -> tuple[int, int]:
-        return int(round(x * scale)), int(round(y * scale))
-
-    for tr in trajs.values():
-        cv2.polylines(img, [np.array([pt(x, y) for x, y in tr[:, 1:3]], np.int32)], False,
-                      (90, 90, 90), 1, cv2.LINE_AA)
-    cv2.rectangle(img, pt(mx, my), pt(mx + mw, my + mh), (0, 220, 220), 1)
-    for g in gaps:
-        for x, y in g.truth[:, 1:3]:
-            cv2.circle(img, pt(x, y), 2, (255, 255, 255), -1, cv2.LINE_AA)
+    pad = 0.15 * max(mw, mh)
+    side = max(mw, mh) + 2 * pad
+    s_zoom = height / side
+    right = _draw_panel(trajs, gaps, paths, mask, methods, (mx - pad, my - pad), s_zoom,
+                        (height, height))
+    img = np.hstack([left, np.full((height, 4, 3), 255, np.uint8), right])
     for k, m in enumerate(methods):
-        if m not in paths:
-            continue
-        for g, p in zip(gaps, paths[m]):
-            full = np.vstack([g.segment_a[-1:, 1:3], p, g.segment_b[:1, 1:3]])
-            cv2.polylines(img, [np.array([pt(x, y) for x, y in full], np.int32)], False,
-                          colours[k % len(colours)], 1, cv2.LINE_AA)
         cv2.putText(img, m, (8, 18 + 18 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
-                    colours[k % len(colours)], 1, cv2.LINE_AA)
-    cv2.putText(img, "truth (white dots: lost points)", (8, 18 + 18 * len(methods)),
+                    _COLOURS[k % len(_COLOURS)], 1, cv2.LINE_AA)
+    cv2.putText(img, "ground truth (dots: lost points)", (8, 18 + 18 * len(methods)),
                 cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
     return img
 
