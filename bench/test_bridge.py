@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from pftrack import _core
 from pftrack.recovery import constant_velocity_A
 from pftrack.recovery import experiment as E
@@ -43,8 +42,9 @@ def test_core(benchmark, T):
 def test_numpy_reference(benchmark, T):
     benchmark.group = f"gdt path T={T}"
     if T == 10000:
-        benchmark.pedantic(ref.gdt_numpy_fast, args=(A, Q, H, R, M0, P0, goal(T), T),
-                           rounds=3, iterations=1)
+        benchmark.pedantic(
+            ref.gdt_numpy_fast, args=(A, Q, H, R, M0, P0, goal(T), T), rounds=3, iterations=1
+        )
     else:
         benchmark(ref.gdt_numpy_fast, A, Q, H, R, M0, P0, goal(T), T)
 

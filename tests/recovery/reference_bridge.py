@@ -66,23 +66,23 @@ def joint_conditional(A, Q, H, Pi_T, m0, Pi_0, y, T):
     dim = n * (T + 1)
     L = np.zeros((dim, dim))
     for t in range(T + 1):
-        L[t * n:(t + 1) * n, 0:n] = phi(A, t, 0)
+        L[t * n : (t + 1) * n, 0:n] = phi(A, t, 0)
         for i in range(1, t + 1):
-            L[t * n:(t + 1) * n, i * n:(i + 1) * n] = phi(A, t, i)
+            L[t * n : (t + 1) * n, i * n : (i + 1) * n] = phi(A, t, i)
     C0 = np.zeros((dim, dim))
     C0[0:n, 0:n] = Pi_0
     for i in range(1, T + 1):
-        C0[i * n:(i + 1) * n, i * n:(i + 1) * n] = Q[i - 1]
+        C0[i * n : (i + 1) * n, i * n : (i + 1) * n] = Q[i - 1]
     mu = L @ np.concatenate([m0, np.zeros(n * T)])
     C = L @ C0 @ L.T
     Hy = np.zeros((H.shape[0], dim))
-    Hy[:, T * n:] = H
+    Hy[:, T * n :] = H
     Syy = Hy @ C @ Hy.T + Pi_T
     K = C @ Hy.T @ np.linalg.inv(Syy)
     mean = mu + K @ (y - Hy @ mu)
     cov = C - K @ Hy @ C
     means = mean.reshape(T + 1, n)
-    covs = np.array([cov[t * n:(t + 1) * n, t * n:(t + 1) * n] for t in range(T + 1)])
+    covs = np.array([cov[t * n : (t + 1) * n, t * n : (t + 1) * n] for t in range(T + 1)])
     return means, covs
 
 
@@ -156,5 +156,3 @@ def loglik_grid(runs, axis, q, r):
             p01 = (1.0 - k0) * a01
             p11 = a11 - k1 * a01
     return ll
-
-

@@ -6,9 +6,9 @@ import threading
 
 import numpy as np
 import pytest
-
 from pftrack import _core
 from pftrack.recovery import constant_velocity_A, goal_directed_path, sample_goal_directed_paths
+
 from . import reference_bridge as ref
 
 
@@ -25,8 +25,16 @@ def problem(rng, n=4, m=2, T=7, varying=False):
         A = np.eye(n) + 0.2 * rng.standard_normal((n, n))
         Q = spd(rng, n, 0.1)
     H = rng.standard_normal((m, n))
-    return dict(A=A, Q=Q, H_T=H, Pi_T=spd(rng, m, 0.05), m0=rng.standard_normal(n),
-                Pi_0=spd(rng, n, 0.2), y_T=rng.standard_normal(m), T=T)
+    return dict(
+        A=A,
+        Q=Q,
+        H_T=H,
+        Pi_T=spd(rng, m, 0.05),
+        m0=rng.standard_normal(n),
+        Pi_0=spd(rng, n, 0.2),
+        y_T=rng.standard_normal(m),
+        T=T,
+    )
 
 
 def as_ref(p):
@@ -100,8 +108,16 @@ def cv_problem(T=10, Pi_T=1e-6):
     A = constant_velocity_A(1.0)
     Q = np.diag([1e-2, 1e-2, 1e-2, 1e-2])
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
-    return dict(A=A, Q=Q, H_T=H, Pi_T=Pi_T * np.eye(2), m0=np.array([0.0, 0.0, 1.0, 0.5]),
-                Pi_0=1e-3 * np.eye(4), y_T=np.array([30.0, -20.0]), T=T)
+    return dict(
+        A=A,
+        Q=Q,
+        H_T=H,
+        Pi_T=Pi_T * np.eye(2),
+        m0=np.array([0.0, 0.0, 1.0, 0.5]),
+        Pi_0=1e-3 * np.eye(4),
+        y_T=np.array([30.0, -20.0]),
+        T=T,
+    )
 
 
 def test_huge_goal_covariance_follows_the_kalman_prediction():
@@ -236,8 +252,9 @@ def test_kalman_filter_matches_reference():
 def test_numpy_peer_matches():
     rng = np.random.default_rng(12)
     p = problem(rng, T=40)
-    np.testing.assert_allclose(ref.gdt_numpy_fast(*as_ref(p)), goal_directed_path(**p).path,
-                               rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(
+        ref.gdt_numpy_fast(*as_ref(p)), goal_directed_path(**p).path, rtol=1e-8, atol=1e-9
+    )
 
 
 @pytest.mark.parametrize("n,m", [(3, 1), (5, 3), (4, 3), (6, 2)])

@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from pftrack.io.mot import read_mot
 from pftrack.recovery import experiment as E
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from pftrack.cli import main
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, fill_gaps, link_tracklets
@@ -27,12 +26,14 @@ def walker(tid, frames, x0, y0, vx, vy, w=20.0, h=50.0):
 def scene():
     # object A fragmented into ids 1 and 5 (gap of 9 frames); object B (id 2) far away with a
     # hole of 4 frames; id 7 starts after id 2 ends but far from it (must not be linked)
-    return np.vstack([
-        walker(1, range(1, 41), 100, 100, 2.0, 0.5),
-        walker(5, range(50, 90), 100, 100, 2.0, 0.5),
-        walker(2, list(range(1, 30)) + list(range(35, 60)), 400, 300, -1.0, 0.2),
-        walker(7, range(62, 90), 50, 500, 1.0, 0.0),
-    ])
+    return np.vstack(
+        [
+            walker(1, range(1, 41), 100, 100, 2.0, 0.5),
+            walker(5, range(50, 90), 100, 100, 2.0, 0.5),
+            walker(2, list(range(1, 30)) + list(range(35, 60)), 400, 300, -1.0, 0.2),
+            walker(7, range(62, 90), 50, 500, 1.0, 0.0),
+        ]
+    )
 
 
 def test_link_tracklets_joins_fragments_of_one_object_only():
@@ -72,11 +73,39 @@ def test_cli_recover_twice_changes_nothing(tmp_path, capsys):
     before = src.read_bytes()
     out1 = tmp_path / "filled.txt"
     out2 = tmp_path / "filled2.txt"
-    assert main(["recover", str(src), "--out", str(out1), "--link", "--max-gap", "20",
-                 "--max-distance", "30"]) == 0
+    assert (
+        main(
+            [
+                "recover",
+                str(src),
+                "--out",
+                str(out1),
+                "--link",
+                "--max-gap",
+                "20",
+                "--max-distance",
+                "30",
+            ]
+        )
+        == 0
+    )
     assert src.read_bytes() == before  # input untouched
-    assert main(["recover", str(out1), "--out", str(out2), "--link", "--max-gap", "20",
-                 "--max-distance", "30"]) == 0
+    assert (
+        main(
+            [
+                "recover",
+                str(out1),
+                "--out",
+                str(out2),
+                "--link",
+                "--max-gap",
+                "20",
+                "--max-distance",
+                "30",
+            ]
+        )
+        == 0
+    )
     assert out1.read_bytes() == out2.read_bytes()
     rows = read_mot(out1)
     assert np.sum(rows[:, FLAG_COLUMN] == 1) == 14  # the flag round-trips through read_mot
@@ -144,8 +173,25 @@ def test_cli_experiment_gaps(tmp_path, capsys):
     gt = tmp_path / "gt.txt"
     write_mot(gt, synthetic_gt())
     fig = tmp_path / "fig.png"
-    assert main(["experiment", "gaps", "--gt", str(gt), "--grid", "40", "--repeat", "1",
-                 "--max-positions", "3", "--figure", str(fig)]) == 0
+    assert (
+        main(
+            [
+                "experiment",
+                "gaps",
+                "--gt",
+                str(gt),
+                "--grid",
+                "40",
+                "--repeat",
+                "1",
+                "--max-positions",
+                "3",
+                "--figure",
+                str(fig),
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     for word in ("MMAE x", "MMAE total", "MAE total", "time (ms)", "median over", "gdt-bi"):
         assert word in out

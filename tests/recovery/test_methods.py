@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from pftrack.recovery import METHODS, estimate_noise, goal_directed_path, recover_gap, recover_gaps
 from pftrack.recovery.demo import demo_report
 from pftrack.recovery.gdt import GdtModel
@@ -45,7 +44,7 @@ def test_recover_gaps_equals_recover_gap():
         xy = np.cumsum(np.cumsum(rng.normal(0, 0.1, (len(t), 2)), axis=0), axis=0)
         tr = np.column_stack([t, xy])
         s = 20 + 3 * k
-        gaps.append((tr[:s], tr[s + 5 + k:]))
+        gaps.append((tr[:s], tr[s + 5 + k :]))
     for m in ("gdt", "gdt-bi", "bspline"):
         batch = recover_gaps(gaps, m)
         noise = estimate_noise([g[0] for g in gaps] + [g[1] for g in gaps])
@@ -64,8 +63,9 @@ def test_paper_gdt_equals_kalman_plus_reference_equation():
     m_init = np.array([z[0, 0], z[0, 1], *(z[1] - z[0])])
     P_init = np.diag([*model.r, model.p_init_velocity, model.p_init_velocity])
     m0, P0 = ref.kalman_filter(z, model.A, model.Q, model.H, model.R, m_init, P_init)
-    path, *_ = ref.gdt_general(model.A, model.Q, model.H, model.R, m0, P0, b[0, 1:3], 13,
-                               start_conditioned=False)
+    path, *_ = ref.gdt_general(
+        model.A, model.Q, model.H, model.R, m0, P0, b[0, 1:3], 13, start_conditioned=False
+    )
     got = recover_gap(a, b, method="gdt")
     np.testing.assert_allclose(got, path[1:-1, :2], rtol=1e-7, atol=1e-6)
     # the Python problem builder + general solver agree too
@@ -153,8 +153,10 @@ def test_noise_loglik_grid_matches_reference():
     from pftrack import _core
 
     rng = np.random.default_rng(8)
-    runs = [np.column_stack([np.arange(n), np.cumsum(rng.normal(0, 1, (n, 2)), axis=0)])
-            for n in (3, 10, 25, 4)]
+    runs = [
+        np.column_stack([np.arange(n), np.cumsum(rng.normal(0, 1, (n, 2)), axis=0)])
+        for n in (3, 10, 25, 4)
+    ]
     q = np.array([0.01, 0.1, 1.0, 3.0])
     r = np.array([0.5, 0.01, 2.0, 1.0])
     for axis in range(2):

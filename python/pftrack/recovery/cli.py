@@ -17,7 +17,7 @@ def add_recover_parser(sub: Any) -> None:
     """Add the ``recover`` sub-command."""
     p = sub.add_parser(
         "recover",
-        help="fill the gaps of any tracker's MOTChallenge output (optionally link fragments first)",
+        help="fill the gaps of any tracker's MOTChallenge output (optionally link fragments)",
         description=(
             "Fill holes of at most --max-gap frames inside each track. Filled rows have the "
             "interpolated flag (column 8, 1-based) set to 1. Rows flagged by an earlier run "
@@ -29,11 +29,18 @@ def add_recover_parser(sub: Any) -> None:
     p.add_argument("--method", default="gdt-bi", choices=METHODS, help="recovery method")
     p.add_argument("--max-gap", type=int, default=30, help="longest hole filled, in frames")
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
-    p.add_argument("--max-distance", type=float, default=50.0,
-                   help="linking gate on the motion-prediction distance (pixels)")
+    p.add_argument(
+        "--max-distance",
+        type=float,
+        default=50.0,
+        help="linking gate on the motion-prediction distance (pixels)",
+    )
     p.add_argument("--video", help="video or image folder for the colour term of --link")
-    p.add_argument("--in-place", action="store_true",
-                   help="allow --out to be the input file (it is replaced atomically)")
+    p.add_argument(
+        "--in-place",
+        action="store_true",
+        help="allow --out to be the input file (it is replaced atomically)",
+    )
     p.set_defaults(func=run_recover)
 
 
@@ -55,19 +62,31 @@ def add_experiment_parser(sub: Any) -> None:
     )
     g.add_argument("--gt", required=True, help="ground truth (MOTChallenge)")
     g.add_argument("--mask", help="x,y,w,h of the representative mask (default: chosen by rule)")
-    g.add_argument("--point", default="centre", choices=("centre", "foot"),
-                   help="box point used as the trajectory")
+    g.add_argument(
+        "--point",
+        default="centre",
+        choices=("centre", "foot"),
+        help="box point used as the trajectory",
+    )
     g.add_argument("--size", type=float, default=100.0, help="mask side for the sweep (px)")
     g.add_argument("--grid", type=float, default=4.0, help="mask position step of the sweep (px)")
     g.add_argument("--image-size", help="WxH of the ground-truth coordinates (default: GT extent)")
     g.add_argument("--trajectories", type=int, help="keep positions with exactly this many")
     g.add_argument("--gaps", type=int, help="keep positions with exactly this many gaps")
-    g.add_argument("--min-gaps", type=int, default=3,
-                   help="without --trajectories/--gaps: keep positions with at least this many")
+    g.add_argument(
+        "--min-gaps",
+        type=int,
+        default=3,
+        help="without --trajectories/--gaps: keep positions with at least this many",
+    )
     g.add_argument("--methods", default=",".join(METHODS), help="comma-separated methods")
     g.add_argument("--repeat", type=int, default=5, help="timing: best of this many runs")
-    g.add_argument("--max-positions", type=int, default=0,
-                   help="evaluate at most this many positions of the sweep, evenly spread (0 = all)")
+    g.add_argument(
+        "--max-positions",
+        type=int,
+        default=0,
+        help="evaluate at most this many sweep positions, evenly spread (0 = all)",
+    )
     g.add_argument("--figure", help="PNG of ground truth against recovered paths (OpenCV)")
     g.set_defaults(func=run_experiment_gaps)
 
@@ -152,11 +171,14 @@ def run_experiment_gaps(args: argparse.Namespace) -> int:
         width = float(np.ceil(np.max(gt[:, 2] + gt[:, 4])))
         height = float(np.ceil(np.max(gt[:, 3] + gt[:, 5])))
     trajs = E.trajectories(gt, args.point)
-    sweep = E.sweep(trajs, args.size, width, height, args.grid, args.trajectories, args.gaps,
-                    args.min_gaps)
+    sweep = E.sweep(
+        trajs, args.size, width, height, args.grid, args.trajectories, args.gaps, args.min_gaps
+    )
     print(f"{args.gt}: {len(trajs)} trajectories, {args.point} point, {width:.0f}x{height:.0f}")
-    print(f"sweep: {args.size:g}x{args.size:g} masks on a {args.grid:g} px grid, "
-          f"{len(sweep)} positions kept ({sweep.selection})")
+    print(
+        f"sweep: {args.size:g}x{args.size:g} masks on a {args.grid:g} px grid, "
+        f"{len(sweep)} positions kept ({sweep.selection})"
+    )
     if args.mask:
         mask = _parse_mask(args.mask)
     elif len(sweep):
@@ -165,17 +187,21 @@ def run_experiment_gaps(args: argparse.Namespace) -> int:
         raise ValueError("no mask position meets the selection; pass --mask")
     run = E.run_mask(trajs, mask, methods, args.repeat)
     print()
-    print(f"representative mask x,y,w,h = {','.join(f'{v:g}' for v in mask)}: "
-          f"{run.n_traj} trajectories, {len(run.gaps)} gaps, "
-          f"{sum(len(g.truth) for g in run.gaps)} lost points")
+    print(
+        f"representative mask x,y,w,h = {','.join(f'{v:g}' for v in mask)}: "
+        f"{run.n_traj} trajectories, {len(run.gaps)} gaps, "
+        f"{sum(len(g.truth) for g in run.gaps)} lost points"
+    )
     if not run.gaps:
         print("no gap under this mask")
         return 0
     print(E.format_table(run.scores))
     if run.noise is not None:
-        print(f"gdt-bi noise (estimated from the observed points, {run.noise_ms:.1f} ms): "
-              f"q = {run.noise.q[0]:.4g}, {run.noise.q[1]:.4g} px^2/frame^3, "
-              f"r = {run.noise.r[0]:.4g}, {run.noise.r[1]:.4g} px^2")
+        print(
+            f"gdt-bi noise (estimated from the observed points, {run.noise_ms:.1f} ms): "
+            f"q = {run.noise.q[0]:.4g}, {run.noise.q[1]:.4g} px^2/frame^3, "
+            f"r = {run.noise.r[0]:.4g}, {run.noise.r[1]:.4g} px^2"
+        )
     if len(sweep):
         med = E.median_over(trajs, sweep, methods, args.max_positions)
         print()
@@ -185,8 +211,14 @@ def run_experiment_gaps(args: argparse.Namespace) -> int:
 
         from pftrack.io.atomic import atomic_path
 
-        img = E.draw_figure(trajs, run.gaps, run.paths, mask, (int(width), int(height)),
-                            [m for m in ("gdt", "gdt-bi", "bspline") if m in methods])
+        img = E.draw_figure(
+            trajs,
+            run.gaps,
+            run.paths,
+            mask,
+            (int(width), int(height)),
+            [m for m in ("gdt", "gdt-bi", "bspline") if m in methods],
+        )
         with atomic_path(args.figure) as tmp:
             if not cv2.imwrite(str(tmp), img, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
                 raise ValueError(f"cannot write figure {args.figure}")

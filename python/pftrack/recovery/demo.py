@@ -60,11 +60,13 @@ def demo_report(
         tr = tracks[int(gen.integers(len(tracks)))]
         length = int(gen.integers(lo, min(hi, len(tr) - 10) + 1))
         start = int(gen.integers(5, len(tr) - length - 4))
-        gaps.append((tr[:start], tr[start + length:]))
-        truths.append(tr[start:start + length, 1:3])
+        gaps.append((tr[:start], tr[start + length :]))
+        truths.append(tr[start : start + length, 1:3])
     noise = estimate_noise([g[0] for g in gaps] + [g[1] for g in gaps])
-    lines = [f"recovery demo: {len(gaps)} gaps of {lo}-{hi} frames cut into {len(tracks)} tracks",
-             f"{'method':<10}{'mean error (px)':>17}{'time (ms)':>11}"]
+    lines = [
+        f"recovery demo: {len(gaps)} gaps of {lo}-{hi} frames cut into {len(tracks)} tracks",
+        f"{'method':<10}{'mean error (px)':>17}{'time (ms)':>11}",
+    ]
     for m in methods:
         t0 = time.perf_counter()
         paths = recover_gaps(gaps, m, noise=noise)

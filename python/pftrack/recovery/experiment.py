@@ -33,8 +33,10 @@ class Gap:
 
 
 def trajectories(gt: F64, point: str = "centre") -> dict[int, F64]:
-    """Per id, rows ``(frame, x, y)`` sorted by frame; ``point`` is the box centre or its
-    bottom centre (``"foot"``)."""
+    """Split ground truth into trajectories: per id, rows ``(frame, x, y)`` sorted by frame.
+
+    ``point`` is the box centre or its bottom centre (``"foot"``).
+    """
     if point not in ("centre", "center", "foot"):
         raise ValueError(f"trajectories: point is {point!r}, expected 'centre' or 'foot'")
     out: dict[int, F64] = {}
@@ -48,8 +50,10 @@ def trajectories(gt: F64, point: str = "centre") -> dict[int, F64]:
 
 
 def find_gaps(trajs: dict[int, F64], mask: Sequence[float]) -> tuple[list[Gap], int]:
-    """Gaps made by `mask` ``(x, y, w, h)``; returns the gaps and the number of trajectories
-    that have at least one."""
+    """Find the gaps made by `mask` ``(x, y, w, h)``.
+
+    Returns the gaps and the number of trajectories that have at least one.
+    """
     mx, my, mw, mh = (float(v) for v in mask)
     gaps: list[Gap] = []
     n_traj = 0
@@ -72,7 +76,7 @@ def find_gaps(trajs: dict[int, F64], mask: Sequence[float]) -> tuple[list[Gap], 
 def count_gaps_grid(
     trajs: dict[int, F64], size: float, width: float, height: float, step: float
 ) -> tuple[F64, F64, NDArray[np.int64], NDArray[np.int64]]:
-    """Number of trajectories and gaps for every mask position on a grid (vectorised)."""
+    """Count trajectories and gaps for every mask position on a grid (vectorised)."""
     xs = np.arange(0.0, width - size + 1e-9, step)
     ys = np.arange(0.0, height - size + 1e-9, step)
     n_traj = np.zeros((len(ys), len(xs)), dtype=np.int64)
@@ -162,8 +166,11 @@ class MaskRun:
 def run_mask(
     trajs: dict[int, F64], mask: Sequence[float], methods: Sequence[str] = METHODS, repeat: int = 1
 ) -> MaskRun:
-    """All methods on one mask. The noise levels of ``"gdt-bi"`` are estimated once from every
-    observed point of the sequence (all points outside the mask), timed separately."""
+    """Run all methods on one mask.
+
+    The noise levels of ``"gdt-bi"`` are estimated once from every observed point of the
+    sequence (all points outside the mask), timed separately.
+    """
     gaps, n_traj = find_gaps(trajs, mask)
     scores: dict[str, MethodScore] = {}
     paths: dict[str, list[F64]] = {}
@@ -187,12 +194,17 @@ def format_table(scores: dict[str, MethodScore], title: str = "") -> str:
     head = f"{'':<14}" + "".join(f"{m:>{width}}" for m in methods)
     rows = [title, head] if title else [head]
     for label, attr in [
-        ("MMAE x", "mmae_x"), ("MMAE y", "mmae_y"), ("MMAE total", "mmae_total"),
-        ("MAE x", "mae_x"), ("MAE y", "mae_y"), ("MAE total", "mae_total"),
+        ("MMAE x", "mmae_x"),
+        ("MMAE y", "mmae_y"),
+        ("MMAE total", "mmae_total"),
+        ("MAE x", "mae_x"),
+        ("MAE y", "mae_y"),
+        ("MAE total", "mae_total"),
         ("time (ms)", "time_ms"),
     ]:
-        fmt = "{:>%d.3f}" % width
-        rows.append(f"{label:<14}" + "".join(fmt.format(getattr(scores[m], attr)) for m in methods))
+        rows.append(
+            f"{label:<14}" + "".join(f"{getattr(scores[m], attr):>{width}.3f}" for m in methods)
+        )
     return "\n".join(rows)
 
 
@@ -212,8 +224,9 @@ def _draw_panel(
     ox, oy = origin
 
     def pts(xy: F64) -> NDArray[np.int32]:
-        return np.round(np.column_stack([(xy[:, 0] - ox) * scale, (xy[:, 1] - oy) * scale])
-                        * 16).astype(np.int32)
+        return np.round(
+            np.column_stack([(xy[:, 0] - ox) * scale, (xy[:, 1] - oy) * scale]) * 16
+        ).astype(np.int32)
 
     for tr in trajs.values():
         cv2.polylines(img, [pts(tr[:, 1:3])], False, (90, 90, 90), 1, cv2.LINE_AA, 4)
@@ -243,27 +256,47 @@ def draw_figure(
     methods: Sequence[str] = ("gdt", "gdt-bi", "bspline"),
     height: int = 360,
 ) -> NDArray[np.uint8]:
-    """Ground truth against recovered paths, drawn with OpenCV: the whole scene (left) and the
-    mask region enlarged (right). Grey: ground-truth trajectories; white dots: the lost
-    (ground-truth) points; coloured: recovered paths; yellow: the mask."""
+    """Draw ground truth against recovered paths with OpenCV.
+
+    Left: the whole scene; right: the mask region enlarged. Grey: ground-truth trajectories;
+    white dots: the lost (ground-truth) points; coloured: recovered paths; yellow: the mask.
+    """
     import cv2
 
     w, h = size
     s_full = height / float(h)
-    left = _draw_panel(trajs, gaps, paths, mask, methods, (0.0, 0.0), s_full,
-                       (int(round(w * s_full)), height))
+    left = _draw_panel(
+        trajs, gaps, paths, mask, methods, (0.0, 0.0), s_full, (int(round(w * s_full)), height)
+    )
     mx, my, mw, mh = mask
     pad = 0.15 * max(mw, mh)
     side = max(mw, mh) + 2 * pad
     s_zoom = height / side
-    right = _draw_panel(trajs, gaps, paths, mask, methods, (mx - pad, my - pad), s_zoom,
-                        (height, height))
+    right = _draw_panel(
+        trajs, gaps, paths, mask, methods, (mx - pad, my - pad), s_zoom, (height, height)
+    )
     img = np.hstack([left, np.full((height, 4, 3), 255, np.uint8), right])
     for k, m in enumerate(methods):
-        cv2.putText(img, m, (8, 18 + 18 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
-                    _COLOURS[k % len(_COLOURS)], 1, cv2.LINE_AA)
-    cv2.putText(img, "ground truth (dots: lost points)", (8, 18 + 18 * len(methods)),
-                cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
+        cv2.putText(
+            img,
+            m,
+            (8, 18 + 18 * k),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.5,
+            _COLOURS[k % len(_COLOURS)],
+            1,
+            cv2.LINE_AA,
+        )
+    cv2.putText(
+        img,
+        "ground truth (dots: lost points)",
+        (8, 18 + 18 * len(methods)),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        0.5,
+        (255, 255, 255),
+        1,
+        cv2.LINE_AA,
+    )
     return img
 
 
@@ -278,8 +311,10 @@ class Sweep:
         return len(self.positions)
 
     def representative(self) -> tuple[float, float, float, float]:
-        """The kept position nearest the centroid of all kept positions (a rule that does not
-        look at any result)."""
+        """Return the kept position nearest the centroid of all kept positions.
+
+        A rule that does not look at any result.
+        """
         c = self.positions[:, :2].mean(axis=0)
         i = int(np.argmin(np.hypot(*(self.positions[:, :2] - c).T)))
         x, y, w, h = (float(v) for v in self.positions[i])
@@ -296,8 +331,11 @@ def sweep(
     n_gaps: int | None = None,
     min_gaps: int = 1,
 ) -> Sweep:
-    """Mask positions (``size`` squares on a ``step`` grid) with exactly `n_trajectories`
-    trajectories and `n_gaps` gaps when given, else with at least `min_gaps` gaps."""
+    """Select mask positions (``size`` squares on a ``step`` grid).
+
+    Kept: exactly `n_trajectories` trajectories and `n_gaps` gaps when given, else at least
+    `min_gaps` gaps.
+    """
     if size <= 0 or step <= 0:
         raise ValueError(f"sweep: size {size} and step {step} must be > 0")
     xs, ys, nt, ng = count_gaps_grid(trajs, size, width, height, step)
@@ -329,8 +367,10 @@ class MedianScores:
 def median_over(
     trajs: dict[int, F64], sw: Sweep, methods: Sequence[str] = METHODS, max_positions: int = 0
 ) -> MedianScores:
-    """Run every method at every kept position (or `max_positions` evenly spread ones) and
-    take the median of each score."""
+    """Run every method at every kept position and take the median of each score.
+
+    With `max_positions`, only that many evenly spread positions are evaluated.
+    """
     pos = sw.positions
     if max_positions and len(pos) > max_positions:
         pos = pos[np.linspace(0, len(pos) - 1, max_positions).round().astype(int)]
@@ -343,8 +383,9 @@ def median_over(
         for m in methods:
             per[m].append(r.scores[m])
         wins[min(methods, key=lambda m: r.scores[m].mmae_total)] += 1
+    fields = list(MethodScore.__dataclass_fields__)
     med = {
-        m: MethodScore(*(float(np.median([getattr(s, f) for s in v])) for f in MethodScore.__dataclass_fields__))
+        m: MethodScore(*(float(np.median([getattr(s, f) for s in v])) for f in fields))
         for m, v in per.items()
         if v
     }

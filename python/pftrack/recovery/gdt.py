@@ -185,10 +185,16 @@ def goal_directed_path(
     T = _check_T(T)
     _check_form(form)
     r = _core.gdt_solve(
-        _as_stack(A, "A"), _as_stack(Q, "Q"), np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
-        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)), np.asarray(m0, dtype=np.float64),
-        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)), np.asarray(y_T, dtype=np.float64),
-        T, form, bool(start_conditioned),
+        _as_stack(A, "A"),
+        _as_stack(Q, "Q"),
+        np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
+        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)),
+        np.asarray(m0, dtype=np.float64),
+        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)),
+        np.asarray(y_T, dtype=np.float64),
+        T,
+        form,
+        bool(start_conditioned),
     )
     return GdtSolution(r["path"], r["eps"], r["cov"], r["x0_mean"], r["x0_cov"])
 
@@ -219,9 +225,17 @@ def sample_goal_directed_paths(
         raise ValueError(f"sample_goal_directed_paths: n_samples is {n_samples}, expected > 0")
     seed = int(np.random.default_rng(rng).integers(2**63))
     out: NDArray[np.float64] = _core.gdt_sample(
-        _as_stack(A, "A"), _as_stack(Q, "Q"), np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
-        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)), np.asarray(m0, dtype=np.float64),
-        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)), np.asarray(y_T, dtype=np.float64),
-        T, int(n_samples), seed, form, bool(start_conditioned),
+        _as_stack(A, "A"),
+        _as_stack(Q, "Q"),
+        np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
+        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)),
+        np.asarray(m0, dtype=np.float64),
+        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)),
+        np.asarray(y_T, dtype=np.float64),
+        T,
+        int(n_samples),
+        seed,
+        form,
+        bool(start_conditioned),
     )
     return out

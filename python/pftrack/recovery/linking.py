@@ -49,7 +49,9 @@ class LinkConfig:
 
 
 def _centres(rows: F64) -> F64:
-    return np.column_stack([rows[:, 0], rows[:, 2] + 0.5 * rows[:, 4], rows[:, 3] + 0.5 * rows[:, 5]])
+    return np.column_stack(
+        [rows[:, 0], rows[:, 2] + 0.5 * rows[:, 4], rows[:, 3] + 0.5 * rows[:, 5]]
+    )
 
 
 def _end_velocity(c: F64, k: int, tail: bool) -> F64:
@@ -105,7 +107,8 @@ def link_cost_matrix(
         if key not in hists:
             row = tracks[tid][-1 if last else 0]
             f = int(row[0]) - 1
-            hists[key] = _histogram(frames[f], row) if frames is not None and 0 <= f < len(frames) else None
+            ok = frames is not None and 0 <= f < len(frames)
+            hists[key] = _histogram(frames[f], row) if ok and frames is not None else None
         return hists[key]
 
     for i, ti in enumerate(ids):

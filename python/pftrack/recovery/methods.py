@@ -69,8 +69,10 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
 
 @dataclass(frozen=True)
 class NoiseEstimate:
-    """White-noise-acceleration intensity ``q`` (px²/frame³) and measurement variance ``r``
-    (px²), per axis (x, y)."""
+    """Noise levels per axis (x, y).
+
+    ``q``: white-noise-acceleration intensity (px²/frame³); ``r``: measurement variance (px²).
+    """
 
     q: tuple[float, float]
     r: tuple[float, float]
@@ -228,7 +230,7 @@ def _kf_init(seg: F64, r: Sequence[float], p_vel: float) -> tuple[F64, F64]:
 
 
 def _contiguous_tail(seg: F64) -> F64:
-    """The last run of consecutive frames (the Kalman filter steps one frame at a time)."""
+    """Return the last run of consecutive frames (the Kalman filter steps one frame at a time)."""
     br = np.flatnonzero(np.diff(seg[:, 0]) != 1)
     return seg[br[-1] + 1 :] if len(br) else seg
 
@@ -241,7 +243,7 @@ def _contiguous_head(seg: F64) -> F64:
 def gdt_problem(
     seg_a: F64, seg_b: F64, model: GdtModel = _PAPER, history: int = 30
 ) -> tuple[Any, ...]:
-    """The paper's problem tuple ``(A, Q, H, Pi_T, m0, Pi_0, y, T)`` for one gap.
+    """Build the paper's problem tuple ``(A, Q, H, Pi_T, m0, Pi_0, y, T)`` for one gap.
 
     The Kalman filter runs over the last `history` points of segment A's final run of
     consecutive frames (the paper's noise levels give a filter whose memory is a few frames,
@@ -250,9 +252,7 @@ def gdt_problem(
     tail = _contiguous_tail(seg_a)[-history:]
     A, Q, H, R = model.A, model.Q, model.H, model.R
     m_init, P_init = _kf_init(tail, model.r, model.p_init_velocity)
-    m0, P0 = _core.kalman_filter(
-        np.ascontiguousarray(tail[:, 1:3]), A, Q, H, R, m_init, P_init
-    )
+    m0, P0 = _core.kalman_filter(np.ascontiguousarray(tail[:, 1:3]), A, Q, H, R, m_init, P_init)
     T = int(seg_b[0, 0] - seg_a[-1, 0])
     return (A, Q, H, R, m0, P0, np.ascontiguousarray(seg_b[0, 1:3]), T)
 
@@ -260,7 +260,7 @@ def gdt_problem(
 def gdt_bi_problem(
     seg_a: F64, seg_b: F64, noise: NoiseEstimate | None = None, history: int = 30
 ) -> tuple[Any, ...]:
-    """pftrack's two-sided problem: forward filter on A, backward filter on B, noise estimated."""
+    """Pftrack's two-sided problem: forward filter on A, backward filter on B, noise estimated."""
     if noise is None:
         noise = estimate_noise([seg_a, seg_b])
     A = constant_velocity_A(1.0)
@@ -356,7 +356,11 @@ def _gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) -
 
 
 def _rts(
-    seg_a: F64, seg_b: F64, frames: NDArray[np.int64], q: float = 0.1, r: float = 1.0,
+    seg_a: F64,
+    seg_b: F64,
+    frames: NDArray[np.int64],
+    q: float = 0.1,
+    r: float = 1.0,
     history: int = 30,
 ) -> F64:
     a = seg_a[-history:]
@@ -394,8 +398,9 @@ def _rts(
     return ms[(frames - f_first).astype(int), :2]
 
 
-def _gdt_path(problem: tuple[Any, ...], start_conditioned: bool, frames: NDArray[np.int64],
-              f0: float) -> F64:
+def _gdt_path(
+    problem: tuple[Any, ...], start_conditioned: bool, frames: NDArray[np.int64], f0: float
+) -> F64:
     r = _core.gdt_solve(*problem, "general", start_conditioned)
     return np.asarray(r["path"][(frames - f0).astype(int), :2], dtype=np.float64)
 
@@ -481,8 +486,15 @@ def _segment_model(method: str, noise: NoiseEstimate | None) -> tuple[Any, ...]:
         return (m.A, m.Q, m.H, m.R, m.p_init_velocity, "first_point", False)
     assert noise is not None
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
-    return (constant_velocity_A(1.0), wna_Q(noise.q), H, np.diag(noise.r), 1e2,
-            "backward_state", True)
+    return (
+        constant_velocity_A(1.0),
+        wna_Q(noise.q),
+        H,
+        np.diag(noise.r),
+        1e2,
+        "backward_state",
+        True,
+    )
 
 
 def recover_gaps(
@@ -538,8 +550,14 @@ def recover_gaps(
     b_len = np.array([len(s) for s in seg_b], dtype=np.int32)
     a = np.ascontiguousarray(np.concatenate(seg_a)[:, :3])
     b = np.ascontiguousarray(np.concatenate(seg_b)[:, :3])
-    out = _core.gdt_recover_batch(a, a_len, b, b_len, *_segment_model(method, noise)[:6],
-                                  2**31 - 1 if history is None else int(history),
-                                  _segment_model(method, noise)[6])
+    out = _core.gdt_recover_batch(
+        a,
+        a_len,
+        b,
+        b_len,
+        *_segment_model(method, noise)[:6],
+        2**31 - 1 if history is None else int(history),
+        _segment_model(method, noise)[6],
+    )
     T = (b[np.cumsum(b_len) - b_len, 0] - a[np.cumsum(a_len) - 1, 0]).astype(np.int64)
     return np.split(out, np.cumsum(T - 1)[:-1])
