@@ -12,7 +12,7 @@ from typing import Any, Literal, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack import _core
+import pftrack._core as _core
 
 Form = Literal["general", "invertible", "pseudo_inverse"]
 RngLike = Union[np.random.Generator, int, None]

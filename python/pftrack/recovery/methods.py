@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack import _core
+import pftrack._core as _core
 from pftrack.recovery.gdt import GdtModel, constant_velocity_A
 
 METHODS = ("gdt", "gdt-bi", "linear", "cubic", "bspline", "gsi", "rts")
@@ -285,7 +285,8 @@ def _fill_sizes(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64 | None
         return None
     f0, f1 = seg_a[-1, 0], seg_b[0, 0]
     s = (frames - f0) / (f1 - f0)
-    return (1.0 - s)[:, None] * seg_a[-1, 3:5] + s[:, None] * seg_b[0, 3:5]
+    out: F64 = (1.0 - s)[:, None] * seg_a[-1, 3:5] + s[:, None] * seg_b[0, 3:5]
+    return out
 
 
 def _window(seg_a: F64, seg_b: F64, k: int) -> tuple[F64, F64]:
@@ -296,7 +297,8 @@ def _window(seg_a: F64, seg_b: F64, k: int) -> tuple[F64, F64]:
 def _linear(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64:
     f0, f1 = seg_a[-1, 0], seg_b[0, 0]
     s = (frames - f0) / (f1 - f0)
-    return (1.0 - s)[:, None] * seg_a[-1, 1:3] + s[:, None] * seg_b[0, 1:3]
+    out: F64 = (1.0 - s)[:, None] * seg_a[-1, 1:3] + s[:, None] * seg_b[0, 1:3]
+    return out
 
 
 def _cubic(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], window: int = 30) -> F64:
