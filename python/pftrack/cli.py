@@ -148,6 +148,11 @@ def build_parser() -> argparse.ArgumentParser:
     from pftrack.eval.cli import add_eval_parser
 
     add_eval_parser(sub)
+
+    from pftrack.recovery.cli import add_experiment_parser, add_recover_parser
+
+    add_recover_parser(sub)
+    add_experiment_parser(sub)
     return parser
 
 

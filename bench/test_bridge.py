@@ -1,0 +1,72 @@
+"""Goal-directed path: C++ core against a NumPy implementation of the same O(T) recursion,
+T = 10 ... 10 000 (cost must grow linearly in T), and all gaps of a PETS mask.
+
+Locally: ``pytest bench/test_bridge.py --benchmark-only``; CI: ``--benchmark-disable``.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pftrack import _core
+from pftrack.recovery import constant_velocity_A
+from pftrack.recovery import experiment as E
+from pftrack.recovery.methods import recover_gaps
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "recovery"))
+import reference_bridge as ref  # noqa: E402
+
+A = constant_velocity_A(1.0)
+Q = np.diag([1e-6, 1e-6, 1e-4, 1e-4])
+H = np.hstack([np.eye(2), np.zeros((2, 2))])
+R = 1e-6 * np.eye(2)
+M0 = np.array([0.0, 0.0, 1.0, 0.5])
+P0 = 1e-3 * np.eye(4)
+SIZES = [10, 100, 1000, 10000]
+
+
+def goal(T):
+    return np.array([1.0 * T, 0.5 * T + 3.0])
+
+
+@pytest.mark.parametrize("T", SIZES)
+def test_core(benchmark, T):
+    benchmark.group = f"gdt path T={T}"
+    benchmark(_core.gdt_solve, A, Q, H, R, M0, P0, goal(T), T, "general", True)
+
+
+@pytest.mark.parametrize("T", SIZES)
+def test_numpy_reference(benchmark, T):
+    benchmark.group = f"gdt path T={T}"
+    if T == 10000:
+        benchmark.pedantic(
+            ref.gdt_numpy_fast, args=(A, Q, H, R, M0, P0, goal(T), T), rounds=3, iterations=1
+        )
+    else:
+        benchmark(ref.gdt_numpy_fast, A, Q, H, R, M0, P0, goal(T), T)
+
+
+def _pets_gaps():
+    root = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "pets09-s2l1" / "gt.txt"
+    if not root.is_file():
+        pytest.skip("PETS09-S2L1 ground truth not available")
+    from pftrack.io.mot import read_mot
+
+    trajs = E.trajectories(read_mot(root))
+    gaps, _ = E.find_gaps(trajs, (396, 224, 100, 100))
+    return [(g.segment_a, g.segment_b) for g in gaps]
+
+
+@pytest.mark.benchmark(group="PETS mask 396,224: all 23 gaps")
+@pytest.mark.parametrize("method", ["gdt", "gdt-bi", "linear", "cubic", "bspline"])
+def test_pets_all_gaps(benchmark, method):
+    pairs = _pets_gaps()
+    noise = None
+    if method == "gdt-bi":
+        from pftrack.recovery import estimate_noise
+
+        noise = estimate_noise([p for pair in pairs for p in pair])
+    benchmark(recover_gaps, pairs, method, noise=noise)

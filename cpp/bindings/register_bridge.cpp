@@ -1,0 +1,202 @@
+// Bindings of bridge.hpp: the goal-directed state equation and the segment Kalman filter.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+#include "pftrack/bridge.hpp"
+#include "pftrack/gdt_noise.hpp"
+
+namespace py = pybind11;
+using namespace pftrack;
+
+namespace {
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+GdtForm parse_form(const std::string& name, const char* fn) {
+    if (name == "general") return GdtForm::general;
+    if (name == "invertible") return GdtForm::invertible;
+    if (name == "pseudo_inverse" || name == "pinv") return GdtForm::pseudo_inverse;
+    fail(fn, "form is '" + name + "', expected 'general', 'invertible' or 'pseudo_inverse'");
+}
+
+/// (n, n) -> one matrix; (k, n, n) -> k matrices.
+std::vector<MatrixXd> matrix_stack(const Array& a, const char* fn, const char* what) {
+    std::vector<MatrixXd> out;
+    if (a.ndim() == 2) {
+        out.emplace_back(Eigen::Map<const RowMatrixXd>(a.data(), a.shape(0), a.shape(1)));
+    } else if (a.ndim() == 3) {
+        require(a.shape(0) > 0, fn, std::string(what) + " stack is empty");
+        for (py::ssize_t k = 0; k < a.shape(0); ++k)
+            out.emplace_back(Eigen::Map<const RowMatrixXd>(a.data(k, 0, 0), a.shape(1), a.shape(2)));
+    } else {
+        fail(fn, std::string(what) + " must be (n, n) or (T, n, n), got ndim " +
+                     std::to_string(a.ndim()));
+    }
+    return out;
+}
+
+MatrixXd matrix2(const Array& a, const char* fn, const char* what) {
+    require(a.ndim() == 2, fn, (std::string(what) + " ndim").c_str(), a.ndim(), 2);
+    return Eigen::Map<const RowMatrixXd>(a.data(), a.shape(0), a.shape(1));
+}
+
+VectorXd vector1(const Array& a, const char* fn, const char* what) {
+    require(a.ndim() == 1, fn, (std::string(what) + " ndim").c_str(), a.ndim(), 1);
+    return Eigen::Map<const VectorXd>(a.data(), a.shape(0));
+}
+
+GdtProblem make_problem(const Array& A, const Array& Q, const Array& H, const Array& Pi_T,
+                        const Array& m0, const Array& Pi_0, const Array& y, int T, const char* fn) {
+    GdtProblem p;
+    p.A = matrix_stack(A, fn, "A");
+    p.Q = matrix_stack(Q, fn, "Q");
+    p.H = matrix2(H, fn, "H");
+    p.Pi_T = matrix2(Pi_T, fn, "Pi_T");
+    p.m0 = vector1(m0, fn, "m0");
+    p.Pi_0 = matrix2(Pi_0, fn, "Pi_0");
+    p.y = vector1(y, fn, "y");
+    p.T = T;
+    return p;
+}
+
+py::dict result_dict(GdtResult&& r, bool paths_only) {
+    py::dict d;
+    d["path"] = std::move(r.path);
+    if (!paths_only) {
+        const Index n = r.x0_mean.size();
+        RowMatrixXd eps = std::move(r.eps);
+        RowMatrixXd cov = std::move(r.cov);
+        py::array_t<double> e = py::cast(std::move(eps));
+        py::array_t<double> c = py::cast(std::move(cov));
+        d["eps"] = e.reshape({e.shape(0), static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(n)});
+        d["cov"] = c.reshape({c.shape(0), static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(n)});
+        d["x0_mean"] = std::move(r.x0_mean);
+        d["x0_cov"] = std::move(r.x0_cov);
+    }
+    return d;
+}
+
+}  // namespace
+
+void register_bridge(py::module_& m) {
+    m.def(
+        "gdt_solve",
+        [](const Array& A, const Array& Q, const Array& H, const Array& Pi_T, const Array& m0,
+           const Array& Pi_0, const Array& y, int T, const std::string& form,
+           bool start_conditioned) {
+            const GdtForm f = parse_form(form, "gdt_solve");
+            GdtProblem p = make_problem(A, Q, H, Pi_T, m0, Pi_0, y, T, "gdt_solve");
+            GdtResult r;
+            {
+                py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
+                r = gdt_solve(p, f, start_conditioned);
+            }
+            return result_dict(std::move(r), false);
+        },
+        py::arg("A"), py::arg("Q"), py::arg("H"), py::arg("Pi_T"), py::arg("m0"), py::arg("Pi_0"),
+        py::arg("y"), py::arg("T"), py::arg("form") = "general",
+        py::arg("start_conditioned") = true,
+        "Goal-directed path: dict path (T+1, n), eps (T, n, n), cov (T+1, n, n), x0_mean, x0_cov.");
+    m.def(
+        "gdt_sample",
+        [](const Array& A, const Array& Q, const Array& H, const Array& Pi_T, const Array& m0,
+           const Array& Pi_0, const Array& y, int T, int n_samples, std::uint64_t seed,
+           const std::string& form, bool start_conditioned) {
+            const GdtForm f = parse_form(form, "gdt_sample");
+            GdtProblem p = make_problem(A, Q, H, Pi_T, m0, Pi_0, y, T, "gdt_sample");
+            RowMatrixXd out;
+            {
+                py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
+                out = gdt_sample(p, f, start_conditioned, n_samples, seed);
+            }
+            const py::ssize_t n = static_cast<py::ssize_t>(p.m0.size());
+            py::array_t<double> a = py::cast(std::move(out));
+            return a.reshape({static_cast<py::ssize_t>(n_samples), static_cast<py::ssize_t>(T + 1), n});
+        },
+        py::arg("A"), py::arg("Q"), py::arg("H"), py::arg("Pi_T"), py::arg("m0"), py::arg("Pi_0"),
+        py::arg("y"), py::arg("T"), py::arg("n_samples"), py::arg("seed"),
+        py::arg("form") = "general", py::arg("start_conditioned") = true,
+        "Sampled goal-directed paths (n_samples, T+1, n), eps_t noise from a counter-based seed.");
+    m.def(
+        "gdt_solve_batch",
+        [](const py::list& problems, const std::string& form, bool start_conditioned,
+           bool paths_only) {
+            const GdtForm f = parse_form(form, "gdt_solve_batch");
+            std::vector<GdtProblem> ps;
+            ps.reserve(problems.size());
+            for (const py::handle& h : problems) {
+                const py::tuple t = py::reinterpret_borrow<py::tuple>(h);
+                require(t.size() == 8, "gdt_solve_batch",
+                        "each problem must be a tuple (A, Q, H, Pi_T, m0, Pi_0, y, T)");
+                ps.push_back(make_problem(t[0].cast<Array>(), t[1].cast<Array>(),
+                                          t[2].cast<Array>(), t[3].cast<Array>(),
+                                          t[4].cast<Array>(), t[5].cast<Array>(),
+                                          t[6].cast<Array>(), t[7].cast<int>(),
+                                          "gdt_solve_batch"));
+            }
+            std::vector<GdtResult> rs(ps.size());
+            {
+                py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
+                for (size_t i = 0; i < ps.size(); ++i) rs[i] = gdt_solve(ps[i], f, start_conditioned);
+            }
+            py::list out;
+            for (auto& r : rs) out.append(result_dict(std::move(r), paths_only));
+            return out;
+        },
+        py::arg("problems"), py::arg("form") = "general", py::arg("start_conditioned") = true,
+        py::arg("paths_only") = false,
+        "Many problems (tuples A, Q, H, Pi_T, m0, Pi_0, y, T) in one call, GIL released.");
+    m.def(
+        "kalman_filter",
+        [](const Array& z, const Array& A, const Array& Q, const Array& H, const Array& R,
+           const Array& m_init, const Array& P_init) {
+            const char* fn = "kalman_filter";
+            const RowMatrixXd zz = matrix2(z, fn, "z");
+            const MatrixXd a = matrix2(A, fn, "A"), q = matrix2(Q, fn, "Q"), h = matrix2(H, fn, "H"),
+                           r = matrix2(R, fn, "R"), p0 = matrix2(P_init, fn, "P_init");
+            const VectorXd m0 = vector1(m_init, fn, "m_init");
+            KalmanEstimate e;
+            {
+                py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
+                e = kalman_filter(zz, a, q, h, r, m0, p0);
+            }
+            return py::make_tuple(e.m, e.P);
+        },
+        py::arg("z"), py::arg("A"), py::arg("Q"), py::arg("H"), py::arg("R"), py::arg("m_init"),
+        py::arg("P_init"), "Filtered (m (n,), P (n, n)) after the last of z (K, m).");
+    m.def(
+        "gdt_recover_batch",
+        [](Eigen::Ref<const RowMatrixXd> seg_a, Eigen::Ref<const Eigen::VectorXi> a_len,
+           Eigen::Ref<const RowMatrixXd> seg_b, Eigen::Ref<const Eigen::VectorXi> b_len,
+           const Array& A, const Array& Q, const Array& H, const Array& R, double p_init_velocity,
+           const std::string& goal, int history, bool start_conditioned) {
+            const char* fn = "gdt_recover_batch";
+            SegmentModel model{matrix2(A, fn, "A"), matrix2(Q, fn, "Q"), matrix2(H, fn, "H"),
+                               matrix2(R, fn, "R"), p_init_velocity};
+            GoalKind kind;
+            if (goal == "first_point") kind = GoalKind::first_point;
+            else if (goal == "backward_state") kind = GoalKind::backward_state;
+            else fail(fn, "goal is '" + goal + "', expected 'first_point' or 'backward_state'");
+            py::gil_scoped_release nogil;  // safe: Eigen views and C++ copies only
+            return gdt_recover_batch(seg_a, a_len, seg_b, b_len, model, kind, history,
+                                     start_conditioned);
+        },
+        py::arg("seg_a"), py::arg("a_len"), py::arg("seg_b"), py::arg("b_len"), py::arg("A"),
+        py::arg("Q"), py::arg("H"), py::arg("R"), py::arg("p_init_velocity"), py::arg("goal"),
+        py::arg("history"), py::arg("start_conditioned"),
+        "Interior positions (sum(T_g - 1), m) of every gap; segments stacked (frame, pos...).");
+    m.def(
+        "noise_loglik_grid",
+        [](Eigen::Ref<const Eigen::VectorXd> z, Eigen::Ref<const Eigen::VectorXi> lengths,
+           Eigen::Ref<const Eigen::VectorXd> q, Eigen::Ref<const Eigen::VectorXd> r) {
+            py::gil_scoped_release nogil;  // safe: Eigen views only
+            return noise_loglik_grid(z, lengths, q, r);
+        },
+        py::arg("z"), py::arg("lengths"), py::arg("q"), py::arg("r"),
+        "Log-likelihood (G,) of runs z (stacked, lengths) under each (q, r) pair.");
+}

@@ -1,0 +1,400 @@
+"""The paper's experiment: points of ground-truth trajectories inside a mask are lost; recover.
+
+Protocol (Oh & Jung 2015, sec. 4): a ``w x h`` mask region (100 x 100 px); every ground-truth
+point inside it is treated as lost; each maximal run of lost points of a trajectory is one gap,
+recovered from the observed segments before and after it (from the previous gap, or the
+trajectory's start, to the next gap, or its end); trajectories that start or end inside the mask
+are left out. Errors per gap: mean absolute error per axis and mean Euclidean distance; MMAE is
+their mean over gaps, MAE the mean over all recovered points.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack.recovery.methods import METHODS, NoiseEstimate, estimate_noise, recover_gaps
+
+F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Gap:
+    """One gap: the segments around it and the true lost points ``(frame, x, y)``."""
+
+    track_id: int
+    segment_a: F64
+    segment_b: F64
+    truth: F64
+
+
+def trajectories(gt: F64, point: str = "centre") -> dict[int, F64]:
+    """Split ground truth into trajectories: per id, rows ``(frame, x, y)`` sorted by frame.
+
+    ``point`` is the box centre or its bottom centre (``"foot"``).
+    """
+    if point not in ("centre", "center", "foot"):
+        raise ValueError(f"trajectories: point is {point!r}, expected 'centre' or 'foot'")
+    out: dict[int, F64] = {}
+    for tid in np.unique(gt[:, 1]).astype(int):
+        r = gt[gt[:, 1] == tid]
+        r = r[np.argsort(r[:, 0])]
+        x = r[:, 2] + 0.5 * r[:, 4]
+        y = r[:, 3] + (r[:, 5] if point == "foot" else 0.5 * r[:, 5])
+        out[int(tid)] = np.column_stack([r[:, 0], x, y])
+    return out
+
+
+def find_gaps(trajs: dict[int, F64], mask: Sequence[float]) -> tuple[list[Gap], int]:
+    """Find the gaps made by `mask` ``(x, y, w, h)``.
+
+    Returns the gaps and the number of trajectories that have at least one.
+    """
+    mx, my, mw, mh = (float(v) for v in mask)
+    gaps: list[Gap] = []
+    n_traj = 0
+    for tid, tr in trajs.items():
+        inside = (tr[:, 1] >= mx) & (tr[:, 1] < mx + mw) & (tr[:, 2] >= my) & (tr[:, 2] < my + mh)
+        if not inside.any() or inside[0] or inside[-1]:
+            continue
+        n_traj += 1
+        edges = np.diff(inside.astype(np.int8))
+        starts = np.flatnonzero(edges == 1) + 1
+        ends = np.flatnonzero(edges == -1) + 1  # exclusive
+        bounds = [0] + [int(v) for pair in zip(starts, ends) for v in pair] + [len(tr)]
+        for g, (s, e) in enumerate(zip(starts, ends)):
+            a = tr[bounds[2 * g] : s]
+            b = tr[e : bounds[2 * g + 3]]
+            gaps.append(Gap(tid, a, b, tr[s:e]))
+    return gaps, n_traj
+
+
+def count_gaps_grid(
+    trajs: dict[int, F64], size: float, width: float, height: float, step: float
+) -> tuple[F64, F64, NDArray[np.int64], NDArray[np.int64]]:
+    """Count trajectories and gaps for every mask position on a grid (vectorised)."""
+    xs = np.arange(0.0, width - size + 1e-9, step)
+    ys = np.arange(0.0, height - size + 1e-9, step)
+    n_traj = np.zeros((len(ys), len(xs)), dtype=np.int64)
+    n_gaps = np.zeros((len(ys), len(xs)), dtype=np.int64)
+    for tr in trajs.values():
+        inx = (tr[None, :, 1] >= xs[:, None]) & (tr[None, :, 1] < xs[:, None] + size)  # (X, P)
+        iny = (tr[None, :, 2] >= ys[:, None]) & (tr[None, :, 2] < ys[:, None] + size)  # (Y, P)
+        inside = iny[:, None, :] & inx[None, :, :]  # (Y, X, P)
+        ok = inside.any(axis=2) & ~inside[:, :, 0] & ~inside[:, :, -1]
+        runs = np.sum(np.diff(inside.astype(np.int8), axis=2) == 1, axis=2)
+        n_traj += ok
+        n_gaps += np.where(ok, runs, 0)
+    return xs, ys, n_traj, n_gaps
+
+
+@dataclass(frozen=True)
+class MethodScore:
+    """Scores of one method over the gaps of one mask."""
+
+    mmae_x: float
+    mmae_y: float
+    mmae_total: float
+    mae_x: float
+    mae_y: float
+    mae_total: float
+    time_ms: float
+
+
+def observed_runs(trajs: dict[int, F64], mask: Sequence[float]) -> list[F64]:
+    """Every run of consecutive observed (outside the mask) points of every trajectory."""
+    mx, my, mw, mh = (float(v) for v in mask)
+    runs: list[F64] = []
+    for tr in trajs.values():
+        inside = (tr[:, 1] >= mx) & (tr[:, 1] < mx + mw) & (tr[:, 2] >= my) & (tr[:, 2] < my + mh)
+        cut = np.flatnonzero(np.diff(inside.astype(np.int8)) != 0) + 1
+        for part, flag in zip(np.split(tr, cut), np.split(inside, cut)):
+            if not flag[0]:
+                runs.append(part)
+    return runs
+
+
+def score(
+    gaps: Sequence[Gap], method: str, repeat: int = 1, noise: NoiseEstimate | None = None
+) -> tuple[MethodScore, list[F64]]:
+    """Recover all gaps with `method` (best wall time of `repeat` runs) and score them."""
+    pairs = [(g.segment_a, g.segment_b) for g in gaps]
+    best = np.inf
+    paths: list[F64] = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        paths = recover_gaps(pairs, method, noise=noise)
+        best = min(best, time.perf_counter() - t0)
+    ex, ey, ee = [], [], []
+    for g, p in zip(gaps, paths):
+        d = p - g.truth[:, 1:3]
+        ex.append(np.abs(d[:, 0]))
+        ey.append(np.abs(d[:, 1]))
+        ee.append(np.hypot(d[:, 0], d[:, 1]))
+    cat = np.concatenate
+    return (
+        MethodScore(
+            float(np.mean([v.mean() for v in ex])),
+            float(np.mean([v.mean() for v in ey])),
+            float(np.mean([v.mean() for v in ee])),
+            float(cat(ex).mean()),
+            float(cat(ey).mean()),
+            float(cat(ee).mean()),
+            1e3 * best,
+        ),
+        paths,
+    )
+
+
+@dataclass
+class MaskRun:
+    """Everything measured on one mask position."""
+
+    mask: tuple[float, float, float, float]
+    gaps: list[Gap]
+    n_traj: int
+    scores: dict[str, MethodScore]
+    paths: dict[str, list[F64]]
+    noise: NoiseEstimate | None
+    noise_ms: float
+
+
+def run_mask(
+    trajs: dict[int, F64], mask: Sequence[float], methods: Sequence[str] = METHODS, repeat: int = 1
+) -> MaskRun:
+    """Run all methods on one mask.
+
+    The noise levels of ``"gdt-bi"`` are estimated once from every observed point of the
+    sequence (all points outside the mask), timed separately.
+    """
+    gaps, n_traj = find_gaps(trajs, mask)
+    scores: dict[str, MethodScore] = {}
+    paths: dict[str, list[F64]] = {}
+    noise = None
+    noise_ms = 0.0
+    if gaps:
+        if "gdt-bi" in methods:
+            t0 = time.perf_counter()
+            noise = estimate_noise(observed_runs(trajs, mask))
+            noise_ms = 1e3 * (time.perf_counter() - t0)
+        for m in methods:
+            scores[m], paths[m] = score(gaps, m, repeat, noise)
+    mk = tuple(float(v) for v in mask)
+    return MaskRun((mk[0], mk[1], mk[2], mk[3]), gaps, n_traj, scores, paths, noise, noise_ms)
+
+
+def format_table(scores: dict[str, MethodScore], title: str = "") -> str:
+    """Table 1 + 2 of the paper, one column per method."""
+    methods = list(scores)
+    width = max(10, *(len(m) + 2 for m in methods))
+    head = f"{'':<14}" + "".join(f"{m:>{width}}" for m in methods)
+    rows = [title, head] if title else [head]
+    for label, attr in [
+        ("MMAE x", "mmae_x"),
+        ("MMAE y", "mmae_y"),
+        ("MMAE total", "mmae_total"),
+        ("MAE x", "mae_x"),
+        ("MAE y", "mae_y"),
+        ("MAE total", "mae_total"),
+        ("time (ms)", "time_ms"),
+    ]:
+        rows.append(
+            f"{label:<14}" + "".join(f"{getattr(scores[m], attr):>{width}.3f}" for m in methods)
+        )
+    return "\n".join(rows)
+
+
+def _draw_panel(
+    trajs: dict[int, F64],
+    gaps: Sequence[Gap],
+    paths: dict[str, list[F64]],
+    mask: Sequence[float],
+    methods: Sequence[str],
+    origin: tuple[float, float],
+    scale: float,
+    size: tuple[int, int],
+) -> NDArray[np.uint8]:
+    import cv2
+
+    img = np.zeros((size[1], size[0], 3), np.uint8)
+    ox, oy = origin
+
+    def pts(xy: F64) -> NDArray[np.int32]:
+        return np.round(
+            np.column_stack([(xy[:, 0] - ox) * scale, (xy[:, 1] - oy) * scale]) * 16
+        ).astype(np.int32)
+
+    for tr in trajs.values():
+        cv2.polylines(img, [pts(tr[:, 1:3])], False, (90, 90, 90), 1, cv2.LINE_AA, 4)
+    mx, my, mw, mh = mask
+    corners = pts(np.array([[mx, my], [mx + mw, my + mh]]))
+    cv2.rectangle(img, tuple(corners[0]), tuple(corners[1]), (0, 200, 200), 1, cv2.LINE_AA, 4)
+    for k, m in enumerate(methods):
+        for g, p in zip(gaps, paths.get(m, [])):
+            full = np.vstack([g.segment_a[-1:, 1:3], p, g.segment_b[:1, 1:3]])
+            cv2.polylines(img, [pts(full)], False, _COLOURS[k % len(_COLOURS)], 1, cv2.LINE_AA, 4)
+    radius = max(1, int(round(0.6 * scale)))
+    for g in gaps:
+        for x, y in pts(g.truth[:, 1:3]):
+            cv2.circle(img, (int(x), int(y)), radius * 16, (255, 255, 255), -1, cv2.LINE_AA, 4)
+    return img
+
+
+_COLOURS = [(60, 60, 255), (0, 220, 0), (255, 160, 0), (255, 0, 255), (0, 255, 255)]
+
+
+def draw_figure(
+    trajs: dict[int, F64],
+    gaps: Sequence[Gap],
+    paths: dict[str, list[F64]],
+    mask: Sequence[float],
+    size: tuple[int, int],
+    methods: Sequence[str] = ("gdt", "gdt-bi", "bspline"),
+    height: int = 360,
+) -> NDArray[np.uint8]:
+    """Draw ground truth against recovered paths with OpenCV.
+
+    Left: the whole scene; right: the mask region enlarged. Grey: ground-truth trajectories;
+    white dots: the lost (ground-truth) points; coloured: recovered paths; yellow: the mask.
+    """
+    import cv2
+
+    w, h = size
+    s_full = height / float(h)
+    left = _draw_panel(
+        trajs, gaps, paths, mask, methods, (0.0, 0.0), s_full, (int(round(w * s_full)), height)
+    )
+    mx, my, mw, mh = mask
+    pad = 0.15 * max(mw, mh)
+    side = max(mw, mh) + 2 * pad
+    s_zoom = height / side
+    right = _draw_panel(
+        trajs, gaps, paths, mask, methods, (mx - pad, my - pad), s_zoom, (height, height)
+    )
+    img = np.hstack([left, np.full((height, 4, 3), 255, np.uint8), right])
+    for k, m in enumerate(methods):
+        cv2.putText(
+            img,
+            m,
+            (8, 18 + 18 * k),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            0.5,
+            _COLOURS[k % len(_COLOURS)],
+            1,
+            cv2.LINE_AA,
+        )
+    cv2.putText(
+        img,
+        "ground truth (dots: lost points)",
+        (8, 18 + 18 * len(methods)),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        0.5,
+        (255, 255, 255),
+        1,
+        cv2.LINE_AA,
+    )
+    return img
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """Mask positions of a grid that meet a selection."""
+
+    positions: F64  # (K, 4) x, y, w, h
+    selection: str
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+    def representative(self) -> tuple[float, float, float, float]:
+        """Return the kept position nearest the centroid of all kept positions.
+
+        A rule that does not look at any result.
+        """
+        c = self.positions[:, :2].mean(axis=0)
+        i = int(np.argmin(np.hypot(*(self.positions[:, :2] - c).T)))
+        x, y, w, h = (float(v) for v in self.positions[i])
+        return x, y, w, h
+
+
+def sweep(
+    trajs: dict[int, F64],
+    size: float,
+    width: float,
+    height: float,
+    step: float,
+    n_trajectories: int | None = None,
+    n_gaps: int | None = None,
+    min_gaps: int = 1,
+) -> Sweep:
+    """Select mask positions (``size`` squares on a ``step`` grid).
+
+    Kept: exactly `n_trajectories` trajectories and `n_gaps` gaps when given, else at least
+    `min_gaps` gaps.
+    """
+    if size <= 0 or step <= 0:
+        raise ValueError(f"sweep: size {size} and step {step} must be > 0")
+    xs, ys, nt, ng = count_gaps_grid(trajs, size, width, height, step)
+    keep = np.ones_like(nt, dtype=bool)
+    parts = []
+    if n_trajectories is not None:
+        keep &= nt == n_trajectories
+        parts.append(f"{n_trajectories} trajectories")
+    if n_gaps is not None:
+        keep &= ng == n_gaps
+        parts.append(f"{n_gaps} gaps")
+    if n_trajectories is None and n_gaps is None:
+        keep &= ng >= min_gaps
+        parts.append(f">= {min_gaps} gaps")
+    iy, ix = np.nonzero(keep)
+    pos = np.column_stack([xs[ix], ys[iy], np.full(len(ix), size), np.full(len(ix), size)])
+    return Sweep(pos.astype(np.float64), ", ".join(parts))
+
+
+@dataclass(frozen=True)
+class MedianScores:
+    """Medians over mask positions, per method, and how often each method was best."""
+
+    n_positions: int
+    median: dict[str, MethodScore]
+    wins: dict[str, int]
+
+
+def median_over(
+    trajs: dict[int, F64], sw: Sweep, methods: Sequence[str] = METHODS, max_positions: int = 0
+) -> MedianScores:
+    """Run every method at every kept position and take the median of each score.
+
+    With `max_positions`, only that many evenly spread positions are evaluated.
+    """
+    pos = sw.positions
+    if max_positions and len(pos) > max_positions:
+        pos = pos[np.linspace(0, len(pos) - 1, max_positions).round().astype(int)]
+    per: dict[str, list[MethodScore]] = {m: [] for m in methods}
+    wins = {m: 0 for m in methods}
+    for p in pos:
+        r = run_mask(trajs, p, methods)
+        if not r.gaps:
+            continue
+        for m in methods:
+            per[m].append(r.scores[m])
+        wins[min(methods, key=lambda m: r.scores[m].mmae_total)] += 1
+    fields = list(MethodScore.__dataclass_fields__)
+    med = {
+        m: MethodScore(*(float(np.median([getattr(s, f) for s in v])) for f in fields))
+        for m, v in per.items()
+        if v
+    }
+    return MedianScores(len(per[methods[0]]), med, wins)
+
+
+def format_median(ms: MedianScores) -> str:
+    """Table of the medians, plus the number of positions where each method was best."""
+    text = format_table(ms.median, f"median over {ms.n_positions} mask positions")
+    methods = list(ms.median)
+    width = max(10, *(len(m) + 2 for m in methods))
+    return text + "\n" + f"{'best at':<14}" + "".join(f"{ms.wins[m]:>{width}d}" for m in methods)

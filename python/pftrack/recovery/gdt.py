@@ -1,0 +1,241 @@
+"""The goal-directed state equation (Oh & Jung 2015, eqs. 7-18) and its model defaults.
+
+The heavy lifting is in C++ (``cpp/include/pftrack/bridge.hpp``); this module checks Python-side
+arguments, converts them and documents the maths.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+import pftrack._core as _core
+
+Form = Literal["general", "invertible", "pseudo_inverse"]
+RngLike = Union[np.random.Generator, int, None]
+_FORMS = ("general", "invertible", "pseudo_inverse")
+
+
+def constant_velocity_A(dt: float = 1.0) -> NDArray[np.float64]:
+    """State transition of the paper's eq. (19) for the state ``(x, y, vx, vy)``.
+
+    Parameters
+    ----------
+    dt : float
+        Time between two frames. pftrack measures time in **frames** (``dt = 1``), so
+        velocities are pixels per frame; the paper does not say which unit it used.
+    """
+    a = np.eye(4)
+    a[0, 2] = a[1, 3] = dt
+    return a
+
+
+@dataclass(frozen=True)
+class GdtModel:
+    """The paper's model (eqs. 19-22), as documented defaults.
+
+    Attributes
+    ----------
+    dt : float
+        Frame interval in frames (1.0): the unit of time is one frame.
+    q : tuple of 4 float
+        Diagonal of the process noise ``Q`` (px², px², (px/frame)², (px/frame)²), eq. (20).
+    r : tuple of 2 float
+        Diagonal of the measurement noise ``R`` (px²), eq. (22); also the goal's ``Pi_T``.
+    p_init_velocity : float
+        Prior variance of the velocity when the Kalman filter over segment A starts (the paper
+        does not give one; the position starts at the first point with variance ``r``).
+    """
+
+    dt: float = 1.0
+    q: tuple[float, float, float, float] = (1e-6, 1e-6, 1e-4, 1e-4)
+    r: tuple[float, float] = (1e-6, 1e-6)
+    p_init_velocity: float = 1e2
+
+    @property
+    def A(self) -> NDArray[np.float64]:  # noqa: N802 - the paper's name
+        """Constant-velocity transition, eq. (19)."""
+        return constant_velocity_A(self.dt)
+
+    @property
+    def Q(self) -> NDArray[np.float64]:  # noqa: N802
+        """Process noise, eq. (20)."""
+        return np.diag(np.asarray(self.q, dtype=np.float64))
+
+    @property
+    def H(self) -> NDArray[np.float64]:  # noqa: N802
+        """``[I_2 0_2]``, eq. (21)."""
+        return np.hstack([np.eye(2), np.zeros((2, 2))])
+
+    @property
+    def R(self) -> NDArray[np.float64]:  # noqa: N802
+        """Measurement noise, eq. (22)."""
+        return np.diag(np.asarray(self.r, dtype=np.float64))
+
+
+def _as_stack(a: ArrayLike, name: str, n: int | None = None) -> NDArray[np.float64]:
+    arr = np.ascontiguousarray(a, dtype=np.float64)
+    if arr.ndim not in (2, 3):
+        raise ValueError(f"goal_directed_path: {name} must be (n, n) or (T, n, n), got {arr.shape}")
+    return arr
+
+
+@dataclass(frozen=True)
+class GdtSolution:
+    """Result of :func:`goal_directed_path`.
+
+    Attributes
+    ----------
+    path : (T+1, n) ndarray
+        Mean states ``x_0 .. x_T``.
+    eps : (T, n, n) ndarray
+        Covariances ``eps_t = cov(w_t | x_{t-1}, y_T)``, t = 1..T (eqs. 8, 12).
+    cov : (T+1, n, n) ndarray
+        Covariances of the states along the path.
+    x0_mean : (n,) ndarray
+        ``E[x_0 | y_T]`` (eqs. 10, 15, 18).
+    x0_cov : (n, n) ndarray
+        ``cov(x_0 | y_T)`` (eqs. 9, 14).
+    """
+
+    path: NDArray[np.float64]
+    eps: NDArray[np.float64]
+    cov: NDArray[np.float64]
+    x0_mean: NDArray[np.float64]
+    x0_cov: NDArray[np.float64]
+
+
+def _check_T(T: Any) -> int:
+    if isinstance(T, bool) or not isinstance(T, (int, np.integer)):
+        raise TypeError(f"goal_directed_path: T must be an int, got {type(T).__name__}")
+    if T <= 0:
+        raise ValueError(f"goal_directed_path: T is {T}, expected > 0")
+    return int(T)
+
+
+def _check_form(form: str) -> None:
+    if form not in _FORMS:
+        raise ValueError(f"goal_directed_path: form is {form!r}, expected one of {_FORMS}")
+
+
+def goal_directed_path(
+    A: ArrayLike,  # noqa: N803 - the paper's names
+    Q: ArrayLike,  # noqa: N803
+    H_T: ArrayLike,  # noqa: N803
+    Pi_T: ArrayLike,  # noqa: N803
+    m0: ArrayLike,
+    Pi_0: ArrayLike,  # noqa: N803
+    y_T: ArrayLike,  # noqa: N803
+    T: int,  # noqa: N803
+    *,
+    form: Form = "general",
+    start_conditioned: bool = True,
+) -> GdtSolution:
+    """Mean path and covariances of the goal-directed state equation.
+
+    ``x_t = A_t x_{t-1} + u_t + eps_t`` with drift ``u_t = E[w_t | x_{t-1}, y_T]`` and noise
+    covariance ``eps_t = cov(w_t | x_{t-1}, y_T)``, for a goal ``y_T = H_T x_T + v_T``,
+    ``v_T ~ N(0, Pi_T)`` and an initial state ``x_0 ~ N(m0, Pi_0)``.
+
+    Parameters
+    ----------
+    A, Q : (n, n) or (T, n, n) array_like
+        Transition and process noise, constant or one per step (``A[t-1] = A_t``).
+    H_T : (m, n) array_like
+        Goal measurement matrix.
+    Pi_T : (m, m) array_like
+        Goal covariance (symmetric positive definite).
+    m0 : (n,) array_like
+        Initial mean.
+    Pi_0 : (n, n) array_like
+        Initial covariance (symmetric positive definite).
+    y_T : (m,) array_like
+        The goal.
+    T : int
+        Steps from ``x_0`` to the goal's state ``x_T`` (> 0).
+    form : {"general", "invertible", "pseudo_inverse"}
+        Eqs. 7-10 (any ``H_T``), 11-15 (square invertible ``H_T``) or 16-18 (``H_T`` of full
+        column rank; the paper's eq. 17 reads ``H^+ Pi_T H^+T`` with ``H^+ = (H^T H)^-1 H^T``,
+        which equals the general form when ``Pi_T`` is a multiple of the identity or ``H_T`` is
+        square). The latter two also need invertible ``A_t``.
+    start_conditioned : bool
+        Start the path at ``E[x_0 | y_T]`` (then ``path[t] = E[x_t | y_T]``), else at ``m0``
+        (the paper's framework, where ``x_0`` is the Kalman estimate at the end of segment A).
+
+    Returns
+    -------
+    GdtSolution
+
+    Raises
+    ------
+    ValueError
+        T <= 0, mismatched dimensions, NaN, non-symmetric or non-PSD ``Q``, singular or non-PD
+        ``Pi_0``/``Pi_T``, ``H_T`` unfit for `form`.
+
+    References
+    ----------
+    .. [1] Oh, S. H. & Jung, S. K. (2015). Trajectory recovery using goal-directed tracking.
+       Journal of Korea Multimedia Society 18(5).
+    .. [2] Srinivasan, L. et al. (2006). A state-space analysis for reconstruction of
+       goal-directed movements using neural signals. Neural Computation 18(10).
+    """
+    T = _check_T(T)
+    _check_form(form)
+    r = _core.gdt_solve(
+        _as_stack(A, "A"),
+        _as_stack(Q, "Q"),
+        np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
+        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)),
+        np.asarray(m0, dtype=np.float64),
+        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)),
+        np.asarray(y_T, dtype=np.float64),
+        T,
+        form,
+        bool(start_conditioned),
+    )
+    return GdtSolution(r["path"], r["eps"], r["cov"], r["x0_mean"], r["x0_cov"])
+
+
+def sample_goal_directed_paths(
+    A: ArrayLike,  # noqa: N803
+    Q: ArrayLike,  # noqa: N803
+    H_T: ArrayLike,  # noqa: N803
+    Pi_T: ArrayLike,  # noqa: N803
+    m0: ArrayLike,
+    Pi_0: ArrayLike,  # noqa: N803
+    y_T: ArrayLike,  # noqa: N803
+    T: int,  # noqa: N803
+    n_samples: int,
+    *,
+    rng: RngLike = None,
+    form: Form = "general",
+    start_conditioned: bool = True,
+) -> NDArray[np.float64]:
+    """Random paths ``(n_samples, T+1, n)`` of the goal-directed process with ``eps_t`` noise.
+
+    Arguments as :func:`goal_directed_path`; `rng` gives one 63-bit seed for the C++
+    counter-based generator, so results do not depend on thread count.
+    """
+    T = _check_T(T)
+    _check_form(form)
+    if n_samples <= 0:
+        raise ValueError(f"sample_goal_directed_paths: n_samples is {n_samples}, expected > 0")
+    seed = int(np.random.default_rng(rng).integers(2**63))
+    out: NDArray[np.float64] = _core.gdt_sample(
+        _as_stack(A, "A"),
+        _as_stack(Q, "Q"),
+        np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
+        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)),
+        np.asarray(m0, dtype=np.float64),
+        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)),
+        np.asarray(y_T, dtype=np.float64),
+        T,
+        int(n_samples),
+        seed,
+        form,
+        bool(start_conditioned),
+    )
+    return out

@@ -1,0 +1,202 @@
+"""Linking, gap filling and the ``pftrack recover`` / ``experiment gaps`` commands."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pftrack.cli import main
+from pftrack.io.mot import read_mot, write_mot
+from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, fill_gaps, link_tracklets
+
+
+def walker(tid, frames, x0, y0, vx, vy, w=20.0, h=50.0):
+    f = np.asarray(frames, dtype=float)
+    rows = np.zeros((len(f), 10))
+    rows[:, 0] = f
+    rows[:, 1] = tid
+    rows[:, 2] = x0 + vx * f - w / 2
+    rows[:, 3] = y0 + vy * f - h / 2
+    rows[:, 4] = w
+    rows[:, 5] = h
+    rows[:, 6] = 1
+    rows[:, 7:] = -1
+    return rows
+
+
+def scene():
+    # object A fragmented into ids 1 and 5 (gap of 9 frames); object B (id 2) far away with a
+    # hole of 4 frames; id 7 starts after id 2 ends but far from it (must not be linked)
+    return np.vstack(
+        [
+            walker(1, range(1, 41), 100, 100, 2.0, 0.5),
+            walker(5, range(50, 90), 100, 100, 2.0, 0.5),
+            walker(2, list(range(1, 30)) + list(range(35, 60)), 400, 300, -1.0, 0.2),
+            walker(7, range(62, 90), 50, 500, 1.0, 0.0),
+        ]
+    )
+
+
+def test_link_tracklets_joins_fragments_of_one_object_only():
+    rows, mapping = link_tracklets(scene(), LinkConfig(max_gap=20, max_distance=30))
+    assert mapping == {5: 1}
+    assert set(np.unique(rows[:, 1]).astype(int)) == {1, 2, 7}
+
+
+def test_link_respects_the_gap_gate():
+    _, mapping = link_tracklets(scene(), LinkConfig(max_gap=5, max_distance=30))
+    assert mapping == {}
+
+
+def test_fill_gaps_flags_rows_and_is_exact_on_straight_walkers():
+    rows, _ = link_tracklets(scene(), LinkConfig(max_gap=20, max_distance=30))
+    filled, rep = fill_gaps(rows, "gdt-bi", max_gap=20)
+    assert rep.n_gaps == 2 and rep.n_filled_rows == 9 + 5
+    new = filled[filled[:, FLAG_COLUMN] == 1]
+    assert len(new) == 14
+    truth = walker(1, new[new[:, 1] == 1, 0], 100, 100, 2.0, 0.5)
+    np.testing.assert_allclose(new[new[:, 1] == 1, 2:6], truth[:, 2:6], atol=1e-6)
+    keys = filled[:, 0] * 1000 + filled[:, 1]
+    assert len(np.unique(keys)) == len(keys)
+    # sorted by (frame, id)
+    assert np.all(np.diff(keys) > 0)
+
+
+def test_fill_rejects_duplicates():
+    rows = scene()
+    with pytest.raises(ValueError, match="duplicate rows for frame 1, id 1"):
+        fill_gaps(np.vstack([rows, rows[:1]]))
+
+
+def test_cli_recover_twice_changes_nothing(tmp_path, capsys):
+    src = tmp_path / "tracks.txt"
+    write_mot(src, scene())
+    before = src.read_bytes()
+    out1 = tmp_path / "filled.txt"
+    out2 = tmp_path / "filled2.txt"
+    assert (
+        main(
+            [
+                "recover",
+                str(src),
+                "--out",
+                str(out1),
+                "--link",
+                "--max-gap",
+                "20",
+                "--max-distance",
+                "30",
+            ]
+        )
+        == 0
+    )
+    assert src.read_bytes() == before  # input untouched
+    assert (
+        main(
+            [
+                "recover",
+                str(out1),
+                "--out",
+                str(out2),
+                "--link",
+                "--max-gap",
+                "20",
+                "--max-distance",
+                "30",
+            ]
+        )
+        == 0
+    )
+    assert out1.read_bytes() == out2.read_bytes()
+    rows = read_mot(out1)
+    assert np.sum(rows[:, FLAG_COLUMN] == 1) == 14  # the flag round-trips through read_mot
+    assert "interpolated flag: column 8" in capsys.readouterr().out
+
+
+def test_cli_recover_refuses_to_overwrite_input(tmp_path, capsys):
+    src = tmp_path / "tracks.txt"
+    write_mot(src, scene())
+    before = src.read_bytes()
+    assert main(["recover", str(src), "--out", str(src)]) == 2
+    assert "--in-place" in capsys.readouterr().err
+    assert src.read_bytes() == before
+    assert main(["recover", str(src), "--out", str(src), "--in-place"]) == 0
+    assert src.read_bytes() != before
+
+
+def test_cli_recover_reports_bad_rows_with_line_number(tmp_path, capsys):
+    src = tmp_path / "bad.txt"
+    src.write_text("1,1,10,10,5,5,1,-1,-1,-1\n# comment\n2,1,11,oops,5,5,1,-1,-1,-1\n")
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt")]) == 2
+    assert "bad.txt:3" in capsys.readouterr().err
+    src.write_text("1,1,10,10,5,5,1,-1,-1,-1\n\n1,1,11,10,5,5,1,-1,-1,-1\n")
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt")]) == 2
+    assert "lines 1 and 3" in capsys.readouterr().err
+    assert not (tmp_path / "o.txt").exists()
+
+
+def synthetic_gt():
+    rows = []
+    rng = np.random.default_rng(0)
+    for tid in range(1, 7):
+        f = np.arange(1, 150)
+        y0 = 40 + 30 * tid
+        x = 10 + 2.0 * f
+        y = y0 + 5 * np.sin(f / 15.0 + tid) + np.cumsum(rng.normal(0, 0.05, len(f)))
+        for fr, xx, yy in zip(f, x, y):
+            rows.append([fr, tid, xx - 10, yy - 20, 20, 40, 1, -1, -1, -1])
+    rows.append([1, 99, 150, 120, 20, 40, 1, -1, -1, -1])  # starts (and ends) inside the mask
+    rows.append([2, 99, 151, 120, 20, 40, 1, -1, -1, -1])
+    return np.array(rows)
+
+
+def test_experiment_gaps_protocol():
+    from pftrack.recovery import experiment as E
+
+    trajs = E.trajectories(synthetic_gt())
+    gaps, n_traj = E.find_gaps(trajs, (140, 60, 100, 100))
+    # trajectories 1-3 cross the mask (y centre 70..130 within 60..160), id 99 is left out
+    assert n_traj == len({g.track_id for g in gaps}) and 99 not in {g.track_id for g in gaps}
+    for g in gaps:
+        assert g.segment_a[-1, 0] + 1 == g.truth[0, 0]
+        assert g.truth[-1, 0] + 1 == g.segment_b[0, 0]
+        x, y = g.truth[:, 1], g.truth[:, 2]
+        assert np.all((x >= 140) & (x < 240) & (y >= 60) & (y < 160))
+    # the vectorised grid count agrees with find_gaps
+    xs, ys, nt, ng = E.count_gaps_grid(trajs, 100, 400, 300, 20)
+    for iy in range(0, len(ys), 3):
+        for ix in range(0, len(xs), 3):
+            g2, n2 = E.find_gaps(trajs, (xs[ix], ys[iy], 100, 100))
+            assert (nt[iy, ix], ng[iy, ix]) == (n2, len(g2))
+
+
+def test_cli_experiment_gaps(tmp_path, capsys):
+    gt = tmp_path / "gt.txt"
+    write_mot(gt, synthetic_gt())
+    fig = tmp_path / "fig.png"
+    assert (
+        main(
+            [
+                "experiment",
+                "gaps",
+                "--gt",
+                str(gt),
+                "--grid",
+                "40",
+                "--repeat",
+                "1",
+                "--max-positions",
+                "3",
+                "--figure",
+                str(fig),
+            ]
+        )
+        == 0
+    )
+    out = capsys.readouterr().out
+    for word in ("MMAE x", "MMAE total", "MAE total", "time (ms)", "median over", "gdt-bi"):
+        assert word in out
+    import cv2
+
+    img = cv2.imread(str(fig))
+    assert img is not None and img.ndim == 3
+    assert main(["experiment", "gaps", "--gt", str(gt), "--mask", "1,2,3"]) == 2

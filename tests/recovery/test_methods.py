@@ -1,0 +1,167 @@
+"""recover_gap and its baselines, noise estimation."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pftrack.recovery import METHODS, estimate_noise, goal_directed_path, recover_gap, recover_gaps
+from pftrack.recovery.demo import demo_report
+from pftrack.recovery.gdt import GdtModel
+from pftrack.recovery.methods import gdt_problem
+
+from . import reference_bridge as ref
+
+
+def line(frames, x0=10.0, y0=20.0, vx=1.5, vy=-0.7, w=30.0, h=60.0, dw=0.1):
+    f = np.asarray(frames, dtype=float)
+    return np.column_stack([f, x0 + vx * f, y0 + vy * f, w + dw * f, h + 2 * dw * f])
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_straight_constant_velocity_path_is_recovered_exactly(method):
+    a = line(np.arange(1, 31))
+    b = line(np.arange(45, 80))
+    got = recover_gap(a, b, method=method)
+    truth = line(np.arange(31, 45))
+    tol = 1e-3 if method == "gsi" else 1e-6
+    np.testing.assert_allclose(got[:, :2], truth[:, 1:3], atol=tol)
+    np.testing.assert_allclose(got[:, 2:], truth[:, 3:5], atol=1e-9)  # sizes: linear
+
+
+def test_frames_subset_and_no_sizes():
+    a = line(np.arange(1, 20))[:, :3]
+    b = line(np.arange(30, 50))[:, :3]
+    got = recover_gap(a, b, frames=[22, 25], method="gdt-bi")
+    assert got.shape == (2, 2)
+    np.testing.assert_allclose(got, line([22, 25])[:, 1:3], atol=1e-6)
+
+
+def test_recover_gaps_equals_recover_gap():
+    rng = np.random.default_rng(0)
+    gaps = []
+    for k in range(6):
+        t = np.arange(1, 80)
+        xy = np.cumsum(np.cumsum(rng.normal(0, 0.1, (len(t), 2)), axis=0), axis=0)
+        tr = np.column_stack([t, xy])
+        s = 20 + 3 * k
+        gaps.append((tr[:s], tr[s + 5 + k :]))
+    for m in ("gdt", "gdt-bi", "bspline"):
+        batch = recover_gaps(gaps, m)
+        noise = estimate_noise([g[0] for g in gaps] + [g[1] for g in gaps])
+        for (a, b), p in zip(gaps, batch):
+            np.testing.assert_allclose(recover_gap(a, b, method=m, noise=noise), p, atol=1e-12)
+
+
+def test_paper_gdt_equals_kalman_plus_reference_equation():
+    rng = np.random.default_rng(1)
+    t = np.arange(1, 60)
+    xy = 100 + np.cumsum(np.cumsum(rng.normal(0, 0.2, (len(t), 2)), axis=0), axis=0)
+    a = np.column_stack([t[:30], xy[:30]])
+    b = np.column_stack([t[42:], xy[42:]])
+    model = GdtModel()
+    z = a[:, 1:3]
+    m_init = np.array([z[0, 0], z[0, 1], *(z[1] - z[0])])
+    P_init = np.diag([*model.r, model.p_init_velocity, model.p_init_velocity])
+    m0, P0 = ref.kalman_filter(z, model.A, model.Q, model.H, model.R, m_init, P_init)
+    path, *_ = ref.gdt_general(
+        model.A, model.Q, model.H, model.R, m0, P0, b[0, 1:3], 13, start_conditioned=False
+    )
+    got = recover_gap(a, b, method="gdt")
+    np.testing.assert_allclose(got, path[1:-1, :2], rtol=1e-7, atol=1e-6)
+    # the Python problem builder + general solver agree too
+    sol = goal_directed_path(*gdt_problem(a, b), start_conditioned=False)
+    np.testing.assert_allclose(got, sol.path[1:-1, :2], atol=1e-9)
+
+
+@pytest.mark.parametrize("method", ["ml", "moments"])
+def test_noise_estimates_recover_simulated_levels(method):
+    rng = np.random.default_rng(2)
+    q, r = 0.2, 0.5
+    segs = []
+    for _ in range(20):
+        n = 200
+        x = np.zeros((n, 2))
+        v = np.zeros(2)
+        for k in range(1, n):
+            # exact discretisation of continuous white-noise acceleration, one frame
+            cov = q * np.array([[1 / 3, 1 / 2], [1 / 2, 1]])
+            L = np.linalg.cholesky(cov)
+            for ax in range(2):
+                e = L @ rng.standard_normal(2)
+                x[k, ax] = x[k - 1, ax] + v[ax] + e[0]
+                v[ax] += e[1]
+        z = x + rng.normal(0, np.sqrt(r), x.shape)
+        segs.append(np.column_stack([np.arange(n), z]))
+    est = estimate_noise(segs, method=method)
+    for ax in range(2):
+        assert 0.6 * q < est.q[ax] < 1.6 * q, est
+        assert 0.6 * r < est.r[ax] < 1.6 * r, est
+
+
+def test_noise_estimate_defaults_without_data():
+    from pftrack.recovery.methods import DEFAULT_NOISE
+
+    assert estimate_noise([np.zeros((2, 3))]) == DEFAULT_NOISE
+    with pytest.raises(ValueError, match="method"):
+        estimate_noise([], method="bad")
+
+
+def test_bad_segments_raise():
+    a = line(np.arange(1, 10))
+    b = line(np.arange(15, 20))
+    with pytest.raises(ValueError, match="segment_a is empty"):
+        recover_gap(np.zeros((0, 3)), b)
+    with pytest.raises(ValueError, match="segment_b must have shape"):
+        recover_gap(a, np.zeros((4, 2)))
+    nan = a.copy()
+    nan[3, 1] = np.nan
+    with pytest.raises(ValueError, match="non-finite"):
+        recover_gap(nan, b)
+    with pytest.raises(ValueError, match="starts at frame"):
+        recover_gap(b, a)
+    with pytest.raises(ValueError, match="method"):
+        recover_gap(a, b, method="magic")
+    with pytest.raises(ValueError, match="strictly between"):
+        recover_gap(a, b, frames=[9])
+    with pytest.raises(ValueError, match="increase"):
+        recover_gap(a[::-1], b)
+    with pytest.raises(ValueError, match="segment_a of gap 0"):
+        recover_gaps([(np.zeros((0, 3)), b)], "gdt")
+
+
+def test_demo_report_runs_and_names_every_method():
+    rng = np.random.default_rng(3)
+    rows = []
+    for tid in range(1, 4):
+        t = np.arange(1, 120)
+        xy = 200 + np.cumsum(np.cumsum(rng.normal(0, 0.1, (len(t), 2)), axis=0), axis=0)
+        for f, (x, y) in zip(t, xy):
+            rows.append([f, tid, x - 10, y - 20, 20, 40, 1, -1, -1, -1])
+    text = demo_report(np.array(rows), rng=4)
+    for m in METHODS:
+        assert m in text
+    lines = text.splitlines()
+    assert len(lines) == 2 + len(METHODS)
+    errs = {ln.split()[0]: float(ln.split()[1]) for ln in lines[2:]}
+    assert all(np.isfinite(v) and v >= 0 for v in errs.values())
+    # same seed, same gaps, same errors (timings aside)
+    again = demo_report(np.array(rows), rng=4).splitlines()
+    assert [ln.split()[:2] for ln in again[2:]] == [ln.split()[:2] for ln in lines[2:]]
+
+
+def test_noise_loglik_grid_matches_reference():
+    from pftrack import _core
+
+    rng = np.random.default_rng(8)
+    runs = [
+        np.column_stack([np.arange(n), np.cumsum(rng.normal(0, 1, (n, 2)), axis=0)])
+        for n in (3, 10, 25, 4)
+    ]
+    q = np.array([0.01, 0.1, 1.0, 3.0])
+    r = np.array([0.5, 0.01, 2.0, 1.0])
+    for axis in range(2):
+        z = np.concatenate([run[:, 1 + axis] for run in runs])
+        got = _core.noise_loglik_grid(z, np.array([len(x) for x in runs], np.int32), q, r)
+        np.testing.assert_allclose(got, ref.loglik_grid(runs, axis, q, r), rtol=1e-12)
+    with pytest.raises(ValueError, match="q and r must be finite and > 0"):
+        _core.noise_loglik_grid(z, np.array([len(z)], np.int32), np.array([0.0]), np.array([1.0]))
