@@ -8,6 +8,7 @@ import numpy as np
 
 from pftrack.eval import evaluate_mot, format_metrics
 from pftrack.io.mot import write_mot
+from pftrack.recovery.demo import demo_report
 from pftrack.render import plot_trajectories, write_annotated_video
 from pftrack.run import track_frames
 from pftrack.synthetic import make_scene
@@ -39,12 +40,7 @@ def run_demo(out_dir: Path, *, seed: int = 0, n_frames: int = 150, particles: in
     write_annotated_video(out_dir / "annotated.mp4", scene.frames, run.rows, scene.fps)
     plot_trajectories(out_dir / "trajectories.png", run.rows, background=scene.background,
                       truth=scene.truth, title="tracks (colour) over truth (grey)")  # fmt: skip
-    try:
-        from pftrack.recovery import demo_report
-    except ImportError:  # pragma: no cover - recovery not installed in this build
-        demo_report = None
-    if demo_report is not None:
-        print()
-        print(demo_report(scene.truth, rng=seed))
+    print()
+    print(demo_report(scene.truth, rng=seed))
     print(f"\nwrote {out_dir}/tracks.txt, truth.txt, annotated.mp4, trajectories.png")
     return 0
