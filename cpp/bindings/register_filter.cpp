@@ -5,27 +5,12 @@
 #include <string>
 
 #include "pftrack/sis.hpp"
+#include "step_args.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
 
-Kernel parse_kernel(const std::string& name, const char* fn);  // register_histogram.cpp
-
-namespace {
-
-Ar2Model make_model(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
-                    double s_min, double s_max, bool use_means) {
-    Ar2Model m;
-    m.a = a.array();
-    m.b = b.array();
-    m.sigma = sigma.array();
-    m.s_min = s_min;
-    m.s_max = s_max;
-    m.use_means = use_means;
-    return m;
-}
-
-}  // namespace
+using bind::make_model;
 
 void register_filter(py::module_& m) {
     m.def(
@@ -91,27 +76,14 @@ void register_filter(py::module_& m) {
            const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
            double s_min, double s_max, bool use_means, double lam, const std::string& kernel,
            bool resample, std::uint64_t seed, std::uint64_t step) {
-            SisParams prm;
-            prm.model = make_model(a, b, sigma, s_min, s_max, use_means);
-            prm.lambda = lam;
-            prm.kernel = parse_kernel(kernel, "sis_step");
-            prm.w0 = w0;
-            prm.h0 = h0;
-            prm.resample = resample;
+            const SisParams prm = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means,
+                                                         lam, kernel, resample, "sis_step");
             SisResult r;
             {
                 py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
                 r = sis_step(particles, weights, means, image.view(), ref, prm, seed, step);
             }
-            py::dict out;
-            out["mean"] = Eigen::Vector3d(r.estimate.mean);
-            out["map"] = Eigen::Vector3d(r.estimate.map);
-            out["map_index"] = r.estimate.map_index;
-            out["ess"] = r.ess;
-            out["rho_max"] = r.rho_max;
-            out["rho_mean"] = r.rho_mean;
-            out["fg_mean"] = r.fg_mean;
-            return out;
+            return bind::step_result_dict(r);
         },
         py::arg("particles").noconvert(), py::arg("weights").noconvert(),
         py::arg("means").noconvert(), py::arg("image"), py::arg("ref"), py::arg("w0"),

@@ -14,11 +14,11 @@
 #include "arrays.hpp"
 #include "pftrack/mh.hpp"
 #include "pftrack/rjmcmc.hpp"
+#include "step_args.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
 
-Kernel parse_kernel(const std::string& name, const char* fn);  // register_histogram.cpp
 
 namespace {
 
@@ -107,17 +107,8 @@ void register_mcmc(py::module_& m) {
            const Eigen::Vector3d& rw_sigma) {
             const char* fn = "mh_step";
             MhParams prm;
-            prm.base.model.a = a.array();
-            prm.base.model.b = b.array();
-            prm.base.model.sigma = sigma.array();
-            prm.base.model.s_min = s_min;
-            prm.base.model.s_max = s_max;
-            prm.base.model.use_means = use_means;
-            prm.base.lambda = lam;
-            prm.base.kernel = parse_kernel(kernel, fn);
-            prm.base.w0 = w0;
-            prm.base.h0 = h0;
-            prm.base.resample = resample;
+            prm.base = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means, lam,
+                                              kernel, resample, fn);
             prm.n_iter = n_iter;
             prm.burn_in = burn_in;
             if (proposal == "dynamics")
@@ -132,14 +123,7 @@ void register_mcmc(py::module_& m) {
                 py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
                 r = mh_step(particles, weights, means, image.view(), ref, prm, seed, step);
             }
-            py::dict out;
-            out["mean"] = Eigen::Vector3d(r.estimate.mean);
-            out["map"] = Eigen::Vector3d(r.estimate.map);
-            out["map_index"] = r.estimate.map_index;
-            out["ess"] = r.ess;
-            out["rho_max"] = r.rho_max;
-            out["rho_mean"] = r.rho_mean;
-            out["fg_mean"] = r.fg_mean;
+            py::dict out = bind::step_result_dict(r);
             out["acceptance"] = r.acceptance;
             return out;
         },

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
 from pftrack._typing import RngLike
+from pftrack.eval.metrics import iou_xywh
 from pftrack.particle_filter import (
     Ar2Model,
     ColourParticleFilter,
@@ -154,18 +155,11 @@ class Track:
 
 
 def iou_matrix(a_xywh: ArrayLike, b_xywh: ArrayLike) -> NDArray[np.float64]:
-    """Intersection over union of every box in `a` (M, 4) with every box in `b` (K, 4)."""
-    a = np.asarray(a_xywh, dtype=np.float64).reshape(-1, 4)
-    b = np.asarray(b_xywh, dtype=np.float64).reshape(-1, 4)
-    ax1, ay1 = a[:, 0:1], a[:, 1:2]
-    ax2, ay2 = ax1 + a[:, 2:3], ay1 + a[:, 3:4]
-    bx1, by1 = b[:, 0], b[:, 1]
-    bx2, by2 = bx1 + b[:, 2], by1 + b[:, 3]
-    iw = np.clip(np.minimum(ax2, bx2) - np.maximum(ax1, bx1), 0, None)
-    ih = np.clip(np.minimum(ay2, by2) - np.maximum(ay1, by1), 0, None)
-    inter = iw * ih
-    union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
-    return np.where(union > 0, inter / np.maximum(union, 1e-12), 0.0)
+    """Intersection over union of every box in `a` (M, 4) with every box in `b` (K, 4).
+
+    The same function as :func:`pftrack.eval.iou_xywh`, so tracking and scoring never disagree.
+    """
+    return iou_xywh(a_xywh, b_xywh)
 
 
 def refine_boxes(boxes_xywh: NDArray[np.float64], mask: NDArray[np.uint8], fraction: float = 0.1,
@@ -277,21 +271,25 @@ class MultiObjectTracker:
         Reading ahead (e.g. the first 30 frames) gives the background model a picture of the
         empty scene before frame 1 is tracked; detectors without ``prime`` ignore it.
         """
+        detector = self._ensure_detector()
+        if hasattr(detector, "prime"):
+            detector.prime(frames)
+
+    def _ensure_detector(self) -> Any:
+        """The detector, made on first use with the tracker's own HSV binning, so that its
+        foreground bins and the tracker's histograms always share one layout."""
         if self._detector is None:
             from pftrack.detection import make_detector
 
-            self._detector = make_detector(self.config.detector)
-        if hasattr(self._detector, "prime"):
-            self._detector.prime(frames)
+            b = self.config.binning
+            self._detector = make_detector(self.config.detector, n_h=b.n_h, n_s=b.n_s, n_v=b.n_v,
+                                           s_min=b.s_min, v_min=b.v_min)  # fmt: skip
+        return self._detector
 
-    def _detect(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64], Any]:
-        if self._detector is None:
-            from pftrack.detection import make_detector
-
-            self._detector = make_detector(self.config.detector)
-        det = self._detector.detect(frame)
+    def _detect(self, frame: NDArray[np.uint8]) -> Any:
+        det = self._ensure_detector().detect(frame)
         self.last_mask = det.mask
-        return np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4), np.asarray(det.scores, dtype=np.float64), det.binned
+        return det
 
     @staticmethod
     def _check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -340,14 +338,17 @@ class MultiObjectTracker:
         cfg = self.config
         self.frame_index += 1
         if detections is None:
-            boxes, scores, binned = self._detect(f)
+            det = self._detect(f)
+            boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
+            scores = np.asarray(det.scores, dtype=np.float64)
+            binned = det.binned
         else:
             boxes, scores = self._check_detections(detections, f.shape[:2])
-            binned = hsv_bins(f, None, cfg.binning)
-            if cfg.refine_boxes or cfg.sampler == "rjmcmc":
-                _, _, _ = self._detect(f)
-                if cfg.refine_boxes and self.last_mask is not None and len(boxes):
-                    boxes = refine_boxes(boxes, self.last_mask, cfg.refine_fraction)
+            det = self._detect(f) if cfg.refine_boxes or cfg.sampler == "rjmcmc" else None
+            # full-frame bins: from the detector's fused pass when it made them, else one pass here
+            binned = det.frame_bins if det is not None and det.frame_bins is not None else hsv_bins(f, None, cfg.binning)
+            if cfg.refine_boxes and det is not None and len(boxes):
+                boxes = refine_boxes(boxes, det.mask, cfg.refine_fraction)
         keep = scores >= cfg.min_score
         index = np.flatnonzero(keep)
         boxes, scores = boxes[keep], scores[keep]
@@ -359,8 +360,7 @@ class MultiObjectTracker:
             state = t.filter.step(binned)
             t.rho = state.rho
             cx, cy = state.box_cxcywh[:2]
-            t.pf_box = np.array([cx - t.size[0] / 2, cy - t.size[1] / 2, t.size[0], t.size[1]])
-            t.box = t.pf_box
+            t.box = np.array([cx - t.size[0] / 2, cy - t.size[1] / 2, t.size[0], t.size[1]])
             t.age += 1
 
         # 2. association

@@ -60,12 +60,7 @@ struct MhParams {
     }
 };
 
-struct MhResult {
-    Estimate estimate;
-    double ess = 0.0;
-    double rho_max = 0.0;
-    double rho_mean = 0.0;
-    double fg_mean = 0.0;
+struct MhResult : SisResult {
     double acceptance = 0.0;  // accepted / proposed over the post-burn-in iterations
 };
 
@@ -116,25 +111,15 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
                         const Eigen::Ref<const Eigen::VectorXd>& ref, const MhParams& prm,
                         std::uint64_t seed, std::uint64_t step) {
     const char* fn = "mh_step";
-    check_particles(particles, fn);
+    check_particle_set(particles, weights, means, fn);
     const Index n = particles.rows();
-    require(weights.size() == n, fn, "weights size", weights.size(), n);
-    require_weights(weights, fn);
-    require(means.rows() == 2 && means.cols() == kStateDim, fn,
-            "means must be (2, 3): particle-set means at t-1 and t-2");
-    require_finite(means, fn, "means");
     prm.validate(fn);
     check_bin_image(img, fn);
     const Eigen::VectorXd sqref = sqrt_reference(ref, img.n_bins, fn);
     const Ar2Model& model = prm.base.model;
 
     const CounterRng rng(seed, step);
-    if (prm.base.resample) {
-        const IndexVector idx = systematic_resample(weights, rng.uniform(~std::uint64_t(0)));
-        RowMatrixXd kept(n, kParticleCols);
-        for (Index i = 0; i < n; ++i) kept.row(i) = particles.row(idx(i));
-        particles = kept;
-    }
+    if (prm.base.resample) resample_systematic_in_place(particles, weights, rng);
 
     // Predictions mu_j = A x_{t-1}^j + B x_{t-2}^j of every (resampled) parent j   (eq. 7 / eq. 8)
     RowMatrixXd mu(n, kStateDim);

@@ -29,6 +29,31 @@ struct SisResult {
     double fg_mean = 0.0;   // weight-averaged counted pixels (foreground) per particle box
 };
 
+/// Checks shared by sis_step and mh_step: particles (N, 6) finite, weights (N,) valid,
+/// means (2, 3) finite.
+inline void check_particle_set(const Eigen::Ref<const RowMatrixXd>& particles,
+                               const Eigen::Ref<const Eigen::VectorXd>& weights,
+                               const Eigen::Ref<const RowMatrixXd>& means, const char* fn) {
+    check_particles(particles, fn);
+    require(weights.size() == particles.rows(), fn, "weights size", weights.size(),
+            particles.rows());
+    require_weights(weights, fn);
+    require(means.rows() == 2 && means.cols() == kStateDim, fn,
+            "means must be (2, 3): particle-set means at t-1 and t-2");
+    require_finite(means, fn, "means");
+}
+
+/// Systematic resampling of the rows of `particles` by `weights`, with the stream's uniform of
+/// index 2^64 - 1 (outside the range the normals use). Weights are left to the caller.
+inline void resample_systematic_in_place(Eigen::Ref<RowMatrixXd> particles,
+                                         const Eigen::Ref<const Eigen::VectorXd>& weights,
+                                         const CounterRng& rng) {
+    const IndexVector idx = systematic_resample(weights, rng.uniform(~std::uint64_t(0)));
+    RowMatrixXd kept(particles.rows(), kParticleCols);
+    for (Index i = 0; i < particles.rows(); ++i) kept.row(i) = particles.row(idx(i));
+    particles = kept;
+}
+
 struct SisParams {
     Ar2Model model;
     double lambda = 20.0;
@@ -45,13 +70,8 @@ inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::V
                           const Eigen::Ref<const Eigen::VectorXd>& ref, const SisParams& prm,
                           std::uint64_t seed, std::uint64_t step) {
     const char* fn = "sis_step";
-    check_particles(particles, fn);
+    check_particle_set(particles, weights, means, fn);
     const Index n = particles.rows();
-    require(weights.size() == n, fn, "weights size", weights.size(), n);
-    require_weights(weights, fn);
-    require(means.rows() == 2 && means.cols() == kStateDim, fn,
-            "means must be (2, 3): particle-set means at t-1 and t-2");
-    require_finite(means, fn, "means");
     prm.model.validate(fn);
     check_lambda(prm.lambda, fn);
     require(std::isfinite(prm.w0) && std::isfinite(prm.h0) && prm.w0 > 0.0 && prm.h0 > 0.0, fn,
@@ -60,12 +80,9 @@ inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::V
     const Eigen::VectorXd sqref = sqrt_reference(ref, img.n_bins, fn);
 
     const CounterRng rng(seed, step);
-    // 1. resample: one uniform (stream position 0 of the uniform draws, beyond the normals' range)
+    // 1. resample
     if (prm.resample) {
-        const IndexVector idx = systematic_resample(weights, rng.uniform(~std::uint64_t(0)));
-        RowMatrixXd kept(n, kParticleCols);
-        for (Index i = 0; i < n; ++i) kept.row(i) = particles.row(idx(i));
-        particles = kept;
+        resample_systematic_in_place(particles, weights, rng);
         weights.setConstant(1.0 / static_cast<double>(n));
     }
     // 2. propagate

@@ -27,12 +27,16 @@ class Detections:
     binned : pftrack._core.BinnedImage
         HSV bins of the frame with background pixels set to -1 (foreground only), for the
         particles' colour histograms.
+    frame_bins : pftrack._core.BinnedImage or None
+        HSV bins of every pixel, when the detector computed them anyway (the paper's fused
+        pass does; MOG2 and KNN do not), so a caller needing them never bins the frame twice.
     """
 
     boxes: NDArray[np.float64]
     scores: NDArray[np.float64]
     mask: NDArray[np.uint8]
     binned: _core.BinnedImage
+    frame_bins: _core.BinnedImage | None = None
 
     def __len__(self) -> int:
         return int(self.boxes.shape[0])

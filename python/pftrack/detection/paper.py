@@ -143,4 +143,4 @@ class PaperDetector:
         binned, raw = self._model.apply(frame)
         mask = self._blobs.clean(raw)
         boxes, scores = self._blobs.boxes(mask)
-        return Detections(boxes, scores, mask, _core.mask_bins(binned, mask))
+        return Detections(boxes, scores, mask, _core.mask_bins(binned, mask), frame_bins=binned)
