@@ -30,7 +30,6 @@ from pftrack.particle_filter import (
     MHColourParticleFilter,
     RJMCMCConfig,
     RJMCMCFilter,
-    bhattacharyya_coefficient,
     box_histograms,
     hsv_bins,
 )
@@ -462,7 +461,10 @@ class MultiObjectTracker:
         heights = np.array([t.size[1] for t in self.tracks])
         coast = np.array([t.time_since_update for t in self.tracks])
         radius = cfg.match_distance * heights * (1.0 + 0.25 * np.minimum(coast, 8))
-        rho = np.stack([bhattacharyya_coefficient(det_hists, t.filter.reference) if det_hists.sum() > 0 else np.zeros(nd) for t in self.tracks])
+        # Bhattacharyya coefficients of every (track reference, detection) pair in one product;
+        # references are kept normalised by the filters, detection rows sum to 1 (or 0: empty)
+        refs = np.array([t.filter.reference for t in self.tracks])
+        rho = np.sqrt(refs) @ np.sqrt(det_hists).T
         cost = (1.0 - iou) + cfg.colour_weight * (1.0 - rho) + np.minimum(dist / radius[:, None], 2.0)
         gate = (iou >= cfg.match_iou) | (dist <= radius[:, None])
         big = 1e6
