@@ -85,6 +85,20 @@ class TrackerConfig:
     refine_fraction : float
         A row or column belongs to the object when its foreground fraction exceeds this share of
         the box's densest row or column.
+    birth_score : float
+        An external detection starts a track only with at least this score (a detection too
+        unsure to start a track can still keep one alive, as in ByteTrack). Applied while every
+        score seen lies in [0, 1], i.e. scores are confidences; a detector with other scores,
+        and the built-in detector, start tracks from any detection.
+    smooth_external : bool
+        With external detections, report a matched track's filtered box (Kalman centre,
+        smoothed size) rather than the detection's own box, which jitters from frame to frame.
+        The built-in detector's boxes are the foreground's extent and are reported as they are.
+    motion_accel, detection_noise, colour_noise : float
+        The constant-velocity Kalman filter of each track's centre, in track heights: the
+        standard deviation of the acceleration per frame², of a detection's centre and of the
+        colour filter's estimate (the measurement while the track coasts, and a second opinion
+        before association).
     """
 
     filter: FilterConfig = field(
@@ -107,7 +121,12 @@ class TrackerConfig:
     coast_min_rho: float = 0.5
     tentative_coast: int = 0
     refine_boxes: bool = True
-    refine_fraction: float = 0.1
+    refine_fraction: float = 0.05
+    birth_score: float = 0.9
+    smooth_external: bool = True
+    motion_accel: float = 0.01
+    detection_noise: float = 0.05
+    colour_noise: float = 0.15
 
     def __post_init__(self) -> None:
         if self.sampler not in ("sis", "mh", "rjmcmc"):
@@ -210,6 +229,44 @@ def _cxcywh_to_xywh(b: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.concatenate([b[..., :2] - b[..., 2:] / 2, b[..., 2:]], axis=-1)
 
 
+class _CentreKalman:
+    """Constant-velocity Kalman filter of a track's centre, both axes sharing one covariance.
+
+    Noise levels are in units of the track's height ``h`` so that one rule fits any image scale:
+    white-noise acceleration ``σ_a = accel·h`` per frame², and a measurement standard deviation
+    of ``det_noise·h`` for a detection, larger for a colour-filter estimate.
+    """
+
+    def __init__(self, centre: NDArray[np.float64], height: float, accel: float) -> None:
+        self.p = np.array(centre, dtype=np.float64)
+        self.v = np.zeros(2)
+        self.accel = accel
+        # unknown initial velocity: about a third of a height per frame (a fast walker at 5 fps)
+        self.P = np.array([[(0.05 * height) ** 2, 0.0], [0.0, (0.3 * height) ** 2]])
+
+    def predict(self, height: float) -> None:
+        self.p = self.p + self.v
+        P = self.P
+        q = (self.accel * height) ** 2
+        p00 = P[0, 0] + 2 * P[0, 1] + P[1, 1] + q / 4
+        p01 = P[0, 1] + P[1, 1] + q / 2
+        p11 = P[1, 1] + q
+        self.P = np.array([[p00, p01], [p01, p11]])
+
+    def predicted(self, steps: int) -> NDArray[np.float64]:
+        """The centre `steps` frames after the current state."""
+        return self.p + steps * self.v
+
+    def update(self, z: NDArray[np.float64], sigma: float) -> None:
+        P = self.P
+        s = P[0, 0] + sigma**2
+        k0, k1 = P[0, 0] / s, P[0, 1] / s
+        y = np.asarray(z, dtype=np.float64) - self.p
+        self.p = self.p + k0 * y
+        self.v = self.v + k1 * y
+        self.P = np.array([[(1 - k0) * P[0, 0], (1 - k0) * P[0, 1]], [(1 - k0) * P[0, 1], P[1, 1] - k1 * P[0, 1]]])
+
+
 class _TrackState:
     """A live track: its particle filter and bookkeeping (internal)."""
 
@@ -220,8 +277,7 @@ class _TrackState:
         self.filter = cls(_xywh_to_cxcywh(box_xywh), reference, config.filter, rng=seed)
         self.box = box_xywh.copy()
         self.size = box_xywh[2:].copy()  # smoothed detection size
-        self.velocity = np.zeros(2)
-        self.last_centre = box_xywh[:2] + box_xywh[2:] / 2
+        self.motion = _CentreKalman(box_xywh[:2] + box_xywh[2:] / 2, box_xywh[3], config.motion_accel)
         self.hits = 1
         self.age = 1
         self.time_since_update = 0
@@ -262,6 +318,7 @@ class MultiObjectTracker:
         self.frame_index = 0
         self.last_mask: NDArray[np.uint8] | None = None
         self._joint: RJMCMCFilter | None = None
+        self._scores_are_confidences = True
 
     # -- detections -------------------------------------------------------------------------
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
@@ -343,6 +400,8 @@ class MultiObjectTracker:
             binned = det.binned
         else:
             boxes, scores = self._check_detections(detections, f.shape[:2])
+            if np.any((scores < 0) | (scores > 1)):
+                self._scores_are_confidences = False
             det = self._detect(f) if cfg.refine_boxes or cfg.sampler == "rjmcmc" else None
             # full-frame bins: from the detector's fused pass when it made them, else one pass here
             binned = det.frame_bins if det is not None and det.frame_bins is not None else hsv_bins(f, None, cfg.binning)
@@ -358,7 +417,10 @@ class MultiObjectTracker:
         for t in self.tracks:
             state = t.filter.step(binned)
             t.rho = state.rho
-            cx, cy = state.box_cxcywh[:2]
+            # the motion model predicts, the colour filter's estimate is a noisy measurement of it
+            t.motion.predict(t.size[1])
+            t.motion.update(state.box_cxcywh[:2], cfg.colour_noise * t.size[1])
+            cx, cy = t.motion.p
             t.box = np.array([cx - t.size[0] / 2, cy - t.size[1] / 2, t.size[0], t.size[1]])
             t.age += 1
 
@@ -367,6 +429,7 @@ class MultiObjectTracker:
         matches, unmatched_t, unmatched_d = self._associate(boxes, det_hists)
 
         # 3. matched tracks follow their detection
+        smooth = cfg.smooth_external and detections is not None
         for ti, di in matches:
             t = self.tracks[ti]
             b = boxes[di]
@@ -379,12 +442,11 @@ class MultiObjectTracker:
                 t.det_index = None
                 continue
             centre = b[:2] + b[2:] / 2
-            t.velocity = 0.7 * t.velocity + 0.3 * (centre - t.last_centre) / max(1, t.frames_since_det)
-            t.last_centre = centre
+            t.motion.update(centre, cfg.detection_noise * t.size[1])
             t.frames_since_det = 0
             t.size = 0.7 * t.size + 0.3 * b[2:]
-            t.box = b.copy()
-            t.filter.reinitialise(_xywh_to_cxcywh(b), velocity=t.velocity)
+            t.box = np.concatenate([t.motion.p - t.size / 2, t.size]) if smooth else b.copy()
+            t.filter.reinitialise(_xywh_to_cxcywh(b), velocity=t.motion.v)
             hist = det_hists[di]
             if cfg.reference_rate > 0 and hist.sum() > 0:
                 t.filter.set_reference((1 - cfg.reference_rate) * t.filter.reference + cfg.reference_rate * hist)
@@ -401,10 +463,11 @@ class MultiObjectTracker:
             t for t in self.tracks
             if t.time_since_update <= (cfg.max_coast if t.hits >= cfg.min_hits else min(cfg.max_coast, cfg.tentative_coast))
         ]  # fmt: skip
+        birth_score = cfg.birth_score if detections is not None and self._scores_are_confidences else -np.inf
         for di in unmatched_d:
             hist = det_hists[di]
-            if hist.sum() <= 0:
-                continue  # no foreground colour to build a reference from
+            if hist.sum() <= 0 or scores[di] < birth_score:
+                continue  # no foreground colour to build a reference from, or too unsure
             t = _TrackState(next(self._ids), boxes[di].copy(), hist, cfg, int(self._rng.integers(2**63)), float(scores[di]))
             t.det_index = int(index[di])
             t.frames_since_det = 0
