@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import itertools
 import os
 import sys
 import time
@@ -199,14 +200,22 @@ def make_motpy(seq: Sequence) -> Step:
 
 
 def make_pftrack(seq: Sequence) -> Step:
-    from pftrack.tracker import MultiObjectTracker  # written by the lead; may be absent
+    """pftrack as ``pftrack track`` runs it: the background primed from the first 30 frames,
+    output through :class:`~pftrack.tracker.TrackWriter` (bridged gaps written once the track
+    is re-detected, a new track's first boxes once it is confirmed)."""
+    from pftrack.tracker import MultiObjectTracker, TrackWriter
 
-    trk = MultiObjectTracker()
+    trk = MultiObjectTracker(rng=0)
+    writer = TrackWriter()
+    count = itertools.count(1)
 
     def step(frame, boxes):
-        tracks = trk.update(frame, detections=boxes)
-        return [(int(t.id), *(float(v) for v in t.box_xywh)) for t in tracks]
+        dets = None if boxes is None else np.asarray(boxes, dtype=np.float64).reshape(-1, 5)
+        writer.add(next(count), trk.update(frame, detections=dets))
+        return []
 
+    step.prime = lambda frames: trk.prime(frames[:30])  # type: ignore[attr-defined]
+    step.result = writer.result  # type: ignore[attr-defined]
     return step
 
 
@@ -242,6 +251,8 @@ def run_one(
         elapsed += time.perf_counter() - t0
         rows += [(f, i, x, y, w, h, 1.0, -1.0, -1.0, -1.0) for i, x, y, w, h in out]
     res = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+    if hasattr(step, "result"):  # a tracker that writes its rows at the end (pftrack)
+        res = step.result()
     return res, len(frames) / elapsed if elapsed > 0 else float("inf")
 
 
@@ -300,6 +311,8 @@ def main(argv: list[str] | None = None) -> int:
                         notes.append(note)
                     continue
                 feed: Iterable[Boxes | None] = [None] * len(frames) if own else dets
+                if hasattr(step, "prime"):
+                    step.prime(frames)
                 with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
                     warnings.simplefilter("ignore")
                     res, fps = run_one(step, frames, feed)

@@ -162,6 +162,10 @@ class Track:
         Frames since birth.
     time_since_update : int
         Frames since the last matched detection (0 when matched this frame).
+    history : tuple of (frame, box_xywh, score)
+        On the frame a new track is first reported, the matched boxes it had while it waited
+        for ``min_hits`` (frame numbers count :meth:`~MultiObjectTracker.update` calls from 1);
+        empty otherwise. Offline writers back-fill them; online users may ignore them.
     """
 
     id: int
@@ -170,6 +174,7 @@ class Track:
     detection_index: Optional[int]
     age: int
     time_since_update: int
+    history: tuple[tuple[int, NDArray[np.float64], float], ...] = ()
 
 
 def iou_matrix(a_xywh: ArrayLike, b_xywh: ArrayLike) -> NDArray[np.float64]:
@@ -285,6 +290,8 @@ class _TrackState:
         self.rho = 1.0
         self.det_index: int | None = None
         self.frames_since_det = 0
+        self.unreported: list[tuple[int, NDArray[np.float64], float]] = []
+        self.reported = False
 
 
 class MultiObjectTracker:
@@ -543,13 +550,16 @@ class MultiObjectTracker:
         early = self.frame_index <= cfg.min_hits
         out = []
         for t in self.tracks:
-            if t.hits < cfg.min_hits and not early:
+            if t.hits < cfg.min_hits and not early and not t.reported:
+                if t.time_since_update == 0:
+                    t.unreported.append((self.frame_index, t.box.copy(), float(t.score)))
                 continue
             if t.time_since_update > 0 and t.rho < cfg.coast_min_rho:
                 continue
+            history, t.unreported, t.reported = tuple(t.unreported), [], True
             out.append(Track(id=t.id, box_xywh=t.box.copy(), score=float(t.score),
                              detection_index=t.det_index, age=t.age,
-                             time_since_update=t.time_since_update))  # fmt: skip
+                             time_since_update=t.time_since_update, history=history))  # fmt: skip
         return out
 
 
@@ -583,6 +593,8 @@ class TrackWriter:
     def add(self, frame: int, tracks: list[Track]) -> None:
         """Record the tracks reported for `frame` (1-based)."""
         for t in tracks:
+            for f, box, score in t.history:  # a new track's boxes from before it was confirmed
+                self.rows.append([float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0])
             row = [float(frame), float(t.id), *map(float, t.box_xywh), float(t.score), -1.0, -1.0, -1.0]
             if t.time_since_update == 0:
                 pending = self._pending.pop(t.id, [])
