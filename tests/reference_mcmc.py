@@ -48,6 +48,15 @@ def box_mask(rng_box, shape):
     return m
 
 
+def iou_cxcywh(a, b):
+    """IoU of two (cx, cy, w, h) boxes, continuous coordinates."""
+    iw = min(a[0] + a[2] / 2, b[0] + b[2] / 2) - max(a[0] - a[2] / 2, b[0] - b[2] / 2)
+    ih = min(a[1] + a[3] / 2, b[1] + b[3] / 2) - max(a[1] - a[3] / 2, b[1] - b[3] / 2)
+    if iw <= 0 or ih <= 0:
+        return 0.0
+    return iw * ih / (a[2] * a[3] + b[2] * b[3] - iw * ih)
+
+
 def histogram(bins, n_bins, box):
     x0, x1, y0, y1 = box_pixels(*box, *bins.shape)
     if x0 >= x1 or y0 >= y1:
@@ -125,7 +134,8 @@ def mh_step(particles, bins, n_bins, ref, w0, h0, a, b, sigma, s_min, s_max, lam
 class RjReference:
     """The RJ-MCMC model of one frame, from its documented definition."""
 
-    def __init__(self, bins, n_bins, mask, slots, tracks, params):
+    def __init__(self, bins, n_bins, mask, slots, tracks, params, detections=()):
+        self.dets = np.asarray(detections, float).reshape(-1, 4)  # all candidates, cx, cy, w, h
         self.bins, self.n_bins = bins, n_bins
         self.fg = np.asarray(mask) != 0
         self.slots, self.p = slots, params
@@ -177,6 +187,9 @@ class RjReference:
             ref = self.slots[slot]["ref"]
             t += colour_loglik(self.bins, self.n_bins, self.box(slot, x), ref, p["lam"])
             t += lp + self.log_omega(slot)
+            if len(self.dets):  # detection support delta max_k IoU(b, d_k)
+                b = self.box(slot, x)
+                t += self.p["detection"] * max(iou_cxcywh(b, d) for d in self.dets)
             m = box_mask(self.rng_box(slot, x), self.fg.shape)
             masks.append(m)
             union |= m

@@ -144,7 +144,8 @@ void register_mcmc(py::module_& m) {
                          const Eigen::Vector3d& b, const Eigen::Vector3d& sigma, double s_min,
                          double s_max, double lam, const std::string& kernel, double interaction,
                          double coverage, double background_penalty, double birth_prior, double survival,
-                         double birth_sigma_xy, double birth_sigma_s, double birth_eps) {
+                         double birth_sigma_xy, double birth_sigma_s, double birth_eps,
+                         double birth_gate, double detection) {
                  RjParams p;
                  p.burn_in = burn_in;
                  p.n_samples = n_samples;
@@ -167,6 +168,8 @@ void register_mcmc(py::module_& m) {
                  p.birth_sigma_xy = birth_sigma_xy;
                  p.birth_sigma_s = birth_sigma_s;
                  p.birth_eps = birth_eps;
+                 p.birth_gate = birth_gate;
+                 p.detection = detection;
                  return PyRjTracker{RJMCMCTracker(p), nullptr, nullptr};
              }),
              py::arg("burn_in") = 50, py::arg("n_samples") = 200, py::arg("p_birth") = 0.1,
@@ -178,7 +181,8 @@ void register_mcmc(py::module_& m) {
              py::arg("interaction") = 10.0, py::arg("coverage") = 20.0, py::arg("background_penalty") = 0.25,
              py::arg("birth_prior") = 2.0, py::arg("survival") = 0.95,
              py::arg("birth_sigma_xy") = 3.0, py::arg("birth_sigma_s") = 0.05,
-             py::arg("birth_eps") = 0.02)
+             py::arg("birth_eps") = 0.02, py::arg("birth_gate") = 0.1,
+             py::arg("detection") = 20.0)
         .def(
             "step",
             [](PyRjTracker& self, const BinnedImage& image, const py::array& mask,

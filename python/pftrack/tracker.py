@@ -52,8 +52,8 @@ class TrackerConfig:
         object, or one joint RJ-MCMC chain over all objects (Smith et al. 2005): the paper's
         comparison samplers.
     rjmcmc : RJMCMCConfig
-        Settings of the joint sampler (used with ``sampler="rjmcmc"``); its sample count is
-        set from ``filter.n_particles`` so that budgets compare.
+        Settings of the joint sampler (used with ``sampler="rjmcmc"``); its sample count and
+        AR2 dynamics are set from ``filter`` so that budgets and models compare.
     detector : {"paper", "mog2", "knn"}
         Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections.
     max_coast : int
@@ -488,7 +488,11 @@ class MultiObjectTracker:
         if self._joint is None:
             from dataclasses import replace
 
-            rj = replace(self.config.rjmcmc, n_samples=self.config.filter.n_particles)
+            # same budget and the same AR2 dynamics as the per-object filters, so that only the
+            # sampler differs between sampler="sis" | "mh" | "rjmcmc"
+            m = self.config.filter.model
+            rj = replace(self.config.rjmcmc, n_samples=self.config.filter.n_particles,
+                         a=tuple(m.a), b=tuple(m.b), sigma=tuple(m.sigma), s_min=m.s_min, s_max=m.s_max)
             self._joint = RJMCMCFilter(rj, rng=self._rng)
         mask = self.last_mask
         if mask is None or mask.shape != frame.shape[:2]:

@@ -9,7 +9,8 @@
 //   log pi(X) = sum_{i in X} [ -lambda D^2(q*_i, q(x_i))              colour likelihood (eq. 9-10)
 //                              + log P_i(x_i)                         predictive prior of i
 //                              + log omega_i                          prior odds that i is present
-//                              + kappa cov(b_i) ]                     foreground coverage
+//                              + kappa cov(b_i)                       foreground coverage
+//                              + delta max_k IoU(b_i, d_k) ]          detection support
 //             + sum_{i<j}  [ -gamma IoU(b_i, b_j)                     pairwise interaction prior
 //                            - kappa cov(b_i & b_j) ]                 (inclusion-exclusion)
 //
@@ -23,8 +24,18 @@
 // previous kept samples that contain it,  P_i(x) = 1/N_i sum_n N(x; A x_n + B x'_n, C^2)
 // (Khan et al. 2005's factored predictive prior), and for a newborn of candidate k,
 // P_k(x) = N(x; (cx_k, cy_k, 1), diag(tau_xy^2, tau_xy^2, tau_s^2)). Outside s in [s_min, s_max]
-// the target is 0. omega_i = e_i / (1 - e_i) with e_i = p_survive x (fraction of the previous
-// kept samples containing i), clipped to [1e-3, 1 - 1e-3]; omega_k = beta for a newborn.
+// the target is 0. d_k are all the frame's candidate (detector) boxes: the detections support the
+// identities they overlap (a unary term: the ratios below keep their form). omega_i =
+// e_i / (1 - e_i) with e_i = p_survive x (fraction of the previous kept samples containing i),
+// clipped to [1e-3, 1 - 1e-3]; omega_k = beta for a newborn.
+//
+// Identity table and birth gate: a candidate whose box overlaps the mean prediction of an identity
+// with existence >= 1/2 by IoU >= birth_gate gets NO newborn slot (it is that identity's
+// detection). Without the gate a newborn slot sits on every detected person: its reference is the
+// histogram of this very box and its prior a tight Gaussian on it, so it out-scores the kept
+// identity (older reference, broad AR2 prior), and death + birth hand every person a new id
+// every ~4 frames. The gate only decides which slots exist in this frame; the chain and its
+// ratios below are unchanged (the detailed-balance test covers them).
 //
 // Moves, chosen with probabilities p_b, p_d, p_u, p_s (a move that is impossible in X, e.g. a
 // death in the empty configuration, leaves X unchanged):
@@ -54,6 +65,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -84,6 +96,9 @@ struct RjParams {
     double survival = 0.95;     // p_survive
     double birth_sigma_xy = 3.0, birth_sigma_s = 0.05;  // spread of P_k around a candidate
     double birth_eps = 0.02;    // eps of the birth weights
+    double detection = 20.0;    // delta: log D_i = delta max_k IoU(b_i, d_k) over the candidates
+    double birth_gate = 0.1;    // no newborn slot for a candidate with IoU >= this with a kept
+                                // identity's predicted box (> 1: every candidate gets a slot)
 
     void validate(const char* fn) const {
         require(burn_in >= 0, fn, "burn_in", burn_in, ">= 0");
@@ -107,6 +122,8 @@ struct RjParams {
                     birth_sigma_s > 0.0,
                 fn, "birth_sigma_xy and birth_sigma_s must be > 0");
         require(std::isfinite(birth_eps) && birth_eps > 0.0, fn, "birth_eps", birth_eps, "> 0");
+        require(std::isfinite(birth_gate) && birth_gate > 0.0, fn, "birth_gate", birth_gate, "> 0");
+        require(std::isfinite(detection) && detection >= 0.0, fn, "detection", detection, ">= 0");
     }
     double move_total() const { return p_birth + p_death + p_update + p_swap; }
     double move_prob(RjMove m) const {
@@ -172,13 +189,23 @@ inline PixelRange range_intersection(const PixelRange& a, const PixelRange& b) {
                       std::min(a.y1, b.y1)};
 }
 
+/// IoU of two (cx, cy, w, h) boxes (continuous coordinates).
+inline double iou_cxcywh(const double* a, const double* b) {
+    const double iw = std::min(a[0] + a[2] / 2, b[0] + b[2] / 2) - std::max(a[0] - a[2] / 2, b[0] - b[2] / 2);
+    const double ih = std::min(a[1] + a[3] / 2, b[1] + b[3] / 2) - std::max(a[1] - a[3] / 2, b[1] - b[3] / 2);
+    if (iw <= 0.0 || ih <= 0.0) return 0.0;
+    const double inter = iw * ih;
+    return inter / (a[2] * a[3] + b[2] * b[3] - inter);
+}
+
 /// One frame's model: image, foreground integral, identity table and parameters. Every log-target,
 /// proposal and acceptance term of the chain is computed here.
 class RjFrame {
 public:
-    RjFrame(const BinImage& img, FgIntegral fg, std::vector<RjIdentity> ids, const RjParams& prm)
-        : img_(img), fg_(std::move(fg)), ids_(std::move(ids)), prm_(prm), scratch_(img.n_bins),
-          hist_(static_cast<size_t>(img.n_bins)) {}
+    RjFrame(const BinImage& img, FgIntegral fg, std::vector<RjIdentity> ids, const RjParams& prm,
+            std::vector<std::array<double, 4>> detections = {})
+        : img_(img), fg_(std::move(fg)), ids_(std::move(ids)), prm_(prm),
+          dets_(std::move(detections)), scratch_(img.n_bins), hist_(static_cast<size_t>(img.n_bins)) {}
 
     const std::vector<RjIdentity>& identities() const { return ids_; }
     const RjParams& params() const { return prm_; }
@@ -240,12 +267,22 @@ public:
         return prm_.coverage * (c - prm_.background_penalty * (range_area(r) - c)) / f;
     }
 
+    /// Detection term delta max_k IoU(b, d_k) of slot at x (0 without candidates).
+    double detection_of(int slot, const double* x) const {
+        if (prm_.detection <= 0.0 || dets_.empty()) return 0.0;
+        const RjIdentity& id = ids_[static_cast<size_t>(slot)];
+        const double b[4] = {x[0], x[1], x[2] * id.w0, x[2] * id.h0};
+        double best = 0.0;
+        for (const auto& d : dets_) best = std::max(best, iou_cxcywh(b, d.data()));
+        return prm_.detection * best;
+    }
+
     /// The single-object term of log pi (-inf outside the scale bounds).
     double unary(int slot, const double* x) {
         const double lp = log_prior_pos(slot, x);
         if (!std::isfinite(lp)) return kNegInf;
         return log_colour(slot, x) + lp + ids_[static_cast<size_t>(slot)].log_omega +
-               coverage_of(box(slot, x));
+               coverage_of(box(slot, x)) + detection_of(slot, x);
     }
 
     /// The pairwise term of log pi for two objects.
@@ -443,6 +480,7 @@ private:
     FgIntegral fg_;
     std::vector<RjIdentity> ids_;
     RjParams prm_;
+    std::vector<std::array<double, 4>> dets_;  // every candidate box (cx, cy, w, h)
     HistogramScratch scratch_;
     std::vector<double> hist_;
     mutable std::vector<double> lse_;
@@ -557,9 +595,19 @@ public:
             id.anchor[3] = s * t.h0;
             ids.push_back(std::move(id));
         }
+        const size_t n_kept = ids.size();
         for (Index k = 0; k < cands.rows(); ++k) {
             const double sum = hists.row(k).sum();
             if (!(sum > 0.0) || !(cands(k, 2) > 0.0) || !(cands(k, 3) > 0.0)) continue;
+            // Birth gate: a candidate that a confident identity's prediction already covers is
+            // that identity's detection, not a new object. Without the gate its newborn slot
+            // (reference histogram from this very box, tight prior on it) out-scores the kept
+            // identity, and death + birth hand the object a new id every few frames.
+            const double cbox[4] = {cands(k, 0), cands(k, 1), cands(k, 2), cands(k, 3)};
+            bool explained = false;
+            for (size_t s = 0; s < n_kept && !explained; ++s)
+                explained = tracks_[s].existence >= 0.5 && iou_cxcywh(cbox, ids[s].anchor) >= prm_.birth_gate;
+            if (explained) continue;
             require_weights(hists.row(k), fn, "candidate_hists row");
             RjIdentity id;
             id.candidate = static_cast<int>(k);
@@ -571,7 +619,10 @@ public:
             for (int d = 0; d < 4; ++d) id.anchor[d] = cands(k, d);
             ids.push_back(std::move(id));
         }
-        return RjFrame(img, std::move(fg), std::move(ids), prm_);
+        std::vector<std::array<double, 4>> dets;
+        for (Index k = 0; k < cands.rows(); ++k)
+            dets.push_back({cands(k, 0), cands(k, 1), cands(k, 2), cands(k, 3)});
+        return RjFrame(img, std::move(fg), std::move(ids), prm_, std::move(dets));
     }
 
     /// The chain's start: every identity with existence >= 1/2 at its mean prediction.

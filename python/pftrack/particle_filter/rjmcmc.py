@@ -53,6 +53,12 @@ class RJMCMCConfig:
         Spread of a newborn's prior around its candidate box (pixels, scale).
     birth_eps : float
         ``eps`` added to every birth weight.
+    birth_gate : float
+        A candidate whose box overlaps the predicted box of an identity with existence >= 1/2 by
+        IoU >= this gets no newborn slot: it is that identity's detection (> 1: no gate).
+    detection : float
+        ``delta``: each object's target gains ``delta`` times its best IoU with a candidate box
+        (the detections support the identities they overlap; 0: off).
     min_existence : float
         ``step`` reports identities whose existence probability is at least this.
     """
@@ -78,6 +84,8 @@ class RJMCMCConfig:
     birth_sigma_xy: float = 3.0
     birth_sigma_s: float = 0.05
     birth_eps: float = 0.02
+    birth_gate: float = 0.1
+    detection: float = 20.0
     min_existence: float = 0.5
 
     def core_kwargs(self) -> dict[str, Any]:
@@ -85,7 +93,7 @@ class RJMCMCConfig:
         out = {k: getattr(self, k) for k in (
             "burn_in", "n_samples", "p_birth", "p_death", "p_update", "p_swap", "s_min", "s_max",
             "lam", "kernel", "interaction", "coverage", "background_penalty", "birth_prior", "survival",
-            "birth_sigma_xy", "birth_sigma_s", "birth_eps")}
+            "birth_sigma_xy", "birth_sigma_s", "birth_eps", "birth_gate", "detection")}
         for k in ("a", "b", "sigma"):
             out[k] = np.asarray(getattr(self, k), dtype=np.float64)
         return out
