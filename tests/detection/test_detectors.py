@@ -215,3 +215,18 @@ def test_group_split():
         det.prime([bg])
         d = det.detect(f)
         np.testing.assert_allclose(d.boxes, want, atol=3.0)  # parts keep the hands in the gaps
+
+
+def test_group_split_drops_slivers():
+    """A wide blob whose cut leaves a part below min_area gives no box for that part."""
+    bg = textured_background(seed=4)
+    f = bg.copy()
+    f[30:90, 40:60] = (0, 0, 255)  # a 20 x 60 person
+    f[84:90, 60:80] = (0, 0, 255)  # a low 20 x 6 strip joined at the feet: cut off as a part
+    det = make_detector("paper", person_aspect=2.8, min_area=0.01)
+    det.prime([bg])
+    boxes = det.detect(f).boxes
+    frame_area = bg.shape[0] * bg.shape[1]
+    assert len(boxes) == 1, boxes
+    assert boxes[0][2] * boxes[0][3] >= 0.01 * frame_area
+    np.testing.assert_allclose(boxes[0][:2], [40, 30], atol=3.0)

@@ -194,8 +194,13 @@ class BlobExtractor:
     def _split_groups(
         self, mask: NDArray[np.uint8], rects: NDArray[np.float64], fill: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Cut blobs wider than 1.5 objects at the minima of their column profile."""
+        """Cut blobs wider than 1.5 objects at the minima of their column profile.
+
+        A part must pass the blob filters' ``min_area`` (foreground pixels) too: a sliver cut
+        off a large blob is not a person.
+        """
         pa = self.config.person_aspect
+        min_pixels = self.config.min_area * mask.shape[0] * mask.shape[1]
         out_r: list[NDArray[np.float64]] = []
         out_f: list[float] = []
         for r, f in zip(rects, fill):
@@ -218,7 +223,7 @@ class BlobExtractor:
                 part = roi[:, a:b]
                 rows = np.flatnonzero(part.any(axis=1))
                 cols = np.flatnonzero(part.any(axis=0))
-                if len(rows) == 0:
+                if len(rows) == 0 or part.sum() < min_pixels:
                     continue
                 pw, ph = cols[-1] - cols[0] + 1, rows[-1] - rows[0] + 1
                 out_r.append(np.array([x + a + cols[0], y + rows[0], pw, ph], np.float64))
