@@ -1,0 +1,243 @@
+"""Principled variants of ``gdt-bi`` on the paper's mask protocol (an exploration, not a test).
+
+Reproduces the table "Variants tried" of docs/recovery.md: the median over mask positions of
+the MMAE total (box centre) of the shipped ``gdt-bi`` and of variants whose parameters are all
+estimated from observed points, never chosen on the lost ones:
+
+* ``per-gap noise``: ``q, r`` estimated by maximum likelihood from the two segments of each gap
+  instead of from every observed point of the sequence;
+* ``history H``: the end-state filters use only the last/first ``H`` points;
+* ``iou tau=K``: velocity as an Ornstein-Uhlenbeck process of time constant ``K`` frames
+  (``dv = -v/K dt + sqrt(q) dW``; ``K -> inf`` is the white-noise-acceleration model of
+  ``gdt-bi``), ``q, r`` re-estimated by maximum likelihood for each ``K``, fixed-interval
+  (RTS) smoother over both segments and the gap;
+* ``bma over tau``: per gap and axis, Bayesian model average of the ``iou`` smoothers
+  (``K`` in {inf, 40, 20, 10, 5}) weighted by the Kalman likelihood of the gap's window.
+
+For the ``iou`` variants ``q, r`` are fitted once per sequence on the points observed around
+the representative mask (the fit is cheap in C++ for ``gdt-bi`` but slow in this NumPy
+exploration), so they see nothing inside that mask.
+
+Run (about 3 minutes on one core)::
+
+    python bench/recovery_variants.py --data ../shared/data
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.linalg import expm
+from scipy.optimize import minimize
+
+from pftrack.io.mot import read_mot
+from pftrack.recovery import experiment as E
+from pftrack.recovery.methods import estimate_noise, recover_gaps
+
+F64 = NDArray[np.float64]
+_BIG = 1e4  # prior variance of the unknown initial position and velocity
+
+
+def iou_model(q: float, tau: float) -> tuple[F64, F64]:
+    """One-frame transition and noise of ``(p, v)`` with ``dv = -v/tau dt + sqrt(q) dW``.
+
+    Van Loan's matrix exponential, so ``tau = inf`` gives the white-noise-acceleration model.
+    """
+    Fc = np.array([[0.0, 1.0], [0.0, 0.0 if np.isinf(tau) else -1.0 / tau]])
+    M = np.zeros((4, 4))
+    M[:2, :2] = -Fc
+    M[1, 3] = q
+    M[2:, 2:] = Fc.T
+    V = expm(M)
+    F = V[2:, 2:].T
+    Q = F @ V[:2, 2:]
+    return F, 0.5 * (Q + Q.T)
+
+
+def _loglik(F: F64, Q: F64, r: float, Z: F64, mask: NDArray[np.bool_]) -> float:
+    """Kalman prediction-error log-likelihood of many runs (rows of Z), first 2 points given."""
+    n_runs = Z.shape[0]
+    m = np.zeros((n_runs, 2))
+    m[:, 0] = Z[:, 0]
+    P = np.broadcast_to(np.diag([_BIG, _BIG]), (n_runs, 2, 2)).copy()
+    ll = 0.0
+    for t in range(Z.shape[1]):
+        if t > 0:
+            m = m @ F.T
+            P = F @ P @ F.T + Q
+        S = P[:, 0, 0] + r
+        v = Z[:, t] - m[:, 0]
+        K = P[:, :, 0] / S[:, None]
+        ok = mask[:, t]
+        m = np.where(ok[:, None], m + K * v[:, None], m)
+        P = np.where(ok[:, None, None], P - K[:, :, None] * P[:, 0, None, :], P)
+        if t >= 2:
+            ll -= 0.5 * float(np.sum((np.log(S) + v * v / S)[ok]))
+    return ll
+
+
+def fit_iou(runs: Sequence[F64], axis: int, tau: float) -> tuple[float, float]:
+    """Maximum-likelihood ``(q, r)`` of one axis for a given ``tau`` (Nelder-Mead on logs)."""
+    runs = [r for r in runs if len(r) >= 6]
+    L = max(len(r) for r in runs)
+    Z = np.zeros((len(runs), L))
+    mask = np.zeros((len(runs), L), dtype=bool)
+    for i, r in enumerate(runs):
+        Z[i, : len(r)] = r[:, 1 + axis]
+        mask[i, : len(r)] = True
+
+    def nll(th: F64) -> float:
+        F, Q = iou_model(float(np.exp(th[0])), tau)
+        return -_loglik(F, Q, float(np.exp(th[1])), Z, mask)
+
+    res = minimize(nll, np.log([0.1, 0.1]), method="Nelder-Mead", options={"xatol": 1e-3})
+    return float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+
+
+def smooth_gap(
+    F: F64, Q: F64, r: float, a: F64, b: F64, axis: int, history: int = 60
+) -> tuple[F64, float]:
+    """RTS-smoothed positions inside the gap and the window's Kalman log-likelihood."""
+    a, b = a[-history:], b[:history]
+    f0 = int(a[0, 0])
+    n = int(b[-1, 0]) - f0 + 1
+    z = np.full(n, np.nan)
+    z[(a[:, 0] - f0).astype(int)] = a[:, 1 + axis]
+    z[(b[:, 0] - f0).astype(int)] = b[:, 1 + axis]
+    m = np.array([z[0], 0.0])
+    P = np.diag([_BIG, _BIG])
+    ms, Ps = np.zeros((n, 2)), np.zeros((n, 2, 2))
+    mp, Pp = np.zeros((n, 2)), np.zeros((n, 2, 2))
+    ll, seen = 0.0, 0
+    for t in range(n):
+        if t > 0:
+            m, P = F @ m, F @ P @ F.T + Q
+        mp[t], Pp[t] = m, P
+        if not np.isnan(z[t]):
+            S = P[0, 0] + r
+            v = z[t] - m[0]
+            if seen >= 2:
+                ll -= 0.5 * (np.log(2.0 * np.pi * S) + v * v / S)
+            seen += 1
+            K = P[:, 0] / S
+            m, P = m + K * v, P - np.outer(K, P[0])
+        ms[t], Ps[t] = m, P
+    for t in range(n - 2, -1, -1):
+        C = Ps[t] @ F.T @ np.linalg.inv(Pp[t + 1])
+        ms[t] = ms[t] + C @ (ms[t + 1] - mp[t + 1])
+    fa, fb = int(a[-1, 0]) - f0, int(b[0, 0]) - f0
+    return ms[fa + 1 : fb, 0], ll
+
+
+Variant = Callable[[list[E.Gap], list[F64]], list[F64]]
+
+
+def shipped(history: int | None = None, per_gap: bool = False) -> Variant:
+    def run(gaps: list[E.Gap], runs: list[F64]) -> list[F64]:
+        pairs = [(g.segment_a, g.segment_b) for g in gaps]
+        if per_gap:
+            return [recover_gaps([p], "gdt-bi", history=history)[0] for p in pairs]
+        return recover_gaps(pairs, "gdt-bi", noise=estimate_noise(runs), history=history)
+
+    return run
+
+
+def iou(models: list[list[tuple[F64, F64, float]]]) -> Variant:
+    """One model per axis -> RTS smoother; several -> per-gap likelihood-weighted average."""
+
+    def run(gaps: list[E.Gap], runs: list[F64]) -> list[F64]:
+        out = []
+        for g in gaps:
+            cols = []
+            for axis in range(2):
+                paths, lls = [], []
+                for F, Q, r in models[axis]:
+                    p, ll = smooth_gap(F, Q, r, g.segment_a, g.segment_b, axis)
+                    paths.append(p)
+                    lls.append(ll)
+                w = np.exp(np.array(lls) - max(lls))
+                cols.append(np.sum(w[:, None] * np.array(paths), axis=0) / w.sum())
+            out.append(np.column_stack(cols))
+        return out
+
+    return run
+
+
+def median_mmae(masks: list[tuple[list[E.Gap], list[F64]]], variant: Variant) -> float:
+    per = []
+    for gaps, runs in masks:
+        paths = variant(gaps, runs)
+        per.append(np.mean([np.hypot(*(p - g.truth[:, 1:3]).T).mean() for p, g in zip(paths, gaps)]))
+    return float(np.median(per))
+
+
+def by_length(data: Path) -> None:
+    """Mean error of ``gdt-bi`` and ``linear`` per gap-length bin, all PETS 15/23 masks."""
+    trajs = E.trajectories(read_mot(data / "pets09-s2l1" / "gt.txt"))
+    rows = []
+    for p in E.sweep(trajs, 100, 768, 576, 4, 15, 23).positions:
+        gaps = E.find_gaps(trajs, p)[0]
+        pairs = [(g.segment_a, g.segment_b) for g in gaps]
+        bi = recover_gaps(pairs, "gdt-bi", noise=estimate_noise(E.observed_runs(trajs, p)))
+        lin = recover_gaps(pairs, "linear")
+        for g, pb, pl in zip(gaps, bi, lin):
+            t = g.truth[:, 1:3]
+            rows.append((len(t), np.hypot(*(pb - t).T).mean(), np.hypot(*(pl - t).T).mean()))
+    a = np.array(rows)
+    print(f"{len(a)} gaps; lost frames | gaps | gdt-bi mean | linear mean (px)")
+    for lo, hi in [(1, 10), (10, 20), (20, 30), (30, 1000)]:
+        s = (a[:, 0] >= lo) & (a[:, 0] < hi)
+        print(f"{lo:>4}-{hi - 1:<4}{int(s.sum()):>6}{a[s, 1].mean():>10.3f}{a[s, 2].mean():>10.3f}")
+
+
+def main() -> None:
+    env = os.environ.get("PFTRACK_DATA")
+    default = Path(env) if env else Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--data", type=Path, default=default)
+    ap.add_argument("--max-positions", type=int, default=60, help="for TUD-Campus")
+    ap.add_argument("--by-length", action="store_true", help="PETS: gdt-bi error by gap length")
+    args = ap.parse_args()
+    if args.by_length:
+        by_length(args.data)
+        return
+    setups = [
+        ("pets09-s2l1", (768, 576), {"n_trajectories": 15, "n_gaps": 23}),
+        ("tud-campus", (640, 480), {"min_gaps": 3}),
+    ]
+    taus = [np.inf, 40.0, 20.0, 10.0, 5.0]
+    for name, (w, h), sel in setups:
+        trajs = E.trajectories(read_mot(args.data / name / "gt.txt"))
+        sw = E.sweep(trajs, 100, w, h, 4, **sel)  # type: ignore[arg-type]
+        pos = sw.positions
+        if len(pos) > args.max_positions:
+            pos = pos[np.linspace(0, len(pos) - 1, args.max_positions).round().astype(int)]
+        masks = [(E.find_gaps(trajs, p)[0], E.observed_runs(trajs, p)) for p in pos]
+        fit_runs = E.observed_runs(trajs, sw.representative())
+        per_tau = {}
+        for tau in taus:
+            per_tau[tau] = []
+            for axis in range(2):
+                q, r = fit_iou(fit_runs, axis, tau)
+                F, Q = iou_model(q, tau)
+                per_tau[tau].append((F, Q, r))
+        variants: dict[str, Variant] = {
+            "gdt-bi (shipped)": shipped(),
+            "per-gap noise": shipped(per_gap=True),
+            "history 10": shipped(history=10),
+        }
+        for tau in taus:
+            variants[f"iou tau={tau:g}"] = iou([[per_tau[tau][0]], [per_tau[tau][1]]])
+        variants["bma over tau"] = iou([[per_tau[t][a] for t in taus] for a in range(2)])
+        print(f"{name}: median MMAE total over {len(masks)} positions ({sw.selection})")
+        for label, v in variants.items():
+            print(f"  {label:<20}{median_mmae(masks, v):8.3f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
