@@ -135,3 +135,34 @@ def test_seeded_results_are_reproducible():
     for fn in RESAMPLERS.values():
         np.testing.assert_array_equal(fn(w, rng=42), fn(w, rng=42))
         np.testing.assert_array_equal(fn(w, rng=np.random.default_rng(9)), fn(w, rng=9))
+
+
+@pytest.mark.parametrize(
+    ("n", "kind", "u0"),
+    [
+        (10_000, "random", 0.37),  # blocked-total pass
+        (100_000, "random", 0.37),  # exact-total pass (N too large for the blocked margin)
+        (10_000, "equal", 0.0),  # every threshold on an integer: settled exactly, list overflows
+        (10_000, "equal", 0.5),
+        (4096, "dyadic", 0.25),  # integer weights: thresholds land on integers
+        (5000, "sparse", np.nextafter(1.0, 0.0)),
+    ],
+)
+def test_systematic_matches_reference_at_scale(n, kind, u0):
+    rng = np.random.default_rng(n)
+    w = {
+        "random": lambda: rng.random(n),
+        "equal": lambda: np.ones(n),
+        "dyadic": lambda: rng.integers(0, 4, n).astype(float),
+        "sparse": lambda: rng.random(n) * (rng.random(n) < 0.1),
+    }[kind]()
+    np.testing.assert_array_equal(_core.systematic_resample(w, u0), ref.systematic_resample(w, u0))
+
+
+def test_unseeded_generator_is_shared_and_seeded_calls_are_not():
+    from pftrack.particle_filter import resample as rs
+
+    g = np.random.default_rng(3)
+    assert rs._generator(g) is g
+    assert rs._generator(None) is rs._generator(None)
+    assert rs._generator(5).random() == np.random.default_rng(5).random()
