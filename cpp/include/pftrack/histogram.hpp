@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "likelihood.hpp"
 #include "types.hpp"
 
 namespace pftrack {
@@ -78,6 +79,24 @@ public:
     }
     /// Per-bin counts of the last count_box (n_bins values).
     const std::int32_t* counts() const { return counts_.data() + 1; }
+
+    /// Bhattacharyya coefficient of one box's normalised histogram with the reference whose
+    /// square roots are `sqrt_ref`, without writing the histogram out. For the uniform kernel
+    /// straight from the integer counts: rho = sum_k sqrt(c_k) sqrt(q_k) / sqrt(n). `counted`
+    /// gets the counted weight (pixels, for the uniform kernel); an empty box has rho = 0.
+    double coefficient(const BinImage& img, double cx, double cy, double w, double h, Kernel kernel,
+                       const double* sqrt_ref, double& counted) {
+        if (kernel == Kernel::kUniform) {
+            const std::int64_t total = count_box(img, cx, cy, w, h);
+            counted = static_cast<double>(total);
+            return total > 0 ? sqrt_count_dot(counts(), sqrt_ref, n_bins_) /
+                                   std::sqrt(static_cast<double>(total))
+                             : 0.0;
+        }
+        hist_.resize(static_cast<size_t>(n_bins_));
+        counted = compute(img, cx, cy, w, h, kernel, hist_.data());
+        return bhattacharyya_coefficient_row(hist_.data(), sqrt_ref, n_bins_);
+    }
 
 private:
     std::int64_t count(const BinImage& img, const PixelRange& r) {
@@ -149,6 +168,7 @@ private:
     std::vector<std::int32_t> counts_;
     std::vector<double> weights_;
     std::vector<double> rowk_;
+    std::vector<double> hist_;
 };
 
 inline void check_bin_image(const BinImage& img, const char* fn) {
@@ -181,6 +201,20 @@ inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<D
         scratch.compute(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
                         out.row(i).data());
     return out;
+}
+
+/// Bhattacharyya coefficients (K,) of K boxes' histograms against a reference, fused: no
+/// (K, B) histogram matrix is made. `sqrt_ref` = sqrt(ref / sum(ref)) (sqrt_reference).
+template <class Derived>
+inline Eigen::VectorXd box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                                        const Eigen::VectorXd& sqrt_ref, Kernel kernel) {
+    Eigen::VectorXd rho(boxes.rows());
+    HistogramScratch scratch(img.n_bins);
+    double counted = 0.0;
+    for (Index i = 0; i < boxes.rows(); ++i)
+        rho(i) = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
+                                     sqrt_ref.data(), counted);
+    return rho;
 }
 
 }  // namespace pftrack
