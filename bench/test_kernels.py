@@ -57,6 +57,15 @@ def test_histograms_weights_core(benchmark, case):
     np.testing.assert_allclose(w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300)
 
 
+def test_histograms_weights_core_fused(benchmark, case):
+    """The same weights from one call that never builds the (K, B) histogram matrix."""
+    name, image, boxes, ref, pixels = case
+    benchmark.group = f"histograms+weights {name}"
+    benchmark.extra_info["pixels"] = pixels
+    w = benchmark(_core.box_weights, image, boxes, ref, 20.0)
+    np.testing.assert_allclose(w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300)
+
+
 def test_histograms_weights_numpy(benchmark, case):
     name, image, boxes, ref, pixels = case
     benchmark.group = f"histograms+weights {name}"
