@@ -43,12 +43,16 @@ inline bool box_is_sane(double cx, double cy, double w, double h) {
 }
 
 /// Scratch space for one histogram. Slot 0 collects background (bin -1) so the inner loop never
-/// branches; four interleaved copies break the store-to-load dependency of runs of equal bins.
+/// branches; kCopies interleaved copies break the store-to-load dependency of runs of equal bins.
 class HistogramScratch {
 public:
+    // Interleaved copies of the counts: neighbouring pixels often share a bin (59% of pixels in
+    // 20x50 PETS boxes equal the one 4 to the left), and ++c[b] on one copy waits for the
+    // previous increment's store. 8 copies measured 5-15% faster than 4 on PETS frames.
+    static constexpr int kCopies = 8;
     explicit HistogramScratch(int n_bins)
-        : n_bins_(n_bins), stride_(n_bins + 1), counts_(4 * static_cast<size_t>(stride_)),
-          weights_(4 * static_cast<size_t>(stride_)) {}
+        : n_bins_(n_bins), stride_(n_bins + 1), counts_(kCopies * static_cast<size_t>(stride_)),
+          weights_(4 * static_cast<size_t>(stride_)), hist_(static_cast<size_t>(n_bins)) {}
 
     /// Writes the normalised histogram of one box to `out` (n_bins values).
     /// Returns the total counted weight (0 for an empty box).
@@ -89,37 +93,62 @@ public:
         if (kernel == Kernel::kUniform) {
             const std::int64_t total = count_box(img, cx, cy, w, h);
             counted = static_cast<double>(total);
-            return total > 0 ? sqrt_count_dot(counts(), sqrt_ref, n_bins_) /
-                                   std::sqrt(static_cast<double>(total))
-                             : 0.0;
+            if (total == 0) return 0.0;
+            const double norm = std::sqrt(static_cast<double>(total));
+            if (total >= kSqrtTableMax) return sqrt_count_dot(counts(), sqrt_ref, n_bins_) / norm;
+            // every count is <= total: look the square roots up (same values as std::sqrt)
+            const double* tab = sqrt_table(static_cast<size_t>(total));
+            const std::int32_t* c = counts();
+            double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+            int k = 0;
+            for (; k + 4 <= n_bins_; k += 4) {
+                r0 += tab[c[k]] * sqrt_ref[k];
+                r1 += tab[c[k + 1]] * sqrt_ref[k + 1];
+                r2 += tab[c[k + 2]] * sqrt_ref[k + 2];
+                r3 += tab[c[k + 3]] * sqrt_ref[k + 3];
+            }
+            for (; k < n_bins_; ++k) r0 += tab[c[k]] * sqrt_ref[k];
+            return ((r0 + r1) + (r2 + r3)) / norm;
         }
-        hist_.resize(static_cast<size_t>(n_bins_));
         counted = compute(img, cx, cy, w, h, kernel, hist_.data());
         return bhattacharyya_coefficient_row(hist_.data(), sqrt_ref, n_bins_);
     }
 
 private:
+    // Boxes of fewer pixels look sqrt(count) up in a table (110 square roots per box cost as
+    // much as counting a 20x50 box's pixels); larger boxes compute them.
+    static constexpr std::int64_t kSqrtTableMax = std::int64_t(1) << 16;
+
+    /// sqrt(0 .. at_least), grown on demand (each entry exactly std::sqrt of its index).
+    const double* sqrt_table(size_t at_least) {
+        if (sqrt_counts_.size() <= at_least) {
+            const size_t old = sqrt_counts_.size();
+            sqrt_counts_.resize(std::max(at_least + 1, 2 * old));
+            for (size_t i = old; i < sqrt_counts_.size(); ++i)
+                sqrt_counts_[i] = std::sqrt(static_cast<double>(i));
+        }
+        return sqrt_counts_.data();
+    }
+
     std::int64_t count(const BinImage& img, const PixelRange& r) {
         std::fill(counts_.begin(), counts_.end(), 0);
-        std::int32_t* c0 = counts_.data() + 1;  // +1: bin -1 lands in slot 0
-        std::int32_t* c1 = c0 + stride_;
-        std::int32_t* c2 = c1 + stride_;
-        std::int32_t* c3 = c2 + stride_;
+        std::int32_t* c[kCopies];
+        for (int q = 0; q < kCopies; ++q) c[q] = counts_.data() + 1 + q * stride_;  // +1: bin -1
+        const Index w = r.x1 - r.x0;
         for (Index y = r.y0; y < r.y1; ++y) {
-            const std::int16_t* b = img.row(y);
-            Index x = r.x0;
-            for (; x + 4 <= r.x1; x += 4) {
-                ++c0[b[x]];
-                ++c1[b[x + 1]];
-                ++c2[b[x + 2]];
-                ++c3[b[x + 3]];
-            }
-            for (; x < r.x1; ++x) ++c0[b[x]];
+            const std::int16_t* b = img.row(y) + r.x0;
+            Index x = 0;
+            for (; x + kCopies <= w; x += kCopies)
+                for (int q = 0; q < kCopies; ++q) ++c[q][b[x + q]];
+            for (int q = 0; x < w; ++x, ++q) ++c[q][b[x]];
         }
         std::int64_t total = 0;
+        std::int32_t* c0 = c[0];
         for (int k = 0; k < n_bins_; ++k) {
-            c0[k] += c1[k] + c2[k] + c3[k];
-            total += c0[k];
+            std::int32_t s = c0[k];
+            for (int q = 1; q < kCopies; ++q) s += c[q][k];
+            c0[k] = s;
+            total += s;
         }
         return total;
     }
@@ -169,6 +198,7 @@ private:
     std::vector<double> weights_;
     std::vector<double> rowk_;
     std::vector<double> hist_;
+    std::vector<double> sqrt_counts_;
 };
 
 inline void check_bin_image(const BinImage& img, const char* fn) {
