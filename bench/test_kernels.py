@@ -103,6 +103,15 @@ def test_resample_core(benchmark, weights_10k):
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
+def test_resample_python_api(benchmark, weights_10k):
+    """The public function with a Generator: a new offset each call, Python checks included."""
+    from pftrack.particle_filter import systematic_resample
+
+    rng = np.random.default_rng(4)
+    benchmark(systematic_resample, weights_10k, rng)
+
+
+@pytest.mark.benchmark(group="systematic resample N=10000")
 def test_resample_numpy(benchmark, weights_10k):
     benchmark(npb.systematic_resample, weights_10k, 0.37)
 

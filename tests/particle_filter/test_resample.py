@@ -140,8 +140,10 @@ def test_seeded_results_are_reproducible():
 @pytest.mark.parametrize(
     ("n", "kind", "u0"),
     [
-        (10_000, "random", 0.37),  # blocked-total pass
-        (100_000, "random", 0.37),  # exact-total pass (N too large for the blocked margin)
+        (10_000, "random", 0.37),  # quarters on estimated sums
+        (60_000, "random", 0.9),  # still quarters, widest margin
+        (100_000, "random", 0.37),  # exact-total pass (N too large for the estimated margin)
+        (1001, "zero runs", 0.6),  # quarters whose stores meet at one position
         (10_000, "equal", 0.0),  # every threshold on an integer: settled exactly, list overflows
         (10_000, "equal", 0.5),
         (4096, "dyadic", 0.25),  # integer weights: thresholds land on integers
@@ -155,6 +157,7 @@ def test_systematic_matches_reference_at_scale(n, kind, u0):
         "equal": lambda: np.ones(n),
         "dyadic": lambda: rng.integers(0, 4, n).astype(float),
         "sparse": lambda: rng.random(n) * (rng.random(n) < 0.1),
+        "zero runs": lambda: np.r_[rng.random(300), np.zeros(400), rng.random(1), np.zeros(300)],
     }[kind]()
     np.testing.assert_array_equal(_core.systematic_resample(w, u0), ref.systematic_resample(w, u0))
 

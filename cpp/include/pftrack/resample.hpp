@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -86,110 +87,183 @@ inline void merge_positions(const double* cdf, Index n_cdf, Index n_out, Positio
 /// position at or above it at k (0 where none). The firsts are ordered like the cdf, so the
 /// nonzero entries increase with k. Then idx_i = #{j < N-1 : cdf[j] <= p_i}
 /// = max_{k <= i} idx[k], which is numpy.searchsorted(cdf, p_i, side="right") clamped to N-1.
-/// A branch-free running maximum: no data-dependent branch, no read-modify-write chain.
+/// The nonzero entries increase with k, so the running maximum is "the last nonzero entry",
+/// selected with a mask: a compare-and-branch would mispredict on about half the entries (the
+/// branch predictor only hides this when the very same input is resampled again and again).
 inline void firsts_to_indices(int* idx, Index n) {
-    int run = 0;
+    std::uint32_t run = 0;
     for (Index i = 0; i < n; ++i) {
-        const int v = idx[i];
-        run += (v - run) & -static_cast<int>(v > run);
-        idx[i] = run;
+        const auto v = static_cast<std::uint32_t>(idx[i]);
+        const std::uint32_t keep = 0u - static_cast<std::uint32_t>(v == 0);  // all ones if v == 0
+        run = v | (run & keep);
+        idx[i] = static_cast<int>(run);
     }
 }
 
-/// Sum of x_0 .. x_{n-1} in four interleaved partial sums (fast; within ~(n/4 + 2) eps of the
-/// sequential sum's value, relatively, for x >= 0), and min(0, x_i) in `lowest`. A NaN or
-/// infinite x makes the sum non-finite.
-PFTRACK_NOINLINE inline double blocked_sum(const double* x, Index n, double& lowest) {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    double l0 = 0.0, l1 = 0.0, l2 = 0.0, l3 = 0.0;
-    Index i = 0;
-    for (; i + 4 <= n; i += 4) {
-        s0 += x[i];
-        s1 += x[i + 1];
-        s2 += x[i + 2];
-        s3 += x[i + 3];
-        l0 = std::min(l0, x[i]);
-        l1 = std::min(l1, x[i + 1]);
-        l2 = std::min(l2, x[i + 2]);
-        l3 = std::min(l3, x[i + 3]);
+/// The first position p_k = (k + u0) / N at or above cdf[j] = acc / total is k = ceil(t),
+/// t = N acc / total - u0 > -1, unless t lies within `margin` of an integer. Returns false in
+/// that case (the caller settles it exactly); else sets k (k = N: no position reaches cdf[j]).
+struct FirstPosition {
+    double scale;       // N / total (or an estimate of it)
+    double u1;          // u0 - 1: t + 1 in one subtraction
+    double half_width;  // 0.5 - margin
+    bool operator()(double acc, Index& k) const {
+        const double t1 = acc * scale - u1;               // t + 1 > 0
+        k = static_cast<Index>(t1);                       // floor(t + 1) = ceil(t) off integers
+        const double frac = t1 - static_cast<double>(k);  // in [0, 1)
+        return std::abs(frac - 0.5) < half_width;
     }
-    for (; i < n; ++i) {
-        s0 += x[i];
-        l0 = std::min(l0, x[i]);
-    }
-    lowest = std::min(std::min(l0, l1), std::min(l2, l3));
-    return (s0 + s1) + (s2 + s3);
-}
+};
 
-/// The counting pass of systematic_resample: for each j < N-1 stores j + 1 at idx[K_j], where
-/// K_j = #{i : p_i < cdf[j]} is the first position p_i = (i + u0) / N at or above
-/// cdf[j] = acc[j] / total, acc the running sum of x (K_j = N: none, nothing stored). `idx` holds
-/// N zeros on entry; `x` is contiguous (Eigen::Ref<const VectorXd> has unit inner stride).
-///
-/// K_j = ceil(t_j), t_j = acc[j] * N / total - u0, except within round-off of an integer, where
-/// exact comparisons of p_i with cdf[j] settle it. `scale_total` is `total` (kKnown) or an
-/// estimate of it whose error `margin` covers; then the exact comparisons, which need the exact
-/// total (the running sum's last value), wait in a short list until the end of the pass.
-/// Returns false (and leaves `idx` dirty) if that list overflows.
-template <bool kKnown>
-PFTRACK_NOINLINE bool systematic_firsts(const double* x, Index n, double scale_total, double u0,
-                                        double margin, int* idx) {
-    constexpr int kMaxDeferred = 64;
-    Index deferred_j[kMaxDeferred];
-    double deferred_acc[kMaxDeferred];
-    int n_deferred = 0;
+/// Exact first position at or above cdf[j] = acc / total by comparing p_k with it (what
+/// numpy.searchsorted does), starting from the estimate `guess`; stores j + 1 there (max with
+/// what is there: the store order is then free).
+inline void settle_first(Index j, double acc, double total, double u0, Index guess, Index n,
+                         int* idx) {
     const double dn = static_cast<double>(n);
-    const double scale = dn / scale_total;  // finite: checked by the caller
-    const double half_width = 0.5 - margin;
-    const double u1 = u0 - 1.0;  // t + 1 in one subtraction
-    const auto settle = [&](Index j, double acc, double total) {
-        const double c = acc / total;  // the reference's cdf[j]
-        const auto p = [&](Index i) { return (static_cast<double>(i) + u0) / dn; };
-        Index k = std::min<Index>(static_cast<Index>(std::max(acc * scale - u1, 0.0)), n);
-        while (k > 0 && p(k - 1) >= c) --k;
-        while (k < n && p(k) < c) ++k;
-        if (k < n) idx[k] = std::max(idx[k], static_cast<int>(j + 1));
-    };
+    const double c = acc / total;  // the reference's cdf[j]
+    const auto p = [&](Index i) { return (static_cast<double>(i) + u0) / dn; };
+    Index k = std::min<Index>(std::max<Index>(guess, 0), n);
+    while (k > 0 && p(k - 1) >= c) --k;
+    while (k < n && p(k) < c) ++k;
+    if (k < n) idx[k] = std::max(idx[k], static_cast<int>(j + 1));
+}
+
+/// The counting pass of systematic_resample with the exact total: for each j < N-1 stores j + 1
+/// at idx[K_j], K_j = #{i : p_i < cdf[j]} the first position p_i = (i + u0) / N at or above
+/// cdf[j] = acc[j] / total, acc the running sum of x (K_j = N: none, nothing stored). The
+/// stores go in order of j, so each idx[k] ends with the largest j. `idx` holds N zeros on entry;
+/// `x` is contiguous (Eigen::Ref<const VectorXd> has unit inner stride).
+PFTRACK_NOINLINE inline void systematic_firsts_exact(const double* x, Index n, double total,
+                                                     double u0, double margin, int* idx) {
+    const FirstPosition first{static_cast<double>(n) / total, u0 - 1.0, 0.5 - margin};
     double acc = 0.0;
     for (Index j = 0; j + 1 < n; ++j) {
         acc += x[j];  // the same running sum, in the same order, as numpy.cumsum
-        // real threshold: p_k >= cdf[j]  <=>  k >= t = N acc / total - u0, and t > -1
-        const double t1 = acc * scale - u1;               // t + 1 > 0
-        const Index k = static_cast<Index>(t1);           // floor(t + 1) = ceil(t) off integers
-        const double frac = t1 - static_cast<double>(k);  // in [0, 1)
-        if (!(std::abs(frac - 0.5) < half_width)) {       // rare: settle it exactly
-            if (kKnown) {
-                settle(j, acc, scale_total);
-            } else {
-                if (n_deferred == kMaxDeferred) return false;
-                deferred_j[n_deferred] = j;
-                deferred_acc[n_deferred++] = acc;
-            }
+        Index k;
+        if (!first(acc, k))
+            settle_first(j, acc, total, u0, k, n, idx);  // rare: within round-off of an integer
+        else if (k < n)
+            idx[k] = static_cast<int>(j + 1);
+    }
+}
+
+/// The same counting pass without first paying for the exact total (a sequential sum, bound by
+/// the add latency): the j < N-1 are split into four quarters run side by side, each with its
+/// own running sum started from `offsets` (sums of the earlier quarters), and `total` is an
+/// estimate. Sums of non-negative terms in any order are within gamma_N = N eps/(1 - N eps) of
+/// the exact value, so t moves by at most ~4 eps N (N + 1), which `margin` covers; the rare j
+/// near an integer wait in a short list for one exact sequential pass at the end. Returns false
+/// if that list overflows (the caller redoes it all with the exact total).
+PFTRACK_NOINLINE inline bool systematic_firsts_split(const double* x, Index n, Index quarter,
+                                                     const double* offsets, double total,
+                                                     double u0, double margin, int* idx) {
+    constexpr int kMaxDeferred = 64;
+    Index deferred[kMaxDeferred];
+    int n_deferred = 0;
+    const FirstPosition first{static_cast<double>(n) / total, u0 - 1.0, 0.5 - margin};
+    const auto step = [&](Index j, double acc) {
+        Index k;
+        if (!first(acc, k)) {
+            if (n_deferred == kMaxDeferred) return false;
+            deferred[n_deferred++] = j;
         } else if (k < n) {
             idx[k] = static_cast<int>(j + 1);
         }
+        return true;
+    };
+    const Index L = quarter;
+    double a0 = offsets[0], a1 = offsets[1], a2 = offsets[2], a3 = offsets[3];
+    bool ok = true;
+    for (Index m = 0; m < L; ++m) {
+        a0 += x[m];
+        a1 += x[L + m];
+        a2 += x[2 * L + m];
+        a3 += x[3 * L + m];
+        ok &= step(m, a0);
+        ok &= step(L + m, a1);
+        ok &= step(2 * L + m, a2);
+        ok &= step(3 * L + m, a3);
     }
-    if (!kKnown) {
-        const double total = acc + x[n - 1];  // the sequential total
-        // |t' - t| <= (N + 1)(|total / scale_total - 1| + 3 eps), plus the comparison's own
-        // round-off 6 eps (N + 3): the margin must cover twice that, or the pass is redone.
-        constexpr double kEps = std::numeric_limits<double>::epsilon();
-        const double dev = (dn + 1.0) * (std::abs(total / scale_total - 1.0) + 3.0 * kEps) +
-                           6.0 * kEps * (dn + 3.0);
-        if (!(2.0 * dev <= margin)) return false;
-        for (int d = 0; d < n_deferred; ++d) settle(deferred_j[d], deferred_acc[d], total);
+    for (Index j = 4 * L; j + 1 < n; ++j) {  // the last quarter's tail, after everything else
+        a3 += x[j];
+        ok &= step(j, a3);
+    }
+    if (!ok) return false;
+    // Quarters ran side by side, so at the one position where quarter q's first store and an
+    // earlier quarter's last stores can meet, the earlier (smaller) j may have landed last:
+    // put back quarter q's largest j for its first position.
+    for (int q = 1; q < 4; ++q) {
+        double acc = offsets[q];
+        Index kf = -1;
+        int v = 0;
+        for (Index j = q * L; j < (q + 1) * L; ++j) {
+            acc += x[j];
+            Index k;
+            if (!first(acc, k)) continue;  // deferred: settled below
+            if (k >= n || (kf >= 0 && k != kf)) break;
+            kf = k;
+            v = static_cast<int>(j + 1);
+        }
+        if (kf >= 0) idx[kf] = std::max(idx[kf], v);
+    }
+    if (n_deferred > 0) {  // exact running sums and total, in numpy.cumsum's order
+        std::sort(deferred, deferred + n_deferred);
+        double acc = 0.0;
+        double exact[kMaxDeferred];
+        int d = 0;
+        for (Index j = 0; j < n; ++j) {
+            acc += x[j];
+            while (d < n_deferred && deferred[d] == j) exact[d++] = acc;
+        }
+        const double scale = static_cast<double>(n) / acc;
+        for (d = 0; d < n_deferred; ++d)
+            settle_first(deferred[d], exact[d], acc, u0,
+                         static_cast<Index>(std::max(exact[d] * scale - u0, 0.0)), n, idx);
     }
     return true;
+}
+
+/// Sums of the four quarters [qL, (q+1)L) of x (L = quarter), each in its own running sum, and
+/// of the rest; min(0, x_i) in `lowest`. A NaN or infinite x makes a sum non-finite.
+PFTRACK_NOINLINE inline double quarter_sums(const double* x, Index n, Index quarter, double* sums,
+                                            double& lowest) {
+    const Index L = quarter;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    double l0 = 0.0, l1 = 0.0, l2 = 0.0, l3 = 0.0;
+    for (Index m = 0; m < L; ++m) {
+        s0 += x[m];
+        s1 += x[L + m];
+        s2 += x[2 * L + m];
+        s3 += x[3 * L + m];
+        l0 = std::min(l0, x[m]);
+        l1 = std::min(l1, x[L + m]);
+        l2 = std::min(l2, x[2 * L + m]);
+        l3 = std::min(l3, x[3 * L + m]);
+    }
+    double rest = 0.0;
+    for (Index j = 4 * L; j < n; ++j) {
+        rest += x[j];
+        l0 = std::min(l0, x[j]);
+    }
+    sums[0] = s0;
+    sums[1] = s1;
+    sums[2] = s2;
+    sums[3] = s3;
+    lowest = std::min(std::min(l0, l1), std::min(l2, l3));
+    return ((s0 + s1) + (s2 + s3)) + rest;
 }
 
 /// Systematic resampling (Kitagawa 1996): positions p_i = (i + u0) / N with one draw u0 in
 /// [0, 1); index i is the first j with p_i < cdf[j], cdf[j] = acc[j] / acc[N-1] with acc the
 /// running sum of the weights and cdf[N-1] = 1, clamped to N-1. The same result as
-/// numpy.searchsorted(cdf, p, side="right") (and filterpy's loop), computed without a
-/// data-dependent branch per particle (see systematic_firsts). The exact total, the running
-/// sum's last value, is only known at the end of that pass, so for N up to ~40 000 the pass runs on
-/// a fast blocked estimate of it (with a margin for the difference) instead of first paying a
-/// second add-latency-bound pass; larger N, or a failed check, use the exact total.
+/// numpy.searchsorted(cdf, p, side="right") (and filterpy's loop), in O(N) without a
+/// data-dependent branch per particle: the first position at or above cdf[j] is
+/// ceil(N cdf[j] - u0), estimated with a multiply and settled by exact comparisons of p_i with
+/// cdf[j] only when the estimate lies within round-off of an integer (practically never). Up to
+/// N ~ 65 000 the pass runs in four independent quarters on estimated sums
+/// (systematic_firsts_split); larger N (whose margin would be too wide), or a list overflow,
+/// take the exact sequential total first (systematic_firsts_exact).
 inline IndexVector systematic_resample(const Eigen::Ref<const Eigen::VectorXd>& weights, double u0) {
     const char* fn = "systematic_resample";
     constexpr double kEps = std::numeric_limits<double>::epsilon();
@@ -202,17 +276,22 @@ inline IndexVector systematic_resample(const Eigen::Ref<const Eigen::VectorXd>& 
     const double dn = static_cast<double>(n);
     IndexVector idx = IndexVector::Zero(n);
     // ceil(t) is exact at >= 6 eps (N + 3) from integers (three roundings on each side of
-    // p_k >= cdf[j]); a blocked total adds <= (N + 1)(1.25 N + 5) eps. Margins: 2.5x and 2x.
+    // p_k >= cdf[j]); estimated sums add <= ~4 eps N (N + 1). Margins: 2.5x those.
     const double margin_exact = 16.0 * kEps * (dn + 4.0);
-    const double margin_blocked = margin_exact + 2.0 * kEps * (dn + 1.0) * (1.25 * dn + 5.0);
-    double lowest = 0.0;
-    const double blocked = blocked_sum(x, n, lowest);
-    if (lowest >= 0.0 && blocked > 0.0 && dn / blocked <= kMax && margin_blocked < 1e-6) {
-        if (systematic_firsts<false>(x, n, blocked, u0, margin_blocked, idx.data())) {
-            firsts_to_indices(idx.data(), n);
-            return idx;
+    const double margin_split = 10.0 * kEps * (dn + 3.0) * (dn + 3.0);
+    const Index quarter = (n - 1) / 4;
+    if (quarter >= 16 && margin_split < 1e-5) {
+        double sums[4], lowest = 0.0;
+        const double total = quarter_sums(x, n, quarter, sums, lowest);
+        const double offsets[4] = {0.0, sums[0], sums[0] + sums[1], (sums[0] + sums[1]) + sums[2]};
+        if (lowest >= 0.0 && total > 0.0 && dn / total <= kMax) {
+            if (systematic_firsts_split(x, n, quarter, offsets, total, u0, margin_split,
+                                        idx.data())) {
+                firsts_to_indices(idx.data(), n);
+                return idx;
+            }
+            idx.setZero();
         }
-        idx.setZero();
     }
     const double total = checked_sequential_sum(weights, fn);  // throws on bad weights
     if (!(dn / total <= kMax)) {  // subnormal total: plain merge
@@ -221,7 +300,7 @@ inline IndexVector systematic_resample(const Eigen::Ref<const Eigen::VectorXd>& 
                         idx.data());
         return idx;
     }
-    systematic_firsts<true>(x, n, total, u0, margin_exact, idx.data());
+    systematic_firsts_exact(x, n, total, u0, margin_exact, idx.data());
     firsts_to_indices(idx.data(), n);
     return idx;
 }
