@@ -164,7 +164,8 @@ private:
             for (int q = 0; x < w; ++x, ++q) ++c[q][b[x]];
         }
         std::int32_t* out = counts_.data() + 1;
-        for (int k = 0; k < n_bins_; ++k) {
+        const int nb = n_bins_;  // a local: stores through `out` (int32) could alias n_bins_
+        for (int k = 0; k < nb; ++k) {
             T s = c[0][k];
             for (int q = 1; q < kCopies; ++q) s = static_cast<T>(s + c[q][k]);  // <= area: no wrap
             out[k] = static_cast<std::int32_t>(s);
