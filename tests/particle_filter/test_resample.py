@@ -169,3 +169,23 @@ def test_unseeded_generator_is_shared_and_seeded_calls_are_not():
     assert rs._generator(g) is g
     assert rs._generator(None) is rs._generator(None)
     assert rs._generator(5).random() == np.random.default_rng(5).random()
+
+
+@pytest.mark.parametrize("kind", ["random", "equal", "dyadic", "zero runs"])
+@pytest.mark.parametrize("u_kind", ["random", "zero", "top", "eighths"])
+def test_stratified_matches_reference_at_scale(kind, u_kind):
+    rng = np.random.default_rng(17)
+    n = 3000
+    w = {
+        "random": lambda: rng.random(n),
+        "equal": lambda: np.ones(n),
+        "dyadic": lambda: rng.integers(0, 4, n).astype(float),
+        "zero runs": lambda: np.r_[rng.random(1000), np.zeros(1000), rng.random(1000)],
+    }[kind]()
+    u = {
+        "random": lambda: rng.random(n),
+        "zero": lambda: np.zeros(n),
+        "top": lambda: np.full(n, np.nextafter(1.0, 0.0)),
+        "eighths": lambda: rng.integers(0, 8, n) / 8,
+    }[u_kind]()
+    np.testing.assert_array_equal(_core.stratified_resample(w, u), ref.stratified_resample(w, u))

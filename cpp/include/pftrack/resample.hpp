@@ -305,18 +305,58 @@ inline IndexVector systematic_resample(const Eigen::Ref<const Eigen::VectorXd>& 
     return idx;
 }
 
-/// Stratified resampling: positions (i + u_i) / N, one draw per stratum.
+/// The counting pass of stratified_resample (positions p_i = (i + u_i) / N): stores j + 1 at
+/// idx[K_j], K_j the first i with p_i >= cdf[j] = acc[j] / total, for j < N-1 in order. With
+/// t = N acc / total, cdf[j] lies in stratum s = floor(t), so K_j is s or s + 1: s + 1 when
+/// s + u_s < t. Both comparisons (t against the integers, s + u_s against t) are settled by
+/// the estimate unless within `margin` of a tie; then exactly, as numpy.searchsorted compares.
+PFTRACK_NOINLINE inline void stratified_firsts(const double* x, const double* u, Index n,
+                                               double total, double margin, int* idx) {
+    const double dn = static_cast<double>(n);
+    const double scale = dn / total;
+    const auto p = [&](Index i) { return (static_cast<double>(i) + u[i]) / dn; };
+    double acc = 0.0;
+    for (Index j = 0; j + 1 < n; ++j) {
+        acc += x[j];  // numpy.cumsum's order
+        const double t = acc * scale;                    // N cdf[j], >= 0
+        const Index st = static_cast<Index>(t);          // the stratum, off integers
+        const double frac = t - static_cast<double>(st);
+        const Index sc = std::min<Index>(st, n - 1);     // a valid index either way
+        const double d = (static_cast<double>(sc) + u[sc]) - t;  // N (p_s - cdf[j]), estimated
+        Index k = st + (d < 0.0 ? 1 : 0);
+        if (!(std::abs(frac - 0.5) < 0.5 - margin && std::abs(d) > margin && st < n)) {
+            const double c = acc / total;  // rare: settle it exactly
+            k = std::min<Index>(st, n);
+            while (k > 0 && p(k - 1) >= c) --k;
+            while (k < n && p(k) < c) ++k;
+        }
+        if (k < n) idx[k] = static_cast<int>(j + 1);  // K is nondecreasing in j
+    }
+}
+
+/// Stratified resampling: positions (i + u_i) / N, one draw per stratum. The same result as
+/// numpy.searchsorted(cdf, positions, side="right") clamped to N-1, by the counting pass above
+/// (no data-dependent branch per particle) and firsts_to_indices.
 inline IndexVector stratified_resample(const Eigen::Ref<const Eigen::VectorXd>& weights,
                                        const Eigen::Ref<const Eigen::VectorXd>& u) {
     const char* fn = "stratified_resample";
-    const double sum = require_weights(weights, fn);
+    constexpr double kEps = std::numeric_limits<double>::epsilon();
     const Index n = weights.size();
+    const double total = checked_sequential_sum(weights, fn);  // throws on bad weights
+    require(n < std::numeric_limits<int>::max(), fn, "weights size", n, "< 2^31 - 1");
     check_uniforms(u, n, fn);
-    const auto cdf = normalised_cdf(weights, sum);
     const double dn = static_cast<double>(n);
-    IndexVector idx(n);
-    merge_positions(cdf.data(), n, n, [&](Index i) { return (static_cast<double>(i) + u(i)) / dn; },
-                    idx.data());
+    IndexVector idx = IndexVector::Zero(n);
+    if (!(dn / total <= std::numeric_limits<double>::max())) {  // subnormal total: plain merge
+        const auto cdf = normalised_cdf(weights, total);
+        merge_positions(cdf.data(), n, n,
+                        [&](Index i) { return (static_cast<double>(i) + u(i)) / dn; }, idx.data());
+        return idx;
+    }
+    // t is within 3 eps (N + 1) of N acc / total, and each side of p_s >= cdf[j] within one
+    // rounding: ties closer than ~5 eps (N + 2) are settled exactly (margin 3x that).
+    stratified_firsts(weights.data(), u.data(), n, total, 16.0 * kEps * (dn + 4.0), idx.data());
+    firsts_to_indices(idx.data(), n);
     return idx;
 }
 
