@@ -122,6 +122,27 @@ def test_resample_filterpy(benchmark, weights_10k):
     benchmark(mc.systematic_resample, weights_10k)
 
 
+@pytest.fixture(scope="module")
+def uniforms_10k():
+    return np.random.default_rng(5).random(10_000)
+
+
+@pytest.mark.benchmark(group="stratified resample N=10000")
+def test_stratified_core(benchmark, weights_10k, uniforms_10k):
+    benchmark(_core.stratified_resample, weights_10k, uniforms_10k)
+
+
+@pytest.mark.benchmark(group="stratified resample N=10000")
+def test_stratified_numpy(benchmark, weights_10k, uniforms_10k):
+    benchmark(npb.stratified_resample, weights_10k, uniforms_10k)
+
+
+@pytest.mark.benchmark(group="stratified resample N=10000")
+def test_stratified_filterpy(benchmark, weights_10k):
+    mc = pytest.importorskip("filterpy.monte_carlo")
+    benchmark(mc.stratified_resample, weights_10k)
+
+
 @pytest.mark.benchmark(group="sis_step 10 objects x 200 particles, 20x50, 480x360")
 def test_sis_step_10x200(benchmark, frame_480):
     from pftrack.particle_filter import ColourParticleFilter, FilterConfig
