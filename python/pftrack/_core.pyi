@@ -16,7 +16,8 @@ _I32 = NDArray[np.int32]
 class BinnedImage:
     """A frame's colour-bin index per pixel (-1: never counted)."""
 
-    def __init__(self, bins: ArrayLike, n_bins: int) -> None: ...  # bins (H, W) int16 in [-1, n_bins)
+    # bins (H, W) int16, every value in [-1, n_bins)
+    def __init__(self, bins: ArrayLike, n_bins: int) -> None: ...
     @property
     def n_bins(self) -> int: ...
     @property

@@ -7,9 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
 import pftrack
+import pytest
 
 ALLOWLIST = Path(__file__).with_name("stubtest_allowlist.txt")
 
