@@ -40,3 +40,10 @@ def systematic_resample(weights, u0):
     cdf = np.cumsum(weights)
     cdf /= cdf[-1]
     return np.minimum(np.searchsorted(cdf, (np.arange(n) + u0) / n, side="right"), n - 1)
+
+
+def stratified_resample(weights, u):
+    n = len(weights)
+    cdf = np.cumsum(weights)
+    cdf /= cdf[-1]
+    return np.minimum(np.searchsorted(cdf, (np.arange(n) + u) / n, side="right"), n - 1)

@@ -57,6 +57,16 @@ def test_histograms_weights_core(benchmark, case):
     np.testing.assert_allclose(w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300)
 
 
+def test_histograms_weights_core_fused(benchmark, case):
+    """The same weights from one call that never builds the (K, B) histogram matrix."""
+    name, image, boxes, ref, pixels = case
+    benchmark.group = f"histograms+weights {name}"
+    benchmark.extra_info["pixels"] = pixels
+    w = benchmark(_core.box_weights, image, boxes, ref, 20.0)
+    want = npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref)
+    np.testing.assert_allclose(w, want, rtol=1e-8, atol=1e-300)
+
+
 def test_histograms_weights_numpy(benchmark, case):
     name, image, boxes, ref, pixels = case
     benchmark.group = f"histograms+weights {name}"
@@ -94,6 +104,15 @@ def test_resample_core(benchmark, weights_10k):
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
+def test_resample_python_api(benchmark, weights_10k):
+    """The public function with a Generator: a new offset each call, Python checks included."""
+    from pftrack.particle_filter import systematic_resample
+
+    rng = np.random.default_rng(4)
+    benchmark(systematic_resample, weights_10k, rng)
+
+
+@pytest.mark.benchmark(group="systematic resample N=10000")
 def test_resample_numpy(benchmark, weights_10k):
     benchmark(npb.systematic_resample, weights_10k, 0.37)
 
@@ -102,6 +121,27 @@ def test_resample_numpy(benchmark, weights_10k):
 def test_resample_filterpy(benchmark, weights_10k):
     mc = pytest.importorskip("filterpy.monte_carlo")
     benchmark(mc.systematic_resample, weights_10k)
+
+
+@pytest.fixture(scope="module")
+def uniforms_10k():
+    return np.random.default_rng(5).random(10_000)
+
+
+@pytest.mark.benchmark(group="stratified resample N=10000")
+def test_stratified_core(benchmark, weights_10k, uniforms_10k):
+    benchmark(_core.stratified_resample, weights_10k, uniforms_10k)
+
+
+@pytest.mark.benchmark(group="stratified resample N=10000")
+def test_stratified_numpy(benchmark, weights_10k, uniforms_10k):
+    benchmark(npb.stratified_resample, weights_10k, uniforms_10k)
+
+
+@pytest.mark.benchmark(group="stratified resample N=10000")
+def test_stratified_filterpy(benchmark, weights_10k):
+    mc = pytest.importorskip("filterpy.monte_carlo")
+    benchmark(mc.stratified_resample, weights_10k)
 
 
 @pytest.mark.benchmark(group="sis_step 10 objects x 200 particles, 20x50, 480x360")

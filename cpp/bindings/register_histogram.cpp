@@ -10,6 +10,7 @@
 #include "arrays.hpp"
 #include "pftrack/histogram.hpp"
 #include "pftrack/hsv.hpp"
+#include "pftrack/likelihood.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
@@ -93,4 +94,22 @@ void register_histogram(py::module_& m) {
         },
         py::arg("image"), py::arg("boxes"), py::arg("kernel") = "uniform",
         "Normalised histograms (K, B) of boxes (K, 4) = (cx, cy, w, h); empty box -> zero row.");
+
+    m.def(
+        "box_weights",
+        [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes,
+           Eigen::Ref<const Eigen::VectorXd> ref, double lam, const std::string& kernel) {
+            const char* fn = "box_weights";
+            check_boxes(boxes, fn, "boxes");
+            check_lambda(lam, fn);
+            const Kernel k = parse_kernel(kernel, fn);
+            py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
+            require(boxes.rows() > 0, fn, "boxes rows", boxes.rows(), ">= 1");
+            const Eigen::VectorXd sq = sqrt_reference(ref, image.n_bins, fn);
+            return weights_from_rho(box_coefficients(image.view(), boxes, sq, k), lam, fn);
+        },
+        py::arg("image"), py::arg("boxes"), py::arg("ref"), py::arg("lam") = 20.0,
+        py::arg("kernel") = "uniform",
+        "Weights (K,) ~ exp(-lam D^2) of boxes (K, 4) against ref (B,): box_histograms + "
+        "bhattacharyya_weights fused, no (K, B) matrix.");
 }

@@ -97,6 +97,49 @@ def test_box_histograms_match_reference(box_list, kernel, masked):
     assert np.all(np.isclose(sums, 1.0) | (sums == 0.0))
 
 
+@settings(max_examples=60, deadline=None)
+@given(boxes, st.sampled_from(["uniform", "epanechnikov"]), st.booleans(), st.floats(0, 50))
+def test_fused_box_weights_match_reference(box_list, kernel, masked, lam):
+    textured_frame = _frame()
+    mask = None
+    if masked:
+        mask = np.zeros(textured_frame.shape[:2], np.uint8)
+        mask[10:60, 15:70] = 1
+    image = hsv_bins(textured_frame, mask)
+    b = np.array(box_list)
+    r = ref.box_histograms(image.bins, image.n_bins, np.array([[30.0, 25.0, 30.0, 40.0]]))[0] + 1e-3
+    hists = ref.box_histograms(image.bins, image.n_bins, b, kernel)
+    want = ref.bhattacharyya_weights(hists, r, lam)
+    got = _core.box_weights(image, b, r, lam, kernel)
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-300)
+    two_calls = _core.bhattacharyya_weights(box_histograms(image, b, kernel), r, lam)
+    np.testing.assert_allclose(got, two_calls, rtol=1e-9, atol=1e-300)
+
+
+def test_box_weights_bad_input():
+    image = hsv_bins(_frame())
+    r = np.ones(image.n_bins)
+    with pytest.raises(ValueError, match="boxes rows"):
+        _core.box_weights(image, np.zeros((0, 4)), r)
+    with pytest.raises(ValueError, match="ref size"):
+        _core.box_weights(image, np.ones((2, 4)), r[:-1])
+    with pytest.raises(ValueError, match="lambda"):
+        _core.box_weights(image, np.ones((2, 4)), r, -1.0)
+    with pytest.raises(ValueError, match=r"boxes\[1\]"):
+        _core.box_weights(image, np.array([[1.0, 1, 1, 1], [np.nan, 1, 1, 1]]), r)
+    with pytest.raises(ValueError, match="kernel"):
+        _core.box_weights(image, np.ones((2, 4)), r, 20.0, "gauss")
+
+
+def test_bhattacharyya_rejects_bad_histogram_entries():
+    r = np.ones(4)
+    for bad in (-0.5, np.nan, np.inf):
+        h = np.full((3, 4), 0.25)
+        h[2, 1] = bad
+        with pytest.raises(ValueError, match=r"hists\[2, 1\]"):
+            _core.bhattacharyya_coefficient(h, r)
+
+
 def test_empty_box_gives_zero_histogram_and_distance_one(textured_frame):
     image = hsv_bins(textured_frame)
     h = box_histograms(image, [[-500, -500, 20, 50], [40, 30, 0, 0]])

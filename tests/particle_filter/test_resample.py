@@ -135,3 +135,57 @@ def test_seeded_results_are_reproducible():
     for fn in RESAMPLERS.values():
         np.testing.assert_array_equal(fn(w, rng=42), fn(w, rng=42))
         np.testing.assert_array_equal(fn(w, rng=np.random.default_rng(9)), fn(w, rng=9))
+
+
+@pytest.mark.parametrize(
+    ("n", "kind", "u0"),
+    [
+        (10_000, "random", 0.37),  # quarters on estimated sums
+        (60_000, "random", 0.9),  # still quarters, widest margin
+        (100_000, "random", 0.37),  # exact-total pass (N too large for the estimated margin)
+        (1001, "zero runs", 0.6),  # quarters whose stores meet at one position
+        (10_000, "equal", 0.0),  # every threshold on an integer: settled exactly, list overflows
+        (10_000, "equal", 0.5),
+        (4096, "dyadic", 0.25),  # integer weights: thresholds land on integers
+        (5000, "sparse", np.nextafter(1.0, 0.0)),
+    ],
+)
+def test_systematic_matches_reference_at_scale(n, kind, u0):
+    rng = np.random.default_rng(n)
+    w = {
+        "random": lambda: rng.random(n),
+        "equal": lambda: np.ones(n),
+        "dyadic": lambda: rng.integers(0, 4, n).astype(float),
+        "sparse": lambda: rng.random(n) * (rng.random(n) < 0.1),
+        "zero runs": lambda: np.r_[rng.random(300), np.zeros(400), rng.random(1), np.zeros(300)],
+    }[kind]()
+    np.testing.assert_array_equal(_core.systematic_resample(w, u0), ref.systematic_resample(w, u0))
+
+
+def test_unseeded_generator_is_shared_and_seeded_calls_are_not():
+    from pftrack.particle_filter import resample as rs
+
+    g = np.random.default_rng(3)
+    assert rs._generator(g) is g
+    assert rs._generator(None) is rs._generator(None)
+    assert rs._generator(5).random() == np.random.default_rng(5).random()
+
+
+@pytest.mark.parametrize("kind", ["random", "equal", "dyadic", "zero runs"])
+@pytest.mark.parametrize("u_kind", ["random", "zero", "top", "eighths"])
+def test_stratified_matches_reference_at_scale(kind, u_kind):
+    rng = np.random.default_rng(17)
+    n = 3000
+    w = {
+        "random": lambda: rng.random(n),
+        "equal": lambda: np.ones(n),
+        "dyadic": lambda: rng.integers(0, 4, n).astype(float),
+        "zero runs": lambda: np.r_[rng.random(1000), np.zeros(1000), rng.random(1000)],
+    }[kind]()
+    u = {
+        "random": lambda: rng.random(n),
+        "zero": lambda: np.zeros(n),
+        "top": lambda: np.full(n, np.nextafter(1.0, 0.0)),
+        "eighths": lambda: rng.integers(0, 8, n) / 8,
+    }[u_kind]()
+    np.testing.assert_array_equal(_core.stratified_resample(w, u), ref.stratified_resample(w, u))

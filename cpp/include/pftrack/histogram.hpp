@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "likelihood.hpp"
 #include "types.hpp"
 
 namespace pftrack {
@@ -26,12 +27,21 @@ struct PixelRange {
 
 inline Index round_half_up(double v) { return static_cast<Index>(std::floor(v + 0.5)); }
 
+/// floor(v + 1/2) for v + 1/2 clamped to [-2, hi]: the same after clipping to [0, hi - 2], and
+/// without a call to floor (a library call without SSE4.1). NaN lands on -2.
+inline Index round_half_up_clamped(double v, double hi) {
+    const double c = std::min(std::max(v + 0.5, -2.0), hi);
+    const auto i = static_cast<Index>(c);                    // truncation towards zero
+    return i - (static_cast<double>(i) > c ? 1 : 0);         // floor for negative c
+}
+
 inline PixelRange box_pixels(double cx, double cy, double w, double h, Index rows, Index cols) {
+    const double xh = static_cast<double>(cols) + 2.0, yh = static_cast<double>(rows) + 2.0;
     PixelRange r;
-    r.x0 = std::max<Index>(0, round_half_up(cx - 0.5 * w));
-    r.x1 = std::min<Index>(cols, round_half_up(cx + 0.5 * w));
-    r.y0 = std::max<Index>(0, round_half_up(cy - 0.5 * h));
-    r.y1 = std::min<Index>(rows, round_half_up(cy + 0.5 * h));
+    r.x0 = std::max<Index>(0, round_half_up_clamped(cx - 0.5 * w, xh));
+    r.x1 = std::min<Index>(cols, round_half_up_clamped(cx + 0.5 * w, xh));
+    r.y0 = std::max<Index>(0, round_half_up_clamped(cy - 0.5 * h, yh));
+    r.y1 = std::min<Index>(rows, round_half_up_clamped(cy + 0.5 * h, yh));
     return r;
 }
 
@@ -42,12 +52,18 @@ inline bool box_is_sane(double cx, double cy, double w, double h) {
 }
 
 /// Scratch space for one histogram. Slot 0 collects background (bin -1) so the inner loop never
-/// branches; four interleaved copies break the store-to-load dependency of runs of equal bins.
+/// branches; kCopies interleaved copies break the store-to-load dependency of runs of equal bins.
 class HistogramScratch {
 public:
+    // Interleaved copies of the counts: neighbouring pixels often share a bin (59% of pixels in
+    // 20x50 PETS boxes equal the one 4 to the left), and ++c[b] on one copy waits for the
+    // previous increment's store. 8 copies measured 5-15% faster than 4 on PETS frames.
+    static constexpr int kCopies = 8;
     explicit HistogramScratch(int n_bins)
-        : n_bins_(n_bins), stride_(n_bins + 1), counts_(4 * static_cast<size_t>(stride_)),
-          weights_(4 * static_cast<size_t>(stride_)) {}
+        : n_bins_(n_bins), stride_(n_bins + 1), stride16_((n_bins + 1 + 7) & ~7),
+          counts_(kCopies * static_cast<size_t>(stride_)),
+          counts16_(kCopies * static_cast<size_t>(stride16_)),
+          weights_(4 * static_cast<size_t>(stride_)), hist_(static_cast<size_t>(n_bins)) {}
 
     /// Writes the normalised histogram of one box to `out` (n_bins values).
     /// Returns the total counted weight (0 for an empty box).
@@ -79,30 +95,84 @@ public:
     /// Per-bin counts of the last count_box (n_bins values).
     const std::int32_t* counts() const { return counts_.data() + 1; }
 
-private:
-    std::int64_t count(const BinImage& img, const PixelRange& r) {
-        std::fill(counts_.begin(), counts_.end(), 0);
-        std::int32_t* c0 = counts_.data() + 1;  // +1: bin -1 lands in slot 0
-        std::int32_t* c1 = c0 + stride_;
-        std::int32_t* c2 = c1 + stride_;
-        std::int32_t* c3 = c2 + stride_;
-        for (Index y = r.y0; y < r.y1; ++y) {
-            const std::int16_t* b = img.row(y);
-            Index x = r.x0;
-            for (; x + 4 <= r.x1; x += 4) {
-                ++c0[b[x]];
-                ++c1[b[x + 1]];
-                ++c2[b[x + 2]];
-                ++c3[b[x + 3]];
+    /// Bhattacharyya coefficient of one box's normalised histogram with the reference whose
+    /// square roots are `sqrt_ref`, without writing the histogram out. For the uniform kernel
+    /// straight from the integer counts: rho = sum_k sqrt(c_k) sqrt(q_k) / sqrt(n). `counted`
+    /// gets the counted weight (pixels, for the uniform kernel); an empty box has rho = 0.
+    double coefficient(const BinImage& img, double cx, double cy, double w, double h, Kernel kernel,
+                       const double* sqrt_ref, double& counted) {
+        if (kernel == Kernel::kUniform) {
+            const std::int64_t total = count_box(img, cx, cy, w, h);
+            counted = static_cast<double>(total);
+            if (total == 0) return 0.0;
+            const double norm = std::sqrt(static_cast<double>(total));
+            if (total >= kSqrtTableMax) return sqrt_count_dot(counts(), sqrt_ref, n_bins_) / norm;
+            // every count is <= total: look the square roots up (same values as std::sqrt)
+            const double* tab = sqrt_table(static_cast<size_t>(total));
+            const std::int32_t* c = counts();
+            double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+            int k = 0;
+            for (; k + 4 <= n_bins_; k += 4) {
+                r0 += tab[c[k]] * sqrt_ref[k];
+                r1 += tab[c[k + 1]] * sqrt_ref[k + 1];
+                r2 += tab[c[k + 2]] * sqrt_ref[k + 2];
+                r3 += tab[c[k + 3]] * sqrt_ref[k + 3];
             }
-            for (; x < r.x1; ++x) ++c0[b[x]];
+            for (; k < n_bins_; ++k) r0 += tab[c[k]] * sqrt_ref[k];
+            return ((r0 + r1) + (r2 + r3)) / norm;
         }
-        std::int64_t total = 0;
-        for (int k = 0; k < n_bins_; ++k) {
-            c0[k] += c1[k] + c2[k] + c3[k];
-            total += c0[k];
+        counted = compute(img, cx, cy, w, h, kernel, hist_.data());
+        return bhattacharyya_coefficient_row(hist_.data(), sqrt_ref, n_bins_);
+    }
+
+private:
+    // Boxes of fewer pixels look sqrt(count) up in a table (110 square roots per box cost as
+    // much as counting a 20x50 box's pixels); larger boxes compute them.
+    static constexpr std::int64_t kSqrtTableMax = std::int64_t(1) << 16;
+
+    /// sqrt(0 .. at_least), grown on demand (each entry exactly std::sqrt of its index).
+    const double* sqrt_table(size_t at_least) {
+        if (sqrt_counts_.size() <= at_least) {
+            const size_t old = sqrt_counts_.size();
+            sqrt_counts_.resize(std::max(at_least + 1, 2 * old));
+            for (size_t i = old; i < sqrt_counts_.size(); ++i)
+                sqrt_counts_[i] = std::sqrt(static_cast<double>(i));
         }
-        return total;
+        return sqrt_counts_.data();
+    }
+
+    /// Counts the range's pixels per bin into counts_ (slot 0: background); returns the total.
+    std::int64_t count(const BinImage& img, const PixelRange& r) {
+        const Index area = (r.x1 - r.x0) * (r.y1 - r.y0);
+        return area < 65536 ? count_copies(img, r, counts16_.data(), stride16_)
+                            : count_copies(img, r, counts_.data(), stride_);
+    }
+
+    /// kCopies interleaved copies of type T (uint16 when no count can reach 65536: half the
+    /// bytes to clear and add up per box), summed into counts_.
+    template <class T>
+    std::int64_t count_copies(const BinImage& img, const PixelRange& r, T* base, int stride) {
+        std::fill(base, base + kCopies * static_cast<size_t>(stride), T(0));
+        T* c[kCopies];
+        for (int q = 0; q < kCopies; ++q) c[q] = base + 1 + q * stride;  // +1: bin -1 in slot 0
+        const Index w = r.x1 - r.x0;
+        for (Index y = r.y0; y < r.y1; ++y) {
+            const std::int16_t* b = img.row(y) + r.x0;
+            Index x = 0;
+            for (; x + kCopies <= w; x += kCopies)
+                for (int q = 0; q < kCopies; ++q) ++c[q][b[x + q]];
+            for (int q = 0; x < w; ++x, ++q) ++c[q][b[x]];
+        }
+        std::int32_t* out = counts_.data() + 1;
+        const int nb = n_bins_;  // a local: stores through `out` (int32) could alias n_bins_
+        for (int k = 0; k < nb; ++k) {
+            T s = c[0][k];
+            for (int q = 1; q < kCopies; ++q) s = static_cast<T>(s + c[q][k]);  // <= area: no wrap
+            out[k] = static_cast<std::int32_t>(s);
+        }
+        std::int64_t background = 0;  // slot -1
+        for (int q = 0; q < kCopies; ++q) background += c[q][-1];
+        return (r.x1 - r.x0) * (r.y1 - r.y0) - background;
     }
 
     // Epanechnikov profile k(r^2) = max(0, 1 - r^2), r^2 = ((x-cx)/(w/2))^2 + ((y-cy)/(h/2))^2.
@@ -146,9 +216,13 @@ private:
 
     int n_bins_;
     int stride_;
-    std::vector<std::int32_t> counts_;
+    int stride16_;
+    std::vector<std::int32_t> counts_;    // kCopies x stride_; copy 0 holds the summed counts
+    std::vector<std::uint16_t> counts16_;  // kCopies x stride16_, for boxes under 65536 pixels
     std::vector<double> weights_;
     std::vector<double> rowk_;
+    std::vector<double> hist_;
+    std::vector<double> sqrt_counts_;
 };
 
 inline void check_bin_image(const BinImage& img, const char* fn) {
@@ -181,6 +255,20 @@ inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<D
         scratch.compute(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
                         out.row(i).data());
     return out;
+}
+
+/// Bhattacharyya coefficients (K,) of K boxes' histograms against a reference, fused: no
+/// (K, B) histogram matrix is made. `sqrt_ref` = sqrt(ref / sum(ref)) (sqrt_reference).
+template <class Derived>
+inline Eigen::VectorXd box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                                        const Eigen::VectorXd& sqrt_ref, Kernel kernel) {
+    Eigen::VectorXd rho(boxes.rows());
+    HistogramScratch scratch(img.n_bins);
+    double counted = 0.0;
+    for (Index i = 0; i < boxes.rows(); ++i)
+        rho(i) = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
+                                     sqrt_ref.data(), counted);
+    return rho;
 }
 
 }  // namespace pftrack

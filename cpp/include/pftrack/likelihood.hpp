@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "check.hpp"
@@ -12,10 +13,33 @@
 namespace pftrack {
 
 /// rho[q*, q] = sum_n sqrt(q*(n) q(n)); rows of `hists` against `ref`. `sqrt_ref` = sqrt(ref).
+/// Four partial sums so that the square roots pipeline (and vectorise). A negative, NaN or
+/// infinite entry makes the result non-finite (sqrt(-x) and NaN * 0 are NaN).
 inline double bhattacharyya_coefficient_row(const double* hist, const double* sqrt_ref, int n) {
-    double rho = 0.0;
-    for (int k = 0; k < n; ++k) rho += std::sqrt(hist[k]) * sqrt_ref[k];
-    return rho;
+    double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+    int k = 0;
+    for (; k + 4 <= n; k += 4) {
+        r0 += std::sqrt(hist[k]) * sqrt_ref[k];
+        r1 += std::sqrt(hist[k + 1]) * sqrt_ref[k + 1];
+        r2 += std::sqrt(hist[k + 2]) * sqrt_ref[k + 2];
+        r3 += std::sqrt(hist[k + 3]) * sqrt_ref[k + 3];
+    }
+    for (; k < n; ++k) r0 += std::sqrt(hist[k]) * sqrt_ref[k];
+    return (r0 + r1) + (r2 + r3);
+}
+
+/// sum_k sqrt(counts_k) * sqrt_ref_k over integer counts, in four partial sums.
+inline double sqrt_count_dot(const std::int32_t* counts, const double* sqrt_ref, int n) {
+    double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+    int k = 0;
+    for (; k + 4 <= n; k += 4) {
+        r0 += std::sqrt(static_cast<double>(counts[k])) * sqrt_ref[k];
+        r1 += std::sqrt(static_cast<double>(counts[k + 1])) * sqrt_ref[k + 1];
+        r2 += std::sqrt(static_cast<double>(counts[k + 2])) * sqrt_ref[k + 2];
+        r3 += std::sqrt(static_cast<double>(counts[k + 3])) * sqrt_ref[k + 3];
+    }
+    for (; k < n; ++k) r0 += std::sqrt(static_cast<double>(counts[k])) * sqrt_ref[k];
+    return (r0 + r1) + (r2 + r3);
 }
 
 /// D = sqrt(1 - rho) (eq. 10), with rho clipped to [0, 1] against round-off.
@@ -45,16 +69,20 @@ inline void check_histograms(const Eigen::MatrixBase<Derived>& h, const char* fn
             }
 }
 
-template <class Derived, class DerivedRef>
-inline Eigen::VectorXd bhattacharyya_coefficient(const Eigen::MatrixBase<Derived>& hists,
+/// rho of each row of `hists` (K, B) against `ref` (B,). `hists` maps row-major rows without a
+/// copy (a column-major argument gets one temporary copy from Eigen::Ref).
+template <class DerivedRef>
+inline Eigen::VectorXd bhattacharyya_coefficient(const Eigen::Ref<const RowMatrixXd>& h,
                                                  const Eigen::MatrixBase<DerivedRef>& ref) {
     const char* fn = "bhattacharyya_coefficient";
-    check_histograms(hists, fn);
-    const Eigen::VectorXd sq = sqrt_reference(ref, hists.cols(), fn);
-    const RowMatrixXd h = hists;  // row-major, contiguous rows
+    const Eigen::VectorXd sq = sqrt_reference(ref, h.cols(), fn);
     Eigen::VectorXd rho(h.rows());
-    for (Index i = 0; i < h.rows(); ++i)
+    bool finite = true;
+    for (Index i = 0; i < h.rows(); ++i) {
         rho(i) = bhattacharyya_coefficient_row(h.row(i).data(), sq.data(), static_cast<int>(h.cols()));
+        finite &= std::isfinite(rho(i));
+    }
+    if (!finite) check_histograms(h, fn);  // a bad entry: throws, naming it
     return rho;
 }
 

@@ -14,13 +14,6 @@
 
 namespace pftrack {
 
-/// sum_k sqrt(counts_k) * sqrt_ref_k (vectorisable: no errno with -fno-math-errno).
-inline double sqrt_count_dot(const std::int32_t* counts, const double* sqrt_ref, int n) {
-    double acc = 0.0;
-    for (int k = 0; k < n; ++k) acc += std::sqrt(static_cast<double>(counts[k])) * sqrt_ref[k];
-    return acc;
-}
-
 struct SisResult {
     Estimate estimate;
     double ess = 0.0;       // effective sample size 1 / sum w^2 of the new weights
@@ -96,23 +89,11 @@ inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::V
     }
     // 3-4. histogram and weigh: log w_i = log w_i(resampled) - lambda D_i^2
     HistogramScratch scratch(img.n_bins);
-    std::vector<double> hist(static_cast<size_t>(img.n_bins));
     Eigen::VectorXd rho(n), counted(n), logw(n);
     for (Index i = 0; i < n; ++i) {
         const double s = particles(i, 2);
-        if (prm.kernel == Kernel::kUniform) {
-            // rho = sum_k sqrt(c_k / total) sqrt(q*_k): straight from the integer counts
-            const std::int64_t total =
-                scratch.count_box(img, particles(i, 0), particles(i, 1), s * prm.w0, s * prm.h0);
-            counted(i) = static_cast<double>(total);
-            rho(i) = total > 0 ? sqrt_count_dot(scratch.counts(), sqref.data(), img.n_bins) /
-                                     std::sqrt(static_cast<double>(total))
-                               : 0.0;
-        } else {
-            counted(i) = scratch.compute(img, particles(i, 0), particles(i, 1), s * prm.w0,
-                                         s * prm.h0, prm.kernel, hist.data());
-            rho(i) = bhattacharyya_coefficient_row(hist.data(), sqref.data(), img.n_bins);
-        }
+        rho(i) = scratch.coefficient(img, particles(i, 0), particles(i, 1), s * prm.w0, s * prm.h0,
+                                     prm.kernel, sqref.data(), counted(i));
         const double d = bhattacharyya_distance_from_rho(rho(i));
         logw(i) = std::log(weights(i)) - prm.lambda * d * d;
     }

@@ -1,0 +1,311 @@
+# Hand-written stubs for the compiled module pftrack._core (cpp/bindings/*.cpp).
+# Checked by tests/test_stubs.py with `python -m mypy.stubtest pftrack._core`: keep in step.
+# Shapes and dtypes are in the comments; every array argument is converted to the dtype shown
+# (one copy when it differs) unless marked "in place", which must already be C-contiguous
+# float64 and is written without a copy.
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+_F64 = NDArray[np.float64]
+_I32 = NDArray[np.int32]
+
+class BinnedImage:
+    """A frame's colour-bin index per pixel (-1: never counted)."""
+
+    # bins (H, W) int16, every value in [-1, n_bins)
+    def __init__(self, bins: ArrayLike, n_bins: int) -> None: ...
+    @property
+    def n_bins(self) -> int: ...
+    @property
+    def shape(self) -> tuple[int, int]: ...  # (H, W)
+    @property
+    def bins(self) -> NDArray[np.int16]: ...  # (H, W) int16, read-only view
+
+class BackgroundModel:
+    """Adaptive background + frame difference + threshold, fused with HSV binning."""
+
+    def __init__(
+        self,
+        alpha: float = 0.05,
+        alpha_fg: float = 0.005,
+        n_learn: int = 30,
+        k_noise: float = 4.0,
+        t_min: float = 25.0,
+        t_max: float = 60.0,
+        low_ratio: float = 0.5,
+        shadow_lo: float = 0.5,
+        shadow_chroma: float = 0.03,
+        n_h: int = 10,
+        n_s: int = 10,
+        n_v: int = 10,
+        s_min: float = 0.1,
+        v_min: float = 0.2,
+    ) -> None: ...
+    # frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8 0/255)
+    def apply(self, frame: NDArray[np.uint8]) -> tuple[BinnedImage, NDArray[np.uint8]]: ...
+    def set_background(self, background: ArrayLike) -> None: ...  # (H, W, 3) BGR, float32
+    def reset(self) -> None: ...
+    @property
+    def initialized(self) -> bool: ...
+    @property
+    def frame_count(self) -> int: ...
+    @property
+    def threshold(self) -> float: ...
+    @property
+    def n_bins(self) -> int: ...
+    @property
+    def shape(self) -> Any: ...  # (H, W), or None before the first frame
+    @property
+    def background(self) -> Any: ...  # (H, W, 3) float32, or None before the first frame
+    @property
+    def difference_histogram(self) -> NDArray[np.int64]: ...  # (256,) int64
+    @property
+    def alpha(self) -> float: ...
+    @property
+    def alpha_fg(self) -> float: ...
+    @property
+    def n_learn(self) -> int: ...
+    @property
+    def k_noise(self) -> float: ...
+    @property
+    def t_min(self) -> float: ...
+    @property
+    def t_max(self) -> float: ...
+    @property
+    def low_ratio(self) -> float: ...
+    @property
+    def shadow_lo(self) -> float: ...
+    @property
+    def shadow_chroma(self) -> float: ...
+
+class RJMCMCTracker:
+    """Reversible-jump MCMC joint tracker (birth, death, update, swap)."""
+
+    def __init__(
+        self,
+        burn_in: int = 50,
+        n_samples: int = 200,
+        p_birth: float = 0.1,
+        p_death: float = 0.1,
+        p_update: float = 0.7,
+        p_swap: float = 0.1,
+        a: ArrayLike = ...,  # (3,) AR2 coefficients
+        b: ArrayLike = ...,  # (3,)
+        sigma: ArrayLike = ...,  # (3,) noise std of cx, cy, s
+        s_min: float = 0.2,
+        s_max: float = 5.0,
+        lam: float = 10.0,
+        kernel: str = "uniform",
+        interaction: float = 10.0,
+        coverage: float = 20.0,
+        background_penalty: float = 0.25,
+        birth_prior: float = 2.0,
+        survival: float = 0.95,
+        birth_sigma_xy: float = 3.0,
+        birth_sigma_s: float = 0.05,
+        birth_eps: float = 0.02,
+    ) -> None: ...
+    # mask (H, W) uint8/bool; candidates (K, 4) cx, cy, w, h; candidate_hists (K, B) or None.
+    # seed and step have no default (pass them by keyword).
+    def step(
+        self,
+        image: BinnedImage,
+        mask: NDArray[Any],
+        candidates: _F64,
+        candidate_hists: ArrayLike | None,
+        seed: int,
+        step: int,
+    ) -> dict[str, Any]: ...
+    @property
+    def tracks(self) -> list[Any]: ...
+    def prepare(
+        self,
+        image: BinnedImage,
+        mask: NDArray[Any],
+        candidates: _F64,  # (K, 4)
+        candidate_hists: ArrayLike | None = None,  # (K, B)
+    ) -> None: ...
+    def slots(self) -> list[Any]: ...
+    # slots (M,) int32, states (M, 6) float64
+    def log_target(self, slots: _I32, states: _F64) -> float: ...
+    def log_acceptance(
+        self,
+        move: str,
+        slots: _I32,
+        states: _F64,
+        to_slots: _I32,
+        to_states: _F64,
+        slot: int = -1,
+    ) -> float: ...
+    def propose(
+        self, move: str, slots: _I32, states: _F64, seed: int, step: int, k: int
+    ) -> tuple[_I32, _F64, int] | None: ...
+
+# --- colour: binning, histograms, likelihood ---------------------------------------------
+# frame (H, W, 3) uint8 BGR; mask (H, W) uint8/bool, 0 = background (bin -1)
+def hsv_bins(
+    frame: NDArray[np.uint8],
+    mask: NDArray[Any] | None = None,
+    n_h: int = 10,
+    n_s: int = 10,
+    n_v: int = 10,
+    s_min: float = 0.1,
+    v_min: float = 0.2,
+) -> BinnedImage: ...
+def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # mask (H, W)
+
+# boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)
+def box_histograms(image: BinnedImage, boxes: _F64, kernel: str = "uniform") -> _F64: ...
+
+# boxes (K, 4), ref (B,) -> (K,) weights ~ exp(-lam D^2), summing to 1 (fused histograms)
+def box_weights(
+    image: BinnedImage, boxes: _F64, ref: _F64, lam: float = 20.0, kernel: str = "uniform"
+) -> _F64: ...
+
+# hists (K, B) float64, ref (B,) -> (K,)
+def bhattacharyya_coefficient(hists: _F64, ref: _F64) -> _F64: ...
+def bhattacharyya_distance(hists: _F64, ref: _F64) -> _F64: ...
+def bhattacharyya_weights(hists: _F64, ref: _F64, lam: float = 20.0) -> _F64: ...
+
+# --- resampling: weights (N,) float64 >= 0 -> indices (N,) int32 --------------------------
+def systematic_resample(weights: _F64, u0: float) -> _I32: ...  # u0 in [0, 1)
+def stratified_resample(weights: _F64, u: _F64) -> _I32: ...  # u (N,) in [0, 1)
+def multinomial_resample(weights: _F64, u: _F64) -> _I32: ...  # draw order
+def residual_resample(weights: _F64, u: _F64) -> _I32: ...  # first R of u used
+
+# --- dynamics and filter steps --------------------------------------------------------------
+# particles (N, 6) in place; noise (N, 3) N(0, 1); a, b, sigma, mean_prev, mean_prev2 (3,)
+def propagate(
+    particles: _F64,
+    noise: _F64,
+    a: ArrayLike,
+    b: ArrayLike,
+    sigma: ArrayLike,
+    s_min: float,
+    s_max: float,
+    use_means: bool,
+    mean_prev: ArrayLike,
+    mean_prev2: ArrayLike,
+) -> None: ...
+
+# particles (N, 6), weights (N,) -> (mean (3,), map (3,), map_index)
+def estimate(particles: _F64, weights: _F64) -> tuple[_F64, _F64, int]: ...
+
+# particles (N, 6), weights (N,), means (2, 3): in place; ref (B,); returns a dict of estimates
+def sis_step(
+    particles: _F64,
+    weights: _F64,
+    means: _F64,
+    image: BinnedImage,
+    ref: _F64,
+    w0: float,
+    h0: float,
+    a: ArrayLike,
+    b: ArrayLike,
+    sigma: ArrayLike,
+    s_min: float,
+    s_max: float,
+    use_means: bool,
+    lam: float,
+    kernel: str,
+    resample: bool,
+    seed: int,
+    step: int,
+) -> dict[str, Any]: ...
+def mh_step(
+    particles: _F64,
+    weights: _F64,
+    means: _F64,
+    image: BinnedImage,
+    ref: _F64,
+    w0: float,
+    h0: float,
+    a: ArrayLike,
+    b: ArrayLike,
+    sigma: ArrayLike,
+    s_min: float,
+    s_max: float,
+    use_means: bool,
+    lam: float,
+    kernel: str,
+    resample: bool,
+    seed: int,
+    step: int,
+    n_iter: int = 1,
+    burn_in: int = 0,
+    proposal: str = "dynamics",
+    rw_sigma: ArrayLike = ...,  # (3,)
+) -> dict[str, Any]: ...
+
+# counter-based random streams (CounterRng), for tests and references: (n,) float64
+def counter_normals(seed: int, stream: int, n: int) -> _F64: ...
+def counter_uniforms(seed: int, stream: int, start: int, n: int) -> _F64: ...
+
+# --- trajectory recovery ----------------------------------------------------------------------
+# A (n, n), Q (n, n), H (m, n), Pi_T (m, m), m0 (n,), Pi_0 (n, n), y (m,) goal, T steps
+def gdt_solve(
+    A: ArrayLike,
+    Q: ArrayLike,
+    H: ArrayLike,
+    Pi_T: ArrayLike,
+    m0: ArrayLike,
+    Pi_0: ArrayLike,
+    y: ArrayLike,
+    T: int,
+    form: str = "general",
+    start_conditioned: bool = True,
+) -> dict[str, Any]: ...  # path (T+1, n), eps (T, n, n), cov (T+1, n, n), x0_mean, x0_cov
+def gdt_solve_batch(
+    problems: list[Any],
+    form: str = "general",
+    start_conditioned: bool = True,
+    paths_only: bool = False,
+) -> list[Any]: ...
+def gdt_sample(
+    A: ArrayLike,
+    Q: ArrayLike,
+    H: ArrayLike,
+    Pi_T: ArrayLike,
+    m0: ArrayLike,
+    Pi_0: ArrayLike,
+    y: ArrayLike,
+    T: int,
+    n_samples: int,
+    seed: int,
+    form: str = "general",
+    start_conditioned: bool = True,
+) -> NDArray[np.float64]: ...  # (n_samples, T+1, n)
+
+# seg_a, seg_b stacked (frame, pos...) rows; a_len, b_len (G,) int32 -> (sum(T_g - 1), m)
+def gdt_recover_batch(
+    seg_a: _F64,
+    a_len: _I32,
+    seg_b: _F64,
+    b_len: _I32,
+    A: ArrayLike,
+    Q: ArrayLike,
+    H: ArrayLike,
+    R: ArrayLike,
+    p_init_velocity: float,
+    goal: str,
+    history: int,
+    start_conditioned: bool,
+) -> _F64: ...
+
+# z (K, m) -> (m (n,), P (n, n)) after the last observation
+def kalman_filter(
+    z: ArrayLike,
+    A: ArrayLike,
+    Q: ArrayLike,
+    H: ArrayLike,
+    R: ArrayLike,
+    m_init: ArrayLike,
+    P_init: ArrayLike,
+) -> tuple[_F64, _F64]: ...
+
+# z stacked runs (sum lengths,), lengths (R,) int32, q, r (G,) -> (G,) log-likelihoods
+def noise_loglik_grid(z: _F64, lengths: _I32, q: _F64, r: _F64) -> _F64: ...
