@@ -108,6 +108,8 @@ class RJMCMCTracker:
         birth_sigma_xy: float = 3.0,
         birth_sigma_s: float = 0.05,
         birth_eps: float = 0.02,
+        birth_gate: float = 0.1,  # no newborn on a candidate overlapping a kept identity this much
+        detection: float = 20.0,  # weight of an object's best IoU with a candidate in log π
     ) -> None: ...
     # mask (H, W) uint8/bool; candidates (K, 4) cx, cy, w, h; candidate_hists (K, B) or None.
     # seed and step have no default (pass them by keyword).

@@ -28,3 +28,70 @@ def test_stubtest_reports_no_errors(tmp_path):
         capture_output=True, text=True, timeout=300, cwd=tmp_path,
     )  # fmt: skip
     assert proc.returncode == 0, f"stubtest found errors:\n{proc.stdout}\n{proc.stderr}"
+
+
+def _top_level_split(text: str) -> list[str]:
+    parts, depth, cur = [], 0, ""
+    for ch in text:
+        depth += ch in "([{"
+        depth -= ch in ")]}"
+        if ch == "," and depth == 0:
+            parts.append(cur)
+            cur = ""
+        else:
+            cur += ch
+    return [p.strip() for p in parts + [cur] if p.strip()]
+
+
+def _binding_params(obj: object) -> list[str] | None:
+    """Parameter names from pybind11's signature line ``name(a: T, b: U = 1) -> R``."""
+    doc = (getattr(obj, "__doc__", None) or "").strip()
+    if not doc or doc.startswith("Overloaded function"):
+        return None
+    line = doc.splitlines()[0]
+    start = line.find("(")
+    depth = 0
+    for end in range(start, len(line)):
+        depth += line[end] in "([{"
+        depth -= line[end] in ")]}"
+        if depth == 0:
+            break
+    return [p.split(":")[0].split("=")[0].strip() for p in _top_level_split(line[start + 1 : end])]
+
+
+def test_stub_parameter_names_match_the_bindings():
+    """stubtest cannot read pybind11 signatures, so compare parameter names with the docstrings."""
+    import ast
+
+    from pftrack import _core
+
+    tree = ast.parse((Path(pftrack.__file__).parent / "_core.pyi").read_text())
+
+    def names(fn: ast.FunctionDef) -> list[str]:
+        a = fn.args
+        out = [x.arg for x in a.posonlyargs + a.args]
+        if a.vararg or a.kwonlyargs:
+            out.append("*" if not a.vararg else f"*{a.vararg.arg}")
+        return out + [x.arg for x in a.kwonlyargs]
+
+    checked, mismatched = 0, []
+    for node in tree.body:
+        pairs = []
+        if isinstance(node, ast.FunctionDef):
+            pairs.append((node, getattr(_core, node.name, None), node.name))
+        elif isinstance(node, ast.ClassDef):
+            cls = getattr(_core, node.name, None)
+            for fn in node.body:
+                if isinstance(fn, ast.FunctionDef) and not any(
+                    isinstance(d, ast.Name) and d.id == "property" for d in fn.decorator_list
+                ):
+                    pairs.append((fn, getattr(cls, fn.name, None), f"{node.name}.{fn.name}"))
+        for fn, obj, label in pairs:
+            got = _binding_params(obj) if obj is not None else None
+            if got is None:
+                continue
+            checked += 1
+            if [n for n in got if n != "*"] != [n for n in names(fn) if n != "*"]:
+                mismatched.append(f"{label}: binding {got}, stub {names(fn)}")
+    assert checked >= 15, f"only {checked} signatures compared"
+    assert not mismatched, "\n".join(mismatched)
