@@ -229,3 +229,28 @@ def test_tud_campus_public_detections():
     m = evaluate_mot(read_mot(folder / "gt.txt"), run.rows)
     # Measured 61.6 / 60.9 (README)
     assert m.mota >= 0.58 and m.idf1 >= 0.57, m.table()
+
+
+def test_drop_in_mode_with_a_detector_that_has_only_detect(scene):
+    """External detections with refinement: a detector without ``foreground`` falls back to
+    ``detect`` and gives the same tracks as the built-in one."""
+    from pftrack.detection import make_detector
+
+    class DetectOnly:
+        def __init__(self):
+            self._d = make_detector("paper")
+
+        def detect(self, frame):
+            return self._d.detect(frame)
+
+        def reset(self):
+            self._d.reset()
+
+    dets = [np.column_stack([g[:, 2:6], np.ones(len(g))]) for g in
+            (scene.truth[scene.truth[:, 0] == f] for f in range(1, 31))]  # fmt: skip
+    a, b = MultiObjectTracker(rng=0), MultiObjectTracker(rng=0, detector=DetectOnly())
+    for frame, d in zip(scene.frames[:30], dets):
+        ta, tb = a.update(frame, d), b.update(frame, d)
+        assert [(t.id, t.detection_index) for t in ta] == [(t.id, t.detection_index) for t in tb]
+        np.testing.assert_array_equal([t.box_xywh for t in ta], [t.box_xywh for t in tb])
+    assert len(ta) >= 2  # walkers in view at frame 30

@@ -239,7 +239,7 @@ class _CentreKalman:
 
     Noise levels are in units of the track's height ``h`` so that one rule fits any image scale:
     white-noise acceleration ``σ_a = accel·h`` per frame², and a measurement standard deviation
-    of ``det_noise·h`` for a detection, larger for a colour-filter estimate.
+    of ``detection_noise·h`` for a detection and ``colour_noise·h`` for a colour-filter estimate.
     """
 
     def __init__(self, centre: NDArray[np.float64], height: float, accel: float) -> None:
@@ -257,10 +257,6 @@ class _CentreKalman:
         p01 = P[0, 1] + P[1, 1] + q / 2
         p11 = P[1, 1] + q
         self.P = np.array([[p00, p01], [p01, p11]])
-
-    def predicted(self, steps: int) -> NDArray[np.float64]:
-        """The centre `steps` frames after the current state."""
-        return self.p + steps * self.v
 
     def update(self, z: NDArray[np.float64], sigma: float) -> None:
         P = self.P
@@ -289,7 +285,6 @@ class _TrackState:
         self.score = score
         self.rho = 1.0
         self.det_index: int | None = None
-        self.frames_since_det = 0
         self.unreported: list[tuple[int, NDArray[np.float64], float]] = []
         self.reported = False
 
@@ -354,6 +349,18 @@ class MultiObjectTracker:
         self.last_mask = det.mask
         return det
 
+    def _foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], Any]:
+        """Foreground mask and full-frame bins (or None) for external detections: the
+        detector's ``foreground`` when it has one (no blob pass), else its ``detect``."""
+        detector = self._ensure_detector()
+        if hasattr(detector, "foreground"):
+            mask, frame_bins = detector.foreground(frame)
+        else:
+            det = detector.detect(frame)
+            mask, frame_bins = det.mask, det.frame_bins
+        self.last_mask = mask
+        return mask, frame_bins
+
     @staticmethod
     def _check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         d = np.asarray(detections, dtype=np.float64)
@@ -409,11 +416,11 @@ class MultiObjectTracker:
             boxes, scores = self._check_detections(detections, f.shape[:2])
             if np.any((scores < 0) | (scores > 1)):
                 self._scores_are_confidences = False
-            det = self._detect(f) if cfg.refine_boxes or cfg.sampler == "rjmcmc" else None
-            # full-frame bins: from the detector's fused pass when it made them, else one pass here
-            binned = det.frame_bins if det is not None and det.frame_bins is not None else hsv_bins(f, None, cfg.binning)
-            if cfg.refine_boxes and det is not None and len(boxes):
-                boxes = refine_boxes(boxes, det.mask, cfg.refine_fraction)
+            mask, binned = self._foreground(f) if cfg.refine_boxes or cfg.sampler == "rjmcmc" else (None, None)
+            if binned is None:  # full-frame bins: the detector's fused pass made them, or one pass here
+                binned = hsv_bins(f, None, cfg.binning)
+            if cfg.refine_boxes and mask is not None and len(boxes):
+                boxes = refine_boxes(boxes, mask, cfg.refine_fraction)
         keep = scores >= cfg.min_score
         index = np.flatnonzero(keep)
         boxes, scores = boxes[keep], scores[keep]
@@ -450,7 +457,6 @@ class MultiObjectTracker:
                 continue
             centre = b[:2] + b[2:] / 2
             t.motion.update(centre, cfg.detection_noise * t.size[1])
-            t.frames_since_det = 0
             t.size = 0.7 * t.size + 0.3 * b[2:]
             t.box = np.concatenate([t.motion.p - t.size / 2, t.size]) if smooth else b.copy()
             t.filter.reinitialise(_xywh_to_cxcywh(b), velocity=t.motion.v)
@@ -461,7 +467,6 @@ class MultiObjectTracker:
         for ti in unmatched_t:
             t = self.tracks[ti]
             t.time_since_update += 1
-            t.frames_since_det += 1
             t.det_index = None
             t.score = t.rho
 
@@ -477,7 +482,6 @@ class MultiObjectTracker:
                 continue  # no foreground colour to build a reference from, or too unsure
             t = _TrackState(next(self._ids), boxes[di].copy(), hist, cfg, int(self._rng.integers(2**63)), float(scores[di]))
             t.det_index = int(index[di])
-            t.frames_since_det = 0
             self.tracks.append(t)
 
         return self._report()

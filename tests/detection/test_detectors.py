@@ -230,3 +230,23 @@ def test_group_split_drops_slivers():
     assert len(boxes) == 1, boxes
     assert boxes[0][2] * boxes[0][3] >= 0.01 * frame_area
     np.testing.assert_allclose(boxes[0][:2], [40, 30], atol=3.0)
+
+
+@pytest.mark.parametrize("name", ["paper", "mog2", "knn"])
+def test_foreground_is_detect_without_the_blobs(name):
+    """``foreground`` advances the model as ``detect`` does and returns the same mask (and, for
+    the fused pass, the same full-frame bins)."""
+    bg = textured_background(seed=2)
+    a, b = make_detector(name), make_detector(name)
+    for k in range(6):
+        f = bg.copy()
+        f[30:90, 20 + 8 * k : 40 + 8 * k] = (0, 0, 255)
+        det = a.detect(f)
+        mask, frame_bins = b.foreground(f)
+        np.testing.assert_array_equal(mask, det.mask)
+        if det.frame_bins is None:
+            assert frame_bins is None
+        else:
+            np.testing.assert_array_equal(frame_bins.bins, det.frame_bins.bins)
+    with pytest.raises((TypeError, ValueError), match="foreground"):
+        b.foreground(np.zeros((4, 4), np.uint8))

@@ -81,7 +81,15 @@ class _OpenCvDetector:
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
         """Detect the moving objects of one BGR uint8 frame (H, W, 3); see `Detections`."""
-        fn = f"{type(self).__name__}.detect"
+        frame = check_frame(frame, f"{type(self).__name__}.detect")
+        mask, _ = self.foreground(frame)
+        boxes, scores = self._blobs.boxes(mask)
+        return Detections(boxes, scores, mask, _core.hsv_bins(frame, mask, **self._hsv))
+
+    def foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], None]:
+        """The cleaned foreground mask (shadows are background), without blobs or boxes; no
+        full-frame bins (None: OpenCV's subtractors do not make them)."""
+        fn = f"{type(self).__name__}.foreground"
         frame = check_frame(frame, fn)
         if self._shape is not None and frame.shape != self._shape:
             raise ValueError(
@@ -92,9 +100,7 @@ class _OpenCvDetector:
         raw = self._sub.apply(frame, learningRate=self._learning_rate)
         # 255 = foreground, 127 = shadow: shadows are background.
         raw = np.where(raw == 255, np.uint8(255), np.uint8(0))
-        mask = self._blobs.clean(raw)
-        boxes, scores = self._blobs.boxes(mask)
-        return Detections(boxes, scores, mask, _core.hsv_bins(frame, mask, **self._hsv))
+        return self._blobs.clean(raw), None
 
 
 class Mog2Detector(_OpenCvDetector):

@@ -139,8 +139,18 @@ class PaperDetector:
         -------
         Detections
         """
-        frame = check_frame(frame, "PaperDetector.detect")
-        binned, raw = self._model.apply(frame)
-        mask = self._blobs.clean(raw)
+        mask, binned = self._foreground(frame, "PaperDetector.detect")
         boxes, scores = self._blobs.boxes(mask)
         return Detections(boxes, scores, mask, _core.mask_bins(binned, mask), frame_bins=binned)
+
+    def foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
+        """The cleaned foreground mask and the frame's HSV bins, without blobs or boxes.
+
+        The background model advances exactly as with :meth:`detect`; a tracker fed by another
+        detector needs only these (to refine that detector's boxes) and skips the blob pass.
+        """
+        return self._foreground(frame, "PaperDetector.foreground")
+
+    def _foreground(self, frame: NDArray[np.uint8], fn: str) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
+        binned, raw = self._model.apply(check_frame(frame, fn))
+        return self._blobs.clean(raw), binned

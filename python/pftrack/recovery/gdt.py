@@ -121,6 +121,15 @@ def _check_form(form: str) -> None:
         raise ValueError(f"goal_directed_path: form is {form!r}, expected one of {_FORMS}")
 
 
+def _model_arrays(A: ArrayLike, Q: ArrayLike, H_T: ArrayLike, Pi_T: ArrayLike, m0: ArrayLike,
+                  Pi_0: ArrayLike, y_T: ArrayLike) -> tuple[NDArray[np.float64], ...]:  # noqa: N803  # fmt: skip
+    """The model as the float64 arrays ``gdt_solve``/``gdt_sample`` take (A, Q stacked per step)."""
+    f64 = np.float64
+    return (_as_stack(A, "A"), _as_stack(Q, "Q"), np.atleast_2d(np.asarray(H_T, dtype=f64)),
+            np.atleast_2d(np.asarray(Pi_T, dtype=f64)), np.asarray(m0, dtype=f64),
+            np.atleast_2d(np.asarray(Pi_0, dtype=f64)), np.asarray(y_T, dtype=f64))  # fmt: skip
+
+
 def goal_directed_path(
     A: ArrayLike,  # noqa: N803 - the paper's names
     Q: ArrayLike,  # noqa: N803
@@ -185,13 +194,7 @@ def goal_directed_path(
     T = _check_T(T)
     _check_form(form)
     r = _core.gdt_solve(
-        _as_stack(A, "A"),
-        _as_stack(Q, "Q"),
-        np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
-        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)),
-        np.asarray(m0, dtype=np.float64),
-        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)),
-        np.asarray(y_T, dtype=np.float64),
+        *_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T),
         T,
         form,
         bool(start_conditioned),
@@ -225,13 +228,7 @@ def sample_goal_directed_paths(
         raise ValueError(f"sample_goal_directed_paths: n_samples is {n_samples}, expected > 0")
     seed = int(np.random.default_rng(rng).integers(2**63))
     out: NDArray[np.float64] = _core.gdt_sample(
-        _as_stack(A, "A"),
-        _as_stack(Q, "Q"),
-        np.atleast_2d(np.asarray(H_T, dtype=np.float64)),
-        np.atleast_2d(np.asarray(Pi_T, dtype=np.float64)),
-        np.asarray(m0, dtype=np.float64),
-        np.atleast_2d(np.asarray(Pi_0, dtype=np.float64)),
-        np.asarray(y_T, dtype=np.float64),
+        *_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T),
         T,
         int(n_samples),
         seed,
