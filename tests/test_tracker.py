@@ -145,7 +145,7 @@ def test_new_track_reports_its_unconfirmed_boxes_once():
     frame = np.zeros((60, 80, 3), np.uint8)
     frame[10:30, 10:20] = (0, 0, 255)
     tracker = MultiObjectTracker(TrackerConfig(min_hits=3, max_coast=0, refine_boxes=False), rng=0)
-    writer = TrackWriter()
+    writer = TrackWriter(link=None)  # linking would join tracks 1 and 2 across frame 4
     reported = []
     for f in range(1, 8):
         if f == 4:

@@ -50,7 +50,15 @@ def _add_tracker_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--max-coast", type=int, default=10, metavar="FRAMES",
                    help="frames a track survives on its particle filter alone (default 10)")
     p.add_argument("--fill", choices=("linear", "pf"), default="linear",
-                   help="boxes of a gap the filter bridged: interpolated, or the filter's own")
+                   help="with --no-smooth, boxes of a gap the filter bridged: interpolated, or "
+                        "the filter's own")
+    p.add_argument("--no-smooth", action="store_true",
+                   help="write each frame's box as the tracker reported it online, instead of "
+                        "smoothing every track over the whole run (RTS smoother; bridged gaps "
+                        "are the smoother's interpolation)")
+    p.add_argument("--no-link", action="store_true",
+                   help="keep fragments of one object under separate ids, instead of joining "
+                        "them by motion and size across gaps of up to 30 frames")
 
 
 def _tracker_config(args: argparse.Namespace):  # type: ignore[no-untyped-def]
@@ -69,7 +77,9 @@ def _cmd_track(args: argparse.Namespace) -> int:
     from pftrack.io.mot import write_mot
     from pftrack.io.video import FrameSource
     from pftrack.render import plot_trajectories, write_annotated_video
+    from pftrack.recovery.linking import LinkConfig
     from pftrack.run import load_detections, track_frames
+    from pftrack.smoothing import BoxSmoother
 
     for out in (args.out, args.render, args.plot):
         if out is not None and Path(out).resolve() == Path(args.source).resolve():
@@ -77,7 +87,8 @@ def _cmd_track(args: argparse.Namespace) -> int:
     source = FrameSource(args.source)
     dets = load_detections(args.detections, args.det_scale) if args.detections else None
     run = track_frames(source, detections=dets, config=_tracker_config(args), rng=args.seed,
-                       fill=args.fill)  # fmt: skip
+                       fill=args.fill, smoother=None if args.no_smooth else BoxSmoother(),
+                       link=None if args.no_link else LinkConfig())  # fmt: skip
     write_mot(args.out, run.rows)
     n_ids = len(set(run.rows[:, 1].astype(int))) if len(run.rows) else 0
     print(f"{run.n_frames} frames, {n_ids} tracks, {len(run.rows)} boxes in {run.seconds:.2f} s "

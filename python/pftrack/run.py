@@ -16,6 +16,8 @@ from pftrack._progress import progress
 from pftrack._typing import RngLike
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import FrameSource
+from pftrack.recovery.linking import LinkConfig
+from pftrack.smoothing import BoxSmoother
 from pftrack.tracker import MultiObjectTracker, TrackerConfig, TrackWriter
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -73,6 +75,8 @@ def track_frames(
     fill: str = "linear",
     show_progress: bool | None = None,
     prime_frames: int = 30,
+    smoother: BoxSmoother | None = BoxSmoother(),
+    link: LinkConfig | None = LinkConfig(),
 ) -> TrackingRun:
     """Track every frame of `source`.
 
@@ -93,6 +97,11 @@ def track_frames(
     prime_frames : int
         Read this many frames ahead to start the background model from their median (0: learn
         from frame 1 on).
+    smoother : BoxSmoother or None
+        Offline smoothing of every track's boxes once the run is over (None: boxes as the
+        tracker reported them, frame by frame).
+    link : LinkConfig or None
+        Join fragments of one object once the run is over (None: keep every id).
     """
     frames = source if isinstance(source, (FrameSource, list, tuple)) else FrameSource(source)
     if detections is not None and len(detections) and max(detections) > max(len(frames), 1) > 1:
@@ -102,7 +111,7 @@ def track_frames(
     tracker = MultiObjectTracker(config, rng=rng)
     if prime_frames > 0 and (detections is None or config.refine_boxes):
         tracker.prime(itertools.islice(iter(frames), prime_frames))
-    writer = TrackWriter(coasting, fill)
+    writer = TrackWriter(coasting, fill, smoother, link)
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0

@@ -22,6 +22,8 @@ from scipy.optimize import linear_sum_assignment
 
 from pftrack._typing import RngLike
 from pftrack.eval.metrics import iou_xywh
+from pftrack.recovery.linking import LinkConfig, link_tracklets
+from pftrack.smoothing import BoxSmoother
 from pftrack.particle_filter import (
     Ar2Model,
     ColourParticleFilter,
@@ -163,9 +165,13 @@ class Track:
     time_since_update : int
         Frames since the last matched detection (0 when matched this frame).
     history : tuple of (frame, box_xywh, score)
-        On the frame a new track is first reported, the matched boxes it had while it waited
-        for ``min_hits`` (frame numbers count :meth:`~MultiObjectTracker.update` calls from 1);
-        empty otherwise. Offline writers back-fill them; online users may ignore them.
+        On the frame a new track is first reported, the detection boxes it was matched to while
+        it waited for ``min_hits`` (frame numbers count :meth:`~MultiObjectTracker.update` calls
+        from 1); empty otherwise. Offline writers back-fill them; online users may ignore them.
+    detection_box : (4,) ndarray or None
+        The matched detection's box (after refinement) as the tracker measured it, when it
+        re-seeded the track this frame; None when coasting or inside a merged blob. ``box_xywh``
+        may be a filtered version of it (``smooth_external``).
     """
 
     id: int
@@ -175,6 +181,7 @@ class Track:
     age: int
     time_since_update: int
     history: tuple[tuple[int, NDArray[np.float64], float], ...] = ()
+    detection_box: Optional[NDArray[np.float64]] = None
 
 
 def iou_matrix(a_xywh: ArrayLike, b_xywh: ArrayLike) -> NDArray[np.float64]:
@@ -285,6 +292,7 @@ class _TrackState:
         self.score = score
         self.rho = 1.0
         self.det_index: int | None = None
+        self.measured: NDArray[np.float64] | None = box_xywh.copy()  # this frame's detection box
         self.unreported: list[tuple[int, NDArray[np.float64], float]] = []
         self.reported = False
 
@@ -429,6 +437,7 @@ class MultiObjectTracker:
 
         # 1. every track's particle filter looks at this frame
         for t in self.tracks:
+            t.measured = None
             state = t.filter.step(binned)
             t.rho = state.rho
             # the motion model predicts, the colour filter's estimate is a noisy measurement of it
@@ -455,6 +464,7 @@ class MultiObjectTracker:
             if merged:
                 t.det_index = None
                 continue
+            t.measured = b.copy()
             centre = b[:2] + b[2:] / 2
             t.motion.update(centre, cfg.detection_noise * t.size[1])
             t.size = 0.7 * t.size + 0.3 * b[2:]
@@ -559,15 +569,16 @@ class MultiObjectTracker:
         out = []
         for t in self.tracks:
             if t.hits < cfg.min_hits and not early and not t.reported:
-                if t.time_since_update == 0:
-                    t.unreported.append((self.frame_index, t.box.copy(), float(t.score)))
+                if t.measured is not None:
+                    t.unreported.append((self.frame_index, t.measured.copy(), float(t.score)))
                 continue
             if t.time_since_update > 0 and t.rho < cfg.coast_min_rho:
                 continue
             history, t.unreported, t.reported = tuple(t.unreported), [], True
             out.append(Track(id=t.id, box_xywh=t.box.copy(), score=float(t.score),
                              detection_index=t.det_index, age=t.age,
-                             time_since_update=t.time_since_update, history=history))  # fmt: skip
+                             time_since_update=t.time_since_update, history=history,
+                             detection_box=None if t.measured is None else t.measured.copy()))  # fmt: skip
         return out
 
 
@@ -577,32 +588,50 @@ class TrackWriter:
     A track carried by its particle filter alone (no detection) is held back: its boxes are
     written once a detection confirms the track again, and dropped if the track ends unconfirmed.
     So an occlusion the filter bridged is filled, and a filter that lost its object adds nothing.
+    With a `smoother`, :meth:`result` replaces every track's boxes by the smoother's estimates
+    from the track's detection boxes before and after each frame (offline: the whole run).
 
     Parameters
     ----------
     coasting : {"confirmed", "all", "none"}
         Write held-back boxes when the track is re-detected (default), always, or never.
     fill : {"linear", "pf"}
-        Boxes of a bridged gap: interpolated between the detections at its ends (default;
-        measured better on PETS09 and TUD-Campus), or the particle filter's own estimates.
+        Boxes of a bridged gap without a smoother: interpolated between the detections at its
+        ends (default; measured better on PETS09 and TUD-Campus), or the particle filter's own
+        estimates.
+    smoother : BoxSmoother or None
+        Offline smoothing of each track (default on; measured +7 MOTA on PETS09 and +5 on
+        TUD-Campus public detections, README). None writes the boxes as reported.
+    link : LinkConfig or None
+        Join fragments of one object (:func:`pftrack.recovery.link_tracklets`, motion and size
+        terms) before smoothing, so a joined track is smoothed as one. None keeps every id.
     """
 
-    def __init__(self, coasting: str = "confirmed", fill: str = "linear") -> None:
+    def __init__(self, coasting: str = "confirmed", fill: str = "linear",
+                 smoother: BoxSmoother | None = BoxSmoother(),
+                 link: LinkConfig | None = LinkConfig()) -> None:  # fmt: skip
         if coasting not in ("confirmed", "all", "none"):
             raise ValueError(f"coasting is {coasting!r}, expected 'confirmed', 'all' or 'none'")
         if fill not in ("linear", "pf"):
             raise ValueError(f"fill is {fill!r}, expected 'linear' or 'pf'")
         self.coasting = coasting
+        self.fill = fill
+        self.smoother = smoother
+        self.link = link
         self.rows: list[list[float]] = []
+        self._measured: list[Optional[NDArray[np.float64]]] = []  # per row: the detection box
         self._pending: dict[int, list[list[float]]] = {}
         self._last: dict[int, list[float]] = {}
-        self.fill = fill
+
+    def _append(self, row: list[float], measured: Optional[NDArray[np.float64]]) -> None:
+        self.rows.append(row)
+        self._measured.append(measured)
 
     def add(self, frame: int, tracks: list[Track]) -> None:
         """Record the tracks reported for `frame` (1-based)."""
         for t in tracks:
-            for f, box, score in t.history:  # a new track's boxes from before it was confirmed
-                self.rows.append([float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0])
+            for f, box, score in t.history:  # a new track's detections from before it was confirmed
+                self._append([float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0], np.asarray(box))
             row = [float(frame), float(t.id), *map(float, t.box_xywh), float(t.score), -1.0, -1.0, -1.0]
             if t.time_since_update == 0:
                 pending = self._pending.pop(t.id, [])
@@ -611,17 +640,31 @@ class TrackWriter:
                     for p in pending:
                         u = (p[0] - a[0]) / (b[0] - a[0])
                         p[2:6] = list((1 - u) * a[2:6] + u * b[2:6])
-                self.rows.extend(pending)
-                self.rows.append(row)
+                for p in pending:
+                    self._append(p, None)
+                self._append(row, t.detection_box)
                 self._last[t.id] = row
             elif self.coasting == "all":
-                self.rows.append(row)
+                self._append(row, None)
             elif self.coasting == "confirmed":
                 self._pending.setdefault(t.id, []).append(row)
 
     def result(self) -> NDArray[np.float64]:
-        """All rows written so far, (M, 10), sorted by frame then id."""
+        """All rows written so far, (M, 10), sorted by frame then id (linked and smoothed when
+        the writer has a link config and a smoother)."""
         if not self.rows:
             return np.zeros((0, 10))
         a = np.asarray(self.rows)
+        if self.link is not None:
+            a, _ = link_tracklets(a, self.link)
+        if self.smoother is not None:
+            measured = np.array([m is not None for m in self._measured])
+            boxes = a[:, 2:6].copy()
+            if measured.any():
+                boxes[measured] = [m for m in self._measured if m is not None]
+            for tid in np.unique(a[:, 1]):
+                idx = np.flatnonzero(a[:, 1] == tid)
+                idx = idx[np.argsort(a[idx, 0], kind="stable")]
+                if measured[idx].any():
+                    a[idx, 2:6] = self.smoother.smooth(a[idx, 0], boxes[idx], measured[idx])
         return a[np.lexsort((a[:, 1], a[:, 0]))]

@@ -1,0 +1,158 @@
+"""Offline smoothing of a track's boxes: a Rauch-Tung-Striebel smoother over the whole track.
+
+An online tracker must report each box before it sees the next frame, so its filtered boxes lag
+behind turns and carry the detector's frame-to-frame jitter. Once a run is over, every box can
+use the frames after it as well: a constant-velocity model for the centre and for the size,
+a forward Kalman pass over the track's detections and a backward Rauch-Tung-Striebel pass give
+each frame the mean of its box given the whole track. Frames without a detection (occlusions
+the particle filter bridged, merged blobs) get the smoother's interpolation through the gap.
+
+Noise levels are in units of the track's median box height, so that one rule fits any image
+scale. With the defaults (measured on PETS09-S2L1 and TUD-Campus public detections, README)
+the smoothed boxes match the annotation far more often than the detections themselves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["BoxSmoother"]
+
+F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class BoxSmoother:
+    """Constant-velocity RTS smoother of box centres and sizes.
+
+    Attributes
+    ----------
+    accel : float
+        Standard deviation of the centre's acceleration per frame², in track heights.
+    noise : float
+        Standard deviation of a detection's centre, in track heights.
+    size_accel : float
+        Standard deviation of the width's and height's second difference per frame², in track
+        heights.
+    size_noise : float
+        Standard deviation of a detection's width and height, in track heights.
+
+    Only the ratios ``accel / noise`` and ``size_accel / size_noise`` change the smoothed
+    boxes; the smaller they are, the smoother the path.
+    """
+
+    accel: float = 0.0025
+    noise: float = 0.05
+    size_accel: float = 0.003
+    size_noise: float = 0.1
+
+    def __post_init__(self) -> None:
+        for name in ("accel", "noise", "size_accel", "size_noise"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"BoxSmoother: {name} is {v}, expected a finite value > 0")
+
+    def smooth(self, frames: ArrayLike, boxes_xywh: ArrayLike, observed: ArrayLike) -> F64:
+        """Smooth one track.
+
+        Parameters
+        ----------
+        frames : (n,) array_like of int
+            Strictly increasing frame numbers of the track's rows (holes are allowed: the model
+            steps through every frame in between).
+        boxes_xywh : (n, 4) array_like
+            Left, top, width, height; rows with ``observed`` False are ignored (their values
+            may be anything finite, e.g. an interpolation).
+        observed : (n,) array_like of bool
+            Which rows are measurements (a matched detection).
+
+        Returns
+        -------
+        (n, 4) ndarray
+            Smoothed boxes for every row. A track with no observed row comes back unchanged.
+        """
+        f = np.asarray(frames, dtype=np.int64)
+        b = np.asarray(boxes_xywh, dtype=np.float64)
+        obs = np.asarray(observed, dtype=bool)
+        n = len(f)
+        if b.shape != (n, 4) or obs.shape != (n,):
+            raise ValueError(
+                f"BoxSmoother.smooth: frames {f.shape}, boxes_xywh {b.shape} and observed "
+                f"{obs.shape} must be (n,), (n, 4) and (n,)"
+            )
+        if n > 1 and np.any(np.diff(f) <= 0):
+            raise ValueError("BoxSmoother.smooth: frames must be strictly increasing")
+        if not np.all(np.isfinite(b[obs])):
+            raise ValueError("BoxSmoother.smooth: observed boxes contain NaN or inf")
+        if not obs.any():
+            return b.copy()
+        z = np.column_stack([b[:, :2] + b[:, 2:] / 2, b[:, 2:]])  # cx, cy, w, h
+        height = float(np.median(b[obs, 3]))
+        if not height > 0:
+            raise ValueError(f"BoxSmoother.smooth: the median observed height is {height}, expected > 0")
+        q = height * np.array([self.accel, self.accel, self.size_accel, self.size_accel])
+        r = height * np.array([self.noise, self.noise, self.size_noise, self.size_noise])
+        first = int(np.argmax(obs))
+        steps = int(f[-1] - f[first]) + 1
+        zt = np.zeros((steps, 4))
+        has = np.zeros(steps, dtype=bool)
+        zt[f[first:] - f[first]] = z[first:]
+        has[f[first:] - f[first]] = obs[first:]
+        mean = _rts(zt, has, q, r, velocity_sd=10.0 * height)
+        out = b.copy()
+        s = mean[f[first:] - f[first]]
+        out[first:] = np.column_stack([s[:, :2] - s[:, 2:] / 2, s[:, 2:]])
+        if first > 0:  # rows before the first detection keep their own boxes
+            out[:first] = b[:first]
+        return out
+
+
+def _rts(z: F64, has: NDArray[np.bool_], q: F64, r: F64, velocity_sd: float) -> F64:
+    """Smoothed positions of independent constant-velocity axes (one per column of `z`).
+
+    Each axis has state (position, velocity), white-noise acceleration ``q`` (per-frame
+    standard deviation) and position measurements with standard deviation ``r`` where `has`.
+    The first step must have a measurement: it sets the initial state, ``N([z_0, 0],
+    diag(r², velocity_sd²))`` (a wide `velocity_sd` leaves the velocity to the data).
+    Covariances are 2x2 per axis, kept as their three entries so that all axes advance together.
+    """
+    steps = len(z)
+    q2, r2 = q * q, r * r
+    m0, m1 = z[0].copy(), np.zeros_like(q)
+    p00, p01, p11 = r2.copy(), np.zeros_like(q), np.full_like(q, velocity_sd**2)
+    fm = np.empty((steps, 2, len(q)))  # filtered mean
+    fp = np.empty((steps, 3, len(q)))  # filtered covariance
+    pp = np.empty((steps, 3, len(q)))  # predicted covariance
+    pm = np.empty((steps, 2, len(q)))  # predicted mean
+    for t in range(steps):
+        if t > 0:
+            m0 = m0 + m1
+            p00, p01, p11 = p00 + 2 * p01 + p11 + q2 / 4, p01 + p11 + q2 / 2, p11 + q2
+        pm[t, 0], pm[t, 1] = m0, m1
+        pp[t, 0], pp[t, 1], pp[t, 2] = p00, p01, p11
+        if has[t] and t > 0:  # step 0's measurement is the initial state
+            s = p00 + r2
+            k0, k1 = p00 / s, p01 / s
+            e = z[t] - m0
+            m0, m1 = m0 + k0 * e, m1 + k1 * e
+            p00, p01, p11 = (1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01
+        fm[t, 0], fm[t, 1] = m0, m1
+        fp[t, 0], fp[t, 1], fp[t, 2] = p00, p01, p11
+    out = np.empty((steps, len(q)))
+    s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
+    out[-1] = s0
+    for t in range(steps - 2, -1, -1):
+        a, b, c = fp[t]
+        # gain C = P_f F^T P_pred^-1 with F = [[1, 1], [0, 1]]
+        u00, u01, u10, u11 = a + b, b, b + c, c
+        x, y, w = pp[t + 1]
+        det = x * w - y * y
+        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
+        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
+        d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
+        s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
+        out[t] = s0
+    return out
