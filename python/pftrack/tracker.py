@@ -96,6 +96,11 @@ class TrackerConfig:
         With external detections, report a matched track's filtered box (Kalman centre,
         smoothed size) rather than the detection's own box, which jitters from frame to frame.
         The built-in detector's boxes are the foreground's extent and are reported as they are.
+    unmatched_cost : float
+        What leaving a track or a detection unassigned costs in the association: a pair is made
+        only when its cost is below twice this, not merely because it passed the gate. The
+        default 1.5 refuses a pair that neither overlaps nor lies within two radii whatever
+        its colour (those two terms alone reach 3); ``inf`` assigns every gated pair it can.
     motion_accel, detection_noise, colour_noise : float
         The constant-velocity Kalman filter of each track's centre, in track heights: the
         standard deviation of the acceleration per frame², of a detection's centre and of the
@@ -129,6 +134,7 @@ class TrackerConfig:
     motion_accel: float = 0.01
     detection_noise: float = 0.05
     colour_noise: float = 0.15
+    unmatched_cost: float = 1.5
 
     def __post_init__(self) -> None:
         if self.sampler not in ("sis", "mh", "rjmcmc"):
@@ -139,6 +145,8 @@ class TrackerConfig:
             v = getattr(self, name)
             if not isinstance(v, (int, np.integer)) or v < 0:
                 raise ValueError(f"{name} is {v!r}, expected an integer >= 0")
+        if not self.unmatched_cost > 0:  # NaN fails too
+            raise ValueError(f"unmatched_cost is {self.unmatched_cost}, expected a value > 0 (inf: off)")
         for name in ("match_iou", "reference_rate", "coast_min_rho"):
             v = getattr(self, name)
             if not 0.0 <= v <= 1.0:
@@ -557,7 +565,20 @@ class MultiObjectTracker:
         gate = (iou >= cfg.match_iou) | (dist <= radius[:, None])
         big = 1e6
         cost = np.where(gate, cost, big)
-        rows, cols = linear_sum_assignment(cost)
+        if np.isfinite(cfg.unmatched_cost):
+            # leaving a track or a detection unmatched costs `unmatched_cost` each, so a pair is
+            # only made when it is cheaper than leaving both alone (not just because it is gated)
+            tau = cfg.unmatched_cost
+            padded = np.full((nt + nd, nd + nt), big)
+            padded[:nt, :nd] = cost
+            padded[:nt, nd:][np.diag_indices(nt)] = tau
+            padded[nt:, :nd][np.diag_indices(nd)] = tau
+            padded[nt:, nd:] = 0.0
+            rows, cols = linear_sum_assignment(padded)
+            keep = (rows < nt) & (cols < nd)
+            rows, cols = rows[keep], cols[keep]
+        else:
+            rows, cols = linear_sum_assignment(cost)
         matches = [(int(r), int(c)) for r, c in zip(rows, cols) if cost[r, c] < big]
         mt = {r for r, _ in matches}
         md = {c for _, c in matches}
@@ -604,7 +625,9 @@ class TrackWriter:
         TUD-Campus public detections, README). None writes the boxes as reported.
     link : LinkConfig or None
         Join fragments of one object (:func:`pftrack.recovery.link_tracklets`, motion and size
-        terms) before smoothing, so a joined track is smoothed as one. None keeps every id.
+        terms) before smoothing, so a joined track is smoothed as one; with a smoother, the
+        frames missing inside a track (up to ``link.max_gap``) are then written with the
+        smoother's interpolation. None keeps every id and every hole.
     """
 
     def __init__(self, coasting: str = "confirmed", fill: str = "linear",
@@ -655,13 +678,29 @@ class TrackWriter:
         if not self.rows:
             return np.zeros((0, 10))
         a = np.asarray(self.rows)
+        measured = [m is not None for m in self._measured]
+        meas = [m for m in self._measured if m is not None]
         if self.link is not None:
             a, _ = link_tracklets(a, self.link)
+        if self.smoother is not None and self.link is not None:
+            # frames missing inside a track (between joined fragments, or coasting the writer
+            # did not keep) become rows the smoother interpolates, up to the linking gap
+            extra = [
+                [float(g), float(tid), 0.0, 0.0, 1.0, 1.0, 0.0, -1.0, -1.0, -1.0]
+                for tid in np.unique(a[:, 1])
+                for f in [np.sort(a[a[:, 1] == tid, 0]).astype(int)]
+                for f0, f1 in zip(f[:-1], f[1:])
+                if f1 - f0 - 1 <= self.link.max_gap
+                for g in range(f0 + 1, f1)
+            ]
+            if extra:
+                a = np.vstack([a, extra])
+                measured += [False] * len(extra)
         if self.smoother is not None:
-            measured = np.array([m is not None for m in self._measured])
+            measured = np.asarray(measured)
             boxes = a[:, 2:6].copy()
             if measured.any():
-                boxes[measured] = [m for m in self._measured if m is not None]
+                boxes[measured] = meas
             for tid in np.unique(a[:, 1]):
                 idx = np.flatnonzero(a[:, 1] == tid)
                 idx = idx[np.argsort(a[idx, 0], kind="stable")]

@@ -98,6 +98,7 @@ def test_writer_links_fragments_then_smooths_them_as_one():
 
     linked = feed(TrackWriter())
     assert set(linked[:, 1]) == {1}
+    assert linked[:, 0].tolist() == list(range(1, 24))  # frames 11-13 filled by the smoother
     np.testing.assert_allclose(linked[:, 2], 3.0 * linked[:, 0], atol=1e-4)
     assert set(feed(TrackWriter(link=None))[:, 1]) == {1, 2}
 
