@@ -199,14 +199,16 @@ def make_motpy(seq: Sequence) -> Step:
     return step
 
 
-def make_pftrack(seq: Sequence) -> Step:
+def make_pftrack(seq: Sequence, offline: bool = True) -> Step:
     """pftrack as ``pftrack track`` runs it: the background primed from the first 30 frames,
     output through :class:`~pftrack.tracker.TrackWriter` (bridged gaps written once the track
-    is re-detected, a new track's first boxes once it is confirmed)."""
+    is re-detected, a new track's first boxes once it is confirmed), whose offline pass links
+    fragments and smooths each track over the whole run; ``offline=False`` (``pftrack-online``,
+    ``pftrack track --no-smooth --no-link``) writes each frame's boxes as reported."""
     from pftrack.tracker import MultiObjectTracker, TrackWriter
 
     trk = MultiObjectTracker(rng=0)
-    writer = TrackWriter()
+    writer = TrackWriter() if offline else TrackWriter(smoother=None, link=None)
     count = itertools.count(1)
 
     def step(frame, boxes):
@@ -225,6 +227,7 @@ TRACKERS: dict[str, Callable[[Sequence], Step]] = {
     "norfair": make_norfair,
     "motpy": make_motpy,
     "pftrack": make_pftrack,
+    "pftrack-online": lambda seq: make_pftrack(seq, offline=False),
 }
 
 
@@ -281,6 +284,9 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--tracker", nargs="+", default=list(TRACKERS), choices=list(TRACKERS))
     ap.add_argument("--out", default=None, help="also write the markdown table here")
+    ap.add_argument("--smooth-peers", action="store_true",
+                    help="also score every peer's output after pftrack's offline pass "
+                         "(pftrack.smoothing.smooth_tracks: link, fill, smooth) as '<peer>+smooth'")
     args = ap.parse_args(argv)
 
     root = data_root(args.data)
@@ -320,6 +326,13 @@ def main(argv: list[str] | None = None) -> int:
                 row = Row(tname, name, "own" if own else detector, m, fps)
                 rows.append(row)
                 print(markdown([row]).splitlines()[-1], flush=True)
+                if args.smooth_peers and not tname.startswith("pftrack"):
+                    from pftrack.smoothing import smooth_tracks
+
+                    m = evaluate_mot(gt, smooth_tracks(res), scale=seq.scale, image_size=size)
+                    row = Row(f"{tname}+smooth", name, detector, m, fps)
+                    rows.append(row)
+                    print(markdown([row]).splitlines()[-1], flush=True)
     table = markdown(rows)
     print()
     print(table)

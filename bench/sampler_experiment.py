@@ -109,8 +109,9 @@ def run_sampler(
     seed : int
         Tracker seed.
     """
+    # online output (no offline linking or smoothing): the samplers are what is compared
     run = track_frames(source, detections=detections, config=config_for(sampler, particles),
-                       rng=seed, show_progress=False)  # fmt: skip
+                       rng=seed, show_progress=False, smoother=None, link=None)  # fmt: skip
     m = evaluate_mot(gt, run.rows, scale=gt_scale, image_size=image_size)
     n_tracks = len(np.unique(run.rows[:, 1])) if len(run.rows) else 0
     return SamplerResult(sequence, detector, sampler, m, n_tracks, run.fps)
@@ -304,7 +305,8 @@ def occlusion_figure(scene: Scene, path: Path, particles: int = 100, seed: int =
     frames = [max(1, fc - offset), fc, min(len(scene.frames), fc + offset)]
     rows_by = {}
     for s in SAMPLERS:
-        run = track_frames(scene.frames, config=config_for(s, particles), rng=seed, show_progress=False)
+        run = track_frames(scene.frames, config=config_for(s, particles), rng=seed, show_progress=False,
+                           smoother=None, link=None)
         rows_by[s] = run.rows
     g = scene.truth[(scene.truth[:, 0] == fc) & np.isin(scene.truth[:, 1], (1, 2))]
     cx = float(np.mean(g[:, 2] + g[:, 4] / 2))

@@ -19,7 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["BoxSmoother"]
+from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, link_tracklets
+
+__all__ = ["BoxSmoother", "smooth_tracks"]
 
 F64 = NDArray[np.float64]
 
@@ -156,3 +158,70 @@ def _rts(z: F64, has: NDArray[np.bool_], q: F64, r: F64, velocity_sd: float) -> 
         s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
         out[t] = s0
     return out
+
+
+def smooth_tracks(
+    rows: ArrayLike,
+    observed: ArrayLike | None = None,
+    smoother: BoxSmoother | None = BoxSmoother(),
+    link: LinkConfig | None = LinkConfig(),
+    measurements: ArrayLike | None = None,
+) -> F64:
+    """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
+
+    Parameters
+    ----------
+    rows : (M, 10) array_like
+        ``frame, id, left, top, width, height, conf, x, y, z`` rows, one per (frame, id).
+    observed : (M,) array_like of bool, optional
+        Which rows are detections; the others (e.g. a tracker's coasting boxes) are
+        interpolated by the smoother. Default: every row.
+    smoother : BoxSmoother or None
+        None links only (and fills nothing).
+    link : LinkConfig or None
+        Join fragments of one object first (:func:`pftrack.recovery.link_tracklets`); with a
+        smoother, frames missing inside a track (up to ``link.max_gap``) are added as rows of
+        the smoother's interpolation, flagged in column 8 (1-based) as pftrack's filled rows
+        are (:data:`pftrack.recovery.linking.FLAG_COLUMN`). None keeps ids and holes.
+    measurements : (M, 4) array_like, optional
+        The boxes the smoother fits at observed rows, when they differ from the rows' own
+        (which linking uses): e.g. raw detections behind a tracker's filtered boxes.
+
+    Returns
+    -------
+    (M', 10) ndarray
+        The rows, sorted by frame then id.
+    """
+    a = np.array(rows, dtype=np.float64, copy=True).reshape(-1, 10) if np.size(rows) else np.zeros((0, 10))
+    obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
+    if obs.shape != (len(a),):
+        raise ValueError(f"smooth_tracks: observed has shape {obs.shape}, expected ({len(a)},)")
+    if len(a) == 0:
+        return a
+    z = a[:, 2:6].copy() if measurements is None else np.array(measurements, dtype=np.float64).reshape(-1, 4)
+    if z.shape != (len(a), 4):
+        raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
+    if link is not None:
+        a, _ = link_tracklets(a, link)
+        if smoother is not None:
+            holes = [
+                [float(g), float(tid), 0.0, 0.0, 1.0, 1.0, 0.0, -1.0, -1.0, -1.0]
+                for tid in np.unique(a[:, 1])
+                for f in [np.sort(a[a[:, 1] == tid, 0]).astype(np.int64)]
+                for f0, f1 in zip(f[:-1], f[1:])
+                if f1 - f0 - 1 <= link.max_gap
+                for g in range(f0 + 1, f1)
+            ]
+            if holes:
+                extra = np.asarray(holes)
+                extra[:, FLAG_COLUMN] = 1.0
+                a = np.vstack([a, extra])
+                obs = np.concatenate([obs, np.zeros(len(extra), dtype=bool)])
+                z = np.vstack([z, extra[:, 2:6]])
+    if smoother is not None:
+        for tid in np.unique(a[:, 1]):
+            idx = np.flatnonzero(a[:, 1] == tid)
+            idx = idx[np.argsort(a[idx, 0], kind="stable")]
+            if obs[idx].any():
+                a[idx, 2:6] = smoother.smooth(a[idx, 0], z[idx], obs[idx])
+    return a[np.lexsort((a[:, 1], a[:, 0]))]

@@ -22,8 +22,8 @@ from scipy.optimize import linear_sum_assignment
 
 from pftrack._typing import RngLike
 from pftrack.eval.metrics import iou_xywh
-from pftrack.recovery.linking import LinkConfig, link_tracklets
-from pftrack.smoothing import BoxSmoother
+from pftrack.recovery.linking import LinkConfig
+from pftrack.smoothing import BoxSmoother, smooth_tracks
 from pftrack.particle_filter import (
     Ar2Model,
     ColourParticleFilter,
@@ -678,32 +678,8 @@ class TrackWriter:
         if not self.rows:
             return np.zeros((0, 10))
         a = np.asarray(self.rows)
-        measured = [m is not None for m in self._measured]
-        meas = [m for m in self._measured if m is not None]
-        if self.link is not None:
-            a, _ = link_tracklets(a, self.link)
-        if self.smoother is not None and self.link is not None:
-            # frames missing inside a track (between joined fragments, or coasting the writer
-            # did not keep) become rows the smoother interpolates, up to the linking gap
-            extra = [
-                [float(g), float(tid), 0.0, 0.0, 1.0, 1.0, 0.0, -1.0, -1.0, -1.0]
-                for tid in np.unique(a[:, 1])
-                for f in [np.sort(a[a[:, 1] == tid, 0]).astype(int)]
-                for f0, f1 in zip(f[:-1], f[1:])
-                if f1 - f0 - 1 <= self.link.max_gap
-                for g in range(f0 + 1, f1)
-            ]
-            if extra:
-                a = np.vstack([a, extra])
-                measured += [False] * len(extra)
-        if self.smoother is not None:
-            measured = np.asarray(measured)
-            boxes = a[:, 2:6].copy()
-            if measured.any():
-                boxes[measured] = meas
-            for tid in np.unique(a[:, 1]):
-                idx = np.flatnonzero(a[:, 1] == tid)
-                idx = idx[np.argsort(a[idx, 0], kind="stable")]
-                if measured[idx].any():
-                    a[idx, 2:6] = self.smoother.smooth(a[idx, 0], boxes[idx], measured[idx])
-        return a[np.lexsort((a[:, 1], a[:, 0]))]
+        observed = np.array([m is not None for m in self._measured])
+        z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
+        if observed.any():
+            z[observed] = [m for m in self._measured if m is not None]
+        return smooth_tracks(a, observed, self.smoother, self.link, z)

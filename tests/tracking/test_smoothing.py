@@ -114,3 +114,26 @@ def test_writer_smooths_measured_boxes_not_reported_ones():
     plain = TrackWriter(link=None, smoother=None)
     plain.add(1, [Track(1, np.array([9.0, 17, 10, 20]), 1.0, 0, 1, 0, detection_box=np.zeros(4))])
     np.testing.assert_array_equal(plain.result()[0, 2:6], [9, 17, 10, 20])
+
+
+def test_smooth_tracks_on_any_trackers_output():
+    """Another tracker's rows: two fragments of one walker, jittered, with a 4-frame hole."""
+    from pftrack.recovery.linking import FLAG_COLUMN
+    from pftrack.smoothing import smooth_tracks
+
+    rng = np.random.default_rng(0)
+    frames = np.r_[np.arange(1, 21), np.arange(25, 45)]
+    ids = np.where(frames < 21, 7, 9)
+    truth = np.column_stack([2.0 * frames, np.full(40, 30.0), np.full(40, 10.0), np.full(40, 24.0)])
+    rows = np.column_stack([frames, ids, truth + rng.normal(0, 1.0, truth.shape), np.ones(40), -np.ones((40, 3))])
+    out = smooth_tracks(rows)
+    assert set(out[:, 1]) == {7} and out[:, 0].tolist() == list(range(1, 45))
+    filled = out[:, FLAG_COLUMN] == 1
+    assert out[filled, 0].tolist() == [21, 22, 23, 24]
+    want = np.column_stack([2.0 * out[:, 0], np.full(44, 30.0), np.full(44, 10.0), np.full(44, 24.0)])
+    assert np.abs(out[:, 2:6] - want).mean() < 0.5 * np.abs(rows[:, 2:6] - truth).mean()
+    only_linked = smooth_tracks(rows, smoother=None)
+    np.testing.assert_array_equal(only_linked[:, 2:6], rows[:, 2:6])  # ids joined, boxes as given
+    assert len(smooth_tracks(np.zeros((0, 10)))) == 0
+    with pytest.raises(ValueError, match="observed has shape"):
+        smooth_tracks(rows, observed=np.ones(3, bool))
