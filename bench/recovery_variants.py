@@ -43,12 +43,11 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import expm
-from scipy.optimize import minimize
-
 from pftrack.io.mot import read_mot
 from pftrack.recovery import experiment as E
 from pftrack.recovery.methods import NoiseEstimate, estimate_noise, gdt_bi_problem, recover_gaps
+from scipy.linalg import expm
+from scipy.optimize import minimize
 
 F64 = NDArray[np.float64]
 _BIG = 1e4  # prior variance of the unknown initial position and velocity
@@ -180,9 +179,10 @@ def iou(models: list[list[tuple[F64, F64, float]]]) -> Variant:
 
 
 def state_model(q: float, tau_a: float, tau_v: float = np.inf) -> tuple[F64, F64]:
-    """One-frame ``(F, Q)`` of ``(p, v, a)`` with ``da = -a/tau_a dt + sqrt(q) dW``, ``dv = (a - v/tau_v) dt``.
+    """One-frame ``(F, Q)`` of ``(p, v, a)`` (Van Loan), continuous model below.
 
-    ``tau_a = inf`` is constant acceleration (white jerk).
+    ``da = -a/tau_a dt + sqrt(q) dW`` and ``dv = (a - v/tau_v) dt``; ``tau_a = inf`` is
+    constant acceleration (white jerk), finite ``tau_a`` the Singer model.
     """
     Fc = np.array(
         [
@@ -315,9 +315,7 @@ def stop_rate(runs: Sequence[F64], noise: NoiseEstimate, k: int = 8) -> float:
     return onsets / max(walking, 1)
 
 
-def stop_mixture(
-    a: F64, b: F64, noise: NoiseEstimate, rate: float, v2: F64, grid: int = 12
-) -> F64:
+def stop_mixture(a: F64, b: F64, noise: NoiseEstimate, rate: float, v2: F64, grid: int = 12) -> F64:
     """``gdt-bi`` mixed over hypotheses "walks, stands still from step t1 to t2, walks on".
 
     Each hypothesis is a linear-Gaussian path with per-step ``A_t, Q_t`` (standing: velocity
@@ -388,8 +386,17 @@ def oracle_ratio(masks: list[tuple[list[E.Gap], list[F64]]]) -> float:
         pairs = [(g.segment_a, g.segment_b) for g in gaps]
         best = np.inf
         for f in 10.0 ** np.arange(-2.0, 2.01, 0.5):
-            paths = recover_gaps(pairs, "gdt-bi", noise=NoiseEstimate(q=(n.q[0] * f, n.q[1] * f), r=n.r))
-            best = min(best, float(np.mean([np.hypot(*(p - g.truth[:, 1:3]).T).mean() for p, g in zip(paths, gaps)])))
+            paths = recover_gaps(
+                pairs, "gdt-bi", noise=NoiseEstimate(q=(n.q[0] * f, n.q[1] * f), r=n.r)
+            )
+            best = min(
+                best,
+                float(
+                    np.mean(
+                        [np.hypot(*(p - g.truth[:, 1:3]).T).mean() for p, g in zip(paths, gaps)]
+                    )
+                ),
+            )
         per.append(best)
     return float(np.median(per))
 
@@ -431,7 +438,9 @@ def median_mmae(masks: list[tuple[list[E.Gap], list[F64]]], variant: Variant) ->
     per = []
     for gaps, runs in masks:
         paths = variant(gaps, runs)
-        per.append(np.mean([np.hypot(*(p - g.truth[:, 1:3]).T).mean() for p, g in zip(paths, gaps)]))
+        per.append(
+            np.mean([np.hypot(*(p - g.truth[:, 1:3]).T).mean() for p, g in zip(paths, gaps)])
+        )
     return float(np.median(per))
 
 
