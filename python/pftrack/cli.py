@@ -109,6 +109,29 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return run_demo(Path(args.out_dir), seed=args.seed, n_frames=args.frames, particles=args.particles)
 
 
+def _cmd_smooth(args: argparse.Namespace) -> int:
+    import os
+
+    import numpy as np
+
+    from pftrack.io.mot import read_mot, write_mot
+    from pftrack.recovery.linking import LinkConfig, check_unique
+    from pftrack.smoothing import smooth_tracks
+
+    src, out = Path(args.tracks), Path(args.out)
+    if out.exists() and os.path.samefile(out, src):
+        raise ValueError(f"--out {out} is the input file; write the result elsewhere")
+    rows = read_mot(src, what="tracks file")
+    check_unique(rows)
+    link = None if args.no_link else LinkConfig(max_gap=args.max_gap)
+    result = smooth_tracks(rows, link=link)
+    write_mot(out, result)
+    print(f"{src}: {len(np.unique(rows[:, 1])) if len(rows) else 0} ids, {len(rows)} rows -> "
+          f"{len(np.unique(result[:, 1])) if len(result) else 0} ids, {len(result)} rows "
+          f"(filled rows flagged in column 8) -> {out}")  # fmt: skip
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command."""
     parser = argparse.ArgumentParser(
@@ -155,6 +178,23 @@ def build_parser() -> argparse.ArgumentParser:
     track.add_argument("--plot", help="write a trajectory plot (.png)")
     _add_tracker_options(track)
     track.set_defaults(func=_cmd_track)
+
+    smooth = sub.add_parser(
+        "smooth", help="link, fill and smooth any tracker's MOTChallenge output (offline)",
+        description="The offline pass pftrack track applies to its own tracks, for any "
+                    "tracker's output: join fragments of one object by motion and size across "
+                    "gaps of up to --max-gap frames, add the frames missing inside each track "
+                    "(flagged 1 in column 8), and replace every box by a Rauch-Tung-Striebel "
+                    "smoother's estimate over the whole track. Measured on PETS09-S2L1 public "
+                    "detections: SORT 62.3/35.2 -> 71.7/60.1 MOTA/IDF1, ByteTrack 59.1/43.0 -> "
+                    "75.2/52.3 (README). Smoothing is not idempotent: run it once, on raw output.",
+    )  # fmt: skip
+    smooth.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,conf,...)")
+    smooth.add_argument("--out", required=True, help="output file (written atomically; never the input)")
+    smooth.add_argument("--max-gap", type=_positive_int, default=30, metavar="FRAMES",
+                        help="longest gap joined and filled (default 30)")
+    smooth.add_argument("--no-link", action="store_true", help="smooth each id as it is")
+    smooth.set_defaults(func=_cmd_smooth)
 
     from pftrack.eval.cli import add_eval_parser
 

@@ -137,3 +137,20 @@ def test_smooth_tracks_on_any_trackers_output():
     assert len(smooth_tracks(np.zeros((0, 10)))) == 0
     with pytest.raises(ValueError, match="observed has shape"):
         smooth_tracks(rows, observed=np.ones(3, bool))
+
+
+def test_cli_smooth_links_fills_and_refuses_its_input(tmp_path, capsys):
+    from pftrack.cli import main
+    from pftrack.io.mot import read_mot, write_mot
+
+    frames = np.r_[np.arange(1, 11), np.arange(14, 24)]
+    rows = np.column_stack([frames, np.where(frames < 11, 1, 2), 3.0 * frames, np.full(20, 5.0),
+                            np.full(20, 10.0), np.full(20, 20.0), np.ones(20), -np.ones((20, 3))])  # fmt: skip
+    src = tmp_path / "bytetrack.txt"
+    write_mot(src, rows)
+    assert main(["smooth", str(src), "--out", str(tmp_path / "out.txt")]) == 0
+    out = read_mot(tmp_path / "out.txt")
+    assert set(out[:, 1]) == {1} and len(out) == 23
+    assert main(["smooth", str(src), "--out", str(src)]) == 2
+    assert "is the input file" in capsys.readouterr().err
+    np.testing.assert_array_equal(read_mot(src), rows)  # untouched
