@@ -110,6 +110,14 @@ public:
         return bhattacharyya_coefficient_row(hist_.data(), sqrt_ref, n_bins_);
     }
 
+    /// Uniform-kernel coefficient of the pixels of `r` (already clipped, as box_pixels gives).
+    double coefficient_of_range(const BinImage& img, const PixelRange& r, const double* sqrt_ref,
+                                double& counted) {
+        const std::int64_t total = r.empty() ? 0 : count(img, r);
+        counted = static_cast<double>(total);
+        return coefficient_of_counts(counts(), total, sqrt_ref);
+    }
+
     /// rho = sum_k sqrt(c_k) sqrt(q_k) / sqrt(total) of integer counts c (n_bins values summing
     /// to `total`); 0 when total is 0. Every path that counts a box (directly, or from an
     /// integral histogram) ends here, so equal counts give bit-identical coefficients.

@@ -147,29 +147,30 @@ private:
     std::vector<std::uint16_t> local_;       // one box's (or one row's running) compact counts
 };
 
-/// Cost model of one group (times in ~ns on the reference machine, see docs/kernels.md):
-/// direct = pixels of all boxes + per box; integral = region scan + table build per pixel and
-/// per vector of bins + per box four table rows and a scatter.
+/// Cost model of one group, in ns on the development machine (a least-squares fit over boxes of
+/// 4x4 to 60x150 pixels, 1 to 256 boxes, PETS and noise frames; docs/kernels.md). Both include
+/// the coefficient. direct: per box pixel and per box; integral: per region pixel (scan, table
+/// build) and per region pixel and vector of 8 bins, per box and per box and vector of bins.
 struct BoxCostModel {
-    double direct_pixel = 0.3, direct_box = 60.0;
-    double scan_pixel = 0.4, build_pixel = 0.5, build_vector = 0.6;
-    double box_vector = 1.0, box_fixed = 40.0;
+    double direct_pixel = 0.31, direct_box = 79.0;
+    double region_pixel = 2.6, region_vector = 0.82;
+    double box_fixed = 63.0, box_vector = 3.6;
 
     double direct(Index box_pixels, Index n_boxes) const {
         return direct_pixel * static_cast<double>(box_pixels) + direct_box * static_cast<double>(n_boxes);
     }
-    /// Without the direct path's fixed per-box part: both paths end in the same coefficient.
     double integral(Index region_pixels, Index n_boxes, int vectors) const {
         const double a = static_cast<double>(region_pixels), v = static_cast<double>(vectors);
-        return a * (scan_pixel + build_pixel + build_vector * v) +
+        return a * (region_pixel + region_vector * v) +
                static_cast<double>(n_boxes) * (box_fixed + box_vector * v);
     }
 };
 
 /// Uniform-kernel coefficients rho (K,) and counted pixels (K,) of K boxes (rows (cx, cy, w, h))
 /// against `sqrt_ref`. Boxes are grouped greedily in the given order (up to kOpenGroups groups
-/// stay open, so interleaved objects still group): a box joins the first open group whose
-/// clipped union grows by no more than the box's own area. Each group is then counted directly
+/// stay open, so interleaved objects still group): a box joins the most recently joined open
+/// group whose clipped union grows by at most twice the box's area (two particles of one object
+/// offset by half a box still join; two objects a box apart do not). Each group is then counted directly
 /// or from an integral histogram of its union, whichever the cost model finds cheaper.
 /// Epanechnikov boxes are always counted directly. Scratch is local to the call.
 template <class Derived>
@@ -190,6 +191,7 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
     // worst case (every bin present) are not grown.
     constexpr Index kMaxTableEntries = Index(1) << 22;
     constexpr size_t kOpenGroups = 8;
+    constexpr Index kMinGroupedPixels = 64;
     const Index max_vectors = (img.n_bins + 1 + IntegralHistogram::kLanes - 1) / IntegralHistogram::kLanes;
     const Index max_region = std::max<Index>(4096, kMaxTableEntries / (max_vectors * IntegralHistogram::kLanes));
 
@@ -210,12 +212,17 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
             counted[i] = 0.0;
             continue;
         }
-        if (a > IntegralHistogram::kMaxBoxPixels) continue;  // uint16 counts could wrap: direct
+        // Direct: boxes whose uint16 counts could wrap, and (unless forced) boxes so small that
+        // a table lookup saves less than the grouping costs.
+        if (a > IntegralHistogram::kMaxBoxPixels || (path == BoxPath::kAuto && a < kMinGroupedPixels)) {
+            rho[i] = scratch.coefficient_of_range(img, r, sqrt_ref, counted[i]);
+            continue;
+        }
         size_t slot = open.size();
         for (size_t j = 0; j < open.size(); ++j) {
             const Group& g = groups[open[j]];
             const Index ua = pixel_count(bounding_union(g.u, r));
-            if (ua <= pixel_count(g.u) + a && ua <= max_region) {
+            if (ua <= pixel_count(g.u) + 2 * a && ua <= max_region) {
                 slot = j;
                 break;
             }
@@ -237,9 +244,6 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
         }
         group_of[static_cast<size_t>(i)] = static_cast<std::int32_t>(gi);
     }
-    // Boxes too large for uint16 counts: direct.
-    for (Index i = 0; i < n; ++i)
-        if (group_of[static_cast<size_t>(i)] < 0 && pixel_count(ranges[static_cast<size_t>(i)]) > 0) direct(i);
     if (groups.empty()) return;
 
     // Members of each group, in box order (counting sort).
@@ -274,7 +278,9 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
                         cost.integral(region, grp.n_boxes, stride / IntegralHistogram::kLanes) < direct_cost);
         }
         if (!integral) {
-            for (const Index* m = m0; m != m1; ++m) direct(*m);
+            for (const Index* m = m0; m != m1; ++m)
+                rho[*m] = scratch.coefficient_of_range(img, ranges[static_cast<size_t>(*m)], sqrt_ref,
+                                                       counted[*m]);
             continue;
         }
         table.build(img);
