@@ -93,15 +93,19 @@ void register_histogram(py::module_& m) {
 
     m.def(
         "box_histograms",
-        [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes, const std::string& kernel) {
+        [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes, const std::string& kernel,
+           const std::string& method) {
             const char* fn = "box_histograms";
             check_boxes(boxes, fn, "boxes");
             const Kernel k = parse_kernel(kernel, fn);
+            const BoxPath path = parse_method(method, fn);
             py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
-            return box_histograms(image.view(), boxes, k);
+            return box_histograms(image.view(), boxes, k, path);
         },
         py::arg("image"), py::arg("boxes"), py::arg("kernel") = "uniform",
-        "Normalised histograms (K, B) of boxes (K, 4) = (cx, cy, w, h); empty box -> zero row.");
+        py::arg("method") = "auto",
+        "Normalised histograms (K, B) of boxes (K, 4) = (cx, cy, w, h); empty box -> zero row. "
+        "method: as box_weights.");
 
     m.def(
         "box_weights",

@@ -38,9 +38,14 @@ def _cloud(rng: np.random.Generator, centre, size, spread: float, n: int) -> np.
 
 
 def _weights_all_paths(image, boxes, r, lam=30.0):
+    """box_weights and box_histograms: every method bit-identical, and equal to the reference."""
+    want_hists = ref.box_histograms(image.bins, image.n_bins, boxes)
+    hists = {m: _core.box_histograms(image, boxes, "uniform", m) for m in METHODS}
     got = {m: _core.box_weights(image, boxes, r, lam, "uniform", m) for m in METHODS}
-    want = ref.bhattacharyya_weights(ref.box_histograms(image.bins, image.n_bins, boxes), r, lam)
+    want = ref.bhattacharyya_weights(want_hists, r, lam)
     for m in METHODS:
+        np.testing.assert_array_equal(hists[m], hists["direct"], err_msg=m)
+        np.testing.assert_allclose(hists[m], want_hists, rtol=1e-12, atol=1e-15, err_msg=m)
         np.testing.assert_array_equal(got[m], got["direct"], err_msg=m)
         np.testing.assert_allclose(got[m], want, rtol=1e-9, atol=1e-300, err_msg=m)
     return got["direct"]
@@ -110,6 +115,8 @@ def test_epanechnikov_ignores_the_method(rng):
     for m in METHODS:
         got = _core.box_weights(image, boxes, r, 20.0, "epanechnikov", m)
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-300)
+        hists = _core.box_histograms(image, boxes, "epanechnikov", m)
+        np.testing.assert_array_equal(hists, _core.box_histograms(image, boxes, "epanechnikov"))
 
 
 def test_bad_method_and_bad_boxes(rng):
@@ -117,6 +124,8 @@ def test_bad_method_and_bad_boxes(rng):
     r = np.ones(image.n_bins)
     with pytest.raises(ValueError, match="method"):
         _core.box_weights(image, np.ones((2, 4)), r, 20.0, "uniform", "fast")
+    with pytest.raises(ValueError, match="method"):
+        _core.box_histograms(image, np.ones((2, 4)), "uniform", "fast")
     for m in METHODS:
         with pytest.raises(ValueError, match=r"boxes\[2\]"):
             _core.box_weights(image, np.array([[5.0, 5, 4, 4]] * 2 + [[np.nan, 5, 4, 4]]), r, 20.0, "uniform", m)

@@ -221,25 +221,22 @@ struct BoxCostModel {
     }
 };
 
-/// Uniform-kernel coefficients rho (K,) and counted pixels (K,) of K boxes (rows (cx, cy, w, h))
-/// against `sqrt_ref`. Boxes are grouped greedily in the given order (up to kOpenGroups groups
-/// stay open, so interleaved objects still group): a box joins the most recently joined open
-/// group whose clipped union grows by at most twice the box's area (two particles of one object
-/// offset by half a box still join; two objects a box apart do not). Each group is then counted directly
-/// or from an integral histogram of its union, whichever the cost model finds cheaper.
-/// Epanechnikov boxes are always counted directly. Scratch is local to the call.
-template <class Derived>
-inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
-                             const double* sqrt_ref, Kernel kernel, BoxPath path, double* rho,
-                             double* counted) {
+/// Uniform-kernel counts of K boxes (rows (cx, cy, w, h)), reusing work across overlapping
+/// boxes. Boxes are grouped greedily in the given order (up to kOpenGroups groups stay open, so
+/// interleaved objects still group): a box joins the most recently joined open group whose
+/// clipped union grows by at most twice the box's area (two particles of one object offset by
+/// half a box still join; two objects a box apart do not). Each group is then counted directly or
+/// from an integral histogram of its union, whichever the cost model finds cheaper.
+/// Calls `from_counts(i, c, total)` with box i's counts c[0 .. n_bins) (c[-1]: background) and
+/// counted pixels for boxes counted from a table, and `direct(i, r)` with the clipped pixel
+/// range of every other box (empty ones included). Scratch is local to the call.
+template <class Derived, class FromCounts, class Direct>
+inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                               BoxPath path, FromCounts&& from_counts, Direct&& direct) {
     const Index n = boxes.rows();
-    HistogramScratch scratch(img.n_bins);
-    const auto direct = [&](Index i) {
-        rho[i] = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
-                                     sqrt_ref, counted[i]);
-    };
-    if (kernel != Kernel::kUniform || path == BoxPath::kDirect) {
-        for (Index i = 0; i < n; ++i) direct(i);
+    if (path == BoxPath::kDirect) {
+        for (Index i = 0; i < n; ++i)
+            direct(i, box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols));
         return;
     }
     // Table size cap (uint16 entries: 8 MB); regions of more pixels than the cap allows at the
@@ -262,15 +259,11 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
         const PixelRange r = box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols);
         ranges[static_cast<size_t>(i)] = r;
         const Index a = pixel_count(r);
-        if (a == 0) {  // nothing to count: rho 0, as the direct path gives
-            rho[i] = 0.0;
-            counted[i] = 0.0;
-            continue;
-        }
-        // Direct: boxes whose uint16 counts could wrap, and (unless forced) boxes so small that
-        // a table lookup saves less than the grouping costs.
-        if (a > IntegralHistogram::kMaxBoxPixels || (path == BoxPath::kAuto && a < kMinGroupedPixels)) {
-            rho[i] = scratch.coefficient_of_range(img, r, sqrt_ref, counted[i]);
+        // Direct: empty boxes, boxes whose uint16 counts could wrap, and (unless forced) boxes so
+        // small that a table lookup saves less than the grouping costs.
+        if (a == 0 || a > IntegralHistogram::kMaxBoxPixels ||
+            (path == BoxPath::kAuto && a < kMinGroupedPixels)) {
+            direct(i, r);
             continue;
         }
         size_t slot = open.size();
@@ -333,9 +326,7 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
                         cost.integral(region, grp.n_boxes, stride / IntegralHistogram::kLanes) < direct_cost);
         }
         if (!integral) {
-            for (const Index* m = m0; m != m1; ++m)
-                rho[*m] = scratch.coefficient_of_range(img, ranges[static_cast<size_t>(*m)], sqrt_ref,
-                                                       counted[*m]);
+            for (const Index* m = m0; m != m1; ++m) direct(*m, ranges[static_cast<size_t>(*m)]);
             continue;
         }
         table.build(img);
@@ -343,11 +334,61 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
         for (const Index* m = m0; m != m1; ++m) {
             const PixelRange& r = ranges[static_cast<size_t>(*m)];
             table.box_counts(r, c);
-            const std::int64_t total = pixel_count(r) - c[-1];
-            counted[*m] = static_cast<double>(total);
-            rho[*m] = scratch.coefficient_of_counts(c, total, sqrt_ref);
+            from_counts(*m, static_cast<const std::int32_t*>(c), pixel_count(r) - c[-1]);
         }
     }
+}
+
+/// Coefficients rho (K,) and counted pixels (K,) of K boxes (rows (cx, cy, w, h)) against
+/// `sqrt_ref`. Uniform kernel: for_each_box_count (bit-identical to counting each box);
+/// Epanechnikov: each box directly.
+template <class Derived>
+inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                             const double* sqrt_ref, Kernel kernel, BoxPath path, double* rho,
+                             double* counted) {
+    HistogramScratch scratch(img.n_bins);
+    if (kernel != Kernel::kUniform) {
+        for (Index i = 0; i < boxes.rows(); ++i)
+            rho[i] = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3),
+                                         kernel, sqrt_ref, counted[i]);
+        return;
+    }
+    for_each_box_count(
+        img, boxes, path,
+        [&](Index i, const std::int32_t* c, std::int64_t total) {
+            counted[i] = static_cast<double>(total);
+            rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref);
+        },
+        [&](Index i, const PixelRange& r) {
+            rho[i] = scratch.coefficient_of_range(img, r, sqrt_ref, counted[i]);
+        });
+}
+
+/// Histograms (K, n_bins) of K boxes, as box_histograms(img, boxes, kernel), with the uniform
+/// kernel's counts from for_each_box_count (the same values: c_k / total, or a zero row).
+template <class Derived>
+inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                                  Kernel kernel, BoxPath path) {
+    if (kernel != Kernel::kUniform) return box_histograms(img, boxes, kernel);
+    RowMatrixXd out(boxes.rows(), img.n_bins);
+    HistogramScratch scratch(img.n_bins);
+    const int nb = img.n_bins;
+    for_each_box_count(
+        img, boxes, path,
+        [&](Index i, const std::int32_t* c, std::int64_t total) {
+            double* row = out.row(i).data();
+            if (total == 0) {
+                std::fill(row, row + nb, 0.0);
+                return;
+            }
+            const double inv = 1.0 / static_cast<double>(total);
+            for (int k = 0; k < nb; ++k) row[k] = static_cast<double>(c[k]) * inv;
+        },
+        [&](Index i, const PixelRange&) {
+            scratch.compute(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
+                            out.row(i).data());
+        });
+    return out;
 }
 
 /// Bhattacharyya coefficients (K,) of K boxes' histograms against a reference, fused: no
