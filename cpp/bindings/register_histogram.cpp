@@ -9,6 +9,7 @@
 
 #include "arrays.hpp"
 #include "pftrack/histogram.hpp"
+#include "pftrack/integral_histogram.hpp"
 #include "pftrack/hsv.hpp"
 #include "pftrack/likelihood.hpp"
 
@@ -19,6 +20,13 @@ Kernel parse_kernel(const std::string& name, const char* fn) {
     if (name == "uniform") return Kernel::kUniform;
     if (name == "epanechnikov") return Kernel::kEpanechnikov;
     fail(fn, "kernel is '" + name + "', expected 'uniform' or 'epanechnikov'");
+}
+
+BoxPath parse_method(const std::string& name, const char* fn) {
+    if (name == "auto") return BoxPath::kAuto;
+    if (name == "direct") return BoxPath::kDirect;
+    if (name == "integral") return BoxPath::kIntegral;
+    fail(fn, "method is '" + name + "', expected 'auto', 'direct' or 'integral'");
 }
 
 void register_histogram(py::module_& m) {
@@ -85,31 +93,39 @@ void register_histogram(py::module_& m) {
 
     m.def(
         "box_histograms",
-        [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes, const std::string& kernel) {
+        [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes, const std::string& kernel,
+           const std::string& method) {
             const char* fn = "box_histograms";
             check_boxes(boxes, fn, "boxes");
             const Kernel k = parse_kernel(kernel, fn);
+            const BoxPath path = parse_method(method, fn);
             py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
-            return box_histograms(image.view(), boxes, k);
+            return box_histograms(image.view(), boxes, k, path);
         },
         py::arg("image"), py::arg("boxes"), py::arg("kernel") = "uniform",
-        "Normalised histograms (K, B) of boxes (K, 4) = (cx, cy, w, h); empty box -> zero row.");
+        py::arg("method") = "auto",
+        "Normalised histograms (K, B) of boxes (K, 4) = (cx, cy, w, h); empty box -> zero row. "
+        "method: as box_weights.");
 
     m.def(
         "box_weights",
         [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes,
-           Eigen::Ref<const Eigen::VectorXd> ref, double lam, const std::string& kernel) {
+           Eigen::Ref<const Eigen::VectorXd> ref, double lam, const std::string& kernel,
+           const std::string& method) {
             const char* fn = "box_weights";
             check_boxes(boxes, fn, "boxes");
             check_lambda(lam, fn);
             const Kernel k = parse_kernel(kernel, fn);
+            const BoxPath path = parse_method(method, fn);
             py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
             require(boxes.rows() > 0, fn, "boxes rows", boxes.rows(), ">= 1");
             const Eigen::VectorXd sq = sqrt_reference(ref, image.n_bins, fn);
-            return weights_from_rho(box_coefficients(image.view(), boxes, sq, k), lam, fn);
+            return weights_from_rho(box_coefficients(image.view(), boxes, sq, k, path), lam, fn);
         },
         py::arg("image"), py::arg("boxes"), py::arg("ref"), py::arg("lam") = 20.0,
-        py::arg("kernel") = "uniform",
+        py::arg("kernel") = "uniform", py::arg("method") = "auto",
         "Weights (K,) ~ exp(-lam D^2) of boxes (K, 4) against ref (B,): box_histograms + "
-        "bhattacharyya_weights fused, no (K, B) matrix.");
+        "bhattacharyya_weights fused, no (K, B) matrix. method: 'auto', 'direct' or 'integral' "
+        "(uniform-kernel counts from integral histograms of groups of overlapping boxes; same "
+        "result).");
 }

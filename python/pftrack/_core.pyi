@@ -161,11 +161,21 @@ def hsv_bins(
 def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # mask (H, W)
 
 # boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)
-def box_histograms(image: BinnedImage, boxes: _F64, kernel: str = "uniform") -> _F64: ...
+# method "auto" | "direct" | "integral", as box_weights (the same histograms on every path)
+def box_histograms(
+    image: BinnedImage, boxes: _F64, kernel: str = "uniform", method: str = "auto"
+) -> _F64: ...
 
-# boxes (K, 4), ref (B,) -> (K,) weights ~ exp(-lam D^2), summing to 1 (fused histograms)
+# boxes (K, 4), ref (B,) -> (K,) weights ~ exp(-lam D^2), summing to 1 (fused histograms);
+# method "auto" | "direct" | "integral" (uniform-kernel counts from integral histograms of
+# groups of overlapping boxes; the same weights on every path)
 def box_weights(
-    image: BinnedImage, boxes: _F64, ref: _F64, lam: float = 20.0, kernel: str = "uniform"
+    image: BinnedImage,
+    boxes: _F64,
+    ref: _F64,
+    lam: float = 20.0,
+    kernel: str = "uniform",
+    method: str = "auto",
 ) -> _F64: ...
 
 # hists (K, B) float64, ref (B,) -> (K,)

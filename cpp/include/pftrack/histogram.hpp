@@ -104,25 +104,39 @@ public:
         if (kernel == Kernel::kUniform) {
             const std::int64_t total = count_box(img, cx, cy, w, h);
             counted = static_cast<double>(total);
-            if (total == 0) return 0.0;
-            const double norm = std::sqrt(static_cast<double>(total));
-            if (total >= kSqrtTableMax) return sqrt_count_dot(counts(), sqrt_ref, n_bins_) / norm;
-            // every count is <= total: look the square roots up (same values as std::sqrt)
-            const double* tab = sqrt_table(static_cast<size_t>(total));
-            const std::int32_t* c = counts();
-            double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
-            int k = 0;
-            for (; k + 4 <= n_bins_; k += 4) {
-                r0 += tab[c[k]] * sqrt_ref[k];
-                r1 += tab[c[k + 1]] * sqrt_ref[k + 1];
-                r2 += tab[c[k + 2]] * sqrt_ref[k + 2];
-                r3 += tab[c[k + 3]] * sqrt_ref[k + 3];
-            }
-            for (; k < n_bins_; ++k) r0 += tab[c[k]] * sqrt_ref[k];
-            return ((r0 + r1) + (r2 + r3)) / norm;
+            return coefficient_of_counts(counts(), total, sqrt_ref);
         }
         counted = compute(img, cx, cy, w, h, kernel, hist_.data());
         return bhattacharyya_coefficient_row(hist_.data(), sqrt_ref, n_bins_);
+    }
+
+    /// Uniform-kernel coefficient of the pixels of `r` (already clipped, as box_pixels gives).
+    double coefficient_of_range(const BinImage& img, const PixelRange& r, const double* sqrt_ref,
+                                double& counted) {
+        const std::int64_t total = r.empty() ? 0 : count(img, r);
+        counted = static_cast<double>(total);
+        return coefficient_of_counts(counts(), total, sqrt_ref);
+    }
+
+    /// rho = sum_k sqrt(c_k) sqrt(q_k) / sqrt(total) of integer counts c (n_bins values summing
+    /// to `total`); 0 when total is 0. Every path that counts a box (directly, or from an
+    /// integral histogram) ends here, so equal counts give bit-identical coefficients.
+    double coefficient_of_counts(const std::int32_t* c, std::int64_t total, const double* sqrt_ref) {
+        if (total == 0) return 0.0;
+        const double norm = std::sqrt(static_cast<double>(total));
+        if (total >= kSqrtTableMax) return sqrt_count_dot(c, sqrt_ref, n_bins_) / norm;
+        // every count is <= total: look the square roots up (same values as std::sqrt)
+        const double* tab = sqrt_table(static_cast<size_t>(total));
+        double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+        int k = 0;
+        for (; k + 4 <= n_bins_; k += 4) {
+            r0 += tab[c[k]] * sqrt_ref[k];
+            r1 += tab[c[k + 1]] * sqrt_ref[k + 1];
+            r2 += tab[c[k + 2]] * sqrt_ref[k + 2];
+            r3 += tab[c[k + 3]] * sqrt_ref[k + 3];
+        }
+        for (; k < n_bins_; ++k) r0 += tab[c[k]] * sqrt_ref[k];
+        return ((r0 + r1) + (r2 + r3)) / norm;
     }
 
 private:
@@ -255,20 +269,6 @@ inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<D
         scratch.compute(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
                         out.row(i).data());
     return out;
-}
-
-/// Bhattacharyya coefficients (K,) of K boxes' histograms against a reference, fused: no
-/// (K, B) histogram matrix is made. `sqrt_ref` = sqrt(ref / sum(ref)) (sqrt_reference).
-template <class Derived>
-inline Eigen::VectorXd box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
-                                        const Eigen::VectorXd& sqrt_ref, Kernel kernel) {
-    Eigen::VectorXd rho(boxes.rows());
-    HistogramScratch scratch(img.n_bins);
-    double counted = 0.0;
-    for (Index i = 0; i < boxes.rows(); ++i)
-        rho(i) = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
-                                     sqrt_ref.data(), counted);
-    return rho;
 }
 
 }  // namespace pftrack

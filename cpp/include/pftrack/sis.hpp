@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "histogram.hpp"
+#include "integral_histogram.hpp"
 #include "likelihood.hpp"
 #include "propagate.hpp"
 #include "resample.hpp"
@@ -88,12 +89,16 @@ inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::V
         ar2_step(particles.row(i).data(), w, prm.model, m1.data(), m2.data());
     }
     // 3-4. histogram and weigh: log w_i = log w_i(resampled) - lambda D_i^2
-    HistogramScratch scratch(img.n_bins);
-    Eigen::VectorXd rho(n), counted(n), logw(n);
+    //    (the particles' boxes overlap: box_coefficients may count them from one integral
+    //    histogram of their union)
+    RowMatrixXd boxes(n, 4);
     for (Index i = 0; i < n; ++i) {
         const double s = particles(i, 2);
-        rho(i) = scratch.coefficient(img, particles(i, 0), particles(i, 1), s * prm.w0, s * prm.h0,
-                                     prm.kernel, sqref.data(), counted(i));
+        boxes.row(i) << particles(i, 0), particles(i, 1), s * prm.w0, s * prm.h0;
+    }
+    Eigen::VectorXd rho(n), counted(n), logw(n);
+    box_coefficients(img, boxes, sqref.data(), prm.kernel, BoxPath::kAuto, rho.data(), counted.data());
+    for (Index i = 0; i < n; ++i) {
         const double d = bhattacharyya_distance_from_rho(rho(i));
         logw(i) = std::log(weights(i)) - prm.lambda * d * d;
     }

@@ -124,6 +124,17 @@ def box_histograms(
     (K, B) ndarray of float64
         Rows sum to 1; a box with nothing to count (outside the image, or only background)
         gets an all-zero row, whose Bhattacharyya coefficient with any reference is 0.
+
+    Notes
+    -----
+    With the uniform kernel, the counts of many overlapping boxes (one object's particles) may
+    come from one integral histogram of their union [1]_ instead of visiting every pixel of
+    every box; the counts, hence the histograms, are exactly the same.
+
+    References
+    ----------
+    .. [1] Porikli, F. (2005). Integral histogram: a fast way to extract histograms in
+       Cartesian spaces. CVPR 2005, 829-836.
     """
     b = np.ascontiguousarray(np.atleast_2d(np.asarray(boxes_cxcywh, dtype=np.float64)))
     return _core.box_histograms(image, b, kernel)

@@ -1,0 +1,405 @@
+// Uniform-kernel box counts for many overlapping boxes (the particles of one object) from one
+// integral histogram per group of boxes: T[y][x][k] = pixels of bin k above row y and left of
+// column x in the group's region, so a box's counts are four table rows, T[y1][x1] - T[y0][x1]
+// - T[y1][x0] + T[y0][x0], whatever its size (Porikli 2005). Counts are exact integers, equal to
+// the direct count, so the coefficients built from them are bit-identical.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "histogram.hpp"
+
+namespace pftrack {
+
+/// How box_coefficients counts uniform-kernel boxes: per group by a cost model, always pixel by
+/// pixel, or from an integral histogram wherever one is allowed (tests force each path).
+enum class BoxPath { kAuto = 0, kDirect = 1, kIntegral = 2 };
+
+inline Index pixel_count(const PixelRange& r) { return r.empty() ? 0 : (r.x1 - r.x0) * (r.y1 - r.y0); }
+
+inline PixelRange bounding_union(const PixelRange& a, const PixelRange& b) {
+    return {std::min(a.x0, b.x0), std::max(a.x1, b.x1), std::min(a.y0, b.y0), std::max(a.y1, b.y1)};
+}
+
+/// Integral histogram of one rectangular region of a bin image, over the bins present in the
+/// region only (numbered compactly: fewer table entries to build and to read per box).
+/// Entries are uint16 and wrap around; differences of four of them are still exact for any box
+/// of fewer than 65536 pixels (its counts are < 2^16), however large the region.
+class IntegralHistogram {
+public:
+    static constexpr int kLanes = 8;  // uint16 lanes of a 128-bit vector
+    /// Largest box (pixels) whose counts are exact in uint16.
+    static constexpr Index kMaxBoxPixels = 65535;
+
+    explicit IntegralHistogram(int n_bins)
+        : n_bins_(n_bins), local_of_(static_cast<size_t>(n_bins) + 1),
+          seen_(static_cast<size_t>(n_bins) + 1) {}
+
+    /// Numbers the bins present in `region` (background, bin -1, included when present).
+    /// Returns the table's entries per pixel: a multiple of kLanes.
+    int prepare(const BinImage& img, const PixelRange& region) {
+        region_ = region;
+        std::fill(seen_.begin(), seen_.end(), std::uint8_t(0));
+        std::uint8_t* seen = seen_.data() + 1;  // seen[-1]: background
+        for (Index y = region.y0; y < region.y1; ++y) {
+            const std::int16_t* b = img.row(y);
+            for (Index x = region.x0; x < region.x1; ++x) seen[b[x]] = 1;
+        }
+        bin_of_local_.clear();
+        for (int b = -1; b < n_bins_; ++b) {
+            local_of_[static_cast<size_t>(b + 1)] = static_cast<std::int16_t>(bin_of_local_.size());
+            if (seen[b]) bin_of_local_.push_back(b);
+        }
+        n_local_ = static_cast<int>(bin_of_local_.size());
+        stride_ = (n_local_ + kLanes - 1) / kLanes * kLanes;
+        return stride_;
+    }
+
+    /// Fills the table of the prepared region: row 0 and column 0 are zero, and
+    /// T[y+1][x+1] = T[y][x+1] + (counts of the pixels (y, 0 .. x) of the region).
+    void build(const BinImage& img) {
+        const Index w = region_.x1 - region_.x0, h = region_.y1 - region_.y0;
+        row_len_ = (w + 1) * stride_;
+        table_.resize(static_cast<size_t>((h + 1) * row_len_));
+        local_.resize(static_cast<size_t>(stride_));
+        std::uint16_t* t = table_.data();
+        std::fill(t, t + row_len_, std::uint16_t(0));
+        std::vector<std::uint16_t>& run = local_;  // the running row histogram
+        const std::int16_t* local_of = local_of_.data() + 1;
+        const int s = stride_;
+#if defined(__SSE2__)
+        switch (s / kLanes) {  // the running row histogram in registers: up to 16 vectors
+            case 1: return build_rows<1>(img, w, h);
+            case 2: return build_rows<2>(img, w, h);
+            case 3: return build_rows<3>(img, w, h);
+            case 4: return build_rows<4>(img, w, h);
+            case 5: return build_rows<5>(img, w, h);
+            case 6: return build_rows<6>(img, w, h);
+            case 7: return build_rows<7>(img, w, h);
+            case 8: return build_rows<8>(img, w, h);
+            case 9: return build_rows<9>(img, w, h);
+            case 10: return build_rows<10>(img, w, h);
+            case 11: return build_rows<11>(img, w, h);
+            case 12: return build_rows<12>(img, w, h);
+            case 13: return build_rows<13>(img, w, h);
+            case 14: return build_rows<14>(img, w, h);
+            case 15: return build_rows<15>(img, w, h);
+            case 16: return build_rows<16>(img, w, h);
+            default: break;
+        }
+#endif
+        for (Index y = 0; y < h; ++y) {
+            const std::uint16_t* above = t + y * row_len_ + s;
+            std::uint16_t* cur = t + (y + 1) * row_len_;
+            std::fill(cur, cur + s, std::uint16_t(0));
+            cur += s;
+            std::fill(run.begin(), run.end(), std::uint16_t(0));
+            const std::int16_t* b = img.row(region_.y0 + y) + region_.x0;
+            for (Index x = 0; x < w; ++x, above += s, cur += s)
+                add_pixel(run.data(), local_of[b[x]], above, cur, s);
+        }
+    }
+
+    /// Counts of the box `r` (inside the region, at most kMaxBoxPixels pixels) written to c[bin]
+    /// for each bin present in the region, c[-1] for background; other entries are left alone.
+    void box_counts(const PixelRange& r, std::int32_t* c) {
+        const Index x0 = r.x0 - region_.x0, x1 = r.x1 - region_.x0;
+        const Index y0 = r.y0 - region_.y0, y1 = r.y1 - region_.y0;
+        const std::uint16_t* t = table_.data();
+        const std::uint16_t* a = t + y0 * row_len_ + x0 * stride_;
+        const std::uint16_t* b = t + y0 * row_len_ + x1 * stride_;
+        const std::uint16_t* d = t + y1 * row_len_ + x0 * stride_;
+        const std::uint16_t* e = t + y1 * row_len_ + x1 * stride_;
+        std::uint16_t* out = local_.data();
+#if defined(__SSE2__)
+        for (int k = 0; k < stride_; k += kLanes) {
+            const __m128i v = _mm_add_epi16(
+                _mm_sub_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(e + k)),
+                              _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + k))),
+                _mm_sub_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + k)),
+                              _mm_loadu_si128(reinterpret_cast<const __m128i*>(d + k))));
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(out + k), v);
+        }
+#else
+        for (int k = 0; k < stride_; ++k)
+            out[k] = static_cast<std::uint16_t>(e[k] - b[k] - d[k] + a[k]);  // mod 2^16: exact
+#endif
+        const std::int16_t* bin = bin_of_local_.data();
+        for (int k = 0; k < n_local_; ++k) c[bin[k]] = out[k];
+    }
+
+private:
+#if defined(__SSE2__)
+    /// build() with V vectors of bins: the running row histogram stays in V registers, and
+    /// pixel of compact bin l adds (lane == l) to each, a compare and a subtract per vector
+    /// (no dependency through memory from one pixel to the next).
+    template <int V>
+    void build_rows(const BinImage& img, Index w, Index h) {
+        const std::int16_t* local_of = local_of_.data() + 1;
+        __m128i lane[V];
+        for (int j = 0; j < V; ++j)
+            lane[j] = _mm_add_epi16(_mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7),
+                                    _mm_set1_epi16(static_cast<short>(j * kLanes)));
+        std::uint16_t* t = table_.data();
+        for (Index y = 0; y < h; ++y) {
+            const std::uint16_t* above = t + y * row_len_ + V * kLanes;
+            std::uint16_t* cur = t + (y + 1) * row_len_;
+            std::fill(cur, cur + V * kLanes, std::uint16_t(0));
+            cur += V * kLanes;
+            __m128i run[V];
+            for (int j = 0; j < V; ++j) run[j] = _mm_setzero_si128();
+            const std::int16_t* b = img.row(region_.y0 + y) + region_.x0;
+            for (Index x = 0; x < w; ++x, above += V * kLanes, cur += V * kLanes) {
+                const __m128i l = _mm_set1_epi16(local_of[b[x]]);
+                for (int j = 0; j < V; ++j) {
+                    run[j] = _mm_sub_epi16(run[j], _mm_cmpeq_epi16(lane[j], l));  // -(-1) = +1
+                    _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + j * kLanes),
+                                     _mm_add_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(
+                                                       above + j * kLanes)),
+                                                   run[j]));
+                }
+            }
+        }
+    }
+#endif
+
+    // cur = above + run after run[l] += 1, over s entries.
+    static void add_pixel(std::uint16_t* run, int l, const std::uint16_t* above, std::uint16_t* cur,
+                          int s) {
+#if defined(__SSE2__)
+        // One vector add of a unit vector (a sliding window on kUnit) so that the loads of `run`
+        // below forward from vector stores of the same size (a scalar ++run[l] would stall them).
+        alignas(16) static const std::uint16_t kUnit[2 * kLanes] = {0, 0, 0, 0, 0, 0, 0, 0,
+                                                                    1, 0, 0, 0, 0, 0, 0, 0};
+        auto* chunk = reinterpret_cast<__m128i*>(run + (l & ~(kLanes - 1)));
+        _mm_storeu_si128(chunk, _mm_add_epi16(_mm_loadu_si128(chunk),
+                                              _mm_loadu_si128(reinterpret_cast<const __m128i*>(
+                                                  kUnit + kLanes - (l & (kLanes - 1))))));
+        for (int k = 0; k < s; k += kLanes)
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + k),
+                             _mm_add_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(above + k)),
+                                           _mm_loadu_si128(reinterpret_cast<const __m128i*>(run + k))));
+#else
+        ++run[l];
+        for (int k = 0; k < s; ++k) cur[k] = static_cast<std::uint16_t>(above[k] + run[k]);
+#endif
+    }
+
+    int n_bins_;
+    int n_local_ = 0;
+    int stride_ = 0;
+    Index row_len_ = 0;
+    PixelRange region_{0, 0, 0, 0};
+    std::vector<std::int16_t> local_of_;     // bin + 1 -> compact index (for bins present)
+    std::vector<std::uint8_t> seen_;         // bin + 1 -> present in the region
+    std::vector<std::int16_t> bin_of_local_;  // compact index -> bin (-1: background)
+    std::vector<std::uint16_t> table_;       // (h + 1) x (w + 1) x stride_
+    std::vector<std::uint16_t> local_;       // one box's (or one row's running) compact counts
+};
+
+/// Cost model of one group, in ns on the development machine (a least-squares fit over boxes of
+/// 4x4 to 60x150 pixels, 1 to 256 boxes, PETS and noise frames; docs/kernels.md). Both include
+/// the coefficient. direct: per box pixel and per box; integral: per region pixel (scan, table
+/// build) and per region pixel and vector of 8 bins, per box and per box and vector of bins.
+struct BoxCostModel {
+    double direct_pixel = 0.31, direct_box = 76.0;
+    double region_pixel = 1.74, region_vector = 0.54;
+    double box_fixed = 61.0, box_vector = 3.5;
+
+    double direct(Index box_pixels, Index n_boxes) const {
+        return direct_pixel * static_cast<double>(box_pixels) + direct_box * static_cast<double>(n_boxes);
+    }
+    double integral(Index region_pixels, Index n_boxes, int vectors) const {
+        const double a = static_cast<double>(region_pixels), v = static_cast<double>(vectors);
+        return a * (region_pixel + region_vector * v) +
+               static_cast<double>(n_boxes) * (box_fixed + box_vector * v);
+    }
+};
+
+/// Uniform-kernel counts of K boxes (rows (cx, cy, w, h)), reusing work across overlapping
+/// boxes. Boxes are grouped greedily in the given order (up to kOpenGroups groups stay open, so
+/// interleaved objects still group): a box joins the most recently joined open group whose
+/// clipped union grows by at most twice the box's area (two particles of one object offset by
+/// half a box still join; two objects a box apart do not). Each group is then counted directly or
+/// from an integral histogram of its union, whichever the cost model finds cheaper.
+/// Calls `from_counts(i, c, total)` with box i's counts c[0 .. n_bins) (c[-1]: background) and
+/// counted pixels for boxes counted from a table, and `direct(i, r)` with the clipped pixel
+/// range of every other box (empty ones included). Scratch is local to the call.
+template <class Derived, class FromCounts, class Direct>
+inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                               BoxPath path, FromCounts&& from_counts, Direct&& direct) {
+    const Index n = boxes.rows();
+    if (path == BoxPath::kDirect) {
+        for (Index i = 0; i < n; ++i)
+            direct(i, box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols));
+        return;
+    }
+    // Table size cap (uint16 entries: 8 MB); regions of more pixels than the cap allows at the
+    // worst case (every bin present) are not grown.
+    constexpr Index kMaxTableEntries = Index(1) << 22;
+    constexpr size_t kOpenGroups = 8;
+    constexpr Index kMinGroupedPixels = 64;
+    const Index max_vectors = (img.n_bins + 1 + IntegralHistogram::kLanes - 1) / IntegralHistogram::kLanes;
+    const Index max_region = std::max<Index>(4096, kMaxTableEntries / (max_vectors * IntegralHistogram::kLanes));
+
+    struct Group {
+        PixelRange u;
+        Index box_pixels, n_boxes;
+    };
+    std::vector<Group> groups;
+    std::vector<size_t> open;  // indices into groups, most recently joined first
+    std::vector<PixelRange> ranges(static_cast<size_t>(n));
+    std::vector<std::int32_t> group_of(static_cast<size_t>(n), -1);
+    for (Index i = 0; i < n; ++i) {
+        const PixelRange r = box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols);
+        ranges[static_cast<size_t>(i)] = r;
+        const Index a = pixel_count(r);
+        // Direct: empty boxes, boxes whose uint16 counts could wrap, and (unless forced) boxes so
+        // small that a table lookup saves less than the grouping costs.
+        if (a == 0 || a > IntegralHistogram::kMaxBoxPixels ||
+            (path == BoxPath::kAuto && a < kMinGroupedPixels)) {
+            direct(i, r);
+            continue;
+        }
+        size_t slot = open.size();
+        for (size_t j = 0; j < open.size(); ++j) {
+            const Group& g = groups[open[j]];
+            const Index ua = pixel_count(bounding_union(g.u, r));
+            if (ua <= pixel_count(g.u) + 2 * a && ua <= max_region) {
+                slot = j;
+                break;
+            }
+        }
+        size_t gi;
+        if (slot == open.size()) {
+            gi = groups.size();
+            groups.push_back({r, a, 1});
+            open.insert(open.begin(), gi);
+            if (open.size() > kOpenGroups) open.pop_back();
+        } else {
+            gi = open[slot];
+            Group& g = groups[gi];
+            g.u = bounding_union(g.u, r);
+            g.box_pixels += a;
+            ++g.n_boxes;
+            std::rotate(open.begin(), open.begin() + static_cast<std::ptrdiff_t>(slot),
+                        open.begin() + static_cast<std::ptrdiff_t>(slot) + 1);
+        }
+        group_of[static_cast<size_t>(i)] = static_cast<std::int32_t>(gi);
+    }
+    if (groups.empty()) return;
+
+    // Members of each group, in box order (counting sort).
+    std::vector<Index> start(groups.size() + 1, 0), members(static_cast<size_t>(n));
+    for (Index i = 0; i < n; ++i)
+        if (group_of[static_cast<size_t>(i)] >= 0) ++start[static_cast<size_t>(group_of[static_cast<size_t>(i)]) + 1];
+    for (size_t g = 0; g < groups.size(); ++g) start[g + 1] += start[g];
+    {
+        std::vector<Index> fill(start.begin(), start.end() - 1);
+        for (Index i = 0; i < n; ++i) {
+            const std::int32_t g = group_of[static_cast<size_t>(i)];
+            if (g >= 0) members[static_cast<size_t>(fill[static_cast<size_t>(g)]++)] = i;
+        }
+    }
+
+    const BoxCostModel cost;
+    IntegralHistogram table(img.n_bins);
+    std::vector<std::int32_t> counts(static_cast<size_t>(img.n_bins) + 1);
+    std::int32_t* c = counts.data() + 1;  // c[-1]: background
+    for (size_t g = 0; g < groups.size(); ++g) {
+        const Group& grp = groups[g];
+        const Index* m0 = members.data() + start[g];
+        const Index* m1 = members.data() + start[g + 1];
+        const Index region = pixel_count(grp.u);
+        const double direct_cost = cost.direct(grp.box_pixels, grp.n_boxes);
+        bool integral = path == BoxPath::kIntegral ||
+                        cost.integral(region, grp.n_boxes, 1) < direct_cost;  // best case first
+        if (integral) {
+            const int stride = table.prepare(img, grp.u);
+            integral = region * stride <= kMaxTableEntries &&
+                       (path == BoxPath::kIntegral ||
+                        cost.integral(region, grp.n_boxes, stride / IntegralHistogram::kLanes) < direct_cost);
+        }
+        if (!integral) {
+            for (const Index* m = m0; m != m1; ++m) direct(*m, ranges[static_cast<size_t>(*m)]);
+            continue;
+        }
+        table.build(img);
+        std::fill(counts.begin(), counts.end(), 0);  // bins absent from the region stay 0
+        for (const Index* m = m0; m != m1; ++m) {
+            const PixelRange& r = ranges[static_cast<size_t>(*m)];
+            table.box_counts(r, c);
+            from_counts(*m, static_cast<const std::int32_t*>(c), pixel_count(r) - c[-1]);
+        }
+    }
+}
+
+/// Coefficients rho (K,) and counted pixels (K,) of K boxes (rows (cx, cy, w, h)) against
+/// `sqrt_ref`. Uniform kernel: for_each_box_count (bit-identical to counting each box);
+/// Epanechnikov: each box directly.
+template <class Derived>
+inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                             const double* sqrt_ref, Kernel kernel, BoxPath path, double* rho,
+                             double* counted) {
+    HistogramScratch scratch(img.n_bins);
+    if (kernel != Kernel::kUniform) {
+        for (Index i = 0; i < boxes.rows(); ++i)
+            rho[i] = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3),
+                                         kernel, sqrt_ref, counted[i]);
+        return;
+    }
+    for_each_box_count(
+        img, boxes, path,
+        [&](Index i, const std::int32_t* c, std::int64_t total) {
+            counted[i] = static_cast<double>(total);
+            rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref);
+        },
+        [&](Index i, const PixelRange& r) {
+            rho[i] = scratch.coefficient_of_range(img, r, sqrt_ref, counted[i]);
+        });
+}
+
+/// Histograms (K, n_bins) of K boxes, as box_histograms(img, boxes, kernel), with the uniform
+/// kernel's counts from for_each_box_count (the same values: c_k / total, or a zero row).
+template <class Derived>
+inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                                  Kernel kernel, BoxPath path) {
+    if (kernel != Kernel::kUniform) return box_histograms(img, boxes, kernel);
+    RowMatrixXd out(boxes.rows(), img.n_bins);
+    HistogramScratch scratch(img.n_bins);
+    const int nb = img.n_bins;
+    for_each_box_count(
+        img, boxes, path,
+        [&](Index i, const std::int32_t* c, std::int64_t total) {
+            double* row = out.row(i).data();
+            if (total == 0) {
+                std::fill(row, row + nb, 0.0);
+                return;
+            }
+            const double inv = 1.0 / static_cast<double>(total);
+            for (int k = 0; k < nb; ++k) row[k] = static_cast<double>(c[k]) * inv;
+        },
+        [&](Index i, const PixelRange&) {
+            scratch.compute(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), kernel,
+                            out.row(i).data());
+        });
+    return out;
+}
+
+/// Bhattacharyya coefficients (K,) of K boxes' histograms against a reference, fused: no
+/// (K, B) histogram matrix is made. `sqrt_ref` = sqrt(ref / sum(ref)) (sqrt_reference).
+template <class Derived>
+inline Eigen::VectorXd box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                                        const Eigen::VectorXd& sqrt_ref, Kernel kernel,
+                                        BoxPath path = BoxPath::kAuto) {
+    Eigen::VectorXd rho(boxes.rows()), counted(boxes.rows());
+    box_coefficients(img, boxes, sqrt_ref.data(), kernel, path, rho.data(), counted.data());
+    return rho;
+}
+
+}  // namespace pftrack
