@@ -355,9 +355,7 @@ class MultiObjectTracker:
         if self._detector is None:
             from pftrack.detection import make_detector
 
-            b = self.config.binning
-            self._detector = make_detector(self.config.detector, n_h=b.n_h, n_s=b.n_s, n_v=b.n_v,
-                                           s_min=b.s_min, v_min=b.v_min)  # fmt: skip
+            self._detector = make_detector(self.config.detector, hsv=self.config.binning)
         return self._detector
 
     def _detect(self, frame: NDArray[np.uint8]) -> Any:

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
+from pftrack.particle_filter.colour import HsvBinning
 
 
 @dataclass(frozen=True)
@@ -231,35 +232,6 @@ class BlobExtractor:
         return np.array(out_r, np.float64).reshape(-1, 4), np.array(out_f, np.float64)
 
 
-@dataclass(frozen=True)
-class HsvConfig:
-    """HSV binning of the foreground (Perez et al. 2002): ``n_h * n_s`` colour + ``n_v`` grey bins.
-
-    Attributes
-    ----------
-    n_h, n_s, n_v : int
-        Hue, saturation and grey (value) bins, each in [1, 64].
-    s_min, v_min : float
-        A pixel gets a colour bin when its saturation > `s_min` and value > `v_min` (on [0, 1]).
-    """
-
-    n_h: int = 10
-    n_s: int = 10
-    n_v: int = 10
-    s_min: float = 0.1
-    v_min: float = 0.2
-
-    def __post_init__(self) -> None:
-        for name in ("n_h", "n_s", "n_v"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, np.integer)) and 1 <= v <= 64):
-                raise ValueError(f"{name} is {v!r}, expected an int in [1, 64]")
-        for name in ("s_min", "v_min"):
-            v = getattr(self, name)
-            if not (0.0 <= v <= 1.0):
-                raise ValueError(f"{name} is {v!r}, expected a value in [0, 1]")
-
-    @property
-    def n_bins(self) -> int:
-        """Number of bins, ``n_h * n_s + n_v``."""
-        return self.n_h * self.n_s + self.n_v
+# The detector's foreground bins and the tracker's histograms must share one layout, so the
+# detectors take the particle filter's own binning settings.
+HsvConfig = HsvBinning

@@ -53,6 +53,16 @@ class HsvBinning:
     s_min: float = 0.1
     v_min: float = 0.2
 
+    def __post_init__(self) -> None:
+        for name in ("n_h", "n_s", "n_v"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, np.integer)) and 1 <= v <= 64):
+                raise ValueError(f"{name} is {v!r}, expected an int in [1, 64]")
+        for name in ("s_min", "v_min"):
+            v = getattr(self, name)
+            if not (0.0 <= v <= 1.0):
+                raise ValueError(f"{name} is {v!r}, expected a value in [0, 1]")
+
     @property
     def n_bins(self) -> int:
         """Total number of bins."""
