@@ -49,10 +49,7 @@ struct MhParams {
     Eigen::Array3d rw_sigma{2.0, 2.0, 0.01};       // tau of the random-walk proposal
 
     void validate(const char* fn) const {
-        base.model.validate(fn);
-        check_lambda(base.lambda, fn);
-        require(std::isfinite(base.w0) && std::isfinite(base.h0) && base.w0 > 0.0 && base.h0 > 0.0,
-                fn, "base box size (w0, h0) must be finite and > 0");
+        base.validate(fn);
         require(n_iter >= 1, fn, "n_iter", n_iter, ">= 1");
         require(burn_in >= 0 && burn_in < n_iter, fn, "burn_in", burn_in, "in [0, n_iter)");
         require(rw_sigma.allFinite() && (rw_sigma >= 0.0).all(), fn,

@@ -55,6 +55,13 @@ struct SisParams {
     double w0 = 1.0;  // base box size: box = (cx, cy, s*w0, s*h0)
     double h0 = 1.0;
     bool resample = true;
+
+    void validate(const char* fn) const {
+        model.validate(fn);
+        check_lambda(lambda, fn);
+        require(std::isfinite(w0) && std::isfinite(h0) && w0 > 0.0 && h0 > 0.0, fn,
+                "base box size (w0, h0) must be finite and > 0");
+    }
 };
 
 /// Advances one particle set by one frame. `particles` (N, 6), `weights` (N,) and `means` (2, 3):
@@ -66,10 +73,7 @@ inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::V
     const char* fn = "sis_step";
     check_particle_set(particles, weights, means, fn);
     const Index n = particles.rows();
-    prm.model.validate(fn);
-    check_lambda(prm.lambda, fn);
-    require(std::isfinite(prm.w0) && std::isfinite(prm.h0) && prm.w0 > 0.0 && prm.h0 > 0.0, fn,
-            "base box size (w0, h0) must be finite and > 0");
+    prm.validate(fn);
     check_bin_image(img, fn);
     const Eigen::VectorXd sqref = sqrt_reference(ref, img.n_bins, fn);
 
