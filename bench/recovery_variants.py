@@ -69,28 +69,6 @@ def iou_model(q: float, tau: float) -> tuple[F64, F64]:
     return F, 0.5 * (Q + Q.T)
 
 
-def _loglik(F: F64, Q: F64, r: float, Z: F64, mask: NDArray[np.bool_]) -> float:
-    """Kalman prediction-error log-likelihood of many runs (rows of Z), first 2 points given."""
-    n_runs = Z.shape[0]
-    m = np.zeros((n_runs, 2))
-    m[:, 0] = Z[:, 0]
-    P = np.broadcast_to(np.diag([_BIG, _BIG]), (n_runs, 2, 2)).copy()
-    ll = 0.0
-    for t in range(Z.shape[1]):
-        if t > 0:
-            m = m @ F.T
-            P = F @ P @ F.T + Q
-        S = P[:, 0, 0] + r
-        v = Z[:, t] - m[:, 0]
-        K = P[:, :, 0] / S[:, None]
-        ok = mask[:, t]
-        m = np.where(ok[:, None], m + K * v[:, None], m)
-        P = np.where(ok[:, None, None], P - K[:, :, None] * P[:, 0, None, :], P)
-        if t >= 2:
-            ll -= 0.5 * float(np.sum((np.log(S) + v * v / S)[ok]))
-    return ll
-
-
 def fit_iou(runs: Sequence[F64], axis: int, tau: float) -> tuple[float, float]:
     """Maximum-likelihood ``(q, r)`` of one axis for a given ``tau`` (Nelder-Mead on logs)."""
     runs = [r for r in runs if len(r) >= 6]
@@ -112,17 +90,20 @@ def fit_iou(runs: Sequence[F64], axis: int, tau: float) -> tuple[float, float]:
 def smooth_gap(
     F: F64, Q: F64, r: float, a: F64, b: F64, axis: int, history: int = 60
 ) -> tuple[F64, float]:
-    """RTS-smoothed positions inside the gap and the window's Kalman log-likelihood."""
+    """RTS-smoothed positions inside the gap and the window's Kalman log-likelihood, for any
+    state dimension (position first; diffuse start)."""
     a, b = a[-history:], b[:history]
+    d = F.shape[0]
     f0 = int(a[0, 0])
     n = int(b[-1, 0]) - f0 + 1
     z = np.full(n, np.nan)
     z[(a[:, 0] - f0).astype(int)] = a[:, 1 + axis]
     z[(b[:, 0] - f0).astype(int)] = b[:, 1 + axis]
-    m = np.array([z[0], 0.0])
-    P = np.diag([_BIG, _BIG])
-    ms, Ps = np.zeros((n, 2)), np.zeros((n, 2, 2))
-    mp, Pp = np.zeros((n, 2)), np.zeros((n, 2, 2))
+    m = np.zeros(d)
+    m[0] = z[0]
+    P = np.eye(d) * _BIG
+    ms, Ps = np.zeros((n, d)), np.zeros((n, d, d))
+    mp, Pp = np.zeros((n, d)), np.zeros((n, d, d))
     ll, seen = 0.0, 0
     for t in range(n):
         if t > 0:
@@ -202,8 +183,9 @@ def state_model(q: float, tau_a: float, tau_v: float = np.inf) -> tuple[F64, F64
     return F, 0.5 * (Q + Q.T)
 
 
-def _loglik_nd(F: F64, Q: F64, r: float, Z: F64, mask: NDArray[np.bool_]) -> float:
-    """Like :func:`_loglik` for any state dimension ``d`` (first ``d`` points given)."""
+def _loglik(F: F64, Q: F64, r: float, Z: F64, mask: NDArray[np.bool_]) -> float:
+    """Kalman prediction-error log-likelihood of many runs (rows of Z) for any state dimension
+    ``d`` (first ``d`` points given; -inf when it is not finite)."""
     n_runs, d = Z.shape[0], F.shape[0]
     m = np.zeros((n_runs, d))
     m[:, 0] = Z[:, 0]
@@ -243,7 +225,7 @@ def fit_state_model(runs: Sequence[F64], axis: int, kind: str) -> tuple[F64, F64
     def nll(th: F64) -> float:
         q, r, tau_a, tau_v = unpack(th)
         F, Q = state_model(q, tau_a, tau_v)
-        ll = _loglik_nd(F, Q, r, Z, mask)
+        ll = _loglik(F, Q, r, Z, mask)
         return -ll if np.isfinite(ll) else 1e12
 
     x0 = np.log([0.1, 0.1, 3.0, 50.0][: {"ca": 2, "singer": 3, "singer+ou": 4}[kind]])
@@ -254,41 +236,11 @@ def fit_state_model(runs: Sequence[F64], axis: int, kind: str) -> tuple[F64, F64
     return F, Q, r
 
 
-def smooth_gap_nd(F: F64, Q: F64, r: float, a: F64, b: F64, axis: int, history: int = 60) -> F64:
-    """RTS-smoothed positions inside the gap for any state dimension (diffuse start)."""
-    a, b = a[-history:], b[:history]
-    d = F.shape[0]
-    f0 = int(a[0, 0])
-    n = int(b[-1, 0]) - f0 + 1
-    z = np.full(n, np.nan)
-    z[(a[:, 0] - f0).astype(int)] = a[:, 1 + axis]
-    z[(b[:, 0] - f0).astype(int)] = b[:, 1 + axis]
-    m = np.zeros(d)
-    m[0] = z[0]
-    P = np.eye(d) * _BIG
-    ms, Ps = np.zeros((n, d)), np.zeros((n, d, d))
-    mp, Pp = np.zeros((n, d)), np.zeros((n, d, d))
-    for t in range(n):
-        if t > 0:
-            m, P = F @ m, F @ P @ F.T + Q
-        mp[t], Pp[t] = m, P
-        if not np.isnan(z[t]):
-            S = P[0, 0] + r
-            K = P[:, 0] / S
-            m, P = m + K * (z[t] - m[0]), P - np.outer(K, P[0])
-        ms[t], Ps[t] = m, P
-    for t in range(n - 2, -1, -1):
-        C = Ps[t] @ F.T @ np.linalg.inv(Pp[t + 1])
-        ms[t] = ms[t] + C @ (ms[t + 1] - mp[t + 1])
-    fa, fb = int(a[-1, 0]) - f0, int(b[0, 0]) - f0
-    return ms[fa + 1 : fb, 0]
-
-
 def nd_variant(models: list[tuple[F64, F64, float]]) -> Variant:
     def run(gaps: list[E.Gap], runs: list[F64]) -> list[F64]:
         return [
             np.column_stack(
-                [smooth_gap_nd(*models[ax], g.segment_a, g.segment_b, ax) for ax in range(2)]
+                [smooth_gap(*models[ax], g.segment_a, g.segment_b, ax)[0] for ax in range(2)]
             )
             for g in gaps
         ]
