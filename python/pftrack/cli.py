@@ -114,7 +114,7 @@ def _cmd_smooth(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from pftrack.io.mot import read_mot, write_mot
+    from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery.linking import LinkConfig, check_unique
     from pftrack.smoothing import smooth_tracks
 
@@ -122,7 +122,7 @@ def _cmd_smooth(args: argparse.Namespace) -> int:
     if out.exists() and os.path.samefile(out, src):
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
     rows = read_mot(src, what="tracks file")
-    check_unique(rows)
+    check_unique(rows, data_line_numbers(src))
     link = None if args.no_link else LinkConfig(max_gap=args.max_gap)
     result = smooth_tracks(rows, link=link)
     write_mot(out, result)

@@ -107,9 +107,7 @@ class BoxSmoother:
         out = b.copy()
         s = mean[f[first:] - f[first]]
         out[first:] = np.column_stack([s[:, :2] - s[:, 2:] / 2, s[:, 2:]])
-        if first > 0:  # rows before the first detection keep their own boxes
-            out[:first] = b[:first]
-        return out
+        return out  # rows before the first detection keep their own boxes
 
 
 def _rts(z: F64, has: NDArray[np.bool_], q: F64, r: F64, velocity_sd: float) -> F64:
@@ -203,25 +201,28 @@ def smooth_tracks(
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
     if link is not None:
         a, _ = link_tracklets(a, link)
-        if smoother is not None:
-            holes = [
-                [float(g), float(tid), 0.0, 0.0, 1.0, 1.0, 0.0, -1.0, -1.0, -1.0]
-                for tid in np.unique(a[:, 1])
-                for f in [np.sort(a[a[:, 1] == tid, 0]).astype(np.int64)]
-                for f0, f1 in zip(f[:-1], f[1:])
-                if f1 - f0 - 1 <= link.max_gap
-                for g in range(f0 + 1, f1)
-            ]
-            if holes:
-                extra = np.asarray(holes)
-                extra[:, FLAG_COLUMN] = 1.0
-                a = np.vstack([a, extra])
-                obs = np.concatenate([obs, np.zeros(len(extra), dtype=bool)])
-                z = np.vstack([z, extra[:, 2:6]])
+    order = np.lexsort((a[:, 0], a[:, 1]))  # by id, then frame
+    a, obs, z = a[order], obs[order], z[order]
+    if smoother is not None and link is not None:
+        missing = a[1:, 0] - a[:-1, 0] - 1
+        hole = np.flatnonzero((a[1:, 1] == a[:-1, 1]) & (missing >= 1) & (missing <= link.max_gap))
+        if len(hole):
+            counts = missing[hole].astype(np.int64)
+            extra = np.zeros((int(counts.sum()), 10))
+            extra[:, 7:] = -1.0
+            extra[:, FLAG_COLUMN] = 1.0
+            first = np.repeat(a[hole, 0] + 1 - np.r_[0, np.cumsum(counts)[:-1]], counts)
+            extra[:, 0] = first + np.arange(len(extra))  # the frames after each hole's start
+            extra[:, 1] = np.repeat(a[hole, 1], counts)
+            extra[:, 4:6] = 1.0  # placeholders: the smoother writes every filled box
+            a = np.vstack([a, extra])
+            obs = np.concatenate([obs, np.zeros(len(extra), dtype=bool)])
+            z = np.vstack([z, extra[:, 2:6]])
+            order = np.lexsort((a[:, 0], a[:, 1]))
+            a, obs, z = a[order], obs[order], z[order]
     if smoother is not None:
-        for tid in np.unique(a[:, 1]):
-            idx = np.flatnonzero(a[:, 1] == tid)
-            idx = idx[np.argsort(a[idx, 0], kind="stable")]
-            if obs[idx].any():
-                a[idx, 2:6] = smoother.smooth(a[idx, 0], z[idx], obs[idx])
+        starts = np.flatnonzero(np.r_[True, a[1:, 1] != a[:-1, 1], True])
+        for i, j in zip(starts[:-1], starts[1:]):
+            if obs[i:j].any():
+                a[i:j, 2:6] = smoother.smooth(a[i:j, 0], z[i:j], obs[i:j])
     return a[np.lexsort((a[:, 1], a[:, 0]))]

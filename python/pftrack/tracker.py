@@ -615,9 +615,9 @@ class TrackWriter:
     coasting : {"confirmed", "all", "none"}
         Write held-back boxes when the track is re-detected (default), always, or never.
     fill : {"linear", "pf"}
-        Boxes of a bridged gap without a smoother: interpolated between the detections at its
-        ends (default; measured better on PETS09 and TUD-Campus), or the particle filter's own
-        estimates.
+        Boxes of a bridged gap: interpolated between the detections at its ends (default;
+        measured better on PETS09 and TUD-Campus), or the particle filter's own estimates. A
+        smoother replaces them when the track has detection boxes to fit.
     smoother : BoxSmoother or None
         Offline smoothing of each track (default on; measured +7 MOTA on PETS09 and +5 on
         TUD-Campus public detections, README). None writes the boxes as reported.

@@ -7,7 +7,7 @@ files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``) and alw
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Union
 
@@ -21,6 +21,20 @@ PathLike = Union[str, "os.PathLike[str]"]
 #: Column indices of a MOTChallenge row.
 FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
 _DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 1.0, -1.0, -1.0, -1.0)
+
+
+def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
+    """(1-based line number, stripped text) of every line that holds a row."""
+    with path.open("r", encoding="utf-8", errors="replace") as fh:
+        for lineno, line in enumerate(fh, start=1):
+            text = line.strip()
+            if text and not text.startswith("#"):
+                yield lineno, text
+
+
+def data_line_numbers(path: PathLike) -> list[int]:
+    """The file's line number of each row :func:`read_mot` returns, for error messages."""
+    return [n for n, _ in _data_lines(Path(path))]
 
 
 def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
@@ -51,32 +65,28 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
     if not p.is_file():
         raise FileNotFoundError(f"{what} not found: {p}")
     rows: list[list[float]] = []
-    with p.open("r", encoding="utf-8", errors="replace") as fh:
-        for lineno, line in enumerate(fh, start=1):
-            text = line.strip()
-            if not text or text.startswith("#"):
-                continue
-            fields = text.replace(",", " ").split()
-            if len(fields) < 6:
-                raise ValueError(
-                    f"{p}:{lineno}: {what} line has {len(fields)} fields, expected at least 6 "
-                    f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
-                )
-            try:
-                values = [float(f) for f in fields[:10]]
-            except ValueError:
-                raise ValueError(f"{p}:{lineno}: {what} line has a non-number: {text[:80]!r}") from None
-            if not all(np.isfinite(values[:6])):
-                raise ValueError(f"{p}:{lineno}: {what} line has a non-finite value: {text[:80]!r}")
-            frame = values[FRAME]
-            if frame < 1 or frame != int(frame):
-                raise ValueError(
-                    f"{p}:{lineno}: frame is {fields[0]}, expected an integer >= 1 (frames count from 1)"
-                )
-            if values[WIDTH] < 0 or values[HEIGHT] < 0:
-                raise ValueError(f"{p}:{lineno}: negative box width or height: {text[:80]!r}")
-            values.extend(_DEFAULTS[len(values) :])
-            rows.append(values)
+    for lineno, text in _data_lines(p):
+        fields = text.replace(",", " ").split()
+        if len(fields) < 6:
+            raise ValueError(
+                f"{p}:{lineno}: {what} line has {len(fields)} fields, expected at least 6 "
+                f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
+            )
+        try:
+            values = [float(f) for f in fields[:10]]
+        except ValueError:
+            raise ValueError(f"{p}:{lineno}: {what} line has a non-number: {text[:80]!r}") from None
+        if not all(np.isfinite(values[:6])):
+            raise ValueError(f"{p}:{lineno}: {what} line has a non-finite value: {text[:80]!r}")
+        frame = values[FRAME]
+        if frame < 1 or frame != int(frame):
+            raise ValueError(
+                f"{p}:{lineno}: frame is {fields[0]}, expected an integer >= 1 (frames count from 1)"
+            )
+        if values[WIDTH] < 0 or values[HEIGHT] < 0:
+            raise ValueError(f"{p}:{lineno}: negative box width or height: {text[:80]!r}")
+        values.extend(_DEFAULTS[len(values) :])
+        rows.append(values)
     if not rows:
         return np.zeros((0, 10))
     return np.asarray(rows, dtype=np.float64)

@@ -91,24 +91,14 @@ def add_experiment_parser(sub: Any) -> None:
     g.set_defaults(func=run_experiment_gaps)
 
 
-def _data_line_numbers(path: Path) -> list[int]:
-    out = []
-    with path.open("r", encoding="utf-8", errors="replace") as fh:
-        for n, line in enumerate(fh, start=1):
-            t = line.strip()
-            if t and not t.startswith("#"):
-                out.append(n)
-    return out
-
-
 def run_recover(args: argparse.Namespace) -> int:
     """``pftrack recover``."""
-    from pftrack.io.mot import read_mot, write_mot
+    from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery.linking import LinkConfig, check_unique, fill_gaps, link_tracklets
 
     src = Path(args.tracks)
     rows = read_mot(src, what="tracks file")
-    check_unique(rows, _data_line_numbers(src))
+    check_unique(rows, data_line_numbers(src))
     out = Path(args.out)
     if out.exists() and os.path.samefile(out, src) and not args.in_place:
         raise ValueError(
