@@ -15,13 +15,14 @@ the smoothed boxes match the annotation far more often than the detections thems
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, link_tracklets
 
-__all__ = ["BoxSmoother", "smooth_tracks"]
+__all__ = ["BoxSmoother", "cv_predict", "cv_update", "smooth_tracks"]
 
 F64 = NDArray[np.float64]
 
@@ -110,6 +111,24 @@ class BoxSmoother:
         return out  # rows before the first detection keep their own boxes
 
 
+def cv_predict(m: tuple[Any, Any], p: tuple[Any, Any, Any], q2: Any) -> tuple[tuple[Any, Any], tuple[Any, Any, Any]]:
+    """One step of a constant-velocity axis: mean (position, velocity) and covariance entries
+    ``(p00, p01, p11)`` advanced with white-noise acceleration of variance `q2` per frame.
+    Works on floats or on arrays of independent axes alike."""
+    p00, p01, p11 = p
+    return (m[0] + m[1], m[1]), (p00 + 2 * p01 + p11 + q2 / 4, p01 + p11 + q2 / 2, p11 + q2)
+
+
+def cv_update(m: tuple[Any, Any], p: tuple[Any, Any, Any], z: Any, r2: Any
+              ) -> tuple[tuple[Any, Any], tuple[Any, Any, Any]]:  # fmt: skip
+    """Kalman update of a constant-velocity axis with a position measurement `z` of variance `r2`."""
+    p00, p01, p11 = p
+    s = p00 + r2
+    k0, k1 = p00 / s, p01 / s
+    e = z - m[0]
+    return (m[0] + k0 * e, m[1] + k1 * e), ((1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01)
+
+
 def _rts(z: F64, has: NDArray[np.bool_], q: F64, r: F64, velocity_sd: float) -> F64:
     """Smoothed positions of independent constant-velocity axes (one per column of `z`).
 
@@ -121,26 +140,19 @@ def _rts(z: F64, has: NDArray[np.bool_], q: F64, r: F64, velocity_sd: float) -> 
     """
     steps = len(z)
     q2, r2 = q * q, r * r
-    m0, m1 = z[0].copy(), np.zeros_like(q)
-    p00, p01, p11 = r2.copy(), np.zeros_like(q), np.full_like(q, velocity_sd**2)
+    m = (z[0].copy(), np.zeros_like(q))
+    p = (r2.copy(), np.zeros_like(q), np.full_like(q, velocity_sd**2))
     fm = np.empty((steps, 2, len(q)))  # filtered mean
     fp = np.empty((steps, 3, len(q)))  # filtered covariance
     pp = np.empty((steps, 3, len(q)))  # predicted covariance
     pm = np.empty((steps, 2, len(q)))  # predicted mean
     for t in range(steps):
         if t > 0:
-            m0 = m0 + m1
-            p00, p01, p11 = p00 + 2 * p01 + p11 + q2 / 4, p01 + p11 + q2 / 2, p11 + q2
-        pm[t, 0], pm[t, 1] = m0, m1
-        pp[t, 0], pp[t, 1], pp[t, 2] = p00, p01, p11
+            m, p = cv_predict(m, p, q2)
+        pm[t], pp[t] = m, p
         if has[t] and t > 0:  # step 0's measurement is the initial state
-            s = p00 + r2
-            k0, k1 = p00 / s, p01 / s
-            e = z[t] - m0
-            m0, m1 = m0 + k0 * e, m1 + k1 * e
-            p00, p01, p11 = (1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01
-        fm[t, 0], fm[t, 1] = m0, m1
-        fp[t, 0], fp[t, 1], fp[t, 2] = p00, p01, p11
+            m, p = cv_update(m, p, z[t], r2)
+        fm[t], fp[t] = m, p
     out = np.empty((steps, len(q)))
     s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
     out[-1] = s0

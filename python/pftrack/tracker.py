@@ -23,7 +23,7 @@ from scipy.optimize import linear_sum_assignment
 from pftrack._typing import RngLike
 from pftrack.eval.metrics import iou_xywh
 from pftrack.recovery.linking import LinkConfig
-from pftrack.smoothing import BoxSmoother, smooth_tracks
+from pftrack.smoothing import BoxSmoother, cv_predict, cv_update, smooth_tracks
 from pftrack.particle_filter import (
     Ar2Model,
     ColourParticleFilter,
@@ -255,6 +255,8 @@ class _CentreKalman:
     Noise levels are in units of the track's height ``h`` so that one rule fits any image scale:
     white-noise acceleration ``σ_a = accel·h`` per frame², and a measurement standard deviation
     of ``detection_noise·h`` for a detection and ``colour_noise·h`` for a colour-filter estimate.
+    The equations are those of the offline smoother (:func:`pftrack.smoothing.cv_predict`,
+    :func:`~pftrack.smoothing.cv_update`), run on both axes at once.
     """
 
     def __init__(self, centre: NDArray[np.float64], height: float, accel: float) -> None:
@@ -262,25 +264,19 @@ class _CentreKalman:
         self.v = np.zeros(2)
         self.accel = accel
         # unknown initial velocity: about a third of a height per frame (a fast walker at 5 fps)
-        self.P = np.array([[(0.05 * height) ** 2, 0.0], [0.0, (0.3 * height) ** 2]])
+        self.cov = ((0.05 * height) ** 2, 0.0, (0.3 * height) ** 2)  # p00, p01, p11
+
+    @property
+    def P(self) -> NDArray[np.float64]:  # noqa: N802 - the usual name
+        """The (position, velocity) covariance of one axis, 2x2."""
+        p00, p01, p11 = self.cov
+        return np.array([[p00, p01], [p01, p11]])
 
     def predict(self, height: float) -> None:
-        self.p = self.p + self.v
-        P = self.P
-        q = (self.accel * height) ** 2
-        p00 = P[0, 0] + 2 * P[0, 1] + P[1, 1] + q / 4
-        p01 = P[0, 1] + P[1, 1] + q / 2
-        p11 = P[1, 1] + q
-        self.P = np.array([[p00, p01], [p01, p11]])
+        (self.p, self.v), self.cov = cv_predict((self.p, self.v), self.cov, (self.accel * height) ** 2)
 
     def update(self, z: NDArray[np.float64], sigma: float) -> None:
-        P = self.P
-        s = P[0, 0] + sigma**2
-        k0, k1 = P[0, 0] / s, P[0, 1] / s
-        y = np.asarray(z, dtype=np.float64) - self.p
-        self.p = self.p + k0 * y
-        self.v = self.v + k1 * y
-        self.P = np.array([[(1 - k0) * P[0, 0], (1 - k0) * P[0, 1]], [(1 - k0) * P[0, 1], P[1, 1] - k1 * P[0, 1]]])
+        (self.p, self.v), self.cov = cv_update((self.p, self.v), self.cov, np.asarray(z, dtype=np.float64), sigma**2)
 
 
 class _TrackState:
