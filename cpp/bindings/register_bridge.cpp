@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pftrack/bridge.hpp"
+#include "pftrack/gap_mixture.hpp"
 #include "pftrack/gdt_noise.hpp"
 
 namespace py = pybind11;
@@ -199,4 +200,29 @@ void register_bridge(py::module_& m) {
         },
         py::arg("z"), py::arg("lengths"), py::arg("q"), py::arg("r"),
         "Log-likelihood (G,) of runs z (stacked, lengths) under each (q, r) pair.");
+    m.def(
+        "gap_mixture",
+        [](Eigen::Ref<const Eigen::VectorXd> z, Index fa, Index fb, Eigen::Ref<const RowMatrixXd> F,
+           Eigen::Ref<const RowMatrixXd> Q, double r, Eigen::Ref<const Eigen::VectorXd> p0,
+           Eigen::Ref<const Eigen::VectorXi> t1, Eigen::Ref<const Eigen::VectorXi> t2, double v2) {
+            GapMixtureResult res;
+            {
+                py::gil_scoped_release nogil;  // safe: Eigen views and C++ copies only
+                res = gap_mixture(z, fa, fb, F, Q, r, p0, t1, t2, v2);
+            }
+            return py::make_tuple(std::move(res.paths), std::move(res.loglik));
+        },
+        py::arg("z"), py::arg("fa"), py::arg("fb"), py::arg("F"), py::arg("Q"), py::arg("r"),
+        py::arg("p0"), py::arg("t1"), py::arg("t2"), py::arg("v2"),
+        "Smoothed gap positions (H, T-1) and window log-likelihoods (H,) per stand hypothesis.");
+    m.def(
+        "state_loglik_batch",
+        [](Eigen::Ref<const Eigen::VectorXd> z, Eigen::Ref<const Eigen::VectorXi> lengths,
+           Eigen::Ref<const RowMatrixXd> F, Eigen::Ref<const RowMatrixXd> Q,
+           Eigen::Ref<const Eigen::VectorXd> r, double big) {
+            py::gil_scoped_release nogil;  // safe: Eigen views only
+            return state_loglik_batch(z, lengths, F, Q, r, big);
+        },
+        py::arg("z"), py::arg("lengths"), py::arg("F"), py::arg("Q"), py::arg("r"), py::arg("big"),
+        "Kalman log-likelihood (K,) of runs z (stacked, lengths) under K models (F, Q stacked).");
 }

@@ -321,3 +321,23 @@ def kalman_filter(
 
 # z stacked runs (sum lengths,), lengths (R,) int32, q, r (G,) -> (G,) log-likelihoods
 def noise_loglik_grid(z: _F64, lengths: _I32, q: _F64, r: _F64) -> _F64: ...
+
+# one coordinate's window z (n,) with NaN where unobserved; gap from index fa to fb; F, Q (d, d),
+# d = 2 or 3; p0 (d,) prior variances; stand hypotheses t1, t2 (H,) int32 ((-1, -1) = none)
+# -> smoothed gap positions (H, fb - fa - 1), window log-likelihoods (H,)
+def gap_mixture(
+    z: _F64,
+    fa: int,
+    fb: int,
+    F: _F64,
+    Q: _F64,
+    r: float,
+    p0: _F64,
+    t1: _I32,
+    t2: _I32,
+    v2: float,
+) -> tuple[_F64, _F64]: ...
+
+# z stacked runs (sum lengths,), lengths (R,) int32; F, Q (K * d, d) stacked models, r (K,)
+# -> (K,) log-likelihoods
+def state_loglik_batch(z: _F64, lengths: _I32, F: _F64, Q: _F64, r: _F64, big: float) -> _F64: ...

@@ -26,7 +26,7 @@ def add_recover_parser(sub: Any) -> None:
     )
     p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,conf,x,y,z)")
     p.add_argument("--out", required=True, help="output file (written atomically)")
-    p.add_argument("--method", default="gdt-bi", choices=METHODS, help="recovery method")
+    p.add_argument("--method", default="gdt-mix", choices=METHODS, help="recovery method")
     p.add_argument("--max-gap", type=int, default=30, help="longest hole filled, in frames")
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
     p.add_argument(
@@ -192,6 +192,11 @@ def run_experiment_gaps(args: argparse.Namespace) -> int:
             f"q = {run.noise.q[0]:.4g}, {run.noise.q[1]:.4g} px^2/frame^3, "
             f"r = {run.noise.r[0]:.4g}, {run.noise.r[1]:.4g} px^2"
         )
+    if run.motion is not None:
+        print(
+            f"gdt-mix model (fitted to the observed points, {run.motion_ms:.1f} ms): "
+            f"{run.motion.describe()}"
+        )
     if len(sweep):
         med = E.median_over(trajs, sweep, methods, args.max_positions)
         print()
@@ -207,7 +212,7 @@ def run_experiment_gaps(args: argparse.Namespace) -> int:
             run.paths,
             mask,
             (int(width), int(height)),
-            [m for m in ("gdt", "gdt-bi", "bspline") if m in methods],
+            [m for m in ("gdt", "gdt-mix", "bspline") if m in methods],
         )
         with atomic_path(args.figure) as tmp:
             if not cv2.imwrite(str(tmp), img, [cv2.IMWRITE_PNG_COMPRESSION, 9]):

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack.recovery.methods import METHODS, NoiseEstimate, estimate_noise, recover_gaps
+from pftrack.recovery.mixture import MotionFit, fit_motion
 
 F64 = NDArray[np.float64]
 
@@ -119,7 +120,11 @@ def observed_runs(trajs: dict[int, F64], mask: Sequence[float]) -> list[F64]:
 
 
 def score(
-    gaps: Sequence[Gap], method: str, repeat: int = 1, noise: NoiseEstimate | None = None
+    gaps: Sequence[Gap],
+    method: str,
+    repeat: int = 1,
+    noise: NoiseEstimate | None = None,
+    motion: MotionFit | None = None,
 ) -> tuple[MethodScore, list[F64]]:
     """Recover all gaps with `method` (best wall time of `repeat` runs) and score them."""
     pairs = [(g.segment_a, g.segment_b) for g in gaps]
@@ -127,7 +132,7 @@ def score(
     paths: list[F64] = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        paths = recover_gaps(pairs, method, noise=noise)
+        paths = recover_gaps(pairs, method, noise=noise, motion=motion)
         best = min(best, time.perf_counter() - t0)
     ex, ey, ee = [], [], []
     for g, p in zip(gaps, paths):
@@ -161,6 +166,8 @@ class MaskRun:
     paths: dict[str, list[F64]]
     noise: NoiseEstimate | None
     noise_ms: float
+    motion: MotionFit | None = None
+    motion_ms: float = 0.0
 
 
 def run_mask(
@@ -168,23 +175,38 @@ def run_mask(
 ) -> MaskRun:
     """Run all methods on one mask.
 
-    The noise levels of ``"gdt-bi"`` are estimated once from every observed point of the
-    sequence (all points outside the mask), timed separately.
+    The noise levels of ``"gdt-bi"`` and the model of ``"gdt-mix"`` are estimated once from
+    every observed point of the sequence (all points outside the mask), timed separately.
     """
     gaps, n_traj = find_gaps(trajs, mask)
     scores: dict[str, MethodScore] = {}
     paths: dict[str, list[F64]] = {}
-    noise = None
-    noise_ms = 0.0
+    noise = motion = None
+    noise_ms = motion_ms = 0.0
     if gaps:
-        if "gdt-bi" in methods:
+        if "gdt-bi" in methods or "gdt-mix" in methods:
+            runs = observed_runs(trajs, mask)
             t0 = time.perf_counter()
-            noise = estimate_noise(observed_runs(trajs, mask))
+            noise = estimate_noise(runs)
             noise_ms = 1e3 * (time.perf_counter() - t0)
+            if "gdt-mix" in methods:
+                t0 = time.perf_counter()
+                motion = fit_motion(runs, noise)
+                motion_ms = 1e3 * (time.perf_counter() - t0)
         for m in methods:
-            scores[m], paths[m] = score(gaps, m, repeat, noise)
+            scores[m], paths[m] = score(gaps, m, repeat, noise, motion)
     mk = tuple(float(v) for v in mask)
-    return MaskRun((mk[0], mk[1], mk[2], mk[3]), gaps, n_traj, scores, paths, noise, noise_ms)
+    return MaskRun(
+        (mk[0], mk[1], mk[2], mk[3]),
+        gaps,
+        n_traj,
+        scores,
+        paths,
+        noise,
+        noise_ms,
+        motion,
+        motion_ms,
+    )
 
 
 def format_table(scores: dict[str, MethodScore], title: str = "") -> str:
@@ -253,7 +275,7 @@ def draw_figure(
     paths: dict[str, list[F64]],
     mask: Sequence[float],
     size: tuple[int, int],
-    methods: Sequence[str] = ("gdt", "gdt-bi", "bspline"),
+    methods: Sequence[str] = ("gdt", "gdt-mix", "bspline"),
     height: int = 360,
 ) -> NDArray[np.uint8]:
     """Draw ground truth against recovered paths with OpenCV.

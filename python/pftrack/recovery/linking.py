@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack.recovery.methods import METHODS, NoiseEstimate, estimate_noise, recover_gaps
+from pftrack.recovery.mixture import fit_motion
 
 F64 = NDArray[np.float64]
 FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTChallenge row)
@@ -201,7 +202,7 @@ class FillReport:
 
 
 def fill_gaps(
-    tracks: F64, method: str = "gdt-bi", max_gap: int = 30, noise: NoiseEstimate | None = None
+    tracks: F64, method: str = "gdt-mix", max_gap: int = 30, noise: NoiseEstimate | None = None
 ) -> tuple[F64, FillReport]:
     """Fill every hole of at most `max_gap` missing frames inside each id's track.
 
@@ -230,11 +231,16 @@ def fill_gaps(
                 continue
             segs.append((seg[: h + 1], seg[h + 1 :]))
             meta.append((tid, r[h], r[h + 1]))
-    if method == "gdt-bi" and noise is None and segs:
-        noise = estimate_noise([_segment(r) for r in per_id.values()])
+    motion = None
+    if method in ("gdt-bi", "gdt-mix") and segs:
+        whole = [_segment(r) for r in per_id.values()]
+        if noise is None:
+            noise = estimate_noise(whole)
+        if method == "gdt-mix":  # one model for the file, not one per pair of segments
+            motion = fit_motion(whole, noise)
     new_rows: list[F64] = []
     if segs:
-        paths = recover_gaps(segs, method, noise=noise)
+        paths = recover_gaps(segs, method, noise=noise, motion=motion)
         for (tid, ra, rb), xy in zip(meta, paths):
             fr = np.arange(ra[0] + 1, rb[0])
             s = (fr - ra[0]) / (rb[0] - ra[0])

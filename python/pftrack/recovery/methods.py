@@ -17,6 +17,11 @@ Methods
     (``H_T = I``), and whose noise levels (white-noise-acceleration ``q`` and measurement
     ``r``, per axis) are estimated from the observed segments by the method of moments on
     second differences (:func:`estimate_noise`). The path starts at ``E[x_0 | y_T]``.
+``"gdt-mix"`` (pftrack's default)
+    ``gdt-bi`` mixed over "walks through" and "stands still for a while" hypotheses, each
+    weighted by its evidence, with the Singer motion model (correlated acceleration) where the
+    observed points support it; every parameter estimated from the observed points
+    (:mod:`pftrack.recovery.mixture`).
 ``"linear"``
     Straight line between the two ends (ByteTrack's post-processing).
 ``"cubic"``
@@ -37,7 +42,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -45,8 +50,11 @@ from numpy.typing import ArrayLike, NDArray
 import pftrack._core as _core
 from pftrack.recovery.gdt import GdtModel, constant_velocity_A
 
-METHODS = ("gdt", "gdt-bi", "linear", "cubic", "bspline", "gsi", "rts")
-PFTRACK_METHODS = ("gdt", "gdt-bi")
+if TYPE_CHECKING:
+    from pftrack.recovery.mixture import MotionFit
+
+METHODS = ("gdt", "gdt-bi", "gdt-mix", "linear", "cubic", "bspline", "gsi", "rts")
+PFTRACK_METHODS = ("gdt", "gdt-bi", "gdt-mix")
 F64 = NDArray[np.float64]
 
 _PAPER = GdtModel()
@@ -431,6 +439,7 @@ def recover_gap(
     method: str = "gdt",
     *,
     noise: NoiseEstimate | None = None,
+    motion: MotionFit | None = None,
 ) -> F64:
     """Positions (and sizes) of an object in the frames between two observed segments.
 
@@ -445,6 +454,9 @@ def recover_gap(
     noise : NoiseEstimate, optional
         For ``"gdt-bi"``: noise levels to use instead of estimating them from the two segments
         (e.g. pooled over a whole file with :func:`estimate_noise`).
+    motion : MotionFit, optional
+        For ``"gdt-mix"``: the model to use instead of fitting it to the two segments
+        (e.g. fitted to a whole file with :func:`pftrack.recovery.mixture.fit_motion`).
 
     Returns
     -------
@@ -466,7 +478,7 @@ def recover_gap(
         return np.zeros((0, 4 if a.shape[1] == 5 and b.shape[1] == 5 else 2))
     f0 = a[-1, 0]
     if method in PFTRACK_METHODS:
-        full = recover_gaps([(a, b)], method, noise=noise)[0]
+        full = recover_gaps([(a, b)], method, noise=noise, motion=motion)[0]
         xy = full[(fr - f0 - 1).astype(int)]
     elif method == "linear":
         xy = _linear(a, b, fr)
@@ -505,6 +517,7 @@ def recover_gaps(
     *,
     noise: NoiseEstimate | None = None,
     history: int | None = None,
+    motion: MotionFit | None = None,
 ) -> list[F64]:
     """Recover many gaps at once.
 
@@ -520,6 +533,9 @@ def recover_gaps(
     history : int, optional
         The Kalman filters of the goal-directed methods use at most this many points of the run
         of consecutive frames next to the gap; default: the whole run.
+    motion : MotionFit, optional
+        For ``"gdt-mix"``: the model shared by all gaps; default: fitted to all the segments
+        given (:func:`pftrack.recovery.mixture.fit_motion`, with `noise` as its fallback).
 
     Returns
     -------
@@ -546,6 +562,21 @@ def recover_gaps(
                 f"recover_gaps: {name} of gap {k % len(gaps)} must have shape (k, 3|5), "
                 f"non-empty; got {s.shape}"
             )
+    if method == "gdt-mix":
+        from pftrack.recovery.mixture import fit_motion, recover_mixture_gaps
+
+        pairs = [
+            (as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in zip(seg_a, seg_b)
+        ]
+        for k, (a, b) in enumerate(pairs):
+            if b[0, 0] <= a[-1, 0]:
+                raise ValueError(
+                    f"recover_gaps: gap {k}: segment_b starts at frame {b[0, 0]:g}, expected "
+                    f"after segment_a's end {a[-1, 0]:g}"
+                )
+        if motion is None:
+            motion = fit_motion(seg_a + seg_b, noise)
+        return recover_mixture_gaps(pairs, motion)
     if method == "gdt-bi" and noise is None:
         noise = estimate_noise(seg_a + seg_b)
     a_len = np.array([len(s) for s in seg_a], dtype=np.int32)

@@ -1,0 +1,251 @@
+// Gap recovery as a mixture over walk/stand hypotheses, for one coordinate.
+//
+// The path is a linear-Gaussian state-space model x_t = F x_{t-1} + w_t, w_t ~ N(0, Q), observed
+// as z_t = x_t[0] + v_t, v_t ~ N(0, r), with state (position, velocity) or (position, velocity,
+// acceleration). A window of observations z_0..z_{n-1} (NaN = not observed) holds the end of
+// segment A at index fa and the start of segment B at fb; the gap has T = fb - fa steps.
+// Hypothesis (t1, t2), 0 <= t1 < t2 <= T - 1, says the object stands still from gap step t1 + 1
+// to t2 + 1: on those steps F becomes diag(1, 0, ...) (velocity and acceleration reset to 0) and
+// Q becomes diag(Q[0][0], 0, ...) (the position wanders a little), and on step t2 + 1 a fresh
+// velocity of variance v2 starts. (-1, -1) is "walks through the gap".
+//
+// For every hypothesis one Kalman filter and Rauch-Tung-Striebel smoother run over the window
+// (the filter over the part before the gap is shared); the result is the smoothed positions
+// inside the gap and the log-likelihood of the window's observations, so that the caller can
+// weight the hypotheses by their evidence. For a linear-Gaussian model the smoothed mean inside
+// the gap is the goal-directed path conditioned on the filtered states at both ends.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+#include "pftrack/check.hpp"
+#include "pftrack/types.hpp"
+
+namespace pftrack {
+
+struct GapMixtureResult {
+    RowMatrixXd paths;       // (H, T - 1): smoothed positions of gap steps 1..T-1
+    Eigen::VectorXd loglik;  // (H,): log-likelihood of the window's observations
+};
+
+namespace detail {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+/// Pseudo-inverse of a symmetric positive semi-definite matrix (a standing object's velocity
+/// has zero predicted variance, so the RTS gain needs it).
+template <int D>
+Eigen::Matrix<double, D, D> psd_pinv(const Eigen::Matrix<double, D, D>& P) {
+    // Walking steps: well conditioned, the closed-form inverse is exact enough and cheap.
+    const double scale = P.diagonal().prod();
+    if (scale > 0.0 && P.determinant() > 1e-9 * scale) return P.inverse();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> es(P);
+    const auto& ev = es.eigenvalues();
+    const double tol = 1e-12 * std::max(1.0, ev.cwiseAbs().maxCoeff());
+    Eigen::Matrix<double, D, 1> inv;
+    for (int i = 0; i < D; ++i) inv(i) = ev(i) > tol ? 1.0 / ev(i) : 0.0;
+    return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+}
+
+template <int D>
+GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index fa, Index fb,
+                             const Eigen::Ref<const RowMatrixXd>& F_in,
+                             const Eigen::Ref<const RowMatrixXd>& Q_in, double r,
+                             const Eigen::Ref<const Eigen::VectorXd>& p0,
+                             const Eigen::Ref<const Eigen::VectorXi>& t1s,
+                             const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2) {
+    using Mat = Eigen::Matrix<double, D, D>;
+    using Vec = Eigen::Matrix<double, D, 1>;
+    const Index n = z.size(), T = fb - fa, H = t1s.size();
+    const Mat F = F_in, Q = Q_in;
+    Mat stand = Mat::Zero();
+    stand(0, 0) = 1.0;
+    Mat q_stand = Mat::Zero();
+    q_stand(0, 0) = Q(0, 0);
+    Mat q_restart = q_stand;
+    q_restart(1, 1) = v2;
+
+    // Filter over the window up to the end of segment A: the same for every hypothesis.
+    Vec m = Vec::Zero();
+    m(0) = z(0);
+    Mat P = p0.asDiagonal();
+    double ll_prefix = 0.0;
+    int seen = 0;
+    auto update = [&](Vec& mm, Mat& PP, double zt, double& ll) {
+        const double s = PP(0, 0) + r;
+        const double v = zt - mm(0);
+        if (seen >= D) ll -= 0.5 * (std::log(kTwoPi * s) + v * v / s);
+        ++seen;
+        const Vec k = PP.col(0) / s;
+        mm += k * v;
+        PP -= k * PP.row(0);
+        PP = 0.5 * (PP + PP.transpose()).eval();
+    };
+    for (Index t = 0; t <= fa; ++t) {
+        if (t > 0) {
+            m = F * m;
+            P = F * P * F.transpose() + Q;
+        }
+        if (std::isfinite(z(t))) update(m, P, z(t), ll_prefix);
+    }
+    const int seen_prefix = seen;
+
+    GapMixtureResult out{RowMatrixXd(H, T - 1), Eigen::VectorXd(H)};
+    const Index len = n - fa;  // window steps from the end of A on
+    std::vector<Vec> mp(len), ms(len);
+    std::vector<Mat> Pp(len), Ps(len), Fs(len);
+    for (Index h = 0; h < H; ++h) {
+        const int t1 = t1s(h), t2 = t2s(h);
+        Vec mh = m;
+        Mat Ph = P;
+        double ll = ll_prefix;
+        seen = seen_prefix;
+        ms[0] = mh;
+        Ps[0] = Ph;
+        for (Index j = 1; j < len; ++j) {  // window index fa + j, gap step j
+            const Mat* Fj = &F;
+            const Mat* Qj = &Q;
+            if (t1 >= 0 && j >= t1 + 1 && j <= t2 + 1) {
+                Fj = &stand;
+                Qj = j == t2 + 1 ? &q_restart : &q_stand;
+            }
+            Fs[j] = *Fj;
+            mh = (*Fj) * mh;
+            Ph = (*Fj) * Ph * Fj->transpose() + *Qj;
+            mp[j] = mh;
+            Pp[j] = Ph;
+            if (std::isfinite(z(fa + j))) update(mh, Ph, z(fa + j), ll);
+            ms[j] = mh;
+            Ps[j] = Ph;
+        }
+        for (Index j = len - 2; j >= 1; --j) {
+            const Mat C = Ps[j] * Fs[j + 1].transpose() * psd_pinv<D>(Pp[j + 1]);
+            ms[j] += C * (ms[j + 1] - mp[j + 1]);
+        }
+        for (Index j = 1; j < T; ++j) out.paths(h, j - 1) = ms[j](0);
+        out.loglik(h) = ll;
+    }
+    return out;
+}
+
+}  // namespace detail
+
+/// Smoothed gap positions and window log-likelihood under each walk/stand hypothesis (see the
+/// file comment). F, Q: (d, d) with d = 2 or 3; p0: (d,) prior variances of the state at z_0
+/// (mean (z_0, 0, ...)); t1s, t2s: (H,) stand intervals, (-1, -1) for none; v2: variance of the
+/// velocity after standing. The first d observations are not counted in the log-likelihood.
+inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index fa, Index fb,
+                                    const Eigen::Ref<const RowMatrixXd>& F,
+                                    const Eigen::Ref<const RowMatrixXd>& Q, double r,
+                                    const Eigen::Ref<const Eigen::VectorXd>& p0,
+                                    const Eigen::Ref<const Eigen::VectorXi>& t1s,
+                                    const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2) {
+    const char* fn = "gap_mixture";
+    const Index n = z.size(), d = F.rows();
+    require(d == 2 || d == 3, fn, "state dimension (rows of F)", d, "2 or 3");
+    require(F.cols() == d, fn, "F cols", F.cols(), d);
+    require(Q.rows() == d && Q.cols() == d, fn, "Q must be (d, d) like F");
+    require(p0.size() == d, fn, "len(p0)", p0.size(), d);
+    require(0 <= fa && fa < fb && fb < n, fn,
+            "need 0 <= fa < fb < len(z), got fa=" + std::to_string(fa) +
+                ", fb=" + std::to_string(fb) + ", len(z)=" + std::to_string(n));
+    require(fb - fa >= 2, fn, "the gap has no lost step (fb - fa must be >= 2)");
+    require(std::isfinite(z(0)) && std::isfinite(z(fa)) && std::isfinite(z(fb)), fn,
+            "z[0], z[fa] and z[fb] must be observed (finite)");
+    require_finite(F, fn, "F");
+    require_finite(Q, fn, "Q");
+    require_finite(p0, fn, "p0");
+    require((Q - Q.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + Q.cwiseAbs().maxCoeff()),
+            fn, "Q must be symmetric");
+    for (Index i = 0; i < d; ++i)
+        require(Q(i, i) >= 0.0 && p0(i) >= 0.0, fn, "Q and p0 must have non-negative variances");
+    require(std::isfinite(r) && r > 0.0, fn, "r", r, "a finite value > 0");
+    require(std::isfinite(v2) && v2 >= 0.0, fn, "v2", v2, "a finite value >= 0");
+    require(t1s.size() == t2s.size(), fn, "len(t2s)", t2s.size(), t1s.size());
+    require(t1s.size() > 0, fn, "no hypothesis given (t1s is empty)");
+    const Index T = fb - fa;
+    for (Index h = 0; h < t1s.size(); ++h) {
+        const int t1 = t1s(h), t2 = t2s(h);
+        const bool none = t1 == -1 && t2 == -1;
+        require(none || (0 <= t1 && t1 < t2 && t2 <= T - 1), fn,
+                "hypothesis " + std::to_string(h) + " is (" + std::to_string(t1) + ", " +
+                    std::to_string(t2) + "), expected (-1, -1) or 0 <= t1 < t2 <= T-1 = " +
+                    std::to_string(T - 1));
+    }
+    if (d == 2) return detail::gap_mixture<2>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
+    return detail::gap_mixture<3>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
+}
+
+/// Kalman prediction-error log-likelihood of one coordinate of many runs, for K models
+/// (F_k, Q_k, r_k) with state dimension 2 or 3. Each run starts at (z_0, 0, ...) with variance
+/// `big` on every state entry; its first d innovations are not counted. Runs shorter than d + 2
+/// are skipped. F, Q: (K * d, d) stacked.
+inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd>& z,
+                                          const Eigen::Ref<const Eigen::VectorXi>& lengths,
+                                          const Eigen::Ref<const RowMatrixXd>& F,
+                                          const Eigen::Ref<const RowMatrixXd>& Q,
+                                          const Eigen::Ref<const Eigen::VectorXd>& r, double big) {
+    const char* fn = "state_loglik_batch";
+    const Index K = r.size();
+    require(K > 0, fn, "no model given (r is empty)");
+    const Index d = F.cols();
+    require(d == 2 || d == 3, fn, "state dimension (cols of F)", d, "2 or 3");
+    require(F.rows() == K * d && Q.rows() == K * d && Q.cols() == d, fn,
+            "F and Q must be (K * d, d) with K = len(r)");
+    require(lengths.sum() == z.size(), fn, "sum(lengths)", lengths.sum(), z.size());
+    require_finite(z, fn, "z");
+    require_finite(F, fn, "F");
+    require_finite(Q, fn, "Q");
+    for (Index k = 0; k < K; ++k)
+        require(std::isfinite(r(k)) && r(k) > 0.0, fn,
+                "r must be finite and > 0 (model " + std::to_string(k) + ")");
+    require(std::isfinite(big) && big > 0.0, fn, "big", big, "a finite value > 0");
+    Eigen::VectorXd ll(K);
+    auto run_all = [&](auto dim) {
+        constexpr int D = decltype(dim)::value;
+        using Mat = Eigen::Matrix<double, D, D>;
+        using Vec = Eigen::Matrix<double, D, 1>;
+        for (Index k = 0; k < K; ++k) {
+            const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
+            const double rk = r(k);
+            double total = 0.0;
+            Index start = 0;
+            for (Index run = 0; run < lengths.size(); ++run) {
+                const Index len = lengths(run);
+                const double* zz = z.data() + start;
+                start += len;
+                if (len < D + 2) continue;
+                Vec m = Vec::Zero();
+                m(0) = zz[0];
+                Mat P = Mat::Identity() * big;
+                for (Index i = 0; i < len; ++i) {
+                    if (i > 0) {
+                        m = Fk * m;
+                        P = Fk * P * Fk.transpose() + Qk;
+                    }
+                    const double s = P(0, 0) + rk;
+                    const double v = zz[i] - m(0);
+                    if (i >= D) total -= 0.5 * (std::log(detail::kTwoPi * s) + v * v / s);
+                    const Vec g = P.col(0) / s;
+                    m += g * v;
+                    P -= g * P.row(0);
+                    P = 0.5 * (P + P.transpose()).eval();
+                }
+            }
+            ll(k) = std::isfinite(total) ? total : -std::numeric_limits<double>::infinity();
+        }
+    };
+    if (d == 2) run_all(std::integral_constant<int, 2>{});
+    else run_all(std::integral_constant<int, 3>{});
+    return ll;
+}
+
+}  // namespace pftrack

@@ -1,0 +1,299 @@
+"""The ``gdt-mix`` method: goal-directed recovery mixed over walk/stand hypotheses.
+
+``gdt-bi`` conditions one smooth motion model on both segments. Its errors come from two
+things a single smooth model cannot express (docs/recovery.md): people who stop, linger or turn
+round inside the gap, and acceleration that is correlated over a few frames (gait, keyframed
+annotation). ``gdt-mix`` adds both, with every parameter estimated from the observed points:
+
+* **Motion model, per axis** (:func:`fit_motion`): the Singer model (acceleration an
+  Ornstein-Uhlenbeck process of time constant ``tau``: ``da = -a/tau dt + sqrt(q) dW``) with
+  ``q``, ``r`` and ``tau`` by maximum likelihood of the observed runs. When the fitted ``tau``
+  is below one frame the data cannot tell correlated acceleration from jitter (the fit then
+  describes box noise, not motion), so the axis falls back to ``gdt-bi``'s white-noise-
+  acceleration model with the multi-scale noise estimate (:func:`estimate_noise`).
+* **Stand hypotheses**: "walks through the gap" and "stands still from step ``t1`` to ``t2``,
+  then walks on with a fresh velocity" for ``t1 < t2`` on a grid of ``grid`` steps. Standing:
+  velocity and acceleration reset to 0, the position wanders with the model's one-frame
+  variance; the new velocity has the mean squared velocity of the observed points as variance.
+  The prior ``P(no stand) = exp(-rate T)`` uses the stand rate of the observed runs
+  (:func:`stand_rate`); the posterior weights are the evidence of each hypothesis.
+* For each hypothesis a Kalman filter and RTS smoother run over ``window`` points on each side
+  and the gap (C++, ``_core.gap_mixture``); for a linear-Gaussian model this smoothed mean is
+  the goal-directed path conditioned on the filtered states at both ends. The result is the
+  posterior mean over the hypotheses.
+
+With no stand seen in the observed runs (``rate = 0``) and ``tau < 1`` on both axes, it reduces
+to a fixed-interval smoother of the ``gdt-bi`` model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+import pftrack._core as _core
+from pftrack.recovery.methods import NoiseEstimate, estimate_noise, recover_gaps
+
+F64 = NDArray[np.float64]
+ArrayLikeF = float | F64
+
+#: Prior variance of the position at the start of a window (px^2): uninformative.
+DIFFUSE = 1e4
+#: Candidate times of standing still per gap (191 hypotheses with 20).
+GRID = 20
+#: Observed points used on each side of a gap.
+WINDOW = 30
+
+
+def _expm(M: F64) -> F64:
+    """Matrix exponential of a stack ``(K, n, n)``: scaling and squaring with a Taylor series."""
+    norm = np.abs(M).sum(axis=2).max(axis=1)
+    s = np.maximum(0, np.ceil(np.log2(np.maximum(norm, 1e-300))) + 1).astype(int)
+    A = M / (2.0**s)[:, None, None]
+    E = np.broadcast_to(np.eye(M.shape[1]), M.shape).copy()
+    term = E.copy()
+    for k in range(1, 19):
+        term = term @ A / k
+        E += term
+    for i in range(int(s.max())):
+        sq = s > i
+        E[sq] = E[sq] @ E[sq]
+    return E
+
+
+def singer_model(q: ArrayLikeF, tau: ArrayLikeF) -> tuple[F64, F64]:
+    """One-frame transition ``F`` and noise ``Q`` of ``(position, velocity, acceleration)``.
+
+    Continuous model ``da = -a/tau dt + sqrt(q) dW`` (``tau = inf``: white jerk), discretised
+    exactly (Van Loan). ``q`` and ``tau`` broadcast; returns ``(K, 3, 3)`` stacks.
+    """
+    q, tau = np.broadcast_arrays(np.atleast_1d(np.asarray(q, float)), np.atleast_1d(tau))
+    K = q.size
+    M = np.zeros((K, 6, 6))
+    Fc = np.zeros((K, 3, 3))
+    Fc[:, 0, 1] = Fc[:, 1, 2] = 1.0
+    with np.errstate(divide="ignore"):
+        Fc[:, 2, 2] = np.where(np.isinf(tau), 0.0, -1.0 / tau).ravel()
+    M[:, :3, :3] = -Fc
+    M[:, 2, 5] = q.ravel()
+    M[:, 3:, 3:] = Fc.transpose(0, 2, 1)
+    V = _expm(M)
+    F = V[:, 3:, 3:].transpose(0, 2, 1)
+    Q = F @ V[:, :3, 3:]
+    return F, 0.5 * (Q + Q.transpose(0, 2, 1))
+
+
+def wna_model(q: float) -> tuple[F64, F64]:
+    """``F`` and ``Q`` of ``(position, velocity)`` under white-noise acceleration ``q``."""
+    return np.array([[1.0, 1.0], [0.0, 1.0]]), q * np.array([[1 / 3, 1 / 2], [1 / 2, 1.0]])
+
+
+@dataclass(frozen=True)
+class AxisModel:
+    """Motion model of one axis: ``kind`` is ``"singer"`` or ``"wna"`` (white-noise
+    acceleration); ``tau`` (frames) is the Singer time constant found by maximum likelihood,
+    also kept when the axis fell back to ``"wna"``.
+    """
+
+    kind: str
+    q: float
+    r: float
+    tau: float
+
+    def matrices(self) -> tuple[F64, F64]:
+        """One-frame ``F`` and ``Q``."""
+        if self.kind == "singer":
+            F, Q = singer_model(self.q, self.tau)
+            return F[0], Q[0]
+        return wna_model(self.q)
+
+    def prior(self, v2: float) -> F64:
+        """Prior variances of the state at a window's first point."""
+        if self.kind == "singer":
+            a2 = self.q * self.tau / 2.0  # stationary variance of the acceleration
+            return np.array([DIFFUSE, v2, a2])
+        return np.array([DIFFUSE, v2])
+
+
+@dataclass(frozen=True)
+class MotionFit:
+    """Everything ``gdt-mix`` estimates from the observed points (:func:`fit_motion`).
+
+    ``axes``: the (x, y) models; ``stand_rate``: stands per walking frame; ``v2``: mean squared
+    velocity per axis (px^2/frame^2), the variance of a velocity after standing still.
+    """
+
+    axes: tuple[AxisModel, AxisModel]
+    stand_rate: float
+    v2: tuple[float, float]
+    noise: NoiseEstimate
+
+    def describe(self) -> str:
+        """One line: the model of each axis, the stand rate and the restart velocity."""
+        parts = []
+        for name, m in zip("xy", self.axes):
+            if m.kind == "singer":
+                parts.append(f"{name}: Singer q={m.q:.3g} r={m.r:.3g} tau={m.tau:.2f} frames")
+            else:
+                parts.append(
+                    f"{name}: white acceleration q={m.q:.3g} r={m.r:.3g} (tau={m.tau:.2f})"
+                )
+        parts.append(f"stand rate {self.stand_rate:.4f}/frame")
+        parts.append(f"velocity variance {self.v2[0]:.3g}, {self.v2[1]:.3g} px^2/frame^2")
+        return "; ".join(parts)
+
+    @property
+    def is_gdt_bi(self) -> bool:
+        """No stand seen and white-noise acceleration on both axes: the ``gdt-bi`` model."""
+        return self.stand_rate == 0.0 and all(m.kind == "wna" for m in self.axes)
+
+
+def _stack_runs(runs: Sequence[F64], axis: int) -> tuple[F64, NDArray[np.int32]]:
+    z = np.ascontiguousarray(np.concatenate([r[:, 1 + axis] for r in runs]))
+    return z, np.array([len(r) for r in runs], dtype=np.int32)
+
+
+def fit_singer(runs: Sequence[F64], axis: int, levels: int = 4) -> tuple[float, float, float]:
+    """Maximum-likelihood ``(q, r, tau)`` of the Singer model for one axis of the runs.
+
+    Kalman prediction-error likelihood (C++, ``_core.state_loglik_batch``) maximised on a
+    coarse-to-fine 7x7x7 grid of ``log q``, ``log r``, ``log tau``.
+    """
+    z, lengths = _stack_runs(runs, axis)
+    lo = np.array([-5.0, -3.0, -1.5])  # log10 of q, r, tau
+    hi = np.array([3.0, 3.0, 2.5])
+    best = (lo + hi) / 2.0
+    for _ in range(levels):
+        axes = [np.linspace(lo[i], hi[i], 7) for i in range(3)]
+        g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        q, r, tau = 10.0 ** g[:, 0], 10.0 ** g[:, 1], 10.0 ** g[:, 2]
+        F, Q = singer_model(q, tau)
+        ll = _core.state_loglik_batch(
+            z,
+            lengths,
+            np.ascontiguousarray(F.reshape(-1, 3)),
+            np.ascontiguousarray(Q.reshape(-1, 3)),
+            r,
+            DIFFUSE,
+        )
+        best = g[int(np.argmax(ll))]
+        step = (hi - lo) / 6.0
+        lo, hi = best - step, best + step
+    q, r, tau = 10.0**best
+    return float(q), float(r), float(tau)
+
+
+def stand_rate(runs: Sequence[F64], noise: NoiseEstimate, k: int = 8) -> float:
+    """Stands per walking frame in the observed runs.
+
+    A frame is *standing* when its ``k``-frame displacement is, on both axes, within two
+    standard deviations of what a standing object gives (position random walk ``q/3`` per frame
+    plus measurement noise: ``sqrt(k q / 3 + 2 r)``); a stand starts at a walking-to-standing
+    change. ``k = 8`` is the coarsest scale of :func:`estimate_noise`.
+    """
+    sd = np.sqrt(k * np.asarray(noise.q) / 3.0 + 2.0 * np.asarray(noise.r))
+    onsets = walking = 0
+    for r in runs:
+        if len(r) <= k:
+            continue
+        standing = np.all(np.abs(r[k:, 1:3] - r[:-k, 1:3]) < 2.0 * sd, axis=1)
+        onsets += int(np.sum(standing[1:] & ~standing[:-1]))
+        walking += int(np.sum(~standing))
+    return onsets / max(walking, 1)
+
+
+def _runs(segments: Sequence[F64], min_points: int = 6) -> list[F64]:
+    out: list[F64] = []
+    for s in segments:
+        a = np.asarray(s, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
+            continue
+        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
+            if len(run) >= min_points:
+                out.append(run)
+    return out
+
+
+def fit_motion(segments: Sequence[F64], noise: NoiseEstimate | None = None) -> MotionFit:
+    """Estimate the ``gdt-mix`` model from observed segments (rows ``(frame, x, y, ...)``).
+
+    ``noise``: the white-noise-acceleration estimate used as fallback and for the stand rate;
+    default :func:`estimate_noise` of the same segments.
+    """
+    runs = _runs(segments)
+    if noise is None:
+        noise = estimate_noise(runs)
+    if sum(len(r) for r in runs) < 20:  # too little to fit anything: gdt-bi's model, no stands
+        axes = tuple(AxisModel("wna", noise.q[i], noise.r[i], 0.0) for i in range(2))
+        return MotionFit((axes[0], axes[1]), 0.0, (1.0, 1.0), noise)
+    models = []
+    for axis in range(2):
+        q, r, tau = fit_singer(runs, axis)
+        if tau >= 1.0:
+            models.append(AxisModel("singer", q, r, tau))
+        else:
+            models.append(AxisModel("wna", noise.q[axis], noise.r[axis], tau))
+    vel = np.vstack([np.diff(r[:, 1:3], axis=0) for r in runs])
+    v2 = np.mean(vel**2, axis=0)
+    return MotionFit(
+        (models[0], models[1]), stand_rate(runs, noise), (float(v2[0]), float(v2[1])), noise
+    )
+
+
+def stand_hypotheses(T: int, grid: int = GRID) -> tuple[NDArray[np.int32], NDArray[np.int32]]:
+    """``(t1, t2)`` of every hypothesis: first ``(-1, -1)`` (no stand), then ``t1 < t2`` on
+    ``min(grid, T)`` evenly spaced steps of ``0 .. T-1``.
+    """
+    ks = np.unique(np.round(np.linspace(0, T - 1, min(grid, T))).astype(np.int32))
+    i, j = np.triu_indices(len(ks), k=1)
+    return (
+        np.concatenate([[-1], ks[i]]).astype(np.int32),
+        np.concatenate([[-1], ks[j]]).astype(np.int32),
+    )
+
+
+def recover_mixture(
+    seg_a: F64, seg_b: F64, fit: MotionFit, grid: int = GRID, window: int = WINDOW
+) -> F64:
+    """``(T - 1, 2)`` positions inside the gap between two segments (``(frame, x, y, ...)``)."""
+    a, b = seg_a[-window:], seg_b[:window]
+    f0 = int(a[0, 0])
+    n = int(b[-1, 0]) - f0 + 1
+    fa, fb = int(a[-1, 0]) - f0, int(b[0, 0]) - f0
+    T = fb - fa
+    if T < 2:
+        return np.zeros((0, 2))
+    if fit.stand_rate > 0.0:
+        t1, t2 = stand_hypotheses(T, grid)
+        n_stand = len(t1) - 1
+        log_prior = np.full(len(t1), np.log(-np.expm1(-fit.stand_rate * T) / max(n_stand, 1)))
+        log_prior[0] = -fit.stand_rate * T
+    else:
+        t1 = t2 = np.array([-1], dtype=np.int32)
+        log_prior = np.zeros(1)
+    ia, ib = (a[:, 0] - f0).astype(int), (b[:, 0] - f0).astype(int)
+    paths, loglik = [], log_prior.copy()
+    for axis, model in enumerate(fit.axes):
+        z = np.full(n, np.nan)
+        z[ia], z[ib] = a[:, 1 + axis], b[:, 1 + axis]
+        F, Q = model.matrices()
+        p, ll = _core.gap_mixture(
+            z, fa, fb, F, Q, model.r, model.prior(fit.v2[axis]), t1, t2, fit.v2[axis]
+        )
+        paths.append(p)
+        loglik += ll
+    w = np.exp(loglik - loglik.max())
+    w /= w.sum()
+    return np.column_stack([w @ paths[0], w @ paths[1]])
+
+
+def recover_mixture_gaps(gaps: Sequence[tuple[F64, F64]], fit: MotionFit) -> list[F64]:
+    """:func:`recover_mixture` for many gaps; ``gdt-bi`` itself (one C++ call) when the fitted
+    model is ``gdt-bi``'s (:attr:`MotionFit.is_gdt_bi`).
+    """
+    if fit.is_gdt_bi:
+        return recover_gaps(gaps, "gdt-bi", noise=fit.noise)
+    return [recover_mixture(a, b, fit) for a, b in gaps]
