@@ -46,6 +46,7 @@ from numpy.typing import NDArray
 from pftrack.io.mot import read_mot
 from pftrack.recovery import experiment as E
 from pftrack.recovery.methods import NoiseEstimate, estimate_noise, gdt_bi_problem, recover_gaps
+from pftrack.recovery.mixture import fit_motion
 from scipy.linalg import expm
 from scipy.optimize import minimize
 
@@ -320,6 +321,17 @@ def stop_mixture(a: F64, b: F64, noise: NoiseEstimate, rate: float, v2: F64, gri
     return np.asarray(np.einsum("h,htc->tc", w / w.sum(), paths)[1:T])
 
 
+def gdt_mix() -> Variant:
+    """The shipped ``gdt-mix``: model fitted per mask to every observed point."""
+
+    def run(gaps: list[E.Gap], runs: list[F64]) -> list[F64]:
+        pairs = [(g.segment_a, g.segment_b) for g in gaps]
+        noise = estimate_noise(runs)
+        return recover_gaps(pairs, "gdt-mix", noise=noise, motion=fit_motion(runs, noise))
+
+    return run
+
+
 def stop_variant() -> Variant:
     def run(gaps: list[E.Gap], runs: list[F64]) -> list[F64]:
         noise = estimate_noise(runs)
@@ -380,6 +392,7 @@ def more(data: Path, max_positions: int, point: str) -> None:
         for kind in ("ca", "singer", "singer+ou"):
             variants[kind] = nd_variant([fit_state_model(fit_runs, ax, kind) for ax in range(2)])
         variants["stop mixture"] = stop_variant()
+        variants["gdt-mix (shipped)"] = gdt_mix()
         print(f"{name} ({point}): median MMAE total over {len(masks)} positions", flush=True)
         for label, v in variants.items():
             print(f"  {label:<20}{median_mmae(masks, v):8.3f}", flush=True)

@@ -18,6 +18,7 @@ from pftrack.recovery.methods import recover_gaps
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "recovery"))
 import reference_bridge as ref  # noqa: E402
+import reference_mixture as ref_mix  # noqa: E402
 
 A = constant_velocity_A(1.0)
 Q = np.diag([1e-6, 1e-6, 1e-4, 1e-4])
@@ -61,12 +62,43 @@ def _pets_gaps():
 
 
 @pytest.mark.benchmark(group="PETS mask 396,224: all 23 gaps")
-@pytest.mark.parametrize("method", ["gdt", "gdt-bi", "linear", "cubic", "bspline"])
+@pytest.mark.parametrize("method", ["gdt", "gdt-bi", "gdt-mix", "linear", "cubic", "bspline"])
 def test_pets_all_gaps(benchmark, method):
     pairs = _pets_gaps()
-    noise = None
-    if method == "gdt-bi":
+    noise = motion = None
+    if method in ("gdt-bi", "gdt-mix"):
         from pftrack.recovery import estimate_noise
+        from pftrack.recovery.mixture import fit_motion
 
-        noise = estimate_noise([p for pair in pairs for p in pair])
-    benchmark(recover_gaps, pairs, method, noise=noise)
+        segments = [p for pair in pairs for p in pair]
+        noise = estimate_noise(segments)
+        motion = fit_motion(segments, noise) if method == "gdt-mix" else None
+    benchmark(recover_gaps, pairs, method, noise=noise, motion=motion)
+
+
+def _mixture_problem(T: int):
+    """A walking window (30 points each side) with a gap of T steps and every stand hypothesis
+    of gdt-mix (191 for T >= 20), Singer model as fitted on PETS."""
+    from pftrack.recovery.mixture import singer_model, stand_hypotheses
+
+    rng = np.random.default_rng(0)
+    n = 60 + T
+    z = np.cumsum(rng.normal(3.0, 0.3, n))
+    z[30 : 30 + T - 1] = np.nan
+    F, Qm = singer_model(0.0635, 2.99)
+    t1, t2 = stand_hypotheses(T)
+    return (z, 29, 29 + T, F[0], Qm[0], 0.0774, np.array([1e4, 21.9, 0.1]), t1, t2, 21.9)
+
+
+@pytest.mark.parametrize("T", [10, 40, 160])
+def test_gap_mixture_core(benchmark, T):
+    benchmark.group = f"gdt-mix one gap, one axis, T={T}"
+    benchmark(_core.gap_mixture, *_mixture_problem(T))
+
+
+@pytest.mark.parametrize("T", [10, 40, 160])
+def test_gap_mixture_numpy(benchmark, T):
+    benchmark.group = f"gdt-mix one gap, one axis, T={T}"
+    benchmark.pedantic(
+        ref_mix.gap_mixture_vectorised, args=_mixture_problem(T), rounds=3, iterations=1
+    )

@@ -18,6 +18,7 @@ from pftrack.recovery.mixture import (
 )
 
 from .reference_mixture import gap_mixture as ref_gap_mixture
+from .reference_mixture import gap_mixture_vectorised
 from .reference_mixture import singer_quadrature, state_loglik
 
 
@@ -44,6 +45,9 @@ def test_gap_mixture_matches_numpy(d: int, seed: int) -> None:
     assert got_p.shape == (len(t1), fb - fa - 1)
     np.testing.assert_allclose(got_p, ref_p, rtol=1e-9, atol=1e-8)
     np.testing.assert_allclose(got_ll, ref_ll, rtol=1e-10, atol=1e-8)
+    vec_p, vec_ll = gap_mixture_vectorised(z, fa, fb, F, Q, 0.3, p0, t1, t2, 4.0)
+    np.testing.assert_allclose(vec_p, ref_p, rtol=1e-9, atol=1e-8)
+    np.testing.assert_allclose(vec_ll, ref_ll, rtol=1e-10, atol=1e-8)
 
 
 def test_gap_mixture_walk_hypothesis_is_the_gaussian_conditional() -> None:

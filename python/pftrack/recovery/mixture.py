@@ -93,9 +93,11 @@ def wna_model(q: float) -> tuple[F64, F64]:
 
 @dataclass(frozen=True)
 class AxisModel:
-    """Motion model of one axis: ``kind`` is ``"singer"`` or ``"wna"`` (white-noise
-    acceleration); ``tau`` (frames) is the Singer time constant found by maximum likelihood,
-    also kept when the axis fell back to ``"wna"``.
+    """Motion model of one axis.
+
+    ``kind`` is ``"singer"`` or ``"wna"`` (white-noise acceleration); ``tau`` (frames) is the
+    Singer time constant found by maximum likelihood, also kept when the axis fell back to
+    ``"wna"``.
     """
 
     kind: str
@@ -244,8 +246,10 @@ def fit_motion(segments: Sequence[F64], noise: NoiseEstimate | None = None) -> M
 
 
 def stand_hypotheses(T: int, grid: int = GRID) -> tuple[NDArray[np.int32], NDArray[np.int32]]:
-    """``(t1, t2)`` of every hypothesis: first ``(-1, -1)`` (no stand), then ``t1 < t2`` on
-    ``min(grid, T)`` evenly spaced steps of ``0 .. T-1``.
+    """Return ``(t1, t2)`` of every stand hypothesis of a gap of ``T`` steps.
+
+    First ``(-1, -1)`` (no stand), then every ``t1 < t2`` on ``min(grid, T)`` evenly spaced
+    steps of ``0 .. T-1``.
     """
     ks = np.unique(np.round(np.linspace(0, T - 1, min(grid, T))).astype(np.int32))
     i, j = np.triu_indices(len(ks), k=1)
@@ -291,8 +295,10 @@ def recover_mixture(
 
 
 def recover_mixture_gaps(gaps: Sequence[tuple[F64, F64]], fit: MotionFit) -> list[F64]:
-    """:func:`recover_mixture` for many gaps; ``gdt-bi`` itself (one C++ call) when the fitted
-    model is ``gdt-bi``'s (:attr:`MotionFit.is_gdt_bi`).
+    """Recover many gaps with :func:`recover_mixture`.
+
+    When the fitted model is ``gdt-bi``'s (:attr:`MotionFit.is_gdt_bi`), ``gdt-bi`` itself runs
+    (one C++ call for all gaps).
     """
     if fit.is_gdt_bi:
         return recover_gaps(gaps, "gdt-bi", noise=fit.noise)
