@@ -22,7 +22,8 @@ synthetic scenes 0/1/2:
   time constant by maximum likelihood;
 * ``singer+ou``: the same plus a mean-reverting velocity (both time constants by ML);
 * ``stop mixture``: ``gdt-bi`` mixed over "the object stands still inside the gap" hypotheses
-  (:func:`stop_mixture`), stop rate estimated from the observed runs (:func:`stop_rate`);
+  (:func:`stop_mixture`), stop rate estimated from the observed runs
+  (:func:`pftrack.recovery.mixture.stand_rate`);
 * the per-mask oracle of ``gdt-bi`` over the ratio ``q / r`` (a bound, uses the lost points).
 
 For the ``iou`` variants ``q, r`` are fitted once per sequence on the points observed around
@@ -46,7 +47,7 @@ from numpy.typing import NDArray
 from pftrack.io.mot import read_mot
 from pftrack.recovery import experiment as E
 from pftrack.recovery.methods import NoiseEstimate, estimate_noise, gdt_bi_problem, recover_gaps
-from pftrack.recovery.mixture import fit_motion
+from pftrack.recovery.mixture import fit_motion, stand_rate
 from scipy.linalg import expm
 from scipy.optimize import minimize
 
@@ -249,25 +250,6 @@ def nd_variant(models: list[tuple[F64, F64, float]]) -> Variant:
     return run
 
 
-def stop_rate(runs: Sequence[F64], noise: NoiseEstimate, k: int = 8) -> float:
-    """Stops per walking frame in the observed runs.
-
-    A frame is *standing* when its ``k``-frame displacement is, on both axes, within two
-    standard deviations of what a standing object gives (position random walk ``q/3`` per
-    frame plus measurement noise: ``sqrt(k q / 3 + 2 r)``); a stop is a walking-to-standing
-    change. ``k = 8`` is the coarsest scale of :func:`estimate_noise`.
-    """
-    sd = np.sqrt(k * np.asarray(noise.q) / 3.0 + 2.0 * np.asarray(noise.r))
-    onsets = walking = 0
-    for r in runs:
-        if len(r) <= k:
-            continue
-        standing = np.all(np.abs(r[k:, 1:3] - r[:-k, 1:3]) < 2.0 * sd, axis=1)
-        onsets += int(np.sum(standing[1:] & ~standing[:-1]))
-        walking += int(np.sum(~standing))
-    return onsets / max(walking, 1)
-
-
 def stop_mixture(a: F64, b: F64, noise: NoiseEstimate, rate: float, v2: F64, grid: int = 12) -> F64:
     """``gdt-bi`` mixed over hypotheses "walks, stands still from step t1 to t2, walks on".
 
@@ -335,7 +317,7 @@ def gdt_mix() -> Variant:
 def stop_variant() -> Variant:
     def run(gaps: list[E.Gap], runs: list[F64]) -> list[F64]:
         noise = estimate_noise(runs)
-        rate = stop_rate(runs, noise)
+        rate = stand_rate(runs, noise)
         v2 = np.mean(np.vstack([np.diff(r[:, 1:3], axis=0) for r in runs if len(r) > 1]) ** 2, 0)
         return [stop_mixture(g.segment_a, g.segment_b, noise, rate, v2) for g in gaps]
 

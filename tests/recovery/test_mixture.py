@@ -18,8 +18,7 @@ from pftrack.recovery.mixture import (
 )
 
 from .reference_mixture import gap_mixture as ref_gap_mixture
-from .reference_mixture import gap_mixture_vectorised
-from .reference_mixture import singer_quadrature, state_loglik
+from .reference_mixture import gap_mixture_vectorised, singer_quadrature, state_loglik
 
 
 def _window(rng: np.random.Generator, n: int, fa: int, fb: int, holes: int) -> np.ndarray:

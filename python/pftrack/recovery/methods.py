@@ -139,6 +139,22 @@ def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseE
     return NoiseEstimate(q=(qs[0], qs[1]), r=(rs[0], rs[1]))
 
 
+def consecutive_runs(segments: Sequence[ArrayLike], min_points: int) -> list[F64]:
+    """Split segments (rows ``(frame, x, y, ...)``) into runs of consecutive frames.
+
+    Runs shorter than `min_points` and malformed or empty segments are skipped.
+    """
+    runs: list[F64] = []
+    for s in segments:
+        a = np.asarray(s, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
+            continue
+        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
+            if len(run) >= min_points:
+                runs.append(run)
+    return runs
+
+
 def estimate_noise(
     segments: Sequence[ArrayLike],
     *,
@@ -182,14 +198,7 @@ def estimate_noise(
     """
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
-    runs: list[F64] = []
-    for s in segments:
-        a = np.asarray(s, dtype=np.float64)
-        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
-            continue
-        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
-            if len(run) >= max(min_points, 4):
-                runs.append(run)
+    runs = consecutive_runs(segments, max(min_points, 4))
     if sum(len(r) - 3 for r in runs) < 4:
         return DEFAULT_NOISE
     if not scales or any(int(v) < 1 for v in scales):

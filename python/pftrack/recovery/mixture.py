@@ -35,7 +35,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 import pftrack._core as _core
-from pftrack.recovery.methods import NoiseEstimate, estimate_noise, recover_gaps
+from pftrack.recovery.methods import (
+    NoiseEstimate,
+    consecutive_runs,
+    estimate_noise,
+    recover_gaps,
+)
 
 F64 = NDArray[np.float64]
 ArrayLikeF = float | F64
@@ -207,25 +212,13 @@ def stand_rate(runs: Sequence[F64], noise: NoiseEstimate, k: int = 8) -> float:
     return onsets / max(walking, 1)
 
 
-def _runs(segments: Sequence[F64], min_points: int = 6) -> list[F64]:
-    out: list[F64] = []
-    for s in segments:
-        a = np.asarray(s, dtype=np.float64)
-        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
-            continue
-        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
-            if len(run) >= min_points:
-                out.append(run)
-    return out
-
-
 def fit_motion(segments: Sequence[F64], noise: NoiseEstimate | None = None) -> MotionFit:
     """Estimate the ``gdt-mix`` model from observed segments (rows ``(frame, x, y, ...)``).
 
     ``noise``: the white-noise-acceleration estimate used as fallback and for the stand rate;
     default :func:`estimate_noise` of the same segments.
     """
-    runs = _runs(segments)
+    runs = consecutive_runs(segments, 6)
     if noise is None:
         noise = estimate_noise(runs)
     if sum(len(r) for r in runs) < 20:  # too little to fit anything: gdt-bi's model, no stands
