@@ -30,9 +30,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.linalg import expm
 
 import pftrack._core as _core
 from pftrack.recovery.methods import (
@@ -53,22 +55,6 @@ GRID = 20
 WINDOW = 30
 
 
-def _expm(M: F64) -> F64:
-    """Matrix exponential of a stack ``(K, n, n)``: scaling and squaring with a Taylor series."""
-    norm = np.abs(M).sum(axis=2).max(axis=1)
-    s = np.maximum(0, np.ceil(np.log2(np.maximum(norm, 1e-300))) + 1).astype(int)
-    A = M / (2.0**s)[:, None, None]
-    E = np.broadcast_to(np.eye(M.shape[1]), M.shape).copy()
-    term = E.copy()
-    for k in range(1, 19):
-        term = term @ A / k
-        E += term
-    for i in range(int(s.max())):
-        sq = s > i
-        E[sq] = E[sq] @ E[sq]
-    return E
-
-
 def singer_model(q: ArrayLikeF, tau: ArrayLikeF) -> tuple[F64, F64]:
     """One-frame transition ``F`` and noise ``Q`` of ``(position, velocity, acceleration)``.
 
@@ -85,7 +71,7 @@ def singer_model(q: ArrayLikeF, tau: ArrayLikeF) -> tuple[F64, F64]:
     M[:, :3, :3] = -Fc
     M[:, 2, 5] = q.ravel()
     M[:, 3:, 3:] = Fc.transpose(0, 2, 1)
-    V = _expm(M)
+    V = expm(M)
     F = V[:, 3:, 3:].transpose(0, 2, 1)
     Q = F @ V[:, :3, 3:]
     return F, 0.5 * (Q + Q.transpose(0, 2, 1))
@@ -110,8 +96,9 @@ class AxisModel:
     r: float
     tau: float
 
+    @cached_property
     def matrices(self) -> tuple[F64, F64]:
-        """One-frame ``F`` and ``Q``."""
+        """One-frame ``F`` and ``Q`` (computed once per model, not once per gap)."""
         if self.kind == "singer":
             F, Q = singer_model(self.q, self.tau)
             return F[0], Q[0]
@@ -276,7 +263,7 @@ def recover_mixture(
     for axis, model in enumerate(fit.axes):
         z = np.full(n, np.nan)
         z[ia], z[ib] = a[:, 1 + axis], b[:, 1 + axis]
-        F, Q = model.matrices()
+        F, Q = model.matrices
         p, ll = _core.gap_mixture(
             z, fa, fb, F, Q, model.r, model.prior(fit.v2[axis]), t1, t2, fit.v2[axis]
         )
