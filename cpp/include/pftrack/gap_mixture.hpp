@@ -100,24 +100,55 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
 
     GapMixtureResult out{RowMatrixXd(H, T - 1), Eigen::VectorXd(H)};
     const Index len = n - fa;  // window steps from the end of A on
+    // The walking filter over the rest of the window, kept: a stand hypothesis (t1, t2) is the
+    // same filter up to gap step t1, so it starts from there instead of from the end of A.
+    std::vector<Vec> walk_m(len), walk_mp(len);
+    std::vector<Mat> walk_P(len), walk_Pp(len);
+    std::vector<double> walk_ll(len);
+    std::vector<int> walk_seen(len);
+    walk_m[0] = walk_mp[0] = m;
+    walk_P[0] = walk_Pp[0] = P;
+    walk_ll[0] = ll_prefix;
+    walk_seen[0] = seen_prefix;
+    for (Index j = 1; j < len; ++j) {
+        Vec mj = F * walk_m[j - 1];
+        Mat Pj = F * walk_P[j - 1] * F.transpose() + Q;
+        walk_mp[j] = mj;
+        walk_Pp[j] = Pj;
+        double ll = walk_ll[j - 1];
+        seen = walk_seen[j - 1];
+        if (std::isfinite(z(fa + j))) update(mj, Pj, z(fa + j), ll);
+        walk_m[j] = mj;
+        walk_P[j] = Pj;
+        walk_ll[j] = ll;
+        walk_seen[j] = seen;
+    }
+
     std::vector<Vec> mp(len), ms(len);
-    std::vector<Mat> Pp(len), Ps(len), Fs(len);
+    std::vector<Mat> Pp(len), Ps(len);
+    std::vector<const Mat*> Fs(len, &F);
     for (Index h = 0; h < H; ++h) {
         const int t1 = t1s(h), t2 = t2s(h);
-        Vec mh = m;
-        Mat Ph = P;
-        double ll = ll_prefix;
-        seen = seen_prefix;
-        ms[0] = mh;
-        Ps[0] = Ph;
-        for (Index j = 1; j < len; ++j) {  // window index fa + j, gap step j
+        const Index first = t1 < 0 ? len : t1 + 1;  // first step that differs from walking
+        for (Index j = 0; j < first; ++j) {
+            ms[j] = walk_m[j];
+            Ps[j] = walk_P[j];
+            Pp[j] = walk_Pp[j];
+            mp[j] = walk_mp[j];
+            Fs[j] = &F;
+        }
+        Vec mh = ms[first - 1];
+        Mat Ph = Ps[first - 1];
+        double ll = walk_ll[first - 1];
+        seen = walk_seen[first - 1];
+        for (Index j = first; j < len; ++j) {  // window index fa + j, gap step j
             const Mat* Fj = &F;
             const Mat* Qj = &Q;
-            if (t1 >= 0 && j >= t1 + 1 && j <= t2 + 1) {
+            if (j <= t2 + 1) {
                 Fj = &stand;
                 Qj = j == t2 + 1 ? &q_restart : &q_stand;
             }
-            Fs[j] = *Fj;
+            Fs[j] = Fj;
             mh = (*Fj) * mh;
             Ph = (*Fj) * Ph * Fj->transpose() + *Qj;
             mp[j] = mh;
@@ -127,7 +158,7 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
             Ps[j] = Ph;
         }
         for (Index j = len - 2; j >= 1; --j) {
-            const Mat C = Ps[j] * Fs[j + 1].transpose() * psd_pinv<D>(Pp[j + 1]);
+            const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
             ms[j] += C * (ms[j + 1] - mp[j + 1]);
         }
         for (Index j = 1; j < T; ++j) out.paths(h, j - 1) = ms[j](0);
