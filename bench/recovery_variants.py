@@ -71,8 +71,9 @@ def iou_model(q: float, tau: float) -> tuple[F64, F64]:
     return F, 0.5 * (Q + Q.T)
 
 
-def fit_iou(runs: Sequence[F64], axis: int, tau: float) -> tuple[float, float]:
-    """Maximum-likelihood ``(q, r)`` of one axis for a given ``tau`` (Nelder-Mead on logs)."""
+def _padded(runs: Sequence[F64], axis: int) -> tuple[F64, NDArray[np.bool_]]:
+    """One axis of every run of at least 6 points, as rows padded to the longest, and the mask
+    of real entries (what :func:`_loglik` takes)."""
     runs = [r for r in runs if len(r) >= 6]
     L = max(len(r) for r in runs)
     Z = np.zeros((len(runs), L))
@@ -80,6 +81,12 @@ def fit_iou(runs: Sequence[F64], axis: int, tau: float) -> tuple[float, float]:
     for i, r in enumerate(runs):
         Z[i, : len(r)] = r[:, 1 + axis]
         mask[i, : len(r)] = True
+    return Z, mask
+
+
+def fit_iou(runs: Sequence[F64], axis: int, tau: float) -> tuple[float, float]:
+    """Maximum-likelihood ``(q, r)`` of one axis for a given ``tau`` (Nelder-Mead on logs)."""
+    Z, mask = _padded(runs, axis)
 
     def nll(th: F64) -> float:
         F, Q = iou_model(float(np.exp(th[0])), tau)
@@ -210,13 +217,7 @@ def _loglik(F: F64, Q: F64, r: float, Z: F64, mask: NDArray[np.bool_]) -> float:
 
 def fit_state_model(runs: Sequence[F64], axis: int, kind: str) -> tuple[F64, F64, float]:
     """Maximum-likelihood ``(F, Q, r)`` of one axis; ``kind`` in {ca, singer, singer+ou}."""
-    runs = [r for r in runs if len(r) >= 6]
-    L = max(len(r) for r in runs)
-    Z = np.zeros((len(runs), L))
-    mask = np.zeros((len(runs), L), dtype=bool)
-    for i, r in enumerate(runs):
-        Z[i, : len(r)] = r[:, 1 + axis]
-        mask[i, : len(r)] = True
+    Z, mask = _padded(runs, axis)
 
     def unpack(th: F64) -> tuple[float, float, float, float]:
         e = np.exp(th)
