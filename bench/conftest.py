@@ -1,7 +1,6 @@
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
 import cv2
@@ -9,7 +8,6 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))  # tests.reference: the NumPy baselines
 DATA = Path(os.environ.get("PFTRACK_DATA", ROOT.parent / "shared" / "data"))
 
 

@@ -6,7 +6,6 @@ Locally: ``pytest bench/test_bridge.py --benchmark-only``; CI: ``--benchmark-dis
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,9 +15,8 @@ from pftrack.recovery import constant_velocity_A
 from pftrack.recovery import experiment as E
 from pftrack.recovery.methods import recover_gaps
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "recovery"))
-import reference_bridge as ref  # noqa: E402
-import reference_mixture as ref_mix  # noqa: E402
+from tests.reference import bridge as ref
+from tests.reference import mixture as ref_mix
 
 A = constant_velocity_A(1.0)
 Q = np.diag([1e-6, 1e-6, 1e-4, 1e-4])

@@ -7,17 +7,15 @@ from __future__ import annotations
 
 import itertools
 import os
-import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from pftrack import _core  # noqa: E402
 from pftrack.detection import make_detector  # noqa: E402
-from reference_detection import BackgroundReference  # noqa: E402
+from tests.reference.detection import BackgroundReference
 
 SIZES = {"480x360": (480, 360), "768x576": (768, 576)}
 N_FRAMES = 60

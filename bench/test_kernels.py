@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bench import numpy_baselines as npb
+from tests.reference import fused as npb
 from pftrack import _core
 from pftrack.particle_filter import box_histograms, hsv_bins
 

@@ -17,7 +17,7 @@ from pftrack.particle_filter import (
     box_histograms,
     hsv_bins,
 )
-from tests import reference as ref
+from tests.reference import kernels as ref
 
 frames = hnp.arrays(
     np.uint8,

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from pftrack import _core
 from pftrack.particle_filter import hsv_bins
-from tests import reference as ref
+from tests.reference import kernels as ref
 
 METHODS = ("auto", "direct", "integral")
 

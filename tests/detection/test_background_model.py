@@ -7,7 +7,7 @@ import threading
 import numpy as np
 import pytest
 from pftrack import _core
-from reference_detection import BackgroundReference, hsv_bin_reference
+from tests.reference.detection import BackgroundReference, hsv_bin_reference
 
 
 def random_scene(rng: np.random.Generator, shape=(48, 64), steps=6) -> list[np.ndarray]:

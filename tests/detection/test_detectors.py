@@ -5,7 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
-from detection_data import data_dir
+from tests.detection.detection_data import data_dir
 from pftrack import _core
 from pftrack.detection import (
     BlobConfig,

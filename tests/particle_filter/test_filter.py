@@ -18,7 +18,7 @@ from pftrack.particle_filter import (
     hsv_bins,
     propagate,
 )
-from tests import reference as ref
+from tests.reference import kernels as ref
 
 
 def _particles(rng, n=64):

@@ -6,7 +6,7 @@ from scipy import stats
 
 from pftrack import _core
 from pftrack.particle_filter.mh import MHConfig, MHParticleFilter, mh_step
-from tests import reference_mcmc as ref
+from tests.reference import mcmc as ref
 
 @pytest.fixture
 def rng() -> np.random.Generator:

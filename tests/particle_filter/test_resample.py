@@ -15,7 +15,7 @@ from pftrack.particle_filter import (
     stratified_resample,
     systematic_resample,
 )
-from tests import reference as ref
+from tests.reference import kernels as ref
 
 RESAMPLERS = {
     "systematic": systematic_resample,

@@ -8,7 +8,7 @@ import pytest
 
 from pftrack import _core
 from pftrack.particle_filter.rjmcmc import RJMCMCConfig, RJMCMCFilter
-from tests import reference_mcmc as ref
+from tests.reference import mcmc as ref
 
 PARAMS = dict(burn_in=20, n_samples=150, p_birth=0.2, p_death=0.15, p_update=0.5, p_swap=0.15,
               a=(2.0, 2.0, 2.0), b=(-1.0, -1.0, -1.0), sigma=(3.0, 3.0, 0.03), s_min=0.5,

@@ -9,7 +9,7 @@ import pytest
 from pftrack import _core
 from pftrack.recovery import constant_velocity_A, goal_directed_path, sample_goal_directed_paths
 
-from . import reference_bridge as ref
+from tests.reference import bridge as ref
 
 
 def spd(rng, n, scale=1.0):

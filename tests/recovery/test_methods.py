@@ -9,7 +9,7 @@ from pftrack.recovery.demo import demo_report
 from pftrack.recovery.gdt import GdtModel
 from pftrack.recovery.methods import gdt_problem
 
-from . import reference_bridge as ref
+from tests.reference import bridge as ref
 
 
 def line(frames, x0=10.0, y0=20.0, vx=1.5, vy=-0.7, w=30.0, h=60.0, dw=0.1):

@@ -17,8 +17,8 @@ from pftrack.recovery.mixture import (
     wna_model,
 )
 
-from .reference_mixture import gap_mixture as ref_gap_mixture
-from .reference_mixture import gap_mixture_vectorised, singer_quadrature, state_loglik
+from tests.reference.mixture import gap_mixture as ref_gap_mixture
+from tests.reference.mixture import gap_mixture_vectorised, singer_quadrature, state_loglik
 
 
 def _window(rng: np.random.Generator, n: int, fa: int, fb: int, holes: int) -> np.ndarray:

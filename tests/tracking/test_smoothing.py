@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from pftrack.smoothing import BoxSmoother
 from pftrack.tracker import Track, TrackWriter
-from tests.reference_smoothing import cv_posterior_mean
+from tests.reference.smoothing import cv_posterior_mean
 
 
 def _reference(frames, boxes, observed, sm: BoxSmoother):

@@ -1,0 +1,7 @@
+"""Straightforward NumPy references of the C++ kernels, shared by tests/ and bench/.
+
+One module per wing: ``kernels`` (HSV bins, histograms, Bhattacharyya, resampling, SIS),
+``fused`` (vectorised NumPy peers for the benchmarks), ``mcmc`` (MH and RJ-MCMC), ``detection``
+(background model), ``smoothing`` (constant-velocity posterior), ``bridge`` (goal-directed
+recovery), ``mixture`` (stand/walk gap mixture).
+"""
