@@ -4,7 +4,8 @@ import time
 
 import numpy as np
 import pytest
-from pftrack.eval import iou_xywh
+
+from pftrack.boxes import iou_xywh
 from pftrack.io.mot import read_mot
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import make_scene
@@ -18,7 +19,7 @@ def scene():
 def test_deterministic(scene):
     again = make_scene()
     assert len(again.frames) == len(scene.frames) == 120
-    assert all(np.array_equal(a, b) for a, b in zip(scene.frames, again.frames))
+    assert all(np.array_equal(a, b) for a, b in zip(scene.frames, again.frames, strict=True))
     np.testing.assert_array_equal(scene.truth, again.truth)
     other = make_scene(rng=1)
     assert not np.array_equal(other.frames[0], scene.frames[0])
@@ -97,8 +98,12 @@ def test_writers(tmp_path):
 
 @pytest.mark.parametrize(
     ("kwargs", "match"),
-    [({"n_frames": 0}, "n_frames"), ({"width": 10}, "width"), ({"n_walkers": 0}, "n_walkers"),
-     ({"noise": -1.0}, "noise")],
+    [
+        ({"n_frames": 0}, "n_frames"),
+        ({"width": 10}, "width"),
+        ({"n_walkers": 0}, "n_walkers"),
+        ({"noise": -1.0}, "noise"),
+    ],
 )
 def test_bad_arguments(kwargs, match):
     with pytest.raises(ValueError, match=match):

@@ -161,11 +161,17 @@ def test_bhattacharyya_kernels_match_reference(rng):
     hists = rng.random((30, 110))
     hists /= hists.sum(axis=1, keepdims=True)
     r = rng.random(110) * 3  # unnormalised reference is normalised by the kernels
-    np.testing.assert_allclose(bhattacharyya_coefficient(hists, r), ref.bhattacharyya_coefficient(hists, r), rtol=1e-12)
-    np.testing.assert_allclose(bhattacharyya_distance(hists, r), ref.bhattacharyya_distance(hists, r), rtol=1e-10)
+    np.testing.assert_allclose(
+        bhattacharyya_coefficient(hists, r), ref.bhattacharyya_coefficient(hists, r), rtol=1e-12
+    )
+    np.testing.assert_allclose(
+        bhattacharyya_distance(hists, r), ref.bhattacharyya_distance(hists, r), rtol=1e-10
+    )
     for lam in (0.0, 1.0, 20.0, 1e4):
         w = bhattacharyya_weights(hists, r, lam)
-        np.testing.assert_allclose(w, ref.bhattacharyya_weights(hists, r, lam), rtol=1e-9, atol=1e-300)
+        np.testing.assert_allclose(
+            w, ref.bhattacharyya_weights(hists, r, lam), rtol=1e-9, atol=1e-300
+        )
         assert w.sum() == pytest.approx(1.0)
 
 

@@ -128,7 +128,9 @@ def test_bad_method_and_bad_boxes(rng):
         _core.box_histograms(image, np.ones((2, 4)), "uniform", "fast")
     for m in METHODS:
         with pytest.raises(ValueError, match=r"boxes\[2\]"):
-            _core.box_weights(image, np.array([[5.0, 5, 4, 4]] * 2 + [[np.nan, 5, 4, 4]]), r, 20.0, "uniform", m)
+            _core.box_weights(
+                image, np.array([[5.0, 5, 4, 4]] * 2 + [[np.nan, 5, 4, 4]]), r, 20.0, "uniform", m
+            )
         with pytest.raises(ValueError, match=r"boxes\[0\]"):
             _core.box_weights(image, np.array([[5.0, 5, -4, 4]]), r, 20.0, "uniform", m)
 
@@ -139,7 +141,11 @@ def test_threads_give_the_serial_result(rng):
     clouds = [_cloud(rng, (40 + 20 * k, 60), (20, 40), 4.0, 200) for k in range(4)]
     serial = [_core.box_weights(image, b, r, 20.0, "uniform", "integral") for b in clouds]
     with ThreadPoolExecutor(4) as pool:
-        threaded = list(pool.map(lambda b: _core.box_weights(image, b, r, 20.0, "uniform", "integral"), clouds * 3))
+        threaded = list(
+            pool.map(
+                lambda b: _core.box_weights(image, b, r, 20.0, "uniform", "integral"), clouds * 3
+            )
+        )
     for k, w in enumerate(threaded):
         np.testing.assert_array_equal(w, serial[k % 4])
 
@@ -153,8 +159,12 @@ cloud_spec = st.tuples(
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.lists(cloud_spec, min_size=1, max_size=4), st.sampled_from([0.0, 0.5, 0.95]), st.booleans(),
-       st.integers(0, 2**32 - 1))  # fmt: skip
+@given(
+    st.lists(cloud_spec, min_size=1, max_size=4),
+    st.sampled_from([0.0, 0.5, 0.95]),
+    st.booleans(),
+    st.integers(0, 2**32 - 1),
+)
 def test_random_clouds_property(specs, background, shuffle, seed):
     rng = np.random.default_rng(seed)
     image = _image(rng, 64, 80, background)

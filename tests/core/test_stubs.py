@@ -7,8 +7,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pftrack
 import pytest
+
+import pftrack
 
 ALLOWLIST = Path(__file__).with_name("stubtest_allowlist.txt")
 

@@ -6,6 +6,7 @@ import threading
 
 import numpy as np
 import pytest
+
 from pftrack import _core
 from tests.reference.detection import BackgroundReference, hsv_bin_reference
 
@@ -159,5 +160,5 @@ def test_threads_give_serial_result():
     for t in threads:
         t.join()
     for r in results:
-        for a, b in zip(r, serial):
+        for a, b in zip(r, serial, strict=True):
             np.testing.assert_array_equal(a, b)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
-from tests.detection.detection_data import data_dir
+
 from pftrack import _core
 from pftrack.detection import (
     BlobConfig,
@@ -17,6 +17,7 @@ from pftrack.detection import (
     PaperDetector,
     make_detector,
 )
+from tests.detection.detection_data import data_dir
 
 
 def textured_background(shape=(120, 160), seed=0) -> np.ndarray:
@@ -158,7 +159,7 @@ def test_pets_smoke():
     gt = group_by_frame(read_mot(seq / "gt.txt"))
     det = PaperDetector()
     src = FrameSource(seq / "video.avi")
-    det.prime(f for f, _ in zip(src, range(30)))
+    det.prime(f for f, _ in zip(src, range(30), strict=False))
     found = total = 0
     for i, frame in enumerate(src, start=1):
         d = det.detect(frame)

@@ -37,7 +37,9 @@ def test_propagate_matches_reference(rng, use_means):
     model = Ar2Model(sigma_xy=3.0, sigma_s=0.05, velocity_gain=0.7, scale_gain=1.0, s_min=0.9,
                      s_max=1.1, use_means=use_means)  # fmt: skip
     means = rng.normal(40, 2, (2, 3))
-    want = ref.propagate(p, noise, model.a, model.b, model.sigma, 0.9, 1.1, use_means, means[0], means[1])
+    want = ref.propagate(
+        p, noise, model.a, model.b, model.sigma, 0.9, 1.1, use_means, means[0], means[1]
+    )
     propagate(p, noise, model, means)
     np.testing.assert_array_equal(p, want)
 
@@ -76,8 +78,26 @@ def test_sis_step_matches_numpy_composition(textured_frame, rng, kernel, use_mea
         model.sigma, model.s_min, model.s_max, use_means, 20.0, kernel, u0, normals,
     )  # fmt: skip
     m_before = means.copy()
-    out = _core.sis_step(p, w, means, image, reference, 20.0, 30.0, model.a, model.b, model.sigma,
-                         model.s_min, model.s_max, use_means, 20.0, kernel, True, seed, step)  # fmt: skip
+    out = _core.sis_step(
+        p,
+        w,
+        means,
+        image,
+        reference,
+        20.0,
+        30.0,
+        model.a,
+        model.b,
+        model.sigma,
+        model.s_min,
+        model.s_max,
+        use_means,
+        20.0,
+        kernel,
+        True,
+        seed,
+        step,
+    )
     np.testing.assert_allclose(p, want_p, rtol=0, atol=1e-12)
     np.testing.assert_allclose(w, want_w, rtol=1e-9, atol=1e-15)
     np.testing.assert_allclose(out["mean"], want_mean, rtol=1e-12)
@@ -97,8 +117,8 @@ def test_counter_normals_are_standard_normal():
 def _scene(shift=0):
     rng = np.random.default_rng(0)
     frame = rng.integers(60, 120, (120, 160, 3), dtype=np.uint8)
-    frame[40:80, 50 + shift:70 + shift] = (20, 20, 220)  # red walker
-    frame[60:80, 50 + shift:70 + shift] = (200, 60, 20)  # blue trousers
+    frame[40:80, 50 + shift : 70 + shift] = (20, 20, 220)  # red walker
+    frame[60:80, 50 + shift : 70 + shift] = (200, 60, 20)  # blue trousers
     return frame
 
 
@@ -136,7 +156,9 @@ def test_four_threads_equal_serial():
     reference = box_histograms(frames[0], [[60, 60, 20, 40]])[0]
 
     def run(seed, out, k):
-        f = ColourParticleFilter([60, 60, 20, 40], reference, FilterConfig(n_particles=300), rng=seed)
+        f = ColourParticleFilter(
+            [60, 60, 20, 40], reference, FilterConfig(n_particles=300), rng=seed
+        )
         out[k] = np.array([f.step(img).box_cxcywh for img in frames])
 
     serial = [None] * 8
@@ -152,7 +174,7 @@ def test_four_threads_equal_serial():
         t.start()
     for t in threads[4:]:
         t.join()
-    for s, t in zip(serial, threaded):
+    for s, t in zip(serial, threaded, strict=True):
         np.testing.assert_array_equal(s, t)
 
 

@@ -5,8 +5,9 @@ import pytest
 from scipy import stats
 
 from pftrack import _core
-from pftrack.particle_filter.mh import MHConfig, MHParticleFilter, mh_step
+from pftrack.particle_filter import Ar2Model, FilterConfig, MHColourParticleFilter
 from tests.reference import mcmc as ref
+
 
 @pytest.fixture
 def rng() -> np.random.Generator:
@@ -28,11 +29,45 @@ def particles_at(n: int, cx: float, cy: float, vx: float = 0.0) -> np.ndarray:
     return np.ascontiguousarray(np.tile([cx, cy, 1.0, cx - vx, cy, 1.0], (n, 1)))
 
 
-def call(p, w, m, img, r, seed=3, step=0, lam=20.0, n_iter=3, burn_in=1, proposal="dynamics",
-         rw=(2.0, 2.0, 0.01), sigma=SIGMA):
-    return _core.mh_step(p, w, m, img, r, 12.0, 20.0, A, B, sigma, 0.2, 5.0, False, lam, "uniform",
-                         True, seed, step, n_iter=n_iter, burn_in=burn_in, proposal=proposal,
-                         rw_sigma=np.asarray(rw, float))
+def call(
+    p,
+    w,
+    m,
+    img,
+    r,
+    seed=3,
+    step=0,
+    lam=20.0,
+    n_iter=3,
+    burn_in=1,
+    proposal="dynamics",
+    rw=(2.0, 2.0, 0.01),
+    sigma=SIGMA,
+):
+    return _core.mh_step(
+        p,
+        w,
+        m,
+        img,
+        r,
+        12.0,
+        20.0,
+        A,
+        B,
+        sigma,
+        0.2,
+        5.0,
+        False,
+        lam,
+        "uniform",
+        True,
+        seed,
+        step,
+        n_iter=n_iter,
+        burn_in=burn_in,
+        proposal=proposal,
+        rw_sigma=np.asarray(rw, float),
+    )
 
 
 @pytest.mark.parametrize("proposal", ["dynamics", "random_walk"])
@@ -44,8 +79,26 @@ def test_matches_numpy_reference(rng, proposal):
     p[:, 0] += np.arange(12) * 0.5
     w = np.full(12, 1 / 12)
     m = np.zeros((2, 3))
-    expect, mean, acc = ref.mh_step(p, img.bins, img.n_bins, r, 12.0, 20.0, A, B, SIGMA, 0.2, 5.0,
-                                    20.0, 11, 4, 5, 2, proposal, (2.0, 2.0, 0.01))
+    expect, mean, acc = ref.mh_step(
+        p,
+        img.bins,
+        img.n_bins,
+        r,
+        12.0,
+        20.0,
+        A,
+        B,
+        SIGMA,
+        0.2,
+        5.0,
+        20.0,
+        11,
+        4,
+        5,
+        2,
+        proposal,
+        (2.0, 2.0, 0.01),
+    )
     out = call(p, w, m, img, r, seed=11, step=4, n_iter=5, burn_in=2, proposal=proposal)
     np.testing.assert_allclose(p, expect, rtol=0, atol=1e-9)
     np.testing.assert_allclose(out["mean"], mean, atol=1e-9)
@@ -64,8 +117,19 @@ def test_flat_likelihood_samples_the_dynamics(rng):
     n = 3000
     p = particles_at(n, 40.0, 30.0, vx=2.0)
     sigma = [4.0, 4.0, 0.05]
-    out = call(p, np.full(n, 1 / n), np.zeros((2, 3)), img, r, lam=0.0, n_iter=20, burn_in=0,
-               proposal="random_walk", rw=(6.0, 6.0, 0.08), sigma=sigma)
+    out = call(
+        p,
+        np.full(n, 1 / n),
+        np.zeros((2, 3)),
+        img,
+        r,
+        lam=0.0,
+        n_iter=20,
+        burn_in=0,
+        proposal="random_walk",
+        rw=(6.0, 6.0, 0.08),
+        sigma=sigma,
+    )
     mu = [42.0, 30.0, 1.0]
     for d in range(3):
         assert stats.kstest(p[:, d], "norm", args=(mu[d], sigma[d])).pvalue > 1e-3
@@ -109,22 +173,79 @@ def test_errors(rng):
         call(p, w, m, img, r, proposal="gibbs")
     with pytest.raises(ValueError, match="weights size"):
         call(p, np.full(3, 1 / 3), m, img, r)
-    with pytest.raises(ValueError, match="burn_in"):
-        MHConfig(n_iter=1, burn_in=1)
-    with pytest.raises(ValueError, match="box_cxcywh"):
-        MHParticleFilter([1, 2, 0, 4], r)
+    with pytest.raises(ValueError, match="n_iter is 0"):
+        MHColourParticleFilter([40, 30, 12, 20], r, n_iter=0)
+    with pytest.raises(ValueError, match=r"box is \[1.0, 2.0, 0.0, 4.0\]"):
+        MHColourParticleFilter([1, 2, 0, 4], r)
+
+
+#: AR(2) with A = 2, B = -1 (constant velocity) and the kernel tests' noise, as a filter model
+MODEL = Ar2Model(
+    sigma_xy=4.0, sigma_s=0.02, velocity_gain=1.0, scale_gain=1.0, s_min=0.2, s_max=5.0
+)
+
+
+@pytest.mark.parametrize("n_iter", [1, 4])
+def test_filter_step_matches_numpy_reference(rng, n_iter):
+    """The tracker's MH filter is the kernel with the dynamics proposal and no burn-in."""
+    frame, mask = scene(rng)
+    img = _core.hsv_bins(frame, mask)
+    r = _core.box_histograms(img, np.array([[40.0, 30, 12, 20]]))[0]
+    f = MHColourParticleFilter(
+        [38.0, 31, 12, 20],
+        r,
+        FilterConfig(n_particles=12, model=MODEL),
+        rng=4,
+        velocity=(1.0, 0.0),
+        n_iter=n_iter,
+    )
+    np.testing.assert_array_equal(MODEL.a, A)
+    np.testing.assert_array_equal(MODEL.b, B)
+    np.testing.assert_array_equal(MODEL.sigma, SIGMA)
+    for step in range(3):
+        before = f.particles.copy()
+        expect, mean, acc = ref.mh_step(
+            before,
+            img.bins,
+            img.n_bins,
+            f.reference,
+            12.0,
+            20.0,
+            A,
+            B,
+            SIGMA,
+            0.2,
+            5.0,
+            20.0,
+            f._seed,
+            step,
+            n_iter,
+            0,
+            "dynamics",
+            (2.0, 2.0, 0.01),
+        )
+        state = f.step(img)
+        np.testing.assert_allclose(f.particles, expect, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(
+            state.box_cxcywh, [mean[0], mean[1], 12 * mean[2], 20 * mean[2]], atol=1e-9
+        )
+        assert f.acceptance == pytest.approx(acc)
+        np.testing.assert_allclose(f.weights, 1 / 12)
+    assert 0.0 < f.acceptance < 1.0
 
 
 def test_filter_follows_a_moving_object(rng):
-    cfg = MHConfig(n_particles=150, n_iter=2, burn_in=0, sigma=(3.0, 3.0, 0.01))
+    cfg = FilterConfig(
+        n_particles=150, model=Ar2Model(sigma_xy=3.0, sigma_s=0.01, s_min=0.2, s_max=5.0)
+    )
     frame, _ = scene(rng, 30, 30)
     img = _core.hsv_bins(frame)
     r = _core.box_histograms(img, np.array([[30.0, 30, 12, 20]]))[0]
-    f = MHParticleFilter([30, 30, 12, 20], r, cfg, rng=1)
+    f = MHColourParticleFilter([30, 30, 12, 20], r, cfg, rng=1, n_iter=2)
     for t in range(1, 16):
         cx = 30 + 2 * t
         frame, _ = scene(np.random.default_rng(t), cx, 30)
         state = f.step(_core.hsv_bins(frame))  # every pixel counted: shifts add clutter
-        assert 0.0 <= state.acceptance <= 1.0
+        assert 0.0 <= f.acceptance <= 1.0
     assert abs(state.box_cxcywh[0] - cx) < 4 and abs(state.box_cxcywh[1] - 30) < 4
     assert state.rho > 0.8

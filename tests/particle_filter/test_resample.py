@@ -115,7 +115,9 @@ def test_drop_in_for_filterpy(name):
             mine = _core.systematic_resample(w, np.random.random())
         elif name == "residual":
             k = int(np.floor(len(w) * w).sum())
-            mine = _core.residual_resample(w, np.concatenate([np.random.random(len(w) - k), np.zeros(k)]))
+            mine = _core.residual_resample(
+                w, np.concatenate([np.random.random(len(w) - k), np.zeros(k)])
+            )
         else:
             mine = getattr(_core, f"{name}_resample")(w, np.random.random(len(w)))
     finally:
@@ -162,13 +164,23 @@ def test_systematic_matches_reference_at_scale(n, kind, u0):
     np.testing.assert_array_equal(_core.systematic_resample(w, u0), ref.systematic_resample(w, u0))
 
 
-def test_unseeded_generator_is_shared_and_seeded_calls_are_not():
+@pytest.mark.parametrize("name", RESAMPLERS)
+def test_rng_is_default_rng_and_there_is_no_global_state(name):
+    """A Generator is used as given (its stream advances), a seed is default_rng(seed), and
+    None draws fresh entropy: no module-level generator to share or to fork."""
     from pftrack.particle_filter import resample as rs
 
-    g = np.random.default_rng(3)
-    assert rs._generator(g) is g
-    assert rs._generator(None) is rs._generator(None)
-    assert rs._generator(5).random() == np.random.default_rng(5).random()
+    fn = RESAMPLERS[name]
+    w = np.random.default_rng(8).random(400)
+    g, h = np.random.default_rng(3), np.random.default_rng(3)
+    first = fn(w, rng=g)
+    np.testing.assert_array_equal(first, fn(w, rng=h))
+    np.testing.assert_array_equal(fn(w, rng=g), fn(w, rng=h))  # both streams moved on alike
+    assert g.random() == h.random()
+    np.testing.assert_array_equal(fn(w, rng=5), fn(w, rng=np.random.default_rng(5)))
+    unseeded = fn(w)
+    assert unseeded.shape == (400,) and unseeded.min() >= 0 and unseeded.max() < 400
+    assert not any(isinstance(v, np.random.Generator) for v in vars(rs).values())
 
 
 @pytest.mark.parametrize("kind", ["random", "equal", "dyadic", "zero runs"])

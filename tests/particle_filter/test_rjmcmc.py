@@ -10,11 +10,31 @@ from pftrack import _core
 from pftrack.particle_filter.rjmcmc import RJMCMCConfig, RJMCMCFilter
 from tests.reference import mcmc as ref
 
-PARAMS = dict(burn_in=20, n_samples=150, p_birth=0.2, p_death=0.15, p_update=0.5, p_swap=0.15,
-              a=(2.0, 2.0, 2.0), b=(-1.0, -1.0, -1.0), sigma=(3.0, 3.0, 0.03), s_min=0.5,
-              s_max=2.0, lam=15.0, kernel="uniform", interaction=4.0, coverage=8.0, background_penalty=0.4,
-              birth_prior=2.0, survival=0.9, birth_sigma_xy=2.5, birth_sigma_s=0.04,
-              birth_eps=0.05, birth_gate=0.3, detection=6.0)
+PARAMS = dict(
+    burn_in=20,
+    n_samples=150,
+    p_birth=0.2,
+    p_death=0.15,
+    p_update=0.5,
+    p_swap=0.15,
+    a=(2.0, 2.0, 2.0),
+    b=(-1.0, -1.0, -1.0),
+    sigma=(3.0, 3.0, 0.03),
+    s_min=0.5,
+    s_max=2.0,
+    lam=15.0,
+    kernel="uniform",
+    interaction=4.0,
+    coverage=8.0,
+    background_penalty=0.4,
+    birth_prior=2.0,
+    survival=0.9,
+    birth_sigma_xy=2.5,
+    birth_sigma_s=0.04,
+    birth_eps=0.05,
+    birth_gate=0.3,
+    detection=6.0,
+)
 BLOBS = [((30, 24), (200, 40, 30)), ((62, 30), (40, 200, 40)), ((90, 20), (30, 60, 220))]
 
 
@@ -81,9 +101,17 @@ def arrays(config):
 def moves_between(x, y):
     """(move, slot) pairs that take configuration x to y in one step."""
     dx, dy = dict(x), dict(y)
-    if set(dy) - set(dx) and len(dy) == len(dx) + 1 and all(np.array_equal(dx[s], dy[s]) for s in dx):
+    if (
+        set(dy) - set(dx)
+        and len(dy) == len(dx) + 1
+        and all(np.array_equal(dx[s], dy[s]) for s in dx)
+    ):
         return [("birth", (set(dy) - set(dx)).pop())]
-    if set(dx) - set(dy) and len(dx) == len(dy) + 1 and all(np.array_equal(dx[s], dy[s]) for s in dy):
+    if (
+        set(dx) - set(dy)
+        and len(dx) == len(dy) + 1
+        and all(np.array_equal(dx[s], dy[s]) for s in dy)
+    ):
         return [("death", (set(dx) - set(dy)).pop())]
     if set(dx) != set(dy):
         return []
@@ -144,8 +172,10 @@ def test_swaps_never_duplicate_an_identity(model):
     t, r = model
     g = np.random.default_rng(0)
     for k in range(200):
-        config = ((0, positions(r, 0)[k % 3] + g.normal(0, 1, 3) * [1, 1, 0]),
-                  (1, positions(r, 1)[(k // 3) % 3]))
+        config = (
+            (0, positions(r, 0)[k % 3] + g.normal(0, 1, 3) * [1, 1, 0]),
+            (1, positions(r, 1)[(k // 3) % 3]),
+        )
         slots, states = arrays(config)
         out = t.propose("swap", slots, states, seed=11, step=2, k=k)
         assert sorted(out[0]) == [0, 1]
@@ -181,9 +211,9 @@ def test_fixed_seed_fixed_result():
         return out
 
     a, b, c = run(1), run(1), run(2)
-    for x, y in zip(a, b):
+    for x, y in zip(a, b, strict=True):
         np.testing.assert_array_equal(x, y)
-    assert any(x.shape != z.shape or not np.array_equal(x, z) for x, z in zip(a, c))
+    assert any(x.shape != z.shape or not np.array_equal(x, z) for x, z in zip(a, c, strict=True))
 
 
 def test_errors():

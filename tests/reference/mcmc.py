@@ -75,8 +75,26 @@ def colour_loglik(bins, n_bins, box, ref, lam):
 
 
 # ---- Metropolis-Hastings step (mh.hpp's documented draw layout), equal-weight input ----
-def mh_step(particles, bins, n_bins, ref, w0, h0, a, b, sigma, s_min, s_max, lam, seed, step,
-            n_iter, burn_in, proposal, rw_sigma):
+def mh_step(
+    particles,
+    bins,
+    n_bins,
+    ref,
+    w0,
+    h0,
+    a,
+    b,
+    sigma,
+    s_min,
+    s_max,
+    lam,
+    seed,
+    step,
+    n_iter,
+    burn_in,
+    proposal,
+    rw_sigma,
+):
     """Returns (new particles, mean estimate, acceptance). Input weights must be equal
     (systematic resampling then keeps every particle in order)."""
     rng = CounterRng(seed, step)
@@ -97,7 +115,7 @@ def mh_step(particles, bins, n_bins, ref, w0, h0, a, b, sigma, s_min, s_max, lam
     mus = a * particles[:, :3] + b * particles[:, 3:]
     for i in range(n):
         par = i
-        base = lambda j: 4 * (i * (n_iter + 1) + j)  # noqa: E731
+        base = lambda j, i=i: 4 * (i * (n_iter + 1) + j)  # noqa: E731
         x = mus[par] + sigma * np.array([rng.normal(base(0) + d) for d in range(3)])
         x[2] = min(max(x[2], s_min), s_max)
         cur = loglik(x) + log_dyn(x, mus[par])
@@ -227,10 +245,15 @@ class RjReference:
         n = len(config)
         if move == "birth":
             present = {s for s, _ in config}
-            w = {s: self.birth_weight(s, config) for s in range(len(self.slots)) if s not in present}
+            w = {
+                s: self.birth_weight(s, config) for s in range(len(self.slots)) if s not in present
+            }
             x = dict(to)[slot]
-            return (math.log(self.move_prob("birth")) + math.log(w[slot] / sum(w.values()))
-                    + self.log_prior_pos(slot, x))
+            return (
+                math.log(self.move_prob("birth"))
+                + math.log(w[slot] / sum(w.values()))
+                + self.log_prior_pos(slot, x)
+            )
         if move == "death":
             return math.log(self.move_prob("death") / n)
         if move == "update":

@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 
-def cv_posterior_mean(z: np.ndarray, has: np.ndarray, q: float, r: float, velocity_sd: float) -> np.ndarray:
+def cv_posterior_mean(
+    z: np.ndarray, has: np.ndarray, q: float, r: float, velocity_sd: float
+) -> np.ndarray:
     """Posterior mean of the positions of one constant-velocity axis, from the joint Gaussian.
 
     States s_t = (p_t, v_t), s_0 ~ N([z_0, 0], diag(r², velocity_sd²)), s_t = F s_{t-1} + w_t with
@@ -38,5 +40,89 @@ def cv_posterior_mean(z: np.ndarray, has: np.ndarray, q: float, r: float, veloci
     for k, t in enumerate(rows):
         H[k, 2 * t] = 1.0
     S = H @ cov @ H.T + r * r * np.eye(len(rows))
+    post = mean + cov @ H.T @ np.linalg.solve(S, z[rows] - H @ mean)
+    return post[0::2]
+
+
+def dense_kalman_rts(
+    z: np.ndarray,
+    has: np.ndarray,
+    F: np.ndarray,
+    Q: np.ndarray,
+    H: np.ndarray,
+    R: np.ndarray,
+    m0: np.ndarray,
+    P0: np.ndarray,
+    update_first: bool = True,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Textbook matrix Kalman filter + RTS smoother (one loop over frames, full covariances).
+
+    States s_0 ~ N(m0, P0), s_t = F s_{t-1} + N(0, Q); measurements z_t = H s_t + N(0, R) where
+    `has` (frame 0 only with `update_first`). Returns the filtered means, smoothed means and
+    smoothed covariances, (T, d), (T, d) and (T, d, d).
+    """
+    steps, d = len(z), len(m0)
+    m, P = m0.astype(float).copy(), P0.astype(float).copy()
+    fm, fP = np.zeros((steps, d)), np.zeros((steps, d, d))
+    pm, pP = np.zeros((steps, d)), np.zeros((steps, d, d))
+    for t in range(steps):
+        if t > 0:
+            m, P = F @ m, F @ P @ F.T + Q
+        pm[t], pP[t] = m, P
+        if has[t] and (t > 0 or update_first):
+            S = H @ P @ H.T + R
+            K = P @ H.T @ np.linalg.inv(S)
+            m = m + K @ (z[t] - H @ m)
+            P = (np.eye(d) - K @ H) @ P
+        fm[t], fP[t] = m, P
+    sm, sP = fm.copy(), fP.copy()
+    for t in range(steps - 2, -1, -1):
+        C = fP[t] @ F.T @ np.linalg.inv(pP[t + 1])
+        sm[t] = fm[t] + C @ (sm[t + 1] - pm[t + 1])
+        sP[t] = fP[t] + C @ (sP[t + 1] - pP[t + 1]) @ C.T
+    return fm, sm, sP
+
+
+def wna_posterior_mean(
+    z: np.ndarray,
+    has: np.ndarray,
+    q: float,
+    r2: float,
+    velocity_sd: float,
+    update_first: bool,
+    quarter: bool = False,
+) -> np.ndarray:
+    """Posterior mean of one constant-velocity axis's positions, from the joint Gaussian.
+
+    Like :func:`cv_posterior_mean` but with the noise intensity `q` and measurement variance
+    `r2` as variances: ``Q = q [[1/3, 1/2], [1/2, 1]]`` (or ``[[1/4, ...]]`` with `quarter`),
+    and frame 0's measurement also conditioned on when `update_first`.
+    """
+    steps = len(z)
+    F = np.array([[1.0, 1.0], [0.0, 1.0]])
+    Q = q * np.array([[0.25 if quarter else 1.0 / 3.0, 0.5], [0.5, 1.0]])
+    mean = np.zeros(2 * steps)
+    m = np.array([z[0], 0.0])
+    marg = [np.diag([r2, velocity_sd**2])]
+    mean[:2] = m
+    for t in range(1, steps):
+        m = F @ m
+        mean[2 * t : 2 * t + 2] = m
+        marg.append(F @ marg[-1] @ F.T + Q)
+    cov = np.zeros((2 * steps, 2 * steps))
+    for t in range(steps):
+        block = marg[t]
+        cov[2 * t : 2 * t + 2, 2 * t : 2 * t + 2] = block
+        for u in range(t + 1, steps):
+            block = F @ block
+            cov[2 * u : 2 * u + 2, 2 * t : 2 * t + 2] = block
+            cov[2 * t : 2 * t + 2, 2 * u : 2 * u + 2] = block.T
+    rows = [t for t in range(steps) if has[t] and (t > 0 or update_first)]
+    if not rows:
+        return mean[0::2]
+    H = np.zeros((len(rows), 2 * steps))
+    for k, t in enumerate(rows):
+        H[k, 2 * t] = 1.0
+    S = H @ cov @ H.T + r2 * np.eye(len(rows))
     post = mean + cov @ H.T @ np.linalg.solve(S, z[rows] - H @ mean)
     return post[0::2]

@@ -9,9 +9,11 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from pftrack.detection.base import BlobConfig, Detections, Detector, HsvConfig
+from pftrack.detection.base import BlobConfig, Detections, Detector, check_detections, check_frame
 from pftrack.detection.opencv_bg import KnnConfig, KnnDetector, Mog2Config, Mog2Detector
 from pftrack.detection.paper import PaperConfig, PaperDetector
+from pftrack.detection.refine import refine_boxes
+from pftrack.particle_filter.colour import HsvBinning
 
 DETECTORS = ("paper", "mog2", "knn")
 
@@ -20,14 +22,16 @@ __all__ = [
     "BlobConfig",
     "Detections",
     "Detector",
-    "HsvConfig",
     "KnnConfig",
     "KnnDetector",
     "Mog2Config",
     "Mog2Detector",
     "PaperConfig",
     "PaperDetector",
+    "check_detections",
+    "check_frame",
     "make_detector",
+    "refine_boxes",
 ]
 
 
@@ -35,7 +39,7 @@ def _split(cls: type, config: dict[str, Any], name: str) -> Any:
     """Build `cls` from flat keywords: its own fields, plus those of its blobs/hsv sub-configs."""
     own = {f.name for f in dataclasses.fields(cls)} - {"blobs", "hsv"}
     blob_fields = {f.name for f in dataclasses.fields(BlobConfig)}
-    hsv_fields = {f.name for f in dataclasses.fields(HsvConfig)}
+    hsv_fields = {f.name for f in dataclasses.fields(HsvBinning)}
     unknown = sorted(set(config) - own - blob_fields - hsv_fields - {"blobs", "hsv"})
     if unknown:
         raise TypeError(
@@ -45,7 +49,7 @@ def _split(cls: type, config: dict[str, Any], name: str) -> Any:
     blobs = config.get("blobs") or BlobConfig(
         **{k: v for k, v in config.items() if k in blob_fields}
     )
-    hsv = config.get("hsv") or HsvConfig(**{k: v for k, v in config.items() if k in hsv_fields})
+    hsv = config.get("hsv") or HsvBinning(**{k: v for k, v in config.items() if k in hsv_fields})
     return cls(**{k: v for k, v in config.items() if k in own}, blobs=blobs, hsv=hsv)
 
 
@@ -58,7 +62,7 @@ def make_detector(name: str, **config: Any) -> PaperDetector | Mog2Detector | Kn
         The paper's detector (C++ pass), or OpenCV's MOG2 / KNN subtractors.
     **config
         Fields of `PaperConfig` / `Mog2Config` / `KnnConfig`, of `BlobConfig` (``min_area`` …)
-        and of `HsvConfig` (``n_h`` …), flat; or ``blobs=`` / ``hsv=`` config objects.
+        and of `HsvBinning` (``n_h`` …), flat; or ``blobs=`` / ``hsv=`` config objects.
 
     Returns
     -------

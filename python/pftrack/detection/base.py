@@ -7,10 +7,10 @@ from typing import Protocol, runtime_checkable
 
 import cv2
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack.particle_filter.colour import HsvBinning
+from pftrack._typing import F64
 
 
 @dataclass(frozen=True)
@@ -132,6 +132,53 @@ def check_frame(frame: object, fn: str) -> NDArray[np.uint8]:
     return frame
 
 
+def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64, F64]:
+    """Check external detections against a frame of `shape` (rows, cols).
+
+    Parameters
+    ----------
+    detections : (K, 4) or (K, 5) array_like
+        ``[left, top, width, height(, score)]``; a missing score is 1.
+    shape : (int, int)
+        The frame's rows and columns.
+
+    Returns
+    -------
+    boxes : (K, 4) ndarray
+    scores : (K,) ndarray
+
+    Raises
+    ------
+    ValueError
+        Wrong shape, NaN or inf, a box with no area, or one wholly outside the frame (usually
+        a wrong coordinate scale).
+    """
+    d = np.asarray(detections, dtype=np.float64)
+    if d.size == 0:
+        return np.zeros((0, 4)), np.zeros(0)
+    if d.ndim != 2 or d.shape[1] not in (4, 5):
+        raise ValueError(
+            f"detections must have shape (K, 4) or (K, 5) [left, top, w, h(, score)], got {d.shape}"
+        )
+    if not np.all(np.isfinite(d)):
+        raise ValueError("detections contain NaN or inf")
+    if np.any(d[:, 2] <= 0) or np.any(d[:, 3] <= 0):
+        k = int(np.flatnonzero((d[:, 2] <= 0) | (d[:, 3] <= 0))[0])
+        raise ValueError(f"detection {k} has width or height <= 0: {d[k].tolist()}")
+    rows, cols = shape
+    outside = (
+        (d[:, 0] >= cols) | (d[:, 1] >= rows) | (d[:, 0] + d[:, 2] <= 0) | (d[:, 1] + d[:, 3] <= 0)
+    )
+    if np.any(outside):
+        k = int(np.flatnonzero(outside)[0])
+        raise ValueError(
+            f"detection {k} {d[k, :4].tolist()} lies outside the {cols}x{rows} frame "
+            "(wrong coordinate scale? PETS boxes need --det-scale 0.625)"
+        )
+    scores = d[:, 4] if d.shape[1] == 5 else np.ones(len(d))
+    return d[:, :4].copy(), scores.copy()
+
+
 class BlobExtractor:
     """Raw mask -> cleaned mask (opening, then closing) -> filtered 8-connected blobs."""
 
@@ -204,7 +251,7 @@ class BlobExtractor:
         min_pixels = self.config.min_area * mask.shape[0] * mask.shape[1]
         out_r: list[NDArray[np.float64]] = []
         out_f: list[float] = []
-        for r, f in zip(rects, fill):
+        for r, f in zip(rects, fill, strict=True):
             x, y, w, h = (int(v) for v in r)
             n = int(round(w * pa / h))
             if w * pa / h < 1.5 or n < 2:
@@ -220,7 +267,7 @@ class BlobExtractor:
                 lo, hi = max(cuts[-1] + 1, c - half), min(w - 1, c + half + 1)
                 cuts.append(lo + int(np.argmin(profile[lo:hi])) if hi > lo else c)
             cuts.append(w)
-            for a, b in zip(cuts[:-1], cuts[1:]):
+            for a, b in zip(cuts[:-1], cuts[1:], strict=True):
                 part = roi[:, a:b]
                 rows = np.flatnonzero(part.any(axis=1))
                 cols = np.flatnonzero(part.any(axis=0))
@@ -230,8 +277,3 @@ class BlobExtractor:
                 out_r.append(np.array([x + a + cols[0], y + rows[0], pw, ph], np.float64))
                 out_f.append(float(part.sum()) / (pw * ph))
         return np.array(out_r, np.float64).reshape(-1, 4), np.array(out_f, np.float64)
-
-
-# The detector's foreground bins and the tracker's histograms must share one layout, so the
-# detectors take the particle filter's own binning settings.
-HsvConfig = HsvBinning

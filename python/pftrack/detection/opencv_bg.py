@@ -10,7 +10,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, HsvConfig, check_frame
+from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, check_frame
+from pftrack.particle_filter.colour import HsvBinning
 
 
 @dataclass(frozen=True)
@@ -25,7 +26,7 @@ class Mog2Config:
         Squared Mahalanobis distance above which a pixel is foreground.
     learning_rate : float
         -1 lets OpenCV choose (1 / min(frames seen, history)).
-    blobs, hsv : BlobConfig, HsvConfig
+    blobs, hsv : BlobConfig, HsvBinning
         As for `PaperDetector`.
     """
 
@@ -33,7 +34,7 @@ class Mog2Config:
     var_threshold: float = 16.0
     learning_rate: float = -1.0
     blobs: BlobConfig = field(default_factory=BlobConfig)
-    hsv: HsvConfig = field(default_factory=HsvConfig)
+    hsv: HsvBinning = field(default_factory=HsvBinning)
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,7 @@ class KnnConfig:
         Squared distance under which a sample counts as near.
     learning_rate : float
         -1 lets OpenCV choose.
-    blobs, hsv : BlobConfig, HsvConfig
+    blobs, hsv : BlobConfig, HsvBinning
         As for `PaperDetector`.
     """
 
@@ -56,7 +57,7 @@ class KnnConfig:
     dist2_threshold: float = 400.0
     learning_rate: float = -1.0
     blobs: BlobConfig = field(default_factory=BlobConfig)
-    hsv: HsvConfig = field(default_factory=HsvConfig)
+    hsv: HsvBinning = field(default_factory=HsvBinning)
 
 
 class _OpenCvDetector:
@@ -64,7 +65,7 @@ class _OpenCvDetector:
 
     _name = "detector"
 
-    def __init__(self, blobs: BlobConfig, hsv: HsvConfig, learning_rate: float) -> None:
+    def __init__(self, blobs: BlobConfig, hsv: HsvBinning, learning_rate: float) -> None:
         self._blobs = BlobExtractor(blobs)
         self._hsv = asdict(hsv)
         self._learning_rate = float(learning_rate)
@@ -87,8 +88,10 @@ class _OpenCvDetector:
         return Detections(boxes, scores, mask, _core.hsv_bins(frame, mask, **self._hsv))
 
     def foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], None]:
-        """The cleaned foreground mask (shadows are background), without blobs or boxes; no
-        full-frame bins (None: OpenCV's subtractors do not make them)."""
+        """Return the cleaned foreground mask (shadows are background), without blobs or boxes.
+
+        No full-frame bins come with it (None: OpenCV's subtractors do not make them).
+        """
         fn = f"{type(self).__name__}.foreground"
         frame = check_frame(frame, fn)
         if self._shape is not None and frame.shape != self._shape:

@@ -9,7 +9,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, HsvConfig, check_frame
+from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, check_frame
+from pftrack.particle_filter.colour import HsvBinning
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,7 @@ class PaperConfig:
         ``shadow_lo=1`` turns it off.
     blobs : BlobConfig
         Morphology and blob filters.
-    hsv : HsvConfig
+    hsv : HsvBinning
         Colour binning of the frame (done in the same pass).
     """
 
@@ -57,7 +58,7 @@ class PaperConfig:
     shadow_lo: float = 0.5
     shadow_chroma: float = 0.03
     blobs: BlobConfig = field(default_factory=BlobConfig)
-    hsv: HsvConfig = field(default_factory=HsvConfig)
+    hsv: HsvBinning = field(default_factory=HsvBinning)
 
 
 class PaperDetector:
@@ -81,8 +82,9 @@ class PaperDetector:
 
     References
     ----------
-    .. [1] The detection of ``/work/shared/papers/000_f11c25999834422a.txt``: adaptive
-       background and frame differences, thresholded, cleaned by morphology.
+    .. [1] The detection step of the first method's paper (multi-object tracking with background
+       subtraction and colour particle filters; restated in English in the project's papers
+       README): adaptive background and frame differences, thresholded, cleaned by morphology.
     """
 
     def __init__(self, config: PaperConfig | None = None) -> None:
@@ -151,6 +153,8 @@ class PaperDetector:
         """
         return self._foreground(frame, "PaperDetector.foreground")
 
-    def _foreground(self, frame: NDArray[np.uint8], fn: str) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
+    def _foreground(
+        self, frame: NDArray[np.uint8], fn: str
+    ) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
         binned, raw = self._model.apply(check_frame(frame, fn))
         return self._blobs.clean(raw), binned

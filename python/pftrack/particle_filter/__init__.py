@@ -13,20 +13,14 @@ from pftrack.particle_filter.colour import (
 )
 from pftrack.particle_filter.dynamics import Ar2Model, estimate, propagate
 from pftrack.particle_filter.filter import ColourParticleFilter, FilterConfig, FilterState
-from pftrack.particle_filter.mh import (
-    MHColourParticleFilter,
-    MHConfig,
-    MHParticleFilter,
-    MHState,
-    mh_step,
-)
-from pftrack.particle_filter.rjmcmc import RJMCMCConfig, RJMCMCFilter, RJTrack
+from pftrack.particle_filter.mh import MHColourParticleFilter
 from pftrack.particle_filter.resample import (
     multinomial_resample,
     residual_resample,
     stratified_resample,
     systematic_resample,
 )
+from pftrack.particle_filter.rjmcmc import RJMCMCConfig, RJMCMCFilter, RJTrack
 
 __all__ = [
     "Ar2Model",
@@ -36,9 +30,6 @@ __all__ = [
     "FilterState",
     "HsvBinning",
     "MHColourParticleFilter",
-    "MHConfig",
-    "MHParticleFilter",
-    "MHState",
     "RJMCMCConfig",
     "RJMCMCFilter",
     "RJTrack",
@@ -48,7 +39,6 @@ __all__ = [
     "box_histograms",
     "estimate",
     "hsv_bins",
-    "mh_step",
     "multinomial_resample",
     "propagate",
     "residual_resample",

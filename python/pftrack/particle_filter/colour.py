@@ -108,9 +108,7 @@ def hsv_bins(
         if m.shape != f.shape[:2]:
             raise ValueError(f"mask shape is {m.shape}, expected the frame's {f.shape[:2]}")
         m = np.ascontiguousarray(m)
-    return _core.hsv_bins(
-        f, m, binning.n_h, binning.n_s, binning.n_v, binning.s_min, binning.v_min
-    )
+    return _core.hsv_bins(f, m, binning.n_h, binning.n_s, binning.n_v, binning.s_min, binning.v_min)
 
 
 def box_histograms(
@@ -165,7 +163,9 @@ def bhattacharyya_distance(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float
     return _core.bhattacharyya_distance(h, np.asarray(ref, dtype=np.float64))
 
 
-def bhattacharyya_weights(hists: ArrayLike, ref: ArrayLike, lam: float = 20.0) -> NDArray[np.float64]:
+def bhattacharyya_weights(
+    hists: ArrayLike, ref: ArrayLike, lam: float = 20.0
+) -> NDArray[np.float64]:
     """Normalised particle weights ``w ∝ exp(-λ D²)``, computed in log space.
 
     Parameters

@@ -95,8 +95,8 @@ class ColourParticleFilter:
         Initial box; its size is the base size ``(w0, h0)`` that the scale multiplies.
     reference : (B,) array_like
         Reference colour histogram of the object (need not be normalised).
-    config : FilterConfig
-        Particles, dynamics, likelihood.
+    config : FilterConfig, optional
+        Particles, dynamics, likelihood (default ``FilterConfig()``).
     rng : numpy.random.Generator, int or None
         Seeds the filter: same seed, same particles, whatever the thread count.
     velocity : (2,) array_like, optional
@@ -112,18 +112,18 @@ class ColourParticleFilter:
         self,
         box_cxcywh: ArrayLike,
         reference: ArrayLike,
-        config: FilterConfig = FilterConfig(),
+        config: FilterConfig | None = None,
         rng: RngLike = None,
         velocity: ArrayLike = (0.0, 0.0),
     ) -> None:
-        self.config = config
+        self.config = config if config is not None else FilterConfig()
         self._rng = np.random.default_rng(rng)
         self._seed = int(self._rng.integers(2**63))
         self._step = 0
         b = _box(box_cxcywh)
         self.w0, self.h0 = float(b[2]), float(b[3])
         self.set_reference(reference)
-        n = config.n_particles
+        n = self.config.n_particles
         self.particles = np.empty((n, 6))
         self.weights = np.full(n, 1.0 / n)
         self.means = np.empty((2, 3))

@@ -7,8 +7,6 @@ can never produce an index >= N (the CDF's last value is set to 1 and indices ar
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -32,36 +30,6 @@ def _weights(weights: ArrayLike) -> NDArray[np.float64]:
     return np.ascontiguousarray(w, dtype=np.float64)
 
 
-_unseeded: np.random.Generator | None = None
-
-
-def _reseed_unseeded() -> None:
-    global _unseeded
-    _unseeded = None  # a forked child must not repeat its parent's draws
-
-
-if hasattr(os, "register_at_fork"):  # not on Windows, which has no fork
-    os.register_at_fork(after_in_child=_reseed_unseeded)
-
-
-def _generator(rng: RngLike) -> np.random.Generator:
-    """``np.random.default_rng(rng)``, except that ``rng=None`` reuses one generator.
-
-    ``default_rng(None)`` gathers fresh OS entropy on every call (~8 us, more than resampling
-    10 000 weights takes). An unseeded call promises no reproducibility, so a single generator
-    seeded from OS entropy on first use (and again in a forked child) gives the same guarantee
-    for less. A Generator or an int seed behaves exactly as ``default_rng`` does.
-    """
-    global _unseeded
-    if rng is None:
-        if _unseeded is None:
-            _unseeded = np.random.default_rng()
-        return _unseeded
-    if isinstance(rng, np.random.Generator):
-        return rng
-    return np.random.default_rng(rng)
-
-
 def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
     """Indices of the particles kept by systematic resampling.
 
@@ -74,8 +42,8 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     weights : (N,) array_like of float
         Non-negative particle weights; need not sum to 1.
     rng : numpy.random.Generator, int or None
-        Source of the single uniform offset: ``default_rng(rng).random()``. With None, a
-        module-level generator seeded from OS entropy (see Notes).
+        Source of the single uniform offset: ``default_rng(rng).random()`` (None: fresh OS
+        entropy; pass a Generator when resampling often, it is cheaper than building one).
 
     Returns
     -------
@@ -85,10 +53,8 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     Notes
     -----
     A seed or a Generator gives exactly ``default_rng(rng).random()`` as the offset, so results
-    are reproducible. ``rng=None`` skips building a new Generator from OS entropy on each call
-    (which costs more than the resampling): the resamplers share one unseeded generator, made on
-    first use and remade in a forked child. The kernel runs in O(N) without a data-dependent
-    branch per particle and returns the same indices as ``numpy.searchsorted`` on the
+    are reproducible; there is no module-level generator. The kernel runs in O(N) without a
+    data-dependent branch per particle and returns the same indices as ``numpy.searchsorted`` on the
     normalised cumulative sum (side="right", clamped to N-1), i.e. as filterpy.
 
     References
@@ -97,7 +63,7 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
        state space models. Journal of Computational and Graphical Statistics 5(1), 1-25.
     """
     w = _weights(weights)
-    return _core.systematic_resample(w, _generator(rng).random())
+    return _core.systematic_resample(w, np.random.default_rng(rng).random())
 
 
 def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
@@ -120,7 +86,7 @@ def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
        particle filtering. ISPA 2005, 64-69.
     """
     w = _weights(weights)
-    return _core.stratified_resample(w, _generator(rng).random(len(w)))
+    return _core.stratified_resample(w, np.random.default_rng(rng).random(len(w)))
 
 
 def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
@@ -145,7 +111,7 @@ def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.
        Bayesian state estimation. IEE Proceedings F 140(2), 107-113.
     """
     w = _weights(weights)
-    return _core.multinomial_resample(w, _generator(rng).random(len(w)))
+    return _core.multinomial_resample(w, np.random.default_rng(rng).random(len(w)))
 
 
 def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
@@ -171,4 +137,4 @@ def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int
        JASA 93(443), 1032-1044.
     """
     w = _weights(weights)
-    return _core.residual_resample(w, _generator(rng).random(len(w)))
+    return _core.residual_resample(w, np.random.default_rng(rng).random(len(w)))

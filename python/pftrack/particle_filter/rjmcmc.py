@@ -90,10 +90,31 @@ class RJMCMCConfig:
 
     def core_kwargs(self) -> dict[str, Any]:
         """Keyword arguments of ``pftrack._core.RJMCMCTracker``."""
-        out = {k: getattr(self, k) for k in (
-            "burn_in", "n_samples", "p_birth", "p_death", "p_update", "p_swap", "s_min", "s_max",
-            "lam", "kernel", "interaction", "coverage", "background_penalty", "birth_prior", "survival",
-            "birth_sigma_xy", "birth_sigma_s", "birth_eps", "birth_gate", "detection")}
+        out = {
+            k: getattr(self, k)
+            for k in (
+                "burn_in",
+                "n_samples",
+                "p_birth",
+                "p_death",
+                "p_update",
+                "p_swap",
+                "s_min",
+                "s_max",
+                "lam",
+                "kernel",
+                "interaction",
+                "coverage",
+                "background_penalty",
+                "birth_prior",
+                "survival",
+                "birth_sigma_xy",
+                "birth_sigma_s",
+                "birth_eps",
+                "birth_gate",
+                "detection",
+            )
+        }
         for k in ("a", "b", "sigma"):
             out[k] = np.asarray(getattr(self, k), dtype=np.float64)
         return out
@@ -130,7 +151,10 @@ class RJMCMCFilter:
     def __init__(self, config: RJMCMCConfig | None = None, rng: RngLike = None) -> None:
         self.config = config if config is not None else RJMCMCConfig()
         if self.config.kernel not in ("uniform", "epanechnikov"):
-            raise ValueError(f"RJMCMCConfig: kernel is {self.config.kernel!r}, expected 'uniform' or 'epanechnikov'")
+            raise ValueError(
+                f"RJMCMCConfig: kernel is {self.config.kernel!r}, "
+                "expected 'uniform' or 'epanechnikov'"
+            )
         self._core = _core.RJMCMCTracker(**self.config.core_kwargs())
         self.seed = int(np.random.default_rng(rng).integers(2**63))
         self.n_steps = 0
@@ -168,7 +192,11 @@ class RJMCMCFilter:
             m = m.view(np.uint8)
         m = np.ascontiguousarray(m)
         cands = np.ascontiguousarray(np.asarray(candidates_cxcywh, dtype=np.float64).reshape(-1, 4))
-        hists = None if candidate_hists is None else np.ascontiguousarray(candidate_hists, dtype=np.float64)
+        hists = (
+            None
+            if candidate_hists is None
+            else np.ascontiguousarray(candidate_hists, dtype=np.float64)
+        )
         r = self._core.step(binned, m, cands, hists, seed=self.seed, step=self.n_steps)
         self.n_steps += 1
         self.last = dict(r)

@@ -1,4 +1,4 @@
-"""The offline box smoother against a dense Gaussian reference, and the writer that uses it."""
+"""The offline pass (smoother vs a dense Gaussian reference, linking, filling) and the writer."""
 
 from __future__ import annotations
 
@@ -7,8 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pftrack.smoothing import BoxSmoother
-from pftrack.tracker import Track, TrackWriter
+from pftrack.tracking import BoxSmoother, Track, TrackWriter, smooth_tracks
 from tests.reference.smoothing import cv_posterior_mean
 
 
@@ -23,18 +22,27 @@ def _reference(frames, boxes, observed, sm: BoxSmoother):
     h = np.median(boxes[observed, 3])
     q = h * np.array([sm.accel, sm.accel, sm.size_accel, sm.size_accel])
     r = h * np.array([sm.noise, sm.noise, sm.size_noise, sm.size_noise])
-    s = np.column_stack([cv_posterior_mean(zt[:, k], has, q[k], r[k], 10 * h) for k in range(4)])[frames - f0]
+    s = np.column_stack([cv_posterior_mean(zt[:, k], has, q[k], r[k], 10 * h) for k in range(4)])[
+        frames - f0
+    ]
     return np.column_stack([s[:, :2] - s[:, 2:] / 2, s[:, 2:]])
 
 
 @settings(max_examples=40, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), n=st.integers(2, 40), accel=st.sampled_from([0.0025, 0.02, 0.3]))
+@given(
+    seed=st.integers(0, 2**31 - 1), n=st.integers(2, 40), accel=st.sampled_from([0.0025, 0.02, 0.3])
+)
 def test_smoother_matches_dense_reference(seed, n, accel):
     rng = np.random.default_rng(seed)
     frames = np.cumsum(rng.integers(1, 4, n))  # holes of up to 2 frames
-    boxes = np.column_stack([
-        np.cumsum(rng.normal(2, 1, n)), rng.normal(100, 3, n), rng.uniform(15, 25, n), rng.uniform(40, 60, n),
-    ])  # fmt: skip
+    boxes = np.column_stack(
+        [
+            np.cumsum(rng.normal(2, 1, n)),
+            rng.normal(100, 3, n),
+            rng.uniform(15, 25, n),
+            rng.uniform(40, 60, n),
+        ]
+    )
     observed = rng.random(n) < 0.7
     observed[0] = True
     sm = BoxSmoother(accel=accel)
@@ -44,7 +52,9 @@ def test_smoother_matches_dense_reference(seed, n, accel):
 
 def test_straight_path_is_kept_and_gaps_follow_it():
     frames = np.arange(1, 31)
-    boxes = np.column_stack([10 + 2.5 * frames, 50 - 0.5 * frames, np.full(30, 20.0), np.full(30, 50.0)])
+    boxes = np.column_stack(
+        [10 + 2.5 * frames, 50 - 0.5 * frames, np.full(30, 20.0), np.full(30, 50.0)]
+    )
     observed = np.ones(30, bool)
     observed[10:18] = False  # a bridged occlusion: rows present, values meaningless
     junk = boxes.copy()
@@ -56,7 +66,9 @@ def test_straight_path_is_kept_and_gaps_follow_it():
 def test_smoothing_removes_detection_jitter():
     rng = np.random.default_rng(3)
     frames = np.arange(200)
-    truth = np.column_stack([100 + 40 * np.sin(frames / 40), 80 + frames * 0.3, np.full(200, 20.0), np.full(200, 50.0)])
+    truth = np.column_stack(
+        [100 + 40 * np.sin(frames / 40), 80 + frames * 0.3, np.full(200, 20.0), np.full(200, 50.0)]
+    )
     noisy = truth + rng.normal(0, 2.5, truth.shape)  # 5% of the height, the default's noise
     got = BoxSmoother().smooth(frames, noisy, np.ones(200, bool))
     raw_err = np.abs(noisy - truth).mean()
@@ -85,7 +97,15 @@ def test_smoother_bad_input():
 
 def _track(tid, x, tsu, measured=True):
     box = np.array([x, 10.0, 10, 20])
-    return Track(tid, box, 1.0, 0 if tsu == 0 else None, 1, tsu, detection_box=box if measured and tsu == 0 else None)
+    return Track(
+        tid,
+        box,
+        1.0,
+        0 if tsu == 0 else None,
+        1,
+        tsu,
+        detection_box=box if measured and tsu == 0 else None,
+    )
 
 
 def test_writer_links_fragments_then_smooths_them_as_one():
@@ -119,18 +139,21 @@ def test_writer_smooths_measured_boxes_not_reported_ones():
 def test_smooth_tracks_on_any_trackers_output():
     """Another tracker's rows: two fragments of one walker, jittered, with a 4-frame hole."""
     from pftrack.recovery.linking import FLAG_COLUMN
-    from pftrack.smoothing import smooth_tracks
 
     rng = np.random.default_rng(0)
     frames = np.r_[np.arange(1, 21), np.arange(25, 45)]
     ids = np.where(frames < 21, 7, 9)
     truth = np.column_stack([2.0 * frames, np.full(40, 30.0), np.full(40, 10.0), np.full(40, 24.0)])
-    rows = np.column_stack([frames, ids, truth + rng.normal(0, 1.0, truth.shape), np.ones(40), -np.ones((40, 3))])
+    rows = np.column_stack(
+        [frames, ids, truth + rng.normal(0, 1.0, truth.shape), np.ones(40), -np.ones((40, 3))]
+    )
     out = smooth_tracks(rows)
     assert set(out[:, 1]) == {7} and out[:, 0].tolist() == list(range(1, 45))
     filled = out[:, FLAG_COLUMN] == 1
     assert out[filled, 0].tolist() == [21, 22, 23, 24]
-    want = np.column_stack([2.0 * out[:, 0], np.full(44, 30.0), np.full(44, 10.0), np.full(44, 24.0)])
+    want = np.column_stack(
+        [2.0 * out[:, 0], np.full(44, 30.0), np.full(44, 10.0), np.full(44, 24.0)]
+    )
     assert np.abs(out[:, 2:6] - want).mean() < 0.5 * np.abs(rows[:, 2:6] - truth).mean()
     only_linked = smooth_tracks(rows, smoother=None)
     np.testing.assert_array_equal(only_linked[:, 2:6], rows[:, 2:6])  # ids joined, boxes as given
@@ -144,8 +167,18 @@ def test_cli_smooth_links_fills_and_refuses_its_input(tmp_path, capsys):
     from pftrack.io.mot import read_mot, write_mot
 
     frames = np.r_[np.arange(1, 11), np.arange(14, 24)]
-    rows = np.column_stack([frames, np.where(frames < 11, 1, 2), 3.0 * frames, np.full(20, 5.0),
-                            np.full(20, 10.0), np.full(20, 20.0), np.ones(20), -np.ones((20, 3))])  # fmt: skip
+    rows = np.column_stack(
+        [
+            frames,
+            np.where(frames < 11, 1, 2),
+            3.0 * frames,
+            np.full(20, 5.0),
+            np.full(20, 10.0),
+            np.full(20, 20.0),
+            np.ones(20),
+            -np.ones((20, 3)),
+        ]
+    )
     src = tmp_path / "bytetrack.txt"
     write_mot(src, rows)
     assert main(["smooth", str(src), "--out", str(tmp_path / "out.txt")]) == 0

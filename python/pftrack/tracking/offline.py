@@ -1,11 +1,12 @@
-"""Offline smoothing of a track's boxes: a Rauch-Tung-Striebel smoother over the whole track.
+"""The offline pass over a finished run: link fragments, fill holes, smooth every track.
 
 An online tracker must report each box before it sees the next frame, so its filtered boxes lag
 behind turns and carry the detector's frame-to-frame jitter. Once a run is over, every box can
 use the frames after it as well: a constant-velocity model for the centre and for the size,
-a forward Kalman pass over the track's detections and a backward Rauch-Tung-Striebel pass give
-each frame the mean of its box given the whole track. Frames without a detection (occlusions
-the particle filter bridged, merged blobs) get the smoother's interpolation through the gap.
+a forward Kalman pass over the track's detections and a backward Rauch-Tung-Striebel pass
+(:func:`pftrack.kalman.rts_smooth`) give each frame the mean of its box given the whole track.
+Frames without a detection (occlusions the particle filter bridged, merged blobs) get the
+smoother's interpolation through the gap.
 
 Noise levels are in units of the track's median box height, so that one rule fits any image
 scale. With the defaults (measured on PETS09-S2L1 and TUD-Campus public detections, README)
@@ -15,16 +16,16 @@ the smoothed boxes match the annotation far more often than the detections thems
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._typing import F64
+from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
+from pftrack.kalman import rts_smooth
 from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, link_tracklets
 
-__all__ = ["BoxSmoother", "cv_predict", "cv_update", "smooth_tracks"]
-
-F64 = NDArray[np.float64]
+__all__ = ["BoxSmoother", "smooth_tracks"]
 
 
 @dataclass(frozen=True)
@@ -44,7 +45,9 @@ class BoxSmoother:
         Standard deviation of a detection's width and height, in track heights.
 
     Only the ratios ``accel / noise`` and ``size_accel / size_noise`` change the smoothed
-    boxes; the smaller they are, the smoother the path.
+    boxes; the smaller they are, the smoother the path. The model is
+    :func:`pftrack.kalman.rts_smooth` with ``discretisation="piecewise"`` (transitional) and the
+    first detection as the initial state.
     """
 
     accel: float = 0.0025
@@ -78,7 +81,7 @@ class BoxSmoother:
             Smoothed boxes for every row. A track with no observed row comes back unchanged.
         """
         f = np.asarray(frames, dtype=np.int64)
-        b = np.asarray(boxes_xywh, dtype=np.float64)
+        b: F64 = np.asarray(boxes_xywh, dtype=np.float64)
         obs = np.asarray(observed, dtype=bool)
         n = len(f)
         if b.shape != (n, 4) or obs.shape != (n,):
@@ -91,11 +94,13 @@ class BoxSmoother:
         if not np.all(np.isfinite(b[obs])):
             raise ValueError("BoxSmoother.smooth: observed boxes contain NaN or inf")
         if not obs.any():
-            return b.copy()
-        z = np.column_stack([b[:, :2] + b[:, 2:] / 2, b[:, 2:]])  # cx, cy, w, h
+            return np.array(b, dtype=np.float64)  # a copy
+        z = xywh_to_cxcywh(b)
         height = float(np.median(b[obs, 3]))
         if not height > 0:
-            raise ValueError(f"BoxSmoother.smooth: the median observed height is {height}, expected > 0")
+            raise ValueError(
+                f"BoxSmoother.smooth: the median observed height is {height}, expected > 0"
+            )
         q = height * np.array([self.accel, self.accel, self.size_accel, self.size_accel])
         r = height * np.array([self.noise, self.noise, self.size_noise, self.size_noise])
         first = int(np.argmax(obs))
@@ -104,77 +109,18 @@ class BoxSmoother:
         has = np.zeros(steps, dtype=bool)
         zt[f[first:] - f[first]] = z[first:]
         has[f[first:] - f[first]] = obs[first:]
-        mean = _rts(zt, has, q, r, velocity_sd=10.0 * height)
-        out = b.copy()
-        s = mean[f[first:] - f[first]]
-        out[first:] = np.column_stack([s[:, :2] - s[:, 2:] / 2, s[:, 2:]])
+        mean = rts_smooth(zt, has, q * q, r * r, velocity_sd=10.0 * height, update_first=False,
+                          discretisation="piecewise")  # fmt: skip
+        out: F64 = b.copy()
+        out[first:] = cxcywh_to_xywh(mean[f[first:] - f[first]])
         return out  # rows before the first detection keep their own boxes
-
-
-def cv_predict(m: tuple[Any, Any], p: tuple[Any, Any, Any], q2: Any) -> tuple[tuple[Any, Any], tuple[Any, Any, Any]]:
-    """One step of a constant-velocity axis: mean (position, velocity) and covariance entries
-    ``(p00, p01, p11)`` advanced with white-noise acceleration of variance `q2` per frame.
-    Works on floats or on arrays of independent axes alike."""
-    p00, p01, p11 = p
-    return (m[0] + m[1], m[1]), (p00 + 2 * p01 + p11 + q2 / 4, p01 + p11 + q2 / 2, p11 + q2)
-
-
-def cv_update(m: tuple[Any, Any], p: tuple[Any, Any, Any], z: Any, r2: Any
-              ) -> tuple[tuple[Any, Any], tuple[Any, Any, Any]]:  # fmt: skip
-    """Kalman update of a constant-velocity axis with a position measurement `z` of variance `r2`."""
-    p00, p01, p11 = p
-    s = p00 + r2
-    k0, k1 = p00 / s, p01 / s
-    e = z - m[0]
-    return (m[0] + k0 * e, m[1] + k1 * e), ((1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01)
-
-
-def _rts(z: F64, has: NDArray[np.bool_], q: F64, r: F64, velocity_sd: float) -> F64:
-    """Smoothed positions of independent constant-velocity axes (one per column of `z`).
-
-    Each axis has state (position, velocity), white-noise acceleration ``q`` (per-frame
-    standard deviation) and position measurements with standard deviation ``r`` where `has`.
-    The first step must have a measurement: it sets the initial state, ``N([z_0, 0],
-    diag(r², velocity_sd²))`` (a wide `velocity_sd` leaves the velocity to the data).
-    Covariances are 2x2 per axis, kept as their three entries so that all axes advance together.
-    """
-    steps = len(z)
-    q2, r2 = q * q, r * r
-    m = (z[0].copy(), np.zeros_like(q))
-    p = (r2.copy(), np.zeros_like(q), np.full_like(q, velocity_sd**2))
-    fm = np.empty((steps, 2, len(q)))  # filtered mean
-    fp = np.empty((steps, 3, len(q)))  # filtered covariance
-    pp = np.empty((steps, 3, len(q)))  # predicted covariance
-    pm = np.empty((steps, 2, len(q)))  # predicted mean
-    for t in range(steps):
-        if t > 0:
-            m, p = cv_predict(m, p, q2)
-        pm[t], pp[t] = m, p
-        if has[t] and t > 0:  # step 0's measurement is the initial state
-            m, p = cv_update(m, p, z[t], r2)
-        fm[t], fp[t] = m, p
-    out = np.empty((steps, len(q)))
-    s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
-    out[-1] = s0
-    for t in range(steps - 2, -1, -1):
-        a, b, c = fp[t]
-        # gain C = P_f F^T P_pred^-1 with F = [[1, 1], [0, 1]]
-        u00, u01, u10, u11 = a + b, b, b + c, c
-        x, y, w = pp[t + 1]
-        det = x * w - y * y
-        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
-        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
-        d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
-        s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
-        out[t] = s0
-    return out
 
 
 def smooth_tracks(
     rows: ArrayLike,
     observed: ArrayLike | None = None,
-    smoother: BoxSmoother | None = BoxSmoother(),
-    link: LinkConfig | None = LinkConfig(),
+    smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
+    link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
     measurements: ArrayLike | None = None,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
@@ -189,10 +135,10 @@ def smooth_tracks(
     smoother : BoxSmoother or None
         None links only (and fills nothing).
     link : LinkConfig or None
-        Join fragments of one object first (:func:`pftrack.recovery.link_tracklets`); with a
-        smoother, frames missing inside a track (up to ``link.max_gap``) are added as rows of
-        the smoother's interpolation, flagged in column 8 (1-based) as pftrack's filled rows
-        are (:data:`pftrack.recovery.linking.FLAG_COLUMN`). None keeps ids and holes.
+        Join fragments of one object first (:func:`pftrack.recovery.linking.link_tracklets`);
+        with a smoother, frames missing inside a track (up to ``link.max_gap``) are added as
+        rows of the smoother's interpolation, flagged in column 8 (1-based) as pftrack's filled
+        rows are (:data:`pftrack.recovery.linking.FLAG_COLUMN`). None keeps ids and holes.
     measurements : (M, 4) array_like, optional
         The boxes the smoother fits at observed rows, when they differ from the rows' own
         (which linking uses): e.g. raw detections behind a tracker's filtered boxes.
@@ -202,13 +148,19 @@ def smooth_tracks(
     (M', 10) ndarray
         The rows, sorted by frame then id.
     """
-    a = np.array(rows, dtype=np.float64, copy=True).reshape(-1, 10) if np.size(rows) else np.zeros((0, 10))
+    if np.size(rows):
+        a = np.array(rows, dtype=np.float64, copy=True).reshape(-1, 10)
+    else:
+        a = np.zeros((0, 10))
     obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
     if obs.shape != (len(a),):
         raise ValueError(f"smooth_tracks: observed has shape {obs.shape}, expected ({len(a)},)")
     if len(a) == 0:
         return a
-    z = a[:, 2:6].copy() if measurements is None else np.array(measurements, dtype=np.float64).reshape(-1, 4)
+    if measurements is None:
+        z = a[:, 2:6].copy()
+    else:
+        z = np.array(measurements, dtype=np.float64).reshape(-1, 4)
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
     if link is not None:
@@ -216,25 +168,38 @@ def smooth_tracks(
     order = np.lexsort((a[:, 0], a[:, 1]))  # by id, then frame
     a, obs, z = a[order], obs[order], z[order]
     if smoother is not None and link is not None:
-        missing = a[1:, 0] - a[:-1, 0] - 1
-        hole = np.flatnonzero((a[1:, 1] == a[:-1, 1]) & (missing >= 1) & (missing <= link.max_gap))
-        if len(hole):
-            counts = missing[hole].astype(np.int64)
-            extra = np.zeros((int(counts.sum()), 10))
-            extra[:, 7:] = -1.0
-            extra[:, FLAG_COLUMN] = 1.0
-            first = np.repeat(a[hole, 0] + 1 - np.r_[0, np.cumsum(counts)[:-1]], counts)
-            extra[:, 0] = first + np.arange(len(extra))  # the frames after each hole's start
-            extra[:, 1] = np.repeat(a[hole, 1], counts)
-            extra[:, 4:6] = 1.0  # placeholders: the smoother writes every filled box
-            a = np.vstack([a, extra])
-            obs = np.concatenate([obs, np.zeros(len(extra), dtype=bool)])
-            z = np.vstack([z, extra[:, 2:6]])
-            order = np.lexsort((a[:, 0], a[:, 1]))
-            a, obs, z = a[order], obs[order], z[order]
+        a, obs, z = _add_hole_rows(a, obs, z, link.max_gap)
     if smoother is not None:
         starts = np.flatnonzero(np.r_[True, a[1:, 1] != a[:-1, 1], True])
-        for i, j in zip(starts[:-1], starts[1:]):
+        for i, j in zip(starts[:-1], starts[1:], strict=True):
             if obs[i:j].any():
                 a[i:j, 2:6] = smoother.smooth(a[i:j, 0], z[i:j], obs[i:j])
-    return a[np.lexsort((a[:, 1], a[:, 0]))]
+    out: F64 = a[np.lexsort((a[:, 1], a[:, 0]))]
+    return out
+
+
+def _add_hole_rows(
+    a: F64, obs: NDArray[np.bool_], z: F64, max_gap: int
+) -> tuple[F64, NDArray[np.bool_], F64]:
+    """Add a flagged placeholder row for every frame missing inside a track.
+
+    Only holes of at most `max_gap` frames are filled; rows must be sorted by id, then frame,
+    and come back so.
+    """
+    missing = a[1:, 0] - a[:-1, 0] - 1
+    hole = np.flatnonzero((a[1:, 1] == a[:-1, 1]) & (missing >= 1) & (missing <= max_gap))
+    if not len(hole):
+        return a, obs, z
+    counts = missing[hole].astype(np.int64)
+    extra = np.zeros((int(counts.sum()), 10))
+    extra[:, 7:] = -1.0
+    extra[:, FLAG_COLUMN] = 1.0
+    first = np.repeat(a[hole, 0] + 1 - np.r_[0, np.cumsum(counts)[:-1]], counts)
+    extra[:, 0] = first + np.arange(len(extra))  # the frames after each hole's start
+    extra[:, 1] = np.repeat(a[hole, 1], counts)
+    extra[:, 4:6] = 1.0  # placeholders: the smoother writes every filled box
+    a = np.vstack([a, extra])
+    obs = np.concatenate([obs, np.zeros(len(extra), dtype=bool)])
+    z = np.vstack([z, extra[:, 2:6]])
+    order = np.lexsort((a[:, 0], a[:, 1]))
+    return a[order], obs[order], z[order]

@@ -1,16 +1,28 @@
-"""End-to-end tracking on synthetic scenes with known truth, drop-in mode, determinism, data sets."""
+"""End-to-end tracking on synthetic scenes with known truth, drop-in mode, determinism, data."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from pftrack.boxes import iou_xywh
+from pftrack.detection import refine_boxes
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot
 from pftrack.particle_filter import box_histograms, hsv_bins
-from pftrack.run import load_detections, track_frames
 from pftrack.synthetic import make_scene
-from pftrack.tracker import MultiObjectTracker, TrackerConfig, TrackWriter, iou_matrix, refine_boxes
+from pftrack.tracking import (
+    AssociationConfig,
+    LifecycleConfig,
+    MultiObjectTracker,
+    RefineConfig,
+    Track,
+    TrackerConfig,
+    TrackWriter,
+    load_detections,
+    track_frames,
+)
+from pftrack.tracking.association import associate
 from tests.conftest import dataset
 
 
@@ -44,7 +56,7 @@ def test_identity_survives_the_crossing(scene, scene_run):
             g = truth[(truth[:, 0] == f) & (truth[:, 1] == walker_id)]
             r = rows[rows[:, 0] == f]
             if len(g) and len(r):
-                iou = iou_matrix(g[:, 2:6], r[:, 2:6])[0]
+                iou = iou_xywh(g[:, 2:6], r[:, 2:6])[0]
                 if iou.max() >= 0.3:
                     ids.append(int(r[np.argmax(iou), 1]))
         assert ids, f"walker {walker_id} never tracked in frames {frames[0]}..{frames[-1]}"
@@ -75,7 +87,9 @@ def test_drop_in_mode_with_truth_boxes_as_detections(scene, dynamics):
     from dataclasses import replace
 
     base = TrackerConfig()
-    config = replace(base, filter=replace(base.filter, model=replace(base.filter.model, use_means=dynamics)))
+    config = replace(
+        base, filter=replace(base.filter, model=replace(base.filter.model, use_means=dynamics))
+    )
     dets = {}
     for f in range(1, len(scene.frames) + 1):
         if f % 5 == 0:
@@ -90,7 +104,9 @@ def test_drop_in_mode_with_truth_boxes_as_detections(scene, dynamics):
 
 def test_update_api_reports_detection_index():
     scene = make_scene(n_frames=12, n_walkers=1, rng=3, occluder=False)
-    tracker = MultiObjectTracker(TrackerConfig(min_hits=1, min_score=0.5), rng=0)
+    tracker = MultiObjectTracker(
+        TrackerConfig(lifecycle=LifecycleConfig(min_hits=1, min_score=0.5)), rng=0
+    )
     for f, frame in enumerate(scene.frames, start=1):
         g = scene.truth[scene.truth[:, 0] == f]
         dets = np.column_stack([g[:, 2:6], np.full(len(g), 0.9)])
@@ -104,11 +120,11 @@ def test_update_api_reports_detection_index():
 
 def test_centre_kalman_matches_the_matrix_filter():
     """The tracker's per-axis closed form equals a textbook 4-state constant-velocity filter."""
-    from pftrack.tracker import _CentreKalman
+    from pftrack.tracking.motion import CentreKalman
 
     rng = np.random.default_rng(5)
     h, accel = 40.0, 0.01
-    kf = _CentreKalman(np.array([100.0, 50.0]), h, accel)
+    kf = CentreKalman(np.array([100.0, 50.0]), h, accel)
     F = np.kron(np.array([[1.0, 1.0], [0.0, 1.0]]), np.eye(2))  # state [px, py, vx, vy]
     G = np.kron(np.array([[0.5], [1.0]]), np.eye(2))
     Q = (accel * h) ** 2 * G @ G.T
@@ -134,7 +150,9 @@ def test_unsure_detections_do_not_start_tracks():
     frame[10:30, 10:20] = (0, 0, 255)
     frame[10:30, 50:60] = (255, 0, 0)
     dets = np.array([[10, 10, 10, 20, 0.95], [50, 10, 10, 20, 0.5]])
-    config = TrackerConfig(min_hits=1, refine_boxes=False)
+    config = TrackerConfig(
+        lifecycle=LifecycleConfig(min_hits=1), refine=RefineConfig(enabled=False)
+    )
     tracks = MultiObjectTracker(config, rng=0).update(frame, dets)
     assert [t.detection_index for t in tracks] == [0]
     # scores that are not confidences in [0, 1] (e.g. raw detector margins) never gate births
@@ -145,7 +163,12 @@ def test_unsure_detections_do_not_start_tracks():
 def test_new_track_reports_its_unconfirmed_boxes_once():
     frame = np.zeros((60, 80, 3), np.uint8)
     frame[10:30, 10:20] = (0, 0, 255)
-    tracker = MultiObjectTracker(TrackerConfig(min_hits=3, max_coast=0, refine_boxes=False), rng=0)
+    tracker = MultiObjectTracker(
+        TrackerConfig(
+            lifecycle=LifecycleConfig(min_hits=3, max_coast=0), refine=RefineConfig(enabled=False)
+        ),
+        rng=0,
+    )
     writer = TrackWriter(link=None)  # linking would join tracks 1 and 2 across frame 4
     reported = []
     for f in range(1, 8):
@@ -199,8 +222,6 @@ def test_refine_boxes_shrinks_to_foreground():
 
 
 def test_track_writer_holds_back_unconfirmed_coasting():
-    from pftrack.tracker import Track
-
     def t(tid, x, tsu):
         return Track(tid, np.array([x, 0.0, 10, 10]), 1.0, None, 1, tsu)
 
@@ -259,7 +280,7 @@ def test_drop_in_mode_with_a_detector_that_has_only_detect(scene):
     dets = [np.column_stack([g[:, 2:6], np.ones(len(g))]) for g in
             (scene.truth[scene.truth[:, 0] == f] for f in range(1, 31))]  # fmt: skip
     a, b = MultiObjectTracker(rng=0), MultiObjectTracker(rng=0, detector=DetectOnly())
-    for frame, d in zip(scene.frames[:30], dets):
+    for frame, d in zip(scene.frames[:30], dets, strict=True):
         ta, tb = a.update(frame, d), b.update(frame, d)
         assert [(t.id, t.detection_index) for t in ta] == [(t.id, t.detection_index) for t in tb]
         np.testing.assert_array_equal([t.box_xywh for t in ta], [t.box_xywh for t in tb])
@@ -272,15 +293,30 @@ def test_association_leaves_pairs_unmade_when_cheaper(tau, expected):
     only track 0's. Forcing every gated pair swaps them (two poor pairs); with a cost for
     leaving things unmatched, track 0 keeps its detection and track 1 waits."""
     frame = np.full((200, 300, 3), 128, np.uint8)  # one colour: only geometry decides
-    config = TrackerConfig(min_hits=1, refine_boxes=False, unmatched_cost=tau)
+    config = TrackerConfig(
+        lifecycle=LifecycleConfig(min_hits=1),
+        refine=RefineConfig(enabled=False),
+        association=AssociationConfig(unmatched_cost=tau),
+    )
     tracker = MultiObjectTracker(config, rng=0)
     tracker.update(frame, np.array([[100.0, 50, 20, 50, 1.0], [112, 50, 20, 50, 1.0]]))
     boxes = np.array([[100.0, 50, 20, 50], [88, 50, 20, 50]])
-    hists = box_histograms(hsv_bins(frame), np.column_stack([boxes[:, :2] + boxes[:, 2:] / 2, boxes[:, 2:]]))
-    matches, _, _ = tracker._associate(boxes, hists)
-    assert sorted(matches) == expected
+    hists = box_histograms(
+        hsv_bins(frame), np.column_stack([boxes[:, :2] + boxes[:, 2:] / 2, boxes[:, 2:]])
+    )
+    ts = tracker.tracks
+    result = associate(
+        np.array([t.box for t in ts]),
+        np.array([t.size[1] for t in ts]),
+        np.array([t.time_since_update for t in ts]),
+        np.array([t.filter.reference for t in ts]),
+        boxes,
+        hists,
+        config.association,
+    )
+    assert sorted(result.matches) == expected
 
 
 def test_unmatched_cost_must_be_positive():
     with pytest.raises(ValueError, match="unmatched_cost"):
-        TrackerConfig(unmatched_cost=0.0)
+        AssociationConfig(unmatched_cost=0.0)

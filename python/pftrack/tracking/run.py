@@ -7,20 +7,19 @@ import os
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Union
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._progress import progress
-from pftrack._typing import RngLike
+from pftrack._typing import F64, PathLike, RngLike
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
-from pftrack.smoothing import BoxSmoother
-from pftrack.tracker import MultiObjectTracker, TrackerConfig, TrackWriter
-
-PathLike = Union[str, "os.PathLike[str]"]
+from pftrack.tracking.config import TrackerConfig
+from pftrack.tracking.offline import BoxSmoother
+from pftrack.tracking.tracker import MultiObjectTracker
+from pftrack.tracking.writer import TrackWriter
 
 __all__ = ["TrackingRun", "load_detections", "track_frames"]
 
@@ -39,7 +38,7 @@ class TrackingRun:
         Wall time of decoding, detection and tracking.
     """
 
-    rows: NDArray[np.float64]
+    rows: F64
     n_frames: int
     seconds: float
 
@@ -49,7 +48,7 @@ class TrackingRun:
         return self.n_frames / self.seconds if self.seconds > 0 else float("inf")
 
 
-def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, NDArray[np.float64]]:
+def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     """Read a MOTChallenge detection file as ``{frame: (k, 5) [left, top, w, h, score]}``.
 
     Parameters
@@ -62,21 +61,23 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, NDArray[np.
     if not (np.isfinite(scale) and scale > 0):
         raise ValueError(f"detection scale is {scale}, expected a finite value > 0")
     rows = read_mot(path, what="detection file")
-    return {f: np.column_stack([r[:, 2:6] * scale, r[:, 6]]) for f, r in group_by_frame(rows).items()}
+    return {
+        f: np.column_stack([r[:, 2:6] * scale, r[:, 6]]) for f, r in group_by_frame(rows).items()
+    }
 
 
 def track_frames(
     source: PathLike | FrameSource | Sequence[NDArray[np.uint8]],
     *,
-    detections: dict[int, NDArray[np.float64]] | None = None,
-    config: TrackerConfig = TrackerConfig(),
+    detections: dict[int, F64] | None = None,
+    config: TrackerConfig | None = None,
     rng: RngLike = None,
     coasting: str = "confirmed",
     fill: str = "linear",
     show_progress: bool | None = None,
     prime_frames: int = 30,
-    smoother: BoxSmoother | None = BoxSmoother(),
-    link: LinkConfig | None = LinkConfig(),
+    smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
+    link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
 ) -> TrackingRun:
     """Track every frame of `source`.
 
@@ -86,12 +87,13 @@ def track_frames(
         Video file or image folder, or BGR uint8 frames in memory.
     detections : dict, optional
         Per-frame detections from :func:`load_detections`; None uses the built-in detector.
-    config : TrackerConfig
-        Tracker settings.
+    config : TrackerConfig, optional
+        Tracker settings (default ``TrackerConfig()``).
     rng : numpy.random.Generator, int or None
         Seed.
     coasting, fill : str
-        How gaps bridged by the particle filters are written (see :class:`TrackWriter`).
+        How gaps bridged by the particle filters are written (see
+        :class:`~pftrack.tracking.TrackWriter`).
     show_progress : bool, optional
         Progress bar on stderr (default: when stderr is a terminal).
     prime_frames : int
@@ -103,19 +105,23 @@ def track_frames(
     link : LinkConfig or None
         Join fragments of one object once the run is over (None: keep every id).
     """
-    frames = source if isinstance(source, (FrameSource, list, tuple)) else FrameSource(source)
+    config = config if config is not None else TrackerConfig()
+    frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
     if detections is not None and len(detections) and max(detections) > max(len(frames), 1) > 1:
         raise ValueError(
             f"detections go up to frame {max(detections)} but the video has {len(frames)} frames"
         )
     tracker = MultiObjectTracker(config, rng=rng)
-    if prime_frames > 0 and (detections is None or config.refine_boxes):
+    if prime_frames > 0 and (detections is None or config.refine.enabled):
         tracker.prime(itertools.islice(iter(frames), prime_frames))
     writer = TrackWriter(coasting, fill, smoother, link)
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0
-    for n, frame in enumerate(progress(frames, total=len(frames) or None, desc="tracking", enable=show_progress), start=1):
+    total = len(frames) or None
+    for n, frame in enumerate(
+        progress(frames, total=total, desc="tracking", enable=show_progress), start=1
+    ):
         dets = None if detections is None else detections.get(n, empty)
         writer.add(n, tracker.update(frame, dets))
     if n == 0:

@@ -1,0 +1,57 @@
+"""Axis-aligned boxes: overlap and the two layouts pftrack uses.
+
+``xywh`` is ``(left, top, width, height)`` (MOTChallenge files, detections, reported tracks);
+``cxcywh`` is ``(centre x, centre y, width, height)`` (particle filters, the colour kernels).
+Tracking and scoring share :func:`iou_xywh`, so they never disagree about an overlap.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pftrack._typing import F64
+
+__all__ = ["cxcywh_to_xywh", "iou_xywh", "xywh_to_cxcywh"]
+
+
+def iou_xywh(a: ArrayLike, b: ArrayLike) -> F64:
+    """Intersection over union of every box of `a` with every box of `b`.
+
+    Parameters
+    ----------
+    a : (n, 4) array_like of float
+        Boxes ``left, top, width, height``.
+    b : (m, 4) array_like of float
+        Boxes ``left, top, width, height``.
+
+    Returns
+    -------
+    (n, m) ndarray of float64
+        IoU in [0, 1]; 0 where the union is empty.
+    """
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 4)
+    b = np.asarray(b, dtype=np.float64).reshape(-1, 4)
+    ax0, ay0 = a[:, 0:1], a[:, 1:2]
+    ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
+    bx0, by0 = b[:, 0], b[:, 1]
+    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
+    iw = np.clip(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0, None)
+    ih = np.clip(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0, None)
+    inter = iw * ih
+    union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(union > 0, inter / union, 0.0)
+    return np.asarray(out, dtype=np.float64)
+
+
+def xywh_to_cxcywh(boxes: ArrayLike) -> F64:
+    """``(left, top, w, h)`` to ``(cx, cy, w, h)``; any leading shape, last axis 4."""
+    b = np.asarray(boxes, dtype=np.float64)
+    return np.concatenate([b[..., :2] + b[..., 2:] / 2, b[..., 2:]], axis=-1)
+
+
+def cxcywh_to_xywh(boxes: ArrayLike) -> F64:
+    """``(cx, cy, w, h)`` to ``(left, top, w, h)``; any leading shape, last axis 4."""
+    b = np.asarray(boxes, dtype=np.float64)
+    return np.concatenate([b[..., :2] - b[..., 2:] / 2, b[..., 2:]], axis=-1)

@@ -1,0 +1,255 @@
+"""The constant-velocity Kalman filter and Rauch-Tung-Striebel smoother of pftrack.
+
+One model serves the whole package: each axis (a box centre's x, a box's width, ...) has the
+state ``(position, velocity)``, moves at constant velocity, and is pushed by white-noise
+acceleration; measurements see the position only. Axes are independent, so every function
+here runs any number of them at once: means and covariance entries are arrays over axes (or
+plain floats), and a covariance is kept as its three entries ``(p00, p01, p11)``.
+
+Time is measured in frames. Over one frame, continuous white-noise acceleration of spectral
+density ``q`` (px²/frame³) adds the covariance
+
+    Q = q [[1/3, 1/2], [1/2, 1]]                                     (:func:`wna_Q`)
+
+to the state (Bar-Shalom et al. 2001, sec. 6.2.2). This is the model's discretisation.
+
+Users
+-----
+- the online tracker's centre filter (:mod:`pftrack.tracking.motion`):
+  :func:`cv_predict`, :func:`cv_update`;
+- the offline box smoother (:class:`pftrack.tracking.BoxSmoother`) and the recovery ``rts``
+  baseline: :func:`rts_smooth` (``update_first=False``: the first measurement *is* the
+  initial state; ``update_first=True``: a prior centred on it, then the usual update);
+- the recovery code that builds matrices for the C++ filters (``_core.kalman_filter``,
+  goal-directed tracking): :func:`cv_transition`, :func:`wna_Q` (one axis, ``(2, 2)``),
+  :func:`cv_transition_xy`, :func:`wna_Q_xy` (state ``(x, y, vx, vy)``, ``(4, 4)``).
+
+Transitional: ``discretisation="piecewise"``
+--------------------------------------------
+The tracker and the box smoother were tuned with the piecewise-constant discretisation
+``Q = q [[1/4, 1/2], [1/2, 1]]`` (``q`` the variance of the acceleration per frame²). To keep
+their outputs byte-identical while the package is restructured, :func:`cv_predict` and
+:func:`rts_smooth` take ``discretisation="piecewise"``; they are the only callers. The keyword
+goes away once their noise levels are re-measured under the continuous model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Literal, TypeAlias
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pftrack._typing import F64
+
+__all__ = [
+    "Cov",
+    "Discretisation",
+    "Mean",
+    "Value",
+    "cv_predict",
+    "cv_transition",
+    "cv_transition_xy",
+    "cv_update",
+    "rts_smooth",
+    "wna_Q",
+    "wna_Q_xy",
+]
+
+#: How white-noise acceleration is discretised over one frame (see the module docstring).
+Discretisation: TypeAlias = Literal["continuous", "piecewise"]
+#: One axis quantity (or one per axis): a float or an array over axes.
+Value: TypeAlias = "float | F64"
+#: Mean of the state: ``(position, velocity)``.
+Mean: TypeAlias = "tuple[Value, Value]"
+#: Covariance of the state, as its entries ``(p00, p01, p11)``.
+Cov: TypeAlias = "tuple[Value, Value, Value]"
+
+
+def cv_transition(dt: float = 1.0) -> F64:
+    """Transition ``F = [[1, dt], [0, 1]]`` of one axis' ``(position, velocity)``."""
+    return np.array([[1.0, dt], [0.0, 1.0]])
+
+
+def wna_Q(q: float, dt: float = 1.0) -> F64:  # noqa: N802 - the usual name
+    """Process noise of one axis over `dt` frames: ``q [[dt³/3, dt²/2], [dt²/2, dt]]``.
+
+    Parameters
+    ----------
+    q : float
+        Spectral density of the white-noise acceleration (px²/frame³).
+    dt : float
+        Time step in frames.
+    """
+    c = q * dt**2 / 2.0
+    return np.array([[q * dt**3 / 3.0, c], [c, q * dt]])
+
+
+def _xy_block(blocks: Sequence[F64]) -> F64:
+    """Arrange per-axis ``(position, velocity)`` 2x2 blocks for the state ``(p_1.., v_1..)``."""
+    n = len(blocks)
+    out = np.zeros((2 * n, 2 * n))
+    for axis, b in enumerate(blocks):
+        i, j = axis, axis + n
+        out[i, i], out[i, j], out[j, i], out[j, j] = b[0, 0], b[0, 1], b[1, 0], b[1, 1]
+    return out
+
+
+def cv_transition_xy(dt: float = 1.0) -> F64:
+    """Transition of the state ``(x, y, vx, vy)``, ``(4, 4)``."""
+    f = cv_transition(dt)
+    return _xy_block([f, f])
+
+
+def wna_Q_xy(q: Sequence[float], dt: float = 1.0) -> F64:  # noqa: N802 - the usual name
+    """Process noise of the state ``(x, y, vx, vy)``, ``(4, 4)``: :func:`wna_Q` per axis.
+
+    Parameters
+    ----------
+    q : sequence of 2 float
+        Spectral densities of the x and y accelerations (px²/frame³).
+    dt : float
+        Time step in frames.
+    """
+    if len(q) != 2:
+        raise ValueError(f"wna_Q_xy: q has {len(q)} values, expected 2 (x, y)")
+    return _xy_block([wna_Q(float(qi), dt) for qi in q])
+
+
+def cv_predict(
+    mean: Mean, cov: Cov, q: Value, *, discretisation: Discretisation = "continuous"
+) -> tuple[Mean, Cov]:
+    """Advance independent constant-velocity axes by one frame.
+
+    Parameters
+    ----------
+    mean : (position, velocity)
+        Floats or arrays over axes.
+    cov : (p00, p01, p11)
+        Covariance entries, floats or arrays over axes.
+    q : float or ndarray
+        Noise intensity: the spectral density of the acceleration (``"continuous"``), or
+        its variance per frame² (``"piecewise"``, transitional).
+    discretisation : {"continuous", "piecewise"}
+        ``Q = q [[1/3, 1/2], [1/2, 1]]`` or ``q [[1/4, 1/2], [1/2, 1]]``.
+
+    Returns
+    -------
+    mean, cov
+        The predicted state.
+    """
+    p00, p01, p11 = cov
+    if discretisation == "continuous":
+        q00 = q / 3.0
+    elif discretisation == "piecewise":
+        q00 = q / 4
+    else:
+        raise ValueError(
+            f"discretisation is {discretisation!r}, expected 'continuous' or 'piecewise'"
+        )
+    return (mean[0] + mean[1], mean[1]), (p00 + 2 * p01 + p11 + q00, p01 + p11 + q / 2, p11 + q)
+
+
+def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
+    """Kalman update of independent constant-velocity axes with position measurements.
+
+    Parameters
+    ----------
+    mean, cov
+        The predicted state (see :func:`cv_predict`).
+    z : float or ndarray
+        Measured positions.
+    r2 : float or ndarray
+        Their variances.
+
+    Returns
+    -------
+    mean, cov
+        The filtered state.
+    """
+    p00, p01, p11 = cov
+    s = p00 + r2
+    k0, k1 = p00 / s, p01 / s
+    e = z - mean[0]
+    return (mean[0] + k0 * e, mean[1] + k1 * e), ((1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01)
+
+
+def rts_smooth(
+    z: ArrayLike,
+    has: ArrayLike,
+    q: ArrayLike,
+    r2: ArrayLike,
+    *,
+    velocity_sd: float,
+    update_first: bool,
+    discretisation: Discretisation = "continuous",
+) -> F64:
+    """Smoothed positions of independent constant-velocity axes (Rauch-Tung-Striebel).
+
+    Parameters
+    ----------
+    z : (T, n) array_like
+        Position measurements, one column per axis, one row per frame; rows without a
+        measurement may hold anything (NaN included).
+    has : (T,) array_like of bool
+        Which frames have a measurement. The first must: the initial state is
+        ``N([z_0, 0], diag(r2, velocity_sd²))``.
+    q : (n,) array_like
+        Noise intensity per axis (see :func:`cv_predict`).
+    r2 : (n,) array_like
+        Measurement variance per axis.
+    velocity_sd : float
+        Prior standard deviation of the initial velocity (wide: the data decide).
+    update_first : bool
+        Also apply the Kalman update with ``z_0`` at frame 0 (halves the initial position
+        variance); False takes ``z_0`` as the initial state only.
+    discretisation : {"continuous", "piecewise"}
+        See :func:`cv_predict` (``"piecewise"`` is transitional).
+
+    Returns
+    -------
+    (T, n) ndarray
+        Mean of each position given every measurement.
+    """
+    zz = np.asarray(z, dtype=np.float64)
+    hh = np.asarray(has, dtype=bool)
+    q2 = np.asarray(q, dtype=np.float64)
+    rr = np.asarray(r2, dtype=np.float64)
+    steps = len(zz)
+    n = len(q2)
+    if zz.ndim != 2 or zz.shape[1] != n or hh.shape != (steps,) or rr.shape != (n,) or q2.ndim != 1:
+        raise ValueError(
+            f"rts_smooth: z {zz.shape}, has {hh.shape}, q {q2.shape} and r2 {rr.shape} must be "
+            "(T, n), (T,), (n,) and (n,)"
+        )
+    if steps == 0 or not hh[0]:
+        raise ValueError("rts_smooth: the first frame must have a measurement")
+    m: Mean = (zz[0].copy(), np.zeros_like(q2))
+    p: Cov = (rr.copy(), np.zeros_like(q2), np.full_like(q2, velocity_sd**2))
+    fm = np.empty((steps, 2, n))  # filtered mean
+    fp = np.empty((steps, 3, n))  # filtered covariance
+    pm = np.empty((steps, 2, n))  # predicted mean
+    pp = np.empty((steps, 3, n))  # predicted covariance
+    for t in range(steps):
+        if t > 0:
+            m, p = cv_predict(m, p, q2, discretisation=discretisation)
+        pm[t], pp[t] = m, p
+        if hh[t] and (t > 0 or update_first):
+            m, p = cv_update(m, p, zz[t], rr)
+        fm[t], fp[t] = m, p
+    out = np.empty((steps, n))
+    s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
+    out[-1] = s0
+    for t in range(steps - 2, -1, -1):
+        a, b, c = fp[t]
+        # gain C = P_f F^T P_pred^-1 with F = [[1, 1], [0, 1]]
+        u00, u01, u10, u11 = a + b, b, b + c, c
+        x, y, w = pp[t + 1]
+        det = x * w - y * y
+        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
+        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
+        d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
+        s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
+        out[t] = s0
+    return out

@@ -1,0 +1,40 @@
+"""Multi-object tracking: the online tracker, its settings and the offline pass.
+
+- :class:`MultiObjectTracker` (:mod:`.tracker`): frame by frame, one colour particle filter per
+  object; :class:`TrackerConfig` and its parts (:mod:`.config`); :class:`Track` (:mod:`.track`).
+- :class:`TrackWriter` (:mod:`.writer`): a run's tracks as MOTChallenge rows.
+- :class:`BoxSmoother`, :func:`smooth_tracks` (:mod:`.offline`): link, fill and smooth a
+  finished run (any tracker's).
+- :func:`track_frames`, :func:`load_detections` (:mod:`.run`): a whole video, end to end.
+"""
+
+from __future__ import annotations
+
+from pftrack.tracking.config import (
+    AssociationConfig,
+    LifecycleConfig,
+    MotionConfig,
+    RefineConfig,
+    TrackerConfig,
+)
+from pftrack.tracking.offline import BoxSmoother, smooth_tracks
+from pftrack.tracking.run import TrackingRun, load_detections, track_frames
+from pftrack.tracking.track import Track
+from pftrack.tracking.tracker import MultiObjectTracker
+from pftrack.tracking.writer import TrackWriter
+
+__all__ = [
+    "AssociationConfig",
+    "BoxSmoother",
+    "LifecycleConfig",
+    "MotionConfig",
+    "MultiObjectTracker",
+    "RefineConfig",
+    "Track",
+    "TrackWriter",
+    "TrackerConfig",
+    "TrackingRun",
+    "load_detections",
+    "smooth_tracks",
+    "track_frames",
+]

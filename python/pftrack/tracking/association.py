@@ -1,0 +1,114 @@
+"""Pairing tracks with detections: a gated cost matrix and a padded Hungarian assignment.
+
+The cost of a (track, detection) pair adds three dissimilarities: ``1 - IoU``, the colour term
+``colour_weight (1 - rho)`` (``rho`` the Bhattacharyya coefficient of the track's reference
+histogram and the detection's), and the centre distance in units of a radius that grows with
+the time the track has coasted (capped at 2). A pair is admissible (gated) when the boxes
+overlap enough or the centres lie within the radius. Leaving a track or a detection unassigned
+costs ``unmatched_cost`` each, so a gated pair is only made when it is cheaper than that.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+from pftrack._typing import F64
+from pftrack.boxes import iou_xywh
+from pftrack.tracking.config import AssociationConfig
+
+__all__ = ["Association", "associate", "covers_another"]
+
+#: Cost of a pair the gate forbids: larger than any sum of admissible costs.
+FORBIDDEN = 1e6
+
+
+@dataclass(frozen=True)
+class Association:
+    """Result of :func:`associate`: pairs ``(track, detection)`` and what is left alone."""
+
+    matches: list[tuple[int, int]]
+    unmatched_tracks: list[int]
+    unmatched_detections: list[int]
+
+
+def associate(
+    track_boxes: F64,
+    heights: F64,
+    coasted: NDArray[np.int_],
+    references: F64,
+    boxes: F64,
+    hists: F64,
+    config: AssociationConfig,
+) -> Association:
+    """Pair tracks with detections.
+
+    Parameters
+    ----------
+    track_boxes : (T, 4) ndarray
+        The tracks' predicted boxes (xywh).
+    heights : (T,) ndarray
+        The tracks' smoothed heights (the unit of the distance gate).
+    coasted : (T,) ndarray of int
+        Frames since each track's last detection.
+    references : (T, B) ndarray
+        The tracks' reference histograms (normalised).
+    boxes : (D, 4) ndarray
+        Detection boxes (xywh).
+    hists : (D, B) ndarray
+        Detection histograms (rows sum to 1, or 0 when empty).
+    config : AssociationConfig
+        Gates, weights and the cost of leaving things unmatched.
+
+    Returns
+    -------
+    Association
+    """
+    nt, nd = len(track_boxes), len(boxes)
+    if nt == 0 or nd == 0:
+        return Association([], list(range(nt)), list(range(nd)))
+    iou = iou_xywh(track_boxes, boxes)
+    tc = track_boxes[:, :2] + track_boxes[:, 2:] / 2
+    dc = boxes[:, :2] + boxes[:, 2:] / 2
+    dist = np.linalg.norm(tc[:, None, :] - dc[None, :, :], axis=2)
+    radius = config.match_distance * heights * (1.0 + 0.25 * np.minimum(coasted, 8))
+    # Bhattacharyya coefficients of every (track reference, detection) pair in one product
+    rho = np.sqrt(references) @ np.sqrt(hists).T
+    cost = (
+        (1.0 - iou) + config.colour_weight * (1.0 - rho) + np.minimum(dist / radius[:, None], 2.0)
+    )
+    gate = (iou >= config.match_iou) | (dist <= radius[:, None])
+    cost = np.where(gate, cost, FORBIDDEN)
+    if np.isfinite(config.unmatched_cost):
+        # leaving a track or a detection unmatched costs `unmatched_cost` each, so a pair is
+        # only made when it is cheaper than leaving both alone (not just because it is gated)
+        tau = config.unmatched_cost
+        padded = np.full((nt + nd, nd + nt), FORBIDDEN)
+        padded[:nt, :nd] = cost
+        padded[:nt, nd:][np.diag_indices(nt)] = tau
+        padded[nt:, :nd][np.diag_indices(nd)] = tau
+        padded[nt:, nd:] = 0.0
+        rows, cols = linear_sum_assignment(padded)
+        keep = (rows < nt) & (cols < nd)
+        rows, cols = rows[keep], cols[keep]
+    else:
+        rows, cols = linear_sum_assignment(cost)
+    matches = [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if cost[r, c] < FORBIDDEN]
+    mt = {r for r, _ in matches}
+    md = {c for _, c in matches}
+    return Association(
+        matches, [i for i in range(nt) if i not in mt], [j for j in range(nd) if j not in md]
+    )
+
+
+def covers_another(box_xywh: F64, others_xywh: F64) -> bool:
+    """Tell whether `box_xywh` contains the centre of any of `others_xywh` (a merged blob)."""
+    if len(others_xywh) == 0:
+        return False
+    b, o = box_xywh, others_xywh
+    inside_x = (o[:, 0] + o[:, 2] / 2 > b[0]) & (o[:, 0] + o[:, 2] / 2 < b[0] + b[2])
+    inside_y = (o[:, 1] + o[:, 3] / 2 > b[1]) & (o[:, 1] + o[:, 3] / 2 < b[1] + b[3])
+    return bool(np.any(inside_x & inside_y))

@@ -1,0 +1,198 @@
+"""Settings of :class:`~pftrack.tracking.MultiObjectTracker`, one small dataclass per concern.
+
+Every default is a rule, not a per-sequence tuning (README).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pftrack.detection import DETECTORS
+from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
+
+__all__ = [
+    "AssociationConfig",
+    "LifecycleConfig",
+    "MotionConfig",
+    "RefineConfig",
+    "TrackerConfig",
+]
+
+SAMPLERS = ("sis", "mh", "rjmcmc")
+
+
+def _in_unit_interval(owner: str, **values: float) -> None:
+    for name, v in values.items():
+        if not 0.0 <= v <= 1.0:
+            raise ValueError(f"{owner}: {name} is {v}, expected a value in [0, 1]")
+
+
+@dataclass(frozen=True)
+class AssociationConfig:
+    """How tracks and detections are paired (Hungarian method over a gated cost).
+
+    Attributes
+    ----------
+    match_iou : float
+        Minimum overlap (IoU) for a track-detection pair, unless the centres are close.
+    match_distance : float
+        Maximum centre distance of a pair, in track heights (grows with the time coasted).
+    colour_weight : float
+        Weight of colour dissimilarity ``1 - rho`` in the association cost.
+    unmatched_cost : float
+        What leaving a track or a detection unassigned costs: a pair is made only when its cost
+        is below twice this, not merely because it passed the gate. The default 1.5 refuses a
+        pair that neither overlaps nor lies within two radii whatever its colour (those two
+        terms alone reach 3); ``inf`` assigns every gated pair it can.
+    merge_ratio : float
+        A matched detection this many times larger than its track, that also covers another
+        track, is a merged blob: it does not re-seed the track's particles (the colour filter
+        carries the track through the merge).
+    """
+
+    match_iou: float = 0.1
+    match_distance: float = 0.3
+    colour_weight: float = 0.5
+    unmatched_cost: float = 1.5
+    merge_ratio: float = 1.8
+
+    def __post_init__(self) -> None:
+        if not self.unmatched_cost > 0:  # NaN fails too
+            raise ValueError(
+                f"AssociationConfig: unmatched_cost is {self.unmatched_cost}, expected a value > 0 "
+                "(inf: off)"
+            )
+        _in_unit_interval("AssociationConfig", match_iou=self.match_iou)
+
+
+@dataclass(frozen=True)
+class LifecycleConfig:
+    """When tracks are born, reported and ended.
+
+    Attributes
+    ----------
+    min_score : float
+        Detections with a lower score are ignored.
+    birth_score : float
+        An external detection starts a track only with at least this score (a detection too
+        unsure to start a track can still keep one alive, as in ByteTrack). Applied while every
+        score seen lies in [0, 1], i.e. scores are confidences; a detector with other scores,
+        and the built-in detector, start tracks from any detection.
+    min_hits : int
+        Matched frames before a new track is reported (tracks born in the first `min_hits`
+        frames are reported at once).
+    max_coast : int
+        Frames a track goes on from its particle filter alone before it ends.
+    tentative_coast : int
+        Frames a not yet confirmed track may go without a detection before it is dropped.
+    coast_min_rho : float
+        A coasting track is reported only while its colour match ``rho`` stays above this.
+    """
+
+    min_score: float = 0.0
+    birth_score: float = 0.9
+    min_hits: int = 4
+    max_coast: int = 10
+    tentative_coast: int = 0
+    coast_min_rho: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name in ("max_coast", "min_hits"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, np.integer)) or v < 0:
+                raise ValueError(f"LifecycleConfig: {name} is {v!r}, expected an integer >= 0")
+        _in_unit_interval("LifecycleConfig", coast_min_rho=self.coast_min_rho)
+
+
+@dataclass(frozen=True)
+class MotionConfig:
+    """The constant-velocity Kalman filter of each track's centre (:mod:`.motion`).
+
+    Attributes
+    ----------
+    accel, detection_noise, colour_noise : float
+        In track heights: the standard deviation of the acceleration per frame², of a
+        detection's centre and of the colour filter's estimate (the measurement while the track
+        coasts, and a second opinion before association).
+    smooth_external : bool
+        With external detections, report a matched track's filtered box (Kalman centre,
+        smoothed size) rather than the detection's own box, which jitters from frame to frame.
+        The built-in detector's boxes are the foreground's extent and are reported as they are.
+    """
+
+    accel: float = 0.01
+    detection_noise: float = 0.05
+    colour_noise: float = 0.15
+    smooth_external: bool = True
+
+
+@dataclass(frozen=True)
+class RefineConfig:
+    """Shrinking external detection boxes to their foreground.
+
+    See :func:`pftrack.detection.refine_boxes`.
+
+    Attributes
+    ----------
+    enabled : bool
+        With external detections, also run the background model and shrink each detection box
+        to the rows and columns where its foreground is (static cameras: detector boxes are
+        often loose). A box with too little foreground is left as it is.
+    fraction : float
+        A row or column belongs to the object when its foreground fraction exceeds this share of
+        the box's densest row or column.
+    """
+
+    enabled: bool = True
+    fraction: float = 0.05
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """Configuration of :class:`~pftrack.tracking.MultiObjectTracker`.
+
+    Attributes
+    ----------
+    filter : FilterConfig
+        Particles per object, AR(2) dynamics (eq. 7, or eq. 8 with ``use_means``), λ.
+    binning : HsvBinning
+        HSV histogram layout (110 bins by default).
+    sampler : {"sis", "mh", "rjmcmc"}
+        Sequential importance sampling per object (the paper's method), Metropolis-Hastings per
+        object, or one joint RJ-MCMC chain over all objects (Smith et al. 2005): the paper's
+        comparison samplers.
+    rjmcmc : RJMCMCConfig
+        Settings of the joint sampler (used with ``sampler="rjmcmc"``); its sample count and
+        AR2 dynamics are set from ``filter`` so that budgets and models compare.
+    detector : {"paper", "mog2", "knn"}
+        Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections.
+    reference_rate : float
+        How fast a reference histogram adapts to a matched detection (0 keeps the first one).
+    refine, association, motion, lifecycle
+        Box refinement, pairing, centre filter, and birth/report/end rules.
+    """
+
+    filter: FilterConfig = field(
+        default_factory=lambda: FilterConfig(
+            n_particles=100,
+            model=Ar2Model(sigma_xy=3.0, sigma_s=0.02, velocity_gain=0.5, scale_gain=0.0),
+        )
+    )
+    binning: HsvBinning = field(default_factory=HsvBinning)
+    sampler: str = "sis"
+    rjmcmc: RJMCMCConfig = field(default_factory=RJMCMCConfig)
+    detector: str = "paper"
+    reference_rate: float = 0.05
+    refine: RefineConfig = field(default_factory=RefineConfig)
+    association: AssociationConfig = field(default_factory=AssociationConfig)
+    motion: MotionConfig = field(default_factory=MotionConfig)
+    lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
+
+    def __post_init__(self) -> None:
+        if self.sampler not in SAMPLERS:
+            raise ValueError(f"sampler is {self.sampler!r}, expected 'sis', 'mh' or 'rjmcmc'")
+        if self.detector not in DETECTORS:
+            raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
+        _in_unit_interval("TrackerConfig", reference_rate=self.reference_rate)

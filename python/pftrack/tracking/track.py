@@ -1,0 +1,187 @@
+"""A track: what the tracker reports for one frame, and the live state behind it.
+
+Lifecycle of a live track: born from a detection no track explains; each frame its colour
+particle filter looks at the frame and its centre filter predicts (:meth:`LiveTrack.predict`);
+a matched detection re-seeds it (:meth:`LiveTrack.follow`), otherwise it coasts
+(:meth:`LiveTrack.coast`); it ends when it has coasted too long (:meth:`LiveTrack.alive`);
+it is reported once confirmed, and while coasting only as long as its colour still matches
+(:meth:`LiveTrack.report`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pftrack._core import BinnedImage
+from pftrack._typing import F64
+from pftrack.boxes import xywh_to_cxcywh
+from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
+from pftrack.tracking.config import LifecycleConfig, TrackerConfig
+from pftrack.tracking.motion import CentreKalman
+
+__all__ = ["LiveTrack", "Track"]
+
+
+@dataclass(frozen=True)
+class Track:
+    """A track as reported for one frame.
+
+    Attributes
+    ----------
+    id : int
+        Identity, unique within one tracker (from 1).
+    box_xywh : (4,) ndarray
+        Left, top, width, height in pixels.
+    score : float
+        Confidence: the matched detection's score, or the colour match ``rho`` when coasting.
+    detection_index : int or None
+        Index of the detection (in the order given to
+        :meth:`~pftrack.tracking.MultiObjectTracker.update`) matched to this track, or None
+        when it was carried by its particle filter alone.
+    age : int
+        Frames since birth.
+    time_since_update : int
+        Frames since the last matched detection (0 when matched this frame).
+    history : tuple of (frame, box_xywh, score)
+        On the frame a new track is first reported, the detection boxes it was matched to while
+        it waited for ``min_hits`` (frame numbers count ``update`` calls from 1); empty
+        otherwise. Offline writers back-fill them; online users may ignore them.
+    detection_box : (4,) ndarray or None
+        The matched detection's box (after refinement) as the tracker measured it, when it
+        re-seeded the track this frame; None when coasting or inside a merged blob. ``box_xywh``
+        may be a filtered version of it (``MotionConfig.smooth_external``).
+    """
+
+    id: int
+    box_xywh: F64
+    score: float
+    detection_index: int | None
+    age: int
+    time_since_update: int
+    history: tuple[tuple[int, F64, float], ...] = ()
+    detection_box: F64 | None = None
+
+
+class LiveTrack:
+    """A live track: its particle filter, centre filter and bookkeeping.
+
+    Parameters
+    ----------
+    track_id : int
+        Identity.
+    box_xywh : (4,) ndarray
+        The detection it is born from.
+    reference : (B,) ndarray
+        Reference colour histogram (the detection's).
+    config : TrackerConfig
+        Settings (sampler, particle filter, centre filter).
+    seed : int
+        Seed of its particle filter.
+    score : float
+        The detection's score.
+    """
+
+    def __init__(self, track_id: int, box_xywh: F64, reference: F64, config: TrackerConfig,
+                 seed: int, score: float) -> None:  # fmt: skip
+        self.id = track_id
+        cls = MHColourParticleFilter if config.sampler == "mh" else ColourParticleFilter
+        self.filter: ColourParticleFilter = cls(
+            xywh_to_cxcywh(box_xywh), reference, config.filter, rng=seed
+        )
+        self.box = box_xywh.copy()
+        self.size = box_xywh[2:].copy()  # smoothed detection size
+        self.motion = CentreKalman(
+            box_xywh[:2] + box_xywh[2:] / 2, box_xywh[3], config.motion.accel
+        )
+        self.hits = 1
+        self.age = 1
+        self.time_since_update = 0
+        self.score = score
+        self.rho = 1.0
+        self.det_index: int | None = None
+        self.measured: F64 | None = box_xywh.copy()  # this frame's detection box
+        self.unreported: list[tuple[int, F64, float]] = []
+        self.reported = False
+
+    def predict(self, binned: BinnedImage, colour_noise: float) -> None:
+        """Step the particle filter on the frame and the centre filter by one frame.
+
+        The particle filter's estimate is a noisy measurement of the centre filter's
+        prediction (standard deviation `colour_noise` heights).
+        """
+        self.measured = None
+        state = self.filter.step(binned)
+        self.rho = state.rho
+        self.motion.predict(self.size[1])
+        self.motion.update(state.box_cxcywh[:2], colour_noise * self.size[1])
+        cx, cy = self.motion.p
+        self.box = np.array(
+            [cx - self.size[0] / 2, cy - self.size[1] / 2, self.size[0], self.size[1]]
+        )
+        self.age += 1
+
+    def follow(self, box_xywh: F64, hist: F64, config: TrackerConfig, smooth: bool) -> None:
+        """Follow a matched detection (not a merged blob).
+
+        Update the centre filter and the size, re-seed the particles around the detection and
+        blend its colour into the reference.
+        """
+        b = box_xywh
+        self.measured = b.copy()
+        centre = b[:2] + b[2:] / 2
+        self.motion.update(centre, config.motion.detection_noise * self.size[1])
+        self.size = 0.7 * self.size + 0.3 * b[2:]
+        self.box = (
+            np.concatenate([self.motion.p - self.size / 2, self.size]) if smooth else b.copy()
+        )
+        self.filter.reinitialise(xywh_to_cxcywh(b), velocity=self.motion.v)
+        rate = config.reference_rate
+        if rate > 0 and hist.sum() > 0:
+            self.filter.set_reference((1 - rate) * self.filter.reference + rate * hist)
+
+    def matched(self, score: float, det_index: int | None) -> None:
+        """Count a match (also a merged blob's, which does not re-seed the track)."""
+        self.score = score
+        self.hits += 1
+        self.time_since_update = 0
+        self.det_index = det_index
+
+    def coast(self) -> None:
+        """A frame without a detection: the particle filter alone carries the track."""
+        self.time_since_update += 1
+        self.det_index = None
+        self.score = self.rho
+
+    def alive(self, rules: LifecycleConfig) -> bool:
+        """Tell whether the track has coasted no longer than it may (less if unconfirmed)."""
+        if self.hits >= rules.min_hits:
+            limit = rules.max_coast
+        else:
+            limit = min(rules.max_coast, rules.tentative_coast)
+        return self.time_since_update <= limit
+
+    def report(self, frame_index: int, early: bool, rules: LifecycleConfig) -> Track | None:
+        """What to report for frame `frame_index` (None: nothing yet, or not any more).
+
+        An unconfirmed track (outside the start-up frames, `early`) keeps its detection boxes
+        to hand over with its first report, as :attr:`Track.history`.
+        """
+        if self.hits < rules.min_hits and not early and not self.reported:
+            if self.measured is not None:
+                self.unreported.append((frame_index, self.measured.copy(), float(self.score)))
+            return None
+        if self.time_since_update > 0 and self.rho < rules.coast_min_rho:
+            return None
+        history, self.unreported, self.reported = tuple(self.unreported), [], True
+        return Track(
+            id=self.id,
+            box_xywh=self.box.copy(),
+            score=float(self.score),
+            detection_index=self.det_index,
+            age=self.age,
+            time_since_update=self.time_since_update,
+            history=history,
+            detection_box=None if self.measured is None else self.measured.copy(),
+        )

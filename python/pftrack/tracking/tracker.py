@@ -1,0 +1,211 @@
+"""Multi-object tracking with one colour particle filter per object (the first paper's method).
+
+Each frame: detections come from the built-in background-subtraction detector or from any
+detector the caller runs (refined to their foreground, :mod:`pftrack.detection.refine`);
+every live track advances its own colour particle filter on the frame (foreground pixels only
+when a foreground mask is known) and its centre filter (:mod:`.motion`); tracks and detections
+are paired by the Hungarian method over overlap, centre distance and colour similarity
+(:mod:`.association`); a matched track's particles are re-seeded around its detection; a track
+without a detection goes on from its particle filter alone (through merged blobs and
+occlusions) for ``max_coast`` frames, then ends; a detection no track explains starts a new
+track whose reference histogram is taken from it (:mod:`.track`). With ``sampler="rjmcmc"``
+one joint sampler replaces all of this (:mod:`.joint`).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pftrack._core import BinnedImage
+from pftrack._typing import F64, RngLike
+from pftrack.boxes import xywh_to_cxcywh
+from pftrack.detection import check_detections, make_detector, refine_boxes
+from pftrack.particle_filter import box_histograms, hsv_bins
+from pftrack.tracking.association import associate, covers_another
+from pftrack.tracking.config import TrackerConfig
+from pftrack.tracking.joint import JointTracker
+from pftrack.tracking.track import LiveTrack, Track
+
+__all__ = ["MultiObjectTracker"]
+
+
+class MultiObjectTracker:
+    """Track many objects with one colour particle filter each.
+
+    Parameters
+    ----------
+    config : TrackerConfig
+        All settings.
+    rng : numpy.random.Generator, int or None
+        Seed: the same seed and input give the same tracks.
+    detector : object, optional
+        Any object with ``detect(frame) -> Detections`` (see :mod:`pftrack.detection`); by
+        default the one named by ``config.detector``, created on first use.
+
+    Examples
+    --------
+    >>> tracker = MultiObjectTracker(rng=0)                       # doctest: +SKIP
+    >>> for frame in frames:                                       # doctest: +SKIP
+    ...     for t in tracker.update(frame, detections=boxes_xywh_score):
+    ...         print(t.id, t.box_xywh)
+    """
+
+    def __init__(self, config: TrackerConfig | None = None, rng: RngLike = None,
+                 detector: Any = None) -> None:  # fmt: skip
+        self.config = config if config is not None else TrackerConfig()
+        self._rng = np.random.default_rng(rng)
+        self._ids = itertools.count(1)
+        self._detector = detector
+        self.tracks: list[LiveTrack] = []
+        self.frame_index = 0
+        self.last_mask: NDArray[np.uint8] | None = None
+        self._joint = JointTracker(self.config, self._rng)
+        self._scores_are_confidences = True
+
+    # -- detections -------------------------------------------------------------------------
+    def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
+        """Start the built-in detector's background from the median of `frames`.
+
+        Reading ahead (e.g. the first 30 frames) gives the background model a picture of the
+        empty scene before frame 1 is tracked; detectors without ``prime`` ignore it.
+        """
+        detector = self._ensure_detector()
+        if hasattr(detector, "prime"):
+            detector.prime(frames)
+
+    def _ensure_detector(self) -> Any:
+        """Return the detector, made on first use.
+
+        It gets the tracker's own HSV binning, so that its foreground bins and the tracker's
+        histograms always share one layout.
+        """
+        if self._detector is None:
+            self._detector = make_detector(self.config.detector, hsv=self.config.binning)
+        return self._detector
+
+    def _detections(self, frame: NDArray[np.uint8], detections: ArrayLike | None
+                    ) -> tuple[F64, F64, BinnedImage]:  # fmt: skip
+        """Return this frame's boxes, scores and bins.
+
+        The built-in detector's (with foreground-only bins), or the caller's detections,
+        refined, with full-frame bins.
+        """
+        cfg = self.config
+        if detections is None:
+            det = self._ensure_detector().detect(frame)
+            self.last_mask = det.mask
+            boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
+            return boxes, np.asarray(det.scores, dtype=np.float64), det.binned
+        boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
+        if np.any((scores < 0) | (scores > 1)):
+            self._scores_are_confidences = False
+        mask, binned = None, None
+        if cfg.refine.enabled or cfg.sampler == "rjmcmc":
+            mask, binned = self._foreground(frame)
+        if binned is None:  # full-frame bins: the detector's fused pass made them, or one here
+            binned = hsv_bins(frame, None, cfg.binning)
+        if cfg.refine.enabled and mask is not None and len(boxes):
+            boxes = refine_boxes(boxes, mask, cfg.refine.fraction)
+        return boxes, scores, binned
+
+    def _foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], Any]:
+        """Return the foreground mask and full-frame bins (or None) for external detections.
+
+        From the detector's ``foreground`` when it has one (no blob pass), else its ``detect``.
+        """
+        detector = self._ensure_detector()
+        if hasattr(detector, "foreground"):
+            mask, frame_bins = detector.foreground(frame)
+        else:
+            det = detector.detect(frame)
+            mask, frame_bins = det.mask, det.frame_bins
+        self.last_mask = mask
+        return mask, frame_bins
+
+    # -- the per-frame step -----------------------------------------------------------------
+    def update(self, frame: ArrayLike, detections: ArrayLike | None = None) -> list[Track]:
+        """Advance the tracker by one frame.
+
+        Parameters
+        ----------
+        frame : (H, W, 3) array_like of uint8
+            BGR frame.
+        detections : (K, 4) or (K, 5) array_like, optional
+            ``[left, top, width, height(, score)]`` from any detector; None runs the built-in
+            background-subtraction detector.
+
+        Returns
+        -------
+        list of Track
+            The tracks reported for this frame (confirmed, and coasting ones the colour filter
+            still holds), with the index of the detection each was matched to.
+        """
+        f = np.asarray(frame)
+        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
+            raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        cfg = self.config
+        self.frame_index += 1
+        boxes, scores, binned = self._detections(f, detections)
+        index = np.flatnonzero(scores >= cfg.lifecycle.min_score)
+        boxes, scores = boxes[index], scores[index]
+        if cfg.sampler == "rjmcmc":
+            mask = self.last_mask
+            if mask is None or mask.shape != f.shape[:2]:
+                mask = np.full(f.shape[:2], 255, np.uint8)  # no background model: all foreground
+            return self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
+
+        # 1. every track's particle filter looks at this frame, its centre filter predicts
+        for t in self.tracks:
+            t.predict(binned, cfg.motion.colour_noise)
+
+        # 2. association
+        if len(boxes):
+            hists = box_histograms(binned, xywh_to_cxcywh(boxes), "uniform")
+        else:
+            hists = np.zeros((0, binned.n_bins))
+        result = associate(
+            np.array([t.box for t in self.tracks]).reshape(-1, 4),
+            np.array([t.size[1] for t in self.tracks]),
+            np.array([t.time_since_update for t in self.tracks]),
+            np.array([t.filter.reference for t in self.tracks]),
+            boxes,
+            hists,
+            cfg.association,
+        )
+
+        # 3. matched tracks follow their detection, unless it is a blob of several tracks
+        smooth = cfg.motion.smooth_external and detections is not None
+        for ti, di in result.matches:
+            t, b = self.tracks[ti], boxes[di]
+            merged = b[2] * b[3] > cfg.association.merge_ratio * t.size[0] * t.size[1] and (
+                covers_another(b, np.array([o.box for k, o in enumerate(self.tracks) if k != ti]))
+            )
+            t.matched(float(scores[di]), None if merged else int(index[di]))
+            if not merged:
+                t.follow(b, hists[di], cfg, smooth)
+        for ti in result.unmatched_tracks:
+            self.tracks[ti].coast()
+
+        # 4. tracks that coasted too long end; 5. unexplained detections start tracks
+        self.tracks = [t for t in self.tracks if t.alive(cfg.lifecycle)]
+        confidences = detections is not None and self._scores_are_confidences
+        birth_score = cfg.lifecycle.birth_score if confidences else -np.inf
+        for di in result.unmatched_detections:
+            if hists[di].sum() <= 0 or scores[di] < birth_score:
+                continue  # no foreground colour to build a reference from, or too unsure
+            seed = int(self._rng.integers(2**63))
+            t = LiveTrack(
+                next(self._ids), boxes[di].copy(), hists[di], cfg, seed, float(scores[di])
+            )
+            t.det_index = int(index[di])
+            self.tracks.append(t)
+
+        # 6. report
+        early = self.frame_index <= cfg.lifecycle.min_hits
+        reports = (t.report(self.frame_index, early, cfg.lifecycle) for t in self.tracks)
+        return [r for r in reports if r is not None]

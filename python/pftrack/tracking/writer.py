@@ -1,0 +1,99 @@
+"""Collecting a run's tracks as MOTChallenge rows, deciding what coasting becomes."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pftrack._typing import F64
+from pftrack.recovery.linking import LinkConfig
+from pftrack.tracking.offline import BoxSmoother, smooth_tracks
+from pftrack.tracking.track import Track
+
+__all__ = ["TrackWriter"]
+
+
+class TrackWriter:
+    """Collects a run's tracks as MOTChallenge rows, deciding what coasting becomes.
+
+    A track carried by its particle filter alone (no detection) is held back: its boxes are
+    written once a detection confirms the track again, and dropped if the track ends unconfirmed.
+    So an occlusion the filter bridged is filled, and a filter that lost its object adds nothing.
+    :meth:`result` then hands the rows to the offline pass (:func:`~.offline.smooth_tracks`):
+    linking fragments, and replacing every track's boxes by the smoother's estimates from the
+    track's detection boxes before and after each frame.
+
+    Parameters
+    ----------
+    coasting : {"confirmed", "all", "none"}
+        Write held-back boxes when the track is re-detected (default), always, or never.
+    fill : {"linear", "pf"}
+        Boxes of a bridged gap: interpolated between the detections at its ends (default;
+        measured better on PETS09 and TUD-Campus), or the particle filter's own estimates. A
+        smoother replaces them when the track has detection boxes to fit.
+    smoother : BoxSmoother or None
+        Offline smoothing of each track (default on; measured +7 MOTA on PETS09 and +5 on
+        TUD-Campus public detections, README). None writes the boxes as reported.
+    link : LinkConfig or None
+        Join fragments of one object (:func:`pftrack.recovery.linking.link_tracklets`, motion
+        and size terms) before smoothing, so a joined track is smoothed as one; with a smoother,
+        the frames missing inside a track (up to ``link.max_gap``) are then written with the
+        smoother's interpolation. None keeps every id and every hole.
+    """
+
+    def __init__(self, coasting: str = "confirmed", fill: str = "linear",
+                 smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen
+                 link: LinkConfig | None = LinkConfig()) -> None:  # noqa: B008  # fmt: skip
+        if coasting not in ("confirmed", "all", "none"):
+            raise ValueError(f"coasting is {coasting!r}, expected 'confirmed', 'all' or 'none'")
+        if fill not in ("linear", "pf"):
+            raise ValueError(f"fill is {fill!r}, expected 'linear' or 'pf'")
+        self.coasting = coasting
+        self.fill = fill
+        self.smoother = smoother
+        self.link = link
+        self.rows: list[list[float]] = []
+        self._measured: list[F64 | None] = []  # per row: the detection box
+        self._pending: dict[int, list[list[float]]] = {}
+        self._last: dict[int, list[float]] = {}
+
+    def _append(self, row: list[float], measured: F64 | None) -> None:
+        self.rows.append(row)
+        self._measured.append(measured)
+
+    def add(self, frame: int, tracks: list[Track]) -> None:
+        """Record the tracks reported for `frame` (1-based)."""
+        for t in tracks:
+            for f, box, score in t.history:  # a new track's detections from before confirmation
+                row = [float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0]
+                self._append(row, np.asarray(box))
+            row = [float(frame), float(t.id), *map(float, t.box_xywh), float(t.score)]
+            row += [-1.0, -1.0, -1.0]
+            if t.time_since_update == 0:
+                pending = self._pending.pop(t.id, [])
+                if pending and self.fill == "linear" and t.id in self._last:
+                    a, b = np.asarray(self._last[t.id]), np.asarray(row)
+                    for p in pending:
+                        u = (p[0] - a[0]) / (b[0] - a[0])
+                        p[2:6] = list((1 - u) * a[2:6] + u * b[2:6])
+                for p in pending:
+                    self._append(p, None)
+                self._append(row, t.detection_box)
+                self._last[t.id] = row
+            elif self.coasting == "all":
+                self._append(row, None)
+            elif self.coasting == "confirmed":
+                self._pending.setdefault(t.id, []).append(row)
+
+    def result(self) -> F64:
+        """All rows written so far, (M, 10), sorted by frame then id.
+
+        Linked and smoothed when the writer has a link config and a smoother.
+        """
+        if not self.rows:
+            return np.zeros((0, 10))
+        a = np.asarray(self.rows)
+        observed = np.array([m is not None for m in self._measured])
+        z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
+        if observed.any():
+            z[observed] = [m for m in self._measured if m is not None]
+        return smooth_tracks(a, observed, self.smoother, self.link, z)

@@ -1,0 +1,140 @@
+"""pftrack.kalman against NumPy references: a dense matrix Kalman/RTS loop, the joint Gaussian."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from pftrack.kalman import (
+    cv_predict,
+    cv_transition,
+    cv_transition_xy,
+    cv_update,
+    rts_smooth,
+    wna_Q,
+    wna_Q_xy,
+)
+from tests.reference.smoothing import cv_posterior_mean, dense_kalman_rts, wna_posterior_mean
+
+
+def _problem(
+    seed: int, steps: int, n: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    z = np.cumsum(rng.normal(1.0, 2.0, (steps, n)), axis=0)
+    has = rng.random(steps) < 0.7
+    has[0] = True
+    z[~has] = np.nan  # never read
+    return z, has, rng.uniform(0.01, 2.0, n), rng.uniform(0.1, 4.0, n)
+
+
+def test_matrices():
+    np.testing.assert_array_equal(cv_transition(2.0), [[1, 2], [0, 1]])
+    np.testing.assert_allclose(wna_Q(0.6, 2.0), 0.6 * np.array([[8 / 3, 2], [2, 2]]), rtol=1e-15)
+    F, Q = cv_transition_xy(1.5), wna_Q_xy((0.2, 0.7), 1.5)
+    for axis, q in enumerate((0.2, 0.7)):
+        idx = np.ix_([axis, axis + 2], [axis, axis + 2])
+        np.testing.assert_array_equal(F[idx], cv_transition(1.5))
+        np.testing.assert_array_equal(Q[idx], wna_Q(q, 1.5))
+    assert np.count_nonzero(Q) == 8 and np.count_nonzero(F) == 6
+    with pytest.raises(ValueError, match="expected 2"):
+        wna_Q_xy((1.0, 2.0, 3.0))
+
+
+@pytest.mark.parametrize("discretisation", ["continuous", "piecewise"])
+def test_predict_update_match_matrix_form(discretisation):
+    rng = np.random.default_rng(4)
+    F = cv_transition()
+    quarter = 0.25 if discretisation == "piecewise" else 1.0 / 3.0
+    for _ in range(20):
+        L = rng.normal(size=(2, 2))
+        P = L @ L.T + 0.1 * np.eye(2)
+        m = rng.normal(size=2)
+        q, r2, z = rng.uniform(0.01, 3), rng.uniform(0.1, 3), rng.normal()
+        (p, v), (a, b, c) = cv_predict(
+            (m[0], m[1]), (P[0, 0], P[0, 1], P[1, 1]), q, discretisation=discretisation
+        )
+        Pp = F @ P @ F.T + q * np.array([[quarter, 0.5], [0.5, 1.0]])
+        np.testing.assert_allclose([p, v], F @ m, rtol=1e-13)
+        np.testing.assert_allclose([[a, b], [b, c]], Pp, rtol=1e-12)
+        (p2, v2), (a2, b2, c2) = cv_update((p, v), (a, b, c), z, r2)
+        K = Pp[:, 0] / (Pp[0, 0] + r2)
+        np.testing.assert_allclose([p2, v2], F @ m + K * (z - p), rtol=1e-12)
+        np.testing.assert_allclose(
+            [[a2, b2], [b2, c2]], (np.eye(2) - np.outer(K, [1, 0])) @ Pp, rtol=1e-12, atol=1e-14
+        )
+    with pytest.raises(ValueError, match="discretisation"):
+        cv_predict((0.0, 0.0), (1.0, 0.0, 1.0), 1.0, discretisation="exact")  # type: ignore[arg-type]
+
+
+def test_predict_update_vectorised_over_axes():
+    """Arrays over axes give what each axis gives alone (the tracker shares one covariance)."""
+    m = (np.array([1.0, -2.0]), np.array([0.5, 0.25]))
+    cov = (2.0, 0.3, 1.5)  # floats: one covariance for both axes
+    (p, v), c = cv_update(
+        *cv_predict(m, cov, 0.4, discretisation="piecewise"), np.array([2.0, -1.0]), 0.8
+    )
+    for k in range(2):
+        (pk, vk), ck = cv_update(
+            *cv_predict((m[0][k], m[1][k]), cov, 0.4, discretisation="piecewise"),
+            [2.0, -1.0][k],
+            0.8,
+        )
+        assert (p[k], v[k]) == (pk, vk) and c == ck
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), steps=st.integers(1, 40), update_first=st.booleans(),
+       discretisation=st.sampled_from(["continuous", "piecewise"]))  # fmt: skip
+def test_rts_matches_dense_matrix_loop(seed, steps, update_first, discretisation):
+    """Two axes at once against the (x, y, vx, vy) 4x4 matrix filter (the rts baseline's form)."""
+    z, has, q, r2 = _problem(seed, steps, 2)
+    vsd = 10.0
+    got = rts_smooth(
+        z, has, q, r2, velocity_sd=vsd, update_first=update_first, discretisation=discretisation
+    )
+    F = cv_transition_xy()
+    Q = wna_Q_xy(q)
+    if discretisation == "piecewise":  # q [[1/4, 1/2], [1/2, 1]] per axis
+        Q = wna_Q_xy(q)
+        Q[0, 0], Q[1, 1] = q[0] / 4, q[1] / 4
+    H = np.hstack([np.eye(2), np.zeros((2, 2))])
+    m0 = np.r_[z[0], 0.0, 0.0]
+    P0 = np.diag([r2[0], r2[1], vsd**2, vsd**2])
+    _, sm, _ = dense_kalman_rts(z, has, F, Q, H, np.diag(r2), m0, P0, update_first)
+    np.testing.assert_allclose(got, sm[:, :2], rtol=1e-9, atol=1e-8)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), steps=st.integers(1, 30), update_first=st.booleans())
+def test_rts_is_the_posterior_mean(seed, steps, update_first):
+    """The smoother's means are the joint Gaussian's conditional means (continuous model)."""
+    z, has, q, r2 = _problem(seed, steps, 3)
+    got = rts_smooth(z, has, q, r2, velocity_sd=5.0, update_first=update_first)
+    want = np.column_stack(
+        [wna_posterior_mean(z[:, k], has, q[k], r2[k], 5.0, update_first) for k in range(3)]
+    )
+    np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-6)
+
+
+def test_piecewise_without_first_update_is_the_box_smoothers_model():
+    z, has, q, r2 = _problem(7, 25, 1)
+    z[~has] = 0.0
+    got = rts_smooth(z, has, q, r2, velocity_sd=8.0, update_first=False, discretisation="piecewise")
+    want = cv_posterior_mean(z[:, 0], has, float(np.sqrt(q[0])), float(np.sqrt(r2[0])), 8.0)
+    np.testing.assert_allclose(got[:, 0], want, rtol=1e-7, atol=1e-6)
+    assert got[0, 0] != z[0, 0] or not has[1:].any()  # later data move frame 0
+
+
+def test_rts_bad_input():
+    z = np.zeros((4, 2))
+    with pytest.raises(ValueError, match="first frame"):
+        rts_smooth(z, [False, True, True, True], [1, 1], [1, 1], velocity_sd=1.0, update_first=True)
+    with pytest.raises(ValueError, match="must be"):
+        rts_smooth(z, [True] * 4, [1, 1, 1], [1, 1], velocity_sd=1.0, update_first=True)
+    with pytest.raises(ValueError, match="first frame"):
+        rts_smooth(
+            np.zeros((0, 2)), np.zeros(0, bool), [1, 1], [1, 1], velocity_sd=1.0, update_first=True
+        )
