@@ -6,9 +6,10 @@ import threading
 
 import numpy as np
 import pytest
-from pftrack import _core
-from pftrack.recovery import constant_velocity_A, goal_directed_path, sample_goal_directed_paths
 
+from pftrack import _core
+from pftrack.kalman import cv_transition_xy
+from pftrack.recovery import GdtModel, goal_directed_path, sample_goal_directed_paths
 from tests.reference import bridge as ref
 
 
@@ -105,7 +106,7 @@ def test_forms_reject_what_they_cannot_handle():
 
 
 def cv_problem(T=10, Pi_T=1e-6):
-    A = constant_velocity_A(1.0)
+    A = cv_transition_xy(1.0)
     Q = np.diag([1e-2, 1e-2, 1e-2, 1e-2])
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
     return dict(
@@ -193,7 +194,7 @@ def test_batch_equals_single_and_threads_equal_serial():
     ps = [problem(rng, T=int(rng.integers(1, 30))) for _ in range(20)]
     tuples = [as_ref(p) for p in ps]
     batch = _core.gdt_solve_batch(tuples, "general", True, False)
-    for p, b in zip(ps, batch):
+    for p, b in zip(ps, batch, strict=True):
         single = goal_directed_path(**p)
         np.testing.assert_array_equal(b["path"], single.path)
         np.testing.assert_array_equal(b["cov"], single.cov)
@@ -208,7 +209,7 @@ def test_batch_equals_single_and_threads_equal_serial():
     for t in threads:
         t.join()
     for r in results:
-        for a, b in zip(r, batch):
+        for a, b in zip(r, batch, strict=True):
             np.testing.assert_array_equal(a["path"], b["path"])
 
 
@@ -232,7 +233,7 @@ def test_samples_reproducible_and_centred_on_the_mean_path():
 
 def test_kalman_filter_matches_reference():
     rng = np.random.default_rng(11)
-    A = constant_velocity_A(1.0)
+    A = cv_transition_xy(1.0)
     Q = np.diag([0.01, 0.01, 0.1, 0.1])
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
     R = 0.5 * np.eye(2)
@@ -267,3 +268,12 @@ def test_dynamic_size_path_matches_reference(n, m):
     np.testing.assert_allclose(got.path, path, rtol=1e-8, atol=1e-9)
     np.testing.assert_allclose(got.eps, eps, rtol=1e-8, atol=1e-10)
     np.testing.assert_allclose(got.x0_cov, x0c, rtol=1e-8, atol=1e-10)
+
+
+def test_paper_model_is_the_constant_velocity_model_of_eq_19():
+    m = GdtModel()
+    want = np.array([[1, 0, 1, 0], [0, 1, 0, 1], [0, 0, 1, 0], [0, 0, 0, 1]], dtype=float)
+    np.testing.assert_array_equal(m.A, want)
+    np.testing.assert_array_equal(m.A, cv_transition_xy(m.dt))
+    np.testing.assert_array_equal(m.H, np.hstack([np.eye(2), np.zeros((2, 2))]))
+    np.testing.assert_array_equal(np.diag(m.Q), m.q)

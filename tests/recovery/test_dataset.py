@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from pftrack.io.mot import read_mot
 from pftrack.recovery import experiment as E
 
@@ -58,5 +59,5 @@ def test_tud_gdt_mix_falls_back_to_gdt_bi():
     sw = E.sweep(trajs, 100, 640, 480, 4, min_gaps=3)
     run = E.run_mask(trajs, sw.representative(), ("gdt-bi", "gdt-mix"))
     assert run.motion is not None and run.motion.is_gdt_bi
-    for a, b in zip(run.paths["gdt-bi"], run.paths["gdt-mix"]):
+    for a, b in zip(run.paths["gdt-bi"], run.paths["gdt-mix"], strict=True):
         np.testing.assert_array_equal(a, b)

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from pftrack.cli import main
 from pftrack.io.mot import read_mot, write_mot
-from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, fill_gaps, link_tracklets
+from pftrack.recovery.fill import fill_gaps
+from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, link_cost_matrix, link_tracklets
 
 
 def walker(tid, frames, x0, y0, vx, vy, w=20.0, h=50.0):
@@ -45,6 +47,39 @@ def test_link_tracklets_joins_fragments_of_one_object_only():
 def test_link_respects_the_gap_gate():
     _, mapping = link_tracklets(scene(), LinkConfig(max_gap=5, max_distance=30))
     assert mapping == {}
+
+
+def _frames_with_colours(rows, colours, n_frames=100, size=(600, 700)):
+    """BGR frames in which each id's box is painted in its colour (grey background)."""
+    frames = [np.full((*size, 3), 128, np.uint8) for _ in range(n_frames)]
+    for r in rows:
+        f, tid = int(r[0]) - 1, int(r[1])
+        x0, y0 = int(r[2]), int(r[3])
+        frames[f][y0 : y0 + int(r[5]), x0 : x0 + int(r[4])] = colours[tid]
+    return frames
+
+
+def test_colour_term_uses_the_hsv_histograms():
+    rows = scene()
+    cfg = LinkConfig(max_gap=20, max_distance=30)
+    ids, plain = link_cost_matrix(
+        {t: rows[rows[:, 1] == t] for t in np.unique(rows[:, 1]).astype(int)}, cfg
+    )
+    i, j = ids.index(1), ids.index(5)
+    same = _frames_with_colours(
+        rows, {1: (0, 0, 255), 5: (0, 0, 255), 2: (255, 0, 0), 7: (0, 255, 0)}
+    )
+    other = _frames_with_colours(
+        rows, {1: (0, 0, 255), 5: (255, 0, 0), 2: (255, 0, 0), 7: (0, 255, 0)}
+    )
+    per_id = {t: rows[rows[:, 1] == t] for t in ids}
+    _, c_same = link_cost_matrix(per_id, cfg, same)
+    _, c_other = link_cost_matrix(per_id, cfg, other)
+    # same colour: Bhattacharyya distance 0, the cost is the motion cost alone
+    assert c_same[i, j] == pytest.approx(plain[i, j], abs=1e-6)
+    # red against blue: no common bin, distance 1
+    assert c_other[i, j] == pytest.approx(plain[i, j] + cfg.w_appearance, abs=1e-6)
+    assert link_tracklets(rows, cfg, same)[1] == {5: 1}
 
 
 def test_fill_gaps_flags_rows_and_is_exact_on_straight_walkers():
@@ -142,7 +177,7 @@ def synthetic_gt():
         y0 = 40 + 30 * tid
         x = 10 + 2.0 * f
         y = y0 + 5 * np.sin(f / 15.0 + tid) + np.cumsum(rng.normal(0, 0.05, len(f)))
-        for fr, xx, yy in zip(f, x, y):
+        for fr, xx, yy in zip(f, x, y, strict=True):
             rows.append([fr, tid, xx - 10, yy - 20, 20, 40, 1, -1, -1, -1])
     rows.append([1, 99, 150, 120, 20, 40, 1, -1, -1, -1])  # starts (and ends) inside the mask
     rows.append([2, 99, 151, 120, 20, 40, 1, -1, -1, -1])

@@ -4,11 +4,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pftrack.recovery import METHODS, estimate_noise, goal_directed_path, recover_gap, recover_gaps
+
+from pftrack.recovery import (
+    DEFAULT_METHOD,
+    METHODS,
+    estimate_noise,
+    fill_gaps,
+    goal_directed_path,
+    recover_gap,
+    recover_gaps,
+)
 from pftrack.recovery.demo import demo_report
 from pftrack.recovery.gdt import GdtModel
-from pftrack.recovery.methods import gdt_problem
-
+from pftrack.recovery.noise import DEFAULT_NOISE
+from pftrack.recovery.problems import GdtProblem, gdt_bi_problem, gdt_problem
 from tests.reference import bridge as ref
 
 
@@ -48,7 +57,7 @@ def test_recover_gaps_equals_recover_gap():
     for m in ("gdt", "gdt-bi", "bspline"):
         batch = recover_gaps(gaps, m)
         noise = estimate_noise([g[0] for g in gaps] + [g[1] for g in gaps])
-        for (a, b), p in zip(gaps, batch):
+        for (a, b), p in zip(gaps, batch, strict=True):
             np.testing.assert_allclose(recover_gap(a, b, method=m, noise=noise), p, atol=1e-12)
 
 
@@ -69,8 +78,45 @@ def test_paper_gdt_equals_kalman_plus_reference_equation():
     got = recover_gap(a, b, method="gdt")
     np.testing.assert_allclose(got, path[1:-1, :2], rtol=1e-7, atol=1e-6)
     # the Python problem builder + general solver agree too
-    sol = goal_directed_path(*gdt_problem(a, b), start_conditioned=False)
+    p = gdt_problem(a, b)
+    assert isinstance(p, GdtProblem) and p.T == 13
+    sol = goal_directed_path(
+        p.A, p.Q, p.H_T, p.Pi_T, p.m0, p.Pi_0, p.y_T, p.T, start_conditioned=False
+    )
     np.testing.assert_allclose(got, sol.path[1:-1, :2], atol=1e-9)
+    np.testing.assert_array_equal(p.solve(start_conditioned=False).path, sol.path)
+
+
+def test_gdt_bi_problem_solves_to_the_batch_path():
+    rng = np.random.default_rng(6)
+    t = np.arange(1, 70)
+    xy = 50 + np.cumsum(np.cumsum(rng.normal(0, 0.2, (len(t), 2)), axis=0), axis=0)
+    a = np.column_stack([t[:30], xy[:30]])
+    b = np.column_stack([t[41:], xy[41:]])
+    noise = estimate_noise([a, b])
+    p = gdt_bi_problem(a, b, noise)
+    assert p.H_T.shape == (4, 4) and p.T == 12
+    np.testing.assert_allclose(p.Pi_T, p.Pi_T.T, atol=0)
+    got = recover_gap(a, b, method="gdt-bi", noise=noise)
+    np.testing.assert_allclose(p.solve().path[1:-1, :2], got, atol=1e-8)
+
+
+def test_default_method_is_gdt_mix_everywhere():
+    assert DEFAULT_METHOD == "gdt-mix"
+    rng = np.random.default_rng(7)
+    t = np.arange(1, 90)
+    xy = 80 + np.cumsum(np.cumsum(rng.normal(0, 0.1, (len(t), 2)), axis=0), axis=0)
+    a = np.column_stack([t[:40], xy[:40]])
+    b = np.column_stack([t[52:], xy[52:]])
+    want = recover_gap(a, b, method="gdt-mix")
+    np.testing.assert_array_equal(recover_gap(a, b), want)
+    np.testing.assert_array_equal(recover_gaps([(a, b)])[0], want)
+    rows = np.zeros((len(a) + len(b), 10))
+    rows[:, 0] = np.r_[a[:, 0], b[:, 0]]
+    rows[:, 1] = 1
+    rows[:, 2:4] = np.r_[a[:, 1:3], b[:, 1:3]] - 5.0
+    rows[:, 4:6] = 10.0
+    assert np.array_equal(fill_gaps(rows)[0], fill_gaps(rows, "gdt-mix")[0])
 
 
 @pytest.mark.parametrize("method", ["ml", "moments"])
@@ -99,8 +145,6 @@ def test_noise_estimates_recover_simulated_levels(method):
 
 
 def test_noise_estimate_defaults_without_data():
-    from pftrack.recovery.methods import DEFAULT_NOISE
-
     assert estimate_noise([np.zeros((2, 3))]) == DEFAULT_NOISE
     with pytest.raises(ValueError, match="method"):
         estimate_noise([], method="bad")
@@ -110,21 +154,21 @@ def test_bad_segments_raise():
     a = line(np.arange(1, 10))
     b = line(np.arange(15, 20))
     with pytest.raises(ValueError, match="segment_a is empty"):
-        recover_gap(np.zeros((0, 3)), b)
+        recover_gap(np.zeros((0, 3)), b, method="gdt")
     with pytest.raises(ValueError, match="segment_b must have shape"):
-        recover_gap(a, np.zeros((4, 2)))
+        recover_gap(a, np.zeros((4, 2)), method="gdt")
     nan = a.copy()
     nan[3, 1] = np.nan
     with pytest.raises(ValueError, match="non-finite"):
-        recover_gap(nan, b)
+        recover_gap(nan, b, method="gdt")
     with pytest.raises(ValueError, match="starts at frame"):
-        recover_gap(b, a)
+        recover_gap(b, a, method="gdt")
     with pytest.raises(ValueError, match="method"):
         recover_gap(a, b, method="magic")
     with pytest.raises(ValueError, match="strictly between"):
-        recover_gap(a, b, frames=[9])
+        recover_gap(a, b, frames=[9], method="gdt")
     with pytest.raises(ValueError, match="increase"):
-        recover_gap(a[::-1], b)
+        recover_gap(a[::-1], b, method="gdt")
     with pytest.raises(ValueError, match="segment_a of gap 0"):
         recover_gaps([(np.zeros((0, 3)), b)], "gdt")
 
@@ -135,7 +179,7 @@ def test_demo_report_runs_and_names_every_method():
     for tid in range(1, 4):
         t = np.arange(1, 120)
         xy = 200 + np.cumsum(np.cumsum(rng.normal(0, 0.1, (len(t), 2)), axis=0), axis=0)
-        for f, (x, y) in zip(t, xy):
+        for f, (x, y) in zip(t, xy, strict=True):
             rows.append([f, tid, x - 10, y - 20, 20, 40, 1, -1, -1, -1])
     text = demo_report(np.array(rows), rng=4)
     for m in METHODS:

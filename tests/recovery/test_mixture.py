@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
-import pftrack._core as _core
 import pytest
+
+import pftrack._core as _core
+from pftrack.kalman import cv_transition, wna_Q
 from pftrack.recovery import recover_gap, recover_gaps
-from pftrack.recovery.methods import estimate_noise
 from pftrack.recovery.mixture import (
     MotionFit,
     fit_motion,
@@ -14,9 +15,8 @@ from pftrack.recovery.mixture import (
     recover_mixture,
     singer_model,
     stand_hypotheses,
-    wna_model,
 )
-
+from pftrack.recovery.noise import estimate_noise
 from tests.reference.mixture import gap_mixture as ref_gap_mixture
 from tests.reference.mixture import gap_mixture_vectorised, singer_quadrature, state_loglik
 
@@ -35,7 +35,7 @@ def test_gap_mixture_matches_numpy(d: int, seed: int) -> None:
     rng = np.random.default_rng(seed)
     n, fa, fb = 60, 22, 41
     z = _window(rng, n, fa, fb, holes=4)
-    F, Q = singer_model(0.3, 2.5) if d == 3 else (wna_model(0.2)[0][None], wna_model(0.2)[1][None])
+    F, Q = singer_model(0.3, 2.5) if d == 3 else (cv_transition()[None], wna_Q(0.2)[None])
     F, Q = F[0], Q[0]
     t1, t2 = stand_hypotheses(fb - fa, grid=7)
     p0 = np.array([1e4, 4.0, 0.5][:d])
@@ -54,7 +54,7 @@ def test_gap_mixture_walk_hypothesis_is_the_gaussian_conditional() -> None:
     rng = np.random.default_rng(5)
     n, fa, fb, r = 30, 9, 20, 0.4
     z = _window(rng, n, fa, fb, holes=2)
-    F, Q = wna_model(0.15)
+    F, Q = cv_transition(), wna_Q(0.15)
     p0 = np.array([1e4, 9.0])
     got, _ = _core.gap_mixture(
         z, fa, fb, F, Q, r, p0, np.array([-1], np.int32), np.array([-1], np.int32), 0.0
@@ -196,7 +196,7 @@ def test_same_input_same_output() -> None:
     pairs = [(w[:50], w[90:]) for w in runs]
     one = recover_gaps(pairs, "gdt-mix")
     two = recover_gaps(pairs, "gdt-mix")
-    for x, y in zip(one, two):
+    for x, y in zip(one, two, strict=True):
         np.testing.assert_array_equal(x, y)
 
 

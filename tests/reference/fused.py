@@ -1,5 +1,8 @@
 """Vectorised NumPy implementations a Python user would write: the speed baselines.
-(tests/reference.py holds the obviously-correct references; these are the fast-as-NumPy-gets ones.)"""
+
+``tests.reference.kernels`` holds the obviously-correct references; these are the
+fast-as-NumPy-gets ones.
+"""
 
 from __future__ import annotations
 
@@ -25,7 +28,7 @@ def histograms_and_weights(bins, n_bins, boxes, ref, lam=20.0):
     y0 = np.clip(np.floor(boxes[:, 1] - boxes[:, 3] / 2 + 0.5).astype(int), 0, rows)
     y1 = np.clip(np.floor(boxes[:, 1] + boxes[:, 3] / 2 + 0.5).astype(int), 0, rows)
     for i in range(len(boxes)):
-        patch = bins[y0[i]:y1[i], x0[i]:x1[i]].ravel()
+        patch = bins[y0[i] : y1[i], x0[i] : x1[i]].ravel()
         patch = patch[patch >= 0]
         if patch.size:
             hists[i] = np.bincount(patch, minlength=n_bins) / patch.size

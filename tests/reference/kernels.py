@@ -126,8 +126,26 @@ def propagate(particles, noise, a, b, sigma, s_min, s_max, use_means=False, m1=N
     return p
 
 
-def sis_step(particles, weights, means, bins, n_bins, ref, w0, h0, a, b, sigma, s_min, s_max,
-             use_means, lam, kernel, u0, normals):
+def sis_step(
+    particles,
+    weights,
+    means,
+    bins,
+    n_bins,
+    ref,
+    w0,
+    h0,
+    a,
+    b,
+    sigma,
+    s_min,
+    s_max,
+    use_means,
+    lam,
+    kernel,
+    u0,
+    normals,
+):
     """One SIS step given the draws (u0 for resampling, (N, 3) normals)."""
     idx = systematic_resample(weights, u0)
     p = particles[idx]

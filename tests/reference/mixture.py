@@ -35,7 +35,7 @@ def gap_mixture(
     """One Kalman filter + RTS smoother per hypothesis, written out step by step."""
     n, d, T = len(z), F.shape[0], fb - fa
     paths, lls = [], []
-    for t1, t2 in zip(t1s, t2s):
+    for t1, t2 in zip(t1s, t2s, strict=True):
         Fg, Qg = step_models(F, Q, v2, T, int(t1), int(t2))
         Ft = [F if (t <= fa or t > fb) else Fg[t - fa - 1] for t in range(n)]
         Qt = [Q if (t <= fa or t > fb) else Qg[t - fa - 1] for t in range(n)]
@@ -118,7 +118,7 @@ def gap_mixture_vectorised(
     n, d, T, nh = len(z), F.shape[0], fb - fa, len(t1s)
     Fs = np.broadcast_to(F, (nh, n, d, d)).copy()
     Qs = np.broadcast_to(Q, (nh, n, d, d)).copy()
-    for h, (t1, t2) in enumerate(zip(t1s, t2s)):
+    for h, (t1, t2) in enumerate(zip(t1s, t2s, strict=True)):
         if t1 < 0:
             continue
         Fg, Qg = step_models(F, Q, v2, T, int(t1), int(t2))

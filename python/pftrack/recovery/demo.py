@@ -3,18 +3,19 @@
 from __future__ import annotations
 
 import time
-from typing import Union
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike
 
-from pftrack.recovery.methods import METHODS, estimate_noise, recover_gaps
+from pftrack._typing import RngLike
+from pftrack.recovery.noise import estimate_noise
+from pftrack.recovery.registry import METHODS, recover_gaps
 
-RngLike = Union[np.random.Generator, int, None]
+__all__ = ["demo_report"]
 
 
 def demo_report(
-    tracks_rows: NDArray[np.float64],
+    tracks_rows: ArrayLike,
     rng: RngLike = None,
     *,
     n_gaps: int = 20,
@@ -25,7 +26,7 @@ def demo_report(
 
     Parameters
     ----------
-    tracks_rows : (M, 10) ndarray
+    tracks_rows : (M, 10) array_like
         MOTChallenge rows (true tracks or a tracker's output); box centres are the points.
     rng : numpy.random.Generator, int or None
         Chooses the gaps.
@@ -71,6 +72,6 @@ def demo_report(
         t0 = time.perf_counter()
         paths = recover_gaps(gaps, m, noise=noise)
         dt = 1e3 * (time.perf_counter() - t0)
-        err = np.mean([np.hypot(*(p - t).T).mean() for p, t in zip(paths, truths)])
+        err = np.mean([np.hypot(*(p - t).T).mean() for p, t in zip(paths, truths, strict=True)])
         lines.append(f"{m:<10}{err:>17.3f}{dt:>11.2f}")
     return "\n".join(lines)

@@ -17,10 +17,29 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack.recovery.methods import METHODS, NoiseEstimate, estimate_noise, recover_gaps
+from pftrack._typing import F64
 from pftrack.recovery.mixture import MotionFit, fit_motion
+from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.registry import METHODS, recover_gaps
 
-F64 = NDArray[np.float64]
+__all__ = [
+    "Gap",
+    "MaskRun",
+    "MedianScores",
+    "MethodScore",
+    "Sweep",
+    "count_gaps_grid",
+    "draw_figure",
+    "find_gaps",
+    "format_median",
+    "format_table",
+    "median_over",
+    "observed_runs",
+    "run_mask",
+    "score",
+    "sweep",
+    "trajectories",
+]
 
 
 @dataclass(frozen=True)
@@ -66,8 +85,8 @@ def find_gaps(trajs: dict[int, F64], mask: Sequence[float]) -> tuple[list[Gap], 
         edges = np.diff(inside.astype(np.int8))
         starts = np.flatnonzero(edges == 1) + 1
         ends = np.flatnonzero(edges == -1) + 1  # exclusive
-        bounds = [0] + [int(v) for pair in zip(starts, ends) for v in pair] + [len(tr)]
-        for g, (s, e) in enumerate(zip(starts, ends)):
+        bounds = [0] + [int(v) for pair in zip(starts, ends, strict=True) for v in pair] + [len(tr)]
+        for g, (s, e) in enumerate(zip(starts, ends, strict=True)):
             a = tr[bounds[2 * g] : s]
             b = tr[e : bounds[2 * g + 3]]
             gaps.append(Gap(tid, a, b, tr[s:e]))
@@ -113,7 +132,7 @@ def observed_runs(trajs: dict[int, F64], mask: Sequence[float]) -> list[F64]:
     for tr in trajs.values():
         inside = (tr[:, 1] >= mx) & (tr[:, 1] < mx + mw) & (tr[:, 2] >= my) & (tr[:, 2] < my + mh)
         cut = np.flatnonzero(np.diff(inside.astype(np.int8)) != 0) + 1
-        for part, flag in zip(np.split(tr, cut), np.split(inside, cut)):
+        for part, flag in zip(np.split(tr, cut), np.split(inside, cut), strict=True):
             if not flag[0]:
                 runs.append(part)
     return runs
@@ -135,7 +154,7 @@ def score(
         paths = recover_gaps(pairs, method, noise=noise, motion=motion)
         best = min(best, time.perf_counter() - t0)
     ex, ey, ee = [], [], []
-    for g, p in zip(gaps, paths):
+    for g, p in zip(gaps, paths, strict=True):
         d = p - g.truth[:, 1:3]
         ex.append(np.abs(d[:, 0]))
         ey.append(np.abs(d[:, 1]))
@@ -246,9 +265,9 @@ def _draw_panel(
     ox, oy = origin
 
     def pts(xy: F64) -> NDArray[np.int32]:
-        return np.round(
-            np.column_stack([(xy[:, 0] - ox) * scale, (xy[:, 1] - oy) * scale]) * 16
-        ).astype(np.int32)
+        scaled = np.column_stack([(xy[:, 0] - ox) * scale, (xy[:, 1] - oy) * scale]) * 16
+        out: NDArray[np.int32] = np.round(scaled).astype(np.int32)
+        return out
 
     for tr in trajs.values():
         cv2.polylines(img, [pts(tr[:, 1:3])], False, (90, 90, 90), 1, cv2.LINE_AA, 4)
@@ -256,7 +275,7 @@ def _draw_panel(
     corners = pts(np.array([[mx, my], [mx + mw, my + mh]]))
     cv2.rectangle(img, tuple(corners[0]), tuple(corners[1]), (0, 200, 200), 1, cv2.LINE_AA, 4)
     for k, m in enumerate(methods):
-        for g, p in zip(gaps, paths.get(m, [])):
+        for g, p in zip(gaps, paths.get(m, []), strict=False):
             full = np.vstack([g.segment_a[-1:, 1:3], p, g.segment_b[:1, 1:3]])
             cv2.polylines(img, [pts(full)], False, _COLOURS[k % len(_COLOURS)], 1, cv2.LINE_AA, 4)
     radius = max(1, int(round(0.6 * scale)))

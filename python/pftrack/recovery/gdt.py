@@ -7,30 +7,20 @@ arguments, converts them and documents the maths.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal, Union
+from typing import Literal, TypeAlias
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 import pftrack._core as _core
+from pftrack._typing import F64, RngLike
+from pftrack.kalman import cv_transition_xy
 
-Form = Literal["general", "invertible", "pseudo_inverse"]
-RngLike = Union[np.random.Generator, int, None]
+__all__ = ["Form", "GdtModel", "GdtSolution", "goal_directed_path", "sample_goal_directed_paths"]
+
+#: Which of the paper's equivalent forms solves the problem.
+Form: TypeAlias = Literal["general", "invertible", "pseudo_inverse"]
 _FORMS = ("general", "invertible", "pseudo_inverse")
-
-
-def constant_velocity_A(dt: float = 1.0) -> NDArray[np.float64]:
-    """State transition of the paper's eq. (19) for the state ``(x, y, vx, vy)``.
-
-    Parameters
-    ----------
-    dt : float
-        Time between two frames. pftrack measures time in **frames** (``dt = 1``), so
-        velocities are pixels per frame; the paper does not say which unit it used.
-    """
-    a = np.eye(4)
-    a[0, 2] = a[1, 3] = dt
-    return a
 
 
 @dataclass(frozen=True)
@@ -40,7 +30,8 @@ class GdtModel:
     Attributes
     ----------
     dt : float
-        Frame interval in frames (1.0): the unit of time is one frame.
+        Frame interval in frames (1.0): pftrack measures time in frames, so velocities are
+        pixels per frame (the paper does not say which unit it used).
     q : tuple of 4 float
         Diagonal of the process noise ``Q`` (px², px², (px/frame)², (px/frame)²), eq. (20).
     r : tuple of 2 float
@@ -56,27 +47,27 @@ class GdtModel:
     p_init_velocity: float = 1e2
 
     @property
-    def A(self) -> NDArray[np.float64]:  # noqa: N802 - the paper's name
-        """Constant-velocity transition, eq. (19)."""
-        return constant_velocity_A(self.dt)
+    def A(self) -> F64:  # noqa: N802 - the paper's name
+        """Constant-velocity transition, eq. (19) (:func:`pftrack.kalman.cv_transition_xy`)."""
+        return cv_transition_xy(self.dt)
 
     @property
-    def Q(self) -> NDArray[np.float64]:  # noqa: N802
+    def Q(self) -> F64:  # noqa: N802
         """Process noise, eq. (20)."""
         return np.diag(np.asarray(self.q, dtype=np.float64))
 
     @property
-    def H(self) -> NDArray[np.float64]:  # noqa: N802
+    def H(self) -> F64:  # noqa: N802
         """``[I_2 0_2]``, eq. (21)."""
         return np.hstack([np.eye(2), np.zeros((2, 2))])
 
     @property
-    def R(self) -> NDArray[np.float64]:  # noqa: N802
+    def R(self) -> F64:  # noqa: N802
         """Measurement noise, eq. (22)."""
         return np.diag(np.asarray(self.r, dtype=np.float64))
 
 
-def _as_stack(a: ArrayLike, name: str, n: int | None = None) -> NDArray[np.float64]:
+def _as_stack(a: ArrayLike, name: str) -> F64:
     arr = np.ascontiguousarray(a, dtype=np.float64)
     if arr.ndim not in (2, 3):
         raise ValueError(f"goal_directed_path: {name} must be (n, n) or (T, n, n), got {arr.shape}")
@@ -101,14 +92,14 @@ class GdtSolution:
         ``cov(x_0 | y_T)`` (eqs. 9, 14).
     """
 
-    path: NDArray[np.float64]
-    eps: NDArray[np.float64]
-    cov: NDArray[np.float64]
-    x0_mean: NDArray[np.float64]
-    x0_cov: NDArray[np.float64]
+    path: F64
+    eps: F64
+    cov: F64
+    x0_mean: F64
+    x0_cov: F64
 
 
-def _check_T(T: Any) -> int:
+def _check_T(T: object) -> int:
     if isinstance(T, bool) or not isinstance(T, (int, np.integer)):
         raise TypeError(f"goal_directed_path: T must be an int, got {type(T).__name__}")
     if T <= 0:
@@ -121,13 +112,26 @@ def _check_form(form: str) -> None:
         raise ValueError(f"goal_directed_path: form is {form!r}, expected one of {_FORMS}")
 
 
-def _model_arrays(A: ArrayLike, Q: ArrayLike, H_T: ArrayLike, Pi_T: ArrayLike, m0: ArrayLike,
-                  Pi_0: ArrayLike, y_T: ArrayLike) -> tuple[NDArray[np.float64], ...]:  # noqa: N803  # fmt: skip
+def _model_arrays(
+    A: ArrayLike,  # noqa: N803 - the paper's names
+    Q: ArrayLike,  # noqa: N803
+    H_T: ArrayLike,  # noqa: N803
+    Pi_T: ArrayLike,  # noqa: N803
+    m0: ArrayLike,
+    Pi_0: ArrayLike,  # noqa: N803
+    y_T: ArrayLike,  # noqa: N803
+) -> tuple[F64, F64, F64, F64, F64, F64, F64]:
     """The model as the float64 arrays ``gdt_solve``/``gdt_sample`` take (A, Q stacked per step)."""
     f64 = np.float64
-    return (_as_stack(A, "A"), _as_stack(Q, "Q"), np.atleast_2d(np.asarray(H_T, dtype=f64)),
-            np.atleast_2d(np.asarray(Pi_T, dtype=f64)), np.asarray(m0, dtype=f64),
-            np.atleast_2d(np.asarray(Pi_0, dtype=f64)), np.asarray(y_T, dtype=f64))  # fmt: skip
+    return (
+        _as_stack(A, "A"),
+        _as_stack(Q, "Q"),
+        np.atleast_2d(np.asarray(H_T, dtype=f64)),
+        np.atleast_2d(np.asarray(Pi_T, dtype=f64)),
+        np.asarray(m0, dtype=f64),
+        np.atleast_2d(np.asarray(Pi_0, dtype=f64)),
+        np.asarray(y_T, dtype=f64),
+    )
 
 
 def goal_directed_path(
@@ -216,7 +220,7 @@ def sample_goal_directed_paths(
     rng: RngLike = None,
     form: Form = "general",
     start_conditioned: bool = True,
-) -> NDArray[np.float64]:
+) -> F64:
     """Random paths ``(n_samples, T+1, n)`` of the goal-directed process with ``eps_t`` noise.
 
     Arguments as :func:`goal_directed_path`; `rng` gives one 63-bit seed for the C++
@@ -227,7 +231,7 @@ def sample_goal_directed_paths(
     if n_samples <= 0:
         raise ValueError(f"sample_goal_directed_paths: n_samples is {n_samples}, expected > 0")
     seed = int(np.random.default_rng(rng).integers(2**63))
-    out: NDArray[np.float64] = _core.gdt_sample(
+    out: F64 = _core.gdt_sample(
         *_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T),
         T,
         int(n_samples),

@@ -1,10 +1,10 @@
-"""Tracklet linking and gap filling of any tracker's MOTChallenge output.
+"""Tracklet linking: join the fragments of one object in any tracker's MOTChallenge output.
 
 Rows are ``(M, 10)`` MOTChallenge arrays ``frame,id,left,top,width,height,conf,x,y,z``.
-Filled rows carry the **interpolated flag in column 8** (1-based; index 7, the world-``x``
-column, which is -1 in 2D MOTChallenge files): ``1`` on every row pftrack filled, observed rows
-untouched. Rows already flagged count as observed when a file is processed again, so running
-the fill twice changes nothing more.
+Rows pftrack fills (:mod:`pftrack.recovery.fill`, the offline tracker) carry the
+**interpolated flag in column 8** (1-based; index :data:`FLAG_COLUMN` = 7, the world-``x``
+column, which is -1 in 2D MOTChallenge files): ``1`` on every filled row, observed rows
+untouched.
 """
 
 from __future__ import annotations
@@ -15,10 +15,25 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack.recovery.methods import METHODS, NoiseEstimate, estimate_noise, recover_gaps
-from pftrack.recovery.mixture import fit_motion
+from pftrack._typing import F64
+from pftrack.boxes import xywh_to_cxcywh
+from pftrack.particle_filter.colour import (
+    BinnedImage,
+    bhattacharyya_distance,
+    box_histograms,
+    hsv_bins,
+)
 
-F64 = NDArray[np.float64]
+__all__ = [
+    "FLAG_COLUMN",
+    "LinkConfig",
+    "box_centres",
+    "check_unique",
+    "link_cost_matrix",
+    "link_tracklets",
+    "split_tracks",
+]
+
 FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTChallenge row)
 
 
@@ -35,8 +50,9 @@ class LinkConfig:
         fragment's first (or, backwards, last) box centre.
     w_gap, w_size, w_appearance : float
         Weights of the time gap (as a fraction of `max_gap`), the box-height log ratio and the
-        colour-histogram Bhattacharyya distance; the motion term (mean prediction distance over
-        `max_distance`) has weight 1.
+        Bhattacharyya distance between the HSV colour histograms
+        (:mod:`pftrack.particle_filter.colour`, default binning) of the two boxes that meet;
+        the motion term (mean prediction distance over `max_distance`) has weight 1.
     velocity_points : int
         Points used to fit each fragment's end velocity.
     """
@@ -49,7 +65,8 @@ class LinkConfig:
     velocity_points: int = 5
 
 
-def _centres(rows: F64) -> F64:
+def box_centres(rows: F64) -> F64:
+    """Rows ``(frame, cx, cy)`` of the box centres of MOTChallenge rows."""
     return np.column_stack(
         [rows[:, 0], rows[:, 2] + 0.5 * rows[:, 4], rows[:, 3] + 0.5 * rows[:, 5]]
     )
@@ -73,18 +90,22 @@ def split_tracks(rows: F64) -> dict[int, F64]:
     return out
 
 
-def _histogram(frame: NDArray[np.uint8], row: F64) -> NDArray[np.float32] | None:
-    import cv2
+class _Histograms:
+    """Colour histograms of fragment ends, each frame binned once (lazily: only gated pairs)."""
 
-    h, w = frame.shape[:2]
-    x0, y0 = max(int(row[2]), 0), max(int(row[3]), 0)
-    x1, y1 = min(int(row[2] + row[4]), w), min(int(row[3] + row[5]), h)
-    if x1 - x0 < 2 or y1 - y0 < 2:
-        return None
-    hsv = cv2.cvtColor(np.ascontiguousarray(frame[y0:y1, x0:x1]), cv2.COLOR_BGR2HSV)
-    hist = cv2.calcHist([hsv], [0, 1], None, [8, 8], [0, 180, 0, 256])
-    total = float(hist.sum())
-    return None if total <= 0 else np.asarray(hist / total, dtype=np.float32)
+    def __init__(self, frames: Sequence[NDArray[np.uint8]]) -> None:
+        self.frames = frames
+        self.images: dict[int, BinnedImage] = {}
+
+    def of(self, row: F64) -> F64 | None:
+        """Histogram of the box of a row, None when there is no frame or nothing to count."""
+        f = int(row[0]) - 1
+        if not 0 <= f < len(self.frames):
+            return None
+        if f not in self.images:
+            self.images[f] = hsv_bins(self.frames[f])
+        hist = box_histograms(self.images[f], xywh_to_cxcywh(row[2:6])[None])[0]
+        return hist if hist.sum() > 0 else None
 
 
 def link_cost_matrix(
@@ -100,17 +121,15 @@ def link_cost_matrix(
     ids = list(tracks)
     k = len(ids)
     cost = np.full((k, k), np.inf)
-    cent = {t: _centres(r) for t, r in tracks.items()}
-    hists: dict[tuple[int, bool], NDArray[np.float32] | None] = {}
+    cent = {t: box_centres(r) for t, r in tracks.items()}
+    colour = _Histograms(frames) if frames is not None else None
+    hists: dict[tuple[int, bool], F64 | None] = {}
 
-    def hist(tid: int, last: bool) -> NDArray[np.float32] | None:
+    def hist(tid: int, last: bool) -> F64 | None:
         key = (tid, last)
-        if key not in hists:
-            row = tracks[tid][-1 if last else 0]
-            f = int(row[0]) - 1
-            ok = frames is not None and 0 <= f < len(frames)
-            hists[key] = _histogram(frames[f], row) if ok and frames is not None else None
-        return hists[key]
+        if key not in hists and colour is not None:
+            hists[key] = colour.of(tracks[tid][-1 if last else 0])
+        return hists.get(key)
 
     for i, ti in enumerate(ids):
         ci = cent[ti]
@@ -133,11 +152,10 @@ def link_cost_matrix(
             hi, hj = tracks[ti][-1, 5], tracks[tj][0, 5]
             if hi > 0 and hj > 0:
                 c += config.w_size * abs(float(np.log(hi / hj)))
-            if frames is not None and config.w_appearance > 0:
+            if colour is not None and config.w_appearance > 0:
                 a, b = hist(ti, True), hist(tj, False)
                 if a is not None and b is not None:
-                    bc = float(np.sum(np.sqrt(a * b)))
-                    c += config.w_appearance * float(np.sqrt(max(1.0 - bc, 0.0)))
+                    c += config.w_appearance * float(bhattacharyya_distance(a, b)[0])
             cost[i, j] = c
     return ids, cost
 
@@ -156,7 +174,7 @@ def link_tracklets(
     config : LinkConfig
         Gates and weights.
     frames : sequence of (H, W, 3) uint8, optional
-        The video's frames (index ``frame - 1``) for the colour-histogram term.
+        The video's BGR frames (index ``frame - 1``) for the colour-histogram term.
 
     Returns
     -------
@@ -177,7 +195,7 @@ def link_tracklets(
         return rows, {}
     big = 1e6
     r, c = linear_sum_assignment(np.where(finite, cost, big))
-    nxt = {ids[i]: ids[j] for i, j in zip(r, c) if finite[i, j]}
+    nxt = {ids[i]: ids[j] for i, j in zip(r, c, strict=True) if finite[i, j]}
     has_prev = set(nxt.values())
     mapping: dict[int, int] = {}
     for head in ids:
@@ -190,82 +208,6 @@ def link_tracklets(
     for old, new in mapping.items():
         rows[rows[:, 1] == old, 1] = new
     return rows, mapping
-
-
-@dataclass(frozen=True)
-class FillReport:
-    """What :func:`fill_gaps` did."""
-
-    n_gaps: int
-    n_filled_rows: int
-    noise: NoiseEstimate | None
-
-
-def fill_gaps(
-    tracks: F64, method: str = "gdt-mix", max_gap: int = 30, noise: NoiseEstimate | None = None
-) -> tuple[F64, FillReport]:
-    """Fill every hole of at most `max_gap` missing frames inside each id's track.
-
-    Filled rows get positions from `method`, sizes by linear interpolation, ``conf`` = the
-    smaller of the two neighbours' and the interpolated flag (column 8) set to 1. Rows come back
-    sorted by (frame, id).
-    """
-    if method not in METHODS:
-        raise ValueError(f"fill_gaps: method is {method!r}, expected one of {METHODS}")
-    if max_gap < 1:
-        raise ValueError(f"fill_gaps: max_gap is {max_gap}, expected >= 1")
-    rows = np.asarray(tracks, dtype=np.float64)
-    if rows.ndim != 2 or rows.shape[1] != 10:
-        raise ValueError(f"fill_gaps: tracks must have shape (M, 10), got {rows.shape}")
-    check_unique(rows)
-    per_id = split_tracks(rows)
-    segs: list[tuple[F64, F64]] = []
-    meta: list[tuple[int, F64, F64]] = []
-    for tid, r in per_id.items():
-        c = _centres(r)
-        seg = np.column_stack([c, r[:, 4], r[:, 5]])
-        holes = np.flatnonzero(np.diff(r[:, 0]) > 1)
-        for h in holes:
-            missing = int(r[h + 1, 0] - r[h, 0] - 1)
-            if missing > max_gap:
-                continue
-            segs.append((seg[: h + 1], seg[h + 1 :]))
-            meta.append((tid, r[h], r[h + 1]))
-    motion = None
-    if method in ("gdt-bi", "gdt-mix") and segs:
-        whole = [_segment(r) for r in per_id.values()]
-        if noise is None:
-            noise = estimate_noise(whole)
-        if method == "gdt-mix":  # one model for the file, not one per pair of segments
-            motion = fit_motion(whole, noise)
-    new_rows: list[F64] = []
-    if segs:
-        paths = recover_gaps(segs, method, noise=noise, motion=motion)
-        for (tid, ra, rb), xy in zip(meta, paths):
-            fr = np.arange(ra[0] + 1, rb[0])
-            s = (fr - ra[0]) / (rb[0] - ra[0])
-            w = (1 - s) * ra[4] + s * rb[4]
-            h = (1 - s) * ra[5] + s * rb[5]
-            out = np.empty((len(fr), 10))
-            out[:, 0] = fr
-            out[:, 1] = tid
-            out[:, 2] = xy[:, 0] - 0.5 * w
-            out[:, 3] = xy[:, 1] - 0.5 * h
-            out[:, 4] = w
-            out[:, 5] = h
-            out[:, 6] = min(ra[6], rb[6])
-            out[:, 7] = 1.0
-            out[:, 8] = -1.0
-            out[:, 9] = -1.0
-            new_rows.append(out)
-    filled = np.vstack([rows, *new_rows]) if new_rows else rows.copy()
-    order = np.lexsort((filled[:, 1], filled[:, 0]))
-    n_new = sum(len(r) for r in new_rows)
-    return filled[order], FillReport(len(segs), n_new, noise)
-
-
-def _segment(r: F64) -> F64:
-    return _centres(r)
 
 
 def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:

@@ -33,19 +33,30 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
 import pftrack._core as _core
-from pftrack.recovery.methods import (
-    NoiseEstimate,
-    consecutive_runs,
-    estimate_noise,
-    recover_gaps,
-)
+from pftrack._typing import F64
+from pftrack.kalman import cv_transition, wna_Q
+from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.problems import SegmentModel
+from pftrack.recovery.segments import consecutive_runs
 
-F64 = NDArray[np.float64]
-ArrayLikeF = float | F64
+__all__ = [
+    "DIFFUSE",
+    "GRID",
+    "WINDOW",
+    "AxisModel",
+    "MotionFit",
+    "fit_motion",
+    "fit_singer",
+    "recover_mixture",
+    "recover_mixture_gaps",
+    "singer_model",
+    "stand_hypotheses",
+    "stand_rate",
+]
 
 #: Prior variance of the position at the start of a window (px^2): uninformative.
 DIFFUSE = 1e4
@@ -55,7 +66,7 @@ GRID = 20
 WINDOW = 30
 
 
-def singer_model(q: ArrayLikeF, tau: ArrayLikeF) -> tuple[F64, F64]:
+def singer_model(q: ArrayLike, tau: ArrayLike) -> tuple[F64, F64]:
     """One-frame transition ``F`` and noise ``Q`` of ``(position, velocity, acceleration)``.
 
     Continuous model ``da = -a/tau dt + sqrt(q) dW`` (``tau = inf``: white jerk), discretised
@@ -75,11 +86,6 @@ def singer_model(q: ArrayLikeF, tau: ArrayLikeF) -> tuple[F64, F64]:
     F = V[:, 3:, 3:].transpose(0, 2, 1)
     Q = F @ V[:, :3, 3:]
     return F, 0.5 * (Q + Q.transpose(0, 2, 1))
-
-
-def wna_model(q: float) -> tuple[F64, F64]:
-    """``F`` and ``Q`` of ``(position, velocity)`` under white-noise acceleration ``q``."""
-    return np.array([[1.0, 1.0], [0.0, 1.0]]), q * np.array([[1 / 3, 1 / 2], [1 / 2, 1.0]])
 
 
 @dataclass(frozen=True)
@@ -102,7 +108,7 @@ class AxisModel:
         if self.kind == "singer":
             F, Q = singer_model(self.q, self.tau)
             return F[0], Q[0]
-        return wna_model(self.q)
+        return cv_transition(), wna_Q(self.q)
 
     def prior(self, v2: float) -> F64:
         """Prior variances of the state at a window's first point."""
@@ -128,7 +134,7 @@ class MotionFit:
     def describe(self) -> str:
         """One line: the model of each axis, the stand rate and the restart velocity."""
         parts = []
-        for name, m in zip("xy", self.axes):
+        for name, m in zip("xy", self.axes, strict=True):
             if m.kind == "singer":
                 parts.append(f"{name}: Singer q={m.q:.3g} r={m.r:.3g} tau={m.tau:.2f} frames")
             else:
@@ -278,8 +284,12 @@ def recover_mixture_gaps(gaps: Sequence[tuple[F64, F64]], fit: MotionFit) -> lis
     """Recover many gaps with :func:`recover_mixture`.
 
     When the fitted model is ``gdt-bi``'s (:attr:`MotionFit.is_gdt_bi`), ``gdt-bi`` itself runs
-    (one C++ call for all gaps).
+    (:meth:`SegmentModel.two_sided <pftrack.recovery.problems.SegmentModel.two_sided>`, one C++
+    call for all gaps).
     """
     if fit.is_gdt_bi:
-        return recover_gaps(gaps, "gdt-bi", noise=fit.noise)
+        if not gaps:
+            return []
+        model = SegmentModel.two_sided(fit.noise)
+        return model.recover([a for a, _ in gaps], [b for _, b in gaps])
     return [recover_mixture(a, b, fit) for a, b in gaps]

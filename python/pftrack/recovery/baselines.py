@@ -1,0 +1,199 @@
+"""The baselines pftrack compares goal-directed recovery with.
+
+Every baseline takes two checked segments (rows ``(frame, x, y[, w, h])``, see
+:mod:`pftrack.recovery.segments`) and the frames to fill, strictly inside the gap, and returns
+``(F, 2)`` positions ``(x, y)``. Box sizes are filled by :func:`interpolate_sizes` (linear) for
+every method.
+
+``"linear"``
+    Straight line between the two ends (ByteTrack's post-processing).
+``"cubic"``
+    Interpolating cubic spline (not-a-knot) through the points of both segments near the gap.
+``"bspline"``
+    Weighted least-squares cubic B-spline (Sun et al. 2005) over the points near the gap.
+``"gsi"``
+    Gaussian-smoothed interpolation (StrongSORT): linear fill, then Gaussian-process regression
+    with an RBF kernel of length ``clip(tau log(tau^3 / n), 1/tau, tau^2)``, ``tau = 10``.
+``"rts"``
+    Constant-velocity Kalman filter + Rauch-Tung-Striebel smoother (:mod:`pftrack.kalman`)
+    over both segments and the gap, with fixed noise (``q = 0.1 px^2/frame^3``,
+    ``r = 1 px^2``).
+
+References
+----------
+.. [1] Zhang, Y. et al. (2022). ByteTrack: multi-object tracking by associating every detection
+   box. ECCV 2022.
+.. [2] Du, Y. et al. (2023). StrongSORT: make DeepSORT great again. IEEE TMM 25.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
+from typing import TypeAlias
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack._typing import F64
+from pftrack.kalman import rts_smooth
+
+__all__ = [
+    "BASELINES",
+    "Baseline",
+    "bspline",
+    "cubic",
+    "gsi",
+    "interpolate_sizes",
+    "linear",
+    "rts",
+]
+
+#: A baseline: ``(segment_a, segment_b, frames) -> (F, 2)`` positions.
+Baseline: TypeAlias = Callable[[F64, F64, NDArray[np.int64]], F64]
+
+
+def interpolate_sizes(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64 | None:
+    """Box sizes ``(w, h)`` linearly interpolated between the two ends, ``(F, 2)``.
+
+    None when either segment carries no sizes (3 columns).
+    """
+    if seg_a.shape[1] < 5 or seg_b.shape[1] < 5:
+        return None
+    f0, f1 = seg_a[-1, 0], seg_b[0, 0]
+    s = (frames - f0) / (f1 - f0)
+    out: F64 = (1.0 - s)[:, None] * seg_a[-1, 3:5] + s[:, None] * seg_b[0, 3:5]
+    return out
+
+
+def _window(seg_a: F64, seg_b: F64, k: int) -> tuple[F64, F64]:
+    pts = np.vstack([seg_a[-k:, :3], seg_b[:k, :3]])
+    return pts[:, 0], pts[:, 1:3]
+
+
+def linear(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64:
+    """Straight line from segment A's last point to segment B's first."""
+    f0, f1 = seg_a[-1, 0], seg_b[0, 0]
+    s = (frames - f0) / (f1 - f0)
+    out: F64 = (1.0 - s)[:, None] * seg_a[-1, 1:3] + s[:, None] * seg_b[0, 1:3]
+    return out
+
+
+def cubic(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], window: int = 30) -> F64:
+    """Not-a-knot cubic spline through `window` points on each side (linear if fewer than 4)."""
+    from scipy.interpolate import CubicSpline
+
+    t, xy = _window(seg_a, seg_b, window)
+    if len(t) < 4:
+        return linear(seg_a, seg_b, frames)
+    return np.asarray(CubicSpline(t, xy, axis=0)(frames), dtype=np.float64)
+
+
+def bspline(
+    seg_a: F64, seg_b: F64, frames: NDArray[np.int64], window: int = 12, spacing: int = 4
+) -> F64:
+    """Weighted least-squares cubic B-spline over `window` points on each side.
+
+    Interior knots every `spacing` frames inside each observed window; points near the gap
+    weigh more (Sun et al. 2005, the paper's first baseline). Falls back to :func:`cubic`
+    with fewer than 8 points or a singular fit.
+    """
+    from scipy.interpolate import make_lsq_spline
+
+    t, xy = _window(seg_a, seg_b, window)
+    if len(t) < 8:
+        return cubic(seg_a, seg_b, frames)
+    f0, f1 = seg_a[-1, 0], seg_b[0, 0]
+    # interior knots every `spacing` frames inside each observed window, none inside the gap
+    # (no data there: Schoenberg-Whitney), so one cubic piece spans the gap
+    left = np.arange(f0 - spacing, t[0] + spacing / 2, -spacing)[::-1]
+    right = np.arange(f1 + spacing, t[-1] - spacing / 2, spacing)
+    interior = np.concatenate([left, right])
+    k = 3
+    knots = np.concatenate([[t[0]] * (k + 1), interior, [t[-1]] * (k + 1)])
+    dist = np.where(t <= f0, f0 - t, t - f1)
+    w = 1.0 / (1.0 + dist / 5.0)  # points near the gap count more
+    try:
+        spl = make_lsq_spline(t, xy, knots, k=k, w=w, axis=0)
+    except (ValueError, np.linalg.LinAlgError):
+        return cubic(seg_a, seg_b, frames)
+    return np.asarray(spl(frames), dtype=np.float64)
+
+
+def gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) -> F64:
+    """StrongSORT's Gaussian-smoothed interpolation.
+
+    Linear interpolation, then Gaussian-process regression (RBF kernel, fixed length
+    ``clip(tau log(tau^3 / n), 1/tau, tau^2)`` for a track of ``n`` points) over the whole
+    track; here over the points within 3 length scales of the gap.
+    """
+    t_all = np.concatenate([seg_a[:, 0], frames, seg_b[:, 0]])
+    xy_all = np.vstack([seg_a[:, 1:3], linear(seg_a, seg_b, frames), seg_b[:, 1:3]])
+    n_track = len(t_all)
+    ls = float(np.clip(tau * np.log(tau**3 / n_track), 1.0 / tau, tau**2))
+    keep = (t_all >= frames[0] - 3 * ls - 1) & (t_all <= frames[-1] + 3 * ls + 1)
+    t, xy = t_all[keep], xy_all[keep]
+    K = np.exp(-0.5 * ((t[:, None] - t[None, :]) / ls) ** 2)
+    jitter = 1e-10
+    while True:
+        try:
+            L = np.linalg.cholesky(K + jitter * np.eye(len(t)))
+            break
+        except np.linalg.LinAlgError:
+            jitter *= 10.0
+    alpha = np.linalg.solve(L.T, np.linalg.solve(L, xy))
+    Ks = np.exp(-0.5 * ((frames[:, None] - t[None, :]) / ls) ** 2)
+    return np.asarray(Ks @ alpha, dtype=np.float64)
+
+
+def rts(
+    seg_a: F64,
+    seg_b: F64,
+    frames: NDArray[np.int64],
+    q: float = 0.1,
+    r: float = 1.0,
+    history: int = 30,
+) -> F64:
+    """Kalman filter + RTS smoother over `history` points on each side and the gap.
+
+    Parameters
+    ----------
+    seg_a, seg_b : (k, 3+) ndarray
+        Checked segments.
+    frames : (F,) ndarray of int64
+        Frames to fill.
+    q : float
+        White-noise-acceleration intensity (px²/frame³), both axes.
+    r : float
+        Measurement variance (px²), both axes.
+    history : int
+        Points used on each side.
+
+    Notes
+    -----
+    :func:`pftrack.kalman.rts_smooth` with the continuous discretisation; the first point is
+    both the prior's centre (velocity standard deviation 10 px/frame) and a measurement.
+    """
+    a = seg_a[-history:]
+    b = seg_b[:history]
+    f_first, f_last = int(a[0, 0]), int(b[-1, 0])
+    n = f_last - f_first + 1
+    z = np.full((n, 2), np.nan)
+    z[(a[:, 0] - f_first).astype(int)] = a[:, 1:3]
+    z[(b[:, 0] - f_first).astype(int)] = b[:, 1:3]
+    smoothed = rts_smooth(
+        z,
+        ~np.isnan(z[:, 0]),
+        np.array([q, q]),
+        np.array([r, r]),
+        velocity_sd=10.0,
+        update_first=True,
+    )
+    out: F64 = smoothed[(frames - f_first).astype(int)]
+    return out
+
+
+#: The baselines by method name (read-only).
+BASELINES: Mapping[str, Baseline] = MappingProxyType(
+    {"linear": linear, "cubic": cubic, "bspline": bspline, "gsi": gsi, "rts": rts}
+)

@@ -1,0 +1,157 @@
+"""Noise levels of the constant-velocity / white-noise-acceleration model, from observed points.
+
+The model (:mod:`pftrack.kalman`): each axis moves at constant velocity pushed by continuous
+white-noise acceleration of intensity ``q`` (px²/frame³) and is measured every frame with
+variance ``r`` (px²). :func:`estimate_noise` estimates ``q`` and ``r`` per axis from the runs of
+consecutive frames of observed segments.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+import pftrack._core as _core
+from pftrack._typing import F64
+from pftrack.recovery.segments import consecutive_runs
+
+__all__ = ["DEFAULT_NOISE", "NoiseEstimate", "estimate_noise"]
+
+
+@dataclass(frozen=True)
+class NoiseEstimate:
+    """Noise levels per axis (x, y).
+
+    ``q``: white-noise-acceleration intensity (px²/frame³); ``r``: measurement variance (px²).
+    """
+
+    q: tuple[float, float]
+    r: tuple[float, float]
+
+
+#: Used when the segments are too short to estimate anything.
+DEFAULT_NOISE = NoiseEstimate(q=(0.1, 0.1), r=(1.0, 1.0))
+
+
+def _moments_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseEstimate:
+    # Second differences d_t = z_{t+1} - 2 z_t + z_{t-1} of a continuous white-noise-
+    # acceleration path measured with variance r: var d = 2q/3 + 6r, cov(d_t, d_{t+1}) = q/6 - 4r.
+    c0 = np.zeros(2)
+    c1 = np.zeros(2)
+    n0 = n1 = 0
+    for run in segments:
+        if len(run) < 4:
+            continue
+        d = run[2:, 1:3] - 2.0 * run[1:-1, 1:3] + run[:-2, 1:3]
+        c0 += np.sum(d * d, axis=0)
+        c1 += np.sum(d[1:] * d[:-1], axis=0)
+        n0 += len(d)
+        n1 += len(d) - 1
+    if n1 < 4:
+        return DEFAULT_NOISE
+    c0 /= n0
+    c1 /= n1
+    r = np.maximum((c0 - 4.0 * c1) / 22.0, floor_r)
+    q = np.maximum(1.5 * (c0 - 6.0 * r), floor_q)
+    return NoiseEstimate(q=(float(q[0]), float(q[1])), r=(float(r[0]), float(r[1])))
+
+
+def _loglik_grid(runs: Sequence[F64], axis: int, q: F64, r: F64) -> F64:
+    """Kalman log-likelihood of one axis of every run, for each (q, r) pair (C++)."""
+    z = np.ascontiguousarray(np.concatenate([run[:, 1 + axis] for run in runs]))
+    lengths = np.array([len(run) for run in runs], dtype=np.int32)
+    out: F64 = _core.noise_loglik_grid(z, lengths, np.ascontiguousarray(q), np.ascontiguousarray(r))
+    return out
+
+
+def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseEstimate:
+    qs, rs = [], []
+    for axis in range(2):
+        lq_lo, lq_hi, lr_lo, lr_hi = np.log10(floor_q), 2.0, np.log10(floor_r), 2.0
+        best = (0.0, 0.0)
+        for _ in range(3):  # coarse-to-fine grid on log10 q, log10 r
+            lq, lr = np.meshgrid(np.linspace(lq_lo, lq_hi, 9), np.linspace(lr_lo, lr_hi, 9))
+            q, r = 10.0 ** lq.ravel(), 10.0 ** lr.ravel()
+            i = int(np.argmax(_loglik_grid(segments, axis, q, r)))
+            best = (float(q[i]), float(r[i]))
+            dq, dr = (lq_hi - lq_lo) / 8.0, (lr_hi - lr_lo) / 8.0
+            lq_lo, lq_hi = max(np.log10(q[i]) - dq, np.log10(floor_q)), np.log10(q[i]) + dq
+            lr_lo, lr_hi = max(np.log10(r[i]) - dr, np.log10(floor_r)), np.log10(r[i]) + dr
+        qs.append(best[0])
+        rs.append(best[1])
+    return NoiseEstimate(q=(qs[0], qs[1]), r=(rs[0], rs[1]))
+
+
+def estimate_noise(
+    segments: Sequence[ArrayLike],
+    *,
+    method: str = "ml",
+    floor_q: float = 1e-5,
+    floor_r: float = 1e-3,
+    min_points: int = 4,
+    scales: Sequence[int] = (1, 2, 4, 8),
+) -> NoiseEstimate:
+    """Estimate the motion noise ``q`` and measurement noise ``r`` per axis from observed data.
+
+    The model is a constant-velocity path driven by continuous white-noise acceleration of
+    intensity ``q`` (px²/frame³), observed every frame with variance ``r`` (px²). Segments are
+    split into runs of consecutive frames; runs shorter than `min_points` are ignored.
+
+    Parameters
+    ----------
+    segments : sequence of (k, 3+) array_like
+        Observed rows ``(frame, x, y, ...)``.
+    method : {"ml", "moments"}
+        ``"ml"``: maximum likelihood (Kalman-filter prediction-error likelihood, pooled over all
+        runs, maximised on a coarse-to-fine log grid); ``"moments"``: method of moments on
+        second differences (``r = (c0 - 4 c1) / 22``, ``q = 3 (c0 - 6 r) / 2``).
+    floor_q, floor_r : float
+        Lower bounds of the estimates.
+    min_points : int
+        Shortest run used.
+    scales : sequence of int
+        ``"ml"`` only: the model is fitted to the runs sampled every ``s`` frames for each
+        ``s``; per axis, going from fine to coarse, a scale replaces the current estimate when
+        its ``q`` (in per-frame units, ``q_s / s^3``) is less than half the current one, and
+        its ``r`` comes with it. White acceleration gives the same ``q`` at every scale (within
+        sampling error, hence the factor 2); jitter correlated over a few frames (gait sway,
+        box annotation noise) inflates ``q`` at the finest scales and would make long
+        predictions too wiggly.
+
+    Returns
+    -------
+    NoiseEstimate
+        :data:`DEFAULT_NOISE` when no run is long enough.
+    """
+    if method not in ("ml", "moments"):
+        raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
+    runs = consecutive_runs(segments, max(min_points, 4))
+    if sum(len(r) - 3 for r in runs) < 4:
+        return DEFAULT_NOISE
+    if not scales or any(int(v) < 1 for v in scales):
+        raise ValueError(f"estimate_noise: scales is {scales!r}, expected integers >= 1")
+    if method == "moments":
+        return _moments_noise(runs, floor_q, floor_r)
+    best: list[tuple[float, float]] = []
+    for s in (int(v) for v in scales):
+        sub: list[F64] = []
+        for run in runs:
+            for j in range(s):
+                part = run[j::s]
+                if len(part) >= 4:
+                    sub.append(part)
+        if sum(len(r) - 3 for r in sub) < 4:
+            continue
+        est = _ml_noise(sub, floor_q * s**3, floor_r)
+        for axis in range(2):
+            q = est.q[axis] / s**3  # per s frames -> per frame
+            if len(best) <= axis:
+                best.append((q, est.r[axis]))
+            elif q < 0.5 * best[axis][0]:  # clearly smaller at this scale: correlated jitter
+                best[axis] = (q, est.r[axis])
+    if len(best) < 2:
+        return DEFAULT_NOISE
+    return NoiseEstimate(q=(best[0][0], best[1][0]), r=(best[0][1], best[1][1]))

@@ -1,0 +1,176 @@
+"""The recovery methods by name, and the two entry points that dispatch to them.
+
+Recovering the path of one object across a gap between two observed segments: a *segment* is an
+``(k, 3)`` or ``(k, 5)`` array of rows ``(frame, x, y[, w, h])`` with increasing frames; the gap
+is every frame strictly between the last frame of segment A and the first frame of segment B.
+Time is measured in frames (``dt = 1``).
+
+Methods
+-------
+``"gdt"``
+    Goal-directed tracking exactly as in Oh & Jung (2015)
+    (:func:`~pftrack.recovery.problems.gdt_problem`).
+``"gdt-bi"`` (pftrack's variant)
+    Goal-directed tracking towards the state of a backward Kalman filter over segment B, noise
+    levels estimated from the observed segments
+    (:func:`~pftrack.recovery.problems.gdt_bi_problem`,
+    :func:`~pftrack.recovery.noise.estimate_noise`).
+``"gdt-mix"`` (the default, :data:`DEFAULT_METHOD`)
+    ``gdt-bi`` mixed over "walks through" and "stands still for a while" hypotheses, each
+    weighted by its evidence, with the Singer motion model (correlated acceleration) where the
+    observed points support it; every parameter estimated from the observed points
+    (:mod:`pftrack.recovery.mixture`).
+``"linear"``, ``"cubic"``, ``"bspline"``, ``"gsi"``, ``"rts"``
+    The baselines of :mod:`pftrack.recovery.baselines`.
+
+Box sizes (``w, h``), when given, are interpolated linearly by every method.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pftrack._typing import F64
+from pftrack.recovery.baselines import BASELINES, interpolate_sizes
+from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
+from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.problems import SegmentModel
+from pftrack.recovery.segments import as_segment, gap_frames
+
+__all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS", "recover_gap", "recover_gaps"]
+
+#: Every method, in the order tables list them.
+METHODS = ("gdt", "gdt-bi", "gdt-mix", "linear", "cubic", "bspline", "gsi", "rts")
+#: The goal-directed methods (pftrack's own), solved for all gaps at once.
+GOAL_DIRECTED_METHODS = ("gdt", "gdt-bi", "gdt-mix")
+#: The method of :func:`recover_gap`, :func:`recover_gaps`, ``fill_gaps`` and ``pftrack recover``.
+DEFAULT_METHOD = "gdt-mix"
+
+
+def recover_gap(
+    segment_a: ArrayLike,
+    segment_b: ArrayLike,
+    frames: ArrayLike | None = None,
+    method: str = DEFAULT_METHOD,
+    *,
+    noise: NoiseEstimate | None = None,
+    motion: MotionFit | None = None,
+) -> F64:
+    """Positions (and sizes) of an object in the frames between two observed segments.
+
+    Parameters
+    ----------
+    segment_a, segment_b : (k, 3) or (k, 5) array_like
+        Rows ``(frame, x, y[, w, h])`` before and after the gap, frames increasing.
+    frames : (F,) array_like of int, optional
+        Frames to fill, strictly between the two segments; default: all of them.
+    method : str
+        One of :data:`METHODS` (see the module docstring); default ``"gdt-mix"``.
+    noise : NoiseEstimate, optional
+        For ``"gdt-bi"``: noise levels to use instead of estimating them from the two segments
+        (e.g. pooled over a whole file with :func:`~pftrack.recovery.noise.estimate_noise`).
+    motion : MotionFit, optional
+        For ``"gdt-mix"``: the model to use instead of fitting it to the two segments
+        (e.g. fitted to a whole file with :func:`pftrack.recovery.mixture.fit_motion`).
+
+    Returns
+    -------
+    (F, 2) or (F, 4) ndarray of float64
+        ``(x, y)`` per frame, plus ``(w, h)`` (linear) when both segments carry sizes.
+
+    Raises
+    ------
+    ValueError
+        Empty or malformed segments, NaN, overlapping segments, frames outside the gap or an
+        unknown method.
+    """
+    a = as_segment(segment_a, "segment_a")
+    b = as_segment(segment_b, "segment_b")
+    fr = gap_frames(a, b, frames)
+    if method not in METHODS:
+        raise ValueError(f"recover_gap: method is {method!r}, expected one of {METHODS}")
+    if fr.size == 0:
+        return np.zeros((0, 4 if a.shape[1] == 5 and b.shape[1] == 5 else 2))
+    if method in GOAL_DIRECTED_METHODS:
+        full = recover_gaps([(a, b)], method, noise=noise, motion=motion)[0]
+        xy = full[(fr - a[-1, 0] - 1).astype(int)]
+    else:
+        xy = BASELINES[method](a, b, fr)
+    wh = interpolate_sizes(a, b, fr)
+    return xy if wh is None else np.hstack([xy, wh])
+
+
+def recover_gaps(
+    gaps: Sequence[tuple[ArrayLike, ArrayLike]],
+    method: str = DEFAULT_METHOD,
+    *,
+    noise: NoiseEstimate | None = None,
+    history: int | None = None,
+    motion: MotionFit | None = None,
+) -> list[F64]:
+    """Recover many gaps at once.
+
+    Parameters
+    ----------
+    gaps : sequence of (segment_a, segment_b)
+        Segments as in :func:`recover_gap` (only ``frame, x, y`` are used).
+    method : str
+        One of :data:`METHODS`; default ``"gdt-mix"``.
+    noise : NoiseEstimate, optional
+        For ``"gdt-bi"``: noise levels shared by all gaps; default: estimated from all the
+        segments given (:func:`~pftrack.recovery.noise.estimate_noise`).
+    history : int, optional
+        For ``"gdt"`` and ``"gdt-bi"``: the Kalman filters use at most this many points of the
+        run of consecutive frames next to the gap; default: the whole run.
+    motion : MotionFit, optional
+        For ``"gdt-mix"``: the model shared by all gaps; default: fitted to all the segments
+        given (:func:`pftrack.recovery.mixture.fit_motion`, with `noise` as its fallback).
+
+    Returns
+    -------
+    list of (T_g - 1, 2) ndarray
+        ``(x, y)`` of every frame inside each gap.
+
+    Notes
+    -----
+    ``"gdt"`` and ``"gdt-bi"`` filter the segments and solve every gap in one C++ call with
+    the GIL released (O(T) per gap, :meth:`SegmentModel.recover
+    <pftrack.recovery.problems.SegmentModel.recover>`).
+    """
+    if method not in METHODS:
+        raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
+    if method not in GOAL_DIRECTED_METHODS:
+        return [recover_gap(a, b, method=method, noise=noise)[:, :2] for a, b in gaps]
+    if not gaps:
+        return []
+    seg_a = [np.asarray(a, dtype=np.float64) for a, _ in gaps]
+    seg_b = [np.asarray(b, dtype=np.float64) for _, b in gaps]
+    for k, s in enumerate(seg_a + seg_b):
+        if s.ndim != 2 or s.shape[1] < 3 or s.shape[0] == 0:
+            name = "segment_a" if k < len(gaps) else "segment_b"
+            raise ValueError(
+                f"recover_gaps: {name} of gap {k % len(gaps)} must have shape (k, 3|5), "
+                f"non-empty; got {s.shape}"
+            )
+    if method == "gdt-mix":
+        pairs = [
+            (as_segment(a, "segment_a"), as_segment(b, "segment_b"))
+            for a, b in zip(seg_a, seg_b, strict=True)
+        ]
+        for k, (a, b) in enumerate(pairs):
+            if b[0, 0] <= a[-1, 0]:
+                raise ValueError(
+                    f"recover_gaps: gap {k}: segment_b starts at frame {b[0, 0]:g}, expected "
+                    f"after segment_a's end {a[-1, 0]:g}"
+                )
+        if motion is None:
+            motion = fit_motion(seg_a + seg_b, noise)
+        return recover_mixture_gaps(pairs, motion)
+    if method == "gdt":
+        model = SegmentModel.paper()
+    else:
+        model = SegmentModel.two_sided(estimate_noise(seg_a + seg_b) if noise is None else noise)
+    return model.recover(seg_a, seg_b, history)

@@ -1,0 +1,101 @@
+"""Observed segments of a trajectory: checking them and cutting them into runs.
+
+A *segment* is a ``(k, 3)`` or ``(k, 5)`` array of rows ``(frame, x, y[, w, h])`` with
+increasing frames. A gap lies between two segments: every frame strictly between the last frame
+of segment A and the first frame of segment B. Time is measured in frames.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pftrack._typing import F64
+
+__all__ = ["as_segment", "consecutive_runs", "contiguous_head", "contiguous_tail", "gap_frames"]
+
+
+def as_segment(seg: ArrayLike, name: str) -> F64:
+    """Check and convert one segment to a C-contiguous ``(k, 3|5)`` float64 array.
+
+    Parameters
+    ----------
+    seg : (k, 3) or (k, 5) array_like
+        Rows ``(frame, x, y[, w, h])``.
+    name : str
+        How error messages name the segment (``"segment_a"``, ...).
+
+    Returns
+    -------
+    (k, 3) or (k, 5) ndarray of float64
+
+    Raises
+    ------
+    ValueError
+        Wrong shape, no row, a non-finite value or frames that do not increase strictly.
+    """
+    a = np.asarray(seg, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] not in (3, 5):
+        raise ValueError(f"recover_gap: {name} must have shape (k, 3) or (k, 5), got {a.shape}")
+    if a.shape[0] == 0:
+        raise ValueError(f"recover_gap: {name} is empty")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"recover_gap: {name} has a non-finite value")
+    if np.any(np.diff(a[:, 0]) <= 0):
+        raise ValueError(f"recover_gap: {name} frames must increase strictly")
+    return np.ascontiguousarray(a)
+
+
+def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.int64]:
+    """Frames to fill between two checked segments (default: every frame of the gap).
+
+    Raises
+    ------
+    ValueError
+        Segment B does not start after segment A ends, or `frames` is not 1-D integers strictly
+        inside the gap.
+    """
+    f0, f1 = int(seg_a[-1, 0]), int(seg_b[0, 0])
+    if f1 <= f0:
+        raise ValueError(
+            f"recover_gap: segment_b starts at frame {f1}, expected after segment_a's end {f0}"
+        )
+    if frames is None:
+        return np.arange(f0 + 1, f1, dtype=np.int64)
+    fr = np.asarray(frames)
+    if fr.ndim != 1 or (fr.size and not np.all(fr == np.round(fr))):
+        raise ValueError("recover_gap: frames must be a 1-D array of integers")
+    fr = fr.astype(np.int64)
+    if fr.size and (fr.min() <= f0 or fr.max() >= f1):
+        raise ValueError(f"recover_gap: frames must lie strictly between {f0} and {f1}")
+    return fr
+
+
+def consecutive_runs(segments: Sequence[ArrayLike], min_points: int) -> list[F64]:
+    """Split segments (rows ``(frame, x, y, ...)``) into runs of consecutive frames.
+
+    Runs shorter than `min_points` and malformed or empty segments are skipped.
+    """
+    runs: list[F64] = []
+    for s in segments:
+        a = np.asarray(s, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
+            continue
+        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
+            if len(run) >= min_points:
+                runs.append(run)
+    return runs
+
+
+def contiguous_tail(seg: F64) -> F64:
+    """The last run of consecutive frames of a segment (Kalman filters step one frame at a time)."""
+    br = np.flatnonzero(np.diff(seg[:, 0]) != 1)
+    return seg[br[-1] + 1 :] if len(br) else seg
+
+
+def contiguous_head(seg: F64) -> F64:
+    """The first run of consecutive frames of a segment."""
+    br = np.flatnonzero(np.diff(seg[:, 0]) != 1)
+    return seg[: br[0] + 1] if len(br) else seg
