@@ -6,7 +6,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-DATA = Path(os.environ.get("PFTRACK_DATA", Path(__file__).resolve().parents[1].parent / "shared" / "data"))
+DATA = Path(
+    os.environ.get("PFTRACK_DATA", Path(__file__).resolve().parents[1].parent / "shared" / "data")
+)
 
 
 def dataset(name: str) -> Path:

@@ -10,9 +10,8 @@ from pftrack.eval import evaluate_mot, format_metrics
 from pftrack.io.mot import write_mot
 from pftrack.recovery.demo import demo_report
 from pftrack.render import plot_trajectories, write_annotated_video
-from pftrack.run import track_frames
 from pftrack.synthetic import make_scene
-from pftrack.tracker import TrackerConfig
+from pftrack.tracking import TrackerConfig, track_frames
 
 __all__ = ["run_demo"]
 

@@ -9,20 +9,18 @@ mild per-frame sensor noise. Ground truth is a MOTChallenge array of the walkers
 from __future__ import annotations
 
 import dataclasses
-import os
 from pathlib import Path
-from typing import Union
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
 
 __all__ = ["Scene", "Walker", "make_scene"]
 
-PathLike = Union[str, "os.PathLike[str]"]
 
 # Clothing colours (BGR), far apart in hue so colour histograms can tell walkers apart.
 _SHIRTS = [
@@ -180,8 +178,13 @@ def _background(width: int, height: int, rng: np.random.Generator) -> NDArray[np
 
 
 def _sprite(
-    width: int, height: int, shirt: tuple[int, int, int], trousers: tuple[int, int, int],
-    skin: tuple[int, int, int], phase: int, rng: np.random.Generator,
+    width: int,
+    height: int,
+    shirt: tuple[int, int, int],
+    trousers: tuple[int, int, int],
+    skin: tuple[int, int, int],
+    phase: int,
+    rng: np.random.Generator,
 ) -> tuple[NDArray[np.uint8], NDArray[np.bool_]]:
     """Draw a walker: (height, width) BGR image and mask of head, torso and legs in a stride."""
     img = np.zeros((height, width, 3), np.uint8)
@@ -212,9 +215,18 @@ def _sprite(
 
 
 def _path(
-    rng: np.random.Generator, width: int, height: int, w: int, h: int, n_frames: int,
-    *, left_to_right: bool, start_inside: bool, y_band: tuple[float, float],
-    start_frame: int, speed_range: tuple[float, float],
+    rng: np.random.Generator,
+    width: int,
+    height: int,
+    w: int,
+    h: int,
+    n_frames: int,
+    *,
+    left_to_right: bool,
+    start_inside: bool,
+    y_band: tuple[float, float],
+    start_frame: int,
+    speed_range: tuple[float, float],
 ) -> tuple[int, NDArray[np.float64]]:
     """Quadratic Bézier from one side border to the other, walked at `speed_range` px a frame."""
     y0 = rng.uniform(*y_band) * height
@@ -311,9 +323,19 @@ def make_scene(
             start = int(gen.integers(1, max(2, n_frames * 2 // 3)))
             ltr, inside, band = bool(gen.integers(2)), False, (0.35, 0.75)
         speeds = (4.0, 5.0) if k == 0 else (2.5, 4.5)  # walker 1 leaves within ~100 frames
-        first, centres = _path(gen, width, height, w, h, n_frames, left_to_right=ltr,
-                               start_inside=inside, y_band=band, start_frame=start,
-                               speed_range=speeds)
+        first, centres = _path(
+            gen,
+            width,
+            height,
+            w,
+            h,
+            n_frames,
+            left_to_right=ltr,
+            start_inside=inside,
+            y_band=band,
+            start_frame=start,
+            speed_range=speeds,
+        )
         shirt = _SHIRTS[int(shirt_order[k % len(_SHIRTS)])]
         trousers = _TROUSERS[int(gen.integers(len(_TROUSERS)))]
         skin = _SKIN[int(gen.integers(len(_SKIN)))]

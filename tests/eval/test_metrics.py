@@ -6,6 +6,7 @@ import warnings
 
 import numpy as np
 import pytest
+
 from pftrack.cli import main
 from pftrack.eval import MotMetrics, evaluate_mot, format_metrics, iou_xywh
 from pftrack.io.mot import write_mot
@@ -153,8 +154,17 @@ def test_cli_eval(tmp_path, capsys):
     write_mot(tmp_path / "gt.txt", HAND_GT)
     write_mot(tmp_path / "res.txt", HAND_RES)
     out = tmp_path / "m.json"
-    code = main(["eval", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt"),
-                 "--json", str(out)])
+    code = main(
+        [
+            "eval",
+            "--gt",
+            str(tmp_path / "gt.txt"),
+            "--res",
+            str(tmp_path / "res.txt"),
+            "--json",
+            str(out),
+        ]
+    )
     assert code == 0
     assert "21.4" in capsys.readouterr().out  # MOTA 3/14 in percent
     assert json.loads(out.read_text())["num_switches"] == 1
@@ -193,8 +203,15 @@ def random_case(seed):
             res.append((f, hid, bx + jitter[0], by + jitter[1], w + jitter[2], h + jitter[3]))
     for f in range(1, n_frames + 1):  # clutter near the walkers
         for _ in range(int(rng.integers(0, 3))):
-            res.append((f, int(rng.integers(100, next_hid + 3)), *rng.uniform(0, 150, 2),
-                        rng.uniform(15, 30), rng.uniform(30, 60)))
+            res.append(
+                (
+                    f,
+                    int(rng.integers(100, next_hid + 3)),
+                    *rng.uniform(0, 150, 2),
+                    rng.uniform(15, 30),
+                    rng.uniform(30, 60),
+                )
+            )
     # Swap two result ids over a stretch, to create identity switches.
     res_a = rows(*res)
     ids = np.unique(res_a[:, 1])
@@ -219,9 +236,20 @@ def motmetrics_summary(gt, res, thr=0.5):
             d = 1.0 - iou_loop(g[:, 2:6], r[:, 2:6])
             d = np.where(d > 1.0 - thr, np.nan, d)
             acc.update(g[:, 1].astype(int).tolist(), r[:, 1].astype(int).tolist(), d, frameid=f)
-        names = ["mota", "motp", "idf1", "idp", "idr", "num_switches", "num_fragmentations",
-                 "mostly_tracked", "partially_tracked", "mostly_lost", "num_false_positives",
-                 "num_misses"]
+        names = [
+            "mota",
+            "motp",
+            "idf1",
+            "idp",
+            "idr",
+            "num_switches",
+            "num_fragmentations",
+            "mostly_tracked",
+            "partially_tracked",
+            "mostly_lost",
+            "num_false_positives",
+            "num_misses",
+        ]
         s = mm.metrics.create().compute(acc, metrics=names, name="x")
         return {k: float(s[k].iloc[0]) for k in names}
 

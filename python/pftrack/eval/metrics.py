@@ -9,12 +9,13 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
+from pftrack.boxes import iou_xywh
 from pftrack.io.mot import CONF, FRAME, ID, LEFT
 
 __all__ = ["MotMetrics", "evaluate_mot", "format_metrics", "iou_xywh"]
@@ -22,36 +23,6 @@ __all__ = ["MotMetrics", "evaluate_mot", "format_metrics", "iou_xywh"]
 # Cost of a forbidden pair in the per-frame assignment: larger than any sum of admissible
 # costs (each is at most 1), so the solver first maximises the number of admissible pairs.
 _FORBIDDEN = 1e6
-
-
-def iou_xywh(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
-    """Intersection over union of every box of `a` with every box of `b`.
-
-    Parameters
-    ----------
-    a : (n, 4) array_like of float
-        Boxes ``left, top, width, height``.
-    b : (m, 4) array_like of float
-        Boxes ``left, top, width, height``.
-
-    Returns
-    -------
-    (n, m) ndarray of float64
-        IoU in [0, 1]; 0 where the union is empty.
-    """
-    a = np.asarray(a, dtype=np.float64).reshape(-1, 4)
-    b = np.asarray(b, dtype=np.float64).reshape(-1, 4)
-    ax0, ay0 = a[:, 0:1], a[:, 1:2]
-    ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
-    bx0, by0 = b[:, 0], b[:, 1]
-    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
-    iw = np.clip(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0, None)
-    ih = np.clip(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0, None)
-    inter = iw * ih
-    union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = np.where(union > 0, inter / union, 0.0)
-    return np.asarray(out, dtype=np.float64)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -175,7 +146,7 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
     success rates; counts for the rest.
     """
     rows = {"result": m} if isinstance(m, MotMetrics) else dict(m)
-    cols = [
+    cols: list[tuple[str, Callable[[MotMetrics], str]]] = [
         ("MOTA", lambda r: _pct(r.mota)),
         ("MOTP(IoU)", lambda r: _pct(r.motp_iou)),
         ("IDF1", lambda r: _pct(r.idf1)),
@@ -193,16 +164,28 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
         ("ML", lambda r: str(r.mostly_lost)),
         ("Succ", lambda r: _pct(r.success_rate)),
         ("Succ@IoU", lambda r: _pct(r.success_rate_strict)),
-        ("CD(px)", lambda r: "nan" if not math.isfinite(r.centroid_distance_px)
-         else f"{r.centroid_distance_px:.1f}"),
-        ("CD/px", lambda r: "nan" if not math.isfinite(r.centroid_distance_ratio)
-         else f"{r.centroid_distance_ratio:.2e}"),
+        (
+            "CD(px)",
+            lambda r: (
+                "nan"
+                if not math.isfinite(r.centroid_distance_px)
+                else f"{r.centroid_distance_px:.1f}"
+            ),
+        ),
+        (
+            "CD/px",
+            lambda r: (
+                "nan"
+                if not math.isfinite(r.centroid_distance_ratio)
+                else f"{r.centroid_distance_ratio:.2e}"
+            ),
+        ),
     ]
     header = ["name"] + [c for c, _ in cols]
     body = [[name] + [fn(r) for _, fn in cols] for name, r in rows.items()]
     widths = [max(len(str(x[i])) for x in [header] + body) for i in range(len(header))]
-    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths))]
-    lines += ["  ".join(v.rjust(w) for v, w in zip(row, widths)) for row in body]
+    lines = ["  ".join(h.rjust(w) for h, w in zip(header, widths, strict=True))]
+    lines += ["  ".join(v.rjust(w) for v, w in zip(row, widths, strict=True)) for row in body]
     first = next(iter(rows.values()))
     lines.append(
         f"(IoU threshold {first.iou_threshold:g}; MOTP = mean IoU of matches; "
@@ -233,7 +216,7 @@ def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
     r = rows[order]
     frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
     ends = list(starts[1:]) + [len(r)]
-    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends)}
+    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}
 
 
 def _assign(cost: NDArray[np.float64]) -> list[tuple[int, int]]:
@@ -241,7 +224,7 @@ def _assign(cost: NDArray[np.float64]) -> list[tuple[int, int]]:
     if cost.size == 0:
         return []
     r, c = linear_sum_assignment(cost)
-    return [(int(i), int(j)) for i, j in zip(r, c) if cost[i, j] < _FORBIDDEN]
+    return [(int(i), int(j)) for i, j in zip(r, c, strict=True) if cost[i, j] < _FORBIDDEN]
 
 
 def evaluate_mot(

@@ -7,13 +7,15 @@ import os
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Union
+from typing import IO, Any
 
-PathLike = Union[str, "os.PathLike[str]"]
+from pftrack._typing import PathLike
 
 
 @contextlib.contextmanager
-def atomic_write(path: PathLike, mode: str = "w", *, suffix: str | None = None) -> Iterator[IO]:
+def atomic_write(
+    path: PathLike, mode: str = "w", *, suffix: str | None = None
+) -> Iterator[IO[Any]]:
     """Open a temporary file beside `path`; on success it replaces `path` atomically.
 
     If the block raises, the temporary file is removed and `path` is left exactly as it was,
@@ -32,9 +34,7 @@ def atomic_write(path: PathLike, mode: str = "w", *, suffix: str | None = None) 
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"output folder does not exist: {folder}")
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{target.name}.", suffix=suffix or ".tmp", dir=folder
-    )
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or ".tmp", dir=folder)
     try:
         with os.fdopen(fd, mode) as fh:
             yield fh

@@ -6,17 +6,14 @@ files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``) and alw
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import Union
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_write
-
-PathLike = Union[str, "os.PathLike[str]"]
 
 #: Column indices of a MOTChallenge row.
 FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
@@ -81,7 +78,8 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         frame = values[FRAME]
         if frame < 1 or frame != int(frame):
             raise ValueError(
-                f"{p}:{lineno}: frame is {fields[0]}, expected an integer >= 1 (frames count from 1)"
+                f"{p}:{lineno}: frame is {fields[0]}, expected an integer >= 1 "
+                "(frames count from 1)"
             )
         if values[WIDTH] < 0 or values[HEIGHT] < 0:
             raise ValueError(f"{p}:{lineno}: negative box width or height: {text[:80]!r}")
@@ -121,11 +119,6 @@ def write_mot(path: PathLike, rows: NDArray[np.float64] | Iterable[Iterable[floa
             fh.write(format_mot_row(r) + "\n")
 
 
-def boxes_of_frame(rows: NDArray[np.float64], frame: int) -> NDArray[np.float64]:
-    """Rows of one frame (rows must be sorted by frame for speed; any order works)."""
-    return rows[rows[:, FRAME] == frame]
-
-
 def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
     """Split rows by frame number: ``{frame: (k, 10) rows}``."""
     if len(rows) == 0:
@@ -134,4 +127,4 @@ def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
     r = rows[order]
     frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
     ends = list(starts[1:]) + [len(r)]
-    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends)}
+    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}

@@ -2,16 +2,16 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Union
+from typing import Any
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-PathLike = Union[str, "os.PathLike[str]"]
+from pftrack._typing import PathLike
+
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
 
 
@@ -67,11 +67,11 @@ class FrameSource:
         first = self._resize(first)
         self.height, self.width = int(first.shape[0]), int(first.shape[1])
 
-    def _resize(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
-        if self.scale == 1.0:
-            return frame
-        size = (round(frame.shape[1] * self.scale), round(frame.shape[0] * self.scale))
-        return cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR)
+    def _resize(self, frame: NDArray[Any]) -> NDArray[np.uint8]:
+        if self.scale != 1.0:
+            size = (round(frame.shape[1] * self.scale), round(frame.shape[0] * self.scale))
+            frame = cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR)
+        return np.asarray(frame, dtype=np.uint8)  # OpenCV's colour reads are uint8: no copy
 
     def __len__(self) -> int:
         return self.n_frames

@@ -1,0 +1,92 @@
+"""Argument types and option groups shared by several sub-commands."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from pftrack.tracking import TrackerConfig
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Show every option's default and keep the examples' line breaks."""
+
+
+def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
+    """Add sub-command `name` to `sub` with the package's help formatter."""
+    parser: argparse.ArgumentParser = sub.add_parser(name, formatter_class=HelpFormatter, **kwargs)
+    return parser
+
+
+def positive_int(text: str) -> int:
+    """Argument type: an integer >= 1."""
+    v = int(text)
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {v}")
+    return v
+
+
+def positive_float(text: str) -> float:
+    """Argument type: a finite number > 0."""
+    v = float(text)
+    if not 0 < v < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {v}")
+    return v
+
+
+def add_tracker_options(p: argparse.ArgumentParser) -> None:
+    """The tracker's options, shared by ``track`` (and any command that tracks)."""
+    p.add_argument("--particles", type=positive_int, default=100, metavar="N",
+                   help="particles per object")  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="random seed: same seed, same tracks")
+    p.add_argument(
+        "--detector", choices=("paper", "mog2", "knn"), default="paper",
+        help="built-in detector: the paper's adaptive background (C++), or OpenCV's MOG2/KNN",
+    )  # fmt: skip
+    p.add_argument(
+        "--sampler", choices=("sis", "mh", "rjmcmc"), default="sis",
+        help="sis: one sequential-importance-sampling filter per object (the paper's method); "
+        "mh: Metropolis-Hastings per object; rjmcmc: one joint RJ-MCMC chain over all objects "
+        "(Smith et al. 2005)",
+    )  # fmt: skip
+    p.add_argument(
+        "--dynamics", choices=("ar2", "ar2-mean"), default="ar2",
+        help="AR(2) model per particle (eq. 7) or from the particle-set means (eq. 8)",
+    )  # fmt: skip
+    p.add_argument("--max-coast", type=int, default=10, metavar="FRAMES",
+                   help="frames a track survives on its particle filter alone")  # fmt: skip
+    p.add_argument(
+        "--fill", choices=("linear", "pf"), default="linear",
+        help="with --no-smooth, boxes of a gap the filter bridged: interpolated, or the "
+        "filter's own",
+    )  # fmt: skip
+    p.add_argument(
+        "--no-smooth", action="store_true",
+        help="write each frame's box as the tracker reported it online, instead of smoothing "
+        "every track over the whole run (RTS smoother; bridged gaps are the smoother's "
+        "interpolation)",
+    )  # fmt: skip
+    p.add_argument(
+        "--no-link", action="store_true",
+        help="keep fragments of one object under separate ids, instead of joining them by "
+        "motion and size across gaps of up to 30 frames",
+    )  # fmt: skip
+
+
+def tracker_config(args: argparse.Namespace) -> TrackerConfig:
+    """The :class:`~pftrack.tracking.TrackerConfig` that :func:`add_tracker_options` describes."""
+    from dataclasses import replace
+
+    from pftrack.tracking import TrackerConfig
+
+    base = TrackerConfig()
+    model = replace(base.filter.model, use_means=args.dynamics == "ar2-mean")
+    filt = replace(base.filter, n_particles=args.particles, model=model)
+    return replace(
+        base,
+        filter=filt,
+        detector=args.detector,
+        sampler=args.sampler,
+        lifecycle=replace(base.lifecycle, max_coast=args.max_coast),
+    )
