@@ -1,19 +1,40 @@
+"""Shared fixtures of the benchmarks: where the data is, and PETS09-S2L1 frames.
+
+The data folder is the experiments' (:func:`experiments._common.data_root`: ``$PFTRACK_DATA``
+or ``../shared/data``); a benchmark that needs a real sequence skips when it is absent, the
+frame fixtures fall back to synthetic frames.
+"""
+
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
+from numpy.typing import NDArray
 
-ROOT = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("PFTRACK_DATA", ROOT.parent / "shared" / "data"))
+from experiments._common import data_root
 
 
-def pets_frame(size: tuple[int, int]) -> np.ndarray:
+@pytest.fixture(scope="session")
+def data_dir() -> Path:
+    """The folder holding ``pets09-s2l1/`` and ``tud-campus/`` (it may not exist)."""
+    return data_root()
+
+
+@pytest.fixture(scope="session")
+def pets_dir(data_dir: Path) -> Path:
+    """The PETS09-S2L1 folder; skips the benchmark when it is absent."""
+    folder = data_dir / "pets09-s2l1"
+    if not folder.is_dir():
+        pytest.skip(f"PETS09-S2L1 not found at {folder}")
+    return folder
+
+
+def pets_frame(data: Path, size: tuple[int, int]) -> NDArray[np.uint8]:
     """Frame 100 of PETS09-S2L1 resized to `size` (W, H), or a synthetic textured frame."""
-    video = DATA / "pets09-s2l1" / "video.avi"
+    video = data / "pets09-s2l1" / "video.avi"
     frame = None
     if video.is_file():
         cap = cv2.VideoCapture(str(video))
@@ -24,14 +45,14 @@ def pets_frame(size: tuple[int, int]) -> np.ndarray:
     if frame is None:
         rng = np.random.default_rng(0)
         frame = rng.integers(0, 256, (360, 480, 3), dtype=np.uint8)
-    return cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR)
+    return np.asarray(cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR), dtype=np.uint8)
 
 
 @pytest.fixture(scope="session")
-def frame_480() -> np.ndarray:
-    return pets_frame((480, 360))
+def frame_480(data_dir: Path) -> NDArray[np.uint8]:
+    return pets_frame(data_dir, (480, 360))
 
 
 @pytest.fixture(scope="session")
-def frame_720() -> np.ndarray:
-    return pets_frame((1280, 720))
+def frame_720(data_dir: Path) -> NDArray[np.uint8]:
+    return pets_frame(data_dir, (1280, 720))

@@ -7,18 +7,23 @@ Locally: ``pytest bench/test_bridge.py --benchmark-only``; CI: ``--benchmark-dis
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
-from pftrack import _core
-from pftrack.recovery import constant_velocity_A
-from pftrack.recovery import experiment as E
-from pftrack.recovery.methods import recover_gaps
+from pytest_benchmark.fixture import BenchmarkFixture
 
+from pftrack import _core
+from pftrack._typing import F64
+from pftrack.io.mot import read_mot
+from pftrack.kalman import cv_transition_xy
+from pftrack.recovery import estimate_noise, fit_motion, recover_gaps
+from pftrack.recovery import experiment as E
+from pftrack.recovery.mixture import singer_model, stand_hypotheses
 from tests.reference import bridge as ref
 from tests.reference import mixture as ref_mix
 
-A = constant_velocity_A(1.0)
+A = cv_transition_xy(1.0)
 Q = np.diag([1e-6, 1e-6, 1e-4, 1e-4])
 H = np.hstack([np.eye(2), np.zeros((2, 2))])
 R = 1e-6 * np.eye(2)
@@ -27,18 +32,18 @@ P0 = 1e-3 * np.eye(4)
 SIZES = [10, 100, 1000, 10000]
 
 
-def goal(T):
+def goal(T: int) -> F64:
     return np.array([1.0 * T, 0.5 * T + 3.0])
 
 
 @pytest.mark.parametrize("T", SIZES)
-def test_core(benchmark, T):
+def test_core(benchmark: BenchmarkFixture, T: int) -> None:
     benchmark.group = f"gdt path T={T}"
     benchmark(_core.gdt_solve, A, Q, H, R, M0, P0, goal(T), T, "general", True)
 
 
 @pytest.mark.parametrize("T", SIZES)
-def test_numpy_reference(benchmark, T):
+def test_numpy_reference(benchmark: BenchmarkFixture, T: int) -> None:
     benchmark.group = f"gdt path T={T}"
     if T == 10000:
         benchmark.pedantic(
@@ -48,37 +53,34 @@ def test_numpy_reference(benchmark, T):
         benchmark(ref.gdt_numpy_fast, A, Q, H, R, M0, P0, goal(T), T)
 
 
-def _pets_gaps():
-    root = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "pets09-s2l1" / "gt.txt"
-    if not root.is_file():
+@pytest.fixture(scope="module")
+def pets_gaps(pets_dir: Path) -> list[tuple[F64, F64]]:
+    """(segment before, segment after) of the 23 gaps of the PETS mask at (396, 224)."""
+    gt = pets_dir / "gt.txt"
+    if not gt.is_file():
         pytest.skip("PETS09-S2L1 ground truth not available")
-    from pftrack.io.mot import read_mot
-
-    trajs = E.trajectories(read_mot(root))
+    trajs = E.trajectories(read_mot(gt))
     gaps, _ = E.find_gaps(trajs, (396, 224, 100, 100))
     return [(g.segment_a, g.segment_b) for g in gaps]
 
 
 @pytest.mark.benchmark(group="PETS mask 396,224: all 23 gaps")
 @pytest.mark.parametrize("method", ["gdt", "gdt-bi", "gdt-mix", "linear", "cubic", "bspline"])
-def test_pets_all_gaps(benchmark, method):
-    pairs = _pets_gaps()
+def test_pets_all_gaps(
+    benchmark: BenchmarkFixture, pets_gaps: list[tuple[F64, F64]], method: str
+) -> None:
+    pairs = pets_gaps
     noise = motion = None
     if method in ("gdt-bi", "gdt-mix"):
-        from pftrack.recovery import estimate_noise
-        from pftrack.recovery.mixture import fit_motion
-
         segments = [p for pair in pairs for p in pair]
         noise = estimate_noise(segments)
         motion = fit_motion(segments, noise) if method == "gdt-mix" else None
     benchmark(recover_gaps, pairs, method, noise=noise, motion=motion)
 
 
-def _mixture_problem(T: int):
+def _mixture_problem(T: int) -> tuple[Any, ...]:
     """A walking window (30 points each side) with a gap of T steps and every stand hypothesis
     of gdt-mix (191 for T >= 20), Singer model as fitted on PETS."""
-    from pftrack.recovery.mixture import singer_model, stand_hypotheses
-
     rng = np.random.default_rng(0)
     n = 60 + T
     z = np.cumsum(rng.normal(3.0, 0.3, n))
@@ -89,13 +91,13 @@ def _mixture_problem(T: int):
 
 
 @pytest.mark.parametrize("T", [10, 40, 160])
-def test_gap_mixture_core(benchmark, T):
+def test_gap_mixture_core(benchmark: BenchmarkFixture, T: int) -> None:
     benchmark.group = f"gdt-mix one gap, one axis, T={T}"
     benchmark(_core.gap_mixture, *_mixture_problem(T))
 
 
 @pytest.mark.parametrize("T", [10, 40, 160])
-def test_gap_mixture_numpy(benchmark, T):
+def test_gap_mixture_numpy(benchmark: BenchmarkFixture, T: int) -> None:
     benchmark.group = f"gdt-mix one gap, one axis, T={T}"
     benchmark.pedantic(
         ref_mix.gap_mixture_vectorised, args=_mixture_problem(T), rounds=3, iterations=1

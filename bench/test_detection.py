@@ -6,58 +6,65 @@ pytest bench/test_detection.py --benchmark-only --benchmark-group-by=group
 from __future__ import annotations
 
 import itertools
-import os
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
 import pytest
+from numpy.typing import NDArray
+from pytest_benchmark.fixture import BenchmarkFixture
 
-from pftrack import _core  # noqa: E402
-from pftrack.detection import make_detector  # noqa: E402
+from pftrack import _core
+from pftrack.detection import make_detector
 from tests.reference.detection import BackgroundReference
 
 SIZES = {"480x360": (480, 360), "768x576": (768, 576)}
 N_FRAMES = 60
 
+Frame = NDArray[np.uint8]
+Frames = tuple[str, list[Frame]]  # (size name, frames)
 
-def load_frames(size: tuple[int, int]) -> list[np.ndarray]:
+
+def load_frames(data: Path, size: tuple[int, int]) -> list[Frame]:
     """60 PETS09-S2L1 frames resized to `size`, or synthetic ones without the data."""
-    root = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
-    video = Path(os.environ.get("PFTRACK_DATA", root)) / "pets09-s2l1" / "video.avi"
-    frames = []
+    video = data / "pets09-s2l1" / "video.avi"
+    frames: list[Frame] = []
     if video.is_file():
         cap = cv2.VideoCapture(str(video))
         while len(frames) < N_FRAMES:
             ok, f = cap.read()
             if not ok:
                 break
-            frames.append(
-                cv2.resize(f, size, interpolation=cv2.INTER_LINEAR) if f.shape[1::-1] != size else f
-            )
+            if f.shape[1::-1] != size:
+                f = cv2.resize(f, size, interpolation=cv2.INTER_LINEAR)
+            frames.append(np.asarray(f, dtype=np.uint8))
         cap.release()
     if len(frames) < N_FRAMES:
         rng = np.random.default_rng(0)
-        bg = cv2.resize(rng.integers(0, 256, (size[1] // 8, size[0] // 8, 3), dtype=np.uint8), size)
+        small = rng.integers(0, 256, (size[1] // 8, size[0] // 8, 3), dtype=np.uint8)
+        bg = np.asarray(cv2.resize(small, size), dtype=np.uint8)
         frames = []
         for k in range(N_FRAMES):
-            f = bg.copy()
-            f[100:180, 10 + 6 * k : 40 + 6 * k] = (40, 60, 200)
-            frames.append(f)
+            frame = bg.copy()
+            frame[100:180, 10 + 6 * k : 40 + 6 * k] = (40, 60, 200)
+            frames.append(frame)
     return frames
 
 
 @pytest.fixture(scope="module", params=list(SIZES))
-def frames(request):
-    return request.param, load_frames(SIZES[request.param])
+def frames(request: pytest.FixtureRequest, data_dir: Path) -> Frames:
+    return request.param, load_frames(data_dir, SIZES[request.param])
 
 
-def cycle_apply(fn, frames):
+def cycle_apply(fn: Callable[[Frame], Any], frames: list[Frame]) -> Callable[[], Any]:
+    """A no-argument call of `fn` on the next frame, round and round (what is timed)."""
     it = itertools.cycle(frames)
     return lambda: fn(next(it))
 
 
-def test_core_background_pass(benchmark, frames):
+def test_core_background_pass(benchmark: BenchmarkFixture, frames: Frames) -> None:
     name, fr = frames
     benchmark.group = f"per-pixel pass {name}"
     m = _core.BackgroundModel()
@@ -66,7 +73,7 @@ def test_core_background_pass(benchmark, frames):
 
 
 @pytest.fixture(params=[1, 0], ids=["1 thread", "cv2 threads"])
-def cv2_threads(request):
+def cv2_threads(request: pytest.FixtureRequest) -> Iterator[int]:
     """OpenCV on one thread (like the C++ pass) or on its default pool."""
     before = cv2.getNumThreads()
     cv2.setNumThreads(request.param if request.param else -1)
@@ -74,7 +81,7 @@ def cv2_threads(request):
     cv2.setNumThreads(before)
 
 
-def test_opencv_mog2_apply(benchmark, frames, cv2_threads):
+def test_opencv_mog2_apply(benchmark: BenchmarkFixture, frames: Frames, cv2_threads: int) -> None:
     name, fr = frames
     benchmark.group = f"per-pixel pass {name}"
     sub = cv2.createBackgroundSubtractorMOG2(detectShadows=True)
@@ -83,7 +90,7 @@ def test_opencv_mog2_apply(benchmark, frames, cv2_threads):
     benchmark(cycle_apply(sub.apply, fr))
 
 
-def test_numpy_reference(benchmark, frames):
+def test_numpy_reference(benchmark: BenchmarkFixture, frames: Frames) -> None:
     name, fr = frames
     benchmark.group = f"per-pixel pass {name}"
     ref = BackgroundReference()
@@ -92,7 +99,7 @@ def test_numpy_reference(benchmark, frames):
 
 
 @pytest.mark.parametrize("detector", ["paper", "mog2", "knn"])
-def test_whole_detector(benchmark, frames, detector):
+def test_whole_detector(benchmark: BenchmarkFixture, frames: Frames, detector: str) -> None:
     name, fr = frames
     benchmark.group = f"whole detect() {name}"
     det = make_detector(detector)

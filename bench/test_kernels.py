@@ -7,13 +7,26 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from numpy.typing import NDArray
+from pytest_benchmark.fixture import BenchmarkFixture
 
-from tests.reference import fused as npb
 from pftrack import _core
-from pftrack.particle_filter import box_histograms, hsv_bins
+from pftrack._typing import F64
+from pftrack.particle_filter import BinnedImage, box_histograms, hsv_bins
+from tests.reference import fused as npb
+
+Case = tuple[str, BinnedImage, F64, F64, int]  # name, binned frame, boxes, reference, pixels
 
 
-def _boxes(rng, n_objects, n_particles, w, h, frame_shape):
+def _boxes(
+    rng: np.random.Generator,
+    n_objects: int,
+    n_particles: int,
+    w: int,
+    h: int,
+    frame_shape: tuple[int, ...],
+) -> F64:
+    """`n_particles` boxes (cx, cy, w, h) jittered around each of `n_objects` random centres."""
     rows, cols = frame_shape[:2]
     centres = rng.uniform([w, h], [cols - w, rows - h], (n_objects, 2))
     out = []
@@ -34,7 +47,7 @@ CASES = {
 
 
 @pytest.fixture(params=list(CASES), scope="module")
-def case(request):
+def case(request: pytest.FixtureRequest) -> Case:
     name = request.param
     fixture, n_obj, n_part, w, h = CASES[name]
     frame = request.getfixturevalue(fixture)
@@ -45,19 +58,21 @@ def case(request):
     return name, image, boxes, ref, n_part * n_obj * w * h
 
 
-def _core_hist_weights(image, boxes, ref):
+def _core_hist_weights(image: BinnedImage, boxes: F64, ref: F64) -> F64:
     return _core.bhattacharyya_weights(_core.box_histograms(image, boxes, "uniform"), ref, 20.0)
 
 
-def test_histograms_weights_core(benchmark, case):
+def test_histograms_weights_core(benchmark: BenchmarkFixture, case: Case) -> None:
     name, image, boxes, ref, pixels = case
     benchmark.group = f"histograms+weights {name}"
     benchmark.extra_info["pixels"] = pixels
     w = benchmark(_core_hist_weights, image, boxes, ref)
-    np.testing.assert_allclose(w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300)
+    np.testing.assert_allclose(
+        w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300
+    )
 
 
-def test_histograms_weights_core_fused(benchmark, case):
+def test_histograms_weights_core_fused(benchmark: BenchmarkFixture, case: Case) -> None:
     """The same weights from one call that never builds the (K, B) histogram matrix."""
     name, image, boxes, ref, pixels = case
     benchmark.group = f"histograms+weights {name}"
@@ -67,44 +82,49 @@ def test_histograms_weights_core_fused(benchmark, case):
     np.testing.assert_allclose(w, want, rtol=1e-8, atol=1e-300)
 
 
-def test_histograms_weights_numpy(benchmark, case):
+def test_histograms_weights_numpy(benchmark: BenchmarkFixture, case: Case) -> None:
     name, image, boxes, ref, pixels = case
     benchmark.group = f"histograms+weights {name}"
-    if len(boxes) > 2000:
-        benchmark.pedantic(npb.histograms_and_weights, args=(image.bins, image.n_bins, boxes, ref), rounds=2, iterations=1)
-    else:
-        benchmark(npb.histograms_and_weights, image.bins, image.n_bins, boxes, ref)
-    benchmark.group = f"histograms+weights {name}"
     benchmark.extra_info["pixels"] = pixels
+    args = (image.bins, image.n_bins, boxes, ref)
+    if len(boxes) > 2000:
+        benchmark.pedantic(npb.histograms_and_weights, args=args, rounds=2, iterations=1)
+    else:
+        benchmark(npb.histograms_and_weights, *args)
 
 
 @pytest.mark.parametrize("size", ["frame_480", "frame_720"])
-def test_hsv_bins_core(benchmark, request, size):
+def test_hsv_bins_core(
+    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str
+) -> None:
     frame = request.getfixturevalue(size)
     benchmark.group = f"hsv bins {frame.shape[1]}x{frame.shape[0]}"
     benchmark(_core.hsv_bins, frame)
 
 
 @pytest.mark.parametrize("size", ["frame_480", "frame_720"])
-def test_hsv_bins_opencv_numpy(benchmark, request, size):
+def test_hsv_bins_opencv_numpy(
+    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str
+) -> None:
     frame = request.getfixturevalue(size)
     benchmark.group = f"hsv bins {frame.shape[1]}x{frame.shape[0]}"
     benchmark(npb.hsv_bins, frame)
 
 
 @pytest.fixture(scope="module")
-def weights_10k():
+def weights_10k() -> F64:
     w = np.random.default_rng(2).random(10_000)
-    return w / w.sum()
+    w /= w.sum()
+    return w
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
-def test_resample_core(benchmark, weights_10k):
+def test_resample_core(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     benchmark(_core.systematic_resample, weights_10k, 0.37)
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
-def test_resample_python_api(benchmark, weights_10k):
+def test_resample_python_api(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     """The public function with a Generator: a new offset each call, Python checks included."""
     from pftrack.particle_filter import systematic_resample
 
@@ -113,50 +133,52 @@ def test_resample_python_api(benchmark, weights_10k):
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
-def test_resample_numpy(benchmark, weights_10k):
+def test_resample_numpy(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     benchmark(npb.systematic_resample, weights_10k, 0.37)
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
-def test_resample_filterpy(benchmark, weights_10k):
+def test_resample_filterpy(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     mc = pytest.importorskip("filterpy.monte_carlo")
     benchmark(mc.systematic_resample, weights_10k)
 
 
 @pytest.fixture(scope="module")
-def uniforms_10k():
+def uniforms_10k() -> F64:
     return np.random.default_rng(5).random(10_000)
 
 
 @pytest.mark.benchmark(group="stratified resample N=10000")
-def test_stratified_core(benchmark, weights_10k, uniforms_10k):
+def test_stratified_core(benchmark: BenchmarkFixture, weights_10k: F64, uniforms_10k: F64) -> None:
     benchmark(_core.stratified_resample, weights_10k, uniforms_10k)
 
 
 @pytest.mark.benchmark(group="stratified resample N=10000")
-def test_stratified_numpy(benchmark, weights_10k, uniforms_10k):
+def test_stratified_numpy(benchmark: BenchmarkFixture, weights_10k: F64, uniforms_10k: F64) -> None:
     benchmark(npb.stratified_resample, weights_10k, uniforms_10k)
 
 
 @pytest.mark.benchmark(group="stratified resample N=10000")
-def test_stratified_filterpy(benchmark, weights_10k):
+def test_stratified_filterpy(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     mc = pytest.importorskip("filterpy.monte_carlo")
     benchmark(mc.stratified_resample, weights_10k)
 
 
 @pytest.mark.benchmark(group="sis_step 10 objects x 200 particles, 20x50, 480x360")
-def test_sis_step_10x200(benchmark, frame_480):
+def test_sis_step_10x200(benchmark: BenchmarkFixture, frame_480: NDArray[np.uint8]) -> None:
     from pftrack.particle_filter import ColourParticleFilter, FilterConfig
 
     image = hsv_bins(frame_480)
     rng = np.random.default_rng(3)
     boxes = _boxes(rng, 10, 1, 20, 50, frame_480.shape)
     filters = [
-        ColourParticleFilter(b, box_histograms(image, [b])[0] + 1e-6, FilterConfig(n_particles=200), rng=k)
+        ColourParticleFilter(
+            b, box_histograms(image, [b])[0] + 1e-6, FilterConfig(n_particles=200), rng=k
+        )
         for k, b in enumerate(boxes)
     ]
 
-    def frame_step():
+    def frame_step() -> None:
         for f in filters:
             f.step(image)
 

@@ -1,32 +1,44 @@
-"""The sampler experiment script (bench/sampler_experiment.py) on tiny inputs."""
+"""The sampler experiment (``python -m experiments.sampler_experiment``) on tiny inputs."""
 
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
-from bench import sampler_experiment as se
-from pftrack.synthetic import make_scene
+from experiments import sampler_experiment as se
+from pftrack.synthetic import Scene, make_scene
 from tests.conftest import dataset
 
 
 @pytest.fixture(scope="module")
-def scene():
+def scene() -> Scene:
     return make_scene(n_frames=24, n_walkers=2, rng=3, occluder=False)
 
 
-def test_same_budget_and_only_the_sampler_differs():
+def test_same_budget_and_only_the_sampler_differs() -> None:
     a, b = se.config_for("sis", 37), se.config_for("rjmcmc", 37)
     assert a.filter.n_particles == b.filter.n_particles == 37
     assert replace(a, sampler="rjmcmc") == b
 
 
-def test_all_samplers_run_and_table_lists_them(scene):
+def test_all_samplers_run_and_table_lists_them(scene: Scene) -> None:
     run = se.synthetic_run(scene)
-    res = [se.run_sampler(run["source"], run["gt"], s, detections=None, gt_scale=1.0,
-                          image_size=run["image_size"], particles=30, sequence="syn", detector="own")
-           for s in se.SAMPLERS]  # fmt: skip
+    res = [
+        se.run_sampler(
+            run["source"],
+            run["gt"],
+            s,
+            detections=None,
+            gt_scale=1.0,
+            image_size=run["image_size"],
+            particles=30,
+            sequence="syn",
+            detector="own",
+        )
+        for s in se.SAMPLERS
+    ]
     table = se.format_table(res).splitlines()
     assert len(table) == 2 + 3
     assert [r.sampler for r in res] == list(se.SAMPLERS)
@@ -35,7 +47,7 @@ def test_all_samplers_run_and_table_lists_them(scene):
         assert r.metrics.num_objects == len(scene.truth)
 
 
-def test_time_per_frame_grows_with_particles(scene):
+def test_time_per_frame_grows_with_particles(scene: Scene) -> None:
     # SIS cost is linear in N: 16x the particles must cost clearly more than 1x
     small = min(se.time_per_frame(scene, "sis", 25) for _ in range(2))
     large = min(se.time_per_frame(scene, "sis", 400) for _ in range(2))
@@ -43,7 +55,7 @@ def test_time_per_frame_grows_with_particles(scene):
     assert se.time_per_frame(scene, "rjmcmc", 25) > 0
 
 
-def test_crossing_frame_is_where_walkers_1_and_2_overlap():
+def test_crossing_frame_is_where_walkers_1_and_2_overlap() -> None:
     s = make_scene(n_frames=120, n_walkers=2, rng=0)
     f = se.crossing_frame(s)
     rows = s.truth[s.truth[:, 0] == f]
@@ -51,7 +63,7 @@ def test_crossing_frame_is_where_walkers_1_and_2_overlap():
     assert abs((a[2] + a[4] / 2) - (b[2] + b[4] / 2)) < (a[4] + b[4]) / 2
 
 
-def test_figures_are_small_pngs(tmp_path):
+def test_figures_are_small_pngs(tmp_path: Path) -> None:
     s = make_scene(n_frames=60, n_walkers=2, rng=0)
     p = se.occlusion_figure(s, tmp_path / "occ.png", particles=30, offset=4)
     assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size < 300_000
@@ -61,11 +73,18 @@ def test_figures_are_small_pngs(tmp_path):
 
 
 @pytest.mark.dataset
-def test_real_sequences_first_frames():
+def test_real_sequences_first_frames() -> None:
     runs = se.real_sequences(dataset("tud-campus").parent, max_frames=8)
     assert {r["sequence"] for r in runs} <= {"PETS09-S2L1", "TUD-Campus"}
     tud = [r for r in runs if r["sequence"] == "TUD-Campus"][0]
     assert len(tud["source"]) == 8 and tud["gt"][:, 0].max() <= 8
-    res = se.run_sampler(tud["source"], tud["gt"], "rjmcmc", detections=tud["detections"], gt_scale=1.0,
-                         image_size=tud["image_size"], particles=30)  # fmt: skip
+    res = se.run_sampler(
+        tud["source"],
+        tud["gt"],
+        "rjmcmc",
+        detections=tud["detections"],
+        gt_scale=1.0,
+        image_size=tud["image_size"],
+        particles=30,
+    )
     assert res.metrics.num_objects == len(tud["gt"]) and res.n_tracks >= 1

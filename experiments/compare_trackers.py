@@ -1,6 +1,6 @@
 """Compare pftrack with the trackers people use today, on the same detections, scored alike.
 
-Not a pytest benchmark: a script. Peers (``pip install -e .[peers]``): supervision's ByteTrack
+Peers (``pip install -e .[peers]``): supervision's ByteTrack
 (supervision < 0.27, where ``sv.ByteTrack`` still lives), norfair, motpy, and SORT from the
 ``sort-track`` package (a packaging of Bewley's ``sort.py``; install it with ``--no-deps``,
 its metadata pins an old SciPy). A peer that is not installed is skipped with a note.
@@ -18,36 +18,43 @@ mog2
 All results are scored by :func:`pftrack.eval.evaluate_mot` against the ground truth (scaled the
 same way) with IoU 0.5; fps counts only the trackers' update calls (not decoding or detection).
 
-Usage::
+Prints one table row per run as it finishes, then the whole table; the table and the notes on
+skipped peers are also written to ``trackers.md`` in ``--out`` (default ``out/compare_trackers``).
 
-    python bench/compare_trackers.py [--data ../shared/data] [--seq pets09-s2l1 tud-campus]
-        [--detector public mog2] [--tracker sort bytetrack norfair motpy pftrack] [--out t.md]
+Usage (from the repository root)::
+
+    python -m experiments.compare_trackers [--data ../shared/data] [--seq pets09-s2l1 tud-campus]
+        [--detector public mog2] [--tracker sort bytetrack norfair motpy pftrack]
+        [--smooth-peers] [--out out/compare_trackers]
 """
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import io
 import itertools
-import os
 import sys
 import time
 import warnings
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeAlias
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
+
+from experiments._common import data_root, experiment_parser, write_text
 from pftrack.eval import MotMetrics, evaluate_mot
-from pftrack.io.atomic import atomic_write
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import read_frames
 
-Boxes = NDArray[np.float64]  # (K, 5) left, top, w, h, score
-Step = Callable[[NDArray[np.uint8], "Boxes | None"], list[tuple[int, float, float, float, float]]]
+Boxes: TypeAlias = NDArray[np.float64]  # (K, 5) left, top, w, h, score
+Frame: TypeAlias = NDArray[np.uint8]  # (H, W, 3) BGR
+Track: TypeAlias = tuple[int, float, float, float, float]  # id, left, top, w, h
+Step: TypeAlias = Callable[[Frame, "Boxes | None"], list[Track]]
+"""One tracker: (frame, detections or None) -> the tracks it reports for that frame."""
 
 
 @dataclass(frozen=True)
@@ -65,14 +72,6 @@ SEQUENCES = {
     # 71 frames of people in view from frame 1: a short memory and a low threshold do best.
     "tud-campus": Sequence("tud-campus", "video.mp4", 1.0, 25.0, 100, 16.0),
 }
-
-
-def data_root(arg: str | None) -> Path:
-    if arg:
-        return Path(arg)
-    if os.environ.get("PFTRACK_DATA"):
-        return Path(os.environ["PFTRACK_DATA"])
-    return Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 
 
 # ---- detectors -------------------------------------------------------------------------------
@@ -122,14 +121,24 @@ def mog2_detections(
 
 
 def make_sort(seq: Sequence) -> Step:
-    from sort.tracker import SortTracker  # sort-track: Bewley's defaults
+    # sort-track ships no type information; its defaults are Bewley's
+    from sort.tracker import SortTracker  # type: ignore[import-untyped]
 
     trk = SortTracker(max_age=1, min_hits=3, iou_threshold=0.3)
 
-    def step(frame, boxes):
-        d = np.zeros((0, 6)) if boxes is None or len(boxes) == 0 else np.c_[
-            boxes[:, 0], boxes[:, 1], boxes[:, 0] + boxes[:, 2], boxes[:, 1] + boxes[:, 3],
-            boxes[:, 4], np.zeros(len(boxes))]
+    def step(frame: Frame, boxes: Boxes | None) -> list[Track]:
+        d = (
+            np.zeros((0, 6))
+            if boxes is None or len(boxes) == 0
+            else np.c_[
+                boxes[:, 0],
+                boxes[:, 1],
+                boxes[:, 0] + boxes[:, 2],
+                boxes[:, 1] + boxes[:, 3],
+                boxes[:, 4],
+                np.zeros(len(boxes)),
+            ]
+        )
         out = trk.update(d, None)
         return [(int(r[4]), r[0], r[1], r[2] - r[0], r[3] - r[1]) for r in out]
 
@@ -143,7 +152,7 @@ def make_bytetrack(seq: Sequence) -> Step:
         raise ImportError("supervision >= 0.27 has no ByteTrack: pip install 'supervision<0.27'")
     trk = sv.ByteTrack(frame_rate=int(round(seq.fps)))  # documented defaults otherwise
 
-    def step(frame, boxes):
+    def step(frame: Frame, boxes: Boxes | None) -> list[Track]:
         b = np.zeros((0, 5)) if boxes is None else boxes
         det = sv.Detections(
             xyxy=np.c_[b[:, 0], b[:, 1], b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]].reshape(-1, 4),
@@ -151,43 +160,53 @@ def make_bytetrack(seq: Sequence) -> Step:
             class_id=np.zeros(len(b), dtype=int),
         )
         out = trk.update_with_detections(det)
-        return [(int(t), x0, y0, x1 - x0, y1 - y0)
-                for (x0, y0, x1, y1), t in zip(out.xyxy, out.tracker_id)]
+        ids = out.tracker_id if out.tracker_id is not None else np.zeros(0, dtype=int)
+        return [
+            (int(t), x0, y0, x1 - x0, y1 - y0)
+            for (x0, y0, x1, y1), t in zip(out.xyxy, ids, strict=True)
+        ]
 
     return step
 
 
 def make_norfair(seq: Sequence) -> Step:
-    import norfair
+    from norfair.tracker import Detection, Tracker
 
     # norfair's bounding-box demos: IoU distance, threshold 0.7; other settings default.
-    trk = norfair.Tracker(distance_function="iou", distance_threshold=0.7)
+    trk = Tracker(distance_function="iou", distance_threshold=0.7)
 
-    def step(frame, boxes):
-        dets = [] if boxes is None else [
-            norfair.Detection(points=np.array([[x, y], [x + w, y + h]]), scores=np.array([s, s]))
-            for x, y, w, h, s in boxes
-        ]
+    def step(frame: Frame, boxes: Boxes | None) -> list[Track]:
+        dets = (
+            []
+            if boxes is None
+            else [
+                Detection(points=np.array([[x, y], [x + w, y + h]]), scores=np.array([s, s]))
+                for x, y, w, h, s in boxes
+            ]
+        )
         objs = trk.update(detections=dets)
         out = []
         for o in objs:
             (x0, y0), (x1, y1) = o.estimate
-            out.append((int(o.id), x0, y0, x1 - x0, y1 - y0))
+            out.append((int(o.id or 0), x0, y0, x1 - x0, y1 - y0))  # id is set once initialised
         return out
 
     return step
 
 
 def make_motpy(seq: Sequence) -> Step:
-    from motpy import Detection, MultiObjectTracker
+    # motpy ships no type information
+    from motpy import Detection, MultiObjectTracker  # type: ignore[import-untyped]
 
     trk = MultiObjectTracker(dt=1.0 / seq.fps)  # defaults: constant velocity, IoU matching
     ids: dict[str, int] = {}
 
-    def step(frame, boxes):
-        dets = [] if boxes is None else [
-            Detection(box=np.array([x, y, x + w, y + h]), score=s) for x, y, w, h, s in boxes
-        ]
+    def step(frame: Frame, boxes: Boxes | None) -> list[Track]:
+        dets = (
+            []
+            if boxes is None
+            else [Detection(box=np.array([x, y, x + w, y + h]), score=s) for x, y, w, h, s in boxes]
+        )
         trk.step(detections=dets)
         out = []
         for t in trk.active_tracks(min_steps_alive=3):
@@ -199,26 +218,40 @@ def make_motpy(seq: Sequence) -> Step:
     return step
 
 
-def make_pftrack(seq: Sequence, offline: bool = True) -> Step:
-    """pftrack as ``pftrack track`` runs it: the background primed from the first 30 frames,
-    output through :class:`~pftrack.tracker.TrackWriter` (bridged gaps written once the track
-    is re-detected, a new track's first boxes once it is confirmed), whose offline pass links
-    fragments and smooths each track over the whole run; ``offline=False`` (``pftrack-online``,
-    ``pftrack track --no-smooth --no-link``) writes each frame's boxes as reported."""
-    from pftrack.tracker import MultiObjectTracker, TrackWriter
+class PftrackStep:
+    """pftrack as ``pftrack track`` runs it, as a step that reports nothing until the end.
 
-    trk = MultiObjectTracker(rng=0)
-    writer = TrackWriter() if offline else TrackWriter(smoother=None, link=None)
-    count = itertools.count(1)
+    The background is primed from the first 30 frames (:meth:`prime`); output goes through
+    :class:`~pftrack.tracking.TrackWriter` (bridged gaps written once the track is re-detected, a
+    new track's first boxes once it is confirmed), whose offline pass links fragments and smooths
+    each track over the whole run; ``offline=False`` (``pftrack-online``,
+    ``pftrack track --no-smooth --no-link``) writes each frame's boxes as reported. The rows are
+    read with :meth:`result`.
+    """
 
-    def step(frame, boxes):
+    def __init__(self, offline: bool = True) -> None:
+        from pftrack.tracking import MultiObjectTracker, TrackWriter
+
+        self._trk = MultiObjectTracker(rng=0)
+        self._writer = TrackWriter() if offline else TrackWriter(smoother=None, link=None)
+        self._count = itertools.count(1)
+
+    def __call__(self, frame: Frame, boxes: Boxes | None) -> list[Track]:
         dets = None if boxes is None else np.asarray(boxes, dtype=np.float64).reshape(-1, 5)
-        writer.add(next(count), trk.update(frame, detections=dets))
+        self._writer.add(next(self._count), self._trk.update(frame, detections=dets))
         return []
 
-    step.prime = lambda frames: trk.prime(frames[:30])  # type: ignore[attr-defined]
-    step.result = writer.result  # type: ignore[attr-defined]
-    return step
+    def prime(self, frames: list[Frame]) -> None:
+        """Start the background model from the first 30 frames."""
+        self._trk.prime(frames[:30])
+
+    def result(self) -> NDArray[np.float64]:
+        """Every row written, after the offline pass (MOTChallenge layout)."""
+        return self._writer.result()
+
+
+def make_pftrack(seq: Sequence, offline: bool = True) -> Step:
+    return PftrackStep(offline)
 
 
 TRACKERS: dict[str, Callable[[Sequence], Step]] = {
@@ -248,20 +281,22 @@ def run_one(
 ) -> tuple[NDArray[np.float64], float]:
     rows = []
     elapsed = 0.0
-    for f, (frame, boxes) in enumerate(zip(frames, dets), start=1):
+    for f, (frame, boxes) in enumerate(zip(frames, dets, strict=True), start=1):
         t0 = time.perf_counter()
         out = step(frame, boxes)
         elapsed += time.perf_counter() - t0
         rows += [(f, i, x, y, w, h, 1.0, -1.0, -1.0, -1.0) for i, x, y, w, h in out]
     res = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
-    if hasattr(step, "result"):  # a tracker that writes its rows at the end (pftrack)
+    if isinstance(step, PftrackStep):  # writes its rows at the end
         res = step.result()
     return res, len(frames) / elapsed if elapsed > 0 else float("inf")
 
 
 def markdown(rows: list[Row]) -> str:
-    head = ("| tracker | sequence | detector | MOTA | IDF1 | MOTP(IoU) | IDSW | Frag | FP | FN "
-            "| MT | ML | GT | fps |")
+    head = (
+        "| tracker | sequence | detector | MOTA | IDF1 | MOTP(IoU) | IDSW | Frag | FP | FN "
+        "| MT | ML | GT | fps |"
+    )
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         m = r.metrics
@@ -276,17 +311,16 @@ def markdown(rows: list[Row]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--data", default=None, help="folder with pets09-s2l1/ and tud-campus/")
+    ap = experiment_parser("compare_trackers", __doc__)
     ap.add_argument("--seq", nargs="+", default=list(SEQUENCES), choices=list(SEQUENCES))
-    ap.add_argument(
-        "--detector", nargs="+", default=["public", "mog2"], choices=["public", "mog2"]
-    )
+    ap.add_argument("--detector", nargs="+", default=["public", "mog2"], choices=["public", "mog2"])
     ap.add_argument("--tracker", nargs="+", default=list(TRACKERS), choices=list(TRACKERS))
-    ap.add_argument("--out", default=None, help="also write the markdown table here")
-    ap.add_argument("--smooth-peers", action="store_true",
-                    help="also score every peer's output after pftrack's offline pass "
-                         "(pftrack.smoothing.smooth_tracks: link, fill, smooth) as '<peer>+smooth'")
+    ap.add_argument(
+        "--smooth-peers",
+        action="store_true",
+        help="also score every peer's output after pftrack's offline pass "
+        "(pftrack.tracking.smooth_tracks: link, fill, smooth) as '<peer>+smooth'",
+    )
     args = ap.parse_args(argv)
 
     root = data_root(args.data)
@@ -317,7 +351,7 @@ def main(argv: list[str] | None = None) -> int:
                         notes.append(note)
                     continue
                 feed: Iterable[Boxes | None] = [None] * len(frames) if own else dets
-                if hasattr(step, "prime"):
+                if isinstance(step, PftrackStep):
                     step.prime(frames)
                 with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
                     warnings.simplefilter("ignore")
@@ -327,7 +361,7 @@ def main(argv: list[str] | None = None) -> int:
                 rows.append(row)
                 print(markdown([row]).splitlines()[-1], flush=True)
                 if args.smooth_peers and not tname.startswith("pftrack"):
-                    from pftrack.smoothing import smooth_tracks
+                    from pftrack.tracking import smooth_tracks
 
                     m = evaluate_mot(gt, smooth_tracks(res), scale=seq.scale, image_size=size)
                     row = Row(f"{tname}+smooth", name, detector, m, fps)
@@ -338,9 +372,7 @@ def main(argv: list[str] | None = None) -> int:
     print(table)
     for n in notes:
         print(f"- {n}")
-    if args.out:
-        with atomic_write(args.out) as fh:
-            fh.write(table + "\n" + "".join(f"\n- {n}" for n in notes) + "\n")
+    write_text(args.out / "trackers.md", table + "\n" + "".join(f"\n- {n}" for n in notes) + "\n")
     return 0
 
 

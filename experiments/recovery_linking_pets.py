@@ -2,30 +2,43 @@
 
 Every ground-truth track is cut into fragments of 40-119 frames separated by holes of 3-19
 frames; each fragment after the first gets a new id. ``link_tracklets`` should join fragments
-of one person (and no others), ``fill_gaps`` should put the removed boxes back.
+of one person (and no others), ``fill_gaps`` should put the removed boxes back. Prints the
+links made (and how many are right) and the centre error of the filled boxes; the same lines
+go to ``linking.txt`` in ``--out`` (default ``out/recovery_linking_pets``).
 
-Run: ``python bench/recovery_linking_pets.py [--seed 0]``.
+Usage (from the repository root)::
+
+    python -m experiments.recovery_linking_pets [--data ../shared/data] [--seed 0]
+        [--method gdt-bi] [--out out/recovery_linking_pets]
 """
 
 from __future__ import annotations
 
-import argparse
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+
+from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack.io.mot import read_mot
-from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, fill_gaps, link_tracklets
+from pftrack.recovery import FLAG_COLUMN, LinkConfig, fill_gaps, link_tracklets
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser()
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = experiment_parser("recovery_linking_pets", __doc__)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--method", default="gdt-bi")
-    args = ap.parse_args()
-    path = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "pets09-s2l1" / "gt.txt"
+    args = ap.parse_args(argv)
+    with tee_stdout(args.out / "linking.txt"):
+        link_and_fill(data_root(args.data) / "pets09-s2l1" / "gt.txt", args.seed, args.method)
+    return 0
+
+
+def link_and_fill(path: Path, seed: int, method: str) -> None:
+    """Cut the ground truth of `path` into fragments, link and fill them, print the scores."""
     gt = read_mot(path)
-    rng = np.random.default_rng(args.seed)
+    rng = np.random.default_rng(seed)
     rows, cut_rows = [], []
     owner: dict[int, int] = {}
     next_id = 1000
@@ -57,7 +70,7 @@ def main() -> None:
         f"correct {correct} ({1e3 * (t1 - t0):.1f} ms)"
     )
     t0 = time.perf_counter()
-    filled, rep = fill_gaps(linked, args.method, max_gap=20)
+    filled, rep = fill_gaps(linked, method, max_gap=20)
     t1 = time.perf_counter()
     cut = np.vstack([c for c in cut_rows if len(c)])
     errs = []
@@ -68,11 +81,11 @@ def main() -> None:
             ct = np.array([m[0, 2] + m[0, 4] / 2, m[0, 3] + m[0, 5] / 2])
             errs.append(float(np.hypot(*(c - ct))))
     print(
-        f"{rep.n_gaps} gaps, {rep.n_filled_rows} rows filled ({args.method}, "
+        f"{rep.n_gaps} gaps, {rep.n_filled_rows} rows filled ({method}, "
         f"{1e3 * (t1 - t0):.1f} ms incl. noise estimation); {len(errs)} match a removed box: "
         f"mean centre error {np.mean(errs):.2f} px, median {np.median(errs):.2f} px"
     )
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

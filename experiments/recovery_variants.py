@@ -30,28 +30,40 @@ For the ``iou`` variants ``q, r`` are fitted once per sequence on the points obs
 the representative mask (the fit is cheap in C++ for ``gdt-bi`` but slow in this NumPy
 exploration), so they see nothing inside that mask.
 
-Run (about 3 minutes on one core)::
+The printed tables are also written to ``--out`` (default ``out/recovery_variants``):
+``variants.txt``, ``by_length.txt`` (``--by-length``: ``gdt-bi`` and ``linear`` error per
+gap-length bin on PETS) or ``more_centre.txt`` / ``more_foot.txt`` (``--more``, which also writes
+the synthetic scenes' ground truth there).
 
-    python bench/recovery_variants.py --data ../shared/data
+Usage (from the repository root; about 3 minutes on one core)::
+
+    python -m experiments.recovery_variants [--data ../shared/data] [--max-positions 60]
+        [--by-length | --more [--point centre|foot]] [--out out/recovery_variants]
 """
 
 from __future__ import annotations
 
-import argparse
-import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from pftrack.io.mot import read_mot
-from pftrack.recovery import experiment as E
-from pftrack.recovery.methods import NoiseEstimate, estimate_noise, gdt_bi_problem, recover_gaps
-from pftrack.recovery.mixture import fit_motion, stand_rate
 from scipy.linalg import expm
 from scipy.optimize import minimize
 
-F64 = NDArray[np.float64]
+from experiments._common import data_root, experiment_parser, tee_stdout
+from pftrack._typing import F64
+from pftrack.io.mot import read_mot
+from pftrack.recovery import (
+    NoiseEstimate,
+    estimate_noise,
+    fit_motion,
+    gdt_bi_problem,
+    recover_gaps,
+)
+from pftrack.recovery import experiment as E
+from pftrack.recovery.mixture import stand_rate
+
 _BIG = 1e4  # prior variance of the unknown initial position and velocity
 
 
@@ -135,6 +147,13 @@ def smooth_gap(
 
 
 Variant = Callable[[list[E.Gap], list[F64]], list[F64]]
+"""A recovery variant: (gaps of one mask, observed runs of that mask) -> one path per gap."""
+
+Selection = tuple[int | None, int | None, int]
+"""Mask positions kept by :func:`pftrack.recovery.experiment.sweep`: n_trajectories, n_gaps,
+min_gaps."""
+PETS_MASKS: Selection = (15, 23, 1)  # the paper's: 15 trajectories, 23 gaps
+OTHER_MASKS: Selection = (None, None, 3)  # at least 3 gaps
 
 
 def shipped(history: int | None = None, per_gap: bool = False) -> Variant:
@@ -261,7 +280,8 @@ def stop_mixture(a: F64, b: F64, noise: NoiseEstimate, rate: float, v2: F64, gri
     prior ``P(no stop) = exp(-rate T)``, the rest spread evenly; posterior weights from the
     evidence of the goal. ``rate = 0`` is ``gdt-bi`` exactly.
     """
-    _, _, _, Pi, m0, P0, y, T = gdt_bi_problem(a, b, noise)
+    problem = gdt_bi_problem(a, b, noise)
+    Pi, m0, P0, y, T = problem.Pi_T, problem.m0, problem.Pi_0, problem.y_T, problem.T
     if rate <= 0.0:
         return recover_gaps([(a, b)], "gdt-bi", noise=noise)[0]
     ks = np.unique(np.round(np.linspace(0, T - 1, min(grid, T))).astype(int))
@@ -340,7 +360,10 @@ def oracle_ratio(masks: list[tuple[list[E.Gap], list[F64]]]) -> float:
                 best,
                 float(
                     np.mean(
-                        [np.hypot(*(p - g.truth[:, 1:3]).T).mean() for p, g in zip(paths, gaps)]
+                        [
+                            np.hypot(*(p - g.truth[:, 1:3]).T).mean()
+                            for p, g in zip(paths, gaps, strict=True)
+                        ]
                     )
                 ),
             )
@@ -348,23 +371,24 @@ def oracle_ratio(masks: list[tuple[list[E.Gap], list[F64]]]) -> float:
     return float(np.median(per))
 
 
-def more(data: Path, max_positions: int, point: str) -> None:
-    """Second round: higher-order ML models, the stop mixture and the q/r oracle."""
-    import tempfile
+def more(data: Path, max_positions: int, point: str, out: Path) -> None:
+    """Second round: higher-order ML models, the stop mixture and the q/r oracle.
 
+    The ground truth of the synthetic scenes is written to `out` (``syn0.txt`` ...) and read back.
+    """
     from pftrack.synthetic import make_scene
 
-    tmp = Path(tempfile.mkdtemp())
-    setups: list[tuple[str, Path, tuple[int, int], dict[str, int]]] = [
-        ("PETS", data / "pets09-s2l1" / "gt.txt", (768, 576), {"n_trajectories": 15, "n_gaps": 23}),
-        ("TUD-Campus", data / "tud-campus" / "gt.txt", (640, 480), {"min_gaps": 3}),
+    setups: list[tuple[str, Path, tuple[int, int], Selection]] = [
+        ("PETS", data / "pets09-s2l1" / "gt.txt", (768, 576), PETS_MASKS),
+        ("TUD-Campus", data / "tud-campus" / "gt.txt", (640, 480), OTHER_MASKS),
     ]
+    out.mkdir(parents=True, exist_ok=True)
     for seed in (0, 1, 2):
-        path = make_scene(n_frames=300, n_walkers=12, rng=seed).write_truth(tmp / f"syn{seed}.txt")
-        setups.append((f"synthetic {seed}", path, (480, 360), {"min_gaps": 3}))
+        path = make_scene(n_frames=300, n_walkers=12, rng=seed).write_truth(out / f"syn{seed}.txt")
+        setups.append((f"synthetic {seed}", path, (480, 360), OTHER_MASKS))
     for name, gt, (w, h), sel in setups:
         trajs = E.trajectories(read_mot(gt), point)
-        sw = E.sweep(trajs, 100, w, h, 4, **sel)  # type: ignore[arg-type]
+        sw = E.sweep(trajs, 100, w, h, 4, *sel)
         pos = sw.positions
         cap = 0 if name == "PETS" else max_positions
         if cap and len(pos) > cap:
@@ -387,7 +411,12 @@ def median_mmae(masks: list[tuple[list[E.Gap], list[F64]]], variant: Variant) ->
     for gaps, runs in masks:
         paths = variant(gaps, runs)
         per.append(
-            np.mean([np.hypot(*(p - g.truth[:, 1:3]).T).mean() for p, g in zip(paths, gaps)])
+            np.mean(
+                [
+                    np.hypot(*(p - g.truth[:, 1:3]).T).mean()
+                    for p, g in zip(paths, gaps, strict=True)
+                ]
+            )
         )
     return float(np.median(per))
 
@@ -401,7 +430,7 @@ def by_length(data: Path) -> None:
         pairs = [(g.segment_a, g.segment_b) for g in gaps]
         bi = recover_gaps(pairs, "gdt-bi", noise=estimate_noise(E.observed_runs(trajs, p)))
         lin = recover_gaps(pairs, "linear")
-        for g, pb, pl in zip(gaps, bi, lin):
+        for g, pb, pl in zip(gaps, bi, lin, strict=True):
             t = g.truth[:, 1:3]
             rows.append((len(t), np.hypot(*(pb - t).T).mean(), np.hypot(*(pl - t).T).mean()))
     a = np.array(rows)
@@ -411,36 +440,42 @@ def by_length(data: Path) -> None:
         print(f"{lo:>4}-{hi - 1:<4}{int(s.sum()):>6}{a[s, 1].mean():>10.3f}{a[s, 2].mean():>10.3f}")
 
 
-def main() -> None:
-    env = os.environ.get("PFTRACK_DATA")
-    default = Path(env) if env else Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--data", type=Path, default=default)
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = experiment_parser("recovery_variants", __doc__)
     ap.add_argument("--max-positions", type=int, default=60, help="for TUD-Campus")
     ap.add_argument("--by-length", action="store_true", help="PETS: gdt-bi error by gap length")
     ap.add_argument("--more", action="store_true", help="second round (docs: Second round)")
     ap.add_argument("--point", choices=("centre", "foot"), default="centre", help="with --more")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
+    data = data_root(args.data)
     if args.more:
-        more(args.data, args.max_positions, args.point)
-        return
-    if args.by_length:
-        by_length(args.data)
-        return
-    setups = [
-        ("pets09-s2l1", (768, 576), {"n_trajectories": 15, "n_gaps": 23}),
-        ("tud-campus", (640, 480), {"min_gaps": 3}),
+        with tee_stdout(args.out / f"more_{args.point}.txt"):
+            more(data, args.max_positions, args.point, args.out)
+    elif args.by_length:
+        with tee_stdout(args.out / "by_length.txt"):
+            by_length(data)
+    else:
+        with tee_stdout(args.out / "variants.txt"):
+            first_round(data, args.max_positions)
+    return 0
+
+
+def first_round(data: Path, max_positions: int) -> None:
+    """The table "Variants tried": shipped ``gdt-bi``, per-gap noise, history, ``iou``, BMA."""
+    setups: list[tuple[str, tuple[int, int], Selection]] = [
+        ("pets09-s2l1", (768, 576), PETS_MASKS),
+        ("tud-campus", (640, 480), OTHER_MASKS),
     ]
     taus = [np.inf, 40.0, 20.0, 10.0, 5.0]
     for name, (w, h), sel in setups:
-        trajs = E.trajectories(read_mot(args.data / name / "gt.txt"))
-        sw = E.sweep(trajs, 100, w, h, 4, **sel)  # type: ignore[arg-type]
+        trajs = E.trajectories(read_mot(data / name / "gt.txt"))
+        sw = E.sweep(trajs, 100, w, h, 4, *sel)
         pos = sw.positions
-        if len(pos) > args.max_positions:
-            pos = pos[np.linspace(0, len(pos) - 1, args.max_positions).round().astype(int)]
+        if len(pos) > max_positions:
+            pos = pos[np.linspace(0, len(pos) - 1, max_positions).round().astype(int)]
         masks = [(E.find_gaps(trajs, p)[0], E.observed_runs(trajs, p)) for p in pos]
         fit_runs = E.observed_runs(trajs, sw.representative())
-        per_tau = {}
+        per_tau: dict[float, list[tuple[F64, F64, float]]] = {}
         for tau in taus:
             per_tau[tau] = []
             for axis in range(2):
@@ -461,4 +496,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

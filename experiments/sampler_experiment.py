@@ -1,32 +1,30 @@
 """The first paper's experiment: SIS vs Metropolis-Hastings vs RJ-MCMC in one tracker.
 
-All three samplers run inside :class:`pftrack.tracker.MultiObjectTracker` with the same settings
+All three samplers run inside :class:`pftrack.tracking.MultiObjectTracker` with the same settings
 except ``sampler``, at the same particle budget: ``--particles`` particles per object for SIS and
 MH (MH: one chain step per particle, so 2 N likelihoods per object and frame), ``--particles``
 kept samples (+ the configured burn-in) of the one joint chain for RJ-MCMC.
 
-Outputs (``--out-dir``, default ``docs/``):
+Outputs (in ``--out``, default ``out/sampler_experiment``):
 
 * a Markdown table (stdout, and ``sampler_results.md``): Smith's success rate, the
   centroid-distance ratio, MOTA, IDF1, ID switches, tracks and frames/s (whole pipeline: decoding,
   detection, tracking) per sequence and sampler;
-* ``sampler_time.png``: the samplers' time per frame (frame binning and foreground mask
-  excluded) against the number of objects in view (synthetic scenes with 1..N walkers,
-  ground-truth boxes as the objects / birth candidates) and against the particle budget;
+* ``sampler_time.png`` and ``sampler_timing.md``: the samplers' time per frame (frame binning and
+  foreground mask excluded) against the number of objects in view (synthetic scenes with 1..N
+  walkers, ground-truth boxes as the objects / birth candidates) and against the particle budget;
 * ``sampler_occlusion.png``: the crossing of walkers 1 and 2 of the synthetic scene, before,
   during and after, one row per sampler (the paper's Figures 1-2).
 
-Usage::
+Usage (from the repository root)::
 
-    python bench/sampler_experiment.py [--data ../shared/data] [--particles 100] [--seed 0]
-        [--max-walkers 8] [--out-dir docs] [--skip-timing] [--skip-figure]
+    python -m experiments.sampler_experiment [--data ../shared/data] [--particles 100] [--seed 0]
+        [--max-walkers 8] [--out out/sampler_experiment] [--skip-timing] [--skip-figure]
 """
 
 from __future__ import annotations
 
-import argparse
 import itertools
-import os
 import sys
 import time
 from collections.abc import Sequence
@@ -38,13 +36,12 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from experiments._common import data_root, experiment_parser, write_text
+from pftrack.boxes import iou_xywh
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.atomic import atomic_path, atomic_write
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import FrameSource
-from pftrack.render import draw_tracks
-from pftrack.run import load_detections, track_frames
-from pftrack.synthetic import Scene, make_scene
 from pftrack.particle_filter import (
     ColourParticleFilter,
     MHColourParticleFilter,
@@ -52,10 +49,11 @@ from pftrack.particle_filter import (
     box_histograms,
     hsv_bins,
 )
-from pftrack.tracker import TrackerConfig
+from pftrack.render import draw_tracks
+from pftrack.synthetic import Scene, make_scene
+from pftrack.tracking import TrackerConfig, load_detections, track_frames
 
 SAMPLERS = ("sis", "mh", "rjmcmc")
-REPO = Path(__file__).resolve().parents[1]
 
 
 @dataclass(frozen=True)
@@ -110,8 +108,15 @@ def run_sampler(
         Tracker seed.
     """
     # online output (no offline linking or smoothing): the samplers are what is compared
-    run = track_frames(source, detections=detections, config=config_for(sampler, particles),
-                       rng=seed, show_progress=False, smoother=None, link=None)  # fmt: skip
+    run = track_frames(
+        source,
+        detections=detections,
+        config=config_for(sampler, particles),
+        rng=seed,
+        show_progress=False,
+        smoother=None,
+        link=None,
+    )
     m = evaluate_mot(gt, run.rows, scale=gt_scale, image_size=image_size)
     n_tracks = len(np.unique(run.rows[:, 1])) if len(run.rows) else 0
     return SamplerResult(sequence, detector, sampler, m, n_tracks, run.fps)
@@ -129,7 +134,8 @@ def format_table(results: Sequence[SamplerResult]) -> str:
         lines.append(
             f"| {r.sequence} | {r.detector} | {r.sampler} | {m.success_rate:.3f} | "
             f"{m.success_rate_strict:.3f} | {m.centroid_distance_ratio * 1e5:.2f} | "
-            f"{m.mota * 100:.1f} | {m.idf1 * 100:.1f} | {m.num_switches} | {r.n_tracks} | {r.fps:.0f} |"
+            f"{m.mota * 100:.1f} | {m.idf1 * 100:.1f} | {m.num_switches} | {r.n_tracks} | "
+            f"{r.fps:.0f} |"
         )
     return "\n".join(lines)
 
@@ -147,14 +153,40 @@ def real_sequences(data: Path, max_frames: int | None = None) -> list[dict[str, 
     if pets.is_dir():
         gt = read_mot(pets / "gt.txt")
         frames = _frames_of(pets / "video.avi", max_frames)
-        out.append(dict(sequence="PETS09-S2L1", detector="public", source=frames, gt=gt, gt_scale=0.625,
-                        image_size=(480, 360), detections=load_detections(pets / "det.txt", 0.625)))  # fmt: skip
-        out.append(dict(sequence="PETS09-S2L1", detector="built-in", source=frames, gt=gt, gt_scale=0.625,
-                        image_size=(480, 360), detections=None))  # fmt: skip
+        out.append(
+            dict(
+                sequence="PETS09-S2L1",
+                detector="public",
+                source=frames,
+                gt=gt,
+                gt_scale=0.625,
+                image_size=(480, 360),
+                detections=load_detections(pets / "det.txt", 0.625),
+            )
+        )
+        out.append(
+            dict(
+                sequence="PETS09-S2L1",
+                detector="built-in",
+                source=frames,
+                gt=gt,
+                gt_scale=0.625,
+                image_size=(480, 360),
+                detections=None,
+            )
+        )
     if tud.is_dir():
-        out.append(dict(sequence="TUD-Campus", detector="public", source=_frames_of(tud / "video.mp4", max_frames),
-                        gt=read_mot(tud / "gt.txt"), gt_scale=1.0, image_size=(640, 480),
-                        detections=load_detections(tud / "det.txt", 1.0)))  # fmt: skip
+        out.append(
+            dict(
+                sequence="TUD-Campus",
+                detector="public",
+                source=_frames_of(tud / "video.mp4", max_frames),
+                gt=read_mot(tud / "gt.txt"),
+                gt_scale=1.0,
+                image_size=(640, 480),
+                detections=load_detections(tud / "det.txt", 1.0),
+            )
+        )
     if max_frames is not None:
         for s in out:
             s["gt"] = s["gt"][s["gt"][:, 0] <= max_frames]
@@ -165,13 +197,23 @@ def real_sequences(data: Path, max_frames: int | None = None) -> list[dict[str, 
 
 def synthetic_run(scene: Scene, name: str = "synthetic") -> dict[str, Any]:
     """A synthetic scene run with the built-in detector."""
-    return dict(sequence=name, detector="built-in", source=scene.frames, gt=scene.truth, gt_scale=1.0,
-                image_size=(scene.width, scene.height), detections=None)  # fmt: skip
+    return dict(
+        sequence=name,
+        detector="built-in",
+        source=scene.frames,
+        gt=scene.truth,
+        gt_scale=1.0,
+        image_size=(scene.width, scene.height),
+        detections=None,
+    )
 
 
 def truth_detections(scene: Scene) -> dict[int, NDArray[np.float64]]:
     """Ground-truth boxes as detections (score 1) per frame."""
-    return {f: np.column_stack([r[:, 2:6], np.ones(len(r))]) for f, r in group_by_frame(scene.truth).items()}
+    return {
+        f: np.column_stack([r[:, 2:6], np.ones(len(r))])
+        for f, r in group_by_frame(scene.truth).items()
+    }
 
 
 def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) -> float:
@@ -189,8 +231,18 @@ def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) ->
     joint = None
     if sampler == "rjmcmc":
         m = cfg.filter.model
-        joint = RJMCMCFilter(replace(cfg.rjmcmc, n_samples=particles, a=tuple(m.a), b=tuple(m.b),
-                                     sigma=tuple(m.sigma), s_min=m.s_min, s_max=m.s_max), rng=rng)  # fmt: skip
+        joint = RJMCMCFilter(
+            replace(
+                cfg.rjmcmc,
+                n_samples=particles,
+                a=tuple(m.a),
+                b=tuple(m.b),
+                sigma=tuple(m.sigma),
+                s_min=m.s_min,
+                s_max=m.s_max,
+            ),
+            rng=rng,
+        )
     cls = MHColourParticleFilter if sampler == "mh" else ColourParticleFilter
     total = 0.0
     for n, frame in enumerate(scene.frames, start=1):
@@ -198,10 +250,19 @@ def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) ->
         mask = (diff > 30).astype(np.uint8)
         binned = hsv_bins(frame, mask, cfg.binning)
         rows = frames.get(n, np.zeros((0, 10)))
-        boxes = np.column_stack([rows[:, 2:4] + rows[:, 4:6] / 2, rows[:, 4:6]]) if len(rows) else np.zeros((0, 4))
+        boxes = (
+            np.column_stack([rows[:, 2:4] + rows[:, 4:6] / 2, rows[:, 4:6]])
+            if len(rows)
+            else np.zeros((0, 4))
+        )
         refs = box_histograms(binned, boxes, "uniform") if len(rows) else None
         for k, r in enumerate(rows):
-            if joint is None and int(r[1]) not in filters and refs is not None and refs[k].sum() > 0:
+            if (
+                joint is None
+                and int(r[1]) not in filters
+                and refs is not None
+                and refs[k].sum() > 0
+            ):
                 filters[int(r[1])] = cls(boxes[k], refs[k], cfg.filter, rng=rng)
         in_view = {int(r[1]) for r in rows}
         start = time.perf_counter()
@@ -215,8 +276,9 @@ def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) ->
     return total / len(scene.frames)
 
 
-def timing_vs_objects(max_walkers: int, particles: int, n_frames: int = 40, seed: int = 0
-                      ) -> dict[str, list[tuple[float, float]]]:  # fmt: skip
+def timing_vs_objects(
+    max_walkers: int, particles: int, n_frames: int = 40, seed: int = 0
+) -> dict[str, list[tuple[float, float]]]:
     """(mean objects in view, ms/frame) per sampler for scenes with 1..max_walkers walkers.
 
     The walkers all start inside the view (scene frames from the middle of a longer scene are
@@ -243,19 +305,32 @@ def _middle(scene: Scene, n_frames: int) -> Scene:
     return replace(scene, frames=scene.frames[first : first + n_frames], truth=truth)
 
 
-def timing_vs_particles(budgets: Sequence[int], n_walkers: int = 4, n_frames: int = 40, seed: int = 0
-                        ) -> dict[str, list[tuple[float, float]]]:  # fmt: skip
+def timing_vs_particles(
+    budgets: Sequence[int], n_walkers: int = 4, n_frames: int = 40, seed: int = 0
+) -> dict[str, list[tuple[float, float]]]:
     """(particles, ms/frame) per sampler on one synthetic scene."""
-    sub = _middle(make_scene(n_frames=3 * n_frames, n_walkers=n_walkers, rng=seed, occluder=False), n_frames)
-    return {s: [(float(n), 1e3 * time_per_frame(sub, s, n, seed)) for n in budgets] for s in SAMPLERS}
+    sub = _middle(
+        make_scene(n_frames=3 * n_frames, n_walkers=n_walkers, rng=seed, occluder=False), n_frames
+    )
+    return {
+        s: [(float(n), 1e3 * time_per_frame(sub, s, n, seed)) for n in budgets] for s in SAMPLERS
+    }
 
 
-_STYLE = {"sis": ("tab:blue", "o", "SIS (paper)"), "mh": ("tab:orange", "s", "MH per object"),
-          "rjmcmc": ("tab:green", "^", "RJ-MCMC joint")}  # fmt: skip
+_STYLE = {
+    "sis": ("tab:blue", "o", "SIS (paper)"),
+    "mh": ("tab:orange", "s", "MH per object"),
+    "rjmcmc": ("tab:green", "^", "RJ-MCMC joint"),
+}
 
 
-def plot_timing(by_objects: dict[str, list[tuple[float, float]]], by_particles: dict[str, list[tuple[float, float]]],
-                path: Path, particles: int, n_walkers: int) -> Path:  # fmt: skip
+def plot_timing(
+    by_objects: dict[str, list[tuple[float, float]]],
+    by_particles: dict[str, list[tuple[float, float]]],
+    path: Path,
+    particles: int,
+    n_walkers: int,
+) -> Path:
     """Two panels: ms/frame against objects in view and against the particle budget."""
     import matplotlib
 
@@ -269,10 +344,18 @@ def plot_timing(by_objects: dict[str, list[tuple[float, float]]], by_particles: 
         axes[0].plot(x, y, marker=mk, color=c, label=label)
         x, y = np.array(by_particles[s]).T
         axes[1].plot(x, y, marker=mk, color=c, label=label)
-    axes[0].set(xlabel="objects in view (mean per frame)", ylabel="sampler ms / frame",
-                title=f"{particles} particles / samples")  # fmt: skip
-    axes[1].set(xlabel="particles per object (SIS, MH) / kept samples (RJ-MCMC)", ylabel="sampler ms / frame",
-                title=f"synthetic scene, {n_walkers} walkers", xscale="log", yscale="log")  # fmt: skip
+    axes[0].set(
+        xlabel="objects in view (mean per frame)",
+        ylabel="sampler ms / frame",
+        title=f"{particles} particles / samples",
+    )
+    axes[1].set(
+        xlabel="particles per object (SIS, MH) / kept samples (RJ-MCMC)",
+        ylabel="sampler ms / frame",
+        title=f"synthetic scene, {n_walkers} walkers",
+        xscale="log",
+        yscale="log",
+    )
     for ax in axes:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
@@ -286,8 +369,6 @@ def plot_timing(by_objects: dict[str, list[tuple[float, float]]], by_particles: 
 
 def crossing_frame(scene: Scene, a: int = 1, b: int = 2) -> int:
     """The frame where walkers `a` and `b` overlap most (their crossing)."""
-    from pftrack.eval import iou_xywh
-
     best, frame = -1.0, 1
     for f, rows in group_by_frame(scene.truth).items():
         ra, rb = rows[rows[:, 1] == a], rows[rows[:, 1] == b]
@@ -298,15 +379,27 @@ def crossing_frame(scene: Scene, a: int = 1, b: int = 2) -> int:
     return frame
 
 
-def occlusion_figure(scene: Scene, path: Path, particles: int = 100, seed: int = 0, offset: int = 8,
-                     crop: tuple[int, int] = (200, 130)) -> Path:  # fmt: skip
+def occlusion_figure(
+    scene: Scene,
+    path: Path,
+    particles: int = 100,
+    seed: int = 0,
+    offset: int = 8,
+    crop: tuple[int, int] = (200, 130),
+) -> Path:
     """Frames before, during and after walkers 1 and 2 cross, one row per sampler (PNG)."""
     fc = crossing_frame(scene)
     frames = [max(1, fc - offset), fc, min(len(scene.frames), fc + offset)]
     rows_by = {}
     for s in SAMPLERS:
-        run = track_frames(scene.frames, config=config_for(s, particles), rng=seed, show_progress=False,
-                           smoother=None, link=None)
+        run = track_frames(
+            scene.frames,
+            config=config_for(s, particles),
+            rng=seed,
+            show_progress=False,
+            smoother=None,
+            link=None,
+        )
         rows_by[s] = run.rows
     g = scene.truth[(scene.truth[:, 0] == fc) & np.isin(scene.truth[:, 1], (1, 2))]
     cx = float(np.mean(g[:, 2] + g[:, 4] / 2))
@@ -319,76 +412,99 @@ def occlusion_figure(scene: Scene, path: Path, particles: int = 100, seed: int =
         tiles = []
         for f in frames:
             r = rows_by[s]
-            img = draw_tracks(scene.frames[f - 1], r[r[:, 0] == f])[y0 : y0 + ch, x0 : x0 + cw]
-            img = cv2.copyMakeBorder(img, 16, 2, 2, 2, cv2.BORDER_CONSTANT, value=(255, 255, 255))
+            crop_img = draw_tracks(scene.frames[f - 1], r[r[:, 0] == f])[y0 : y0 + ch, x0 : x0 + cw]
+            img = cv2.copyMakeBorder(
+                crop_img, 16, 2, 2, 2, cv2.BORDER_CONSTANT, value=(255, 255, 255)
+            )
             label = f"{_STYLE[s][2]}, frame {f}"
-            cv2.putText(img, label, (4, 12), cv2.FONT_HERSHEY_SIMPLEX, 0.38, (0, 0, 0), 1, cv2.LINE_AA)
+            cv2.putText(
+                img, label, (4, 12), cv2.FONT_HERSHEY_SIMPLEX, 0.38, (0, 0, 0), 1, cv2.LINE_AA
+            )
             tiles.append(img)
         grid.append(np.hstack(tiles))
     out = np.vstack(grid)
     path.parent.mkdir(parents=True, exist_ok=True)
     from PIL import Image  # a matplotlib dependency; 128-colour palette keeps the PNG small
 
-    img = Image.fromarray(cv2.cvtColor(out, cv2.COLOR_BGR2RGB)).quantize(colors=128)
+    png = Image.fromarray(cv2.cvtColor(out, cv2.COLOR_BGR2RGB)).quantize(colors=128)
     with atomic_write(path, "wb") as fh:
-        img.save(fh, format="PNG", optimize=True)
+        png.save(fh, format="PNG", optimize=True)
     return path
 
 
-def _write_text(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_write(path) as fh:
-        fh.write(text)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--data", type=Path, default=Path(os.environ.get("PFTRACK_DATA", REPO / ".." / "shared" / "data")))
+    p = experiment_parser("sampler_experiment", __doc__)
     p.add_argument("--particles", type=int, default=100)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--max-walkers", type=int, default=8)
-    p.add_argument("--max-frames", type=int, default=None, help="only the first frames of each real sequence")
-    p.add_argument("--out-dir", type=Path, default=REPO / "docs")
+    p.add_argument(
+        "--max-frames", type=int, default=None, help="only the first frames of each real sequence"
+    )
     p.add_argument("--skip-timing", action="store_true")
     p.add_argument("--skip-figure", action="store_true")
     args = p.parse_args(argv)
 
-    runs = real_sequences(args.data, args.max_frames)
+    data = data_root(args.data)
+    runs = real_sequences(data, args.max_frames)
     if not runs:
-        print(f"note: no sequence under {args.data}; synthetic scene only", file=sys.stderr)
+        print(f"note: no sequence under {data}; synthetic scene only", file=sys.stderr)
     runs.append(synthetic_run(make_scene(n_frames=150, n_walkers=6, rng=args.seed)))
     results = []
     for r in runs:
         for s in SAMPLERS:
-            res = run_sampler(r["source"], r["gt"], s, detections=r["detections"], gt_scale=r["gt_scale"],
-                              image_size=r["image_size"], particles=args.particles, seed=args.seed,
-                              sequence=r["sequence"], detector=r["detector"])  # fmt: skip
+            res = run_sampler(
+                r["source"],
+                r["gt"],
+                s,
+                detections=r["detections"],
+                gt_scale=r["gt_scale"],
+                image_size=r["image_size"],
+                particles=args.particles,
+                seed=args.seed,
+                sequence=r["sequence"],
+                detector=r["detector"],
+            )
             results.append(res)
-            print(f"{r['sequence']} {r['detector']} {s}: MOTA {res.metrics.mota * 100:.1f} "
-                  f"IDF1 {res.metrics.idf1 * 100:.1f}", file=sys.stderr)  # fmt: skip
+            print(
+                f"{r['sequence']} {r['detector']} {s}: MOTA {res.metrics.mota * 100:.1f} "
+                f"IDF1 {res.metrics.idf1 * 100:.1f}",
+                file=sys.stderr,
+            )
     table = format_table(results)
-    header = (f"<!-- python bench/sampler_experiment.py --particles {args.particles} --seed {args.seed} "
-              f"--max-walkers {args.max_walkers} -->\n")  # fmt: skip
+    header = (
+        f"<!-- python -m experiments.sampler_experiment --particles {args.particles} "
+        f"--seed {args.seed} --max-walkers {args.max_walkers} -->\n"
+    )
     print(table)
-    _write_text(args.out_dir / "sampler_results.md", header + table + "\n")
+    write_text(args.out / "sampler_results.md", header + table + "\n")
     if not args.skip_timing:
         by_obj = timing_vs_objects(args.max_walkers, args.particles, seed=args.seed)
         budgets = (25, 50, 100, 200, 400, 800)
         by_n = timing_vs_particles(budgets, seed=args.seed)
-        plot_timing(by_obj, by_n, args.out_dir / "sampler_time.png", args.particles, 4)
-        lines = ["| sampler | " + " | ".join(f"{x:.1f} obj" for x, _ in by_obj['sis']) + " |",
-                 "|---|" + "---|" * len(by_obj["sis"])]  # fmt: skip
+        plot_timing(by_obj, by_n, args.out / "sampler_time.png", args.particles, 4)
+        lines = [
+            "| sampler | " + " | ".join(f"{x:.1f} obj" for x, _ in by_obj["sis"]) + " |",
+            "|---|" + "---|" * len(by_obj["sis"]),
+        ]
         for s in SAMPLERS:
             lines.append(f"| {s} | " + " | ".join(f"{y:.2f}" for _, y in by_obj[s]) + " |")
-        lines += ["", "| sampler | " + " | ".join(f"N={n}" for n in budgets) + " |", "|---|" + "---|" * len(budgets)]
+        lines += [
+            "",
+            "| sampler | " + " | ".join(f"N={n}" for n in budgets) + " |",
+            "|---|" + "---|" * len(budgets),
+        ]
         for s in SAMPLERS:
             lines.append(f"| {s} | " + " | ".join(f"{y:.2f}" for _, y in by_n[s]) + " |")
         timing = "\n".join(lines)
         print("\nms per frame\n" + timing)
-        _write_text(args.out_dir / "sampler_timing.md", header + timing + "\n")
+        write_text(args.out / "sampler_timing.md", header + timing + "\n")
     if not args.skip_figure:
-        occlusion_figure(make_scene(n_frames=150, n_walkers=6, rng=args.seed), args.out_dir / "sampler_occlusion.png",
-                         args.particles, args.seed)  # fmt: skip
+        occlusion_figure(
+            make_scene(n_frames=150, n_walkers=6, rng=args.seed),
+            args.out / "sampler_occlusion.png",
+            args.particles,
+            args.seed,
+        )
     return 0
 
 

@@ -1,0 +1,92 @@
+"""What the experiment scripts share: where the data is, where the output goes."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import TextIO
+
+from pftrack._typing import PathLike
+from pftrack.io.atomic import atomic_write
+
+REPO = Path(__file__).resolve().parents[1]
+"""The repository root (the folder holding ``experiments/``)."""
+
+
+def data_root(arg: PathLike | None = None) -> Path:
+    """The folder holding ``pets09-s2l1/`` and ``tud-campus/``.
+
+    `arg` if given, else ``$PFTRACK_DATA``, else ``../shared/data`` beside the repository.
+    """
+    if arg:
+        return Path(arg)
+    if os.environ.get("PFTRACK_DATA"):
+        return Path(os.environ["PFTRACK_DATA"])
+    return REPO / ".." / "shared" / "data"
+
+
+def experiment_parser(name: str, doc: str | None) -> argparse.ArgumentParser:
+    """The parser of ``python -m experiments.<name>``, with ``--data`` and ``--out``.
+
+    Parameters
+    ----------
+    name : str
+        The experiment's module name; the default output folder is ``out/<name>``.
+    doc : str or None
+        The module docstring; its first line is the description.
+    """
+    parser = argparse.ArgumentParser(
+        prog=f"python -m experiments.{name}", description=(doc or name).split("\n")[0]
+    )
+    parser.add_argument(
+        "--data",
+        type=Path,
+        default=None,
+        help="folder with pets09-s2l1/ and tud-campus/ (default: $PFTRACK_DATA or ../shared/data)",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("out") / name,
+        help=f"output folder for tables and figures (default: out/{name})",
+    )
+    return parser
+
+
+def write_text(path: Path, text: str) -> None:
+    """Write `text` to `path` atomically, creating its folder."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_write(path) as fh:
+        fh.write(text)
+
+
+class _Tee(io.StringIO):
+    """A text stream that keeps what is written and passes it on to `stream`."""
+
+    def __init__(self, stream: TextIO) -> None:
+        super().__init__()
+        self._stream = stream
+
+    def write(self, s: str) -> int:
+        self._stream.write(s)
+        return super().write(s)
+
+    def flush(self) -> None:
+        self._stream.flush()
+
+
+@contextlib.contextmanager
+def tee_stdout(path: Path) -> Iterator[None]:
+    """Print as usual inside the block and also save everything printed to `path`.
+
+    The file is written when the block ends without an exception.
+    """
+    tee = _Tee(sys.stdout)
+    with contextlib.redirect_stdout(tee):
+        yield
+    write_text(path, tee.getvalue())
