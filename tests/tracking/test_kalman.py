@@ -16,7 +16,7 @@ from pftrack.kalman import (
     wna_Q,
     wna_Q_xy,
 )
-from tests.reference.smoothing import cv_posterior_mean, dense_kalman_rts, wna_posterior_mean
+from tests.reference.smoothing import dense_kalman_rts, wna_posterior_mean
 
 
 def _problem(
@@ -43,20 +43,16 @@ def test_matrices():
         wna_Q_xy((1.0, 2.0, 3.0))
 
 
-@pytest.mark.parametrize("discretisation", ["continuous", "piecewise"])
-def test_predict_update_match_matrix_form(discretisation):
+def test_predict_update_match_matrix_form():
     rng = np.random.default_rng(4)
     F = cv_transition()
-    quarter = 0.25 if discretisation == "piecewise" else 1.0 / 3.0
     for _ in range(20):
         L = rng.normal(size=(2, 2))
         P = L @ L.T + 0.1 * np.eye(2)
         m = rng.normal(size=2)
         q, r2, z = rng.uniform(0.01, 3), rng.uniform(0.1, 3), rng.normal()
-        (p, v), (a, b, c) = cv_predict(
-            (m[0], m[1]), (P[0, 0], P[0, 1], P[1, 1]), q, discretisation=discretisation
-        )
-        Pp = F @ P @ F.T + q * np.array([[quarter, 0.5], [0.5, 1.0]])
+        (p, v), (a, b, c) = cv_predict((m[0], m[1]), (P[0, 0], P[0, 1], P[1, 1]), q)
+        Pp = F @ P @ F.T + wna_Q(q)
         np.testing.assert_allclose([p, v], F @ m, rtol=1e-13)
         np.testing.assert_allclose([[a, b], [b, c]], Pp, rtol=1e-12)
         (p2, v2), (a2, b2, c2) = cv_update((p, v), (a, b, c), z, r2)
@@ -65,20 +61,16 @@ def test_predict_update_match_matrix_form(discretisation):
         np.testing.assert_allclose(
             [[a2, b2], [b2, c2]], (np.eye(2) - np.outer(K, [1, 0])) @ Pp, rtol=1e-12, atol=1e-14
         )
-    with pytest.raises(ValueError, match="discretisation"):
-        cv_predict((0.0, 0.0), (1.0, 0.0, 1.0), 1.0, discretisation="exact")  # type: ignore[arg-type]
 
 
 def test_predict_update_vectorised_over_axes():
     """Arrays over axes give what each axis gives alone (the tracker shares one covariance)."""
     m = (np.array([1.0, -2.0]), np.array([0.5, 0.25]))
     cov = (2.0, 0.3, 1.5)  # floats: one covariance for both axes
-    (p, v), c = cv_update(
-        *cv_predict(m, cov, 0.4, discretisation="piecewise"), np.array([2.0, -1.0]), 0.8
-    )
+    (p, v), c = cv_update(*cv_predict(m, cov, 0.4), np.array([2.0, -1.0]), 0.8)
     for k in range(2):
         (pk, vk), ck = cv_update(
-            *cv_predict((m[0][k], m[1][k]), cov, 0.4, discretisation="piecewise"),
+            *cv_predict((m[0][k], m[1][k]), cov, 0.4),
             [2.0, -1.0][k],
             0.8,
         )
@@ -86,20 +78,14 @@ def test_predict_update_vectorised_over_axes():
 
 
 @settings(max_examples=30, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), steps=st.integers(1, 40), update_first=st.booleans(),
-       discretisation=st.sampled_from(["continuous", "piecewise"]))  # fmt: skip
-def test_rts_matches_dense_matrix_loop(seed, steps, update_first, discretisation):
+@given(seed=st.integers(0, 2**31 - 1), steps=st.integers(1, 40), update_first=st.booleans())
+def test_rts_matches_dense_matrix_loop(seed, steps, update_first):
     """Two axes at once against the (x, y, vx, vy) 4x4 matrix filter (the rts baseline's form)."""
     z, has, q, r2 = _problem(seed, steps, 2)
     vsd = 10.0
-    got = rts_smooth(
-        z, has, q, r2, velocity_sd=vsd, update_first=update_first, discretisation=discretisation
-    )
+    got = rts_smooth(z, has, q, r2, velocity_sd=vsd, update_first=update_first)
     F = cv_transition_xy()
     Q = wna_Q_xy(q)
-    if discretisation == "piecewise":  # q [[1/4, 1/2], [1/2, 1]] per axis
-        Q = wna_Q_xy(q)
-        Q[0, 0], Q[1, 1] = q[0] / 4, q[1] / 4
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
     m0 = np.r_[z[0], 0.0, 0.0]
     P0 = np.diag([r2[0], r2[1], vsd**2, vsd**2])
@@ -117,15 +103,6 @@ def test_rts_is_the_posterior_mean(seed, steps, update_first):
         [wna_posterior_mean(z[:, k], has, q[k], r2[k], 5.0, update_first) for k in range(3)]
     )
     np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-6)
-
-
-def test_piecewise_without_first_update_is_the_box_smoothers_model():
-    z, has, q, r2 = _problem(7, 25, 1)
-    z[~has] = 0.0
-    got = rts_smooth(z, has, q, r2, velocity_sd=8.0, update_first=False, discretisation="piecewise")
-    want = cv_posterior_mean(z[:, 0], has, float(np.sqrt(q[0])), float(np.sqrt(r2[0])), 8.0)
-    np.testing.assert_allclose(got[:, 0], want, rtol=1e-7, atol=1e-6)
-    assert got[0, 0] != z[0, 0] or not has[1:].any()  # later data move frame 0
 
 
 def test_rts_bad_input():

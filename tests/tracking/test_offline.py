@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pftrack.tracking import BoxSmoother, Track, TrackWriter, smooth_tracks
-from tests.reference.smoothing import cv_posterior_mean
+from tests.reference.smoothing import wna_posterior_mean
 
 
 def _reference(frames, boxes, observed, sm: BoxSmoother):
@@ -22,9 +22,10 @@ def _reference(frames, boxes, observed, sm: BoxSmoother):
     h = np.median(boxes[observed, 3])
     q = h * np.array([sm.accel, sm.accel, sm.size_accel, sm.size_accel])
     r = h * np.array([sm.noise, sm.noise, sm.size_noise, sm.size_noise])
-    s = np.column_stack([cv_posterior_mean(zt[:, k], has, q[k], r[k], 10 * h) for k in range(4)])[
-        frames - f0
-    ]
+    s = np.column_stack(
+        [wna_posterior_mean(zt[:, k], has, q[k] ** 2, r[k] ** 2, 10 * h, False) for k in range(4)]
+    )[frames - f0]
+    s[:, 2:] = np.maximum(s[:, 2:], 0.5 * z[observed, 2:].min(axis=0))  # BoxSmoother's size floor
     return np.column_stack([s[:, :2] - s[:, 2:] / 2, s[:, 2:]])
 
 

@@ -126,8 +126,8 @@ def test_centre_kalman_matches_the_matrix_filter():
     h, accel = 40.0, 0.01
     kf = CentreKalman(np.array([100.0, 50.0]), h, accel)
     F = np.kron(np.array([[1.0, 1.0], [0.0, 1.0]]), np.eye(2))  # state [px, py, vx, vy]
-    G = np.kron(np.array([[0.5], [1.0]]), np.eye(2))
-    Q = (accel * h) ** 2 * G @ G.T
+    # continuous white-noise acceleration of spectral density (accel h)^2, written out
+    Q = (accel * h) ** 2 * np.kron(np.array([[1 / 3, 1 / 2], [1 / 2, 1.0]]), np.eye(2))
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
     x = np.array([100.0, 50.0, 0.0, 0.0])
     P = np.diag([(0.05 * h) ** 2] * 2 + [(0.3 * h) ** 2] * 2)

@@ -1,6 +1,6 @@
 """Settings of :class:`~pftrack.tracking.MultiObjectTracker`, one small dataclass per concern.
 
-Every default is a rule, not a per-sequence tuning (README).
+Every default is a rule, not a per-sequence tuning (measured in docs/results.md).
 """
 
 from __future__ import annotations
@@ -113,8 +113,9 @@ class MotionConfig:
     Attributes
     ----------
     accel, detection_noise, colour_noise : float
-        In track heights: the standard deviation of the acceleration per frame², of a
-        detection's centre and of the colour filter's estimate (the measurement while the track
+        In track heights: the square root of the acceleration's spectral density (white-noise
+        acceleration, per frame^1.5), and the standard deviations of a detection's centre and of
+        the colour filter's estimate (the measurement while the track
         coasts, and a second opinion before association).
     smooth_external : bool
         With external detections, report a matched track's filtered box (Kalman centre,

@@ -15,10 +15,10 @@ class CentreKalman:
     """Constant-velocity Kalman filter of a track's centre, both axes sharing one covariance.
 
     Noise levels are in units of the track's height ``h`` so that one rule fits any image scale:
-    acceleration of standard deviation ``accel·h`` per frame², and a measurement standard
-    deviation given at each update (a detection's or the colour filter's, in pixels). The
-    equations are :func:`pftrack.kalman.cv_predict` and :func:`~pftrack.kalman.cv_update`
-    (``discretisation="piecewise"``, transitional), run on both axes at once.
+    white-noise acceleration of spectral density ``(accel·h)²`` (px²/frame³), and a measurement
+    standard deviation given at each update (a detection's or the colour filter's, in pixels).
+    The equations are :func:`pftrack.kalman.cv_predict` and :func:`~pftrack.kalman.cv_update`,
+    run on both axes at once.
 
     Parameters
     ----------
@@ -27,7 +27,7 @@ class CentreKalman:
     height : float
         The track's height, pixels.
     accel : float
-        Acceleration standard deviation in heights per frame².
+        Square root of the acceleration's spectral density, in heights (per frame^1.5).
 
     Attributes
     ----------
@@ -50,9 +50,7 @@ class CentreKalman:
 
     def predict(self, height: float) -> None:
         """Advance one frame, with the acceleration scaled by the track's current `height`."""
-        (p, v), self.cov = cv_predict(
-            (self.p, self.v), self.cov, (self.accel * height) ** 2, discretisation="piecewise"
-        )
+        (p, v), self.cov = cv_predict((self.p, self.v), self.cov, (self.accel * height) ** 2)
         self.p, self.v = np.asarray(p), np.asarray(v)
 
     def update(self, z: ArrayLike, sigma: float) -> None:

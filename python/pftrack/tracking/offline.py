@@ -9,7 +9,7 @@ Frames without a detection (occlusions the particle filter bridged, merged blobs
 smoother's interpolation through the gap.
 
 Noise levels are in units of the track's median box height, so that one rule fits any image
-scale. With the defaults (measured on PETS09-S2L1 and TUD-Campus public detections, README)
+scale. With the defaults (measured on PETS09-S2L1 and TUD-Campus public detections, docs/results.md)
 the smoothed boxes match the annotation far more often than the detections themselves.
 """
 
@@ -35,19 +35,20 @@ class BoxSmoother:
     Attributes
     ----------
     accel : float
-        Standard deviation of the centre's acceleration per frame², in track heights.
+        Square root of the spectral density of the centre's white-noise acceleration, in track
+        heights (per frame^1.5).
     noise : float
         Standard deviation of a detection's centre, in track heights.
     size_accel : float
-        Standard deviation of the width's and height's second difference per frame², in track
-        heights.
+        The same for the width and height, in track heights.
     size_noise : float
         Standard deviation of a detection's width and height, in track heights.
 
     Only the ratios ``accel / noise`` and ``size_accel / size_noise`` change the smoothed
     boxes; the smaller they are, the smoother the path. The model is
-    :func:`pftrack.kalman.rts_smooth` with ``discretisation="piecewise"`` (transitional) and the
-    first detection as the initial state.
+    :func:`pftrack.kalman.rts_smooth` with the first detection as the initial state. A smoothed
+    width or height never falls below half the track's smallest detected one (a size velocity
+    extrapolated past the last detection could otherwise shrink a box through zero).
     """
 
     accel: float = 0.0025
@@ -109,8 +110,8 @@ class BoxSmoother:
         has = np.zeros(steps, dtype=bool)
         zt[f[first:] - f[first]] = z[first:]
         has[f[first:] - f[first]] = obs[first:]
-        mean = rts_smooth(zt, has, q * q, r * r, velocity_sd=10.0 * height, update_first=False,
-                          discretisation="piecewise")  # fmt: skip
+        mean = rts_smooth(zt, has, q * q, r * r, velocity_sd=10.0 * height, update_first=False)
+        np.maximum(mean[:, 2:], 0.5 * z[obs, 2:].min(axis=0), out=mean[:, 2:])
         out: F64 = b.copy()
         out[first:] = cxcywh_to_xywh(mean[f[first:] - f[first]])
         return out  # rows before the first detection keep their own boxes
