@@ -52,6 +52,7 @@ from pftrack.particle_filter import (
 from pftrack.render import draw_tracks
 from pftrack.synthetic import Scene, make_scene
 from pftrack.tracking import TrackerConfig, load_detections, track_frames
+from pftrack.tracking.joint import joint_config
 
 SAMPLERS = ("sis", "mh", "rjmcmc")
 
@@ -230,19 +231,7 @@ def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) ->
     filters: dict[int, Any] = {}
     joint = None
     if sampler == "rjmcmc":
-        m = cfg.filter.model
-        joint = RJMCMCFilter(
-            replace(
-                cfg.rjmcmc,
-                n_samples=particles,
-                a=tuple(m.a),
-                b=tuple(m.b),
-                sigma=tuple(m.sigma),
-                s_min=m.s_min,
-                s_max=m.s_max,
-            ),
-            rng=rng,
-        )
+        joint = RJMCMCFilter(joint_config(cfg), rng=rng)
     cls = MHColourParticleFilter if sampler == "mh" else ColourParticleFilter
     total = 0.0
     for n, frame in enumerate(scene.frames, start=1):

@@ -16,11 +16,29 @@ from numpy.typing import NDArray
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, iou_xywh, xywh_to_cxcywh
-from pftrack.particle_filter import RJMCMCFilter
+from pftrack.particle_filter import RJMCMCConfig, RJMCMCFilter
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.track import Track
 
-__all__ = ["JointTracker"]
+__all__ = ["JointTracker", "joint_config"]
+
+
+def joint_config(config: TrackerConfig) -> RJMCMCConfig:
+    """The joint sampler's settings with the per-object filters' budget and AR(2) dynamics.
+
+    ``config.rjmcmc`` with the sample count of ``config.filter`` and its dynamics, so that only
+    the sampler differs between ``sampler="sis" | "mh" | "rjmcmc"``.
+    """
+    m = config.filter.model
+    return replace(
+        config.rjmcmc,
+        n_samples=config.filter.n_particles,
+        a=tuple(m.a),
+        b=tuple(m.b),
+        sigma=tuple(m.sigma),
+        s_min=m.s_min,
+        s_max=m.s_max,
+    )
 
 
 class JointTracker:
@@ -45,11 +63,7 @@ class JointTracker:
              scores: F64, index: NDArray[np.intp]) -> list[Track]:  # fmt: skip
         """One frame: `boxes` (xywh) are the birth candidates, `index` their input positions."""
         if self._filter is None:
-            m = self.config.filter.model
-            rj = replace(self.config.rjmcmc, n_samples=self.config.filter.n_particles,
-                         a=tuple(m.a), b=tuple(m.b), sigma=tuple(m.sigma), s_min=m.s_min,
-                         s_max=m.s_max)  # fmt: skip
-            self._filter = RJMCMCFilter(rj, rng=self._rng)
+            self._filter = RJMCMCFilter(joint_config(self.config), rng=self._rng)
         estimates = self._filter.step(binned, mask, xywh_to_cxcywh(boxes))
         ebox = np.array([cxcywh_to_xywh(e.box_cxcywh) for e in estimates]).reshape(-1, 4)
         iou = iou_xywh(ebox, boxes) if len(boxes) else np.zeros((len(estimates), 0))
