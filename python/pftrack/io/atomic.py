@@ -1,15 +1,31 @@
-"""Atomic file output: write next to the target, then rename over it in one step."""
+"""Atomic file output: write next to the target, then rename over it in one step.
+
+The temporary file is created with mode ``0o666`` filtered by the process umask, as ``open``
+would create the target itself (``tempfile.mkstemp`` would make every output ``0o600``).
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+import secrets
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
 from pftrack._typing import PathLike
+
+
+def _create_beside(folder: Path, prefix: str, suffix: str) -> tuple[int, str]:
+    """Create a new, unique file in `folder`; the kernel applies the umask to ``0o666``."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+    for _ in range(100):
+        path = os.path.join(folder, f"{prefix}{secrets.token_hex(6)}{suffix}")
+        try:
+            return os.open(path, flags, 0o666), path
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"cannot create a temporary file in {folder}")
 
 
 @contextlib.contextmanager
@@ -34,7 +50,7 @@ def atomic_write(
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"output folder does not exist: {folder}")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or ".tmp", dir=folder)
+    fd, tmp = _create_beside(folder, f".{target.name}.", suffix or ".tmp")
     try:
         with os.fdopen(fd, mode) as fh:
             yield fh
@@ -57,7 +73,7 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"output folder does not exist: {folder}")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix, dir=folder)
+    fd, tmp = _create_beside(folder, f".{target.stem}.", target.suffix)
     os.close(fd)
     try:
         yield Path(tmp)

@@ -1,0 +1,59 @@
+"""Atomic outputs: all or nothing, and created with the user's umask."""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+import pytest
+
+from pftrack.io.atomic import atomic_path, atomic_write
+from pftrack.io.mot import write_mot
+
+
+@pytest.fixture
+def umask():
+    """Set the process umask for one test, then restore it."""
+    old = os.umask(0o022)
+    os.umask(old)
+
+    def set_mask(mask: int) -> None:
+        os.umask(mask)
+
+    yield set_mask
+    os.umask(old)
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o077, 0o002])
+def test_outputs_follow_the_umask(tmp_path: Path, umask, mask: int) -> None:
+    umask(mask)
+    write_mot(tmp_path / "t.txt", [[1, 1, 0, 0, 10, 10]])
+    with atomic_path(tmp_path / "p.bin") as tmp:
+        tmp.write_bytes(b"x")
+    for name in ("t.txt", "p.bin"):
+        assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o666 & ~mask, name
+
+
+def test_failed_write_keeps_the_old_file_and_leaves_nothing(tmp_path: Path) -> None:
+    target = tmp_path / "out.txt"
+    target.write_text("old\n")
+    with pytest.raises(RuntimeError), atomic_write(target) as fh:
+        fh.write("new, half")
+        raise RuntimeError("crash in the middle")
+    assert target.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
+
+
+def test_empty_atomic_path_is_an_error(tmp_path: Path) -> None:
+    with pytest.raises(OSError, match="nothing was written"), atomic_path(tmp_path / "v.mp4"):
+        pass
+    assert not any(tmp_path.iterdir())
+
+
+def test_missing_folder_is_named(tmp_path: Path) -> None:
+    with (
+        pytest.raises(FileNotFoundError, match="missing"),
+        atomic_write(tmp_path / "missing" / "x"),
+    ):
+        pass
