@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -15,14 +16,28 @@ from pftrack._typing import PathLike
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
 
 
+def natural_key(name: str) -> tuple[tuple[int, int | str], ...]:
+    """Sort key that orders the digit runs of `name` as numbers: ``9.jpg < 10.jpg``.
+
+    Image folders written by tools that do not zero-pad frame numbers (``1.jpg, 2.jpg, ...,
+    10.jpg``) would otherwise be read as 1, 10, 11, ..., 2, silently scrambling the video.
+    """
+    return tuple(
+        (0, int(part)) if part.isdigit() else (1, part.lower())
+        for part in re.split(r"(\d+)", name)
+        if part
+    )
+
+
 class FrameSource:
     """Iterate over BGR uint8 frames of a video file or an image folder.
 
     Parameters
     ----------
     source : str or os.PathLike
-        A video file OpenCV can decode, or a folder of images (sorted by name). A MOTChallenge
-        sequence folder with an ``img1/`` sub-folder is accepted too.
+        A video file OpenCV can decode, or a folder of images in natural order (``2.jpg``
+        before ``10.jpg``; see :func:`natural_key`). A MOTChallenge sequence folder with an
+        ``img1/`` sub-folder is accepted too.
     scale : float
         Resize factor applied to every frame (1 keeps the size).
 
@@ -44,7 +59,8 @@ class FrameSource:
         self._images: list[Path] | None = None
         if self.path.is_dir():
             folder = self.path / "img1" if (self.path / "img1").is_dir() else self.path
-            self._images = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+            images = (p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+            self._images = sorted(images, key=lambda p: natural_key(p.name))
             if not self._images:
                 raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
             first = cv2.imread(str(self._images[0]), cv2.IMREAD_COLOR)
