@@ -1,6 +1,23 @@
-"""pftrack: colour particle-filter multi-object tracking and trajectory recovery."""
+"""pftrack: colour particle-filter multi-object tracking and trajectory recovery.
+
+The public API, importable from the top level; each name loads its module on first use, so
+``import pftrack`` (and ``pftrack --help``) stays fast:
+
+- tracking: :class:`MultiObjectTracker`, :class:`TrackerConfig`, :class:`Track`,
+  :func:`track_frames`, :func:`load_detections`, :func:`smooth_tracks`, :class:`BoxSmoother`;
+- recovery: :func:`recover_gap`, :func:`recover_gaps`, :func:`fill_gaps`,
+  :func:`link_tracklets`, :class:`LinkConfig`, :func:`goal_directed_path`;
+- MOTChallenge files and video: :func:`read_mot`, :func:`write_mot`, :class:`FrameSource`;
+- evaluation: :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
+- kernels: :class:`ColourParticleFilter`, :func:`systematic_resample`, :func:`hsv_bins`,
+  :func:`box_histograms`, :func:`bhattacharyya_weights`;
+- :func:`make_scene`, a synthetic scene with known truth.
+"""
 
 from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 try:
     from pftrack import _core  # noqa: F401
@@ -10,5 +27,109 @@ except ImportError as exc:  # pragma: no cover - only without a build
         "or, for development, `pip install --no-build-isolation -ve .`"
     ) from exc
 
+if TYPE_CHECKING:
+    from pftrack.eval import MotMetrics, evaluate_mot, format_metrics
+    from pftrack.io.mot import read_mot, write_mot
+    from pftrack.io.video import FrameSource
+    from pftrack.particle_filter import (
+        ColourParticleFilter,
+        bhattacharyya_weights,
+        box_histograms,
+        hsv_bins,
+        systematic_resample,
+    )
+    from pftrack.recovery import (
+        LinkConfig,
+        fill_gaps,
+        goal_directed_path,
+        link_tracklets,
+        recover_gap,
+        recover_gaps,
+    )
+    from pftrack.synthetic import make_scene
+    from pftrack.tracking import (
+        BoxSmoother,
+        MultiObjectTracker,
+        Track,
+        TrackerConfig,
+        load_detections,
+        smooth_tracks,
+        track_frames,
+    )
+
 __version__ = "0.1.0"
-__all__ = ["__version__"]
+
+_HOME = {
+    "pftrack.tracking": (
+        "BoxSmoother",
+        "MultiObjectTracker",
+        "Track",
+        "TrackerConfig",
+        "load_detections",
+        "smooth_tracks",
+        "track_frames",
+    ),
+    "pftrack.recovery": (
+        "LinkConfig",
+        "fill_gaps",
+        "goal_directed_path",
+        "link_tracklets",
+        "recover_gap",
+        "recover_gaps",
+    ),
+    "pftrack.io.mot": ("read_mot", "write_mot"),
+    "pftrack.io.video": ("FrameSource",),
+    "pftrack.eval": ("MotMetrics", "evaluate_mot", "format_metrics"),
+    "pftrack.particle_filter": (
+        "ColourParticleFilter",
+        "bhattacharyya_weights",
+        "box_histograms",
+        "hsv_bins",
+        "systematic_resample",
+    ),
+    "pftrack.synthetic": ("make_scene",),
+}
+_MODULE_OF = {name: module for module, names in _HOME.items() for name in names}
+
+__all__ = [
+    "__version__",
+    "BoxSmoother",
+    "ColourParticleFilter",
+    "FrameSource",
+    "LinkConfig",
+    "MotMetrics",
+    "MultiObjectTracker",
+    "Track",
+    "TrackerConfig",
+    "bhattacharyya_weights",
+    "box_histograms",
+    "evaluate_mot",
+    "fill_gaps",
+    "format_metrics",
+    "goal_directed_path",
+    "hsv_bins",
+    "link_tracklets",
+    "load_detections",
+    "make_scene",
+    "read_mot",
+    "recover_gap",
+    "recover_gaps",
+    "smooth_tracks",
+    "systematic_resample",
+    "track_frames",
+    "write_mot",
+]
+
+
+def __getattr__(name: str) -> Any:
+    """Load a public name's module on first use (PEP 562)."""
+    module = _MODULE_OF.get(name)
+    if module is None:
+        raise AttributeError(f"module 'pftrack' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
