@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -80,7 +81,11 @@ def test_track_with_public_detections_matches_the_truth(
     ("argv", "message"),
     [
         (["track", "missing.avi", "--out", "t.txt"], "missing.avi"),
-        (["track", "{video}", "--out", "{video}"], "overwrite the input"),
+        (["track", "{video}", "--out", "{video}"], "is an input of this run"),
+        (["track", "{video}", "--out", "."], "is a folder"),
+        (["track", "{video}", "--out", "nowhere/t.txt"], "does not exist"),
+        (["track", "{video}", "--out", "t.txt", "--render", "a.xyz"], "unsupported extension"),
+        (["track", "{video}", "--out", "t.txt", "--plot", "p.txt"], "unsupported extension"),
         (["track", "{video}", "--out", "t.txt", "--detections", "nothing.txt"], "nothing.txt"),
     ],
 )
@@ -119,3 +124,27 @@ def test_every_row_is_inside_the_scene(video: Path, scene: Scene, tmp_path: Path
         rows[:, 3] + rows[:, 5],
     )
     assert np.all((right > 0) & (bottom > 0) & (left < scene.width) & (top < scene.height))
+
+
+def test_unwritable_output_folder_is_refused_before_work(
+    video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        if os.access(locked, os.W_OK):  # running as root: permissions are not enforced
+            pytest.skip("the file system lets this user write anywhere")
+        assert main(["track", str(video), "--out", str(locked / "t.txt")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("pftrack track: error: --out") and "not writable" in err
+    finally:
+        locked.chmod(0o700)
+
+
+def test_failed_run_leaves_an_existing_output_alone(video: Path, tmp_path: Path) -> None:
+    out = tmp_path / "tracks.txt"
+    out.write_text("keep me\n")
+    argv = ["track", str(video), "--out", str(out), "--render", str(tmp_path / "a.xyz")]
+    assert main(argv) == 2
+    assert out.read_text() == "keep me\n"

@@ -35,9 +35,11 @@ def add_parser(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack eval``: print the table, optionally write JSON; return the exit status."""
     from pftrack.eval import evaluate_mot
-    from pftrack.io.atomic import atomic_write
+    from pftrack.io.atomic import atomic_write, check_output
     from pftrack.io.mot import read_mot
 
+    if args.json:
+        check_output(args.json, what="--json", suffixes=(".json",), inputs=(args.gt, args.res))
     gt = read_mot(args.gt, what="ground truth")
     res = read_mot(args.res, what="result file")
     size = tuple(args.image_size) if args.image_size else None

@@ -37,15 +37,19 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack track``; return the exit status."""
+    from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.io.video import FrameSource
     from pftrack.recovery import LinkConfig
     from pftrack.render import plot_trajectories, write_annotated_video
     from pftrack.tracking import BoxSmoother, load_detections, track_frames
 
-    for out in (args.out, args.render, args.plot):
-        if out is not None and Path(out).resolve() == Path(args.source).resolve():
-            raise ValueError(f"output {out} would overwrite the input video")
+    inputs = (args.source,) + ((args.detections,) if args.detections else ())
+    check_output(args.out, what="--out", inputs=inputs)
+    if args.render:
+        check_output(args.render, what="--render", suffixes=(".mp4", ".avi"), inputs=inputs)
+    if args.plot:
+        check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
     source = FrameSource(args.source)
     dets = load_detections(args.detections, args.det_scale) if args.detections else None
     result = track_frames(

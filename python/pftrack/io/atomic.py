@@ -84,3 +84,55 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def check_output(
+    path: PathLike,
+    *,
+    what: str = "output",
+    suffixes: tuple[str, ...] | None = None,
+    inputs: tuple[PathLike, ...] = (),
+) -> Path:
+    """Check, before any work, that `path` can be written; return it as a :class:`Path`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+    what : str
+        How error messages name it (e.g. ``"--render"``).
+    suffixes : tuple of str, optional
+        Accepted extensions, lower case with the dot (e.g. ``(".mp4", ".avi")``).
+    inputs : tuple of paths
+        Files the run reads: the output must not be one of them.
+
+    Raises
+    ------
+    ValueError
+        The extension is not supported, the path is a folder, or it names an input.
+    FileNotFoundError
+        Its folder does not exist.
+    PermissionError
+        Its folder (or the existing file) is not writable.
+    """
+    target = Path(path)
+    if suffixes is not None and target.suffix.lower() not in suffixes:
+        raise ValueError(
+            f"{what} {target}: unsupported extension {target.suffix or '(none)'!r}, expected "
+            f"one of {', '.join(suffixes)}"
+        )
+    if target.is_dir():
+        raise ValueError(f"{what} {target} is a folder; give a file name")
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise FileNotFoundError(f"{what} {target}: folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK) or (
+        target.exists() and not os.access(target, os.W_OK)
+    ):
+        raise PermissionError(f"{what} {target}: not writable")
+    for source in inputs:
+        if target.exists() and Path(source).exists() and os.path.samefile(target, source):
+            raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
+        if target.resolve() == Path(source).resolve():
+            raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
+    return target
