@@ -126,6 +126,64 @@ def test_every_row_is_inside_the_scene(video: Path, scene: Scene, tmp_path: Path
     assert np.all((right > 0) & (bottom > 0) & (left < scene.width) & (top < scene.height))
 
 
+def test_recover_explain_prints_the_choice(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rng = np.random.default_rng(3)
+    rows = []
+    for tid in range(1, 7):
+        t = np.arange(1, 101, dtype=np.float64)
+        xy = 200 + np.cumsum(rng.uniform(-2, 2, (100, 2)), axis=0)
+        keep = (t < 40) | (t > 47)
+        r = np.zeros((int(keep.sum()), 10))
+        r[:, 0] = t[keep]
+        r[:, 1] = tid
+        r[:, 2:4] = xy[keep] - 10
+        r[:, 4:6] = 20
+        r[:, 6] = 1
+        r[:, 7:] = -1
+        rows.append(r)
+    src = tmp_path / "in.txt"
+    write_mot(src, np.vstack(rows))
+    out = tmp_path / "out.txt"
+    assert main(["recover", str(src), "--out", str(out), "--explain"]) == 0
+    text = capsys.readouterr().out
+    assert "(auto," in text and "chosen" in text and "8 " in text.split("chosen")[1]
+    assert len(read_mot(out)) == sum(len(r) for r in rows) + 6 * 8
+
+
+def test_experiment_gaps_several_sequences_writes_json(tmp_path: Path) -> None:
+    import json
+
+    rng = np.random.default_rng(4)
+    paths = []
+    for k in range(2):
+        seq = tmp_path / f"SEQ{k}"
+        (seq / "gt").mkdir(parents=True)
+        (seq / "seqinfo.ini").write_text(
+            f"[Sequence]\nname=SEQ{k}\nframeRate=25\nimWidth=768\nimHeight=576\n"
+        )
+        rows = []
+        for tid in range(1, 16):
+            t = np.arange(1, 151, dtype=np.float64)
+            start = rng.uniform(100, 600, 2)
+            xy = start + np.cumsum(rng.normal(0, 0.5, (150, 2)) + rng.uniform(-2, 2, 2), axis=0)
+            xy = np.clip(xy, 20, [740, 550])
+            r = np.zeros((150, 10))
+            r[:, 0], r[:, 1], r[:, 2:4], r[:, 4:6], r[:, 6], r[:, 7:] = t, tid, xy - 5, 10, 1, -1
+            rows.append(r)
+        write_mot(seq / "gt" / "gt.txt", np.vstack(rows))
+        paths.append(str(seq / "gt" / "gt.txt"))
+    out = tmp_path / "res.json"
+    argv = ["experiment", "gaps", "--gt", *paths, "--methods", "auto,linear", "--json", str(out)]
+    assert main(argv) == 0
+    doc = json.loads(out.read_text())
+    assert [s["name"] for s in doc["sequences"]] == ["SEQ0", "SEQ1"]
+    assert set(doc["pooled"]["mmae"]) == {"auto", "linear"}
+    for s in doc["sequences"]:
+        assert 1 <= len(s["masks"]) <= 3 and all(m[2] == 100 for m in s["masks"])
+
+
 def test_unwritable_output_folder_is_refused_before_work(
     video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -101,14 +101,14 @@ def test_gdt_bi_problem_solves_to_the_batch_path():
     np.testing.assert_allclose(p.solve().path[1:-1, :2], got, atol=1e-8)
 
 
-def test_default_method_is_gdt_mix_everywhere():
-    assert DEFAULT_METHOD == "gdt-mix"
+def test_default_method_is_auto_everywhere():
+    assert DEFAULT_METHOD == "auto"
     rng = np.random.default_rng(7)
     t = np.arange(1, 90)
     xy = 80 + np.cumsum(np.cumsum(rng.normal(0, 0.1, (len(t), 2)), axis=0), axis=0)
     a = np.column_stack([t[:40], xy[:40]])
     b = np.column_stack([t[52:], xy[52:]])
-    want = recover_gap(a, b, method="gdt-mix")
+    want = recover_gap(a, b, method="auto")
     np.testing.assert_array_equal(recover_gap(a, b), want)
     np.testing.assert_array_equal(recover_gaps([(a, b)])[0], want)
     rows = np.zeros((len(a) + len(b), 10))
@@ -116,7 +116,7 @@ def test_default_method_is_gdt_mix_everywhere():
     rows[:, 1] = 1
     rows[:, 2:4] = np.r_[a[:, 1:3], b[:, 1:3]] - 5.0
     rows[:, 4:6] = 10.0
-    assert np.array_equal(fill_gaps(rows)[0], fill_gaps(rows, "gdt-mix")[0])
+    assert np.array_equal(fill_gaps(rows)[0], fill_gaps(rows, "auto")[0])
 
 
 @pytest.mark.parametrize("method", ["ml", "moments"])

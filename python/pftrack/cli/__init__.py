@@ -23,7 +23,7 @@ examples:
   pftrack track video.avi --out tracks.txt --render annotated.mp4 --plot paths.png
   pftrack track seq/img1 --detections det.txt --out tracks.txt      # drop-in for any detector
   pftrack eval --gt gt.txt --res tracks.txt --scale 0.625
-  pftrack recover tracks.txt --out filled.txt --link                # default method: gdt-mix
+  pftrack recover tracks.txt --out filled.txt --link                # default method: auto
   pftrack smooth bytetrack.txt --out smoothed.txt                   # any tracker's output
 """
 

@@ -22,9 +22,17 @@ def add_parser(sub: Any) -> None:
         "lost points is one gap recovered from the observed segments around it; trajectories "
         "starting or ending inside the mask are left out. Prints MMAE per axis, MMAE total "
         "(mean Euclidean), pooled MAE and wall time per method, for one mask and as the median "
-        "over every mask position on a grid that meets the selection.",
+        "over every mask position on a grid that meets the selection. With several --gt files "
+        "(or --auto-masks): per sequence, 3 non-overlapping square masks of side round(100 W/768) "
+        "px placed greedily on a round(4 W/768) px grid where they cut the most gaps; prints "
+        "per-sequence and pooled MMAE of every method (image size W x H from seqinfo.ini beside "
+        "the ground truth or one folder up, else --image-size).",
     )
-    g.add_argument("--gt", required=True, help="ground truth (MOTChallenge)")
+    g.add_argument("--gt", required=True, nargs="+", help="ground truth file(s) (MOTChallenge)")
+    g.add_argument("--auto-masks", action="store_true",
+                   help="the multi-sequence protocol, even for one --gt")  # fmt: skip
+    g.add_argument("--n-masks", type=positive_int, default=3, help="masks per sequence")
+    g.add_argument("--json", metavar="OUT", help="write the multi-sequence results as JSON")
     g.add_argument("--mask", help="x,y,w,h of the representative mask (default: chosen by rule)")
     g.add_argument("--point", default="centre", choices=("centre", "foot"),
                    help="box point used as the trajectory")  # fmt: skip
@@ -66,20 +74,49 @@ def _parse_size(text: str) -> tuple[float, float]:
         raise ValueError(f"--image-size is {text!r}, expected WxH") from None
 
 
+def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
+    """Name and image size from ``seqinfo.ini`` beside the ground truth or one folder up."""
+    import configparser
+    from pathlib import Path
+
+    gt = Path(gt_path).resolve()
+    for folder in (gt.parent, gt.parent.parent):
+        ini = folder / "seqinfo.ini"
+        if ini.is_file():
+            cp = configparser.ConfigParser()
+            cp.read(ini)
+            try:
+                sec = cp["Sequence"]
+                return sec.get("name", folder.name), float(sec["imWidth"]), float(sec["imHeight"])
+            except (KeyError, ValueError):
+                raise ValueError(f"{ini}: expected [Sequence] imWidth and imHeight") from None
+    return None
+
+
+def _methods(text: str) -> list[str]:
+    methods = [m.strip() for m in text.split(",") if m.strip()]
+    for m in methods:
+        if m not in METHODS:
+            raise ValueError(f"--methods: unknown method {m!r}, expected some of {METHODS}")
+    if not methods:
+        raise ValueError("--methods is empty")
+    return methods
+
+
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
+    if len(args.gt) > 1 or args.auto_masks:
+        return _run_sequences(args)
     import numpy as np
 
     from pftrack.io.mot import read_mot
     from pftrack.recovery import experiment as E
 
+    args.gt = args.gt[0]
     gt = read_mot(args.gt, what="ground truth")
     if len(gt) == 0:
         raise ValueError(f"ground truth {args.gt} is empty")
-    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    for m in methods:
-        if m not in METHODS:
-            raise ValueError(f"--methods: unknown method {m!r}, expected some of {METHODS}")
+    methods = _methods(args.methods)
     if args.image_size:
         width, height = _parse_size(args.image_size)
     else:
@@ -142,3 +179,68 @@ def _write_figure(path: str, image: Any) -> None:
     with atomic_path(path) as tmp:
         if not cv2.imwrite(str(tmp), image, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
             raise ValueError(f"cannot write figure {path}")
+
+
+def _run_sequences(args: argparse.Namespace) -> int:
+    """The multi-sequence protocol with automatic masks (``--gt A B ...`` or ``--auto-masks``)."""
+    import json
+    from pathlib import Path
+
+    from pftrack._progress import progress
+    from pftrack.io.atomic import atomic_write
+    from pftrack.io.mot import read_mot
+    from pftrack.recovery import experiment as E
+
+    methods = _methods(args.methods)
+    jobs = []
+    for path in args.gt:
+        gt = read_mot(path, what="ground truth")
+        if len(gt) == 0:
+            raise ValueError(f"ground truth {path} is empty")
+        info = _seqinfo(path)
+        if info is not None:
+            name, width, height = info
+        elif args.image_size:
+            width, height = _parse_size(args.image_size)
+            name = Path(path).resolve().parent.name
+        else:
+            raise ValueError(
+                f"{path}: no seqinfo.ini beside it or one folder up; pass --image-size"
+            )
+        jobs.append((name, E.trajectories(gt, args.point), width, height))
+    results = [
+        E.run_sequence(name, trajs, width, height, methods, args.n_masks)
+        for name, trajs, width, height in progress(jobs, total=len(jobs), desc="sequences")
+    ]
+    for r in results:
+        masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks)
+        print(f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}")
+    print()
+    print("MMAE (px, mean over gaps of the mean Euclidean error); * = best of the row")
+    print(E.format_sequences(results, methods))
+    if args.json:
+        doc: dict[str, Any] = {
+            "protocol": "auto masks: side round(100W/768), grid round(4W/768), greedy, "
+            f"{args.n_masks} per sequence, {args.point} point",
+            "methods": methods,
+            "sequences": [
+                {
+                    "name": r.name,
+                    "image_size": list(r.image_size),
+                    "masks": [list(m) for m in r.masks],
+                    "n_gaps": r.n_gaps,
+                    "mmae": {m: r.mmae(m) if r.n_gaps else None for m in methods},
+                    "gap_errors": {m: list(r.errors[m]) for m in methods},
+                }
+                for r in results
+            ],
+        }
+        pooled = {m: [e for r in results for e in r.errors[m]] for m in methods}
+        doc["pooled"] = {
+            "n_gaps": sum(r.n_gaps for r in results),
+            "mmae": {m: (sum(v) / len(v) if v else None) for m, v in pooled.items()},
+        }
+        with atomic_write(args.json) as f:
+            json.dump(doc, f, indent=1)
+        print(f"json: {args.json}")
+    return 0

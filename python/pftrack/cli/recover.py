@@ -27,6 +27,11 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--method", default=DEFAULT_METHOD, choices=METHODS, help="recovery method")
     p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
                    help="longest hole filled, in frames")  # fmt: skip
+    p.add_argument("--explain", action="store_true",
+                   help="with auto: print the method chosen per gap length and its validation "
+                   "MMAE")  # fmt: skip
+    p.add_argument("--seed", type=int, default=0,
+                   help="auto: seed of the artificial calibration gaps")  # fmt: skip
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
     p.add_argument("--max-distance", type=float, default=50.0, metavar="PX",
                    help="linking gate on the motion-prediction distance (pixels)")  # fmt: skip
@@ -60,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         rows, mapping = link_tracklets(rows, cfg, frames)
         n_links = len(mapping)
     t0 = time.perf_counter()
-    filled, rep = fill_gaps(rows, args.method, args.max_gap)
+    filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
     dt = time.perf_counter() - t0
     write_mot(out, filled)
     print(
@@ -68,4 +73,11 @@ def run(args: argparse.Namespace) -> int:
         f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "
         f"(interpolated flag: column 8)"
     )
+    if args.explain:
+        if rep.calibration is not None:
+            print(rep.calibration.describe())
+        elif args.method == "auto":
+            print("auto: no gap to fill")
+        else:
+            print(f"--explain: {args.method} was given, nothing was chosen")
     return 0

@@ -27,15 +27,19 @@ __all__ = [
     "MaskRun",
     "MedianScores",
     "MethodScore",
+    "SequenceResult",
     "Sweep",
+    "auto_masks",
     "count_gaps_grid",
     "draw_figure",
     "find_gaps",
     "format_median",
+    "format_sequences",
     "format_table",
     "median_over",
     "observed_runs",
     "run_mask",
+    "run_sequence",
     "score",
     "sweep",
     "trajectories",
@@ -144,14 +148,18 @@ def score(
     repeat: int = 1,
     noise: NoiseEstimate | None = None,
     motion: MotionFit | None = None,
+    observed: Sequence[F64] | None = None,
 ) -> tuple[MethodScore, list[F64]]:
-    """Recover all gaps with `method` (best wall time of `repeat` runs) and score them."""
+    """Recover all gaps with `method` (best wall time of `repeat` runs) and score them.
+
+    `observed`: for ``"auto"``, the observed runs it calibrates on (all points outside the mask).
+    """
     pairs = [(g.segment_a, g.segment_b) for g in gaps]
     best = np.inf
     paths: list[F64] = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        paths = recover_gaps(pairs, method, noise=noise, motion=motion)
+        paths = recover_gaps(pairs, method, noise=noise, motion=motion, observed=observed)
         best = min(best, time.perf_counter() - t0)
     ex, ey, ee = [], [], []
     for g, p in zip(gaps, paths, strict=True):
@@ -195,14 +203,18 @@ def run_mask(
     """Run all methods on one mask.
 
     The noise levels of ``"gdt-bi"`` and the model of ``"gdt-mix"`` are estimated once from
-    every observed point of the sequence (all points outside the mask), timed separately.
+    every observed point of the sequence (all points outside the mask), timed separately;
+    ``"auto"`` calibrates on the same observed points (its time includes the calibration).
     """
     gaps, n_traj = find_gaps(trajs, mask)
     scores: dict[str, MethodScore] = {}
     paths: dict[str, list[F64]] = {}
     noise = motion = None
     noise_ms = motion_ms = 0.0
+    runs: list[F64] | None = None
     if gaps:
+        if "auto" in methods:
+            runs = observed_runs(trajs, mask)
         if "gdt-bi" in methods or "gdt-mix" in methods:
             runs = observed_runs(trajs, mask)
             t0 = time.perf_counter()
@@ -213,7 +225,10 @@ def run_mask(
                 motion = fit_motion(runs, noise)
                 motion_ms = 1e3 * (time.perf_counter() - t0)
         for m in methods:
-            scores[m], paths[m] = score(gaps, m, repeat, noise, motion)
+            if m == "auto":  # calibrates itself, from the observed points only
+                scores[m], paths[m] = score(gaps, m, repeat, observed=runs)
+            else:
+                scores[m], paths[m] = score(gaps, m, repeat, noise, motion)
     mk = tuple(float(v) for v in mask)
     return MaskRun(
         (mk[0], mk[1], mk[2], mk[3]),
@@ -439,3 +454,117 @@ def format_median(ms: MedianScores) -> str:
     methods = list(ms.median)
     width = max(10, *(len(m) + 2 for m in methods))
     return text + "\n" + f"{'best at':<14}" + "".join(f"{ms.wins[m]:>{width}d}" for m in methods)
+
+
+def auto_masks(
+    trajs: dict[int, F64], width: float, height: float, n: int = 3
+) -> list[tuple[float, float, float, float]]:
+    """Masks of the multi-sequence protocol, placed greedily where they cut the most gaps.
+
+    Squares of side ``round(100 W / 768)`` px on a ``round(4 W / 768)`` px grid, fully inside
+    the ``width x height`` image; each next mask is the position (not overlapping the masks
+    already placed) with the most gaps, ties broken by more trajectories, then by the mask
+    centre nearer the image centre, then by grid order. Positions without a gap are not used,
+    so fewer than `n` masks may be returned.
+
+    Raises
+    ------
+    ValueError
+        A non-positive image size, an image smaller than the mask, or `n` < 1.
+    """
+    if width <= 0 or height <= 0:
+        raise ValueError(f"auto_masks: image size is {width:g}x{height:g}, expected > 0")
+    if n < 1:
+        raise ValueError(f"auto_masks: n is {n}, expected >= 1")
+    size = float(round(100.0 * width / 768.0))
+    step = float(max(1, round(4.0 * width / 768.0)))
+    if size > width or size > height:
+        raise ValueError(
+            f"auto_masks: mask side {size:g} px exceeds the image {width:g}x{height:g}"
+        )
+    xs, ys, nt, ng = count_gaps_grid(trajs, size, width, height, step)
+    gx, gy = np.meshgrid(xs, ys)
+    dist = np.hypot(gx + size / 2 - width / 2, gy + size / 2 - height / 2)
+    # lexsort: last key first -> most gaps, most trajectories, nearest centre, grid order
+    order = np.lexsort((np.arange(dist.size), dist.ravel(), -nt.ravel(), -ng.ravel()))
+    masks: list[tuple[float, float, float, float]] = []
+    for i in order:
+        if ng.flat[i] <= 0 or len(masks) >= n:
+            break
+        x, y = float(gx.flat[i]), float(gy.flat[i])
+        if all(abs(x - m[0]) >= size or abs(y - m[1]) >= size for m in masks):
+            masks.append((x, y, size, size))
+    return masks
+
+
+@dataclass(frozen=True)
+class SequenceResult:
+    """Multi-sequence protocol, one sequence: its masks and the errors of every gap per method.
+
+    ``errors[m]`` holds the mean Euclidean error (px) of each gap, in mask order; the
+    sequence's MMAE is their mean.
+    """
+
+    name: str
+    image_size: tuple[float, float]
+    masks: tuple[tuple[float, float, float, float], ...]
+    n_gaps: int
+    errors: dict[str, tuple[float, ...]]
+
+    def mmae(self, method: str) -> float:
+        """MMAE of `method` over every gap of the sequence (NaN without gaps)."""
+        e = self.errors[method]
+        return float(np.mean(e)) if e else float("nan")
+
+
+def run_sequence(
+    name: str,
+    trajs: dict[int, F64],
+    width: float,
+    height: float,
+    methods: Sequence[str] = METHODS,
+    n_masks: int = 3,
+) -> SequenceResult:
+    """Run every method on the gaps of the automatic masks (:func:`auto_masks`) of a sequence.
+
+    Each mask is its own experiment: the points inside it are lost, everything outside it is
+    observed (noise levels, motion model and ``"auto"``'s calibration use only those).
+    """
+    masks = auto_masks(trajs, width, height, n_masks)
+    errors: dict[str, list[float]] = {m: [] for m in methods}
+    n_gaps = 0
+    for mk in masks:
+        run = run_mask(trajs, mk, methods)
+        n_gaps += len(run.gaps)
+        for m in methods:
+            for g, p in zip(run.gaps, run.paths.get(m, []), strict=True):
+                errors[m].append(float(np.mean(np.hypot(*(p - g.truth[:, 1:3]).T))))
+    return SequenceResult(
+        name,
+        (float(width), float(height)),
+        tuple(masks),
+        n_gaps,
+        {m: tuple(v) for m, v in errors.items()},
+    )
+
+
+def format_sequences(results: Sequence[SequenceResult], methods: Sequence[str]) -> str:
+    """Per-sequence and pooled MMAE (px), one column per method; ``*`` marks each row's best."""
+    width = max(10, *(len(m) + 3 for m in methods))
+    name_w = max(12, *(len(r.name) + 2 for r in results)) if results else 12
+    head = f"{'sequence':<{name_w}}{'gaps':>6}" + "".join(f"{m:>{width}}" for m in methods)
+    lines = [head]
+    pooled = {m: [e for r in results for e in r.errors[m]] for m in methods}
+    rows = [(r.name, r.n_gaps, {m: r.mmae(m) for m in methods}) for r in results]
+    n_all = sum(r.n_gaps for r in results)
+    rows.append(
+        ("pooled", n_all, {m: float(np.mean(v)) if v else float("nan") for m, v in pooled.items()})
+    )
+    for label, n, vals in rows:
+        finite = [v for v in vals.values() if np.isfinite(v)]
+        best = min(finite) if finite else float("nan")
+        cells = "".join(
+            f"{vals[m]:>{width - 1}.3f}{'*' if vals[m] == best else ' '}" for m in methods
+        )
+        lines.append(f"{label:<{name_w}}{n:>6}{cells}")
+    return "\n".join(lines)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pftrack._typing import F64
+from pftrack.recovery.calibrate import Calibration, recover_auto
 from pftrack.recovery.linking import FLAG_COLUMN, box_centres, check_unique, split_tracks
 from pftrack.recovery.mixture import MotionFit, fit_motion
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
@@ -24,11 +25,16 @@ __all__ = ["FillReport", "fill_gaps"]
 
 @dataclass(frozen=True)
 class FillReport:
-    """What :func:`fill_gaps` did."""
+    """What :func:`fill_gaps` did.
+
+    ``calibration``: with ``"auto"``, the method chosen per gap-length bucket and the
+    validation MMAE of every candidate (:class:`~pftrack.recovery.calibrate.Calibration`).
+    """
 
     n_gaps: int
     n_filled_rows: int
     noise: NoiseEstimate | None
+    calibration: Calibration | None = None
 
 
 def fill_gaps(
@@ -36,6 +42,8 @@ def fill_gaps(
     method: str = DEFAULT_METHOD,
     max_gap: int = 30,
     noise: NoiseEstimate | None = None,
+    *,
+    seed: int = 0,
 ) -> tuple[F64, FillReport]:
     """Fill every hole of at most `max_gap` missing frames inside each id's track.
 
@@ -44,13 +52,16 @@ def fill_gaps(
     tracks : (M, 10) ndarray
         MOTChallenge rows; each (frame, id) at most once.
     method : str
-        One of :data:`~pftrack.recovery.registry.METHODS`; default ``"gdt-mix"``.
+        One of :data:`~pftrack.recovery.registry.METHODS`; default ``"auto"`` (calibrated on
+        the file's own observed tracks, :mod:`pftrack.recovery.calibrate`).
     max_gap : int
         Longest hole filled, in frames (>= 1).
     noise : NoiseEstimate, optional
         For ``"gdt-bi"`` and ``"gdt-mix"``: noise levels to use; default: estimated from every
         track of the file (:func:`~pftrack.recovery.noise.estimate_noise`). ``"gdt-mix"`` fits
         one motion model to the whole file.
+    seed : int
+        For ``"auto"``: seed of the generator placing the artificial calibration gaps.
 
     Returns
     -------
@@ -59,7 +70,8 @@ def fill_gaps(
         `method`, sizes by linear interpolation, ``conf`` = the smaller of the two neighbours'
         and the interpolated flag (column 8, :data:`FLAG_COLUMN`) set to 1.
     report : FillReport
-        How many holes and rows were filled.
+        How many holes and rows were filled; with ``"auto"``, what was chosen
+        (``report.calibration``).
 
     Raises
     ------
@@ -88,6 +100,7 @@ def fill_gaps(
             segs.append((seg[: h + 1], seg[h + 1 :]))
             meta.append((tid, r[h], r[h + 1]))
     motion: MotionFit | None = None
+    calibration: Calibration | None = None
     if method in ("gdt-bi", "gdt-mix") and segs:
         whole = [box_centres(r) for r in per_id.values()]
         if noise is None:
@@ -96,7 +109,11 @@ def fill_gaps(
             motion = fit_motion(whole, noise)
     new_rows: list[F64] = []
     if segs:
-        paths = recover_gaps(segs, method, noise=noise, motion=motion)
+        if method == "auto":
+            whole = [box_centres(r) for r in per_id.values()]
+            paths, calibration = recover_auto(segs, whole, noise, motion, seed=seed)
+        else:
+            paths = recover_gaps(segs, method, noise=noise, motion=motion)
         for (tid, ra, rb), xy in zip(meta, paths, strict=True):
             fr = np.arange(ra[0] + 1, rb[0])
             s = (fr - ra[0]) / (rb[0] - ra[0])
@@ -117,4 +134,4 @@ def fill_gaps(
     filled = np.vstack([rows, *new_rows]) if new_rows else rows.copy()
     order = np.lexsort((filled[:, 1], filled[:, 0]))
     n_new = sum(len(r) for r in new_rows)
-    return filled[order], FillReport(len(segs), n_new, noise)
+    return filled[order], FillReport(len(segs), n_new, noise, calibration)

@@ -15,7 +15,15 @@ Methods
     levels estimated from the observed segments
     (:func:`~pftrack.recovery.problems.gdt_bi_problem`,
     :func:`~pftrack.recovery.noise.estimate_noise`).
-``"gdt-mix"`` (the default, :data:`DEFAULT_METHOD`)
+``"auto"`` (the default, :data:`DEFAULT_METHOD`)
+    Calibrated on the file itself: artificial gaps of the lengths to fill are cut into the
+    observed runs, every candidate method recovers them, and each gap-length bucket uses the
+    best (a straight line unless another method is clearly better;
+    :mod:`pftrack.recovery.calibrate`).
+``"gdt-fixed"`` (pftrack's variant)
+    ``gdt-bi``'s two-sided goal with the paper's fixed noise levels (nothing estimated, so
+    camera motion and annotation jitter cannot inflate them).
+``"gdt-mix"``
     ``gdt-bi`` mixed over "walks through" and "stands still for a while" hypotheses, each
     weighted by its evidence, with the Singer motion model (correlated acceleration) where the
     observed points support it; every parameter estimated from the observed points
@@ -35,6 +43,7 @@ from numpy.typing import ArrayLike
 
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes
+from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
@@ -43,11 +52,13 @@ from pftrack.recovery.segments import as_segment, gap_frames
 __all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS", "recover_gap", "recover_gaps"]
 
 #: Every method, in the order tables list them.
-METHODS = ("gdt", "gdt-bi", "gdt-mix", "linear", "cubic", "bspline", "gsi", "rts")
-#: The goal-directed methods (pftrack's own), solved for all gaps at once.
-GOAL_DIRECTED_METHODS = ("gdt", "gdt-bi", "gdt-mix")
+METHODS = (
+    "auto", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "linear", "cubic", "bspline", "gsi", "rts"
+)  # fmt: skip
+#: The methods solved for all gaps at once (pftrack's own and the calibrated ``"auto"``).
+GOAL_DIRECTED_METHODS = ("auto", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
 #: The method of :func:`recover_gap`, :func:`recover_gaps`, ``fill_gaps`` and ``pftrack recover``.
-DEFAULT_METHOD = "gdt-mix"
+DEFAULT_METHOD = "auto"
 
 
 def recover_gap(
@@ -68,7 +79,8 @@ def recover_gap(
     frames : (F,) array_like of int, optional
         Frames to fill, strictly between the two segments; default: all of them.
     method : str
-        One of :data:`METHODS` (see the module docstring); default ``"gdt-mix"``.
+        One of :data:`METHODS` (see the module docstring); default ``"auto"`` (calibrated on
+        the two segments only; :func:`recover_gaps` with `observed` calibrates on a whole file).
     noise : NoiseEstimate, optional
         For ``"gdt-bi"``: noise levels to use instead of estimating them from the two segments
         (e.g. pooled over a whole file with :func:`~pftrack.recovery.noise.estimate_noise`).
@@ -110,6 +122,7 @@ def recover_gaps(
     noise: NoiseEstimate | None = None,
     history: int | None = None,
     motion: MotionFit | None = None,
+    observed: Sequence[F64] | None = None,
 ) -> list[F64]:
     """Recover many gaps at once.
 
@@ -118,7 +131,7 @@ def recover_gaps(
     gaps : sequence of (segment_a, segment_b)
         Segments as in :func:`recover_gap` (only ``frame, x, y`` are used).
     method : str
-        One of :data:`METHODS`; default ``"gdt-mix"``.
+        One of :data:`METHODS`; default ``"auto"``.
     noise : NoiseEstimate, optional
         For ``"gdt-bi"``: noise levels shared by all gaps; default: estimated from all the
         segments given (:func:`~pftrack.recovery.noise.estimate_noise`).
@@ -128,6 +141,10 @@ def recover_gaps(
     motion : MotionFit, optional
         For ``"gdt-mix"``: the model shared by all gaps; default: fitted to all the segments
         given (:func:`pftrack.recovery.mixture.fit_motion`, with `noise` as its fallback).
+    observed : sequence of (k, 3+) ndarray, optional
+        For ``"auto"``: every observed track of the file to calibrate on; default: the
+        segments given (:func:`pftrack.recovery.calibrate.recover_auto`, which also returns
+        what was chosen).
 
     Returns
     -------
@@ -155,6 +172,8 @@ def recover_gaps(
                 f"recover_gaps: {name} of gap {k % len(gaps)} must have shape (k, 3|5), "
                 f"non-empty; got {s.shape}"
             )
+    if method == "auto":
+        return recover_auto(list(zip(seg_a, seg_b, strict=True)), observed, noise, motion)[0]
     if method == "gdt-mix":
         pairs = [
             (as_segment(a, "segment_a"), as_segment(b, "segment_b"))
@@ -171,6 +190,8 @@ def recover_gaps(
         return recover_mixture_gaps(pairs, motion)
     if method == "gdt":
         model = SegmentModel.paper()
+    elif method == "gdt-fixed":
+        model = fixed_noise_model()
     else:
         model = SegmentModel.two_sided(estimate_noise(seg_a + seg_b) if noise is None else noise)
     return model.recover(seg_a, seg_b, history)

@@ -1,0 +1,382 @@
+"""The ``"auto"`` method: choose a recovery method per file and gap length, on the file itself.
+
+Calibration cuts artificial gaps into the observed runs of consecutive frames of the file's
+own tracks, with the lengths of the gaps that need filling, recovers them with every candidate
+method (:data:`CANDIDATES`) and keeps, per gap-length bucket, the method with the lowest
+validation MMAE (mean over gaps of the mean Euclidean error). A straight line wins ties within
+:data:`LINEAR_MARGIN`: where nothing beats it clearly, the result is a straight line.
+
+Only observed points are used: the points inside the gaps to fill are not part of the input.
+The artificial gaps are drawn with a seeded generator, so the same input gives the same output.
+
+Buckets are powers of two of the number of missing frames: ``1``, ``2``, ``3-4``, ``5-8``,
+``9-16``, ... (:func:`bucket_of`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from pftrack._typing import F64
+from pftrack.recovery.baselines import BASELINES
+from pftrack.recovery.gdt import GdtModel
+from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
+from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.problems import SegmentModel
+from pftrack.recovery.segments import as_segment
+
+__all__ = [
+    "CANDIDATES",
+    "LINEAR_MARGIN",
+    "MAX_CALIBRATION_GAPS",
+    "BucketChoice",
+    "Calibration",
+    "bucket_of",
+    "calibrate",
+    "fixed_noise_model",
+    "recover_auto",
+    "recover_with",
+]
+
+#: Methods scored by the calibration (``"gdt-fixed"``: two-sided goal, the paper's fixed noise).
+CANDIDATES = ("linear", "bspline", "rts", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
+#: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
+LINEAR_MARGIN = 0.01
+#: At most this many artificial gaps per file, over all buckets.
+MAX_CALIBRATION_GAPS = 200
+#: Fewer validation gaps than this in a bucket: the bucket falls back to ``"linear"``.
+MIN_VALIDATION_GAPS = 5
+#: Observed points kept on each side of an artificial gap, at least.
+CONTEXT = 3
+#: Noise levels and the motion model of ``"auto"`` are fitted to at most about this many
+#: observed points (whole runs, drawn with the calibration's seed), so big files stay fast.
+MAX_FIT_POINTS = 5000
+
+
+def bucket_of(length: int) -> int:
+    """Bucket index of a gap of `length` missing frames (``1 -> 0, 2 -> 1, 3-4 -> 2, ...``)."""
+    return int(length - 1).bit_length()
+
+
+def _bucket_range(b: int) -> tuple[int, int]:
+    return (1, 1) if b == 0 else (2 ** (b - 1) + 1, 2**b)
+
+
+@dataclass(frozen=True)
+class BucketChoice:
+    """The choice for one gap-length bucket.
+
+    Attributes
+    ----------
+    lengths : (int, int)
+        Smallest and largest number of missing frames of the bucket.
+    method : str
+        The chosen method.
+    n_gaps : int
+        Gaps to fill in this bucket.
+    n_validation : int
+        Artificial gaps scored.
+    mmae : tuple of (str, float)
+        Validation MMAE (px) of each candidate, in :data:`CANDIDATES` order (empty without
+        validation gaps).
+    """
+
+    lengths: tuple[int, int]
+    method: str
+    n_gaps: int
+    n_validation: int
+    mmae: tuple[tuple[str, float], ...]
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """What ``"auto"`` chose for one file: one :class:`BucketChoice` per gap-length bucket."""
+
+    buckets: tuple[BucketChoice, ...]
+
+    def method_for(self, length: int) -> str:
+        """The method chosen for a gap of `length` missing frames (``"linear"`` if unseen)."""
+        lo_hi = _bucket_range(bucket_of(length))
+        for c in self.buckets:
+            if c.lengths == lo_hi:
+                return c.method
+        return "linear"
+
+    def describe(self) -> str:
+        """A table: per bucket, the chosen method, each candidate's validation MMAE, counts."""
+        if not self.buckets:
+            return "auto: no gap to fill"
+        names = [m for m, _ in next((c.mmae for c in self.buckets if c.mmae), ())]
+        head = f"{'gap length':<12}{'gaps':>6}{'val.':>6}  {'chosen':<10}"
+        head += "".join(f"{m:>11}" for m in names)
+        lines = ["auto: validation MMAE (px) on artificial gaps cut into observed runs", head]
+        for c in self.buckets:
+            lo, hi = c.lengths
+            span = f"{lo}" if lo == hi else f"{lo}-{hi}"
+            vals = dict(c.mmae)
+            cells = "".join(f"{vals[m]:>11.3f}" if m in vals else f"{'-':>11}" for m in names)
+            lines.append(f"{span:<12}{c.n_gaps:>6}{c.n_validation:>6}  {c.method:<10}{cells}")
+        return "\n".join(lines)
+
+
+def fixed_noise_model(model: GdtModel | None = None) -> SegmentModel:
+    """``"gdt-fixed"``: the two-sided goal of ``gdt-bi`` with the paper's fixed noise levels.
+
+    Nothing is estimated, so camera motion or annotation jitter cannot inflate the noise.
+    """
+    m = GdtModel() if model is None else model
+    return SegmentModel(m.A, m.Q, m.H, m.R, m.p_init_velocity, "backward_state", True)
+
+
+def recover_with(
+    method: str,
+    pairs: Sequence[tuple[F64, F64]],
+    noise: NoiseEstimate,
+    motion: MotionFit,
+) -> list[F64]:
+    """Recover checked ``(segment_a, segment_b)`` pairs with one of :data:`CANDIDATES`.
+
+    Returns the ``(x, y)`` of every frame inside each gap.
+    """
+    if not pairs:
+        return []
+    if method == "linear":  # vectorised: one straight line per gap between the end points
+        ends_a = np.array([a[-1, :3] for a, _ in pairs])
+        ends_b = np.array([b[0, :3] for _, b in pairs])
+        n = (ends_b[:, 0] - ends_a[:, 0] - 1).astype(np.int64)
+        k = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n) + 1.0
+        s = (k / np.repeat(n + 1, n))[:, None]
+        xy = (1.0 - s) * np.repeat(ends_a[:, 1:3], n, axis=0) + s * np.repeat(
+            ends_b[:, 1:3], n, axis=0
+        )
+        return np.split(xy, np.cumsum(n)[:-1])
+    if method in BASELINES:
+        out = []
+        for a, b in pairs:
+            fr = np.arange(int(a[-1, 0]) + 1, int(b[0, 0]), dtype=np.int64)
+            out.append(np.asarray(BASELINES[method](a, b, fr), dtype=np.float64)[:, :2])
+        return out
+    seg_a = [a for a, _ in pairs]
+    seg_b = [b for _, b in pairs]
+    if method == "gdt-mix":
+        return recover_mixture_gaps(list(pairs), motion)
+    if method == "gdt":
+        return SegmentModel.paper().recover(seg_a, seg_b)
+    if method == "gdt-bi":
+        return SegmentModel.two_sided(noise).recover(seg_a, seg_b)
+    if method == "gdt-fixed":
+        return fixed_noise_model().recover(seg_a, seg_b)
+    raise ValueError(f"recover_with: method is {method!r}, expected one of {CANDIDATES}")
+
+
+def _observed_runs(observed: Sequence[F64]) -> list[F64]:
+    """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order."""
+    seen: dict[tuple[float, float, float, float, int], F64] = {}
+    for s in observed:
+        a = np.asarray(s, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
+            continue
+        a = a[:, :3]
+        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
+            if len(run) and np.all(np.isfinite(run)):
+                key = (float(run[0, 0]), float(run[0, 1]), float(run[0, 2]), float(run[-1, 0]),
+                       len(run))  # fmt: skip
+                seen.setdefault(key, run)
+    return [seen[k] for k in sorted(seen)]
+
+
+def _fit_sample(runs: Sequence[F64], seed: int) -> list[F64]:
+    """Whole runs drawn at random (seeded) until :data:`MAX_FIT_POINTS` points are reached."""
+    if sum(len(r) for r in runs) <= MAX_FIT_POINTS:
+        return list(runs)
+    order = np.random.default_rng([seed, 999]).permutation(len(runs))
+    out: list[F64] = []
+    total = 0
+    for i in order:
+        if total >= MAX_FIT_POINTS:
+            break
+        out.append(runs[i])
+        total += len(runs[i])
+    return out
+
+
+def _artificial_gaps(
+    runs: Sequence[F64], lengths: Sequence[int], n: int, rng: np.random.Generator
+) -> list[tuple[F64, F64, F64]]:
+    """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` with lengths from `lengths`."""
+    sizes = np.array([len(r) for r in runs], dtype=np.int64)
+    out: list[tuple[F64, F64, F64]] = []
+    used: set[tuple[int, int, int]] = set()
+    for _ in range(4 * n):
+        if len(out) >= n:
+            break
+        L = int(lengths[int(rng.integers(len(lengths)))])
+        slots = np.maximum(sizes - L - 2 * CONTEXT + 1, 0)
+        total = int(slots.sum())
+        if total == 0:
+            continue
+        k = int(rng.integers(total))
+        i = int(np.searchsorted(np.cumsum(slots), k, side="right"))
+        s = CONTEXT + k - int(np.cumsum(slots)[i] - slots[i])
+        if (i, s, L) in used:
+            continue
+        used.add((i, s, L))
+        r = runs[i]
+        out.append((r[:s], r[s + L :], r[s : s + L]))
+    return out
+
+
+def calibrate(
+    observed: Sequence[F64],
+    gap_lengths: Sequence[int],
+    noise: NoiseEstimate | None = None,
+    motion: MotionFit | None = None,
+    *,
+    candidates: Sequence[str] = CANDIDATES,
+    max_gaps: int = MAX_CALIBRATION_GAPS,
+    seed: int = 0,
+) -> Calibration:
+    """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
+
+    Parameters
+    ----------
+    observed : sequence of (k, 3+) ndarray
+        Observed rows ``(frame, x, y, ...)`` of the file's tracks (runs of consecutive frames
+        are used; duplicates are counted once).
+    gap_lengths : sequence of int
+        Missing frames of every gap to fill (each >= 1).
+    noise, motion : optional
+        For ``"gdt-bi"`` and ``"gdt-mix"``: default estimated from `observed`.
+    candidates : sequence of str
+        Methods scored (some of :data:`CANDIDATES`; ``"linear"`` is always added).
+    max_gaps : int
+        At most this many artificial gaps in all (>= 1).
+    seed : int
+        Seed of the generator that places the artificial gaps.
+
+    Returns
+    -------
+    Calibration
+
+    Raises
+    ------
+    ValueError
+        A gap length < 1, `max_gaps` < 1 or an unknown candidate.
+    """
+    lengths = [int(v) for v in gap_lengths]
+    if any(v < 1 for v in lengths):
+        raise ValueError(f"calibrate: gap lengths must be >= 1, got {min(lengths)}")
+    if max_gaps < 1:
+        raise ValueError(f"calibrate: max_gaps is {max_gaps}, expected >= 1")
+    for m in candidates:
+        if m not in CANDIDATES:
+            raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
+    names = tuple(m for m in CANDIDATES if m in candidates or m == "linear")
+    by_bucket: dict[int, list[int]] = {}
+    for v in lengths:
+        by_bucket.setdefault(bucket_of(v), []).append(v)
+    if not by_bucket:
+        return Calibration(())
+    runs = _observed_runs(observed)
+    whole = _fit_sample([r for r in runs if len(r) >= 4], seed)
+    if noise is None and ("gdt-bi" in names or "gdt-mix" in names):
+        noise = estimate_noise(whole) if whole else None
+    if motion is None and "gdt-mix" in names and whole:
+        motion = fit_motion(whole, noise)
+    per_bucket = max(MIN_VALIDATION_GAPS, max_gaps // len(by_bucket))
+    choices = []
+    for b in sorted(by_bucket):
+        rng = np.random.default_rng([seed, b])
+        cut = _artificial_gaps(runs, by_bucket[b], per_bucket, rng)
+        mmae: tuple[tuple[str, float], ...] = ()
+        method = "linear"
+        if len(cut) >= MIN_VALIDATION_GAPS:
+            pairs = [(a, c) for a, c, _ in cut]
+            scores = []
+            for m in names:
+                if m in ("gdt-bi", "gdt-mix") and (noise is None or motion is None):
+                    continue
+                paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
+                err = [float(np.mean(np.hypot(*(p - t[:, 1:3]).T))) for p, (_, _, t) in
+                       zip(paths, cut, strict=True)]  # fmt: skip
+                scores.append((m, float(np.mean(err))))
+            mmae = tuple(scores)
+            best_m, best = min(scores, key=lambda s: s[1])
+            lin = dict(scores)["linear"]
+            method = "linear" if lin <= (1.0 + LINEAR_MARGIN) * best else best_m
+        choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), len(cut), mmae))
+    return Calibration(tuple(choices))
+
+
+# Placeholders that are never used (the methods needing them are skipped without them).
+_NO_NOISE = NoiseEstimate(q=(0.1, 0.1), r=(1.0, 1.0))
+_NO_MOTION: MotionFit = None  # type: ignore[assignment]
+
+
+def recover_auto(
+    pairs: Sequence[tuple[F64, F64]],
+    observed: Sequence[F64] | None = None,
+    noise: NoiseEstimate | None = None,
+    motion: MotionFit | None = None,
+    *,
+    seed: int = 0,
+) -> tuple[list[F64], Calibration]:
+    """Recover every gap with the method :func:`calibrate` chose for its length.
+
+    Parameters
+    ----------
+    pairs : sequence of (segment_a, segment_b)
+        Segments around each gap (rows ``frame, x, y[, w, h]``).
+    observed : sequence of (k, 3+) ndarray, optional
+        Every observed track of the file, for calibration; default: the segments of `pairs`.
+    noise, motion : optional
+        For ``"gdt-bi"`` and ``"gdt-mix"``: default estimated from the observed runs (at most
+        about :data:`MAX_FIT_POINTS` points of them).
+    seed : int
+        Seed of the calibration.
+
+    Returns
+    -------
+    paths : list of (T_g - 1, 2) ndarray
+        ``(x, y)`` of every frame inside each gap.
+    calibration : Calibration
+        What was chosen, and why.
+
+    Raises
+    ------
+    ValueError
+        Malformed segments or a segment B that does not start after its segment A.
+    """
+    checked = []
+    for k, (a, b) in enumerate(pairs):
+        sa, sb = (
+            as_segment(np.asarray(a)[:, :3], "segment_a"),
+            as_segment(np.asarray(b)[:, :3], "segment_b"),
+        )
+        if sb[0, 0] <= sa[-1, 0]:
+            raise ValueError(
+                f"recover_gaps: gap {k}: segment_b starts at frame {sb[0, 0]:g}, expected after "
+                f"segment_a's end {sa[-1, 0]:g}"
+            )
+        checked.append((sa, sb))
+    if observed is None:
+        observed = [s for pair in checked for s in pair]
+    lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
+    runs = _fit_sample([r for r in _observed_runs(observed) if len(r) >= 4], seed)
+    if noise is None:
+        noise = estimate_noise(runs) if runs else _NO_NOISE
+    if motion is None and runs:
+        motion = fit_motion(runs, noise)
+    cal = calibrate(observed, [v for v in lengths if v > 0], noise, motion, seed=seed)
+    paths: list[F64 | None] = [None] * len(checked)
+    groups: dict[str, list[int]] = {}
+    for k, L in enumerate(lengths):
+        groups.setdefault(cal.method_for(L) if L > 0 else "linear", []).append(k)
+    for m, idx in groups.items():
+        got = recover_with(m, [checked[k] for k in idx], noise, motion or _NO_MOTION)
+        for k, p in zip(idx, got, strict=True):
+            paths[k] = p
+    return [p if p is not None else np.zeros((0, 2)) for p in paths], cal

@@ -1,0 +1,169 @@
+"""The calibrated default ``"auto"``: choice, no peeking at the deleted points, determinism."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pftrack.recovery import DEFAULT_METHOD, fill_gaps, recover_gaps
+from pftrack.recovery.calibrate import Calibration, bucket_of, calibrate, recover_auto
+from pftrack.recovery.experiment import auto_masks, find_gaps, trajectories
+
+from ..conftest import dataset
+
+
+def _straight_tracks(rng: np.random.Generator, n: int = 30, length: int = 120) -> list[np.ndarray]:
+    """Straight one-frame steps in independent random directions, 0.3 px jitter: (frame, x, y).
+
+    A random walk: the velocity next to a gap says nothing about the path inside it, and the
+    best guess between two ends (a Brownian bridge's mean) is the straight line.
+    """
+    out = []
+    for _ in range(n):
+        steps = rng.uniform(-3, 3, (length, 2))
+        xy = rng.uniform(0, 500, 2) + np.cumsum(steps, axis=0) + rng.normal(0, 0.3, (length, 2))
+        out.append(np.column_stack([np.arange(length, dtype=np.float64), xy]))
+    return out
+
+
+def _manoeuvring_tracks(
+    rng: np.random.Generator, n: int = 30, length: int = 160
+) -> list[np.ndarray]:
+    """Smooth curving paths (turning at varying rates), little measurement noise."""
+    out = []
+    for _ in range(n):
+        t = np.arange(length, dtype=np.float64)
+        heading = rng.uniform(0, 2 * np.pi) + np.cumsum(0.06 * np.sin(t / rng.uniform(8, 14)))
+        speed = 3.0
+        xy = np.cumsum(speed * np.column_stack([np.cos(heading), np.sin(heading)]), axis=0)
+        xy += rng.normal(0, 0.05, xy.shape)
+        out.append(np.column_stack([t, xy + 300.0]))
+    return out
+
+
+def _cut(tracks: list[np.ndarray], length: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    pairs = []
+    for tr in tracks:
+        s = len(tr) // 2
+        pairs.append((tr[:s], tr[s + length :]))
+    return pairs
+
+
+def test_default_is_auto() -> None:
+    assert DEFAULT_METHOD == "auto"
+
+
+def test_picks_linear_on_straight_jittered_segments() -> None:
+    tracks = _straight_tracks(np.random.default_rng(0))
+    cal = calibrate(tracks, [5, 12, 25])
+    assert [c.method for c in cal.buckets] == ["linear"] * 3, cal.describe()
+    paths, cal2 = recover_auto(_cut(tracks, 12), tracks)
+    a, b = _cut(tracks, 12)[0]
+    # a straight line between the two end points, exactly
+    s = np.arange(1, 13) / 13.0
+    line = (1 - s)[:, None] * a[-1, 1:3] + s[:, None] * b[0, 1:3]
+    np.testing.assert_allclose(paths[0], line, atol=1e-9)
+    assert cal2.method_for(12) == "linear"
+
+
+def test_picks_goal_directed_on_manoeuvring_data() -> None:
+    tracks = _manoeuvring_tracks(np.random.default_rng(1))
+    cal = calibrate(tracks, [20, 40])
+    assert all(c.method.startswith("gdt") for c in cal.buckets), cal.describe()
+
+
+def test_calibration_never_reads_the_deleted_points() -> None:
+    rng = np.random.default_rng(2)
+    truth = _manoeuvring_tracks(rng, n=20)
+    rows = []
+    for tid, tr in enumerate(truth, start=1):
+        w, h = 20.0, 40.0
+        r = np.column_stack([tr[:, 0] + 1, np.full(len(tr), tid), tr[:, 1] - w / 2,
+                             tr[:, 2] - h / 2, np.full((len(tr), 2), (w, h)),
+                             np.ones(len(tr)), -np.ones((len(tr), 3))])  # fmt: skip
+        rows.append(r)
+    full = np.vstack(rows)
+    holes = (full[:, 0] >= 60) & (full[:, 0] < 75)
+    cut = full[~holes]
+    out1, rep1 = fill_gaps(cut, max_gap=50)
+    poisoned = full.copy()
+    poisoned[holes, 2:4] = 1e9  # the deleted points, poisoned in a copy: never seen
+    out2, rep2 = fill_gaps(poisoned[~holes], max_gap=50)
+    np.testing.assert_array_equal(out1, out2)
+    assert rep1.calibration == rep2.calibration
+    assert rep1.calibration is not None and rep1.calibration.buckets[0].n_validation > 0
+
+
+def test_deterministic() -> None:
+    tracks = _manoeuvring_tracks(np.random.default_rng(3), n=10)
+    pairs = _cut(tracks, 17)
+    p1, c1 = recover_auto(pairs, tracks)
+    p2, c2 = recover_auto(pairs, tracks)
+    assert c1 == c2
+    for a, b in zip(p1, p2, strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert isinstance(c1, Calibration)
+    assert "chosen" in c1.describe()
+
+
+def test_recover_gaps_auto_matches_recover_auto() -> None:
+    tracks = _straight_tracks(np.random.default_rng(4), n=8)
+    pairs = _cut(tracks, 6)
+    got = recover_gaps(pairs, "auto", observed=tracks)
+    want, _ = recover_auto(pairs, tracks)
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_no_runs_long_enough_falls_back_to_linear() -> None:
+    a = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
+    b = np.array([[10.0, 10.0, 10.0], [11.0, 11.0, 11.0]])
+    paths, cal = recover_auto([(a, b)])
+    assert cal.buckets[0].method == "linear" and cal.buckets[0].n_validation == 0
+    np.testing.assert_allclose(paths[0][:, 0], np.arange(2, 10))
+
+
+def test_buckets() -> None:
+    assert [bucket_of(v) for v in (1, 2, 3, 4, 5, 8, 9, 16, 17)] == [0, 1, 2, 2, 3, 3, 4, 4, 5]
+
+
+def test_bad_input() -> None:
+    tracks = _straight_tracks(np.random.default_rng(5), n=3)
+    with pytest.raises(ValueError, match="gap lengths must be >= 1"):
+        calibrate(tracks, [0])
+    with pytest.raises(ValueError, match="max_gaps"):
+        calibrate(tracks, [3], max_gaps=0)
+    with pytest.raises(ValueError, match="candidate 'spline9'"):
+        calibrate(tracks, [3], candidates=["spline9"])
+    a = np.array([[5.0, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="segment_b starts at frame"):
+        recover_auto([(a, a)])
+    with pytest.raises(ValueError, match="non-finite"):
+        recover_auto([(np.array([[0.0, np.nan, 0.0]]), np.array([[3.0, 0.0, 0.0]]))])
+
+
+def test_auto_masks_rules() -> None:
+    rng = np.random.default_rng(6)
+    trajs = {k: t for k, t in enumerate(_straight_tracks(rng, n=40, length=200))}
+    masks = auto_masks(trajs, 768, 576)
+    assert 1 <= len(masks) <= 3
+    for x, y, w, h in masks:
+        assert w == h == 100 and x % 4 == 0 and y % 4 == 0
+        assert 0 <= x and x + w <= 768 and 0 <= y and y + h <= 576
+        assert find_gaps(trajs, (x, y, w, h))[0]
+    for i, m in enumerate(masks):
+        for n in masks[i + 1 :]:
+            assert abs(m[0] - n[0]) >= 100 or abs(m[1] - n[1]) >= 100
+    assert auto_masks(trajs, 768, 576) == masks
+    with pytest.raises(ValueError, match="image size"):
+        auto_masks(trajs, 0, 576)
+
+
+def test_auto_never_worse_than_linear_on_tud() -> None:
+    from pftrack.io.mot import read_mot
+    from pftrack.recovery.experiment import run_sequence
+
+    gt = read_mot(dataset("tud-campus") / "gt.txt")
+    r = run_sequence("tud", trajectories(gt), 640, 480, ["auto", "linear"])
+    assert r.n_gaps > 0
+    assert r.mmae("auto") <= r.mmae("linear") + 1e-9
