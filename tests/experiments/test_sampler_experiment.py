@@ -48,10 +48,12 @@ def test_all_samplers_run_and_table_lists_them(scene: Scene) -> None:
 
 
 def test_time_per_frame_grows_with_particles(scene: Scene) -> None:
-    # SIS cost is linear in N: 16x the particles must cost clearly more than 1x
-    small = min(se.time_per_frame(scene, "sis", 25) for _ in range(2))
-    large = min(se.time_per_frame(scene, "sis", 400) for _ in range(2))
-    assert large > 2 * small
+    # SIS cost grows with N (sub-linearly at small N: integral histograms share work between
+    # overlapping particle boxes). 128x the particles must cost clearly more, whatever the load:
+    # measured 0.17 ms at 25 and 2.3 ms at 3200 particles per frame
+    small = min(se.time_per_frame(scene, "sis", 25) for _ in range(3))
+    large = min(se.time_per_frame(scene, "sis", 3200) for _ in range(3))
+    assert large > 3 * small
     assert se.time_per_frame(scene, "rjmcmc", 25) > 0
 
 
