@@ -35,3 +35,13 @@ def test_import_pftrack_loads_no_wing() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_cli_parser_loads_no_scipy() -> None:
+    """``pftrack --help`` builds every sub-command's parser without loading a method."""
+    code = (
+        "import sys; from pftrack.cli import build_parser; build_parser(); "
+        "print(sorted(m for m in sys.modules if m.startswith(('scipy', 'pftrack.recovery.'))))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "['pftrack.recovery.names']"

@@ -6,7 +6,7 @@ import argparse
 from typing import Any
 
 from pftrack.cli._options import add_command, positive_int
-from pftrack.recovery.registry import METHODS
+from pftrack.recovery.names import METHODS
 
 
 def add_parser(sub: Any) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli._options import add_command, positive_int
-from pftrack.recovery.registry import DEFAULT_METHOD, METHODS
+from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 
 def add_parser(sub: Any) -> None:

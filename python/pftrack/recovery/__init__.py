@@ -8,38 +8,63 @@ One concept per module, from the bottom up:
 - :mod:`~pftrack.recovery.problems`: the ``gdt`` and ``gdt-bi`` problems of one gap;
 - :mod:`~pftrack.recovery.baselines`: ``linear``, ``cubic``, ``bspline``, ``gsi``, ``rts``;
 - :mod:`~pftrack.recovery.mixture`: ``gdt-mix``;
-- :mod:`~pftrack.recovery.registry`: the methods by name, :func:`recover_gap`,
-  :func:`recover_gaps`;
+- :mod:`~pftrack.recovery.names`, :mod:`~pftrack.recovery.registry`: the methods by name,
+  :func:`recover_gap`, :func:`recover_gaps`;
 - :mod:`~pftrack.recovery.linking`, :mod:`~pftrack.recovery.fill`: tracklet linking and gap
   filling of MOTChallenge files;
 - :mod:`~pftrack.recovery.experiment`, :mod:`~pftrack.recovery.demo`: the paper's experiment
   and the demo's table.
+
+The names below load their module on first use (PEP 562), so listing the methods
+(:mod:`~pftrack.recovery.names`) does not load SciPy.
 """
 
 from __future__ import annotations
 
-from pftrack.recovery.fill import FillReport, fill_gaps
-from pftrack.recovery.gdt import (
-    GdtModel,
-    GdtSolution,
-    goal_directed_path,
-    sample_goal_directed_paths,
-)
-from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, check_unique, link_tracklets
-from pftrack.recovery.mixture import MotionFit, fit_motion
-from pftrack.recovery.noise import NoiseEstimate, estimate_noise
-from pftrack.recovery.problems import GdtProblem, SegmentModel, gdt_bi_problem, gdt_problem
-from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, recover_gap, recover_gaps
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from pftrack.recovery.fill import FillReport, fill_gaps
+    from pftrack.recovery.gdt import (
+        GdtModel,
+        GdtSolution,
+        goal_directed_path,
+        sample_goal_directed_paths,
+    )
+    from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, check_unique, link_tracklets
+    from pftrack.recovery.mixture import MotionFit, fit_motion
+    from pftrack.recovery.names import DEFAULT_METHOD, METHODS
+    from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+    from pftrack.recovery.problems import GdtProblem, SegmentModel, gdt_bi_problem, gdt_problem
+    from pftrack.recovery.registry import recover_gap, recover_gaps
+
+_HOME = {
+    "pftrack.recovery.fill": ("FillReport", "fill_gaps"),
+    "pftrack.recovery.gdt": (
+        "GdtModel",
+        "GdtSolution",
+        "goal_directed_path",
+        "sample_goal_directed_paths",
+    ),
+    "pftrack.recovery.linking": ("FLAG_COLUMN", "LinkConfig", "check_unique", "link_tracklets"),
+    "pftrack.recovery.mixture": ("MotionFit", "fit_motion"),
+    "pftrack.recovery.noise": ("NoiseEstimate", "estimate_noise"),
+    "pftrack.recovery.problems": ("GdtProblem", "SegmentModel", "gdt_bi_problem", "gdt_problem"),
+    "pftrack.recovery.registry": ("recover_gap", "recover_gaps"),
+    "pftrack.recovery.names": ("DEFAULT_METHOD", "METHODS"),
+}
+_MODULE_OF = {name: module for module, names in _HOME.items() for name in names}
 
 __all__ = [
     "DEFAULT_METHOD",
     "FLAG_COLUMN",
-    "METHODS",
     "FillReport",
     "GdtModel",
     "GdtProblem",
     "GdtSolution",
     "LinkConfig",
+    "METHODS",
     "MotionFit",
     "NoiseEstimate",
     "SegmentModel",
@@ -55,3 +80,17 @@ __all__ = [
     "recover_gaps",
     "sample_goal_directed_paths",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Load a public name's module on first use (PEP 562)."""
+    module = _MODULE_OF.get(name)
+    if module is None:
+        raise AttributeError(f"module 'pftrack.recovery' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -45,20 +45,12 @@ from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes
 from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
+from pftrack.recovery.names import DEFAULT_METHOD, GOAL_DIRECTED_METHODS, METHODS
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
 from pftrack.recovery.segments import as_segment, gap_frames
 
 __all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS", "recover_gap", "recover_gaps"]
-
-#: Every method, in the order tables list them.
-METHODS = (
-    "auto", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "linear", "cubic", "bspline", "gsi", "rts"
-)  # fmt: skip
-#: The methods solved for all gaps at once (pftrack's own and the calibrated ``"auto"``).
-GOAL_DIRECTED_METHODS = ("auto", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
-#: The method of :func:`recover_gap`, :func:`recover_gaps`, ``fill_gaps`` and ``pftrack recover``.
-DEFAULT_METHOD = "auto"
 
 
 def recover_gap(

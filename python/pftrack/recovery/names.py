@@ -1,0 +1,18 @@
+"""The recovery methods by name.
+
+Constants only, so that the command line can list them without loading the methods (and SciPy).
+"""
+
+from __future__ import annotations
+
+__all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS"]
+
+#: Every method, in the order tables list them.
+METHODS = (
+    "auto", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "linear", "cubic", "bspline", "gsi", "rts"
+)  # fmt: skip
+#: The methods solved for all gaps at once (pftrack's own and the calibrated ``"auto"``).
+GOAL_DIRECTED_METHODS = ("auto", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
+#: The method of :func:`~pftrack.recovery.recover_gap`, ``recover_gaps``, ``fill_gaps`` and
+#: ``pftrack recover``.
+DEFAULT_METHOD = "auto"
