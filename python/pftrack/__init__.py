@@ -16,8 +16,9 @@ The public API, importable from the top level; each name loads its module on fir
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from pftrack._lazy import lazy_exports
 
 try:
     from pftrack import _core  # noqa: F401
@@ -89,7 +90,6 @@ _HOME = {
     ),
     "pftrack.synthetic": ("make_scene",),
 }
-_MODULE_OF = {name: module for module, names in _HOME.items() for name in names}
 
 __all__ = [
     "__version__",
@@ -121,15 +121,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562)."""
-    module = _MODULE_OF.get(name)
-    if module is None:
-        raise AttributeError(f"module 'pftrack' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+_MODULE_OF, __getattr__, __dir__ = lazy_exports(__name__, _HOME, globals())

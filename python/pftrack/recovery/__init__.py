@@ -21,8 +21,9 @@ The names below load their module on first use (PEP 562), so listing the methods
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from pftrack._lazy import lazy_exports
 
 if TYPE_CHECKING:
     from pftrack.recovery.fill import FillReport, fill_gaps
@@ -54,7 +55,6 @@ _HOME = {
     "pftrack.recovery.registry": ("recover_gap", "recover_gaps"),
     "pftrack.recovery.names": ("DEFAULT_METHOD", "METHODS"),
 }
-_MODULE_OF = {name: module for module, names in _HOME.items() for name in names}
 
 __all__ = [
     "DEFAULT_METHOD",
@@ -82,15 +82,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562)."""
-    module = _MODULE_OF.get(name)
-    if module is None:
-        raise AttributeError(f"module 'pftrack.recovery' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+_MODULE_OF, __getattr__, __dir__ = lazy_exports(__name__, _HOME, globals())
