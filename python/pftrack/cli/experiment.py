@@ -202,7 +202,8 @@ def _run_sequences(args: argparse.Namespace) -> int:
             name, width, height = info
         elif args.image_size:
             width, height = _parse_size(args.image_size)
-            name = Path(path).resolve().parent.name
+            p = Path(path).resolve()  # SEQ/gt/gt.txt or SEQ/gt.txt: the sequence; else the file
+            name = p.parent.name if p.stem == "gt" else p.stem
         else:
             raise ValueError(
                 f"{path}: no seqinfo.ini beside it or one folder up; pass --image-size"
