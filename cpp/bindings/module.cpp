@@ -11,6 +11,7 @@ void register_filter(py::module_& m);
 void register_detection(py::module_& m);
 void register_mcmc(py::module_& m);
 void register_bridge(py::module_& m);
+void register_assignment(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -21,4 +22,5 @@ PYBIND11_MODULE(_core, m) {
     register_detection(m);
     register_mcmc(m);
     register_bridge(m);
+    register_assignment(m);
 }

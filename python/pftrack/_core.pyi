@@ -183,6 +183,9 @@ def bhattacharyya_coefficient(hists: _F64, ref: _F64) -> _F64: ...
 def bhattacharyya_distance(hists: _F64, ref: _F64) -> _F64: ...
 def bhattacharyya_weights(hists: _F64, ref: _F64, lam: float = 20.0) -> _F64: ...
 
+# --- assignment: cost (R, C) float64, +inf forbids a pair -> (rows, cols) int32 ----------
+def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascending
+
 # --- resampling: weights (N,) float64 >= 0 -> indices (N,) int32 --------------------------
 def systematic_resample(weights: _F64, u0: float) -> _I32: ...  # u0 in [0, 1)
 def stratified_resample(weights: _F64, u: _F64) -> _I32: ...  # u (N,) in [0, 1)

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import linear_sum_assignment
 
 from pftrack._typing import F64
+from pftrack.assignment import linear_sum_assignment
 from pftrack.boxes import iou_xywh
 from pftrack.tracking.config import AssociationConfig
 
