@@ -44,9 +44,7 @@ def test_same_pairs_as_scipy_on_continuous_costs(shape):
 
 def test_accepts_integer_and_strided_input():
     cost = np.arange(36).reshape(6, 6)[::2, ::-1]
-    np.testing.assert_array_equal(
-        np.stack(linear_sum_assignment(cost)), np.stack(scipy_lsa(cost))
-    )
+    np.testing.assert_array_equal(np.stack(linear_sum_assignment(cost)), np.stack(scipy_lsa(cost)))
 
 
 @pytest.mark.parametrize(
