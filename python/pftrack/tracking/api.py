@@ -23,7 +23,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._typing import F64
+from pftrack._typing import F64, RngLike
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
@@ -226,7 +226,7 @@ class Tracker:
     def from_config(
         cls,
         config: TrackerConfig | None = None,
-        seed: int | None = 0,
+        seed: RngLike = 0,
         *,
         frame_rate: float = REFERENCE_RATE,
         coasting: str = "confirmed",
@@ -241,8 +241,9 @@ class Tracker:
         ----------
         config : TrackerConfig, optional
             All tracker settings (default ``TrackerConfig()``).
-        seed : int or None
-            Seed.
+        seed : int, numpy.random.Generator or None
+            Seed (with a Generator, :meth:`reset` goes on drawing from it rather than
+            starting over).
         frame_rate : float
             Recorded only: `config` is already in frames.
         coasting, fill : str
@@ -265,11 +266,11 @@ class Tracker:
         )
         return self
 
-    def _setup(self, config: TrackerConfig, seed: int | None, *, frame_rate: float, fill: str,
+    def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: float, fill: str,
                smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: int,
                coasting: str = "confirmed") -> None:  # fmt: skip
-        if seed is not None and not isinstance(seed, (int, np.integer)):
-            raise TypeError(f"seed must be an int or None, got {type(seed).__name__}")
+        if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
+            raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")
         if not isinstance(prime_frames, (int, np.integer)) or prime_frames < 0:
             raise ValueError(f"prime_frames is {prime_frames!r}, expected an integer >= 0")
         self.config = config

@@ -93,7 +93,7 @@ def track_frames(
     config : TrackerConfig, optional
         Tracker settings (default ``TrackerConfig()``).
     rng : numpy.random.Generator, int or None
-        Seed (a Generator gives one integer seed drawn from it).
+        Seed.
     coasting, fill : str
         How gaps bridged by the particle filters are written (see
         :class:`~pftrack.tracking.TrackWriter`).
