@@ -63,8 +63,9 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--birth-score", type=float, default=0.9, metavar="S",
-        help="a detection starts a track with a score of at least min(S, the median score of "
-        "the first 50 frames) (scores in [0, 1] only; other scores never gate births)",
+        help="a detection starts a track with a score of at least min(S, the lower quartile of "
+        "the scores of the first 50 frames) (scores in [0, 1] only; other scores never gate "
+        "births)",
     )  # fmt: skip
     p.add_argument(
         "--camera-motion", choices=("auto", "on", "off"), default="auto",

@@ -181,7 +181,7 @@ class Tracker:
         max_coast: float = 0.4,
         min_conf: float = 0.0,
         birth_score: float = 0.9,
-        birth_quantile: float | None = 0.5,
+        birth_quantile: float | None = 0.25,
         camera_motion: str = "auto",
         fill: str = "linear",
         smooth: bool = True,
