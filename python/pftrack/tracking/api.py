@@ -87,7 +87,7 @@ def check_boxes_xyxy(
         when the rows look like ``x, y, w, h`` instead).
     """
     d = np.asarray(dets)
-    if d.dtype.kind not in "biuf":
+    if d.dtype.kind not in "iuf":
         raise TypeError(f"dets must be an array of numbers, got dtype {d.dtype}")
     d = d.astype(np.float64)
     if d.size == 0:
