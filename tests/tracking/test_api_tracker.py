@@ -271,7 +271,12 @@ def test_options_and_frames():
     with pytest.raises(TypeError, match="uint8"):
         pftrack.Tracker().update(None, np.zeros((30, 40, 3)))
     # seconds become frames at the frame rate; 25/s gives the command's defaults
-    assert pftrack.Tracker().config == TrackerConfig()
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+
+    cli = tracker_config(build_parser().parse_args(["track", "v.avi", "--out", "t.txt"]))
+    assert pftrack.Tracker().config == TrackerConfig() == cli
+    assert pftrack.Tracker().prime_frames == 30
     slow = pftrack.Tracker(frame_rate=7.0)
     assert slow.config.lifecycle.max_coast == 3 and slow.prime_frames == 8
     assert pftrack.Tracker(frame_rate=50.0).config.lifecycle.birth_window == 100

@@ -305,11 +305,6 @@ class Tracker:
             raise ValueError("prime() must come before the first update()")
         self._tracker.prime(frames)
 
-    @property
-    def needs_priming(self) -> bool:
-        """Whether :meth:`prime` changes anything for detections given (or not) to update."""
-        return self.prime_frames > 0
-
     def update(self, dets: ArrayLike | None, frame: ArrayLike) -> F64:
         """Track one frame.
 
