@@ -82,6 +82,7 @@ ALLOWED = {
     "recovery": {"particle_filter"},  # linking's colour term uses the core's HSV histograms
     "tracking": {"particle_filter", "detection", "recovery"},
     "eval": set(),
+    "integrations": {"tracking"},  # adapters to other libraries' tracker interfaces
 }
 
 

@@ -3,7 +3,8 @@
 The public API, importable from the top level; each name loads its module on first use, so
 ``import pftrack`` (and ``pftrack --help``) stays fast:
 
-- tracking: :class:`MultiObjectTracker`, :class:`TrackerConfig`, :class:`Track`,
+- tracking: :class:`Tracker` (the drop-in ``update(dets, frame)`` / ``finalize()`` API),
+  :class:`MultiObjectTracker`, :class:`TrackerConfig`, :class:`Track`,
   :func:`track_frames`, :func:`load_detections`, :func:`smooth_tracks`, :class:`BoxSmoother`;
 - recovery: :func:`recover_gap`, :func:`recover_gaps`, :func:`fill_gaps`,
   :func:`link_tracklets`, :class:`LinkConfig`, :func:`goal_directed_path`;
@@ -52,6 +53,7 @@ if TYPE_CHECKING:
         BoxSmoother,
         MultiObjectTracker,
         Track,
+        Tracker,
         TrackerConfig,
         load_detections,
         smooth_tracks,
@@ -65,6 +67,7 @@ _HOME = {
         "BoxSmoother",
         "MultiObjectTracker",
         "Track",
+        "Tracker",
         "TrackerConfig",
         "load_detections",
         "smooth_tracks",
@@ -100,6 +103,7 @@ __all__ = [
     "MotMetrics",
     "MultiObjectTracker",
     "Track",
+    "Tracker",
     "TrackerConfig",
     "bhattacharyya_weights",
     "box_histograms",

@@ -55,7 +55,23 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         help="AR(2) model per particle (eq. 7) or from the particle-set means (eq. 8)",
     )  # fmt: skip
     p.add_argument("--max-coast", type=int, default=10, metavar="FRAMES",
-                   help="frames a track survives on its particle filter alone")  # fmt: skip
+                   help="frames a track survives on its particle filter alone (0.4 s at 25 "
+                   "frames/s: pftrack.Tracker's max_coast is in seconds)")  # fmt: skip
+    p.add_argument(
+        "--min-conf", type=float, default=0.0, metavar="C",
+        help="ignore detections whose score is below C",
+    )  # fmt: skip
+    p.add_argument(
+        "--birth-score", type=float, default=0.9, metavar="S",
+        help="a detection starts a track with a score of at least min(S, the lower quartile of "
+        "the scores of the first 50 frames) (scores in [0, 1] only; other scores never gate "
+        "births)",
+    )  # fmt: skip
+    p.add_argument(
+        "--camera-motion", choices=("auto", "on", "off"), default="auto",
+        help="camera-motion compensation: auto (only while the camera is found to move), on "
+        "(always), off (static camera)",
+    )  # fmt: skip
     p.add_argument(
         "--fill", choices=("linear", "pf"), default="linear",
         help="with --no-smooth, boxes of a gap the filter bridged: interpolated, or the "
@@ -88,5 +104,11 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         filter=filt,
         detector=args.detector,
         sampler=args.sampler,
-        lifecycle=replace(base.lifecycle, max_coast=args.max_coast),
+        camera_motion=args.camera_motion,
+        lifecycle=replace(
+            base.lifecycle,
+            max_coast=args.max_coast,
+            min_score=args.min_conf,
+            birth_score=args.birth_score,
+        ),
     )

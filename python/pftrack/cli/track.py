@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -52,15 +54,19 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
     source = FrameSource(args.source)
     dets = load_detections(args.detections, args.det_scale) if args.detections else None
-    result = track_frames(
-        source,
-        detections=dets,
-        config=tracker_config(args),
-        rng=args.seed,
-        fill=args.fill,
-        smoother=None if args.no_smooth else BoxSmoother(),
-        link=None if args.no_link else LinkConfig(),
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = track_frames(
+            source,
+            detections=dets,
+            config=tracker_config(args),
+            rng=args.seed,
+            fill=args.fill,
+            smoother=None if args.no_smooth else BoxSmoother(),
+            link=None if args.no_link else LinkConfig(),
+        )
+    for w in caught:  # clipped boxes, a run without any track: said, not fatal
+        print(f"pftrack track: warning: {w.message}", file=sys.stderr)
     write_mot(args.out, result.rows)
     n_ids = len(set(result.rows[:, 1].astype(int))) if len(result.rows) else 0
     print(

@@ -5,11 +5,14 @@
 - :class:`TrackWriter` (:mod:`.writer`): a run's tracks as MOTChallenge rows.
 - :class:`BoxSmoother`, :func:`smooth_tracks` (:mod:`.offline`): link, fill and smooth a
   finished run (any tracker's).
+- :class:`Tracker` (:mod:`.api`): the drop-in tracker (``update(dets, frame)``, ``finalize()``),
+  the one object behind both a user's loop and ``pftrack track``.
 - :func:`track_frames`, :func:`load_detections` (:mod:`.run`): a whole video, end to end.
 """
 
 from __future__ import annotations
 
+from pftrack.tracking.api import Tracker
 from pftrack.tracking.config import (
     AssociationConfig,
     LifecycleConfig,
@@ -32,6 +35,7 @@ __all__ = [
     "RefineConfig",
     "Track",
     "TrackWriter",
+    "Tracker",
     "TrackerConfig",
     "TrackingRun",
     "load_detections",

@@ -43,6 +43,7 @@ def associate(
     boxes: F64,
     hists: F64,
     config: AssociationConfig,
+    allowed: NDArray[np.bool_] | None = None,
 ) -> Association:
     """Pair tracks with detections.
 
@@ -62,6 +63,8 @@ def associate(
         Detection histograms (rows sum to 1, or 0 when empty).
     config : AssociationConfig
         Gates, weights and the cost of leaving things unmatched.
+    allowed : (T, D) ndarray of bool, optional
+        Pairs that may be made at all (e.g. same class); None allows every pair.
 
     Returns
     -------
@@ -81,6 +84,8 @@ def associate(
         (1.0 - iou) + config.colour_weight * (1.0 - rho) + np.minimum(dist / radius[:, None], 2.0)
     )
     gate = (iou >= config.match_iou) | (dist <= radius[:, None])
+    if allowed is not None:
+        gate &= allowed
     cost = np.where(gate, cost, FORBIDDEN)
     if np.isfinite(config.unmatched_cost):
         # leaving a track or a detection unmatched costs `unmatched_cost` each, so a pair is

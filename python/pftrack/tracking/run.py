@@ -16,10 +16,9 @@ from pftrack._typing import F64, PathLike, RngLike
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
+from pftrack.tracking.api import Tracker, xywh_to_xyxy_dets
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
-from pftrack.tracking.tracker import MultiObjectTracker
-from pftrack.tracking.writer import TrackWriter
 
 __all__ = ["TrackingRun", "load_detections", "track_frames"]
 
@@ -79,7 +78,11 @@ def track_frames(
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
 ) -> TrackingRun:
-    """Track every frame of `source`.
+    """Track every frame of `source`: :class:`~pftrack.tracking.api.Tracker` over every frame.
+
+    The same object a user's loop drives (priming, ``update``, ``finalize``): this function
+    only reads the frames and turns each frame's ``[left, top, w, h, score]`` detections into
+    ``[x1, y1, x2, y2, score]`` for :meth:`Tracker.update`.
 
     Parameters
     ----------
@@ -111,10 +114,17 @@ def track_frames(
         raise ValueError(
             f"detections go up to frame {max(detections)} but the video has {len(frames)} frames"
         )
-    tracker = MultiObjectTracker(config, rng=rng)
+    seed = (
+        rng
+        if rng is None or isinstance(rng, (int, np.integer))
+        else int(np.random.default_rng(rng).integers(2**63))
+    )
+    tracker = Tracker.from_config(
+        config, seed, coasting=coasting, fill=fill, smoother=smoother, link=link,
+        prime_frames=prime_frames,
+    )  # fmt: skip
     if prime_frames > 0 and (detections is None or config.refine.enabled):
         tracker.prime(itertools.islice(iter(frames), prime_frames))
-    writer = TrackWriter(coasting, fill, smoother, link)
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0
@@ -122,8 +132,33 @@ def track_frames(
     for n, frame in enumerate(
         progress(frames, total=total, desc="tracking", enable=show_progress), start=1
     ):
-        dets = None if detections is None else detections.get(n, empty)
-        writer.add(n, tracker.update(frame, dets))
+        if detections is None:
+            tracker.update(None, frame)
+            continue
+        dets = detections.get(n, empty)
+        if n == 1:
+            _check_layout(detections, frame.shape[:2])
+        tracker.update(xywh_to_xyxy_dets(dets), frame)
     if n == 0:
         raise ValueError(f"no frame could be read from {source}")
-    return TrackingRun(writer.result(), n, time.perf_counter() - start)
+    return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+
+
+def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
+    """Refuse detections that read as x1, y1, x2, y2 where left, top, w, h are expected.
+
+    Decided on the whole file: more than half of the boxes, read as ``left, top, w, h``, reach
+    past the frame's right or bottom edge, while every box read as ``x1, y1, x2, y2`` lies in it.
+    """
+    d = np.concatenate([v[:, :4] for v in detections.values() if len(v)] or [np.zeros((0, 4))])
+    if len(d) == 0:
+        return
+    rows, cols = shape[0], shape[1]
+    past = (d[:, 0] + d[:, 2] > cols) | (d[:, 1] + d[:, 3] > rows)
+    as_xyxy = (d[:, 2] > d[:, 0]) & (d[:, 3] > d[:, 1]) & (d[:, 2] <= cols) & (d[:, 3] <= rows)
+    if past.mean() > 0.5 and as_xyxy.all():
+        raise ValueError(
+            f"{past.sum()} of {len(d)} detection boxes reach past the {cols}x{rows} frame as "
+            "left, top, width, height, and all fit it as x1, y1, x2, y2: the file's boxes look "
+            "like x1, y1, x2, y2 (MOTChallenge det.txt has left, top, width, height)"
+        )

@@ -38,8 +38,9 @@ class Track:
         Confidence: the matched detection's score, or the colour match ``rho`` when coasting.
     detection_index : int or None
         Index of the detection (in the order given to
-        :meth:`~pftrack.tracking.MultiObjectTracker.update`) matched to this track, or None
-        when it was carried by its particle filter alone.
+        :meth:`~pftrack.tracking.MultiObjectTracker.update`) matched to this track (also a
+        merged blob's, which several tracks share), or None when it was carried by its particle
+        filter alone.
     age : int
         Frames since birth.
     time_since_update : int
@@ -52,6 +53,9 @@ class Track:
         The matched detection's box (after refinement) as the tracker measured it, when it
         re-seeded the track this frame; None when coasting or inside a merged blob. ``box_xywh``
         may be a filtered version of it (``MotionConfig.smooth_external``).
+    cls : int
+        Class id: that of the detection the track was born from (0 when none is given). A
+        track is only ever matched to detections of its own class.
     """
 
     id: int
@@ -62,6 +66,7 @@ class Track:
     time_since_update: int
     history: tuple[tuple[int, F64, float], ...] = ()
     detection_box: F64 | None = None
+    cls: int = 0
 
 
 class LiveTrack:
@@ -101,6 +106,7 @@ class LiveTrack:
         self.score = score
         self.rho = 1.0
         self.det_index: int | None = None
+        self.cls = 0  # class id, set by the tracker at birth
         self.measured: F64 | None = box_xywh.copy()  # this frame's detection box
         self.unreported: list[tuple[int, F64, float]] = []
         self.reported = False
@@ -184,4 +190,5 @@ class LiveTrack:
             time_since_update=self.time_since_update,
             history=history,
             detection_box=None if self.measured is None else self.measured.copy(),
+            cls=self.cls,
         )

@@ -66,6 +66,8 @@ class MultiObjectTracker:
         self.last_mask: NDArray[np.uint8] | None = None
         self._joint = JointTracker(self.config, self._rng)
         self._scores_are_confidences = True
+        self._birth_scores: list[F64] = []  # scores of the first frames (birth_quantile)
+        self._birth_level = np.inf
 
     # -- detections -------------------------------------------------------------------------
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
@@ -127,8 +129,23 @@ class MultiObjectTracker:
         self.last_mask = mask
         return mask, frame_bins
 
+    def _birth_threshold(self, scores: F64) -> float:
+        """The score a detection needs to start a track (``LifecycleConfig.birth_quantile``).
+
+        Learned from the scores of the first ``birth_window`` frames, then fixed.
+        """
+        rules = self.config.lifecycle
+        if rules.birth_quantile is None:
+            return rules.birth_score
+        if self.frame_index <= rules.birth_window and len(scores):
+            self._birth_scores.append(scores)
+            seen = np.concatenate(self._birth_scores)
+            self._birth_level = float(np.quantile(seen, rules.birth_quantile))
+        return min(rules.birth_score, self._birth_level)
+
     # -- the per-frame step -----------------------------------------------------------------
-    def update(self, frame: ArrayLike, detections: ArrayLike | None = None) -> list[Track]:
+    def update(self, frame: ArrayLike, detections: ArrayLike | None = None,
+               classes: ArrayLike | None = None) -> list[Track]:  # fmt: skip
         """Advance the tracker by one frame.
 
         Parameters
@@ -138,6 +155,9 @@ class MultiObjectTracker:
         detections : (K, 4) or (K, 5) array_like, optional
             ``[left, top, width, height(, score)]`` from any detector; None runs the built-in
             background-subtraction detector.
+        classes : (K,) array_like of int, optional
+            Class id of each detection: a track is only matched to detections of the class it
+            was born with, so classes never share an identity (default: one class).
 
         Returns
         -------
@@ -151,9 +171,16 @@ class MultiObjectTracker:
         cfg = self.config
         self.frame_index += 1
         boxes, scores, binned = self._detections(f, detections)
+        labels = np.zeros(len(boxes), np.int64)
+        if classes is not None and detections is not None:
+            labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
+            if len(labels) != len(boxes):
+                raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
         index = np.flatnonzero(scores >= cfg.lifecycle.min_score)
-        boxes, scores = boxes[index], scores[index]
+        boxes, scores, labels = boxes[index], scores[index], labels[index]
         if cfg.sampler == "rjmcmc":
+            if len(np.unique(labels)) > 1:
+                raise ValueError("sampler 'rjmcmc' tracks one class; got several class ids")
             mask = self.last_mask
             if mask is None or mask.shape != f.shape[:2]:
                 mask = np.full(f.shape[:2], 255, np.uint8)  # no background model: all foreground
@@ -176,6 +203,7 @@ class MultiObjectTracker:
             boxes,
             hists,
             cfg.association,
+            np.array([t.cls for t in self.tracks], np.int64)[:, None] == labels[None, :],
         )
 
         # 3. matched tracks follow their detection, unless it is a blob of several tracks
@@ -185,7 +213,7 @@ class MultiObjectTracker:
             merged = b[2] * b[3] > cfg.association.merge_ratio * t.size[0] * t.size[1] and (
                 covers_another(b, np.array([o.box for k, o in enumerate(self.tracks) if k != ti]))
             )
-            t.matched(float(scores[di]), None if merged else int(index[di]))
+            t.matched(float(scores[di]), int(index[di]))
             if not merged:
                 t.follow(b, hists[di], cfg, smooth)
         for ti in result.unmatched_tracks:
@@ -194,7 +222,7 @@ class MultiObjectTracker:
         # 4. tracks that coasted too long end; 5. unexplained detections start tracks
         self.tracks = [t for t in self.tracks if t.alive(cfg.lifecycle)]
         confidences = detections is not None and self._scores_are_confidences
-        birth_score = cfg.lifecycle.birth_score if confidences else -np.inf
+        birth_score = self._birth_threshold(scores) if confidences else -np.inf
         for di in result.unmatched_detections:
             if hists[di].sum() <= 0 or scores[di] < birth_score:
                 continue  # no foreground colour to build a reference from, or too unsure
@@ -203,6 +231,7 @@ class MultiObjectTracker:
                 next(self._ids), boxes[di].copy(), hists[di], cfg, seed, float(scores[di])
             )
             t.det_index = int(index[di])
+            t.cls = int(labels[di])
             self.tracks.append(t)
 
         # 6. report

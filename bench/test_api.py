@@ -1,0 +1,66 @@
+"""Cost of :meth:`pftrack.Tracker.update` per frame, beyond the caller's detector.
+
+pytest bench/test_api.py --benchmark-enable --benchmark-only
+
+A synthetic 480x360 scene in which 10 people are in view on every timed frame; the detections
+are the truth's boxes (x1, y1, x2, y2, conf), so nothing here is a detector's cost. Each round
+runs a fresh tracker over the same frames; the first frames (births, start-up) are not timed.
+``extra_info["ms_per_frame"]`` is the mean per ``update``; "default" includes the background
+model behind box refinement (on by default with detections), "no refine" is the tracker alone.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from pytest_benchmark.fixture import BenchmarkFixture
+
+import pftrack
+from pftrack.io.mot import group_by_frame
+from pftrack.synthetic import make_scene
+
+WARM = 20  # untimed frames: every walker is born and confirmed
+
+
+@pytest.fixture(scope="module")
+def scene_dets() -> tuple[list[np.ndarray], list[np.ndarray]]:
+    scene = make_scene(n_frames=80, n_walkers=10, rng=0, occluder=False)
+    by_frame = group_by_frame(scene.truth)
+    dets = []
+    for n in range(1, len(scene.frames) + 1):
+        r = by_frame.get(n, np.zeros((0, 10)))
+        dets.append(np.column_stack([r[:, 2:4], r[:, 2:4] + r[:, 4:6], np.full(len(r), 0.9)]))
+    return scene.frames, dets
+
+
+@pytest.mark.parametrize("refine", [True, False], ids=["default", "no refine"])
+def test_update_10_objects(
+    benchmark: BenchmarkFixture, scene_dets: tuple[list[np.ndarray], list[np.ndarray]], refine: bool
+) -> None:
+    frames, dets = scene_dets
+    timed = [k for k in range(WARM, len(frames)) if len(dets[k]) == 10]
+    assert len(timed) >= 20  # the scene keeps 10 people in view long enough
+    benchmark.group = "Tracker.update, 10 objects, 480x360"
+
+    def run() -> float:
+        tracker = pftrack.Tracker(seed=0, prime=0)
+        if not refine:
+            from dataclasses import replace
+
+            config = replace(tracker.config, refine=replace(tracker.config.refine, enabled=False))
+            tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
+        for k in range(WARM):
+            tracker.update(dets[k], frames[k])
+        spent = 0.0
+        for k in range(WARM, len(frames)):
+            start = time.perf_counter()
+            out = tracker.update(dets[k], frames[k])
+            if k in timed:
+                spent += time.perf_counter() - start
+            assert len(out) <= len(dets[k])
+        return 1000 * spent / len(timed)
+
+    ms = benchmark.pedantic(run, rounds=3, iterations=1)
+    benchmark.extra_info["ms_per_frame"] = round(ms, 3)

@@ -1,0 +1,105 @@
+"""pftrack behind supervision's tracker interface (``update_with_detections``).
+
+supervision is imported lazily, when a tracker is first updated; install it with
+``pip install "pftrack[supervision]"``. That extra installs supervision's ``opencv-python`` next to
+pftrack's ``opencv-python-headless``: both wheels of one OpenCV release write the same ``cv2``
+package, so either works (see the README); do not uninstall one of the two afterwards, which
+removes ``cv2`` for both (``pip install --force-reinstall --no-deps opencv-python-headless``
+repairs it).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pftrack._typing import F64
+from pftrack.tracking.api import Tracker
+
+if TYPE_CHECKING:
+    import supervision as sv
+
+__all__ = ["SupervisionTracker"]
+
+
+def _detections_class() -> Any:
+    """``supervision.Detections``, imported on first use with a clear error when missing."""
+    try:
+        import supervision
+    except ImportError as exc:
+        raise ImportError(
+            'pftrack.integrations.supervision needs supervision: pip install "pftrack[supervision]"'
+        ) from exc
+    return supervision.Detections
+
+
+class SupervisionTracker:
+    """:class:`pftrack.Tracker` with supervision's ``update_with_detections``.
+
+    Parameters
+    ----------
+    frame_rate : float
+        Frames per second of the video.
+    **options
+        Any other option of :class:`pftrack.Tracker` (``seed``, ``min_conf``, ...).
+
+    Examples
+    --------
+    >>> tracker = SupervisionTracker(frame_rate=25.0)                 # doctest: +SKIP
+    >>> for frame in frames:                                           # doctest: +SKIP
+    ...     detections = sv.Detections.from_ultralytics(model(frame)[0])
+    ...     detections = tracker.update_with_detections(detections, frame)
+    ...     print(detections.tracker_id)
+    """
+
+    def __init__(self, frame_rate: float = 25.0, **options: Any) -> None:
+        self.tracker = Tracker(frame_rate, **options)
+
+    def update_with_detections(self, detections: sv.Detections, frame: ArrayLike) -> sv.Detections:
+        """Track one frame's detections; return those that belong to a track, with its id.
+
+        Parameters
+        ----------
+        detections : supervision.Detections
+            This frame's detections (``xyxy``; ``confidence`` and ``class_id`` when present).
+        frame : (H, W, 3) array_like of uint8
+            The BGR frame: pftrack follows each object's colour, so unlike supervision's
+            ByteTrack it needs the image.
+
+        Returns
+        -------
+        supervision.Detections
+            As supervision's ByteTrack does: the detections matched to a confirmed track this
+            frame, in track order, with ``tracker_id`` set and every other field (boxes, masks,
+            data) taken from the input. Tracks sharing one detection (a blob of people who
+            merged) each get a row with that track's own box.
+        """
+        detections_cls = _detections_class()
+        if not isinstance(detections, detections_cls):
+            raise TypeError(
+                f"detections must be a supervision.Detections, got {type(detections).__name__}"
+            )
+        n = len(detections)
+        conf = np.ones(n) if detections.confidence is None else detections.confidence
+        cls = np.zeros(n) if detections.class_id is None else detections.class_id
+        dets = np.column_stack([np.asarray(detections.xyxy, np.float64).reshape(n, 4), conf, cls])
+        tracks = self.tracker.update(dets, frame)
+        rows = tracks[:, 7].astype(np.int64)
+        out = detections[rows]
+        shared = np.bincount(rows, minlength=n)[rows] > 1 if len(rows) else np.zeros(0, bool)
+        if shared.any():
+            out.xyxy = np.asarray(out.xyxy, np.float64).copy()
+            out.xyxy[shared] = tracks[shared, :4]
+        out.tracker_id = tracks[:, 4].astype(int)
+        result: sv.Detections = out
+        return result
+
+    def finalize(self) -> F64:
+        """The run's MOTChallenge rows after the offline pass (:meth:`pftrack.Tracker.finalize`)."""
+        return self.tracker.finalize()
+
+    def reset(self) -> None:
+        """Forget every track (:meth:`pftrack.Tracker.reset`)."""
+        self.tracker.reset()

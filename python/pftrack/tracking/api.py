@@ -1,0 +1,380 @@
+"""The drop-in tracker: BoxMOT's ``update(dets, frame)`` convention, and the offline pass.
+
+:class:`Tracker` is the one object behind both ``pftrack track`` (through
+:func:`~pftrack.tracking.run.track_frames`) and a user's own loop, so that a script and the
+command never disagree: the same frames, detections and seed give the same rows.
+
+Time constants are given in seconds and turned into frames with ``frame_rate``
+(``round(seconds * frame_rate)``). The defaults are the command's frame-based defaults at the
+reference rate of 25 frames/s (:data:`REFERENCE_RATE`): ``max_coast=0.4`` s is 10 frames,
+``prime=1.2`` s is 30 frames, the linking gap 1.2 s is 30 frames and the birth-score window
+2 s is 50 frames. ``pftrack track`` keeps its options in frames and does not read the video's
+frame rate, so its results do not depend on container metadata; ``Tracker(frame_rate=25.0)``
+with default options is exactly ``pftrack track`` with default options. Motion noise levels
+(particle and centre filters) stay per frame.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterable
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pftrack._typing import F64, RngLike
+from pftrack.recovery.linking import LinkConfig
+from pftrack.tracking.config import TrackerConfig
+from pftrack.tracking.offline import BoxSmoother
+from pftrack.tracking.tracker import MultiObjectTracker
+from pftrack.tracking.writer import TrackWriter
+
+__all__ = ["REFERENCE_RATE", "Tracker", "check_boxes_xyxy", "xywh_to_xyxy_dets"]
+
+#: Frames per second at which the frame-based defaults of ``pftrack track`` are stated.
+REFERENCE_RATE = 25.0
+
+#: Columns of :meth:`Tracker.update`'s output.
+TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
+
+
+def _frames(seconds: float, frame_rate: float, name: str) -> int:
+    """`seconds` as a whole number of frames at `frame_rate`."""
+    if not (np.isfinite(seconds) and seconds >= 0):
+        raise ValueError(f"{name} is {seconds} s, expected a finite number of seconds >= 0")
+    return int(round(seconds * frame_rate))
+
+
+def xywh_to_xyxy_dets(dets: ArrayLike) -> F64:
+    """``[left, top, w, h, ...]`` rows as ``[x1, y1, x2, y2, ...]`` (other columns kept)."""
+    d = np.asarray(dets, dtype=np.float64)
+    if d.size == 0:
+        return np.zeros((0, 5))
+    out: F64 = d.copy()
+    out[:, 2:4] = d[:, :2] + d[:, 2:4]
+    return out
+
+
+def check_boxes_xyxy(
+    dets: ArrayLike, shape: tuple[int, int]
+) -> tuple[F64, NDArray[np.int64], NDArray[np.int64], bool]:
+    """Check detections ``[x1, y1, x2, y2(, conf(, cls))]`` and clip them to the frame.
+
+    Parameters
+    ----------
+    dets : (N, 4), (N, 5) or (N, 6) array_like of float
+        Boxes in pixels, optionally with confidence (default 1) and class id (default 0).
+    shape : (int, int)
+        The frame's rows and columns.
+
+    Returns
+    -------
+    xywh_score : (K, 5) ndarray
+        The boxes inside the frame as ``[left, top, w, h, conf]``, clipped to it.
+    classes : (K,) ndarray of int
+    kept : (K,) ndarray of int
+        Row of `dets` each kept box comes from (boxes wholly outside the frame are dropped).
+    clipped : bool
+        Whether any box reached outside the frame.
+
+    Raises
+    ------
+    TypeError
+        Not numbers.
+    ValueError
+        Wrong shape, NaN or inf, or a box with ``x2 <= x1`` or ``y2 <= y1`` (the message says
+        when the rows look like ``x, y, w, h`` instead).
+    """
+    d = np.asarray(dets)
+    if d.dtype.kind not in "iuf":
+        raise TypeError(f"dets must be an array of numbers, got dtype {d.dtype}")
+    d = d.astype(np.float64)
+    if d.size == 0:
+        return np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64), False
+    if d.ndim != 2 or d.shape[1] not in (4, 5, 6):
+        raise ValueError(
+            f"dets must have shape (N, 4), (N, 5) or (N, 6) [x1, y1, x2, y2(, conf(, cls))], "
+            f"got {d.shape}"
+        )
+    if not np.all(np.isfinite(d)):
+        k = int(np.flatnonzero(~np.isfinite(d).all(axis=1))[0])
+        raise ValueError(f"dets row {k} contains NaN or inf: {d[k].tolist()}")
+    bad = (d[:, 2] <= d[:, 0]) | (d[:, 3] <= d[:, 1])
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        if np.all(d[bad, 2:4] > 0):  # positive as widths and heights: x, y, w, h rows
+            raise ValueError(
+                f"dets row {k} {d[k, :4].tolist()} has x2 <= x1 or y2 <= y1: the boxes look "
+                "like x, y, w, h; give x1, y1, x2, y2 (x2 = x + w, y2 = y + h)"
+            )
+        raise ValueError(f"dets row {k} {d[k, :4].tolist()} has x2 <= x1 or y2 <= y1")
+    rows, cols = shape
+    limit = np.array([cols, rows, cols, rows], np.float64)
+    box = np.clip(d[:, :4], 0.0, limit)
+    clipped = bool(np.any(box != d[:, :4]))
+    inside = (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1])
+    kept = np.flatnonzero(inside).astype(np.int64)
+    box = box[kept]
+    conf = d[kept, 4] if d.shape[1] >= 5 else np.ones(len(kept))
+    cls = d[kept, 5].astype(np.int64) if d.shape[1] == 6 else np.zeros(len(kept), np.int64)
+    xywh = np.column_stack([box[:, :2], box[:, 2:] - box[:, :2], conf])
+    return xywh, cls, kept, clipped
+
+
+class Tracker:
+    """pftrack as a drop-in multi-object tracker: one ``update`` per frame, then ``finalize``.
+
+    Parameters
+    ----------
+    frame_rate : float
+        Frames per second of the input: turns the time constants below into frames.
+    seed : int or None
+        Seed: the same seed, frames and detections give the same tracks (None: fresh entropy).
+    detector : {"paper", "mog2", "knn"}
+        Built-in detector, used when ``update`` gets ``dets=None`` (and, with detections, for
+        the foreground that shrinks their boxes).
+    sampler : {"sis", "mh", "rjmcmc"}
+        Particle filter per object (sis, the paper's; mh) or one joint RJ-MCMC chain.
+    particles : int
+        Particles per object.
+    dynamics : {"ar2", "ar2-mean"}
+        AR(2) model per particle, or from the particle-set means.
+    max_coast : float
+        Seconds a track survives on its particle filter alone (0.4 s: 10 frames at 25/s).
+    min_conf : float
+        Detections with a lower confidence are ignored.
+    birth_score : float
+        Cap of the confidence a detection needs to start a track.
+    birth_quantile : float or None
+        The birth threshold is ``min(birth_score, quantile)`` of the confidences seen in the
+        first 2 s, so a detector whose scores are all low still starts tracks (None: always
+        `birth_score`). See :class:`~pftrack.tracking.LifecycleConfig`.
+    camera_motion : {"auto", "on", "off"}
+        Camera-motion compensation (:attr:`TrackerConfig.camera_motion`).
+    fill : {"linear", "pf"}
+        Boxes of a gap the particle filter bridged, before smoothing.
+    smooth, link : bool
+        The offline pass of :meth:`finalize`: smooth each track's boxes, join fragments of one
+        object across gaps of up to 1.2 s.
+    prime : float
+        Seconds of frames :meth:`prime` reads (what ``pftrack track`` reads ahead).
+
+    Examples
+    --------
+    >>> tracker = pftrack.Tracker(frame_rate=25.0)         # doctest: +SKIP
+    >>> for frame in frames:                                # doctest: +SKIP
+    ...     dets = my_detector(frame)                       # (N, 6) x1, y1, x2, y2, conf, cls
+    ...     tracks = tracker.update(dets, frame)            # (M, 8) x1..y2, id, conf, cls, det_ind
+    >>> rows = tracker.finalize()                           # doctest: +SKIP
+    """
+
+    def __init__(
+        self,
+        frame_rate: float = REFERENCE_RATE,
+        *,
+        seed: int | None = 0,
+        detector: str = "paper",
+        sampler: str = "sis",
+        particles: int = 100,
+        dynamics: str = "ar2",
+        max_coast: float = 0.4,
+        min_conf: float = 0.0,
+        birth_score: float = 0.9,
+        birth_quantile: float | None = 0.25,
+        camera_motion: str = "auto",
+        fill: str = "linear",
+        smooth: bool = True,
+        link: bool = True,
+        prime: float = 1.2,
+    ) -> None:
+        if not (np.isfinite(frame_rate) and frame_rate > 0):
+            raise ValueError(f"frame_rate is {frame_rate}, expected a finite value > 0")
+        if dynamics not in ("ar2", "ar2-mean"):
+            raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
+        if not isinstance(particles, (int, np.integer)) or particles < 1:
+            raise ValueError(f"particles is {particles!r}, expected an integer >= 1")
+        base = TrackerConfig()
+        model = replace(base.filter.model, use_means=dynamics == "ar2-mean")
+        config = replace(
+            base,
+            filter=replace(base.filter, n_particles=int(particles), model=model),
+            detector=detector,
+            sampler=sampler,
+            camera_motion=camera_motion,
+            lifecycle=replace(
+                base.lifecycle,
+                max_coast=_frames(max_coast, frame_rate, "max_coast"),
+                min_score=float(min_conf),
+                birth_score=float(birth_score),
+                birth_quantile=birth_quantile,
+                birth_window=_frames(2.0, frame_rate, "birth window"),
+            ),
+        )
+        link_config = LinkConfig(max_gap=max(1, _frames(1.2, frame_rate, "link gap")))
+        self._setup(
+            config,
+            seed,
+            frame_rate=float(frame_rate),
+            fill=fill,
+            smoother=BoxSmoother() if smooth else None,
+            link=link_config if link else None,
+            prime_frames=_frames(prime, frame_rate, "prime"),
+        )
+
+    @classmethod
+    def from_config(
+        cls,
+        config: TrackerConfig | None = None,
+        seed: RngLike = 0,
+        *,
+        frame_rate: float = REFERENCE_RATE,
+        coasting: str = "confirmed",
+        fill: str = "linear",
+        smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
+        link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
+        prime_frames: int = 30,
+    ) -> Tracker:
+        """A tracker from a full :class:`TrackerConfig` (frame-based), as ``pftrack track`` makes.
+
+        Parameters
+        ----------
+        config : TrackerConfig, optional
+            All tracker settings (default ``TrackerConfig()``).
+        seed : int, numpy.random.Generator or None
+            Seed (with a Generator, :meth:`reset` goes on drawing from it rather than
+            starting over).
+        frame_rate : float
+            Recorded only: `config` is already in frames.
+        coasting, fill : str
+            What coasting becomes in :meth:`finalize` (:class:`TrackWriter`).
+        smoother, link : optional
+            The offline pass (None: off).
+        prime_frames : int
+            Frames :meth:`prime` reads.
+        """
+        self = cls.__new__(cls)
+        self._setup(
+            config if config is not None else TrackerConfig(),
+            seed,
+            frame_rate=frame_rate,
+            fill=fill,
+            smoother=smoother,
+            link=link,
+            prime_frames=prime_frames,
+            coasting=coasting,
+        )
+        return self
+
+    def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: float, fill: str,
+               smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: int,
+               coasting: str = "confirmed") -> None:  # fmt: skip
+        if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
+            raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")
+        if not isinstance(prime_frames, (int, np.integer)) or prime_frames < 0:
+            raise ValueError(f"prime_frames is {prime_frames!r}, expected an integer >= 0")
+        self.config = config
+        self.frame_rate = frame_rate
+        self.seed = seed
+        self.prime_frames = int(prime_frames)
+        self._writer_args = (coasting, fill, smoother, link)
+        TrackWriter(*self._writer_args)  # check the writer's options now
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every track and frame: the tracker is as new (same settings and seed)."""
+        self._tracker = MultiObjectTracker(self.config, rng=self.seed)
+        self._writer = TrackWriter(*self._writer_args)
+        self.frame_count = 0
+        self._clip_warned = False
+        self._max_conf = -np.inf
+
+    @property
+    def tracker(self) -> MultiObjectTracker:
+        """The online tracker inside (its live tracks, detector and foreground mask)."""
+        return self._tracker
+
+    def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
+        """Start the background model from the median of `frames` (before the first update).
+
+        ``pftrack track`` reads its first ``prime_frames`` frames ahead this way (with the
+        built-in detector, or with detections when box refinement is on, the default); a loop
+        that does the same gets the command's rows. Detectors without a background ignore it.
+        """
+        if self.frame_count:
+            raise ValueError("prime() must come before the first update()")
+        self._tracker.prime(frames)
+
+    def update(self, dets: ArrayLike | None, frame: ArrayLike) -> F64:
+        """Track one frame.
+
+        Parameters
+        ----------
+        dets : (N, 6), (N, 5) or (N, 4) array_like of float, or None
+            ``x1, y1, x2, y2, conf, cls`` in pixels (conf default 1, cls default 0); boxes
+            reaching outside the frame are clipped to it (with one warning), boxes wholly
+            outside are ignored. None runs the built-in background-subtraction detector.
+        frame : (H, W, 3) array_like of uint8
+            BGR frame.
+
+        Returns
+        -------
+        (M, 8) ndarray of float
+            ``x1, y1, x2, y2, id, conf, cls, det_ind`` of the confirmed tracks matched to a
+            detection this frame (BoxMOT's convention): ``det_ind`` is the row of `dets` the
+            track was matched to (a merged blob's row for each track inside it; -1 with
+            ``dets=None``). Boxes are the track's filtered boxes, ``conf`` the detection's.
+        """
+        f = np.asarray(frame)
+        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
+            raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        if dets is None:
+            kept = None
+            reports = self._tracker.update(f, None)
+        else:
+            xywh, cls, kept, clipped = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
+            if clipped and not self._clip_warned:
+                self._clip_warned = True
+                warnings.warn(
+                    f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
+                    "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
+                    stacklevel=2,
+                )
+            if len(xywh):
+                self._max_conf = max(self._max_conf, float(xywh[:, 4].max()))
+            reports = self._tracker.update(f, xywh, cls)
+        self.frame_count += 1
+        self._writer.add(self.frame_count, reports)
+        out = np.zeros((len(reports), 8))
+        m = 0
+        for t in reports:
+            if t.time_since_update != 0:
+                continue  # coasting: carried by the particle filter alone, held back
+            b = t.box_xywh
+            di = -1 if kept is None or t.detection_index is None else kept[t.detection_index]
+            out[m] = (b[0], b[1], b[0] + b[2], b[1] + b[3], t.id, t.score, t.cls, di)
+            m += 1
+        return out[:m]
+
+    def finalize(self) -> F64:
+        """The run's MOTChallenge rows after the offline pass (what ``pftrack track`` writes).
+
+        Returns
+        -------
+        (R, 10) ndarray of float
+            ``frame, id, left, top, width, height, conf, -1, -1, -1``, frames from 1 (one per
+            ``update``), sorted by frame then id. Warns when there is no row at all.
+        """
+        rows = self._writer.result()
+        if len(rows) == 0 and self.frame_count:
+            cfg = self.config.lifecycle
+            hint = (
+                f"the highest detection confidence was {self._max_conf:.3g} (min_conf "
+                f"{cfg.min_score:.3g}, birth_score {cfg.birth_score:.3g})"
+                if np.isfinite(self._max_conf)
+                else "no external detection was given"
+            )
+            warnings.warn(
+                f"no track over {self.frame_count} frames: {hint}", RuntimeWarning, stacklevel=2
+            )
+        return rows

@@ -1,0 +1,79 @@
+"""pftrack.integrations.supervision against the real supervision (in the test extra)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import supervision as sv
+
+import pftrack
+from pftrack.integrations.supervision import SupervisionTracker
+from pftrack.io.mot import group_by_frame
+from pftrack.synthetic import make_scene
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return make_scene(n_frames=30, rng=2)
+
+
+def frame_detections(scene, n):
+    r = group_by_frame(scene.truth).get(n, np.zeros((0, 10)))
+    xyxy = np.column_stack([r[:, 2:4], r[:, 2:4] + r[:, 4:6]])
+    return sv.Detections(
+        xyxy=xyxy,
+        confidence=np.full(len(r), 0.95),
+        class_id=np.zeros(len(r), int),
+        data={"truth_id": r[:, 1].astype(int)},
+    )
+
+
+def test_update_with_detections_sets_tracker_id_like_the_tracker(scene):
+    adapter = SupervisionTracker(frame_rate=10.0, seed=1)
+    plain = pftrack.Tracker(frame_rate=10.0, seed=1)
+    seen = 0
+    for n, frame in enumerate(scene.frames, start=1):
+        dets = frame_detections(scene, n)
+        out = adapter.update_with_detections(dets, frame)
+        ref = plain.update(np.column_stack([dets.xyxy, dets.confidence, dets.class_id]), frame)
+        assert isinstance(out, sv.Detections) and out.tracker_id is not None
+        np.testing.assert_array_equal(out.tracker_id, ref[:, 4].astype(int))
+        # the rows are the input detections the tracks were matched to, with all their fields
+        rows = ref[:, 7].astype(int)
+        np.testing.assert_array_equal(out.xyxy, dets.xyxy[rows])
+        np.testing.assert_array_equal(out.data["truth_id"], dets.data["truth_id"][rows])
+        seen += len(out)
+    assert seen > 0.7 * len(scene.truth)
+    np.testing.assert_array_equal(adapter.finalize(), plain.finalize())
+    adapter.reset()
+    assert adapter.tracker.frame_count == 0
+
+
+def test_ids_follow_the_truth(scene):
+    adapter = SupervisionTracker(frame_rate=10.0)
+    pairs = set()
+    for n, frame in enumerate(scene.frames, start=1):
+        out = adapter.update_with_detections(frame_detections(scene, n), frame)
+        pairs |= set(zip(out.tracker_id.tolist(), out.data["truth_id"].tolist(), strict=True))
+    tracker_ids = [t for t, _ in pairs]
+    assert len(tracker_ids) == len(set(tracker_ids))  # one truth per tracker id
+
+
+def test_empty_and_bad_input(scene):
+    adapter = SupervisionTracker()
+    out = adapter.update_with_detections(sv.Detections.empty(), scene.frames[0])
+    assert len(out) == 0
+    with pytest.raises(TypeError, match="supervision.Detections"):
+        adapter.update_with_detections(np.zeros((0, 5)), scene.frames[0])
+
+
+def test_supervision_is_imported_lazily():
+    code = (
+        "import sys, pftrack.integrations.supervision as m, pftrack; pftrack.Tracker; "
+        "print('supervision' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

@@ -1,0 +1,306 @@
+"""pftrack.Tracker: the drop-in contract (update, finalize, reset), its inputs and the CLI."""
+
+from __future__ import annotations
+
+import itertools
+import warnings
+
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack.cli import main
+from pftrack.eval import evaluate_mot
+from pftrack.io.mot import group_by_frame, read_mot, write_mot
+from pftrack.io.video import FrameSource
+from pftrack.synthetic import make_scene
+from pftrack.tracking import TrackerConfig, track_frames
+from pftrack.tracking.api import check_boxes_xyxy, xywh_to_xyxy_dets
+from tests.conftest import dataset
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return make_scene(n_frames=40, rng=1)
+
+
+def scene_dets(scene, scores=None, rng=0):
+    """Per-frame (N, 5) x1, y1, x2, y2, conf from the scene's truth (shuffled rows)."""
+    g = np.random.default_rng(rng)
+    by_frame = group_by_frame(scene.truth)
+    out = []
+    for f in range(1, len(scene.frames) + 1):
+        r = by_frame.get(f, np.zeros((0, 10)))
+        r = r[g.permutation(len(r))]
+        conf = np.ones(len(r)) if scores is None else g.uniform(*scores, len(r))
+        out.append(xywh_to_xyxy_dets(np.column_stack([r[:, 2:6], conf])))
+    return out
+
+
+def run_loop(tracker, frames, dets):
+    outs = [tracker.update(d, f) for d, f in zip(dets, frames, strict=True)]
+    return outs, tracker.finalize()
+
+
+# -- the contract on real sequences ----------------------------------------------------------
+SEQUENCES = {
+    "pets09-s2l1": ("video.avi", 0.625),
+    "tud-campus": ("video.mp4", 1.0),
+}
+
+
+@pytest.mark.dataset
+@pytest.mark.parametrize("name", sorted(SEQUENCES))
+def test_documented_loop_is_the_cli_byte_for_byte(name, tmp_path):
+    folder = dataset(name)
+    video, scale = SEQUENCES[name]
+    cli_out = tmp_path / "cli.txt"
+    argv = ["track", str(folder / video), "--detections", str(folder / "det.txt")]
+    assert main([*argv, "--det-scale", str(scale), "--out", str(cli_out)]) == 0
+
+    # the README's loop: a detector's (N, 5) x1, y1, x2, y2, conf per frame
+    det = read_mot(folder / "det.txt")
+    by_frame = group_by_frame(det)
+    tracker = pftrack.Tracker(frame_rate=25.0)
+    tracker.prime(itertools.islice(iter(FrameSource(folder / video)), 30))
+    for n, frame in enumerate(FrameSource(folder / video), start=1):
+        r = by_frame.get(n, np.zeros((0, 10)))
+        dets = np.column_stack([r[:, 2:4] * scale, (r[:, 2:4] + r[:, 4:6]) * scale, r[:, 6]])
+        # x2 as the CLI computes it, from the scaled left and width: same floats, same bytes
+        dets[:, 2:4] = r[:, 2:4] * scale + r[:, 4:6] * scale
+        tracks = tracker.update(dets, frame)
+        assert tracks.shape[1] == 8 and tracks.dtype == np.float64
+        ids = tracks[:, 4]
+        assert len(set(ids)) == len(ids) and np.all(ids >= 1) and np.all(ids == np.round(ids))
+        di = tracks[:, 7].astype(int)
+        assert np.all((di >= 0) & (di < len(dets)))  # every reported track has its detection
+        np.testing.assert_array_equal(tracks[:, 5], dets[di, 4])
+        assert np.all(tracks[:, 6] == 0)
+    rows = tracker.finalize()
+    api_out = tmp_path / "api.txt"
+    write_mot(api_out, rows)
+    assert api_out.read_bytes() == cli_out.read_bytes()
+    gt = read_mot(folder / "gt.txt")
+    a = evaluate_mot(gt, read_mot(api_out), scale=scale)
+    b = evaluate_mot(gt, read_mot(cli_out), scale=scale)
+    assert (a.mota, a.idf1) == (b.mota, b.idf1)
+
+
+# -- update's output ------------------------------------------------------------------------
+def test_update_returns_confirmed_matched_tracks_with_det_ind(scene):
+    dets = scene_dets(scene)
+    tracker = pftrack.Tracker(seed=0)
+    outs, rows = run_loop(tracker, scene.frames, dets)
+    assert sum(len(o) for o in outs) > 0.8 * len(scene.truth)
+    for o, d in zip(outs, dets, strict=True):
+        assert o.shape[1] == 8
+        di = o[:, 7].astype(int)
+        assert np.all(di >= 0)
+        # the track's box sits on the detection it names (a shuffled order must not matter)
+        centre_t = (o[:, :2] + o[:, 2:4]) / 2
+        centre_d = (d[di, :2] + d[di, 2:4]) / 2
+        assert np.all(np.abs(centre_t - centre_d) < 0.5 * (d[di, 3] - d[di, 1])[:, None])
+    assert rows.shape[1] == 10 and len(rows) >= sum(len(o) for o in outs) * 0.9
+    m = evaluate_mot(scene.truth, rows)
+    assert m.mota > 0.7 and m.idf1 > 0.8  # measured 0.79 / 0.89
+
+
+def test_update_drops_coasting_tracks_that_the_old_api_reports(scene):
+    """Frames without detections: update reports no box; MultiObjectTracker still coasts."""
+    dets = scene_dets(scene)[:15]
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    for d, f in zip(dets, scene.frames, strict=False):
+        tracker.update(d, f)
+    frame = scene.frames[15]
+    assert len(tracker.update(np.zeros((0, 5)), frame)) == 0
+    coasting = [t for t in tracker.tracker.tracks if t.time_since_update == 1]
+    assert coasting  # still alive inside, held back for finalize's offline pass
+
+
+def test_reset_gives_a_fresh_tracker(scene):
+    dets = scene_dets(scene)
+    tracker = pftrack.Tracker(seed=3)
+    outs_a, rows_a = run_loop(tracker, scene.frames, dets)
+    tracker.reset()
+    outs_b, rows_b = run_loop(tracker, scene.frames, dets)
+    outs_c, rows_c = run_loop(pftrack.Tracker(seed=3), scene.frames, dets)
+    for a, b, c in zip(outs_a, outs_b, outs_c, strict=True):
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(a, c)
+    np.testing.assert_array_equal(rows_a, rows_b)
+    np.testing.assert_array_equal(rows_a, rows_c)
+    # and the seed matters (the particle filters draw from it)
+    _, rows_d = run_loop(pftrack.Tracker(seed=4, smooth=False), scene.frames, dets)
+    _, rows_e = run_loop(pftrack.Tracker(seed=3, smooth=False), scene.frames, dets)
+    assert not np.array_equal(rows_d, rows_e)
+
+
+def test_classes_never_share_an_identity():
+    """One object seen as class 0, then as class 1 in the same place: two identities."""
+    frame = np.zeros((80, 100, 3), np.uint8)
+    frame[20:60, 30:50] = (40, 60, 220)
+    box = [30.0, 20.0, 50.0, 60.0, 0.95]
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    ids: dict[int, set[int]] = {}
+    for k in range(12):
+        cls = 0 if k < 6 else 1
+        out = tracker.update(np.array([[*box, cls]]), frame)
+        for row in out:
+            ids.setdefault(int(row[4]), set()).add(int(row[6]))
+    assert all(len(c) == 1 for c in ids.values())
+    assert {c for cs in ids.values() for c in cs} == {0, 1}  # both classes were tracked
+    # the same run with one class keeps one identity
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    one = set()
+    for _ in range(12):
+        one |= {int(r[4]) for r in tracker.update(np.array([box]), frame)}
+    assert len(one) == 1
+
+
+def test_merged_blob_rows_name_the_blob():
+    from pftrack.tracking import LifecycleConfig, RefineConfig
+    from pftrack.tracking.tracker import MultiObjectTracker
+
+    frame = np.zeros((80, 120, 3), np.uint8)
+    frame[20:60, 20:36] = (40, 60, 220)
+    frame[20:60, 40:56] = (220, 60, 40)
+    config = TrackerConfig(lifecycle=LifecycleConfig(min_hits=1), refine=RefineConfig(False))
+    mot = MultiObjectTracker(config, rng=0)
+    two = np.array([[20, 20, 16, 40, 1.0], [40, 20, 16, 40, 1.0]])
+    assert sorted(t.id for t in mot.update(frame, two)) == [1, 2]
+    blob = np.array([[100.0, 0.0, 3.0, 3.0, 1.0], [18, 18, 40, 44, 1.0]])  # both people inside
+    tracks = [t for t in mot.update(frame, blob) if t.id in (1, 2)]
+    matched = [t for t in tracks if t.time_since_update == 0]
+    assert [t.detection_index for t in matched] == [1]  # the blob, no longer None
+    assert matched[0].detection_box is None  # a blob does not re-seed the track
+
+
+# -- birth gates -----------------------------------------------------------------------------
+def test_low_score_detector_still_gives_tracks(scene):
+    dets = scene_dets(scene, scores=(0.2, 0.5))
+    outs, rows = run_loop(pftrack.Tracker(seed=0), scene.frames, dets)
+    assert len(rows) > 0 and sum(len(o) for o in outs) > 0
+    assert evaluate_mot(scene.truth, rows).mota > 0.5
+    # the fixed 0.9 threshold of before drops the whole detector, and says so
+    with pytest.warns(RuntimeWarning, match="no track over 40 frames.*highest detection"):
+        run_loop(pftrack.Tracker(seed=0, birth_quantile=None), scene.frames, dets)
+
+
+def test_min_conf_ignores_detections(scene):
+    dets = scene_dets(scene, scores=(0.2, 0.5))
+    with pytest.warns(RuntimeWarning, match="no track"):
+        outs, rows = run_loop(pftrack.Tracker(seed=0, min_conf=0.6), scene.frames, dets)
+    assert len(rows) == 0
+
+
+def test_cli_warns_when_no_track(scene, tmp_path, capsys):
+    video = tmp_path / "scene.avi"
+    scene.write_video(video)
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 0.3
+    write_mot(tmp_path / "det.txt", det)
+    out = tmp_path / "t.txt"
+    argv = ["track", str(video), "--detections", str(tmp_path / "det.txt"), "--out", str(out)]
+    assert main([*argv, "--min-conf", "0.5"]) == 0
+    assert "pftrack track: warning: no track" in capsys.readouterr().err
+    assert main(argv) == 0  # the default birth threshold follows the detector's scores
+    assert len(read_mot(out)) > 0 and "warning" not in capsys.readouterr().err
+
+
+# -- inputs ----------------------------------------------------------------------------------
+def test_xywh_given_as_xyxy_is_refused(scene):
+    d = scene_dets(scene)[0]
+    xywh = d.copy()
+    xywh[:, 2:4] = d[:, 2:4] - d[:, :2]
+    with pytest.raises(ValueError, match="look like x, y, w, h"):
+        pftrack.Tracker().update(xywh, scene.frames[0])
+
+
+def test_xyxy_file_where_xywh_is_expected_is_refused(scene):
+    d = scene_dets(scene)
+    as_file = {n: v for n, v in enumerate(d, start=1) if len(v)}  # x1, y1, x2, y2 "as xywh"
+    with pytest.raises(ValueError, match="look like x1, y1, x2, y2"):
+        track_frames(scene.frames, detections=as_file, rng=0)
+
+
+def test_boxes_outside_the_frame_are_clipped_once(scene):
+    frame = scene.frames[0]
+    h, w = frame.shape[:2]
+    d = scene_dets(scene)[0]
+    extra = np.array([[w + 10, 5, w + 40, 50, 1.0], [-20, h - 30, 15, h + 30, 1.0]])
+    dets = np.vstack([extra, d])
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    with pytest.warns(UserWarning, match="clipped"):
+        out = tracker.update(dets, frame)
+    assert np.all(out[:, 7] != 0)  # the box wholly outside never matches
+    assert np.all((out[:, :4] >= -1) & (out[:, [2]] <= w + 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # warned once per tracker
+        tracker.update(dets, scene.frames[1])
+    xywh, cls, kept, clipped = check_boxes_xyxy(dets, (h, w))
+    assert clipped and kept[0] == 1 and 0 not in kept
+    np.testing.assert_array_equal(xywh[0], [0, h - 30, 15, 30, 1.0])  # clipped at x = 0, y = h
+    inside = np.all((d[:, :2] >= 0) & (d[:, 2:4] <= [w, h]), axis=1)
+    assert inside.any()
+    np.testing.assert_array_equal(  # boxes inside the frame are untouched
+        xywh[1:][inside, :4], np.column_stack([d[:, :2], d[:, 2:4] - d[:, :2]])[inside]
+    )
+
+
+@pytest.mark.parametrize(
+    ("dets", "error", "match"),
+    [
+        (np.ones((2, 7)), ValueError, r"shape \(N, 4\), \(N, 5\) or \(N, 6\)"),
+        (np.array([[1.0, 2, np.nan, 4]]), ValueError, "NaN or inf"),
+        (np.array([["a", "b", "c", "d"]]), TypeError, "numbers"),
+        (np.array([[10.0, 10, 5, -4]]), ValueError, "x2 <= x1"),
+    ],
+)
+def test_bad_detections_are_one_line_errors(dets, error, match):
+    with pytest.raises(error, match=match):
+        pftrack.Tracker().update(dets, np.zeros((30, 40, 3), np.uint8))
+
+
+def test_options_and_frames():
+    with pytest.raises(ValueError, match="frame_rate"):
+        pftrack.Tracker(frame_rate=0)
+    with pytest.raises(ValueError, match="max_coast"):
+        pftrack.Tracker(max_coast=-1.0)
+    with pytest.raises(ValueError, match="camera_motion"):
+        pftrack.Tracker(camera_motion="sometimes")
+    with pytest.raises(TypeError, match="uint8"):
+        pftrack.Tracker().update(None, np.zeros((30, 40, 3)))
+    # seconds become frames at the frame rate; 25/s gives the command's defaults
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+
+    cli = tracker_config(build_parser().parse_args(["track", "v.avi", "--out", "t.txt"]))
+    assert pftrack.Tracker().config == TrackerConfig() == cli
+    assert pftrack.Tracker().prime_frames == 30
+    slow = pftrack.Tracker(frame_rate=7.0)
+    assert slow.config.lifecycle.max_coast == 3 and slow.prime_frames == 8
+    assert pftrack.Tracker(frame_rate=50.0).config.lifecycle.birth_window == 100
+
+
+def test_builtin_detector_when_dets_is_none(scene):
+    tracker = pftrack.Tracker(seed=0)
+    tracker.prime(scene.frames[:30])
+    outs = [tracker.update(None, f) for f in scene.frames]
+    assert sum(len(o) for o in outs) > 0
+    assert all(np.all(o[:, 7] == -1) for o in outs)
+    assert len(tracker.finalize()) > 0
+    with pytest.raises(ValueError, match="before the first update"):
+        tracker.prime(scene.frames[:3])
+
+
+def test_track_frames_is_the_tracker_loop(scene):
+    """track_frames (the CLI's library) and a loop over Tracker agree (priming included)."""
+    d = scene_dets(scene)
+    as_file = {n: np.column_stack([v[:, :2], v[:, 2:4] - v[:, :2], v[:, 4]]) for n, v in
+               enumerate(d, start=1)}  # fmt: skip
+    run = track_frames(scene.frames, detections=as_file, rng=5)
+    tracker = pftrack.Tracker(seed=5)
+    tracker.prime(scene.frames[:30])
+    for n, f in enumerate(scene.frames, start=1):
+        tracker.update(xywh_to_xyxy_dets(as_file[n]), f)
+    np.testing.assert_array_equal(tracker.finalize(), run.rows)
