@@ -51,9 +51,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--gt", required=True, help="ground truth: a MOTChallenge file or folder")
     p.add_argument("--res", required=True, help="results: a MOTChallenge file, or a folder")
     p.add_argument(
-        "--scale", type=scale_spec, action="append", default=[], metavar="[NAME=]S",
+        "--scale", type=scale_spec, action="append", default=None, metavar="[NAME=]S",
         help="multiply ground-truth boxes by S, for every sequence or for sequence NAME "
-        "(repeat the option); 0.625 for PETS09 gt on its 480x360 video (default: 1)",
+        "(repeat the option); 0.625 for PETS09 gt on its 480x360 video; None: 1 everywhere",
     )  # fmt: skip
     p.add_argument("--iou", type=float, default=0.5, help="IoU threshold of a CLEAR-MOT match")
     p.add_argument(
@@ -62,10 +62,10 @@ def add_parser(sub: Any) -> None:
         "visibilities, else MOT15",
     )  # fmt: skip
     p.add_argument("--seqs", nargs="+", metavar="NAME", default=None,
-                   help="score only these sequences of a folder (default: all)")  # fmt: skip
+                   help="score only these sequences of a folder; None: all")  # fmt: skip
     p.add_argument("--image-size", type=int, nargs=2, metavar=("W", "H"), default=None,
-                   help="image size for the centroid-distance ratio (default: seqinfo.ini's "
-                   "size times the scale, if any)")  # fmt: skip
+                   help="image size for the centroid-distance ratio; None: seqinfo.ini's "
+                   "size times the scale, if any")  # fmt: skip
     p.add_argument(
         "--no-scale-check", action="store_true",
         help="score even when result boxes look like another pixel scale than the ground truth",
@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         check_output(args.csv, what="--csv", suffixes=(".csv",), inputs=inputs)
     jobs = _jobs(args)
-    scales = _scales(args.scale, [name for name, _, _ in jobs])
+    scales = _scales(args.scale or [], [name for name, _, _ in jobs])
 
     loaded = []
     for name, seq, path in jobs:  # read and check everything before scoring anything
