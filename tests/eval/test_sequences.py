@@ -24,7 +24,7 @@ from pftrack.eval import (
 from pftrack.eval.sequences import read_seqinfo
 from pftrack.io.mot import read_mot, write_mot
 from tests.conftest import dataset
-from tests.eval.test_hota import perturbed, write_rows
+from tests.eval.cases import perturbed, write_rows
 from tests.eval.test_metrics import iou_loop, random_case
 
 CLEAR = ["mota", "motp", "idf1", "idp", "idr", "num_switches", "num_fragmentations",
