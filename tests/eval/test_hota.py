@@ -210,6 +210,10 @@ def test_empty_inputs_and_errors() -> None:
     assert m.hota == 0.0 and np.all(m.fn == 1) and np.all(m.loc_a == 1)
     m = evaluate_hota(np.zeros((0, 10)), gt)
     assert m.hota == 0.0 and np.all(m.fp == 1)
+    apart = evaluate_hota(gt, gt + [1, 0, 0, 0, 0, 0])  # no common frame
+    assert apart.hota == 0.0 and np.all(apart.fn == 1) and np.all(apart.fp == 1)
+    far = evaluate_hota(gt, gt + [0, 0, 50, 0, 0, 0])  # a common frame, no overlap
+    assert far.hota == 0.0 and np.all(far.tp == 0)
     with pytest.raises(ValueError, match="more than once in frame 1"):
         evaluate_hota(np.vstack([gt, gt]), gt)
     with pytest.raises(ValueError, match="beyond the sequence"):

@@ -127,6 +127,8 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack eval``: print the table, optionally write JSON/CSV; return the status."""
+    import json
+
     from pftrack._progress import progress
     from pftrack.eval.sequences import (
         SequenceScores,
@@ -178,13 +180,12 @@ def run(args: argparse.Namespace) -> int:
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
     print(format_scores(scores, combined))
     if args.json:
+        if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
+            text = json.dumps(next(iter(scores.values())).as_dict(), indent=2)
+        else:
+            text = scores_json(scores, combined)
         with atomic_write(args.json) as fh:
-            if len(jobs) == 1 and Path(args.gt).is_file():
-                import json
-
-                fh.write(json.dumps(next(iter(scores.values())).as_dict(), indent=2) + "\n")
-            else:
-                fh.write(scores_json(scores, combined) + "\n")
+            fh.write(text + "\n")
     if args.csv:
         with atomic_write(args.csv) as fh:
             fh.write(scores_csv(scores, combined))

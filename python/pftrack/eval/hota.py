@@ -219,7 +219,7 @@ def prepare_mot(
     return np.concatenate(keep_g), np.concatenate(keep_r)
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, eq=False)  # arrays: no element-wise ==
 class HotaMetrics:
     """HOTA and its parts for one sequence or several combined.
 
