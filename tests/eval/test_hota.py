@@ -234,3 +234,21 @@ def test_cli_prints_hota(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     text = capsys.readouterr().out
     expected = evaluate_hota(read_mot(folder / "gt.txt"), read_mot(res)).hota
     assert "HOTA" in text and f"{100 * expected:.1f}" in text
+
+
+@pytest.mark.dataset
+@pytest.mark.slow
+def test_equals_trackeval_on_pftrack_track_output(tmp_path: Path) -> None:
+    """A real tracker's output: `pftrack track` on TUD-Campus with its public detections."""
+    folder = dataset("tud-campus")
+    out = tmp_path / "tracks.txt"
+    argv = ["track", str(folder / "video.mp4"), "--detections", str(folder / "det.txt")]
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main([*argv, "--out", str(out)]) == 0
+    gt, res = read_mot(folder / "gt.txt"), read_mot(out)
+    ref = trackeval_hota(tmp_path / "te", {"tud": (gt, res)}, "MOT15")
+    g = read_mot(tmp_path / "te" / "gt" / "tud" / "gt" / "gt.txt")
+    r = read_mot(tmp_path / "te" / "trackers" / "t" / "data" / "tud.txt")
+    ours = evaluate_hota(g, r)
+    assert_same(ours, ref["tud"])
+    assert ours.hota > 0.4
