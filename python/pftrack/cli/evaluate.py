@@ -1,11 +1,34 @@
-"""``pftrack eval``: score a MOTChallenge result file against ground truth."""
+"""``pftrack eval``: score tracking results against ground truth, one file or a folder."""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
 from pftrack.cli._options import add_command
+
+EXAMPLES = """\
+examples:
+  pftrack eval --gt gt.txt --res tracks.txt
+  pftrack eval --gt pets09-s2l1/gt.txt --res tracks.txt --scale 0.625   # gt 768x576, video 480x360
+  pftrack eval --gt MOT17/train --res results/ --csv scores.csv         # results/SEQ.txt per SEQ
+  pftrack eval --gt data --res results/ --scale pets09-s2l1=0.625 --seqs pets09-s2l1 tud-campus
+"""
+
+
+def scale_spec(text: str) -> tuple[str | None, float]:
+    """Argument type of ``--scale``: ``S`` (every sequence) or ``NAME=S`` (one sequence)."""
+    name, _, value = text.rpartition("=")
+    try:
+        v = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected S or NAME=S with S a number, got {text!r}"
+        ) from None
+    if not 0 < v < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a scale > 0, got {v}")
+    return (name or None), v
 
 
 def add_parser(sub: Any) -> None:
@@ -13,39 +36,157 @@ def add_parser(sub: Any) -> None:
     p = add_command(
         sub,
         "eval",
-        help="score a tracking result against ground truth (MOTA, IDF1, ...)",
-        description="Score a MOTChallenge result file against a ground-truth file: CLEAR-MOT "
-        "(MOTA, MOTP as mean IoU of matches, FP, FN, IDSW, Frag, MT/PT/ML), IDF1/IDP/IDR, and "
-        "Smith et al.'s success rate and centroid distance. Ground-truth rows with conf 0 are "
-        "not scored.",
+        help="score tracking results against ground truth (HOTA, MOTA, IDF1, ...)",
+        description="Score a MOTChallenge result file against a ground-truth file, or a folder "
+        "of results (RES/SEQ.txt) against a MOTChallenge folder of sequences (GT/SEQ/gt/gt.txt "
+        "or GT/SEQ/gt.txt, with GT/SEQ/seqinfo.ini), with one row per sequence and a combined "
+        "row. Reports HOTA, DetA, AssA and LocA exactly as TrackEval computes them (its "
+        "MOTChallenge ground-truth rules: zero-marked rows dropped; for MOT16/17/20 only "
+        "pedestrians scored and result boxes on distractors removed), CLEAR-MOT (MOTA, MOTP as "
+        "mean IoU of matches, FP, FN, IDSW, Frag, MT/PT/ML) and IDF1/IDP/IDR as py-motmetrics "
+        "computes them (ground-truth rows with conf 0 not scored, result boxes on them dropped), "
+        "and Smith et al.'s success rate. The combined row sums counts, as TrackEval does.",
+        epilog=EXAMPLES,
     )
-    p.add_argument("--gt", required=True, help="ground truth, MOTChallenge text file")
-    p.add_argument("--res", required=True, help="result, MOTChallenge text file")
+    p.add_argument("--gt", required=True, help="ground truth: a MOTChallenge file or folder")
+    p.add_argument("--res", required=True, help="results: a MOTChallenge file, or a folder")
     p.add_argument(
-        "--scale", type=float, default=1.0,
-        help="multiply ground-truth boxes by this (0.625 for PETS09 gt on the 480x360 video)",
+        "--scale", type=scale_spec, action="append", default=None, metavar="[NAME=]S",
+        help="multiply ground-truth boxes by S, for every sequence or for sequence NAME "
+        "(repeat the option); 0.625 for PETS09 gt on its 480x360 video; None: 1 everywhere",
     )  # fmt: skip
-    p.add_argument("--iou", type=float, default=0.5, help="IoU threshold of a match")
+    p.add_argument("--iou", type=float, default=0.5, help="IoU threshold of a CLEAR-MOT match")
+    p.add_argument(
+        "--benchmark", choices=("auto", "MOT15", "MOT16", "MOT17", "MOT20"), default="auto",
+        help="ground-truth rules for HOTA; auto: MOT17 when columns 8-9 hold classes 1-13 and "
+        "visibilities, else MOT15",
+    )  # fmt: skip
+    p.add_argument("--seqs", nargs="+", metavar="NAME", default=None,
+                   help="score only these sequences of a folder; None: all")  # fmt: skip
     p.add_argument("--image-size", type=int, nargs=2, metavar=("W", "H"), default=None,
-                   help="image size for the centroid-distance ratio")  # fmt: skip
+                   help="image size for the centroid-distance ratio; None: seqinfo.ini's "
+                   "size times the scale, if any")  # fmt: skip
+    p.add_argument(
+        "--no-scale-check", action="store_true",
+        help="score even when result boxes look like another pixel scale than the ground truth",
+    )  # fmt: skip
     p.add_argument("--json", default=None, help="also write all metrics to this JSON file")
+    p.add_argument("--csv", default=None, help="also write the table's scores to this CSV file")
     p.set_defaults(func=run)
 
 
+def _scales(specs: list[tuple[str | None, float]], names: list[str]) -> dict[str, float]:
+    """Scale per sequence name from the ``--scale`` options."""
+    default = 1.0
+    per: dict[str, float] = {}
+    for name, value in specs:
+        if name is None:
+            default = value
+        elif name not in names:
+            raise ValueError(f"--scale {name}={value:g}: no sequence {name!r} (have {names})")
+        else:
+            per[name] = value
+    return {n: per.get(n, default) for n in names}
+
+
+def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
+    """(name, SequenceInfo, result file) of every sequence to score, checked before work."""
+    from pftrack.eval import SequenceInfo, find_sequences
+
+    gt, res = Path(args.gt), Path(args.res)
+    if gt.is_file():
+        if not res.is_file():
+            raise FileNotFoundError(f"result file not found: {res}")
+        if args.seqs:
+            raise ValueError("--seqs needs a ground-truth folder, not a file")
+        return [(res.stem, SequenceInfo(res.stem, gt), res)]
+    seqs = find_sequences(gt)
+    if args.seqs:
+        known = {s.name for s in seqs}
+        unknown = [n for n in args.seqs if n not in known]
+        if unknown:
+            raise ValueError(f"--seqs: no sequence {unknown[0]!r} in {gt} (have {sorted(known)})")
+        seqs = [s for s in seqs if s.name in args.seqs]
+    if res.is_file() and len(seqs) == 1:
+        return [(seqs[0].name, seqs[0], res)]
+    if not res.is_dir():
+        raise FileNotFoundError(
+            f"results folder not found: {res} (a ground-truth folder of {len(seqs)} sequences "
+            "needs a folder of SEQ.txt results)"
+        )
+    jobs = []
+    for s in seqs:
+        path = res / f"{s.name}.txt"
+        if not path.is_file():
+            raise FileNotFoundError(
+                f"no result for sequence {s.name}: {path} (choose sequences with --seqs)"
+            )
+        jobs.append((s.name, s, path))
+    return jobs
+
+
 def run(args: argparse.Namespace) -> int:
-    """Run ``pftrack eval``: print the table, optionally write JSON; return the exit status."""
-    from pftrack.eval import evaluate_mot
+    """Run ``pftrack eval``: print the table, optionally write JSON/CSV; return the status."""
+    import json
+
+    from pftrack._progress import progress
+    from pftrack.eval.sequences import (
+        SequenceScores,
+        check_scale,
+        evaluate_sequence,
+        format_scores,
+        scores_csv,
+        scores_json,
+    )
     from pftrack.io.atomic import atomic_write, check_output
     from pftrack.io.mot import read_mot
 
+    if not 0 < args.iou <= 1:
+        raise ValueError(f"--iou is {args.iou}, expected in (0, 1]")
+    inputs = (args.gt, args.res)
     if args.json:
-        check_output(args.json, what="--json", suffixes=(".json",), inputs=(args.gt, args.res))
-    gt = read_mot(args.gt, what="ground truth")
-    res = read_mot(args.res, what="result file")
-    size = tuple(args.image_size) if args.image_size else None
-    m = evaluate_mot(gt, res, iou_threshold=args.iou, scale=args.scale, image_size=size)
-    print(m.table())
+        check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
+    if args.csv:
+        check_output(args.csv, what="--csv", suffixes=(".csv",), inputs=inputs)
+    jobs = _jobs(args)
+    scales = _scales(args.scale or [], [name for name, _, _ in jobs])
+
+    loaded = []
+    for name, seq, path in jobs:  # read and check everything before scoring anything
+        gt = read_mot(seq.gt_path, what="ground truth")
+        res = read_mot(path, what="result file")
+        if not args.no_scale_check:
+            check_scale(gt, res, scale=scales[name], name=f"{path}")
+        loaded.append((name, seq, gt, res))
+
+    scores: dict[str, SequenceScores] = {}
+    for name, seq, gt, res in progress(loaded, total=len(loaded), desc="eval"):
+        s = scales[name]
+        size = tuple(args.image_size) if args.image_size else None
+        if size is None and seq.width and seq.height:
+            size = (round(seq.width * s), round(seq.height * s))
+        try:
+            scores[name] = evaluate_sequence(
+                gt,
+                res,
+                iou_threshold=args.iou,
+                scale=s,
+                image_size=size,
+                benchmark=args.benchmark,
+                num_frames=seq.length,
+            )
+        except ValueError as exc:
+            raise ValueError(f"{name}: {exc}") from None
+    combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
+    print(format_scores(scores, combined))
     if args.json:
+        if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
+            text = json.dumps(next(iter(scores.values())).as_dict(), indent=2)
+        else:
+            text = scores_json(scores, combined)
         with atomic_write(args.json) as fh:
-            fh.write(m.to_json() + "\n")
+            fh.write(text + "\n")
+    if args.csv:
+        with atomic_write(args.csv) as fh:
+            fh.write(scores_csv(scores, combined))
     return 0

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,7 +18,7 @@ from scipy.optimize import linear_sum_assignment
 from pftrack.boxes import iou_xywh
 from pftrack.io.mot import CONF, FRAME, ID, LEFT
 
-__all__ = ["MotMetrics", "evaluate_mot", "format_metrics", "iou_xywh"]
+__all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_xywh"]
 
 # Cost of a forbidden pair in the per-frame assignment: larger than any sum of admissible
 # costs (each is at most 1), so the solver first maximises the number of admissible pairs.
@@ -474,4 +474,82 @@ def evaluate_mot(
         centroid_distance_ratio=ratio,
         iou_threshold=float(iou_threshold),
         scale=float(scale),
+    )
+
+
+def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
+    """Several sequences' scores as one, as TrackEval and py-motmetrics combine them.
+
+    Counts (FP, FN, IDSW, Frag, MT/PT/ML, IDTP/IDFP/IDFN, matches, boxes, objects) are summed and
+    the ratios recomputed from the sums: MOTA from summed FN + FP + IDSW over summed ground-truth
+    boxes, MOTP as the mean IoU of all matches, IDF1/IDP/IDR from summed IDTP/IDFP/IDFN.
+    Smith et al.'s success rates are the means over all objects of all sequences. The centroid
+    distances are NaN (a mean over pairs that is not kept per sequence) and
+    `success_per_object` is empty (ids repeat across sequences).
+
+    Parameters
+    ----------
+    parts : sequence of MotMetrics
+        One per sequence, all with the same IoU threshold.
+
+    Returns
+    -------
+    MotMetrics
+    """
+    if not parts:
+        raise ValueError("combine_mot: no sequences to combine")
+    thresholds = {p.iou_threshold for p in parts}
+    if len(thresholds) != 1:
+        raise ValueError(f"combine_mot: IoU thresholds differ: {sorted(thresholds)}")
+
+    def total(name: str) -> int:
+        return sum(int(getattr(p, name)) for p in parts)
+
+    n_gt, n_res, n_match = total("num_objects"), total("num_predictions"), total("num_matches")
+    fn, fp, sw = total("misses"), total("false_positives"), total("num_switches")
+    idtp, idfp, idfn = total("idtp"), total("idfp"), total("idfn")
+    n_obj = total("num_unique_objects")
+    iou_sum = sum(p.motp_iou * p.num_matches for p in parts if p.num_matches)
+    scales = {p.scale for p in parts}
+    nan = float("nan")
+
+    def ratio(num: float, den: float) -> float:
+        return num / den if den else nan
+
+    def over_objects(name: str) -> float:
+        weighted = [(getattr(p, name), p.num_unique_objects) for p in parts if p.num_unique_objects]
+        return ratio(sum(v * n for v, n in weighted), n_obj)
+
+    return MotMetrics(
+        mota=1.0 - (fn + fp + sw) / n_gt if n_gt else nan,
+        motp_iou=ratio(iou_sum, n_match),
+        idf1=ratio(2 * idtp, 2 * idtp + idfp + idfn),
+        idp=ratio(idtp, idtp + idfp),
+        idr=ratio(idtp, idtp + idfn),
+        idtp=idtp,
+        idfp=idfp,
+        idfn=idfn,
+        num_switches=sw,
+        num_fragmentations=total("num_fragmentations"),
+        mostly_tracked=total("mostly_tracked"),
+        partially_tracked=total("partially_tracked"),
+        mostly_lost=total("mostly_lost"),
+        false_positives=fp,
+        misses=fn,
+        num_matches=n_match,
+        num_objects=n_gt,
+        num_predictions=n_res,
+        num_unique_objects=n_obj,
+        num_frames=total("num_frames"),
+        num_ignored_gt=total("num_ignored_gt"),
+        num_ignored_predictions=total("num_ignored_predictions"),
+        precision=ratio(n_match, n_res),
+        recall=ratio(n_match, n_gt),
+        success_rate=over_objects("success_rate"),
+        success_rate_strict=over_objects("success_rate_strict"),
+        success_per_object=(),
+        centroid_distance_px=nan,
+        centroid_distance_ratio=nan,
+        iou_threshold=parts[0].iou_threshold,
+        scale=parts[0].scale if len(scales) == 1 else nan,
     )

@@ -1,0 +1,479 @@
+"""HOTA, DetA, AssA and their parts (Luiten et al. 2021), as TrackEval computes them.
+
+The functions here reproduce TrackEval 1.3.0's ``HOTA`` metric on its ``MotChallenge2DBox``
+dataset, including that dataset's preprocessing of ground truth (see :func:`prepare_mot`):
+``tests/eval/test_hota.py`` holds them equal to TrackEval to 1e-9 on real sequences.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable, Sequence
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linear_sum_assignment
+
+from pftrack.io.mot import CONF, FRAME, ID, LEFT
+
+__all__ = [
+    "ALPHAS",
+    "BENCHMARKS",
+    "HotaMetrics",
+    "combine_hota",
+    "evaluate_hota",
+    "guess_benchmark",
+    "mot_iou",
+    "prepare_mot",
+]
+
+Benchmark = Literal["MOT15", "MOT16", "MOT17", "MOT20"]
+#: Ground-truth conventions :func:`prepare_mot` knows (MOT16 and MOT17 are the same).
+BENCHMARKS: tuple[str, ...] = ("MOT15", "MOT16", "MOT17", "MOT20")
+
+#: The 19 localisation thresholds HOTA averages over: 0.05, 0.10, ..., 0.95 (TrackEval's values).
+ALPHAS: NDArray[np.float64] = np.arange(0.05, 0.99, 0.05)
+
+_EPS = float(np.finfo(float).eps)
+# MOTChallenge 16/17/20 class numbers (column 8 of ground truth).
+_PEDESTRIAN = 1
+_DISTRACTORS = (2, 7, 8, 12)  # person_on_vehicle, static_person, distractor, reflection
+_NON_MOT_VEHICLE = 6  # a distractor in MOT20 only
+_N_CLASSES = 13
+_CLASS, _VISIBILITY = 7, 8  # columns of MOT16+ ground truth
+
+
+def mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """IoU of every box of `a` with every box of `b`, with TrackEval's arithmetic.
+
+    Boxes are MOTChallenge ``left, top, width, height``. The corners are formed first and areas
+    taken from them (``(x1 - x0) * (y1 - y0)``), exactly as TrackEval does, so that a match at
+    a threshold is decided the same way to the last bit. A box with no area overlaps nothing,
+    and an empty union gives 0.
+
+    Parameters
+    ----------
+    a : (n, 4) array_like of float
+    b : (m, 4) array_like of float
+
+    Returns
+    -------
+    (n, m) ndarray of float64
+    """
+    p = np.array(a, dtype=np.float64).reshape(-1, 4)
+    q = np.array(b, dtype=np.float64).reshape(-1, 4)
+    p[:, 2:] += p[:, :2]
+    q[:, 2:] += q[:, :2]
+    lo = np.minimum(p[:, None, :], q[None, :, :])
+    hi = np.maximum(p[:, None, :], q[None, :, :])
+    inter = np.maximum(lo[..., 2] - hi[..., 0], 0) * np.maximum(lo[..., 3] - hi[..., 1], 0)
+    area_p = (p[:, 2] - p[:, 0]) * (p[:, 3] - p[:, 1])
+    area_q = (q[:, 2] - q[:, 0]) * (q[:, 3] - q[:, 1])
+    union = area_p[:, None] + area_q[None, :] - inter
+    inter[area_p <= _EPS, :] = 0
+    inter[:, area_q <= _EPS] = 0
+    inter[union <= _EPS] = 0
+    union[union <= _EPS] = 1
+    out: NDArray[np.float64] = inter / union
+    return out
+
+
+def _rows(rows: ArrayLike, name: str) -> NDArray[np.float64]:
+    a = np.asarray(rows, dtype=np.float64)
+    if a.size == 0:
+        return np.zeros((0, 10))
+    if a.ndim != 2 or a.shape[1] < 6:
+        raise ValueError(f"{name} has shape {a.shape}, expected (M, 6..10) MOT rows")
+    if not np.all(np.isfinite(a[:, :6])):
+        raise ValueError(f"{name} has non-finite values in its first 6 columns")
+    if a.shape[1] < 10:
+        pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
+        a = np.hstack([a, pad])
+    return a
+
+
+def _by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
+    """``{frame: rows}``, rows of a frame in file order (TrackEval keeps file order)."""
+    if len(rows) == 0:
+        return {}
+    order = np.argsort(rows[:, FRAME], kind="stable")
+    r = rows[order]
+    frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
+    ends = [*starts[1:], len(r)]
+    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}
+
+
+def _check_unique(frames: dict[int, NDArray[np.float64]], name: str) -> None:
+    for f, r in frames.items():
+        ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
+        if np.any(counts > 1):
+            raise ValueError(
+                f"{name} has id {int(ids[counts > 1][0])} more than once in frame {f} "
+                "(ids must be unique within a frame)"
+            )
+
+
+def guess_benchmark(gt: ArrayLike) -> str:
+    """``"MOT17"`` if `gt` looks like MOT16/17/20 ground truth, else ``"MOT15"``.
+
+    MOT16+ ground truth has ``frame, id, left, top, w, h, flag, class, visibility``: the class
+    column holds integers 1-13 and the visibility column values in [0, 1]. MOT15 ground truth
+    has world coordinates (or -1) there. MOT20's one extra distractor class is not guessed:
+    name ``"MOT20"`` explicitly.
+    """
+    g = _rows(gt, "ground truth")
+    if len(g) == 0:
+        return "MOT15"
+    cls, vis = g[:, _CLASS], g[:, _VISIBILITY]
+    integral = np.all(cls == np.round(cls)) and np.all((cls >= 1) & (cls <= _N_CLASSES))
+    return "MOT17" if integral and np.all((vis >= 0) & (vis <= 1)) else "MOT15"
+
+
+def prepare_mot(
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    benchmark: str = "MOT15",
+    scale: float = 1.0,
+    num_frames: int | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The ground-truth and result rows that are scored, by MOTChallenge's rules.
+
+    This is TrackEval's ``MotChallenge2DBox`` preprocessing (``DO_PREPROC`` on):
+
+    * Ground-truth rows whose ``conf`` column (the "consider" flag), truncated to an integer,
+      is 0 are removed ("zero-marked").
+    * MOT16/17/20 only: ground-truth rows of another class than pedestrian (1) are removed,
+      and, in each frame first, result boxes matched to a *distractor* ground-truth box are
+      removed. The match is the Hungarian assignment maximising IoU among pairs with
+      IoU >= 0.5; distractors are person on vehicle (2), static person (7), distractor (8),
+      reflection (12) and, for MOT20, non-MOT vehicle (6). Every class must be 1-13.
+    * MOT15 has no classes: result boxes on zero-marked boxes stay, and are false positives.
+    * No visibility threshold is applied (TrackEval applies none).
+
+    Parameters
+    ----------
+    gt, result : (M, 6..10) array_like of float
+        MOT rows. Ids must be unique within a frame. The class of result rows is not looked at.
+    benchmark : {"MOT15", "MOT16", "MOT17", "MOT20"}
+        Which conventions (see :func:`guess_benchmark`).
+    scale : float
+        Multiplies the ground-truth boxes first (e.g. 0.625 for PETS09 ground truth against
+        results on the 480x360 video).
+    num_frames : int, optional
+        The sequence length (``seqLength``); a row in a later frame is an error, as in TrackEval.
+
+    Returns
+    -------
+    gt, result : ndarray of float64
+        The scored rows, each sorted by frame (file order within a frame), gt boxes scaled.
+    """
+    if benchmark not in BENCHMARKS:
+        raise ValueError(f"benchmark is {benchmark!r}, expected one of {', '.join(BENCHMARKS)}")
+    if not (math.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale is {scale}, expected a finite value > 0")
+    g = _rows(gt, "ground truth").copy()
+    r = _rows(result, "result")
+    g[:, LEFT : LEFT + 4] *= scale
+    for rows, name in ((g, "ground truth"), (r, "result")):
+        if num_frames is not None and len(rows) and rows[:, FRAME].max() > num_frames:
+            raise ValueError(
+                f"{name} has frame {int(rows[:, FRAME].max())}, beyond the sequence's "
+                f"{num_frames} frames (seqLength)"
+            )
+    gf, rf = _by_frame(g), _by_frame(r)
+    _check_unique(gf, "ground truth")
+    _check_unique(rf, "result")
+    with_classes = benchmark != "MOT15"
+    if with_classes and len(g):
+        cls = g[:, _CLASS]
+        bad = (cls != np.round(cls)) | (cls < 1) | (cls > _N_CLASSES)
+        if np.any(bad):
+            raise ValueError(
+                f"ground truth has class {g[bad][0, _CLASS]:g} (frame {int(g[bad][0, FRAME])}), "
+                f"expected 1-13 for {benchmark}; MOT15-style files need benchmark MOT15"
+            )
+    distractors = _DISTRACTORS + ((_NON_MOT_VEHICLE,) if benchmark == "MOT20" else ())
+    keep_g: list[NDArray[np.float64]] = []
+    keep_r: list[NDArray[np.float64]] = []
+    empty = np.zeros((0, 10))
+    for f in sorted(set(gf) | set(rf)):
+        gt_f, res_f = gf.get(f, empty), rf.get(f, empty)
+        if with_classes and len(gt_f) and len(res_f):
+            score = mot_iou(gt_f[:, LEFT : LEFT + 4], res_f[:, LEFT : LEFT + 4])
+            score[score < 0.5 - _EPS] = 0
+            rows_m, cols_m = linear_sum_assignment(-score)
+            hit = score[rows_m, cols_m] > _EPS
+            rows_m, cols_m = rows_m[hit], cols_m[hit]
+            drop = cols_m[np.isin(gt_f[rows_m, _CLASS].astype(np.int64), distractors)]
+            res_f = np.delete(res_f, drop, axis=0)
+        keep = gt_f[:, CONF].astype(np.int64) != 0
+        if with_classes:
+            keep &= gt_f[:, _CLASS].astype(np.int64) == _PEDESTRIAN
+        keep_g.append(gt_f[keep])
+        keep_r.append(res_f)
+    if not keep_g:
+        return np.zeros((0, 10)), np.zeros((0, 10))
+    return np.concatenate(keep_g), np.concatenate(keep_r)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)  # arrays: no element-wise ==
+class HotaMetrics:
+    """HOTA and its parts for one sequence or several combined.
+
+    Each array has one value per localisation threshold in :data:`ALPHAS`; the scalar
+    properties are their means over the thresholds, as TrackEval reports them.
+
+    Attributes
+    ----------
+    tp, fn, fp : (19,) ndarray of float64
+        Detection true positives, false negatives and false positives (counts) per threshold.
+    ass_a, ass_re, ass_pr : (19,) ndarray of float64
+        Association accuracy, recall and precision per threshold.
+    loc_a : (19,) ndarray of float64
+        Mean IoU of the matched pairs per threshold (1 when there is no match).
+    """
+
+    tp: NDArray[np.float64]
+    fn: NDArray[np.float64]
+    fp: NDArray[np.float64]
+    ass_a: NDArray[np.float64]
+    ass_re: NDArray[np.float64]
+    ass_pr: NDArray[np.float64]
+    loc_a: NDArray[np.float64]
+
+    @property
+    def det_a_alpha(self) -> NDArray[np.float64]:
+        """DetA per threshold: ``TP / (TP + FN + FP)``."""
+        return self.tp / np.maximum(1, self.tp + self.fn + self.fp)
+
+    @property
+    def det_re_alpha(self) -> NDArray[np.float64]:
+        """Detection recall per threshold: ``TP / (TP + FN)``."""
+        return self.tp / np.maximum(1, self.tp + self.fn)
+
+    @property
+    def det_pr_alpha(self) -> NDArray[np.float64]:
+        """Detection precision per threshold: ``TP / (TP + FP)``."""
+        return self.tp / np.maximum(1, self.tp + self.fp)
+
+    @property
+    def hota_alpha(self) -> NDArray[np.float64]:
+        """HOTA per threshold: ``sqrt(DetA * AssA)``."""
+        out: NDArray[np.float64] = np.sqrt(self.det_a_alpha * self.ass_a)
+        return out
+
+    @property
+    def hota(self) -> float:
+        """HOTA: the mean over thresholds of ``sqrt(DetA_alpha * AssA_alpha)``."""
+        return float(np.mean(self.hota_alpha))
+
+    @property
+    def det_a(self) -> float:
+        """DetA, mean over thresholds."""
+        return float(np.mean(self.det_a_alpha))
+
+    @property
+    def ass_a_mean(self) -> float:
+        """AssA, mean over thresholds."""
+        return float(np.mean(self.ass_a))
+
+    @property
+    def det_re(self) -> float:
+        """DetRe, mean over thresholds."""
+        return float(np.mean(self.det_re_alpha))
+
+    @property
+    def det_pr(self) -> float:
+        """DetPr, mean over thresholds."""
+        return float(np.mean(self.det_pr_alpha))
+
+    @property
+    def ass_re_mean(self) -> float:
+        """AssRe, mean over thresholds."""
+        return float(np.mean(self.ass_re))
+
+    @property
+    def ass_pr_mean(self) -> float:
+        """AssPr, mean over thresholds."""
+        return float(np.mean(self.ass_pr))
+
+    @property
+    def loc_a_mean(self) -> float:
+        """LocA, mean over thresholds."""
+        return float(np.mean(self.loc_a))
+
+    @property
+    def hota0(self) -> float:
+        """HOTA at the lowest threshold (0.05), TrackEval's ``HOTA(0)``."""
+        return float(self.hota_alpha[0])
+
+    def summary(self) -> dict[str, float]:
+        """The scalar scores (means over thresholds), keyed by metric name."""
+        return {
+            "hota": self.hota,
+            "det_a": self.det_a,
+            "ass_a": self.ass_a_mean,
+            "det_re": self.det_re,
+            "det_pr": self.det_pr,
+            "ass_re": self.ass_re_mean,
+            "ass_pr": self.ass_pr_mean,
+            "loc_a": self.loc_a_mean,
+        }
+
+    def as_dict(self) -> dict[str, object]:
+        """:meth:`summary` plus the per-threshold arrays as lists (JSON-ready)."""
+        out: dict[str, object] = dict(self.summary())
+        out["alphas"] = [round(float(a), 2) for a in ALPHAS]
+        for name in ("hota_alpha", "det_a_alpha", "ass_a", "loc_a", "tp", "fn", "fp"):
+            out[f"{name.removesuffix('_alpha')}_per_alpha"] = [
+                float(v) for v in getattr(self, name)
+            ]
+        return out
+
+
+def _empty(num_gt: int, num_res: int) -> HotaMetrics:
+    n = len(ALPHAS)
+    z = np.zeros(n)
+    return HotaMetrics(
+        tp=z.copy(),
+        fn=np.full(n, float(num_gt)),
+        fp=np.full(n, float(num_res)),
+        ass_a=z.copy(),
+        ass_re=z.copy(),
+        ass_pr=z.copy(),
+        loc_a=np.ones(n),
+    )
+
+
+def evaluate_hota(
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    benchmark: str = "MOT15",
+    scale: float = 1.0,
+    num_frames: int | None = None,
+) -> HotaMetrics:
+    """HOTA, DetA, AssA, LocA and their recall/precision parts of one sequence.
+
+    Parameters
+    ----------
+    gt, result : (M, 6..10) array_like of float
+        Ground-truth and result MOT rows, as read by :func:`pftrack.io.mot.read_mot`.
+    benchmark, scale, num_frames
+        Passed to :func:`prepare_mot`, which chooses the rows that are scored.
+
+    Returns
+    -------
+    HotaMetrics
+
+    Notes
+    -----
+    Similarity is :func:`mot_iou`. First, over the whole sequence, every (gt id, result id)
+    pair accumulates ``sum_t IoU_t / (rowsum + colsum - IoU_t)`` (its soft match count), giving a
+    global alignment score ``A = count / (n_gt + n_res - count)``. Then, in each frame, boxes are
+    matched by the Hungarian algorithm maximising ``A * IoU``; for each threshold alpha a match
+    with ``IoU >= alpha`` is a TP. AssA at alpha is the TP-weighted mean over matched pairs of
+    ``TPA / (TPA + FNA + FPA)`` (TPA: frames the pair is matched; FNA, FPA: the rest of the
+    gt's and the result track's boxes). Everything is TrackEval 1.3.0's arithmetic, vectorised
+    over thresholds.
+
+    References
+    ----------
+    .. [1] Luiten, J. et al. (2021). HOTA: a higher order metric for evaluating multi-object
+       tracking. International Journal of Computer Vision 129, 548-578.
+    .. [2] Luiten, J. & Hoffhues, A. (2020). TrackEval. (``trackeval.metrics.HOTA``)
+    """
+    g, r = prepare_mot(gt, result, benchmark=benchmark, scale=scale, num_frames=num_frames)
+    if len(r) == 0 or len(g) == 0:
+        return _empty(len(g), len(r))
+    gf, rf = _by_frame(g), _by_frame(r)
+    g_ids, g_idx = np.unique(g[:, ID].astype(np.int64), return_inverse=True)
+    r_ids, r_idx = np.unique(r[:, ID].astype(np.int64), return_inverse=True)
+    gt_count = np.bincount(g_idx, minlength=len(g_ids)).astype(np.float64)
+    res_count = np.bincount(r_idx, minlength=len(r_ids)).astype(np.float64)
+
+    # Frames with both gt and result boxes: (gt index, result index, IoU) of each.
+    both: list[tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64]]] = []
+    for f in sorted(set(gf) & set(rf)):
+        gi = np.searchsorted(g_ids, gf[f][:, ID].astype(np.int64))
+        ri = np.searchsorted(r_ids, rf[f][:, ID].astype(np.int64))
+        both.append((gi, ri, mot_iou(gf[f][:, LEFT : LEFT + 4], rf[f][:, LEFT : LEFT + 4])))
+
+    # Soft match counts of id pairs (ids are unique within a frame: plain fancy-index add).
+    potential = np.zeros((len(g_ids), len(r_ids)))
+    for gi, ri, sim in both:
+        denom = sim.sum(0)[None, :] + sim.sum(1)[:, None] - sim
+        soft = np.zeros_like(sim)
+        ok = denom > _EPS
+        soft[ok] = sim[ok] / denom[ok]
+        potential[gi[:, None], ri[None, :]] += soft
+    align = potential / (gt_count[:, None] + res_count[None, :] - potential)
+
+    pair_g: list[NDArray[np.intp]] = []
+    pair_r: list[NDArray[np.intp]] = []
+    pair_s: list[NDArray[np.float64]] = []
+    for gi, ri, sim in both:
+        score = align[gi[:, None], ri[None, :]] * sim
+        rows_m, cols_m = linear_sum_assignment(-score)
+        pair_g.append(gi[rows_m])
+        pair_r.append(ri[cols_m])
+        pair_s.append(sim[rows_m, cols_m])
+    mg = np.concatenate(pair_g) if pair_g else np.zeros(0, dtype=np.intp)
+    mr = np.concatenate(pair_r) if pair_r else np.zeros(0, dtype=np.intp)
+    ms = np.concatenate(pair_s) if pair_s else np.zeros(0)
+
+    hit = ms[None, :] >= ALPHAS[:, None] - _EPS  # (alphas, matched pairs)
+    tp = hit.sum(axis=1).astype(np.float64)
+    loc_sum = (hit * ms[None, :]).sum(axis=1)
+    n_res_ids = len(r_ids)
+    ass_a = np.zeros(len(ALPHAS))
+    ass_re = np.zeros(len(ALPHAS))
+    ass_pr = np.zeros(len(ALPHAS))
+    for a in range(len(ALPHAS)):
+        keys, tpa = np.unique(mg[hit[a]] * n_res_ids + mr[hit[a]], return_counts=True)
+        c = tpa.astype(np.float64)
+        gc, rc = gt_count[keys // n_res_ids], res_count[keys % n_res_ids]
+        w = max(1.0, float(tp[a]))
+        ass_a[a] = np.sum(c * (c / np.maximum(1, gc + rc - c))) / w
+        ass_re[a] = np.sum(c * (c / np.maximum(1, gc))) / w
+        ass_pr[a] = np.sum(c * (c / np.maximum(1, rc))) / w
+    return HotaMetrics(
+        tp=tp,
+        fn=len(g) - tp,
+        fp=len(r) - tp,
+        ass_a=ass_a,
+        ass_re=ass_re,
+        ass_pr=ass_pr,
+        loc_a=np.maximum(1e-10, loc_sum) / np.maximum(1e-10, tp),
+    )
+
+
+def combine_hota(parts: Iterable[HotaMetrics] | Sequence[HotaMetrics]) -> HotaMetrics:
+    """Several sequences as one, as TrackEval combines them.
+
+    TP, FN and FP are summed per threshold; AssA, AssRe, AssPr and LocA are the TP-weighted
+    means of the sequences' values, so DetA and HOTA are those of the summed counts.
+    """
+    items = list(parts)
+    if not items:
+        raise ValueError("combine_hota: no sequences to combine")
+    tp = np.sum([p.tp for p in items], axis=0)
+    w = np.maximum(1.0, tp)
+
+    def weighted(name: str) -> NDArray[np.float64]:
+        out: NDArray[np.float64] = sum(getattr(p, name) * p.tp for p in items) / w
+        return out
+
+    loc = sum(p.loc_a * p.tp for p in items)
+    return HotaMetrics(
+        tp=tp,
+        fn=np.sum([p.fn for p in items], axis=0),
+        fp=np.sum([p.fp for p in items], axis=0),
+        ass_a=weighted("ass_a"),
+        ass_re=weighted("ass_re"),
+        ass_pr=weighted("ass_pr"),
+        loc_a=np.maximum(1e-10, loc) / np.maximum(1e-10, tp),
+    )

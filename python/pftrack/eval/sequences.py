@@ -1,0 +1,352 @@
+"""Scoring one result or a MOTChallenge folder of sequences: HOTA, CLEAR-MOT and IDF1 together.
+
+A MOTChallenge ground-truth folder holds one folder per sequence, ``SEQ/gt/gt.txt`` (or
+``SEQ/gt.txt``) with ``SEQ/seqinfo.ini``; results are ``RESULTS/SEQ.txt``, as TrackEval reads
+them.
+"""
+
+from __future__ import annotations
+
+import configparser
+import csv
+import dataclasses
+import io
+import json
+import math
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pftrack._typing import PathLike
+from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark, mot_iou
+from pftrack.eval.metrics import MotMetrics, combine_mot, evaluate_mot
+from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT
+
+__all__ = [
+    "COMBINED",
+    "SequenceInfo",
+    "SequenceScores",
+    "check_scale",
+    "evaluate_sequence",
+    "find_sequences",
+    "format_scores",
+    "read_seqinfo",
+    "scores_csv",
+    "scores_json",
+]
+
+#: Name of the combined row in tables, JSON and CSV.
+COMBINED = "COMBINED"
+
+
+@dataclasses.dataclass(frozen=True)
+class SequenceInfo:
+    """One sequence of a MOTChallenge ground-truth folder.
+
+    Attributes
+    ----------
+    name : str
+        The folder's name (results are ``RESULTS/<name>.txt``).
+    gt_path : pathlib.Path
+        Its ground-truth file.
+    length : int or None
+        ``seqLength`` from ``seqinfo.ini`` (None without one).
+    width, height : int or None
+        ``imWidth``, ``imHeight`` from ``seqinfo.ini``.
+    """
+
+    name: str
+    gt_path: Path
+    length: int | None = None
+    width: int | None = None
+    height: int | None = None
+
+
+def read_seqinfo(path: PathLike) -> dict[str, str]:
+    """The ``[Sequence]`` section of a MOTChallenge ``seqinfo.ini`` as a dict of strings."""
+    parser = configparser.ConfigParser()
+    try:
+        parser.read_string(Path(path).read_text(encoding="utf-8", errors="replace"))
+    except configparser.Error as exc:
+        raise ValueError(
+            f"{path}: not a seqinfo.ini file ({exc.message.splitlines()[0]})"
+        ) from None
+    if not parser.has_section("Sequence"):
+        raise ValueError(f"{path}: no [Sequence] section")
+    return dict(parser["Sequence"])
+
+
+def _int_field(info: Mapping[str, str], key: str, path: Path) -> int | None:
+    text = info.get(key.lower())
+    if text is None:
+        return None
+    try:
+        value = int(text)
+    except ValueError:
+        raise ValueError(f"{path}: {key} is {text!r}, expected an integer") from None
+    if value < 1:
+        raise ValueError(f"{path}: {key} is {value}, expected >= 1")
+    return value
+
+
+def _sequence(folder: Path) -> SequenceInfo | None:
+    gt = next((p for p in (folder / "gt" / "gt.txt", folder / "gt.txt") if p.is_file()), None)
+    if gt is None:
+        return None
+    ini = folder / "seqinfo.ini"
+    if not ini.is_file():
+        return SequenceInfo(folder.name, gt)
+    info = read_seqinfo(ini)
+    return SequenceInfo(
+        folder.name,
+        gt,
+        length=_int_field(info, "seqLength", ini),
+        width=_int_field(info, "imWidth", ini),
+        height=_int_field(info, "imHeight", ini),
+    )
+
+
+def find_sequences(root: PathLike) -> list[SequenceInfo]:
+    """The sequences of a MOTChallenge ground-truth folder, by name.
+
+    `root` is either one sequence folder (it has ``gt/gt.txt`` or ``gt.txt``) or a folder of
+    them; folders without a ground-truth file are skipped.
+
+    Raises
+    ------
+    FileNotFoundError
+        `root` is not a folder.
+    ValueError
+        No sequence was found, or a ``seqinfo.ini`` is malformed.
+    """
+    base = Path(root)
+    if not base.is_dir():
+        raise FileNotFoundError(f"ground-truth folder not found: {base}")
+    own = _sequence(base)
+    if own is not None:
+        return [own]
+    found = [s for d in sorted(base.iterdir()) if d.is_dir() and (s := _sequence(d)) is not None]
+    if not found:
+        raise ValueError(
+            f"no sequence in {base}: expected folders SEQ/ with SEQ/gt/gt.txt (or SEQ/gt.txt) "
+            "and SEQ/seqinfo.ini"
+        )
+    return found
+
+
+# Factors tried around the box-height ratio by check_scale.
+_AROUND = np.geomspace(1 / 1.3, 1.3, 27)
+
+
+def _matched_fraction(
+    gt: NDArray[np.float64], res: NDArray[np.float64], scale: float, frames: NDArray[np.int64]
+) -> float:
+    """Fraction of the gt boxes of `frames` that some result box overlaps with IoU >= 0.5."""
+    hit = total = 0
+    for f in frames:
+        g = gt[gt[:, FRAME] == f, LEFT : LEFT + 4] * scale
+        r = res[res[:, FRAME] == f, LEFT : LEFT + 4]
+        total += len(g)
+        if len(g) and len(r):
+            hit += int(np.count_nonzero(mot_iou(g, r).max(axis=1) >= 0.5))
+    return hit / total if total else 0.0
+
+
+def check_scale(
+    gt: ArrayLike, result: ArrayLike, *, scale: float = 1.0, name: str = "result"
+) -> None:
+    """Refuse a result whose boxes are in another pixel scale than the (scaled) ground truth.
+
+    The median box height of the result and of the ground truth (times `scale`) are compared;
+    when they differ by more than 25 %, the share of ground-truth boxes that a result box
+    overlaps with IoU >= 0.5 is measured on up to 40 frames, as given and with the ground
+    truth rescaled by factors within 30 % of the height ratio. If the best of them more than
+    doubles that share (and reaches 30 %), the coordinate systems differ: typically PETS09
+    ground truth (768x576) against results on its 480x360 video, which needs ``scale=0.625``.
+
+    Raises
+    ------
+    ValueError
+        On such a mismatch, with the scale that fits.
+    """
+    g = np.asarray(gt, dtype=np.float64)
+    r = np.asarray(result, dtype=np.float64)
+    for a, what in ((g, "ground truth"), (r, "result")):
+        if a.size and (a.ndim != 2 or a.shape[1] < 6):
+            raise ValueError(f"{what} has shape {a.shape}, expected (M, 6..10) MOT rows")
+    if g.size == 0 or r.size == 0 or len(g) < 10 or len(r) < 10:
+        return
+    if g.shape[1] > CONF:
+        g = g[g[:, CONF] != 0]
+    g_h = float(np.median(g[:, HEIGHT])) * scale
+    r_h = float(np.median(r[:, HEIGHT]))
+    if g_h <= 0 or r_h <= 0:
+        return
+    ratio = r_h / g_h
+    if 0.8 <= ratio <= 1.25:
+        return
+    common = np.intersect1d(g[:, FRAME], r[:, FRAME]).astype(np.int64)
+    if len(common) == 0:
+        return
+    sample = common[np.linspace(0, len(common) - 1, min(40, len(common))).astype(np.int64)]
+    as_given = _matched_fraction(g, r, scale, sample)
+    # Box heights give the ratio roughly; positions need it closer (a 5 % error moves a box
+    # at x = 600 by 30 px), so try factors around it and keep the best.
+    best, fit = max(
+        ((_matched_fraction(g, r, scale * k, sample), scale * k) for k in ratio * _AROUND),
+        key=lambda t: t[0],
+    )
+    if best >= 0.3 and best > 2 * as_given:
+        raise ValueError(
+            f"{name}: its boxes look {fit / scale:.2g} times the ground truth's (median height "
+            f"{r_h:.0f} vs {g_h:.0f} px; {as_given:.0%} of ground-truth boxes matched, "
+            f"{best:.0%} with the ground truth scaled by {fit:.2g}): pass --scale S, S the ratio "
+            f"of the image sizes (about {fit:.2g} here; 0.625 for PETS09 ground truth on its "
+            "480x360 video), or --no-scale-check"
+        )
+
+
+@dataclasses.dataclass(frozen=True)
+class SequenceScores:
+    """HOTA and CLEAR-MOT/identity scores of one sequence (or of several combined).
+
+    Attributes
+    ----------
+    mot : MotMetrics
+        CLEAR-MOT, IDF1 and Smith et al.'s measures (:func:`~pftrack.eval.evaluate_mot`).
+    hota : HotaMetrics
+        HOTA and its parts (:func:`~pftrack.eval.evaluate_hota`).
+    benchmark : str
+        The ground-truth conventions HOTA used ("MOT15", "MOT17", ...).
+    """
+
+    mot: MotMetrics
+    hota: HotaMetrics
+    benchmark: str
+
+    def as_dict(self) -> dict[str, object]:
+        """Flat JSON-ready dict: HOTA's scores, then CLEAR-MOT's, per-alpha arrays nested."""
+        h = self.hota.as_dict()
+        scalars = {k: v for k, v in h.items() if not isinstance(v, list)}
+        arrays = {k: v for k, v in h.items() if isinstance(v, list)}
+        return {**scalars, **self.mot.as_dict(), "benchmark": self.benchmark, "per_alpha": arrays}
+
+    @staticmethod
+    def combine(parts: Sequence[SequenceScores]) -> SequenceScores:
+        """Sequences combined as TrackEval combines them (see :func:`combine_hota`)."""
+        marks = {p.benchmark for p in parts}
+        return SequenceScores(
+            mot=combine_mot([p.mot for p in parts]),
+            hota=combine_hota([p.hota for p in parts]),
+            benchmark=marks.pop() if len(marks) == 1 else "mixed",
+        )
+
+
+def evaluate_sequence(
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    iou_threshold: float = 0.5,
+    scale: float = 1.0,
+    image_size: tuple[int, int] | None = None,
+    benchmark: str = "auto",
+    num_frames: int | None = None,
+) -> SequenceScores:
+    """Score one result against its ground truth: HOTA family and CLEAR-MOT/IDF1.
+
+    Parameters
+    ----------
+    gt, result : (M, 6..10) array_like of float
+        MOT rows.
+    iou_threshold, scale, image_size
+        As in :func:`~pftrack.eval.evaluate_mot` (HOTA has no IoU threshold: it averages
+        over 0.05...0.95).
+    benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
+        Ground-truth conventions of HOTA (:func:`~pftrack.eval.prepare_mot`); ``"auto"``
+        guesses MOT15 or MOT17 from the columns (:func:`~pftrack.eval.guess_benchmark`).
+    num_frames : int, optional
+        The sequence length; later frames are an error.
+    """
+    mark = guess_benchmark(gt) if benchmark == "auto" else benchmark
+    h = evaluate_hota(gt, result, benchmark=mark, scale=scale, num_frames=num_frames)
+    m = evaluate_mot(gt, result, iou_threshold=iou_threshold, scale=scale, image_size=image_size)
+    return SequenceScores(mot=m, hota=h, benchmark=mark)
+
+
+def _pct(x: float) -> str:
+    return "nan" if not math.isfinite(x) else f"{100.0 * x:.1f}"
+
+
+_COLUMNS: list[tuple[str, Callable[[SequenceScores], str]]] = [
+    ("HOTA", lambda s: _pct(s.hota.hota)),
+    ("DetA", lambda s: _pct(s.hota.det_a)),
+    ("AssA", lambda s: _pct(s.hota.ass_a_mean)),
+    ("LocA", lambda s: _pct(s.hota.loc_a_mean)),
+    ("MOTA", lambda s: _pct(s.mot.mota)),
+    ("IDF1", lambda s: _pct(s.mot.idf1)),
+    ("IDP", lambda s: _pct(s.mot.idp)),
+    ("IDR", lambda s: _pct(s.mot.idr)),
+    ("MOTP(IoU)", lambda s: _pct(s.mot.motp_iou)),
+    ("FP", lambda s: str(s.mot.false_positives)),
+    ("FN", lambda s: str(s.mot.misses)),
+    ("IDSW", lambda s: str(s.mot.num_switches)),
+    ("Frag", lambda s: str(s.mot.num_fragmentations)),
+    ("GT", lambda s: str(s.mot.num_unique_objects)),
+    ("MT", lambda s: str(s.mot.mostly_tracked)),
+    ("PT", lambda s: str(s.mot.partially_tracked)),
+    ("ML", lambda s: str(s.mot.mostly_lost)),
+    ("Succ", lambda s: _pct(s.mot.success_rate)),
+]
+
+
+def format_scores(
+    rows: Mapping[str, SequenceScores], combined: SequenceScores | None = None
+) -> str:
+    """Text table: one row per sequence, then the combined row if given.
+
+    Percentages for HOTA, DetA, AssA, LocA (means over the 19 HOTA thresholds), MOTA, IDF1, IDP,
+    IDR, MOTP (mean IoU of matches) and Smith et al.'s success rate; counts for the rest.
+    """
+    named = dict(rows)
+    if combined is not None:
+        named[COMBINED] = combined
+    header = ["sequence"] + [c for c, _ in _COLUMNS]
+    body = [[name] + [fn(s) for _, fn in _COLUMNS] for name, s in named.items()]
+    widths = [max(len(r[i]) for r in [header, *body]) for i in range(len(header))]
+    lines = ["  ".join(v.rjust(w) for v, w in zip(r, widths, strict=True)) for r in [header, *body]]
+    first = next(iter(named.values()))
+    marks = sorted({s.benchmark for s in named.values()})
+    lines.append(
+        f"(HOTA/DetA/AssA/LocA: TrackEval's, {'/'.join(marks)} ground-truth rules; CLEAR-MOT and "
+        f"IDF1 at IoU {first.mot.iou_threshold:g}; MOTP = mean IoU of matches; Succ: Smith et "
+        "al.'s success rate)"
+    )
+    return "\n".join(lines)
+
+
+def scores_json(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
+    """JSON text: ``{"sequences": {name: scores}, "combined": scores}`` (NaN as null)."""
+    doc: dict[str, object] = {"sequences": {k: v.as_dict() for k, v in rows.items()}}
+    if combined is not None:
+        doc["combined"] = combined.as_dict()
+    return json.dumps(doc, indent=2)
+
+
+def scores_csv(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
+    """CSV text: a header, one line per sequence, then ``COMBINED``; scalar scores only."""
+    named = dict(rows)
+    if combined is not None:
+        named[COMBINED] = combined
+    flat = {
+        name: {k: v for k, v in s.as_dict().items() if not isinstance(v, (list, dict))}
+        for name, s in named.items()
+    }
+    fields = list(next(iter(flat.values())))
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(["sequence", *fields])
+    for name, values in flat.items():
+        writer.writerow([name, *("" if values[f] is None else values[f] for f in fields)])
+    return out.getvalue()

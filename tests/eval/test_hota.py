@@ -1,0 +1,254 @@
+"""HOTA against TrackEval 1.3.0 itself, on real sequences and on MOT17-style synthetic files.
+
+TrackEval is installed with ``pip install --no-deps trackeval==1.3.0`` (its metadata pulls in
+opencv-python, which would replace opencv-python-headless); its HOTA path needs only NumPy and
+SciPy. The README's test command installs it so, and these tests run in CI.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pftrack.cli import main
+from pftrack.eval.hota import (
+    ALPHAS,
+    combine_hota,
+    evaluate_hota,
+    guess_benchmark,
+    mot_iou,
+    prepare_mot,
+)
+from pftrack.io.mot import read_mot
+from tests.conftest import dataset
+from tests.eval.cases import perturbed, write_rows
+
+if os.environ.get("CI"):  # the README's test command installs it: CI must run these tests
+    import trackeval
+else:
+    trackeval = pytest.importorskip("trackeval", reason="pip install --no-deps trackeval==1.3.0")
+
+FIELDS = ("HOTA", "DetA", "AssA", "DetRe", "DetPr", "AssRe", "AssPr", "LocA")
+OURS = ("hota_alpha", "det_a_alpha", "ass_a", "det_re_alpha", "det_pr_alpha", "ass_re",
+        "ass_pr", "loc_a")  # fmt: skip
+
+
+def trackeval_hota(tmp: Path, seqs: dict[str, tuple[np.ndarray, np.ndarray]], benchmark: str):
+    """TrackEval's HOTA per sequence and combined, through its MotChallenge2DBox dataset."""
+    gt_root, tr_root = tmp / "gt", tmp / "trackers"
+    lengths = {}
+    for name, (gt, res) in seqs.items():
+        n = int(max(gt[:, 0].max(initial=1), res[:, 0].max(initial=1)))
+        lengths[name] = n
+        write_rows(gt_root / name / "gt" / "gt.txt", gt)
+        (gt_root / name / "seqinfo.ini").write_text(f"[Sequence]\nname={name}\nseqLength={n}\n")
+        write_rows(tr_root / "t" / "data" / f"{name}.txt", res)
+    config = {
+        "GT_FOLDER": str(gt_root),
+        "TRACKERS_FOLDER": str(tr_root),
+        "BENCHMARK": benchmark,
+        "SKIP_SPLIT_FOL": True,
+        "SEQ_INFO": lengths,
+        "TRACKERS_TO_EVAL": ["t"],
+        "PRINT_CONFIG": False,
+    }
+    with contextlib.redirect_stdout(io.StringIO()):
+        data = trackeval.datasets.MotChallenge2DBox(config)
+        metric = trackeval.metrics.HOTA()
+        out = {}
+        for name in seqs:
+            raw = data.get_raw_seq_data("t", name)
+            pre = data.get_preprocessed_seq_data(raw, "pedestrian")
+            out[name] = metric.eval_sequence(pre)
+        out["COMBINED"] = metric.combine_sequences({k: out[k] for k in seqs})
+    return out
+
+
+def assert_same(ours, ref) -> None:
+    for field, attr in zip(FIELDS, OURS, strict=True):
+        got = getattr(ours, attr)
+        np.testing.assert_allclose(got, ref[field], rtol=0, atol=1e-9, err_msg=field)
+    np.testing.assert_array_equal(ours.tp, ref["HOTA_TP"])
+    np.testing.assert_array_equal(ours.fn, ref["HOTA_FN"])
+    np.testing.assert_array_equal(ours.fp, ref["HOTA_FP"])
+    assert abs(ours.hota - float(np.mean(ref["HOTA"]))) < 1e-9
+
+
+def det_as_tracker(det: np.ndarray, seed: int) -> np.ndarray:
+    """Public detections as a "tracker": ids chained frame to frame by best IoU >= 0.3."""
+    rng = np.random.default_rng(seed)
+    out = det.copy()
+    next_id, prev = 1, None
+    for f in np.unique(det[:, 0]):
+        idx = np.flatnonzero(det[:, 0] == f)
+        ids = np.zeros(len(idx))
+        taken: set[float] = set()
+        for k, i in enumerate(idx):
+            if prev is not None and len(prev):
+                iou = mot_iou(det[i : i + 1, 2:6], prev[:, 2:6])[0]
+                j = int(np.argmax(iou))
+                if iou[j] >= 0.3 and prev[j, 1] not in taken and rng.random() > 0.05:
+                    ids[k] = prev[j, 1]
+                    taken.add(ids[k])
+                    continue
+            ids[k] = next_id
+            next_id += 1
+        out[idx, 1] = ids
+        prev = out[idx]
+    return out
+
+
+def real_cases() -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    cases = {}
+    for name in ("pets09-s2l1", "tud-campus", "mot15-gt/ADL-Rundle-6", "mot15-gt/ETH-Sunnyday",
+                 "mot15-gt/KITTI-17"):  # fmt: skip
+        folder = dataset(name)
+        gt = read_mot(folder / "gt.txt")
+        det = read_mot(folder / "det.txt")
+        cases[name.split("/")[-1]] = (gt, det_as_tracker(det, seed=len(cases)))
+    return cases
+
+
+@pytest.mark.dataset
+def test_equals_trackeval_on_real_sequences(tmp_path: Path) -> None:
+    cases = real_cases()
+    ref = trackeval_hota(tmp_path, cases, "MOT15")
+    ours = {}
+    for name in cases:
+        # Both read the files TrackEval read, so both see the same numbers.
+        g = read_mot(tmp_path / "gt" / name / "gt" / "gt.txt")
+        r = read_mot(tmp_path / "trackers" / "t" / "data" / f"{name}.txt")
+        ours[name] = evaluate_hota(g, r, benchmark=guess_benchmark(g))
+        assert 0.1 < ours[name].hota < 0.9, name  # a real, non-degenerate case
+        assert_same(ours[name], ref[name])
+    assert_same(combine_hota(ours.values()), ref["COMBINED"])
+
+
+@pytest.mark.dataset
+def test_equals_trackeval_with_scale_and_perturbed_truth(tmp_path: Path) -> None:
+    # PETS: results on the 480x360 video, gt in 768x576; TrackEval gets the gt scaled in a file.
+    gt = read_mot(dataset("pets09-s2l1") / "gt.txt")
+    res = perturbed(gt, 0)
+    res[:, 2:6] *= 0.625
+    scaled = gt.copy()
+    scaled[:, 2:6] *= 0.625
+    ref = trackeval_hota(tmp_path, {"pets": (scaled, res)}, "MOT15")
+    r = read_mot(tmp_path / "trackers" / "t" / "data" / "pets.txt")
+    ours = evaluate_hota(gt, r, scale=0.625)
+    np.testing.assert_allclose(ours.hota_alpha, ref["pets"]["HOTA"], rtol=0, atol=1e-9)
+    assert ours.hota > 0.4
+
+
+def mot17_case(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """MOT17-style gt (flag, class, visibility) with distractors and zero-marked rows."""
+    rng = np.random.default_rng(seed)
+    gt = []
+    for oid in range(1, 16):
+        start = int(rng.integers(1, 30))
+        end = int(rng.integers(start + 5, 61))
+        x, y = rng.uniform(0, 300, 2)
+        v = rng.normal(0, 3, 2)
+        w, h = rng.uniform(20, 40), rng.uniform(50, 90)
+        cls = rng.choice([1, 1, 1, 1, 2, 3, 6, 7, 8, 12])
+        for f in range(start, end + 1):
+            flag = 0 if (cls != 1 or rng.random() < 0.05) else 1
+            gt.append([f, oid, x + v[0] * f, y + v[1] * f, w, h, flag, cls, rng.random(), 0])
+    g = np.asarray(gt)
+    res = perturbed(g, seed + 1)
+    return g[:, :9], res
+
+
+@pytest.mark.parametrize("bench_name", ["MOT17", "MOT20"])
+@pytest.mark.parametrize("seed", range(3))
+def test_equals_trackeval_mot17_preprocessing(tmp_path: Path, bench_name: str, seed: int) -> None:
+    gt, res = mot17_case(seed)
+    assert guess_benchmark(np.c_[gt, -np.ones(len(gt))]) == "MOT17"
+    ref = trackeval_hota(tmp_path, {"s": (gt, res)}, bench_name)
+    g = read_mot(tmp_path / "gt" / "s" / "gt" / "gt.txt")
+    r = read_mot(tmp_path / "trackers" / "t" / "data" / "s.txt")
+    ours = evaluate_hota(g, r, benchmark=bench_name)
+    assert_same(ours, ref["s"])
+    # The preprocessing does remove something: distractor matches and non-pedestrian rows.
+    kept_g, kept_r = prepare_mot(g, r, benchmark=bench_name)
+    assert len(kept_g) < len(g) and len(kept_r) < len(r)
+
+
+def test_iou_matches_trackeval() -> None:
+    rng = np.random.default_rng(1)
+    a = np.c_[rng.uniform(0, 50, (9, 2)), rng.uniform(0, 30, (9, 2))]
+    b = np.c_[rng.uniform(0, 50, (6, 2)), rng.uniform(0, 30, (6, 2))]
+    b[0, 2] = 0.0  # no area: overlaps nothing
+    ref = trackeval.datasets._base_dataset._BaseDataset._calculate_box_ious(a, b)
+    np.testing.assert_array_equal(mot_iou(a, b), ref)
+
+
+def test_hand_case() -> None:
+    # One object over 4 frames, tracked as id 7 (frames 1-2, exact) then id 8 (frames 3-4, exact).
+    gt = np.array([[f, 1, 0, 0, 10, 10] for f in range(1, 5)], dtype=float)
+    res = np.array([[f, 7 if f <= 2 else 8, 0, 0, 10, 10] for f in range(1, 5)], dtype=float)
+    m = evaluate_hota(gt, res)
+    # DetA = 1 at every alpha; each pair has TPA 2, FNA 2, FPA 0: A = 1/2, so AssA = 1/2.
+    np.testing.assert_allclose(m.det_a_alpha, 1.0)
+    np.testing.assert_allclose(m.ass_a, 0.5)
+    assert m.hota == pytest.approx(np.sqrt(0.5))
+    assert m.loc_a_mean == pytest.approx(1.0)
+    # Half-overlapping boxes (IoU 1/3) count only for alpha <= 1/3.
+    half = res.copy()
+    half[:, 2] = 5.0
+    m = evaluate_hota(gt, half)
+    np.testing.assert_array_equal(m.tp, np.where(ALPHAS <= 1 / 3, 4, 0))
+
+
+def test_empty_inputs_and_errors() -> None:
+    gt = np.array([[1, 1, 0, 0, 10, 10]], dtype=float)
+    m = evaluate_hota(gt, np.zeros((0, 10)))
+    assert m.hota == 0.0 and np.all(m.fn == 1) and np.all(m.loc_a == 1)
+    m = evaluate_hota(np.zeros((0, 10)), gt)
+    assert m.hota == 0.0 and np.all(m.fp == 1)
+    apart = evaluate_hota(gt, gt + [1, 0, 0, 0, 0, 0])  # no common frame
+    assert apart.hota == 0.0 and np.all(apart.fn == 1) and np.all(apart.fp == 1)
+    far = evaluate_hota(gt, gt + [0, 0, 50, 0, 0, 0])  # a common frame, no overlap
+    assert far.hota == 0.0 and np.all(far.tp == 0)
+    with pytest.raises(ValueError, match="more than once in frame 1"):
+        evaluate_hota(np.vstack([gt, gt]), gt)
+    with pytest.raises(ValueError, match="beyond the sequence"):
+        evaluate_hota(gt, gt + [5, 0, 0, 0, 0, 0], num_frames=3)
+    with pytest.raises(ValueError, match="benchmark"):
+        evaluate_hota(gt, gt, benchmark="MOT99")
+    with pytest.raises(ValueError, match="expected 1-13"):
+        evaluate_hota(np.c_[gt, [[1, -3.5, 0.5, 0]]], gt, benchmark="MOT17")
+    with pytest.raises(ValueError, match="no sequences"):
+        combine_hota([])
+
+
+@pytest.mark.dataset
+def test_cli_prints_hota(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = dataset("tud-campus")
+    res = write_rows(tmp_path / "res.txt", perturbed(read_mot(folder / "gt.txt"), 3))
+    assert main(["eval", "--gt", str(folder / "gt.txt"), "--res", str(res)]) == 0
+    text = capsys.readouterr().out
+    expected = evaluate_hota(read_mot(folder / "gt.txt"), read_mot(res)).hota
+    assert "HOTA" in text and f"{100 * expected:.1f}" in text
+
+
+@pytest.mark.dataset
+@pytest.mark.slow
+def test_equals_trackeval_on_pftrack_track_output(tmp_path: Path) -> None:
+    """A real tracker's output: `pftrack track` on TUD-Campus with its public detections."""
+    folder = dataset("tud-campus")
+    out = tmp_path / "tracks.txt"
+    argv = ["track", str(folder / "video.mp4"), "--detections", str(folder / "det.txt")]
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main([*argv, "--out", str(out)]) == 0
+    gt, res = read_mot(folder / "gt.txt"), read_mot(out)
+    ref = trackeval_hota(tmp_path / "te", {"tud": (gt, res)}, "MOT15")
+    g = read_mot(tmp_path / "te" / "gt" / "tud" / "gt" / "gt.txt")
+    r = read_mot(tmp_path / "te" / "trackers" / "t" / "data" / "tud.txt")
+    ours = evaluate_hota(g, r)
+    assert_same(ours, ref["tud"])
+    assert ours.hota > 0.4

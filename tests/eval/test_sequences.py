@@ -1,0 +1,237 @@
+"""Several sequences: combining as py-motmetrics and TrackEval do, folders, the scale check, CLI."""
+
+from __future__ import annotations
+
+import csv
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pftrack.cli import main
+from pftrack.eval import (
+    SequenceScores,
+    check_scale,
+    combine_hota,
+    combine_mot,
+    evaluate_hota,
+    evaluate_mot,
+    evaluate_sequence,
+    find_sequences,
+)
+from pftrack.eval.sequences import read_seqinfo
+from pftrack.io.mot import read_mot, write_mot
+from tests.conftest import dataset
+from tests.eval.cases import perturbed, write_rows
+from tests.eval.test_metrics import iou_loop, random_case
+
+CLEAR = ["mota", "motp", "idf1", "idp", "idr", "num_switches", "num_fragmentations",
+         "mostly_tracked", "partially_tracked", "mostly_lost", "num_false_positives",
+         "num_misses"]  # fmt: skip
+
+
+def motmetrics_overall(cases):
+    mm = pytest.importorskip("motmetrics")
+    accs = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for gt, res in cases:
+            acc = mm.MOTAccumulator(auto_id=False)
+            for f in sorted(set(gt[:, 0].astype(int)) | set(res[:, 0].astype(int))):
+                g, r = gt[gt[:, 0] == f], res[res[:, 0] == f]
+                d = 1.0 - iou_loop(g[:, 2:6], r[:, 2:6])
+                d = np.where(d > 0.5, np.nan, d)
+                acc.update(g[:, 1].astype(int).tolist(), r[:, 1].astype(int).tolist(), d, frameid=f)
+            accs.append(acc)
+        names = [str(k) for k in range(len(accs))]
+        s = mm.metrics.create().compute_many(
+            accs, metrics=CLEAR, names=names, generate_overall=True
+        )
+    return {k: float(s.loc["OVERALL", k]) for k in CLEAR}
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_combined_clear_and_idf1_equal_motmetrics_overall(seed: int) -> None:
+    cases = [random_case(10 * seed + k) for k in range(3)]
+    ref = motmetrics_overall(cases)
+    m = combine_mot([evaluate_mot(g, r) for g, r in cases])
+    assert m.mota == pytest.approx(ref["mota"], abs=1e-12)
+    assert m.motp_iou == pytest.approx(1.0 - ref["motp"], abs=1e-12)
+    for ours, theirs in (("idf1", "idf1"), ("idp", "idp"), ("idr", "idr")):
+        assert getattr(m, ours) == pytest.approx(ref[theirs], abs=1e-12)
+    assert (m.num_switches, m.num_fragmentations) == (ref["num_switches"],
+                                                       ref["num_fragmentations"])  # fmt: skip
+    assert (m.mostly_tracked, m.partially_tracked, m.mostly_lost) == (
+        ref["mostly_tracked"], ref["partially_tracked"], ref["mostly_lost"])  # fmt: skip
+    assert (m.false_positives, m.misses) == (ref["num_false_positives"], ref["num_misses"])
+
+
+def test_combine_errors() -> None:
+    gt, res = random_case(0)
+    with pytest.raises(ValueError, match="no sequences"):
+        combine_mot([])
+    with pytest.raises(ValueError, match="IoU thresholds differ"):
+        combine_mot([evaluate_mot(gt, res), evaluate_mot(gt, res, iou_threshold=0.4)])
+
+
+def make_layout(root: Path, cases: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[Path, Path]:
+    """GT/SEQ/gt/gt.txt + GT/SEQ/seqinfo.ini and RES/SEQ.txt, as TrackEval reads them."""
+    gt_root, res_root = root / "gt", root / "res"
+    for name, (gt, res) in cases.items():
+        write_mot(write_rows(gt_root / name / "gt" / "gt.txt", gt), gt)
+        n = int(max(gt[:, 0].max(), res[:, 0].max()))
+        (gt_root / name / "seqinfo.ini").write_text(
+            f"[Sequence]\nname={name}\nseqLength={n}\nimWidth=200\nimHeight=150\n"
+        )
+        write_mot(write_rows(res_root / f"{name}.txt", res), res)
+    return gt_root, res_root
+
+
+def test_cli_folder_of_sequences(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cases = {f"SEQ-{k:02d}": random_case(k) for k in range(3)}
+    gt_root, res_root = make_layout(tmp_path, cases)
+    (gt_root / "not-a-sequence").mkdir()  # skipped: no ground truth
+    seqs = find_sequences(gt_root)
+    assert [s.name for s in seqs] == list(cases) and seqs[0].length is not None
+    out_json, out_csv = tmp_path / "s.json", tmp_path / "s.csv"
+    argv = ["eval", "--gt", str(gt_root), "--res", str(res_root)]
+    assert main([*argv, "--json", str(out_json), "--csv", str(out_csv)]) == 0
+    text = capsys.readouterr().out
+    assert all(name in text for name in cases) and "COMBINED" in text and "HOTA" in text
+
+    # What the files say is what the library computes, sequence by sequence and combined.
+    def files(n: str) -> tuple[np.ndarray, np.ndarray]:
+        return read_mot(gt_root / n / "gt" / "gt.txt"), read_mot(res_root / f"{n}.txt")
+
+    parts = {n: evaluate_sequence(*files(n)) for n in cases}
+    doc = json.loads(out_json.read_text())
+    assert list(doc["sequences"]) == list(cases)
+    for name, s in parts.items():
+        assert doc["sequences"][name]["hota"] == pytest.approx(s.hota.hota, abs=1e-12)
+        assert doc["sequences"][name]["mota"] == pytest.approx(s.mot.mota, abs=1e-12)
+    combined = SequenceScores.combine(list(parts.values()))
+    assert doc["combined"]["hota"] == pytest.approx(combined.hota.hota, abs=1e-12)
+    assert doc["combined"]["idf1"] == pytest.approx(combined.mot.idf1, abs=1e-12)
+    assert len(doc["combined"]["per_alpha"]["hota_per_alpha"]) == 19
+    # Combined HOTA is not the mean of the sequences' HOTA: it is that of the summed counts.
+    hotas = [p.hota for p in parts.values()]
+    assert combined.hota.hota == pytest.approx(combine_hota(hotas).hota)
+    det = combined.hota.tp / (combined.hota.tp + combined.hota.fn + combined.hota.fp)
+    np.testing.assert_allclose(combined.hota.det_a_alpha, det)
+    rows = list(csv.DictReader(out_csv.read_text().splitlines()))
+    assert [r["sequence"] for r in rows] == [*cases, "COMBINED"]
+    assert float(rows[-1]["mota"]) == pytest.approx(combined.mot.mota, abs=1e-12)
+
+    # --seqs: a subset (one sequence: no combined row); a single sequence folder also works.
+    assert main([*argv, "--seqs", "SEQ-01"]) == 0
+    text = capsys.readouterr().out
+    assert "SEQ-01" in text and "SEQ-00" not in text and "COMBINED" not in text
+    assert main(["eval", "--gt", str(gt_root / "SEQ-02"), "--res", str(res_root)]) == 0
+    assert "SEQ-02" in capsys.readouterr().out
+
+
+def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cases = {"A": random_case(1), "B": random_case(2)}
+    gt_root, res_root = make_layout(tmp_path, cases)
+    argv = ["eval", "--gt", str(gt_root), "--res", str(res_root)]
+
+    def error(*extra: str) -> str:
+        assert main([*argv, *extra]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("pftrack eval: error: ") and err.count("\n") == 1
+        return err
+
+    # Outputs are checked before any work.
+    assert "folder" in error("--json", str(tmp_path / "no" / "x.json"))
+    assert "extension" in error("--csv", str(tmp_path / "x.txt"))
+    assert "no sequence 'C'" in error("--seqs", "C")
+    assert "no sequence 'C'" in error("--scale", "C=0.5")
+    (res_root / "B.txt").unlink()
+    assert "no result for sequence B" in error()
+    write_mot(res_root / "B.txt", cases["B"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
+    assert "B: result has frame" in error()  # beyond seqLength
+    assert main(["eval", "--gt", str(tmp_path / "nothing"), "--res", str(res_root)]) == 2
+    assert "ground-truth folder not found" in capsys.readouterr().err
+    (tmp_path / "empty").mkdir()
+    assert main(["eval", "--gt", str(tmp_path / "empty"), "--res", str(res_root)]) == 2
+    assert "no sequence in" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main([*argv, "--scale", "A=-1"])
+
+
+def test_read_seqinfo_errors(tmp_path: Path) -> None:
+    p = tmp_path / "seqinfo.ini"
+    p.write_text("no section here\n")
+    with pytest.raises(ValueError, match="not a seqinfo.ini"):
+        read_seqinfo(p)
+    p.write_text("[Other]\na=1\n")
+    with pytest.raises(ValueError, match=r"no \[Sequence\]"):
+        read_seqinfo(p)
+    p.write_text("[Sequence]\nseqLength=ten\n")
+    (tmp_path / "gt.txt").write_text("1,1,0,0,10,10,1,-1,-1,-1\n")
+    with pytest.raises(ValueError, match="seqLength is 'ten'"):
+        find_sequences(tmp_path)
+
+
+def spread_scene(seed: int) -> np.ndarray:
+    """Ground truth of 8 walkers spread over a 768x576 image, 60 frames."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for oid in range(1, 9):
+        x, y = rng.uniform(50, 650), rng.uniform(50, 450)
+        v = rng.normal(0, 2, 2)
+        for f in range(1, 61):
+            rows.append([f, oid, x + v[0] * f, y + v[1] * f, 30, 80, 1, -1, -1, -1])
+    return np.asarray(rows, dtype=float)
+
+
+def test_scale_mismatch_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    gt = spread_scene(0)
+    res = perturbed(gt, 1)
+    res[:, 2:6] *= 0.625  # the result lives in a 480x360 image
+    with pytest.raises(ValueError, match=r"--scale S.*about 0\.6"):
+        check_scale(gt, res)
+    check_scale(gt, res, scale=0.625)  # the right scale passes
+    check_scale(gt, perturbed(gt, 2))  # same scale passes
+    small = res.copy()
+    small[:, 2:4] += 1000  # smaller boxes elsewhere: not a scale problem, scored as given
+    check_scale(gt, small)
+    write_mot(tmp_path / "gt.txt", gt)
+    write_mot(tmp_path / "res.txt", res)
+    argv = ["eval", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "pftrack eval: error:" in err and "--scale" in err and err.count("\n") == 1
+    assert main([*argv, "--scale", "0.625"]) == 0
+    assert main([*argv, "--no-scale-check"]) == 0
+    assert "-" in capsys.readouterr().out.split("\n")[2]  # a negative MOTA, as asked
+
+
+@pytest.mark.dataset
+def test_cli_on_real_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """../shared/data as a MOTChallenge folder (SEQ/gt.txt), PETS results on the video's scale."""
+    data = dataset("pets09-s2l1").parent
+    res_root = tmp_path / "res"
+    truth = {}
+    for k, name in enumerate(("pets09-s2l1", "tud-campus")):
+        truth[name] = read_mot(data / name / "gt.txt")
+        res = perturbed(truth[name], k)
+        if name == "pets09-s2l1":
+            res[:, 2:6] *= 0.625
+        write_rows(res_root / f"{name}.txt", res)
+    argv = ["eval", "--gt", str(data), "--res", str(res_root), "--seqs", "pets09-s2l1",
+            "tud-campus"]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "pets09-s2l1.txt: its boxes look 0.6" in err and "--scale" in err
+    out = tmp_path / "s.json"
+    assert main([*argv, "--scale", "pets09-s2l1=0.625", "--json", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    pets = read_mot(res_root / "pets09-s2l1.txt")
+    expected = evaluate_hota(truth["pets09-s2l1"], pets, scale=0.625, num_frames=795)
+    assert doc["sequences"]["pets09-s2l1"]["hota"] == pytest.approx(expected.hota, abs=1e-12)
+    assert doc["sequences"]["pets09-s2l1"]["scale"] == 0.625
+    assert doc["sequences"]["tud-campus"]["scale"] == 1.0
+    assert 0.3 < doc["combined"]["hota"] < 0.9
