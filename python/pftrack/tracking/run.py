@@ -5,7 +5,7 @@ from __future__ import annotations
 import itertools
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,6 +18,7 @@ from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
+from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
 from pftrack.tracking.writer import TrackWriter
 
@@ -78,6 +79,7 @@ def track_frames(
     prime_frames: int = 30,
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
+    on_frame: Callable[[int, NDArray[np.uint8], list[Track], F64], None] | None = None,
 ) -> TrackingRun:
     """Track every frame of `source`.
 
@@ -104,6 +106,12 @@ def track_frames(
         tracker reported them, frame by frame).
     link : LinkConfig or None
         Join fragments of one object once the run is over (None: keep every id).
+    on_frame : callable, optional
+        Called after each frame as ``on_frame(index, frame, tracks, rows)``: the 1-based frame
+        index, the BGR frame, the tracks reported on it, and the (k, 10) MOTChallenge rows the
+        run's writer settled during this frame (online boxes, before the offline pass; a
+        bridged gap's rows arrive when the track is re-detected). For rendering while tracking
+        and for writing rows of a live source as they come.
     """
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
@@ -120,10 +128,17 @@ def track_frames(
     n = 0
     total = len(frames) or None
     for n, frame in enumerate(
-        progress(frames, total=total, desc="tracking", enable=show_progress), start=1
+        progress(frames, total=total, desc="tracking", enable=show_progress, unit="frame"),
+        start=1,
     ):
         dets = None if detections is None else detections.get(n, empty)
-        writer.add(n, tracker.update(frame, dets))
+        tracks = tracker.update(frame, dets)
+        settled = len(writer.rows)
+        writer.add(n, tracks)
+        if on_frame is not None:
+            on_frame(
+                n, frame, tracks, np.asarray(writer.rows[settled:], np.float64).reshape(-1, 10)
+            )
     if n == 0:
         raise ValueError(f"no frame could be read from {source}")
     return TrackingRun(writer.result(), n, time.perf_counter() - start)
