@@ -170,6 +170,7 @@ def test_quiet_silences_the_progress_bar(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     monkeypatch.setattr(_progress, "_quiet", False)
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # as on a terminal
     argv = ["track", str(sequence), "--detections", "auto", "--out", str(tmp_path / "t.txt")]
     assert main(argv) == 0

@@ -12,6 +12,8 @@ from typing import TypeVar
 T = TypeVar("T")
 
 _quiet = False
+DELAY = 0.5
+"""Seconds before a bar appears: quick steps draw nothing."""
 
 
 def set_quiet(quiet: bool = True) -> None:
@@ -38,6 +40,9 @@ def progress(
     unit: str = "it",
 ) -> Iterator[T]:
     """Yield `items`, drawing ``desc  37%|####    | 290/795 [00:07<00:12, 41.2 it/s]`` on stderr.
+
+    The bar (tqdm's) shows the count, elapsed time, time left and rate; it appears once the
+    loop has run for :data:`DELAY` seconds.
 
     Parameters
     ----------
@@ -69,5 +74,6 @@ def progress(
         dynamic_ncols=True,
         mininterval=0.2,
         smoothing=0.1,
+        delay=DELAY,
     ) as bar:
         yield from bar
