@@ -88,6 +88,27 @@ def test_fps_overrides_seqinfo(sequence: Path, tmp_path: Path) -> None:
     assert _video_info(video)[2:] == (12.5, 60)
 
 
+def test_sequence_detections_in_seqinfo_pixels_are_scaled(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Like PETS09 (boxes in 768x576, video 480x360): seqinfo.ini's imWidth sets the scale."""
+    seq = tmp_path / "BIG"
+    (seq / "det").mkdir(parents=True)
+    (seq / "img1").symlink_to(sequence / "img1")
+    (seq / "seqinfo.ini").write_text(f"[Sequence]\nframeRate=7\nimWidth={2 * scene.width}\n")
+    det = read_mot(sequence / "det" / "det.txt")
+    det[:, 2:6] *= 2
+    write_mot(seq / "det" / "det.txt", det)
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 0
+    assert "detections scaled by 0.5" in capsys.readouterr().out
+    assert evaluate_mot(scene.truth, read_mot(out)).mota > 0.8
+    # --det-scale wins: 1 leaves the boxes too large, and the tracker says so
+    argv = ["track", str(seq), "--detections", "auto", "--det-scale", "1", "--out", str(out)]
+    assert main(argv) == 2
+    assert "outside" in capsys.readouterr().err
+
+
 def test_auto_detections_need_a_sequence(
     scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -161,6 +182,10 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
     truth = scene.truth[scene.truth[:, 0] <= n_frames]
     assert evaluate_mot(truth, rows).mota > 0.7
     assert _video_info(video) == ("h264", "yuv420p", 25.0, n_frames)
+    mask = os.umask(0)
+    os.umask(mask)
+    for path in (out, video):
+        assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask, path.name
 
 
 def test_quiet_silences_the_progress_bar(
@@ -177,6 +202,9 @@ def test_quiet_silences_the_progress_bar(
     err = capsys.readouterr().err
     assert "tracking" in err and "60/60" in err and "frame/s" in err  # tqdm: count, rate
     assert main(["--quiet", *argv]) == 0
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(_progress, "_quiet", False)
+    assert main([*argv, "-q"]) == 0  # after the command too
     assert capsys.readouterr().err == ""
 
 

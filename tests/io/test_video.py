@@ -5,8 +5,11 @@ from __future__ import annotations
 import itertools
 import os
 import re
+import threading
+from fractions import Fraction
 from pathlib import Path
 
+import av
 import cv2
 import numpy as np
 import pytest
@@ -136,6 +139,41 @@ def test_http_stream_is_read_frame_by_frame_as_it_arrives(monkeypatch: pytest.Mo
     assert max(errors) < 8
     with pytest.raises(ValueError, match="read already"):  # 40 frames went past the 16 kept
         next(iter(src))
+
+
+def test_named_pipe_is_a_live_source(tmp_path: Path) -> None:
+    """A FIFO fed by an encoder in another thread, as ``ffmpeg ... -f mpegts pipe`` would."""
+    frames = make_scene(n_frames=20, rng=1).frames
+    fifo = tmp_path / "live.ts"
+    os.mkfifo(fifo)
+
+    def feed() -> None:
+        with open(fifo, "wb") as fh:
+            out = av.open(fh, "w", format="mpegts")
+            stream = out.add_stream("mpeg1video", rate=Fraction(25))
+            stream.width, stream.height, stream.pix_fmt = (
+                frames[0].shape[1],
+                frames[0].shape[0],
+                "yuv420p",
+            )
+            stream.bit_rate = 8_000_000
+            for f in frames:
+                for packet in stream.encode(av.VideoFrame.from_ndarray(f, format="bgr24")):
+                    out.mux(packet)
+            for packet in stream.encode(None):
+                out.mux(packet)
+            out.close()
+
+    writer = threading.Thread(target=feed)
+    writer.start()
+    try:
+        src = FrameSource(fifo, fps=25)
+        got = list(src)
+    finally:
+        writer.join(timeout=30)
+    assert src.live and (src.fps, src.fps_origin) == (25.0, "given")
+    assert len(got) == len(frames)
+    assert max(np.abs(g.astype(int) - f).mean() for g, f in zip(got, frames, strict=True)) < 8
 
 
 def test_stop_ends_the_iteration(tmp_path: Path) -> None:

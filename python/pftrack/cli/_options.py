@@ -33,6 +33,10 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
 def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
     """Add sub-command `name` to `sub` with the package's help formatter."""
     parser: argparse.ArgumentParser = sub.add_parser(name, formatter_class=HelpFormatter, **kwargs)
+    parser.add_argument(  # also accepted after the command; SUPPRESS keeps the global value
+        "-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
+        help="no progress bars (as pftrack --quiet)",
+    )  # fmt: skip
     return parser
 
 

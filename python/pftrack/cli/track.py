@@ -42,9 +42,10 @@ def add_parser(sub: Any) -> None:
         "sequence's det/det.txt (default: the built-in detector)",
     )  # fmt: skip
     p.add_argument(
-        "--det-scale", type=positive_float, default=1.0, metavar="S",
+        "--det-scale", type=positive_float, metavar="S",
         help="multiply detection boxes by S to reach the video's pixels (0.625 for PETS09 "
-        "det.txt on its 480x360 video)",
+        "det.txt on its 480x360 video) (default: for the sequence's own detections, the frame "
+        "width over seqinfo.ini's imWidth; else 1)",
     )  # fmt: skip
     p.add_argument(
         "--fps", type=positive_float, metavar="FPS",
@@ -95,6 +96,24 @@ def _resolve_detections(args: argparse.Namespace, source: Any) -> str | None:
     return str(found)
 
 
+def _det_scale(args: argparse.Namespace, source: Any, det_path: str) -> float:
+    """``--det-scale``, or the sequence's own: its detections are in seqinfo.ini's pixels."""
+    if args.det_scale is not None:
+        return float(args.det_scale)
+    seq = source.sequence
+    own = seq.detections if seq is not None else None
+    if own is None or seq.width is None or not own.samefile(det_path):
+        return 1.0
+    if seq.width == source.width:
+        return 1.0
+    scale = float(source.width / seq.width)
+    print(
+        f"detections scaled by {scale:g}: frames are {source.width} px wide, "
+        f"{seq.folder / 'seqinfo.ini'} says imWidth={seq.width} (--det-scale overrides)"
+    )
+    return scale
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack track``; return the exit status."""
     import contextlib
@@ -119,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
     source = FrameSource(args.source, fps=args.fps)
     det_path = _resolve_detections(args, source)
-    dets = load_detections(det_path, args.det_scale) if det_path else None
+    dets = load_detections(det_path, _det_scale(args, source, det_path)) if det_path else None
     renderer = TrackRenderer(args.render, source.fps) if args.render else None
     first: list[Any] = []
     stream: IO[str] | None = None
