@@ -137,25 +137,26 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
     source = FrameSource(args.source, fps=args.fps)
-    det_path = _resolve_detections(args, source)
-    dets = load_detections(det_path, _det_scale(args, source, det_path)) if det_path else None
-    renderer = TrackRenderer(args.render, source.fps) if args.render else None
-    first: list[Any] = []
-    stream: IO[str] | None = None
-
-    def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
-        if n == 1:
-            first.append(frame)
-        if renderer is not None:
-            renderer.add(frame, tracks)
-        if stream is not None:
-            for r in rows:
-                stream.write(format_mot_row(r) + "\n")
-            stream.flush()
-
+    renderer: TrackRenderer | None = None
     try:
+        det_path = _resolve_detections(args, source)
+        dets = load_detections(det_path, _det_scale(args, source, det_path)) if det_path else None
+        renderer = TrackRenderer(args.render, source.fps) if args.render else None
+        first: list[Any] = []
+        stream: IO[str] | None = None
+
+        def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
+            if n == 1:
+                first.append(frame)
+            if renderer is not None:
+                renderer.add(frame, tracks)
+            if stream is not None:
+                for r in rows:
+                    stream.write(format_mot_row(r) + "\n")
+                stream.flush()
+
         with contextlib.ExitStack() as stack:
-            if live:
+            if live:  # --out grows while tracking; replaced by the finished tracks below
                 stream = stack.enter_context(open(args.out, "w", encoding="utf-8"))  # noqa: SIM115
                 stack.enter_context(_StopOnCtrlC(source))
             result = track_frames(
@@ -167,29 +168,28 @@ def run(args: argparse.Namespace) -> int:
                 smoother=None if args.no_smooth else BoxSmoother(),
                 link=None if args.no_link else LinkConfig(),
                 on_frame=on_frame,
-                show_progress=None,
             )
+        write_mot(args.out, result.rows)
+        n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
+        stopped = " (stopped by Ctrl-C)" if source.stopped else ""
+        print(
+            f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
+            f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> {args.out}"
+        )
+        if renderer is not None:
+            renderer.close()
+            print(
+                f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
+                f"{source.fps_origin}) -> {args.render}"
+            )
+        if args.plot:
+            name = source.sequence.name if source.sequence is not None else Path(args.source).name
+            plot_trajectories(args.plot, result.rows, background=first[0], title=name)
+            print(f"trajectory plot -> {args.plot}")
     except BaseException:
         if renderer is not None:
-            renderer.abort()
+            renderer.abort()  # no half-written video (a finished one stays)
         raise
     finally:
         source.close()
-    write_mot(args.out, result.rows)
-    n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
-    stopped = " (stopped by Ctrl-C)" if source.stopped else ""
-    print(
-        f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
-        f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> {args.out}"
-    )
-    if renderer is not None:
-        renderer.close()
-        print(
-            f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
-            f"{source.fps_origin}) -> {args.render}"
-        )
-    if args.plot:
-        title = source.sequence.name if source.sequence is not None else Path(args.source).name
-        plot_trajectories(args.plot, result.rows, background=first[0], title=title)
-        print(f"trajectory plot -> {args.plot}")
     return 0

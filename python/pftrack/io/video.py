@@ -18,7 +18,7 @@ from __future__ import annotations
 import configparser
 import re
 import stat
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -317,16 +317,19 @@ class FrameSource:
 
     def __iter__(self) -> Iterator[NDArray[np.uint8]]:
         frames = self._iter_live() if self.live else self._iter_stored()
-        for frame in frames:
-            if self.stopped:
-                return
-            yield frame
+        try:
+            for frame in frames:
+                if self.stopped:
+                    return
+                yield frame
+        finally:
+            frames.close()  # a video file's capture is released now, not when collected
 
     def stop(self) -> None:
         """End every iteration before its next frame (safe to call from a signal handler)."""
         self.stopped = True
 
-    def _iter_stored(self) -> Iterator[NDArray[np.uint8]]:
+    def _iter_stored(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._images is not None:
             for p in self._images:
                 img = cv2.imread(str(p), cv2.IMREAD_COLOR)
@@ -344,7 +347,7 @@ class FrameSource:
         finally:
             cap.release()
 
-    def _iter_live(self) -> Iterator[NDArray[np.uint8]]:
+    def _iter_live(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._read_past_replay:
             raise ValueError(f"live source {self.name} was read already; open it again")
         yield from list(self._replay)
