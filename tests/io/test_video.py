@@ -115,6 +115,17 @@ def test_live_sources_are_recognised(tmp_path: Path) -> None:
         assert not is_live_source(source), source
 
 
+def test_a_folder_named_by_digits_is_not_a_camera(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "2024").mkdir()
+    cv2.imwrite(str(tmp_path / "2024" / "1.png"), np.zeros((4, 4, 3), np.uint8))
+    assert not is_live_source("2024") and is_live_source("2025")
+    src = FrameSource("2024")
+    assert not src.live and len(src) == 1
+
+
 @pytest.mark.parametrize("url", ["rtsp://127.0.0.1:9/none", "http://127.0.0.1:9/x.ts"])
 def test_stream_url_is_not_mangled_as_a_path(url: str) -> None:
     with pytest.raises(ValueError, match=f"stream {re.escape(url)}$"):

@@ -155,12 +155,21 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     return None
 
 
-def is_live_source(source: PathLike | int) -> bool:
-    """Whether `source` is a camera index, a stream URL (``scheme://``) or a named pipe."""
+def _camera_index(source: PathLike | int) -> int | None:
+    """The camera index `source` names (``0``, ``"1"``), unless a file or folder has that name."""
     if isinstance(source, int):
-        return True
+        return source
     text = str(source)
-    if text.isdigit() or "://" in text:
+    return int(text) if text.isdigit() and not Path(text).exists() else None
+
+
+def is_live_source(source: PathLike | int) -> bool:
+    """Whether `source` is a camera index, a stream URL (``scheme://``) or a named pipe.
+
+    A digit string is a camera index unless a file or folder of that name exists.
+    """
+    text = str(source)
+    if _camera_index(source) is not None or "://" in text:
         return True
     try:
         return stat.S_ISFIFO(Path(text).stat().st_mode) or stat.S_ISCHR(Path(text).stat().st_mode)
@@ -230,7 +239,8 @@ class FrameSource:
         self._read_past_replay = False
         self.stopped = False
         text = str(source)
-        self._target: str | int = int(text) if text.isdigit() else text
+        camera = _camera_index(source)
+        self._target: str | int = text if camera is None else camera
         self.path: Path | None = None
         header_fps = 0.0
         if isinstance(self._target, int) or "://" in text:
