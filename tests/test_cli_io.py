@@ -149,13 +149,13 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
     tmp_path: Path,
 ) -> None:
     """A stream served over HTTP as a camera would; pftrack tracks it in another process."""
-    scene = make_scene(n_frames=400, rng=0)
+    scene = make_scene(n_frames=200, rng=0)
     det = scene.truth.copy()
     det[:, 1], det[:, 6] = -1, 1.0
     write_mot(tmp_path / "det.txt", det)
     out, video = tmp_path / "live.txt", tmp_path / "live.mp4"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    with serve_stream(scene.frames, pace=0.04) as server:
+    with serve_stream(scene.frames, pace=0.05) as server:  # 10 s of video
         argv = [sys.executable, "-m", "pftrack.cli", "track", server.url, "--out", str(out),
                 "--detections", str(tmp_path / "det.txt"), "--render", str(video),
                 "--fps", "25"]  # fmt: skip
