@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -31,17 +32,40 @@ def test_import_pftrack_loads_no_wing() -> None:
     code = (
         "import sys, pftrack; "
         "print(sorted(m for m in sys.modules if m.startswith(('pftrack.tracking', "
-        "'pftrack.recovery', 'scipy'))))"
+        "'pftrack.recovery', 'scipy', 'numpy', 'cv2', 'pftrack._core'))))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
 
 
 def test_cli_parser_loads_no_scipy() -> None:
-    """``pftrack --help`` builds every sub-command's parser without loading a method."""
+    """``pftrack --help`` builds every sub-command's parser without loading a method.
+
+    Not even NumPy or OpenCV: ``pftrack --help`` then takes about 0.1 s more than Python
+    itself (0.19 s against 0.11 s, measured while the machine was busy).
+    """
     code = (
         "import sys; from pftrack.cli import build_parser; build_parser(); "
-        "print(sorted(m for m in sys.modules if m.startswith(('scipy', 'pftrack.recovery.'))))"
+        "print(sorted(m for m in sys.modules if m.startswith(('scipy', 'numpy', 'cv2', "
+        "'pftrack.recovery.'))))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "['pftrack.recovery.names']"
+
+
+def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """mypy sees the real signatures through the lazy re-exports (and the package's py.typed)."""
+    api = pytest.importorskip("mypy.api")
+    monkeypatch.setenv("MYPYPATH", str(Path(pftrack.__file__).parents[1]))
+    code = tmp_path / "use.py"
+    code.write_text(
+        "import pftrack\n"
+        "reveal_type(pftrack.read_mot)\n"
+        "reveal_type(pftrack.FrameSource('x').fps)\n"
+        "pftrack.fill_gaps(1, method=2)\n"
+    )
+    out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
+    assert status == 1, out  # the bad call is caught, so the names are not Any
+    assert 'Revealed type is "def (path: ' in out
+    assert 'Revealed type is "float"' in out or 'Revealed type is "builtins.float"' in out
+    assert 'Argument "method" to "fill_gaps" has incompatible type "int"' in out

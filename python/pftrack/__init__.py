@@ -4,11 +4,15 @@ The public API, importable from the top level; each name loads its module on fir
 ``import pftrack`` (and ``pftrack --help``) stays fast:
 
 - tracking: :class:`Tracker` (the drop-in ``update(dets, frame)`` / ``finalize()`` API),
-  :class:`MultiObjectTracker`, :class:`TrackerConfig`, :class:`Track`,
-  :func:`track_frames`, :func:`load_detections`, :func:`smooth_tracks`, :class:`BoxSmoother`;
+  :class:`MultiObjectTracker`, :class:`TrackerConfig`, :class:`Track`, :func:`track_frames`,
+  :class:`TrackingRun`, :func:`load_detections`, :func:`smooth_tracks`, :class:`BoxSmoother`;
 - recovery: :func:`recover_gap`, :func:`recover_gaps`, :func:`fill_gaps`,
   :func:`link_tracklets`, :class:`LinkConfig`, :func:`goal_directed_path`;
-- MOTChallenge files and video: :func:`read_mot`, :func:`write_mot`, :class:`FrameSource`;
+- MOTChallenge files and video: :func:`read_mot`, :func:`write_mot`, :class:`FrameSource`
+  (files, image folders, sequences, cameras, streams), :func:`read_seqinfo`,
+  :class:`SequenceInfo`, :class:`VideoWriter` (H.264 MP4);
+- pictures: :class:`TrackRenderer` (annotated video while tracking),
+  :func:`write_annotated_video`, :func:`plot_trajectories`;
 - evaluation: :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
 - kernels: :class:`ColourParticleFilter`, :func:`systematic_resample`, :func:`hsv_bins`,
   :func:`box_histograms`, :func:`bhattacharyya_weights`;
@@ -17,22 +21,24 @@ The public API, importable from the top level; each name loads its module on fir
 
 from __future__ import annotations
 
+import importlib.util
 from typing import TYPE_CHECKING
 
 from pftrack._lazy import lazy_exports
 
-try:
-    from pftrack import _core  # noqa: F401
-except ImportError as exc:  # pragma: no cover - only without a build
+if importlib.util.find_spec("pftrack._core") is None:  # pragma: no cover - only without a build
+    # found, not imported: loading it (and NumPy) waits for the first name that needs it,
+    # so `pftrack --help` stays fast
     raise ImportError(
         "pftrack's compiled core (pftrack._core) is not built: install with `pip install .` "
         "or, for development, `pip install --no-build-isolation -ve .`"
-    ) from exc
+    )
 
 if TYPE_CHECKING:
     from pftrack.eval import MotMetrics, evaluate_mot, format_metrics
     from pftrack.io.mot import read_mot, write_mot
-    from pftrack.io.video import FrameSource
+    from pftrack.io.video import FrameSource, SequenceInfo, read_seqinfo
+    from pftrack.io.video_writer import VideoWriter
     from pftrack.particle_filter import (
         ColourParticleFilter,
         bhattacharyya_weights,
@@ -48,6 +54,7 @@ if TYPE_CHECKING:
         recover_gap,
         recover_gaps,
     )
+    from pftrack.render import TrackRenderer, plot_trajectories, write_annotated_video
     from pftrack.synthetic import make_scene
     from pftrack.tracking import (
         BoxSmoother,
@@ -55,6 +62,7 @@ if TYPE_CHECKING:
         Track,
         Tracker,
         TrackerConfig,
+        TrackingRun,
         load_detections,
         smooth_tracks,
         track_frames,
@@ -69,6 +77,7 @@ _HOME = {
         "Track",
         "Tracker",
         "TrackerConfig",
+        "TrackingRun",
         "load_detections",
         "smooth_tracks",
         "track_frames",
@@ -82,7 +91,9 @@ _HOME = {
         "recover_gaps",
     ),
     "pftrack.io.mot": ("read_mot", "write_mot"),
-    "pftrack.io.video": ("FrameSource",),
+    "pftrack.io.video": ("FrameSource", "SequenceInfo", "read_seqinfo"),
+    "pftrack.io.video_writer": ("VideoWriter",),
+    "pftrack.render": ("TrackRenderer", "plot_trajectories", "write_annotated_video"),
     "pftrack.eval": ("MotMetrics", "evaluate_mot", "format_metrics"),
     "pftrack.particle_filter": (
         "ColourParticleFilter",
@@ -102,9 +113,13 @@ __all__ = [
     "LinkConfig",
     "MotMetrics",
     "MultiObjectTracker",
+    "SequenceInfo",
     "Track",
+    "TrackRenderer",
     "Tracker",
     "TrackerConfig",
+    "TrackingRun",
+    "VideoWriter",
     "bhattacharyya_weights",
     "box_histograms",
     "evaluate_mot",
@@ -115,12 +130,15 @@ __all__ = [
     "link_tracklets",
     "load_detections",
     "make_scene",
+    "plot_trajectories",
     "read_mot",
+    "read_seqinfo",
     "recover_gap",
     "recover_gaps",
     "smooth_tracks",
     "systematic_resample",
     "track_frames",
+    "write_annotated_video",
     "write_mot",
 ]
 

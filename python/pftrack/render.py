@@ -1,9 +1,13 @@
-"""Pictures people would rather look at than read: annotated video and trajectory plots (OpenCV)."""
+"""Pictures people would rather look at than read: annotated video and trajectory plots."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import queue
+import threading
+from collections import deque
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Protocol
 
 import cv2
 import numpy as np
@@ -12,8 +16,16 @@ from numpy.typing import NDArray
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import group_by_frame
+from pftrack.io.video_writer import VideoWriter
 
-__all__ = ["colour_of", "draw_tracks", "plot_trajectories", "write_annotated_video"]
+__all__ = [
+    "TrackRenderer",
+    "colour_of",
+    "draw_tracks",
+    "draw_trails",
+    "plot_trajectories",
+    "write_annotated_video",
+]
 
 
 def colour_of(track_id: int) -> tuple[int, int, int]:
@@ -44,36 +56,182 @@ def draw_tracks(
     return out
 
 
+def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
+    """Bottom centre of an ``[left, top, width, height]`` box: where a walker stands."""
+    return float(box[0] + box[2] / 2), float(box[1] + box[3])
+
+
+def draw_trails(
+    frame: NDArray[np.uint8], trails: Mapping[int, Sequence[tuple[float, float]]]
+) -> None:
+    """Draw each id's recent foot points on `frame` in place, as a line in the id's colour."""
+    for tid, pts in trails.items():
+        if len(pts) > 1:
+            line = np.round(np.asarray(pts, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
+            cv2.polylines(frame, [line], False, colour_of(tid), 1, cv2.LINE_AA)
+
+
 def write_annotated_video(
     path: PathLike,
     frames: Iterable[NDArray[np.uint8]],
     rows: NDArray[np.float64],
     fps: float = 10.0,
+    *,
+    trail: int = 40,
 ) -> Path:
     """Write `frames` with the tracks of `rows` (MOT, 1-based frames) drawn on, atomically.
 
-    The container follows the extension (``.mp4`` uses the ``mp4v`` codec, ``.avi`` MJPG).
+    ``.mp4`` is H.264 (see :class:`~pftrack.io.video_writer.VideoWriter`), ``.avi`` MJPG. Each
+    track trails its foot points of the last `trail` frames.
     """
-    target = Path(path)
-    fourcc = cv2.VideoWriter.fourcc(*("MJPG" if target.suffix.lower() == ".avi" else "mp4v"))
     by_frame = group_by_frame(rows)
-    with atomic_path(target) as tmp:
-        writer = None
-        try:
-            for k, frame in enumerate(frames, start=1):
-                if writer is None:
-                    h, w = frame.shape[:2]
-                    writer = cv2.VideoWriter(str(tmp), fourcc, float(fps), (w, h))
-                    if not writer.isOpened():
-                        raise ValueError(
-                            f"OpenCV cannot write video {target} (codec for {target.suffix!r}?)"
-                        )
-                empty = np.zeros((0, 10))
-                writer.write(draw_tracks(frame, by_frame.get(k, empty), f"frame {k}"))
-        finally:
-            if writer is not None:
-                writer.release()
-    return target
+    empty = np.zeros((0, 10))
+    trails: dict[int, deque[tuple[float, float]]] = {}
+    with VideoWriter(path, fps) as writer:
+        for k, frame in enumerate(frames, start=1):
+            here = by_frame.get(k, empty)
+            for r in here:
+                trails.setdefault(int(r[1]), deque(maxlen=max(trail, 1))).append(_foot(r[2:6]))
+            shown = {int(r[1]): trails[int(r[1])] for r in here} if trail > 0 else {}
+            image = draw_tracks(frame, here, f"frame {k}")
+            draw_trails(image, shown)
+            writer.write(image)
+    return Path(path)
+
+
+class TrackLike(Protocol):
+    """What :class:`TrackRenderer` reads of a track (e.g. :class:`pftrack.tracking.Track`)."""
+
+    @property
+    def id(self) -> int: ...  # noqa: D102
+
+    @property
+    def box_xywh(self) -> NDArray[np.float64]: ...  # noqa: D102
+
+    @property
+    def time_since_update(self) -> int: ...  # noqa: D102
+
+
+_Job = tuple[int, NDArray[np.uint8], NDArray[np.float64], dict[int, list[tuple[float, float]]]]
+
+
+class TrackRenderer:
+    """Draw tracks with trails on frames as they are tracked, and encode them, on a thread.
+
+    Tracking hands each decoded frame and its tracks to :meth:`add`; a worker thread draws
+    and encodes while the next frame is tracked (OpenCV's drawing and the encoder release the
+    GIL), so the video costs no second decode. Boxes are the tracker's online estimates.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.mp4`` (H.264) or ``.avi``; written atomically by
+        :class:`~pftrack.io.video_writer.VideoWriter`.
+    fps : float
+        Frame rate of the video.
+    trail : int
+        Foot points of the last `trail` frames drawn behind each track (0: none).
+    threaded : bool
+        Draw and encode on a worker thread (False: in :meth:`add`).
+    backend : {"pyav", "opencv"}, optional
+        Encoder (default: PyAV when installed).
+    queue_size : int
+        Frames waiting for the worker at most; :meth:`add` blocks beyond.
+    """
+
+    def __init__(
+        self,
+        path: PathLike,
+        fps: float,
+        *,
+        trail: int = 40,
+        threaded: bool = True,
+        backend: str | None = None,
+        queue_size: int = 8,
+    ) -> None:
+        if trail < 0:
+            raise ValueError(f"trail is {trail}, expected >= 0")
+        self.writer = VideoWriter(path, fps, backend=backend)
+        self.trail = int(trail)
+        self._trails: dict[int, deque[tuple[float, float]]] = {}
+        self._error: BaseException | None = None
+        self._n = 0
+        self._queue: queue.Queue[_Job | None] | None = None
+        self._thread: threading.Thread | None = None
+        if threaded:
+            self._queue = queue.Queue(maxsize=max(queue_size, 1))
+            self._thread = threading.Thread(target=self._work, name="pftrack-render", daemon=True)
+            self._thread.start()
+
+    def add(self, frame: NDArray[np.uint8], tracks: Iterable[TrackLike]) -> None:
+        """Queue `frame` (BGR, not modified) with the tracks reported on it."""
+        self._raise_worker_error()
+        self._n += 1
+        boxes, seen = [], set()
+        for t in tracks:
+            box = np.asarray(t.box_xywh, dtype=np.float64)
+            boxes.append([float(t.id), *box[:4], 1.0 if t.time_since_update else 0.0])
+            seen.add(t.id)
+            if self.trail:
+                trail = self._trails.setdefault(t.id, deque(maxlen=self.trail))
+                trail.append(_foot(box))
+        for tid in set(self._trails) - seen:
+            del self._trails[tid]
+        trails = {tid: list(pts) for tid, pts in self._trails.items()}
+        job = (self._n, frame, np.asarray(boxes, dtype=np.float64).reshape(-1, 6), trails)
+        if self._queue is None:
+            self._draw(job)
+        else:
+            self._queue.put(job)
+
+    def _draw(self, job: _Job) -> None:
+        n, frame, boxes, trails = job
+        rows = np.zeros((len(boxes), 8))
+        rows[:, 0] = n
+        rows[:, 1:6] = boxes[:, :5]
+        rows[:, 7] = boxes[:, 5]  # column 8: 1 = coasting, drawn thin
+        image = draw_tracks(frame, rows, f"frame {n}")
+        draw_trails(image, trails)
+        self.writer.write(image)
+
+    def _work(self) -> None:
+        assert self._queue is not None
+        while True:
+            job = self._queue.get()
+            if job is None:
+                return
+            if self._error is None:
+                try:
+                    self._draw(job)
+                except BaseException as exc:  # handed to the caller by add() or close()
+                    self._error = exc
+
+    def _raise_worker_error(self) -> None:
+        if self._error is not None:
+            self.abort()
+            raise self._error
+
+    def _join(self) -> None:
+        if self._thread is not None and self._queue is not None:
+            self._queue.put(None)
+            self._thread.join()
+            self._thread = None
+
+    def close(self) -> Path:
+        """Wait for the queued frames, finish the file and return its path."""
+        self._join()
+        self._raise_worker_error()
+        return self.writer.close()
+
+    def abort(self) -> None:
+        """Stop without writing: the partial file is removed."""
+        self._join()
+        self.writer.abort()
+
+    @property
+    def n_frames(self) -> int:
+        """Frames encoded so far."""
+        return self.writer.n_frames
 
 
 def plot_trajectories(

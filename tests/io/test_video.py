@@ -1,13 +1,23 @@
-"""Frame sources: image folders are read in natural order."""
+"""Frame sources: image folders in natural order, MOTChallenge sequences, live streams."""
 
 from __future__ import annotations
 
+import itertools
+import os
+import re
+import threading
+from fractions import Fraction
 from pathlib import Path
 
+import av
 import cv2
 import numpy as np
+import pytest
 
-from pftrack.io.video import FrameSource, natural_key
+from pftrack.io.video import FrameSource, is_live_source, natural_key, read_seqinfo
+from pftrack.synthetic import make_scene
+from tests.conftest import dataset
+from tests.io.streaming import serve_stream
 
 
 def test_natural_key_orders_numbers_as_numbers() -> None:
@@ -23,3 +33,167 @@ def test_unpadded_image_folder_plays_in_order(tmp_path: Path) -> None:
         cv2.imwrite(str(tmp_path / f"{k}.png"), np.full((8, 8, 3), k, np.uint8))
     levels = [int(frame[0, 0, 0]) for frame in FrameSource(tmp_path)]
     assert levels == list(range(1, 13))
+
+
+def _sequence(root: Path, n: int = 12, *, rate: str = "7", im_dir: str = "img1") -> Path:
+    """A MOTChallenge sequence folder: seqinfo.ini, unpadded images, det/det.txt."""
+    (root / im_dir).mkdir(parents=True)
+    for k in range(1, n + 1):
+        cv2.imwrite(str(root / im_dir / f"{k}.png"), np.full((8, 10, 3), k, np.uint8))
+    (root / "seqinfo.ini").write_text(
+        f"[Sequence]\nname=SEQ\nimDir={im_dir}\nframeRate={rate}\nseqLength={n}\n"
+        "imWidth=10\nimHeight=8\nimExt=.png\n"
+    )
+    (root / "det").mkdir()
+    (root / "det" / "det.txt").write_text("1,-1,1,1,3,3,0.9,-1,-1,-1\n")
+    return root
+
+
+def test_sequence_folder_follows_seqinfo(tmp_path: Path) -> None:
+    seq = _sequence(tmp_path / "SEQ", im_dir="frames")
+    src = FrameSource(seq)
+    assert (src.fps, src.fps_origin, len(src)) == (7.0, "seqinfo.ini", 12)
+    assert [int(f[0, 0, 0]) for f in src] == list(range(1, 13))
+    assert src.sequence is not None and src.sequence.name == "SEQ"
+    assert src.sequence.detections == seq / "det" / "det.txt"
+    # its image folder given directly finds the same sequence one level up
+    assert FrameSource(seq / "frames").fps_origin == "seqinfo.ini"
+
+
+def test_fps_given_beats_seqinfo_and_header(tmp_path: Path) -> None:
+    seq = _sequence(tmp_path / "SEQ")
+    src = FrameSource(seq, fps=12.5)
+    assert (src.fps, src.fps_origin) == (12.5, "given")
+    with pytest.raises(ValueError, match="fps is 0"):
+        FrameSource(seq, fps=0)
+
+
+def test_video_beside_seqinfo_takes_its_frame_rate(tmp_path: Path) -> None:
+    """PETS09's header says 10 fps, its seqinfo.ini 7: the sequence file wins."""
+    video = tmp_path / "video.avi"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter.fourcc(*"MJPG"), 10.0, (16, 8))
+    for k in range(5):
+        writer.write(np.full((8, 16, 3), 40 * k, np.uint8))
+    writer.release()
+    assert (FrameSource(video).fps, FrameSource(video).fps_origin) == (10.0, "container")
+    (tmp_path / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\n")
+    assert (FrameSource(video).fps, FrameSource(video).fps_origin) == (7.0, "seqinfo.ini")
+
+
+def test_image_folder_without_seqinfo_gets_the_default_rate(tmp_path: Path) -> None:
+    cv2.imwrite(str(tmp_path / "1.png"), np.zeros((4, 4, 3), np.uint8))
+    src = FrameSource(tmp_path)
+    assert (src.fps, src.fps_origin, src.sequence) == (25.0, "default", None)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[Other]\nx=1\n", r"expected a \[Sequence\] section"),
+        ("[Sequence]\nframeRate=fast\n", "frameRate"),
+    ],
+)
+def test_bad_seqinfo_is_one_clear_error(tmp_path: Path, text: str, message: str) -> None:
+    (tmp_path / "seqinfo.ini").write_text(text)
+    with pytest.raises(ValueError, match=message):
+        read_seqinfo(tmp_path)
+
+
+def test_seqinfo_of_pets_gives_its_true_frame_rate() -> None:
+    folder = dataset("pets09-s2l1")
+    src = FrameSource(folder / "video.avi")
+    assert (src.fps, src.fps_origin) == (7.0, "seqinfo.ini")  # the AVI header says 10
+    assert src.sequence is not None and src.sequence.length == 795
+
+
+def test_live_sources_are_recognised(tmp_path: Path) -> None:
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    for source in ("0", 3, "rtsp://cam.local/stream", "http://127.0.0.1:8080/video", fifo):
+        assert is_live_source(source), source
+    for source in (tmp_path, tmp_path / "video.mp4", "video.mp4"):
+        assert not is_live_source(source), source
+
+
+def test_a_folder_named_by_digits_is_not_a_camera(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "2024").mkdir()
+    cv2.imwrite(str(tmp_path / "2024" / "1.png"), np.zeros((4, 4, 3), np.uint8))
+    assert not is_live_source("2024") and is_live_source("2025")
+    src = FrameSource("2024")
+    assert not src.live and len(src) == 1
+
+
+@pytest.mark.parametrize("url", ["rtsp://127.0.0.1:9/none", "http://127.0.0.1:9/x.ts"])
+def test_stream_url_is_not_mangled_as_a_path(url: str) -> None:
+    with pytest.raises(ValueError, match=f"stream {re.escape(url)}$"):
+        FrameSource(url)
+
+
+def test_http_stream_is_read_frame_by_frame_as_it_arrives(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr("pftrack.io.video.REPLAY_FRAMES", 16)  # frames kept for a second pass
+    frames = make_scene(n_frames=40, rng=0).frames
+    with serve_stream(frames, pace=0.01) as server:
+        src = FrameSource(server.url)
+        assert src.live and len(src) == 0
+        primed = list(itertools.islice(iter(src), 10))  # the tracker's read-ahead
+        assert server.sent < len(frames)  # it was still sending: frames came as they arrived
+        got = list(src)  # the second pass replays the read-ahead, then goes on
+        src.close()
+    assert len(got) == len(frames)
+    for a, b in zip(primed, got[:10], strict=True):
+        np.testing.assert_array_equal(a, b)
+    # lossy MPEG-1, but frame k is frame k of the scene
+    errors = [np.abs(g.astype(int) - f).mean() for g, f in zip(got, frames, strict=True)]
+    assert max(errors) < 8
+    with pytest.raises(ValueError, match="read already"):  # 40 frames went past the 16 kept
+        next(iter(src))
+
+
+def test_named_pipe_is_a_live_source(tmp_path: Path) -> None:
+    """A FIFO fed by an encoder in another thread, as ``ffmpeg ... -f mpegts pipe`` would."""
+    frames = make_scene(n_frames=20, rng=1).frames
+    fifo = tmp_path / "live.ts"
+    os.mkfifo(fifo)
+
+    def feed() -> None:
+        with open(fifo, "wb") as fh:
+            out = av.open(fh, "w", format="mpegts")
+            stream = out.add_stream("mpeg1video", rate=Fraction(25))
+            stream.width, stream.height, stream.pix_fmt = (
+                frames[0].shape[1],
+                frames[0].shape[0],
+                "yuv420p",
+            )
+            stream.bit_rate = 8_000_000
+            for f in frames:
+                for packet in stream.encode(av.VideoFrame.from_ndarray(f, format="bgr24")):
+                    out.mux(packet)
+            for packet in stream.encode(None):
+                out.mux(packet)
+            out.close()
+
+    writer = threading.Thread(target=feed)
+    writer.start()
+    try:
+        src = FrameSource(fifo, fps=25)
+        got = list(src)
+    finally:
+        writer.join(timeout=30)
+    assert src.live and (src.fps, src.fps_origin) == (25.0, "given")
+    assert len(got) == len(frames)
+    assert max(np.abs(g.astype(int) - f).mean() for g, f in zip(got, frames, strict=True)) < 8
+
+
+def test_stop_ends_the_iteration(tmp_path: Path) -> None:
+    for k in range(1, 6):
+        cv2.imwrite(str(tmp_path / f"{k}.png"), np.full((4, 4, 3), k, np.uint8))
+    src = FrameSource(tmp_path)
+    seen = []
+    for frame in src:
+        seen.append(int(frame[0, 0, 0]))
+        if len(seen) == 2:
+            src.stop()
+    assert seen == [1, 2]

@@ -21,6 +21,8 @@ EPILOG = """\
 examples:
   pftrack demo                                   # synthetic scene: track, render, score, recover
   pftrack track video.avi --out tracks.txt --render annotated.mp4 --plot paths.png
+  pftrack track MOT17-04/ --detections auto --out tracks.txt        # a MOTChallenge sequence
+  pftrack track 0 --out live.txt --render live.mp4                  # camera 0; Ctrl-C ends it
   pftrack track seq/img1 --detections det.txt --out tracks.txt      # drop-in for any detector
   pftrack eval --gt gt.txt --res tracks.txt --scale 0.625
   pftrack recover tracks.txt --out filled.txt --link                # default method: auto
@@ -37,6 +39,10 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=EPILOG,
         formatter_class=HelpFormatter,
     )
+    parser.add_argument(
+        "-q", "--quiet", action="store_true",
+        help="no progress bars (they are drawn only when stderr is a terminal anyway)",
+    )  # fmt: skip
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for command in (demo, track, smooth, evaluate, recover, experiment):
@@ -56,8 +62,15 @@ def _one_line(exc: BaseException) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pftrack`` script; returns the exit status."""
     args = build_parser().parse_args(argv)
+    if args.quiet:
+        from pftrack._progress import set_quiet
+
+        set_quiet(True)
     try:
         return int(args.func(args))
+    except KeyboardInterrupt:  # Ctrl-C: outputs are written atomically, so none is half-written
+        print(f"\npftrack {args.command}: interrupted", file=sys.stderr)
+        return 130
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1

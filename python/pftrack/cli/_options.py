@@ -9,13 +9,34 @@ if TYPE_CHECKING:
     from pftrack.tracking import TrackerConfig
 
 
-class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
-    """Show every option's default and keep the examples' line breaks."""
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Show every option's default and keep the description's and examples' line breaks.
+
+    An option's help ends in ``(default: X)``, unless it says its default itself (the word
+    "default" in it); a missing value reads ``(default: none)``. Flags (on when given) and
+    required options show none.
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        if (
+            "default" in text
+            or action.default is argparse.SUPPRESS
+            or action.required
+            or action.nargs == 0  # a flag: off unless given
+            or not action.option_strings  # a positional argument
+        ):
+            return text
+        return f"{text} (default: {'none' if action.default is None else '%(default)s'})"
 
 
 def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
     """Add sub-command `name` to `sub` with the package's help formatter."""
     parser: argparse.ArgumentParser = sub.add_parser(name, formatter_class=HelpFormatter, **kwargs)
+    parser.add_argument(  # also accepted after the command; SUPPRESS keeps the global value
+        "-q", "--quiet", action="store_true", default=argparse.SUPPRESS,
+        help="no progress bars (as pftrack --quiet)",
+    )  # fmt: skip
     return parser
 
 

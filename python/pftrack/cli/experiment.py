@@ -32,15 +32,18 @@ def add_parser(sub: Any) -> None:
     g.add_argument("--auto-masks", action="store_true",
                    help="the multi-sequence protocol, even for one --gt")  # fmt: skip
     g.add_argument("--n-masks", type=positive_int, default=3, help="masks per sequence")
-    g.add_argument("--json", metavar="OUT", help="write the multi-sequence results as JSON")
+    g.add_argument("--json", metavar="OUT",
+                   help="write the multi-sequence results as JSON (default: none)")  # fmt: skip
     g.add_argument("--mask", help="x,y,w,h of the representative mask (default: chosen by rule)")
     g.add_argument("--point", default="centre", choices=("centre", "foot"),
                    help="box point used as the trajectory")  # fmt: skip
     g.add_argument("--size", type=float, default=100.0, help="mask side for the sweep (px)")
     g.add_argument("--grid", type=float, default=4.0, help="mask position step of the sweep (px)")
     g.add_argument("--image-size", help="WxH of the ground-truth coordinates (default: GT extent)")
-    g.add_argument("--trajectories", type=int, help="keep positions with exactly this many")
-    g.add_argument("--gaps", type=int, help="keep positions with exactly this many gaps")
+    g.add_argument("--trajectories", type=int,
+                   help="keep positions with exactly this many (default: any number)")  # fmt: skip
+    g.add_argument("--gaps", type=int,
+                   help="keep positions with exactly this many gaps (default: any)")  # fmt: skip
     g.add_argument(
         "--min-gaps", type=int, default=3,
         help="without --trajectories/--gaps: keep positions with at least this many",
@@ -51,7 +54,8 @@ def add_parser(sub: Any) -> None:
         "--max-positions", type=int, default=0,
         help="evaluate at most this many sweep positions, evenly spread (0 = all)",
     )  # fmt: skip
-    g.add_argument("--figure", help="PNG of ground truth against recovered paths (OpenCV)")
+    g.add_argument("--figure", metavar="PNG",
+                   help="PNG of ground truth against recovered paths (default: none)")  # fmt: skip
     g.set_defaults(func=run_gaps)
 
 
@@ -105,6 +109,13 @@ def _methods(text: str) -> list[str]:
 
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
+    from pftrack.io.atomic import check_output
+
+    inputs = tuple(args.gt)
+    if args.json:
+        check_output(args.json, what="--json", inputs=inputs)
+    if args.figure:
+        check_output(args.figure, what="--figure", suffixes=(".png", ".jpg"), inputs=inputs)
     if len(args.gt) > 1 or args.auto_masks:
         return _run_sequences(args)
     import numpy as np

@@ -35,7 +35,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
     p.add_argument("--max-distance", type=float, default=50.0, metavar="PX",
                    help="linking gate on the motion-prediction distance (pixels)")  # fmt: skip
-    p.add_argument("--video", help="video or image folder for the colour term of --link")
+    p.add_argument("--video", help="video or image folder for the colour term of --link "
+                   "(default: none, motion and size only)")  # fmt: skip
     p.add_argument("--in-place", action="store_true",
                    help="allow --out to be the input file (it is replaced atomically)")  # fmt: skip
     p.set_defaults(func=run)
@@ -43,9 +44,11 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack recover``; return the exit status."""
+    from pftrack.io.atomic import check_output
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery import LinkConfig, check_unique, fill_gaps, link_tracklets
 
+    check_output(args.out, what="--out")
     src = Path(args.tracks)
     rows = read_mot(src, what="tracks file")
     check_unique(rows, data_line_numbers(src))

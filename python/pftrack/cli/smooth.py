@@ -34,11 +34,12 @@ def run(args: argparse.Namespace) -> int:
     """Run ``pftrack smooth``; return the exit status."""
     import numpy as np
 
+    from pftrack.io.atomic import check_output
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery import LinkConfig, check_unique
     from pftrack.tracking import smooth_tracks
 
-    src, out = Path(args.tracks), Path(args.out)
+    src, out = Path(args.tracks), check_output(args.out, what="--out")
     if out.exists() and os.path.samefile(out, src):
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
     rows = read_mot(src, what="tracks file")

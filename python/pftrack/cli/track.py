@@ -1,12 +1,13 @@
-"""``pftrack track``: track a video or image folder, MOTChallenge rows out."""
+"""``pftrack track``: track a video, image folder, sequence, camera or stream; MOT rows out."""
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from pftrack.cli._options import add_command, add_tracker_options, positive_float, tracker_config
 
@@ -16,68 +17,184 @@ def add_parser(sub: Any) -> None:
     p = add_command(
         sub,
         "track",
-        help="track a video or image folder; MOTChallenge output",
-        description="Track every object in SOURCE (a video file, or a folder of images such as "
-        "a MOTChallenge img1/). Without --detections, objects come from background "
-        "subtraction; with a MOTChallenge det.txt the tracker is a drop-in backend for any "
-        "detector. Output: MOTChallenge rows frame,id,left,top,width,height,score,-1,-1,-1 "
-        "(1-based frames, pixels of SOURCE), written atomically.",
+        help="track a video, image folder, camera or stream; MOTChallenge output",
+        description="Track every object in SOURCE: a video file, a folder of images (natural "
+        "order: 2.jpg before 10.jpg), a MOTChallenge sequence folder (seqinfo.ini gives the "
+        "frame rate and image folder, det/det.txt the detections of --detections auto), a "
+        "camera index (0) or a stream URL (rtsp://, http://, ...). Without --detections, "
+        "objects come from background subtraction; with a MOTChallenge det.txt the tracker is "
+        "a drop-in backend for any detector. Output: MOTChallenge rows "
+        "frame,id,left,top,width,height,score,-1,-1,-1 (1-based frames, pixels of SOURCE), "
+        "written atomically.\n\n"
+        "Live sources (camera, stream URL, named pipe): --out grows as the tracker settles "
+        "rows (online boxes, flushed every frame); Ctrl-C stops after the current frame, and "
+        "--out is then replaced by the finished tracks (linked and smoothed, unless --no-link "
+        "/ --no-smooth) with exit status 0; a second Ctrl-C aborts (exit 130). On a file "
+        "source, Ctrl-C aborts and leaves --out as it was (exit 130).",
     )
-    p.add_argument("source", help="video file or image folder")
-    p.add_argument("--out", required=True, help="tracks in MOTChallenge format (e.g. tracks.txt)")
-    p.add_argument("--detections", help="MOTChallenge detection file (frame,-1,l,t,w,h,score,...)")
     p.add_argument(
-        "--det-scale", type=positive_float, default=1.0, metavar="S",
-        help="multiply detection boxes by S to reach the video's pixels (0.625 for PETS09 "
-        "det.txt on its 480x360 video)",
+        "source",
+        help="video file, image folder, MOTChallenge sequence folder, camera index or URL",
+    )
+    p.add_argument("--out", required=True, help="tracks in MOTChallenge format (e.g. tracks.txt)")
+    p.add_argument(
+        "--detections", metavar="FILE",
+        help="MOTChallenge detection file (frame,-1,l,t,w,h,score,...), or 'auto' for the "
+        "sequence's det/det.txt (default: the built-in detector)",
     )  # fmt: skip
-    p.add_argument("--render", help="write an annotated video (.mp4 or .avi)")
-    p.add_argument("--plot", help="write a trajectory plot (.png)")
+    p.add_argument(
+        "--det-scale", type=positive_float, metavar="S",
+        help="multiply detection boxes by S to reach the video's pixels (0.625 for PETS09 "
+        "det.txt on its 480x360 video) (default: for the sequence's own detections, the frame "
+        "width over seqinfo.ini's imWidth; else 1)",
+    )  # fmt: skip
+    p.add_argument(
+        "--fps", type=positive_float, metavar="FPS",
+        help="frame rate of SOURCE, for --render (default: seqinfo.ini's frameRate, else the "
+        "container's header, else 25)",
+    )  # fmt: skip
+    p.add_argument(
+        "--render", metavar="VIDEO",
+        help="write an annotated video while tracking: .mp4 (H.264, plays in browsers) or "
+        ".avi (MJPG); boxes, ids and trails as tracked online (default: none)",
+    )  # fmt: skip
+    p.add_argument("--plot", metavar="PNG",
+                   help="write a trajectory plot (.png) (default: none)")  # fmt: skip
     add_tracker_options(p)
     p.set_defaults(func=run)
 
 
+class _StopOnCtrlC:
+    """While active, the first Ctrl-C stops `source` after the current frame; a second aborts."""
+
+    def __init__(self, source: Any) -> None:
+        self.source = source
+        self._previous: Any = None
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        if self.source.stopped:
+            raise KeyboardInterrupt
+        self.source.stop()
+        print("\nstopping after this frame (Ctrl-C again to abort)", file=sys.stderr)
+
+    def __enter__(self) -> _StopOnCtrlC:
+        self._previous = signal.signal(signal.SIGINT, self._handler)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        signal.signal(signal.SIGINT, self._previous)
+
+
+def _resolve_detections(args: argparse.Namespace, source: Any) -> str | None:
+    if args.detections != "auto":
+        return str(args.detections) if args.detections else None
+    found = source.sequence.detections if source.sequence is not None else None
+    if found is None:
+        raise ValueError(
+            f"--detections auto: {args.source} is not a MOTChallenge sequence with det/det.txt "
+            "(seqinfo.ini beside it); give the detection file"
+        )
+    return str(found)
+
+
+def _det_scale(args: argparse.Namespace, source: Any, det_path: str) -> float:
+    """``--det-scale``, or the sequence's own: its detections are in seqinfo.ini's pixels."""
+    if args.det_scale is not None:
+        return float(args.det_scale)
+    seq = source.sequence
+    own = seq.detections if seq is not None else None
+    if own is None or seq.width is None or not own.samefile(det_path):
+        return 1.0
+    if seq.width == source.width:
+        return 1.0
+    scale = float(source.width / seq.width)
+    print(
+        f"detections scaled by {scale:g}: frames are {source.width} px wide, "
+        f"{seq.folder / 'seqinfo.ini'} says imWidth={seq.width} (--det-scale overrides)"
+    )
+    return scale
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack track``; return the exit status."""
+    import contextlib
+
+    import numpy as np
+
     from pftrack.io.atomic import check_output
-    from pftrack.io.mot import write_mot
-    from pftrack.io.video import FrameSource
+    from pftrack.io.mot import format_mot_row, write_mot
+    from pftrack.io.video import FrameSource, is_live_source
+    from pftrack.io.video_writer import VIDEO_SUFFIXES
     from pftrack.recovery import LinkConfig
-    from pftrack.render import plot_trajectories, write_annotated_video
+    from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections, track_frames
 
-    inputs = (args.source,) + ((args.detections,) if args.detections else ())
+    live = is_live_source(args.source)
+    given = [d for d in (args.detections,) if d and d != "auto"]
+    inputs = tuple([args.source] if not live else []) + tuple(given)
     check_output(args.out, what="--out", inputs=inputs)
     if args.render:
-        check_output(args.render, what="--render", suffixes=(".mp4", ".avi"), inputs=inputs)
+        check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
     if args.plot:
         check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
-    source = FrameSource(args.source)
-    dets = load_detections(args.detections, args.det_scale) if args.detections else None
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = track_frames(
-            source,
-            detections=dets,
-            config=tracker_config(args),
-            rng=args.seed,
-            fill=args.fill,
-            smoother=None if args.no_smooth else BoxSmoother(),
-            link=None if args.no_link else LinkConfig(),
+    source = FrameSource(args.source, fps=args.fps)
+    renderer: TrackRenderer | None = None
+    try:
+        det_path = _resolve_detections(args, source)
+        dets = load_detections(det_path, _det_scale(args, source, det_path)) if det_path else None
+        renderer = TrackRenderer(args.render, source.fps) if args.render else None
+        first: list[Any] = []
+        stream: IO[str] | None = None
+
+        def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
+            if n == 1:
+                first.append(frame)
+            if renderer is not None:
+                renderer.add(frame, tracks)
+            if stream is not None:
+                for r in rows:
+                    stream.write(format_mot_row(r) + "\n")
+                stream.flush()
+
+        with contextlib.ExitStack() as stack:
+            if live:  # --out grows while tracking; replaced by the finished tracks below
+                stream = stack.enter_context(open(args.out, "w", encoding="utf-8"))  # noqa: SIM115
+                stack.enter_context(_StopOnCtrlC(source))
+            caught = stack.enter_context(warnings.catch_warnings(record=True))
+            warnings.simplefilter("always")
+            result = track_frames(
+                source,
+                detections=dets,
+                config=tracker_config(args),
+                rng=args.seed,
+                fill=args.fill,
+                smoother=None if args.no_smooth else BoxSmoother(),
+                link=None if args.no_link else LinkConfig(),
+                on_frame=on_frame,
+            )
+        for w in caught:  # clipped boxes, a run without any track: said, not fatal
+            print(f"pftrack track: warning: {w.message}", file=sys.stderr)
+        write_mot(args.out, result.rows)
+        n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
+        stopped = " (stopped by Ctrl-C)" if source.stopped else ""
+        print(
+            f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
+            f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> {args.out}"
         )
-    for w in caught:  # clipped boxes, a run without any track: said, not fatal
-        print(f"pftrack track: warning: {w.message}", file=sys.stderr)
-    write_mot(args.out, result.rows)
-    n_ids = len(set(result.rows[:, 1].astype(int))) if len(result.rows) else 0
-    print(
-        f"{result.n_frames} frames, {n_ids} tracks, {len(result.rows)} boxes in "
-        f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> {args.out}"
-    )
-    if args.render:
-        write_annotated_video(args.render, FrameSource(args.source), result.rows, source.fps)
-        print(f"annotated video -> {args.render}")
-    if args.plot:
-        first = next(iter(FrameSource(args.source)))
-        plot_trajectories(args.plot, result.rows, background=first, title=Path(args.source).name)
-        print(f"trajectory plot -> {args.plot}")
+        if renderer is not None:
+            renderer.close()
+            print(
+                f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
+                f"{source.fps_origin}) -> {args.render}"
+            )
+        if args.plot:
+            name = source.sequence.name if source.sequence is not None else Path(args.source).name
+            plot_trajectories(args.plot, result.rows, background=first[0], title=name)
+            print(f"trajectory plot -> {args.plot}")
+    except BaseException:
+        if renderer is not None:
+            renderer.abort()  # no half-written video (a finished one stays)
+        raise
+    finally:
+        source.close()
     return 0

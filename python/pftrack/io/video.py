@@ -1,9 +1,25 @@
-"""Frames from a video file or a folder of images (MOTChallenge ``img1/``), via OpenCV."""
+"""Frames from a video file, an image folder, a MOTChallenge sequence, a camera or a stream.
+
+Sources, as :class:`FrameSource` takes them:
+
+- a video file OpenCV can decode;
+- a folder of images, read in natural order (``2.jpg`` before ``10.jpg``);
+- a MOTChallenge sequence folder: ``seqinfo.ini`` gives the frame rate and the image folder
+  (``imDir``, default ``img1``); ``det/det.txt`` is its public detection file;
+- a camera index (``"0"``), or a stream URL (anything with ``://``: ``rtsp://``, ``http://``,
+  ``udp://``, ...), or a named pipe: *live* sources, read once, of unknown length.
+
+The frame rate comes from the caller (``fps=``), else ``seqinfo.ini`` (beside a video file, in a
+sequence folder or one level above its image folder), else the container header, else 25.
+"""
 
 from __future__ import annotations
 
+import configparser
 import re
-from collections.abc import Iterator
+import stat
+from collections.abc import Generator, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +29,20 @@ from numpy.typing import NDArray
 
 from pftrack._typing import PathLike
 
+__all__ = [
+    "FrameSource",
+    "SequenceInfo",
+    "find_sequence",
+    "is_live_source",
+    "natural_key",
+    "read_frames",
+    "read_seqinfo",
+]
+
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
+DEFAULT_FPS = 25.0
+REPLAY_FRAMES = 64
+"""Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
 
 
 def natural_key(name: str) -> tuple[tuple[int, int | str], ...]:
@@ -29,59 +58,263 @@ def natural_key(name: str) -> tuple[tuple[int, int | str], ...]:
     )
 
 
+@dataclass(frozen=True)
+class SequenceInfo:
+    """The ``[Sequence]`` section of a MOTChallenge ``seqinfo.ini``.
+
+    Attributes
+    ----------
+    folder : Path
+        The sequence folder (the one holding ``seqinfo.ini``).
+    name : str
+        ``name`` (default: the folder's name).
+    frame_rate : float or None
+        ``frameRate``, frames per second.
+    image_dir : str
+        ``imDir`` (default ``img1``).
+    width, height : int or None
+        ``imWidth``, ``imHeight``: the image size the ground truth is given in.
+    length : int or None
+        ``seqLength``, frames.
+    """
+
+    folder: Path
+    name: str
+    frame_rate: float | None
+    image_dir: str
+    width: int | None
+    height: int | None
+    length: int | None
+
+    @property
+    def detections(self) -> Path | None:
+        """``det/det.txt`` (or ``det.txt``) of the sequence, if it exists."""
+        for path in (self.folder / "det" / "det.txt", self.folder / "det.txt"):
+            if path.is_file():
+                return path
+        return None
+
+
+def read_seqinfo(path: PathLike) -> SequenceInfo:
+    """Read a MOTChallenge ``seqinfo.ini`` (or the one in folder `path`).
+
+    Raises
+    ------
+    ValueError
+        No ``[Sequence]`` section, or a field that is not a positive number.
+    """
+    ini = Path(path)
+    if ini.is_dir():
+        ini = ini / "seqinfo.ini"
+    parser = configparser.ConfigParser(interpolation=None)
+    try:
+        parser.read(ini, encoding="utf-8")
+        sec = parser["Sequence"]
+    except (configparser.Error, KeyError):
+        raise ValueError(
+            f"{ini}: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
+        ) from None
+
+    def number(key: str) -> float | None:
+        text = sec.get(key)
+        if text is None or not text.strip():
+            return None
+        try:
+            value = float(text)
+        except ValueError:
+            value = float("nan")
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{ini}: {key} is {text!r}, expected a number > 0")
+        return value
+
+    def integer(key: str) -> int | None:
+        value = number(key)
+        return None if value is None else round(value)
+
+    return SequenceInfo(
+        folder=ini.parent,
+        name=sec.get("name", ini.parent.name),
+        frame_rate=number("frameRate"),
+        image_dir=sec.get("imDir", "img1") or "img1",
+        width=integer("imWidth"),
+        height=integer("imHeight"),
+        length=integer("seqLength"),
+    )
+
+
+def find_sequence(source: PathLike) -> SequenceInfo | None:
+    """The MOTChallenge sequence `source` belongs to, from the ``seqinfo.ini`` nearest to it.
+
+    Looks in `source` itself (a sequence folder), beside it (a video file, or an image folder
+    inside the sequence folder), in that order; None when there is none.
+    """
+    path = Path(source)
+    for folder in (path, path.parent) if path.is_dir() else (path.parent,):
+        if (folder / "seqinfo.ini").is_file():
+            return read_seqinfo(folder)
+    return None
+
+
+def _camera_index(source: PathLike | int) -> int | None:
+    """The camera index `source` names (``0``, ``"1"``), unless a file or folder has that name."""
+    if isinstance(source, int):
+        return source
+    text = str(source)
+    return int(text) if text.isdigit() and not Path(text).exists() else None
+
+
+def is_live_source(source: PathLike | int) -> bool:
+    """Whether `source` is a camera index, a stream URL (``scheme://``) or a named pipe.
+
+    A digit string is a camera index unless a file or folder of that name exists.
+    """
+    text = str(source)
+    if _camera_index(source) is not None or "://" in text:
+        return True
+    try:
+        return stat.S_ISFIFO(Path(text).stat().st_mode) or stat.S_ISCHR(Path(text).stat().st_mode)
+    except OSError:
+        return False
+
+
 class FrameSource:
-    """Iterate over BGR uint8 frames of a video file or an image folder.
+    """Iterate over BGR uint8 frames of a video, image folder, sequence, camera or stream.
 
     Parameters
     ----------
-    source : str or os.PathLike
-        A video file OpenCV can decode, or a folder of images in natural order (``2.jpg``
-        before ``10.jpg``; see :func:`natural_key`). A MOTChallenge sequence folder with an
-        ``img1/`` sub-folder is accepted too.
+    source : str, int or os.PathLike
+        A video file, an image folder, a MOTChallenge sequence folder (``seqinfo.ini``,
+        ``img1/``), a camera index (``0`` or ``"0"``), or a stream URL such as
+        ``rtsp://host/path`` or ``http://host:8080/video`` (passed to OpenCV's FFmpeg
+        backend untouched).
     scale : float
         Resize factor applied to every frame (1 keeps the size).
+    fps : float, optional
+        Frame rate; overrides ``seqinfo.ini`` and the container header.
+
+    Attributes
+    ----------
+    fps : float
+        Frames per second (see `fps_origin`).
+    fps_origin : str
+        Where `fps` came from: ``"given"``, ``"seqinfo.ini"``, ``"container"`` or ``"default"``.
+    n_frames : int
+        Frames expected (0 when unknown, as for live sources).
+    live : bool
+        A camera, stream or pipe: read once, frames as they arrive.
+    sequence : SequenceInfo or None
+        The MOTChallenge sequence `source` belongs to.
+    width, height : int
+        Frame size after `scale`.
 
     Raises
     ------
     FileNotFoundError
-        If `source` does not exist.
+        If a path `source` does not exist.
     ValueError
-        If it cannot be decoded, or holds no frame.
+        If it cannot be opened or decoded, or holds no frame.
+
+    Notes
+    -----
+    A file or folder can be iterated any number of times. A live source can be iterated once,
+    except that the first 64 frames are kept: a second iteration (the tracker primes its
+    background model on the first frames, then tracks from frame 1) replays them and goes on
+    reading, as long as the first one stopped within them.
     """
 
-    def __init__(self, source: PathLike, *, scale: float = 1.0) -> None:
-        self.path = Path(source)
-        if not self.path.exists():
-            raise FileNotFoundError(f"video source not found: {self.path}")
+    def __init__(
+        self, source: PathLike | int, *, scale: float = 1.0, fps: float | None = None
+    ) -> None:
         if not (np.isfinite(scale) and scale > 0):
             raise ValueError(f"scale is {scale}, expected a finite value > 0")
+        if fps is not None and not (np.isfinite(fps) and fps > 0):
+            raise ValueError(f"fps is {fps}, expected a finite value > 0")
         self.scale = float(scale)
+        self.name = str(source)
+        self.live = is_live_source(source)
+        self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
-        if self.path.is_dir():
-            folder = self.path / "img1" if (self.path / "img1").is_dir() else self.path
-            images = (p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
-            self._images = sorted(images, key=lambda p: natural_key(p.name))
-            if not self._images:
-                raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
-            first = cv2.imread(str(self._images[0]), cv2.IMREAD_COLOR)
-            if first is None:
-                raise ValueError(f"cannot read image {self._images[0]}")
-            self.n_frames = len(self._images)
-            self.fps = 25.0
+        self._cap: Any = None
+        self._replay: list[NDArray[np.uint8]] = []
+        self._read_past_replay = False
+        self.stopped = False
+        text = str(source)
+        camera = _camera_index(source)
+        self._target: str | int = text if camera is None else camera
+        self.path: Path | None = None
+        header_fps = 0.0
+        if isinstance(self._target, int) or "://" in text:
+            first, header_fps, count = self._open_live()
         else:
-            cap = cv2.VideoCapture(str(self.path))
-            ok, first = cap.read() if cap.isOpened() else (False, None)
-            fps = cap.get(cv2.CAP_PROP_FPS) if cap.isOpened() else 0.0
-            count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
-            cap.release()
-            if not ok or first is None:
-                raise ValueError(
-                    f"cannot decode a frame from {self.path}: not a video OpenCV can read, or empty"
-                )
-            self.n_frames = max(count, 0)
-            self.fps = fps if fps and np.isfinite(fps) and fps > 0 else 25.0
+            self.path = Path(text)
+            if not self.path.exists():
+                raise FileNotFoundError(f"video source not found: {self.path}")
+            self.sequence = find_sequence(self.path)
+            if self.path.is_dir():
+                first, count = self._open_folder(self.path)
+            elif self.live:
+                first, header_fps, count = self._open_live()
+            else:
+                first, header_fps, count = self._probe_file(self.path)
+        self.n_frames = max(count, 0)
+        seq_fps = self.sequence.frame_rate if self.sequence is not None else None
+        if fps is not None:
+            self.fps, self.fps_origin = float(fps), "given"
+        elif seq_fps is not None:
+            self.fps, self.fps_origin = float(seq_fps), "seqinfo.ini"
+        elif header_fps and np.isfinite(header_fps) and 0 < header_fps < 1000:
+            self.fps, self.fps_origin = float(header_fps), "container"
+        else:
+            self.fps, self.fps_origin = DEFAULT_FPS, "default"
         first = self._resize(first)
         self.height, self.width = int(first.shape[0]), int(first.shape[1])
+        if self.live:
+            self._replay.append(first)
+
+    def _open_folder(self, path: Path) -> tuple[NDArray[Any], int]:
+        folder = path
+        if self.sequence is not None and self.sequence.folder == path:
+            folder = path / self.sequence.image_dir
+            if not folder.is_dir():
+                raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
+        elif (path / "img1").is_dir():
+            folder = path / "img1"
+        images = (p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+        self._images = sorted(images, key=lambda p: natural_key(p.name))
+        if not self._images:
+            raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
+        first = cv2.imread(str(self._images[0]), cv2.IMREAD_COLOR)
+        if first is None:
+            raise ValueError(f"cannot read image {self._images[0]}")
+        return first, len(self._images)
+
+    @staticmethod
+    def _probe_file(path: Path) -> tuple[NDArray[Any], float, int]:
+        cap = cv2.VideoCapture(str(path))
+        try:
+            ok, first = cap.read() if cap.isOpened() else (False, None)
+            fps = float(cap.get(cv2.CAP_PROP_FPS)) if cap.isOpened() else 0.0
+            count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
+        finally:
+            cap.release()
+        if not ok or first is None:
+            raise ValueError(
+                f"cannot decode a frame from {path}: not a video OpenCV can read, or empty"
+            )
+        return first, fps, count
+
+    def _open_live(self) -> tuple[NDArray[Any], float, int]:
+        what = "camera" if isinstance(self._target, int) else "stream"
+        if isinstance(self._target, int):
+            cap = cv2.VideoCapture(self._target)
+        else:
+            cap = cv2.VideoCapture(self._target, cv2.CAP_FFMPEG)
+        ok, first = cap.read() if cap.isOpened() else (False, None)
+        if not ok or first is None:
+            cap.release()
+            raise ValueError(f"cannot read a frame from {what} {self.name}")
+        self._cap = cap
+        return first, float(cap.get(cv2.CAP_PROP_FPS)), 0
 
     def _resize(self, frame: NDArray[Any]) -> NDArray[np.uint8]:
         if self.scale != 1.0:
@@ -93,6 +326,20 @@ class FrameSource:
         return self.n_frames
 
     def __iter__(self) -> Iterator[NDArray[np.uint8]]:
+        frames = self._iter_live() if self.live else self._iter_stored()
+        try:
+            for frame in frames:
+                if self.stopped:
+                    return
+                yield frame
+        finally:
+            frames.close()  # a video file's capture is released now, not when collected
+
+    def stop(self) -> None:
+        """End every iteration before its next frame (safe to call from a signal handler)."""
+        self.stopped = True
+
+    def _iter_stored(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._images is not None:
             for p in self._images:
                 img = cv2.imread(str(p), cv2.IMREAD_COLOR)
@@ -109,6 +356,35 @@ class FrameSource:
                 yield self._resize(frame)
         finally:
             cap.release()
+
+    def _iter_live(self) -> Generator[NDArray[np.uint8], None, None]:
+        if self._read_past_replay:
+            raise ValueError(f"live source {self.name} was read already; open it again")
+        yield from list(self._replay)
+        while self._cap is not None:
+            ok, frame = self._cap.read()
+            if not ok:
+                self.close()
+                break
+            frame = self._resize(frame)
+            if len(self._replay) < REPLAY_FRAMES:
+                self._replay.append(frame)
+            else:
+                self._read_past_replay = True
+                self._replay.clear()
+            yield frame
+
+    def close(self) -> None:
+        """Release a live source's capture (files and folders hold nothing open)."""
+        if self._cap is not None:
+            self._cap.release()
+            self._cap = None
+
+    def __enter__(self) -> FrameSource:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 def read_frames(source: PathLike, *, scale: float = 1.0) -> list[NDArray[np.uint8]]:

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES
 from pftrack.recovery.gdt import GdtModel
@@ -288,7 +289,7 @@ def calibrate(
         motion = fit_motion(whole, noise)
     per_bucket = max(MIN_VALIDATION_GAPS, max_gaps // len(by_bucket))
     choices = []
-    for b in sorted(by_bucket):
+    for b in progress(sorted(by_bucket), desc="auto: calibrating", unit="bucket"):
         rng = np.random.default_rng([seed, b])
         cut = _artificial_gaps(runs, by_bucket[b], per_bucket, rng)
         mmae: tuple[tuple[str, float], ...] = ()

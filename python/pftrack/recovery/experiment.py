@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.mixture import MotionFit, fit_motion
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
@@ -432,7 +433,7 @@ def median_over(
         pos = pos[np.linspace(0, len(pos) - 1, max_positions).round().astype(int)]
     per: dict[str, list[MethodScore]] = {m: [] for m in methods}
     wins = {m: 0 for m in methods}
-    for p in pos:
+    for p in progress(pos, desc="mask positions", unit="mask"):
         r = run_mask(trajs, p, methods)
         if not r.gaps:
             continue

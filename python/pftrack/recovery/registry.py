@@ -41,6 +41,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes
 from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
@@ -152,7 +153,10 @@ def recover_gaps(
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
     if method not in GOAL_DIRECTED_METHODS:
-        return [recover_gap(a, b, method=method, noise=noise)[:, :2] for a, b in gaps]
+        return [
+            recover_gap(a, b, method=method, noise=noise)[:, :2]
+            for a, b in progress(gaps, desc=method, unit="gap")
+        ]
     if not gaps:
         return []
     seg_a = [np.asarray(a, dtype=np.float64) for a, _ in gaps]

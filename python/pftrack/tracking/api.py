@@ -27,6 +27,7 @@ from pftrack._typing import F64, RngLike
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
+from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
 from pftrack.tracking.writer import TrackWriter
 
@@ -286,6 +287,7 @@ class Tracker:
         self._tracker = MultiObjectTracker(self.config, rng=self.seed)
         self._writer = TrackWriter(*self._writer_args)
         self.frame_count = 0
+        self._reports: list[Track] = []
         self._clip_warned = False
         self._max_conf = -np.inf
 
@@ -345,6 +347,7 @@ class Tracker:
             reports = self._tracker.update(f, xywh, cls)
         self.frame_count += 1
         self._writer.add(self.frame_count, reports)
+        self._reports = reports
         out = np.zeros((len(reports), 8))
         m = 0
         for t in reports:
@@ -355,6 +358,25 @@ class Tracker:
             out[m] = (b[0], b[1], b[0] + b[2], b[1] + b[3], t.id, t.score, t.cls, di)
             m += 1
         return out[:m]
+
+    @property
+    def last_reports(self) -> list[Track]:
+        """Every track the last `update` reported, coasting ones too (what a renderer draws)."""
+        return self._reports
+
+    @property
+    def n_settled(self) -> int:
+        """How many online rows (before the offline pass) the run has settled so far."""
+        return len(self._writer.rows)
+
+    def settled_rows(self, start: int = 0) -> F64:
+        """The online MOTChallenge rows settled so far, from row `start` on.
+
+        These are the rows before the offline pass (no linking or smoothing): a live source
+        writes them as they come. A gap bridged by a particle filter is settled when the track
+        is detected again.
+        """
+        return np.asarray(self._writer.rows[start:], np.float64).reshape(-1, 10)
 
     def finalize(self) -> F64:
         """The run's MOTChallenge rows after the offline pass (what ``pftrack track`` writes).

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
 from pftrack.kalman import rts_smooth
@@ -172,7 +173,8 @@ def smooth_tracks(
         a, obs, z = _add_hole_rows(a, obs, z, link.max_gap)
     if smoother is not None:
         starts = np.flatnonzero(np.r_[True, a[1:, 1] != a[:-1, 1], True])
-        for i, j in zip(starts[:-1], starts[1:], strict=True):
+        spans = list(zip(starts[:-1], starts[1:], strict=True))
+        for i, j in progress(spans, desc="smoothing", unit="track"):
             if obs[i:j].any():
                 a[i:j, 2:6] = smoother.smooth(a[i:j, 0], z[i:j], obs[i:j])
     out: F64 = a[np.lexsort((a[:, 1], a[:, 0]))]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import itertools
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,11 +14,13 @@ from numpy.typing import NDArray
 from pftrack._progress import progress
 from pftrack._typing import F64, PathLike, RngLike
 from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.api import Tracker, xywh_to_xyxy_dets
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
+from pftrack.tracking.track import Track
 
 __all__ = ["TrackingRun", "load_detections", "track_frames"]
 
@@ -77,6 +79,7 @@ def track_frames(
     prime_frames: int = 30,
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
+    on_frame: Callable[[int, NDArray[np.uint8], list[Track], F64], None] | None = None,
 ) -> TrackingRun:
     """Track every frame of `source`: :class:`~pftrack.tracking.api.Tracker` over every frame.
 
@@ -107,6 +110,12 @@ def track_frames(
         tracker reported them, frame by frame).
     link : LinkConfig or None
         Join fragments of one object once the run is over (None: keep every id).
+    on_frame : callable, optional
+        Called after each frame as ``on_frame(index, frame, tracks, rows)``: the 1-based frame
+        index, the BGR frame, the tracks reported on it, and the (k, 10) MOTChallenge rows the
+        run's writer settled during this frame (online boxes, before the offline pass; a
+        bridged gap's rows arrive when the track is re-detected). For rendering while tracking
+        and for writing rows of a live source as they come.
     """
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
@@ -130,15 +139,21 @@ def track_frames(
     n = 0
     total = len(frames) or None
     for n, frame in enumerate(
-        progress(frames, total=total, desc="tracking", enable=show_progress), start=1
+        progress(
+            prefetch(frames), total=total, desc="tracking", enable=show_progress, unit="frame"
+        ),
+        start=1,
     ):
+        settled = tracker.n_settled
         if detections is None:
             tracker.update(None, frame)
-            continue
-        dets = detections.get(n, empty)
-        if n == 1:
-            _check_layout(detections, frame.shape[:2])
-        tracker.update(xywh_to_xyxy_dets(dets), frame)
+        else:
+            dets = detections.get(n, empty)
+            if n == 1:
+                _check_layout(detections, frame.shape[:2])
+            tracker.update(xywh_to_xyxy_dets(dets), frame)
+        if on_frame is not None:
+            on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
     if n == 0:
         raise ValueError(f"no frame could be read from {source}")
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)

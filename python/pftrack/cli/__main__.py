@@ -1,0 +1,9 @@
+"""``python -m pftrack.cli``: the ``pftrack`` command."""
+
+from __future__ import annotations
+
+import sys
+
+from pftrack.cli import main
+
+sys.exit(main())

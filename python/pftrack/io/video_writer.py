@@ -1,0 +1,203 @@
+"""Writing video files that play everywhere: H.264 MP4 through PyAV, OpenCV as the fallback.
+
+Browsers play H.264 in MP4 with 4:2:0 chroma and even frame sizes; OpenCV's ``mp4v`` (MPEG-4
+part 2) they do not. PyAV's wheels ship FFmpeg with libx264, so :class:`VideoWriter` encodes
+with it when ``av`` is importable, with the ``moov`` index first (``faststart``: playback starts
+before the download ends). Without PyAV it falls back to OpenCV's ``avc1`` encoder if the OpenCV
+build has one, else ``mp4v``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+from fractions import Fraction
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack._typing import PathLike
+from pftrack.io.atomic import atomic_path
+
+__all__ = ["VIDEO_SUFFIXES", "VideoWriter", "pyav_available"]
+
+VIDEO_SUFFIXES = (".mp4", ".avi")
+
+
+def pyav_available() -> bool:
+    """Whether PyAV (``import av``) can be used for H.264 output."""
+    return importlib.util.find_spec("av") is not None
+
+
+class VideoWriter:
+    """Write BGR uint8 frames to a video file, atomically.
+
+    The file appears at `path` only when :meth:`close` succeeds; :meth:`abort` (or an exception
+    inside a ``with`` block) leaves any earlier file at `path` untouched.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.mp4`` (H.264, yuv420p) or ``.avi`` (Motion-JPEG, through OpenCV).
+    fps : float
+        Frame rate written into the container.
+    backend : {"pyav", "opencv"}, optional
+        Default: PyAV for ``.mp4`` when installed, else OpenCV.
+    crf : int
+        x264 constant rate factor (lower: better and larger; 23 is x264's default).
+
+    Attributes
+    ----------
+    backend : str
+        The encoder in use.
+    codec : str
+        ``"h264"``, ``"mp4v"`` or ``"mjpeg"``.
+    n_frames : int
+        Frames written so far.
+
+    Notes
+    -----
+    H.264 with 4:2:0 chroma needs even width and height: odd frames get one replicated row or
+    column at the bottom or right. All frames must have the size of the first.
+    """
+
+    def __init__(
+        self, path: PathLike, fps: float, *, backend: str | None = None, crf: int = 23
+    ) -> None:
+        self.path = Path(path)
+        suffix = self.path.suffix.lower()
+        if suffix not in VIDEO_SUFFIXES:
+            raise ValueError(
+                f"video {self.path}: unsupported extension {suffix or '(none)'!r}, expected one "
+                f"of {', '.join(VIDEO_SUFFIXES)}"
+            )
+        if not (np.isfinite(fps) and fps > 0):
+            raise ValueError(f"video frame rate is {fps}, expected a finite value > 0")
+        if backend is None:
+            backend = "pyav" if suffix == ".mp4" and pyav_available() else "opencv"
+        if backend not in ("pyav", "opencv"):
+            raise ValueError(f"backend is {backend!r}, expected 'pyav' or 'opencv'")
+        if backend == "pyav" and suffix != ".mp4":
+            raise ValueError(f"backend 'pyav' writes .mp4, not {suffix}")
+        self.backend = backend
+        self.fps = float(fps)
+        self.crf = int(crf)
+        self.codec = "h264" if backend == "pyav" else ("mjpeg" if suffix == ".avi" else "")
+        self.n_frames = 0
+        self._size: tuple[int, int] | None = None  # (height, width) of the input frames
+        self._stack = contextlib.ExitStack()
+        self._tmp: Path = self._stack.enter_context(atomic_path(self.path))
+        self._container: Any = None
+        self._stream: Any = None
+        self._cv: Any = None
+
+    def _open(self, height: int, width: int) -> None:
+        self._size = (height, width)
+        h, w = height + height % 2, width + width % 2
+        if self.backend == "pyav":
+            import av
+
+            rate = Fraction(self.fps).limit_denominator(1001)
+            self._container = av.open(
+                str(self._tmp), mode="w", format="mp4", options={"movflags": "+faststart"}
+            )
+            stream = self._container.add_stream("libx264", rate=rate)
+            stream.width, stream.height, stream.pix_fmt = w, h, "yuv420p"
+            stream.options = {"crf": str(self.crf), "preset": "veryfast"}
+            self._stream = stream
+            return
+        candidates = ("MJPG",) if self.path.suffix.lower() == ".avi" else ("avc1", "mp4v")
+        for fourcc in candidates:
+            with contextlib.suppress(cv2.error):
+                writer = cv2.VideoWriter(
+                    str(self._tmp), cv2.VideoWriter.fourcc(*fourcc), self.fps, (w, h)
+                )
+                if writer.isOpened():
+                    self._cv = writer
+                    self.codec = {"MJPG": "mjpeg", "avc1": "h264"}.get(fourcc, fourcc)
+                    return
+                writer.release()
+        raise ValueError(f"OpenCV cannot write video {self.path} (no encoder for {candidates})")
+
+    def write(self, frame: NDArray[np.uint8]) -> None:
+        """Append one BGR uint8 frame (H, W, 3)."""
+        if frame.ndim != 3 or frame.shape[2] != 3:
+            raise ValueError(f"frame has shape {frame.shape}, expected (H, W, 3) BGR")
+        if self._size is None:
+            self._open(int(frame.shape[0]), int(frame.shape[1]))
+        h, w = self._size if self._size is not None else (0, 0)
+        if frame.shape[:2] != (h, w):
+            raise ValueError(
+                f"frame {self.n_frames + 1} is {frame.shape[1]}x{frame.shape[0]}, the video {w}x{h}"
+            )
+        image: NDArray[Any] = frame
+        if h % 2 or w % 2:
+            image = cv2.copyMakeBorder(frame, 0, h % 2, 0, w % 2, cv2.BORDER_REPLICATE)
+        image = np.ascontiguousarray(image, dtype=np.uint8)
+        if self._stream is not None:
+            import av
+
+            picture = av.VideoFrame.from_ndarray(image, format="bgr24")
+            for packet in self._stream.encode(picture):
+                self._container.mux(packet)
+        else:
+            self._cv.write(image)
+        self.n_frames += 1
+
+    def close(self) -> Path:
+        """Finish the file and move it to `path`; return `path`.
+
+        Raises
+        ------
+        OSError
+            No frame was written.
+        """
+        try:
+            self._finish()
+        except BaseException as exc:
+            self._stack.__exit__(type(exc), exc, exc.__traceback__)
+            raise
+        self._stack.close()
+        return self.path
+
+    def _finish(self) -> None:
+        if self._stream is not None:
+            for packet in self._stream.encode(None):
+                self._container.mux(packet)
+            self._stream = None
+        if self._container is not None:
+            self._container.close()
+            self._container = None
+        if self._cv is not None:
+            self._cv.release()
+            self._cv = None
+
+    def abort(self) -> None:
+        """Stop and delete the partial file; an earlier file at `path` stays as it was."""
+        with contextlib.suppress(Exception):
+            self._stream = None
+            if self._container is not None:
+                self._container.close()
+            if self._cv is not None:
+                self._cv.release()
+        self._container = self._cv = None
+        error = RuntimeError("video aborted")
+        self._stack.__exit__(RuntimeError, error, None)
+
+    def __enter__(self) -> VideoWriter:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()

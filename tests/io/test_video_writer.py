@@ -1,0 +1,139 @@
+"""Video output: H.264 MP4 that browsers play (PyAV), OpenCV as the fallback, atomically."""
+
+from __future__ import annotations
+
+import os
+import stat
+from collections.abc import Iterator
+from fractions import Fraction
+from pathlib import Path
+from typing import NamedTuple
+
+import av
+import cv2
+import numpy as np
+import pytest
+
+from pftrack.io import video_writer
+from pftrack.io.video_writer import VideoWriter
+
+
+def _frames(n: int, h: int = 21, w: int = 33) -> list[np.ndarray]:
+    """Smooth gradients that move: frame k is recognisable after lossy coding."""
+    y, x = np.mgrid[0:h, 0:w]
+    return [
+        np.stack([(4 * x + 10 * k) % 256, (6 * y) % 256, np.full_like(x, 12 * k % 256)], -1)
+        .astype(np.uint8)
+        for k in range(n)
+    ]  # fmt: skip
+
+
+class Info(NamedTuple):
+    codec: str
+    pix_fmt: str
+    average_rate: Fraction | None
+
+
+def _decode(path: Path) -> tuple[Info, list[np.ndarray]]:
+    """The video's codec, pixel format and rate, and its frames decoded (BGR)."""
+    with av.open(str(path)) as container:
+        stream = container.streams.video[0]
+        frames = [f.to_ndarray(format="bgr24") for f in container.decode(stream)]
+        ctx = stream.codec_context
+        info = Info(ctx.name, ctx.pix_fmt, stream.average_rate)
+    return info, frames
+
+
+@pytest.fixture
+def umask() -> Iterator[int]:
+    old = os.umask(0o027)
+    yield 0o027
+    os.umask(old)
+
+
+def test_mp4_is_h264_yuv420p_at_the_given_rate(tmp_path: Path) -> None:
+    frames = _frames(23)
+    with VideoWriter(tmp_path / "v.mp4", 7) as writer:
+        for f in frames:
+            writer.write(f)
+    assert (writer.backend, writer.codec, writer.n_frames) == ("pyav", "h264", 23)
+    stream, got = _decode(tmp_path / "v.mp4")
+    assert stream.codec == "h264"
+    assert stream.pix_fmt == "yuv420p"
+    assert stream.average_rate == 7
+    assert len(got) == 23
+    assert got[0].shape == (22, 34, 3)  # odd 33x21 padded to even: yuv420p needs it
+    for a, b in zip(got, frames, strict=True):
+        assert np.abs(a[:21, :33].astype(int) - b).mean() < 6
+    data = (tmp_path / "v.mp4").read_bytes()
+    assert 0 < data.find(b"moov") < data.find(b"mdat")  # faststart: the index comes first
+
+
+def test_ntsc_rate_is_kept_exactly(tmp_path: Path) -> None:
+    with VideoWriter(tmp_path / "v.mp4", 30000 / 1001) as writer:
+        for f in _frames(5):
+            writer.write(f)
+    stream, got = _decode(tmp_path / "v.mp4")
+    assert stream.average_rate == Fraction(30000, 1001) and len(got) == 5
+
+
+def test_opencv_fallback_when_pyav_is_missing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(video_writer, "pyav_available", lambda: False)
+    with VideoWriter(tmp_path / "v.mp4", 7) as writer:
+        for f in _frames(9):
+            writer.write(f)
+    assert writer.backend == "opencv"
+    cap = cv2.VideoCapture(str(tmp_path / "v.mp4"))
+    n = 0
+    while cap.read()[0]:
+        n += 1
+    assert n == 9 and cap.get(cv2.CAP_PROP_FPS) == pytest.approx(7)
+    cap.release()
+
+
+def test_avi_is_mjpeg_through_opencv(tmp_path: Path) -> None:
+    with VideoWriter(tmp_path / "v.avi", 10) as writer:
+        for f in _frames(4):
+            writer.write(f)
+    assert (writer.backend, writer.codec) == ("opencv", "mjpeg")
+    stream, got = _decode(tmp_path / "v.avi")
+    assert stream.codec == "mjpeg" and len(got) == 4
+
+
+def test_a_failure_keeps_the_old_file_and_leaves_nothing(tmp_path: Path) -> None:
+    target = tmp_path / "v.mp4"
+    target.write_bytes(b"old")
+    frames = _frames(3)
+    with pytest.raises(ValueError, match="the video 33x21"), VideoWriter(target, 7) as writer:
+        writer.write(frames[0])
+        writer.write(frames[1][:10])  # another size
+    assert target.read_bytes() == b"old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["v.mp4"]
+
+
+def test_output_keeps_the_umask(tmp_path: Path, umask: int) -> None:
+    for name in ("v.mp4", "v.avi"):
+        with VideoWriter(tmp_path / name, 7) as writer:
+            writer.write(_frames(1)[0])
+        assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o666 & ~umask
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"path": "v.mkv", "fps": 7}, "unsupported extension '.mkv'"),
+        ({"path": "v.mp4", "fps": 0}, "frame rate is 0"),
+        ({"path": "v.mp4", "fps": float("nan")}, "frame rate is nan"),
+        ({"path": "v.avi", "fps": 7, "backend": "pyav"}, "writes .mp4"),
+        ({"path": "v.mp4", "fps": 7, "backend": "gst"}, "backend is 'gst'"),
+    ],
+)
+def test_bad_arguments_are_one_clear_error(
+    tmp_path: Path, kwargs: dict[str, object], message: str
+) -> None:
+    kwargs = {**kwargs, "path": tmp_path / str(kwargs["path"])}
+    with pytest.raises(ValueError, match=message):
+        VideoWriter(**kwargs)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,240 @@
+"""``pftrack track`` inputs and outputs: sequences, live streams, Ctrl-C, --render, help."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import stat
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import av
+import cv2
+import pytest
+
+from pftrack import _progress
+from pftrack.cli import build_parser, main
+from pftrack.eval import evaluate_mot
+from pftrack.io.mot import read_mot, write_mot
+from pftrack.synthetic import Scene, make_scene
+from tests.io.streaming import serve_stream
+
+
+@pytest.fixture(scope="module")
+def scene() -> Scene:
+    return make_scene(n_frames=60, rng=0)
+
+
+@pytest.fixture(scope="module")
+def sequence(scene: Scene, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A MOTChallenge sequence folder: unpadded images, seqinfo.ini at 7 fps, det/det.txt."""
+    seq = tmp_path_factory.mktemp("seq") / "SYN-01"
+    (seq / "img1").mkdir(parents=True)
+    for k, frame in enumerate(scene.frames, start=1):
+        cv2.imwrite(str(seq / "img1" / f"{k}.png"), frame)
+    (seq / "seqinfo.ini").write_text(
+        f"[Sequence]\nname=SYN-01\nimDir=img1\nframeRate=7\nseqLength={len(scene.frames)}\n"
+        f"imWidth={scene.width}\nimHeight={scene.height}\nimExt=.png\n"
+    )
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 1.0
+    (seq / "det").mkdir()
+    write_mot(seq / "det" / "det.txt", det)
+    return seq
+
+
+@pytest.fixture
+def umask() -> Iterator[int]:
+    old = os.umask(0o027)
+    yield 0o027
+    os.umask(old)
+
+
+def _video_info(path: Path) -> tuple[str, str, float, int]:
+    with av.open(str(path)) as container:
+        stream = container.streams.video[0]
+        n = sum(1 for _ in container.decode(stream))
+        ctx = stream.codec_context
+        return ctx.name, ctx.pix_fmt, float(stream.average_rate or 0), n
+
+
+def test_sequence_folder_with_auto_detections_renders_at_its_rate(
+    sequence: Path, scene: Scene, tmp_path: Path, umask: int, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out, video, plot = tmp_path / "t.txt", tmp_path / "r.mp4", tmp_path / "p.png"
+    argv = ["track", str(sequence), "--detections", "auto", "--out", str(out),
+            "--render", str(video), "--plot", str(plot)]  # fmt: skip
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "7 fps from seqinfo.ini" in text
+    m = evaluate_mot(scene.truth, read_mot(out))
+    assert m.mota > 0.8 and m.idf1 > 0.8
+    assert _video_info(video) == ("h264", "yuv420p", 7.0, 60)
+    assert cv2.imread(str(plot)).shape == (scene.height, scene.width, 3)
+    for path in (out, video, plot):  # every output keeps the user's umask
+        assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~umask, path.name
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.png", "r.mp4", "t.txt"]
+
+
+def test_fps_overrides_seqinfo(sequence: Path, tmp_path: Path) -> None:
+    video = tmp_path / "r.mp4"
+    argv = ["track", str(sequence), "--detections", "auto", "--out", str(tmp_path / "t.txt"),
+            "--render", str(video), "--fps", "12.5", "--no-link"]  # fmt: skip
+    assert main(argv) == 0
+    assert _video_info(video)[2:] == (12.5, 60)
+
+
+def test_sequence_detections_in_seqinfo_pixels_are_scaled(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Like PETS09 (boxes in 768x576, video 480x360): seqinfo.ini's imWidth sets the scale."""
+    seq = tmp_path / "BIG"
+    (seq / "det").mkdir(parents=True)
+    (seq / "img1").symlink_to(sequence / "img1")
+    (seq / "seqinfo.ini").write_text(f"[Sequence]\nframeRate=7\nimWidth={2 * scene.width}\n")
+    det = read_mot(sequence / "det" / "det.txt")
+    det[:, 2:6] *= 2
+    write_mot(seq / "det" / "det.txt", det)
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 0
+    assert "detections scaled by 0.5" in capsys.readouterr().out
+    assert evaluate_mot(scene.truth, read_mot(out)).mota > 0.8
+    # --det-scale wins: 1 leaves the boxes too large; they are clipped, and the tracker says so
+    argv = ["track", str(seq), "--detections", "auto", "--det-scale", "1", "--out", str(out)]
+    assert main(argv) == 0
+    assert "outside" in capsys.readouterr().err
+
+
+def test_auto_detections_need_a_sequence(
+    scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    video = scene.write_video(tmp_path / "v.avi")
+    assert main(["track", str(video), "--detections", "auto", "--out", str(tmp_path / "t")]) == 2
+    err = capsys.readouterr().err
+    assert "--detections auto" in err and "det/det.txt" in err
+
+
+def test_ctrl_c_on_a_file_aborts_and_keeps_the_old_outputs(
+    sequence: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    out, video = tmp_path / "t.txt", tmp_path / "r.mp4"
+    out.write_text("keep\n")
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("pftrack.tracking.track_frames", interrupted)
+    argv = ["track", str(sequence), "--out", str(out), "--render", str(video)]
+    assert main(argv) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert out.read_text() == "keep\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]  # no partial video
+
+
+def _rows(path: Path) -> int:
+    try:
+        return sum(1 for line in path.read_text().splitlines() if line.strip())
+    except FileNotFoundError:
+        return 0
+
+
+def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
+    tmp_path: Path,
+) -> None:
+    """A stream served over HTTP as a camera would; pftrack tracks it in another process."""
+    scene = make_scene(n_frames=200, rng=0)
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 1.0
+    write_mot(tmp_path / "det.txt", det)
+    out, video = tmp_path / "live.txt", tmp_path / "live.mp4"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    with serve_stream(scene.frames, pace=0.05) as server:  # 10 s of video
+        argv = [sys.executable, "-m", "pftrack.cli", "track", server.url, "--out", str(out),
+                "--detections", str(tmp_path / "det.txt"), "--render", str(video),
+                "--fps", "25"]  # fmt: skip
+        proc = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        try:
+            deadline = time.monotonic() + 60
+            while _rows(out) < 20 and time.monotonic() < deadline and proc.poll() is None:
+                time.sleep(0.1)
+            assert _rows(out) >= 20, proc.stderr.read().decode() if proc.poll() else "no rows"
+            assert server.sent < len(scene.frames)  # rows came while the stream went on
+            proc.send_signal(signal.SIGINT)
+            stdout, stderr = proc.communicate(timeout=60)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    assert proc.returncode == 0, stderr.decode()
+    text = stdout.decode()
+    assert "stopped by Ctrl-C" in text
+    n_frames = int(text.split(" frames")[0])
+    assert 0 < n_frames < len(scene.frames)
+    rows = read_mot(out)  # the finished tracks: linked and smoothed, sorted
+    assert rows[:, 0].max() <= n_frames
+    truth = scene.truth[scene.truth[:, 0] <= n_frames]
+    assert evaluate_mot(truth, rows).mota > 0.7
+    assert _video_info(video) == ("h264", "yuv420p", 25.0, n_frames)
+    mask = os.umask(0)
+    os.umask(mask)
+    for path in (out, video):
+        assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask, path.name
+
+
+def test_quiet_silences_the_progress_bar(
+    sequence: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    monkeypatch.setattr(_progress, "_quiet", False)
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # as on a terminal
+    argv = ["track", str(sequence), "--detections", "auto", "--out", str(tmp_path / "t.txt")]
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "tracking" in err and "60/60" in err and "frame/s" in err  # tqdm: count, rate
+    assert main(["--quiet", *argv]) == 0
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(_progress, "_quiet", False)
+    assert main([*argv, "-q"]) == 0  # after the command too
+    assert capsys.readouterr().err == ""
+
+
+def _actions(
+    parser: argparse.ArgumentParser, name: str = "pftrack"
+) -> Iterator[tuple[str, argparse.Action, argparse.HelpFormatter]]:
+    """(command, option, its help formatter) for every option of every (sub-)command."""
+    formatter = parser._get_formatter()
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub_name, sub in action.choices.items():
+                yield from _actions(sub, f"{name} {sub_name}")
+        elif action.option_strings:
+            yield name, action, formatter
+
+
+def test_every_option_shows_its_default(capsys: pytest.CaptureFixture[str]) -> None:
+    """Flags (off unless given) and required options aside, each option's help names a default."""
+    missing, checked = [], 0
+    for command, action, formatter in _actions(build_parser()):
+        if action.nargs == 0 or action.required:
+            continue
+        checked += 1
+        text = formatter._get_help_string(action) or ""
+        if "default" not in text:
+            missing.append(f"{command} {action.option_strings[-1]}: {text}")
+    assert not missing, "\n".join(missing)
+    assert checked >= 35
+    with pytest.raises(SystemExit):
+        main(["recover", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "recovery method (default: auto)" in text and "(default: 30)" in text
+    assert "--link join fragments of one object first --max-distance" in text  # flags: no noise

@@ -1,0 +1,55 @@
+"""Progress bars: tqdm's rate and time left on a terminal, nothing otherwise or when quiet."""
+
+from __future__ import annotations
+
+import io
+import sys
+
+import pytest
+
+from pftrack import _progress
+from pftrack._progress import progress, set_quiet
+
+
+@pytest.fixture(autouse=True)
+def loud(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(_progress, "_quiet", False)
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+
+
+def _run(monkeypatch: pytest.MonkeyPatch, tty: bool, **kwargs: object) -> tuple[list[int], str]:
+    err = io.StringIO()
+    err.isatty = lambda: tty  # type: ignore[method-assign]
+    monkeypatch.setattr(sys, "stderr", err)
+    got = list(progress(range(50), desc="work", unit="gap", **kwargs))  # type: ignore[arg-type]
+    return got, err.getvalue()
+
+
+def test_bar_shows_count_rate_and_time_left_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
+    got, text = _run(monkeypatch, tty=True)
+    assert got == list(range(50))
+    assert "work" in text and "50/50" in text and "gap/s" in text and "<" in text  # ETA
+
+
+def test_silent_when_not_a_terminal_or_quiet(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert _run(monkeypatch, tty=False) == (list(range(50)), "")
+    set_quiet(True)
+    assert _run(monkeypatch, tty=True) == (list(range(50)), "")
+    assert _run(monkeypatch, tty=True, enable=True)[1] == ""  # quiet wins over enable
+    set_quiet(False)
+    assert "50/50" in _run(monkeypatch, tty=False, enable=True)[1]
+
+
+def test_a_quick_loop_draws_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(_progress, "DELAY", 10.0)
+    assert _run(monkeypatch, tty=True)[1] == ""
+
+
+def test_total_defaults_to_the_length(monkeypatch: pytest.MonkeyPatch) -> None:
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    assert list(progress([1, 2, 3], enable=True)) == [1, 2, 3]
+    assert "3/3" in err.getvalue()
+    err.truncate(0)
+    assert list(progress(iter([1, 2, 3]), enable=True)) == [1, 2, 3]
+    assert "3it" in err.getvalue()  # unknown total: the count alone

@@ -1,0 +1,90 @@
+"""Annotated video: drawn while tracking, on a worker thread, with trails."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+from typing import NamedTuple
+
+import av
+import numpy as np
+import pytest
+
+from pftrack.render import TrackRenderer, colour_of, write_annotated_video
+
+
+@dataclass(frozen=True)
+class FakeTrack:
+    id: int
+    box_xywh: np.ndarray
+    time_since_update: int = 0
+
+
+def _walk(n: int) -> list[list[FakeTrack]]:
+    """One object walking right, 4 px a frame, from (10, 20)."""
+    return [[FakeTrack(5, np.array([10.0 + 4 * k, 20.0, 12.0, 30.0]))] for k in range(n)]
+
+
+class Info(NamedTuple):
+    codec: str
+    pix_fmt: str
+    average_rate: Fraction | None
+
+
+def _decode(path: Path) -> tuple[Info, list[np.ndarray]]:
+    """The video's codec, pixel format and rate, and its frames decoded (BGR)."""
+    with av.open(str(path)) as container:
+        stream = container.streams.video[0]
+        frames = [f.to_ndarray(format="bgr24") for f in container.decode(stream)]
+        ctx = stream.codec_context
+        info = Info(ctx.name, ctx.pix_fmt, stream.average_rate)
+    return info, frames
+
+
+def _render(path: Path, threaded: bool, n: int = 20) -> Path:
+    renderer = TrackRenderer(path, 7, threaded=threaded, trail=40)
+    for tracks in _walk(n):
+        renderer.add(np.full((80, 120, 3), 40, np.uint8), tracks)
+    return renderer.close()
+
+
+def test_threaded_rendering_equals_drawing_in_line(tmp_path: Path) -> None:
+    a = _render(tmp_path / "a.mp4", threaded=True)
+    b = _render(tmp_path / "b.mp4", threaded=False)
+    stream, fa = _decode(a)
+    _, fb = _decode(b)
+    assert (stream.codec, stream.pix_fmt) == ("h264", "yuv420p")
+    assert stream.average_rate == 7 and len(fa) == len(fb) == 20
+    for x, y in zip(fa, fb, strict=True):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_the_trail_follows_the_foot_points(tmp_path: Path) -> None:
+    _, frames = _decode(_render(tmp_path / "a.mp4", threaded=True))
+    last = frames[-1].astype(int)
+    colour = np.array(colour_of(5))
+    # foot points run along y = 50 from x = 16 to 16 + 4 * 19 = 92; the box (x >= 86) aside,
+    # the trail is there on the last frame and was not on the first
+    row = last[50, 20:80]
+    assert np.abs(row - colour).sum(axis=1).max() < 120
+    assert np.abs(frames[0][50, 30:80].astype(int) - 40).max() < 10  # the first box ends at 22
+
+
+def test_a_worker_error_surfaces_and_leaves_no_file(tmp_path: Path) -> None:
+    renderer = TrackRenderer(tmp_path / "a.mp4", 7)
+    renderer.add(np.zeros((40, 60, 3), np.uint8), [])
+    renderer.add(np.zeros((30, 60, 3), np.uint8), [])  # another size: the encoder refuses it
+    with pytest.raises(ValueError, match="the video 60x40"):
+        renderer.close()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_annotated_video_from_rows(tmp_path: Path) -> None:
+    rows = np.array([[k, 3, 10 + 2 * k, 10, 8, 16, 1, -1, -1, -1] for k in range(1, 11)], float)
+    frames = [np.zeros((48, 64, 3), np.uint8) for _ in range(10)]
+    stream, got = _decode(write_annotated_video(tmp_path / "v.mp4", frames, rows, fps=12.5))
+    assert stream.average_rate == 12.5 and len(got) == 10
+    # foot points along y = 26 from x = 16 to 34; the last box spans x 30..38
+    assert got[-1][26, 17:28].max(axis=1).min() > 100
+    assert got[0][26, 22:28].max() < 30
