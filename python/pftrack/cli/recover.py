@@ -48,7 +48,10 @@ def run(args: argparse.Namespace) -> int:
 
     src = Path(args.tracks)
     rows = read_mot(src, what="tracks file")
-    check_unique(rows, data_line_numbers(src))
+    try:
+        check_unique(rows)
+    except ValueError:  # name the lines (reading the file again costs time: only on error)
+        check_unique(rows, data_line_numbers(src))
     out = Path(args.out)
     if out.exists() and os.path.samefile(out, src) and not args.in_place:
         raise ValueError(

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pftrack._typing import F64
-from pftrack.recovery.baselines import BASELINES
+from pftrack.recovery.baselines import BASELINES, rts_batch
 from pftrack.recovery.gdt import GdtModel
 from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
@@ -42,18 +42,23 @@ __all__ = [
 ]
 
 #: Methods scored by the calibration (``"gdt-fixed"``: two-sided goal, the paper's fixed noise).
-CANDIDATES = ("linear", "bspline", "rts", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
+CANDIDATES = ("linear", "rts", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
 #: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
 LINEAR_MARGIN = 0.01
 #: At most this many artificial gaps per file, over all buckets.
-MAX_CALIBRATION_GAPS = 200
-#: Fewer validation gaps than this in a bucket: the bucket falls back to ``"linear"``.
+MAX_CALIBRATION_GAPS = 400
+#: Fewer validation gaps than this in a bucket: the bucket takes the file's pooled choice.
 MIN_VALIDATION_GAPS = 5
+#: A method replaces the reference (linear for the file, the file's choice for a bucket) only
+#: if its mean paired validation error is lower by more than this many standard errors.
+PAIRED_Z = 2.0
 #: Observed points kept on each side of an artificial gap, at least.
 CONTEXT = 3
+#: Random places drawn per artificial gap; the one nearest the real gap's speed is kept.
+MATCH_DRAWS = 16
 #: Noise levels and the motion model of ``"auto"`` are fitted to at most about this many
 #: observed points (whole runs, drawn with the calibration's seed), so big files stay fast.
-MAX_FIT_POINTS = 5000
+MAX_FIT_POINTS = 1000
 
 
 def bucket_of(length: int) -> int:
@@ -93,17 +98,28 @@ class BucketChoice:
 
 @dataclass(frozen=True)
 class Calibration:
-    """What ``"auto"`` chose for one file: one :class:`BucketChoice` per gap-length bucket."""
+    """What ``"auto"`` chose for one file.
+
+    Attributes
+    ----------
+    buckets : tuple of BucketChoice
+        One per gap-length bucket.
+    pooled : str
+        The file's choice (every bucket's validation gaps, weighted by its real gaps): used by
+        buckets without enough validation gaps, and kept by the others unless their own best
+        beats it by a paired test.
+    """
 
     buckets: tuple[BucketChoice, ...]
+    pooled: str = "linear"
 
     def method_for(self, length: int) -> str:
-        """The method chosen for a gap of `length` missing frames (``"linear"`` if unseen)."""
+        """The method chosen for a gap of `length` missing frames (:attr:`pooled` if unseen)."""
         lo_hi = _bucket_range(bucket_of(length))
         for c in self.buckets:
             if c.lengths == lo_hi:
                 return c.method
-        return "linear"
+        return self.pooled
 
     def describe(self) -> str:
         """A table: per bucket, the chosen method, each candidate's validation MMAE, counts."""
@@ -112,7 +128,11 @@ class Calibration:
         names = [m for m, _ in next((c.mmae for c in self.buckets if c.mmae), ())]
         head = f"{'gap length':<12}{'gaps':>6}{'val.':>6}  {'chosen':<10}"
         head += "".join(f"{m:>11}" for m in names)
-        lines = ["auto: validation MMAE (px) on artificial gaps cut into observed runs", head]
+        lines = [
+            "auto: validation MMAE (px) on artificial gaps cut into observed runs; file's "
+            f"choice {self.pooled}",
+            head,
+        ]
         for c in self.buckets:
             lo, hi = c.lengths
             span = f"{lo}" if lo == hi else f"{lo}-{hi}"
@@ -153,6 +173,8 @@ def recover_with(
             ends_b[:, 1:3], n, axis=0
         )
         return np.split(xy, np.cumsum(n)[:-1])
+    if method == "rts":
+        return rts_batch(pairs)
     if method in BASELINES:
         out = []
         for a, b in pairs:
@@ -204,28 +226,48 @@ def _fit_sample(runs: Sequence[F64], seed: int) -> list[F64]:
 
 
 def _artificial_gaps(
-    runs: Sequence[F64], lengths: Sequence[int], n: int, rng: np.random.Generator
+    runs: Sequence[F64],
+    targets: Sequence[tuple[int, float]],
+    n: int,
+    rng: np.random.Generator,
 ) -> list[tuple[F64, F64, F64]]:
-    """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` with lengths from `lengths`."""
+    """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` matched to `targets`.
+
+    Each target is a real gap's ``(missing frames, distance between its two end points)``.
+    Targets are taken in turn (shuffled); for each, :data:`MATCH_DRAWS` random places of that
+    length are drawn from the runs and the one whose end-point distance is nearest the
+    target's (in log scale) is kept, so the validation gaps have the real gaps' lengths and
+    speeds.
+    """
     sizes = np.array([len(r) for r in runs], dtype=np.int64)
     out: list[tuple[F64, F64, F64]] = []
     used: set[tuple[int, int, int]] = set()
-    for _ in range(4 * n):
-        if len(out) >= n:
+    order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
+    for attempt in range(4 * n):
+        if len(out) >= n or not len(order):
             break
-        L = int(lengths[int(rng.integers(len(lengths)))])
+        L, dist = targets[int(order[attempt % len(order)])]
         slots = np.maximum(sizes - L - 2 * CONTEXT + 1, 0)
-        total = int(slots.sum())
+        cum = np.cumsum(slots)
+        total = int(cum[-1]) if len(cum) else 0
         if total == 0:
             continue
-        k = int(rng.integers(total))
-        i = int(np.searchsorted(np.cumsum(slots), k, side="right"))
-        s = CONTEXT + k - int(np.cumsum(slots)[i] - slots[i])
-        if (i, s, L) in used:
+        ks = rng.integers(total, size=MATCH_DRAWS)
+        idx = np.searchsorted(cum, ks, side="right")
+        starts = CONTEXT + ks - (cum[idx] - slots[idx])
+        j = 0
+        if dist >= 0:
+            d = [
+                np.hypot(*(runs[i][s + L, 1:3] - runs[i][s - 1, 1:3]))
+                for i, s in zip(idx, starts, strict=True)
+            ]
+            j = int(np.argmin(np.abs(np.log1p(d) - np.log1p(dist))))
+        i, st = int(idx[j]), int(starts[j])
+        if (i, st, L) in used:
             continue
-        used.add((i, s, L))
+        used.add((i, st, L))
         r = runs[i]
-        out.append((r[:s], r[s + L :], r[s : s + L]))
+        out.append((r[:st], r[st + L :], r[st : st + L]))
     return out
 
 
@@ -238,6 +280,7 @@ def calibrate(
     candidates: Sequence[str] = CANDIDATES,
     max_gaps: int = MAX_CALIBRATION_GAPS,
     seed: int = 0,
+    spans: Sequence[float] | None = None,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -256,6 +299,9 @@ def calibrate(
         At most this many artificial gaps in all (>= 1).
     seed : int
         Seed of the generator that places the artificial gaps.
+    spans : sequence of float, optional
+        Distance (px) between the two end points of each gap in `gap_lengths`: artificial
+        gaps are matched to it (default: no matching, any place of the right length).
 
     Returns
     -------
@@ -275,9 +321,14 @@ def calibrate(
         if m not in CANDIDATES:
             raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
     names = tuple(m for m in CANDIDATES if m in candidates or m == "linear")
+    dists = [-1.0] * len(lengths) if spans is None else [float(v) for v in spans]
+    if len(dists) != len(lengths):
+        raise ValueError(f"calibrate: {len(dists)} spans for {len(lengths)} gap lengths")
     by_bucket: dict[int, list[int]] = {}
-    for v in lengths:
+    targets: dict[int, list[tuple[int, float]]] = {}
+    for v, dv in zip(lengths, dists, strict=True):
         by_bucket.setdefault(bucket_of(v), []).append(v)
+        targets.setdefault(bucket_of(v), []).append((v, dv))
     if not by_bucket:
         return Calibration(())
     runs = _observed_runs(observed)
@@ -287,28 +338,82 @@ def calibrate(
     if motion is None and "gdt-mix" in names and whole:
         motion = fit_motion(whole, noise)
     per_bucket = max(MIN_VALIDATION_GAPS, max_gaps // len(by_bucket))
-    choices = []
+    scored = [
+        m
+        for m in names
+        if m not in ("gdt-bi", "gdt-mix") or (noise is not None and motion is not None)
+    ]
+    errors: dict[int, dict[str, F64]] = {}
+    n_cut: dict[int, int] = {}
     for b in sorted(by_bucket):
         rng = np.random.default_rng([seed, b])
-        cut = _artificial_gaps(runs, by_bucket[b], per_bucket, rng)
+        cut = _artificial_gaps(runs, targets[b], per_bucket, rng)
+        n_cut[b] = len(cut)
+        if len(cut) < MIN_VALIDATION_GAPS:
+            continue
+        pairs = [(a, c) for a, c, _ in cut]
+        errors[b] = {}
+        for m in scored:
+            paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
+            errors[b][m] = np.array(
+                [
+                    np.mean(np.hypot(*(p - t[:, 1:3]).T))
+                    for p, (_, _, t) in zip(paths, cut, strict=True)
+                ]
+            )
+    weights = {b: len(by_bucket[b]) for b in errors}
+    pooled = _pooled_choice(errors, weights, scored)
+    choices = []
+    for b in sorted(by_bucket):
         mmae: tuple[tuple[str, float], ...] = ()
-        method = "linear"
-        if len(cut) >= MIN_VALIDATION_GAPS:
-            pairs = [(a, c) for a, c, _ in cut]
-            scores = []
-            for m in names:
-                if m in ("gdt-bi", "gdt-mix") and (noise is None or motion is None):
-                    continue
-                paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
-                err = [float(np.mean(np.hypot(*(p - t[:, 1:3]).T))) for p, (_, _, t) in
-                       zip(paths, cut, strict=True)]  # fmt: skip
-                scores.append((m, float(np.mean(err))))
-            mmae = tuple(scores)
-            best_m, best = min(scores, key=lambda s: s[1])
-            lin = dict(scores)["linear"]
-            method = "linear" if lin <= (1.0 + LINEAR_MARGIN) * best else best_m
-        choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), len(cut), mmae))
-    return Calibration(tuple(choices))
+        method = pooled
+        if b in errors:
+            e = errors[b]
+            mmae = tuple((m, float(e[m].mean())) for m in scored)
+            best = min(scored, key=lambda m: float(e[m].mean()))
+            if best != pooled and _better(e[best], e[pooled]):
+                method = best
+        choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), n_cut[b], mmae))
+    return Calibration(tuple(choices), pooled)
+
+
+def _better(cand: F64, ref: F64) -> bool:
+    """`cand` beats `ref` on the same validation gaps: a paired test and the margin."""
+    d = cand - ref
+    se = float(np.std(d, ddof=1)) / np.sqrt(len(d)) if len(d) > 1 else np.inf
+    mean = float(d.mean())
+    return mean < -PAIRED_Z * se and mean < -LINEAR_MARGIN * float(ref.mean())
+
+
+def _pooled_choice(
+    errors: dict[int, dict[str, F64]], weights: dict[int, int], names: Sequence[str]
+) -> str:
+    """The file's method: validation MMAE of every bucket weighted by its real gaps.
+
+    ``"linear"`` unless the best beats it by :data:`LINEAR_MARGIN` and :data:`PAIRED_Z`
+    standard errors of the weighted paired difference.
+    """
+    if not errors:
+        return "linear"
+    total = float(sum(weights.values()))
+    w = {b: weights[b] / total for b in errors}
+
+    def score(m: str) -> float:
+        return sum(w[b] * float(errors[b][m].mean()) for b in errors)
+
+    best = min(names, key=score)
+    if best == "linear":
+        return "linear"
+    diff = sum(w[b] * float((errors[b][best] - errors[b]["linear"]).mean()) for b in errors)
+    var = sum(
+        w[b] ** 2
+        * float(np.var(errors[b][best] - errors[b]["linear"], ddof=1))
+        / len(errors[b][best])
+        for b in errors
+    )
+    if diff < -PAIRED_Z * np.sqrt(var) and diff < -LINEAR_MARGIN * score("linear"):
+        return best
+    return "linear"
 
 
 # Placeholders that are never used (the methods needing them are skipped without them).
@@ -370,7 +475,16 @@ def recover_auto(
         noise = estimate_noise(runs) if runs else _NO_NOISE
     if motion is None and runs:
         motion = fit_motion(runs, noise)
-    cal = calibrate(observed, [v for v in lengths if v > 0], noise, motion, seed=seed)
+    spans = [float(np.hypot(*(b[0, 1:3] - a[-1, 1:3]))) for a, b in checked]
+    keep = [k for k, v in enumerate(lengths) if v > 0]
+    cal = calibrate(
+        observed,
+        [lengths[k] for k in keep],
+        noise,
+        motion,
+        seed=seed,
+        spans=[spans[k] for k in keep],
+    )
     paths: list[F64 | None] = [None] * len(checked)
     groups: dict[str, list[int]] = {}
     for k, L in enumerate(lengths):

@@ -83,11 +83,12 @@ def _end_velocity(c: F64, k: int, tail: bool) -> F64:
 
 def split_tracks(rows: F64) -> dict[int, F64]:
     """Rows of each id, sorted by frame."""
-    out: dict[int, F64] = {}
-    for tid in np.unique(rows[:, 1]).astype(np.int64):
-        r = rows[rows[:, 1] == tid]
-        out[int(tid)] = r[np.argsort(r[:, 0], kind="stable")]
-    return out
+    if len(rows) == 0:
+        return {}
+    r = rows[np.lexsort((rows[:, 0], rows[:, 1]))]  # by id, then frame (stable)
+    starts = np.flatnonzero(np.r_[True, r[1:, 1] != r[:-1, 1]])
+    ends = np.r_[starts[1:], len(r)]
+    return {int(r[i, 1]): r[i:j] for i, j in zip(starts, ends, strict=True)}
 
 
 class _Histograms:
