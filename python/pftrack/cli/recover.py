@@ -78,7 +78,11 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.explain:
         if rep.calibration is not None:
+            print("box centres (x, y):")
             print(rep.calibration.describe())
+        if rep.size_calibration is not None:
+            print("box sizes (w, h):")
+            print(rep.size_calibration.describe())
         elif args.method == "auto":
             print("auto: no gap to fill")
         else:

@@ -341,7 +341,7 @@ def calibrate(
     scored = [
         m
         for m in names
-        if m not in ("gdt-bi", "gdt-mix") or (noise is not None and motion is not None)
+        if (m != "gdt-bi" or noise is not None) and (m != "gdt-mix" or motion is not None)
     ]
     errors: dict[int, dict[str, F64]] = {}
     n_cut: dict[int, int] = {}
@@ -428,6 +428,7 @@ def recover_auto(
     motion: MotionFit | None = None,
     *,
     seed: int = 0,
+    candidates: Sequence[str] = CANDIDATES,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -442,6 +443,9 @@ def recover_auto(
         about :data:`MAX_FIT_POINTS` points of them).
     seed : int
         Seed of the calibration.
+    candidates : sequence of str
+        Methods scored (some of :data:`CANDIDATES`; ``"linear"`` is always added). Without
+        ``"gdt-mix"`` no motion model is fitted (box sizes use ``linear, rts, gdt-bi``).
 
     Returns
     -------
@@ -473,7 +477,7 @@ def recover_auto(
     runs = _fit_sample([r for r in _observed_runs(observed) if len(r) >= 4], seed)
     if noise is None:
         noise = estimate_noise(runs) if runs else _NO_NOISE
-    if motion is None and runs:
+    if motion is None and runs and "gdt-mix" in candidates:
         motion = fit_motion(runs, noise)
     spans = [float(np.hypot(*(b[0, 1:3] - a[-1, 1:3]))) for a, b in checked]
     keep = [k for k, v in enumerate(lengths) if v > 0]
@@ -484,6 +488,7 @@ def recover_auto(
         motion,
         seed=seed,
         spans=[spans[k] for k in keep],
+        candidates=candidates,
     )
     paths: list[F64 | None] = [None] * len(checked)
     groups: dict[str, list[int]] = {}
