@@ -222,10 +222,10 @@ def check_rows(rows: object, what: str) -> F64:
     Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, and the
     box columns (``left, top, width, height``) finite. `what` names the caller in messages.
     """
-    try:
-        a = np.asarray(rows, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{what}: rows must be a real (M, 10) array") from None
+    raw = np.asarray(rows)
+    if raw.dtype.kind not in "biuf":
+        raise TypeError(f"{what}: rows must be a real (M, 10) array, got dtype {raw.dtype}")
+    a = raw.astype(np.float64)
     if a.ndim != 2 or a.shape[1] != 10:
         raise ValueError(f"{what}: rows must have shape (M, 10), got {a.shape}")
     f, i = a[:, 0], a[:, 1]
