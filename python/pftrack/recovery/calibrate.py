@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, rts_batch
@@ -42,7 +43,7 @@ __all__ = [
 ]
 
 #: Methods scored by the calibration (``"gdt-fixed"``: two-sided goal, the paper's fixed noise).
-CANDIDATES = ("linear", "rts", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
+CANDIDATES = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed")
 #: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
 LINEAR_MARGIN = 0.01
 #: At most this many artificial gaps per file, over all buckets.
@@ -196,18 +197,25 @@ def recover_with(
 
 def _observed_runs(observed: Sequence[F64]) -> list[F64]:
     """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order."""
-    seen: dict[tuple[float, float, float, float, int], F64] = {}
+    arrs = []
     for s in observed:
         a = np.asarray(s, dtype=np.float64)
-        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
-            continue
-        a = a[:, :3]
-        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
-            if len(run) and np.all(np.isfinite(run)):
-                key = (float(run[0, 0]), float(run[0, 1]), float(run[0, 2]), float(run[-1, 0]),
-                       len(run))  # fmt: skip
-                seen.setdefault(key, run)
-    return [seen[k] for k in sorted(seen)]
+        if a.ndim == 2 and a.shape[1] >= 3 and len(a):
+            arrs.append(a[:, :3])
+    if not arrs:
+        return []
+    X = np.vstack(arrs)
+    bound = np.zeros(len(X), dtype=bool)
+    bound[np.cumsum([len(a) for a in arrs])[:-1]] = True
+    brk = np.flatnonzero(bound[1:] | (np.diff(X[:, 0]) != 1)) + 1
+    starts, ends = np.r_[0, brk], np.r_[brk, len(X)]
+    ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
+    starts, ends = starts[ok], ends[ok]
+    if not len(starts):
+        return []
+    keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
+    _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
+    return [X[starts[k] : ends[k]] for k in first]
 
 
 def _fit_sample(runs: Sequence[F64], seed: int) -> list[F64]:
@@ -225,11 +233,20 @@ def _fit_sample(runs: Sequence[F64], seed: int) -> list[F64]:
     return out
 
 
+def _flat(runs: Sequence[F64]) -> tuple[NDArray[np.int64], NDArray[np.int64], F64]:
+    """Lengths and offsets of the runs, and all their ``(x, y)`` stacked."""
+    sizes = np.array([len(r) for r in runs], dtype=np.int64)
+    offset = np.r_[0, np.cumsum(sizes)[:-1]].astype(np.int64)
+    xy = np.vstack([r[:, 1:3] for r in runs]) if runs else np.zeros((0, 2))
+    return sizes, offset, xy
+
+
 def _artificial_gaps(
     runs: Sequence[F64],
     targets: Sequence[tuple[int, float]],
     n: int,
     rng: np.random.Generator,
+    flat: tuple[NDArray[np.int64], NDArray[np.int64], F64] | None = None,
 ) -> list[tuple[F64, F64, F64]]:
     """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` matched to `targets`.
 
@@ -239,7 +256,7 @@ def _artificial_gaps(
     target's (in log scale) is kept, so the validation gaps have the real gaps' lengths and
     speeds.
     """
-    sizes = np.array([len(r) for r in runs], dtype=np.int64)
+    sizes, offset, xy = _flat(runs) if flat is None else flat
     out: list[tuple[F64, F64, F64]] = []
     used: set[tuple[int, int, int]] = set()
     order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
@@ -257,10 +274,8 @@ def _artificial_gaps(
         starts = CONTEXT + ks - (cum[idx] - slots[idx])
         j = 0
         if dist >= 0:
-            d = [
-                np.hypot(*(runs[i][s + L, 1:3] - runs[i][s - 1, 1:3]))
-                for i, s in zip(idx, starts, strict=True)
-            ]
+            at = offset[idx] + starts
+            d = np.hypot(*(xy[at + L] - xy[at - 1]).T)
             j = int(np.argmin(np.abs(np.log1p(d) - np.log1p(dist))))
         i, st = int(idx[j]), int(starts[j])
         if (i, st, L) in used:
@@ -345,22 +360,19 @@ def calibrate(
     ]
     errors: dict[int, dict[str, F64]] = {}
     n_cut: dict[int, int] = {}
+    flat = _flat(runs)
     for b in sorted(by_bucket):
         rng = np.random.default_rng([seed, b])
-        cut = _artificial_gaps(runs, targets[b], per_bucket, rng)
+        cut = _artificial_gaps(runs, targets[b], per_bucket, rng, flat)
         n_cut[b] = len(cut)
         if len(cut) < MIN_VALIDATION_GAPS:
             continue
         pairs = [(a, c) for a, c, _ in cut]
+        truth = [t for _, _, t in cut]
         errors[b] = {}
         for m in scored:
             paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
-            errors[b][m] = np.array(
-                [
-                    np.mean(np.hypot(*(p - t[:, 1:3]).T))
-                    for p, (_, _, t) in zip(paths, cut, strict=True)
-                ]
-            )
+            errors[b][m] = _gap_errors(paths, truth)
     weights = {b: len(by_bucket[b]) for b in errors}
     pooled = _pooled_choice(errors, weights, scored)
     choices = []
@@ -375,6 +387,14 @@ def calibrate(
                 method = best
         choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), n_cut[b], mmae))
     return Calibration(tuple(choices), pooled)
+
+
+def _gap_errors(paths: Sequence[F64], truth: Sequence[F64]) -> F64:
+    """Mean Euclidean error of each gap's path against its truth (rows ``frame, x, y``)."""
+    n = np.array([len(t) for t in truth])
+    d = np.concatenate(paths) - np.concatenate([t[:, 1:3] for t in truth])
+    out: F64 = np.add.reduceat(np.hypot(d[:, 0], d[:, 1]), np.r_[0, np.cumsum(n)[:-1]]) / n
+    return out
 
 
 def _better(cand: F64, ref: F64) -> bool:
@@ -445,7 +465,7 @@ def recover_auto(
         Seed of the calibration.
     candidates : sequence of str
         Methods scored (some of :data:`CANDIDATES`; ``"linear"`` is always added). Without
-        ``"gdt-mix"`` no motion model is fitted (box sizes use ``linear, rts, gdt-bi``).
+        ``"gdt-mix"`` no motion model is fitted, without ``"gdt-bi"`` no noise levels.
 
     Returns
     -------
@@ -474,15 +494,17 @@ def recover_auto(
     if observed is None:
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
-    runs = _fit_sample([r for r in _observed_runs(observed) if len(r) >= 4], seed)
+    all_runs = _observed_runs(observed)
+    runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:
-        noise = estimate_noise(runs) if runs else _NO_NOISE
+        needs = "gdt-bi" in candidates or "gdt-mix" in candidates
+        noise = estimate_noise(runs) if runs and needs else _NO_NOISE
     if motion is None and runs and "gdt-mix" in candidates:
         motion = fit_motion(runs, noise)
     spans = [float(np.hypot(*(b[0, 1:3] - a[-1, 1:3]))) for a, b in checked]
     keep = [k for k, v in enumerate(lengths) if v > 0]
     cal = calibrate(
-        observed,
+        all_runs,
         [lengths[k] for k in keep],
         noise,
         motion,

@@ -42,7 +42,7 @@ DEFAULT_MAX_GAP = 30
 #: Largest `max_gap` accepted: a hole longer than this is never filled (refused, not capped).
 MAX_GAP_LIMIT = 100_000
 #: Methods ``"auto"`` scores for box sizes ``(w, h)``, calibrated like the centres.
-SIZE_CANDIDATES = ("linear", "rts", "gdt-bi")
+SIZE_CANDIDATES = ("linear", "rts")
 
 
 @dataclass(frozen=True)

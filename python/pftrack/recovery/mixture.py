@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -258,12 +258,18 @@ def stand_hypotheses(T: int, grid: int = GRID) -> tuple[NDArray[np.int32], NDArr
     First ``(-1, -1)`` (no stand), then every ``t1 < t2`` on ``min(grid, T)`` evenly spaced
     steps of ``0 .. T-1``.
     """
+    return _stand_hypotheses(int(T), int(grid))
+
+
+@lru_cache(maxsize=1024)
+def _stand_hypotheses(T: int, grid: int) -> tuple[NDArray[np.int32], NDArray[np.int32]]:
     ks = np.unique(np.round(np.linspace(0, T - 1, min(grid, T))).astype(np.int32))
     i, j = np.triu_indices(len(ks), k=1)
-    return (
-        np.concatenate([[-1], ks[i]]).astype(np.int32),
-        np.concatenate([[-1], ks[j]]).astype(np.int32),
-    )
+    t1 = np.concatenate([[-1], ks[i]]).astype(np.int32)
+    t2 = np.concatenate([[-1], ks[j]]).astype(np.int32)
+    t1.setflags(write=False)  # shared by every gap of this length
+    t2.setflags(write=False)
+    return t1, t2
 
 
 def recover_mixture(
