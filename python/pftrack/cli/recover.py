@@ -26,7 +26,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="output file (written atomically)")
     p.add_argument("--method", default=DEFAULT_METHOD, choices=METHODS, help="recovery method")
     p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
-                   help="longest hole filled, in frames")  # fmt: skip
+                   help="longest hole filled, in frames (at most 100000; longer holes stay "
+                   "holes: bounded work)")  # fmt: skip
     p.add_argument("--explain", action="store_true",
                    help="with auto: print the method chosen per gap length and its validation "
                    "MMAE")  # fmt: skip
