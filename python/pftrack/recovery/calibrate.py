@@ -47,7 +47,7 @@ CANDIDATES = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed")
 #: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
 LINEAR_MARGIN = 0.01
 #: At most this many artificial gaps per file, over all buckets.
-MAX_CALIBRATION_GAPS = 400
+MAX_CALIBRATION_GAPS = 300
 #: Fewer validation gaps than this in a bucket: the bucket takes the file's pooled choice.
 MIN_VALIDATION_GAPS = 5
 #: A method replaces the reference (linear for the file, the file's choice for a bucket) only
@@ -449,6 +449,7 @@ def recover_auto(
     *,
     seed: int = 0,
     candidates: Sequence[str] = CANDIDATES,
+    max_gaps: int = MAX_CALIBRATION_GAPS,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -466,6 +467,8 @@ def recover_auto(
     candidates : sequence of str
         Methods scored (some of :data:`CANDIDATES`; ``"linear"`` is always added). Without
         ``"gdt-mix"`` no motion model is fitted, without ``"gdt-bi"`` no noise levels.
+    max_gaps : int
+        At most this many artificial gaps (:func:`calibrate`).
 
     Returns
     -------
@@ -511,6 +514,7 @@ def recover_auto(
         seed=seed,
         spans=[spans[k] for k in keep],
         candidates=candidates,
+        max_gaps=max_gaps,
     )
     paths: list[F64 | None] = [None] * len(checked)
     groups: dict[str, list[int]] = {}

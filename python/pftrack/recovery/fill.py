@@ -43,6 +43,8 @@ DEFAULT_MAX_GAP = 30
 MAX_GAP_LIMIT = 100_000
 #: Methods ``"auto"`` scores for box sizes ``(w, h)``, calibrated like the centres.
 SIZE_CANDIDATES = ("linear", "rts")
+#: At most this many artificial gaps calibrate the box sizes.
+SIZE_GAPS = 120
 
 
 @dataclass(frozen=True)
@@ -169,7 +171,7 @@ def fill_rows(
             sizes = [r[:, [0, 4, 5]] for r in per_id.values()]
             size_segs = [(a[:, [0, 3, 4]], b[:, [0, 3, 4]]) for a, b in segs]
             wh_paths, size_cal = recover_auto(
-                size_segs, sizes, seed=seed, candidates=SIZE_CANDIDATES
+                size_segs, sizes, seed=seed, candidates=SIZE_CANDIDATES, max_gaps=SIZE_GAPS
             )
         else:
             paths = recover_gaps(segs, method, noise=noise, motion=motion)
