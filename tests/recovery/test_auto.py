@@ -234,3 +234,27 @@ def test_box_sizes_are_calibrated_too() -> None:
 
     assert err(out) < 0.5 * err(lin)
     assert np.all(out[:, 4:6] > 0)
+
+
+def test_cli_explain_prints_centres_and_sizes(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    from pftrack.cli import main
+    from pftrack.io.mot import write_mot
+
+    rng = np.random.default_rng(11)
+    rows = []
+    for tid, tr in enumerate(_manoeuvring_tracks(rng, n=12), start=1):
+        keep = np.ones(len(tr), bool)
+        keep[50:58] = False
+        r = np.column_stack([tr[:, 0] + 1, np.full(len(tr), tid), tr[:, 1] - 10, tr[:, 2] - 20,
+                             np.full((len(tr), 2), (20.0, 40.0)), np.ones(len(tr)),
+                             -np.ones((len(tr), 3))])  # fmt: skip
+        rows.append(r[keep])
+    src = tmp_path / "t.txt"
+    write_mot(src, np.vstack(rows))
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--explain"]) == 0
+    out = capsys.readouterr().out
+    assert "box centres (x, y):" in out and "box sizes (w, h):" in out
+    assert "file's choice" in out and "5-8" in out
+    assert main(["recover", str(src), "--out", str(tmp_path / "l.txt"), "--method", "linear",
+                 "--explain"]) == 0  # fmt: skip
+    assert "nothing was chosen" in capsys.readouterr().out

@@ -146,3 +146,26 @@ def test_numpy_expm_matches_scipy() -> None:
         M = rng.normal(0, scale, (20, 6, 6))
         want = expm(M)
         np.testing.assert_allclose(_expm(M), want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+
+
+def test_cli_smooth_and_recover_bounded_and_refusing(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    from pftrack.cli import main
+    from pftrack.io.mot import read_mot, write_mot
+
+    src = tmp_path / "far.txt"
+    write_mot(src, FAR)
+    t0 = time.perf_counter()
+    assert main(["smooth", str(src), "--out", str(tmp_path / "s.txt")]) == 0
+    assert main(["recover", str(src), "--out", str(tmp_path / "r.txt")]) == 0
+    assert time.perf_counter() - t0 < 20.0
+    assert len(read_mot(tmp_path / "s.txt")) == len(FAR) + 3
+    assert len(read_mot(tmp_path / "r.txt")) == len(FAR) + 3
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1,1,10,10,20,40\n3000000000,1,12,10,20,40\n")
+    for cmd in ("smooth", "recover"):
+        assert main([cmd, str(bad), "--out", str(tmp_path / "o.txt")]) == 2
+        err = capsys.readouterr().err
+        assert f"pftrack {cmd}: error:" in err and "3e+09 is not an integer in 1..2147483647" in err
+    assert not (tmp_path / "o.txt").exists()
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--max-gap", "200000"]) == 2
+    assert "max_gap is 200000" in capsys.readouterr().err
