@@ -167,3 +167,94 @@ def test_auto_never_worse_than_linear_on_tud() -> None:
     r = run_sequence("tud", trajectories(gt), 640, 480, ["auto", "linear"])
     assert r.n_gaps > 0
     assert r.mmae("auto") <= r.mmae("linear") + 1e-9
+
+
+def test_paired_test_keeps_the_reference_within_noise() -> None:
+    from pftrack.recovery.calibrate import _better
+
+    rng = np.random.default_rng(7)
+    ref = rng.uniform(1.0, 2.0, 40)
+    assert not _better(ref - 0.001, ref)  # below the 1 % margin
+    noisy = ref + rng.normal(0, 0.5, 40)
+    noisy -= noisy.mean() - ref.mean() + 0.02  # 1.3 % better on average, but within noise
+    assert not _better(noisy, ref)
+    assert _better(0.8 * ref, ref)  # clearly better on every gap
+
+
+def test_small_buckets_take_the_files_choice() -> None:
+    """A bucket with too few validation gaps follows the file's pooled choice, not linear."""
+    tracks = _manoeuvring_tracks(np.random.default_rng(8))
+    cal = calibrate(tracks, [20] * 20 + [200])  # no run can hold a 200-frame gap
+    long = [c for c in cal.buckets if c.lengths[0] > 128][0]
+    assert long.n_validation == 0 and long.method == cal.pooled
+    assert cal.pooled.startswith("gdt") and cal.method_for(1000) == cal.pooled
+
+
+def test_matched_validation_gaps_have_the_real_speed() -> None:
+    """Artificial gaps are drawn near each real gap's end-point distance."""
+    from pftrack.recovery.calibrate import _artificial_gaps
+
+    rng = np.random.default_rng(9)
+    runs = []
+    for k in range(40):  # slow and fast walkers
+        v = 0.5 if k % 2 else 6.0
+        t = np.arange(100.0)
+        runs.append(np.column_stack([t, v * t, np.zeros(100)]))
+    for dist, lo, hi in ((5.0, 4.0, 6.0), (60.0, 50.0, 70.0)):
+        cut = _artificial_gaps(runs, [(10, dist)], 30, np.random.default_rng(1))
+        d = [np.hypot(*(b[0, 1:3] - a[-1, 1:3])) for a, b, _ in cut]
+        assert len(cut) >= 20 and lo <= np.median(d) <= hi
+    assert rng is not None
+
+
+def test_box_sizes_are_calibrated_too() -> None:
+    """Boxes that grow and shrink smoothly: the sizes of filled rows follow the curve."""
+    rng = np.random.default_rng(10)
+    rows = []
+    for tid in range(1, 31):
+        t = np.arange(150.0)
+        w = 40 + 15 * np.sin(t / rng.uniform(12, 20) + rng.uniform(0, 6))
+        h = 2 * w
+        cx, cy = 300 + 2 * t, 200 + 0.5 * t
+        r = np.column_stack([t + 1, np.full(150, tid), cx - w / 2, cy - h / 2, w, h,
+                             np.ones(150), -np.ones((150, 3))])  # fmt: skip
+        rows.append(r)
+    full = np.vstack(rows)
+    hole = (full[:, 0] >= 70) & (full[:, 0] < 86)
+    out, rep = fill_gaps(full[~hole])
+    assert rep.size_calibration is not None and rep.size_calibration.pooled != "linear"
+    lin, _ = fill_gaps(full[~hole], method="linear")
+    key = full[hole][:, :2]
+
+    def err(o: np.ndarray) -> float:
+        got = o[np.isin(o[:, 0] * 1000 + o[:, 1], key[:, 0] * 1000 + key[:, 1])]
+        got = got[np.lexsort((got[:, 0], got[:, 1]))]
+        want = full[hole][np.lexsort((full[hole][:, 0], full[hole][:, 1]))]
+        return float(np.abs(got[:, 4:6] - want[:, 4:6]).mean())
+
+    assert err(out) < 0.5 * err(lin)
+    assert np.all(out[:, 4:6] > 0)
+
+
+def test_cli_explain_prints_centres_and_sizes(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    from pftrack.cli import main
+    from pftrack.io.mot import write_mot
+
+    rng = np.random.default_rng(11)
+    rows = []
+    for tid, tr in enumerate(_manoeuvring_tracks(rng, n=12), start=1):
+        keep = np.ones(len(tr), bool)
+        keep[50:58] = False
+        r = np.column_stack([tr[:, 0] + 1, np.full(len(tr), tid), tr[:, 1] - 10, tr[:, 2] - 20,
+                             np.full((len(tr), 2), (20.0, 40.0)), np.ones(len(tr)),
+                             -np.ones((len(tr), 3))])  # fmt: skip
+        rows.append(r[keep])
+    src = tmp_path / "t.txt"
+    write_mot(src, np.vstack(rows))
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--explain"]) == 0
+    out = capsys.readouterr().out
+    assert "box centres (x, y):" in out and "box sizes (w, h):" in out
+    assert "file's choice" in out and "5-8" in out
+    assert main(["recover", str(src), "--out", str(tmp_path / "l.txt"), "--method", "linear",
+                 "--explain"]) == 0  # fmt: skip
+    assert "nothing was chosen" in capsys.readouterr().out

@@ -26,7 +26,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="output file (written atomically)")
     p.add_argument("--method", default=DEFAULT_METHOD, choices=METHODS, help="recovery method")
     p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
-                   help="longest hole filled, in frames")  # fmt: skip
+                   help="longest hole filled, in frames (at most 100000; longer holes stay "
+                   "holes: bounded work)")  # fmt: skip
     p.add_argument("--explain", action="store_true",
                    help="with auto: print the method chosen per gap length and its validation "
                    "MMAE")  # fmt: skip
@@ -51,7 +52,10 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.out, what="--out")
     src = Path(args.tracks)
     rows = read_mot(src, what="tracks file")
-    check_unique(rows, data_line_numbers(src))
+    try:
+        check_unique(rows)
+    except ValueError:  # name the lines (reading the file again costs time: only on error)
+        check_unique(rows, data_line_numbers(src))
     out = Path(args.out)
     if out.exists() and os.path.samefile(out, src) and not args.in_place:
         raise ValueError(
@@ -78,7 +82,11 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.explain:
         if rep.calibration is not None:
+            print("box centres (x, y):")
             print(rep.calibration.describe())
+        if rep.size_calibration is not None:
+            print("box sizes (w, h):")
+            print(rep.size_calibration.describe())
         elif args.method == "auto":
             print("auto: no gap to fill")
         else:

@@ -18,14 +18,16 @@ def add_parser(sub: Any) -> None:
         help="link, fill and smooth any tracker's MOTChallenge output (offline)",
         description="The offline pass pftrack track applies to its own tracks, for any "
         "tracker's output: join fragments of one object by motion and size across gaps of up "
-        "to --max-gap frames, add the frames missing inside each track (flagged 1 in column 8), "
+        "to --max-gap frames, add the frames missing inside each track (recovered by the method "
+        "of pftrack recover, auto; flagged 1 in column 8), "
         "and replace every box by a Rauch-Tung-Striebel smoother's estimate over the whole "
         "track. Smoothing is not idempotent: run it once, on raw output.",
     )
     p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,conf,...)")
     p.add_argument("--out", required=True, help="output file (written atomically; never the input)")
     p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
-                   help="longest gap joined and filled")  # fmt: skip
+                   help="longest gap joined and filled (longer holes stay holes: bounded "
+                   "work)")  # fmt: skip
     p.add_argument("--no-link", action="store_true", help="smooth each id as it is")
     p.set_defaults(func=run)
 

@@ -61,6 +61,9 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
     p = Path(path)
     if not p.is_file():
         raise FileNotFoundError(f"{what} not found: {p}")
+    fast = _read_fast(p)
+    if fast is not None:
+        return fast
     rows: list[list[float]] = []
     for lineno, text in _data_lines(p):
         fields = text.replace(",", " ").split()
@@ -90,6 +93,38 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
     return np.asarray(rows, dtype=np.float64)
 
 
+def _read_fast(p: Path) -> NDArray[np.float64] | None:
+    """The rows of a well-formed file in one vectorised parse, or None.
+
+    None sends the file to the line-by-line reader, which names the first bad line.
+    """
+    try:
+        with p.open("r", encoding="utf-8") as fh:
+            first = ""
+            for line in fh:
+                if line.strip():
+                    first = line
+                    break
+        if not first:
+            return np.zeros((0, 10))
+        a = np.loadtxt(
+            p, delimiter="," if "," in first else None, ndmin=2, encoding="utf-8", comments=None
+        )
+    except (ValueError, UnicodeDecodeError):
+        return None
+    n = a.shape[1]
+    if not 6 <= n <= 10:
+        return None
+    fr, wh = a[:, FRAME], a[:, WIDTH : HEIGHT + 1]
+    if not (
+        np.all(np.isfinite(a[:, :6])) and np.all(fr >= 1) and np.all(fr == np.floor(fr))
+    ) or np.any(wh < 0):
+        return None
+    if n < 10:
+        a = np.hstack([a, np.tile(np.asarray(_DEFAULTS[n:]), (len(a), 1))])
+    return a
+
+
 def format_mot_row(row: Iterable[float]) -> str:
     """One MOTChallenge line (10 columns): integers where integral, else 2 decimals."""
     r = list(row)
@@ -113,10 +148,23 @@ def write_mot(path: PathLike, rows: NDArray[np.float64] | Iterable[Iterable[floa
     if a.shape[1] < 10:
         pad = np.tile(np.asarray(_DEFAULTS[a.shape[1] :]), (a.shape[0], 1))
         a = np.hstack([a, pad])
-    order = np.lexsort((a[:, ID], a[:, FRAME]))
+    if not np.all(np.isfinite(a)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(a), axis=1))[0])
+        raise ValueError(f"write_mot: row {bad} has a non-finite value: {a[bad].tolist()}")
+    a = a[np.lexsort((a[:, ID], a[:, FRAME]))]
+    # format_mot_row, vectorised: one format string per pattern of integral columns
+    integral = (a[:, 2:] == np.floor(a[:, 2:])) & (np.abs(a[:, 2:]) < 1e15)
+    pattern = integral @ (1 << np.arange(8))
+    fmts = {
+        int(k): ",".join(["%d", "%d"] + ["%d" if k >> j & 1 else "%.2f" for j in range(8)])
+        for k in np.unique(pattern)
+    }
+    a = a + 0.0  # -0.0 -> 0.0, as int() writes it
+    text = "".join(
+        fmts[k] % tuple(r) + "\n" for k, r in zip(pattern.tolist(), a.tolist(), strict=True)
+    )
     with atomic_write(path) as fh:
-        for r in a[order]:
-            fh.write(format_mot_row(r) + "\n")
+        fh.write(text)
 
 
 def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:

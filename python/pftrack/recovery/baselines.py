@@ -28,7 +28,7 @@ References
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType
 from typing import TypeAlias
 
@@ -47,6 +47,7 @@ __all__ = [
     "interpolate_sizes",
     "linear",
     "rts",
+    "rts_batch",
 ]
 
 #: A baseline: ``(segment_a, segment_b, frames) -> (F, 2)`` positions.
@@ -96,7 +97,7 @@ def bspline(
 
     Interior knots every `spacing` frames inside each observed window; points near the gap
     weigh more (Sun et al. 2005, the paper's first baseline). Falls back to :func:`cubic`
-    with fewer than 8 points or a singular fit.
+    with fewer than 8 points or a singular fit (an error or a non-finite result).
     """
     from scipy.interpolate import make_lsq_spline
 
@@ -117,7 +118,10 @@ def bspline(
         spl = make_lsq_spline(t, xy, knots, k=k, w=w, axis=0)
     except (ValueError, np.linalg.LinAlgError):
         return cubic(seg_a, seg_b, frames)
-    return np.asarray(spl(frames), dtype=np.float64)
+    out = np.asarray(spl(frames), dtype=np.float64)
+    if not np.all(np.isfinite(out)):  # SciPy may return NaN for a rank-deficient fit
+        return cubic(seg_a, seg_b, frames)
+    return out
 
 
 def gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) -> F64:
@@ -191,6 +195,69 @@ def rts(
     )
     out: F64 = smoothed[(frames - f_first).astype(int)]
     return out
+
+
+def rts_batch(
+    pairs: Sequence[tuple[F64, F64]], q: float = 0.1, r: float = 1.0, history: int = 30
+) -> list[F64]:
+    """:func:`rts` for many gaps at once: every frame inside each gap, ``(x, y)``.
+
+    The windows of all gaps (up to `history` points each side and the gap) are stacked as
+    columns of one array and filtered and smoothed together, one vectorised step per frame
+    of the longest window (the same equations as :func:`pftrack.kalman.rts_smooth`, with a
+    measurement mask per column). Segments must be checked, B after A.
+    """
+    if not pairs:
+        return []
+    wins = [(a[-history:], b[:history]) for a, b in pairs]
+    first = np.array([a[0, 0] for a, _ in wins])
+    steps = np.array([b[-1, 0] for _, b in wins]) - first + 1
+    T, n = int(steps.max()), 2 * len(wins)
+    z = np.zeros((T, n))
+    has = np.zeros((T, n), dtype=bool)
+    for g, (a, b) in enumerate(wins):
+        for seg in (a, b):
+            rows = (seg[:, 0] - first[g]).astype(np.int64)
+            z[rows, 2 * g : 2 * g + 2] = seg[:, 1:3]
+            has[rows, 2 * g : 2 * g + 2] = True
+    fm = np.empty((T, 2, n))
+    fp = np.empty((T, 3, n))
+    pm = np.empty((T, 2, n))
+    pp = np.empty((T, 3, n))
+    m0, m1 = z[0].copy(), np.zeros(n)
+    p00, p01, p11 = np.full(n, r), np.zeros(n), np.full(n, 100.0)
+    for t in range(T):
+        if t > 0:
+            m0, m1 = m0 + m1, m1
+            p00, p01, p11 = p00 + 2 * p01 + p11 + q / 3.0, p01 + p11 + q / 2.0, p11 + q
+        pm[t] = m0, m1
+        pp[t] = p00, p01, p11
+        h = has[t]
+        s = p00 + r
+        k0, k1 = np.where(h, p00 / s, 0.0), np.where(h, p01 / s, 0.0)
+        e = z[t] - m0
+        m0, m1 = m0 + k0 * e, m1 + k1 * e
+        p00, p01, p11 = (1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01
+        fm[t] = m0, m1
+        fp[t] = p00, p01, p11
+    out = np.empty((T, n))
+    s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
+    out[-1] = s0
+    for t in range(T - 2, -1, -1):
+        a_, b_, c_ = fp[t]
+        u00, u01, u10, u11 = a_ + b_, b_, b_ + c_, c_
+        x, y, w = pp[t + 1]
+        det = x * w - y * y
+        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
+        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
+        d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
+        s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
+        out[t] = s0
+    res = []
+    for g, (a, b) in enumerate(wins):
+        lo, hi = int(a[-1, 0] - first[g]) + 1, int(b[0, 0] - first[g])
+        res.append(np.ascontiguousarray(out[lo:hi, 2 * g : 2 * g + 2]))
+    return res
 
 
 #: The baselines by method name (read-only).

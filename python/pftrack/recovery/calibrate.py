@@ -19,10 +19,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pftrack._progress import progress
 from pftrack._typing import F64
-from pftrack.recovery.baselines import BASELINES
+from pftrack.recovery.baselines import BASELINES, rts_batch
 from pftrack.recovery.gdt import GdtModel
 from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
@@ -43,18 +44,23 @@ __all__ = [
 ]
 
 #: Methods scored by the calibration (``"gdt-fixed"``: two-sided goal, the paper's fixed noise).
-CANDIDATES = ("linear", "bspline", "rts", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed")
+CANDIDATES = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed")
 #: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
 LINEAR_MARGIN = 0.01
 #: At most this many artificial gaps per file, over all buckets.
-MAX_CALIBRATION_GAPS = 200
-#: Fewer validation gaps than this in a bucket: the bucket falls back to ``"linear"``.
+MAX_CALIBRATION_GAPS = 300
+#: Fewer validation gaps than this in a bucket: the bucket takes the file's pooled choice.
 MIN_VALIDATION_GAPS = 5
+#: A method replaces the reference (linear for the file, the file's choice for a bucket) only
+#: if its mean paired validation error is lower by more than this many standard errors.
+PAIRED_Z = 2.0
 #: Observed points kept on each side of an artificial gap, at least.
 CONTEXT = 3
+#: Random places drawn per artificial gap; the one nearest the real gap's speed is kept.
+MATCH_DRAWS = 16
 #: Noise levels and the motion model of ``"auto"`` are fitted to at most about this many
 #: observed points (whole runs, drawn with the calibration's seed), so big files stay fast.
-MAX_FIT_POINTS = 5000
+MAX_FIT_POINTS = 1000
 
 
 def bucket_of(length: int) -> int:
@@ -94,17 +100,28 @@ class BucketChoice:
 
 @dataclass(frozen=True)
 class Calibration:
-    """What ``"auto"`` chose for one file: one :class:`BucketChoice` per gap-length bucket."""
+    """What ``"auto"`` chose for one file.
+
+    Attributes
+    ----------
+    buckets : tuple of BucketChoice
+        One per gap-length bucket.
+    pooled : str
+        The file's choice (every bucket's validation gaps, weighted by its real gaps): used by
+        buckets without enough validation gaps, and kept by the others unless their own best
+        beats it by a paired test.
+    """
 
     buckets: tuple[BucketChoice, ...]
+    pooled: str = "linear"
 
     def method_for(self, length: int) -> str:
-        """The method chosen for a gap of `length` missing frames (``"linear"`` if unseen)."""
+        """The method chosen for a gap of `length` missing frames (:attr:`pooled` if unseen)."""
         lo_hi = _bucket_range(bucket_of(length))
         for c in self.buckets:
             if c.lengths == lo_hi:
                 return c.method
-        return "linear"
+        return self.pooled
 
     def describe(self) -> str:
         """A table: per bucket, the chosen method, each candidate's validation MMAE, counts."""
@@ -113,7 +130,11 @@ class Calibration:
         names = [m for m, _ in next((c.mmae for c in self.buckets if c.mmae), ())]
         head = f"{'gap length':<12}{'gaps':>6}{'val.':>6}  {'chosen':<10}"
         head += "".join(f"{m:>11}" for m in names)
-        lines = ["auto: validation MMAE (px) on artificial gaps cut into observed runs", head]
+        lines = [
+            "auto: validation MMAE (px) on artificial gaps cut into observed runs; file's "
+            f"choice {self.pooled}",
+            head,
+        ]
         for c in self.buckets:
             lo, hi = c.lengths
             span = f"{lo}" if lo == hi else f"{lo}-{hi}"
@@ -154,6 +175,8 @@ def recover_with(
             ends_b[:, 1:3], n, axis=0
         )
         return np.split(xy, np.cumsum(n)[:-1])
+    if method == "rts":
+        return rts_batch(pairs)
     if method in BASELINES:
         out = []
         for a, b in pairs:
@@ -175,18 +198,25 @@ def recover_with(
 
 def _observed_runs(observed: Sequence[F64]) -> list[F64]:
     """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order."""
-    seen: dict[tuple[float, float, float, float, int], F64] = {}
+    arrs = []
     for s in observed:
         a = np.asarray(s, dtype=np.float64)
-        if a.ndim != 2 or a.shape[1] < 3 or len(a) == 0:
-            continue
-        a = a[:, :3]
-        for run in np.split(a, np.flatnonzero(np.diff(a[:, 0]) != 1) + 1):
-            if len(run) and np.all(np.isfinite(run)):
-                key = (float(run[0, 0]), float(run[0, 1]), float(run[0, 2]), float(run[-1, 0]),
-                       len(run))  # fmt: skip
-                seen.setdefault(key, run)
-    return [seen[k] for k in sorted(seen)]
+        if a.ndim == 2 and a.shape[1] >= 3 and len(a):
+            arrs.append(a[:, :3])
+    if not arrs:
+        return []
+    X = np.vstack(arrs)
+    bound = np.zeros(len(X), dtype=bool)
+    bound[np.cumsum([len(a) for a in arrs])[:-1]] = True
+    brk = np.flatnonzero(bound[1:] | (np.diff(X[:, 0]) != 1)) + 1
+    starts, ends = np.r_[0, brk], np.r_[brk, len(X)]
+    ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
+    starts, ends = starts[ok], ends[ok]
+    if not len(starts):
+        return []
+    keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
+    _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
+    return [X[starts[k] : ends[k]] for k in first]
 
 
 def _fit_sample(runs: Sequence[F64], seed: int) -> list[F64]:
@@ -204,29 +234,56 @@ def _fit_sample(runs: Sequence[F64], seed: int) -> list[F64]:
     return out
 
 
-def _artificial_gaps(
-    runs: Sequence[F64], lengths: Sequence[int], n: int, rng: np.random.Generator
-) -> list[tuple[F64, F64, F64]]:
-    """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` with lengths from `lengths`."""
+def _flat(runs: Sequence[F64]) -> tuple[NDArray[np.int64], NDArray[np.int64], F64]:
+    """Lengths and offsets of the runs, and all their ``(x, y)`` stacked."""
     sizes = np.array([len(r) for r in runs], dtype=np.int64)
+    offset = np.r_[0, np.cumsum(sizes)[:-1]].astype(np.int64)
+    xy = np.vstack([r[:, 1:3] for r in runs]) if runs else np.zeros((0, 2))
+    return sizes, offset, xy
+
+
+def _artificial_gaps(
+    runs: Sequence[F64],
+    targets: Sequence[tuple[int, float]],
+    n: int,
+    rng: np.random.Generator,
+    flat: tuple[NDArray[np.int64], NDArray[np.int64], F64] | None = None,
+) -> list[tuple[F64, F64, F64]]:
+    """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` matched to `targets`.
+
+    Each target is a real gap's ``(missing frames, distance between its two end points)``.
+    Targets are taken in turn (shuffled); for each, :data:`MATCH_DRAWS` random places of that
+    length are drawn from the runs and the one whose end-point distance is nearest the
+    target's (in log scale) is kept, so the validation gaps have the real gaps' lengths and
+    speeds.
+    """
+    sizes, offset, xy = _flat(runs) if flat is None else flat
     out: list[tuple[F64, F64, F64]] = []
     used: set[tuple[int, int, int]] = set()
-    for _ in range(4 * n):
-        if len(out) >= n:
+    order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
+    for attempt in range(4 * n):
+        if len(out) >= n or not len(order):
             break
-        L = int(lengths[int(rng.integers(len(lengths)))])
+        L, dist = targets[int(order[attempt % len(order)])]
         slots = np.maximum(sizes - L - 2 * CONTEXT + 1, 0)
-        total = int(slots.sum())
+        cum = np.cumsum(slots)
+        total = int(cum[-1]) if len(cum) else 0
         if total == 0:
             continue
-        k = int(rng.integers(total))
-        i = int(np.searchsorted(np.cumsum(slots), k, side="right"))
-        s = CONTEXT + k - int(np.cumsum(slots)[i] - slots[i])
-        if (i, s, L) in used:
+        ks = rng.integers(total, size=MATCH_DRAWS)
+        idx = np.searchsorted(cum, ks, side="right")
+        starts = CONTEXT + ks - (cum[idx] - slots[idx])
+        j = 0
+        if dist >= 0:
+            at = offset[idx] + starts
+            d = np.hypot(*(xy[at + L] - xy[at - 1]).T)
+            j = int(np.argmin(np.abs(np.log1p(d) - np.log1p(dist))))
+        i, st = int(idx[j]), int(starts[j])
+        if (i, st, L) in used:
             continue
-        used.add((i, s, L))
+        used.add((i, st, L))
         r = runs[i]
-        out.append((r[:s], r[s + L :], r[s : s + L]))
+        out.append((r[:st], r[st + L :], r[st : st + L]))
     return out
 
 
@@ -239,6 +296,7 @@ def calibrate(
     candidates: Sequence[str] = CANDIDATES,
     max_gaps: int = MAX_CALIBRATION_GAPS,
     seed: int = 0,
+    spans: Sequence[float] | None = None,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -257,6 +315,9 @@ def calibrate(
         At most this many artificial gaps in all (>= 1).
     seed : int
         Seed of the generator that places the artificial gaps.
+    spans : sequence of float, optional
+        Distance (px) between the two end points of each gap in `gap_lengths`: artificial
+        gaps are matched to it (default: no matching, any place of the right length).
 
     Returns
     -------
@@ -276,9 +337,14 @@ def calibrate(
         if m not in CANDIDATES:
             raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
     names = tuple(m for m in CANDIDATES if m in candidates or m == "linear")
+    dists = [-1.0] * len(lengths) if spans is None else [float(v) for v in spans]
+    if len(dists) != len(lengths):
+        raise ValueError(f"calibrate: {len(dists)} spans for {len(lengths)} gap lengths")
     by_bucket: dict[int, list[int]] = {}
-    for v in lengths:
+    targets: dict[int, list[tuple[int, float]]] = {}
+    for v, dv in zip(lengths, dists, strict=True):
         by_bucket.setdefault(bucket_of(v), []).append(v)
+        targets.setdefault(bucket_of(v), []).append((v, dv))
     if not by_bucket:
         return Calibration(())
     runs = _observed_runs(observed)
@@ -288,28 +354,87 @@ def calibrate(
     if motion is None and "gdt-mix" in names and whole:
         motion = fit_motion(whole, noise)
     per_bucket = max(MIN_VALIDATION_GAPS, max_gaps // len(by_bucket))
-    choices = []
+    scored = [
+        m
+        for m in names
+        if (m != "gdt-bi" or noise is not None) and (m != "gdt-mix" or motion is not None)
+    ]
+    errors: dict[int, dict[str, F64]] = {}
+    n_cut: dict[int, int] = {}
+    flat = _flat(runs)
     for b in progress(sorted(by_bucket), desc="auto: calibrating", unit="bucket"):
         rng = np.random.default_rng([seed, b])
-        cut = _artificial_gaps(runs, by_bucket[b], per_bucket, rng)
+        cut = _artificial_gaps(runs, targets[b], per_bucket, rng, flat)
+        n_cut[b] = len(cut)
+        if len(cut) < MIN_VALIDATION_GAPS:
+            continue
+        pairs = [(a, c) for a, c, _ in cut]
+        truth = [t for _, _, t in cut]
+        errors[b] = {}
+        for m in scored:
+            paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
+            errors[b][m] = _gap_errors(paths, truth)
+    weights = {b: len(by_bucket[b]) for b in errors}
+    pooled = _pooled_choice(errors, weights, scored)
+    choices = []
+    for b in sorted(by_bucket):
         mmae: tuple[tuple[str, float], ...] = ()
-        method = "linear"
-        if len(cut) >= MIN_VALIDATION_GAPS:
-            pairs = [(a, c) for a, c, _ in cut]
-            scores = []
-            for m in names:
-                if m in ("gdt-bi", "gdt-mix") and (noise is None or motion is None):
-                    continue
-                paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
-                err = [float(np.mean(np.hypot(*(p - t[:, 1:3]).T))) for p, (_, _, t) in
-                       zip(paths, cut, strict=True)]  # fmt: skip
-                scores.append((m, float(np.mean(err))))
-            mmae = tuple(scores)
-            best_m, best = min(scores, key=lambda s: s[1])
-            lin = dict(scores)["linear"]
-            method = "linear" if lin <= (1.0 + LINEAR_MARGIN) * best else best_m
-        choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), len(cut), mmae))
-    return Calibration(tuple(choices))
+        method = pooled
+        if b in errors:
+            e = errors[b]
+            mmae = tuple((m, float(e[m].mean())) for m in scored)
+            best = min(scored, key=lambda m: float(e[m].mean()))
+            if best != pooled and _better(e[best], e[pooled]):
+                method = best
+        choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), n_cut[b], mmae))
+    return Calibration(tuple(choices), pooled)
+
+
+def _gap_errors(paths: Sequence[F64], truth: Sequence[F64]) -> F64:
+    """Mean Euclidean error of each gap's path against its truth (rows ``frame, x, y``)."""
+    n = np.array([len(t) for t in truth])
+    d = np.concatenate(paths) - np.concatenate([t[:, 1:3] for t in truth])
+    out: F64 = np.add.reduceat(np.hypot(d[:, 0], d[:, 1]), np.r_[0, np.cumsum(n)[:-1]]) / n
+    return out
+
+
+def _better(cand: F64, ref: F64) -> bool:
+    """`cand` beats `ref` on the same validation gaps: a paired test and the margin."""
+    d = cand - ref
+    se = float(np.std(d, ddof=1)) / np.sqrt(len(d)) if len(d) > 1 else np.inf
+    mean = float(d.mean())
+    return mean < -PAIRED_Z * se and mean < -LINEAR_MARGIN * float(ref.mean())
+
+
+def _pooled_choice(
+    errors: dict[int, dict[str, F64]], weights: dict[int, int], names: Sequence[str]
+) -> str:
+    """The file's method: validation MMAE of every bucket weighted by its real gaps.
+
+    ``"linear"`` unless the best beats it by :data:`LINEAR_MARGIN` and :data:`PAIRED_Z`
+    standard errors of the weighted paired difference.
+    """
+    if not errors:
+        return "linear"
+    total = float(sum(weights.values()))
+    w = {b: weights[b] / total for b in errors}
+
+    def score(m: str) -> float:
+        return sum(w[b] * float(errors[b][m].mean()) for b in errors)
+
+    best = min(names, key=score)
+    if best == "linear":
+        return "linear"
+    diff = sum(w[b] * float((errors[b][best] - errors[b]["linear"]).mean()) for b in errors)
+    var = sum(
+        w[b] ** 2
+        * float(np.var(errors[b][best] - errors[b]["linear"], ddof=1))
+        / len(errors[b][best])
+        for b in errors
+    )
+    if diff < -PAIRED_Z * np.sqrt(var) and diff < -LINEAR_MARGIN * score("linear"):
+        return best
+    return "linear"
 
 
 # Placeholders that are never used (the methods needing them are skipped without them).
@@ -324,6 +449,8 @@ def recover_auto(
     motion: MotionFit | None = None,
     *,
     seed: int = 0,
+    candidates: Sequence[str] = CANDIDATES,
+    max_gaps: int = MAX_CALIBRATION_GAPS,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -338,6 +465,11 @@ def recover_auto(
         about :data:`MAX_FIT_POINTS` points of them).
     seed : int
         Seed of the calibration.
+    candidates : sequence of str
+        Methods scored (some of :data:`CANDIDATES`; ``"linear"`` is always added). Without
+        ``"gdt-mix"`` no motion model is fitted, without ``"gdt-bi"`` no noise levels.
+    max_gaps : int
+        At most this many artificial gaps (:func:`calibrate`).
 
     Returns
     -------
@@ -366,12 +498,25 @@ def recover_auto(
     if observed is None:
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
-    runs = _fit_sample([r for r in _observed_runs(observed) if len(r) >= 4], seed)
+    all_runs = _observed_runs(observed)
+    runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:
-        noise = estimate_noise(runs) if runs else _NO_NOISE
-    if motion is None and runs:
+        needs = "gdt-bi" in candidates or "gdt-mix" in candidates
+        noise = estimate_noise(runs) if runs and needs else _NO_NOISE
+    if motion is None and runs and "gdt-mix" in candidates:
         motion = fit_motion(runs, noise)
-    cal = calibrate(observed, [v for v in lengths if v > 0], noise, motion, seed=seed)
+    spans = [float(np.hypot(*(b[0, 1:3] - a[-1, 1:3]))) for a, b in checked]
+    keep = [k for k, v in enumerate(lengths) if v > 0]
+    cal = calibrate(
+        all_runs,
+        [lengths[k] for k in keep],
+        noise,
+        motion,
+        seed=seed,
+        spans=[spans[k] for k in keep],
+        candidates=candidates,
+        max_gaps=max_gaps,
+    )
     paths: list[F64 | None] = [None] * len(checked)
     groups: dict[str, list[int]] = {}
     for k, L in enumerate(lengths):

@@ -15,12 +15,36 @@ import numpy as np
 
 from pftrack._typing import F64
 from pftrack.recovery.calibrate import Calibration, recover_auto
-from pftrack.recovery.linking import FLAG_COLUMN, box_centres, check_unique, split_tracks
+from pftrack.recovery.linking import (
+    FLAG_COLUMN,
+    box_centres,
+    check_rows,
+    check_unique,
+    split_tracks,
+)
 from pftrack.recovery.mixture import MotionFit, fit_motion
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, recover_gaps
 
-__all__ = ["FillReport", "fill_gaps"]
+__all__ = [
+    "DEFAULT_MAX_GAP",
+    "MAX_GAP_LIMIT",
+    "SIZE_CANDIDATES",
+    "FillReport",
+    "fill_gaps",
+    "fill_rows",
+]
+
+#: Longest hole filled by default, in frames, everywhere pftrack fills holes (``recover``,
+#: ``smooth``, the tracker's offline pass): longer holes stay holes, so work and memory are
+#: bounded by the number of rows whatever the frame numbers.
+DEFAULT_MAX_GAP = 30
+#: Largest `max_gap` accepted: a hole longer than this is never filled (refused, not capped).
+MAX_GAP_LIMIT = 100_000
+#: Methods ``"auto"`` scores for box sizes ``(w, h)``, calibrated like the centres.
+SIZE_CANDIDATES = ("linear", "rts")
+#: At most this many artificial gaps calibrate the box sizes.
+SIZE_GAPS = 120
 
 
 @dataclass(frozen=True)
@@ -28,19 +52,22 @@ class FillReport:
     """What :func:`fill_gaps` did.
 
     ``calibration``: with ``"auto"``, the method chosen per gap-length bucket and the
-    validation MMAE of every candidate (:class:`~pftrack.recovery.calibrate.Calibration`).
+    validation MMAE of every candidate (:class:`~pftrack.recovery.calibrate.Calibration`);
+    ``size_calibration``: the same for the box sizes ``(w, h)`` (candidates
+    :data:`SIZE_CANDIDATES`).
     """
 
     n_gaps: int
     n_filled_rows: int
     noise: NoiseEstimate | None
     calibration: Calibration | None = None
+    size_calibration: Calibration | None = None
 
 
 def fill_gaps(
     tracks: F64,
     method: str = DEFAULT_METHOD,
-    max_gap: int = 30,
+    max_gap: int = DEFAULT_MAX_GAP,
     noise: NoiseEstimate | None = None,
     *,
     seed: int = 0,
@@ -67,8 +94,10 @@ def fill_gaps(
     -------
     rows : (M + n, 10) ndarray
         The rows plus the filled ones, sorted by (frame, id). Filled rows get positions from
-        `method`, sizes by linear interpolation, ``conf`` = the smaller of the two neighbours'
-        and the interpolated flag (column 8, :data:`FLAG_COLUMN`) set to 1.
+        `method`; sizes from the same calibration with ``"auto"`` (:data:`SIZE_CANDIDATES`,
+        never below half the smaller end size), else by linear interpolation; ``conf`` = the
+        smaller of the two neighbours' and the interpolated flag (column 8,
+        :data:`FLAG_COLUMN`) set to 1.
     report : FillReport
         How many holes and rows were filled; with ``"auto"``, what was chosen
         (``report.calibration``).
@@ -76,15 +105,40 @@ def fill_gaps(
     Raises
     ------
     ValueError
-        Unknown method, `max_gap` < 1, rows not ``(M, 10)`` or a duplicate (frame, id).
+        Unknown method, `max_gap` not an integer in ``1..MAX_GAP_LIMIT``, rows not
+        ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer id, a
+        non-finite box or a duplicate (frame, id).
+    """
+    rows = check_rows(tracks, "fill_gaps")
+    new_rows, report = fill_rows(rows, method, max_gap, noise, seed=seed)
+    filled = np.vstack([rows, new_rows])
+    order = np.lexsort((filled[:, 1], filled[:, 0]))
+    return filled[order], report
+
+
+def fill_rows(
+    rows: F64,
+    method: str = DEFAULT_METHOD,
+    max_gap: int = DEFAULT_MAX_GAP,
+    noise: NoiseEstimate | None = None,
+    *,
+    seed: int = 0,
+) -> tuple[F64, FillReport]:
+    """The rows :func:`fill_gaps` adds (flagged, in no particular order), and its report.
+
+    Parameters are those of :func:`fill_gaps`; `rows` are checked the same way.
     """
     if method not in METHODS:
         raise ValueError(f"fill_gaps: method is {method!r}, expected one of {METHODS}")
-    if max_gap < 1:
-        raise ValueError(f"fill_gaps: max_gap is {max_gap}, expected >= 1")
-    rows = np.asarray(tracks, dtype=np.float64)
-    if rows.ndim != 2 or rows.shape[1] != 10:
-        raise ValueError(f"fill_gaps: tracks must have shape (M, 10), got {rows.shape}")
+    if (
+        not isinstance(max_gap, (int, np.integer))
+        or isinstance(max_gap, bool)
+        or not 1 <= max_gap <= MAX_GAP_LIMIT
+    ):
+        raise ValueError(
+            f"fill_gaps: max_gap is {max_gap!r}, expected an integer in 1..{MAX_GAP_LIMIT}"
+        )
+    rows = check_rows(rows, "fill_gaps")
     check_unique(rows)
     per_id = split_tracks(rows)
     segs: list[tuple[F64, F64]] = []
@@ -95,7 +149,7 @@ def fill_gaps(
         holes = np.flatnonzero(np.diff(r[:, 0]) > 1)
         for h in holes:
             missing = int(r[h + 1, 0] - r[h, 0] - 1)
-            if missing > max_gap:
+            if missing > max_gap:  # bounded work: longer holes stay holes
                 continue
             segs.append((seg[: h + 1], seg[h + 1 :]))
             meta.append((tid, r[h], r[h + 1]))
@@ -108,17 +162,28 @@ def fill_gaps(
         if method == "gdt-mix":  # one model for the file, not one per pair of segments
             motion = fit_motion(whole, noise)
     new_rows: list[F64] = []
+    size_cal: Calibration | None = None
     if segs:
+        wh_paths: list[F64] | None = None
         if method == "auto":
             whole = [box_centres(r) for r in per_id.values()]
             paths, calibration = recover_auto(segs, whole, noise, motion, seed=seed)
+            sizes = [r[:, [0, 4, 5]] for r in per_id.values()]
+            size_segs = [(a[:, [0, 3, 4]], b[:, [0, 3, 4]]) for a, b in segs]
+            wh_paths, size_cal = recover_auto(
+                size_segs, sizes, seed=seed, candidates=SIZE_CANDIDATES, max_gaps=SIZE_GAPS
+            )
         else:
             paths = recover_gaps(segs, method, noise=noise, motion=motion)
-        for (tid, ra, rb), xy in zip(meta, paths, strict=True):
+        for k, ((tid, ra, rb), xy) in enumerate(zip(meta, paths, strict=True)):
             fr = np.arange(ra[0] + 1, rb[0])
-            s = (fr - ra[0]) / (rb[0] - ra[0])
-            w = (1 - s) * ra[4] + s * rb[4]
-            h = (1 - s) * ra[5] + s * rb[5]
+            if wh_paths is None:  # sizes by linear interpolation
+                s = (fr - ra[0]) / (rb[0] - ra[0])
+                w = (1 - s) * ra[4] + s * rb[4]
+                h = (1 - s) * ra[5] + s * rb[5]
+            else:  # never below half the smaller end size
+                w = np.maximum(wh_paths[k][:, 0], 0.5 * min(ra[4], rb[4]))
+                h = np.maximum(wh_paths[k][:, 1], 0.5 * min(ra[5], rb[5]))
             out = np.empty((len(fr), 10))
             out[:, 0] = fr
             out[:, 1] = tid
@@ -131,7 +196,5 @@ def fill_gaps(
             out[:, 8] = -1.0
             out[:, 9] = -1.0
             new_rows.append(out)
-    filled = np.vstack([rows, *new_rows]) if new_rows else rows.copy()
-    order = np.lexsort((filled[:, 1], filled[:, 0]))
-    n_new = sum(len(r) for r in new_rows)
-    return filled[order], FillReport(len(segs), n_new, noise, calibration)
+    added = np.vstack(new_rows) if new_rows else np.zeros((0, 10))
+    return added, FillReport(len(segs), len(added), noise, calibration, size_cal)

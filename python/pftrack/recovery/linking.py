@@ -28,6 +28,7 @@ __all__ = [
     "FLAG_COLUMN",
     "LinkConfig",
     "box_centres",
+    "check_rows",
     "check_unique",
     "link_cost_matrix",
     "link_tracklets",
@@ -35,6 +36,10 @@ __all__ = [
 ]
 
 FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTChallenge row)
+#: Largest frame number accepted (2^31 - 1: over two years of video at 30 fps).
+MAX_FRAME = 2**31 - 1
+#: Largest absolute track id accepted.
+MAX_ID = 2**31 - 1
 
 
 @dataclass(frozen=True)
@@ -83,11 +88,12 @@ def _end_velocity(c: F64, k: int, tail: bool) -> F64:
 
 def split_tracks(rows: F64) -> dict[int, F64]:
     """Rows of each id, sorted by frame."""
-    out: dict[int, F64] = {}
-    for tid in np.unique(rows[:, 1]).astype(np.int64):
-        r = rows[rows[:, 1] == tid]
-        out[int(tid)] = r[np.argsort(r[:, 0], kind="stable")]
-    return out
+    if len(rows) == 0:
+        return {}
+    r = rows[np.lexsort((rows[:, 0], rows[:, 1]))]  # by id, then frame (stable)
+    starts = np.flatnonzero(np.r_[True, r[1:, 1] != r[:-1, 1]])
+    ends = np.r_[starts[1:], len(r)]
+    return {int(r[i, 1]): r[i:j] for i, j in zip(starts, ends, strict=True)}
 
 
 class _Histograms:
@@ -208,6 +214,32 @@ def link_tracklets(
     for old, new in mapping.items():
         rows[rows[:, 1] == old, 1] = new
     return rows, mapping
+
+
+def check_rows(rows: object, what: str) -> F64:
+    """The rows as an ``(M, 10)`` float64 array, checked; ValueError/TypeError naming the problem.
+
+    Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, and the
+    box columns (``left, top, width, height``) finite. `what` names the caller in messages.
+    """
+    raw = np.asarray(rows)
+    if raw.dtype.kind not in "biuf":
+        raise TypeError(f"{what}: rows must be a real (M, 10) array, got dtype {raw.dtype}")
+    a = raw.astype(np.float64)
+    if a.ndim != 2 or a.shape[1] != 10:
+        raise ValueError(f"{what}: rows must have shape (M, 10), got {a.shape}")
+    f, i = a[:, 0], a[:, 1]
+    if not np.all(np.isfinite(a[:, :6])):
+        raise ValueError(f"{what}: frame, id and box columns must be finite")
+    bad = (f < 1) | (f > MAX_FRAME) | (f != np.floor(f))
+    if bad.any():
+        raise ValueError(
+            f"{what}: frame {f[bad][0]:g} is not an integer in 1..{MAX_FRAME} (refused)"
+        )
+    bad = (np.abs(i) > MAX_ID) | (i != np.floor(i))
+    if bad.any():
+        raise ValueError(f"{what}: track id {i[bad][0]:g} is not an integer with |id| <= {MAX_ID}")
+    return a
 
 
 def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:

@@ -30,11 +30,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import expm
 
 import pftrack._core as _core
 from pftrack._typing import F64
@@ -66,6 +65,28 @@ GRID = 20
 WINDOW = 30
 
 
+def _expm(M: F64) -> F64:
+    """Matrix exponential of a ``(K, n, n)`` stack: scaling and squaring of a Taylor series.
+
+    For the small Van Loan matrices of :func:`singer_model` (NumPy only: no SciPy import on
+    the recovery path). Each matrix is scaled to a 1-norm of at most 1/2, where 18 terms are
+    exact to double precision.
+    """
+    norm = np.abs(M).sum(axis=1).max(axis=-1)
+    s = np.maximum(0, np.ceil(np.log2(np.maximum(norm, 1e-300) / 0.5))).astype(np.int64)
+    A = M / (2.0**s)[:, None, None]
+    eye = np.broadcast_to(np.eye(M.shape[-1]), M.shape)
+    out = eye.copy()
+    term = eye.copy()
+    for k in range(1, 19):
+        term = term @ A / k
+        out = out + term
+    for k in range(int(s.max()) if len(s) else 0):
+        sq = out @ out
+        out = np.where((k < s)[:, None, None], sq, out)
+    return np.asarray(out, dtype=np.float64)
+
+
 def singer_model(q: ArrayLike, tau: ArrayLike) -> tuple[F64, F64]:
     """One-frame transition ``F`` and noise ``Q`` of ``(position, velocity, acceleration)``.
 
@@ -82,7 +103,7 @@ def singer_model(q: ArrayLike, tau: ArrayLike) -> tuple[F64, F64]:
     M[:, :3, :3] = -Fc
     M[:, 2, 5] = q.ravel()
     M[:, 3:, 3:] = Fc.transpose(0, 2, 1)
-    V = expm(M)
+    V = _expm(M)
     F = V[:, 3:, 3:].transpose(0, 2, 1)
     Q = F @ V[:, :3, 3:]
     return F, 0.5 * (Q + Q.transpose(0, 2, 1))
@@ -237,12 +258,18 @@ def stand_hypotheses(T: int, grid: int = GRID) -> tuple[NDArray[np.int32], NDArr
     First ``(-1, -1)`` (no stand), then every ``t1 < t2`` on ``min(grid, T)`` evenly spaced
     steps of ``0 .. T-1``.
     """
+    return _stand_hypotheses(int(T), int(grid))
+
+
+@lru_cache(maxsize=1024)
+def _stand_hypotheses(T: int, grid: int) -> tuple[NDArray[np.int32], NDArray[np.int32]]:
     ks = np.unique(np.round(np.linspace(0, T - 1, min(grid, T))).astype(np.int32))
     i, j = np.triu_indices(len(ks), k=1)
-    return (
-        np.concatenate([[-1], ks[i]]).astype(np.int32),
-        np.concatenate([[-1], ks[j]]).astype(np.int32),
-    )
+    t1 = np.concatenate([[-1], ks[i]]).astype(np.int32)
+    t2 = np.concatenate([[-1], ks[j]]).astype(np.int32)
+    t1.setflags(write=False)  # shared by every gap of this length
+    t2.setflags(write=False)
+    return t1, t2
 
 
 def recover_mixture(

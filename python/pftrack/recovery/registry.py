@@ -43,7 +43,7 @@ from numpy.typing import ArrayLike
 
 from pftrack._progress import progress
 from pftrack._typing import F64
-from pftrack.recovery.baselines import BASELINES, interpolate_sizes
+from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
 from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
 from pftrack.recovery.names import DEFAULT_METHOD, GOAL_DIRECTED_METHODS, METHODS
@@ -152,6 +152,11 @@ def recover_gaps(
     """
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
+    if method == "rts" and gaps:  # one vectorised pass over all gaps
+        pairs = [(as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in gaps]
+        for a, b in pairs:
+            gap_frames(a, b, None)  # B after A
+        return rts_batch(pairs)
     if method not in GOAL_DIRECTED_METHODS:
         return [
             recover_gap(a, b, method=method, noise=noise)[:, :2]

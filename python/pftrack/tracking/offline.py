@@ -24,7 +24,9 @@ from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
 from pftrack.kalman import rts_smooth
-from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, link_tracklets
+from pftrack.recovery.fill import fill_rows
+from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
+from pftrack.recovery.names import DEFAULT_METHOD
 
 __all__ = ["BoxSmoother", "smooth_tracks"]
 
@@ -45,6 +47,10 @@ class BoxSmoother:
     size_noise : float
         Standard deviation of a detection's width and height, in track heights.
 
+    max_hole : int
+        A track is smoothed in independent pieces split at holes longer than this many frames,
+        so the work is bounded by ``(max_hole + 1)`` steps per row whatever the frame numbers.
+
     Only the ratios ``accel / noise`` and ``size_accel / size_noise`` change the smoothed
     boxes; the smaller they are, the smoother the path. The model is
     :func:`pftrack.kalman.rts_smooth` with the first detection as the initial state. A smoothed
@@ -56,12 +62,18 @@ class BoxSmoother:
     noise: float = 0.05
     size_accel: float = 0.003
     size_noise: float = 0.1
+    max_hole: int = 300
 
     def __post_init__(self) -> None:
         for name in ("accel", "noise", "size_accel", "size_noise"):
             v = getattr(self, name)
-            if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"BoxSmoother: {name} is {v}, expected a finite value > 0")
+            if not (isinstance(v, (int, float)) and np.isfinite(v) and 0 < v < 1e6):
+                raise ValueError(
+                    f"BoxSmoother: {name} is {v!r}, expected a finite value in (0, 1e6)"
+                )
+        h = self.max_hole
+        if not isinstance(h, (int, np.integer)) or isinstance(h, bool) or h < 1:
+            raise ValueError(f"BoxSmoother: max_hole is {h!r}, expected an integer >= 1")
 
     def smooth(self, frames: ArrayLike, boxes_xywh: ArrayLike, observed: ArrayLike) -> F64:
         """Smooth one track.
@@ -97,6 +109,13 @@ class BoxSmoother:
             raise ValueError("BoxSmoother.smooth: observed boxes contain NaN or inf")
         if not obs.any():
             return np.array(b, dtype=np.float64)  # a copy
+        cuts = np.flatnonzero(np.diff(f) > self.max_hole + 1) + 1
+        if len(cuts):  # independent pieces: bounded work
+            out_p: F64 = b.copy()
+            for i, j in zip(np.r_[0, cuts], np.r_[cuts, n], strict=True):
+                if obs[i:j].any():
+                    out_p[i:j] = self.smooth(f[i:j], b[i:j], obs[i:j])
+            return out_p
         z = xywh_to_cxcywh(b)
         height = float(np.median(b[obs, 3]))
         if not height > 0:
@@ -124,6 +143,9 @@ def smooth_tracks(
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
     measurements: ArrayLike | None = None,
+    *,
+    fill_method: str = DEFAULT_METHOD,
+    seed: int = 0,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 
@@ -138,22 +160,36 @@ def smooth_tracks(
         None links only (and fills nothing).
     link : LinkConfig or None
         Join fragments of one object first (:func:`pftrack.recovery.linking.link_tracklets`);
-        with a smoother, frames missing inside a track (up to ``link.max_gap``) are added as
-        rows of the smoother's interpolation, flagged in column 8 (1-based) as pftrack's filled
-        rows are (:data:`pftrack.recovery.linking.FLAG_COLUMN`). None keeps ids and holes.
+        with a smoother, frames missing inside a track (holes of at most ``link.max_gap``
+        frames; longer holes stay holes, so work and memory are bounded by the number of rows)
+        are added as rows recovered by `fill_method`
+        (:func:`pftrack.recovery.fill.fill_rows`, the default of ``pftrack recover``), shifted
+        by the smoother's correction of the boxes on each side, and flagged in column 8
+        (1-based) as pftrack's filled rows are (:data:`pftrack.recovery.linking.FLAG_COLUMN`).
+        None keeps ids and holes.
     measurements : (M, 4) array_like, optional
         The boxes the smoother fits at observed rows, when they differ from the rows' own
         (which linking uses): e.g. raw detections behind a tracker's filtered boxes.
+
+    fill_method : str
+        Recovery method of the holes (one of :data:`pftrack.recovery.METHODS`); default
+        ``"auto"``, calibrated on the rows themselves.
+    seed : int
+        Seed of ``"auto"``'s calibration.
 
     Returns
     -------
     (M', 10) ndarray
         The rows, sorted by frame then id.
+
+    Raises
+    ------
+    ValueError
+        Rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
+        id, a non-finite box, or `observed` / `measurements` of the wrong shape.
     """
-    if np.size(rows):
-        a = np.array(rows, dtype=np.float64, copy=True).reshape(-1, 10)
-    else:
-        a = np.zeros((0, 10))
+    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "smooth_tracks")
+    a = a.copy()
     obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
     if obs.shape != (len(a),):
         raise ValueError(f"smooth_tracks: observed has shape {obs.shape}, expected ({len(a)},)")
@@ -162,47 +198,52 @@ def smooth_tracks(
     if measurements is None:
         z = a[:, 2:6].copy()
     else:
-        z = np.array(measurements, dtype=np.float64).reshape(-1, 4)
+        z = np.array(measurements, dtype=np.float64)
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
     if link is not None:
         a, _ = link_tracklets(a, link)
     order = np.lexsort((a[:, 0], a[:, 1]))  # by id, then frame
     a, obs, z = a[order], obs[order], z[order]
+    new = np.zeros(len(a), dtype=bool)
     if smoother is not None and link is not None:
-        a, obs, z = _add_hole_rows(a, obs, z, link.max_gap)
+        a, obs, z, new = _add_hole_rows(a, obs, z, link.max_gap, fill_method, seed)
     if smoother is not None:
         starts = np.flatnonzero(np.r_[True, a[1:, 1] != a[:-1, 1], True])
         spans = list(zip(starts[:-1], starts[1:], strict=True))
         for i, j in progress(spans, desc="smoothing", unit="track"):
             if obs[i:j].any():
-                a[i:j, 2:6] = smoother.smooth(a[i:j, 0], z[i:j], obs[i:j])
+                sm = smoother.smooth(a[i:j, 0], z[i:j], obs[i:j])
+                nw = new[i:j]
+                if nw.any() and not nw.all():  # filled rows: the recovered path, shifted as
+                    # the smoother shifted the boxes on both sides of each hole
+                    shift = sm[~nw] - z[i:j][~nw]
+                    fr = a[i:j, 0]
+                    for c in range(4):
+                        sm[nw, c] = z[i:j][nw, c] + np.interp(fr[nw], fr[~nw], shift[:, c])
+                a[i:j, 2:6] = sm
     out: F64 = a[np.lexsort((a[:, 1], a[:, 0]))]
     return out
 
 
 def _add_hole_rows(
-    a: F64, obs: NDArray[np.bool_], z: F64, max_gap: int
-) -> tuple[F64, NDArray[np.bool_], F64]:
-    """Add a flagged placeholder row for every frame missing inside a track.
+    a: F64, obs: NDArray[np.bool_], z: F64, max_gap: int, method: str, seed: int
+) -> tuple[F64, NDArray[np.bool_], F64, NDArray[np.bool_]]:
+    """Add a flagged row for every frame missing inside a track, recovered by `method`.
 
-    Only holes of at most `max_gap` frames are filled; rows must be sorted by id, then frame,
-    and come back so.
+    Only holes of at most `max_gap` frames are filled, from the measured boxes `z` (observed
+    rows) and the rows' own boxes (the others); rows must be sorted by id, then frame, and come
+    back so, with a mask of the added rows.
     """
-    missing = a[1:, 0] - a[:-1, 0] - 1
-    hole = np.flatnonzero((a[1:, 1] == a[:-1, 1]) & (missing >= 1) & (missing <= max_gap))
-    if not len(hole):
-        return a, obs, z
-    counts = missing[hole].astype(np.int64)
-    extra = np.zeros((int(counts.sum()), 10))
-    extra[:, 7:] = -1.0
-    extra[:, FLAG_COLUMN] = 1.0
-    first = np.repeat(a[hole, 0] + 1 - np.r_[0, np.cumsum(counts)[:-1]], counts)
-    extra[:, 0] = first + np.arange(len(extra))  # the frames after each hole's start
-    extra[:, 1] = np.repeat(a[hole, 1], counts)
-    extra[:, 4:6] = 1.0  # placeholders: the smoother writes every filled box
+    src = a.copy()
+    src[:, 2:6] = z
+    extra, _ = fill_rows(src, method, max_gap, seed=seed)
+    n = len(a)
+    if not len(extra):
+        return a, obs, z, np.zeros(n, dtype=bool)
     a = np.vstack([a, extra])
     obs = np.concatenate([obs, np.zeros(len(extra), dtype=bool)])
     z = np.vstack([z, extra[:, 2:6]])
+    new = np.r_[np.zeros(n, dtype=bool), np.ones(len(extra), dtype=bool)]
     order = np.lexsort((a[:, 0], a[:, 1]))
-    return a[order], obs[order], z[order]
+    return a[order], obs[order], z[order], new[order]

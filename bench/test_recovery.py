@@ -1,0 +1,114 @@
+"""Recovery of a whole MOT file and its hot parts against their NumPy references.
+
+* ``fill 500 tracks``: :func:`pftrack.recovery.fill_gaps` on the 500-track synthetic file of
+  :mod:`bench.recovery_file` (``auto``, calibration included, and ``linear``).
+* ``rts gaps``: the batched Kalman/RTS smoother of the ``rts`` candidate
+  (:func:`~pftrack.recovery.baselines.rts_batch`, one vectorised pass for all gaps) against the
+  textbook matrix loop of ``tests/reference/smoothing.py``, one gap at a time.
+* ``singer loglik``: the C++ likelihood behind ``fit_motion`` against
+  ``tests/reference/mixture.py``.
+
+Locally: ``pytest bench/test_recovery.py --benchmark-only``; CI: ``--benchmark-disable``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pytest_benchmark.fixture import BenchmarkFixture
+
+from bench.recovery_file import synthetic_tracks
+from pftrack import _core
+from pftrack._typing import F64
+from pftrack.kalman import cv_transition, wna_Q
+from pftrack.recovery import fill_gaps
+from pftrack.recovery.baselines import rts_batch
+from pftrack.recovery.mixture import DIFFUSE, singer_model
+from tests.reference import mixture as ref_mix
+from tests.reference.smoothing import dense_kalman_rts
+
+
+@pytest.fixture(scope="module")
+def tracks_500() -> F64:
+    return synthetic_tracks(500, seed=0)
+
+
+@pytest.mark.parametrize("method", ["auto", "linear"])
+def test_fill_500_tracks(benchmark: BenchmarkFixture, tracks_500: F64, method: str) -> None:
+    benchmark.group = "fill 500 tracks"
+    out, rep = benchmark.pedantic(fill_gaps, args=(tracks_500, method), rounds=3, iterations=1)
+    assert rep.n_gaps > 400 and np.all(np.isfinite(out))
+
+
+def _gaps(n: int = 400) -> list[tuple[F64, F64]]:
+    rng = np.random.default_rng(0)
+    out = []
+    for _ in range(n):
+        na, nb, L = (int(v) for v in rng.integers(5, 40, 3))
+        fa, fb = np.arange(na, dtype=float), np.arange(na + L, na + L + nb, dtype=float)
+        a = np.column_stack([fa, np.cumsum(rng.normal(0, 2, (na, 2)), axis=0)])
+        b = np.column_stack([fb, np.cumsum(rng.normal(0, 2, (nb, 2)), axis=0)])
+        out.append((a, b))
+    return out
+
+
+def _rts_reference(pairs: list[tuple[F64, F64]], q: float = 0.1, r: float = 1.0) -> list[F64]:
+    """One textbook matrix Kalman/RTS loop per gap and axis (30 points each side)."""
+    F, Q = cv_transition(), wna_Q(q)
+    H, R = np.array([[1.0, 0.0]]), np.array([[r]])
+    res = []
+    for a, b in pairs:
+        a, b = a[-30:], b[:30]
+        f0 = int(a[0, 0])
+        n = int(b[-1, 0]) - f0 + 1
+        has = np.zeros(n, dtype=bool)
+        has[(a[:, 0] - f0).astype(int)] = has[(b[:, 0] - f0).astype(int)] = True
+        cols = []
+        for axis in (1, 2):
+            z = np.zeros((n, 1))
+            z[(a[:, 0] - f0).astype(int), 0] = a[:, axis]
+            z[(b[:, 0] - f0).astype(int), 0] = b[:, axis]
+            m0, P0 = np.array([z[0, 0], 0.0]), np.diag([r, 100.0])
+            _, sm, _ = dense_kalman_rts(z, has, F, Q, H, R, m0, P0)
+            cols.append(sm[:, 0])
+        lo, hi = int(a[-1, 0]) - f0 + 1, int(b[0, 0]) - f0
+        res.append(np.column_stack(cols)[lo:hi])
+    return res
+
+
+def test_rts_batch(benchmark: BenchmarkFixture) -> None:
+    benchmark.group = "rts gaps"
+    pairs = _gaps()
+    got = benchmark(rts_batch, pairs)
+    want = _rts_reference(pairs[:20])
+    for g, w in zip(got[:20], want, strict=True):
+        np.testing.assert_allclose(g, w, rtol=1e-8, atol=1e-8)
+
+
+def test_rts_numpy_reference(benchmark: BenchmarkFixture) -> None:
+    benchmark.group = "rts gaps"
+    benchmark.pedantic(_rts_reference, args=(_gaps(),), rounds=3, iterations=1)
+
+
+@pytest.fixture(scope="module")
+def singer_runs() -> list[F64]:
+    rng = np.random.default_rng(1)
+    return [np.cumsum(np.cumsum(rng.normal(0, 0.3, 120))) for _ in range(8)]
+
+
+def test_singer_loglik_core(benchmark: BenchmarkFixture, singer_runs: list[F64]) -> None:
+    benchmark.group = "singer loglik"
+    F, Q = singer_model(0.1, 3.0)
+    z = np.concatenate(singer_runs)
+    lengths = np.array([len(r) for r in singer_runs], dtype=np.int32)
+    args = (z, lengths, np.ascontiguousarray(F.reshape(-1, 3)),
+            np.ascontiguousarray(Q.reshape(-1, 3)), np.array([0.5]), DIFFUSE)  # fmt: skip
+    got = benchmark(_core.state_loglik_batch, *args)
+    want = ref_mix.state_loglik(singer_runs, F[0], Q[0], 0.5, DIFFUSE)
+    np.testing.assert_allclose(got[0], want, rtol=1e-9)
+
+
+def test_singer_loglik_numpy(benchmark: BenchmarkFixture, singer_runs: list[F64]) -> None:
+    benchmark.group = "singer loglik"
+    F, Q = singer_model(0.1, 3.0)
+    benchmark(ref_mix.state_loglik, singer_runs, F[0], Q[0], 0.5, DIFFUSE)

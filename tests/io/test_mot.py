@@ -1,0 +1,74 @@
+"""read_mot/write_mot: the vectorised paths give exactly what the line-by-line ones give."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pftrack.io import mot
+
+
+def _slow_read(path: Path) -> np.ndarray:
+    rows = []
+    for _, text in mot._data_lines(path):
+        v = [float(f) for f in text.replace(",", " ").split()[:10]]
+        rows.append(v + list(mot._DEFAULTS[len(v) :]))
+    return np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+
+
+def test_write_equals_format_mot_row(tmp_path: Path) -> None:
+    rng = np.random.default_rng(0)
+    n = 3000
+    a = np.column_stack(
+        [rng.integers(1, 100, n), rng.integers(-3, 9, n), rng.normal(0, 50, (n, 8))]
+    )
+    digits = rng.integers(0, 4, (n, 8))
+    a[:, 2:] = np.round(a[:, 2:] * 10.0**digits) / 10.0**digits
+    a[::7, 2] = -0.0
+    a[::11, 3] = 1e16
+    a[::13, 4] = 3.999
+    a[::17, 5] = -2.004
+    mot.write_mot(tmp_path / "t.txt", a)
+    o = a[np.lexsort((a[:, 1], a[:, 0]))]
+    want = "".join(mot.format_mot_row(r) + "\n" for r in o)
+    assert (tmp_path / "t.txt").read_text() == want
+
+
+def test_fast_read_equals_line_by_line(tmp_path: Path) -> None:
+    p = tmp_path / "t.txt"
+    p.write_text("1,2,3.5,4,5,6,0.9,-1,-1,-1\n\n2,3,4,5,6,7,1,-1,-1,-1\n")
+    np.testing.assert_array_equal(mot.read_mot(p), _slow_read(p))
+    p.write_text("1 2 3 4 5 6\n2 3 4 5 6 7\n")  # whitespace, 6 columns
+    got = mot.read_mot(p)
+    np.testing.assert_array_equal(got, _slow_read(p))
+    assert got[0, 6:].tolist() == [1.0, -1.0, -1.0, -1.0]
+    p.write_text("# a comment\n1,2,3,4,5,6\n")  # comments: the line-by-line reader
+    assert mot.read_mot(p).shape == (1, 10)
+    p.write_text("")
+    assert mot.read_mot(p).shape == (0, 10)
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("1,2,3,4,5,6\n2,3,4,5,6\n", ":2: .*5 fields"),
+        ("1.5,2,3,4,5,6\n", ":1: frame is 1.5"),
+        ("1,2,3,4,-5,6\n", ":1: negative box"),
+        ("1,2,nan,4,5,6\n", ":1: .*non-finite"),
+    ],
+)
+def test_bad_lines_still_named(tmp_path: Path, text: str, match: str) -> None:
+    p = tmp_path / "t.txt"
+    p.write_text(text)
+    with pytest.raises(ValueError, match=match):
+        mot.read_mot(p)
+
+
+def test_write_refuses_non_finite(tmp_path: Path) -> None:
+    a = np.ones((2, 10))
+    a[1, 3] = np.nan
+    with pytest.raises(ValueError, match="row 1 has a non-finite value"):
+        mot.write_mot(tmp_path / "t.txt", a)
+    assert not (tmp_path / "t.txt").exists()

@@ -1,0 +1,171 @@
+"""Bounded work and memory of hole filling, refused absurd input, batched kernels = references."""
+
+from __future__ import annotations
+
+import time
+import tracemalloc
+from collections.abc import Callable
+from typing import TypeVar
+
+import numpy as np
+import pytest
+
+from pftrack.recovery import fill_gaps
+from pftrack.recovery.baselines import rts, rts_batch
+from pftrack.recovery.fill import DEFAULT_MAX_GAP, MAX_GAP_LIMIT
+from pftrack.tracking import BoxSmoother, smooth_tracks
+
+
+def _rows(frames: list[int], ids: list[int]) -> np.ndarray:
+    n = len(frames)
+    x = np.arange(n, dtype=np.float64)
+    return np.column_stack([frames, ids, 10 + x, 20 + 0.5 * x, np.full((n, 2), (20.0, 40.0)),
+                            np.ones(n), -np.ones((n, 3))])  # fmt: skip
+
+
+T = TypeVar("T")
+FAR = _rows([1, 2, 3, 10_000_000, 10_000_001, 5, 9], [1, 1, 1, 1, 1, 2, 2])
+
+
+def _bounded(fn: Callable[[], T], seconds: float = 10.0, megabytes: float = 50.0) -> T:
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    try:
+        out = fn()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert time.perf_counter() - t0 < seconds
+    assert peak < megabytes * 2**20, f"peak {peak / 2**20:.0f} MB"
+    return out
+
+
+@pytest.mark.parametrize("method", ["auto", "linear", "gdt-bi", "rts"])
+def test_fill_gaps_leaves_a_ten_million_frame_hole(method: str) -> None:
+    out, rep = _bounded(lambda: fill_gaps(FAR, method))
+    assert rep.n_gaps == 1 and rep.n_filled_rows == 3  # only id 2's 3-frame hole
+    assert len(out) == len(FAR) + 3
+
+
+def test_smooth_tracks_is_bounded_by_rows_not_frames() -> None:
+    out = _bounded(lambda: smooth_tracks(FAR))
+    assert len(out) == len(FAR) + 3  # id 2's hole filled, id 1's 10M-frame hole left alone
+    assert np.all(np.isfinite(out))
+    sm = _bounded(lambda: BoxSmoother().smooth(FAR[:5, 0], FAR[:5, 2:6], np.ones(5, bool)))
+    assert np.all(np.isfinite(sm))
+
+
+def test_smoother_pieces_equal_separate_runs() -> None:
+    """Split at a hole longer than max_hole: each piece is smoothed on its own."""
+    sm = BoxSmoother(max_hole=50)
+    rows = _rows([*range(1, 21), *range(200, 230)], [1] * 50)
+    obs = np.ones(50, bool)
+    both = sm.smooth(rows[:, 0], rows[:, 2:6], obs)
+    np.testing.assert_array_equal(both[:20], sm.smooth(rows[:20, 0], rows[:20, 2:6], obs[:20]))
+    np.testing.assert_array_equal(both[20:], sm.smooth(rows[20:, 0], rows[20:, 2:6], obs[20:]))
+
+
+def test_default_max_gap_everywhere() -> None:
+    import inspect
+
+    from pftrack.recovery.fill import fill_rows
+
+    assert DEFAULT_MAX_GAP == 30
+    for fn in (fill_gaps, fill_rows):
+        assert inspect.signature(fn).parameters["max_gap"].default == DEFAULT_MAX_GAP
+
+
+@pytest.mark.parametrize(
+    ("bad", "match"),
+    [
+        (1e12, "frame 1e\\+12 is not an integer"),
+        (2.5, "frame 2.5 is not an integer"),
+        (0, "frame 0 is not an integer"),
+        (np.nan, "must be finite"),
+    ],
+)
+def test_absurd_frames_refused(bad: float, match: str) -> None:
+    rows = FAR.copy()
+    rows[0, 0] = bad
+    with pytest.raises(ValueError, match=match):
+        fill_gaps(rows)
+    with pytest.raises(ValueError, match=match):
+        smooth_tracks(rows)
+
+
+def test_bad_shapes_ids_and_max_gap_refused() -> None:
+    for shape in [(6, 2), (6, 11), (10,)]:
+        with pytest.raises(ValueError, match=r"shape \(M, 10\)"):
+            smooth_tracks(np.ones(shape))
+        with pytest.raises(ValueError, match=r"shape \(M, 10\)"):
+            fill_gaps(np.ones(shape))
+    rows = FAR.copy()
+    rows[0, 1] = 2.5
+    with pytest.raises(ValueError, match="track id 2.5"):
+        fill_gaps(rows)
+    rows[0, 1] = 1e19
+    with pytest.raises(ValueError, match="track id 1e\\+19"):
+        smooth_tracks(rows)
+    for g in (0, MAX_GAP_LIMIT + 1, True, 2.0):
+        with pytest.raises(ValueError, match="max_gap"):
+            fill_gaps(FAR, max_gap=g)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="real"):
+        fill_gaps(np.full((2, 10), 1 + 1j))
+    with pytest.raises(ValueError, match="size_noise"):
+        BoxSmoother(size_noise=1e308)
+    with pytest.raises(ValueError, match="max_hole"):
+        BoxSmoother(max_hole=0)
+
+
+def test_rts_batch_equals_rts_per_gap() -> None:
+    rng = np.random.default_rng(0)
+    pairs = []
+    for _ in range(60):
+        na, nb, L = (int(v) for v in rng.integers(1, 45, 3))
+        f0 = int(rng.integers(1, 100))
+        fa, fb = np.arange(f0, f0 + na), np.arange(f0 + na + L, f0 + na + L + nb)
+        a = np.column_stack([fa, np.cumsum(rng.normal(0, 2, (na, 2)), axis=0)])
+        b = np.column_stack([fb, np.cumsum(rng.normal(0, 2, (nb, 2)), axis=0) + 5])
+        if na > 5:
+            a = np.delete(a, 2, axis=0)  # a hole inside the segment
+        pairs.append((a, b))
+    got = rts_batch(pairs)
+    for (a, b), g in zip(pairs, got, strict=True):
+        fr = np.arange(a[-1, 0] + 1, b[0, 0]).astype(np.int64)
+        np.testing.assert_allclose(g, rts(a, b, fr), rtol=1e-12, atol=1e-9)
+    assert rts_batch([]) == []
+
+
+def test_numpy_expm_matches_scipy() -> None:
+    from scipy.linalg import expm
+
+    from pftrack.recovery.mixture import _expm
+
+    rng = np.random.default_rng(1)
+    for scale in (1e-3, 1.0, 30.0):
+        M = rng.normal(0, scale, (20, 6, 6))
+        want = expm(M)
+        np.testing.assert_allclose(_expm(M), want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+
+
+def test_cli_smooth_and_recover_bounded_and_refusing(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    from pftrack.cli import main
+    from pftrack.io.mot import read_mot, write_mot
+
+    src = tmp_path / "far.txt"
+    write_mot(src, FAR)
+    t0 = time.perf_counter()
+    assert main(["smooth", str(src), "--out", str(tmp_path / "s.txt")]) == 0
+    assert main(["recover", str(src), "--out", str(tmp_path / "r.txt")]) == 0
+    assert time.perf_counter() - t0 < 20.0
+    assert len(read_mot(tmp_path / "s.txt")) == len(FAR) + 3
+    assert len(read_mot(tmp_path / "r.txt")) == len(FAR) + 3
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1,1,10,10,20,40\n3000000000,1,12,10,20,40\n")
+    for cmd in ("smooth", "recover"):
+        assert main([cmd, str(bad), "--out", str(tmp_path / "o.txt")]) == 2
+        err = capsys.readouterr().err
+        assert f"pftrack {cmd}: error:" in err and "3e+09 is not an integer in 1..2147483647" in err
+    assert not (tmp_path / "o.txt").exists()
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--max-gap", "200000"]) == 2
+    assert "max_gap is 200000" in capsys.readouterr().err
