@@ -12,7 +12,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from pftrack.cli import demo, evaluate, experiment, recover, smooth, track
+from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
 from pftrack.cli._options import HelpFormatter
 
 __all__ = ["build_parser", "main"]
@@ -22,6 +22,7 @@ examples:
   pftrack demo                                   # synthetic scene: track, render, score, recover
   pftrack track video.avi --out tracks.txt --render annotated.mp4 --plot paths.png
   pftrack track seq/img1 --detections det.txt --out tracks.txt      # drop-in for any detector
+  pftrack batch videos/ MOT17/train/ --out results/ --detections auto  # many, on Dask
   pftrack eval --gt gt.txt --res tracks.txt --scale 0.625
   pftrack recover tracks.txt --out filled.txt --link                # default method: auto
   pftrack smooth bytetrack.txt --out smoothed.txt                   # any tracker's output
@@ -39,7 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for command in (demo, track, smooth, evaluate, recover, experiment):
+    for command in (demo, track, batch, smooth, evaluate, recover, experiment):
         command.add_parser(sub)
     return parser
 

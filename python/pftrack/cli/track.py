@@ -40,9 +40,8 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.io.video import FrameSource
-    from pftrack.recovery import LinkConfig
     from pftrack.render import plot_trajectories, write_annotated_video
-    from pftrack.tracking import BoxSmoother, load_detections, track_frames
+    from pftrack.tracking.run import track_path
 
     inputs = (args.source,) + ((args.detections,) if args.detections else ())
     check_output(args.out, what="--out", inputs=inputs)
@@ -51,15 +50,15 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
     source = FrameSource(args.source)
-    dets = load_detections(args.detections, args.det_scale) if args.detections else None
-    result = track_frames(
+    result = track_path(
         source,
-        detections=dets,
+        detections=args.detections,
+        det_scale=args.det_scale,
         config=tracker_config(args),
-        rng=args.seed,
+        seed=args.seed,
         fill=args.fill,
-        smoother=None if args.no_smooth else BoxSmoother(),
-        link=None if args.no_link else LinkConfig(),
+        smooth=not args.no_smooth,
+        link=not args.no_link,
     )
     write_mot(args.out, result.rows)
     n_ids = len(set(result.rows[:, 1].astype(int))) if len(result.rows) else 0
