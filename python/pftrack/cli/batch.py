@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -94,19 +95,26 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _finish(summary: BatchSummary) -> int:
+def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
+    """Run the batch; print its table, or what stopped it; return the exit status."""
+    try:
+        summary = call()
+    except KeyboardInterrupt:
+        print(
+            f"pftrack {command}: interrupted; the outputs written so far are complete (re-run "
+            "to finish the rest)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    except ImportError as exc:  # Dask is an extra: pftrack[dask]
+        print(f"pftrack {command}: error: {exc}", file=sys.stderr)
+        return 2
+    for e in summary.entries if explain else ():
+        if e.get("explain"):
+            print(f"{e['name']}:\n{e['explain']}")
     print(summary.table())
     print(f"summary -> {summary.out_dir / 'summary.json'}")
     return EXIT_SOME_FAILED if summary.failed else 0
-
-
-def _interrupted(command: str) -> int:
-    print(
-        f"pftrack {command}: interrupted; the outputs written so far are complete (re-run to "
-        "finish the rest)",
-        file=sys.stderr,
-    )
-    return EXIT_INTERRUPTED
 
 
 def _where(args: argparse.Namespace) -> dict[str, Any]:
@@ -129,11 +137,7 @@ def run(args: argparse.Namespace) -> int:
         render=".mp4" if args.render else None,
         iou=args.iou,
     )
-    try:
-        summary = track_many(args.inputs, args.out, options=options, **_where(args))
-    except KeyboardInterrupt:
-        return _interrupted("batch")
-    return _finish(summary)
+    return _run("batch", lambda: track_many(args.inputs, args.out, options=options, **_where(args)))
 
 
 def run_recover(args: argparse.Namespace) -> int:
@@ -150,15 +154,12 @@ def run_recover(args: argparse.Namespace) -> int:
         link=args.link,
         max_distance=args.max_distance,
     )
-    try:
-        summary = recover_many(args.tracks, args.out, options=options, **_where(args))
-    except KeyboardInterrupt:
-        return _interrupted("recover")
-    if args.explain:
-        for e in summary.entries:
-            if e.get("explain"):
-                print(f"{e['name']}:\n{e['explain']}")
-    return _finish(summary)
+    where = _where(args)
+    return _run(
+        "recover",
+        lambda: recover_many(args.tracks, args.out, options=options, **where),
+        explain=args.explain,
+    )
 
 
 def run_smooth(args: argparse.Namespace) -> int:
@@ -166,8 +167,5 @@ def run_smooth(args: argparse.Namespace) -> int:
     from pftrack.batch import SmoothOptions, smooth_many
 
     options = SmoothOptions(max_gap=args.max_gap, link=not args.no_link)
-    try:
-        summary = smooth_many(args.tracks, args.out, options=options, **_where(args))
-    except KeyboardInterrupt:
-        return _interrupted("smooth")
-    return _finish(summary)
+    where = _where(args)
+    return _run("smooth", lambda: smooth_many(args.tracks, args.out, options=options, **where))
