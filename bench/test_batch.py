@@ -17,6 +17,7 @@ Figures go to ``extra_info`` and are printed (``-s``).
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -63,7 +64,11 @@ def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
     start = time.perf_counter()
     summary = track_many(inputs, out, client, force=True, show_progress=False, **kwargs)
     assert not summary.failed, summary.table()
+    CPU[str(out)] = [e["cpu_seconds"] for e in summary.entries]
     return time.perf_counter() - start
+
+
+CPU: dict[str, list[float]] = {}  # CPU seconds of each sequence's task, by output folder
 
 
 TIMES: dict[str, float] = {}  # the serial time, for the speed-up printed by the next case
@@ -72,10 +77,16 @@ TIMES: dict[str, float] = {}  # the serial time, for the speed-up printed by the
 def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> float:
     seconds = float(benchmark.pedantic(_run, args, kwargs, rounds=1))
     TIMES[key] = seconds
-    benchmark.extra_info["seconds"] = seconds
+    cpu = CPU[str(args[1])]
+    load = os.getloadavg()[0]  # the other users of the cores, for reading the figures
+    benchmark.extra_info.update(seconds=seconds, cpu_seconds_per_sequence=cpu, loadavg=load)
+    line = f"\n{key}: {seconds:.1f} s (load {load:.1f}); CPU s per sequence " + " ".join(
+        f"{c:.2f}" for c in cpu
+    )
     if key != "serial" and "serial" in TIMES:
         benchmark.extra_info["speedup"] = TIMES["serial"] / seconds
-        print(f"\n{key}: {seconds:.1f} s, {TIMES['serial'] / seconds:.2f}x serial")
+        line += f"; {TIMES['serial'] / seconds:.2f}x serial"
+    print(line)
     return seconds
 
 

@@ -47,8 +47,8 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     g.add_argument(
         "--workers", type=non_negative_int, default=os.cpu_count() or 1, metavar="N",
-        help="worker processes of the local cluster, one thread each (default: one per "
-        "core); 0 runs in this process without Dask",
+        help="worker processes of the local cluster, one thread each (one per core unless "
+        "given; not used with --scheduler); 0 runs in this process without Dask",
     )  # fmt: skip
     g.add_argument("--force", action="store_true",
                    help="redo inputs whose outputs are complete, instead of skipping "
