@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import math
 import os
 import time
@@ -259,12 +260,13 @@ def dask_client(
             threads_per_worker=1,
             processes=True,
             host="127.0.0.1",
+            silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks (Ctrl-C)
             dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not 8787:
             scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # several batches at once
         ) as cluster,
         Client(cluster) as c,
     ):
-        c.register_plugin(SingleThreaded())
+        c.register_plugin(SingleThreaded(ignore_interrupt=True))
         yield c
 
 
