@@ -408,3 +408,12 @@ def test_render_writes_a_video_per_sequence_and_counts_for_resume(
     assert track_many(data / "plain", tmp_path, client, options=options).entries[0]["status"] == (
         "skipped"
     )
+
+
+def test_scheduler_address_from_the_environment(
+    data: Path, client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", client.scheduler.address)
+    assert main(["batch", str(data / "plain"), "--out", str(tmp_path), *FAST]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["scheduler"] == client.scheduler.address and summary["workers"] == 2
