@@ -136,6 +136,14 @@ def sequence_metrics(
     return {k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in out.items()}
 
 
+def _as_written(rows: F64) -> F64:
+    """`rows` rounded as ``NAME.txt`` stores them: the metrics are ``pftrack eval``'s on it."""
+    from pftrack.io.mot import format_mot_row
+
+    lines = [format_mot_row(r).split(",") for r in rows]
+    return np.array(lines, dtype=np.float64).reshape(len(rows), 10)
+
+
 def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     """Track one sequence as ``pftrack track`` would; score it where it has ground truth.
 
@@ -182,7 +190,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     metrics = None
     if seq.gt is not None:
         gt = read_mot(seq.gt, what="ground truth")
-        metrics = sequence_metrics(gt, rows, scale=auto_scale, iou=options.iou)
+        metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
     files: dict[str, bytes] = {}
     if options.render is not None:
         from pftrack.render import write_annotated_video
