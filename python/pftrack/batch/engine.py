@@ -146,20 +146,21 @@ class BatchSummary:
         counts = ", ".join(
             f"{n} {s}" for s in _STATUSES if (n := sum(e["status"] == s for e in self.entries))
         )
-        where = f"{self.workers} workers" if self.workers else "in this process"
+        where = _count(self.workers, "worker") if self.workers else "in this process"
         if self.scheduler:
             where += f" at {self.scheduler}"
-        text.append(f"{len(self.entries)} {self._noun}: {counts}; {self.seconds:.1f} s, {where}")
+        noun = "sequence" if self.kind == "track" else "file"
+        text.append(f"{_count(len(self.entries), noun)}: {counts}; {self.seconds:.1f} s, {where}")
         for e in self.failed:
             text.append(f"{e['name']}: error: {e['error']}")
         return "\n".join(text)
 
-    @property
-    def _noun(self) -> str:
-        return "sequences" if self.kind == "track" else "files"
-
 
 _STATUSES = ("done", "skipped", "failed", "cancelled")
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
 def _pct(v: float) -> str:
@@ -462,6 +463,9 @@ def _run_on_dask(
     """Submit `pending` to Dask and record each result as it completes."""
     from distributed import as_completed
 
+    if n_workers is None:
+        n_workers = os.cpu_count() or 1
+    n_workers = min(n_workers, len(pending))  # a local cluster: no idle worker to start
     with dask_client(client, scheduler, n_workers) as c:
         info = c.scheduler_info()
         summary.workers = len(info.get("workers", {}))
