@@ -434,7 +434,8 @@ def run_jobs(
                 "traceback": trace,
             }
 
-    bar = {"total": len(pending), "desc": kind, "enable": show_progress}
+    desc = "sequences" if kind == "track" else "files"
+    bar = {"total": len(pending), "desc": desc, "enable": show_progress}
     try:
         if pending and n_workers == 0:
             for job in progress(pending, **bar):  # type: ignore[arg-type]
