@@ -83,6 +83,8 @@ ALLOWED = {
     "tracking": {"particle_filter", "detection", "recovery"},
     "eval": set(),
     "integrations": {"tracking"},  # adapters to other libraries' tracker interfaces
+    # the batch layer runs whole commands: it scores (eval) and renders like the CLI does
+    "batch": {"particle_filter", "detection", "recovery", "tracking", "eval", "render"},
 }
 
 

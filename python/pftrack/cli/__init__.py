@@ -12,7 +12,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from pftrack.cli import demo, evaluate, experiment, recover, smooth, track
+from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
 from pftrack.cli._options import HelpFormatter
 
 __all__ = ["build_parser", "main"]
@@ -24,6 +24,7 @@ examples:
   pftrack track MOT17-04/ --detections auto --out tracks.txt        # a MOTChallenge sequence
   pftrack track 0 --out live.txt --render live.mp4                  # camera 0; Ctrl-C ends it
   pftrack track seq/img1 --detections det.txt --out tracks.txt      # drop-in for any detector
+  pftrack batch videos/ MOT17/train/ --out results/ --detections auto  # many, on Dask
   pftrack eval --gt gt.txt --res tracks.txt --scale 0.625
   pftrack recover tracks.txt --out filled.txt --link                # default method: auto
   pftrack smooth bytetrack.txt --out smoothed.txt                   # any tracker's output
@@ -45,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     )  # fmt: skip
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for command in (demo, track, smooth, evaluate, recover, experiment):
+    for command in (demo, track, batch, smooth, evaluate, recover, experiment):
         command.add_parser(sub)
     return parser
 

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from pftrack.cli import batch
 from pftrack.cli._options import add_command, positive_int
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
@@ -22,7 +23,9 @@ def add_parser(sub: Any) -> None:
         "have the interpolated flag (column 8, 1-based) set to 1. Rows flagged by an earlier "
         "run count as observed, so running it twice changes nothing more.",
     )
-    p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,conf,x,y,z)")
+    p.add_argument("tracks", nargs="+", help="MOTChallenge tracks file (frame,id,left,top,w,h,"
+                   "conf,x,y,z); several, or folders of *.txt: a batch on Dask, --out is then a "
+                   "folder (see pftrack batch)")  # fmt: skip
     p.add_argument("--out", required=True, help="output file (written atomically)")
     p.add_argument("--method", default=DEFAULT_METHOD, choices=METHODS, help="recovery method")
     p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
@@ -40,11 +43,15 @@ def add_parser(sub: Any) -> None:
                    "(default: none, motion and size only)")  # fmt: skip
     p.add_argument("--in-place", action="store_true",
                    help="allow --out to be the input file (it is replaced atomically)")  # fmt: skip
+    batch.add_batch_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack recover``; return the exit status."""
+    if batch.is_batch(args.tracks):
+        return batch.run_recover(args)
+    args.tracks = args.tracks[0]
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery import LinkConfig, check_unique, fill_gaps, link_tracklets

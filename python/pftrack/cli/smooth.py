@@ -7,6 +7,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+from pftrack.cli import batch
 from pftrack.cli._options import add_command, positive_int
 
 
@@ -23,17 +24,23 @@ def add_parser(sub: Any) -> None:
         "and replace every box by a Rauch-Tung-Striebel smoother's estimate over the whole "
         "track. Smoothing is not idempotent: run it once, on raw output.",
     )
-    p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,conf,...)")
+    p.add_argument("tracks", nargs="+", help="MOTChallenge tracks file (frame,id,left,top,w,h,"
+                   "conf,...); several, or folders of *.txt: a batch on Dask, --out is then a "
+                   "folder (see pftrack batch)")  # fmt: skip
     p.add_argument("--out", required=True, help="output file (written atomically; never the input)")
     p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
                    help="longest gap joined and filled (longer holes stay holes: bounded "
                    "work)")  # fmt: skip
     p.add_argument("--no-link", action="store_true", help="smooth each id as it is")
+    batch.add_batch_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack smooth``; return the exit status."""
+    if batch.is_batch(args.tracks):
+        return batch.run_smooth(args)
+    args.tracks = args.tracks[0]
     import numpy as np
 
     from pftrack.io.atomic import check_output

@@ -22,7 +22,7 @@ from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
 from pftrack.tracking.track import Track
 
-__all__ = ["TrackingRun", "load_detections", "track_frames"]
+__all__ = ["TrackingRun", "load_detections", "track_frames", "track_path"]
 
 
 @dataclass(frozen=True)
@@ -177,3 +177,54 @@ def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
             "left, top, width, height, and all fit it as x1, y1, x2, y2: the file's boxes look "
             "like x1, y1, x2, y2 (MOTChallenge det.txt has left, top, width, height)"
         )
+
+
+def track_path(
+    source: PathLike | FrameSource,
+    *,
+    detections: PathLike | None = None,
+    det_scale: float = 1.0,
+    config: TrackerConfig | None = None,
+    seed: int = 0,
+    fill: str = "linear",
+    smooth: bool = True,
+    link: bool = True,
+    show_progress: bool | None = None,
+) -> TrackingRun:
+    """Track a video file or image folder as ``pftrack track`` does (and ``pftrack batch``).
+
+    The one place that turns the command's settings into a run, so that ``pftrack track`` and
+    every task of ``pftrack batch`` give the same rows for the same seed.
+
+    Parameters
+    ----------
+    source : path or FrameSource
+        Video file, image folder or MOTChallenge sequence folder.
+    detections : path, optional
+        MOTChallenge detection file; None uses the built-in detector of `config`.
+    det_scale : float
+        Multiplies the detection boxes (see :func:`load_detections`).
+    config : TrackerConfig, optional
+        Tracker settings (default ``TrackerConfig()``).
+    seed : int
+        Random seed.
+    fill : {"linear", "pf"}
+        Boxes of bridged gaps when `smooth` is False (see :func:`track_frames`).
+    smooth, link : bool
+        Smooth every track offline (:class:`BoxSmoother`); join fragments of one object
+        (:class:`~pftrack.recovery.LinkConfig`).
+    show_progress : bool, optional
+        Per-frame progress bar on stderr (default: when stderr is a terminal).
+    """
+    frames = source if isinstance(source, FrameSource) else FrameSource(source)
+    dets = load_detections(detections, det_scale) if detections is not None else None
+    return track_frames(
+        frames,
+        detections=dets,
+        config=config,
+        rng=seed,
+        fill=fill,
+        show_progress=show_progress,
+        smoother=BoxSmoother() if smooth else None,
+        link=LinkConfig() if link else None,
+    )

@@ -1,0 +1,152 @@
+"""``pftrack batch`` on Dask: speed-up over serial, per-task overhead, worker memory.
+
+nice pytest bench/test_batch.py --benchmark-enable --benchmark-only --benchmark-group-by=group
+
+- ``batch 4 sequences``: four PETS09-S2L1 videos (the one video under four names; a synthetic
+  480x360 scene of 795 frames when the data is absent) tracked with ``pftrack track``'s
+  defaults, one after the other in this process (``n_workers=0``) and on a warm two-worker
+  ``LocalCluster``; and once more including the cluster's start and close, as
+  ``pftrack batch`` does it. Goal: serial / two workers >= 1.7 on two cores.
+- ``batch overhead``: 40 tiny sequences (3 frames of 64x64): the scheduler's cost per sequence,
+  ``2 * t_dask / n - t_serial / n`` (worker-seconds per sequence beyond the work), goal <= 0.5 s.
+- ``batch memory``: 100 tiny sequences on the two workers; each worker's resident memory after
+  the first 10 and after all 100 (goal: flat).
+
+Figures go to ``extra_info`` and are printed (``-s``).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from pytest_benchmark.fixture import BenchmarkFixture
+
+from pftrack.batch import dask_client, track_many
+from pftrack.synthetic import make_scene
+
+pytest.importorskip("distributed")
+
+N_WORKERS = 2
+
+
+@pytest.fixture(scope="module")
+def client() -> Iterator[Any]:
+    with dask_client(n_workers=N_WORKERS) as c:
+        yield c
+
+
+@pytest.fixture(scope="module")
+def four_sequences(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("four")
+    video = data_dir / "pets09-s2l1" / "video.avi"
+    if not video.is_file():
+        video = make_scene(n_frames=795, rng=0).write_video(folder.parent / "synthetic.avi")
+    for k in range(1, 5):
+        (folder / f"seq{k}.avi").symlink_to(video)  # a link, not a copy of the data
+    return folder
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("tiny")
+    scene = make_scene(n_frames=3, width=64, height=64, n_walkers=1, rng=0)
+    for k in range(100):
+        scene.write_images(folder / f"t{k:03d}")
+    return folder
+
+
+def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
+    start = time.perf_counter()
+    summary = track_many(inputs, out, client, force=True, show_progress=False, **kwargs)
+    assert not summary.failed, summary.table()
+    CPU[str(out)] = [e["cpu_seconds"] for e in summary.entries]
+    return time.perf_counter() - start
+
+
+CPU: dict[str, list[float]] = {}  # CPU seconds of each sequence's task, by output folder
+
+
+TIMES: dict[str, float] = {}  # the serial time, for the speed-up printed by the next case
+
+
+def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> float:
+    seconds = float(benchmark.pedantic(_run, args, kwargs, rounds=1))
+    TIMES[key] = seconds
+    cpu = CPU[str(args[1])]
+    load = os.getloadavg()[0]  # the other users of the cores, for reading the figures
+    benchmark.extra_info.update(seconds=seconds, cpu_seconds_per_sequence=cpu, loadavg=load)
+    line = f"\n{key}: {seconds:.1f} s (load {load:.1f}); CPU s per sequence " + " ".join(
+        f"{c:.2f}" for c in cpu
+    )
+    if key != "serial" and "serial" in TIMES:
+        benchmark.extra_info["speedup"] = TIMES["serial"] / seconds
+        line += f"; {TIMES['serial'] / seconds:.2f}x serial"
+    print(line)
+    return seconds
+
+
+@pytest.mark.benchmark(group="batch 4 sequences")
+def test_four_serial(benchmark: BenchmarkFixture, four_sequences: Path, tmp_path: Path) -> None:
+    _timed(benchmark, "serial", four_sequences, tmp_path, n_workers=0)
+
+
+@pytest.mark.benchmark(group="batch 4 sequences")
+def test_four_two_workers(
+    benchmark: BenchmarkFixture, four_sequences: Path, client: Any, tmp_path: Path
+) -> None:
+    _run([four_sequences / "seq1.avi"], tmp_path, client)  # workers import pftrack: not timed
+    _timed(benchmark, "two workers (warm cluster)", four_sequences, tmp_path, client)
+
+
+@pytest.mark.benchmark(group="batch 4 sequences")
+def test_four_two_workers_with_cluster_start(
+    benchmark: BenchmarkFixture, four_sequences: Path, tmp_path: Path
+) -> None:
+    _timed(benchmark, "two workers (cluster started)", four_sequences, tmp_path, n_workers=2)
+
+
+@pytest.mark.benchmark(group="batch overhead")
+def test_overhead_per_sequence(
+    benchmark: BenchmarkFixture, client: Any, tiny: Path, tmp_path: Path
+) -> None:
+    inputs = sorted(tiny.iterdir())[:40]
+    _run(inputs[:4], tmp_path / "warm", client)
+    serial = _run(inputs, tmp_path / "serial", n_workers=0)
+    dask = float(benchmark.pedantic(_run, (inputs, tmp_path / "dask", client), rounds=1))
+    overhead = N_WORKERS * dask / len(inputs) - serial / len(inputs)
+    benchmark.extra_info.update(serial_s=serial, dask_s=dask, overhead_s=overhead)
+    print(
+        f"\n{len(inputs)} tiny sequences: serial {serial:.2f} s, {N_WORKERS} workers "
+        f"{dask:.2f} s; overhead {1e3 * overhead:.0f} ms per sequence (goal <= 500 ms)"
+    )
+    assert overhead < 0.5
+
+
+def _rss() -> int:
+    import psutil
+
+    return int(psutil.Process().memory_info().rss)
+
+
+@pytest.mark.benchmark(group="batch memory")
+def test_worker_memory_is_flat(
+    benchmark: BenchmarkFixture, client: Any, tiny: Path, tmp_path: Path
+) -> None:
+    inputs = sorted(tiny.iterdir())
+    _run(inputs[:10], tmp_path / "a", client)
+    after_10 = client.run(_rss)
+    benchmark.pedantic(_run, (inputs[10:], tmp_path / "b", client), rounds=1)
+    after_100 = client.run(_rss)
+    growth = {w: (after_100[w] - after_10[w]) / 2**20 for w in after_10}
+    benchmark.extra_info["rss_mib_after_10"] = [after_10[w] / 2**20 for w in after_10]
+    benchmark.extra_info["rss_mib_after_100"] = [after_100[w] / 2**20 for w in after_10]
+    print(
+        "\nworker RSS after 10 / 100 tiny sequences (MiB): "
+        + ", ".join(f"{after_10[w] / 2**20:.0f} / {after_100[w] / 2**20:.0f}" for w in after_10)
+    )
+    assert max(growth.values()) < 20, growth

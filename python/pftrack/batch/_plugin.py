@@ -1,0 +1,49 @@
+"""The Dask worker plugin of a batch (imports Dask: load it only when a cluster is used)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+from typing import Any
+
+from distributed.diagnostics.plugin import WorkerPlugin
+
+__all__ = ["SingleThreaded"]
+
+#: Thread-count variables read by BLAS and OpenMP libraries at load time.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+class SingleThreaded(WorkerPlugin):
+    """Make each worker process single-threaded: one sequence per core, no oversubscription.
+
+    OpenCV gets ``cv2.setNumThreads(1)`` when the plugin is set up. BLAS and OpenMP read their
+    thread counts when they load, so those come from the environment the worker starts with:
+    Dask's nanny sets ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` and ``MKL_NUM_THREADS`` to 1
+    by default (``distributed.nanny.pre-spawn-environ``); the plugin sets them too, for the
+    child processes a worker may start.
+
+    Parameters
+    ----------
+    ignore_interrupt : bool
+        Ignore SIGINT in the worker: for the local cluster of a run, whose workers share the
+        terminal's process group, so that Ctrl-C reaches only the client, which cancels the
+        tasks and closes the cluster (instead of every worker printing a traceback).
+    """
+
+    idempotent = True
+    name = "pftrack-single-threaded"
+
+    def __init__(self, ignore_interrupt: bool = False) -> None:
+        self.ignore_interrupt = ignore_interrupt
+
+    def setup(self, worker: Any) -> None:
+        """Limit OpenCV to one thread in this worker process."""
+        import cv2
+
+        for var in THREAD_VARIABLES:
+            os.environ.setdefault(var, "1")
+        cv2.setNumThreads(1)
+        if self.ignore_interrupt and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGINT, signal.SIG_IGN)

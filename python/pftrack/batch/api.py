@@ -1,0 +1,147 @@
+"""The batch entry points: :func:`track_many`, :func:`recover_many`, :func:`smooth_many`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from pftrack._typing import PathLike
+from pftrack.batch.engine import BatchSummary, Job, run_jobs
+from pftrack.batch.inputs import find_sequences, find_track_files
+from pftrack.batch.tasks import (
+    RecoverOptions,
+    SmoothOptions,
+    TrackOptions,
+    recover_file,
+    smooth_file,
+    track_sequence,
+)
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+__all__ = ["recover_many", "smooth_many", "track_many"]
+
+Inputs = PathLike | list[PathLike] | tuple[PathLike, ...]
+
+
+def track_many(
+    inputs: Inputs,
+    out_dir: PathLike,
+    client: Client | None = None,
+    *,
+    options: TrackOptions | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    force: bool = False,
+    show_progress: bool | None = None,
+) -> BatchSummary:
+    """Track every sequence of `inputs`, one Dask task each; write ``out_dir/NAME.txt``.
+
+    Parameters
+    ----------
+    inputs : path or sequence of paths
+        Videos, image folders, MOTChallenge sequence folders, or folders of them (see
+        :func:`~pftrack.batch.find_sequences`). Workers read them by these paths.
+    out_dir : path
+        Output folder (created if missing): ``NAME.txt`` (byte-identical to ``pftrack track``
+        with the same settings), ``NAME.mp4`` with ``options.render``, the sidecar
+        ``NAME.json`` and ``summary.json``. Written by this process, not by the workers.
+    client : distributed.Client, optional
+        Run on this client's cluster (left open). Default: `scheduler`, else a new
+        ``LocalCluster`` with `n_workers` single-threaded worker processes, closed at the end.
+    options : TrackOptions, optional
+        Tracker and output settings (default ``TrackOptions()``).
+    scheduler : str, optional
+        Address of a running Dask scheduler (also read from ``DASK_SCHEDULER_ADDRESS``).
+    n_workers : int, optional
+        Workers of the local cluster (default: one per core); 0 runs in this process, one
+        sequence after the other, without Dask.
+    force : bool
+        Redo sequences whose outputs are already complete.
+    show_progress : bool, optional
+        Progress bar over sequences (default: when stderr is a terminal).
+
+    Returns
+    -------
+    BatchSummary
+        Frames, tracks, frames/s and metrics (where ``gt/gt.txt`` exists) per sequence; failed
+        sequences with their error.
+    """
+    opts = options if options is not None else TrackOptions()
+    seqs = find_sequences(inputs)
+    jobs = [Job(s.name, track_sequence, (s, opts), s.files) for s in seqs]
+    return run_jobs(
+        jobs,
+        Path(out_dir),
+        kind="track",
+        settings=opts.settings(),
+        suffixes=(opts.render,) if opts.render else (),
+        client=client,
+        scheduler=scheduler,
+        n_workers=n_workers,
+        force=force,
+        show_progress=show_progress,
+    )
+
+
+def recover_many(
+    inputs: Inputs,
+    out_dir: PathLike,
+    client: Client | None = None,
+    *,
+    options: RecoverOptions | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    force: bool = False,
+    show_progress: bool | None = None,
+) -> BatchSummary:
+    """Fill the gaps of every tracks file of `inputs` (files or folders of ``*.txt``).
+
+    As :func:`track_many`; each ``out_dir/NAME.txt`` equals ``pftrack recover FILE`` with the
+    same settings.
+    """
+    opts = options if options is not None else RecoverOptions()
+    jobs = [Job(p.stem, recover_file, (p, opts), (p,)) for p in find_track_files(inputs)]
+    return run_jobs(
+        jobs,
+        Path(out_dir),
+        kind="recover",
+        settings=opts.settings(),
+        client=client,
+        scheduler=scheduler,
+        n_workers=n_workers,
+        force=force,
+        show_progress=show_progress,
+    )
+
+
+def smooth_many(
+    inputs: Inputs,
+    out_dir: PathLike,
+    client: Client | None = None,
+    *,
+    options: SmoothOptions | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    force: bool = False,
+    show_progress: bool | None = None,
+) -> BatchSummary:
+    """Link, fill and smooth every tracks file of `inputs` (files or folders of ``*.txt``).
+
+    As :func:`track_many`; each ``out_dir/NAME.txt`` equals ``pftrack smooth FILE`` with the
+    same settings.
+    """
+    opts = options if options is not None else SmoothOptions()
+    jobs = [Job(p.stem, smooth_file, (p, opts), (p,)) for p in find_track_files(inputs)]
+    return run_jobs(
+        jobs,
+        Path(out_dir),
+        kind="smooth",
+        settings=opts.settings(),
+        client=client,
+        scheduler=scheduler,
+        n_workers=n_workers,
+        force=force,
+        show_progress=show_progress,
+    )

@@ -1,0 +1,490 @@
+"""Run many tasks on Dask distributed; write their outputs on the client; resume; summarise.
+
+One task per sequence (or tracks file). The client submits every task that is not already
+complete, writes each result as it arrives (``DIR/NAME.txt``, extra files, then the sidecar
+``DIR/NAME.json``, each atomically), and writes ``DIR/summary.json`` at the end.
+
+*Complete* means: the sidecar exists, names the same inputs and settings, and every output it
+lists exists. The sidecar is written last, and every file atomically, so a run stopped at any
+point leaves each output either complete or absent; a re-run skips the complete ones.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import math
+import os
+import time
+import traceback
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from pftrack._progress import progress
+from pftrack.batch.tasks import TaskResult
+from pftrack.io.atomic import atomic_write, check_output
+from pftrack.io.mot import write_mot
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+__all__ = ["BatchSummary", "Job", "dask_client", "run_jobs"]
+
+SUMMARY_NAME = "summary.json"
+
+#: Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536, which turns off glibc's adaptive mmap
+#: threshold: every frame-sized array is then mmap'ed and unmapped again (11x the page faults,
+#: ~1.5x the CPU time per sequence, measured on a 480x360 video). Unset for the local cluster.
+NO_MALLOC_TRIM = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+#: The workers' statistical profiler samples every thread 100 times a second, for a dashboard
+#: the local cluster does not have: ~10 % of a worker's CPU time (noisy). Off for the local cluster.
+NO_PROFILER = "distributed.worker.profile.enabled"
+
+
+@dataclass(frozen=True)
+class Job:
+    """One task of a batch.
+
+    Attributes
+    ----------
+    name : str
+        Output name: ``DIR/NAME.txt`` and the sidecar ``DIR/NAME.json``.
+    func : callable
+        A module-level function (Dask pickles it by name) returning a :class:`TaskResult`.
+    args : tuple
+        Its arguments (picklable).
+    reads : tuple of Path
+        Files and folders the task reads (outputs may not be one of them).
+    """
+
+    name: str
+    func: Callable[..., TaskResult]
+    args: tuple[Any, ...]
+    reads: tuple[Path, ...]
+
+
+@dataclass
+class BatchSummary:
+    """What a batch did: one entry per task, in input order.
+
+    Attributes
+    ----------
+    kind : str
+        ``"track"``, ``"recover"`` or ``"smooth"``.
+    out_dir : Path
+        The output folder.
+    entries : list of dict
+        Per task: ``name``, ``status`` (``"done"``, ``"skipped"``: complete from an earlier run,
+        ``"failed"``, ``"cancelled"``), ``error`` (one line, failed only), and the task's figures
+        (``frames``, ``tracks``, ``fps``, ``metrics`` ... for tracking).
+    seconds : float
+        Wall time of the batch (cluster start included).
+    workers : int
+        Workers that ran it (0: in this process).
+    scheduler : str or None
+        Address of the Dask scheduler (None: in this process).
+    settings : dict
+        The settings every task ran with.
+    """
+
+    kind: str
+    out_dir: Path
+    entries: list[dict[str, Any]] = field(default_factory=list)
+    seconds: float = 0.0
+    workers: int = 0
+    scheduler: str | None = None
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def failed(self) -> list[dict[str, Any]]:
+        """Entries of the tasks that failed."""
+        return [e for e in self.entries if e["status"] == "failed"]
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (NaN and infinities become None)."""
+        counts = {s: sum(e["status"] == s for e in self.entries) for s in _STATUSES}
+        out: dict[str, Any] = _clean(
+            {
+                "kind": self.kind,
+                "out_dir": str(self.out_dir),
+                "seconds": self.seconds,
+                "workers": self.workers,
+                "scheduler": self.scheduler,
+                "counts": counts,
+                "settings": self.settings,
+                "sequences" if self.kind == "track" else "files": self.entries,
+            }
+        )
+        return out
+
+    def to_json(self) -> str:
+        """JSON text of :meth:`as_dict`."""
+        return json.dumps(self.as_dict(), indent=2)
+
+    def table(self) -> str:
+        """A text table: one line per task, then the totals."""
+        cols = _COLUMNS[self.kind]
+        head = ["name", "status"] + [c for c, _, _ in cols]
+        lines = [head]
+        for e in self.entries:
+            line = [e["name"], e["status"]]
+            for _, key, fmt in cols:
+                value = _lookup(e, key)
+                line.append("-" if value is None else fmt(value))
+            lines.append(line)
+        widths = [max(len(r[i]) for r in lines) for i in range(len(head))]
+        text = [
+            "  ".join(
+                c.ljust(w) if i < 2 else c.rjust(w)
+                for i, (c, w) in enumerate(zip(r, widths, strict=True))
+            )
+            for r in lines
+        ]
+        counts = ", ".join(
+            f"{n} {s}" for s in _STATUSES if (n := sum(e["status"] == s for e in self.entries))
+        )
+        where = _count(self.workers, "worker") if self.workers else "in this process"
+        if self.scheduler:
+            where += f" at {self.scheduler}"
+        noun = "sequence" if self.kind == "track" else "file"
+        text.append(f"{_count(len(self.entries), noun)}: {counts}; {self.seconds:.1f} s, {where}")
+        for e in self.failed:
+            text.append(f"{e['name']}: error: {e['error']}")
+        return "\n".join(text)
+
+
+_STATUSES = ("done", "skipped", "failed", "cancelled")
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
+def _pct(v: float) -> str:
+    return f"{100.0 * v:.1f}"
+
+
+def _int(v: float) -> str:
+    return str(int(v))
+
+
+# Columns of the table per kind: (header, key in the entry ("a.b" looks in a dict), format).
+_COLUMNS: dict[str, list[tuple[str, str, Callable[[Any], str]]]] = {
+    "track": [
+        ("frames", "frames", _int),
+        ("tracks", "tracks", _int),
+        ("frames/s", "fps", lambda v: f"{v:.0f}"),
+        ("MOTA%", "metrics.mota", _pct),
+        ("IDF1%", "metrics.idf1", _pct),
+        # HOTA%: add ("HOTA%", "metrics.hota", _pct) once sequence_metrics returns it.
+        ("IDsw", "metrics.id_switches", _int),
+    ],
+    "recover": [
+        ("rows in", "rows_in", _int),
+        ("linked", "fragments_linked", _int),
+        ("gaps", "gaps", _int),
+        ("filled", "filled_rows", _int),
+        ("ms", "seconds", lambda v: f"{1e3 * v:.1f}"),
+    ],
+    "smooth": [
+        ("ids in", "ids_in", _int),
+        ("rows in", "rows_in", _int),
+        ("ids out", "ids_out", _int),
+        ("rows out", "rows_out", _int),
+        ("ms", "seconds", lambda v: f"{1e3 * v:.1f}"),
+    ],
+}
+
+
+def _lookup(entry: dict[str, Any], key: str) -> Any:
+    value: Any = entry
+    for part in key.split("."):
+        value = value.get(part) if isinstance(value, dict) else None
+    return value
+
+
+def _clean(value: Any) -> Any:
+    """JSON-ready copy: NaN and infinities -> None, tuples -> lists."""
+    if isinstance(value, dict):
+        return {str(k): _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+@contextlib.contextmanager
+def dask_client(
+    client: Client | None = None, scheduler: str | None = None, n_workers: int | None = None
+) -> Iterator[Client]:
+    """A Dask client for a batch; whatever this starts, it closes.
+
+    Parameters
+    ----------
+    client : distributed.Client, optional
+        Use this client (left open).
+    scheduler : str, optional
+        Address of a running scheduler (``tcp://HOST:8786``); default: Dask's
+        ``scheduler-address`` setting (``DASK_SCHEDULER_ADDRESS``), else a new cluster.
+    n_workers : int, optional
+        Workers of the new ``LocalCluster`` (default: one per core), each a process with one
+        thread.
+    """
+    try:
+        import dask
+        from distributed import Client, LocalCluster
+    except ImportError as exc:  # pragma: no cover - only without the extra
+        raise ImportError(
+            "pftrack batch runs on Dask: pip install 'pftrack[dask]' (dask[distributed])"
+        ) from exc
+    from pftrack.batch._plugin import SingleThreaded
+
+    if client is not None:
+        client.register_plugin(SingleThreaded())
+        yield client
+        return
+    address = scheduler or dask.config.get("scheduler-address", None)
+    if address:
+        with Client(address, timeout="20s") as c:
+            c.register_plugin(SingleThreaded())
+            yield c
+        return
+    n = n_workers if n_workers is not None else (os.cpu_count() or 1)
+    with (
+        dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}),
+        LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks (Ctrl-C)
+            dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not 8787:
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # several batches at once
+        ) as cluster,
+        Client(cluster) as c,
+    ):
+        c.register_plugin(SingleThreaded(ignore_interrupt=True))
+        yield c
+
+
+def _sidecar(out_dir: Path, name: str) -> Path:
+    return out_dir / f"{name}.json"
+
+
+def _complete(
+    out_dir: Path, job: Job, kind: str, settings: dict[str, Any]
+) -> dict[str, Any] | None:
+    """The sidecar of `job` if its outputs are complete for these inputs and settings."""
+    path = _sidecar(out_dir, job.name)
+    try:
+        entry = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(entry, dict):
+        return None
+    same = (
+        entry.get("kind") == kind
+        and entry.get("settings") == settings
+        and entry.get("inputs") == [str(p) for p in job.reads]
+        and entry.get("status") == "done"
+    )
+    outputs = entry.get("outputs")
+    if not same or not isinstance(outputs, list):
+        return None
+    if not all((out_dir / str(o)).is_file() for o in outputs):
+        return None
+    return entry
+
+
+def _write(
+    out_dir: Path, job: Job, result: TaskResult, kind: str, settings: dict[str, Any]
+) -> dict[str, Any]:
+    """Write one task's outputs, sidecar last; return its summary entry."""
+    outputs = [f"{job.name}.txt"]
+    write_mot(out_dir / outputs[0], result.rows)
+    for suffix, data in result.files.items():
+        outputs.append(f"{job.name}{suffix}")
+        with atomic_write(out_dir / outputs[-1], "wb", suffix=suffix) as fh:
+            fh.write(data)
+    entry = {"name": job.name, "status": "done", **result.info, "outputs": outputs}
+    sidecar = {"kind": kind, "settings": settings, "inputs": [str(p) for p in job.reads], **entry}
+    with atomic_write(_sidecar(out_dir, job.name)) as fh:
+        fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
+    return entry
+
+
+def _one_line(exc: BaseException) -> str:
+    """The error as one line; the kind is named unless it is a plain input error."""
+    text = " ".join(str(exc).split())
+    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in text:
+        text = f"{text}: {exc.filename}"
+    if isinstance(exc, (ValueError, TypeError, OSError)) and text:
+        return text
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def call_task(
+    func: Callable[..., TaskResult], args: tuple[Any, ...]
+) -> tuple[TaskResult | None, str | None, str | None]:
+    """Run one task; an exception comes back as data (its line and traceback), not raised.
+
+    So a failing input is reported in the summary without Dask logging it as a failed
+    computation on the worker; a worker that dies still fails the future (``KilledWorker``).
+    """
+    try:
+        return func(*args), None, None
+    except Exception as exc:  # noqa: BLE001 - reported per task
+        return None, _one_line(exc), traceback.format_exc()
+
+
+def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) -> None:
+    """Before any work: the folder is writable and no output overwrites an input."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ValueError(f"--out {out_dir} is a file; give a folder")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    check_output(out_dir / SUMMARY_NAME, what="--out")  # the folder is writable
+    reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
+    names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]
+    for name in [SUMMARY_NAME, *names]:
+        target = out_dir / name
+        if target.resolve() in reads:
+            raise ValueError(f"--out {target} is an input of this run; write elsewhere")
+        if target.is_dir():
+            raise ValueError(f"--out {target} is a folder; it would be an output of this run")
+
+
+def run_jobs(
+    jobs: Sequence[Job],
+    out_dir: str | os.PathLike[str],
+    *,
+    kind: str,
+    settings: dict[str, Any],
+    suffixes: Sequence[str] = (),
+    client: Client | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    force: bool = False,
+    show_progress: bool | None = None,
+) -> BatchSummary:
+    """Run `jobs`, one task each, and write their outputs to `out_dir`.
+
+    Parameters
+    ----------
+    jobs : sequence of Job
+        The tasks (unique names).
+    out_dir : path
+        Output folder (created if missing).
+    kind : {"track", "recover", "smooth"}
+        What the jobs do (the table's columns).
+    settings : dict
+        JSON-ready settings shared by the jobs: stored in each sidecar, so that a re-run with
+        other settings redoes the work.
+    suffixes : sequence of str
+        Extra outputs per job (``".mp4"``), checked before any work.
+    client, scheduler, n_workers
+        Where the tasks run (see :func:`dask_client`); ``n_workers=0`` runs them one after the
+        other in this process, without Dask.
+    force : bool
+        Redo jobs whose outputs are complete.
+    show_progress : bool, optional
+        Progress bar over tasks on stderr (default: when stderr is a terminal).
+
+    Returns
+    -------
+    BatchSummary
+        Also written to ``out_dir/summary.json``. Failed tasks are in it with their error; the
+        others finish.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        After cancelling the tasks still running and closing the cluster this started; the
+        outputs written so far are complete.
+    """
+    if n_workers is not None and n_workers < 0:
+        raise ValueError(f"n_workers is {n_workers}, expected >= 0")
+    out = Path(out_dir)
+    start = time.perf_counter()
+    _check_outputs(jobs, out, suffixes)
+    summary = BatchSummary(kind, out, settings=settings)
+    entries: dict[str, dict[str, Any]] = {}
+    pending: list[Job] = []
+    for job in jobs:
+        earlier = None if force else _complete(out, job, kind, settings)
+        if earlier is None:
+            pending.append(job)
+        else:
+            keep = {k: v for k, v in earlier.items() if k not in ("kind", "settings", "inputs")}
+            entries[job.name] = {**keep, "status": "skipped"}
+
+    def record(job: Job, outcome: tuple[TaskResult | None, str | None, str | None]) -> None:
+        result, error, trace = outcome
+        if result is not None:
+            entries[job.name] = _write(out, job, result, kind, settings)
+        else:
+            entries[job.name] = {
+                "name": job.name,
+                "status": "failed",
+                "source": str(job.reads[0]) if job.reads else None,
+                "error": error,
+                "traceback": trace,
+            }
+
+    desc = "sequences" if kind == "track" else "files"
+    bar = {"total": len(pending), "desc": desc, "enable": show_progress}
+    try:
+        if pending and n_workers == 0:
+            for job in progress(pending, **bar):  # type: ignore[arg-type]
+                record(job, call_task(job.func, job.args))
+        elif pending:
+            _run_on_dask(pending, record, summary, client, scheduler, n_workers, bar)
+    finally:
+        for job in jobs:
+            entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
+        summary.entries = [entries[job.name] for job in jobs]
+        summary.seconds = time.perf_counter() - start
+        with atomic_write(out / SUMMARY_NAME) as fh:
+            fh.write(summary.to_json() + "\n")
+    return summary
+
+
+def _run_on_dask(
+    pending: Sequence[Job],
+    record: Callable[[Job, tuple[TaskResult | None, str | None, str | None]], None],
+    summary: BatchSummary,
+    client: Client | None,
+    scheduler: str | None,
+    n_workers: int | None,
+    bar: dict[str, Any],
+) -> None:
+    """Submit `pending` to Dask and record each result as it completes."""
+    from distributed import as_completed
+
+    if n_workers is None:
+        n_workers = os.cpu_count() or 1
+    n_workers = min(n_workers, len(pending))  # a local cluster: no idle worker to start
+    with dask_client(client, scheduler, n_workers) as c:
+        info = c.scheduler_info()
+        summary.workers = len(info.get("workers", {}))
+        summary.scheduler = str(info.get("address")) if info.get("address") else None
+        futures = {}
+        for job in pending:
+            key = f"pftrack-{summary.kind}-{job.name}-{os.urandom(4).hex()}"
+            fut = c.submit(call_task, job.func, job.args, key=key, pure=False)
+            futures[fut.key] = (fut, job)
+        try:
+            for fut in progress(as_completed([f for f, _ in futures.values()]), **bar):
+                _, job = futures.pop(fut.key)
+                if fut.status == "finished":
+                    record(job, fut.result())
+                elif fut.status == "error":  # the worker died (KilledWorker) or the like
+                    exc = fut.exception()
+                    record(job, (None, _one_line(exc), None))
+                fut.release()  # cancelled (by another client): left "cancelled" in the summary
+        except BaseException:
+            c.cancel([f for f, _ in futures.values()], force=True)
+            raise

@@ -1,0 +1,212 @@
+"""What a batch runs on: sequences found in videos, image folders and MOTChallenge folders.
+
+A *sequence* is one video file, one folder of images, or one MOTChallenge sequence folder
+(``SEQ/img1/`` or a single video in ``SEQ/``, with ``seqinfo.ini``, ``det/det.txt`` and
+``gt/gt.txt``; ``SEQ/det.txt`` and ``SEQ/gt.txt`` are accepted too). A folder that is none of
+these is a folder of sequences: each entry in it that is a sequence is one (one level deep).
+"""
+
+from __future__ import annotations
+
+import configparser
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from pftrack._typing import PathLike
+from pftrack.io.video import IMAGE_SUFFIXES, natural_key
+
+__all__ = ["VIDEO_SUFFIXES", "SequenceInput", "find_sequences", "find_track_files"]
+
+#: File extensions taken as videos when a folder is scanned.
+VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
+
+#: Names a sequence may not have: its outputs would overwrite the batch's own files.
+RESERVED_NAMES = ("summary",)
+
+
+@dataclass(frozen=True)
+class SequenceInput:
+    """One sequence of a batch.
+
+    Attributes
+    ----------
+    name : str
+        Output name: the video's stem or the sequence folder's name (``DIR/NAME.txt``).
+    frames : Path
+        What :class:`~pftrack.io.video.FrameSource` reads: a video file or an image folder.
+    detections : Path or None
+        The sequence's detection file (``det/det.txt`` or ``det.txt``), if any.
+    gt : Path or None
+        Its ground truth (``gt/gt.txt`` or ``gt.txt``), if any.
+    image_width : int or None
+        ``imWidth`` of its ``seqinfo.ini``: the size the detection and ground-truth boxes are
+        given in (PETS09's are 768 px wide for a 480 px video).
+    """
+
+    name: str
+    frames: Path
+    detections: Path | None = None
+    gt: Path | None = None
+    image_width: int | None = None
+
+    @property
+    def files(self) -> tuple[Path, ...]:
+        """Every file or folder the sequence reads."""
+        return tuple(p for p in (self.frames, self.detections, self.gt) if p is not None)
+
+
+def _absolute(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> list[Path]:
+    """The inputs as absolute paths: workers may run in another folder than this process."""
+    paths = [inputs] if isinstance(inputs, (str, os.PathLike)) else list(inputs)
+    return [Path(os.path.abspath(p)) for p in paths]
+
+
+def _first_file(folder: Path, *candidates: str) -> Path | None:
+    for rel in candidates:
+        if (folder / rel).is_file():
+            return folder / rel
+    return None
+
+
+def _image_width(folder: Path) -> int | None:
+    ini = folder / "seqinfo.ini"
+    if not ini.is_file():
+        return None
+    parser = configparser.ConfigParser()
+    try:
+        parser.read(ini, encoding="utf-8")
+        width = parser.getint("Sequence", "imWidth", fallback=0)
+    except (configparser.Error, ValueError) as exc:
+        raise ValueError(f"cannot read {ini}: {' '.join(str(exc).split())}") from None
+    return width if width > 0 else None
+
+
+def _videos(folder: Path) -> list[Path]:
+    return sorted(
+        (p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
+        key=lambda p: natural_key(p.name),
+    )
+
+
+def _has_images(folder: Path) -> bool:
+    return any(p.suffix.lower() in IMAGE_SUFFIXES for p in folder.iterdir())
+
+
+def _as_sequence(path: Path) -> SequenceInput | None:
+    """`path` as one sequence, or None when it is a folder of sequences."""
+    if path.is_file():
+        return SequenceInput(path.stem, path)
+    if path.name == "img1" and (path.parent / "seqinfo.ini").is_file():
+        path = path.parent  # SEQ/img1 given: the sequence is SEQ
+    marked = (path / "seqinfo.ini").is_file()
+    if (path / "img1").is_dir():
+        frames = path / "img1"
+    elif _has_images(path):
+        frames = path
+    elif marked and len(_videos(path)) == 1:  # the shared data's layout: SEQ/video.avi
+        frames = _videos(path)[0]
+    elif marked:
+        raise ValueError(
+            f"sequence folder {path} has no img1/ and not exactly one video "
+            f"({len(_videos(path))} found)"
+        )
+    else:
+        return None
+    return SequenceInput(
+        path.name,
+        frames,
+        _first_file(path, "det/det.txt", "det.txt"),
+        _first_file(path, "gt/gt.txt", "gt.txt"),
+        _image_width(path),
+    )
+
+
+def find_sequences(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> list[SequenceInput]:
+    """The sequences named by `inputs`, in order (a folder of sequences in natural order).
+
+    Parameters
+    ----------
+    inputs : path or sequence of paths
+        Video files, image folders, MOTChallenge sequence folders, or folders of any of these.
+
+    Raises
+    ------
+    FileNotFoundError
+        An input does not exist.
+    ValueError
+        No sequence is found, or two have the same name (their outputs would collide).
+    """
+    paths = _absolute(inputs)
+    if not paths:
+        raise ValueError("no input given")
+    found: list[SequenceInput] = []
+    for path in paths:
+        if not path.exists():
+            raise FileNotFoundError(f"input not found: {path}")
+        seq = _as_sequence(path)
+        if seq is not None:
+            found.append(seq)
+            continue
+        entries = sorted(path.iterdir(), key=lambda p: natural_key(p.name))
+        before = len(found)
+        for entry in entries:
+            if entry.name.startswith("."):
+                continue
+            if entry.is_file() and entry.suffix.lower() not in VIDEO_SUFFIXES:
+                continue
+            child = _as_sequence(entry)
+            if child is not None:
+                found.append(child)
+        if len(found) == before:
+            raise ValueError(
+                f"no sequence in folder {path}: expected videos ({', '.join(VIDEO_SUFFIXES)}), "
+                "image folders or MOTChallenge sequence folders"
+            )
+    _check_names([s.name for s in found], [s.frames for s in found])
+    return found
+
+
+def find_track_files(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> list[Path]:
+    """MOTChallenge text files named by `inputs`: files, or the ``*.txt`` files of folders.
+
+    Raises
+    ------
+    FileNotFoundError
+        An input does not exist.
+    ValueError
+        A folder holds no ``.txt`` file, or two files have the same name.
+    """
+    paths = _absolute(inputs)
+    if not paths:
+        raise ValueError("no input given")
+    found: list[Path] = []
+    for path in paths:
+        if not path.exists():
+            raise FileNotFoundError(f"input not found: {path}")
+        if path.is_file():
+            found.append(path)
+            continue
+        files = sorted(
+            (p for p in path.iterdir() if p.is_file() and p.suffix == ".txt"),
+            key=lambda p: natural_key(p.name),
+        )
+        files = [p for p in files if not p.name.startswith(".")]
+        if not files:
+            raise ValueError(f"no .txt file in folder {path}")
+        found.extend(files)
+    _check_names([p.stem for p in found], found)
+    return found
+
+
+def _check_names(names: list[str], sources: list[Path]) -> None:
+    seen: dict[str, Path] = {}
+    for name, source in zip(names, sources, strict=True):
+        if name in RESERVED_NAMES:
+            raise ValueError(f"{source}: the name {name!r} is reserved for the batch's own file")
+        if name in seen:
+            raise ValueError(
+                f"two inputs are both named {name!r} ({seen[name]} and {source}): their outputs "
+                "would collide; run them in separate batches"
+            )
+        seen[name] = source

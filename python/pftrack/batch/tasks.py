@@ -1,0 +1,293 @@
+"""The work of one batch task: track one sequence, or recover or smooth one tracks file.
+
+These functions run on Dask workers (or in the calling process with ``n_workers=0``). They
+read their inputs by path (workers must see the same paths: a shared or copied folder) and
+write nothing: they return the rows, any extra file as bytes, and a JSON-ready summary, and the
+client writes the outputs (:mod:`pftrack.batch.engine`). Workers on other machines therefore
+need no access to the output folder. Nothing here imports Dask.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import socket
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pftrack._typing import F64
+from pftrack.batch.inputs import SequenceInput
+from pftrack.tracking.config import TrackerConfig
+
+__all__ = [
+    "RecoverOptions",
+    "SmoothOptions",
+    "TaskResult",
+    "TrackOptions",
+    "recover_file",
+    "sequence_metrics",
+    "smooth_file",
+    "track_sequence",
+]
+
+
+@dataclass(frozen=True)
+class TaskResult:
+    """What one task sends back to the client.
+
+    Attributes
+    ----------
+    rows : (M, 10) ndarray of float64
+        MOTChallenge rows, written to ``DIR/NAME.txt``.
+    files : dict of str to bytes
+        Extra outputs by suffix (``{".mp4": ...}`` for ``--render``): ``DIR/NAME<suffix>``.
+    info : dict
+        JSON-ready figures of the run (frames, tracks, seconds, metrics, ...).
+    """
+
+    rows: F64
+    files: dict[str, bytes] = field(default_factory=dict)
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def _settings(options: object) -> dict[str, Any]:
+    """The options as plain JSON values (what a re-run compares to decide "complete")."""
+    import json
+
+    text = json.dumps(dataclasses.asdict(options), sort_keys=True, default=str)  # type: ignore[call-overload]
+    value: dict[str, Any] = json.loads(text)
+    return value
+
+
+@dataclass(frozen=True)
+class TrackOptions:
+    """Settings of ``pftrack batch`` shared by every sequence.
+
+    Attributes
+    ----------
+    config : TrackerConfig
+        Tracker settings.
+    seed : int
+        Random seed (the same for every sequence, as ``pftrack track --seed``).
+    detections : {None, "auto"}
+        None: the built-in detector; ``"auto"``: each sequence's ``det/det.txt`` (or
+        ``det.txt``); a sequence without one fails.
+    det_scale : float or None
+        Multiplies detection boxes; None: the frame width over ``seqinfo.ini``'s ``imWidth``
+        when the sequence has one (0.625 for PETS09-S2L1's video), else 1.
+    fill : {"linear", "pf"}
+        As ``pftrack track --fill``.
+    smooth, link : bool
+        As ``pftrack track`` without ``--no-smooth`` and ``--no-link``.
+    render : str or None
+        Also write an annotated video ``DIR/NAME<render>`` (``".mp4"`` or ``".avi"``).
+    iou : float
+        IoU threshold of a match for the metrics (where ground truth exists).
+    """
+
+    config: TrackerConfig = field(default_factory=TrackerConfig)
+    seed: int = 0
+    detections: str | None = None
+    det_scale: float | None = None
+    fill: str = "linear"
+    smooth: bool = True
+    link: bool = True
+    render: str | None = None
+    iou: float = 0.5
+
+    def __post_init__(self) -> None:
+        if self.detections not in (None, "auto"):
+            raise ValueError(f"detections is {self.detections!r}, expected None or 'auto'")
+        scale = self.det_scale
+        if scale is not None and not (math.isfinite(scale) and scale > 0):
+            raise ValueError(f"det_scale is {self.det_scale}, expected a finite value > 0")
+        if self.render not in (None, ".mp4", ".avi"):
+            raise ValueError(f"render is {self.render!r}, expected None, '.mp4' or '.avi'")
+
+    def settings(self) -> dict[str, Any]:
+        """JSON-ready settings (stored beside each output)."""
+        return _settings(self)
+
+
+def sequence_metrics(
+    gt: F64, rows: F64, *, scale: float = 1.0, iou: float = 0.5
+) -> dict[str, float | int | None]:
+    """The figures of one sequence's tracks against its ground truth, for the summary.
+
+    MOTA, IDF1 and their counts from :func:`pftrack.eval.evaluate_mot`. HOTA goes here too
+    once :mod:`pftrack.eval` has it (one more key): the table and JSON show every key.
+    """
+    from pftrack.eval import evaluate_mot
+
+    m = evaluate_mot(gt, rows, iou_threshold=iou, scale=scale)
+    out: dict[str, float | int | None] = {
+        "mota": m.mota,
+        "idf1": m.idf1,
+        "motp_iou": m.motp_iou,
+        "id_switches": m.num_switches,
+        "false_positives": m.false_positives,
+        "misses": m.misses,
+    }
+    return {k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in out.items()}
+
+
+def _as_written(rows: F64) -> F64:
+    """`rows` rounded as ``NAME.txt`` stores them: the metrics are ``pftrack eval``'s on it."""
+    from pftrack.io.mot import format_mot_row
+
+    lines = [format_mot_row(r).split(",") for r in rows]
+    return np.array(lines, dtype=np.float64).reshape(len(rows), 10)
+
+
+def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
+    """Track one sequence as ``pftrack track`` would; score it where it has ground truth.
+
+    Parameters
+    ----------
+    seq : SequenceInput
+        The sequence (paths as the worker sees them).
+    options : TrackOptions
+        Settings.
+
+    Returns
+    -------
+    TaskResult
+        The rows (byte-identical to ``pftrack track``'s file once written with
+        :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures.
+    """
+    from pftrack.io.mot import read_mot
+    from pftrack.io.video import FrameSource
+    from pftrack.tracking.run import track_path
+
+    cpu = time.process_time()
+    frames = FrameSource(seq.frames)
+    auto_scale = frames.width / seq.image_width if seq.image_width else 1.0
+    det = None
+    if options.detections == "auto":
+        if seq.detections is None:
+            raise ValueError(
+                f"--detections auto: sequence {seq.name} has no det/det.txt (nor det.txt)"
+            )
+        det = seq.detections
+    det_scale = options.det_scale if options.det_scale is not None else auto_scale
+    run = track_path(
+        frames,
+        detections=det,
+        det_scale=det_scale,
+        config=options.config,
+        seed=options.seed,
+        fill=options.fill,
+        smooth=options.smooth,
+        link=options.link,
+        show_progress=False,
+    )
+    rows = run.rows
+    metrics = None
+    if seq.gt is not None:
+        gt = read_mot(seq.gt, what="ground truth")
+        metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
+    files: dict[str, bytes] = {}
+    if options.render is not None:
+        from pftrack.render import write_annotated_video
+
+        with tempfile.TemporaryDirectory(prefix="pftrack-render-") as tmp:
+            target = Path(tmp) / f"{seq.name}{options.render}"
+            write_annotated_video(target, FrameSource(seq.frames), rows, frames.fps)
+            files[options.render] = target.read_bytes()
+    info: dict[str, Any] = {
+        "source": str(seq.frames),
+        "frames": run.n_frames,
+        "tracks": int(len(np.unique(rows[:, 1]))) if len(rows) else 0,
+        "boxes": len(rows),
+        "seconds": run.seconds,
+        "fps": run.fps,
+        "cpu_seconds": time.process_time() - cpu,  # against `seconds`: how loaded the host was
+        "detections": None if det is None else str(det),
+        "det_scale": det_scale,
+        "gt": None if seq.gt is None else str(seq.gt),
+        "gt_scale": auto_scale if seq.gt is not None else None,
+        "metrics": metrics,
+        "host": socket.gethostname(),
+    }
+    return TaskResult(rows, files, info)
+
+
+@dataclass(frozen=True)
+class RecoverOptions:
+    """Settings of ``pftrack recover`` over several files (see its ``--help``)."""
+
+    method: str = "auto"
+    max_gap: int = 30
+    seed: int = 0
+    link: bool = False
+    max_distance: float = 50.0
+
+    def settings(self) -> dict[str, Any]:
+        """JSON-ready settings (stored beside each output)."""
+        return _settings(self)
+
+
+def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
+    """Fill the gaps of one tracks file as ``pftrack recover FILE`` does (no ``--video``)."""
+    from pftrack.io.mot import data_line_numbers, read_mot
+    from pftrack.recovery import LinkConfig, check_unique, fill_gaps, link_tracklets
+
+    rows = read_mot(path, what="tracks file")
+    check_unique(rows, data_line_numbers(path))
+    n_links = 0
+    if options.link:
+        cfg = LinkConfig(max_gap=options.max_gap, max_distance=options.max_distance)
+        rows, mapping = link_tracklets(rows, cfg, None)
+        n_links = len(mapping)
+    t0 = time.perf_counter()
+    filled, rep = fill_gaps(rows, options.method, options.max_gap, seed=options.seed)
+    info: dict[str, Any] = {
+        "source": str(path),
+        "rows_in": len(rows),
+        "fragments_linked": n_links,
+        "gaps": rep.n_gaps,
+        "filled_rows": rep.n_filled_rows,
+        "rows_out": len(filled),
+        "seconds": time.perf_counter() - t0,
+        "explain": None if rep.calibration is None else rep.calibration.describe(),
+    }
+    return TaskResult(filled, {}, info)
+
+
+@dataclass(frozen=True)
+class SmoothOptions:
+    """Settings of ``pftrack smooth`` over several files (see its ``--help``)."""
+
+    max_gap: int = 30
+    link: bool = True
+
+    def settings(self) -> dict[str, Any]:
+        """JSON-ready settings (stored beside each output)."""
+        return _settings(self)
+
+
+def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
+    """Link, fill and smooth one tracks file as ``pftrack smooth FILE`` does."""
+    from pftrack.io.mot import data_line_numbers, read_mot
+    from pftrack.recovery import LinkConfig, check_unique
+    from pftrack.tracking import smooth_tracks
+
+    t0 = time.perf_counter()
+    rows = read_mot(path, what="tracks file")
+    check_unique(rows, data_line_numbers(path))
+    link = LinkConfig(max_gap=options.max_gap) if options.link else None
+    result = smooth_tracks(rows, link=link)
+    info: dict[str, Any] = {
+        "source": str(path),
+        "ids_in": int(len(np.unique(rows[:, 1]))) if len(rows) else 0,
+        "rows_in": len(rows),
+        "ids_out": int(len(np.unique(result[:, 1]))) if len(result) else 0,
+        "rows_out": len(result),
+        "seconds": time.perf_counter() - t0,
+    }
+    return TaskResult(result, {}, info)

@@ -1,0 +1,171 @@
+"""``pftrack batch``: track many sequences on Dask; the batch side of ``recover``/``smooth``.
+
+Dask is imported only when a batch runs, never for ``--help``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from pftrack.cli._options import add_command, add_tracker_options, positive_float
+
+if TYPE_CHECKING:
+    from pftrack.batch import BatchSummary
+
+#: Exit status when a batch ran but some of its tasks failed (2: bad usage, nothing ran).
+EXIT_SOME_FAILED = 1
+#: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
+EXIT_INTERRUPTED = 130
+
+
+def det_scale(text: str) -> float | None:
+    """Argument type: ``auto`` (None) or a number > 0."""
+    return None if text == "auto" else positive_float(text)
+
+
+def non_negative_int(text: str) -> int:
+    """Argument type: an integer >= 0."""
+    v = int(text)
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {v}")
+    return v
+
+
+def add_batch_options(p: argparse.ArgumentParser) -> None:
+    """Where a batch runs, and resuming: shared by ``batch``, ``recover`` and ``smooth``."""
+    g = p.add_argument_group("batch (several inputs)")
+    g.add_argument(
+        "--scheduler", metavar="ADDRESS", default=os.environ.get("DASK_SCHEDULER_ADDRESS"),
+        help="a running Dask scheduler, tcp://HOST:8786 (also read from "
+        "$DASK_SCHEDULER_ADDRESS); without it a local cluster is started for the run and "
+        "closed at the end",
+    )  # fmt: skip
+    g.add_argument(
+        "--workers", type=non_negative_int, default=os.cpu_count() or 1, metavar="N",
+        help="worker processes of the local cluster, one thread each (one per core unless "
+        "given; not used with --scheduler); 0 runs in this process without Dask",
+    )  # fmt: skip
+    g.add_argument("--force", action="store_true",
+                   help="redo inputs whose outputs are complete, instead of skipping "
+                   "them")  # fmt: skip
+
+
+def is_batch(paths: list[str]) -> bool:
+    """Several inputs, or a folder: the command runs as a batch (``--out`` is a folder)."""
+    return len(paths) > 1 or any(Path(p).is_dir() for p in paths)
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``batch`` on `sub` (from ``add_subparsers``)."""
+    p = add_command(
+        sub,
+        "batch",
+        help="track many videos or sequences at once on Dask (local or a cluster)",
+        description="Track every sequence of INPUT... (videos, image folders, MOTChallenge "
+        "sequence folders SEQ/img1 + seqinfo.ini + det/det.txt + gt/gt.txt, or folders of "
+        "them), one Dask task per sequence. Writes DIR/NAME.txt exactly as pftrack track "
+        "does (NAME: the video's stem or the sequence folder's name), NAME.json beside it, "
+        "and DIR/summary.json; prints frames, tracks, frames/s and, where gt/gt.txt exists, "
+        "MOTA and IDF1 per sequence. Workers read the inputs by these paths; this process "
+        "writes every output. A re-run skips sequences whose outputs are complete.\n\n"
+        "exit status: 0 all done, 1 some sequences failed (the others' outputs are written), "
+        "2 bad usage (nothing ran), 130 interrupted.",
+    )
+    p.add_argument("inputs", nargs="+", metavar="INPUT", help="video, image or sequence folder")
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    p.add_argument(
+        "--detections", choices=("auto",), default=None,
+        help="auto: each sequence's det/det.txt (or det.txt) instead of the built-in detector",
+    )  # fmt: skip
+    p.add_argument(
+        "--det-scale", type=det_scale, default="auto", metavar="S",
+        help="multiply detection boxes by S; auto: the frame width over seqinfo.ini's imWidth "
+        "where there is one (0.625 for PETS09-S2L1's video), else 1",
+    )  # fmt: skip
+    p.add_argument("--render", action="store_true", help="also write DIR/NAME.mp4, annotated")
+    p.add_argument("--iou", type=positive_float, default=0.5,
+                   help="IoU threshold of a match for the metrics")  # fmt: skip
+    add_tracker_options(p)
+    add_batch_options(p)
+    p.set_defaults(func=run)
+
+
+def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
+    """Run the batch; print its table, or what stopped it; return the exit status."""
+    try:
+        summary = call()
+    except KeyboardInterrupt:
+        print(
+            f"pftrack {command}: interrupted; the outputs written so far are complete (re-run "
+            "to finish the rest)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
+    except ImportError as exc:  # Dask is an extra: pftrack[dask]
+        print(f"pftrack {command}: error: {exc}", file=sys.stderr)
+        return 2
+    for e in summary.entries if explain else ():
+        if e.get("explain"):
+            print(f"{e['name']}:\n{e['explain']}")
+    print(summary.table())
+    print(f"summary -> {summary.out_dir / 'summary.json'}")
+    return EXIT_SOME_FAILED if summary.failed else 0
+
+
+def _where(args: argparse.Namespace) -> dict[str, Any]:
+    return {"scheduler": args.scheduler or None, "n_workers": args.workers, "force": args.force}
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``pftrack batch``; return the exit status."""
+    from pftrack.batch import TrackOptions, track_many
+    from pftrack.cli._options import tracker_config
+
+    options = TrackOptions(
+        config=tracker_config(args),
+        seed=args.seed,
+        detections=args.detections,
+        det_scale=args.det_scale,
+        fill=args.fill,
+        smooth=not args.no_smooth,
+        link=not args.no_link,
+        render=".mp4" if args.render else None,
+        iou=args.iou,
+    )
+    return _run("batch", lambda: track_many(args.inputs, args.out, options=options, **_where(args)))
+
+
+def run_recover(args: argparse.Namespace) -> int:
+    """``pftrack recover`` with several files or a folder: one task per file."""
+    from pftrack.batch import RecoverOptions, recover_many
+
+    for flag, given in (("--video", args.video), ("--in-place", args.in_place)):
+        if given:
+            raise ValueError(f"{flag} takes one tracks file, not several or a folder")
+    options = RecoverOptions(
+        method=args.method,
+        max_gap=args.max_gap,
+        seed=args.seed,
+        link=args.link,
+        max_distance=args.max_distance,
+    )
+    where = _where(args)
+    return _run(
+        "recover",
+        lambda: recover_many(args.tracks, args.out, options=options, **where),
+        explain=args.explain,
+    )
+
+
+def run_smooth(args: argparse.Namespace) -> int:
+    """``pftrack smooth`` with several files or a folder: one task per file."""
+    from pftrack.batch import SmoothOptions, smooth_many
+
+    options = SmoothOptions(max_gap=args.max_gap, link=not args.no_link)
+    where = _where(args)
+    return _run("smooth", lambda: smooth_many(args.tracks, args.out, options=options, **where))

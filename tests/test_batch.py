@@ -1,0 +1,434 @@
+"""``pftrack batch`` and several-file ``recover``/``smooth`` on a real Dask cluster.
+
+One ``LocalCluster`` with two single-threaded worker processes serves the module (started by
+:func:`pftrack.batch.dask_client`, as ``pftrack batch`` starts its own); one test starts
+``dask scheduler`` and ``dask worker`` as subprocesses. Sequences are small synthetic scenes.
+"""
+
+from __future__ import annotations
+
+import _thread
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from pftrack.batch import (
+    Job,
+    SequenceInput,
+    TaskResult,
+    TrackOptions,
+    dask_client,
+    find_sequences,
+    run_jobs,
+    track_many,
+)
+from pftrack.cli import main
+from pftrack.eval import evaluate_mot
+from pftrack.io.mot import read_mot, write_mot
+from pftrack.synthetic import make_scene
+from tests.conftest import dataset
+
+distributed = pytest.importorskip("distributed")
+
+FAST = ["--particles", "30"]  # every run of this module: fewer particles, same code path
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder of three sequences: a video, a MOTChallenge folder (det + gt), an image folder."""
+    root = tmp_path_factory.mktemp("batch") / "in"
+    root.mkdir()
+    scenes = [make_scene(n_frames=30, width=192, height=144, n_walkers=3, rng=k) for k in range(3)]
+    scenes[0].write_video(root / "walk.avi")
+    seq = root / "MOT-01"
+    scenes[1].write_images(seq / "img1", ext=".jpg")
+    (seq / "gt").mkdir()
+    (seq / "det").mkdir()
+    scenes[1].write_truth(seq / "gt" / "gt.txt")
+    det = scenes[1].truth.copy()
+    det[:, 1] = -1
+    write_mot(seq / "det" / "det.txt", det)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nname=MOT-01\nimWidth=192\nimHeight=144\n")
+    scenes[2].write_images(root / "plain", ext=".png")
+    return root
+
+
+@pytest.fixture(scope="module")
+def client() -> Iterator[Any]:
+    with dask_client(n_workers=2) as c:
+        yield c
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(folder.glob("*.txt"))}
+
+
+def test_find_sequences_names_and_files(data: Path) -> None:
+    seqs = {s.name: s for s in find_sequences(data)}
+    assert sorted(seqs) == ["MOT-01", "plain", "walk"]
+    mot = seqs["MOT-01"]
+    assert mot.frames == data / "MOT-01" / "img1" and mot.image_width == 192
+    assert mot.detections == data / "MOT-01" / "det" / "det.txt"
+    assert mot.gt == data / "MOT-01" / "gt" / "gt.txt"
+    assert seqs["walk"].frames == data / "walk.avi" and seqs["walk"].gt is None
+    # SEQ/img1 given directly is the sequence SEQ
+    (direct,) = find_sequences(data / "MOT-01" / "img1")
+    assert direct == mot
+
+
+def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
+    # ../shared/data's layout: SEQ/video.avi + seqinfo.ini + det.txt + gt.txt
+    seq = tmp_path / "pets"
+    seq.mkdir()
+    for name in ("video.avi", "det.txt", "gt.txt"):
+        (seq / name).write_text("")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=768\n")
+    assert find_sequences(tmp_path) == [
+        SequenceInput("pets", seq / "video.avi", seq / "det.txt", seq / "gt.txt", 768)
+    ]
+
+
+@pytest.mark.parametrize(
+    ("layout", "message"),
+    [
+        ({"a/x.avi": "", "b/x.avi": ""}, "both named 'x'"),
+        ({"summary.avi": ""}, "reserved"),
+        ({"notes.txt": ""}, "no sequence in folder"),
+        ({"s/seqinfo.ini": "", "s/a.avi": "", "s/b.avi": ""}, "not exactly one video"),
+    ],
+)
+def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message: str) -> None:
+    for rel, text in layout.items():
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text(text)
+    tops = sorted({tmp_path / rel.split("/")[0] for rel in layout if "/" in rel}) or [tmp_path]
+    with pytest.raises(ValueError, match=message):
+        find_sequences(tops)
+
+
+def test_workers_are_single_threaded(client: Any) -> None:
+    def threads() -> tuple[int, str | None, str | None, str | None]:
+        import cv2
+
+        env = os.environ.get
+        return (
+            cv2.getNumThreads(),
+            env("OPENBLAS_NUM_THREADS"),
+            env("OMP_NUM_THREADS"),
+            env("MALLOC_TRIM_THRESHOLD_"),
+        )
+
+    result = client.run(threads)
+    # and no MALLOC_TRIM_THRESHOLD_: Dask's default makes tracking ~1.5x slower (engine.py)
+    assert len(result) == 2 and set(result.values()) == {(1, "1", "1", None)}
+
+
+def test_cluster_equals_serial_and_pftrack_track(data: Path, client: Any, tmp_path: Path) -> None:
+    options = TrackOptions(config=_config(), detections=None)
+    on_dask = track_many(data, tmp_path / "dask", client, options=options)
+    serial = track_many(data, tmp_path / "serial", options=options, n_workers=0)
+    assert [e["status"] for e in on_dask.entries] == ["done"] * 3
+    assert on_dask.workers == 2 and serial.workers == 0
+    files = _files(tmp_path / "dask")
+    assert sorted(files) == ["MOT-01.txt", "plain.txt", "walk.txt"]
+    assert files == _files(tmp_path / "serial")
+    # byte-identical to `pftrack track` with the same settings
+    for name, source in (("walk", data / "walk.avi"), ("MOT-01", data / "MOT-01")):
+        single = tmp_path / f"{name}.single"
+        assert main(["track", str(source), "--out", str(single), *FAST]) == 0
+        assert single.read_bytes() == files[f"{name}.txt"], name
+    # the summary's metrics are pftrack.eval's on the written file
+    entry = next(e for e in on_dask.entries if e["name"] == "MOT-01")
+    gt = read_mot(data / "MOT-01" / "gt" / "gt.txt")
+    m = evaluate_mot(gt, read_mot(tmp_path / "dask" / "MOT-01.txt"))
+    assert entry["metrics"]["mota"] == m.mota and entry["metrics"]["idf1"] == m.idf1
+    assert entry["frames"] == 30 and entry["tracks"] == len(np.unique(read_mot(single)[:, 1]))
+    written = json.loads((tmp_path / "dask" / "summary.json").read_text())
+    assert [s["name"] for s in written["sequences"]] == ["MOT-01", "plain", "walk"]
+    assert written["counts"] == {"done": 3, "skipped": 0, "failed": 0, "cancelled": 0}
+
+
+def _config() -> Any:
+    from dataclasses import replace
+
+    from pftrack.tracking import TrackerConfig
+
+    base = TrackerConfig()
+    return replace(base, filter=replace(base.filter, n_particles=30))
+
+
+def test_failing_sequence_is_reported_and_the_others_finish(
+    data: Path, client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    broken = tmp_path / "broken.avi"
+    broken.write_text("not a video")
+    out = tmp_path / "out"
+    argv = ["batch", str(data), str(broken), "--out", str(out), "--detections", "auto", *FAST]
+    assert main([*argv, "--scheduler", client.scheduler.address]) == 1
+    text = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    status = {s["name"]: s["status"] for s in summary["sequences"]}
+    # walk.avi and plain/ have no det.txt: with --detections auto they fail too, by name
+    assert status == {"walk": "failed", "MOT-01": "done", "plain": "failed", "broken": "failed"}
+    errors = {s["name"]: s["error"] for s in summary["sequences"] if s["status"] == "failed"}
+    assert "cannot decode a frame" in errors["broken"] and "no det/det.txt" in errors["walk"]
+    assert "broken: error: cannot decode a frame" in text
+    assert sorted(p.name for p in out.iterdir()) == ["MOT-01.json", "MOT-01.txt", "summary.json"]
+    # --detections auto is `pftrack track --detections SEQ/det/det.txt`
+    single = tmp_path / "single.txt"
+    det = data / "MOT-01" / "det" / "det.txt"
+    assert main(["track", str(data / "MOT-01"), "--detections", str(det), "--out", str(single),
+                 *FAST]) == 0  # fmt: skip
+    assert single.read_bytes() == (out / "MOT-01.txt").read_bytes()
+
+
+def test_resume_skips_complete_outputs_and_force_redoes(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    out = tmp_path / "out"
+    argv = ["batch", str(data), "--out", str(out), "--scheduler", client.scheduler.address]
+    assert main([*argv, *FAST]) == 0
+    stamp = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
+    before = _files(out)
+
+    def statuses() -> dict[str, str]:
+        summary = json.loads((out / "summary.json").read_text())
+        return {s["name"]: s["status"] for s in summary["sequences"]}
+
+    assert main([*argv, *FAST]) == 0
+    assert set(statuses().values()) == {"skipped"}
+    assert all(out.joinpath(n).stat().st_mtime_ns == t for n, t in stamp.items() if n[0] != "s")
+    # an interrupted sequence (outputs present, sidecar absent) is redone, alone
+    (out / "plain.json").unlink()
+    assert main([*argv, *FAST]) == 0
+    assert statuses() == {"walk": "skipped", "MOT-01": "skipped", "plain": "done"}
+    # other settings: not complete for them
+    assert main([*argv, "--particles", "31"]) == 0
+    assert set(statuses().values()) == {"done"}
+    assert main([*argv, *FAST, "--force"]) == 0
+    assert set(statuses().values()) == {"done"}
+    assert _files(out) == before
+
+
+def test_ctrl_c_cancels_the_tasks_and_leaves_a_summary(client: Any, tmp_path: Path) -> None:
+    jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(6)]
+    timer = threading.Timer(1.0, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_jobs(jobs, tmp_path, kind="smooth", settings={}, client=client)
+    finally:
+        timer.cancel()
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert {f["status"] for f in summary["files"]} <= {"done", "cancelled"}
+    assert any(f["status"] == "cancelled" for f in summary["files"])
+    deadline = time.monotonic() + 10
+    while client.run_on_scheduler(_n_tasks) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert client.run_on_scheduler(_n_tasks) == 0  # nothing left queued on the cluster
+
+
+def _slow(k: int) -> TaskResult:
+    time.sleep(1.5)
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+
+
+def _n_tasks(dask_scheduler: Any) -> int:
+    return len(dask_scheduler.tasks)
+
+
+def test_cli_interrupt_exits_130(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def interrupted(*args: Any, **kwargs: Any) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("pftrack.batch.track_many", interrupted)
+    assert main(["batch", str(data), "--out", str(tmp_path / "o")]) == 130
+    assert "interrupted" in capsys.readouterr().err
+
+
+def test_bad_usage_exits_2_before_any_work(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    afile = tmp_path / "file"
+    afile.write_text("")
+    assert main(["batch", str(data), "--out", str(afile)]) == 2
+    assert "is a file; give a folder" in capsys.readouterr().err
+    assert main(["batch", str(tmp_path / "missing"), "--out", str(tmp_path / "o")]) == 2
+    assert "input not found" in capsys.readouterr().err
+    # outputs may not overwrite an input: a tracks folder recovered into itself
+    tracks = tmp_path / "tracks"
+    tracks.mkdir()
+    write_mot(tracks / "a.txt", np.array([[1, 1, 0, 0, 5, 5, 1, -1, -1, -1]], float))
+    write_mot(tracks / "b.txt", np.array([[1, 1, 0, 0, 5, 5, 1, -1, -1, -1]], float))
+    assert main(["recover", str(tracks), "--out", str(tracks), "--workers", "0"]) == 2
+    assert "is an input of this run" in capsys.readouterr().err
+    assert main(["recover", str(tracks), "--out", str(tmp_path / "o"), "--video", "v.avi"]) == 2
+    assert "--video takes one tracks file" in capsys.readouterr().err
+
+
+def _tracks_files(folder: Path) -> list[Path]:
+    """Three tracks files with holes, as any tracker would write them."""
+    folder.mkdir()
+    paths = []
+    for k in range(3):
+        truth = make_scene(n_frames=40, width=160, height=120, n_walkers=3, rng=k).truth
+        keep = np.random.default_rng(k).random(len(truth)) > 0.25  # drop a quarter of the boxes
+        paths.append(folder / f"run{k}.txt")
+        write_mot(paths[-1], truth[keep])
+    return paths
+
+
+@pytest.mark.parametrize(
+    ("command", "extra"), [("recover", ["--method", "auto", "--link"]), ("smooth", [])]
+)
+def test_recover_and_smooth_many_files_equal_one_by_one(
+    client: Any, tmp_path: Path, command: str, extra: list[str]
+) -> None:
+    paths = _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = [command, str(tmp_path / "tracks"), "--out", str(out), *extra]
+    assert main([*argv, "--scheduler", client.scheduler.address]) == 0
+    for path in paths:
+        single = tmp_path / f"{path.stem}.single"
+        assert main([command, str(path), "--out", str(single), *extra]) == 0
+        assert single.read_bytes() == (out / path.name).read_bytes(), path.name
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["kind"] == command and [f["status"] for f in summary["files"]] == ["done"] * 3
+    # several files name the same outputs as the folder did; all complete now
+    assert main([command, *map(str, paths), "--out", str(out), *extra, "--workers", "0"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert [f["status"] for f in summary["files"]] == ["skipped"] * 3
+
+
+def test_help_imports_no_dask() -> None:
+    code = (
+        "import sys\nfrom pftrack.cli import main\n"
+        "for cmd in ([], ['batch'], ['recover'], ['smooth']):\n"
+        "    try:\n        main([*cmd, '--help'])\n    except SystemExit:\n        pass\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
+    assert out.strip().splitlines()[-1] == "[]"
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@pytest.mark.slow
+def test_scheduler_and_worker_started_as_processes(data: Path, tmp_path: Path) -> None:
+    dask = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    if dask is None:
+        pytest.skip("the dask command is not installed")
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    port = address.rsplit(":", 1)[1]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    logs = tmp_path / "logs.txt"
+    with logs.open("w") as log:
+        procs = [
+            subprocess.Popen(
+                [dask, "scheduler", "--host", "127.0.0.1", "--port", port, "--no-dashboard"],
+                stdout=log,
+                stderr=log,
+                env=env,
+                cwd=tmp_path,
+            ),  # fmt: skip
+        ]
+        try:
+            procs.append(
+                subprocess.Popen(
+                    [
+                        dask,
+                        "worker",
+                        address,
+                        "--nworkers",
+                        "1",
+                        "--nthreads",
+                        "1",
+                        "--no-dashboard",
+                        "--host",
+                        "127.0.0.1",
+                    ],
+                    stdout=log,
+                    stderr=log,
+                    env=env,
+                    cwd=tmp_path,
+                )  # fmt: skip
+            )
+            with distributed.Client(address, timeout="30s") as c:
+                c.wait_for_workers(1, timeout=30)
+            out = tmp_path / "out"
+            assert main(["batch", str(data), "--out", str(out), "--scheduler", address, *FAST]) == 0
+            serial = tmp_path / "serial"
+            assert main(["batch", str(data), "--out", str(serial), "--workers", "0", *FAST]) == 0
+            assert _files(out) == _files(serial) and len(_files(out)) == 3
+            summary = json.loads((out / "summary.json").read_text())
+            assert summary["scheduler"] == address and summary["workers"] == 1
+        finally:
+            for p in reversed(procs):
+                p.terminate()
+            for p in reversed(procs):
+                try:
+                    p.wait(timeout=15)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
+
+
+def test_render_writes_a_video_per_sequence_and_counts_for_resume(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    from pftrack.io.video import FrameSource
+
+    options = TrackOptions(config=_config(), render=".mp4")
+    first = track_many(data / "plain", tmp_path, client, options=options)
+    assert first.entries[0]["outputs"] == ["plain.txt", "plain.mp4"]
+    video = FrameSource(tmp_path / "plain.mp4")
+    assert (video.width, video.height, len(list(video))) == (192, 144, 30)
+    (tmp_path / "plain.mp4").unlink()  # a listed output missing: not complete
+    again = track_many(data / "plain", tmp_path, client, options=options)
+    assert again.entries[0]["status"] == "done" and (tmp_path / "plain.mp4").is_file()
+    assert track_many(data / "plain", tmp_path, client, options=options).entries[0]["status"] == (
+        "skipped"
+    )
+
+
+def test_scheduler_address_from_the_environment(
+    data: Path, client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", client.scheduler.address)
+    assert main(["batch", str(data / "plain"), "--out", str(tmp_path), *FAST]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["scheduler"] == client.scheduler.address and summary["workers"] == 2
+
+
+@pytest.mark.dataset
+@pytest.mark.slow
+def test_pets_detections_and_truth_are_scaled_from_seqinfo(client: Any, tmp_path: Path) -> None:
+    pets = dataset("pets09-s2l1")  # video.avi 480x360; det.txt, gt.txt 768x576 (seqinfo.ini)
+    summary = track_many(pets, tmp_path, client, options=TrackOptions(detections="auto"))
+    (entry,) = summary.entries
+    assert entry["status"] == "done" and entry["det_scale"] == entry["gt_scale"] == 0.625
+    single = tmp_path / "single.txt"
+    argv = ["track", str(pets / "video.avi"), "--detections", str(pets / "det.txt")]
+    assert main([*argv, "--det-scale", "0.625", "--out", str(single)]) == 0
+    assert single.read_bytes() == (tmp_path / "pets09-s2l1.txt").read_bytes()
+    m = evaluate_mot(read_mot(pets / "gt.txt"), read_mot(single), scale=0.625)
+    assert entry["metrics"]["mota"] == m.mota and entry["metrics"]["idf1"] == m.idf1
