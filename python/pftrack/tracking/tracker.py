@@ -27,6 +27,7 @@ from pftrack.boxes import xywh_to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.tracking.association import associate, covers_another
+from pftrack.tracking.camera import CameraMotion, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
 from pftrack.tracking.track import LiveTrack, Track
@@ -66,6 +67,8 @@ class MultiObjectTracker:
         self.last_mask: NDArray[np.uint8] | None = None
         self._joint = JointTracker(self.config, self._rng)
         self._scores_are_confidences = True
+        self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
+        self._background_ok = True  # False while the camera moves (see .camera)
 
     # -- detections -------------------------------------------------------------------------
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
@@ -76,6 +79,10 @@ class MultiObjectTracker:
         """
         detector = self._ensure_detector()
         if hasattr(detector, "prime"):
+            if self.config.camera_motion != "off":  # a moving camera has no empty scene
+                frames = list(frames)
+                if self.camera.check_frames(frames):
+                    return
             detector.prime(frames)
 
     def _ensure_detector(self) -> Any:
@@ -100,7 +107,12 @@ class MultiObjectTracker:
             det = self._ensure_detector().detect(frame)
             self.last_mask = det.mask
             boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
-            return boxes, np.asarray(det.scores, dtype=np.float64), det.binned
+            binned = det.binned
+            if not self._background_ok:  # moving camera: colour of every pixel, not foreground
+                binned = det.frame_bins
+                if binned is None:
+                    binned = hsv_bins(frame, None, cfg.binning)
+            return boxes, np.asarray(det.scores, dtype=np.float64), binned
         boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
         if np.any((scores < 0) | (scores > 1)):
             self._scores_are_confidences = False
@@ -109,7 +121,7 @@ class MultiObjectTracker:
             mask, binned = self._foreground(frame)
         if binned is None:  # full-frame bins: the detector's fused pass made them, or one here
             binned = hsv_bins(frame, None, cfg.binning)
-        if cfg.refine.enabled and mask is not None and len(boxes):
+        if cfg.refine.enabled and mask is not None and len(boxes) and self._background_ok:
             boxes = refine_boxes(boxes, mask, cfg.refine.fraction)
         return boxes, scores, binned
 
@@ -150,12 +162,17 @@ class MultiObjectTracker:
             raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
         cfg = self.config
         self.frame_index += 1
+        # camera motion: move the tracks into this frame; no background model while it moves
+        step = self.camera.update(f, [t.box for t in self.tracks])
+        if step.apply is not None:
+            warp_tracks(self.tracks, step.apply)
+        self._background_ok = step.background_ok
         boxes, scores, binned = self._detections(f, detections)
         index = np.flatnonzero(scores >= cfg.lifecycle.min_score)
         boxes, scores = boxes[index], scores[index]
         if cfg.sampler == "rjmcmc":
             mask = self.last_mask
-            if mask is None or mask.shape != f.shape[:2]:
+            if mask is None or mask.shape != f.shape[:2] or not self._background_ok:
                 mask = np.full(f.shape[:2], 255, np.uint8)  # no background model: all foreground
             return self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
 
