@@ -54,6 +54,12 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "--dynamics", choices=("ar2", "ar2-mean"), default="ar2",
         help="AR(2) model per particle (eq. 7) or from the particle-set means (eq. 8)",
     )  # fmt: skip
+    p.add_argument(
+        "--camera-motion", choices=("auto", "on", "off"), default="auto",
+        help="camera-motion compensation: auto measures the camera's motion each frame and, "
+        "once it moves, moves the tracks with it and stops using the background model (a still "
+        "camera tracks exactly as with off); on: treat the camera as always moving",
+    )  # fmt: skip
     p.add_argument("--max-coast", type=int, default=10, metavar="FRAMES",
                    help="frames a track survives on its particle filter alone")  # fmt: skip
     p.add_argument(
@@ -89,4 +95,5 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         detector=args.detector,
         sampler=args.sampler,
         lifecycle=replace(base.lifecycle, max_coast=args.max_coast),
+        camera_motion=args.camera_motion,
     )
