@@ -450,10 +450,10 @@ def camera_path(
 def warp_frame(frame: NDArray[np.uint8], affine: NDArray[np.float64]) -> NDArray[np.uint8]:
     """Frame `frame` seen through `affine` (source to image, same size; bilinear)."""
     h, w = frame.shape[:2]
-    return np.asarray(
-        cv2.warpAffine(frame, affine, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT),
-        dtype=np.uint8,
+    out = cv2.warpAffine(
+        frame, affine, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT
     )
+    return np.asarray(out, dtype=np.uint8)
 
 
 def warp_rows(
@@ -495,7 +495,8 @@ def warp_rows(
     vis = np.clip(x1 - x0, 0, None) * np.clip(y1 - y0, 0, None)
     keep = (vis >= min_visible * wh[:, 0] * wh[:, 1]) & (x1 - x0 >= 2) & (y1 - y0 >= 2)
     r[:, 2], r[:, 3], r[:, 4], r[:, 5] = x0, y0, x1 - x0, y1 - y0
-    return r[keep]
+    out: NDArray[np.float64] = r[keep]
+    return out
 
 
 def move_camera(scene: Scene, **path: Any) -> Scene:

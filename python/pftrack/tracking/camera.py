@@ -179,7 +179,7 @@ class _Measure:
         if pts is None or len(pts) < cfg.min_inliers:
             return None
         nxt, status, _ = cv2.calcOpticalFlowPyrLK(
-            prev, cur, pts, None, winSize=(15, 15), maxLevel=3,
+            prev, cur, pts, np.empty_like(pts), winSize=(15, 15), maxLevel=3,
             criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
         )  # fmt: skip
         ok = status.reshape(-1) == 1
@@ -285,7 +285,8 @@ class CameraMotion:
 
 
 def _map_points(xy: F64, affine: F64) -> F64:
-    return xy @ affine[:, :2].T + affine[:, 2]
+    out: F64 = xy @ affine[:, :2].T + affine[:, 2]
+    return out
 
 
 def warp_tracks(tracks: Iterable[LiveTrack], affine: ArrayLike) -> None:
