@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from pftrack.tracking.config import (
     AssociationConfig,
+    CameraConfig,
     LifecycleConfig,
     MotionConfig,
     RefineConfig,
@@ -26,6 +27,7 @@ from pftrack.tracking.writer import TrackWriter
 __all__ = [
     "AssociationConfig",
     "BoxSmoother",
+    "CameraConfig",
     "LifecycleConfig",
     "MotionConfig",
     "MultiObjectTracker",

@@ -121,7 +121,9 @@ class MultiObjectTracker:
             mask, binned = self._foreground(frame)
         if binned is None:  # full-frame bins: the detector's fused pass made them, or one here
             binned = hsv_bins(frame, None, cfg.binning)
-        if cfg.refine.enabled and mask is not None and len(boxes) and self._background_ok:
+        # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
+        # useful (measured in experiments/moving_camera.py)
+        if cfg.refine.enabled and mask is not None and len(boxes):
             boxes = refine_boxes(boxes, mask, cfg.refine.fraction)
         return boxes, scores, binned
 
