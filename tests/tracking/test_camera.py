@@ -239,3 +239,14 @@ def test_camera_path_stays_inside_the_source() -> None:
         assert np.all(src >= 0) and np.all(src[:, 0] <= w) and np.all(src[:, 1] <= h)
     still = camera_path(5, SIZE, zoom_swing=0.0, pan=(0.0, 0.0), roll=0.0)
     assert np.all(still == still[0])
+
+
+def test_cli_option_reaches_the_config() -> None:
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+
+    parser = build_parser()
+    args = parser.parse_args(["track", "v.avi", "--out", "t.txt"])
+    assert tracker_config(args).camera_motion == "auto"
+    args = parser.parse_args(["track", "v.avi", "--out", "t.txt", "--camera-motion", "off"])
+    assert tracker_config(args).camera_motion == "off"
