@@ -27,7 +27,7 @@ References
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64
 from pftrack.tracking.config import CameraConfig
-from pftrack.tracking.track import LiveTrack
+from pftrack.tracking.track import LiveTrack, Track
 
 __all__ = [
     "CameraMotion",
@@ -43,6 +43,7 @@ __all__ = [
     "estimate_motion",
     "invert_affine",
     "motion_magnitude",
+    "Stabiliser",
     "warp_tracks",
 ]
 
@@ -326,3 +327,58 @@ def warp_tracks(tracks: Iterable[LiveTrack], affine: ArrayLike) -> None:
         centre = _map_points((t.box[:2] + t.box[2:] / 2)[None], a)[0]
         t.size = t.size * z
         t.box = np.concatenate([centre - t.box[2:] * z / 2, t.box[2:] * z])
+
+
+def _map_box(box: F64, affine: F64) -> F64:
+    """An xywh box moved by `affine`: centre through it, size times its zoom."""
+    b = np.asarray(box, dtype=np.float64)
+    z = float(np.sqrt(abs(np.linalg.det(affine[:, :2]))))
+    centre = affine[:, :2] @ (b[:2] + b[2:] / 2) + affine[:, 2]
+    return np.concatenate([centre - b[2:] * z / 2, b[2:] * z])
+
+
+class Stabiliser:
+    """The camera's path over a run: each frame's pixels in the first frame's coordinates.
+
+    The offline pass (linking, filling, smoothing) assumes a still camera; with the tracks'
+    boxes in these stabilised coordinates it sees the objects' own motion, and its rows are
+    mapped back to each frame after it. Frames where the tracker applied no transform count
+    as still, so a still camera gives exactly the boxes it was given.
+    """
+
+    def __init__(self) -> None:
+        self.to_first: list[F64] = []  # per frame (from 1): frame pixels -> first-frame pixels
+
+    @property
+    def moved(self) -> bool:
+        """Whether any transform was applied so far."""
+        return any(not np.array_equal(s, IDENTITY) for s in self.to_first)
+
+    def add(self, applied: F64 | None) -> None:
+        """Record the next frame's transform from the previous frame (None: still)."""
+        last = self.to_first[-1] if self.to_first else IDENTITY
+        self.to_first.append(last if applied is None else compose(last, invert_affine(applied)))
+
+    def stabilise(self, tracks: list[Track]) -> list[Track]:
+        """The tracks of the last frame added, boxes in first-frame coordinates."""
+        if not self.moved:
+            return tracks
+        s = self.to_first[-1]
+        out = []
+        for t in tracks:
+            history = tuple((f, _map_box(b, self.to_first[f - 1]), sc) for f, b, sc in t.history)
+            det = None if t.detection_box is None else _map_box(t.detection_box, s)
+            out.append(
+                replace(t, box_xywh=_map_box(t.box_xywh, s), history=history, detection_box=det)
+            )
+        return out
+
+    def restore(self, rows: F64) -> F64:
+        """MOT rows in first-frame coordinates mapped back to their frames' pixels."""
+        if not self.moved or not len(rows):
+            return rows
+        out = np.array(rows, dtype=np.float64, copy=True)
+        for k, row in enumerate(out):
+            back = invert_affine(self.to_first[int(row[0]) - 1])
+            out[k, 2:6] = _map_box(row[2:6], back)
+        return out

@@ -16,6 +16,7 @@ from pftrack._typing import F64, PathLike, RngLike
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
+from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
 from pftrack.tracking.tracker import MultiObjectTracker
@@ -115,6 +116,7 @@ def track_frames(
     if prime_frames > 0 and (detections is None or config.refine.enabled):
         tracker.prime(itertools.islice(iter(frames), prime_frames))
     writer = TrackWriter(coasting, fill, smoother, link)
+    stabiliser = Stabiliser()
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0
@@ -123,7 +125,9 @@ def track_frames(
         progress(frames, total=total, desc="tracking", enable=show_progress), start=1
     ):
         dets = None if detections is None else detections.get(n, empty)
-        writer.add(n, tracker.update(frame, dets))
+        tracks = tracker.update(frame, dets)
+        stabiliser.add(tracker.camera_step.apply)  # the offline pass sees a still camera
+        writer.add(n, stabiliser.stabilise(tracks))
     if n == 0:
         raise ValueError(f"no frame could be read from {source}")
-    return TrackingRun(writer.result(), n, time.perf_counter() - start)
+    return TrackingRun(stabiliser.restore(writer.result()), n, time.perf_counter() - start)

@@ -27,7 +27,7 @@ from pftrack.boxes import xywh_to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.tracking.association import associate, covers_another
-from pftrack.tracking.camera import CameraMotion, warp_tracks
+from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
 from pftrack.tracking.track import LiveTrack, Track
@@ -69,6 +69,7 @@ class MultiObjectTracker:
         self._scores_are_confidences = True
         self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
         self._background_ok = True  # False while the camera moves (see .camera)
+        self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
 
     # -- detections -------------------------------------------------------------------------
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
@@ -169,6 +170,7 @@ class MultiObjectTracker:
         if step.apply is not None:
             warp_tracks(self.tracks, step.apply)
         self._background_ok = step.background_ok
+        self.camera_step = step
         boxes, scores, binned = self._detections(f, detections)
         index = np.flatnonzero(scores >= cfg.lifecycle.min_score)
         boxes, scores = boxes[index], scores[index]
