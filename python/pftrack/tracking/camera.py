@@ -16,6 +16,9 @@ still camera tracks exactly as without compensation.
 previous centre, the AR(2) state; the scale through the filter's base size), the particle-set
 means, each centre filter's position, velocity and covariance, and the box and size.
 
+:class:`Stabiliser` chains the applied transforms over a run so that the offline pass (linking,
+filling, smoothing), which assumes a still camera, works in the first frame's coordinates.
+
 References
 ----------
 .. [1] Shi, J. & Tomasi, C. (1994). Good features to track. CVPR 1994.
