@@ -108,3 +108,36 @@ def test_writers(tmp_path):
 def test_bad_arguments(kwargs, match):
     with pytest.raises(ValueError, match=match):
         make_scene(**kwargs)
+
+
+def test_warp_rows_moves_clips_and_drops():
+    from pftrack.synthetic import warp_rows
+
+    rows = np.array(
+        [
+            [1, 1, 10, 20, 30, 40, 1, -1, -1, -1],  # inside
+            [1, 2, 90, 20, 20, 20, 1, -1, -1, -1],  # 3/4 outside after the shift: dropped
+            [2, 1, 60, 50, 20, 20, 1, -1, -1, -1],  # half outside after the zoom: clipped
+        ],
+        dtype=np.float64,
+    )
+    shift = np.array([[[1.0, 0.0, 5.0], [0.0, 1.0, -2.0]]])
+    zoom = np.array([[[2.0, 0.0, -40.0], [0.0, 2.0, -40.0]]])  # about (40, 40)
+    out = warp_rows(rows, np.concatenate([shift, zoom]), (100, 100))
+    np.testing.assert_allclose(out[0], [1, 1, 15, 18, 30, 40, 1, -1, -1, -1])
+    # centre (70, 60) -> (100, 80), size 40: x from 80 to 120 is clipped to 80..100
+    np.testing.assert_allclose(out[1, 2:6], [80, 60, 20, 40])
+    assert len(out) == 2
+    same = warp_rows(rows, np.tile(np.eye(2, 3), (2, 1, 1)), (100, 200))
+    np.testing.assert_array_equal(same, rows)
+
+
+def test_move_camera_keeps_the_scene_and_moves_its_view():
+    from pftrack.synthetic import move_camera
+
+    still = make_scene(n_frames=6, n_walkers=2, rng=1)
+    moved = move_camera(still)
+    assert len(moved.frames) == 6 and moved.frames[0].shape == still.frames[0].shape
+    assert moved.occluder is None and moved.walkers == still.walkers
+    assert not np.array_equal(moved.frames[0], still.frames[0])
+    assert set(moved.truth[:, 0]) <= set(still.truth[:, 0])

@@ -4,12 +4,17 @@ A textured static background, people-sized two-tone walkers that enter and leave
 borders on gently curving paths (two of them cross), a vertical "lamp post" in front of them and
 mild per-frame sensor noise. Ground truth is a MOTChallenge array of the walkers' visible extent
 (clipped to the image, not to the occluder).
+
+:func:`move_camera` films any scene with a moving camera: :func:`camera_path` gives a smooth
+pan, zoom and roll, :func:`warp_frame` and :func:`warp_rows` apply it to frames and MOTChallenge
+boxes (real sequences too).
 """
 
 from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -19,7 +24,7 @@ from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
 
-__all__ = ["Scene", "Walker", "make_scene"]
+__all__ = ["Scene", "Walker", "camera_path", "make_scene", "move_camera", "warp_frame", "warp_rows"]
 
 
 # Clothing colours (BGR), far apart in hue so colour histograms can tell walkers apart.
@@ -387,3 +392,125 @@ def make_scene(
     if len(t):
         t = t[np.lexsort((t[:, 1], t[:, 0]))]
     return Scene(frames=frames, truth=t, background=bg, occluder=occ, walkers=walkers, fps=fps)
+
+
+def camera_path(
+    n_frames: int,
+    size: tuple[int, int],
+    *,
+    zoom: float = 1.35,
+    zoom_swing: float = 0.1,
+    pan: tuple[float, float] = (0.06, 0.04),
+    roll: float = 3.0,
+    period: float = 120.0,
+) -> NDArray[np.float64]:
+    """A smooth moving-camera path: one source-to-image affine per frame.
+
+    Each frame shows a window of the source, zoomed in by ``zoom ± zoom_swing``, panned by up
+    to ``pan`` (shares of the width and height) from the centre and rolled by up to ``roll``
+    degrees, every part a sinusoid of its own period (``period``, 1.3, 1.7 and 2.1 times it) and
+    phase. The defaults keep the window inside the source (no border). With ``zoom_swing``,
+    ``pan`` and ``roll`` all 0 the camera is still (a fixed crop).
+
+    Parameters
+    ----------
+    n_frames : int
+        Frames (>= 1).
+    size : (height, width)
+        Source and image size.
+    zoom, zoom_swing, pan, roll, period : float
+        As above.
+
+    Returns
+    -------
+    (n_frames, 2, 3) ndarray
+        ``A_t`` maps a source pixel to frame t's pixel (``cv2.warpAffine``'s convention).
+    """
+    if not isinstance(n_frames, (int, np.integer)) or n_frames < 1:
+        raise ValueError(f"camera_path: n_frames is {n_frames!r}, expected an integer >= 1")
+    if not (zoom - zoom_swing > 0 and period > 0):
+        raise ValueError("camera_path: need zoom - zoom_swing > 0 and period > 0")
+    h, w = size
+    t = np.arange(n_frames, dtype=np.float64)
+    z = zoom + zoom_swing * np.sin(2 * np.pi * t / (1.3 * period) + 0.5)
+    sx = pan[0] * w * np.sin(2 * np.pi * t / period)
+    sy = pan[1] * h * np.sin(2 * np.pi * t / (1.7 * period) + 1.0)
+    th = np.deg2rad(roll) * np.sin(2 * np.pi * t / (2.1 * period) + 2.0)
+    c = np.array([w / 2, h / 2])
+    out = np.empty((n_frames, 2, 3))
+    for k in range(n_frames):
+        # u = c + z R(-theta) (x - c - shift)
+        cos, sin = np.cos(th[k]), np.sin(th[k])
+        lin = z[k] * np.array([[cos, sin], [-sin, cos]])
+        out[k, :, :2] = lin
+        out[k, :, 2] = c - lin @ (c + np.array([sx[k], sy[k]]))
+    return out
+
+
+def warp_frame(frame: NDArray[np.uint8], affine: NDArray[np.float64]) -> NDArray[np.uint8]:
+    """Frame `frame` seen through `affine` (source to image, same size; bilinear)."""
+    h, w = frame.shape[:2]
+    out = cv2.warpAffine(
+        frame, affine, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT
+    )
+    return np.asarray(out, dtype=np.uint8)
+
+
+def warp_rows(
+    rows: NDArray[np.float64],
+    affines: NDArray[np.float64],
+    size: tuple[int, int],
+    *,
+    min_visible: float = 0.5,
+) -> NDArray[np.float64]:
+    """MOTChallenge rows (ground truth or detections) moved with the camera.
+
+    Each box's centre goes through its frame's affine and its size is multiplied by the
+    affine's zoom (``sqrt(det)``; the box stays axis-aligned); it is then clipped to the image,
+    and dropped when less than `min_visible` of it remains inside. Frames without an affine
+    (beyond ``len(affines)``) are dropped.
+
+    Parameters
+    ----------
+    rows : (M, >=6) ndarray
+        1-based frame, id, left, top, width, height, ... in source pixels.
+    affines : (T, 2, 3) ndarray
+        From :func:`camera_path`.
+    size : (height, width)
+        Image size.
+    min_visible : float
+        Share of a box that must stay inside the image.
+    """
+    r = np.array(rows, dtype=np.float64, copy=True).reshape(-1, np.shape(rows)[-1])
+    f = r[:, 0].astype(np.int64) - 1
+    r = r[(f >= 0) & (f < len(affines))]
+    a = affines[r[:, 0].astype(np.int64) - 1]
+    zoom = np.sqrt(np.abs(np.linalg.det(a[:, :, :2])))
+    centre = r[:, 2:4] + r[:, 4:6] / 2
+    centre = np.einsum("kij,kj->ki", a[:, :, :2], centre) + a[:, :, 2]
+    wh = r[:, 4:6] * zoom[:, None]
+    x0, y0 = np.maximum(centre - wh / 2, 0.0).T
+    x1 = np.minimum(centre[:, 0] + wh[:, 0] / 2, size[1])
+    y1 = np.minimum(centre[:, 1] + wh[:, 1] / 2, size[0])
+    vis = np.clip(x1 - x0, 0, None) * np.clip(y1 - y0, 0, None)
+    keep = (vis >= min_visible * wh[:, 0] * wh[:, 1]) & (x1 - x0 >= 2) & (y1 - y0 >= 2)
+    r[:, 2], r[:, 3], r[:, 4], r[:, 5] = x0, y0, x1 - x0, y1 - y0
+    out: NDArray[np.float64] = r[keep]
+    return out
+
+
+def move_camera(scene: Scene, **path: Any) -> Scene:
+    """`scene` filmed by a moving camera (:func:`camera_path` with the `path` settings).
+
+    Frames and ground truth are warped; the background is the first frame's view and the
+    occluder is dropped (it moves with the view).
+    """
+    affines = camera_path(len(scene.frames), (scene.height, scene.width), **path)
+    return Scene(
+        frames=[warp_frame(f, a) for f, a in zip(scene.frames, affines, strict=True)],
+        truth=warp_rows(scene.truth, affines, (scene.height, scene.width)),
+        background=warp_frame(scene.background, affines[0]),
+        occluder=None,
+        walkers=scene.walkers,
+        fps=scene.fps,
+    )

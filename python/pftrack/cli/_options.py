@@ -75,6 +75,12 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "--dynamics", choices=("ar2", "ar2-mean"), default="ar2",
         help="AR(2) model per particle (eq. 7) or from the particle-set means (eq. 8)",
     )  # fmt: skip
+    p.add_argument(
+        "--camera-motion", choices=("auto", "on", "off"), default="auto",
+        help="camera-motion compensation: auto measures the camera's motion each frame and, "
+        "once it moves, moves the tracks with it and stops using the background model (a still "
+        "camera tracks exactly as with off); on: treat the camera as always moving",
+    )  # fmt: skip
     p.add_argument("--max-coast", type=int, default=10, metavar="FRAMES",
                    help="frames a track survives on its particle filter alone (0.4 s at 25 "
                    "frames/s: pftrack.Tracker's max_coast is in seconds)")  # fmt: skip
@@ -87,11 +93,6 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         help="a detection starts a track with a score of at least min(S, the lower quartile of "
         "the scores of the first 50 frames) (scores in [0, 1] only; other scores never gate "
         "births)",
-    )  # fmt: skip
-    p.add_argument(
-        "--camera-motion", choices=("auto", "on", "off"), default="auto",
-        help="camera-motion compensation: auto (only while the camera is found to move), on "
-        "(always), off (static camera)",
     )  # fmt: skip
     p.add_argument(
         "--fill", choices=("linear", "pf"), default="linear",

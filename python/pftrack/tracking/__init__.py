@@ -15,6 +15,7 @@ from __future__ import annotations
 from pftrack.tracking.api import Tracker
 from pftrack.tracking.config import (
     AssociationConfig,
+    CameraConfig,
     LifecycleConfig,
     MotionConfig,
     RefineConfig,
@@ -29,6 +30,7 @@ from pftrack.tracking.writer import TrackWriter
 __all__ = [
     "AssociationConfig",
     "BoxSmoother",
+    "CameraConfig",
     "LifecycleConfig",
     "MotionConfig",
     "MultiObjectTracker",

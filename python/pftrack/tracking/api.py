@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64, RngLike
 from pftrack.recovery.linking import LinkConfig
+from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
 from pftrack.tracking.track import Track
@@ -287,6 +288,7 @@ class Tracker:
         self._tracker = MultiObjectTracker(self.config, rng=self.seed)
         self._writer = TrackWriter(*self._writer_args)
         self.frame_count = 0
+        self._stabiliser = Stabiliser()
         self._reports: list[Track] = []
         self._clip_warned = False
         self._max_conf = -np.inf
@@ -346,7 +348,9 @@ class Tracker:
                 self._max_conf = max(self._max_conf, float(xywh[:, 4].max()))
             reports = self._tracker.update(f, xywh, cls)
         self.frame_count += 1
-        self._writer.add(self.frame_count, reports)
+        # the offline pass sees a still camera: boxes in the first frame's coordinates
+        self._stabiliser.add(self._tracker.camera_step.apply)
+        self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
         self._reports = reports
         out = np.zeros((len(reports), 8))
         m = 0
@@ -376,7 +380,8 @@ class Tracker:
         writes them as they come. A gap bridged by a particle filter is settled when the track
         is detected again.
         """
-        return np.asarray(self._writer.rows[start:], np.float64).reshape(-1, 10)
+        rows = np.asarray(self._writer.rows[start:], np.float64).reshape(-1, 10)
+        return self._stabiliser.restore(rows)
 
     def finalize(self) -> F64:
         """The run's MOTChallenge rows after the offline pass (what ``pftrack track`` writes).
@@ -387,7 +392,7 @@ class Tracker:
             ``frame, id, left, top, width, height, conf, -1, -1, -1``, frames from 1 (one per
             ``update``), sorted by frame then id. Warns when there is no row at all.
         """
-        rows = self._writer.result()
+        rows = self._stabiliser.restore(self._writer.result())
         if len(rows) == 0 and self.frame_count:
             cfg = self.config.lifecycle
             hint = (

@@ -27,6 +27,7 @@ from pftrack.boxes import xywh_to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.tracking.association import associate, covers_another
+from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
 from pftrack.tracking.track import LiveTrack, Track
@@ -68,6 +69,9 @@ class MultiObjectTracker:
         self._scores_are_confidences = True
         self._birth_scores: list[F64] = []  # scores of the first frames (birth_quantile)
         self._birth_level = np.inf
+        self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
+        self._background_ok = True  # False while the camera moves (see .camera)
+        self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
 
     # -- detections -------------------------------------------------------------------------
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
@@ -78,6 +82,10 @@ class MultiObjectTracker:
         """
         detector = self._ensure_detector()
         if hasattr(detector, "prime"):
+            if self.config.camera_motion != "off":  # a moving camera has no empty scene
+                frames = list(frames)
+                if self.camera.check_frames(frames):
+                    return
             detector.prime(frames)
 
     def _ensure_detector(self) -> Any:
@@ -102,7 +110,12 @@ class MultiObjectTracker:
             det = self._ensure_detector().detect(frame)
             self.last_mask = det.mask
             boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
-            return boxes, np.asarray(det.scores, dtype=np.float64), det.binned
+            binned = det.binned
+            if not self._background_ok:  # moving camera: colour of every pixel, not foreground
+                binned = det.frame_bins
+                if binned is None:
+                    binned = hsv_bins(frame, None, cfg.binning)
+            return boxes, np.asarray(det.scores, dtype=np.float64), binned
         boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
         if np.any((scores < 0) | (scores > 1)):
             self._scores_are_confidences = False
@@ -111,6 +124,8 @@ class MultiObjectTracker:
             mask, binned = self._foreground(frame)
         if binned is None:  # full-frame bins: the detector's fused pass made them, or one here
             binned = hsv_bins(frame, None, cfg.binning)
+        # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
+        # useful (measured in experiments/moving_camera.py)
         if cfg.refine.enabled and mask is not None and len(boxes):
             boxes = refine_boxes(boxes, mask, cfg.refine.fraction)
         return boxes, scores, binned
@@ -170,6 +185,12 @@ class MultiObjectTracker:
             raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
         cfg = self.config
         self.frame_index += 1
+        # camera motion: move the tracks into this frame; no background model while it moves
+        step = self.camera.update(f, [t.box for t in self.tracks])
+        if step.apply is not None:
+            warp_tracks(self.tracks, step.apply)
+        self._background_ok = step.background_ok
+        self.camera_step = step
         boxes, scores, binned = self._detections(f, detections)
         labels = np.zeros(len(boxes), np.int64)
         if classes is not None and detections is not None:
@@ -182,7 +203,7 @@ class MultiObjectTracker:
             if len(np.unique(labels)) > 1:
                 raise ValueError("sampler 'rjmcmc' tracks one class; got several class ids")
             mask = self.last_mask
-            if mask is None or mask.shape != f.shape[:2]:
+            if mask is None or mask.shape != f.shape[:2] or not self._background_ok:
                 mask = np.full(f.shape[:2], 255, np.uint8)  # no background model: all foreground
             return self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
 

@@ -1,0 +1,392 @@
+"""Camera-motion compensation: the camera's own motion between frames, and the tracks moved by it.
+
+A moving camera moves every object in the image. :class:`CameraMotion` measures that motion
+once per frame as a similarity transform (rotation, uniform scale, translation; a 2x3 affine
+from the previous frame to this one): corners of the previous grey frame
+(``cv2.goodFeaturesToTrack``), outside the boxes of the objects being tracked, followed into
+this frame by pyramidal Lucas-Kanade optical flow (``cv2.calcOpticalFlowPyrLK``), and the
+transform fitted to them by RANSAC (``cv2.estimateAffinePartial2D``), which leaves out the
+points on anything that moves by itself. It then decides, with hysteresis, whether the camera
+moves: a frame moves when a corner of the image moves by more than a share of the image
+diagonal; the camera starts moving after a few such frames in a row and stops after more still
+ones. While it does not move the transform it hands back is None and nothing is changed, so a
+still camera tracks exactly as without compensation.
+
+:func:`warp_tracks` applies a transform to the tracker's state: every particle (its current and
+previous centre, the AR(2) state; the scale through the filter's base size), the particle-set
+means, each centre filter's position, velocity and covariance, and the box and size.
+
+:class:`Stabiliser` chains the applied transforms over a run so that the offline pass (linking,
+filling, smoothing), which assumes a still camera, works in the first frame's coordinates.
+
+References
+----------
+.. [1] Shi, J. & Tomasi, C. (1994). Good features to track. CVPR 1994.
+.. [2] Bouguet, J.-Y. (2001). Pyramidal implementation of the affine Lucas Kanade feature
+   tracker. Intel Corporation.
+.. [3] Fischler, M. A. & Bolles, R. C. (1981). Random sample consensus. CACM 24(6).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, replace
+
+import cv2
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pftrack._typing import F64
+from pftrack.tracking.config import CameraConfig
+from pftrack.tracking.track import LiveTrack, Track
+
+__all__ = [
+    "CameraMotion",
+    "CameraStep",
+    "estimate_motion",
+    "invert_affine",
+    "motion_magnitude",
+    "Stabiliser",
+    "warp_tracks",
+]
+
+IDENTITY: F64 = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+
+@dataclass(frozen=True)
+class CameraStep:
+    """What :meth:`CameraMotion.update` found for one frame.
+
+    Attributes
+    ----------
+    affine : (2, 3) ndarray or None
+        The estimated transform from the previous frame to this one (pixels), None when it
+        could not be estimated (first frame, too few corners or inliers).
+    magnitude : float
+        Largest displacement of an image corner under `affine`, pixels (0 without one).
+    moving : bool
+        Whether the camera counts as moving on this frame.
+    apply : (2, 3) ndarray or None
+        The transform to apply to the tracker's state on this frame (None: leave it as it is).
+        When the camera starts moving it covers the moving frames that led to the decision.
+    background_ok : bool
+        Whether a background model of the scene can be trusted on this frame (the camera is
+        still and has been for ``settle_frames``).
+    """
+
+    affine: F64 | None
+    magnitude: float
+    moving: bool
+    apply: F64 | None
+    background_ok: bool
+
+
+def compose(second: F64, first: F64) -> F64:
+    """The affine doing `first`, then `second` (both (2, 3))."""
+    return np.hstack([second[:, :2] @ first[:, :2], second[:, :2] @ first[:, 2:] + second[:, 2:]])
+
+
+def invert_affine(affine: ArrayLike) -> F64:
+    """The inverse of a (2, 3) affine transform."""
+    a = _affine(affine)
+    lin = np.linalg.inv(a[:, :2])
+    return np.hstack([lin, -lin @ a[:, 2:]])
+
+
+def _affine(affine: ArrayLike) -> F64:
+    a = np.asarray(affine, dtype=np.float64)
+    if a.shape != (2, 3) or not np.all(np.isfinite(a)):
+        raise ValueError(f"affine has shape {a.shape}, expected a finite (2, 3) array")
+    if abs(np.linalg.det(a[:, :2])) < 1e-9:
+        raise ValueError("affine is singular (its 2x2 part has determinant 0)")
+    return a
+
+
+def motion_magnitude(affine: ArrayLike, size: tuple[int, int]) -> float:
+    """Largest displacement (pixels) of the corners of a `size` = (height, width) image."""
+    a = np.asarray(affine, dtype=np.float64)
+    h, w = size
+    corners = np.array([[0.0, 0.0], [w, 0.0], [0.0, h], [w, h]])
+    moved = corners @ a[:, :2].T + a[:, 2]
+    return float(np.max(np.hypot(*(moved - corners).T)))
+
+
+def _grey(frame: NDArray[np.uint8], factor: float) -> NDArray[np.uint8]:
+    g = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    if factor != 1.0:
+        size = (round(g.shape[1] * factor), round(g.shape[0] * factor))
+        g = cv2.resize(g, size, interpolation=cv2.INTER_AREA)
+    return np.asarray(g, dtype=np.uint8)
+
+
+def _exclusion_mask(shape: tuple[int, int], boxes_xywh: F64, factor: float) -> NDArray[np.uint8]:
+    """255 where corners may be taken: outside every box (grown by a quarter of its size)."""
+    mask = np.full(shape, 255, np.uint8)
+    for x, y, w, h in boxes_xywh * factor:
+        x0, y0 = int(np.floor(x - 0.25 * w)), int(np.floor(y - 0.25 * h))
+        x1, y1 = int(np.ceil(x + 1.25 * w)), int(np.ceil(y + 1.25 * h))
+        mask[max(y0, 0) : max(y1, 0), max(x0, 0) : max(x1, 0)] = 0
+    return mask
+
+
+def estimate_motion(
+    previous: NDArray[np.uint8],
+    current: NDArray[np.uint8],
+    exclude_xywh: ArrayLike = (),
+    config: CameraConfig | None = None,
+) -> F64 | None:
+    """The similarity transform from frame `previous` to frame `current`.
+
+    Parameters
+    ----------
+    previous, current : (H, W, 3) ndarray of uint8
+        BGR frames of one size.
+    exclude_xywh : (K, 4) array_like
+        Boxes (left, top, width, height) of objects that move by themselves: no corner is
+        taken inside them.
+    config : CameraConfig, optional
+        Scaling, corners, RANSAC threshold and inlier count.
+
+    Returns
+    -------
+    (2, 3) ndarray or None
+        ``[[a, -b, tx], [b, a, ty]]`` mapping a pixel of `previous` to `current`; None when
+        there are too few corners or inliers.
+    """
+    cfg = config if config is not None else CameraConfig()
+    _, prev = _Measure(cfg).grey(previous)
+    factor, cur = _Measure(cfg).grey(current)
+    if prev.shape != cur.shape:
+        raise ValueError(f"frames differ in size: {previous.shape} and {current.shape}")
+    return _Measure(cfg).fit(prev, cur, factor, np.asarray(exclude_xywh, np.float64))
+
+
+class _Measure:
+    """The estimation steps, shared by :func:`estimate_motion` and :class:`CameraMotion`."""
+
+    def __init__(self, config: CameraConfig) -> None:
+        self.config = config
+
+    def grey(self, frame: NDArray[np.uint8]) -> tuple[float, NDArray[np.uint8]]:
+        f = np.asarray(frame)
+        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
+            raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        factor = min(1.0, self.config.max_side / max(f.shape[:2]))
+        return factor, _grey(f, factor)
+
+    def fit(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], factor: float,
+            exclude: F64) -> F64 | None:  # fmt: skip
+        cfg = self.config
+        mask = _exclusion_mask(prev.shape, exclude.reshape(-1, 4), factor)
+        spacing = max(4.0, min(prev.shape) / 40)
+        pts = cv2.goodFeaturesToTrack(prev, cfg.max_features, 0.01, spacing, mask=mask)
+        if pts is None or len(pts) < cfg.min_inliers:
+            return None
+        nxt, status, _ = cv2.calcOpticalFlowPyrLK(
+            prev, cur, pts, np.empty_like(pts), winSize=(15, 15), maxLevel=3,
+            criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
+        )  # fmt: skip
+        ok = status.reshape(-1) == 1
+        if ok.sum() < cfg.min_inliers:
+            return None
+        src, dst = pts.reshape(-1, 2)[ok], nxt.reshape(-1, 2)[ok]
+        m, inliers = cv2.estimateAffinePartial2D(
+            src, dst, method=cv2.RANSAC, ransacReprojThreshold=cfg.ransac_threshold,
+            maxIters=2000, confidence=0.995, refineIters=10,
+        )  # fmt: skip
+        if m is None or inliers is None or int(inliers.sum()) < cfg.min_inliers:
+            return None
+        a = np.asarray(m, dtype=np.float64)
+        a[:, 2] /= factor  # scaled pixels -> frame pixels (the linear part is the same)
+        return a
+
+
+class CameraMotion:
+    """Measure the camera's motion frame by frame and decide when it moves.
+
+    Parameters
+    ----------
+    mode : {"auto", "on", "off"}
+        ``"auto"``: decide with hysteresis; ``"on"``: the camera always counts as moving (every
+        estimate is applied, the background is never trusted); ``"off"``: measure nothing.
+    config : CameraConfig, optional
+        Estimation and decision settings.
+
+    Examples
+    --------
+    >>> camera = CameraMotion("auto")                                  # doctest: +SKIP
+    >>> step = camera.update(frame, exclude_xywh=boxes)                # doctest: +SKIP
+    >>> if step.apply is not None:                                     # doctest: +SKIP
+    ...     warp_tracks(tracks, step.apply)
+    """
+
+    def __init__(self, mode: str = "auto", config: CameraConfig | None = None) -> None:
+        if mode not in ("auto", "on", "off"):
+            raise ValueError(f"camera_motion is {mode!r}, expected 'auto', 'on' or 'off'")
+        self.mode = mode
+        self.config = config if config is not None else CameraConfig()
+        self._measure = _Measure(self.config)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the previous frame and the moving state (before a new video)."""
+        self._prev: NDArray[np.uint8] | None = None
+        self.moving = self.mode == "on"
+        self._pending: F64 | None = None  # moving frames before the camera counts as moving
+        self._run = 0  # consecutive moving (while still) or still (while moving) frames
+        self._since_moving = self.config.settle_frames if self.mode == "auto" else 0
+
+    def update(self, frame: NDArray[np.uint8], exclude_xywh: ArrayLike = ()) -> CameraStep:
+        """Measure the motion from the previous frame to `frame` and decide.
+
+        Parameters
+        ----------
+        frame : (H, W, 3) ndarray of uint8
+            This BGR frame.
+        exclude_xywh : (K, 4) array_like
+            Boxes of the objects being tracked or detected (corners inside are not used).
+        """
+        if self.mode == "off":
+            return CameraStep(None, 0.0, False, None, True)
+        cfg = self.config
+        factor, grey = self._measure.grey(frame)
+        prev, self._prev = self._prev, grey
+        affine = None
+        if prev is not None and prev.shape == grey.shape:
+            exclude = np.asarray(exclude_xywh, dtype=np.float64).reshape(-1, 4)
+            affine = self._measure.fit(prev, grey, factor, exclude)
+        size = (frame.shape[0], frame.shape[1])
+        magnitude = 0.0 if affine is None else motion_magnitude(affine, size)
+        if self.mode == "on":
+            return CameraStep(affine, magnitude, True, affine, False)
+
+        moves = affine is not None and magnitude > cfg.threshold * float(np.hypot(*size))
+        apply = None
+        if not self.moving:
+            if moves and affine is not None:
+                self._pending = affine if self._pending is None else compose(affine, self._pending)
+                self._run += 1
+                if self._run >= cfg.on_frames:
+                    self.moving, apply, self._pending, self._run = True, self._pending, None, 0
+            else:
+                self._pending, self._run = None, 0
+        else:
+            apply = affine
+            self._run = 0 if moves else self._run + 1
+            if self._run >= cfg.off_frames:
+                self.moving, self._run, self._since_moving = False, 0, 0
+        if self.moving:
+            self._since_moving = 0
+        elif self._since_moving < cfg.settle_frames:
+            self._since_moving += 1
+        background_ok = not self.moving and self._since_moving >= cfg.settle_frames
+        return CameraStep(affine, magnitude, self.moving, apply, background_ok)
+
+    def check_frames(self, frames: Iterable[NDArray[np.uint8]]) -> bool:
+        """Tell whether the camera moves anywhere in `frames` (the moving state is not kept)."""
+        probe = CameraMotion(self.mode, self.config)
+        return any(probe.update(f).moving for f in frames)
+
+
+def _map_points(xy: F64, affine: F64) -> F64:
+    out: F64 = xy @ affine[:, :2].T + affine[:, 2]
+    return out
+
+
+def warp_tracks(tracks: Iterable[LiveTrack], affine: ArrayLike) -> None:
+    """Move every track's state by a similarity transform, in place.
+
+    Parameters
+    ----------
+    tracks : iterable of LiveTrack
+        The tracker's live tracks.
+    affine : (2, 3) array_like
+        From the previous frame's pixels to this frame's (rotation, uniform scale ``z``,
+        translation).
+
+    Notes
+    -----
+    Positions (particles' current and previous centres, particle-set means, the centre filter's
+    position and the box's centre) are mapped by the transform, velocities by its linear part;
+    sizes (the box, the smoothed size and the filter's base size, which the particles' scales
+    multiply) are multiplied by ``z = sqrt(det)``, and the centre filter's covariance (one per
+    axis, shared) by ``z²``. The box stays axis-aligned: a roll changes its centre, not its size.
+    """
+    a = _affine(affine)
+    lin = a[:, :2]
+    z = float(np.sqrt(abs(np.linalg.det(lin))))
+    for t in tracks:
+        f = t.filter
+        p = f.particles
+        p[:, 0:2] = _map_points(p[:, 0:2], a)
+        p[:, 3:5] = _map_points(p[:, 3:5], a)
+        f.means[:, :2] = _map_points(f.means[:, :2], a)
+        f.w0 *= z
+        f.h0 *= z
+        k = t.motion
+        k.p = _map_points(k.p[None], a)[0]
+        k.v = lin @ k.v
+        k.cov = (k.cov[0] * z * z, k.cov[1] * z * z, k.cov[2] * z * z)
+        centre = _map_points((t.box[:2] + t.box[2:] / 2)[None], a)[0]
+        t.size = t.size * z
+        t.box = np.concatenate([centre - t.box[2:] * z / 2, t.box[2:] * z])
+
+
+def _map_box(box: F64, affine: F64) -> F64:
+    """An xywh box moved by `affine`: centre through it, size times its zoom."""
+    b = np.asarray(box, dtype=np.float64)
+    z = float(np.sqrt(abs(np.linalg.det(affine[:, :2]))))
+    centre = affine[:, :2] @ (b[:2] + b[2:] / 2) + affine[:, 2]
+    return np.concatenate([centre - b[2:] * z / 2, b[2:] * z])
+
+
+class Stabiliser:
+    """The camera's path over a run: each frame's pixels in the first frame's coordinates.
+
+    The offline pass (linking, filling, smoothing) assumes a still camera; with the tracks'
+    boxes in these stabilised coordinates it sees the objects' own motion, and its rows are
+    mapped back to each frame after it. Frames where the tracker applied no transform count
+    as still, so a still camera gives exactly the boxes it was given.
+    """
+
+    def __init__(self) -> None:
+        self.to_first: list[F64] = []  # per frame (from 1): frame pixels -> first-frame pixels
+        self._moved = False
+
+    @property
+    def moved(self) -> bool:
+        """Whether any transform was applied so far."""
+        return self._moved
+
+    def add(self, applied: F64 | None) -> None:
+        """Record the next frame's transform from the previous frame (None: still)."""
+        last = self.to_first[-1] if self.to_first else IDENTITY
+        if applied is None:
+            self.to_first.append(last)
+            return
+        self.to_first.append(compose(last, invert_affine(applied)))
+        self._moved = self._moved or not np.array_equal(self.to_first[-1], IDENTITY)
+
+    def stabilise(self, tracks: list[Track]) -> list[Track]:
+        """The tracks of the last frame added, boxes in first-frame coordinates."""
+        if not self.moved:
+            return tracks
+        s = self.to_first[-1]
+        out = []
+        for t in tracks:
+            history = tuple((f, _map_box(b, self.to_first[f - 1]), sc) for f, b, sc in t.history)
+            det = None if t.detection_box is None else _map_box(t.detection_box, s)
+            out.append(
+                replace(t, box_xywh=_map_box(t.box_xywh, s), history=history, detection_box=det)
+            )
+        return out
+
+    def restore(self, rows: F64) -> F64:
+        """MOT rows in first-frame coordinates mapped back to their frames' pixels."""
+        if not self.moved or not len(rows):
+            return rows
+        out = np.array(rows, dtype=np.float64, copy=True)
+        for k, row in enumerate(out):
+            back = invert_affine(self.to_first[int(row[0]) - 1])
+            out[k, 2:6] = _map_box(row[2:6], back)
+        return out

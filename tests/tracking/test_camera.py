@@ -1,0 +1,285 @@
+"""Camera-motion compensation: the estimator, the moving decision, warping a tracker's state."""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from pftrack.io.mot import group_by_frame
+from pftrack.synthetic import Scene, camera_path, make_scene, move_camera, warp_frame
+from pftrack.tracking import (
+    CameraConfig,
+    MultiObjectTracker,
+    RefineConfig,
+    TrackerConfig,
+    track_frames,
+)
+from pftrack.tracking.camera import (
+    CameraMotion,
+    Stabiliser,
+    compose,
+    estimate_motion,
+    invert_affine,
+    motion_magnitude,
+    warp_tracks,
+)
+from pftrack.tracking.track import LiveTrack, Track
+
+SIZE = (360, 480)
+
+
+def similarity(zoom: float, degrees: float, tx: float, ty: float) -> np.ndarray:
+    """Zoom and rotation about the image centre, then a shift."""
+    th = np.deg2rad(degrees)
+    lin = zoom * np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    c = np.array([SIZE[1] / 2, SIZE[0] / 2])
+    return np.hstack([lin, (c - lin @ c + [tx, ty])[:, None]])
+
+
+@pytest.fixture(scope="module")
+def texture() -> np.ndarray:
+    """A textured view (a synthetic background seen zoomed in, so warps need no border)."""
+    bg = make_scene(n_frames=1, rng=5, occluder=False).background
+    return warp_frame(bg, similarity(1.25, 0.0, 0.0, 0.0))
+
+
+def corner_error(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest distance between where `a` and `b` put the image's corners."""
+    return motion_magnitude(compose(invert_affine(b), a), SIZE)
+
+
+@pytest.mark.parametrize(
+    "truth",
+    [
+        similarity(1.0, 0.0, 3.3, -2.1),  # pan
+        similarity(1.03, 0.0, 0.0, 0.0),  # zoom
+        similarity(1.0, 2.0, 0.0, 0.0),  # roll
+        similarity(0.98, -1.5, -4.2, 1.7),  # all three
+    ],
+)
+def test_estimator_recovers_a_known_similarity_to_subpixel(
+    texture: np.ndarray, truth: np.ndarray
+) -> None:
+    moved = warp_frame(texture, truth)
+    estimate = estimate_motion(texture, moved)
+    assert estimate is not None
+    assert corner_error(estimate, truth) < 0.3  # pixels, at the image corners
+
+
+def test_estimator_ignores_corners_inside_excluded_boxes(texture: np.ndarray) -> None:
+    truth = similarity(1.0, 0.0, 2.5, 1.0)
+    moved = warp_frame(texture, truth)
+    # a large patch that moves by itself
+    moved[100:260, 150:330] = np.roll(texture, (9, -13), axis=(0, 1))[100:260, 150:330]
+    estimate = estimate_motion(texture, moved, exclude_xywh=[(150, 100, 180, 160)])
+    assert estimate is not None
+    assert corner_error(estimate, truth) < 0.3
+
+
+def test_static_frames_are_exactly_identity_and_not_moving(texture: np.ndarray) -> None:
+    rng = np.random.default_rng(0)
+    camera = CameraMotion("auto")
+    for _ in range(12):
+        noise = rng.normal(0, 2.0, texture.shape)
+        frame = np.clip(texture + noise, 0, 255).astype(np.uint8)
+        step = camera.update(frame)
+        assert step.apply is None and not step.moving and step.background_ok
+    assert step.affine is not None
+    assert step.magnitude < CameraConfig().threshold * np.hypot(*SIZE)
+
+
+def test_moving_decision_has_hysteresis_and_covers_the_frames_before_it(
+    texture: np.ndarray,
+) -> None:
+    cfg = CameraConfig(on_frames=3, off_frames=4, settle_frames=5)
+    camera = CameraMotion("auto", cfg)
+    shift = similarity(1.0, 0.0, 3.0, 0.0)
+    view = np.eye(2, 3)
+    steps = [camera.update(texture)]
+    for _ in range(5):  # five frames panning 3 px each
+        view = compose(shift, view)
+        steps.append(camera.update(warp_frame(texture, view)))
+    for _ in range(10):  # then still
+        steps.append(camera.update(warp_frame(texture, view)))
+    moving = [s.moving for s in steps]
+    assert moving[:3] == [False] * 3  # frames 1, 2 moved: not yet
+    assert all(moving[3:9])  # from the third moving frame until the 4th still one
+    assert not any(moving[9:])
+    # the switch applies the three pans at once, then one per frame
+    assert steps[3].apply is not None and steps[4].apply is not None
+    assert corner_error(steps[3].apply, similarity(1.0, 0.0, 9.0, 0.0)) < 0.3
+    assert corner_error(steps[4].apply, shift) < 0.3
+    assert all(s.apply is None for s in steps[:3])
+    # the background is trusted again only after settle_frames still frames
+    ok = [s.background_ok for s in steps]
+    assert ok[:3] == [True] * 3 and not any(ok[3:13]) and all(ok[13:])
+
+
+def test_on_and_off_modes(texture: np.ndarray) -> None:
+    on, off = CameraMotion("on"), CameraMotion("off")
+    for _ in range(3):
+        s_on, s_off = on.update(texture), off.update(texture)
+        assert s_on.moving and not s_on.background_ok
+        assert s_off.apply is None and s_off.affine is None and s_off.background_ok
+    assert s_on.apply is not None  # applied every frame, even a tiny estimate
+
+
+def test_bad_input_names_the_problem(texture: np.ndarray) -> None:
+    with pytest.raises(ValueError, match="camera_motion"):
+        CameraMotion("sometimes")
+    with pytest.raises(ValueError, match="camera_motion"):
+        TrackerConfig(camera_motion="yes")
+    with pytest.raises(ValueError, match="threshold"):
+        CameraConfig(threshold=0.0)
+    with pytest.raises(ValueError, match="on_frames"):
+        CameraConfig(on_frames=0)
+    with pytest.raises(ValueError, match="singular"):
+        invert_affine(np.zeros((2, 3)))
+    with pytest.raises(TypeError, match="uint8"):
+        CameraMotion().update(texture.astype(np.float32))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="differ in size"):
+        estimate_motion(texture, texture[:100])
+
+
+# -- the tracker's state -----------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def scene() -> Scene:
+    return make_scene(n_frames=40, n_walkers=4, rng=2, occluder=False)
+
+
+def _state(t: LiveTrack) -> list[np.ndarray]:
+    f, k = t.filter, t.motion
+    return [f.particles, f.means, np.array([f.w0, f.h0]), k.p, k.v, np.array(k.cov), t.box, t.size]
+
+
+def test_warp_then_inverse_restores_the_state(scene: Scene) -> None:
+    tracker = MultiObjectTracker(rng=0)
+    for frame in scene.frames[:12]:
+        tracker.update(frame)
+    assert tracker.tracks
+    before = [[x.copy() for x in _state(t)] for t in tracker.tracks]
+    a = similarity(1.04, 2.5, 6.0, -3.0)
+    warp_tracks(tracker.tracks, a)
+    moved = [[x.copy() for x in _state(t)] for t in tracker.tracks]
+    assert not np.allclose(moved[0][0], before[0][0])
+    warp_tracks(tracker.tracks, invert_affine(a))
+    for t, ref in zip(tracker.tracks, before, strict=True):
+        for got, want in zip(_state(t), ref, strict=True):
+            np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-9)
+
+
+def test_warp_moves_positions_and_sizes_as_the_transform(scene: Scene) -> None:
+    tracker = MultiObjectTracker(rng=0)
+    for frame in scene.frames[:8]:
+        tracker.update(frame)
+    t = tracker.tracks[0]
+    old = copy.deepcopy((t.filter.particles, t.filter.w0, t.motion.p, t.motion.v, t.box))
+    a = similarity(1.1, 0.0, 5.0, 2.0)
+    warp_tracks([t], a)
+    lin, shift = a[:, :2], a[:, 2]
+    np.testing.assert_allclose(t.filter.particles[:, :2], old[0][:, :2] @ lin.T + shift)
+    np.testing.assert_allclose(t.filter.particles[:, 3:5], old[0][:, 3:5] @ lin.T + shift)
+    np.testing.assert_allclose(t.filter.particles[:, [2, 5]], old[0][:, [2, 5]])  # scales
+    assert t.filter.w0 == pytest.approx(1.1 * old[1])
+    np.testing.assert_allclose(t.motion.p, lin @ old[2] + shift)
+    np.testing.assert_allclose(t.motion.v, lin @ old[3])
+    centre = old[4][:2] + old[4][2:] / 2
+    np.testing.assert_allclose(t.box[:2] + t.box[2:] / 2, lin @ centre + shift)
+    np.testing.assert_allclose(t.box[2:], 1.1 * old[4][2:])
+
+
+def test_auto_leaves_a_still_camera_exactly_as_off(scene: Scene) -> None:
+    runs = [
+        track_frames(scene.frames, config=TrackerConfig(camera_motion=m), rng=0).rows
+        for m in ("off", "auto")
+    ]
+    np.testing.assert_array_equal(runs[0], runs[1])
+
+
+def _detections(truth: np.ndarray, size: tuple[int, int]) -> dict[int, np.ndarray]:
+    """Ground-truth boxes, jittered, each object seen 5 frames then missed 5: tracks coast."""
+    rng = np.random.default_rng(1)
+    out = {}
+    for f, r in group_by_frame(truth).items():
+        keep = ((f + 3 * r[:, 1].astype(int)) // 5) % 2 == 0
+        b = r[keep, 2:6] + rng.normal(0, 1.0, (int(keep.sum()), 4))
+        b[:, 2:] = np.maximum(b[:, 2:], 4.0)
+        b[:, :2] = np.clip(b[:, :2], 0, np.column_stack([size[1] - b[:, 2], size[0] - b[:, 3]]))
+        out[f] = np.column_stack([b, np.full(len(b), 0.95)])
+    return out
+
+
+@pytest.mark.parametrize("offline", [False, True])
+def test_compensation_beats_none_on_a_moving_camera(offline: bool) -> None:
+    from pftrack.eval import evaluate_mot
+
+    scene = move_camera(make_scene(n_frames=80, n_walkers=6, rng=0), period=40.0)
+    dets = _detections(scene.truth, SIZE)
+    mota = {}
+    for mode in ("off", "auto"):
+        # no box refinement: the difference is the compensation of the tracks (and, with the
+        # offline pass, of the linking, filling and smoothing)
+        cfg = TrackerConfig(camera_motion=mode, refine=RefineConfig(enabled=False))
+        kwargs = {} if offline else {"smoother": None, "link": None, "fill": "pf"}
+        run = track_frames(scene.frames, detections=dets, config=cfg, rng=0, **kwargs)
+        mota[mode] = evaluate_mot(scene.truth, run.rows).mota
+    assert mota["auto"] > mota["off"] + 0.1
+
+
+def test_stabiliser_round_trip_and_still_passthrough() -> None:
+    still = Stabiliser()
+    box, det = np.array([10.0, 20, 30, 60]), np.array([11.0, 21, 29, 59])
+    t = Track(1, box, 0.9, 0, 1, 0, history=(), detection_box=det)
+    for _ in range(3):
+        still.add(None)
+    assert still.stabilise([t])[0] is t
+    rows = np.array([[2, 1, 10, 20, 30, 60, 1, -1, -1, -1]], dtype=np.float64)
+    assert still.restore(rows) is rows
+
+    moving = Stabiliser()
+    a = similarity(1.05, 2.0, 4.0, -3.0)
+    moving.add(None)
+    moving.add(a)
+    moving.add(a)
+    t3 = replace(t, history=((2, np.array([12.0, 22, 30, 60]), 0.8),))
+    (s3,) = moving.stabilise([t3])
+    assert not np.allclose(s3.box_xywh, t3.box_xywh)
+    rows = np.array(
+        [[2, 1, *s3.history[0][1], 0.8, -1, -1, -1], [3, 1, *s3.box_xywh, 0.9, -1, -1, -1]]
+    )
+    back = moving.restore(rows)
+    np.testing.assert_allclose(back[0, 2:6], [12.0, 22, 30, 60])
+    np.testing.assert_allclose(back[1, 2:6], t.box_xywh)
+    # frame 3's stabilised box is frame 3's box taken back through two steps of `a`
+    inv = invert_affine(a)
+    centre = t.box_xywh[:2] + t.box_xywh[2:] / 2
+    want = inv[:, :2] @ (inv[:, :2] @ centre + inv[:, 2]) + inv[:, 2]
+    np.testing.assert_allclose(s3.box_xywh[:2] + s3.box_xywh[2:] / 2, want)
+
+
+def test_camera_path_stays_inside_the_source() -> None:
+    h, w = SIZE
+    path = camera_path(300, SIZE)
+    corners = np.array([[0, 0], [w, 0], [0, h], [w, h]], dtype=np.float64)
+    for a in path:
+        inv = invert_affine(a)
+        src = corners @ inv[:, :2].T + inv[:, 2]
+        assert np.all(src >= 0) and np.all(src[:, 0] <= w) and np.all(src[:, 1] <= h)
+    still = camera_path(5, SIZE, zoom_swing=0.0, pan=(0.0, 0.0), roll=0.0)
+    assert np.all(still == still[0])
+
+
+def test_cli_option_reaches_the_config() -> None:
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+
+    parser = build_parser()
+    args = parser.parse_args(["track", "v.avi", "--out", "t.txt"])
+    assert tracker_config(args).camera_motion == "auto"
+    args = parser.parse_args(["track", "v.avi", "--out", "t.txt", "--camera-motion", "off"])
+    assert tracker_config(args).camera_motion == "off"
