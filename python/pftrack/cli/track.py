@@ -58,6 +58,7 @@ def run(args: argparse.Namespace) -> int:
         config=tracker_config(args),
         rng=args.seed,
         fill=args.fill,
+        bootstrap=args.bootstrap,
         smoother=None if args.no_smooth else BoxSmoother(),
         link=None if args.no_link else LinkConfig(),
     )

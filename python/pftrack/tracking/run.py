@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
 import os
 import time
 from collections.abc import Sequence
@@ -13,6 +12,7 @@ from numpy.typing import NDArray
 
 from pftrack._progress import progress
 from pftrack._typing import F64, PathLike, RngLike
+from pftrack.detection.bootstrap import bootstrap_frames
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
@@ -76,6 +76,7 @@ def track_frames(
     fill: str = "linear",
     show_progress: bool | None = None,
     prime_frames: int = 30,
+    bootstrap: str = "spread",
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
 ) -> TrackingRun:
@@ -97,8 +98,11 @@ def track_frames(
     show_progress : bool, optional
         Progress bar on stderr (default: when stderr is a terminal).
     prime_frames : int
-        Read this many frames ahead to start the background model from their median (0: learn
+        Start the built-in detector's background from the median of this many frames (0: learn
         from frame 1 on).
+    bootstrap : {"spread", "first", "none"}
+        Which frames (:func:`pftrack.detection.bootstrap.bootstrap_frames`): spread over the
+        whole video (a first pass over a file or in-memory frames), the first ones, or none.
     smoother : BoxSmoother or None
         Offline smoothing of every track's boxes once the run is over (None: boxes as the
         tracker reported them, frame by frame).
@@ -113,7 +117,9 @@ def track_frames(
         )
     tracker = MultiObjectTracker(config, rng=rng)
     if prime_frames > 0 and (detections is None or config.refine.enabled):
-        tracker.prime(itertools.islice(iter(frames), prime_frames))
+        primer = bootstrap_frames(frames, prime_frames, bootstrap)
+        if primer:
+            tracker.prime(primer)
     writer = TrackWriter(coasting, fill, smoother, link)
     empty = np.zeros((0, 5))
     start = time.perf_counter()
