@@ -78,6 +78,7 @@ class _OpenCvDetector:
     def reset(self) -> None:
         """Forget the background model."""
         self._sub = self._make()
+        self._blobs.reset()
         self._shape = None
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:

@@ -112,6 +112,7 @@ class PaperDetector:
     def reset(self) -> None:
         """Forget the background; the next frame initialises it."""
         self._model.reset()
+        self._blobs.reset()
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start from the per-pixel median of `frames` (e.g. frames spread over the video).
