@@ -1,12 +1,15 @@
-"""Background bootstrapping: which frames start the background, and that it removes ghosts."""
+"""Background bootstrapping and ghosts: which frames start the background, the ghost test."""
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
-from pftrack.detection import PaperDetector
+from pftrack import _core
+from pftrack.detection import PaperConfig, PaperDetector
 from pftrack.detection.bootstrap import bootstrap_frames
+from pftrack.detection.ghost import edge_support
 
 
 def numbered(n: int) -> list[np.ndarray]:
@@ -40,7 +43,8 @@ def person_present_from_frame_one(n: int = 60) -> tuple[list[np.ndarray], np.nda
     """A textured scene; a 10x30 block stands at x 20..30 for the first third, then walks away
     right at 3 px a frame. Returns the frames and the empty background."""
     rng = np.random.default_rng(1)
-    bg = rng.integers(60, 190, size=(60, 120, 3)).astype(np.uint8)
+    small = rng.integers(60, 190, size=(8, 15, 3)).astype(np.uint8)
+    bg = np.asarray(cv2.resize(small, (120, 60), interpolation=cv2.INTER_LINEAR), np.uint8)
     frames = []
     for k in range(n):
         f = bg.copy()
@@ -55,10 +59,57 @@ def test_spread_bootstrap_leaves_no_ghost_where_first_frames_do() -> None:
     frames, _ = person_present_from_frame_one()
     ghost_area = {}
     for mode in ("spread", "first"):
-        det = PaperDetector()
+        det = PaperDetector(PaperConfig(ghost_support=0.0))  # the bootstrap alone
         det.prime(bootstrap_frames(frames, 30, mode))
         masks = [det.detect(f).mask for f in frames]
         # the last frame: the block has walked off; anything at x 20..30 is a ghost
         ghost_area[mode] = int((masks[-1][20:50, 20:30] > 0).sum())
     assert ghost_area["spread"] == 0
     assert ghost_area["first"] > 100
+
+
+@pytest.mark.parametrize("mode", ["first", "none"])
+def test_ghost_test_clears_the_ghost_a_streaming_start_leaves(mode: str) -> None:
+    frames, _ = person_present_from_frame_one()
+    area = {}
+    for support in (0.0, 0.3):  # ghost test off, on
+        det = PaperDetector(PaperConfig(ghost_support=support))
+        primer = bootstrap_frames(frames, 30, mode)
+        if primer:
+            det.prime(primer)
+        masks = [det.detect(f).mask for f in frames]
+        area[support] = int((masks[-1][20:50, 20:30] > 0).sum())
+    assert area[0.0] > 100
+    assert area[0.3] == 0
+
+
+def test_edge_support_separates_a_ghost_from_the_object() -> None:
+    frames, bg = person_present_from_frame_one()
+    det = PaperDetector(PaperConfig(ghost_support=0.0))
+    det.prime(frames[:30])  # the block is in the background at x 20..30
+    for f in frames[:40]:
+        d = det.detect(f)
+    support = edge_support(frames[39], det.model.background, d.mask, d.boxes)
+    lefts = d.boxes[:, 0].tolist()
+    assert lefts == [20.0, 77.0]  # the ghost and the walker (x = 20 + 3 * (39 - 20))
+    assert support[0] < 0.3 < 0.6 < support[1]
+
+
+def test_blend_matches_numpy_and_checks_its_arguments() -> None:
+    rng = np.random.default_rng(3)
+    frame = rng.integers(0, 256, (6, 7, 3), dtype=np.uint8)
+    start = rng.uniform(0, 255, (6, 7, 3)).astype(np.float32)
+    mask = (rng.random((6, 7)) < 0.5).astype(np.uint8) * 255
+    model = _core.BackgroundModel()
+    model.set_background(start)
+    model.blend(frame, mask, 0.25)
+    want = start.copy()
+    m = mask > 0
+    want[m] = want[m] + np.float32(0.25) * (frame[m].astype(np.float32) - want[m])
+    np.testing.assert_array_equal(model.background, want)
+    with pytest.raises(ValueError, match="rate"):
+        model.blend(frame, mask, 1.5)
+    with pytest.raises(ValueError, match="shape"):
+        model.blend(frame[:3], mask, 0.5)
+    with pytest.raises(ValueError, match="no background"):
+        _core.BackgroundModel().blend(frame, mask, 0.5)
