@@ -74,12 +74,14 @@ def _robust_line(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float,
     Refitted once on the points within 3 robust sigmas (1.4826 MAD) of the first line: the
     refit removes the bias that groups and fragments (all wider, or all smaller) leave.
     """
-    res = theilslopes(y, x)
+    with np.errstate(invalid="ignore"):  # only theilslopes' confidence interval can be NaN
+        res = theilslopes(y, x)
     r = y - (res.slope * x + res.intercept)
     sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
     keep = np.abs(r) <= 3.0 * max(sigma, 1.0)
     if keep.sum() >= 3 and np.ptp(x[keep]) > 0:
-        res = theilslopes(y[keep], x[keep])
+        with np.errstate(invalid="ignore"):
+            res = theilslopes(y[keep], x[keep])
     return float(res.slope), float(res.intercept)
 
 
