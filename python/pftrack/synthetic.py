@@ -522,15 +522,15 @@ def make_busy_scene(
                 visible.append((centres[i][1] + h / 2.0, k, i))
         for _, k, i in sorted(visible):  # nearer (lower) people in front
             first, centres, w, h, look = people[k]
-            img, mask = look[(i // 3) % 2]
+            sprite, silhouette = look[(i // 3) % 2]
             x0 = int(round(centres[i][0] - w / 2.0))
             y0 = int(round(centres[i][1] - h / 2.0))
             xa, ya = max(x0, 0), max(y0, 0)
             xb, yb = min(x0 + w, width), min(y0 + h, height)
             if xb <= xa or yb <= ya:
                 continue
-            sub = mask[ya - y0 : yb - y0, xa - x0 : xb - x0]
-            frame[ya:yb, xa:xb][sub] = img[ya - y0 : yb - y0, xa - x0 : xb - x0][sub]
+            sub = silhouette[ya - y0 : yb - y0, xa - x0 : xb - x0]
+            frame[ya:yb, xa:xb][sub] = sprite[ya - y0 : yb - y0, xa - x0 : xb - x0][sub]
             truth.append((f, k + 1, xa, ya, xb - xa, yb - ya, 1.0, -1.0, -1.0, -1.0))
         if noise > 0:
             j = int(gen.integers(4))
