@@ -112,3 +112,15 @@ def test_blob_extractor_splits_a_group_once_the_size_is_learnt() -> None:
 def test_bad_config_raises(kwargs: dict[str, float]) -> None:
     with pytest.raises(ValueError):
         SizeModelConfig(**kwargs)  # type: ignore[arg-type]
+
+
+def test_theil_sen_equals_scipy() -> None:
+    from scipy.stats import theilslopes
+
+    from pftrack.detection.size_model import theil_sen
+
+    rng = np.random.default_rng(5)
+    x = rng.uniform(0, 300, 60).round()  # ties in x, as foot rows have
+    y = 0.4 * x + 3 + rng.standard_t(2, 60) * 5
+    want = theilslopes(y, x, method="joint")
+    np.testing.assert_allclose(theil_sen(x, y), (want.slope, want.intercept), rtol=1e-12)

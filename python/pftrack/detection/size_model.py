@@ -3,7 +3,7 @@
 On a ground plane seen by a fixed camera, the image height of a person standing with feet at
 image row ``y`` is close to linear in ``y`` (``h = k (y - y_horizon)``, and so is the width);
 seen from above both are about constant. `PersonSizeModel` fits both lines robustly (Theil-Sen,
-``scipy.stats.theilslopes``, refitted without its outliers) to the boxes of *isolated*
+`theil_sen`, refitted without its outliers) to the boxes of *isolated*
 detections (no other box overlapping their columns), online; `merge_fragments` and
 `split_count` use it to join the fragments of one person and to cut the blob of a group into
 several people. There is no fixed aspect ratio: the width line is learnt as the height line is.
@@ -15,9 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.stats import theilslopes
 
-__all__ = ["PersonSizeModel", "SizeModelConfig"]
+__all__ = ["PersonSizeModel", "SizeModelConfig", "theil_sen"]
 
 
 @dataclass(frozen=True)
@@ -45,8 +44,8 @@ class SizeModelConfig:
     """
 
     min_samples: int = 30
-    max_samples: int = 400
-    refit_every: int = 10
+    max_samples: int = 300
+    refit_every: int = 25
     split_ratio: float = 1.6
     split_max_height: float = 1.5
     merge_slack: float = 1.2
@@ -68,21 +67,41 @@ class SizeModelConfig:
             raise ValueError(f"merge_slack is {self.merge_slack}, expected a finite value >= 1")
 
 
+def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:
+    """Theil-Sen line: the median of the pairwise slopes, intercept ``median(y - slope x)``.
+
+    ``scipy.stats.theilslopes(y, x, method="joint")`` without its confidence interval, which
+    costs several sorts (tests hold the two equal).
+
+    Parameters
+    ----------
+    x, y : (n,) ndarray of float64
+        At least two distinct `x`.
+
+    Returns
+    -------
+    slope, intercept : float
+    """
+    i, j = np.triu_indices(len(x), k=1)
+    dx = x[j] - x[i]
+    ok = dx != 0
+    slope = float(np.median((y[j] - y[i])[ok] / dx[ok]))
+    return slope, float(np.median(y - slope * x))
+
+
 def _robust_line(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:
     """Theil-Sen line ``y = slope x + intercept``, robust to a one-sided block of outliers.
 
     Refitted once on the points within 3 robust sigmas (1.4826 MAD) of the first line: the
     refit removes the bias that groups and fragments (all wider, or all smaller) leave.
     """
-    with np.errstate(invalid="ignore"):  # only theilslopes' confidence interval can be NaN
-        res = theilslopes(y, x)
-    r = y - (res.slope * x + res.intercept)
+    slope, intercept = theil_sen(x, y)
+    r = y - (slope * x + intercept)
     sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
     keep = np.abs(r) <= 3.0 * max(sigma, 1.0)
     if keep.sum() >= 3 and np.ptp(x[keep]) > 0:
-        with np.errstate(invalid="ignore"):
-            res = theilslopes(y[keep], x[keep])
-    return float(res.slope), float(res.intercept)
+        slope, intercept = theil_sen(x[keep], y[keep])
+    return slope, intercept
 
 
 class PersonSizeModel:
