@@ -89,12 +89,45 @@ def detection_scores(
     return out
 
 
+def figure(frames: list[np.ndarray], gt: F64, frame_no: int, path: Path) -> None:
+    """Frame `frame_no` (1-based) before | after: the detector as it was (first 30 frames
+    primed, no ghost test, fixed person aspect) and as it is now (spread bootstrap, ghost
+    test, learnt person size). Ground truth green, detections red. Written as JPEG."""
+    import cv2
+
+    panels = []
+    setups = (
+        ("first", {"ghost_support": 0.0, "learn_size": False}, "before"),
+        ("spread", {}, "after"),
+    )
+    for boot, cfg, label in setups:
+        det = make_detector("paper", **cfg)
+        det.prime(bootstrap_frames(frames, 30, boot))  # type: ignore[union-attr]
+        for f in frames[:frame_no]:
+            d = det.detect(f)
+        img = frames[frame_no - 1].copy()
+        for row in gt[gt[:, 0] == frame_no]:
+            x, y, w, h = row[2:6].astype(int)
+            cv2.rectangle(img, (x, y), (x + w, y + h), (0, 220, 0), 2)
+        for x, y, w, h in d.boxes.astype(int):
+            cv2.rectangle(img, (x, y), (x + w, y + h), (0, 0, 255), 2)
+        cv2.putText(img, label, (8, 24), cv2.FONT_HERSHEY_SIMPLEX, 0.8, (255, 255, 255), 2)
+        panels.append(img)
+    out = np.hstack(panels)
+    scale = 960 / out.shape[1]
+    out = cv2.resize(out, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
+    cv2.imwrite(str(path), out, [cv2.IMWRITE_JPEG_QUALITY, 80])
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     p = experiment_parser("eval_detection", __doc__)
     p.add_argument("--detector", default="paper", choices=("paper", "mog2", "knn"))
     p.add_argument("--sequences", default="pets,tud," + ",".join(BUSY_SCENES))
     p.add_argument("--bootstrap", default="spread", choices=BOOTSTRAPS)
     p.add_argument("--track", action="store_true", help="also track and score MOTA / IDF1")
+    p.add_argument(
+        "--figures", action="store_true", help="write before/after frames (paper detector)"
+    )
     p.add_argument("settings", nargs="*", help="key=value detector settings")
     args = p.parse_args(argv)
     cfg: dict[str, float] = {}
@@ -132,6 +165,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 m = evaluate_mot(gt, run.rows)
                 line += f" MOTA={100 * m.mota:.1f} IDF1={100 * m.idf1:.1f}"
             print(line)
+            if args.figures:
+                args.out.mkdir(parents=True, exist_ok=True)
+                figure(frames, gt, min(len(frames), 60), args.out / f"detection_{name}.jpg")
     return 0
 
 

@@ -113,3 +113,28 @@ def test_blend_matches_numpy_and_checks_its_arguments() -> None:
         model.blend(frame[:3], mask, 0.5)
     with pytest.raises(ValueError, match="no background"):
         _core.BackgroundModel().blend(frame, mask, 0.5)
+
+
+def test_track_cli_offers_bootstrap(capsys: pytest.CaptureFixture[str]) -> None:
+    from pftrack.cli import main
+
+    with pytest.raises(SystemExit) as e:
+        main(["track", "--help"])
+    assert e.value.code == 0
+    out = capsys.readouterr().out
+    assert "--bootstrap {spread,first,none}" in out and "(default: spread)" in out
+    with pytest.raises(SystemExit) as e:
+        main(["track", "x.avi", "--out", "t.txt", "--bootstrap", "median"])
+    assert e.value.code == 2
+
+
+def test_track_frames_bootstrap_modes_run_on_a_busy_scene() -> None:
+    from pftrack.synthetic import make_busy_scene
+    from pftrack.tracking import track_frames
+
+    scene = make_busy_scene("present", n_frames=25, width=160, height=120)
+    for mode in ("spread", "first", "none"):
+        run = track_frames(scene.frames, rng=0, bootstrap=mode, show_progress=False)
+        assert run.n_frames == 25
+    with pytest.raises(ValueError, match="bootstrap mode"):
+        track_frames(scene.frames, rng=0, bootstrap="median", show_progress=False)
