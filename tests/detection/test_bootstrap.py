@@ -138,3 +138,21 @@ def test_track_frames_bootstrap_modes_run_on_a_busy_scene() -> None:
         assert run.n_frames == 25
     with pytest.raises(ValueError, match="bootstrap mode"):
         track_frames(scene.frames, rng=0, bootstrap="median", show_progress=False)
+
+
+@pytest.mark.parametrize("name", ["mog2", "knn"])
+def test_opencv_detectors_prime_from_a_median(name: str) -> None:
+    from pftrack.detection import make_detector
+
+    frames, _ = person_present_from_frame_one()
+    area = {}
+    for primed in (False, True):
+        det = make_detector(name)
+        if primed:
+            det.prime(bootstrap_frames(frames, 30, "spread"))  # type: ignore[union-attr]
+        masks = [det.detect(f).mask for f in frames]
+        # frame 25: the block has walked 15 px; what remains at x 20..30 is a ghost
+        area[primed] = int((masks[25][20:50, 20:30] > 0).sum())
+    assert area[True] == 0 and area[False] > 0
+    with pytest.raises(ValueError, match="empty"):
+        make_detector(name).prime([])  # type: ignore[union-attr]
