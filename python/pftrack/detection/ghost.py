@@ -17,16 +17,16 @@ from numpy.typing import NDArray
 __all__ = ["edge_support"]
 
 
-def _gradient(bgr: NDArray[np.float32]) -> NDArray[np.float32]:
-    """Largest gradient magnitude over the three channels, after a Gaussian blur.
+def _edge_sum(bgr: NDArray[np.float32], band: NDArray[np.bool_]) -> float:
+    """Sum over `band` of the largest gradient magnitude over the channels, after a blur.
 
     A step in colour at equal grey level is an edge too; fine texture (gravel, noise) is no
-    silhouette, hence the blur.
+    silhouette, hence the blur. Only the band's pixels are reduced.
     """
     img = cv2.GaussianBlur(bgr, (5, 5), 1.5)
-    gx = cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3)
-    return np.asarray(np.sqrt(gx * gx + gy * gy).max(axis=2), np.float32)
+    gx = cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3)[band]
+    gy = cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3)[band]
+    return float(np.sqrt((gx * gx + gy * gy).max(axis=1)).sum())
 
 
 def edge_support(
@@ -72,8 +72,8 @@ def edge_support(
         band = (cv2.dilate(m, kernel) > 0) & (cv2.erode(m, kernel) == 0)
         if not band.any():
             continue
-        e_f = float(_gradient(frame[y0:y1, x0:x1].astype(np.float32))[band].sum())
-        e_b = float(_gradient(np.asarray(background[y0:y1, x0:x1], np.float32))[band].sum())
+        e_f = _edge_sum(frame[y0:y1, x0:x1].astype(np.float32), band)
+        e_b = _edge_sum(np.asarray(background[y0:y1, x0:x1], np.float32), band)
         if e_f + e_b > 0:
             out[k] = e_f / (e_f + e_b)
     return out

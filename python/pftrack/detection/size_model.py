@@ -44,8 +44,8 @@ class SizeModelConfig:
     """
 
     min_samples: int = 30
-    max_samples: int = 300
-    refit_every: int = 25
+    max_samples: int = 200
+    refit_every: int = 50
     split_ratio: float = 1.6
     split_max_height: float = 1.5
     merge_slack: float = 1.2
