@@ -67,6 +67,27 @@ void register_detection(py::module_& m) {
             py::arg("frame"),
             "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8 0/255).")
         .def(
+            "blend",
+            [](BackgroundModel& self, py::array frame, py::array mask, double rate) {
+                const char* fn = "BackgroundModel.blend";
+                require(self.initialized(), fn, "the model has no background yet");
+                bind::check_bgr_image(frame, fn, "frame");
+                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+                        "frame shape is " + shape_str(frame) + ", expected (" +
+                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
+                            ", 3)");
+                bind::check_mask(mask, self.rows(), self.cols(), fn);
+                const auto* src = static_cast<const std::uint8_t*>(frame.data());
+                const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
+                const Index stride = frame.strides(0), mstride = mask.strides(0);
+                {
+                    py::gil_scoped_release nogil;  // safe: raw buffers held by the caller
+                    self.blend(src, stride, mptr, mstride, rate);
+                }
+            },
+            py::arg("frame"), py::arg("mask"), py::arg("rate"),
+            "background += rate (frame - background) where mask (H, W) uint8/bool != 0.")
+        .def(
             "set_background",
             [](BackgroundModel& self, py::array_t<float, py::array::c_style | py::array::forcecast> bg) {
                 const char* fn = "BackgroundModel.set_background";

@@ -20,11 +20,21 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._typing import PathLike
+from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
 
-__all__ = ["Scene", "Walker", "camera_path", "make_scene", "move_camera", "warp_frame", "warp_rows"]
+__all__ = [
+    "BUSY_SCENES",
+    "Scene",
+    "Walker",
+    "camera_path",
+    "make_busy_scene",
+    "make_scene",
+    "move_camera",
+    "warp_frame",
+    "warp_rows",
+]
 
 
 # Clothing colours (BGR), far apart in hue so colour histograms can tell walkers apart.
@@ -514,3 +524,172 @@ def move_camera(scene: Scene, **path: Any) -> Scene:
         walkers=scene.walkers,
         fps=scene.fps,
     )
+
+
+BUSY_SCENES = ("present", "groups", "overhead")
+
+
+def make_busy_scene(
+    kind: str,
+    n_frames: int = 100,
+    width: int = 480,
+    height: int = 360,
+    rng: np.random.Generator | int | None = 0,
+    *,
+    noise: float = 3.0,
+    fps: float = 10.0,
+) -> Scene:
+    """A seeded scene reproducing one failure of background subtraction on busy scenes.
+
+    Parameters
+    ----------
+    kind : {"present", "groups", "overhead"}
+        ``"present"``: six people, close to the camera and in perspective (box size grows
+        with the foot row), all in view from frame 1; each stands still for 15 to 50 frames,
+        then walks off through the nearer side border (ghosts of a background learnt from the
+        first frames). ``"groups"``: three groups of two or three people walking side by side
+        (their silhouettes touch: one blob a group), at different depths, entering through
+        the borders at staggered times. ``"overhead"``: a grey (R = G = B) top-down view of
+        14 people as ellipses of one size whatever the row (no tall person shape); half
+        stand for 20 to 60 frames first; all walk in straight lines in random directions.
+    n_frames : int
+        Number of frames (>= 1).
+    width, height : int
+        Frame size (>= 64 x 64).
+    rng : numpy.random.Generator, int or None
+        Seed or generator; the same seed gives the same scene.
+    noise : float
+        Standard deviation of the per-frame sensor noise in grey levels (0 for none).
+    fps : float
+        Nominal frame rate stored in the scene.
+
+    Returns
+    -------
+    Scene
+        With ``occluder=None``; truth boxes are the people's visible extent clipped to the
+        image.
+    """
+    if kind not in BUSY_SCENES:
+        raise ValueError(f"make_busy_scene: kind is {kind!r}, expected one of {BUSY_SCENES}")
+    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
+        if not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"make_busy_scene: {name} is {v!r}, expected an integer >= {lo}")
+    if not (np.isfinite(noise) and noise >= 0):
+        raise ValueError(f"make_busy_scene: noise is {noise}, expected a finite value >= 0")
+    gen = np.random.default_rng(rng)
+    bg = _background(width, height, gen)
+    grey = kind == "overhead"
+    if grey:
+        bg = np.repeat(cv2.cvtColor(bg, cv2.COLOR_BGR2GRAY)[..., None], 3, axis=2)
+    s = width / 480.0  # speeds scale with the frame
+
+    def size_at(foot: float) -> tuple[int, int]:
+        # ground plane: height linear in the foot row, zero at the horizon (0.2 H)
+        h = 1.1 * (foot - 0.2 * height)
+        return max(6, int(round(0.36 * h))), max(14, int(round(h)))
+
+    def stand_then_walk(x: float, foot: float, w: int, h: int, stand: int, vx: float) -> F64:
+        t = np.arange(n_frames, dtype=np.float64)
+        cx = x + vx * np.maximum(t - stand, 0.0)
+        c = np.column_stack([cx, np.full(n_frames, foot - h / 2.0)])
+        inside = (cx + w / 2.0 > 0) & (cx - w / 2.0 < width)
+        return c[: int(np.flatnonzero(inside)[-1]) + 1] if inside.any() else c[:1]
+
+    # (first frame, centres, width, height, sprite phases)
+    people: list[tuple[int, F64, int, int, tuple[tuple[NDArray[np.uint8], NDArray[np.bool_]], ...]]]
+    people = []
+    shirts = gen.permutation(len(_SHIRTS))
+    if kind == "present":
+        for k in range(6):
+            foot = gen.uniform(0.6, 0.98) * height
+            w, h = size_at(foot)
+            x = (k + 0.5) / 6 * width + gen.uniform(-0.03, 0.03) * width
+            vx = gen.uniform(3.0, 5.0) * s * (-1.0 if x < width / 2 else 1.0)
+            centres = stand_then_walk(x, foot, w, h, int(gen.integers(15, 51)), vx)
+            people.append((1, centres, w, h, _looks(w, h, shirts[k % len(shirts)], gen)))
+    elif kind == "groups":
+        for g in range(3):
+            foot = gen.uniform(0.55, 0.95) * height
+            members = int(gen.integers(2, 4))
+            ltr = g % 2 == 0
+            vx = gen.uniform(2.5, 4.0) * s * (1.0 if ltr else -1.0)
+            start = 1 + g * max(1, n_frames // 6)
+            w, h = size_at(foot)
+            for m in range(members):
+                # side by side, shoulders touching (0.85 w apart), feet on one row
+                x0 = (
+                    (-w / 2.0 - 1.0 - m * 0.85 * w) if ltr else (width + w / 2.0 + 1 + m * 0.85 * w)
+                )
+                x0 += vx  # first frame one step in
+                centres = stand_then_walk(x0, foot + gen.uniform(-2, 2), w, h, 0, vx)
+                look = _looks(w, h, shirts[(3 * g + m) % len(shirts)], gen)
+                people.append((start, centres[: max(1, n_frames - start + 1)], w, h, look))
+    else:
+        d = max(8, int(round(0.075 * height)))
+        for k in range(14):
+            w, h = d + int(gen.integers(-1, 2)), int(round(d * 1.15))
+            level = int(gen.choice([gen.integers(20, 70), gen.integers(190, 240)]))
+            angle = gen.uniform(0, 2 * np.pi)
+            speed = gen.uniform(2.0, 3.5) * s
+            stand = int(gen.integers(20, 61)) if k % 2 == 0 else 0
+            p = np.array([gen.uniform(0.1, 0.9) * width, gen.uniform(0.1, 0.9) * height])
+            t = np.maximum(np.arange(n_frames, dtype=np.float64) - stand, 0.0)[:, None]
+            c = p + t * speed * np.array([np.cos(angle), np.sin(angle)])
+            inside = (np.abs(c[:, 0] - width / 2) < width / 2 + w / 2) & (
+                np.abs(c[:, 1] - height / 2) < height / 2 + h / 2
+            )
+            c = c[: int(np.flatnonzero(~inside)[0])] if (~inside).any() else c
+            img = np.zeros((h, w, 3), np.uint8)
+            mask = np.zeros((h, w), np.uint8)
+            cv2.ellipse(mask, (w // 2, h // 2), (w // 2 - 1, h // 2 - 1), 0, 0, 360, 1, -1)
+            tex = gen.normal(0, 6, (h, w, 1))
+            img[:] = np.clip(level + tex, 0, 255).astype(np.uint8)
+            people.append((1, c, w, h, ((img, mask.astype(bool)),) * 2))
+
+    pad = 16
+    pool = gen.normal(0.0, noise, (4, height + pad, width + pad, 1 if grey else 3))
+    frames: list[NDArray[np.uint8]] = []
+    truth: list[tuple[float, ...]] = []
+    for f in range(1, n_frames + 1):
+        frame = bg.copy()
+        visible = []
+        for k, (first, centres, _w, h, _) in enumerate(people):
+            i = f - first
+            if 0 <= i < len(centres):
+                visible.append((centres[i][1] + h / 2.0, k, i))
+        for _, k, i in sorted(visible):  # nearer (lower) people in front
+            first, centres, w, h, look = people[k]
+            sprite, silhouette = look[(i // 3) % 2]
+            x0 = int(round(centres[i][0] - w / 2.0))
+            y0 = int(round(centres[i][1] - h / 2.0))
+            xa, ya = max(x0, 0), max(y0, 0)
+            xb, yb = min(x0 + w, width), min(y0 + h, height)
+            if xb <= xa or yb <= ya:
+                continue
+            sub = silhouette[ya - y0 : yb - y0, xa - x0 : xb - x0]
+            frame[ya:yb, xa:xb][sub] = sprite[ya - y0 : yb - y0, xa - x0 : xb - x0][sub]
+            truth.append((f, k + 1, xa, ya, xb - xa, yb - ya, 1.0, -1.0, -1.0, -1.0))
+        if noise > 0:
+            j = int(gen.integers(4))
+            dx, dy = (int(v) for v in gen.integers(0, pad, 2))
+            n = pool[j][dy : dy + height, dx : dx + width]
+            frame = np.clip(frame + n, 0, 255).astype(np.uint8)
+        frames.append(frame)
+    t = np.asarray(truth, dtype=np.float64).reshape(-1, 10)
+    if len(t):
+        t = t[np.lexsort((t[:, 1], t[:, 0]))]
+    walkers = [
+        Walker(k + 1, w, h, first, centres, (0, 0, 0), (0, 0, 0))
+        for k, (first, centres, w, h, _) in enumerate(people)
+    ]
+    return Scene(frames=frames, truth=t, background=bg, occluder=None, walkers=walkers, fps=fps)
+
+
+def _looks(
+    w: int, h: int, shirt_index: int, gen: np.random.Generator
+) -> tuple[tuple[NDArray[np.uint8], NDArray[np.bool_]], ...]:
+    """The two stride phases of a side-view person of size (h, w)."""
+    shirt = _SHIRTS[int(shirt_index)]
+    trousers = _TROUSERS[int(gen.integers(len(_TROUSERS)))]
+    skin = _SKIN[int(gen.integers(len(_SKIN)))]
+    return tuple(_sprite(w, h, shirt, trousers, skin, ph, gen) for ph in (0, 1))

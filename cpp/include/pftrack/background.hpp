@@ -255,6 +255,29 @@ public:
                 }
     }
 
+    /// Faster update where the caller found a ghost (foreground that is really uncovered
+    /// background): background_c += rate (frame_c - background_c) where mask != 0, in float32
+    /// in this order. The frame (rows x cols BGR, `row_stride` bytes a row) and the mask
+    /// (rows x cols, `mask_stride` bytes a row) must match the model's size.
+    void blend(const std::uint8_t* bgr, Index row_stride, const std::uint8_t* mask,
+               Index mask_stride, double rate) {
+        require(initialized(), "BackgroundModel.blend", "the model has no background yet");
+        require(rate >= 0.0 && rate <= 1.0, "BackgroundModel.blend", "rate", rate, "in [0, 1]");
+        const float a = static_cast<float>(rate);
+        for (Index y = 0; y < rows_; ++y) {
+            const std::uint8_t* px = bgr + y * row_stride;
+            const std::uint8_t* m = mask + y * mask_stride;
+            float* q = background_.data() + y * cols_ * 3;
+            for (Index x = 0; x < cols_; ++x) {
+                if (!m[x]) continue;
+                for (int c = 0; c < 3; ++c) {
+                    float& b = q[c * cols_ + x];
+                    b = b + a * (static_cast<float>(px[3 * x + c]) - b);
+                }
+            }
+        }
+    }
+
     /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols) and
     /// `mask` (rows x cols, 255 = foreground), both packed.
     void apply(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride, std::int16_t* bins,

@@ -66,6 +66,13 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         help="built-in detector: the paper's adaptive background (C++), or OpenCV's MOG2/KNN",
     )  # fmt: skip
     p.add_argument(
+        "--bootstrap", choices=("auto", "spread", "first", "none"), default="auto",
+        help="starting background: the median of 30 frames spread over the whole video (a "
+        "first pass; people present from frame 1 leave no ghost), of the first 30 frames "
+        "(streaming), or the first frame alone; auto: spread for the built-in detector, first "
+        "with --detections (only box refinement uses it)",
+    )  # fmt: skip
+    p.add_argument(
         "--sampler", choices=("sis", "mh", "rjmcmc"), default="sis",
         help="sis: one sequential-importance-sampling filter per object (the paper's method); "
         "mh: Metropolis-Hastings per object; rjmcmc: one joint RJ-MCMC chain over all objects "

@@ -168,6 +168,7 @@ def run(args: argparse.Namespace) -> int:
                 config=tracker_config(args),
                 rng=args.seed,
                 fill=args.fill,
+                bootstrap=args.bootstrap,
                 smoother=None if args.no_smooth else BoxSmoother(),
                 link=None if args.no_link else LinkConfig(),
                 on_frame=on_frame,

@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
 from pftrack._typing import F64
+from pftrack.detection.size_model import PersonSizeModel
 
 
 @dataclass(frozen=True)
@@ -82,7 +83,13 @@ class BlobConfig:
         Group splitting (0 = off): a blob wider than 1.5 objects of height / width
         `person_aspect` (2.8 for standing people) is cut into ``round(w * person_aspect / h)``
         parts at the minima of its column profile (people walking side by side merge into one
-        blob); each part gets its own tight box.
+        blob); each part gets its own tight box. Used until the person-size model is fitted
+        (and always when `learn_size` is off).
+    learn_size : bool
+        Learn a person-size model from the scene (`pftrack.detection.size_model`: box height
+        and width as lines in the foot row, fitted to isolated blobs) and, once it is fitted,
+        use it instead of `person_aspect`: join stacked fragments of one person, cut a group's
+        blob into ``round(w / expected width)`` people.
     """
 
     open_size: int | None = None
@@ -93,6 +100,7 @@ class BlobConfig:
     max_aspect: float = 6.0
     min_fill: float = 0.2
     person_aspect: float = 2.8
+    learn_size: bool = True
 
     def __post_init__(self) -> None:
         for name in ("open_size", "close_size"):
@@ -187,6 +195,11 @@ class BlobExtractor:
         self._rows = -1
         self._open: NDArray[np.uint8] = np.ones((1, 1), np.uint8)
         self._close: NDArray[np.uint8] = np.ones((1, 1), np.uint8)
+        self.size_model = PersonSizeModel()
+
+    def reset(self) -> None:
+        """Forget the learnt person size (before a new video)."""
+        self.size_model.reset()
 
     def _elements(self, rows: int) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
         if self._rows != rows:
@@ -234,30 +247,58 @@ class BlobExtractor:
             & (fill >= cfg.min_fill)
         )
         rects, fill = rects[keep], fill[keep]
-        if cfg.person_aspect > 0 and len(rects):
-            rects, fill = self._split_groups(mask, rects, fill)
+        model = self.size_model
+        if cfg.learn_size and model.fitted and len(rects):
+            rects, fill = self._merge_fragments(mask, rects, fill)
+            rects, fill = self._split_groups(mask, rects, fill, model.split_count(rects))
+        elif cfg.person_aspect > 0 and len(rects):
+            n = np.round(rects[:, 2] * cfg.person_aspect / rects[:, 3]).astype(np.int64)
+            n[rects[:, 2] * cfg.person_aspect / rects[:, 3] < 1.5] = 1
+            rects, fill = self._split_groups(mask, rects, fill, n)
+        if cfg.learn_size:
+            model.observe(rects)
         order = np.lexsort((rects[:, 1], rects[:, 0]))  # deterministic: by left, then top
         return np.ascontiguousarray(rects[order]), np.ascontiguousarray(fill[order])
 
-    def _split_groups(
+    def _merge_fragments(
         self, mask: NDArray[np.uint8], rects: NDArray[np.float64], fill: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Cut blobs wider than 1.5 objects at the minima of their column profile.
+        """Join the blobs that the size model calls fragments of one person (union box)."""
+        groups = self.size_model.merge_fragments(rects)
+        if len(groups) == len(rects):
+            return rects, fill
+        out_r = np.zeros((len(groups), 4))
+        out_f = np.zeros(len(groups))
+        for k, g in enumerate(groups):
+            x0, y0 = rects[g, 0].min(), rects[g, 1].min()
+            x1, y1 = (rects[g, 0] + rects[g, 2]).max(), (rects[g, 1] + rects[g, 3]).max()
+            out_r[k] = (x0, y0, x1 - x0, y1 - y0)
+            roi = mask[int(y0) : int(y1), int(x0) : int(x1)]
+            out_f[k] = cv2.countNonZero(roi) / max(roi.size, 1) if len(g) > 1 else fill[g[0]]
+        return out_r, out_f
+
+    def _split_groups(
+        self,
+        mask: NDArray[np.uint8],
+        rects: NDArray[np.float64],
+        fill: NDArray[np.float64],
+        counts: NDArray[np.int64],
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Cut each blob into ``counts[i]`` people at the minima of its column profile.
 
         A part must pass the blob filters' ``min_area`` (foreground pixels) too: a sliver cut
         off a large blob is not a person.
         """
-        pa = self.config.person_aspect
         min_pixels = self.config.min_area * mask.shape[0] * mask.shape[1]
         out_r: list[NDArray[np.float64]] = []
         out_f: list[float] = []
-        for r, f in zip(rects, fill, strict=True):
+        for r, f, n in zip(rects, fill, counts, strict=True):
             x, y, w, h = (int(v) for v in r)
-            n = int(round(w * pa / h))
-            if w * pa / h < 1.5 or n < 2:
+            if n < 2:
                 out_r.append(r)
                 out_f.append(float(f))
                 continue
+            n = int(n)
             roi = mask[y : y + h, x : x + w] > 0
             profile = roi.sum(axis=0).astype(np.float64)
             cuts = [0]

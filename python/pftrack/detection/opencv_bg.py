@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -78,7 +79,35 @@ class _OpenCvDetector:
     def reset(self) -> None:
         """Forget the background model."""
         self._sub = self._make()
+        self._blobs.reset()
         self._shape = None
+
+    def prime(self, frames: Iterable[NDArray[np.uint8]], repeats: int = 30) -> None:
+        """Start from the per-pixel median of `frames`, shown `repeats` times to a new subtractor.
+
+        OpenCV's subtractors cannot be given a background; learning the median image as
+        `repeats` frames of an empty scene does the same (see `pftrack.detection.bootstrap`).
+
+        Parameters
+        ----------
+        frames : iterable of (H, W, 3) uint8 arrays
+            At least one frame; all of one size.
+        repeats : int
+            How many times the median is learnt (>= 1).
+        """
+        fn = f"{type(self).__name__}.prime"
+        stack = [check_frame(f, fn) for f in frames]
+        if not stack:
+            raise ValueError(f"{fn}: frames is empty, expected at least one frame")
+        if any(f.shape != stack[0].shape for f in stack):
+            raise ValueError(f"{fn}: frames differ in shape, expected one size")
+        if not (isinstance(repeats, int) and repeats >= 1):
+            raise ValueError(f"{fn}: repeats is {repeats!r}, expected an int >= 1")
+        median = np.median(np.stack(stack), axis=0).round().astype(np.uint8)
+        self.reset()
+        for _ in range(repeats):
+            self._sub.apply(median)
+        self._shape = median.shape
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
         """Detect the moving objects of one BGR uint8 frame (H, W, 3); see `Detections`."""

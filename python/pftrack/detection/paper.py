@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, check_frame
+from pftrack.detection.ghost import edge_support
 from pftrack.particle_filter.colour import HsvBinning
 
 
@@ -42,6 +43,14 @@ class PaperConfig:
         ratio ``sum(I) / sum(B)`` in ``[shadow_lo, 1)`` and chromaticity ``I_c / sum(I)`` within
         `shadow_chroma` of the background's, for every channel: background, not learnt.
         ``shadow_lo=1`` turns it off.
+    ghost_support : float
+        Ghost test (`pftrack.detection.ghost.edge_support`): a blob whose boundary holds less
+        than this share of the frame-plus-background edges is a ghost (uncovered background
+        that the background still pictures as an object): dropped, and its pixels learnt at
+        `ghost_rate`. 0 turns the test off.
+    ghost_rate : float
+        Per-pixel update rate of the background inside a ghost, per frame, for as long as
+        those pixels stay foreground.
     blobs : BlobConfig
         Morphology and blob filters.
     hsv : HsvBinning
@@ -57,8 +66,16 @@ class PaperConfig:
     low_ratio: float = 0.5
     shadow_lo: float = 0.5
     shadow_chroma: float = 0.03
+    ghost_support: float = 0.3
+    ghost_rate: float = 0.5
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
+
+    def __post_init__(self) -> None:
+        if not (0.0 <= self.ghost_support <= 1.0):
+            raise ValueError(f"ghost_support is {self.ghost_support}, expected in [0, 1]")
+        if not (0.0 < self.ghost_rate <= 1.0):
+            raise ValueError(f"ghost_rate is {self.ghost_rate}, expected in (0, 1]")
 
 
 class PaperDetector:
@@ -103,6 +120,7 @@ class PaperDetector:
             **asdict(c.hsv),
         )
         self._blobs = BlobExtractor(c.blobs)
+        self._ghost: NDArray[np.uint8] | None = None  # pixels of ghosts still being learnt
 
     @property
     def model(self) -> _core.BackgroundModel:
@@ -112,6 +130,8 @@ class PaperDetector:
     def reset(self) -> None:
         """Forget the background; the next frame initialises it."""
         self._model.reset()
+        self._blobs.reset()
+        self._ghost = None
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start from the per-pixel median of `frames` (e.g. frames spread over the video).
@@ -142,8 +162,37 @@ class PaperDetector:
         Detections
         """
         mask, binned = self._foreground(frame, "PaperDetector.detect")
+        if self.config.ghost_support > 0 and self._ghost is not None:
+            # a ghost found earlier: its pixels still foreground keep being learnt fast
+            carry = np.bitwise_and(mask, self._ghost)
+            if carry.any():
+                self._model.blend(frame, carry, self.config.ghost_rate)
+                mask = np.bitwise_xor(mask, carry)
+            self._ghost = carry
         boxes, scores = self._blobs.boxes(mask)
+        if self.config.ghost_support > 0 and len(boxes):
+            mask, boxes, scores = self._drop_ghosts(frame, mask, boxes, scores)
         return Detections(boxes, scores, mask, _core.mask_bins(binned, mask), frame_bins=binned)
+
+    def _drop_ghosts(
+        self,
+        frame: NDArray[np.uint8],
+        mask: NDArray[np.uint8],
+        boxes: NDArray[np.float64],
+        scores: NDArray[np.float64],
+    ) -> tuple[NDArray[np.uint8], NDArray[np.float64], NDArray[np.float64]]:
+        """Drop the ghost blobs and learn their pixels fast (C++ ``blend``)."""
+        support = edge_support(frame, self._model.background, mask, boxes)
+        ghost = support < self.config.ghost_support
+        if not ghost.any():
+            return mask, boxes, scores
+        gmask = np.zeros_like(mask)
+        for x, y, w, h in boxes[ghost].astype(int):
+            gmask[y : y + h, x : x + w] = mask[y : y + h, x : x + w]
+        self._model.blend(frame, gmask, self.config.ghost_rate)
+        self._ghost = gmask if self._ghost is None else np.bitwise_or(self._ghost, gmask)
+        mask = np.bitwise_xor(mask, gmask)
+        return mask, boxes[~ghost], scores[~ghost]
 
     def foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
         """The cleaned foreground mask and the frame's HSV bins, without blobs or boxes.

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -13,6 +12,7 @@ from numpy.typing import NDArray
 
 from pftrack._progress import progress
 from pftrack._typing import F64, PathLike, RngLike
+from pftrack.detection.bootstrap import bootstrap_frames
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource
@@ -77,6 +77,7 @@ def track_frames(
     fill: str = "linear",
     show_progress: bool | None = None,
     prime_frames: int = 30,
+    bootstrap: str = "auto",
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
     on_frame: Callable[[int, NDArray[np.uint8], list[Track], F64], None] | None = None,
@@ -103,8 +104,14 @@ def track_frames(
     show_progress : bool, optional
         Progress bar on stderr (default: when stderr is a terminal).
     prime_frames : int
-        Read this many frames ahead to start the background model from their median (0: learn
+        Start the built-in detector's background from the median of this many frames (0: learn
         from frame 1 on).
+    bootstrap : {"auto", "spread", "first", "none"}
+        Which frames (:func:`pftrack.detection.bootstrap.bootstrap_frames`): spread over the
+        whole video (a first pass over a file or in-memory frames), the first ones, or none.
+        "auto": spread for the built-in detector; the first ones with `detections` (only box
+        refinement uses the background then, and a :class:`Tracker` loop can prime the same
+        way, so the loop and this function agree).
     smoother : BoxSmoother or None
         Offline smoothing of every track's boxes once the run is over (None: boxes as the
         tracker reported them, frame by frame).
@@ -133,7 +140,11 @@ def track_frames(
         prime_frames=prime_frames,
     )  # fmt: skip
     if prime_frames > 0 and (detections is None or config.refine.enabled):
-        tracker.prime(itertools.islice(iter(frames), prime_frames))
+        if bootstrap == "auto":
+            bootstrap = "spread" if detections is None else "first"
+        primer = bootstrap_frames(frames, prime_frames, bootstrap)
+        if primer:
+            tracker.prime(primer)
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0

@@ -1,0 +1,63 @@
+"""Frames to start a background from: spread over a file, or a window at the start of a stream.
+
+A background started from the first frame keeps every person present in it as a foreground
+"ghost"; the median of frames *spread over the whole video* sees each pixel uncovered most of
+the time and so gives the empty scene, even when nobody ever leaves. When the frames arrive as
+a stream (no second pass possible), the first frames are the only ones to take.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable, Iterator, Sized
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+BOOTSTRAPS = ("spread", "first", "none")
+Bootstrap = Literal["spread", "first", "none"]
+
+__all__ = ["BOOTSTRAPS", "Bootstrap", "bootstrap_frames"]
+
+
+def bootstrap_frames(
+    frames: Iterable[NDArray[np.uint8]], n: int = 30, mode: str = "spread"
+) -> list[NDArray[np.uint8]]:
+    """Pick the frames whose per-pixel median starts the background.
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, 3) uint8 arrays
+        The video. ``"spread"`` iterates it once in full (a first pass over a file, or a
+        `pftrack.io.video.FrameSource`, which can be iterated again); it needs ``len(frames)``
+        to choose its stride, and falls back to ``"first"`` when `frames` has no length.
+    n : int
+        How many frames to return (fewer if the video is shorter); 0 returns none.
+    mode : {"spread", "first", "none"}
+        ``"spread"``: `n` frames evenly spaced over the whole video; ``"first"``: the first `n`
+        frames (the only choice when streaming); ``"none"``: no frames (the background then
+        starts as the first frame).
+
+    Returns
+    -------
+    list of (H, W, 3) uint8 arrays
+    """
+    if mode not in BOOTSTRAPS:
+        raise ValueError(f"bootstrap mode is {mode!r}, expected one of {', '.join(BOOTSTRAPS)}")
+    if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
+        raise ValueError(f"bootstrap frame count is {n!r}, expected an int >= 0")
+    if mode == "none" or n == 0:
+        return []
+    total = len(frames) if isinstance(frames, Sized) else 0
+    if mode == "first" or total <= n:
+        return list(itertools.islice(iter(frames), n))
+    wanted = set(np.linspace(0, total - 1, n).round().astype(int).tolist())
+    picked: list[NDArray[np.uint8]] = []
+    it: Iterator[NDArray[np.uint8]] = iter(frames)
+    for i, frame in enumerate(it):
+        if i in wanted:
+            picked.append(frame)
+            if len(picked) == len(wanted):
+                break
+    return picked

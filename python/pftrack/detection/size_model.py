@@ -1,0 +1,243 @@
+"""A person-size model learned from the scene: box height and width as functions of image y.
+
+On a ground plane seen by a fixed camera, the image height of a person standing with feet at
+image row ``y`` is close to linear in ``y`` (``h = k (y - y_horizon)``, and so is the width);
+seen from above both are about constant. `PersonSizeModel` fits both lines robustly (Theil-Sen,
+`theil_sen`, refitted without its outliers) to the boxes of *isolated*
+detections (no other box overlapping their columns), online; `merge_fragments` and
+`split_count` use it to join the fragments of one person and to cut the blob of a group into
+several people. There is no fixed aspect ratio: the width line is learnt as the height line is.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["PersonSizeModel", "SizeModelConfig", "theil_sen"]
+
+
+@dataclass(frozen=True)
+class SizeModelConfig:
+    """Settings of `PersonSizeModel`.
+
+    Attributes
+    ----------
+    min_samples : int
+        Isolated boxes needed before the model is used (before it, blobs are split by
+        `BlobConfig.person_aspect` and nothing is merged).
+    max_samples : int
+        The most recent boxes kept for the fit (a ring buffer).
+    refit_every : int
+        Refit after this many new samples.
+    split_ratio : float
+        A box wider than ``split_ratio`` expected widths at its foot row is a group: cut into
+        ``round(w / expected width)`` parts ...
+    split_max_height : float
+        ... unless it is taller than ``split_max_height`` expected heights at its foot row
+        (the upper part of a nearer person whose legs went undetected, not a far group).
+    merge_slack : float
+        Two boxes whose columns overlap are one person's fragments when their union is at most
+        ``merge_slack`` times the expected height and width at the union's foot row.
+    """
+
+    min_samples: int = 30
+    max_samples: int = 200
+    refit_every: int = 50
+    split_ratio: float = 1.6
+    split_max_height: float = 1.5
+    merge_slack: float = 1.2
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.min_samples, int) and self.min_samples >= 3):
+            raise ValueError(f"min_samples is {self.min_samples!r}, expected an int >= 3")
+        if not (isinstance(self.max_samples, int) and self.max_samples >= self.min_samples):
+            raise ValueError(f"max_samples is {self.max_samples!r}, expected an int >= min_samples")
+        if not (isinstance(self.refit_every, int) and self.refit_every >= 1):
+            raise ValueError(f"refit_every is {self.refit_every!r}, expected an int >= 1")
+        if not (self.split_ratio > 1.0 and np.isfinite(self.split_ratio)):
+            raise ValueError(f"split_ratio is {self.split_ratio}, expected a finite value > 1")
+        if not (self.split_max_height > 0.0 and np.isfinite(self.split_max_height)):
+            raise ValueError(
+                f"split_max_height is {self.split_max_height}, expected a finite value > 0"
+            )
+        if not (self.merge_slack >= 1.0 and np.isfinite(self.merge_slack)):
+            raise ValueError(f"merge_slack is {self.merge_slack}, expected a finite value >= 1")
+
+
+def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:
+    """Theil-Sen line: the median of the pairwise slopes, intercept ``median(y - slope x)``.
+
+    ``scipy.stats.theilslopes(y, x, method="joint")`` without its confidence interval, which
+    costs several sorts (tests hold the two equal).
+
+    Parameters
+    ----------
+    x, y : (n,) ndarray of float64
+        At least two distinct `x`.
+
+    Returns
+    -------
+    slope, intercept : float
+    """
+    i, j = np.triu_indices(len(x), k=1)
+    dx = x[j] - x[i]
+    ok = dx != 0
+    slope = float(np.median((y[j] - y[i])[ok] / dx[ok]))
+    return slope, float(np.median(y - slope * x))
+
+
+def _robust_line(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:
+    """Theil-Sen line ``y = slope x + intercept``, robust to a one-sided block of outliers.
+
+    Refitted once on the points within 3 robust sigmas (1.4826 MAD) of the first line: the
+    refit removes the bias that groups and fragments (all wider, or all smaller) leave.
+    """
+    slope, intercept = theil_sen(x, y)
+    r = y - (slope * x + intercept)
+    sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    keep = np.abs(r) <= 3.0 * max(sigma, 1.0)
+    if keep.sum() >= 3 and np.ptp(x[keep]) > 0:
+        slope, intercept = theil_sen(x[keep], y[keep])
+    return slope, intercept
+
+
+class PersonSizeModel:
+    """Expected box height and width of one person as straight lines in the foot row ``y``.
+
+    Parameters
+    ----------
+    config : SizeModelConfig, optional
+        Settings (defaults documented there).
+    """
+
+    def __init__(self, config: SizeModelConfig | None = None) -> None:
+        self.config = config if config is not None else SizeModelConfig()
+        self._samples = np.zeros((self.config.max_samples, 3))  # foot y, h, w
+        self._n = 0  # samples seen in all
+        self._since_fit = 0
+        self._coef: NDArray[np.float64] | None = None  # (2, 2): [h, w] x [slope, intercept]
+
+    def reset(self) -> None:
+        """Forget every sample and the fit."""
+        self._n = 0
+        self._since_fit = 0
+        self._coef = None
+
+    @property
+    def fitted(self) -> bool:
+        """Whether enough isolated boxes were seen for `expected` to answer."""
+        return self._coef is not None
+
+    @property
+    def n_samples(self) -> int:
+        """Isolated boxes currently held for the fit."""
+        return min(self._n, self.config.max_samples)
+
+    @property
+    def coefficients(self) -> NDArray[np.float64] | None:
+        """(2, 2) ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in foot row, or None."""
+        return None if self._coef is None else self._coef.copy()
+
+    def expected(self, foot_y: NDArray[np.float64] | float) -> NDArray[np.float64]:
+        """Expected ``(h, w)`` at foot row(s) `foot_y`: shape ``(..., 2)``, at least 1 px.
+
+        Raises
+        ------
+        ValueError
+            Before the model is fitted.
+        """
+        if self._coef is None:
+            raise ValueError("PersonSizeModel.expected: the model is not fitted yet")
+        y = np.asarray(foot_y, np.float64)[..., None]
+        return np.maximum(self._coef[:, 0] * y + self._coef[:, 1], 1.0)
+
+    def observe(self, boxes: NDArray[np.float64]) -> None:
+        """Add the isolated ones among `boxes` (K, 4) ``left, top, w, h`` to the fit.
+
+        A box is isolated when no other box of the frame overlaps its columns: a person
+        stacked over another blob (a fragment, or someone partly hidden) is not sampled.
+        """
+        b = np.asarray(boxes, np.float64).reshape(-1, 4)
+        if len(b) == 0:
+            return
+        left, right = b[:, 0], b[:, 0] + b[:, 2]
+        overlap = (left[:, None] < right[None, :]) & (left[None, :] < right[:, None])
+        np.fill_diagonal(overlap, False)
+        for _x, y, w, h in b[~overlap.any(axis=1)]:
+            self._samples[self._n % self.config.max_samples] = (y + h, h, w)
+            self._n += 1
+            self._since_fit += 1
+        if self.n_samples >= self.config.min_samples and (
+            self._coef is None or self._since_fit >= self.config.refit_every
+        ):
+            self._fit()
+
+    def _fit(self) -> None:
+        s = self._samples[: self.n_samples]
+        coef = np.zeros((2, 2))
+        if np.ptp(s[:, 0]) < 1.0:  # every foot on one row: a constant size
+            coef[:, 1] = np.median(s[:, 1:], axis=0)
+        else:
+            for j in (0, 1):
+                coef[j] = _robust_line(s[:, 0], s[:, 1 + j])
+        self._coef = coef
+        self._since_fit = 0
+
+    def split_count(self, boxes: NDArray[np.float64]) -> NDArray[np.int64]:
+        """How many people each box (K, 4) holds side by side.
+
+        ``round(w / w_exp)`` when ``w > split_ratio * w_exp`` and the box is no taller than
+        ``split_max_height * h_exp`` (expected sizes at its foot row), else 1: a wide box much
+        taller than a person standing at its foot row is the upper part of a nearer person
+        whose legs went undetected, not a far group.
+        """
+        b = np.asarray(boxes, np.float64).reshape(-1, 4)
+        h_exp, w_exp = self.expected(b[:, 1] + b[:, 3]).T
+        wide = (b[:, 2] > self.config.split_ratio * w_exp) & (
+            b[:, 3] <= self.config.split_max_height * h_exp
+        )
+        n = np.where(wide, np.round(b[:, 2] / w_exp), 1.0).astype(np.int64)
+        return np.maximum(n, 1)
+
+    def merge_fragments(self, boxes: NDArray[np.float64]) -> list[list[int]]:
+        """Group the boxes (K, 4) that are fragments of one person.
+
+        Greedily joins the pair whose union is smallest among those whose columns overlap
+        (by at least half the narrower box) and whose union fits within ``merge_slack`` times
+        the expected height and width at its foot row; repeats until no pair fits.
+
+        Returns
+        -------
+        list of lists of int
+            Indices of the boxes of each group (every box in exactly one group).
+        """
+        b = np.asarray(boxes, np.float64).reshape(-1, 4)
+        groups = [[i] for i in range(len(b))]
+        cur = [r.copy() for r in b]
+        slack = self.config.merge_slack
+        while len(cur) > 1:
+            best: tuple[float, int, int, NDArray[np.float64]] | None = None
+            for i in range(len(cur)):
+                for j in range(i + 1, len(cur)):
+                    a, c = cur[i], cur[j]
+                    ov = min(a[0] + a[2], c[0] + c[2]) - max(a[0], c[0])
+                    if ov < 0.5 * min(a[2], c[2]):
+                        continue
+                    x0, y0 = min(a[0], c[0]), min(a[1], c[1])
+                    x1, y1 = max(a[0] + a[2], c[0] + c[2]), max(a[1] + a[3], c[1] + c[3])
+                    h_exp, w_exp = self.expected(y1)
+                    if y1 - y0 > slack * h_exp or x1 - x0 > slack * w_exp:
+                        continue
+                    area = (x1 - x0) * (y1 - y0)
+                    if best is None or area < best[0]:
+                        best = (area, i, j, np.array([x0, y0, x1 - x0, y1 - y0]))
+            if best is None:
+                break
+            _, i, j, u = best
+            cur[i] = u
+            groups[i] = groups[i] + groups[j]
+            del cur[j], groups[j]
+        return groups

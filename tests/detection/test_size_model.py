@@ -1,0 +1,126 @@
+"""The person-size model: robust ground-plane fit, group splitting, fragment merging."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pftrack.detection.base import BlobConfig, BlobExtractor
+from pftrack.detection.size_model import PersonSizeModel, SizeModelConfig
+
+
+def perspective_boxes(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Isolated people on a ground plane: h = 0.5 (foot - 40), w = 0.4 h, 1 px noise."""
+    foot = rng.uniform(120, 350, n)
+    h = 0.5 * (foot - 40) + rng.normal(0, 1, n)
+    w = 0.4 * h + rng.normal(0, 1, n)
+    return np.column_stack([rng.uniform(0, 400, n), foot - h, w, h])
+
+
+def feed(model: PersonSizeModel, boxes: np.ndarray) -> None:
+    for b in boxes:  # one box a frame: each is isolated
+        model.observe(b[None])
+
+
+def test_fit_recovers_the_ground_plane_lines_despite_outliers() -> None:
+    rng = np.random.default_rng(0)
+    boxes = perspective_boxes(rng, 200)
+    boxes[::5, 2] *= 3  # a fifth are groups three people wide
+    model = PersonSizeModel()
+    feed(model, boxes)
+    assert model.fitted
+    feet = np.array([150.0, 350.0])
+    truth = np.column_stack([0.5 * (feet - 40), 0.2 * (feet - 40)])
+    np.testing.assert_allclose(model.expected(feet), truth, atol=3.0)
+
+
+def test_not_fitted_before_min_samples_and_boxes_stacked_in_columns_are_not_sampled() -> None:
+    model = PersonSizeModel(SizeModelConfig(min_samples=5))
+    with pytest.raises(ValueError, match="not fitted"):
+        model.expected(100.0)
+    stacked = np.array([[10, 10, 20, 30], [12, 45, 20, 30.0]])  # same columns
+    for _ in range(10):
+        model.observe(stacked)
+    assert model.n_samples == 0 and not model.fitted
+    model.observe(np.array([[10, 10, 20, 30], [100, 10, 20, 30.0]]))
+    assert model.n_samples == 2
+
+
+def test_overhead_view_gives_a_constant_size() -> None:
+    model = PersonSizeModel(SizeModelConfig(min_samples=5))
+    feed(model, np.array([[x, 100, 30, 32.0] for x in range(0, 300, 30)]))
+    np.testing.assert_allclose(model.expected([50.0, 300.0]), [[32, 30], [32, 30]])
+
+
+def fitted_model() -> PersonSizeModel:
+    model = PersonSizeModel()
+    feed(model, perspective_boxes(np.random.default_rng(1), 100))
+    return model
+
+
+def test_split_count_cuts_groups_but_not_a_near_persons_upper_half() -> None:
+    model = fitted_model()
+    # at foot 240: h_exp = 100, w_exp = 40
+    boxes = np.array(
+        [
+            [0, 140, 40, 100.0],  # one person
+            [100, 140, 120, 100.0],  # three side by side
+            [300, 60, 120, 180.0],  # wide and far taller than a person at foot 240
+        ]
+    )
+    assert model.split_count(boxes).tolist() == [1, 3, 1]
+
+
+def test_merge_fragments_joins_stacked_parts_of_one_person_only() -> None:
+    model = fitted_model()
+    boxes = np.array(
+        [
+            [0, 140, 40, 50.0],  # torso ...
+            [2, 195, 38, 45.0],  # ... and legs of one person at foot 240
+            [200, 140, 40, 100.0],  # a whole person elsewhere
+            [200, 30, 40, 100.0],  # someone standing above: union far too tall
+        ]
+    )
+    groups = sorted(sorted(g) for g in model.merge_fragments(boxes))
+    assert groups == [[0, 1], [2], [3]]
+
+
+def test_blob_extractor_splits_a_group_once_the_size_is_learnt() -> None:
+    ext = BlobExtractor(BlobConfig(min_area=0.0005, person_aspect=0.0, learn_size=True))
+    frame = np.zeros((240, 320), np.uint8)
+    lone = frame.copy()
+    for x in (20, 120, 220):  # isolated people, 20 wide and 60 tall, feet on row 200
+        lone[140:200, x : x + 20] = 255
+    for _ in range(12):
+        assert len(ext.boxes(lone)[0]) == 3
+    assert ext.size_model.fitted
+    group = frame.copy()
+    group[140:200, 100:160] = 255  # three people shoulder to shoulder: one blob
+    group[140:170, 119:121] = 0  # gaps between the heads and shoulders: dips in the
+    group[140:170, 139:141] = 0  # column profile where the cuts go
+    boxes, _ = ext.boxes(group)
+    assert len(boxes) == 3
+    np.testing.assert_allclose(boxes[:, 2], 20, atol=2)
+    ext.reset()
+    assert not ext.size_model.fitted
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [{"min_samples": 2}, {"split_ratio": 1.0}, {"merge_slack": 0.5}, {"split_max_height": 0.0}],
+)
+def test_bad_config_raises(kwargs: dict[str, float]) -> None:
+    with pytest.raises(ValueError):
+        SizeModelConfig(**kwargs)  # type: ignore[arg-type]
+
+
+def test_theil_sen_equals_scipy() -> None:
+    from scipy.stats import theilslopes
+
+    from pftrack.detection.size_model import theil_sen
+
+    rng = np.random.default_rng(5)
+    x = rng.uniform(0, 300, 60).round()  # ties in x, as foot rows have
+    y = 0.4 * x + 3 + rng.standard_t(2, 60) * 5
+    want = theilslopes(y, x, method="joint")
+    np.testing.assert_allclose(theil_sen(x, y), (want.slope, want.intercept), rtol=1e-12)
