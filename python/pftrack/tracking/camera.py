@@ -183,7 +183,7 @@ class _Measure:
         if pts is None or len(pts) < cfg.min_inliers:
             return None
         nxt, status, _ = cv2.calcOpticalFlowPyrLK(
-            prev, cur, pts, np.empty_like(pts), winSize=(15, 15), maxLevel=3,
+            prev, cur, pts, np.empty_like(pts), winSize=(11, 11), maxLevel=2,
             criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
         )  # fmt: skip
         ok = status.reshape(-1) == 1

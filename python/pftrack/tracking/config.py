@@ -201,8 +201,8 @@ class CameraConfig:
         (it learns the new view).
     """
 
-    max_side: int = 320
-    max_features: int = 200
+    max_side: int = 240
+    max_features: int = 100
     ransac_threshold: float = 1.0
     min_inliers: int = 20
     threshold: float = 0.002
