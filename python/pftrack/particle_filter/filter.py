@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -78,7 +79,7 @@ class FilterState:
 
 def _box(box_cxcywh: ArrayLike) -> NDArray[np.float64]:
     b = np.asarray(box_cxcywh, dtype=np.float64).reshape(-1)
-    if b.shape != (4,) or not np.all(np.isfinite(b)) or b[2] <= 0 or b[3] <= 0:
+    if b.shape != (4,) or not np.isfinite(b).all() or b[2] <= 0 or b[3] <= 0:
         raise ValueError(f"box is {b.tolist()}, expected finite (cx, cy, w, h) with w, h > 0")
     return b
 
@@ -154,15 +155,15 @@ class ColourParticleFilter:
         """
         b = _box(box_cxcywh)
         v = self.velocity if velocity is None else np.asarray(velocity, dtype=np.float64)
-        s = float(np.sqrt((b[2] / self.w0) * (b[3] / self.h0)))
+        s = math.sqrt(float((b[2] / self.w0) * (b[3] / self.h0)))
         m = self.config.model
-        s = float(np.clip(s, m.s_min, m.s_max))
+        s = min(max(s, m.s_min), m.s_max)  # np.clip's value, without its call overhead
         n = self.config.n_particles
         noise = self._rng.standard_normal((n, 3))
         p = self.particles
         p[:, 0] = b[0] + spread * m.sigma_xy * noise[:, 0]
         p[:, 1] = b[1] + spread * m.sigma_xy * noise[:, 1]
-        p[:, 2] = np.clip(s + spread * m.sigma_s * noise[:, 2], m.s_min, m.s_max)
+        p[:, 2] = np.minimum(np.maximum(s + spread * m.sigma_s * noise[:, 2], m.s_min), m.s_max)
         p[:, 3] = p[:, 0] - v[0]
         p[:, 4] = p[:, 1] - v[1]
         p[:, 5] = p[:, 2]
