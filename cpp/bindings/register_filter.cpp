@@ -3,14 +3,43 @@
 #include <pybind11/stl.h>
 
 #include <string>
+#include <vector>
 
 #include "pftrack/sis.hpp"
+#include "arrays.hpp"
 #include "step_args.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
 
 using bind::make_model;
+
+namespace {
+
+/// A list item that sis_step_batch updates in place: float64, C-contiguous, writeable, `cols`
+/// columns (a (rows,) vector when cols == 0).
+py::array_t<double> batch_item(const py::handle& h, const char* what, py::ssize_t k,
+                               py::ssize_t rows, py::ssize_t cols) {
+    const char* fn = "sis_step_batch";
+    const std::string name = std::string(what) + "[" + std::to_string(k) + "]";
+    require(py::isinstance<py::array>(h), fn, name + " must be a NumPy array");
+    const auto a = py::reinterpret_borrow<py::array>(h);
+    require(a.dtype().is(py::dtype::of<double>()), fn, (name + " dtype").c_str(),
+            bind::dtype_name(a), "float64");
+    require((a.flags() & py::array::c_style) != 0 && a.writeable(), fn,
+            name + " must be C-contiguous and writeable");
+    if (cols == 0) {
+        require(a.ndim() == 1 && (rows < 0 || a.shape(0) == rows), fn,
+                name + " must have shape (N,), N the particles' rows");
+    } else {
+        require(a.ndim() == 2 && a.shape(1) == cols && (rows < 0 || a.shape(0) == rows), fn,
+                name + " must have shape (" + (rows < 0 ? std::string("N") : std::to_string(rows)) +
+                    ", " + std::to_string(cols) + ")");
+    }
+    return py::reinterpret_borrow<py::array_t<double>>(a);
+}
+
+}  // namespace
 
 void register_filter(py::module_& m) {
     m.def(
@@ -92,4 +121,80 @@ void register_filter(py::module_& m) {
         py::arg("resample"), py::arg("seed"), py::arg("step"),
         "Resample, propagate, histogram, weigh, estimate; particles (N, 6), weights (N,), "
         "means (2, 3) updated in place.");
+
+    m.def(
+        "sis_step_batch",
+        [](const py::list& particles, const py::list& weights, const py::list& means,
+           const BinnedImage& image, const py::list& refs,
+           Eigen::Ref<const Eigen::VectorXd> w0, Eigen::Ref<const Eigen::VectorXd> h0,
+           const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
+           double s_min, double s_max, bool use_means, double lam, const std::string& kernel,
+           bool resample, const std::vector<std::uint64_t>& seeds,
+           const std::vector<std::uint64_t>& steps) {
+            const char* fn = "sis_step_batch";
+            const auto k = static_cast<py::ssize_t>(particles.size());
+            require(static_cast<py::ssize_t>(weights.size()) == k &&
+                        static_cast<py::ssize_t>(means.size()) == k &&
+                        static_cast<py::ssize_t>(refs.size()) == k && w0.size() == k &&
+                        h0.size() == k && static_cast<py::ssize_t>(seeds.size()) == k &&
+                        static_cast<py::ssize_t>(steps.size()) == k,
+                    fn, "particles, weights, means, refs, w0, h0, seeds and steps must all have "
+                        "one entry per object");
+            // Every array is checked (and every parameter set validated) with the GIL held,
+            // before any object steps: a bad entry changes nothing.
+            std::vector<py::array_t<double>> keep;
+            keep.reserve(static_cast<size_t>(4 * k));
+            std::vector<SisParams> prms;
+            prms.reserve(static_cast<size_t>(k));
+            for (py::ssize_t i = 0; i < k; ++i) {
+                auto p = batch_item(particles[i], "particles", i, -1, kParticleCols);
+                const py::ssize_t n = p.shape(0);
+                keep.push_back(p);
+                keep.push_back(batch_item(weights[i], "weights", i, n, 0));
+                keep.push_back(batch_item(means[i], "means", i, 2, kStateDim));
+                auto r = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+                    refs[i]);
+                require(static_cast<bool>(r) && r.ndim() == 1, fn,
+                        "refs[" + std::to_string(i) + "] must be a (B,) float array");
+                keep.push_back(r);
+                prms.push_back(bind::make_step_params(w0(i), h0(i), a, b, sigma, s_min, s_max,
+                                                      use_means, lam, kernel, resample, fn));
+                prms.back().validate(fn);
+            }
+            using MatMap = Eigen::Map<RowMatrixXd>;
+            using VecMap = Eigen::Map<Eigen::VectorXd>;
+            using ConstVecMap = Eigen::Map<const Eigen::VectorXd>;
+            // columns: mean (3), map (3), map_index, ess, rho_max, rho_mean, fg_mean
+            RowMatrixXd out(k, 11);
+            {
+                py::gil_scoped_release nogil;  // safe: raw buffers kept alive by `keep`
+                const BinImage img = image.view();
+                for (py::ssize_t i = 0; i < k; ++i) {
+                    auto& pa = keep[static_cast<size_t>(4 * i)];
+                    auto& wa = keep[static_cast<size_t>(4 * i + 1)];
+                    auto& ma = keep[static_cast<size_t>(4 * i + 2)];
+                    auto& ra = keep[static_cast<size_t>(4 * i + 3)];
+                    MatMap p(pa.mutable_data(), pa.shape(0), kParticleCols);
+                    VecMap w(wa.mutable_data(), wa.shape(0));
+                    MatMap mm(ma.mutable_data(), 2, kStateDim);
+                    ConstVecMap ref(ra.data(), ra.shape(0));
+                    const SisResult r = sis_step(p, w, mm, img, ref, prms[static_cast<size_t>(i)],
+                                                 seeds[static_cast<size_t>(i)],
+                                                 steps[static_cast<size_t>(i)]);
+                    out.row(i) << r.estimate.mean.transpose(), r.estimate.map.transpose(),
+                        static_cast<double>(r.estimate.map_index), r.ess, r.rho_max, r.rho_mean,
+                        r.fg_mean;
+                }
+            }
+            return out;
+        },
+        py::arg("particles"), py::arg("weights"), py::arg("means"), py::arg("image"),
+        py::arg("refs"), py::arg("w0"), py::arg("h0"), py::arg("a"), py::arg("b"),
+        py::arg("sigma"), py::arg("s_min"), py::arg("s_max"), py::arg("use_means"),
+        py::arg("lam"), py::arg("kernel"), py::arg("resample"), py::arg("seeds"),
+        py::arg("steps"),
+        "sis_step for K objects on one image in one call (the GIL released): lists of K "
+        "particles (N_k, 6), weights (N_k,), means (2, 3) updated in place, K refs; w0, h0, seeds, "
+        "steps (K,). Returns (K, 11): mean (3), map (3), map_index, ess, rho_max, rho_mean, "
+        "fg_mean; each row equal to sis_step's for the same object.");
 }

@@ -4,10 +4,12 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 
 #include "arrays.hpp"
+#include "pftrack/background.hpp"
 #include "pftrack/histogram.hpp"
 #include "pftrack/integral_histogram.hpp"
 #include "pftrack/hsv.hpp"
@@ -15,6 +17,25 @@
 
 namespace py = pybind11;
 using namespace pftrack;
+
+namespace {
+
+/// The HsvLut of the last binning asked for (tables of ~260 KB, built once per binning): the
+/// same bins as hsv_bin_of for every colour (tests/core check it), several times faster.
+std::shared_ptr<const HsvLut> cached_lut(const HsvBinning& p) {
+    static std::mutex mu;
+    static std::shared_ptr<const HsvLut> lut;
+    static HsvBinning key;
+    const std::lock_guard<std::mutex> lock(mu);
+    if (!lut || key.n_h != p.n_h || key.n_s != p.n_s || key.n_v != p.n_v ||
+        key.s_min != p.s_min || key.v_min != p.v_min) {
+        lut = std::make_shared<const HsvLut>(p);
+        key = p;
+    }
+    return lut;
+}
+
+}  // namespace
 
 Kernel parse_kernel(const std::string& name, const char* fn) {
     if (name == "uniform") return Kernel::kUniform;
@@ -81,9 +102,19 @@ void register_histogram(py::module_& m) {
             auto img = std::make_shared<BinnedImage>(rows, cols, p.n_bins());
             const auto* src = static_cast<const std::uint8_t*>(frame.data());
             const auto stride = frame.strides(0);
+            const std::shared_ptr<const HsvLut> lut = cached_lut(p);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers only, held alive by the caller
-                hsv_bins(src, rows, cols, stride, mptr, mstride, p, img->data.data());
+                std::int16_t* out = img->data.data();
+                for (py::ssize_t y = 0; y < rows; ++y) {
+                    const std::uint8_t* px = src + y * stride;
+                    const std::uint8_t* m = mptr ? mptr + y * mstride : nullptr;
+                    std::int16_t* o = out + y * cols;
+                    for (py::ssize_t x = 0; x < cols; ++x) {
+                        const int bin = lut->bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]);
+                        o[x] = (m && m[x] == 0) ? std::int16_t(-1) : static_cast<std::int16_t>(bin);
+                    }
+                }
             }
             return img;
         },

@@ -233,6 +233,30 @@ def sis_step(
     seed: int,
     step: int,
 ) -> dict[str, Any]: ...
+
+# sis_step for K objects on one image, one call (GIL released): lists of K particles (N_k, 6),
+# weights (N_k,), means (2, 3) updated in place; returns (K, 11): mean (3), map (3), map_index,
+# ess, rho_max, rho_mean, fg_mean
+def sis_step_batch(
+    particles: list[_F64],
+    weights: list[_F64],
+    means: list[_F64],
+    image: BinnedImage,
+    refs: list[_F64],
+    w0: ArrayLike,
+    h0: ArrayLike,
+    a: ArrayLike,
+    b: ArrayLike,
+    sigma: ArrayLike,
+    s_min: float,
+    s_max: float,
+    use_means: bool,
+    lam: float,
+    kernel: str,
+    resample: bool,
+    seeds: list[int],
+    steps: list[int],
+) -> _F64: ...
 def mh_step(
     particles: _F64,
     weights: _F64,

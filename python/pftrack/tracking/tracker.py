@@ -30,7 +30,7 @@ from pftrack.tracking.association import associate, covers_another
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
-from pftrack.tracking.track import LiveTrack, Track
+from pftrack.tracking.track import LiveTrack, Track, predict_tracks
 
 __all__ = ["MultiObjectTracker"]
 
@@ -208,8 +208,7 @@ class MultiObjectTracker:
             return self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
 
         # 1. every track's particle filter looks at this frame, its centre filter predicts
-        for t in self.tracks:
-            t.predict(binned, cfg.motion.colour_noise)
+        predict_tracks(self.tracks, binned, cfg.motion.colour_noise)
 
         # 2. association
         if len(boxes):

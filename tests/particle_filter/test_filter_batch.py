@@ -1,0 +1,227 @@
+"""One C++ call for every object's filter step: sis_step_batch and step_filters against the
+per-object sis_step / ColourParticleFilter.step (bit for bit) and the NumPy composition, and
+the tracker's predict_tracks against LiveTrack.predict."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+from pftrack import _core
+from pftrack.particle_filter import (
+    Ar2Model,
+    ColourParticleFilter,
+    FilterConfig,
+    MHColourParticleFilter,
+    box_histograms,
+    hsv_bins,
+)
+from pftrack.particle_filter.filter import step_filters
+from pftrack.tracking.config import TrackerConfig
+from pftrack.tracking.track import LiveTrack, predict_tracks
+from tests.reference import kernels as ref
+
+
+def _particles(rng: np.random.Generator, n: int) -> np.ndarray:
+    p = np.empty((n, 6))
+    p[:, :2] = rng.normal(40, 5, (n, 2))
+    p[:, 2] = rng.uniform(0.8, 1.2, n)
+    p[:, 3:5] = p[:, :2] - rng.normal(1, 1, (n, 2))
+    p[:, 5] = p[:, 2] * rng.uniform(0.95, 1.05, n)
+    return p
+
+
+def _objects(rng: np.random.Generator, image: _core.BinnedImage, k: int) -> list[dict]:
+    objs = []
+    for i in range(k):
+        box = [25 + 8 * i, 20 + 5 * i, 16 + 2 * i, 24 + i]
+        objs.append(
+            {
+                "p": _particles(rng, 20 + 13 * i),  # a different N per object
+                "w": rng.random(20 + 13 * i) + 0.01,
+                "m": rng.normal(40, 2, (2, 3)),
+                "ref": box_histograms(image, [box])[0] + 1e-3,
+                "w0": float(box[2]),
+                "h0": float(box[3]),
+                "seed": int(rng.integers(2**63)),
+                "step": int(rng.integers(0, 50)),
+            }
+        )
+    return objs
+
+
+@pytest.mark.parametrize("kernel", ["uniform", "epanechnikov"])
+@pytest.mark.parametrize("use_means", [False, True])
+def test_batch_equals_per_object_sis_step_bit_for_bit(textured_frame, rng, kernel, use_means):
+    mask = np.zeros(textured_frame.shape[:2], np.uint8)
+    mask[5:70, 10:90] = 1
+    image = hsv_bins(textured_frame, mask)
+    model = Ar2Model(sigma_xy=2.0, sigma_s=0.03, use_means=use_means)
+    objs = _objects(rng, image, 5)
+    single = copy.deepcopy(objs)
+    args = (model.a, model.b, model.sigma, model.s_min, model.s_max, use_means, 20.0, kernel, True)
+    out = _core.sis_step_batch(
+        [o["p"] for o in objs], [o["w"] for o in objs], [o["m"] for o in objs], image,
+        [o["ref"] for o in objs], np.array([o["w0"] for o in objs]),
+        np.array([o["h0"] for o in objs]), *args, [o["seed"] for o in objs],
+        [o["step"] for o in objs],
+    )  # fmt: skip
+    assert out.shape == (5, 11)
+    for o, s, row in zip(objs, single, out, strict=True):
+        r = _core.sis_step(s["p"], s["w"], s["m"], image, s["ref"], s["w0"], s["h0"], *args,
+                           s["seed"], s["step"])  # fmt: skip
+        np.testing.assert_array_equal(o["p"], s["p"])
+        np.testing.assert_array_equal(o["w"], s["w"])
+        np.testing.assert_array_equal(o["m"], s["m"])
+        want = [*r["mean"], *r["map"], r["map_index"], r["ess"], r["rho_max"], r["rho_mean"]]
+        np.testing.assert_array_equal(row, [*want, r["fg_mean"]])
+
+
+def test_batch_matches_numpy_composition(textured_frame, rng):
+    image = hsv_bins(textured_frame)
+    model = Ar2Model(sigma_xy=2.0, sigma_s=0.03)
+    objs = _objects(rng, image, 3)
+    wants = []
+    for o in objs:
+        u0 = _core.counter_uniforms(o["seed"], o["step"], 2**64 - 1, 1)[0]
+        normals = _core.counter_normals(o["seed"], o["step"], 3 * len(o["p"])).reshape(-1, 3)
+        wants.append(
+            ref.sis_step(
+                o["p"],
+                o["w"],
+                o["m"],
+                image.bins,
+                image.n_bins,
+                o["ref"],
+                o["w0"],
+                o["h0"],
+                model.a,
+                model.b,
+                model.sigma,
+                model.s_min,
+                model.s_max,
+                False,
+                20.0,
+                "uniform",
+                u0,
+                normals,
+            )  # fmt: skip
+        )
+    out = _core.sis_step_batch(
+        [o["p"] for o in objs], [o["w"] for o in objs], [o["m"] for o in objs], image,
+        [o["ref"] for o in objs], np.array([o["w0"] for o in objs]),
+        np.array([o["h0"] for o in objs]), model.a, model.b, model.sigma, model.s_min,
+        model.s_max, False, 20.0, "uniform", True, [o["seed"] for o in objs],
+        [o["step"] for o in objs],
+    )  # fmt: skip
+    for o, (want_p, want_w, want_mean, _), row in zip(objs, wants, out, strict=True):
+        np.testing.assert_allclose(o["p"], want_p, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(o["w"], want_w, rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(row[:3], want_mean, rtol=1e-12)
+        assert row[7] == pytest.approx(1 / np.sum(want_w**2), rel=1e-9)
+
+
+def test_batch_rejects_bad_input_and_changes_nothing(textured_frame, rng):
+    image = hsv_bins(textured_frame)
+    model = Ar2Model()
+    objs = _objects(rng, image, 2)
+    before = copy.deepcopy(objs)
+
+    def call(particles, weights, seeds):
+        return _core.sis_step_batch(
+            particles, weights, [o["m"] for o in objs], image, [o["ref"] for o in objs],
+            np.array([o["w0"] for o in objs]), np.array([o["h0"] for o in objs]), model.a,
+            model.b, model.sigma, model.s_min, model.s_max, False, 20.0, "uniform", True, seeds,
+            [o["step"] for o in objs],
+        )  # fmt: skip
+
+    ps, ws, seeds = [o["p"] for o in objs], [o["w"] for o in objs], [o["seed"] for o in objs]
+    with pytest.raises(ValueError, match="one entry per object"):
+        call(ps, ws, seeds[:1])
+    with pytest.raises(ValueError, match=r"particles\[1\] dtype"):
+        call([ps[0], ps[1].astype(np.float32)], ws, seeds)
+    with pytest.raises(ValueError, match=r"weights\[1\] must have shape"):
+        call(ps, [ws[0], ws[1][:-1]], seeds)
+    with pytest.raises(ValueError, match=r"particles\[0\] must be C-contiguous"):
+        call([np.asfortranarray(ps[0]), ps[1]], ws, seeds)
+    for o, b in zip(objs, before, strict=True):
+        np.testing.assert_array_equal(o["p"], b["p"])
+        np.testing.assert_array_equal(o["w"], b["w"])
+    empty = _core.sis_step_batch([], [], [], image, [], np.zeros(0), np.zeros(0), model.a,
+                                 model.b, model.sigma, model.s_min, model.s_max, False, 20.0,
+                                 "uniform", True, [], [])  # fmt: skip
+    assert empty.shape == (0, 11)
+
+
+def _scene(shift: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(0)
+    frame = rng.integers(60, 120, (120, 160, 3), dtype=np.uint8)
+    frame[40:80, 30 + shift : 50 + shift] = (20, 20, 220)
+    frame[30:60, 100 - shift : 115 - shift] = (200, 60, 20)
+    return frame
+
+
+@pytest.mark.parametrize("estimate", ["mean", "map"])
+def test_step_filters_equals_step_each(estimate):
+    image0 = hsv_bins(_scene())
+    cfg = FilterConfig(n_particles=50, estimate=estimate)
+    boxes = [[40, 60, 20, 40], [107, 45, 15, 30], [60, 60, 20, 40]]
+
+    def make() -> list[ColourParticleFilter]:
+        fs = [
+            ColourParticleFilter(b, box_histograms(image0, [b])[0] + 1e-3, cfg, rng=k)
+            for k, b in enumerate(boxes)
+        ]
+        # an MH filter and one of another configuration step one by one, in their place
+        fs.insert(1, MHColourParticleFilter(boxes[0], fs[0].reference, cfg, rng=7))
+        fs.append(ColourParticleFilter(boxes[1], fs[1].reference, FilterConfig(30), rng=8))
+        return fs
+
+    batched, single = make(), make()
+    for t in range(1, 6):
+        image = hsv_bins(_scene(2 * t))
+        got = step_filters(batched, image)
+        want = [f.step(image) for f in single]
+        for g, w, fb, fs in zip(got, want, batched, single, strict=True):
+            np.testing.assert_array_equal(g.box_cxcywh, w.box_cxcywh)
+            assert (g.rho, g.rho_max, g.ess, g.foreground) == (w.rho, w.rho_max, w.ess,
+                                                               w.foreground)  # fmt: skip
+            np.testing.assert_array_equal(fb.particles, fs.particles)
+            np.testing.assert_array_equal(fb.means, fs.means)
+            assert fb.last == g
+    assert step_filters([], image0) == []
+
+
+def test_predict_tracks_equals_predict_each():
+    image0 = hsv_bins(_scene())
+    cfg = TrackerConfig()
+    boxes = [np.array([30.0, 40.0, 20.0, 40.0]), np.array([100.0, 30.0, 15.0, 30.0])]
+
+    def make() -> list[LiveTrack]:
+        out = []
+        for k, b in enumerate(boxes):
+            c = b[:2] + b[2:] / 2
+            hist = box_histograms(image0, [[*c, *b[2:]]])[0] + 1e-3
+            out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
+        return out
+
+    batched, single = make(), make()
+    for t in range(1, 6):
+        image = hsv_bins(_scene(2 * t))
+        predict_tracks(batched, image, cfg.motion.colour_noise)
+        for s in single:
+            s.predict(image, cfg.motion.colour_noise)
+        if t == 3:  # a matched detection in between: follow() after a batched predict
+            for group in (batched, single):
+                group[0].follow(np.array([36.0, 41.0, 21.0, 39.0]), group[0].filter.reference,
+                                cfg, True)  # fmt: skip
+        for b, s in zip(batched, single, strict=True):
+            np.testing.assert_array_equal(b.box, s.box)
+            np.testing.assert_array_equal(b.motion.p, s.motion.p)
+            np.testing.assert_array_equal(b.motion.v, s.motion.v)
+            assert b.motion.cov == pytest.approx(s.motion.cov, rel=0, abs=0)
+            assert (b.rho, b.age) == (s.rho, s.age)
+            assert (b.measured is None) == (s.measured is None)
+            np.testing.assert_array_equal(b.filter.particles, s.filter.particles)
