@@ -56,7 +56,11 @@ def test_cli_parser_loads_no_scipy() -> None:
 def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """mypy sees the real signatures through the lazy re-exports (and the package's py.typed)."""
     api = pytest.importorskip("mypy.api")
-    monkeypatch.setenv("MYPYPATH", str(Path(pftrack.__file__).parents[1]))
+    root = Path(pftrack.__file__).parents[1]
+    if root.name not in ("site-packages", "dist-packages"):
+        # a source checkout (PYTHONPATH=python): mypy finds installed packages by itself and
+        # refuses site-packages on MYPYPATH
+        monkeypatch.setenv("MYPYPATH", str(root))
     code = tmp_path / "use.py"
     code.write_text(
         "import pftrack\n"
