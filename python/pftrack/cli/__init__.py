@@ -64,6 +64,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (OSError, ValueError, TypeError) as exc:  # OSError: missing, unwritable, full disk
         print(f"pftrack {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print(f"pftrack {args.command}: error: out of memory", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:  # outputs are atomic: nothing half-written is left behind
+        print(f"pftrack {args.command}: interrupted; no output was changed", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

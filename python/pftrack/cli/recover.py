@@ -43,17 +43,19 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack recover``; return the exit status."""
+    from pftrack.io.atomic import check_output
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery import LinkConfig, check_unique, fill_gaps, link_tracklets
 
     src = Path(args.tracks)
-    rows = read_mot(src, what="tracks file")
-    check_unique(rows, data_line_numbers(src))
     out = Path(args.out)
-    if out.exists() and os.path.samefile(out, src) and not args.in_place:
+    if out.exists() and src.exists() and os.path.samefile(out, src) and not args.in_place:
         raise ValueError(
             f"--out {out} is the input file; pass --in-place to replace it (atomically)"
         )
+    check_output(out, what="--out", inputs=(args.video,) if args.video else ())
+    rows = read_mot(src, what="tracks file")
+    check_unique(rows, data_line_numbers(src))
     n_links = 0
     if args.link:
         frames = None

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 from typing import Any
 
@@ -34,13 +33,13 @@ def run(args: argparse.Namespace) -> int:
     """Run ``pftrack smooth``; return the exit status."""
     import numpy as np
 
+    from pftrack.io.atomic import check_output
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery import LinkConfig, check_unique
     from pftrack.tracking import smooth_tracks
 
-    src, out = Path(args.tracks), Path(args.out)
-    if out.exists() and os.path.samefile(out, src):
-        raise ValueError(f"--out {out} is the input file; write the result elsewhere")
+    src = Path(args.tracks)
+    out = check_output(args.out, what="--out", inputs=(src,))
     rows = read_mot(src, what="tracks file")
     check_unique(rows, data_line_numbers(src))
     link = None if args.no_link else LinkConfig(max_gap=args.max_gap)

@@ -37,7 +37,7 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack track``; return the exit status."""
-    from pftrack.io.atomic import check_output
+    from pftrack.io.atomic import check_output, staged_outputs
     from pftrack.io.mot import write_mot
     from pftrack.io.video import FrameSource
     from pftrack.recovery import LinkConfig
@@ -61,17 +61,22 @@ def run(args: argparse.Namespace) -> int:
         smoother=None if args.no_smooth else BoxSmoother(),
         link=None if args.no_link else LinkConfig(),
     )
-    write_mot(args.out, result.rows)
     n_ids = len(set(result.rows[:, 1].astype(int))) if len(result.rows) else 0
+    with staged_outputs() as stage:  # all outputs replaced at the end, or none
+        write_mot(stage(args.out), result.rows)
+        if args.render:
+            write_annotated_video(stage(args.render), FrameSource(args.source), result.rows,
+                                  source.fps)  # fmt: skip
+        if args.plot:
+            first = next(iter(FrameSource(args.source)))
+            plot_trajectories(stage(args.plot), result.rows, background=first,
+                              title=Path(args.source).name)  # fmt: skip
     print(
         f"{result.n_frames} frames, {n_ids} tracks, {len(result.rows)} boxes in "
         f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> {args.out}"
     )
     if args.render:
-        write_annotated_video(args.render, FrameSource(args.source), result.rows, source.fps)
         print(f"annotated video -> {args.render}")
     if args.plot:
-        first = next(iter(FrameSource(args.source)))
-        plot_trajectories(args.plot, result.rows, background=first, title=Path(args.source).name)
         print(f"trajectory plot -> {args.plot}")
     return 0
