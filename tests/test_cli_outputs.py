@@ -89,8 +89,25 @@ COMMANDS: dict[str, Builder] = {
         "--json",
         str(o),
     ],  # fmt: skip
+    "experiment --json": lambda i, o: [
+        "experiment",
+        "gaps",
+        "--gt",
+        str(i["gt"]),
+        "--json",
+        str(o),
+    ],  # fmt: skip
+    "experiment --figure": lambda i, o: [
+        "experiment",
+        "gaps",
+        "--gt",
+        str(i["gt"]),
+        "--figure",
+        str(o),
+    ],  # fmt: skip
 }
-GOOD_NAME = {"track --render": "v.mp4", "track --plot": "p.png", "eval --json": "m.json"}
+GOOD_NAME = {"track --render": "v.mp4", "track --plot": "p.png", "eval --json": "m.json",
+             "experiment --json": "e.json", "experiment --figure": "f.png"}  # fmt: skip
 
 
 def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> Path:

@@ -105,6 +105,12 @@ def _methods(text: str) -> list[str]:
 
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
+    from pftrack.io.atomic import check_output
+
+    if args.json:
+        check_output(args.json, what="--json", suffixes=(".json",), inputs=tuple(args.gt))
+    if args.figure:
+        check_output(args.figure, what="--figure", suffixes=(".png",), inputs=tuple(args.gt))
     if len(args.gt) > 1 or args.auto_masks:
         return _run_sequences(args)
     import numpy as np
