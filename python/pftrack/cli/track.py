@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from pftrack.cli._options import add_command, add_tracker_options, positive_float, tracker_config
+from pftrack.cli._options import add_command, add_tracker_options, bounded_float, tracker_config
 
 
 def add_parser(sub: Any) -> None:
@@ -25,7 +25,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="tracks in MOTChallenge format (e.g. tracks.txt)")
     p.add_argument("--detections", help="MOTChallenge detection file (frame,-1,l,t,w,h,score,...)")
     p.add_argument(
-        "--det-scale", type=positive_float, default=1.0, metavar="S",
+        "--det-scale", type=bounded_float(1e-3, 1e3), default=1.0, metavar="S",
         help="multiply detection boxes by S to reach the video's pixels (0.625 for PETS09 "
         "det.txt on its 480x360 video)",
     )  # fmt: skip

@@ -1,0 +1,17 @@
+"""Hypothesis profiles of the fuzz suite: ``short`` in the default run, ``long`` for ``-m slow``."""
+
+from __future__ import annotations
+
+import os
+
+from hypothesis import HealthCheck, settings
+
+# The short profile keeps the default run quick; each target gets a few dozen examples.
+settings.register_profile(
+    "fuzz-short",
+    max_examples=int(os.environ.get("PFTRACK_FUZZ_EXAMPLES", "30")),
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                           HealthCheck.filter_too_much],
+)  # fmt: skip
