@@ -47,32 +47,32 @@ def _unwritable(tmp: Path) -> Path:
     return d
 
 
-# (name, command builder): the builder gets the inputs, the temp folder and the bad output path
-Builder = Callable[[dict[str, Path], Path], list[str]]
+# (name, command builder): the builder gets the inputs, the bad output path and the temp folder
+Builder = Callable[[dict[str, Path], Path, Path], list[str]]
 COMMANDS: dict[str, Builder] = {
-    "track --out": lambda i, o: ["track", str(i["video"]), "--out", str(o), "--particles", "20"],
-    "track --render": lambda i, o: [
+    "track --out": lambda i, o, t: ["track", str(i["video"]), "--out", str(o), "--particles", "20"],
+    "track --render": lambda i, o, t: [
         "track",
         str(i["video"]),
         "--out",
-        str(o.parent / "t_ok.txt"),
+        str(t / "t_ok.txt"),
         "--render",
         str(o),
         "--particles",
         "20",
     ],  # fmt: skip
-    "track --plot": lambda i, o: [
+    "track --plot": lambda i, o, t: [
         "track",
         str(i["video"]),
         "--out",
-        str(o.parent / "t_ok.txt"),
+        str(t / "t_ok.txt"),
         "--plot",
         str(o),
         "--particles",
         "20",
     ],  # fmt: skip
-    "smooth --out": lambda i, o: ["smooth", str(i["tracks"]), "--out", str(o)],
-    "recover --out": lambda i, o: [
+    "smooth --out": lambda i, o, t: ["smooth", str(i["tracks"]), "--out", str(o)],
+    "recover --out": lambda i, o, t: [
         "recover",
         str(i["tracks"]),
         "--out",
@@ -80,7 +80,7 @@ COMMANDS: dict[str, Builder] = {
         "--method",
         "linear",
     ],  # fmt: skip
-    "eval --json": lambda i, o: [
+    "eval --json": lambda i, o, t: [
         "eval",
         "--gt",
         str(i["gt"]),
@@ -89,7 +89,7 @@ COMMANDS: dict[str, Builder] = {
         "--json",
         str(o),
     ],  # fmt: skip
-    "experiment --json": lambda i, o: [
+    "experiment --json": lambda i, o, t: [
         "experiment",
         "gaps",
         "--gt",
@@ -97,7 +97,7 @@ COMMANDS: dict[str, Builder] = {
         "--json",
         str(o),
     ],  # fmt: skip
-    "experiment --figure": lambda i, o: [
+    "experiment --figure": lambda i, o, t: [
         "experiment",
         "gaps",
         "--gt",
@@ -161,7 +161,7 @@ def test_bad_output_is_refused_before_any_work(
     out = _bad_output(case, command, inputs, tmp_path)
     before_inputs = {k: p.read_bytes() for k, p in inputs.items()}
     before = _snapshot(tmp_path)
-    assert main(COMMANDS[command](inputs, out)) == 2
+    assert main(COMMANDS[command](inputs, out, tmp_path)) == 2
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"pftrack {command.split()[0]}: error: "), err
