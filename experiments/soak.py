@@ -49,6 +49,7 @@ class Soak:
     rss: list[float]
     warmup: int
     seconds: float
+    objects: int  # tracks reported on the last frame
 
     @property
     def base(self) -> float:
@@ -69,7 +70,8 @@ class Soak:
     def row(self) -> str:
         """One line of the table."""
         return (
-            f"{self.name:6s} {self.frames[-1]:6d} frames in {self.seconds:7.1f} s  RSS "
+            f"{self.name:6s} {self.frames[-1]:6d} frames in {self.seconds:7.1f} s, "
+            f"{self.objects:3d} tracks on the last  RSS "
             f"{self.rss[0]:6.1f} -> {self.base:6.1f} (after {self.warmup}) -> "
             f"{self.rss[-1]:6.1f} MiB, max growth {100 * self.growth:+.2f} %  "
             f"{'flat' if self.flat else 'GROWING'}"
@@ -89,14 +91,15 @@ def soak(
 
     tracker = tracker if tracker is not None else MultiObjectTracker(rng=0)
     seen, rss = [0], [rss_mib()]
+    reported: list[Any] = []
     t0 = time.perf_counter()
     for k in range(1, n_frames + 1):
         frame, dets = next(frames)
-        tracker.update(frame, dets)
+        reported = tracker.update(frame, dets)
         if k % every == 0 or k == n_frames:
             seen.append(k)
             rss.append(rss_mib())
-    return Soak(name, seen, rss, warmup, time.perf_counter() - t0)
+    return Soak(name, seen, rss, warmup, time.perf_counter() - t0, len(reported))
 
 
 def looped_video(source: Path | Callable[[], Any]) -> Iterator[tuple[NDArray[np.uint8], None]]:
