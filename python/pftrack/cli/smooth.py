@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 from typing import Any
 
@@ -38,8 +39,10 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.recovery import LinkConfig, check_unique
     from pftrack.tracking import smooth_tracks
 
-    src = Path(args.tracks)
-    out = check_output(args.out, what="--out", inputs=(src,))
+    src, out = Path(args.tracks), Path(args.out)
+    if out.exists() and src.exists() and os.path.samefile(out, src):
+        raise ValueError(f"--out {out} is the input file; write the result elsewhere")
+    check_output(out, what="--out")
     rows = read_mot(src, what="tracks file")
     check_unique(rows, data_line_numbers(src))
     link = None if args.no_link else LinkConfig(max_gap=args.max_gap)
