@@ -17,7 +17,8 @@ from tests.fuzz.targets_api import TARGETS as API_TARGETS
 from tests.fuzz.targets_core import TARGETS as CORE_TARGETS
 
 TARGETS = CORE_TARGETS + API_TARGETS
-LONG_TOTAL = 10_000  # examples over all targets in the slow run
+LONG_TOTAL = 10_000  # examples over the targets without a known failure, in the slow run
+LONG_EACH = math.ceil(LONG_TOTAL / sum(not t.known for t in TARGETS))
 
 
 def _params(strict: bool) -> list[object]:
@@ -47,8 +48,7 @@ def test_fuzz_short(target: Target, data: st.DataObject) -> None:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("target", _params(strict=False))
-@settings(settings.get_profile("fuzz-short"), max_examples=math.ceil(LONG_TOTAL / len(TARGETS)),
-          derandomize=False)  # fmt: skip
+@settings(settings.get_profile("fuzz-short"), max_examples=LONG_EACH, derandomize=False)
 @given(data=st.data())
 def test_fuzz_long(target: Target, data: st.DataObject) -> None:
     _run(target, data)
