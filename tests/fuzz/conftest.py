@@ -6,7 +6,8 @@ import os
 
 from hypothesis import HealthCheck, settings
 
-# The short profile keeps the default run quick; each target gets a few dozen examples.
+# The short profile keeps the default run quick: 30 examples per target, derandomised (the same
+# examples every run). PFTRACK_FUZZ_EXAMPLES=N changes the count (e.g. to hunt locally).
 settings.register_profile(
     "fuzz-short",
     max_examples=int(os.environ.get("PFTRACK_FUZZ_EXAMPLES", "30")),
