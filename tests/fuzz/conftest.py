@@ -1,4 +1,4 @@
-"""Hypothesis profiles of the fuzz suite: ``short`` in the default run, ``long`` for ``-m slow``."""
+"""Hypothesis settings of the fuzz suite: one profile, `fuzz-short`; the slow test overrides it."""
 
 from __future__ import annotations
 
