@@ -22,8 +22,9 @@ LONG_EACH = math.ceil(LONG_TOTAL / sum(not t.known for t in TARGETS))
 
 
 def _params(strict: bool) -> list[object]:
-    """One parameter per target; a known failure is an xfail with its reason (strict in the
-    derandomised short run, where the failing example is always drawn)."""
+    """One parameter per target; a known failure is an xfail with its reason. Not strict: a
+    short run need not draw the failing input (tests/fuzz/test_known_failures.py pins each
+    one, strictly)."""
     return [
         pytest.param(
             t,
@@ -39,7 +40,7 @@ def _run(target: Target, data: st.DataObject) -> None:
     check_call(fn, args, kwargs, finite=target.finite)
 
 
-@pytest.mark.parametrize("target", _params(strict=True))
+@pytest.mark.parametrize("target", _params(strict=False))
 @settings(settings.get_profile("fuzz-short"))
 @given(data=st.data())
 def test_fuzz_short(target: Target, data: st.DataObject) -> None:
