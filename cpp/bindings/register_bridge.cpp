@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -62,7 +63,47 @@ GdtProblem make_problem(const Array& A, const Array& Q, const Array& H, const Ar
     p.Pi_0 = matrix2(Pi_0, fn, "Pi_0");
     p.y = vector1(y, fn, "y");
     p.T = T;
+    const double n = static_cast<double>(p.m0.size());
+    // eps and cov hold (T + 1) n x n matrices each
+    require_size((static_cast<double>(T) + 1.0) * n * std::max(n, 1.0), fn, "T steps of the path");
     return p;
+}
+
+/// A path that is not finite comes from a model that blows up over the gap: refuse it.
+template <class M>
+void require_finite_result(const M& path, const char* fn) {
+    require(path.allFinite(), fn,
+            "the result is not finite: A is unstable over T steps, or the covariances are "
+            "singular (check A's eigenvalues, Q and Pi_0)");
+}
+
+/// Problem k of a batch as C++ arrays; a wrong type becomes a TypeError, not RuntimeError.
+GdtProblem batch_problem(const py::handle& h, std::size_t k) {
+    const char* fn = "gdt_solve_batch";
+    if (!py::isinstance<py::tuple>(h) || py::len(h) != 8)
+        fail(fn, "problem " + std::to_string(k) +
+                     " must be a tuple (A, Q, H, Pi_T, m0, Pi_0, y, T)");
+    const py::tuple t = py::reinterpret_borrow<py::tuple>(h);
+    if (!py::isinstance<py::int_>(t[7]) || py::isinstance<py::bool_>(t[7]))
+        throw py::type_error(std::string(fn) + ": problem " + std::to_string(k) +
+                             ": T must be an int, got " +
+                             std::string(py::str(py::type::of(t[7]).attr("__name__"))));
+    std::vector<Array> a;
+    for (int i = 0; i < 7; ++i) {
+        try {
+            a.push_back(t[static_cast<std::size_t>(i)].cast<Array>());
+        } catch (const py::cast_error&) {
+            throw py::type_error(std::string(fn) + ": problem " + std::to_string(k) + ": item " +
+                                 std::to_string(i) + " is not an array of numbers");
+        }
+    }
+    int T = 0;
+    try {
+        T = t[7].cast<int>();
+    } catch (const py::cast_error&) {
+        fail(fn, "problem " + std::to_string(k) + ": T does not fit in an int");
+    }
+    return make_problem(a[0], a[1], a[2], a[3], a[4], a[5], a[6], T, fn);
 }
 
 py::dict result_dict(GdtResult&& r, bool paths_only) {
@@ -97,6 +138,8 @@ void register_bridge(py::module_& m) {
                 py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
                 r = gdt_solve(p, f, start_conditioned);
             }
+            require_finite_result(r.path, "gdt_solve");
+            require_finite_result(r.cov, "gdt_solve");
             return result_dict(std::move(r), false);
         },
         py::arg("A"), py::arg("Q"), py::arg("H"), py::arg("Pi_T"), py::arg("m0"), py::arg("Pi_0"),
@@ -110,11 +153,16 @@ void register_bridge(py::module_& m) {
            const std::string& form, bool start_conditioned) {
             const GdtForm f = parse_form(form, "gdt_sample");
             GdtProblem p = make_problem(A, Q, H, Pi_T, m0, Pi_0, y, T, "gdt_sample");
+            require(n_samples >= 0, "gdt_sample", "n_samples", n_samples, ">= 0");
+            require_size(static_cast<double>(n_samples) * (static_cast<double>(T) + 1.0) *
+                             static_cast<double>(p.m0.size()),
+                         "gdt_sample", "n_samples paths of T steps");
             RowMatrixXd out;
             {
                 py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
                 out = gdt_sample(p, f, start_conditioned, n_samples, seed);
             }
+            require_finite_result(out, "gdt_sample");
             const py::ssize_t n = static_cast<py::ssize_t>(p.m0.size());
             py::array_t<double> a = py::cast(std::move(out));
             return a.reshape({static_cast<py::ssize_t>(n_samples), static_cast<py::ssize_t>(T + 1), n});
@@ -130,23 +178,18 @@ void register_bridge(py::module_& m) {
             const GdtForm f = parse_form(form, "gdt_solve_batch");
             std::vector<GdtProblem> ps;
             ps.reserve(problems.size());
-            for (const py::handle& h : problems) {
-                const py::tuple t = py::reinterpret_borrow<py::tuple>(h);
-                require(t.size() == 8, "gdt_solve_batch",
-                        "each problem must be a tuple (A, Q, H, Pi_T, m0, Pi_0, y, T)");
-                ps.push_back(make_problem(t[0].cast<Array>(), t[1].cast<Array>(),
-                                          t[2].cast<Array>(), t[3].cast<Array>(),
-                                          t[4].cast<Array>(), t[5].cast<Array>(),
-                                          t[6].cast<Array>(), t[7].cast<int>(),
-                                          "gdt_solve_batch"));
-            }
+            for (const py::handle& h : problems) ps.push_back(batch_problem(h, ps.size()));
             std::vector<GdtResult> rs(ps.size());
             {
                 py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
                 for (size_t i = 0; i < ps.size(); ++i) rs[i] = gdt_solve(ps[i], f, start_conditioned);
             }
             py::list out;
-            for (auto& r : rs) out.append(result_dict(std::move(r), paths_only));
+            for (auto& r : rs) {
+                require_finite_result(r.path, "gdt_solve_batch");
+                if (!paths_only) require_finite_result(r.cov, "gdt_solve_batch");
+                out.append(result_dict(std::move(r), paths_only));
+            }
             return out;
         },
         py::arg("problems"), py::arg("form") = "general", py::arg("start_conditioned") = true,

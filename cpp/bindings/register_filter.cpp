@@ -61,6 +61,7 @@ void register_filter(py::module_& m) {
         "counter_uniforms",
         [](std::uint64_t seed, std::uint64_t stream, std::uint64_t start, Index n) {
             require(n >= 0, "counter_uniforms", "n", n, ">= 0");
+            require_size(static_cast<double>(n), "counter_uniforms", "n");
             const CounterRng rng(seed, stream);
             Eigen::VectorXd u(n);
             for (Index i = 0; i < n; ++i) u(i) = rng.uniform(start + static_cast<std::uint64_t>(i));
@@ -72,6 +73,7 @@ void register_filter(py::module_& m) {
         "counter_normals",
         [](std::uint64_t seed, std::uint64_t stream, Index n) {
             require(n >= 0, "counter_normals", "n", n, ">= 0");
+            require_size(static_cast<double>(n), "counter_normals", "n");
             const CounterRng rng(seed, stream);
             Eigen::VectorXd z(n);
             for (Index i = 0; i < n; ++i) z(i) = rng.normal(static_cast<std::uint64_t>(i));

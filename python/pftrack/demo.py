@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from pftrack.eval import evaluate_mot, format_metrics
+from pftrack.io.atomic import check_output, staged_outputs
 from pftrack.io.mot import write_mot
 from pftrack.recovery.demo import demo_report
 from pftrack.render import plot_trajectories, write_annotated_video
@@ -24,21 +25,28 @@ def run_demo(out_dir: Path, *, seed: int = 0, n_frames: int = 150, particles: in
     """
     from dataclasses import replace
 
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ValueError(f"--out-dir {out_dir} is a file; give a folder")
     out_dir.mkdir(parents=True, exist_ok=True)
+    names = ("tracks.txt", "truth.txt", "annotated.mp4", "trajectories.png")
+    for name in names:  # before any work: every output can be written
+        check_output(out_dir / name, what="--out-dir")
     scene = make_scene(n_frames=n_frames, rng=seed)
     base = TrackerConfig()
     config = replace(base, filter=replace(base.filter, n_particles=particles))
     run = track_frames(scene.frames, config=config, rng=seed)
-    write_mot(out_dir / "tracks.txt", run.rows)
-    scene.write_truth(out_dir / "truth.txt")
+    with staged_outputs() as stage:  # the four files are replaced together, or not at all
+        write_mot(stage(out_dir / "tracks.txt"), run.rows)
+        scene.write_truth(stage(out_dir / "truth.txt"))
+        write_annotated_video(stage(out_dir / "annotated.mp4"), scene.frames, run.rows, scene.fps)
+        plot_trajectories(stage(out_dir / "trajectories.png"), run.rows,
+                          background=scene.background, truth=scene.truth,
+                          title="tracks (colour) over truth (grey)")  # fmt: skip
     metrics = evaluate_mot(scene.truth, run.rows, image_size=(scene.width, scene.height))
     print(f"pftrack demo: synthetic scene, {n_frames} frames {scene.width}x{scene.height}, "
           f"{len(np.unique(scene.truth[:, 1]))} walkers, seed {seed}")  # fmt: skip
     print(f"tracked at {run.fps:.0f} frames/s (detection + {particles} particles per object)")
     print(format_metrics({"pftrack": metrics}))
-    write_annotated_video(out_dir / "annotated.mp4", scene.frames, run.rows, scene.fps)
-    plot_trajectories(out_dir / "trajectories.png", run.rows, background=scene.background,
-                      truth=scene.truth, title="tracks (colour) over truth (grey)")  # fmt: skip
     print()
     print(demo_report(scene.truth, rng=seed))
     print(f"\nwrote {out_dir}/tracks.txt, truth.txt, annotated.mp4, trajectories.png")

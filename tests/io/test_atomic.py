@@ -57,3 +57,24 @@ def test_missing_folder_is_named(tmp_path: Path) -> None:
         atomic_write(tmp_path / "missing" / "x"),
     ):
         pass
+
+
+def test_staged_outputs_replace_all_or_none(tmp_path: Path, umask) -> None:
+    from pftrack.io.atomic import staged_outputs
+
+    umask(0o022)
+    a, b = tmp_path / "a.txt", tmp_path / "b.png"
+    a.write_text("old a")
+    b.write_text("old b")
+    with pytest.raises(KeyboardInterrupt), staged_outputs() as stage:
+        write_mot(stage(a), [[1, 1, 0, 0, 10, 10]])
+        stage(b).write_bytes(b"half")
+        raise KeyboardInterrupt
+    assert (a.read_text(), b.read_text()) == ("old a", "old b")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.png"]
+    with staged_outputs() as stage:
+        write_mot(stage(a), [[1, 1, 0, 0, 10, 10]])
+        stage(b).write_bytes(b"new")
+    assert a.read_text().startswith("1,1,0,0,10,10") and b.read_bytes() == b"new"
+    assert {stat.S_IMODE(p.stat().st_mode) for p in (a, b)} == {0o644}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.png"]

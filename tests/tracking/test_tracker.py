@@ -199,8 +199,8 @@ def test_trackers_never_share_ids():
 def test_bad_detections_are_rejected():
     tracker = MultiObjectTracker(rng=0)
     frame = np.zeros((60, 80, 3), np.uint8)
-    with pytest.raises(ValueError, match="outside the 80x60 frame"):
-        tracker.update(frame, [[500, 500, 10, 10]])
+    with pytest.warns(UserWarning, match="outside the 80x60 frame dropped"):
+        assert tracker.update(frame, [[500, 500, 10, 10]]) == []
     with pytest.raises(ValueError, match="width or height <= 0"):
         tracker.update(frame, [[5, 5, 0, 10]])
     with pytest.raises(ValueError, match=r"shape \(K, 4\) or \(K, 5\)"):

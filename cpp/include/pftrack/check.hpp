@@ -28,6 +28,20 @@ inline void require(bool ok, const char* fn, const std::string& message) {
     if (!ok) fail(fn, message);
 }
 
+/// Largest array one call may allocate, in elements (2^28 doubles: 2 GiB). Sizes computed from
+/// the arguments are checked against it before allocation, so an absurd size is refused with a
+/// message instead of ending in std::bad_alloc (MemoryError) or an out-of-memory kill.
+constexpr double kMaxElements = 268435456.0;
+
+/// `count` (computed in double, so products cannot overflow) within kMaxElements.
+inline void require_size(double count, const char* fn, const std::string& what) {
+    if (count <= kMaxElements) return;
+    std::ostringstream s;
+    s << what << " needs " << count << " values, more than the limit of " << kMaxElements
+      << " (2 GiB); use a smaller size";
+    fail(fn, s.str());
+}
+
 /// Every entry finite; the message gives the first bad position.
 template <class Derived>
 inline void require_finite(const Eigen::DenseBase<Derived>& a, const char* fn, const char* what) {

@@ -69,15 +69,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         set_quiet(True)
     try:
         return int(args.func(args))
-    except KeyboardInterrupt:  # Ctrl-C: outputs are written atomically, so none is half-written
-        print(f"\npftrack {args.command}: interrupted", file=sys.stderr)
-        return 130
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
     except (OSError, ValueError, TypeError) as exc:  # OSError: missing, unwritable, full disk
         print(f"pftrack {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print(f"pftrack {args.command}: error: out of memory", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:  # outputs are atomic: nothing half-written is left behind
+        print(f"\npftrack {args.command}: interrupted; no output was changed", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

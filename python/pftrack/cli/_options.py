@@ -56,10 +56,36 @@ def positive_float(text: str) -> float:
     return v
 
 
+def bounded_int(lo: int, hi: int) -> Any:
+    """Argument type: an integer in [lo, hi] (absurd sizes are refused, not tried)."""
+
+    def parse(text: str) -> int:
+        v = int(text)
+        if not lo <= v <= hi:
+            raise argparse.ArgumentTypeError(f"expected an integer in [{lo}, {hi}], got {v}")
+        return v
+
+    parse.__name__ = "int"  # argparse names the type in its messages
+    return parse
+
+
+def bounded_float(lo: float, hi: float) -> Any:
+    """Argument type: a number in [lo, hi]."""
+
+    def parse(text: str) -> float:
+        v = float(text)
+        if not lo <= v <= hi:
+            raise argparse.ArgumentTypeError(f"expected a number in [{lo:g}, {hi:g}], got {v:g}")
+        return v
+
+    parse.__name__ = "float"
+    return parse
+
+
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
     """The tracker's options, shared by ``track`` (and any command that tracks)."""
-    p.add_argument("--particles", type=positive_int, default=100, metavar="N",
-                   help="particles per object")  # fmt: skip
+    p.add_argument("--particles", type=bounded_int(1, 100_000), default=100, metavar="N",
+                   help="particles per object (1 to 100000)")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed, same tracks")
     p.add_argument(
         "--detector", choices=("paper", "mog2", "knn"), default="paper",
@@ -88,7 +114,7 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "once it moves, moves the tracks with it and stops using the background model (a still "
         "camera tracks exactly as with off); on: treat the camera as always moving",
     )  # fmt: skip
-    p.add_argument("--max-coast", type=int, default=10, metavar="FRAMES",
+    p.add_argument("--max-coast", type=bounded_int(0, 100_000), default=10, metavar="FRAMES",
                    help="frames a track survives on its particle filter alone (0.4 s at 25 "
                    "frames/s: pftrack.Tracker's max_coast is in seconds)")  # fmt: skip
     p.add_argument(

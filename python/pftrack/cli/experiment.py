@@ -113,7 +113,7 @@ def run_gaps(args: argparse.Namespace) -> int:
 
     inputs = tuple(args.gt)
     if args.json:
-        check_output(args.json, what="--json", inputs=inputs)
+        check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.figure:
         check_output(args.figure, what="--figure", suffixes=(".png", ".jpg"), inputs=inputs)
     if len(args.gt) > 1 or args.auto_masks:

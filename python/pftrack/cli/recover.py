@@ -58,16 +58,17 @@ def run(args: argparse.Namespace) -> int:
 
     check_output(args.out, what="--out")
     src = Path(args.tracks)
+    out = Path(args.out)
+    if out.exists() and src.exists() and os.path.samefile(out, src) and not args.in_place:
+        raise ValueError(
+            f"--out {out} is the input file; pass --in-place to replace it (atomically)"
+        )
+    check_output(out, what="--out", inputs=(args.video,) if args.video else ())
     rows = read_mot(src, what="tracks file")
     try:
         check_unique(rows)
     except ValueError:  # name the lines (reading the file again costs time: only on error)
         check_unique(rows, data_line_numbers(src))
-    out = Path(args.out)
-    if out.exists() and os.path.samefile(out, src) and not args.in_place:
-        raise ValueError(
-            f"--out {out} is the input file; pass --in-place to replace it (atomically)"
-        )
     n_links = 0
     if args.link:
         frames = None

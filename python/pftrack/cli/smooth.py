@@ -48,9 +48,10 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.recovery import LinkConfig, check_unique
     from pftrack.tracking import smooth_tracks
 
-    src, out = Path(args.tracks), check_output(args.out, what="--out")
-    if out.exists() and os.path.samefile(out, src):
+    src, out = Path(args.tracks), Path(args.out)
+    if out.exists() and src.exists() and os.path.samefile(out, src):
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
+    check_output(out, what="--out")
     rows = read_mot(src, what="tracks file")
     check_unique(rows, data_line_numbers(src))
     link = None if args.no_link else LinkConfig(max_gap=args.max_gap)

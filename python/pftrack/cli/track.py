@@ -9,7 +9,13 @@ import warnings
 from pathlib import Path
 from typing import IO, Any
 
-from pftrack.cli._options import add_command, add_tracker_options, positive_float, tracker_config
+from pftrack.cli._options import (
+    add_command,
+    add_tracker_options,
+    bounded_float,
+    positive_float,
+    tracker_config,
+)
 
 
 def add_parser(sub: Any) -> None:
@@ -43,7 +49,7 @@ def add_parser(sub: Any) -> None:
         "sequence's det/det.txt (default: the built-in detector)",
     )  # fmt: skip
     p.add_argument(
-        "--det-scale", type=positive_float, metavar="S",
+        "--det-scale", type=bounded_float(1e-3, 1e3), metavar="S",
         help="multiply detection boxes by S to reach the video's pixels (0.625 for PETS09 "
         "det.txt on its 480x360 video) (default: for the sequence's own detections, the frame "
         "width over seqinfo.ini's imWidth; else 1)",
@@ -121,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from pftrack.io.atomic import check_output
+    from pftrack.io.atomic import check_output, staged_outputs
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, is_live_source
     from pftrack.io.video_writer import VIDEO_SUFFIXES
@@ -140,58 +146,64 @@ def run(args: argparse.Namespace) -> int:
     source = FrameSource(args.source, fps=args.fps)
     renderer: TrackRenderer | None = None
     try:
-        det_path = _resolve_detections(args, source)
-        dets = load_detections(det_path, _det_scale(args, source, det_path)) if det_path else None
-        renderer = TrackRenderer(args.render, source.fps) if args.render else None
-        first: list[Any] = []
-        stream: IO[str] | None = None
-
-        def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
-            if n == 1:
-                first.append(frame)
-            if renderer is not None:
-                renderer.add(frame, tracks)
-            if stream is not None:
-                for r in rows:
-                    stream.write(format_mot_row(r) + "\n")
-                stream.flush()
-
-        with contextlib.ExitStack() as stack:
-            if live:  # --out grows while tracking; replaced by the finished tracks below
-                stream = stack.enter_context(open(args.out, "w", encoding="utf-8"))  # noqa: SIM115
-                stack.enter_context(_StopOnCtrlC(source))
-            caught = stack.enter_context(warnings.catch_warnings(record=True))
-            warnings.simplefilter("always")
-            result = track_frames(
-                source,
-                detections=dets,
-                config=tracker_config(args),
-                rng=args.seed,
-                fill=args.fill,
-                bootstrap=args.bootstrap,
-                smoother=None if args.no_smooth else BoxSmoother(),
-                link=None if args.no_link else LinkConfig(),
-                on_frame=on_frame,
+        with staged_outputs() as stage:  # every output replaced at the end, or none
+            det_path = _resolve_detections(args, source)
+            dets = (
+                load_detections(det_path, _det_scale(args, source, det_path)) if det_path else None
             )
-        for w in caught:  # clipped boxes, a run without any track: said, not fatal
-            print(f"pftrack track: warning: {w.message}", file=sys.stderr)
-        write_mot(args.out, result.rows)
-        n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
-        stopped = " (stopped by Ctrl-C)" if source.stopped else ""
-        print(
-            f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
-            f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> {args.out}"
-        )
-        if renderer is not None:
-            renderer.close()
+            renderer = TrackRenderer(stage(args.render), source.fps) if args.render else None
+            first: list[Any] = []
+            stream: IO[str] | None = None
+
+            def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
+                if n == 1:
+                    first.append(frame)
+                if renderer is not None:
+                    renderer.add(frame, tracks)
+                if stream is not None:
+                    for r in rows:
+                        stream.write(format_mot_row(r) + "\n")
+                    stream.flush()
+
+            with contextlib.ExitStack() as stack:
+                if live:  # --out grows while tracking; replaced by the finished tracks below
+                    stream = stack.enter_context(open(args.out, "w", encoding="utf-8"))  # noqa: SIM115
+                    stack.enter_context(_StopOnCtrlC(source))
+                caught = stack.enter_context(warnings.catch_warnings(record=True))
+                warnings.simplefilter("always")
+                result = track_frames(
+                    source,
+                    detections=dets,
+                    config=tracker_config(args),
+                    rng=args.seed,
+                    fill=args.fill,
+                    bootstrap=args.bootstrap,
+                    smoother=None if args.no_smooth else BoxSmoother(),
+                    link=None if args.no_link else LinkConfig(),
+                    on_frame=on_frame,
+                )
+            for w in caught:  # clipped boxes, a run without any track: said, not fatal
+                print(f"pftrack track: warning: {w.message}", file=sys.stderr)
+            write_mot(stage(args.out), result.rows)
+            n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
+            stopped = " (stopped by Ctrl-C)" if source.stopped else ""
             print(
-                f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
-                f"{source.fps_origin}) -> {args.render}"
+                f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
+                f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> "
+                f"{args.out}"
             )
-        if args.plot:
-            name = source.sequence.name if source.sequence is not None else Path(args.source).name
-            plot_trajectories(args.plot, result.rows, background=first[0], title=name)
-            print(f"trajectory plot -> {args.plot}")
+            if renderer is not None:
+                renderer.close()
+                print(
+                    f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
+                    f"{source.fps_origin}) -> {args.render}"
+                )
+            if args.plot:
+                name = (
+                    source.sequence.name if source.sequence is not None else Path(args.source).name
+                )
+                plot_trajectories(stage(args.plot), result.rows, background=first[0], title=name)
+                print(f"trajectory plot -> {args.plot}")
     except BaseException:
         if renderer is not None:
             renderer.abort()  # no half-written video (a finished one stays)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -158,8 +159,12 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
     Raises
     ------
     ValueError
-        Wrong shape, NaN or inf, a box with no area, or one wholly outside the frame (usually
-        a wrong coordinate scale).
+        Wrong shape, NaN or inf, or a box with no area.
+
+    Warns
+    -----
+    UserWarning
+        Boxes wholly outside the frame (usually a wrong coordinate scale) are dropped.
     """
     d = np.asarray(detections, dtype=np.float64)
     if d.size == 0:
@@ -177,12 +182,16 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
     outside = (
         (d[:, 0] >= cols) | (d[:, 1] >= rows) | (d[:, 0] + d[:, 2] <= 0) | (d[:, 1] + d[:, 3] <= 0)
     )
-    if np.any(outside):
+    if np.any(outside):  # nothing to track there: dropped, and said so once per call site
         k = int(np.flatnonzero(outside)[0])
-        raise ValueError(
-            f"detection {k} {d[k, :4].tolist()} lies outside the {cols}x{rows} frame "
-            "(wrong coordinate scale? PETS boxes need --det-scale 0.625)"
+        warnings.warn(
+            f"{int(outside.sum())} detection(s) wholly outside the {cols}x{rows} frame dropped, "
+            f"e.g. {d[k, :4].tolist()} (wrong coordinate scale? PETS boxes need "
+            "--det-scale 0.625)",
+            UserWarning,
+            stacklevel=3,
         )
+        d = d[~outside]
     scores = d[:, 4] if d.shape[1] == 5 else np.ones(len(d))
     return d[:, :4].copy(), scores.copy()
 

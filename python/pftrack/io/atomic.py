@@ -9,7 +9,7 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
@@ -113,7 +113,8 @@ def check_output(
     FileNotFoundError
         Its folder does not exist.
     PermissionError
-        Its folder (or the existing file) is not writable.
+        Its folder (or the existing file) is not writable: checked by creating (and removing)
+        a file beside it.
     """
     target = Path(path)
     if suffixes is not None and target.suffix.lower() not in suffixes:
@@ -130,9 +131,56 @@ def check_output(
         target.exists() and not os.access(target, os.W_OK)
     ):
         raise PermissionError(f"{what} {target}: not writable")
+    try:  # access() says yes to root on a read-only or special file system: try it
+        fd, probe = _create_beside(folder, f".{target.name}.", ".probe")
+    except OSError as exc:
+        raise PermissionError(
+            f"{what} {target}: folder {folder} is not writable ({exc.strerror or exc})"
+        ) from None
+    os.close(fd)
+    os.unlink(probe)
     for source in inputs:
         if target.exists() and Path(source).exists() and os.path.samefile(target, source):
             raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
         if target.resolve() == Path(source).resolve():
             raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
     return target
+
+
+@contextlib.contextmanager
+def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
+    """Several outputs of one run, all replaced at the end or none at all.
+
+    Yields ``stage(path) -> Path``: a temporary path beside `path`, with its extension, for a
+    writer to fill. When the block ends normally every staged file is renamed over its target;
+    when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
+    target is left as it was, so an interrupted run never leaves a new tracks file beside an old
+    video, or a half-written file anywhere.
+
+    Examples
+    --------
+    >>> with staged_outputs() as stage:  # doctest: +SKIP
+    ...     write_mot(stage("tracks.txt"), rows)
+    ...     write_annotated_video(stage("video.mp4"), frames, rows)
+    """
+    staged: list[tuple[str, Path]] = []
+
+    def stage(path: PathLike) -> Path:
+        target = Path(path)
+        folder = target.parent if str(target.parent) else Path(".")
+        if not folder.is_dir():
+            raise FileNotFoundError(f"output folder does not exist: {folder}")
+        fd, tmp = _create_beside(folder, f".{target.stem}.", target.suffix or ".tmp")
+        os.close(fd)
+        staged.append((tmp, target))
+        return Path(tmp)
+
+    try:
+        yield stage
+        for tmp, target in staged:
+            os.replace(tmp, target)
+    except BaseException:
+        for tmp, _ in staged:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        raise

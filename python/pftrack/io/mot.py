@@ -138,13 +138,22 @@ def format_mot_row(row: Iterable[float]) -> str:
 def write_mot(path: PathLike, rows: NDArray[np.float64] | Iterable[Iterable[float]]) -> None:
     """Write rows (M, 6..10) as a MOTChallenge file, atomically, sorted by (frame, id).
 
-    Columns beyond those given get the defaults ``conf=1, x=y=z=-1``.
+    Columns beyond those given get the defaults ``conf=1, x=y=z=-1``. Every value must be
+    finite and frames and ids integers (a ValueError names the first bad row otherwise).
     """
     a = np.asarray(rows, dtype=np.float64)
     if a.size == 0:
         a = np.zeros((0, 10))
     if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
         raise ValueError(f"write_mot: rows must have shape (M, 6..10), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        k = int(np.flatnonzero(~np.all(np.isfinite(a), axis=1))[0])
+        raise ValueError(f"write_mot: row {k} has NaN or inf: {a[k].tolist()}")
+    ids = a[:, :2]
+    if np.any(ids != np.round(ids)) or np.any(np.abs(ids) > 2**53):
+        k = int(np.flatnonzero(np.any((ids != np.round(ids)) | (np.abs(ids) > 2**53), axis=1))[0])
+        raise ValueError(f"write_mot: row {k} has a frame or id that is not an integer: "
+                         f"{a[k, :2].tolist()}")  # fmt: skip
     if a.shape[1] < 10:
         pad = np.tile(np.asarray(_DEFAULTS[a.shape[1] :]), (a.shape[0], 1))
         a = np.hstack([a, pad])

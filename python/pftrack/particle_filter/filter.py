@@ -16,6 +16,10 @@ from pftrack.particle_filter.dynamics import Ar2Model
 __all__ = ["ColourParticleFilter", "FilterConfig", "FilterState", "step_filters"]
 
 
+MAX_PARTICLES = 1_000_000
+"""Most particles one object's filter may have (48 MB of state; more is refused, not tried)."""
+
+
 @dataclass(frozen=True)
 class FilterConfig:
     """Configuration of a :class:`ColourParticleFilter`.
@@ -41,8 +45,14 @@ class FilterConfig:
     estimate: str = "mean"
 
     def __post_init__(self) -> None:
-        if not isinstance(self.n_particles, (int, np.integer)) or self.n_particles < 1:
-            raise ValueError(f"n_particles is {self.n_particles!r}, expected an integer >= 1")
+        if (
+            not isinstance(self.n_particles, (int, np.integer))
+            or isinstance(self.n_particles, bool)
+            or not 1 <= self.n_particles <= MAX_PARTICLES
+        ):
+            raise ValueError(
+                f"n_particles is {self.n_particles!r}, expected an integer in [1, {MAX_PARTICLES}]"
+            )
         if not (np.isfinite(self.lam) and self.lam >= 0):
             raise ValueError(f"lam is {self.lam}, expected a finite value >= 0")
         if self.kernel not in ("uniform", "epanechnikov"):

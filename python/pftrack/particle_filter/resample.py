@@ -25,6 +25,8 @@ def _weights(weights: ArrayLike) -> NDArray[np.float64]:
     w = np.asarray(weights)
     if w.dtype == object or not (np.issubdtype(w.dtype, np.number) or w.dtype == bool):
         raise TypeError(f"weights must be numeric, got dtype {w.dtype}")
+    if np.iscomplexobj(w):
+        raise TypeError(f"weights must be real, got dtype {w.dtype}")
     if w.ndim != 1:
         raise ValueError(f"weights must be 1-D (N,), got shape {w.shape}")
     return np.ascontiguousarray(w, dtype=np.float64)

@@ -69,6 +69,20 @@ class LinkConfig:
     w_appearance: float = 1.0
     velocity_points: int = 5
 
+    def __post_init__(self) -> None:
+        for name, hi in (("max_gap", 100_000), ("velocity_points", 1_000)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 1 <= v <= hi:
+                raise ValueError(f"LinkConfig.{name} is {v!r}, expected an int in 1..{hi}")
+        for name in ("max_distance", "w_gap", "w_size", "w_appearance"):
+            v = getattr(self, name)
+            ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
+            if not ok or not np.isfinite(v) or v < 0 or (name == "max_distance" and v == 0):
+                raise ValueError(
+                    f"LinkConfig.{name} is {v!r}, expected a finite number "
+                    + ("> 0" if name == "max_distance" else ">= 0")
+                )
+
 
 def box_centres(rows: F64) -> F64:
     """Rows ``(frame, cx, cy)`` of the box centres of MOTChallenge rows."""
@@ -191,7 +205,7 @@ def link_tracklets(
     """
     from scipy.optimize import linear_sum_assignment
 
-    rows = np.array(tracks, dtype=np.float64, copy=True)
+    rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
     if len(rows) == 0:
         return rows, {}
     per_id = split_tracks(rows)
@@ -227,10 +241,10 @@ def check_rows(rows: object, what: str) -> F64:
         raise TypeError(f"{what}: rows must be a real (M, 10) array, got dtype {raw.dtype}")
     a = raw.astype(np.float64)
     if a.ndim != 2 or a.shape[1] != 10:
-        raise ValueError(f"{what}: rows must have shape (M, 10), got {a.shape}")
+        raise ValueError(f"{what}: rows must have shape (M, 10) (10 columns), got {a.shape}")
     f, i = a[:, 0], a[:, 1]
     if not np.all(np.isfinite(a[:, :6])):
-        raise ValueError(f"{what}: frame, id and box columns must be finite")
+        raise ValueError(f"{what}: frame, id and box columns must be finite (NaN or inf found)")
     bad = (f < 1) | (f > MAX_FRAME) | (f != np.floor(f))
     if bad.any():
         raise ValueError(

@@ -1,0 +1,52 @@
+"""The bindings refuse absurd sizes before allocating, and results that are not finite."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pftrack import _core
+
+I2 = np.eye(2)
+PROBLEM = (I2, I2, I2, I2, np.zeros(2), I2, np.ones(2))
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: _core.counter_normals(0, 0, 2**62),
+        lambda: _core.counter_uniforms(0, 0, 0, 2**62),
+        lambda: _core.gdt_solve(*PROBLEM, 2**30),
+        lambda: _core.gdt_sample(*PROBLEM, 100, 2**30, 0),
+    ],
+    ids=["counter_normals", "counter_uniforms", "gdt_solve", "gdt_sample"],
+)
+def test_huge_sizes_are_refused_not_allocated(call) -> None:
+    with pytest.raises(ValueError, match="more than the limit"):
+        call()
+
+
+@pytest.mark.parametrize("scale, T", [(1.5, 2000), (5.0, 500), (1e200, 3)])
+def test_an_unstable_model_is_an_error_not_a_nan_path(scale: float, T: int) -> None:
+    A = scale * I2
+    with pytest.raises(ValueError, match="not finite: A is unstable"):
+        _core.gdt_solve(A, *PROBLEM[1:], T)
+    with pytest.raises(ValueError, match="not finite: A is unstable"):
+        _core.gdt_sample(A, *PROBLEM[1:], T, 2, 0)
+    with pytest.raises(ValueError, match="not finite: A is unstable"):
+        _core.gdt_solve_batch([(A, *PROBLEM[1:], T)])
+
+
+def test_a_stable_long_gap_is_still_solved() -> None:
+    F = np.array([[1.0, 1.0], [0.0, 1.0]])  # constant velocity: polynomial growth only
+    out = _core.gdt_solve(F, 0.01 * I2, np.eye(1, 2), np.eye(1), np.zeros(2), I2, np.ones(1), 2000)
+    assert out["path"].shape == (2001, 2) and np.all(np.isfinite(out["path"]))
+
+
+def test_batch_items_of_the_wrong_kind_are_type_and_value_errors() -> None:
+    with pytest.raises(TypeError, match="T must be an int, got float"):
+        _core.gdt_solve_batch([(*PROBLEM, 3.0)])
+    with pytest.raises(ValueError, match="problem 0 must be a tuple"):
+        _core.gdt_solve_batch([[1]])
+    with pytest.raises((TypeError, ValueError), match="not an array of numbers|convert string"):
+        _core.gdt_solve_batch([("abc", *PROBLEM[1:], 3)])

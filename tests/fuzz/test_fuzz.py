@@ -1,0 +1,62 @@
+"""Fuzz every public function of ``pftrack._core`` and the main Python API.
+
+The default run tries a short profile (a few dozen examples per target); ``pytest -m slow``
+runs the long one, at least 10 000 examples in all (CI runs it: see .ci/run).
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tests.fuzz.harness import Target, check_call
+from tests.fuzz.targets_api import TARGETS as API_TARGETS
+from tests.fuzz.targets_core import TARGETS as CORE_TARGETS
+
+TARGETS = CORE_TARGETS + API_TARGETS
+LONG_TOTAL = 10_000  # examples over the targets without a known failure, in the slow run
+LONG_EACH = math.ceil(LONG_TOTAL / sum(not t.known for t in TARGETS))
+
+
+def _params(strict: bool) -> list[object]:
+    """One parameter per target; a known failure is an xfail with its reason. Not strict: a
+    short run need not draw the failing input (tests/fuzz/test_known_failures.py pins each
+    one, strictly)."""
+    return [
+        pytest.param(
+            t,
+            id=t.name,
+            marks=[pytest.mark.xfail(strict=strict, reason=t.known)] if t.known else [],
+        )  # fmt: skip
+        for t in TARGETS
+    ]
+
+
+def _run(target: Target, data: st.DataObject) -> None:
+    fn, args, kwargs = data.draw(target.calls, label="call")
+    check_call(fn, args, kwargs, finite=target.finite)
+
+
+@pytest.mark.parametrize("target", _params(strict=False))
+@settings(settings.get_profile("fuzz-short"))
+@given(data=st.data())
+def test_fuzz_short(target: Target, data: st.DataObject) -> None:
+    _run(target, data)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("target", _params(strict=False))
+@settings(settings.get_profile("fuzz-short"), max_examples=LONG_EACH, derandomize=False)
+@given(data=st.data())
+def test_fuzz_long(target: Target, data: st.DataObject) -> None:
+    _run(target, data)
+
+
+def test_every_core_function_is_fuzzed() -> None:
+    from pftrack import _core
+
+    public = {n for n in dir(_core) if not n.startswith("_")}
+    assert public <= {t.name for t in CORE_TARGETS}, public - {t.name for t in CORE_TARGETS}
