@@ -33,8 +33,12 @@ std::vector<MatrixXd> matrix_stack(const Array& a, const char* fn, const char* w
         out.emplace_back(Eigen::Map<const RowMatrixXd>(a.data(), a.shape(0), a.shape(1)));
     } else if (a.ndim() == 3) {
         require(a.shape(0) > 0, fn, std::string(what) + " stack is empty");
+        // C-contiguous (Array is c_style): matrix k starts k * rows * cols values in, which is
+        // also right when a side is 0 (a.data(k, 0, 0) would raise IndexError there)
+        const auto* base = static_cast<const double*>(a.data());
+        const py::ssize_t step = a.shape(1) * a.shape(2);
         for (py::ssize_t k = 0; k < a.shape(0); ++k)
-            out.emplace_back(Eigen::Map<const RowMatrixXd>(a.data(k, 0, 0), a.shape(1), a.shape(2)));
+            out.emplace_back(Eigen::Map<const RowMatrixXd>(base + k * step, a.shape(1), a.shape(2)));
     } else {
         fail(fn, std::string(what) + " must be (n, n) or (T, n, n), got ndim " +
                      std::to_string(a.ndim()));

@@ -206,6 +206,7 @@ def link_tracklets(
     from scipy.optimize import linear_sum_assignment
 
     rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
+    check_unique(rows)  # a track seen twice in one frame has no velocity to link with
     if len(rows) == 0:
         return rows, {}
     per_id = split_tracks(rows)

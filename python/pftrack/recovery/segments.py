@@ -33,10 +33,15 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
 
     Raises
     ------
+    TypeError
+        Values that are not real numbers (complex, text, objects).
     ValueError
         Wrong shape, no row, a non-finite value or frames that do not increase strictly.
     """
-    a = np.asarray(seg, dtype=np.float64)
+    raw = np.asarray(seg)
+    if raw.dtype.kind not in "biuf":
+        raise TypeError(f"recover_gap: {name} must hold real numbers, got dtype {raw.dtype}")
+    a = raw.astype(np.float64)
     if a.ndim != 2 or a.shape[1] not in (3, 5):
         raise ValueError(f"recover_gap: {name} must have shape (k, 3) or (k, 5), got {a.shape}")
     if a.shape[0] == 0:
