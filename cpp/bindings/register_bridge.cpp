@@ -94,8 +94,13 @@ GdtProblem batch_problem(const py::handle& h, std::size_t k) {
                              std::string(py::str(py::type::of(t[7]).attr("__name__"))));
     std::vector<Array> a;
     for (int i = 0; i < 7; ++i) {
+        const py::object item = t[static_cast<std::size_t>(i)];
+        const py::array probe = py::array::ensure(item);
+        if (PyComplex_Check(item.ptr()) || (probe && probe.dtype().kind() == 'c'))
+            throw py::type_error(std::string(fn) + ": problem " + std::to_string(k) + ": item " +
+                                 std::to_string(i) + " is complex, expected real numbers");
         try {
-            a.push_back(t[static_cast<std::size_t>(i)].cast<Array>());
+            a.push_back(item.cast<Array>());
         } catch (const py::cast_error&) {
             throw py::type_error(std::string(fn) + ": problem " + std::to_string(k) + ": item " +
                                  std::to_string(i) + " is not an array of numbers");
@@ -208,11 +213,16 @@ void register_bridge(py::module_& m) {
             const MatrixXd a = matrix2(A, fn, "A"), q = matrix2(Q, fn, "Q"), h = matrix2(H, fn, "H"),
                            r = matrix2(R, fn, "R"), p0 = matrix2(P_init, fn, "P_init");
             const VectorXd m0 = vector1(m_init, fn, "m_init");
+            require_finite(zz, fn, "z");
+            require_finite(m0, fn, "m_init");
+            require_finite(p0, fn, "P_init");
             KalmanEstimate e;
             {
                 py::gil_scoped_release nogil;  // safe: C++ copies of the inputs only
                 e = kalman_filter(zz, a, q, h, r, m0, p0);
             }
+            require_finite_result(e.m, fn);
+            require_finite_result(e.P, fn);
             return py::make_tuple(e.m, e.P);
         },
         py::arg("z"), py::arg("A"), py::arg("Q"), py::arg("H"), py::arg("R"), py::arg("m_init"),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import tempfile
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -97,8 +98,11 @@ def _tracker(frames: list[Any], dets: list[Any], particles: Any) -> Any:
     tracker = MultiObjectTracker(replace(base, filter=replace(base.filter, n_particles=particles)),
                                  rng=0)  # fmt: skip
     out = []
-    for f, d in zip(frames, dets, strict=False):
-        out.append([t.box_xywh.tolist() for t in tracker.update(f, d)])
+    with warnings.catch_warnings():
+        # boxes outside the frame are dropped with a warning by design (tested elsewhere)
+        warnings.filterwarnings("ignore", message=r".*outside the .* frame", category=UserWarning)
+        for f, d in zip(frames, dets, strict=False):
+            out.append([t.box_xywh.tolist() for t in tracker.update(f, d)])
     return out
 
 

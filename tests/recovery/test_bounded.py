@@ -81,7 +81,7 @@ def test_default_max_gap_everywhere() -> None:
         (1e12, "frame 1e\\+12 is not an integer"),
         (2.5, "frame 2.5 is not an integer"),
         (0, "frame 0 is not an integer"),
-        (np.nan, "must be finite"),
+        (np.nan, "non-finite"),
     ],
 )
 def test_absurd_frames_refused(bad: float, match: str) -> None:

@@ -234,8 +234,8 @@ def link_tracklets(
 def check_rows(rows: object, what: str) -> F64:
     """The rows as an ``(M, 10)`` float64 array, checked; ValueError/TypeError naming the problem.
 
-    Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, and the
-    box columns (``left, top, width, height``) finite. `what` names the caller in messages.
+    Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, and every
+    value finite. `what` names the caller in messages.
     """
     raw = np.asarray(rows)
     if raw.dtype.kind not in "biuf":
@@ -244,8 +244,11 @@ def check_rows(rows: object, what: str) -> F64:
     if a.ndim != 2 or a.shape[1] != 10:
         raise ValueError(f"{what}: rows must have shape (M, 10) (10 columns), got {a.shape}")
     f, i = a[:, 0], a[:, 1]
-    if not np.all(np.isfinite(a[:, :6])):
-        raise ValueError(f"{what}: frame, id and box columns must be finite (NaN or inf found)")
+    finite = np.isfinite(a)
+    if not finite.all():
+        r, c = np.argwhere(~finite)[0]
+        names = ("frame", "id", "left", "top", "width", "height", "conf", "x", "y", "z")
+        raise ValueError(f"{what}: row {r} has a non-finite {names[c]} ({a[r, c]}): NaN or inf")
     bad = (f < 1) | (f > MAX_FRAME) | (f != np.floor(f))
     if bad.any():
         raise ValueError(
