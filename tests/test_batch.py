@@ -34,7 +34,7 @@ from pftrack.batch import (
     track_many,
 )
 from pftrack.cli import main
-from pftrack.eval import evaluate_mot
+from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
@@ -151,8 +151,11 @@ def test_cluster_equals_serial_and_pftrack_track(data: Path, client: Any, tmp_pa
     # the summary's metrics are pftrack.eval's on the written file
     entry = next(e for e in on_dask.entries if e["name"] == "MOT-01")
     gt = read_mot(data / "MOT-01" / "gt" / "gt.txt")
-    m = evaluate_mot(gt, read_mot(tmp_path / "dask" / "MOT-01.txt"))
+    s = evaluate_sequence(gt, read_mot(tmp_path / "dask" / "MOT-01.txt"))
+    m, h = s.mot, s.hota
     assert entry["metrics"]["mota"] == m.mota and entry["metrics"]["idf1"] == m.idf1
+    assert entry["metrics"]["hota"] == h.hota and entry["metrics"]["ass_a"] == h.ass_a_mean
+    assert 0.0 < h.hota < 1.0 and "HOTA%" in on_dask.table()
     assert entry["frames"] == 30 and entry["tracks"] == len(np.unique(read_mot(single)[:, 1]))
     written = json.loads((tmp_path / "dask" / "summary.json").read_text())
     assert [s["name"] for s in written["sequences"]] == ["MOT-01", "plain", "walk"]
@@ -430,5 +433,24 @@ def test_pets_detections_and_truth_are_scaled_from_seqinfo(client: Any, tmp_path
     argv = ["track", str(pets / "video.avi"), "--detections", str(pets / "det.txt")]
     assert main([*argv, "--det-scale", "0.625", "--out", str(single)]) == 0
     assert single.read_bytes() == (tmp_path / "pets09-s2l1.txt").read_bytes()
-    m = evaluate_mot(read_mot(pets / "gt.txt"), read_mot(single), scale=0.625)
-    assert entry["metrics"]["mota"] == m.mota and entry["metrics"]["idf1"] == m.idf1
+    s = evaluate_sequence(read_mot(pets / "gt.txt"), read_mot(single), scale=0.625)
+    assert entry["metrics"]["mota"] == s.mot.mota and entry["metrics"]["idf1"] == s.mot.idf1
+    assert entry["metrics"]["hota"] == s.hota.hota and entry["metrics"]["benchmark"] == "MOT15"
+
+
+def test_a_sequences_warnings_come_back_to_the_summary(
+    client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # three frames of one small walker: no track is confirmed, and the tracker warns so
+    scene = make_scene(n_frames=3, width=64, height=64, n_walkers=1, rng=0)
+    scene.write_images(tmp_path / "in" / "short")
+    out = tmp_path / "out"
+    assert main(["batch", str(tmp_path / "in"), "--out", str(out),
+                 "--scheduler", client.scheduler.address, *FAST]) == 0  # fmt: skip
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["status"] == "done"
+    assert len(entry["warnings"]) == 1 and entry["warnings"][0].startswith("no track over 3")
+    assert f"short: warning: {entry['warnings'][0]}" in capsys.readouterr().out
+    # in this process too, whatever the warning filters say (pytest makes them errors here)
+    serial = track_many(tmp_path / "in", tmp_path / "serial", n_workers=0)
+    assert serial.entries[0]["warnings"] == entry["warnings"]

@@ -12,12 +12,14 @@ point leaves each output either complete or absent; a re-run skips the complete 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import logging
 import math
 import os
 import time
 import traceback
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -151,6 +153,8 @@ class BatchSummary:
             where += f" at {self.scheduler}"
         noun = "sequence" if self.kind == "track" else "file"
         text.append(f"{_count(len(self.entries), noun)}: {counts}; {self.seconds:.1f} s, {where}")
+        for e in self.entries:
+            text.extend(f"{e['name']}: warning: {w}" for w in e.get("warnings", ()))
         for e in self.failed:
             text.append(f"{e['name']}: error: {e['error']}")
         return "\n".join(text)
@@ -177,9 +181,9 @@ _COLUMNS: dict[str, list[tuple[str, str, Callable[[Any], str]]]] = {
         ("frames", "frames", _int),
         ("tracks", "tracks", _int),
         ("frames/s", "fps", lambda v: f"{v:.0f}"),
+        ("HOTA%", "metrics.hota", _pct),
         ("MOTA%", "metrics.mota", _pct),
         ("IDF1%", "metrics.idf1", _pct),
-        # HOTA%: add ("HOTA%", "metrics.hota", _pct) once sequence_metrics returns it.
         ("IDsw", "metrics.id_switches", _int),
     ],
     "recover": [
@@ -334,11 +338,20 @@ def call_task(
 
     So a failing input is reported in the summary without Dask logging it as a failed
     computation on the worker; a worker that dies still fails the future (``KilledWorker``).
+    Warnings the task raises (no track found, boxes out of the frame, ...) would stay in a
+    worker's log: they come back in the result's ``info["warnings"]``, one line each, in order,
+    each once.
     """
-    try:
-        return func(*args), None, None
-    except Exception as exc:  # noqa: BLE001 - reported per task
-        return None, _one_line(exc), traceback.format_exc()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            result = func(*args)
+        except Exception as exc:  # noqa: BLE001 - reported per task
+            return None, _one_line(exc), traceback.format_exc()
+    said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
+    if said:
+        result = dataclasses.replace(result, info={**result.info, "warnings": said})
+    return result, None, None
 
 
 def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) -> None:

@@ -116,22 +116,29 @@ class TrackOptions:
 
 def sequence_metrics(
     gt: F64, rows: F64, *, scale: float = 1.0, iou: float = 0.5
-) -> dict[str, float | int | None]:
+) -> dict[str, float | int | str | None]:
     """The figures of one sequence's tracks against its ground truth, for the summary.
 
-    MOTA, IDF1 and their counts from :func:`pftrack.eval.evaluate_mot`. HOTA goes here too
-    once :mod:`pftrack.eval` has it (one more key): the table and JSON show every key.
+    HOTA, DetA, AssA and LocA (TrackEval's, with the benchmark guessed from `gt`'s columns),
+    then MOTA, IDF1 and their counts: :func:`pftrack.eval.evaluate_sequence`, what
+    ``pftrack eval`` prints for the same files.
     """
-    from pftrack.eval import evaluate_mot
+    from pftrack.eval import evaluate_sequence
 
-    m = evaluate_mot(gt, rows, iou_threshold=iou, scale=scale)
-    out: dict[str, float | int | None] = {
+    s = evaluate_sequence(gt, rows, iou_threshold=iou, scale=scale)
+    m, h = s.mot, s.hota
+    out: dict[str, float | int | str | None] = {
+        "hota": h.hota,
+        "det_a": h.det_a,
+        "ass_a": h.ass_a_mean,
+        "loc_a": h.loc_a_mean,
         "mota": m.mota,
         "idf1": m.idf1,
         "motp_iou": m.motp_iou,
         "id_switches": m.num_switches,
         "false_positives": m.false_positives,
         "misses": m.misses,
+        "benchmark": s.benchmark,
     }
     return {k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in out.items()}
 

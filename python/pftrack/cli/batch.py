@@ -71,7 +71,8 @@ def add_parser(sub: Any) -> None:
         "them), one Dask task per sequence. Writes DIR/NAME.txt exactly as pftrack track "
         "does (NAME: the video's stem or the sequence folder's name), NAME.json beside it, "
         "and DIR/summary.json; prints frames, tracks, frames/s and, where gt/gt.txt exists, "
-        "MOTA and IDF1 per sequence. Workers read the inputs by these paths; this process "
+        "HOTA, MOTA and IDF1 per sequence (pftrack eval's figures), and the warnings each "
+        "sequence raised. Workers read the inputs by these paths; this process "
         "writes every output. A re-run skips sequences whose outputs are complete.\n\n"
         "exit status: 0 all done, 1 some sequences failed (the others' outputs are written), "
         "2 bad usage (nothing ran), 130 interrupted.",
