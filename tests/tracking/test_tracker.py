@@ -207,6 +207,10 @@ def test_bad_detections_are_rejected():
         tracker.update(frame, [[5, 5, 10]])
     with pytest.raises(ValueError, match="NaN or inf"):
         tracker.update(frame, [[5, 5, np.nan, 10]])
+    with pytest.raises(TypeError, match="detections must hold real numbers, got dtype complex"):
+        tracker.update(frame, [[5, 5, 10 + 1j, 10]])  # not its real part with a warning
+    with pytest.raises(TypeError, match="detections must hold real numbers, got dtype <U"):
+        tracker.update(frame, [["5", "5", "10", "10"]])
     with pytest.raises(TypeError, match="uint8"):
         tracker.update(frame.astype(float), None)
     with pytest.raises(ValueError, match="sampler is 'gibbs'"):

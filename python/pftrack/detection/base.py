@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import real_array
 from pftrack._typing import F64
 from pftrack.detection.size_model import PersonSizeModel
 
@@ -158,6 +159,8 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
 
     Raises
     ------
+    TypeError
+        Values that are not real numbers (complex, text).
     ValueError
         Wrong shape, NaN or inf, or a box with no area.
 
@@ -166,7 +169,7 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
     UserWarning
         Boxes wholly outside the frame (usually a wrong coordinate scale) are dropped.
     """
-    d = np.asarray(detections, dtype=np.float64)
+    d = real_array(detections, "detections")
     if d.size == 0:
         return np.zeros((0, 4)), np.zeros(0)
     if d.ndim != 2 or d.shape[1] not in (4, 5):
