@@ -3,8 +3,10 @@
 * ``fill 500 tracks``: :func:`pftrack.recovery.fill_gaps` on the 500-track synthetic file of
   :mod:`bench.recovery_file` (``auto``, calibration included, and ``linear``).
 * ``rts gaps``: the batched Kalman/RTS smoother of the ``rts`` candidate
-  (:func:`~pftrack.recovery.baselines.rts_batch`, one vectorised pass for all gaps) against the
-  textbook matrix loop of ``tests/reference/smoothing.py``, one gap at a time.
+  (:func:`~pftrack.recovery.baselines.rts_batch`, one C++ call ``_core.rts_gaps_batch`` for all
+  gaps) against its vectorised NumPy reference (``rts_batch_numpy``, one NumPy step per frame
+  for all gaps) and the textbook matrix loop of ``tests/reference/smoothing.py``, one gap at a
+  time.
 * ``singer loglik``: the C++ likelihood behind ``fit_motion`` against
   ``tests/reference/mixture.py``.
 
@@ -25,7 +27,7 @@ from pftrack.recovery import fill_gaps
 from pftrack.recovery.baselines import rts_batch
 from pftrack.recovery.mixture import DIFFUSE, singer_model
 from tests.reference import mixture as ref_mix
-from tests.reference.smoothing import dense_kalman_rts
+from tests.reference.smoothing import dense_kalman_rts, rts_batch_numpy
 
 
 @pytest.fixture(scope="module")
@@ -83,6 +85,14 @@ def test_rts_batch(benchmark: BenchmarkFixture) -> None:
     want = _rts_reference(pairs[:20])
     for g, w in zip(got[:20], want, strict=True):
         np.testing.assert_allclose(g, w, rtol=1e-8, atol=1e-8)
+
+
+def test_rts_numpy_vectorised(benchmark: BenchmarkFixture) -> None:
+    benchmark.group = "rts gaps"
+    pairs = _gaps()
+    got = benchmark(rts_batch_numpy, pairs)
+    for g, w in zip(got, rts_batch(pairs), strict=True):
+        np.testing.assert_allclose(g, w, rtol=1e-10, atol=1e-8)
 
 
 def test_rts_numpy_reference(benchmark: BenchmarkFixture) -> None:

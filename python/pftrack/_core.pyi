@@ -370,3 +370,10 @@ def gap_mixture(
 # z stacked runs (sum lengths,), lengths (R,) int32; F, Q (K * d, d) stacked models, r (K,)
 # -> (K,) log-likelihoods
 def state_loglik_batch(z: _F64, lengths: _I32, F: _F64, Q: _F64, r: _F64, big: float) -> _F64: ...
+
+# rts_gaps.hpp (register_smoothing.cpp)
+# points (P, 3) float64 rows (frame, x, y); offsets (G + 1,) int32 window bounds; n_before (G,)
+# int32 points of segment A per window -> (M, 2) smoothed (x, y) of every frame inside every gap
+def rts_gaps_batch(
+    points: _F64, offsets: _I32, n_before: _I32, q: float, r: float, v0: float
+) -> _F64: ...

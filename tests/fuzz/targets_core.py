@@ -246,6 +246,25 @@ def _state_loglik() -> st.SearchStrategy[Any]:
 
 
 @st.composite
+def _rts_gaps(draw: st.DrawFn) -> Any:
+    g = draw(st.integers(0, 4))
+    pts, offsets, n_before = [np.zeros((0, 3))], [0], []
+    for _ in range(g):
+        na, nb = draw(st.integers(1, 6)), draw(st.integers(1, 6))
+        steps = draw(st.lists(st.integers(1, 4), min_size=na + nb - 1, max_size=na + nb - 1))
+        fr = draw(st.integers(-5, 50)) + np.r_[0, np.cumsum(steps)]
+        pts.append(np.column_stack([fr, draw(floats_array((na + nb, 2), -500, 500))]))
+        offsets.append(offsets[-1] + na + nb)
+        n_before.append(na)
+    return draw(call(
+        _core.rts_gaps_batch, maybe(st.just(np.vstack(pts))),
+        maybe(st.just(np.asarray(offsets, np.int32))),
+        maybe(st.just(np.asarray(n_before, np.int32))),
+        maybe(fl(1e-3, 100)), maybe(fl(1e-3, 100)), maybe(fl(1e-3, 1e4)),
+    ))  # fmt: skip
+
+
+@st.composite
 def _gap_mixture(draw: st.DrawFn) -> Any:
     n = draw(st.integers(2, 30))
     fa = draw(st.integers(0, n - 2))
@@ -415,6 +434,7 @@ TARGETS: list[Target] = [
     Target("noise_loglik_grid", _noise_grid()),
     Target("state_loglik_batch", _state_loglik()),
     Target("gap_mixture", _gap_mixture()),
+    Target("rts_gaps_batch", _rts_gaps()),
     Target("BackgroundModel", _background_calls()),
     Target("RJMCMCTracker", _rjmcmc_calls()),
 ]

@@ -135,6 +135,10 @@ def test_bad_input() -> None:
         calibrate(tracks, [3], max_gaps=0)
     with pytest.raises(ValueError, match="candidate 'spline9'"):
         calibrate(tracks, [3], candidates=["spline9"])
+    with pytest.raises(ValueError, match="1 contexts for 2 gap lengths"):
+        calibrate(tracks, [3, 4], contexts=[(3, 3)])
+    with pytest.raises(ValueError, match="contexts must be >= 1, got 0"):
+        calibrate(tracks, [3], contexts=[(0, 3)])
     a = np.array([[5.0, 0.0, 0.0]])
     with pytest.raises(ValueError, match="segment_b starts at frame"):
         recover_auto([(a, a)])
@@ -205,6 +209,24 @@ def test_matched_validation_gaps_have_the_real_speed() -> None:
         d = [np.hypot(*(b[0, 1:3] - a[-1, 1:3])) for a, b, _ in cut]
         assert len(cut) >= 20 and lo <= np.median(d) <= hi
     assert rng is not None
+
+
+def test_validation_gaps_keep_the_real_context() -> None:
+    """Artificial gaps keep as many observed points on each side as the real gap they match."""
+    from pftrack.recovery.calibrate import CONTEXT, MAX_CONTEXT, _artificial_gaps
+
+    t = np.arange(100.0)
+    runs = [np.column_stack([t, k * t, np.zeros(100)]) for k in range(1, 21)]
+    for n_a, n_b in ((1, 2), (4, 7), (60, 40)):
+        cut = _artificial_gaps(runs, [(10, -1.0, n_a, n_b)], 40, np.random.default_rng(2))
+        assert len(cut) == 40
+        for a, b, truth in cut:
+            assert len(truth) == 10 and b[0, 0] - a[-1, 0] == 11
+            assert len(b) == n_b if n_b <= MAX_CONTEXT else MAX_CONTEXT <= len(b) <= n_b
+            start = int(truth[0, 0])  # frame 0 is the run's first point
+            assert start >= min(max(n_a, CONTEXT), MAX_CONTEXT) and len(a) == min(n_a, start)
+    whole = _artificial_gaps(runs, [(10, -1.0)], 40, np.random.default_rng(2))
+    assert all(a[0, 0] == 0 and b[-1, 0] == 99 for a, b, _ in whole)  # whole runs without
 
 
 def test_box_sizes_are_calibrated_too() -> None:

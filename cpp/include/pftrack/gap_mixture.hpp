@@ -231,6 +231,7 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
     require(d == 2 || d == 3, fn, "state dimension (cols of F)", d, "2 or 3");
     require(F.rows() == K * d && Q.rows() == K * d && Q.cols() == d, fn,
             "F and Q must be (K * d, d) with K = len(r)");
+    require(lengths.size() == 0 || lengths.minCoeff() >= 0, fn, "lengths must be >= 0");
     require(lengths.sum() == z.size(), fn, "sum(lengths)", lengths.sum(), z.size());
     require_finite(z, fn, "z");
     require_finite(F, fn, "F");
@@ -240,13 +241,31 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                 "r must be finite and > 0 (model " + std::to_string(k) + ")");
     require(std::isfinite(big) && big > 0.0, fn, "big", big, "a finite value > 0");
     Eigen::VectorXd ll(K);
+    const Index longest = lengths.size() ? lengths.maxCoeff() : 0;
     auto run_all = [&](auto dim) {
         constexpr int D = decltype(dim)::value;
         using Mat = Eigen::Matrix<double, D, D>;
         using Vec = Eigen::Matrix<double, D, 1>;
+        // Every run starts from the same covariance, so the innovation variances s_i and gains
+        // g_i depend on the model and the step only: computed once per model, shared by the runs.
+        std::vector<double> S(static_cast<std::size_t>(std::max<Index>(longest, 0)));
+        std::vector<double> logS(S.size());
+        std::vector<Vec, Eigen::aligned_allocator<Vec>> G(S.size());
         for (Index k = 0; k < K; ++k) {
             const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
             const double rk = r(k);
+            Mat P = Mat::Identity() * big;
+            for (Index i = 0; i < longest; ++i) {
+                const auto u = static_cast<std::size_t>(i);
+                if (i > 0) P = Fk * P * Fk.transpose() + Qk;
+                const double s = P(0, 0) + rk;
+                S[u] = s;
+                logS[u] = std::log(detail::kTwoPi * s);
+                const Vec g = P.col(0) / s;
+                G[u] = g;
+                P -= g * P.row(0);
+                P = 0.5 * (P + P.transpose()).eval();
+            }
             double total = 0.0;
             Index start = 0;
             for (Index run = 0; run < lengths.size(); ++run) {
@@ -256,19 +275,12 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                 if (len < D + 2) continue;
                 Vec m = Vec::Zero();
                 m(0) = zz[0];
-                Mat P = Mat::Identity() * big;
                 for (Index i = 0; i < len; ++i) {
-                    if (i > 0) {
-                        m = Fk * m;
-                        P = Fk * P * Fk.transpose() + Qk;
-                    }
-                    const double s = P(0, 0) + rk;
+                    const auto u = static_cast<std::size_t>(i);
+                    if (i > 0) m = Fk * m;
                     const double v = zz[i] - m(0);
-                    if (i >= D) total -= 0.5 * (std::log(detail::kTwoPi * s) + v * v / s);
-                    const Vec g = P.col(0) / s;
-                    m += g * v;
-                    P -= g * P.row(0);
-                    P = 0.5 * (P + P.transpose()).eval();
+                    if (i >= D) total -= 0.5 * (logS[u] + v * v / S[u]);
+                    m += G[u] * v;
                 }
             }
             ll(k) = std::isfinite(total) ? total : -std::numeric_limits<double>::infinity();

@@ -35,6 +35,7 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack import _core
 from pftrack._typing import F64
 from pftrack.kalman import rts_smooth
 
@@ -202,62 +203,24 @@ def rts_batch(
 ) -> list[F64]:
     """:func:`rts` for many gaps at once: every frame inside each gap, ``(x, y)``.
 
-    The windows of all gaps (up to `history` points each side and the gap) are stacked as
-    columns of one array and filtered and smoothed together, one vectorised step per frame
-    of the longest window (the same equations as :func:`pftrack.kalman.rts_smooth`, with a
-    measurement mask per column). Segments must be checked, B after A.
+    The windows of all gaps (up to `history` points each side and the gap) go to one C++ call
+    (``_core.rts_gaps_batch``, GIL released), which filters and smooths each window with the
+    equations of :func:`pftrack.kalman.rts_smooth` (x and y share one covariance recursion).
+    ``tests/reference/smoothing.py`` holds the vectorised NumPy version it is tested against.
+    Segments must be checked, B after A.
     """
     if not pairs:
         return []
-    wins = [(a[-history:], b[:history]) for a, b in pairs]
-    first = np.array([a[0, 0] for a, _ in wins])
-    steps = np.array([b[-1, 0] for _, b in wins]) - first + 1
-    T, n = int(steps.max()), 2 * len(wins)
-    z = np.zeros((T, n))
-    has = np.zeros((T, n), dtype=bool)
-    for g, (a, b) in enumerate(wins):
-        for seg in (a, b):
-            rows = (seg[:, 0] - first[g]).astype(np.int64)
-            z[rows, 2 * g : 2 * g + 2] = seg[:, 1:3]
-            has[rows, 2 * g : 2 * g + 2] = True
-    fm = np.empty((T, 2, n))
-    fp = np.empty((T, 3, n))
-    pm = np.empty((T, 2, n))
-    pp = np.empty((T, 3, n))
-    m0, m1 = z[0].copy(), np.zeros(n)
-    p00, p01, p11 = np.full(n, r), np.zeros(n), np.full(n, 100.0)
-    for t in range(T):
-        if t > 0:
-            m0, m1 = m0 + m1, m1
-            p00, p01, p11 = p00 + 2 * p01 + p11 + q / 3.0, p01 + p11 + q / 2.0, p11 + q
-        pm[t] = m0, m1
-        pp[t] = p00, p01, p11
-        h = has[t]
-        s = p00 + r
-        k0, k1 = np.where(h, p00 / s, 0.0), np.where(h, p01 / s, 0.0)
-        e = z[t] - m0
-        m0, m1 = m0 + k0 * e, m1 + k1 * e
-        p00, p01, p11 = (1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01
-        fm[t] = m0, m1
-        fp[t] = p00, p01, p11
-    out = np.empty((T, n))
-    s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
-    out[-1] = s0
-    for t in range(T - 2, -1, -1):
-        a_, b_, c_ = fp[t]
-        u00, u01, u10, u11 = a_ + b_, b_, b_ + c_, c_
-        x, y, w = pp[t + 1]
-        det = x * w - y * y
-        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
-        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
-        d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
-        s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
-        out[t] = s0
-    res = []
-    for g, (a, b) in enumerate(wins):
-        lo, hi = int(a[-1, 0] - first[g]) + 1, int(b[0, 0] - first[g])
-        res.append(np.ascontiguousarray(out[lo:hi, 2 * g : 2 * g + 2]))
-    return res
+    wins = [(a[-history:, :3], b[:history, :3]) for a, b in pairs]
+    sizes = np.array([len(a) + len(b) for a, b in wins], dtype=np.int64)
+    if int(sizes.sum()) >= 2**31:
+        raise ValueError(f"rts_batch: {int(sizes.sum())} window points, expected < 2^31")
+    points = np.ascontiguousarray(np.vstack([s for w in wins for s in w]), dtype=np.float64)
+    offsets = np.r_[0, np.cumsum(sizes)].astype(np.int32)
+    n_before = np.array([len(a) for a, _ in wins], dtype=np.int32)
+    out = _core.rts_gaps_batch(points, offsets, n_before, q, r, 100.0)
+    lengths = np.array([b[0, 0] - a[-1, 0] - 1 for a, b in wins], dtype=np.int64)
+    return np.split(out, np.cumsum(lengths)[:-1])
 
 
 #: The baselines by method name (read-only).

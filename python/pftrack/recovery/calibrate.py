@@ -56,6 +56,10 @@ MIN_VALIDATION_GAPS = 5
 PAIRED_Z = 2.0
 #: Observed points kept on each side of an artificial gap, at least.
 CONTEXT = 3
+#: An artificial gap keeps as many observed points on each side as the real gap it matches
+#: (the filters see as much history as they will on the real gap), and is placed only where
+#: the run has that many, up to this bound (more would leave few places in short runs).
+MAX_CONTEXT = 10
 #: Random places drawn per artificial gap; the one nearest the real gap's speed is kept.
 MATCH_DRAWS = 16
 #: Noise levels and the motion model of ``"auto"`` are fitted to at most about this many
@@ -244,18 +248,21 @@ def _flat(runs: Sequence[F64]) -> tuple[NDArray[np.int64], NDArray[np.int64], F6
 
 def _artificial_gaps(
     runs: Sequence[F64],
-    targets: Sequence[tuple[int, float]],
+    targets: Sequence[tuple[int, float] | tuple[int, float, int, int]],
     n: int,
     rng: np.random.Generator,
     flat: tuple[NDArray[np.int64], NDArray[np.int64], F64] | None = None,
 ) -> list[tuple[F64, F64, F64]]:
     """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` matched to `targets`.
 
-    Each target is a real gap's ``(missing frames, distance between its two end points)``.
-    Targets are taken in turn (shuffled); for each, :data:`MATCH_DRAWS` random places of that
-    length are drawn from the runs and the one whose end-point distance is nearest the
-    target's (in log scale) is kept, so the validation gaps have the real gaps' lengths and
-    speeds.
+    Each target is a real gap's ``(missing frames, distance between its two end points)``,
+    optionally followed by its observed points before and after (``n_a, n_b``; negative:
+    whole runs). Targets are taken in turn (shuffled); for each, :data:`MATCH_DRAWS` random
+    places of that length are drawn from the runs and the one whose end-point distance is
+    nearest the target's (in log scale) is kept, so the validation gaps have the real gaps'
+    lengths and speeds. With ``n_a, n_b``, a place needs ``clip(n, CONTEXT, MAX_CONTEXT)``
+    observed points on each side and the artificial segments are cut to ``n_a`` and ``n_b``
+    points: the candidates see as much of the track as on the real gap.
     """
     sizes, offset, xy = _flat(runs) if flat is None else flat
     out: list[tuple[F64, F64, F64]] = []
@@ -264,15 +271,19 @@ def _artificial_gaps(
     for attempt in range(4 * n):
         if len(out) >= n or not len(order):
             break
-        L, dist = targets[int(order[attempt % len(order)])]
-        slots = np.maximum(sizes - L - 2 * CONTEXT + 1, 0)
+        t = targets[int(order[attempt % len(order)])]
+        L, dist = int(t[0]), float(t[1])
+        n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
+        ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
+        ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
+        slots = np.maximum(sizes - L - ctx_a - ctx_b + 1, 0)
         cum = np.cumsum(slots)
         total = int(cum[-1]) if len(cum) else 0
         if total == 0:
             continue
         ks = rng.integers(total, size=MATCH_DRAWS)
         idx = np.searchsorted(cum, ks, side="right")
-        starts = CONTEXT + ks - (cum[idx] - slots[idx])
+        starts = ctx_a + ks - (cum[idx] - slots[idx])
         j = 0
         if dist >= 0:
             at = offset[idx] + starts
@@ -283,7 +294,9 @@ def _artificial_gaps(
             continue
         used.add((i, st, L))
         r = runs[i]
-        out.append((r[:st], r[st + L :], r[st : st + L]))
+        lo = 0 if n_a < 0 else max(0, st - n_a)
+        hi = len(r) if n_b < 0 else st + L + n_b
+        out.append((r[lo:st], r[st + L : hi], r[st : st + L]))
     return out
 
 
@@ -297,6 +310,7 @@ def calibrate(
     max_gaps: int = MAX_CALIBRATION_GAPS,
     seed: int = 0,
     spans: Sequence[float] | None = None,
+    contexts: Sequence[tuple[int, int]] | None = None,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -318,6 +332,9 @@ def calibrate(
     spans : sequence of float, optional
         Distance (px) between the two end points of each gap in `gap_lengths`: artificial
         gaps are matched to it (default: no matching, any place of the right length).
+    contexts : sequence of (int, int), optional
+        Observed points before and after each gap (each >= 1): artificial gaps keep as many
+        (:func:`_artificial_gaps`; default: the whole run on each side).
 
     Returns
     -------
@@ -326,7 +343,8 @@ def calibrate(
     Raises
     ------
     ValueError
-        A gap length < 1, `max_gaps` < 1 or an unknown candidate.
+        A gap length < 1, `max_gaps` < 1, an unknown candidate, a context < 1 or `spans` /
+        `contexts` of another length than `gap_lengths`.
     """
     lengths = [int(v) for v in gap_lengths]
     if any(v < 1 for v in lengths):
@@ -340,11 +358,18 @@ def calibrate(
     dists = [-1.0] * len(lengths) if spans is None else [float(v) for v in spans]
     if len(dists) != len(lengths):
         raise ValueError(f"calibrate: {len(dists)} spans for {len(lengths)} gap lengths")
+    sides = (
+        [(-1, -1)] * len(lengths) if contexts is None else [(int(a), int(b)) for a, b in contexts]
+    )
+    if len(sides) != len(lengths):
+        raise ValueError(f"calibrate: {len(sides)} contexts for {len(lengths)} gap lengths")
+    if contexts is not None and any(min(c) < 1 for c in sides):
+        raise ValueError(f"calibrate: contexts must be >= 1, got {min(min(c) for c in sides)}")
     by_bucket: dict[int, list[int]] = {}
-    targets: dict[int, list[tuple[int, float]]] = {}
-    for v, dv in zip(lengths, dists, strict=True):
+    targets: dict[int, list[tuple[int, float, int, int]]] = {}
+    for v, dv, (na, nb) in zip(lengths, dists, sides, strict=True):
         by_bucket.setdefault(bucket_of(v), []).append(v)
-        targets.setdefault(bucket_of(v), []).append((v, dv))
+        targets.setdefault(bucket_of(v), []).append((v, dv, na, nb))
     if not by_bucket:
         return Calibration(())
     runs = _observed_runs(observed)
@@ -514,6 +539,7 @@ def recover_auto(
         motion,
         seed=seed,
         spans=[spans[k] for k in keep],
+        contexts=[(len(checked[k][0]), len(checked[k][1])) for k in keep],
         candidates=candidates,
         max_gaps=max_gaps,
     )
