@@ -206,3 +206,13 @@ def test_failed_run_leaves_an_existing_output_alone(video: Path, tmp_path: Path)
     argv = ["track", str(video), "--out", str(out), "--render", str(tmp_path / "a.xyz")]
     assert main(argv) == 2
     assert out.read_text() == "keep me\n"
+
+
+def test_python_dash_m_pftrack_is_the_command() -> None:
+    import subprocess
+    import sys
+
+    for module in ("pftrack", "pftrack.cli"):
+        out = subprocess.run([sys.executable, "-m", module, "--version"], capture_output=True,
+                             text=True, check=False)  # fmt: skip
+        assert out.returncode == 0 and out.stdout.startswith("pftrack "), (module, out)

@@ -12,6 +12,7 @@ import os
 import sys
 from collections.abc import Sequence
 
+from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
 from pftrack.cli._options import HelpFormatter
 
@@ -44,6 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
         "-q", "--quiet", action="store_true",
         help="no progress bars (they are drawn only when stderr is a terminal anyway)",
     )  # fmt: skip
+    parser.add_argument("--version", action="version", version=f"pftrack {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for command in (demo, track, batch, smooth, evaluate, recover, experiment):
