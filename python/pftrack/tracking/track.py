@@ -20,11 +20,11 @@ from pftrack._typing import F64
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.kalman import cv_predict, cv_update
 from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
-from pftrack.particle_filter.filter import step_filters
+from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.motion import CentreKalman
 
-__all__ = ["LiveTrack", "Track", "predict_tracks"]
+__all__ = ["LiveTrack", "Track", "predict_tracks", "reseed_tracks"]
 
 
 @dataclass(frozen=True)
@@ -135,7 +135,16 @@ class LiveTrack:
         """Follow a matched detection (not a merged blob).
 
         Update the centre filter and the size, re-seed the particles around the detection and
-        blend its colour into the reference.
+        blend its colour into the reference (:meth:`follow_motion`, then :func:`reseed_tracks`).
+        """
+        self.follow_motion(box_xywh, config, smooth)
+        reseed_tracks([self], box_xywh[None], hist[None], config)
+
+    def follow_motion(self, box_xywh: F64, config: TrackerConfig, smooth: bool) -> None:
+        """The first half of :meth:`follow`: the centre filter, the size and the box.
+
+        The particles and the reference still have to be re-seeded (:func:`reseed_tracks`,
+        which does it for many tracks at once).
         """
         b = box_xywh
         self.measured = b.copy()
@@ -145,10 +154,6 @@ class LiveTrack:
         self.box = (
             np.concatenate([self.motion.p - self.size / 2, self.size]) if smooth else b.copy()
         )
-        self.filter.reinitialise(xywh_to_cxcywh(b), velocity=self.motion.v)
-        rate = config.reference_rate
-        if rate > 0 and hist.sum() > 0:
-            self.filter.set_reference((1 - rate) * self.filter.reference + rate * hist)
 
     def matched(self, score: float, det_index: int | None) -> None:
         """Count a match (also a merged blob's, which does not re-seed the track)."""
@@ -235,3 +240,44 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
         m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
         t.box = boxes[k]
         t.age += 1
+
+
+def reseed_tracks(
+    tracks: Sequence[LiveTrack], boxes_xywh: F64, hists: F64, config: TrackerConfig
+) -> None:
+    """The second half of :meth:`LiveTrack.follow` for many tracks, as arrays over them.
+
+    Each track's particles are re-seeded around its detection with its centre filter's
+    velocity (:func:`~pftrack.particle_filter.filter.reinitialise_filters`), and the
+    detection's colour is blended into its reference at ``config.reference_rate`` (unless the
+    detection has no colour). The same numbers as one track at a time.
+
+    Parameters
+    ----------
+    tracks : sequence of LiveTrack
+        Tracks that followed a detection (:meth:`LiveTrack.follow_motion`), updated in place.
+    boxes_xywh : (K, 4) ndarray
+        Their detections' boxes.
+    hists : (K, B) ndarray
+        Their detections' histograms.
+    config : TrackerConfig
+        Settings.
+    """
+    if not tracks:
+        return
+    filters = [t.filter for t in tracks]
+    reinitialise_filters(
+        filters, xywh_to_cxcywh(boxes_xywh), np.array([t.motion.v for t in tracks])
+    )
+    rate = config.reference_rate
+    if rate <= 0:
+        return
+    has = hists.sum(axis=1) > 0
+    idx = np.flatnonzero(has)
+    if not len(idx):
+        return
+    blend = (1 - rate) * np.array([filters[i].reference for i in idx]) + rate * hists[idx]
+    if not (np.isfinite(blend).all() and (blend >= 0).all()):
+        raise ValueError("reference histogram must be finite, >= 0 and not all zero")
+    for i, row in zip(idx.tolist(), blend, strict=True):
+        filters[i].reference = row / row.sum()

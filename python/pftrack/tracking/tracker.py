@@ -30,7 +30,7 @@ from pftrack.tracking.association import associate, covers_another
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
-from pftrack.tracking.track import LiveTrack, Track, predict_tracks
+from pftrack.tracking.track import LiveTrack, Track, predict_tracks, reseed_tracks
 
 __all__ = ["MultiObjectTracker"]
 
@@ -227,7 +227,9 @@ class MultiObjectTracker:
         )
 
         # 3. matched tracks follow their detection, unless it is a blob of several tracks
+        #    (the particles and references of all of them re-seeded at once, at the end)
         smooth = cfg.motion.smooth_external and detections is not None
+        followed: list[tuple[int, int]] = []
         for ti, di in result.matches:
             t, b = self.tracks[ti], boxes[di]
             merged = b[2] * b[3] > cfg.association.merge_ratio * t.size[0] * t.size[1] and (
@@ -235,7 +237,11 @@ class MultiObjectTracker:
             )
             t.matched(float(scores[di]), int(index[di]))
             if not merged:
-                t.follow(b, hists[di], cfg, smooth)
+                t.follow_motion(b, cfg, smooth)
+                followed.append((ti, di))
+        if followed:
+            dis = [di for _, di in followed]
+            reseed_tracks([self.tracks[ti] for ti, _ in followed], boxes[dis], hists[dis], cfg)
         for ti in result.unmatched_tracks:
             self.tracks[ti].coast()
 
