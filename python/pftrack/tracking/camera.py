@@ -191,7 +191,7 @@ class _Measure:
         pts = cv2.goodFeaturesToTrack(prev, cfg.max_features, 0.01, spacing, mask=mask)
         if pts is None or len(pts) < cfg.min_inliers:
             return None, None
-        return self.follow(prev, cur, pts, factor)
+        return self.follow(prev, cur, np.asarray(pts, np.float32), factor)
 
     def follow(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32],
                factor: float) -> tuple[F64 | None, NDArray[np.float32] | None]:  # fmt: skip
