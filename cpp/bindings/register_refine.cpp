@@ -17,8 +17,13 @@ void register_refine(py::module_& m) {
            double min_cover) {
             const char* fn = "refine_boxes";
             require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
+            // (bind::check_mask names the dtype up front: a costly str() on every call)
+            if (!mask.dtype().is(py::dtype::of<std::uint8_t>()) &&
+                !mask.dtype().is(py::dtype::of<bool>()))
+                require(false, fn, "mask dtype", bind::dtype_name(mask), "uint8 or bool");
             require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
-            bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
+            require(mask.strides(1) == 1 && mask.strides(0) > 0, fn,
+                    "mask must be packed along rows (use numpy.ascontiguousarray)");
             require(std::isfinite(fraction) && fraction >= 0.0 && fraction < 1.0, fn, "fraction",
                     fraction, "in [0, 1)");
             require(std::isfinite(min_cover) && min_cover >= 0.0 && min_cover <= 1.0, fn,

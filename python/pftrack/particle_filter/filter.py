@@ -327,7 +327,9 @@ def reinitialise_filters(
     w0 = np.array([f.w0 for f in filters])
     h0 = np.array([f.h0 for f in filters])
     s = np.minimum(np.maximum(np.sqrt((b[:, 2] / w0) * (b[:, 3] / h0)), m.s_min), m.s_max)
-    noise = np.stack([f._rng.standard_normal((n, 3)) for f in filters])  # (K, n, 3)
+    noise = np.empty((k, n, 3))
+    for i, f in enumerate(filters):  # each filter's own draws, as reinitialise takes them
+        f._rng.standard_normal(out=noise[i])
     p = np.empty((k, n, 6))
     p[:, :, 0] = b[:, 0:1] + spread * m.sigma_xy * noise[:, :, 0]
     p[:, :, 1] = b[:, 1:2] + spread * m.sigma_xy * noise[:, :, 1]
