@@ -17,6 +17,7 @@ void register_refine(py::module_& m) {
            double min_cover) {
             const char* fn = "refine_boxes";
             require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
+            require_finite(boxes, fn, "boxes");
             // (bind::check_mask names the dtype up front: a costly str() on every call)
             if (!mask.dtype().is(py::dtype::of<std::uint8_t>()) &&
                 !mask.dtype().is(py::dtype::of<bool>()))

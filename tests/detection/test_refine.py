@@ -76,3 +76,10 @@ def test_bad_input() -> None:
 def test_no_foreground_with_min_cover_0_is_unchanged() -> None:
     box = np.array([[2.0, 2.0, 10.0, 10.0]])
     np.testing.assert_array_equal(refine_boxes(box, np.zeros((20, 20), np.uint8), 0.05, 0.0), box)
+
+
+def test_core_refuses_non_finite_boxes() -> None:
+    from pftrack import _core
+
+    with pytest.raises(ValueError, match="boxes has a non-finite value"):
+        _core.refine_boxes(np.array([[1.0, np.inf, 5, 5]]), np.zeros((9, 9), np.uint8), 0.1, 0.1)
