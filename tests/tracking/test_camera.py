@@ -187,6 +187,10 @@ def test_bad_input_names_the_problem(texture: np.ndarray) -> None:
         CameraConfig(threshold=0.0)
     with pytest.raises(ValueError, match="on_frames"):
         CameraConfig(on_frames=0)
+    with pytest.raises(ValueError, match="still_features is -1, expected an integer >= 0"):
+        CameraConfig(still_features=-1)
+    with pytest.raises(ValueError, match="refresh_frames is 0, expected an integer >= 1"):
+        CameraConfig(refresh_frames=0)
     with pytest.raises(ValueError, match="singular"):
         invert_affine(np.zeros((2, 3)))
     with pytest.raises(TypeError, match="uint8"):
