@@ -20,7 +20,7 @@ from pftrack.particle_filter import (
 )
 from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import TrackerConfig
-from pftrack.tracking.track import LiveTrack, predict_tracks, reseed_tracks
+from pftrack.tracking.track import LiveTrack, follow_tracks_motion, predict_tracks, reseed_tracks
 from tests.reference import kernels as ref
 
 
@@ -297,3 +297,33 @@ def test_reseed_tracks_equals_follow_one_at_a_time():
         np.testing.assert_array_equal(b.filter.reference, s.filter.reference)
     assert not np.array_equal(batched[0].filter.reference, make()[0].filter.reference)
     np.testing.assert_array_equal(batched[2].filter.reference, make()[2].filter.reference)
+
+
+@pytest.mark.parametrize("smooth", [True, False])
+def test_follow_tracks_motion_equals_follow_motion_each(smooth: bool):
+    image = hsv_bins(_scene())
+    cfg = TrackerConfig()
+    boxes = np.array([[30.0, 40.0, 20.0, 40.0], [100.0, 30.0, 15.0, 30.0], [60, 10, 10, 20]])
+
+    def make() -> list[LiveTrack]:
+        out = []
+        for k, b in enumerate(boxes):
+            c = b[:2] + b[2:] / 2
+            hist = box_histograms(image, [[*c, *b[2:]]])[0] + 1e-3
+            out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
+        predict_tracks(out, image, cfg.motion.colour_noise)  # a velocity and a covariance
+        return out
+
+    batched, single = make(), make()
+    det = boxes + [[2.0, -1.0, 1.5, 0.5], [0.3, 0.2, -1.0, 2.0], [-4.0, 1.0, 0.0, 0.0]]
+    follow_tracks_motion(batched, det, cfg, smooth)
+    for t, b in zip(single, det, strict=True):
+        t.follow_motion(b, cfg, smooth)
+    for b, s in zip(batched, single, strict=True):
+        np.testing.assert_array_equal(b.box, s.box)
+        np.testing.assert_array_equal(b.size, s.size)
+        np.testing.assert_array_equal(b.measured, s.measured)
+        np.testing.assert_array_equal(b.motion.p, s.motion.p)
+        np.testing.assert_array_equal(b.motion.v, s.motion.v)
+        assert b.motion.cov == s.motion.cov
+    assert not np.array_equal(batched[0].box, make()[0].box)

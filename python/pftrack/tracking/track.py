@@ -24,7 +24,7 @@ from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.motion import CentreKalman
 
-__all__ = ["LiveTrack", "Track", "predict_tracks", "reseed_tracks"]
+__all__ = ["LiveTrack", "Track", "follow_tracks_motion", "predict_tracks", "reseed_tracks"]
 
 
 @dataclass(frozen=True)
@@ -240,6 +240,44 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
         m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
         t.box = boxes[k]
         t.age += 1
+
+
+def follow_tracks_motion(
+    tracks: Sequence[LiveTrack], boxes_xywh: F64, config: TrackerConfig, smooth: bool
+) -> None:
+    """:meth:`LiveTrack.follow_motion` for many tracks, as arrays over them (the same numbers).
+
+    Parameters
+    ----------
+    tracks : sequence of LiveTrack
+        Tracks that follow a detection each, updated in place.
+    boxes_xywh : (K, 4) ndarray
+        Their detections' boxes.
+    config : TrackerConfig
+        Settings (the detection's noise level).
+    smooth : bool
+        Report the filtered box rather than the detection's (see :meth:`LiveTrack.follow`).
+    """
+    if not tracks:
+        return
+    b = np.asarray(boxes_xywh, dtype=np.float64).reshape(-1, 4)
+    size = np.array([t.size for t in tracks])  # (K, 2)
+    p = np.array([t.motion.p for t in tracks])
+    v = np.array([t.motion.v for t in tracks])
+    cov = np.array([t.motion.cov for t in tracks])  # (K, 3): p00, p01, p11
+    centre = b[:, :2] + b[:, 2:] / 2
+    sigma = config.motion.detection_noise * size[:, 1:2]
+    mean, c = cv_update((p, v), (cov[:, 0:1], cov[:, 1:2], cov[:, 2:3]), centre, sigma**2)
+    p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
+    size = 0.7 * size + 0.3 * b[:, 2:]
+    boxes = np.concatenate([p - size / 2, size], axis=1) if smooth else b.copy()
+    covs = np.concatenate(c, axis=1).tolist()
+    for k, t in enumerate(tracks):
+        t.measured = b[k].copy()
+        m = t.motion
+        m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
+        t.size = size[k]
+        t.box = boxes[k]
 
 
 def reseed_tracks(
