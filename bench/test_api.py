@@ -2,16 +2,25 @@
 
 pytest bench/test_api.py --benchmark-enable --benchmark-only
 
+The goal (issue 13): ``update`` with 10 objects costs at most 0.5 ms of Python+C++ per frame
+beyond the detector (:data:`GOAL_MS`).
+
 A synthetic 480x360 scene in which 10 people are in view on every timed frame; the detections
 are the truth's boxes (x1, y1, x2, y2, conf), so nothing here is a detector's cost. Each round
 runs a fresh tracker over the same frames; the first frames (births, start-up) are not timed.
-``extra_info["ms_per_frame"]`` is the mean per ``update``; "default" includes the background
-model behind box refinement (on by default with detections), "no refine" is the tracker alone.
+``extra_info["ms_per_frame"]`` is the CPU time (``time.process_time``: every thread of the
+process, not what other processes take from the cores) of one ``update``: for each timed frame
+the least of its rounds (every round computes the same; the least is the one other processes
+disturbed least), averaged over the frames. ``extra_info["wall_ms_per_frame"]`` is the same
+for the wall-clock time. "default" includes the background
+model behind box refinement (on by default with detections) and the camera-motion check
+(``"auto"``); "no refine" is the tracker without the background model.
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -22,6 +31,8 @@ from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import make_scene
 
 WARM = 20  # untimed frames: every walker is born and confirmed
+GOAL_MS = 0.5  # per frame, 10 objects, beyond the detector
+ROUNDS = 5
 
 
 @pytest.fixture(scope="module")
@@ -44,23 +55,30 @@ def test_update_10_objects(
     assert len(timed) >= 20  # the scene keeps 10 people in view long enough
     benchmark.group = "Tracker.update, 10 objects, 480x360"
 
-    def run() -> float:
+    cpu: list[list[float]] = []  # per round, per timed frame
+    wall: list[list[float]] = []
+
+    def run() -> None:
         tracker = pftrack.Tracker(seed=0, prime=0)
         if not refine:
-            from dataclasses import replace
-
             config = replace(tracker.config, refine=replace(tracker.config.refine, enabled=False))
             tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
         for k in range(WARM):
             tracker.update(dets[k], frames[k])
-        spent = 0.0
+        cpu.append([])
+        wall.append([])
         for k in range(WARM, len(frames)):
-            start = time.perf_counter()
+            start_cpu, start_wall = time.process_time(), time.perf_counter()
             out = tracker.update(dets[k], frames[k])
             if k in timed:
-                spent += time.perf_counter() - start
+                cpu[-1].append(1000 * (time.process_time() - start_cpu))
+                wall[-1].append(1000 * (time.perf_counter() - start_wall))
             assert len(out) <= len(dets[k])
-        return 1000 * spent / len(timed)
 
-    ms = benchmark.pedantic(run, rounds=3, iterations=1)
+    benchmark.pedantic(run, rounds=ROUNDS, iterations=1)
+    # each frame's least disturbed round (the rounds compute the same), averaged over frames
+    ms = float(np.mean(np.min(cpu, axis=0)))
+    benchmark.extra_info["goal_ms"] = GOAL_MS
     benchmark.extra_info["ms_per_frame"] = round(ms, 3)
+    benchmark.extra_info["wall_ms_per_frame"] = round(float(np.mean(np.min(wall, axis=0))), 3)
+    benchmark.extra_info["within_goal"] = ms <= GOAL_MS

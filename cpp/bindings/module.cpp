@@ -13,6 +13,7 @@ void register_mcmc(py::module_& m);
 void register_bridge(py::module_& m);
 void register_assignment(py::module_& m);
 void register_smoothing(py::module_& m);
+void register_refine(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -25,4 +26,5 @@ PYBIND11_MODULE(_core, m) {
     register_bridge(m);
     register_assignment(m);
     register_smoothing(m);
+    register_refine(m);
 }

@@ -24,8 +24,8 @@ py::array_t<double> batch_item(const py::handle& h, const char* what, py::ssize_
     const std::string name = std::string(what) + "[" + std::to_string(k) + "]";
     require(py::isinstance<py::array>(h), fn, name + " must be a NumPy array");
     const auto a = py::reinterpret_borrow<py::array>(h);
-    require(a.dtype().is(py::dtype::of<double>()), fn, (name + " dtype").c_str(),
-            bind::dtype_name(a), "float64");
+    if (!a.dtype().is(py::dtype::of<double>()))  // the dtype's name only on failure (costly)
+        require(false, fn, (name + " dtype").c_str(), bind::dtype_name(a), "float64");
     require((a.flags() & py::array::c_style) != 0 && a.writeable(), fn,
             name + " must be C-contiguous and writeable");
     if (cols == 0) {

@@ -188,6 +188,9 @@ def bhattacharyya_weights(hists: _F64, ref: _F64, lam: float = 20.0) -> _F64: ..
 # --- assignment: cost (R, C) float64, +inf forbids a pair -> (rows, cols) int32 ----------
 def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascending
 
+# --- box refinement: boxes (K, 4) left, top, w, h; mask (H, W) uint8 or bool -> (K, 4) -----
+def refine_boxes(boxes: _F64, mask: NDArray[Any], fraction: float, min_cover: float) -> _F64: ...
+
 # --- resampling: weights (N,) float64 >= 0 -> indices (N,) int32 --------------------------
 def systematic_resample(weights: _F64, u0: float) -> _I32: ...  # u0 in [0, 1)
 def stratified_resample(weights: _F64, u: _F64) -> _I32: ...  # u (N,) in [0, 1)

@@ -408,6 +408,16 @@ TARGETS: list[Target] = [
     Target("sis_step_batch", _sis_batch()),
     Target("linear_sum_assignment", _assignment()),
     Target(
+        "refine_boxes",
+        call(
+            _core.refine_boxes,
+            maybe(boxes()),
+            st.one_of(masks(), masks().flatmap(layout), garbage()),
+            maybe(fl(-1, 2)),
+            maybe(fl(-1, 2)),
+        ),
+    ),  # fmt: skip
+    Target(
         "counter_normals",
         call(
             _core.counter_normals,

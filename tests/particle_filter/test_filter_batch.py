@@ -18,9 +18,9 @@ from pftrack.particle_filter import (
     box_histograms,
     hsv_bins,
 )
-from pftrack.particle_filter.filter import step_filters
+from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import TrackerConfig
-from pftrack.tracking.track import LiveTrack, predict_tracks
+from pftrack.tracking.track import LiveTrack, follow_tracks_motion, predict_tracks, reseed_tracks
 from tests.reference import kernels as ref
 
 
@@ -225,3 +225,105 @@ def test_predict_tracks_equals_predict_each():
             assert (b.rho, b.age) == (s.rho, s.age)
             assert (b.measured is None) == (s.measured is None)
             np.testing.assert_array_equal(b.filter.particles, s.filter.particles)
+
+
+def test_reinitialise_filters_equals_one_at_a_time():
+    cfg = FilterConfig(n_particles=50)
+    other = FilterConfig(n_particles=30)
+    ref0 = np.ones(110)
+
+    def make() -> list[ColourParticleFilter]:
+        return [
+            ColourParticleFilter(
+                [40.0 + 9 * k, 30.0, 12.0 + k, 30.0 - k], ref0, other if k == 3 else cfg, rng=k
+            )  # fmt: skip
+            for k in range(5)
+        ]
+
+    rng = np.random.default_rng(7)
+    boxes = np.column_stack([rng.uniform(20, 90, (5, 2)), rng.uniform(5, 40, (5, 2))])
+    boxes[1, 2:] = [1e3, 1e3]  # a scale clipped to s_max
+    vel = rng.normal(0, 2, (5, 2))
+    for mixed in (False, True):
+        batched, single = make(), make()
+        if not mixed:  # one configuration: the array path
+            del batched[3], single[3]
+        b = boxes[: len(batched)]
+        v = vel[: len(batched)]
+        reinitialise_filters(batched, b, v, spread=0.7)
+        for f, box, vv in zip(single, b, v, strict=True):
+            f.reinitialise(box, velocity=vv, spread=0.7)
+        for fb, fs in zip(batched, single, strict=True):
+            np.testing.assert_array_equal(fb.particles, fs.particles)
+            np.testing.assert_array_equal(fb.weights, fs.weights)
+            np.testing.assert_array_equal(fb.means, fs.means)
+            assert fb._rng.random() == fs._rng.random()  # the same draws were taken
+
+
+def test_reinitialise_filters_checks_its_input():
+    fs = [ColourParticleFilter([40.0, 30.0, 12.0, 30.0], np.ones(110), rng=k) for k in range(2)]
+    with pytest.raises(ValueError, match="2 boxes and 1 velocities for 2 filters"):
+        reinitialise_filters(fs, np.ones((2, 4)), np.zeros((1, 2)))
+    with pytest.raises(ValueError, match=r"expected finite \(cx, cy, w, h\)"):
+        reinitialise_filters(fs, [[1.0, 1, 5, 5], [1.0, 1, 0, 5]], np.zeros((2, 2)))
+
+
+def test_reseed_tracks_equals_follow_one_at_a_time():
+    image = hsv_bins(_scene())
+    cfg = TrackerConfig()
+    boxes = np.array([[30.0, 40.0, 20.0, 40.0], [100.0, 30.0, 15.0, 30.0], [60, 10, 10, 20]])
+
+    def make() -> list[LiveTrack]:
+        out = []
+        for k, b in enumerate(boxes):
+            c = b[:2] + b[2:] / 2
+            hist = box_histograms(image, [[*c, *b[2:]]])[0] + 1e-3
+            out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
+        return out
+
+    batched, single = make(), make()
+    det = boxes + [[2.0, -1.0, 1.0, 0.5]]
+    hists = box_histograms(image, np.column_stack([det[:, :2] + det[:, 2:] / 2, det[:, 2:]]))
+    hists[2] = 0.0  # a detection without colour: the reference stays
+    for t, b in zip(batched, det, strict=True):
+        t.follow_motion(b, cfg, True)
+    reseed_tracks(batched, det, hists, cfg)
+    for t, b, h in zip(single, det, hists, strict=True):
+        t.follow(b, h, cfg, True)
+    for b, s in zip(batched, single, strict=True):
+        np.testing.assert_array_equal(b.box, s.box)
+        np.testing.assert_array_equal(b.filter.particles, s.filter.particles)
+        np.testing.assert_array_equal(b.filter.means, s.filter.means)
+        np.testing.assert_array_equal(b.filter.reference, s.filter.reference)
+    assert not np.array_equal(batched[0].filter.reference, make()[0].filter.reference)
+    np.testing.assert_array_equal(batched[2].filter.reference, make()[2].filter.reference)
+
+
+@pytest.mark.parametrize("smooth", [True, False])
+def test_follow_tracks_motion_equals_follow_motion_each(smooth: bool):
+    image = hsv_bins(_scene())
+    cfg = TrackerConfig()
+    boxes = np.array([[30.0, 40.0, 20.0, 40.0], [100.0, 30.0, 15.0, 30.0], [60, 10, 10, 20]])
+
+    def make() -> list[LiveTrack]:
+        out = []
+        for k, b in enumerate(boxes):
+            c = b[:2] + b[2:] / 2
+            hist = box_histograms(image, [[*c, *b[2:]]])[0] + 1e-3
+            out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
+        predict_tracks(out, image, cfg.motion.colour_noise)  # a velocity and a covariance
+        return out
+
+    batched, single = make(), make()
+    det = boxes + [[2.0, -1.0, 1.5, 0.5], [0.3, 0.2, -1.0, 2.0], [-4.0, 1.0, 0.0, 0.0]]
+    follow_tracks_motion(batched, det, cfg, smooth)
+    for t, b in zip(single, det, strict=True):
+        t.follow_motion(b, cfg, smooth)
+    for b, s in zip(batched, single, strict=True):
+        np.testing.assert_array_equal(b.box, s.box)
+        np.testing.assert_array_equal(b.size, s.size)
+        np.testing.assert_array_equal(b.measured, s.measured)
+        np.testing.assert_array_equal(b.motion.p, s.motion.p)
+        np.testing.assert_array_equal(b.motion.v, s.motion.v)
+        assert b.motion.cov == s.motion.cov
+    assert not np.array_equal(batched[0].box, make()[0].box)

@@ -2,6 +2,6 @@
 
 One module per wing: ``kernels`` (HSV bins, histograms, Bhattacharyya, resampling, SIS),
 ``fused`` (vectorised NumPy peers for the benchmarks), ``mcmc`` (MH and RJ-MCMC), ``detection``
-(background model), ``smoothing`` (constant-velocity posterior), ``bridge`` (goal-directed
-recovery), ``mixture`` (stand/walk gap mixture).
+(background model), ``refine`` (box refinement), ``smoothing`` (constant-velocity posterior),
+``bridge`` (goal-directed recovery), ``mixture`` (stand/walk gap mixture).
 """

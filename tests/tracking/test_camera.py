@@ -91,6 +91,57 @@ def test_static_frames_are_exactly_identity_and_not_moving(texture: np.ndarray) 
     assert step.magnitude < CameraConfig().threshold * np.hypot(*SIZE)
 
 
+def _count_corner_searches(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    import cv2
+
+    calls = [0]
+    search = cv2.goodFeaturesToTrack
+
+    def counted(*args: object, **kwargs: object) -> object:
+        calls[0] += 1
+        return search(*args, **kwargs)
+
+    monkeypatch.setattr(cv2, "goodFeaturesToTrack", counted)
+    return calls
+
+
+@pytest.mark.parametrize("still_features", [40, 0])
+def test_a_still_camera_follows_its_corners_without_searching_anew(
+    texture: np.ndarray, monkeypatch: pytest.MonkeyPatch, still_features: int
+) -> None:
+    calls = _count_corner_searches(monkeypatch)
+    cfg = CameraConfig(still_features=still_features, refresh_frames=10)
+    camera = CameraMotion("auto", cfg)
+    rng = np.random.default_rng(0)
+    steps = []
+    for _ in range(31):
+        noise = rng.normal(0, 2.0, texture.shape)
+        steps.append(camera.update(np.clip(texture + noise, 0, 255).astype(np.uint8)))
+    assert all(s.apply is None and not s.moving and s.background_ok for s in steps)
+    assert all(s.affine is not None for s in steps[1:])
+    limit = 0.5 * cfg.threshold * np.hypot(*SIZE)
+    assert all(s.magnitude < limit for s in steps[1:])
+    # 30 measured frames: in full on the first, then every 10 (refresh) when following corners
+    assert calls[0] == (3 if still_features else 30)
+
+
+def test_camera_starting_to_move_is_measured_in_full(
+    texture: np.ndarray, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = _count_corner_searches(monkeypatch)
+    camera = CameraMotion("auto")
+    view = np.eye(2, 3)
+    steps = [camera.update(texture) for _ in range(5)]
+    assert calls[0] == 1  # still: corners followed
+    shift = similarity(1.0, 0.2, 2.0, 1.0)
+    for _ in range(4):
+        view = compose(shift, view)
+        steps.append(camera.update(warp_frame(texture, view)))
+    assert calls[0] == 5  # every moving frame in full
+    assert [s.moving for s in steps[5:]] == [False, False, True, True]
+    assert corner_error(steps[7].apply, compose(shift, compose(shift, shift))) < 0.3
+
+
 def test_moving_decision_has_hysteresis_and_covers_the_frames_before_it(
     texture: np.ndarray,
 ) -> None:
@@ -136,6 +187,10 @@ def test_bad_input_names_the_problem(texture: np.ndarray) -> None:
         CameraConfig(threshold=0.0)
     with pytest.raises(ValueError, match="on_frames"):
         CameraConfig(on_frames=0)
+    with pytest.raises(ValueError, match="still_features is -1, expected an integer >= 0"):
+        CameraConfig(still_features=-1)
+    with pytest.raises(ValueError, match="refresh_frames is 0, expected an integer >= 1"):
+        CameraConfig(refresh_frames=0)
     with pytest.raises(ValueError, match="singular"):
         invert_affine(np.zeros((2, 3)))
     with pytest.raises(TypeError, match="uint8"):

@@ -13,7 +13,13 @@ from pftrack import _core
 from pftrack._typing import RngLike
 from pftrack.particle_filter.dynamics import Ar2Model
 
-__all__ = ["ColourParticleFilter", "FilterConfig", "FilterState", "step_filters"]
+__all__ = [
+    "ColourParticleFilter",
+    "FilterConfig",
+    "FilterState",
+    "reinitialise_filters",
+    "step_filters",
+]
 
 
 MAX_PARTICLES = 1_000_000
@@ -271,3 +277,73 @@ def step_filters(
         if states[k] is None:
             states[k] = f.step(image)
     return [s for s in states if s is not None]
+
+
+def reinitialise_filters(
+    filters: Sequence[ColourParticleFilter],
+    boxes_cxcywh: ArrayLike,
+    velocities: ArrayLike,
+    spread: float = 0.5,
+) -> None:
+    """:meth:`ColourParticleFilter.reinitialise` of many filters, as arrays over the filters.
+
+    The same numbers as ``f.reinitialise(box, velocity=v, spread=spread)`` for each filter in
+    turn (each filter draws its own noise from its own generator, in order); filters whose
+    configurations differ from the first one's are re-seeded one by one.
+
+    Parameters
+    ----------
+    filters : sequence of ColourParticleFilter
+        Re-seeded in place.
+    boxes_cxcywh : (K, 4) array_like
+        One box per filter: centre of its new particle cloud, and its size.
+    velocities : (K, 2) array_like
+        Velocity to give each filter's particles, pixels per frame.
+    spread : float
+        Position spread as a multiple of ``model.sigma_xy``.
+
+    Raises
+    ------
+    ValueError
+        Not one finite box (w, h > 0) and one velocity per filter.
+    """
+    k = len(filters)
+    b = np.asarray(boxes_cxcywh, dtype=np.float64).reshape(-1, 4)
+    v = np.asarray(velocities, dtype=np.float64).reshape(-1, 2)
+    if len(b) != k or len(v) != k:
+        raise ValueError(f"{len(b)} boxes and {len(v)} velocities for {k} filters")
+    if k == 0:
+        return
+    cfg = filters[0].config
+    if not all(f.config is cfg or f.config == cfg for f in filters):
+        for f, box, vel in zip(filters, b, v, strict=True):
+            f.reinitialise(box, velocity=vel, spread=spread)
+        return
+    bad = ~(np.isfinite(b).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0))
+    if bad.any():
+        _box(b[int(np.flatnonzero(bad)[0])])  # raises, naming the box
+    m = cfg.model
+    n = cfg.n_particles
+    w0 = np.array([f.w0 for f in filters])
+    h0 = np.array([f.h0 for f in filters])
+    s = np.minimum(np.maximum(np.sqrt((b[:, 2] / w0) * (b[:, 3] / h0)), m.s_min), m.s_max)
+    noise = np.empty((k, n, 3))
+    for i, f in enumerate(filters):  # each filter's own draws, as reinitialise takes them
+        f._rng.standard_normal(out=noise[i])
+    p = np.empty((k, n, 6))
+    p[:, :, 0] = b[:, 0:1] + spread * m.sigma_xy * noise[:, :, 0]
+    p[:, :, 1] = b[:, 1:2] + spread * m.sigma_xy * noise[:, :, 1]
+    p[:, :, 2] = np.minimum(
+        np.maximum(s[:, None] + spread * m.sigma_s * noise[:, :, 2], m.s_min), m.s_max
+    )
+    p[:, :, 3] = p[:, :, 0] - v[:, 0:1]
+    p[:, :, 4] = p[:, :, 1] - v[:, 1:2]
+    p[:, :, 5] = p[:, :, 2]
+    means = np.empty((k, 2, 3))
+    means[:, 0, :2] = b[:, :2]
+    means[:, 1, :2] = b[:, :2] - v
+    means[:, :, 2] = s[:, None]
+    for i, f in enumerate(filters):
+        f.particles[...] = p[i]
+        f.weights.fill(1.0 / n)
+        f.means[...] = means[i]

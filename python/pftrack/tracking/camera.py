@@ -10,7 +10,11 @@ points on anything that moves by itself. It then decides, with hysteresis, wheth
 moves: a frame moves when a corner of the image moves by more than a share of the image
 diagonal; the camera starts moving after a few such frames in a row and stops after more still
 ones. While it does not move the transform it hands back is None and nothing is changed, so a
-still camera tracks exactly as without compensation.
+still camera tracks exactly as without compensation. While it is still, the measurement is
+cheap: the last corners found are followed from frame to frame (at most
+``CameraConfig.still_features``, no new corner search), and a frame is measured in full only
+when that finds motion near the threshold or too few inliers, or the corners are
+``refresh_frames`` old.
 
 :func:`warp_tracks` applies a transform to the tracker's state: every particle (its current and
 previous centre, the AR(2) state; the scale through the filter's base size), the particle-set
@@ -176,29 +180,45 @@ class _Measure:
 
     def fit(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], factor: float,
             exclude: F64) -> F64 | None:  # fmt: skip
+        return self.fit_corners(prev, cur, factor, exclude)[0]
+
+    def fit_corners(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], factor: float,
+                    exclude: F64) -> tuple[F64 | None, NDArray[np.float32] | None]:  # fmt: skip
+        """The transform from new corners of `prev`, and its inlier corners moved into `cur`."""
         cfg = self.config
         mask = _exclusion_mask(prev.shape, exclude.reshape(-1, 4), factor)
         spacing = max(4.0, min(prev.shape) / 40)
         pts = cv2.goodFeaturesToTrack(prev, cfg.max_features, 0.01, spacing, mask=mask)
         if pts is None or len(pts) < cfg.min_inliers:
-            return None
+            return None, None
+        return self.follow(prev, cur, np.asarray(pts, np.float32), factor)
+
+    def follow(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32],
+               factor: float) -> tuple[F64 | None, NDArray[np.float32] | None]:  # fmt: skip
+        """The transform that moves corners `pts` (N, 1, 2) of `prev` into `cur`.
+
+        Returns it (None: too few corners followed or inliers) and the inlier corners' places
+        in `cur` (in the order of `pts`: strongest first, as ``goodFeaturesToTrack`` gives them).
+        """
+        cfg = self.config
         nxt, status, _ = cv2.calcOpticalFlowPyrLK(
             prev, cur, pts, np.empty_like(pts), winSize=(11, 11), maxLevel=2,
             criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
         )  # fmt: skip
         ok = status.reshape(-1) == 1
         if ok.sum() < cfg.min_inliers:
-            return None
+            return None, None
         src, dst = pts.reshape(-1, 2)[ok], nxt.reshape(-1, 2)[ok]
         m, inliers = cv2.estimateAffinePartial2D(
             src, dst, method=cv2.RANSAC, ransacReprojThreshold=cfg.ransac_threshold,
             maxIters=2000, confidence=0.995, refineIters=10,
         )  # fmt: skip
         if m is None or inliers is None or int(inliers.sum()) < cfg.min_inliers:
-            return None
+            return None, None
         a = np.asarray(m, dtype=np.float64)
         a[:, 2] /= factor  # scaled pixels -> frame pixels (the linear part is the same)
-        return a
+        kept = np.ascontiguousarray(dst[inliers.reshape(-1) == 1].reshape(-1, 1, 2))
+        return a, kept
 
 
 class CameraMotion:
@@ -235,6 +255,8 @@ class CameraMotion:
         self._pending: F64 | None = None  # moving frames before the camera counts as moving
         self._run = 0  # consecutive moving (while still) or still (while moving) frames
         self._since_moving = self.config.settle_frames if self.mode == "auto" else 0
+        self._corners: NDArray[np.float32] | None = None  # followed while still ("auto")
+        self._corner_age = 0
 
     def update(self, frame: NDArray[np.uint8], exclude_xywh: ArrayLike = ()) -> CameraStep:
         """Measure the motion from the previous frame to `frame` and decide.
@@ -252,10 +274,14 @@ class CameraMotion:
         factor, grey = self._measure.grey(frame)
         prev, self._prev = self._prev, grey
         affine = None
-        if prev is not None and prev.shape == grey.shape:
-            exclude = np.asarray(exclude_xywh, dtype=np.float64).reshape(-1, 4)
-            affine = self._measure.fit(prev, grey, factor, exclude)
         size = (frame.shape[0], frame.shape[1])
+        if prev is not None and prev.shape == grey.shape:
+            affine = self._still(prev, grey, factor, size)
+            if affine is None:  # in full: new corners
+                exclude = np.asarray(exclude_xywh, dtype=np.float64).reshape(-1, 4)
+                affine, corners = self._measure.fit_corners(prev, grey, factor, exclude)
+                self._corners = None if corners is None else corners[: cfg.still_features]
+                self._corner_age = 0
         magnitude = 0.0 if affine is None else motion_magnitude(affine, size)
         if self.mode == "on":
             return CameraStep(affine, magnitude, True, affine, False)
@@ -281,6 +307,31 @@ class CameraMotion:
             self._since_moving += 1
         background_ok = not self.moving and self._since_moving >= cfg.settle_frames
         return CameraStep(affine, magnitude, self.moving, apply, background_ok)
+
+    def _still(self, prev: NDArray[np.uint8], grey: NDArray[np.uint8], factor: float,
+               size: tuple[int, int]) -> F64 | None:  # fmt: skip
+        """The cheap measurement of a still camera ("auto"): None when it must be done in full.
+
+        The corners kept from earlier frames are followed into this one; the estimate stands
+        when enough of them are inliers and it moves the image by under half the threshold.
+        """
+        cfg = self.config
+        corners = self._corners
+        if (
+            self.mode != "auto"
+            or self.moving
+            or self._pending is not None
+            or corners is None
+            or len(corners) < cfg.min_inliers
+            or self._corner_age >= cfg.refresh_frames
+        ):
+            return None
+        affine, kept = self._measure.follow(prev, grey, corners, factor)
+        limit = 0.5 * cfg.threshold * float(np.hypot(*size))
+        if affine is None or motion_magnitude(affine, size) >= limit:
+            return None
+        self._corners, self._corner_age = kept, self._corner_age + 1
+        return affine
 
     def check_frames(self, frames: Iterable[NDArray[np.uint8]]) -> bool:
         """Tell whether the camera moves anywhere in `frames` (the moving state is not kept)."""

@@ -199,6 +199,13 @@ class CameraConfig:
     settle_frames : int
         Frames after the camera stops during which the background model is still not trusted
         (it learns the new view).
+    still_features : int
+        While the camera is still (``"auto"``), the motion is measured on at most this many of
+        the last corners found, followed from frame to frame, with no new corner search; a frame
+        whose motion reaches half of `threshold`, or that keeps too few inliers, is measured in
+        full. 0: every frame in full.
+    refresh_frames : int
+        The corners followed while still are found anew after this many frames.
     """
 
     max_side: int = 240
@@ -209,16 +216,19 @@ class CameraConfig:
     on_frames: int = 3
     off_frames: int = 10
     settle_frames: int = 25
+    still_features: int = 40
+    refresh_frames: int = 25
 
     def __post_init__(self) -> None:
-        for name in ("max_side", "max_features", "min_inliers", "on_frames", "off_frames"):
+        names = ("max_side", "max_features", "min_inliers", "on_frames", "off_frames")
+        for name in (*names, "refresh_frames"):
             v = getattr(self, name)
             if not isinstance(v, (int, np.integer)) or v < 1:
                 raise ValueError(f"CameraConfig: {name} is {v!r}, expected an integer >= 1")
-        if not isinstance(self.settle_frames, (int, np.integer)) or self.settle_frames < 0:
-            raise ValueError(
-                f"CameraConfig: settle_frames is {self.settle_frames!r}, expected an integer >= 0"
-            )
+        for name in ("settle_frames", "still_features"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, np.integer)) or v < 0:
+                raise ValueError(f"CameraConfig: {name} is {v!r}, expected an integer >= 0")
         for name in ("ransac_threshold", "threshold"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):

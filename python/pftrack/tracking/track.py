@@ -20,11 +20,11 @@ from pftrack._typing import F64
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.kalman import cv_predict, cv_update
 from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
-from pftrack.particle_filter.filter import step_filters
+from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.motion import CentreKalman
 
-__all__ = ["LiveTrack", "Track", "predict_tracks"]
+__all__ = ["LiveTrack", "Track", "follow_tracks_motion", "predict_tracks", "reseed_tracks"]
 
 
 @dataclass(frozen=True)
@@ -135,7 +135,16 @@ class LiveTrack:
         """Follow a matched detection (not a merged blob).
 
         Update the centre filter and the size, re-seed the particles around the detection and
-        blend its colour into the reference.
+        blend its colour into the reference (:meth:`follow_motion`, then :func:`reseed_tracks`).
+        """
+        self.follow_motion(box_xywh, config, smooth)
+        reseed_tracks([self], box_xywh[None], hist[None], config)
+
+    def follow_motion(self, box_xywh: F64, config: TrackerConfig, smooth: bool) -> None:
+        """The first half of :meth:`follow`: the centre filter, the size and the box.
+
+        The particles and the reference still have to be re-seeded (:func:`reseed_tracks`,
+        which does it for many tracks at once).
         """
         b = box_xywh
         self.measured = b.copy()
@@ -145,10 +154,6 @@ class LiveTrack:
         self.box = (
             np.concatenate([self.motion.p - self.size / 2, self.size]) if smooth else b.copy()
         )
-        self.filter.reinitialise(xywh_to_cxcywh(b), velocity=self.motion.v)
-        rate = config.reference_rate
-        if rate > 0 and hist.sum() > 0:
-            self.filter.set_reference((1 - rate) * self.filter.reference + rate * hist)
 
     def matched(self, score: float, det_index: int | None) -> None:
         """Count a match (also a merged blob's, which does not re-seed the track)."""
@@ -235,3 +240,82 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
         m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
         t.box = boxes[k]
         t.age += 1
+
+
+def follow_tracks_motion(
+    tracks: Sequence[LiveTrack], boxes_xywh: F64, config: TrackerConfig, smooth: bool
+) -> None:
+    """:meth:`LiveTrack.follow_motion` for many tracks, as arrays over them (the same numbers).
+
+    Parameters
+    ----------
+    tracks : sequence of LiveTrack
+        Tracks that follow a detection each, updated in place.
+    boxes_xywh : (K, 4) ndarray
+        Their detections' boxes.
+    config : TrackerConfig
+        Settings (the detection's noise level).
+    smooth : bool
+        Report the filtered box rather than the detection's (see :meth:`LiveTrack.follow`).
+    """
+    if not tracks:
+        return
+    b = np.asarray(boxes_xywh, dtype=np.float64).reshape(-1, 4)
+    size = np.array([t.size for t in tracks])  # (K, 2)
+    p = np.array([t.motion.p for t in tracks])
+    v = np.array([t.motion.v for t in tracks])
+    cov = np.array([t.motion.cov for t in tracks])  # (K, 3): p00, p01, p11
+    centre = b[:, :2] + b[:, 2:] / 2
+    sigma = config.motion.detection_noise * size[:, 1:2]
+    mean, c = cv_update((p, v), (cov[:, 0:1], cov[:, 1:2], cov[:, 2:3]), centre, sigma**2)
+    p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
+    size = 0.7 * size + 0.3 * b[:, 2:]
+    boxes = np.concatenate([p - size / 2, size], axis=1) if smooth else b.copy()
+    covs = np.concatenate(c, axis=1).tolist()
+    for k, t in enumerate(tracks):
+        t.measured = b[k].copy()
+        m = t.motion
+        m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
+        t.size = size[k]
+        t.box = boxes[k]
+
+
+def reseed_tracks(
+    tracks: Sequence[LiveTrack], boxes_xywh: F64, hists: F64, config: TrackerConfig
+) -> None:
+    """The second half of :meth:`LiveTrack.follow` for many tracks, as arrays over them.
+
+    Each track's particles are re-seeded around its detection with its centre filter's
+    velocity (:func:`~pftrack.particle_filter.filter.reinitialise_filters`), and the
+    detection's colour is blended into its reference at ``config.reference_rate`` (unless the
+    detection has no colour). The same numbers as one track at a time.
+
+    Parameters
+    ----------
+    tracks : sequence of LiveTrack
+        Tracks that followed a detection (:meth:`LiveTrack.follow_motion`), updated in place.
+    boxes_xywh : (K, 4) ndarray
+        Their detections' boxes.
+    hists : (K, B) ndarray
+        Their detections' histograms.
+    config : TrackerConfig
+        Settings.
+    """
+    if not tracks:
+        return
+    filters = [t.filter for t in tracks]
+    reinitialise_filters(
+        filters, xywh_to_cxcywh(boxes_xywh), np.array([t.motion.v for t in tracks])
+    )
+    rate = config.reference_rate
+    if rate <= 0:
+        return
+    has = hists.sum(axis=1) > 0
+    idx = np.flatnonzero(has)
+    if not len(idx):
+        return
+    blend = (1 - rate) * np.array([filters[i].reference for i in idx]) + rate * hists[idx]
+    if not (np.isfinite(blend).all() and (blend >= 0).all()):
+        raise ValueError("reference histogram must be finite, >= 0 and not all zero")
+    for i, row in zip(idx.tolist(), blend, strict=True):
+        filters[i].reference = row / row.sum()

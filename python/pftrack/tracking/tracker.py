@@ -30,7 +30,13 @@ from pftrack.tracking.association import associate, covers_another
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
-from pftrack.tracking.track import LiveTrack, Track, predict_tracks
+from pftrack.tracking.track import (
+    LiveTrack,
+    Track,
+    follow_tracks_motion,
+    predict_tracks,
+    reseed_tracks,
+)
 
 __all__ = ["MultiObjectTracker"]
 
@@ -227,15 +233,30 @@ class MultiObjectTracker:
         )
 
         # 3. matched tracks follow their detection, unless it is a blob of several tracks
+        #    (the particles and references of all of them re-seeded at once, at the end)
         smooth = cfg.motion.smooth_external and detections is not None
-        for ti, di in result.matches:
+        followed: list[tuple[int, int]] = []
+        pairs = np.array(result.matches, np.int64).reshape(-1, 2)
+        size = np.array([self.tracks[ti].size for ti in pairs[:, 0]]).reshape(-1, 2)
+        b = boxes[pairs[:, 1]]
+        large = b[:, 2] * b[:, 3] > cfg.association.merge_ratio * size[:, 0] * size[:, 1]
+        if not large.any():  # no merged blob possible: every matched track follows, at once
+            for ti, di in result.matches:
+                self.tracks[ti].matched(float(scores[di]), int(index[di]))
+            follow_tracks_motion([self.tracks[ti] for ti in pairs[:, 0]], b, cfg, smooth)
+            followed = result.matches
+        for ti, di in result.matches if large.any() else ():
             t, b = self.tracks[ti], boxes[di]
             merged = b[2] * b[3] > cfg.association.merge_ratio * t.size[0] * t.size[1] and (
                 covers_another(b, np.array([o.box for k, o in enumerate(self.tracks) if k != ti]))
             )
             t.matched(float(scores[di]), int(index[di]))
             if not merged:
-                t.follow(b, hists[di], cfg, smooth)
+                t.follow_motion(b, cfg, smooth)
+                followed.append((ti, di))
+        if followed:
+            dis = [di for _, di in followed]
+            reseed_tracks([self.tracks[ti] for ti, _ in followed], boxes[dis], hists[dis], cfg)
         for ti in result.unmatched_tracks:
             self.tracks[ti].coast()
 

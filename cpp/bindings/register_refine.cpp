@@ -1,0 +1,43 @@
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+
+#include "pftrack/refine.hpp"
+#include "arrays.hpp"
+
+namespace py = pybind11;
+using namespace pftrack;
+
+void register_refine(py::module_& m) {
+    m.def(
+        "refine_boxes",
+        [](Eigen::Ref<const RowMatrixXd> boxes, const py::array& mask, double fraction,
+           double min_cover) {
+            const char* fn = "refine_boxes";
+            require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
+            require_finite(boxes, fn, "boxes");
+            // (bind::check_mask names the dtype up front: a costly str() on every call)
+            if (!mask.dtype().is(py::dtype::of<std::uint8_t>()) &&
+                !mask.dtype().is(py::dtype::of<bool>()))
+                require(false, fn, "mask dtype", bind::dtype_name(mask), "uint8 or bool");
+            require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
+            require(mask.strides(1) == 1 && mask.strides(0) > 0, fn,
+                    "mask must be packed along rows (use numpy.ascontiguousarray)");
+            require(std::isfinite(fraction) && fraction >= 0.0 && fraction < 1.0, fn, "fraction",
+                    fraction, "in [0, 1)");
+            require(std::isfinite(min_cover) && min_cover >= 0.0 && min_cover <= 1.0, fn,
+                    "min_cover", min_cover, "in [0, 1]");
+            RowMatrixXd out = boxes;
+            const auto* data = static_cast<const std::uint8_t*>(mask.data());
+            const Index rows = mask.shape(0), cols = mask.shape(1), stride = mask.strides(0);
+            {
+                py::gil_scoped_release nogil;  // safe: `out` is ours, `mask` kept alive by the caller
+                refine_boxes(out, data, rows, cols, stride, fraction, min_cover);
+            }
+            return out;
+        },
+        py::arg("boxes"), py::arg("mask"), py::arg("fraction"), py::arg("min_cover"),
+        "Boxes (K, 4) left, top, w, h shrunk to the foreground of mask (H, W) uint8 or bool.");
+}

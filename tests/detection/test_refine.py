@@ -1,0 +1,85 @@
+"""Box refinement (pftrack._core.refine_boxes) against its NumPy reference."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pftrack.detection import refine_boxes
+from tests.reference.refine import refine_boxes_reference
+
+
+def _scene(rng: np.random.Generator, rows: int = 90, cols: int = 120) -> np.ndarray:
+    """A mask of a few filled rectangles with noise, as a background model gives."""
+    mask = np.zeros((rows, cols), np.uint8)
+    for _ in range(5):
+        x, y = rng.integers(0, cols - 5), rng.integers(0, rows - 5)
+        w, h = rng.integers(3, 30), rng.integers(3, 40)
+        mask[y : y + h, x : x + w] = 255
+    mask[rng.random((rows, cols)) < 0.03] = 255
+    mask[rng.random((rows, cols)) < 0.05] = 0
+    return mask
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_matches_reference(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    mask = _scene(rng)
+    k = 30
+    boxes = np.column_stack(
+        [rng.uniform(-20, 130, k), rng.uniform(-20, 100, k), rng.uniform(0, 60, (k, 2))]
+    )
+    for fraction, min_cover in [(0.05, 0.1), (0.0, 0.01), (0.5, 0.3), (0.99, 1.0)]:
+        got = refine_boxes(boxes, mask, fraction, min_cover)
+        want = refine_boxes_reference(boxes, mask, fraction, min_cover)
+        np.testing.assert_array_equal(got, want)
+        got_bool = refine_boxes(boxes, mask > 0, fraction, min_cover)
+        np.testing.assert_array_equal(got_bool, want)
+
+
+def test_strided_mask_and_boxes_untouched() -> None:
+    rng = np.random.default_rng(1)
+    big = _scene(rng, 90, 240)
+    view = big[:, ::2]  # columns not packed: copied once
+    boxes = np.array([[10.5, 3.2, 30.0, 40.7], [50.0, 20.0, 2.5, 9.0]])
+    before = boxes.copy()
+    got = refine_boxes(boxes, view, 0.05)
+    np.testing.assert_array_equal(got, refine_boxes_reference(boxes, view, 0.05))
+    np.testing.assert_array_equal(boxes, before)
+
+
+def test_shrinks_to_foreground() -> None:
+    mask = np.zeros((50, 50), np.uint8)
+    mask[10:40, 20:30] = 255
+    out = refine_boxes(np.array([[12.0, 5.0, 30.0, 40.0], [0.0, 0.0, 5.0, 5.0]]), mask)
+    np.testing.assert_array_equal(out, [[20, 10, 10, 30], [0, 0, 5, 5]])
+    assert refine_boxes(np.zeros((0, 4)), mask).shape == (0, 4)
+
+
+def test_bad_input() -> None:
+    mask = np.zeros((20, 20), np.uint8)
+    box = np.array([[1.0, 1.0, 5.0, 5.0]])
+    with pytest.raises(ValueError, match=r"expected \(K, 4\)"):
+        refine_boxes(np.ones((2, 3)), mask)
+    with pytest.raises(ValueError, match="NaN or inf"):
+        refine_boxes([[np.nan, 1, 5, 5]], mask)
+    with pytest.raises(ValueError, match="mask dtype"):
+        refine_boxes(box, mask.astype(np.float32))
+    with pytest.raises(ValueError, match=r"\(H, W\)"):
+        refine_boxes(box, np.zeros((4, 4, 3), np.uint8))
+    with pytest.raises(ValueError, match="fraction"):
+        refine_boxes(box, mask, 1.0)
+    with pytest.raises(ValueError, match="min_cover"):
+        refine_boxes(box, mask, 0.1, -0.5)
+
+
+def test_no_foreground_with_min_cover_0_is_unchanged() -> None:
+    box = np.array([[2.0, 2.0, 10.0, 10.0]])
+    np.testing.assert_array_equal(refine_boxes(box, np.zeros((20, 20), np.uint8), 0.05, 0.0), box)
+
+
+def test_core_refuses_non_finite_boxes() -> None:
+    from pftrack import _core
+
+    with pytest.raises(ValueError, match="boxes has a non-finite value"):
+        _core.refine_boxes(np.array([[1.0, np.inf, 5, 5]]), np.zeros((9, 9), np.uint8), 0.1, 0.1)

@@ -1,0 +1,26 @@
+"""NumPy reference of box refinement (pftrack._core.refine_boxes): one box at a time."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def refine_boxes_reference(
+    boxes_xywh: np.ndarray, mask: np.ndarray, fraction: float = 0.05, min_cover: float = 0.1
+) -> np.ndarray:
+    """Shrink each (left, top, w, h) box to the rows and columns of its foreground."""
+    out = np.array(boxes_xywh, dtype=np.float64, copy=True).reshape(-1, 4)
+    rows, cols = mask.shape
+    for k, (x, y, w, h) in enumerate(out):
+        x0, x1 = int(max(0, np.floor(x))), int(min(cols, np.ceil(x + w)))
+        y0, y1 = int(max(0, np.floor(y))), int(min(rows, np.ceil(y + h)))
+        if x1 - x0 < 3 or y1 - y0 < 3:
+            continue
+        patch = mask[y0:y1, x0:x1] > 0
+        if patch.mean() < min_cover:
+            continue
+        col, row = patch.mean(axis=0), patch.mean(axis=1)
+        cs = np.flatnonzero(col > fraction * col.max())
+        rs = np.flatnonzero(row > fraction * row.max())
+        out[k] = (x0 + cs[0], y0 + rs[0], cs[-1] + 1 - cs[0], rs[-1] + 1 - rs[0])
+    return out
