@@ -304,3 +304,25 @@ def test_track_frames_is_the_tracker_loop(scene):
     for n, f in enumerate(scene.frames, start=1):
         tracker.update(xywh_to_xyxy_dets(as_file[n]), f)
     np.testing.assert_array_equal(tracker.finalize(), run.rows)
+
+
+def test_startup_tracks_that_never_reach_min_hits_are_dropped_offline(scene):
+    # a box seen in the first two frames only: SORT's convention reports it at once (frames
+    # 1 .. min_hits), but it never reaches min_hits matches, so the offline pass drops it
+    frames = scene.frames[:12]
+    dets = scene_dets(scene)[:12]
+    flash = np.array([[5.0, 5.0, 25.0, 45.0, 1.0]])
+    dets = [np.vstack([d, flash]) if k < 2 else d for k, d in enumerate(dets)]
+    tracker = pftrack.Tracker(frame_rate=25.0, seed=0)
+    outs, rows = run_loop(tracker, frames, dets)
+    flash_ids = {int(r[4]) for r in outs[0] if r[0] < 30 and r[1] < 30}
+    assert len(flash_ids) == 1  # reported online ...
+    (flash_id,) = flash_ids
+    assert flash_id in tracker.tracker.never_confirmed()
+    assert flash_id not in rows[:, 1]  # ... and not in the final rows
+    others = {int(i) for o in outs for i in o[:, 4]} - flash_ids
+    assert others and others <= set(rows[:, 1].astype(int))  # the walkers all stay
+    # without the flash the same run gives the same rows: nothing else changed
+    clean = pftrack.Tracker(frame_rate=25.0, seed=0)
+    _, rows_clean = run_loop(clean, frames, scene_dets(scene)[:12])
+    assert len(rows_clean) == len(rows)

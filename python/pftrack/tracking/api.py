@@ -392,7 +392,7 @@ class Tracker:
             ``frame, id, left, top, width, height, conf, -1, -1, -1``, frames from 1 (one per
             ``update``), sorted by frame then id. Warns when there is no row at all.
         """
-        rows = self._stabiliser.restore(self._writer.result())
+        rows = self._stabiliser.restore(self._writer.result(drop=self._tracker.never_confirmed()))
         if len(rows) == 0 and self.frame_count:
             cfg = self.config.lifecycle
             hint = (

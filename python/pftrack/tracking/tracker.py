@@ -69,6 +69,7 @@ class MultiObjectTracker:
         self._ids = itertools.count(1)
         self._detector = detector
         self.tracks: list[LiveTrack] = []
+        self._ended_unconfirmed: set[int] = set()
         self.frame_index = 0
         self.last_mask: NDArray[np.uint8] | None = None
         self._joint = JointTracker(self.config, self._rng)
@@ -163,6 +164,16 @@ class MultiObjectTracker:
             seen = np.concatenate(self._birth_scores)
             self._birth_level = float(np.quantile(seen, rules.birth_quantile))
         return min(rules.birth_score, self._birth_level)
+
+    def never_confirmed(self) -> set[int]:
+        """Ids of start-up tracks that never reached ``min_hits`` matches.
+
+        SORT's convention reports the tracks born in the first ``min_hits`` frames at once;
+        those that end (or the run ends) before ``min_hits`` matches are dropped by the
+        offline pass (:meth:`pftrack.Tracker.finalize`).
+        """
+        n = self.config.lifecycle.min_hits
+        return self._ended_unconfirmed | {t.id for t in self.tracks if t.reported and t.hits < n}
 
     # -- the per-frame step -----------------------------------------------------------------
     def update(self, frame: ArrayLike, detections: ArrayLike | None = None,
@@ -261,7 +272,13 @@ class MultiObjectTracker:
             self.tracks[ti].coast()
 
         # 4. tracks that coasted too long end; 5. unexplained detections start tracks
-        self.tracks = [t for t in self.tracks if t.alive(cfg.lifecycle)]
+        alive = [t.alive(cfg.lifecycle) for t in self.tracks]
+        self._ended_unconfirmed.update(
+            t.id
+            for t, a in zip(self.tracks, alive, strict=True)
+            if not a and t.reported and t.hits < cfg.lifecycle.min_hits
+        )
+        self.tracks = [t for t, a in zip(self.tracks, alive, strict=True) if a]
         confidences = detections is not None and self._scores_are_confidences
         birth_score = self._birth_threshold(scores) if confidences else -np.inf
         for di in result.unmatched_detections:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Collection
+
 import numpy as np
 
 from pftrack._typing import F64
@@ -84,16 +86,22 @@ class TrackWriter:
             elif self.coasting == "confirmed":
                 self._pending.setdefault(t.id, []).append(row)
 
-    def result(self) -> F64:
+    def result(self, drop: Collection[int] = ()) -> F64:
         """All rows written so far, (M, 10), sorted by frame then id.
 
-        Linked and smoothed when the writer has a link config and a smoother.
+        Linked and smoothed when the writer has a link config and a smoother; the tracks of
+        the ids in `drop` are left out first.
         """
-        if not self.rows:
+        a = np.asarray(self.rows, np.float64).reshape(-1, 10)
+        observed = np.array([m is not None for m in self._measured], bool)
+        measured = self._measured
+        if len(drop):
+            keep = ~np.isin(a[:, 1], np.fromiter(drop, np.float64))
+            a, observed = a[keep], observed[keep]
+            measured = [m for m, k in zip(measured, keep, strict=True) if k]
+        if len(a) == 0:
             return np.zeros((0, 10))
-        a = np.asarray(self.rows)
-        observed = np.array([m is not None for m in self._measured])
         z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
         if observed.any():
-            z[observed] = [m for m in self._measured if m is not None]
+            z[observed] = [m for m in measured if m is not None]
         return smooth_tracks(a, observed, self.smoother, self.link, z)
