@@ -203,7 +203,7 @@ def link_tracklets(
     mapping : dict
         Old id -> new id for every relabelled fragment.
     """
-    from scipy.optimize import linear_sum_assignment
+    from pftrack.assignment import linear_sum_assignment  # SciPy's pairs, without SciPy
 
     rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
     check_unique(rows)  # a track seen twice in one frame has no velocity to link with
