@@ -6,6 +6,7 @@
 
 #include "arrays.hpp"
 #include "pftrack/background.hpp"
+#include "pftrack/ghost.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
@@ -87,6 +88,41 @@ void register_detection(py::module_& m) {
             },
             py::arg("frame"), py::arg("mask"), py::arg("rate"),
             "background += rate (frame - background) where mask (H, W) uint8/bool != 0.")
+        .def(
+            "edge_support",
+            [](const BackgroundModel& self, py::array frame, py::array mask,
+               py::array_t<double, py::array::c_style | py::array::forcecast> boxes) {
+                const char* fn = "BackgroundModel.edge_support";
+                require(self.initialized(), fn, "the model has no background yet");
+                bind::check_bgr_image(frame, fn, "frame");
+                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+                        "frame shape is " + shape_str(frame) + ", expected (" +
+                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
+                            ", 3)");
+                bind::check_mask(mask, self.rows(), self.cols(), fn);
+                require(boxes.ndim() == 2 && boxes.shape(1) == 4, fn,
+                        "boxes must have shape (K, 4), got " + shape_str(boxes));
+                const Index k = boxes.shape(0);
+                const double* bp = boxes.data();
+                for (Index i = 0; i < 4 * k; ++i)
+                    require(std::isfinite(bp[i]) && std::abs(bp[i]) <= 1e9, fn, "box value",
+                            bp[i], "finite, within +-1e9");
+                py::array_t<double> out(static_cast<py::ssize_t>(k));
+                const auto* src = static_cast<const std::uint8_t*>(frame.data());
+                const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
+                const Index stride = frame.strides(0), mstride = mask.strides(0);
+                double* optr = out.mutable_data();
+                {
+                    // safe: raw buffers held by the caller / owned here; the model is only read
+                    py::gil_scoped_release nogil;
+                    const Index cols = self.cols();
+                    edge_support(src, stride, self.background_planar(), 3 * cols, cols, 1,
+                                 self.rows(), cols, mptr, mstride, bp, k, optr);
+                }
+                return out;
+            },
+            py::arg("frame"), py::arg("mask"), py::arg("boxes"),
+            "Ghost test: share (K,) of each box's (K, 4) mask-boundary edges held by the frame.")
         .def(
             "set_background",
             [](BackgroundModel& self, py::array_t<float, py::array::c_style | py::array::forcecast> bg) {

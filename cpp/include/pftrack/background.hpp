@@ -221,6 +221,9 @@ public:
     long frame_count() const { return frame_count_; }
     double threshold() const { return threshold_; }
     const std::array<std::int64_t, 256>& difference_histogram() const { return hist_; }
+    /// The background as stored: planar per row, channel c of pixel (y, x) at
+    /// [(y * 3 + c) * cols + x] (see `background_bgr` for the interleaved copy).
+    const float* background_planar() const { return background_.data(); }
 
     /// The background, interleaved BGR, into `out` (rows x cols x 3 floats).
     void background_bgr(float* out) const {
