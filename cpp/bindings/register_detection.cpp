@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "arrays.hpp"
 #include "pftrack/background.hpp"
@@ -178,6 +179,57 @@ void register_detection(py::module_& m) {
         .def_property_readonly("shadow_lo", [](const BackgroundModel& s) { return s.config().shadow_lo; })
         .def_property_readonly("shadow_chroma",
                                [](const BackgroundModel& s) { return s.config().shadow_chroma; });
+
+    m.def(
+        "median_frames",
+        [](const py::sequence& frames) {
+            const char* fn = "median_frames";
+            const auto m = static_cast<Index>(py::len(frames));
+            require(m >= 1, fn, "frames is empty, expected at least one frame");
+            require(m <= 65535, fn, "frames holds", m, "at most 65535 frames");
+            std::vector<py::array> keep;  // holds every frame while the GIL is released
+            keep.reserve(static_cast<size_t>(m));
+            for (Index f = 0; f < m; ++f) {
+                py::object item = frames[static_cast<size_t>(f)];
+                require(py::isinstance<py::array>(item), fn,
+                        "frames[" + std::to_string(f) + "] is " +
+                            std::string(py::str(py::type::of(item).attr("__name__"))) +
+                            ", expected a numpy.ndarray");
+                keep.push_back(item.cast<py::array>());
+                const std::string what = "frames[" + std::to_string(f) + "]";
+                bind::check_bgr_image(keep.back(), fn, what.c_str());
+                require(keep.back().shape(0) == keep[0].shape(0) &&
+                            keep.back().shape(1) == keep[0].shape(1),
+                        fn,
+                        what + " shape is " + shape_str(keep.back()) + ", expected " +
+                            shape_str(keep[0]) + " as frames[0]");
+            }
+            const Index rows = keep[0].shape(0), cols = keep[0].shape(1), n = 3 * cols;
+            py::array_t<float> out({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols),
+                                    py::ssize_t(3)});
+            std::vector<const std::uint8_t*> base(static_cast<size_t>(m)), row(static_cast<size_t>(m));
+            std::vector<Index> stride(static_cast<size_t>(m));
+            for (Index f = 0; f < m; ++f) {
+                base[static_cast<size_t>(f)] = static_cast<const std::uint8_t*>(keep[static_cast<size_t>(f)].data());
+                stride[static_cast<size_t>(f)] = keep[static_cast<size_t>(f)].strides(0);
+            }
+            float* optr = out.mutable_data();
+            {
+                // safe: the frames are held in `keep`, the output is owned here
+                py::gil_scoped_release nogil;
+                std::vector<std::uint8_t> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n)),
+                    cand(static_cast<size_t>(n));
+                std::vector<std::uint16_t> count(static_cast<size_t>(n));
+                for (Index y = 0; y < rows; ++y) {
+                    for (size_t f = 0; f < base.size(); ++f) row[f] = base[f] + y * stride[f];
+                    median_u8(row.data(), m, n, optr + y * n, lo.data(), hi.data(), cand.data(),
+                              count.data());
+                }
+            }
+            return out;
+        },
+        py::arg("frames"),
+        "Per-pixel median (H, W, 3) float32 of a sequence of (H, W, 3) uint8 frames.");
 
     m.def(
         "mask_bins",

@@ -5,6 +5,7 @@
 # float64 and is written without a copy.
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -164,6 +165,9 @@ def hsv_bins(
     s_min: float = 0.1,
     v_min: float = 0.2,
 ) -> BinnedImage: ...
+
+# per-pixel median (H, W, 3) float32 of (H, W, 3) uint8 frames (numpy.median's values)
+def median_frames(frames: Sequence[NDArray[np.uint8]]) -> NDArray[np.float32]: ...
 def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # mask (H, W)
 
 # boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)

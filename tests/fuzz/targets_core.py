@@ -340,6 +340,9 @@ TARGETS: list[Target] = [
     ),  # fmt: skip
     Target("mask_bins", call(_core.mask_bins, maybe(binned()), maybe(masks()))),
     Target(
+        "median_frames", call(_core.median_frames, maybe(st.lists(maybe(frames()), max_size=4)))
+    ),
+    Target(
         "BinnedImage",
         call(
             _binned_image,

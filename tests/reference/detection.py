@@ -142,3 +142,10 @@ def edge_support_reference(
         if e_f + e_b > 0:
             out[k] = e_f / (e_f + e_b)
     return out
+
+
+def median_frames_reference(frames: list[np.ndarray]) -> np.ndarray:
+    """Per-pixel median (H, W, 3) float32 of uint8 frames: a sort, the middle one(s)."""
+    s = np.sort(np.stack(frames).astype(np.float64), axis=0)
+    m = len(frames)
+    return ((s[(m - 1) // 2] + s[m // 2]) / 2).astype(np.float32)

@@ -146,7 +146,9 @@ class PaperDetector:
         if any(f.shape != stack[0].shape for f in stack):
             raise ValueError("PaperDetector.prime: frames differ in shape, expected one size")
         self._model.reset()
-        self._model.set_background(np.median(np.stack(stack), axis=0).astype(np.float32))
+        # numpy.median(stack, axis=0)'s values, in C++ without stacking the frames (tests hold
+        # the two equal): 2-3 times faster, and no (N, H, W, 3) copy
+        self._model.set_background(_core.median_frames(stack))
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
         """Detect the moving objects of one frame.
