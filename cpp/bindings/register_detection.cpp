@@ -1,6 +1,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -220,11 +221,17 @@ void register_detection(py::module_& m) {
                 std::vector<std::uint8_t> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n)),
                     cand(static_cast<size_t>(n));
                 std::vector<std::uint16_t> count(static_cast<size_t>(n));
-                for (Index y = 0; y < rows; ++y) {
-                    for (size_t f = 0; f < base.size(); ++f) row[f] = base[f] + y * stride[f];
-                    median_u8(row.data(), m, n, optr + y * n, lo.data(), hi.data(), cand.data(),
-                              count.data());
-                }
+                // chunks of a row small enough that the m frames' pieces stay in L1 over the
+                // 8 (or 16) passes of the selection
+                const Index chunk = std::max(Index(64), Index(16384) / m);
+                for (Index y = 0; y < rows; ++y)
+                    for (Index x0 = 0; x0 < n; x0 += chunk) {
+                        const Index len = std::min(chunk, n - x0);
+                        for (size_t f = 0; f < base.size(); ++f)
+                            row[f] = base[f] + y * stride[f] + x0;
+                        median_u8(row.data(), m, len, optr + y * n + x0, lo.data(), hi.data(),
+                                  cand.data(), count.data());
+                    }
             }
             return out;
         },
