@@ -106,3 +106,42 @@ def test_whole_detector(benchmark: BenchmarkFixture, frames: Frames, detector: s
     for f in fr:
         det.detect(f)
     benchmark(cycle_apply(det.detect, fr))
+
+
+@pytest.fixture(scope="module")
+def ghost_case(frames: Frames) -> tuple[str, Any, Frame, Frame, Any]:
+    """A primed model after 30 frames, and the last frame's mask and blob boxes."""
+    name, fr = frames
+    det = make_detector("paper")
+    det.prime(fr[::2])
+    for f in fr[:30]:
+        d = det.detect(f)
+    return name, det.model, fr[29], d.mask, d.boxes
+
+
+def test_ghost_test_core(benchmark: BenchmarkFixture, ghost_case: Any) -> None:
+    name, model, frame, mask, boxes = ghost_case
+    benchmark.group = f"ghost test {name}"
+    benchmark.extra_info["boxes"] = len(boxes)
+    benchmark(model.edge_support, frame, mask, boxes)
+
+
+def test_ghost_test_opencv(benchmark: BenchmarkFixture, ghost_case: Any) -> None:
+    from pftrack.detection.ghost import edge_support
+
+    name, model, frame, mask, boxes = ghost_case
+    benchmark.group = f"ghost test {name}"
+    # the detector's earlier path: the background copied out, then the OpenCV version
+    benchmark(lambda: edge_support(frame, model.background, mask, boxes))
+
+
+def test_prime_median_core(benchmark: BenchmarkFixture, frames: Frames) -> None:
+    name, fr = frames
+    benchmark.group = f"prime median of 30 frames {name}"
+    benchmark(_core.median_frames, fr[:30])
+
+
+def test_prime_median_numpy(benchmark: BenchmarkFixture, frames: Frames) -> None:
+    name, fr = frames
+    benchmark.group = f"prime median of 30 frames {name}"
+    benchmark(lambda: np.median(np.stack(fr[:30]), axis=0).astype(np.float32))

@@ -1,11 +1,14 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "arrays.hpp"
 #include "pftrack/background.hpp"
+#include "pftrack/ghost.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
@@ -88,6 +91,41 @@ void register_detection(py::module_& m) {
             py::arg("frame"), py::arg("mask"), py::arg("rate"),
             "background += rate (frame - background) where mask (H, W) uint8/bool != 0.")
         .def(
+            "edge_support",
+            [](const BackgroundModel& self, py::array frame, py::array mask,
+               py::array_t<double, py::array::c_style | py::array::forcecast> boxes) {
+                const char* fn = "BackgroundModel.edge_support";
+                require(self.initialized(), fn, "the model has no background yet");
+                bind::check_bgr_image(frame, fn, "frame");
+                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+                        "frame shape is " + shape_str(frame) + ", expected (" +
+                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
+                            ", 3)");
+                bind::check_mask(mask, self.rows(), self.cols(), fn);
+                require(boxes.ndim() == 2 && boxes.shape(1) == 4, fn,
+                        "boxes must have shape (K, 4), got " + shape_str(boxes));
+                const Index k = boxes.shape(0);
+                const double* bp = boxes.data();
+                for (Index i = 0; i < 4 * k; ++i)
+                    require(std::isfinite(bp[i]) && std::abs(bp[i]) <= 1e9, fn, "box value",
+                            bp[i], "finite, within +-1e9");
+                py::array_t<double> out(static_cast<py::ssize_t>(k));
+                const auto* src = static_cast<const std::uint8_t*>(frame.data());
+                const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
+                const Index stride = frame.strides(0), mstride = mask.strides(0);
+                double* optr = out.mutable_data();
+                {
+                    // safe: raw buffers held by the caller / owned here; the model is only read
+                    py::gil_scoped_release nogil;
+                    const Index cols = self.cols();
+                    edge_support(src, stride, self.background_planar(), 3 * cols, cols, 1,
+                                 self.rows(), cols, mptr, mstride, bp, k, optr);
+                }
+                return out;
+            },
+            py::arg("frame"), py::arg("mask"), py::arg("boxes"),
+            "Ghost test: share (K,) of each box's (K, 4) mask-boundary edges held by the frame.")
+        .def(
             "set_background",
             [](BackgroundModel& self, py::array_t<float, py::array::c_style | py::array::forcecast> bg) {
                 const char* fn = "BackgroundModel.set_background";
@@ -142,6 +180,63 @@ void register_detection(py::module_& m) {
         .def_property_readonly("shadow_lo", [](const BackgroundModel& s) { return s.config().shadow_lo; })
         .def_property_readonly("shadow_chroma",
                                [](const BackgroundModel& s) { return s.config().shadow_chroma; });
+
+    m.def(
+        "median_frames",
+        [](const py::sequence& frames) {
+            const char* fn = "median_frames";
+            const auto m = static_cast<Index>(py::len(frames));
+            require(m >= 1, fn, "frames is empty, expected at least one frame");
+            require(m <= 65535, fn, "frames holds", m, "at most 65535 frames");
+            std::vector<py::array> keep;  // holds every frame while the GIL is released
+            keep.reserve(static_cast<size_t>(m));
+            for (Index f = 0; f < m; ++f) {
+                py::object item = frames[static_cast<size_t>(f)];
+                require(py::isinstance<py::array>(item), fn,
+                        "frames[" + std::to_string(f) + "] is " +
+                            std::string(py::str(py::type::of(item).attr("__name__"))) +
+                            ", expected a numpy.ndarray");
+                keep.push_back(item.cast<py::array>());
+                const std::string what = "frames[" + std::to_string(f) + "]";
+                bind::check_bgr_image(keep.back(), fn, what.c_str());
+                require(keep.back().shape(0) == keep[0].shape(0) &&
+                            keep.back().shape(1) == keep[0].shape(1),
+                        fn,
+                        what + " shape is " + shape_str(keep.back()) + ", expected " +
+                            shape_str(keep[0]) + " as frames[0]");
+            }
+            const Index rows = keep[0].shape(0), cols = keep[0].shape(1), n = 3 * cols;
+            py::array_t<float> out({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols),
+                                    py::ssize_t(3)});
+            std::vector<const std::uint8_t*> base(static_cast<size_t>(m)), row(static_cast<size_t>(m));
+            std::vector<Index> stride(static_cast<size_t>(m));
+            for (Index f = 0; f < m; ++f) {
+                base[static_cast<size_t>(f)] = static_cast<const std::uint8_t*>(keep[static_cast<size_t>(f)].data());
+                stride[static_cast<size_t>(f)] = keep[static_cast<size_t>(f)].strides(0);
+            }
+            float* optr = out.mutable_data();
+            {
+                // safe: the frames are held in `keep`, the output is owned here
+                py::gil_scoped_release nogil;
+                std::vector<std::uint8_t> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n)),
+                    cand(static_cast<size_t>(n));
+                std::vector<std::uint16_t> count(static_cast<size_t>(n));
+                // chunks of a row small enough that the m frames' pieces stay in L1 over the
+                // 8 (or 16) passes of the selection
+                const Index chunk = std::max(Index(64), Index(16384) / m);
+                for (Index y = 0; y < rows; ++y)
+                    for (Index x0 = 0; x0 < n; x0 += chunk) {
+                        const Index len = std::min(chunk, n - x0);
+                        for (size_t f = 0; f < base.size(); ++f)
+                            row[f] = base[f] + y * stride[f] + x0;
+                        median_u8(row.data(), m, len, optr + y * n + x0, lo.data(), hi.data(),
+                                  cand.data(), count.data());
+                    }
+            }
+            return out;
+        },
+        py::arg("frames"),
+        "Per-pixel median (H, W, 3) float32 of a sequence of (H, W, 3) uint8 frames.");
 
     m.def(
         "mask_bins",

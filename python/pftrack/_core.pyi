@@ -5,6 +5,7 @@
 # float64 and is written without a copy.
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -49,6 +50,10 @@ class BackgroundModel:
     def apply(self, frame: NDArray[np.uint8]) -> tuple[BinnedImage, NDArray[np.uint8]]: ...
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...
+    # ghost test: (K,) share of each box's (K, 4) mask-boundary edges held by the frame
+    def edge_support(
+        self, frame: NDArray[np.uint8], mask: ArrayLike, boxes: ArrayLike
+    ) -> NDArray[np.float64]: ...
     def set_background(self, background: ArrayLike) -> None: ...  # (H, W, 3) BGR, float32
     def reset(self) -> None: ...
     @property
@@ -160,6 +165,9 @@ def hsv_bins(
     s_min: float = 0.1,
     v_min: float = 0.2,
 ) -> BinnedImage: ...
+
+# per-pixel median (H, W, 3) float32 of (H, W, 3) uint8 frames (numpy.median's values)
+def median_frames(frames: Sequence[NDArray[np.uint8]]) -> NDArray[np.float32]: ...
 def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # mask (H, W)
 
 # boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)

@@ -156,3 +156,31 @@ def test_opencv_detectors_prime_from_a_median(name: str) -> None:
     assert area[True] == 0 and area[False] > 0
     with pytest.raises(ValueError, match="empty"):
         make_detector(name).prime([])  # type: ignore[union-attr]
+
+
+def test_spread_from_a_frame_source_equals_iterating_it(tmp_path) -> None:
+    from pftrack.io.video import FrameSource
+    from pftrack.io.video_writer import VideoWriter
+
+    rng = np.random.default_rng(4)
+    frames = [rng.integers(0, 256, (24, 32, 3), dtype=np.uint8) for _ in range(23)]
+    folder = tmp_path / "img1"
+    folder.mkdir()
+    for i, f in enumerate(frames):
+        cv2.imwrite(str(folder / f"{i + 1:06d}.png"), f)
+    with VideoWriter(tmp_path / "v.mp4", 25.0) as w:
+        for f in frames:
+            w.write(f)
+    for path in (folder, tmp_path / "v.mp4"):
+        src = FrameSource(path)
+        every = list(src)  # iterate it all, keep the chosen frames
+        assert len(src) == len(every) == 23
+        want = [every[i] for i in sorted(set(np.linspace(0, 22, 6).round().astype(int)))]
+        got = bootstrap_frames(src, 6, "spread")
+        assert len(got) == len(want) == 6
+        for g, e in zip(got, want, strict=True):
+            np.testing.assert_array_equal(g, e)
+        assert src.frames_at([]) == []
+        assert len(src.frames_at([0, 22, 40])) == 2  # past the end: left out
+        with pytest.raises(ValueError, match="frame index is -1"):
+            src.frames_at([-1, 3])

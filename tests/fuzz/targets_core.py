@@ -292,14 +292,18 @@ def _kalman() -> st.SearchStrategy[Any]:
     ))  # fmt: skip
 
 
-def _background(params: dict[str, Any], frames_: list[Any], mask: Any, rate: Any) -> Any:
+def _background(
+    params: dict[str, Any], frames_: list[Any], mask: Any, rate: Any, boxes: Any
+) -> Any:
     model = _core.BackgroundModel(**params)
     out = None
     for f in frames_:
         out = model.apply(f)
+    support = None
     if frames_:
         model.blend(frames_[-1], mask, rate)  # ghosts learnt faster (after the last frame)
-    return None if out is None else (out[0].bins, out[1], model.threshold)
+        support = model.edge_support(frames_[-1], mask, boxes)  # the ghost test
+    return None if out is None else (out[0].bins, out[1], model.threshold, support)
 
 
 def _background_calls() -> st.SearchStrategy[Any]:
@@ -309,7 +313,7 @@ def _background_calls() -> st.SearchStrategy[Any]:
         "low_ratio": maybe(fl(0, 1)), "n_h": maybe(ints(1, 64)), "s_min": maybe(fl(0, 1)),
     })  # fmt: skip
     return call(_background, params, st.lists(maybe(frames()), max_size=4), maybe(masks()),
-                maybe(fl(0, 1)))  # fmt: skip
+                maybe(fl(0, 1)), maybe(boxes()))  # fmt: skip
 
 
 def _rjmcmc(params: dict[str, Any], image: Any, mask: Any, cands: Any, hists: Any, seed: Any,
@@ -354,6 +358,9 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target("mask_bins", call(_core.mask_bins, maybe(binned()), maybe(masks()))),
+    Target(
+        "median_frames", call(_core.median_frames, maybe(st.lists(maybe(frames()), max_size=4)))
+    ),
     Target(
         "BinnedImage",
         call(

@@ -92,3 +92,60 @@ class BackgroundReference:
         median = i + (half - cum[i]) / hist[i]
         self.threshold = min(max(self.k_noise * median, self.t_min), self.t_max)
         return bins, np.where(fore, 255, 0).astype(np.uint8)
+
+
+def _edge_sum_reference(img: np.ndarray, band: np.ndarray) -> float:
+    """Sum over `band` of max_c |Sobel(Gaussian 5x5, sigma 1.5)(img_c)|, reflect-101 borders."""
+    x = np.arange(-2, 3, dtype=np.float64)
+    g = np.exp(-(x * x) / (2 * 1.5**2))
+    g /= g.sum()
+    a = np.asarray(img, np.float64)
+    h, w = a.shape[:2]
+    p = np.pad(a, ((0, 0), (2, 2), (0, 0)), mode="reflect")  # NumPy "reflect" is reflect-101
+    a = sum(g[k] * p[:, k : k + w] for k in range(5))
+    p = np.pad(a, ((2, 2), (0, 0), (0, 0)), mode="reflect")
+    a = sum(g[k] * p[k : k + h] for k in range(5))
+    p = np.pad(a, ((1, 1), (1, 1), (0, 0)), mode="reflect")
+    dx = p[:, 2:] - p[:, :-2]  # (h + 2, w, 3)
+    dy = p[2:] - p[:-2]  # (h, w + 2, 3)
+    gx = dx[:-2] + 2 * dx[1:-1] + dx[2:]
+    gy = dy[:, :-2] + 2 * dy[:, 1:-1] + dy[:, 2:]
+    return float(np.sqrt((gx * gx + gy * gy).max(axis=2))[band].sum())
+
+
+def edge_support_reference(
+    frame: np.ndarray, background: np.ndarray, mask: np.ndarray, boxes: np.ndarray
+) -> np.ndarray:
+    """The ghost test (BackgroundModel.edge_support) in float64 NumPy, no OpenCV."""
+    out = np.full(len(boxes), 0.5)
+    rows, cols = mask.shape
+    for k, (x, y, w, h) in enumerate(np.asarray(boxes, np.float64).reshape(-1, 4)):
+        x0, y0 = max(int(x) - 4, 0), max(int(y) - 4, 0)
+        x1, y1 = min(int(x + w) + 4, cols), min(int(y + h) + 4, rows)
+        if x1 - x0 < 3 or y1 - y0 < 3:
+            continue
+        m = mask[y0:y1, x0:x1] > 0
+        hh, ww = m.shape
+        lo = np.pad(m, 1, constant_values=False)  # dilation: outside is background
+        hi = np.pad(m, 1, constant_values=True)  # erosion: outside is foreground
+        dil = np.zeros_like(m)
+        ero = np.ones_like(m)
+        for dy in range(3):
+            for dx in range(3):
+                dil |= lo[dy : dy + hh, dx : dx + ww]
+                ero &= hi[dy : dy + hh, dx : dx + ww]
+        band = dil & ~ero
+        if not band.any():
+            continue
+        e_f = _edge_sum_reference(frame[y0:y1, x0:x1], band)
+        e_b = _edge_sum_reference(background[y0:y1, x0:x1], band)
+        if e_f + e_b > 0:
+            out[k] = e_f / (e_f + e_b)
+    return out
+
+
+def median_frames_reference(frames: list[np.ndarray]) -> np.ndarray:
+    """Per-pixel median (H, W, 3) float32 of uint8 frames: a sort, the middle one(s)."""
+    s = np.sort(np.stack(frames).astype(np.float64), axis=0)
+    m = len(frames)
+    return ((s[(m - 1) // 2] + s[m // 2]) / 2).astype(np.float32)

@@ -221,6 +221,9 @@ public:
     long frame_count() const { return frame_count_; }
     double threshold() const { return threshold_; }
     const std::array<std::int64_t, 256>& difference_histogram() const { return hist_; }
+    /// The background as stored: planar per row, channel c of pixel (y, x) at
+    /// [(y * 3 + c) * cols + x] (see `background_bgr` for the interleaved copy).
+    const float* background_planar() const { return background_.data(); }
 
     /// The background, interleaved BGR, into `out` (rows x cols x 3 floats).
     void background_bgr(float* out) const {
@@ -418,14 +421,72 @@ private:
     std::vector<std::int32_t> scratch_i_;  // row scratch: table indices, histogram bins
 };
 
+namespace detail {
+
+/// count[e] += v[e] < cand[e] (its own function: `__restrict` on the arguments is what lets
+/// the compiler vectorise it).
+inline void count_less(const std::uint8_t* __restrict v, const std::uint8_t* __restrict cand,
+                       std::uint16_t* __restrict count, Index n) {
+    for (Index e = 0; e < n; ++e)
+        count[e] = static_cast<std::uint16_t>(count[e] + (v[e] < cand[e] ? 1 : 0));
+}
+
+/// For each of the n elements: the k-th smallest (0-based) of the m <= 65535 values
+/// frames[0][e], ..., frames[m-1][e], by a binary search on the value's bits (the largest x with
+/// #{v < x} <= k), 8 passes over the m values, each vectorised over the elements.
+PFTRACK_VECTOR_CLONES static void kth_smallest_u8(const std::uint8_t* const* frames, Index m,
+                                                   Index n, Index k, std::uint8_t* __restrict out,
+                                                   std::uint8_t* __restrict cand,
+                                                   std::uint16_t* __restrict count) {
+    const auto kk = static_cast<std::uint16_t>(k);
+    for (Index e = 0; e < n; ++e) out[e] = 0;
+    for (int bit = 7; bit >= 0; --bit) {
+        const auto step = static_cast<std::uint8_t>(1 << bit);
+        for (Index e = 0; e < n; ++e) {
+            cand[e] = static_cast<std::uint8_t>(out[e] | step);  // the lower bits are still 0
+            count[e] = 0;
+        }
+        for (Index f = 0; f < m; ++f) count_less(frames[f], cand, count, n);
+        for (Index e = 0; e < n; ++e) out[e] = count[e] <= kk ? cand[e] : out[e];
+    }
+}
+
+}  // namespace detail
+
+/// Per-element median of m >= 1 images of n bytes each (`frames[f]` points at image f's row
+/// `y`, see the binding): numpy.median's value, the middle one for odd m, the mean of the two
+/// middle ones for even m (exact in float32: a half-integer). `lo`, `hi`, `cand`, `count` are
+/// scratch of
+/// n elements; m <= 65535.
+inline void median_u8(const std::uint8_t* const* frames, Index m, Index n, float* out,
+                      std::uint8_t* lo, std::uint8_t* hi, std::uint8_t* cand,
+                      std::uint16_t* count) {
+    detail::kth_smallest_u8(frames, m, n, (m - 1) / 2, lo, cand, count);
+    if (m % 2 == 1) {
+        for (Index e = 0; e < n; ++e) out[e] = static_cast<float>(lo[e]);
+        return;
+    }
+    detail::kth_smallest_u8(frames, m, n, m / 2, hi, cand, count);
+    for (Index e = 0; e < n; ++e)
+        out[e] = 0.5f * (static_cast<float>(lo[e]) + static_cast<float>(hi[e]));
+}
+
+namespace detail {
+
+/// One row of `mask_bins` (restrict-qualified arguments: the loop vectorises).
+PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict src,
+                                                const std::uint8_t* __restrict m,
+                                                std::int16_t* __restrict o, Index cols) {
+    for (Index x = 0; x < cols; ++x) o[x] = m[x] ? src[x] : std::int16_t(-1);
+}
+
+}  // namespace detail
+
 /// Bins with background set to -1: out = mask == 0 ? -1 : bins.
 inline void mask_bins(const std::int16_t* bins, Index rows, Index cols, const std::uint8_t* mask,
                       Index mask_stride, std::int16_t* out) {
     for (Index y = 0; y < rows; ++y) {
-        const std::int16_t* src = bins + y * cols;
-        const std::uint8_t* m = mask + y * mask_stride;
-        std::int16_t* o = out + y * cols;
-        for (Index x = 0; x < cols; ++x) o[x] = m[x] ? src[x] : std::int16_t(-1);
+        detail::mask_bins_row(bins + y * cols, mask + y * mask_stride, out + y * cols, cols);
     }
 }
 

@@ -9,7 +9,7 @@ a stream (no second pass possible), the first frames are the only ones to take.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Iterator, Sized
+from collections.abc import Iterable, Iterator, Sequence, Sized
 from typing import Literal
 
 import numpy as np
@@ -29,9 +29,11 @@ def bootstrap_frames(
     Parameters
     ----------
     frames : iterable of (H, W, 3) uint8 arrays
-        The video. ``"spread"`` iterates it once in full (a first pass over a file, or a
-        `pftrack.io.video.FrameSource`, which can be iterated again); it needs ``len(frames)``
-        to choose its stride, and falls back to ``"first"`` when `frames` has no length.
+        The video. ``"spread"`` needs ``len(frames)`` to choose its stride, and falls back to
+        ``"first"`` when `frames` has no length. It reads a `pftrack.io.video.FrameSource`
+        with its ``frames_at`` (a folder: only the chosen images; a file: one pass that
+        decodes every frame, as it must, but converts only the chosen ones), indexes a
+        sequence, and otherwise iterates `frames` once up to the last chosen frame.
     n : int
         How many frames to return (fewer if the video is shorter); 0 returns none.
     mode : {"spread", "first", "none"}
@@ -53,6 +55,11 @@ def bootstrap_frames(
     if mode == "first" or total <= n:
         return list(itertools.islice(iter(frames), n))
     wanted = set(np.linspace(0, total - 1, n).round().astype(int).tolist())
+    pick = getattr(frames, "frames_at", None)
+    if callable(pick):  # a FrameSource: only the wanted images of a folder, no BGR in between
+        return list(pick(sorted(wanted)))
+    if isinstance(frames, Sequence):
+        return [frames[i] for i in sorted(wanted)]
     picked: list[NDArray[np.uint8]] = []
     it: Iterator[NDArray[np.uint8]] = iter(frames)
     for i, frame in enumerate(it):

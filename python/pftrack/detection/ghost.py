@@ -6,6 +6,10 @@ nobody in it, a "ghost". A real object has its silhouette's edges in the *curren
 ghost has them in the *background* (where the object's picture is) and not in the frame. The
 test compares the gradient magnitude of the frame and of the background along the blob's
 boundary.
+
+`edge_support` here is the OpenCV statement of the test; the detector runs the same computation
+in C++ (``pftrack._core.BackgroundModel.edge_support``, on the model's own background, about 4
+times faster), held equal to this function to 1e-5 by the tests.
 """
 
 from __future__ import annotations

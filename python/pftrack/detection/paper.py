@@ -10,7 +10,6 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, check_frame
-from pftrack.detection.ghost import edge_support
 from pftrack.particle_filter.colour import HsvBinning
 
 
@@ -147,7 +146,9 @@ class PaperDetector:
         if any(f.shape != stack[0].shape for f in stack):
             raise ValueError("PaperDetector.prime: frames differ in shape, expected one size")
         self._model.reset()
-        self._model.set_background(np.median(np.stack(stack), axis=0).astype(np.float32))
+        # numpy.median(stack, axis=0)'s values, in C++ without stacking the frames (tests hold
+        # the two equal): 0.23 s instead of 1.4-1.7 s for 30 frames of 1280x720, no stack
+        self._model.set_background(_core.median_frames(stack))
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
         """Detect the moving objects of one frame.
@@ -181,8 +182,13 @@ class PaperDetector:
         boxes: NDArray[np.float64],
         scores: NDArray[np.float64],
     ) -> tuple[NDArray[np.uint8], NDArray[np.float64], NDArray[np.float64]]:
-        """Drop the ghost blobs and learn their pixels fast (C++ ``blend``)."""
-        support = edge_support(frame, self._model.background, mask, boxes)
+        """Drop the ghost blobs and learn their pixels fast (C++ ``blend``).
+
+        The support is `pftrack.detection.ghost.edge_support` computed in C++
+        (``BackgroundModel.edge_support``: the same blur, Sobel and band, read from the model's
+        own background without copying it; tests hold the two equal to 1e-5).
+        """
+        support = self._model.edge_support(frame, mask, boxes)
         ghost = support < self.config.ghost_support
         if not ghost.any():
             return mask, boxes, scores

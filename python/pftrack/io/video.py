@@ -18,7 +18,7 @@ from __future__ import annotations
 import configparser
 import re
 import stat
-from collections.abc import Generator, Iterator
+from collections.abc import Generator, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -334,6 +334,53 @@ class FrameSource:
                 yield frame
         finally:
             frames.close()  # a video file's capture is released now, not when collected
+
+    def frames_at(self, indices: Iterable[int]) -> list[NDArray[np.uint8]]:
+        """The frames at 0-based `indices` (in increasing order, each once), read in one pass.
+
+        The same pixels as iterating and keeping those frames: a folder reads only those
+        images; a video file is decoded in order (seeking is not frame-exact in every
+        container, and costs a decode from the previous key frame anyway), but the frames in
+        between are only grabbed (``VideoCapture.grab``: decoded, not converted to BGR or
+        copied to Python). Indices past the last frame are left out.
+
+        Raises
+        ------
+        ValueError
+            For a live source (it can only be read in order, once), or a negative index.
+        """
+        wanted = sorted({int(i) for i in indices})
+        if wanted and wanted[0] < 0:
+            raise ValueError(f"frame index is {wanted[0]}, expected >= 0")
+        if self.live:
+            raise ValueError(f"live source {self.name} cannot be read at chosen frames")
+        if not wanted:
+            return []
+        if self._images is not None:
+            out = []
+            for i in (i for i in wanted if i < len(self._images)):
+                img = cv2.imread(str(self._images[i]), cv2.IMREAD_COLOR)
+                if img is None:
+                    raise ValueError(f"cannot read image {self._images[i]}")
+                out.append(self._resize(img))
+            return out
+        picked: list[NDArray[np.uint8]] = []
+        keep = set(wanted)
+        cap = cv2.VideoCapture(str(self.path))
+        try:
+            for i in range(wanted[-1] + 1):
+                if self.stopped:
+                    break
+                if i in keep:
+                    ok, frame = cap.read()
+                    if not ok:
+                        break
+                    picked.append(self._resize(frame))
+                elif not cap.grab():
+                    break
+        finally:
+            cap.release()
+        return picked
 
     def stop(self) -> None:
         """End every iteration before its next frame (safe to call from a signal handler)."""

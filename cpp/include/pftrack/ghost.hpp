@@ -1,0 +1,196 @@
+// The detector's ghost test in one pass per blob: the share of a blob's boundary edges that the
+// current frame holds, against the background's. A real object has its silhouette's edges in the
+// frame; a ghost (uncovered background the model still pictures as an object) has them only in
+// the background. Same quantity as the OpenCV version in python/pftrack/detection/ghost.py:
+// Gaussian blur 5x5 (sigma 1.5), Sobel 3x3, largest gradient magnitude over the channels, summed
+// over the boundary band of the mask inside the blob's box (4 px margin), borders reflected
+// (OpenCV's BORDER_REFLECT_101) at the edges of that box.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "types.hpp"
+
+namespace pftrack {
+
+namespace detail {
+
+/// OpenCV's BORDER_REFLECT_101 (gfedcb|abcdefgh|gfedcba) for an axis of n >= 1 samples.
+inline Index reflect101(Index p, Index n) {
+    if (n == 1) return 0;
+    while (p < 0 || p >= n) p = p < 0 ? -p : 2 * (n - 1) - p;
+    return p;
+}
+
+/// cv::getGaussianKernel(5, 1.5): exp(-x^2 / (2 sigma^2)), x = -2 .. 2, normalised to sum 1.
+inline std::array<double, 5> gaussian5_sigma15() {
+    std::array<double, 5> g{};
+    double s = 0.0;
+    for (int i = 0; i < 5; ++i) {
+        const double x = i - 2;
+        g[static_cast<size_t>(i)] = std::exp(-x * x / (2.0 * 1.5 * 1.5));
+        s += g[static_cast<size_t>(i)];
+    }
+    for (double& v : g) v /= s;
+    return g;
+}
+
+/// Scratch of `edge_sum`, reused from blob to blob.
+struct EdgeScratch {
+    std::vector<float> pad, tmp, blur;       // padded channel, row-filtered, blurred (3 planes)
+    std::vector<Index> rx, ry, xm, xp;      // reflected indices
+};
+
+/// Sum over the band pixels (`band`, h x w, row-major, non-zero = in) of
+/// sqrt(max_c (gx_c^2 + gy_c^2)), gx, gy the 3x3 Sobel derivatives of the 5x5 Gaussian blur
+/// (float32, as OpenCV's) of channel c of the h x w image `pixel(y, x, c)`.
+template <class Pixel>
+double edge_sum(Pixel pixel, Index h, Index w, const std::vector<std::uint8_t>& band,
+                EdgeScratch& s) {
+    static const std::array<double, 5> gd = gaussian5_sigma15();
+    const float g0 = static_cast<float>(gd[0]), g1 = static_cast<float>(gd[1]),
+                g2 = static_cast<float>(gd[2]);  // symmetric: g3 = g1, g4 = g0
+    const Index pw = w + 4, ph = h + 4;
+    s.rx.resize(static_cast<size_t>(pw));
+    s.ry.resize(static_cast<size_t>(ph));
+    for (Index j = 0; j < pw; ++j) s.rx[static_cast<size_t>(j)] = reflect101(j - 2, w);
+    for (Index j = 0; j < ph; ++j) s.ry[static_cast<size_t>(j)] = reflect101(j - 2, h);
+    s.xm.resize(static_cast<size_t>(w));
+    s.xp.resize(static_cast<size_t>(w));
+    for (Index x = 0; x < w; ++x) {
+        s.xm[static_cast<size_t>(x)] = reflect101(x - 1, w);
+        s.xp[static_cast<size_t>(x)] = reflect101(x + 1, w);
+    }
+    s.pad.resize(static_cast<size_t>(pw * ph));
+    s.tmp.resize(static_cast<size_t>(w * ph));
+    s.blur.resize(static_cast<size_t>(3 * w * h));
+    for (int c = 0; c < 3; ++c) {
+        // the channel with 2 reflected pixels on every side
+        for (Index yy = 0; yy < ph; ++yy) {
+            float* row = s.pad.data() + yy * pw;
+            const Index y = s.ry[static_cast<size_t>(yy)];
+            for (Index xx = 0; xx < pw; ++xx) row[xx] = pixel(y, s.rx[static_cast<size_t>(xx)], c);
+        }
+        // rows first, then columns (OpenCV's separable order)
+        for (Index yy = 0; yy < ph; ++yy) {
+            const float* __restrict p = s.pad.data() + yy * pw;
+            float* __restrict t = s.tmp.data() + yy * w;
+            for (Index x = 0; x < w; ++x)
+                t[x] = g0 * p[x] + g1 * p[x + 1] + g2 * p[x + 2] + g1 * p[x + 3] + g0 * p[x + 4];
+        }
+        for (Index y = 0; y < h; ++y) {
+            const float* __restrict t0 = s.tmp.data() + y * w;
+            float* __restrict b = s.blur.data() + (c * h + y) * w;
+            for (Index x = 0; x < w; ++x)
+                b[x] = g0 * t0[x] + g1 * t0[x + w] + g2 * t0[x + 2 * w] + g1 * t0[x + 3 * w] +
+                       g0 * t0[x + 4 * w];
+        }
+    }
+    double total = 0.0;
+    for (Index y = 0; y < h; ++y) {
+        const Index ym = reflect101(y - 1, h), yp = reflect101(y + 1, h);
+        const std::uint8_t* in = band.data() + y * w;
+        for (Index x = 0; x < w; ++x) {
+            if (!in[x]) continue;
+            const Index xm = s.xm[static_cast<size_t>(x)], xp = s.xp[static_cast<size_t>(x)];
+            float best = 0.0f;
+            for (int c = 0; c < 3; ++c) {
+                const float* b = s.blur.data() + c * h * w;
+                const float* r0 = b + ym * w;
+                const float* r1 = b + y * w;
+                const float* r2 = b + yp * w;
+                // Sobel: [-1 0 1] along the axis, [1 2 1] across it
+                const float gx = (r0[xp] - r0[xm]) + 2.0f * (r1[xp] - r1[xm]) + (r2[xp] - r2[xm]);
+                const float gy = (r2[xm] - r0[xm]) + 2.0f * (r2[x] - r0[x]) + (r2[xp] - r0[xp]);
+                best = std::max(best, gx * gx + gy * gy);
+            }
+            total += std::sqrt(static_cast<double>(best));
+        }
+    }
+    return total;
+}
+
+}  // namespace detail
+
+/// Share of each blob's boundary edges that the current frame holds (the ghost test).
+///
+/// For box k (`boxes` K x 4 doubles, left, top, w, h, row-major): the region
+/// [int(left) - 4, int(left + w) + 4) x [int(top) - 4, int(top + h) + 4), clipped to the frame;
+/// its band = (3x3 dilation of the mask != 0) and not (3x3 erosion of it), both taken inside the
+/// region only; out[k] = E_frame / (E_frame + E_background), the `detail::edge_sum` of the frame
+/// (`bgr`, interleaved, `row_stride` bytes a row) and of the background (`background`: float
+/// rows of `bg_row_stride` floats, channel c of pixel x at [c * bg_plane_stride + x * bg_pixel
+/// _stride]). 0.5 when the region is under 3 px on a side, its band is empty, or both sums are 0.
+inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float* background,
+                         Index bg_row_stride, Index bg_plane_stride, Index bg_pixel_stride,
+                         Index rows, Index cols, const std::uint8_t* mask, Index mask_stride,
+                         const double* boxes, Index k, double* out) {
+    detail::EdgeScratch scratch;
+    std::vector<std::uint8_t> band, hmax, hmin;
+    for (Index i = 0; i < k; ++i) {
+        out[i] = 0.5;
+        const double* b = boxes + 4 * i;
+        // Python's int(): truncation toward zero
+        const Index x0 = std::max(static_cast<Index>(b[0]) - 4, Index(0));
+        const Index y0 = std::max(static_cast<Index>(b[1]) - 4, Index(0));
+        const Index x1 = std::min(static_cast<Index>(b[0] + b[2]) + 4, cols);
+        const Index y1 = std::min(static_cast<Index>(b[1] + b[3]) + 4, rows);
+        if (x1 - x0 < 3 || y1 - y0 < 3) continue;
+        const Index w = x1 - x0, h = y1 - y0;
+        const auto n = static_cast<size_t>(w * h);
+        // 3x3 dilation and erosion inside the region (outside neighbours do not count), as
+        // row maxima / minima of the 0/1 mask, then column ones
+        hmax.resize(n);
+        hmin.resize(n);
+        band.resize(n);
+        for (Index y = 0; y < h; ++y) {
+            const std::uint8_t* m = mask + (y0 + y) * mask_stride + x0;
+            std::uint8_t* mx = hmax.data() + y * w;
+            std::uint8_t* mn = hmin.data() + y * w;
+            for (Index x = 0; x < w; ++x) {
+                const Index a = std::max(x - 1, Index(0)), z = std::min(x + 1, w - 1);
+                std::uint8_t hi = 0, lo = 1;
+                for (Index xx = a; xx <= z; ++xx) {
+                    const std::uint8_t on = m[xx] != 0;
+                    hi = std::max(hi, on);
+                    lo = std::min(lo, on);
+                }
+                mx[x] = hi;
+                mn[x] = lo;
+            }
+        }
+        bool any = false;
+        for (Index y = 0; y < h; ++y) {
+            const Index a = std::max(y - 1, Index(0)), z = std::min(y + 1, h - 1);
+            for (Index x = 0; x < w; ++x) {
+                std::uint8_t dil = 0, ero = 1;
+                for (Index yy = a; yy <= z; ++yy) {
+                    dil = std::max(dil, hmax[static_cast<size_t>(yy * w + x)]);
+                    ero = std::min(ero, hmin[static_cast<size_t>(yy * w + x)]);
+                }
+                const bool in = dil && !ero;
+                band[static_cast<size_t>(y * w + x)] = in ? 1 : 0;
+                any = any || in;
+            }
+        }
+        if (!any) continue;
+        const double e_f = detail::edge_sum(
+            [&](Index y, Index x, int c) {
+                return static_cast<float>(bgr[(y0 + y) * row_stride + 3 * (x0 + x) + c]);
+            },
+            h, w, band, scratch);
+        const double e_b = detail::edge_sum(
+            [&](Index y, Index x, int c) {
+                return background[(y0 + y) * bg_row_stride + c * bg_plane_stride +
+                                  (x0 + x) * bg_pixel_stride];
+            },
+            h, w, band, scratch);
+        if (e_f + e_b > 0.0) out[i] = e_f / (e_f + e_b);
+    }
+}
+
+}  // namespace pftrack

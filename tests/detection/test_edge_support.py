@@ -1,0 +1,103 @@
+"""The C++ ghost test (BackgroundModel.edge_support) against NumPy and the OpenCV version."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from pftrack import _core
+from pftrack.detection.ghost import edge_support
+from tests.reference.detection import edge_support_reference
+
+
+def scene(
+    rng: np.random.Generator, shape: tuple[int, int] = (60, 80), n: int = 6
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A textured frame and background, a mask of `n` random blobs and boxes about them."""
+    rows, cols = shape
+    frame = rng.integers(0, 256, (rows, cols, 3), dtype=np.uint8)
+    frame = (frame // 32 * 32).astype(np.uint8)  # steps: strong edges
+    background = rng.uniform(0, 255, (rows, cols, 3)).astype(np.float32)
+    mask = np.zeros(shape, np.uint8)
+    boxes = []
+    for _ in range(n):
+        w, h = int(rng.integers(1, 20)), int(rng.integers(1, 25))
+        x, y = int(rng.integers(0, cols - w)), int(rng.integers(0, rows - h))
+        mask[y : y + h, x : x + w] = np.where(rng.random((h, w)) < 0.8, 255, 0)
+        boxes.append([x, y, w, h])
+    boxes.append([cols - 2, rows - 2, 5.7, 9.2])  # reaching past the corner: clipped
+    boxes.append([-3.5, 10.2, 1.0, 1.0])  # a region under 3 px wide: 0.5
+    return frame, background, mask, np.array(boxes, np.float64)
+
+
+def model_with(background: np.ndarray) -> _core.BackgroundModel:
+    model = _core.BackgroundModel()
+    model.set_background(background)
+    return model
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_edge_support_matches_numpy_reference(seed: int) -> None:
+    frame, background, mask, boxes = scene(np.random.default_rng(seed))
+    got = model_with(background).edge_support(frame, mask, boxes)
+    want = edge_support_reference(frame, background, mask, boxes)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-5)
+    assert got[-1] == 0.5
+    assert np.all((got >= 0) & (got <= 1))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_edge_support_matches_opencv_version(seed: int) -> None:
+    frame, background, mask, boxes = scene(np.random.default_rng(10 + seed), (90, 120), 10)
+    got = model_with(background).edge_support(frame, mask, boxes)
+    np.testing.assert_allclose(got, edge_support(frame, background, mask, boxes), atol=1e-5)
+
+
+def test_edge_support_of_strided_frame_and_no_boxes() -> None:
+    frame, background, mask, boxes = scene(np.random.default_rng(7))
+    model = model_with(background)
+    wide = np.zeros((60, 90, 3), np.uint8)
+    wide[:, 5:85] = frame
+    view = wide[:, 5:85]  # rows strided
+    np.testing.assert_array_equal(
+        model.edge_support(view, mask, boxes), model.edge_support(frame, mask, boxes)
+    )
+    assert model.edge_support(frame, mask, np.zeros((0, 4))).shape == (0,)
+
+
+def test_edge_support_checks_its_arguments() -> None:
+    frame, background, mask, boxes = scene(np.random.default_rng(1))
+    with pytest.raises(ValueError, match="no background yet"):
+        _core.BackgroundModel().edge_support(frame, mask, boxes)
+    model = model_with(background)
+    with pytest.raises(ValueError, match=r"boxes must have shape \(K, 4\)"):
+        model.edge_support(frame, mask, boxes[:, :3])
+    bad = boxes.copy()
+    bad[0, 2] = np.nan
+    with pytest.raises(ValueError, match="box value is nan"):
+        model.edge_support(frame, mask, bad)
+    with pytest.raises(ValueError, match="frame shape"):
+        model.edge_support(frame[:-1], mask, boxes)
+    with pytest.raises(ValueError, match="mask"):
+        model.edge_support(frame, mask[:-1], boxes)
+
+
+def test_edge_support_threads_give_serial_result() -> None:
+    frame, background, mask, boxes = scene(np.random.default_rng(2), (120, 160), 30)
+    model = model_with(background)
+    want = model.edge_support(frame, mask, boxes)
+    out: list[np.ndarray] = []
+
+    def run() -> None:
+        for _ in range(20):
+            out.append(model.edge_support(frame, mask, boxes))
+
+    threads = [threading.Thread(target=run) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for o in out:
+        np.testing.assert_array_equal(o, want)
