@@ -4,7 +4,8 @@ nice pytest bench/test_batch.py --benchmark-enable --benchmark-only --benchmark-
 
 - ``batch 4 sequences``: four PETS09-S2L1 videos (the one video under four names; a synthetic
   480x360 scene of 795 frames when the data is absent) tracked with ``pftrack track``'s
-  defaults, one after the other in this process (``n_workers=0``) and on a warm two-worker
+  defaults, one after the other in this process (``n_workers=0``, OpenCV at one thread as
+  ``pftrack track`` and ``pftrack batch --workers 0`` set it) and on a warm two-worker
   ``LocalCluster``; and once more including the cluster's start and close, as
   ``pftrack batch`` does it. Goal: serial / two workers >= 1.7 on two cores.
 - ``batch overhead``: 40 tiny sequences (3 frames of 64x64): the scheduler's cost per sequence,
@@ -92,7 +93,14 @@ def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> 
 
 @pytest.mark.benchmark(group="batch 4 sequences")
 def test_four_serial(benchmark: BenchmarkFixture, four_sequences: Path, tmp_path: Path) -> None:
-    _timed(benchmark, "serial", four_sequences, tmp_path, n_workers=0)
+    import cv2
+
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)  # as `pftrack batch --workers 0` and `pftrack track` run
+    try:
+        _timed(benchmark, "serial", four_sequences, tmp_path, n_workers=0)
+    finally:
+        cv2.setNumThreads(threads)
 
 
 @pytest.mark.benchmark(group="batch 4 sequences")

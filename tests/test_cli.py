@@ -216,3 +216,25 @@ def test_python_dash_m_pftrack_is_the_command() -> None:
         out = subprocess.run([sys.executable, "-m", module, "--version"], capture_output=True,
                              text=True, check=False)  # fmt: skip
         assert out.returncode == 0 and out.stdout.startswith("pftrack "), (module, out)
+
+
+def test_track_gives_opencv_one_thread_and_the_same_tracks(video: Path, tmp_path: Path) -> None:
+    import cv2
+
+    from pftrack.io.mot import write_mot
+    from pftrack.io.video import FrameSource
+    from pftrack.tracking import TrackerConfig, track_frames
+
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(4)
+    try:
+        # the library leaves OpenCV's setting alone and gives the CLI's tracks with 4 threads
+        config = TrackerConfig()
+        run = track_frames(FrameSource(video), config=config, rng=0, show_progress=False)
+        assert cv2.getNumThreads() == 4
+        write_mot(tmp_path / "lib.txt", run.rows)
+        assert main(["track", str(video), "--out", str(tmp_path / "cli.txt")]) == 0
+        assert cv2.getNumThreads() == 1  # the command's process: one OpenCV thread
+        assert (tmp_path / "cli.txt").read_bytes() == (tmp_path / "lib.txt").read_bytes()
+    finally:
+        cv2.setNumThreads(threads)

@@ -53,5 +53,6 @@ class SingleThreaded(WorkerPlugin):
         import pftrack.io.video
         import pftrack.recovery
         import pftrack.tracking.run  # noqa: F401
+
         if self.ignore_interrupt and threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGINT, signal.SIG_IGN)

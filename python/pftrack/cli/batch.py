@@ -125,7 +125,9 @@ def _where(args: argparse.Namespace) -> dict[str, Any]:
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack batch``; return the exit status."""
     from pftrack.batch import TrackOptions, track_many
-    from pftrack.cli._options import tracker_config
+    from pftrack.cli._options import opencv_single_threaded, tracker_config
+
+    opencv_single_threaded()
 
     options = TrackOptions(
         config=tracker_config(args),

@@ -32,7 +32,10 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack demo``; return the exit status."""
+    from pftrack.cli._options import opencv_single_threaded
     from pftrack.demo import run_demo
+
+    opencv_single_threaded()
 
     return run_demo(
         Path(args.out_dir), seed=args.seed, n_frames=args.frames, particles=args.particles

@@ -127,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
+    from pftrack.cli._options import opencv_single_threaded
     from pftrack.io.atomic import check_output, staged_outputs
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, is_live_source
@@ -134,6 +135,8 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections, track_frames
+
+    opencv_single_threaded()
 
     live = is_live_source(args.source)
     given = [d for d in (args.detections,) if d and d != "auto"]
