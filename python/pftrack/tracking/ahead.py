@@ -143,12 +143,21 @@ def _mask_and_bins(detector: Any) -> Any:
 
 
 def _work(frames: Iterable[Any], call: Any) -> Iterator[_Work]:
-    """Each frame with the detector's result, or with its error (and then no further frame)."""
-    for item in frames:
-        frame = np.asarray(item)  # the very object update() will hand the detector
-        try:
-            result = call(frame)
-        except Exception as error:  # raised by the stand-in in update(), where it belongs
-            yield frame, None, error
-            return
-        yield frame, result, None
+    """Each frame with the detector's result, or with its error (and then no further frame).
+
+    `frames`' iterator is closed when this ends, however it ends (a reader thread stops).
+    """
+    it = iter(frames)
+    try:
+        for item in it:
+            frame = np.asarray(item)  # the very object update() will hand the detector
+            try:
+                result = call(frame)
+            except Exception as error:  # raised by the stand-in in update(), where it belongs
+                yield frame, None, error
+                return
+            yield frame, result, None
+    finally:
+        close = getattr(it, "close", None)
+        if close is not None:
+            close()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Sequence
-from contextlib import nullcontext
+from contextlib import closing
 from dataclasses import dataclass
 
 import numpy as np
@@ -158,7 +158,7 @@ def track_frames(
     stream = (
         DetectAhead(tracker.tracker, prefetch(frames), external=detections is not None)
         if ahead
-        else nullcontext(prefetch(frames))
+        else closing(prefetch(frames))
     )
     with stream as decoded:
         for n, frame in enumerate(
