@@ -125,6 +125,15 @@ def track_frames(
         run's writer settled during this frame (online boxes, before the offline pass; a
         bridged gap's rows arrive when the track is re-detected). For rendering while tracking
         and for writing rows of a live source as they come.
+
+    Notes
+    -----
+    Three threads share the work: one decodes (:func:`~pftrack.io.prefetch.prefetch`), one runs
+    the detector on the frames in order ahead of the tracker
+    (:class:`~pftrack.tracking.ahead.DetectAhead`: the built-in detector, or the foreground that
+    refines external detections), and this one tracks. The rows are those of the loop that calls
+    the detector inside ``update``, byte for byte, and a detector error is raised from
+    ``update`` on its frame as there.
     """
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
