@@ -104,13 +104,13 @@ class DetectAhead:
 
     def __enter__(self) -> Iterator[NDArray[np.uint8]]:
         detector = self._tracker.detector
-        # the tracker asks for foreground() when the detector has one, else detect()
-        call = (
-            detector.foreground
-            if self._external and hasattr(detector, "foreground")
-            else detector.detect
-        )
-        if self._external and not hasattr(detector, "foreground"):
+        # what update() reads: detect(); with external detections the foreground, from the
+        # detector's foreground() when it has one, else from its detect()
+        if not self._external:
+            call = detector.detect
+        elif hasattr(detector, "foreground"):
+            call = detector.foreground
+        else:
             call = _mask_and_bins(detector)
         self._detector = detector
         self._stand_in = _StandIn(self._external)
