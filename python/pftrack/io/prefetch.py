@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import queue
 import threading
-from collections.abc import Iterable, Iterator
+from collections.abc import Generator, Iterable
 from typing import TypeVar
 
 __all__ = ["prefetch"]
@@ -23,7 +23,7 @@ class _Failed:
         self.error = error
 
 
-def prefetch(items: Iterable[T], depth: int = 4) -> Iterator[T]:
+def prefetch(items: Iterable[T], depth: int = 4) -> Generator[T, None, None]:
     """Iterate over `items` with a producer thread that stays up to `depth` items ahead.
 
     The items arrive in order; an exception raised by the producer is raised here, at the
@@ -46,7 +46,7 @@ def prefetch(items: Iterable[T], depth: int = 4) -> Iterator[T]:
     return _read_ahead(items, depth)
 
 
-def _read_ahead(items: Iterable[T], depth: int) -> Iterator[T]:
+def _read_ahead(items: Iterable[T], depth: int) -> Generator[T, None, None]:
     buffer: queue.Queue[object] = queue.Queue(maxsize=depth)
     stop = threading.Event()
 

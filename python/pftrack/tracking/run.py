@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Sequence
+from contextlib import closing
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +18,7 @@ from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
+from pftrack.tracking.ahead import DetectAhead
 from pftrack.tracking.api import Tracker, xywh_to_xyxy_dets
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
@@ -123,6 +125,15 @@ def track_frames(
         run's writer settled during this frame (online boxes, before the offline pass; a
         bridged gap's rows arrive when the track is re-detected). For rendering while tracking
         and for writing rows of a live source as they come.
+
+    Notes
+    -----
+    Three threads share the work: one decodes (:func:`~pftrack.io.prefetch.prefetch`), one runs
+    the detector on the frames in order ahead of the tracker
+    (:class:`~pftrack.tracking.ahead.DetectAhead`: the built-in detector, or the foreground that
+    refines external detections), and this one tracks. The rows are those of the loop that calls
+    the detector inside ``update``, byte for byte, and a detector error is raised from
+    ``update`` on its frame as there.
     """
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
@@ -149,22 +160,30 @@ def track_frames(
     start = time.perf_counter()
     n = 0
     total = len(frames) or None
-    for n, frame in enumerate(
-        progress(
-            prefetch(frames), total=total, desc="tracking", enable=show_progress, unit="frame"
-        ),
-        start=1,
-    ):
-        settled = tracker.n_settled
-        if detections is None:
-            tracker.update(None, frame)
-        else:
-            dets = detections.get(n, empty)
-            if n == 1:
-                _check_layout(detections, frame.shape[:2])
-            tracker.update(xywh_to_xyxy_dets(dets), frame)
-        if on_frame is not None:
-            on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
+    # the detector runs on a thread ahead of the tracker (exact: it never reads the tracker's
+    # state), whenever update() would call it: always with the built-in detector, for box
+    # refinement's foreground with external detections
+    ahead = detections is None or config.refine.enabled or config.sampler == "rjmcmc"
+    stream = (
+        DetectAhead(tracker.tracker, prefetch(frames), external=detections is not None)
+        if ahead
+        else closing(prefetch(frames))
+    )
+    with stream as decoded:
+        for n, frame in enumerate(
+            progress(decoded, total=total, desc="tracking", enable=show_progress, unit="frame"),
+            start=1,
+        ):
+            settled = tracker.n_settled
+            if detections is None:
+                tracker.update(None, frame)
+            else:
+                dets = detections.get(n, empty)
+                if n == 1:
+                    _check_layout(detections, frame.shape[:2])
+                tracker.update(xywh_to_xyxy_dets(dets), frame)
+            if on_frame is not None:
+                on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
     if n == 0:
         raise ValueError(f"no frame could be read from {source}")
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)

@@ -95,6 +95,19 @@ class MultiObjectTracker:
                     return
             detector.prime(frames)
 
+    @property
+    def detector(self) -> Any:
+        """The detector: the one given, or the built-in ``config.detector`` (made on first use).
+
+        Assignable: :class:`~pftrack.tracking.ahead.DetectAhead` puts a stand-in here for the
+        length of a run, whose results a thread computed ahead with this detector.
+        """
+        return self._ensure_detector()
+
+    @detector.setter
+    def detector(self, detector: Any) -> None:
+        self._detector = detector
+
     def _ensure_detector(self) -> Any:
         """Return the detector, made on first use.
 

@@ -1,0 +1,163 @@
+"""The detector a frame ahead of the tracker, on a thread: detection overlaps tracking.
+
+The built-in detector's result for frame t depends only on frames 1..t and the priming (the
+tracker never writes to it: camera motion decides which of the detector's bins the tracker
+uses, not what the detector computes), so it can run on a second thread, in order, while the
+main thread tracks the frames before. Its heavy parts (the C++ background pass, the ghost test,
+OpenCV's morphology and labelling) release the GIL, so on two cores detection of frame t+1 runs
+while frame t is tracked.
+
+:class:`DetectAhead` swaps the tracker's detector for a stand-in for the length of a run: the
+stand-in hands the tracker, for the very frame object it was given, what the thread computed
+with the real detector, or raises the error the detector raised on that frame, at the place in
+``update`` where the detector would have raised it. The tracker's output is therefore the same,
+byte for byte, as with the detector called in ``update``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from types import TracebackType
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack.io.prefetch import prefetch
+from pftrack.tracking.tracker import MultiObjectTracker
+
+__all__ = ["DetectAhead"]
+
+_Work = tuple[NDArray[np.uint8], Any, BaseException | None]
+
+
+class _StandIn:
+    """The tracker's detector during a run: returns what the thread computed for each frame."""
+
+    def __init__(self, foreground_only: bool) -> None:
+        self._foreground_only = foreground_only
+        self._next: _Work | None = None
+
+    def expect(self, work: _Work) -> None:
+        """The next frame the tracker will ask about, and the thread's result or error."""
+        self._next = work
+
+    def _take(self, frame: NDArray[np.uint8], foreground_only: bool) -> Any:
+        work, self._next = self._next, None
+        if work is None or work[0] is not frame or foreground_only != self._foreground_only:
+            raise RuntimeError(
+                "DetectAhead: the tracker asked about a frame the detection thread did not "
+                "detect (one update per frame of the run, in order)"
+            )
+        if work[2] is not None:
+            raise work[2]
+        return work[1]
+
+    def detect(self, frame: NDArray[np.uint8]) -> Any:
+        """The thread's ``detect(frame)``."""
+        return self._take(frame, False)
+
+    def foreground(self, frame: NDArray[np.uint8]) -> Any:
+        """The thread's ``foreground(frame)`` (or the mask and bins of its ``detect``)."""
+        return self._take(frame, True)
+
+    def reset(self) -> None:
+        """Refused: the real detector belongs to the thread during a run."""
+        raise RuntimeError("DetectAhead: the detector cannot be reset during a run")
+
+
+class DetectAhead:
+    """Run `tracker`'s detector on a thread, one or more frames ahead of ``tracker.update``.
+
+    Use as a context manager around the run's loop: it yields the frames, in order, and each
+    frame's detection is ready when ``update`` asks for it. On exit the thread is stopped and
+    the tracker gets its own detector back.
+
+    Parameters
+    ----------
+    tracker : MultiObjectTracker
+        The tracker of the run, primed already (priming must come before any detection).
+    frames : iterable of (H, W, 3) uint8 arrays
+        The run's frames (e.g. a :func:`~pftrack.io.prefetch.prefetch` of a video).
+    external : bool
+        Whether ``update`` gets the caller's detections: then only the foreground (box
+        refinement) is computed ahead, as ``update`` asks for it; otherwise ``detect``.
+    depth : int
+        How many frames may wait detected.
+
+    Examples
+    --------
+    >>> with DetectAhead(mot, prefetch(source), external=False) as frames:  # doctest: +SKIP
+    ...     for frame in frames:
+    ...         mot.update(frame, None)
+    """
+
+    def __init__(self, tracker: MultiObjectTracker, frames: Iterable[NDArray[np.uint8]],
+                 *, external: bool, depth: int = 2) -> None:  # fmt: skip
+        self._tracker = tracker
+        self._frames = frames
+        self._external = external
+        self._depth = depth
+        self._detector: Any = None
+        self._stand_in: _StandIn | None = None
+        self._stream: Iterator[_Work] | None = None
+
+    def __enter__(self) -> Iterator[NDArray[np.uint8]]:
+        detector = self._tracker.detector
+        # what update() reads: detect(); with external detections the foreground, from the
+        # detector's foreground() when it has one, else from its detect()
+        if not self._external:
+            call = detector.detect
+        elif hasattr(detector, "foreground"):
+            call = detector.foreground
+        else:
+            call = _mask_and_bins(detector)
+        self._detector = detector
+        self._stand_in = _StandIn(self._external)
+        self._stream = prefetch(_work(self._frames, call), depth=self._depth)
+        self._tracker.detector = self._stand_in
+        return self._hand_over(self._stream, self._stand_in)
+
+    def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
+                 trace: TracebackType | None) -> None:  # fmt: skip
+        close = getattr(self._stream, "close", None)
+        if close is not None:
+            close()  # stops the thread and waits for it
+        self._tracker.detector = self._detector
+
+    @staticmethod
+    def _hand_over(stream: Iterator[_Work], stand_in: _StandIn) -> Iterator[NDArray[np.uint8]]:
+        for work in stream:
+            stand_in.expect(work)
+            yield work[0]
+
+
+def _mask_and_bins(detector: Any) -> Any:
+    """``detect`` as the tracker reads it without ``foreground``: the mask and full-frame bins."""
+
+    def call(frame: NDArray[np.uint8]) -> tuple[Any, Any]:
+        det = detector.detect(frame)
+        return det.mask, det.frame_bins
+
+    return call
+
+
+def _work(frames: Iterable[Any], call: Any) -> Iterator[_Work]:
+    """Each frame with the detector's result, or with its error (and then no further frame).
+
+    `frames`' iterator is closed when this ends, however it ends (a reader thread stops).
+    """
+    it = iter(frames)
+    try:
+        for item in it:
+            frame = np.asarray(item)  # the very object update() will hand the detector
+            try:
+                result = call(frame)
+            except Exception as error:  # raised by the stand-in in update(), where it belongs
+                yield frame, None, error
+                return
+            yield frame, result, None
+    finally:
+        close = getattr(it, "close", None)
+        if close is not None:
+            close()

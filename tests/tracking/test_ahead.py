@@ -1,0 +1,139 @@
+"""The detector on a thread ahead of the tracker: same rows and same errors as in update()."""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import replace
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack.cli import main
+from pftrack.detection.bootstrap import bootstrap_frames
+from pftrack.io.mot import group_by_frame
+from pftrack.synthetic import make_scene, move_camera
+from pftrack.tracking import TrackerConfig, track_frames
+from pftrack.tracking.ahead import DetectAhead
+from pftrack.tracking.api import xywh_to_xyxy_dets
+from pftrack.tracking.tracker import MultiObjectTracker
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return make_scene(n_frames=40, rng=3)
+
+
+def as_file(scene):
+    """The scene's truth as a detection file read by load_detections: {frame: (k, 5)}."""
+    rows = group_by_frame(scene.truth)
+    return {f: np.column_stack([r[:, 2:6], np.ones(len(r))]) for f, r in rows.items()}
+
+
+def loop_rows(frames, config, seed, dets=None, bootstrap="spread"):
+    """The tracker loop with the detector called inside update() (no thread)."""
+    tracker = pftrack.Tracker.from_config(config, seed)
+    primer = bootstrap_frames(frames, 30, bootstrap)
+    if primer:
+        tracker.prime(primer)
+    empty = np.zeros((0, 5))
+    for n, f in enumerate(frames, start=1):
+        d = None if dets is None else xywh_to_xyxy_dets(dets.get(n, empty))
+        tracker.update(d, f)
+    return tracker.finalize()
+
+
+def no_reader_thread():
+    return not any(t.name == "pftrack-prefetch" for t in threading.enumerate())
+
+
+@pytest.mark.parametrize("camera", ["auto", "on"])
+def test_builtin_detector_ahead_gives_the_loops_rows(scene, camera):
+    # "on": the background is never trusted, the tracker reads the detector's full-frame bins
+    frames = move_camera(scene).frames if camera == "on" else scene.frames
+    config = replace(TrackerConfig(), camera_motion=camera)
+    run = track_frames(frames, config=config, rng=4)
+    expected = loop_rows(frames, config, 4)
+    assert len(expected) > 0
+    np.testing.assert_array_equal(run.rows, expected)
+
+
+@pytest.mark.parametrize("detector", ["paper", "mog2"])
+def test_foreground_ahead_gives_the_loops_rows(scene, detector):
+    config = replace(TrackerConfig(), detector=detector)
+    assert config.refine.enabled
+    run = track_frames(scene.frames, detections=as_file(scene), config=config, rng=2)
+    expected = loop_rows(scene.frames, config, 2, as_file(scene), bootstrap="first")
+    assert len(expected) > 0
+    np.testing.assert_array_equal(run.rows, expected)
+
+
+def resized_at(frames, k):
+    """`frames` with frame `k` (0-based) half the size: the detector refuses it."""
+    out = list(frames)
+    out[k] = np.ascontiguousarray(out[k][::2, ::2])
+    return out
+
+
+@pytest.mark.parametrize("external", [False, True])
+def test_detector_error_is_the_loops_error(scene, external):
+    frames = resized_at(scene.frames, 12)
+    # no box on the small frame: its only error is the detector's
+    dets = {f: v for f, v in as_file(scene).items() if f != 13} if external else None
+    config = TrackerConfig()
+    with pytest.raises(ValueError) as in_loop:
+        loop_rows(frames, config, 0, dets, bootstrap="none")
+    with pytest.raises(ValueError) as ahead:
+        track_frames(frames, detections=dets, config=config, rng=0, prime_frames=0)
+    assert "frame shape is" in str(in_loop.value)
+    assert str(ahead.value) == str(in_loop.value)
+    assert no_reader_thread()
+
+
+def test_cli_reports_a_detector_error_in_one_line(scene, tmp_path, capsys):
+    folder = tmp_path / "images"
+    folder.mkdir()
+    for n, f in enumerate(resized_at(scene.frames[:20], 15), start=1):
+        cv2.imwrite(str(folder / f"{n:06d}.png"), f)
+    out = tmp_path / "t.txt"
+    assert main(["track", str(folder), "--bootstrap", "none", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("pftrack track: error:") and "frame shape is" in err
+    assert "\n" not in err
+    assert not out.exists()
+    assert no_reader_thread()
+
+
+def test_the_tracker_gets_its_detector_back(scene):
+    mot = MultiObjectTracker(TrackerConfig(), rng=0)
+    detector = mot.detector
+    with DetectAhead(mot, scene.frames[:5], external=False) as frames:
+        assert mot.detector is not detector
+        for frame in frames:
+            mot.update(frame, None)
+    assert mot.detector is detector
+    assert no_reader_thread()
+
+
+def test_a_frame_the_thread_did_not_detect_is_refused(scene):
+    mot = MultiObjectTracker(TrackerConfig(), rng=0)
+    with DetectAhead(mot, scene.frames[:5], external=False) as frames:
+        next(frames)
+        with pytest.raises(RuntimeError, match="did not detect"):
+            mot.update(scene.frames[1].copy(), None)
+    assert no_reader_thread()
+
+
+def test_folder_source_is_read_once_in_order(scene, tmp_path: Path):
+    # a FrameSource behind the thread: the detector sees every frame once, in order
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    for n, f in enumerate(scene.frames, start=1):
+        cv2.imwrite(str(folder / f"{n:06d}.png"), f)
+    from pftrack.io.video import FrameSource
+
+    run = track_frames(FrameSource(folder), rng=1)
+    frames = list(FrameSource(folder))
+    np.testing.assert_array_equal(run.rows, loop_rows(frames, TrackerConfig(), 1))
