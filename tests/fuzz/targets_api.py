@@ -158,11 +158,6 @@ def _try(cls: Any, params: dict[str, Any]) -> Any:
         return cls()
 
 
-OFFLINE = (
-    "tracking/offline.py: BoxSmoother with extreme noise levels (e.g. size_noise near 1e308 or "
-    "tiny accel) returns NaN boxes or overflows with a RuntimeWarning"
-)
-
 tracker_frames = st.lists(
     hnp.arrays(np.uint8, (24, 32, 3), elements=st.integers(0, 255)), min_size=1, max_size=3
 )
@@ -174,9 +169,8 @@ TARGETS: list[Target] = [
     Target(
         "smooth_tracks",
         call(_smooth, mot_rows(), _smoother_or_none(), st.one_of(st.none(), _link_config())),
-        known=OFFLINE,
     ),
-    Target("BoxSmoother", call(_box_smoother, _box_params(), mot_rows()), known=OFFLINE),
+    Target("BoxSmoother", call(_box_smoother, _box_params(), mot_rows())),
     Target("link_tracklets", call(_link, mot_rows(), _link_config())),
     Target(
         "fill_gaps",
