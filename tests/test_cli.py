@@ -238,3 +238,46 @@ def test_track_gives_opencv_one_thread_and_the_same_tracks(video: Path, tmp_path
         assert (tmp_path / "cli.txt").read_bytes() == (tmp_path / "lib.txt").read_bytes()
     finally:
         cv2.setNumThreads(threads)
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--mask", "nan,0,10,10", "--mask is 'nan,0,10,10', expected x,y,w,h with w, h > 0"),
+        ("--mask", "1e9,0,10,10", "each within ±100000"),
+        ("--mask", "0,0,inf,5", "each within ±100000"),
+        ("--image-size", "0x0", "--image-size is '0x0', expected W and H in (0, 100000] px"),
+        ("--image-size", "nanxnan", "expected W and H in (0, 100000] px"),
+        ("--image-size", "1e9x1e9", "expected W and H in (0, 100000] px"),
+        ("--size", "1e308", "argument --size: expected a number in [1, 100000]"),
+        ("--grid", "1e-300", "argument --grid: expected a number in [0.1, 100000]"),
+        ("--grid", "nan", "argument --grid: expected a number in [0.1, 100000]"),
+    ],
+)
+def test_experiment_gaps_refuses_absurd_masks_and_sizes_before_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str, message: str
+) -> None:
+    # the ground truth does not exist: the option is refused before it is read (was: NaN and
+    # far masks accepted, "out of memory", "arange: cannot compute length", "Maximum allowed
+    # size exceeded")
+    argv = ["experiment", "gaps", "--gt", str(tmp_path / "none.txt"), option, value]
+    try:
+        status = main(argv)
+    except SystemExit as exc:  # argparse's own refusal: usage, then the one error line
+        status = exc.code
+    assert status == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert message in err[-1] and err[-1].startswith("pftrack experiment")
+    assert "Traceback" not in "\n".join(err)
+
+
+def test_experiment_gaps_refuses_a_sweep_of_too_many_positions(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    gt = tmp_path / "gt.txt"
+    gt.write_text("".join(f"{f},1,{10 + f},10,8,16,1,-1,-1,-1\n" for f in range(1, 30)))
+    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "100000x100000", "--grid", "1"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("pftrack experiment: error: sweep: a 1 px grid over 100000 x 100000")
+    assert "more than the limit of 1000000; use a coarser grid" in err and "\n" not in err

@@ -169,3 +169,16 @@ def test_cli_smooth_and_recover_bounded_and_refusing(tmp_path, capsys) -> None: 
     assert not (tmp_path / "o.txt").exists()
     assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--max-gap", "200000"]) == 2
     assert "max_gap is 200000" in capsys.readouterr().err
+
+
+def test_sweep_refuses_huge_grids_and_non_finite_sizes() -> None:
+    from pftrack.recovery.experiment import MAX_SWEEP_POSITIONS, sweep
+
+    trajs = {1: np.column_stack([np.arange(1.0, 11), np.arange(10.0), np.arange(10.0)])}
+    assert len(sweep(trajs, 5.0, 20.0, 20.0, 1.0, min_gaps=0)) == 16 * 16
+    with pytest.raises(ValueError, match=f"more than the limit of {MAX_SWEEP_POSITIONS}"):
+        sweep(trajs, 1.0, 1e5, 1e5, 0.1)
+    with pytest.raises(ValueError, match="must be finite"):
+        sweep(trajs, 1.0, np.nan, 20.0, 1.0)
+    with pytest.raises(ValueError, match="must be finite and > 0"):
+        sweep(trajs, np.inf, 20.0, 20.0, 1.0)
