@@ -182,3 +182,19 @@ def test_sweep_refuses_huge_grids_and_non_finite_sizes() -> None:
         sweep(trajs, 1.0, np.nan, 20.0, 1.0)
     with pytest.raises(ValueError, match="must be finite and > 0"):
         sweep(trajs, np.inf, 20.0, 20.0, 1.0)
+
+
+@pytest.mark.parametrize("method", ["linear", "cubic", "bspline", "gsi", "rts", "gdt", "gdt-bi"])
+def test_recover_gap_refuses_far_coordinates(method: str) -> None:
+    # the fuzz suite's find: x = 1e308 overflowed inside SciPy's CubicSpline (RuntimeWarning)
+    from pftrack.recovery import recover_gap
+
+    a = np.array([[1.0, 0, 0], [2, 0, 0]])
+    b = np.array([[20.0, 1e308, 0], [21, 0, 0]])
+    with pytest.raises(ValueError, match=r"segment_b row 0 has x = 1e\+308, beyond ±1e\+09 px"):
+        recover_gap(a, b, None, method)
+    a5 = np.array([[1.0, 0, 0, 10, 2e9]])
+    with pytest.raises(ValueError, match=r"segment_a row 0 has h = 2e\+09"):
+        recover_gap(a5, np.array([[5.0, 0, 0, 10, 20]]), None, method)
+    got = recover_gap(a, np.array([[20.0, 1e9, 0], [21, 0, 0]]), None, method)
+    assert np.all(np.isfinite(got))  # the bound itself is accepted

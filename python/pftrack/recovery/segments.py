@@ -16,6 +16,9 @@ from pftrack._typing import F64
 
 __all__ = ["as_segment", "consecutive_runs", "contiguous_head", "contiguous_tail", "gap_frames"]
 
+MAX_COORD = 1e9  # px: positions and sizes beyond this are refused (splines and Kalman
+# filters square and multiply them: 1e308 overflows, and no image is a billion pixels wide)
+
 
 def as_segment(seg: ArrayLike, name: str) -> F64:
     """Check and convert one segment to a C-contiguous ``(k, 3|5)`` float64 array.
@@ -36,7 +39,8 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
     TypeError
         Values that are not real numbers (complex, text, objects).
     ValueError
-        Wrong shape, no row, a non-finite value or frames that do not increase strictly.
+        Wrong shape, no row, a non-finite value, a position or size beyond ``MAX_COORD``
+        (1e9 px) or frames that do not increase strictly.
     """
     raw = np.asarray(seg)
     if raw.dtype.kind not in "biuf":
@@ -48,6 +52,13 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
         raise ValueError(f"recover_gap: {name} is empty")
     if not np.all(np.isfinite(a)):
         raise ValueError(f"recover_gap: {name} has a non-finite value")
+    far = np.abs(a[:, 1:]) > MAX_COORD
+    if far.any():
+        r, c = np.argwhere(far)[0]
+        raise ValueError(
+            f"recover_gap: {name} row {r} has {('x', 'y', 'w', 'h')[c]} = {a[r, c + 1]:g}, "
+            f"beyond ±{MAX_COORD:g} px (refused)"
+        )
     if np.any(np.diff(a[:, 0]) <= 0):
         raise ValueError(f"recover_gap: {name} frames must increase strictly")
     return np.ascontiguousarray(a)
