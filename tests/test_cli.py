@@ -281,3 +281,35 @@ def test_experiment_gaps_refuses_a_sweep_of_too_many_positions(
     err = capsys.readouterr().err.strip()
     assert err.startswith("pftrack experiment: error: sweep: a 1 px grid over 100000 x 100000")
     assert "more than the limit of 1000000; use a coarser grid" in err and "\n" not in err
+
+
+def test_track_on_a_truncated_video_or_a_folder_of_mixed_sizes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import cv2
+
+    rng = np.random.default_rng(2)
+    full = tmp_path / "full.avi"
+    w = cv2.VideoWriter(str(full), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
+    for _ in range(20):
+        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
+    w.release()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    assert main(["-q", "track", str(cut), "--out", str(tmp_path / "t.txt")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("pftrack track: warning: ")
+    assert "ended after" in err[0] and "header says 20" in err[0]
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in range(1, 8):
+        shape = (60, 80, 3) if k == 6 else (48, 64, 3)
+        cv2.imwrite(str(folder / f"{k}.png"), rng.integers(0, 256, shape, dtype=np.uint8))
+    out = tmp_path / "f.txt"
+    assert main(["-q", "track", str(folder), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"pftrack track: error: image {folder / '6.png'} is 80x60 but 1.png is 64x48: "
+        "every image of a folder must have one size"
+    )
+    assert not out.exists()
