@@ -313,3 +313,56 @@ def test_track_on_a_truncated_video_or_a_folder_of_mixed_sizes(
         "every image of a folder must have one size"
     )
     assert not out.exists()
+
+
+def _tracks(path: Path) -> Path:
+    path.write_text("".join(f"{f},1,{10 + f},10,8,16,1,-1,-1,-1\n" for f in (1, 2, 3, 9, 10)))
+    return path
+
+
+def test_recover_refuses_options_it_would_ignore_or_cannot_use(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
+    # was: --video (even a missing file) silently ignored without --link
+    assert main(["recover", str(src), "--out", str(out), "--video", str(tmp_path / "no.avi")]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "pftrack recover: error: --video is used only by --link (its colour term); add --link "
+        "or drop it"
+    )
+    for bad in ("nan", "-1", "0"):  # was: accepted (and ignored without --link)
+        with pytest.raises(SystemExit) as exc:
+            main(["recover", str(src), "--out", str(out), "--max-distance", bad])
+        assert exc.value.code == 2
+        err = capsys.readouterr().err.strip().splitlines()[-1]
+        assert err.startswith("pftrack recover: error: argument --max-distance: expected a")
+    assert not out.exists()
+
+
+def test_library_warnings_are_one_line_for_every_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import warnings
+
+    import cv2
+
+    rng = np.random.default_rng(3)
+    full = tmp_path / "full.avi"
+    w = cv2.VideoWriter(str(full), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
+    for _ in range(12):
+        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
+    w.release()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
+        argv = ["-q", "recover", str(src), "--out", str(out), "--link", "--video", str(cut)]
+        assert main(argv) == 0
+        before = warnings.showwarning
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"pftrack recover: warning: {cut} ended after {err[0].split()[6]} frames but its header "
+        "says 12: a truncated or damaged file?"
+    ]
+    assert warnings.showwarning is before  # main restores the formatter it replaced
