@@ -12,12 +12,10 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import MAX_COORD
 from pftrack._typing import F64
 
 __all__ = ["as_segment", "consecutive_runs", "contiguous_head", "contiguous_tail", "gap_frames"]
-
-MAX_COORD = 1e9  # px: positions and sizes beyond this are refused (splines and Kalman
-# filters square and multiply them: 1e308 overflows, and no image is a billion pixels wide)
 
 
 def as_segment(seg: ArrayLike, name: str) -> F64:
