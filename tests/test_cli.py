@@ -366,3 +366,40 @@ def test_library_warnings_are_one_line_for_every_command(
         "says 12: a truncated or damaged file?"
     ]
     assert warnings.showwarning is before  # main restores the formatter it replaced
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["smooth", "A", "B", "--out", "/sys/pftrack-no/x", "--workers", "0"],
+        ["batch", "V", "--out", "/sys/pftrack-no/x", "--workers", "0"],
+        ["demo", "--out-dir", "/sys/pftrack-no/x"],
+    ],
+    ids=["smooth batch", "batch", "demo"],
+)
+def test_an_output_folder_that_cannot_be_created_is_one_line(
+    argv: list[str], tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    if not Path("/sys").is_dir():
+        pytest.skip("no /sys (a folder nobody can create files in) here")
+    a, b = _tracks(tmp_path / "a.txt"), _tracks(tmp_path / "b.txt")
+    argv = [{"A": str(a), "B": str(b), "V": str(video)}.get(x, x) for x in argv]
+    assert main(argv) == 2  # was: "Operation not permitted: /sys/x" without the option
+    err = capsys.readouterr().err.strip()
+    flag = "--out-dir" if argv[0] == "demo" else "--out"
+    assert err.startswith(
+        f"pftrack {argv[0]}: error: {flag} /sys/pftrack-no/x: cannot create the folder ("
+    )  # (Operation not permitted) as root, (Permission denied) otherwise
+    assert "\n" not in err
+
+
+@pytest.mark.parametrize("fps", ["1e-300", "1e308", "0.001", "nan"])
+def test_track_fps_is_bounded(
+    fps: str, video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: 1e-300 accepted, and an --render video written at 1e-300 frames/s
+    with pytest.raises(SystemExit) as exc:
+        main(["track", str(video), "--out", str(tmp_path / "t.txt"), "--fps", fps])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("pftrack track: error: argument --fps: expected a number in [0.01, 1000]")

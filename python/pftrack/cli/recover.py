@@ -50,10 +50,10 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack recover``; return the exit status."""
-    if args.video and not args.link:
-        raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     if batch.is_batch(args.tracks):
         return batch.run_recover(args)
+    if args.video and not args.link:
+        raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot
