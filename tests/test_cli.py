@@ -238,3 +238,168 @@ def test_track_gives_opencv_one_thread_and_the_same_tracks(video: Path, tmp_path
         assert (tmp_path / "cli.txt").read_bytes() == (tmp_path / "lib.txt").read_bytes()
     finally:
         cv2.setNumThreads(threads)
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--mask", "nan,0,10,10", "--mask is 'nan,0,10,10', expected x,y,w,h with w, h > 0"),
+        ("--mask", "1e9,0,10,10", "each within ±100000"),
+        ("--mask", "0,0,inf,5", "each within ±100000"),
+        ("--image-size", "0x0", "--image-size is '0x0', expected W and H in (0, 100000] px"),
+        ("--image-size", "nanxnan", "expected W and H in (0, 100000] px"),
+        ("--image-size", "1e9x1e9", "expected W and H in (0, 100000] px"),
+        ("--size", "1e308", "argument --size: expected a number in [1, 100000]"),
+        ("--grid", "1e-300", "argument --grid: expected a number in [0.1, 100000]"),
+        ("--grid", "nan", "argument --grid: expected a number in [0.1, 100000]"),
+    ],
+)
+def test_experiment_gaps_refuses_absurd_masks_and_sizes_before_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str, message: str
+) -> None:
+    # the ground truth does not exist: the option is refused before it is read (was: NaN and
+    # far masks accepted, "out of memory", "arange: cannot compute length", "Maximum allowed
+    # size exceeded")
+    argv = ["experiment", "gaps", "--gt", str(tmp_path / "none.txt"), option, value]
+    try:
+        status = main(argv)
+    except SystemExit as exc:  # argparse's own refusal: usage, then the one error line
+        status = exc.code
+    assert status == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert message in err[-1] and err[-1].startswith("pftrack experiment")
+    assert "Traceback" not in "\n".join(err)
+
+
+def test_experiment_gaps_refuses_a_sweep_of_too_many_positions(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    gt = tmp_path / "gt.txt"
+    gt.write_text("".join(f"{f},1,{10 + f},10,8,16,1,-1,-1,-1\n" for f in range(1, 30)))
+    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "100000x100000", "--grid", "1"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("pftrack experiment: error: sweep: a 1 px grid over 100000 x 100000")
+    assert "more than the limit of 1000000; use a coarser grid" in err and "\n" not in err
+
+
+def test_track_on_a_truncated_video_or_a_folder_of_mixed_sizes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import cv2
+
+    rng = np.random.default_rng(2)
+    full = tmp_path / "full.avi"
+    w = cv2.VideoWriter(str(full), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
+    for _ in range(20):
+        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
+    w.release()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    assert main(["-q", "track", str(cut), "--out", str(tmp_path / "t.txt")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("pftrack track: warning: ")
+    assert "ended after" in err[0] and "header says 20" in err[0]
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in range(1, 8):
+        shape = (60, 80, 3) if k == 6 else (48, 64, 3)
+        cv2.imwrite(str(folder / f"{k}.png"), rng.integers(0, 256, shape, dtype=np.uint8))
+    out = tmp_path / "f.txt"
+    assert main(["-q", "track", str(folder), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"pftrack track: error: image {folder / '6.png'} is 80x60 but 1.png is 64x48: "
+        "every image of a folder must have one size"
+    )
+    assert not out.exists()
+
+
+def _tracks(path: Path) -> Path:
+    path.write_text("".join(f"{f},1,{10 + f},10,8,16,1,-1,-1,-1\n" for f in (1, 2, 3, 9, 10)))
+    return path
+
+
+def test_recover_refuses_options_it_would_ignore_or_cannot_use(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
+    # was: --video (even a missing file) silently ignored without --link
+    assert main(["recover", str(src), "--out", str(out), "--video", str(tmp_path / "no.avi")]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "pftrack recover: error: --video is used only by --link (its colour term); add --link "
+        "or drop it"
+    )
+    for bad in ("nan", "-1", "0"):  # was: accepted (and ignored without --link)
+        with pytest.raises(SystemExit) as exc:
+            main(["recover", str(src), "--out", str(out), "--max-distance", bad])
+        assert exc.value.code == 2
+        err = capsys.readouterr().err.strip().splitlines()[-1]
+        assert err.startswith("pftrack recover: error: argument --max-distance: expected a")
+    assert not out.exists()
+
+
+def test_library_warnings_are_one_line_for_every_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import warnings
+
+    import cv2
+
+    rng = np.random.default_rng(3)
+    full = tmp_path / "full.avi"
+    w = cv2.VideoWriter(str(full), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
+    for _ in range(12):
+        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
+    w.release()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
+        argv = ["-q", "recover", str(src), "--out", str(out), "--link", "--video", str(cut)]
+        assert main(argv) == 0
+        before = warnings.showwarning
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"pftrack recover: warning: {cut} ended after {err[0].split()[6]} frames but its header "
+        "says 12: a truncated or damaged file?"
+    ]
+    assert warnings.showwarning is before  # main restores the formatter it replaced
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["smooth", "A", "B", "--out", "/sys/pftrack-no/x", "--workers", "0"],
+        ["batch", "V", "--out", "/sys/pftrack-no/x", "--workers", "0"],
+        ["demo", "--out-dir", "/sys/pftrack-no/x"],
+    ],
+    ids=["smooth batch", "batch", "demo"],
+)
+def test_an_output_folder_that_cannot_be_created_is_one_line(
+    argv: list[str], tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    if not Path("/sys").is_dir():
+        pytest.skip("no /sys (a folder nobody can create files in) here")
+    a, b = _tracks(tmp_path / "a.txt"), _tracks(tmp_path / "b.txt")
+    argv = [{"A": str(a), "B": str(b), "V": str(video)}.get(x, x) for x in argv]
+    assert main(argv) == 2  # was: "Operation not permitted: /sys/x" without the option
+    err = capsys.readouterr().err.strip()
+    flag = "--out-dir" if argv[0] == "demo" else "--out"
+    assert err.startswith(
+        f"pftrack {argv[0]}: error: {flag} /sys/pftrack-no/x: cannot create the folder ("
+    )  # (Operation not permitted) as root, (Permission denied) otherwise
+    assert "\n" not in err
+
+
+@pytest.mark.parametrize("fps", ["1e-300", "1e308", "0.001", "nan"])
+def test_track_fps_is_bounded(
+    fps: str, video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: 1e-300 accepted, and an --render video written at 1e-300 frames/s
+    with pytest.raises(SystemExit) as exc:
+        main(["track", str(video), "--out", str(tmp_path / "t.txt"), "--fps", fps])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("pftrack track: error: argument --fps: expected a number in [0.01, 1000]")

@@ -7,7 +7,13 @@ from numpy.typing import ArrayLike
 
 from pftrack._typing import F64
 
-__all__ = ["real_array"]
+__all__ = ["MAX_COORD", "MAX_FRAME", "real_array"]
+
+#: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
+#: wide, and splines and Kalman filters square and multiply them (1e308 overflows).
+MAX_COORD = 1e9
+#: The largest frame number anywhere (a 32-bit int: 2.3 years of video at 30 frames/s).
+MAX_FRAME = 2**31 - 1
 
 
 def real_array(values: ArrayLike, what: str) -> F64:

@@ -27,7 +27,12 @@ def run_demo(out_dir: Path, *, seed: int = 0, n_frames: int = 150, particles: in
 
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out-dir {out_dir} is a file; give a folder")
-    out_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # a read-only or special file system, a file on the way
+        raise ValueError(
+            f"--out-dir {out_dir}: cannot create the folder ({exc.strerror})"
+        ) from None
     names = ("tracks.txt", "truth.txt", "annotated.mp4", "trajectories.png")
     for name in names:  # before any work: every output can be written
         check_output(out_dir / name, what="--out-dir")

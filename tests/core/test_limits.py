@@ -50,3 +50,33 @@ def test_batch_items_of_the_wrong_kind_are_type_and_value_errors() -> None:
         _core.gdt_solve_batch([[1]])
     with pytest.raises((TypeError, ValueError), match="not an array of numbers|convert string"):
         _core.gdt_solve_batch([("abc", *PROBLEM[1:], 3)])
+
+
+@pytest.mark.parametrize(
+    "states, weights",
+    [
+        ([[1e308, 0, 0]], [1e308]),  # the fuzz suite's find: w * x overflowed to inf
+        ([[1e308, -1e308, 5], [1e308, -1e308, 7]], [1e300, 3e300]),
+        ([[1.5e308, 0, 0], [1.5e308, 0, 0], [-1e308, 1, 2]], [1.0, 1.0, 2.0]),
+    ],
+)
+def test_estimate_mean_is_finite_near_the_largest_double(states, weights) -> None:
+    p = np.zeros((len(states), 6))
+    p[:, :3] = states
+    w = np.asarray(weights, dtype=float)
+    mean, map_state, k = _core.estimate(p, w)
+    assert np.all(np.isfinite(mean))
+    c = w / w.sum()  # the reference: a convex combination, summed without overflow
+    np.testing.assert_allclose(mean, (c[:, None] * (p[:, :3] / 1e300)).sum(axis=0) * 1e300)
+    assert k == int(np.argmax(w)) and np.array_equal(map_state, p[k, :3])
+
+
+def test_estimate_of_ordinary_input_is_the_plain_weighted_mean() -> None:
+    rng = np.random.default_rng(7)
+    p = rng.normal(0, 100, (50, 6))
+    w = rng.uniform(0, 1, 50)
+    total, acc = 0.0, [0.0, 0.0, 0.0]
+    for i in range(len(w)):  # the kernel's order of additions: the same bits
+        total += w[i]
+        acc = [acc[d] + w[i] * p[i, d] for d in range(3)]
+    np.testing.assert_array_equal(_core.estimate(p, w)[0], np.array(acc) / total)

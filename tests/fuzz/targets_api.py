@@ -106,6 +106,35 @@ def _tracker(frames: list[Any], dets: list[Any], particles: Any) -> Any:
     return out
 
 
+def _api_tracker(dets: list[Any], options: dict[str, Any]) -> Any:
+    import pftrack
+
+    tracker = pftrack.Tracker(**options)
+    frame = np.zeros((24, 32, 3), np.uint8)
+    with warnings.catch_warnings():
+        # by design: boxes outside the frame are dropped, and an empty run says so
+        warnings.filterwarnings("ignore", message=r".*outside the .* frame", category=UserWarning)
+        warnings.filterwarnings("ignore", message=r"no track over", category=RuntimeWarning)
+        out = [tracker.update(d, frame) for d in dets]
+        out.append(tracker.finalize())
+    return out
+
+
+def _tracker_options() -> st.SearchStrategy[dict[str, Any]]:
+    return st.fixed_dictionaries({}, optional={
+        "particles": maybe(ints(1, 50)), "max_coast": maybe(fl(0, 5)),
+        "min_conf": maybe(fl(0, 1)), "birth_score": maybe(fl(0, 1)), "prime": maybe(fl(0, 3)),
+        "frame_rate": maybe(fl(0.1, 100)), "birth_quantile": maybe(fl(0, 1)),
+    })  # fmt: skip
+
+
+def _evaluate(gt: Any, result: Any, iou: Any, scale: Any, size: Any) -> Any:
+    from pftrack.eval import evaluate_mot
+
+    m = evaluate_mot(gt, result, iou_threshold=iou, scale=scale, image_size=size)
+    return {k: v for k, v in vars(m).items() if isinstance(v, int | float)}
+
+
 def _resample(name: str) -> Any:
     from pftrack import particle_filter
 
@@ -158,11 +187,6 @@ def _try(cls: Any, params: dict[str, Any]) -> Any:
         return cls()
 
 
-OFFLINE = (
-    "tracking/offline.py: BoxSmoother with extreme noise levels (e.g. size_noise near 1e308 or "
-    "tiny accel) returns NaN boxes or overflows with a RuntimeWarning"
-)
-
 tracker_frames = st.lists(
     hnp.arrays(np.uint8, (24, 32, 3), elements=st.integers(0, 255)), min_size=1, max_size=3
 )
@@ -174,9 +198,8 @@ TARGETS: list[Target] = [
     Target(
         "smooth_tracks",
         call(_smooth, mot_rows(), _smoother_or_none(), st.one_of(st.none(), _link_config())),
-        known=OFFLINE,
     ),
-    Target("BoxSmoother", call(_box_smoother, _box_params(), mot_rows()), known=OFFLINE),
+    Target("BoxSmoother", call(_box_smoother, _box_params(), mot_rows())),
     Target("link_tracklets", call(_link, mot_rows(), _link_config())),
     Target(
         "fill_gaps",
@@ -211,6 +234,32 @@ TARGETS: list[Target] = [
     Target(
         "MultiObjectTracker.update",
         call(_tracker, tracker_frames, tracker_dets, maybe(ints(1, 30))),
+    ),  # fmt: skip
+    Target(
+        "Tracker",
+        call(
+            _api_tracker,
+            st.lists(
+                st.one_of(
+                    st.none(), floats_array((2, 5), -40, 60), maybe(floats_array((1, 4), 0, 30))
+                ),
+                min_size=1,
+                max_size=3,
+            ),
+            _tracker_options(),
+        ),
+    ),  # fmt: skip
+    Target(
+        "evaluate_mot",
+        call(
+            _evaluate,
+            mot_rows(),
+            mot_rows(),
+            maybe(fl(0.01, 1)),
+            maybe(fl(0.1, 10)),
+            st.one_of(st.none(), maybe(st.tuples(ints(1, 2000), ints(1, 2000)))),
+        ),
+        finite=False,  # MOTA, IDF1, ... are NaN by definition when nothing is scored
     ),  # fmt: skip
     *[
         Target(

@@ -39,6 +39,11 @@ CASES = {
         ),
         "size_noise",
     ),
+    "BoxSmoother(accel=5e-324)": (lambda: BoxSmoother(accel=5e-324), "accel"),
+    "BoxSmoother.smooth NaN frame": (
+        lambda: BoxSmoother().smooth(np.array([np.nan]), np.full((1, 4), 10.0), np.ones(1, bool)),
+        "frames",
+    ),
 }
 
 

@@ -57,6 +57,10 @@ def test_fast_read_equals_line_by_line(tmp_path: Path) -> None:
         ("1.5,2,3,4,5,6\n", ":1: frame is 1.5"),
         ("1,2,3,4,-5,6\n", ":1: negative box"),
         ("1,2,nan,4,5,6\n", ":1: .*non-finite"),
+        ("1,2,3,4,5,6\n1e10,2,3,4,5,6\n", r":2: frame is 1e10, expected an integer in 1\.\."),
+        ("1,2,1e300,4,5,6\n", r":1: a box value is beyond ±1e\+09 px"),  # was: read, then
+        ("1,2,3,4,5,-1e300\n", ":1: negative box"),  # "x2 <= x1" (1e300 + 8 == 1e300)
+        ("1,2,3,4,5,2e9\n", r":1: a box value is beyond ±1e\+09 px"),
     ],
 )
 def test_bad_lines_still_named(tmp_path: Path, text: str, match: str) -> None:
@@ -72,3 +76,14 @@ def test_write_refuses_non_finite(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="row 1 has (a non-finite value|NaN or inf)"):
         mot.write_mot(tmp_path / "t.txt", a)
     assert not (tmp_path / "t.txt").exists()
+
+
+def test_a_byte_order_mark_is_not_a_field(tmp_path: Path) -> None:
+    # Windows editors save UTF-8 with a BOM (was: "line has a non-number: '\ufeff1,...'")
+    p = tmp_path / "t.txt"
+    p.write_bytes(b"\xef\xbb\xbf1,-1,10,10,8,16,1\r\n2,-1,10,10,8,16,1\r\n")
+    got = mot.read_mot(p)
+    assert got.shape == (2, 10) and got[:, 0].tolist() == [1.0, 2.0]
+    np.testing.assert_array_equal(got, _slow_read(p))
+    p.write_bytes(b"\xef\xbb\xbf# comment\n1,-1,10,10,8,16,1\n")  # the line-by-line reader
+    assert mot.read_mot(p).shape == (1, 10)

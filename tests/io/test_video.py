@@ -197,3 +197,40 @@ def test_stop_ends_the_iteration(tmp_path: Path) -> None:
         if len(seen) == 2:
             src.stop()
     assert seen == [1, 2]
+
+
+def _mjpg(path: Path, n: int, rng: np.random.Generator) -> Path:
+    w = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
+    for _ in range(n):
+        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
+    w.release()
+    return path
+
+
+def test_a_video_that_ends_before_its_header_says_warns_once(tmp_path: Path) -> None:
+    full = _mjpg(tmp_path / "full.avi", 20, np.random.default_rng(0))
+    data = full.read_bytes()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: len(data) // 2])  # the header still says 20 frames
+    src = FrameSource(cut)
+    assert len(src) == 20
+    with pytest.warns(UserWarning, match=r"cut.avi ended after \d+ frames but its header says 20"):
+        n = sum(1 for _ in src)
+    assert 0 < n < 20
+    assert sum(1 for _ in src) == n  # a second pass: the same frames, no second warning
+    assert len(list(itertools.islice(FrameSource(cut), 3))) == 3  # stopped early: no warning
+    assert sum(1 for _ in FrameSource(full)) == 20  # whole: no warning (warnings are errors)
+
+
+def test_an_image_of_another_size_in_a_folder_is_named(tmp_path: Path) -> None:
+    rng = np.random.default_rng(1)
+    for k in range(1, 6):
+        shape = (60, 80, 3) if k == 4 else (48, 64, 3)
+        cv2.imwrite(str(tmp_path / f"{k}.png"), rng.integers(0, 256, shape, dtype=np.uint8))
+    src = FrameSource(tmp_path)
+    message = r"image .*4.png is 80x60 but 1.png is 64x48: every image of a folder must have one"
+    with pytest.raises(ValueError, match=message):
+        list(src)
+    with pytest.raises(ValueError, match=message):
+        src.frames_at([0, 3])
+    assert len(src.frames_at([0, 1, 4])) == 3

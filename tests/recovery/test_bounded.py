@@ -165,7 +165,39 @@ def test_cli_smooth_and_recover_bounded_and_refusing(tmp_path, capsys) -> None: 
     for cmd in ("smooth", "recover"):
         assert main([cmd, str(bad), "--out", str(tmp_path / "o.txt")]) == 2
         err = capsys.readouterr().err
-        assert f"pftrack {cmd}: error:" in err and "3e+09 is not an integer in 1..2147483647" in err
+        assert (
+            f"pftrack {cmd}: error: {bad}:2: frame is 3000000000, expected an integer in "
+            "1..2147483647" in err
+        )  # the reader names the line
     assert not (tmp_path / "o.txt").exists()
     assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--max-gap", "200000"]) == 2
     assert "max_gap is 200000" in capsys.readouterr().err
+
+
+def test_sweep_refuses_huge_grids_and_non_finite_sizes() -> None:
+    from pftrack.recovery.experiment import MAX_SWEEP_POSITIONS, sweep
+
+    trajs = {1: np.column_stack([np.arange(1.0, 11), np.arange(10.0), np.arange(10.0)])}
+    assert len(sweep(trajs, 5.0, 20.0, 20.0, 1.0, min_gaps=0)) == 16 * 16
+    with pytest.raises(ValueError, match=f"more than the limit of {MAX_SWEEP_POSITIONS}"):
+        sweep(trajs, 1.0, 1e5, 1e5, 0.1)
+    with pytest.raises(ValueError, match="must be finite"):
+        sweep(trajs, 1.0, np.nan, 20.0, 1.0)
+    with pytest.raises(ValueError, match="must be finite and > 0"):
+        sweep(trajs, np.inf, 20.0, 20.0, 1.0)
+
+
+@pytest.mark.parametrize("method", ["linear", "cubic", "bspline", "gsi", "rts", "gdt", "gdt-bi"])
+def test_recover_gap_refuses_far_coordinates(method: str) -> None:
+    # the fuzz suite's find: x = 1e308 overflowed inside SciPy's CubicSpline (RuntimeWarning)
+    from pftrack.recovery import recover_gap
+
+    a = np.array([[1.0, 0, 0], [2, 0, 0]])
+    b = np.array([[20.0, 1e308, 0], [21, 0, 0]])
+    with pytest.raises(ValueError, match=r"segment_b row 0 has x = 1e\+308, beyond ±1e\+09 px"):
+        recover_gap(a, b, None, method)
+    a5 = np.array([[1.0, 0, 0, 10, 2e9]])
+    with pytest.raises(ValueError, match=r"segment_a row 0 has h = 2e\+09"):
+        recover_gap(a5, np.array([[5.0, 0, 0, 10, 20]]), None, method)
+    got = recover_gap(a, np.array([[20.0, 1e9, 0], [21, 0, 0]]), None, method)
+    assert np.all(np.isfinite(got))  # the bound itself is accepted

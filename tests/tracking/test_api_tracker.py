@@ -266,6 +266,15 @@ def test_options_and_frames():
         pftrack.Tracker(frame_rate=0)
     with pytest.raises(ValueError, match="max_coast"):
         pftrack.Tracker(max_coast=-1.0)
+    # absurd spans and rates (a fuzz find: max_coast=1e308 was an OverflowError)
+    span = r"max_coast is 1e\+308 s, inf frames at 25 frames/s: more than 100000"
+    with pytest.raises(ValueError, match=span):
+        pftrack.Tracker(max_coast=1e308)
+    with pytest.raises(ValueError, match=r"prime is 5000 s, 1.25e\+05 frames .*more than 100000"):
+        pftrack.Tracker(prime=5000.0)
+    with pytest.raises(ValueError, match=r"frame_rate is 1e\+308, expected a number in \(0, 1000"):
+        pftrack.Tracker(frame_rate=1e308)
+    assert pftrack.Tracker(max_coast=4000.0).config.lifecycle.max_coast == 100_000  # the bound
     with pytest.raises(ValueError, match="camera_motion"):
         pftrack.Tracker(camera_motion="sometimes")
     with pytest.raises(TypeError, match="uint8"):

@@ -94,6 +94,39 @@ def test_smoother_bad_input():
         sm.smooth([1, 2, 3], b * np.nan, [True] * 3)
     with pytest.raises(ValueError, match="noise is -1"):
         BoxSmoother(noise=-1)
+    for frames in ([1, np.nan, 3], [1, 2.5, 3], [1, 2, 1e19]):
+        with pytest.raises(ValueError, match="frames must be integers"):
+            sm.smooth(frames, b, [True] * 3)
+    with pytest.raises(TypeError, match="boxes_xywh must hold real numbers"):
+        sm.smooth([1, 2, 3], b + 1j, [True] * 3)
+    with pytest.raises(ValueError, match="track heights"):
+        sm.smooth([1, 2, 3], np.array([[1e308, 0, 1, 1e-300]] * 3), [True] * 3)
+
+
+@pytest.mark.parametrize("name", ["accel", "noise", "size_accel", "size_noise"])
+@pytest.mark.parametrize("value", [0.0, 5e-324, 1e-7, 1.1e6, 1e308, np.inf, np.nan, True, "1"])
+def test_smoother_noise_levels_out_of_bounds_are_refused(name, value):
+    with pytest.raises(ValueError, match=rf"{name} is .*expected a number in \[1e-06, 1e\+06\]"):
+        BoxSmoother(**{name: value})
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    levels=st.lists(st.sampled_from([1e-6, 1e-3, 1.0, 1e3, 1e6]), min_size=4, max_size=4),
+    scale=st.sampled_from([1e-200, 1e-3, 1.0, 1e4, 1e200]),
+)
+def test_smoother_is_finite_at_the_bounds_and_scale_free(levels, scale):
+    # the noise levels are in track heights: scaling the boxes scales the smoothed boxes, and
+    # any level inside the bounds gives finite boxes (was: NaN boxes or an overflow)
+    rng = np.random.default_rng(5)
+    frames = np.array([1, 2, 3, 7, 8, 20, 320, 700])
+    boxes = np.column_stack([rng.uniform(0, 300, (8, 2)), rng.uniform(5, 50, (8, 2))])
+    observed = np.array([1, 1, 0, 1, 1, 1, 1, 1], bool)
+    sm = BoxSmoother(*levels)
+    unit = sm.smooth(frames, boxes, observed)
+    got = sm.smooth(frames, boxes * scale, observed)
+    assert np.all(np.isfinite(got))
+    np.testing.assert_allclose(got / scale, unit, rtol=1e-9, atol=1e-9 * np.abs(unit).max())
 
 
 def _track(tid, x, tsu, measured=True):

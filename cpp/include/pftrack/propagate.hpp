@@ -91,6 +91,19 @@ inline Estimate estimate_state(const Eigen::Ref<const RowMatrixXd>& particles,
         }
     }
     e.mean /= sum;
+    if (!std::isfinite(sum) || !e.mean.allFinite()) {
+        // w * x or the sum overflowed (weights or states near 1e308): again as a convex
+        // combination, sum_i c_i x_i with c_i = (w_i / w_max) / sum_j (w_j / w_max), whose
+        // partial sums never exceed max |x_i|. Only then: other inputs keep their exact bits.
+        const double w_max = weights.maxCoeff();
+        double scaled_sum = 0.0;
+        for (Index i = 0; i < particles.rows(); ++i) scaled_sum += weights(i) / w_max;
+        e.mean.setZero();
+        for (Index i = 0; i < particles.rows(); ++i) {
+            const double c = (weights(i) / w_max) / scaled_sum;
+            for (int d = 0; d < kStateDim; ++d) e.mean[d] += c * particles(i, d);
+        }
+    }
     e.map = particles.row(e.map_index).head<kStateDim>().transpose();
     return e;
 }

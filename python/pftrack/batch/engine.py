@@ -358,7 +358,10 @@ def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) 
     """Before any work: the folder is writable and no output overwrites an input."""
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file; give a folder")
-    out_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # a read-only or special file system, a file on the way
+        raise ValueError(f"--out {out_dir}: cannot create the folder ({exc.strerror})") from None
     check_output(out_dir / SUMMARY_NAME, what="--out")  # the folder is writable
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
     names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]

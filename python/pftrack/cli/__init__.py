@@ -10,7 +10,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
 
 from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
@@ -62,6 +63,15 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(text.split())
 
 
+def _one_line_warning(command: str) -> Callable[..., None]:
+    """A ``warnings.showwarning`` printing ``pftrack CMD: warning: ...`` (no source line)."""
+
+    def show(message: Warning | str, *_: object, **__: object) -> None:
+        print(f"pftrack {command}: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+    return show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pftrack`` script; returns the exit status."""
     args = build_parser().parse_args(argv)
@@ -70,7 +80,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         set_quiet(True)
     try:
-        return int(args.func(args))
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning(args.command)
+            return int(args.func(args))
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1

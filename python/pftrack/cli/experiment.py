@@ -5,8 +5,10 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from pftrack.cli._options import add_command, positive_int
+from pftrack.cli._options import add_command, bounded_float, positive_int
 from pftrack.recovery.names import METHODS
+
+MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this are refused
 
 
 def add_parser(sub: Any) -> None:
@@ -37,8 +39,10 @@ def add_parser(sub: Any) -> None:
     g.add_argument("--mask", help="x,y,w,h of the representative mask (default: chosen by rule)")
     g.add_argument("--point", default="centre", choices=("centre", "foot"),
                    help="box point used as the trajectory")  # fmt: skip
-    g.add_argument("--size", type=float, default=100.0, help="mask side for the sweep (px)")
-    g.add_argument("--grid", type=float, default=4.0, help="mask position step of the sweep (px)")
+    g.add_argument("--size", type=bounded_float(1.0, MAX_SIDE), default=100.0,
+                   help=f"mask side for the sweep (px, 1 to {MAX_SIDE:g})")  # fmt: skip
+    g.add_argument("--grid", type=bounded_float(0.1, MAX_SIDE), default=4.0,
+                   help=f"mask position step of the sweep (px, 0.1 to {MAX_SIDE:g})")  # fmt: skip
     g.add_argument("--image-size", help="WxH of the ground-truth coordinates (default: GT extent)")
     g.add_argument("--trajectories", type=int,
                    help="keep positions with exactly this many (default: any number)")  # fmt: skip
@@ -65,17 +69,22 @@ def _parse_mask(text: str) -> tuple[float, float, float, float]:
         vals = [float(v) for v in parts]
     except ValueError:
         raise ValueError(f"--mask is {text!r}, expected x,y,w,h numbers") from None
-    if len(vals) != 4 or vals[2] <= 0 or vals[3] <= 0:
-        raise ValueError(f"--mask is {text!r}, expected x,y,w,h with w, h > 0")
+    if len(vals) != 4 or not all(abs(v) <= MAX_SIDE for v in vals) or min(vals[2:]) <= 0:
+        raise ValueError(
+            f"--mask is {text!r}, expected x,y,w,h with w, h > 0 and each within ±{MAX_SIDE:g}"
+        )
     return vals[0], vals[1], vals[2], vals[3]
 
 
 def _parse_size(text: str) -> tuple[float, float]:
     try:
         w_s, h_s = text.lower().split("x")
-        return float(w_s), float(h_s)
+        w, h = float(w_s), float(h_s)
     except ValueError:
         raise ValueError(f"--image-size is {text!r}, expected WxH") from None
+    if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
+        raise ValueError(f"--image-size is {text!r}, expected W and H in (0, {MAX_SIDE:g}] px")
+    return w, h
 
 
 def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
@@ -112,6 +121,10 @@ def run_gaps(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output
 
     inputs = tuple(args.gt)
+    if args.mask:
+        _parse_mask(args.mask)  # bad options are refused before any work
+    if args.image_size:
+        _parse_size(args.image_size)
     if args.json:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.figure:

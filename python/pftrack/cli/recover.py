@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, positive_int
+from pftrack.cli._options import add_command, bounded_float, positive_int
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 
@@ -37,8 +37,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--seed", type=int, default=0,
                    help="auto: seed of the artificial calibration gaps")  # fmt: skip
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
-    p.add_argument("--max-distance", type=float, default=50.0, metavar="PX",
-                   help="linking gate on the motion-prediction distance (pixels)")  # fmt: skip
+    p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=50.0, metavar="PX",
+                   help="linking gate on the motion-prediction distance (pixels, 0.001 to "
+                   "1e6)")  # fmt: skip
     p.add_argument("--video", help="video or image folder for the colour term of --link "
                    "(default: none, motion and size only)")  # fmt: skip
     p.add_argument("--in-place", action="store_true",
@@ -51,6 +52,8 @@ def run(args: argparse.Namespace) -> int:
     """Run ``pftrack recover``; return the exit status."""
     if batch.is_batch(args.tracks):
         return batch.run_recover(args)
+    if args.video and not args.link:
+        raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot

@@ -13,7 +13,6 @@ from pftrack.cli._options import (
     add_command,
     add_tracker_options,
     bounded_float,
-    positive_float,
     tracker_config,
 )
 
@@ -55,9 +54,9 @@ def add_parser(sub: Any) -> None:
         "width over seqinfo.ini's imWidth; else 1)",
     )  # fmt: skip
     p.add_argument(
-        "--fps", type=positive_float, metavar="FPS",
-        help="frame rate of SOURCE, for --render (default: seqinfo.ini's frameRate, else the "
-        "container's header, else 25)",
+        "--fps", type=bounded_float(0.01, 1000.0), metavar="FPS",
+        help="frame rate of SOURCE, for --render, 0.01 to 1000 (default: seqinfo.ini's "
+        "frameRate, else the container's header, else 25)",
     )  # fmt: skip
     p.add_argument(
         "--render", metavar="VIDEO",

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import MAX_COORD, MAX_FRAME
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_write
 
@@ -22,7 +23,7 @@ _DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 1.0, -1.0, -1.0, -1
 
 def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
     """(1-based line number, stripped text) of every line that holds a row."""
-    with path.open("r", encoding="utf-8", errors="replace") as fh:
+    with path.open("r", encoding="utf-8-sig", errors="replace") as fh:  # -sig: a BOM is no field
         for lineno, line in enumerate(fh, start=1):
             text = line.strip()
             if text and not text.startswith("#"):
@@ -55,8 +56,9 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         If `path` does not exist.
     ValueError
         On a malformed line, naming the file and the 1-based line number: fewer than 6 fields,
-        a non-number, a non-finite value, a frame that is not a positive integer, or a negative
-        width or height.
+        a non-number, a non-finite value, a frame that is not an integer in ``1..2**31-1``, a
+        negative width or height, or a box value beyond ±1e9 px. A UTF-8 byte-order mark is
+        skipped.
     """
     p = Path(path)
     if not p.is_file():
@@ -79,13 +81,17 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         if not all(np.isfinite(values[:6])):
             raise ValueError(f"{p}:{lineno}: {what} line has a non-finite value: {text[:80]!r}")
         frame = values[FRAME]
-        if frame < 1 or frame != int(frame):
+        if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
             raise ValueError(
-                f"{p}:{lineno}: frame is {fields[0]}, expected an integer >= 1 "
+                f"{p}:{lineno}: frame is {fields[0]}, expected an integer in 1..{MAX_FRAME} "
                 "(frames count from 1)"
             )
         if values[WIDTH] < 0 or values[HEIGHT] < 0:
             raise ValueError(f"{p}:{lineno}: negative box width or height: {text[:80]!r}")
+        if max(abs(v) for v in values[LEFT : HEIGHT + 1]) > MAX_COORD:
+            raise ValueError(
+                f"{p}:{lineno}: a box value is beyond ±{MAX_COORD:g} px: {text[:80]!r}"
+            )
         values.extend(_DEFAULTS[len(values) :])
         rows.append(values)
     if not rows:
@@ -99,7 +105,7 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
     None sends the file to the line-by-line reader, which names the first bad line.
     """
     try:
-        with p.open("r", encoding="utf-8") as fh:
+        with p.open("r", encoding="utf-8-sig") as fh:
             first = ""
             for line in fh:
                 if line.strip():
@@ -108,7 +114,7 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
         if not first:
             return np.zeros((0, 10))
         a = np.loadtxt(
-            p, delimiter="," if "," in first else None, ndmin=2, encoding="utf-8", comments=None
+            p, delimiter="," if "," in first else None, ndmin=2, encoding="utf-8-sig", comments=None
         )
     except (ValueError, UnicodeDecodeError):
         return None
@@ -120,6 +126,8 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
         np.all(np.isfinite(a[:, :6])) and np.all(fr >= 1) and np.all(fr == np.floor(fr))
     ) or np.any(wh < 0):
         return None
+    if np.any(fr > MAX_FRAME) or np.any(np.abs(a[:, LEFT : HEIGHT + 1]) > MAX_COORD):
+        return None  # the line reader names the line
     if n < 10:
         a = np.hstack([a, np.tile(np.asarray(_DEFAULTS[n:]), (len(a), 1))])
     return a

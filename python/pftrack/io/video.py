@@ -18,6 +18,7 @@ from __future__ import annotations
 import configparser
 import re
 import stat
+import warnings
 from collections.abc import Generator, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -234,6 +235,8 @@ class FrameSource:
         self.live = is_live_source(source)
         self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
+        self._image_shape = (0, 0)  # (height, width) of a folder's first image
+        self._warned_short = False  # a video that ended before its header's frame count
         self._cap: Any = None
         self._replay: list[NDArray[np.uint8]] = []
         self._read_past_replay = False
@@ -286,6 +289,7 @@ class FrameSource:
         first = cv2.imread(str(self._images[0]), cv2.IMREAD_COLOR)
         if first is None:
             raise ValueError(f"cannot read image {self._images[0]}")
+        self._image_shape = (int(first.shape[0]), int(first.shape[1]))
         return first, len(self._images)
 
     @staticmethod
@@ -321,6 +325,20 @@ class FrameSource:
             size = (round(frame.shape[1] * self.scale), round(frame.shape[0] * self.scale))
             frame = cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR)
         return np.asarray(frame, dtype=np.uint8)  # OpenCV's colour reads are uint8: no copy
+
+    def _read_image(self, path: Path) -> NDArray[np.uint8]:
+        """One image of a folder, resized; ValueError if unreadable or not the first's size."""
+        img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+        if img is None:
+            raise ValueError(f"cannot read image {path}")
+        if img.shape[:2] != self._image_shape:
+            h0, w0 = self._image_shape
+            first = self._images[0].name if self._images else "the first image"
+            raise ValueError(
+                f"image {path} is {img.shape[1]}x{img.shape[0]} but {first} is {w0}x{h0}: "
+                "every image of a folder must have one size"
+            )
+        return self._resize(img)
 
     def __len__(self) -> int:
         return self.n_frames
@@ -359,10 +377,7 @@ class FrameSource:
         if self._images is not None:
             out = []
             for i in (i for i in wanted if i < len(self._images)):
-                img = cv2.imread(str(self._images[i]), cv2.IMREAD_COLOR)
-                if img is None:
-                    raise ValueError(f"cannot read image {self._images[i]}")
-                out.append(self._resize(img))
+                out.append(self._read_image(self._images[i]))
             return out
         picked: list[NDArray[np.uint8]] = []
         keep = set(wanted)
@@ -389,20 +404,27 @@ class FrameSource:
     def _iter_stored(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._images is not None:
             for p in self._images:
-                img = cv2.imread(str(p), cv2.IMREAD_COLOR)
-                if img is None:
-                    raise ValueError(f"cannot read image {p}")
-                yield self._resize(img)
+                yield self._read_image(p)
             return
         cap = cv2.VideoCapture(str(self.path))
+        decoded = 0
         try:
             while True:
                 ok, frame = cap.read()
                 if not ok:
                     break
+                decoded += 1
                 yield self._resize(frame)
         finally:
             cap.release()
+        if decoded < self.n_frames and not self._warned_short:  # read to the end (a stopped
+            self._warned_short = True  # reader never gets here); once, not on every pass
+            warnings.warn(
+                f"{self.name} ended after {decoded} frames but its header says "
+                f"{self.n_frames}: a truncated or damaged file?",
+                UserWarning,
+                stacklevel=2,
+            )
 
     def _iter_live(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._read_past_replay:

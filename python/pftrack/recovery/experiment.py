@@ -46,6 +46,8 @@ __all__ = [
     "trajectories",
 ]
 
+MAX_SWEEP_POSITIONS = 1_000_000  # mask positions of one sweep (each costs a pass over the points)
+
 
 @dataclass(frozen=True)
 class Gap:
@@ -393,8 +395,17 @@ def sweep(
     Kept: exactly `n_trajectories` trajectories and `n_gaps` gaps when given, else at least
     `min_gaps` gaps.
     """
-    if size <= 0 or step <= 0:
-        raise ValueError(f"sweep: size {size} and step {step} must be > 0")
+    if not (size > 0 and step > 0 and np.isfinite(size) and np.isfinite(step)):
+        raise ValueError(f"sweep: size {size} and step {step} must be finite and > 0")
+    if not (np.isfinite(width) and np.isfinite(height)):
+        raise ValueError(f"sweep: the image size {width} x {height} must be finite")
+    nx = max(0.0, np.floor((width - size) / step) + 1)
+    ny = max(0.0, np.floor((height - size) / step) + 1)
+    if nx * ny > MAX_SWEEP_POSITIONS:
+        raise ValueError(
+            f"sweep: a {step:g} px grid over {width:g} x {height:g} gives {nx * ny:.3g} mask "
+            f"positions, more than the limit of {MAX_SWEEP_POSITIONS}; use a coarser grid"
+        )
     xs, ys, nt, ng = count_gaps_grid(trajs, size, width, height, step)
     keep = np.ones_like(nt, dtype=bool)
     parts = []

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import MAX_COORD
 from pftrack._typing import F64
 
 __all__ = ["as_segment", "consecutive_runs", "contiguous_head", "contiguous_tail", "gap_frames"]
@@ -36,7 +37,8 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
     TypeError
         Values that are not real numbers (complex, text, objects).
     ValueError
-        Wrong shape, no row, a non-finite value or frames that do not increase strictly.
+        Wrong shape, no row, a non-finite value, a position or size beyond ``MAX_COORD``
+        (1e9 px) or frames that do not increase strictly.
     """
     raw = np.asarray(seg)
     if raw.dtype.kind not in "biuf":
@@ -48,6 +50,13 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
         raise ValueError(f"recover_gap: {name} is empty")
     if not np.all(np.isfinite(a)):
         raise ValueError(f"recover_gap: {name} has a non-finite value")
+    far = np.abs(a[:, 1:]) > MAX_COORD
+    if far.any():
+        r, c = np.argwhere(far)[0]
+        raise ValueError(
+            f"recover_gap: {name} row {r} has {('x', 'y', 'w', 'h')[c]} = {a[r, c + 1]:g}, "
+            f"beyond ±{MAX_COORD:g} px (refused)"
+        )
     if np.any(np.diff(a[:, 0]) <= 0):
         raise ValueError(f"recover_gap: {name} frames must increase strictly")
     return np.ascontiguousarray(a)

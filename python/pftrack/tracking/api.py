@@ -37,6 +37,11 @@ __all__ = ["REFERENCE_RATE", "Tracker", "check_boxes_xyxy", "xywh_to_xyxy_dets"]
 #: Frames per second at which the frame-based defaults of ``pftrack track`` are stated.
 REFERENCE_RATE = 25.0
 
+#: The longest span an option in seconds may give, in frames (as ``pftrack track --max-coast``).
+MAX_SPAN_FRAMES = 100_000
+#: The highest frame rate :class:`Tracker` accepts (as ``pftrack track --fps``).
+MAX_FRAME_RATE = 1000.0
+
 #: Columns of :meth:`Tracker.update`'s output.
 TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
 
@@ -45,7 +50,13 @@ def _frames(seconds: float, frame_rate: float, name: str) -> int:
     """`seconds` as a whole number of frames at `frame_rate`."""
     if not (np.isfinite(seconds) and seconds >= 0):
         raise ValueError(f"{name} is {seconds} s, expected a finite number of seconds >= 0")
-    return int(round(seconds * frame_rate))
+    n = seconds * frame_rate
+    if n > MAX_SPAN_FRAMES:
+        raise ValueError(
+            f"{name} is {seconds:g} s, {n:.3g} frames at {frame_rate:g} frames/s: more than "
+            f"{MAX_SPAN_FRAMES}"
+        )
+    return int(round(n))
 
 
 def xywh_to_xyxy_dets(dets: ArrayLike) -> F64:
@@ -190,8 +201,10 @@ class Tracker:
         link: bool = True,
         prime: float = 1.2,
     ) -> None:
-        if not (np.isfinite(frame_rate) and frame_rate > 0):
-            raise ValueError(f"frame_rate is {frame_rate}, expected a finite value > 0")
+        if not (np.isfinite(frame_rate) and 0 < frame_rate <= MAX_FRAME_RATE):
+            raise ValueError(
+                f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
+            )
         if dynamics not in ("ar2", "ar2-mean"):
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
         if not isinstance(particles, (int, np.integer)) or particles < 1:

@@ -20,15 +20,19 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
 from pftrack.kalman import rts_smooth
 from pftrack.recovery.fill import fill_rows
-from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
+from pftrack.recovery.linking import MAX_FRAME, LinkConfig, check_rows, link_tracklets
 from pftrack.recovery.names import DEFAULT_METHOD
 
 __all__ = ["BoxSmoother", "smooth_tracks"]
+
+NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
+NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
 
 
 @dataclass(frozen=True)
@@ -67,9 +71,11 @@ class BoxSmoother:
     def __post_init__(self) -> None:
         for name in ("accel", "noise", "size_accel", "size_noise"):
             v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and np.isfinite(v) and 0 < v < 1e6):
+            ok = isinstance(v, (int, float)) and not isinstance(v, bool)
+            if not (ok and NOISE_MIN <= v <= NOISE_MAX):
                 raise ValueError(
-                    f"BoxSmoother: {name} is {v!r}, expected a finite value in (0, 1e6)"
+                    f"BoxSmoother: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
+                    f"{NOISE_MAX:g}] (track heights)"
                 )
         h = self.max_hole
         if not isinstance(h, (int, np.integer)) or isinstance(h, bool) or h < 1:
@@ -94,8 +100,15 @@ class BoxSmoother:
         (n, 4) ndarray
             Smoothed boxes for every row. A track with no observed row comes back unchanged.
         """
-        f = np.asarray(frames, dtype=np.int64)
-        b: F64 = np.asarray(boxes_xywh, dtype=np.float64)
+        fr = real_array(frames, "BoxSmoother.smooth: frames")
+        with np.errstate(invalid="ignore"):  # NaN frames are refused just below
+            whole = (fr == np.floor(fr)) & (np.abs(fr) <= MAX_FRAME)
+        if not np.all(whole):
+            raise ValueError(
+                f"BoxSmoother.smooth: frames must be integers with |frame| <= {MAX_FRAME}"
+            )
+        f = fr.astype(np.int64)
+        b: F64 = real_array(boxes_xywh, "BoxSmoother.smooth: boxes_xywh")
         obs = np.asarray(observed, dtype=bool)
         n = len(f)
         if b.shape != (n, 4) or obs.shape != (n,):
@@ -122,15 +135,22 @@ class BoxSmoother:
             raise ValueError(
                 f"BoxSmoother.smooth: the median observed height is {height}, expected > 0"
             )
-        q = height * np.array([self.accel, self.accel, self.size_accel, self.size_accel])
-        r = height * np.array([self.noise, self.noise, self.size_noise, self.size_noise])
+        # in track heights: the same numbers whatever the image scale (no under- or overflow)
+        with np.errstate(over="ignore"):
+            zh = z / height
+        if not np.all(np.isfinite(zh[obs])):
+            raise ValueError(
+                f"BoxSmoother.smooth: boxes span more than {np.finfo(float).max:g} track heights"
+            )
+        q = np.array([self.accel, self.accel, self.size_accel, self.size_accel])
+        r = np.array([self.noise, self.noise, self.size_noise, self.size_noise])
         first = int(np.argmax(obs))
         steps = int(f[-1] - f[first]) + 1
         zt = np.zeros((steps, 4))
         has = np.zeros(steps, dtype=bool)
-        zt[f[first:] - f[first]] = z[first:]
+        zt[f[first:] - f[first]] = np.where(obs[first:, None], zh[first:], 0.0)
         has[f[first:] - f[first]] = obs[first:]
-        mean = rts_smooth(zt, has, q * q, r * r, velocity_sd=10.0 * height, update_first=False)
+        mean = height * rts_smooth(zt, has, q * q, r * r, velocity_sd=10.0, update_first=False)
         np.maximum(mean[:, 2:], 0.5 * z[obs, 2:].min(axis=0), out=mean[:, 2:])
         out: F64 = b.copy()
         out[first:] = cxcywh_to_xywh(mean[f[first:] - f[first]])
