@@ -324,3 +324,14 @@ def test_association_leaves_pairs_unmade_when_cheaper(tau, expected):
 def test_unmatched_cost_must_be_positive():
     with pytest.raises(ValueError, match="unmatched_cost"):
         AssociationConfig(unmatched_cost=0.0)
+
+
+def test_load_detections_bounds_its_scale_as_the_cli(tmp_path):
+    det = tmp_path / "det.txt"
+    det.write_text("1,-1,10,20,30,40,0.9,-1,-1,-1\n")
+    assert load_detections(det, 0.5)[1].tolist() == [[5.0, 10.0, 15.0, 20.0, 0.9]]
+    for scale in (1e308, 0.0, -1.0, float("nan"), 1e-4):
+        with pytest.raises(ValueError, match=r"detection scale is .*expected a number in \[0.001"):
+            load_detections(det, scale)
+    with pytest.raises(TypeError, match="detection scale must be a number, got str"):
+        load_detections(det, "2")  # type: ignore[arg-type]

@@ -59,10 +59,20 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     path : str or os.PathLike
         ``det.txt`` (``frame,-1,left,top,width,height,score,...``).
     scale : float
-        Multiplies the box coordinates (e.g. 0.625 for PETS09 boxes on the 480x360 video).
+        Multiplies the box coordinates (e.g. 0.625 for PETS09 boxes on the 480x360 video), in
+        [0.001, 1000] as ``--det-scale``.
+
+    Raises
+    ------
+    TypeError
+        `scale` is not a real number.
+    ValueError
+        `scale` outside [0.001, 1000], or a bad detection file.
     """
-    if not (np.isfinite(scale) and scale > 0):
-        raise ValueError(f"detection scale is {scale}, expected a finite value > 0")
+    if isinstance(scale, bool) or not isinstance(scale, (int, float, np.integer, np.floating)):
+        raise TypeError(f"detection scale must be a number, got {type(scale).__name__}")
+    if not (1e-3 <= scale <= 1e3):
+        raise ValueError(f"detection scale is {scale}, expected a number in [0.001, 1000]")
     rows = read_mot(path, what="detection file")
     return {
         f: np.column_stack([r[:, 2:6] * scale, r[:, 6]]) for f, r in group_by_frame(rows).items()
