@@ -92,16 +92,31 @@ def test_detector_error_is_the_loops_error(scene, external):
     assert no_reader_thread()
 
 
-def test_cli_reports_a_detector_error_in_one_line(scene, tmp_path, capsys):
+def test_cli_reports_a_detector_error_in_one_line(scene, tmp_path, capsys, monkeypatch):
+    # frames of another size are refused by the folder reader itself (naming the image), so
+    # the detector is made to fail on the 16th frame it sees, on its thread
+    from pftrack.detection.paper import PaperDetector
+
     folder = tmp_path / "images"
     folder.mkdir()
-    for n, f in enumerate(resized_at(scene.frames[:20], 15), start=1):
+    for n, f in enumerate(scene.frames[:20], start=1):
         cv2.imwrite(str(folder / f"{n:06d}.png"), f)
+    detect = PaperDetector.detect
+    calls = []
+
+    def failing(self, frame):
+        calls.append(threading.current_thread().name)
+        if len(calls) == 16:
+            raise ValueError("PaperDetector.detect: the detector failed on this frame\n(two lines)")
+        return detect(self, frame)
+
+    monkeypatch.setattr(PaperDetector, "detect", failing)
     out = tmp_path / "t.txt"
     assert main(["track", str(folder), "--bootstrap", "none", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("pftrack track: error:") and "frame shape is" in err
-    assert "\n" not in err
+    said = "PaperDetector.detect: the detector failed on this frame (two lines)"
+    assert err == f"pftrack track: error: {said}"
+    assert threading.main_thread().name not in calls  # it ran on the detector's thread
     assert not out.exists()
     assert no_reader_thread()
 
