@@ -169,6 +169,12 @@ def test_cli_eval(tmp_path, capsys):
     assert "21.4" in capsys.readouterr().out  # MOTA 3/14 in percent
     assert json.loads(out.read_text())["num_switches"] == 1
     assert main(["eval", "--gt", str(tmp_path / "nope.txt"), "--res", str(out)]) == 2
+    capsys.readouterr()
+    # a results folder against one ground-truth file: named as such, not "not found"
+    assert main(["eval", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"pftrack eval: error: --res {tmp_path} is a folder but --gt")
+    assert "\n" not in err
 
 
 # ---- agreement with py-motmetrics on random cases -------------------------------------------

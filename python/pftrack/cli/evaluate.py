@@ -95,6 +95,11 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
 
     gt, res = Path(args.gt), Path(args.res)
     if gt.is_file():
+        if res.is_dir():
+            raise ValueError(
+                f"--res {res} is a folder but --gt {gt} is one file; give one result file, or "
+                "a ground-truth folder of sequences with a folder of SEQ.txt results"
+            )
         if not res.is_file():
             raise FileNotFoundError(f"result file not found: {res}")
         if args.seqs:
