@@ -118,8 +118,10 @@ def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message:
 
 
 def test_workers_are_single_threaded(client: Any) -> None:
-    def threads() -> tuple[int, str | None, str | None, str | None]:
+    def threads() -> tuple[int, str | None, str | None, str | None, bool]:
         import cv2
+
+        from pftrack.batch.tasks import tracking_threads
 
         env = os.environ.get
         return (
@@ -127,11 +129,16 @@ def test_workers_are_single_threaded(client: Any) -> None:
             env("OPENBLAS_NUM_THREADS"),
             env("OMP_NUM_THREADS"),
             env("MALLOC_TRIM_THRESHOLD_"),
+            tracking_threads(),
         )
 
     result = client.run(threads)
-    # and no MALLOC_TRIM_THRESHOLD_: Dask's default makes tracking ~1.5x slower (engine.py)
-    assert len(result) == 2 and set(result.values()) == {(1, "1", "1", None)}
+    # and no MALLOC_TRIM_THRESHOLD_: Dask's default makes tracking ~1.5x slower (engine.py);
+    # no read-ahead or detector thread in a worker: it has one core already
+    assert len(result) == 2 and set(result.values()) == {(1, "1", "1", None, False)}
+    from pftrack.batch.tasks import tracking_threads
+
+    assert tracking_threads()  # this process (serial runs) keeps them
 
 
 def test_cluster_equals_serial_and_pftrack_track(data: Path, client: Any, tmp_path: Path) -> None:

@@ -152,3 +152,17 @@ def test_folder_source_is_read_once_in_order(scene, tmp_path: Path):
     run = track_frames(FrameSource(folder), rng=1)
     frames = list(FrameSource(folder))
     np.testing.assert_array_equal(run.rows, loop_rows(frames, TrackerConfig(), 1))
+
+
+def test_without_threads_the_rows_are_the_same(scene):
+    # threads=False (a batch worker): everything on the calling thread, the same rows
+    config = TrackerConfig()
+    on = track_frames(scene.frames, config=config, rng=0)
+    before = {t.name for t in threading.enumerate()}
+    off = track_frames(scene.frames, config=config, rng=0, threads=False)
+    assert {t.name for t in threading.enumerate()} == before
+    np.testing.assert_array_equal(on.rows, off.rows)
+    dets = as_file(scene)
+    on = track_frames(scene.frames, detections=dets, config=config, rng=0)
+    off = track_frames(scene.frames, detections=dets, config=config, rng=0, threads=False)
+    np.testing.assert_array_equal(on.rows, off.rows)

@@ -18,6 +18,8 @@ THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"
 class SingleThreaded(WorkerPlugin):
     """Make each worker process single-threaded: one sequence per core, no oversubscription.
 
+    Tracking in a worker uses no read-ahead or detector thread (`tracking_threads`).
+
     OpenCV gets ``cv2.setNumThreads(1)`` when the plugin is set up. BLAS and OpenMP read their
     thread counts when they load, so those come from the environment the worker starts with:
     Dask's nanny sets ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` and ``MKL_NUM_THREADS`` to 1
@@ -49,6 +51,9 @@ class SingleThreaded(WorkerPlugin):
         for var in THREAD_VARIABLES:
             os.environ.setdefault(var, "1")
         cv2.setNumThreads(1)
+        from pftrack.batch.tasks import WORKER_THREADS_VARIABLE
+
+        os.environ[WORKER_THREADS_VARIABLE] = "0"  # no read-ahead or detector thread either
         import pftrack.eval
         import pftrack.io.video
         import pftrack.recovery

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import socket
 import tempfile
 import time
@@ -33,6 +34,7 @@ __all__ = [
     "sequence_metrics",
     "smooth_file",
     "track_sequence",
+    "tracking_threads",
 ]
 
 
@@ -151,6 +153,20 @@ def _as_written(rows: F64) -> F64:
     return np.array(lines, dtype=np.float64).reshape(len(rows), 10)
 
 
+#: Set to "0" by the worker plugin (:mod:`pftrack.batch._plugin`) in every Dask worker.
+WORKER_THREADS_VARIABLE = "PFTRACK_TRACKING_THREADS"
+
+
+def tracking_threads() -> bool:
+    """Whether tracking here decodes and detects on threads ahead of the tracker.
+
+    Yes in an ordinary process (``pftrack track``, ``pftrack batch --workers 0``); no in a
+    Dask worker of a batch, which already has one task per core: the threads would only cost
+    CPU there (the rows are the same either way).
+    """
+    return os.environ.get(WORKER_THREADS_VARIABLE, "1") != "0"
+
+
 def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     """Track one sequence as ``pftrack track`` would; score it where it has ground truth.
 
@@ -192,6 +208,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         smooth=options.smooth,
         link=options.link,
         show_progress=False,
+        threads=tracking_threads(),
     )
     rows = run.rows
     metrics = None

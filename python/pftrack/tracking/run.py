@@ -5,8 +5,9 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Sequence
-from contextlib import closing
+from contextlib import closing, nullcontext
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -93,6 +94,7 @@ def track_frames(
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
     on_frame: Callable[[int, NDArray[np.uint8], list[Track], F64], None] | None = None,
+    threads: bool = True,
 ) -> TrackingRun:
     """Track every frame of `source`: :class:`~pftrack.tracking.api.Tracker` over every frame.
 
@@ -135,6 +137,10 @@ def track_frames(
         run's writer settled during this frame (online boxes, before the offline pass; a
         bridged gap's rows arrive when the track is re-detected). For rendering while tracking
         and for writing rows of a live source as they come.
+    threads : bool
+        Decode and detect on threads ahead of the tracker (below). False does all the work on
+        the calling thread, with the same rows: for a process that already has one task per
+        core, such as a worker of ``pftrack batch``, where the extra threads only cost CPU.
 
     Notes
     -----
@@ -174,11 +180,13 @@ def track_frames(
     # state), whenever update() would call it: always with the built-in detector, for box
     # refinement's foreground with external detections
     ahead = detections is None or config.refine.enabled or config.sampler == "rjmcmc"
-    stream = (
-        DetectAhead(tracker.tracker, prefetch(frames), external=detections is not None)
-        if ahead
-        else closing(prefetch(frames))
-    )
+    if not threads:
+        it = iter(frames)
+        stream: Any = closing(it) if hasattr(it, "close") else nullcontext(it)
+    elif ahead:
+        stream = DetectAhead(tracker.tracker, prefetch(frames), external=detections is not None)
+    else:
+        stream = closing(prefetch(frames))
     with stream as decoded:
         for n, frame in enumerate(
             progress(decoded, total=total, desc="tracking", enable=show_progress, unit="frame"),
@@ -230,6 +238,7 @@ def track_path(
     smooth: bool = True,
     link: bool = True,
     show_progress: bool | None = None,
+    threads: bool = True,
 ) -> TrackingRun:
     """Track a video file or image folder as ``pftrack track`` does (and ``pftrack batch``).
 
@@ -255,6 +264,8 @@ def track_path(
         (:class:`~pftrack.recovery.LinkConfig`).
     show_progress : bool, optional
         Per-frame progress bar on stderr (default: when stderr is a terminal).
+    threads : bool
+        Decode and detect on threads ahead of the tracker (see :func:`track_frames`).
     """
     frames = source if isinstance(source, FrameSource) else FrameSource(source)
     dets = load_detections(detections, det_scale) if detections is not None else None
@@ -267,4 +278,5 @@ def track_path(
         show_progress=show_progress,
         smoother=BoxSmoother() if smooth else None,
         link=LinkConfig() if link else None,
+        threads=threads,
     )
