@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from pftrack.eval import evaluate_mot
 from pftrack.recovery import fill_gaps, link_tracklets
 from pftrack.tracking import BoxSmoother, smooth_tracks
 
@@ -40,6 +41,13 @@ CASES = {
         "size_noise",
     ),
     "BoxSmoother(accel=5e-324)": (lambda: BoxSmoother(accel=5e-324), "accel"),
+    # found by the long fuzz run on the sanitized build: 1e308 frames and ids reached an int cast
+    "evaluate_mot frame 1e308": (lambda: evaluate_mot(ROWS[:0], _with(0, 1e308)), "beyond"),
+    "evaluate_mot id 1e308": (lambda: evaluate_mot(ROWS, _with(1, 1e308)), "frame or id"),
+    "evaluate_mot complex rows": (
+        lambda: evaluate_mot(ROWS, ROWS.astype(complex)),
+        "must hold real numbers",
+    ),
     "BoxSmoother.smooth NaN frame": (
         lambda: BoxSmoother().smooth(np.array([np.nan]), np.full((1, 4), 10.0), np.ones(1, bool)),
         "frames",
@@ -50,5 +58,5 @@ CASES = {
 @pytest.mark.parametrize("name", list(CASES))
 def test_refused_with_a_message(name: str) -> None:
     fn, word = CASES[name]
-    with pytest.raises(ValueError, match=word):
+    with pytest.raises((ValueError, TypeError), match=word):
         fn()

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
+from pftrack._check import MAX_FRAME, real_array
 from pftrack.boxes import iou_xywh
 from pftrack.io.mot import CONF, FRAME, ID, LEFT
 
@@ -196,13 +197,19 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
 
 
 def _check_rows(rows: ArrayLike, name: str) -> NDArray[np.float64]:
-    a = np.asarray(rows, dtype=np.float64)
+    a = real_array(rows, f"evaluate_mot: {name}")
     if a.size == 0:
         return np.zeros((0, 10))
     if a.ndim != 2 or a.shape[1] < 6:
         raise ValueError(f"evaluate_mot: {name} has shape {a.shape}, expected (M, 6..10) MOT rows")
     if not np.all(np.isfinite(a[:, :6])):
         raise ValueError(f"evaluate_mot: {name} has non-finite values in its first 6 columns")
+    huge = np.abs(a[:, :2]) > MAX_FRAME
+    if huge.any():
+        k = int(np.flatnonzero(huge.any(axis=1))[0])
+        raise ValueError(
+            f"evaluate_mot: {name} row {k} has frame or id {a[k, :2].tolist()} beyond {MAX_FRAME}"
+        )
     if a.shape[1] < 10:
         pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
         a = np.hstack([a, pad])
