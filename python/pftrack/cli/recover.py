@@ -59,7 +59,6 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.mot import data_line_numbers, read_mot, write_mot
     from pftrack.recovery import LinkConfig, check_unique, fill_gaps, link_tracklets
 
-    check_output(args.out, what="--out")
     src = Path(args.tracks)
     out = Path(args.out)
     if out.exists() and src.exists() and os.path.samefile(out, src) and not args.in_place:
