@@ -283,19 +283,27 @@ def test_experiment_gaps_refuses_a_sweep_of_too_many_positions(
     assert "more than the limit of 1000000; use a coarser grid" in err and "\n" not in err
 
 
+def _truncated_video(tmp_path: Path, rng: np.random.Generator, frames: int) -> Path:
+    """``cut.avi``: the first half of the bytes of a `frames`-frame 64x48 noise MJPG video."""
+    import cv2
+
+    full = tmp_path / "full.avi"
+    w = cv2.VideoWriter(str(full), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
+    for _ in range(frames):
+        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
+    w.release()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    return cut
+
+
 def test_track_on_a_truncated_video_or_a_folder_of_mixed_sizes(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     import cv2
 
     rng = np.random.default_rng(2)
-    full = tmp_path / "full.avi"
-    w = cv2.VideoWriter(str(full), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
-    for _ in range(20):
-        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
-    w.release()
-    cut = tmp_path / "cut.avi"
-    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    cut = _truncated_video(tmp_path, rng, 20)
     assert main(["-q", "track", str(cut), "--out", str(tmp_path / "t.txt")]) == 0
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("pftrack track: warning: ")
@@ -344,16 +352,7 @@ def test_library_warnings_are_one_line_for_every_command(
 ) -> None:
     import warnings
 
-    import cv2
-
-    rng = np.random.default_rng(3)
-    full = tmp_path / "full.avi"
-    w = cv2.VideoWriter(str(full), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
-    for _ in range(12):
-        w.write(rng.integers(0, 256, (48, 64, 3), dtype=np.uint8))
-    w.release()
-    cut = tmp_path / "cut.avi"
-    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    cut = _truncated_video(tmp_path, np.random.default_rng(3), 12)
     src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
     with warnings.catch_warnings():
         warnings.simplefilter("default")  # as outside the test suite (which makes them errors)

@@ -49,8 +49,8 @@ def progress(
     items : iterable
         What to iterate.
     total : int, optional
-        Number of items if known (else only the count, time and rate are shown). Taken from
-        ``len(items)`` when there is one.
+        Number of items if known (else only the count, time and rate are shown). tqdm takes
+        it from ``len(items)`` when there is one.
     desc : str
         Label in front of the bar.
     enable : bool, optional
@@ -63,8 +63,6 @@ def progress(
         return
     from tqdm import tqdm  # only when a bar is drawn: keeps `import pftrack` light
 
-    if total is None and hasattr(items, "__len__"):
-        total = len(items) or None  # type: ignore[arg-type]
     with tqdm(
         items,
         total=total,

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from pftrack._typing import PathLike
 from pftrack.batch.engine import BatchSummary, Job, run_jobs
-from pftrack.batch.inputs import find_sequences, find_track_files
+from pftrack.batch.inputs import Inputs, find_sequences, find_track_files
 from pftrack.batch.tasks import (
     RecoverOptions,
     SmoothOptions,
@@ -21,8 +21,6 @@ if TYPE_CHECKING:
     from distributed import Client
 
 __all__ = ["recover_many", "smooth_many", "track_many"]
-
-Inputs = PathLike | list[PathLike] | tuple[PathLike, ...]
 
 
 def track_many(

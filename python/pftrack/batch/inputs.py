@@ -21,6 +21,9 @@ __all__ = ["VIDEO_SUFFIXES", "SequenceInput", "find_sequences", "find_track_file
 #: File extensions taken as videos when a folder is scanned.
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 
+#: What a batch is given: one path or several.
+Inputs = PathLike | list[PathLike] | tuple[PathLike, ...]
+
 #: Names a sequence may not have: its outputs would overwrite the batch's own files.
 RESERVED_NAMES = ("summary",)
 
@@ -56,9 +59,11 @@ class SequenceInput:
         return tuple(p for p in (self.frames, self.detections, self.gt) if p is not None)
 
 
-def _absolute(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> list[Path]:
+def _absolute(inputs: Inputs) -> list[Path]:
     """The inputs as absolute paths: workers may run in another folder than this process."""
     paths = [inputs] if isinstance(inputs, (str, os.PathLike)) else list(inputs)
+    if not paths:
+        raise ValueError("no input given")
     return [Path(os.path.abspath(p)) for p in paths]
 
 
@@ -104,15 +109,14 @@ def _as_sequence(path: Path) -> SequenceInput | None:
         frames = path / "img1"
     elif _has_images(path):
         frames = path
-    elif marked and len(_videos(path)) == 1:  # the shared data's layout: SEQ/video.avi
-        frames = _videos(path)[0]
-    elif marked:
-        raise ValueError(
-            f"sequence folder {path} has no img1/ and not exactly one video "
-            f"({len(_videos(path))} found)"
-        )
-    else:
+    elif not marked:
         return None
+    elif len(videos := _videos(path)) == 1:  # the shared data's layout: SEQ/video.avi
+        frames = videos[0]
+    else:
+        raise ValueError(
+            f"sequence folder {path} has no img1/ and not exactly one video ({len(videos)} found)"
+        )
     return SequenceInput(
         path.name,
         frames,
@@ -122,7 +126,7 @@ def _as_sequence(path: Path) -> SequenceInput | None:
     )
 
 
-def find_sequences(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> list[SequenceInput]:
+def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     """The sequences named by `inputs`, in order (a folder of sequences in natural order).
 
     Parameters
@@ -138,8 +142,6 @@ def find_sequences(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> 
         No sequence is found, or two have the same name (their outputs would collide).
     """
     paths = _absolute(inputs)
-    if not paths:
-        raise ValueError("no input given")
     found: list[SequenceInput] = []
     for path in paths:
         if not path.exists():
@@ -167,7 +169,7 @@ def find_sequences(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> 
     return found
 
 
-def find_track_files(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -> list[Path]:
+def find_track_files(inputs: Inputs) -> list[Path]:
     """MOTChallenge text files named by `inputs`: files, or the ``*.txt`` files of folders.
 
     Raises
@@ -178,8 +180,6 @@ def find_track_files(inputs: PathLike | list[PathLike] | tuple[PathLike, ...]) -
         A folder holds no ``.txt`` file, or two files have the same name.
     """
     paths = _absolute(inputs)
-    if not paths:
-        raise ValueError("no input given")
     found: list[Path] = []
     for path in paths:
         if not path.exists():

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from pftrack._typing import F64
+from pftrack._typing import F64, PathLike
 from pftrack.batch.inputs import SequenceInput
 from pftrack.tracking.config import TrackerConfig
 
@@ -30,6 +30,7 @@ __all__ = [
     "SmoothOptions",
     "TaskResult",
     "TrackOptions",
+    "read_tracks",
     "recover_file",
     "sequence_metrics",
     "smooth_file",
@@ -241,6 +242,22 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     return TaskResult(rows, files, info)
 
 
+def read_tracks(path: PathLike) -> F64:
+    """Read a tracks file whose (frame, id) pairs are unique (an error names the lines).
+
+    The file is read a second time, for its line numbers, only when a pair repeats.
+    """
+    from pftrack.io.mot import data_line_numbers, read_mot
+    from pftrack.recovery import check_unique
+
+    rows = read_mot(path, what="tracks file")
+    try:
+        check_unique(rows)
+    except ValueError:
+        check_unique(rows, data_line_numbers(path))
+    return rows
+
+
 @dataclass(frozen=True)
 class RecoverOptions:
     """Settings of ``pftrack recover`` over several files (see its ``--help``)."""
@@ -258,11 +275,9 @@ class RecoverOptions:
 
 def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
     """Fill the gaps of one tracks file as ``pftrack recover FILE`` does (no ``--video``)."""
-    from pftrack.io.mot import data_line_numbers, read_mot
-    from pftrack.recovery import LinkConfig, check_unique, fill_gaps, link_tracklets
+    from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
 
-    rows = read_mot(path, what="tracks file")
-    check_unique(rows, data_line_numbers(path))
+    rows = read_tracks(path)
     n_links = 0
     if options.link:
         cfg = LinkConfig(max_gap=options.max_gap, max_distance=options.max_distance)
@@ -297,13 +312,11 @@ class SmoothOptions:
 
 def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     """Link, fill and smooth one tracks file as ``pftrack smooth FILE`` does."""
-    from pftrack.io.mot import data_line_numbers, read_mot
-    from pftrack.recovery import LinkConfig, check_unique
+    from pftrack.recovery import LinkConfig
     from pftrack.tracking import smooth_tracks
 
     t0 = time.perf_counter()
-    rows = read_mot(path, what="tracks file")
-    check_unique(rows, data_line_numbers(path))
+    rows = read_tracks(path)
     link = LinkConfig(max_gap=options.max_gap) if options.link else None
     result = smooth_tracks(rows, link=link)
     info: dict[str, Any] = {

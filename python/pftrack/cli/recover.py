@@ -55,11 +55,11 @@ def run(args: argparse.Namespace) -> int:
     if args.video and not args.link:
         raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
+    from pftrack.batch.tasks import read_tracks
     from pftrack.io.atomic import check_output
-    from pftrack.io.mot import data_line_numbers, read_mot, write_mot
-    from pftrack.recovery import LinkConfig, check_unique, fill_gaps, link_tracklets
+    from pftrack.io.mot import write_mot
+    from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
 
-    check_output(args.out, what="--out")
     src = Path(args.tracks)
     out = Path(args.out)
     if out.exists() and src.exists() and os.path.samefile(out, src) and not args.in_place:
@@ -67,11 +67,7 @@ def run(args: argparse.Namespace) -> int:
             f"--out {out} is the input file; pass --in-place to replace it (atomically)"
         )
     check_output(out, what="--out", inputs=(args.video,) if args.video else ())
-    rows = read_mot(src, what="tracks file")
-    try:
-        check_unique(rows)
-    except ValueError:  # name the lines (reading the file again costs time: only on error)
-        check_unique(rows, data_line_numbers(src))
+    rows = read_tracks(src)
     n_links = 0
     if args.link:
         frames = None

@@ -43,17 +43,17 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     import numpy as np
 
+    from pftrack.batch.tasks import read_tracks
     from pftrack.io.atomic import check_output
-    from pftrack.io.mot import data_line_numbers, read_mot, write_mot
-    from pftrack.recovery import LinkConfig, check_unique
+    from pftrack.io.mot import write_mot
+    from pftrack.recovery import LinkConfig
     from pftrack.tracking import smooth_tracks
 
     src, out = Path(args.tracks), Path(args.out)
     if out.exists() and src.exists() and os.path.samefile(out, src):
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
     check_output(out, what="--out")
-    rows = read_mot(src, what="tracks file")
-    check_unique(rows, data_line_numbers(src))
+    rows = read_tracks(src)
     link = None if args.no_link else LinkConfig(max_gap=args.max_gap)
     result = smooth_tracks(rows, link=link)
     write_mot(out, result)
