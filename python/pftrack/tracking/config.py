@@ -296,7 +296,3 @@ class TrackerConfig:
         if self.detector not in DETECTORS:
             raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
         _in_unit_interval("TrackerConfig", reference_rate=self.reference_rate)
-        if self.camera_motion not in CAMERA_MOTION:
-            raise ValueError(
-                f"camera_motion is {self.camera_motion!r}, expected 'auto', 'on' or 'off'"
-            )
