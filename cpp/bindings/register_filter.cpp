@@ -21,20 +21,22 @@ namespace {
 py::array_t<double> batch_item(const py::handle& h, const char* what, py::ssize_t k,
                                py::ssize_t rows, py::ssize_t cols) {
     const char* fn = "sis_step_batch";
-    const std::string name = std::string(what) + "[" + std::to_string(k) + "]";
-    require(py::isinstance<py::array>(h), fn, name + " must be a NumPy array");
+    // every message (the item's name, the dtype's) built only on failure: this runs for each
+    // object on every frame
+    const auto name = [&] { return std::string(what) + "[" + std::to_string(k) + "]"; };
+    if (!py::isinstance<py::array>(h)) fail(fn, name() + " must be a NumPy array");
     const auto a = py::reinterpret_borrow<py::array>(h);
-    if (!a.dtype().is(py::dtype::of<double>()))  // the dtype's name only on failure (costly)
-        require(false, fn, (name + " dtype").c_str(), bind::dtype_name(a), "float64");
-    require((a.flags() & py::array::c_style) != 0 && a.writeable(), fn,
-            name + " must be C-contiguous and writeable");
+    if (!a.dtype().is(py::dtype::of<double>()))
+        require(false, fn, (name() + " dtype").c_str(), bind::dtype_name(a), "float64");
+    if (!((a.flags() & py::array::c_style) != 0 && a.writeable()))
+        fail(fn, name() + " must be C-contiguous and writeable");
     if (cols == 0) {
-        require(a.ndim() == 1 && (rows < 0 || a.shape(0) == rows), fn,
-                name + " must have shape (N,), N the particles' rows");
-    } else {
-        require(a.ndim() == 2 && a.shape(1) == cols && (rows < 0 || a.shape(0) == rows), fn,
-                name + " must have shape (" + (rows < 0 ? std::string("N") : std::to_string(rows)) +
-                    ", " + std::to_string(cols) + ")");
+        if (!(a.ndim() == 1 && (rows < 0 || a.shape(0) == rows)))
+            fail(fn, name() + " must have shape (N,), N the particles' rows");
+    } else if (!(a.ndim() == 2 && a.shape(1) == cols && (rows < 0 || a.shape(0) == rows))) {
+        fail(fn, name() + " must have shape (" +
+                     (rows < 0 ? std::string("N") : std::to_string(rows)) + ", " +
+                     std::to_string(cols) + ")");
     }
     return py::reinterpret_borrow<py::array_t<double>>(a);
 }
@@ -156,8 +158,8 @@ void register_filter(py::module_& m) {
                 keep.push_back(batch_item(means[i], "means", i, 2, kStateDim));
                 auto r = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
                     refs[i]);
-                require(static_cast<bool>(r) && r.ndim() == 1, fn,
-                        "refs[" + std::to_string(i) + "] must be a (B,) float array");
+                if (!(r && r.ndim() == 1))
+                    fail(fn, "refs[" + std::to_string(i) + "] must be a (B,) float array");
                 keep.push_back(r);
                 prms.push_back(bind::make_step_params(w0(i), h0(i), a, b, sigma, s_min, s_max,
                                                       use_means, lam, kernel, resample, fn));

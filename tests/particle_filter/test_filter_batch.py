@@ -21,16 +21,8 @@ from pftrack.particle_filter import (
 from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.track import LiveTrack, follow_tracks_motion, predict_tracks, reseed_tracks
+from tests.particle_filter.test_filter import _particles
 from tests.reference import kernels as ref
-
-
-def _particles(rng: np.random.Generator, n: int) -> np.ndarray:
-    p = np.empty((n, 6))
-    p[:, :2] = rng.normal(40, 5, (n, 2))
-    p[:, 2] = rng.uniform(0.8, 1.2, n)
-    p[:, 3:5] = p[:, :2] - rng.normal(1, 1, (n, 2))
-    p[:, 5] = p[:, 2] * rng.uniform(0.95, 1.05, n)
-    return p
 
 
 def _objects(rng: np.random.Generator, image: _core.BinnedImage, k: int) -> list[dict]:
@@ -163,6 +155,16 @@ def _scene(shift: int = 0) -> np.ndarray:
     return frame
 
 
+def _live_tracks(image: _core.BinnedImage, cfg: TrackerConfig, boxes) -> list[LiveTrack]:
+    """One LiveTrack per box (left, top, w, h), its reference the box's colour."""
+    out = []
+    for k, b in enumerate(boxes):
+        c = b[:2] + b[2:] / 2
+        hist = box_histograms(image, [[*c, *b[2:]]])[0] + 1e-3
+        out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
+    return out
+
+
 @pytest.mark.parametrize("estimate", ["mean", "map"])
 def test_step_filters_equals_step_each(estimate):
     image0 = hsv_bins(_scene())
@@ -199,15 +201,7 @@ def test_predict_tracks_equals_predict_each():
     cfg = TrackerConfig()
     boxes = [np.array([30.0, 40.0, 20.0, 40.0]), np.array([100.0, 30.0, 15.0, 30.0])]
 
-    def make() -> list[LiveTrack]:
-        out = []
-        for k, b in enumerate(boxes):
-            c = b[:2] + b[2:] / 2
-            hist = box_histograms(image0, [[*c, *b[2:]]])[0] + 1e-3
-            out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
-        return out
-
-    batched, single = make(), make()
+    batched, single = _live_tracks(image0, cfg, boxes), _live_tracks(image0, cfg, boxes)
     for t in range(1, 6):
         image = hsv_bins(_scene(2 * t))
         predict_tracks(batched, image, cfg.motion.colour_noise)
@@ -274,12 +268,7 @@ def test_reseed_tracks_equals_follow_one_at_a_time():
     boxes = np.array([[30.0, 40.0, 20.0, 40.0], [100.0, 30.0, 15.0, 30.0], [60, 10, 10, 20]])
 
     def make() -> list[LiveTrack]:
-        out = []
-        for k, b in enumerate(boxes):
-            c = b[:2] + b[2:] / 2
-            hist = box_histograms(image, [[*c, *b[2:]]])[0] + 1e-3
-            out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
-        return out
+        return _live_tracks(image, cfg, boxes)
 
     batched, single = make(), make()
     det = boxes + [[2.0, -1.0, 1.0, 0.5]]
@@ -306,11 +295,7 @@ def test_follow_tracks_motion_equals_follow_motion_each(smooth: bool):
     boxes = np.array([[30.0, 40.0, 20.0, 40.0], [100.0, 30.0, 15.0, 30.0], [60, 10, 10, 20]])
 
     def make() -> list[LiveTrack]:
-        out = []
-        for k, b in enumerate(boxes):
-            c = b[:2] + b[2:] / 2
-            hist = box_histograms(image, [[*c, *b[2:]]])[0] + 1e-3
-            out.append(LiveTrack(k + 1, b, hist, cfg, 100 + k, 0.9))
+        out = _live_tracks(image, cfg, boxes)
         predict_tracks(out, image, cfg.motion.colour_noise)  # a velocity and a covariance
         return out
 

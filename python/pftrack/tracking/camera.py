@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64
-from pftrack.tracking.config import CameraConfig
+from pftrack.tracking.config import CAMERA_MOTION, CameraConfig
 from pftrack.tracking.track import LiveTrack, Track
 
 __all__ = [
@@ -157,12 +157,12 @@ def estimate_motion(
         ``[[a, -b, tx], [b, a, ty]]`` mapping a pixel of `previous` to `current`; None when
         there are too few corners or inliers.
     """
-    cfg = config if config is not None else CameraConfig()
-    _, prev = _Measure(cfg).grey(previous)
-    factor, cur = _Measure(cfg).grey(current)
+    measure = _Measure(config if config is not None else CameraConfig())
+    _, prev = measure.grey(previous)
+    factor, cur = measure.grey(current)
     if prev.shape != cur.shape:
         raise ValueError(f"frames differ in size: {previous.shape} and {current.shape}")
-    return _Measure(cfg).fit(prev, cur, factor, np.asarray(exclude_xywh, np.float64))
+    return measure.fit_corners(prev, cur, factor, np.asarray(exclude_xywh, np.float64))[0]
 
 
 class _Measure:
@@ -177,10 +177,6 @@ class _Measure:
             raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
         factor = min(1.0, self.config.max_side / max(f.shape[:2]))
         return factor, _grey(f, factor)
-
-    def fit(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], factor: float,
-            exclude: F64) -> F64 | None:  # fmt: skip
-        return self.fit_corners(prev, cur, factor, exclude)[0]
 
     def fit_corners(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], factor: float,
                     exclude: F64) -> tuple[F64 | None, NDArray[np.float32] | None]:  # fmt: skip
@@ -241,7 +237,7 @@ class CameraMotion:
     """
 
     def __init__(self, mode: str = "auto", config: CameraConfig | None = None) -> None:
-        if mode not in ("auto", "on", "off"):
+        if mode not in CAMERA_MOTION:
             raise ValueError(f"camera_motion is {mode!r}, expected 'auto', 'on' or 'off'")
         self.mode = mode
         self.config = config if config is not None else CameraConfig()
@@ -274,19 +270,24 @@ class CameraMotion:
         factor, grey = self._measure.grey(frame)
         prev, self._prev = self._prev, grey
         affine = None
+        magnitude = 0.0
         size = (frame.shape[0], frame.shape[1])
+        diagonal = float(np.hypot(*size))
         if prev is not None and prev.shape == grey.shape:
-            affine = self._still(prev, grey, factor, size)
-            if affine is None:  # in full: new corners
+            still = self._still(prev, grey, factor, size, diagonal)
+            if still is not None:
+                affine, magnitude = still
+            else:  # in full: new corners
                 exclude = np.asarray(exclude_xywh, dtype=np.float64).reshape(-1, 4)
                 affine, corners = self._measure.fit_corners(prev, grey, factor, exclude)
                 self._corners = None if corners is None else corners[: cfg.still_features]
                 self._corner_age = 0
-        magnitude = 0.0 if affine is None else motion_magnitude(affine, size)
+                if affine is not None:
+                    magnitude = motion_magnitude(affine, size)
         if self.mode == "on":
             return CameraStep(affine, magnitude, True, affine, False)
 
-        moves = affine is not None and magnitude > cfg.threshold * float(np.hypot(*size))
+        moves = affine is not None and magnitude > cfg.threshold * diagonal
         apply = None
         if not self.moving:
             if moves and affine is not None:
@@ -309,11 +310,12 @@ class CameraMotion:
         return CameraStep(affine, magnitude, self.moving, apply, background_ok)
 
     def _still(self, prev: NDArray[np.uint8], grey: NDArray[np.uint8], factor: float,
-               size: tuple[int, int]) -> F64 | None:  # fmt: skip
+               size: tuple[int, int], diagonal: float) -> tuple[F64, float] | None:  # fmt: skip
         """The cheap measurement of a still camera ("auto"): None when it must be done in full.
 
         The corners kept from earlier frames are followed into this one; the estimate stands
         when enough of them are inliers and it moves the image by under half the threshold.
+        Returns the estimate and its :func:`motion_magnitude`.
         """
         cfg = self.config
         corners = self._corners
@@ -327,11 +329,13 @@ class CameraMotion:
         ):
             return None
         affine, kept = self._measure.follow(prev, grey, corners, factor)
-        limit = 0.5 * cfg.threshold * float(np.hypot(*size))
-        if affine is None or motion_magnitude(affine, size) >= limit:
+        if affine is None:
+            return None
+        magnitude = motion_magnitude(affine, size)
+        if magnitude >= 0.5 * cfg.threshold * diagonal:
             return None
         self._corners, self._corner_age = kept, self._corner_age + 1
-        return affine
+        return affine, magnitude
 
     def check_frames(self, frames: Iterable[NDArray[np.uint8]]) -> bool:
         """Tell whether the camera moves anywhere in `frames` (the moving state is not kept)."""

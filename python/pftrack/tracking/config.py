@@ -32,6 +32,13 @@ def _in_unit_interval(owner: str, **values: float) -> None:
             raise ValueError(f"{owner}: {name} is {v}, expected a value in [0, 1]")
 
 
+def _integers_at_least(owner: str, lo: int, config: object, *names: str) -> None:
+    for name in names:
+        v = getattr(config, name)
+        if not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"{owner}: {name} is {v!r}, expected an integer >= {lo}")
+
+
 @dataclass(frozen=True)
 class AssociationConfig:
     """How tracks and detections are paired (Hungarian method over a gated cost).
@@ -117,10 +124,7 @@ class LifecycleConfig:
     coast_min_rho: float = 0.5
 
     def __post_init__(self) -> None:
-        for name in ("max_coast", "min_hits", "birth_window"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, np.integer)) or v < 0:
-                raise ValueError(f"LifecycleConfig: {name} is {v!r}, expected an integer >= 0")
+        _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
         _in_unit_interval("LifecycleConfig", coast_min_rho=self.coast_min_rho)
         if self.birth_quantile is not None:
             _in_unit_interval("LifecycleConfig", birth_quantile=self.birth_quantile)
@@ -221,14 +225,8 @@ class CameraConfig:
 
     def __post_init__(self) -> None:
         names = ("max_side", "max_features", "min_inliers", "on_frames", "off_frames")
-        for name in (*names, "refresh_frames"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, np.integer)) or v < 1:
-                raise ValueError(f"CameraConfig: {name} is {v!r}, expected an integer >= 1")
-        for name in ("settle_frames", "still_features"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, np.integer)) or v < 0:
-                raise ValueError(f"CameraConfig: {name} is {v!r}, expected an integer >= 0")
+        _integers_at_least("CameraConfig", 1, self, *names, "refresh_frames")
+        _integers_at_least("CameraConfig", 0, self, "settle_frames", "still_features")
         for name in ("ransac_threshold", "threshold"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
@@ -296,7 +294,3 @@ class TrackerConfig:
         if self.detector not in DETECTORS:
             raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
         _in_unit_interval("TrackerConfig", reference_rate=self.reference_rate)
-        if self.camera_motion not in CAMERA_MOTION:
-            raise ValueError(
-                f"camera_motion is {self.camera_motion!r}, expected 'auto', 'on' or 'off'"
-            )

@@ -202,6 +202,18 @@ class LiveTrack:
         )
 
 
+def _motion_state(tracks: Sequence[LiveTrack]) -> tuple[F64, F64, tuple[F64, F64, F64]]:
+    """The centre filters' state as arrays over the tracks.
+
+    p (K, 2), v (K, 2), and the covariance's p00, p01, p11 as (K, 1) columns: what
+    :func:`pftrack.kalman.cv_predict` and :func:`~pftrack.kalman.cv_update` take.
+    """
+    p = np.array([t.motion.p for t in tracks])
+    v = np.array([t.motion.v for t in tracks])
+    cov = np.array([t.motion.cov for t in tracks])  # (K, 3): p00, p01, p11
+    return p, v, (cov[:, 0:1], cov[:, 1:2], cov[:, 2:3])
+
+
 def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_noise: float) -> None:
     """:meth:`LiveTrack.predict` for every track at once.
 
@@ -223,12 +235,10 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
     states = step_filters([t.filter for t in tracks], binned)
     size = np.array([t.size for t in tracks])  # (K, 2)
     h = size[:, 1:2]
-    p = np.array([t.motion.p for t in tracks])
-    v = np.array([t.motion.v for t in tracks])
-    cov = np.array([t.motion.cov for t in tracks])  # (K, 3): p00, p01, p11
+    p, v, cov = _motion_state(tracks)
     accel = np.array([t.motion.accel for t in tracks])[:, None]
     z = np.array([s.box_cxcywh[:2] for s in states])
-    mean, c = cv_predict((p, v), (cov[:, 0:1], cov[:, 1:2], cov[:, 2:3]), (accel * h) ** 2)
+    mean, c = cv_predict((p, v), cov, (accel * h) ** 2)
     mean, c = cv_update(mean, c, z, (colour_noise * h) ** 2)
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     boxes = np.concatenate([p - size / 2, size], axis=1)
@@ -262,12 +272,10 @@ def follow_tracks_motion(
         return
     b = np.asarray(boxes_xywh, dtype=np.float64).reshape(-1, 4)
     size = np.array([t.size for t in tracks])  # (K, 2)
-    p = np.array([t.motion.p for t in tracks])
-    v = np.array([t.motion.v for t in tracks])
-    cov = np.array([t.motion.cov for t in tracks])  # (K, 3): p00, p01, p11
+    p, v, cov = _motion_state(tracks)
     centre = b[:, :2] + b[:, 2:] / 2
     sigma = config.motion.detection_noise * size[:, 1:2]
-    mean, c = cv_update((p, v), (cov[:, 0:1], cov[:, 1:2], cov[:, 2:3]), centre, sigma**2)
+    mean, c = cv_update((p, v), cov, centre, sigma**2)
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     size = 0.7 * size + 0.3 * b[:, 2:]
     boxes = np.concatenate([p - size / 2, size], axis=1) if smooth else b.copy()

@@ -269,15 +269,16 @@ class MultiObjectTracker:
                 self.tracks[ti].matched(float(scores[di]), int(index[di]))
             follow_tracks_motion([self.tracks[ti] for ti in pairs[:, 0]], b, cfg, smooth)
             followed = result.matches
-        for ti, di in result.matches if large.any() else ():
-            t, b = self.tracks[ti], boxes[di]
-            merged = b[2] * b[3] > cfg.association.merge_ratio * t.size[0] * t.size[1] and (
-                covers_another(b, np.array([o.box for k, o in enumerate(self.tracks) if k != ti]))
-            )
-            t.matched(float(scores[di]), int(index[di]))
-            if not merged:
-                t.follow_motion(b, cfg, smooth)
-                followed.append((ti, di))
+        else:  # in turn: a blob is tested against the boxes of the tracks followed before it
+            for (ti, di), big in zip(result.matches, large.tolist(), strict=True):
+                t = self.tracks[ti]
+                merged = big and covers_another(
+                    boxes[di], np.array([o.box for k, o in enumerate(self.tracks) if k != ti])
+                )
+                t.matched(float(scores[di]), int(index[di]))
+                if not merged:
+                    t.follow_motion(boxes[di], cfg, smooth)
+                    followed.append((ti, di))
         if followed:
             dis = [di for _, di in followed]
             reseed_tracks([self.tracks[ti] for ti, _ in followed], boxes[dis], hists[dis], cfg)
