@@ -18,10 +18,7 @@ void register_refine(py::module_& m) {
             const char* fn = "refine_boxes";
             require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
             require_finite(boxes, fn, "boxes");
-            // (bind::check_mask names the dtype up front: a costly str() on every call)
-            if (!mask.dtype().is(py::dtype::of<std::uint8_t>()) &&
-                !mask.dtype().is(py::dtype::of<bool>()))
-                require(false, fn, "mask dtype", bind::dtype_name(mask), "uint8 or bool");
+            bind::check_mask_dtype(mask, fn);
             require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
             require(mask.strides(1) == 1 && mask.strides(0) > 0, fn,
                     "mask must be packed along rows (use numpy.ascontiguousarray)");
