@@ -20,13 +20,12 @@ model behind box refinement (on by default with detections) and the camera-motio
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 
 import numpy as np
 import pytest
 from pytest_benchmark.fixture import BenchmarkFixture
 
-import pftrack
+from experiments.cost_per_object import new_tracker
 from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import make_scene
 
@@ -59,10 +58,7 @@ def test_update_10_objects(
     wall: list[list[float]] = []
 
     def run() -> None:
-        tracker = pftrack.Tracker(seed=0, prime=0)
-        if not refine:
-            config = replace(tracker.config, refine=replace(tracker.config.refine, enabled=False))
-            tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
+        tracker = new_tracker(refine=refine)
         for k in range(WARM):
             tracker.update(dets[k], frames[k])
         cpu.append([])

@@ -8,6 +8,7 @@ import io
 import os
 import sys
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
@@ -16,6 +17,20 @@ from pftrack.io.atomic import atomic_write
 
 REPO = Path(__file__).resolve().parents[1]
 """The repository root (the folder holding ``experiments/``)."""
+
+
+@dataclass(frozen=True)
+class Source:
+    """One real sequence of the data folder: its folder, video file, ground-truth scale onto
+    the video (PETS09's ground truth is in 768x576 pixels, its video 480x360)."""
+
+    name: str
+    video: str
+    scale: float
+
+
+PETS = Source("pets09-s2l1", "video.avi", 0.625)
+TUD = Source("tud-campus", "video.mp4", 1.0)
 
 
 def data_root(arg: PathLike | None = None) -> Path:

@@ -123,15 +123,22 @@ def per_object_loop() -> Iterator[None]:
         tracker_module.predict_tracks = saved
 
 
+def new_tracker(*, refine: bool = True) -> pftrack.Tracker:
+    """A fresh ``pftrack.Tracker`` (seed 0, no priming); ``refine=False`` turns box refinement,
+    and so the background model behind it, off."""
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    if refine:
+        return tracker
+    cfg = tracker.config
+    cfg = replace(cfg, refine=replace(cfg.refine, enabled=False))
+    return pftrack.Tracker.from_config(cfg, 0, prime_frames=0)
+
+
 def time_updates(frames: list[Frame], dets: list[F64], *, refine: bool) -> tuple[float, float]:
     """Best-of-REPEATS (wall, CPU) ms per ``update`` over the timed frames."""
     best_wall, best_cpu = np.inf, np.inf
     for _ in range(REPEATS):
-        tracker = pftrack.Tracker(seed=0, prime=0)
-        if not refine:
-            cfg = tracker.config
-            cfg = replace(cfg, refine=replace(cfg.refine, enabled=False))
-            tracker = pftrack.Tracker.from_config(cfg, 0, prime_frames=0)
+        tracker = new_tracker(refine=refine)
         for k in range(WARM):
             tracker.update(dets[k], frames[k])
         wall0, cpu0 = time.perf_counter(), time.process_time()

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from experiments._common import data_root, experiment_parser, tee_stdout
+from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.boxes import iou_xywh
 from pftrack.detection import PaperDetector, make_detector
@@ -34,7 +34,7 @@ from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import read_frames
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 
-REAL = {"pets": ("pets09-s2l1", "video.avi", 0.625), "tud": ("tud-campus", "video.mp4", 1.0)}
+REAL = {"pets": PETS, "tud": TUD}
 
 
 def n_matches(det: F64, gt: F64, thr: float) -> int:
@@ -51,14 +51,14 @@ def load_sequence(name: str, data: Path) -> tuple[list[np.ndarray], F64] | None:
     if name in BUSY_SCENES:
         scene = make_busy_scene(name, rng=0)
         return scene.frames, scene.truth
-    folder, video, scale = REAL[name]
-    seq = data / folder
-    if not (seq / video).is_file():
+    src = REAL[name]
+    seq = data / src.name
+    if not (seq / src.video).is_file():
         return None
     gt = read_mot(seq / "gt.txt")
     gt = gt[gt[:, 6] != 0]
-    gt[:, 2:6] *= scale
-    return read_frames(seq / video), gt
+    gt[:, 2:6] *= src.scale
+    return read_frames(seq / src.video), gt
 
 
 def detection_scores(

@@ -27,14 +27,13 @@ from __future__ import annotations
 import sys
 import tempfile
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import cv2
 import numpy as np
 
-from experiments._common import REPO, data_root, experiment_parser, tee_stdout
+from experiments._common import PETS, REPO, TUD, Source, data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.cli import main as pftrack_main
 from pftrack.eval import evaluate_mot
@@ -46,16 +45,7 @@ from pftrack.synthetic import camera_path, warp_frame, warp_rows
 PERIOD = 120.0  # frames, both sequences
 
 
-@dataclass(frozen=True)
-class Source:
-    """One source sequence: folder, video file, ground-truth scale onto the video."""
-
-    name: str
-    video: str
-    scale: float
-
-
-SEQUENCES = (Source("pets09-s2l1", "video.avi", 0.625), Source("tud-campus", "video.mp4", 1.0))
+SEQUENCES = (PETS, TUD)
 VERSIONS: dict[str, dict[str, Any]] = {
     "static": {"zoom_swing": 0.0, "pan": (0.0, 0.0), "roll": 0.0},
     "moving": {},

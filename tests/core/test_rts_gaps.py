@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -54,16 +54,9 @@ def test_same_from_threads() -> None:
     """GIL released: four threads at once give the serial result."""
     pairs = _pairs(3, 200)
     want = np.vstack(rts_batch(pairs))
-    res: list[np.ndarray] = []
-
-    def run() -> None:
-        res.append(np.vstack(rts_batch(pairs)))
-
-    threads = [threading.Thread(target=run) for _ in range(4)]
-    for th in threads:
-        th.start()
-    for th in threads:
-        th.join()
+    with ThreadPoolExecutor(4) as pool:
+        res = list(pool.map(lambda _: np.vstack(rts_batch(pairs)), range(4)))
+    assert len(res) == 4
     for r in res:
         np.testing.assert_array_equal(r, want)
 

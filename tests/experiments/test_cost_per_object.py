@@ -8,7 +8,6 @@ import cv2
 import numpy as np
 import pytest
 
-import pftrack
 from experiments import cost_per_object as exp
 
 
@@ -30,7 +29,7 @@ def test_per_object_loop_gives_the_same_tracks():
     frames, dets = exp.make_crowd(6, 12, (320, 240), seed=1)
 
     def run() -> list[np.ndarray]:
-        tracker = pftrack.Tracker(seed=0, prime=0)
+        tracker = exp.new_tracker()
         return [tracker.update(d, f) for d, f in zip(dets, frames, strict=True)]
 
     batched = run()

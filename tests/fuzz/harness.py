@@ -101,7 +101,6 @@ class Target:
     name: str
     calls: st.SearchStrategy[tuple[Callable[..., Any], tuple[Any, ...], dict[str, Any]]]
     finite: bool = True  # every float in the result must be finite
-    known: str = ""  # a known failure in code this suite may not change: its reason (xfail)
 
 
 def check_call(fn: Callable[..., Any], args: tuple[Any, ...], kwargs: dict[str, Any],

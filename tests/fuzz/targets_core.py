@@ -73,15 +73,21 @@ def _resample(name: str) -> Target:
     return Target(name, calls)
 
 
-def _step_kwargs(n: int, b: int) -> dict[str, st.SearchStrategy[Any]]:
+B = 64  # colour bins of the step targets' images (hsv_bins 4 x 4 x 4)
+
+
+def _object_kwargs(n: int) -> dict[str, st.SearchStrategy[Any]]:
+    """One filter's state: particles, weights, means."""
     return {
         "particles": maybe(particles(n)),
         "weights": maybe(weights(n)),
         "means": maybe(floats_array((2, 3), 0, 20)),
-        "image": maybe(binned()),
-        "ref": maybe(floats_array((b,), 0, 1)),
-        "w0": maybe(fl(0.5, 20)),
-        "h0": maybe(fl(0.5, 20)),
+    }
+
+
+def _model_kwargs() -> dict[str, st.SearchStrategy[Any]]:
+    """The motion model and likelihood settings sis_step and sis_step_batch share."""
+    return {
         "a": maybe(vec3()),
         "b": maybe(vec3()),
         "sigma": maybe(vec3(0, 3)),
@@ -91,36 +97,40 @@ def _step_kwargs(n: int, b: int) -> dict[str, st.SearchStrategy[Any]]:
         "lam": maybe(fl(0, 50)),
         "kernel": maybe(st.sampled_from(["uniform", "epanechnikov", "gaussian"])),
         "resample": st.booleans(),
+    }
+
+
+def _step_kwargs(n: int) -> dict[str, st.SearchStrategy[Any]]:
+    return {
+        **_object_kwargs(n),
+        "image": maybe(binned()),
+        "ref": maybe(floats_array((B,), 0, 1)),
+        "w0": maybe(fl(0.5, 20)),
+        "h0": maybe(fl(0.5, 20)),
+        **_model_kwargs(),
         "seed": maybe(ints(0, 2**63 - 1)),
         "step": maybe(ints(0, 1000)),
     }
 
 
 def _sis() -> st.SearchStrategy[Any]:
-    return N.flatmap(lambda n: call(_core.sis_step, **_step_kwargs(n, 64)))
+    return N.flatmap(lambda n: call(_core.sis_step, **_step_kwargs(n)))
 
 
 def _sis_batch() -> st.SearchStrategy[Any]:
     def kw(ns: list[int]) -> dict[str, st.SearchStrategy[Any]]:
         k = len(ns)
-        per = [_step_kwargs(n, 64) for n in ns]
+        per = [_object_kwargs(n) for n in ns]
         return {
-            "particles": maybe(st.tuples(*[p["particles"] for p in per]).map(list)),
-            "weights": maybe(st.tuples(*[p["weights"] for p in per]).map(list)),
-            "means": maybe(st.tuples(*[p["means"] for p in per]).map(list)),
+            **{
+                key: maybe(st.tuples(*[p[key] for p in per]).map(list))
+                for key in ("particles", "weights", "means")
+            },
             "image": maybe(binned()),
-            "refs": maybe(st.lists(floats_array((64,), 0, 1), min_size=k, max_size=k)),
+            "refs": maybe(st.lists(floats_array((B,), 0, 1), min_size=k, max_size=k)),
             "w0": maybe(floats_array((k,), 0.5, 20)),
             "h0": maybe(floats_array((k,), 0.5, 20)),
-            "a": maybe(vec3()),
-            "b": maybe(vec3()),
-            "sigma": maybe(vec3(0, 3)),
-            "s_min": maybe(fl(0.1, 1)),
-            "s_max": maybe(fl(1, 5)),
-            "use_means": st.booleans(),
-            "lam": maybe(fl(0, 50)),
-            "kernel": maybe(st.sampled_from(["uniform", "epanechnikov", "gaussian"])),
-            "resample": st.booleans(),
+            **_model_kwargs(),
             "seeds": maybe(st.lists(ints(0, 2**63 - 1), min_size=k, max_size=k)),
             "steps": maybe(st.lists(ints(0, 1000), min_size=k, max_size=k)),
         }
@@ -138,7 +148,7 @@ def _assignment() -> st.SearchStrategy[Any]:
 
 def _mh() -> st.SearchStrategy[Any]:
     def kw(n: int) -> dict[str, st.SearchStrategy[Any]]:
-        k = _step_kwargs(n, 64)
+        k = _step_kwargs(n)
         k.update(n_iter=maybe(ints(1, 3)), burn_in=maybe(ints(0, 2)),
                  proposal=maybe(st.sampled_from(["dynamics", "random_walk"])),
                  rw_sigma=maybe(vec3(0, 2)))  # fmt: skip

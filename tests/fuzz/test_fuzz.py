@@ -20,23 +20,10 @@ from tests.fuzz.targets_api import TARGETS as API_TARGETS
 from tests.fuzz.targets_core import TARGETS as CORE_TARGETS
 
 TARGETS = CORE_TARGETS + API_TARGETS
-LONG_TOTAL = 10_000  # examples over the targets without a known failure, in the slow run
-LONG_EACH = math.ceil(LONG_TOTAL / sum(not t.known for t in TARGETS))
+IDS = [t.name for t in TARGETS]
+LONG_TOTAL = 10_000  # examples over all targets, in the slow run
+LONG_EACH = math.ceil(LONG_TOTAL / len(TARGETS))
 RANDOM = os.environ.get("PFTRACK_FUZZ_RANDOM", "") not in ("", "0")
-
-
-def _params(strict: bool) -> list[object]:
-    """One parameter per target; a known failure is an xfail with its reason. Not strict: a
-    short run need not draw the failing input (tests/fuzz/test_known_failures.py pins each
-    one, strictly)."""
-    return [
-        pytest.param(
-            t,
-            id=t.name,
-            marks=[pytest.mark.xfail(strict=strict, reason=t.known)] if t.known else [],
-        )  # fmt: skip
-        for t in TARGETS
-    ]
 
 
 def _run(target: Target, data: st.DataObject) -> None:
@@ -44,7 +31,7 @@ def _run(target: Target, data: st.DataObject) -> None:
     check_call(fn, args, kwargs, finite=target.finite)
 
 
-@pytest.mark.parametrize("target", _params(strict=False))
+@pytest.mark.parametrize("target", TARGETS, ids=IDS)
 @settings(settings.get_profile("fuzz-short"))
 @given(data=st.data())
 def test_fuzz_short(target: Target, data: st.DataObject) -> None:
@@ -52,7 +39,7 @@ def test_fuzz_short(target: Target, data: st.DataObject) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("target", _params(strict=False))
+@pytest.mark.parametrize("target", TARGETS, ids=IDS)
 @settings(settings.get_profile("fuzz-short"), max_examples=LONG_EACH, derandomize=not RANDOM)
 @given(data=st.data())
 def test_fuzz_long(target: Target, data: st.DataObject) -> None:
