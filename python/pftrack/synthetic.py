@@ -265,6 +265,15 @@ def _path(
     return start_frame, pts[: max(1, n_frames - start_frame + 1)]
 
 
+def _check_scene_args(fn: str, n_frames: int, width: int, height: int, noise: float) -> None:
+    """The frame count, size and noise level that `make_scene` and `make_busy_scene` share."""
+    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
+        if not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"{fn}: {name} is {v!r}, expected an integer >= {lo}")
+    if not (np.isfinite(noise) and noise >= 0):
+        raise ValueError(f"{fn}: noise is {noise}, expected a finite value >= 0")
+
+
 def make_scene(
     n_frames: int = 120,
     width: int = 480,
@@ -301,13 +310,9 @@ def make_scene(
     -------
     Scene
     """
-    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
-        if not isinstance(v, (int, np.integer)) or v < lo:
-            raise ValueError(f"make_scene: {name} is {v!r}, expected an integer >= {lo}")
+    _check_scene_args("make_scene", n_frames, width, height, noise)
     if not isinstance(n_walkers, (int, np.integer)) or not 1 <= n_walkers <= 40:
         raise ValueError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
-    if not (np.isfinite(noise) and noise >= 0):
-        raise ValueError(f"make_scene: noise is {noise}, expected a finite value >= 0")
     gen = np.random.default_rng(rng)
     bg = _background(width, height, gen)
     size_scale = height / 360.0
@@ -571,11 +576,7 @@ def make_busy_scene(
     """
     if kind not in BUSY_SCENES:
         raise ValueError(f"make_busy_scene: kind is {kind!r}, expected one of {BUSY_SCENES}")
-    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
-        if not isinstance(v, (int, np.integer)) or v < lo:
-            raise ValueError(f"make_busy_scene: {name} is {v!r}, expected an integer >= {lo}")
-    if not (np.isfinite(noise) and noise >= 0):
-        raise ValueError(f"make_busy_scene: noise is {noise}, expected a finite value >= 0")
+    _check_scene_args("make_busy_scene", n_frames, width, height, noise)
     gen = np.random.default_rng(rng)
     bg = _background(width, height, gen)
     grey = kind == "overhead"
