@@ -167,10 +167,11 @@ class TrackRenderer:
         """Queue `frame` (BGR, not modified) with the tracks reported on it."""
         self._raise_worker_error()
         self._n += 1
-        boxes, seen = [], set()
+        rows, seen = [], set()
         for t in tracks:
             box = np.asarray(t.box_xywh, dtype=np.float64)
-            boxes.append([float(t.id), *box[:4], 1.0 if t.time_since_update else 0.0])
+            # MOT row; column 8: 1 = coasting, drawn thin
+            rows.append([self._n, t.id, *box[:4], 0.0, 1.0 if t.time_since_update else 0.0])
             seen.add(t.id)
             if self.trail:
                 trail = self._trails.setdefault(t.id, deque(maxlen=self.trail))
@@ -178,18 +179,14 @@ class TrackRenderer:
         for tid in set(self._trails) - seen:
             del self._trails[tid]
         trails = {tid: list(pts) for tid, pts in self._trails.items()}
-        job = (self._n, frame, np.asarray(boxes, dtype=np.float64).reshape(-1, 6), trails)
+        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 8), trails)
         if self._queue is None:
             self._draw(job)
         else:
             self._queue.put(job)
 
     def _draw(self, job: _Job) -> None:
-        n, frame, boxes, trails = job
-        rows = np.zeros((len(boxes), 8))
-        rows[:, 0] = n
-        rows[:, 1:6] = boxes[:, :5]
-        rows[:, 7] = boxes[:, 5]  # column 8: 1 = coasting, drawn thin
+        n, frame, rows, trails = job
         image = draw_tracks(frame, rows, f"frame {n}")
         draw_trails(image, trails)
         self.writer.write(image)
