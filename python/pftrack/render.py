@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import queue
 import threading
 from collections import deque
@@ -28,8 +29,12 @@ __all__ = [
 ]
 
 
+@functools.lru_cache(maxsize=4096)
 def colour_of(track_id: int) -> tuple[int, int, int]:
-    """A stable, distinct BGR colour for an id (golden-ratio hue steps)."""
+    """A stable, distinct BGR colour for an id (golden-ratio hue steps).
+
+    Cached: every drawn frame asks again for the colour of each track, box and trail.
+    """
     hue = int((track_id * 0.618033988749895 % 1.0) * 179)
     hsv = np.array([[[hue, 220, 255]]], dtype=np.uint8)
     b, g, r = cv2.cvtColor(hsv, cv2.COLOR_HSV2BGR)[0, 0]
