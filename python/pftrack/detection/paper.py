@@ -171,7 +171,9 @@ class PaperDetector:
             if carry.any():
                 self._model.blend(frame, carry, self.config.ghost_rate)
                 mask = np.bitwise_xor(mask, carry)
-            self._ghost = carry
+                self._ghost = carry
+            else:  # learnt: no full-frame AND on the next frames
+                self._ghost = None
         boxes, scores = self._blobs.boxes(mask)
         if self.config.ghost_support > 0 and len(boxes):
             mask, boxes, scores = self._drop_ghosts(frame, mask, boxes, scores)
