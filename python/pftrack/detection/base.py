@@ -281,8 +281,9 @@ class BlobExtractor:
             rects, fill = self._merge_fragments(mask, rects, fill)
             rects, fill = self._split_groups(mask, rects, fill, model.split_count(rects))
         elif cfg.person_aspect > 0 and len(rects):
-            n = np.round(rects[:, 2] * cfg.person_aspect / rects[:, 3]).astype(np.int64)
-            n[rects[:, 2] * cfg.person_aspect / rects[:, 3] < 1.5] = 1
+            objects = rects[:, 2] * cfg.person_aspect / rects[:, 3]  # side by side
+            n = np.round(objects).astype(np.int64)
+            n[objects < 1.5] = 1
             rects, fill = self._split_groups(mask, rects, fill, n)
         if cfg.learn_size:
             model.observe(rects)
