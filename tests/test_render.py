@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 from pathlib import Path
-from typing import NamedTuple
 
-import av
 import numpy as np
 import pytest
 
 from pftrack.render import TrackRenderer, colour_of, write_annotated_video
+from tests.io.decode import decode
 
 
 @dataclass(frozen=True)
@@ -26,22 +24,6 @@ def _walk(n: int) -> list[list[FakeTrack]]:
     return [[FakeTrack(5, np.array([10.0 + 4 * k, 20.0, 12.0, 30.0]))] for k in range(n)]
 
 
-class Info(NamedTuple):
-    codec: str
-    pix_fmt: str
-    average_rate: Fraction | None
-
-
-def _decode(path: Path) -> tuple[Info, list[np.ndarray]]:
-    """The video's codec, pixel format and rate, and its frames decoded (BGR)."""
-    with av.open(str(path)) as container:
-        stream = container.streams.video[0]
-        frames = [f.to_ndarray(format="bgr24") for f in container.decode(stream)]
-        ctx = stream.codec_context
-        info = Info(ctx.name, ctx.pix_fmt, stream.average_rate)
-    return info, frames
-
-
 def _render(path: Path, threaded: bool, n: int = 20) -> Path:
     renderer = TrackRenderer(path, 7, threaded=threaded, trail=40)
     for tracks in _walk(n):
@@ -52,8 +34,8 @@ def _render(path: Path, threaded: bool, n: int = 20) -> Path:
 def test_threaded_rendering_equals_drawing_in_line(tmp_path: Path) -> None:
     a = _render(tmp_path / "a.mp4", threaded=True)
     b = _render(tmp_path / "b.mp4", threaded=False)
-    stream, fa = _decode(a)
-    _, fb = _decode(b)
+    stream, fa = decode(a)
+    _, fb = decode(b)
     assert (stream.codec, stream.pix_fmt) == ("h264", "yuv420p")
     assert stream.average_rate == 7 and len(fa) == len(fb) == 20
     for x, y in zip(fa, fb, strict=True):
@@ -61,7 +43,7 @@ def test_threaded_rendering_equals_drawing_in_line(tmp_path: Path) -> None:
 
 
 def test_the_trail_follows_the_foot_points(tmp_path: Path) -> None:
-    _, frames = _decode(_render(tmp_path / "a.mp4", threaded=True))
+    _, frames = decode(_render(tmp_path / "a.mp4", threaded=True))
     last = frames[-1].astype(int)
     colour = np.array(colour_of(5))
     # foot points run along y = 50 from x = 16 to 16 + 4 * 19 = 92; the box (x >= 86) aside,
@@ -83,7 +65,7 @@ def test_a_worker_error_surfaces_and_leaves_no_file(tmp_path: Path) -> None:
 def test_write_annotated_video_from_rows(tmp_path: Path) -> None:
     rows = np.array([[k, 3, 10 + 2 * k, 10, 8, 16, 1, -1, -1, -1] for k in range(1, 11)], float)
     frames = [np.zeros((48, 64, 3), np.uint8) for _ in range(10)]
-    stream, got = _decode(write_annotated_video(tmp_path / "v.mp4", frames, rows, fps=12.5))
+    stream, got = decode(write_annotated_video(tmp_path / "v.mp4", frames, rows, fps=12.5))
     assert stream.average_rate == 12.5 and len(got) == 10
     # foot points along y = 26 from x = 16 to 34; the last box spans x 30..38
     assert got[-1][26, 17:28].max(axis=1).min() > 100

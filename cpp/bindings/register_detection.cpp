@@ -25,6 +25,17 @@ py::array_t<std::uint8_t> new_mask(Index rows, Index cols) {
     return py::array_t<std::uint8_t>({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
 }
 
+/// A frame and a mask of the size of the model's (initialised) background.
+void check_frame_and_mask(const BackgroundModel& self, const py::array& frame,
+                          const py::array& mask, const char* fn) {
+    require(self.initialized(), fn, "the model has no background yet");
+    bind::check_bgr_image(frame, fn, "frame");
+    require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+            "frame shape is " + shape_str(frame) + ", expected (" + std::to_string(self.rows()) +
+                ", " + std::to_string(self.cols()) + ", 3)");
+    bind::check_mask(mask, self.rows(), self.cols(), fn);
+}
+
 }  // namespace
 
 void register_detection(py::module_& m) {
@@ -73,13 +84,7 @@ void register_detection(py::module_& m) {
             "blend",
             [](BackgroundModel& self, py::array frame, py::array mask, double rate) {
                 const char* fn = "BackgroundModel.blend";
-                require(self.initialized(), fn, "the model has no background yet");
-                bind::check_bgr_image(frame, fn, "frame");
-                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
-                        "frame shape is " + shape_str(frame) + ", expected (" +
-                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
-                            ", 3)");
-                bind::check_mask(mask, self.rows(), self.cols(), fn);
+                check_frame_and_mask(self, frame, mask, fn);
                 const auto* src = static_cast<const std::uint8_t*>(frame.data());
                 const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
                 const Index stride = frame.strides(0), mstride = mask.strides(0);
@@ -95,13 +100,7 @@ void register_detection(py::module_& m) {
             [](const BackgroundModel& self, py::array frame, py::array mask,
                py::array_t<double, py::array::c_style | py::array::forcecast> boxes) {
                 const char* fn = "BackgroundModel.edge_support";
-                require(self.initialized(), fn, "the model has no background yet");
-                bind::check_bgr_image(frame, fn, "frame");
-                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
-                        "frame shape is " + shape_str(frame) + ", expected (" +
-                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
-                            ", 3)");
-                bind::check_mask(mask, self.rows(), self.cols(), fn);
+                check_frame_and_mask(self, frame, mask, fn);
                 require(boxes.ndim() == 2 && boxes.shape(1) == 4, fn,
                         "boxes must have shape (K, 4), got " + shape_str(boxes));
                 const Index k = boxes.shape(0);

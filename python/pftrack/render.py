@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import queue
 import threading
 from collections import deque
@@ -28,8 +29,12 @@ __all__ = [
 ]
 
 
+@functools.lru_cache(maxsize=4096)
 def colour_of(track_id: int) -> tuple[int, int, int]:
-    """A stable, distinct BGR colour for an id (golden-ratio hue steps)."""
+    """A stable, distinct BGR colour for an id (golden-ratio hue steps).
+
+    Cached: every drawn frame asks again for the colour of each track, box and trail.
+    """
     hue = int((track_id * 0.618033988749895 % 1.0) * 179)
     hsv = np.array([[[hue, 220, 255]]], dtype=np.uint8)
     b, g, r = cv2.cvtColor(hsv, cv2.COLOR_HSV2BGR)[0, 0]
@@ -167,10 +172,11 @@ class TrackRenderer:
         """Queue `frame` (BGR, not modified) with the tracks reported on it."""
         self._raise_worker_error()
         self._n += 1
-        boxes, seen = [], set()
+        rows, seen = [], set()
         for t in tracks:
             box = np.asarray(t.box_xywh, dtype=np.float64)
-            boxes.append([float(t.id), *box[:4], 1.0 if t.time_since_update else 0.0])
+            # MOT row; column 8: 1 = coasting, drawn thin
+            rows.append([self._n, t.id, *box[:4], 0.0, 1.0 if t.time_since_update else 0.0])
             seen.add(t.id)
             if self.trail:
                 trail = self._trails.setdefault(t.id, deque(maxlen=self.trail))
@@ -178,18 +184,14 @@ class TrackRenderer:
         for tid in set(self._trails) - seen:
             del self._trails[tid]
         trails = {tid: list(pts) for tid, pts in self._trails.items()}
-        job = (self._n, frame, np.asarray(boxes, dtype=np.float64).reshape(-1, 6), trails)
+        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 8), trails)
         if self._queue is None:
             self._draw(job)
         else:
             self._queue.put(job)
 
     def _draw(self, job: _Job) -> None:
-        n, frame, boxes, trails = job
-        rows = np.zeros((len(boxes), 8))
-        rows[:, 0] = n
-        rows[:, 1:6] = boxes[:, :5]
-        rows[:, 7] = boxes[:, 5]  # column 8: 1 = coasting, drawn thin
+        n, frame, rows, trails = job
         image = draw_tracks(frame, rows, f"frame {n}")
         draw_trails(image, trails)
         self.writer.write(image)

@@ -265,6 +265,37 @@ def _path(
     return start_frame, pts[: max(1, n_frames - start_frame + 1)]
 
 
+def _paste(
+    frame: NDArray[np.uint8],
+    sprite: NDArray[np.uint8],
+    silhouette: NDArray[np.bool_],
+    cx: float,
+    cy: float,
+) -> tuple[int, int, int, int] | None:
+    """Draw `sprite`'s `silhouette` pixels centred at (cx, cy), clipped to the frame.
+
+    Returns the drawn box ``left, top, w, h`` inside the frame, or None when nothing is in it.
+    """
+    h, w = silhouette.shape
+    x0, y0 = int(round(cx - w / 2.0)), int(round(cy - h / 2.0))
+    xa, ya = max(x0, 0), max(y0, 0)
+    xb, yb = min(x0 + w, frame.shape[1]), min(y0 + h, frame.shape[0])
+    if xb <= xa or yb <= ya:
+        return None
+    sub = silhouette[ya - y0 : yb - y0, xa - x0 : xb - x0]
+    frame[ya:yb, xa:xb][sub] = sprite[ya - y0 : yb - y0, xa - x0 : xb - x0][sub]
+    return xa, ya, xb - xa, yb - ya
+
+
+def _check_scene_args(fn: str, n_frames: int, width: int, height: int, noise: float) -> None:
+    """The frame count, size and noise level that `make_scene` and `make_busy_scene` share."""
+    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
+        if not isinstance(v, (int, np.integer)) or v < lo:
+            raise ValueError(f"{fn}: {name} is {v!r}, expected an integer >= {lo}")
+    if not (np.isfinite(noise) and noise >= 0):
+        raise ValueError(f"{fn}: noise is {noise}, expected a finite value >= 0")
+
+
 def make_scene(
     n_frames: int = 120,
     width: int = 480,
@@ -301,13 +332,9 @@ def make_scene(
     -------
     Scene
     """
-    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
-        if not isinstance(v, (int, np.integer)) or v < lo:
-            raise ValueError(f"make_scene: {name} is {v!r}, expected an integer >= {lo}")
+    _check_scene_args("make_scene", n_frames, width, height, noise)
     if not isinstance(n_walkers, (int, np.integer)) or not 1 <= n_walkers <= 40:
         raise ValueError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
-    if not (np.isfinite(noise) and noise >= 0):
-        raise ValueError(f"make_scene: noise is {noise}, expected a finite value >= 0")
     gen = np.random.default_rng(rng)
     bg = _background(width, height, gen)
     size_scale = height / 360.0
@@ -377,16 +404,9 @@ def make_scene(
         # Nearer (lower) walkers are drawn last, in front.
         for _, k, cx, cy in sorted(visible):
             wk = walkers[k]
-            img, mask = sprites[k][((f - wk.first_frame) // 3) % 2]
-            x0 = int(round(cx - wk.width / 2.0))
-            y0 = int(round(cy - wk.height / 2.0))
-            xa, ya = max(x0, 0), max(y0, 0)
-            xb, yb = min(x0 + wk.width, width), min(y0 + wk.height, height)
-            if xb <= xa or yb <= ya:
-                continue
-            sub = mask[ya - y0 : yb - y0, xa - x0 : xb - x0]
-            frame[ya:yb, xa:xb][sub] = img[ya - y0 : yb - y0, xa - x0 : xb - x0][sub]
-            truth.append((f, wk.id, xa, ya, xb - xa, yb - ya, 1.0, -1.0, -1.0, -1.0))
+            box = _paste(frame, *sprites[k][((f - wk.first_frame) // 3) % 2], cx, cy)
+            if box is not None:
+                truth.append((f, wk.id, *box, 1.0, -1.0, -1.0, -1.0))
         if occ is not None:  # the post is in front of everyone
             ox, oy, ow, oh = occ
             frame[oy : oy + oh, ox : ox + ow] = bg[oy : oy + oh, ox : ox + ow]
@@ -571,11 +591,7 @@ def make_busy_scene(
     """
     if kind not in BUSY_SCENES:
         raise ValueError(f"make_busy_scene: kind is {kind!r}, expected one of {BUSY_SCENES}")
-    for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
-        if not isinstance(v, (int, np.integer)) or v < lo:
-            raise ValueError(f"make_busy_scene: {name} is {v!r}, expected an integer >= {lo}")
-    if not (np.isfinite(noise) and noise >= 0):
-        raise ValueError(f"make_busy_scene: noise is {noise}, expected a finite value >= 0")
+    _check_scene_args("make_busy_scene", n_frames, width, height, noise)
     gen = np.random.default_rng(rng)
     bg = _background(width, height, gen)
     grey = kind == "overhead"
@@ -658,17 +674,10 @@ def make_busy_scene(
             if 0 <= i < len(centres):
                 visible.append((centres[i][1] + h / 2.0, k, i))
         for _, k, i in sorted(visible):  # nearer (lower) people in front
-            first, centres, w, h, look = people[k]
-            sprite, silhouette = look[(i // 3) % 2]
-            x0 = int(round(centres[i][0] - w / 2.0))
-            y0 = int(round(centres[i][1] - h / 2.0))
-            xa, ya = max(x0, 0), max(y0, 0)
-            xb, yb = min(x0 + w, width), min(y0 + h, height)
-            if xb <= xa or yb <= ya:
-                continue
-            sub = silhouette[ya - y0 : yb - y0, xa - x0 : xb - x0]
-            frame[ya:yb, xa:xb][sub] = sprite[ya - y0 : yb - y0, xa - x0 : xb - x0][sub]
-            truth.append((f, k + 1, xa, ya, xb - xa, yb - ya, 1.0, -1.0, -1.0, -1.0))
+            _, centres, _, _, look = people[k]
+            box = _paste(frame, *look[(i // 3) % 2], centres[i][0], centres[i][1])
+            if box is not None:
+                truth.append((f, k + 1, *box, 1.0, -1.0, -1.0, -1.0))
         if noise > 0:
             j = int(gen.integers(4))
             dx, dy = (int(v) for v in gen.integers(0, pad, 2))

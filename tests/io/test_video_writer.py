@@ -7,15 +7,14 @@ import stat
 from collections.abc import Iterator
 from fractions import Fraction
 from pathlib import Path
-from typing import NamedTuple
 
-import av
 import cv2
 import numpy as np
 import pytest
 
 from pftrack.io import video_writer
 from pftrack.io.video_writer import VideoWriter
+from tests.io.decode import decode
 
 
 def _frames(n: int, h: int = 21, w: int = 33) -> list[np.ndarray]:
@@ -26,22 +25,6 @@ def _frames(n: int, h: int = 21, w: int = 33) -> list[np.ndarray]:
         .astype(np.uint8)
         for k in range(n)
     ]  # fmt: skip
-
-
-class Info(NamedTuple):
-    codec: str
-    pix_fmt: str
-    average_rate: Fraction | None
-
-
-def _decode(path: Path) -> tuple[Info, list[np.ndarray]]:
-    """The video's codec, pixel format and rate, and its frames decoded (BGR)."""
-    with av.open(str(path)) as container:
-        stream = container.streams.video[0]
-        frames = [f.to_ndarray(format="bgr24") for f in container.decode(stream)]
-        ctx = stream.codec_context
-        info = Info(ctx.name, ctx.pix_fmt, stream.average_rate)
-    return info, frames
 
 
 @pytest.fixture
@@ -57,7 +40,7 @@ def test_mp4_is_h264_yuv420p_at_the_given_rate(tmp_path: Path) -> None:
         for f in frames:
             writer.write(f)
     assert (writer.backend, writer.codec, writer.n_frames) == ("pyav", "h264", 23)
-    stream, got = _decode(tmp_path / "v.mp4")
+    stream, got = decode(tmp_path / "v.mp4")
     assert stream.codec == "h264"
     assert stream.pix_fmt == "yuv420p"
     assert stream.average_rate == 7
@@ -73,7 +56,7 @@ def test_ntsc_rate_is_kept_exactly(tmp_path: Path) -> None:
     with VideoWriter(tmp_path / "v.mp4", 30000 / 1001) as writer:
         for f in _frames(5):
             writer.write(f)
-    stream, got = _decode(tmp_path / "v.mp4")
+    stream, got = decode(tmp_path / "v.mp4")
     assert stream.average_rate == Fraction(30000, 1001) and len(got) == 5
 
 
@@ -98,7 +81,7 @@ def test_avi_is_mjpeg_through_opencv(tmp_path: Path) -> None:
         for f in _frames(4):
             writer.write(f)
     assert (writer.backend, writer.codec) == ("opencv", "mjpeg")
-    stream, got = _decode(tmp_path / "v.avi")
+    stream, got = decode(tmp_path / "v.avi")
     assert stream.codec == "mjpeg" and len(got) == 4
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -142,6 +143,22 @@ def check_frame(frame: object, fn: str) -> NDArray[np.uint8]:
     return frame
 
 
+def median_frame(frames: Iterable[NDArray[np.uint8]], fn: str) -> NDArray[np.float32]:
+    """Per-pixel median (H, W, 3) float32 of `frames` (numpy.median's values), checked.
+
+    The start of a background (the detectors' ``prime``): computed in C++ without stacking
+    the frames. Raises naming `fn` when `frames` is empty, or holds a frame that is not
+    (H, W, 3) uint8 or not of the first one's size.
+    """
+    stack = [check_frame(f, fn) for f in frames]
+    if not stack:
+        raise ValueError(f"{fn}: frames is empty, expected at least one frame")
+    if any(f.shape != stack[0].shape for f in stack):
+        raise ValueError(f"{fn}: frames differ in shape, expected one size")
+    median: NDArray[np.float32] = _core.median_frames(stack)
+    return median
+
+
 def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64, F64]:
     """Check external detections against a frame of `shape` (rows, cols).
 
@@ -264,8 +281,9 @@ class BlobExtractor:
             rects, fill = self._merge_fragments(mask, rects, fill)
             rects, fill = self._split_groups(mask, rects, fill, model.split_count(rects))
         elif cfg.person_aspect > 0 and len(rects):
-            n = np.round(rects[:, 2] * cfg.person_aspect / rects[:, 3]).astype(np.int64)
-            n[rects[:, 2] * cfg.person_aspect / rects[:, 3] < 1.5] = 1
+            objects = rects[:, 2] * cfg.person_aspect / rects[:, 3]  # side by side
+            n = np.round(objects).astype(np.int64)
+            n[objects < 1.5] = 1
             rects, fill = self._split_groups(mask, rects, fill, n)
         if cfg.learn_size:
             model.observe(rects)

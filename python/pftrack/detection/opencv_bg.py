@@ -11,7 +11,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack.detection.base import BlobConfig, BlobExtractor, Detections, check_frame
+from pftrack.detection.base import (
+    BlobConfig,
+    BlobExtractor,
+    Detections,
+    check_frame,
+    median_frame,
+)
 from pftrack.particle_filter.colour import HsvBinning
 
 
@@ -96,14 +102,10 @@ class _OpenCvDetector:
             How many times the median is learnt (>= 1).
         """
         fn = f"{type(self).__name__}.prime"
-        stack = [check_frame(f, fn) for f in frames]
-        if not stack:
-            raise ValueError(f"{fn}: frames is empty, expected at least one frame")
-        if any(f.shape != stack[0].shape for f in stack):
-            raise ValueError(f"{fn}: frames differ in shape, expected one size")
+        median_f = median_frame(frames, fn)
         if not (isinstance(repeats, int) and repeats >= 1):
             raise ValueError(f"{fn}: repeats is {repeats!r}, expected an int >= 1")
-        median = _core.median_frames(stack).round().astype(np.uint8)  # numpy.median's values
+        median = median_f.round().astype(np.uint8)  # numpy.median's values
         self.reset()
         for _ in range(repeats):
             self._sub.apply(median)

@@ -173,9 +173,10 @@ def is_live_source(source: PathLike | int) -> bool:
     if _camera_index(source) is not None or "://" in text:
         return True
     try:
-        return stat.S_ISFIFO(Path(text).stat().st_mode) or stat.S_ISCHR(Path(text).stat().st_mode)
+        mode = Path(text).stat().st_mode
     except OSError:
         return False
+    return stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)
 
 
 class FrameSource:

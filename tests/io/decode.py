@@ -1,0 +1,26 @@
+"""Reading back a written video: its codec, pixel format, rate and frames (PyAV)."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+from typing import NamedTuple
+
+import av
+import numpy as np
+
+
+class Info(NamedTuple):
+    codec: str
+    pix_fmt: str
+    average_rate: Fraction | None
+
+
+def decode(path: Path) -> tuple[Info, list[np.ndarray]]:
+    """The video's codec, pixel format and rate, and its frames decoded (BGR)."""
+    with av.open(str(path)) as container:
+        stream = container.streams.video[0]
+        frames = [f.to_ndarray(format="bgr24") for f in container.decode(stream)]
+        ctx = stream.codec_context
+        info = Info(ctx.name, ctx.pix_fmt, stream.average_rate)
+    return info, frames
