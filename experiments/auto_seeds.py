@@ -16,16 +16,15 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
-import configparser
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.io.mot import read_mot
+from pftrack.io.video import read_seqinfo
 from pftrack.recovery.calibrate import recover_auto
 from pftrack.recovery.experiment import (
     auto_masks,
@@ -113,12 +112,6 @@ def format_rows(rows: Sequence[SeedRow], seeds: Sequence[int], real: Sequence[st
     return "\n".join(lines)
 
 
-def _image_size(folder: Path) -> tuple[float, float]:
-    cfg = configparser.ConfigParser()
-    cfg.read(folder / "seqinfo.ini")
-    return float(cfg["Sequence"]["imWidth"]), float(cfg["Sequence"]["imHeight"])
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     ap = experiment_parser("auto_seeds", __doc__)
     ap.add_argument("--seeds", type=int, default=6, help="calibration seeds 0..N-1 (default 6)")
@@ -131,8 +124,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     for name, sub in SEQUENCES:
         folder = root / sub
         if (folder / "gt.txt").is_file():
-            w, h = _image_size(folder)
-            rows.append(seed_row(name, trajectories(read_mot(folder / "gt.txt")), w, h, seeds))
+            info = read_seqinfo(folder)
+            if info.width is None or info.height is None:
+                raise ValueError(f"{folder}/seqinfo.ini: no imWidth/imHeight")
+            trajs = trajectories(read_mot(folder / "gt.txt"))
+            rows.append(seed_row(name, trajs, float(info.width), float(info.height), seeds))
     for k in range(3):
         truth = make_scene(n_frames=300, n_walkers=12, rng=k).truth
         rows.append(seed_row(f"syn{k}", trajectories(truth), 480.0, 360.0, seeds))

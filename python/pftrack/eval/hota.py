@@ -16,7 +16,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from pftrack.io.mot import CONF, FRAME, ID, LEFT
+from pftrack.eval.metrics import check_eval_rows
+from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
 
 __all__ = [
     "ALPHAS",
@@ -80,31 +81,6 @@ def mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     return out
 
 
-def _rows(rows: ArrayLike, name: str) -> NDArray[np.float64]:
-    a = np.asarray(rows, dtype=np.float64)
-    if a.size == 0:
-        return np.zeros((0, 10))
-    if a.ndim != 2 or a.shape[1] < 6:
-        raise ValueError(f"{name} has shape {a.shape}, expected (M, 6..10) MOT rows")
-    if not np.all(np.isfinite(a[:, :6])):
-        raise ValueError(f"{name} has non-finite values in its first 6 columns")
-    if a.shape[1] < 10:
-        pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
-        a = np.hstack([a, pad])
-    return a
-
-
-def _by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
-    """``{frame: rows}``, rows of a frame in file order (TrackEval keeps file order)."""
-    if len(rows) == 0:
-        return {}
-    order = np.argsort(rows[:, FRAME], kind="stable")
-    r = rows[order]
-    frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
-    ends = [*starts[1:], len(r)]
-    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}
-
-
 def _check_unique(frames: dict[int, NDArray[np.float64]], name: str) -> None:
     for f, r in frames.items():
         ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
@@ -123,7 +99,7 @@ def guess_benchmark(gt: ArrayLike) -> str:
     has world coordinates (or -1) there. MOT20's one extra distractor class is not guessed:
     name ``"MOT20"`` explicitly.
     """
-    g = _rows(gt, "ground truth")
+    g = check_eval_rows(gt, "ground truth")
     if len(g) == 0:
         return "MOT15"
     cls, vis = g[:, _CLASS], g[:, _VISIBILITY]
@@ -174,8 +150,8 @@ def prepare_mot(
         raise ValueError(f"benchmark is {benchmark!r}, expected one of {', '.join(BENCHMARKS)}")
     if not (math.isfinite(scale) and scale > 0):
         raise ValueError(f"scale is {scale}, expected a finite value > 0")
-    g = _rows(gt, "ground truth").copy()
-    r = _rows(result, "result")
+    g = check_eval_rows(gt, "ground truth").copy()
+    r = check_eval_rows(result, "result")
     g[:, LEFT : LEFT + 4] *= scale
     for rows, name in ((g, "ground truth"), (r, "result")):
         if num_frames is not None and len(rows) and rows[:, FRAME].max() > num_frames:
@@ -183,7 +159,7 @@ def prepare_mot(
                 f"{name} has frame {int(rows[:, FRAME].max())}, beyond the sequence's "
                 f"{num_frames} frames (seqLength)"
             )
-    gf, rf = _by_frame(g), _by_frame(r)
+    gf, rf = group_by_frame(g), group_by_frame(r)
     _check_unique(gf, "ground truth")
     _check_unique(rf, "result")
     with_classes = benchmark != "MOT15"
@@ -389,7 +365,7 @@ def evaluate_hota(
     g, r = prepare_mot(gt, result, benchmark=benchmark, scale=scale, num_frames=num_frames)
     if len(r) == 0 or len(g) == 0:
         return _empty(len(g), len(r))
-    gf, rf = _by_frame(g), _by_frame(r)
+    gf, rf = group_by_frame(g), group_by_frame(r)
     g_ids, g_idx = np.unique(g[:, ID].astype(np.int64), return_inverse=True)
     r_ids, r_idx = np.unique(r[:, ID].astype(np.int64), return_inverse=True)
     gt_count = np.bincount(g_idx, minlength=len(g_ids)).astype(np.float64)

@@ -196,20 +196,24 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
     return "\n".join(lines)
 
 
-def _check_rows(rows: ArrayLike, name: str) -> NDArray[np.float64]:
-    a = real_array(rows, f"evaluate_mot: {name}")
+def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
+    """Scored MOT rows as an ``(M, 10)`` float64 array; TypeError/ValueError named by `what`.
+
+    Real numbers, ``(M, 6..10)``, the first 6 columns finite, frames and ids within
+    ``MAX_FRAME`` (they are cast to int); missing columns padded. Shared by
+    :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`.
+    """
+    a = real_array(rows, what)
     if a.size == 0:
         return np.zeros((0, 10))
     if a.ndim != 2 or a.shape[1] < 6:
-        raise ValueError(f"evaluate_mot: {name} has shape {a.shape}, expected (M, 6..10) MOT rows")
+        raise ValueError(f"{what} has shape {a.shape}, expected (M, 6..10) MOT rows")
     if not np.all(np.isfinite(a[:, :6])):
-        raise ValueError(f"evaluate_mot: {name} has non-finite values in its first 6 columns")
+        raise ValueError(f"{what} has non-finite values in its first 6 columns")
     huge = np.abs(a[:, :2]) > MAX_FRAME
     if huge.any():
         k = int(np.flatnonzero(huge.any(axis=1))[0])
-        raise ValueError(
-            f"evaluate_mot: {name} row {k} has frame or id {a[k, :2].tolist()} beyond {MAX_FRAME}"
-        )
+        raise ValueError(f"{what} row {k} has frame or id {a[k, :2].tolist()} beyond {MAX_FRAME}")
     if a.shape[1] < 10:
         pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
         a = np.hstack([a, pad])
@@ -293,8 +297,8 @@ def evaluate_mot(
             raise ValueError(
                 f"evaluate_mot: image_size is {image_size!r}, expected (width, height) > 0"
             )
-    g = _check_rows(gt, "gt").copy()
-    r = _check_rows(result, "result")
+    g = check_eval_rows(gt, "evaluate_mot: gt").copy()
+    r = check_eval_rows(result, "evaluate_mot: result")
     g[:, LEFT : LEFT + 4] *= scale
     gt_frames = _split(g)
     res_frames = _split(r)

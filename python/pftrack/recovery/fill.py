@@ -109,9 +109,8 @@ def fill_gaps(
         ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer id, a
         non-finite box or a duplicate (frame, id).
     """
-    rows = check_rows(tracks, "fill_gaps")
-    new_rows, report = fill_rows(rows, method, max_gap, noise, seed=seed)
-    filled = np.vstack([rows, new_rows])
+    new_rows, report = fill_rows(tracks, method, max_gap, noise, seed=seed)  # checks `tracks`
+    filled = np.vstack([np.asarray(tracks, dtype=np.float64), new_rows])
     order = np.lexsort((filled[:, 1], filled[:, 0]))
     return filled[order], report
 

@@ -13,8 +13,9 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import MAX_FRAME, real_array
 from pftrack._typing import F64
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.particle_filter.colour import (
@@ -36,10 +37,8 @@ __all__ = [
 ]
 
 FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTChallenge row)
-#: Largest frame number accepted (2^31 - 1: over two years of video at 30 fps).
-MAX_FRAME = 2**31 - 1
 #: Largest absolute track id accepted.
-MAX_ID = 2**31 - 1
+MAX_ID = MAX_FRAME
 
 
 @dataclass(frozen=True)
@@ -231,16 +230,13 @@ def link_tracklets(
     return rows, mapping
 
 
-def check_rows(rows: object, what: str) -> F64:
+def check_rows(rows: ArrayLike, what: str) -> F64:
     """The rows as an ``(M, 10)`` float64 array, checked; ValueError/TypeError naming the problem.
 
     Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, and every
     value finite. `what` names the caller in messages.
     """
-    raw = np.asarray(rows)
-    if raw.dtype.kind not in "biuf":
-        raise TypeError(f"{what}: rows must be a real (M, 10) array, got dtype {raw.dtype}")
-    a = raw.astype(np.float64)
+    a = real_array(rows, f"{what}: rows")
     if a.ndim != 2 or a.shape[1] != 10:
         raise ValueError(f"{what}: rows must have shape (M, 10) (10 columns), got {a.shape}")
     f, i = a[:, 0], a[:, 1]

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_COORD
+from pftrack._check import MAX_COORD, real_array
 from pftrack._typing import F64
 
 __all__ = ["as_segment", "consecutive_runs", "contiguous_head", "contiguous_tail", "gap_frames"]
@@ -40,10 +40,7 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
         Wrong shape, no row, a non-finite value, a position or size beyond ``MAX_COORD``
         (1e9 px) or frames that do not increase strictly.
     """
-    raw = np.asarray(seg)
-    if raw.dtype.kind not in "biuf":
-        raise TypeError(f"recover_gap: {name} must hold real numbers, got dtype {raw.dtype}")
-    a = raw.astype(np.float64)
+    a = real_array(seg, f"recover_gap: {name}")
     if a.ndim != 2 or a.shape[1] not in (3, 5):
         raise ValueError(f"recover_gap: {name} must have shape (k, 3) or (k, 5), got {a.shape}")
     if a.shape[0] == 0:

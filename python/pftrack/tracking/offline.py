@@ -20,13 +20,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import real_array
+from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
 from pftrack.kalman import rts_smooth
 from pftrack.recovery.fill import fill_rows
-from pftrack.recovery.linking import MAX_FRAME, LinkConfig, check_rows, link_tracklets
+from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
 from pftrack.recovery.names import DEFAULT_METHOD
 
 __all__ = ["BoxSmoother", "smooth_tracks"]
