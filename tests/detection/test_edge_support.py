@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -88,16 +88,8 @@ def test_edge_support_threads_give_serial_result() -> None:
     frame, background, mask, boxes = scene(np.random.default_rng(2), (120, 160), 30)
     model = model_with(background)
     want = model.edge_support(frame, mask, boxes)
-    out: list[np.ndarray] = []
-
-    def run() -> None:
-        for _ in range(20):
-            out.append(model.edge_support(frame, mask, boxes))
-
-    threads = [threading.Thread(target=run) for _ in range(4)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
+    with ThreadPoolExecutor(4) as pool:
+        out = list(pool.map(lambda _: model.edge_support(frame, mask, boxes), range(80)))
+    assert len(out) == 80
     for o in out:
         np.testing.assert_array_equal(o, want)
