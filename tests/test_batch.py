@@ -106,6 +106,8 @@ def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
         ({"summary.avi": ""}, "reserved"),
         ({"notes.txt": ""}, "no sequence in folder"),
         ({"s/seqinfo.ini": "", "s/a.avi": "", "s/b.avi": ""}, "not exactly one video"),
+        ({"s/seqinfo.ini": "", "s/a.avi": ""}, r"expected a \[Sequence\] section"),
+        ({"s/seqinfo.ini": "[Sequence]\nimWidth=wide\n", "s/a.avi": ""}, "imWidth is 'wide'"),
     ],
 )
 def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message: str) -> None:

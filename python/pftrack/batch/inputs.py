@@ -8,13 +8,12 @@ these is a folder of sequences: each entry in it that is a sequence is one (one 
 
 from __future__ import annotations
 
-import configparser
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from pftrack._typing import PathLike
-from pftrack.io.video import IMAGE_SUFFIXES, natural_key
+from pftrack.io.video import IMAGE_SUFFIXES, natural_key, read_seqinfo
 
 __all__ = ["VIDEO_SUFFIXES", "SequenceInput", "find_sequences", "find_track_files"]
 
@@ -74,19 +73,6 @@ def _first_file(folder: Path, *candidates: str) -> Path | None:
     return None
 
 
-def _image_width(folder: Path) -> int | None:
-    ini = folder / "seqinfo.ini"
-    if not ini.is_file():
-        return None
-    parser = configparser.ConfigParser()
-    try:
-        parser.read(ini, encoding="utf-8")
-        width = parser.getint("Sequence", "imWidth", fallback=0)
-    except (configparser.Error, ValueError) as exc:
-        raise ValueError(f"cannot read {ini}: {' '.join(str(exc).split())}") from None
-    return width if width > 0 else None
-
-
 def _videos(folder: Path) -> list[Path]:
     return sorted(
         (p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
@@ -122,7 +108,7 @@ def _as_sequence(path: Path) -> SequenceInput | None:
         frames,
         _first_file(path, "det/det.txt", "det.txt"),
         _first_file(path, "gt/gt.txt", "gt.txt"),
-        _image_width(path),
+        read_seqinfo(path).width if marked else None,
     )
 
 
