@@ -22,7 +22,6 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
-import configparser
 from collections.abc import Iterator, Sequence
 
 import numpy as np
@@ -32,7 +31,7 @@ from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import group_by_frame, read_mot
-from pftrack.io.video import FrameSource
+from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 from pftrack.tracking import TrackerConfig, load_detections, track_frames
 
@@ -116,10 +115,10 @@ def main(argv: list[str] | None = None) -> int:
             if not folder.is_dir():
                 print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
                 continue
-            info = configparser.ConfigParser()
-            info.read(folder / "seqinfo.ini")
-            seq = info["Sequence"]
-            frames = BlackFrames(int(seq["seqLength"]), int(seq["imWidth"]), int(seq["imHeight"]))
+            info = read_seqinfo(folder)
+            if info.length is None or info.width is None or info.height is None:
+                raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
+            frames = BlackFrames(info.length, info.width, info.height)
             dets = load_detections(folder / "det.txt")
             run = track_frames(frames, detections=dets, config=config, rng=0)
             print(score(name + " (black)", read_mot(folder / "gt.txt"), run.rows), flush=True)
