@@ -280,3 +280,95 @@ def test_cli_explain_prints_centres_and_sizes(tmp_path, capsys) -> None:  # type
     assert main(["recover", str(src), "--out", str(tmp_path / "l.txt"), "--method", "linear",
                  "--explain"]) == 0  # fmt: skip
     assert "nothing was chosen" in capsys.readouterr().out
+
+
+def test_combination_falls_back_to_linear_on_straight_jittered_segments() -> None:
+    tracks = _straight_tracks(np.random.default_rng(0))
+    cal = calibrate(tracks, [5, 12, 25], combine=True)
+    assert [c.method for c in cal.buckets] == ["linear"] * 3, cal.describe()
+    assert all(c.weights == () for c in cal.buckets)
+    assert cal.weights_for(12) == (("linear", 1.0),)
+    paths, _ = recover_auto(_cut(tracks, 12), tracks, combine=True)
+    a, b = _cut(tracks, 12)[0]
+    s = np.arange(1, 13) / 13.0
+    line = (1 - s)[:, None] * a[-1, 1:3] + s[:, None] * b[0, 1:3]
+    np.testing.assert_allclose(paths[0], line, atol=1e-9)
+
+
+def _two_method_paths(rng: np.random.Generator, n: int) -> tuple[list, list, list]:
+    """Truth and two predictors with independent errors of the same size (3-frame gaps)."""
+    truth = [np.column_stack([np.arange(3.0), rng.uniform(0, 100, (3, 2))]) for _ in range(n)]
+    first = [t[:, 1:3] + rng.normal(0, 1.0, (3, 2)) for t in truth]
+    second = [t[:, 1:3] + rng.normal(0, 1.0, (3, 2)) for t in truth]
+    return first, second, truth
+
+
+def test_combination_weight_fitted_and_shrunk() -> None:
+    """Two equally good, independent predictors: the fitted weight is near 1/2, shrunk by n."""
+    from pftrack.recovery.calibrate import COMBINE_SHRINK, _combine, _gap_errors
+
+    first, second, truth = _two_method_paths(np.random.default_rng(9), 400)
+    w, err = _combine(first, second, truth)
+    shrink = 400 / (400 + COMBINE_SHRINK)
+    assert 0.4 * shrink <= w <= 0.6 * shrink
+    # the errors are those of the blended paths, and lower than either predictor's
+    blend = [(1 - w) * a + w * b for a, b in zip(first, second, strict=True)]
+    np.testing.assert_allclose(err, _gap_errors(blend, truth), rtol=1e-12)
+    assert err.mean() < _gap_errors(first, truth).mean()
+    assert err.mean() < _gap_errors(second, truth).mean()
+    # a useless second predictor gets no weight
+    far = [a + 50.0 for a in second]
+    assert _combine(first, far, truth)[0] == 0.0
+
+
+def test_combination_weights_sum_to_one_and_are_reported() -> None:
+    tracks = _manoeuvring_tracks(np.random.default_rng(1))
+    pairs = _cut(tracks, 20)
+    paths, cal = recover_auto(pairs, tracks, combine=True)
+    for c in cal.buckets:
+        mix = c.weights or ((c.method, 1.0),)
+        assert abs(sum(w for _, w in mix) - 1.0) < 1e-12
+        assert all(0.0 <= w <= 1.0 for _, w in mix)
+        if c.weights:
+            assert c.method == "+".join(m for m, _ in c.weights)
+            assert c.combined_mmae is not None
+            assert f"combination {c.weights[0][1]:.2f} {c.weights[0][0]}" in cal.describe()
+
+
+def test_recover_auto_blends_a_combined_bucket(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A bucket's combination gives the weighted sum of its methods' paths."""
+    import pftrack.recovery.calibrate as cal_mod
+    from pftrack.recovery.calibrate import BucketChoice, recover_with
+    from pftrack.recovery.noise import estimate_noise
+
+    tracks = _manoeuvring_tracks(np.random.default_rng(1), n=8)
+    pairs = _cut(tracks, 20)
+    mix = (("rts", 0.3), ("gdt-bi", 0.7))
+    fixed = Calibration((BucketChoice((17, 32), "rts+gdt-bi", 8, 50, (), mix, 1.0),), "linear")
+    monkeypatch.setattr(cal_mod, "calibrate", lambda *a, **k: fixed)
+    noise = estimate_noise(tracks)
+    paths, cal = recover_auto(pairs, tracks, noise, candidates=("linear", "rts", "gdt-bi"))
+    assert cal is fixed and cal.weights_for(20) == mix
+    rts = recover_with("rts", pairs, noise, None)  # type: ignore[arg-type]
+    bi = recover_with("gdt-bi", pairs, noise, None)  # type: ignore[arg-type]
+    for p, r, g in zip(paths, rts, bi, strict=True):
+        np.testing.assert_allclose(p, 0.3 * r + 0.7 * g, atol=1e-9)
+    assert "combination 0.30 rts + 0.70 gdt-bi, validation MMAE 1.000" in cal.describe()
+
+
+def test_combined_calibration_never_reads_the_deleted_points(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The no-peeking test above, with combinations allowed in ``auto``."""
+    monkeypatch.setitem(recover_auto.__kwdefaults__, "combine", True)
+    test_calibration_never_reads_the_deleted_points()
+
+
+def test_combination_is_deterministic() -> None:
+    tracks = _manoeuvring_tracks(np.random.default_rng(3), n=10)
+    pairs = _cut(tracks, 17)
+    p1, c1 = recover_auto(pairs, tracks, combine=True)
+    p2, c2 = recover_auto(pairs, tracks, combine=True)
+    assert c1 == c2
+    for a, b in zip(p1, p2, strict=True):
+        np.testing.assert_array_equal(a, b)
