@@ -72,9 +72,8 @@ def test_picks_goal_directed_on_manoeuvring_data() -> None:
     assert all(c.method.startswith("gdt") for c in cal.buckets), cal.describe()
 
 
-def test_calibration_never_reads_the_deleted_points() -> None:
-    rng = np.random.default_rng(2)
-    truth = _manoeuvring_tracks(rng, n=20)
+def _mot_rows(truth: list[np.ndarray]) -> np.ndarray:
+    """MOTChallenge rows of fixed 20x40 boxes centred on each track's (x, y)."""
     rows = []
     for tid, tr in enumerate(truth, start=1):
         w, h = 20.0, 40.0
@@ -82,13 +81,19 @@ def test_calibration_never_reads_the_deleted_points() -> None:
                              tr[:, 2] - h / 2, np.full((len(tr), 2), (w, h)),
                              np.ones(len(tr)), -np.ones((len(tr), 3))])  # fmt: skip
         rows.append(r)
-    full = np.vstack(rows)
+    return np.vstack(rows)
+
+
+@pytest.mark.parametrize("combine", [True, False])
+def test_calibration_never_reads_the_deleted_points(combine: bool) -> None:
+    rng = np.random.default_rng(2)
+    full = _mot_rows(_manoeuvring_tracks(rng, n=20))
     holes = (full[:, 0] >= 60) & (full[:, 0] < 75)
     cut = full[~holes]
-    out1, rep1 = fill_gaps(cut, max_gap=50)
+    out1, rep1 = fill_gaps(cut, max_gap=50, combine=combine)
     poisoned = full.copy()
     poisoned[holes, 2:4] = 1e9  # the deleted points, poisoned in a copy: never seen
-    out2, rep2 = fill_gaps(poisoned[~holes], max_gap=50)
+    out2, rep2 = fill_gaps(poisoned[~holes], max_gap=50, combine=combine)
     np.testing.assert_array_equal(out1, out2)
     assert rep1.calibration == rep2.calibration
     assert rep1.calibration is not None and rep1.calibration.buckets[0].n_validation > 0
@@ -356,12 +361,44 @@ def test_recover_auto_blends_a_combined_bucket(monkeypatch: pytest.MonkeyPatch) 
     assert "combination 0.30 rts + 0.70 gdt-bi, validation MMAE 1.000" in cal.describe()
 
 
-def test_combined_calibration_never_reads_the_deleted_points(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    """The no-peeking test above, with combinations allowed in ``auto``."""
-    monkeypatch.setitem(recover_auto.__kwdefaults__, "combine", True)
-    test_calibration_never_reads_the_deleted_points()
+def test_combination_is_the_default_everywhere_auto_runs() -> None:
+    """``fill_gaps`` (recover, smooth, the offline pass) blends by default; False: one method."""
+    import inspect
+
+    from pftrack.recovery.fill import fill_rows
+
+    for fn in (calibrate, recover_auto, fill_gaps, fill_rows):
+        assert inspect.signature(fn).parameters["combine"].default is True, fn.__name__
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(0)))
+    cut = full[~((full[:, 0] >= 80) & (full[:, 0] < 85))]  # 5-frame holes
+    out, rep = fill_gaps(cut)
+    out_on, rep_on = fill_gaps(cut, combine=True)
+    out_off, rep_off = fill_gaps(cut, combine=False)
+    assert rep.calibration is not None and rep_off.calibration is not None
+    assert rep.calibration == rep_on.calibration
+    np.testing.assert_array_equal(out, out_on)
+    assert any(c.weights for c in rep.calibration.buckets), rep.calibration.describe()
+    assert all(c.weights == () for c in rep_off.calibration.buckets)
+    assert all("+" not in c.method for c in rep_off.calibration.buckets)
+    # the blend moves the filled centres; observed rows are untouched
+    assert out.shape == out_off.shape
+    observed = out[:, 7] != 1
+    np.testing.assert_array_equal(out[observed], out_off[observed])
+    assert np.abs(out[~observed, 2:4] - out_off[~observed, 2:4]).max() > 1e-6
+    # recover_gaps("auto") follows the same default
+    pairs = _cut(_manoeuvring_tracks(np.random.default_rng(0)), 5)
+    tracks = _manoeuvring_tracks(np.random.default_rng(0))
+    got = recover_gaps(pairs, "auto", observed=tracks)
+    want, cal = recover_auto(pairs, tracks, combine=True)
+    assert any(c.weights for c in cal.buckets)
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_fill_gaps_combine_must_be_a_bool() -> None:
+    full = _mot_rows(_straight_tracks(np.random.default_rng(0), n=3))
+    with pytest.raises(TypeError, match="combine must be a bool"):
+        fill_gaps(full, combine="no")  # type: ignore[arg-type]
 
 
 def test_combination_is_deterministic() -> None:

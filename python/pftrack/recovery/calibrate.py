@@ -12,11 +12,11 @@ The artificial gaps are drawn with a seeded generator, so the same input gives t
 Buckets are powers of two of the number of missing frames: ``1``, ``2``, ``3-4``, ``5-8``,
 ``9-16``, ... (:func:`bucket_of`).
 
-With ``combine=True`` a bucket may instead use a convex combination of two candidates' paths
-(the chosen method and the best other one; :func:`_combine`): the weight is fitted to the
+By default (``combine=True``) a bucket may instead use a convex combination of two candidates'
+paths (the chosen method and the best other one; :func:`_combine`): the weight is fitted to the
 bucket's validation gaps, shrunk toward the chosen method, and the combination replaces the
 chosen method only if it beats it by the same paired test. The :class:`Calibration` then
-names both methods and their weights.
+names both methods and their weights. ``combine=False`` gives the single-method choice.
 """
 
 from __future__ import annotations
@@ -350,7 +350,7 @@ def calibrate(
     seed: int = 0,
     spans: Sequence[float] | None = None,
     contexts: Sequence[tuple[int, int]] | None = None,
-    combine: bool = False,
+    combine: bool = True,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -377,7 +377,8 @@ def calibrate(
         (:func:`_artificial_gaps`; default: the whole run on each side).
     combine : bool
         Let a bucket use a convex combination of its chosen method and the best other
-        candidate when it beats the chosen method by the paired test (:func:`_combine`).
+        candidate when it beats the chosen method by the paired test (:func:`_combine`;
+        default). False: one method per bucket.
 
     Returns
     -------
@@ -564,7 +565,7 @@ def recover_auto(
     seed: int = 0,
     candidates: Sequence[str] = CANDIDATES,
     max_gaps: int = MAX_CALIBRATION_GAPS,
-    combine: bool = False,
+    combine: bool = True,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -585,7 +586,8 @@ def recover_auto(
     max_gaps : int
         At most this many artificial gaps (:func:`calibrate`).
     combine : bool
-        Allow a convex combination of two candidates per bucket (:func:`calibrate`).
+        Allow a convex combination of two candidates per bucket (:func:`calibrate`; default).
+        False: one method per bucket.
 
     Returns
     -------
