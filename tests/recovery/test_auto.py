@@ -409,3 +409,25 @@ def test_combination_is_deterministic() -> None:
     assert c1 == c2
     for a, b in zip(p1, p2, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_cli_explain_prints_the_blend_weights(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """``pftrack recover --explain`` (default auto) names the blended methods and weights."""
+    from pftrack.cli import main
+    from pftrack.io.mot import read_mot, write_mot
+
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(0)))
+    src = tmp_path / "t.txt"
+    write_mot(src, full[~((full[:, 0] >= 80) & (full[:, 0] < 85))])
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--explain"]) == 0
+    out = capsys.readouterr().out
+    _, rep = fill_gaps(read_mot(src))
+    assert rep.calibration is not None
+    blended = [c for c in rep.calibration.buckets if c.weights]
+    assert blended, rep.calibration.describe()
+    for c in blended:
+        (m1, w1), (m2, w2) = c.weights
+        assert f"combination {w1:.2f} {m1} + {w2:.2f} {m2}, validation MMAE" in out
+    # the file holds the blended fill (written with 2 decimals)
+    want, _ = fill_gaps(read_mot(src))
+    np.testing.assert_allclose(read_mot(tmp_path / "o.txt"), want, rtol=0, atol=0.006)
