@@ -10,11 +10,11 @@ sequences, never worse than ``linear`` anywhere). Written to ``seeds.txt`` in ``
 
 Usage (from the repository root)::
 
-    python -m experiments.auto_seeds [--data ../shared/data] [--seeds 6] [--combine]
+    python -m experiments.auto_seeds [--data ../shared/data] [--seeds 6] [--no-combine]
         [--out out/auto_seeds]
 
-``--combine`` scores ``auto`` with per-bucket combinations of two candidates allowed
-(``recover_auto(..., combine=True)``).
+``auto`` is scored as the CLI runs it, with per-bucket combinations of two candidates allowed;
+``--no-combine`` scores the single-method choice (``recover_auto(..., combine=False)``).
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ def seed_row(
     height: float,
     seeds: Sequence[int],
     fixed: Sequence[str] = FIXED,
-    combine: bool = False,
+    combine: bool = True,
 ) -> SeedRow:
     """Score `fixed` once and ``auto`` with every seed on the automatic masks of a sequence.
 
@@ -140,9 +140,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap = experiment_parser("auto_seeds", __doc__)
     ap.add_argument("--seeds", type=int, default=6, help="calibration seeds 0..N-1 (default 6)")
     ap.add_argument(
-        "--combine",
-        action="store_true",
-        help="allow per-bucket combinations of two candidates in auto (default: off)",
+        "--no-combine",
+        dest="combine",
+        action="store_false",
+        help="score auto with one method per bucket, no combination of two candidates "
+        "(default: combinations allowed, as in the CLI)",
     )
     args = ap.parse_args(argv)
     if args.seeds < 1:
