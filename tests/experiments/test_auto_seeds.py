@@ -27,3 +27,5 @@ def test_seed_row_and_table() -> None:
     assert row.best[0] in ("linear", "rts")
     text = ex.format_rows([row], [0, 1], ["tiny"])
     assert "tiny" in text and "seed 1:" in text
+    pooled = [ln for ln in text.splitlines() if ln.startswith("pooled")]
+    assert len(pooled) == 1 and f"{row.auto[1]:.3f}" in pooled[0]  # one sequence: its own row

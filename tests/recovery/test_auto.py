@@ -72,9 +72,8 @@ def test_picks_goal_directed_on_manoeuvring_data() -> None:
     assert all(c.method.startswith("gdt") for c in cal.buckets), cal.describe()
 
 
-def test_calibration_never_reads_the_deleted_points() -> None:
-    rng = np.random.default_rng(2)
-    truth = _manoeuvring_tracks(rng, n=20)
+def _mot_rows(truth: list[np.ndarray]) -> np.ndarray:
+    """MOTChallenge rows of fixed 20x40 boxes centred on each track's (x, y)."""
     rows = []
     for tid, tr in enumerate(truth, start=1):
         w, h = 20.0, 40.0
@@ -82,13 +81,19 @@ def test_calibration_never_reads_the_deleted_points() -> None:
                              tr[:, 2] - h / 2, np.full((len(tr), 2), (w, h)),
                              np.ones(len(tr)), -np.ones((len(tr), 3))])  # fmt: skip
         rows.append(r)
-    full = np.vstack(rows)
+    return np.vstack(rows)
+
+
+@pytest.mark.parametrize("combine", [True, False])
+def test_calibration_never_reads_the_deleted_points(combine: bool) -> None:
+    rng = np.random.default_rng(2)
+    full = _mot_rows(_manoeuvring_tracks(rng, n=20))
     holes = (full[:, 0] >= 60) & (full[:, 0] < 75)
     cut = full[~holes]
-    out1, rep1 = fill_gaps(cut, max_gap=50)
+    out1, rep1 = fill_gaps(cut, max_gap=50, combine=combine)
     poisoned = full.copy()
     poisoned[holes, 2:4] = 1e9  # the deleted points, poisoned in a copy: never seen
-    out2, rep2 = fill_gaps(poisoned[~holes], max_gap=50)
+    out2, rep2 = fill_gaps(poisoned[~holes], max_gap=50, combine=combine)
     np.testing.assert_array_equal(out1, out2)
     assert rep1.calibration == rep2.calibration
     assert rep1.calibration is not None and rep1.calibration.buckets[0].n_validation > 0
@@ -280,3 +285,149 @@ def test_cli_explain_prints_centres_and_sizes(tmp_path, capsys) -> None:  # type
     assert main(["recover", str(src), "--out", str(tmp_path / "l.txt"), "--method", "linear",
                  "--explain"]) == 0  # fmt: skip
     assert "nothing was chosen" in capsys.readouterr().out
+
+
+def test_combination_falls_back_to_linear_on_straight_jittered_segments() -> None:
+    tracks = _straight_tracks(np.random.default_rng(0))
+    cal = calibrate(tracks, [5, 12, 25], combine=True)
+    assert [c.method for c in cal.buckets] == ["linear"] * 3, cal.describe()
+    assert all(c.weights == () for c in cal.buckets)
+    assert cal.weights_for(12) == (("linear", 1.0),)
+    paths, _ = recover_auto(_cut(tracks, 12), tracks, combine=True)
+    a, b = _cut(tracks, 12)[0]
+    s = np.arange(1, 13) / 13.0
+    line = (1 - s)[:, None] * a[-1, 1:3] + s[:, None] * b[0, 1:3]
+    np.testing.assert_allclose(paths[0], line, atol=1e-9)
+
+
+def _two_method_paths(rng: np.random.Generator, n: int) -> tuple[list, list, list]:
+    """Truth and two predictors with independent errors of the same size (3-frame gaps)."""
+    truth = [np.column_stack([np.arange(3.0), rng.uniform(0, 100, (3, 2))]) for _ in range(n)]
+    first = [t[:, 1:3] + rng.normal(0, 1.0, (3, 2)) for t in truth]
+    second = [t[:, 1:3] + rng.normal(0, 1.0, (3, 2)) for t in truth]
+    return first, second, truth
+
+
+def test_combination_weight_fitted_and_shrunk() -> None:
+    """Two equally good, independent predictors: the fitted weight is near 1/2, shrunk by n."""
+    from pftrack.recovery.calibrate import COMBINE_SHRINK, _combine, _gap_errors
+
+    first, second, truth = _two_method_paths(np.random.default_rng(9), 400)
+    w, err = _combine(first, second, truth)
+    shrink = 400 / (400 + COMBINE_SHRINK)
+    assert 0.4 * shrink <= w <= 0.6 * shrink
+    # the errors are those of the blended paths, and lower than either predictor's
+    blend = [(1 - w) * a + w * b for a, b in zip(first, second, strict=True)]
+    np.testing.assert_allclose(err, _gap_errors(blend, truth), rtol=1e-12)
+    assert err.mean() < _gap_errors(first, truth).mean()
+    assert err.mean() < _gap_errors(second, truth).mean()
+    # a useless second predictor gets no weight
+    far = [a + 50.0 for a in second]
+    assert _combine(first, far, truth)[0] == 0.0
+
+
+def test_combination_weights_sum_to_one_and_are_reported() -> None:
+    tracks = _manoeuvring_tracks(np.random.default_rng(1))
+    pairs = _cut(tracks, 20)
+    paths, cal = recover_auto(pairs, tracks, combine=True)
+    for c in cal.buckets:
+        mix = c.weights or ((c.method, 1.0),)
+        assert abs(sum(w for _, w in mix) - 1.0) < 1e-12
+        assert all(0.0 <= w <= 1.0 for _, w in mix)
+        if c.weights:
+            assert c.method == "+".join(m for m, _ in c.weights)
+            assert c.combined_mmae is not None
+            assert f"combination {c.weights[0][1]:.2f} {c.weights[0][0]}" in cal.describe()
+
+
+def test_recover_auto_blends_a_combined_bucket(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A bucket's combination gives the weighted sum of its methods' paths."""
+    import pftrack.recovery.calibrate as cal_mod
+    from pftrack.recovery.calibrate import BucketChoice, recover_with
+    from pftrack.recovery.noise import estimate_noise
+
+    tracks = _manoeuvring_tracks(np.random.default_rng(1), n=8)
+    pairs = _cut(tracks, 20)
+    mix = (("rts", 0.3), ("gdt-bi", 0.7))
+    fixed = Calibration((BucketChoice((17, 32), "rts+gdt-bi", 8, 50, (), mix, 1.0),), "linear")
+    monkeypatch.setattr(cal_mod, "calibrate", lambda *a, **k: fixed)
+    noise = estimate_noise(tracks)
+    paths, cal = recover_auto(pairs, tracks, noise, candidates=("linear", "rts", "gdt-bi"))
+    assert cal is fixed and cal.weights_for(20) == mix
+    rts = recover_with("rts", pairs, noise, None)  # type: ignore[arg-type]
+    bi = recover_with("gdt-bi", pairs, noise, None)  # type: ignore[arg-type]
+    for p, r, g in zip(paths, rts, bi, strict=True):
+        np.testing.assert_allclose(p, 0.3 * r + 0.7 * g, atol=1e-9)
+    assert "combination 0.30 rts + 0.70 gdt-bi, validation MMAE 1.000" in cal.describe()
+
+
+def test_combination_is_the_default_everywhere_auto_runs() -> None:
+    """``fill_gaps`` (recover, smooth, the offline pass) blends by default; False: one method."""
+    import inspect
+
+    from pftrack.recovery.fill import fill_rows
+
+    for fn in (calibrate, recover_auto, fill_gaps, fill_rows):
+        assert inspect.signature(fn).parameters["combine"].default is True, fn.__name__
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(0)))
+    cut = full[~((full[:, 0] >= 80) & (full[:, 0] < 85))]  # 5-frame holes
+    out, rep = fill_gaps(cut)
+    out_on, rep_on = fill_gaps(cut, combine=True)
+    out_off, rep_off = fill_gaps(cut, combine=False)
+    assert rep.calibration is not None and rep_off.calibration is not None
+    assert rep.calibration == rep_on.calibration
+    np.testing.assert_array_equal(out, out_on)
+    assert any(c.weights for c in rep.calibration.buckets), rep.calibration.describe()
+    assert all(c.weights == () for c in rep_off.calibration.buckets)
+    assert all("+" not in c.method for c in rep_off.calibration.buckets)
+    # the blend moves the filled centres; observed rows are untouched
+    assert out.shape == out_off.shape
+    observed = out[:, 7] != 1
+    np.testing.assert_array_equal(out[observed], out_off[observed])
+    assert np.abs(out[~observed, 2:4] - out_off[~observed, 2:4]).max() > 1e-6
+    # recover_gaps("auto") follows the same default
+    pairs = _cut(_manoeuvring_tracks(np.random.default_rng(0)), 5)
+    tracks = _manoeuvring_tracks(np.random.default_rng(0))
+    got = recover_gaps(pairs, "auto", observed=tracks)
+    want, cal = recover_auto(pairs, tracks, combine=True)
+    assert any(c.weights for c in cal.buckets)
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_fill_gaps_combine_must_be_a_bool() -> None:
+    full = _mot_rows(_straight_tracks(np.random.default_rng(0), n=3))
+    with pytest.raises(TypeError, match="combine must be a bool"):
+        fill_gaps(full, combine="no")  # type: ignore[arg-type]
+
+
+def test_combination_is_deterministic() -> None:
+    tracks = _manoeuvring_tracks(np.random.default_rng(3), n=10)
+    pairs = _cut(tracks, 17)
+    p1, c1 = recover_auto(pairs, tracks, combine=True)
+    p2, c2 = recover_auto(pairs, tracks, combine=True)
+    assert c1 == c2
+    for a, b in zip(p1, p2, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_cli_explain_prints_the_blend_weights(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """``pftrack recover --explain`` (default auto) names the blended methods and weights."""
+    from pftrack.cli import main
+    from pftrack.io.mot import read_mot, write_mot
+
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(0)))
+    src = tmp_path / "t.txt"
+    write_mot(src, full[~((full[:, 0] >= 80) & (full[:, 0] < 85))])
+    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--explain"]) == 0
+    out = capsys.readouterr().out
+    _, rep = fill_gaps(read_mot(src))
+    assert rep.calibration is not None
+    blended = [c for c in rep.calibration.buckets if c.weights]
+    assert blended, rep.calibration.describe()
+    for c in blended:
+        (m1, w1), (m2, w2) = c.weights
+        assert f"combination {w1:.2f} {m1} + {w2:.2f} {m2}, validation MMAE" in out
+    # the file holds the blended fill (written with 2 decimals)
+    want, _ = fill_gaps(read_mot(src))
+    np.testing.assert_allclose(read_mot(tmp_path / "o.txt"), want, rtol=0, atol=0.006)

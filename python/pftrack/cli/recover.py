@@ -32,8 +32,8 @@ def add_parser(sub: Any) -> None:
                    help="longest hole filled, in frames (at most 100000; longer holes stay "
                    "holes: bounded work)")  # fmt: skip
     p.add_argument("--explain", action="store_true",
-                   help="with auto: print the method chosen per gap length and its validation "
-                   "MMAE")  # fmt: skip
+                   help="with auto: print the method chosen per gap length (or the two methods "
+                   "it blends, with their weights) and its validation MMAE")  # fmt: skip
     p.add_argument("--seed", type=int, default=0,
                    help="auto: seed of the artificial calibration gaps")  # fmt: skip
     p.add_argument("--link", action="store_true", help="join fragments of one object first")

@@ -11,6 +11,12 @@ The artificial gaps are drawn with a seeded generator, so the same input gives t
 
 Buckets are powers of two of the number of missing frames: ``1``, ``2``, ``3-4``, ``5-8``,
 ``9-16``, ... (:func:`bucket_of`).
+
+By default (``combine=True``) a bucket may instead use a convex combination of two candidates'
+paths (the chosen method and the best other one; :func:`_combine`): the weight is fitted to the
+bucket's validation gaps, shrunk toward the chosen method, and the combination replaces the
+chosen method only if it beats it by the same paired test. The :class:`Calibration` then
+names both methods and their weights. ``combine=False`` gives the single-method choice.
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ from pftrack.recovery.segments import as_segment
 
 __all__ = [
     "CANDIDATES",
+    "COMBINE_SHRINK",
     "LINEAR_MARGIN",
     "MAX_CALIBRATION_GAPS",
     "BucketChoice",
@@ -65,6 +72,11 @@ MATCH_DRAWS = 16
 #: Noise levels and the motion model of ``"auto"`` are fitted to at most about this many
 #: observed points (whole runs, drawn with the calibration's seed), so big files stay fast.
 MAX_FIT_POINTS = 1000
+#: Weights tried for the second method of a combination: 0, 0.05, ..., 1.
+COMBINE_GRID = np.linspace(0.0, 1.0, 21)
+#: A combination's fitted weight ``a`` is shrunk toward the chosen method as ``a n / (n + S)``
+#: (``n`` validation gaps): a prior worth this many gaps on the chosen method alone.
+COMBINE_SHRINK = 20
 
 
 def bucket_of(length: int) -> int:
@@ -93,6 +105,11 @@ class BucketChoice:
     mmae : tuple of (str, float)
         Validation MMAE (px) of each candidate, in :data:`CANDIDATES` order (empty without
         validation gaps).
+    weights : tuple of (str, float)
+        A combination's methods and weights (they sum to 1; `method` is then ``"a+b"``);
+        empty when one method is used.
+    combined_mmae : float or None
+        The combination's validation MMAE (px), when one was chosen.
     """
 
     lengths: tuple[int, int]
@@ -100,6 +117,8 @@ class BucketChoice:
     n_gaps: int
     n_validation: int
     mmae: tuple[tuple[str, float], ...]
+    weights: tuple[tuple[str, float], ...] = ()
+    combined_mmae: float | None = None
 
 
 @dataclass(frozen=True)
@@ -120,19 +139,31 @@ class Calibration:
     pooled: str = "linear"
 
     def method_for(self, length: int) -> str:
-        """The method chosen for a gap of `length` missing frames (:attr:`pooled` if unseen)."""
+        """The method chosen for a gap of `length` missing frames (:attr:`pooled` if unseen).
+
+        A combination is named ``"a+b"`` (:meth:`weights_for` gives its weights).
+        """
         lo_hi = _bucket_range(bucket_of(length))
         for c in self.buckets:
             if c.lengths == lo_hi:
                 return c.method
         return self.pooled
 
+    def weights_for(self, length: int) -> tuple[tuple[str, float], ...]:
+        """Methods and weights (summing to 1) used for a gap of `length` missing frames."""
+        lo_hi = _bucket_range(bucket_of(length))
+        for c in self.buckets:
+            if c.lengths == lo_hi:
+                return c.weights or ((c.method, 1.0),)
+        return ((self.pooled, 1.0),)
+
     def describe(self) -> str:
         """A table: per bucket, the chosen method, each candidate's validation MMAE, counts."""
         if not self.buckets:
             return "auto: no gap to fill"
         names = [m for m, _ in next((c.mmae for c in self.buckets if c.mmae), ())]
-        head = f"{'gap length':<12}{'gaps':>6}{'val.':>6}  {'chosen':<10}"
+        wide = max([10] + [len(c.method) + 1 for c in self.buckets])
+        head = f"{'gap length':<12}{'gaps':>6}{'val.':>6}  {'chosen':<{wide}}"
         head += "".join(f"{m:>11}" for m in names)
         lines = [
             "auto: validation MMAE (px) on artificial gaps cut into observed runs; file's "
@@ -144,7 +175,15 @@ class Calibration:
             span = f"{lo}" if lo == hi else f"{lo}-{hi}"
             vals = dict(c.mmae)
             cells = "".join(f"{vals[m]:>11.3f}" if m in vals else f"{'-':>11}" for m in names)
-            lines.append(f"{span:<12}{c.n_gaps:>6}{c.n_validation:>6}  {c.method:<10}{cells}")
+            lines.append(f"{span:<12}{c.n_gaps:>6}{c.n_validation:>6}  {c.method:<{wide}}{cells}")
+        for c in self.buckets:
+            if c.weights:
+                lo, hi = c.lengths
+                span = f"{lo}" if lo == hi else f"{lo}-{hi}"
+                mix = " + ".join(f"{w:.2f} {m}" for m, w in c.weights)
+                lines.append(
+                    f"gap length {span}: combination {mix}, validation MMAE {c.combined_mmae:.3f}"
+                )
         return "\n".join(lines)
 
 
@@ -311,6 +350,7 @@ def calibrate(
     seed: int = 0,
     spans: Sequence[float] | None = None,
     contexts: Sequence[tuple[int, int]] | None = None,
+    combine: bool = True,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -335,6 +375,10 @@ def calibrate(
     contexts : sequence of (int, int), optional
         Observed points before and after each gap (each >= 1): artificial gaps keep as many
         (:func:`_artificial_gaps`; default: the whole run on each side).
+    combine : bool
+        Let a bucket use a convex combination of its chosen method and the best other
+        candidate when it beats the chosen method by the paired test (:func:`_combine`;
+        default). False: one method per bucket.
 
     Returns
     -------
@@ -385,6 +429,8 @@ def calibrate(
         if (m != "gdt-bi" or noise is not None) and (m != "gdt-mix" or motion is not None)
     ]
     errors: dict[int, dict[str, F64]] = {}
+    found: dict[int, dict[str, list[F64]]] = {}
+    truths: dict[int, list[F64]] = {}
     n_cut: dict[int, int] = {}
     flat = _flat(runs)
     for b in progress(sorted(by_bucket), desc="auto: calibrating", unit="bucket"):
@@ -396,9 +442,12 @@ def calibrate(
         pairs = [(a, c) for a, c, _ in cut]
         truth = [t for _, _, t in cut]
         errors[b] = {}
+        found[b] = {}
+        truths[b] = truth
         for m in scored:
             paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
             errors[b][m] = _gap_errors(paths, truth)
+            found[b][m] = paths
     weights = {b: len(by_bucket[b]) for b in errors}
     pooled = _pooled_choice(errors, weights, scored)
     choices = []
@@ -411,8 +460,48 @@ def calibrate(
             best = min(scored, key=lambda m: float(e[m].mean()))
             if best != pooled and _better(e[best], e[pooled]):
                 method = best
+            if combine and len(scored) > 1:
+                other = min((m for m in scored if m != method), key=lambda m: float(e[m].mean()))
+                w, err = _combine(found[b][method], found[b][other], truths[b])
+                if 0.0 < w and _better(err, e[method]):
+                    choices.append(
+                        BucketChoice(
+                            _bucket_range(b),
+                            f"{method}+{other}",
+                            len(by_bucket[b]),
+                            n_cut[b],
+                            mmae,
+                            ((method, 1.0 - w), (other, w)),
+                            float(err.mean()),
+                        )
+                    )
+                    continue
         choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), n_cut[b], mmae))
     return Calibration(tuple(choices), pooled)
+
+
+def _combine(
+    first: Sequence[F64], second: Sequence[F64], truth: Sequence[F64]
+) -> tuple[float, F64]:
+    """Weight of `second` in ``(1 - w) first + w second`` and the per-gap errors it gives.
+
+    `w` minimises the validation MMAE over :data:`COMBINE_GRID` and is then shrunk toward 0
+    (`first` alone) as ``w n / (n + COMBINE_SHRINK)`` for `n` validation gaps, so few gaps
+    give a combination close to the chosen method.
+    """
+    n = np.array([len(t) for t in truth])
+    starts = np.r_[0, np.cumsum(n)[:-1]]
+    p1, p2 = np.concatenate(first), np.concatenate(second)
+    t = np.concatenate([v[:, 1:3] for v in truth])
+
+    def errors(w: float) -> F64:
+        d = (1.0 - w) * p1 + w * p2 - t
+        out: F64 = np.add.reduceat(np.hypot(d[:, 0], d[:, 1]), starts) / n
+        return out
+
+    fit = min(COMBINE_GRID, key=lambda w: float(errors(float(w)).mean()))
+    w = float(fit) * len(n) / (len(n) + COMBINE_SHRINK)
+    return w, errors(w)
 
 
 def _gap_errors(paths: Sequence[F64], truth: Sequence[F64]) -> F64:
@@ -476,6 +565,7 @@ def recover_auto(
     seed: int = 0,
     candidates: Sequence[str] = CANDIDATES,
     max_gaps: int = MAX_CALIBRATION_GAPS,
+    combine: bool = True,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -495,6 +585,9 @@ def recover_auto(
         ``"gdt-mix"`` no motion model is fitted, without ``"gdt-bi"`` no noise levels.
     max_gaps : int
         At most this many artificial gaps (:func:`calibrate`).
+    combine : bool
+        Allow a convex combination of two candidates per bucket (:func:`calibrate`; default).
+        False: one method per bucket.
 
     Returns
     -------
@@ -542,13 +635,25 @@ def recover_auto(
         contexts=[(len(checked[k][0]), len(checked[k][1])) for k in keep],
         candidates=candidates,
         max_gaps=max_gaps,
+        combine=combine,
     )
-    paths: list[F64 | None] = [None] * len(checked)
-    groups: dict[str, list[int]] = {}
-    for k, L in enumerate(lengths):
-        groups.setdefault(cal.method_for(L) if L > 0 else "linear", []).append(k)
+    mixes = [cal.weights_for(L) if L > 0 else (("linear", 1.0),) for L in lengths]
+    groups: dict[str, list[int]] = {}  # each method once, over every gap that uses it
+    for k, mix in enumerate(mixes):
+        for m, _ in mix:
+            groups.setdefault(m, []).append(k)
+    found: dict[tuple[str, int], F64] = {}
     for m, idx in groups.items():
         got = recover_with(m, [checked[k] for k in idx], noise, motion or _NO_MOTION)
         for k, p in zip(idx, got, strict=True):
-            paths[k] = p
-    return [p if p is not None else np.zeros((0, 2)) for p in paths], cal
+            found[m, k] = p
+    paths = []
+    for k, mix in enumerate(mixes):
+        if len(mix) == 1:
+            paths.append(found[mix[0][0], k] if lengths[k] > 0 else np.zeros((0, 2)))
+        else:
+            blend = np.zeros_like(found[mix[0][0], k])
+            for m, w in mix:
+                blend += w * found[m, k]
+            paths.append(blend)
+    return paths, cal

@@ -71,6 +71,7 @@ def fill_gaps(
     noise: NoiseEstimate | None = None,
     *,
     seed: int = 0,
+    combine: bool = True,
 ) -> tuple[F64, FillReport]:
     """Fill every hole of at most `max_gap` missing frames inside each id's track.
 
@@ -89,6 +90,10 @@ def fill_gaps(
         one motion model to the whole file.
     seed : int
         For ``"auto"``: seed of the generator placing the artificial calibration gaps.
+    combine : bool
+        For ``"auto"``: a gap-length bucket may use a convex combination of two methods when
+        it beats the single best on the validation gaps (default;
+        :func:`~pftrack.recovery.calibrate.calibrate`). False: one method per bucket.
 
     Returns
     -------
@@ -109,7 +114,7 @@ def fill_gaps(
         ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer id, a
         non-finite box or a duplicate (frame, id).
     """
-    new_rows, report = fill_rows(tracks, method, max_gap, noise, seed=seed)  # checks `tracks`
+    new_rows, report = fill_rows(tracks, method, max_gap, noise, seed=seed, combine=combine)
     filled = np.vstack([np.asarray(tracks, dtype=np.float64), new_rows])
     order = np.lexsort((filled[:, 1], filled[:, 0]))
     return filled[order], report
@@ -122,6 +127,7 @@ def fill_rows(
     noise: NoiseEstimate | None = None,
     *,
     seed: int = 0,
+    combine: bool = True,
 ) -> tuple[F64, FillReport]:
     """The rows :func:`fill_gaps` adds (flagged, in no particular order), and its report.
 
@@ -129,6 +135,8 @@ def fill_rows(
     """
     if method not in METHODS:
         raise ValueError(f"fill_gaps: method is {method!r}, expected one of {METHODS}")
+    if not isinstance(combine, (bool, np.bool_)):
+        raise TypeError(f"fill_gaps: combine must be a bool, got {type(combine).__name__}")
     if (
         not isinstance(max_gap, (int, np.integer))
         or isinstance(max_gap, bool)
@@ -166,11 +174,18 @@ def fill_rows(
         wh_paths: list[F64] | None = None
         if method == "auto":
             whole = [box_centres(r) for r in per_id.values()]
-            paths, calibration = recover_auto(segs, whole, noise, motion, seed=seed)
+            paths, calibration = recover_auto(
+                segs, whole, noise, motion, seed=seed, combine=combine
+            )
             sizes = [r[:, [0, 4, 5]] for r in per_id.values()]
             size_segs = [(a[:, [0, 3, 4]], b[:, [0, 3, 4]]) for a, b in segs]
             wh_paths, size_cal = recover_auto(
-                size_segs, sizes, seed=seed, candidates=SIZE_CANDIDATES, max_gaps=SIZE_GAPS
+                size_segs,
+                sizes,
+                seed=seed,
+                candidates=SIZE_CANDIDATES,
+                max_gaps=SIZE_GAPS,
+                combine=combine,
             )
         else:
             paths = recover_gaps(segs, method, noise=noise, motion=motion)

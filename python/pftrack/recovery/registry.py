@@ -18,8 +18,8 @@ Methods
 ``"auto"`` (the default, :data:`DEFAULT_METHOD`)
     Calibrated on the file itself: artificial gaps of the lengths to fill are cut into the
     observed runs, every candidate method recovers them, and each gap-length bucket uses the
-    best (a straight line unless another method is clearly better;
-    :mod:`pftrack.recovery.calibrate`).
+    best (a straight line unless another method is clearly better), or a convex combination
+    of the best two where it is clearly better still (:mod:`pftrack.recovery.calibrate`).
 ``"gdt-fixed"`` (pftrack's variant)
     ``gdt-bi``'s two-sided goal with the paper's fixed noise levels (nothing estimated, so
     camera motion and annotation jitter cannot inflate them).
