@@ -53,6 +53,21 @@ def test_cli_parser_loads_no_scipy() -> None:
     assert out.stdout.strip() == "['pftrack.recovery.names']"
 
 
+def test_recover_loads_no_tracker(tmp_path: Path) -> None:
+    """``pftrack recover`` runs without importing the tracker (about 0.14 s of imports)."""
+    tracks = tmp_path / "t.txt"
+    tracks.write_text("1,1,10,10,5,5,1,-1,-1,-1\n4,1,13,10,5,5,1,-1,-1,-1\n")
+    code = (
+        "import sys; from pftrack.cli import main; "
+        f"status = main(['-q', 'recover', {str(tracks)!r}, '--out', {str(tmp_path / 'o.txt')!r}]); "
+        "print(status, sorted(m for m in sys.modules if m.startswith(('pftrack.tracking', "
+        "'pftrack.detection'))))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "0 []"
+    assert (tmp_path / "o.txt").read_text().count("\n") == 4  # frames 2 and 3 filled
+
+
 def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """mypy sees the real signatures through the lazy re-exports (and the package's py.typed)."""
     api = pytest.importorskip("mypy.api")

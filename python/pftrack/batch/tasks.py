@@ -17,13 +17,15 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from pftrack._typing import F64, PathLike
 from pftrack.batch.inputs import SequenceInput
-from pftrack.tracking.config import TrackerConfig
+
+if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover needs none of it
+    from pftrack.tracking.config import TrackerConfig
 
 __all__ = [
     "RecoverOptions",
@@ -67,6 +69,12 @@ def _settings(options: object) -> dict[str, Any]:
     return value
 
 
+def _default_config() -> TrackerConfig:
+    from pftrack.tracking.config import TrackerConfig
+
+    return TrackerConfig()
+
+
 @dataclass(frozen=True)
 class TrackOptions:
     """Settings of ``pftrack batch`` shared by every sequence.
@@ -93,7 +101,7 @@ class TrackOptions:
         IoU threshold of a match for the metrics (where ground truth exists).
     """
 
-    config: TrackerConfig = field(default_factory=TrackerConfig)
+    config: TrackerConfig = field(default_factory=_default_config)
     seed: int = 0
     detections: str | None = None
     det_scale: float | None = None
