@@ -284,7 +284,8 @@ inline void split_groups(const std::uint8_t* mask, Index stride, std::vector<Blo
     for (std::size_t i = 0; i < rects.size(); ++i) {
         const auto x = static_cast<Index>(rects[i].x), y = static_cast<Index>(rects[i].y);
         const auto w = static_cast<Index>(rects[i].w), h = static_cast<Index>(rects[i].h);
-        const std::int64_t n = std::min<std::int64_t>(counts[i], w);  // at most a part a column
+        // at most 2^20 parts (bounds the work; a real frame's counts are far below)
+        const std::int64_t n = std::min<std::int64_t>(counts[i], std::int64_t{1} << 20);
         if (n < 2) {
             out_r.push_back(rects[i]);
             out_f.push_back(fill[i]);
