@@ -118,6 +118,24 @@ void register_blobs(py::module_& m) {
         "Groups (list of lists of indices) of the boxes (K, 4) that are one person's fragments.");
 
     m.def(
+        "size_fit",
+        [](Eigen::Ref<const RowMatrixXd> samples) {
+            const char* fn = "size_fit";
+            require(samples.cols() == 3, fn, "samples cols", samples.cols(), "3 (foot y, h, w)");
+            require_finite(samples, fn, "samples");
+            SizeLines s;
+            {
+                py::gil_scoped_release nogil;  // safe: `samples` kept alive by the caller
+                s = size_fit(samples.data(), samples.rows(), samples.outerStride());
+            }
+            RowMatrixXd out(2, 2);
+            out << s.h_slope, s.h_intercept, s.w_slope, s.w_intercept;
+            return out;
+        },
+        py::arg("samples"),
+        "Size lines (2, 2) [[h_slope, h_intercept], [w_slope, w_intercept]] from samples (n, 3).");
+
+    m.def(
         "theil_sen",
         [](Eigen::Ref<const Eigen::VectorXd> x, Eigen::Ref<const Eigen::VectorXd> y) {
             const char* fn = "theil_sen";

@@ -218,6 +218,7 @@ def split_count(
     boxes: _F64, size_lines: _F64, split_ratio: float, split_max_height: float
 ) -> NDArray[np.int64]: ...  # (K,)
 def merge_fragments(boxes: _F64, size_lines: _F64, merge_slack: float) -> list[list[int]]: ...
+def size_fit(samples: _F64) -> _F64: ...  # (n, 3) foot y, h, w -> (2, 2) size lines
 def theil_sen(x: _F64, y: _F64) -> tuple[float, float]: ...  # x, y (n,) -> slope, intercept
 
 # --- resampling: weights (N,) float64 >= 0 -> indices (N,) int32 --------------------------

@@ -108,6 +108,26 @@ def test_size_kernels_equal_reference(seed: int) -> None:
             assert theil_sen(x, y) == ref.theil_sen(x, y)
 
 
+@pytest.mark.parametrize("seed", range(12))
+def test_size_fit_equals_reference(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = int(rng.choice([1, 2, 3, 30, 31, 200]))
+    y = rng.uniform(50, 350, n).round(0)
+    if seed % 4 == 0:
+        y[:] = 200.0 + rng.uniform(0, 0.9)  # every foot on one row: a constant size
+    h = 0.3 * y + rng.normal(0, 4, n).round(1)
+    w = 0.1 * y + rng.normal(0, 2, n).round(1)
+    h[::7] *= 1.9  # a one-sided block of outliers (groups)
+    samples = np.column_stack([y, h, w])
+    if n == 1 or np.ptp(y) >= 1.0 or seed % 4 == 0:
+        np.testing.assert_array_equal(_core.size_fit(samples), ref.size_fit(samples))
+    model = PersonSizeModel()
+    model.observe(np.column_stack([np.arange(n) * 1000.0, y - h, w, h]))  # all isolated
+    if model.fitted:  # the samples held (foot rows recomputed as top + h)
+        held = model._samples[: model.n_samples]
+        np.testing.assert_array_equal(model.lines, ref.size_fit(held))
+
+
 def test_model_methods_and_extractor_use_the_kernels() -> None:
     model = PersonSizeModel()
     model._coef = LINES.copy()  # a fitted model without feeding it samples
@@ -144,6 +164,10 @@ def test_bad_input() -> None:
         theil_sen(np.ones(5), np.arange(5.0))
     with pytest.raises(ValueError, match="theil_sen: y size is 4"):
         theil_sen(np.arange(5.0), np.arange(4.0))
+    with pytest.raises(ValueError, match="size_fit: samples cols is 2"):
+        _core.size_fit(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="size_fit: samples is empty"):
+        _core.size_fit(np.zeros((0, 3)))
     with pytest.raises(ValueError, match="PersonSizeModel.split_count: the model is not fitted"):
         PersonSizeModel().split_count(np.zeros((1, 4)))
 

@@ -475,6 +475,10 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target(
+        "size_fit",
+        N.flatmap(lambda n: call(_core.size_fit, maybe(floats_array((n, 3), 0, 500)))),
+    ),  # fmt: skip
+    Target(
         "theil_sen",
         N.flatmap(
             lambda n: call(_core.theil_sen, maybe(floats_array((n,))), maybe(floats_array((n,))))

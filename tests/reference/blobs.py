@@ -1,4 +1,5 @@
-"""Reference of the blob pass (pftrack._core.blob_boxes, split_count, merge_fragments, theil_sen).
+"""Reference of the blob pass (pftrack._core.blob_boxes, split_count, merge_fragments, theil_sen,
+size_fit).
 
 The detectors' blob pass as it was written in Python before it moved to C++: OpenCV's outer
 contours (``cv2.findContours`` with ``RETR_EXTERNAL``), NumPy filters, the person-size model's
@@ -22,6 +23,29 @@ def theil_sen(x: F64, y: F64) -> tuple[float, float]:
     ok = dx != 0
     slope = float(np.median((y[j] - y[i])[ok] / dx[ok]))
     return slope, float(np.median(y - slope * x))
+
+
+def robust_line(x: F64, y: F64) -> tuple[float, float]:
+    """Theil-Sen line refitted once on the points within 3 robust sigmas of the first."""
+    slope, intercept = theil_sen(x, y)
+    r = y - (slope * x + intercept)
+    sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    keep = np.abs(r) <= 3.0 * max(sigma, 1.0)
+    if keep.sum() >= 3 and np.ptp(x[keep]) > 0:
+        slope, intercept = theil_sen(x[keep], y[keep])
+    return slope, intercept
+
+
+def size_fit(samples: F64) -> F64:
+    """The size model's (2, 2) lines from samples (n, 3) foot y, h, w."""
+    s = np.asarray(samples, np.float64)
+    coef = np.zeros((2, 2))
+    if np.ptp(s[:, 0]) < 1.0:  # every foot on one row: a constant size
+        coef[:, 1] = np.median(s[:, 1:], axis=0)
+    else:
+        for j in (0, 1):
+            coef[j] = robust_line(s[:, 0], s[:, 1 + j])
+    return coef
 
 
 def expected(coef: F64, foot_y: F64 | float) -> F64:

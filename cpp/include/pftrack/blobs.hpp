@@ -64,6 +64,54 @@ inline std::pair<double, double> theil_sen(const double* x, const double* y, Ind
     return {slope, intercept};
 }
 
+/// Theil-Sen line refitted once on the points within 3 robust sigmas (1.4826 MAD, at least 1)
+/// of the first line, when at least 3 points with distinct x remain (PersonSizeModel's fit).
+inline std::pair<double, double> robust_line(const std::vector<double>& x,
+                                             const std::vector<double>& y) {
+    const Index n = static_cast<Index>(x.size());
+    auto [slope, intercept] = theil_sen(x.data(), y.data(), n);
+    std::vector<double> r(x.size()), dev(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        const double sx = slope * x[i];
+        const double fit = sx + intercept;
+        r[i] = y[i] - fit;
+    }
+    std::vector<double> tmp = r;
+    const double mid = median_of(tmp);
+    for (std::size_t i = 0; i < x.size(); ++i) dev[i] = std::abs(r[i] - mid);
+    const double sigma = 1.4826 * median_of(dev);
+    const double bound = 3.0 * std::max(sigma, 1.0);
+    std::vector<double> kx, ky;
+    for (std::size_t i = 0; i < x.size(); ++i)
+        if (std::abs(r[i]) <= bound) {
+            kx.push_back(x[i]);
+            ky.push_back(y[i]);
+        }
+    if (kx.size() >= 3 &&
+        *std::max_element(kx.begin(), kx.end()) - *std::min_element(kx.begin(), kx.end()) > 0.0)
+        return theil_sen(kx.data(), ky.data(), static_cast<Index>(kx.size()));
+    return {slope, intercept};
+}
+
+/// The person-size model's lines from its samples (n rows of foot y, h, w, `stride` doubles a
+/// row): [[h_slope, h_intercept], [w_slope, w_intercept]]. Every foot on one row (spread under
+/// 1 px): slopes 0 and the median sizes; otherwise `robust_line` of h and of w against foot y.
+inline SizeLines size_fit(const double* samples, Index n, Index stride) {
+    if (n < 1) fail("size_fit", "samples is empty, expected at least one row");
+    std::vector<double> y(static_cast<std::size_t>(n)), h(y.size()), w(y.size());
+    for (Index i = 0; i < n; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        y[k] = samples[i * stride];
+        h[k] = samples[i * stride + 1];
+        w[k] = samples[i * stride + 2];
+    }
+    if (*std::max_element(y.begin(), y.end()) - *std::min_element(y.begin(), y.end()) < 1.0)
+        return {0.0, median_of(h), 0.0, median_of(w)};
+    const auto [hs, hi] = robust_line(y, h);
+    const auto [ws, wi] = robust_line(y, w);
+    return {hs, hi, ws, wi};
+}
+
 /// round(v) half to even (numpy.round), as an integer count, clamped to [0, 2^53].
 inline std::int64_t to_count(double v) {
     return static_cast<std::int64_t>(std::nearbyint(std::clamp(v, 0.0, 9007199254740992.0)));

@@ -94,21 +94,6 @@ def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, fl
     return _core.theil_sen(np.asarray(x, np.float64), np.asarray(y, np.float64))
 
 
-def _robust_line(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:
-    """Theil-Sen line ``y = slope x + intercept``, robust to a one-sided block of outliers.
-
-    Refitted once on the points within 3 robust sigmas (1.4826 MAD) of the first line: the
-    refit removes the bias that groups and fragments (all wider, or all smaller) leave.
-    """
-    slope, intercept = theil_sen(x, y)
-    r = y - (slope * x + intercept)
-    sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
-    keep = np.abs(r) <= 3.0 * max(sigma, 1.0)
-    if keep.sum() >= 3 and np.ptp(x[keep]) > 0:
-        slope, intercept = theil_sen(x[keep], y[keep])
-    return slope, intercept
-
-
 class PersonSizeModel:
     """Expected box height and width of one person as straight lines in the foot row ``y``.
 
@@ -186,14 +171,14 @@ class PersonSizeModel:
             self._fit()
 
     def _fit(self) -> None:
-        s = self._samples[: self.n_samples]
-        coef = np.zeros((2, 2))
-        if np.ptp(s[:, 0]) < 1.0:  # every foot on one row: a constant size
-            coef[:, 1] = np.median(s[:, 1:], axis=0)
-        else:
-            for j in (0, 1):
-                coef[j] = _robust_line(s[:, 0], s[:, 1 + j])
-        self._coef = coef
+        """Both lines from the samples held, in C++ (``pftrack._core.size_fit``).
+
+        Each is a Theil-Sen line of h (or w) against the foot row, refitted once on the
+        points within 3 robust sigmas (1.4826 MAD, at least 1 px) of the first line: the refit
+        removes the bias that groups and fragments (all wider, or all smaller) leave. Every
+        foot on one row (spread under 1 px): a constant size, the median h and w.
+        """
+        self._coef = _core.size_fit(self._samples[: self.n_samples])
         self._since_fit = 0
 
     def split_count(self, boxes: NDArray[np.float64]) -> NDArray[np.int64]:
