@@ -134,7 +134,9 @@ def test_model_methods_and_extractor_use_the_kernels() -> None:
     boxes = np.array([[10.0, 100.0, 30.0, 35.0], [50.0, 60.0, 8.0, 20.0], [50.0, 80.0, 9.0, 18.0]])
     np.testing.assert_array_equal(model.split_count(boxes), ref.split_count(boxes, LINES))
     assert model.merge_fragments(boxes) == ref.merge_fragments(boxes, LINES)
-    assert model.lines is model._coef
+    lines = model.lines
+    assert lines is not None and not lines.flags.writeable
+    np.testing.assert_array_equal(lines, LINES)
 
 
 def test_bad_input() -> None:

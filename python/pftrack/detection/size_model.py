@@ -133,8 +133,12 @@ class PersonSizeModel:
 
     @property
     def lines(self) -> NDArray[np.float64] | None:
-        """The fit itself (not a copy, do not write), as `coefficients`; None before the fit."""
-        return self._coef
+        """The fit as `coefficients`, a read-only view (no copy per frame); None before the fit."""
+        if self._coef is None:
+            return None
+        view: NDArray[np.float64] = self._coef.view()
+        view.flags.writeable = False
+        return view
 
     def expected(self, foot_y: NDArray[np.float64] | float) -> NDArray[np.float64]:
         """Expected ``(h, w)`` at foot row(s) `foot_y`: shape ``(..., 2)``, at least 1 px.
