@@ -1,4 +1,5 @@
-"""Detection speed: the fused C++ pass vs OpenCV's MOG2 vs the NumPy reference, same frames.
+"""Detection speed: the fused C++ pass vs OpenCV's MOG2 vs the NumPy reference, same frames;
+the blob pass and the size model's Theil-Sen line in C++ vs their Python references.
 
 pytest bench/test_detection.py --benchmark-only --benchmark-group-by=group
 """
@@ -18,6 +19,8 @@ from pytest_benchmark.fixture import BenchmarkFixture
 
 from pftrack import _core
 from pftrack.detection import make_detector
+from tests.reference.blobs import blob_boxes as blob_reference
+from tests.reference.blobs import theil_sen as theil_sen_reference
 from tests.reference.detection import BackgroundReference
 
 SIZES = {"480x360": (480, 360), "768x576": (768, 576)}
@@ -145,3 +148,54 @@ def test_prime_median_numpy(benchmark: BenchmarkFixture, frames: Frames) -> None
     name, fr = frames
     benchmark.group = f"prime median of 30 frames {name}"
     benchmark(lambda: np.median(np.stack(fr[:30]), axis=0).astype(np.float32))
+
+
+@pytest.fixture(scope="module")
+def blob_masks(frames: Frames) -> tuple[str, list[NDArray[np.uint8]], NDArray[np.float64]]:
+    """The cleaned masks of the 60 frames (primed detector) and a size model's lines."""
+    name, fr = frames
+    det = make_detector("paper")
+    det.prime(fr[::2])
+    masks = [det.foreground(f)[0] for f in fr]
+    rows = fr[0].shape[0]
+    lines = np.array([[0.25, 0.0], [0.09, 0.0]]) * (1.0, rows / 360)  # a PETS-like person
+    return name, masks, lines
+
+
+BLOB_ARGS = (0.0015, 0.25, 0.25, 6.0, 0.2, 2.8)  # BlobConfig's defaults: area, aspect, fill
+
+
+@pytest.mark.parametrize("model", ["aspect split", "size model"])
+def test_blob_pass_core(benchmark: BenchmarkFixture, blob_masks: Any, model: str) -> None:
+    name, masks, lines = blob_masks
+    benchmark.group = f"blob pass ({model}) {name}"
+    size = lines if model == "size model" else None
+    benchmark(cycle_apply(lambda m: _core.blob_boxes(m, *BLOB_ARGS, size, 1.6, 1.5, 1.2), masks))
+
+
+@pytest.mark.parametrize("model", ["aspect split", "size model"])
+def test_blob_pass_reference(benchmark: BenchmarkFixture, blob_masks: Any, model: str) -> None:
+    name, masks, lines = blob_masks
+    benchmark.group = f"blob pass ({model}) {name}"
+    size = lines if model == "size model" else None
+    benchmark(cycle_apply(lambda m: blob_reference(m, *BLOB_ARGS, size, 1.6, 1.5, 1.2), masks))
+
+
+@pytest.fixture(scope="module")
+def size_samples() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """200 foot rows and heights (the size model's full ring buffer), one in ten an outlier."""
+    rng = np.random.default_rng(0)
+    y = rng.uniform(100, 360, 200)
+    h = 0.25 * y + rng.normal(0, 3, 200)
+    h[::10] *= 1.8
+    return y, h
+
+
+def test_theil_sen_core(benchmark: BenchmarkFixture, size_samples: Any) -> None:
+    benchmark.group = "Theil-Sen line, 200 samples"
+    benchmark(_core.theil_sen, *size_samples)
+
+
+def test_theil_sen_numpy(benchmark: BenchmarkFixture, size_samples: Any) -> None:
+    benchmark.group = "Theil-Sen line, 200 samples"
+    benchmark(theil_sen_reference, *size_samples)

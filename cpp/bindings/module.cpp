@@ -14,6 +14,7 @@ void register_bridge(py::module_& m);
 void register_assignment(py::module_& m);
 void register_smoothing(py::module_& m);
 void register_refine(py::module_& m);
+void register_blobs(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -27,4 +28,5 @@ PYBIND11_MODULE(_core, m) {
     register_assignment(m);
     register_smoothing(m);
     register_refine(m);
+    register_blobs(m);
 }

@@ -199,6 +199,28 @@ def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascendin
 # --- box refinement: boxes (K, 4) left, top, w, h; mask (H, W) uint8 or bool -> (K, 4) -----
 def refine_boxes(boxes: _F64, mask: NDArray[Any], fraction: float, min_cover: float) -> _F64: ...
 
+# --- blob pass: mask (H, W) uint8 0/255 -> boxes (K, 4) left, top, w, h and fills (K,) -------
+# size_lines (2, 2) [[h_slope, h_intercept], [w_slope, w_intercept]] in the foot row, or None
+def blob_boxes(
+    mask: NDArray[np.uint8],
+    min_area: float,
+    max_area: float,
+    min_aspect: float,
+    max_aspect: float,
+    min_fill: float,
+    person_aspect: float,
+    size_lines: _F64 | None,
+    split_ratio: float,
+    split_max_height: float,
+    merge_slack: float,
+) -> tuple[_F64, _F64]: ...  # unsorted (outer contours' order)
+def split_count(
+    boxes: _F64, size_lines: _F64, split_ratio: float, split_max_height: float
+) -> NDArray[np.int64]: ...  # (K,)
+def merge_fragments(boxes: _F64, size_lines: _F64, merge_slack: float) -> list[list[int]]: ...
+def size_fit(samples: _F64) -> _F64: ...  # (n, 3) foot y, h, w -> (2, 2) size lines
+def theil_sen(x: _F64, y: _F64) -> tuple[float, float]: ...  # x, y (n,) -> slope, intercept
+
 # --- resampling: weights (N,) float64 >= 0 -> indices (N,) int32 --------------------------
 def systematic_resample(weights: _F64, u0: float) -> _I32: ...  # u0 in [0, 1)
 def stratified_resample(weights: _F64, u: _F64) -> _I32: ...  # u (N,) in [0, 1)

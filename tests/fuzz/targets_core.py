@@ -435,6 +435,56 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target(
+        "blob_boxes",
+        call(
+            _core.blob_boxes,
+            st.one_of(
+                masks().map(lambda m: (np.asarray(m) > 0).astype(np.uint8) * 255),
+                masks().flatmap(layout),
+                garbage(),
+            ),
+            maybe(fl(0, 0.01)),
+            maybe(fl(0.01, 1)),
+            maybe(fl(1e-3, 1)),
+            maybe(fl(1, 1e3)),
+            maybe(fl(0, 1)),
+            maybe(fl(0, 10)),
+            st.one_of(st.none(), floats_array((2, 2), -5, 50), garbage()),
+            maybe(fl(1, 3)),
+            maybe(fl(0.5, 3)),
+            maybe(fl(1, 3)),
+        ),
+    ),  # fmt: skip
+    Target(
+        "split_count",
+        call(
+            _core.split_count,
+            maybe(boxes()),
+            maybe(floats_array((2, 2), -5, 50)),
+            maybe(fl(1, 3)),
+            maybe(fl(0.5, 3)),
+        ),
+    ),  # fmt: skip
+    Target(
+        "merge_fragments",
+        call(
+            _core.merge_fragments,
+            maybe(boxes()),
+            maybe(floats_array((2, 2), -5, 50)),
+            maybe(fl(1, 3)),
+        ),
+    ),  # fmt: skip
+    Target(
+        "size_fit",
+        N.flatmap(lambda n: call(_core.size_fit, maybe(floats_array((n, 3), 0, 500)))),
+    ),  # fmt: skip
+    Target(
+        "theil_sen",
+        N.flatmap(
+            lambda n: call(_core.theil_sen, maybe(floats_array((n,))), maybe(floats_array((n,))))
+        ),
+    ),  # fmt: skip
+    Target(
         "counter_normals",
         call(
             _core.counter_normals,

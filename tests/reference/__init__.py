@@ -2,6 +2,7 @@
 
 One module per wing: ``kernels`` (HSV bins, histograms, Bhattacharyya, resampling, SIS),
 ``fused`` (vectorised NumPy peers for the benchmarks), ``mcmc`` (MH and RJ-MCMC), ``detection``
-(background model), ``refine`` (box refinement), ``smoothing`` (constant-velocity posterior),
+(background model), ``refine`` (box refinement), ``blobs`` (the blob pass and
+the size model's kernels), ``smoothing`` (constant-velocity posterior),
 ``bridge`` (goal-directed recovery), ``mixture`` (stand/walk gap mixture).
 """

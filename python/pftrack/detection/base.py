@@ -247,104 +247,36 @@ class BlobExtractor:
     def boxes(self, mask: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Boxes (K, 4) left, top, w, h and scores (K,) of the blobs that pass the filters.
 
-        A blob is an 8-connected foreground region, found by its outer border
-        (``cv2.findContours`` with ``RETR_EXTERNAL``: the regions of
-        ``cv2.connectedComponentsWithStats(connectivity=8)``, about 20 times faster on sparse
-        masks). Its area is the number of foreground pixels in its box.
+        A blob is an 8-connected foreground region that lies in no hole of another one (the
+        regions whose outer borders ``cv2.findContours`` with ``RETR_EXTERNAL`` follows). Its
+        area is the number of foreground pixels in its box. Blobs outside the area, aspect and
+        fill limits are dropped; then, once the person-size model is fitted, the fragments of
+        one person are joined (`PersonSizeModel.merge_fragments`) and groups cut
+        (`PersonSizeModel.split_count`), else groups are cut by `BlobConfig.person_aspect`: a
+        blob is cut into ``counts`` people at the minima of its column profile, each part with
+        its own tight box, and parts under ``min_area`` foreground pixels are dropped.
+
+        The whole pass is one C++ call (``pftrack._core.blob_boxes``, the GIL released;
+        ``tests/reference/blobs.py`` is the OpenCV/NumPy statement it equals bit for bit).
         """
         cfg = self.config
-        contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
-        if not contours:
-            return np.zeros((0, 4)), np.zeros(0)
-        rects = np.array([cv2.boundingRect(c) for c in contours], dtype=np.float64)
-        frame_area = float(mask.shape[0] * mask.shape[1])
-        w, h = rects[:, 2], rects[:, 3]
-        aspect = h / w
-        keep = (
-            (w * h >= cfg.min_area * frame_area)
-            & (aspect >= cfg.min_aspect)
-            & (aspect <= cfg.max_aspect)
-        )
-        area = np.zeros(len(rects))
-        for i in np.flatnonzero(keep):
-            x, y, bw, bh = rects[i].astype(int)
-            area[i] = cv2.countNonZero(mask[y : y + bh, x : x + bw])
-        fill = area / (w * h)
-        keep &= (
-            (area >= cfg.min_area * frame_area)
-            & (area <= cfg.max_area * frame_area)
-            & (fill >= cfg.min_fill)
-        )
-        rects, fill = rects[keep], fill[keep]
         model = self.size_model
-        if cfg.learn_size and model.fitted and len(rects):
-            rects, fill = self._merge_fragments(mask, rects, fill)
-            rects, fill = self._split_groups(mask, rects, fill, model.split_count(rects))
-        elif cfg.person_aspect > 0 and len(rects):
-            objects = rects[:, 2] * cfg.person_aspect / rects[:, 3]  # side by side
-            n = np.round(objects).astype(np.int64)
-            n[objects < 1.5] = 1
-            rects, fill = self._split_groups(mask, rects, fill, n)
+        lines = model.lines if cfg.learn_size else None
+        sc = model.config
+        rects, fill = _core.blob_boxes(
+            mask,
+            cfg.min_area,
+            cfg.max_area,
+            cfg.min_aspect,
+            cfg.max_aspect,
+            cfg.min_fill,
+            cfg.person_aspect,
+            lines,
+            sc.split_ratio,
+            sc.split_max_height,
+            sc.merge_slack,
+        )
         if cfg.learn_size:
             model.observe(rects)
         order = np.lexsort((rects[:, 1], rects[:, 0]))  # deterministic: by left, then top
         return np.ascontiguousarray(rects[order]), np.ascontiguousarray(fill[order])
-
-    def _merge_fragments(
-        self, mask: NDArray[np.uint8], rects: NDArray[np.float64], fill: NDArray[np.float64]
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Join the blobs that the size model calls fragments of one person (union box)."""
-        groups = self.size_model.merge_fragments(rects)
-        if len(groups) == len(rects):
-            return rects, fill
-        out_r = np.zeros((len(groups), 4))
-        out_f = np.zeros(len(groups))
-        for k, g in enumerate(groups):
-            x0, y0 = rects[g, 0].min(), rects[g, 1].min()
-            x1, y1 = (rects[g, 0] + rects[g, 2]).max(), (rects[g, 1] + rects[g, 3]).max()
-            out_r[k] = (x0, y0, x1 - x0, y1 - y0)
-            roi = mask[int(y0) : int(y1), int(x0) : int(x1)]
-            out_f[k] = cv2.countNonZero(roi) / max(roi.size, 1) if len(g) > 1 else fill[g[0]]
-        return out_r, out_f
-
-    def _split_groups(
-        self,
-        mask: NDArray[np.uint8],
-        rects: NDArray[np.float64],
-        fill: NDArray[np.float64],
-        counts: NDArray[np.int64],
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Cut each blob into ``counts[i]`` people at the minima of its column profile.
-
-        A part must pass the blob filters' ``min_area`` (foreground pixels) too: a sliver cut
-        off a large blob is not a person.
-        """
-        min_pixels = self.config.min_area * mask.shape[0] * mask.shape[1]
-        out_r: list[NDArray[np.float64]] = []
-        out_f: list[float] = []
-        for r, f, n in zip(rects, fill, counts, strict=True):
-            x, y, w, h = (int(v) for v in r)
-            if n < 2:
-                out_r.append(r)
-                out_f.append(float(f))
-                continue
-            n = int(n)
-            roi = mask[y : y + h, x : x + w] > 0
-            profile = roi.sum(axis=0).astype(np.float64)
-            cuts = [0]
-            half = max(1, w // (4 * n))
-            for k in range(1, n):
-                c = round(k * w / n)
-                lo, hi = max(cuts[-1] + 1, c - half), min(w - 1, c + half + 1)
-                cuts.append(lo + int(np.argmin(profile[lo:hi])) if hi > lo else c)
-            cuts.append(w)
-            for a, b in zip(cuts[:-1], cuts[1:], strict=True):
-                part = roi[:, a:b]
-                rows = np.flatnonzero(part.any(axis=1))
-                cols = np.flatnonzero(part.any(axis=0))
-                if len(rows) == 0 or part.sum() < min_pixels:
-                    continue
-                pw, ph = cols[-1] - cols[0] + 1, rows[-1] - rows[0] + 1
-                out_r.append(np.array([x + a + cols[0], y + rows[0], pw, ph], np.float64))
-                out_f.append(float(part.sum()) / (pw * ph))
-        return np.array(out_r, np.float64).reshape(-1, 4), np.array(out_f, np.float64)

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack import _core
+
 __all__ = ["PersonSizeModel", "SizeModelConfig", "theil_sen"]
 
 
@@ -71,7 +73,9 @@ def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, fl
     """Theil-Sen line: the median of the pairwise slopes, intercept ``median(y - slope x)``.
 
     ``scipy.stats.theilslopes(y, x, method="joint")`` without its confidence interval, which
-    costs several sorts (tests hold the two equal).
+    costs several sorts (tests hold the two equal). In C++ (``pftrack._core.theil_sen``:
+    selection, not sorting, of the n (n - 1) / 2 slopes); ``tests/reference/blobs.py`` holds the
+    NumPy statement it equals bit for bit.
 
     Parameters
     ----------
@@ -81,27 +85,13 @@ def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, fl
     Returns
     -------
     slope, intercept : float
+
+    Raises
+    ------
+    ValueError
+        `x` and `y` of different lengths, values not finite, or no two distinct `x`.
     """
-    i, j = np.triu_indices(len(x), k=1)
-    dx = x[j] - x[i]
-    ok = dx != 0
-    slope = float(np.median((y[j] - y[i])[ok] / dx[ok]))
-    return slope, float(np.median(y - slope * x))
-
-
-def _robust_line(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:
-    """Theil-Sen line ``y = slope x + intercept``, robust to a one-sided block of outliers.
-
-    Refitted once on the points within 3 robust sigmas (1.4826 MAD) of the first line: the
-    refit removes the bias that groups and fragments (all wider, or all smaller) leave.
-    """
-    slope, intercept = theil_sen(x, y)
-    r = y - (slope * x + intercept)
-    sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
-    keep = np.abs(r) <= 3.0 * max(sigma, 1.0)
-    if keep.sum() >= 3 and np.ptp(x[keep]) > 0:
-        slope, intercept = theil_sen(x[keep], y[keep])
-    return slope, intercept
+    return _core.theil_sen(np.asarray(x, np.float64), np.asarray(y, np.float64))
 
 
 class PersonSizeModel:
@@ -141,6 +131,15 @@ class PersonSizeModel:
         """(2, 2) ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in foot row, or None."""
         return None if self._coef is None else self._coef.copy()
 
+    @property
+    def lines(self) -> NDArray[np.float64] | None:
+        """The fit as `coefficients`, a read-only view (no copy per frame); None before the fit."""
+        if self._coef is None:
+            return None
+        view: NDArray[np.float64] = self._coef.view()
+        view.flags.writeable = False
+        return view
+
     def expected(self, foot_y: NDArray[np.float64] | float) -> NDArray[np.float64]:
         """Expected ``(h, w)`` at foot row(s) `foot_y`: shape ``(..., 2)``, at least 1 px.
 
@@ -176,14 +175,14 @@ class PersonSizeModel:
             self._fit()
 
     def _fit(self) -> None:
-        s = self._samples[: self.n_samples]
-        coef = np.zeros((2, 2))
-        if np.ptp(s[:, 0]) < 1.0:  # every foot on one row: a constant size
-            coef[:, 1] = np.median(s[:, 1:], axis=0)
-        else:
-            for j in (0, 1):
-                coef[j] = _robust_line(s[:, 0], s[:, 1 + j])
-        self._coef = coef
+        """Both lines from the samples held, in C++ (``pftrack._core.size_fit``).
+
+        Each is a Theil-Sen line of h (or w) against the foot row, refitted once on the
+        points within 3 robust sigmas (1.4826 MAD, at least 1 px) of the first line: the refit
+        removes the bias that groups and fragments (all wider, or all smaller) leave. Every
+        foot on one row (spread under 1 px): a constant size, the median h and w.
+        """
+        self._coef = _core.size_fit(self._samples[: self.n_samples])
         self._since_fit = 0
 
     def split_count(self, boxes: NDArray[np.float64]) -> NDArray[np.int64]:
@@ -194,13 +193,14 @@ class PersonSizeModel:
         taller than a person standing at its foot row is the upper part of a nearer person
         whose legs went undetected, not a far group.
         """
-        b = np.asarray(boxes, np.float64).reshape(-1, 4)
-        h_exp, w_exp = self.expected(b[:, 1] + b[:, 3]).T
-        wide = (b[:, 2] > self.config.split_ratio * w_exp) & (
-            b[:, 3] <= self.config.split_max_height * h_exp
+        c = self.config
+        split: NDArray[np.int64] = _core.split_count(
+            np.asarray(boxes, np.float64).reshape(-1, 4),
+            self._fitted_lines("split_count"),
+            c.split_ratio,
+            c.split_max_height,
         )
-        n = np.where(wide, np.round(b[:, 2] / w_exp), 1.0).astype(np.int64)
-        return np.maximum(n, 1)
+        return split
 
     def merge_fragments(self, boxes: NDArray[np.float64]) -> list[list[int]]:
         """Group the boxes (K, 4) that are fragments of one person.
@@ -214,30 +214,14 @@ class PersonSizeModel:
         list of lists of int
             Indices of the boxes of each group (every box in exactly one group).
         """
-        b = np.asarray(boxes, np.float64).reshape(-1, 4)
-        groups = [[i] for i in range(len(b))]
-        cur = [r.copy() for r in b]
-        slack = self.config.merge_slack
-        while len(cur) > 1:
-            best: tuple[float, int, int, NDArray[np.float64]] | None = None
-            for i in range(len(cur)):
-                for j in range(i + 1, len(cur)):
-                    a, c = cur[i], cur[j]
-                    ov = min(a[0] + a[2], c[0] + c[2]) - max(a[0], c[0])
-                    if ov < 0.5 * min(a[2], c[2]):
-                        continue
-                    x0, y0 = min(a[0], c[0]), min(a[1], c[1])
-                    x1, y1 = max(a[0] + a[2], c[0] + c[2]), max(a[1] + a[3], c[1] + c[3])
-                    h_exp, w_exp = self.expected(y1)
-                    if y1 - y0 > slack * h_exp or x1 - x0 > slack * w_exp:
-                        continue
-                    area = (x1 - x0) * (y1 - y0)
-                    if best is None or area < best[0]:
-                        best = (area, i, j, np.array([x0, y0, x1 - x0, y1 - y0]))
-            if best is None:
-                break
-            _, i, j, u = best
-            cur[i] = u
-            groups[i] = groups[i] + groups[j]
-            del cur[j], groups[j]
+        groups: list[list[int]] = _core.merge_fragments(
+            np.asarray(boxes, np.float64).reshape(-1, 4),
+            self._fitted_lines("merge_fragments"),
+            self.config.merge_slack,
+        )
         return groups
+
+    def _fitted_lines(self, fn: str) -> NDArray[np.float64]:
+        if self._coef is None:
+            raise ValueError(f"PersonSizeModel.{fn}: the model is not fitted yet")
+        return self._coef

@@ -1,0 +1,457 @@
+// The detectors' blob pass: a cleaned foreground mask -> filtered, merged and split boxes
+// (python/pftrack/detection/base.py documents the rules; tests/reference/blobs.py is the
+// reference, OpenCV contours plus NumPy, which this matches exactly), and the person-size
+// model's Theil-Sen line (python/pftrack/detection/size_model.py).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <numeric>
+#include <vector>
+
+#include "check.hpp"
+#include "types.hpp"
+
+namespace pftrack {
+
+/// A box: left, top, width, height, in pixels.
+struct BlobRect {
+    double x, y, w, h;
+};
+
+/// The person-size model's lines in the foot row: expected h and w = slope * y + intercept.
+struct SizeLines {
+    double h_slope, h_intercept, w_slope, w_intercept;
+};
+
+/// Blob filters, thresholds as in BlobConfig (fractions of the frame's area).
+struct BlobLimits {
+    double min_area, max_area, min_aspect, max_aspect, min_fill;
+};
+
+/// Median as numpy.median gives it: the middle value, or the mean of the two middle ones.
+inline double median_of(std::vector<double>& v) {
+    const std::size_t m = v.size(), k = m / 2;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    const double hi = v[k];
+    if (m % 2 == 1) return hi;
+    const double lo = *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k));
+    return (lo + hi) / 2.0;
+}
+
+/// Theil-Sen line through (x, y): the median of the slopes over every pair with distinct x,
+/// intercept median(y - slope x). Throws std::invalid_argument when no two x differ.
+inline std::pair<double, double> theil_sen(const double* x, const double* y, Index n) {
+    std::vector<double> s;
+    s.reserve(static_cast<std::size_t>(n > 1 ? n * (n - 1) / 2 : 0));
+    for (Index i = 0; i < n; ++i)
+        for (Index j = i + 1; j < n; ++j) {
+            const double dx = x[j] - x[i];
+            if (dx != 0.0) s.push_back((y[j] - y[i]) / dx);
+        }
+    if (s.empty()) fail("theil_sen", "x has no two distinct values, expected at least two");
+    const double slope = median_of(s);
+    if (!std::isfinite(slope)) fail("theil_sen", "the slope overflows (values too large)");
+    std::vector<double> r(static_cast<std::size_t>(n));
+    for (Index i = 0; i < n; ++i) {
+        const double sx = slope * x[i];  // two roundings, as NumPy's y - slope * x
+        r[static_cast<std::size_t>(i)] = y[i] - sx;
+    }
+    const double intercept = median_of(r);
+    if (!std::isfinite(intercept)) fail("theil_sen", "the intercept overflows (values too large)");
+    return {slope, intercept};
+}
+
+/// Theil-Sen line refitted once on the points within 3 robust sigmas (1.4826 MAD, at least 1)
+/// of the first line, when at least 3 points with distinct x remain (PersonSizeModel's fit).
+inline std::pair<double, double> robust_line(const std::vector<double>& x,
+                                             const std::vector<double>& y) {
+    const Index n = static_cast<Index>(x.size());
+    auto [slope, intercept] = theil_sen(x.data(), y.data(), n);
+    std::vector<double> r(x.size()), dev(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        const double sx = slope * x[i];
+        const double fit = sx + intercept;
+        r[i] = y[i] - fit;
+    }
+    std::vector<double> tmp = r;
+    const double mid = median_of(tmp);
+    for (std::size_t i = 0; i < x.size(); ++i) dev[i] = std::abs(r[i] - mid);
+    const double sigma = 1.4826 * median_of(dev);
+    const double bound = 3.0 * std::max(sigma, 1.0);
+    std::vector<double> kx, ky;
+    for (std::size_t i = 0; i < x.size(); ++i)
+        if (std::abs(r[i]) <= bound) {
+            kx.push_back(x[i]);
+            ky.push_back(y[i]);
+        }
+    if (kx.size() >= 3 &&
+        *std::max_element(kx.begin(), kx.end()) - *std::min_element(kx.begin(), kx.end()) > 0.0)
+        return theil_sen(kx.data(), ky.data(), static_cast<Index>(kx.size()));
+    return {slope, intercept};
+}
+
+/// The person-size model's lines from its samples (n rows of foot y, h, w, `stride` doubles a
+/// row): [[h_slope, h_intercept], [w_slope, w_intercept]]. Every foot on one row (spread under
+/// 1 px): slopes 0 and the median sizes; otherwise `robust_line` of h and of w against foot y.
+inline SizeLines size_fit(const double* samples, Index n, Index stride) {
+    if (n < 1) fail("size_fit", "samples is empty, expected at least one row");
+    std::vector<double> y(static_cast<std::size_t>(n)), h(y.size()), w(y.size());
+    for (Index i = 0; i < n; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        y[k] = samples[i * stride];
+        h[k] = samples[i * stride + 1];
+        w[k] = samples[i * stride + 2];
+    }
+    if (*std::max_element(y.begin(), y.end()) - *std::min_element(y.begin(), y.end()) < 1.0)
+        return {0.0, median_of(h), 0.0, median_of(w)};
+    const auto [hs, hi] = robust_line(y, h);
+    const auto [ws, wi] = robust_line(y, w);
+    return {hs, hi, ws, wi};
+}
+
+/// round(v) half to even (numpy.round), as an integer count, clamped to [0, 2^53].
+inline std::int64_t to_count(double v) {
+    return static_cast<std::int64_t>(std::nearbyint(std::clamp(v, 0.0, 9007199254740992.0)));
+}
+
+/// Expected (h, w) at foot row `foot_y`, at least 1 px (PersonSizeModel.expected).
+inline void expected_size(const SizeLines& s, double foot_y, double& h, double& w) {
+    const double hy = s.h_slope * foot_y, wy = s.w_slope * foot_y;  // no fused multiply-add
+    h = std::max(hy + s.h_intercept, 1.0);
+    w = std::max(wy + s.w_intercept, 1.0);
+}
+
+/// How many people each box holds side by side (PersonSizeModel.split_count).
+inline std::vector<std::int64_t> split_count(const std::vector<BlobRect>& b, const SizeLines& s,
+                                             double split_ratio, double split_max_height) {
+    std::vector<std::int64_t> n(b.size(), 1);
+    for (std::size_t i = 0; i < b.size(); ++i) {
+        double h_exp, w_exp;
+        expected_size(s, b[i].y + b[i].h, h_exp, w_exp);
+        const bool wide = b[i].w > split_ratio * w_exp && b[i].h <= split_max_height * h_exp;
+        // at most 2^53 (any box of a real frame is far below): the cast stays defined
+        if (wide) n[i] = std::max<std::int64_t>(to_count(b[i].w / w_exp), 1);
+    }
+    return n;
+}
+
+/// Groups of boxes that are one person's fragments (PersonSizeModel.merge_fragments): greedily
+/// the pair with the smallest union among those overlapping in columns by half the narrower
+/// box and fitting `merge_slack` expected sizes, until no pair fits. Ties go to the first pair.
+inline std::vector<std::vector<Index>> merge_fragments(const std::vector<BlobRect>& b,
+                                                       const SizeLines& s, double merge_slack) {
+    std::vector<std::vector<Index>> groups(b.size());
+    for (std::size_t i = 0; i < b.size(); ++i) groups[i] = {static_cast<Index>(i)};
+    std::vector<BlobRect> cur = b;
+    while (cur.size() > 1) {
+        bool found = false;
+        double best_area = 0.0;
+        std::size_t bi = 0, bj = 0;
+        BlobRect bu{};
+        for (std::size_t i = 0; i < cur.size(); ++i)
+            for (std::size_t j = i + 1; j < cur.size(); ++j) {
+                const BlobRect &a = cur[i], &c = cur[j];
+                const double ov = std::min(a.x + a.w, c.x + c.w) - std::max(a.x, c.x);
+                if (ov < 0.5 * std::min(a.w, c.w)) continue;
+                const double x0 = std::min(a.x, c.x), y0 = std::min(a.y, c.y);
+                const double x1 = std::max(a.x + a.w, c.x + c.w);
+                const double y1 = std::max(a.y + a.h, c.y + c.h);
+                double h_exp, w_exp;
+                expected_size(s, y1, h_exp, w_exp);
+                if (y1 - y0 > merge_slack * h_exp || x1 - x0 > merge_slack * w_exp) continue;
+                const double area = (x1 - x0) * (y1 - y0);
+                if (!found || area < best_area) {
+                    found = true;
+                    best_area = area;
+                    bi = i;
+                    bj = j;
+                    bu = {x0, y0, x1 - x0, y1 - y0};
+                }
+            }
+        if (!found) break;
+        cur[bi] = bu;
+        groups[bi].insert(groups[bi].end(), groups[bj].begin(), groups[bj].end());
+        cur.erase(cur.begin() + static_cast<std::ptrdiff_t>(bj));
+        groups.erase(groups.begin() + static_cast<std::ptrdiff_t>(bj));
+    }
+    return groups;
+}
+
+namespace detail {
+
+struct Runs {  // runs of equal pixels, row by row, in raster order
+    std::vector<Index> a, b;       // [a, b) columns
+    std::vector<Index> row_start;  // runs of row r: row_start[r] .. row_start[r + 1]
+};
+
+inline Index find_root(std::vector<Index>& parent, Index i) {
+    while (parent[static_cast<std::size_t>(i)] != i) {
+        const Index p = parent[static_cast<std::size_t>(i)];
+        parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(p)];
+        i = p;
+    }
+    return i;
+}
+
+inline void unite(std::vector<Index>& parent, Index i, Index j) {
+    i = find_root(parent, i);
+    j = find_root(parent, j);
+    if (i == j) return;
+    if (i < j) std::swap(i, j);
+    parent[static_cast<std::size_t>(i)] = j;  // the root is the run met first
+}
+
+/// Joins runs of consecutive rows: 8-connected (diagonal contact counts) or 4-connected.
+inline void join_rows(const Runs& r, Index rows, bool eight, std::vector<Index>& parent) {
+    const Index d = eight ? 1 : 0;
+    for (Index y = 1; y < rows; ++y) {
+        Index i = r.row_start[static_cast<std::size_t>(y - 1)];
+        const Index i_end = r.row_start[static_cast<std::size_t>(y)];
+        Index j = i_end;
+        const Index j_end = r.row_start[static_cast<std::size_t>(y + 1)];
+        while (i < i_end && j < j_end) {
+            const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+            if (r.a[ui] < r.b[uj] + d && r.a[uj] < r.b[ui] + d) unite(parent, i, j);
+            if (r.b[ui] < r.b[uj]) ++i;
+            else ++j;
+        }
+    }
+}
+
+inline std::int64_t count_nonzero(const std::uint8_t* mask, Index stride, Index x0, Index y0,
+                                  Index x1, Index y1) {
+    std::int64_t n = 0;
+    for (Index y = y0; y < y1; ++y) {
+        const std::uint8_t* p = mask + y * stride;
+        for (Index x = x0; x < x1; ++x) n += p[x] != 0;
+    }
+    return n;
+}
+
+}  // namespace detail
+
+/// Outer boxes of the 8-connected foreground regions of `mask` (`rows` x `cols` bytes, `stride`
+/// bytes a row, non-zero = foreground) that are not inside a hole of another region: the
+/// bounding rectangles of cv2.findContours(RETR_EXTERNAL), in its order (the reverse raster
+/// order of each region's first pixel). A region is outer when its leftmost pixel touches the
+/// image's edge or the background left of it reaches the edge (4-connected background).
+inline std::vector<BlobRect> outer_regions(const std::uint8_t* mask, Index rows, Index cols,
+                                           Index stride) {
+    detail::Runs fg, bg;
+    std::vector<Index> left_bg;  // per foreground run: the background run just left, or -1
+    fg.row_start.assign(static_cast<std::size_t>(rows + 1), 0);
+    bg.row_start.assign(static_cast<std::size_t>(rows + 1), 0);
+    for (Index y = 0; y < rows; ++y) {
+        fg.row_start[static_cast<std::size_t>(y)] = static_cast<Index>(fg.a.size());
+        bg.row_start[static_cast<std::size_t>(y)] = static_cast<Index>(bg.a.size());
+        const std::uint8_t* p = mask + y * stride;
+        Index x = 0;
+        while (x < cols) {
+            const Index s = x;
+            while (x + 8 <= cols) {  // background is most of a mask: 8 bytes at a time
+                std::uint64_t word;
+                std::memcpy(&word, p + x, 8);
+                if (word != 0) break;
+                x += 8;
+            }
+            while (x < cols && p[x] == 0) ++x;
+            if (x > s) {
+                bg.a.push_back(s);
+                bg.b.push_back(x);
+            }
+            if (x == cols) break;
+            const Index f = x;
+            while (x < cols && p[x] != 0) ++x;
+            fg.a.push_back(f);
+            fg.b.push_back(x);
+            left_bg.push_back(f > 0 ? static_cast<Index>(bg.a.size()) - 1 : -1);
+        }
+    }
+    fg.row_start[static_cast<std::size_t>(rows)] = static_cast<Index>(fg.a.size());
+    bg.row_start[static_cast<std::size_t>(rows)] = static_cast<Index>(bg.a.size());
+
+    std::vector<Index> fp(fg.a.size()), bp(bg.a.size());
+    std::iota(fp.begin(), fp.end(), Index{0});
+    std::iota(bp.begin(), bp.end(), Index{0});
+    detail::join_rows(fg, rows, true, fp);
+    detail::join_rows(bg, rows, false, bp);
+    std::vector<char> outer(bg.a.size(), 0);  // per background root: reaches the image's edge
+    for (Index y = 0; y < rows; ++y)
+        for (Index k = bg.row_start[static_cast<std::size_t>(y)];
+             k < bg.row_start[static_cast<std::size_t>(y + 1)]; ++k) {
+            const auto uk = static_cast<std::size_t>(k);
+            if (y == 0 || y == rows - 1 || bg.a[uk] == 0 || bg.b[uk] == cols)
+                outer[static_cast<std::size_t>(detail::find_root(bp, k))] = 1;
+        }
+
+    struct Region {
+        Index x0, y0, x1, y1, left_run;  // inclusive bounds; the run at the leftmost column
+    };
+    std::vector<Index> slot(fg.a.size(), -1);  // per root: its region
+    std::vector<Region> regions;
+    for (Index y = 0; y < rows; ++y)
+        for (Index k = fg.row_start[static_cast<std::size_t>(y)];
+             k < fg.row_start[static_cast<std::size_t>(y + 1)]; ++k) {
+            const auto uk = static_cast<std::size_t>(k);
+            const auto root = static_cast<std::size_t>(detail::find_root(fp, k));
+            if (slot[root] < 0) {
+                slot[root] = static_cast<Index>(regions.size());
+                regions.push_back({fg.a[uk], y, fg.b[uk] - 1, y, k});
+                continue;
+            }
+            Region& g = regions[static_cast<std::size_t>(slot[root])];
+            if (fg.a[uk] < g.x0) {
+                g.x0 = fg.a[uk];
+                g.left_run = k;
+            }
+            g.x1 = std::max(g.x1, fg.b[uk] - 1);
+            g.y1 = y;
+        }
+    std::vector<BlobRect> out;
+    for (auto it = regions.rbegin(); it != regions.rend(); ++it) {
+        const Index lb = left_bg[static_cast<std::size_t>(it->left_run)];
+        if (lb >= 0 && !outer[static_cast<std::size_t>(detail::find_root(bp, lb))]) continue;
+        out.push_back({double(it->x0), double(it->y0), double(it->x1 - it->x0 + 1),
+                       double(it->y1 - it->y0 + 1)});
+    }
+    return out;
+}
+
+/// Cuts each box into counts[i] people at the minima of its column profile; parts with fewer
+/// than `min_pixels` foreground pixels are dropped, each kept part gets its tight box.
+inline void split_groups(const std::uint8_t* mask, Index stride, std::vector<BlobRect>& rects,
+                         std::vector<double>& fill, const std::vector<std::int64_t>& counts,
+                         double min_pixels) {
+    std::vector<BlobRect> out_r;
+    std::vector<double> out_f;
+    std::vector<std::int64_t> profile;
+    std::vector<Index> cuts;
+    for (std::size_t i = 0; i < rects.size(); ++i) {
+        const auto x = static_cast<Index>(rects[i].x), y = static_cast<Index>(rects[i].y);
+        const auto w = static_cast<Index>(rects[i].w), h = static_cast<Index>(rects[i].h);
+        // at most 2^20 parts (bounds the work; a real frame's counts are far below)
+        const std::int64_t n = std::min<std::int64_t>(counts[i], std::int64_t{1} << 20);
+        if (n < 2) {
+            out_r.push_back(rects[i]);
+            out_f.push_back(fill[i]);
+            continue;
+        }
+        profile.assign(static_cast<std::size_t>(w), 0);
+        for (Index r = 0; r < h; ++r) {
+            const std::uint8_t* p = mask + (y + r) * stride + x;
+            for (Index c = 0; c < w; ++c) profile[static_cast<std::size_t>(c)] += p[c] != 0;
+        }
+        cuts.assign(1, 0);
+        const Index half = std::max<Index>(1, w / (4 * n));
+        for (std::int64_t k = 1; k < n; ++k) {
+            const auto c = static_cast<Index>(std::nearbyint(double(k * w) / double(n)));
+            const Index lo = std::max(cuts.back() + 1, c - half), hi = std::min(w - 1, c + half + 1);
+            if (hi > lo) {
+                const auto first = profile.begin() + lo;
+                cuts.push_back(lo + (std::min_element(first, profile.begin() + hi) - first));
+            } else {
+                cuts.push_back(c);
+            }
+        }
+        cuts.push_back(w);
+        for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+            const Index a = std::max<Index>(cuts[k], 0), b = std::min(cuts[k + 1], w);
+            if (b <= a) continue;
+            Index r0 = h, r1 = -1, c0 = b, c1 = -1;
+            std::int64_t sum = 0;
+            for (Index r = 0; r < h; ++r) {
+                const std::uint8_t* p = mask + (y + r) * stride + x;
+                for (Index c = a; c < b; ++c)
+                    if (p[c] != 0) {
+                        ++sum;
+                        r0 = std::min(r0, r);
+                        r1 = r;
+                        c0 = std::min(c0, c);
+                        c1 = std::max(c1, c);
+                    }
+            }
+            if (r1 < 0 || double(sum) < min_pixels) continue;
+            const Index pw = c1 - c0 + 1, ph = r1 - r0 + 1;
+            out_r.push_back({double(x + c0), double(y + r0), double(pw), double(ph)});
+            out_f.push_back(double(sum) / double(pw * ph));
+        }
+    }
+    rects.swap(out_r);
+    fill.swap(out_f);
+}
+
+/// The whole blob pass of one cleaned mask (BlobExtractor.boxes without the size model's
+/// update and the final sort): outer regions, area / aspect / fill filters, then, with `size`,
+/// fragments merged and groups split by the person-size model, else, with `person_aspect` > 0,
+/// groups split by that aspect. Returns boxes and fills in the reference's (unsorted) order.
+inline void blob_boxes(const std::uint8_t* mask, Index rows, Index cols, Index stride,
+                       const BlobLimits& lim, double person_aspect, const SizeLines* size,
+                       double split_ratio, double split_max_height, double merge_slack,
+                       std::vector<BlobRect>& rects, std::vector<double>& fill) {
+    const std::vector<BlobRect> all = outer_regions(mask, rows, cols, stride);
+    const double frame_area = double(rows * cols);
+    const double lo_area = lim.min_area * frame_area, hi_area = lim.max_area * frame_area;
+    rects.clear();
+    fill.clear();
+    for (const BlobRect& r : all) {
+        const double aspect = r.h / r.w;
+        if (!(r.w * r.h >= lo_area && aspect >= lim.min_aspect && aspect <= lim.max_aspect))
+            continue;
+        const auto x = static_cast<Index>(r.x), y = static_cast<Index>(r.y);
+        const double area = double(detail::count_nonzero(mask, stride, x, y,
+                                                         x + static_cast<Index>(r.w),
+                                                         y + static_cast<Index>(r.h)));
+        const double f = area / (r.w * r.h);
+        if (area >= lo_area && area <= hi_area && f >= lim.min_fill) {
+            rects.push_back(r);
+            fill.push_back(f);
+        }
+    }
+    if (rects.empty()) return;
+    // min_area * H * W, multiplied left to right as in Python
+    const double min_pixels = lim.min_area * double(rows) * double(cols);
+    if (size != nullptr) {
+        const std::vector<std::vector<Index>> groups = merge_fragments(rects, *size, merge_slack);
+        if (groups.size() != rects.size()) {
+            std::vector<BlobRect> mr;
+            std::vector<double> mf;
+            for (const auto& g : groups) {
+                double x0 = rects[static_cast<std::size_t>(g[0])].x, y0 = rects[static_cast<std::size_t>(g[0])].y;
+                double x1 = x0 + rects[static_cast<std::size_t>(g[0])].w;
+                double y1 = y0 + rects[static_cast<std::size_t>(g[0])].h;
+                for (Index k : g) {
+                    const BlobRect& r = rects[static_cast<std::size_t>(k)];
+                    x0 = std::min(x0, r.x);
+                    y0 = std::min(y0, r.y);
+                    x1 = std::max(x1, r.x + r.w);
+                    y1 = std::max(y1, r.y + r.h);
+                }
+                mr.push_back({x0, y0, x1 - x0, y1 - y0});
+                if (g.size() > 1) {
+                    const auto ix0 = static_cast<Index>(x0), iy0 = static_cast<Index>(y0);
+                    const auto ix1 = static_cast<Index>(x1), iy1 = static_cast<Index>(y1);
+                    const double n = double(detail::count_nonzero(mask, stride, ix0, iy0, ix1, iy1));
+                    mf.push_back(n / double(std::max<Index>((ix1 - ix0) * (iy1 - iy0), 1)));
+                } else {
+                    mf.push_back(fill[static_cast<std::size_t>(g[0])]);
+                }
+            }
+            rects.swap(mr);
+            fill.swap(mf);
+        }
+        split_groups(mask, stride, rects, fill,
+                     split_count(rects, *size, split_ratio, split_max_height), min_pixels);
+    } else if (person_aspect > 0.0) {
+        std::vector<std::int64_t> n(rects.size());
+        for (std::size_t i = 0; i < rects.size(); ++i) {
+            const double objects = rects[i].w * person_aspect / rects[i].h;
+            n[i] = objects < 1.5 ? 1 : to_count(objects);
+        }
+        split_groups(mask, stride, rects, fill, n, min_pixels);
+    }
+}
+
+}  // namespace pftrack
