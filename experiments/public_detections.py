@@ -16,8 +16,8 @@ The drop-in mode (`pftrack.tracking.track_frames` with a ``det.txt``, as ``pftra
     missed, one false box every other frame.
 
 The last row of each seed, ``pooled``, scores the eight sequences together (TrackEval's
-combination). ``--seeds`` repeats the run over several tracker seeds (one identity swap moves
-PETS09's IDF1 by 6 points from one seed to the next, docs/tracking.md), and ``--set`` changes
+combination). ``--seeds`` repeats the run over several tracker seeds (PETS09's IDF1 moves
+by 6 points from one seed to the next, docs/tracking.md), and ``--set`` changes
 one `TrackerConfig` field for a trial, e.g. ``--set motion.colour_noise=0.2``.
 
 Usage (from the repository root)::
