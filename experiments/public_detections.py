@@ -15,21 +15,30 @@ The drop-in mode (`pftrack.tracking.track_frames` with a ``det.txt``, as ``pftra
     their truth, seeded: each box moved and resized by 5 % of its height, 10 % of the boxes
     missed, one false box every other frame.
 
+The last row of each seed, ``pooled``, scores the eight sequences together (TrackEval's
+combination). ``--seeds`` repeats the run over several tracker seeds (PETS09's IDF1 moves
+by 6 points from one seed to the next, docs/tracking.md), and ``--set`` changes
+one `TrackerConfig` field for a trial, e.g. ``--set motion.colour_noise=0.2``.
+
 Usage (from the repository root)::
 
     python -m experiments.public_detections [--data ../shared/data] [--out DIR]
+        [--seeds 0 1 2] [--set SECTION.FIELD=VALUE ...]
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
-from pftrack.eval import evaluate_sequence
+from pftrack.eval import SequenceScores, evaluate_sequence
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
@@ -88,47 +97,130 @@ def noisy_detections(
     return out
 
 
-def score(name: str, gt: F64, rows: F64, scale: float = 1.0) -> str:
-    s = evaluate_sequence(gt, rows, scale=scale)
+def line(name: str, s: SequenceScores) -> str:
+    """One row of the table: MOTA, IDF1, HOTA (percent) and identity switches."""
     return (
         f"{name:13s} MOTA {100 * s.mot.mota:6.1f}  IDF1 {100 * s.mot.idf1:5.1f}  "
         f"HOTA {100 * s.hota.hota:5.1f}  IDsw {s.mot.num_switches:3d}"
     )
 
 
+def score(name: str, gt: F64, rows: F64, scale: float = 1.0) -> str:
+    """The table row of one sequence's tracks `rows` against its truth `gt`."""
+    return line(name, evaluate_sequence(gt, rows, scale=scale))
+
+
+def override(config: TrackerConfig, setting: str) -> TrackerConfig:
+    """`config` with one field changed, from ``"SECTION.FIELD=VALUE"`` (or ``"FIELD=VALUE"``).
+
+    The value is converted to the type of the field's current value (``none`` gives None).
+    Raises ValueError naming the problem for a malformed setting or an unknown field.
+    """
+    key, sep, text = setting.partition("=")
+    if not sep or not key:
+        raise ValueError(f"--set {setting!r}: expected SECTION.FIELD=VALUE")
+    path = key.split(".")
+    if len(path) > 2:
+        raise ValueError(f"--set {setting!r}: at most one section (SECTION.FIELD)")
+    owner: object = config if len(path) == 1 else getattr(config, path[0], None)
+    field = path[-1]
+    if not dataclasses.is_dataclass(owner) or field not in {
+        f.name for f in dataclasses.fields(owner)
+    }:
+        raise ValueError(f"--set {setting!r}: TrackerConfig has no field {key!r}")
+    old = getattr(owner, field)
+    value: object
+    if text.lower() == "none":
+        value = None
+    elif isinstance(old, bool):
+        if text.lower() not in ("true", "false"):
+            raise ValueError(f"--set {setting!r}: expected true or false")
+        value = text.lower() == "true"
+    elif isinstance(old, (int, float)) or old is None:
+        try:
+            value = type(old)(text) if old is not None else float(text)
+        except ValueError:
+            raise ValueError(f"--set {setting!r}: {text!r} is not a {type(old).__name__}") from None
+    elif isinstance(old, str):
+        value = text
+    else:
+        raise ValueError(f"--set {setting!r}: {key!r} is not a number, flag or name")
+    new: Any = dataclasses.replace(owner, **{field: value})  # type: ignore[type-var]
+    if len(path) == 1:
+        checked: TrackerConfig = new
+        return checked
+    changes: dict[str, Any] = {path[0]: new}
+    return dataclasses.replace(config, **changes)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = experiment_parser("public_detections", __doc__)
+    p.add_argument(
+        "--seeds", type=int, nargs="+", default=[0], metavar="SEED",
+        help="tracker seeds, one run of every sequence each (default: 0)",
+    )  # fmt: skip
+    p.add_argument(
+        "--set", action="append", default=[], metavar="SECTION.FIELD=VALUE", dest="settings",
+        help="change one TrackerConfig field, e.g. motion.colour_noise=0.2 (repeatable; "
+        "default: none, every default as is)",
+    )  # fmt: skip
     args = p.parse_args(argv)
-    data = data_root(args.data)
     config = TrackerConfig()
+    for setting in args.settings:
+        try:
+            config = override(config, setting)
+        except ValueError as e:
+            p.error(str(e))
+    data = data_root(args.data)
     with tee_stdout(args.out / "public_detections.txt"):
-        for name, (video, scale) in VIDEOS.items():
-            folder = data / name
-            if not folder.is_dir():
-                print(f"{name}: not found under {data}, skipped")
-                continue
-            dets = load_detections(folder / "det.txt", scale)
-            run = track_frames(FrameSource(folder / video), detections=dets, config=config, rng=0)
-            print(score(name, read_mot(folder / "gt.txt"), run.rows, scale), flush=True)
-        for name in NO_VIDEO:
-            folder = data / "mot15-gt" / name
-            if not folder.is_dir():
-                print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
-                continue
-            info = read_seqinfo(folder)
-            if info.length is None or info.width is None or info.height is None:
-                raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
-            frames = BlackFrames(info.length, info.width, info.height)
-            dets = load_detections(folder / "det.txt")
-            run = track_frames(frames, detections=dets, config=config, rng=0)
-            print(score(name + " (black)", read_mot(folder / "gt.txt"), run.rows), flush=True)
-        for kind in BUSY_SCENES:
-            scene = make_busy_scene(kind, rng=0)
-            h, w = scene.frames[0].shape[:2]
-            dets = noisy_detections(scene.truth, len(scene.frames), h, w)
-            run = track_frames(scene.frames, detections=dets, config=config, rng=0)
-            print(score(kind, scene.truth, run.rows), flush=True)
+        for seed in args.seeds:
+            if len(args.seeds) > 1:
+                print(f"-- seed {seed}")
+            scores = run_all(data, config, seed)
+            if scores:
+                print(line("pooled", SequenceScores.combine(scores)), flush=True)
     return 0
+
+
+def run_all(data: Path, config: TrackerConfig, seed: int) -> list[SequenceScores]:
+    """Track every sequence found under `data` and the synthetic scenes; print each row.
+
+    Returns the scores of every sequence run, in order.
+    """
+    out: list[SequenceScores] = []
+
+    def report(name: str, gt: F64, rows: F64, scale: float = 1.0) -> None:
+        s = evaluate_sequence(gt, rows, scale=scale)
+        out.append(s)
+        print(line(name, s), flush=True)
+
+    for name, (video, scale) in VIDEOS.items():
+        folder = data / name
+        if not folder.is_dir():
+            print(f"{name}: not found under {data}, skipped")
+            continue
+        dets = load_detections(folder / "det.txt", scale)
+        run = track_frames(FrameSource(folder / video), detections=dets, config=config, rng=seed)
+        report(name, read_mot(folder / "gt.txt"), run.rows, scale)
+    for name in NO_VIDEO:
+        folder = data / "mot15-gt" / name
+        if not folder.is_dir():
+            print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
+            continue
+        info = read_seqinfo(folder)
+        if info.length is None or info.width is None or info.height is None:
+            raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
+        frames = BlackFrames(info.length, info.width, info.height)
+        dets = load_detections(folder / "det.txt")
+        run = track_frames(frames, detections=dets, config=config, rng=seed)
+        report(name + " (black)", read_mot(folder / "gt.txt"), run.rows)
+    for kind in BUSY_SCENES:
+        scene = make_busy_scene(kind, rng=0)
+        h, w = scene.frames[0].shape[:2]
+        dets = noisy_detections(scene.truth, len(scene.frames), h, w)
+        run = track_frames(scene.frames, detections=dets, config=config, rng=seed)
+        report(kind, scene.truth, run.rows)
+    return out
 
 
 if __name__ == "__main__":

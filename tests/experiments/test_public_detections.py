@@ -31,3 +31,26 @@ def test_noisy_detections_are_seeded_and_close_to_the_truth() -> None:
     run = track_frames(scene.frames, detections=a, config=TrackerConfig(), rng=0)
     s = evaluate_sequence(scene.truth, run.rows)
     assert s.mot.mota > 0.3 and s.hota.hota > 0.3  # the tracker follows the jittered boxes
+
+
+def test_override_changes_one_field_and_refuses_unknown_ones() -> None:
+    base = TrackerConfig()
+    c = ex.override(base, "motion.colour_noise=0.2")
+    assert c.motion.colour_noise == 0.2 and c.motion.accel == base.motion.accel
+    assert c.association == base.association and base.motion.colour_noise != 0.2
+    assert ex.override(base, "reference_rate=0").reference_rate == 0.0
+    assert ex.override(base, "lifecycle.birth_quantile=none").lifecycle.birth_quantile is None
+    assert ex.override(base, "lifecycle.max_coast=4").lifecycle.max_coast == 4
+    assert ex.override(base, "motion.smooth_external=false").motion.smooth_external is False
+    for bad in ("motion.colour_noise", "motion.nope=1", "nope.accel=1", "a.b.c=1",
+                "lifecycle.max_coast=x", "filter=3"):  # fmt: skip
+        with pytest.raises(ValueError, match="--set"):
+            ex.override(base, bad)
+    with pytest.raises(ValueError, match="max_coast"):  # the config's own check still runs
+        ex.override(base, "lifecycle.max_coast=-1")
+
+
+def test_main_rejects_a_bad_setting(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as e:
+        ex.main(["--set", "motion.nope=1"])
+    assert e.value.code == 2 and "no field 'motion.nope'" in capsys.readouterr().err

@@ -142,7 +142,8 @@ class MotionConfig:
         In track heights: the square root of the acceleration's spectral density (white-noise
         acceleration, per frame^1.5), and the standard deviations of a detection's centre and of
         the colour filter's estimate (the measurement while the track
-        coasts, and a second opinion before association).
+        coasts, and a second opinion before association; not a measurement when the frame's
+        colour carries no evidence, :func:`pftrack.tracking.track.colour_evidence`).
     smooth_external : bool
         With external detections, report a matched track's filtered box (Kalman centre,
         smoothed size) rather than the detection's own box, which jitters from frame to frame.

@@ -24,7 +24,29 @@ from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.motion import CentreKalman
 
-__all__ = ["LiveTrack", "Track", "follow_tracks_motion", "predict_tracks", "reseed_tracks"]
+__all__ = [
+    "LiveTrack",
+    "Track",
+    "colour_evidence",
+    "follow_tracks_motion",
+    "predict_tracks",
+    "reseed_tracks",
+]
+
+#: Largest spread between the best and the mean colour match of a particle set that still
+#: counts as no spread at all (round-off): the colour likelihood is flat.
+FLAT_RHO = 1e-9
+
+
+def colour_evidence(rho: float, rho_max: float) -> bool:
+    """Tell whether a colour filter's step carried evidence about where the object is.
+
+    When every particle's colour match ``rho`` is the same (the best one, `rho_max`, equals the
+    weighted mean `rho` to :data:`FLAT_RHO`), the likelihood is flat: a frame of one colour
+    (e.g. black), or boxes with no counted pixel. The filter's estimate is then only its own
+    motion prediction, not a measurement, and the centre filter must not take it as one.
+    """
+    return rho_max - rho > FLAT_RHO
 
 
 @dataclass(frozen=True)
@@ -118,13 +140,15 @@ class LiveTrack:
         """Step the particle filter on the frame and the centre filter by one frame.
 
         The particle filter's estimate is a noisy measurement of the centre filter's
-        prediction (standard deviation `colour_noise` heights).
+        prediction (standard deviation `colour_noise` heights), when the frame's colour
+        carried evidence (:func:`colour_evidence`); otherwise the prediction stands alone.
         """
         self.measured = None
         state = self.filter.step(binned)
         self.rho = state.rho
         self.motion.predict(self.size[1])
-        self.motion.update(state.box_cxcywh[:2], colour_noise * self.size[1])
+        if colour_evidence(state.rho, state.rho_max):
+            self.motion.update(state.box_cxcywh[:2], colour_noise * self.size[1])
         cx, cy = self.motion.p
         self.box = np.array(
             [cx - self.size[0] / 2, cy - self.size[1] / 2, self.size[0], self.size[1]]
@@ -239,7 +263,14 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
     accel = np.array([t.motion.accel for t in tracks])[:, None]
     z = np.array([s.box_cxcywh[:2] for s in states])
     mean, c = cv_predict((p, v), cov, (accel * h) ** 2)
-    mean, c = cv_update(mean, c, z, (colour_noise * h) ** 2)
+    evidence = np.array([colour_evidence(s.rho, s.rho_max) for s in states])
+    if evidence.all():
+        mean, c = cv_update(mean, c, z, (colour_noise * h) ** 2)
+    elif evidence.any():  # a flat likelihood is no measurement: those keep the prediction
+        upd_mean, upd_c = cv_update(mean, c, z, (colour_noise * h) ** 2)
+        e = evidence[:, None]
+        mean = (np.where(e, upd_mean[0], mean[0]), np.where(e, upd_mean[1], mean[1]))
+        c = (np.where(e, upd_c[0], c[0]), np.where(e, upd_c[1], c[1]), np.where(e, upd_c[2], c[2]))
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     boxes = np.concatenate([p - size / 2, size], axis=1)
     covs = np.concatenate(c, axis=1).tolist()
