@@ -172,9 +172,9 @@ def rts_smooth(
     z : (T, n) array_like
         Position measurements, one column per axis, one row per frame; rows without a
         measurement may hold anything (NaN included).
-    has : (T,) array_like of bool
-        Which frames have a measurement. The first must: the initial state is
-        ``N([z_0, 0], diag(r2, velocity_sd²))``.
+    has : (T,) or (T, n) array_like of bool
+        Which frames have a measurement, for every axis or per axis. The first must: the
+        initial state is ``N([z_0, 0], diag(r2, velocity_sd²))``.
     q : (n,) array_like
         Noise intensity per axis (see :func:`cv_predict`).
     r2 : (n,) array_like
@@ -196,13 +196,20 @@ def rts_smooth(
     rr = np.asarray(r2, dtype=np.float64)
     steps = len(zz)
     n = len(q2)
-    if zz.ndim != 2 or zz.shape[1] != n or hh.shape != (steps,) or rr.shape != (n,) or q2.ndim != 1:
+    if (
+        zz.ndim != 2
+        or zz.shape[1] != n
+        or hh.shape not in ((steps,), (steps, n))
+        or rr.shape != (n,)
+        or q2.ndim != 1
+    ):
         raise ValueError(
             f"rts_smooth: z {zz.shape}, has {hh.shape}, q {q2.shape} and r2 {rr.shape} must be "
-            "(T, n), (T,), (n,) and (n,)"
+            "(T, n), (T,) or (T, n), (n,) and (n,)"
         )
-    if steps == 0 or not hh[0]:
+    if steps == 0 or not np.all(hh[0]):
         raise ValueError("rts_smooth: the first frame must have a measurement")
+    per_axis = hh.ndim == 2
     m: Mean = (zz[0].copy(), np.zeros_like(q2))
     p: Cov = (rr.copy(), np.zeros_like(q2), np.full_like(q2, velocity_sd**2))
     fm = np.empty((steps, 2, n))  # filtered mean
@@ -213,7 +220,12 @@ def rts_smooth(
         if t > 0:
             m, p = cv_predict(m, p, q2)
         pm[t], pp[t] = m, p
-        if hh[t] and (t > 0 or update_first):
+        if per_axis and (t > 0 or update_first) and hh[t].any():
+            mu, pu = cv_update(m, p, zz[t], rr)
+            h = hh[t]
+            m = (np.where(h, mu[0], m[0]), np.where(h, mu[1], m[1]))
+            p = (np.where(h, pu[0], p[0]), np.where(h, pu[1], p[1]), np.where(h, pu[2], p[2]))
+        elif not per_axis and hh[t] and (t > 0 or update_first):
             m, p = cv_update(m, p, zz[t], rr)
         fm[t], fp[t] = m, p
     out = np.empty((steps, n))

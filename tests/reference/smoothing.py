@@ -7,6 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from pftrack.kalman import rts_smooth
+
 
 def dense_kalman_rts(
     z: np.ndarray,
@@ -102,9 +104,8 @@ def rts_batch_numpy(
     """NumPy reference of ``pftrack.recovery.baselines.rts_batch`` (``_core.rts_gaps_batch``).
 
     The windows of all gaps (up to `history` points each side and the gap) are stacked as
-    columns of one array and filtered and smoothed together, one vectorised step per frame
-    of the longest window (the equations of ``pftrack.kalman.rts_smooth``, with a measurement
-    mask per column).
+    columns of one array and smoothed together by ``pftrack.kalman.rts_smooth`` with a
+    measurement mask per column: one vectorised step per frame of the longest window.
     """
     if not pairs:
         return []
@@ -119,39 +120,7 @@ def rts_batch_numpy(
             rows = (seg[:, 0] - first[g]).astype(np.int64)
             z[rows, 2 * g : 2 * g + 2] = seg[:, 1:3]
             has[rows, 2 * g : 2 * g + 2] = True
-    fm = np.empty((T, 2, n))
-    fp = np.empty((T, 3, n))
-    pm = np.empty((T, 2, n))
-    pp = np.empty((T, 3, n))
-    m0, m1 = z[0].copy(), np.zeros(n)
-    p00, p01, p11 = np.full(n, r), np.zeros(n), np.full(n, 100.0)
-    for t in range(T):
-        if t > 0:
-            m0, m1 = m0 + m1, m1
-            p00, p01, p11 = p00 + 2 * p01 + p11 + q / 3.0, p01 + p11 + q / 2.0, p11 + q
-        pm[t] = m0, m1
-        pp[t] = p00, p01, p11
-        h = has[t]
-        s = p00 + r
-        k0, k1 = np.where(h, p00 / s, 0.0), np.where(h, p01 / s, 0.0)
-        e = z[t] - m0
-        m0, m1 = m0 + k0 * e, m1 + k1 * e
-        p00, p01, p11 = (1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01
-        fm[t] = m0, m1
-        fp[t] = p00, p01, p11
-    out = np.empty((T, n))
-    s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
-    out[-1] = s0
-    for t in range(T - 2, -1, -1):
-        a_, b_, c_ = fp[t]
-        u00, u01, u10, u11 = a_ + b_, b_, b_ + c_, c_
-        x, y, w = pp[t + 1]
-        det = x * w - y * y
-        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
-        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
-        d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
-        s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
-        out[t] = s0
+    out = rts_smooth(z, has, np.full(n, q), np.full(n, r), velocity_sd=10.0, update_first=True)
     res = []
     for g, (a, b) in enumerate(wins):
         lo, hi = int(a[-1, 0] - first[g]) + 1, int(b[0, 0] - first[g])

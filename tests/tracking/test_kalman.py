@@ -105,12 +105,38 @@ def test_rts_is_the_posterior_mean(seed, steps, update_first):
     np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-6)
 
 
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), steps=st.integers(1, 30), update_first=st.booleans())
+def test_rts_per_axis_mask_is_each_axis_alone(seed, steps, update_first):
+    """A (T, n) mask smooths each axis as a (T,) mask of its own would."""
+    z, _, q, r2 = _problem(seed, steps, 3)
+    has = np.random.default_rng(seed).random((steps, 3)) < 0.6
+    has[0] = True
+    got = rts_smooth(z, has, q, r2, velocity_sd=5.0, update_first=update_first)
+    for k in range(3):
+        alone = rts_smooth(
+            z[:, k : k + 1],
+            has[:, k],
+            q[k : k + 1],
+            r2[k : k + 1],
+            velocity_sd=5.0,
+            update_first=update_first,
+        )
+        np.testing.assert_allclose(got[:, k], alone[:, 0], rtol=1e-12, atol=1e-12)
+
+
 def test_rts_bad_input():
     z = np.zeros((4, 2))
     with pytest.raises(ValueError, match="first frame"):
         rts_smooth(z, [False, True, True, True], [1, 1], [1, 1], velocity_sd=1.0, update_first=True)
     with pytest.raises(ValueError, match="must be"):
         rts_smooth(z, [True] * 4, [1, 1, 1], [1, 1], velocity_sd=1.0, update_first=True)
+    with pytest.raises(ValueError, match="must be"):
+        rts_smooth(z, np.ones((4, 3), bool), [1, 1], [1, 1], velocity_sd=1.0, update_first=True)
+    with pytest.raises(ValueError, match="first frame"):
+        has = np.ones((4, 2), bool)
+        has[0, 1] = False
+        rts_smooth(z, has, [1, 1], [1, 1], velocity_sd=1.0, update_first=True)
     with pytest.raises(ValueError, match="first frame"):
         rts_smooth(
             np.zeros((0, 2)), np.zeros(0, bool), [1, 1], [1, 1], velocity_sd=1.0, update_first=True
