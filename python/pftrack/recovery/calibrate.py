@@ -647,13 +647,8 @@ def recover_auto(
         got = recover_with(m, [checked[k] for k in idx], noise, motion or _NO_MOTION)
         for k, p in zip(idx, got, strict=True):
             found[m, k] = p
-    paths = []
-    for k, mix in enumerate(mixes):
-        if len(mix) == 1:
-            paths.append(found[mix[0][0], k] if lengths[k] > 0 else np.zeros((0, 2)))
-        else:
-            blend = np.zeros_like(found[mix[0][0], k])
-            for m, w in mix:
-                blend += w * found[m, k]
-            paths.append(blend)
+    paths = [
+        found[mix[0][0], k] if len(mix) == 1 else np.sum([w * found[m, k] for m, w in mix], axis=0)
+        for k, mix in enumerate(mixes)
+    ]
     return paths, cal
