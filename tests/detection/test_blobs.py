@@ -125,7 +125,7 @@ def test_size_fit_equals_reference(seed: int) -> None:
     model.observe(np.column_stack([np.arange(n) * 1000.0, y - h, w, h]))  # all isolated
     if model.fitted:  # the samples held (foot rows recomputed as top + h)
         held = model._samples[: model.n_samples]
-        np.testing.assert_array_equal(model.lines, ref.size_fit(held))
+        np.testing.assert_array_equal(model.coefficients, ref.size_fit(held))
 
 
 def test_model_methods_and_extractor_use_the_kernels() -> None:
@@ -134,7 +134,7 @@ def test_model_methods_and_extractor_use_the_kernels() -> None:
     boxes = np.array([[10.0, 100.0, 30.0, 35.0], [50.0, 60.0, 8.0, 20.0], [50.0, 80.0, 9.0, 18.0]])
     np.testing.assert_array_equal(model.split_count(boxes), ref.split_count(boxes, LINES))
     assert model.merge_fragments(boxes) == ref.merge_fragments(boxes, LINES)
-    lines = model.lines
+    lines = model.coefficients
     assert lines is not None and not lines.flags.writeable
     np.testing.assert_array_equal(lines, LINES)
 

@@ -261,7 +261,7 @@ class BlobExtractor:
         """
         cfg = self.config
         model = self.size_model
-        lines = model.lines if cfg.learn_size else None
+        lines = model.coefficients if cfg.learn_size else None
         sc = model.config
         rects, fill = _core.blob_boxes(
             mask,

@@ -128,12 +128,10 @@ class PersonSizeModel:
 
     @property
     def coefficients(self) -> NDArray[np.float64] | None:
-        """(2, 2) ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in foot row, or None."""
-        return None if self._coef is None else self._coef.copy()
+        """(2, 2) ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in foot row, or None.
 
-    @property
-    def lines(self) -> NDArray[np.float64] | None:
-        """The fit as `coefficients`, a read-only view (no copy per frame); None before the fit."""
+        A read-only view of the fit (no copy: the blob pass reads it every frame).
+        """
         if self._coef is None:
             return None
         view: NDArray[np.float64] = self._coef.view()
