@@ -46,11 +46,8 @@ void register_blobs(py::module_& m) {
            std::optional<Eigen::Ref<const RowMatrixXd>> size_lines, double split_ratio,
            double split_max_height, double merge_slack) {
             const char* fn = "blob_boxes";
-            if (!mask.dtype().is(py::dtype::of<std::uint8_t>()))
-                require(false, fn, "mask dtype", bind::dtype_name(mask), "uint8 (0 / 255)");
             require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
-            require(mask.strides(1) == 1 && mask.strides(0) > 0, fn,
-                    "mask must be packed along rows (use numpy.ascontiguousarray)");
+            bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);  // uint8 or bool, packed
             require(std::isfinite(min_area) && std::isfinite(max_area) && 0.0 <= min_area &&
                         min_area <= max_area && max_area <= 1.0,
                     fn, "min_area, max_area must satisfy 0 <= min_area <= max_area <= 1");

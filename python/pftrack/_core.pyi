@@ -202,7 +202,7 @@ def refine_boxes(boxes: _F64, mask: NDArray[Any], fraction: float, min_cover: fl
 # --- blob pass: mask (H, W) uint8 0/255 -> boxes (K, 4) left, top, w, h and fills (K,) -------
 # size_lines (2, 2) [[h_slope, h_intercept], [w_slope, w_intercept]] in the foot row, or None
 def blob_boxes(
-    mask: NDArray[np.uint8],
+    mask: NDArray[np.uint8] | NDArray[np.bool_],
     min_area: float,
     max_area: float,
     min_aspect: float,

@@ -139,6 +139,17 @@ def test_model_methods_and_extractor_use_the_kernels() -> None:
     np.testing.assert_array_equal(lines, LINES)
 
 
+def test_bool_mask_is_the_same_foreground() -> None:
+    mask = np.zeros((60, 80), np.uint8)
+    mask[5:40, 10:22] = 255
+    mask[20:55, 50:58] = 255
+    args = (*DEFAULTS, 2.8, None, *SIZE)
+    want = _core.blob_boxes(mask, *args)
+    assert len(want[0]) == 2
+    for got, w in zip(_core.blob_boxes(mask > 0, *args), want, strict=True):
+        np.testing.assert_array_equal(got, w)
+
+
 def test_bad_input() -> None:
     mask = np.zeros((20, 30), np.uint8)
     args = (*DEFAULTS, 2.8, None, *SIZE)
