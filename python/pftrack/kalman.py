@@ -47,6 +47,7 @@ __all__ = [
     "cv_transition",
     "cv_transition_xy",
     "cv_update",
+    "cv_update_where",
     "rts_smooth",
     "wna_Q",
     "wna_Q_xy",
@@ -156,6 +157,25 @@ def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
     return (mean[0] + k0 * e, mean[1] + k1 * e), ((1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01)
 
 
+def cv_update_where(
+    mean: Mean, cov: Cov, z: Value, r2: Value, where: ArrayLike
+) -> tuple[Mean, Cov]:
+    """:func:`cv_update` where `where` holds; elsewhere the predicted state stays.
+
+    `where` broadcasts against the state's arrays (e.g. (n,) over axes, or (K, 1) over rows
+    of K tracks). All True is exactly :func:`cv_update`; all False returns `mean`, `cov`.
+    """
+    w = np.asarray(where, dtype=bool)
+    if w.all():
+        return cv_update(mean, cov, z, r2)
+    if not w.any():
+        return mean, cov
+    mu, cu = cv_update(mean, cov, z, r2)
+    m0, m1 = (np.where(w, a, b) for a, b in zip(mu, mean, strict=True))
+    c0, c1, c2 = (np.where(w, a, b) for a, b in zip(cu, cov, strict=True))
+    return (m0, m1), (c0, c1, c2)
+
+
 def rts_smooth(
     z: ArrayLike,
     has: ArrayLike,
@@ -209,7 +229,6 @@ def rts_smooth(
         )
     if steps == 0 or not np.all(hh[0]):
         raise ValueError("rts_smooth: the first frame must have a measurement")
-    per_axis = hh.ndim == 2
     m: Mean = (zz[0].copy(), np.zeros_like(q2))
     p: Cov = (rr.copy(), np.zeros_like(q2), np.full_like(q2, velocity_sd**2))
     fm = np.empty((steps, 2, n))  # filtered mean
@@ -220,13 +239,8 @@ def rts_smooth(
         if t > 0:
             m, p = cv_predict(m, p, q2)
         pm[t], pp[t] = m, p
-        if per_axis and (t > 0 or update_first) and hh[t].any():
-            mu, pu = cv_update(m, p, zz[t], rr)
-            h = hh[t]
-            m = (np.where(h, mu[0], m[0]), np.where(h, mu[1], m[1]))
-            p = (np.where(h, pu[0], p[0]), np.where(h, pu[1], p[1]), np.where(h, pu[2], p[2]))
-        elif not per_axis and hh[t] and (t > 0 or update_first):
-            m, p = cv_update(m, p, zz[t], rr)
+        if t > 0 or update_first:
+            m, p = cv_update_where(m, p, zz[t], rr, hh[t])
         fm[t], fp[t] = m, p
     out = np.empty((steps, n))
     s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()

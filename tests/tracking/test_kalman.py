@@ -12,6 +12,7 @@ from pftrack.kalman import (
     cv_transition,
     cv_transition_xy,
     cv_update,
+    cv_update_where,
     rts_smooth,
     wna_Q,
     wna_Q_xy,
@@ -123,6 +124,23 @@ def test_rts_per_axis_mask_is_each_axis_alone(seed, steps, update_first):
             update_first=update_first,
         )
         np.testing.assert_allclose(got[:, k], alone[:, 0], rtol=1e-12, atol=1e-12)
+
+
+def test_update_where_updates_only_the_rows_asked() -> None:
+    rng = np.random.default_rng(3)
+    mean = (rng.normal(size=(4, 2)), rng.normal(size=(4, 2)))
+    cov = (rng.uniform(1, 2, (4, 1)), rng.uniform(0, 0.5, (4, 1)), rng.uniform(1, 2, (4, 1)))
+    z, r2 = rng.normal(size=(4, 2)), rng.uniform(0.5, 1, (4, 1))
+    full = cv_update(mean, cov, z, r2)
+    got = cv_update_where(mean, cov, z, r2, np.ones((4, 1), bool))
+    for a, b in zip([*got[0], *got[1]], [*full[0], *full[1]], strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert cv_update_where(mean, cov, z, r2, np.zeros((4, 1), bool)) == (mean, cov)
+    rows = np.array([[True], [False], [True], [False]])
+    got = cv_update_where(mean, cov, z, r2, rows)
+    for new, upd, old in zip([*got[0], *got[1]], [*full[0], *full[1]], [*mean, *cov], strict=True):
+        np.testing.assert_array_equal(new[[0, 2]], upd[[0, 2]])
+        np.testing.assert_array_equal(new[[1, 3]], old[[1, 3]])
 
 
 def test_rts_bad_input():

@@ -18,7 +18,7 @@ import numpy as np
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
 from pftrack.boxes import xywh_to_cxcywh
-from pftrack.kalman import cv_predict, cv_update
+from pftrack.kalman import cv_predict, cv_update, cv_update_where
 from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
 from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
@@ -263,14 +263,9 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
     accel = np.array([t.motion.accel for t in tracks])[:, None]
     z = np.array([s.box_cxcywh[:2] for s in states])
     mean, c = cv_predict((p, v), cov, (accel * h) ** 2)
-    evidence = np.array([colour_evidence(s.rho, s.rho_max) for s in states])
-    if evidence.all():
-        mean, c = cv_update(mean, c, z, (colour_noise * h) ** 2)
-    elif evidence.any():  # a flat likelihood is no measurement: those keep the prediction
-        upd_mean, upd_c = cv_update(mean, c, z, (colour_noise * h) ** 2)
-        e = evidence[:, None]
-        mean = (np.where(e, upd_mean[0], mean[0]), np.where(e, upd_mean[1], mean[1]))
-        c = (np.where(e, upd_c[0], c[0]), np.where(e, upd_c[1], c[1]), np.where(e, upd_c[2], c[2]))
+    # a flat likelihood is no measurement: those tracks keep the prediction
+    evidence = np.array([[colour_evidence(s.rho, s.rho_max)] for s in states])
+    mean, c = cv_update_where(mean, c, z, (colour_noise * h) ** 2, evidence)
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     boxes = np.concatenate([p - size / 2, size], axis=1)
     covs = np.concatenate(c, axis=1).tolist()
