@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import data_root, experiment_parser, tee_stdout
+from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.eval import SequenceScores, evaluate_sequence
 from pftrack.io.mot import group_by_frame, read_mot
@@ -44,7 +44,6 @@ from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 from pftrack.tracking import TrackerConfig, load_detections, track_frames
 
-VIDEOS = {"pets09-s2l1": ("video.avi", 0.625), "tud-campus": ("video.mp4", 1.0)}
 NO_VIDEO = ("ADL-Rundle-6", "ETH-Sunnyday", "KITTI-17")
 
 
@@ -103,11 +102,6 @@ def line(name: str, s: SequenceScores) -> str:
         f"{name:13s} MOTA {100 * s.mot.mota:6.1f}  IDF1 {100 * s.mot.idf1:5.1f}  "
         f"HOTA {100 * s.hota.hota:5.1f}  IDsw {s.mot.num_switches:3d}"
     )
-
-
-def score(name: str, gt: F64, rows: F64, scale: float = 1.0) -> str:
-    """The table row of one sequence's tracks `rows` against its truth `gt`."""
-    return line(name, evaluate_sequence(gt, rows, scale=scale))
 
 
 def override(config: TrackerConfig, setting: str) -> TrackerConfig:
@@ -194,14 +188,15 @@ def run_all(data: Path, config: TrackerConfig, seed: int) -> list[SequenceScores
         out.append(s)
         print(line(name, s), flush=True)
 
-    for name, (video, scale) in VIDEOS.items():
-        folder = data / name
+    for src in (PETS, TUD):
+        folder = data / src.name
         if not folder.is_dir():
-            print(f"{name}: not found under {data}, skipped")
+            print(f"{src.name}: not found under {data}, skipped")
             continue
-        dets = load_detections(folder / "det.txt", scale)
-        run = track_frames(FrameSource(folder / video), detections=dets, config=config, rng=seed)
-        report(name, read_mot(folder / "gt.txt"), run.rows, scale)
+        dets = load_detections(folder / "det.txt", src.scale)
+        video = FrameSource(folder / src.video)
+        run = track_frames(video, detections=dets, config=config, rng=seed)
+        report(src.name, read_mot(folder / "gt.txt"), run.rows, src.scale)
     for name in NO_VIDEO:
         folder = data / "mot15-gt" / name
         if not folder.is_dir():
