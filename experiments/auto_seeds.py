@@ -22,17 +22,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
 from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.io.mot import read_mot
 from pftrack.io.video import read_seqinfo
-from pftrack.recovery.calibrate import recover_auto
 from pftrack.recovery.experiment import (
-    auto_masks,
-    find_gaps,
-    observed_runs,
     run_sequence,
     trajectories,
 )
@@ -79,22 +73,10 @@ def seed_row(
     `combine` is passed to :func:`~pftrack.recovery.calibrate.recover_auto`.
     """
     res = run_sequence(name, trajs, width, height, fixed)
-    per_seed = []
-    for s in seeds:
-        errs: list[float] = []
-        for mk in auto_masks(trajs, width, height, 3):
-            gaps, _ = find_gaps(trajs, mk)
-            if not gaps:
-                continue
-            paths, _ = recover_auto(
-                [(g.segment_a, g.segment_b) for g in gaps],
-                observed_runs(trajs, mk),
-                seed=s,
-                combine=combine,
-            )
-            for g, p in zip(gaps, paths, strict=True):
-                errs.append(float(np.mean(np.hypot(*(p - g.truth[:, 1:3]).T))))
-        per_seed.append(float(np.mean(errs)) if errs else float("nan"))
+    per_seed = [
+        run_sequence(name, trajs, width, height, ("auto",), seed=s, combine=combine).mmae("auto")
+        for s in seeds
+    ]
     return SeedRow(name, res.n_gaps, {m: res.mmae(m) for m in fixed}, tuple(per_seed))
 
 

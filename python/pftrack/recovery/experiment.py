@@ -152,17 +152,24 @@ def score(
     noise: NoiseEstimate | None = None,
     motion: MotionFit | None = None,
     observed: Sequence[F64] | None = None,
+    *,
+    seed: int = 0,
+    combine: bool = True,
 ) -> tuple[MethodScore, list[F64]]:
     """Recover all gaps with `method` (best wall time of `repeat` runs) and score them.
 
-    `observed`: for ``"auto"``, the observed runs it calibrates on (all points outside the mask).
+    `observed`, `seed`, `combine`: for ``"auto"``, the observed runs it calibrates on (all
+    points outside the mask), its calibration seed and whether it may blend two methods.
     """
     pairs = [(g.segment_a, g.segment_b) for g in gaps]
     best = np.inf
     paths: list[F64] = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        paths = recover_gaps(pairs, method, noise=noise, motion=motion, observed=observed)
+        paths = recover_gaps(
+            pairs, method, noise=noise, motion=motion, observed=observed, seed=seed,
+            combine=combine,
+        )  # fmt: skip
         best = min(best, time.perf_counter() - t0)
     ex, ey, ee = [], [], []
     for g, p in zip(gaps, paths, strict=True):
@@ -201,13 +208,20 @@ class MaskRun:
 
 
 def run_mask(
-    trajs: dict[int, F64], mask: Sequence[float], methods: Sequence[str] = METHODS, repeat: int = 1
+    trajs: dict[int, F64],
+    mask: Sequence[float],
+    methods: Sequence[str] = METHODS,
+    repeat: int = 1,
+    *,
+    seed: int = 0,
+    combine: bool = True,
 ) -> MaskRun:
     """Run all methods on one mask.
 
     The noise levels of ``"gdt-bi"`` and the model of ``"gdt-mix"`` are estimated once from
     every observed point of the sequence (all points outside the mask), timed separately;
-    ``"auto"`` calibrates on the same observed points (its time includes the calibration).
+    ``"auto"`` calibrates on the same observed points (its time includes the calibration),
+    with calibration seed `seed` and blends allowed by `combine`.
     """
     gaps, n_traj = find_gaps(trajs, mask)
     scores: dict[str, MethodScore] = {}
@@ -229,7 +243,9 @@ def run_mask(
                 motion_ms = 1e3 * (time.perf_counter() - t0)
         for m in methods:
             if m == "auto":  # calibrates itself, from the observed points only
-                scores[m], paths[m] = score(gaps, m, repeat, observed=runs)
+                scores[m], paths[m] = score(
+                    gaps, m, repeat, observed=runs, seed=seed, combine=combine
+                )
             else:
                 scores[m], paths[m] = score(gaps, m, repeat, noise, motion)
     mk = tuple(float(v) for v in mask)
@@ -536,17 +552,21 @@ def run_sequence(
     height: float,
     methods: Sequence[str] = METHODS,
     n_masks: int = 3,
+    *,
+    seed: int = 0,
+    combine: bool = True,
 ) -> SequenceResult:
     """Run every method on the gaps of the automatic masks (:func:`auto_masks`) of a sequence.
 
     Each mask is its own experiment: the points inside it are lost, everything outside it is
-    observed (noise levels, motion model and ``"auto"``'s calibration use only those).
+    observed (noise levels, motion model and ``"auto"``'s calibration use only those; `seed`
+    and `combine` are ``"auto"``'s, as in :func:`run_mask`).
     """
     masks = auto_masks(trajs, width, height, n_masks)
     errors: dict[str, list[float]] = {m: [] for m in methods}
     n_gaps = 0
     for mk in masks:
-        run = run_mask(trajs, mk, methods)
+        run = run_mask(trajs, mk, methods, seed=seed, combine=combine)
         n_gaps += len(run.gaps)
         for m in methods:
             for g, p in zip(run.gaps, run.paths.get(m, []), strict=True):

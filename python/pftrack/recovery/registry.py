@@ -116,6 +116,8 @@ def recover_gaps(
     history: int | None = None,
     motion: MotionFit | None = None,
     observed: Sequence[F64] | None = None,
+    seed: int = 0,
+    combine: bool = True,
 ) -> list[F64]:
     """Recover many gaps at once.
 
@@ -138,6 +140,9 @@ def recover_gaps(
         For ``"auto"``: every observed track of the file to calibrate on; default: the
         segments given (:func:`pftrack.recovery.calibrate.recover_auto`, which also returns
         what was chosen).
+    seed, combine
+        For ``"auto"``: the calibration's seed and whether a bucket may blend two methods
+        (:func:`~pftrack.recovery.calibrate.recover_auto`).
 
     Returns
     -------
@@ -174,7 +179,8 @@ def recover_gaps(
                 f"non-empty; got {s.shape}"
             )
     if method == "auto":
-        return recover_auto(list(zip(seg_a, seg_b, strict=True)), observed, noise, motion)[0]
+        pairs = list(zip(seg_a, seg_b, strict=True))
+        return recover_auto(pairs, observed, noise, motion, seed=seed, combine=combine)[0]
     if method == "gdt-mix":
         pairs = [
             (as_segment(a, "segment_a"), as_segment(b, "segment_b"))
