@@ -198,7 +198,7 @@ def extend_legs(
     """
     out = np.array(boxes, np.float64).reshape(-1, 4)
     b, a = float(coef[0, 0]), float(coef[0, 1])
-    if not 1.0 - b > 0.0:
+    if 1.0 - b == 0.0:
         return out
     rows, cols = mask.shape
     counts = np.concatenate(

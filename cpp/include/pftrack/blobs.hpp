@@ -183,7 +183,8 @@ inline std::vector<std::vector<Index>> merge_fragments(const std::vector<BlobRec
 /// Legs lost to the shadow test, recovered within the person-size model (PaperConfig.leg_height):
 /// a box shorter than `min_height` times the height of a person whose head is at its top row
 /// (h_e solves h = h_intercept + h_slope (top + h), so h_e = (h_intercept + h_slope top) /
-/// (1 - h_slope); no solution when h_slope >= 1 or h_e <= 0) is extended down, row by row,
+/// (1 - h_slope); h_slope > 1 is a camera below head height, where nearer heads are higher;
+/// no such person when h_slope = 1 or h_e <= 0) is extended down, row by row,
 /// through the rows below it where at least `row_fill` of the box's columns (and at least one)
 /// are non-zero in `mask` (foreground 255 or shadow 127), never past the expected foot row
 /// top + h_e. Columns [round(x), round(x + w)) and the first row round(y + h) are clipped to
@@ -192,7 +193,7 @@ inline void extend_legs(const std::uint8_t* mask, Index rows, Index cols, Index 
                         std::vector<BlobRect>& boxes, const SizeLines& s, double min_height,
                         double row_fill) {
     const double denom = 1.0 - s.h_slope;
-    if (!(denom > 0.0)) return;
+    if (denom == 0.0) return;
     const auto clip = [](double v, Index hi) {
         return static_cast<Index>(std::nearbyint(std::clamp(v, 0.0, double(hi))));
     };

@@ -232,9 +232,11 @@ class PersonSizeModel:
         the box's top row ``y`` (``h_e`` solves ``h = h_intercept + h_slope (y + h)``) grows down
         one row at a time while at least `row_fill` of its columns (and at least one) are
         non-zero in `mask` (foreground 255 or shadow 127) in the row just below it, and never
-        past the expected foot row ``y + h_e``. No box changes when ``h_slope >= 1`` (no such
-        person). One C++ call (``pftrack._core.extend_legs``; ``tests/reference/blobs.py`` holds
-        the NumPy statement it equals).
+        past the expected foot row ``y + h_e``. ``h_slope > 1`` is a camera below head height
+        (nearer people's heads are higher; TUD-Campus's ground truth gives 1.49); no box
+        changes when ``h_slope = 1``, nor one whose ``h_e <= 0``. One C++ call
+        (``pftrack._core.extend_legs``; ``tests/reference/blobs.py`` holds the NumPy statement
+        it equals).
 
         Parameters
         ----------
