@@ -83,8 +83,8 @@ class PaperConfig:
     shadow_chroma: float = 0.03
     ghost_support: float = 0.3
     ghost_rate: float = 0.5
-    leg_height: float = 0.0
-    leg_fill: float = 0.3
+    leg_height: float = 0.8
+    leg_fill: float = 0.2
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
