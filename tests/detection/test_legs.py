@@ -199,3 +199,29 @@ def test_foreground_is_the_cleaned_255_mask_whatever_the_shadows() -> None:
         mask, _ = det.foreground(f)
         np.testing.assert_array_equal(mask, fg)  # no 127 reaches the public mask
         np.testing.assert_array_equal(foreground_only(raw), (raw == 255).astype(np.uint8) * 255)
+
+
+def test_boxes_do_not_grow_into_a_ghost() -> None:
+    rows, cols = 140, 320
+    ground = np.empty((rows, cols, 3), np.uint8)
+    ground[:] = GROUND
+    primed = ground.copy()
+    primed[80:130, 100:125] = (150, 60, 30)  # someone who stood there while it was primed
+    frame = ground.copy()
+    frame[30:60, 100:120] = (40, 40, 200)  # a torso, its legs shadow-like down to row 80
+    frame[60:80, 100:120] = np.round(0.65 * GROUND).astype(np.uint8)
+    boxes = {}
+    for leg_height in (0.0, 0.8):
+        det = make_detector("paper", leg_height=leg_height, leg_fill=0.2)
+        det.prime([primed] * 3)
+        size = det._blobs.size_model
+        for foot in np.linspace(50, 130, 40):  # h = 0.5 foot + 20: a head at row 30, foot row 100
+            h = 0.5 * foot + 20
+            size.observe(np.array([[10.0, foot - h, 20.0, h]]))  # 20 px wide
+        np.testing.assert_allclose(size.coefficients[0], [0.5, 20.0], atol=1e-9)
+        d = det.detect(frame)
+        assert len(d) == 1 and det._ghost is not None and det._ghost[80:130, 100:125].all()
+        boxes[leg_height] = d.boxes[0]
+    np.testing.assert_array_equal(boxes[0.0], [100, 30, 20, 30])  # the torso alone
+    # through the shadow, but not into the ghost below it (which the foot row 100 would allow)
+    np.testing.assert_array_equal(boxes[0.8], [100, 30, 20, 50])

@@ -196,7 +196,10 @@ class PaperDetector:
             mask, boxes, scores = self._drop_ghosts(frame, mask, boxes, scores)
         size = self._blobs.size_model
         if self.config.leg_height > 0 and len(boxes) and size.fitted:
-            # after the size model observed the blobs' own boxes (it never learns from these)
+            # after the size model observed the blobs' own boxes (it never learns from these);
+            # no box grows into a ghost (this frame's ghost pixels are background being learnt)
+            if self._ghost is not None:
+                shaded = np.where(self._ghost != 0, np.uint8(0), shaded)
             boxes = size.extend_legs(shaded, boxes, self.config.leg_height, self.config.leg_fill)
         return Detections(boxes, scores, mask, _core.mask_bins(binned, mask), frame_bins=binned)
 
