@@ -115,6 +115,33 @@ void register_blobs(py::module_& m) {
         "Groups (list of lists of indices) of the boxes (K, 4) that are one person's fragments.");
 
     m.def(
+        "extend_legs",
+        [](const py::array& mask, Eigen::Ref<const RowMatrixXd> boxes,
+           Eigen::Ref<const RowMatrixXd> size_lines, double min_height, double row_fill) {
+            const char* fn = "extend_legs";
+            require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
+            bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);  // uint8 or bool, packed
+            std::vector<BlobRect> b = to_rects(boxes, fn);
+            const SizeLines s = to_lines(size_lines, fn);
+            require(std::isfinite(min_height) && min_height >= 0.0, fn, "min_height", min_height,
+                    "a finite value >= 0");
+            require(row_fill >= 0.0 && row_fill <= 1.0, fn, "row_fill", row_fill, "in [0, 1]");
+            const auto* data = static_cast<const std::uint8_t*>(mask.data());
+            const Index rows = mask.shape(0), cols = mask.shape(1), stride = mask.strides(0);
+            {
+                py::gil_scoped_release nogil;  // safe: plain buffers, `mask` kept alive by the caller
+                extend_legs(data, rows, cols, stride, b, s, min_height, row_fill);
+            }
+            RowMatrixXd out(static_cast<Index>(b.size()), 4);
+            for (std::size_t i = 0; i < b.size(); ++i)
+                out.row(static_cast<Index>(i)) << b[i].x, b[i].y, b[i].w, b[i].h;
+            return out;
+        },
+        py::arg("mask"), py::arg("boxes"), py::arg("size_lines"), py::arg("min_height"),
+        py::arg("row_fill"),
+        "Boxes (K, 4) of short people extended down through mask (H, W) rows (lost legs).");
+
+    m.def(
         "size_fit",
         [](Eigen::Ref<const RowMatrixXd> samples) {
             const char* fn = "size_fit";

@@ -79,7 +79,8 @@ void register_detection(py::module_& m) {
                 return py::make_tuple(img, mask);
             },
             py::arg("frame"),
-            "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8 0/255).")
+            "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8: 255 "
+            "foreground, 127 shadow, 0 background).")
         .def(
             "blend",
             [](BackgroundModel& self, py::array frame, py::array mask, double rate) {

@@ -46,7 +46,8 @@ class BackgroundModel:
         s_min: float = 0.1,
         v_min: float = 0.2,
     ) -> None: ...
-    # frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8 0/255)
+    # frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8:
+    # 255 foreground, 127 shadow, 0 background)
     def apply(self, frame: NDArray[np.uint8]) -> tuple[BinnedImage, NDArray[np.uint8]]: ...
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...
@@ -219,6 +220,15 @@ def split_count(
 ) -> NDArray[np.int64]: ...  # (K,)
 def merge_fragments(boxes: _F64, size_lines: _F64, merge_slack: float) -> list[list[int]]: ...
 def size_fit(samples: _F64) -> _F64: ...  # (n, 3) foot y, h, w -> (2, 2) size lines
+
+# short boxes (K, 4) extended down through rows of mask != 0, to the expected foot row
+def extend_legs(
+    mask: NDArray[np.uint8] | NDArray[np.bool_],
+    boxes: _F64,
+    size_lines: _F64,
+    min_height: float,
+    row_fill: float,
+) -> _F64: ...  # (K, 4)
 def theil_sen(x: _F64, y: _F64) -> tuple[float, float]: ...  # x, y (n,) -> slope, intercept
 
 # --- resampling: weights (N,) float64 >= 0 -> indices (N,) int32 --------------------------

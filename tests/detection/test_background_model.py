@@ -63,7 +63,7 @@ def test_hsv_reference_matches_core_on_random_pixels():
 def test_background_model_matches_reference(seed, kw):
     rng = np.random.default_rng(seed)
     model, ref = _core.BackgroundModel(**kw), BackgroundReference(**kw)
-    n_fg = 0
+    n_fg = n_shadow = 0
     for frame in random_scene(rng):
         bins, mask = model.apply(frame)
         rbins, rmask = ref.apply(frame)
@@ -71,8 +71,10 @@ def test_background_model_matches_reference(seed, kw):
         np.testing.assert_array_equal(mask, rmask)
         np.testing.assert_array_equal(model.background, ref.background)
         assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
-        n_fg += int((mask > 0).sum())
+        n_fg += int((mask == 255).sum())
+        n_shadow += int((mask == 127).sum())
     assert n_fg > 0  # the moving patch was foreground at some point
+    assert n_shadow > 0 or kw.get("shadow_lo") == 1.0  # and shadows marked 127, when tested
     assert model.frame_count == 6
 
 
@@ -85,7 +87,9 @@ def test_selective_update_and_shadow_are_not_learnt():
     f[10:15, 10:15] = 70  # a shadow: darker, same chromaticity -> background, not learnt
     f[16:, 16:] = 110  # small change below threshold -> learnt at alpha
     _, mask = m.apply(f)
-    assert (mask[:5, :5] == 255).all() and mask.sum() == 25 * 255
+    # MOG2's convention: 255 foreground, 127 shadow, 0 background
+    assert (mask[:5, :5] == 255).all() and (mask == 255).sum() == 25
+    assert (mask[10:15, 10:15] == 127).all() and (mask == 127).sum() == 25
     b = m.background
     assert (b[:5, :5] == 100).all() and (b[10:15, 10:15] == 100).all()
     assert (b[16:, 16:] == 105).all()

@@ -456,6 +456,21 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target(
+        "extend_legs",
+        call(
+            _core.extend_legs,
+            st.one_of(
+                masks().map(lambda m: (np.asarray(m, np.uint8) % 3) * 127),  # 0, 127, 254
+                masks().flatmap(layout),
+                garbage(),
+            ),
+            maybe(boxes()),
+            st.one_of(floats_array((2, 2), -5, 50), garbage()),
+            maybe(fl(0, 3)),
+            maybe(fl(0, 1)),
+        ),
+    ),  # fmt: skip
+    Target(
         "split_count",
         call(
             _core.split_count,

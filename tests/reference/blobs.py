@@ -1,5 +1,5 @@
 """Reference of the blob pass (pftrack._core.blob_boxes, split_count, merge_fragments, theil_sen,
-size_fit).
+size_fit, extend_legs).
 
 The detectors' blob pass as it was written in Python before it moved to C++: OpenCV's outer
 contours (``cv2.findContours`` with ``RETR_EXTERNAL``), NumPy filters, the person-size model's
@@ -184,3 +184,40 @@ def blob_boxes(
         n[objects < 1.5] = 1
         rects, fill = _split(mask, rects, fill, n, min_area)
     return rects, fill
+
+
+def extend_legs(
+    mask: NDArray[np.uint8], boxes: F64, coef: F64, min_height: float, row_fill: float
+) -> F64:
+    """Short boxes grown down through the rows below them that `mask` fills, to the foot row.
+
+    The expected height of a person whose head is at row ``y``: ``h = a + b (y + h)``, so
+    ``(a + b y) / (1 - b)``. Each row's count of non-zero pixels in the box's columns is read
+    from a cumulative sum; the box takes every row down to the first that fills less than
+    `row_fill` of them (or none), stopping at the expected foot row.
+    """
+    out = np.array(boxes, np.float64).reshape(-1, 4)
+    b, a = float(coef[0, 0]), float(coef[0, 1])
+    if 1.0 - b == 0.0:
+        return out
+    rows, cols = mask.shape
+    counts = np.concatenate(
+        [np.zeros((rows, 1), np.int64), np.cumsum(mask != 0, axis=1, dtype=np.int64)], axis=1
+    )
+    for k, (x, y, w, h) in enumerate(out):
+        h_exp = (a + b * y) / (1.0 - b)
+        if not (h_exp > 0.0 and h < min_height * h_exp):
+            continue
+        x0, x1 = (int(np.rint(np.clip(v, 0, cols))) for v in (x, x + w))
+        if x1 <= x0:
+            continue
+        start = int(np.rint(np.clip(y + h, 0, rows)))
+        last = int(min(rows, np.floor(y + h_exp)))  # rows r with r + 1 <= y + h_exp: r < last
+        if last <= start:
+            continue
+        n = counts[start:last, x1] - counts[start:last, x0]
+        bad = (n == 0) | (n < row_fill * (x1 - x0))
+        grow = int(np.argmax(bad)) if bad.any() else len(n)
+        if grow:
+            out[k, 3] = float(start + grow) - y
+    return out

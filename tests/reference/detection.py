@@ -91,7 +91,7 @@ class BackgroundReference:
         i = int(np.searchsorted(cum[1:], half))  # first bin whose cumulative count >= half
         median = i + (half - cum[i]) / hist[i]
         self.threshold = min(max(self.k_noise * median, self.t_min), self.t_max)
-        return bins, np.where(fore, 255, 0).astype(np.uint8)
+        return bins, np.select([fore, shadow], [255, 127], 0).astype(np.uint8)
 
 
 def _edge_sum_reference(img: np.ndarray, band: np.ndarray) -> float:

@@ -192,7 +192,8 @@ PFTRACK_VECTOR_CLONES static void background_row_update(
 ///   (a) bins each pixel (`hsv_bin_of`'s bins, via HsvLut),
 ///   (b) d_bg = max_c |frame_c - background_c|, d_prev = max_c |frame_c - previous_c|,
 ///   (c) candidate = d_bg > T or (d_prev > T and d_bg > low_ratio * T); a candidate that is a
-///       shadow (see BackgroundConfig) is not foreground; mask 255/0,
+///       shadow (see BackgroundConfig) is not foreground; mask 255 foreground, 127 shadow,
+///       0 background (OpenCV MOG2's convention),
 ///   (d) background_c += a (frame_c - background_c), a = alpha where not a candidate, alpha_fg
 ///       where a candidate (foreground or shadow); a = max(1 / k, alpha) everywhere for the
 ///       k-th frame while k <= n_learn (float32 arithmetic, in this order, so a NumPy
@@ -282,7 +283,7 @@ public:
     }
 
     /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols) and
-    /// `mask` (rows x cols, 255 = foreground), both packed.
+    /// `mask` (rows x cols, 255 = foreground, 127 = shadow, 0 = background), both packed.
     void apply(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride, std::int16_t* bins,
                std::uint8_t* mask) {
         if (!initialized()) {
@@ -337,7 +338,7 @@ public:
             for (Index x = 0; x < cols; ++x) {
                 o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
                 ++h4[static_cast<size_t>(x & 3)][static_cast<size_t>(di[x])];
-                bool fore = false;
+                std::uint8_t out = 0;
                 if (cand[x] != 0.0f) {
                     // shadow: darker by a bounded ratio, same chromaticity:
                     // |I_c sB - B_c sI| <= k sI sB for every c
@@ -350,9 +351,9 @@ public:
                                  std::abs(g * s_b - qg[x] * s_i) <= tol &&
                                  std::abs(r * s_b - qr[x] * s_i) <= tol;
                     }
-                    fore = !shadow;
+                    out = shadow ? 127 : 255;
                 }
-                m[x] = fore ? 255 : 0;
+                m[x] = out;
             }
             // (5) background_c += a (frame_c - background_c), vectorised (selective update)
             detail::background_row_update(cols, fb, fg, fr, qb, qg, qr, cand, a_bg, a_fg);

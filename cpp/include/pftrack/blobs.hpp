@@ -180,6 +180,45 @@ inline std::vector<std::vector<Index>> merge_fragments(const std::vector<BlobRec
     return groups;
 }
 
+/// Legs lost to the shadow test, recovered within the person-size model (PaperConfig.leg_height):
+/// a box shorter than `min_height` times the height of a person whose head is at its top row
+/// (h_e solves h = h_intercept + h_slope (top + h), so h_e = (h_intercept + h_slope top) /
+/// (1 - h_slope); h_slope > 1 is a camera below head height, where nearer heads are higher;
+/// no such person when h_slope = 1 or h_e <= 0) is extended down, row by row,
+/// through the rows below it where at least `row_fill` of the box's columns (and at least one)
+/// are non-zero in `mask` (foreground 255 or shadow 127), never past the expected foot row
+/// top + h_e. Columns [round(x), round(x + w)) and the first row round(y + h) are clipped to
+/// the mask. Boxes are changed in place; only heights change.
+inline void extend_legs(const std::uint8_t* mask, Index rows, Index cols, Index stride,
+                        std::vector<BlobRect>& boxes, const SizeLines& s, double min_height,
+                        double row_fill) {
+    const double denom = 1.0 - s.h_slope;
+    if (denom == 0.0) return;
+    const auto clip = [](double v, Index hi) {
+        return static_cast<Index>(std::nearbyint(std::clamp(v, 0.0, double(hi))));
+    };
+    for (BlobRect& b : boxes) {
+        const double hy = s.h_slope * b.y;  // no fused multiply-add (NumPy's rounding)
+        const double h_exp = (s.h_intercept + hy) / denom;
+        if (!(h_exp > 0.0) || !(b.h < min_height * h_exp)) continue;
+        const double foot = b.y + h_exp;
+        const Index x0 = clip(b.x, cols), x1 = clip(b.x + b.w, cols);
+        if (x1 <= x0) continue;
+        const double need = row_fill * double(x1 - x0);
+        Index r = clip(b.y + b.h, rows);
+        const Index start = r;
+        // row r joins when the new bottom r + 1 stays at or above the expected foot row
+        while (r < rows && double(r + 1) <= foot) {
+            const std::uint8_t* m = mask + r * stride;
+            Index n = 0;
+            for (Index x = x0; x < x1; ++x) n += m[x] != 0;
+            if (n == 0 || double(n) < need) break;
+            ++r;
+        }
+        if (r > start) b.h = double(r) - b.y;
+    }
+}
+
 namespace detail {
 
 struct Runs {  // runs of equal pixels, row by row, in raster order

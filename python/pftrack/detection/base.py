@@ -239,7 +239,7 @@ class BlobExtractor:
         return self._open, self._close
 
     def clean(self, raw: NDArray[np.uint8]) -> NDArray[np.uint8]:
-        """Clean the raw 0/255 mask: opening, then closing."""
+        """Clean the raw mask: opening, then closing (grey-level: 127 shadows are cleaned too)."""
         k_open, k_close = self._elements(raw.shape[0])
         m = cv2.morphologyEx(raw, cv2.MORPH_OPEN, k_open)
         return np.asarray(cv2.morphologyEx(m, cv2.MORPH_CLOSE, k_close), np.uint8)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 
@@ -56,6 +57,15 @@ class PaperConfig:
     ghost_rate : float
         Per-pixel update rate of the background inside a ghost, per frame, for as long as
         those pixels stay foreground.
+    leg_height : float
+        Lost legs (the shadow test takes dark trousers on a grey path for shadow): once the
+        person-size model is fitted, a box shorter than `leg_height` times the height of a
+        person whose head is at its top is extended down through the rows below it that
+        shadow or foreground fills (`leg_fill`), never past that person's expected foot row
+        (`PersonSizeModel.extend_legs`). 0 turns it off.
+    leg_fill : float
+        Share of a box's columns that a row below it must fill (shadow or foreground) for the
+        box to grow into it.
     blobs : BlobConfig
         Morphology and blob filters.
     hsv : HsvBinning
@@ -73,6 +83,8 @@ class PaperConfig:
     shadow_chroma: float = 0.03
     ghost_support: float = 0.3
     ghost_rate: float = 0.5
+    leg_height: float = 0.8
+    leg_fill: float = 0.2
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
@@ -81,6 +93,10 @@ class PaperConfig:
             raise ValueError(f"ghost_support is {self.ghost_support}, expected in [0, 1]")
         if not (0.0 < self.ghost_rate <= 1.0):
             raise ValueError(f"ghost_rate is {self.ghost_rate}, expected in (0, 1]")
+        if not (0.0 <= self.leg_height < np.inf):
+            raise ValueError(f"leg_height is {self.leg_height}, expected a finite value >= 0")
+        if not (0.0 <= self.leg_fill <= 1.0):
+            raise ValueError(f"leg_fill is {self.leg_fill}, expected in [0, 1]")
 
 
 class PaperDetector:
@@ -164,7 +180,8 @@ class PaperDetector:
         -------
         Detections
         """
-        mask, binned = self._foreground(frame, "PaperDetector.detect")
+        shaded, binned = self._foreground(frame, "PaperDetector.detect")
+        mask = foreground_only(shaded)
         if self.config.ghost_support > 0 and self._ghost is not None:
             # a ghost found earlier: its pixels still foreground keep being learnt fast
             carry = np.bitwise_and(mask, self._ghost)
@@ -177,6 +194,13 @@ class PaperDetector:
         boxes, scores = self._blobs.boxes(mask)
         if self.config.ghost_support > 0 and len(boxes):
             mask, boxes, scores = self._drop_ghosts(frame, mask, boxes, scores)
+        size = self._blobs.size_model
+        if self.config.leg_height > 0 and len(boxes) and size.fitted:
+            # after the size model observed the blobs' own boxes (it never learns from these);
+            # no box grows into a ghost (this frame's ghost pixels are background being learnt)
+            if self._ghost is not None:
+                shaded = np.where(self._ghost != 0, np.uint8(0), shaded)
+            boxes = size.extend_legs(shaded, boxes, self.config.leg_height, self.config.leg_fill)
         return Detections(boxes, scores, mask, _core.mask_bins(binned, mask), frame_bins=binned)
 
     def _drop_ghosts(
@@ -210,10 +234,21 @@ class PaperDetector:
         The background model advances exactly as with :meth:`detect`; a tracker fed by another
         detector needs only these (to refine that detector's boxes) and skips the blob pass.
         """
-        return self._foreground(frame, "PaperDetector.foreground")
+        shaded, binned = self._foreground(frame, "PaperDetector.foreground")
+        return foreground_only(shaded), binned
 
     def _foreground(
         self, frame: NDArray[np.uint8], fn: str
     ) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
+        """The cleaned mask with shadows (255, 127, 0) and the frame's bins."""
         binned, raw = self._model.apply(check_frame(frame, fn))
         return self._blobs.clean(raw), binned
+
+
+def foreground_only(shaded: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """The 0/255 foreground of a mask with shadows (255 foreground, 127 shadow, 0 background).
+
+    Opening and closing are minima and maxima over a window, which commute with a threshold:
+    the foreground of the cleaned mask with shadows is the cleaned foreground, bit for bit.
+    """
+    return np.asarray(cv2.threshold(shaded, 127, 255, cv2.THRESH_BINARY)[1], np.uint8)

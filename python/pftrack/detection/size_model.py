@@ -219,6 +219,55 @@ class PersonSizeModel:
         )
         return groups
 
+    def extend_legs(
+        self,
+        mask: NDArray[np.uint8],
+        boxes: NDArray[np.float64],
+        min_height: float,
+        row_fill: float,
+    ) -> NDArray[np.float64]:
+        """Extend the boxes of people whose legs were lost down to the expected foot row.
+
+        A box shorter than `min_height` times the height ``h_e`` of a person whose head is at
+        the box's top row ``y`` (``h_e`` solves ``h = h_intercept + h_slope (y + h)``) grows down
+        one row at a time while at least `row_fill` of its columns (and at least one) are
+        non-zero in `mask` (foreground 255 or shadow 127) in the row just below it, and never
+        past the expected foot row ``y + h_e``. ``h_slope > 1`` is a camera below head height
+        (nearer people's heads are higher; TUD-Campus's ground truth gives 1.49); no box
+        changes when ``h_slope = 1``, nor one whose ``h_e <= 0``. One C++ call
+        (``pftrack._core.extend_legs``; ``tests/reference/blobs.py`` holds the NumPy statement
+        it equals).
+
+        Parameters
+        ----------
+        mask : (H, W) ndarray of uint8
+            The cleaned mask with its shadow pixels (255 foreground, 127 shadow, 0 background).
+        boxes : (K, 4) ndarray of float64
+            ``left, top, w, h``.
+        min_height : float
+            Share of the expected height below which a box is extended (0: none is).
+        row_fill : float
+            Share of the box's columns a row below it must fill, in [0, 1].
+
+        Returns
+        -------
+        (K, 4) ndarray of float64
+            The boxes, only heights changed.
+
+        Raises
+        ------
+        ValueError
+            Before the model is fitted, or arguments out of range.
+        """
+        out: NDArray[np.float64] = _core.extend_legs(
+            mask,
+            np.asarray(boxes, np.float64).reshape(-1, 4),
+            self._fitted_lines("extend_legs"),
+            min_height,
+            row_fill,
+        )
+        return out
+
     def _fitted_lines(self, fn: str) -> NDArray[np.float64]:
         if self._coef is None:
             raise ValueError(f"PersonSizeModel.{fn}: the model is not fitted yet")
