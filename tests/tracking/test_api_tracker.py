@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import warnings
 
@@ -13,9 +14,10 @@ from pftrack.cli import main
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import group_by_frame, read_mot, write_mot
 from pftrack.io.video import FrameSource
-from pftrack.synthetic import make_scene
+from pftrack.synthetic import make_busy_scene, make_scene
 from pftrack.tracking import TrackerConfig, track_frames
 from pftrack.tracking.api import check_boxes_xyxy, xywh_to_xyxy_dets
+from pftrack.tracking.offline import drop_nested
 from tests.conftest import dataset
 
 
@@ -335,3 +337,39 @@ def test_startup_tracks_that_never_reach_min_hits_are_dropped_offline(scene):
     clean = pftrack.Tracker(frame_rate=25.0, seed=0)
     _, rows_clean = run_loop(clean, frames, scene_dets(scene)[:12])
     assert len(rows_clean) == len(rows)
+
+
+def _lifecycle(**changes):
+    return TrackerConfig(lifecycle=dataclasses.replace(TrackerConfig().lifecycle, **changes))
+
+
+def test_finalize_drops_the_builtin_detectors_nested_boxes():
+    """Built-in detector: finalize() leaves out boxes inside a larger one (drop_nested) ..."""
+    busy = make_busy_scene("present", n_frames=100, rng=0)  # people split into fragments
+
+    def rows(config, dets=None):
+        tracker = pftrack.Tracker.from_config(config, 0)
+        tracker.prime(busy.frames[:30])
+        for k, f in enumerate(busy.frames):
+            tracker.update(None if dets is None else dets[k], f)
+        return tracker.finalize()
+
+    life = TrackerConfig().lifecycle
+    kept = rows(_lifecycle(nested_inside=None))
+    assert len(kept) > len(drop_nested(kept, life.nested_inside, life.nested_area))  # some to drop
+    np.testing.assert_array_equal(
+        rows(TrackerConfig()), drop_nested(kept, life.nested_inside, life.nested_area)
+    )
+    # ... but never given detections: a box inside a larger one is then a partly hidden person
+    d = scene_dets(busy)
+    np.testing.assert_array_equal(rows(TrackerConfig(), d), rows(_lifecycle(nested_inside=None), d))
+
+
+@pytest.mark.parametrize(
+    ("changes", "match"),
+    [({"nested_inside": 0.0}, "nested_inside is 0.0"), ({"nested_inside": 1.2}, "nested_inside"),
+     ({"nested_area": 0.9}, "nested_area is 0.9"), ({"nested_area": float("nan")}, "nested_area")],
+)  # fmt: skip
+def test_nested_settings_are_checked(changes, match):
+    with pytest.raises(ValueError, match=match):
+        _lifecycle(**changes)

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pftrack.tracking import BoxSmoother, Track, TrackWriter, smooth_tracks
+from pftrack.tracking.offline import drop_nested
 from tests.reference.smoothing import wna_posterior_mean
 
 
@@ -221,3 +222,68 @@ def test_cli_smooth_links_fills_and_refuses_its_input(tmp_path, capsys):
     assert main(["smooth", str(src), "--out", str(src)]) == 2
     assert "is the input file" in capsys.readouterr().err
     np.testing.assert_array_equal(read_mot(src), rows)  # untouched
+
+
+# -- drop_nested: the built-in detector's fragments ------------------------------------------
+def _nested_reference(rows, inside, area_ratio):
+    """Pair by pair: row i goes when some row j of its frame covers it as drop_nested says."""
+    keep = []
+    for i, a in enumerate(rows):
+        covered = False
+        for j, b in enumerate(rows):
+            if i == j or a[0] != b[0]:
+                continue
+            ix = min(a[2] + a[4], b[2] + b[4]) - max(a[2], b[2])
+            iy = min(a[3] + a[5], b[3] + b[5]) - max(a[3], b[3])
+            overlap = max(ix, 0.0) * max(iy, 0.0)
+            if overlap > inside * a[4] * a[5] and b[4] * b[5] > area_ratio * a[4] * a[5]:
+                covered = True
+        if not covered:
+            keep.append(i)
+    return rows[keep]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(0, 40),
+    inside=st.sampled_from([0.5, 0.7, 1.0]),
+    area_ratio=st.sampled_from([1.0, 1.5, 3.0]),
+)
+def test_drop_nested_matches_the_pairwise_reference(seed, n, inside, area_ratio):
+    rng = np.random.default_rng(seed)
+    rows = np.zeros((n, 10))
+    rows[:, 0] = rng.integers(1, 4, n)  # a few frames, several boxes each
+    rows[:, 1] = np.arange(n)
+    rows[:, 2:4] = rng.uniform(0, 60, (n, 2))
+    rows[:, 4:6] = rng.uniform(2, 50, (n, 2))
+    got = drop_nested(rows, inside, area_ratio)
+    np.testing.assert_array_equal(got, _nested_reference(rows, inside, area_ratio))
+
+
+def test_drop_nested_keeps_a_partly_covered_box_and_the_cover():
+    rows = np.zeros((4, 10))
+    rows[:, 0] = [1, 1, 1, 2]
+    rows[:, 1] = [1, 2, 3, 2]
+    rows[:, 2:6] = [
+        [0, 0, 40, 100],  # a person
+        [10, 60, 15, 30],  # a leg fragment, wholly inside: dropped
+        [30, 0, 40, 100],  # a neighbour overlapping by a quarter: kept
+        [10, 60, 15, 30],  # the same box on another frame, alone: kept
+    ]
+    np.testing.assert_array_equal(drop_nested(rows)[:, 1], [1, 3, 2])
+    # equal boxes never drop each other (the cover must be larger)
+    twins = np.array([[1, 1, 0, 0, 10, 10, 1, -1, -1, -1], [1, 2, 0, 0, 10, 10, 1, -1, -1, -1]])
+    assert len(drop_nested(twins, 1.0, 1.0)) == 2
+
+
+@pytest.mark.parametrize(
+    ("inside", "area_ratio", "match"),
+    [(0.0, 1.5, "inside is 0.0"), (1.5, 1.5, "inside is 1.5"), (0.7, 0.5, "area_ratio is 0.5"),
+     (0.7, float("inf"), "area_ratio is inf")],
+)  # fmt: skip
+def test_drop_nested_bad_arguments(inside, area_ratio, match):
+    with pytest.raises(ValueError, match=match):
+        drop_nested(np.zeros((0, 10)), inside, area_ratio)
+    with pytest.raises(ValueError, match="drop_nested"):
+        drop_nested(np.zeros((3, 4)))

@@ -27,7 +27,7 @@ from pftrack._typing import F64, RngLike
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import TrackerConfig
-from pftrack.tracking.offline import BoxSmoother
+from pftrack.tracking.offline import BoxSmoother, drop_nested
 from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
 from pftrack.tracking.writer import TrackWriter
@@ -305,6 +305,7 @@ class Tracker:
         self._reports: list[Track] = []
         self._clip_warned = False
         self._max_conf = -np.inf
+        self._given = False  # some update() of the run had detections
 
     @property
     def tracker(self) -> MultiObjectTracker:
@@ -350,6 +351,7 @@ class Tracker:
             reports = self._tracker.update(f, None)
         else:
             xywh, cls, kept, clipped = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
+            self._given = True
             if clipped and not self._clip_warned:
                 self._clip_warned = True
                 warnings.warn(
@@ -403,9 +405,17 @@ class Tracker:
         -------
         (R, 10) ndarray of float
             ``frame, id, left, top, width, height, conf, -1, -1, -1``, frames from 1 (one per
-            ``update``), sorted by frame then id. Warns when there is no row at all.
+            ``update``), sorted by frame then id. Warns when there is no row at all. With the
+            built-in detector (no ``update`` of the run had detections) and the smoother on,
+            boxes mostly inside a larger box of the same frame are left out
+            (``LifecycleConfig.nested_inside``).
         """
         rows = self._stabiliser.restore(self._writer.result(drop=self._tracker.never_confirmed()))
+        life = self.config.lifecycle
+        smoothed = self._writer_args[2] is not None
+        if smoothed and not self._given and life.nested_inside is not None and len(rows):
+            # the built-in detector's fragments (LifecycleConfig.nested_inside)
+            rows = drop_nested(rows, life.nested_inside, life.nested_area)
         if len(rows) == 0 and self.frame_count:
             cfg = self.config.lifecycle
             hint = (

@@ -112,6 +112,14 @@ class LifecycleConfig:
         Frames a not yet confirmed track may go without a detection before it is dropped.
     coast_min_rho : float
         A coasting track is reported only while its colour match ``rho`` stays above this.
+    nested_inside, nested_area : float or None
+        With the built-in detector, the offline pass leaves out every box that lies by more than
+        `nested_inside` of its area inside a box of the same frame more than `nested_area`
+        times larger (:func:`pftrack.tracking.offline.drop_nested`): background subtraction
+        gives one box per silhouette, so such a box is a fragment of the larger one. Given
+        detections are left alone (a box inside a larger one is then often a partly hidden
+        person). None: off. The defaults are the best of a grid over every scene with ground
+        truth (docs/detection.md).
     """
 
     min_score: float = 0.0
@@ -122,10 +130,21 @@ class LifecycleConfig:
     max_coast: int = 10
     tentative_coast: int = 0
     coast_min_rho: float = 0.5
+    nested_inside: float | None = 0.7
+    nested_area: float = 1.5
 
     def __post_init__(self) -> None:
         _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
         _in_unit_interval("LifecycleConfig", coast_min_rho=self.coast_min_rho)
+        if self.nested_inside is not None and not 0.0 < self.nested_inside <= 1.0:
+            raise ValueError(
+                f"LifecycleConfig: nested_inside is {self.nested_inside}, expected a value in "
+                "(0, 1] or None"
+            )
+        if not 1.0 <= self.nested_area < np.inf:
+            raise ValueError(
+                f"LifecycleConfig: nested_area is {self.nested_area}, expected a finite value >= 1"
+            )
         if self.birth_quantile is not None:
             _in_unit_interval("LifecycleConfig", birth_quantile=self.birth_quantile)
         if not np.isfinite(self.min_score):

@@ -29,7 +29,7 @@ from pftrack.recovery.fill import fill_rows
 from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
 from pftrack.recovery.names import DEFAULT_METHOD
 
-__all__ = ["BoxSmoother", "smooth_tracks"]
+__all__ = ["BoxSmoother", "drop_nested", "smooth_tracks"]
 
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
@@ -244,6 +244,57 @@ def smooth_tracks(
                 a[i:j, 2:6] = sm
     out: F64 = a[np.lexsort((a[:, 1], a[:, 0]))]
     return out
+
+
+def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -> F64:
+    """Leave out every box that lies mostly inside a larger box of the same frame.
+
+    A row is dropped when more than `inside` of its box's area lies inside the box of another
+    row of the same frame whose area is more than `area_ratio` times its own. Background
+    subtraction sees one silhouette per connected region, so such a box is a fragment of the
+    larger object (a limb, a piece cut off by the shadow test, a track that bridged into
+    what became part of another blob), not a person of its own: another detector's boxes
+    inside a larger one are often partly hidden people, and are not to be dropped this way.
+
+    Parameters
+    ----------
+    rows : (M, 10) array_like
+        MOTChallenge rows ``frame, id, left, top, width, height, ...``.
+    inside : float
+        Share of a box's area, in (0, 1].
+    area_ratio : float
+        How much larger the covering box must be, at least 1 (then equal boxes never drop each
+        other).
+
+    Returns
+    -------
+    (M', 10) ndarray
+        The rows kept, in their order.
+
+    Raises
+    ------
+    ValueError
+        Bad rows, `inside` outside (0, 1] or `area_ratio` below 1.
+    """
+    if not 0.0 < inside <= 1.0:
+        raise ValueError(f"drop_nested: inside is {inside}, expected a value in (0, 1]")
+    if not 1.0 <= area_ratio < np.inf:
+        raise ValueError(f"drop_nested: area_ratio is {area_ratio}, expected a finite value >= 1")
+    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "drop_nested")
+    order = np.argsort(a[:, 0], kind="stable")
+    cuts = np.flatnonzero(np.diff(a[order, 0])) + 1
+    drop = np.zeros(len(a), dtype=bool)
+    for idx in np.split(order, cuts):
+        if len(idx) < 2:
+            continue
+        x0, y0, w, h = a[idx, 2], a[idx, 3], a[idx, 4], a[idx, 5]
+        ix = np.minimum((x0 + w)[:, None], (x0 + w)[None, :]) - np.maximum(x0[:, None], x0[None, :])
+        iy = np.minimum((y0 + h)[:, None], (y0 + h)[None, :]) - np.maximum(y0[:, None], y0[None, :])
+        overlap = np.clip(ix, 0.0, None) * np.clip(iy, 0.0, None)  # [i, j]: box i inside box j
+        area = w * h
+        covered = (overlap > inside * area[:, None]) & (area[None, :] > area_ratio * area[:, None])
+        drop[idx] = covered.any(axis=1)
+    return a[~drop]
 
 
 def _add_hole_rows(
