@@ -9,6 +9,10 @@
   time.
 * ``singer loglik``: the C++ likelihood behind ``fit_motion`` against
   ``tests/reference/mixture.py``.
+* ``rts smooth, 500 tracks``: :func:`pftrack.kalman.rts_smooth` (one C++ call ``_core.rts_smooth``
+  per track, what the offline pass and ``pftrack smooth`` run for every track's box) against
+  the NumPy loop it replaced (``rts_smooth_numpy``), over the 500 tracks of
+  :mod:`bench.recovery_file` (four axes: centre and size).
 
 Locally: ``pytest bench/test_recovery.py --benchmark-only``; CI: ``--benchmark-disable``.
 """
@@ -22,12 +26,12 @@ from pytest_benchmark.fixture import BenchmarkFixture
 from bench.recovery_file import synthetic_tracks
 from pftrack import _core
 from pftrack._typing import F64
-from pftrack.kalman import cv_transition, wna_Q
+from pftrack.kalman import cv_transition, rts_smooth, wna_Q
 from pftrack.recovery import fill_gaps
 from pftrack.recovery.baselines import rts_batch
 from pftrack.recovery.mixture import DIFFUSE, singer_model
 from tests.reference import mixture as ref_mix
-from tests.reference.smoothing import dense_kalman_rts, rts_batch_numpy
+from tests.reference.smoothing import dense_kalman_rts, rts_batch_numpy, rts_smooth_numpy
 
 
 @pytest.fixture(scope="module")
@@ -122,3 +126,49 @@ def test_singer_loglik_numpy(benchmark: BenchmarkFixture, singer_runs: list[F64]
     benchmark.group = "singer loglik"
     F, Q = singer_model(0.1, 3.0)
     benchmark(ref_mix.state_loglik, singer_runs, F[0], Q[0], 0.5, DIFFUSE)
+
+
+@pytest.fixture(scope="module")
+def track_boxes() -> list[tuple[F64, np.ndarray]]:
+    """Per track of the 500-track file: the (T, 4) centre-and-size rows over its frame span
+    (holes included, NaN there) and which frames are observed, as the offline pass builds them."""
+    rows = synthetic_tracks(500, seed=0)
+    out = []
+    for tid in np.unique(rows[:, 1]):
+        r = rows[rows[:, 1] == tid]
+        f = (r[:, 0] - r[0, 0]).astype(int)
+        z = np.full((f[-1] + 1, 4), np.nan)
+        z[f] = np.column_stack([r[:, 2:4] + r[:, 4:6] / 2, r[:, 4:6]])
+        has = np.zeros(len(z), bool)
+        has[f] = True
+        out.append((z, has))
+    return out
+
+
+_Q, _R = np.array([0.5, 0.5, 0.1, 0.1]), np.array([4.0, 4.0, 9.0, 9.0])
+
+
+def test_rts_smooth_core(
+    benchmark: BenchmarkFixture, track_boxes: list[tuple[F64, np.ndarray]]
+) -> None:
+    benchmark.group = "rts smooth, 500 tracks"
+
+    def run() -> list[F64]:
+        return [
+            rts_smooth(z, h, _Q, _R, velocity_sd=10.0, update_first=False) for z, h in track_boxes
+        ]
+
+    got = benchmark(run)
+    for (z, h), g in list(zip(track_boxes, got, strict=True))[:25]:
+        np.testing.assert_array_equal(g, rts_smooth_numpy(z, h, _Q, _R, 10.0, False))
+
+
+def test_rts_smooth_numpy(
+    benchmark: BenchmarkFixture, track_boxes: list[tuple[F64, np.ndarray]]
+) -> None:
+    benchmark.group = "rts smooth, 500 tracks"
+    benchmark.pedantic(
+        lambda: [rts_smooth_numpy(z, h, _Q, _R, 10.0, False) for z, h in track_boxes],
+        rounds=3,
+        iterations=1,
+    )

@@ -420,3 +420,14 @@ def state_loglik_batch(z: _F64, lengths: _I32, F: _F64, Q: _F64, r: _F64, big: f
 def rts_gaps_batch(
     points: _F64, offsets: _I32, n_before: _I32, q: float, r: float, v0: float
 ) -> _F64: ...
+
+# z (T, n) float64; has (T,) or (T, n) bool/uint8 (rows without a measurement never read); q, r2
+# (n,) -> (T, n) RTS-smoothed positions of independent constant-velocity axes
+def rts_smooth(
+    z: ArrayLike,
+    has: ArrayLike,
+    q: ArrayLike,
+    r2: ArrayLike,
+    velocity_sd: float,
+    update_first: bool,
+) -> _F64: ...

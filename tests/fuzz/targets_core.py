@@ -275,6 +275,18 @@ def _rts_gaps(draw: st.DrawFn) -> Any:
 
 
 @st.composite
+def _rts_smooth(draw: st.DrawFn) -> Any:
+    steps, n = draw(st.integers(0, 30)), draw(st.integers(0, 4))
+    per_axis = draw(st.booleans())
+    has = draw(floats_array((steps, n) if per_axis else (steps,), 0, 1)) > 0.4
+    return draw(call(
+        _core.rts_smooth, maybe(floats_array((steps, n), -1e4, 1e4)), maybe(st.just(has)),
+        maybe(floats_array((n,), 1e-6, 1e3)), maybe(floats_array((n,), 1e-6, 1e3)),
+        maybe(fl(0.0, 1e3)), st.booleans(),
+    ))  # fmt: skip
+
+
+@st.composite
 def _gap_mixture(draw: st.DrawFn) -> Any:
     n = draw(st.integers(2, 30))
     fa = draw(st.integers(0, n - 2))
@@ -527,6 +539,7 @@ TARGETS: list[Target] = [
     Target("state_loglik_batch", _state_loglik()),
     Target("gap_mixture", _gap_mixture()),
     Target("rts_gaps_batch", _rts_gaps()),
+    Target("rts_smooth", _rts_smooth()),
     Target("BackgroundModel", _background_calls()),
     Target("RJMCMCTracker", _rjmcmc_calls()),
 ]

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from pftrack.kalman import rts_smooth
+from pftrack.kalman import Cov, Mean, cv_predict, cv_update_where, rts_smooth
 
 
 def dense_kalman_rts(
@@ -126,3 +126,44 @@ def rts_batch_numpy(
         lo, hi = int(a[-1, 0] - first[g]) + 1, int(b[0, 0] - first[g])
         res.append(np.ascontiguousarray(out[lo:hi, 2 * g : 2 * g + 2]))
     return res
+
+
+def rts_smooth_numpy(
+    z: np.ndarray, has: np.ndarray, q: np.ndarray, r2: np.ndarray, velocity_sd: float,
+    update_first: bool,
+) -> np.ndarray:  # fmt: skip
+    """pftrack.kalman.rts_smooth as NumPy arrays over axes, one Python step per frame.
+
+    The statement the C++ ``_core.rts_smooth`` is held to (it was the library's code before):
+    every axis at once through :func:`pftrack.kalman.cv_predict` and
+    :func:`~pftrack.kalman.cv_update_where`, then the RTS backward pass.
+    """
+    zz, hh = np.asarray(z, np.float64), np.asarray(has, bool)
+    q2, rr = np.asarray(q, np.float64), np.asarray(r2, np.float64)
+    steps, n = zz.shape
+    m: Mean = (zz[0].copy(), np.zeros_like(q2))
+    p: Cov = (rr.copy(), np.zeros_like(q2), np.full_like(q2, velocity_sd**2))
+    fm, fp = np.empty((steps, 2, n)), np.empty((steps, 3, n))  # filtered mean, covariance
+    pm, pp = np.empty((steps, 2, n)), np.empty((steps, 3, n))  # predicted mean, covariance
+    for t in range(steps):
+        if t > 0:
+            m, p = cv_predict(m, p, q2)
+        pm[t], pp[t] = m, p
+        if t > 0 or update_first:
+            m, p = cv_update_where(m, p, zz[t], rr, hh[t])
+        fm[t], fp[t] = m, p
+    out = np.empty((steps, n))
+    s0, s1 = fm[-1, 0].copy(), fm[-1, 1].copy()
+    out[-1] = s0
+    for t in range(steps - 2, -1, -1):
+        a, b, c = fp[t]
+        # gain C = P_f F^T P_pred^-1 with F = [[1, 1], [0, 1]]
+        u00, u01, u10, u11 = a + b, b, b + c, c
+        x, y, w = pp[t + 1]
+        det = x * w - y * y
+        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
+        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
+        d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
+        s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
+        out[t] = s0
+    return out

@@ -7,6 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from pftrack import _core
 from pftrack.kalman import (
     cv_predict,
     cv_transition,
@@ -17,7 +18,7 @@ from pftrack.kalman import (
     wna_Q,
     wna_Q_xy,
 )
-from tests.reference.smoothing import dense_kalman_rts, wna_posterior_mean
+from tests.reference.smoothing import dense_kalman_rts, rts_smooth_numpy, wna_posterior_mean
 
 
 def _problem(
@@ -113,6 +114,7 @@ def test_rts_per_axis_mask_is_each_axis_alone(seed, steps, update_first):
     z, _, q, r2 = _problem(seed, steps, 3)
     has = np.random.default_rng(seed).random((steps, 3)) < 0.6
     has[0] = True
+    z = np.where(has, np.nan_to_num(z, nan=3.0), np.nan)  # measured: finite; the rest unread
     got = rts_smooth(z, has, q, r2, velocity_sd=5.0, update_first=update_first)
     for k in range(3):
         alone = rts_smooth(
@@ -124,6 +126,51 @@ def test_rts_per_axis_mask_is_each_axis_alone(seed, steps, update_first):
             update_first=update_first,
         )
         np.testing.assert_allclose(got[:, k], alone[:, 0], rtol=1e-12, atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    steps=st.integers(1, 60),
+    n=st.integers(1, 5),
+    per_axis=st.booleans(),
+    update_first=st.booleans(),
+)
+def test_rts_is_the_numpy_loop(seed, steps, n, per_axis, update_first):
+    """The C++ smoother against the NumPy loop it replaced (tests/reference/smoothing.py)."""
+    z, has, q, r2 = _problem(seed, steps, n)
+    if per_axis:
+        has = np.random.default_rng(seed + 1).random((steps, n)) < 0.6
+        has[0] = True
+        z = np.where(has, np.nan_to_num(z, nan=7.0), np.inf)  # unmeasured: never read
+    vsd = float(np.random.default_rng(seed).uniform(0.5, 20.0))
+    got = rts_smooth(z, has, q, r2, velocity_sd=vsd, update_first=update_first)
+    want = rts_smooth_numpy(z, has, q, r2, vsd, update_first)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-9)
+    assert np.isfinite(got).all()
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        ((np.zeros((3, 2)), np.array([0, 1, 1], np.uint8), [1.0, 1.0], [1.0, 1.0]), "first frame"),
+        ((np.zeros((3, 2)), np.ones(3, np.uint8), [1.0], [1.0, 1.0]), "q and r2"),
+        ((np.zeros(3), np.ones(3, np.uint8), [1.0], [1.0]), "z must"),
+        ((np.zeros((3, 2)), np.ones(4, np.uint8), [1.0, 1.0], [1.0, 1.0]), "has must"),
+        ((np.zeros((3, 2)), np.ones((3, 1), np.uint8), [1.0, 1.0], [1.0, 1.0]), "has must"),
+        ((np.zeros((0, 2)), np.ones(0, np.uint8), [1.0, 1.0], [1.0, 1.0]), "first frame"),
+        ((np.zeros((3, 2)), np.ones(3, np.uint8), [np.nan, 1.0], [1.0, 1.0]), "q must be"),
+        ((np.zeros((3, 2)), np.ones(3, np.uint8), [1.0, 1.0], [1.0, 0.0]), "r2 finite and > 0"),
+        ((np.full((3, 1), np.inf), np.ones(3, np.uint8), [1.0], [1.0]), "frame 0, axis 0"),
+        ((np.array([[0.0], [np.nan], [2.0]]), np.ones(3, np.uint8), [1.0], [1.0]), "frame 1"),
+    ],
+)
+def test_rts_core_refuses_bad_arrays(args, match):
+    """The kernel checks what it reads itself (one-line ValueError, never a crash)."""
+    with pytest.raises(ValueError, match=match):
+        _core.rts_smooth(*args, 1.0, False)
+    with pytest.raises(ValueError, match="rts_smooth"):
+        rts_smooth(*args, velocity_sd=1.0, update_first=False)
 
 
 def test_update_where_updates_only_the_rows_asked() -> None:
