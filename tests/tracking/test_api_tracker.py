@@ -355,10 +355,10 @@ def test_finalize_drops_the_builtin_detectors_nested_boxes():
         return tracker.finalize()
 
     life = TrackerConfig().lifecycle
-    kept = rows(_lifecycle(nested_inside=None))
+    kept = rows(_lifecycle(nested_inside=None, amodal_share=None))
     assert len(kept) > len(drop_nested(kept, life.nested_inside, life.nested_area))  # some to drop
     np.testing.assert_array_equal(
-        rows(TrackerConfig()), drop_nested(kept, life.nested_inside, life.nested_area)
+        rows(_lifecycle(amodal_share=None)), drop_nested(kept, life.nested_inside, life.nested_area)
     )
     # ... but never given detections: a box inside a larger one is then a partly hidden person
     d = scene_dets(busy)

@@ -127,7 +127,9 @@ class LifecycleConfig:
         expects with its head at the box's top to that person's height (width)
         (:func:`pftrack.tracking.offline.complete_boxes`): background subtraction boxes only
         the visible part of a partly hidden person, ground truth the whole person. Groups
-        (wider than 1.6 persons) are left alone, and so are given detections. None: off.
+        (wider than 1.6 persons) are left alone, and so are given detections. None: off. The
+        default (0.8, ``"side"``) is the best of a grid over every scene with ground truth
+        (docs/detection.md).
     amodal_anchor : {"side", "centre"}
         Which edge a widened box keeps: ``"side"`` grows it towards the one side that lies
         inside another box (the hidden side), else about its centre; ``"centre"`` always about
@@ -144,7 +146,7 @@ class LifecycleConfig:
     coast_min_rho: float = 0.5
     nested_inside: float | None = 0.7
     nested_area: float = 1.5
-    amodal_share: float | None = None
+    amodal_share: float | None = 0.8
     amodal_anchor: str = "side"
 
     def __post_init__(self) -> None:
