@@ -17,7 +17,7 @@ from pftrack.io.video import FrameSource
 from pftrack.synthetic import make_busy_scene, make_scene
 from pftrack.tracking import TrackerConfig, track_frames
 from pftrack.tracking.api import check_boxes_xyxy, xywh_to_xyxy_dets
-from pftrack.tracking.offline import drop_nested
+from pftrack.tracking.offline import complete_boxes, drop_nested
 from tests.conftest import dataset
 
 
@@ -355,14 +355,51 @@ def test_finalize_drops_the_builtin_detectors_nested_boxes():
         return tracker.finalize()
 
     life = TrackerConfig().lifecycle
-    kept = rows(_lifecycle(nested_inside=None))
+    kept = rows(_lifecycle(nested_inside=None, amodal_share=None))
     assert len(kept) > len(drop_nested(kept, life.nested_inside, life.nested_area))  # some to drop
     np.testing.assert_array_equal(
-        rows(TrackerConfig()), drop_nested(kept, life.nested_inside, life.nested_area)
+        rows(_lifecycle(amodal_share=None)), drop_nested(kept, life.nested_inside, life.nested_area)
     )
     # ... but never given detections: a box inside a larger one is then a partly hidden person
     d = scene_dets(busy)
     np.testing.assert_array_equal(rows(TrackerConfig(), d), rows(_lifecycle(nested_inside=None), d))
+
+
+@pytest.mark.parametrize("anchor", ["side", "centre"])
+def test_finalize_completes_partly_seen_people_with_the_builtin_detector(anchor):
+    """Built-in detector: finalize() completes short and narrow boxes to the size model's
+    person (complete_boxes, after drop_nested) ..."""
+    busy = make_busy_scene("present", n_frames=100, rng=0)
+
+    def run(config, dets=None):
+        tracker = pftrack.Tracker.from_config(config, 0)
+        tracker.prime(busy.frames[:30])
+        for k, f in enumerate(busy.frames):
+            tracker.update(None if dets is None else dets[k], f)
+        return tracker.finalize(), tracker.tracker.detector
+
+    plain, detector = run(_lifecycle(amodal_share=None))
+    lines = detector.size_model.coefficients
+    assert lines is not None  # the model was fitted on this scene
+    done, _ = run(_lifecycle(amodal_share=0.9, amodal_anchor=anchor))
+    expected = complete_boxes(plain, lines, 0.9, anchor, detector.size_model.config.split_ratio)
+    assert not np.array_equal(expected, plain)  # some box was completed
+    np.testing.assert_array_equal(done, expected)
+    # ... but never given detections (a person detector boxes the whole person)
+    d = scene_dets(busy)
+    np.testing.assert_array_equal(
+        run(_lifecycle(amodal_share=0.9), d)[0], run(_lifecycle(amodal_share=None), d)[0]
+    )
+
+
+@pytest.mark.parametrize(
+    ("changes", "match"),
+    [({"amodal_share": 0.0}, "amodal_share is 0.0"), ({"amodal_share": 1.1}, "amodal_share"),
+     ({"amodal_anchor": "top"}, "amodal_anchor is 'top'")],
+)  # fmt: skip
+def test_amodal_settings_are_checked(changes, match):
+    with pytest.raises(ValueError, match=match):
+        _lifecycle(**changes)
 
 
 @pytest.mark.parametrize(

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pftrack.tracking import BoxSmoother, Track, TrackWriter, smooth_tracks
-from pftrack.tracking.offline import drop_nested
+from pftrack.tracking.offline import complete_boxes, drop_nested
 from tests.reference.smoothing import wna_posterior_mean
 
 
@@ -287,3 +287,103 @@ def test_drop_nested_bad_arguments(inside, area_ratio, match):
         drop_nested(np.zeros((0, 10)), inside, area_ratio)
     with pytest.raises(ValueError, match="drop_nested"):
         drop_nested(np.zeros((3, 4)))
+
+
+# -- complete_boxes: partly seen people completed to the size model's person ----------------
+def _complete_reference(rows, lines, share, anchor, max_width):
+    """Row by row, with plain floats: the rule complete_boxes states."""
+    (hs, hi), (ws, wi) = lines
+    out = rows.copy()
+    for i, (f, _, x, y, w, h) in enumerate(rows[:, :6]):
+        if hs == 1.0:
+            continue
+        h_exp = (hi + hs * y) / (1.0 - hs)
+        if not h_exp > 0.0:
+            continue
+        new_h = h_exp if h < share * h_exp else h
+        w_exp = max(wi + ws * (y + new_h), 1.0)
+        if w > max_width * w_exp:
+            continue
+        out[i, 5] = new_h
+        if not w < share * w_exp:
+            continue
+        hid_l = hid_r = False
+        for j, (g, _, xj, yj, wj, hj) in enumerate(rows[:, :6]):
+            if j == i or g != f or not (yj < y + h and y < yj + hj):
+                continue
+            hid_l |= xj < x < xj + wj
+            hid_r |= xj < x + w < xj + wj
+        if anchor == "side" and hid_l and not hid_r:
+            out[i, 2] = x + (w - w_exp)  # the right edge kept
+        elif anchor == "side" and hid_r and not hid_l:
+            out[i, 2] = x
+        else:
+            out[i, 2] = x + 0.5 * (w - w_exp)
+        out[i, 4] = w_exp
+    return out
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(0, 30),
+    share=st.sampled_from([0.5, 0.8, 1.0]),
+    anchor=st.sampled_from(["side", "centre"]),
+    max_width=st.sampled_from([1.0, 1.6]),
+)
+def test_complete_boxes_matches_the_row_by_row_reference(seed, n, share, anchor, max_width):
+    rng = np.random.default_rng(seed)
+    rows = np.zeros((n, 10))
+    rows[:, 0] = rng.integers(1, 4, n)
+    rows[:, 1] = np.arange(n)
+    rows[:, 2:4] = rng.uniform(0, 200, (n, 2))
+    rows[:, 4:6] = rng.uniform(2, 80, (n, 2))
+    rows[::3, 2:6] = np.round(rows[::3, 2:6])  # integer boxes too (edges that coincide)
+    lines = np.array([[rng.uniform(-0.5, 2.0), rng.uniform(-80, 80)], [rng.uniform(0, 0.4), 5.0]])
+    got = complete_boxes(rows, lines, share, anchor, max_width)
+    np.testing.assert_allclose(got, _complete_reference(rows, lines, share, anchor, max_width))
+    assert np.all(got[:, 4:6] >= rows[:, 4:6])  # nothing shrinks
+    np.testing.assert_array_equal(got[:, [0, 1, 3, 6, 7, 8, 9]], rows[:, [0, 1, 3, 6, 7, 8, 9]])
+
+
+def test_complete_boxes_grows_a_partly_hidden_person_towards_the_hidden_side():
+    # h = 0.5 * foot: a head at row y has h_e = y (foot 2y); w = 0.4 h at the foot row
+    lines = np.array([[0.5, 0.0], [0.2, 0.0]])
+    rows = np.zeros((5, 10))
+    rows[:, 0] = [1, 1, 1, 1, 2]
+    rows[:, 1] = [1, 2, 3, 4, 2]
+    rows[:, 2:6] = [
+        [100, 100, 40, 100],  # a whole person (h_e 100, w_e 40): unchanged
+        [80, 100, 30, 60],  # behind it, its right side hidden: grows to 40 x 100, left kept
+        [300, 50, 10, 20],  # alone, short and narrow: 20 x 50 about its centre
+        [400, 100, 100, 50],  # a group (wider than 1.6 persons): unchanged
+        [80, 100, 30, 60],  # the same box alone on frame 2: about its centre
+    ]
+    got = complete_boxes(rows, lines, 0.8, "side")
+    np.testing.assert_array_equal(got[0], rows[0])
+    np.testing.assert_array_equal(got[1, 2:6], [80, 100, 40, 100])
+    np.testing.assert_array_equal(got[2, 2:6], [295, 50, 20, 50])
+    np.testing.assert_array_equal(got[3], rows[3])
+    np.testing.assert_array_equal(got[4, 2:6], [75, 100, 40, 100])
+    centre = complete_boxes(rows, lines, 0.8, "centre")
+    np.testing.assert_array_equal(centre[1, 2:6], [75, 100, 40, 100])
+    mirror = rows.copy()
+    mirror[1, 2] = 130  # now its left side is inside the person's box: the right edge is kept
+    np.testing.assert_array_equal(complete_boxes(mirror, lines, 0.8)[1, 2:6], [120, 100, 40, 100])
+    # a box above 0.8 of the expected size, a camera at head height (h_slope 1): unchanged
+    np.testing.assert_array_equal(complete_boxes(rows, lines, 0.1), rows)
+    np.testing.assert_array_equal(complete_boxes(rows, [[1.0, 5.0], [0.2, 0.0]], 0.8), rows)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [({"share": 0.0}, "share is 0.0"), ({"share": 1.5}, "share is 1.5"),
+     ({"anchor": "top"}, "anchor is 'top'"), ({"max_width": 0.5}, "max_width is 0.5"),
+     ({"lines": np.zeros((2, 3))}, "lines must be"), ({"lines": [[np.nan, 1], [0, 1]]}, "lines")],
+)  # fmt: skip
+def test_complete_boxes_bad_arguments(kwargs, match):
+    args = {"lines": np.array([[0.5, 0.0], [0.2, 0.0]]), "share": 0.8} | kwargs
+    with pytest.raises(ValueError, match=match):
+        complete_boxes(np.zeros((0, 10)), **args)
+    with pytest.raises(ValueError, match="complete_boxes"):
+        complete_boxes(np.zeros((3, 4)), [[0.5, 0.0], [0.2, 0.0]], 0.8)

@@ -18,6 +18,7 @@ from pftrack.detection.base import (
     check_frame,
     median_frame,
 )
+from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning
 
 
@@ -78,6 +79,11 @@ class _OpenCvDetector:
         self._learning_rate = float(learning_rate)
         self._sub: Any = self._make()
         self._shape: tuple[int, ...] | None = None
+
+    @property
+    def size_model(self) -> PersonSizeModel:
+        """The person-size model learnt from this video's isolated blobs (see `BlobConfig`)."""
+        return self._blobs.size_model
 
     def _make(self) -> Any:  # pragma: no cover - overridden
         raise NotImplementedError

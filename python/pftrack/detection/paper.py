@@ -17,6 +17,7 @@ from pftrack.detection.base import (
     check_frame,
     median_frame,
 )
+from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning
 
 
@@ -147,6 +148,11 @@ class PaperDetector:
     def model(self) -> _core.BackgroundModel:
         """The C++ background model (read its ``background``, ``threshold``)."""
         return self._model
+
+    @property
+    def size_model(self) -> PersonSizeModel:
+        """The person-size model learnt from this video's isolated blobs (see `BlobConfig`)."""
+        return self._blobs.size_model
 
     def reset(self) -> None:
         """Forget the background; the next frame initialises it."""

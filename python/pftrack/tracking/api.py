@@ -24,10 +24,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64, RngLike
+from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import TrackerConfig
-from pftrack.tracking.offline import BoxSmoother, drop_nested
+from pftrack.tracking.offline import BoxSmoother, complete_boxes, drop_nested
 from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
 from pftrack.tracking.writer import TrackWriter
@@ -408,7 +409,8 @@ class Tracker:
             ``update``), sorted by frame then id. Warns when there is no row at all. With the
             built-in detector (no ``update`` of the run had detections) and the smoother on,
             boxes mostly inside a larger box of the same frame are left out
-            (``LifecycleConfig.nested_inside``).
+            (``LifecycleConfig.nested_inside``), and the boxes of partly seen people completed
+            to the detector's expected person (``LifecycleConfig.amodal_share``).
         """
         rows = self._stabiliser.restore(self._writer.result(drop=self._tracker.never_confirmed()))
         life = self.config.lifecycle
@@ -416,6 +418,17 @@ class Tracker:
         if smoothed and not self._given and life.nested_inside is not None and len(rows):
             # the built-in detector's fragments (LifecycleConfig.nested_inside)
             rows = drop_nested(rows, life.nested_inside, life.nested_area)
+        if smoothed and not self._given and life.amodal_share is not None and len(rows):
+            # partly seen people completed to the size model's person (amodal_share)
+            size = getattr(self._tracker.detector, "size_model", None)
+            if isinstance(size, PersonSizeModel) and size.coefficients is not None:
+                rows = complete_boxes(
+                    rows,
+                    size.coefficients,
+                    life.amodal_share,
+                    life.amodal_anchor,
+                    size.config.split_ratio,
+                )
         if len(rows) == 0 and self.frame_count:
             cfg = self.config.lifecycle
             hint = (

@@ -11,6 +11,7 @@ import numpy as np
 
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
+from pftrack.tracking.offline import AMODAL_ANCHORS
 
 __all__ = [
     "AssociationConfig",
@@ -120,6 +121,19 @@ class LifecycleConfig:
         detections are left alone (a box inside a larger one is then often a partly hidden
         person). None: off. The defaults are the best of a grid over every scene with ground
         truth (docs/detection.md).
+    amodal_share : float or None
+        With the built-in detector, after `nested_inside`, the offline pass completes every
+        box shorter (narrower) than `amodal_share` of the person the detector's size model
+        expects with its head at the box's top to that person's height (width)
+        (:func:`pftrack.tracking.offline.complete_boxes`): background subtraction boxes only
+        the visible part of a partly hidden person, ground truth the whole person. Groups
+        (wider than 1.6 persons) are left alone, and so are given detections. None: off. The
+        default (0.8, ``"side"``) is the best of a grid over every scene with ground truth
+        (docs/detection.md).
+    amodal_anchor : {"side", "centre"}
+        Which edge a widened box keeps: ``"side"`` grows it towards the one side that lies
+        inside another box (the hidden side), else about its centre; ``"centre"`` always about
+        its centre.
     """
 
     min_score: float = 0.0
@@ -132,6 +146,8 @@ class LifecycleConfig:
     coast_min_rho: float = 0.5
     nested_inside: float | None = 0.7
     nested_area: float = 1.5
+    amodal_share: float | None = 0.8
+    amodal_anchor: str = "side"
 
     def __post_init__(self) -> None:
         _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
@@ -144,6 +160,16 @@ class LifecycleConfig:
         if not 1.0 <= self.nested_area < np.inf:
             raise ValueError(
                 f"LifecycleConfig: nested_area is {self.nested_area}, expected a finite value >= 1"
+            )
+        if self.amodal_share is not None and not 0.0 < self.amodal_share <= 1.0:
+            raise ValueError(
+                f"LifecycleConfig: amodal_share is {self.amodal_share}, expected a value in "
+                "(0, 1] or None"
+            )
+        if self.amodal_anchor not in AMODAL_ANCHORS:
+            raise ValueError(
+                f"LifecycleConfig: amodal_anchor is {self.amodal_anchor!r}, expected one of "
+                f"{AMODAL_ANCHORS}"
             )
         if self.birth_quantile is not None:
             _in_unit_interval("LifecycleConfig", birth_quantile=self.birth_quantile)

@@ -29,8 +29,9 @@ from pftrack.recovery.fill import fill_rows
 from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
 from pftrack.recovery.names import DEFAULT_METHOD
 
-__all__ = ["BoxSmoother", "drop_nested", "smooth_tracks"]
+__all__ = ["AMODAL_ANCHORS", "BoxSmoother", "complete_boxes", "drop_nested", "smooth_tracks"]
 
+AMODAL_ANCHORS = ("side", "centre")  # complete_boxes: where a widened box keeps its evidence
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
 
@@ -295,6 +296,107 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
         covered = (overlap > inside * area[:, None]) & (area[None, :] > area_ratio * area[:, None])
         drop[idx] = covered.any(axis=1)
     return a[~drop]
+
+
+def complete_boxes(
+    rows: ArrayLike,
+    lines: ArrayLike,
+    share: float,
+    anchor: str = "side",
+    max_width: float = 1.6,
+) -> F64:
+    """Complete the boxes of partly seen people to the expected person box (amodal boxes).
+
+    Background subtraction boxes only what it sees of a person: one half hidden behind a nearer
+    person, or cut by the shadow test, gets a box narrower and shorter than the whole person
+    that ground truth (and a person detector) draws. With the person-size model's lines
+    (`pftrack.detection.size_model.PersonSizeModel.coefficients`: height and width as lines in
+    the foot row), each box is compared with the person whose head is at its top row ``y``:
+    height ``h_e`` solving ``h = h_intercept + h_slope (y + h)`` (as
+    `PersonSizeModel.extend_legs`), width ``w_e`` the width line at that person's foot row.
+
+    * A box shorter than ``share * h_e`` gets height ``h_e``, its top kept (the head).
+    * A box narrower than ``share * w_e`` gets width ``w_e`` (``w_e`` taken at the new foot
+      row). With ``anchor="side"``, when exactly one of its sides lies inside another box of
+      the same frame (overlapping it in rows too), that side is the hidden one: the box grows
+      towards it and keeps the other edge; otherwise (and with ``anchor="centre"``) it keeps
+      its centre.
+    * A box wider than ``max_width * w_e`` (a group, which the detector cuts at
+      ``SizeModelConfig.split_ratio``) and a box whose ``h_e`` is not positive (a head below
+      the horizon; or ``h_slope = 1``) are left as they are. No box shrinks.
+
+    Parameters
+    ----------
+    rows : (M, 10) array_like
+        MOTChallenge rows ``frame, id, left, top, width, height, ...``.
+    lines : (2, 2) array_like
+        ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in the foot row.
+    share : float
+        Share of the expected height (and width) below which a box is completed, in (0, 1].
+    anchor : {"side", "centre"}
+        Which edge a widened box keeps (see above).
+    max_width : float
+        Boxes wider than this many expected widths are groups, left alone (>= 1).
+
+    Returns
+    -------
+    (M, 10) ndarray
+        The rows in their order, only ``left``, ``width`` and ``height`` changed.
+
+    Raises
+    ------
+    ValueError
+        Bad rows or lines, or `share`, `anchor` or `max_width` out of range.
+    """
+    if not 0.0 < share <= 1.0:
+        raise ValueError(f"complete_boxes: share is {share}, expected a value in (0, 1]")
+    if anchor not in AMODAL_ANCHORS:
+        raise ValueError(f"complete_boxes: anchor is {anchor!r}, expected one of {AMODAL_ANCHORS}")
+    if not 1.0 <= max_width < np.inf:
+        raise ValueError(f"complete_boxes: max_width is {max_width}, expected a finite value >= 1")
+    coef = real_array(lines, "complete_boxes: lines")
+    if coef.shape != (2, 2) or not np.all(np.isfinite(coef)):
+        raise ValueError(
+            f"complete_boxes: lines must be a finite (2, 2) array [[h_slope, h_intercept], "
+            f"[w_slope, w_intercept]], got shape {coef.shape}"
+        )
+    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "complete_boxes").copy()
+    (h_slope, h_icpt), (w_slope, w_icpt) = coef
+    if h_slope == 1.0 or len(a) == 0:
+        return a
+    x, y, w, h = (a[:, c].copy() for c in range(2, 6))
+    h_exp = (h_icpt + h_slope * y) / (1.0 - h_slope)  # the head at row y: h = h_icpt + h_slope foot
+    known = h_exp > 0.0
+    new_h = np.where(known & (h < share * h_exp), h_exp, h)
+    w_exp = np.maximum(w_icpt + w_slope * (y + new_h), 1.0)
+    person = known & (w <= max_width * w_exp)
+    new_h = np.where(person, new_h, h)
+    widen = person & (w < share * w_exp)
+    new_w = np.where(widen, w_exp, w)
+    shift = 0.5 * (w - new_w)  # centred
+    if anchor == "side" and widen.any():
+        order = np.argsort(a[:, 0], kind="stable")
+        cuts = np.flatnonzero(np.diff(a[order, 0])) + 1
+        for idx in np.split(order, cuts):
+            if len(idx) < 2 or not widen[idx].any():
+                continue
+            x0, y0, x1, y1 = x[idx], y[idx], x[idx] + w[idx], y[idx] + h[idx]
+            rows_meet = (y0[:, None] < y1[None, :]) & (y0[None, :] < y1[:, None])
+            np.fill_diagonal(rows_meet, False)
+            # [i, j]: box i's left (right) edge lies inside box j's columns
+            left_in = (x0[None, :] < x0[:, None]) & (x0[:, None] < x1[None, :]) & rows_meet
+            right_in = (x0[None, :] < x1[:, None]) & (x1[:, None] < x1[None, :]) & rows_meet
+            hid_l, hid_r = left_in.any(axis=1), right_in.any(axis=1)
+            grow_left = hid_l & ~hid_r  # keep the right edge
+            grow_right = hid_r & ~hid_l  # keep the left edge
+            s = shift[idx]
+            s[grow_left] = (w[idx] - new_w[idx])[grow_left]
+            s[grow_right] = 0.0
+            shift[idx] = s
+    a[:, 2] = np.where(widen, x + shift, x)
+    a[:, 4] = new_w
+    a[:, 5] = new_h
+    return a
 
 
 def _add_hole_rows(
