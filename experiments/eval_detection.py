@@ -89,15 +89,29 @@ def detection_scores(
     return out
 
 
-def figure(frames: list[np.ndarray], gt: F64, frame_no: int, path: Path) -> None:
-    """Frame `frame_no` (1-based) before | after: the detector as it was (first 30 frames
-    primed, no ghost test, fixed person aspect) and as it is now (spread bootstrap, ghost
-    test, learnt person size). Ground truth green, detections red. Written as JPEG."""
+def figure(
+    frames: list[np.ndarray], gt: F64, frame_no: int, path: Path, tracked: F64 | None = None
+) -> None:
+    """Frame `frame_no` (1-based) before | after [| tracked]: the detector as it was (first 30
+    frames primed, no ghost test, fixed person aspect), as it is now (spread bootstrap, ghost
+    test, learnt person size, lost legs), and with `tracked` the rows `pftrack track` writes
+    (after the offline pass: fragments inside a larger box left out, partly seen people
+    completed). Ground truth green, boxes red. Written as JPEG."""
     import cv2
+
+    def draw(boxes: F64, label: str) -> np.ndarray:
+        img = frames[frame_no - 1].copy()
+        for row in gt[gt[:, 0] == frame_no]:
+            x, y, w, h = row[2:6].astype(int)
+            cv2.rectangle(img, (x, y), (x + w, y + h), (0, 220, 0), 2)
+        for x, y, w, h in boxes.astype(int):
+            cv2.rectangle(img, (x, y), (x + w, y + h), (0, 0, 255), 2)
+        cv2.putText(img, label, (8, 24), cv2.FONT_HERSHEY_SIMPLEX, 0.8, (255, 255, 255), 2)
+        return img
 
     panels = []
     setups = (
-        ("first", {"ghost_support": 0.0, "learn_size": False}, "before"),
+        ("first", {"ghost_support": 0.0, "learn_size": False, "leg_height": 0.0}, "before"),
         ("spread", {}, "after"),
     )
     for boot, cfg, label in setups:
@@ -105,16 +119,11 @@ def figure(frames: list[np.ndarray], gt: F64, frame_no: int, path: Path) -> None
         det.prime(bootstrap_frames(frames, 30, boot))  # type: ignore[union-attr]
         for f in frames[:frame_no]:
             d = det.detect(f)
-        img = frames[frame_no - 1].copy()
-        for row in gt[gt[:, 0] == frame_no]:
-            x, y, w, h = row[2:6].astype(int)
-            cv2.rectangle(img, (x, y), (x + w, y + h), (0, 220, 0), 2)
-        for x, y, w, h in d.boxes.astype(int):
-            cv2.rectangle(img, (x, y), (x + w, y + h), (0, 0, 255), 2)
-        cv2.putText(img, label, (8, 24), cv2.FONT_HERSHEY_SIMPLEX, 0.8, (255, 255, 255), 2)
-        panels.append(img)
+        panels.append(draw(d.boxes, label))
+    if tracked is not None:
+        panels.append(draw(tracked[tracked[:, 0] == frame_no, 2:6], "tracked"))
     out = np.hstack(panels)
-    scale = 960 / out.shape[1]
+    scale = 320 * len(panels) / out.shape[1]
     out = cv2.resize(out, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
     cv2.imwrite(str(path), out, [cv2.IMWRITE_JPEG_QUALITY, 80])
 
@@ -126,7 +135,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--bootstrap", default="spread", choices=BOOTSTRAPS)
     p.add_argument("--track", action="store_true", help="also track and score MOTA / IDF1")
     p.add_argument(
-        "--figures", action="store_true", help="write before/after frames (paper detector)"
+        "--figures",
+        action="store_true",
+        help="write before/after frames (paper detector; with --track also the tracked boxes)",
     )
     p.add_argument("settings", nargs="*", help="key=value detector settings")
     args = p.parse_args(argv)
@@ -149,6 +160,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             frames, gt = seq
             sc = detection_scores(frames, gt, make_detector(args.detector, **cfg), args.bootstrap)
             line = f"{name:9s} " + " ".join(f"{k}={v:.3f}" for k, v in sc.items())
+            rows = None
             if args.track:
                 from pftrack.eval import evaluate_mot
                 from pftrack.tracking import TrackerConfig, track_frames
@@ -162,12 +174,14 @@ def main(argv: Sequence[str] | None = None) -> int:
                     bootstrap=args.bootstrap,
                     show_progress=False,
                 )
-                m = evaluate_mot(gt, run.rows)
+                rows = run.rows
+                m = evaluate_mot(gt, rows)
                 line += f" MOTA={100 * m.mota:.1f} IDF1={100 * m.idf1:.1f}"
             print(line)
             if args.figures:
                 args.out.mkdir(parents=True, exist_ok=True)
-                figure(frames, gt, min(len(frames), 60), args.out / f"detection_{name}.jpg")
+                path = args.out / f"detection_{name}.jpg"
+                figure(frames, gt, min(len(frames), 60), path, rows)
     return 0
 
 
