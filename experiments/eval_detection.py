@@ -3,7 +3,9 @@
 For each sequence: per-frame precision / recall of the detector's boxes (a detection matches a
 ground-truth box one-to-one, Hungarian on IoU, when IoU >= the threshold) and the detector's
 milliseconds per frame; with ``--track``, also MOTA / IDF1 of the whole tracker fed by that
-detector (`pftrack.tracking.track_frames`, seed 0). Sequences: ``pets`` (PETS09-S2L1, ground
+detector (`pftrack.tracking.track_frames`, seed 0), and the longest run of one track's boxes
+on empty floor in seconds (issue 14's crowd-clip goal: none over 2 s; `empty_floor_runs`).
+Sequences: ``pets`` (PETS09-S2L1, ground
 truth scaled by 0.625 to the 480x360 video), ``tud`` (TUD-Campus), and the synthetic busy
 scenes of `pftrack.synthetic.make_busy_scene` (``present``, ``groups``, ``overhead``), which
 need no data. What is printed is also written to ``detection.txt`` in ``--out`` (default
@@ -18,6 +20,7 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
+import configparser
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -46,11 +49,12 @@ def n_matches(det: F64, gt: F64, thr: float) -> int:
     return int((iou[r, c] >= thr).sum())
 
 
-def load_sequence(name: str, data: Path) -> tuple[list[np.ndarray], F64] | None:
-    """Frames and ground truth (scaled to the frames' pixels) of `name`; None if absent."""
+def load_sequence(name: str, data: Path) -> tuple[list[np.ndarray], F64, float] | None:
+    """Frames, ground truth (scaled to the frames' pixels) and frame rate of `name`; None if
+    absent."""
     if name in BUSY_SCENES:
         scene = make_busy_scene(name, rng=0)
-        return scene.frames, scene.truth
+        return scene.frames, scene.truth, scene.fps
     src = REAL[name]
     seq = data / src.name
     if not (seq / src.video).is_file():
@@ -58,7 +62,54 @@ def load_sequence(name: str, data: Path) -> tuple[list[np.ndarray], F64] | None:
     gt = read_mot(seq / "gt.txt")
     gt = gt[gt[:, 6] != 0]
     gt[:, 2:6] *= src.scale
-    return read_frames(seq / src.video), gt
+    return read_frames(seq / src.video), gt, read_frame_rate(seq / "seqinfo.ini")
+
+
+def read_frame_rate(path: Path) -> float:
+    """``frameRate`` of a MOTChallenge ``seqinfo.ini``."""
+    parser = configparser.ConfigParser()
+    parser.read(path)
+    return float(parser["Sequence"]["frameRate"])
+
+
+def empty_floor_runs(rows: F64, gt: F64) -> tuple[int, int]:
+    """The longest run of consecutive frames in which one track's box is on empty floor.
+
+    Two readings of "empty floor" (issue 14's crowd-clip goal: no box on empty floor for more
+    than 2 s): IoU <= 0.1 with every ground-truth box of the frame, and (stricter) at most 0.1
+    of the box's area inside any one ground-truth box, which does not count a fragment of a
+    person (a head box inside the person's box has a small IoU but lies on the person).
+
+    Returns
+    -------
+    (int, int)
+        The longest runs in frames, by IoU and by covered area.
+    """
+    gt_by = group_by_frame(gt)
+    best = [0, 0]
+    for tid in np.unique(rows[:, 1]):
+        track = rows[rows[:, 1] == tid]
+        track = track[np.argsort(track[:, 0], kind="stable")]
+        run = [0, 0]
+        prev = -1
+        for row in track:
+            frame = int(row[0])
+            g = gt_by.get(frame)
+            box = row[2:6]
+            if g is None or len(g) == 0:
+                empty = [True, True]
+            else:
+                gb = g[:, 2:6]
+                lo = np.maximum(box[:2], gb[:, :2])
+                hi = np.minimum(box[:2] + box[2:], gb[:, :2] + gb[:, 2:])
+                inter = np.prod(np.clip(hi - lo, 0.0, None), axis=1)
+                covered = inter.max() / max(box[2] * box[3], 1e-9)
+                empty = [bool(iou_xywh(box[None], gb).max() <= 0.1), bool(covered <= 0.1)]
+            for i in range(2):
+                run[i] = (run[i] + 1 if frame == prev + 1 else 1) if empty[i] else 0
+                best[i] = max(best[i], run[i])
+            prev = frame
+    return best[0], best[1]
 
 
 def detection_scores(
@@ -157,7 +208,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             if seq is None:
                 print(f"{name}: data not found, skipped")
                 continue
-            frames, gt = seq
+            frames, gt, fps = seq
             sc = detection_scores(frames, gt, make_detector(args.detector, **cfg), args.bootstrap)
             line = f"{name:9s} " + " ".join(f"{k}={v:.3f}" for k, v in sc.items())
             rows = None
@@ -177,6 +228,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 rows = run.rows
                 m = evaluate_mot(gt, rows)
                 line += f" MOTA={100 * m.mota:.1f} IDF1={100 * m.idf1:.1f}"
+                by_iou, by_area = empty_floor_runs(rows, gt)
+                line += f" empty_floor_s={by_iou / fps:.1f} (area {by_area / fps:.1f})"
             print(line)
             if args.figures:
                 args.out.mkdir(parents=True, exist_ok=True)

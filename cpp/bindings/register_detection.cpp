@@ -99,8 +99,13 @@ void register_detection(py::module_& m) {
         .def(
             "edge_support",
             [](const BackgroundModel& self, py::array frame, py::array mask,
-               py::array_t<double, py::array::c_style | py::array::forcecast> boxes) {
+               py::array_t<double, py::array::c_style | py::array::forcecast> boxes,
+               const std::string& statistic) {
                 const char* fn = "BackgroundModel.edge_support";
+                require(statistic == "ratio" || statistic == "vote", fn,
+                        "statistic is '" + statistic + "', expected 'ratio' or 'vote'");
+                const auto stat =
+                    statistic == "vote" ? GhostStatistic::vote : GhostStatistic::ratio;
                 check_frame_and_mask(self, frame, mask, fn);
                 require(boxes.ndim() == 2 && boxes.shape(1) == 4, fn,
                         "boxes must have shape (K, 4), got " + shape_str(boxes));
@@ -119,12 +124,13 @@ void register_detection(py::module_& m) {
                     py::gil_scoped_release nogil;
                     const Index cols = self.cols();
                     edge_support(src, stride, self.background_planar(), 3 * cols, cols, 1,
-                                 self.rows(), cols, mptr, mstride, bp, k, optr);
+                                 self.rows(), cols, mptr, mstride, bp, k, optr, stat);
                 }
                 return out;
             },
-            py::arg("frame"), py::arg("mask"), py::arg("boxes"),
-            "Ghost test: share (K,) of each box's (K, 4) mask-boundary edges held by the frame.")
+            py::arg("frame"), py::arg("mask"), py::arg("boxes"), py::arg("statistic") = "ratio",
+            "Ghost test: share (K,) of each box's (K, 4) mask-boundary edges held by the frame "
+            "('ratio': of the summed magnitudes; 'vote': of the band pixels).")
         .def(
             "set_background",
             [](BackgroundModel& self, py::array_t<float, py::array::c_style | py::array::forcecast> bg) {

@@ -52,8 +52,13 @@ class BackgroundModel:
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...
     # ghost test: (K,) share of each box's (K, 4) mask-boundary edges held by the frame
+    # (statistic 'ratio': of the summed magnitudes, 'vote': of the band pixels)
     def edge_support(
-        self, frame: NDArray[np.uint8], mask: ArrayLike, boxes: ArrayLike
+        self,
+        frame: NDArray[np.uint8],
+        mask: ArrayLike,
+        boxes: ArrayLike,
+        statistic: str = "ratio",
     ) -> NDArray[np.float64]: ...
     def set_background(self, background: ArrayLike) -> None: ...  # (H, W, 3) BGR, float32
     def reset(self) -> None: ...

@@ -95,6 +95,39 @@ def test_edge_support_separates_a_ghost_from_the_object() -> None:
     assert support[0] < 0.3 < 0.6 < support[1]
 
 
+def test_default_ghost_vote_drops_the_ghosts_their_owners_leave() -> None:
+    # issue 14: on the synthetic "present" scene the spread median still pictures the people
+    # who stood for most of the video; when one walks off, the uncovered floor beside them is a
+    # ghost whose boundary holds their silhouette on one side. The summed test ("ratio") keeps
+    # those ghosts; the default per-pixel vote drops them and no person's box.
+    from pftrack.boxes import iou_xywh
+    from pftrack.io.mot import group_by_frame
+    from pftrack.synthetic import make_busy_scene
+
+    scene = make_busy_scene("present", rng=0)
+    truth = group_by_frame(scene.truth)
+    primer = bootstrap_frames(scene.frames, 30, "spread")
+    assert PaperConfig().ghost_statistic == "vote"
+    off, matched = {}, {}
+    for statistic in ("ratio", "vote"):
+        det = PaperDetector(PaperConfig(ghost_statistic=statistic))
+        det.prime(primer)
+        off[statistic] = matched[statistic] = 0
+        for n, frame in enumerate(scene.frames, start=1):
+            boxes = det.detect(frame).boxes
+            if len(boxes):
+                iou = iou_xywh(boxes, truth[n][:, 2:6])
+                off[statistic] += int((iou.max(axis=1) <= 0.1).sum())  # on nobody
+                matched[statistic] += int((iou.max(axis=0) >= 0.5).sum())  # people boxed
+    assert off["vote"] <= 0.85 * off["ratio"]
+    assert matched["vote"] >= matched["ratio"]
+
+
+def test_ghost_statistic_is_checked() -> None:
+    with pytest.raises(ValueError, match="ghost_statistic is 'sum', expected 'vote' or 'ratio'"):
+        PaperConfig(ghost_statistic="sum")
+
+
 def test_blend_matches_numpy_and_checks_its_arguments() -> None:
     rng = np.random.default_rng(3)
     frame = rng.integers(0, 256, (6, 7, 3), dtype=np.uint8)

@@ -238,7 +238,11 @@ def test_foreground_is_detect_without_the_blobs(name):
     """``foreground`` advances the model as ``detect`` does and returns the same mask (and, for
     the fused pass, the same full-frame bins)."""
     bg = textured_background(seed=2)
-    a, b = make_detector(name), make_detector(name)
+    # the block starts in the first frame, so the background holds it: its ghost lies beside
+    # it on the next frames, which the paper detector's ghost test (detect only) drops and
+    # learns; off here, the two passes are compared on the same model
+    cfg = {"ghost_support": 0.0} if name == "paper" else {}
+    a, b = make_detector(name, **cfg), make_detector(name, **cfg)
     for k in range(6):
         f = bg.copy()
         f[30:90, 20 + 8 * k : 40 + 8 * k] = (0, 0, 255)

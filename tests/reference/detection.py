@@ -94,8 +94,9 @@ class BackgroundReference:
         return bins, np.select([fore, shadow], [255, 127], 0).astype(np.uint8)
 
 
-def _edge_sum_reference(img: np.ndarray, band: np.ndarray) -> float:
-    """Sum over `band` of max_c |Sobel(Gaussian 5x5, sigma 1.5)(img_c)|, reflect-101 borders."""
+def _edge_magnitudes_reference(img: np.ndarray, band: np.ndarray) -> np.ndarray:
+    """max_c |Sobel(Gaussian 5x5, sigma 1.5)(img_c)| at the `band` pixels (row-major order),
+    reflect-101 borders."""
     x = np.arange(-2, 3, dtype=np.float64)
     g = np.exp(-(x * x) / (2 * 1.5**2))
     g /= g.sum()
@@ -110,13 +111,21 @@ def _edge_sum_reference(img: np.ndarray, band: np.ndarray) -> float:
     dy = p[2:] - p[:-2]  # (h, w + 2, 3)
     gx = dx[:-2] + 2 * dx[1:-1] + dx[2:]
     gy = dy[:, :-2] + 2 * dy[:, 1:-1] + dy[:, 2:]
-    return float(np.sqrt((gx * gx + gy * gy).max(axis=2))[band].sum())
+    return np.sqrt((gx * gx + gy * gy).max(axis=2))[band]
 
 
 def edge_support_reference(
-    frame: np.ndarray, background: np.ndarray, mask: np.ndarray, boxes: np.ndarray
+    frame: np.ndarray,
+    background: np.ndarray,
+    mask: np.ndarray,
+    boxes: np.ndarray,
+    statistic: str = "ratio",
 ) -> np.ndarray:
-    """The ghost test (BackgroundModel.edge_support) in float64 NumPy, no OpenCV."""
+    """The ghost test (BackgroundModel.edge_support) in float64 NumPy, no OpenCV.
+
+    ``"ratio"``: summed frame magnitudes over the summed frame-plus-background ones on the
+    boundary band; ``"vote"``: the share of band pixels where the frame's magnitude is larger.
+    """
     out = np.full(len(boxes), 0.5)
     rows, cols = mask.shape
     for k, (x, y, w, h) in enumerate(np.asarray(boxes, np.float64).reshape(-1, 4)):
@@ -137,8 +146,12 @@ def edge_support_reference(
         band = dil & ~ero
         if not band.any():
             continue
-        e_f = _edge_sum_reference(frame[y0:y1, x0:x1], band)
-        e_b = _edge_sum_reference(background[y0:y1, x0:x1], band)
+        m_f = _edge_magnitudes_reference(frame[y0:y1, x0:x1], band)
+        m_b = _edge_magnitudes_reference(background[y0:y1, x0:x1], band)
+        if statistic == "vote":
+            out[k] = float(np.mean(m_f > m_b))
+            continue
+        e_f, e_b = float(m_f.sum()), float(m_b.sum())
         if e_f + e_b > 0:
             out[k] = e_f / (e_f + e_b)
     return out

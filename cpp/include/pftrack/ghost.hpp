@@ -45,12 +45,12 @@ struct EdgeScratch {
     std::vector<Index> rx, ry, xm, xp;      // reflected indices
 };
 
-/// Sum over the band pixels (`band`, h x w, row-major, non-zero = in) of
-/// sqrt(max_c (gx_c^2 + gy_c^2)), gx, gy the 3x3 Sobel derivatives of the 5x5 Gaussian blur
-/// (float32, as OpenCV's) of channel c of the h x w image `pixel(y, x, c)`.
+/// The edge magnitude at each band pixel (`band`, h x w, row-major, non-zero = in), in row-major
+/// order, into `mag`: sqrt(max_c (gx_c^2 + gy_c^2)), gx, gy the 3x3 Sobel derivatives of the 5x5
+/// Gaussian blur (float32, as OpenCV's) of channel c of the h x w image `pixel(y, x, c)`.
 template <class Pixel>
-double edge_sum(Pixel pixel, Index h, Index w, const std::vector<std::uint8_t>& band,
-                EdgeScratch& s) {
+void edge_magnitudes(Pixel pixel, Index h, Index w, const std::vector<std::uint8_t>& band,
+                     EdgeScratch& s, std::vector<double>& mag) {
     static const std::array<double, 5> gd = gaussian5_sigma15();
     const float g0 = static_cast<float>(gd[0]), g1 = static_cast<float>(gd[1]),
                 g2 = static_cast<float>(gd[2]);  // symmetric: g3 = g1, g4 = g0
@@ -90,7 +90,7 @@ double edge_sum(Pixel pixel, Index h, Index w, const std::vector<std::uint8_t>& 
                        g0 * t0[x + 4 * w];
         }
     }
-    double total = 0.0;
+    mag.clear();
     for (Index y = 0; y < h; ++y) {
         const Index ym = reflect101(y - 1, h), yp = reflect101(y + 1, h);
         const std::uint8_t* in = band.data() + y * w;
@@ -108,13 +108,18 @@ double edge_sum(Pixel pixel, Index h, Index w, const std::vector<std::uint8_t>& 
                 const float gy = (r2[xm] - r0[xm]) + 2.0f * (r2[x] - r0[x]) + (r2[xp] - r0[xp]);
                 best = std::max(best, gx * gx + gy * gy);
             }
-            total += std::sqrt(static_cast<double>(best));
+            mag.push_back(std::sqrt(static_cast<double>(best)));
         }
     }
-    return total;
 }
 
 }  // namespace detail
+
+/// The ghost test's statistic over a blob's boundary band.
+enum class GhostStatistic {
+    ratio,  // E_frame / (E_frame + E_background): the summed edge magnitudes
+    vote,   // the share of band pixels whose frame edge is stronger than the background's
+};
 
 /// Share of each blob's boundary edges that the current frame holds (the ghost test).
 ///
@@ -125,11 +130,17 @@ double edge_sum(Pixel pixel, Index h, Index w, const std::vector<std::uint8_t>& 
 /// (`bgr`, interleaved, `row_stride` bytes a row) and of the background (`background`: float
 /// rows of `bg_row_stride` floats, channel c of pixel x at [c * bg_plane_stride + x * bg_pixel
 /// _stride]). 0.5 when the region is under 3 px on a side, its band is empty, or both sums are 0.
+/// With `GhostStatistic::vote`, out[k] is instead the share of band pixels whose frame magnitude
+/// is strictly larger than the background's: a ghost that its owner has just left keeps the
+/// owner's strong edge on one side of its boundary, which outweighs the rest in the sums but is
+/// one side in the vote (0.5 when the band is empty or the region too small).
 inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float* background,
                          Index bg_row_stride, Index bg_plane_stride, Index bg_pixel_stride,
                          Index rows, Index cols, const std::uint8_t* mask, Index mask_stride,
-                         const double* boxes, Index k, double* out) {
+                         const double* boxes, Index k, double* out,
+                         GhostStatistic statistic = GhostStatistic::ratio) {
     detail::EdgeScratch scratch;
+    std::vector<double> mag_f, mag_b;
     std::vector<std::uint8_t> band, hmax, hmin;
     for (Index i = 0; i < k; ++i) {
         out[i] = 0.5;
@@ -178,17 +189,26 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
             }
         }
         if (!any) continue;
-        const double e_f = detail::edge_sum(
+        detail::edge_magnitudes(
             [&](Index y, Index x, int c) {
                 return static_cast<float>(bgr[(y0 + y) * row_stride + 3 * (x0 + x) + c]);
             },
-            h, w, band, scratch);
-        const double e_b = detail::edge_sum(
+            h, w, band, scratch, mag_f);
+        detail::edge_magnitudes(
             [&](Index y, Index x, int c) {
                 return background[(y0 + y) * bg_row_stride + c * bg_plane_stride +
                                   (x0 + x) * bg_pixel_stride];
             },
-            h, w, band, scratch);
+            h, w, band, scratch, mag_b);
+        if (statistic == GhostStatistic::vote) {
+            Index stronger = 0;
+            for (size_t j = 0; j < mag_f.size(); ++j) stronger += mag_f[j] > mag_b[j] ? 1 : 0;
+            out[i] = static_cast<double>(stronger) / static_cast<double>(mag_f.size());
+            continue;
+        }
+        double e_f = 0.0, e_b = 0.0;  // summed in the band's row-major order
+        for (const double v : mag_f) e_f += v;
+        for (const double v : mag_b) e_b += v;
         if (e_f + e_b > 0.0) out[i] = e_f / (e_f + e_b);
     }
 }

@@ -18,11 +18,14 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["edge_support"]
+__all__ = ["GHOST_STATISTICS", "edge_support"]
 
 
-def _edge_sum(bgr: NDArray[np.float32], band: NDArray[np.bool_]) -> float:
-    """Sum over `band` of the largest gradient magnitude over the channels, after a blur.
+GHOST_STATISTICS = ("ratio", "vote")
+
+
+def _edge_magnitudes(bgr: NDArray[np.float32], band: NDArray[np.bool_]) -> NDArray[np.float32]:
+    """The largest gradient magnitude over the channels, after a blur, at the `band` pixels.
 
     A step in colour at equal grey level is an edge too; fine texture (gravel, noise) is no
     silhouette, hence the blur. Only the band's pixels are reduced.
@@ -30,7 +33,7 @@ def _edge_sum(bgr: NDArray[np.float32], band: NDArray[np.bool_]) -> float:
     img = cv2.GaussianBlur(bgr, (5, 5), 1.5)
     gx = cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3)[band]
     gy = cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3)[band]
-    return float(np.sqrt((gx * gx + gy * gy).max(axis=1)).sum())
+    return np.asarray(np.sqrt((gx * gx + gy * gy).max(axis=1)), np.float32)
 
 
 def edge_support(
@@ -38,14 +41,19 @@ def edge_support(
     background: NDArray[np.float32],
     mask: NDArray[np.uint8],
     boxes: NDArray[np.float64],
+    statistic: str = "ratio",
 ) -> NDArray[np.float64]:
     """Share of each blob's boundary edges that the current frame holds.
 
     For each box, over the boundary of the mask inside it (its 3x3 dilation minus its
     erosion): ``E_frame / (E_frame + E_background)``, the summed gradient magnitudes (largest
-    over the colour channels) of the frame and of the background. About 1 for an object in
-    front of a smooth background, about 0.5 when both are textured alike, near 0 for a ghost
-    (its edges are only in the background's picture of the object that left).
+    over the colour channels) of the frame and of the background (``"ratio"``), or the share of
+    the boundary's pixels where the frame's magnitude is the larger (``"vote"``). About 1 for
+    an object in front of a smooth background, about 0.5 when both are textured alike, near 0
+    for a ghost (its edges are only in the background's picture of the object that left).
+    A ghost that its owner has just walked out of keeps the owner's edge on one side of its
+    boundary: a high-contrast silhouette that can outweigh the rest of the boundary in the
+    sums, but is only its share of the pixels in the vote.
 
     Parameters
     ----------
@@ -57,12 +65,16 @@ def edge_support(
         Cleaned foreground mask (0 / 255).
     boxes : (K, 4) float64
         Blob boxes ``left, top, w, h``.
+    statistic : {"ratio", "vote"}
+        Summed magnitudes, or a per-pixel vote.
 
     Returns
     -------
     (K,) ndarray of float64
         In [0, 1]; 0.5 for a box with no boundary edge at all.
     """
+    if statistic not in GHOST_STATISTICS:
+        raise ValueError(f"edge_support: statistic is {statistic!r}, expected 'ratio' or 'vote'")
     out = np.full(len(boxes), 0.5)
     rows, cols = mask.shape
     kernel = np.ones((3, 3), np.uint8)
@@ -76,8 +88,12 @@ def edge_support(
         band = (cv2.dilate(m, kernel) > 0) & (cv2.erode(m, kernel) == 0)
         if not band.any():
             continue
-        e_f = _edge_sum(frame[y0:y1, x0:x1].astype(np.float32), band)
-        e_b = _edge_sum(np.asarray(background[y0:y1, x0:x1], np.float32), band)
+        m_f = _edge_magnitudes(frame[y0:y1, x0:x1].astype(np.float32), band)
+        m_b = _edge_magnitudes(np.asarray(background[y0:y1, x0:x1], np.float32), band)
+        if statistic == "vote":
+            out[k] = float(np.mean(m_f > m_b))
+            continue
+        e_f, e_b = float(m_f.sum()), float(m_b.sum())
         if e_f + e_b > 0:
             out[k] = e_f / (e_f + e_b)
     return out

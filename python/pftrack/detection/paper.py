@@ -17,6 +17,7 @@ from pftrack.detection.base import (
     check_frame,
     median_frame,
 )
+from pftrack.detection.ghost import GHOST_STATISTICS
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning
 
@@ -58,6 +59,12 @@ class PaperConfig:
     ghost_rate : float
         Per-pixel update rate of the background inside a ghost, per frame, for as long as
         those pixels stay foreground.
+    ghost_statistic : {"vote", "ratio"}
+        How the ghost test measures the boundary's support (`edge_support`'s `statistic`):
+        ``"vote"``, the share of the boundary's pixels where the frame's edge is the stronger
+        (a ghost that its owner has just left keeps the owner's silhouette on one side, which
+        outweighs the rest of the boundary in summed magnitudes but is one side in a vote);
+        ``"ratio"``, the summed magnitudes (the test before; issue 14's ghosts).
     leg_height : float
         Lost legs (the shadow test takes dark trousers on a grey path for shadow): once the
         person-size model is fitted, a box shorter than `leg_height` times the height of a
@@ -84,6 +91,7 @@ class PaperConfig:
     shadow_chroma: float = 0.03
     ghost_support: float = 0.3
     ghost_rate: float = 0.5
+    ghost_statistic: str = "vote"
     leg_height: float = 0.8
     leg_fill: float = 0.2
     blobs: BlobConfig = field(default_factory=BlobConfig)
@@ -94,6 +102,10 @@ class PaperConfig:
             raise ValueError(f"ghost_support is {self.ghost_support}, expected in [0, 1]")
         if not (0.0 < self.ghost_rate <= 1.0):
             raise ValueError(f"ghost_rate is {self.ghost_rate}, expected in (0, 1]")
+        if self.ghost_statistic not in GHOST_STATISTICS:
+            raise ValueError(
+                f"ghost_statistic is {self.ghost_statistic!r}, expected 'vote' or 'ratio'"
+            )
         if not (0.0 <= self.leg_height < np.inf):
             raise ValueError(f"leg_height is {self.leg_height}, expected a finite value >= 0")
         if not (0.0 <= self.leg_fill <= 1.0):
@@ -220,9 +232,10 @@ class PaperDetector:
 
         The support is `pftrack.detection.ghost.edge_support` computed in C++
         (``BackgroundModel.edge_support``: the same blur, Sobel and band, read from the model's
-        own background without copying it; tests hold the two equal to 1e-5).
+        own background without copying it; tests hold the two equal to 1e-5), with the
+        statistic of ``ghost_statistic``.
         """
-        support = self._model.edge_support(frame, mask, boxes)
+        support = self._model.edge_support(frame, mask, boxes, self.config.ghost_statistic)
         ghost = support < self.config.ghost_support
         if not ghost.any():
             return mask, boxes, scores
