@@ -48,8 +48,8 @@ class SizeModelConfig:
         isolated boxes it was fitted from is rejected: those boxes are single people but for a
         few groups, so such a fit contradicts its own samples (one person's many near-identical
         boxes, or a person's boxes truncated at the image's side, took it over). The previous
-        fit (or none) stays and the next try comes ``refit_every`` samples later. 1 accepts
-        every fit.
+        fit stays and the next try comes ``refit_every`` samples later; with no previous fit,
+        the next frame with an isolated box tries again. 1 accepts every fit.
     """
 
     min_samples: int = 30
