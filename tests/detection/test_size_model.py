@@ -107,7 +107,15 @@ def test_blob_extractor_splits_a_group_once_the_size_is_learnt() -> None:
 
 @pytest.mark.parametrize(
     "kwargs",
-    [{"min_samples": 2}, {"split_ratio": 1.0}, {"merge_slack": 0.5}, {"split_max_height": 0.0}],
+    [
+        {"min_samples": 2},
+        {"split_ratio": 1.0},
+        {"merge_slack": 0.5},
+        {"split_max_height": 0.0},
+        {"max_cut_share": -0.1},
+        {"max_cut_share": 1.5},
+        {"max_cut_share": float("nan")},
+    ],
 )
 def test_bad_config_raises(kwargs: dict[str, float]) -> None:
     with pytest.raises(ValueError):
@@ -124,3 +132,67 @@ def test_theil_sen_equals_scipy() -> None:
     y = 0.4 * x + 3 + rng.standard_t(2, 60) * 5
     want = theilslopes(y, x, method="joint")
     np.testing.assert_allclose(theil_sen(x, y), (want.slope, want.intercept), rtol=1e-12)
+
+
+def seed2_like_stream(rng: np.random.Generator) -> list[np.ndarray]:
+    """The first 18 frames' isolated boxes of ``make_scene(rng=2)``, with 1 px jitter.
+
+    A far person walking slowly (13 x 28 px, foot row about 192, 4 px a frame) and, from the
+    fifth frame, a walker 39 x 74 px coming in at the right edge (boxes truncated by the image:
+    widths 11, 14, 17, ... 39). 31 samples, 17 of them the far person's near-identical boxes.
+    """
+    frames = []
+    for t in range(18):
+        far = [88.0 + 4 * t, 164.0 - 0.9 * t, 13.0, 28.0 + rng.integers(0, 2)]
+        boxes = [far]
+        if t >= 4:
+            w = min(11.0 + 3.5 * (t - 4), 39.0)
+            boxes.append([480.0 - w - (t - 4), 160.0 + 0.3 * t, w, 74.0])
+        frames.append(np.array(boxes))
+    return frames
+
+
+def walker_stream(rng: np.random.Generator, n: int) -> list[np.ndarray]:
+    """``n`` frames of one whole walker (31 x 74 px at foot row about 234) crossing the floor."""
+    return [
+        np.array([[40.0 + 3 * t, 160.0 + rng.normal(0, 1), 31 + rng.normal(0, 1), 74.0]])
+        for t in range(n)
+    ]
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_fit_taken_over_by_one_persons_identical_boxes_is_refused(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    stream = seed2_like_stream(rng)
+    accepting = PersonSizeModel(SizeModelConfig(max_cut_share=1.0))  # the former behaviour
+    model = PersonSizeModel()
+    for boxes in stream:
+        accepting.observe(boxes)
+        model.observe(boxes)
+    # the fit these samples give: walkers' width at their foot row far too small, so that
+    # every whole walker would be cut into strips
+    assert accepting.fitted and accepting.n_samples == model.n_samples >= 30
+    assert accepting.expected(234.0)[1] < 20.0
+    walker = np.array([[200.0, 160.0, 31.0, 74.0]])
+    assert accepting.split_count(walker)[0] >= 2
+    assert not model.fitted  # refused: it would cut over a fifth of its own samples
+    for boxes in walker_stream(rng, 60):  # more people seen: the next fit is kept
+        model.observe(boxes)
+    assert model.fitted
+    np.testing.assert_allclose(model.expected(234.0), [74.0, 31.0], atol=3.0)
+    assert model.split_count(walker)[0] == 1
+
+
+def test_a_refused_refit_keeps_the_previous_fit() -> None:
+    cfg = SizeModelConfig(min_samples=20, max_samples=20, refit_every=20)  # one fit a batch
+    model = PersonSizeModel(cfg)
+    feed(model, perspective_boxes(np.random.default_rng(3), 20))
+    assert model.coefficients is not None
+    kept = model.coefficients.copy()
+    narrow = perspective_boxes(np.random.default_rng(4), 20)
+    narrow[:11, 2] *= 0.25  # 11 strips (the majority) and 9 whole people
+    feed(model, narrow)  # its fit would cut the 9 whole people: refused
+    np.testing.assert_array_equal(model.coefficients, kept)
+    feed(model, perspective_boxes(np.random.default_rng(5), 20))  # a sound batch: refitted
+    assert not np.array_equal(model.coefficients, kept)
+    np.testing.assert_allclose(model.expected(240.0), [100.0, 40.0], atol=3.0)

@@ -43,6 +43,13 @@ class SizeModelConfig:
     merge_slack : float
         Two boxes whose columns overlap are one person's fragments when their union is at most
         ``merge_slack`` times the expected height and width at the union's foot row.
+    max_cut_share : float
+        A fit that would cut (`PersonSizeModel.split_count` > 1) more than this share of the
+        isolated boxes it was fitted from is rejected: those boxes are single people but for a
+        few groups, so such a fit contradicts its own samples (one person's many near-identical
+        boxes, or a person's boxes truncated at the image's side, took it over). The previous
+        fit stays and the next try comes ``refit_every`` samples later; with no previous fit,
+        the next frame with an isolated box tries again. 1 accepts every fit.
     """
 
     min_samples: int = 30
@@ -51,6 +58,7 @@ class SizeModelConfig:
     split_ratio: float = 1.6
     split_max_height: float = 1.5
     merge_slack: float = 1.2
+    max_cut_share: float = 0.2
 
     def __post_init__(self) -> None:
         if not (isinstance(self.min_samples, int) and self.min_samples >= 3):
@@ -67,6 +75,8 @@ class SizeModelConfig:
             )
         if not (self.merge_slack >= 1.0 and np.isfinite(self.merge_slack)):
             raise ValueError(f"merge_slack is {self.merge_slack}, expected a finite value >= 1")
+        if not (0.0 <= self.max_cut_share <= 1.0):
+            raise ValueError(f"max_cut_share is {self.max_cut_share}, expected a value in [0, 1]")
 
 
 def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:
@@ -179,9 +189,24 @@ class PersonSizeModel:
         points within 3 robust sigmas (1.4826 MAD, at least 1 px) of the first line: the refit
         removes the bias that groups and fragments (all wider, or all smaller) leave. Every
         foot on one row (spread under 1 px): a constant size, the median h and w.
+
+        The new fit is kept only if it would cut at most `SizeModelConfig.max_cut_share` of the
+        samples it came from. When more than half of them are one slow person's identical
+        boxes, their robust sigma is 1 px and the refit drops every other person as an outlier
+        (on `pftrack.synthetic.make_scene` seed 2: a width of 13 px where walkers are 31 px
+        wide, which then cuts each walker into strips); such a fit cuts the other people's
+        boxes it was given, and is refused.
         """
-        self._coef = _core.size_fit(self._samples[: self.n_samples])
+        samples = self._samples[: self.n_samples]
+        coef: NDArray[np.float64] = _core.size_fit(samples)
         self._since_fit = 0
+        c = self.config
+        boxes = np.column_stack(
+            [np.zeros(len(samples)), samples[:, 0] - samples[:, 1], samples[:, 2], samples[:, 1]]
+        )  # left, top, w, h of each sample (left plays no part in the count)
+        cut = _core.split_count(boxes, coef, c.split_ratio, c.split_max_height) > 1
+        if cut.mean() <= c.max_cut_share:
+            self._coef = coef
 
     def split_count(self, boxes: NDArray[np.float64]) -> NDArray[np.int64]:
         """How many people each box (K, 4) holds side by side.
