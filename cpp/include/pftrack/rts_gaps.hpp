@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include "pftrack/check.hpp"
+#include "pftrack/cv_axis.hpp"
 #include "pftrack/types.hpp"
 
 namespace pftrack {
@@ -92,13 +93,14 @@ inline RowMatrixXd rts_gaps_batch(const Eigen::Ref<const RowMatrixXd>& points,
     require_size(14.0 * longest, fn, "the longest window");
 
     RowMatrixXd out(static_cast<Eigen::Index>(total), 2);
-    // Per step: predicted mean (x0, x1, y0, y1) and covariance (p00, p01, p11), filtered same.
-    std::vector<double> pm, pp, fm, fp;
+    // Per step: predicted mean (x0, x1, y0, y1) and covariance (x and y share it), filtered same.
+    std::vector<double> pm, fm;
+    std::vector<cv_axis::Cov> pp, fp;
     const auto n_long = static_cast<std::size_t>(longest);
     pm.resize(4 * n_long);
     fm.resize(4 * n_long);
-    pp.resize(3 * n_long);
-    fp.resize(3 * n_long);
+    pp.resize(n_long);
+    fp.resize(n_long);
     Eigen::Index row = 0;
     for (Eigen::Index g = 0; g < G; ++g) {
         const int lo = offsets(g), hi = offsets(g + 1);
@@ -107,49 +109,40 @@ inline RowMatrixXd rts_gaps_batch(const Eigen::Ref<const RowMatrixXd>& points,
         const std::int64_t fb = detail::frame_at(points, lo + n_before(g));
         const auto T = static_cast<std::size_t>(detail::frame_at(points, hi - 1) - f0 + 1);
         double mx = points(lo, 1), my = points(lo, 2), vx = 0.0, vy = 0.0;
-        double p00 = r, p01 = 0.0, p11 = v0;
+        cv_axis::Cov p{r, 0.0, v0};
         int k = lo;  // next observed row
         for (std::size_t t = 0; t < T; ++t) {
             if (t > 0) {
                 // x_t|t-1 = F x_t-1,  P_t|t-1 = F P F^T + Q
                 mx += vx;
                 my += vy;
-                p00 = p00 + 2.0 * p01 + p11 + q / 3.0;
-                p01 = p01 + p11 + q / 2.0;
-                p11 = p11 + q;
+                p = cv_axis::predict(p, q);
             }
             pm[4 * t] = mx, pm[4 * t + 1] = vx, pm[4 * t + 2] = my, pm[4 * t + 3] = vy;
-            pp[3 * t] = p00, pp[3 * t + 1] = p01, pp[3 * t + 2] = p11;
+            pp[t] = p;
             if (k < hi && detail::frame_at(points, k) == f0 + static_cast<std::int64_t>(t)) {
                 // K = P H^T / (H P H^T + r),  x += K (z - H x),  P = (I - K H) P
-                const double s = p00 + r, k0 = p00 / s, k1 = p01 / s;
+                const cv_axis::Gain g = cv_axis::gain(p, r);
                 const double ex = points(k, 1) - mx, ey = points(k, 2) - my;
-                mx += k0 * ex, vx += k1 * ex;
-                my += k0 * ey, vy += k1 * ey;
-                const double n00 = (1.0 - k0) * p00, n01 = (1.0 - k0) * p01;
-                p11 = p11 - k1 * p01;
-                p00 = n00, p01 = n01;
+                mx += g.k0 * ex, vx += g.k1 * ex;
+                my += g.k0 * ey, vy += g.k1 * ey;
+                p = cv_axis::updated(p, g);
                 ++k;
             }
             fm[4 * t] = mx, fm[4 * t + 1] = vx, fm[4 * t + 2] = my, fm[4 * t + 3] = vy;
-            fp[3 * t] = p00, fp[3 * t + 1] = p01, fp[3 * t + 2] = p11;
+            fp[t] = p;
         }
         // RTS: C_t = P_t|t F^T P_t+1|t^-1,  s_t = m_t|t + C_t (s_t+1 - m_t+1|t)
         double sx = fm[4 * (T - 1)], svx = fm[4 * (T - 1) + 1];
         double sy = fm[4 * (T - 1) + 2], svy = fm[4 * (T - 1) + 3];
         for (std::size_t t = T - 1; t-- > 0;) {
-            const double a = fp[3 * t], b = fp[3 * t + 1], c = fp[3 * t + 2];
-            const double u00 = a + b, u01 = b, u10 = b + c, u11 = c;
-            const double x = pp[3 * (t + 1)], y = pp[3 * (t + 1) + 1], w = pp[3 * (t + 1) + 2];
-            const double det = x * w - y * y;
-            const double c00 = (u00 * w - u01 * y) / det, c01 = (u01 * x - u00 * y) / det;
-            const double c10 = (u10 * w - u11 * y) / det, c11 = (u11 * x - u10 * y) / det;
+            const cv_axis::SmootherGain c = cv_axis::smoother_gain(fp[t], pp[t + 1]);
             const double dx0 = sx - pm[4 * (t + 1)], dx1 = svx - pm[4 * (t + 1) + 1];
             const double dy0 = sy - pm[4 * (t + 1) + 2], dy1 = svy - pm[4 * (t + 1) + 3];
-            sx = fm[4 * t] + c00 * dx0 + c01 * dx1;
-            svx = fm[4 * t + 1] + c10 * dx0 + c11 * dx1;
-            sy = fm[4 * t + 2] + c00 * dy0 + c01 * dy1;
-            svy = fm[4 * t + 3] + c10 * dy0 + c11 * dy1;
+            sx = fm[4 * t] + c.c00 * dx0 + c.c01 * dx1;
+            svx = fm[4 * t + 1] + c.c10 * dx0 + c.c11 * dx1;
+            sy = fm[4 * t + 2] + c.c00 * dy0 + c.c01 * dy1;
+            svy = fm[4 * t + 3] + c.c10 * dy0 + c.c11 * dy1;
             const std::int64_t f = f0 + static_cast<std::int64_t>(t);
             if (f > fa && f < fb) {
                 const Eigen::Index i = row + static_cast<Eigen::Index>(f - fa - 1);
