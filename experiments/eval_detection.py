@@ -20,7 +20,6 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
-import configparser
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -34,7 +33,7 @@ from pftrack.boxes import iou_xywh
 from pftrack.detection import PaperDetector, make_detector
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
 from pftrack.io.mot import group_by_frame, read_mot
-from pftrack.io.video import read_frames
+from pftrack.io.video import read_frames, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 
 REAL = {"pets": PETS, "tud": TUD}
@@ -62,14 +61,10 @@ def load_sequence(name: str, data: Path) -> tuple[list[np.ndarray], F64, float] 
     gt = read_mot(seq / "gt.txt")
     gt = gt[gt[:, 6] != 0]
     gt[:, 2:6] *= src.scale
-    return read_frames(seq / src.video), gt, read_frame_rate(seq / "seqinfo.ini")
-
-
-def read_frame_rate(path: Path) -> float:
-    """``frameRate`` of a MOTChallenge ``seqinfo.ini``."""
-    parser = configparser.ConfigParser()
-    parser.read(path)
-    return float(parser["Sequence"]["frameRate"])
+    fps = read_seqinfo(seq).frame_rate
+    if fps is None:
+        raise ValueError(f"{seq}: seqinfo.ini has no frameRate")
+    return read_frames(seq / src.video), gt, fps
 
 
 def empty_floor_runs(rows: F64, gt: F64) -> tuple[int, int]:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import cv2
 import numpy as np
@@ -82,17 +82,14 @@ def test_extend_legs_matches_reference(seed: int) -> None:
 
 def test_extend_legs_from_threads_equals_serial() -> None:
     cases = [random_case(np.random.default_rng(s)) for s in range(20)]
-    serial = [_core.extend_legs(m, b, c, 1.2, 0.3) for m, b, c in cases]
-    out: list[list[np.ndarray]] = [[] for _ in range(4)]
 
-    def work(i: int) -> None:
-        out[i] = [_core.extend_legs(m, b, c, 1.2, 0.3) for m, b, c in cases]
+    def work(_: int) -> list[np.ndarray]:
+        return [_core.extend_legs(m, b, c, 1.2, 0.3) for m, b, c in cases]
 
-    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
+    serial = work(0)
+    with ThreadPoolExecutor(4) as pool:  # as tests/detection/test_blobs.py's thread test
+        out = list(pool.map(work, range(4)))
+    assert len(out) == 4
     for res in out:
         for a, b in zip(res, serial, strict=True):
             np.testing.assert_array_equal(a, b)
@@ -167,7 +164,7 @@ def test_dark_legs_are_lost_without_the_extension_and_found_with_it() -> None:
     det_off, off, truth = run(0.0)
     det_on, on, _ = run(0.9)
     assert det_on.model.threshold >= 25  # the legs differ from the path by 35-41 grey levels ...
-    assert det_on._blobs.size_model.fitted  # (fitted from the blue-trousered people first)
+    assert det_on.size_model.fitted  # (fitted from the blue-trousered people first)
     bottoms_off, bottoms_on = [], []
     for f, x, top, _w, h in truth:
         b_off, b_on = dark_person_box(off[int(f)], x), dark_person_box(on[int(f)], x)
@@ -214,7 +211,7 @@ def test_boxes_do_not_grow_into_a_ghost() -> None:
     for leg_height in (0.0, 0.8):
         det = make_detector("paper", leg_height=leg_height, leg_fill=0.2)
         det.prime([primed] * 3)
-        size = det._blobs.size_model
+        size = det.size_model
         for foot in np.linspace(50, 130, 40):  # h = 0.5 foot + 20: a head at row 30, foot row 100
             h = 0.5 * foot + 20
             size.observe(np.array([[10.0, foot - h, 20.0, h]]))  # 20 px wide

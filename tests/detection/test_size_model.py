@@ -176,9 +176,22 @@ def test_a_fit_taken_over_by_one_persons_identical_boxes_is_refused(seed: int) -
     walker = np.array([[200.0, 160.0, 31.0, 74.0]])
     assert accepting.split_count(walker)[0] >= 2
     assert not model.fitted  # refused: it would cut over a fifth of its own samples
+    fits = 0
+    refit = model._fit
+
+    def counted() -> None:
+        nonlocal fits
+        fits += 1
+        refit()
+
+    model._fit = counted  # type: ignore[method-assign]
+    stacked = np.array([[100.0, 100.0, 20.0, 40.0], [105.0, 150.0, 20.0, 40.0]])
+    for _ in range(5):  # frames without an isolated box: the refused fit is not redone
+        model.observe(stacked)
+    assert fits == 0 and not model.fitted
     for boxes in walker_stream(rng, 60):  # more people seen: the next fit is kept
         model.observe(boxes)
-    assert model.fitted
+    assert model.fitted and fits >= 1
     np.testing.assert_allclose(model.expected(234.0), [74.0, 31.0], atol=3.0)
     assert model.split_count(walker)[0] == 1
 

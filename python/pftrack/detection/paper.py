@@ -216,8 +216,8 @@ class PaperDetector:
         if self.config.leg_height > 0 and len(boxes) and size.fitted:
             # after the size model observed the blobs' own boxes (it never learns from these);
             # no box grows into a ghost (this frame's ghost pixels are background being learnt)
-            if self._ghost is not None:
-                shaded = np.where(self._ghost != 0, np.uint8(0), shaded)
+            if self._ghost is not None:  # in place: `shaded` is this frame's own array
+                shaded[self._ghost != 0] = 0
             boxes = size.extend_legs(shaded, boxes, self.config.leg_height, self.config.leg_fill)
         return Detections(boxes, scores, mask, _core.mask_bins(binned, mask), frame_bins=binned)
 

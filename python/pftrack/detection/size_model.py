@@ -177,8 +177,12 @@ class PersonSizeModel:
             self._samples[self._n % self.config.max_samples] = (y + h, h, w)
             self._n += 1
             self._since_fit += 1
-        if self.n_samples >= self.config.min_samples and (
-            self._coef is None or self._since_fit >= self.config.refit_every
+        # only with a sample new since the last try: a refused first fit is not redone, on
+        # every frame, from the same samples (it would be refused again)
+        if (
+            self._since_fit > 0
+            and self.n_samples >= self.config.min_samples
+            and (self._coef is None or self._since_fit >= self.config.refit_every)
         ):
             self._fit()
 
