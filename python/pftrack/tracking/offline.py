@@ -282,10 +282,8 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
     if not 1.0 <= area_ratio < np.inf:
         raise ValueError(f"drop_nested: area_ratio is {area_ratio}, expected a finite value >= 1")
     a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "drop_nested")
-    order = np.argsort(a[:, 0], kind="stable")
-    cuts = np.flatnonzero(np.diff(a[order, 0])) + 1
     drop = np.zeros(len(a), dtype=bool)
-    for idx in np.split(order, cuts):
+    for idx in _frame_groups(a[:, 0]):
         if len(idx) < 2:
             continue
         x0, y0, w, h = a[idx, 2], a[idx, 3], a[idx, 4], a[idx, 5]
@@ -375,9 +373,7 @@ def complete_boxes(
     new_w = np.where(widen, w_exp, w)
     shift = 0.5 * (w - new_w)  # centred
     if anchor == "side" and widen.any():
-        order = np.argsort(a[:, 0], kind="stable")
-        cuts = np.flatnonzero(np.diff(a[order, 0])) + 1
-        for idx in np.split(order, cuts):
+        for idx in _frame_groups(a[:, 0]):
             if len(idx) < 2 or not widen[idx].any():
                 continue
             x0, y0, x1, y1 = x[idx], y[idx], x[idx] + w[idx], y[idx] + h[idx]
@@ -397,6 +393,12 @@ def complete_boxes(
     a[:, 4] = new_w
     a[:, 5] = new_h
     return a
+
+
+def _frame_groups(frames: F64) -> list[NDArray[np.intp]]:
+    """Row indices of each frame, frames ascending, rows in their order within a frame."""
+    order = np.argsort(frames, kind="stable")
+    return np.split(order, np.flatnonzero(np.diff(frames[order])) + 1)
 
 
 def _add_hole_rows(
