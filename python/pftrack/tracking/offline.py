@@ -24,6 +24,7 @@ from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
+from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import rts_smooth
 from pftrack.recovery.fill import fill_rows
 from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
@@ -359,14 +360,13 @@ def complete_boxes(
             f"[w_slope, w_intercept]], got shape {coef.shape}"
         )
     a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "complete_boxes").copy()
-    (h_slope, h_icpt), (w_slope, w_icpt) = coef
-    if h_slope == 1.0 or len(a) == 0:
+    if coef[0, 0] == 1.0 or len(a) == 0:  # h_slope = 1: no head row gives a height
         return a
     x, y, w, h = (a[:, c].copy() for c in range(2, 6))
-    h_exp = (h_icpt + h_slope * y) / (1.0 - h_slope)  # the head at row y: h = h_icpt + h_slope foot
+    h_exp = head_height(coef, y)
     known = h_exp > 0.0
     new_h = np.where(known & (h < share * h_exp), h_exp, h)
-    w_exp = np.maximum(w_icpt + w_slope * (y + new_h), 1.0)
+    w_exp = expected_size(coef, y + new_h)[:, 1]
     person = known & (w <= max_width * w_exp)
     new_h = np.where(person, new_h, h)
     widen = person & (w < share * w_exp)
