@@ -35,14 +35,14 @@ void register_smoothing(py::module_& m) {
            py::array_t<double, py::array::c_style | py::array::forcecast> r2, double velocity_sd,
            bool update_first) {
             const char* fn = "rts_smooth";
-            require(z.ndim() == 2, fn, "z must have shape (T, n)");
+            require(z.ndim() == 2, fn, "z must be of shape (T, n)");
             const py::ssize_t steps = z.shape(0), n = z.shape(1);
             require(q.ndim() == 1 && q.shape(0) == n && r2.ndim() == 1 && r2.shape(0) == n, fn,
-                    "q and r2 must have shape (n,), n = " + std::to_string(n) + " columns of z");
+                    "q and r2 must be of shape (n,), n = " + std::to_string(n) + " columns of z");
             const bool per_axis = has.ndim() == 2;
             require((has.ndim() == 1 && has.shape(0) == steps) ||
                         (per_axis && has.shape(0) == steps && has.shape(1) == n),
-                    fn, "has must have shape (T,) or (T, n) as z " + std::to_string(steps) + " x " +
+                    fn, "has must be of shape (T,) or (T, n) as z " + std::to_string(steps) + " x " +
                             std::to_string(n));
             require(steps > 0, fn, "the first frame must have a measurement (z is empty)");
             require(std::isfinite(velocity_sd) && velocity_sd >= 0.0, fn, "velocity_sd",

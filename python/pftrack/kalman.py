@@ -211,26 +211,10 @@ def rts_smooth(
     (T, n) ndarray
         Mean of each position given every measurement.
     """
-    zz = np.asarray(z, dtype=np.float64)
-    hh = np.asarray(has, dtype=bool)
-    q2 = np.asarray(q, dtype=np.float64)
-    rr = np.asarray(r2, dtype=np.float64)
-    steps = len(zz)
-    n = len(q2)
-    if (
-        zz.ndim != 2
-        or zz.shape[1] != n
-        or hh.shape not in ((steps,), (steps, n))
-        or rr.shape != (n,)
-        or q2.ndim != 1
-    ):
-        raise ValueError(
-            f"rts_smooth: z {zz.shape}, has {hh.shape}, q {q2.shape} and r2 {rr.shape} must be "
-            "(T, n), (T,) or (T, n), (n,) and (n,)"
-        )
-    if steps == 0 or not np.all(hh[0]):
-        raise ValueError("rts_smooth: the first frame must have a measurement")
     # one C++ loop over frames per axis (tests/reference/smoothing.py holds the NumPy loop it
-    # equals); rows without a measurement are never read
+    # equals), which checks the shapes, the first frame and every value it reads; rows without
+    # a measurement are never read
+    zz, hh = np.asarray(z, dtype=np.float64), np.asarray(has, dtype=bool)
+    q2, rr = np.asarray(q, dtype=np.float64), np.asarray(r2, dtype=np.float64)
     out: F64 = _core.rts_smooth(zz, hh, q2, rr, float(velocity_sd), bool(update_first))
     return out

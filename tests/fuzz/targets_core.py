@@ -12,6 +12,8 @@ from pftrack import _core
 from tests.fuzz.harness import Target, call, fl, floats_array, garbage, ints, layout, maybe
 
 N = st.integers(0, 12)  # particles, boxes, steps: small, 0 included
+# a person-size model's lines [[h_slope, h_intercept], [w_slope, w_intercept]]
+SIZE_LINES = floats_array((2, 2), -5, 50)
 
 
 @st.composite
@@ -461,7 +463,7 @@ TARGETS: list[Target] = [
             maybe(fl(1, 1e3)),
             maybe(fl(0, 1)),
             maybe(fl(0, 10)),
-            st.one_of(st.none(), floats_array((2, 2), -5, 50), garbage()),
+            st.one_of(st.none(), SIZE_LINES, garbage()),
             maybe(fl(1, 3)),
             maybe(fl(0.5, 3)),
             maybe(fl(1, 3)),
@@ -477,7 +479,7 @@ TARGETS: list[Target] = [
                 garbage(),
             ),
             maybe(boxes()),
-            st.one_of(floats_array((2, 2), -5, 50), garbage()),
+            st.one_of(SIZE_LINES, garbage()),
             maybe(fl(0, 3)),
             maybe(fl(0, 1)),
         ),
@@ -487,7 +489,7 @@ TARGETS: list[Target] = [
         call(
             _core.split_count,
             maybe(boxes()),
-            maybe(floats_array((2, 2), -5, 50)),
+            maybe(SIZE_LINES),
             maybe(fl(1, 3)),
             maybe(fl(0.5, 3)),
         ),
@@ -497,7 +499,7 @@ TARGETS: list[Target] = [
         call(
             _core.merge_fragments,
             maybe(boxes()),
-            maybe(floats_array((2, 2), -5, 50)),
+            maybe(SIZE_LINES),
             maybe(fl(1, 3)),
         ),
     ),  # fmt: skip

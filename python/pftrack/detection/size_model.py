@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 
-__all__ = ["PersonSizeModel", "SizeModelConfig", "theil_sen"]
+__all__ = ["PersonSizeModel", "SizeModelConfig", "expected_size", "head_height", "theil_sen"]
 
 
 @dataclass(frozen=True)
@@ -104,6 +104,51 @@ def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, fl
     return _core.theil_sen(np.asarray(x, np.float64), np.asarray(y, np.float64))
 
 
+def expected_size(
+    lines: NDArray[np.float64], foot_y: NDArray[np.float64] | float
+) -> NDArray[np.float64]:
+    """Expected ``(h, w)`` of a person at foot row(s) `foot_y`, at least 1 px.
+
+    Parameters
+    ----------
+    lines : (2, 2) ndarray
+        ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in the foot row
+        (`PersonSizeModel.coefficients`).
+    foot_y : float or ndarray
+        Foot row(s).
+
+    Returns
+    -------
+    (..., 2) ndarray
+        ``h, w`` per foot row.
+    """
+    y = np.asarray(foot_y, np.float64)[..., None]
+    return np.maximum(lines[:, 0] * y + lines[:, 1], 1.0)
+
+
+def head_height(lines: NDArray[np.float64], top: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Height ``h_e`` of the person whose head is at row(s) `top`.
+
+    ``h_e`` solves ``h = h_intercept + h_slope (top + h)``, as the C++ ``extend_legs`` does
+    (`PersonSizeModel.extend_legs`).
+
+    Parameters
+    ----------
+    lines : (2, 2) ndarray
+        ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in the foot row, ``h_slope != 1``.
+    top : ndarray
+        Head (top) row(s).
+
+    Returns
+    -------
+    ndarray
+        ``h_e`` per row; not positive where there is no such person (a head below the horizon).
+    """
+    h_slope, h_icpt = lines[0]
+    out: NDArray[np.float64] = (h_icpt + h_slope * top) / (1.0 - h_slope)
+    return out
+
+
 class PersonSizeModel:
     """Expected box height and width of one person as straight lines in the foot row ``y``.
 
@@ -158,8 +203,7 @@ class PersonSizeModel:
         """
         if self._coef is None:
             raise ValueError("PersonSizeModel.expected: the model is not fitted yet")
-        y = np.asarray(foot_y, np.float64)[..., None]
-        return np.maximum(self._coef[:, 0] * y + self._coef[:, 1], 1.0)
+        return expected_size(self._coef, foot_y)
 
     def observe(self, boxes: NDArray[np.float64]) -> None:
         """Add the isolated ones among `boxes` (K, 4) ``left, top, w, h`` to the fit.

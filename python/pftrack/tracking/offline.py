@@ -24,6 +24,7 @@ from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
+from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import rts_smooth
 from pftrack.recovery.fill import fill_rows
 from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
@@ -282,10 +283,8 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
     if not 1.0 <= area_ratio < np.inf:
         raise ValueError(f"drop_nested: area_ratio is {area_ratio}, expected a finite value >= 1")
     a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "drop_nested")
-    order = np.argsort(a[:, 0], kind="stable")
-    cuts = np.flatnonzero(np.diff(a[order, 0])) + 1
     drop = np.zeros(len(a), dtype=bool)
-    for idx in np.split(order, cuts):
+    for idx in _frame_groups(a[:, 0]):
         if len(idx) < 2:
             continue
         x0, y0, w, h = a[idx, 2], a[idx, 3], a[idx, 4], a[idx, 5]
@@ -361,23 +360,20 @@ def complete_boxes(
             f"[w_slope, w_intercept]], got shape {coef.shape}"
         )
     a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "complete_boxes").copy()
-    (h_slope, h_icpt), (w_slope, w_icpt) = coef
-    if h_slope == 1.0 or len(a) == 0:
+    if coef[0, 0] == 1.0 or len(a) == 0:  # h_slope = 1: no head row gives a height
         return a
     x, y, w, h = (a[:, c].copy() for c in range(2, 6))
-    h_exp = (h_icpt + h_slope * y) / (1.0 - h_slope)  # the head at row y: h = h_icpt + h_slope foot
+    h_exp = head_height(coef, y)
     known = h_exp > 0.0
     new_h = np.where(known & (h < share * h_exp), h_exp, h)
-    w_exp = np.maximum(w_icpt + w_slope * (y + new_h), 1.0)
+    w_exp = expected_size(coef, y + new_h)[:, 1]
     person = known & (w <= max_width * w_exp)
     new_h = np.where(person, new_h, h)
     widen = person & (w < share * w_exp)
     new_w = np.where(widen, w_exp, w)
     shift = 0.5 * (w - new_w)  # centred
     if anchor == "side" and widen.any():
-        order = np.argsort(a[:, 0], kind="stable")
-        cuts = np.flatnonzero(np.diff(a[order, 0])) + 1
-        for idx in np.split(order, cuts):
+        for idx in _frame_groups(a[:, 0]):
             if len(idx) < 2 or not widen[idx].any():
                 continue
             x0, y0, x1, y1 = x[idx], y[idx], x[idx] + w[idx], y[idx] + h[idx]
@@ -397,6 +393,12 @@ def complete_boxes(
     a[:, 4] = new_w
     a[:, 5] = new_h
     return a
+
+
+def _frame_groups(frames: F64) -> list[NDArray[np.intp]]:
+    """Row indices of each frame, frames ascending, rows in their order within a frame."""
+    order = np.argsort(frames, kind="stable")
+    return np.split(order, np.flatnonzero(np.diff(frames[order])) + 1)
 
 
 def _add_hole_rows(
