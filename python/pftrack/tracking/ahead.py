@@ -16,7 +16,7 @@ byte for byte, as with the detector called in ``update``.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from types import TracebackType
 from typing import Any
 
@@ -28,7 +28,9 @@ from pftrack.tracking.tracker import MultiObjectTracker
 
 __all__ = ["DetectAhead"]
 
-_Work = tuple[NDArray[np.uint8], Any, BaseException | None]
+# (the frame as read, the frame the detector saw, its result, its error)
+_Work = tuple[NDArray[np.uint8], NDArray[np.uint8], Any, BaseException | None]
+_Frame = NDArray[np.uint8]
 
 
 class _StandIn:
@@ -44,14 +46,14 @@ class _StandIn:
 
     def _take(self, frame: NDArray[np.uint8], foreground_only: bool) -> Any:
         work, self._next = self._next, None
-        if work is None or work[0] is not frame or foreground_only != self._foreground_only:
+        if work is None or work[1] is not frame or foreground_only != self._foreground_only:
             raise RuntimeError(
                 "DetectAhead: the tracker asked about a frame the detection thread did not "
                 "detect (one update per frame of the run, in order)"
             )
-        if work[2] is not None:
-            raise work[2]
-        return work[1]
+        if work[3] is not None:
+            raise work[3]
+        return work[2]
 
     def detect(self, frame: NDArray[np.uint8]) -> Any:
         """The thread's ``detect(frame)``."""
@@ -84,6 +86,12 @@ class DetectAhead:
         refinement) is computed ahead, as ``update`` asks for it; otherwise ``detect``.
     depth : int
         How many frames may wait detected.
+    prepare : callable, optional
+        Turns each frame into the one the tracker's detector sees (the working resolution,
+        :meth:`pftrack.Tracker.working_frame`), on the thread; default: the frame itself.
+    hand_over : callable, optional
+        Called as ``hand_over(frame, prepared)`` just before `frame` is yielded, so that the
+        caller's ``update`` uses the very prepared array (:meth:`pftrack.Tracker.hand_over`).
 
     Examples
     --------
@@ -93,11 +101,15 @@ class DetectAhead:
     """
 
     def __init__(self, tracker: MultiObjectTracker, frames: Iterable[NDArray[np.uint8]],
-                 *, external: bool, depth: int = 2) -> None:  # fmt: skip
+                 *, external: bool, depth: int = 2,
+                 prepare: Callable[[_Frame], _Frame] | None = None,
+                 hand_over: Callable[[_Frame, _Frame], None] | None = None) -> None:  # fmt: skip
         self._tracker = tracker
         self._frames = frames
         self._external = external
         self._depth = depth
+        self._prepare = prepare
+        self._hand = hand_over
         self._detector: Any = None
         self._stand_in: _StandIn | None = None
         self._stream: Iterator[_Work] | None = None
@@ -114,9 +126,9 @@ class DetectAhead:
             call = _mask_and_bins(detector)
         self._detector = detector
         self._stand_in = _StandIn(self._external)
-        self._stream = prefetch(_work(self._frames, call), depth=self._depth)
+        self._stream = prefetch(_work(self._frames, call, self._prepare), depth=self._depth)
         self._tracker.detector = self._stand_in
-        return self._hand_over(self._stream, self._stand_in)
+        return self._hand_over(self._stream, self._stand_in, self._hand)
 
     def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
                  trace: TracebackType | None) -> None:  # fmt: skip
@@ -126,9 +138,12 @@ class DetectAhead:
         self._tracker.detector = self._detector
 
     @staticmethod
-    def _hand_over(stream: Iterator[_Work], stand_in: _StandIn) -> Iterator[NDArray[np.uint8]]:
+    def _hand_over(stream: Iterator[_Work], stand_in: _StandIn,
+                   hand: Callable[[_Frame, _Frame], None] | None) -> Iterator[_Frame]:  # fmt: skip
         for work in stream:
             stand_in.expect(work)
+            if hand is not None:
+                hand(work[0], work[1])
             yield work[0]
 
 
@@ -142,21 +157,24 @@ def _mask_and_bins(detector: Any) -> Any:
     return call
 
 
-def _work(frames: Iterable[Any], call: Any) -> Iterator[_Work]:
-    """Each frame with the detector's result, or with its error (and then no further frame).
+def _work(frames: Iterable[Any], call: Any,
+          prepare: Callable[[_Frame], _Frame] | None) -> Iterator[_Work]:  # fmt: skip
+    """Each frame, prepared, with the detector's result, or with its error (then no more).
 
     `frames`' iterator is closed when this ends, however it ends (a reader thread stops).
     """
     it = iter(frames)
     try:
         for item in it:
-            frame = np.asarray(item)  # the very object update() will hand the detector
+            frame = np.asarray(item)  # the very object update() will be given
             try:
-                result = call(frame)
+                # the very object update() hands the detector
+                work = frame if prepare is None else prepare(frame)
+                result = call(work)
             except Exception as error:  # raised by the stand-in in update(), where it belongs
-                yield frame, None, error
+                yield frame, frame, None, error
                 return
-            yield frame, result, None
+            yield frame, work, result, None
     finally:
         close = getattr(it, "close", None)
         if close is not None:

@@ -20,6 +20,7 @@ import warnings
 from collections.abc import Iterable
 from dataclasses import replace
 
+import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -33,7 +34,13 @@ from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
 from pftrack.tracking.writer import TrackWriter
 
-__all__ = ["REFERENCE_RATE", "Tracker", "check_boxes_xyxy", "xywh_to_xyxy_dets"]
+__all__ = [
+    "REFERENCE_RATE",
+    "Tracker",
+    "check_boxes_xyxy",
+    "working_size",
+    "xywh_to_xyxy_dets",
+]
 
 #: Frames per second at which the frame-based defaults of ``pftrack track`` are stated.
 REFERENCE_RATE = 25.0
@@ -68,6 +75,19 @@ def xywh_to_xyxy_dets(dets: ArrayLike) -> F64:
     out: F64 = d.copy()
     out[:, 2:4] = d[:, :2] + d[:, 2:4]
     return out
+
+
+def working_size(shape: tuple[int, ...], max_side: int | None) -> tuple[int, int] | None:
+    """The (width, height) a frame of `shape` is tracked at, or None for its own size.
+
+    A frame whose longer side exceeds `max_side` is scaled to that longer side, the other side
+    rounded (at least 1 pixel) (:attr:`TrackerConfig.max_side`).
+    """
+    rows, cols = int(shape[0]), int(shape[1])
+    if max_side is None or max(rows, cols) <= max_side:
+        return None
+    s = max_side / max(rows, cols)
+    return max(1, round(cols * s)), max(1, round(rows * s))
 
 
 def check_boxes_xyxy(
@@ -173,6 +193,10 @@ class Tracker:
         object across gaps of up to 1.2 s.
     prime : float
         Seconds of frames :meth:`prime` reads (what ``pftrack track`` reads ahead).
+    max_side : int or None
+        Working resolution (:attr:`TrackerConfig.max_side`): larger frames are scaled down to
+        this longer side for detection and tracking; boxes in and out stay in the frame's
+        pixels. None: the frame's own size.
 
     Examples
     --------
@@ -201,6 +225,7 @@ class Tracker:
         smooth: bool = True,
         link: bool = True,
         prime: float = 1.2,
+        max_side: int | None = TrackerConfig.max_side,
     ) -> None:
         if not (np.isfinite(frame_rate) and 0 < frame_rate <= MAX_FRAME_RATE):
             raise ValueError(
@@ -218,6 +243,7 @@ class Tracker:
             detector=detector,
             sampler=sampler,
             camera_motion=camera_motion,
+            max_side=max_side,
             lifecycle=replace(
                 base.lifecycle,
                 max_coast=_frames(max_coast, frame_rate, "max_coast"),
@@ -307,11 +333,64 @@ class Tracker:
         self._clip_warned = False
         self._max_conf = -np.inf
         self._given = False  # some update() of the run had detections
+        self._scale: tuple[float, float] | None = None  # working / frame pixels (x, y)
+        self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
 
     @property
     def tracker(self) -> MultiObjectTracker:
-        """The online tracker inside (its live tracks, detector and foreground mask)."""
+        """The online tracker inside (its live tracks, detector and foreground mask).
+
+        It works at the working resolution (:attr:`TrackerConfig.max_side`): its boxes are in
+        the pixels of :meth:`working_frame`, not of the frames given to :meth:`update`.
+        """
         return self._tracker
+
+    def working_frame(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        """`frame` as the tracker inside sees it: scaled down to ``max_side``, or `frame` itself.
+
+        OpenCV's ``INTER_AREA`` (the mean of the pixels each output pixel covers), to the size
+        :func:`working_size` gives.
+        """
+        size = working_size(frame.shape, self.config.max_side)
+        if size is None:
+            return frame
+        return np.asarray(cv2.resize(frame, size, interpolation=cv2.INTER_AREA), np.uint8)
+
+    def hand_over(self, frame: NDArray[np.uint8], working: NDArray[np.uint8]) -> None:
+        """Give the next :meth:`update` of `frame` its :meth:`working_frame`, made elsewhere.
+
+        :class:`~pftrack.tracking.ahead.DetectAhead` scales each frame on its thread, where
+        the detector runs on the scaled frame; ``update`` then takes that very array (the
+        detector's result belongs to it) instead of scaling `frame` again.
+        """
+        self._prepared = (frame, working)
+
+    def _working(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        prepared, self._prepared = self._prepared, None
+        if prepared is not None and prepared[0] is frame:
+            return prepared[1]
+        return self.working_frame(frame)
+
+    def _restore_rows(self, rows: F64) -> F64:
+        """MOTChallenge rows from working pixels to the frame's."""
+        if self._scale is None or len(rows) == 0:
+            return rows
+        sx, sy = self._scale
+        out = rows.copy()
+        out[:, [2, 4]] /= sx
+        out[:, [3, 5]] /= sy
+        return out
+
+    def _restore_track(self, t: Track) -> Track:
+        """A reported track with its boxes in the frame's pixels."""
+        assert self._scale is not None
+        k = np.array([self._scale[0], self._scale[1], self._scale[0], self._scale[1]])
+        return replace(
+            t,
+            box_xywh=np.asarray(t.box_xywh, np.float64) / k,
+            detection_box=None if t.detection_box is None else t.detection_box / k,
+            history=tuple((n, np.asarray(b, np.float64) / k, c) for n, b, c in t.history),
+        )
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start the background model from the median of `frames` (before the first update).
@@ -322,7 +401,7 @@ class Tracker:
         """
         if self.frame_count:
             raise ValueError("prime() must come before the first update()")
-        self._tracker.prime(frames)
+        self._tracker.prime([self.working_frame(np.asarray(f)) for f in frames])
 
     def update(self, dets: ArrayLike | None, frame: ArrayLike) -> F64:
         """Track one frame.
@@ -347,9 +426,13 @@ class Tracker:
         f = np.asarray(frame)
         if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
             raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        work = self._working(f)
+        self._scale = (
+            None if work is f else (work.shape[1] / f.shape[1], work.shape[0] / f.shape[0])
+        )
         if dets is None:
             kept = None
-            reports = self._tracker.update(f, None)
+            reports = self._tracker.update(work, None)
         else:
             xywh, cls, kept, clipped = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
             self._given = True
@@ -362,18 +445,22 @@ class Tracker:
                 )
             if len(xywh):
                 self._max_conf = max(self._max_conf, float(xywh[:, 4].max()))
-            reports = self._tracker.update(f, xywh, cls)
+            if self._scale is not None:
+                xywh[:, [0, 2]] *= self._scale[0]
+                xywh[:, [1, 3]] *= self._scale[1]
+            reports = self._tracker.update(work, xywh, cls)
         self.frame_count += 1
         # the offline pass sees a still camera: boxes in the first frame's coordinates
         self._stabiliser.add(self._tracker.camera_step.apply)
         self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
         self._reports = reports
         out = np.zeros((len(reports), 8))
+        k = (1.0, 1.0) if self._scale is None else self._scale
         m = 0
         for t in reports:
             if t.time_since_update != 0:
                 continue  # coasting: carried by the particle filter alone, held back
-            b = t.box_xywh
+            b = t.box_xywh / np.array([k[0], k[1], k[0], k[1]])
             di = -1 if kept is None or t.detection_index is None else kept[t.detection_index]
             out[m] = (b[0], b[1], b[0] + b[2], b[1] + b[3], t.id, t.score, t.cls, di)
             m += 1
@@ -382,7 +469,9 @@ class Tracker:
     @property
     def last_reports(self) -> list[Track]:
         """Every track the last `update` reported, coasting ones too (what a renderer draws)."""
-        return self._reports
+        if self._scale is None:
+            return self._reports
+        return [self._restore_track(t) for t in self._reports]
 
     @property
     def n_settled(self) -> int:
@@ -397,7 +486,7 @@ class Tracker:
         is detected again.
         """
         rows = np.asarray(self._writer.rows[start:], np.float64).reshape(-1, 10)
-        return self._stabiliser.restore(rows)
+        return self._restore_rows(self._stabiliser.restore(rows))
 
     def finalize(self) -> F64:
         """The run's MOTChallenge rows after the offline pass (what ``pftrack track`` writes).
@@ -440,4 +529,4 @@ class Tracker:
             warnings.warn(
                 f"no track over {self.frame_count} frames: {hint}", RuntimeWarning, stacklevel=2
             )
-        return rows
+        return self._restore_rows(rows)

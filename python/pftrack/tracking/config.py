@@ -25,6 +25,8 @@ __all__ = [
 SAMPLERS = ("sis", "mh", "rjmcmc")
 #: Values of :attr:`TrackerConfig.camera_motion`.
 CAMERA_MOTION = ("auto", "on", "off")
+#: Bounds of :attr:`TrackerConfig.max_side` (pixels).
+MIN_SIDE, MAX_SIDE = 64, 100_000
 
 
 def _in_unit_interval(owner: str, **values: float) -> None:
@@ -310,6 +312,12 @@ class TrackerConfig:
         treats the camera as moving on every frame.
     camera : CameraConfig
         How the motion is measured and decided.
+    max_side : int or None
+        Working resolution: a frame whose longer side is larger is scaled down (OpenCV's
+        ``INTER_AREA``) to this longer side before detection and tracking, and every box the
+        tracker reports is scaled back to the frame's pixels (:class:`~pftrack.Tracker`; the
+        inner :class:`~pftrack.tracking.MultiObjectTracker` works in the scaled pixels). None
+        tracks at the frame's own size.
     """
 
     filter: FilterConfig = field(
@@ -329,8 +337,18 @@ class TrackerConfig:
     lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
     camera_motion: str = "auto"
     camera: CameraConfig = field(default_factory=CameraConfig)
+    max_side: int | None = None
 
     def __post_init__(self) -> None:
+        if self.max_side is not None and (
+            isinstance(self.max_side, bool)
+            or not isinstance(self.max_side, (int, np.integer))
+            or not MIN_SIDE <= self.max_side <= MAX_SIDE
+        ):
+            raise ValueError(
+                f"max_side is {self.max_side!r}, expected None or an integer in "
+                f"[{MIN_SIDE}, {MAX_SIDE}]"
+            )
         if self.camera_motion not in CAMERA_MOTION:
             raise ValueError(
                 f"camera_motion is {self.camera_motion!r}, expected 'auto', 'on' or 'off'"

@@ -184,7 +184,13 @@ def track_frames(
         it = iter(frames)
         stream: Any = closing(it) if hasattr(it, "close") else nullcontext(it)
     elif ahead:
-        stream = DetectAhead(tracker.tracker, prefetch(frames), external=detections is not None)
+        stream = DetectAhead(
+            tracker.tracker,
+            prefetch(frames),
+            external=detections is not None,
+            prepare=tracker.working_frame,
+            hand_over=tracker.hand_over,
+        )
     else:
         stream = closing(prefetch(frames))
     with stream as decoded:
