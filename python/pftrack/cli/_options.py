@@ -8,6 +8,10 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from pftrack.tracking import TrackerConfig
 
+#: ``--max-side``'s default: :attr:`pftrack.tracking.TrackerConfig.max_side` (0: None). Stated
+#: here, not imported, so that ``--help`` does not import the tracker; a test checks they agree.
+DEFAULT_MAX_SIDE = 0
+
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
     """Show every option's default and keep the description's and examples' line breaks.
@@ -82,6 +86,21 @@ def bounded_float(lo: float, hi: float) -> Any:
     return parse
 
 
+def max_side(text: str) -> int:
+    """Argument type of ``--max-side``: 0 (the frame's own size) or pixels in [64, 100000]."""
+    from pftrack.tracking.config import MAX_SIDE, MIN_SIDE
+
+    v = int(text)
+    if v != 0 and not MIN_SIDE <= v <= MAX_SIDE:
+        raise argparse.ArgumentTypeError(
+            f"expected 0 (full size) or an integer in [{MIN_SIDE}, {MAX_SIDE}], got {v}"
+        )
+    return v
+
+
+max_side.__name__ = "int"
+
+
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
     """The tracker's options, shared by ``track`` (and any command that tracks)."""
     p.add_argument("--particles", type=bounded_int(1, 100_000), default=100, metavar="N",
@@ -113,6 +132,12 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         help="camera-motion compensation: auto measures the camera's motion each frame and, "
         "once it moves, moves the tracks with it and stops using the background model (a still "
         "camera tracks exactly as with off); on: treat the camera as always moving",
+    )  # fmt: skip
+    p.add_argument(
+        "--max-side", type=max_side, default=DEFAULT_MAX_SIDE, metavar="PX",
+        help="working resolution: frames whose longer side is larger are scaled down to PX "
+        "pixels for detection and tracking, boxes written in the frame's pixels; 0 tracks at "
+        "the frame's own size",
     )  # fmt: skip
     p.add_argument("--max-coast", type=bounded_int(0, 100_000), default=10, metavar="FRAMES",
                    help="frames a track survives on its particle filter alone (0.4 s at 25 "
@@ -160,6 +185,7 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         detector=args.detector,
         sampler=args.sampler,
         camera_motion=args.camera_motion,
+        max_side=args.max_side or None,
         lifecycle=replace(
             base.lifecycle,
             max_coast=args.max_coast,

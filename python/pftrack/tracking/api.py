@@ -376,7 +376,7 @@ class Tracker:
         if self._scale is None or len(rows) == 0:
             return rows
         sx, sy = self._scale
-        out = rows.copy()
+        out: F64 = rows.copy()
         out[:, [2, 4]] /= sx
         out[:, [3, 5]] /= sy
         return out

@@ -1,0 +1,144 @@
+"""The working resolution (TrackerConfig.max_side): frames scaled down, boxes scaled back.
+
+A frame upscaled twice by pixel repetition and scaled back by ``INTER_AREA`` is the original
+frame exactly, and halving or doubling a box is exact in floating point: so a tracker at
+``max_side`` on the doubled frames must give, byte for byte, twice the boxes of a tracker on
+the original frames.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack.cli import main
+from pftrack.io.mot import group_by_frame
+from pftrack.synthetic import make_scene
+from pftrack.tracking import TrackerConfig, track_frames
+from pftrack.tracking.api import working_size, xywh_to_xyxy_dets
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return make_scene(n_frames=30, rng=3)
+
+
+def doubled(frame: np.ndarray) -> np.ndarray:
+    return np.repeat(np.repeat(frame, 2, axis=0), 2, axis=1)
+
+
+def truth_dets(scene) -> list[np.ndarray]:
+    by_frame = group_by_frame(scene.truth)
+    return [
+        xywh_to_xyxy_dets(
+            np.column_stack([r[:, 2:6], np.ones(len(r))])
+            if len(r := by_frame.get(f, np.zeros((0, 10))))
+            else np.zeros((0, 5))
+        )
+        for f in range(1, len(scene.frames) + 1)
+    ]
+
+
+@pytest.mark.parametrize(
+    ("shape", "side", "size"),
+    [
+        ((360, 480, 3), 640, None),
+        ((480, 640, 3), 640, None),
+        ((720, 1280, 3), 640, (640, 360)),
+        ((1080, 1920, 3), 640, (640, 360)),
+        ((1280, 720, 3), 640, (360, 640)),
+        ((370, 1224, 3), 640, (640, 193)),
+        ((720, 1280, 3), None, None),
+    ],
+)
+def test_working_size(shape, side, size):
+    assert working_size(shape, side) == size
+
+
+def test_working_frame_is_inter_area(scene):
+    tracker = pftrack.Tracker(max_side=480)
+    f = scene.frames[0]
+    assert tracker.working_frame(f) is f  # 480x360: tracked as it is
+    assert np.array_equal(tracker.working_frame(doubled(f)), f)
+
+
+@pytest.mark.parametrize("given", [True, False], ids=["detections", "builtin"])
+def test_doubled_frames_give_doubled_boxes_byte_for_byte(scene, given):
+    dets = truth_dets(scene) if given else [None] * len(scene.frames)
+    small = pftrack.Tracker(seed=5)
+    large = pftrack.Tracker(seed=5, max_side=480)
+    small.prime(scene.frames[:10])
+    large.prime([doubled(f) for f in scene.frames[:10]])
+    n_out = 0
+    for f, d in zip(scene.frames, dets, strict=True):
+        a = small.update(d, f)
+        b = large.update(None if d is None else d * [2, 2, 2, 2, 1], doubled(f))
+        expect = a.copy()
+        expect[:, :4] *= 2
+        assert np.array_equal(b, expect)
+        n_out += len(a)
+        ra, rb = small.last_reports, large.last_reports
+        assert [t.id for t in ra] == [t.id for t in rb]
+        for s, t in zip(ra, rb, strict=True):
+            assert np.array_equal(2 * s.box_xywh, t.box_xywh)
+            assert (s.detection_box is None) == (t.detection_box is None)
+    assert n_out > 0
+    rows_a, rows_b = small.finalize(), large.finalize()
+    assert len(rows_a) > 0
+    expect = rows_a.copy()
+    expect[:, 2:6] *= 2
+    assert np.array_equal(rows_b, expect)
+
+
+def test_the_run_scales_on_the_detection_thread_with_the_loops_rows(scene):
+    frames = [doubled(f) for f in scene.frames]
+    config = dataclasses.replace(TrackerConfig(), max_side=480)
+    threaded = track_frames(frames, config=config, rng=2)
+    single = track_frames(frames, config=config, rng=2, threads=False)
+    reference = track_frames(scene.frames, rng=2)
+    assert np.array_equal(threaded.rows, single.rows)
+    expect = reference.rows.copy()
+    expect[:, 2:6] *= 2
+    assert np.array_equal(threaded.rows, expect)
+
+
+@pytest.mark.parametrize("side", [10, 0, True, 640.0, "640"])
+def test_bad_max_side_is_refused(side):
+    with pytest.raises(ValueError, match="max_side"):
+        TrackerConfig(max_side=side)
+
+
+def test_cli_max_side(scene, tmp_path, capsys):
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    for n, f in enumerate(scene.frames[:12], start=1):
+        cv2.imwrite(str(folder / f"{n:06d}.png"), doubled(f))
+    out = tmp_path / "t.txt"
+    with pytest.raises(SystemExit) as refused:
+        main(["-q", "track", str(folder), "--max-side", "20", "--out", str(out)])
+    assert refused.value.code == 2
+    assert "--max-side" in capsys.readouterr().err
+    assert not out.exists()
+    assert main(["-q", "track", str(folder), "--max-side", "480", "--out", str(out)]) == 0
+    half = tmp_path / "h.txt"
+    small = tmp_path / "small"
+    small.mkdir()
+    for n, f in enumerate(scene.frames[:12], start=1):
+        cv2.imwrite(str(small / f"{n:06d}.png"), f)
+    assert main(["-q", "track", str(small), "--out", str(half)]) == 0
+    a = np.loadtxt(half, delimiter=",", ndmin=2)
+    b = np.loadtxt(out, delimiter=",", ndmin=2)
+    assert len(a) > 0
+    a[:, 2:6] *= 2
+    np.testing.assert_allclose(b, a, atol=0.02)  # written with 2 decimals
+
+
+def test_cli_default_is_the_config_default():
+    from pftrack.cli._options import DEFAULT_MAX_SIDE
+
+    assert (DEFAULT_MAX_SIDE or None) == TrackerConfig().max_side
+    assert pftrack.Tracker().config.max_side == TrackerConfig().max_side
