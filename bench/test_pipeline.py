@@ -16,7 +16,9 @@ the data is absent (``$PFTRACK_DATA``). Each source is timed four ways, from the
 * ``public``: the same with the sequence's detections (det.txt for PETS, the walkers' true
   boxes for the crowds);
 * ``render``: ``builtin`` plus a :class:`~pftrack.render.TrackRenderer` writing an H.264 video
-  from ``on_frame`` (as ``pftrack track --render``).
+  from ``on_frame`` (as ``pftrack track --render``);
+* ``builtin-640``, ``render-640``: ``builtin`` and ``render`` at the working resolution
+  ``--max-side 640`` (``TrackerConfig.max_side``; the same as full size on 480x360).
 
 ``extra_info`` holds the frames, ms per frame (wall), the wall and CPU seconds of the process,
 and, for every mode but ``decode``, the same source decoded alone just before it in the same
@@ -29,6 +31,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -41,11 +44,11 @@ from experiments.cost_per_object import make_crowd
 from pftrack._typing import F64
 from pftrack.io.video_writer import VideoWriter
 from pftrack.render import TrackRenderer
-from pftrack.tracking import track_frames
+from pftrack.tracking import TrackerConfig, track_frames
 from pftrack.tracking.run import load_detections
 
 SOURCES = ["pets 480x360", "pets 1280x720", "crowd 10", "crowd 30", "crowd 100"]
-MODES = ["decode", "builtin", "builtin-first", "public", "render"]
+MODES = ["decode", "builtin", "builtin-first", "public", "render", "builtin-640", "render-640"]
 N_720, N_CROWD = 300, 150
 
 Source = tuple[Path, dict[int, F64]]  # (video, detections {frame: (k, 5) l, t, w, h, score})
@@ -108,7 +111,11 @@ def _decode(video: Path) -> int:
 
 
 def _track(
-    video: Path, dets: dict[int, F64] | None, render: Path | None, bootstrap: str = "auto"
+    video: Path,
+    dets: dict[int, F64] | None,
+    render: Path | None,
+    bootstrap: str = "auto",
+    max_side: int | None = None,
 ) -> int:
     renderer = TrackRenderer(render, 25.0) if render is not None else None
 
@@ -117,7 +124,13 @@ def _track(
             renderer.add(frame, tracks)
 
     run = track_frames(
-        video, detections=dets, rng=0, show_progress=False, on_frame=on_frame, bootstrap=bootstrap
+        video,
+        detections=dets,
+        config=replace(TrackerConfig(), max_side=max_side),
+        rng=0,
+        show_progress=False,
+        on_frame=on_frame,
+        bootstrap=bootstrap,
     )
     if renderer is not None:
         renderer.close()
@@ -143,6 +156,8 @@ def test_pipeline(
         "builtin-first": lambda: _track(video, None, None, bootstrap="first"),
         "public": lambda: _track(video, dets, None),
         "render": lambda: _track(video, None, tmp_path / "render.mp4"),
+        "builtin-640": lambda: _track(video, None, None, max_side=640),
+        "render-640": lambda: _track(video, None, tmp_path / "render.mp4", max_side=640),
     }
     if mode != "decode":  # decoding alone, just before, for the ratio side by side
         cpu0, wall0 = time.process_time(), time.perf_counter()
@@ -152,7 +167,7 @@ def test_pipeline(
     n = benchmark.pedantic(jobs[mode], rounds=1, iterations=1)
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
     assert n > 0
-    if mode == "render":
+    if mode.startswith("render"):
         assert _decode(tmp_path / "render.mp4") == n
     benchmark.extra_info.update(
         frames=n, ms_per_frame=round(1000 * wall / n, 3), cpu_s=round(cpu, 3), wall_s=round(wall, 3)
