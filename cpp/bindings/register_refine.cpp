@@ -14,7 +14,7 @@ void register_refine(py::module_& m) {
     m.def(
         "refine_boxes",
         [](Eigen::Ref<const RowMatrixXd> boxes, const py::array& mask, double fraction,
-           double min_cover) {
+           double min_cover, double leg_fill) {
             const char* fn = "refine_boxes";
             require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
             require_finite(boxes, fn, "boxes");
@@ -26,15 +26,19 @@ void register_refine(py::module_& m) {
                     fraction, "in [0, 1)");
             require(std::isfinite(min_cover) && min_cover >= 0.0 && min_cover <= 1.0, fn,
                     "min_cover", min_cover, "in [0, 1]");
+            require(std::isfinite(leg_fill) && leg_fill <= 1.0, fn, "leg_fill", leg_fill,
+                    "in [0, 1] (negative: off)");
             RowMatrixXd out = boxes;
             const auto* data = static_cast<const std::uint8_t*>(mask.data());
             const Index rows = mask.shape(0), cols = mask.shape(1), stride = mask.strides(0);
             {
                 py::gil_scoped_release nogil;  // safe: `out` is ours, `mask` kept alive by the caller
-                refine_boxes(out, data, rows, cols, stride, fraction, min_cover);
+                refine_boxes(out, data, rows, cols, stride, fraction, min_cover, leg_fill);
             }
             return out;
         },
         py::arg("boxes"), py::arg("mask"), py::arg("fraction"), py::arg("min_cover"),
-        "Boxes (K, 4) left, top, w, h shrunk to the foreground of mask (H, W) uint8 or bool.");
+        py::arg("leg_fill") = -1.0,
+        "Boxes (K, 4) left, top, w, h shrunk to the foreground of mask (H, W) uint8 or bool; "
+        "with leg_fill in [0, 1], mask 255/127/0 and boxes grown down through shadowed legs.");
 }

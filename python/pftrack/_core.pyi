@@ -203,7 +203,9 @@ def bhattacharyya_weights(hists: _F64, ref: _F64, lam: float = 20.0) -> _F64: ..
 def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascending
 
 # --- box refinement: boxes (K, 4) left, top, w, h; mask (H, W) uint8 or bool -> (K, 4) -----
-def refine_boxes(boxes: _F64, mask: NDArray[Any], fraction: float, min_cover: float) -> _F64: ...
+def refine_boxes(
+    boxes: _F64, mask: NDArray[Any], fraction: float, min_cover: float, leg_fill: float = ...
+) -> _F64: ...
 
 # --- blob pass: mask (H, W) uint8 0/255 -> boxes (K, 4) left, top, w, h and fills (K,) -------
 # size_lines (2, 2) [[h_slope, h_intercept], [w_slope, w_intercept]] in the foot row, or None

@@ -37,6 +37,47 @@ def test_matches_reference(seed: int) -> None:
         np.testing.assert_array_equal(got_bool, want)
 
 
+def _shaded(rng: np.random.Generator, rows: int = 90, cols: int = 120) -> np.ndarray:
+    """The same with shadow pixels (127): patches of shadow, some of them below an object."""
+    mask = _scene(rng, rows, cols)
+    for _ in range(6):
+        x, y = rng.integers(0, cols - 5), rng.integers(0, rows - 5)
+        w, h = rng.integers(3, 30), rng.integers(3, 30)
+        patch = mask[y : y + h, x : x + w]
+        patch[(patch == 0) & (rng.random(patch.shape) < 0.8)] = 127
+    return mask
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_legs_match_reference(seed: int) -> None:
+    rng = np.random.default_rng(100 + seed)
+    mask = _shaded(rng)
+    k = 30
+    boxes = np.column_stack(
+        [rng.uniform(-20, 130, k), rng.uniform(-20, 100, k), rng.uniform(0, 60, (k, 2))]
+    )
+    for fraction, min_cover, fill in [(0.05, 0.1, 0.5), (0.0, 0.01, 0.0), (0.5, 0.3, 1.0)]:
+        got = refine_boxes(boxes, mask, fraction, min_cover, fill)
+        want = refine_boxes_reference(boxes, mask, fraction, min_cover, fill)
+        np.testing.assert_array_equal(got, want)
+
+
+def test_legs_taken_for_shadow_come_back_a_cast_shadow_does_not() -> None:
+    mask = np.zeros((60, 60), np.uint8)
+    mask[5:30, 20:30] = 255  # torso: foreground
+    mask[30:50, 21:29] = 127  # legs, taken for shadow
+    mask[50:54, 30:58] = 127  # the shadow cast beside the feet
+    box = np.array([[15.0, 2.0, 45.0, 55.0]])
+    np.testing.assert_array_equal(refine_boxes(box, mask, 0.05, leg_fill=0.5), [[20, 5, 10, 45]])
+    # without legs every non-zero pixel is foreground: the shadow widens the box
+    np.testing.assert_array_equal(refine_boxes(box, mask, 0.05), [[20, 5, 38, 49]])
+    np.testing.assert_array_equal(
+        refine_boxes(box, np.where(mask == 255, 255, 0).astype(np.uint8), 0.05), [[20, 5, 10, 25]]
+    )
+    with pytest.raises(ValueError, match="leg_fill"):
+        refine_boxes(box, mask, 0.05, leg_fill=1.5)
+
+
 def test_strided_mask_and_boxes_untouched() -> None:
     rng = np.random.default_rng(1)
     big = _scene(rng, 90, 240)

@@ -20,8 +20,19 @@ namespace pftrack {
 /// columns whose foreground share exceeds `fraction` times the densest one's are kept and the
 /// box spans the first to the last kept one. Shares are count / length in double, as NumPy's
 /// mean of a boolean patch gives them, so the comparisons are the reference's to the bit.
+///
+/// With `leg_fill` in [0, 1] the mask has shadows (255 foreground, 127 shadow, 0 background):
+/// only 255 is foreground for the steps above, and a refined box then grows down, row by row
+/// below its last row and down to the clipped box's last row, while the row's share of
+/// foreground or shadow pixels between its first and last column is at least `leg_fill`:
+/// legs that the shadow test took for shadow (dark trousers on a grey path), which a cast
+/// shadow beside the feet, outside those columns, does not extend. A negative `leg_fill`: no
+/// growing, and every non-zero pixel is foreground.
 inline void refine_boxes(Eigen::Ref<RowMatrixXd> boxes, const std::uint8_t* mask, Index rows,
-                         Index cols, Index stride, double fraction, double min_cover) {
+                         Index cols, Index stride, double fraction, double min_cover,
+                         double leg_fill = -1.0) {
+    const bool legs = leg_fill >= 0.0;
+    const std::uint8_t level = legs ? 127 : 0;  // foreground: mask > level
     std::vector<std::int32_t> col_count, row_count;
     for (Index k = 0; k < boxes.rows(); ++k) {
         const double x = boxes(k, 0), y = boxes(k, 1), w = boxes(k, 2), h = boxes(k, 3);
@@ -38,7 +49,7 @@ inline void refine_boxes(Eigen::Ref<RowMatrixXd> boxes, const std::uint8_t* mask
             const std::uint8_t* m = mask + (y0 + r) * stride + x0;
             std::int32_t n = 0;
             for (Index c = 0; c < pw; ++c) {
-                const std::int32_t on = m[c] != 0;
+                const std::int32_t on = m[c] > level;
                 n += on;
                 col_count[static_cast<size_t>(c)] += on;
             }
@@ -62,6 +73,16 @@ inline void refine_boxes(Eigen::Ref<RowMatrixXd> boxes, const std::uint8_t* mask
                 r1 = r;
             }
         if (c0 < 0 || r0 < 0) continue;  // fraction >= 1: nothing exceeds the densest
+        if (legs) {
+            const double span = static_cast<double>(c1 + 1 - c0);
+            while (r1 + 1 < ph) {
+                const std::uint8_t* m = mask + (y0 + r1 + 1) * stride + x0;
+                std::int32_t n = 0;
+                for (Index c = c0; c <= c1; ++c) n += m[c] != 0;
+                if (static_cast<double>(n) / span < leg_fill) break;
+                ++r1;
+            }
+        }
         boxes(k, 0) = static_cast<double>(x0 + c0);
         boxes(k, 1) = static_cast<double>(y0 + r0);
         boxes(k, 2) = static_cast<double>(c1 + 1 - c0);

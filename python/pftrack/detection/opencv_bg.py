@@ -124,10 +124,14 @@ class _OpenCvDetector:
         boxes, scores = self._blobs.boxes(mask)
         return Detections(boxes, scores, mask, _core.hsv_bins(frame, mask, **self._hsv))
 
-    def foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], None]:
+    def foreground(
+        self, frame: NDArray[np.uint8], shadows: bool = False
+    ) -> tuple[NDArray[np.uint8], None]:
         """Return the cleaned foreground mask (shadows are background), without blobs or boxes.
 
-        No full-frame bins come with it (None: OpenCV's subtractors do not make them).
+        With `shadows` the mask keeps OpenCV's shadow pixels as 127 (255 foreground, 0
+        background). No full-frame bins come with it (None: OpenCV's subtractors do not make
+        them).
         """
         fn = f"{type(self).__name__}.foreground"
         frame = check_frame(frame, fn)
@@ -138,6 +142,8 @@ class _OpenCvDetector:
             )
         self._shape = frame.shape
         raw = self._sub.apply(frame, learningRate=self._learning_rate)
+        if shadows:  # 255 foreground, 127 shadow (the grey-level cleaning keeps both)
+            return self._blobs.clean(np.asarray(raw, np.uint8)), None
         # 255 = foreground, 127 = shadow: shadows are background.
         raw = np.where(raw == 255, np.uint8(255), np.uint8(0))
         return self._blobs.clean(raw), None

@@ -247,14 +247,17 @@ class PaperDetector:
         mask = np.bitwise_xor(mask, gmask)
         return mask, boxes[~ghost], scores[~ghost]
 
-    def foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
+    def foreground(
+        self, frame: NDArray[np.uint8], shadows: bool = False
+    ) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
         """The cleaned foreground mask and the frame's HSV bins, without blobs or boxes.
 
         The background model advances exactly as with :meth:`detect`; a tracker fed by another
         detector needs only these (to refine that detector's boxes) and skips the blob pass.
+        With `shadows` the mask keeps the shadow pixels as 127 (255 foreground, 0 background).
         """
         shaded, binned = self._foreground(frame, "PaperDetector.foreground")
-        return foreground_only(shaded), binned
+        return (shaded if shadows else foreground_only(shaded)), binned
 
     def _foreground(
         self, frame: NDArray[np.uint8], fn: str

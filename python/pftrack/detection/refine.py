@@ -21,6 +21,7 @@ def refine_boxes(
     mask: NDArray[np.uint8] | NDArray[np.bool_],
     fraction: float = 0.1,
     min_cover: float = 0.1,
+    leg_fill: float | None = None,
 ) -> F64:
     """Shrink boxes to the extent of their foreground.
 
@@ -29,13 +30,21 @@ def refine_boxes(
     boxes_xywh : (K, 4) array_like
         Boxes (left, top, width, height).
     mask : (H, W) ndarray of uint8 or bool
-        Foreground mask (non-zero = foreground).
+        Foreground mask (non-zero = foreground); with `leg_fill`, a mask with shadows (255
+        foreground, 127 shadow, 0 background, OpenCV MOG2's convention).
     fraction : float
         Rows and columns whose foreground share is above ``fraction`` times the densest row or
         column's are kept; the new box spans the first to the last kept one. In [0, 1).
     min_cover : float
         Boxes whose foreground covers less than this share are returned unchanged (the
         background model has not seen the object move, or it is not there). In [0, 1].
+    leg_fill : float, optional
+        In [0, 1]: only 255 is foreground for the steps above, and a refined box then grows
+        down, row by row, while the row's share of foreground or shadow pixels between the
+        refined box's first and last column is at least `leg_fill`, no further than the
+        original box. Legs the shadow test took for shadow (dark trousers on a grey path) come
+        back; a shadow cast beside the feet, outside those columns, does not extend the box.
+        None: no growing, every non-zero pixel is foreground.
 
     Returns
     -------
@@ -46,8 +55,8 @@ def refine_boxes(
     Raises
     ------
     ValueError
-        `boxes_xywh` not (K, 4) or not finite, `mask` not 2-D uint8 or bool, or `fraction` or
-        `min_cover` out of range.
+        `boxes_xywh` not (K, 4) or not finite, `mask` not 2-D uint8 or bool, or `fraction`,
+        `min_cover` or `leg_fill` out of range.
     """
     b = np.ascontiguousarray(boxes_xywh, dtype=np.float64)
     if b.size == 0:
@@ -59,5 +68,8 @@ def refine_boxes(
     m = np.asarray(mask)
     if m.ndim == 2 and m.strides[1] != 1:
         m = np.ascontiguousarray(m)
-    out: F64 = _core.refine_boxes(b, m, float(fraction), float(min_cover))
+    if leg_fill is not None and not 0.0 <= leg_fill <= 1.0:
+        raise ValueError(f"refine_boxes: leg_fill is {leg_fill}, expected None or [0, 1]")
+    fill = -1.0 if leg_fill is None else float(leg_fill)
+    out: F64 = _core.refine_boxes(b, m, float(fraction), float(min_cover), fill)
     return out

@@ -16,6 +16,7 @@ byte for byte, as with the detector called in ``update``.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Iterable, Iterator
 from types import TracebackType
 from typing import Any
@@ -24,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack.io.prefetch import prefetch
-from pftrack.tracking.tracker import MultiObjectTracker
+from pftrack.tracking.tracker import MultiObjectTracker, takes_shadows
 
 __all__ = ["DetectAhead"]
 
@@ -36,9 +37,10 @@ _Frame = NDArray[np.uint8]
 class _StandIn:
     """The tracker's detector during a run: returns what the thread computed for each frame."""
 
-    def __init__(self, foreground_only: bool) -> None:
+    def __init__(self, foreground_only: bool, shadows: bool) -> None:
         self._foreground_only = foreground_only
         self._next: _Work | None = None
+        self.foreground_shadows = shadows  # whether the real detector's foreground takes them
 
     def expect(self, work: _Work) -> None:
         """The next frame the tracker will ask about, and the thread's result or error."""
@@ -59,8 +61,11 @@ class _StandIn:
         """The thread's ``detect(frame)``."""
         return self._take(frame, False)
 
-    def foreground(self, frame: NDArray[np.uint8]) -> Any:
-        """The thread's ``foreground(frame)`` (or the mask and bins of its ``detect``)."""
+    def foreground(self, frame: NDArray[np.uint8], shadows: bool = False) -> Any:
+        """The thread's ``foreground(frame)`` (or the mask and bins of its ``detect``).
+
+        Computed there with the `shadows` the tracker asks for (its ``wants_shadows``).
+        """
         return self._take(frame, True)
 
     def reset(self) -> None:
@@ -122,10 +127,13 @@ class DetectAhead:
             call = detector.detect
         elif hasattr(detector, "foreground"):
             call = detector.foreground
+            if self._tracker.wants_shadows and takes_shadows(detector):
+                call = functools.partial(detector.foreground, shadows=True)
         else:
             call = _mask_and_bins(detector)
+        shadows = hasattr(detector, "foreground") and takes_shadows(detector)
         self._detector = detector
-        self._stand_in = _StandIn(self._external)
+        self._stand_in = _StandIn(self._external, shadows)
         self._stream = prefetch(_work(self._frames, call, self._prepare), depth=self._depth)
         self._tracker.detector = self._stand_in
         return self._hand_over(self._stream, self._stand_in, self._hand)

@@ -218,10 +218,21 @@ class RefineConfig:
     fraction : float
         A row or column belongs to the object when its foreground fraction exceeds this share of
         the box's densest row or column.
+    leg_fill : float or None
+        Shadow pixels are not foreground, but a refined box grows down through rows where
+        foreground or shadow fills at least this share of its columns, no further than the
+        detection's box: legs that the shadow test took for shadow come back, a shadow cast
+        beside the feet does not widen the box (``refine_boxes``' `leg_fill`). None: shadows
+        are background and boxes do not grow.
     """
 
     enabled: bool = True
     fraction: float = 0.05
+    leg_fill: float | None = 0.5
+
+    def __post_init__(self) -> None:
+        if self.leg_fill is not None and not 0.0 <= self.leg_fill <= 1.0:
+            raise ValueError(f"RefineConfig: leg_fill is {self.leg_fill}, expected None or [0, 1]")
 
 
 @dataclass(frozen=True)

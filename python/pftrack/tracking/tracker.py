@@ -14,6 +14,7 @@ one joint sampler replaces all of this (:mod:`.joint`).
 
 from __future__ import annotations
 
+import inspect
 import itertools
 from collections.abc import Iterable
 from typing import Any
@@ -25,6 +26,7 @@ from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
+from pftrack.detection.paper import foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.tracking.association import associate, covers_another
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
@@ -139,30 +141,47 @@ class MultiObjectTracker:
         boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
         if np.any((scores < 0) | (scores > 1)):
             self._scores_are_confidences = False
-        mask, binned = None, None
+        mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
-            mask, binned = self._foreground(frame)
+            mask, binned, shaded = self._foreground(frame)
         if binned is None:  # full-frame bins: the detector's fused pass made them, or one here
             binned = hsv_bins(frame, None, cfg.binning)
         # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
         # useful (measured in experiments/moving_camera.py)
         if cfg.refine.enabled and mask is not None and len(boxes):
-            boxes = refine_boxes(boxes, mask, cfg.refine.fraction)
+            fill = cfg.refine.leg_fill if shaded else None
+            boxes = refine_boxes(boxes, mask, cfg.refine.fraction, leg_fill=fill)
         return boxes, scores, binned
 
-    def _foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], Any]:
-        """Return the foreground mask and full-frame bins (or None) for external detections.
+    @property
+    def wants_shadows(self) -> bool:
+        """Whether box refinement asks the detector's ``foreground`` for shadows (127).
 
-        From the detector's ``foreground`` when it has one (no blob pass), else its ``detect``.
+        With :attr:`RefineConfig.leg_fill` set (a detector whose ``foreground`` takes no
+        `shadows` argument gives its plain mask, and boxes do not grow).
+        """
+        cfg = self.config.refine
+        return cfg.enabled and cfg.leg_fill is not None
+
+    def _foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], Any, bool]:
+        """Return the mask, full-frame bins (or None) and whether the mask has shadows (127).
+
+        From the detector's ``foreground`` when it has one (no blob pass), with shadows when
+        :attr:`wants_shadows`, else its ``detect``. :attr:`last_mask` is the foreground alone.
         """
         detector = self._ensure_detector()
+        shaded = False
         if hasattr(detector, "foreground"):
-            mask, frame_bins = detector.foreground(frame)
+            shaded = self.wants_shadows and takes_shadows(detector)
+            if shaded:
+                mask, frame_bins = detector.foreground(frame, shadows=True)
+            else:
+                mask, frame_bins = detector.foreground(frame)
         else:
             det = detector.detect(frame)
             mask, frame_bins = det.mask, det.frame_bins
-        self.last_mask = mask
-        return mask, frame_bins
+        self.last_mask = foreground_only(mask) if shaded else mask
+        return mask, frame_bins, shaded
 
     def _birth_threshold(self, scores: F64) -> float:
         """The score a detection needs to start a track (``LifecycleConfig.birth_quantile``).
@@ -310,3 +329,18 @@ class MultiObjectTracker:
         early = self.frame_index <= cfg.lifecycle.min_hits
         reports = (t.report(self.frame_index, early, cfg.lifecycle) for t in self.tracks)
         return [r for r in reports if r is not None]
+
+
+def takes_shadows(detector: Any) -> bool:
+    """Whether `detector`'s ``foreground`` takes a `shadows` argument (pftrack's detectors do).
+
+    A detector may say so itself with a boolean ``foreground_shadows`` attribute (the stand-in
+    of :class:`~pftrack.tracking.ahead.DetectAhead` repeats its real detector's answer).
+    """
+    said = getattr(detector, "foreground_shadows", None)
+    if isinstance(said, bool):
+        return said
+    try:
+        return "shadows" in inspect.signature(detector.foreground).parameters
+    except (TypeError, ValueError):  # no signature (a C extension's method)
+        return False
