@@ -106,6 +106,15 @@ def test_the_run_scales_on_the_detection_thread_with_the_loops_rows(scene):
     assert np.array_equal(threaded.rows, expect)
 
 
+def test_a_frame_of_another_size_is_refused(scene):
+    tracker = pftrack.Tracker(max_side=480)
+    tracker.update(None, doubled(scene.frames[0]))
+    with pytest.raises(ValueError, match="earlier frames 960x720"):
+        tracker.update(None, scene.frames[1])
+    tracker.reset()
+    tracker.update(None, scene.frames[1])  # a new run may have another size
+
+
 @pytest.mark.parametrize("side", [10, 0, True, 640.0, "640"])
 def test_bad_max_side_is_refused(side):
     with pytest.raises(ValueError, match="max_side"):

@@ -334,6 +334,7 @@ class Tracker:
         self._max_conf = -np.inf
         self._given = False  # some update() of the run had detections
         self._scale: tuple[float, float] | None = None  # working / frame pixels (x, y)
+        self._shape: tuple[int, ...] | None = None  # the run's frame shape, with max_side
         self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
 
     @property
@@ -426,6 +427,15 @@ class Tracker:
         f = np.asarray(frame)
         if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
             raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        if self.config.max_side is not None:  # one scale for the whole run's rows
+            if self._shape is None:
+                self._shape = f.shape
+            elif f.shape != self._shape:
+                raise ValueError(
+                    f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
+                    f"{self._shape[1]}x{self._shape[0]} (max_side scales one size per run; "
+                    "call reset() before a new video)"
+                )
         work = self._working(f)
         self._scale = (
             None if work is f else (work.shape[1] / f.shape[1], work.shape[0] / f.shape[0])
