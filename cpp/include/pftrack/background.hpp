@@ -478,7 +478,9 @@ namespace detail {
 PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict src,
                                                 const std::uint8_t* __restrict m,
                                                 std::int16_t* __restrict o, Index cols) {
-    for (Index x = 0; x < cols; ++x) o[x] = m[x] ? src[x] : std::int16_t(-1);
+    // branch-free: -1 (all bits set) where the mask is 0, the bin where it is not
+    for (Index x = 0; x < cols; ++x)
+        o[x] = static_cast<std::int16_t>(src[x] | -static_cast<std::int16_t>(m[x] == 0));
 }
 
 }  // namespace detail
