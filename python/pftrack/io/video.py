@@ -46,7 +46,7 @@ REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
 
 
-def _file_capture(path: PathLike) -> cv2.VideoCapture:
+def _file_capture(path: str) -> cv2.VideoCapture:
     """A ``cv2.VideoCapture`` of a stored video file whose decoder runs on the calling thread.
 
     OpenCV's FFmpeg backend otherwise starts one decoding thread per CPU; measured on the
@@ -55,11 +55,11 @@ def _file_capture(path: PathLike) -> cv2.VideoCapture:
     on a thread of its own already (:mod:`pftrack.io.prefetch`), and a ``pftrack batch`` worker
     has one core. Falls back to OpenCV's default backend choice if FFmpeg cannot open the file.
     """
-    cap = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, 1])
+    cap = cv2.VideoCapture(path, cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, 1])
     if cap.isOpened():
         return cap
     cap.release()
-    return cv2.VideoCapture(str(path))
+    return cv2.VideoCapture(path)
 
 
 def natural_key(name: str) -> tuple[tuple[int, int | str], ...]:
@@ -311,7 +311,7 @@ class FrameSource:
 
     @staticmethod
     def _probe_file(path: Path) -> tuple[NDArray[Any], float, int]:
-        cap = _file_capture(path)
+        cap = _file_capture(str(path))
         try:
             ok, first = cap.read() if cap.isOpened() else (False, None)
             fps = float(cap.get(cv2.CAP_PROP_FPS)) if cap.isOpened() else 0.0
@@ -398,7 +398,7 @@ class FrameSource:
             return out
         picked: list[NDArray[np.uint8]] = []
         keep = set(wanted)
-        cap = _file_capture(self.path)
+        cap = _file_capture(str(self.path))
         try:
             for i in range(wanted[-1] + 1):
                 if self.stopped:
@@ -423,7 +423,7 @@ class FrameSource:
             for p in self._images:
                 yield self._read_image(p)
             return
-        cap = _file_capture(self.path)
+        cap = _file_capture(str(self.path))
         decoded = 0
         try:
             while True:
