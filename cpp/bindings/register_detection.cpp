@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -9,6 +10,7 @@
 #include "arrays.hpp"
 #include "pftrack/background.hpp"
 #include "pftrack/ghost.hpp"
+#include "pftrack/morphology.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
@@ -34,6 +36,16 @@ void check_frame_and_mask(const BackgroundModel& self, const py::array& frame,
             "frame shape is " + shape_str(frame) + ", expected (" + std::to_string(self.rows()) +
                 ", " + std::to_string(self.cols()) + ", 3)");
     bind::check_mask(mask, self.rows(), self.cols(), fn);
+}
+
+/// A structuring element: (kh, kw) uint8 or bool, C-contiguous, each row one run.
+std::vector<ElementRow> to_element(const py::array& k, const char* fn) {
+    bind::check_mask_dtype(k, fn);
+    if (!(k.ndim() == 2 && k.shape(0) >= 1 && k.shape(1) >= 1))
+        fail(fn, "element must have shape (kh, kw) with kh, kw >= 1");
+    if (!(k.strides(1) == 1 && k.strides(0) == k.shape(1)))
+        fail(fn, "element must be C-contiguous");
+    return element_rows(static_cast<const std::uint8_t*>(k.data()), k.shape(0), k.shape(1), fn);
 }
 
 }  // namespace
@@ -261,4 +273,37 @@ void register_detection(py::module_& m) {
         },
         py::arg("binned"), py::arg("mask"),
         "New BinnedImage with bins -1 where mask (H, W) uint8/bool is 0 (background).");
+
+    m.def(
+        "close_mask",
+        [](const py::array& mask, const py::array& element) {
+            const char* fn = "close_mask";
+            if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
+                fail(fn, "mask must be a non-empty (H, W) array");
+            bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
+            const std::vector<ElementRow> el = to_element(element, fn);
+            const Index rows = mask.shape(0), cols = mask.shape(1);
+            auto out = new_mask(rows, cols);
+            std::uint8_t* optr = out.mutable_data();
+            const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
+            const Index mstride = mask.strides(0);
+            {
+                py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
+                std::vector<std::uint8_t> packed;  // the mask's rows packed, if they are strided
+                if (mstride != cols) {
+                    packed.resize(static_cast<size_t>(rows * cols));
+                    for (Index y = 0; y < rows; ++y)
+                        std::memcpy(packed.data() + y * cols, mptr + y * mstride,
+                                    static_cast<size_t>(cols));
+                    mptr = packed.data();
+                }
+                std::unique_ptr<std::uint8_t[]> tmp(new std::uint8_t[static_cast<size_t>(rows * cols)]);
+                MorphScratch scratch;
+                close_mask(mptr, optr, tmp.get(), rows, cols, el, scratch);
+            }
+            return out;
+        },
+        py::arg("mask"), py::arg("element"),
+        "Closing (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
+        "single runs: cv2.morphologyEx(mask, MORPH_CLOSE, element)'s values.");
 }

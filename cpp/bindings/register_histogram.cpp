@@ -105,16 +105,7 @@ void register_histogram(py::module_& m) {
             const std::shared_ptr<const HsvLut> lut = cached_lut(p);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers only, held alive by the caller
-                std::int16_t* out = img->data.data();
-                for (py::ssize_t y = 0; y < rows; ++y) {
-                    const std::uint8_t* px = src + y * stride;
-                    const std::uint8_t* m = mptr ? mptr + y * mstride : nullptr;
-                    std::int16_t* o = out + y * cols;
-                    for (py::ssize_t x = 0; x < cols; ++x) {
-                        const int bin = lut->bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]);
-                        o[x] = (m && m[x] == 0) ? std::int16_t(-1) : static_cast<std::int16_t>(bin);
-                    }
-                }
+                hsv_bins_image(*lut, src, rows, cols, stride, mptr, mstride, img->data.data());
             }
             return img;
         },

@@ -176,6 +176,10 @@ def hsv_bins(
 def median_frames(frames: Sequence[NDArray[np.uint8]]) -> NDArray[np.float32]: ...
 def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # mask (H, W)
 
+# closing of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are single runs,
+# as cv2.morphologyEx(MORPH_CLOSE) -> new (H, W) uint8
+def close_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: ...
+
 # boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)
 # method "auto" | "direct" | "integral", as box_weights (the same histograms on every path)
 def box_histograms(

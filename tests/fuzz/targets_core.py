@@ -383,6 +383,16 @@ TARGETS: list[Target] = [
     ),  # fmt: skip
     Target("mask_bins", call(_core.mask_bins, maybe(binned()), maybe(masks()))),
     Target(
+        "close_mask",
+        call(
+            _core.close_mask,
+            maybe(masks().flatmap(layout)),
+            maybe(
+                hnp.arrays(st.sampled_from([np.uint8, np.bool_]), st.tuples(ints(1, 7), ints(1, 7)))
+            ),
+        ),
+    ),  # fmt: skip
+    Target(
         "median_frames", call(_core.median_frames, maybe(st.lists(maybe(frames()), max_size=4)))
     ),
     Target(

@@ -234,3 +234,53 @@ def test_an_image_of_another_size_in_a_folder_is_named(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=message):
         src.frames_at([0, 3])
     assert len(src.frames_at([0, 1, 4])) == 3
+
+
+def _default_capture_frames(path: Path) -> list[np.ndarray]:
+    cap = cv2.VideoCapture(str(path))  # OpenCV's own choice of backend and decoder threads
+    frames = []
+    while True:
+        ok, frame = cap.read()
+        if not ok:
+            break
+        frames.append(frame)
+    cap.release()
+    return frames
+
+
+def _assert_same_pixels_as_default_capture(path: Path) -> None:
+    """FrameSource decodes with one FFmpeg thread: every frame the same as OpenCV's default."""
+    want = _default_capture_frames(path)
+    src = FrameSource(path)
+    got = list(src)
+    assert len(got) == len(want) > 0
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, b)
+    picked = [0, len(want) // 3, len(want) - 1]
+    for a, k in zip(src.frames_at(picked), picked, strict=True):
+        np.testing.assert_array_equal(a, want[k])
+
+
+def test_h264_file_frames_equal_the_default_capture(tmp_path: Path) -> None:
+    path = tmp_path / "walk.mp4"
+    scene = make_scene(n_frames=40, n_walkers=4, rng=1)
+    try:
+        out = av.open(str(path), "w")
+        stream = out.add_stream("libx264", rate=10)
+    except (av.FFmpegError, ValueError) as error:  # an av build without x264
+        pytest.skip(f"no H.264 encoder: {error}")
+    stream.height, stream.width = scene.frames[0].shape[:2]
+    stream.pix_fmt = "yuv420p"
+    stream.options = {"bf": "2", "g": "12"}  # B-frames and several key frames: reordering
+    for frame in scene.frames:
+        out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
+    out.mux(stream.encode())
+    out.close()
+    _assert_same_pixels_as_default_capture(path)
+
+
+@pytest.mark.dataset
+@pytest.mark.parametrize("name", ["pets09-s2l1/video.avi", "tud-campus/video.mp4"])
+def test_dataset_frames_equal_the_default_capture(name: str) -> None:
+    folder, file = name.split("/")
+    _assert_same_pixels_as_default_capture(dataset(folder) / file)

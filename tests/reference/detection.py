@@ -162,3 +162,27 @@ def median_frames_reference(frames: list[np.ndarray]) -> np.ndarray:
     s = np.sort(np.stack(frames).astype(np.float64), axis=0)
     m = len(frames)
     return ((s[(m - 1) // 2] + s[m // 2]) / 2).astype(np.float32)
+
+
+def morphology_reference(src: np.ndarray, element: np.ndarray, op: str) -> np.ndarray:
+    """Grey erosion (``"erode"``) or dilation (``"dilate"``) of `src` by `element`, in NumPy.
+
+    dst(y, x) = min or max over the element's set pixels (dy, dx), taken about its centre
+    (kh // 2, kw // 2), of src(y + dy, x + dx); pixels outside the image never win (padded with
+    255 for an erosion, 0 for a dilation): cv2.erode / cv2.dilate with their default border.
+    """
+    kh, kw = element.shape
+    ay, ax = kh // 2, kw // 2
+    fill = 255 if op == "erode" else 0
+    pad = np.full((src.shape[0] + kh, src.shape[1] + kw), fill, np.uint8)
+    pad[ay : ay + src.shape[0], ax : ax + src.shape[1]] = src
+    reduce = np.minimum if op == "erode" else np.maximum
+    out = np.full(src.shape, fill, np.uint8)
+    for dy, dx in zip(*np.nonzero(element), strict=True):
+        out = reduce(out, pad[dy : dy + src.shape[0], dx : dx + src.shape[1]])
+    return out
+
+
+def close_mask_reference(mask: np.ndarray, element: np.ndarray) -> np.ndarray:
+    """The closing of `mask` by `element` (a dilation, then an erosion), in NumPy."""
+    return morphology_reference(morphology_reference(mask, element, "dilate"), element, "erode")

@@ -128,25 +128,41 @@ namespace detail {
 
 /// Per pixel of one row, in float (exact on these small integers), branch-free: HsvLut indices
 /// (sat, hue), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
+/// The HsvLut indices of one pixel (HsvLut::bin's sat and hue), in float (exact on these small
+/// integers) and without branches, so that the loops calling it vectorise.
+inline __attribute__((always_inline)) void hsv_indices(float b, float g, float r,
+                                                       std::int32_t& sat, std::int32_t& hue) {
+    const float hue_stride = static_cast<float>(HsvLut::kHueStride);
+    const float mx = std::max(r, std::max(g, b));
+    const float mn = std::min(r, std::min(g, b));
+    // sector 0 if max is r, else 1 if g, else 2; num = g - b, b - r, r - g resp. (0/1 blends)
+    const float not_r = static_cast<float>(mx != r), not_g = static_cast<float>(mx != g);
+    const float sector = not_r * (1.0f + not_g);
+    const float num =
+        (1.0f - not_r) * (g - b) + not_r * ((1.0f - not_g) * (b - r) + not_g * (r - g));
+    const float d = mx - mn;
+    sat = static_cast<std::int32_t>(mx * 256.0f + mn);
+    hue = static_cast<std::int32_t>(sector * hue_stride + (d * d + (num + d)));
+}
+
+/// The HsvLut indices of one row of BGR bytes (see `hsv_indices`).
+PFTRACK_VECTOR_CLONES static void hsv_row_indices(Index n, const std::uint8_t* __restrict px,
+                                                  std::int32_t* __restrict si,
+                                                  std::int32_t* __restrict hi) {
+    for (Index x = 0; x < n; ++x)
+        hsv_indices(static_cast<float>(px[3 * x]), static_cast<float>(px[3 * x + 1]),
+                    static_cast<float>(px[3 * x + 2]), si[x], hi[x]);
+}
+
 PFTRACK_VECTOR_CLONES static void background_row_scan(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
     const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
     const float* __restrict dprev, float t, float t_low, std::int32_t* __restrict si,
     std::int32_t* __restrict hi, std::int32_t* __restrict di,
     float* __restrict cand) {
-    const float hue_stride = static_cast<float>(HsvLut::kHueStride);
     for (Index x = 0; x < n; ++x) {
         const float b = fb[x], g = fg[x], r = fr[x];
-        const float mx = std::max(r, std::max(g, b));
-        const float mn = std::min(r, std::min(g, b));
-        // sector 0 if max is r, else 1 if g, else 2; num = g - b, b - r, r - g resp. (0/1 blends)
-        const float not_r = static_cast<float>(mx != r), not_g = static_cast<float>(mx != g);
-        const float sector = not_r * (1.0f + not_g);
-        const float num =
-            (1.0f - not_r) * (g - b) + not_r * ((1.0f - not_g) * (b - r) + not_g * (r - g));
-        const float d = mx - mn;
-        si[x] = static_cast<std::int32_t>(mx * 256.0f + mn);
-        hi[x] = static_cast<std::int32_t>(sector * hue_stride + (d * d + (num + d)));
+        hsv_indices(b, g, r, si[x], hi[x]);
         const float d_bg = std::max(std::abs(b - qb[x]), std::max(std::abs(g - qg[x]), std::abs(r - qr[x])));
         di[x] = static_cast<std::int32_t>(std::min(d_bg, 255.0f));
         cand[x] = ((d_bg > t) | ((dprev[x] > t) & (d_bg > t_low))) ? 1.0f : 0.0f;
@@ -478,10 +494,37 @@ namespace detail {
 PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict src,
                                                 const std::uint8_t* __restrict m,
                                                 std::int16_t* __restrict o, Index cols) {
-    for (Index x = 0; x < cols; ++x) o[x] = m[x] ? src[x] : std::int16_t(-1);
+    // branch-free: -1 (all bits set) where the mask is 0, the bin where it is not
+    for (Index x = 0; x < cols; ++x)
+        o[x] = static_cast<std::int16_t>(src[x] | -static_cast<std::int16_t>(m[x] == 0));
 }
 
 }  // namespace detail
+
+/// `HsvLut::bin` of every pixel of a BGR frame (rows x cols, `row_stride` bytes a row) into
+/// `out` (rows x cols, packed), -1 where `mask` (if not null, `mask_stride` bytes a row) is 0: the
+/// table indices of a whole row by the vectorised `hsv_row_indices`, then the look-ups (the same
+/// bins as `HsvLut::bin` pixel by pixel, several times faster).
+inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
+                           Index row_stride, const std::uint8_t* mask, Index mask_stride,
+                           std::int16_t* out) {
+    std::vector<std::int32_t> si(static_cast<size_t>(cols)), hi(static_cast<size_t>(cols));
+    for (Index y = 0; y < rows; ++y) {
+        detail::hsv_row_indices(cols, bgr + y * row_stride, si.data(), hi.data());
+        std::int16_t* o = out + y * cols;
+        if (mask == nullptr) {
+            for (Index x = 0; x < cols; ++x)
+                o[x] = static_cast<std::int16_t>(lut.bin_at(si[static_cast<size_t>(x)],
+                                                            hi[static_cast<size_t>(x)]));
+            continue;
+        }
+        const std::uint8_t* m = mask + y * mask_stride;
+        for (Index x = 0; x < cols; ++x)  // -1 (all bits set) where the mask is 0
+            o[x] = static_cast<std::int16_t>(
+                lut.bin_at(si[static_cast<size_t>(x)], hi[static_cast<size_t>(x)]) |
+                -static_cast<int>(m[x] == 0));
+    }
+}
 
 /// Bins with background set to -1: out = mask == 0 ? -1 : bins.
 inline void mask_bins(const std::int16_t* bins, Index rows, Index cols, const std::uint8_t* mask,

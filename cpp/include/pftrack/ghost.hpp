@@ -47,9 +47,10 @@ struct EdgeScratch {
 
 /// The edge magnitude at each band pixel (`band`, h x w, row-major, non-zero = in), in row-major
 /// order, into `mag`: sqrt(max_c (gx_c^2 + gy_c^2)), gx, gy the 3x3 Sobel derivatives of the 5x5
-/// Gaussian blur (float32, as OpenCV's) of channel c of the h x w image `pixel(y, x, c)`.
-template <class Pixel>
-void edge_magnitudes(Pixel pixel, Index h, Index w, const std::vector<std::uint8_t>& band,
+/// Gaussian blur (float32, as OpenCV's) of channel c of the h x w image whose row y of channel c
+/// `fill_row(y, c, out)` writes to out[0 .. w).
+template <class FillRow>
+void edge_magnitudes(FillRow fill_row, Index h, Index w, const std::vector<std::uint8_t>& band,
                      EdgeScratch& s, std::vector<double>& mag) {
     static const std::array<double, 5> gd = gaussian5_sigma15();
     const float g0 = static_cast<float>(gd[0]), g1 = static_cast<float>(gd[1]),
@@ -69,11 +70,13 @@ void edge_magnitudes(Pixel pixel, Index h, Index w, const std::vector<std::uint8
     s.tmp.resize(static_cast<size_t>(w * ph));
     s.blur.resize(static_cast<size_t>(3 * w * h));
     for (int c = 0; c < 3; ++c) {
-        // the channel with 2 reflected pixels on every side
+        // the channel with 2 reflected pixels on every side: each row read once, its 2 + 2
+        // margin pixels copied from inside it
         for (Index yy = 0; yy < ph; ++yy) {
             float* row = s.pad.data() + yy * pw;
-            const Index y = s.ry[static_cast<size_t>(yy)];
-            for (Index xx = 0; xx < pw; ++xx) row[xx] = pixel(y, s.rx[static_cast<size_t>(xx)], c);
+            fill_row(s.ry[static_cast<size_t>(yy)], c, row + 2);
+            for (const Index xx : {Index(0), Index(1), w + 2, w + 3})
+                row[xx] = row[2 + s.rx[static_cast<size_t>(xx)]];
         }
         // rows first, then columns (OpenCV's separable order)
         for (Index yy = 0; yy < ph; ++yy) {
@@ -141,7 +144,7 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
                          GhostStatistic statistic = GhostStatistic::ratio) {
     detail::EdgeScratch scratch;
     std::vector<double> mag_f, mag_b;
-    std::vector<std::uint8_t> band, hmax, hmin;
+    std::vector<std::uint8_t> on, band, hmax, hmin;
     for (Index i = 0; i < k; ++i) {
         out[i] = 0.5;
         const double* b = boxes + 4 * i;
@@ -154,50 +157,59 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
         const Index w = x1 - x0, h = y1 - y0;
         const auto n = static_cast<size_t>(w * h);
         // 3x3 dilation and erosion inside the region (outside neighbours do not count), as
-        // row maxima / minima of the 0/1 mask, then column ones
+        // row maxima / minima of the 0/1 mask, then column ones (w, h >= 3 here); plain loops
+        // over whole rows, which the compiler vectorises
+        on.resize(n);
         hmax.resize(n);
         hmin.resize(n);
         band.resize(n);
         for (Index y = 0; y < h; ++y) {
-            const std::uint8_t* m = mask + (y0 + y) * mask_stride + x0;
-            std::uint8_t* mx = hmax.data() + y * w;
-            std::uint8_t* mn = hmin.data() + y * w;
-            for (Index x = 0; x < w; ++x) {
-                const Index a = std::max(x - 1, Index(0)), z = std::min(x + 1, w - 1);
-                std::uint8_t hi = 0, lo = 1;
-                for (Index xx = a; xx <= z; ++xx) {
-                    const std::uint8_t on = m[xx] != 0;
-                    hi = std::max(hi, on);
-                    lo = std::min(lo, on);
-                }
-                mx[x] = hi;
-                mn[x] = lo;
+            const std::uint8_t* __restrict m = mask + (y0 + y) * mask_stride + x0;
+            std::uint8_t* __restrict o = on.data() + y * w;
+            for (Index x = 0; x < w; ++x) o[x] = m[x] != 0 ? 1 : 0;
+            std::uint8_t* __restrict mx = hmax.data() + y * w;
+            std::uint8_t* __restrict mn = hmin.data() + y * w;
+            mx[0] = std::max(o[0], o[1]);
+            mn[0] = std::min(o[0], o[1]);
+            for (Index x = 1; x + 1 < w; ++x) {
+                mx[x] = std::max(std::max(o[x - 1], o[x]), o[x + 1]);
+                mn[x] = std::min(std::min(o[x - 1], o[x]), o[x + 1]);
             }
+            mx[w - 1] = std::max(o[w - 2], o[w - 1]);
+            mn[w - 1] = std::min(o[w - 2], o[w - 1]);
         }
-        bool any = false;
+        std::uint8_t any = 0;
         for (Index y = 0; y < h; ++y) {
             const Index a = std::max(y - 1, Index(0)), z = std::min(y + 1, h - 1);
+            const std::uint8_t* __restrict xa = hmax.data() + a * w;
+            const std::uint8_t* __restrict xy = hmax.data() + y * w;
+            const std::uint8_t* __restrict xz = hmax.data() + z * w;
+            const std::uint8_t* __restrict na = hmin.data() + a * w;
+            const std::uint8_t* __restrict ny = hmin.data() + y * w;
+            const std::uint8_t* __restrict nz = hmin.data() + z * w;
+            std::uint8_t* __restrict bd = band.data() + y * w;
             for (Index x = 0; x < w; ++x) {
-                std::uint8_t dil = 0, ero = 1;
-                for (Index yy = a; yy <= z; ++yy) {
-                    dil = std::max(dil, hmax[static_cast<size_t>(yy * w + x)]);
-                    ero = std::min(ero, hmin[static_cast<size_t>(yy * w + x)]);
-                }
-                const bool in = dil && !ero;
-                band[static_cast<size_t>(y * w + x)] = in ? 1 : 0;
-                any = any || in;
+                const std::uint8_t dil = std::max(std::max(xa[x], xy[x]), xz[x]);
+                const std::uint8_t ero = std::min(std::min(na[x], ny[x]), nz[x]);
+                bd[x] = static_cast<std::uint8_t>(dil & (ero ^ 1));
+                any |= bd[x];
             }
         }
         if (!any) continue;
         detail::edge_magnitudes(
-            [&](Index y, Index x, int c) {
-                return static_cast<float>(bgr[(y0 + y) * row_stride + 3 * (x0 + x) + c]);
+            [&](Index y, int c, float* __restrict out) {
+                const std::uint8_t* __restrict p = bgr + (y0 + y) * row_stride + 3 * x0 + c;
+                for (Index x = 0; x < w; ++x) out[x] = static_cast<float>(p[3 * x]);
             },
             h, w, band, scratch, mag_f);
         detail::edge_magnitudes(
-            [&](Index y, Index x, int c) {
-                return background[(y0 + y) * bg_row_stride + c * bg_plane_stride +
-                                  (x0 + x) * bg_pixel_stride];
+            [&](Index y, int c, float* __restrict out) {
+                const float* __restrict p = background + (y0 + y) * bg_row_stride +
+                                            c * bg_plane_stride + x0 * bg_pixel_stride;
+                if (bg_pixel_stride == 1)
+                    std::copy(p, p + w, out);
+                else
+                    for (Index x = 0; x < w; ++x) out[x] = p[x * bg_pixel_stride];
             },
             h, w, band, scratch, mag_b);
         if (statistic == GhostStatistic::vote) {

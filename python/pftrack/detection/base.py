@@ -239,10 +239,17 @@ class BlobExtractor:
         return self._open, self._close
 
     def clean(self, raw: NDArray[np.uint8]) -> NDArray[np.uint8]:
-        """Clean the raw mask: opening, then closing (grey-level: 127 shadows are cleaned too)."""
+        """Clean the raw mask: opening, then closing (grey-level: 127 shadows are cleaned too).
+
+        The opening by a rectangle is OpenCV's (separable, fast); the closing by an ellipse is
+        one C++ call (``pftrack._core.close_mask``, the GIL released): the values of
+        ``cv2.morphologyEx(MORPH_CLOSE)`` bit for bit (tests/detection/test_morphology.py), about
+        twice as fast as OpenCV's generic path at 1280x720 (its 11x11 ellipse).
+        """
         k_open, k_close = self._elements(raw.shape[0])
         m = cv2.morphologyEx(raw, cv2.MORPH_OPEN, k_open)
-        return np.asarray(cv2.morphologyEx(m, cv2.MORPH_CLOSE, k_close), np.uint8)
+        closed: NDArray[np.uint8] = _core.close_mask(m, k_close)
+        return closed
 
     def boxes(self, mask: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Boxes (K, 4) left, top, w, h and scores (K,) of the blobs that pass the filters.

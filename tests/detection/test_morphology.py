@@ -1,0 +1,105 @@
+"""The mask's closing in C++ (pftrack._core.close_mask) against the NumPy reference
+(tests/reference/detection.py) and cv2.morphologyEx, bit for bit."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from pftrack import _core
+from pftrack.detection.base import BlobConfig, BlobExtractor
+from tests.reference.detection import close_mask_reference
+
+
+def _opencv(mask: np.ndarray, element: np.ndarray) -> np.ndarray:
+    return np.asarray(cv2.morphologyEx(mask, cv2.MORPH_CLOSE, element), np.uint8)
+
+
+def _mask(rng: np.random.Generator, rows: int, cols: int) -> np.ndarray:
+    """Shadow and foreground blocks (127, 255) with speckle, or any grey levels."""
+    if rng.random() < 0.3:  # min / max of grey levels, not a binary operation
+        return rng.integers(0, 256, (rows, cols), dtype=np.uint8)
+    m = np.zeros((rows, cols), np.uint8)
+    for _ in range(int(rng.integers(0, 10))):
+        x, y = int(rng.integers(-5, cols)), int(rng.integers(-5, rows))
+        w, h = int(rng.integers(1, 30)), int(rng.integers(1, 40))
+        m[max(y, 0) : y + h, max(x, 0) : x + w] = rng.choice([127, 255])
+    m[rng.random((rows, cols)) < rng.choice([0.0, 0.02, 0.2])] = 255
+    m[rng.random((rows, cols)) < 0.01] = 127
+    return m
+
+
+@pytest.mark.parametrize(
+    "shape, size",
+    [
+        (cv2.MORPH_ELLIPSE, (5, 5)),
+        (cv2.MORPH_ELLIPSE, (9, 9)),
+        (cv2.MORPH_ELLIPSE, (11, 11)),
+        (cv2.MORPH_ELLIPSE, (6, 6)),  # even: the anchor is at (3, 3)
+        (cv2.MORPH_ELLIPSE, (7, 3)),
+        (cv2.MORPH_ELLIPSE, (21, 21)),
+        (cv2.MORPH_RECT, (1, 1)),
+        (cv2.MORPH_RECT, (4, 2)),
+        (cv2.MORPH_CROSS, (5, 5)),
+    ],
+)
+def test_close_mask_equals_reference_and_opencv(shape: int, size: tuple[int, int]) -> None:
+    rng = np.random.default_rng(size[0] * 100 + size[1] + shape)
+    el = np.asarray(cv2.getStructuringElement(shape, size), np.uint8)
+    for rows, cols in [(1, 1), (2, 7), (13, 1), (40, 57), (64, 96), (360, 480)]:
+        mask = _mask(rng, rows, cols)
+        got = _core.close_mask(mask, el)
+        np.testing.assert_array_equal(got, close_mask_reference(mask, el))
+        np.testing.assert_array_equal(got, _opencv(mask, el))
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    rows=st.integers(1, 40),
+    cols=st.integers(1, 40),
+    kh=st.integers(1, 12),
+    kw=st.integers(1, 12),
+)
+def test_close_mask_any_element_of_runs(seed: int, rows: int, cols: int, kh: int, kw: int) -> None:
+    """One run per row anywhere (off centre, asymmetric, empty rows): the reference's values."""
+    rng = np.random.default_rng(seed)
+    el = np.zeros((kh, kw), np.uint8)
+    for y in range(kh):
+        if rng.random() < 0.8:
+            lo = int(rng.integers(0, kw))
+            el[y, lo : int(rng.integers(lo, kw)) + 1] = 1
+    if not el.any():
+        el[int(rng.integers(0, kh)), int(rng.integers(0, kw))] = 1
+    mask = _mask(rng, rows, cols)
+    got = _core.close_mask(mask, el)
+    np.testing.assert_array_equal(got, close_mask_reference(mask, el))
+    np.testing.assert_array_equal(got, _opencv(mask, el))
+
+
+def test_clean_is_opening_then_this_closing_on_a_strided_view() -> None:
+    rng = np.random.default_rng(3)
+    view = _mask(rng, 80, 120)[:, 10:100]  # rows strided
+    ex = BlobExtractor(BlobConfig())
+    k_open, k_close = ex._elements(80)
+    opened = cv2.morphologyEx(np.ascontiguousarray(view), cv2.MORPH_OPEN, k_open)
+    want = close_mask_reference(opened, k_close)
+    np.testing.assert_array_equal(_core.close_mask(view, k_close), _opencv(view, k_close))
+    np.testing.assert_array_equal(ex.clean(view), want)
+
+
+def test_close_mask_refuses_bad_input() -> None:
+    mask = np.zeros((5, 5), np.uint8)
+    with pytest.raises(ValueError, match="not one run"):
+        _core.close_mask(mask, np.array([[1, 0, 1]], np.uint8))
+    with pytest.raises(ValueError, match="no set pixel"):
+        _core.close_mask(mask, np.zeros((3, 3), np.uint8))
+    with pytest.raises(ValueError, match="shape"):
+        _core.close_mask(mask, np.ones(3, np.uint8))
+    with pytest.raises(ValueError, match="dtype"):
+        _core.close_mask(mask.astype(np.float32), np.ones((3, 3), np.uint8))
+    with pytest.raises(ValueError, match="non-empty"):
+        _core.close_mask(np.zeros((0, 5), np.uint8), np.ones((3, 3), np.uint8))
