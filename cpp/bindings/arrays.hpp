@@ -15,12 +15,23 @@ namespace py = pybind11;
 
 inline std::string dtype_name(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
 
+/// Whether dtype `d` is T's: the same descriptor object (the usual case, no call), or an
+/// equivalent one (PyArray_EquivTypes: an array that went through pickle has an equal but
+/// distinct descriptor; a byte-swapped one is not equivalent).
+template <typename T>
+inline bool is_dtype(const py::dtype& d) {
+    const py::dtype want = py::dtype::of<T>();
+    return d.is(want) || d.equal(want);
+}
+inline bool is_u8(const py::dtype& d) { return is_dtype<std::uint8_t>(d); }
+inline bool is_bool(const py::dtype& d) { return is_dtype<bool>(d); }
+
 /// A (H, W, 3) uint8 image whose pixels are packed (3 bytes a pixel, 1 a channel); rows may be
 /// strided (views of a larger image are fine).
 inline void check_bgr_image(const py::array& a, const char* fn, const char* what) {
     // Every message is built only on failure: these checks run on every frame, and naming the
     // dtype (a str() through Python) or concatenating strings up front cost a call each time.
-    if (!a.dtype().is(py::dtype::of<std::uint8_t>()))
+    if (!is_u8(a.dtype()))
         require(false, fn, (std::string(what) + " dtype").c_str(), dtype_name(a),
                 "uint8 (BGR, as cv2 reads it)");
     if (!(a.ndim() == 3 && a.shape(2) == 3))
@@ -32,7 +43,8 @@ inline void check_bgr_image(const py::array& a, const char* fn, const char* what
 
 /// A mask's dtype: uint8 or bool (named in the message only on failure).
 inline void check_mask_dtype(const py::array& m, const char* fn) {
-    if (!m.dtype().is(py::dtype::of<std::uint8_t>()) && !m.dtype().is(py::dtype::of<bool>()))
+    const py::dtype d = m.dtype();
+    if (!is_u8(d) && !is_bool(d))
         require(false, fn, "mask dtype", dtype_name(m), "uint8 or bool");
 }
 

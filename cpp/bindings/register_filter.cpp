@@ -26,7 +26,7 @@ py::array_t<double> batch_item(const py::handle& h, const char* what, py::ssize_
     const auto name = [&] { return std::string(what) + "[" + std::to_string(k) + "]"; };
     if (!py::isinstance<py::array>(h)) fail(fn, name() + " must be a NumPy array");
     const auto a = py::reinterpret_borrow<py::array>(h);
-    if (!a.dtype().is(py::dtype::of<double>()))
+    if (!bind::is_dtype<double>(a.dtype()))
         require(false, fn, (name() + " dtype").c_str(), bind::dtype_name(a), "float64");
     if (!((a.flags() & py::array::c_style) != 0 && a.writeable()))
         fail(fn, name() + " must be C-contiguous and writeable");

@@ -136,3 +136,17 @@ def test_filter_bad_inputs():
     image = hsv_bins(np.zeros((10, 10, 3), np.uint8))
     with pytest.raises(ValueError, match="sis_step: ref size is 7, expected 110"):
         f.step(image)
+
+
+def test_arrays_through_pickle_are_accepted():
+    # an array that went through pickle has an equal but distinct dtype object
+    import pickle
+
+    frame = pickle.loads(pickle.dumps(np.zeros((8, 8, 3), np.uint8)))
+    mask = pickle.loads(pickle.dumps(np.ones((8, 8), np.uint8)))
+    binned = _core.hsv_bins(frame, mask)
+    assert binned.shape == (8, 8)
+    boxes = pickle.loads(pickle.dumps(np.array([[1.0, 1.0, 4.0, 4.0]])))
+    assert _core.refine_boxes(boxes, mask, 0.05, 0.1).shape == (1, 4)
+    with pytest.raises(ValueError, match="frame dtype is >u2"):
+        _core.hsv_bins(np.zeros((8, 8, 3), ">u2"), None)
