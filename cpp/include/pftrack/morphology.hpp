@@ -21,14 +21,6 @@
 #include "check.hpp"
 #include "types.hpp"
 
-// The vectorisable loops, compiled twice on x86-64 Linux with GCC (AVX2 and baseline), the CPU
-// picking one at load time (the same definition as in background.hpp).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define PFTRACK_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define PFTRACK_VECTOR_CLONES
-#endif
-
 namespace pftrack {
 
 /// One row of a structuring element: the columns [lo, hi] of its run at row offset dy, all
