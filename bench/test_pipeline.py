@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -126,7 +125,7 @@ def _track(
     run = track_frames(
         video,
         detections=dets,
-        config=replace(TrackerConfig(), max_side=max_side),
+        config=TrackerConfig(max_side=max_side),
         rng=0,
         show_progress=False,
         on_frame=on_frame,

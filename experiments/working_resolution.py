@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
             for mode in ("builtin", "public"):
                 for side in sides:
                     for seed in args.seeds:
-                        config = dataclasses.replace(TrackerConfig(), max_side=side)
+                        config = TrackerConfig(max_side=side)
                         run = track_frames(
                             made.video,
                             detections=made.dets if mode == "public" else None,

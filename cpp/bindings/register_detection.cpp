@@ -2,7 +2,6 @@
 #include <pybind11/pybind11.h>
 
 #include <algorithm>
-#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -289,17 +288,9 @@ void register_detection(py::module_& m) {
             const Index mstride = mask.strides(0);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
-                std::vector<std::uint8_t> packed;  // the mask's rows packed, if they are strided
-                if (mstride != cols) {
-                    packed.resize(static_cast<size_t>(rows * cols));
-                    for (Index y = 0; y < rows; ++y)
-                        std::memcpy(packed.data() + y * cols, mptr + y * mstride,
-                                    static_cast<size_t>(cols));
-                    mptr = packed.data();
-                }
                 std::unique_ptr<std::uint8_t[]> tmp(new std::uint8_t[static_cast<size_t>(rows * cols)]);
                 MorphScratch scratch;
-                close_mask(mptr, optr, tmp.get(), rows, cols, el, scratch);
+                close_mask(mptr, mstride, optr, tmp.get(), rows, cols, el, scratch);
             }
             return out;
         },

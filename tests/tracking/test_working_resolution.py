@@ -8,8 +8,6 @@ the original frames.
 
 from __future__ import annotations
 
-import dataclasses
-
 import cv2
 import numpy as np
 import pytest
@@ -96,7 +94,7 @@ def test_doubled_frames_give_doubled_boxes_byte_for_byte(scene, given):
 
 def test_the_run_scales_on_the_detection_thread_with_the_loops_rows(scene):
     frames = [doubled(f) for f in scene.frames]
-    config = dataclasses.replace(TrackerConfig(), max_side=480)
+    config = TrackerConfig(max_side=480)
     threaded = track_frames(frames, config=config, rng=2)
     single = track_frames(frames, config=config, rng=2, threads=False)
     reference = track_frames(scene.frames, rng=2)

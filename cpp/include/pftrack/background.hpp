@@ -116,18 +116,8 @@ struct BackgroundConfig {
     }
 };
 
-// The vectorisable per-row loops, compiled twice on x86-64 Linux with GCC (AVX2 and baseline),
-// the CPU picking one at load time. Neither uses FMA, so both give the same floats.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define PFTRACK_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define PFTRACK_VECTOR_CLONES
-#endif
-
 namespace detail {
 
-/// Per pixel of one row, in float (exact on these small integers), branch-free: HsvLut indices
-/// (sat, hue), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
 /// The HsvLut indices of one pixel (HsvLut::bin's sat and hue), in float (exact on these small
 /// integers) and without branches, so that the loops calling it vectorise.
 inline __attribute__((always_inline)) void hsv_indices(float b, float g, float r,
@@ -154,6 +144,8 @@ PFTRACK_VECTOR_CLONES static void hsv_row_indices(Index n, const std::uint8_t* _
                     static_cast<float>(px[3 * x + 2]), si[x], hi[x]);
 }
 
+/// Per pixel of one row, in float (exact on these small integers), branch-free: HsvLut indices
+/// (sat, hue), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
 PFTRACK_VECTOR_CLONES static void background_row_scan(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
     const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,

@@ -21,14 +21,6 @@
 #include "check.hpp"
 #include "types.hpp"
 
-// The vectorisable loops, compiled twice on x86-64 Linux with GCC (AVX2 and baseline), the CPU
-// picking one at load time (the same definition as in background.hpp).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define PFTRACK_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define PFTRACK_VECTOR_CLONES
-#endif
-
 namespace pftrack {
 
 /// One row of a structuring element: the columns [lo, hi] of its run at row offset dy, all
@@ -94,11 +86,12 @@ struct MorphScratch {
     std::vector<std::uint8_t> pow2, ring;
 };
 
-/// dst = erosion (min) or dilation (max) of src (rows x cols, packed) by the element `el`:
-/// dst(y, x) = extremum over (dy, dx) in the element of src(y + dy, x + dx), pixels outside the
-/// image left out. `dst` must not alias `src`.
-inline void morphology(const std::uint8_t* src, std::uint8_t* dst, Index rows, Index cols,
-                       const std::vector<ElementRow>& el, MorphOp op, MorphScratch& s) {
+/// dst (rows x cols, packed) = erosion (min) or dilation (max) of src (rows x cols,
+/// `src_stride` bytes a row) by the element `el`: dst(y, x) = extremum over (dy, dx) in the
+/// element of src(y + dy, x + dx), pixels outside the image left out. `dst` must not alias `src`.
+inline void morphology(const std::uint8_t* src, Index src_stride, std::uint8_t* dst, Index rows,
+                       Index cols, const std::vector<ElementRow>& el, MorphOp op,
+                       MorphScratch& s) {
     const bool dil = op == MorphOp::dilate;
     const std::uint8_t identity = dil ? 0 : 255;
     // the distinct runs (lo, hi), and each element row's run
@@ -125,7 +118,7 @@ inline void morphology(const std::uint8_t* src, std::uint8_t* dst, Index rows, I
     // the runs of source row sy into ring slot sy mod span
     auto reduce_row = [&](Index sy) {
         std::uint8_t* p0 = s.pow2.data();
-        std::memcpy(p0 + ext, src + sy * cols, static_cast<size_t>(cols));
+        std::memcpy(p0 + ext, src + sy * src_stride, static_cast<size_t>(cols));
         for (Index j = 1; j < levels; ++j) {  // level j: extremum of pixels [i, i + 2^j)
             const Index half = Index(1) << (j - 1);
             const std::uint8_t* prev = p0 + (j - 1) * pw;
@@ -165,13 +158,14 @@ inline void morphology(const std::uint8_t* src, std::uint8_t* dst, Index rows, I
     }
 }
 
-/// The closing (a dilation, then an erosion) of `src` by `el` into `dst` (rows x cols,
-/// packed), as cv2.morphologyEx(MORPH_CLOSE). `tmp` is scratch of rows x cols bytes; no two of
-/// src, dst, tmp may alias.
-inline void close_mask(const std::uint8_t* src, std::uint8_t* dst, std::uint8_t* tmp, Index rows,
-                       Index cols, const std::vector<ElementRow>& el, MorphScratch& s) {
-    morphology(src, tmp, rows, cols, el, MorphOp::dilate, s);
-    morphology(tmp, dst, rows, cols, el, MorphOp::erode, s);
+/// The closing (a dilation, then an erosion) of `src` (rows x cols, `src_stride` bytes a row)
+/// by `el` into `dst` (rows x cols, packed), as cv2.morphologyEx(MORPH_CLOSE). `tmp` is scratch
+/// of rows x cols bytes; no two of src, dst, tmp may alias.
+inline void close_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
+                       std::uint8_t* tmp, Index rows, Index cols,
+                       const std::vector<ElementRow>& el, MorphScratch& s) {
+    morphology(src, src_stride, tmp, rows, cols, el, MorphOp::dilate, s);
+    morphology(tmp, cols, dst, rows, cols, el, MorphOp::erode, s);
 }
 
 }  // namespace pftrack

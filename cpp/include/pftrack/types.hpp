@@ -9,6 +9,15 @@
 #include <utility>
 #include <vector>
 
+// The vectorisable per-row loops (background.hpp, morphology.hpp), compiled twice on x86-64
+// Linux with GCC (AVX2 and baseline), the CPU picking one at load time. None uses FMA, so both
+// give the same values.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define PFTRACK_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define PFTRACK_VECTOR_CLONES
+#endif
+
 namespace pftrack {
 
 using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;

@@ -141,11 +141,11 @@ class _OpenCvDetector:
                 "frames (call reset() before a new video)"
             )
         self._shape = frame.shape
-        raw = self._sub.apply(frame, learningRate=self._learning_rate)
-        if shadows:  # 255 foreground, 127 shadow (the grey-level cleaning keeps both)
-            return self._blobs.clean(np.asarray(raw, np.uint8)), None
-        # 255 = foreground, 127 = shadow: shadows are background.
-        raw = np.where(raw == 255, np.uint8(255), np.uint8(0))
+        # 255 = foreground, 127 = shadow: kept with `shadows` (the grey-level cleaning keeps
+        # both), else shadows are background
+        raw = np.asarray(self._sub.apply(frame, learningRate=self._learning_rate), np.uint8)
+        if not shadows:
+            raw = np.where(raw == 255, np.uint8(255), np.uint8(0))
         return self._blobs.clean(raw), None
 
 

@@ -40,7 +40,7 @@ class _StandIn:
     def __init__(self, foreground_only: bool, shadows: bool) -> None:
         self._foreground_only = foreground_only
         self._next: _Work | None = None
-        self.foreground_shadows = shadows  # whether the real detector's foreground takes them
+        self.foreground_shadows = shadows  # whether the thread computed the mask with them
 
     def expect(self, work: _Work) -> None:
         """The next frame the tracker will ask about, and the thread's result or error."""
@@ -123,15 +123,16 @@ class DetectAhead:
         detector = self._tracker.detector
         # what update() reads: detect(); with external detections the foreground, from the
         # detector's foreground() when it has one, else from its detect()
+        shadows = False  # whether the thread's foreground has them (the stand-in says so)
         if not self._external:
             call = detector.detect
         elif hasattr(detector, "foreground"):
+            shadows = self._tracker.wants_shadows and takes_shadows(detector)
             call = detector.foreground
-            if self._tracker.wants_shadows and takes_shadows(detector):
+            if shadows:
                 call = functools.partial(detector.foreground, shadows=True)
         else:
             call = _mask_and_bins(detector)
-        shadows = hasattr(detector, "foreground") and takes_shadows(detector)
         self._detector = detector
         self._stand_in = _StandIn(self._external, shadows)
         self._stream = prefetch(_work(self._frames, call, self._prepare), depth=self._depth)

@@ -333,7 +333,8 @@ class Tracker:
         self._clip_warned = False
         self._max_conf = -np.inf
         self._given = False  # some update() of the run had detections
-        self._scale: tuple[float, float] | None = None  # working / frame pixels (x, y)
+        # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box
+        self._scale: F64 | None = None
         self._shape: tuple[int, ...] | None = None  # the run's frame shape, with max_side
         self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
 
@@ -376,16 +377,14 @@ class Tracker:
         """MOTChallenge rows from working pixels to the frame's."""
         if self._scale is None or len(rows) == 0:
             return rows
-        sx, sy = self._scale
         out: F64 = rows.copy()
-        out[:, [2, 4]] /= sx
-        out[:, [3, 5]] /= sy
+        out[:, 2:6] /= self._scale
         return out
 
     def _restore_track(self, t: Track) -> Track:
         """A reported track with its boxes in the frame's pixels."""
-        assert self._scale is not None
-        k = np.array([self._scale[0], self._scale[1], self._scale[0], self._scale[1]])
+        k = self._scale
+        assert k is not None
         return replace(
             t,
             box_xywh=np.asarray(t.box_xywh, np.float64) / k,
@@ -437,9 +436,11 @@ class Tracker:
                     "call reset() before a new video)"
                 )
         work = self._working(f)
-        self._scale = (
-            None if work is f else (work.shape[1] / f.shape[1], work.shape[0] / f.shape[0])
-        )
+        if work is f:
+            self._scale = None
+        else:
+            sx, sy = work.shape[1] / f.shape[1], work.shape[0] / f.shape[0]
+            self._scale = np.array([sx, sy, sx, sy])
         if dets is None:
             kept = None
             reports = self._tracker.update(work, None)
@@ -456,8 +457,7 @@ class Tracker:
             if len(xywh):
                 self._max_conf = max(self._max_conf, float(xywh[:, 4].max()))
             if self._scale is not None:
-                xywh[:, [0, 2]] *= self._scale[0]
-                xywh[:, [1, 3]] *= self._scale[1]
+                xywh[:, :4] *= self._scale
             reports = self._tracker.update(work, xywh, cls)
         self.frame_count += 1
         # the offline pass sees a still camera: boxes in the first frame's coordinates
@@ -465,12 +465,11 @@ class Tracker:
         self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
         self._reports = reports
         out = np.zeros((len(reports), 8))
-        k = (1.0, 1.0) if self._scale is None else self._scale
         m = 0
         for t in reports:
             if t.time_since_update != 0:
                 continue  # coasting: carried by the particle filter alone, held back
-            b = t.box_xywh / np.array([k[0], k[1], k[0], k[1]])
+            b = t.box_xywh if self._scale is None else t.box_xywh / self._scale
             di = -1 if kept is None or t.detection_index is None else kept[t.detection_index]
             out[m] = (b[0], b[1], b[0] + b[2], b[1] + b[3], t.id, t.score, t.cls, di)
             m += 1

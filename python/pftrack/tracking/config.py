@@ -231,8 +231,8 @@ class RefineConfig:
     leg_fill: float | None = 0.5
 
     def __post_init__(self) -> None:
-        if self.leg_fill is not None and not 0.0 <= self.leg_fill <= 1.0:
-            raise ValueError(f"RefineConfig: leg_fill is {self.leg_fill}, expected None or [0, 1]")
+        if self.leg_fill is not None:
+            _in_unit_interval("RefineConfig", leg_fill=self.leg_fill)
 
 
 @dataclass(frozen=True)

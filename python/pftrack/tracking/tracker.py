@@ -335,7 +335,8 @@ def takes_shadows(detector: Any) -> bool:
     """Whether `detector`'s ``foreground`` takes a `shadows` argument (pftrack's detectors do).
 
     A detector may say so itself with a boolean ``foreground_shadows`` attribute (the stand-in
-    of :class:`~pftrack.tracking.ahead.DetectAhead` repeats its real detector's answer).
+    of :class:`~pftrack.tracking.ahead.DetectAhead` says whether its thread computed the mask
+    with shadows).
     """
     said = getattr(detector, "foreground_shadows", None)
     if isinstance(said, bool):
