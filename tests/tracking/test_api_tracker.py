@@ -6,6 +6,7 @@ import dataclasses
 import itertools
 import warnings
 
+import cv2
 import numpy as np
 import pytest
 
@@ -15,7 +16,7 @@ from pftrack.eval import evaluate_mot
 from pftrack.io.mot import group_by_frame, read_mot, write_mot
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import make_busy_scene, make_scene
-from pftrack.tracking import TrackerConfig, track_frames
+from pftrack.tracking import TrackerConfig, load_detections, track_frames
 from pftrack.tracking.api import check_boxes_xyxy, xywh_to_xyxy_dets
 from pftrack.tracking.offline import complete_boxes, drop_nested
 from tests.conftest import dataset
@@ -291,6 +292,42 @@ def test_options_and_frames():
     slow = pftrack.Tracker(frame_rate=7.0)
     assert slow.config.lifecycle.max_coast == 3 and slow.prime_frames == 8
     assert pftrack.Tracker(frame_rate=50.0).config.lifecycle.birth_window == 100
+
+
+def test_no_refine_takes_the_boxes_as_given(scene, tmp_path):
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+
+    args = build_parser().parse_args(["track", "v.avi", "--out", "t.txt", "--no-refine"])
+    config = tracker_config(args)
+    assert pftrack.Tracker(refine=False).config == config
+    assert not config.refine.enabled and config.refine.leg_fill == TrackerConfig().refine.leg_fill
+    dets = scene_dets(scene)
+    plain = pftrack.Tracker(refine=False)
+    refined = pftrack.Tracker()
+    for d, f in zip(dets[:15], scene.frames[:15], strict=True):
+        a, b = plain.update(d, f), refined.update(d, f)
+    assert plain.tracker.last_mask is None  # no background model ran
+    assert refined.tracker.last_mask is not None
+    # the same frames through the command with --no-refine give the loop's rows
+    assert len(a) and len(b)
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    det_rows = []
+    for n, (d, f) in enumerate(zip(dets, scene.frames, strict=True), start=1):
+        cv2.imwrite(str(folder / f"{n:06d}.png"), f)
+        det_rows += [[n, -1, x1, y1, x2 - x1, y2 - y1, c, -1, -1, -1] for x1, y1, x2, y2, c in d]
+    write_mot(tmp_path / "det.txt", np.asarray(det_rows))
+    out = tmp_path / "t.txt"
+    argv = ["-q", "track", str(folder), "--detections", str(tmp_path / "det.txt")]
+    assert main([*argv, "--no-refine", "--out", str(out)]) == 0
+    given = load_detections(tmp_path / "det.txt")  # as the command reads the file
+    loop = pftrack.Tracker(refine=False)
+    for n, f in enumerate(scene.frames, start=1):
+        loop.update(xywh_to_xyxy_dets(given.get(n, np.zeros((0, 5)))), f)
+    written = tmp_path / "loop.txt"
+    write_mot(written, loop.finalize())
+    assert written.read_bytes() == out.read_bytes()
 
 
 def test_builtin_detector_when_dets_is_none(scene):

@@ -164,6 +164,12 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "interpolation)",
     )  # fmt: skip
     p.add_argument(
+        "--no-refine", action="store_true",
+        help="with --detections, take the boxes as given instead of shrinking each to the "
+        "foreground of a background model (for a detector with tight boxes; no background "
+        "model runs, no frames are read ahead for it)",
+    )  # fmt: skip
+    p.add_argument(
         "--no-link", action="store_true",
         help="keep fragments of one object under separate ids, instead of joining them by "
         "motion and size across gaps of up to 30 frames",
@@ -186,6 +192,7 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         sampler=args.sampler,
         camera_motion=args.camera_motion,
         max_side=args.max_side or None,
+        refine=replace(base.refine, enabled=not args.no_refine),
         lifecycle=replace(
             base.lifecycle,
             max_coast=args.max_coast,

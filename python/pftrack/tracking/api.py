@@ -186,6 +186,10 @@ class Tracker:
         `birth_score`). See :class:`~pftrack.tracking.LifecycleConfig`.
     camera_motion : {"auto", "on", "off"}
         Camera-motion compensation (:attr:`TrackerConfig.camera_motion`).
+    refine : bool
+        Shrink given detection boxes to the foreground of a background model (the default;
+        :class:`~pftrack.tracking.RefineConfig`). False takes the boxes as given and runs no
+        background model: for a detector with tight boxes, and about 0.5 ms less a frame.
     fill : {"linear", "pf"}
         Boxes of a gap the particle filter bridged, before smoothing.
     smooth, link : bool
@@ -221,6 +225,7 @@ class Tracker:
         birth_score: float = 0.9,
         birth_quantile: float | None = 0.25,
         camera_motion: str = "auto",
+        refine: bool = True,
         fill: str = "linear",
         smooth: bool = True,
         link: bool = True,
@@ -244,6 +249,7 @@ class Tracker:
             sampler=sampler,
             camera_motion=camera_motion,
             max_side=max_side,
+            refine=replace(base.refine, enabled=bool(refine)),
             lifecycle=replace(
                 base.lifecycle,
                 max_coast=_frames(max_coast, frame_rate, "max_coast"),
