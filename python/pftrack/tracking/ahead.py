@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack.io.prefetch import prefetch
-from pftrack.tracking.tracker import MultiObjectTracker, takes_shadows
+from pftrack.tracking.tracker import MultiObjectTracker
 
 __all__ = ["DetectAhead"]
 
@@ -64,7 +64,7 @@ class _StandIn:
     def foreground(self, frame: NDArray[np.uint8], shadows: bool = False) -> Any:
         """The thread's ``foreground(frame)`` (or the mask and bins of its ``detect``).
 
-        Computed there with the `shadows` the tracker asks for (its ``wants_shadows``).
+        Computed there with the `shadows` the tracker asks for (its ``shadows_of``).
         """
         return self._take(frame, True)
 
@@ -127,7 +127,7 @@ class DetectAhead:
         if not self._external:
             call = detector.detect
         elif hasattr(detector, "foreground"):
-            shadows = self._tracker.wants_shadows and takes_shadows(detector)
+            shadows = self._tracker.shadows_of(detector)
             call = detector.foreground
             if shadows:
                 call = functools.partial(detector.foreground, shadows=True)

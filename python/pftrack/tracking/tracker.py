@@ -73,7 +73,9 @@ class MultiObjectTracker:
         self.tracks: list[LiveTrack] = []
         self._ended_unconfirmed: set[int] = set()
         self.frame_index = 0
-        self.last_mask: NDArray[np.uint8] | None = None
+        self._mask: NDArray[np.uint8] | None = None  # the last frame's, see last_mask
+        self._mask_shaded = False  # whether _mask still has its shadow pixels (127)
+        self._shadows: tuple[Any, bool] | None = None  # (detector, shadows_of(detector))
         self._joint = JointTracker(self.config, self._rng)
         self._scores_are_confidences = True
         self._birth_scores: list[F64] = []  # scores of the first frames (birth_quantile)
@@ -130,7 +132,7 @@ class MultiObjectTracker:
         cfg = self.config
         if detections is None:
             det = self._ensure_detector().detect(frame)
-            self.last_mask = det.mask
+            self._mask, self._mask_shaded = det.mask, False
             boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
             binned = det.binned
             if not self._background_ok:  # moving camera: colour of every pixel, not foreground
@@ -154,25 +156,40 @@ class MultiObjectTracker:
         return boxes, scores, binned
 
     @property
-    def wants_shadows(self) -> bool:
-        """Whether box refinement asks the detector's ``foreground`` for shadows (127).
+    def last_mask(self) -> NDArray[np.uint8] | None:
+        """The last frame's foreground mask (0 / 255), None before any background model ran.
 
-        With :attr:`RefineConfig.leg_fill` set (a detector whose ``foreground`` takes no
-        `shadows` argument gives its plain mask, and boxes do not grow).
+        A mask with shadows (refinement's, :meth:`shadows_of`) is thresholded here, on demand:
+        only the joint sampler reads it on every frame.
         """
-        cfg = self.config.refine
-        return cfg.enabled and cfg.leg_fill is not None
+        if self._mask_shaded and self._mask is not None:
+            self._mask, self._mask_shaded = foreground_only(self._mask), False
+        return self._mask
+
+    def shadows_of(self, detector: Any) -> bool:
+        """Whether box refinement asks `detector`'s ``foreground`` for shadows (127).
+
+        With :attr:`RefineConfig.leg_fill` set and a ``foreground`` that takes `shadows`
+        (:func:`takes_shadows`; otherwise the plain mask, and boxes do not grow). Decided once
+        per detector object (the detector is swapped for a stand-in during a run).
+        """
+        cached = self._shadows
+        if cached is None or cached[0] is not detector:
+            cfg = self.config.refine
+            wants = cfg.enabled and cfg.leg_fill is not None
+            cached = self._shadows = (detector, wants and takes_shadows(detector))
+        return cached[1]
 
     def _foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], Any, bool]:
         """Return the mask, full-frame bins (or None) and whether the mask has shadows (127).
 
         From the detector's ``foreground`` when it has one (no blob pass), with shadows when
-        :attr:`wants_shadows`, else its ``detect``. :attr:`last_mask` is the foreground alone.
+        :meth:`shadows_of` says so, else its ``detect``.
         """
         detector = self._ensure_detector()
         shaded = False
         if hasattr(detector, "foreground"):
-            shaded = self.wants_shadows and takes_shadows(detector)
+            shaded = self.shadows_of(detector)
             if shaded:
                 mask, frame_bins = detector.foreground(frame, shadows=True)
             else:
@@ -180,7 +197,7 @@ class MultiObjectTracker:
         else:
             det = detector.detect(frame)
             mask, frame_bins = det.mask, det.frame_bins
-        self.last_mask = foreground_only(mask) if shaded else mask
+        self._mask, self._mask_shaded = mask, shaded
         return mask, frame_bins, shaded
 
     def _birth_threshold(self, scores: F64) -> float:
