@@ -1,8 +1,10 @@
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <cstdint>
+#include <optional>
 
 #include "pftrack/refine.hpp"
 #include "arrays.hpp"
@@ -14,7 +16,7 @@ void register_refine(py::module_& m) {
     m.def(
         "refine_boxes",
         [](Eigen::Ref<const RowMatrixXd> boxes, const py::array& mask, double fraction,
-           double min_cover, double leg_fill) {
+           double min_cover, std::optional<double> leg_fill) {
             const char* fn = "refine_boxes";
             require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
             require_finite(boxes, fn, "boxes");
@@ -26,19 +28,22 @@ void register_refine(py::module_& m) {
                     fraction, "in [0, 1)");
             require(std::isfinite(min_cover) && min_cover >= 0.0 && min_cover <= 1.0, fn,
                     "min_cover", min_cover, "in [0, 1]");
-            require(std::isfinite(leg_fill) && leg_fill <= 1.0, fn, "leg_fill", leg_fill,
-                    "in [0, 1] (negative: off)");
+            if (leg_fill)
+                require(std::isfinite(*leg_fill) && *leg_fill >= 0.0 && *leg_fill <= 1.0, fn,
+                        "leg_fill", *leg_fill, "None or in [0, 1]");
+            const double fill = leg_fill.value_or(-1.0);  // the core's "off"
+
             RowMatrixXd out = boxes;
             const auto* data = static_cast<const std::uint8_t*>(mask.data());
             const Index rows = mask.shape(0), cols = mask.shape(1), stride = mask.strides(0);
             {
                 py::gil_scoped_release nogil;  // safe: `out` is ours, `mask` kept alive by the caller
-                refine_boxes(out, data, rows, cols, stride, fraction, min_cover, leg_fill);
+                refine_boxes(out, data, rows, cols, stride, fraction, min_cover, fill);
             }
             return out;
         },
         py::arg("boxes"), py::arg("mask"), py::arg("fraction"), py::arg("min_cover"),
-        py::arg("leg_fill") = -1.0,
+        py::arg("leg_fill") = py::none(),
         "Boxes (K, 4) left, top, w, h shrunk to the foreground of mask (H, W) uint8 or bool; "
         "with leg_fill in [0, 1], mask 255/127/0 and boxes grown down through shadowed legs.");
 }

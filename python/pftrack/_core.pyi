@@ -208,7 +208,11 @@ def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascendin
 
 # --- box refinement: boxes (K, 4) left, top, w, h; mask (H, W) uint8 or bool -> (K, 4) -----
 def refine_boxes(
-    boxes: _F64, mask: NDArray[Any], fraction: float, min_cover: float, leg_fill: float = ...
+    boxes: _F64,
+    mask: NDArray[Any],
+    fraction: float,
+    min_cover: float,
+    leg_fill: float | None = ...,
 ) -> _F64: ...
 
 # --- blob pass: mask (H, W) uint8 0/255 -> boxes (K, 4) left, top, w, h and fills (K,) -------

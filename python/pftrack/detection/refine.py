@@ -68,8 +68,6 @@ def refine_boxes(
     m = np.asarray(mask)
     if m.ndim == 2 and m.strides[1] != 1:
         m = np.ascontiguousarray(m)
-    if leg_fill is not None and not 0.0 <= leg_fill <= 1.0:
-        raise ValueError(f"refine_boxes: leg_fill is {leg_fill}, expected None or [0, 1]")
-    fill = -1.0 if leg_fill is None else float(leg_fill)
+    fill = None if leg_fill is None else float(leg_fill)
     out: F64 = _core.refine_boxes(b, m, float(fraction), float(min_cover), fill)
     return out
