@@ -288,9 +288,11 @@ void register_detection(py::module_& m) {
             const Index mstride = mask.strides(0);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
-                std::unique_ptr<std::uint8_t[]> tmp(new std::uint8_t[static_cast<size_t>(rows * cols)]);
-                MorphScratch scratch;
-                close_mask(mptr, mstride, optr, tmp.get(), rows, cols, el, scratch);
+                // scratch kept per thread from frame to frame (each detector runs on one thread)
+                thread_local std::vector<std::uint8_t> tmp;
+                thread_local MorphScratch scratch;
+                tmp.resize(static_cast<size_t>(rows * cols));
+                close_mask(mptr, mstride, optr, tmp.data(), rows, cols, el, scratch);
             }
             return out;
         },
