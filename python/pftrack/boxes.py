@@ -12,7 +12,33 @@ from numpy.typing import ArrayLike
 
 from pftrack._typing import F64
 
-__all__ = ["cxcywh_to_xywh", "iou_xywh", "xywh_to_cxcywh"]
+__all__ = ["cxcywh_to_xywh", "intersection_xywh", "iou_xywh", "xywh_to_cxcywh"]
+
+
+def intersection_xywh(a: ArrayLike, b: ArrayLike) -> F64:
+    """Area of the intersection of every box of `a` with every box of `b`.
+
+    Parameters
+    ----------
+    a : (n, 4) array_like of float
+        Boxes ``left, top, width, height``.
+    b : (m, 4) array_like of float
+        Boxes ``left, top, width, height``.
+
+    Returns
+    -------
+    (n, m) ndarray of float64
+        Areas, 0 where two boxes do not meet.
+    """
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 4)
+    b = np.asarray(b, dtype=np.float64).reshape(-1, 4)
+    ax0, ay0 = a[:, 0:1], a[:, 1:2]
+    ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
+    bx0, by0 = b[:, 0], b[:, 1]
+    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
+    iw = np.clip(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0, None)
+    ih = np.clip(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0, None)
+    return np.asarray(iw * ih, dtype=np.float64)
 
 
 def iou_xywh(a: ArrayLike, b: ArrayLike) -> F64:
@@ -32,13 +58,7 @@ def iou_xywh(a: ArrayLike, b: ArrayLike) -> F64:
     """
     a = np.asarray(a, dtype=np.float64).reshape(-1, 4)
     b = np.asarray(b, dtype=np.float64).reshape(-1, 4)
-    ax0, ay0 = a[:, 0:1], a[:, 1:2]
-    ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
-    bx0, by0 = b[:, 0], b[:, 1]
-    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
-    iw = np.clip(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0, None)
-    ih = np.clip(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0, None)
-    inter = iw * ih
+    inter = intersection_xywh(a, b)
     union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.where(union > 0, inter / union, 0.0)

@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pftrack.boxes import cxcywh_to_xywh, iou_xywh, xywh_to_cxcywh
+from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh, xywh_to_cxcywh
 
 
 def _iou_loop(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -29,6 +29,23 @@ def test_iou_matches_loop(seed, n, m):
     got = iou_xywh(a, b)
     assert got.shape == (n, m) and got.dtype == np.float64
     np.testing.assert_allclose(got, _iou_loop(a, b), atol=1e-12)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(0, 6), m=st.integers(0, 6))
+def test_intersection_matches_loop(seed, n, m):
+    rng = np.random.default_rng(seed)
+    a = np.column_stack([rng.uniform(0, 50, (n, 2)), rng.uniform(0, 30, (n, 2))])
+    b = np.column_stack([rng.uniform(0, 50, (m, 2)), rng.uniform(0, 30, (m, 2))])
+    want = np.zeros((n, m))
+    for i, (ax, ay, aw, ah) in enumerate(a):
+        for j, (bx, by, bw, bh) in enumerate(b):
+            iw = max(0.0, min(ax + aw, bx + bw) - max(ax, bx))
+            ih = max(0.0, min(ay + ah, by + bh) - max(ay, by))
+            want[i, j] = iw * ih
+    got = intersection_xywh(a, b)
+    assert got.shape == (n, m) and got.dtype == np.float64
+    np.testing.assert_allclose(got, want, atol=1e-12)
 
 
 def test_iou_special_cases():

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
-from pftrack.boxes import cxcywh_to_xywh, xywh_to_cxcywh
+from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import rts_smooth
 from pftrack.recovery.fill import fill_rows
@@ -287,11 +287,9 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
     for idx in _frame_groups(a[:, 0]):
         if len(idx) < 2:
             continue
-        x0, y0, w, h = a[idx, 2], a[idx, 3], a[idx, 4], a[idx, 5]
-        ix = np.minimum((x0 + w)[:, None], (x0 + w)[None, :]) - np.maximum(x0[:, None], x0[None, :])
-        iy = np.minimum((y0 + h)[:, None], (y0 + h)[None, :]) - np.maximum(y0[:, None], y0[None, :])
-        overlap = np.clip(ix, 0.0, None) * np.clip(iy, 0.0, None)  # [i, j]: box i inside box j
-        area = w * h
+        box = a[idx, 2:6]
+        overlap = intersection_xywh(box, box)  # [i, j]: area of box i inside box j
+        area = box[:, 2] * box[:, 3]
         covered = (overlap > inside * area[:, None]) & (area[None, :] > area_ratio * area[:, None])
         drop[idx] = covered.any(axis=1)
     return a[~drop]
