@@ -31,7 +31,9 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import itertools
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -44,6 +46,7 @@ from experiments.cost_per_object import make_crowd
 from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.video import FrameSource
 from pftrack.tracking import TrackerConfig, track_frames
 
 SOURCES = ("pets768", "pets720", "tud1280", "crowd10", "crowd30")
@@ -59,6 +62,8 @@ class Made:
 
 
 def _write(path: Path, frames: Iterable[NDArray[np.uint8]], fps: float = 25.0) -> None:
+    """MJPG at quality 95 (`pftrack.io.video_writer.VideoWriter` writes .avi at OpenCV's
+    default quality, which would blur the sources this experiment scales)."""
     writer: cv2.VideoWriter | None = None
     for f in frames:
         if writer is None:
@@ -71,15 +76,9 @@ def _write(path: Path, frames: Iterable[NDArray[np.uint8]], fps: float = 25.0) -
 
 
 def _resized(video: Path, size: tuple[int, int], n: int | None) -> Iterable[NDArray[np.uint8]]:
-    cap = cv2.VideoCapture(str(video))
-    k = 0
-    while n is None or k < n:
-        ok, f = cap.read()
-        if not ok:
-            break
-        k += 1
-        yield cv2.resize(f, size, interpolation=cv2.INTER_LINEAR)
-    cap.release()
+    with contextlib.closing(iter(FrameSource(video))) as frames:
+        for f in itertools.islice(frames, n):
+            yield cv2.resize(f, size, interpolation=cv2.INTER_LINEAR)
 
 
 def _scaled(rows: F64, sx: float, sy: float, last: int | None = None) -> F64:
