@@ -211,7 +211,7 @@ def test_matched_validation_gaps_have_the_real_speed() -> None:
         runs.append(np.column_stack([t, v * t, np.zeros(100)]))
     for dist, lo, hi in ((5.0, 4.0, 6.0), (60.0, 50.0, 70.0)):
         cut = _artificial_gaps(runs, [(10, dist)], 30, np.random.default_rng(1))
-        d = [np.hypot(*(b[0, 1:3] - a[-1, 1:3])) for a, b, _ in cut]
+        d = [np.hypot(*(b[0, 1:3] - a[-1, 1:3])) for a, b, _, _ in cut]
         assert len(cut) >= 20 and lo <= np.median(d) <= hi
     assert rng is not None
 
@@ -225,13 +225,13 @@ def test_validation_gaps_keep_the_real_context() -> None:
     for n_a, n_b in ((1, 2), (4, 7), (60, 40)):
         cut = _artificial_gaps(runs, [(10, -1.0, n_a, n_b)], 40, np.random.default_rng(2))
         assert len(cut) == 40
-        for a, b, truth in cut:
+        for a, b, truth, _ in cut:
             assert len(truth) == 10 and b[0, 0] - a[-1, 0] == 11
             assert len(b) == n_b if n_b <= MAX_CONTEXT else MAX_CONTEXT <= len(b) <= n_b
             start = int(truth[0, 0])  # frame 0 is the run's first point
             assert start >= min(max(n_a, CONTEXT), MAX_CONTEXT) and len(a) == min(n_a, start)
     whole = _artificial_gaps(runs, [(10, -1.0)], 40, np.random.default_rng(2))
-    assert all(a[0, 0] == 0 and b[-1, 0] == 99 for a, b, _ in whole)  # whole runs without
+    assert all(a[0, 0] == 0 and b[-1, 0] == 99 for a, b, _, _ in whole)  # whole runs without
 
 
 def test_box_sizes_are_calibrated_too() -> None:

@@ -32,6 +32,12 @@ from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, rts_batch
 from pftrack.recovery.gdt import GdtModel
 from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
+from pftrack.recovery.neighbours import (
+    NB_SUFFIX,
+    Neighbourhood,
+    consecutive_runs,
+    correct_by_neighbours,
+)
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
 from pftrack.recovery.segments import as_segment
@@ -50,8 +56,10 @@ __all__ = [
     "recover_with",
 ]
 
-#: Methods scored by the calibration (``"gdt-fixed"``: two-sided goal, the paper's fixed noise).
-CANDIDATES = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed")
+#: Methods scored by the calibration (``"gdt-fixed"``: two-sided goal, the paper's fixed noise;
+#: ``"-nb"``: corrected by the errors of the tracks seen over the same frames,
+#: :mod:`pftrack.recovery.neighbours`).
+CANDIDATES = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed", "linear-nb", "rts-nb")
 #: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
 LINEAR_MARGIN = 0.01
 #: At most this many artificial gaps per file, over all buckets.
@@ -201,13 +209,28 @@ def recover_with(
     pairs: Sequence[tuple[F64, F64]],
     noise: NoiseEstimate,
     motion: MotionFit,
+    hood: Neighbourhood | None = None,
+    excludes: Sequence[int] | None = None,
 ) -> list[F64]:
     """Recover checked ``(segment_a, segment_b)`` pairs with one of :data:`CANDIDATES`.
+
+    `hood` and `excludes` are for the ``"-nb"`` methods: the observed runs whose errors
+    correct each path, and per pair the run not to use (default: the pairs' own segments,
+    none left out; :func:`~pftrack.recovery.neighbours.correct_by_neighbours`).
 
     Returns the ``(x, y)`` of every frame inside each gap.
     """
     if not pairs:
         return []
+    if method.endswith(NB_SUFFIX) and method in CANDIDATES:
+        base = method[: -len(NB_SUFFIX)]
+        if hood is None:
+            hood = Neighbourhood(consecutive_runs([s for pair in pairs for s in pair]))
+
+        def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
+            return recover_with(base, ps, noise, motion)
+
+        return correct_by_neighbours(recover, pairs, hood, excludes)
     if method == "linear":  # vectorised: one straight line per gap between the end points
         ends_a = np.array([a[-1, :3] for a, _ in pairs])
         ends_b = np.array([b[0, :3] for _, b in pairs])
@@ -239,29 +262,6 @@ def recover_with(
     raise ValueError(f"recover_with: method is {method!r}, expected one of {CANDIDATES}")
 
 
-def _observed_runs(observed: Sequence[F64]) -> list[F64]:
-    """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order."""
-    arrs = []
-    for s in observed:
-        a = np.asarray(s, dtype=np.float64)
-        if a.ndim == 2 and a.shape[1] >= 3 and len(a):
-            arrs.append(a[:, :3])
-    if not arrs:
-        return []
-    X = np.vstack(arrs)
-    bound = np.zeros(len(X), dtype=bool)
-    bound[np.cumsum([len(a) for a in arrs])[:-1]] = True
-    brk = np.flatnonzero(bound[1:] | (np.diff(X[:, 0]) != 1)) + 1
-    starts, ends = np.r_[0, brk], np.r_[brk, len(X)]
-    ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
-    starts, ends = starts[ok], ends[ok]
-    if not len(starts):
-        return []
-    keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
-    _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
-    return [X[starts[k] : ends[k]] for k in first]
-
-
 def _fit_sample(runs: Sequence[F64], seed: int) -> list[F64]:
     """Whole runs drawn at random (seeded) until :data:`MAX_FIT_POINTS` points are reached."""
     if sum(len(r) for r in runs) <= MAX_FIT_POINTS:
@@ -291,8 +291,10 @@ def _artificial_gaps(
     n: int,
     rng: np.random.Generator,
     flat: tuple[NDArray[np.int64], NDArray[np.int64], F64] | None = None,
-) -> list[tuple[F64, F64, F64]]:
-    """Up to `n` artificial gaps ``(segment_a, segment_b, truth)`` matched to `targets`.
+) -> list[tuple[F64, F64, F64, int]]:
+    """Up to `n` artificial gaps ``(segment_a, segment_b, truth, run)`` matched to `targets`.
+
+    ``run`` is the index in `runs` of the run the gap was cut from.
 
     Each target is a real gap's ``(missing frames, distance between its two end points)``,
     optionally followed by its observed points before and after (``n_a, n_b``; negative:
@@ -304,7 +306,7 @@ def _artificial_gaps(
     points: the candidates see as much of the track as on the real gap.
     """
     sizes, offset, xy = _flat(runs) if flat is None else flat
-    out: list[tuple[F64, F64, F64]] = []
+    out: list[tuple[F64, F64, F64, int]] = []
     used: set[tuple[int, int, int]] = set()
     order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
     for attempt in range(4 * n):
@@ -335,7 +337,7 @@ def _artificial_gaps(
         r = runs[i]
         lo = 0 if n_a < 0 else max(0, st - n_a)
         hi = len(r) if n_b < 0 else st + L + n_b
-        out.append((r[lo:st], r[st + L : hi], r[st : st + L]))
+        out.append((r[lo:st], r[st + L : hi], r[st : st + L], i))
     return out
 
 
@@ -416,7 +418,7 @@ def calibrate(
         targets.setdefault(bucket_of(v), []).append((v, dv, na, nb))
     if not by_bucket:
         return Calibration(())
-    runs = _observed_runs(observed)
+    runs = consecutive_runs(observed)
     whole = _fit_sample([r for r in runs if len(r) >= 4], seed)
     if noise is None and ("gdt-bi" in names or "gdt-mix" in names):
         noise = estimate_noise(whole) if whole else None
@@ -433,19 +435,21 @@ def calibrate(
     truths: dict[int, list[F64]] = {}
     n_cut: dict[int, int] = {}
     flat = _flat(runs)
+    hood = Neighbourhood(runs)
     for b in progress(sorted(by_bucket), desc="auto: calibrating", unit="bucket"):
         rng = np.random.default_rng([seed, b])
         cut = _artificial_gaps(runs, targets[b], per_bucket, rng, flat)
         n_cut[b] = len(cut)
         if len(cut) < MIN_VALIDATION_GAPS:
             continue
-        pairs = [(a, c) for a, c, _ in cut]
-        truth = [t for _, _, t in cut]
+        pairs = [(a, c) for a, c, _, _ in cut]
+        truth = [t for _, _, t, _ in cut]
+        cut_from = [i for _, _, _, i in cut]
         errors[b] = {}
         found[b] = {}
         truths[b] = truth
         for m in scored:
-            paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION)
+            paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION, hood, cut_from)
             errors[b][m] = _gap_errors(paths, truth)
             found[b][m] = paths
     weights = {b: len(by_bucket[b]) for b in errors}
@@ -616,7 +620,8 @@ def recover_auto(
     if observed is None:
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
-    all_runs = _observed_runs(observed)
+    all_runs = consecutive_runs(observed)
+    hood = Neighbourhood(all_runs)
     runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:
         needs = "gdt-bi" in candidates or "gdt-mix" in candidates
@@ -644,7 +649,7 @@ def recover_auto(
             groups.setdefault(m, []).append(k)
     found: dict[tuple[str, int], F64] = {}
     for m, idx in groups.items():
-        got = recover_with(m, [checked[k] for k in idx], noise, motion or _NO_MOTION)
+        got = recover_with(m, [checked[k] for k in idx], noise, motion or _NO_MOTION, hood)
         for k, p in zip(idx, got, strict=True):
             found[m, k] = p
     paths = [

@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.mixture import MotionFit, fit_motion
+from pftrack.recovery.names import NEIGHBOUR_METHODS
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.registry import METHODS, recover_gaps
 
@@ -159,7 +160,8 @@ def score(
     """Recover all gaps with `method` (best wall time of `repeat` runs) and score them.
 
     `observed`, `seed`, `combine`: for ``"auto"``, the observed runs it calibrates on (all
-    points outside the mask), its calibration seed and whether it may blend two methods.
+    points outside the mask), its calibration seed and whether it may blend two methods;
+    `observed` also for ``"linear-nb"`` and ``"rts-nb"`` (the tracks that correct them).
     """
     pairs = [(g.segment_a, g.segment_b) for g in gaps]
     best = np.inf
@@ -230,7 +232,7 @@ def run_mask(
     noise_ms = motion_ms = 0.0
     runs: list[F64] | None = None
     if gaps:
-        if "auto" in methods:
+        if "auto" in methods or any(m in NEIGHBOUR_METHODS for m in methods):
             runs = observed_runs(trajs, mask)
         if "gdt-bi" in methods or "gdt-mix" in methods:
             runs = observed_runs(trajs, mask)
@@ -246,6 +248,8 @@ def run_mask(
                 scores[m], paths[m] = score(
                     gaps, m, repeat, observed=runs, seed=seed, combine=combine
                 )
+            elif m in NEIGHBOUR_METHODS:  # corrected by the other tracks outside the mask
+                scores[m], paths[m] = score(gaps, m, repeat, observed=runs)
             else:
                 scores[m], paths[m] = score(gaps, m, repeat, noise, motion)
     mk = tuple(float(v) for v in mask)

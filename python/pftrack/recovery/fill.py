@@ -23,6 +23,7 @@ from pftrack.recovery.linking import (
     split_tracks,
 )
 from pftrack.recovery.mixture import MotionFit, fit_motion
+from pftrack.recovery.names import NEIGHBOUR_METHODS
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, recover_gaps
 
@@ -188,7 +189,8 @@ def fill_rows(
                 combine=combine,
             )
         else:
-            paths = recover_gaps(segs, method, noise=noise, motion=motion)
+            whole = [box_centres(r) for r in per_id.values()] if method in NEIGHBOUR_METHODS else []
+            paths = recover_gaps(segs, method, noise=noise, motion=motion, observed=whole or None)
         for k, ((tid, ra, rb), xy) in enumerate(zip(meta, paths, strict=True)):
             fr = np.arange(ra[0] + 1, rb[0])
             if wh_paths is None:  # sizes by linear interpolation

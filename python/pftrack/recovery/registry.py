@@ -30,6 +30,12 @@ Methods
     (:mod:`pftrack.recovery.mixture`).
 ``"linear"``, ``"cubic"``, ``"bspline"``, ``"gsi"``, ``"rts"``
     The baselines of :mod:`pftrack.recovery.baselines`.
+``"linear-nb"``, ``"rts-nb"`` (pftrack's variants)
+    ``"linear"`` and ``"rts"``, each path corrected by the median error the same method makes
+    on the other tracks observed over the gap's frames, cut like the gap: the motion they
+    share, such as a moving camera's (:mod:`pftrack.recovery.neighbours`). They need the
+    file's other tracks (`observed`); without them, or without a track seen over the whole
+    gap, the path is the baseline's.
 
 Box sizes (``w, h``), when given, are interpolated linearly by every method.
 """
@@ -46,7 +52,18 @@ from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
 from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
-from pftrack.recovery.names import DEFAULT_METHOD, GOAL_DIRECTED_METHODS, METHODS
+from pftrack.recovery.names import (
+    DEFAULT_METHOD,
+    GOAL_DIRECTED_METHODS,
+    METHODS,
+    NEIGHBOUR_METHODS,
+)
+from pftrack.recovery.neighbours import (
+    NB_SUFFIX,
+    Neighbourhood,
+    consecutive_runs,
+    correct_by_neighbours,
+)
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
 from pftrack.recovery.segments import as_segment, gap_frames
@@ -99,7 +116,7 @@ def recover_gap(
         raise ValueError(f"recover_gap: method is {method!r}, expected one of {METHODS}")
     if fr.size == 0:
         return np.zeros((0, 4 if a.shape[1] == 5 and b.shape[1] == 5 else 2))
-    if method in GOAL_DIRECTED_METHODS:
+    if method in GOAL_DIRECTED_METHODS or method in NEIGHBOUR_METHODS:
         full = recover_gaps([(a, b)], method, noise=noise, motion=motion)[0]
         xy = full[(fr - a[-1, 0] - 1).astype(int)]
     else:
@@ -137,9 +154,10 @@ def recover_gaps(
         For ``"gdt-mix"``: the model shared by all gaps; default: fitted to all the segments
         given (:func:`pftrack.recovery.mixture.fit_motion`, with `noise` as its fallback).
     observed : sequence of (k, 3+) ndarray, optional
-        For ``"auto"``: every observed track of the file to calibrate on; default: the
-        segments given (:func:`pftrack.recovery.calibrate.recover_auto`, which also returns
-        what was chosen).
+        For ``"auto"``: every observed track of the file to calibrate on; for ``"linear-nb"``
+        and ``"rts-nb"``: the tracks whose errors correct the paths. Default: the segments
+        given (:func:`pftrack.recovery.calibrate.recover_auto`, which also returns what was
+        chosen).
     seed, combine
         For ``"auto"``: the calibration's seed and whether a bucket may blend two methods
         (:func:`~pftrack.recovery.calibrate.recover_auto`).
@@ -162,6 +180,17 @@ def recover_gaps(
         for a, b in pairs:
             gap_frames(a, b, None)  # B after A
         return rts_batch(pairs)
+    if method in NEIGHBOUR_METHODS:
+        pairs = [(as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in gaps]
+        for a, b in pairs:
+            gap_frames(a, b, None)  # B after A
+        runs = consecutive_runs([s for p in pairs for s in p] if observed is None else observed)
+        base = method.removesuffix(NB_SUFFIX)
+
+        def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
+            return recover_gaps(ps, base)
+
+        return correct_by_neighbours(recover, pairs, Neighbourhood(runs))
     if method not in GOAL_DIRECTED_METHODS:
         return [
             recover_gap(a, b, method=method, noise=noise)[:, :2]

@@ -1,0 +1,155 @@
+"""Common motion: correct a gap's path by what the other tracks seen over its frames did.
+
+A camera that moves (a rig carried by a walker that bobs, a car that turns) moves every
+object in the image together, and no method that looks at one track alone can know how it
+moved while the track was lost. The other tracks observed over the same frames saw it: each
+such *neighbour* is cut as if it had the same gap (the same frames, the same observed points
+on each side), recovered with the same method, and its error on its own known points is the
+shared motion the method missed. The gap's path is corrected by the median of those errors,
+shrunk toward none as ``n / (n + 1)`` for ``n`` neighbours.
+
+Where objects move independently (a still camera) the neighbours' errors are their own
+manoeuvres and the correction only adds noise; ``"auto"`` scores the corrected methods
+(``"linear-nb"``, ``"rts-nb"``) on the file's own artificial gaps and keeps them only where
+they win (:mod:`pftrack.recovery.calibrate`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack._typing import F64
+
+__all__ = [
+    "MAX_NEIGHBOURS",
+    "NB_SUFFIX",
+    "Neighbourhood",
+    "consecutive_runs",
+    "correct_by_neighbours",
+]
+
+#: At most this many neighbours per gap (the nearest to the gap's last observed point).
+MAX_NEIGHBOURS = 8
+#: A method name ending in this is the method corrected by its neighbours' errors.
+NB_SUFFIX = "-nb"
+
+Window = tuple[F64, F64, F64]  # a neighbour cut like the gap: segment A, segment B, truth
+
+
+def consecutive_runs(observed: Sequence[F64]) -> list[F64]:
+    """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order.
+
+    Each array of `observed` is split where a frame is skipped; runs with a non-finite value
+    are left out, and a run given twice is kept once.
+    """
+    arrs = []
+    for s in observed:
+        a = np.asarray(s, dtype=np.float64)
+        if a.ndim == 2 and a.shape[1] >= 3 and len(a):
+            arrs.append(a[:, :3])
+    if not arrs:
+        return []
+    X = np.vstack(arrs)
+    bound = np.zeros(len(X), dtype=bool)
+    bound[np.cumsum([len(a) for a in arrs])[:-1]] = True
+    brk = np.flatnonzero(bound[1:] | (np.diff(X[:, 0]) != 1)) + 1
+    starts, ends = np.r_[0, brk], np.r_[brk, len(X)]
+    ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
+    starts, ends = starts[ok], ends[ok]
+    if not len(starts):
+        return []
+    keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
+    _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
+    return [X[starts[k] : ends[k]] for k in first]
+
+
+class Neighbourhood:
+    """Runs of consecutive observed frames, to find those seen over a gap's frames.
+
+    Parameters
+    ----------
+    runs : sequence of (k, 3+) ndarray
+        Rows ``(frame, x, y, ...)`` with consecutive frames (as
+        :func:`consecutive_runs` gives them); not copied.
+    """
+
+    def __init__(self, runs: Sequence[F64]) -> None:
+        self.runs = list(runs)
+        self.first = np.array([r[0, 0] for r in self.runs], dtype=np.float64)
+        self.last = np.array([r[-1, 0] for r in self.runs], dtype=np.float64)
+
+    def windows(self, segment_a: F64, segment_b: F64, exclude: int = -1) -> list[Window]:
+        """The neighbours of the gap between `segment_a` and `segment_b`, cut like it.
+
+        A neighbour is a run (other than run `exclude`, the one an artificial gap was cut
+        from) observed on every frame from the gap's last point before to its first point
+        after. It is cut into as many points before and after as the gap has (fewer where
+        the run is shorter) and the points between, its truth. At most
+        :data:`MAX_NEIGHBOURS`, nearest first to the gap's last point before.
+        """
+        fa, fb = float(segment_a[-1, 0]), float(segment_b[0, 0])
+        idx = np.flatnonzero((self.first <= fa) & (self.last >= fb))
+        idx = idx[idx != exclude]
+        if not len(idx):
+            return []
+        at = (fa - self.first[idx]).astype(np.int64)
+        here = np.array([self.runs[j][i, 1:3] for j, i in zip(idx, at, strict=True)])
+        d = np.hypot(*(here - segment_a[-1, 1:3]).T)
+        order = np.lexsort((idx, d))[:MAX_NEIGHBOURS]  # ties: run order (deterministic)
+        n_gap = int(fb - fa) - 1
+        out: list[Window] = []
+        for k in order:
+            r, i = self.runs[int(idx[k])], int(at[k])
+            lo = max(0, i + 1 - len(segment_a))
+            hi = i + 1 + n_gap + len(segment_b)
+            out.append((r[lo : i + 1], r[i + 1 + n_gap : hi], r[i + 1 : i + 1 + n_gap]))
+        return out
+
+
+def correct_by_neighbours(
+    recover: Callable[[list[tuple[F64, F64]]], list[F64]],
+    pairs: Sequence[tuple[F64, F64]],
+    hood: Neighbourhood,
+    excludes: Sequence[int] | None = None,
+) -> list[F64]:
+    """Recover `pairs` with `recover`, each path corrected by its neighbours' errors.
+
+    Parameters
+    ----------
+    recover : callable
+        The method: ``recover(pairs) -> paths`` (``(x, y)`` of every frame inside each gap).
+    pairs : sequence of (segment_a, segment_b)
+        Checked segments (rows ``frame, x, y``).
+    hood : Neighbourhood
+        The observed runs the neighbours come from.
+    excludes : sequence of int, optional
+        Per pair, the run of `hood` not to use (an artificial gap's own run); default none.
+
+    Returns
+    -------
+    list of (T_g - 1, 2) ndarray
+        The corrected paths; a gap without neighbours keeps the method's path.
+    """
+    pairs = list(pairs)
+    skip = [-1] * len(pairs) if excludes is None else [int(e) for e in excludes]
+    base = recover(pairs)
+    wins = [hood.windows(a, b, e) for (a, b), e in zip(pairs, skip, strict=True)]
+    flat = [w for ws in wins for w in ws]
+    if not flat:
+        return base
+    got = recover([(a, b) for a, b, _ in flat])
+    errors = [t[:, 1:3] - p for (_, _, t), p in zip(flat, got, strict=True)]
+    out: list[F64] = []
+    k = 0
+    for path, ws in zip(base, wins, strict=True):
+        n = len(ws)
+        if n == 0:
+            out.append(path)
+            continue
+        shared: NDArray[np.float64] = np.median(np.stack(errors[k : k + n]), axis=0)
+        out.append(path + shared * (n / (n + 1.0)))
+        k += n
+    return out
