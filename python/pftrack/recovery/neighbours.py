@@ -80,6 +80,10 @@ class Neighbourhood:
         self.runs = list(runs)
         self.first = np.array([r[0, 0] for r in self.runs], dtype=np.float64)
         self.last = np.array([r[-1, 0] for r in self.runs], dtype=np.float64)
+        sizes = np.array([len(r) for r in self.runs], dtype=np.int64)
+        self._offset = np.r_[0, np.cumsum(sizes)[:-1]].astype(np.int64)
+        self._xy = np.vstack([r[:, 1:3] for r in self.runs]) if self.runs else np.zeros((0, 2))
+        self._cache: dict[tuple[float, ...], list[Window]] = {}  # each "-nb" method asks
 
     def windows(self, segment_a: F64, segment_b: F64, exclude: int = -1) -> list[Window]:
         """The neighbours of the gap between `segment_a` and `segment_b`, cut like it.
@@ -91,13 +95,17 @@ class Neighbourhood:
         :data:`MAX_NEIGHBOURS`, nearest first to the gap's last point before.
         """
         fa, fb = float(segment_a[-1, 0]), float(segment_b[0, 0])
+        x, y = float(segment_a[-1, 1]), float(segment_a[-1, 2])
+        key = (fa, fb, x, y, float(len(segment_a)), float(len(segment_b)), float(exclude))
+        if key in self._cache:
+            return self._cache[key]
         idx = np.flatnonzero((self.first <= fa) & (self.last >= fb))
         idx = idx[idx != exclude]
         if not len(idx):
+            self._cache[key] = []
             return []
         at = (fa - self.first[idx]).astype(np.int64)
-        here = np.array([self.runs[j][i, 1:3] for j, i in zip(idx, at, strict=True)])
-        d = np.hypot(*(here - segment_a[-1, 1:3]).T)
+        d = np.hypot(*(self._xy[self._offset[idx] + at] - (x, y)).T)
         order = np.lexsort((idx, d))[:MAX_NEIGHBOURS]  # ties: run order (deterministic)
         n_gap = int(fb - fa) - 1
         out: list[Window] = []
@@ -106,6 +114,7 @@ class Neighbourhood:
             lo = max(0, i + 1 - len(segment_a))
             hi = i + 1 + n_gap + len(segment_b)
             out.append((r[lo : i + 1], r[i + 1 + n_gap : hi], r[i + 1 : i + 1 + n_gap]))
+        self._cache[key] = out
         return out
 
 
