@@ -33,7 +33,10 @@ from pftrack.recovery.experiment import (
 from pftrack.synthetic import make_scene
 
 #: The fixed methods `auto` is compared with (every method of the protocol but ``cubic``).
-FIXED = ("gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "linear", "bspline", "gsi", "rts")
+FIXED = (
+    "gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "linear", "bspline", "gsi", "rts",
+    "linear-nb", "rts-nb",
+)  # fmt: skip
 SEQUENCES = (
     ("PETS09-S2L1", "pets09-s2l1"),
     ("TUD-Campus", "tud-campus"),
