@@ -151,8 +151,10 @@ def fill_rows(
     per_id = split_tracks(rows)
     segs: list[tuple[F64, F64]] = []
     meta: list[tuple[int, F64, F64]] = []
+    whole: list[F64] = []  # every track's centres (frame, x, y): noise, motion, calibration
     for tid, r in per_id.items():
         c = box_centres(r)
+        whole.append(c)
         seg = np.column_stack([c, r[:, 4], r[:, 5]])
         holes = np.flatnonzero(np.diff(r[:, 0]) > 1)
         for h in holes:
@@ -164,7 +166,6 @@ def fill_rows(
     motion: MotionFit | None = None
     calibration: Calibration | None = None
     if method in ("gdt-bi", "gdt-mix") and segs:
-        whole = [box_centres(r) for r in per_id.values()]
         if noise is None:
             noise = estimate_noise(whole)
         if method == "gdt-mix":  # one model for the file, not one per pair of segments
@@ -174,7 +175,6 @@ def fill_rows(
     if segs:
         wh_paths: list[F64] | None = None
         if method == "auto":
-            whole = [box_centres(r) for r in per_id.values()]
             paths, calibration = recover_auto(
                 segs, whole, noise, motion, seed=seed, combine=combine
             )
@@ -189,8 +189,8 @@ def fill_rows(
                 combine=combine,
             )
         else:
-            whole = [box_centres(r) for r in per_id.values()] if method in NEIGHBOUR_METHODS else []
-            paths = recover_gaps(segs, method, noise=noise, motion=motion, observed=whole or None)
+            observed = whole if method in NEIGHBOUR_METHODS else None
+            paths = recover_gaps(segs, method, noise=noise, motion=motion, observed=observed)
         for k, ((tid, ra, rb), xy) in enumerate(zip(meta, paths, strict=True)):
             fr = np.arange(ra[0] + 1, rb[0])
             if wh_paths is None:  # sizes by linear interpolation
