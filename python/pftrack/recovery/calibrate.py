@@ -211,12 +211,14 @@ def recover_with(
     motion: MotionFit,
     hood: Neighbourhood | None = None,
     excludes: Sequence[int] | None = None,
+    base_paths: Sequence[F64] | None = None,
 ) -> list[F64]:
     """Recover checked ``(segment_a, segment_b)`` pairs with one of :data:`CANDIDATES`.
 
-    `hood` and `excludes` are for the ``"-nb"`` methods: the observed runs whose errors
-    correct each path, and per pair the run not to use (default: the pairs' own segments,
-    none left out; :func:`~pftrack.recovery.neighbours.correct_by_neighbours`).
+    `hood`, `excludes` and `base_paths` are for the ``"-nb"`` methods: the observed runs whose
+    errors correct each path, per pair the run not to use (default: the pairs' own segments,
+    none left out), and the uncorrected method's paths if already recovered
+    (:func:`~pftrack.recovery.neighbours.correct_by_neighbours`).
 
     Returns the ``(x, y)`` of every frame inside each gap.
     """
@@ -230,7 +232,7 @@ def recover_with(
         def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
             return recover_with(base, ps, noise, motion)
 
-        return correct_by_neighbours(recover, pairs, hood, excludes)
+        return correct_by_neighbours(recover, pairs, hood, excludes, base_paths)
     if method == "linear":  # vectorised: one straight line per gap between the end points
         ends_a = np.array([a[-1, :3] for a, _ in pairs])
         ends_b = np.array([b[0, :3] for _, b in pairs])
@@ -448,8 +450,11 @@ def calibrate(
         errors[b] = {}
         found[b] = {}
         truths[b] = truth
-        for m in scored:
-            paths = recover_with(m, pairs, noise or _NO_NOISE, motion or _NO_MOTION, hood, cut_from)
+        for m in scored:  # a "-nb" method corrects its base's paths, scored before it
+            base = found[b].get(m.removesuffix(NB_SUFFIX)) if m.endswith(NB_SUFFIX) else None
+            paths = recover_with(
+                m, pairs, noise or _NO_NOISE, motion or _NO_MOTION, hood, cut_from, base
+            )
             errors[b][m] = _gap_errors(paths, truth)
             found[b][m] = paths
     weights = {b: len(by_bucket[b]) for b in errors}

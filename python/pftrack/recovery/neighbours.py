@@ -123,6 +123,7 @@ def correct_by_neighbours(
     pairs: Sequence[tuple[F64, F64]],
     hood: Neighbourhood,
     excludes: Sequence[int] | None = None,
+    base: Sequence[F64] | None = None,
 ) -> list[F64]:
     """Recover `pairs` with `recover`, each path corrected by its neighbours' errors.
 
@@ -136,6 +137,9 @@ def correct_by_neighbours(
         The observed runs the neighbours come from.
     excludes : sequence of int, optional
         Per pair, the run of `hood` not to use (an artificial gap's own run); default none.
+    base : sequence of ndarray, optional
+        ``recover(pairs)`` when the caller has it already (the calibration scored the method
+        itself); default: recovered here.
 
     Returns
     -------
@@ -144,7 +148,7 @@ def correct_by_neighbours(
     """
     pairs = list(pairs)
     skip = [-1] * len(pairs) if excludes is None else [int(e) for e in excludes]
-    base = recover(pairs)
+    base = recover(pairs) if base is None else list(base)
     wins = [hood.windows(a, b, e) for (a, b), e in zip(pairs, skip, strict=True)]
     flat = [w for ws in wins for w in ws]
     if not flat:
