@@ -339,7 +339,8 @@ class Tracker:
         self._clip_warned = False
         self._max_conf = -np.inf
         self._given = False  # some update() of the run had detections
-        # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box
+        # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
+        # with the run's first frame (None: tracked at the frame's own size)
         self._scale: F64 | None = None
         self._shape: tuple[int, ...] | None = None  # the run's frame shape, with max_side
         self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
@@ -435,6 +436,10 @@ class Tracker:
         if self.config.max_side is not None:  # one scale for the whole run's rows
             if self._shape is None:
                 self._shape = f.shape
+                size = working_size(f.shape, self.config.max_side)
+                if size is not None:
+                    sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
+                    self._scale = np.array([sx, sy, sx, sy])
             elif f.shape != self._shape:
                 raise ValueError(
                     f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
@@ -442,11 +447,6 @@ class Tracker:
                     "call reset() before a new video)"
                 )
         work = self._working(f)
-        if work is f:
-            self._scale = None
-        else:
-            sx, sy = work.shape[1] / f.shape[1], work.shape[0] / f.shape[0]
-            self._scale = np.array([sx, sy, sx, sy])
         if dets is None:
             kept = None
             reports = self._tracker.update(work, None)
