@@ -135,7 +135,7 @@ def test_auto_picks_the_correction_under_a_carried_camera() -> None:
     assert cal.pooled.endswith("-nb"), cal.describe()
     pairs = [(tr[:60], tr[72:]) for tr in tracks[:6]]
     truth = [tr[60:72, 1:3] for tr in tracks[:6]]
-    paths, _ = recover_auto(pairs, [tr for tr in tracks])
+    paths, _ = recover_auto(pairs, tracks)
     lin = recover_gaps(pairs, "linear")
     err = [np.hypot(*(p - t).T).mean() for p, t in zip(paths, truth, strict=True)]
     err_lin = [np.hypot(*(p - t).T).mean() for p, t in zip(lin, truth, strict=True)]
