@@ -10,9 +10,9 @@ from pftrack.recovery.calibrate import CANDIDATES, calibrate, recover_auto
 from pftrack.recovery.neighbours import (
     MAX_NEIGHBOURS,
     Neighbourhood,
-    consecutive_runs,
     correct_by_neighbours,
 )
+from pftrack.recovery.segments import distinct_runs
 
 
 def _bob(t: np.ndarray) -> np.ndarray:
@@ -68,7 +68,7 @@ def test_correction_matches_a_numpy_reference() -> None:
     gap = tracks[0]
     pair = (gap[:60], gap[75:])
     others = tracks[1:]
-    got = correct_by_neighbours(_linear, [pair], Neighbourhood(consecutive_runs(others)))[0]
+    got = correct_by_neighbours(_linear, [pair], Neighbourhood(distinct_runs(others)))[0]
     np.testing.assert_allclose(got, _reference_correction(pair, others), atol=1e-9)
 
 
@@ -79,7 +79,7 @@ def test_shared_motion_is_recovered_up_to_the_shrinkage() -> None:
     pair = (gap[:50], gap[70:])
     truth = gap[50:70, 1:3]
     plain = _linear([pair])[0]
-    hood = Neighbourhood(consecutive_runs(tracks[1:]))
+    hood = Neighbourhood(distinct_runs(tracks[1:]))
     got = correct_by_neighbours(_linear, [pair], hood)[0]
     np.testing.assert_allclose(got - truth, (plain - truth) / 5.0, atol=1e-9)
     assert np.abs(plain - truth).max() > 3.0  # the bob bends the path: a real correction
@@ -87,7 +87,7 @@ def test_shared_motion_is_recovered_up_to_the_shrinkage() -> None:
 
 def test_windows_leave_out_the_excluded_run_and_cap_the_count() -> None:
     tracks = _carried_camera_tracks(np.random.default_rng(2), n=12)
-    runs = consecutive_runs(tracks)
+    runs = distinct_runs(tracks)
     hood = Neighbourhood(runs)
     a, b = runs[3][:40], runs[3][55:]
     wins = hood.windows(a, b, exclude=3)
@@ -103,7 +103,7 @@ def test_windows_leave_out_the_excluded_run_and_cap_the_count() -> None:
     every = sorted(np.hypot(*(r[39, 1:3] - a[-1, 1:3])) for r in runs if r is not runs[3])
     assert d == every[:MAX_NEIGHBOURS]  # the nearest ones
     short = [r[:45] for r in tracks[1:]]  # nobody is seen up to the gap's far end
-    assert Neighbourhood(consecutive_runs(short)).windows(a, b) == []
+    assert Neighbourhood(distinct_runs(short)).windows(a, b) == []
 
 
 def test_without_neighbours_the_method_is_unchanged() -> None:

@@ -35,12 +35,11 @@ from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
 from pftrack.recovery.neighbours import (
     NB_SUFFIX,
     Neighbourhood,
-    consecutive_runs,
     correct_by_neighbours,
 )
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment
+from pftrack.recovery.segments import as_segment, distinct_runs
 
 __all__ = [
     "CANDIDATES",
@@ -227,7 +226,7 @@ def recover_with(
     if method.endswith(NB_SUFFIX) and method in CANDIDATES:
         base = method[: -len(NB_SUFFIX)]
         if hood is None:
-            hood = Neighbourhood(consecutive_runs([s for pair in pairs for s in pair]))
+            hood = Neighbourhood(distinct_runs([s for pair in pairs for s in pair]))
 
         def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
             return recover_with(base, ps, noise, motion)
@@ -420,7 +419,7 @@ def calibrate(
         targets.setdefault(bucket_of(v), []).append((v, dv, na, nb))
     if not by_bucket:
         return Calibration(())
-    runs = consecutive_runs(observed)
+    runs = distinct_runs(observed)
     whole = _fit_sample([r for r in runs if len(r) >= 4], seed)
     if noise is None and ("gdt-bi" in names or "gdt-mix" in names):
         noise = estimate_noise(whole) if whole else None
@@ -625,7 +624,7 @@ def recover_auto(
     if observed is None:
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
-    all_runs = consecutive_runs(observed)
+    all_runs = distinct_runs(observed)
     hood = Neighbourhood(all_runs)
     runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:

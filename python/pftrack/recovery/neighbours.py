@@ -27,7 +27,6 @@ __all__ = [
     "MAX_NEIGHBOURS",
     "NB_SUFFIX",
     "Neighbourhood",
-    "consecutive_runs",
     "correct_by_neighbours",
 ]
 
@@ -39,33 +38,6 @@ NB_SUFFIX = "-nb"
 Window = tuple[F64, F64, F64]  # a neighbour cut like the gap: segment A, segment B, truth
 
 
-def consecutive_runs(observed: Sequence[F64]) -> list[F64]:
-    """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order.
-
-    Each array of `observed` is split where a frame is skipped; runs with a non-finite value
-    are left out, and a run given twice is kept once.
-    """
-    arrs = []
-    for s in observed:
-        a = np.asarray(s, dtype=np.float64)
-        if a.ndim == 2 and a.shape[1] >= 3 and len(a):
-            arrs.append(a[:, :3])
-    if not arrs:
-        return []
-    X = np.vstack(arrs)
-    bound = np.zeros(len(X), dtype=bool)
-    bound[np.cumsum([len(a) for a in arrs])[:-1]] = True
-    brk = np.flatnonzero(bound[1:] | (np.diff(X[:, 0]) != 1)) + 1
-    starts, ends = np.r_[0, brk], np.r_[brk, len(X)]
-    ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
-    starts, ends = starts[ok], ends[ok]
-    if not len(starts):
-        return []
-    keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
-    _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
-    return [X[starts[k] : ends[k]] for k in first]
-
-
 class Neighbourhood:
     """Runs of consecutive observed frames, to find those seen over a gap's frames.
 
@@ -73,7 +45,7 @@ class Neighbourhood:
     ----------
     runs : sequence of (k, 3+) ndarray
         Rows ``(frame, x, y, ...)`` with consecutive frames (as
-        :func:`consecutive_runs` gives them); not copied.
+        :func:`~pftrack.recovery.segments.distinct_runs` gives them); not copied.
     """
 
     def __init__(self, runs: Sequence[F64]) -> None:

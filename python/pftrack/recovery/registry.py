@@ -61,12 +61,11 @@ from pftrack.recovery.names import (
 from pftrack.recovery.neighbours import (
     NB_SUFFIX,
     Neighbourhood,
-    consecutive_runs,
     correct_by_neighbours,
 )
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, gap_frames
+from pftrack.recovery.segments import as_segment, distinct_runs, gap_frames
 
 __all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS", "recover_gap", "recover_gaps"]
 
@@ -184,7 +183,7 @@ def recover_gaps(
         pairs = [(as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in gaps]
         for a, b in pairs:
             gap_frames(a, b, None)  # B after A
-        runs = consecutive_runs([s for p in pairs for s in p] if observed is None else observed)
+        runs = distinct_runs([s for p in pairs for s in p] if observed is None else observed)
         base = method.removesuffix(NB_SUFFIX)
 
         def recover(ps: list[tuple[F64, F64]]) -> list[F64]:

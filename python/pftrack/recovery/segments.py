@@ -15,7 +15,14 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import MAX_COORD, real_array
 from pftrack._typing import F64
 
-__all__ = ["as_segment", "consecutive_runs", "contiguous_head", "contiguous_tail", "gap_frames"]
+__all__ = [
+    "as_segment",
+    "consecutive_runs",
+    "contiguous_head",
+    "contiguous_tail",
+    "distinct_runs",
+    "gap_frames",
+]
 
 
 def as_segment(seg: ArrayLike, name: str) -> F64:
@@ -98,6 +105,35 @@ def consecutive_runs(segments: Sequence[ArrayLike], min_points: int) -> list[F64
             if len(run) >= min_points:
                 runs.append(run)
     return runs
+
+
+def distinct_runs(observed: Sequence[F64]) -> list[F64]:
+    """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order.
+
+    Each array of `observed` is split where a frame is skipped, as :func:`consecutive_runs`
+    does, but in one vectorised pass over all of them (files of many tracks) and keeping only
+    ``frame, x, y``; runs with a non-finite value are left out, and a run given twice (a
+    segment shared by two gaps) is kept once.
+    """
+    arrs = []
+    for s in observed:
+        a = np.asarray(s, dtype=np.float64)
+        if a.ndim == 2 and a.shape[1] >= 3 and len(a):
+            arrs.append(a[:, :3])
+    if not arrs:
+        return []
+    X = np.vstack(arrs)
+    bound = np.zeros(len(X), dtype=bool)
+    bound[np.cumsum([len(a) for a in arrs])[:-1]] = True
+    brk = np.flatnonzero(bound[1:] | (np.diff(X[:, 0]) != 1)) + 1
+    starts, ends = np.r_[0, brk], np.r_[brk, len(X)]
+    ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
+    starts, ends = starts[ok], ends[ok]
+    if not len(starts):
+        return []
+    keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
+    _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
+    return [X[starts[k] : ends[k]] for k in first]
 
 
 def contiguous_tail(seg: F64) -> F64:
