@@ -106,6 +106,18 @@ def test_windows_leave_out_the_excluded_run_and_cap_the_count() -> None:
     assert Neighbourhood(distinct_runs(short)).windows(a, b) == []
 
 
+def test_a_track_on_other_frame_times_is_no_neighbour() -> None:
+    """Observed frames half a frame off the gap's (fractional frame numbers) are not its frames."""
+    tracks = _carried_camera_tracks(np.random.default_rng(9), n=3)
+    pair = (tracks[0][:50], tracks[0][70:])
+    shifted = [np.column_stack([tr[:, 0] + 0.5, tr[:, 1:]]) for tr in tracks[1:]]
+    assert Neighbourhood(distinct_runs(shifted)).windows(*pair) == []
+    np.testing.assert_array_equal(
+        recover_gaps([pair], "linear-nb", observed=shifted)[0], recover_gaps([pair], "linear")[0]
+    )
+    assert len(Neighbourhood(distinct_runs(tracks[1:])).windows(*pair)) == 2
+
+
 def test_without_neighbours_the_method_is_unchanged() -> None:
     tracks = _carried_camera_tracks(np.random.default_rng(3), n=1)
     pair = (tracks[0][:50], tracks[0][70:])

@@ -54,7 +54,8 @@ class Neighbourhood:
         self.last = np.array([r[-1, 0] for r in self.runs], dtype=np.float64)
         sizes = np.array([len(r) for r in self.runs], dtype=np.int64)
         self._offset = np.r_[0, np.cumsum(sizes)[:-1]].astype(np.int64)
-        self._xy = np.vstack([r[:, 1:3] for r in self.runs]) if self.runs else np.zeros((0, 2))
+        stacked = np.vstack([r[:, :3] for r in self.runs]) if self.runs else np.zeros((0, 3))
+        self._frame, self._xy = stacked[:, 0], stacked[:, 1:3]
         self._cache: dict[tuple[float, ...], list[Window]] = {}  # each "-nb" method asks
 
     def windows(self, segment_a: F64, segment_b: F64, exclude: int = -1) -> list[Window]:
@@ -77,6 +78,8 @@ class Neighbourhood:
             self._cache[key] = []
             return []
         at = (fa - self.first[idx]).astype(np.int64)
+        on = self._frame[self._offset[idx] + at] == fa  # frames off the gap's (fractional)
+        idx, at = idx[on], at[on]
         d = np.hypot(*(self._xy[self._offset[idx] + at] - (x, y)).T)
         order = np.lexsort((idx, d))[:MAX_NEIGHBOURS]  # ties: run order (deterministic)
         n_gap = int(fb - fa) - 1
