@@ -232,10 +232,9 @@ def run_mask(
     noise_ms = motion_ms = 0.0
     runs: list[F64] | None = None
     if gaps:
-        if "auto" in methods or any(m in NEIGHBOUR_METHODS for m in methods):
-            runs = observed_runs(trajs, mask)
-        if "gdt-bi" in methods or "gdt-mix" in methods:
-            runs = observed_runs(trajs, mask)
+        if set(methods) & {"auto", "gdt-bi", "gdt-mix", *NEIGHBOUR_METHODS}:
+            runs = observed_runs(trajs, mask)  # what those methods see of the sequence
+        if runs is not None and ("gdt-bi" in methods or "gdt-mix" in methods):
             t0 = time.perf_counter()
             noise = estimate_noise(runs)
             noise_ms = 1e3 * (time.perf_counter() - t0)
