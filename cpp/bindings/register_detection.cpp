@@ -67,7 +67,7 @@ void register_detection(py::module_& m) {
              py::arg("v_min") = 0.2)
         .def(
             "apply",
-            [](BackgroundModel& self, py::array frame) {
+            [](BackgroundModel& self, py::array frame, bool bins) {
                 const char* fn = "BackgroundModel.apply";
                 bind::check_bgr_image(frame, fn, "frame");
                 const Index rows = frame.shape(0), cols = frame.shape(1);
@@ -76,22 +76,24 @@ void register_detection(py::module_& m) {
                             "frame shape is " + shape_str(frame) + ", expected (" +
                                 std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
                                 ", 3) as the earlier frames (call reset() before a new video)");
-                auto img = std::make_shared<BinnedImage>(rows, cols, self.binning().n_bins());
+                std::shared_ptr<BinnedImage> img;
+                if (bins) img = std::make_shared<BinnedImage>(rows, cols, self.binning().n_bins());
                 auto mask = new_mask(rows, cols);
                 const auto* src = static_cast<const std::uint8_t*>(frame.data());
                 const Index stride = frame.strides(0);
                 std::uint8_t* mptr = mask.mutable_data();
+                std::int16_t* bptr = img ? img->data.data() : nullptr;
                 {
                     // safe: raw buffers kept alive by the caller / owned here; the model is not
                     // shared between threads by pftrack (one model per video)
                     py::gil_scoped_release nogil;
-                    self.apply(src, rows, cols, stride, img->data.data(), mptr);
+                    self.apply(src, rows, cols, stride, bptr, mptr);
                 }
-                return py::make_tuple(img, mask);
+                return py::make_tuple(bins ? py::cast(img) : py::none(), mask);
             },
-            py::arg("frame"),
-            "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8: 255 "
-            "foreground, 127 shadow, 0 background).")
+            py::arg("frame"), py::arg("bins") = true,
+            "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, or None without bins; raw "
+            "mask (H, W) uint8: 255 foreground, 127 shadow, 0 background).")
         .def(
             "blend",
             [](BackgroundModel& self, py::array frame, py::array mask, double rate) {

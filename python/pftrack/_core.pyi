@@ -6,7 +6,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -48,7 +48,15 @@ class BackgroundModel:
     ) -> None: ...
     # frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8:
     # 255 foreground, 127 shadow, 0 background)
-    def apply(self, frame: NDArray[np.uint8]) -> tuple[BinnedImage, NDArray[np.uint8]]: ...
+    # bins=False: no bins (None), for a caller that bins only the pixels it keeps (hsv_bins)
+    @overload
+    def apply(
+        self, frame: NDArray[np.uint8], bins: Literal[True] = True
+    ) -> tuple[BinnedImage, NDArray[np.uint8]]: ...
+    @overload
+    def apply(
+        self, frame: NDArray[np.uint8], bins: Literal[False]
+    ) -> tuple[None, NDArray[np.uint8]]: ...
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...
     # ghost test: (K,) share of each box's (K, 4) mask-boundary edges held by the frame

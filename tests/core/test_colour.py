@@ -52,6 +52,21 @@ def test_hsv_bins_mask_marks_background(textured_frame, rng):
     np.testing.assert_array_equal(hsv_bins(textured_frame, mask.astype(bool)).bins, got)
 
 
+def test_hsv_bins_sparse_mask(textured_frame):
+    # masked pixels are binned one by one and empty runs of 8 mask bytes skipped: blobs, empty
+    # rows, pixels at both row ends, a width that is no multiple of 8, a strided mask
+    frame = textured_frame[:, :61]
+    mask = np.zeros((frame.shape[0], 64), np.uint8)
+    mask[3:9, 10:23] = 255
+    mask[12, 0] = mask[12, 60] = mask[13, 59] = 1
+    mask[20:, 7:9] = 255
+    view = mask[:, :61]
+    got = hsv_bins(frame, view).bins
+    np.testing.assert_array_equal(got, ref.hsv_bins(frame, view))
+    assert (got[view > 0] >= 0).all() and (got[view == 0] == -1).all()
+    assert (hsv_bins(frame, np.zeros(frame.shape[:2], np.uint8)).bins == -1).all()
+
+
 def test_hsv_bins_of_a_strided_view(textured_frame):
     view = textured_frame[5:50, 10:70]  # rows strided, pixels packed
     np.testing.assert_array_equal(hsv_bins(view).bins, ref.hsv_bins(view))

@@ -83,6 +83,23 @@ def test_background_model_matches_reference(seed, kw):
     assert model.frame_count == 6
 
 
+def test_apply_without_bins_is_the_same_pass():
+    # bins=False (the built-in detector: it bins only its foreground) changes nothing else
+    frames = random_scene(np.random.default_rng(3), shape=(37, 61), steps=5)
+    with_bins, without = _core.BackgroundModel(n_learn=2), _core.BackgroundModel(n_learn=2)
+    for frame in frames:
+        bins, mask = with_bins.apply(frame)
+        none, same = without.apply(frame, bins=False)
+        assert none is None
+        np.testing.assert_array_equal(same, mask)
+        np.testing.assert_array_equal(without.background, with_bins.background)
+        assert without.threshold == with_bins.threshold
+        # the foreground's own bins, binned afterwards, are the fused pass's
+        np.testing.assert_array_equal(
+            _core.hsv_bins(frame, mask).bins, _core.mask_bins(bins, mask).bins
+        )
+
+
 def test_selective_update_and_shadow_are_not_learnt():
     bg = np.full((20, 20, 3), 100, np.uint8)
     m = _core.BackgroundModel(alpha=0.5, alpha_fg=0.0, n_learn=0, t_min=20.0, t_max=20.0)

@@ -144,6 +144,16 @@ PFTRACK_VECTOR_CLONES static void hsv_row_indices(Index n, const std::uint8_t* _
                     static_cast<float>(px[3 * x + 2]), si[x], hi[x]);
 }
 
+/// d_bg = max_c |frame_c - background_c| of one pixel, floor(d_bg) clamped to 255 into `di`,
+/// and the candidate flag (1 or 0) into `cand`.
+inline __attribute__((always_inline)) void candidate(float b, float g, float r, float qb, float qg,
+                                                     float qr, float dprev, float t, float t_low,
+                                                     std::int32_t& di, float& cand) {
+    const float d_bg = std::max(std::abs(b - qb), std::max(std::abs(g - qg), std::abs(r - qr)));
+    di = static_cast<std::int32_t>(std::min(d_bg, 255.0f));
+    cand = ((d_bg > t) | ((dprev > t) & (d_bg > t_low))) ? 1.0f : 0.0f;
+}
+
 /// Per pixel of one row, in float (exact on these small integers), branch-free: HsvLut indices
 /// (sat, hue), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
 PFTRACK_VECTOR_CLONES static void background_row_scan(
@@ -153,12 +163,19 @@ PFTRACK_VECTOR_CLONES static void background_row_scan(
     std::int32_t* __restrict hi, std::int32_t* __restrict di,
     float* __restrict cand) {
     for (Index x = 0; x < n; ++x) {
-        const float b = fb[x], g = fg[x], r = fr[x];
-        hsv_indices(b, g, r, si[x], hi[x]);
-        const float d_bg = std::max(std::abs(b - qb[x]), std::max(std::abs(g - qg[x]), std::abs(r - qr[x])));
-        di[x] = static_cast<std::int32_t>(std::min(d_bg, 255.0f));
-        cand[x] = ((d_bg > t) | ((dprev[x] > t) & (d_bg > t_low))) ? 1.0f : 0.0f;
+        hsv_indices(fb[x], fg[x], fr[x], si[x], hi[x]);
+        candidate(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, di[x], cand[x]);
     }
+}
+
+/// `background_row_scan` without the HsvLut indices.
+PFTRACK_VECTOR_CLONES static void background_row_candidates(
+    Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
+    const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
+    const float* __restrict dprev, float t, float t_low, std::int32_t* __restrict di,
+    float* __restrict cand) {
+    for (Index x = 0; x < n; ++x)
+        candidate(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, di[x], cand[x]);
 }
 
 /// One row of BGR bytes (and of the previous frame) -> float planes b, g, r and
@@ -290,8 +307,9 @@ public:
         }
     }
 
-    /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols) and
-    /// `mask` (rows x cols, 255 = foreground, 127 = shadow, 0 = background), both packed.
+    /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols; none
+    /// when null: the caller bins only the pixels it keeps, with `hsv_bins_image`) and `mask`
+    /// (rows x cols, 255 = foreground, 127 = shadow, 0 = background), both packed.
     void apply(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride, std::int16_t* bins,
                std::uint8_t* mask) {
         if (!initialized()) {
@@ -335,16 +353,22 @@ public:
             float* __restrict qg = qb + cols;
             float* __restrict qr = qg + cols;
             std::uint8_t* __restrict prev = previous_.data() + y * n3;
-            std::int16_t* __restrict o = bins + y * cols;
+            std::int16_t* __restrict o = bins != nullptr ? bins + y * cols : nullptr;
             std::uint8_t* __restrict m = mask + y * cols;
             // (1) deinterleave into float planes, d_prev; I' <- I
             detail::background_row_split(cols, px, prev, fb, fg, fr, dprev);
-            // (3) per pixel, vectorised: table indices, d_bg, candidates
-            detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, si, hi,
-                                        di, cand);
+            // (3) per pixel, vectorised: table indices (with bins), d_bg, candidates
+            if (o != nullptr)
+                detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, si, hi,
+                                            di, cand);
+            else
+                detail::background_row_candidates(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low,
+                                                  di, cand);
             // (4) bins by table look-up, histogram of floor(d_bg), shadow test on candidates
+            if (o != nullptr)
+                for (Index x = 0; x < cols; ++x)
+                    o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
             for (Index x = 0; x < cols; ++x) {
-                o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
                 ++h4[static_cast<size_t>(x & 3)][static_cast<size_t>(di[x])];
                 std::uint8_t out = 0;
                 if (cand[x] != 0.0f) {
@@ -394,8 +418,9 @@ private:
                         static_cast<float>(px[3 * x + c]);
                     previous_[static_cast<size_t>(y * cols * 3 + 3 * x + c)] = px[3 * x + c];
                 }
-                bins[y * cols + x] =
-                    static_cast<std::int16_t>(lut_.bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
+                if (bins != nullptr)
+                    bins[y * cols + x] = static_cast<std::int16_t>(
+                        lut_.bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
             }
         }
         std::fill(mask, mask + rows * cols, std::uint8_t(0));
@@ -496,25 +521,45 @@ PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict s
 /// `HsvLut::bin` of every pixel of a BGR frame (rows x cols, `row_stride` bytes a row) into
 /// `out` (rows x cols, packed), -1 where `mask` (if not null, `mask_stride` bytes a row) is 0: the
 /// table indices of a whole row by the vectorised `hsv_row_indices`, then the look-ups (the same
-/// bins as `HsvLut::bin` pixel by pixel, several times faster).
+/// bins as `HsvLut::bin` pixel by pixel, several times faster). With a mask, only the masked
+/// pixels are binned, one by one: a foreground mask leaves most pixels out, and most rows empty
+/// (skipped eight bytes at a time).
 inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
                            Index row_stride, const std::uint8_t* mask, Index mask_stride,
                            std::int16_t* out) {
-    std::vector<std::int32_t> si(static_cast<size_t>(cols)), hi(static_cast<size_t>(cols));
+    std::vector<std::int32_t> si, hi;
+    if (mask == nullptr) {
+        si.resize(static_cast<size_t>(cols));
+        hi.resize(static_cast<size_t>(cols));
+    }
     for (Index y = 0; y < rows; ++y) {
-        detail::hsv_row_indices(cols, bgr + y * row_stride, si.data(), hi.data());
         std::int16_t* o = out + y * cols;
+        const std::uint8_t* px = bgr + y * row_stride;
         if (mask == nullptr) {
+            detail::hsv_row_indices(cols, px, si.data(), hi.data());
             for (Index x = 0; x < cols; ++x)
                 o[x] = static_cast<std::int16_t>(lut.bin_at(si[static_cast<size_t>(x)],
                                                             hi[static_cast<size_t>(x)]));
             continue;
         }
         const std::uint8_t* m = mask + y * mask_stride;
-        for (Index x = 0; x < cols; ++x)  // -1 (all bits set) where the mask is 0
-            o[x] = static_cast<std::int16_t>(
-                lut.bin_at(si[static_cast<size_t>(x)], hi[static_cast<size_t>(x)]) |
-                -static_cast<int>(m[x] == 0));
+        std::fill(o, o + cols, std::int16_t(-1));
+        Index x = 0;
+        while (x < cols) {
+            if (x + 8 <= cols) {
+                std::uint64_t word;
+                std::memcpy(&word, m + x, 8);
+                if (word == 0) {
+                    x += 8;
+                    continue;
+                }
+            }
+            const Index stop = std::min(x + 8, cols);
+            for (; x < stop; ++x)
+                if (m[x] != 0)
+                    o[x] = static_cast<std::int16_t>(
+                        lut.bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
+        }
     }
 }
 

@@ -19,7 +19,7 @@ from pftrack.detection.base import (
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
 from pftrack.detection.size_model import PersonSizeModel
-from pftrack.particle_filter.colour import HsvBinning
+from pftrack.particle_filter.colour import HsvBinning, hsv_bins
 
 
 @dataclass(frozen=True)
@@ -198,7 +198,9 @@ class PaperDetector:
         -------
         Detections
         """
-        shaded, binned = self._foreground(frame, "PaperDetector.detect")
+        frame = check_frame(frame, "PaperDetector.detect")
+        _, raw = self._model.apply(frame, bins=False)  # bins below, of the foreground only
+        shaded = self._blobs.clean(raw)
         mask = foreground_only(shaded)
         if self.config.ghost_support > 0 and self._ghost is not None:
             # a ghost found earlier: its pixels still foreground keep being learnt fast
@@ -219,7 +221,9 @@ class PaperDetector:
             if self._ghost is not None:  # in place: `shaded` is this frame's own array
                 shaded[self._ghost != 0] = 0
             boxes = size.extend_legs(shaded, boxes, self.config.leg_height, self.config.leg_fill)
-        return Detections(boxes, scores, mask, _core.mask_bins(binned, mask), frame_bins=binned)
+        # the colours of the kept foreground only (the full frame's bins, which only a moving
+        # camera needs, are binned by the tracker then)
+        return Detections(boxes, scores, mask, hsv_bins(frame, mask, self.config.hsv))
 
     def _drop_ghosts(
         self,
