@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 from dataclasses import replace
 
+import cv2
 import numpy as np
 import pytest
 
@@ -20,6 +21,7 @@ from pftrack.tracking import (
 from pftrack.tracking.camera import (
     CameraMotion,
     Stabiliser,
+    _grey,
     compose,
     estimate_motion,
     invert_affine,
@@ -67,6 +69,30 @@ def test_estimator_recovers_a_known_similarity_to_subpixel(
     estimate = estimate_motion(texture, moved)
     assert estimate is not None
     assert corner_error(estimate, truth) < 0.3  # pixels, at the image corners
+
+
+def test_large_frames_are_halved_before_scaling(texture: np.ndarray) -> None:
+    # 1280x720: halved to 640x360 before the area resize to 240x135; close to the one-step
+    # resize, and the motion of a pan still measured to a fraction of a pixel
+    big = cv2.resize(texture, (1280, 720), interpolation=cv2.INTER_CUBIC)
+    factor = 240 / 1280
+    grey = _grey(big, factor)
+    one_step = cv2.resize(
+        cv2.cvtColor(big, cv2.COLOR_BGR2GRAY), (240, 135), interpolation=cv2.INTER_AREA
+    )
+    assert grey.shape == one_step.shape
+    assert np.abs(grey.astype(int) - one_step).mean() < 1.0
+    small = texture[:, :400]  # under four times the target: one step, as before
+    np.testing.assert_array_equal(
+        _grey(small, 0.6),
+        cv2.resize(
+            cv2.cvtColor(small, cv2.COLOR_BGR2GRAY), (240, 216), interpolation=cv2.INTER_AREA
+        ),
+    )
+    shift = np.array([[1.0, 0.0, 6.4], [0.0, 1.0, -3.2]])
+    estimate = estimate_motion(big, cv2.warpAffine(big, shift, (1280, 720), flags=cv2.INTER_LINEAR))
+    assert estimate is not None
+    assert motion_magnitude(compose(invert_affine(shift), estimate), (720, 1280)) < 0.5
 
 
 def test_estimator_ignores_corners_inside_excluded_boxes(texture: np.ndarray) -> None:
