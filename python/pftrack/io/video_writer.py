@@ -147,7 +147,7 @@ class VideoWriter:
 
             # to 4:2:0 by OpenCV (BT.601 limited range, as PyAV's swscale conversion of bgr24
             # gives it): write() takes 2.06 instead of 2.32 ms a 480x360 frame
-            yuv = cv2.cvtColor(image, cv2.COLOR_BGR2YUV_I420)
+            yuv = np.asarray(cv2.cvtColor(image, cv2.COLOR_BGR2YUV_I420), dtype=np.uint8)
             picture = av.VideoFrame.from_ndarray(yuv, format="yuv420p")
             for packet in self._stream.encode(picture):
                 self._container.mux(packet)
