@@ -259,6 +259,12 @@ def _assert_same_pixels_as_default_capture(path: Path) -> None:
     picked = [0, len(want) // 3, len(want) - 1]
     for a, k in zip(src.frames_at(picked), picked, strict=True):
         np.testing.assert_array_equal(a, want[k])
+    # two halves at once, the second from a seek (past key frames and B-frames): the same
+    spread = np.linspace(0, len(want) - 1, 9).round().astype(int).tolist()
+    got = src.frames_at(spread, split=True)
+    assert len(got) == len(spread)
+    for a, k in zip(got, spread, strict=True):
+        np.testing.assert_array_equal(a, want[k])
 
 
 def test_h264_file_frames_equal_the_default_capture(tmp_path: Path) -> None:
@@ -277,6 +283,27 @@ def test_h264_file_frames_equal_the_default_capture(tmp_path: Path) -> None:
     out.mux(stream.encode())
     out.close()
     _assert_same_pixels_as_default_capture(path)
+
+
+@pytest.mark.parametrize("fault", ["late", "refused"])
+def test_a_split_pass_whose_seek_goes_wrong_reads_on_from_the_first_half(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fault: str
+) -> None:
+    path = _mjpg(tmp_path / "v.avi", 30, np.random.default_rng(4))
+    src = FrameSource(path)
+    spread = [0, 4, 9, 14, 15, 16, 22, 29]
+    plain = src.frames_at(spread)
+    seek = FrameSource._read_from_seek
+
+    def wrong(self: FrameSource, middle: int, wanted: list[int]) -> object:
+        # a container whose seek lands one frame late, or that cannot seek at all
+        return seek(self, middle + 1, wanted) if fault == "late" else None
+
+    monkeypatch.setattr(FrameSource, "_read_from_seek", wrong)
+    got = src.frames_at(spread, split=True)
+    assert len(got) == len(plain) == len(spread)
+    for a, b in zip(got, plain, strict=True):
+        np.testing.assert_array_equal(a, b)
 
 
 @pytest.mark.dataset

@@ -22,7 +22,7 @@ __all__ = ["BOOTSTRAPS", "Bootstrap", "bootstrap_frames"]
 
 
 def bootstrap_frames(
-    frames: Iterable[NDArray[np.uint8]], n: int = 30, mode: str = "spread"
+    frames: Iterable[NDArray[np.uint8]], n: int = 30, mode: str = "spread", *, split: bool = False
 ) -> list[NDArray[np.uint8]]:
     """Pick the frames whose per-pixel median starts the background.
 
@@ -40,6 +40,9 @@ def bootstrap_frames(
         ``"spread"``: `n` frames evenly spaced over the whole video; ``"first"``: the first `n`
         frames (the only choice when streaming); ``"none"``: no frames (the background then
         starts as the first frame).
+    split : bool
+        ``"spread"`` over a file: decode its two halves at once, on two threads
+        (``FrameSource.frames_at(split=True)``; the same frames).
 
     Returns
     -------
@@ -57,7 +60,7 @@ def bootstrap_frames(
     wanted = set(np.linspace(0, total - 1, n).round().astype(int).tolist())
     pick = getattr(frames, "frames_at", None)
     if callable(pick):  # a FrameSource: only the wanted images of a folder, no BGR in between
-        return list(pick(sorted(wanted)))
+        return list(pick(sorted(wanted), split=True) if split else pick(sorted(wanted)))
     if isinstance(frames, Sequence):
         return [frames[i] for i in sorted(wanted)]
     picked: list[NDArray[np.uint8]] = []

@@ -138,9 +138,11 @@ def track_frames(
         bridged gap's rows arrive when the track is re-detected). For rendering while tracking
         and for writing rows of a live source as they come.
     threads : bool
-        Decode and detect on threads ahead of the tracker (below). False does all the work on
-        the calling thread, with the same rows: for a process that already has one task per
-        core, such as a worker of ``pftrack batch``, where the extra threads only cost CPU.
+        Decode and detect on threads ahead of the tracker (below), and decode the two halves
+        of a file at once for the spread bootstrap (``bootstrap_frames(split=True)``). False
+        does all the work on the calling thread, with the same rows: for a process that already
+        has one task per core, such as a worker of ``pftrack batch``, where the extra threads
+        only cost CPU.
 
     Notes
     -----
@@ -169,7 +171,7 @@ def track_frames(
     if prime_frames > 0 and (detections is None or config.refine.enabled):
         if bootstrap == "auto":
             bootstrap = "spread" if detections is None else "first"
-        primer = bootstrap_frames(frames, prime_frames, bootstrap)
+        primer = bootstrap_frames(frames, prime_frames, bootstrap, split=threads)
         if primer:
             tracker.prime(primer)
     empty = np.zeros((0, 5))
