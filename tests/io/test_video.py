@@ -14,6 +14,7 @@ import cv2
 import numpy as np
 import pytest
 
+from pftrack.io import video
 from pftrack.io.video import FrameSource, is_live_source, natural_key, read_seqinfo
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
@@ -302,6 +303,39 @@ def test_a_split_pass_whose_seek_goes_wrong_reads_on_from_the_first_half(
     monkeypatch.setattr(FrameSource, "_read_from_seek", wrong)
     got = src.frames_at(spread, split=True)
     assert len(got) == len(plain) == len(spread)
+    for a, b in zip(got, plain, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_a_split_pass_whose_seek_raises_reads_on_from_the_first_half(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = _mjpg(tmp_path / "v.avi", 30, np.random.default_rng(5))
+    src = FrameSource(path)
+    spread = [0, 9, 14, 15, 29]
+    plain = src.frames_at(spread)
+    opened = video._file_capture
+
+    class Failing:  # the second half's capture: OpenCV fails on the seek
+        def __init__(self, cap: cv2.VideoCapture) -> None:
+            self.cap = cap
+
+        def set(self, *args: object) -> bool:
+            raise cv2.error("seek failed")
+
+        def release(self) -> None:
+            self.cap.release()
+
+    captures: list[object] = []
+
+    def capture(name: str) -> object:
+        cap = opened(name)
+        captures.append(cap)
+        return cap if len(captures) == 1 else Failing(cap)
+
+    monkeypatch.setattr(video, "_file_capture", capture)
+    got = src.frames_at(spread, split=True)
+    assert len(captures) == 2  # the split was tried
     for a, b in zip(got, plain, strict=True):
         np.testing.assert_array_equal(a, b)
 

@@ -463,13 +463,18 @@ class FrameSource:
     def _read_from_seek(
         self, middle: int, wanted: list[int]
     ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]]] | None:
-        """The second half of a split pass: frames from `middle` on, after a seek to it."""
+        """The second half of a split pass: frames from `middle` on, after a seek to it.
+
+        None when the file cannot seek (or OpenCV fails on it): the first half reads on.
+        """
         cap = _file_capture(str(self.path))
         try:
             if not cap.set(cv2.CAP_PROP_POS_FRAMES, middle):
                 return None
             picked, seen, _ = self._read_at(cap, middle, [i for i in wanted if i >= middle], middle)
             return picked, seen
+        except cv2.error:
+            return None
         finally:
             cap.release()
 
