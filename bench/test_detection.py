@@ -1,4 +1,5 @@
-"""Detection speed: the fused C++ pass vs OpenCV's MOG2 vs the NumPy reference, same frames;
+"""Detection speed: the fused C++ pass (with and without HSV bins) vs OpenCV's MOG2 vs the
+NumPy reference, same frames;
 the blob pass and the size model's Theil-Sen line in C++ vs their Python references.
 
 pytest bench/test_detection.py --benchmark-only --benchmark-group-by=group
@@ -73,6 +74,15 @@ def test_core_background_pass(benchmark: BenchmarkFixture, frames: Frames) -> No
     m = _core.BackgroundModel()
     m.apply(fr[0])
     benchmark(cycle_apply(m.apply, fr[1:]))
+
+
+def test_core_background_pass_without_bins(benchmark: BenchmarkFixture, frames: Frames) -> None:
+    """The pass as ``PaperDetector.detect`` runs it: no bins (its foreground is binned after)."""
+    name, fr = frames
+    benchmark.group = f"per-pixel pass {name}"
+    m = _core.BackgroundModel()
+    m.apply(fr[0])
+    benchmark(cycle_apply(lambda f: m.apply(f, bins=False), fr[1:]))
 
 
 @pytest.fixture(params=[1, 0], ids=["1 thread", "cv2 threads"])
