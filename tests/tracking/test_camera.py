@@ -82,6 +82,12 @@ def test_large_frames_are_halved_before_scaling(texture: np.ndarray) -> None:
     )
     assert grey.shape == one_step.shape
     assert np.abs(grey.astype(int) - one_step).mean() < 1.0
+    halved = cv2.resize(
+        cv2.cvtColor(big, cv2.COLOR_BGR2GRAY), (640, 360), interpolation=cv2.INTER_AREA
+    )
+    np.testing.assert_array_equal(
+        grey, cv2.resize(halved, (240, 135), interpolation=cv2.INTER_AREA)
+    )
     small = texture[:, :400]  # under four times the target: one step, as before
     np.testing.assert_array_equal(
         _grey(small, 0.6),
