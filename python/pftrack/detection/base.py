@@ -33,8 +33,10 @@ class Detections:
         HSV bins of the frame with background pixels set to -1 (foreground only), for the
         particles' colour histograms.
     frame_bins : pftrack._core.BinnedImage or None
-        HSV bins of every pixel, when the detector computed them anyway (the paper's fused
-        pass does; MOG2 and KNN do not), so a caller needing them never bins the frame twice.
+        HSV bins of every pixel, when the detector computed them anyway, so a caller needing
+        them never bins the frame twice. None from the built-in detectors' ``detect``: the
+        paper's pass bins only the kept foreground (its ``foreground``, for box refinement,
+        still bins every pixel in the same pass); MOG2 and KNN bin none.
     """
 
     boxes: NDArray[np.float64]
