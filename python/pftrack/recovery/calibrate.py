@@ -436,7 +436,7 @@ def calibrate(
     truths: dict[int, list[F64]] = {}
     n_cut: dict[int, int] = {}
     flat = _flat(runs)
-    hood = Neighbourhood(runs)
+    hood = Neighbourhood(runs) if any(m.endswith(NB_SUFFIX) for m in scored) else None
     for b in progress(sorted(by_bucket), desc="auto: calibrating", unit="bucket"):
         rng = np.random.default_rng([seed, b])
         cut = _artificial_gaps(runs, targets[b], per_bucket, rng, flat)
@@ -625,7 +625,6 @@ def recover_auto(
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
     all_runs = distinct_runs(observed)
-    hood = Neighbourhood(all_runs)
     runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:
         needs = "gdt-bi" in candidates or "gdt-mix" in candidates
@@ -652,6 +651,7 @@ def recover_auto(
         for m, _ in mix:
             groups.setdefault(m, []).append(k)
     found: dict[tuple[str, int], F64] = {}
+    hood = Neighbourhood(all_runs) if any(m.endswith(NB_SUFFIX) for m in groups) else None
     for m, idx in groups.items():
         got = recover_with(m, [checked[k] for k in idx], noise, motion or _NO_MOTION, hood)
         for k, p in zip(idx, got, strict=True):

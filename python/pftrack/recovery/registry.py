@@ -124,6 +124,14 @@ def recover_gap(
     return xy if wh is None else np.hstack([xy, wh])
 
 
+def _checked_pairs(gaps: Sequence[tuple[ArrayLike, ArrayLike]]) -> list[tuple[F64, F64]]:
+    """The gaps as checked ``(segment_a, segment_b)`` arrays, each B after its A."""
+    pairs = [(as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in gaps]
+    for a, b in pairs:
+        gap_frames(a, b, None)
+    return pairs
+
+
 def recover_gaps(
     gaps: Sequence[tuple[ArrayLike, ArrayLike]],
     method: str = DEFAULT_METHOD,
@@ -175,14 +183,9 @@ def recover_gaps(
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
     if method == "rts" and gaps:  # one vectorised pass over all gaps
-        pairs = [(as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in gaps]
-        for a, b in pairs:
-            gap_frames(a, b, None)  # B after A
-        return rts_batch(pairs)
+        return rts_batch(_checked_pairs(gaps))
     if method in NEIGHBOUR_METHODS:
-        pairs = [(as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in gaps]
-        for a, b in pairs:
-            gap_frames(a, b, None)  # B after A
+        pairs = _checked_pairs(gaps)
         runs = distinct_runs([s for p in pairs for s in p] if observed is None else observed)
         base = method.removesuffix(NB_SUFFIX)
 
