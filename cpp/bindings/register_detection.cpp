@@ -267,7 +267,7 @@ void register_detection(py::module_& m) {
             const Index mstride = mask.strides(0);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
-                mask_bins(binned.data.data(), binned.rows, binned.cols, mptr, mstride,
+                mask_bins(binned.view().data, binned.rows, binned.cols, mptr, mstride,
                           out->data.data());
             }
             return out;

@@ -114,7 +114,7 @@ void register_filter(py::module_& m) {
             SisResult r;
             {
                 py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
-                r = sis_step(particles, weights, means, image.view(), ref, prm, seed, step);
+                r = sis_step(particles, weights, means, image.lazy_view(), ref, prm, seed, step);
             }
             return bind::step_result_dict(r);
         },
@@ -172,7 +172,7 @@ void register_filter(py::module_& m) {
             RowMatrixXd out(k, 11);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers kept alive by `keep`
-                const BinImage img = image.view();
+                const BinImage img = image.lazy_view();
                 for (py::ssize_t i = 0; i < k; ++i) {
                     auto& pa = keep[static_cast<size_t>(4 * i)];
                     auto& wa = keep[static_cast<size_t>(4 * i + 1)];

@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -72,9 +73,16 @@ void register_histogram(py::module_& m) {
         .def_property_readonly("n_bins", [](const BinnedImage& b) { return b.n_bins; })
         .def_property_readonly("shape", [](const BinnedImage& b) { return py::make_tuple(b.rows, b.cols); })
         .def_property_readonly(
+            "tiles_pending", [](const BinnedImage& b) { return b.lazy ? b.lazy->pending() : Index(0); },
+            "Tiles (16 x 32 pixels) a lazy image has not binned yet (0: every bin computed)")
+        .def_property_readonly(
             "bins",
             [](py::object self) {
                 const auto& b = self.cast<const BinnedImage&>();
+                {
+                    py::gil_scoped_release nogil;  // safe: the C++ image only, kept by `self`
+                    b.complete();  // a lazy image bins what no reader has asked for yet
+                }
                 py::array_t<std::int16_t> a({b.rows, b.cols},
                                             {static_cast<py::ssize_t>(b.cols * 2), py::ssize_t(2)},
                                             b.data.data(), self);
@@ -86,7 +94,7 @@ void register_histogram(py::module_& m) {
     m.def(
         "hsv_bins",
         [](py::array frame, std::optional<py::array> mask, int n_h, int n_s, int n_v, double s_min,
-           double v_min) {
+           double v_min, bool lazy) {
             const char* fn = "hsv_bins";
             bind::check_bgr_image(frame, fn, "frame");
             const HsvBinning p{n_h, n_s, n_v, s_min, v_min};
@@ -103,6 +111,32 @@ void register_histogram(py::module_& m) {
             const auto* src = static_cast<const std::uint8_t*>(frame.data());
             const auto stride = frame.strides(0);
             const std::shared_ptr<const HsvLut> lut = cached_lut(p);
+            if (lazy) {
+                // Its own packed copies of the frame (and mask): the caller may change or drop
+                // them before a reader bins a tile.
+                auto bgr = std::make_shared<std::vector<std::uint8_t>>(
+                    static_cast<size_t>(rows * cols * 3));
+                auto m = std::make_shared<std::vector<std::uint8_t>>(
+                    mptr ? static_cast<size_t>(rows * cols) : size_t(0));
+                {
+                    py::gil_scoped_release nogil;  // safe: raw buffers, held alive by the caller
+                    for (py::ssize_t y = 0; y < rows; ++y) {
+                        std::memcpy(bgr->data() + y * cols * 3, src + y * stride,
+                                    static_cast<size_t>(cols * 3));
+                        if (mptr)
+                            std::memcpy(m->data() + y * cols, mptr + y * mstride,
+                                        static_cast<size_t>(cols));
+                    }
+                }
+                std::int16_t* out = img->data.data();
+                const Index c = cols;
+                img->make_lazy([bgr, m, lut, out, c](Index y0, Index y1, Index x0, Index x1) {
+                    const std::uint8_t* mk = m->empty() ? nullptr : m->data() + y0 * c + x0;
+                    hsv_bins_image(*lut, bgr->data() + (y0 * c + x0) * 3, y1 - y0, x1 - x0, c * 3,
+                                   mk, c, out + y0 * c + x0, c);
+                });
+                return img;
+            }
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers only, held alive by the caller
                 hsv_bins_image(*lut, src, rows, cols, stride, mptr, mstride, img->data.data());
@@ -111,7 +145,9 @@ void register_histogram(py::module_& m) {
         },
         py::arg("frame"), py::arg("mask") = py::none(), py::arg("n_h") = 10, py::arg("n_s") = 10,
         py::arg("n_v") = 10, py::arg("s_min") = 0.1, py::arg("v_min") = 0.2,
-        "Bin index per pixel of a BGR uint8 frame (H, W, 3); mask (H, W) zero = background.");
+        py::arg("lazy") = false,
+        "Bin index per pixel of a BGR uint8 frame (H, W, 3); mask (H, W) zero = background. "
+        "lazy: each tile binned when first read (same bins).");
 
     m.def(
         "box_histograms",
@@ -122,7 +158,7 @@ void register_histogram(py::module_& m) {
             const Kernel k = parse_kernel(kernel, fn);
             const BoxPath path = parse_method(method, fn);
             py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
-            return box_histograms(image.view(), boxes, k, path);
+            return box_histograms(image.lazy_view(), boxes, k, path);
         },
         py::arg("image"), py::arg("boxes"), py::arg("kernel") = "uniform",
         py::arg("method") = "auto",
@@ -142,7 +178,7 @@ void register_histogram(py::module_& m) {
             py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
             require(boxes.rows() > 0, fn, "boxes rows", boxes.rows(), ">= 1");
             const Eigen::VectorXd sq = sqrt_reference(ref, image.n_bins, fn);
-            return weights_from_rho(box_coefficients(image.view(), boxes, sq, k, path), lam, fn);
+            return weights_from_rho(box_coefficients(image.lazy_view(), boxes, sq, k, path), lam, fn);
         },
         py::arg("image"), py::arg("boxes"), py::arg("ref"), py::arg("lam") = 20.0,
         py::arg("kernel") = "uniform", py::arg("method") = "auto",

@@ -121,7 +121,7 @@ void register_mcmc(py::module_& m) {
             MhResult r;
             {
                 py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
-                r = mh_step(particles, weights, means, image.view(), ref, prm, seed, step);
+                r = mh_step(particles, weights, means, image.lazy_view(), ref, prm, seed, step);
             }
             py::dict out = bind::step_result_dict(r);
             out["acceptance"] = r.acceptance;

@@ -25,6 +25,8 @@ class BinnedImage:
     def shape(self) -> tuple[int, int]: ...  # (H, W)
     @property
     def bins(self) -> NDArray[np.int16]: ...  # (H, W) int16, read-only view
+    @property
+    def tiles_pending(self) -> int: ...  # tiles of 16 x 32 pixels a lazy image has not binned
 
 class BackgroundModel:
     """Adaptive background + frame difference + threshold, fused with HSV binning."""
@@ -178,6 +180,7 @@ def hsv_bins(
     n_v: int = 10,
     s_min: float = 0.1,
     v_min: float = 0.2,
+    lazy: bool = False,  # tiles binned when first read (same bins); .bins bins the rest
 ) -> BinnedImage: ...
 
 # per-pixel median (H, W, 3) float32 of (H, W, 3) uint8 frames (numpy.median's values)

@@ -8,9 +8,9 @@ import pytest
 from pftrack.boxes import iou_xywh
 from pftrack.detection import refine_boxes
 from pftrack.eval import evaluate_mot
-from pftrack.io.mot import read_mot
+from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.particle_filter import box_histograms, hsv_bins
-from pftrack.synthetic import make_scene
+from pftrack.synthetic import make_scene, move_camera
 from pftrack.tracking import (
     AssociationConfig,
     LifecycleConfig,
@@ -337,3 +337,44 @@ def test_load_detections_bounds_its_scale_as_the_cli(tmp_path):
             load_detections(det, scale)
     with pytest.raises(TypeError, match="detection scale must be a number, got str"):
         load_detections(det, "2")  # type: ignore[arg-type]
+
+
+def _eager_and_lazy_runs(monkeypatch, frames, **kwargs):
+    """The same run with the tracker's full-frame bins lazy (as shipped) and forced eager."""
+    import pftrack.tracking.tracker as tracker_module
+
+    calls: list[bool] = []
+
+    def spy(frame, mask=None, binning=None, lazy=False):
+        calls.append(lazy)
+        return hsv_bins(frame, mask, binning, lazy=lazy)
+
+    def eager(frame, mask=None, binning=None, lazy=False):
+        return hsv_bins(frame, mask, binning, lazy=False)
+
+    monkeypatch.setattr(tracker_module, "hsv_bins", spy)
+    lazy_run = track_frames(frames, rng=0, **kwargs)
+    monkeypatch.setattr(tracker_module, "hsv_bins", eager)
+    eager_run = track_frames(frames, rng=0, **kwargs)
+    return lazy_run, eager_run, calls
+
+
+def test_lazy_frame_bins_give_the_same_tracks_with_detections(scene, monkeypatch):
+    dets = {
+        f: np.column_stack([r[:, 2:6], np.full(len(r), 0.95)])
+        for f, r in group_by_frame(scene.truth).items()
+    }
+    cfg = TrackerConfig(refine=RefineConfig(enabled=False))  # full-frame bins on every frame
+    lazy, eager, calls = _eager_and_lazy_runs(monkeypatch, scene.frames, detections=dets,
+                                              config=cfg)  # fmt: skip
+    assert calls and all(calls)  # every frame's bins were lazy
+    assert len(lazy.rows) > 0
+    np.testing.assert_array_equal(lazy.rows, eager.rows)
+
+
+def test_lazy_frame_bins_give_the_same_tracks_on_a_moving_camera(monkeypatch):
+    moving = move_camera(make_scene(n_frames=50, n_walkers=5, rng=3), period=30.0)
+    lazy, eager, calls = _eager_and_lazy_runs(monkeypatch, moving.frames)
+    assert any(calls)  # the camera moved: full-frame bins of the built-in detector's frames
+    assert len(lazy.rows) > 0
+    np.testing.assert_array_equal(lazy.rows, eager.rows)

@@ -523,17 +523,19 @@ PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict s
 /// table indices of a whole row by the vectorised `hsv_row_indices`, then the look-ups (the same
 /// bins as `HsvLut::bin` pixel by pixel, several times faster). With a mask, only the masked
 /// pixels are binned, one by one: a foreground mask leaves most pixels out, and most rows empty
-/// (skipped eight bytes at a time).
+/// (skipped eight bytes at a time). `out_stride` is in elements: the bins of one rectangle of a
+/// larger image (each pixel's bin depends on that pixel only, so any rectangle gets the bins the
+/// whole image would).
 inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
                            Index row_stride, const std::uint8_t* mask, Index mask_stride,
-                           std::int16_t* out) {
+                           std::int16_t* out, Index out_stride) {
     std::vector<std::int32_t> si, hi;
     if (mask == nullptr) {
         si.resize(static_cast<size_t>(cols));
         hi.resize(static_cast<size_t>(cols));
     }
     for (Index y = 0; y < rows; ++y) {
-        std::int16_t* o = out + y * cols;
+        std::int16_t* o = out + y * out_stride;
         const std::uint8_t* px = bgr + y * row_stride;
         if (mask == nullptr) {
             detail::hsv_row_indices(cols, px, si.data(), hi.data());
@@ -561,6 +563,13 @@ inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index row
                         lut.bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
         }
     }
+}
+
+/// `hsv_bins_image` into a packed `out` (rows x cols).
+inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
+                           Index row_stride, const std::uint8_t* mask, Index mask_stride,
+                           std::int16_t* out) {
+    hsv_bins_image(lut, bgr, rows, cols, row_stride, mask, mask_stride, out, cols);
 }
 
 /// Bins with background set to -1: out = mask == 0 ? -1 : bins.

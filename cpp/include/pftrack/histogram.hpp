@@ -157,6 +157,7 @@ private:
 
     /// Counts the range's pixels per bin into counts_ (slot 0: background); returns the total.
     std::int64_t count(const BinImage& img, const PixelRange& r) {
+        img.ensure(r.x0, r.x1, r.y0, r.y1);  // a lazy image bins the range first
         const Index area = (r.x1 - r.x0) * (r.y1 - r.y0);
         return area < 65536 ? count_copies(img, r, counts16_.data(), stride16_)
                             : count_copies(img, r, counts_.data(), stride_);
@@ -192,6 +193,7 @@ private:
     // Epanechnikov profile k(r^2) = max(0, 1 - r^2), r^2 = ((x-cx)/(w/2))^2 + ((y-cy)/(h/2))^2.
     double epanechnikov(const BinImage& img, const PixelRange& r, double cx, double cy, double w,
                         double h, double* out) {
+        img.ensure(r.x0, r.x1, r.y0, r.y1);  // a lazy image bins the range first
         std::fill(weights_.begin(), weights_.end(), 0.0);
         double* a0 = weights_.data() + 1;
         double* a1 = a0 + stride_;

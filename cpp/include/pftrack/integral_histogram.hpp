@@ -41,8 +41,10 @@ public:
           seen_(static_cast<size_t>(n_bins) + 1) {}
 
     /// Numbers the bins present in `region` (background, bin -1, included when present).
-    /// Returns the table's entries per pixel: a multiple of kLanes.
+    /// Returns the table's entries per pixel: a multiple of kLanes. A lazy image bins the
+    /// region here, for build() too (which reads the prepared region only).
     int prepare(const BinImage& img, const PixelRange& region) {
+        img.ensure(region.x0, region.x1, region.y0, region.y1);
         region_ = region;
         std::fill(seen_.begin(), seen_.end(), std::uint8_t(0));
         std::uint8_t* seen = seen_.data() + 1;  // seen[-1]: background

@@ -81,7 +81,10 @@ def _frame(frame: ArrayLike, name: str = "frame") -> NDArray[np.uint8]:
 
 
 def hsv_bins(
-    frame: ArrayLike, mask: ArrayLike | None = None, binning: HsvBinning = HsvBinning()
+    frame: ArrayLike,
+    mask: ArrayLike | None = None,
+    binning: HsvBinning = HsvBinning(),
+    lazy: bool = False,
 ) -> BinnedImage:
     """Bin every pixel of a BGR uint8 frame once, for all the histograms of that frame.
 
@@ -93,6 +96,11 @@ def hsv_bins(
         Foreground mask; zero pixels get bin -1 and are never counted.
     binning : HsvBinning
         Bin counts and thresholds.
+    lazy : bool
+        Bin on demand: the image keeps a copy of the frame (and mask) and bins each tile of
+        16x32 pixels the first time a histogram, weight or filter step reads it, so pixels
+        that no box covers are never binned. The bins are the same; ``.bins`` and any copy
+        bin every pixel still missing first.
 
     Returns
     -------
@@ -108,7 +116,11 @@ def hsv_bins(
         if m.shape != f.shape[:2]:
             raise ValueError(f"mask shape is {m.shape}, expected the frame's {f.shape[:2]}")
         m = np.ascontiguousarray(m)
-    return _core.hsv_bins(f, m, binning.n_h, binning.n_s, binning.n_v, binning.s_min, binning.v_min)
+    if not isinstance(lazy, (bool, np.bool_)):
+        raise TypeError(f"lazy must be a bool, got {type(lazy).__name__}")
+    return _core.hsv_bins(
+        f, m, binning.n_h, binning.n_s, binning.n_v, binning.s_min, binning.v_min, bool(lazy)
+    )
 
 
 def box_histograms(

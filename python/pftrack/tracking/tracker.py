@@ -137,8 +137,8 @@ class MultiObjectTracker:
             binned = det.binned
             if not self._background_ok:  # moving camera: colour of every pixel, not foreground
                 binned = det.frame_bins
-                if binned is None:
-                    binned = hsv_bins(frame, None, cfg.binning)
+                if binned is None:  # binned on demand: only the pixels the boxes read
+                    binned = hsv_bins(frame, None, cfg.binning, lazy=True)
             return boxes, np.asarray(det.scores, dtype=np.float64), binned
         boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
         if np.any((scores < 0) | (scores > 1)):
@@ -146,8 +146,8 @@ class MultiObjectTracker:
         mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
             mask, binned, shaded = self._foreground(frame)
-        if binned is None:  # full-frame bins: the detector's fused pass made them, or one here
-            binned = hsv_bins(frame, None, cfg.binning)
+        if binned is None:  # full-frame bins: the detector's fused pass made them, or lazy ones
+            binned = hsv_bins(frame, None, cfg.binning, lazy=True)  # (only the pixels read)
         # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
         # useful (measured in experiments/moving_camera.py)
         if cfg.refine.enabled and mask is not None and len(boxes):
