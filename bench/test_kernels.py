@@ -111,6 +111,35 @@ def test_hsv_bins_opencv_numpy(
     benchmark(npb.hsv_bins, frame)
 
 
+@pytest.mark.parametrize("lazy", [False, True], ids=["eager", "lazy"])
+@pytest.mark.parametrize("size", ["frame_480", "frame_720"])
+def test_frame_bins_and_weights_10_objects(
+    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str, lazy: bool
+) -> None:
+    """A tracker's frame: full-frame bins, then the weights of 10 objects' particles.
+
+    Eager bins every pixel first; lazy (``hsv_bins(..., lazy=True)``) bins only the tiles
+    the particles' boxes read. The weights are the same.
+    """
+    frame = request.getfixturevalue(size)
+    rows, cols = frame.shape[:2]
+    w, h = (20, 50) if cols < 1000 else (60, 150)
+    boxes = _boxes(np.random.default_rng(1), 10, 200, w, h, frame.shape)
+    ref = box_histograms(hsv_bins(frame), boxes[:1])[0] + 1e-6
+    benchmark.group = f"frame bins + weights, 10 objects x 200 particles, {cols}x{rows}"
+
+    def one_frame() -> list[F64]:
+        image = hsv_bins(frame, lazy=lazy)
+        return [_core.box_weights(image, boxes[200 * k : 200 * (k + 1)], ref) for k in range(10)]
+
+    eager = [
+        _core.box_weights(hsv_bins(frame), boxes[200 * k : 200 * (k + 1)], ref) for k in range(10)
+    ]
+    for got, want in zip(one_frame(), eager, strict=True):
+        np.testing.assert_array_equal(got, want)
+    benchmark(one_frame)
+
+
 @pytest.fixture(scope="module")
 def weights_10k() -> F64:
     w = np.random.default_rng(2).random(10_000)
