@@ -114,10 +114,10 @@ void register_histogram(py::module_& m) {
             if (lazy) {
                 // Its own packed copies of the frame (and mask): the caller may change or drop
                 // them before a reader bins a tile.
-                auto bgr = std::make_shared<std::vector<std::uint8_t>>(
-                    static_cast<size_t>(rows * cols * 3));
-                auto m = std::make_shared<std::vector<std::uint8_t>>(
-                    mptr ? static_cast<size_t>(rows * cols) : size_t(0));
+                // (not zeroed first: every byte is copied below)
+                using Bytes = std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>>;
+                auto bgr = std::make_shared<Bytes>(static_cast<size_t>(rows * cols * 3));
+                auto m = std::make_shared<Bytes>(mptr ? static_cast<size_t>(rows * cols) : size_t(0));
                 {
                     py::gil_scoped_release nogil;  // safe: raw buffers, held alive by the caller
                     for (py::ssize_t y = 0; y < rows; ++y) {
