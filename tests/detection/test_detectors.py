@@ -17,6 +17,7 @@ from pftrack.detection import (
     PaperDetector,
     make_detector,
 )
+from pftrack.particle_filter import hsv_bins
 from tests.detection.detection_data import data_dir
 
 
@@ -255,3 +256,19 @@ def test_foreground_is_detect_without_the_blobs(name):
             np.testing.assert_array_equal(np.where(mask > 0, frame_bins.bins, -1), det.binned.bins)
     with pytest.raises((TypeError, ValueError), match="foreground"):
         b.foreground(np.zeros((4, 4), np.uint8))
+
+
+def test_paper_foreground_without_bins_is_the_same_pass():
+    """``foreground(bins=False)``: the same masks frame after frame (the model advances the
+    same), no bins; ``hsv_bins`` of the frame (lazy or not) gives the fused pass's bins."""
+    bg = textured_background(seed=3)
+    a, b = make_detector("paper"), make_detector("paper")
+    for k in range(6):
+        f = bg.copy()
+        f[30:90, 20 + 8 * k : 40 + 8 * k] = (0, 0, 255)
+        shadows = k % 2 == 1
+        mask, frame_bins = a.foreground(f, shadows=shadows)
+        mask_b, none = b.foreground(f, shadows=shadows, bins=False)
+        assert none is None
+        np.testing.assert_array_equal(mask_b, mask)
+        np.testing.assert_array_equal(hsv_bins(f, lazy=True).bins, frame_bins.bins)

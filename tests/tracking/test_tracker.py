@@ -378,3 +378,36 @@ def test_lazy_frame_bins_give_the_same_tracks_on_a_moving_camera(monkeypatch):
     assert any(calls)  # the camera moved: full-frame bins of the built-in detector's frames
     assert len(lazy.rows) > 0
     np.testing.assert_array_equal(lazy.rows, eager.rows)
+
+
+def test_lazy_bins_in_place_of_the_fused_pass_give_the_same_tracks(scene, monkeypatch):
+    """With refinement (the default), the paper detector in `update`'s thread leaves the bins
+    to the tracker's lazy ones; forcing its fused full-frame bins gives the same tracks."""
+    import pftrack.tracking.tracker as tracker_module
+
+    by_frame = group_by_frame(scene.truth)
+    calls: list[bool] = []
+
+    def spy(frame, mask=None, binning=None, lazy=False):
+        calls.append(lazy)
+        return hsv_bins(frame, mask, binning, lazy=lazy)
+
+    def run() -> list[tuple]:
+        tracker = MultiObjectTracker(rng=0)
+        out = []
+        for n, frame in enumerate(scene.frames, start=1):
+            r = by_frame.get(n, np.zeros((0, 10)))
+            dets = np.column_stack([r[:, 2:6], np.full(len(r), 0.95)])
+            for t in tracker.update(frame, dets):
+                out.append((n, t.id, *t.box_xywh, t.score, t.detection_index))
+        return out
+
+    monkeypatch.setattr(tracker_module, "hsv_bins", spy)
+    lazy = run()
+    assert len(calls) == len(scene.frames) and all(calls)
+    monkeypatch.setattr(tracker_module.MultiObjectTracker, "_lazy_bins_from", lambda s, d: False)
+    calls.clear()
+    fused = run()
+    assert not calls  # the detector's fused bins on every frame
+    assert len(lazy) > 100
+    assert lazy == fused

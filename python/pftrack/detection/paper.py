@@ -252,23 +252,28 @@ class PaperDetector:
         return mask, boxes[~ghost], scores[~ghost]
 
     def foreground(
-        self, frame: NDArray[np.uint8], shadows: bool = False
-    ) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
+        self, frame: NDArray[np.uint8], shadows: bool = False, bins: bool = True
+    ) -> tuple[NDArray[np.uint8], _core.BinnedImage | None]:
         """The cleaned foreground mask and the frame's HSV bins, without blobs or boxes.
 
         The background model advances exactly as with :meth:`detect`; a tracker fed by another
         detector needs only these (to refine that detector's boxes) and skips the blob pass.
         With `shadows` the mask keeps the shadow pixels as 127 (255 foreground, 0 background).
+        With `bins` False the background pass makes no bins (None in their place): for a
+        caller that bins only the pixels it reads (``hsv_bins(..., lazy=True)``).
         """
-        shaded, binned = self._foreground(frame, "PaperDetector.foreground")
+        shaded, binned = self._foreground(frame, "PaperDetector.foreground", bins)
         return (shaded if shadows else foreground_only(shaded)), binned
 
     def _foreground(
-        self, frame: NDArray[np.uint8], fn: str
-    ) -> tuple[NDArray[np.uint8], _core.BinnedImage]:
-        """The cleaned mask with shadows (255, 127, 0) and the frame's bins."""
-        binned, raw = self._model.apply(check_frame(frame, fn))
-        return self._blobs.clean(raw), binned
+        self, frame: NDArray[np.uint8], fn: str, bins: bool = True
+    ) -> tuple[NDArray[np.uint8], _core.BinnedImage | None]:
+        """The cleaned mask with shadows (255, 127, 0) and the frame's bins (None without)."""
+        if bins:
+            binned, raw = self._model.apply(check_frame(frame, fn))
+            return self._blobs.clean(raw), binned
+        _, raw = self._model.apply(check_frame(frame, fn), bins=False)
+        return self._blobs.clean(raw), None
 
 
 def foreground_only(shaded: NDArray[np.uint8]) -> NDArray[np.uint8]:

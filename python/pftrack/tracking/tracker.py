@@ -26,7 +26,7 @@ from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
-from pftrack.detection.paper import foreground_only
+from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.tracking.association import associate, covers_another
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
@@ -190,15 +190,24 @@ class MultiObjectTracker:
         shaded = False
         if hasattr(detector, "foreground"):
             shaded = self.shadows_of(detector)
+            # In this thread, the paper's detector leaves the bins to the tracker's lazy ones
+            # (binned where the boxes read: cheaper than its fused pass binning every pixel);
+            # a detector on its own thread (DetectAhead's stand-in), or RJ-MCMC (which reads
+            # every pixel), keeps the fused bins.
+            kw = {"bins": False} if self._lazy_bins_from(detector) else {}
             if shaded:
-                mask, frame_bins = detector.foreground(frame, shadows=True)
+                mask, frame_bins = detector.foreground(frame, shadows=True, **kw)
             else:
-                mask, frame_bins = detector.foreground(frame)
+                mask, frame_bins = detector.foreground(frame, **kw)
         else:
             det = detector.detect(frame)
             mask, frame_bins = det.mask, det.frame_bins
         self._mask, self._mask_shaded = mask, shaded
         return mask, frame_bins, shaded
+
+    def _lazy_bins_from(self, detector: Any) -> bool:
+        """Whether ``detector.foreground`` should skip its bins for the tracker's lazy ones."""
+        return isinstance(detector, PaperDetector) and self.config.sampler != "rjmcmc"
 
     def _birth_threshold(self, scores: F64) -> float:
         """The score a detection needs to start a track (``LifecycleConfig.birth_quantile``).
