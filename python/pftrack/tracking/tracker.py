@@ -138,7 +138,7 @@ class MultiObjectTracker:
             if not self._background_ok:  # moving camera: colour of every pixel, not foreground
                 binned = det.frame_bins
                 if binned is None:  # binned on demand: only the pixels the boxes read
-                    binned = hsv_bins(frame, None, cfg.binning, lazy=True)
+                    binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)
             return boxes, np.asarray(det.scores, dtype=np.float64), binned
         boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
         if np.any((scores < 0) | (scores > 1)):
@@ -147,7 +147,7 @@ class MultiObjectTracker:
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
             mask, binned, shaded = self._foreground(frame)
         if binned is None:  # full-frame bins: the detector's fused pass made them, or lazy ones
-            binned = hsv_bins(frame, None, cfg.binning, lazy=True)  # (only the pixels read)
+            binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)  # (only pixels read)
         # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
         # useful (measured in experiments/moving_camera.py)
         if cfg.refine.enabled and mask is not None and len(boxes):
@@ -205,9 +205,14 @@ class MultiObjectTracker:
         self._mask, self._mask_shaded = mask, shaded
         return mask, frame_bins, shaded
 
+    @property
+    def _lazy(self) -> bool:
+        """Whether full-frame bins made here are lazy: not for RJ-MCMC, which reads every pixel."""
+        return self.config.sampler != "rjmcmc"
+
     def _lazy_bins_from(self, detector: Any) -> bool:
         """Whether ``detector.foreground`` should skip its bins for the tracker's lazy ones."""
-        return isinstance(detector, PaperDetector) and self.config.sampler != "rjmcmc"
+        return self._lazy and isinstance(detector, PaperDetector)
 
     def _birth_threshold(self, scores: F64) -> float:
         """The score a detection needs to start a track (``LifecycleConfig.birth_quantile``).
