@@ -237,3 +237,18 @@ def test_lazy_with_other_binnings(rng):
 def test_lazy_must_be_a_bool(rng):
     with pytest.raises(TypeError, match="lazy must be a bool"):
         hsv_bins(_frame(rng, 8, 8), lazy="yes")  # type: ignore[arg-type]
+
+
+def test_lazy_bins_of_strided_views_and_masks(rng):
+    frame = _frame(rng, 90, 140)
+    mask = (rng.random((90, 140)) < 0.6).astype(np.uint8)
+    view, mview = frame[5:80, 10:120], mask[5:80, 10:120]  # rows strided, pixels packed
+    flipped = frame[:, ::-1]  # pixels not packed: copied once by the wrapper
+    for f, m in ((view, None), (view, mview), (flipped, None), (flipped, mask)):
+        lazy = hsv_bins(f, m, lazy=True)
+        b = _boxes(rng, f.shape[0], f.shape[1], 8)
+        got = _core.box_histograms(lazy, b)
+        np.testing.assert_array_equal(got, _core.box_histograms(hsv_bins(f, m), b))
+        want = ref.box_histograms(ref.hsv_bins(f, m), lazy.n_bins, b)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+        np.testing.assert_array_equal(lazy.bins, ref.hsv_bins(f, m))
