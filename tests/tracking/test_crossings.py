@@ -7,14 +7,18 @@ import dataclasses
 import cv2
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import pftrack
+from pftrack.boxes import iou_xywh
 from pftrack.cli import build_parser, main
 from pftrack.cli._options import DEFAULT_CROSSINGS, tracker_config
 from pftrack.io.mot import group_by_frame, write_mot
 from pftrack.synthetic import make_scene
 from pftrack.tracking import CrossingConfig, TrackerConfig, repair_crossings, smooth_tracks
 from pftrack.tracking.api import xywh_to_xyxy_dets
+from pftrack.tracking.offline import _overlapping_pairs
 
 ON = CrossingConfig(enabled=True)
 
@@ -184,3 +188,27 @@ def test_finalize_with_crossings_is_the_cli_byte_for_byte(tmp_path):
     written = tmp_path / "loop.txt"
     write_mot(written, loop.finalize())
     assert written.read_bytes() == out.read_bytes()
+
+
+def _pairs_reference(a, min_iou):
+    """Frame by frame, the IoU matrix of its rows (pftrack.boxes.iou_xywh), pairs p < q."""
+    out = []
+    for f in np.unique(a[:, 0]):
+        idx = np.flatnonzero(a[:, 0] == f)
+        iou = iou_xywh(a[idx, 2:6], a[idx, 2:6])
+        for u in range(len(idx)):
+            for v in range(u + 1, len(idx)):
+                if iou[u, v] >= min_iou:
+                    out.append([f, idx[u], idx[v], iou[u, v]])
+    return np.asarray(out).reshape(-1, 4)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(0, 60), min_iou=st.sampled_from([0.01, 0.3]))
+def test_overlapping_pairs_match_the_frame_by_frame_reference(seed, n, min_iou):
+    rng = np.random.default_rng(seed)
+    a = np.zeros((n, 10))
+    a[:, 0] = np.sort(rng.integers(1, 6, n))
+    a[:, 2:4] = rng.uniform(0, 50, (n, 2))
+    a[:, 4:6] = rng.uniform(0, 30, (n, 2)) * (rng.random((n, 1)) > 0.1)  # some empty boxes
+    np.testing.assert_array_equal(_overlapping_pairs(a, min_iou), _pairs_reference(a, min_iou))

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
-from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh, xywh_to_cxcywh
+from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import rts_smooth
 from pftrack.recovery.fill import fill_rows
@@ -332,16 +332,35 @@ def repair_crossings(
 
 
 def _overlapping_pairs(a: F64, min_iou: float) -> F64:
-    """(P, 4) rows ``frame, row p, row q, IoU`` (p < q) of boxes of one frame overlapping enough."""
-    found = []
-    for idx in _frame_groups(a[:, 0]):
-        if len(idx) < 2:
-            continue
-        iou = iou_xywh(a[idx, 2:6], a[idx, 2:6])
-        p, q = np.nonzero(np.triu(iou >= min_iou, 1))
-        if len(p):
-            found.append(np.column_stack([a[idx[p], 0], idx[p], idx[q], iou[p, q]]))
-    return np.vstack(found) if found else np.zeros((0, 4))
+    """(P, 4) rows ``frame, row p, row q, IoU`` (p < q) of boxes of one frame overlapping enough.
+
+    `a` is sorted by frame. Every pair of rows of one frame at once: row p is paired with the
+    rows after it in its frame (``sum k (k - 1) / 2`` pairs for frames of k rows).
+    """
+    n = len(a)
+    if n < 2:
+        return np.zeros((0, 4))
+    fr = a[:, 0]
+    first = np.flatnonzero(np.r_[True, fr[1:] != fr[:-1]])
+    size = np.diff(np.r_[first, n])
+    end = np.repeat(first + size, size)  # one past the last row of each row's frame
+    later = end - np.arange(n) - 1  # rows after each row in its frame
+    total = int(later.sum())
+    if total == 0:
+        return np.zeros((0, 4))
+    p = np.repeat(np.arange(n), later)
+    q = p + 1 + np.arange(total) - np.repeat(np.cumsum(later) - later, later)
+    x0, y0 = a[:, 2], a[:, 3]
+    x1, y1 = x0 + a[:, 4], y0 + a[:, 5]
+    iw = np.clip(np.minimum(x1[p], x1[q]) - np.maximum(x0[p], x0[q]), 0.0, None)
+    ih = np.clip(np.minimum(y1[p], y1[q]) - np.maximum(y0[p], y0[q]), 0.0, None)
+    inter = iw * ih
+    area = a[:, 4] * a[:, 5]
+    union = area[p] + area[q] - inter
+    with np.errstate(invalid="ignore", divide="ignore"):
+        iou = np.where(union > 0, inter / union, 0.0)
+    keep = iou >= min_iou
+    return np.column_stack([fr[p[keep]], p[keep], q[keep], iou[keep]])
 
 
 def _windows(pairs: F64, lab: F64, join_gap: int) -> list[tuple[float, float, float, float, float]]:
