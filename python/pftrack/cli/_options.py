@@ -11,6 +11,9 @@ if TYPE_CHECKING:
 #: ``--max-side``'s default: :attr:`pftrack.tracking.TrackerConfig.max_side` (0: None). Stated
 #: here, not imported, so that ``--help`` does not import the tracker; a test checks they agree.
 DEFAULT_MAX_SIDE = 0
+#: ``--crossings``' default: :attr:`pftrack.tracking.CrossingConfig.enabled` ("on" for True),
+#: stated here for the same reason (a test checks they agree).
+DEFAULT_CROSSINGS = "off"
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
@@ -164,6 +167,12 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "interpolation)",
     )  # fmt: skip
     p.add_argument(
+        "--crossings", choices=("on", "off"), default=DEFAULT_CROSSINGS,
+        help="offline pass: where two tracks' boxes overlapped, exchange their tails when "
+        "each one's motion and size before the crossing predict the other's after it better "
+        "(tracks the tracker swapped; motion and size only, no colour); needs the smoother",
+    )  # fmt: skip
+    p.add_argument(
         "--no-refine", action="store_true",
         help="with --detections, take the boxes as given instead of shrinking each to the "
         "foreground of a background model (for a detector with tight boxes; no background "
@@ -193,6 +202,7 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         camera_motion=args.camera_motion,
         max_side=args.max_side or None,
         refine=replace(base.refine, enabled=not args.no_refine),
+        crossings=replace(base.crossings, enabled=args.crossings == "on"),
         lifecycle=replace(
             base.lifecycle,
             max_coast=args.max_coast,

@@ -4,7 +4,8 @@
   object; :class:`TrackerConfig` and its parts (:mod:`.config`); :class:`Track` (:mod:`.track`).
 - :class:`TrackWriter` (:mod:`.writer`): a run's tracks as MOTChallenge rows.
 - :class:`BoxSmoother`, :func:`smooth_tracks` (:mod:`.offline`): link, fill and smooth a
-  finished run (any tracker's).
+  finished run (any tracker's); :func:`repair_crossings` (:class:`CrossingConfig`): tracks
+  swapped where they crossed, exchanged back.
 - :class:`Tracker` (:mod:`.api`): the drop-in tracker (``update(dets, frame)``, ``finalize()``),
   the one object behind both a user's loop and ``pftrack track``.
 - :func:`track_frames`, :func:`load_detections` (:mod:`.run`): a whole video, end to end.
@@ -21,7 +22,7 @@ from pftrack.tracking.config import (
     RefineConfig,
     TrackerConfig,
 )
-from pftrack.tracking.offline import BoxSmoother, smooth_tracks
+from pftrack.tracking.offline import BoxSmoother, CrossingConfig, repair_crossings, smooth_tracks
 from pftrack.tracking.run import TrackingRun, load_detections, track_frames
 from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
@@ -31,6 +32,7 @@ __all__ = [
     "AssociationConfig",
     "BoxSmoother",
     "CameraConfig",
+    "CrossingConfig",
     "LifecycleConfig",
     "MotionConfig",
     "MultiObjectTracker",
@@ -41,6 +43,7 @@ __all__ = [
     "TrackerConfig",
     "TrackingRun",
     "load_detections",
+    "repair_crossings",
     "smooth_tracks",
     "track_frames",
 ]

@@ -29,7 +29,7 @@ from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import TrackerConfig
-from pftrack.tracking.offline import BoxSmoother, complete_boxes, drop_nested
+from pftrack.tracking.offline import BoxSmoother, CrossingConfig, complete_boxes, drop_nested
 from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
 from pftrack.tracking.writer import TrackWriter
@@ -195,6 +195,10 @@ class Tracker:
     smooth, link : bool
         The offline pass of :meth:`finalize`: smooth each track's boxes, join fragments of one
         object across gaps of up to 1.2 s.
+    crossings : bool
+        With `smooth`, :meth:`finalize` also gives back the tails of two tracks the tracker
+        swapped where they crossed (:class:`~pftrack.tracking.CrossingConfig`, motion and
+        size only).
     prime : float
         Seconds of frames :meth:`prime` reads (what ``pftrack track`` reads ahead).
     max_side : int or None
@@ -229,6 +233,7 @@ class Tracker:
         fill: str = "linear",
         smooth: bool = True,
         link: bool = True,
+        crossings: bool = CrossingConfig.enabled,
         prime: float = 1.2,
         max_side: int | None = TrackerConfig.max_side,
     ) -> None:
@@ -250,6 +255,7 @@ class Tracker:
             camera_motion=camera_motion,
             max_side=max_side,
             refine=replace(base.refine, enabled=bool(refine)),
+            crossings=replace(base.crossings, enabled=bool(crossings)),
             lifecycle=replace(
                 base.lifecycle,
                 max_coast=_frames(max_coast, frame_rate, "max_coast"),
@@ -514,11 +520,16 @@ class Tracker:
             built-in detector (no ``update`` of the run had detections) and the smoother on,
             boxes mostly inside a larger box of the same frame are left out
             (``LifecycleConfig.nested_inside``), and the boxes of partly seen people completed
-            to the detector's expected person (``LifecycleConfig.amodal_share``).
+            to the detector's expected person (``LifecycleConfig.amodal_share``). With the
+            smoother on and ``TrackerConfig.crossings.enabled``, tracks swapped where they
+            crossed are exchanged back after linking (:func:`~.offline.repair_crossings`).
         """
-        rows = self._stabiliser.restore(self._writer.result(drop=self._tracker.never_confirmed()))
-        life = self.config.lifecycle
         smoothed = self._writer_args[2] is not None
+        crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
+        rows = self._stabiliser.restore(
+            self._writer.result(drop=self._tracker.never_confirmed(), crossings=crossings)
+        )
+        life = self.config.lifecycle
         if smoothed and not self._given and life.nested_inside is not None and len(rows):
             # the built-in detector's fragments (LifecycleConfig.nested_inside)
             rows = drop_nested(rows, life.nested_inside, life.nested_area)

@@ -11,7 +11,7 @@ import numpy as np
 
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
-from pftrack.tracking.offline import AMODAL_ANCHORS
+from pftrack.tracking.offline import AMODAL_ANCHORS, CrossingConfig
 
 __all__ = [
     "AssociationConfig",
@@ -323,6 +323,10 @@ class TrackerConfig:
         treats the camera as moving on every frame.
     camera : CameraConfig
         How the motion is measured and decided.
+    crossings : CrossingConfig
+        The offline pass's repair of identities swapped where two tracks cross
+        (:func:`~pftrack.tracking.offline.repair_crossings`), run by
+        :meth:`pftrack.Tracker.finalize` when the smoother is on and ``crossings.enabled``.
     max_side : int or None
         Working resolution: a frame whose longer side is larger is scaled down (OpenCV's
         ``INTER_AREA``) to this longer side before detection and tracking, and every box the
@@ -348,6 +352,7 @@ class TrackerConfig:
     lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
     camera_motion: str = "auto"
     camera: CameraConfig = field(default_factory=CameraConfig)
+    crossings: CrossingConfig = field(default_factory=CrossingConfig)
     max_side: int | None = None
 
     def __post_init__(self) -> None:

@@ -27,10 +27,18 @@ from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import rts_smooth
 from pftrack.recovery.fill import fill_rows
-from pftrack.recovery.linking import LinkConfig, check_rows, link_tracklets
+from pftrack.recovery.linking import LinkConfig, check_rows, check_unique, link_tracklets
 from pftrack.recovery.names import DEFAULT_METHOD
 
-__all__ = ["AMODAL_ANCHORS", "BoxSmoother", "complete_boxes", "drop_nested", "smooth_tracks"]
+__all__ = [
+    "AMODAL_ANCHORS",
+    "BoxSmoother",
+    "CrossingConfig",
+    "complete_boxes",
+    "drop_nested",
+    "repair_crossings",
+    "smooth_tracks",
+]
 
 AMODAL_ANCHORS = ("side", "centre")  # complete_boxes: where a widened box keeps its evidence
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
@@ -159,6 +167,286 @@ class BoxSmoother:
         return out  # rows before the first detection keep their own boxes
 
 
+@dataclass(frozen=True)
+class CrossingConfig:
+    """Offline repair of identities exchanged where two tracks cross (:func:`repair_crossings`).
+
+    Attributes
+    ----------
+    enabled : bool
+        Run the repair in the offline pass, after linking and before filling and smoothing
+        (``TrackerConfig.crossings``; ``pftrack track --crossings``).
+    min_iou : float
+        Two tracks interact in a frame where their boxes overlap by at least this IoU, in (0, 1].
+    join_gap : int
+        Interaction frames of one pair at most this many frames apart form one window.
+    max_window : int
+        Windows longer than this many frames (people walking or standing together) are left as
+        they are: a constant-velocity prediction across them says little.
+    span : int
+        The evidence: each track's detections in the `span` frames before the window and in
+        the `span` frames after it.
+    min_points : int
+        Detections each of the two tracks needs on each side of the window (at least 2).
+    accel, noise : float
+        The centre's constant-velocity model, in box heights: the square root of the
+        acceleration's spectral density (per frame^1.5) and a detection's standard deviation.
+    size_accel, size_noise : float
+        The same for the width and height.
+    margin : float
+        The tails are exchanged only when the exchanged pairing is more likely than the one
+        the tracker made by at least this log-likelihood ratio (nats, >= 0).
+    """
+
+    enabled: bool = False
+    min_iou: float = 0.1
+    join_gap: int = 5
+    max_window: int = 50
+    span: int = 15
+    min_points: int = 3
+    accel: float = 0.01
+    noise: float = 0.05
+    size_accel: float = 0.003
+    size_noise: float = 0.1
+    margin: float = 5.0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.enabled, (bool, np.bool_)):
+            raise TypeError(f"CrossingConfig: enabled is {self.enabled!r}, expected a bool")
+        if not 0.0 < self.min_iou <= 1.0:
+            raise ValueError(
+                f"CrossingConfig: min_iou is {self.min_iou}, expected a value in (0, 1]"
+            )
+        for name, lo in (("join_gap", 0), ("max_window", 1), ("span", 1), ("min_points", 2)):
+            v = getattr(self, name)
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, (int, np.integer))
+                or not lo <= v <= MAX_FRAME
+            ):
+                raise ValueError(f"CrossingConfig: {name} is {v!r}, expected an integer >= {lo}")
+        for name in ("accel", "noise", "size_accel", "size_noise"):
+            v = getattr(self, name)
+            ok = isinstance(v, (int, float)) and not isinstance(v, bool)
+            if not (ok and NOISE_MIN <= v <= NOISE_MAX):
+                raise ValueError(
+                    f"CrossingConfig: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
+                    f"{NOISE_MAX:g}] (box heights)"
+                )
+        if not 0.0 <= self.margin < np.inf:
+            raise ValueError(
+                f"CrossingConfig: margin is {self.margin}, expected a finite value >= 0"
+            )
+
+
+def repair_crossings(
+    rows: ArrayLike,
+    observed: ArrayLike | None = None,
+    config: CrossingConfig = CrossingConfig(),  # noqa: B008 - frozen, shared safely
+    measurements: ArrayLike | None = None,
+) -> F64:
+    """Exchange the tails of two tracks where the tracker swapped them at a crossing.
+
+    Where two people cross, an online tracker may hand each one's detections to the other's
+    track. Once the run is over, both sides of the crossing are known. For every window of
+    frames in which two tracks' boxes overlap (IoU at least ``config.min_iou``, frames at
+    most ``join_gap`` apart joined, windows up to ``max_window`` frames), the detections of
+    each track in the ``span`` frames before the window and after it are compared under two
+    pairings: as the tracker made them (each track's before with its own after), and
+    exchanged. Each pairing's likelihood is that of a constant-velocity Kalman filter over the
+    box centre, width and height (in the pair's median box height, so the rule is
+    scale-free) run through the before detections and then scoring the after detections
+    (the innovations' Gaussian log-density). When the exchanged pairing is more likely by at
+    least ``margin`` nats, the two tracks' ids are exchanged from the window's frame of
+    largest overlap on. Windows are taken in time order; after an exchange, the later windows
+    are found again with the new ids. Both tracks need ``min_points`` detections on each side.
+
+    Motion and size are all that is compared: two people of the same size who meet and turn
+    back look, to this rule, like a crossing whose identities were swapped.
+
+    Parameters
+    ----------
+    rows : (M, 10) array_like
+        MOTChallenge rows ``frame, id, left, top, width, height, ...``, at most one per
+        (frame, id). Their boxes decide which tracks overlap.
+    observed : (M,) array_like of bool, optional
+        Which rows are detections (the evidence); default every row.
+    config : CrossingConfig
+        Windows, evidence, model and margin (`enabled` is not read here).
+    measurements : (M, 4) array_like, optional
+        The detection boxes ``left, top, width, height`` behind observed rows, when they differ
+        from the rows' own; default the rows' boxes.
+
+    Returns
+    -------
+    (M, 10) ndarray
+        The rows in their order, only ids changed.
+
+    Raises
+    ------
+    ValueError
+        Bad rows, a (frame, id) seen twice, or `observed` / `measurements` of the wrong shape.
+    """
+    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "repair_crossings")
+    a = a.copy()
+    n = len(a)
+    obs = np.ones(n, dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
+    if obs.shape != (n,):
+        raise ValueError(f"repair_crossings: observed has shape {obs.shape}, expected ({n},)")
+    z = a[:, 2:6].copy() if measurements is None else real_array(measurements, "repair_crossings")
+    if z.shape != (n, 4) or not np.all(np.isfinite(z[obs])):
+        raise ValueError(
+            f"repair_crossings: measurements has shape {z.shape}, expected finite ({n}, 4)"
+        )
+    check_unique(a)
+    if n < 2:
+        return a
+    perm = np.argsort(a[:, 0], kind="stable")  # rows by frame: every selection in time order
+    fr, lab = a[perm, 0], a[perm, 1].copy()
+    ob, cz = obs[perm], xywh_to_cxcywh(z[perm])
+    pairs = _overlapping_pairs(a[perm], config.min_iou)
+    wins = _windows(pairs, lab, config.join_gap)
+    k = 0
+    while k < len(wins):
+        cut, i, j, start, end = wins[k]
+        k += 1
+        if end - start + 1 > config.max_window:
+            continue
+        segments = []
+        for t in (i, j):
+            mine = (lab == t) & ob
+            before = np.flatnonzero(mine & (fr >= start - config.span) & (fr < start))
+            after = np.flatnonzero(mine & (fr > end) & (fr <= end + config.span))
+            segments.append((before, after))
+        if min(len(s) for seg in segments for s in seg) < config.min_points:
+            continue
+        if not _exchange_is_likelier(fr, cz, segments, config):
+            continue
+        late = fr >= cut
+        ii, jj = (lab == i) & late, (lab == j) & late
+        lab[ii], lab[jj] = j, i
+        wins = [w for w in _windows(pairs, lab, config.join_gap) if w[:3] > (cut, i, j)]
+        k = 0
+    a[perm, 1] = lab
+    return a
+
+
+def _overlapping_pairs(a: F64, min_iou: float) -> F64:
+    """(P, 4) rows ``frame, row p, row q, IoU`` (p < q) of boxes of one frame overlapping enough.
+
+    `a` is sorted by frame. Every pair of rows of one frame at once: row p is paired with the
+    rows after it in its frame (``sum k (k - 1) / 2`` pairs for frames of k rows).
+    """
+    n = len(a)
+    if n < 2:
+        return np.zeros((0, 4))
+    fr = a[:, 0]
+    first = np.flatnonzero(np.r_[True, fr[1:] != fr[:-1]])
+    size = np.diff(np.r_[first, n])
+    end = np.repeat(first + size, size)  # one past the last row of each row's frame
+    later = end - np.arange(n) - 1  # rows after each row in its frame
+    total = int(later.sum())
+    if total == 0:
+        return np.zeros((0, 4))
+    p = np.repeat(np.arange(n), later)
+    q = p + 1 + np.arange(total) - np.repeat(np.cumsum(later) - later, later)
+    x0, y0 = a[:, 2], a[:, 3]
+    x1, y1 = x0 + a[:, 4], y0 + a[:, 5]
+    iw = np.clip(np.minimum(x1[p], x1[q]) - np.maximum(x0[p], x0[q]), 0.0, None)
+    ih = np.clip(np.minimum(y1[p], y1[q]) - np.maximum(y0[p], y0[q]), 0.0, None)
+    inter = iw * ih
+    area = a[:, 4] * a[:, 5]
+    union = area[p] + area[q] - inter
+    with np.errstate(invalid="ignore", divide="ignore"):
+        iou = np.where(union > 0, inter / union, 0.0)
+    keep = iou >= min_iou
+    return np.column_stack([fr[p[keep]], p[keep], q[keep], iou[keep]])
+
+
+def _windows(pairs: F64, lab: F64, join_gap: int) -> list[tuple[float, float, float, float, float]]:
+    """Interaction windows ``(cut, id_lo, id_hi, start, end)`` of the overlapping pairs, sorted.
+
+    `cut` is the window's first frame of largest overlap.
+    """
+    if not len(pairs):
+        return []
+    la, lb = lab[pairs[:, 1].astype(np.intp)], lab[pairs[:, 2].astype(np.intp)]
+    lo, hi, f, iou = np.minimum(la, lb), np.maximum(la, lb), pairs[:, 0], pairs[:, 3]
+    order = np.lexsort((f, hi, lo))
+    lo, hi, f, iou = lo[order], hi[order], f[order], iou[order]
+    new = np.r_[True, (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1]) | (np.diff(f) > join_gap + 1)]
+    starts = np.flatnonzero(new)
+    out = []
+    for s, e in zip(starts, np.r_[starts[1:], len(f)], strict=True):
+        cut = f[s + int(np.argmax(iou[s:e]))]
+        out.append((float(cut), float(lo[s]), float(hi[s]), float(f[s]), float(f[e - 1])))
+    out.sort()
+    return out
+
+
+def _exchange_is_likelier(
+    fr: F64,
+    cz: F64,
+    segments: list[tuple[NDArray[np.intp], NDArray[np.intp]]],
+    config: CrossingConfig,
+) -> bool:
+    """Whether tails exchanged beat the tracker's pairing by ``config.margin`` nats."""
+    (bi, ai), (bj, aj) = segments
+    height = float(np.median(cz[np.concatenate([bi, ai, bj, aj]), 3]))
+    if not height > 0:
+        return False
+    pairings = [(bi, ai), (bj, aj), (bi, aj), (bj, ai)]  # kept, kept, exchanged, exchanged
+    nll = _after_nll(fr, cz / height, pairings, config)
+    return bool(nll[0] + nll[1] - nll[2] - nll[3] > config.margin)
+
+
+def _after_nll(
+    fr: F64, zh: F64, pairings: list[tuple[NDArray[np.intp], NDArray[np.intp]]], c: CrossingConfig
+) -> F64:
+    """Negative log-likelihood of each pairing's after rows given its before rows.
+
+    A constant-velocity Kalman filter per axis (centre x, y, width, height), started at the
+    first before row with a wide velocity prior; all pairings run at once, padded with
+    steps of zero frames and no measurement.
+    """
+    seqs = [np.concatenate([b, f]) for b, f in pairings]
+    length = max(len(s) for s in seqs)
+    m = len(seqs)
+    dt = np.zeros((length, m))
+    zs = np.zeros((length, m, 4))
+    has = np.zeros((length, m), dtype=bool)
+    counts = np.zeros((length, m), dtype=bool)
+    for k, (s, (b, _)) in enumerate(zip(seqs, pairings, strict=True)):
+        dt[1 : len(s), k] = np.diff(fr[s])
+        zs[: len(s), k] = zh[s]
+        has[: len(s), k] = True
+        counts[len(b) : len(s), k] = True
+    q = np.array([c.accel, c.accel, c.size_accel, c.size_accel]) ** 2
+    r2 = np.array([c.noise, c.noise, c.size_noise, c.size_noise]) ** 2
+    m0, m1 = zs[0].copy(), np.zeros((m, 4))
+    p00, p01, p11 = np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0)
+    nll = np.zeros(m)
+    for t in range(1, length):
+        d = dt[t][:, None]
+        # x' = F x, P' = F P F^T + q [[d^3/3, d^2/2], [d^2/2, d]] with F = [[1, d], [0, 1]]
+        m0 = m0 + d * m1
+        p00 = p00 + 2 * d * p01 + d * d * p11 + q * d**3 / 3
+        p01 = p01 + d * p11 + q * d * d / 2
+        p11 = p11 + q * d
+        s = p00 + r2
+        e = zs[t] - m0
+        w = has[t][:, None]
+        nll += np.where(counts[t], 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
+        k0, k1 = p00 / s, p01 / s
+        m0, m1 = np.where(w, m0 + k0 * e, m0), np.where(w, m1 + k1 * e, m1)
+        p00, p01, p11 = (
+            np.where(w, (1 - k0) * p00, p00),
+            np.where(w, (1 - k0) * p01, p01),
+            np.where(w, p11 - k1 * p01, p11),
+        )
+    return nll
+
+
 def smooth_tracks(
     rows: ArrayLike,
     observed: ArrayLike | None = None,
@@ -168,6 +456,7 @@ def smooth_tracks(
     *,
     fill_method: str = DEFAULT_METHOD,
     seed: int = 0,
+    crossings: CrossingConfig | None = None,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 
@@ -198,6 +487,10 @@ def smooth_tracks(
         ``"auto"``, calibrated on the rows themselves.
     seed : int
         Seed of ``"auto"``'s calibration.
+    crossings : CrossingConfig or None
+        When given and enabled, after linking, tracks whose identities the tracker swapped
+        where they crossed get their tails exchanged back (:func:`repair_crossings`; the rows'
+        boxes find the crossings, `measurements` are the evidence). None: off.
 
     Returns
     -------
@@ -225,6 +518,8 @@ def smooth_tracks(
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
     if link is not None:
         a, _ = link_tracklets(a, link)
+    if crossings is not None and crossings.enabled:
+        a = repair_crossings(a, obs, crossings, z)
     order = np.lexsort((a[:, 0], a[:, 1]))  # by id, then frame
     a, obs, z = a[order], obs[order], z[order]
     new = np.zeros(len(a), dtype=bool)

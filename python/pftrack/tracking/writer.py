@@ -8,7 +8,7 @@ import numpy as np
 
 from pftrack._typing import F64
 from pftrack.recovery.linking import LinkConfig
-from pftrack.tracking.offline import BoxSmoother, smooth_tracks
+from pftrack.tracking.offline import BoxSmoother, CrossingConfig, smooth_tracks
 from pftrack.tracking.track import Track
 
 __all__ = ["TrackWriter"]
@@ -86,11 +86,12 @@ class TrackWriter:
             elif self.coasting == "confirmed":
                 self._pending.setdefault(t.id, []).append(row)
 
-    def result(self, drop: Collection[int] = ()) -> F64:
+    def result(self, drop: Collection[int] = (), crossings: CrossingConfig | None = None) -> F64:
         """All rows written so far, (M, 10), sorted by frame then id.
 
         Linked and smoothed when the writer has a link config and a smoother; the tracks of
-        the ids in `drop` are left out first.
+        the ids in `drop` are left out first. With `crossings` (enabled), tracks swapped where
+        they crossed are exchanged back after linking (:func:`~.offline.repair_crossings`).
         """
         a = np.asarray(self.rows, np.float64).reshape(-1, 10)
         observed = np.array([m is not None for m in self._measured], bool)
@@ -104,4 +105,4 @@ class TrackWriter:
         z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
         if observed.any():
             z[observed] = [m for m in measured if m is not None]
-        return smooth_tracks(a, observed, self.smoother, self.link, z)
+        return smooth_tracks(a, observed, self.smoother, self.link, z, crossings=crossings)

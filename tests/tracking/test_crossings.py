@@ -1,0 +1,214 @@
+"""The offline crossing repair: swapped tails exchanged back, bounces and crossings kept."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import pftrack
+from pftrack.boxes import iou_xywh
+from pftrack.cli import build_parser, main
+from pftrack.cli._options import DEFAULT_CROSSINGS, tracker_config
+from pftrack.io.mot import group_by_frame, write_mot
+from pftrack.synthetic import make_scene
+from pftrack.tracking import CrossingConfig, TrackerConfig, repair_crossings, smooth_tracks
+from pftrack.tracking.api import xywh_to_xyxy_dets
+from pftrack.tracking.offline import _overlapping_pairs
+
+ON = CrossingConfig(enabled=True)
+
+
+def walkers(n=60, meet=30, bounce=False, heights=(60.0, 64.0), swap_at=None, seed=0):
+    """Two walkers meeting at frame `meet`: rows ``(2n, 10)`` and each row's true person (1, 2).
+
+    A walks right from x = 40 and B left, 4 px a frame each. They pass each other, or with
+    `bounce` both turn back where they meet. With `swap_at`, the rows' ids are exchanged from
+    that frame on, as a tracker that swapped them at the crossing writes them.
+    """
+    rng = np.random.default_rng(seed)
+    f = np.arange(1, n + 1, dtype=float)
+    xa = 40 + 4 * (f - 1)
+    xb = 40 + 8 * (meet - 1) - 4 * (f - 1)
+    if bounce:
+        xa, xb = np.minimum(xa, 2 * xa[meet - 1] - xa), np.maximum(xb, 2 * xb[meet - 1] - xb)
+    rows, truth = [], []
+    for person, x, h, y in ((1, xa, heights[0], 100.0), (2, xb, heights[1], 106.0)):
+        w = 0.4 * h
+        box = np.column_stack([x - w / 2, np.full(n, y - h / 2), np.full(n, w), np.full(n, h)])
+        box += rng.normal(0.0, 0.02 * h, box.shape)
+        rows.append(np.column_stack([f, np.full(n, person), box, np.ones(n), -np.ones((n, 3))]))
+        truth.append(np.full(n, person))
+    r, t = np.vstack(rows), np.concatenate(truth)
+    if swap_at is not None:
+        late = r[:, 0] >= swap_at
+        r[late, 1] = 3 - r[late, 1]
+    return r, t
+
+
+def same_person_per_id(rows, truth):
+    return all(len(np.unique(truth[rows[:, 1] == i])) == 1 for i in np.unique(rows[:, 1]))
+
+
+@pytest.mark.parametrize("swap_at", [27, 31, 34])
+def test_a_crossing_the_tracker_swapped_is_repaired(swap_at):
+    rows, truth = walkers(swap_at=swap_at)
+    assert not same_person_per_id(rows, truth)  # the tracker's swap
+    out = repair_crossings(rows, config=ON)
+    np.testing.assert_array_equal(out[:, [0, *range(2, 10)]], rows[:, [0, *range(2, 10)]])
+    late = rows[:, 0] >= max(swap_at, 31)  # after the cut (largest overlap) every row is right
+    ids = {int(p): np.unique(out[late & (truth == p), 1]) for p in (1, 2)}
+    assert len(ids[1]) == len(ids[2]) == 1 and ids[1][0] != ids[2][0]
+    assert ids[1][0] == np.unique(out[(rows[:, 0] <= 20) & (truth == 1), 1])[0]
+
+
+def test_a_crossing_tracked_right_and_a_bounce_are_kept():
+    rows, truth = walkers()
+    np.testing.assert_array_equal(repair_crossings(rows, config=ON), rows)
+    # people who meet and turn back: motion alone says "swapped"; their sizes say they are not
+    rows, truth = walkers(bounce=True, heights=(50.0, 80.0))
+    assert same_person_per_id(rows, truth)
+    np.testing.assert_array_equal(repair_crossings(rows, config=ON), rows)
+    # without the size difference the rule cannot tell a bounce from a swap (documented)
+    same, _ = walkers(bounce=True, heights=(60.0, 60.0))
+    assert not np.array_equal(repair_crossings(same, config=ON), same)
+
+
+def test_margin_window_and_evidence_gates():
+    rows, truth = walkers(swap_at=31)
+    for change in ({"margin": 1e9}, {"max_window": 2}, {"min_points": 40}):
+        config = dataclasses.replace(ON, **change)
+        assert np.array_equal(repair_crossings(rows, config=config), rows), change
+    # only the detections are evidence: none observed, nothing judged
+    none = np.zeros(len(rows), bool)
+    assert np.array_equal(repair_crossings(rows, none, ON), rows)
+
+
+def test_deterministic_scale_free_and_row_order_free():
+    rows, _ = walkers(swap_at=31, seed=3)
+    out = repair_crossings(rows, config=ON)
+    assert out.tobytes() == repair_crossings(rows, config=ON).tobytes()
+    big = rows.copy()
+    big[:, 2:6] *= 7.0
+    np.testing.assert_array_equal(repair_crossings(big, config=ON)[:, 1], out[:, 1])
+    perm = np.random.default_rng(0).permutation(len(rows))
+    np.testing.assert_array_equal(repair_crossings(rows[perm], config=ON)[:, 1], out[perm, 1])
+
+
+def test_measurements_are_the_evidence():
+    # the rows' boxes (a tracker's filtered ones) find the overlap; the detections decide
+    rows, truth = walkers(swap_at=31)
+    fixed = repair_crossings(rows, config=ON)
+    filtered = rows.copy()
+    filtered[:, 2:6] += np.random.default_rng(1).normal(0, 0.5, (len(rows), 4))
+    got = repair_crossings(filtered, np.ones(len(rows), bool), ON, rows[:, 2:6])
+    np.testing.assert_array_equal(got[:, 1], fixed[:, 1])
+
+
+def test_off_leaves_the_offline_pass_byte_identical():
+    rows, _ = walkers(swap_at=31)
+    base = smooth_tracks(rows)
+    assert smooth_tracks(rows, crossings=CrossingConfig()).tobytes() == base.tobytes()
+    assert smooth_tracks(rows, crossings=None).tobytes() == base.tobytes()
+    on = smooth_tracks(rows, crossings=ON)
+    assert on.tobytes() != base.tobytes()
+    np.testing.assert_array_equal(on, smooth_tracks(repair_crossings(rows, config=ON)))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"min_iou": 0.0}, "min_iou"),
+        ({"join_gap": -1}, "join_gap"),
+        ({"max_window": 0}, "max_window"),
+        ({"min_points": 1}, "min_points"),
+        ({"span": 2.5}, "span"),
+        ({"accel": 0.0}, "accel"),
+        ({"size_noise": float("nan")}, "size_noise"),
+        ({"margin": -1.0}, "margin"),
+        ({"margin": float("inf")}, "margin"),
+    ],
+)
+def test_bad_settings(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        CrossingConfig(**kwargs)
+
+
+def test_bad_inputs():
+    rows, _ = walkers()
+    with pytest.raises(ValueError, match="observed has shape"):
+        repair_crossings(rows, np.ones(3, bool), ON)
+    with pytest.raises(ValueError, match="measurements has shape"):
+        repair_crossings(rows, None, ON, np.ones((3, 4)))
+    with pytest.raises(ValueError, match="twice|duplicate|more than once"):
+        repair_crossings(np.vstack([rows, rows[:1]]), config=ON)
+    with pytest.raises(TypeError, match="enabled"):
+        CrossingConfig(enabled="yes")  # type: ignore[arg-type]
+    assert repair_crossings(np.zeros((0, 10)), config=ON).shape == (0, 10)
+
+
+def test_cli_option_matches_the_config_and_the_tracker(capsys):
+    assert (DEFAULT_CROSSINGS == "on") == CrossingConfig().enabled
+    argv = ["track", "v.avi", "--out", "t.txt"]
+    on = tracker_config(build_parser().parse_args([*argv, "--crossings", "on"]))
+    enabled = dataclasses.replace(TrackerConfig().crossings, enabled=True)
+    assert on == dataclasses.replace(TrackerConfig(), crossings=enabled)
+    assert tracker_config(build_parser().parse_args(argv)) == pftrack.Tracker().config
+    assert pftrack.Tracker(crossings=True).config == dataclasses.replace(
+        pftrack.Tracker().config, crossings=enabled
+    )
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    assert f"(default: {DEFAULT_CROSSINGS})" in " ".join(capsys.readouterr().out.split())
+
+
+def test_finalize_with_crossings_is_the_cli_byte_for_byte(tmp_path):
+    scene = make_scene(n_frames=40, rng=1)
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    det_rows = []
+    by_frame = group_by_frame(scene.truth)
+    for n, f in enumerate(scene.frames, start=1):
+        cv2.imwrite(str(folder / f"{n:06d}.png"), f)
+        det_rows += [[n, -1, *r[2:6], 1.0, -1, -1, -1] for r in by_frame.get(n, [])]
+    write_mot(tmp_path / "det.txt", np.asarray(det_rows))
+    out = tmp_path / "t.txt"
+    argv = ["-q", "track", str(folder), "--detections", str(tmp_path / "det.txt")]
+    assert main([*argv, "--crossings", "on", "--out", str(out)]) == 0
+    loop = pftrack.Tracker(crossings=True)
+    loop.prime(scene.frames[:30])
+    dets = np.asarray(det_rows)
+    for n, f in enumerate(scene.frames, start=1):
+        r = dets[dets[:, 0] == n]
+        loop.update(xywh_to_xyxy_dets(np.column_stack([r[:, 2:6], r[:, 6]])), f)
+    written = tmp_path / "loop.txt"
+    write_mot(written, loop.finalize())
+    assert written.read_bytes() == out.read_bytes()
+
+
+def _pairs_reference(a, min_iou):
+    """Frame by frame, the IoU matrix of its rows (pftrack.boxes.iou_xywh), pairs p < q."""
+    out = []
+    for f in np.unique(a[:, 0]):
+        idx = np.flatnonzero(a[:, 0] == f)
+        iou = iou_xywh(a[idx, 2:6], a[idx, 2:6])
+        for u in range(len(idx)):
+            for v in range(u + 1, len(idx)):
+                if iou[u, v] >= min_iou:
+                    out.append([f, idx[u], idx[v], iou[u, v]])
+    return np.asarray(out).reshape(-1, 4)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(0, 60), min_iou=st.sampled_from([0.01, 0.3]))
+def test_overlapping_pairs_match_the_frame_by_frame_reference(seed, n, min_iou):
+    rng = np.random.default_rng(seed)
+    a = np.zeros((n, 10))
+    a[:, 0] = np.sort(rng.integers(1, 6, n))
+    a[:, 2:4] = rng.uniform(0, 50, (n, 2))
+    a[:, 4:6] = rng.uniform(0, 30, (n, 2)) * (rng.random((n, 1)) > 0.1)  # some empty boxes
+    np.testing.assert_array_equal(_overlapping_pairs(a, min_iou), _pairs_reference(a, min_iou))
