@@ -36,8 +36,9 @@ def intersection_xywh(a: ArrayLike, b: ArrayLike) -> F64:
     ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
     bx0, by0 = b[:, 0], b[:, 1]
     bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
-    iw = np.clip(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0, None)
-    ih = np.clip(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0, None)
+    # np.maximum(x, 0.0): what np.clip(x, 0.0, None) computes, without its Python wrapper
+    iw = np.maximum(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0)
+    ih = np.maximum(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0)
     return np.asarray(iw * ih, dtype=np.float64)
 
 

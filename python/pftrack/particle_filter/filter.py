@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._typing import RngLike
+from pftrack._typing import F64, RngLike
 from pftrack.particle_filter.dynamics import Ar2Model
 
 __all__ = [
@@ -19,6 +19,7 @@ __all__ = [
     "FilterState",
     "reinitialise_filters",
     "step_filters",
+    "step_filters_summary",
 ]
 
 
@@ -242,8 +243,25 @@ def step_filters(
     list of FilterState
         One per filter, in order.
     """
+    return step_filters_summary(filters, image)[0]
+
+
+def step_filters_summary(
+    filters: Sequence[ColourParticleFilter], image: _core.BinnedImage
+) -> tuple[list[FilterState], F64]:
+    """:func:`step_filters`, and the numbers a tracker reads from the states, as one array.
+
+    Returns
+    -------
+    states : list of FilterState
+        One per filter, in order (what :func:`step_filters` returns).
+    summary : (K, 4) ndarray
+        Per filter: the estimate's centre ``cx, cy``, ``rho`` and ``rho_max`` (the same
+        floats as in `states`, without reading K objects back).
+    """
+    summary = np.empty((len(filters), 4))
     if not filters:
-        return []
+        return [], summary
     cfg = filters[0].config
     batch = [
         k
@@ -261,6 +279,10 @@ def step_filters(
             [f._seed for f in fs], [f._step for f in fs],
         )  # fmt: skip
         col = 3 if cfg.estimate == "map" else 0
+        at = slice(None) if len(batch) == len(filters) else batch
+        summary[at, 0:2] = out[:, col : col + 2]
+        summary[at, 2] = out[:, 9]
+        summary[at, 3] = out[:, 8]
         for k, f, row in zip(batch, fs, out.tolist(), strict=True):
             f._step += 1
             cx, cy, s = row[col : col + 3]
@@ -273,10 +295,12 @@ def step_filters(
             )
             f.last = state
             states[k] = state
-    for k, f in enumerate(filters):
-        if states[k] is None:
-            states[k] = f.step(image)
-    return [s for s in states if s is not None]
+    if len(batch) < len(filters):
+        for k, f in enumerate(filters):
+            if states[k] is None:
+                st = states[k] = f.step(image)
+                summary[k] = (st.box_cxcywh[0], st.box_cxcywh[1], st.rho, st.rho_max)
+    return [s for s in states if s is not None], summary
 
 
 def reinitialise_filters(

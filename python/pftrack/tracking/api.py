@@ -470,22 +470,31 @@ class Tracker:
                 self._max_conf = max(self._max_conf, float(xywh[:, 4].max()))
             if self._scale is not None:
                 xywh[:, :4] *= self._scale
-            reports = self._tracker.update(work, xywh, cls)
+            # inside the frame as checked: the tracker need not check them again (scaled
+            # boxes are, in case a box's scaled edge rounds past the working frame's)
+            reports = self._tracker.update(work, xywh, cls, checked=self._scale is None)
         self.frame_count += 1
         # the offline pass sees a still camera: boxes in the first frame's coordinates
         self._stabiliser.add(self._tracker.camera_step.apply)
         self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
         self._reports = reports
-        out = np.zeros((len(reports), 8))
-        m = 0
-        for t in reports:
-            if t.time_since_update != 0:
-                continue  # coasting: carried by the particle filter alone, held back
-            b = t.box_xywh if self._scale is None else t.box_xywh / self._scale
-            di = -1 if kept is None or t.detection_index is None else kept[t.detection_index]
-            out[m] = (b[0], b[1], b[0] + b[2], b[1] + b[3], t.id, t.score, t.cls, di)
-            m += 1
-        return out[:m]
+        # coasting tracks (carried by the particle filter alone) are held back
+        live = [t for t in reports if t.time_since_update == 0]
+        out = np.zeros((len(live), 8))
+        if live:
+            b = np.array([t.box_xywh for t in live])
+            if self._scale is not None:
+                b = b / self._scale
+            out[:, 0:2] = b[:, 0:2]
+            out[:, 2:4] = b[:, 0:2] + b[:, 2:4]
+            out[:, 4:7] = [(t.id, t.score, t.cls) for t in live]
+            if kept is not None:
+                out[:, 7] = [
+                    -1 if t.detection_index is None else kept[t.detection_index] for t in live
+                ]
+            else:
+                out[:, 7] = -1
+        return out
 
     @property
     def last_reports(self) -> list[Track]:

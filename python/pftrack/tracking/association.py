@@ -76,7 +76,8 @@ def associate(
     iou = iou_xywh(track_boxes, boxes)
     tc = track_boxes[:, :2] + track_boxes[:, 2:] / 2
     dc = boxes[:, :2] + boxes[:, 2:] / 2
-    dist = np.linalg.norm(tc[:, None, :] - dc[None, :, :], axis=2)
+    dx, dy = tc[:, 0:1] - dc[:, 0], tc[:, 1:2] - dc[:, 1]
+    dist = np.sqrt(dx * dx + dy * dy)  # np.linalg.norm over (dx, dy), the same floats
     radius = config.match_distance * heights * (1.0 + 0.25 * np.minimum(coasted, 8))
     # Bhattacharyya coefficients of every (track reference, detection) pair in one product
     rho = np.sqrt(references) @ np.sqrt(hists).T
@@ -101,11 +102,16 @@ def associate(
         rows, cols = rows[keep], cols[keep]
     else:
         rows, cols = linear_sum_assignment(cost)
-    matches = [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if cost[r, c] < FORBIDDEN]
-    mt = {r for r, _ in matches}
-    md = {c for _, c in matches}
+    ok = cost[rows, cols] < FORBIDDEN
+    rows, cols = rows[ok], cols[ok]
+    free_t = np.ones(nt, bool)
+    free_t[rows] = False
+    free_d = np.ones(nd, bool)
+    free_d[cols] = False
     return Association(
-        matches, [i for i in range(nt) if i not in mt], [j for j in range(nd) if j not in md]
+        list(zip(rows.tolist(), cols.tolist(), strict=True)),
+        np.flatnonzero(free_t).tolist(),
+        np.flatnonzero(free_d).tolist(),
     )
 
 

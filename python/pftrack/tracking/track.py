@@ -20,7 +20,7 @@ from pftrack._typing import F64
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.kalman import cv_predict, cv_update, cv_update_where
 from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
-from pftrack.particle_filter.filter import reinitialise_filters, step_filters
+from pftrack.particle_filter.filter import reinitialise_filters, step_filters_summary
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.motion import CentreKalman
 
@@ -256,22 +256,23 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
     """
     if not tracks:
         return
-    states = step_filters([t.filter for t in tracks], binned)
+    _, summary = step_filters_summary([t.filter for t in tracks], binned)
     size = np.array([t.size for t in tracks])  # (K, 2)
     h = size[:, 1:2]
     p, v, cov = _motion_state(tracks)
     accel = np.array([t.motion.accel for t in tracks])[:, None]
-    z = np.array([s.box_cxcywh[:2] for s in states])
+    z = summary[:, 0:2]
     mean, c = cv_predict((p, v), cov, (accel * h) ** 2)
     # a flat likelihood is no measurement: those tracks keep the prediction
-    evidence = np.array([[colour_evidence(s.rho, s.rho_max)] for s in states])
+    # (colour_evidence over the tracks: rho_max - rho > FLAT_RHO)
+    evidence = summary[:, 3:4] - summary[:, 2:3] > FLAT_RHO
     mean, c = cv_update_where(mean, c, z, (colour_noise * h) ** 2, evidence)
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     boxes = np.concatenate([p - size / 2, size], axis=1)
     covs = np.concatenate(c, axis=1).tolist()
-    for k, t in enumerate(tracks):
+    for k, (t, rho) in enumerate(zip(tracks, summary[:, 2].tolist(), strict=True)):
         t.measured = None
-        t.rho = states[k].rho
+        t.rho = rho
         m = t.motion
         m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
         t.box = boxes[k]
@@ -351,5 +352,7 @@ def reseed_tracks(
     blend = (1 - rate) * np.array([filters[i].reference for i in idx]) + rate * hists[idx]
     if not (np.isfinite(blend).all() and (blend >= 0).all()):
         raise ValueError("reference histogram must be finite, >= 0 and not all zero")
+    # each row over its own sum (the same floats as row / row.sum(), row by row)
+    blend /= blend.sum(axis=1, keepdims=True)
     for i, row in zip(idx.tolist(), blend, strict=True):
-        filters[i].reference = row / row.sum()
+        filters[i].reference = row

@@ -68,7 +68,7 @@ class TrackWriter:
             for f, box, score in t.history:  # a new track's detections from before confirmation
                 row = [float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0]
                 self._append(row, np.asarray(box))
-            row = [float(frame), float(t.id), *map(float, t.box_xywh), float(t.score)]
+            row = [float(frame), float(t.id), *t.box_xywh.tolist(), float(t.score)]
             row += [-1.0, -1.0, -1.0]
             if t.time_since_update == 0:
                 pending = self._pending.pop(t.id, [])
