@@ -61,9 +61,9 @@ def iou_xywh(a: ArrayLike, b: ArrayLike) -> F64:
     b = np.asarray(b, dtype=np.float64).reshape(-1, 4)
     inter = intersection_xywh(a, b)
     union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = np.where(union > 0, inter / union, 0.0)
-    return np.asarray(out, dtype=np.float64)
+    # inter / union where union > 0, else 0 (divided only there: nothing to warn about)
+    out: F64 = np.divide(inter, union, out=np.zeros(inter.shape), where=union > 0)
+    return out
 
 
 def xywh_to_cxcywh(boxes: ArrayLike) -> F64:

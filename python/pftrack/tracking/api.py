@@ -131,11 +131,11 @@ def check_boxes_xyxy(
             f"dets must have shape (N, 4), (N, 5) or (N, 6) [x1, y1, x2, y2(, conf(, cls))], "
             f"got {d.shape}"
         )
-    if not np.all(np.isfinite(d)):
+    if not np.isfinite(d).all():
         k = int(np.flatnonzero(~np.isfinite(d).all(axis=1))[0])
         raise ValueError(f"dets row {k} contains NaN or inf: {d[k].tolist()}")
     bad = (d[:, 2] <= d[:, 0]) | (d[:, 3] <= d[:, 1])
-    if np.any(bad):
+    if bad.any():
         k = int(np.flatnonzero(bad)[0])
         if np.all(d[bad, 2:4] > 0):  # positive as widths and heights: x, y, w, h rows
             raise ValueError(
@@ -146,13 +146,16 @@ def check_boxes_xyxy(
     rows, cols = shape
     limit = np.array([cols, rows, cols, rows], np.float64)
     box = np.clip(d[:, :4], 0.0, limit)
-    clipped = bool(np.any(box != d[:, :4]))
+    clipped = bool((box != d[:, :4]).any())
     inside = (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1])
     kept = np.flatnonzero(inside).astype(np.int64)
     box = box[kept]
     conf = d[kept, 4] if d.shape[1] >= 5 else np.ones(len(kept))
     cls = d[kept, 5].astype(np.int64) if d.shape[1] == 6 else np.zeros(len(kept), np.int64)
-    xywh = np.column_stack([box[:, :2], box[:, 2:] - box[:, :2], conf])
+    xywh = np.empty((len(box), 5))
+    xywh[:, 0:2] = box[:, :2]
+    xywh[:, 2:4] = box[:, 2:] - box[:, :2]
+    xywh[:, 4] = conf
     return xywh, cls, kept, clipped
 
 

@@ -94,8 +94,9 @@ def associate(
         tau = config.unmatched_cost
         padded = np.full((nt + nd, nd + nt), FORBIDDEN)
         padded[:nt, :nd] = cost
-        padded[:nt, nd:][np.diag_indices(nt)] = tau
-        padded[nt:, :nd][np.diag_indices(nd)] = tau
+        k = np.arange(max(nt, nd))
+        padded[k[:nt], nd + k[:nt]] = tau  # the diagonal of padded[:nt, nd:]
+        padded[nt + k[:nd], k[:nd]] = tau  # the diagonal of padded[nt:, :nd]
         padded[nt:, nd:] = 0.0
         rows, cols = linear_sum_assignment(padded)
         keep = (rows < nt) & (cols < nd)
