@@ -148,7 +148,7 @@ def check_boxes_xyxy(
     box = np.clip(d[:, :4], 0.0, limit)
     clipped = bool((box != d[:, :4]).any())
     inside = (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1])
-    kept = np.flatnonzero(inside).astype(np.int64)
+    kept = inside.nonzero()[0].astype(np.int64)
     box = box[kept]
     conf = d[kept, 4] if d.shape[1] >= 5 else np.ones(len(kept))
     cls = d[kept, 5].astype(np.int64) if d.shape[1] == 6 else np.zeros(len(kept), np.int64)

@@ -111,8 +111,8 @@ def associate(
     free_d[cols] = False
     return Association(
         list(zip(rows.tolist(), cols.tolist(), strict=True)),
-        np.flatnonzero(free_t).tolist(),
-        np.flatnonzero(free_d).tolist(),
+        free_t.nonzero()[0].tolist(),
+        free_d.nonzero()[0].tolist(),
     )
 
 

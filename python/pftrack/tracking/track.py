@@ -346,7 +346,7 @@ def reseed_tracks(
     if rate <= 0:
         return
     has = hists.sum(axis=1) > 0
-    idx = np.flatnonzero(has)
+    idx = has.nonzero()[0]
     if not len(idx):
         return
     blend = (1 - rate) * np.array([filters[i].reference for i in idx]) + rate * hists[idx]

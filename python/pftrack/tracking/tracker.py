@@ -287,7 +287,7 @@ class MultiObjectTracker:
             labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
             if len(labels) != len(boxes):
                 raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
-        index = np.flatnonzero(scores >= cfg.lifecycle.min_score)
+        index = (scores >= cfg.lifecycle.min_score).nonzero()[0]
         boxes, scores, labels = boxes[index], scores[index], labels[index]
         if cfg.sampler == "rjmcmc":
             if len(np.unique(labels)) > 1:
