@@ -18,7 +18,11 @@ from pftrack.particle_filter import (
     box_histograms,
     hsv_bins,
 )
-from pftrack.particle_filter.filter import reinitialise_filters, step_filters
+from pftrack.particle_filter.filter import (
+    reinitialise_filters,
+    step_filters,
+    step_filters_summary,
+)
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.track import LiveTrack, follow_tracks_motion, predict_tracks, reseed_tracks
 from tests.particle_filter.test_filter import _particles
@@ -194,6 +198,15 @@ def test_step_filters_equals_step_each(estimate):
             np.testing.assert_array_equal(fb.means, fs.means)
             assert fb.last == g
     assert step_filters([], image0) == []
+
+    # the summary array holds the states' numbers, batched filters and the others alike
+    image = hsv_bins(_scene(12))
+    states, summary = step_filters_summary(batched, image)
+    assert summary.shape == (len(batched), 4)
+    for s, row in zip(states, summary.tolist(), strict=True):
+        assert row == [s.box_cxcywh[0], s.box_cxcywh[1], s.rho, s.rho_max]
+    states, summary = step_filters_summary([], image)
+    assert states == [] and summary.shape == (0, 4)
 
 
 def test_predict_tracks_equals_predict_each():
