@@ -201,12 +201,17 @@ def test_step_filters_equals_step_each(estimate):
 
     # the summary array holds the states' numbers, batched filters and the others alike
     image = hsv_bins(_scene(12))
-    states, summary = step_filters_summary(batched, image)
+    summary = step_filters_summary(batched, image)
+    want = [f.step(image) for f in single]
     assert summary.shape == (len(batched), 4)
-    for s, row in zip(states, summary.tolist(), strict=True):
-        assert row == [s.box_cxcywh[0], s.box_cxcywh[1], s.rho, s.rho_max]
-    states, summary = step_filters_summary([], image)
-    assert states == [] and summary.shape == (0, 4)
+    for f, w, row in zip(batched, want, summary.tolist(), strict=True):
+        assert row == [w.box_cxcywh[0], w.box_cxcywh[1], w.rho, w.rho_max]
+        got = f.last  # made on reading: the filter's own step's state
+        assert got is not None and got is f.last
+        np.testing.assert_array_equal(got.box_cxcywh, w.box_cxcywh)
+        assert (got.rho, got.rho_max, got.ess, got.foreground) == (w.rho, w.rho_max, w.ess,
+                                                                   w.foreground)  # fmt: skip
+    assert step_filters_summary([], image).shape == (0, 4)
 
 
 def test_predict_tracks_equals_predict_each():

@@ -147,7 +147,34 @@ class ColourParticleFilter:
         self.weights = np.full(n, 1.0 / n)
         self.means = np.empty((2, 3))
         self.reinitialise(b, velocity=velocity)
-        self.last: FilterState | None = None
+        self._last: FilterState | None = None  # see last
+        # (row of sis_step_batch's output, the estimate's column, w0, h0) not yet made a state
+        self._last_row: tuple[list[float], int, float, float] | None = None
+
+    @property
+    def last(self) -> FilterState | None:
+        """The state the last step reported (None before the first step).
+
+        A batched step (:func:`step_filters_summary`) keeps only its row of numbers; the
+        state is made from it on first reading.
+        """
+        pending = self._last_row
+        if pending is not None:
+            row, col, w0, h0 = pending
+            cx, cy, s = row[col : col + 3]
+            self._last = FilterState(
+                box_cxcywh=np.array([cx, cy, s * w0, s * h0]),
+                rho=row[9],
+                rho_max=row[8],
+                ess=row[7],
+                foreground=row[10],
+            )
+            self._last_row = None
+        return self._last
+
+    @last.setter
+    def last(self, state: FilterState | None) -> None:
+        self._last, self._last_row = state, None
 
     def set_reference(self, reference: ArrayLike) -> None:
         """Replace the reference histogram (e.g. a slow blend with the current appearance)."""
@@ -243,32 +270,31 @@ def step_filters(
     list of FilterState
         One per filter, in order.
     """
-    return step_filters_summary(filters, image)[0]
+    step_filters_summary(filters, image)
+    return [f.last for f in filters if f.last is not None]
 
 
-def step_filters_summary(
-    filters: Sequence[ColourParticleFilter], image: _core.BinnedImage
-) -> tuple[list[FilterState], F64]:
-    """:func:`step_filters`, and the numbers a tracker reads from the states, as one array.
+def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.BinnedImage) -> F64:
+    """:func:`step_filters`, returning the numbers a tracker reads from the states as one array.
+
+    Each filter's :attr:`ColourParticleFilter.last` is its new state, as after
+    :func:`step_filters` (made when first read).
 
     Returns
     -------
-    states : list of FilterState
-        One per filter, in order (what :func:`step_filters` returns).
-    summary : (K, 4) ndarray
-        Per filter: the estimate's centre ``cx, cy``, ``rho`` and ``rho_max`` (the same
-        floats as in `states`, without reading K objects back).
+    (K, 4) ndarray
+        Per filter: the estimate's centre ``cx, cy``, ``rho`` and ``rho_max`` (the same floats
+        as in the states, without making K objects).
     """
     summary = np.empty((len(filters), 4))
     if not filters:
-        return [], summary
+        return summary
     cfg = filters[0].config
     batch = [
         k
         for k, f in enumerate(filters)
         if type(f).step is ColourParticleFilter.step and (f.config is cfg or f.config == cfg)
     ]
-    states: list[FilterState | None] = [None] * len(filters)
     if batch:
         fs = [filters[k] for k in batch]
         m = cfg.model
@@ -283,24 +309,16 @@ def step_filters_summary(
         summary[at, 0:2] = out[:, col : col + 2]
         summary[at, 2] = out[:, 9]
         summary[at, 3] = out[:, 8]
-        for k, f, row in zip(batch, fs, out.tolist(), strict=True):
+        for f, row in zip(fs, out.tolist(), strict=True):
             f._step += 1
-            cx, cy, s = row[col : col + 3]
-            state = FilterState(
-                box_cxcywh=np.array([cx, cy, s * f.w0, s * f.h0]),
-                rho=row[9],
-                rho_max=row[8],
-                ess=row[7],
-                foreground=row[10],
-            )
-            f.last = state
-            states[k] = state
+            f._last, f._last_row = None, (row, col, f.w0, f.h0)
     if len(batch) < len(filters):
+        done = set(batch)
         for k, f in enumerate(filters):
-            if states[k] is None:
-                st = states[k] = f.step(image)
+            if k not in done:
+                st = f.step(image)
                 summary[k] = (st.box_cxcywh[0], st.box_cxcywh[1], st.rho, st.rho_max)
-    return [s for s in states if s is not None], summary
+    return summary
 
 
 def reinitialise_filters(

@@ -256,7 +256,7 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
     """
     if not tracks:
         return
-    _, summary = step_filters_summary([t.filter for t in tracks], binned)
+    summary = step_filters_summary([t.filter for t in tracks], binned)
     size = np.array([t.size for t in tracks])  # (K, 2)
     h = size[:, 1:2]
     p, v, cov = _motion_state(tracks)
