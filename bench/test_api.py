@@ -25,9 +25,8 @@ import numpy as np
 import pytest
 from pytest_benchmark.fixture import BenchmarkFixture
 
+from experiments import python_share
 from experiments.cost_per_object import new_tracker
-from pftrack.io.mot import group_by_frame
-from pftrack.synthetic import make_scene
 
 WARM = 20  # untimed frames: every walker is born and confirmed
 GOAL_MS = 0.5  # per frame, 10 objects, beyond the detector
@@ -36,13 +35,7 @@ ROUNDS = 5
 
 @pytest.fixture(scope="module")
 def scene_dets() -> tuple[list[np.ndarray], list[np.ndarray]]:
-    scene = make_scene(n_frames=80, n_walkers=10, rng=0, occluder=False)
-    by_frame = group_by_frame(scene.truth)
-    dets = []
-    for n in range(1, len(scene.frames) + 1):
-        r = by_frame.get(n, np.zeros((0, 10)))
-        dets.append(np.column_stack([r[:, 2:4], r[:, 2:4] + r[:, 4:6], np.full(len(r), 0.9)]))
-    return scene.frames, dets
+    return python_share.scene_dets()
 
 
 @pytest.mark.parametrize("refine", [True, False], ids=["default", "no refine"])
