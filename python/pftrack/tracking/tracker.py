@@ -398,12 +398,10 @@ def sorted_quantile(values: F64, q: float) -> float:
     if not isinstance(v, float):  # an integer index: NumPy takes the value itself
         return float(values[v])
     if v >= n - 1:
-        below = above = n - 1
-    else:
-        below = math.floor(v)
-        above = below + 1
-    gamma = v - (below if v < n - 1 else -1)
-    a, b = float(values[below]), float(values[above])
+        return float(values[n - 1])
+    below = math.floor(v)
+    gamma = v - below
+    a, b = float(values[below]), float(values[below + 1])
     diff = b - a
     return b - diff * (1 - gamma) if gamma >= 0.5 else a + diff * gamma
 
