@@ -59,6 +59,10 @@ class BackgroundModel:
     def apply(
         self, frame: NDArray[np.uint8], bins: Literal[False]
     ) -> tuple[None, NDArray[np.uint8]]: ...
+    @overload
+    def apply(
+        self, frame: NDArray[np.uint8], bins: bool
+    ) -> tuple[BinnedImage | None, NDArray[np.uint8]]: ...
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...
     # ghost test: (K,) share of each box's (K, 4) mask-boundary edges held by the frame

@@ -269,11 +269,8 @@ class PaperDetector:
         self, frame: NDArray[np.uint8], fn: str, bins: bool = True
     ) -> tuple[NDArray[np.uint8], _core.BinnedImage | None]:
         """The cleaned mask with shadows (255, 127, 0) and the frame's bins (None without)."""
-        if bins:
-            binned, raw = self._model.apply(check_frame(frame, fn))
-            return self._blobs.clean(raw), binned
-        _, raw = self._model.apply(check_frame(frame, fn), bins=False)
-        return self._blobs.clean(raw), None
+        binned, raw = self._model.apply(check_frame(frame, fn), bins=bins)
+        return self._blobs.clean(raw), binned
 
 
 def foreground_only(shaded: NDArray[np.uint8]) -> NDArray[np.uint8]:

@@ -219,18 +219,15 @@ class PersonSizeModel:
         np.fill_diagonal(overlap, False)
         iso = b[~overlap.any(axis=1)]
         m, size = len(iso), self.config.max_samples
-        if m <= size:  # at once, into the ring buffer's next m slots (none written twice)
-            slots = (self._n + np.arange(m)) % size
-            self._samples[slots, 0] = iso[:, 1] + iso[:, 3]
-            self._samples[slots, 1] = iso[:, 3]
-            self._samples[slots, 2] = iso[:, 2]
-            self._n += m
-            self._since_fit += m
-        else:  # more isolated boxes than slots: in turn, the later ones overwrite
-            for _x, y, w, h in iso:
-                self._samples[self._n % size] = (y + h, h, w)
-                self._n += 1
-                self._since_fit += 1
+        # the ring buffer's next m slots at once; of more boxes than slots, the last ones
+        # (those written in turn would overwrite the earlier)
+        kept = iso[-size:]
+        slots = (self._n + m - len(kept) + np.arange(len(kept))) % size
+        self._samples[slots, 0] = kept[:, 1] + kept[:, 3]
+        self._samples[slots, 1] = kept[:, 3]
+        self._samples[slots, 2] = kept[:, 2]
+        self._n += m
+        self._since_fit += m
         # only with a sample new since the last try: a refused first fit is not redone, on
         # every frame, from the same samples (it would be refused again)
         if (
