@@ -12,8 +12,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
@@ -38,13 +40,18 @@ __all__ = [
 FLAT_RHO = 1e-9
 
 
-def colour_evidence(rho: float, rho_max: float) -> bool:
+@overload
+def colour_evidence(rho: float, rho_max: float) -> bool: ...
+@overload
+def colour_evidence(rho: F64, rho_max: F64) -> NDArray[np.bool_]: ...
+def colour_evidence(rho: float | F64, rho_max: float | F64) -> bool | NDArray[np.bool_]:
     """Tell whether a colour filter's step carried evidence about where the object is.
 
     When every particle's colour match ``rho`` is the same (the best one, `rho_max`, equals the
     weighted mean `rho` to :data:`FLAT_RHO`), the likelihood is flat: a frame of one colour
     (e.g. black), or boxes with no counted pixel. The filter's estimate is then only its own
     motion prediction, not a measurement, and the centre filter must not take it as one.
+    Arrays of several filters' values give one answer per filter.
     """
     return rho_max - rho > FLAT_RHO
 
@@ -264,8 +271,7 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
     z = summary[:, 0:2]
     mean, c = cv_predict((p, v), cov, (accel * h) ** 2)
     # a flat likelihood is no measurement: those tracks keep the prediction
-    # (colour_evidence over the tracks: rho_max - rho > FLAT_RHO)
-    evidence = summary[:, 3:4] - summary[:, 2:3] > FLAT_RHO
+    evidence = colour_evidence(summary[:, 2:3], summary[:, 3:4])
     mean, c = cv_update_where(mean, c, z, (colour_noise * h) ** 2, evidence)
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     boxes = np.concatenate([p - size / 2, size], axis=1)
