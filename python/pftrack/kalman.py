@@ -112,8 +112,8 @@ def wna_Q_xy(q: Sequence[float], dt: float = 1.0) -> F64:  # noqa: N802 - the us
     return _xy_block([wna_Q(float(qi), dt) for qi in q])
 
 
-def cv_predict(mean: Mean, cov: Cov, q: Value) -> tuple[Mean, Cov]:
-    """Advance independent constant-velocity axes by one frame.
+def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, Cov]:
+    """Advance independent constant-velocity axes by `dt` frames (one by default).
 
     Parameters
     ----------
@@ -122,7 +122,10 @@ def cv_predict(mean: Mean, cov: Cov, q: Value) -> tuple[Mean, Cov]:
     cov : (p00, p01, p11)
         Covariance entries, floats or arrays over axes.
     q : float or ndarray
-        Spectral density of the acceleration (px²/frame³): ``Q = q [[1/3, 1/2], [1/2, 1]]``.
+        Spectral density of the acceleration (px²/frame³): ``Q = q [[dt³/3, dt²/2], [dt²/2,
+        dt]]`` (:func:`wna_Q`).
+    dt : float or ndarray
+        Frames to advance, per axis when an array (0: the state stays).
 
     Returns
     -------
@@ -130,8 +133,13 @@ def cv_predict(mean: Mean, cov: Cov, q: Value) -> tuple[Mean, Cov]:
         The predicted state.
     """
     p00, p01, p11 = cov
-    # P' = F P F^T + Q with F = [[1, 1], [0, 1]]
-    return (mean[0] + mean[1], mean[1]), (p00 + 2 * p01 + p11 + q / 3.0, p01 + p11 + q / 2, p11 + q)
+    # P' = F P F^T + Q with F = [[1, dt], [0, 1]] (dt = 1: products by 1.0 are exact, so one
+    # frame gives the same floats as the one-frame formula)
+    return (mean[0] + dt * mean[1], mean[1]), (
+        p00 + 2 * dt * p01 + dt * dt * p11 + q * dt**3 / 3.0,
+        p01 + dt * p11 + q * dt * dt / 2,
+        p11 + q * dt,
+    )
 
 
 def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:

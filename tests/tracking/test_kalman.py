@@ -65,6 +65,28 @@ def test_predict_update_match_matrix_form():
         )
 
 
+def test_predict_over_dt_frames_matches_matrix_form():
+    rng = np.random.default_rng(5)
+    for dt in (0.0, 0.5, 2.0, 7.0):
+        F = cv_transition(dt)
+        L = rng.normal(size=(2, 2))
+        P = L @ L.T + 0.1 * np.eye(2)
+        m = rng.normal(size=2)
+        q = rng.uniform(0.01, 3)
+        (p, v), (a, b, c) = cv_predict((m[0], m[1]), (P[0, 0], P[0, 1], P[1, 1]), q, dt)
+        np.testing.assert_allclose([p, v], F @ m, rtol=1e-13)
+        np.testing.assert_allclose([[a, b], [b, c]], F @ P @ F.T + wna_Q(q, dt), rtol=1e-12)
+
+
+def test_predict_one_frame_is_the_one_frame_formula_bit_for_bit():
+    rng = np.random.default_rng(6)
+    m0, m1, p00, p01, p11, q = rng.normal(size=(6, 50))
+    (p, v), (a, b, c) = cv_predict((m0, m1), (p00, p01, p11), q)
+    assert np.array_equal(p, m0 + m1) and np.array_equal(v, m1)
+    assert np.array_equal(a, p00 + 2 * p01 + p11 + q / 3.0)
+    assert np.array_equal(b, p01 + p11 + q / 2) and np.array_equal(c, p11 + q)
+
+
 def test_predict_update_vectorised_over_axes():
     """Arrays over axes give what each axis gives alone (the tracker shares one covariance)."""
     m = (np.array([1.0, -2.0]), np.array([0.5, 0.25]))

@@ -25,7 +25,7 @@ from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
-from pftrack.kalman import rts_smooth
+from pftrack.kalman import Cov, Mean, cv_predict, cv_update_where, rts_smooth
 from pftrack.recovery.fill import fill_rows
 from pftrack.recovery.linking import LinkConfig, check_rows, check_unique, link_tracklets
 from pftrack.recovery.names import DEFAULT_METHOD
@@ -43,6 +43,18 @@ __all__ = [
 AMODAL_ANCHORS = ("side", "centre")  # complete_boxes: where a widened box keeps its evidence
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
+
+
+def _check_noise_levels(owner: str, config: object, unit: str) -> None:
+    """`config`'s ``accel, noise, size_accel, size_noise``: numbers in [NOISE_MIN, NOISE_MAX]."""
+    for name in ("accel", "noise", "size_accel", "size_noise"):
+        v = getattr(config, name)
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool)
+        if not (ok and NOISE_MIN <= v <= NOISE_MAX):
+            raise ValueError(
+                f"{owner}: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
+                f"{NOISE_MAX:g}] ({unit})"
+            )
 
 
 @dataclass(frozen=True)
@@ -79,14 +91,7 @@ class BoxSmoother:
     max_hole: int = 300
 
     def __post_init__(self) -> None:
-        for name in ("accel", "noise", "size_accel", "size_noise"):
-            v = getattr(self, name)
-            ok = isinstance(v, (int, float)) and not isinstance(v, bool)
-            if not (ok and NOISE_MIN <= v <= NOISE_MAX):
-                raise ValueError(
-                    f"BoxSmoother: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
-                    f"{NOISE_MAX:g}] (track heights)"
-                )
+        _check_noise_levels("BoxSmoother", self, "track heights")
         h = self.max_hole
         if not isinstance(h, (int, np.integer)) or isinstance(h, bool) or h < 1:
             raise ValueError(f"BoxSmoother: max_hole is {h!r}, expected an integer >= 1")
@@ -225,14 +230,7 @@ class CrossingConfig:
                 or not lo <= v <= MAX_FRAME
             ):
                 raise ValueError(f"CrossingConfig: {name} is {v!r}, expected an integer >= {lo}")
-        for name in ("accel", "noise", "size_accel", "size_noise"):
-            v = getattr(self, name)
-            ok = isinstance(v, (int, float)) and not isinstance(v, bool)
-            if not (ok and NOISE_MIN <= v <= NOISE_MAX):
-                raise ValueError(
-                    f"CrossingConfig: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
-                    f"{NOISE_MAX:g}] (box heights)"
-                )
+        _check_noise_levels("CrossingConfig", self, "box heights")
         if not 0.0 <= self.margin < np.inf:
             raise ValueError(
                 f"CrossingConfig: margin is {self.margin}, expected a finite value >= 0"
@@ -405,9 +403,9 @@ def _after_nll(
 ) -> F64:
     """Negative log-likelihood of each pairing's after rows given its before rows.
 
-    A constant-velocity Kalman filter per axis (centre x, y, width, height), started at the
-    first before row with a wide velocity prior; all pairings run at once, padded with
-    steps of zero frames and no measurement.
+    The package's constant-velocity Kalman filter (:mod:`pftrack.kalman`) per axis (centre x,
+    y, width, height), started at the first before row with a wide velocity prior; all
+    pairings run at once, padded with steps of zero frames and no measurement.
     """
     seqs = [np.concatenate([b, f]) for b, f in pairings]
     length = max(len(s) for s in seqs)
@@ -423,27 +421,15 @@ def _after_nll(
         counts[len(b) : len(s), k] = True
     q = np.array([c.accel, c.accel, c.size_accel, c.size_accel]) ** 2
     r2 = np.array([c.noise, c.noise, c.size_noise, c.size_noise]) ** 2
-    m0, m1 = zs[0].copy(), np.zeros((m, 4))
-    p00, p01, p11 = np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0)
+    mean: Mean = (zs[0].copy(), np.zeros((m, 4)))
+    cov: Cov = (np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0))
     nll = np.zeros(m)
     for t in range(1, length):
-        d = dt[t][:, None]
-        # x' = F x, P' = F P F^T + q [[d^3/3, d^2/2], [d^2/2, d]] with F = [[1, d], [0, 1]]
-        m0 = m0 + d * m1
-        p00 = p00 + 2 * d * p01 + d * d * p11 + q * d**3 / 3
-        p01 = p01 + d * p11 + q * d * d / 2
-        p11 = p11 + q * d
-        s = p00 + r2
-        e = zs[t] - m0
-        w = has[t][:, None]
+        mean, cov = cv_predict(mean, cov, q, dt[t][:, None])
+        s = cov[0] + r2
+        e = zs[t] - mean[0]
         nll += np.where(counts[t], 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
-        k0, k1 = p00 / s, p01 / s
-        m0, m1 = np.where(w, m0 + k0 * e, m0), np.where(w, m1 + k1 * e, m1)
-        p00, p01, p11 = (
-            np.where(w, (1 - k0) * p00, p00),
-            np.where(w, (1 - k0) * p01, p01),
-            np.where(w, p11 - k1 * p01, p11),
-        )
+        mean, cov = cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
     return nll
 
 
