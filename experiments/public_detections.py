@@ -18,12 +18,15 @@ The drop-in mode (`pftrack.tracking.track_frames` with a ``det.txt``, as ``pftra
 The last row of each seed, ``pooled``, scores the eight sequences together (TrackEval's
 combination). ``--seeds`` repeats the run over several tracker seeds (PETS09's IDF1 moves
 by 6 points from one seed to the next, docs/tracking.md), and ``--set`` changes
-one `TrackerConfig` field for a trial, e.g. ``--set motion.colour_noise=0.2``.
+one `TrackerConfig` field for a trial, e.g. ``--set motion.colour_noise=0.2``. ``--upscale 2``
+runs every sequence as footage of twice the resolution (frames resized bilinearly as they are
+read, detections and truth scaled): a tracker whose settings fit the frame's size scores the
+same.
 
 Usage (from the repository root)::
 
     python -m experiments.public_detections [--data ../shared/data] [--out DIR]
-        [--seeds 0 1 2] [--set SECTION.FIELD=VALUE ...]
+        [--seeds 0 1 2] [--upscale 2] [--set SECTION.FIELD=VALUE ...]
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 
@@ -65,6 +69,37 @@ class BlackFrames(Sequence[NDArray[np.uint8]]):
 
     def __iter__(self) -> Iterator[NDArray[np.uint8]]:
         return (self._frame for _ in range(self._n))
+
+
+class Resized(Sequence[NDArray[np.uint8]]):
+    """The frames of `frames` scaled by `factor` (bilinear) as they are read; `frames` if 1."""
+
+    def __init__(self, frames: Sequence[NDArray[np.uint8]] | FrameSource, factor: float) -> None:
+        self._frames = frames
+        self._factor = factor
+
+    def __len__(self) -> int:
+        return len(self._frames)
+
+    def _resize(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        if self._factor == 1.0:
+            return frame
+        h, w = frame.shape[:2]
+        size = (round(w * self._factor), round(h * self._factor))
+        return np.asarray(cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR), np.uint8)
+
+    def __getitem__(self, i: int) -> NDArray[np.uint8]:  # type: ignore[override]
+        if isinstance(self._frames, FrameSource):
+            raise TypeError("a video is read in order, not by index")
+        return self._resize(self._frames[i])
+
+    def __iter__(self) -> Iterator[NDArray[np.uint8]]:
+        return (self._resize(f) for f in self._frames)
+
+
+def scaled(dets: dict[int, F64], factor: float) -> dict[int, F64]:
+    """Detections ``{frame: [left, top, w, h, score]}`` with their boxes times `factor`."""
+    return {f: np.column_stack([d[:, :4] * factor, d[:, 4:]]) for f, d in dets.items()}
 
 
 def noisy_detections(
@@ -154,11 +189,18 @@ def main(argv: list[str] | None = None) -> int:
         help="tracker seeds, one run of every sequence each (default: 0)",
     )  # fmt: skip
     p.add_argument(
+        "--upscale", type=float, default=1.0, metavar="FACTOR",
+        help="scale every sequence's frames, detections and truth by FACTOR, as footage of "
+        "the same scene at another resolution (default: 1.0, as they are)",
+    )  # fmt: skip
+    p.add_argument(
         "--set", action="append", default=[], metavar="SECTION.FIELD=VALUE", dest="settings",
         help="change one TrackerConfig field, e.g. motion.colour_noise=0.2 (repeatable; "
         "default: none, every default as is)",
     )  # fmt: skip
     args = p.parse_args(argv)
+    if not (np.isfinite(args.upscale) and 0.1 <= args.upscale <= 8):
+        p.error(f"--upscale is {args.upscale}, expected a factor in [0.1, 8]")
     config = TrackerConfig()
     for setting in args.settings:
         try:
@@ -170,21 +212,24 @@ def main(argv: list[str] | None = None) -> int:
         for seed in args.seeds:
             if len(args.seeds) > 1:
                 print(f"-- seed {seed}")
-            scores = run_all(data, config, seed)
+            scores = run_all(data, config, seed, args.upscale)
             if scores:
                 print(line("pooled", SequenceScores.combine(scores)), flush=True)
     return 0
 
 
-def run_all(data: Path, config: TrackerConfig, seed: int) -> list[SequenceScores]:
+def run_all(
+    data: Path, config: TrackerConfig, seed: int, factor: float = 1.0
+) -> list[SequenceScores]:
     """Track every sequence found under `data` and the synthetic scenes; print each row.
 
-    Returns the scores of every sequence run, in order.
+    `factor` scales every sequence's frames, detections and truth (``--upscale``). Returns the
+    scores of every sequence run, in order.
     """
     out: list[SequenceScores] = []
 
     def report(name: str, gt: F64, rows: F64, scale: float = 1.0) -> None:
-        s = evaluate_sequence(gt, rows, scale=scale)
+        s = evaluate_sequence(gt, rows, scale=scale * factor)
         out.append(s)
         print(line(name, s), flush=True)
 
@@ -193,9 +238,10 @@ def run_all(data: Path, config: TrackerConfig, seed: int) -> list[SequenceScores
         if not folder.is_dir():
             print(f"{src.name}: not found under {data}, skipped")
             continue
-        dets = load_detections(folder / "det.txt", src.scale)
+        dets = scaled(load_detections(folder / "det.txt", src.scale), factor)
         video = FrameSource(folder / src.video)
-        run = track_frames(video, detections=dets, config=config, rng=seed)
+        source = video if factor == 1 else Resized(video, factor)
+        run = track_frames(source, detections=dets, config=config, rng=seed)
         report(src.name, read_mot(folder / "gt.txt"), run.rows, src.scale)
     for name in NO_VIDEO:
         folder = data / "mot15-gt" / name
@@ -205,15 +251,17 @@ def run_all(data: Path, config: TrackerConfig, seed: int) -> list[SequenceScores
         info = read_seqinfo(folder)
         if info.length is None or info.width is None or info.height is None:
             raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
-        frames = BlackFrames(info.length, info.width, info.height)
-        dets = load_detections(folder / "det.txt")
+        size = round(info.width * factor), round(info.height * factor)
+        frames = BlackFrames(info.length, *size)
+        dets = scaled(load_detections(folder / "det.txt"), factor)
         run = track_frames(frames, detections=dets, config=config, rng=seed)
         report(name + " (black)", read_mot(folder / "gt.txt"), run.rows)
     for kind in BUSY_SCENES:
         scene = make_busy_scene(kind, rng=0)
         h, w = scene.frames[0].shape[:2]
-        dets = noisy_detections(scene.truth, len(scene.frames), h, w)
-        run = track_frames(scene.frames, detections=dets, config=config, rng=seed)
+        dets = scaled(noisy_detections(scene.truth, len(scene.frames), h, w), factor)
+        source = scene.frames if factor == 1 else Resized(scene.frames, factor)
+        run = track_frames(source, detections=dets, config=config, rng=seed)
         report(kind, scene.truth, run.rows)
     return out
 

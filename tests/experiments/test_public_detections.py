@@ -54,3 +54,21 @@ def test_main_rejects_a_bad_setting(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as e:
         ex.main(["--set", "motion.nope=1"])
     assert e.value.code == 2 and "no field 'motion.nope'" in capsys.readouterr().err
+
+
+def test_resized_frames_and_scaled_detections() -> None:
+    frames = [np.full((6, 8, 3), i, np.uint8) for i in range(3)]
+    big = ex.Resized(frames, 2.0)
+    assert len(big) == 3 and big[1].shape == (12, 16, 3) and (big[1] == 1).all()
+    assert [f.shape for f in big] == [(12, 16, 3)] * 3
+    assert ex.Resized(frames, 1.0)[2] is frames[2]
+    dets = {1: np.array([[1.0, 2.0, 3.0, 4.0, 0.5]])}
+    assert np.array_equal(ex.scaled(dets, 2.0)[1], [[2.0, 4.0, 6.0, 8.0, 0.5]])
+    assert ex.override(TrackerConfig(), "pixel_diagonal=none").pixel_diagonal is None
+
+
+@pytest.mark.parametrize("factor", ["0", "nan", "100"])
+def test_main_rejects_a_bad_upscale(factor: str, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as e:
+        ex.main(["--upscale", factor])
+    assert e.value.code == 2 and "--upscale" in capsys.readouterr().err

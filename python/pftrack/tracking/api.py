@@ -538,6 +538,10 @@ class Tracker:
         """
         smoothed = self._writer_args[2] is not None
         crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
+        link = self._writer_args[3]
+        if link is not None:  # its pixel gate grows with the frame (TrackerConfig.pixel_diagonal)
+            scale = self._tracker.pixel_scale
+            self._writer.link = replace(link, max_distance=link.max_distance * scale)
         rows = self._stabiliser.restore(
             self._writer.result(drop=self._tracker.never_confirmed(), crossings=crossings)
         )

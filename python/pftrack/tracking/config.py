@@ -5,7 +5,7 @@ Every default is a rule, not a per-sequence tuning (measured in docs/results.md)
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -27,6 +27,8 @@ SAMPLERS = ("sis", "mh", "rjmcmc")
 CAMERA_MOTION = ("auto", "on", "off")
 #: Bounds of :attr:`TrackerConfig.max_side` (pixels).
 MIN_SIDE, MAX_SIDE = 64, 100_000
+#: Default of :attr:`TrackerConfig.pixel_diagonal`: a 640x480 frame's diagonal (pixels).
+PIXEL_DIAGONAL = 800.0
 
 
 def _in_unit_interval(owner: str, **values: float) -> None:
@@ -333,6 +335,13 @@ class TrackerConfig:
         tracker reports is scaled back to the frame's pixels (:class:`~pftrack.Tracker`; the
         inner :class:`~pftrack.tracking.MultiObjectTracker` works in the scaled pixels). None
         tracks at the frame's own size.
+    pixel_diagonal : float or None
+        The settings given in pixels (the particle filter's ``filter.model.sigma_xy`` and the
+        offline linker's ``max_distance``) hold for frames whose diagonal is at most this
+        (default 800: 640x480), and grow in proportion to the diagonal of larger (working)
+        frames, so that a video tracks the same at 1280x720 as at 640x360
+        (:meth:`pixel_scale`). They were set on 480x360 and 640x480 videos, which track with
+        the same values. None: the settings are in the frame's own pixels at every size.
     """
 
     filter: FilterConfig = field(
@@ -354,8 +363,18 @@ class TrackerConfig:
     camera: CameraConfig = field(default_factory=CameraConfig)
     crossings: CrossingConfig = field(default_factory=CrossingConfig)
     max_side: int | None = None
+    pixel_diagonal: float | None = PIXEL_DIAGONAL
 
     def __post_init__(self) -> None:
+        if self.pixel_diagonal is not None and not (
+            isinstance(self.pixel_diagonal, (int, float, np.integer, np.floating))
+            and not isinstance(self.pixel_diagonal, bool)
+            and np.isfinite(self.pixel_diagonal)
+            and self.pixel_diagonal > 0
+        ):
+            raise ValueError(
+                f"pixel_diagonal is {self.pixel_diagonal!r}, expected None or a finite value > 0"
+            )
         if self.max_side is not None and (
             isinstance(self.max_side, bool)
             or not isinstance(self.max_side, (int, np.integer))
@@ -374,3 +393,23 @@ class TrackerConfig:
         if self.detector not in DETECTORS:
             raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
         _in_unit_interval("TrackerConfig", reference_rate=self.reference_rate)
+
+    def pixel_scale(self, height: int, width: int) -> float:
+        """How much the pixel settings grow on a (working) frame of `height` x `width` pixels.
+
+        ``max(1, diagonal / pixel_diagonal)``; 1 with ``pixel_diagonal=None``.
+        """
+        if self.pixel_diagonal is None:
+            return 1.0
+        return max(1.0, float(np.hypot(height, width)) / float(self.pixel_diagonal))
+
+    def scaled_pixels(self, scale: float) -> TrackerConfig:
+        """The configuration with its pixel settings (``filter.model.sigma_xy``) times `scale`.
+
+        The offline linker's ``max_distance`` is not part of it: :class:`pftrack.Tracker`
+        scales its :class:`~pftrack.recovery.LinkConfig` with the same factor.
+        """
+        if scale == 1.0:
+            return self
+        model = replace(self.filter.model, sigma_xy=self.filter.model.sigma_xy * scale)
+        return replace(self, filter=replace(self.filter, model=model))

@@ -57,6 +57,12 @@ class MultiObjectTracker:
         Any object with ``detect(frame) -> Detections`` (see :mod:`pftrack.detection`); by
         default the one named by ``config.detector``, created on first use.
 
+    Attributes
+    ----------
+    pixel_scale : float
+        The factor of the pixel settings on this run's frames
+        (:meth:`TrackerConfig.pixel_scale` of the first frame's size; 1 before it).
+
     Examples
     --------
     >>> tracker = MultiObjectTracker(rng=0)                       # doctest: +SKIP
@@ -78,6 +84,10 @@ class MultiObjectTracker:
         self._mask_shaded = False  # whether _mask still has its shadow pixels (127)
         self._shadows: tuple[Any, bool] | None = None  # (detector, shadows_of(detector))
         self._joint = JointTracker(self.config, self._rng)
+        # the configuration the tracks run with: `config` with its pixel settings scaled to the
+        # first frame's size (TrackerConfig.pixel_diagonal), set by the first update
+        self._effective: TrackerConfig | None = None
+        self.pixel_scale = 1.0
         self._scores_are_confidences = True
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
         self._birth_level = np.inf
@@ -273,7 +283,11 @@ class MultiObjectTracker:
         f = np.asarray(frame)
         if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
             raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
-        cfg = self.config
+        cfg = self._effective
+        if cfg is None:
+            self.pixel_scale = self.config.pixel_scale(f.shape[0], f.shape[1])
+            cfg = self._effective = self.config.scaled_pixels(self.pixel_scale)
+            self._joint.config = cfg
         self.frame_index += 1
         # camera motion: move the tracks into this frame; no background model while it moves
         step = self.camera.update(f, [t.box for t in self.tracks])
