@@ -235,3 +235,54 @@ def test_cli_experiment_gaps(tmp_path, capsys):
     img = cv2.imread(str(fig))
     assert img is not None and img.ndim == 3
     assert main(["experiment", "gaps", "--gt", str(gt), "--mask", "1,2,3"]) == 2
+
+
+@pytest.mark.parametrize(
+    ("width", "height", "scale"),
+    [(480, 360, 1.0), (640, 480, 1.0), (1280, 960, 2.0), (1920, 1440, 3.0), (0, 0, 1.0)],
+)
+def test_pixel_scale_grows_with_the_diagonal_above_640x480(width, height, scale):
+    from pftrack.recovery.linking import pixel_scale
+
+    assert pixel_scale(width, height) == pytest.approx(scale)
+
+
+def jumped(factor):
+    """One walker in two fragments, 40 px (times `factor`) off its motion after the gap.
+
+    The boxes reach 640x480 times `factor`: a corner box marks the frame's extent.
+    """
+    a = walker(1, range(1, 21), 100, 150, 2.0, 0.0)
+    b = walker(2, range(31, 51), 140, 150, 2.0, 0.0)
+    corner = walker(3, [1], 620, 455, 0.0, 0.0, w=40, h=50)
+    rows = np.vstack([a, b, corner])
+    rows[:, 2:6] *= factor
+    return rows
+
+
+def test_the_gate_grows_with_the_boxes_extent():
+    from pftrack.recovery.linking import gate_for_rows
+
+    cfg = LinkConfig()
+    assert gate_for_rows(cfg, jumped(1.0)) == cfg
+    assert gate_for_rows(cfg, jumped(2.0)).max_distance == pytest.approx(100.0)
+    assert gate_for_rows(cfg, np.zeros((0, 10))) == cfg
+    # the same footage at twice the size links as at its own size
+    for factor in (1.0, 2.0):
+        _, mapping = link_tracklets(jumped(factor), gate_for_rows(cfg, jumped(factor)))
+        assert mapping == {2: 1}
+    _, mapping = link_tracklets(jumped(2.0), cfg)  # 80 px against a 50 px gate
+    assert mapping == {}
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_cli_gate_follows_the_frame(command, tmp_path, capsys):
+    src = tmp_path / "big.txt"
+    write_mot(src, jumped(2.0))
+    link = ["--link"] if command == "recover" else []
+    assert main([command, str(src), "--out", str(tmp_path / "a.txt"), *link]) == 0
+    assert set(read_mot(tmp_path / "a.txt")[:, 1].astype(int)) == {1, 3}
+    if command == "recover":  # a gate given in pixels is taken as it is
+        out = tmp_path / "b.txt"
+        assert main([command, str(src), "--out", str(out), "--link", "--max-distance", "50"]) == 0
+        assert set(read_mot(out)[:, 1].astype(int)) == {1, 2, 3}

@@ -15,7 +15,7 @@ import os
 import socket
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -274,7 +274,7 @@ class RecoverOptions:
     max_gap: int = 30
     seed: int = 0
     link: bool = False
-    max_distance: float = 50.0
+    max_distance: float | None = None  # None: 50 px grown to the frame (gate_for_rows)
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""
@@ -284,11 +284,16 @@ class RecoverOptions:
 def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
     """Fill the gaps of one tracks file as ``pftrack recover FILE`` does (no ``--video``)."""
     from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
+    from pftrack.recovery.linking import gate_for_rows
 
     rows = read_tracks(path)
     n_links = 0
     if options.link:
-        cfg = LinkConfig(max_gap=options.max_gap, max_distance=options.max_distance)
+        cfg = LinkConfig(max_gap=options.max_gap)
+        if options.max_distance is None:
+            cfg = gate_for_rows(cfg, rows)
+        else:
+            cfg = replace(cfg, max_distance=options.max_distance)
         rows, mapping = link_tracklets(rows, cfg, None)
         n_links = len(mapping)
     t0 = time.perf_counter()
@@ -321,11 +326,12 @@ class SmoothOptions:
 def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     """Link, fill and smooth one tracks file as ``pftrack smooth FILE`` does."""
     from pftrack.recovery import LinkConfig
+    from pftrack.recovery.linking import gate_for_rows
     from pftrack.tracking import smooth_tracks
 
     t0 = time.perf_counter()
     rows = read_tracks(path)
-    link = LinkConfig(max_gap=options.max_gap) if options.link else None
+    link = gate_for_rows(LinkConfig(max_gap=options.max_gap), rows) if options.link else None
     result = smooth_tracks(rows, link=link)
     info: dict[str, Any] = {
         "source": str(path),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -37,9 +38,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--seed", type=int, default=0,
                    help="auto: seed of the artificial calibration gaps")  # fmt: skip
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
-    p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=50.0, metavar="PX",
-                   help="linking gate on the motion-prediction distance (pixels, 0.001 to "
-                   "1e6)")  # fmt: skip
+    p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=None, metavar="PX",
+                   help="linking gate on the motion-prediction distance (pixels, 0.001 to 1e6; "
+                   "default: 50 px, times the diagonal of the boxes' extent over 800 when it is "
+                   "larger than 640x480)")  # fmt: skip
     p.add_argument("--video", help="video or image folder for the colour term of --link "
                    "(default: none, motion and size only)")  # fmt: skip
     p.add_argument("--in-place", action="store_true",
@@ -59,6 +61,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
+    from pftrack.recovery.linking import gate_for_rows
 
     src = Path(args.tracks)
     out = Path(args.out)
@@ -75,7 +78,11 @@ def run(args: argparse.Namespace) -> int:
             from pftrack.io.video import read_frames
 
             frames = read_frames(args.video)
-        cfg = LinkConfig(max_gap=args.max_gap, max_distance=args.max_distance)
+        cfg = LinkConfig(max_gap=args.max_gap)
+        if args.max_distance is None:  # 50 px grown to the frame (gate_for_rows)
+            cfg = gate_for_rows(cfg, rows)
+        else:
+            cfg = replace(cfg, max_distance=args.max_distance)
         rows, mapping = link_tracklets(rows, cfg, frames)
         n_links = len(mapping)
     t0 = time.perf_counter()

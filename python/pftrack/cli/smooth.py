@@ -19,8 +19,9 @@ def add_parser(sub: Any) -> None:
         help="link, fill and smooth any tracker's MOTChallenge output (offline)",
         description="The offline pass pftrack track applies to its own tracks, for any "
         "tracker's output: join fragments of one object by motion and size across gaps of up "
-        "to --max-gap frames, add the frames missing inside each track (recovered by the method "
-        "of pftrack recover, auto; flagged 1 in column 8), "
+        "to --max-gap frames (gate: 50 px, times the diagonal of the boxes' extent over 800 "
+        "when it is larger than 640x480), add the frames missing inside each track (recovered "
+        "by the method of pftrack recover, auto; flagged 1 in column 8), "
         "and replace every box by a Rauch-Tung-Striebel smoother's estimate over the whole "
         "track. Smoothing is not idempotent: run it once, on raw output.",
     )
@@ -47,6 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig
+    from pftrack.recovery.linking import gate_for_rows
     from pftrack.tracking import smooth_tracks
 
     src, out = Path(args.tracks), Path(args.out)
@@ -54,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
     check_output(out, what="--out")
     rows = read_tracks(src)
-    link = None if args.no_link else LinkConfig(max_gap=args.max_gap)
+    link = None if args.no_link else gate_for_rows(LinkConfig(max_gap=args.max_gap), rows)
     result = smooth_tracks(rows, link=link)
     write_mot(out, result)
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0

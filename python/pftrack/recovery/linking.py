@@ -10,7 +10,7 @@ untouched.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -31,12 +31,16 @@ __all__ = [
     "box_centres",
     "check_rows",
     "check_unique",
+    "gate_for_rows",
     "link_cost_matrix",
     "link_tracklets",
+    "pixel_scale",
     "split_tracks",
 ]
 
 FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTChallenge row)
+#: Frames up to this diagonal (640x480) take pixel settings as given; larger ones scale them.
+REFERENCE_DIAGONAL = 800.0
 #: Largest absolute track id accepted.
 MAX_ID = MAX_FRAME
 
@@ -81,6 +85,29 @@ class LinkConfig:
                     f"LinkConfig.{name} is {v!r}, expected a finite number "
                     + ("> 0" if name == "max_distance" else ">= 0")
                 )
+
+
+def pixel_scale(width: float, height: float, diagonal: float = REFERENCE_DIAGONAL) -> float:
+    """``max(1, hypot(width, height) / diagonal)``: how much pixel settings grow on a frame."""
+    return max(1.0, float(np.hypot(width, height)) / float(diagonal))
+
+
+def gate_for_rows(config: LinkConfig, rows: ArrayLike) -> LinkConfig:
+    """`config` with its pixel gate grown to the frame the rows' boxes span.
+
+    The frame is taken to reach the rightmost and lowest box edge of `rows` (MOTChallenge rows;
+    a lower bound of the frame the tracker saw), and ``max_distance`` is multiplied by
+    :func:`pixel_scale` of it: as given up to 640x480, in proportion to the diagonal above, as
+    :class:`pftrack.Tracker` scales it by its frames (``TrackerConfig.pixel_diagonal``). What
+    ``pftrack smooth`` and ``pftrack recover --link`` (without ``--max-distance``) use.
+    """
+    a = np.asarray(rows, np.float64).reshape(-1, 10) if np.size(rows) else np.zeros((0, 10))
+    if len(a) == 0:
+        return config
+    right = float(np.max(a[:, 2] + a[:, 4]))
+    bottom = float(np.max(a[:, 3] + a[:, 5]))
+    scale = pixel_scale(max(right, 0.0), max(bottom, 0.0))
+    return replace(config, max_distance=config.max_distance * scale)
 
 
 def box_centres(rows: F64) -> F64:

@@ -11,6 +11,7 @@ import numpy as np
 
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
+from pftrack.recovery.linking import REFERENCE_DIAGONAL, pixel_scale
 from pftrack.tracking.offline import AMODAL_ANCHORS, CrossingConfig
 
 __all__ = [
@@ -28,7 +29,7 @@ CAMERA_MOTION = ("auto", "on", "off")
 #: Bounds of :attr:`TrackerConfig.max_side` (pixels).
 MIN_SIDE, MAX_SIDE = 64, 100_000
 #: Default of :attr:`TrackerConfig.pixel_diagonal`: a 640x480 frame's diagonal (pixels).
-PIXEL_DIAGONAL = 800.0
+PIXEL_DIAGONAL = REFERENCE_DIAGONAL
 
 
 def _in_unit_interval(owner: str, **values: float) -> None:
@@ -401,7 +402,7 @@ class TrackerConfig:
         """
         if self.pixel_diagonal is None:
             return 1.0
-        return max(1.0, float(np.hypot(height, width)) / float(self.pixel_diagonal))
+        return pixel_scale(width, height, self.pixel_diagonal)
 
     def scaled_pixels(self, scale: float) -> TrackerConfig:
         """The configuration with its pixel settings (``filter.model.sigma_xy``) times `scale`.
