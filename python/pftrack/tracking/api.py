@@ -7,11 +7,12 @@ command never disagree: the same frames, detections and seed give the same rows.
 Time constants are given in seconds and turned into frames with ``frame_rate``
 (``round(seconds * frame_rate)``). The defaults are the command's frame-based defaults at the
 reference rate of 25 frames/s (:data:`REFERENCE_RATE`): ``max_coast=0.4`` s is 10 frames,
-``prime=1.2`` s is 30 frames, the linking gap 1.2 s is 30 frames and the birth-score window
-2 s is 50 frames. ``pftrack track`` keeps its options in frames and does not read the video's
-frame rate, so its results do not depend on container metadata; ``Tracker(frame_rate=25.0)``
-with default options is exactly ``pftrack track`` with default options. Motion noise levels
-(particle and centre filters) stay per frame.
+``prime=1.2`` s is 30 frames, the linking gap 1.2 s is 30 frames, the birth-score window
+2 s is 50 frames and the offline pass's cut after 0.24 s of coasting
+(``LifecycleConfig.relink_coast``) is 6 frames. ``pftrack track`` keeps its options in frames
+and does not read the video's frame rate, so its results do not depend on container metadata;
+``Tracker(frame_rate=25.0)`` with default options is exactly ``pftrack track`` with default
+options. Motion noise levels (particle and centre filters) stay per frame.
 """
 
 from __future__ import annotations
@@ -262,6 +263,7 @@ class Tracker:
             lifecycle=replace(
                 base.lifecycle,
                 max_coast=_frames(max_coast, frame_rate, "max_coast"),
+                relink_coast=max(1, _frames(0.24, frame_rate, "relink coast")),
                 min_score=float(min_conf),
                 birth_score=float(birth_score),
                 birth_quantile=birth_quantile,
@@ -542,8 +544,12 @@ class Tracker:
         if link is not None:  # its pixel gate grows with the frame (TrackerConfig.pixel_diagonal)
             scale = self._tracker.pixel_scale
             self._writer.link = replace(link, max_distance=link.max_distance * scale)
+        # given detections only: the built-in detector's tracks coast through merged blobs
+        relink = self.config.lifecycle.relink_coast if smoothed and self._given else None
         rows = self._stabiliser.restore(
-            self._writer.result(drop=self._tracker.never_confirmed(), crossings=crossings)
+            self._writer.result(
+                drop=self._tracker.never_confirmed(), crossings=crossings, relink_coast=relink
+            )
         )
         life = self.config.lifecycle
         if smoothed and not self._given and life.nested_inside is not None and len(rows):

@@ -118,6 +118,15 @@ class LifecycleConfig:
         Frames a not yet confirmed track may go without a detection before it is dropped.
     coast_min_rho : float
         A coasting track is reported only while its colour match ``rho`` stays above this.
+    relink_coast : int or None
+        With given detections, the offline pass (with linking) cuts a track where a detection
+        re-finds it after at least this many frames carried by its particle filter alone,
+        leaves those frames out, and lets the linker decide whether the two pieces are one
+        object (:func:`pftrack.tracking.offline.split_refound`): a filter that coasted that
+        long may have drifted onto another person, whose detection then re-found the track. A
+        kept join gets the frames back, filled as any hole. The built-in detector's tracks are
+        left alone: they coast through merged blobs, where the colour filter is what carries
+        them. None: off.
     nested_inside, nested_area : float or None
         With the built-in detector, the offline pass leaves out every box that lies by more than
         `nested_inside` of its area inside a box of the same frame more than `nested_area`
@@ -149,6 +158,7 @@ class LifecycleConfig:
     max_coast: int = 10
     tentative_coast: int = 0
     coast_min_rho: float = 0.5
+    relink_coast: int | None = 6
     nested_inside: float | None = 0.7
     nested_area: float = 1.5
     amodal_share: float | None = 0.8
@@ -156,6 +166,8 @@ class LifecycleConfig:
 
     def __post_init__(self) -> None:
         _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
+        if self.relink_coast is not None:
+            _integers_at_least("LifecycleConfig", 1, self, "relink_coast")
         _in_unit_interval("LifecycleConfig", coast_min_rho=self.coast_min_rho)
         if self.nested_inside is not None and not 0.0 < self.nested_inside <= 1.0:
             raise ValueError(

@@ -38,6 +38,7 @@ __all__ = [
     "drop_nested",
     "repair_crossings",
     "smooth_tracks",
+    "split_refound",
 ]
 
 AMODAL_ANCHORS = ("side", "centre")  # complete_boxes: where a widened box keeps its evidence
@@ -443,6 +444,7 @@ def smooth_tracks(
     fill_method: str = DEFAULT_METHOD,
     seed: int = 0,
     crossings: CrossingConfig | None = None,
+    relink_coast: int | None = None,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 
@@ -477,6 +479,11 @@ def smooth_tracks(
         When given and enabled, after linking, tracks whose identities the tracker swapped
         where they crossed get their tails exchanged back (:func:`repair_crossings`; the rows'
         boxes find the crossings, `measurements` are the evidence). None: off.
+    relink_coast : int or None
+        With `link`, before linking: where an observed row follows at least this many
+        unobserved rows of its track, the track is cut there and those rows are left out
+        (:func:`split_refound`), so that the linker decides whether the two pieces are one
+        object; a kept join gets the hole filled as any other. None (default): off.
 
     Returns
     -------
@@ -502,6 +509,8 @@ def smooth_tracks(
         z = np.array(measurements, dtype=np.float64)
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
+    if link is not None and relink_coast is not None:
+        a, obs, z = split_refound(a, obs, z, relink_coast)
     if link is not None:
         a, _ = link_tracklets(a, link)
     if crossings is not None and crossings.enabled:
@@ -678,6 +687,63 @@ def _frame_groups(frames: F64) -> list[NDArray[np.intp]]:
     """Row indices of each frame, frames ascending, rows in their order within a frame."""
     order = np.argsort(frames, kind="stable")
     return np.split(order, np.flatnonzero(np.diff(frames[order])) + 1)
+
+
+def split_refound(
+    rows: F64, observed: NDArray[np.bool_], measurements: F64, min_unobserved: int
+) -> tuple[F64, NDArray[np.bool_], F64]:
+    """Cut each track where a detection re-finds it after `min_unobserved` coasted rows or more.
+
+    A tracker's coasting rows (``observed`` False: e.g. a particle filter's boxes while no
+    detection matched) may have drifted onto another object, and the detection that re-finds
+    the track is then that object's. This cuts the track before such a detection and leaves
+    the coasted rows out: the piece after the cut gets a new id (above every id in `rows`), and
+    :func:`~pftrack.recovery.linking.link_tracklets` then joins the pieces back only where
+    their motion and size say they are one object. Unobserved rows before a track's first
+    observed row are kept.
+
+    Parameters
+    ----------
+    rows : (M, 10) ndarray
+        MOTChallenge rows, one per (frame, id).
+    observed : (M,) ndarray of bool
+        Which rows are detections.
+    measurements : (M, 4) ndarray
+        Per-row boxes carried along (the smoother's evidence).
+    min_unobserved : int
+        Fewest consecutive unobserved rows before a detection that cut the track (>= 1).
+
+    Returns
+    -------
+    rows, observed, measurements
+        The kept rows, sorted by id then frame, with the new ids; `observed` and
+        `measurements` in the same order.
+    """
+    if isinstance(min_unobserved, bool) or not isinstance(min_unobserved, (int, np.integer)):
+        raise TypeError(f"min_unobserved must be an int, got {type(min_unobserved).__name__}")
+    if min_unobserved < 1:
+        raise ValueError(f"min_unobserved is {min_unobserved}, expected an integer >= 1")
+    order = np.lexsort((rows[:, 0], rows[:, 1]))
+    a, obs, z = rows[order].copy(), observed[order], measurements[order]
+    n = len(a)
+    if n == 0:
+        return a, obs, z
+    i = np.arange(n)
+    start = np.maximum.accumulate(np.where(np.r_[True, a[1:, 1] != a[:-1, 1]], i, 0))
+    last_obs = np.maximum.accumulate(np.where(obs, i, -1))  # last observed row at or before i
+    prev_obs = np.r_[-1, last_obs[:-1]]  # ... strictly before i
+    run = i - prev_obs - 1  # unobserved rows just before row i
+    cut = obs & (prev_obs >= start) & (run >= min_unobserved)
+    if not cut.any():
+        return a, obs, z
+    drop = np.zeros(n, dtype=bool)
+    for c in np.flatnonzero(cut):
+        drop[c - run[c] : c] = True
+    count = np.cumsum(cut)  # cuts so far, over all tracks
+    piece = count - (count[start] - cut[start])  # cuts so far within the row's track
+    a[piece > 0, 1] = float(np.max(a[:, 1])) + count[piece > 0]
+    keep = ~drop
+    return a[keep], obs[keep], z[keep]
 
 
 def _add_hole_rows(

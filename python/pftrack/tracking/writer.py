@@ -86,11 +86,14 @@ class TrackWriter:
             elif self.coasting == "confirmed":
                 self._pending.setdefault(t.id, []).append(row)
 
-    def result(self, drop: Collection[int] = (), crossings: CrossingConfig | None = None) -> F64:
+    def result(self, drop: Collection[int] = (), crossings: CrossingConfig | None = None,
+               relink_coast: int | None = None) -> F64:  # fmt: skip
         """All rows written so far, (M, 10), sorted by frame then id.
 
         Linked and smoothed when the writer has a link config and a smoother; the tracks of
-        the ids in `drop` are left out first. With `crossings` (enabled), tracks swapped where
+        the ids in `drop` are left out first. With `relink_coast`, a track re-found after at
+        least that many coasted frames is cut there before linking
+        (:func:`~.offline.split_refound`). With `crossings` (enabled), tracks swapped where
         they crossed are exchanged back after linking (:func:`~.offline.repair_crossings`).
         """
         a = np.asarray(self.rows, np.float64).reshape(-1, 10)
@@ -105,4 +108,6 @@ class TrackWriter:
         z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
         if observed.any():
             z[observed] = [m for m in measured if m is not None]
-        return smooth_tracks(a, observed, self.smoother, self.link, z, crossings=crossings)
+        return smooth_tracks(
+            a, observed, self.smoother, self.link, z, crossings=crossings, relink_coast=relink_coast
+        )
