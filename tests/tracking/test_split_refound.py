@@ -164,11 +164,11 @@ def test_the_tracker_cuts_coasts_before_linking(monkeypatch):
 
     monkeypatch.setattr(offline, "split_refound", spy)
     on = coasting_run(TrackerConfig())
-    assert calls == [(6, 7)]  # 7 coasted rows, cut at the 6-frame default
+    assert calls == [(7, 7)]  # 7 coasted rows, cut at the 7-frame default
     assert len(np.unique(on[:, 1])) == 1  # the linker joined the two pieces back
     assert sorted(on[:, 0].astype(int)) == list(range(1, 41))  # the hole filled again
     calls.clear()
     off = coasting_run(TrackerConfig(lifecycle=LifecycleConfig(relink_coast=None)))
     assert calls == [] and len(np.unique(off[:, 1])) == 1
-    assert pftrack.Tracker().config.lifecycle.relink_coast == 6
-    assert pftrack.Tracker(frame_rate=10.0).config.lifecycle.relink_coast == 2
+    assert pftrack.Tracker().config.lifecycle.relink_coast == 7
+    assert pftrack.Tracker(frame_rate=10.0).config.lifecycle.relink_coast == 3

@@ -8,8 +8,8 @@ Time constants are given in seconds and turned into frames with ``frame_rate``
 (``round(seconds * frame_rate)``). The defaults are the command's frame-based defaults at the
 reference rate of 25 frames/s (:data:`REFERENCE_RATE`): ``max_coast=0.4`` s is 10 frames,
 ``prime=1.2`` s is 30 frames, the linking gap 1.2 s is 30 frames, the birth-score window
-2 s is 50 frames and the offline pass's cut after 0.24 s of coasting
-(``LifecycleConfig.relink_coast``) is 6 frames. ``pftrack track`` keeps its options in frames
+2 s is 50 frames and the offline pass's cut after 0.28 s of coasting
+(``LifecycleConfig.relink_coast``) is 7 frames. ``pftrack track`` keeps its options in frames
 and does not read the video's frame rate, so its results do not depend on container metadata;
 ``Tracker(frame_rate=25.0)`` with default options is exactly ``pftrack track`` with default
 options. Motion noise levels (particle and centre filters) stay per frame.
@@ -263,7 +263,7 @@ class Tracker:
             lifecycle=replace(
                 base.lifecycle,
                 max_coast=_frames(max_coast, frame_rate, "max_coast"),
-                relink_coast=max(1, _frames(0.24, frame_rate, "relink coast")),
+                relink_coast=max(1, _frames(0.28, frame_rate, "relink coast")),
                 min_score=float(min_conf),
                 birth_score=float(birth_score),
                 birth_quantile=birth_quantile,

@@ -158,7 +158,7 @@ class LifecycleConfig:
     max_coast: int = 10
     tentative_coast: int = 0
     coast_min_rho: float = 0.5
-    relink_coast: int | None = 6
+    relink_coast: int | None = 7
     nested_inside: float | None = 0.7
     nested_area: float = 1.5
     amodal_share: float | None = 0.8
