@@ -167,7 +167,7 @@ def override(config: TrackerConfig, setting: str) -> TrackerConfig:
         value = text.lower() == "true"
     elif isinstance(old, (int, float)) or old is None:
         try:
-            value = type(old)(text) if old is not None else float(text)
+            value = type(old)(text) if old is not None else _number(text)
         except ValueError:
             raise ValueError(f"--set {setting!r}: {text!r} is not a {type(old).__name__}") from None
     elif isinstance(old, str):
@@ -180,6 +180,14 @@ def override(config: TrackerConfig, setting: str) -> TrackerConfig:
         return checked
     changes: dict[str, Any] = {path[0]: new}
     return dataclasses.replace(config, **changes)
+
+
+def _number(text: str) -> int | float:
+    """An int for an integer literal (e.g. ``max_side=640``), else a float."""
+    try:
+        return int(text)
+    except ValueError:
+        return float(text)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -72,3 +72,8 @@ def test_main_rejects_a_bad_upscale(factor: str, capsys: pytest.CaptureFixture[s
     with pytest.raises(SystemExit) as e:
         ex.main(["--upscale", factor])
     assert e.value.code == 2 and "--upscale" in capsys.readouterr().err
+
+
+def test_override_of_an_unset_field_takes_an_int_or_a_float() -> None:
+    assert ex.override(TrackerConfig(), "max_side=640").max_side == 640
+    assert ex.override(TrackerConfig(), "pixel_diagonal=400.5").pixel_diagonal == 400.5
