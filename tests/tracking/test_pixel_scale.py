@@ -17,14 +17,14 @@ from pftrack.tracking import MultiObjectTracker, TrackerConfig
 
 
 @pytest.mark.parametrize(
-    ("height", "width", "scale"),
-    [(360, 480, 1.0), (480, 640, 1.0), (240, 320, 1.0), (960, 1280, 2.0), (1440, 1920, 3.0)],
+    ("width", "height", "scale"),
+    [(480, 360, 1.0), (640, 480, 1.0), (320, 240, 1.0), (1280, 960, 2.0), (1920, 1440, 3.0)],
 )
-def test_pixel_scale_is_the_diagonal_over_800_above_640x480(height, width, scale):
-    assert TrackerConfig().pixel_scale(height, width) == pytest.approx(scale)
-    assert TrackerConfig(pixel_diagonal=None).pixel_scale(height, width) == 1.0
-    assert TrackerConfig(pixel_diagonal=400).pixel_scale(height, width) == pytest.approx(
-        max(1.0, np.hypot(height, width) / 400)
+def test_pixel_scale_is_the_diagonal_over_800_above_640x480(width, height, scale):
+    assert TrackerConfig().pixel_scale(width, height) == pytest.approx(scale)
+    assert TrackerConfig(pixel_diagonal=None).pixel_scale(width, height) == 1.0
+    assert TrackerConfig(pixel_diagonal=400).pixel_scale(width, height) == pytest.approx(
+        max(1.0, np.hypot(width, height) / 400)
     )
 
 

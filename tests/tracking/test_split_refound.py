@@ -172,3 +172,12 @@ def test_the_tracker_cuts_coasts_before_linking(monkeypatch):
     assert calls == [] and len(np.unique(off[:, 1])) == 1
     assert pftrack.Tracker().config.lifecycle.relink_coast == 7
     assert pftrack.Tracker(frame_rate=10.0).config.lifecycle.relink_coast == 3
+
+
+def test_split_refound_refuses_ids_it_cannot_extend():
+    from pftrack.recovery.linking import MAX_ID
+
+    rows, obs = walker_rows(MAX_ID, range(1, 12), 100, 2.0)
+    obs[3:9] = False  # one cut would need the id MAX_ID + 1
+    with pytest.raises(ValueError, match="no room"):
+        split_refound(rows, obs, np.zeros((len(rows), 4)), 6)

@@ -407,8 +407,8 @@ class TrackerConfig:
             raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
         _in_unit_interval("TrackerConfig", reference_rate=self.reference_rate)
 
-    def pixel_scale(self, height: int, width: int) -> float:
-        """How much the pixel settings grow on a (working) frame of `height` x `width` pixels.
+    def pixel_scale(self, width: int, height: int) -> float:
+        """How much the pixel settings grow on a (working) frame of `width` x `height` pixels.
 
         ``max(1, diagonal / pixel_diagonal)``; 1 with ``pixel_diagonal=None``.
         """

@@ -27,7 +27,13 @@ from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, cv_predict, cv_update_where, rts_smooth
 from pftrack.recovery.fill import fill_rows
-from pftrack.recovery.linking import LinkConfig, check_rows, check_unique, link_tracklets
+from pftrack.recovery.linking import (
+    MAX_ID,
+    LinkConfig,
+    check_rows,
+    check_unique,
+    link_tracklets,
+)
 from pftrack.recovery.names import DEFAULT_METHOD
 
 __all__ = [
@@ -740,8 +746,11 @@ def split_refound(
     for c in np.flatnonzero(cut):
         drop[c - run[c] : c] = True
     count = np.cumsum(cut)  # cuts so far, over all tracks
-    piece = count - (count[start] - cut[start])  # cuts so far within the row's track
-    a[piece > 0, 1] = float(np.max(a[:, 1])) + count[piece > 0]
+    piece = count - count[start]  # cuts so far within the row's track (never at its first row)
+    top = float(np.max(a[:, 1]))
+    if top + count[-1] > MAX_ID:
+        raise ValueError(f"split_refound: ids reach {top:.0f}; no room for {count[-1]} new ids")
+    a[piece > 0, 1] = top + count[piece > 0]
     keep = ~drop
     return a[keep], obs[keep], z[keep]
 

@@ -285,7 +285,7 @@ class MultiObjectTracker:
             raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
         cfg = self._effective
         if cfg is None:
-            self.pixel_scale = self.config.pixel_scale(f.shape[0], f.shape[1])
+            self.pixel_scale = self.config.pixel_scale(f.shape[1], f.shape[0])
             cfg = self._effective = self.config.scaled_pixels(self.pixel_scale)
             self._joint.config = cfg
         self.frame_index += 1
