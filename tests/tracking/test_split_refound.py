@@ -88,9 +88,13 @@ def test_split_refound_bad_count(k, error):
         split_refound(np.zeros((0, 10)), np.zeros(0, bool), np.zeros((0, 4)), k)
 
 
-def test_relink_coast_is_checked():
+@pytest.mark.parametrize("value", [0, -1, 2.0, True, "7"])
+def test_relink_coast_is_checked(value):
     with pytest.raises(ValueError, match="relink_coast"):
-        LifecycleConfig(relink_coast=0)
+        LifecycleConfig(relink_coast=value)
+    rows, obs = walker_rows(1, range(1, 5), 100, 2.0)
+    with pytest.raises(ValueError, match="smooth_tracks: relink_coast"):
+        smooth_tracks(rows, obs, relink_coast=value)
     assert LifecycleConfig(relink_coast=None).relink_coast is None
 
 

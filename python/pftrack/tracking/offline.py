@@ -515,6 +515,14 @@ def smooth_tracks(
         z = np.array(measurements, dtype=np.float64)
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
+    if relink_coast is not None and (
+        isinstance(relink_coast, bool)
+        or not isinstance(relink_coast, (int, np.integer))
+        or relink_coast < 1
+    ):
+        raise ValueError(
+            f"smooth_tracks: relink_coast is {relink_coast!r}, expected None or an int >= 1"
+        )
     if link is not None and relink_coast is not None:
         a, obs, z = split_refound(a, obs, z, relink_coast)
     if link is not None:
