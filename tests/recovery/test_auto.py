@@ -431,3 +431,25 @@ def test_cli_explain_prints_the_blend_weights(tmp_path, capsys) -> None:  # type
     # the file holds the blended fill (written with 2 decimals)
     want, _ = fill_gaps(read_mot(src))
     np.testing.assert_allclose(read_mot(tmp_path / "o.txt"), want, rtol=0, atol=0.006)
+
+
+def test_bucket_quotas_follow_the_real_gaps_with_a_floor():
+    from pftrack.recovery.calibrate import MIN_VALIDATION_GAPS, bucket_quotas
+
+    q = bucket_quotas({1: 1, 4: 1, 16: 8, 32: 10}, 300)
+    assert q == {1: 15, 4: 15, 16: 120, 32: 150}  # 300 in proportion to 1 : 1 : 8 : 10
+    q = bucket_quotas({1: 1, 64: 999}, 300)
+    assert q[1] == MIN_VALIDATION_GAPS and q[64] == 300
+    assert bucket_quotas({8: 3}, 120) == {8: 120}
+    assert bucket_quotas({}, 300) == {}
+
+
+def test_calibration_cuts_its_gaps_where_the_real_ones_are():
+    rng = np.random.default_rng(5)
+    observed = [
+        np.column_stack([np.arange(200.0), np.cumsum(rng.normal(1.0, 0.3, 200)), np.zeros(200)])
+        for _ in range(6)
+    ]
+    cal = calibrate(observed, [1] + [12] * 9, max_gaps=100)
+    counts = {c.lengths: c.n_validation for c in cal.buckets}
+    assert counts == {(1, 1): 10, (9, 16): 90}  # 100 in proportion to 1 : 9

@@ -49,6 +49,7 @@ __all__ = [
     "BucketChoice",
     "Calibration",
     "bucket_of",
+    "bucket_quotas",
     "calibrate",
     "fixed_noise_model",
     "recover_auto",
@@ -286,6 +287,19 @@ def _flat(runs: Sequence[F64]) -> tuple[NDArray[np.int64], NDArray[np.int64], F6
     return sizes, offset, xy
 
 
+def bucket_quotas(real_gaps: dict[int, int], max_gaps: int) -> dict[int, int]:
+    """Artificial gaps to cut per bucket: `max_gaps` in proportion to its real gaps.
+
+    The validation budget goes where the file's errors will be made: a bucket holding most
+    of the gaps to fill gets most of the artificial ones. Every bucket gets at least
+    :data:`MIN_VALIDATION_GAPS` (rounded shares; so the total may pass `max_gaps` by a few).
+    """
+    total = sum(real_gaps.values())
+    if total <= 0:
+        return {b: MIN_VALIDATION_GAPS for b in real_gaps}
+    return {b: max(MIN_VALIDATION_GAPS, round(max_gaps * n / total)) for b, n in real_gaps.items()}
+
+
 def _artificial_gaps(
     runs: Sequence[F64],
     targets: Sequence[tuple[int, float] | tuple[int, float, int, int]],
@@ -425,7 +439,7 @@ def calibrate(
         noise = estimate_noise(whole) if whole else None
     if motion is None and "gdt-mix" in names and whole:
         motion = fit_motion(whole, noise)
-    per_bucket = max(MIN_VALIDATION_GAPS, max_gaps // len(by_bucket))
+    quota = bucket_quotas({b: len(v) for b, v in by_bucket.items()}, max_gaps)
     scored = [
         m
         for m in names
@@ -439,7 +453,7 @@ def calibrate(
     hood = Neighbourhood(runs) if any(m.endswith(NB_SUFFIX) for m in scored) else None
     for b in progress(sorted(by_bucket), desc="auto: calibrating", unit="bucket"):
         rng = np.random.default_rng([seed, b])
-        cut = _artificial_gaps(runs, targets[b], per_bucket, rng, flat)
+        cut = _artificial_gaps(runs, targets[b], quota[b], rng, flat)
         n_cut[b] = len(cut)
         if len(cut) < MIN_VALIDATION_GAPS:
             continue
