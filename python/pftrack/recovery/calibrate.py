@@ -62,7 +62,8 @@ __all__ = [
 CANDIDATES = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed", "linear-nb", "rts-nb")
 #: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
 LINEAR_MARGIN = 0.01
-#: At most this many artificial gaps per file, over all buckets.
+#: Artificial gaps per file, shared among the buckets in proportion to their real gaps
+#: (:func:`bucket_quotas`: at least MIN_VALIDATION_GAPS each, so a few more in all at most).
 MAX_CALIBRATION_GAPS = 300
 #: Fewer validation gaps than this in a bucket: the bucket takes the file's pooled choice.
 MIN_VALIDATION_GAPS = 5
@@ -383,7 +384,8 @@ def calibrate(
     candidates : sequence of str
         Methods scored (some of :data:`CANDIDATES`; ``"linear"`` is always added).
     max_gaps : int
-        At most this many artificial gaps in all (>= 1).
+        Artificial gaps in all (>= 1), shared among the buckets in proportion to their gaps
+        (:func:`bucket_quotas`; a bucket gets at least :data:`MIN_VALIDATION_GAPS`).
     seed : int
         Seed of the generator that places the artificial gaps.
     spans : sequence of float, optional
