@@ -142,6 +142,12 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "pixels for detection and tracking, boxes written in the frame's pixels; 0 tracks at "
         "the frame's own size",
     )  # fmt: skip
+    p.add_argument(
+        "--open-size", type=bounded_int(0, 255), default=0, metavar="PX",
+        help="built-in detector: side of the opening that cleans its mask, in pixels; 0 takes "
+        "it from the frame's rows (3 at 360 rows, 5 at 480): raise it when touching people "
+        "stay joined, lower it when thin people break apart",
+    )  # fmt: skip
     p.add_argument("--max-coast", type=bounded_int(0, 100_000), default=10, metavar="FRAMES",
                    help="frames a track survives on its particle filter alone (0.4 s at 25 "
                    "frames/s: pftrack.Tracker's max_coast is in seconds)")  # fmt: skip
@@ -201,6 +207,7 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         sampler=args.sampler,
         camera_motion=args.camera_motion,
         max_side=args.max_side or None,
+        open_size=args.open_size or None,
         refine=replace(base.refine, enabled=not args.no_refine),
         crossings=replace(base.crossings, enabled=args.crossings == "on"),
         lifecycle=replace(

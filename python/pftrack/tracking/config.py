@@ -28,6 +28,8 @@ SAMPLERS = ("sis", "mh", "rjmcmc")
 CAMERA_MOTION = ("auto", "on", "off")
 #: Bounds of :attr:`TrackerConfig.max_side` (pixels).
 MIN_SIDE, MAX_SIDE = 64, 100_000
+#: Largest :attr:`TrackerConfig.open_size` (pixels).
+MAX_OPEN_SIZE = 255
 #: Default of :attr:`TrackerConfig.pixel_diagonal`: a 640x480 frame's diagonal (pixels).
 PIXEL_DIAGONAL = REFERENCE_DIAGONAL
 
@@ -352,6 +354,13 @@ class TrackerConfig:
         tracker reports is scaled back to the frame's pixels (:class:`~pftrack.Tracker`; the
         inner :class:`~pftrack.tracking.MultiObjectTracker` works in the scaled pixels). None
         tracks at the frame's own size.
+    open_size : int or None
+        Side (pixels) of the built-in detector's opening element (``BlobConfig.open_size``).
+        None: from the frame's rows, ``max(3, round(rows / 120))`` made odd (3 at 360 rows, 5
+        at 480). The element that works follows the people's size and the video's noise, not
+        the rows: PETS09-S2L1 upscaled to 480 rows tracks best with 3 and TUD-Campus at its own
+        480 rows with 5 (docs/detection.md, "Known limit"), so set it for your footage when
+        the default blobs split thin people or join touching ones.
     pixel_diagonal : float or None
         The settings given in pixels (the particle filter's ``filter.model.sigma_xy`` and the
         offline linker's ``max_distance``) hold for frames whose diagonal is at most this
@@ -380,9 +389,18 @@ class TrackerConfig:
     camera: CameraConfig = field(default_factory=CameraConfig)
     crossings: CrossingConfig = field(default_factory=CrossingConfig)
     max_side: int | None = None
+    open_size: int | None = None
     pixel_diagonal: float | None = PIXEL_DIAGONAL
 
     def __post_init__(self) -> None:
+        if self.open_size is not None and (
+            isinstance(self.open_size, bool)
+            or not isinstance(self.open_size, (int, np.integer))
+            or not 1 <= self.open_size <= MAX_OPEN_SIZE
+        ):
+            raise ValueError(
+                f"open_size is {self.open_size!r}, expected None or an int in [1, {MAX_OPEN_SIZE}]"
+            )
         if self.pixel_diagonal is not None and not (
             isinstance(self.pixel_diagonal, (int, float, np.integer, np.floating))
             and not isinstance(self.pixel_diagonal, bool)

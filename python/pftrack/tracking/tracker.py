@@ -130,7 +130,9 @@ class MultiObjectTracker:
         histograms always share one layout.
         """
         if self._detector is None:
-            self._detector = make_detector(self.config.detector, hsv=self.config.binning)
+            size = self.config.open_size
+            extra = {} if size is None else {"open_size": size}
+            self._detector = make_detector(self.config.detector, hsv=self.config.binning, **extra)
         return self._detector
 
     def _detections(self, frame: NDArray[np.uint8], detections: ArrayLike | None,
