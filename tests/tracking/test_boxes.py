@@ -3,10 +3,17 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh, xywh_to_cxcywh
+from pftrack.boxes import (
+    cxcywh_to_xywh,
+    intersection_xywh,
+    iou_xywh,
+    iou_xywh_rows,
+    xywh_to_cxcywh,
+)
 
 
 def _iou_loop(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -46,6 +53,20 @@ def test_intersection_matches_loop(seed, n, m):
     got = intersection_xywh(a, b)
     assert got.shape == (n, m) and got.dtype == np.float64
     np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(0, 6))
+def test_iou_rows_is_the_diagonal_bit_for_bit(seed, n):
+    rng = np.random.default_rng(seed)
+    a = np.column_stack([rng.uniform(0, 50, (n, 2)), rng.uniform(0, 30, (n, 2))])
+    b = np.column_stack([rng.uniform(0, 50, (n, 2)), rng.uniform(0, 30, (n, 2))])
+    got = iou_xywh_rows(a, b)
+    assert got.shape == (n,) and got.dtype == np.float64
+    np.testing.assert_array_equal(got, np.diagonal(iou_xywh(a, b)))
+    np.testing.assert_allclose(got, np.diagonal(_iou_loop(a, b)), atol=1e-12)
+    with pytest.raises(ValueError, match="as many"):
+        iou_xywh_rows(a, np.zeros((n + 1, 4)))
 
 
 def test_iou_special_cases():

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
-from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, xywh_to_cxcywh
+from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh_rows, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, cv_predict, cv_update_where, rts_smooth
 from pftrack.recovery.fill import fill_rows
@@ -355,15 +355,7 @@ def _overlapping_pairs(a: F64, min_iou: float) -> F64:
         return np.zeros((0, 4))
     p = np.repeat(np.arange(n), later)
     q = p + 1 + np.arange(total) - np.repeat(np.cumsum(later) - later, later)
-    x0, y0 = a[:, 2], a[:, 3]
-    x1, y1 = x0 + a[:, 4], y0 + a[:, 5]
-    iw = np.clip(np.minimum(x1[p], x1[q]) - np.maximum(x0[p], x0[q]), 0.0, None)
-    ih = np.clip(np.minimum(y1[p], y1[q]) - np.maximum(y0[p], y0[q]), 0.0, None)
-    inter = iw * ih
-    area = a[:, 4] * a[:, 5]
-    union = area[p] + area[q] - inter
-    with np.errstate(invalid="ignore", divide="ignore"):
-        iou = np.where(union > 0, inter / union, 0.0)
+    iou = iou_xywh_rows(a[p, 2:6], a[q, 2:6])
     keep = iou >= min_iou
     return np.column_stack([fr[p[keep]], p[keep], q[keep], iou[keep]])
 
