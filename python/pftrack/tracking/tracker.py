@@ -347,28 +347,28 @@ class MultiObjectTracker:
         score_list, index_list = scores.tolist(), index.tolist()
         for ti, di in result.matches:
             tracks[ti].matched(score_list[di], index_list[di])
-        if not large.any():  # no merged blob possible: every matched track follows, at once
-            follow_tracks_motion([tracks[ti] for ti in pairs[:, 0]], b, cfg, smooth)
-            followed = result.matches
-        else:  # in turn: a blob is tested against the boxes of the tracks followed before it
-            start = 0  # followed[start:] have not moved yet: moved at once before a blob test
-            for (ti, di), big in zip(result.matches, large.tolist(), strict=True):
-                if big:
-                    if start < len(followed):
-                        moved = followed[start:]
-                        follow_tracks_motion(
-                            [tracks[k] for k, _ in moved], boxes[[d for _, d in moved]], cfg, smooth
-                        )
-                        start = len(followed)
-                    others = np.array([o.box for k, o in enumerate(tracks) if k != ti])
-                    if covers_another(boxes[di], others):
-                        continue  # a merged blob: the track keeps its own prediction
-                followed.append((ti, di))
-            if start < len(followed):
-                moved = followed[start:]
+        # A large detection is tested against the boxes of the tracks followed before it, so
+        # the tracks followed so far move (at once, in one call) before each such test; with
+        # no large detection, every matched track follows in one call.
+        moved = 0  # followed[:moved] have moved
+
+        def follow_pending() -> None:
+            nonlocal moved
+            if moved < len(followed):
+                pending = followed[moved:]
                 follow_tracks_motion(
-                    [tracks[k] for k, _ in moved], boxes[[d for _, d in moved]], cfg, smooth
+                    [tracks[k] for k, _ in pending], boxes[[d for _, d in pending]], cfg, smooth
                 )
+                moved = len(followed)
+
+        for (ti, di), big in zip(result.matches, large.tolist(), strict=True):
+            if big:
+                follow_pending()
+                others = np.array([o.box for k, o in enumerate(tracks) if k != ti])
+                if covers_another(boxes[di], others):
+                    continue  # a merged blob: the track keeps its own prediction
+            followed.append((ti, di))
+        follow_pending()
         if followed:
             dis = [di for _, di in followed]
             reseed_tracks([self.tracks[ti] for ti, _ in followed], boxes[dis], hists[dis], cfg)
