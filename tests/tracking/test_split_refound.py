@@ -185,3 +185,15 @@ def test_split_refound_refuses_ids_it_cannot_extend():
     obs[3:9] = False  # one cut would need the id MAX_ID + 1
     with pytest.raises(ValueError, match="no room"):
         split_refound(rows, obs, np.zeros((len(rows), 4)), 6)
+
+
+@pytest.mark.parametrize(
+    ("owner", "field"),
+    [("lifecycle", "max_coast"), ("lifecycle", "min_hits"), ("camera", "on_frames")],
+)
+def test_frame_counts_refuse_a_bool(owner, field):
+    from pftrack.tracking import CameraConfig
+
+    cls = LifecycleConfig if owner == "lifecycle" else CameraConfig
+    with pytest.raises(ValueError, match=field):
+        cls(**{field: True})

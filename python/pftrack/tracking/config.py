@@ -43,7 +43,7 @@ def _in_unit_interval(owner: str, **values: float) -> None:
 def _integers_at_least(owner: str, lo: int, config: object, *names: str) -> None:
     for name in names:
         v = getattr(config, name)
-        if not isinstance(v, (int, np.integer)) or v < lo:
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
             raise ValueError(f"{owner}: {name} is {v!r}, expected an integer >= {lo}")
 
 
@@ -169,10 +169,6 @@ class LifecycleConfig:
     def __post_init__(self) -> None:
         _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
         if self.relink_coast is not None:
-            if isinstance(self.relink_coast, bool):
-                raise ValueError(
-                    "LifecycleConfig: relink_coast is a bool, expected an int >= 1 or None"
-                )
             _integers_at_least("LifecycleConfig", 1, self, "relink_coast")
         _in_unit_interval("LifecycleConfig", coast_min_rho=self.coast_min_rho)
         if self.nested_inside is not None and not 0.0 < self.nested_inside <= 1.0:
