@@ -98,7 +98,11 @@ class Resized(Sequence[NDArray[np.uint8]]):
 
 
 def scaled(dets: dict[int, F64], factor: float) -> dict[int, F64]:
-    """Detections ``{frame: [left, top, w, h, score]}`` with their boxes times `factor`."""
+    """Detections ``{frame: [left, top, w, h, score]}`` with their boxes times `factor`.
+
+    For the synthetic scenes' detections; a ``det.txt`` is scaled as it is read
+    (`load_detections`' `scale`).
+    """
     return {f: np.column_stack([d[:, :4] * factor, d[:, 4:]]) for f, d in dets.items()}
 
 
@@ -246,7 +250,7 @@ def run_all(
         if not folder.is_dir():
             print(f"{src.name}: not found under {data}, skipped")
             continue
-        dets = scaled(load_detections(folder / "det.txt", src.scale), factor)
+        dets = load_detections(folder / "det.txt", src.scale * factor)
         video = FrameSource(folder / src.video)
         source = video if factor == 1 else Resized(video, factor)
         run = track_frames(source, detections=dets, config=config, rng=seed)
@@ -261,7 +265,7 @@ def run_all(
             raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
         size = round(info.width * factor), round(info.height * factor)
         frames = BlackFrames(info.length, *size)
-        dets = scaled(load_detections(folder / "det.txt"), factor)
+        dets = load_detections(folder / "det.txt", factor)
         run = track_frames(frames, detections=dets, config=config, rng=seed)
         report(name + " (black)", read_mot(folder / "gt.txt"), run.rows)
     for kind in BUSY_SCENES:
