@@ -110,7 +110,8 @@ def test_help_shows_defaults(capsys: pytest.CaptureFixture[str]) -> None:
         main(["track", "--help"])
     assert exc.value.code == 0
     text = " ".join(capsys.readouterr().out.split())
-    assert "(default: 100)" in text and "(default: paper)" in text
+    assert "(default: paper)" in text and "(default: 0)" in text
+    assert "200 with --detections, 100 with the built-in detector (default: 0)" in text
 
 
 def test_every_row_is_inside_the_scene(video: Path, scene: Scene, tmp_path: Path) -> None:

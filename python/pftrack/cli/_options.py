@@ -106,8 +106,11 @@ max_side.__name__ = "int"
 
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
     """The tracker's options, shared by ``track`` (and any command that tracks)."""
-    p.add_argument("--particles", type=bounded_int(1, 100_000), default=100, metavar="N",
-                   help="particles per object (1 to 100000)")  # fmt: skip
+    p.add_argument(
+        "--particles", type=bounded_int(0, 100_000), default=0, metavar="N",
+        help="particles per object (1 to 100000); 0: 200 with --detections, 100 with the "
+        "built-in detector",
+    )  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed, same tracks")
     p.add_argument(
         "--detector", choices=("paper", "mog2", "knn"), default="paper",
@@ -199,10 +202,11 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
 
     base = TrackerConfig()
     model = replace(base.filter.model, use_means=args.dynamics == "ar2-mean")
-    filt = replace(base.filter, n_particles=args.particles, model=model)
+    filt = replace(base.filter, n_particles=args.particles or base.filter.n_particles, model=model)
     return replace(
         base,
         filter=filt,
+        given_particles=None if args.particles else base.given_particles,
         detector=args.detector,
         sampler=args.sampler,
         camera_motion=args.camera_motion,

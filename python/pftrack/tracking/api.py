@@ -174,8 +174,9 @@ class Tracker:
         the foreground that shrinks their boxes).
     sampler : {"sis", "mh", "rjmcmc"}
         Particle filter per object (sis, the paper's; mh) or one joint RJ-MCMC chain.
-    particles : int
-        Particles per object.
+    particles : int or None
+        Particles per object. None: 200 for tracks born from given detections, 100 for the
+        built-in detector's (``TrackerConfig.given_particles``).
     dynamics : {"ar2", "ar2-mean"}
         AR(2) model per particle, or from the particle-set means.
     max_coast : float
@@ -226,7 +227,7 @@ class Tracker:
         seed: int | None = 0,
         detector: str = "paper",
         sampler: str = "sis",
-        particles: int = 100,
+        particles: int | None = None,
         dynamics: str = "ar2",
         max_coast: float = 0.4,
         min_conf: float = 0.0,
@@ -247,13 +248,19 @@ class Tracker:
             )
         if dynamics not in ("ar2", "ar2-mean"):
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
-        if not isinstance(particles, (int, np.integer)) or particles < 1:
-            raise ValueError(f"particles is {particles!r}, expected an integer >= 1")
+        if particles is not None and (
+            isinstance(particles, bool) or not isinstance(particles, (int, np.integer))
+            or particles < 1
+        ):  # fmt: skip
+            raise ValueError(f"particles is {particles!r}, expected None or an integer >= 1")
         base = TrackerConfig()
         model = replace(base.filter.model, use_means=dynamics == "ar2-mean")
         config = replace(
             base,
-            filter=replace(base.filter, n_particles=int(particles), model=model),
+            filter=replace(
+                base.filter, n_particles=int(particles or base.filter.n_particles), model=model
+            ),
+            given_particles=base.given_particles if particles is None else None,
             detector=detector,
             sampler=sampler,
             camera_motion=camera_motion,

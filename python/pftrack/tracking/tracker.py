@@ -385,12 +385,13 @@ class MultiObjectTracker:
         self.tracks = [t for t, a in zip(self.tracks, alive, strict=True) if a]
         confidences = detections is not None and self._scores_are_confidences
         birth_score = self._birth_threshold(scores) if confidences else -np.inf
+        born = cfg if detections is None else cfg.for_given()  # given_particles
         for di in result.unmatched_detections:
             if hists[di].sum() <= 0 or scores[di] < birth_score:
                 continue  # no foreground colour to build a reference from, or too unsure
             seed = int(self._rng.integers(2**63))
             t = LiveTrack(
-                next(self._ids), boxes[di].copy(), hists[di], cfg, seed, float(scores[di])
+                next(self._ids), boxes[di].copy(), hists[di], born, seed, float(scores[di])
             )
             t.det_index = int(index[di])
             t.cls = int(labels[di])
