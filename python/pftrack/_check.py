@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64
 
-__all__ = ["MAX_COORD", "MAX_FRAME", "real_array"]
+__all__ = ["MAX_COORD", "MAX_FRAME", "bgr_frame", "real_array"]
 
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
 #: wide, and splines and Kalman filters square and multiply them (1e308 overflows).
@@ -38,3 +38,24 @@ def real_array(values: ArrayLike, what: str) -> F64:
     if raw.dtype.kind not in "biuf":
         raise TypeError(f"{what} must hold real numbers, got dtype {raw.dtype}")
     return raw.astype(np.float64, copy=False)
+
+
+def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
+    """`frame` as a C-contiguous (H, W, 3) uint8 array with at least one pixel.
+
+    A view that is not packed row by row (``frame[..., ::-1]``, a Fortran-ordered array, a
+    crop of a larger image) is copied; a packed array is returned as it is (the same object).
+
+    Raises
+    ------
+    TypeError
+        Not a (H, W, 3) uint8 array (grey, BGRA, float frames; ``None``).
+    ValueError
+        A frame with no pixel (height or width 0).
+    """
+    f = np.asarray(frame)
+    if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
+        raise TypeError(f"{what} must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+    if f.shape[0] == 0 or f.shape[1] == 0:
+        raise ValueError(f"{what} is {f.shape[1]}x{f.shape[0]} pixels, expected at least 1x1")
+    return np.ascontiguousarray(f)

@@ -25,6 +25,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import bgr_frame
 from pftrack._typing import F64, RngLike
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
@@ -242,6 +243,14 @@ class Tracker:
         prime: float = 1.2,
         max_side: int | None = TrackerConfig.max_side,
     ) -> None:
+        if isinstance(frame_rate, bool) or not isinstance(
+            frame_rate, (int, float, np.integer, np.floating)
+        ):
+            raise TypeError(f"frame_rate must be a number, got {type(frame_rate).__name__}")
+        if seed is not None and (
+            isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0
+        ):
+            raise ValueError(f"seed is {seed!r}, expected None or an integer >= 0")
         if not (np.isfinite(frame_rate) and 0 < frame_rate <= MAX_FRAME_RATE):
             raise ValueError(
                 f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
@@ -426,7 +435,7 @@ class Tracker:
         """
         if self.frame_count:
             raise ValueError("prime() must come before the first update()")
-        self._tracker.prime([self.working_frame(np.asarray(f)) for f in frames])
+        self._tracker.prime([self.working_frame(bgr_frame(f, "prime frame")) for f in frames])
 
     def update(self, dets: ArrayLike | None, frame: ArrayLike) -> F64:
         """Track one frame.
@@ -448,9 +457,7 @@ class Tracker:
             track was matched to (a merged blob's row for each track inside it; -1 with
             ``dets=None``). Boxes are the track's filtered boxes, ``conf`` the detection's.
         """
-        f = np.asarray(frame)
-        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
-            raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        f = bgr_frame(frame)
         if self.config.max_side is not None:  # one scale for the whole run's rows
             if self._shape is None:
                 self._shape = f.shape

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import bgr_frame
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack.boxes import xywh_to_cxcywh
@@ -87,6 +88,7 @@ class MultiObjectTracker:
         # the configuration the tracks run with: `config` with its pixel settings scaled to the
         # first frame's size (TrackerConfig.pixel_diagonal), set by the first update
         self._effective: TrackerConfig | None = None
+        self._frame_shape: tuple[int, ...] = ()  # the first frame's, set with _effective
         self.pixel_scale = 1.0
         self._scores_are_confidences = True
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
@@ -282,11 +284,16 @@ class MultiObjectTracker:
             The tracks reported for this frame (confirmed, and coasting ones the colour filter
             still holds), with the index of the detection each was matched to.
         """
-        f = np.asarray(frame)
-        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
-            raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        f = bgr_frame(frame)
         cfg = self._effective
+        if cfg is not None and f.shape != self._frame_shape:
+            h, w = self._frame_shape[:2]
+            raise ValueError(
+                f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames {w}x{h} (one "
+                "size per run: a new tracker for a new video)"
+            )
         if cfg is None:
+            self._frame_shape = f.shape
             self.pixel_scale = self.config.pixel_scale(f.shape[1], f.shape[0])
             cfg = self._effective = self.config.scaled_pixels(self.pixel_scale)
             self._joint.config = cfg

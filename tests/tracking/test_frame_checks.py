@@ -1,0 +1,93 @@
+"""Frames and settings a user may pass by mistake: a clear error, or the frame used as it is.
+
+A frame with no pixel, a non-frame given to ``prime``, a frame of another size mid-run, a
+frame rate or seed of the wrong kind: one-line ``ValueError``/``TypeError`` naming the problem.
+A BGR view that is not packed (``frame[..., ::-1]``, Fortran order, a crop) tracks exactly as
+its packed copy.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack._check import bgr_frame
+from pftrack.synthetic import make_scene
+from pftrack.tracking import MultiObjectTracker, load_detections
+
+
+@pytest.fixture(scope="module")
+def frames() -> list[np.ndarray]:
+    return make_scene(n_frames=8, n_walkers=2, rng=4).frames
+
+
+@pytest.mark.parametrize("shape", [(0, 0, 3), (0, 5, 3), (5, 0, 3)])
+def test_a_frame_without_pixels_is_refused(shape):
+    empty = np.zeros(shape, np.uint8)
+    with pytest.raises(ValueError, match="expected at least 1x1"):
+        pftrack.Tracker().update(np.array([[1.0, 1.0, 5.0, 5.0, 0.9]]), empty)
+    with pytest.raises(ValueError, match="expected at least 1x1"):
+        pftrack.Tracker().update(None, empty)
+    with pytest.raises(ValueError, match="expected at least 1x1"):
+        MultiObjectTracker(rng=0).update(empty)
+
+
+@pytest.mark.parametrize("bad", [None, np.zeros((4, 4), np.uint8), np.zeros((4, 4, 3))])
+def test_prime_refuses_what_is_not_a_frame(bad):
+    with pytest.raises(TypeError, match="prime frame must be a"):
+        pftrack.Tracker().prime([bad])
+
+
+def test_unpacked_views_track_as_their_packed_copies(frames):
+    rgb = [np.ascontiguousarray(f[..., ::-1]) for f in frames]  # a user's RGB frames
+    views = [f[..., ::-1] for f in rgb]  # the usual RGB -> BGR view
+    fortran = [np.asfortranarray(f) for f in frames]
+    assert not views[0].flags.c_contiguous and not fortran[0].flags.c_contiguous
+    dets = np.array([[40.0, 40.0, 70.0, 120.0, 0.9]])
+
+    def run(seq):
+        t = pftrack.Tracker()
+        out = [t.update(dets, f) for f in seq] + [t.update(None, f) for f in seq]
+        return out, t.finalize()
+
+    base = run(frames)
+    for seq in (views, fortran):
+        got = run(seq)
+        assert all(np.array_equal(a, b) for a, b in zip(got[0], base[0], strict=True))
+        assert np.array_equal(got[1], base[1])
+
+
+def test_a_packed_frame_is_not_copied(frames):
+    assert bgr_frame(frames[0]) is frames[0]
+
+
+def test_a_new_size_mid_run_names_the_sizes(frames):
+    tracker = MultiObjectTracker(rng=0)
+    tracker.update(frames[0])
+    with pytest.raises(ValueError, match=r"frame is 100x50, the run's earlier frames 480x360"):
+        tracker.update(np.zeros((50, 100, 3), np.uint8))
+    assert "reset" not in str(pytest.raises(ValueError, tracker.update, frames[0][:50]).value)
+
+
+@pytest.mark.parametrize("rate", ["25", True, None, [25.0]])
+def test_frame_rate_of_the_wrong_kind(rate):
+    with pytest.raises(TypeError, match="frame_rate must be a number"):
+        pftrack.Tracker(frame_rate=rate)
+
+
+@pytest.mark.parametrize("seed", [-1, True, 2.5, "0"])
+def test_bad_seed(seed):
+    with pytest.raises(ValueError, match="seed is"):
+        pftrack.Tracker(seed=seed)
+
+
+def test_zero_size_detections_are_left_out_with_a_warning(tmp_path):
+    det = tmp_path / "det.txt"
+    det.write_text(
+        "1,-1,10,10,0,40,0.9,-1,-1,-1\n1,-1,20,20,10,30,0.8,-1,-1,-1\n2,-1,5,5,8,0,0.7\n"
+    )
+    with pytest.warns(UserWarning, match=r"2 detection\(s\) with zero width or height left out"):
+        dets = load_detections(det)
+    assert list(dets) == [1]
+    assert np.array_equal(dets[1], [[20.0, 20.0, 10.0, 30.0, 0.8]])
