@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from contextlib import closing, nullcontext
 from dataclasses import dataclass
@@ -69,12 +70,25 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
         `scale` is not a real number.
     ValueError
         `scale` outside [0.001, 1000], or a bad detection file.
+
+    Warns
+    -----
+    UserWarning
+        Boxes of zero width or height are left out (a box with no area cannot be tracked).
     """
     if isinstance(scale, bool) or not isinstance(scale, (int, float, np.integer, np.floating)):
         raise TypeError(f"detection scale must be a number, got {type(scale).__name__}")
     if not (1e-3 <= scale <= 1e3):
         raise ValueError(f"detection scale is {scale}, expected a number in [0.001, 1000]")
     rows = read_mot(path, what="detection file")
+    flat = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
+    if flat.any():
+        warnings.warn(
+            f"{path}: {int(flat.sum())} detection(s) with zero width or height left out (the "
+            f"first in frame {int(rows[np.argmax(flat), 0])})",
+            stacklevel=2,
+        )
+        rows = rows[~flat]
     return {
         f: np.column_stack([r[:, 2:6] * scale, r[:, 6]]) for f, r in group_by_frame(rows).items()
     }
