@@ -15,6 +15,7 @@ from pftrack.cli import main
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import group_by_frame, read_mot, write_mot
 from pftrack.io.video import FrameSource
+from pftrack.recovery.linking import LinkConfig
 from pftrack.synthetic import make_busy_scene, make_scene
 from pftrack.tracking import TrackerConfig, load_detections, track_frames
 from pftrack.tracking.api import check_boxes_xyxy, xywh_to_xyxy_dets
@@ -282,16 +283,18 @@ def test_options_and_frames():
         pftrack.Tracker(camera_motion="sometimes")
     with pytest.raises(TypeError, match="uint8"):
         pftrack.Tracker().update(None, np.zeros((30, 40, 3)))
-    # seconds become frames at the frame rate; 25/s gives the command's defaults
+    # the defaults are the command's frame counts at any rate; seconds given become frames
     from pftrack.cli import build_parser
     from pftrack.cli._options import tracker_config
 
     cli = tracker_config(build_parser().parse_args(["track", "v.avi", "--out", "t.txt"]))
-    assert pftrack.Tracker().config == TrackerConfig() == cli
-    assert pftrack.Tracker().prime_frames == 30
-    slow = pftrack.Tracker(frame_rate=7.0)
+    for rate in (7.0, 25.0, 50.0):
+        tracker = pftrack.Tracker(frame_rate=rate)
+        assert tracker.config == TrackerConfig() == cli
+        assert tracker.prime_frames == 30 and tracker._writer_args[3] == LinkConfig()
+    slow = pftrack.Tracker(frame_rate=7.0, max_coast=0.4, prime=1.2)
     assert slow.config.lifecycle.max_coast == 3 and slow.prime_frames == 8
-    assert pftrack.Tracker(frame_rate=50.0).config.lifecycle.birth_window == 100
+    assert pftrack.Tracker(frame_rate=50.0, max_coast=0.4).config.lifecycle.max_coast == 20
 
 
 def test_no_refine_takes_the_boxes_as_given(scene, tmp_path):

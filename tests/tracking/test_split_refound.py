@@ -175,7 +175,7 @@ def test_the_tracker_cuts_coasts_before_linking(monkeypatch):
     off = coasting_run(TrackerConfig(lifecycle=LifecycleConfig(relink_coast=None)))
     assert calls == [] and len(np.unique(off[:, 1])) == 1
     assert pftrack.Tracker().config.lifecycle.relink_coast == 7
-    assert pftrack.Tracker(frame_rate=10.0).config.lifecycle.relink_coast == 3
+    assert pftrack.Tracker(frame_rate=10.0).config.lifecycle.relink_coast == 7  # frames
 
 
 def test_split_refound_refuses_ids_it_cannot_extend():
