@@ -403,3 +403,15 @@ def test_track_fps_is_bounded(
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert err.startswith("pftrack track: error: argument --fps: expected a number in [0.01, 1000]")
+
+
+def test_an_empty_detection_file_is_said_to_be_empty(
+    video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "det.txt").write_text("")
+    argv = ["-q", "track", str(video), "--detections", str(tmp_path / "det.txt")]
+    assert main([*argv, "--out", str(tmp_path / "t.txt")]) == 0
+    # was: "no external detection was given", of a run that was given a detection file
+    assert capsys.readouterr().err == (
+        "pftrack track: warning: no track over 60 frames: the detections given held no box\n"
+    )
