@@ -405,6 +405,144 @@ def test_track_fps_is_bounded(
     assert err.startswith("pftrack track: error: argument --fps: expected a number in [0.01, 1000]")
 
 
+@pytest.mark.parametrize("command", ["track", "batch"])
+def test_crossings_without_the_smoother_are_refused(
+    command: str, video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: accepted, and the crossing repair (part of the smoothing pass) silently never ran
+    out = tmp_path / ("t.txt" if command == "track" else "out")
+    argv = [command, str(video), "--out", str(out), "--crossings", "on", "--no-smooth"]
+    assert main([*argv, "--workers", "0"] if command == "batch" else argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {command}: error: --crossings on needs the smoother, which --no-smooth turns "
+        "off; drop one of them\n"
+    )
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["track", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
+        (["demo", "--seed", "-1"], "argument --seed: expected an integer >= 0, got -1"),
+        (["batch", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
+        (
+            ["track", "V", "--out", "O", "--min-conf", "nan"],
+            "argument --min-conf: expected a finite number, got nan",
+        ),
+        (
+            ["track", "V", "--out", "O", "--birth-score", "nan"],
+            "argument --birth-score: expected a finite number, got nan",
+        ),
+        (
+            ["smooth", "T", "--out", "O", "--max-gap", "100000000"],
+            "argument --max-gap: expected an integer in [1, 100000], got 100000000",
+        ),
+        (
+            ["recover", "T", "--out", "O", "--max-gap", "100001"],
+            "argument --max-gap: expected an integer in [1, 100000], got 100001",
+        ),
+        (
+            ["track", "V", "--out", "O", "--det-scale", "1e-7"],
+            "argument --det-scale: expected a number in [0.001, 1000], got 1e-07",
+        ),
+        (
+            ["batch", "V", "--out", "O", "--det-scale", "1e-7"],
+            "argument --det-scale: expected a number in [0.001, 1000], got 1e-07",
+        ),
+        (
+            ["batch", "V", "--out", "O", "--det-scale", "nan"],
+            "argument --det-scale: expected a number in [0.001, 1000], got nan",
+        ),
+    ],
+)
+def test_bad_option_values_are_named_in_one_line(
+    argv: list[str],
+    message: str,
+    video: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Were: "expected non-negative integer", "LifecycleConfig: min_score is nan", a nan
+    birth score accepted, "LinkConfig.max_gap is ...", "fill_gaps: max_gap is ...", and
+    batch's --det-scale accepting what track refused (the sequence then failed)."""
+    tracks = _tracks(tmp_path / "t.txt")
+    names = {"V": str(video), "T": str(tracks), "O": str(tmp_path / "o.txt")}
+    argv = [names.get(a, a) for a in argv]
+    if argv[0] == "demo":
+        argv += ["--out-dir", str(tmp_path / "d")]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith(f"pftrack {argv[0]}: error: {message}"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
+
+
+@pytest.mark.parametrize(
+    ("detections", "message"),
+    [
+        ("nosuch.txt", "--detections nosuch.txt: no such file"),
+        ("folder", "--detections folder: is a folder, not a file"),
+    ],
+)
+def test_a_detection_file_that_is_not_a_file_is_named(
+    detections: str,
+    message: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # was "detection file not found: folder", and for a missing file beside a sequence folder
+    # (seqinfo.ini) "No such file or directory: nosuch.txt"
+    seq = tmp_path / "SEQ"
+    make_scene(n_frames=5, rng=0).write_images(seq / "img1")
+    (seq / "det").mkdir()
+    (seq / "det" / "det.txt").write_text("1,-1,10,10,20,40,1\n")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=960\n")
+    (tmp_path / "folder").mkdir()
+    monkeypatch.chdir(tmp_path)
+    assert main(["track", "SEQ", "--detections", detections, "--out", "t.txt"]) == 2
+    assert capsys.readouterr().err == f"pftrack track: error: {message}\n"
+    assert not (tmp_path / "t.txt").exists()
+
+
+def test_option_bounds_stated_for_help_are_the_librarys(tmp_path: Path) -> None:
+    from pftrack.cli import batch
+    from pftrack.cli._options import DET_SCALE_RANGE
+    from pftrack.recovery import LinkConfig, fill_gaps
+    from pftrack.recovery.fill import MAX_GAP_LIMIT
+    from pftrack.tracking import load_detections
+
+    assert batch.MAX_GAP == MAX_GAP_LIMIT
+    LinkConfig(max_gap=batch.MAX_GAP)
+    with pytest.raises(ValueError, match="max_gap"):
+        LinkConfig(max_gap=batch.MAX_GAP + 1)
+    with pytest.raises(ValueError, match="max_gap"):
+        fill_gaps(np.zeros((0, 10)), "linear", batch.MAX_GAP + 1)
+    lo, hi = DET_SCALE_RANGE
+    empty = tmp_path / "det.txt"
+    empty.write_text("")
+    for inside in (lo, hi):
+        load_detections(empty, inside)
+    for outside in (lo * 0.999, hi * 1.001):
+        with pytest.raises(ValueError, match="detection scale"):
+            load_detections(empty, outside)
+
+
+def test_help_shows_the_bounds_of_det_scale_and_max_gap(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    for command, option, bound in (("track", "--det-scale S", "(0.001 to 1000"),
+                                   ("batch", "--det-scale S", "(0.001 to 1000)"),
+                                   ("smooth", "--max-gap FRAMES", "(1 to 100000;"),
+                                   ("recover", "--max-gap FRAMES", "(1 to 100000;")):  # fmt: skip
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = " ".join(capsys.readouterr().out.split())
+        assert bound in text.split(f" {option} ")[-1].split(" --")[0], (command, option)
+
+
 def test_an_empty_detection_file_is_said_to_be_empty(
     video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

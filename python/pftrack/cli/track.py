@@ -10,9 +10,11 @@ from pathlib import Path
 from typing import IO, Any
 
 from pftrack.cli._options import (
+    DET_SCALE_RANGE,
     add_command,
     add_tracker_options,
     bounded_float,
+    det_scale,
     tracker_config,
 )
 
@@ -48,10 +50,11 @@ def add_parser(sub: Any) -> None:
         "sequence's det/det.txt (default: the built-in detector)",
     )  # fmt: skip
     p.add_argument(
-        "--det-scale", type=bounded_float(1e-3, 1e3), metavar="S",
-        help="multiply detection boxes by S to reach the video's pixels (0.625 for PETS09 "
-        "det.txt on its 480x360 video) (default: for the sequence's own detections, the frame "
-        "width over seqinfo.ini's imWidth; else 1)",
+        "--det-scale", type=det_scale, default="auto", metavar="S",
+        help="multiply detection boxes by S to reach the video's pixels "
+        f"({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}; 0.625 for PETS09 det.txt on its "
+        "480x360 video); auto: for the sequence's own detections, the frame width over "
+        "seqinfo.ini's imWidth, else 1",
     )  # fmt: skip
     p.add_argument(
         "--fps", type=bounded_float(0.01, 1000.0), metavar="FPS",
@@ -126,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from pftrack.cli._options import opencv_single_threaded
+    from pftrack.cli._options import check_input_file, opencv_single_threaded
     from pftrack.io.atomic import check_output, staged_outputs
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, is_live_source
@@ -138,7 +141,10 @@ def run(args: argparse.Namespace) -> int:
     opencv_single_threaded()
 
     live = is_live_source(args.source)
+    config = tracker_config(args)  # contradictory options refused before any work
     given = [d for d in (args.detections,) if d and d != "auto"]
+    for det in given:
+        check_input_file(det, what="--detections")
     inputs = tuple([args.source] if not live else []) + tuple(given)
     check_output(args.out, what="--out", inputs=inputs)
     if args.render:
@@ -176,7 +182,7 @@ def run(args: argparse.Namespace) -> int:
                 result = track_frames(
                     source,
                     detections=dets,
-                    config=tracker_config(args),
+                    config=config,
                     rng=args.seed,
                     fill=args.fill,
                     bootstrap=args.bootstrap,
