@@ -82,7 +82,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _one_line_warning(args.command)
-            return int(args.func(args))
+            status = int(args.func(args))
+        if sys.stdout is not None:  # a buffered stdout's last lines: a closed pipe fails here
+            sys.stdout.flush()
+        return status
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
