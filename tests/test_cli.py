@@ -543,6 +543,55 @@ def test_help_shows_the_bounds_of_det_scale_and_max_gap(
         assert bound in text.split(f" {option} ")[-1].split(" --")[0], (command, option)
 
 
+@pytest.mark.parametrize(
+    "source", ["empty.txt", "0", "rtsp://127.0.0.1:1/x", "http://127.0.0.1:1/x.mp4"]
+)
+def test_an_unreadable_source_is_one_line_without_opencv_logs(source: str, tmp_path: Path) -> None:
+    # was: OpenCV's "[ WARN:0@0.030] global cap.cpp:212 open VIDEOIO(FFMPEG) ..." and FFmpeg's
+    # "[tcp @ 0x...] Connection to tcp://127.0.0.1:1 failed" before pftrack's own error
+    import subprocess
+    import sys
+
+    if source == "0" and Path("/dev/video0").exists():
+        pytest.skip("this machine has a camera 0: it would be tracked")
+    (tmp_path / "empty.txt").write_bytes(b"")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("OPENCV_")}
+    run = subprocess.run([sys.executable, "-m", "pftrack", "-q", "track", source, "--out", "o.txt"],
+                         cwd=tmp_path, env=env, capture_output=True, text=True, check=False,
+                         timeout=120)  # fmt: skip
+    assert run.returncode == 2
+    assert run.stderr.startswith("pftrack track: error: cannot "), run.stderr
+    assert run.stderr.count("\n") == 1, run.stderr
+
+
+def test_main_silences_opencv_only_while_a_command_runs(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    import cv2
+
+    import pftrack.cli.evaluate as evaluate
+
+    for name in ("OPENCV_LOG_LEVEL", "OPENCV_FFMPEG_LOGLEVEL"):
+        monkeypatch.delenv(name, raising=False)
+    log = cv2.utils.logging
+    level = log.getLogLevel()
+    assert level != log.LOG_LEVEL_SILENT
+    seen: dict[str, object] = {}
+
+    def spy(args: object) -> int:
+        seen.update(level=log.getLogLevel(), env=os.environ.get("OPENCV_FFMPEG_LOGLEVEL"))
+        return 0
+
+    monkeypatch.setattr(evaluate, "run", spy)
+    assert main(["eval", "--gt", "g.txt", "--res", "r.txt"]) == 0
+    assert seen == {"level": log.LOG_LEVEL_SILENT, "env": "-8"}
+    # a caller's own process gets its settings back
+    assert log.getLogLevel() == level and "OPENCV_FFMPEG_LOGLEVEL" not in os.environ
+    monkeypatch.setenv("OPENCV_LOG_LEVEL", "DEBUG")  # the user's choice is kept
+    assert main(["eval", "--gt", "g.txt", "--res", "r.txt"]) == 0
+    assert seen["level"] == level
+
+
 def test_an_empty_detection_file_is_said_to_be_empty(
     video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
