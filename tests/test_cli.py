@@ -592,6 +592,33 @@ def test_main_silences_opencv_only_while_a_command_runs(
     assert seen["level"] == level
 
 
+@pytest.mark.parametrize("command", ["batch", "smooth"])
+def test_a_batch_without_dask_says_how_to_install_it(
+    command: str,
+    video: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import sys
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if not installed
+    inputs = [str(video)] if command == "batch" else [
+        str(_tracks(tmp_path / "a.txt")), str(_tracks(tmp_path / "b.txt"))
+    ]  # fmt: skip
+    out = tmp_path / "out"
+    assert main([command, *inputs, "--out", str(out), "--workers", "1"]) == 2
+    err = capsys.readouterr().err
+    # was: "pftrack batch: error: No module named 'distributed'", the hint never reached
+    assert err.startswith(f"pftrack {command}: error: batches run on Dask, which cannot be "
+                          "imported (")  # fmt: skip
+    assert err.endswith(
+        "pip install 'pftrack[dask]' (dask[distributed]); or --workers 0: in this process, "
+        "without Dask\n"
+    )
+    assert err.count("\n") == 1 and list(out.iterdir()) == []  # nothing run, nothing written
+
+
 def test_an_empty_detection_file_is_said_to_be_empty(
     video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

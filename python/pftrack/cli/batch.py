@@ -104,6 +104,10 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
+#: The modules of the ``pftrack[dask]`` extra.
+_DASK = ("dask", "distributed")
+
+
 def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
     """Run the batch; print its table, or what stopped it; return the exit status."""
     try:
@@ -116,7 +120,8 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
         )
         return EXIT_INTERRUPTED
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
-        print(f"pftrack {command}: error: {exc}", file=sys.stderr)
+        hint = "; or --workers 0: in this process, without Dask" if exc.name in _DASK else ""
+        print(f"pftrack {command}: error: {exc}{hint}", file=sys.stderr)
         return 2
     for e in summary.entries if explain else ():
         if e.get("explain"):
