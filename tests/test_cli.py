@@ -403,3 +403,229 @@ def test_track_fps_is_bounded(
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert err.startswith("pftrack track: error: argument --fps: expected a number in [0.01, 1000]")
+
+
+@pytest.mark.parametrize("command", ["track", "batch"])
+def test_crossings_without_the_smoother_are_refused(
+    command: str, video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: accepted, and the crossing repair (part of the smoothing pass) silently never ran
+    out = tmp_path / ("t.txt" if command == "track" else "out")
+    argv = [command, str(video), "--out", str(out), "--crossings", "on", "--no-smooth"]
+    assert main([*argv, "--workers", "0"] if command == "batch" else argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {command}: error: --crossings on needs the smoother, which --no-smooth turns "
+        "off; drop one of them\n"
+    )
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["track", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
+        (["demo", "--seed", "-1"], "argument --seed: expected an integer >= 0, got -1"),
+        (["batch", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
+        (
+            ["track", "V", "--out", "O", "--min-conf", "nan"],
+            "argument --min-conf: expected a finite number, got nan",
+        ),
+        (
+            ["track", "V", "--out", "O", "--birth-score", "nan"],
+            "argument --birth-score: expected a finite number, got nan",
+        ),
+        (
+            ["smooth", "T", "--out", "O", "--max-gap", "100000000"],
+            "argument --max-gap: expected an integer in [1, 100000], got 100000000",
+        ),
+        (
+            ["recover", "T", "--out", "O", "--max-gap", "100001"],
+            "argument --max-gap: expected an integer in [1, 100000], got 100001",
+        ),
+        (
+            ["track", "V", "--out", "O", "--det-scale", "1e-7"],
+            "argument --det-scale: expected a number in [0.001, 1000], got 1e-07",
+        ),
+        (
+            ["batch", "V", "--out", "O", "--det-scale", "1e-7"],
+            "argument --det-scale: expected a number in [0.001, 1000], got 1e-07",
+        ),
+        (
+            ["batch", "V", "--out", "O", "--det-scale", "nan"],
+            "argument --det-scale: expected a number in [0.001, 1000], got nan",
+        ),
+    ],
+)
+def test_bad_option_values_are_named_in_one_line(
+    argv: list[str],
+    message: str,
+    video: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Were: "expected non-negative integer", "LifecycleConfig: min_score is nan", a nan
+    birth score accepted, "LinkConfig.max_gap is ...", "fill_gaps: max_gap is ...", and
+    batch's --det-scale accepting what track refused (the sequence then failed)."""
+    tracks = _tracks(tmp_path / "t.txt")
+    names = {"V": str(video), "T": str(tracks), "O": str(tmp_path / "o.txt")}
+    argv = [names.get(a, a) for a in argv]
+    if argv[0] == "demo":
+        argv += ["--out-dir", str(tmp_path / "d")]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith(f"pftrack {argv[0]}: error: {message}"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
+
+
+@pytest.mark.parametrize(
+    ("detections", "message"),
+    [
+        ("nosuch.txt", "--detections nosuch.txt: no such file"),
+        ("folder", "--detections folder: is a folder, not a file"),
+    ],
+)
+def test_a_detection_file_that_is_not_a_file_is_named(
+    detections: str,
+    message: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # was "detection file not found: folder", and for a missing file beside a sequence folder
+    # (seqinfo.ini) "No such file or directory: nosuch.txt"
+    seq = tmp_path / "SEQ"
+    make_scene(n_frames=5, rng=0).write_images(seq / "img1")
+    (seq / "det").mkdir()
+    (seq / "det" / "det.txt").write_text("1,-1,10,10,20,40,1\n")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=960\n")
+    (tmp_path / "folder").mkdir()
+    monkeypatch.chdir(tmp_path)
+    assert main(["track", "SEQ", "--detections", detections, "--out", "t.txt"]) == 2
+    assert capsys.readouterr().err == f"pftrack track: error: {message}\n"
+    assert not (tmp_path / "t.txt").exists()
+
+
+def test_option_bounds_stated_for_help_are_the_librarys(tmp_path: Path) -> None:
+    from pftrack.cli import batch
+    from pftrack.cli._options import DET_SCALE_RANGE
+    from pftrack.recovery import LinkConfig, fill_gaps
+    from pftrack.recovery.fill import MAX_GAP_LIMIT
+    from pftrack.tracking import load_detections
+
+    assert batch.MAX_GAP == MAX_GAP_LIMIT
+    LinkConfig(max_gap=batch.MAX_GAP)
+    with pytest.raises(ValueError, match="max_gap"):
+        LinkConfig(max_gap=batch.MAX_GAP + 1)
+    with pytest.raises(ValueError, match="max_gap"):
+        fill_gaps(np.zeros((0, 10)), "linear", batch.MAX_GAP + 1)
+    lo, hi = DET_SCALE_RANGE
+    empty = tmp_path / "det.txt"
+    empty.write_text("")
+    for inside in (lo, hi):
+        load_detections(empty, inside)
+    for outside in (lo * 0.999, hi * 1.001):
+        with pytest.raises(ValueError, match="detection scale"):
+            load_detections(empty, outside)
+
+
+def test_help_shows_the_bounds_of_det_scale_and_max_gap(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    for command, option, bound in (("track", "--det-scale S", "(0.001 to 1000"),
+                                   ("batch", "--det-scale S", "(0.001 to 1000)"),
+                                   ("smooth", "--max-gap FRAMES", "(1 to 100000;"),
+                                   ("recover", "--max-gap FRAMES", "(1 to 100000;")):  # fmt: skip
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = " ".join(capsys.readouterr().out.split())
+        assert bound in text.split(f" {option} ")[-1].split(" --")[0], (command, option)
+
+
+@pytest.mark.parametrize(
+    "source", ["empty.txt", "0", "rtsp://127.0.0.1:1/x", "http://127.0.0.1:1/x.mp4"]
+)
+def test_an_unreadable_source_is_one_line_without_opencv_logs(source: str, tmp_path: Path) -> None:
+    # was: OpenCV's "[ WARN:0@0.030] global cap.cpp:212 open VIDEOIO(FFMPEG) ..." and FFmpeg's
+    # "[tcp @ 0x...] Connection to tcp://127.0.0.1:1 failed" before pftrack's own error
+    import subprocess
+    import sys
+
+    if source == "0" and Path("/dev/video0").exists():
+        pytest.skip("this machine has a camera 0: it would be tracked")
+    (tmp_path / "empty.txt").write_bytes(b"")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("OPENCV_")}
+    run = subprocess.run([sys.executable, "-m", "pftrack", "-q", "track", source, "--out", "o.txt"],
+                         cwd=tmp_path, env=env, capture_output=True, text=True, check=False,
+                         timeout=120)  # fmt: skip
+    assert run.returncode == 2
+    assert run.stderr.startswith("pftrack track: error: cannot "), run.stderr
+    assert run.stderr.count("\n") == 1, run.stderr
+
+
+def test_main_silences_opencv_only_while_a_command_runs(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    import cv2
+
+    import pftrack.cli.evaluate as evaluate
+
+    for name in ("OPENCV_LOG_LEVEL", "OPENCV_FFMPEG_LOGLEVEL"):
+        monkeypatch.delenv(name, raising=False)
+    log = cv2.utils.logging
+    level = log.getLogLevel()
+    assert level != log.LOG_LEVEL_SILENT
+    seen: dict[str, object] = {}
+
+    def spy(args: object) -> int:
+        seen.update(level=log.getLogLevel(), env=os.environ.get("OPENCV_FFMPEG_LOGLEVEL"))
+        return 0
+
+    monkeypatch.setattr(evaluate, "run", spy)
+    assert main(["eval", "--gt", "g.txt", "--res", "r.txt"]) == 0
+    assert seen == {"level": log.LOG_LEVEL_SILENT, "env": "-8"}
+    # a caller's own process gets its settings back
+    assert log.getLogLevel() == level and "OPENCV_FFMPEG_LOGLEVEL" not in os.environ
+    monkeypatch.setenv("OPENCV_LOG_LEVEL", "DEBUG")  # the user's choice is kept
+    assert main(["eval", "--gt", "g.txt", "--res", "r.txt"]) == 0
+    assert seen["level"] == level
+
+
+@pytest.mark.parametrize("command", ["batch", "smooth"])
+def test_a_batch_without_dask_says_how_to_install_it(
+    command: str,
+    video: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import sys
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if not installed
+    inputs = [str(video)] if command == "batch" else [
+        str(_tracks(tmp_path / "a.txt")), str(_tracks(tmp_path / "b.txt"))
+    ]  # fmt: skip
+    out = tmp_path / "out"
+    assert main([command, *inputs, "--out", str(out), "--workers", "1"]) == 2
+    err = capsys.readouterr().err
+    # was: "pftrack batch: error: No module named 'distributed'", the hint never reached
+    assert err.startswith(f"pftrack {command}: error: batches run on Dask, which cannot be "
+                          "imported (")  # fmt: skip
+    assert err.endswith(
+        "pip install 'pftrack[dask]' (dask[distributed]); or --workers 0: in this process, "
+        "without Dask\n"
+    )
+    assert err.count("\n") == 1 and list(out.iterdir()) == []  # nothing run, nothing written
+
+
+def test_an_empty_detection_file_is_said_to_be_empty(
+    video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "det.txt").write_text("")
+    argv = ["-q", "track", str(video), "--detections", str(tmp_path / "det.txt")]
+    assert main([*argv, "--out", str(tmp_path / "t.txt")]) == 0
+    # was: "no external detection was given", of a run that was given a detection file
+    assert capsys.readouterr().err == (
+        "pftrack track: warning: no track over 60 frames: the detections given held no box\n"
+    )

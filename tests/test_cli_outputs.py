@@ -255,3 +255,113 @@ def test_failed_smooth_and_recover_leave_the_old_output(
         assert capsys.readouterr().err.count("\n") == 1
         assert out.read_text() == "good\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.txt", "out.txt"]
+
+
+def _walkers(path: Path, seed: int = 4) -> Path:
+    """Ground truth of 15 walkers over 150 frames of a 768x576 scene, with its seqinfo.ini."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for tid in range(1, 16):
+        xy = rng.uniform(100, 600, 2) + np.cumsum(
+            rng.normal(0, 0.5, (150, 2)) + rng.uniform(-2, 2, 2), axis=0
+        )
+        r = np.full((150, 10), -1.0)
+        r[:, 0], r[:, 1], r[:, 2:4], r[:, 4:6], r[:, 6] = np.arange(1, 151), tid, xy - 5, 10, 1
+        rows.append(r)
+    (path / "gt").mkdir(parents=True)
+    (path / "seqinfo.ini").write_text("[Sequence]\nimWidth=768\nimHeight=576\n")
+    write_mot(path / "gt" / "gt.txt", np.vstack(rows))
+    return path / "gt" / "gt.txt"
+
+
+# command line (VIDEO, GT, TRACKS, A and B: inputs) and outputs, run with an unread stdout
+CLOSED_STDOUT = {
+    "track": ("track VIDEO --out t.txt --render v.mp4 --plot p.png --particles 20",
+              ["t.txt", "v.mp4", "p.png"]),
+    "eval": ("eval --gt GT --res TRACKS --json s.json --csv s.csv --image-size 480 360",
+             ["s.json", "s.csv"]),
+    "experiment gaps --figure": (
+        "experiment gaps --gt A --figure f.png --methods linear --repeat 1 --max-positions 2",
+        ["f.png"],
+    ),
+    "experiment gaps --json": ("experiment gaps --gt A B --json e.json --methods linear",
+                               ["e.json"]),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("buffered", [False, True], ids=["unbuffered", "buffered"])
+@pytest.mark.parametrize("command", list(CLOSED_STDOUT))
+def test_a_closed_stdout_loses_no_output(
+    command: str, buffered: bool, inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """``pftrack track ... | true``: was exit 1 with no output (the summary line was printed
+    before the files were committed); buffered, a traceback-like "Exception ignored" at exit."""
+    import subprocess
+    import sys
+
+    line, outputs = CLOSED_STDOUT[command]
+    names = {"VIDEO": inputs["video"], "GT": inputs["gt"], "TRACKS": inputs["tracks"]}
+    if command.startswith("experiment"):
+        names.update(A=_walkers(tmp_path / "A"), B=_walkers(tmp_path / "B", 5))
+    argv = [str(names.get(a, a)) for a in line.split()]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    if not buffered:
+        env["PYTHONUNBUFFERED"] = "1"
+    read, write = os.pipe()
+    os.close(read)  # every write to stdout fails with EPIPE, as after `| true` or `| head -0`
+    try:
+        run = subprocess.run([sys.executable, "-m", "pftrack", "-q", *argv], cwd=tmp_path,
+                             stdout=write, stderr=subprocess.PIPE, text=True, env=env,
+                             check=False, timeout=300)  # fmt: skip
+    finally:
+        os.close(write)
+    assert run.returncode == 1 and run.stderr == "", run.stderr  # as `recover ... | head`
+    for name in outputs:
+        assert (tmp_path / name).stat().st_size > 0, name
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [("--out", "--render"), ("--out", "--plot")],
+)
+@pytest.mark.parametrize("spelling", ["same", "dot", "link"])
+def test_two_outputs_on_one_file_are_refused_before_any_work(
+    first: str,
+    second: str,
+    spelling: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Was: exit 0, one output written over the other (the video lost, a CSV left)."""
+    import pftrack.tracking as tracking
+
+    def no_work(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("work started before the outputs were checked")
+
+    monkeypatch.setattr(tracking, "track_frames", no_work)
+    monkeypatch.chdir(tmp_path)
+    name = "same.mp4" if second == "--render" else "same.png"
+    (tmp_path / name).write_bytes(b"an earlier result\n")
+    other = {"same": name, "dot": f"./{name}", "link": "alias" + Path(name).suffix}[spelling]
+    if spelling == "link":
+        (tmp_path / other).symlink_to(name)
+    before = _snapshot(tmp_path)
+    argv = ["track", str(inputs["video"]), first, name, second, other, "--particles", "20"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"pftrack track: error: {first} {name} and {second} {Path(other)} are the same file; "
+        "give each output its own\n"
+    )
+    assert _snapshot(tmp_path) == before
+
+
+def test_check_distinct_names_both_outputs(tmp_path: Path) -> None:
+    from pftrack.io.atomic import check_distinct
+
+    check_distinct({"--json": tmp_path / "a.json", "--csv": tmp_path / "a.csv", "--x": None})
+    with pytest.raises(ValueError, match=r"^--a .*x.txt and --c .*x.txt are the same file"):
+        check_distinct({"--a": tmp_path / "x.txt", "--b": None, "--c": tmp_path / "." / "x.txt"})

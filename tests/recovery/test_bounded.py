@@ -170,8 +170,12 @@ def test_cli_smooth_and_recover_bounded_and_refusing(tmp_path, capsys) -> None: 
             "1..2147483647" in err
         )  # the reader names the line
     assert not (tmp_path / "o.txt").exists()
-    assert main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--max-gap", "200000"]) == 2
-    assert "max_gap is 200000" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:  # refused by the option's own bound, named
+        main(["recover", str(src), "--out", str(tmp_path / "o.txt"), "--max-gap", "200000"])
+    assert exc.value.code == 2
+    assert "argument --max-gap: expected an integer in [1, 100000], got 200000" in (
+        capsys.readouterr().err
+    )
 
 
 def test_sweep_refuses_huge_grids_and_non_finite_sizes() -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import re
 import warnings
 
 import cv2
@@ -450,3 +451,23 @@ def test_amodal_settings_are_checked(changes, match):
 def test_nested_settings_are_checked(changes, match):
     with pytest.raises(ValueError, match=match):
         _lifecycle(**changes)
+
+
+@pytest.mark.parametrize(
+    ("where", "hint"),
+    [
+        ("no box", "the detections given held no box"),
+        ("outside", r"no detection lay inside the frame \(wrong coordinate scale\?\)"),
+    ],
+)
+def test_no_track_warning_says_what_the_detections_were(scene, where, hint):
+    # was "no external detection was given" for both: detections were given
+    w = scene.frames[0].shape[1]
+    far = np.array([[w + 10.0, 10.0, w + 30.0, 50.0, 1.0]])
+    dets = [np.zeros((0, 5)) if where == "no box" else far] * len(scene.frames)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _, rows = run_loop(pftrack.Tracker(seed=0), scene.frames, dets)
+    assert len(rows) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert len(said) == 1 and re.fullmatch(f"no track over 40 frames: {hint}", said[0]), said

@@ -221,6 +221,19 @@ def _clean(value: Any) -> Any:
     return value
 
 
+def _require_dask() -> None:
+    """Import Dask distributed, or raise an ImportError that says how to install it."""
+    try:
+        import dask  # noqa: F401
+        import distributed  # noqa: F401
+    except ImportError as exc:  # only without the extra
+        raise ImportError(
+            f"batches run on Dask, which cannot be imported ({exc}): pip install "
+            "'pftrack[dask]' (dask[distributed])",
+            name=exc.name,
+        ) from exc
+
+
 @contextlib.contextmanager
 def dask_client(
     client: Client | None = None, scheduler: str | None = None, n_workers: int | None = None
@@ -238,13 +251,10 @@ def dask_client(
         Workers of the new ``LocalCluster`` (default: one per core), each a process with one
         thread.
     """
-    try:
-        import dask
-        from distributed import Client, LocalCluster
-    except ImportError as exc:  # pragma: no cover - only without the extra
-        raise ImportError(
-            "pftrack batch runs on Dask: pip install 'pftrack[dask]' (dask[distributed])"
-        ) from exc
+    _require_dask()
+    import dask
+    from distributed import Client, LocalCluster
+
     from pftrack.batch._plugin import SingleThreaded
 
     if client is not None:
@@ -417,6 +427,9 @@ def run_jobs(
 
     Raises
     ------
+    ImportError
+        Tasks are to run on Dask (`n_workers` is not 0) and Dask distributed is not installed
+        (the message says how to install it); raised before any task runs or file is written.
     KeyboardInterrupt
         After cancelling the tasks still running and closing the cluster this started; the
         outputs written so far are complete.
@@ -450,6 +463,8 @@ def run_jobs(
                 "traceback": trace,
             }
 
+    if pending and n_workers != 0 and client is None:
+        _require_dask()  # before the summary: a missing extra changes no file
     desc = "sequences" if kind == "track" else "files"
     bar = {"total": len(pending), "desc": desc, "enable": show_progress}
     try:
@@ -478,12 +493,12 @@ def _run_on_dask(
     bar: dict[str, Any],
 ) -> None:
     """Submit `pending` to Dask and record each result as it completes."""
-    from distributed import as_completed
-
     if n_workers is None:
         n_workers = os.cpu_count() or 1
     n_workers = min(n_workers, len(pending))  # a local cluster: no idle worker to start
     with dask_client(client, scheduler, n_workers) as c:
+        from distributed import as_completed  # after dask_client: its install hint first
+
         info = c.scheduler_info()
         summary.workers = len(info.get("workers", {}))
         summary.scheduler = str(info.get("address")) if info.get("address") else None

@@ -8,10 +8,11 @@ imported only when a command runs.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 
 from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
@@ -72,6 +73,40 @@ def _one_line_warning(command: str) -> Callable[..., None]:
     return show
 
 
+#: OpenCV's and FFmpeg's own log lines (``[ WARN:0@0.030] global cap.cpp:212 open ...``,
+#: ``[tcp @ 0x...] Connection ... refused``) before pftrack's one-line error on a source they
+#: cannot open: off for the command's process, unless the environment sets them. OpenCV reads
+#: its variable when cv2 is imported, FFmpeg's when OpenCV first opens a file or stream.
+QUIET_OPENCV = {"OPENCV_LOG_LEVEL": "SILENT", "OPENCV_FFMPEG_LOGLEVEL": "-8"}  # -8: AV_LOG_QUIET
+
+
+@contextlib.contextmanager
+def _quiet_opencv() -> Iterator[None]:
+    """While a command runs, OpenCV and FFmpeg log nothing (variables the user set are kept).
+
+    The variables are set before cv2 is imported (the command imports it only when it runs); a
+    cv2 already imported by a caller of :func:`main` in its own process gets its log level set,
+    and both are restored afterwards. A cv2 first imported by the command keeps the silent
+    level: the command's process ends with it.
+    """
+    before = {name: os.environ.get(name) for name in QUIET_OPENCV}
+    for name, value in QUIET_OPENCV.items():
+        os.environ.setdefault(name, value)
+    cv2 = sys.modules.get("cv2")
+    level = None
+    if cv2 is not None and before["OPENCV_LOG_LEVEL"] is None:
+        level = cv2.utils.logging.getLogLevel()
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
+    try:
+        yield
+    finally:
+        for name in QUIET_OPENCV:
+            if before[name] is None:
+                os.environ.pop(name, None)
+        if cv2 is not None and level is not None:
+            cv2.utils.logging.setLogLevel(level)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pftrack`` script; returns the exit status."""
     args = build_parser().parse_args(argv)
@@ -80,9 +115,12 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         set_quiet(True)
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), _quiet_opencv():
             warnings.showwarning = _one_line_warning(args.command)
-            return int(args.func(args))
+            status = int(args.func(args))
+        if sys.stdout is not None:  # a buffered stdout's last lines: a closed pipe fails here
+            sys.stdout.flush()
+        return status
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -14,6 +15,10 @@ DEFAULT_MAX_SIDE = 0
 #: ``--crossings``' default: :attr:`pftrack.tracking.CrossingConfig.enabled` ("on" for True),
 #: stated here for the same reason (a test checks they agree).
 DEFAULT_CROSSINGS = "off"
+#: ``--det-scale``'s range (``track`` and ``batch``): the one
+#: :func:`pftrack.tracking.load_detections` accepts, stated here for the same reason (a test
+#: checks they agree).
+DET_SCALE_RANGE = (1e-3, 1e3)
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
@@ -53,6 +58,28 @@ def positive_int(text: str) -> int:
     if v < 1:
         raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {v}")
     return v
+
+
+def non_negative_int(text: str) -> int:
+    """Argument type: an integer >= 0 (``--seed``, ``--workers``)."""
+    v = int(text)
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {v}")
+    return v
+
+
+non_negative_int.__name__ = "int"  # argparse names the type in its messages
+
+
+def finite_float(text: str) -> float:
+    """Argument type: a finite number (not nan, not inf)."""
+    v = float(text)
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {v}")
+    return v
+
+
+finite_float.__name__ = "float"
 
 
 def positive_float(text: str) -> float:
@@ -104,6 +131,38 @@ def max_side(text: str) -> int:
 max_side.__name__ = "int"
 
 
+def det_scale(text: str) -> float | None:
+    """Argument type of ``--det-scale``: ``auto`` (None) or a number in :data:`DET_SCALE_RANGE`."""
+    return None if text == "auto" else float(bounded_float(*DET_SCALE_RANGE)(text))
+
+
+det_scale.__name__ = "float"
+
+
+def check_input_file(path: str, *, what: str) -> None:
+    """Check, before any work, that the input file `path` of option `what` can be read.
+
+    Raises
+    ------
+    FileNotFoundError
+        It does not exist.
+    ValueError
+        It is a folder.
+    PermissionError
+        It cannot be read.
+    """
+    import os
+    from pathlib import Path
+
+    p = Path(path)
+    if p.is_dir():
+        raise ValueError(f"{what} {path}: is a folder, not a file")
+    if not p.exists():
+        raise FileNotFoundError(f"{what} {path}: no such file")
+    if not os.access(p, os.R_OK):
+        raise PermissionError(f"{what} {path}: not readable")
+
+
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
     """The tracker's options, shared by ``track`` (and any command that tracks)."""
     p.add_argument(
@@ -111,7 +170,8 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         help="particles per object (1 to 100000); 0: 200 with --detections, 100 with the "
         "built-in detector",
     )  # fmt: skip
-    p.add_argument("--seed", type=int, default=0, help="random seed: same seed, same tracks")
+    p.add_argument("--seed", type=non_negative_int, default=0,
+                   help="random seed, an integer >= 0: same seed, same tracks")  # fmt: skip
     p.add_argument(
         "--detector", choices=("paper", "mog2", "knn"), default="paper",
         help="built-in detector: the paper's adaptive background (C++), or OpenCV's MOG2/KNN",
@@ -155,11 +215,11 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
                    help="frames a track survives on its particle filter alone (0.4 s at 25 "
                    "frames/s: pftrack.Tracker's max_coast is in seconds)")  # fmt: skip
     p.add_argument(
-        "--min-conf", type=float, default=0.0, metavar="C",
+        "--min-conf", type=finite_float, default=0.0, metavar="C",
         help="ignore detections whose score is below C",
     )  # fmt: skip
     p.add_argument(
-        "--birth-score", type=float, default=0.9, metavar="S",
+        "--birth-score", type=finite_float, default=0.9, metavar="S",
         help="a detection starts a track with a score of at least min(S, the lower quartile of "
         "the scores of the first 50 frames) (scores in [0, 1] only; other scores never gate "
         "births)",
@@ -179,7 +239,8 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "--crossings", choices=("on", "off"), default=DEFAULT_CROSSINGS,
         help="offline pass: where two tracks' boxes overlapped, exchange their tails when "
         "each one's motion and size before the crossing predict the other's after it better "
-        "(tracks the tracker swapped; motion and size only, no colour); needs the smoother",
+        "(tracks the tracker swapped; motion and size only, no colour); part of the smoothing "
+        "pass: refused with --no-smooth",
     )  # fmt: skip
     p.add_argument(
         "--no-refine", action="store_true",
@@ -195,8 +256,19 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
 
 
 def tracker_config(args: argparse.Namespace) -> TrackerConfig:
-    """The :class:`~pftrack.tracking.TrackerConfig` that :func:`add_tracker_options` describes."""
+    """The :class:`~pftrack.tracking.TrackerConfig` that :func:`add_tracker_options` describes.
+
+    Raises
+    ------
+    ValueError
+        Options that contradict each other (``--crossings on`` with ``--no-smooth``).
+    """
     from dataclasses import replace
+
+    if args.crossings == "on" and args.no_smooth:  # the repair is part of the offline pass
+        raise ValueError(
+            "--crossings on needs the smoother, which --no-smooth turns off; drop one of them"
+        )
 
     from pftrack.tracking import TrackerConfig
 

@@ -12,7 +12,15 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from pftrack.cli._options import add_command, add_tracker_options, positive_float
+from pftrack.cli._options import (
+    DET_SCALE_RANGE,
+    add_command,
+    add_tracker_options,
+    bounded_int,
+    det_scale,
+    non_negative_int,
+    positive_float,
+)
 
 if TYPE_CHECKING:
     from pftrack.batch import BatchSummary
@@ -21,19 +29,18 @@ if TYPE_CHECKING:
 EXIT_SOME_FAILED = 1
 #: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
+#: ``--max-gap``'s upper bound (``recover``, ``smooth``, one file or a batch):
+#: :data:`pftrack.recovery.fill.MAX_GAP_LIMIT` and :class:`pftrack.recovery.LinkConfig`'s,
+#: stated here so that ``--help`` does not import the recovery code (a test checks they agree).
+MAX_GAP = 100_000
 
 
-def det_scale(text: str) -> float | None:
-    """Argument type: ``auto`` (None) or a number > 0."""
-    return None if text == "auto" else positive_float(text)
+def max_gap(text: str) -> int:
+    """Argument type of ``--max-gap`` (``recover``, ``smooth``; one file or a batch)."""
+    return int(bounded_int(1, MAX_GAP)(text))
 
 
-def non_negative_int(text: str) -> int:
-    """Argument type: an integer >= 0."""
-    v = int(text)
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {v}")
-    return v
+max_gap.__name__ = "int"  # argparse names the type in its messages
 
 
 def add_batch_options(p: argparse.ArgumentParser) -> None:
@@ -85,8 +92,9 @@ def add_parser(sub: Any) -> None:
     )  # fmt: skip
     p.add_argument(
         "--det-scale", type=det_scale, default="auto", metavar="S",
-        help="multiply detection boxes by S; auto: the frame width over seqinfo.ini's imWidth "
-        "where there is one (0.625 for PETS09-S2L1's video), else 1",
+        help=f"multiply detection boxes by S ({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}); "
+        "auto: the frame width over seqinfo.ini's imWidth where there is one (0.625 for "
+        "PETS09-S2L1's video), else 1",
     )  # fmt: skip
     p.add_argument("--render", action="store_true", help="also write DIR/NAME.mp4, annotated")
     p.add_argument("--iou", type=positive_float, default=0.5,
@@ -94,6 +102,10 @@ def add_parser(sub: Any) -> None:
     add_tracker_options(p)
     add_batch_options(p)
     p.set_defaults(func=run)
+
+
+#: The modules of the ``pftrack[dask]`` extra.
+_DASK = ("dask", "distributed")
 
 
 def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
@@ -108,7 +120,8 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
         )
         return EXIT_INTERRUPTED
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
-        print(f"pftrack {command}: error: {exc}", file=sys.stderr)
+        hint = "; or --workers 0: in this process, without Dask" if exc.name in _DASK else ""
+        print(f"pftrack {command}: error: {exc}{hint}", file=sys.stderr)
         return 2
     for e in summary.entries if explain else ():
         if e.get("explain"):

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from pftrack.cli._options import add_command, bounded_int
+from pftrack.cli._options import add_command, bounded_int, non_negative_int
 
 
 def add_parser(sub: Any) -> None:
@@ -22,7 +22,8 @@ def add_parser(sub: Any) -> None:
         "error. Needs no data and no download.",
     )
     p.add_argument("--out-dir", default="pftrack-demo", help="folder for the outputs")
-    p.add_argument("--seed", type=int, default=0, help="scene and tracker seed")
+    p.add_argument("--seed", type=non_negative_int, default=0,
+                   help="scene and tracker seed, an integer >= 0")  # fmt: skip
     p.add_argument("--frames", type=bounded_int(1, 1000), default=150,
                    help="scene length (1 to 1000: the scene is held in memory)")  # fmt: skip
     p.add_argument("--particles", type=bounded_int(1, 100_000), default=100,

@@ -131,7 +131,7 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run ``pftrack eval``: print the table, optionally write JSON/CSV; return the status."""
+    """Run ``pftrack eval``: optionally write JSON/CSV, then print the table; return the status."""
     import json
 
     from pftrack._progress import progress
@@ -183,7 +183,6 @@ def run(args: argparse.Namespace) -> int:
         except ValueError as exc:
             raise ValueError(f"{name}: {exc}") from None
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
-    print(format_scores(scores, combined))
     if args.json:
         if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
             text = json.dumps(next(iter(scores.values())).as_dict(), indent=2)
@@ -194,4 +193,5 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         with atomic_write(args.csv) as fh:
             fh.write(scores_csv(scores, combined))
+    print(format_scores(scores, combined))  # after the files: a closed stdout cannot lose them
     return 0

@@ -150,11 +150,11 @@ def run_gaps(args: argparse.Namespace) -> int:
     sweep = E.sweep(
         trajs, args.size, width, height, args.grid, args.trajectories, args.gaps, args.min_gaps
     )
-    print(f"{args.gt}: {len(trajs)} trajectories, {args.point} point, {width:.0f}x{height:.0f}")
-    print(
+    said = [  # printed once the figure is written: a closed stdout cannot lose it
+        f"{args.gt}: {len(trajs)} trajectories, {args.point} point, {width:.0f}x{height:.0f}",
         f"sweep: {args.size:g}x{args.size:g} masks on a {args.grid:g} px grid, "
-        f"{len(sweep)} positions kept ({sweep.selection})"
-    )
+        f"{len(sweep)} positions kept ({sweep.selection})",
+    ]
     if args.mask:
         mask = _parse_mask(args.mask)
     elif len(sweep):
@@ -162,36 +162,36 @@ def run_gaps(args: argparse.Namespace) -> int:
     else:
         raise ValueError("no mask position meets the selection; pass --mask")
     run = E.run_mask(trajs, mask, methods, args.repeat)
-    print()
-    print(
+    said += [
+        "",
         f"representative mask x,y,w,h = {','.join(f'{v:g}' for v in mask)}: "
         f"{run.n_traj} trajectories, {len(run.gaps)} gaps, "
-        f"{sum(len(g.truth) for g in run.gaps)} lost points"
-    )
+        f"{sum(len(g.truth) for g in run.gaps)} lost points",
+    ]
     if not run.gaps:
-        print("no gap under this mask")
+        print("\n".join([*said, "no gap under this mask"]))
         return 0
-    print(E.format_table(run.scores))
+    said.append(E.format_table(run.scores))
     if run.noise is not None:
-        print(
+        said.append(
             f"gdt-bi noise (estimated from the observed points, {run.noise_ms:.1f} ms): "
             f"q = {run.noise.q[0]:.4g}, {run.noise.q[1]:.4g} px^2/frame^3, "
             f"r = {run.noise.r[0]:.4g}, {run.noise.r[1]:.4g} px^2"
         )
     if run.motion is not None:
-        print(
+        said.append(
             f"gdt-mix model (fitted to the observed points, {run.motion_ms:.1f} ms): "
             f"{run.motion.describe()}"
         )
     if len(sweep):
-        print()
-        print(E.format_median(E.median_over(trajs, sweep, methods, args.max_positions)))
+        said += ["", E.format_median(E.median_over(trajs, sweep, methods, args.max_positions))]
     if args.figure:
         _write_figure(args.figure, E.draw_figure(
             trajs, run.gaps, run.paths, mask, (int(width), int(height)),
             [m for m in ("gdt", "gdt-mix", "bspline") if m in methods],
         ))  # fmt: skip
-        print(f"figure: {args.figure}")
+        said.append(f"figure: {args.figure}")
+    print("\n".join(said))
     return 0
 
 
@@ -237,12 +237,6 @@ def _run_sequences(args: argparse.Namespace) -> int:
         E.run_sequence(name, trajs, width, height, methods, args.n_masks)
         for name, trajs, width, height in progress(jobs, total=len(jobs), desc="sequences")
     ]
-    for r in results:
-        masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks)
-        print(f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}")
-    print()
-    print("MMAE (px, mean over gaps of the mean Euclidean error); * = best of the row")
-    print(E.format_sequences(results, methods))
     if args.json:
         doc: dict[str, Any] = {
             "protocol": "auto masks: side round(100W/768), grid round(4W/768), greedy, "
@@ -267,5 +261,12 @@ def _run_sequences(args: argparse.Namespace) -> int:
         }
         with atomic_write(args.json) as f:
             json.dump(doc, f, indent=1)
+    for r in results:  # printed once the JSON is written: a closed stdout cannot lose it
+        masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks)
+        print(f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}")
+    print()
+    print("MMAE (px, mean over gaps of the mean Euclidean error); * = best of the row")
+    print(E.format_sequences(results, methods))
+    if args.json:
         print(f"json: {args.json}")
     return 0

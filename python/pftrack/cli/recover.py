@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, bounded_float, positive_int
+from pftrack.cli._options import add_command, bounded_float
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 
@@ -29,9 +29,9 @@ def add_parser(sub: Any) -> None:
                    "folder (see pftrack batch)")  # fmt: skip
     p.add_argument("--out", required=True, help="output file (written atomically)")
     p.add_argument("--method", default=DEFAULT_METHOD, choices=METHODS, help="recovery method")
-    p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
-                   help="longest hole filled, in frames (at most 100000; longer holes stay "
-                   "holes: bounded work)")  # fmt: skip
+    p.add_argument("--max-gap", type=batch.max_gap, default=30, metavar="FRAMES",
+                   help=f"longest hole filled, in frames (1 to {batch.MAX_GAP}; longer holes "
+                   "stay holes: bounded work)")  # fmt: skip
     p.add_argument("--explain", action="store_true",
                    help="with auto: print the method chosen per gap length (or the two methods "
                    "it blends, with their weights) and its validation MMAE")  # fmt: skip

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, positive_int
+from pftrack.cli._options import add_command
 
 
 def add_parser(sub: Any) -> None:
@@ -29,9 +29,9 @@ def add_parser(sub: Any) -> None:
                    "conf,...); several, or folders of *.txt: a batch on Dask, --out is then a "
                    "folder (see pftrack batch)")  # fmt: skip
     p.add_argument("--out", required=True, help="output file (written atomically; never the input)")
-    p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
-                   help="longest gap joined and filled (longer holes stay holes: bounded "
-                   "work)")  # fmt: skip
+    p.add_argument("--max-gap", type=batch.max_gap, default=30, metavar="FRAMES",
+                   help=f"longest gap joined and filled, in frames (1 to {batch.MAX_GAP}; longer "
+                   "holes stay holes: bounded work)")  # fmt: skip
     p.add_argument("--no-link", action="store_true", help="smooth each id as it is")
     batch.add_batch_options(p)
     p.set_defaults(func=run)

@@ -10,9 +10,11 @@ from pathlib import Path
 from typing import IO, Any
 
 from pftrack.cli._options import (
+    DET_SCALE_RANGE,
     add_command,
     add_tracker_options,
     bounded_float,
+    det_scale,
     tracker_config,
 )
 
@@ -48,10 +50,11 @@ def add_parser(sub: Any) -> None:
         "sequence's det/det.txt (default: the built-in detector)",
     )  # fmt: skip
     p.add_argument(
-        "--det-scale", type=bounded_float(1e-3, 1e3), metavar="S",
-        help="multiply detection boxes by S to reach the video's pixels (0.625 for PETS09 "
-        "det.txt on its 480x360 video) (default: for the sequence's own detections, the frame "
-        "width over seqinfo.ini's imWidth; else 1)",
+        "--det-scale", type=det_scale, default="auto", metavar="S",
+        help="multiply detection boxes by S to reach the video's pixels "
+        f"({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}; 0.625 for PETS09 det.txt on its "
+        "480x360 video); auto: for the sequence's own detections, the frame width over "
+        "seqinfo.ini's imWidth, else 1",
     )  # fmt: skip
     p.add_argument(
         "--fps", type=bounded_float(0.01, 1000.0), metavar="FPS",
@@ -102,8 +105,11 @@ def _resolve_detections(args: argparse.Namespace, source: Any) -> str | None:
     return str(found)
 
 
-def _det_scale(args: argparse.Namespace, source: Any, det_path: str) -> float:
-    """``--det-scale``, or the sequence's own: its detections are in seqinfo.ini's pixels."""
+def _det_scale(args: argparse.Namespace, source: Any, det_path: str, said: list[str]) -> float:
+    """``--det-scale``, or the sequence's own: its detections are in seqinfo.ini's pixels.
+
+    A scale taken from seqinfo.ini is said in `said` (printed once the outputs are written).
+    """
     if args.det_scale is not None:
         return float(args.det_scale)
     seq = source.sequence
@@ -113,24 +119,45 @@ def _det_scale(args: argparse.Namespace, source: Any, det_path: str) -> float:
     if seq.width == source.width:
         return 1.0
     scale = float(source.width / seq.width)
-    print(
+    said.append(
         f"detections scaled by {scale:g}: frames are {source.width} px wide, "
         f"{seq.folder / 'seqinfo.ini'} says imWidth={seq.width} (--det-scale overrides)"
     )
     return scale
 
 
+def _check_outputs(args: argparse.Namespace, live: bool) -> None:
+    """Before any work: the detection file can be read, every output written, none twice."""
+    from pftrack.cli._options import check_input_file
+    from pftrack.io.atomic import check_distinct, check_output
+    from pftrack.io.video_writer import VIDEO_SUFFIXES
+
+    given = [d for d in (args.detections,) if d and d != "auto"]
+    for det in given:
+        check_input_file(det, what="--detections")
+    inputs = tuple([args.source] if not live else []) + tuple(given)
+    check_output(args.out, what="--out", inputs=inputs)
+    if args.render:
+        check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
+    if args.plot:
+        check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
+    check_distinct({"--out": args.out, "--render": args.render, "--plot": args.plot})
+
+
 def run(args: argparse.Namespace) -> int:
-    """Run ``pftrack track``; return the exit status."""
+    """Run ``pftrack track``; return the exit status.
+
+    What it has to say (warnings on stderr, the summary on stdout) is printed once every output
+    is written: a closed stdout (``| head``) then costs the messages, never the files.
+    """
     import contextlib
 
     import numpy as np
 
     from pftrack.cli._options import opencv_single_threaded
-    from pftrack.io.atomic import check_output, staged_outputs
+    from pftrack.io.atomic import staged_outputs
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, is_live_source
-    from pftrack.io.video_writer import VIDEO_SUFFIXES
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections, track_frames
@@ -138,20 +165,19 @@ def run(args: argparse.Namespace) -> int:
     opencv_single_threaded()
 
     live = is_live_source(args.source)
-    given = [d for d in (args.detections,) if d and d != "auto"]
-    inputs = tuple([args.source] if not live else []) + tuple(given)
-    check_output(args.out, what="--out", inputs=inputs)
-    if args.render:
-        check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
-    if args.plot:
-        check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
+    config = tracker_config(args)  # contradictory options refused before any work
+    _check_outputs(args, live)
     source = FrameSource(args.source, fps=args.fps)
     renderer: TrackRenderer | None = None
+    said: list[str] = []  # stdout, after the outputs are written
+    warned: list[str] = []  # stderr, likewise
     try:
         with staged_outputs() as stage:  # every output replaced at the end, or none
             det_path = _resolve_detections(args, source)
             dets = (
-                load_detections(det_path, _det_scale(args, source, det_path)) if det_path else None
+                load_detections(det_path, _det_scale(args, source, det_path, said))
+                if det_path
+                else None
             )
             renderer = TrackRenderer(stage(args.render), source.fps) if args.render else None
             first: list[Any] = []
@@ -176,7 +202,7 @@ def run(args: argparse.Namespace) -> int:
                 result = track_frames(
                     source,
                     detections=dets,
-                    config=tracker_config(args),
+                    config=config,
                     rng=args.seed,
                     fill=args.fill,
                     bootstrap=args.bootstrap,
@@ -184,19 +210,19 @@ def run(args: argparse.Namespace) -> int:
                     link=None if args.no_link else LinkConfig(),
                     on_frame=on_frame,
                 )
-            for w in caught:  # clipped boxes, a run without any track: said, not fatal
-                print(f"pftrack track: warning: {w.message}", file=sys.stderr)
+            # clipped boxes, a run without any track: said, not fatal
+            warned.extend(f"pftrack track: warning: {w.message}" for w in caught)
             write_mot(stage(args.out), result.rows)
             n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
             stopped = " (stopped by Ctrl-C)" if source.stopped else ""
-            print(
+            said.append(
                 f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
                 f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> "
                 f"{args.out}"
             )
             if renderer is not None:
                 renderer.close()
-                print(
+                said.append(
                     f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
                     f"{source.fps_origin}) -> {args.render}"
                 )
@@ -205,11 +231,15 @@ def run(args: argparse.Namespace) -> int:
                     source.sequence.name if source.sequence is not None else Path(args.source).name
                 )
                 plot_trajectories(stage(args.plot), result.rows, background=first[0], title=name)
-                print(f"trajectory plot -> {args.plot}")
+                said.append(f"trajectory plot -> {args.plot}")
     except BaseException:
         if renderer is not None:
             renderer.abort()  # no half-written video (a finished one stays)
         raise
     finally:
         source.close()
+    for line in warned:
+        print(line, file=sys.stderr)
+    for line in said:
+        print(line)
     return 0

@@ -9,7 +9,7 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
 
@@ -140,11 +140,43 @@ def check_output(
     os.close(fd)
     os.unlink(probe)
     for source in inputs:
-        if target.exists() and Path(source).exists() and os.path.samefile(target, source):
-            raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
-        if target.resolve() == Path(source).resolve():
+        if _same_file(target, Path(source)):
             raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
     return target
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether `a` and `b` name one file: the same path once resolved, or one file on disk."""
+    if a.exists() and b.exists() and os.path.samefile(a, b):
+        return True  # hard links, bind mounts
+    return a.resolve() == b.resolve()
+
+
+def check_distinct(outputs: Mapping[str, PathLike | None]) -> None:
+    """Check, before any work, that no two outputs of one run are the same file.
+
+    Parameters
+    ----------
+    outputs : mapping of str to path or None
+        Each output by the name error messages give it (e.g. ``"--render"``); None: not written.
+
+    Raises
+    ------
+    ValueError
+        Two of them name one file (one would overwrite the other), naming both.
+    """
+    seen: list[tuple[str, Path]] = []
+    for what, path in outputs.items():
+        if path is None:
+            continue
+        target = Path(path)
+        for other_what, other in seen:
+            if _same_file(target, other):
+                raise ValueError(
+                    f"{other_what} {other} and {what} {target} are the same file; give each "
+                    "output its own"
+                )
+        seen.append((what, target))
 
 
 @contextlib.contextmanager

@@ -593,12 +593,17 @@ class Tracker:
                 )
         if len(rows) == 0 and self.frame_count:
             cfg = self.config.lifecycle
-            hint = (
-                f"the highest detection confidence was {self._max_conf:.3g} (min_conf "
-                f"{cfg.min_score:.3g}, birth_score {cfg.birth_score:.3g})"
-                if np.isfinite(self._max_conf)
-                else "no external detection was given"
-            )
+            if np.isfinite(self._max_conf):
+                hint = (
+                    f"the highest detection confidence was {self._max_conf:.3g} (min_conf "
+                    f"{cfg.min_score:.3g}, birth_score {cfg.birth_score:.3g})"
+                )
+            elif self._clip_warned:  # boxes were given, every one wholly outside the frame
+                hint = "no detection lay inside the frame (wrong coordinate scale?)"
+            elif self._given:
+                hint = "the detections given held no box"
+            else:
+                hint = "no external detection was given"
             warnings.warn(
                 f"no track over {self.frame_count} frames: {hint}", RuntimeWarning, stacklevel=2
             )
