@@ -156,9 +156,9 @@ def sequence_metrics(
 
 def _as_written(rows: F64) -> F64:
     """`rows` rounded as ``NAME.txt`` stores them: the metrics are ``pftrack eval``'s on it."""
-    from pftrack.io.mot import format_mot_row
+    from pftrack.io.mot import mot_text
 
-    lines = [format_mot_row(r).split(",") for r in rows]
+    lines = [line.split(",") for line in mot_text(rows).splitlines()]
     return np.array(lines, dtype=np.float64).reshape(len(rows), 10)
 
 

@@ -21,8 +21,10 @@ def add_parser(sub: Any) -> None:
         "recover",
         help="fill the gaps of any tracker's MOTChallenge output (optionally link fragments)",
         description="Fill holes of at most --max-gap frames inside each track. Filled rows "
-        "have the interpolated flag (column 8, 1-based) set to 1. Rows flagged by an earlier "
-        "run count as observed, so running it twice changes nothing more.",
+        "have the interpolated flag (column 8, 1-based) set to 1 and columns 9-10 set to -1; "
+        "observed rows keep their values (written in their shortest form: 88.00 as 88). Rows "
+        "flagged by an earlier run count as observed, so running it twice changes nothing "
+        "more.",
     )
     p.add_argument("tracks", nargs="+", help="MOTChallenge tracks file (frame,id,left,top,w,h,"
                    "conf,x,y,z); several, or folders of *.txt: a batch on Dask, --out is then a "
@@ -92,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"{src}: {len(rows)} rows, {n_links} fragments linked, {rep.n_gaps} gaps filled with "
         f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "
-        f"(interpolated flag: column 8)"
+        f"({flag_note(rows)})"
     )
     if args.explain:
         if rep.calibration is not None:
@@ -106,3 +108,12 @@ def run(args: argparse.Namespace) -> int:
         else:
             print(f"--explain: {args.method} was given, nothing was chosen")
     return 0
+
+
+def flag_note(rows: Any) -> str:
+    """How filled rows are marked, and how many input rows were marked so already."""
+    from pftrack.recovery.linking import filled_mask
+
+    note = "interpolated flag: column 8 = 1, columns 9-10 = -1"
+    n = int(filled_mask(rows).sum())
+    return note + (f"; {n} input rows had it already, kept as observed" if n else "")

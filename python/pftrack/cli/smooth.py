@@ -21,7 +21,8 @@ def add_parser(sub: Any) -> None:
         "tracker's output: join fragments of one object by motion and size across gaps of up "
         "to --max-gap frames (gate: 50 px, times the diagonal of the boxes' extent over 800 "
         "when it is larger than 640x480), add the frames missing inside each track (recovered "
-        "by the method of pftrack recover, auto; flagged 1 in column 8), "
+        "by the method of pftrack recover, auto; flagged 1 in column 8, with -1 in columns "
+        "9-10), "
         "and replace every box by a Rauch-Tung-Striebel smoother's estimate over the whole "
         "track. Smoothing is not idempotent: run it once, on raw output.",
     )
@@ -45,6 +46,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from pftrack.batch.tasks import read_tracks
+    from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig
@@ -63,6 +65,6 @@ def run(args: argparse.Namespace) -> int:
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
     print(
         f"{src}: {ids_in} ids, {len(rows)} rows -> {ids_out} ids, {len(result)} rows "
-        f"(filled rows flagged in column 8) -> {out}"
+        f"({flag_note(rows)}) -> {out}"
     )
     return 0

@@ -3,8 +3,10 @@
 Rows are ``(M, 10)`` MOTChallenge arrays ``frame,id,left,top,width,height,conf,x,y,z``.
 Rows pftrack fills (:mod:`pftrack.recovery.fill`, the offline tracker) carry the
 **interpolated flag in column 8** (1-based; index :data:`FLAG_COLUMN` = 7, the world-``x``
-column, which is -1 in 2D MOTChallenge files): ``1`` on every filled row, observed rows
-untouched.
+column, which is -1 in 2D MOTChallenge files): ``1`` on every filled row, with columns 9-10
+``-1``; observed rows untouched. Column 8 alone can hold 1 in an observed row (class 1,
+pedestrian, in MOT16+ ground truth; a world ``x`` in MOT15's): :func:`filled_mask` tests all
+three columns.
 """
 
 from __future__ import annotations
@@ -26,11 +28,13 @@ from pftrack.particle_filter.colour import (
 )
 
 __all__ = [
+    "FILLED_MARK",
     "FLAG_COLUMN",
     "LinkConfig",
     "box_centres",
     "check_rows",
     "check_unique",
+    "filled_mask",
     "gate_for_rows",
     "link_cost_matrix",
     "link_tracklets",
@@ -39,6 +43,8 @@ __all__ = [
 ]
 
 FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTChallenge row)
+#: Columns 8-10 (1-based) of every row pftrack filled: the flag, then no world ``y``, ``z``.
+FILLED_MARK = (1.0, -1.0, -1.0)
 #: Frames up to this diagonal (640x480) take pixel settings as given; larger ones scale them.
 REFERENCE_DIAGONAL = 800.0
 #: Largest absolute track id accepted.
@@ -108,6 +114,38 @@ def gate_for_rows(config: LinkConfig, rows: ArrayLike) -> LinkConfig:
     bottom = float(np.max(a[:, 3] + a[:, 5]))
     scale = pixel_scale(max(right, 0.0), max(bottom, 0.0))
     return replace(config, max_distance=config.max_distance * scale)
+
+
+def filled_mask(rows: ArrayLike) -> NDArray[np.bool_]:
+    """Which MOTChallenge rows pftrack filled: columns 8-10 (1-based) are ``1, -1, -1``.
+
+    Parameters
+    ----------
+    rows : (M, 10) array_like
+        MOTChallenge rows, e.g. :func:`pftrack.io.mot.read_mot` of a ``pftrack recover`` or
+        ``pftrack smooth`` output.
+
+    Returns
+    -------
+    (M,) ndarray of bool
+        True where the interpolated flag (column 8, :data:`FLAG_COLUMN`) is 1 and columns 9-10
+        are -1 (:data:`FILLED_MARK`). An observed row of a tracker's output (``-1, -1, -1``),
+        of MOT16+ ground truth (class, visibility in 0..1, ``-1``) or of MOT15 ground truth
+        (world coordinates) never matches unless it holds those three values exactly.
+
+    Raises
+    ------
+    ValueError
+        If `rows` is not ``(M, 10)``.
+    """
+    a = np.asarray(rows, dtype=np.float64)
+    if a.size == 0:
+        return np.zeros(0, dtype=bool)
+    if a.ndim != 2 or a.shape[1] != 10:
+        raise ValueError(f"filled_mask: rows must have shape (M, 10), got {a.shape}")
+    mark = np.asarray(FILLED_MARK)
+    out: NDArray[np.bool_] = np.all(a[:, FLAG_COLUMN : FLAG_COLUMN + 3] == mark, axis=1)
+    return out
 
 
 def box_centres(rows: F64) -> F64:
