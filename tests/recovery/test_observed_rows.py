@@ -3,6 +3,7 @@
 Regression tests: column 8 holds the interpolated flag, and observed values there (MOT15 world
 ``x``, MOT16+ class) were rounded to 2 decimals, so ``0.99502`` became ``1.00`` and counted as
 filled; re-running ``recover`` on its own output rewrote ``88.00`` as ``88``.
+``smooth --no-link`` left the holes inside each id.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import pytest
 from pftrack.cli import main
 from pftrack.io.mot import read_mot
 from pftrack.recovery.linking import FILLED_MARK, filled_mask
+from pftrack.tracking import smooth_tracks
 from tests.recovery.test_dataset import data_dir
 
 
@@ -111,6 +113,47 @@ def test_smooth_flags_only_the_rows_it_adds(
     assert filled.sum() == len(rows) - len(given) == 48
     # observed rows keep conf and columns 8-10 exactly (the boxes are the smoother's)
     np.testing.assert_array_equal(rows[~filled, 6:], given[:, 6:])
+
+
+def test_smooth_no_link_fills_holes_inside_each_id_and_joins_none(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    lines = _lines("tracker")
+    # id 7 continues id 1 after frame 100: smooth joins them, --no-link must not
+    c = _walks(0)[0]
+    x, y = c[-1, 1:]
+    lines += [f"{f},7,{x - 10 + 0.3 * (f - 100):.2f},{y - 20:.2f},20.5,40,1,-1,-1,-1"
+              for f in range(103, 140)]  # fmt: skip
+    src = _write(tmp_path / "in.txt", lines)
+    linked, plain = tmp_path / "linked.txt", tmp_path / "plain.txt"
+    assert main(["smooth", str(src), "--out", str(linked)]) == 0
+    assert main(["smooth", str(src), "--out", str(plain), "--no-link"]) == 0
+    capsys.readouterr()
+    a, b, given = read_mot(linked), read_mot(plain), read_mot(src)
+    assert set(a[:, 1]) == set(range(1, 7)) and set(b[:, 1]) == set(range(1, 8))
+    assert filled_mask(a).sum() == 48 + 2 and filled_mask(b).sum() == 48  # + frames 101-102
+    for tid in range(1, 8):  # every id of --no-link's output runs without a hole
+        fr = np.sort(b[b[:, 1] == tid, 0])
+        assert np.all(np.diff(fr) == 1), tid
+    assert len(b) == len(given) + 48
+    # a hole longer than --max-gap stays a hole, as with linking
+    assert main(["smooth", str(src), "--out", str(plain), "--no-link", "--max-gap", "7"]) == 0
+    assert filled_mask(read_mot(plain)).sum() == 0
+
+
+def test_smooth_tracks_max_gap_fills_without_linking() -> None:
+    rows = read_mot_text(_lines("tracker"))
+    assert len(smooth_tracks(rows, link=None)) == len(rows)  # the library default: as before
+    out = smooth_tracks(rows, link=None, max_gap=8)
+    assert filled_mask(out).sum() == 48 and set(out[:, 1]) == set(rows[:, 1])
+    assert len(smooth_tracks(rows, link=None, max_gap=7)) == len(rows)
+    for bad in (0, True, 2.5, 100_001):
+        with pytest.raises(ValueError, match="smooth_tracks: max_gap is"):
+            smooth_tracks(rows, link=None, max_gap=bad)  # type: ignore[arg-type]
+
+
+def read_mot_text(lines: list[str]) -> np.ndarray:
+    return np.array([line.split(",") for line in lines], dtype=np.float64)
 
 
 @pytest.mark.dataset

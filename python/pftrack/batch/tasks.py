@@ -332,7 +332,7 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     t0 = time.perf_counter()
     rows = read_tracks(path)
     link = gate_for_rows(LinkConfig(max_gap=options.max_gap), rows) if options.link else None
-    result = smooth_tracks(rows, link=link)
+    result = smooth_tracks(rows, link=link, max_gap=options.max_gap)
     info: dict[str, Any] = {
         "source": str(path),
         "ids_in": int(len(np.unique(rows[:, 1]))) if len(rows) else 0,

@@ -22,7 +22,7 @@ def add_parser(sub: Any) -> None:
         "to --max-gap frames (gate: 50 px, times the diagonal of the boxes' extent over 800 "
         "when it is larger than 640x480), add the frames missing inside each track (recovered "
         "by the method of pftrack recover, auto; flagged 1 in column 8, with -1 in columns "
-        "9-10), "
+        "9-10; also with --no-link), "
         "and replace every box by a Rauch-Tung-Striebel smoother's estimate over the whole "
         "track. Smoothing is not idempotent: run it once, on raw output.",
     )
@@ -33,7 +33,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--max-gap", type=positive_int, default=30, metavar="FRAMES",
                    help="longest gap joined and filled (longer holes stay holes: bounded "
                    "work)")  # fmt: skip
-    p.add_argument("--no-link", action="store_true", help="smooth each id as it is")
+    p.add_argument("--no-link", action="store_true",
+                   help="join no fragments: fill the holes inside each id and smooth each id "
+                   "as it is")  # fmt: skip
     batch.add_batch_options(p)
     p.set_defaults(func=run)
 
@@ -59,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     check_output(out, what="--out")
     rows = read_tracks(src)
     link = None if args.no_link else gate_for_rows(LinkConfig(max_gap=args.max_gap), rows)
-    result = smooth_tracks(rows, link=link)
+    result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
     write_mot(out, result)
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
