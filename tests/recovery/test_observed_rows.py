@@ -4,6 +4,7 @@ Regression tests: column 8 holds the interpolated flag, and observed values ther
 ``x``, MOT16+ class) were rounded to 2 decimals, so ``0.99502`` became ``1.00`` and counted as
 filled; re-running ``recover`` on its own output rewrote ``88.00`` as ``88``.
 ``smooth --no-link`` left the holes inside each id.
+Batch ``recover --explain`` left out the box sizes.
 """
 
 from __future__ import annotations
@@ -154,6 +155,29 @@ def test_smooth_tracks_max_gap_fills_without_linking() -> None:
 
 def read_mot_text(lines: list[str]) -> np.ndarray:
     return np.array([line.split(",") for line in lines], dtype=np.float64)
+
+
+def test_batch_explain_prints_what_one_file_prints(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = tmp_path / "tracks"
+    folder.mkdir()
+    for k, name in enumerate(("a", "b")):
+        _write(folder / f"{name}.txt", _lines("tracker", seed=k))
+    assert main(["recover", str(folder), "--out", str(tmp_path / "o"), "--workers", "0",
+                 "--explain"]) == 0  # fmt: skip
+    batch = capsys.readouterr().out
+    for name in ("a", "b"):
+        assert main(["recover", str(folder / f"{name}.txt"), "--out",
+                     str(tmp_path / f"{name}.txt"), "--explain"]) == 0  # fmt: skip
+        single = capsys.readouterr().out.split("\n", 1)[1]  # after the summary line
+        assert "box centres (x, y):" in single and "box sizes (w, h):" in single
+        assert f"{name}:\n{single}" in batch
+    assert batch.count("box sizes (w, h):") == 2
+    # a named method: nothing chosen, as for one file
+    assert main(["recover", str(folder), "--out", str(tmp_path / "l"), "--workers", "0",
+                 "--method", "linear", "--explain"]) == 0  # fmt: skip
+    assert capsys.readouterr().out.count("--explain: linear was given, nothing was chosen") == 2
 
 
 @pytest.mark.dataset

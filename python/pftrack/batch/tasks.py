@@ -306,7 +306,7 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
         "filled_rows": rep.n_filled_rows,
         "rows_out": len(filled),
         "seconds": time.perf_counter() - t0,
-        "explain": None if rep.calibration is None else rep.calibration.describe(),
+        "explain": rep.describe(options.method),
     }
     return TaskResult(filled, {}, info)
 

@@ -97,16 +97,7 @@ def run(args: argparse.Namespace) -> int:
         f"({flag_note(rows)})"
     )
     if args.explain:
-        if rep.calibration is not None:
-            print("box centres (x, y):")
-            print(rep.calibration.describe())
-        if rep.size_calibration is not None:
-            print("box sizes (w, h):")
-            print(rep.size_calibration.describe())
-        elif args.method == "auto":
-            print("auto: no gap to fill")
-        else:
-            print(f"--explain: {args.method} was given, nothing was chosen")
+        print(rep.describe(args.method))
     return 0
 
 

@@ -67,6 +67,24 @@ class FillReport:
     calibration: Calibration | None = None
     size_calibration: Calibration | None = None
 
+    def describe(self, method: str) -> str:
+        """What ``pftrack recover --explain`` prints for a fill by `method`.
+
+        With ``"auto"``, the choice for the box centres, then for the box sizes
+        (:meth:`~pftrack.recovery.calibrate.Calibration.describe`), or that there was no gap
+        to fill; with a named method, that nothing was chosen.
+        """
+        parts = []
+        if self.calibration is not None:
+            parts += ["box centres (x, y):", self.calibration.describe()]
+        if self.size_calibration is not None:
+            parts += ["box sizes (w, h):", self.size_calibration.describe()]
+        elif method == "auto":
+            parts.append("auto: no gap to fill")
+        else:
+            parts.append(f"--explain: {method} was given, nothing was chosen")
+        return "\n".join(parts)
+
 
 def fill_gaps(
     tracks: F64,
