@@ -253,17 +253,12 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
 def read_tracks(path: PathLike) -> F64:
     """Read a tracks file whose (frame, id) pairs are unique (an error names the lines).
 
-    The file is read a second time, for its line numbers, only when a pair repeats.
+    :func:`pftrack.recovery.linking.read_tracks`, which the one-file commands import without
+    this package.
     """
-    from pftrack.io.mot import data_line_numbers, read_mot
-    from pftrack.recovery import check_unique
+    from pftrack.recovery.linking import read_tracks as read
 
-    rows = read_mot(path, what="tracks file")
-    try:
-        check_unique(rows)
-    except ValueError:
-        check_unique(rows, data_line_numbers(path))
-    return rows
+    return read(path)
 
 
 @dataclass(frozen=True)

@@ -59,11 +59,10 @@ def run(args: argparse.Namespace) -> int:
     if args.video and not args.link:
         raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
-    from pftrack.batch.tasks import read_tracks
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
-    from pftrack.recovery.linking import gate_for_rows
+    from pftrack.recovery.linking import gate_for_rows, read_tracks
 
     src = Path(args.tracks)
     out = Path(args.out)

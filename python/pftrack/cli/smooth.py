@@ -47,12 +47,11 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     import numpy as np
 
-    from pftrack.batch.tasks import read_tracks
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig
-    from pftrack.recovery.linking import gate_for_rows
+    from pftrack.recovery.linking import gate_for_rows, read_tracks
     from pftrack.tracking import smooth_tracks
 
     src, out = Path(args.tracks), Path(args.out)

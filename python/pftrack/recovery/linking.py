@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import MAX_FRAME, real_array
-from pftrack._typing import F64
+from pftrack._typing import F64, PathLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.particle_filter.colour import (
     BinnedImage,
@@ -39,6 +39,7 @@ __all__ = [
     "link_cost_matrix",
     "link_tracklets",
     "pixel_scale",
+    "read_tracks",
     "split_tracks",
 ]
 
@@ -338,3 +339,20 @@ def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:
             f"duplicate rows for frame {int(rows[i, 0])}, id {int(rows[i, 1])}{where}: "
             "each (frame, id) may appear once"
         )
+
+
+def read_tracks(path: PathLike) -> F64:
+    """Read a tracks file whose (frame, id) pairs are unique (an error names the lines).
+
+    :func:`pftrack.io.mot.read_mot` (``what="tracks file"``), then :func:`check_unique`; the
+    file is read a second time, for its line numbers, only when a pair repeats. What
+    ``pftrack recover`` and ``pftrack smooth`` read, one file or many.
+    """
+    from pftrack.io.mot import data_line_numbers, read_mot
+
+    rows = read_mot(path, what="tracks file")
+    try:
+        check_unique(rows)
+    except ValueError:
+        check_unique(rows, data_line_numbers(path))
+    return rows
