@@ -304,7 +304,8 @@ def _tracks_files(folder: Path) -> list[Path]:
 
 
 @pytest.mark.parametrize(
-    ("command", "extra"), [("recover", ["--method", "auto", "--link"]), ("smooth", [])]
+    ("command", "extra"),
+    [("recover", ["--method", "auto", "--link"]), ("smooth", []), ("smooth", ["--no-link"])],
 )
 def test_recover_and_smooth_many_files_equal_one_by_one(
     client: Any, tmp_path: Path, command: str, extra: list[str]

@@ -87,3 +87,38 @@ def test_a_byte_order_mark_is_not_a_field(tmp_path: Path) -> None:
     np.testing.assert_array_equal(got, _slow_read(p))
     p.write_bytes(b"\xef\xbb\xbf# comment\n1,-1,10,10,8,16,1\n")  # the line-by-line reader
     assert mot.read_mot(p).shape == (1, 10)
+
+
+def test_values_read_are_written_unchanged_and_writing_is_a_fixed_point(tmp_path: Path) -> None:
+    """Regression: every value was written with 2 decimals (0.99502 -> 1.00, which column 8
+    then read as pftrack's interpolated flag) and 88.0 as 88.00 but 88 once read back."""
+    p, q = tmp_path / "in.txt", tmp_path / "out.txt"
+    text = (
+        "1,1,10,20.5,31.03,75.17,0.995616,-4.1554,-7.3591,0\n"
+        "1,2,1234.56789,0.0012345,1e-3,99,9999999999,0.99502,-0.099279,-1\n"
+        "2,1,88.00,-7.00,1.50,0.10,1.000,-1.0,-1,-1\n"
+    )
+    p.write_text(text)
+    mot.write_mot(q, mot.read_mot(p))
+    assert q.read_text().splitlines() == [
+        "1,1,10,20.5,31.03,75.17,0.995616,-4.1554,-7.3591,0",
+        "1,2,1234.56789,0.0012345,0.001,99,9999999999,0.99502,-0.099279,-1",
+        "2,1,88,-7,1.5,0.1,1,-1,-1,-1",
+    ]
+    np.testing.assert_array_equal(mot.read_mot(q), mot.read_mot(p))
+    # computed values: 2 decimals in their shortest form, and the same bytes once read back
+    rng = np.random.default_rng(1)
+    a = np.column_stack([np.arange(1, 2001), np.ones(2000), rng.normal(0, 300, (2000, 8))])
+    a[::5, 2:] = np.round(a[::5, 2:], 2)  # 88.0, 12.5: no trailing zeros
+    a[:, 4:6] = np.abs(a[:, 4:6])
+    a[::7, 3] = -np.pi * 1e-9  # rounds to 0, never "-0"
+    a[::11, 8] = 1e16
+    mot.write_mot(q, a)
+    first = q.read_bytes()
+    back = mot.read_mot(q)
+    assert np.abs(back - a).max() <= 0.005 + 1e-9
+    mot.write_mot(q, back)
+    assert q.read_bytes() == first
+    fields = first.decode().replace("\n", ",").split(",")
+    assert "-0" not in fields and not any(f.endswith((".00", ".0")) for f in fields)
+    assert all(len(f.partition(".")[2]) <= 2 for f in fields)

@@ -156,9 +156,9 @@ def sequence_metrics(
 
 def _as_written(rows: F64) -> F64:
     """`rows` rounded as ``NAME.txt`` stores them: the metrics are ``pftrack eval``'s on it."""
-    from pftrack.io.mot import format_mot_row
+    from pftrack.io.mot import mot_text
 
-    lines = [format_mot_row(r).split(",") for r in rows]
+    lines = [line.split(",") for line in mot_text(rows).splitlines()]
     return np.array(lines, dtype=np.float64).reshape(len(rows), 10)
 
 
@@ -253,17 +253,12 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
 def read_tracks(path: PathLike) -> F64:
     """Read a tracks file whose (frame, id) pairs are unique (an error names the lines).
 
-    The file is read a second time, for its line numbers, only when a pair repeats.
+    :func:`pftrack.recovery.linking.read_tracks`, which the one-file commands import without
+    this package.
     """
-    from pftrack.io.mot import data_line_numbers, read_mot
-    from pftrack.recovery import check_unique
+    from pftrack.recovery.linking import read_tracks as read
 
-    rows = read_mot(path, what="tracks file")
-    try:
-        check_unique(rows)
-    except ValueError:
-        check_unique(rows, data_line_numbers(path))
-    return rows
+    return read(path)
 
 
 @dataclass(frozen=True)
@@ -306,7 +301,7 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
         "filled_rows": rep.n_filled_rows,
         "rows_out": len(filled),
         "seconds": time.perf_counter() - t0,
-        "explain": None if rep.calibration is None else rep.calibration.describe(),
+        "explain": rep.describe(options.method),
     }
     return TaskResult(filled, {}, info)
 
@@ -332,7 +327,7 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     t0 = time.perf_counter()
     rows = read_tracks(path)
     link = gate_for_rows(LinkConfig(max_gap=options.max_gap), rows) if options.link else None
-    result = smooth_tracks(rows, link=link)
+    result = smooth_tracks(rows, link=link, max_gap=options.max_gap)
     info: dict[str, Any] = {
         "source": str(path),
         "ids_in": int(len(np.unique(rows[:, 1]))) if len(rows) else 0,

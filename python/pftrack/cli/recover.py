@@ -21,8 +21,10 @@ def add_parser(sub: Any) -> None:
         "recover",
         help="fill the gaps of any tracker's MOTChallenge output (optionally link fragments)",
         description="Fill holes of at most --max-gap frames inside each track. Filled rows "
-        "have the interpolated flag (column 8, 1-based) set to 1. Rows flagged by an earlier "
-        "run count as observed, so running it twice changes nothing more.",
+        "have the interpolated flag (column 8, 1-based) set to 1 and columns 9-10 set to -1; "
+        "observed rows keep their values (written in their shortest form: 88.00 as 88). Rows "
+        "flagged by an earlier run count as observed, so running it twice changes nothing "
+        "more.",
     )
     p.add_argument("tracks", nargs="+", help="MOTChallenge tracks file (frame,id,left,top,w,h,"
                    "conf,x,y,z); several, or folders of *.txt: a batch on Dask, --out is then a "
@@ -57,11 +59,10 @@ def run(args: argparse.Namespace) -> int:
     if args.video and not args.link:
         raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
-    from pftrack.batch.tasks import read_tracks
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
-    from pftrack.recovery.linking import gate_for_rows
+    from pftrack.recovery.linking import gate_for_rows, read_tracks
 
     src = Path(args.tracks)
     out = Path(args.out)
@@ -92,17 +93,17 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"{src}: {len(rows)} rows, {n_links} fragments linked, {rep.n_gaps} gaps filled with "
         f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "
-        f"(interpolated flag: column 8)"
+        f"({flag_note(rows)})"
     )
     if args.explain:
-        if rep.calibration is not None:
-            print("box centres (x, y):")
-            print(rep.calibration.describe())
-        if rep.size_calibration is not None:
-            print("box sizes (w, h):")
-            print(rep.size_calibration.describe())
-        elif args.method == "auto":
-            print("auto: no gap to fill")
-        else:
-            print(f"--explain: {args.method} was given, nothing was chosen")
+        print(rep.describe(args.method))
     return 0
+
+
+def flag_note(rows: Any) -> str:
+    """How filled rows are marked, and how many input rows were marked so already."""
+    from pftrack.recovery.linking import filled_mask
+
+    note = "interpolated flag: column 8 = 1, columns 9-10 = -1"
+    n = int(filled_mask(rows).sum())
+    return note + (f"; {n} input rows had it already, kept as observed" if n else "")

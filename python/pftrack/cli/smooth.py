@@ -21,7 +21,8 @@ def add_parser(sub: Any) -> None:
         "tracker's output: join fragments of one object by motion and size across gaps of up "
         "to --max-gap frames (gate: 50 px, times the diagonal of the boxes' extent over 800 "
         "when it is larger than 640x480), add the frames missing inside each track (recovered "
-        "by the method of pftrack recover, auto; flagged 1 in column 8), "
+        "by the method of pftrack recover, auto; flagged 1 in column 8, with -1 in columns "
+        "9-10; also with --no-link), "
         "and replace every box by a Rauch-Tung-Striebel smoother's estimate over the whole "
         "track. Smoothing is not idempotent: run it once, on raw output.",
     )
@@ -32,7 +33,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--max-gap", type=batch.max_gap, default=30, metavar="FRAMES",
                    help=f"longest gap joined and filled, in frames (1 to {batch.MAX_GAP}; longer "
                    "holes stay holes: bounded work)")  # fmt: skip
-    p.add_argument("--no-link", action="store_true", help="smooth each id as it is")
+    p.add_argument("--no-link", action="store_true",
+                   help="join no fragments: fill the holes inside each id and smooth each id "
+                   "as it is")  # fmt: skip
     batch.add_batch_options(p)
     p.set_defaults(func=run)
 
@@ -44,11 +47,11 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     import numpy as np
 
-    from pftrack.batch.tasks import read_tracks
+    from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig
-    from pftrack.recovery.linking import gate_for_rows
+    from pftrack.recovery.linking import gate_for_rows, read_tracks
     from pftrack.tracking import smooth_tracks
 
     src, out = Path(args.tracks), Path(args.out)
@@ -57,12 +60,12 @@ def run(args: argparse.Namespace) -> int:
     check_output(out, what="--out")
     rows = read_tracks(src)
     link = None if args.no_link else gate_for_rows(LinkConfig(max_gap=args.max_gap), rows)
-    result = smooth_tracks(rows, link=link)
+    result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
     write_mot(out, result)
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
     print(
         f"{src}: {ids_in} ids, {len(rows)} rows -> {ids_out} ids, {len(result)} rows "
-        f"(filled rows flagged in column 8) -> {out}"
+        f"({flag_note(rows)}) -> {out}"
     )
     return 0

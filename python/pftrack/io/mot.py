@@ -1,7 +1,9 @@
 """MOTChallenge text files: ``frame,id,left,top,width,height,conf,x,y,z`` one box a line.
 
 Frames count from 1. Detection files use id -1. pftrack reads comma- or whitespace-separated
-files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``) and always writes 10.
+files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``) and always writes 10:
+the values a file held come out unchanged, in their shortest form (``88.00`` as ``88``); values
+pftrack computed are rounded to 2 decimals (:func:`mot_text`).
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import MAX_COORD, MAX_FRAME
-from pftrack._typing import PathLike
+from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write
 
 #: Column indices of a MOTChallenge row.
@@ -133,14 +135,126 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
     return a
 
 
+#: A value is written exactly when it needs at most this many significant digits (every number
+#: a MOTChallenge file holds as text, a tracker's ``%.6f`` of a 4-digit pixel position too,
+#: and a computed value that happens to be that short, such as the midpoint 53.485 of two
+#: 2-decimal sizes); others (what pftrack computes) are rounded to 2 decimals.
+EXACT_DIGITS = 10
+_POW10 = np.array([float(f"1e{k}") for k in range(23)])  # exact doubles
+
+
+def _decimals(v: F64, limit: float, most: int) -> NDArray[np.int64]:
+    """The fewest decimals ``d <= most`` that print each of `v` exactly, or -1.
+
+    ``d`` prints ``v`` exactly when ``v`` is the double nearest to ``n / 10**d`` for the integer
+    ``n = rint(v * 10**d)`` and ``|n| < limit`` (<= 2**52, so ``%.{d}f`` prints the digits of
+    ``n``): the division of two exact doubles is correctly rounded, as is parsing the text back.
+    """
+    x = v.ravel()
+    d = np.full(x.size, -1, np.int64)
+    idx: NDArray[np.intp] | None = None  # where x is in v; None: everywhere
+    for k in range(most + 1):
+        if k:
+            n = x * _POW10[k]
+            np.rint(n, out=n)
+            small = np.abs(n) < limit
+            n /= _POW10[k]
+        else:  # the same, without multiplying and dividing by 1
+            n = np.rint(x)
+            small = np.abs(n) < limit
+        ok = n == x
+        ok &= small
+        d[ok if idx is None else idx[ok]] = k
+        small &= ~ok  # the rest: |n| only grows with k
+        idx = np.flatnonzero(small) if idx is None else idx[small]
+        if not idx.size:
+            break
+        x = x[small]
+    return d
+
+
+def _printable(a: F64) -> tuple[F64, NDArray[np.int64]]:
+    """The values written for columns 3-10 of `a` (M, 10) and the decimals of each.
+
+    A value with at most :data:`EXACT_DIGITS` significant digits is written exactly, with the
+    fewest decimals; any other is rounded to 2 decimals as ``%.2f`` rounds it, then written
+    with the fewest decimals that value needs. So a file read back writes the same text
+    (``88.00`` is written ``88`` the first time already) and the values a file held are
+    written unchanged.
+    """
+    v = a[:, 2:].ravel()
+    d = _decimals(v, 10.0**EXACT_DIGITS, len(_POW10) - 1)
+    rest = d < 0
+    if rest.any():
+        v = v.copy()
+        p = v[rest] * 100.0
+        r = np.rint(p) / 100.0
+        tie = np.flatnonzero(p - np.floor(p) == 0.5)  # the product rounded to a tie: as %.2f
+        r[tie] = [float(f"{x:.2f}") for x in v[rest][tie].tolist()]
+        dr = _decimals(r, 1e15, 2)
+        dr[dr < 0] = np.where(r[dr < 0] == np.floor(r[dr < 0]), 0, 2)  # beyond ±1e13
+        v[rest], d[rest] = r, dr
+    v = v + 0.0  # -0.0 -> 0.0: never "-0"
+    return v.reshape(len(a), -1), d.reshape(len(a), -1)
+
+
+def _lines(a: F64) -> str:
+    """The MOTChallenge lines of checked (M, 10) rows, in their order."""
+    if not len(a):
+        return ""
+    values, dec = _printable(a)
+    pattern = dec @ (np.int64(1) << (5 * np.arange(8, dtype=np.int64)))  # 5 bits a column
+    fmts = {
+        int(k): ",".join(["%d", "%d"] + [f"%.{k >> 5 * j & 31}f" for j in range(8)]) + "\n"
+        for k in np.unique(pattern).tolist()
+    }
+    flat = np.column_stack([a[:, :2], values]).ravel().tolist()
+    # one % over all values: a third less time than one % per row
+    return "".join([fmts[k] for k in pattern.tolist()]) % tuple(flat)
+
+
+def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) -> F64:
+    """`rows` (M, 6..10) as (M, 10) float64 with the default columns added, or a ValueError."""
+    a = np.asarray(rows, dtype=np.float64)
+    if a.size == 0:
+        a = np.zeros((0, 10))
+    if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
+        raise ValueError(f"{who}: rows must have shape (M, 6..10), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        k = int(np.flatnonzero(~np.all(np.isfinite(a), axis=1))[0])
+        raise ValueError(f"{who}: row {k} has NaN or inf: {a[k].tolist()}")
+    ids = a[:, :2]
+    if np.any(ids != np.round(ids)) or np.any(np.abs(ids) > 2**53):
+        k = int(np.flatnonzero(np.any((ids != np.round(ids)) | (np.abs(ids) > 2**53), axis=1))[0])
+        raise ValueError(f"{who}: row {k} has a frame or id that is not an integer: "
+                         f"{a[k, :2].tolist()}")  # fmt: skip
+    if a.shape[1] < 10:
+        pad = np.tile(np.asarray(_DEFAULTS[a.shape[1] :]), (a.shape[0], 1))
+        a = np.hstack([a, pad])
+    return a
+
+
+def mot_text(rows: NDArray[np.float64] | Iterable[Iterable[float]]) -> str:
+    """The MOTChallenge lines :func:`write_mot` writes for `rows` (M, 6..10), in their order.
+
+    Frame and id as integers; every other value exactly when it has at most
+    :data:`EXACT_DIGITS` significant digits (every value a file held), else rounded to 2
+    decimals (values pftrack computed); with the fewest decimals either way (``88``,
+    ``0.99502``, ``12.35``). So the text of what :func:`read_mot` reads of it is the same.
+    Missing columns get the defaults ``conf=1, x=y=z=-1``.
+
+    Raises
+    ------
+    ValueError
+        Rows not ``(M, 6..10)``, a NaN or infinite value, or a frame or id that is not an
+        integer.
+    """
+    return _lines(_checked(rows, "mot_text"))
+
+
 def format_mot_row(row: Iterable[float]) -> str:
-    """One MOTChallenge line (10 columns): integers where integral, else 2 decimals."""
-    r = list(row)
-    out = [str(int(r[FRAME])), str(int(r[ID]))]
-    for v in r[2:]:
-        v = float(v)
-        out.append(str(int(v)) if v == int(v) and abs(v) < 1e15 else f"{v:.2f}")
-    return ",".join(out)
+    """One MOTChallenge line (10 columns, no newline), as :func:`mot_text` writes it."""
+    return _lines(_checked([list(row)], "format_mot_row"))[:-1]
 
 
 def write_mot(path: PathLike, rows: NDArray[np.float64] | Iterable[Iterable[float]]) -> None:
@@ -148,37 +262,13 @@ def write_mot(path: PathLike, rows: NDArray[np.float64] | Iterable[Iterable[floa
 
     Columns beyond those given get the defaults ``conf=1, x=y=z=-1``. Every value must be
     finite and frames and ids integers (a ValueError names the first bad row otherwise).
+    Values are written as :func:`mot_text` writes them: a value read from a file comes out
+    unchanged, in its shortest form, and writing what :func:`read_mot` reads of a written file
+    gives the same bytes.
     """
-    a = np.asarray(rows, dtype=np.float64)
-    if a.size == 0:
-        a = np.zeros((0, 10))
-    if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
-        raise ValueError(f"write_mot: rows must have shape (M, 6..10), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        k = int(np.flatnonzero(~np.all(np.isfinite(a), axis=1))[0])
-        raise ValueError(f"write_mot: row {k} has NaN or inf: {a[k].tolist()}")
-    ids = a[:, :2]
-    if np.any(ids != np.round(ids)) or np.any(np.abs(ids) > 2**53):
-        k = int(np.flatnonzero(np.any((ids != np.round(ids)) | (np.abs(ids) > 2**53), axis=1))[0])
-        raise ValueError(f"write_mot: row {k} has a frame or id that is not an integer: "
-                         f"{a[k, :2].tolist()}")  # fmt: skip
-    if a.shape[1] < 10:
-        pad = np.tile(np.asarray(_DEFAULTS[a.shape[1] :]), (a.shape[0], 1))
-        a = np.hstack([a, pad])
-    if not np.all(np.isfinite(a)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(a), axis=1))[0])
-        raise ValueError(f"write_mot: row {bad} has a non-finite value: {a[bad].tolist()}")
+    a = _checked(rows, "write_mot")
     a = a[np.lexsort((a[:, ID], a[:, FRAME]))]
-    # format_mot_row, vectorised: one format string per pattern of integral columns
-    integral = (a[:, 2:] == np.floor(a[:, 2:])) & (np.abs(a[:, 2:]) < 1e15)
-    pattern = integral @ (1 << np.arange(8))
-    fmts = {
-        int(k): ",".join(["%d", "%d"] + ["%d" if k >> j & 1 else "%.2f" for j in range(8)]) + "\n"
-        for k in np.unique(pattern)
-    }
-    a = a + 0.0  # -0.0 -> 0.0, as int() writes it
-    # one % over all values: a third less time than one % per row
-    text = "".join([fmts[k] for k in pattern.tolist()]) % tuple(a.ravel().tolist())
+    text = _lines(a)
     with atomic_write(path) as fh:
         fh.write(text)
 

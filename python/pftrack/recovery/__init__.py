@@ -33,7 +33,13 @@ if TYPE_CHECKING:
         goal_directed_path,
         sample_goal_directed_paths,
     )
-    from pftrack.recovery.linking import FLAG_COLUMN, LinkConfig, check_unique, link_tracklets
+    from pftrack.recovery.linking import (
+        FLAG_COLUMN,
+        LinkConfig,
+        check_unique,
+        filled_mask,
+        link_tracklets,
+    )
     from pftrack.recovery.mixture import MotionFit, fit_motion
     from pftrack.recovery.names import DEFAULT_METHOD, METHODS
     from pftrack.recovery.noise import NoiseEstimate, estimate_noise
@@ -48,7 +54,13 @@ _HOME = {
         "goal_directed_path",
         "sample_goal_directed_paths",
     ),
-    "pftrack.recovery.linking": ("FLAG_COLUMN", "LinkConfig", "check_unique", "link_tracklets"),
+    "pftrack.recovery.linking": (
+        "FLAG_COLUMN",
+        "LinkConfig",
+        "check_unique",
+        "filled_mask",
+        "link_tracklets",
+    ),
     "pftrack.recovery.mixture": ("MotionFit", "fit_motion"),
     "pftrack.recovery.noise": ("NoiseEstimate", "estimate_noise"),
     "pftrack.recovery.problems": ("GdtProblem", "SegmentModel", "gdt_bi_problem", "gdt_problem"),
@@ -71,6 +83,7 @@ __all__ = [
     "check_unique",
     "estimate_noise",
     "fill_gaps",
+    "filled_mask",
     "fit_motion",
     "gdt_bi_problem",
     "gdt_problem",

@@ -3,6 +3,8 @@
 Every hole of at most ``max_gap`` frames inside an id's track is filled by a recovery method
 (:mod:`pftrack.recovery.registry`); filled rows carry the **interpolated flag in column 8**
 (1-based; index :data:`~pftrack.recovery.linking.FLAG_COLUMN`): ``1`` on every row pftrack filled,
+with columns 9-10 ``-1`` (:data:`~pftrack.recovery.linking.FILLED_MARK`; test a row with
+:func:`~pftrack.recovery.linking.filled_mask`, as column 8 alone may hold 1 in ground truth);
 observed rows untouched. Rows already flagged count as observed when a file is processed again,
 so running the fill twice changes nothing more.
 """
@@ -16,6 +18,7 @@ import numpy as np
 from pftrack._typing import F64
 from pftrack.recovery.calibrate import Calibration, recover_auto
 from pftrack.recovery.linking import (
+    FILLED_MARK,
     FLAG_COLUMN,
     box_centres,
     check_rows,
@@ -64,6 +67,24 @@ class FillReport:
     calibration: Calibration | None = None
     size_calibration: Calibration | None = None
 
+    def describe(self, method: str) -> str:
+        """What ``pftrack recover --explain`` prints for a fill by `method`.
+
+        With ``"auto"``, the choice for the box centres, then for the box sizes
+        (:meth:`~pftrack.recovery.calibrate.Calibration.describe`), or that there was no gap
+        to fill; with a named method, that nothing was chosen.
+        """
+        parts = []
+        if self.calibration is not None:
+            parts += ["box centres (x, y):", self.calibration.describe()]
+        if self.size_calibration is not None:
+            parts += ["box sizes (w, h):", self.size_calibration.describe()]
+        elif method == "auto":
+            parts.append("auto: no gap to fill")
+        else:
+            parts.append(f"--explain: {method} was given, nothing was chosen")
+        return "\n".join(parts)
+
 
 def fill_gaps(
     tracks: F64,
@@ -102,8 +123,9 @@ def fill_gaps(
         The rows plus the filled ones, sorted by (frame, id). Filled rows get positions from
         `method`; sizes from the same calibration with ``"auto"`` (:data:`SIZE_CANDIDATES`,
         never below half the smaller end size), else by linear interpolation; ``conf`` = the
-        smaller of the two neighbours' and the interpolated flag (column 8,
-        :data:`FLAG_COLUMN`) set to 1.
+        smaller of the two neighbours' and columns 8-10 ``1, -1, -1``: the interpolated flag
+        (column 8, :data:`FLAG_COLUMN`) and no world ``y``, ``z`` (:data:`FILLED_MARK`).
+        Observed rows are returned unchanged.
     report : FillReport
         How many holes and rows were filled; with ``"auto"``, what was chosen
         (``report.calibration``).
@@ -208,9 +230,7 @@ def fill_rows(
             out[:, 4] = w
             out[:, 5] = h
             out[:, 6] = min(ra[6], rb[6])
-            out[:, FLAG_COLUMN] = 1.0
-            out[:, 8] = -1.0
-            out[:, 9] = -1.0
+            out[:, FLAG_COLUMN : FLAG_COLUMN + 3] = FILLED_MARK
             new_rows.append(out)
     added = np.vstack(new_rows) if new_rows else np.zeros((0, 10))
     return added, FillReport(len(segs), len(added), noise, calibration, size_cal)

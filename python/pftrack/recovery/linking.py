@@ -3,8 +3,10 @@
 Rows are ``(M, 10)`` MOTChallenge arrays ``frame,id,left,top,width,height,conf,x,y,z``.
 Rows pftrack fills (:mod:`pftrack.recovery.fill`, the offline tracker) carry the
 **interpolated flag in column 8** (1-based; index :data:`FLAG_COLUMN` = 7, the world-``x``
-column, which is -1 in 2D MOTChallenge files): ``1`` on every filled row, observed rows
-untouched.
+column, which is -1 in 2D MOTChallenge files): ``1`` on every filled row, with columns 9-10
+``-1``; observed rows untouched. Column 8 alone can hold 1 in an observed row (class 1,
+pedestrian, in MOT16+ ground truth; a world ``x`` in MOT15's): :func:`filled_mask` tests all
+three columns.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import MAX_FRAME, real_array
-from pftrack._typing import F64
+from pftrack._typing import F64, PathLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.particle_filter.colour import (
     BinnedImage,
@@ -26,19 +28,24 @@ from pftrack.particle_filter.colour import (
 )
 
 __all__ = [
+    "FILLED_MARK",
     "FLAG_COLUMN",
     "LinkConfig",
     "box_centres",
     "check_rows",
     "check_unique",
+    "filled_mask",
     "gate_for_rows",
     "link_cost_matrix",
     "link_tracklets",
     "pixel_scale",
+    "read_tracks",
     "split_tracks",
 ]
 
 FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTChallenge row)
+#: Columns 8-10 (1-based) of every row pftrack filled: the flag, then no world ``y``, ``z``.
+FILLED_MARK = (1.0, -1.0, -1.0)
 #: Frames up to this diagonal (640x480) take pixel settings as given; larger ones scale them.
 REFERENCE_DIAGONAL = 800.0
 #: Largest absolute track id accepted.
@@ -108,6 +115,38 @@ def gate_for_rows(config: LinkConfig, rows: ArrayLike) -> LinkConfig:
     bottom = float(np.max(a[:, 3] + a[:, 5]))
     scale = pixel_scale(max(right, 0.0), max(bottom, 0.0))
     return replace(config, max_distance=config.max_distance * scale)
+
+
+def filled_mask(rows: ArrayLike) -> NDArray[np.bool_]:
+    """Which MOTChallenge rows pftrack filled: columns 8-10 (1-based) are ``1, -1, -1``.
+
+    Parameters
+    ----------
+    rows : (M, 10) array_like
+        MOTChallenge rows, e.g. :func:`pftrack.io.mot.read_mot` of a ``pftrack recover`` or
+        ``pftrack smooth`` output.
+
+    Returns
+    -------
+    (M,) ndarray of bool
+        True where the interpolated flag (column 8, :data:`FLAG_COLUMN`) is 1 and columns 9-10
+        are -1 (:data:`FILLED_MARK`). An observed row of a tracker's output (``-1, -1, -1``),
+        of MOT16+ ground truth (class, visibility in 0..1, ``-1``) or of MOT15 ground truth
+        (world coordinates) never matches unless it holds those three values exactly.
+
+    Raises
+    ------
+    ValueError
+        If `rows` is not ``(M, 10)``.
+    """
+    a = np.asarray(rows, dtype=np.float64)
+    if a.size == 0:
+        return np.zeros(0, dtype=bool)
+    if a.ndim != 2 or a.shape[1] != 10:
+        raise ValueError(f"filled_mask: rows must have shape (M, 10), got {a.shape}")
+    mark = np.asarray(FILLED_MARK)
+    out: NDArray[np.bool_] = np.all(a[:, FLAG_COLUMN : FLAG_COLUMN + 3] == mark, axis=1)
+    return out
 
 
 def box_centres(rows: F64) -> F64:
@@ -300,3 +339,20 @@ def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:
             f"duplicate rows for frame {int(rows[i, 0])}, id {int(rows[i, 1])}{where}: "
             "each (frame, id) may appear once"
         )
+
+
+def read_tracks(path: PathLike) -> F64:
+    """Read a tracks file whose (frame, id) pairs are unique (an error names the lines).
+
+    :func:`pftrack.io.mot.read_mot` (``what="tracks file"``), then :func:`check_unique`; the
+    file is read a second time, for its line numbers, only when a pair repeats. What
+    ``pftrack recover`` and ``pftrack smooth`` read, one file or many.
+    """
+    from pftrack.io.mot import data_line_numbers, read_mot
+
+    rows = read_mot(path, what="tracks file")
+    try:
+        check_unique(rows)
+    except ValueError:
+        check_unique(rows, data_line_numbers(path))
+    return rows

@@ -26,7 +26,7 @@ from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh_rows, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, cv_predict, cv_update_where, rts_smooth
-from pftrack.recovery.fill import fill_rows
+from pftrack.recovery.fill import MAX_GAP_LIMIT, fill_rows
 from pftrack.recovery.linking import (
     MAX_ID,
     LinkConfig,
@@ -443,6 +443,7 @@ def smooth_tracks(
     seed: int = 0,
     crossings: CrossingConfig | None = None,
     relink_coast: int | None = None,
+    max_gap: int | None = None,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 
@@ -463,7 +464,7 @@ def smooth_tracks(
         (:func:`pftrack.recovery.fill.fill_rows`, the default of ``pftrack recover``), shifted
         by the smoother's correction of the boxes on each side, and flagged in column 8
         (1-based) as pftrack's filled rows are (:data:`pftrack.recovery.linking.FLAG_COLUMN`).
-        None keeps ids and holes.
+        None keeps ids, and holes unless `max_gap` is given.
     measurements : (M, 4) array_like, optional
         The boxes the smoother fits at observed rows, when they differ from the rows' own
         (which linking uses): e.g. raw detections behind a tracker's filtered boxes.
@@ -482,6 +483,10 @@ def smooth_tracks(
         unobserved rows of its track, the track is cut there and those rows are left out
         (:func:`split_refound`), so that the linker decides whether the two pieces are one
         object; a kept join gets the hole filled as any other. None (default): off.
+    max_gap : int or None
+        With a smoother: fill the holes of at most this many frames inside each id's track,
+        as `link` does (an int in ``1..MAX_GAP_LIMIT``; ``pftrack smooth --no-link`` passes
+        it without `link`). None (default): ``link.max_gap``, and no filling without `link`.
 
     Returns
     -------
@@ -492,8 +497,17 @@ def smooth_tracks(
     ------
     ValueError
         Rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
-        id, a non-finite box, or `observed` / `measurements` of the wrong shape.
+        id, a non-finite box, `observed` / `measurements` of the wrong shape, or `max_gap` not
+        None or an int in ``1..MAX_GAP_LIMIT``.
     """
+    if max_gap is not None and (
+        isinstance(max_gap, bool)
+        or not isinstance(max_gap, (int, np.integer))
+        or not 1 <= max_gap <= MAX_GAP_LIMIT
+    ):
+        raise ValueError(
+            f"smooth_tracks: max_gap is {max_gap!r}, expected None or an int in 1..{MAX_GAP_LIMIT}"
+        )
     a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "smooth_tracks")
     a = a.copy()
     obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
@@ -515,6 +529,7 @@ def smooth_tracks(
         raise ValueError(
             f"smooth_tracks: relink_coast is {relink_coast!r}, expected None or an int >= 1"
         )
+    fill_gap = max_gap if max_gap is not None else None if link is None else link.max_gap
     if link is not None and relink_coast is not None:
         a, obs, z = split_refound(a, obs, z, relink_coast)
     if link is not None:
@@ -524,8 +539,8 @@ def smooth_tracks(
     order = np.lexsort((a[:, 0], a[:, 1]))  # by id, then frame
     a, obs, z = a[order], obs[order], z[order]
     new = np.zeros(len(a), dtype=bool)
-    if smoother is not None and link is not None:
-        a, obs, z, new = _add_hole_rows(a, obs, z, link.max_gap, fill_method, seed)
+    if smoother is not None and fill_gap is not None:
+        a, obs, z, new = _add_hole_rows(a, obs, z, fill_gap, fill_method, seed)
     if smoother is not None:
         starts = np.flatnonzero(np.r_[True, a[1:, 1] != a[:-1, 1], True])
         spans = list(zip(starts[:-1], starts[1:], strict=True))
