@@ -83,16 +83,17 @@ def write_annotated_video(
     fps: float = 10.0,
     *,
     trail: int = 40,
+    preset: str = "ultrafast",
 ) -> Path:
     """Write `frames` with the tracks of `rows` (MOT, 1-based frames) drawn on, atomically.
 
-    ``.mp4`` is H.264 (see :class:`~pftrack.io.video_writer.VideoWriter`), ``.avi`` MJPG. Each
-    track trails its foot points of the last `trail` frames.
+    ``.mp4`` is H.264 (see :class:`~pftrack.io.video_writer.VideoWriter`, whose x264 `preset`
+    this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames.
     """
     by_frame = group_by_frame(rows)
     empty = np.zeros((0, 10))
     trails: dict[int, deque[tuple[float, float]]] = {}
-    with VideoWriter(path, fps) as writer:
+    with VideoWriter(path, fps, preset=preset) as writer:
         for k, frame in enumerate(frames, start=1):
             here = by_frame.get(k, empty)
             for r in here:
@@ -142,6 +143,8 @@ class TrackRenderer:
         Encoder (default: PyAV when installed).
     queue_size : int
         Frames waiting for the worker at most; :meth:`add` blocks beyond.
+    preset : str
+        x264 preset of an ``.mp4`` (:class:`~pftrack.io.video_writer.VideoWriter`).
     """
 
     def __init__(
@@ -153,10 +156,11 @@ class TrackRenderer:
         threaded: bool = True,
         backend: str | None = None,
         queue_size: int = 8,
+        preset: str = "ultrafast",
     ) -> None:
         if trail < 0:
             raise ValueError(f"trail is {trail}, expected >= 0")
-        self.writer = VideoWriter(path, fps, backend=backend)
+        self.writer = VideoWriter(path, fps, backend=backend, preset=preset)
         self.trail = int(trail)
         self._trails: dict[int, deque[tuple[float, float]]] = {}
         self._error: BaseException | None = None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import os
 import stat
 from collections.abc import Iterator
@@ -111,6 +112,7 @@ def test_output_keeps_the_umask(tmp_path: Path, umask: int) -> None:
         ({"path": "v.mp4", "fps": float("nan")}, "frame rate is nan"),
         ({"path": "v.avi", "fps": 7, "backend": "pyav"}, "writes .mp4"),
         ({"path": "v.mp4", "fps": 7, "backend": "gst"}, "backend is 'gst'"),
+        ({"path": "v.mp4", "fps": 7, "preset": "quick"}, "preset is 'quick', expected one of"),
     ],
 )
 def test_bad_arguments_are_one_clear_error(
@@ -120,3 +122,18 @@ def test_bad_arguments_are_one_clear_error(
     with pytest.raises(ValueError, match=message):
         VideoWriter(**kwargs)  # type: ignore[arg-type]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_preset_trades_encoding_time_for_size(tmp_path: Path) -> None:
+    frames = _frames(40, 120, 160)
+    sizes = {}
+    for preset in ("ultrafast", "medium"):
+        with VideoWriter(tmp_path / f"{preset}.mp4", 10, preset=preset) as writer:
+            for f in frames:
+                writer.write(f)
+        assert writer.preset == preset
+        sizes[preset] = (tmp_path / f"{preset}.mp4").stat().st_size
+        _, got = decode(tmp_path / f"{preset}.mp4")
+        assert len(got) == 40 and np.abs(got[-1].astype(int) - frames[-1]).mean() < 6
+    assert sizes["ultrafast"] > sizes["medium"]  # the same quality target, a larger file
+    assert inspect.signature(VideoWriter).parameters["preset"].default == "ultrafast"
