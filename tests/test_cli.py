@@ -345,7 +345,14 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
         assert exc.value.code == 2
         err = capsys.readouterr().err.strip().splitlines()[-1]
         assert err.startswith("pftrack recover: error: argument --max-distance: expected a")
+    # was: --seed silently ignored by every method but auto
+    assert main(["recover", str(src), "--out", str(out), "--method", "linear", "--seed", "3"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "pftrack recover: error: --seed is used only by --method auto (its calibration gaps), "
+        "not linear; drop it"
+    )
     assert not out.exists()
+    assert main(["recover", str(src), "--out", str(out), "--seed", "3"]) == 0  # auto: used
 
 
 def test_library_warnings_are_one_line_for_every_command(
@@ -426,6 +433,7 @@ def test_crossings_without_the_smoother_are_refused(
         (["track", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
         (["demo", "--seed", "-1"], "argument --seed: expected an integer >= 0, got -1"),
         (["batch", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
+        (["recover", "T", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer"),
         (
             ["track", "V", "--out", "O", "--min-conf", "nan"],
             "argument --min-conf: expected a finite number, got nan",
@@ -464,8 +472,9 @@ def test_bad_option_values_are_named_in_one_line(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     """Were: "expected non-negative integer", "LifecycleConfig: min_score is nan", a nan
-    birth score accepted, "LinkConfig.max_gap is ...", "fill_gaps: max_gap is ...", and
-    batch's --det-scale accepting what track refused (the sequence then failed)."""
+    birth score accepted, "LinkConfig.max_gap is ...", "fill_gaps: max_gap is ...",
+    batch's --det-scale accepting what track refused (the sequence then failed), and
+    recover's --seed -1 accepted."""
     tracks = _tracks(tmp_path / "t.txt")
     names = {"V": str(video), "T": str(tracks), "O": str(tmp_path / "o.txt")}
     argv = [names.get(a, a) for a in argv]
