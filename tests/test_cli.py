@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 from pathlib import Path
 
@@ -183,6 +184,26 @@ def test_experiment_gaps_several_sequences_writes_json(tmp_path: Path) -> None:
     assert set(doc["pooled"]["mmae"]) == {"auto", "linear"}
     for s in doc["sequences"]:
         assert 1 <= len(s["masks"]) <= 3 and all(m[2] == 100 for m in s["masks"])
+
+
+@pytest.mark.parametrize("command", ["eval", "batch"])
+@pytest.mark.parametrize("iou", ["1.5", "0", "-0.5", "nan", "inf"])
+def test_iou_is_refused_alike_by_eval_and_batch(
+    command: str, iou: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: batch --iou 1.5, 0 or nan accepted (each sequence's scoring then failed), eval
+    # refusing them with its own "--iou is 1.5, expected in (0, 1]"
+    argv = {
+        "eval": ["eval", "--gt", "g.txt", "--res", "r.txt"],
+        "batch": ["batch", "v.avi", "--out", str(tmp_path / "out"), "--workers", "0"],
+    }[command]
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, "--iou", iou])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    message = f"argument --iou: expected a number in (0, 1], got {iou}"
+    assert err == f"pftrack {command}: error: {message}"
+    assert not (tmp_path / "out").exists()
 
 
 def test_unwritable_output_folder_is_refused_before_work(
@@ -435,6 +456,10 @@ def test_crossings_without_the_smoother_are_refused(
         (["batch", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
         (["recover", "T", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer"),
         (
+            ["eval", "--gt", "T", "--res", "T", "--image-size", "0", "360"],
+            "argument --image-size: expected an integer in [1, 100000], got 0",
+        ),
+        (
             ["track", "V", "--out", "O", "--min-conf", "nan"],
             "argument --min-conf: expected a finite number, got nan",
         ),
@@ -473,8 +498,8 @@ def test_bad_option_values_are_named_in_one_line(
 ) -> None:
     """Were: "expected non-negative integer", "LifecycleConfig: min_score is nan", a nan
     birth score accepted, "LinkConfig.max_gap is ...", "fill_gaps: max_gap is ...",
-    batch's --det-scale accepting what track refused (the sequence then failed), and
-    recover's --seed -1 accepted."""
+    batch's --det-scale accepting what track refused (the sequence then failed), recover's
+    --seed -1 accepted, and eval's "gt: evaluate_mot: image_size is (0, 360)"."""
     tracks = _tracks(tmp_path / "t.txt")
     names = {"V": str(video), "T": str(tracks), "O": str(tmp_path / "o.txt")}
     argv = [names.get(a, a) for a in argv]
@@ -529,6 +554,16 @@ def test_option_bounds_stated_for_help_are_the_librarys(tmp_path: Path) -> None:
         LinkConfig(max_gap=batch.MAX_GAP + 1)
     with pytest.raises(ValueError, match="max_gap"):
         fill_gaps(np.zeros((0, 10)), "linear", batch.MAX_GAP + 1)
+    from pftrack.cli._options import iou_threshold
+
+    one = np.array([[1, 1, 10, 10, 20, 40, 1, -1, -1, -1]], dtype=np.float64)
+    for inside in ("1", "1e-9"):
+        evaluate_mot(one, one, iou_threshold=iou_threshold(inside))
+    for outside in (0.0, 1.0 + 1e-9, float("nan")):
+        with pytest.raises(ValueError, match="iou_threshold"):
+            evaluate_mot(one, one, iou_threshold=outside)
+        with pytest.raises(argparse.ArgumentTypeError):
+            iou_threshold(str(outside))
     lo, hi = DET_SCALE_RANGE
     empty = tmp_path / "det.txt"
     empty.write_text("")
