@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 from pathlib import Path
 
@@ -185,6 +186,107 @@ def test_experiment_gaps_several_sequences_writes_json(tmp_path: Path) -> None:
         assert 1 <= len(s["masks"]) <= 3 and all(m[2] == 100 for m in s["masks"])
 
 
+def test_experiment_gaps_one_sequence_writes_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    # was: --json silently ignored with one --gt (only the multi-sequence protocol wrote it)
+    gt = _walkers(tmp_path / "gt.txt")
+    out = tmp_path / "one.json"
+    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--methods",
+            "linear,gdt-bi", "--repeat", "1", "--max-positions", "2",
+            "--json", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    said = capsys.readouterr().out
+    assert f"json: {out}" in said
+    doc = json.loads(out.read_text())
+    assert doc["gt"] == str(gt) and doc["methods"] == ["linear", "gdt-bi"]
+    assert doc["image_size"] == [768, 576] and doc["point"] == "centre"
+    mask = doc["mask"]
+    assert f"x,y,w,h = {','.join(f'{v:g}' for v in mask['box'])}:" in said
+    assert f"{mask['n_gaps']} gaps, {mask['n_lost_points']} lost points" in said
+    for m in ("linear", "gdt-bi"):
+        errors = mask["gap_errors"][m]
+        assert len(errors) == mask["n_gaps"] > 0
+        assert mask["scores"][m]["mmae_total"] == pytest.approx(np.mean(errors))
+    row = said.split("MMAE total")[1].split()[:2]  # the representative mask's table
+    assert row == [f"{mask['scores'][m]['mmae_total']:.3f}" for m in ("linear", "gdt-bi")]
+    sweep = doc["sweep"]
+    assert (sweep["size"], sweep["grid"], sweep["selection"]) == (100, 4, ">= 3 gaps")
+    assert sweep["median"]["n_positions"] == 2
+    assert sum(sweep["median"]["best_at"].values()) == 2
+
+
+def _walkers(path: Path) -> Path:
+    """Ground truth of 15 random walkers over 150 frames of a 768x576 scene."""
+    rng = np.random.default_rng(4)
+    rows = []
+    for tid in range(1, 16):
+        t = np.arange(1, 151, dtype=np.float64)
+        xy = rng.uniform(100, 600, 2) + np.cumsum(
+            rng.normal(0, 0.5, (150, 2)) + rng.uniform(-2, 2, 2), axis=0
+        )
+        r = np.full((150, 10), -1.0)
+        r[:, 0], r[:, 1], r[:, 2:4], r[:, 4:6], r[:, 6] = t, tid, np.clip(xy, 20, 700) - 5, 10, 1
+        rows.append(r)
+    write_mot(path, np.vstack(rows))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("gts", "options", "message"),
+    [
+        (2, ["--figure", "f.png"], "--figure belongs to the one-sequence mask sweep; with several "
+         "--gt files (automatic masks per sequence) nothing uses it: drop it"),
+        (1, ["--auto-masks", "--repeat", "2"], "--repeat belongs to the one-sequence mask "
+         "sweep; with --auto-masks (automatic masks per sequence) nothing uses it: drop it"),
+        (2, ["--size", "100"], "--size belongs to the one-sequence mask sweep"),
+        (2, ["--mask", "1,2,3,4"], "--mask belongs to the one-sequence mask sweep"),
+        (1, ["--n-masks", "2"], "--n-masks belongs to the multi-sequence protocol; with one --gt "
+         "nothing uses it: add --auto-masks or drop it"),
+        (1, ["--gaps", "3", "--min-gaps", "2"],
+         "--min-gaps selects positions only without --trajectories/--gaps; drop one"),
+    ],
+)  # fmt: skip
+def test_experiment_gaps_refuses_the_other_modes_options_before_work(
+    gts: int,
+    options: list[str],
+    message: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # was: silently ignored (--figure with several sequences wrote no figure, exit 0); the
+    # ground truth does not exist: the combination is refused before it is read
+    monkeypatch.chdir(tmp_path)
+    argv = ["experiment", "gaps", "--gt", *(f"none{k}.txt" for k in range(gts)), *options]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pftrack experiment: error: {message}") and err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("command", ["eval", "batch"])
+@pytest.mark.parametrize("iou", ["1.5", "0", "-0.5", "nan", "inf"])
+def test_iou_is_refused_alike_by_eval_and_batch(
+    command: str, iou: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: batch --iou 1.5, 0 or nan accepted (each sequence's scoring then failed), eval
+    # refusing them with its own "--iou is 1.5, expected in (0, 1]"
+    argv = {
+        "eval": ["eval", "--gt", "g.txt", "--res", "r.txt"],
+        "batch": ["batch", "v.avi", "--out", str(tmp_path / "out"), "--workers", "0"],
+    }[command]
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, "--iou", iou])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    message = f"argument --iou: expected a number in (0, 1], got {iou}"
+    assert err == f"pftrack {command}: error: {message}"
+    assert not (tmp_path / "out").exists()
+
+
 def test_unwritable_output_folder_is_refused_before_work(
     video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -253,6 +355,11 @@ def test_track_gives_opencv_one_thread_and_the_same_tracks(video: Path, tmp_path
         ("--size", "1e308", "argument --size: expected a number in [1, 100000]"),
         ("--grid", "1e-300", "argument --grid: expected a number in [0.1, 100000]"),
         ("--grid", "nan", "argument --grid: expected a number in [0.1, 100000]"),
+        ("--max-positions", "-1", "argument --max-positions: expected an integer >= 0, got -1"),
+        ("--min-gaps", "-1", "argument --min-gaps: expected an integer >= 0, got -1"),
+        ("--trajectories", "-1", "argument --trajectories: expected an integer >= 0, got -1"),
+        ("--gaps", "-2", "argument --gaps: expected an integer >= 0, got -2"),
+        ("--repeat", "x", "argument --repeat: invalid int value: 'x'"),
     ],
 )
 def test_experiment_gaps_refuses_absurd_masks_and_sizes_before_work(
@@ -260,7 +367,8 @@ def test_experiment_gaps_refuses_absurd_masks_and_sizes_before_work(
 ) -> None:
     # the ground truth does not exist: the option is refused before it is read (was: NaN and
     # far masks accepted, "out of memory", "arange: cannot compute length", "Maximum allowed
-    # size exceeded")
+    # size exceeded", "Number of samples, -1, must be non-negative", "invalid positive_int
+    # value")
     argv = ["experiment", "gaps", "--gt", str(tmp_path / "none.txt"), option, value]
     try:
         status = main(argv)
@@ -345,7 +453,14 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
         assert exc.value.code == 2
         err = capsys.readouterr().err.strip().splitlines()[-1]
         assert err.startswith("pftrack recover: error: argument --max-distance: expected a")
+    # was: --seed silently ignored by every method but auto
+    assert main(["recover", str(src), "--out", str(out), "--method", "linear", "--seed", "3"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "pftrack recover: error: --seed is used only by --method auto (its calibration gaps), "
+        "not linear; drop it"
+    )
     assert not out.exists()
+    assert main(["recover", str(src), "--out", str(out), "--seed", "3"]) == 0  # auto: used
 
 
 def test_library_warnings_are_one_line_for_every_command(
@@ -426,6 +541,11 @@ def test_crossings_without_the_smoother_are_refused(
         (["track", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
         (["demo", "--seed", "-1"], "argument --seed: expected an integer >= 0, got -1"),
         (["batch", "V", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer >= 0"),
+        (["recover", "T", "--out", "O", "--seed", "-1"], "argument --seed: expected an integer"),
+        (
+            ["eval", "--gt", "T", "--res", "T", "--image-size", "0", "360"],
+            "argument --image-size: expected an integer in [1, 100000], got 0",
+        ),
         (
             ["track", "V", "--out", "O", "--min-conf", "nan"],
             "argument --min-conf: expected a finite number, got nan",
@@ -464,8 +584,9 @@ def test_bad_option_values_are_named_in_one_line(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     """Were: "expected non-negative integer", "LifecycleConfig: min_score is nan", a nan
-    birth score accepted, "LinkConfig.max_gap is ...", "fill_gaps: max_gap is ...", and
-    batch's --det-scale accepting what track refused (the sequence then failed)."""
+    birth score accepted, "LinkConfig.max_gap is ...", "fill_gaps: max_gap is ...",
+    batch's --det-scale accepting what track refused (the sequence then failed), recover's
+    --seed -1 accepted, and eval's "gt: evaluate_mot: image_size is (0, 360)"."""
     tracks = _tracks(tmp_path / "t.txt")
     names = {"V": str(video), "T": str(tracks), "O": str(tmp_path / "o.txt")}
     argv = [names.get(a, a) for a in argv]
@@ -520,6 +641,16 @@ def test_option_bounds_stated_for_help_are_the_librarys(tmp_path: Path) -> None:
         LinkConfig(max_gap=batch.MAX_GAP + 1)
     with pytest.raises(ValueError, match="max_gap"):
         fill_gaps(np.zeros((0, 10)), "linear", batch.MAX_GAP + 1)
+    from pftrack.cli._options import iou_threshold
+
+    one = np.array([[1, 1, 10, 10, 20, 40, 1, -1, -1, -1]], dtype=np.float64)
+    for inside in ("1", "1e-9"):
+        evaluate_mot(one, one, iou_threshold=iou_threshold(inside))
+    for outside in (0.0, 1.0 + 1e-9, float("nan")):
+        with pytest.raises(ValueError, match="iou_threshold"):
+            evaluate_mot(one, one, iou_threshold=outside)
+        with pytest.raises(argparse.ArgumentTypeError):
+            iou_threshold(str(outside))
     lo, hi = DET_SCALE_RANGE
     empty = tmp_path / "det.txt"
     empty.write_text("")

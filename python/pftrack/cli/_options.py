@@ -60,6 +60,9 @@ def positive_int(text: str) -> int:
     return v
 
 
+positive_int.__name__ = "int"  # argparse names the type in its messages
+
+
 def non_negative_int(text: str) -> int:
     """Argument type: an integer >= 0 (``--seed``, ``--workers``)."""
     v = int(text)
@@ -82,12 +85,22 @@ def finite_float(text: str) -> float:
 finite_float.__name__ = "float"
 
 
-def positive_float(text: str) -> float:
-    """Argument type: a finite number > 0."""
+def iou_threshold(text: str) -> float:
+    """Argument type of ``--iou`` (``eval``, ``batch``): a number in (0, 1].
+
+    The range :func:`pftrack.eval.evaluate_mot` accepts (a test checks they agree); stated in
+    :data:`IOU_HELP`.
+    """
     v = float(text)
-    if not 0 < v < float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {v}")
+    if not 0 < v <= 1:  # also refuses nan
+        raise argparse.ArgumentTypeError(f"expected a number in (0, 1], got {v:g}")
     return v
+
+
+iou_threshold.__name__ = "float"
+
+#: ``--iou``'s help (``eval``, ``batch``): one wording of :func:`iou_threshold`'s range.
+IOU_HELP = "IoU threshold of a CLEAR-MOT match, in (0, 1]"
 
 
 def bounded_int(lo: int, hi: int) -> Any:

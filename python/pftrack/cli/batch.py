@@ -14,12 +14,13 @@ from typing import TYPE_CHECKING, Any
 
 from pftrack.cli._options import (
     DET_SCALE_RANGE,
+    IOU_HELP,
     add_command,
     add_tracker_options,
     bounded_int,
     det_scale,
+    iou_threshold,
     non_negative_int,
-    positive_float,
 )
 
 if TYPE_CHECKING:
@@ -97,8 +98,8 @@ def add_parser(sub: Any) -> None:
         "PETS09-S2L1's video), else 1",
     )  # fmt: skip
     p.add_argument("--render", action="store_true", help="also write DIR/NAME.mp4, annotated")
-    p.add_argument("--iou", type=positive_float, default=0.5,
-                   help="IoU threshold of a match for the metrics")  # fmt: skip
+    p.add_argument("--iou", type=iou_threshold, default=0.5,
+                   help=f"{IOU_HELP}, for the metrics")  # fmt: skip
     add_tracker_options(p)
     add_batch_options(p)
     p.set_defaults(func=run)

@@ -6,7 +6,10 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from pftrack.cli._options import add_command
+from pftrack.cli._options import IOU_HELP, add_command, bounded_int, iou_threshold
+
+#: ``--image-size``'s largest side (px), as ``experiment gaps``' MAX_SIDE.
+MAX_IMAGE_SIDE = 100_000
 
 EXAMPLES = """\
 examples:
@@ -55,7 +58,7 @@ def add_parser(sub: Any) -> None:
         help="multiply ground-truth boxes by S, for every sequence or for sequence NAME "
         "(repeat the option); 0.625 for PETS09 gt on its 480x360 video; None: 1 everywhere",
     )  # fmt: skip
-    p.add_argument("--iou", type=float, default=0.5, help="IoU threshold of a CLEAR-MOT match")
+    p.add_argument("--iou", type=iou_threshold, default=0.5, help=IOU_HELP)
     p.add_argument(
         "--benchmark", choices=("auto", "MOT15", "MOT16", "MOT17", "MOT20"), default="auto",
         help="ground-truth rules for HOTA; auto: MOT17 when columns 8-9 hold classes 1-13 and "
@@ -63,9 +66,11 @@ def add_parser(sub: Any) -> None:
     )  # fmt: skip
     p.add_argument("--seqs", nargs="+", metavar="NAME", default=None,
                    help="score only these sequences of a folder; None: all")  # fmt: skip
-    p.add_argument("--image-size", type=int, nargs=2, metavar=("W", "H"), default=None,
-                   help="image size for the centroid-distance ratio; None: seqinfo.ini's "
-                   "size times the scale, if any")  # fmt: skip
+    p.add_argument("--image-size", type=bounded_int(1, MAX_IMAGE_SIDE), nargs=2,
+                   metavar=("W", "H"), default=None,
+                   help=f"image size for the centroid-distance ratio (px, 1 to "
+                   f"{MAX_IMAGE_SIDE}); None: seqinfo.ini's size times the scale, if "
+                   "any")  # fmt: skip
     p.add_argument(
         "--no-scale-check", action="store_true",
         help="score even when result boxes look like another pixel scale than the ground truth",
@@ -146,8 +151,6 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import atomic_write, check_output
     from pftrack.io.mot import read_mot
 
-    if not 0 < args.iou <= 1:
-        raise ValueError(f"--iou is {args.iou}, expected in (0, 1]")
     inputs = (args.gt, args.res)
     if args.json:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)

@@ -3,12 +3,22 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import asdict
 from typing import Any
 
-from pftrack.cli._options import add_command, bounded_float, positive_int
+from pftrack.cli._options import add_command, bounded_float, non_negative_int, positive_int
 from pftrack.recovery.names import METHODS
 
 MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this are refused
+#: Options of the one-sequence sweep (one --gt, no --auto-masks): refused in the other mode.
+SINGLE_ONLY = ("mask", "size", "grid", "trajectories", "gaps", "min_gaps", "repeat",
+               "max_positions", "figure")  # fmt: skip
+#: Options of the multi-sequence protocol (several --gt, or --auto-masks): refused with one.
+MULTI_ONLY = ("n_masks",)
+#: Defaults of the options above that have one (their parser default is None: given or not).
+DEFAULTS: dict[str, Any] = {
+    "size": 100.0, "grid": 4.0, "min_gaps": 3, "repeat": 5, "max_positions": 0, "n_masks": 3,
+}  # fmt: skip
 
 
 def add_parser(sub: Any) -> None:
@@ -22,44 +32,70 @@ def add_parser(sub: Any) -> None:
         help="trajectory recovery under a mask (Oh & Jung 2015, Tables 1 and 2)",
         description="Ground-truth points inside a square mask are lost; each maximal run of "
         "lost points is one gap recovered from the observed segments around it; trajectories "
-        "starting or ending inside the mask are left out. Prints MMAE per axis, MMAE total "
-        "(mean Euclidean), pooled MAE and wall time per method, for one mask and as the median "
-        "over every mask position on a grid that meets the selection. With several --gt files "
-        "(or --auto-masks): per sequence, 3 non-overlapping square masks of side round(100 W/768) "
-        "px placed greedily on a round(4 W/768) px grid where they cut the most gaps; prints "
-        "per-sequence and pooled MMAE of every method (image size W x H from seqinfo.ini beside "
-        "the ground truth or one folder up, else --image-size).",
+        "starting or ending inside the mask are left out. Two modes:\n\n"
+        "one sequence (one --gt): prints MMAE per axis, MMAE total (mean Euclidean), pooled MAE "
+        "and wall time per method, for one mask and as the median over every mask position on "
+        "a grid that meets the selection.\n\n"
+        "multi-sequence (several --gt files, or --auto-masks): per sequence, --n-masks "
+        "non-overlapping square masks of side round(100 W/768) px placed greedily on a "
+        "round(4 W/768) px grid where they cut the most gaps; prints per-sequence and pooled "
+        "MMAE of every method (image size W x H from seqinfo.ini beside the ground truth or one "
+        "folder up, else --image-size).\n\n"
+        "Options whose help starts with 'one sequence:' or 'multi-sequence:' belong to that "
+        "mode and are refused in the other; the others serve both.",
     )
-    g.add_argument("--gt", required=True, nargs="+", help="ground truth file(s) (MOTChallenge)")
+    g.add_argument("--gt", required=True, nargs="+",
+                   help="ground truth file(s) (MOTChallenge); one: the one-sequence sweep, "
+                   "several: the multi-sequence protocol")  # fmt: skip
     g.add_argument("--auto-masks", action="store_true",
                    help="the multi-sequence protocol, even for one --gt")  # fmt: skip
-    g.add_argument("--n-masks", type=positive_int, default=3, help="masks per sequence")
+    g.add_argument("--n-masks", type=positive_int, default=None, metavar="N",
+                   help=f"multi-sequence: masks per sequence (default: "
+                   f"{DEFAULTS['n_masks']})")  # fmt: skip
     g.add_argument("--json", metavar="OUT",
-                   help="write the multi-sequence results as JSON (default: none)")  # fmt: skip
-    g.add_argument("--mask", help="x,y,w,h of the representative mask (default: chosen by rule)")
+                   help="write the results as JSON (default: none); multi-sequence: protocol, "
+                   "methods, per sequence its name, image size, masks, gaps, MMAE and per-gap "
+                   "errors, and the pooled MMAE; one sequence: protocol, ground truth, image "
+                   "size, point, methods, the representative mask with its trajectories, gaps, "
+                   "lost points, scores (the table's rows) and per-gap errors, and the sweep "
+                   "with its medians")  # fmt: skip
+    g.add_argument("--mask", help="one sequence: x,y,w,h of the representative mask (default: "
+                   "chosen by rule)")  # fmt: skip
     g.add_argument("--point", default="centre", choices=("centre", "foot"),
                    help="box point used as the trajectory")  # fmt: skip
-    g.add_argument("--size", type=bounded_float(1.0, MAX_SIDE), default=100.0,
-                   help=f"mask side for the sweep (px, 1 to {MAX_SIDE:g})")  # fmt: skip
-    g.add_argument("--grid", type=bounded_float(0.1, MAX_SIDE), default=4.0,
-                   help=f"mask position step of the sweep (px, 0.1 to {MAX_SIDE:g})")  # fmt: skip
-    g.add_argument("--image-size", help="WxH of the ground-truth coordinates (default: GT extent)")
-    g.add_argument("--trajectories", type=int,
-                   help="keep positions with exactly this many (default: any number)")  # fmt: skip
-    g.add_argument("--gaps", type=int,
-                   help="keep positions with exactly this many gaps (default: any)")  # fmt: skip
+    g.add_argument("--size", type=bounded_float(1.0, MAX_SIDE), default=None, metavar="PX",
+                   help=f"one sequence: mask side for the sweep (px, 1 to {MAX_SIDE:g}; "
+                   f"default: {DEFAULTS['size']:g})")  # fmt: skip
+    g.add_argument("--grid", type=bounded_float(0.1, MAX_SIDE), default=None, metavar="PX",
+                   help=f"one sequence: mask position step of the sweep (px, 0.1 to "
+                   f"{MAX_SIDE:g}; default: {DEFAULTS['grid']:g})")  # fmt: skip
+    g.add_argument("--image-size", metavar="WxH",
+                   help="image size of the ground-truth coordinates (default: the ground "
+                   "truth's extent; multi-sequence: used only for sequences without "
+                   "seqinfo.ini, which need it)")  # fmt: skip
+    g.add_argument("--trajectories", type=non_negative_int, metavar="N",
+                   help="one sequence: keep positions with exactly this many (default: any "
+                   "number)")  # fmt: skip
+    g.add_argument("--gaps", type=non_negative_int, metavar="N",
+                   help="one sequence: keep positions with exactly this many gaps (default: "
+                   "any)")  # fmt: skip
     g.add_argument(
-        "--min-gaps", type=int, default=3,
-        help="without --trajectories/--gaps: keep positions with at least this many",
+        "--min-gaps", type=non_negative_int, default=None, metavar="N",
+        help="one sequence, without --trajectories/--gaps: keep positions with at least this "
+        f"many gaps (default: {DEFAULTS['min_gaps']})",
     )  # fmt: skip
     g.add_argument("--methods", default=",".join(METHODS), help="comma-separated methods")
-    g.add_argument("--repeat", type=positive_int, default=5, help="timing: best of this many runs")
+    g.add_argument("--repeat", type=positive_int, default=None, metavar="N",
+                   help="one sequence: timing, best of this many runs (default: "
+                   f"{DEFAULTS['repeat']})")  # fmt: skip
     g.add_argument(
-        "--max-positions", type=int, default=0,
-        help="evaluate at most this many sweep positions, evenly spread (0 = all)",
+        "--max-positions", type=non_negative_int, default=None, metavar="N",
+        help="one sequence: evaluate at most this many sweep positions, evenly spread "
+        f"(default: {DEFAULTS['max_positions']}, all)",
     )  # fmt: skip
     g.add_argument("--figure", metavar="PNG",
-                   help="PNG of ground truth against recovered paths (default: none)")  # fmt: skip
+                   help="one sequence: PNG of ground truth against recovered paths under the "
+                   "representative mask (default: none)")  # fmt: skip
     g.set_defaults(func=run_gaps)
 
 
@@ -116,10 +152,51 @@ def _methods(text: str) -> list[str]:
     return methods
 
 
+def _option(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def _check_mode(args: argparse.Namespace) -> bool:
+    """Refuse the options of the other mode; fill in the defaults; True for multi-sequence.
+
+    Raises
+    ------
+    ValueError
+        An option of the one-sequence sweep with several ``--gt`` or ``--auto-masks``, one of
+        the multi-sequence protocol with one ``--gt``, or ``--min-gaps`` with
+        ``--trajectories``/``--gaps`` (it selects only without them).
+    """
+    multi = len(args.gt) > 1 or args.auto_masks
+    if multi:
+        for name in SINGLE_ONLY:
+            if getattr(args, name) is not None:
+                why = "several --gt files" if len(args.gt) > 1 else "--auto-masks"
+                raise ValueError(
+                    f"{_option(name)} belongs to the one-sequence mask sweep; with {why} "
+                    "(automatic masks per sequence) nothing uses it: drop it"
+                )
+    else:
+        for name in MULTI_ONLY:
+            if getattr(args, name) is not None:
+                raise ValueError(
+                    f"{_option(name)} belongs to the multi-sequence protocol; with one --gt "
+                    "nothing uses it: add --auto-masks or drop it"
+                )
+        if args.min_gaps is not None and (args.trajectories is not None or args.gaps is not None):
+            raise ValueError(
+                "--min-gaps selects positions only without --trajectories/--gaps; drop one"
+            )
+    for name, value in DEFAULTS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
+    return bool(multi)
+
+
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
     from pftrack.io.atomic import check_output
 
+    multi = _check_mode(args)  # before any other check: the options a mode does not use
     inputs = tuple(args.gt)
     if args.mask:
         _parse_mask(args.mask)  # bad options are refused before any work
@@ -129,7 +206,7 @@ def run_gaps(args: argparse.Namespace) -> int:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.figure:
         check_output(args.figure, what="--figure", suffixes=(".png", ".jpg"), inputs=inputs)
-    if len(args.gt) > 1 or args.auto_masks:
+    if multi:
         return _run_sequences(args)
     import numpy as np
 
@@ -168,8 +245,30 @@ def run_gaps(args: argparse.Namespace) -> int:
         f"{run.n_traj} trajectories, {len(run.gaps)} gaps, "
         f"{sum(len(g.truth) for g in run.gaps)} lost points",
     ]
+    doc: dict[str, Any] = {
+        "protocol": f"one sequence: {args.size:g} px square masks on a {args.grid:g} px grid, "
+        f"positions kept: {sweep.selection}; representative mask: "
+        f"{'--mask' if args.mask else 'the kept position nearest their centroid'}; "
+        f"{args.point} point",
+        "gt": str(args.gt),
+        "image_size": [width, height],
+        "point": args.point,
+        "methods": methods,
+        "mask": _mask_doc(run, methods),
+        "sweep": {
+            "size": args.size,
+            "grid": args.grid,
+            "selection": sweep.selection,
+            "n_positions": len(sweep),
+            "median": None,
+        },
+    }
     if not run.gaps:
-        print("\n".join([*said, "no gap under this mask"]))
+        said.append("no gap under this mask")
+        if args.json:
+            _write_json(args.json, doc)
+            said.append(f"json: {args.json}")
+        print("\n".join(said))
         return 0
     said.append(E.format_table(run.scores))
     if run.noise is not None:
@@ -184,15 +283,53 @@ def run_gaps(args: argparse.Namespace) -> int:
             f"{run.motion.describe()}"
         )
     if len(sweep):
-        said += ["", E.format_median(E.median_over(trajs, sweep, methods, args.max_positions))]
+        median = E.median_over(trajs, sweep, methods, args.max_positions)
+        said += ["", E.format_median(median)]
+        doc["sweep"]["median"] = {
+            "n_positions": median.n_positions,
+            "scores": {m: asdict(v) for m, v in median.median.items()},
+            "best_at": median.wins,
+        }
     if args.figure:
         _write_figure(args.figure, E.draw_figure(
             trajs, run.gaps, run.paths, mask, (int(width), int(height)),
             [m for m in ("gdt", "gdt-mix", "bspline") if m in methods],
         ))  # fmt: skip
         said.append(f"figure: {args.figure}")
-    print("\n".join(said))
+    if args.json:
+        _write_json(args.json, doc)
+        said.append(f"json: {args.json}")
+    print("\n".join(said))  # after the files: a closed stdout cannot lose them
     return 0
+
+
+def _mask_doc(run: Any, methods: list[str]) -> dict[str, Any]:
+    """One mask's part of the one-sequence JSON: what it cuts, and every method's scores."""
+    import numpy as np
+
+    return {
+        "box": list(run.mask),  # x, y, w, h
+        "n_trajectories": run.n_traj,
+        "n_gaps": len(run.gaps),
+        "n_lost_points": sum(len(g.truth) for g in run.gaps),
+        "scores": {m: asdict(run.scores[m]) if m in run.scores else None for m in methods},
+        "gap_errors": {  # mean Euclidean error of each gap (px), as the multi-sequence JSON's
+            m: [
+                float(np.mean(np.hypot(*(p - g.truth[:, 1:3]).T)))
+                for g, p in zip(run.gaps, run.paths.get(m, []), strict=True)
+            ]
+            for m in methods
+        },
+    }
+
+
+def _write_json(path: str, doc: dict[str, Any]) -> None:
+    import json
+
+    from pftrack.io.atomic import atomic_write
+
+    with atomic_write(path) as f:
+        json.dump(doc, f, indent=1)
 
 
 def _write_figure(path: str, image: Any) -> None:
@@ -207,11 +344,9 @@ def _write_figure(path: str, image: Any) -> None:
 
 def _run_sequences(args: argparse.Namespace) -> int:
     """The multi-sequence protocol with automatic masks (``--gt A B ...`` or ``--auto-masks``)."""
-    import json
     from pathlib import Path
 
     from pftrack._progress import progress
-    from pftrack.io.atomic import atomic_write
     from pftrack.io.mot import read_mot
     from pftrack.recovery import experiment as E
 
@@ -259,8 +394,7 @@ def _run_sequences(args: argparse.Namespace) -> int:
             "n_gaps": sum(r.n_gaps for r in results),
             "mmae": {m: (sum(v) / len(v) if v else None) for m, v in pooled.items()},
         }
-        with atomic_write(args.json) as f:
-            json.dump(doc, f, indent=1)
+        _write_json(args.json, doc)
     for r in results:  # printed once the JSON is written: a closed stdout cannot lose it
         masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks)
         print(f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}")

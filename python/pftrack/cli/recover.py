@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, bounded_float
+from pftrack.cli._options import add_command, bounded_float, non_negative_int
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 
@@ -37,8 +37,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--explain", action="store_true",
                    help="with auto: print the method chosen per gap length (or the two methods "
                    "it blends, with their weights) and its validation MMAE")  # fmt: skip
-    p.add_argument("--seed", type=int, default=0,
-                   help="auto: seed of the artificial calibration gaps")  # fmt: skip
+    p.add_argument("--seed", type=non_negative_int, default=None,
+                   help="auto: seed of the artificial calibration gaps, an integer >= 0 "
+                   "(default: 0; refused with another --method)")  # fmt: skip
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
     p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=None, metavar="PX",
                    help="linking gate on the motion-prediction distance (pixels, 0.001 to 1e6; "
@@ -54,6 +55,12 @@ def add_parser(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack recover``; return the exit status."""
+    if args.seed is not None and args.method != "auto":
+        raise ValueError(
+            f"--seed is used only by --method auto (its calibration gaps), not {args.method}; "
+            "drop it"
+        )
+    args.seed = args.seed or 0
     if batch.is_batch(args.tracks):
         return batch.run_recover(args)
     if args.video and not args.link:
