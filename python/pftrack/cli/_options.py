@@ -52,26 +52,23 @@ def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
     return parser
 
 
-def positive_int(text: str) -> int:
-    """Argument type: an integer >= 1."""
-    v = int(text)
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {v}")
-    return v
+def int_at_least(lo: int) -> Any:
+    """Argument type: an integer >= `lo`."""
+
+    def parse(text: str) -> int:
+        v = int(text)
+        if v < lo:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {lo}, got {v}")
+        return v
+
+    parse.__name__ = "int"  # argparse names the type in its messages
+    return parse
 
 
-positive_int.__name__ = "int"  # argparse names the type in its messages
-
-
-def non_negative_int(text: str) -> int:
-    """Argument type: an integer >= 0 (``--seed``, ``--workers``)."""
-    v = int(text)
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {v}")
-    return v
-
-
-non_negative_int.__name__ = "int"  # argparse names the type in its messages
+#: An integer >= 1.
+positive_int = int_at_least(1)
+#: An integer >= 0 (``--seed``, ``--workers``).
+non_negative_int = int_at_least(0)
 
 
 def finite_float(text: str) -> float:
