@@ -141,6 +141,17 @@ def _snapshot(folder: Path) -> dict[str, bytes | None]:
     return {p.name: (p.read_bytes() if p.is_file() else None) for p in folder.iterdir()}
 
 
+@pytest.fixture
+def no_work(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Tracking fails the test: the command must refuse before any work."""
+    import pftrack.tracking as tracking
+
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("work started before the outputs were checked")
+
+    monkeypatch.setattr(tracking, "track_frames", refuse)
+
+
 @pytest.mark.parametrize("case", CASES)
 @pytest.mark.parametrize("command", list(COMMANDS))
 def test_bad_output_is_refused_before_any_work(
@@ -149,14 +160,8 @@ def test_bad_output_is_refused_before_any_work(
     inputs: dict[str, Path],
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
-    monkeypatch: pytest.MonkeyPatch,
+    no_work: None,
 ) -> None:
-    import pftrack.tracking as tracking
-
-    def no_work(*args: Any, **kwargs: Any) -> Any:
-        raise AssertionError("work started before the outputs were checked")
-
-    monkeypatch.setattr(tracking, "track_frames", no_work)
     (tmp_path / "t_ok.txt").write_text("old tracks\n")
     out = _bad_output(case, command, inputs, tmp_path)
     before_inputs = {k: p.read_bytes() for k, p in inputs.items()}
@@ -334,14 +339,9 @@ def test_two_outputs_on_one_file_are_refused_before_any_work(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
+    no_work: None,
 ) -> None:
     """Was: exit 0, one output written over the other (the video lost, a CSV left)."""
-    import pftrack.tracking as tracking
-
-    def no_work(*args: Any, **kwargs: Any) -> Any:
-        raise AssertionError("work started before the outputs were checked")
-
-    monkeypatch.setattr(tracking, "track_frames", no_work)
     monkeypatch.chdir(tmp_path)
     name = "same.mp4" if second == "--render" else "same.png"
     (tmp_path / name).write_bytes(b"an earlier result\n")

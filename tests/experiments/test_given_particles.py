@@ -8,23 +8,6 @@ import pytest
 
 from experiments import given_particles as gp
 from experiments._common import Source
-from pftrack.io.mot import write_mot
-from pftrack.synthetic import make_scene
-
-
-@pytest.fixture(scope="module")
-def data(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A data folder with one short sequence laid out like the real ones."""
-    root = tmp_path_factory.mktemp("data")
-    scene = make_scene(n_frames=12, n_walkers=2, rng=4, occluder=False)
-    folder = root / "tiny"
-    folder.mkdir()
-    scene.write_images(folder / "img", ext=".png")
-    write_mot(folder / "gt.txt", scene.truth)
-    dets = scene.truth.copy()
-    dets[:, 1] = -1
-    write_mot(folder / "det.txt", dets)
-    return root
 
 
 def test_scores_are_seeded_and_in_percent(data: Path) -> None:

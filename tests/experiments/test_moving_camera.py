@@ -5,28 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from experiments import moving_camera as mc
 from experiments._common import REPO
-from pftrack.io.mot import read_mot, write_mot
+from pftrack.io.mot import read_mot
 from pftrack.io.video import read_frames
-from pftrack.synthetic import make_scene
-
-
-@pytest.fixture(scope="module")
-def data(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A data folder with one short sequence laid out like the real ones."""
-    root = tmp_path_factory.mktemp("data")
-    scene = make_scene(n_frames=12, n_walkers=2, rng=4, occluder=False)
-    folder = root / "tiny"
-    folder.mkdir()
-    scene.write_images(folder / "img", ext=".png")
-    write_mot(folder / "gt.txt", scene.truth)
-    dets = scene.truth.copy()
-    dets[:, 1] = -1
-    write_mot(folder / "det.txt", dets)
-    return root
 
 
 def test_versions_move_frames_and_boxes_together(data: Path, tmp_path: Path) -> None:
