@@ -184,6 +184,8 @@ def _printable(a: F64) -> tuple[F64, NDArray[np.int64]]:
     """
     v = a[:, 2:].ravel()
     d = _decimals(v, 10.0**EXACT_DIGITS, len(_POW10) - 1)
+    whole = np.abs(v) >= 2.0**52  # every such double is an integer (and v * 100 may overflow)
+    d[whole & (d < 0)] = 0
     rest = d < 0
     if rest.any():
         v = v.copy()
