@@ -162,6 +162,47 @@ def test_classes_never_share_an_identity():
     assert len(one) == 1
 
 
+@pytest.mark.parametrize("cls", [0.7, -0.5, 1e20, 2.0**31 + 1])
+def test_class_ids_must_be_integers(cls):
+    frame = np.zeros((80, 100, 3), np.uint8)
+    dets = np.array([[30.0, 20.0, 50.0, 60.0, 0.9, 0.0], [60.0, 20.0, 80.0, 60.0, 0.9, cls]])
+    with pytest.raises(ValueError, match=r"dets row 1 has class id .*, expected an integer"):
+        pftrack.Tracker().update(dets, frame)
+    dets[1, 5] = 3.0  # an integer held as a float is a class id
+    assert pftrack.Tracker().update(dets, frame).shape[1] == 8
+
+
+@pytest.mark.parametrize("second_class", [0, 1])
+def test_finalize_never_links_two_classes(scene, second_class):
+    """A walker seen as class 0, undetected for 12 frames, then seen as `second_class`.
+
+    With one class the offline pass links the two tracks into one identity; with two it must
+    not (it did: finalize() gave one id to both classes, the user trial's defect).
+    """
+    who = int(scene.truth[0, 1])
+    rows = scene.truth[scene.truth[:, 1] == who]
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    online: dict[int, set[int]] = {}
+    for f in range(1, 41):
+        r = rows[rows[:, 0] == f]
+        cls = 0 if f <= 14 else second_class
+        dets = np.zeros((0, 6))
+        if len(r) and not 15 <= f <= 26:  # frames 15-26: no detection
+            x, y, w, h = r[0, 2:6]
+            dets = np.array([[x, y, x + w, y + h, 0.95, cls]])
+        for t in tracker.update(dets, scene.frames[f - 1]):
+            online.setdefault(int(t[4]), set()).add(int(t[6]))
+    assert len(online) == 2  # longer than max_coast (10 frames): a new id after the gap
+    final = tracker.finalize()
+    before = set(final[final[:, 0] <= 14, 1].astype(int))
+    after = set(final[final[:, 0] >= 27, 1].astype(int))
+    assert len(before) == len(after) == 1
+    if second_class == 0:
+        assert before == after  # linked: one identity
+    else:
+        assert before != after  # two classes: two identities, as update() gave
+
+
 def test_merged_blob_rows_name_the_blob():
     from pftrack.tracking import LifecycleConfig, RefineConfig
     from pftrack.tracking.tracker import MultiObjectTracker

@@ -57,6 +57,7 @@ class TrackWriter:
         self._measured: list[F64 | None] = []  # per row: the detection box
         self._pending: dict[int, list[list[float]]] = {}
         self._last: dict[int, list[float]] = {}
+        self._cls: dict[int, int] = {}  # class of each track id
 
     def _append(self, row: list[float], measured: F64 | None) -> None:
         self.rows.append(row)
@@ -65,6 +66,7 @@ class TrackWriter:
     def add(self, frame: int, tracks: list[Track]) -> None:
         """Record the tracks reported for `frame` (1-based)."""
         for t in tracks:
+            self._cls[t.id] = t.cls
             for f, box, score in t.history:  # a new track's detections from before confirmation
                 row = [float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0]
                 self._append(row, np.asarray(box))
@@ -90,7 +92,8 @@ class TrackWriter:
                relink_coast: int | None = None) -> F64:  # fmt: skip
         """All rows written so far, (M, 10), sorted by frame then id.
 
-        Linked and smoothed when the writer has a link config and a smoother; the tracks of
+        Linked and smoothed when the writer has a link config and a smoother, each class's tracks
+        apart (``Track.cls``: the linker never joins two classes); the tracks of
         the ids in `drop` are left out first. With `relink_coast`, a track re-found after at
         least that many coasted frames is cut there before linking
         (:func:`~.offline.split_refound`). With `crossings` (enabled), tracks swapped where
@@ -108,6 +111,30 @@ class TrackWriter:
         z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
         if observed.any():
             z[observed] = [m for m in measured if m is not None]
-        return smooth_tracks(
-            a, observed, self.smoother, self.link, z, crossings=crossings, relink_coast=relink_coast
-        )
+        cls = np.array([self._cls.get(int(i), 0) for i in a[:, 1]], np.int64)
+        classes = np.unique(cls)
+        if len(classes) == 1:
+            return smooth_tracks(
+                a, observed, self.smoother, self.link, z, crossings=crossings,
+                relink_coast=relink_coast,
+            )  # fmt: skip
+        # classes never share an identity: each class's tracks are linked among themselves, and
+        # an id a pass makes (a cut piece) is renumbered above every id of the run
+        parts = []
+        fresh = int(a[:, 1].max()) + 1
+        for c in classes:
+            k = cls == c
+            out = smooth_tracks(
+                a[k], observed[k], self.smoother, self.link, z[k], crossings=crossings,
+                relink_coast=relink_coast,
+            )  # fmt: skip
+            new = np.setdiff1d(out[:, 1], a[k, 1])
+            if len(new):
+                ids = out[:, 1].copy()
+                for i, v in enumerate(new.tolist()):
+                    ids[out[:, 1] == v] = fresh + i
+                out[:, 1] = ids
+                fresh += len(new)
+            parts.append(out)
+        rows = np.vstack(parts)
+        return rows[np.lexsort((rows[:, 1], rows[:, 0]))]
