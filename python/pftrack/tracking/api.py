@@ -58,6 +58,8 @@ MAX_SPAN_FRAMES = 100_000
 #: The highest frame rate :class:`Tracker` accepts (as ``pftrack track --fps``).
 MAX_FRAME_RATE = 1000.0
 
+#: Largest class id (in absolute value) :meth:`Tracker.update` takes.
+MAX_CLASS = 2**31
 #: Columns of :meth:`Tracker.update`'s output.
 TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
 
@@ -125,8 +127,9 @@ def check_boxes_xyxy(
     TypeError
         Not numbers.
     ValueError
-        Wrong shape, NaN or inf, or a box with ``x2 <= x1`` or ``y2 <= y1`` (the message says
-        when the rows look like ``x, y, w, h`` instead).
+        Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31]``, or
+        a box with ``x2 <= x1`` or ``y2 <= y1`` (the message says when the rows look like
+        ``x, y, w, h`` instead).
     """
     d = np.asarray(dets)
     if d.dtype.kind not in "iuf":
@@ -142,6 +145,15 @@ def check_boxes_xyxy(
     if not np.isfinite(d).all():
         k = int(np.flatnonzero(~np.isfinite(d).all(axis=1))[0])
         raise ValueError(f"dets row {k} contains NaN or inf: {d[k].tolist()}")
+    if d.shape[1] == 6:
+        c = d[:, 5]
+        odd = (c != np.round(c)) | (np.abs(c) > MAX_CLASS)
+        if odd.any():
+            k = int(np.flatnonzero(odd)[0])
+            raise ValueError(
+                f"dets row {k} has class id {c[k]:g}, expected an integer in "
+                f"[-{MAX_CLASS}, {MAX_CLASS}] (column 6: x1, y1, x2, y2, conf, cls)"
+            )
     bad = (d[:, 2] <= d[:, 0]) | (d[:, 3] <= d[:, 1])
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
@@ -554,7 +566,8 @@ class Tracker:
         Returns
         -------
         (R, 10) ndarray of float
-            ``frame, id, left, top, width, height, conf, -1, -1, -1``, frames from 1 (one per
+            ``frame, id, left, top, width, height, conf, flag, -1, -1`` (``flag`` 1 on a row the
+            offline pass filled in a hole, else -1), frames from 1 (one per
             ``update``), sorted by frame then id. Warns when there is no row at all. With the
             built-in detector (no ``update`` of the run had detections) and the smoother on,
             boxes mostly inside a larger box of the same frame are left out

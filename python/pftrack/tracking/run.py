@@ -99,7 +99,7 @@ def track_frames(
     *,
     detections: dict[int, F64] | None = None,
     config: TrackerConfig | None = None,
-    rng: RngLike = None,
+    rng: RngLike = 0,
     coasting: str = "confirmed",
     fill: str = "linear",
     show_progress: bool | None = None,
@@ -125,7 +125,8 @@ def track_frames(
     config : TrackerConfig, optional
         Tracker settings (default ``TrackerConfig()``).
     rng : numpy.random.Generator, int or None
-        Seed.
+        Seed (default 0, as ``pftrack track`` and :class:`~pftrack.Tracker`: the same frames
+        give the same rows; None: fresh entropy).
     coasting, fill : str
         How gaps bridged by the particle filters are written (see
         :class:`~pftrack.tracking.TrackWriter`).
