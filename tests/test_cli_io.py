@@ -135,6 +135,19 @@ def test_a_missing_image_of_a_sequence_is_one_line_not_a_shift(
     assert not out.exists()
 
 
+def test_a_seqinfo_with_a_byte_order_mark_is_read(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'seqinfo.ini: expected a [Sequence] section' (det, gt and results took a BOM)."""
+    seq = _copy_sequence(sequence, tmp_path / "SEQ")
+    ini = seq / "seqinfo.ini"
+    ini.write_bytes(b"\xef\xbb\xbf" + ini.read_bytes())
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 0
+    assert capsys.readouterr().out.startswith("60 frames, ")
+    assert evaluate_mot(scene.truth, read_mot(out)).mota > 0.8
+
+
 def test_auto_detections_need_a_sequence(
     scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

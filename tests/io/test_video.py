@@ -100,6 +100,13 @@ def test_bad_seqinfo_is_one_clear_error(tmp_path: Path, text: str, message: str)
         read_seqinfo(tmp_path)
 
 
+def test_seqinfo_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
+    """Notepad's UTF-8 starts the file with a BOM; det/gt/results already skip it."""
+    (tmp_path / "seqinfo.ini").write_bytes(b"\xef\xbb\xbf[Sequence]\nframeRate=7\nseqLength=3\n")
+    info = read_seqinfo(tmp_path)
+    assert (info.frame_rate, info.length) == (7.0, 3)
+
+
 def _numbered(folder: Path, names: list[str]) -> Path:
     """Images `names` in `folder`, image i (0-based, in the order given) of grey level i + 1."""
     folder.mkdir(parents=True, exist_ok=True)

@@ -138,7 +138,7 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         ini = ini / "seqinfo.ini"
     parser = configparser.ConfigParser(interpolation=None)
     try:
-        parser.read(ini, encoding="utf-8")
+        parser.read(ini, encoding="utf-8-sig")  # -sig: skips a byte-order mark (Notepad)
         sec = parser["Sequence"]
     except (configparser.Error, KeyError):
         raise ValueError(
