@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import ast
+import inspect
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -88,3 +91,79 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
     assert 'Revealed type is "def (path: ' in out
     assert 'Revealed type is "float"' in out or 'Revealed type is "builtins.float"' in out
     assert 'Argument "method" to "fill_gaps" has incompatible type "int"' in out
+
+
+API_DOC = Path(__file__).resolve().parents[1] / "docs" / "api.md"
+
+
+def _calls(cell: str) -> list[tuple[str, list[str]]]:
+    """Every ``name(arg, arg, ...)`` of a table cell, its arguments split at top-level commas."""
+    found: list[tuple[str, list[str]]] = []
+    for m in re.finditer(r"(\w+)\(", cell):
+        depth, start = 1, m.end()
+        args: list[str] = []
+        for i in range(m.end(), len(cell)):
+            if cell[i] in "([":
+                depth += 1
+            elif cell[i] in ")]":
+                depth -= 1
+            if depth == 0 or (depth == 1 and cell[i] == ","):
+                args.append(cell[start:i].strip())
+                start = i + 1
+            if depth == 0:
+                break
+        found.append((m.group(1), [a for a in args if a]))
+    return found
+
+
+def _documented() -> list[tuple[str, list[str]]]:
+    """The calls of pftrack's top-level names in the first column of docs/api.md's tables."""
+    rows = [line[2:].split(" | ")[0] for line in API_DOC.read_text().splitlines()]
+    return [
+        (name, args)
+        for cell in rows
+        for name, args in _calls(cell)
+        if name in pftrack.__all__ and cell.startswith("`")
+    ]
+
+
+def test_docs_api_names_every_public_name() -> None:
+    """pftrack.Tracker, the drop-in API, was missing from the Tracking table."""
+    spans = " ".join(re.findall(r"`([^`]*)`", API_DOC.read_text()))
+    missing = [
+        n for n in pftrack.__all__ if n != "__version__" and not re.search(rf"\b{n}\b", spans)
+    ]
+    assert not missing
+
+
+@pytest.mark.parametrize(("name", "args"), _documented(), ids=lambda x: str(x)[:40])
+def test_docs_api_signatures_are_the_real_ones(name: str, args: list[str]) -> None:
+    """Each ``x=default`` shown is the real parameter at that place, keyword-only after ``*``.
+
+    docs/api.md showed ``recover_gap(segment_a, segment_b, method="auto")``: the third
+    parameter is ``frames``.
+    """
+    params = list(inspect.signature(getattr(pftrack, name)).parameters.values())
+    positional = [p for p in params if p.kind is not p.KEYWORD_ONLY]
+    keyword_only, skipped = False, False
+    for i, arg in enumerate(args):
+        if arg == "*":
+            keyword_only = True
+            continue
+        if arg == "...":
+            skipped = True  # parameters left out: the next ones' places are unknown
+            continue
+        if "=" not in arg or "(" in arg.split("=", 1)[0]:
+            assert not keyword_only and i < len(positional), f"{name}: {arg} has no place"
+            continue
+        key, default = (t.strip() for t in arg.split("=", 1))
+        real = {p.name: p for p in params}
+        assert key in real, f"{name} has no parameter {key}"
+        assert (real[key].kind is real[key].KEYWORD_ONLY) == keyword_only, f"{name}: {key}"
+        if not keyword_only and not skipped:
+            assert positional[i].name == key, f"{name}: parameter {i + 1} is {positional[i].name}"
+        try:
+            value = ast.literal_eval(default)
+        except (ValueError, SyntaxError):  # not a literal: LinkConfig(), a name
+            continue
+        assert real[key].default == value, f"{name}: {key} defaults to {real[key].default!r}"

@@ -186,6 +186,19 @@ def test_experiment_gaps_several_sequences_writes_json(tmp_path: Path) -> None:
         assert 1 <= len(s["masks"]) <= 3 and all(m[2] == 100 for m in s["masks"])
 
 
+def test_experiment_reads_a_seqinfo_with_a_byte_order_mark(tmp_path: Path) -> None:
+    from pftrack.cli.experiment import _seqinfo
+
+    gt = tmp_path / "SEQ" / "gt" / "gt.txt"
+    gt.parent.mkdir(parents=True)
+    ini = tmp_path / "SEQ" / "seqinfo.ini"
+    ini.write_bytes(b"\xef\xbb\xbf[Sequence]\nname=S\nimWidth=768\nimHeight=576\n")
+    assert _seqinfo(str(gt)) == ("S", 768.0, 576.0)
+    ini.write_text("no section\n")  # was configparser's MissingSectionHeaderError: a traceback
+    with pytest.raises(ValueError, match=r"seqinfo.ini: expected \[Sequence\] imWidth"):
+        _seqinfo(str(gt))
+
+
 def test_experiment_gaps_one_sequence_writes_json(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -109,6 +109,45 @@ def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     assert "outside" in capsys.readouterr().err
 
 
+def _copy_sequence(sequence: Path, seq: Path, *, skip: str = "") -> Path:
+    """`sequence` at `seq`: its images linked (all but `skip`), seqinfo.ini and det/ copied."""
+    (seq / "img1").mkdir(parents=True)
+    for image in (sequence / "img1").iterdir():
+        if image.name != skip:
+            (seq / "img1" / image.name).symlink_to(image)
+    (seq / "det").mkdir()
+    (seq / "det" / "det.txt").write_bytes((sequence / "det" / "det.txt").read_bytes())
+    (seq / "seqinfo.ini").write_bytes((sequence / "seqinfo.ini").read_bytes())
+    return seq
+
+
+def test_a_missing_image_of_a_sequence_is_one_line_not_a_shift(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 59 frames tracked, image 11 as frame 10, exit 0 (or, with detections up to the
+    last frame, 'detections go up to frame 60 but the video has 59 frames')."""
+    seq = _copy_sequence(sequence, tmp_path / "SEQ", skip="10.png")
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers)\n"
+    )
+    assert not out.exists()
+
+
+def test_a_seqinfo_with_a_byte_order_mark_is_read(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'seqinfo.ini: expected a [Sequence] section' (det, gt and results took a BOM)."""
+    seq = _copy_sequence(sequence, tmp_path / "SEQ")
+    ini = seq / "seqinfo.ini"
+    ini.write_bytes(b"\xef\xbb\xbf" + ini.read_bytes())
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 0
+    assert capsys.readouterr().out.startswith("60 frames, ")
+    assert evaluate_mot(scene.truth, read_mot(out)).mota > 0.8
+
+
 def test_auto_detections_need_a_sequence(
     scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

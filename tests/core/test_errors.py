@@ -33,6 +33,7 @@ RESAMPLERS = [systematic_resample, stratified_resample, multinomial_resample, re
         ([0.5, np.nan], r"weights\[1\] is nan"),
         ([0.5, np.inf], r"weights\[1\] is inf"),
         ([0.0, 0.0], "sum to 0"),
+        ([1e308] * 3, r"weights sum is not finite \(overflow"),  # was "sum to 0 (all ... 0"
         ([[0.5, 0.5]], "1-D"),
     ],
 )
@@ -95,6 +96,8 @@ def test_likelihood_bad_inputs():
         bhattacharyya_weights(h, np.ones(3))
     with pytest.raises(ValueError, match="ref sum to 0"):
         bhattacharyya_weights(h, np.zeros(4))
+    with pytest.raises(ValueError, match=r"ref sum is not finite \(overflow"):
+        bhattacharyya_weights(h, np.full(4, 1e308))
     with pytest.raises(ValueError, match=r"hists\[1, 2\] is nan"):
         bad = h.copy()
         bad[1, 2] = np.nan

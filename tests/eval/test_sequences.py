@@ -161,6 +161,19 @@ def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
         main([*argv, "--scale", "A=-1"])
 
 
+def test_seqinfo_with_a_byte_order_mark_is_read(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'not a seqinfo.ini file (File contains no section headers.)'."""
+    gt_root, res_root = make_layout(tmp_path, {"SEQ": random_case(0)})
+    ini = gt_root / "SEQ" / "seqinfo.ini"
+    ini.write_bytes(b"\xef\xbb\xbf" + ini.read_bytes())
+    [seq] = find_sequences(gt_root)
+    assert (seq.width, seq.height) == (200, 150) and seq.length is not None
+    assert main(["eval", "--gt", str(gt_root), "--res", str(res_root)]) == 0
+    assert "SEQ" in capsys.readouterr().out
+
+
 def test_read_seqinfo_errors(tmp_path: Path) -> None:
     p = tmp_path / "seqinfo.ini"
     p.write_text("no section here\n")

@@ -100,6 +100,72 @@ def test_bad_seqinfo_is_one_clear_error(tmp_path: Path, text: str, message: str)
         read_seqinfo(tmp_path)
 
 
+def test_seqinfo_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
+    """Notepad's UTF-8 starts the file with a BOM; det/gt/results already skip it."""
+    (tmp_path / "seqinfo.ini").write_bytes(b"\xef\xbb\xbf[Sequence]\nframeRate=7\nseqLength=3\n")
+    info = read_seqinfo(tmp_path)
+    assert (info.frame_rate, info.length) == (7.0, 3)
+
+
+def _numbered(folder: Path, names: list[str]) -> Path:
+    """Images `names` in `folder`, image i (0-based, in the order given) of grey level i + 1."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for i, name in enumerate(names):
+        cv2.imwrite(str(folder / name), np.full((8, 10, 3), i + 1, np.uint8))
+    return folder
+
+
+def test_a_missing_numbered_image_is_refused_not_shifted(tmp_path: Path) -> None:
+    """Image 000011 must not become frame 10: a hole in frame-number names is an error."""
+    names = [f"{k:06d}.png" for k in range(1, 61) if k != 10]
+    folder = _numbered(tmp_path / "img1", names)
+    message = r"img1: image 000010 is missing \(names 000001\.\.000060 are frame numbers\)$"
+    with pytest.raises(ValueError, match=message):
+        FrameSource(folder)
+    # unpadded names too, and outside any sequence
+    folder = _numbered(tmp_path / "plain", ["1.png", "2.png", "4.png"])
+    with pytest.raises(ValueError, match=r"plain: image 3 is missing \(names 1\.\.4 are"):
+        FrameSource(folder)
+    folder = _numbered(tmp_path / "twice", ["1.png", "01.jpg", "2.png"])
+    with pytest.raises(ValueError, match=r"twice: images 01.jpg and 1.png are both frame 1"):
+        FrameSource(folder)
+
+
+def test_a_sequence_image_folder_is_numbered_from_1_to_seqlength(tmp_path: Path) -> None:
+    seq = _sequence(tmp_path / "SEQ", n=5)
+    assert [int(f[0, 0, 0]) for f in FrameSource(seq)] == [1, 2, 3, 4, 5]
+    (seq / "img1" / "5.png").unlink()  # the last: only seqLength tells
+    message = (
+        r"SEQ/img1: image 5 is missing "
+        r"\(names 1\.\.4 are frame numbers; seqinfo.ini says seqLength=5\)$"
+    )
+    for source in (seq, seq / "img1"):
+        with pytest.raises(ValueError, match=message):
+            FrameSource(source)
+    (seq / "img1" / "1.png").rename(seq / "img1" / "5.png")  # 2..5: frame 1 is missing
+    with pytest.raises(ValueError, match=r"SEQ/img1: image 1 is missing \(names 2\.\.5 are"):
+        FrameSource(seq)
+    _numbered(seq / "img1", ["0.png", "1.png", "6.png"])  # 0..6: seven images, and a frame 0
+    with pytest.raises(ValueError, match=r"SEQ/img1: image 0 is not a frame \(names 0\.\.6 are"):
+        FrameSource(seq)
+    (seq / "img1" / "0.png").unlink()  # 1..6: one more than seqLength
+    with pytest.raises(ValueError, match=r"SEQ/img1: 6 images \(1\.\.6\) but seqinfo.ini says"):
+        FrameSource(seq)
+    # without seqinfo.ini a folder may start anywhere (0-based dumps, a cut of a longer video)
+    (seq / "seqinfo.ini").unlink()
+    zero = _numbered(tmp_path / "zero", ["0.png", "1.png"])
+    assert [int(f[0, 0, 0]) for f in FrameSource(zero)] == [1, 2]
+    assert len(FrameSource(seq)) == 6
+
+
+def test_numbered_and_named_folders_keep_their_order(tmp_path: Path) -> None:
+    numbered = _numbered(tmp_path / "n", [f"{k:06d}.png" for k in (3, 1, 2)])
+    assert [int(f[0, 0, 0]) for f in FrameSource(numbered)] == [2, 3, 1]  # 000001 is level 2
+    # names that are not all numbers: natural order, gaps and all
+    named = _numbered(tmp_path / "f", ["frame_10.png", "frame_2.png", "frame_5.png", "cover.png"])
+    assert [int(f[0, 0, 0]) for f in FrameSource(named)] == [4, 2, 3, 1]
+
+
 def test_seqinfo_of_pets_gives_its_true_frame_rate() -> None:
     folder = dataset("pets09-s2l1")
     src = FrameSource(folder / "video.avi")

@@ -173,6 +173,19 @@ def test_bad_segments_raise():
         recover_gaps([(np.zeros((0, 3)), b)], "gdt")
 
 
+def test_a_method_given_third_is_named_as_the_mix_up():
+    """recover_gaps(gaps, "linear") takes the method second; recover_gap's third is frames."""
+    a, b = line(np.arange(1, 10)), line(np.arange(15, 20))
+    message = r"recover_gap: frames must be .*'linear'; the method goes by keyword: method='linear'"
+    with pytest.raises(TypeError, match=message):  # was "frames must be a 1-D array of integers"
+        recover_gap(a, b, "linear")
+    with pytest.raises(TypeError, match=r"got the string 'fast'$"):
+        recover_gap(a, b, "fast")
+    np.testing.assert_array_equal(
+        recover_gap(a, b, None, "linear"), recover_gap(a, b, method="linear")
+    )
+
+
 def test_demo_report_runs_and_names_every_method():
     rng = np.random.default_rng(3)
     rows = []

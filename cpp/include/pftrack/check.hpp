@@ -56,7 +56,7 @@ inline void require_finite(const Eigen::DenseBase<Derived>& a, const char* fn, c
             }
 }
 
-/// Weights: non-empty, finite, non-negative, positive sum. Returns the sum.
+/// Weights: non-empty, finite, non-negative, positive finite sum. Returns the sum.
 template <class Derived>
 inline double require_weights(const Eigen::DenseBase<Derived>& w, const char* fn,
                               const char* what = "weights") {
@@ -71,9 +71,13 @@ inline double require_weights(const Eigen::DenseBase<Derived>& w, const char* fn
         }
         sum += v;
     }
-    require(sum > 0.0 && std::isfinite(sum), fn,
-            std::string(what) + " sum to 0 (all weights are 0: reference histogram empty, or "
-                                "every particle outside the image?)");
+    if (!std::isfinite(sum))  // each weight is finite: their total overflowed
+        fail(fn, std::string(what) + " sum is not finite (overflow: the weights are finite but "
+                                     "their total exceeds the largest double, 1.8e308; scale "
+                                     "them down, e.g. divide by their maximum)");
+    if (!(sum > 0.0))
+        fail(fn, std::string(what) + " sum to 0 (all weights are 0: reference histogram empty, "
+                                     "or every particle outside the image?)");
     return sum;
 }
 

@@ -133,11 +133,11 @@ def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
         ini = folder / "seqinfo.ini"
         if ini.is_file():
             cp = configparser.ConfigParser()
-            cp.read(ini)
             try:
+                cp.read(ini, encoding="utf-8-sig")
                 sec = cp["Sequence"]
                 return sec.get("name", folder.name), float(sec["imWidth"]), float(sec["imHeight"])
-            except (KeyError, ValueError):
+            except (configparser.Error, KeyError, ValueError):
                 raise ValueError(f"{ini}: expected [Sequence] imWidth and imHeight") from None
     return None
 

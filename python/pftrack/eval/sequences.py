@@ -68,7 +68,7 @@ def read_seqinfo(path: PathLike) -> dict[str, str]:
     """The ``[Sequence]`` section of a MOTChallenge ``seqinfo.ini`` as a dict of strings."""
     parser = configparser.ConfigParser()
     try:
-        parser.read_string(Path(path).read_text(encoding="utf-8", errors="replace"))
+        parser.read_string(Path(path).read_text(encoding="utf-8-sig", errors="replace"))
     except configparser.Error as exc:
         raise ValueError(
             f"{path}: not a seqinfo.ini file ({exc.message.splitlines()[0]})"

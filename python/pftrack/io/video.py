@@ -3,7 +3,9 @@
 Sources, as :class:`FrameSource` takes them:
 
 - a video file OpenCV can decode;
-- a folder of images, read in natural order (``2.jpg`` before ``10.jpg``);
+- a folder of images, read in natural order (``2.jpg`` before ``10.jpg``); when every name is
+  a number (``000001.jpg``, the MOTChallenge convention) the names are frame numbers, and a
+  missing one is refused rather than shifting every later frame;
 - a MOTChallenge sequence folder: ``seqinfo.ini`` gives the frame rate and the image folder
   (``imDir``, default ``img1``); ``det/det.txt`` is its public detection file;
 - a camera index (``"0"``), or a stream URL (anything with ``://``: ``rtsp://``, ``http://``,
@@ -136,7 +138,7 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         ini = ini / "seqinfo.ini"
     parser = configparser.ConfigParser(interpolation=None)
     try:
-        parser.read(ini, encoding="utf-8")
+        parser.read(ini, encoding="utf-8-sig")  # -sig: skips a byte-order mark (Notepad)
         sec = parser["Sequence"]
     except (configparser.Error, KeyError):
         raise ValueError(
@@ -181,6 +183,82 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
         if (folder / "seqinfo.ini").is_file():
             return read_seqinfo(folder)
     return None
+
+
+def _same_folder(a: Path, b: Path) -> bool:
+    """Whether `a` and `b` name the same existing folder (``SEQ/img1`` and ``SEQ/./img1/``)."""
+    try:
+        return a == b or a.samefile(b)
+    except OSError:
+        return False
+
+
+def _frame_order(
+    folder: Path, images: list[Path], sequence: SequenceInfo | None
+) -> list[Path] | None:
+    """`images` in frame order if their names are frame numbers, else None.
+
+    The names are frame numbers when every stem is all digits (``000001.jpg``, ``1.png``: the
+    MOTChallenge convention); a frame is then its image's position, so a hole in the numbering
+    would silently shift every later frame onto the wrong detections and ground truth.
+
+    Parameters
+    ----------
+    folder : Path
+        The image folder (for the messages).
+    images : list of Path
+        Its images, in any order.
+    sequence : SequenceInfo or None
+        The MOTChallenge sequence `folder` is the image folder of: frame 1 is then image 1,
+        and there are ``seqLength`` images when ``seqinfo.ini`` says so.
+
+    Returns
+    -------
+    list of Path or None
+        The images by number; None when some name is not a number (their order is left to
+        the caller).
+
+    Raises
+    ------
+    ValueError
+        A number is missing (a hole, or a sequence's images do not start at 1 or end before
+        its ``seqLength``), two images have one number, or a sequence has more images than
+        its ``seqLength``.
+    """
+    if not all(p.stem.isascii() and p.stem.isdigit() for p in images):
+        return None
+    ordered = sorted(images, key=lambda p: (int(p.stem), p.name))
+    numbers = [int(p.stem) for p in ordered]
+    first, last = ordered[0].stem, ordered[-1].stem
+    names = f"names {first}..{last} are frame numbers"
+
+    def missing(number: int, width: int, why: str) -> ValueError:
+        return ValueError(f"{folder}: image {str(number).zfill(width)} is missing ({why})")
+
+    if sequence is not None and numbers[0] != 1:
+        if numbers[0] > 1:
+            raise missing(1, len(first), f"{names}; frame 1 of a MOTChallenge sequence is image 1")
+        raise ValueError(
+            f"{folder}: image {first} is not a frame ({names}; a MOTChallenge sequence's "
+            "frames start at 1)"
+        )
+    for k in range(1, len(numbers)):
+        if numbers[k] == numbers[k - 1]:
+            raise ValueError(
+                f"{folder}: images {ordered[k - 1].name} and {ordered[k].name} are both "
+                f"frame {numbers[k]} (names that are numbers are frame numbers)"
+            )
+        if numbers[k] != numbers[k - 1] + 1:
+            raise missing(numbers[k - 1] + 1, len(ordered[k - 1].stem), names)
+    length = sequence.length if sequence is not None else None
+    if length is not None and len(ordered) < length:
+        raise missing(numbers[-1] + 1, len(last), f"{names}; seqinfo.ini says seqLength={length}")
+    if length is not None and len(ordered) > length:
+        raise ValueError(
+            f"{folder}: {len(ordered)} images ({first}..{last}) but seqinfo.ini says "
+            f"seqLength={length}"
+        )
+    return ordered
 
 
 def _camera_index(source: PathLike | int) -> int | None:
@@ -241,7 +319,10 @@ class FrameSource:
     FileNotFoundError
         If a path `source` does not exist.
     ValueError
-        If it cannot be opened or decoded, or holds no frame.
+        If it cannot be opened or decoded, or holds no frame; or if the images of a folder are
+        named by number and one is missing (a hole in the numbering; in a MOTChallenge
+        sequence's image folder, also numbers that do not start at 1 or a count other than
+        ``seqLength``).
 
     Notes
     -----
@@ -310,10 +391,13 @@ class FrameSource:
                 raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
         elif (path / "img1").is_dir():
             folder = path / "img1"
-        images = (p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
-        self._images = sorted(images, key=lambda p: natural_key(p.name))
-        if not self._images:
+        images = [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
+        if not images:
             raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
+        seq = self.sequence
+        own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
+        numbered = _frame_order(folder, images, seq if own else None)
+        self._images = numbered or sorted(images, key=lambda p: natural_key(p.name))
         first = cv2.imread(str(self._images[0]), cv2.IMREAD_COLOR)
         if first is None:
             raise ValueError(f"cannot read image {self._images[0]}")

@@ -88,8 +88,9 @@ def recover_gap(
     frames : (F,) array_like of int, optional
         Frames to fill, strictly between the two segments; default: all of them.
     method : str
-        One of :data:`METHODS` (see the module docstring); default ``"auto"`` (calibrated on
-        the two segments only; :func:`recover_gaps` with `observed` calibrates on a whole file).
+        One of :data:`METHODS` (see the module docstring), best given by keyword (the third
+        parameter is `frames`); default ``"auto"`` (calibrated on the two segments only;
+        :func:`recover_gaps` with `observed` calibrates on a whole file).
     noise : NoiseEstimate, optional
         For ``"gdt-bi"``: noise levels to use instead of estimating them from the two segments
         (e.g. pooled over a whole file with :func:`~pftrack.recovery.noise.estimate_noise`).
@@ -104,10 +105,19 @@ def recover_gap(
 
     Raises
     ------
+    TypeError
+        `frames` is a string: a method given positionally, as :func:`recover_gaps` and
+        :func:`~pftrack.recovery.fill.fill_gaps` take it (second); here it goes by keyword.
     ValueError
         Empty or malformed segments, NaN, overlapping segments, frames outside the gap or an
         unknown method.
     """
+    if isinstance(frames, str):  # recover_gap(a, b, "linear"): frames come third here
+        hint = f"; the method goes by keyword: method={frames!r}" if frames in METHODS else ""
+        raise TypeError(
+            f"recover_gap: frames must be a 1-D array of frame numbers, got the string "
+            f"{frames!r}{hint}"
+        )
     a = as_segment(segment_a, "segment_a")
     b = as_segment(segment_b, "segment_b")
     fr = gap_frames(a, b, frames)
