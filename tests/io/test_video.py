@@ -116,19 +116,22 @@ def _numbered(folder: Path, names: list[str]) -> Path:
 
 
 def test_a_missing_numbered_image_is_refused_not_shifted(tmp_path: Path) -> None:
-    """Image 000011 must not become frame 10: a hole in frame-number names is an error."""
+    """In a sequence, image 000011 must not become frame 10: a hole is an error."""
+    seq = tmp_path / "SEQ"
     names = [f"{k:06d}.png" for k in range(1, 61) if k != 10]
-    folder = _numbered(tmp_path / "img1", names)
+    _numbered(seq / "img1", names)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimDir=img1\nframeRate=7\nseqLength=60\n")
     message = r"img1: image 000010 is missing \(names 000001\.\.000060 are frame numbers\)$"
-    with pytest.raises(ValueError, match=message):
-        FrameSource(folder)
-    # unpadded names too, and outside any sequence
-    folder = _numbered(tmp_path / "plain", ["1.png", "2.png", "4.png"])
-    with pytest.raises(ValueError, match=r"plain: image 3 is missing \(names 1\.\.4 are"):
-        FrameSource(folder)
-    folder = _numbered(tmp_path / "twice", ["1.png", "01.jpg", "2.png"])
-    with pytest.raises(ValueError, match=r"twice: images 01.jpg and 1.png are both frame 1"):
-        FrameSource(folder)
+    for source in (seq, seq / "img1"):
+        with pytest.raises(ValueError, match=message):
+            FrameSource(source)
+    (seq / "img1" / "000002.png").rename(seq / "img1" / "2.png")  # 2 and 000002: one frame
+    _numbered(seq / "img1", ["000002.png"])
+    with pytest.raises(ValueError, match=r"images 000002.png and 2.png are both frame 2"):
+        FrameSource(seq)
+    # a folder that is not a sequence's keeps its natural order, holes and all
+    plain = _numbered(tmp_path / "plain", ["5.png", "10.png", "15.png"])
+    assert [int(f[0, 0, 0]) for f in FrameSource(plain)] == [1, 2, 3]
 
 
 def test_a_sequence_image_folder_is_numbered_from_1_to_seqlength(tmp_path: Path) -> None:

@@ -196,11 +196,14 @@ def _same_folder(a: Path, b: Path) -> bool:
 def _frame_order(
     folder: Path, images: list[Path], sequence: SequenceInfo | None
 ) -> list[Path] | None:
-    """`images` in frame order if their names are frame numbers, else None.
+    """A MOTChallenge sequence's images in frame order if their names are frame numbers.
 
     The names are frame numbers when every stem is all digits (``000001.jpg``, ``1.png``: the
-    MOTChallenge convention); a frame is then its image's position, so a hole in the numbering
-    would silently shift every later frame onto the wrong detections and ground truth.
+    MOTChallenge convention). A frame is its image's position, so in a sequence, whose
+    ``det.txt`` and ``gt.txt`` count frames by those numbers, a hole in the numbering would
+    silently shift every later frame onto the wrong detections and ground truth. A folder that
+    is not a sequence's (`sequence` None) keeps its natural order, holes and all: a dump of
+    every fifth frame tracks as it is.
 
     Parameters
     ----------
@@ -210,13 +213,13 @@ def _frame_order(
         Its images, in any order.
     sequence : SequenceInfo or None
         The MOTChallenge sequence `folder` is the image folder of: frame 1 is then image 1,
-        and there are ``seqLength`` images when ``seqinfo.ini`` says so.
+        and there are ``seqLength`` images when ``seqinfo.ini`` says so. None: not checked.
 
     Returns
     -------
     list of Path or None
-        The images by number; None when some name is not a number (their order is left to
-        the caller).
+        The images by number; None outside a sequence or when some name is not a number
+        (their order is left to the caller).
 
     Raises
     ------
@@ -225,7 +228,7 @@ def _frame_order(
         its ``seqLength``), two images have one number, or a sequence has more images than
         its ``seqLength``.
     """
-    if not all(p.stem.isascii() and p.stem.isdigit() for p in images):
+    if sequence is None or not all(p.stem.isascii() and p.stem.isdigit() for p in images):
         return None
     ordered = sorted(images, key=lambda p: (int(p.stem), p.name))
     numbers = [int(p.stem) for p in ordered]
