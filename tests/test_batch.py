@@ -11,6 +11,7 @@ import _thread
 import json
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -233,7 +234,21 @@ def test_resume_skips_complete_outputs_and_force_redoes(
     assert _files(out) == before
 
 
-def test_ctrl_c_cancels_the_tasks_and_leaves_a_summary(client: Any, tmp_path: Path) -> None:
+@pytest.fixture
+def ctrl_c_raises() -> Iterator[None]:
+    """Python's own Ctrl-C handler while the test runs, whatever the test run inherited.
+
+    A shell without job control starts ``cmd &`` with SIGINT ignored; Python then installs no
+    handler and ``_thread.interrupt_main()`` raises nothing.
+    """
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_ctrl_c_cancels_the_tasks_and_leaves_a_summary(
+    client: Any, tmp_path: Path, ctrl_c_raises: None
+) -> None:
     jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(6)]
     timer = threading.Timer(1.0, _thread.interrupt_main)
     timer.start()
