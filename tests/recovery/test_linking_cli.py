@@ -166,6 +166,11 @@ def test_cli_recover_reports_bad_rows_with_line_number(tmp_path, capsys):
     src.write_text("1,1,10,10,5,5,1,-1,-1,-1\n\n1,1,11,10,5,5,1,-1,-1,-1\n")
     assert main(["recover", str(src), "--out", str(tmp_path / "o.txt")]) == 2
     assert "lines 1 and 3" in capsys.readouterr().err
+    src.write_text("1,2,10,10,5,5,1,-1,-1,-1\n# comment\n1,19.5,11,10,5,5,1,-1,-1,-1\n")
+    for command in ("recover", "smooth"):
+        assert main([command, str(src), "--out", str(tmp_path / "o.txt")]) == 2
+        err = capsys.readouterr().err  # was: "fill_gaps: track id 19.5 ..." without the line
+        assert "bad.txt:3: track id 19.5 is not an integer" in err and "fill_gaps" not in err
     assert not (tmp_path / "o.txt").exists()
 
 

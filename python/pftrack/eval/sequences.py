@@ -200,7 +200,7 @@ def check_scale(
     )
     if best >= 0.3 and best > 2 * as_given:
         raise ValueError(
-            f"{name}: its boxes look {fit / scale:.2g} times the ground truth's (median height "
+            f"{name}: its boxes look {fit / scale:.3g} times the ground truth's (median height "
             f"{r_h:.0f} vs {g_h:.0f} px; {as_given:.0%} of ground-truth boxes matched, "
             f"{best:.0%} with the ground truth scaled by {fit:.2g}): pass --scale S, S the ratio "
             f"of the image sizes (about {fit:.2g} here; 0.625 for PETS09 ground truth on its "

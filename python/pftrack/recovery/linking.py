@@ -342,15 +342,24 @@ def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:
 
 
 def read_tracks(path: PathLike) -> F64:
-    """Read a tracks file whose (frame, id) pairs are unique (an error names the lines).
+    """Read a tracks file whose ids are integers and (frame, id) pairs unique (errors name lines).
 
-    :func:`pftrack.io.mot.read_mot` (``what="tracks file"``), then :func:`check_unique`; the
+    :func:`pftrack.io.mot.read_mot` (``what="tracks file"``), the ids' check (``FILE:LINE``),
+    then :func:`check_unique`; the
     file is read a second time, for its line numbers, only when a pair repeats. What
     ``pftrack recover`` and ``pftrack smooth`` read, one file or many.
     """
     from pftrack.io.mot import data_line_numbers, read_mot
 
     rows = read_mot(path, what="tracks file")
+    ids = rows[:, 1]
+    bad = (np.abs(ids) > MAX_ID) | (ids != np.floor(ids))
+    if bad.any():  # the message names the file's line, as read_mot's own checks do
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"{path}:{data_line_numbers(path)[k]}: track id {ids[k]:g} is not an integer with "
+            f"|id| <= {MAX_ID}"
+        )
     try:
         check_unique(rows)
     except ValueError:
