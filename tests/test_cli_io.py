@@ -21,6 +21,7 @@ from pftrack.cli import build_parser, main
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.synthetic import Scene, make_scene
+from tests.conftest import dataset
 from tests.io.streaming import serve_stream
 
 
@@ -155,6 +156,66 @@ def test_auto_detections_need_a_sequence(
     assert main(["track", str(video), "--detections", "auto", "--out", str(tmp_path / "t")]) == 2
     err = capsys.readouterr().err
     assert "--detections auto" in err and "det/det.txt" in err
+
+
+def _video_sequence(sequence: Path, scene: Scene, seq: Path) -> Path:
+    """`sequence` in the layout of the shared data: seqinfo.ini, video.avi, det.txt; no img1/."""
+    seq.mkdir(parents=True)
+    scene.write_video(seq / "video.avi")
+    (seq / "det.txt").write_bytes((sequence / "det" / "det.txt").read_bytes())
+    (seq / "seqinfo.ini").write_bytes((sequence / "seqinfo.ini").read_bytes())  # imDir=img1
+    return seq
+
+
+def test_a_sequence_folder_with_one_video_tracks_as_its_video(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'SEQ/seqinfo.ini: image folder SEQ/img1 does not exist' (pftrack batch took it)."""
+    seq = _video_sequence(sequence, scene, tmp_path / "SEQ")
+    a, b, d = tmp_path / "a.txt", tmp_path / "b.txt", tmp_path / "D"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(a)]) == 0
+    argv = ["track", str(seq / "video.avi"), "--detections", str(seq / "det.txt"), "--out", str(b)]
+    assert main(argv) == 0
+    argv = ["batch", str(seq), "--out", str(d), "--workers", "0", "--detections", "auto"]
+    assert main(argv) == 0
+    assert a.read_bytes() == b.read_bytes() == (d / "SEQ.txt").read_bytes()
+    assert evaluate_mot(scene.truth, read_mot(a)).mota > 0.8
+    capsys.readouterr()
+    # the video it reads is an input: --render over it is refused before any work
+    before = (seq / "video.avi").read_bytes()
+    argv = ["track", str(seq), "--out", str(a), "--render", str(seq / "video.avi")]
+    assert main(argv) == 2
+    assert "is an input of this run" in capsys.readouterr().err
+    assert (seq / "video.avi").read_bytes() == before
+
+
+def test_a_sequence_folder_with_two_videos_is_refused(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    seq = _video_sequence(sequence, scene, tmp_path / "SEQ")
+    (seq / "b.avi").symlink_to(seq / "video.avi")
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: image folder {seq}/img1 does not exist and "
+        f"{seq} holds 2 videos (b.avi, video.avi), not one to read instead\n"
+    )
+    assert not out.exists()
+
+
+def test_tud_campus_folder_tracks_as_batch_and_its_video(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The shared data's layout: ``track SEQ`` = ``batch SEQ`` = ``track SEQ/video.mp4``."""
+    seq = dataset("tud-campus")
+    a, b, d = tmp_path / "a.txt", tmp_path / "b.txt", tmp_path / "D"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(a)]) == 0
+    argv = ["track", str(seq / "video.mp4"), "--detections", str(seq / "det.txt"), "--out", str(b)]
+    assert main(argv) == 0
+    argv = ["batch", str(seq), "--out", str(d), "--workers", "0", "--detections", "auto"]
+    assert main(argv) == 0
+    assert a.read_bytes() == b.read_bytes() == (d / "tud-campus.txt").read_bytes()
+    assert a.stat().st_size > 0
 
 
 def test_ctrl_c_on_a_file_aborts_and_keeps_the_old_outputs(

@@ -200,6 +200,21 @@ def test_recover_in_place_needs_the_flag(
     assert src.read_bytes() != inputs["tracks"].read_bytes()
 
 
+@pytest.mark.parametrize("in_place", [False, True])
+def test_recover_keeps_the_permissions_of_the_file_it_replaces(
+    inputs: dict[str, Path], tmp_path: Path, in_place: bool
+) -> None:
+    """``chmod 600 out.txt`` survives a run that replaces it (was: reset to -rw-r--r--)."""
+    src, out = tmp_path / "t.txt", tmp_path / ("t.txt" if in_place else "out.txt")
+    src.write_bytes(inputs["tracks"].read_bytes())
+    out.write_bytes(src.read_bytes())
+    out.chmod(0o600)
+    flag = ["--in-place"] if in_place else []
+    assert main(["-q", "recover", str(src), "--out", str(out), "--method", "linear", *flag]) == 0
+    assert out.read_bytes() != inputs["tracks"].read_bytes()
+    assert out.stat().st_mode & 0o7777 == 0o600
+
+
 @pytest.mark.parametrize("where", ["render", "plot", "tracking"])
 def test_interrupted_track_run_changes_no_output(
     where: str,

@@ -78,3 +78,33 @@ def test_staged_outputs_replace_all_or_none(tmp_path: Path, umask) -> None:
     assert a.read_text().startswith("1,1,0,0,10,10") and b.read_bytes() == b"new"
     assert {stat.S_IMODE(p.stat().st_mode) for p in (a, b)} == {0o644}
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.png"]
+
+
+@pytest.mark.parametrize("mode", [0o600, 0o640])
+def test_replacing_a_file_keeps_its_permissions(tmp_path: Path, umask, mode: int) -> None:
+    """A file the user restricted stays restricted: not reset to the umask's 0o644."""
+    from pftrack.io.atomic import staged_outputs
+
+    umask(0o022)
+    names = ("t.txt", "p.bin", "s.txt", "v.avi")
+    for name in names:
+        (tmp_path / name).write_text("old")
+        os.chmod(tmp_path / name, mode)
+    with atomic_write(tmp_path / "t.txt") as fh:
+        assert stat.S_IMODE(os.fstat(fh.fileno()).st_mode) == mode  # never wider, even mid-write
+        fh.write("new")
+    with atomic_path(tmp_path / "p.bin") as tmp:
+        tmp.unlink()  # a writer that makes its file anew (umask default) still gets `mode`
+        tmp.write_bytes(b"new")
+    with staged_outputs() as stage:
+        stage(tmp_path / "s.txt").write_text("new")
+        stage(tmp_path / "v.avi").write_bytes(b"new")
+    for name in names:
+        assert (tmp_path / name).read_bytes() == b"new", name
+        assert stat.S_IMODE((tmp_path / name).stat().st_mode) == mode, name
+
+
+def test_a_new_file_still_follows_the_umask(tmp_path: Path, umask) -> None:
+    umask(0o027)
+    write_mot(tmp_path / "t.txt", [[1, 1, 0, 0, 10, 10]])
+    assert stat.S_IMODE((tmp_path / "t.txt").stat().st_mode) == 0o640

@@ -81,6 +81,64 @@ def test_video_beside_seqinfo_takes_its_frame_rate(tmp_path: Path) -> None:
     assert (FrameSource(video).fps, FrameSource(video).fps_origin) == (7.0, "seqinfo.ini")
 
 
+def _video_sequence(root: Path, n: int = 6) -> Path:
+    """The layout of the shared data: seqinfo.ini (imDir=img1, absent), video.avi, det.txt."""
+    root.mkdir(parents=True)
+    writer = cv2.VideoWriter(
+        str(root / "video.avi"), cv2.VideoWriter.fourcc(*"MJPG"), 10.0, (16, 8)
+    )
+    for k in range(n):
+        writer.write(np.full((8, 16, 3), 40 * k, np.uint8))
+    writer.release()
+    (root / "seqinfo.ini").write_text(
+        f"[Sequence]\nname=VSEQ\nimDir=img1\nframeRate=7\nseqLength={n}\nimWidth=16\n"
+    )
+    (root / "det.txt").write_text("1,-1,1,1,3,3,0.9,-1,-1,-1\n")
+    return root
+
+
+def test_sequence_folder_without_images_reads_its_one_video(tmp_path: Path) -> None:
+    """``pftrack batch`` takes SEQ/seqinfo.ini + SEQ/video.avi; FrameSource(SEQ) reads the same."""
+    seq = _video_sequence(tmp_path / "SEQ")
+    src, direct = FrameSource(seq), FrameSource(seq / "video.avi")
+    assert src.path == seq / "video.avi" and src.name == str(seq)
+    assert (src.fps, src.fps_origin, len(src)) == (7.0, "seqinfo.ini", 6)  # the header says 10
+    assert src.sequence is not None and src.sequence.name == "VSEQ"
+    assert src.sequence.detections == seq / "det.txt"
+    frames = list(src)
+    assert len(frames) == 6 and all(
+        np.array_equal(a, b) for a, b in zip(frames, direct, strict=True)
+    )
+    assert all(
+        np.array_equal(a, b) for a, b in zip(src.frames_at([1, 4]), frames[1::3], strict=True)
+    )
+    (seq / "det").mkdir()
+    (seq / "det" / "det.txt").write_text("")
+    assert FrameSource(seq).sequence.detections == seq / "det" / "det.txt"  # type: ignore[union-attr]
+
+
+def test_sequence_folder_without_images_needs_exactly_one_video(tmp_path: Path) -> None:
+    seq = _video_sequence(tmp_path / "SEQ")
+    (seq / "video.avi").rename(seq / "video.txt")
+    message = r"SEQ/img1 does not exist and .*SEQ holds no video \(\.avi, .*\) to read instead$"
+    with pytest.raises(ValueError, match=message):
+        FrameSource(seq)
+    (seq / "video.txt").rename(seq / "a.avi")
+    (seq / "b.MP4").write_bytes((seq / "a.avi").read_bytes())
+    with pytest.raises(ValueError, match=r"holds 2 videos \(a\.avi, b\.MP4\), not one"):
+        FrameSource(seq)
+    (seq / "b.MP4").unlink()
+    (seq / "img1").mkdir()  # its image folder exists: read that, even empty (refused as before)
+    with pytest.raises(ValueError, match="no images"):
+        FrameSource(seq)
+
+
+def test_video_suffixes_are_batchs() -> None:
+    from pftrack.batch.inputs import VIDEO_SUFFIXES
+
+    assert video.VIDEO_SUFFIXES == VIDEO_SUFFIXES
+
+
 def test_image_folder_without_seqinfo_gets_the_default_rate(tmp_path: Path) -> None:
     cv2.imwrite(str(tmp_path / "1.png"), np.zeros((4, 4, 3), np.uint8))
     src = FrameSource(tmp_path)

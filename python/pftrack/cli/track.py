@@ -27,8 +27,10 @@ def add_parser(sub: Any) -> None:
         help="track a video, image folder, camera or stream; MOTChallenge output",
         description="Track every object in SOURCE: a video file, a folder of images (natural "
         "order: 2.jpg before 10.jpg), a MOTChallenge sequence folder (seqinfo.ini gives the "
-        "frame rate and image folder, det/det.txt the detections of --detections auto; its "
-        "image names that are all digits are frame numbers, and a missing one is an error), a "
+        "frame rate and image folder, det/det.txt or det.txt the detections of --detections "
+        "auto; its image names that are all digits are frame numbers, and a missing one is an "
+        "error; without its image folder, the one video file beside seqinfo.ini is read, as "
+        "pftrack batch does), a "
         "camera index (0) or a stream URL (rtsp://, http://, ...). Without --detections, "
         "objects come from background subtraction; with a MOTChallenge det.txt the tracker is "
         "a drop-in backend for any detector. Output: MOTChallenge rows "
@@ -132,12 +134,16 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output
+    from pftrack.io.video import sequence_video
     from pftrack.io.video_writer import VIDEO_SUFFIXES
 
     given = [d for d in (args.detections,) if d and d != "auto"]
     for det in given:
         check_input_file(det, what="--detections")
     inputs = tuple([args.source] if not live else []) + tuple(given)
+    if not live and Path(args.source).is_dir():
+        video = sequence_video(args.source)  # a sequence folder read from its one video
+        inputs += (video,) if video is not None else ()
     check_output(args.out, what="--out", inputs=inputs)
     if args.render:
         check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)

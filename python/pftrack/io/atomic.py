@@ -1,7 +1,10 @@
 """Atomic file output: write next to the target, then rename over it in one step.
 
 The temporary file is created with mode ``0o666`` filtered by the process umask, as ``open``
-would create the target itself (``tempfile.mkstemp`` would make every output ``0o600``).
+would create the target itself (``tempfile.mkstemp`` would make every output ``0o600``). When
+it replaces an existing file it takes that file's permission bits instead (``mode & 0o7777``,
+set on creation and again just before the rename), so a file the user restricted to
+``0o600`` is never replaced by a world-readable one, nor readable while it is written.
 """
 
 from __future__ import annotations
@@ -9,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
+import stat
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any
@@ -28,6 +32,25 @@ def _create_beside(folder: Path, prefix: str, suffix: str) -> tuple[int, str]:
     raise FileExistsError(f"cannot create a temporary file in {folder}")
 
 
+def _existing_mode(target: Path) -> int | None:
+    """The permission bits (``mode & 0o7777``) of the file `target` names; None if none does."""
+    try:
+        st = os.stat(target)
+    except OSError:
+        return None
+    return stat.S_IMODE(st.st_mode) if stat.S_ISREG(st.st_mode) else None
+
+
+def _keep_mode(tmp: str | int, target: Path) -> None:
+    """Give `tmp` (a path or an open descriptor) the permission bits of an existing `target`.
+
+    A new file (no `target` yet) keeps the umask default it was created with.
+    """
+    mode = _existing_mode(target)
+    if mode is not None and (isinstance(tmp, str) or os.chmod in os.supports_fd):
+        os.chmod(tmp, mode)
+
+
 @contextlib.contextmanager
 def atomic_write(
     path: PathLike, mode: str = "w", *, suffix: str | None = None
@@ -35,7 +58,8 @@ def atomic_write(
     """Open a temporary file beside `path`; on success it replaces `path` atomically.
 
     If the block raises, the temporary file is removed and `path` is left exactly as it was,
-    so a crash or a bad input never destroys a user's earlier output.
+    so a crash or a bad input never destroys a user's earlier output. A new file follows the
+    umask; one that replaces an existing file gets that file's permission bits.
 
     Parameters
     ----------
@@ -52,10 +76,12 @@ def atomic_write(
         raise FileNotFoundError(f"output folder does not exist: {folder}")
     fd, tmp = _create_beside(folder, f".{target.name}.", suffix or ".tmp")
     try:
+        _keep_mode(fd, target)
         with os.fdopen(fd, mode) as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
+        _keep_mode(tmp, target)
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
@@ -68,17 +94,22 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
     """Yield a temporary path (same folder, same extension) that replaces `path` on success.
 
     For writers that want a file name rather than a handle (``cv2.VideoWriter``, ``cv2.imwrite``).
+    Permissions as for :func:`atomic_write`: an existing file's are kept.
     """
     target = Path(path)
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"output folder does not exist: {folder}")
     fd, tmp = _create_beside(folder, f".{target.stem}.", target.suffix)
-    os.close(fd)
     try:
+        try:
+            _keep_mode(fd, target)
+        finally:
+            os.close(fd)
         yield Path(tmp)
         if not Path(tmp).exists() or Path(tmp).stat().st_size == 0:
             raise OSError(f"nothing was written for {target}")
+        _keep_mode(tmp, target)  # again: a writer may have made the file anew
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
@@ -203,12 +234,17 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
         if not folder.is_dir():
             raise FileNotFoundError(f"output folder does not exist: {folder}")
         fd, tmp = _create_beside(folder, f".{target.stem}.", target.suffix or ".tmp")
-        os.close(fd)
         staged.append((tmp, target))
+        try:
+            _keep_mode(fd, target)
+        finally:
+            os.close(fd)
         return Path(tmp)
 
     try:
         yield stage
+        for tmp, target in staged:
+            _keep_mode(tmp, target)  # again: a writer may have made the file anew
         for tmp, target in staged:
             os.replace(tmp, target)
     except BaseException:

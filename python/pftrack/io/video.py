@@ -7,7 +7,10 @@ Sources, as :class:`FrameSource` takes them:
   a number (``000001.jpg``, the MOTChallenge convention) the names are frame numbers, and a
   missing one is refused rather than shifting every later frame;
 - a MOTChallenge sequence folder: ``seqinfo.ini`` gives the frame rate and the image folder
-  (``imDir``, default ``img1``); ``det/det.txt`` is its public detection file;
+  (``imDir``, default ``img1``); ``det/det.txt`` (or ``det.txt``) is its public detection
+  file. When the image folder does not exist and the sequence folder holds exactly one video
+  file (``SEQ/video.mp4``: the layout of ``pftrack batch`` and the shared data), that video is
+  read, with the sequence's frame rate and detections;
 - a camera index (``"0"``), or a stream URL (anything with ``://``: ``rtsp://``, ``http://``,
   ``udp://``, ...), or a named pipe: *live* sources, read once, of unknown length.
 
@@ -34,6 +37,7 @@ from numpy.typing import NDArray
 from pftrack._typing import PathLike
 
 __all__ = [
+    "VIDEO_SUFFIXES",
     "FrameSource",
     "SequenceInfo",
     "find_sequence",
@@ -41,9 +45,12 @@ __all__ = [
     "natural_key",
     "read_frames",
     "read_seqinfo",
+    "sequence_video",
 ]
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
+#: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
+VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 DEFAULT_FPS = 25.0
 REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
@@ -185,6 +192,52 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     return None
 
 
+def sequence_video(folder: PathLike) -> Path | None:
+    """The video a MOTChallenge sequence folder without its image folder is read from.
+
+    That is the layout ``pftrack batch`` takes (``SEQ/seqinfo.ini``, ``SEQ/video.mp4``,
+    ``SEQ/det.txt``, no ``SEQ/img1/``).
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        A folder.
+
+    Returns
+    -------
+    Path or None
+        The one video file (:data:`VIDEO_SUFFIXES`) in `folder`, when `folder` holds a
+        ``seqinfo.ini`` whose image folder (``imDir``) does not exist; None when `folder` is
+        not such a sequence folder (no ``seqinfo.ini``, or its image folder exists).
+
+    Raises
+    ------
+    ValueError
+        `folder` is such a sequence folder but holds no video, or several.
+    """
+    path = Path(folder)
+    if not (path / "seqinfo.ini").is_file():
+        return None
+    images = path / read_seqinfo(path).image_dir
+    if images.is_dir():
+        return None
+    videos = sorted(
+        (p for p in path.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
+        key=lambda p: natural_key(p.name),
+    )
+    if len(videos) == 1:
+        return videos[0]
+    found = (
+        f"{len(videos)} videos ({', '.join(p.name for p in videos)}), not one"
+        if videos
+        else f"no video ({', '.join(VIDEO_SUFFIXES)})"
+    )
+    raise ValueError(
+        f"{path / 'seqinfo.ini'}: image folder {images} does not exist and {path} holds "
+        f"{found} to read instead"
+    )
+
+
 def _same_folder(a: Path, b: Path) -> bool:
     """Whether `a` and `b` name the same existing folder (``SEQ/img1`` and ``SEQ/./img1/``)."""
     try:
@@ -293,8 +346,9 @@ class FrameSource:
     Parameters
     ----------
     source : str, int or os.PathLike
-        A video file, an image folder, a MOTChallenge sequence folder (``seqinfo.ini``,
-        ``img1/``), a camera index (``0`` or ``"0"``), or a stream URL such as
+        A video file, an image folder, a MOTChallenge sequence folder (``seqinfo.ini`` and
+        ``img1/``, or ``seqinfo.ini`` and one video file: see :func:`sequence_video`), a
+        camera index (``0`` or ``"0"``), or a stream URL such as
         ``rtsp://host/path`` or ``http://host:8080/video`` (passed to OpenCV's FFmpeg
         backend untouched).
     scale : float
@@ -314,6 +368,9 @@ class FrameSource:
         A camera, stream or pipe: read once, frames as they arrive.
     sequence : SequenceInfo or None
         The MOTChallenge sequence `source` belongs to.
+    path : Path or None
+        The file or folder read: `source`, or a sequence folder's video (see
+        :func:`sequence_video`); None for a camera or a stream URL.
     width, height : int
         Frame size after `scale`.
 
@@ -365,6 +422,9 @@ class FrameSource:
             if not self.path.exists():
                 raise FileNotFoundError(f"video source not found: {self.path}")
             self.sequence = find_sequence(self.path)
+            if self.sequence is not None and self.path.is_dir():
+                video = sequence_video(self.path) if self.sequence.folder == self.path else None
+                self.path = video or self.path  # SEQ/video.mp4 read as SEQ/img1 would be
             if self.path.is_dir():
                 first, count = self._open_folder(self.path)
             elif self.live:
