@@ -187,6 +187,12 @@ def test_a_sequence_folder_with_one_video_tracks_as_its_video(
     assert main(argv) == 2
     assert "is an input of this run" in capsys.readouterr().err
     assert (seq / "video.avi").read_bytes() == before
+    # so is the det.txt that --detections auto finds: --out over it is refused too
+    det = (seq / "det.txt").read_bytes()
+    argv = ["track", str(seq), "--detections", "auto", "--out", str(seq / "det.txt")]
+    assert main(argv) == 2
+    assert "is an input of this run" in capsys.readouterr().err
+    assert (seq / "det.txt").read_bytes() == det
 
 
 def test_a_sequence_folder_with_two_videos_is_refused(

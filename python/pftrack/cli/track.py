@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import signal
 import sys
 import warnings
@@ -134,7 +135,7 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output
-    from pftrack.io.video import sequence_video
+    from pftrack.io.video import find_sequence, sequence_video
     from pftrack.io.video_writer import VIDEO_SUFFIXES
 
     given = [d for d in (args.detections,) if d and d != "auto"]
@@ -144,6 +145,11 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     if not live and Path(args.source).is_dir():
         video = sequence_video(args.source)  # a sequence folder read from its one video
         inputs += (video,) if video is not None else ()
+    if not live and args.detections == "auto":  # the sequence's det.txt is an input too
+        with contextlib.suppress(ValueError):  # a bad seqinfo.ini is refused when read
+            seq = find_sequence(args.source)
+            found = seq.detections if seq is not None else None
+            inputs += (found,) if found is not None else ()
     check_output(args.out, what="--out", inputs=inputs)
     if args.render:
         check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
