@@ -234,6 +234,95 @@ def test_resume_skips_complete_outputs_and_force_redoes(
     assert _files(out) == before
 
 
+def test_resume_redoes_a_file_whose_content_changed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    paths = _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]
+    assert main(argv) == 0
+
+    def entries() -> dict[str, dict[str, Any]]:
+        return {f["name"]: f for f in json.loads((out / "summary.json").read_text())["files"]}
+
+    # cut to its first rows: path and settings as before, the content not
+    rows = read_mot(paths[0])
+    write_mot(paths[0], rows[: len(rows) // 2])
+    capsys.readouterr()
+    assert main(argv) == 0
+    got = entries()
+    assert [e["status"] for e in got.values()] == ["done", "skipped", "skipped"]
+    assert got["run0"]["rows_in"] == len(rows) // 2
+    assert f"run0: redone: {paths[0]} changed since the last run" in capsys.readouterr().out
+    single = tmp_path / "single.txt"
+    assert main(["recover", str(paths[0]), "--out", str(single)]) == 0
+    assert single.read_bytes() == (out / "run0.txt").read_bytes()
+    # the same size, a new modification time: redone too (the content cannot be told apart)
+    st = paths[1].stat()
+    os.utime(paths[1], ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))
+    assert main(argv) == 0
+    assert [e["status"] for e in entries().values()] == ["skipped", "done", "skipped"]
+    assert "note" not in entries()["run0"]
+    # unchanged: skipped, and --force still redoes everything
+    assert main(argv) == 0
+    assert {e["status"] for e in entries().values()} == {"skipped"}
+    assert main([*argv, "--force"]) == 0
+    assert {e["status"] for e in entries().values()} == {"done"}
+
+
+def test_resume_redoes_a_sequence_whose_truth_or_images_changed(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    options = TrackOptions(config=_config())
+    first = track_many(seq, tmp_path / "out", client, options=options).entries[0]
+    assert first["status"] == "done" and first["metrics"]["mota"] is not None
+    gt = read_mot(seq / "gt" / "gt.txt")
+    gt[:, 2] += 60.0  # every true box moved: the same tracks now score badly
+    write_mot(seq / "gt" / "gt.txt", gt)
+    again = track_many(seq, tmp_path / "out", client, options=options).entries[0]
+    assert again["status"] == "done" and again["metrics"]["mota"] < first["metrics"]["mota"]
+    assert again["note"] == f"redone: {seq / 'gt' / 'gt.txt'} changed since the last run"
+    assert track_many(seq, tmp_path / "out", client, options=options).entries[0]["status"] == (
+        "skipped"
+    )
+    # an image folder: one image fewer
+    images = sorted((seq / "img1").iterdir())
+    images[-1].unlink()
+    last = track_many(seq, tmp_path / "out", client, options=options).entries[0]
+    assert last["status"] == "done" and last["frames"] == len(images) - 1
+
+
+@pytest.fixture
+def connect_timeout_1s() -> Iterator[None]:
+    """Dask's connect timeout (``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``) at 1 s."""
+    import dask
+
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        yield
+
+
+def test_an_unreachable_scheduler_writes_nothing(
+    tmp_path: Path, connect_timeout_1s: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _tracks_files(tmp_path / "tracks")
+    address = f"tcp://127.0.0.1:{_free_port()}"  # nothing listens there
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+    start = time.monotonic()
+    assert main([*argv, "--scheduler", address]) == 2
+    assert time.monotonic() - start < 15  # the timeout set above, not a hard-coded 20 s
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot connect to the Dask scheduler" in err
+    assert address in err
+    assert not (tmp_path / "out").exists()
+    # over complete results, --force: the summary and outputs a user had stay as they were
+    assert main([*argv, "--workers", "0"]) == 0
+    before = {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()}
+    assert main([*argv, "--scheduler", address, "--force"]) == 2
+    assert {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()} == before
+
+
 @pytest.fixture
 def ctrl_c_raises() -> Iterator[None]:
     """Python's own Ctrl-C handler while the test runs, whatever the test run inherited.
@@ -445,6 +534,11 @@ def test_scheduler_address_from_the_environment(
     assert main(["batch", str(data / "plain"), "--out", str(tmp_path), *FAST]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["scheduler"] == client.scheduler.address and summary["workers"] == 2
+    # the address as the user gave it, not as Dask reports it (tcp://127.0.0.1:PORT)
+    given = client.scheduler.address.replace("127.0.0.1", "localhost")
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", given)
+    assert main(["batch", str(data / "plain"), "--out", str(tmp_path), "--force", *FAST]) == 0
+    assert json.loads((tmp_path / "summary.json").read_text())["scheduler"] == given
 
 
 @pytest.mark.dataset

@@ -9,7 +9,8 @@ files or a folder fill or smooth many tracks files, one Dask task each:
   what a batch runs on;
 - :class:`TrackOptions`, :class:`RecoverOptions`, :class:`SmoothOptions` and the task
   functions (:mod:`.tasks`): the work of one task, free of Dask;
-- :func:`dask_client`, :func:`run_jobs` (:mod:`.engine`): the Dask layer, outputs and resume.
+- :func:`dask_client`, :func:`run_jobs`, :func:`fingerprint` (:mod:`.engine`): the Dask layer,
+  outputs and resume.
 
 Dask itself is imported only when a cluster is used.
 """
@@ -17,7 +18,7 @@ Dask itself is imported only when a cluster is used.
 from __future__ import annotations
 
 from pftrack.batch.api import recover_many, smooth_many, track_many
-from pftrack.batch.engine import BatchSummary, Job, dask_client, run_jobs
+from pftrack.batch.engine import BatchSummary, Job, dask_client, fingerprint, run_jobs
 from pftrack.batch.inputs import SequenceInput, find_sequences, find_track_files
 from pftrack.batch.tasks import (
     RecoverOptions,
@@ -40,6 +41,7 @@ __all__ = [
     "TrackOptions",
     "dask_client",
     "find_sequences",
+    "fingerprint",
     "find_track_files",
     "recover_file",
     "recover_many",

@@ -4,9 +4,13 @@ One task per sequence (or tracks file). The client submits every task that is no
 complete, writes each result as it arrives (``DIR/NAME.txt``, extra files, then the sidecar
 ``DIR/NAME.json``, each atomically), and writes ``DIR/summary.json`` at the end.
 
-*Complete* means: the sidecar exists, names the same inputs and settings, and every output it
+*Complete* means: the sidecar exists, names the same inputs and settings, records the same
+fingerprint of each input (:func:`fingerprint`: size and modification time), and every output it
 lists exists. The sidecar is written last, and every file atomically, so a run stopped at any
 point leaves each output either complete or absent; a re-run skips the complete ones.
+
+Where the tasks run (a scheduler to connect to, or a local cluster to start) is settled before
+``DIR`` is created or any file written: a scheduler that cannot be reached changes nothing.
 """
 
 from __future__ import annotations
@@ -29,11 +33,12 @@ from pftrack._progress import progress
 from pftrack.batch.tasks import TaskResult
 from pftrack.io.atomic import atomic_write, check_output
 from pftrack.io.mot import write_mot
+from pftrack.io.video import IMAGE_SUFFIXES
 
 if TYPE_CHECKING:
     from distributed import Client
 
-__all__ = ["BatchSummary", "Job", "dask_client", "run_jobs"]
+__all__ = ["BatchSummary", "Job", "dask_client", "fingerprint", "run_jobs"]
 
 SUMMARY_NAME = "summary.json"
 
@@ -80,14 +85,16 @@ class BatchSummary:
         The output folder.
     entries : list of dict
         Per task: ``name``, ``status`` (``"done"``, ``"skipped"``: complete from an earlier run,
-        ``"failed"``, ``"cancelled"``), ``error`` (one line, failed only), and the task's figures
-        (``frames``, ``tracks``, ``fps``, ``metrics`` ... for tracking).
+        ``"failed"``, ``"cancelled"``), ``error`` (one line, failed only), ``note`` (why a task
+        complete from an earlier run was redone: ``"redone: PATH changed since the last run"``),
+        and the task's figures (``frames``, ``tracks``, ``fps``, ``metrics`` ... for tracking).
     seconds : float
         Wall time of the batch (cluster start included).
     workers : int
         Workers that ran it (0: in this process).
     scheduler : str or None
-        Address of the Dask scheduler (None: in this process).
+        Address of the Dask scheduler, as given (``--scheduler``, ``DASK_SCHEDULER_ADDRESS``),
+        else as Dask reports it (None: in this process).
     settings : dict
         The settings every task ran with.
     """
@@ -154,6 +161,8 @@ class BatchSummary:
         noun = "sequence" if self.kind == "track" else "file"
         text.append(f"{_count(len(self.entries), noun)}: {counts}; {self.seconds:.1f} s, {where}")
         for e in self.entries:
+            if e.get("note"):
+                text.append(f"{e['name']}: {e['note']}")
             text.extend(f"{e['name']}: warning: {w}" for w in e.get("warnings", ()))
         for e in self.failed:
             text.append(f"{e['name']}: error: {e['error']}")
@@ -250,6 +259,13 @@ def dask_client(
     n_workers : int, optional
         Workers of the new ``LocalCluster`` (default: one per core), each a process with one
         thread.
+
+    Raises
+    ------
+    OSError
+        The scheduler cannot be reached within Dask's ``distributed.comm.timeouts.connect``
+        (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``): one line naming the
+        address.
     """
     _require_dask()
     import dask
@@ -261,9 +277,16 @@ def dask_client(
         client.register_plugin(SingleThreaded())
         yield client
         return
-    address = scheduler or dask.config.get("scheduler-address", None)
+    address = scheduler_address(scheduler)
     if address:
-        with Client(address, timeout="20s") as c:
+        try:
+            connected = Client(address)  # timeout: distributed.comm.timeouts.connect
+        except OSError as exc:  # TimeoutError, refused, unknown host: one line, the address named
+            text = " ".join(str(exc).split())
+            if address not in text:
+                text = f"{text} ({address})"
+            raise OSError(f"cannot connect to the Dask scheduler: {text}") from None
+        with connected as c:
             c.register_plugin(SingleThreaded())
             yield c
         return
@@ -285,21 +308,76 @@ def dask_client(
         yield c
 
 
+def scheduler_address(scheduler: str | None = None) -> str | None:
+    """The scheduler a batch connects to: `scheduler`, else Dask's ``scheduler-address``."""
+    import dask
+
+    address = scheduler or dask.config.get("scheduler-address", None)
+    return str(address) if address else None
+
+
+def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
+    """What a re-run compares to tell whether each input changed since its outputs were made.
+
+    Parameters
+    ----------
+    paths : sequence of Path
+        A task's inputs (:attr:`Job.reads`).
+
+    Returns
+    -------
+    list of dict
+        Per input: ``path``, and for a file its ``size`` and ``mtime_ns``; for a folder (of
+        images) the number of its image files (``files``), their total ``size`` and the newest
+        ``mtime_ns``; ``missing`` when it cannot be read (the task then fails on its own).
+    """
+    out: list[dict[str, Any]] = []
+    for path in paths:
+        entry: dict[str, Any] = {"path": str(path)}
+        try:
+            st = path.stat()
+            if path.is_dir():
+                images = [
+                    e.stat()
+                    for e in os.scandir(path)
+                    if e.is_file() and os.path.splitext(e.name)[1].lower() in IMAGE_SUFFIXES
+                ]
+                entry["files"] = len(images)
+                entry["size"] = sum(s.st_size for s in images)
+                entry["mtime_ns"] = max((s.st_mtime_ns for s in images), default=0)
+            else:
+                entry["size"] = st.st_size
+                entry["mtime_ns"] = st.st_mtime_ns
+        except OSError:
+            entry["missing"] = True
+        out.append(entry)
+    return out
+
+
 def _sidecar(out_dir: Path, name: str) -> Path:
     return out_dir / f"{name}.json"
 
 
 def _complete(
-    out_dir: Path, job: Job, kind: str, settings: dict[str, Any]
-) -> dict[str, Any] | None:
-    """The sidecar of `job` if its outputs are complete for these inputs and settings."""
+    out_dir: Path, job: Job, kind: str, settings: dict[str, Any], prints: list[dict[str, Any]]
+) -> tuple[dict[str, Any] | None, str | None]:
+    """The sidecar of `job` if its outputs are complete for these inputs and settings.
+
+    Returns
+    -------
+    entry : dict or None
+        The sidecar, or None: the job is to run.
+    note : str or None
+        Why a job whose outputs are otherwise complete is to run again: its inputs changed
+        (their `prints`, from :func:`fingerprint`, differ from the sidecar's).
+    """
     path = _sidecar(out_dir, job.name)
     try:
         entry = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
-        return None
+        return None, None
     if not isinstance(entry, dict):
-        return None
+        return None, None
     same = (
         entry.get("kind") == kind
         and entry.get("settings") == settings
@@ -308,16 +386,27 @@ def _complete(
     )
     outputs = entry.get("outputs")
     if not same or not isinstance(outputs, list):
-        return None
+        return None, None
     if not all((out_dir / str(o)).is_file() for o in outputs):
-        return None
-    return entry
+        return None, None
+    earlier = entry.get("fingerprint")
+    if earlier != prints:
+        if not isinstance(earlier, list) or len(earlier) != len(prints):
+            return None, "redone: its sidecar records no input sizes and times (an older run)"
+        changed = [p["path"] for p, q in zip(prints, earlier, strict=True) if p != q]
+        return None, f"redone: {', '.join(changed)} changed since the last run"
+    return entry, None
 
 
 def _write(
-    out_dir: Path, job: Job, result: TaskResult, kind: str, settings: dict[str, Any]
+    out_dir: Path,
+    job: Job,
+    result: TaskResult,
+    kind: str,
+    settings: dict[str, Any],
+    prints: list[dict[str, Any]],
 ) -> dict[str, Any]:
-    """Write one task's outputs, sidecar last; return its summary entry."""
+    """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry."""
     outputs = [f"{job.name}.txt"]
     write_mot(out_dir / outputs[0], result.rows)
     for suffix, data in result.files.items():
@@ -325,7 +414,8 @@ def _write(
         with atomic_write(out_dir / outputs[-1], "wb", suffix=suffix) as fh:
             fh.write(data)
     entry = {"name": job.name, "status": "done", **result.info, "outputs": outputs}
-    sidecar = {"kind": kind, "settings": settings, "inputs": [str(p) for p in job.reads], **entry}
+    inputs = [str(p) for p in job.reads]
+    sidecar = {"kind": kind, "settings": settings, "inputs": inputs, "fingerprint": prints, **entry}
     with atomic_write(_sidecar(out_dir, job.name)) as fh:
         fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
     return entry
@@ -365,14 +455,9 @@ def call_task(
 
 
 def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) -> None:
-    """Before any work: the folder is writable and no output overwrites an input."""
+    """Before any work, writing nothing: no output overwrites an input or is a folder."""
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file; give a folder")
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:  # a read-only or special file system, a file on the way
-        raise ValueError(f"--out {out_dir}: cannot create the folder ({exc.strerror})") from None
-    check_output(out_dir / SUMMARY_NAME, what="--out")  # the folder is writable
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
     names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]
     for name in [SUMMARY_NAME, *names]:
@@ -381,6 +466,15 @@ def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) 
             raise ValueError(f"--out {target} is an input of this run; write elsewhere")
         if target.is_dir():
             raise ValueError(f"--out {target} is a folder; it would be an output of this run")
+
+
+def _make_out_dir(out_dir: Path) -> None:
+    """Create the output folder and check that it is writable (once the tasks can run)."""
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # a read-only or special file system, a file on the way
+        raise ValueError(f"--out {out_dir}: cannot create the folder ({exc.strerror})") from None
+    check_output(out_dir / SUMMARY_NAME, what="--out")  # the folder is writable
 
 
 def run_jobs(
@@ -430,6 +524,9 @@ def run_jobs(
     ImportError
         Tasks are to run on Dask (`n_workers` is not 0) and Dask distributed is not installed
         (the message says how to install it); raised before any task runs or file is written.
+    OSError
+        The scheduler cannot be reached (see :func:`dask_client`); raised before `out_dir` is
+        created or any file written.
     KeyboardInterrupt
         After cancelling the tasks still running and closing the cluster this started; the
         outputs written so far are complete.
@@ -441,19 +538,26 @@ def run_jobs(
     _check_outputs(jobs, out, suffixes)
     summary = BatchSummary(kind, out, settings=settings)
     entries: dict[str, dict[str, Any]] = {}
+    notes: dict[str, str] = {}
+    prints = {job.name: fingerprint(job.reads) for job in jobs}  # before the tasks read them
     pending: list[Job] = []
     for job in jobs:
-        earlier = None if force else _complete(out, job, kind, settings)
+        earlier, note = (
+            (None, None) if force else _complete(out, job, kind, settings, prints[job.name])
+        )
+        if note:
+            notes[job.name] = note
         if earlier is None:
             pending.append(job)
         else:
-            keep = {k: v for k, v in earlier.items() if k not in ("kind", "settings", "inputs")}
+            drop = ("kind", "settings", "inputs", "fingerprint")
+            keep = {k: v for k, v in earlier.items() if k not in drop}
             entries[job.name] = {**keep, "status": "skipped"}
 
     def record(job: Job, outcome: tuple[TaskResult | None, str | None, str | None]) -> None:
         result, error, trace = outcome
         if result is not None:
-            entries[job.name] = _write(out, job, result, kind, settings)
+            entries[job.name] = _write(out, job, result, kind, settings, prints[job.name])
         else:
             entries[job.name] = {
                 "name": job.name,
@@ -462,60 +566,66 @@ def run_jobs(
                 "error": error,
                 "traceback": trace,
             }
+        if job.name in notes:
+            entries[job.name]["note"] = notes[job.name]
 
-    if pending and n_workers != 0 and client is None:
+    on_dask = bool(pending) and n_workers != 0
+    if on_dask and client is None:
         _require_dask()  # before the summary: a missing extra changes no file
     desc = "sequences" if kind == "track" else "files"
     bar = {"total": len(pending), "desc": desc, "enable": show_progress}
-    try:
-        if pending and n_workers == 0:
-            for job in progress(pending, **bar):  # type: ignore[arg-type]
-                record(job, call_task(job.func, job.args))
-        elif pending:
-            _run_on_dask(pending, record, summary, client, scheduler, n_workers, bar)
-    finally:
-        for job in jobs:
-            entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
-        summary.entries = [entries[job.name] for job in jobs]
-        summary.seconds = time.perf_counter() - start
-        with atomic_write(out / SUMMARY_NAME) as fh:
-            fh.write(summary.to_json() + "\n")
+    with contextlib.ExitStack() as stack:
+        c = None
+        if on_dask:  # connected (or the local cluster started) before --out is touched
+            n = n_workers if n_workers is not None else (os.cpu_count() or 1)
+            n = min(n, len(pending))  # a local cluster: no idle worker to start
+            c = stack.enter_context(dask_client(client, scheduler, n))
+            info = c.scheduler_info()
+            summary.workers = len(info.get("workers", {}))
+            given = None if client is not None else scheduler_address(scheduler)
+            reported = str(info.get("address")) if info.get("address") else None
+            summary.scheduler = given or reported  # the user's spelling of the address
+        _make_out_dir(out)
+        try:
+            if c is not None:
+                _run_on_dask(c, pending, record, summary.kind, bar)
+            elif pending:
+                for job in progress(pending, **bar):  # type: ignore[arg-type]
+                    record(job, call_task(job.func, job.args))
+        finally:
+            for job in jobs:
+                entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
+            summary.entries = [entries[job.name] for job in jobs]
+            summary.seconds = time.perf_counter() - start
+            with atomic_write(out / SUMMARY_NAME) as fh:
+                fh.write(summary.to_json() + "\n")
     return summary
 
 
 def _run_on_dask(
+    c: Client,
     pending: Sequence[Job],
     record: Callable[[Job, tuple[TaskResult | None, str | None, str | None]], None],
-    summary: BatchSummary,
-    client: Client | None,
-    scheduler: str | None,
-    n_workers: int | None,
+    kind: str,
     bar: dict[str, Any],
 ) -> None:
     """Submit `pending` to Dask and record each result as it completes."""
-    if n_workers is None:
-        n_workers = os.cpu_count() or 1
-    n_workers = min(n_workers, len(pending))  # a local cluster: no idle worker to start
-    with dask_client(client, scheduler, n_workers) as c:
-        from distributed import as_completed  # after dask_client: its install hint first
+    from distributed import as_completed
 
-        info = c.scheduler_info()
-        summary.workers = len(info.get("workers", {}))
-        summary.scheduler = str(info.get("address")) if info.get("address") else None
-        futures = {}
-        for job in pending:
-            key = f"pftrack-{summary.kind}-{job.name}-{os.urandom(4).hex()}"
-            fut = c.submit(call_task, job.func, job.args, key=key, pure=False)
-            futures[fut.key] = (fut, job)
-        try:
-            for fut in progress(as_completed([f for f, _ in futures.values()]), **bar):
-                _, job = futures.pop(fut.key)
-                if fut.status == "finished":
-                    record(job, fut.result())
-                elif fut.status == "error":  # the worker died (KilledWorker) or the like
-                    exc = fut.exception()
-                    record(job, (None, _one_line(exc), None))
-                fut.release()  # cancelled (by another client): left "cancelled" in the summary
-        except BaseException:
-            c.cancel([f for f, _ in futures.values()], force=True)
-            raise
+    futures = {}
+    for job in pending:
+        key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
+        fut = c.submit(call_task, job.func, job.args, key=key, pure=False)
+        futures[fut.key] = (fut, job)
+    try:
+        for fut in progress(as_completed([f for f, _ in futures.values()]), **bar):
+            _, job = futures.pop(fut.key)
+            if fut.status == "finished":
+                record(job, fut.result())
+            elif fut.status == "error":  # the worker died (KilledWorker) or the like
+                exc = fut.exception()
+                record(job, (None, _one_line(exc), None))
+            fut.release()  # cancelled (by another client): left "cancelled" in the summary
+    except BaseException:
+        c.cancel([f for f, _ in futures.values()], force=True)
+        raise

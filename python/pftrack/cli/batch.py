@@ -50,8 +50,9 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--scheduler", metavar="ADDRESS", default=os.environ.get("DASK_SCHEDULER_ADDRESS"),
         help="a running Dask scheduler, tcp://HOST:8786 (also read from "
-        "$DASK_SCHEDULER_ADDRESS); without it a local cluster is started for the run and "
-        "closed at the end",
+        "$DASK_SCHEDULER_ADDRESS), connected to before --out is written; waits up to Dask's "
+        "connect timeout (30 s; $DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT); without it a "
+        "local cluster is started for the run and closed at the end",
     )  # fmt: skip
     g.add_argument(
         "--workers", type=non_negative_int, default=os.cpu_count() or 1, metavar="N",
