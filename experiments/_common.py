@@ -45,6 +45,27 @@ def data_root(arg: PathLike | None = None) -> Path:
     return REPO / ".." / "shared" / "data"
 
 
+class _ExperimentParser(argparse.ArgumentParser):
+    """An experiment's parser: ``--help`` shows every option's default.
+
+    An option whose help does not state its default gets ``(default: ...)`` added (flags and
+    options without a default excepted).
+    """
+
+    def format_help(self) -> str:
+        for action in self._actions:
+            default = action.default
+            if not action.option_strings or any(
+                default is v for v in (None, False, argparse.SUPPRESS)
+            ):  # (0 == False: compared by identity)
+                continue
+            if action.help is None:
+                action.help = "(default: %(default)s)"
+            elif "default" not in action.help and action.help != argparse.SUPPRESS:
+                action.help += " (default: %(default)s)"
+        return super().format_help()
+
+
 def experiment_parser(name: str, doc: str | None) -> argparse.ArgumentParser:
     """The parser of ``python -m experiments.<name>``, with ``--data`` and ``--out``.
 
@@ -55,7 +76,7 @@ def experiment_parser(name: str, doc: str | None) -> argparse.ArgumentParser:
     doc : str or None
         The module docstring; its first line is the description.
     """
-    parser = argparse.ArgumentParser(
+    parser = _ExperimentParser(
         prog=f"python -m experiments.{name}", description=(doc or name).split("\n")[0]
     )
     parser.add_argument(

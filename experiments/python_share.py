@@ -124,10 +124,12 @@ def one_round(
     return wall, python
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(
+        prog="python -m experiments.python_share", description=__doc__.splitlines()[0]
+    )
     ap.add_argument("--rounds", type=int, default=7, help="rounds per case (default 7)")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if args.rounds < 1:
         ap.error(f"--rounds is {args.rounds}, expected at least 1")
     frames, dets = scene_dets()

@@ -15,6 +15,7 @@ import pftrack
 from pftrack._check import bgr_frame
 from pftrack.synthetic import make_scene
 from pftrack.tracking import MultiObjectTracker, load_detections
+from tests.conftest import dataset
 
 
 @pytest.fixture(scope="module")
@@ -91,3 +92,30 @@ def test_zero_size_detections_are_left_out_with_a_warning(tmp_path):
         dets = load_detections(det)
     assert list(dets) == [1]
     assert np.array_equal(dets[1], [[20.0, 20.0, 10.0, 30.0, 0.8]])
+
+
+def test_rjmcmc_refuses_the_dynamics_on_particle_means(capsys):
+    """--dynamics ar2-mean was silently ignored with --sampler rjmcmc: the same bytes."""
+    with pytest.raises(ValueError, match=r"needs a per-object sampler"):
+        pftrack.Tracker(sampler="rjmcmc", dynamics="ar2-mean")
+    from pftrack.cli import main
+
+    argv = ["track", "v.avi", "--out", "t.txt", "--sampler", "rjmcmc", "--dynamics", "ar2-mean"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pftrack track: error: ") and "needs a per-object sampler" in err
+    assert pftrack.Tracker(sampler="mh", dynamics="ar2-mean").config.filter.model.use_means
+
+
+def test_finalize_writes_no_row_wholly_outside_the_frame(tmp_path):
+    """TUD-Campus at --max-side 320 wrote a track's boxes below the frame's bottom edge."""
+    from pftrack.cli import main
+    from pftrack.io.mot import read_mot
+
+    folder = dataset("tud-campus")
+    out = tmp_path / "t.txt"
+    argv = ["-q", "track", str(folder / "video.mp4"), "--out", str(out), "--max-side", "320"]
+    assert main(argv) == 0
+    rows = read_mot(out)
+    x, y, bw, bh = rows[:, 2], rows[:, 3], rows[:, 4], rows[:, 5]
+    assert len(rows) and not ((x >= 640) | (y >= 480) | (x + bw <= 0) | (y + bh <= 0)).any()

@@ -568,7 +568,8 @@ class Tracker:
         (R, 10) ndarray of float
             ``frame, id, left, top, width, height, conf, flag, -1, -1`` (``flag`` 1 on a row the
             offline pass filled in a hole, else -1), frames from 1 (one per
-            ``update``), sorted by frame then id. Warns when there is no row at all. With the
+            ``update``), sorted by frame then id; no row lies wholly outside the frame. Warns
+            when there is no row at all. With the
             built-in detector (no ``update`` of the run had detections) and the smoother on,
             boxes mostly inside a larger box of the same frame are left out
             (``LifecycleConfig.nested_inside``), and the boxes of partly seen people completed
@@ -604,6 +605,13 @@ class Tracker:
                     life.amodal_anchor,
                     size.config.split_ratio,
                 )
+        if len(rows) and len(self._tracker.frame_shape) >= 2:
+            # a track carried past the frame's edge (coasting, or the smoother's extrapolation
+            # at a track's end) leaves no row wholly outside the frame
+            h, w = self._tracker.frame_shape[:2]
+            x, y = rows[:, 2], rows[:, 3]
+            inside = (x < w) & (y < h) & (x + rows[:, 4] > 0) & (y + rows[:, 5] > 0)
+            rows = rows[inside]
         if len(rows) == 0 and self.frame_count:
             cfg = self.config.lifecycle
             if np.isfinite(self._max_conf):

@@ -437,6 +437,12 @@ class TrackerConfig:
                 f"max_side is {self.max_side!r}, expected None or an integer in "
                 f"[{MIN_SIDE}, {MAX_SIDE}]"
             )
+        if self.sampler == "rjmcmc" and self.filter.model.use_means:
+            raise ValueError(
+                "the AR(2) model on the particle-set means (use_means; --dynamics ar2-mean) "
+                "needs a per-object sampler ('sis' or 'mh'; --sampler): the joint 'rjmcmc' "
+                "sampler moves each object on its own state"
+            )
         if self.camera_motion not in CAMERA_MOTION:
             raise ValueError(
                 f"camera_motion is {self.camera_motion!r}, expected 'auto', 'on' or 'off'"

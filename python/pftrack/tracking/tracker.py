@@ -97,6 +97,11 @@ class MultiObjectTracker:
         self._background_ok = True  # False while the camera moves (see .camera)
         self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
 
+    @property
+    def frame_shape(self) -> tuple[int, ...]:
+        """The run's frame shape ``(H, W, 3)`` (of its first frame; empty before it)."""
+        return self._frame_shape
+
     # -- detections -------------------------------------------------------------------------
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start the built-in detector's background from the median of `frames`.
