@@ -50,6 +50,15 @@ def _integers_at_least(owner: str, lo: int, config: object, *names: str) -> None
             raise ValueError(f"{owner}: {name} is {v!r}, expected an integer >= {lo}")
 
 
+def _none_or_int_in(config: object, name: str, lo: int, hi: int) -> None:
+    """`config.name` must be None or an int (not a bool) in [lo, hi]."""
+    v = getattr(config, name)
+    if v is not None and (
+        isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi
+    ):
+        raise ValueError(f"{name} is {v!r}, expected None or an int in [{lo}, {hi}]")
+
+
 @dataclass(frozen=True)
 class AssociationConfig:
     """How tracks and detections are paired (Hungarian method over a gated cost).
@@ -402,23 +411,9 @@ class TrackerConfig:
     given_particles: int | None = GIVEN_PARTICLES
 
     def __post_init__(self) -> None:
-        if self.given_particles is not None and (
-            isinstance(self.given_particles, bool)
-            or not isinstance(self.given_particles, (int, np.integer))
-            or not 1 <= self.given_particles <= MAX_PARTICLES
-        ):
-            raise ValueError(
-                f"given_particles is {self.given_particles!r}, expected None or an int in "
-                f"[1, {MAX_PARTICLES}]"
-            )
-        if self.open_size is not None and (
-            isinstance(self.open_size, bool)
-            or not isinstance(self.open_size, (int, np.integer))
-            or not 1 <= self.open_size <= MAX_OPEN_SIZE
-        ):
-            raise ValueError(
-                f"open_size is {self.open_size!r}, expected None or an int in [1, {MAX_OPEN_SIZE}]"
-            )
+        _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
+        _none_or_int_in(self, "open_size", 1, MAX_OPEN_SIZE)
+        _none_or_int_in(self, "max_side", MIN_SIDE, MAX_SIDE)
         if self.pixel_diagonal is not None and not (
             isinstance(self.pixel_diagonal, (int, float, np.integer, np.floating))
             and not isinstance(self.pixel_diagonal, bool)
@@ -427,15 +422,6 @@ class TrackerConfig:
         ):
             raise ValueError(
                 f"pixel_diagonal is {self.pixel_diagonal!r}, expected None or a finite value > 0"
-            )
-        if self.max_side is not None and (
-            isinstance(self.max_side, bool)
-            or not isinstance(self.max_side, (int, np.integer))
-            or not MIN_SIDE <= self.max_side <= MAX_SIDE
-        ):
-            raise ValueError(
-                f"max_side is {self.max_side!r}, expected None or an integer in "
-                f"[{MIN_SIDE}, {MAX_SIDE}]"
             )
         if self.sampler == "rjmcmc" and self.filter.model.use_means:
             raise ValueError(
