@@ -89,6 +89,7 @@ class MultiObjectTracker:
         # first frame's size (TrackerConfig.pixel_diagonal), set by the first update
         self._effective: TrackerConfig | None = None
         self._frame_shape: tuple[int, ...] = ()  # the first frame's, set with _effective
+        self._given_config = self.config  # tracks of given detections (given_particles), too
         self.pixel_scale = 1.0
         self._scores_are_confidences = True
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
@@ -301,6 +302,7 @@ class MultiObjectTracker:
             self._frame_shape = f.shape
             self.pixel_scale = self.config.pixel_scale(f.shape[1], f.shape[0])
             cfg = self._effective = self.config.scaled_pixels(self.pixel_scale)
+            self._given_config = cfg.for_given()  # one object: the filters' configs compare by id
             self._joint.config = cfg
         self.frame_index += 1
         # camera motion: move the tracks into this frame; no background model while it moves
@@ -397,7 +399,7 @@ class MultiObjectTracker:
         self.tracks = [t for t, a in zip(self.tracks, alive, strict=True) if a]
         confidences = detections is not None and self._scores_are_confidences
         birth_score = self._birth_threshold(scores) if confidences else -np.inf
-        born = cfg if detections is None else cfg.for_given()  # given_particles
+        born = cfg if detections is None else self._given_config  # given_particles
         for di in result.unmatched_detections:
             if hists[di].sum() <= 0 or scores[di] < birth_score:
                 continue  # no foreground colour to build a reference from, or too unsure
