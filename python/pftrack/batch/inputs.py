@@ -13,12 +13,17 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pftrack._typing import PathLike
-from pftrack.io.video import IMAGE_SUFFIXES, natural_key, read_seqinfo
+from pftrack.io.video import (
+    IMAGE_SUFFIXES,
+    VIDEO_SUFFIXES,
+    natural_key,
+    read_seqinfo,
+    video_files,
+)
 
 __all__ = ["VIDEO_SUFFIXES", "SequenceInput", "find_sequences", "find_track_files"]
 
 #: File extensions taken as videos when a folder is scanned.
-VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 
 #: What a batch is given: one path or several.
 Inputs = PathLike | list[PathLike] | tuple[PathLike, ...]
@@ -73,13 +78,6 @@ def _first_file(folder: Path, *candidates: str) -> Path | None:
     return None
 
 
-def _videos(folder: Path) -> list[Path]:
-    return sorted(
-        (p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
-        key=lambda p: natural_key(p.name),
-    )
-
-
 def _has_images(folder: Path) -> bool:
     return any(p.suffix.lower() in IMAGE_SUFFIXES for p in folder.iterdir())
 
@@ -97,7 +95,7 @@ def _as_sequence(path: Path) -> SequenceInput | None:
         frames = path
     elif not marked:
         return None
-    elif len(videos := _videos(path)) == 1:  # the shared data's layout: SEQ/video.avi
+    elif len(videos := video_files(path)) == 1:  # the shared data's layout: SEQ/video.avi
         frames = videos[0]
     else:
         raise ValueError(

@@ -46,6 +46,7 @@ __all__ = [
     "read_frames",
     "read_seqinfo",
     "sequence_video",
+    "video_files",
 ]
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
@@ -192,6 +193,14 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     return None
 
 
+def video_files(folder: Path) -> list[Path]:
+    """The video files (:data:`VIDEO_SUFFIXES`) directly in `folder`, in natural order."""
+    return sorted(
+        (p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
+        key=lambda p: natural_key(p.name),
+    )
+
+
 def sequence_video(folder: PathLike) -> Path | None:
     """The video a MOTChallenge sequence folder without its image folder is read from.
 
@@ -221,10 +230,7 @@ def sequence_video(folder: PathLike) -> Path | None:
     images = path / read_seqinfo(path).image_dir
     if images.is_dir():
         return None
-    videos = sorted(
-        (p for p in path.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
-        key=lambda p: natural_key(p.name),
-    )
+    videos = video_files(path)
     if len(videos) == 1:
         return videos[0]
     found = (

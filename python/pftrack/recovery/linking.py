@@ -316,10 +316,20 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
         raise ValueError(
             f"{what}: frame {f[bad][0]:g} is not an integer in 1..{MAX_FRAME} (refused)"
         )
-    bad = (np.abs(i) > MAX_ID) | (i != np.floor(i))
-    if bad.any():
-        raise ValueError(f"{what}: track id {i[bad][0]:g} is not an integer with |id| <= {MAX_ID}")
+    k = _first_bad_id(i)
+    if k is not None:
+        raise ValueError(f"{what}: {_bad_id_message(i[k])}")
     return a
+
+
+def _first_bad_id(ids: F64) -> int | None:
+    """Index of the first id that is not an integer with ``|id| <= MAX_ID``, or None."""
+    bad = (np.abs(ids) > MAX_ID) | (ids != np.floor(ids))
+    return int(np.flatnonzero(bad)[0]) if bad.any() else None
+
+
+def _bad_id_message(value: float) -> str:
+    return f"track id {value:g} is not an integer with |id| <= {MAX_ID}"
 
 
 def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:
@@ -352,14 +362,9 @@ def read_tracks(path: PathLike) -> F64:
     from pftrack.io.mot import data_line_numbers, read_mot
 
     rows = read_mot(path, what="tracks file")
-    ids = rows[:, 1]
-    bad = (np.abs(ids) > MAX_ID) | (ids != np.floor(ids))
-    if bad.any():  # the message names the file's line, as read_mot's own checks do
-        k = int(np.flatnonzero(bad)[0])
-        raise ValueError(
-            f"{path}:{data_line_numbers(path)[k]}: track id {ids[k]:g} is not an integer with "
-            f"|id| <= {MAX_ID}"
-        )
+    k = _first_bad_id(rows[:, 1])
+    if k is not None:  # check_rows' test, with the file's line, as read_mot's own checks
+        raise ValueError(f"{path}:{data_line_numbers(path)[k]}: {_bad_id_message(rows[k, 1])}")
     try:
         check_unique(rows)
     except ValueError:
