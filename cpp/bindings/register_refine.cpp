@@ -16,7 +16,7 @@ void register_refine(py::module_& m) {
     m.def(
         "refine_boxes",
         [](Eigen::Ref<const RowMatrixXd> boxes, const py::array& mask, double fraction,
-           double min_cover, std::optional<double> leg_fill) {
+           double min_cover, std::optional<double> leg_fill, double min_height) {
             const char* fn = "refine_boxes";
             require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
             require_finite(boxes, fn, "boxes");
@@ -31,6 +31,8 @@ void register_refine(py::module_& m) {
             if (leg_fill)
                 require(std::isfinite(*leg_fill) && *leg_fill >= 0.0 && *leg_fill <= 1.0, fn,
                         "leg_fill", *leg_fill, "None or in [0, 1]");
+            require(std::isfinite(min_height) && min_height >= 0.0 && min_height <= 1.0, fn,
+                    "min_height", min_height, "in [0, 1]");
             const double fill = leg_fill.value_or(-1.0);  // the core's "off"
 
             RowMatrixXd out = boxes;
@@ -38,12 +40,13 @@ void register_refine(py::module_& m) {
             const Index rows = mask.shape(0), cols = mask.shape(1), stride = mask.strides(0);
             {
                 py::gil_scoped_release nogil;  // safe: `out` is ours, `mask` kept alive by the caller
-                refine_boxes(out, data, rows, cols, stride, fraction, min_cover, fill);
+                refine_boxes(out, data, rows, cols, stride, fraction, min_cover, fill, min_height);
             }
             return out;
         },
         py::arg("boxes"), py::arg("mask"), py::arg("fraction"), py::arg("min_cover"),
-        py::arg("leg_fill") = py::none(),
+        py::arg("leg_fill") = py::none(), py::arg("min_height") = 0.0,
         "Boxes (K, 4) left, top, w, h shrunk to the foreground of mask (H, W) uint8 or bool; "
-        "with leg_fill in [0, 1], mask 255/127/0 and boxes grown down through shadowed legs.");
+        "with leg_fill in [0, 1], mask 255/127/0 and boxes grown down through shadowed legs; "
+        "a box refined to under min_height of its height keeps its top and height.");
 }

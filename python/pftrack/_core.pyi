@@ -228,6 +228,7 @@ def refine_boxes(
     fraction: float,
     min_cover: float,
     leg_fill: float | None = ...,
+    min_height: float = ...,
 ) -> _F64: ...
 
 # --- blob pass: mask (H, W) uint8 0/255 -> boxes (K, 4) left, top, w, h and fills (K,) -------

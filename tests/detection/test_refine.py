@@ -62,6 +62,44 @@ def test_legs_match_reference(seed: int) -> None:
         np.testing.assert_array_equal(got, want)
 
 
+@pytest.mark.parametrize("seed", range(10))
+def test_min_height_matches_reference(seed: int) -> None:
+    rng = np.random.default_rng(200 + seed)
+    mask = _shaded(rng)
+    k = 30
+    boxes = np.column_stack(
+        [rng.uniform(-20, 130, k), rng.uniform(-20, 100, k), rng.uniform(0, 60, (k, 2))]
+    )
+    kept = 0
+    for fill in (None, 0.5):
+        plain = refine_boxes(boxes, mask, 0.05, 0.1, fill)
+        for min_height in (0.0, 0.3, 0.6, 1.0):
+            got = refine_boxes(boxes, mask, 0.05, 0.1, fill, min_height)
+            want = refine_boxes_reference(boxes, mask, 0.05, 0.1, fill, min_height)
+            np.testing.assert_array_equal(got, want)
+            # columns are refined whatever the height; rows are either refined or the box's own
+            np.testing.assert_array_equal(got[:, [0, 2]], plain[:, [0, 2]])
+            own = (got[:, [1, 3]] == boxes[:, [1, 3]]).all(axis=1)
+            refined = (got[:, [1, 3]] == plain[:, [1, 3]]).all(axis=1)
+            assert (own | refined).all()
+            kept += int((own & ~refined).sum())
+    assert kept > 0  # the test does reach boxes whose height is kept
+
+
+def test_min_height_keeps_the_height_of_a_fragment() -> None:
+    mask = np.zeros((60, 60), np.uint8)
+    mask[5:25, 20:30] = 255  # a torso whose legs are the colour of the ground
+    box = np.array([[15.0, 4.0, 20.0, 50.0]])  # the detector's box: 50 rows
+    # refined to 20 of 50 rows: under 0.6 of the height, so the top and height stay the box's
+    np.testing.assert_array_equal(refine_boxes(box, mask, 0.05, min_height=0.6), [[20, 4, 10, 50]])
+    np.testing.assert_array_equal(refine_boxes(box, mask, 0.05, min_height=0.3), [[20, 5, 10, 20]])
+    np.testing.assert_array_equal(refine_boxes(box, mask, 0.05), [[20, 5, 10, 20]])
+    with pytest.raises(ValueError, match="min_height"):
+        refine_boxes(box, mask, 0.05, min_height=1.5)
+    with pytest.raises(ValueError, match="min_height"):
+        refine_boxes(box, mask, 0.05, min_height=float("nan"))
+
+
 def test_legs_taken_for_shadow_come_back_a_cast_shadow_does_not() -> None:
     mask = np.zeros((60, 60), np.uint8)
     mask[5:30, 20:30] = 255  # torso: foreground

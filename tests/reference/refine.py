@@ -11,11 +11,13 @@ def refine_boxes_reference(
     fraction: float = 0.05,
     min_cover: float = 0.1,
     leg_fill: float | None = None,
+    min_height: float = 0.0,
 ) -> np.ndarray:
     """Shrink each (left, top, w, h) box to the rows and columns of its foreground.
 
     With `leg_fill`: foreground is 255 only, and the refined box then grows down through rows
-    whose foreground-or-shadow share between its columns is at least `leg_fill`.
+    whose foreground-or-shadow share between its columns is at least `leg_fill`. A refined
+    height under `min_height` times the clipped box's keeps the box's own top and height.
     """
     out = np.array(boxes_xywh, dtype=np.float64, copy=True).reshape(-1, 4)
     rows, cols = mask.shape
@@ -36,5 +38,7 @@ def refine_boxes_reference(
             legs = changed[:, cs[0] : cs[-1] + 1].mean(axis=1)
             while last + 1 < len(legs) and legs[last + 1] >= leg_fill:
                 last += 1
-        out[k] = (x0 + cs[0], y0 + rs[0], cs[-1] + 1 - cs[0], last + 1 - rs[0])
+        out[k, 0], out[k, 2] = x0 + cs[0], cs[-1] + 1 - cs[0]
+        if last + 1 - rs[0] >= min_height * (y1 - y0):
+            out[k, 1], out[k, 3] = y0 + rs[0], last + 1 - rs[0]
     return out

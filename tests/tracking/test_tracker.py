@@ -411,3 +411,11 @@ def test_lazy_bins_in_place_of_the_fused_pass_give_the_same_tracks(scene, monkey
     assert not calls  # the detector's fused bins on every frame
     assert len(lazy) > 100
     assert lazy == fused
+
+
+def test_refine_min_height_is_checked_and_defaults_to_0_6():
+    assert RefineConfig().min_height == 0.6
+    assert RefineConfig(min_height=0.0).min_height == 0.0
+    for bad in (-0.1, 1.5):
+        with pytest.raises(ValueError, match=r"RefineConfig: min_height is .*\[0, 1\]"):
+            RefineConfig(min_height=bad)

@@ -28,9 +28,12 @@ namespace pftrack {
 /// legs that the shadow test took for shadow (dark trousers on a grey path), which a cast
 /// shadow beside the feet, outside those columns, does not extend. A negative `leg_fill`: no
 /// growing, and every non-zero pixel is foreground.
+///
+/// A refined box whose height (after the growing) is under `min_height` times the clipped
+/// box's keeps the box's own top and height: only its columns are refined. 0: no such test.
 inline void refine_boxes(Eigen::Ref<RowMatrixXd> boxes, const std::uint8_t* mask, Index rows,
                          Index cols, Index stride, double fraction, double min_cover,
-                         double leg_fill = -1.0) {
+                         double leg_fill = -1.0, double min_height = 0.0) {
     const bool legs = leg_fill >= 0.0;
     const std::uint8_t level = legs ? 127 : 0;  // foreground: mask > level
     std::vector<std::int32_t> col_count, row_count;
@@ -84,8 +87,9 @@ inline void refine_boxes(Eigen::Ref<RowMatrixXd> boxes, const std::uint8_t* mask
             }
         }
         boxes(k, 0) = static_cast<double>(x0 + c0);
-        boxes(k, 1) = static_cast<double>(y0 + r0);
         boxes(k, 2) = static_cast<double>(c1 + 1 - c0);
+        if (static_cast<double>(r1 + 1 - r0) < min_height * dh) continue;  // rows: the box's own
+        boxes(k, 1) = static_cast<double>(y0 + r0);
         boxes(k, 3) = static_cast<double>(r1 + 1 - r0);
     }
 }

@@ -22,6 +22,7 @@ def refine_boxes(
     fraction: float = 0.1,
     min_cover: float = 0.1,
     leg_fill: float | None = None,
+    min_height: float = 0.0,
 ) -> F64:
     """Shrink boxes to the extent of their foreground.
 
@@ -45,6 +46,12 @@ def refine_boxes(
         original box. Legs the shadow test took for shadow (dark trousers on a grey path) come
         back; a shadow cast beside the feet, outside those columns, does not extend the box.
         None: no growing, every non-zero pixel is foreground.
+    min_height : float
+        In [0, 1]: a box refined to less than this share of its height (inside the image)
+        keeps its own top and height, and only its columns are refined. A detector's box is
+        rarely much taller than its object; a refined box that lost most of the height is a
+        fragment of the object (legs the colour of the ground, a standing person the
+        background model has absorbed, a ghost). 0: no such test.
 
     Returns
     -------
@@ -56,7 +63,7 @@ def refine_boxes(
     ------
     ValueError
         `boxes_xywh` not (K, 4) or not finite, `mask` not 2-D uint8 or bool, or `fraction`,
-        `min_cover` or `leg_fill` out of range.
+        `min_cover`, `leg_fill` or `min_height` out of range.
     """
     b = np.ascontiguousarray(boxes_xywh, dtype=np.float64)
     if b.size == 0:
@@ -69,5 +76,5 @@ def refine_boxes(
     if m.ndim == 2 and m.strides[1] != 1:
         m = np.ascontiguousarray(m)
     fill = None if leg_fill is None else float(leg_fill)
-    out: F64 = _core.refine_boxes(b, m, float(fraction), float(min_cover), fill)
+    out: F64 = _core.refine_boxes(b, m, float(fraction), float(min_cover), fill, float(min_height))
     return out

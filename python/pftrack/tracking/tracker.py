@@ -177,7 +177,9 @@ class MultiObjectTracker:
         # useful (measured in experiments/moving_camera.py)
         if cfg.refine.enabled and mask is not None and len(boxes):
             fill = cfg.refine.leg_fill if shaded else None
-            boxes = refine_boxes(boxes, mask, cfg.refine.fraction, leg_fill=fill)
+            boxes = refine_boxes(
+                boxes, mask, cfg.refine.fraction, leg_fill=fill, min_height=cfg.refine.min_height
+            )
         return boxes, scores, binned
 
     @property
