@@ -20,7 +20,8 @@ velocity of each axis side by side (pftrack's ``_xy`` matrices put positions fir
 from __future__ import annotations
 
 import datetime
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -28,7 +29,14 @@ from numpy.typing import ArrayLike
 
 from pftrack._typing import F64
 
-__all__ = ["EPOCH", "cv_models", "stonesoup_rts_smooth", "stonesoup_track"]
+__all__ = [
+    "EPOCH",
+    "BoxTrackerSettings",
+    "box_tracker",
+    "cv_models",
+    "stonesoup_rts_smooth",
+    "stonesoup_track",
+]
 
 EPOCH = datetime.datetime(2000, 1, 1)
 """Frame 0's timestamp; frame ``t`` is ``EPOCH + t`` seconds."""
@@ -169,3 +177,130 @@ def many_rts_smooth(
         stonesoup_rts_smooth(z, h, q, r2, velocity_sd=velocity_sd, update_first=False)
         for z, h in tracks
     ]
+
+
+@dataclass(frozen=True)
+class BoxTrackerSettings:
+    """The settings of :func:`box_tracker`, in pixels and frames.
+
+    Attributes
+    ----------
+    q_pos : float
+        ``ConstantVelocity`` ``noise_diff_coeff`` of the box centre's x and y (px²/frame³).
+    q_size : float
+        ``RandomWalk`` ``noise_diff_coeff`` of the box's width and height (px²/frame).
+    r_pos, r_size : float
+        Measurement variance of the centre and of the size (px²).
+    velocity_sd : float
+        Prior standard deviation of a new track's velocity (px/frame).
+    gate : float
+        ``DistanceHypothesiser``'s ``missed_distance``: the largest Mahalanobis distance a
+        track may be matched at.
+    max_missed : int
+        ``UpdateTimeStepsDeleter``'s ``time_steps_since_update``: a track without an update in
+        this many frames is deleted.
+    min_points : int
+        ``MultiMeasurementInitiator``'s ``min_points``: updates before a track is confirmed.
+    """
+
+    q_pos: float = 1.0
+    q_size: float = 1.0
+    r_pos: float = 25.0
+    r_size: float = 100.0
+    velocity_sd: float = 5.0
+    gate: float = 5.0
+    max_missed: int = 5
+    min_points: int = 3
+
+
+def box_tracker(settings: BoxTrackerSettings) -> Callable[[int, F64], list[tuple[int, F64]]]:
+    """A Stone Soup multi-target tracker of boxes, built as its tutorials build one.
+
+    The state is ``(cx, vx, cy, vy, w, h)``: constant velocity on the centre, a random walk on
+    the size (``CombinedLinearGaussianTransitionModel``); ``LinearGaussian`` measures
+    ``(cx, cy, w, h)``; ``KalmanPredictor``, ``KalmanUpdater``;
+    ``DistanceHypothesiser(Mahalanobis)`` + ``GNNWith2DAssignment``; ``UpdateTimeStepsDeleter``;
+    ``MultiMeasurementInitiator`` (sharing the deleter and associator, as the tutorials do);
+    ``MultiTargetTracker`` stepped by ``update_tracker``.
+
+    Returns
+    -------
+    step(frame, boxes) -> [(id, (left, top, w, h)), ...]
+        `boxes` is ``(k, >= 4)`` ``[left, top, w, h, ...]``; the tracks reported are those
+        updated with a detection in this frame (a coasting track is not reported), with their
+        filtered box. Ids count from 1 in order of first report.
+    """
+    from stonesoup.dataassociator.neighbour import GNNWith2DAssignment
+    from stonesoup.deleter.time import UpdateTimeStepsDeleter
+    from stonesoup.hypothesiser.distance import DistanceHypothesiser
+    from stonesoup.initiator.simple import MultiMeasurementInitiator
+    from stonesoup.measures import Mahalanobis
+    from stonesoup.models.measurement.linear import LinearGaussian
+    from stonesoup.models.transition.linear import (
+        CombinedLinearGaussianTransitionModel,
+        ConstantVelocity,
+        RandomWalk,
+    )
+    from stonesoup.predictor.kalman import KalmanPredictor
+    from stonesoup.tracker.simple import MultiTargetTracker
+    from stonesoup.types.detection import Detection
+    from stonesoup.types.state import GaussianState
+    from stonesoup.types.update import Update
+    from stonesoup.updater.kalman import KalmanUpdater
+
+    s = settings
+    transition = CombinedLinearGaussianTransitionModel(
+        [ConstantVelocity(s.q_pos), ConstantVelocity(s.q_pos), RandomWalk(s.q_size),
+         RandomWalk(s.q_size)]
+    )  # fmt: skip
+    measurement = LinearGaussian(
+        ndim_state=6,
+        mapping=(0, 2, 4, 5),
+        noise_covar=np.diag([s.r_pos, s.r_pos, s.r_size, s.r_size]),
+    )
+    predictor, updater = KalmanPredictor(transition), KalmanUpdater(measurement)
+    hypothesiser = DistanceHypothesiser(
+        predictor, updater, measure=Mahalanobis(), missed_distance=s.gate
+    )
+    associator = GNNWith2DAssignment(hypothesiser)
+    deleter = UpdateTimeStepsDeleter(time_steps_since_update=s.max_missed)
+    v2 = s.velocity_sd**2
+    initiator = MultiMeasurementInitiator(
+        prior_state=GaussianState(np.zeros((6, 1)), np.diag([0.0, v2, 0.0, v2, 0.0, 0.0])),
+        measurement_model=measurement,
+        deleter=deleter,
+        data_associator=associator,
+        updater=updater,
+        min_points=s.min_points,
+    )
+    tracker = MultiTargetTracker(
+        initiator=initiator,
+        deleter=deleter,
+        detector=None,
+        data_associator=associator,
+        updater=updater,
+    )
+    ids: dict[str, int] = {}
+
+    def step(frame: int, boxes: F64) -> list[tuple[int, F64]]:
+        when = at(frame)
+        b = np.asarray(boxes, dtype=np.float64).reshape(-1, boxes.shape[-1] if len(boxes) else 4)
+        dets = {
+            Detection(
+                np.array([[x + w / 2], [y + h / 2], [w], [h]]),
+                timestamp=when,
+                measurement_model=measurement,
+            )
+            for x, y, w, h in b[:, :4]
+        }
+        _, tracks = tracker.update_tracker(when, dets)
+        out = []
+        for track in tracks:
+            state = track.state
+            if isinstance(state, Update) and state.timestamp == when:
+                cx, _, cy, _, w, h = np.asarray(state.state_vector, float)[:, 0]
+                k = ids.setdefault(track.id, len(ids) + 1)
+                out.append((k, np.array([cx - w / 2, cy - h / 2, w, h])))
+        return sorted(out, key=lambda r: r[0])
+
+    return step

@@ -120,3 +120,22 @@ def test_systematic_resamplers_agree_on_copies(seed):
         assert copies.sum() == n
         assert np.all(copies >= np.floor(n * w - 1e-9))
         assert np.all(copies <= np.ceil(n * w + 1e-9))
+
+
+def test_box_tracker_follows_two_walkers():
+    """experiments.compare_stonesoup's Stone Soup tracker: two boxes crossing the frame keep
+    one id each once confirmed (min_points updates)."""
+    from experiments.stonesoup_models import BoxTrackerSettings, box_tracker
+
+    step = box_tracker(BoxTrackerSettings(min_points=3))
+    seen: dict[int, set[int]] = {0: set(), 1: set()}
+    for f in range(1, 31):
+        boxes = np.array([[10.0 + 3 * f, 50.0, 20.0, 50.0], [300.0 - 2 * f, 150.0, 25.0, 60.0]])
+        out = step(f, boxes)
+        if f >= 3:
+            assert len(out) == 2
+        for k, box in out:
+            walker = int(np.argmin(np.abs(boxes[:, 0] - box[0])))
+            np.testing.assert_allclose(box, boxes[walker], atol=3.0)
+            seen[walker].add(k)
+    assert seen == {0: {1}, 1: {2}} or seen == {0: {2}, 1: {1}}
