@@ -18,6 +18,11 @@ scored by :func:`pftrack.eval.evaluate_sequence` (TrackEval's HOTA, CLEAR-MOT an
 Frames/s counts the tracker's own calls: Stone Soup's ``update_tracker`` per frame; pftrack's
 whole ``track_frames`` call on frames already in memory (its offline pass included).
 
+``--smoother`` prints how far Stone Soup's ``KalmanSmoother`` lands from the RTS smoother when
+a track holds its missed frames' predictions (as its trackers append them), on the first 50
+tracks of ``bench/recovery_file.py``'s 500-track file; with no state for a missed frame it is
+exact (tests/experiments/test_stonesoup.py).
+
 ``--grid`` runs Stone Soup alone with each setting of a small grid and prints the pooled scores,
 the tuning behind the default settings (:data:`TUNED`): chosen once by pooled HOTA over all five
 sequences, not per sequence.
@@ -25,6 +30,7 @@ sequences, not per sequence.
 Usage (from the repository root)::
 
     python -m experiments.compare_stonesoup [--data ../shared/data] [--out DIR] [--grid]
+        [--smoother]
 """
 
 from __future__ import annotations
@@ -167,17 +173,55 @@ def grid(cases: list[Case]) -> None:
     print(f"best pooled HOTA {100 * best[0]:.1f}: {best[1]}")
 
 
+def smoother_check(n_tracks: int = 50) -> None:
+    """Largest centre difference per track, Stone Soup's smoother through missed-frame
+    predictions against :func:`pftrack.kalman.rts_smooth` (and the exact form's)."""
+    from bench.recovery_file import synthetic_tracks
+    from experiments.stonesoup_models import stonesoup_rts_smooth
+    from pftrack.kalman import rts_smooth
+
+    rows = synthetic_tracks(500, seed=0)
+    q, r2 = np.array([0.5, 0.5, 0.1, 0.1]), np.array([4.0, 4.0, 9.0, 9.0])
+    exact, through = [], []
+    for tid in np.unique(rows[:, 1])[:n_tracks]:
+        r = rows[rows[:, 1] == tid]
+        f = (r[:, 0] - r[0, 0]).astype(int)
+        z = np.full((f[-1] + 1, 4), np.nan)
+        z[f] = np.column_stack([r[:, 2:4] + r[:, 4:6] / 2, r[:, 4:6]])
+        has = ~np.isnan(z[:, 0])
+        ours = rts_smooth(z, has, q, r2, velocity_sd=10.0, update_first=False)
+        kw = {"velocity_sd": 10.0, "update_first": False}
+        skip = stonesoup_rts_smooth(z, has, q, r2, **kw)
+        pred = stonesoup_rts_smooth(z, has, q, r2, missed="predict", **kw)
+        exact.append(np.abs(skip - ours)[has].max())
+        through.append(np.abs(pred - ours)[:, :2].max())
+    print(f"{n_tracks} tracks; largest difference per track, px:")
+    print(f"  no state for missed frames (measured frames): max {max(exact):.2g}")
+    print(
+        f"  missed frames' predictions in the track (centre, every frame): median "
+        f"{np.median(through):.1f}, max {max(through):.1f}"
+    )
+
+
 def main(argv: list[str] | None = None) -> int:
     p = experiment_parser("compare_stonesoup", __doc__)
     p.add_argument(
         "--grid", action="store_true",
         help="run Stone Soup over the tuning grid instead of the table",
     )  # fmt: skip
+    p.add_argument(
+        "--smoother", action="store_true",
+        help="print Stone Soup's smoother against rts_smooth through missed frames, then stop",
+    )  # fmt: skip
     args = p.parse_args(argv)
     try:
         import stonesoup  # noqa: F401
     except ImportError:
         p.error("Stone Soup is not installed: pip install stonesoup (or '.[peers]')")
+    if args.smoother:
+        with tee_stdout(args.out / "smoother.txt"):
+            smoother_check()
+        return 0
     data = data_root(args.data)
     with tee_stdout(args.out / ("grid.txt" if args.grid else "stonesoup.md")):
         cases = load_cases(data, with_frames=not args.grid)

@@ -93,6 +93,21 @@ def test_stonesoup_smoother_through_missed_frames():
     np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-6)
 
 
+def test_stonesoup_smoother_keeps_the_filtered_state_before_a_missed_frame():
+    """Why the xfail above fails: the frame before each missed frame keeps its filtered mean
+    (the smoother reads the missed frame's smoothed copy as its prediction, G (x - x) = 0)."""
+    from experiments.stonesoup_models import stonesoup_track
+
+    z, has, q, r2 = _track(0, steps=60, n=2)
+    kw = {"velocity_sd": 10.0, "update_first": True, "missed": "predict"}
+    track, _ = stonesoup_track(z, has, q, r2, **kw)
+    filtered = np.array([np.asarray(s.state_vector, float)[0::2, 0] for s in track.states])
+    smoothed = stonesoup_rts_smooth(z, has, q, r2, **kw)
+    before = np.flatnonzero(~has) - 1
+    np.testing.assert_array_equal(smoothed[before], filtered[before])
+    assert np.abs(smoothed - filtered).max() > 0.1  # elsewhere it does smooth
+
+
 def _copies(idx: np.ndarray, n: int) -> np.ndarray:
     return np.bincount(idx, minlength=n)
 
