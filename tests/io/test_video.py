@@ -254,6 +254,65 @@ def test_a_folder_named_by_digits_is_not_a_camera(
     assert not src.live and len(src) == 1
 
 
+def test_a_negative_camera_index_is_refused_not_a_crash() -> None:
+    """Was: a segmentation fault (OpenCV's ``VideoCapture(-1)`` without a camera); run in a
+    child process, so that a regression fails this test, not the whole run."""
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np\n"
+        "from pftrack.io.video import FrameSource\n"
+        "for source in (-1, np.int64(-2)):\n"
+        "    try:\n"
+        "        FrameSource(source)\n"
+        "    except ValueError as exc:\n"
+        "        print(exc)\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                         check=False, timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == (
+        "camera index is -1, expected an int >= 0\ncamera index is -2, expected an int >= 0\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("source", "error", "message"),
+    [
+        (True, TypeError, "video source is True, a bool; expected a video file, "),
+        (np.bool_(False), TypeError, "video source is False, a bool"),
+        ("", ValueError, "video source is '' (empty); expected a video file, "),
+        (1.5, TypeError, "video source must be a path, a URL or an int, got float"),
+        (None, TypeError, "got NoneType"),
+        (b"video.mp4", TypeError, "got bytes"),
+    ],
+)
+def test_a_source_that_names_nothing_is_refused_in_one_line(
+    source: object, error: type[Exception], message: str
+) -> None:
+    """Was: ``True`` a multi-line cv2.error, ``""`` the current folder read."""
+    with pytest.raises(error, match=re.escape(message)) as info:
+        FrameSource(source)  # type: ignore[arg-type]
+    assert "\n" not in str(info.value)
+
+
+def test_track_refuses_an_empty_source(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from pftrack.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    cv2.imwrite(str(tmp_path / "1.png"), np.zeros((8, 8, 3), np.uint8))  # was: tracked
+    assert main(["track", "", "--out", "t.txt"]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack track: error: video source is '' (empty); expected a video file, an image or "
+        "sequence folder, a stream URL or a camera index\n"
+    )
+    assert sorted(os.listdir(tmp_path)) == ["1.png"]
+
+
 @pytest.mark.parametrize("url", ["rtsp://127.0.0.1:9/none", "http://127.0.0.1:9/x.ts"])
 def test_stream_url_is_not_mangled_as_a_path(url: str) -> None:
     with pytest.raises(ValueError, match=f"stream {re.escape(url)}$"):

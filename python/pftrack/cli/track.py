@@ -171,13 +171,14 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.io.atomic import atomic_write, staged_outputs, writes_through
     from pftrack.io.mot import format_mot_row, write_mot
-    from pftrack.io.video import FrameSource, is_live_source
+    from pftrack.io.video import FrameSource, check_source, is_live_source
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections, track_frames
 
     opencv_single_threaded()
 
+    check_source(args.source)  # "" would track the current folder
     live = is_live_source(args.source)
     config = tracker_config(args)  # contradictory options refused before any work
     _check_outputs(args, live)
