@@ -313,6 +313,53 @@ def test_track_refuses_an_empty_source(
     assert sorted(os.listdir(tmp_path)) == ["1.png"]
 
 
+@pytest.mark.parametrize("name", ["det.txt", "notes.nfo", "art.asc"])
+def test_a_text_file_is_not_a_video(
+    tmp_path: Path, name: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: FFmpeg's tty demuxer decoded the text as 640x400 ANSI-art frames, 0 tracks, exit 0."""
+    from pftrack.cli import main
+
+    text = tmp_path / name
+    text.write_text("1,-1,10,20,30,60,0.9,-1,-1,-1\n" * 50)
+    with pytest.raises(ValueError, match=f"^not a video: {re.escape(str(text))} is a text file"):
+        FrameSource(text)
+    assert main(["track", str(text), "--out", str(tmp_path / "t.txt")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pftrack track: error: not a video: ") and err.count("\n") == 1
+    assert not (tmp_path / "t.txt").exists()
+
+
+def test_the_shared_data_detections_are_not_a_video() -> None:
+    with pytest.raises(ValueError, match="not a video"):
+        FrameSource(dataset("pets09-s2l1") / "det.txt")
+
+
+@pytest.mark.parametrize(
+    ("suffix", "container", "codec"),
+    [(".mp4", "mp4", "mpeg4"), (".mkv", "matroska", "mpeg4"), (".mov", "mov", "mpeg4"),
+     (".webm", "webm", "libvpx"), (".avi", "avi", "mjpeg")],
+)  # fmt: skip
+def test_videos_of_every_container_still_open(
+    tmp_path: Path, suffix: str, container: str, codec: str
+) -> None:
+    """The text check reads the codec: real videos (any container) are not refused."""
+    frames = make_scene(n_frames=5, rng=0).frames
+    path = tmp_path / f"v{suffix}"
+    try:
+        with av.open(str(path), "w", format=container) as out:
+            stream = out.add_stream(codec, rate=25)
+            stream.width, stream.height = frames[0].shape[1], frames[0].shape[0]
+            stream.pix_fmt = "yuvj420p" if codec == "mjpeg" else "yuv420p"
+            for f in frames:
+                out.mux(stream.encode(av.VideoFrame.from_ndarray(f, format="bgr24")))
+            out.mux(stream.encode(None))
+    except (av.error.FFmpegError, ValueError) as exc:  # an encoder this PyAV lacks
+        pytest.skip(f"cannot write {codec} in {container}: {exc}")
+    src = FrameSource(path)
+    assert len(list(src)) == 5 and (src.width, src.height) == frames[0].shape[1::-1]
+
+
 @pytest.mark.parametrize("url", ["rtsp://127.0.0.1:9/none", "http://127.0.0.1:9/x.ts"])
 def test_stream_url_is_not_mangled_as_a_path(url: str) -> None:
     with pytest.raises(ValueError, match=f"stream {re.escape(url)}$"):

@@ -2,7 +2,8 @@
 
 Sources, as :class:`FrameSource` takes them:
 
-- a video file OpenCV can decode;
+- a video file OpenCV can decode (a text file is refused, though FFmpeg would decode it as
+  ANSI art: :data:`TEXT_FOURCC`);
 - a folder of images, read in natural order (``2.jpg`` before ``10.jpg``); when every name is
   a number (``000001.jpg``, the MOTChallenge convention) the names are frame numbers, and a
   missing one is refused rather than shifting every later frame;
@@ -55,6 +56,9 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
 #: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 DEFAULT_FPS = 25.0
+#: The codec FFmpeg's ``tty`` demuxer reports: it opens text files (``.txt``, ``.nfo``, ``.asc``,
+#: ...) as ANSI art, 640x400 frames of rendered characters. A text file is not a video.
+TEXT_FOURCC = "ansi"
 REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
 
@@ -76,6 +80,12 @@ def _file_capture(path: str) -> cv2.VideoCapture:
         return cap
     cap.release()
     return cv2.VideoCapture(path)
+
+
+def _fourcc(cap: cv2.VideoCapture) -> str:
+    """The four-character code of the codec `cap` decodes (``"FMP4"``, ``"H264"``, ``"ansi"``)."""
+    code = int(cap.get(cv2.CAP_PROP_FOURCC)) & 0xFFFFFFFF
+    return code.to_bytes(4, "little").decode("latin-1")
 
 
 def _same_frames(a: list[tuple[NDArray[Any], float]], b: list[tuple[NDArray[Any], float]]) -> bool:
@@ -509,6 +519,10 @@ class FrameSource:
     def _probe_file(path: Path) -> tuple[NDArray[Any], float, int]:
         cap = _file_capture(str(path))
         try:
+            if cap.isOpened() and _fourcc(cap) == TEXT_FOURCC:
+                raise ValueError(
+                    f"not a video: {path} is a text file (FFmpeg decodes text as ANSI-art frames)"
+                )
             ok, first = cap.read() if cap.isOpened() else (False, None)
             fps = float(cap.get(cv2.CAP_PROP_FPS)) if cap.isOpened() else 0.0
             count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
