@@ -115,6 +115,24 @@ def test_bad_seed(seed):
         pftrack.Tracker(seed=seed)
 
 
+@pytest.mark.parametrize("name", ["refine", "smooth", "link", "crossings"])
+@pytest.mark.parametrize("value", ["no", "False", 0, 1, None])
+def test_a_flag_that_is_not_a_bool_is_refused(name, value):
+    """Was: ``Tracker(refine="no")`` accepted, and refinement on (a truthy string)."""
+    kind = type(value).__name__
+    with pytest.raises(TypeError, match=f"^{name} must be True or False, got {kind}"):
+        pftrack.Tracker(**{name: value})
+
+
+def test_flags_take_python_and_numpy_bools(tmp_path):
+    from pftrack.tracking.run import track_path
+
+    assert not pftrack.Tracker(refine=np.False_).config.refine.enabled
+    assert pftrack.Tracker(crossings=True).config.crossings.enabled
+    with pytest.raises(TypeError, match="^smooth must be True or False, got str 'no'"):
+        track_path(tmp_path / "none.avi", smooth="no")  # before the source is opened
+
+
 def test_zero_size_detections_are_left_out_with_a_warning(tmp_path):
     det = tmp_path / "det.txt"
     det.write_text(
