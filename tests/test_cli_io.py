@@ -294,6 +294,40 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
         assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask, path.name
 
 
+def test_live_run_into_a_named_pipe_streams_its_rows_there(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A live source into a pipe (or /dev/stdout): the online rows, once, and the pipe stays.
+
+    Was: the pipe replaced by a regular file at the end (the reader saw the online rows and
+    never an end). The finished tracks are not written after the online rows (they would
+    repeat every one).
+    """
+    import threading
+
+    scene = make_scene(n_frames=40, rng=0)
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 1.0
+    write_mot(tmp_path / "det.txt", det)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    with serve_stream(scene.frames, pace=0.0) as server:
+        argv = ["-q", "track", server.url, "--out", str(fifo), "--detections",
+                str(tmp_path / "det.txt"), "--fps", "25"]  # fmt: skip
+        assert main(argv) == 0
+    reader.join(30)
+    out = capsys.readouterr().out
+    assert f"-> {fifo} (online rows, as they settled)" in out
+    lines = got[0].splitlines()
+    assert len(lines) > 20 and all(line.count(",") == 9 for line in lines)
+    keys = [tuple(line.split(",")[:2]) for line in lines]
+    assert len(set(keys)) == len(keys)  # each (frame, id) once: no second, finished copy
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+
+
 def test_quiet_silences_the_progress_bar(
     sequence: Path,
     tmp_path: Path,

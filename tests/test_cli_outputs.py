@@ -9,6 +9,7 @@ status 2, with the existing outputs byte for byte as they were and no stray temp
 from __future__ import annotations
 
 import os
+import stat
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -48,7 +49,7 @@ def _unwritable(tmp: Path) -> Path:
 
 
 # (name, command builder): the builder gets the inputs, the bad output path and the temp folder
-Builder = Callable[[dict[str, Path], Path, Path], list[str]]
+Builder = Callable[[dict[str, Path], Path | str, Path], list[str]]
 COMMANDS: dict[str, Builder] = {
     "track --out": lambda i, o, t: ["track", str(i["video"]), "--out", str(o), "--particles", "20"],
     "track --render": lambda i, o, t: [
@@ -110,8 +111,12 @@ GOOD_NAME = {"track --render": "v.mp4", "track --plot": "p.png", "eval --json": 
              "experiment --json": "e.json", "experiment --figure": "f.png"}  # fmt: skip
 
 
-def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> Path:
+def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> Path | str:
     name = GOOD_NAME.get(command, "out.txt")
+    if case == "new folder with a trailing slash":  # was: a file named `newdir` written
+        return f"{tmp / 'newdir'}/"
+    if case == "-":  # was: a file named `-` written (the test runs in `tmp`)
+        return "-"
     if case == "existing folder":
         (tmp / name).mkdir()
         return tmp / name
@@ -134,7 +139,7 @@ def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> 
 
 
 CASES = ["existing folder", "missing folder", "unwritable folder", "unsupported extension",
-         "an input"]  # fmt: skip
+         "an input", "new folder with a trailing slash", "-"]  # fmt: skip
 
 
 def _snapshot(folder: Path) -> dict[str, bytes | None]:
@@ -160,8 +165,10 @@ def test_bad_output_is_refused_before_any_work(
     inputs: dict[str, Path],
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
     no_work: None,
 ) -> None:
+    monkeypatch.chdir(tmp_path)
     (tmp_path / "t_ok.txt").write_text("old tracks\n")
     out = _bad_output(case, command, inputs, tmp_path)
     before_inputs = {k: p.read_bytes() for k, p in inputs.items()}
@@ -380,3 +387,81 @@ def test_check_distinct_names_both_outputs(tmp_path: Path) -> None:
     check_distinct({"--json": tmp_path / "a.json", "--csv": tmp_path / "a.csv", "--x": None})
     with pytest.raises(ValueError, match=r"^--a .*x.txt and --c .*x.txt are the same file"):
         check_distinct({"--a": tmp_path / "x.txt", "--b": None, "--c": tmp_path / "." / "x.txt"})
+
+
+def test_outputs_through_symlinks_replace_the_target_and_keep_the_link(
+    inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """Was: every command renamed a regular file over the link; its target kept the old text."""
+    real = tmp_path / "real"
+    real.mkdir()
+    for name in ("t.txt", "v.mp4", "r.txt", "in.txt"):
+        (real / name).write_text("old\n")
+        (tmp_path / name).symlink_to(Path("real") / name)
+    (real / "in.txt").write_bytes(inputs["tracks"].read_bytes())
+    argv = ["-q", "track", str(inputs["video"]), "--out", str(tmp_path / "t.txt"),
+            "--render", str(tmp_path / "v.mp4"), "--particles", "20"]  # fmt: skip
+    assert main(argv) == 0
+    argv = ["-q", "recover", str(tmp_path / "in.txt"), "--method", "linear"]
+    assert main([*argv, "--out", str(tmp_path / "r.txt")]) == 0
+    assert main([*argv, "--out", str(tmp_path / "in.txt"), "--in-place"]) == 0
+    for name in ("t.txt", "v.mp4", "r.txt", "in.txt"):
+        assert (tmp_path / name).is_symlink(), name
+        assert (real / name).read_bytes() != b"old\n", name
+    assert (real / "in.txt").read_bytes() == (real / "r.txt").read_bytes()
+    assert sorted(p.name for p in real.iterdir()) == ["in.txt", "r.txt", "t.txt", "v.mp4"]
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth", "track"])
+def test_a_named_pipe_output_is_written_through(
+    command: str, inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """Was: the pipe replaced by a regular file."""
+    import threading
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    source = inputs["video"] if command == "track" else inputs["tracks"]
+    extra = ["--particles", "20"] if command == "track" else []
+    assert main(["-q", command, str(source), "--out", str(fifo), *extra]) == 0
+    reader.join(30)
+    assert got and got[0].count(b"\n") > 20 and got[0].startswith(b"1,")
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo"]
+
+
+def test_out_dev_null_and_a_link_to_it_discard(
+    inputs: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--out /dev/null`` (was: as root, /dev/null replaced); several outputs may share it."""
+    (tmp_path / "v.mp4").symlink_to(os.devnull)
+    argv = ["-q", "track", str(inputs["video"]), "--out", os.devnull,
+            "--render", str(tmp_path / "v.mp4"), "--particles", "20"]  # fmt: skip
+    assert main(argv) == 0
+    assert f"-> {os.devnull}" in capsys.readouterr().out
+    assert stat.S_ISCHR(Path(os.devnull).stat().st_mode)
+    assert (tmp_path / "v.mp4").is_symlink() and sorted(os.listdir(tmp_path)) == ["v.mp4"]
+
+
+def test_out_dev_stdout_prints_the_rows_then_the_summary(
+    inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """Through a link to /dev/stdout in the test folder (a bug would replace only the link)."""
+    import subprocess
+    import sys
+
+    (tmp_path / "stdout").symlink_to("/dev/stdout")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    argv = [sys.executable, "-m", "pftrack", "-q", "recover", str(inputs["tracks"]),
+            "--method", "linear", "--out", str(tmp_path / "stdout")]  # fmt: skip
+    with (tmp_path / "captured.txt").open("w") as stdout:  # a file: the descriptor's offset
+        run = subprocess.run(argv, stdout=stdout, stderr=subprocess.PIPE, text=True, env=env,
+                             check=False, timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    lines = (tmp_path / "captured.txt").read_text().splitlines()
+    assert lines[-1].startswith(f"{inputs['tracks']}: ") and len(lines) > 20
+    assert all(line.count(",") == 9 for line in lines[:-1])
+    assert (tmp_path / "stdout").is_symlink()

@@ -7,7 +7,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64
 
-__all__ = ["MAX_COORD", "MAX_FRAME", "bgr_frame", "real_array"]
+__all__ = ["MAX_COORD", "MAX_FRAME", "bgr_frame", "flag", "real_array"]
 
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
 #: wide, and splines and Kalman filters square and multiply them (1e308 overflows).
@@ -59,3 +59,18 @@ def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     if f.shape[0] == 0 or f.shape[1] == 0:
         raise ValueError(f"{what} is {f.shape[1]}x{f.shape[0]} pixels, expected at least 1x1")
     return np.ascontiguousarray(f)
+
+
+def flag(value: object, what: str) -> bool:
+    """`value` as a bool, refusing anything but ``True`` and ``False`` (NumPy's too).
+
+    A truthy string would otherwise turn an option on: ``refine="no"`` is ``True``.
+
+    Raises
+    ------
+    TypeError
+        Not a bool (a string, a number, None).
+    """
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{what} must be True or False, got {type(value).__name__} {value!r}")
+    return bool(value)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import stat
+import threading
 from pathlib import Path
 
 import pytest
@@ -108,3 +109,136 @@ def test_a_new_file_still_follows_the_umask(tmp_path: Path, umask) -> None:
     umask(0o027)
     write_mot(tmp_path / "t.txt", [[1, 1, 0, 0, 10, 10]])
     assert stat.S_IMODE((tmp_path / "t.txt").stat().st_mode) == 0o640
+
+
+# Outputs that are not plain files (issue: every writer renamed a regular file over them).
+
+
+def _read_in_thread(fifo: Path) -> tuple[threading.Thread, list[bytes]]:
+    """A reader of named pipe `fifo` (a writer's open blocks until one exists)."""
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    return reader, got
+
+
+def test_a_symlink_output_replaces_its_target_and_stays_a_link(tmp_path: Path) -> None:
+    """Was: the link replaced by a regular file, its target left as it was."""
+    from pftrack.io.atomic import staged_outputs
+
+    (tmp_path / "real").mkdir()
+    names = ("t.txt", "p.bin", "s.txt")
+    for name in names:
+        (tmp_path / "real" / name).write_text("old")
+        (tmp_path / name).symlink_to(Path("real") / name)  # relative, as `ln -s` makes them
+        os.chmod(tmp_path / "real" / name, 0o600)
+    with atomic_write(tmp_path / "t.txt") as fh:
+        fh.write("new")
+    with atomic_path(tmp_path / "p.bin") as tmp:
+        assert tmp.parent == tmp_path / "real"  # beside the target: the rename is atomic
+        tmp.write_bytes(b"new")
+    with staged_outputs() as stage:
+        stage(tmp_path / "s.txt").write_text("new")
+    for name in names:
+        assert (tmp_path / name).is_symlink(), name
+        assert (tmp_path / "real" / name).read_text() == "new", name
+        assert stat.S_IMODE((tmp_path / "real" / name).stat().st_mode) == 0o600, name
+    assert sorted(p.name for p in (tmp_path / "real").iterdir()) == sorted(names)
+
+
+def test_a_dangling_symlink_creates_its_target(tmp_path: Path) -> None:
+    (tmp_path / "link.txt").symlink_to("new.txt")
+    write_mot(tmp_path / "link.txt", [[1, 1, 0, 0, 10, 10]])
+    assert (tmp_path / "link.txt").is_symlink()
+    assert (tmp_path / "new.txt").read_text().startswith("1,1,0,0,10,10")
+
+
+def test_a_symlink_loop_is_an_error(tmp_path: Path) -> None:
+    (tmp_path / "a").symlink_to("b")
+    (tmp_path / "b").symlink_to("a")
+    with pytest.raises(OSError, match="symbolic links"), atomic_write(tmp_path / "a"):
+        pass
+
+
+def test_a_named_pipe_is_written_through_not_replaced(tmp_path: Path) -> None:
+    """Was: the pipe replaced by a regular file (its reader waiting forever)."""
+    from pftrack.io.atomic import staged_outputs, writes_through
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    assert writes_through(fifo) and not writes_through(tmp_path / "new.txt")
+    reader, got = _read_in_thread(fifo)
+    write_mot(fifo, [[1, 1, 0, 0, 10, 10]])
+    reader.join(10)
+    assert got == [b"1,1,0,0,10,10,1,-1,-1,-1\n"]
+    reader, got = _read_in_thread(fifo)
+    with staged_outputs() as stage:  # a video or plot: the finished file's bytes
+        (tmp_path / "link.png").symlink_to(fifo)
+        stage(tmp_path / "link.png").write_bytes(b"png bytes")
+    reader.join(10)
+    assert got == [b"png bytes"]
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo", "link.png"]  # no temporary
+
+
+def test_a_link_to_dev_null_discards_and_stays(tmp_path: Path) -> None:
+    """``--out /dev/null`` discards (was: as root, /dev/null replaced by a regular file)."""
+    from pftrack.io.atomic import check_output, staged_outputs
+
+    null = tmp_path / "null.txt"
+    null.symlink_to(os.devnull)
+    assert check_output(null) == null
+    write_mot(null, [[1, 1, 0, 0, 10, 10]])
+    with atomic_path(tmp_path / "null.txt") as tmp:
+        tmp.write_bytes(b"video")
+    with staged_outputs() as stage:
+        stage(null).write_bytes(b"video")
+    assert null.is_symlink() and os.readlink(null) == os.devnull
+    assert stat.S_ISCHR(Path(os.devnull).stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["null.txt"]
+
+
+def test_a_descriptor_output_writes_through_the_descriptor(tmp_path: Path) -> None:
+    """``/dev/stdout`` with stdout redirected to a file: rows, then what was printed after."""
+    import subprocess
+    import sys
+
+    (tmp_path / "out").symlink_to("/dev/stdout")
+    code = (
+        "import sys; from pftrack.io.atomic import atomic_write\n"
+        "print('before', flush=True)\n"
+        "with atomic_write(sys.argv[1]) as fh: fh.write('rows\\n')\n"
+        "print('after')\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    with (tmp_path / "captured.txt").open("w") as stdout:
+        argv = [sys.executable, "-c", code, str(tmp_path / "out")]
+        subprocess.run(argv, stdout=stdout, check=True, timeout=60, env=env)
+    assert (tmp_path / "captured.txt").read_text() == "before\nrows\nafter\n"
+    assert (tmp_path / "out").is_symlink()
+
+
+@pytest.mark.parametrize("name", ["newdir/", "./", "a/.", ".."])
+def test_a_name_that_can_only_be_a_folder_is_refused(tmp_path: Path, name: str) -> None:
+    """Was: ``newdir/`` wrote a file named ``newdir``."""
+    from pftrack.io.atomic import check_output, staged_outputs
+
+    target = f"{tmp_path}/{name}"
+    with pytest.raises(ValueError, match="folder; give a file name"):
+        check_output(target, what="--out")
+    with pytest.raises(ValueError, match="names a folder"), atomic_write(target):
+        pass
+    with pytest.raises(ValueError, match="names a folder"), atomic_path(target):
+        pass
+    with pytest.raises(ValueError, match="names a folder"), staged_outputs() as stage:
+        stage(target)
+    assert not any(tmp_path.iterdir())
+
+
+def test_dash_is_refused_as_an_output_name(tmp_path: Path, monkeypatch) -> None:
+    from pftrack.io.atomic import check_output
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ValueError, match=r"^--out -: standard output .* /dev/stdout$"):
+        check_output("-", what="--out")
+    assert not any(tmp_path.iterdir())

@@ -254,6 +254,112 @@ def test_a_folder_named_by_digits_is_not_a_camera(
     assert not src.live and len(src) == 1
 
 
+def test_a_negative_camera_index_is_refused_not_a_crash() -> None:
+    """Was: a segmentation fault (OpenCV's ``VideoCapture(-1)`` without a camera); run in a
+    child process, so that a regression fails this test, not the whole run."""
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np\n"
+        "from pftrack.io.video import FrameSource\n"
+        "for source in (-1, np.int64(-2)):\n"
+        "    try:\n"
+        "        FrameSource(source)\n"
+        "    except ValueError as exc:\n"
+        "        print(exc)\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
+                         check=False, timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == (
+        "camera index is -1, expected an int >= 0\ncamera index is -2, expected an int >= 0\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("source", "error", "message"),
+    [
+        (True, TypeError, "video source is True, a bool; expected a video file, "),
+        (np.bool_(False), TypeError, "video source is False, a bool"),
+        ("", ValueError, "video source is '' (empty); expected a video file, "),
+        (1.5, TypeError, "video source must be a path, a URL or an int, got float"),
+        (None, TypeError, "got NoneType"),
+        (b"video.mp4", TypeError, "got bytes"),
+    ],
+)
+def test_a_source_that_names_nothing_is_refused_in_one_line(
+    source: object, error: type[Exception], message: str
+) -> None:
+    """Was: ``True`` a multi-line cv2.error, ``""`` the current folder read."""
+    with pytest.raises(error, match=re.escape(message)) as info:
+        FrameSource(source)  # type: ignore[arg-type]
+    assert "\n" not in str(info.value)
+
+
+def test_track_refuses_an_empty_source(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from pftrack.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    cv2.imwrite(str(tmp_path / "1.png"), np.zeros((8, 8, 3), np.uint8))  # was: tracked
+    assert main(["track", "", "--out", "t.txt"]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack track: error: video source is '' (empty); expected a video file, an image or "
+        "sequence folder, a stream URL or a camera index\n"
+    )
+    assert sorted(os.listdir(tmp_path)) == ["1.png"]
+
+
+@pytest.mark.parametrize("name", ["det.txt", "notes.nfo", "art.asc"])
+def test_a_text_file_is_not_a_video(
+    tmp_path: Path, name: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: FFmpeg's tty demuxer decoded the text as 640x400 ANSI-art frames, 0 tracks, exit 0."""
+    from pftrack.cli import main
+
+    text = tmp_path / name
+    text.write_text("1,-1,10,20,30,60,0.9,-1,-1,-1\n" * 50)
+    with pytest.raises(ValueError, match=f"^not a video: {re.escape(str(text))} is a text file"):
+        FrameSource(text)
+    assert main(["track", str(text), "--out", str(tmp_path / "t.txt")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pftrack track: error: not a video: ") and err.count("\n") == 1
+    assert not (tmp_path / "t.txt").exists()
+
+
+def test_the_shared_data_detections_are_not_a_video() -> None:
+    with pytest.raises(ValueError, match="not a video"):
+        FrameSource(dataset("pets09-s2l1") / "det.txt")
+
+
+@pytest.mark.parametrize(
+    ("suffix", "container", "codec"),
+    [(".mp4", "mp4", "mpeg4"), (".mkv", "matroska", "mpeg4"), (".mov", "mov", "mpeg4"),
+     (".webm", "webm", "libvpx"), (".avi", "avi", "mjpeg")],
+)  # fmt: skip
+def test_videos_of_every_container_still_open(
+    tmp_path: Path, suffix: str, container: str, codec: str
+) -> None:
+    """The text check reads the codec: real videos (any container) are not refused."""
+    frames = make_scene(n_frames=5, rng=0).frames
+    path = tmp_path / f"v{suffix}"
+    try:
+        with av.open(str(path), "w", format=container) as out:
+            stream = out.add_stream(codec, rate=25)
+            stream.width, stream.height = frames[0].shape[1], frames[0].shape[0]
+            stream.pix_fmt = "yuvj420p" if codec == "mjpeg" else "yuv420p"
+            for f in frames:
+                out.mux(stream.encode(av.VideoFrame.from_ndarray(f, format="bgr24")))
+            out.mux(stream.encode(None))
+    except (av.error.FFmpegError, ValueError) as exc:  # an encoder this PyAV lacks
+        pytest.skip(f"cannot write {codec} in {container}: {exc}")
+    src = FrameSource(path)
+    assert len(list(src)) == 5 and (src.width, src.height) == frames[0].shape[1::-1]
+
+
 @pytest.mark.parametrize("url", ["rtsp://127.0.0.1:9/none", "http://127.0.0.1:9/x.ts"])
 def test_stream_url_is_not_mangled_as_a_path(url: str) -> None:
     with pytest.raises(ValueError, match=f"stream {re.escape(url)}$"):

@@ -34,6 +34,38 @@ def test_a_frame_without_pixels_is_refused(shape):
         MultiObjectTracker(rng=0).update(empty)
 
 
+@pytest.mark.parametrize("shape", [(1, 500, 3), (500, 1, 3), (1, 1, 3), (2, 5000, 3)])
+@pytest.mark.parametrize("camera_motion", ["auto", "on"])
+def test_a_thin_frame_tracks(shape, camera_motion):
+    """Every frame of at least 1x1 pixels (``bgr_frame``'s one check) is tracked.
+
+    Was: ``cv2.error ... inv_scale_x > 0`` from the camera-motion estimate, whose scaled frame
+    rounded to 0 pixels on a side.
+    """
+    rng = np.random.default_rng(0)
+    h, w = shape[:2]
+    tracker = pftrack.Tracker(camera_motion=camera_motion)
+    for _ in range(5):
+        tracker.update(None, rng.integers(0, 255, shape, dtype=np.uint8))
+    out = tracker.update(np.array([[0.0, 0.0, w, h, 0.95]]), rng.integers(0, 255, shape, np.uint8))
+    assert out.shape[1] == 8
+
+
+def test_a_thin_image_folder_tracks_on_the_command_line(tmp_path, capsys):
+    import cv2
+
+    from pftrack.cli import main
+
+    rng = np.random.default_rng(0)
+    (tmp_path / "thin").mkdir()
+    for k in range(1, 11):
+        image = rng.integers(0, 255, (1, 500, 3), np.uint8)
+        cv2.imwrite(str(tmp_path / "thin" / f"{k}.png"), image)
+    out = tmp_path / "t.txt"
+    assert main(["-q", "track", str(tmp_path / "thin"), "--out", str(out)]) == 0
+    assert "10 frames" in capsys.readouterr().out and out.exists()
+
+
 @pytest.mark.parametrize("bad", [None, np.zeros((4, 4), np.uint8), np.zeros((4, 4, 3))])
 def test_prime_refuses_what_is_not_a_frame(bad):
     with pytest.raises(TypeError, match="prime frame must be a"):
@@ -81,6 +113,24 @@ def test_frame_rate_of_the_wrong_kind(rate):
 def test_bad_seed(seed):
     with pytest.raises(ValueError, match="seed is"):
         pftrack.Tracker(seed=seed)
+
+
+@pytest.mark.parametrize("name", ["refine", "smooth", "link", "crossings"])
+@pytest.mark.parametrize("value", ["no", "False", 0, 1, None])
+def test_a_flag_that_is_not_a_bool_is_refused(name, value):
+    """Was: ``Tracker(refine="no")`` accepted, and refinement on (a truthy string)."""
+    kind = type(value).__name__
+    with pytest.raises(TypeError, match=f"^{name} must be True or False, got {kind}"):
+        pftrack.Tracker(**{name: value})
+
+
+def test_flags_take_python_and_numpy_bools(tmp_path):
+    from pftrack.tracking.run import track_path
+
+    assert not pftrack.Tracker(refine=np.False_).config.refine.enabled
+    assert pftrack.Tracker(crossings=True).config.crossings.enabled
+    with pytest.raises(TypeError, match="^smooth must be True or False, got str 'no'"):
+        track_path(tmp_path / "none.avi", smooth="no")  # before the source is opened
 
 
 def test_zero_size_detections_are_left_out_with_a_warning(tmp_path):

@@ -77,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(
             f"--out {out} is the input file; pass --in-place to replace it (atomically)"
         )
-    check_output(out, what="--out", inputs=(args.video,) if args.video else ())
+    check_output(args.out, what="--out", inputs=(args.video,) if args.video else ())
     rows = read_tracks(src)
     n_links = 0
     if args.link:
@@ -96,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
     dt = time.perf_counter() - t0
-    write_mot(out, filled)
+    write_mot(args.out, filled)
     print(
         f"{src}: {len(rows)} rows, {n_links} fragments linked, {rep.n_gaps} gaps filled with "
         f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "

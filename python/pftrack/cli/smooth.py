@@ -57,11 +57,11 @@ def run(args: argparse.Namespace) -> int:
     src, out = Path(args.tracks), Path(args.out)
     if out.exists() and src.exists() and os.path.samefile(out, src):
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
-    check_output(out, what="--out")
+    check_output(args.out, what="--out")
     rows = read_tracks(src)
     link = None if args.no_link else gate_for_rows(LinkConfig(max_gap=args.max_gap), rows)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
-    write_mot(out, result)
+    write_mot(args.out, result)
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
     print(

@@ -169,15 +169,16 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from pftrack.cli._options import opencv_single_threaded
-    from pftrack.io.atomic import staged_outputs
+    from pftrack.io.atomic import atomic_write, staged_outputs, writes_through
     from pftrack.io.mot import format_mot_row, write_mot
-    from pftrack.io.video import FrameSource, is_live_source
+    from pftrack.io.video import FrameSource, check_source, is_live_source
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections, track_frames
 
     opencv_single_threaded()
 
+    check_source(args.source)  # "" would track the current folder
     live = is_live_source(args.source)
     config = tracker_config(args)  # contradictory options refused before any work
     _check_outputs(args, live)
@@ -207,8 +208,13 @@ def run(args: argparse.Namespace) -> int:
                         stream.write(format_mot_row(r) + "\n")
                     stream.flush()
 
+            # a live run into a device, pipe or descriptor (/dev/stdout) streams its rows there
+            # and only there: the finished tracks cannot replace what was written already
+            streamed = live and writes_through(args.out)
             with contextlib.ExitStack() as stack:
-                if live:  # --out grows while tracking; replaced by the finished tracks below
+                if streamed:
+                    stream = stack.enter_context(atomic_write(args.out))  # written through
+                elif live:  # --out grows while tracking; replaced by the finished tracks below
                     stream = stack.enter_context(open(args.out, "w", encoding="utf-8"))  # noqa: SIM115
                     stack.enter_context(_StopOnCtrlC(source))
                 caught = stack.enter_context(warnings.catch_warnings(record=True))
@@ -226,13 +232,15 @@ def run(args: argparse.Namespace) -> int:
                 )
             # clipped boxes, a run without any track: said, not fatal
             warned.extend(f"pftrack track: warning: {w.message}" for w in caught)
-            write_mot(stage(args.out), result.rows)
+            if not streamed:
+                write_mot(stage(args.out), result.rows)
             n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
             stopped = " (stopped by Ctrl-C)" if source.stopped else ""
+            online = " (online rows, as they settled)" if streamed else ""
             said.append(
                 f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
                 f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> "
-                f"{args.out}"
+                f"{args.out}{online}"
             )
             if renderer is not None:
                 renderer.close()

@@ -5,19 +5,119 @@ would create the target itself (``tempfile.mkstemp`` would make every output ``0
 it replaces an existing file it takes that file's permission bits instead (``mode & 0o7777``,
 set on creation and again just before the rename), so a file the user restricted to
 ``0o600`` is never replaced by a world-readable one, nor readable while it is written.
+
+An output that is a symbolic link replaces the file at the end of the link's chain (the link
+stays a link). One that is not a regular file (a character or block device such as
+``/dev/null``, a FIFO, a socket) or names a descriptor (``/dev/stdout``, ``/dev/fd/N``,
+``/proc/self/fd/N``) is written *through*: opened and written like ``open`` would, never
+replaced, so ``--out /dev/null`` discards and ``--out /dev/stdout`` prints (and a named pipe
+stays a pipe). Such a write is not atomic: a failure can leave part of it written.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
+import re
 import secrets
+import shutil
 import stat
+import sys
+import tempfile
 from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
 from pftrack._typing import PathLike
+
+#: The descriptor folders of Linux's /proc (``/dev/fd`` and ``/proc/self`` resolve to them).
+_FD_FOLDER = re.compile(r"/proc/(\d+)(?:/task/\d+)?/fd")
+#: Symbolic links followed before giving up (Linux's own limit).
+_MAX_LINKS = 40
+
+
+@dataclass(frozen=True)
+class _Target:
+    """Where an output goes.
+
+    Attributes
+    ----------
+    path : Path
+        The file replaced or written: the path as given, or the end of its symbolic links.
+    through : bool
+        Written through (opened and written), not replaced: an existing file that is not a
+        regular file or a folder, or a descriptor.
+    fd : int or None
+        This process's descriptor the path names (``/dev/stdout``: 1), written through a copy
+        of it so the output goes where the descriptor points, at its offset.
+    """
+
+    path: Path
+    through: bool = False
+    fd: int | None = None
+
+
+def _names_folder(text: str) -> bool:
+    """Whether `text` can only name a folder: a trailing slash, or ``.`` or ``..`` last."""
+    return text.endswith(("/", os.sep)) or os.path.basename(text) in ("", ".", "..")
+
+
+def _resolve(path: PathLike) -> _Target:
+    """Where output `path` goes: its symbolic links followed, special files written through."""
+    text = os.fsdecode(os.fspath(path))
+    p, followed = text, False
+    for _ in range(_MAX_LINKS):
+        folder, name = os.path.split(p)
+        fd_folder = _FD_FOLDER.fullmatch(os.path.realpath(folder or "."))
+        if fd_folder is not None and name.isdigit():  # /dev/stdout, /dev/fd/1, /proc/self/fd/1
+            own = int(fd_folder.group(1)) == os.getpid()
+            return _Target(Path(p), through=True, fd=int(name) if own else None)
+        if not os.path.islink(p):
+            break
+        link = os.path.join(folder, os.readlink(p))
+        base = os.path.basename(link)
+        p = (
+            os.path.realpath(link)
+            if base in ("", ".", "..")
+            else os.path.join(os.path.realpath(os.path.dirname(link) or "."), base)
+        )
+        followed = True
+    else:
+        raise OSError(errno.ELOOP, os.strerror(errno.ELOOP), text)
+    try:
+        mode = os.stat(p).st_mode
+    except OSError:  # a new file (or one the write itself will fail on, with its own message)
+        return _Target(Path(p if followed else text))
+    through = not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+    return _Target(Path(p if followed else text), through=through)
+
+
+def writes_through(path: PathLike) -> bool:
+    """Whether output `path` is written through rather than replaced (see the module's notes).
+
+    True for an existing device, FIFO or socket, or a descriptor (``/dev/stdout``), also at
+    the end of symbolic links; False for a regular file, a folder, or a path that does not exist.
+    """
+    return _resolve(path).through
+
+
+def _open_through(target: _Target, mode: str) -> IO[Any]:
+    """Open a written-through `target` for writing (a descriptor: a copy of it)."""
+    if target.fd is None:
+        return open(target.path, mode)  # noqa: SIM115 - the caller closes it
+    for stream in (sys.stdout, sys.stderr):  # what was printed comes first
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            stream.flush()
+    return os.fdopen(os.dup(target.fd), mode)
+
+
+def _refuse_folder_name(path: PathLike, what: str = "output") -> None:
+    """ValueError when `path` can only name a folder (``newdir/``): a file would be written."""
+    text = os.fsdecode(os.fspath(path))
+    if _names_folder(text):
+        raise ValueError(f"{what} {text} names a folder; give a file name")
 
 
 def _create_beside(folder: Path, prefix: str, suffix: str) -> tuple[int, str]:
@@ -69,8 +169,25 @@ def atomic_write(
         Text or binary.
     suffix : str, optional
         Suffix of the temporary file (some writers, e.g. OpenCV's, pick a format by extension).
+
+    Notes
+    -----
+    A symbolic link `path` replaces the file the link leads to; a device, FIFO, socket or
+    descriptor (``/dev/null``, ``/dev/stdout``) is opened and written, not replaced, and not
+    atomically (see the module's notes).
+
+    Raises
+    ------
+    ValueError
+        `path` can only name a folder (a trailing slash, ``.``).
     """
-    target = Path(path)
+    _refuse_folder_name(path)
+    resolved = _resolve(path)
+    if resolved.through:
+        with _open_through(resolved, mode) as fh:
+            yield fh
+        return
+    target = resolved.path
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"output folder does not exist: {folder}")
@@ -94,13 +211,23 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
     """Yield a temporary path (same folder, same extension) that replaces `path` on success.
 
     For writers that want a file name rather than a handle (``cv2.VideoWriter``, ``cv2.imwrite``).
-    Permissions as for :func:`atomic_write`: an existing file's are kept.
+    Permissions as for :func:`atomic_write`: an existing file's are kept. A symbolic link
+    replaces the file it leads to; a device, FIFO or descriptor gets the finished file's bytes
+    written into it (the temporary file is then in the system's temporary folder).
     """
-    target = Path(path)
+    _refuse_folder_name(path)
+    resolved = _resolve(path)
+    if resolved.through:
+        with tempfile.TemporaryDirectory(prefix="pftrack-") as scratch:
+            tmp_path = Path(scratch) / f"out{Path(path).suffix}"
+            yield tmp_path
+            _copy_through(tmp_path, resolved)
+        return
+    target = resolved.path
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"output folder does not exist: {folder}")
-    fd, tmp = _create_beside(folder, f".{target.stem}.", target.suffix)
+    fd, tmp = _create_beside(folder, f".{target.stem}.", Path(path).suffix)
     try:
         try:
             _keep_mode(fd, target)
@@ -115,6 +242,14 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def _copy_through(tmp: Path, target: _Target) -> None:
+    """Write the finished file `tmp` into the written-through `target`."""
+    if not tmp.exists() or tmp.stat().st_size == 0:
+        raise OSError(f"nothing was written for {target.path}")
+    with tmp.open("rb") as src, _open_through(target, "wb") as dst:
+        shutil.copyfileobj(src, dst)
 
 
 def check_output(
@@ -140,40 +275,66 @@ def check_output(
     Raises
     ------
     ValueError
-        The extension is not supported, the path is a folder, or it names an input.
+        The extension is not supported; the path is a folder, or can only name one (a trailing
+        slash: ``newdir/``); it is ``-`` (standard output: give ``/dev/stdout``); or it names
+        an input.
     FileNotFoundError
         Its folder does not exist.
     PermissionError
         Its folder (or the existing file) is not writable: checked by creating (and removing)
         a file beside it.
+
+    Notes
+    -----
+    A symbolic link is checked where it leads: the folder of the file at its end must be
+    writable. A device, FIFO, socket or descriptor (``/dev/null``, ``/dev/stdout``) is written
+    through (see the module's notes): it must be writable itself, its folder need not be.
     """
+    text = os.fsdecode(os.fspath(path))
     target = Path(path)
-    if suffixes is not None and target.suffix.lower() not in suffixes:
+    if text == "-":
         raise ValueError(
-            f"{what} {target}: unsupported extension {target.suffix or '(none)'!r}, expected "
-            f"one of {', '.join(suffixes)}"
+            f"{what} -: standard output is not supported by name '-'; give a file name, or "
+            "/dev/stdout"
         )
     if target.is_dir():
         raise ValueError(f"{what} {target} is a folder; give a file name")
-    folder = target.parent if str(target.parent) else Path(".")
+    _refuse_folder_name(text, what)
+    if suffixes is not None and target.suffix.lower() not in suffixes:
+        raise ValueError(
+            f"{what} {text}: unsupported extension {target.suffix or '(none)'!r}, expected "
+            f"one of {', '.join(suffixes)}"
+        )
+    resolved = _resolve(text)
+    written = resolved.path
+    if resolved.through:
+        if resolved.fd is None and not os.access(written, os.W_OK):
+            raise PermissionError(f"{what} {target}: not writable")
+    else:
+        _check_folder(written, what, target)
+    for source in inputs:
+        if _same_file(target, Path(source)):
+            raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
+    return target
+
+
+def _check_folder(written: Path, what: str, target: Path) -> None:
+    """`written`'s folder exists and takes a new file (the atomic write's temporary file)."""
+    folder = written.parent if str(written.parent) else Path(".")
     if not folder.is_dir():
         raise FileNotFoundError(f"{what} {target}: folder {folder} does not exist")
     if not os.access(folder, os.W_OK | os.X_OK) or (
-        target.exists() and not os.access(target, os.W_OK)
+        written.exists() and not os.access(written, os.W_OK)
     ):
         raise PermissionError(f"{what} {target}: not writable")
     try:  # access() says yes to root on a read-only or special file system: try it
-        fd, probe = _create_beside(folder, f".{target.name}.", ".probe")
+        fd, probe = _create_beside(folder, f".{written.name}.", ".probe")
     except OSError as exc:
         raise PermissionError(
             f"{what} {target}: folder {folder} is not writable ({exc.strerror or exc})"
         ) from None
     os.close(fd)
     os.unlink(probe)
-    for source in inputs:
-        if _same_file(target, Path(source)):
-            raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
-    return target
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -181,6 +342,14 @@ def _same_file(a: Path, b: Path) -> bool:
     if a.exists() and b.exists() and os.path.samefile(a, b):
         return True  # hard links, bind mounts
     return a.resolve() == b.resolve()
+
+
+def _is_devnull(path: Path) -> bool:
+    """Whether `path` is (or leads to) the null device."""
+    try:
+        return os.path.samefile(path, os.devnull)
+    except OSError:
+        return False
 
 
 def check_distinct(outputs: Mapping[str, PathLike | None]) -> None:
@@ -194,13 +363,16 @@ def check_distinct(outputs: Mapping[str, PathLike | None]) -> None:
     Raises
     ------
     ValueError
-        Two of them name one file (one would overwrite the other), naming both.
+        Two of them name one file (one would overwrite the other), naming both. The null
+        device (``/dev/null``, or a link to it) may take several.
     """
     seen: list[tuple[str, Path]] = []
     for what, path in outputs.items():
         if path is None:
             continue
         target = Path(path)
+        if _is_devnull(target):  # discarded: any number of outputs may go there
+            continue
         for other_what, other in seen:
             if _same_file(target, other):
                 raise ValueError(
@@ -218,7 +390,8 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
     writer to fill. When the block ends normally every staged file is renamed over its target;
     when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
     target is left as it was, so an interrupted run never leaves a new tracks file beside an old
-    video, or a half-written file anywhere.
+    video, or a half-written file anywhere. A symbolic link replaces the file it leads to; a
+    device, FIFO or descriptor gets its file's bytes written into it after the renames.
 
     Examples
     --------
@@ -227,13 +400,24 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
     ...     write_annotated_video(stage("video.mp4"), frames, rows)
     """
     staged: list[tuple[str, Path]] = []
+    through: list[tuple[Path, _Target]] = []  # devices, FIFOs, descriptors: written at the end
+    scratch: list[str] = []  # the temporary folder of their files, made when first needed
 
     def stage(path: PathLike) -> Path:
-        target = Path(path)
+        _refuse_folder_name(path)
+        resolved = _resolve(path)
+        suffix = Path(path).suffix
+        if resolved.through:
+            if not scratch:
+                scratch.append(tempfile.mkdtemp(prefix="pftrack-"))
+            tmp_path = Path(scratch[0]) / f"out{len(through)}{suffix}"
+            through.append((tmp_path, resolved))
+            return tmp_path
+        target = resolved.path
         folder = target.parent if str(target.parent) else Path(".")
         if not folder.is_dir():
             raise FileNotFoundError(f"output folder does not exist: {folder}")
-        fd, tmp = _create_beside(folder, f".{target.stem}.", target.suffix or ".tmp")
+        fd, tmp = _create_beside(folder, f".{target.stem}.", suffix or ".tmp")
         staged.append((tmp, target))
         try:
             _keep_mode(fd, target)
@@ -247,8 +431,13 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
             _keep_mode(tmp, target)  # again: a writer may have made the file anew
         for tmp, target in staged:
             os.replace(tmp, target)
+        for tmp_path, resolved in through:  # last: a FIFO waits for its reader
+            _copy_through(tmp_path, resolved)
     except BaseException:
         for tmp, _ in staged:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
         raise
+    finally:
+        if scratch:
+            shutil.rmtree(scratch[0], ignore_errors=True)

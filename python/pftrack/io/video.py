@@ -2,7 +2,8 @@
 
 Sources, as :class:`FrameSource` takes them:
 
-- a video file OpenCV can decode;
+- a video file OpenCV can decode (a text file is refused, though FFmpeg would decode it as
+  ANSI art: :data:`TEXT_FOURCC`);
 - a folder of images, read in natural order (``2.jpg`` before ``10.jpg``); when every name is
   a number (``000001.jpg``, the MOTChallenge convention) the names are frame numbers, and a
   missing one is refused rather than shifting every later frame;
@@ -21,6 +22,7 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import os
 import re
 import stat
 import warnings
@@ -40,6 +42,7 @@ __all__ = [
     "VIDEO_SUFFIXES",
     "FrameSource",
     "SequenceInfo",
+    "check_source",
     "find_sequence",
     "is_live_source",
     "natural_key",
@@ -53,6 +56,9 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
 #: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 DEFAULT_FPS = 25.0
+#: The codec FFmpeg's ``tty`` demuxer reports: it opens text files (``.txt``, ``.nfo``, ``.asc``,
+#: ...) as ANSI art, 640x400 frames of rendered characters. A text file is not a video.
+TEXT_FOURCC = "ansi"
 REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
 
@@ -74,6 +80,12 @@ def _file_capture(path: str) -> cv2.VideoCapture:
         return cap
     cap.release()
     return cv2.VideoCapture(path)
+
+
+def _fourcc(cap: cv2.VideoCapture) -> str:
+    """The four-character code of the codec `cap` decodes (``"FMP4"``, ``"H264"``, ``"ansi"``)."""
+    code = int(cap.get(cv2.CAP_PROP_FOURCC)) & 0xFFFFFFFF
+    return code.to_bytes(4, "little").decode("latin-1")
 
 
 def _same_frames(a: list[tuple[NDArray[Any], float]], b: list[tuple[NDArray[Any], float]]) -> bool:
@@ -323,10 +335,36 @@ def _frame_order(
     return ordered
 
 
+def check_source(source: object) -> None:
+    """Refuse what cannot name a frame source, before anything is opened.
+
+    Raises
+    ------
+    TypeError
+        `source` is not a path, a string or an integer (a bool is refused: ``True`` is not
+        camera 1).
+    ValueError
+        A negative camera index (OpenCV's ``VideoCapture(-1)`` crashes the process when there is
+        no camera), or an empty string (it would read the current folder).
+    """
+    what = "expected a video file, an image or sequence folder, a stream URL or a camera index"
+    if isinstance(source, (bool, np.bool_)):
+        raise TypeError(f"video source is {source}, a bool; {what} (an int >= 0)")
+    if isinstance(source, (int, np.integer)):
+        if source < 0:
+            raise ValueError(f"camera index is {source}, expected an int >= 0")
+        return
+    if not isinstance(source, (str, os.PathLike)):
+        kind = type(source).__name__
+        raise TypeError(f"video source must be a path, a URL or an int, got {kind}")
+    if isinstance(source, str) and not source:
+        raise ValueError(f"video source is {source!r} (empty); {what}")
+
+
 def _camera_index(source: PathLike | int) -> int | None:
     """The camera index `source` names (``0``, ``"1"``), unless a file or folder has that name."""
-    if isinstance(source, int):
-        return source
+    if isinstance(source, (int, np.integer)) and not isinstance(source, (bool, np.bool_)):
+        return int(source)
     text = str(source)
     return int(text) if text.isdigit() and not Path(text).exists() else None
 
@@ -384,8 +422,11 @@ class FrameSource:
     ------
     FileNotFoundError
         If a path `source` does not exist.
+    TypeError
+        If `source` is not a path, a string or an int (a bool is refused).
     ValueError
-        If it cannot be opened or decoded, or holds no frame; or if the images of a folder are
+        If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
+        no frame; or if the images of a folder are
         named by number and one is missing (a hole in the numbering; in a MOTChallenge
         sequence's image folder, also numbers that do not start at 1 or a count other than
         ``seqLength``).
@@ -401,6 +442,7 @@ class FrameSource:
     def __init__(
         self, source: PathLike | int, *, scale: float = 1.0, fps: float | None = None
     ) -> None:
+        check_source(source)
         if not (np.isfinite(scale) and scale > 0):
             raise ValueError(f"scale is {scale}, expected a finite value > 0")
         if fps is not None and not (np.isfinite(fps) and fps > 0):
@@ -477,6 +519,10 @@ class FrameSource:
     def _probe_file(path: Path) -> tuple[NDArray[Any], float, int]:
         cap = _file_capture(str(path))
         try:
+            if cap.isOpened() and _fourcc(cap) == TEXT_FOURCC:
+                raise ValueError(
+                    f"not a video: {path} is a text file (FFmpeg decodes text as ANSI-art frames)"
+                )
             ok, first = cap.read() if cap.isOpened() else (False, None)
             fps = float(cap.get(cv2.CAP_PROP_FPS)) if cap.isOpened() else 0.0
             count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0

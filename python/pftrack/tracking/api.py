@@ -29,7 +29,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame
+from pftrack._check import bgr_frame, flag
 from pftrack._typing import F64, RngLike
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
@@ -233,6 +233,14 @@ class Tracker:
         this longer side for detection and tracking; boxes in and out stay in the frame's
         pixels. None: the frame's own size.
 
+    Raises
+    ------
+    TypeError
+        A flag (`refine`, `smooth`, `link`, `crossings`) that is not ``True`` or ``False``
+        (``refine="no"`` would turn refinement on), or a `frame_rate` that is not a number.
+    ValueError
+        A value out of its range.
+
     Examples
     --------
     >>> tracker = pftrack.Tracker(frame_rate=25.0)         # doctest: +SKIP
@@ -276,6 +284,10 @@ class Tracker:
             raise ValueError(
                 f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
             )
+        refine, smooth, link, crossings = (
+            flag(refine, "refine"), flag(smooth, "smooth"), flag(link, "link"),
+            flag(crossings, "crossings"),
+        )  # fmt: skip
         if dynamics not in ("ar2", "ar2-mean"):
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
         if particles is not None and (
@@ -295,8 +307,8 @@ class Tracker:
             sampler=sampler,
             camera_motion=camera_motion,
             max_side=max_side,
-            refine=replace(base.refine, enabled=bool(refine)),
-            crossings=replace(base.crossings, enabled=bool(crossings)),
+            refine=replace(base.refine, enabled=refine),
+            crossings=replace(base.crossings, enabled=crossings),
             lifecycle=replace(
                 base.lifecycle,
                 max_coast=(

@@ -122,11 +122,12 @@ def _grey(frame: NDArray[np.uint8], factor: float) -> NDArray[np.uint8]:
     first halved (2x2 means, a last odd row or column left out): OpenCV's area resize is slow at
     factors that are not 1/2 (1.4 ms for 1280x720 to 240x135, 0.33 ms halved first; the grey
     levels differ by 0.3 on average). A frame under four times the target's size (under 960
-    pixels with the default ``max_side`` of 240) is scaled in one step.
+    pixels with the default ``max_side`` of 240) is scaled in one step. A side is at least 1
+    pixel (a 1x500 frame scales to 1x240, not 0x240, which OpenCV refuses).
     """
     g = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
     if factor != 1.0:
-        size = (round(g.shape[1] * factor), round(g.shape[0] * factor))
+        size = (max(1, round(g.shape[1] * factor)), max(1, round(g.shape[0] * factor)))
         while g.shape[1] >= 4 * size[0] and g.shape[0] >= 4 * size[1]:
             half = (g.shape[1] // 2, g.shape[0] // 2)
             g = cv2.resize(g[: 2 * half[1], : 2 * half[0]], half, interpolation=cv2.INTER_AREA)

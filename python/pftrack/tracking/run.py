@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import flag
 from pftrack._progress import progress
 from pftrack._typing import F64, PathLike, RngLike
 from pftrack.detection.bootstrap import bootstrap_frames
@@ -284,12 +285,13 @@ def track_path(
         Boxes of bridged gaps when `smooth` is False (see :func:`track_frames`).
     smooth, link : bool
         Smooth every track offline (:class:`BoxSmoother`); join fragments of one object
-        (:class:`~pftrack.recovery.LinkConfig`).
+        (:class:`~pftrack.recovery.LinkConfig`). Only ``True`` or ``False`` (TypeError).
     show_progress : bool, optional
         Per-frame progress bar on stderr (default: when stderr is a terminal).
     threads : bool
         Decode and detect on threads ahead of the tracker (see :func:`track_frames`).
     """
+    smooth, link = flag(smooth, "smooth"), flag(link, "link")
     frames = source if isinstance(source, FrameSource) else FrameSource(source)
     dets = load_detections(detections, det_scale) if detections is not None else None
     return track_frames(
