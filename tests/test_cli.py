@@ -773,3 +773,29 @@ def test_an_empty_detection_file_is_said_to_be_empty(
     assert capsys.readouterr().err == (
         "pftrack track: warning: no track over 60 frames: the detections given held no box\n"
     )
+
+
+@pytest.mark.parametrize(
+    ("argv", "command"),
+    [
+        (["smooth", "t.txt", "--out", "o.txt", "--explain"], "smooth"),
+        (["recover", "t.txt", "--out", "o.txt", "--bogus"], "recover"),
+        (["track", "v.avi", "--out", "o.txt", "--bogus"], "track"),
+        (["batch", "v.avi", "--out", "o", "--bogus"], "batch"),
+        (["eval", "--gt", "g.txt", "--res", "r.txt", "--bogus"], "eval"),
+        (["demo", "--bogus"], "demo"),
+        (["experiment", "gaps", "--gt", "g.txt", "--bogus", "1"], "experiment gaps"),
+        (["smooth", "t.txt", "--out", "o.txt", "extra.txt"], "smooth"),
+    ],
+)
+def test_an_unknown_option_is_named_by_its_command(
+    argv: list[str], command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Regression: ``pftrack smooth ... --explain`` printed the top-level usage and
+    ``pftrack: error: unrecognized arguments``."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"usage: pftrack {command} ")
+    assert err.splitlines()[-1].startswith(f"pftrack {command}: error: unrecognized arguments: ")

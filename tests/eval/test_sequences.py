@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import shutil
 import warnings
 from pathlib import Path
 
@@ -21,7 +22,7 @@ from pftrack.eval import (
     evaluate_sequence,
     find_sequences,
 )
-from pftrack.eval.sequences import read_seqinfo
+from pftrack.eval.sequences import read_seqinfo, result_file
 from pftrack.io.mot import read_mot, write_mot
 from tests.conftest import dataset
 from tests.eval.cases import perturbed, write_rows
@@ -248,3 +249,42 @@ def test_cli_on_real_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     assert doc["sequences"]["pets09-s2l1"]["scale"] == 0.625
     assert doc["sequences"]["tud-campus"]["scale"] == 1.0
     assert 0.3 < doc["combined"]["hota"] < 0.9
+
+
+def test_cli_reads_trackevals_tree(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Regression: ``--res trackers/mot_challenge/MOT15-train/NAME`` (results in ``data/``) said
+    "no result for sequence ... (choose sequences with --seqs)", and ``--gt gt/mot_challenge``
+    "no sequence in ..."."""
+    cases = {"A": random_case(1), "B": random_case(2)}
+    gt_split, res_flat = make_layout(tmp_path / "flat", cases)
+    root = tmp_path / "TrackEval" / "data"
+    gt_root = root / "gt" / "mot_challenge"
+    shutil.copytree(gt_split, gt_root / "MOT15-train")
+    (gt_root / "seqmaps").mkdir()  # TrackEval's lists of sequences: no sequence in it
+    trackers = root / "trackers" / "mot_challenge" / "MOT15-train"
+    shutil.copytree(res_flat, trackers / "mine" / "data")
+    assert [s.name for s in find_sequences(gt_root)] == ["A", "B"]
+    assert result_file(trackers / "mine", "A") == trackers / "mine" / "data" / "A.txt"
+    assert result_file(trackers / "mine", "C") is None
+    assert main(["eval", "--gt", str(gt_split), "--res", str(res_flat)]) == 0
+    want = capsys.readouterr().out
+    for gt in (gt_root, gt_root / "MOT15-train"):
+        assert main(["eval", "--gt", str(gt), "--res", str(trackers / "mine")]) == 0
+        assert capsys.readouterr().out == want
+
+    def error(gt: Path, res: Path) -> str:
+        assert main(["eval", "--gt", str(gt), "--res", str(res)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("pftrack eval: error: ") and err.count("\n") == 1
+        return err
+
+    # the folder of trackers: name them; no results at all: say what is looked for
+    assert "holds tracker folders (mine): give one of them as --res" in error(gt_root, trackers)
+    (tmp_path / "none").mkdir()
+    err = error(gt_root, tmp_path / "none")
+    assert "data/A.txt" in err and "--seqs" not in err
+    (trackers / "mine" / "data" / "B.txt").unlink()  # one missing: --seqs can leave it out
+    assert "no result for sequence B" in error(gt_root, trackers / "mine")
+    assert "--seqs" in error(gt_root, trackers / "mine")
+    shutil.copytree(gt_split, gt_root / "MOT16-train")  # the same names twice
+    assert "sequence A is both in" in error(gt_root, trackers / "mine")

@@ -122,3 +122,56 @@ def test_values_read_are_written_unchanged_and_writing_is_a_fixed_point(tmp_path
     fields = first.decode().replace("\n", ",").split(",")
     assert "-0" not in fields and not any(f.endswith((".00", ".0")) for f in fields)
     assert all(len(f.partition(".")[2]) <= 2 for f in fields)
+
+
+def test_values_of_any_length_are_written_exactly_when_marked(tmp_path: Path) -> None:
+    """Regression: values of more than 10 significant digits (``np.savetxt``'s ``%.18e``) were
+    rounded to 2 decimals even where they were read from a file (499.1234567891234 -> 499.12).
+    """
+    a = np.array(
+        [
+            [1, 1, 499.1234567891234, 10, 20.5, 40, 0.123456789012, -1, -1, -1],
+            [1, 2, 1 / 3, 2e-17, 1e8 / 7, 88, 1, 0.99502, 1.0000000000000002, 3e300],
+            [2, 1, -0.0, 12.345678901234, 20, 40, 0.5, -1, -1, -1],
+        ]
+    )
+    p, q = tmp_path / "savetxt.txt", tmp_path / "out.txt"
+    np.savetxt(p, a, delimiter=",")
+    mot.write_mot(q, mot.read_mot(p), exact=True)
+    np.testing.assert_array_equal(mot.read_mot(q), a)  # the same doubles
+    first = q.read_text()
+    assert first.splitlines()[0] == "1,1,499.1234567891234,10,20.5,40,0.123456789012,-1,-1,-1"
+    assert "-0" not in first.replace("e-", "")
+    mot.write_mot(q, mot.read_mot(q), exact=True)
+    assert q.read_text() == first  # a fixed point
+    # per row and per value: the rest is rounded as before
+    assert mot.mot_text(a, exact=np.array([True, False, False])).splitlines()[2] == (
+        "2,1,0,12.35,20,40,0.5,-1,-1,-1"
+    )
+    cells = np.zeros((3, 7), bool)
+    cells[0, 6] = True  # conf of row 0 only (a 7-column array: the defaults are added)
+    assert mot.mot_text(a[:, :7], exact=cells).splitlines()[0] == (
+        "1,1,499.12,10,20.5,40,0.123456789012,-1,-1,-1"
+    )
+    assert mot.mot_text(a).splitlines()[0] == "1,1,499.12,10,20.5,40,0.12,-1,-1,-1"  # default
+    assert mot.format_mot_row(a[0], exact=True) == first.splitlines()[0]
+    with pytest.raises(ValueError, match=r"exact has shape \(2,\)"):
+        mot.mot_text(a, exact=np.array([True, False]))
+    with pytest.raises(TypeError, match="exact must be a bool"):
+        mot.mot_text(a, exact=np.ones(3))
+
+
+@pytest.mark.parametrize("column", [7, 8, 9, 10])
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
+def test_a_non_finite_value_in_any_column_is_named_by_file_and_line(
+    tmp_path: Path, column: int, value: str
+) -> None:
+    """Regression: NaN in the score (or x, y, z) columns was read, then refused later by
+    the tracker ("dets row 6 contains NaN") or fill_gaps ("row 288 has a non-finite conf")."""
+    fields = "2,1,10,20,30,40,0.9,-1,-1,-1".split(",")
+    fields[column - 1] = value
+    p = tmp_path / "t.txt"
+    p.write_text("1,1,10,20,30,40,0.9,-1,-1,-1\n" + ",".join(fields) + "\n")
+    name = ("conf", "x", "y", "z")[column - 7]
+    with pytest.raises(ValueError, match=rf"t.txt:2: .*non-finite .*column {column} \({name}\)"):
+        mot.read_mot(p, what="detection file")

@@ -198,3 +198,31 @@ def test_pets_smooth_and_recover_flag_exactly_the_filled_rows(
         assert filled_mask(rows).sum() == np.sum(rows[:, 7] == 1) == 96, command
     capsys.readouterr()
     assert set(lines) <= set((tmp_path / "recover.txt").read_text().splitlines())
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_observed_values_with_many_digits_are_kept_exactly(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    """Regression: ``np.savetxt``'s values (``%.18e``) came out rounded to 2 decimals:
+    x 499.1234567891234 as 499.12, conf 0.123456789012 as 0.12."""
+    rows = read_mot(_write(tmp_path / "lines.txt", _lines("tracker")))
+    rows[:, 2] += 0.1234567891234
+    rows[:, 6] = 0.123456789012
+    rows[::3, 9] = np.pi  # a world z of 16 digits
+    src, out = tmp_path / "savetxt.txt", tmp_path / "out.txt"
+    np.savetxt(src, rows, delimiter=",")
+    argv = [command, str(src), "--out", str(out)]
+    assert main(argv + (["--method", "linear"] if command == "recover" else [])) == 0
+    capsys.readouterr()
+    got, given = read_mot(out), _by_key(rows)
+    filled = filled_mask(got)
+    assert filled.sum() == 48
+    if command == "recover":  # observed rows: every value as read
+        np.testing.assert_array_equal(got[~filled], given)
+        assert "4567891234," in out.read_text() and ",0.123456789012," in out.read_text()
+    else:  # smoothed boxes are computed (2 decimals); conf and columns 8-10 are the rows'
+        np.testing.assert_array_equal(got[~filled, 6:], given[:, 6:])
+        assert np.all(np.round(got[:, 2:6], 2) == got[:, 2:6])
+    assert np.all(got[filled, 6] == 0.123456789012)  # a filled row's conf: its neighbour's
+    assert np.all(np.round(got[filled, 2:6], 2) == got[filled, 2:6])  # computed: 2 decimals

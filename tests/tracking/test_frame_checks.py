@@ -8,6 +8,8 @@ its packed copy.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -169,3 +171,14 @@ def test_finalize_writes_no_row_wholly_outside_the_frame(tmp_path):
     rows = read_mot(out)
     x, y, bw, bh = rows[:, 2], rows[:, 3], rows[:, 4], rows[:, 5]
     assert len(rows) and not ((x >= 640) | (y >= 480) | (x + bw <= 0) | (y + bh <= 0)).any()
+
+
+def test_a_non_finite_detection_score_is_named_by_file_and_line_before_tracking(
+    tmp_path: Path,
+) -> None:
+    """Regression: NaN in det.txt's score column passed the reader and stopped the tracker
+    after tracking had started ("dets row 6 contains NaN or inf")."""
+    p = tmp_path / "det.txt"
+    p.write_text("1,-1,10,10,20,40,0.9,-1,-1,-1\n2,-1,12,10,20,40,nan,-1,-1,-1\n")
+    with pytest.raises(ValueError, match=r"det.txt:2: detection file line .*column 7 \(conf\)"):
+        load_detections(p)

@@ -387,3 +387,32 @@ def test_complete_boxes_bad_arguments(kwargs, match):
         complete_boxes(np.zeros((0, 10)), **args)
     with pytest.raises(ValueError, match="complete_boxes"):
         complete_boxes(np.zeros((3, 4)), [[0.5, 0.0], [0.2, 0.0]], 0.8)
+
+
+def test_a_degenerate_track_is_kept_as_it_is_as_recover_keeps_it(tmp_path, capsys):
+    """Regression: one track of zero-height boxes failed the whole file ("the median observed
+    height is 0.0, expected > 0", no file, line or id); recover accepts it."""
+    from pftrack.cli import main
+
+    flat = np.array([[10.0, 10, 0, 0], [14, 10, 0, 0], [14, 10, 5, 0]])
+    np.testing.assert_array_equal(BoxSmoother().smooth([1, 4, 5], flat, [True] * 3), flat)
+    rng = np.random.default_rng(0)
+    rows = []
+    for tid in (1, 2):
+        for f in range(1, 41):
+            if f not in (20, 21):
+                x, y = 50 * tid + 2 * f + rng.normal(0, 1), 100 + rng.normal(0, 1)
+                rows.append([f, tid, x, y, 20, 40, 1, -1, -1, -1])
+    rows += [[200, 99, 10, 10, 0, 0, 1, -1, -1, -1], [203, 99, 14, 10, 0, 0, 1, -1, -1, -1]]
+    a = np.array(rows)
+    out = smooth_tracks(a)
+    got = out[out[:, 1] == 99]
+    assert got[:, 0].tolist() == [200, 201, 202, 203]  # the hole filled, as recover fills it
+    np.testing.assert_array_equal(got[[0, 3]], a[-2:])  # the observed rows as they were
+    assert np.all(got[:, 4:6] == 0)
+    src = tmp_path / "zerow.txt"
+    np.savetxt(src, a, delimiter=",", fmt="%g")
+    for command in ("smooth", "recover"):
+        assert main([command, str(src), "--out", str(tmp_path / f"{command}.txt")]) == 0
+    capsys.readouterr()
+    assert "200,99,10,10,0,0,1,-1,-1,-1" in (tmp_path / "smooth.txt").read_text().splitlines()

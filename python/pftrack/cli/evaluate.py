@@ -41,9 +41,11 @@ def add_parser(sub: Any) -> None:
         "eval",
         help="score tracking results against ground truth (HOTA, MOTA, IDF1, ...)",
         description="Score a MOTChallenge result file against a ground-truth file, or a folder "
-        "of results (RES/SEQ.txt) against a MOTChallenge folder of sequences (GT/SEQ/gt/gt.txt "
-        "or GT/SEQ/gt.txt, with GT/SEQ/seqinfo.ini), with one row per sequence and a combined "
-        "row. Reports HOTA, DetA, AssA and LocA exactly as TrackEval computes them (its "
+        "of results (RES/SEQ.txt, or RES/data/SEQ.txt) against a MOTChallenge folder of "
+        "sequences (GT/SEQ/gt/gt.txt or GT/SEQ/gt.txt, with GT/SEQ/seqinfo.ini), or a folder of "
+        "them, with one row per sequence and a combined row; TrackEval's tree is read as it is "
+        "(--gt gt/mot_challenge/MOT17-train --res trackers/mot_challenge/MOT17-train/NAME). "
+        "Reports HOTA, DetA, AssA and LocA exactly as TrackEval computes them (its "
         "MOTChallenge ground-truth rules: zero-marked rows dropped; for MOT16/17/20 only "
         "pedestrians scored and result boxes on distractors removed), CLEAR-MOT (MOTA, MOTP as "
         "mean IoU of matches, FP, FN, IDSW, Frag, MT/PT/ML) and IDF1/IDP/IDR as py-motmetrics "
@@ -97,6 +99,7 @@ def _scales(specs: list[tuple[str | None, float]], names: list[str]) -> dict[str
 def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
     """(name, SequenceInfo, result file) of every sequence to score, checked before work."""
     from pftrack.eval import SequenceInfo, find_sequences
+    from pftrack.eval.sequences import result_file
 
     gt, res = Path(args.gt), Path(args.res)
     if gt.is_file():
@@ -124,15 +127,32 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
             f"results folder not found: {res} (a ground-truth folder of {len(seqs)} sequences "
             "needs a folder of SEQ.txt results)"
         )
-    jobs = []
-    for s in seqs:
-        path = res / f"{s.name}.txt"
-        if not path.is_file():
-            raise FileNotFoundError(
-                f"no result for sequence {s.name}: {path} (choose sequences with --seqs)"
-            )
-        jobs.append((s.name, s, path))
-    return jobs
+    found = {s.name: result_file(res, s.name) for s in seqs}
+    missing = [name for name, path in found.items() if path is None]
+    if missing:
+        raise FileNotFoundError(_no_result(res, missing, len(seqs)))
+    return [(s.name, s, p) for s in seqs if (p := found[s.name]) is not None]
+
+
+def _no_result(res: Path, missing: list[str], n_seqs: int) -> str:
+    """Why results are missing: the files looked for, and the way out that fits."""
+    where = f"{res / missing[0]}.txt (or {res / 'data' / missing[0]}.txt)"
+    if len(missing) < n_seqs:  # some found: the others may be left out
+        return (
+            f"no result for sequence {missing[0]}: {where}; to score only the sequences with "
+            f"results, name them with --seqs"
+        )
+    trackers = [d.name for d in sorted(res.iterdir()) if d.is_dir() and (d / "data").is_dir()]
+    if trackers:  # TrackEval's trackers/mot_challenge/BENCH-SPLIT: one folder per tracker
+        return (
+            f"no result for sequence {missing[0]} in {res}, which holds tracker folders "
+            f"({', '.join(trackers[:5])}): give one of them as --res"
+        )
+    return (
+        f"no result for sequence {missing[0]}: {where}; --res must hold SEQ.txt for every "
+        "sequence of --gt (or data/SEQ.txt, TrackEval's trackers/mot_challenge/BENCH-SPLIT/"
+        "TRACKER)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -210,11 +210,11 @@ def run_gaps(args: argparse.Namespace) -> int:
         return _run_sequences(args)
     import numpy as np
 
-    from pftrack.io.mot import read_mot
     from pftrack.recovery import experiment as E
+    from pftrack.recovery.linking import read_tracks
 
     args.gt = args.gt[0]
-    gt = read_mot(args.gt, what="ground truth")
+    gt = read_tracks(args.gt, what="ground truth")  # a repeated (frame, id): FILE:LINE
     if len(gt) == 0:
         raise ValueError(f"ground truth {args.gt} is empty")
     methods = _methods(args.methods)
@@ -315,7 +315,7 @@ def _mask_doc(run: Any, methods: list[str]) -> dict[str, Any]:
         "scores": {m: asdict(run.scores[m]) if m in run.scores else None for m in methods},
         "gap_errors": {  # mean Euclidean error of each gap (px), as the multi-sequence JSON's
             m: [
-                float(np.mean(np.hypot(*(p - g.truth[:, 1:3]).T)))
+                float(np.mean(g.errors(p)))
                 for g, p in zip(run.gaps, run.paths.get(m, []), strict=True)
             ]
             for m in methods
@@ -347,13 +347,13 @@ def _run_sequences(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from pftrack._progress import progress
-    from pftrack.io.mot import read_mot
     from pftrack.recovery import experiment as E
+    from pftrack.recovery.linking import read_tracks
 
     methods = _methods(args.methods)
     jobs = []
     for path in args.gt:
-        gt = read_mot(path, what="ground truth")
+        gt = read_tracks(path, what="ground truth")  # a repeated (frame, id): FILE:LINE
         if len(gt) == 0:
             raise ValueError(f"ground truth {path} is empty")
         info = _seqinfo(path)

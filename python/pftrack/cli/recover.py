@@ -69,6 +69,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
+    from pftrack.recovery.fill import copied_values
     from pftrack.recovery.linking import gate_for_rows, read_tracks
 
     src = Path(args.tracks)
@@ -96,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
     dt = time.perf_counter() - t0
-    write_mot(args.out, filled)
+    write_mot(args.out, filled, exact=copied_values(rows, filled))  # given values: all digits
     print(
         f"{src}: {len(rows)} rows, {n_links} fragments linked, {rep.n_gaps} gaps filled with "
         f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "

@@ -61,7 +61,9 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(src)
     link = None if args.no_link else gate_for_rows(LinkConfig(max_gap=args.max_gap), rows)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
-    write_mot(args.out, result)
+    kept = np.zeros(result.shape, dtype=bool)
+    kept[:, 6:] = True  # conf and columns 8-10 are the rows' own: written with all their digits
+    write_mot(args.out, result, exact=kept)
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
     print(

@@ -2,7 +2,9 @@
 
 A MOTChallenge ground-truth folder holds one folder per sequence, ``SEQ/gt/gt.txt`` (or
 ``SEQ/gt.txt``) with ``SEQ/seqinfo.ini``; results are ``RESULTS/SEQ.txt``, as TrackEval reads
-them.
+them. TrackEval's own tree is read too: ground truth ``gt/mot_challenge/BENCH-SPLIT/SEQ/...``
+(a folder of benchmark-split folders, :func:`find_sequences`), results
+``trackers/mot_challenge/BENCH-SPLIT/TRACKER/data/SEQ.txt`` (:func:`result_file`).
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ __all__ = [
     "find_sequences",
     "format_scores",
     "read_seqinfo",
+    "result_file",
     "scores_csv",
     "scores_json",
 ]
@@ -111,15 +114,17 @@ def _sequence(folder: Path) -> SequenceInfo | None:
 def find_sequences(root: PathLike) -> list[SequenceInfo]:
     """The sequences of a MOTChallenge ground-truth folder, by name.
 
-    `root` is either one sequence folder (it has ``gt/gt.txt`` or ``gt.txt``) or a folder of
-    them; folders without a ground-truth file are skipped.
+    `root` is one sequence folder (it has ``gt/gt.txt`` or ``gt.txt``), a folder of them, or
+    a folder of such folders (TrackEval's ``gt/mot_challenge/`` with ``MOT17-train/``, ...:
+    the sequences of all of them); folders without a ground-truth file are skipped.
 
     Raises
     ------
     FileNotFoundError
         `root` is not a folder.
     ValueError
-        No sequence was found, or a ``seqinfo.ini`` is malformed.
+        No sequence was found, two folders of `root` hold a sequence of the same name, or a
+        ``seqinfo.ini`` is malformed.
     """
     base = Path(root)
     if not base.is_dir():
@@ -127,13 +132,44 @@ def find_sequences(root: PathLike) -> list[SequenceInfo]:
     own = _sequence(base)
     if own is not None:
         return [own]
-    found = [s for d in sorted(base.iterdir()) if d.is_dir() and (s := _sequence(d)) is not None]
+    found = _sequences_in(base)
+    if not found:  # TrackEval: gt/mot_challenge/BENCH-SPLIT/SEQ
+        found = [s for d in _folders(base) for s in _sequences_in(d)]
+        seen: dict[str, Path] = {}
+        for s in found:
+            if s.name in seen:
+                raise ValueError(
+                    f"sequence {s.name} is both in {seen[s.name]} and in {s.gt_path}: give one "
+                    f"benchmark-split folder of {base} as the ground truth"
+                )
+            seen[s.name] = s.gt_path
     if not found:
         raise ValueError(
             f"no sequence in {base}: expected folders SEQ/ with SEQ/gt/gt.txt (or SEQ/gt.txt) "
-            "and SEQ/seqinfo.ini"
+            "and SEQ/seqinfo.ini, or folders of them (TrackEval's gt/mot_challenge/BENCH-SPLIT/)"
         )
     return found
+
+
+def _folders(base: Path) -> list[Path]:
+    return [d for d in sorted(base.iterdir()) if d.is_dir()]
+
+
+def _sequences_in(base: Path) -> list[SequenceInfo]:
+    return [s for d in _folders(base) if (s := _sequence(d)) is not None]
+
+
+def result_file(results: PathLike, name: str) -> Path | None:
+    """The result file of sequence `name` in folder `results`, or None.
+
+    ``RESULTS/NAME.txt``, or TrackEval's ``RESULTS/data/NAME.txt`` (`results` is then
+    ``trackers/mot_challenge/BENCH-SPLIT/TRACKER``).
+    """
+    base = Path(results)
+    for path in (base / f"{name}.txt", base / "data" / f"{name}.txt"):
+        if path.is_file():
+            return path
+    return None
 
 
 # Factors tried around the box-height ratio by check_scale.

@@ -2,8 +2,10 @@
 
 Frames count from 1. Detection files use id -1. pftrack reads comma- or whitespace-separated
 files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``) and always writes 10:
-the values a file held come out unchanged, in their shortest form (``88.00`` as ``88``); values
-pftrack computed are rounded to 2 decimals (:func:`mot_text`).
+values of up to 10 significant digits (what MOTChallenge files and trackers hold) come out
+unchanged, in their shortest form (``88.00`` as ``88``); longer values are rounded to 2
+decimals (values pftrack computed) unless marked ``exact`` (values read from a file such as
+``np.savetxt``'s, written in their shortest round-trip form; :func:`mot_text`).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from pftrack.io.atomic import atomic_write
 #: Column indices of a MOTChallenge row.
 FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
 _DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 1.0, -1.0, -1.0, -1.0)
+_NAMES = ("frame", "id", "left", "top", "width", "height", "conf", "x", "y", "z")
 
 
 def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
@@ -58,7 +61,8 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         If `path` does not exist.
     ValueError
         On a malformed line, naming the file and the 1-based line number: fewer than 6 fields,
-        a non-number, a non-finite value, a frame that is not an integer in ``1..2**31-1``, a
+        a non-number, a non-finite value in any of the first 10 columns (a NaN score too), a
+        frame that is not an integer in ``1..2**31-1``, a
         negative width or height, or a box value beyond ±1e9 px. A UTF-8 byte-order mark is
         skipped.
     """
@@ -80,8 +84,12 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
             values = [float(f) for f in fields[:10]]
         except ValueError:
             raise ValueError(f"{p}:{lineno}: {what} line has a non-number: {text[:80]!r}") from None
-        if not all(np.isfinite(values[:6])):
-            raise ValueError(f"{p}:{lineno}: {what} line has a non-finite value: {text[:80]!r}")
+        bad = [c for c, v in enumerate(values) if not np.isfinite(v)]
+        if bad:  # every column is used: conf as a score, columns 8-10 written back
+            raise ValueError(
+                f"{p}:{lineno}: {what} line has a non-finite value (NaN or inf) in column "
+                f"{bad[0] + 1} ({_NAMES[bad[0]]}): {text[:80]!r}"
+            )
         frame = values[FRAME]
         if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
             raise ValueError(
@@ -124,9 +132,8 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
     if not 6 <= n <= 10:
         return None
     fr, wh = a[:, FRAME], a[:, WIDTH : HEIGHT + 1]
-    if not (
-        np.all(np.isfinite(a[:, :6])) and np.all(fr >= 1) and np.all(fr == np.floor(fr))
-    ) or np.any(wh < 0):
+    finite = bool(np.all(np.isfinite(a)))  # every column: a NaN score too
+    if not (finite and np.all(fr >= 1) and np.all(fr == np.floor(fr))) or np.any(wh < 0):
         return None
     if np.any(fr > MAX_FRAME) or np.any(np.abs(a[:, LEFT : HEIGHT + 1]) > MAX_COORD):
         return None  # the line reader names the line
@@ -173,19 +180,26 @@ def _decimals(v: F64, limit: float, most: int) -> NDArray[np.int64]:
     return d
 
 
-def _printable(a: F64) -> tuple[F64, NDArray[np.int64]]:
+#: The "decimals" code of a value written in its shortest round-trip form (``%r``).
+_REPR = 31
+
+
+def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np.int64]]:
     """The values written for columns 3-10 of `a` (M, 10) and the decimals of each.
 
     A value with at most :data:`EXACT_DIGITS` significant digits is written exactly, with the
-    fewest decimals; any other is rounded to 2 decimals as ``%.2f`` rounds it, then written
-    with the fewest decimals that value needs. So a file read back writes the same text
-    (``88.00`` is written ``88`` the first time already) and the values a file held are
-    written unchanged.
+    fewest decimals; so is any value `exact` (M, 10) marks, in its shortest round-trip form
+    (code :data:`_REPR`: ``%r``, the digits Python's ``repr`` gives) when it needs more; any
+    other is rounded to 2 decimals as ``%.2f`` rounds it, then written with the fewest
+    decimals that value needs. So a file read back writes the same text (``88.00`` is written
+    ``88`` the first time already) and the values a file held are written unchanged.
     """
     v = a[:, 2:].ravel()
     d = _decimals(v, 10.0**EXACT_DIGITS, len(_POW10) - 1)
     whole = np.abs(v) >= 2.0**52  # every such double is an integer (and v * 100 may overflow)
     d[whole & (d < 0)] = 0
+    if exact is not None:
+        d[exact[:, 2:].ravel() & (d < 0)] = _REPR
     rest = d < 0
     if rest.any():
         v = v.copy()
@@ -200,14 +214,19 @@ def _printable(a: F64) -> tuple[F64, NDArray[np.int64]]:
     return v.reshape(len(a), -1), d.reshape(len(a), -1)
 
 
-def _lines(a: F64) -> str:
+def _fmt(d: int) -> str:
+    """The ``%`` format of a value with `d` decimals (:data:`_REPR`: its shortest form)."""
+    return "%r" if d == _REPR else f"%.{d}f"
+
+
+def _lines(a: F64, exact: NDArray[np.bool_] | None = None) -> str:
     """The MOTChallenge lines of checked (M, 10) rows, in their order."""
     if not len(a):
         return ""
-    values, dec = _printable(a)
+    values, dec = _printable(a, exact)
     pattern = dec @ (np.int64(1) << (5 * np.arange(8, dtype=np.int64)))  # 5 bits a column
     fmts = {
-        int(k): ",".join(["%d", "%d"] + [f"%.{k >> 5 * j & 31}f" for j in range(8)]) + "\n"
+        int(k): ",".join(["%d", "%d"] + [_fmt(k >> 5 * j & 31) for j in range(8)]) + "\n"
         for k in np.unique(pattern).tolist()
     }
     flat = np.column_stack([a[:, :2], values]).ravel().tolist()
@@ -236,41 +255,87 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
     return a
 
 
-def mot_text(rows: NDArray[np.float64] | Iterable[Iterable[float]]) -> str:
+#: What `exact` of :func:`mot_text` and :func:`write_mot` may be.
+Exact = bool | NDArray[np.bool_] | Iterable[bool] | Iterable[Iterable[bool]]
+
+
+def _exact_mask(exact: Exact, n: int, who: str) -> NDArray[np.bool_] | None:
+    """`exact` as an (n, 10) bool mask (None: nothing marked), or a Type/ValueError."""
+    if exact is False:
+        return None
+    e = np.asarray(exact)
+    if e.dtype != np.bool_:
+        raise TypeError(f"{who}: exact must be a bool or bool array, got dtype {e.dtype}")
+    if e.ndim == 0:
+        return np.full((n, 10), bool(e))
+    if e.shape == (n,):
+        return np.repeat(e[:, None], 10, axis=1)
+    if e.ndim == 2 and e.shape[0] == n and 6 <= e.shape[1] <= 10:
+        return np.hstack([e, np.ones((n, 10 - e.shape[1]), bool)])  # defaults: short anyway
+    raise ValueError(
+        f"{who}: exact has shape {e.shape}, expected a bool, ({n},) or ({n}, 6..10) as rows"
+    )
+
+
+def mot_text(rows: NDArray[np.float64] | Iterable[Iterable[float]], *, exact: Exact = False) -> str:
     """The MOTChallenge lines :func:`write_mot` writes for `rows` (M, 6..10), in their order.
 
     Frame and id as integers; every other value exactly when it has at most
-    :data:`EXACT_DIGITS` significant digits (every value a file held), else rounded to 2
-    decimals (values pftrack computed); with the fewest decimals either way (``88``,
-    ``0.99502``, ``12.35``). So the text of what :func:`read_mot` reads of it is the same.
-    Missing columns get the defaults ``conf=1, x=y=z=-1``.
+    :data:`EXACT_DIGITS` significant digits (every value a file written with up to 10 digits
+    held), else rounded to 2 decimals (values pftrack computed); with the fewest decimals
+    either way (``88``, ``0.99502``, ``12.35``). So the text of what :func:`read_mot` reads of
+    it is the same. Missing columns get the defaults ``conf=1, x=y=z=-1``.
+
+    Parameters
+    ----------
+    rows : (M, 6..10) array_like
+        The rows.
+    exact : bool or (M,) or (M, 6..10) array_like of bool
+        Values never rounded: the marked values (True: all; (M,): whole rows; (M, K): one
+        per value of `rows`) are written exactly, those needing more than
+        :data:`EXACT_DIGITS` digits in their shortest round-trip form (``repr``:
+        ``499.1234567891234``, ``1.2345678901234567e-05``), so reading them back gives the
+        same doubles. For values read from a file (``np.savetxt``'s ``%.18e`` writes 19
+        digits): what ``pftrack recover`` and ``smooth`` pass for the values they keep.
 
     Raises
     ------
     ValueError
-        Rows not ``(M, 6..10)``, a NaN or infinite value, or a frame or id that is not an
-        integer.
+        Rows not ``(M, 6..10)``, a NaN or infinite value, a frame or id that is not an
+        integer, or `exact` of another shape.
     """
-    return _lines(_checked(rows, "mot_text"))
+    a = _checked(rows, "mot_text")
+    return _lines(a, _exact_mask(exact, len(a), "mot_text"))
 
 
-def format_mot_row(row: Iterable[float]) -> str:
+def format_mot_row(row: Iterable[float], *, exact: bool = False) -> str:
     """One MOTChallenge line (10 columns, no newline), as :func:`mot_text` writes it."""
-    return _lines(_checked([list(row)], "format_mot_row"))[:-1]
+    a = _checked([list(row)], "format_mot_row")
+    return _lines(a, _exact_mask(exact, 1, "format_mot_row"))[:-1]
 
 
-def write_mot(path: PathLike, rows: NDArray[np.float64] | Iterable[Iterable[float]]) -> None:
+def write_mot(
+    path: PathLike,
+    rows: NDArray[np.float64] | Iterable[Iterable[float]],
+    *,
+    exact: Exact = False,
+) -> None:
     """Write rows (M, 6..10) as a MOTChallenge file, atomically, sorted by (frame, id).
 
     Columns beyond those given get the defaults ``conf=1, x=y=z=-1``. Every value must be
     finite and frames and ids integers (a ValueError names the first bad row otherwise).
-    Values are written as :func:`mot_text` writes them: a value read from a file comes out
-    unchanged, in its shortest form, and writing what :func:`read_mot` reads of a written file
-    gives the same bytes.
+    Values are written as :func:`mot_text` writes them: a value of at most
+    :data:`EXACT_DIGITS` significant digits (every value of a file written with up to 10
+    digits, as MOTChallenge files and trackers write them) comes out unchanged, in its
+    shortest form, and writing what :func:`read_mot` reads of a written file gives the same
+    bytes. Longer values are rounded to 2 decimals (pftrack's computed boxes) unless marked
+    by `exact` (as in :func:`mot_text`): ``write_mot(out, read_mot(f), exact=True)`` writes
+    every value of any file unchanged.
     """
     a = _checked(rows, "write_mot")
-    a = a[np.lexsort((a[:, ID], a[:, FRAME]))]
-    text = _lines(a)
+    mask = _exact_mask(exact, len(a), "write_mot")
+    order = np.lexsort((a[:, ID], a[:, FRAME]))
+    text = _lines(a[order], None if mask is None else mask[order])
     with atomic_write(path) as fh:
         fh.write(text)
 

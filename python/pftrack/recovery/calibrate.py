@@ -191,9 +191,30 @@ class Calibration:
                 span = f"{lo}" if lo == hi else f"{lo}-{hi}"
                 mix = " + ".join(f"{w:.2f} {m}" for m, w in c.weights)
                 lines.append(
-                    f"gap length {span}: combination {mix}, validation MMAE {c.combined_mmae:.3f}"
+                    f"gap length {span}: combination {mix}, validation MMAE "
+                    f"{c.combined_mmae:.3f}{_blend_note(c)}"
                 )
         return "\n".join(lines)
+
+
+def _blend_note(c: BucketChoice) -> str:
+    """Why a blend is used: it beat the chosen method; a better part alone did not.
+
+    The blend is tested against the bucket's chosen method only (and shrunk toward it), not
+    against every candidate, so its other part alone may score lower on the validation gaps:
+    that part alone did not beat the chosen method by the paired test.
+    """
+    vals = dict(c.mmae)
+    (chosen, _), (other, _) = c.weights
+    if chosen not in vals or other not in vals or c.combined_mmae is None:
+        return ""
+    note = f"; beats {chosen} alone ({vals[chosen]:.3f}), the chosen method, by the paired test"
+    if vals[other] <= c.combined_mmae:
+        note += (
+            f"; {other} alone ({vals[other]:.3f}) did not, so it is not chosen (the blend is "
+            f"compared with {chosen}, not with every candidate)"
+        )
+    return note
 
 
 def fixed_noise_model(model: GdtModel | None = None) -> SegmentModel:

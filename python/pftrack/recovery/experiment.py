@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from pftrack._progress import progress
 from pftrack._typing import F64
+from pftrack.recovery.linking import check_unique
 from pftrack.recovery.mixture import MotionFit, fit_motion
 from pftrack.recovery.names import NEIGHBOUR_METHODS
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
@@ -59,14 +60,39 @@ class Gap:
     segment_b: F64
     truth: F64
 
+    def at_truth(self, path: F64) -> F64:
+        """The rows of `path` at the frames of the true lost points, ``(len(truth), 2)``.
+
+        `path` holds ``(x, y)`` for every frame strictly between the two segments (what the
+        recovery methods return); where the trajectory itself skips frames (ground truth with
+        holes, a tracker's output), only the frames it has are scored.
+        """
+        at = (self.truth[:, 0] - self.segment_a[-1, 0] - 1).astype(np.int64)
+        out: F64 = path[at, :2]
+        return out
+
+    def errors(self, path: F64) -> F64:
+        """Euclidean error of `path` at each true lost point, ``(len(truth),)``."""
+        d = self.at_truth(path) - self.truth[:, 1:3]
+        out: F64 = np.hypot(d[:, 0], d[:, 1])
+        return out
+
 
 def trajectories(gt: F64, point: str = "centre") -> dict[int, F64]:
     """Split ground truth into trajectories: per id, rows ``(frame, x, y)`` sorted by frame.
 
-    ``point`` is the box centre or its bottom centre (``"foot"``).
+    ``point`` is the box centre or its bottom centre (``"foot"``). A trajectory may skip
+    frames (ground truth with holes, a tracker's output): only the frames it has are scored.
+
+    Raises
+    ------
+    ValueError
+        An unknown `point`, or a (frame, id) pair given twice (read a file with
+        :func:`~pftrack.recovery.linking.read_tracks` for the lines).
     """
     if point not in ("centre", "center", "foot"):
         raise ValueError(f"trajectories: point is {point!r}, expected 'centre' or 'foot'")
+    check_unique(gt)
     out: dict[int, F64] = {}
     for tid in np.unique(gt[:, 1]).astype(int):
         r = gt[gt[:, 1] == tid]
@@ -174,8 +200,8 @@ def score(
         )  # fmt: skip
         best = min(best, time.perf_counter() - t0)
     ex, ey, ee = [], [], []
-    for g, p in zip(gaps, paths, strict=True):
-        d = p - g.truth[:, 1:3]
+    for g, p in zip(gaps, paths, strict=True):  # scored where the truth has a point
+        d = g.at_truth(p) - g.truth[:, 1:3]
         ex.append(np.abs(d[:, 0]))
         ey.append(np.abs(d[:, 1]))
         ee.append(np.hypot(d[:, 0], d[:, 1]))
@@ -573,7 +599,7 @@ def run_sequence(
         n_gaps += len(run.gaps)
         for m in methods:
             for g, p in zip(run.gaps, run.paths.get(m, []), strict=True):
-                errors[m].append(float(np.mean(np.hypot(*(p - g.truth[:, 1:3]).T))))
+                errors[m].append(float(np.mean(g.errors(p))))
     return SequenceResult(
         name,
         (float(width), float(height)),

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pftrack._typing import F64
 from pftrack.recovery.calibrate import Calibration, recover_auto
@@ -35,6 +36,7 @@ __all__ = [
     "MAX_GAP_LIMIT",
     "SIZE_CANDIDATES",
     "FillReport",
+    "copied_values",
     "fill_gaps",
     "fill_rows",
 ]
@@ -234,3 +236,29 @@ def fill_rows(
             new_rows.append(out)
     added = np.vstack(new_rows) if new_rows else np.zeros((0, 10))
     return added, FillReport(len(segs), len(added), noise, calibration, size_cal)
+
+
+def copied_values(rows: F64, filled: F64) -> NDArray[np.bool_]:
+    """Which values of `filled` (:func:`fill_gaps` of `rows`) are copies of given values.
+
+    Every value of a row of `rows` (matched by frame and id), and the ``conf`` and columns
+    8-10 of a filled row (a neighbour's ``conf``, then :data:`FILLED_MARK`); the filled boxes
+    are computed. ``write_mot(path, filled, exact=copied_values(rows, filled))`` writes the
+    given values unchanged, however many digits they have, and the computed boxes with 2
+    decimals (:func:`pftrack.io.mot.write_mot`), as ``pftrack recover`` does.
+
+    Returns
+    -------
+    (M', 10) ndarray of bool
+    """
+
+    def key(a: F64) -> NDArray[np.int64]:
+        out: NDArray[np.int64] = a[:, 0].astype(np.int64) * (1 << 32) + a[:, 1].astype(np.int64)
+        return out
+
+    f, r = np.asarray(filled, np.float64), np.asarray(rows, np.float64)
+    mask = np.zeros(f.shape, dtype=bool)
+    if len(f):
+        mask[:, 6:] = True
+        mask[np.isin(key(f), key(r)) if len(r) else np.zeros(len(f), bool)] = True
+    return mask

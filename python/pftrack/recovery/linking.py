@@ -332,8 +332,14 @@ def _bad_id_message(value: float) -> str:
     return f"track id {value:g} is not an integer with |id| <= {MAX_ID}"
 
 
-def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:
-    """Raise ValueError naming the first duplicate (frame, id) pair (and its lines if known)."""
+def check_unique(
+    rows: F64, line_numbers: Iterable[int] | None = None, path: PathLike | None = None
+) -> None:
+    """Raise ValueError naming the first duplicate (frame, id) pair (and its lines if known).
+
+    With `line_numbers` (the file's line of each row) and `path`, the message starts with
+    ``FILE:LINE:`` (the pair's second line) and names both lines.
+    """
     if len(rows) == 0:
         return
     key = rows[:, 0].astype(np.int64) * (1 << 32) + rows[:, 1].astype(np.int64)
@@ -341,32 +347,34 @@ def check_unique(rows: F64, line_numbers: Iterable[int] | None = None) -> None:
     dup = np.flatnonzero(np.diff(key[order]) == 0)
     if len(dup):
         i, j = order[dup[0]], order[dup[0] + 1]
-        where = ""
+        where = head = ""
         if line_numbers is not None:
             ln = list(line_numbers)
             where = f" (lines {ln[i]} and {ln[j]})"
+            head = "" if path is None else f"{path}:{ln[j]}: "
         raise ValueError(
-            f"duplicate rows for frame {int(rows[i, 0])}, id {int(rows[i, 1])}{where}: "
+            f"{head}duplicate rows for frame {int(rows[i, 0])}, id {int(rows[i, 1])}{where}: "
             "each (frame, id) may appear once"
         )
 
 
-def read_tracks(path: PathLike) -> F64:
+def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
     """Read a tracks file whose ids are integers and (frame, id) pairs unique (errors name lines).
 
-    :func:`pftrack.io.mot.read_mot` (``what="tracks file"``), the ids' check (``FILE:LINE``),
-    then :func:`check_unique`; the
-    file is read a second time, for its line numbers, only when a pair repeats. What
-    ``pftrack recover`` and ``pftrack smooth`` read, one file or many.
+    :func:`pftrack.io.mot.read_mot` (`what` names the file in its errors), the ids' check
+    (``FILE:LINE``), then :func:`check_unique` (``FILE:LINE: duplicate rows ...``); the file
+    is read a second time, for its line numbers, only when a pair repeats. What ``pftrack
+    recover`` and ``pftrack smooth`` read, one file or many, and ``pftrack experiment gaps``
+    its ground truth (``what="ground truth"``).
     """
     from pftrack.io.mot import data_line_numbers, read_mot
 
-    rows = read_mot(path, what="tracks file")
+    rows = read_mot(path, what=what)
     k = _first_bad_id(rows[:, 1])
     if k is not None:  # check_rows' test, with the file's line, as read_mot's own checks
         raise ValueError(f"{path}:{data_line_numbers(path)[k]}: {_bad_id_message(rows[k, 1])}")
     try:
         check_unique(rows)
     except ValueError:
-        check_unique(rows, data_line_numbers(path))
+        check_unique(rows, data_line_numbers(path), path)
     return rows

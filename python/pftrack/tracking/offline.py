@@ -120,7 +120,9 @@ class BoxSmoother:
         Returns
         -------
         (n, 4) ndarray
-            Smoothed boxes for every row. A track with no observed row comes back unchanged.
+            Smoothed boxes for every row. A track with no observed row, or whose median
+            observed height is 0 (a degenerate track: flat boxes, no scale to smooth in),
+            comes back unchanged.
         """
         fr = real_array(frames, "BoxSmoother.smooth: frames")
         with np.errstate(invalid="ignore"):  # NaN frames are refused just below
@@ -153,10 +155,8 @@ class BoxSmoother:
             return out_p
         z = xywh_to_cxcywh(b)
         height = float(np.median(b[obs, 3]))
-        if not height > 0:
-            raise ValueError(
-                f"BoxSmoother.smooth: the median observed height is {height}, expected > 0"
-            )
+        if not height > 0:  # no scale to smooth in: the track is kept as it is, as recover does
+            return np.array(b, dtype=np.float64)  # a copy
         # in track heights: the same numbers whatever the image scale (no under- or overflow)
         with np.errstate(over="ignore"):
             zh = z / height
