@@ -358,14 +358,7 @@ def oracle_ratio(masks: list[tuple[list[E.Gap], list[F64]]]) -> float:
             )
             best = min(
                 best,
-                float(
-                    np.mean(
-                        [
-                            np.hypot(*(p - g.truth[:, 1:3]).T).mean()
-                            for p, g in zip(paths, gaps, strict=True)
-                        ]
-                    )
-                ),
+                float(np.mean([g.errors(p).mean() for p, g in zip(paths, gaps, strict=True)])),
             )
         per.append(best)
     return float(np.median(per))
@@ -410,14 +403,7 @@ def median_mmae(masks: list[tuple[list[E.Gap], list[F64]]], variant: Variant) ->
     per = []
     for gaps, runs in masks:
         paths = variant(gaps, runs)
-        per.append(
-            np.mean(
-                [
-                    np.hypot(*(p - g.truth[:, 1:3]).T).mean()
-                    for p, g in zip(paths, gaps, strict=True)
-                ]
-            )
-        )
+        per.append(np.mean([g.errors(p).mean() for p, g in zip(paths, gaps, strict=True)]))
     return float(np.median(per))
 
 
@@ -431,8 +417,7 @@ def by_length(data: Path) -> None:
         bi = recover_gaps(pairs, "gdt-bi", noise=estimate_noise(E.observed_runs(trajs, p)))
         lin = recover_gaps(pairs, "linear")
         for g, pb, pl in zip(gaps, bi, lin, strict=True):
-            t = g.truth[:, 1:3]
-            rows.append((len(t), np.hypot(*(pb - t).T).mean(), np.hypot(*(pl - t).T).mean()))
+            rows.append((len(g.truth), g.errors(pb).mean(), g.errors(pl).mean()))
     a = np.array(rows)
     print(f"{len(a)} gaps; lost frames | gaps | gdt-bi mean | linear mean (px)")
     for lo, hi in [(1, 10), (10, 20), (20, 30), (30, 1000)]:
