@@ -364,6 +364,84 @@ def _n_tasks(dask_scheduler: Any) -> int:
     return len(dask_scheduler.tasks)
 
 
+#: ``python -m pftrack``, with Python's own Ctrl-C handler whatever this test run inherited (a
+#: shell without job control starts ``cmd &`` with SIGINT ignored, and children inherit that).
+_PFTRACK_WITH_CTRL_C = (
+    "import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    "runpy.run_module('pftrack', run_name='__main__', alter_sys=True)"
+)
+
+
+def _group(pgid: int) -> dict[int, str]:
+    """Live processes of process group `pgid` (zombies left out): pid -> command line."""
+    found = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:  # gone meanwhile
+            continue
+        fields = stat[stat.rindex(")") + 2 :].split()  # after "pid (comm) "
+        if int(fields[2]) == pgid and fields[0] != "Z":
+            found[int(entry.name)] = cmdline
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="lists processes in /proc")
+@pytest.mark.parametrize(("whom", "wait"), [("group", 0.0), ("group", 0.4), ("parent", 0.4)])
+def test_ctrl_c_while_the_cluster_starts_is_one_line(
+    data: Path, tmp_path: Path, whom: str, wait: float
+) -> None:
+    """Ctrl-C while the local cluster starts: exit 130, one line on stderr, no process left.
+
+    The signal is sent `wait` seconds after the first worker process appears, while the
+    workers start Python and import Dask (a second or more): to the whole process group, as
+    a terminal does (the workers are in it), or to the batch process alone.
+    """
+    out = tmp_path / "out"
+    argv = [sys.executable, "-c", _PFTRACK_WITH_CTRL_C, "batch", str(data), "--out", str(out),
+            "--workers", "2", *FAST]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.Popen(
+        argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while proc.poll() is None and time.monotonic() < deadline:
+            if any("spawn_main" in cmd for cmd in _group(proc.pid).values()):
+                break  # a worker process is starting
+            time.sleep(0.01)
+        time.sleep(wait)
+        assert proc.poll() is None, proc.communicate()[1].decode()
+        if whom == "group":
+            os.killpg(proc.pid, signal.SIGINT)
+        else:
+            proc.send_signal(signal.SIGINT)
+        _, stderr = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    text = stderr.decode()
+    assert proc.returncode == 130, text
+    assert text.splitlines() == [
+        "pftrack batch: interrupted; the outputs written so far are complete (re-run to "
+        "finish the rest)"
+    ]
+    deadline = time.monotonic() + 20  # the workers end with the cluster, closed on the way out
+    while _group(proc.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _group(proc.pid) == {}
+    # nothing half-written: the folder is made once the cluster runs; every output is whole
+    names = sorted(p.name for p in out.iterdir()) if out.exists() else []
+    for name in names:
+        assert name == "summary.json" or name.endswith((".txt", ".json")), names
+        if name.endswith(".json") and name != "summary.json":
+            assert name.replace(".json", ".txt") in names
+
+
 def test_cli_interrupt_exits_130(
     data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

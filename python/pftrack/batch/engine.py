@@ -21,6 +21,7 @@ import json
 import logging
 import math
 import os
+import signal
 import time
 import traceback
 import warnings
@@ -291,21 +292,54 @@ def dask_client(
             yield c
         return
     n = n_workers if n_workers is not None else (os.cpu_count() or 1)
-    with (
-        dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}),
-        LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks (Ctrl-C)
-            dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not 8787:
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # several batches at once
-        ) as cluster,
-        Client(cluster) as c,
-    ):
-        c.register_plugin(SingleThreaded(ignore_interrupt=True))
+    with contextlib.ExitStack() as stack:
+        with _ctrl_c_held():  # the cluster starts whole, its workers deaf to the terminal's Ctrl-C
+            stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
+            cluster = stack.enter_context(
+                LocalCluster(
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    host="127.0.0.1",
+                    silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks
+                    dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not
+                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # 8787: many batches
+                )
+            )
+            c = stack.enter_context(Client(cluster))
+            c.register_plugin(SingleThreaded(ignore_interrupt=True))
+        # a Ctrl-C held while the cluster started is raised on leaving _ctrl_c_held: the stack
+        # then closes the client and the whole cluster
         yield c
+
+
+@contextlib.contextmanager
+def _ctrl_c_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) in this thread meanwhile; a Ctrl-C held is raised at the end.
+
+    While a local cluster starts: a ``KeyboardInterrupt`` in the middle would leave it half
+    started (nannies that fail to start, Dask's exit hook asserting on the cluster's state, a
+    traceback each). And the threads started meanwhile (Dask's event loop, then the threads
+    that spawn the worker processes) inherit the blocked signal, as do the worker processes
+    they spawn (a signal mask survives fork and exec): the workers, in the terminal's process
+    group, never see its Ctrl-C, not even while Python starts in them. This process, whose main
+    thread unblocks it here, cancels the tasks and closes the cluster instead.
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
+        yield
+        return
+    # multiprocessing's resource tracker, started with the first worker process, unblocks
+    # SIGINT in the thread that starts it (resource_tracker.ensure_running): started now,
+    # before the hold, it is not started again in the thread that spawns the workers
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        # unblocking delivers a held SIGINT at once: KeyboardInterrupt raised from here
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:
