@@ -494,6 +494,38 @@ def test_nested_settings_are_checked(changes, match):
         _lifecycle(**changes)
 
 
+def test_no_track_warning_names_min_hits_when_tracks_started():
+    # was "the highest detection confidence was 0.9 (min_conf 0, birth_score 0.9)": the box
+    # started a track (id 1 every frame), dropped for having fewer than min_hits matches
+    frame = np.zeros((120, 160, 3), np.uint8)
+    frame[40:80, 60:80] = (0, 0, 255)
+    tracker = pftrack.Tracker(refine=False)
+    box = np.array([[60.0, 40.0, 80.0, 80.0, 0.9]])
+    assert [tracker.update(box, frame)[0, 4] for _ in range(3)] == [1, 1, 1]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught]
+    assert said == [
+        "no track over 3 frames: 1 track started but none reached min_hits=4 matched frames "
+        "(shorter tracks are left out)"
+    ]
+
+
+def test_no_track_warning_of_the_built_in_detector_blames_it():
+    # was "no external detection was given", which the user never meant to give
+    tracker = pftrack.Tracker(seed=0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(5):
+            tracker.update(None, np.full((60, 80, 3), 90, np.uint8))
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert said == [
+        "no track over 5 frames: the built-in detector found no object (no detection was given)"
+    ]
+
+
 @pytest.mark.parametrize(
     ("where", "hint"),
     [
