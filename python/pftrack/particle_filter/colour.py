@@ -179,7 +179,9 @@ def _histograms(hists: ArrayLike, fn: str) -> NDArray[np.float64]:
             f"{fn}: hists row {row} sum is not finite (overflow: the counts are finite but "
             "their total exceeds the largest double, 1.8e308; scale them down)"
         )
-    return np.divide(h, total, out=np.zeros_like(h), where=total > 0)
+    out = np.zeros_like(h)
+    np.divide(h, total, out=out, where=total > 0)
+    return out
 
 
 def _reference(ref: ArrayLike, fn: str) -> NDArray[np.float64]:
