@@ -323,6 +323,50 @@ def test_an_unreachable_scheduler_writes_nothing(
     assert {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()} == before
 
 
+def test_progress_counts_frames_within_the_sequences(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The bar was per sequence: a long sequence sat at 0/1 with no time left. It counts the
+    frames of all the sequences (3 x 30 here: their lengths are known) as they are tracked."""
+    from pftrack import _progress
+
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(_progress, "_quiet", False)
+    seen: list[int] = []
+    real_set = _progress.Bar.set
+    monkeypatch.setattr(_progress.Bar, "set", lambda bar, n: (seen.append(n), real_set(bar, n)))
+    options = TrackOptions(config=_config())
+    track_many(data, tmp_path / "out", options=options, n_workers=0, show_progress=True)
+    err = capsys.readouterr().err
+    assert "3/3 sequences" in err and "90/90" in err and "frame/s" in err
+    assert len(seen) >= 90 and seen == sorted(seen)  # frame by frame, within each sequence
+    assert len(set(seen) - {30, 60, 90}) > 80
+
+
+def test_tasks_on_workers_report_their_frames(client: Any, data: Path) -> None:
+    """On Dask, each task sends its frame count to the client as events on a topic."""
+    from pftrack.batch.engine import call_task
+    from pftrack.batch.tasks import sequence_length, track_sequence
+
+    (seq,) = [s for s in find_sequences(data) if s.name == "walk"]
+    assert sequence_length(seq) == 30
+    got: list[Any] = []
+    topic = f"pftrack-test-{os.urandom(4).hex()}"
+    client.subscribe_topic(topic, lambda event: got.append(event[1]))
+    try:
+        options = TrackOptions(config=_config())
+        fut = client.submit(call_task, track_sequence, (seq, options), (topic, "walk"), pure=False)
+        result, error, _ = fut.result()
+        assert error is None and result is not None
+        deadline = time.monotonic() + 10
+        while not got and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        client.unsubscribe_topic(topic)
+    assert got and list(got[0]) == ["walk", 1]  # the first frame at once, then twice a second
+    assert all(0 < n <= 30 for _, n in got)
+
+
 @pytest.fixture
 def ctrl_c_raises() -> Iterator[None]:
     """Python's own Ctrl-C handler while the test runs, whatever the test run inherited.
