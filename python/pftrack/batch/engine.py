@@ -646,11 +646,7 @@ def run_jobs(
     desc = "sequences" if kind == "track" else "files"
     bar = {"total": len(pending), "desc": desc, "enable": show_progress}
     frames: _Frames | None = None
-    if pending and enabled(show_progress) and all(job.count is not None for job in pending):
-        frames = _Frames(pending, desc, show_progress)  # frames over all sequences
     with contextlib.ExitStack() as stack:
-        if frames is not None:
-            stack.enter_context(frames.bar)
         c = None
         if on_dask:  # connected (or the local cluster started) before --out is touched
             n = n_workers if n_workers is not None else (os.cpu_count() or 1)
@@ -661,6 +657,9 @@ def run_jobs(
             given = None if client is not None else scheduler_address(scheduler)
             reported = str(info.get("address")) if info.get("address") else None
             summary.scheduler = given or reported  # the user's spelling of the address
+        if pending and enabled(show_progress) and all(job.count is not None for job in pending):
+            # frames over all sequences; the clock starts once the cluster runs
+            frames = stack.enter_context(_Frames(pending, desc, show_progress))
         _make_out_dir(out)
         try:
             if c is not None:
@@ -721,6 +720,12 @@ class _Frames:
         """A Dask event ``(time, [name, n])`` from a worker's task."""
         name, n = event[1]
         self.report(str(name), int(n))
+
+    def __enter__(self) -> _Frames:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.bar.close()
 
     def finish(self, name: str) -> None:
         """Task `name` is over (done, failed or cancelled)."""
