@@ -41,6 +41,61 @@ def test_import_pftrack_loads_no_wing() -> None:
     assert out.stdout.strip() == "[]"
 
 
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+
+
+def _dotted_names() -> list[str]:
+    """Every public ``pftrack.x.y`` the README and docs/*.md write (not a file name)."""
+    found = set()
+    for doc in DOCS:
+        for m in re.finditer(r"(?<![\w/.])pftrack(\.[A-Za-z_]\w*)+", doc.read_text()):
+            parts = m.group(0).split(".")
+            if not any(p.startswith("_") and p != "__all__" for p in parts[1:]):
+                found.add(m.group(0))
+    return sorted(found - {"pftrack.yaml"})  # ~/.config/dask/pftrack.yaml
+
+
+def test_documented_dotted_names_resolve_after_a_bare_import() -> None:
+    """``pftrack.batch.track_many`` and ``pftrack.recovery.filled_mask`` were AttributeErrors.
+
+    In a fresh interpreter: nothing but ``import pftrack`` before; Dask, SciPy and Matplotlib
+    are not loaded by the import itself.
+    """
+    names = _dotted_names()
+    assert {"pftrack.batch.track_many", "pftrack.recovery.filled_mask"} <= set(names)
+    code = (
+        "import functools, sys, pftrack\n"
+        "heavy = [m for m in sys.modules if m.split('.')[0] in "
+        "('dask', 'distributed', 'scipy', 'matplotlib')]\n"
+        "print('heavy', sorted(heavy))\n"
+        "for name in sys.argv[1:]:\n"
+        "    try:\n"
+        "        functools.reduce(getattr, name.split('.')[1:], pftrack)\n"
+        "    except AttributeError as exc:\n"
+        "        print('missing', name, exc)\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code, *names], capture_output=True, text=True, check=True
+    )
+    assert out.stdout.splitlines() == ["heavy []"]
+
+
+def test_subpackages_load_on_first_use_only() -> None:
+    code = (
+        "import sys, pftrack; before = 'pftrack.batch' in sys.modules; "
+        "pftrack.batch.track_many; "
+        "print(before, 'batch' in dir(pftrack), "
+        "sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False True []"  # Dask itself waits for a batch to run
+    with pytest.raises(AttributeError, match="no_such_module"):
+        pftrack.no_such_module  # noqa: B018
+    with pytest.raises(AttributeError, match="_private"):
+        pftrack._private  # noqa: B018
+
+
 def test_cli_parser_loads_no_scipy() -> None:
     """``pftrack --help`` builds every sub-command's parser without loading a method.
 
@@ -85,12 +140,17 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         "reveal_type(pftrack.read_mot)\n"
         "reveal_type(pftrack.FrameSource('x').fps)\n"
         "pftrack.fill_gaps(1, method=2)\n"
+        "pftrack.batch.track_many(1)\n"
+        "reveal_type(pftrack.recovery.filled_mask)\n"
     )
     out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
     assert status == 1, out  # the bad call is caught, so the names are not Any
     assert 'Revealed type is "def (path: ' in out
     assert 'Revealed type is "float"' in out or 'Revealed type is "builtins.float"' in out
     assert 'Argument "method" to "fill_gaps" has incompatible type "int"' in out
+    # the subpackages too (pftrack.batch.track_many was Any)
+    assert 'Argument 1 to "track_many" has incompatible type "int"' in out
+    assert 'Revealed type is "def (rows: ' in out, out
 
 
 API_DOC = Path(__file__).resolve().parents[1] / "docs" / "api.md"

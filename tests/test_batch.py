@@ -323,6 +323,50 @@ def test_an_unreachable_scheduler_writes_nothing(
     assert {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()} == before
 
 
+def test_progress_counts_frames_within_the_sequences(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The bar was per sequence: a long sequence sat at 0/1 with no time left. It counts the
+    frames of all the sequences (3 x 30 here: their lengths are known) as they are tracked."""
+    from pftrack import _progress
+
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(_progress, "_quiet", False)
+    seen: list[int] = []
+    real_set = _progress.Bar.set
+    monkeypatch.setattr(_progress.Bar, "set", lambda bar, n: (seen.append(n), real_set(bar, n)))
+    options = TrackOptions(config=_config())
+    track_many(data, tmp_path / "out", options=options, n_workers=0, show_progress=True)
+    err = capsys.readouterr().err
+    assert "3/3 sequences" in err and "90/90" in err and "frame/s" in err
+    assert len(seen) >= 90 and seen == sorted(seen)  # frame by frame, within each sequence
+    assert len(set(seen) - {30, 60, 90}) > 80
+
+
+def test_tasks_on_workers_report_their_frames(client: Any, data: Path) -> None:
+    """On Dask, each task sends its frame count to the client as events on a topic."""
+    from pftrack.batch.engine import call_task
+    from pftrack.batch.tasks import sequence_length, track_sequence
+
+    (seq,) = [s for s in find_sequences(data) if s.name == "walk"]
+    assert sequence_length(seq) == 30
+    got: list[Any] = []
+    topic = f"pftrack-test-{os.urandom(4).hex()}"
+    client.subscribe_topic(topic, lambda event: got.append(event[1]))
+    try:
+        options = TrackOptions(config=_config())
+        fut = client.submit(call_task, track_sequence, (seq, options), (topic, "walk"), pure=False)
+        result, error, _ = fut.result()
+        assert error is None and result is not None
+        deadline = time.monotonic() + 10
+        while not got and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        client.unsubscribe_topic(topic)
+    assert got and list(got[0]) == ["walk", 1]  # the first frame at once, then twice a second
+    assert all(0 < n <= 30 for _, n in got)
+
+
 @pytest.fixture
 def ctrl_c_raises() -> Iterator[None]:
     """Python's own Ctrl-C handler while the test runs, whatever the test run inherited.
@@ -362,6 +406,84 @@ def _slow(k: int) -> TaskResult:
 
 def _n_tasks(dask_scheduler: Any) -> int:
     return len(dask_scheduler.tasks)
+
+
+#: ``python -m pftrack``, with Python's own Ctrl-C handler whatever this test run inherited (a
+#: shell without job control starts ``cmd &`` with SIGINT ignored, and children inherit that).
+_PFTRACK_WITH_CTRL_C = (
+    "import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    "runpy.run_module('pftrack', run_name='__main__', alter_sys=True)"
+)
+
+
+def _group(pgid: int) -> dict[int, str]:
+    """Live processes of process group `pgid` (zombies left out): pid -> command line."""
+    found = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:  # gone meanwhile
+            continue
+        fields = stat[stat.rindex(")") + 2 :].split()  # after "pid (comm) "
+        if int(fields[2]) == pgid and fields[0] != "Z":
+            found[int(entry.name)] = cmdline
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="lists processes in /proc")
+@pytest.mark.parametrize(("whom", "wait"), [("group", 0.0), ("group", 0.4), ("parent", 0.4)])
+def test_ctrl_c_while_the_cluster_starts_is_one_line(
+    data: Path, tmp_path: Path, whom: str, wait: float
+) -> None:
+    """Ctrl-C while the local cluster starts: exit 130, one line on stderr, no process left.
+
+    The signal is sent `wait` seconds after the first worker process appears, while the
+    workers start Python and import Dask (a second or more): to the whole process group, as
+    a terminal does (the workers are in it), or to the batch process alone.
+    """
+    out = tmp_path / "out"
+    argv = [sys.executable, "-c", _PFTRACK_WITH_CTRL_C, "batch", str(data), "--out", str(out),
+            "--workers", "2", *FAST]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.Popen(
+        argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while proc.poll() is None and time.monotonic() < deadline:
+            if any("spawn_main" in cmd for cmd in _group(proc.pid).values()):
+                break  # a worker process is starting
+            time.sleep(0.01)
+        time.sleep(wait)
+        assert proc.poll() is None, proc.communicate()[1].decode()
+        if whom == "group":
+            os.killpg(proc.pid, signal.SIGINT)
+        else:
+            proc.send_signal(signal.SIGINT)
+        _, stderr = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    text = stderr.decode()
+    assert proc.returncode == 130, text
+    assert text.splitlines() == [
+        "pftrack batch: interrupted; the outputs written so far are complete (re-run to "
+        "finish the rest)"
+    ]
+    deadline = time.monotonic() + 20  # the workers end with the cluster, closed on the way out
+    while _group(proc.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _group(proc.pid) == {}
+    # nothing half-written: the folder is made once the cluster runs; every output is whole
+    names = sorted(p.name for p in out.iterdir()) if out.exists() else []
+    for name in names:
+        assert name == "summary.json" or name.endswith((".txt", ".json")), names
+        if name.endswith(".json") and name != "summary.json":
+            assert name.replace(".json", ".txt") in names
 
 
 def test_cli_interrupt_exits_130(

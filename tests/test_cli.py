@@ -763,6 +763,23 @@ def test_a_batch_without_dask_says_how_to_install_it(
     assert err.count("\n") == 1 and not out.exists()  # nothing run, not even --out created
 
 
+def test_a_one_frame_video_with_detections_blames_min_hits(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = make_scene(n_frames=1, width=160, height=120, n_walkers=1, rng=0)
+    scene.write_video(tmp_path / "one.avi")
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 0.9
+    write_mot(tmp_path / "det.txt", det)
+    argv = ["-q", "track", str(tmp_path / "one.avi"), "--detections", str(tmp_path / "det.txt")]
+    assert main([*argv, "--out", str(tmp_path / "t.txt")]) == 0
+    # was: "the highest detection confidence was 0.9 (min_conf 0, birth_score 0.9)"
+    assert capsys.readouterr().err == (
+        "pftrack track: warning: no track over 1 frame: 1 track started but none reached "
+        "min_hits=4 matched frames (shorter tracks are left out)\n"
+    )
+
+
 def test_an_empty_detection_file_is_said_to_be_empty(
     video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -53,3 +53,19 @@ def test_total_defaults_to_the_length(monkeypatch: pytest.MonkeyPatch) -> None:
     err.truncate(0)
     assert list(progress(iter([1, 2, 3]), enable=True)) == [1, 2, 3]
     assert "3it" in err.getvalue()  # unknown total: the count alone
+
+
+def test_bar_moved_by_hand(monkeypatch: pytest.MonkeyPatch) -> None:
+    err = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", err)
+    with _progress.Bar(120, desc="0/2 sequences", enable=True, unit="frame") as bar:
+        assert bar.enabled
+        bar.set(50)
+        bar.set(120)
+        bar.describe("2/2 sequences")
+    assert "2/2 sequences" in err.getvalue() and "120/120" in err.getvalue()
+    set_quiet(True)
+    with _progress.Bar(10, enable=True) as bar:
+        assert not bar.enabled
+        bar.set(5)  # nothing drawn, no error
+    set_quiet(False)

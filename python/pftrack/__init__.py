@@ -17,6 +17,9 @@ The public API, importable from the top level; each name loads its module on fir
 - kernels: :class:`ColourParticleFilter`, :func:`systematic_resample`, :func:`hsv_bins`,
   :func:`box_histograms`, :func:`bhattacharyya_weights`;
 - :func:`make_scene`, a synthetic scene with known truth.
+
+Subpackages and modules are attributes too, loaded on first use like the names above:
+``pftrack.batch.track_many``, ``pftrack.recovery.filled_mask``, ``pftrack.io.video``.
 """
 
 from __future__ import annotations
@@ -35,6 +38,22 @@ if importlib.util.find_spec("pftrack._core") is None:  # pragma: no cover - only
     )
 
 if TYPE_CHECKING:
+    # the subpackages and modules, for type checkers: at run time __getattr__ loads them
+    from pftrack import assignment as assignment
+    from pftrack import batch as batch
+    from pftrack import boxes as boxes
+    from pftrack import cli as cli
+    from pftrack import demo as demo
+    from pftrack import detection as detection
+    from pftrack import eval as eval
+    from pftrack import integrations as integrations
+    from pftrack import io as io
+    from pftrack import kalman as kalman
+    from pftrack import particle_filter as particle_filter
+    from pftrack import recovery as recovery
+    from pftrack import render as render
+    from pftrack import synthetic as synthetic
+    from pftrack import tracking as tracking
     from pftrack.eval import MotMetrics, evaluate_mot, format_metrics
     from pftrack.io.mot import read_mot, write_mot
     from pftrack.io.video import FrameSource, SequenceInfo, read_seqinfo

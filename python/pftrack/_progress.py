@@ -6,8 +6,9 @@
 from __future__ import annotations
 
 import sys
+import threading
 from collections.abc import Iterable, Iterator
-from typing import TypeVar
+from typing import Any, TypeVar
 
 T = TypeVar("T")
 
@@ -75,3 +76,70 @@ def progress(
         delay=DELAY,
     ) as bar:
         yield from bar
+
+
+class Bar:
+    """A bar moved by hand (:meth:`set`), from any thread; draws nothing when disabled.
+
+    For progress that does not come from one loop: the frames of a batch's sequences, reported
+    by the tasks as they run. Drawn as :func:`progress` draws, once :data:`DELAY` has passed.
+
+    Parameters
+    ----------
+    total : int, optional
+        The count at the end (None: only the count, time and rate are shown).
+    desc : str
+        Label in front of the bar (:meth:`describe` changes it).
+    enable : bool, optional
+        As :func:`progress`'s.
+    unit : str
+        What one count is.
+    """
+
+    def __init__(
+        self, total: int | None, *, desc: str = "", enable: bool | None = None, unit: str = "it"
+    ) -> None:
+        self._bar: Any = None
+        self._lock = threading.Lock()
+        if enabled(enable):
+            from tqdm import tqdm
+
+            self._bar = tqdm(
+                total=total,
+                desc=desc,
+                unit=unit,
+                file=sys.stderr,
+                dynamic_ncols=True,
+                mininterval=0.2,
+                smoothing=0.1,
+                delay=DELAY,
+            )
+
+    @property
+    def enabled(self) -> bool:
+        """Whether the bar is drawn."""
+        return self._bar is not None
+
+    def set(self, n: int) -> None:
+        """Move the bar to count `n`."""
+        if self._bar is not None:
+            with self._lock:
+                self._bar.update(n - self._bar.n)
+
+    def describe(self, desc: str) -> None:
+        """Change the label."""
+        if self._bar is not None:
+            with self._lock:
+                self._bar.set_description_str(desc, refresh=False)
+
+    def close(self) -> None:
+        """Remove the bar from the terminal's last line (it is left drawn)."""
+        if self._bar is not None:
+            with self._lock:
+                self._bar.close()
+
+    def __enter__(self) -> Bar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

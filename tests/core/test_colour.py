@@ -182,12 +182,60 @@ def test_bhattacharyya_kernels_match_reference(rng):
     np.testing.assert_allclose(
         bhattacharyya_distance(hists, r), ref.bhattacharyya_distance(hists, r), rtol=1e-10
     )
-    for lam in (0.0, 1.0, 20.0, 1e4):
+    for lam in (1.0, 20.0, 1e4):
         w = bhattacharyya_weights(hists, r, lam)
         np.testing.assert_allclose(
             w, ref.bhattacharyya_weights(hists, r, lam), rtol=1e-9, atol=1e-300
         )
         assert w.sum() == pytest.approx(1.0)
+
+
+def test_histogram_rows_are_normalised_as_the_reference(rng):
+    """``H*2`` gave other weights than ``H``, integer counts near-uniform ones: only `ref` was
+    normalised. Each row of `hists` is now normalised too (by the public functions)."""
+    hists = rng.random((4, 110))
+    hists /= hists.sum(axis=1, keepdims=True)
+    r = rng.random(110)
+    want = bhattacharyya_weights(hists, r)
+    counts = np.round(hists * rng.integers(50, 5000, size=(4, 1)))  # pixel counts, per box
+    np.testing.assert_allclose(bhattacharyya_weights(hists * 2, r), want, rtol=1e-12)
+    np.testing.assert_allclose(
+        bhattacharyya_weights(counts, r),
+        ref.bhattacharyya_weights(counts / counts.sum(axis=1, keepdims=True), r),
+        rtol=1e-9,
+    )
+    np.testing.assert_allclose(
+        bhattacharyya_coefficient(hists * 7, r), ref.bhattacharyya_coefficient(hists, r), rtol=1e-12
+    )
+    np.testing.assert_allclose(
+        bhattacharyya_distance(counts.astype(np.int64), r * 3),
+        ref.bhattacharyya_distance(counts / counts.sum(axis=1, keepdims=True), r),
+        rtol=1e-9,
+    )
+    zero = bhattacharyya_distance(np.vstack([np.zeros(110), hists[0]]), r)
+    assert zero[0] == 1.0  # a box with no pixel counted: rho 0
+    with pytest.raises(ValueError, match=r"hists row 1 sum is not finite \(overflow"):
+        bhattacharyya_weights(np.vstack([hists[0], np.full(110, 1e307)]), r)
+
+
+@pytest.mark.parametrize(
+    ("lam", "error", "match"),
+    [
+        ("20", TypeError, "lam must be a real number, got str '20'"),
+        (None, TypeError, "lam must be a real number, got NoneType"),
+        (True, TypeError, "lam must be a real number, got bool"),
+        (1j, TypeError, "lam must be a real number, got complex"),
+        (0, ValueError, "lam is 0, expected a finite number > 0"),
+        (-1.0, ValueError, "lam is -1.0"),
+        (float("nan"), ValueError, "lam is nan"),
+        (float("inf"), ValueError, "lam is inf"),
+    ],
+)
+def test_weights_lambda_is_checked(lam, error, match):
+    h = np.full((2, 4), 0.25)
+    with pytest.raises(error, match=f"bhattacharyya_weights: {match}"):
+        bhattacharyya_weights(h, np.ones(4), lam=lam)
+    assert bhattacharyya_weights(h, np.ones(4), lam=np.float32(3)).shape == (2,)
 
 
 def test_weights_are_stable_for_huge_lambda(rng):

@@ -102,8 +102,12 @@ def test_likelihood_bad_inputs():
         bad = h.copy()
         bad[1, 2] = np.nan
         bhattacharyya_weights(bad, np.ones(4))
-    with pytest.raises(ValueError, match="lambda is -1"):
+    with pytest.raises(ValueError, match="lam is -1"):
         bhattacharyya_weights(h, np.ones(4), lam=-1)
+    with pytest.raises(ValueError, match="lambda is -1"):  # the core's own check
+        _core.bhattacharyya_weights(h, np.ones(4), -1.0)
+    with pytest.raises(TypeError, match="hists must hold real numbers"):
+        bhattacharyya_weights(h.astype(complex), np.ones(4))
 
 
 def test_propagate_bad_inputs():

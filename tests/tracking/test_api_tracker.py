@@ -6,6 +6,7 @@ import dataclasses
 import itertools
 import re
 import warnings
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -89,6 +90,38 @@ def test_documented_loop_is_the_cli_byte_for_byte(name, tmp_path):
     a = evaluate_mot(gt, read_mot(api_out), scale=scale)
     b = evaluate_mot(gt, read_mot(cli_out), scale=scale)
     assert (a.mota, a.idf1) == (b.mota, b.idf1)
+
+
+README = Path(__file__).resolve().parents[2] / "README.md"
+
+
+def _readme_loops() -> tuple[str, str]:
+    """The README's two drop-in loops: with a detector's boxes, and with the built-in one."""
+    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), re.S)
+    first = next(b for b in blocks if "tracker.prime(itertools.islice(" in b)
+    built_in = next(b for b in blocks if "bootstrap_frames(" in b and "update(None" in b)
+    return first, built_in
+
+
+@pytest.mark.parametrize("which", ["built-in", "first"])
+def test_readme_loop_with_the_built_in_detector_is_the_cli(which, tmp_path):
+    """The README said its loop (the first 30 frames primed) is what ``pftrack track`` does;
+    with the built-in detector the command primes with 30 frames spread over the file (4519
+    boxes against 4507 on PETS09). Its second loop is the command; its first, with
+    ``dets=None``, is ``--bootstrap first``. Run as the README writes them."""
+    scene = make_scene(n_frames=80, width=192, height=144, n_walkers=3, rng=1)
+    video = tmp_path / "video.avi"
+    scene.write_video(video)
+    first, built_in = _readme_loops()
+    code = built_in if which == "built-in" else first
+    code = code.replace("my_detector(frame)", "None").replace("tracker.reset()", "")
+    namespace: dict[str, object] = {}
+    exec(code.replace('"video.avi"', repr(str(video))), namespace)  # noqa: S102 - the README's
+    write_mot(tmp_path / "api.txt", namespace["rows"])
+    argv = ["-q", "track", str(video), "--out", str(tmp_path / "cli.txt")]
+    assert main(argv if which == "built-in" else [*argv, "--bootstrap", "first"]) == 0
+    cli = (tmp_path / "cli.txt").read_bytes()
+    assert len(cli) > 0 and (tmp_path / "api.txt").read_bytes() == cli
 
 
 # -- update's output ------------------------------------------------------------------------
@@ -492,6 +525,38 @@ def test_amodal_settings_are_checked(changes, match):
 def test_nested_settings_are_checked(changes, match):
     with pytest.raises(ValueError, match=match):
         _lifecycle(**changes)
+
+
+def test_no_track_warning_names_min_hits_when_tracks_started():
+    # was "the highest detection confidence was 0.9 (min_conf 0, birth_score 0.9)": the box
+    # started a track (id 1 every frame), dropped for having fewer than min_hits matches
+    frame = np.zeros((120, 160, 3), np.uint8)
+    frame[40:80, 60:80] = (0, 0, 255)
+    tracker = pftrack.Tracker(refine=False)
+    box = np.array([[60.0, 40.0, 80.0, 80.0, 0.9]])
+    assert [tracker.update(box, frame)[0, 4] for _ in range(3)] == [1, 1, 1]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught]
+    assert said == [
+        "no track over 3 frames: 1 track started but none reached min_hits=4 matched frames "
+        "(shorter tracks are left out)"
+    ]
+
+
+def test_no_track_warning_of_the_built_in_detector_blames_it():
+    # was "no external detection was given", which the user never meant to give
+    tracker = pftrack.Tracker(seed=0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(5):
+            tracker.update(None, np.full((60, 80, 3), 90, np.uint8))
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert said == [
+        "no track over 5 frames: the built-in detector found no object (no detection was given)"
+    ]
 
 
 @pytest.mark.parametrize(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import threading
@@ -29,9 +30,12 @@ class SingleThreaded(WorkerPlugin):
     Parameters
     ----------
     ignore_interrupt : bool
-        Ignore SIGINT in the worker: for the local cluster of a run, whose workers share the
-        terminal's process group, so that Ctrl-C reaches only the client, which cancels the
-        tasks and closes the cluster (instead of every worker printing a traceback).
+        For the local cluster of a run, whose workers share the terminal's process group, so
+        that Ctrl-C reaches only the client, which cancels the tasks and closes the cluster
+        (instead of every worker printing a traceback): ignore SIGINT in the worker (its
+        process also starts with SIGINT blocked: :func:`pftrack.batch.dask_client`), and
+        silence the worker's Dask logs once it closes (a heartbeat cut short by the close of
+        its connections, a task cancelled in the middle: Dask logs either as an error).
     """
 
     idempotent = True
@@ -61,3 +65,8 @@ class SingleThreaded(WorkerPlugin):
 
         if self.ignore_interrupt and threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def teardown(self, worker: Any) -> None:
+        """The worker closes: from now on, its Dask logs are silent (local cluster only)."""
+        if self.ignore_interrupt:
+            logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -13,6 +14,7 @@ from pftrack.batch.tasks import (
     SmoothOptions,
     TrackOptions,
     recover_file,
+    sequence_length,
     smooth_file,
     track_sequence,
 )
@@ -58,7 +60,11 @@ def track_many(
     force : bool
         Redo sequences whose outputs are already complete.
     show_progress : bool, optional
-        Progress bar over sequences (default: when stderr is a terminal).
+        Progress bar on stderr (default: when stderr is a terminal): the frames tracked over
+        all the sequences, with the time left where every sequence's length is known (a
+        video's header, an image folder; else the count and rate), and the sequences done.
+        The tasks report their frames as they go, from Dask workers too (as Dask events,
+        twice a second at most).
 
     Returns
     -------
@@ -68,7 +74,10 @@ def track_many(
     """
     opts = options if options is not None else TrackOptions()
     seqs = find_sequences(inputs)
-    jobs = [Job(s.name, track_sequence, (s, opts), s.files) for s in seqs]
+    jobs = [
+        Job(s.name, track_sequence, (s, opts), s.files, functools.partial(sequence_length, s))
+        for s in seqs
+    ]
     return run_jobs(
         jobs,
         Path(out_dir),

@@ -21,6 +21,8 @@ import json
 import logging
 import math
 import os
+import signal
+import threading
 import time
 import traceback
 import warnings
@@ -29,8 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from pftrack._progress import progress
-from pftrack.batch.tasks import TaskResult
+from pftrack._progress import Bar, enabled, progress
+from pftrack.batch.tasks import TaskResult, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
@@ -65,12 +67,17 @@ class Job:
         Its arguments (picklable).
     reads : tuple of Path
         Files and folders the task reads (outputs may not be one of them).
+    count : callable, optional
+        For the progress bar: returns how many frames the task will report (through
+        :func:`~pftrack.batch.tasks.reporting_frames`), None if unknown. Called on the client
+        before the tasks run, and only when a bar is drawn.
     """
 
     name: str
     func: Callable[..., TaskResult]
     args: tuple[Any, ...]
     reads: tuple[Path, ...]
+    count: Callable[[], int | None] | None = None
 
 
 @dataclass
@@ -291,21 +298,54 @@ def dask_client(
             yield c
         return
     n = n_workers if n_workers is not None else (os.cpu_count() or 1)
-    with (
-        dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}),
-        LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks (Ctrl-C)
-            dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not 8787:
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # several batches at once
-        ) as cluster,
-        Client(cluster) as c,
-    ):
-        c.register_plugin(SingleThreaded(ignore_interrupt=True))
+    with contextlib.ExitStack() as stack:
+        with _ctrl_c_held():  # the cluster starts whole, its workers deaf to the terminal's Ctrl-C
+            stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
+            cluster = stack.enter_context(
+                LocalCluster(
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    host="127.0.0.1",
+                    silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks
+                    dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not
+                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # 8787: many batches
+                )
+            )
+            c = stack.enter_context(Client(cluster))
+            c.register_plugin(SingleThreaded(ignore_interrupt=True))
+        # a Ctrl-C held while the cluster started is raised on leaving _ctrl_c_held: the stack
+        # then closes the client and the whole cluster
         yield c
+
+
+@contextlib.contextmanager
+def _ctrl_c_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) in this thread meanwhile; a Ctrl-C held is raised at the end.
+
+    While a local cluster starts: a ``KeyboardInterrupt`` in the middle would leave it half
+    started (nannies that fail to start, Dask's exit hook asserting on the cluster's state, a
+    traceback each). And the threads started meanwhile (Dask's event loop, then the threads
+    that spawn the worker processes) inherit the blocked signal, as do the worker processes
+    they spawn (a signal mask survives fork and exec): the workers, in the terminal's process
+    group, never see its Ctrl-C, not even while Python starts in them. This process, whose main
+    thread unblocks it here, cancels the tasks and closes the cluster instead.
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
+        yield
+        return
+    # multiprocessing's resource tracker, started with the first worker process, unblocks
+    # SIGINT in the thread that starts it (resource_tracker.ensure_running): started now,
+    # before the hold, it is not started again in the thread that spawns the workers
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        # unblocking delivers a held SIGINT at once: KeyboardInterrupt raised from here
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:
@@ -431,8 +471,34 @@ def _one_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
+#: Seconds between two frame counts a task on a Dask worker sends to the client.
+REPORT_EVERY = 0.5
+
+
+def _worker_reporter(topic: str, name: str) -> Callable[[int], None] | None:
+    """On a Dask worker: ``report(n)`` logs ``[name, n]`` under `topic`, twice a second at most."""
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+    except (ImportError, ValueError):  # not on a worker
+        return None
+    last = -math.inf
+
+    def report(n: int) -> None:
+        nonlocal last
+        now = time.monotonic()
+        if now - last >= REPORT_EVERY:
+            last = now
+            worker.log_event(topic, [name, int(n)])  # sent from this thread by the worker's loop
+
+    return report
+
+
 def call_task(
-    func: Callable[..., TaskResult], args: tuple[Any, ...]
+    func: Callable[..., TaskResult],
+    args: tuple[Any, ...],
+    progress: Callable[[int], None] | tuple[str, str] | None = None,
 ) -> tuple[TaskResult | None, str | None, str | None]:
     """Run one task; an exception comes back as data (its line and traceback), not raised.
 
@@ -441,8 +507,13 @@ def call_task(
     Warnings the task raises (no track found, boxes out of the frame, ...) would stay in a
     worker's log: they come back in the result's ``info["warnings"]``, one line each, in order,
     each once.
+
+    `progress` receives the frames tracked so far (:func:`~pftrack.batch.tasks.reporting_frames`):
+    a function (in this process), or ``(topic, name)`` on a Dask worker, whose counts then go
+    to the client as Dask events (``Worker.log_event``) twice a second at most.
     """
-    with warnings.catch_warnings(record=True) as caught:
+    report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
+    with warnings.catch_warnings(record=True) as caught, reporting_frames(report):
         warnings.simplefilter("always")
         try:
             result = func(*args)
@@ -574,6 +645,7 @@ def run_jobs(
         _require_dask()  # before the summary: a missing extra changes no file
     desc = "sequences" if kind == "track" else "files"
     bar = {"total": len(pending), "desc": desc, "enable": show_progress}
+    frames: _Frames | None = None
     with contextlib.ExitStack() as stack:
         c = None
         if on_dask:  # connected (or the local cluster started) before --out is touched
@@ -585,10 +657,17 @@ def run_jobs(
             given = None if client is not None else scheduler_address(scheduler)
             reported = str(info.get("address")) if info.get("address") else None
             summary.scheduler = given or reported  # the user's spelling of the address
+        if pending and enabled(show_progress) and all(job.count is not None for job in pending):
+            # frames over all sequences; the clock starts once the cluster runs
+            frames = stack.enter_context(_Frames(pending, desc, show_progress))
         _make_out_dir(out)
         try:
             if c is not None:
-                _run_on_dask(c, pending, record, summary.kind, bar)
+                _run_on_dask(c, pending, record, summary.kind, bar, frames)
+            elif frames is not None:
+                for job in pending:
+                    record(job, call_task(job.func, job.args, frames.reporter(job.name)))
+                    frames.finish(job.name)
             elif pending:
                 for job in progress(pending, **bar):  # type: ignore[arg-type]
                     record(job, call_task(job.func, job.args))
@@ -602,24 +681,89 @@ def run_jobs(
     return summary
 
 
+class _Frames:
+    """The bar of frames over all the sequences of a batch, and the counts that move it.
+
+    Each task reports the frames it has tracked (in this process, or as Dask events from a
+    worker); a finished task counts for all its frames (a failed one too: none are left to do),
+    so that the time left is that of the work left.
+    """
+
+    def __init__(self, pending: Sequence[Job], noun: str, enable: bool | None) -> None:
+        self._counts = {job.name: job.count() if job.count is not None else None for job in pending}
+        known = [n for n in self._counts.values() if n is not None]
+        total = sum(known) if len(known) == len(self._counts) else None  # else no ETA
+        self._noun = noun
+        self._done: dict[str, int] = {}
+        self._sum = 0
+        self._finished = 0
+        self._lock = threading.Lock()
+        self.bar = Bar(total, desc=self._desc(), enable=enable, unit="frame")
+
+    def _desc(self) -> str:
+        return f"{self._finished}/{len(self._counts)} {self._noun}"
+
+    def report(self, name: str, n: int) -> None:
+        """Task `name` has tracked `n` frames."""
+        with self._lock:
+            if name in self._done and self._done[name] >= n:
+                return  # a late event of a finished task, or out of order
+            self._sum += n - self._done.get(name, 0)
+            self._done[name] = n
+            self.bar.set(self._sum)
+
+    def reporter(self, name: str) -> Callable[[int], None]:
+        """``report`` for the task `name` (in this process)."""
+        return lambda n: self.report(name, n)
+
+    def on_event(self, event: Any) -> None:
+        """A Dask event ``(time, [name, n])`` from a worker's task."""
+        name, n = event[1]
+        self.report(str(name), int(n))
+
+    def __enter__(self) -> _Frames:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.bar.close()
+
+    def finish(self, name: str) -> None:
+        """Task `name` is over (done, failed or cancelled)."""
+        self.report(name, self._counts.get(name) or self._done.get(name, 0))
+        with self._lock:
+            self._finished += 1
+            self.bar.describe(self._desc())
+
+
 def _run_on_dask(
     c: Client,
     pending: Sequence[Job],
     record: Callable[[Job, tuple[TaskResult | None, str | None, str | None]], None],
     kind: str,
     bar: dict[str, Any],
+    frames: _Frames | None = None,
 ) -> None:
-    """Submit `pending` to Dask and record each result as it completes."""
+    """Submit `pending` to Dask and record each result as it completes.
+
+    With `frames`, the tasks' frame counts come as Dask events on a topic of this run.
+    """
     from distributed import as_completed
 
+    topic = f"pftrack-progress-{os.urandom(4).hex()}"
+    if frames is not None:
+        c.subscribe_topic(topic, frames.on_event)
     futures = {}
     for job in pending:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
-        fut = c.submit(call_task, job.func, job.args, key=key, pure=False)
+        where = (topic, job.name) if frames is not None else None
+        fut = c.submit(call_task, job.func, job.args, where, key=key, pure=False)
         futures[fut.key] = (fut, job)
+    done = as_completed([f for f, _ in futures.values()])
     try:
-        for fut in progress(as_completed([f for f, _ in futures.values()]), **bar):
+        for fut in progress(done, **bar) if frames is None else done:
             _, job = futures.pop(fut.key)
+            if frames is not None:
+                frames.finish(job.name)
             if fut.status == "finished":
                 record(job, fut.result())
             elif fut.status == "error":  # the worker died (KilledWorker) or the like
@@ -629,3 +773,7 @@ def _run_on_dask(
     except BaseException:
         c.cancel([f for f, _ in futures.values()], force=True)
         raise
+    finally:
+        if frames is not None:
+            with contextlib.suppress(Exception):  # the cluster may be going away (Ctrl-C)
+                c.unsubscribe_topic(topic)

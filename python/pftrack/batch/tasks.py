@@ -9,12 +9,14 @@ need no access to the output folder. Nothing here imports Dask.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
 import socket
 import tempfile
 import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -34,11 +36,44 @@ __all__ = [
     "TrackOptions",
     "read_tracks",
     "recover_file",
+    "reporting_frames",
+    "sequence_length",
     "sequence_metrics",
     "smooth_file",
     "track_sequence",
     "tracking_threads",
 ]
+
+
+#: Where the running task reports the frames it has tracked (``report(n)``): set by the
+#: batch engine around a task (:func:`reporting_frames`), None otherwise.
+_report_frames: Callable[[int], None] | None = None
+
+
+@contextlib.contextmanager
+def reporting_frames(report: Callable[[int], None] | None) -> Iterator[None]:
+    """While the block runs, :func:`track_sequence` calls ``report(n)`` after frame `n`.
+
+    How a batch shows progress within its sequences: the engine passes a function that moves
+    its bar (in this process) or sends the count to the client (on a Dask worker).
+    """
+    global _report_frames
+    before, _report_frames = _report_frames, report
+    try:
+        yield
+    finally:
+        _report_frames = before
+
+
+def sequence_length(seq: SequenceInput) -> int | None:
+    """The number of frames of `seq` if its header or folder says (None: unknown, unreadable)."""
+    from pftrack.io.video import FrameSource
+
+    try:
+        n = len(FrameSource(seq.frames))
+    except (OSError, ValueError):  # the task then fails with its own message
+        return None
+    return n if n > 0 else None
 
 
 @dataclass(frozen=True)
@@ -197,6 +232,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     from pftrack.tracking.run import track_path
 
     cpu = time.process_time()
+    report = _report_frames
     frames = FrameSource(seq.frames)
     auto_scale = frames.width / seq.image_width if seq.image_width else 1.0
     det = None
@@ -218,6 +254,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         link=options.link,
         show_progress=False,
         threads=tracking_threads(),
+        on_frame=None if report is None else lambda n, *_: report(n),
     )
     rows = run.rows
     metrics = None

@@ -14,12 +14,14 @@ References
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import real_array
 
 BinnedImage = _core.BinnedImage
 
@@ -160,19 +162,49 @@ def box_histograms(
     return _core.box_histograms(image, b, kernel)
 
 
+def _histograms(hists: ArrayLike, fn: str) -> NDArray[np.float64]:
+    """`hists` (K, B) with each row divided by its sum, as the reference is.
+
+    A row of zeros (a box with no foreground pixel) stays zeros (rho 0). A negative or
+    non-finite entry is left for the core, whose message names it.
+    """
+    h = np.atleast_2d(real_array(hists, f"{fn}: hists"))
+    if h.ndim != 2 or not h.size or not (np.isfinite(h).all() and (h >= 0).all()):
+        return np.ascontiguousarray(h)  # the core refuses it, naming the shape or the entry
+    with np.errstate(over="ignore"):  # an overflow is refused just below, in one line
+        total = h.sum(axis=1, keepdims=True)
+    if not np.isfinite(total).all():
+        row = int(np.flatnonzero(~np.isfinite(total[:, 0]))[0])
+        raise ValueError(
+            f"{fn}: hists row {row} sum is not finite (overflow: the counts are finite but "
+            "their total exceeds the largest double, 1.8e308; scale them down)"
+        )
+    out = np.zeros_like(h)
+    np.divide(h, total, out=out, where=total > 0)
+    return out
+
+
+def _reference(ref: ArrayLike, fn: str) -> NDArray[np.float64]:
+    return np.ascontiguousarray(real_array(ref, f"{fn}: ref"))
+
+
 def bhattacharyya_coefficient(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float64]:
     """``rho = Σ_n sqrt(q*(n) q(n))`` of each row of `hists` (K, B) against `ref` (B,).
 
-    `ref` is normalised to sum 1 first; rows of `hists` are used as given.
+    `ref` and each row of `hists` are normalised to sum 1 first (a row of zeros has rho 0), so
+    pixel counts serve as well as histograms: rho is in [0, 1], 1 for the same distribution.
     """
-    h = np.ascontiguousarray(np.atleast_2d(np.asarray(hists, dtype=np.float64)))
-    return _core.bhattacharyya_coefficient(h, np.asarray(ref, dtype=np.float64))
+    fn = "bhattacharyya_coefficient"
+    return _core.bhattacharyya_coefficient(_histograms(hists, fn), _reference(ref, fn))
 
 
 def bhattacharyya_distance(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float64]:
-    """Bhattacharyya distance ``D = sqrt(1 - rho)`` of each row of `hists` to `ref`."""
-    h = np.ascontiguousarray(np.atleast_2d(np.asarray(hists, dtype=np.float64)))
-    return _core.bhattacharyya_distance(h, np.asarray(ref, dtype=np.float64))
+    """Bhattacharyya distance ``D = sqrt(1 - rho)`` of each row of `hists` to `ref`.
+
+    Rows and `ref` normalised as by :func:`bhattacharyya_coefficient`.
+    """
+    fn = "bhattacharyya_distance"
+    return _core.bhattacharyya_distance(_histograms(hists, fn), _reference(ref, fn))
 
 
 def bhattacharyya_weights(
@@ -183,11 +215,30 @@ def bhattacharyya_weights(
     Parameters
     ----------
     hists : (K, B) array_like of float
-        Candidate histograms.
+        Candidate histograms, one per particle: bin counts or frequencies, >= 0. Each row is
+        normalised to sum 1 (as `ref`), so counts give the same weights as their frequencies;
+        a row of zeros (no pixel counted) has ``D = 1``.
     ref : (B,) array_like of float
-        Reference histogram of the object.
+        Reference histogram of the object (counts or frequencies; normalised to sum 1).
     lam : float
-        λ, the sharpness of the likelihood (20 by default, as in Pérez et al.).
+        λ > 0, the sharpness of the likelihood (20 by default, as in Pérez et al.).
+
+    Returns
+    -------
+    (K,) ndarray of float
+        Weights summing to 1.
+
+    Raises
+    ------
+    TypeError
+        `lam` is not a real number (a string, None, a bool), or the histograms hold no numbers.
+    ValueError
+        `lam` is not finite and > 0; shapes that do not match; a negative or non-finite
+        entry; `ref` all zeros.
     """
-    h = np.ascontiguousarray(np.atleast_2d(np.asarray(hists, dtype=np.float64)))
-    return _core.bhattacharyya_weights(h, np.asarray(ref, dtype=np.float64), float(lam))
+    fn = "bhattacharyya_weights"
+    if isinstance(lam, bool) or not isinstance(lam, numbers.Real):
+        raise TypeError(f"{fn}: lam must be a real number, got {type(lam).__name__} {lam!r}")
+    if not (np.isfinite(lam) and lam > 0):
+        raise ValueError(f"{fn}: lam is {lam}, expected a finite number > 0")
+    return _core.bhattacharyya_weights(_histograms(hists, fn), _reference(ref, fn), float(lam))

@@ -572,6 +572,28 @@ class Tracker:
         rows = np.asarray(self._writer.rows[start:], np.float64).reshape(-1, 10)
         return self._restore_rows(self._stabiliser.restore(rows))
 
+    def _no_track_cause(self, n_tracked: int) -> str:
+        """Why :meth:`finalize` has no row: the first cause that holds, in the run's order."""
+        cfg = self.config.lifecycle
+        started = self._tracker.tracks_started
+        if started and n_tracked:  # rows, all of them wholly outside the frame
+            return "every box tracked lay outside the frame"
+        if started:
+            return (
+                f"{started} track{'s' * (started != 1)} started but none reached "
+                f"min_hits={cfg.min_hits} matched frames (shorter tracks are left out)"
+            )
+        if not self._given:
+            return "the built-in detector found no object (no detection was given)"
+        if np.isfinite(self._max_conf):
+            return (
+                f"the highest detection confidence was {self._max_conf:.3g} (min_conf "
+                f"{cfg.min_score:.3g}, birth_score {cfg.birth_score:.3g})"
+            )
+        if self._clip_warned:  # boxes were given, every one wholly outside the frame
+            return "no detection lay inside the frame (wrong coordinate scale?)"
+        return "the detections given held no box"
+
     def finalize(self) -> F64:
         """The run's MOTChallenge rows after the offline pass (what ``pftrack track`` writes).
 
@@ -581,7 +603,10 @@ class Tracker:
             ``frame, id, left, top, width, height, conf, flag, -1, -1`` (``flag`` 1 on a row the
             offline pass filled in a hole, else -1), frames from 1 (one per
             ``update``), sorted by frame then id; no row lies wholly outside the frame. Warns
-            when there is no row at all. With the
+            when there is no row at all, naming the first cause that holds: tracks started
+            but none reached ``min_hits`` matches, the built-in detector found nothing, the
+            detections' confidences were below the birth threshold, or lay outside the frame,
+            or there were none. With the
             built-in detector (no ``update`` of the run had detections) and the smoother on,
             boxes mostly inside a larger box of the same frame are left out
             (``LifecycleConfig.nested_inside``), and the boxes of partly seen people completed
@@ -617,6 +642,7 @@ class Tracker:
                     life.amodal_anchor,
                     size.config.split_ratio,
                 )
+        n_tracked = len(rows)  # before the rows wholly outside the frame are left out
         if len(rows) and len(self._tracker.frame_shape) >= 2:
             # a track carried past the frame's edge (coasting, or the smoother's extrapolation
             # at a track's end) leaves no row wholly outside the frame
@@ -625,19 +651,10 @@ class Tracker:
             inside = (x < w) & (y < h) & (x + rows[:, 4] > 0) & (y + rows[:, 5] > 0)
             rows = rows[inside]
         if len(rows) == 0 and self.frame_count:
-            cfg = self.config.lifecycle
-            if np.isfinite(self._max_conf):
-                hint = (
-                    f"the highest detection confidence was {self._max_conf:.3g} (min_conf "
-                    f"{cfg.min_score:.3g}, birth_score {cfg.birth_score:.3g})"
-                )
-            elif self._clip_warned:  # boxes were given, every one wholly outside the frame
-                hint = "no detection lay inside the frame (wrong coordinate scale?)"
-            elif self._given:
-                hint = "the detections given held no box"
-            else:
-                hint = "no external detection was given"
+            n = self.frame_count
             warnings.warn(
-                f"no track over {self.frame_count} frames: {hint}", RuntimeWarning, stacklevel=2
+                f"no track over {n} frame{'s' * (n != 1)}: {self._no_track_cause(n_tracked)}",
+                RuntimeWarning,
+                stacklevel=2,
             )
         return self._restore_rows(rows)

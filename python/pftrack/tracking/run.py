@@ -263,6 +263,7 @@ def track_path(
     link: bool = True,
     show_progress: bool | None = None,
     threads: bool = True,
+    on_frame: Callable[[int, Any, Any, Any], None] | None = None,
 ) -> TrackingRun:
     """Track a video file or image folder as ``pftrack track`` does (and ``pftrack batch``).
 
@@ -290,6 +291,9 @@ def track_path(
         Per-frame progress bar on stderr (default: when stderr is a terminal).
     threads : bool
         Decode and detect on threads ahead of the tracker (see :func:`track_frames`).
+    on_frame : callable, optional
+        Called after each frame (see :func:`track_frames`): ``pftrack batch`` reports its
+        progress through it.
     """
     smooth, link = flag(smooth, "smooth"), flag(link, "link")
     frames = source if isinstance(source, FrameSource) else FrameSource(source)
@@ -304,4 +308,5 @@ def track_path(
         smoother=BoxSmoother() if smooth else None,
         link=LinkConfig() if link else None,
         threads=threads,
+        on_frame=on_frame,
     )

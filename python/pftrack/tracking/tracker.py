@@ -80,6 +80,7 @@ class MultiObjectTracker:
         self._detector = detector
         self.tracks: list[LiveTrack] = []
         self._ended_unconfirmed: set[int] = set()
+        self._n_started = 0  # tracks started so far (see tracks_started)
         self.frame_index = 0
         self._mask: NDArray[np.uint8] | None = None  # the last frame's, see last_mask
         self._mask_shaded = False  # whether _mask still has its shadow pixels (127)
@@ -254,6 +255,11 @@ class MultiObjectTracker:
             self._birth_level = sorted_quantile(self._birth_scores, rules.birth_quantile)
         return min(rules.birth_score, self._birth_level)
 
+    @property
+    def tracks_started(self) -> int:
+        """Tracks started so far, confirmed or not (each with a new id)."""
+        return self._n_started
+
     def never_confirmed(self) -> set[int]:
         """Ids of start-up tracks that never reached ``min_hits`` matches.
 
@@ -412,6 +418,7 @@ class MultiObjectTracker:
             t.det_index = int(index[di])
             t.cls = int(labels[di])
             self.tracks.append(t)
+            self._n_started += 1
 
         # 6. report
         early = self.frame_index <= cfg.lifecycle.min_hits
