@@ -448,7 +448,9 @@ def _write(
 ) -> dict[str, Any]:
     """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry."""
     outputs = [f"{job.name}.txt"]
-    write_mot(out_dir / outputs[0], result.rows)
+    write_mot(
+        out_dir / outputs[0], result.rows, exact=False if result.exact is None else result.exact
+    )
     for suffix, data in result.files.items():
         outputs.append(f"{job.name}{suffix}")
         with atomic_write(out_dir / outputs[-1], "wb", suffix=suffix) as fh:

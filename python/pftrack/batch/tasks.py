@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pftrack._typing import F64, PathLike
 from pftrack.batch.inputs import SequenceInput
@@ -88,11 +89,15 @@ class TaskResult:
         Extra outputs by suffix (``{".mp4": ...}`` for ``--render``): ``DIR/NAME<suffix>``.
     info : dict
         JSON-ready figures of the run (frames, tracks, seconds, metrics, ...).
+    exact : (M, 10) ndarray of bool or None
+        Values of `rows` written with all their digits (given values that ``recover`` and
+        ``smooth`` copy, :func:`~pftrack.io.mot.write_mot`'s `exact`); None: 2 decimals.
     """
 
     rows: F64
     files: dict[str, bytes] = field(default_factory=dict)
     info: dict[str, Any] = field(default_factory=dict)
+    exact: NDArray[np.bool_] | None = None
 
 
 def _settings(options: object) -> dict[str, Any]:
@@ -316,6 +321,7 @@ class RecoverOptions:
 def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
     """Fill the gaps of one tracks file as ``pftrack recover FILE`` does (no ``--video``)."""
     from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
+    from pftrack.recovery.fill import copied_values
     from pftrack.recovery.linking import gate_for_rows
 
     rows = read_tracks(path)
@@ -340,7 +346,7 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
         "seconds": time.perf_counter() - t0,
         "explain": rep.describe(options.method),
     }
-    return TaskResult(filled, {}, info)
+    return TaskResult(filled, {}, info, exact=copied_values(rows, filled))
 
 
 @dataclass(frozen=True)
@@ -373,4 +379,6 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
         "rows_out": len(result),
         "seconds": time.perf_counter() - t0,
     }
-    return TaskResult(result, {}, info)
+    kept = np.zeros(result.shape, dtype=bool)
+    kept[:, 6:] = True  # conf and columns 8-10 are the rows' own, as `pftrack smooth` writes them
+    return TaskResult(result, {}, info, exact=kept)
