@@ -577,3 +577,17 @@ def test_no_track_warning_says_what_the_detections_were(scene, where, hint):
     assert len(rows) == 0
     said = [str(c.message) for c in caught if "no track" in str(c.message)]
     assert len(said) == 1 and re.fullmatch(f"no track over 40 frames: {hint}", said[0]), said
+
+
+def test_negative_confidences_warn_once_and_min_conf_keeps_them() -> None:
+    frame = np.zeros((60, 80, 3), np.uint8)
+    dets = np.array([[10.0, 10.0, 20.0, 40.0, -1.5], [40.0, 10.0, 50.0, 40.0, 0.8]])
+    tracker = pftrack.Tracker(frame_rate=10.0)
+    with pytest.warns(UserWarning, match=r"confidence is -1\.5: .*below min_conf 0 .*logits"):
+        tracker.update(dets, frame)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # once per run
+        tracker.update(dets, frame)
+        # a min_conf below the scores given: nothing is dropped, nothing to say
+        pftrack.Tracker(frame_rate=10.0, min_conf=-10.0).update(dets, frame)
+        pftrack.Tracker(frame_rate=10.0).update(dets[1:], frame)
