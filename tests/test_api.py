@@ -8,7 +8,9 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pytest
 
 import pftrack
@@ -215,6 +217,10 @@ def test_docs_api_signatures_are_the_real_ones(name: str, args: list[str]) -> No
             continue
         if "=" not in arg or "(" in arg.split("=", 1)[0]:
             assert not keyword_only and i < len(positional), f"{name}: {arg} has no place"
+            if arg.isidentifier() and not skipped:  # fill_gaps(rows, ...) was fill_gaps(tracks)
+                assert positional[i].name == arg, (
+                    f"{name}: parameter {i + 1} is {positional[i].name}"
+                )
             continue
         key, default = (t.strip() for t in arg.split("=", 1))
         real = {p.name: p for p in params}
@@ -227,3 +233,14 @@ def test_docs_api_signatures_are_the_real_ones(name: str, args: list[str]) -> No
         except (ValueError, SyntaxError):  # not a literal: LinkConfig(), a name
             continue
         assert real[key].default == value, f"{name}: {key} defaults to {real[key].default!r}"
+
+
+def test_readme_recovery_and_kernels_block_runs_as_written() -> None:
+    """The README's block of recovery and kernels ran only with names it never defined."""
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+    block = next(b for b in blocks if "recover_gap(" in b and "bhattacharyya_weights(" in b)
+    namespace: dict[str, Any] = {}
+    exec(block, namespace)  # noqa: S102 - the README's own code
+    assert namespace["path"].shape == (4, 2)
+    assert namespace["filled"].shape[1] == 10 and namespace["report"].n_filled_rows > 0
+    assert namespace["hists"].shape[0] == 2 and np.isclose(namespace["w"].sum(), 1.0)
