@@ -211,7 +211,10 @@ def test_experiment_gaps_one_sequence_writes_json(
             "linear,gdt-bi", "--repeat", "1", "--max-positions", "2",
             "--json", str(out)]  # fmt: skip
     assert main(argv) == 0
-    said = capsys.readouterr().out
+    captured = capsys.readouterr()
+    said = captured.out
+    # stderr is no terminal here: no bar, so one line says what the sweep will run
+    assert "every method at 2 mask positions of" in captured.err
     assert f"json: {out}" in said
     doc = json.loads(out.read_text())
     assert doc["gt"] == str(gt) and doc["methods"] == ["linear", "gdt-bi"]

@@ -23,6 +23,11 @@ def set_quiet(quiet: bool = True) -> None:
     _quiet = bool(quiet)
 
 
+def quiet() -> bool:
+    """Whether :func:`set_quiet` silenced the process (``pftrack --quiet``)."""
+    return _quiet
+
+
 def enabled(enable: bool | None = None) -> bool:
     """Whether a bar asked for with `enable` is drawn: never when quiet; by default on a TTY."""
     if _quiet:

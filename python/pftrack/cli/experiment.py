@@ -283,6 +283,18 @@ def run_gaps(args: argparse.Namespace) -> int:
             f"{run.motion.describe()}"
         )
     if len(sweep):
+        import sys
+
+        from pftrack._progress import enabled, quiet
+
+        n = len(sweep) if not args.max_positions else min(len(sweep), args.max_positions)
+        if not (quiet() or enabled()):  # no bar to show it: say what is coming (looked hung)
+            print(
+                f"pftrack experiment gaps: every method at {n} mask positions of {len(sweep)} "
+                "(--max-positions N runs N of them)",
+                file=sys.stderr,
+                flush=True,
+            )
         median = E.median_over(trajs, sweep, methods, args.max_positions)
         said += ["", E.format_median(median)]
         doc["sweep"]["median"] = {
