@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
+from bench.recovery_file import synthetic_tracks
 from experiments._common import data_root
 
 
@@ -56,3 +57,21 @@ def frame_480(data_dir: Path) -> NDArray[np.uint8]:
 @pytest.fixture(scope="session")
 def frame_720(data_dir: Path) -> NDArray[np.uint8]:
     return pets_frame(data_dir, (1280, 720))
+
+
+@pytest.fixture(scope="session")
+def track_boxes() -> list[tuple[NDArray[np.float64], NDArray[np.bool_]]]:
+    """Per track of the 500-track file (`bench/recovery_file.py`): the (T, 4) centre-and-size
+    rows over its frame span (NaN in its holes) and which frames are observed, as the offline
+    pass builds them (`test_recovery.py` and `test_stonesoup.py` smooth the same tracks)."""
+    rows = synthetic_tracks(500, seed=0)
+    out = []
+    for tid in np.unique(rows[:, 1]):
+        r = rows[rows[:, 1] == tid]
+        f = (r[:, 0] - r[0, 0]).astype(int)
+        z = np.full((f[-1] + 1, 4), np.nan)
+        z[f] = np.column_stack([r[:, 2:4] + r[:, 4:6] / 2, r[:, 4:6]])
+        has = np.zeros(len(z), bool)
+        has[f] = True
+        out.append((z, has))
+    return out

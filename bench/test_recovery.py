@@ -128,23 +128,6 @@ def test_singer_loglik_numpy(benchmark: BenchmarkFixture, singer_runs: list[F64]
     benchmark(ref_mix.state_loglik, singer_runs, F[0], Q[0], 0.5, DIFFUSE)
 
 
-@pytest.fixture(scope="module")
-def track_boxes() -> list[tuple[F64, np.ndarray]]:
-    """Per track of the 500-track file: the (T, 4) centre-and-size rows over its frame span
-    (holes included, NaN there) and which frames are observed, as the offline pass builds them."""
-    rows = synthetic_tracks(500, seed=0)
-    out = []
-    for tid in np.unique(rows[:, 1]):
-        r = rows[rows[:, 1] == tid]
-        f = (r[:, 0] - r[0, 0]).astype(int)
-        z = np.full((f[-1] + 1, 4), np.nan)
-        z[f] = np.column_stack([r[:, 2:4] + r[:, 4:6] / 2, r[:, 4:6]])
-        has = np.zeros(len(z), bool)
-        has[f] = True
-        out.append((z, has))
-    return out
-
-
 _Q, _R = np.array([0.5, 0.5, 0.1, 0.1]), np.array([4.0, 4.0, 9.0, 9.0])
 
 

@@ -34,7 +34,6 @@ import pytest
 from numpy.typing import NDArray
 from pytest_benchmark.fixture import BenchmarkFixture
 
-from bench.recovery_file import synthetic_tracks
 from experiments.stonesoup_models import EPOCH, stonesoup_rts_smooth
 from pftrack._typing import F64
 from pftrack.kalman import rts_smooth
@@ -68,23 +67,6 @@ def one_track() -> Boxes:
     has[0] = True
     z[~has] = np.nan
     return [(z, has)]
-
-
-@pytest.fixture(scope="module")
-def track_boxes() -> Boxes:
-    """The 500 tracks of bench/recovery_file.py as bench/test_recovery.py's fixture builds them:
-    centre and size over each track's frame span, NaN in its holes."""
-    rows = synthetic_tracks(500, seed=0)
-    out = []
-    for tid in np.unique(rows[:, 1]):
-        r = rows[rows[:, 1] == tid]
-        f = (r[:, 0] - r[0, 0]).astype(int)
-        z = np.full((f[-1] + 1, 4), np.nan)
-        z[f] = np.column_stack([r[:, 2:4] + r[:, 4:6] / 2, r[:, 4:6]])
-        has = np.zeros(len(z), bool)
-        has[f] = True
-        out.append((z, has))
-    return out
 
 
 @pytest.mark.benchmark(group="rts smooth, one track of 400 frames")

@@ -67,20 +67,26 @@ def progress(
     if not enabled(enable):
         yield from items
         return
-    from tqdm import tqdm  # only when a bar is drawn: keeps `import pftrack` light
+    with _tqdm(items, total=total, desc=desc, unit=unit) as bar:
+        yield from bar
 
-    with tqdm(
+
+def _tqdm(items: Iterable[Any] | None = None, **kwargs: Any) -> Any:
+    """A tqdm bar on stderr with pftrack's settings.
+
+    tqdm is imported only when a bar is drawn: it keeps ``import pftrack`` light.
+    """
+    from tqdm import tqdm
+
+    return tqdm(
         items,
-        total=total,
-        desc=desc,
-        unit=unit,
         file=sys.stderr,
         dynamic_ncols=True,
         mininterval=0.2,
         smoothing=0.1,
         delay=DELAY,
-    ) as bar:
-        yield from bar
+        **kwargs,
+    )
 
 
 class Bar:
@@ -107,18 +113,7 @@ class Bar:
         self._bar: Any = None
         self._lock = threading.Lock()
         if enabled(enable):
-            from tqdm import tqdm
-
-            self._bar = tqdm(
-                total=total,
-                desc=desc,
-                unit=unit,
-                file=sys.stderr,
-                dynamic_ncols=True,
-                mininterval=0.2,
-                smoothing=0.1,
-                delay=DELAY,
-            )
+            self._bar = _tqdm(total=total, desc=desc, unit=unit)
 
     @property
     def enabled(self) -> bool:
