@@ -46,12 +46,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
-from experiments.public_detections import NO_VIDEO, BlackFrames
+from experiments.public_detections import NO_VIDEO, BlackFrames, black_frames
 from experiments.stonesoup_models import BoxTrackerSettings, box_tracker
 from pftrack._typing import F64
 from pftrack.eval import SequenceScores, evaluate_sequence
 from pftrack.io.mot import read_mot
-from pftrack.io.video import read_frames, read_seqinfo
+from pftrack.io.video import read_frames
 from pftrack.tracking import load_detections, smooth_tracks, track_frames
 
 TUNED = BoxTrackerSettings(q_pos=0.3, gate=12.0, max_missed=10)
@@ -88,10 +88,7 @@ def load_cases(data: Path, with_frames: bool = True) -> list[Case]:
         if not folder.is_dir():
             print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
             continue
-        info = read_seqinfo(folder)
-        if info.length is None or info.width is None or info.height is None:
-            raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
-        frames = BlackFrames(info.length, info.width, info.height)
+        frames = black_frames(folder)
         dets = load_detections(folder / "det.txt")
         out.append(Case(name, frames, dets, read_mot(folder / "gt.txt"), 1.0))
     return out

@@ -97,6 +97,17 @@ class Resized(Sequence[NDArray[np.uint8]]):
         return (self._resize(f) for f in self._frames)
 
 
+def black_frames(folder: Path, factor: float = 1.0) -> BlackFrames:
+    """The black frames of a sequence without video: ``seqinfo.ini``'s length and size.
+
+    `factor` scales the size (``--upscale``).
+    """
+    info = read_seqinfo(folder)
+    if info.length is None or info.width is None or info.height is None:
+        raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
+    return BlackFrames(info.length, round(info.width * factor), round(info.height * factor))
+
+
 def scaled(dets: dict[int, F64], factor: float) -> dict[int, F64]:
     """Detections ``{frame: [left, top, w, h, score]}`` with their boxes times `factor`.
 
@@ -260,11 +271,7 @@ def run_all(
         if not folder.is_dir():
             print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
             continue
-        info = read_seqinfo(folder)
-        if info.length is None or info.width is None or info.height is None:
-            raise ValueError(f"{folder}/seqinfo.ini: no seqLength/imWidth/imHeight")
-        size = round(info.width * factor), round(info.height * factor)
-        frames = BlackFrames(info.length, *size)
+        frames = black_frames(folder, factor)
         dets = load_detections(folder / "det.txt", factor)
         run = track_frames(frames, detections=dets, config=config, rng=seed)
         report(name + " (black)", read_mot(folder / "gt.txt"), run.rows)
