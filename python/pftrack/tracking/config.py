@@ -129,7 +129,11 @@ class LifecycleConfig:
     max_coast : int
         Frames a track goes on from its particle filter alone before it ends.
     tentative_coast : int
-        Frames a not yet confirmed track may go without a detection before it is dropped.
+        Frames with detections a not yet confirmed track may go without one of them before it
+        is dropped. A frame without any detection (the detector did not run, or saw nothing)
+        does not count: with a detector run every other frame, no track was confirmed before
+        (docs/tracking.md, "Lower frame rates and sparse detections"). It still ends after
+        `max_coast` frames without a match.
     coast_min_rho : float
         A coasting track is reported only while its colour match ``rho`` stays above this.
     relink_coast : int or None

@@ -146,17 +146,18 @@ class LiveTrack:
         self.unreported: list[tuple[int, F64, float]] = []
         self.reported = False
 
-    def predict(self, binned: BinnedImage, colour_noise: float) -> None:
+    def predict(self, binned: BinnedImage, colour_noise: float, accel_gain: float = 1.0) -> None:
         """Step the particle filter on the frame and the centre filter by one frame.
 
         The particle filter's estimate is a noisy measurement of the centre filter's
         prediction (standard deviation `colour_noise` heights), when the frame's colour
         carried evidence (:func:`colour_evidence`); otherwise the prediction stands alone.
+        `accel_gain` multiplies the centre filter's acceleration (see :func:`predict_tracks`).
         """
         self.measured = None
         state = self.filter.step(binned)
         self.rho = state.rho
-        self.motion.predict(self.size[1])
+        self.motion.predict(self.size[1], accel_gain)
         if colour_evidence(state.rho, state.rho_max):
             self.motion.update(state.box_cxcywh[:2], colour_noise * self.size[1])
         cx, cy = self.motion.p
