@@ -9,6 +9,7 @@ ignores). Real sequences are read from ``--data``, else ``$PFTRACK_DATA``, else
 ``compare_trackers``       pftrack against SORT, ByteTrack, norfair and motpy on the same boxes
 ``compare_stonesoup``      pftrack against a Stone Soup tracker and its Kalman smoother
 ``eval_detection``         a detector's precision and recall on PETS09-S2L1
+``frame_rate``             every sequence at full, half and third rate, detections on odd frames
 ``offline_sensitivity``    MOTA / IDF1 under changed association and smoother defaults
 ``recovery_linking_pets``  linking and filling of PETS09-S2L1 ground truth cut into fragments
 ``recovery_variants``      model variants of ``gdt-bi`` on the paper's mask protocol

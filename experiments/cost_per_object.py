@@ -111,9 +111,9 @@ def make_crowd(
 def per_object_loop() -> Iterator[None]:
     """Within the block, trackers step one filter per C++ call (the older loop)."""
 
-    def loop(tracks: Sequence[LiveTrack], binned: Any, noise: float) -> None:
+    def loop(tracks: Sequence[LiveTrack], binned: Any, noise: float, gain: float = 1.0) -> None:
         for t in tracks:
-            t.predict(binned, noise)
+            t.predict(binned, noise, gain)
 
     saved = tracker_module.predict_tracks
     tracker_module.predict_tracks = loop  # type: ignore[assignment]

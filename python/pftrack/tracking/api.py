@@ -633,6 +633,12 @@ class Tracker:
         smoothed = self._writer_args[2] is not None
         crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
         link = self._writer_args[3]
+        smoother = self._writer_args[2]
+        gain = self._tracker.motion_gain()  # faster footage: more acceleration per frame
+        if smoother is not None:
+            self._writer.smoother = replace(
+                smoother, accel=smoother.accel * gain, size_accel=smoother.size_accel * gain
+            )
         if link is not None:  # its pixel gate grows with the frame (TrackerConfig.pixel_diagonal)
             scale = self._tracker.pixel_scale
             self._writer.link = replace(link, max_distance=link.max_distance * scale)

@@ -48,9 +48,13 @@ class CentreKalman:
         p00, p01, p11 = self.cov
         return np.array([[p00, p01], [p01, p11]], dtype=np.float64)
 
-    def predict(self, height: float) -> None:
-        """Advance one frame, with the acceleration scaled by the track's current `height`."""
-        (p, v), self.cov = cv_predict((self.p, self.v), self.cov, (self.accel * height) ** 2)
+    def predict(self, height: float, gain: float = 1.0) -> None:
+        """Advance one frame, with the acceleration scaled by the track's current `height`.
+
+        `gain` multiplies `accel` (faster footage, :meth:`MultiObjectTracker.motion_gain`).
+        """
+        q = (self.accel * gain * height) ** 2
+        (p, v), self.cov = cv_predict((self.p, self.v), self.cov, q)
         self.p, self.v = np.asarray(p), np.asarray(v)
 
     def update(self, z: ArrayLike, sigma: float) -> None:

@@ -135,6 +135,9 @@ class LiveTrack:
         self.hits = 1
         self.age = 1
         self.time_since_update = 0
+        self.missed = 0  # frames with detections since the last match (see alive)
+        # the last matched detections' (frame, centre x, centre y, height): see speed
+        self.trail: list[tuple[int, float, float, float]] = []
         self.score = score
         self.rho = 1.0
         self.det_index: int | None = None
@@ -143,17 +146,18 @@ class LiveTrack:
         self.unreported: list[tuple[int, F64, float]] = []
         self.reported = False
 
-    def predict(self, binned: BinnedImage, colour_noise: float) -> None:
+    def predict(self, binned: BinnedImage, colour_noise: float, accel_gain: float = 1.0) -> None:
         """Step the particle filter on the frame and the centre filter by one frame.
 
         The particle filter's estimate is a noisy measurement of the centre filter's
         prediction (standard deviation `colour_noise` heights), when the frame's colour
         carried evidence (:func:`colour_evidence`); otherwise the prediction stands alone.
+        `accel_gain` multiplies the centre filter's acceleration (see :func:`predict_tracks`).
         """
         self.measured = None
         state = self.filter.step(binned)
         self.rho = state.rho
-        self.motion.predict(self.size[1])
+        self.motion.predict(self.size[1], accel_gain)
         if colour_evidence(state.rho, state.rho_max):
             self.motion.update(state.box_cxcywh[:2], colour_noise * self.size[1])
         cx, cy = self.motion.p
@@ -191,21 +195,52 @@ class LiveTrack:
         self.score = score
         self.hits += 1
         self.time_since_update = 0
+        self.missed = 0
         self.det_index = det_index
 
-    def coast(self) -> None:
-        """A frame without a detection: the particle filter alone carries the track."""
+    def coast(self, detected: bool = True) -> None:
+        """A frame without a detection: the particle filter alone carries the track.
+
+        `detected`: whether the frame had any detection at all. A frame without one (the
+        detector did not run, or saw nothing) is not counted in :attr:`missed`.
+        """
         self.time_since_update += 1
+        self.missed += int(detected)
         self.det_index = None
         self.score = self.rho
 
     def alive(self, rules: LifecycleConfig) -> bool:
-        """Tell whether the track has coasted no longer than it may (less if unconfirmed)."""
+        """Tell whether the track has coasted no longer than it may (less if unconfirmed).
+
+        A confirmed track may coast `max_coast` frames. A tentative one may miss
+        `tentative_coast` frames that had detections (frames without any detection do not count:
+        a detector run every other frame, or one that saw nothing), and coast no more than
+        `max_coast` frames in all.
+        """
         if self.hits >= rules.min_hits:
-            limit = rules.max_coast
-        else:
-            limit = min(rules.max_coast, rules.tentative_coast)
-        return self.time_since_update <= limit
+            return self.time_since_update <= rules.max_coast
+        return self.missed <= rules.tentative_coast and self.time_since_update <= rules.max_coast
+
+    def speed(self, frame_index: int, centre: F64, height: float, span: int) -> float | None:
+        """Record a matched detection; return the track's speed over `span` frames or more.
+
+        In heights per frame: the distance from the oldest recorded detection at least `span`
+        frames back to this one, over the mean height and the frames between (None while there
+        is none). Over several frames, the detections' jitter counts for little.
+        """
+        trail = self.trail
+        trail.append((frame_index, float(centre[0]), float(centre[1]), height))
+        out = None
+        k = -1
+        for i, (f, *_rest) in enumerate(trail):
+            if frame_index - f >= span:
+                k = i
+        if k >= 0:
+            f, x, y, h = trail[k]
+            dist = float(np.hypot(centre[0] - x, centre[1] - y))
+            out = dist / (0.5 * (h + height)) / (frame_index - f)
+            del trail[:k]
+        return out
 
     def report(self, frame_index: int, early: bool, rules: LifecycleConfig) -> Track | None:
         """What to report for frame `frame_index` (None: nothing yet, or not any more).
@@ -245,7 +280,9 @@ def _motion_state(tracks: Sequence[LiveTrack]) -> tuple[F64, F64, tuple[F64, F64
     return p, v, (cov[:, 0:1], cov[:, 1:2], cov[:, 2:3])
 
 
-def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_noise: float) -> None:
+def predict_tracks(
+    tracks: Sequence[LiveTrack], binned: BinnedImage, colour_noise: float, accel_gain: float = 1.0
+) -> None:
     """:meth:`LiveTrack.predict` for every track at once.
 
     One C++ call steps all the particle filters (:func:`~pftrack.particle_filter.filter.
@@ -260,6 +297,8 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
         This frame's bins.
     colour_noise : float
         Standard deviation of the colour filter's centre, in heights.
+    accel_gain : float
+        Multiplies each centre filter's `accel` (:meth:`MultiObjectTracker.motion_gain`).
     """
     if not tracks:
         return
@@ -268,6 +307,8 @@ def predict_tracks(tracks: Sequence[LiveTrack], binned: BinnedImage, colour_nois
     h = size[:, 1:2]
     p, v, cov = _motion_state(tracks)
     accel = np.array([t.motion.accel for t in tracks])[:, None]
+    if accel_gain != 1.0:
+        accel = accel * accel_gain
     z = summary[:, 0:2]
     mean, c = cv_predict((p, v), cov, (accel * h) ** 2)
     # a flat likelihood is no measurement: those tracks keep the prediction

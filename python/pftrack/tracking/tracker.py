@@ -44,6 +44,11 @@ from pftrack.tracking.track import (
 
 __all__ = ["MultiObjectTracker"]
 
+#: Speed samples before :meth:`MultiObjectTracker.motion_gain` leaves 1.
+MIN_SPEED_SAMPLES = 20
+#: The most recent speed samples kept.
+MAX_SPEED_SAMPLES = 5000
+
 
 class MultiObjectTracker:
     """Track many objects with one colour particle filter each.
@@ -98,6 +103,8 @@ class MultiObjectTracker:
         self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
         self._background_ok = True  # False while the camera moves (see .camera)
         self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
+        self._speeds: list[float] = []  # confirmed tracks' speeds (see motion_gain)
+        self._gain = 1.0
 
     @property
     def frame_shape(self) -> tuple[int, ...]:
@@ -256,6 +263,29 @@ class MultiObjectTracker:
         return min(rules.birth_score, self._birth_level)
 
     @property
+    def speed(self) -> float | None:
+        """The median speed of the confirmed tracks so far, heights per frame (None: no sample).
+
+        Each sample is a confirmed track's distance between two of its matched detections
+        ``MotionConfig.speed_span`` or more frames apart, over its height and the frames between.
+        """
+        return float(np.median(self._speeds)) if self._speeds else None
+
+    def motion_gain(self) -> float:
+        """The factor of the per-frame acceleration levels for the speed measured so far.
+
+        ``max(1, speed / speed_reference) ** 1.5`` (``MotionConfig.speed_reference``; 1 when it is
+        None or before 20 speed samples). Continuous white-noise acceleration of density ``q``
+        gives a position variance of ``q dt^3 / 3`` over a step ``dt``: footage whose objects
+        move `k` times further per frame (a `k` times lower frame rate) needs ``k^1.5`` times
+        the acceleration's standard level per frame.
+        """
+        ref = self.config.motion.speed_reference
+        if ref is None or len(self._speeds) < MIN_SPEED_SAMPLES:
+            return 1.0
+        return float(max(1.0, float(np.median(self._speeds)) / ref) ** 1.5)
+
+    @property
     def tracks_started(self) -> int:
         """Tracks started so far, confirmed or not (each with a new id)."""
         return self._n_started
@@ -336,7 +366,7 @@ class MultiObjectTracker:
             return self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
 
         # 1. every track's particle filter looks at this frame, its centre filter predicts
-        predict_tracks(self.tracks, binned, cfg.motion.colour_noise)
+        predict_tracks(self.tracks, binned, cfg.motion.colour_noise, self._gain)
 
         # 2. association
         if len(boxes):
@@ -394,8 +424,10 @@ class MultiObjectTracker:
         if followed:
             dis = [di for _, di in followed]
             reseed_tracks([self.tracks[ti] for ti, _ in followed], boxes[dis], hists[dis], cfg)
+        detected = len(boxes) > 0  # a frame without detections: not a miss (LiveTrack.coast)
         for ti in result.unmatched_tracks:
-            self.tracks[ti].coast()
+            self.tracks[ti].coast(detected)
+        self._measure_speeds(followed, boxes, cfg)
 
         # 4. tracks that coasted too long end; 5. unexplained detections start tracks
         alive = [t.alive(cfg.lifecycle) for t in self.tracks]
@@ -424,6 +456,22 @@ class MultiObjectTracker:
         early = self.frame_index <= cfg.lifecycle.min_hits
         reports = (t.report(self.frame_index, early, cfg.lifecycle) for t in self.tracks)
         return [r for r in reports if r is not None]
+
+    def _measure_speeds(
+        self, followed: list[tuple[int, int]], boxes: F64, cfg: TrackerConfig
+    ) -> None:
+        """Speed samples of the confirmed tracks that followed a detection; the new gain."""
+        n = cfg.lifecycle.min_hits
+        span = cfg.motion.speed_span
+        for ti, di in followed:
+            t = self.tracks[ti]
+            b = boxes[di]
+            v = t.speed(self.frame_index, b[:2] + b[2:] / 2, float(b[3]), span)
+            if v is not None and t.hits >= n:
+                self._speeds.append(v)
+        if len(self._speeds) > MAX_SPEED_SAMPLES:  # the most recent ones
+            del self._speeds[: len(self._speeds) - MAX_SPEED_SAMPLES]
+        self._gain = self.motion_gain()
 
 
 def sorted_quantile(values: F64, q: float) -> float:
