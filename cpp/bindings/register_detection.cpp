@@ -110,6 +110,28 @@ void register_detection(py::module_& m) {
             py::arg("frame"), py::arg("mask"), py::arg("rate"),
             "background += rate (frame - background) where mask (H, W) uint8/bool != 0.")
         .def(
+            "global_gain",
+            [](BackgroundModel& self, py::array frame, Index step, double min_sum) {
+                const char* fn = "BackgroundModel.global_gain";
+                bind::check_bgr_image(frame, fn, "frame");
+                require(self.initialized(), fn, "the model has no background yet");
+                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+                        "frame shape is " + shape_str(frame) + ", expected (" +
+                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
+                            ", 3)");
+                const auto* src = static_cast<const std::uint8_t*>(frame.data());
+                const Index stride = frame.strides(0);
+                py::gil_scoped_release nogil;  // safe: raw buffer held by the caller
+                return self.global_gain(src, stride, step, min_sum);
+            },
+            py::arg("frame"), py::arg("step") = 4, py::arg("min_sum") = 30.0,
+            "Median of sum(frame) / sum(background) over every step-th row and column (pixels "
+            "whose background sum is >= min_sum): the frame's global gain.")
+        .def(
+            "scale",
+            [](BackgroundModel& self, double gain) { self.scale(gain); }, py::arg("gain"),
+            "background *= gain (float32, clipped to 255): follow a global illumination change.")
+        .def(
             "edge_support",
             [](const BackgroundModel& self, py::array frame, py::array mask,
                py::array_t<double, py::array::c_style | py::array::forcecast> boxes,

@@ -65,6 +65,13 @@ class BackgroundModel:
     ) -> tuple[BinnedImage | None, NDArray[np.uint8]]: ...
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...
+    # median of sum(frame) / sum(background) over every step-th row and column (pixels whose
+    # background sum is >= min_sum): the frame's global gain; 1 when no pixel qualifies
+    def global_gain(
+        self, frame: NDArray[np.uint8], step: int = 4, min_sum: float = 30.0
+    ) -> float: ...
+    # background *= gain (float32, clipped to 255)
+    def scale(self, gain: float) -> None: ...
     # ghost test: (K,) share of each box's (K, 4) mask-boundary edges held by the frame
     # (statistic 'ratio': of the summed magnitudes, 'vote': of the band pixels)
     def edge_support(

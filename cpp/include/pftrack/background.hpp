@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cstdint>
 #include <cstdlib>
@@ -307,6 +308,49 @@ public:
         }
     }
 
+    /// Global gain of a frame (rows x cols BGR, `row_stride` bytes a row) against the
+    /// background: the median, over the pixels of every `step`-th row and column whose
+    /// background sum B_b + B_g + B_r is at least `min_sum`, of (I_b + I_g + I_r) / (B_b + B_g +
+    /// B_r), in double (numpy.median's value: the mean of the two middle ratios for an even
+    /// count). Most pixels are background, so a global illumination change shows as a gain far
+    /// from 1 while people move it little. 1 when no pixel qualifies.
+    double global_gain(const std::uint8_t* bgr, Index row_stride, Index step, double min_sum) {
+        require(initialized(), "BackgroundModel.global_gain", "the model has no background yet");
+        require(step >= 1, "BackgroundModel.global_gain", "step", static_cast<double>(step), ">= 1");
+        ratios_.clear();
+        for (Index y = 0; y < rows_; y += step) {
+            const std::uint8_t* px = bgr + y * row_stride;
+            const float* q = background_.data() + y * cols_ * 3;
+            for (Index x = 0; x < cols_; x += step) {
+                const double sb = static_cast<double>(q[x]) + static_cast<double>(q[cols_ + x]) +
+                                  static_cast<double>(q[2 * cols_ + x]);
+                if (sb < min_sum || sb <= 0.0) continue;
+                const double si = static_cast<double>(px[3 * x]) + px[3 * x + 1] + px[3 * x + 2];
+                ratios_.push_back(si / sb);
+            }
+        }
+        const size_t n = ratios_.size();
+        if (n == 0) return 1.0;
+        const size_t k = n / 2;
+        std::nth_element(ratios_.begin(), ratios_.begin() + static_cast<std::ptrdiff_t>(k),
+                         ratios_.end());
+        const double hi = ratios_[k];
+        if (n % 2 == 1) return hi;
+        const double lo = *std::max_element(ratios_.begin(),
+                                            ratios_.begin() + static_cast<std::ptrdiff_t>(k));
+        return 0.5 * (lo + hi);
+    }
+
+    /// background_c *= gain for every pixel and channel (float32: b = b * float(gain)), clipped
+    /// to [0, 255]: follows a global illumination change measured by `global_gain`.
+    void scale(double gain) {
+        require(initialized(), "BackgroundModel.scale", "the model has no background yet");
+        require(std::isfinite(gain) && gain > 0.0, "BackgroundModel.scale", "gain", gain,
+                "finite, > 0");
+        const float g = static_cast<float>(gain);
+        for (float& b : background_) b = std::min(b * g, 255.0f);
+    }
+
     /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols; none
     /// when null: the caller bins only the pixels it keeps, with `hsv_bins_image`) and `mask`
     /// (rows x cols, 255 = foreground, 127 = shadow, 0 = background), both packed.
@@ -451,6 +495,7 @@ private:
     std::vector<float> background_;      // planar rows: [y][channel][x]
     std::vector<std::uint8_t> previous_;  // interleaved, as the frame
     std::array<std::int64_t, 256> hist_{};
+    std::vector<double> ratios_;  // global_gain's sampled frame / background ratios
     std::vector<float> scratch_f_;  // row scratch: B, G, R planes, d_prev, candidate flag
     std::vector<std::int32_t> scratch_i_;  // row scratch: table indices, histogram bins
 };
