@@ -186,6 +186,11 @@ void register_detection(py::module_& m) {
         .def_property_readonly("frame_count", &BackgroundModel::frame_count)
         .def_property_readonly("threshold", &BackgroundModel::threshold,
                                "Threshold the next frame will use (grey levels).")
+        .def("set_threshold_scale", &BackgroundModel::set_threshold_scale, py::arg("s"),
+             "Threshold bounds become [s t_min, s t_max] (at most 255); the current threshold is "
+             "scaled by s / the previous s and clamped to them. reset() sets 1.")
+        .def_property_readonly("threshold_scale", &BackgroundModel::threshold_scale,
+                               "The scale of the threshold's bounds (set_threshold_scale).")
         .def_property_readonly("n_bins", [](const BackgroundModel& s) { return s.binning().n_bins(); })
         .def_property_readonly("shape",
                                [](const BackgroundModel& s) -> py::object {

@@ -8,11 +8,16 @@ import pytest
 
 from pftrack import _core
 from pftrack.detection import PaperConfig, PaperDetector
-from pftrack.detection.light import channel_spread, looks_grey
+from pftrack.detection.light import channel_spread, frame_gain, level_frames, looks_grey
 from pftrack.eval import evaluate_mot
 from pftrack.synthetic import make_scene
 from pftrack.tracking import track_frames
-from tests.reference.detection import global_gain_reference, scale_reference
+from tests.detection.test_background_model import random_scene
+from tests.reference.detection import (
+    BackgroundReference,
+    global_gain_reference,
+    scale_reference,
+)
 
 GREY_WARNING = "ignore:the video is grey:UserWarning"
 
@@ -58,6 +63,46 @@ def test_scale_equals_reference_and_clips() -> None:
         m.scale(gain)
         np.testing.assert_array_equal(m.background, scale_reference(bg, gain))
     assert m.background.max() == 255.0
+
+
+@pytest.mark.parametrize("kw", [{}, {"t_min": 8.0, "t_max": 200.0, "k_noise": 30.0}])
+def test_threshold_scale_equals_reference(kw: dict[str, float]) -> None:
+    # the gain rule's loop (gain, scale, threshold scale) on a darkening then brightening scene
+    frames = random_scene(np.random.default_rng(5), steps=8)
+    light = [1.0, 0.8, 0.6, 0.5, 0.5, 0.9, 1.4, 2.0]
+    frames = [np.clip(f * g, 0, 255).astype(np.uint8) for f, g in zip(frames, light, strict=True)]
+    model, ref = _core.BackgroundModel(n_learn=2, **kw), BackgroundReference(n_learn=2, **kw)
+    for k, frame in enumerate(frames):
+        if k > 0:
+            gain = model.global_gain(frame)
+            assert gain == global_gain_reference(frame, ref.background)
+            model.scale(gain)
+            ref.background = scale_reference(ref.background, gain)
+            model.set_threshold_scale(model.threshold_scale * gain)
+            ref.set_threshold_scale(ref.threshold_scale * gain)
+            assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
+        _, mask = model.apply(frame)
+        _, rmask = ref.apply(frame)
+        np.testing.assert_array_equal(mask, rmask)
+        np.testing.assert_array_equal(model.background, ref.background)
+        assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
+    lo = min(model.threshold_scale * model.t_min, 255.0)
+    assert lo <= model.threshold <= min(model.threshold_scale * model.t_max, 255.0)
+    model.reset()
+    assert model.threshold_scale == 1.0 and model.threshold == model.t_min
+
+
+def test_threshold_scale_bounds_the_threshold() -> None:
+    m = _core.BackgroundModel(t_min=25.0, t_max=60.0)
+    m.set_background(np.full((4, 4, 3), 100, np.float32))
+    assert m.threshold == 25.0
+    m.set_threshold_scale(0.4)
+    assert m.threshold == pytest.approx(10.0)  # 25 * 0.4, in the new bounds [10, 24]
+    m.set_threshold_scale(20.0)
+    assert m.threshold == 255.0  # 10 * 50 = 500, clamped to 255 (t_min * 20 = 500 > 255)
+    for bad in (0.0, -1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="s"):
+            m.set_threshold_scale(bad)
 
 
 def test_gain_errors() -> None:
@@ -195,3 +240,57 @@ def test_ramped_scene_with_the_auto_bootstrap() -> None:
     det.prime(frames[:: len(frames) // 30])
     fixed = max((det.detect(f).mask > 0).mean() for f in frames[:10])
     assert worst > 0.5 and fixed < 0.1, (worst, fixed)
+
+
+# -- the priming median under a light change ------------------------------------------------------
+def test_level_frames_leaves_steady_video_alone_and_levels_a_ramp() -> None:
+    scene = make_scene(n_frames=30, rng=0)
+    steady = scene.frames[::3]
+    assert all(a is b for a, b in zip(level_frames(steady, 0.03), steady, strict=True))
+    assert level_frames(steady, 0.0) is steady
+    dark = ramped(steady)
+    levelled = level_frames(dark, 0.03)
+    assert levelled[0] is dark[0]
+    for f in levelled[1:]:
+        assert abs(frame_gain(f, dark[0]) - 1.0) <= 0.03
+
+
+def test_prime_is_not_biased_by_a_person_standing_under_a_ramp() -> None:
+    # a bright person stands in 40 % of the priming frames while the light falls to 0.4: the
+    # median of the frames as they are takes the upper end of the ground's values there
+    rng = np.random.default_rng(0)
+    ground = rng.integers(60, 120, (60, 80, 3)).astype(np.float32)
+    frames = []
+    for k in range(30):
+        f = ground.copy()
+        if k % 5 < 2:
+            f[10:50, 30:45] = 250.0
+        frames.append(f)
+    frames = ramped([np.clip(f, 0, 255).astype(np.uint8) for f in frames])
+    box = (slice(10, 50), slice(30, 45))
+    for band, ok in ((0.0, False), (0.03, True)):
+        det = PaperDetector(PaperConfig(gain_band=band))
+        det.prime(frames)
+        bg = det.model.background
+        # the first frame's light (the ground is at the first frame's brightness outside)
+        ratio = bg[box].sum() / ground[box].sum()
+        outside = bg[:10].sum() / ground[:10].sum()
+        assert (abs(ratio - 1.0) < 0.05) == ok, (band, ratio)
+        assert (abs(ratio - outside) < 0.05) == ok, (band, ratio, outside)
+
+
+def test_detector_thresholds_follow_the_light() -> None:
+    scene = make_scene(n_frames=60, rng=0)
+    frames = ramped(scene.frames)
+    det = PaperDetector()
+    det.prime(frames[:: len(frames) // 30])
+    for f in frames:
+        det.detect(f)
+    # relative to the first frame's light (0.4 at the last frame; the band lets it lag 3 %)
+    assert 0.38 <= det.model.threshold_scale <= 0.43, det.model.threshold_scale
+    assert det.model.threshold <= 0.43 * 60.0
+    off = PaperDetector(PaperConfig(gain_thresholds=False))
+    off.prime(frames[:: len(frames) // 30])
+    for f in frames:
+        off.detect(f)
+    assert off.model.threshold_scale == 1.0

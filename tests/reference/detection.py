@@ -49,6 +49,19 @@ class BackgroundReference:
         self.background = None
         self.previous = None
         self.threshold = t_min
+        self.threshold_scale = 1.0
+
+    def bounds(self) -> tuple[float, float]:
+        """The threshold's bounds: t_min, t_max times threshold_scale, at most 255."""
+        s = self.threshold_scale
+        return min(s * self.t_min, 255.0), min(s * self.t_max, 255.0)
+
+    def set_threshold_scale(self, s: float) -> None:
+        """BackgroundModel.set_threshold_scale: new bounds; T scaled by s / s_old, clamped."""
+        t = self.threshold * (s / self.threshold_scale)
+        self.threshold_scale = s
+        lo, hi = self.bounds()
+        self.threshold = min(max(t, lo), hi)
 
     def apply(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         bins = hsv_bin_reference(frame)
@@ -56,7 +69,7 @@ class BackgroundReference:
         if self.background is None:
             self.background = f.copy()
             self.previous = frame.copy()
-            self.threshold = self.t_min
+            self.threshold = self.bounds()[0]
             self.frame_count = 1
             return bins, np.zeros(frame.shape[:2], np.uint8)
         bg = self.background
@@ -90,7 +103,8 @@ class BackgroundReference:
         cum = np.concatenate([[0], np.cumsum(hist)])
         i = int(np.searchsorted(cum[1:], half))  # first bin whose cumulative count >= half
         median = i + (half - cum[i]) / hist[i]
-        self.threshold = min(max(self.k_noise * median, self.t_min), self.t_max)
+        lo, hi = self.bounds()
+        self.threshold = min(max(self.k_noise * median, lo), hi)
         return bins, np.select([fore, shadow], [255, 127], 0).astype(np.uint8)
 
 

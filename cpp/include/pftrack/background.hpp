@@ -247,6 +247,7 @@ public:
     Index cols() const { return cols_; }
     long frame_count() const { return frame_count_; }
     double threshold() const { return threshold_; }
+    double threshold_scale() const { return threshold_scale_; }
     const std::array<std::int64_t, 256>& difference_histogram() const { return hist_; }
     /// The background as stored: planar per row, channel c of pixel (y, x) at
     /// [(y * 3 + c) * cols + x] (see `background_bgr` for the interleaved copy).
@@ -266,6 +267,7 @@ public:
         frame_count_ = 0;
         background_.clear();
         previous_.clear();
+        threshold_scale_ = 1.0;
         threshold_ = config_.t_min;
         hist_.fill(0);
     }
@@ -349,6 +351,18 @@ public:
                 "finite, > 0");
         const float g = static_cast<float>(gain);
         for (float& b : background_) b = std::min(b * g, 255.0f);
+    }
+
+    /// Scale the threshold's grey-level bounds: T is clamped to [s t_min, s t_max] (each at
+    /// most 255) from now on, and the current T becomes clamp(T s / s_old) in the new bounds.
+    /// Follows a global illumination change (`scale`): at a gain of 0.4 a person's contrast
+    /// against the background is 0.4 times what it was, and so is the noise. `reset` sets 1.
+    void set_threshold_scale(double s) {
+        require(std::isfinite(s) && s > 0.0 && s <= 1e6, "BackgroundModel.set_threshold_scale",
+                "s", s, "finite, in (0, 1e6]");
+        const double t = threshold_ * (s / threshold_scale_);
+        threshold_scale_ = s;
+        threshold_ = std::min(std::max(t, t_lo()), t_hi());
     }
 
     /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols; none
@@ -446,7 +460,7 @@ private:
         cols_ = cols;
         background_.resize(static_cast<size_t>(rows * cols * 3));
         previous_.resize(static_cast<size_t>(rows * cols * 3));
-        threshold_ = config_.t_min;
+        threshold_ = t_lo();
         hist_.fill(0);
     }
 
@@ -482,8 +496,12 @@ private:
             }
             cum += c;
         }
-        return std::min(std::max(config_.k_noise * median, config_.t_min), config_.t_max);
+        return std::min(std::max(config_.k_noise * median, t_lo()), t_hi());
     }
+
+    // the threshold's bounds, scaled by set_threshold_scale (t_min, t_max at scale 1)
+    double t_lo() const { return std::min(threshold_scale_ * config_.t_min, 255.0); }
+    double t_hi() const { return std::min(threshold_scale_ * config_.t_max, 255.0); }
 
     BackgroundConfig config_;
     HsvBinning binning_;
@@ -492,6 +510,7 @@ private:
     long frame_count_ = 0;
     bool learning_ = false;  // started from a frame (not set_background): learning phase on
     double threshold_ = 0.0;
+    double threshold_scale_ = 1.0;  // set_threshold_scale
     std::vector<float> background_;      // planar rows: [y][channel][x]
     std::vector<std::uint8_t> previous_;  // interleaved, as the frame
     std::array<std::int64_t, 256> hist_{};

@@ -19,7 +19,7 @@ from pftrack.detection.base import (
     median_frame,
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
-from pftrack.detection.light import looks_grey
+from pftrack.detection.light import level_frames, looks_grey
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning, hsv_bins
 
@@ -88,7 +88,12 @@ class PaperConfig:
         Global light change: before each frame, the frame's gain against the background
         (``BackgroundModel.global_gain``: the median ratio of pixel sums over every 4th row and
         column) is measured; outside ``[1 - gain_band, 1 + gain_band]`` the whole background is
-        scaled by it (``BackgroundModel.scale``). 0 turns it off.
+        scaled by it (``BackgroundModel.scale``). `prime` also brings its frames to the first
+        one's brightness first (`pftrack.detection.light.level_frames`). 0 turns both off.
+    gain_thresholds : bool
+        With the gain rule, scale the grey-level threshold bounds `t_min`, `t_max` by the
+        accumulated gain since the first frame (``BackgroundModel.set_threshold_scale``):
+        people's contrast, and the noise, scale with the light.
     blobs : BlobConfig
         Morphology and blob filters.
     hsv : HsvBinning
@@ -112,6 +117,7 @@ class PaperConfig:
     grey_tolerance: float = 3.0
     grey_shadow_lo: float = 1.0
     gain_band: float = 0.03
+    gain_thresholds: bool = True
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
@@ -218,6 +224,11 @@ class PaperDetector:
             gain = self._model.global_gain(frame)
             if abs(gain - 1.0) > self.config.gain_band:
                 self._model.scale(gain)
+                if self.config.gain_thresholds and self._model.frame_count > 0:
+                    # contrasts (and noise) scale with the light: the grey-level thresholds
+                    # follow the brightness relative to the first frame's (a primed model's
+                    # first gain corrects the median's brightness, not a change of light)
+                    self._model.set_threshold_scale(self._model.threshold_scale * gain)
         return self._model.apply(frame, bins=bins)
 
     @property
@@ -248,7 +259,9 @@ class PaperDetector:
         # numpy.median(stack, axis=0)'s values, in C++ without stacking the frames (tests hold
         # the two equal): 0.23 s instead of 1.4-1.7 s for 30 frames of 1280x720, no stack
         frames = list(frames)
-        median = median_frame(frames, "PaperDetector.prime")
+        # under a light change, the median of frames at their own brightness is biased where
+        # people stand often: the frames are brought to the first one's light
+        median = median_frame(level_frames(frames, self.config.gain_band), "PaperDetector.prime")
         if self._grey is None:
             self._decide_grey(frames)
         self._model.reset()
