@@ -8,6 +8,7 @@ ignores). Real sequences are read from ``--data``, else ``$PFTRACK_DATA``, else
 =========================  ====================================================================
 ``compare_trackers``       pftrack against SORT, ByteTrack, norfair and motpy on the same boxes
 ``compare_stonesoup``      pftrack against a Stone Soup tracker and its Kalman smoother
+``detector_robustness``    the built-in detector on grey, darkening and cropped variants
 ``eval_detection``         a detector's precision and recall on PETS09-S2L1
 ``frame_rate``             every sequence at full, half and third rate, detections on odd frames
 ``offline_sensitivity``    MOTA / IDF1 under changed association and smoother defaults

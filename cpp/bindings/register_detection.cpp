@@ -110,6 +110,28 @@ void register_detection(py::module_& m) {
             py::arg("frame"), py::arg("mask"), py::arg("rate"),
             "background += rate (frame - background) where mask (H, W) uint8/bool != 0.")
         .def(
+            "global_gain",
+            [](BackgroundModel& self, py::array frame, Index step, double min_sum) {
+                const char* fn = "BackgroundModel.global_gain";
+                bind::check_bgr_image(frame, fn, "frame");
+                require(self.initialized(), fn, "the model has no background yet");
+                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+                        "frame shape is " + shape_str(frame) + ", expected (" +
+                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
+                            ", 3)");
+                const auto* src = static_cast<const std::uint8_t*>(frame.data());
+                const Index stride = frame.strides(0);
+                py::gil_scoped_release nogil;  // safe: raw buffer held by the caller
+                return self.global_gain(src, stride, step, min_sum);
+            },
+            py::arg("frame"), py::arg("step") = 4, py::arg("min_sum") = 30.0,
+            "Median of sum(frame) / sum(background) over every step-th row and column (pixels "
+            "whose background sum is >= min_sum): the frame's global gain.")
+        .def(
+            "scale",
+            [](BackgroundModel& self, double gain) { self.scale(gain); }, py::arg("gain"),
+            "background *= gain (float32, clipped to 255): follow a global illumination change.")
+        .def(
             "edge_support",
             [](const BackgroundModel& self, py::array frame, py::array mask,
                py::array_t<double, py::array::c_style | py::array::forcecast> boxes,
@@ -164,6 +186,11 @@ void register_detection(py::module_& m) {
         .def_property_readonly("frame_count", &BackgroundModel::frame_count)
         .def_property_readonly("threshold", &BackgroundModel::threshold,
                                "Threshold the next frame will use (grey levels).")
+        .def("set_threshold_scale", &BackgroundModel::set_threshold_scale, py::arg("s"),
+             "Threshold bounds become [s t_min, s t_max] (at most 255); the current threshold is "
+             "scaled by s / the previous s and clamped to them. reset() sets 1.")
+        .def_property_readonly("threshold_scale", &BackgroundModel::threshold_scale,
+                               "The scale of the threshold's bounds (set_threshold_scale).")
         .def_property_readonly("n_bins", [](const BackgroundModel& s) { return s.binning().n_bins(); })
         .def_property_readonly("shape",
                                [](const BackgroundModel& s) -> py::object {

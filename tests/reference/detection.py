@@ -49,6 +49,19 @@ class BackgroundReference:
         self.background = None
         self.previous = None
         self.threshold = t_min
+        self.threshold_scale = 1.0
+
+    def bounds(self) -> tuple[float, float]:
+        """The threshold's bounds: t_min, t_max times threshold_scale, at most 255."""
+        s = self.threshold_scale
+        return min(s * self.t_min, 255.0), min(s * self.t_max, 255.0)
+
+    def set_threshold_scale(self, s: float) -> None:
+        """BackgroundModel.set_threshold_scale: new bounds; T scaled by s / s_old, clamped."""
+        t = self.threshold * (s / self.threshold_scale)
+        self.threshold_scale = s
+        lo, hi = self.bounds()
+        self.threshold = min(max(t, lo), hi)
 
     def apply(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         bins = hsv_bin_reference(frame)
@@ -56,7 +69,7 @@ class BackgroundReference:
         if self.background is None:
             self.background = f.copy()
             self.previous = frame.copy()
-            self.threshold = self.t_min
+            self.threshold = self.bounds()[0]
             self.frame_count = 1
             return bins, np.zeros(frame.shape[:2], np.uint8)
         bg = self.background
@@ -90,7 +103,8 @@ class BackgroundReference:
         cum = np.concatenate([[0], np.cumsum(hist)])
         i = int(np.searchsorted(cum[1:], half))  # first bin whose cumulative count >= half
         median = i + (half - cum[i]) / hist[i]
-        self.threshold = min(max(self.k_noise * median, self.t_min), self.t_max)
+        lo, hi = self.bounds()
+        self.threshold = min(max(self.k_noise * median, lo), hi)
         return bins, np.select([fore, shadow], [255, 127], 0).astype(np.uint8)
 
 
@@ -186,3 +200,22 @@ def morphology_reference(src: np.ndarray, element: np.ndarray, op: str) -> np.nd
 def close_mask_reference(mask: np.ndarray, element: np.ndarray) -> np.ndarray:
     """The closing of `mask` by `element` (a dilation, then an erosion), in NumPy."""
     return morphology_reference(morphology_reference(mask, element, "dilate"), element, "erode")
+
+
+def global_gain_reference(
+    frame: np.ndarray, background: np.ndarray, step: int = 4, min_sum: float = 30.0
+) -> float:
+    """BackgroundModel.global_gain: median of sum(frame) / sum(background) over every `step`-th
+    row and column, pixels whose background sum is >= min_sum (and > 0); 1 when none."""
+    b = background[::step, ::step].astype(np.float64)
+    sb = b[..., 0] + b[..., 1] + b[..., 2]
+    si = frame[::step, ::step].astype(np.float64).sum(axis=2)
+    keep = (sb >= min_sum) & (sb > 0)
+    if not keep.any():
+        return 1.0
+    return float(np.median(si[keep] / sb[keep]))
+
+
+def scale_reference(background: np.ndarray, gain: float) -> np.ndarray:
+    """BackgroundModel.scale: background * float32(gain), clipped to 255, in float32."""
+    return np.minimum(background.astype(np.float32) * np.float32(gain), np.float32(255))

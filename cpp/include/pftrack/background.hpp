@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cstdint>
 #include <cstdlib>
@@ -246,6 +247,7 @@ public:
     Index cols() const { return cols_; }
     long frame_count() const { return frame_count_; }
     double threshold() const { return threshold_; }
+    double threshold_scale() const { return threshold_scale_; }
     const std::array<std::int64_t, 256>& difference_histogram() const { return hist_; }
     /// The background as stored: planar per row, channel c of pixel (y, x) at
     /// [(y * 3 + c) * cols + x] (see `background_bgr` for the interleaved copy).
@@ -265,6 +267,7 @@ public:
         frame_count_ = 0;
         background_.clear();
         previous_.clear();
+        threshold_scale_ = 1.0;
         threshold_ = config_.t_min;
         hist_.fill(0);
     }
@@ -305,6 +308,61 @@ public:
                 }
             }
         }
+    }
+
+    /// Global gain of a frame (rows x cols BGR, `row_stride` bytes a row) against the
+    /// background: the median, over the pixels of every `step`-th row and column whose
+    /// background sum B_b + B_g + B_r is at least `min_sum`, of (I_b + I_g + I_r) / (B_b + B_g +
+    /// B_r), in double (numpy.median's value: the mean of the two middle ratios for an even
+    /// count). Most pixels are background, so a global illumination change shows as a gain far
+    /// from 1 while people move it little. 1 when no pixel qualifies.
+    double global_gain(const std::uint8_t* bgr, Index row_stride, Index step, double min_sum) {
+        require(initialized(), "BackgroundModel.global_gain", "the model has no background yet");
+        require(step >= 1, "BackgroundModel.global_gain", "step", static_cast<double>(step), ">= 1");
+        ratios_.clear();
+        for (Index y = 0; y < rows_; y += step) {
+            const std::uint8_t* px = bgr + y * row_stride;
+            const float* q = background_.data() + y * cols_ * 3;
+            for (Index x = 0; x < cols_; x += step) {
+                const double sb = static_cast<double>(q[x]) + static_cast<double>(q[cols_ + x]) +
+                                  static_cast<double>(q[2 * cols_ + x]);
+                if (sb < min_sum || sb <= 0.0) continue;
+                const double si = static_cast<double>(px[3 * x]) + px[3 * x + 1] + px[3 * x + 2];
+                ratios_.push_back(si / sb);
+            }
+        }
+        const size_t n = ratios_.size();
+        if (n == 0) return 1.0;
+        const size_t k = n / 2;
+        std::nth_element(ratios_.begin(), ratios_.begin() + static_cast<std::ptrdiff_t>(k),
+                         ratios_.end());
+        const double hi = ratios_[k];
+        if (n % 2 == 1) return hi;
+        const double lo = *std::max_element(ratios_.begin(),
+                                            ratios_.begin() + static_cast<std::ptrdiff_t>(k));
+        return 0.5 * (lo + hi);
+    }
+
+    /// background_c *= gain for every pixel and channel (float32: b = b * float(gain)), clipped
+    /// to [0, 255]: follows a global illumination change measured by `global_gain`.
+    void scale(double gain) {
+        require(initialized(), "BackgroundModel.scale", "the model has no background yet");
+        require(std::isfinite(gain) && gain > 0.0, "BackgroundModel.scale", "gain", gain,
+                "finite, > 0");
+        const float g = static_cast<float>(gain);
+        for (float& b : background_) b = std::min(b * g, 255.0f);
+    }
+
+    /// Scale the threshold's grey-level bounds: T is clamped to [s t_min, s t_max] (each at
+    /// most 255) from now on, and the current T becomes clamp(T s / s_old) in the new bounds.
+    /// Follows a global illumination change (`scale`): at a gain of 0.4 a person's contrast
+    /// against the background is 0.4 times what it was, and so is the noise. `reset` sets 1.
+    void set_threshold_scale(double s) {
+        require(std::isfinite(s) && s > 0.0 && s <= 1e6, "BackgroundModel.set_threshold_scale",
+                "s", s, "finite, in (0, 1e6]");
+        const double t = threshold_ * (s / threshold_scale_);
+        threshold_scale_ = s;
+        threshold_ = std::min(std::max(t, t_lo()), t_hi());
     }
 
     /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols; none
@@ -402,7 +460,7 @@ private:
         cols_ = cols;
         background_.resize(static_cast<size_t>(rows * cols * 3));
         previous_.resize(static_cast<size_t>(rows * cols * 3));
-        threshold_ = config_.t_min;
+        threshold_ = t_lo();
         hist_.fill(0);
     }
 
@@ -438,8 +496,12 @@ private:
             }
             cum += c;
         }
-        return std::min(std::max(config_.k_noise * median, config_.t_min), config_.t_max);
+        return std::min(std::max(config_.k_noise * median, t_lo()), t_hi());
     }
+
+    // the threshold's bounds, scaled by set_threshold_scale (t_min, t_max at scale 1)
+    double t_lo() const { return std::min(threshold_scale_ * config_.t_min, 255.0); }
+    double t_hi() const { return std::min(threshold_scale_ * config_.t_max, 255.0); }
 
     BackgroundConfig config_;
     HsvBinning binning_;
@@ -448,9 +510,11 @@ private:
     long frame_count_ = 0;
     bool learning_ = false;  // started from a frame (not set_background): learning phase on
     double threshold_ = 0.0;
+    double threshold_scale_ = 1.0;  // set_threshold_scale
     std::vector<float> background_;      // planar rows: [y][channel][x]
     std::vector<std::uint8_t> previous_;  // interleaved, as the frame
     std::array<std::int64_t, 256> hist_{};
+    std::vector<double> ratios_;  // global_gain's sampled frame / background ratios
     std::vector<float> scratch_f_;  // row scratch: B, G, R planes, d_prev, candidate flag
     std::vector<std::int32_t> scratch_i_;  // row scratch: table indices, histogram bins
 };

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 
@@ -18,6 +19,7 @@ from pftrack.detection.base import (
     median_frame,
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
+from pftrack.detection.light import level_frames, looks_grey
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning, hsv_bins
 
@@ -74,6 +76,24 @@ class PaperConfig:
     leg_fill : float
         Share of a box's columns that a row below it must fill (shadow or foreground) for the
         box to grow into it.
+    grey_tolerance : float
+        Grey video (`pftrack.detection.light.looks_grey`): the priming frames (or the first
+        frame) count as grey when 99 % of their sampled pixels have channels within this many
+        grey levels of each other. 0 never treats a video as grey.
+    grey_shadow_lo : float
+        The shadow test's `shadow_lo` on a grey video (1: no shadow test there). Every pixel
+        of a grey video has the background's (grey) chromaticity, so with `shadow_lo` the
+        test calls every darker pixel shadow, dark clothes included.
+    gain_band : float
+        Global light change: before each frame, the frame's gain against the background
+        (``BackgroundModel.global_gain``: the median ratio of pixel sums over every 4th row and
+        column) is measured; outside ``[1 - gain_band, 1 + gain_band]`` the whole background is
+        scaled by it (``BackgroundModel.scale``). `prime` also brings its frames to the first
+        one's brightness first (`pftrack.detection.light.level_frames`). 0 turns both off.
+    gain_thresholds : bool
+        With the gain rule, scale the grey-level threshold bounds `t_min`, `t_max` by the
+        accumulated gain since the first frame (``BackgroundModel.set_threshold_scale``):
+        people's contrast, and the noise, scale with the light.
     blobs : BlobConfig
         Morphology and blob filters.
     hsv : HsvBinning
@@ -94,6 +114,10 @@ class PaperConfig:
     ghost_statistic: str = "vote"
     leg_height: float = 0.8
     leg_fill: float = 0.2
+    grey_tolerance: float = 3.0
+    grey_shadow_lo: float = 1.0
+    gain_band: float = 0.03
+    gain_thresholds: bool = True
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
@@ -110,6 +134,12 @@ class PaperConfig:
             raise ValueError(f"leg_height is {self.leg_height}, expected a finite value >= 0")
         if not (0.0 <= self.leg_fill <= 1.0):
             raise ValueError(f"leg_fill is {self.leg_fill}, expected in [0, 1]")
+        if not (0.0 <= self.grey_tolerance <= 255.0):
+            raise ValueError(f"grey_tolerance is {self.grey_tolerance}, expected in [0, 255]")
+        if not (0.0 <= self.grey_shadow_lo <= 1.0):
+            raise ValueError(f"grey_shadow_lo is {self.grey_shadow_lo}, expected in [0, 1]")
+        if not (0.0 <= self.gain_band < 1.0):
+            raise ValueError(f"gain_band is {self.gain_band}, expected in [0, 1)")
 
 
 class PaperDetector:
@@ -140,8 +170,14 @@ class PaperDetector:
 
     def __init__(self, config: PaperConfig | None = None) -> None:
         self.config = config if config is not None else PaperConfig()
+        self._model = self._new_model(self.config.shadow_lo)
+        self._blobs = BlobExtractor(self.config.blobs)
+        self._ghost: NDArray[np.uint8] | None = None  # pixels of ghosts still being learnt
+        self._grey: bool | None = None  # decided on the priming frames, else the first frame
+
+    def _new_model(self, shadow_lo: float) -> _core.BackgroundModel:
         c = self.config
-        self._model = _core.BackgroundModel(
+        return _core.BackgroundModel(
             alpha=c.alpha,
             alpha_fg=c.alpha_fg,
             n_learn=c.n_learn,
@@ -149,12 +185,51 @@ class PaperDetector:
             t_min=c.t_min,
             t_max=c.t_max,
             low_ratio=c.low_ratio,
-            shadow_lo=c.shadow_lo,
+            shadow_lo=shadow_lo,
             shadow_chroma=c.shadow_chroma,
             **asdict(c.hsv),
         )
-        self._blobs = BlobExtractor(c.blobs)
-        self._ghost: NDArray[np.uint8] | None = None  # pixels of ghosts still being learnt
+
+    @property
+    def grey(self) -> bool | None:
+        """Whether the video was found grey (None before the first frame or `prime`)."""
+        return self._grey
+
+    def _decide_grey(self, frames: list[NDArray[np.uint8]]) -> None:
+        """Look at the video's first frames once: on a grey video, the grey shadow bound."""
+        c = self.config
+        self._grey = c.grey_tolerance > 0 and looks_grey(frames, c.grey_tolerance)
+        shadow_lo = c.grey_shadow_lo if self._grey else c.shadow_lo
+        if self._model.shadow_lo != shadow_lo:  # before any frame: nothing learnt is lost
+            self._model = self._new_model(shadow_lo)
+        if self._grey:
+            warnings.warn(
+                "the video is grey (its colour channels are equal): the shadow test is "
+                f"{'off' if shadow_lo >= 1 else f'bounded by {shadow_lo}'} (every darker "
+                "pixel has the background's grey chromaticity, dark clothes too), real shadows "
+                "may be detected; without colour, people as bright as the background are "
+                "missed and the trackers tell people apart by brightness alone",
+                UserWarning,
+                stacklevel=3,
+            )
+
+    def _apply(
+        self, frame: NDArray[np.uint8], bins: bool
+    ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
+        """The C++ pass, after the grey test (first frame) or the global gain (later ones)."""
+        if not self._model.initialized:
+            if self._grey is None:
+                self._decide_grey([frame])
+        elif self.config.gain_band > 0:
+            gain = self._model.global_gain(frame)
+            if abs(gain - 1.0) > self.config.gain_band:
+                self._model.scale(gain)
+                if self.config.gain_thresholds and self._model.frame_count > 0:
+                    # contrasts (and noise) scale with the light: the grey-level thresholds
+                    # follow the brightness relative to the first frame's (a primed model's
+                    # first gain corrects the median's brightness, not a change of light)
+                    self._model.set_threshold_scale(self._model.threshold_scale * gain)
+        return self._model.apply(frame, bins=bins)
 
     @property
     def model(self) -> _core.BackgroundModel:
@@ -171,6 +246,7 @@ class PaperDetector:
         self._model.reset()
         self._blobs.reset()
         self._ghost = None
+        self._grey = None
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start from the per-pixel median of `frames` (e.g. frames spread over the video).
@@ -182,7 +258,12 @@ class PaperDetector:
         """
         # numpy.median(stack, axis=0)'s values, in C++ without stacking the frames (tests hold
         # the two equal): 0.23 s instead of 1.4-1.7 s for 30 frames of 1280x720, no stack
-        median = median_frame(frames, "PaperDetector.prime")
+        frames = list(frames)
+        # under a light change, the median of frames at their own brightness is biased where
+        # people stand often: the frames are brought to the first one's light
+        median = median_frame(level_frames(frames, self.config.gain_band), "PaperDetector.prime")
+        if self._grey is None:
+            self._decide_grey(frames)
         self._model.reset()
         self._model.set_background(median)
 
@@ -199,7 +280,7 @@ class PaperDetector:
         Detections
         """
         frame = check_frame(frame, "PaperDetector.detect")
-        _, raw = self._model.apply(frame, bins=False)  # bins below, of the foreground only
+        _, raw = self._apply(frame, bins=False)  # bins below, of the foreground only
         shaded = self._blobs.clean(raw)
         mask = foreground_only(shaded)
         if self.config.ghost_support > 0 and self._ghost is not None:
@@ -269,7 +350,7 @@ class PaperDetector:
         self, frame: NDArray[np.uint8], fn: str, bins: bool = True
     ) -> tuple[NDArray[np.uint8], _core.BinnedImage | None]:
         """The cleaned mask with shadows (255, 127, 0) and the frame's bins (None without)."""
-        binned, raw = self._model.apply(check_frame(frame, fn), bins=bins)
+        binned, raw = self._apply(check_frame(frame, fn), bins)
         return self._blobs.clean(raw), binned
 
 

@@ -1,0 +1,146 @@
+"""Footage the detector's per-pixel tests assume away: grey video, and a global light change.
+
+Two rules of `PaperDetector` (docs/detection.md, "Grey video and changing light"):
+
+* **Grey video.** The shadow test calls a candidate pixel shadow when it is darker than the
+  background with the background's chromaticity. In a grey video (B = G = R) every pixel has
+  the same, grey, chromaticity, so every darker pixel within the brightness bound is "shadow":
+  dark clothes vanish from the mask. :func:`looks_grey` tells such a video from its first
+  frames; the detector then uses ``PaperConfig.grey_shadow_lo`` as the bound (1: no shadow
+  test).
+* **Global gain.** A background learnt at one brightness reads a whole frame taken at another
+  as foreground, and the selective update (slow where foreground) does not catch up.
+  ``BackgroundModel.global_gain`` measures the frame's gain against the background (median
+  ratio of the pixel sums over a grid); when it leaves ``1 +- PaperConfig.gain_band`` the
+  background is scaled by it (``BackgroundModel.scale``) before the frame is compared, and
+  the grey-level thresholds by the gain accumulated since the first frame
+  (``BackgroundModel.set_threshold_scale``). :func:`level_frames` brings the priming frames
+  to one brightness before their median.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "GREY_SAMPLE_STEP",
+    "MIN_CONTENT",
+    "channel_spread",
+    "frame_gain",
+    "level_frames",
+    "looks_grey",
+]
+
+GREY_SAMPLE_STEP = 4
+"""Every how many rows and columns :func:`channel_spread` reads a pixel."""
+
+MIN_CONTENT = 8.0
+"""Least standard deviation of the sampled levels for :func:`looks_grey` to call frames grey."""
+
+
+def channel_spread(frame: NDArray[np.uint8], step: int = GREY_SAMPLE_STEP) -> NDArray[np.int16]:
+    """``max_c I_c - min_c I_c`` of every `step`-th pixel of every `step`-th row, flattened.
+
+    Parameters
+    ----------
+    frame : (H, W, 3) ndarray of uint8
+        A BGR frame.
+    step : int
+        Sampling step in rows and columns.
+
+    Returns
+    -------
+    (K,) ndarray of int16
+    """
+    px = np.asarray(frame[::step, ::step], np.int16).reshape(-1, 3)
+    return np.asarray(px.max(axis=1) - px.min(axis=1), np.int16)
+
+
+def looks_grey(frames: Iterable[NDArray[np.uint8]], tolerance: float = 3.0) -> bool:
+    """True when the frames are grey (B = G = R up to compression).
+
+    Grey when 99 % of their sampled pixels have channels within `tolerance` grey levels of
+    each other: compression leaves grey video a level or two of colour, where the 99th
+    percentile is 92 on PETS09-S2L1 and 41 on TUD-Campus (their first 30 frames).
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, 3) uint8 arrays
+        E.g. the frames that prime the background, or the first frame.
+    tolerance : float
+        Largest channel spread of a grey pixel, in grey levels.
+
+    Returns
+    -------
+    bool
+        False for no frames, and for frames whose sampled levels vary by less than
+        `MIN_CONTENT` (standard deviation): black or flat frames.
+    """
+    frames = list(frames)
+    if not frames:
+        return False
+    spread = np.concatenate([channel_spread(f) for f in frames])
+    level = np.concatenate([f[::GREY_SAMPLE_STEP, ::GREY_SAMPLE_STEP, 1].ravel() for f in frames])
+    # a blank or flat picture (no video, a test pattern) tells nothing about colour
+    return bool(np.percentile(spread, 99) <= tolerance and level.std() >= MIN_CONTENT)
+
+
+def frame_gain(
+    frame: NDArray[np.uint8], reference: NDArray[np.uint8], step: int = 4, min_sum: float = 30.0
+) -> float:
+    """Global gain of `frame` against `reference`: ``BackgroundModel.global_gain``'s measure.
+
+    The median, over every `step`-th pixel of every `step`-th row whose reference sum
+    ``R_b + R_g + R_r`` is at least `min_sum`, of ``sum(I) / sum(R)``; 1 when none qualifies.
+
+    Parameters
+    ----------
+    frame, reference : (H, W, 3) ndarray of uint8
+        Two BGR frames of one size.
+    step : int
+        Sampling step in rows and columns.
+    min_sum : float
+        Least reference sum of a sampled pixel (dark pixels give noisy ratios).
+
+    Returns
+    -------
+    float
+    """
+    sr = reference[::step, ::step].astype(np.float64).sum(axis=2)
+    si = frame[::step, ::step].astype(np.float64).sum(axis=2)
+    keep = (sr >= min_sum) & (sr > 0)
+    return float(np.median(si[keep] / sr[keep])) if keep.any() else 1.0
+
+
+def level_frames(frames: list[NDArray[np.uint8]], band: float) -> list[NDArray[np.uint8]]:
+    """The frames brought to the first one's brightness, for a per-pixel median.
+
+    Under a global light change the median of frames spread over a video is biased wherever
+    people stand in many of them: the background values then span the light's range and the
+    median is their upper or lower end, not the middle. Each frame whose `frame_gain` against
+    the first leaves ``1 +- band`` is divided by it (rounded, clipped to 0..255); the others
+    are returned as they are (the same objects), so steady video is unchanged.
+
+    Parameters
+    ----------
+    frames : list of (H, W, 3) uint8 arrays
+        E.g. the frames that prime the background.
+    band : float
+        Gains within ``1 +- band`` are left alone; 0 returns `frames` unchanged.
+
+    Returns
+    -------
+    list of (H, W, 3) uint8 arrays
+    """
+    if band <= 0 or len(frames) < 2:
+        return frames
+    out = [frames[0]]
+    for f in frames[1:]:
+        g = frame_gain(f, frames[0])
+        if abs(g - 1.0) > band:
+            f = np.clip(np.rint(f.astype(np.float32) / np.float32(g)), 0, 255).astype(np.uint8)
+        out.append(f)
+    return out

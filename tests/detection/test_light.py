@@ -1,0 +1,296 @@
+"""Grey video and global light changes: the rules of `pftrack.detection.light`."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from pftrack import _core
+from pftrack.detection import PaperConfig, PaperDetector
+from pftrack.detection.light import channel_spread, frame_gain, level_frames, looks_grey
+from pftrack.eval import evaluate_mot
+from pftrack.synthetic import make_scene
+from pftrack.tracking import track_frames
+from tests.detection.test_background_model import random_scene
+from tests.reference.detection import (
+    BackgroundReference,
+    global_gain_reference,
+    scale_reference,
+)
+
+GREY_WARNING = "ignore:the video is grey:UserWarning"
+
+
+def to_grey(frame: np.ndarray) -> np.ndarray:
+    return cv2.cvtColor(cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY), cv2.COLOR_GRAY2BGR)
+
+
+def ramped(frames: list[np.ndarray], floor: float = 0.4) -> list[np.ndarray]:
+    """Brightness times 1 at the first frame down to `floor` at the last (float32, truncated)."""
+    n = len(frames)
+    return [
+        np.clip(f.astype(np.float32) * (1.0 - (1.0 - floor) * k / (n - 1)), 0, 255).astype(np.uint8)
+        for k, f in enumerate(frames)
+    ]
+
+
+# -- the C++ kernels against their NumPy references ------------------------------------------------
+@pytest.mark.parametrize("step", [1, 3, 4])
+def test_global_gain_equals_reference(step: int) -> None:
+    rng = np.random.default_rng(step)
+    for shape in ((37, 53), (48, 64)):
+        bg = rng.uniform(0, 255, (*shape, 3)).astype(np.float32)
+        bg[:5] = 3.0  # dark rows: below min_sum, left out
+        frame = np.clip(bg * rng.uniform(0.3, 1.5) + rng.normal(0, 4, bg.shape), 0, 255)
+        frame = frame.astype(np.uint8)
+        m = _core.BackgroundModel()
+        m.set_background(bg)
+        assert m.global_gain(frame, step) == pytest.approx(
+            global_gain_reference(frame, bg, step), rel=0, abs=1e-12
+        )
+    m = _core.BackgroundModel()
+    m.set_background(np.zeros((8, 8, 3), np.float32))
+    assert m.global_gain(np.zeros((8, 8, 3), np.uint8)) == 1.0  # no pixel qualifies
+
+
+def test_scale_equals_reference_and_clips() -> None:
+    rng = np.random.default_rng(1)
+    bg = rng.uniform(0, 255, (20, 30, 3)).astype(np.float32)
+    for gain in (0.4, 1.07, 1.9):
+        m = _core.BackgroundModel()
+        m.set_background(bg)
+        m.scale(gain)
+        np.testing.assert_array_equal(m.background, scale_reference(bg, gain))
+    assert m.background.max() == 255.0
+
+
+@pytest.mark.parametrize("kw", [{}, {"t_min": 8.0, "t_max": 200.0, "k_noise": 30.0}])
+def test_threshold_scale_equals_reference(kw: dict[str, float]) -> None:
+    # the gain rule's loop (gain, scale, threshold scale) on a darkening then brightening scene
+    frames = random_scene(np.random.default_rng(5), steps=8)
+    light = [1.0, 0.8, 0.6, 0.5, 0.5, 0.9, 1.4, 2.0]
+    frames = [np.clip(f * g, 0, 255).astype(np.uint8) for f, g in zip(frames, light, strict=True)]
+    model, ref = _core.BackgroundModel(n_learn=2, **kw), BackgroundReference(n_learn=2, **kw)
+    for k, frame in enumerate(frames):
+        if k > 0:
+            gain = model.global_gain(frame)
+            assert gain == global_gain_reference(frame, ref.background)
+            model.scale(gain)
+            ref.background = scale_reference(ref.background, gain)
+            model.set_threshold_scale(model.threshold_scale * gain)
+            ref.set_threshold_scale(ref.threshold_scale * gain)
+            assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
+        _, mask = model.apply(frame)
+        _, rmask = ref.apply(frame)
+        np.testing.assert_array_equal(mask, rmask)
+        np.testing.assert_array_equal(model.background, ref.background)
+        assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
+    lo = min(model.threshold_scale * model.t_min, 255.0)
+    assert lo <= model.threshold <= min(model.threshold_scale * model.t_max, 255.0)
+    model.reset()
+    assert model.threshold_scale == 1.0 and model.threshold == model.t_min
+
+
+def test_threshold_scale_bounds_the_threshold() -> None:
+    m = _core.BackgroundModel(t_min=25.0, t_max=60.0)
+    m.set_background(np.full((4, 4, 3), 100, np.float32))
+    assert m.threshold == 25.0
+    m.set_threshold_scale(0.4)
+    assert m.threshold == pytest.approx(10.0)  # 25 * 0.4, in the new bounds [10, 24]
+    m.set_threshold_scale(20.0)
+    assert m.threshold == 255.0  # 10 * 50 = 500, clamped to 255 (t_min * 20 = 500 > 255)
+    for bad in (0.0, -1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="s"):
+            m.set_threshold_scale(bad)
+
+
+def test_gain_errors() -> None:
+    m = _core.BackgroundModel()
+    with pytest.raises(ValueError, match="no background"):
+        m.global_gain(np.zeros((4, 4, 3), np.uint8))
+    with pytest.raises(ValueError, match="no background"):
+        m.scale(1.1)
+    m.set_background(np.full((4, 4, 3), 100, np.float32))
+    with pytest.raises(ValueError, match="gain"):
+        m.scale(0.0)
+    with pytest.raises(ValueError, match="frame shape"):
+        m.global_gain(np.zeros((5, 4, 3), np.uint8))
+    with pytest.raises(ValueError, match="step"):
+        m.global_gain(np.zeros((4, 4, 3), np.uint8), 0)
+
+
+# -- the grey test ---------------------------------------------------------------------------------
+def test_looks_grey() -> None:
+    scene = make_scene(n_frames=3, rng=0)
+    colour = scene.frames
+    assert not looks_grey(colour)
+    grey = [to_grey(f) for f in colour]
+    assert looks_grey(grey)
+    assert channel_spread(grey[0]).max() == 0
+    # a compressed grey video keeps a level or two of colour
+    noisy = [np.clip(g.astype(int) + np.random.default_rng(0).integers(-1, 2, g.shape), 0, 255)
+             .astype(np.uint8) for g in grey]  # fmt: skip
+    assert looks_grey(noisy)
+    assert not looks_grey([])
+    assert not looks_grey(grey, tolerance=0) or channel_spread(grey[0]).max() == 0
+
+
+def dark_walker(n: int = 40, colour: tuple[int, int, int] = (150, 60, 50)) -> list[np.ndarray]:
+    """A textured grey-stone background with one walker of `colour` (BGR): in grey, the walker
+    is 0.56 of the background's brightness, which the shadow test (bound 0.5) calls shadow."""
+    rng = np.random.default_rng(0)
+    base = np.clip(rng.normal(120, 6, (120, 160, 3)), 0, 255)
+    frames = []
+    for k in range(n):
+        f = base + rng.normal(0, 2, base.shape)
+        x = 10 + 3 * k
+        f[30:90, x : x + 20] = colour
+        frames.append(np.clip(f, 0, 255).astype(np.uint8))
+    return frames
+
+
+@pytest.mark.filterwarnings(GREY_WARNING)
+def test_grey_video_keeps_dark_clothes() -> None:
+    colour = dark_walker()
+    grey = [to_grey(f) for f in colour]
+    found = {}
+    for name, frames, cfg in (
+        ("colour", colour, PaperConfig()),
+        ("grey", grey, PaperConfig()),
+        ("grey, test kept", grey, PaperConfig(grey_shadow_lo=0.5)),
+    ):
+        det = PaperDetector(cfg)
+        det.prime(frames[:: len(frames) // 10])
+        found[name] = sum((det.detect(f).mask[30:90] == 255).mean() for f in frames[5:])
+        assert det.grey == (name != "colour")
+        assert det.model.shadow_lo == (0.5 if name != "grey" else 1.0)
+    assert found["grey"] > 0.8 * found["colour"]
+    assert found["grey, test kept"] < 0.2 * found["colour"]  # the defect: dark clothes = shadow
+
+
+def test_grey_warns_once_and_decides_on_the_first_frame() -> None:
+    grey = [to_grey(f) for f in dark_walker(4)]
+    det = PaperDetector()
+    with pytest.warns(UserWarning, match="the video is grey"):
+        det.detect(grey[0])
+    assert det.grey is True and det.model.shadow_lo == 1.0
+    det.detect(grey[1])  # no second warning (filterwarnings = error would raise on another)
+    det.reset()
+    assert det.grey is None
+    det = PaperDetector(PaperConfig(grey_tolerance=0))
+    det.detect(grey[0])
+    assert det.grey is False and det.model.shadow_lo == 0.5
+
+
+def test_config_checks() -> None:
+    for bad in ({"grey_tolerance": -1}, {"grey_shadow_lo": 1.5}, {"gain_band": 1.0}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            PaperConfig(**bad)  # type: ignore[arg-type]
+
+
+# -- tracking: grey and ramped synthetic scenes against the colour one ----------------------------
+def mota(frames: list[np.ndarray], truth: np.ndarray) -> float:
+    run = track_frames(frames, rng=0, bootstrap="auto", show_progress=False)
+    return float(evaluate_mot(truth, run.rows).mota)
+
+
+def dark_clothes(scene_rng: int = 3, n: int = 80) -> tuple[list[np.ndarray], np.ndarray]:
+    """`make_scene` with every walker's pixels made dark bluish clothes (B, G, R times 0.9,
+    0.5, 0.45 of the ground behind): in colour not shadow-like, in grey 0.53 of the ground's
+    brightness, which the shadow test (bound 0.5) took for shadow."""
+    scene = make_scene(n_frames=n, rng=scene_rng, occluder=False)
+    bg = scene.background.astype(np.float32)
+    dark = np.clip(bg * np.array([0.9, 0.5, 0.45], np.float32), 0, 255).astype(np.uint8)
+    frames = []
+    for f in scene.frames:
+        walker = np.abs(f.astype(np.int16) - scene.background).max(axis=2) > 40
+        g = f.copy()
+        g[walker] = dark[walker]
+        frames.append(g)
+    return frames, scene.truth
+
+
+@pytest.mark.filterwarnings(GREY_WARNING)
+@pytest.mark.xfail(
+    reason="known gap: with the shadow test off the grey detector still finds far fewer of "
+    "these walkers (R@0.5 0.49 against 0.90, P 0.27 against 0.72): cause not found yet",
+    strict=True,
+)
+def test_grey_scene_tracks_about_as_well_as_its_colour_version() -> None:
+    frames, truth = dark_clothes()
+    colour_score = mota(frames, truth)
+    grey_score = mota([to_grey(f) for f in frames], truth)
+    assert colour_score > 0.3
+    assert grey_score >= colour_score - 0.05, (colour_score, grey_score)
+
+
+def test_ramped_scene_with_the_auto_bootstrap() -> None:
+    scene = make_scene(n_frames=100, rng=0)
+    frames = ramped(scene.frames, 0.7)
+    plain = mota(scene.frames, scene.truth)
+    ramp = mota(frames, scene.truth)
+    assert ramp >= plain - 0.05, (plain, ramp)
+    det = PaperDetector(PaperConfig(gain_band=0))  # the defect without the gain: frames darker
+    # than the spread median read as foreground almost everywhere
+    frames = ramped(scene.frames)  # down to 0.4
+    det.prime(frames[:: len(frames) // 30])
+    worst = max((det.detect(f).mask > 0).mean() for f in frames[:10])
+    det = PaperDetector()
+    det.prime(frames[:: len(frames) // 30])
+    fixed = max((det.detect(f).mask > 0).mean() for f in frames[:10])
+    assert worst > 0.5 and fixed < 0.1, (worst, fixed)
+
+
+# -- the priming median under a light change ------------------------------------------------------
+def test_level_frames_leaves_steady_video_alone_and_levels_a_ramp() -> None:
+    scene = make_scene(n_frames=30, rng=0)
+    steady = scene.frames[::3]
+    assert all(a is b for a, b in zip(level_frames(steady, 0.03), steady, strict=True))
+    assert level_frames(steady, 0.0) is steady
+    dark = ramped(steady)
+    levelled = level_frames(dark, 0.03)
+    assert levelled[0] is dark[0]
+    for f in levelled[1:]:
+        assert abs(frame_gain(f, dark[0]) - 1.0) <= 0.03
+
+
+def test_prime_is_not_biased_by_a_person_standing_under_a_ramp() -> None:
+    # a bright person stands in 40 % of the priming frames while the light falls to 0.4: the
+    # median of the frames as they are takes the upper end of the ground's values there
+    rng = np.random.default_rng(0)
+    ground = rng.integers(60, 120, (60, 80, 3)).astype(np.float32)
+    frames = []
+    for k in range(30):
+        f = ground.copy()
+        if k % 5 < 2:
+            f[10:50, 30:45] = 250.0
+        frames.append(f)
+    frames = ramped([np.clip(f, 0, 255).astype(np.uint8) for f in frames])
+    box = (slice(10, 50), slice(30, 45))
+    for band, ok in ((0.0, False), (0.03, True)):
+        det = PaperDetector(PaperConfig(gain_band=band))
+        det.prime(frames)
+        bg = det.model.background
+        # the first frame's light (the ground is at the first frame's brightness outside)
+        ratio = bg[box].sum() / ground[box].sum()
+        outside = bg[:10].sum() / ground[:10].sum()
+        assert (abs(ratio - 1.0) < 0.05) == ok, (band, ratio)
+        assert (abs(ratio - outside) < 0.05) == ok, (band, ratio, outside)
+
+
+def test_detector_thresholds_follow_the_light() -> None:
+    scene = make_scene(n_frames=60, rng=0)
+    frames = ramped(scene.frames)
+    det = PaperDetector()
+    det.prime(frames[:: len(frames) // 30])
+    for f in frames:
+        det.detect(f)
+    # relative to the first frame's light (0.4 at the last frame; the band lets it lag 3 %)
+    assert 0.38 <= det.model.threshold_scale <= 0.43, det.model.threshold_scale
+    assert det.model.threshold <= 0.43 * 60.0
+    off = PaperDetector(PaperConfig(gain_thresholds=False))
+    off.prime(frames[:: len(frames) // 30])
+    for f in frames:
+        off.detect(f)
+    assert off.model.threshold_scale == 1.0
