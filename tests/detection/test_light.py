@@ -294,3 +294,21 @@ def test_detector_thresholds_follow_the_light() -> None:
     for f in frames:
         off.detect(f)
     assert off.model.threshold_scale == 1.0
+
+
+def test_sample_step_keeps_4_up_to_vga_and_the_sample_count_above() -> None:
+    from pftrack.detection.light import sample_step
+
+    assert [sample_step((h, w)) for h, w in ((360, 480), (480, 640), (64, 64))] == [4, 4, 4]
+    assert sample_step((720, 1280)) == 7 and sample_step((1080, 1920)) == 10
+    for h, w in ((720, 1280), (1080, 1920), (2160, 3840)):
+        n = len(range(0, h, sample_step((h, w)))) * len(range(0, w, sample_step((h, w))))
+        assert 0.7 * 120 * 160 <= n <= 1.3 * 120 * 160  # about 640x480's 19 200 samples
+
+
+def test_a_colour_video_is_told_from_its_first_frame() -> None:
+    rng = np.random.default_rng(0)
+    colour = rng.integers(0, 255, (48, 64, 3), dtype=np.uint8)
+    grey = np.repeat(rng.integers(0, 255, (48, 64, 1), dtype=np.uint8), 3, axis=2)
+    assert not looks_grey([colour, grey, grey])
+    assert looks_grey([grey, grey]) and not looks_grey([grey, colour])
