@@ -301,6 +301,7 @@ def test_sample_step_keeps_4_up_to_vga_and_the_sample_count_above() -> None:
 
     assert [sample_step((h, w)) for h, w in ((360, 480), (480, 640), (64, 64))] == [4, 4, 4]
     assert sample_step((720, 1280)) == 7 and sample_step((1080, 1920)) == 10
+    assert sample_step((360, 480), 8) == 8 and sample_step((720, 1280), 8) == 14  # the gain's
     for h, w in ((720, 1280), (1080, 1920), (2160, 3840)):
         n = len(range(0, h, sample_step((h, w)))) * len(range(0, w, sample_step((h, w))))
         assert 0.7 * 120 * 160 <= n <= 1.3 * 120 * 160  # about 640x480's 19 200 samples

@@ -19,7 +19,7 @@ from pftrack.detection.base import (
     median_frame,
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
-from pftrack.detection.light import level_frames, looks_grey, sample_step
+from pftrack.detection.light import GAIN_SAMPLE_STEP, level_frames, looks_grey, sample_step
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning, hsv_bins
 
@@ -86,7 +86,7 @@ class PaperConfig:
         test calls every darker pixel shadow, dark clothes included.
     gain_band : float
         Global light change: before each frame, the frame's gain against the background
-        (``BackgroundModel.global_gain``: the median ratio of pixel sums over every 4th row and
+        (``BackgroundModel.global_gain``: the median ratio of pixel sums over every 8th row and
         column up to 640x480, sparser on larger frames: `pftrack.detection.light.sample_step`)
         is measured; outside ``[1 - gain_band, 1 + gain_band]`` the whole background is
         scaled by it (``BackgroundModel.scale``). `prime` also brings its frames to the first
@@ -222,7 +222,7 @@ class PaperDetector:
             if self._grey is None:
                 self._decide_grey([frame])
         elif self.config.gain_band > 0:
-            gain = self._model.global_gain(frame, sample_step(frame.shape))
+            gain = self._model.global_gain(frame, sample_step(frame.shape, GAIN_SAMPLE_STEP))
             if abs(gain - 1.0) > self.config.gain_band:
                 self._model.scale(gain)
                 if self.config.gain_thresholds and self._model.frame_count > 0:
