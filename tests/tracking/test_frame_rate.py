@@ -143,16 +143,35 @@ def test_motion_gain_rule():
     cfg = TrackerConfig(motion=MotionConfig(speed_reference=0.05))
     tr = MultiObjectTracker(cfg, rng=0)
     assert tr.motion_gain() == 1.0
-    tr._speeds = [0.1] * (MIN_SPEED_SAMPLES - 1)
+    for _ in range(MIN_SPEED_SAMPLES - 1):
+        tr._speeds.add(0.1)
     assert tr.motion_gain() == 1.0  # too few samples
-    tr._speeds.append(0.1)
+    tr._speeds.add(0.1)
     assert tr.motion_gain() == pytest.approx(2.0**1.5)
-    tr._speeds = [0.02] * MIN_SPEED_SAMPLES
-    assert tr.motion_gain() == 1.0  # slower than the reference: as given
+    slow = MultiObjectTracker(cfg, rng=0)
+    for _ in range(MIN_SPEED_SAMPLES):
+        slow._speeds.add(0.02)
+    assert slow.motion_gain() == 1.0  # slower than the reference: as given
     none = dataclasses.replace(cfg, motion=MotionConfig(speed_reference=None))
     off = MultiObjectTracker(none, rng=0)
-    off._speeds = [0.1] * MIN_SPEED_SAMPLES
+    for _ in range(MIN_SPEED_SAMPLES):
+        off._speeds.add(0.1)
     assert off.motion_gain() == 1.0  # None: the levels as given
+
+
+def test_rolling_median_is_numpys_median_of_the_last_values():
+    from pftrack.tracking.tracker import RollingMedian
+
+    rng = np.random.default_rng(0)
+    values = np.round(rng.gamma(2.0, 0.03, 400), 3)  # ties too
+    for size in (1, 2, 7, 50, 1000):
+        m = RollingMedian(size)
+        assert m.median() is None and len(m) == 0
+        for k, v in enumerate(values):
+            m.add(v)
+            window = values[max(0, k + 1 - size) : k + 1]
+            assert len(m) == len(window)
+            assert m.median() == float(np.median(window))  # the same float
 
 
 def test_speed_reference_is_checked():

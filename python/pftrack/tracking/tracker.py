@@ -14,9 +14,11 @@ one joint sampler replaces all of this (:mod:`.joint`).
 
 from __future__ import annotations
 
+import bisect
 import inspect
 import itertools
 import math
+from collections import deque
 from collections.abc import Iterable
 from typing import Any
 
@@ -48,6 +50,42 @@ __all__ = ["MultiObjectTracker"]
 MIN_SPEED_SAMPLES = 20
 #: The most recent speed samples kept.
 MAX_SPEED_SAMPLES = 5000
+
+
+class RollingMedian:
+    """The median of the last `size` values added, exactly ``np.median``'s, in O(log n + n/w).
+
+    A sorted list beside the values in arrival order: adding one is a binary search and a
+    list insert (and the oldest's removal once full), the median one or two reads. The
+    tracker asks for its speed median every frame: ``np.median`` of 5000 samples took about
+    0.1 ms a frame.
+    """
+
+    def __init__(self, size: int) -> None:
+        self.size = int(size)
+        self._order: deque[float] = deque()
+        self._sorted: list[float] = []
+
+    def add(self, value: float) -> None:
+        """Add `value`; the oldest value leaves once there are more than `size`."""
+        v = float(value)
+        self._order.append(v)
+        bisect.insort(self._sorted, v)
+        if len(self._order) > self.size:
+            old = self._order.popleft()
+            del self._sorted[bisect.bisect_left(self._sorted, old)]
+
+    def __len__(self) -> int:
+        return len(self._sorted)
+
+    def median(self) -> float | None:
+        """``float(np.median(values))`` of the values held, None when there is none."""
+        n = len(self._sorted)
+        if n == 0:
+            return None
+        if n % 2:
+            return self._sorted[n // 2]
+        return (self._sorted[n // 2 - 1] + self._sorted[n // 2]) / 2
 
 
 class MultiObjectTracker:
@@ -103,7 +141,8 @@ class MultiObjectTracker:
         self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
         self._background_ok = True  # False while the camera moves (see .camera)
         self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
-        self._speeds: list[float] = []  # confirmed tracks' speeds (see motion_gain)
+        # confirmed tracks' speeds (see motion_gain), the most recent ones
+        self._speeds = RollingMedian(MAX_SPEED_SAMPLES)
         self._gain = 1.0
 
     @property
@@ -269,7 +308,7 @@ class MultiObjectTracker:
         Each sample is a confirmed track's distance between two of its matched detections
         ``MotionConfig.speed_span`` or more frames apart, over its height and the frames between.
         """
-        return float(np.median(self._speeds)) if self._speeds else None
+        return self._speeds.median()
 
     def motion_gain(self) -> float:
         """The factor of the per-frame acceleration levels for the speed measured so far.
@@ -281,9 +320,10 @@ class MultiObjectTracker:
         the acceleration's standard level per frame.
         """
         ref = self.config.motion.speed_reference
-        if ref is None or len(self._speeds) < MIN_SPEED_SAMPLES:
+        median = self._speeds.median()
+        if ref is None or median is None or len(self._speeds) < MIN_SPEED_SAMPLES:
             return 1.0
-        return float(max(1.0, float(np.median(self._speeds)) / ref) ** 1.5)
+        return float(max(1.0, median / ref) ** 1.5)
 
     @property
     def tracks_started(self) -> int:
@@ -468,9 +508,7 @@ class MultiObjectTracker:
             b = boxes[di]
             v = t.speed(self.frame_index, b[:2] + b[2:] / 2, float(b[3]), span)
             if v is not None and t.hits >= n:
-                self._speeds.append(v)
-        if len(self._speeds) > MAX_SPEED_SAMPLES:  # the most recent ones
-            del self._speeds[: len(self._speeds) - MAX_SPEED_SAMPLES]
+                self._speeds.add(v)
         self._gain = self.motion_gain()
 
 
