@@ -419,3 +419,41 @@ def test_refine_min_height_is_checked_and_defaults_to_0_6():
     for bad in (-0.1, 1.5):
         with pytest.raises(ValueError, match=r"RefineConfig: min_height is .*\[0, 1\]"):
             RefineConfig(min_height=bad)
+
+
+def test_tiny_boxes_inside_the_frame_are_ignored_at_the_border_kept():
+    from pftrack.tracking.tracker import tiny_inside
+
+    boxes = np.array(
+        [
+            [100.0, 100.0, 5.0, 5.0],  # speckle: ignored
+            [100.0, 100.0, 8.0, 8.0],  # 64 pixels: kept
+            [0.0, 100.0, 3.0, 30.0],  # a person entering at the left border: kept
+            [150.0, 355.0, 6.0, 5.0],  # touching the bottom of a 360-row frame: kept
+        ]
+    )
+    assert tiny_inside(boxes, (360, 480, 3), 64.0).tolist() == [True, False, False, False]
+    assert not tiny_inside(boxes, (360, 480, 3), 0.0).any()
+    with pytest.raises(ValueError, match=r"min_area is -1"):
+        LifecycleConfig(min_area=-1.0)
+
+
+def test_a_speckle_of_tiny_boxes_changes_nothing():
+    scene = make_scene(n_frames=40, width=240, height=180, n_walkers=3, rng=2)
+    by_frame = group_by_frame(scene.truth)
+    rng = np.random.default_rng(0)
+
+    def run(speckle: bool) -> np.ndarray:
+        tracker = MultiObjectTracker(TrackerConfig(), rng=0)
+        rows = []
+        for k, frame in enumerate(scene.frames, 1):
+            r = by_frame.get(k, np.zeros((0, 10)))
+            dets = np.column_stack([r[:, 2:6], np.full(len(r), 0.95)])
+            if speckle:
+                xy = rng.uniform(10, 160, (20, 2))
+                tiny = np.column_stack([xy, rng.uniform(2, 6, (20, 2)), np.full(20, 0.95)])
+                dets = np.vstack([dets, tiny])
+            rows += [(k, t.id, *t.box_xywh) for t in tracker.update(frame, dets)]
+        return np.array(rows)
+
+    np.testing.assert_array_equal(run(True), run(False))

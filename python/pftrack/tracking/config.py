@@ -106,6 +106,14 @@ class LifecycleConfig:
     min_score : float
         Detections with a lower score are ignored (``min_conf`` of :class:`pftrack.Tracker`,
         ``--min-conf``).
+    min_area : float
+        A detection smaller than this many pixels (width x height, in the tracker's pixels)
+        and clear of the frame's border is ignored, as one below `min_score`: a colour
+        reference of 110 bins from fewer pixels than an 8x8 box says little, and a detector's
+        speckle of tiny boxes otherwise starts tracks and pulls others (PETS09-S2L1 with 60
+        random boxes of 2-6 px a frame added to its public detections: MOTA 31.3, and 77.9
+        with this rule, as without the speckle; docs/tracking.md). A small box touching the
+        border is kept: an object entering or leaving the frame. 0 keeps every box.
     birth_score : float
         An external detection starts a track only with at least this score (a detection too
         unsure to start a track can still keep one alive, as in ByteTrack). Applied while every
@@ -169,6 +177,7 @@ class LifecycleConfig:
     """
 
     min_score: float = 0.0
+    min_area: float = 64.0
     birth_score: float = 0.9
     birth_quantile: float | None = 0.25
     birth_window: int = 50
@@ -210,6 +219,10 @@ class LifecycleConfig:
             _in_unit_interval("LifecycleConfig", birth_quantile=self.birth_quantile)
         if not np.isfinite(self.min_score):
             raise ValueError(f"LifecycleConfig: min_score is {self.min_score}, expected a number")
+        if not (np.isfinite(self.min_area) and self.min_area >= 0):
+            raise ValueError(
+                f"LifecycleConfig: min_area is {self.min_area}, expected a finite value >= 0"
+            )
 
 
 @dataclass(frozen=True)

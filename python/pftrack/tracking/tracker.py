@@ -395,7 +395,10 @@ class MultiObjectTracker:
             labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
             if len(labels) != len(boxes):
                 raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
-        index = (scores >= cfg.lifecycle.min_score).nonzero()[0]
+        index = (
+            (scores >= cfg.lifecycle.min_score)
+            & ~tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
+        ).nonzero()[0]
         boxes, scores, labels = boxes[index], scores[index], labels[index]
         if cfg.sampler == "rjmcmc":
             if len(np.unique(labels)) > 1:
@@ -510,6 +513,24 @@ class MultiObjectTracker:
             if v is not None and t.hits >= n:
                 self._speeds.add(v)
         self._gain = self.motion_gain()
+
+
+def tiny_inside(boxes: F64, shape: tuple[int, ...], min_area: float) -> NDArray[np.bool_]:
+    """Which `boxes` (``left, top, w, h``) are small and clear of the frame's border.
+
+    Small: under `min_area` pixels (``LifecycleConfig.min_area``). A small box that touches
+    the border is kept: the visible part of an object entering or leaving the frame.
+    """
+    rows, cols = shape[0], shape[1]
+    small = boxes[:, 2] * boxes[:, 3] < min_area
+    clear = (
+        (boxes[:, 0] > 0.5)
+        & (boxes[:, 1] > 0.5)
+        & (boxes[:, 0] + boxes[:, 2] < cols - 0.5)
+        & (boxes[:, 1] + boxes[:, 3] < rows - 0.5)
+    )
+    out: NDArray[np.bool_] = small & clear
+    return out
 
 
 def sorted_quantile(values: F64, q: float) -> float:
