@@ -13,7 +13,8 @@ void register_likelihood(py::module_& m) {
             py::gil_scoped_release nogil;  // safe: Eigen views only
             return bhattacharyya_coefficient(hists, ref);
         },
-        py::arg("hists"), py::arg("ref"), "rho (K,) of histograms (K, B) against ref (B,).");
+        py::arg("hists"), py::arg("ref"),
+        "rho (K,) of histograms (K, B) against ref (B,), each row and ref normalised to sum 1.");
 
     m.def(
         "bhattacharyya_distance",

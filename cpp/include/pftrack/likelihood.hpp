@@ -69,20 +69,30 @@ inline void check_histograms(const Eigen::MatrixBase<Derived>& h, const char* fn
             }
 }
 
-/// rho of each row of `hists` (K, B) against `ref` (B,). `hists` maps row-major rows without a
-/// copy (a column-major argument gets one temporary copy from Eigen::Ref).
+/// rho of each row of `hists` (K, B) against `ref` (B,), each normalised to sum 1 as `ref` is:
+/// rho_i = sum_k sqrt(h_ik q_k) / sqrt(sum_k h_ik), so counts and frequencies give the same rho,
+/// and a row of zeros (no pixel counted) has rho 0. `hists` maps row-major rows without a copy
+/// (a column-major argument gets one temporary copy from Eigen::Ref).
 template <class DerivedRef>
 inline Eigen::VectorXd bhattacharyya_coefficient(const Eigen::Ref<const RowMatrixXd>& h,
                                                  const Eigen::MatrixBase<DerivedRef>& ref) {
     const char* fn = "bhattacharyya_coefficient";
     const Eigen::VectorXd sq = sqrt_reference(ref, h.cols(), fn);
+    const int n = static_cast<int>(h.cols());
     Eigen::VectorXd rho(h.rows());
-    bool finite = true;
     for (Index i = 0; i < h.rows(); ++i) {
-        rho(i) = bhattacharyya_coefficient_row(h.row(i).data(), sq.data(), static_cast<int>(h.cols()));
-        finite &= std::isfinite(rho(i));
+        const double* row = h.row(i).data();
+        double total = 0.0;
+        for (int k = 0; k < n; ++k) total += row[k];
+        const double r = bhattacharyya_coefficient_row(row, sq.data(), n);
+        if (!(std::isfinite(r) && std::isfinite(total))) {
+            check_histograms(h, fn);  // a negative or non-finite entry: throws, naming it
+            fail(fn, "hists row " + std::to_string(i) +
+                         " sum is not finite (overflow: the counts are finite but their total "
+                         "exceeds the largest double, 1.8e308; scale them down)");
+        }
+        rho(i) = total > 0.0 ? r / std::sqrt(total) : 0.0;
     }
-    if (!finite) check_histograms(h, fn);  // a bad entry: throws, naming it
     return rho;
 }
 

@@ -163,25 +163,8 @@ def box_histograms(
 
 
 def _histograms(hists: ArrayLike, fn: str) -> NDArray[np.float64]:
-    """`hists` (K, B) with each row divided by its sum, as the reference is.
-
-    A row of zeros (a box with no foreground pixel) stays zeros (rho 0). A negative or
-    non-finite entry is left for the core, whose message names it.
-    """
-    h = np.atleast_2d(real_array(hists, f"{fn}: hists"))
-    if h.ndim != 2 or not h.size or not (np.isfinite(h).all() and (h >= 0).all()):
-        return np.ascontiguousarray(h)  # the core refuses it, naming the shape or the entry
-    with np.errstate(over="ignore"):  # an overflow is refused just below, in one line
-        total = h.sum(axis=1, keepdims=True)
-    if not np.isfinite(total).all():
-        row = int(np.flatnonzero(~np.isfinite(total[:, 0]))[0])
-        raise ValueError(
-            f"{fn}: hists row {row} sum is not finite (overflow: the counts are finite but "
-            "their total exceeds the largest double, 1.8e308; scale them down)"
-        )
-    out = np.zeros_like(h)
-    np.divide(h, total, out=out, where=total > 0)
-    return out
+    """`hists` as a row-major (K, B) float64 array (the core normalises each row and checks it)."""
+    return np.ascontiguousarray(np.atleast_2d(real_array(hists, f"{fn}: hists")))
 
 
 def _reference(ref: ArrayLike, fn: str) -> NDArray[np.float64]:
