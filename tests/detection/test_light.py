@@ -15,7 +15,6 @@ from pftrack.tracking import track_frames
 from tests.detection.test_background_model import random_scene
 from tests.reference.detection import (
     BackgroundReference,
-    global_gain_reference,
     scale_reference,
 )
 
@@ -35,7 +34,7 @@ def ramped(frames: list[np.ndarray], floor: float = 0.4) -> list[np.ndarray]:
     ]
 
 
-# -- the C++ kernels against their NumPy references ------------------------------------------------
+# -- the C++ kernels against their NumPy references (the gain's: light.frame_gain) ---------------
 @pytest.mark.parametrize("step", [1, 3, 4])
 def test_global_gain_equals_reference(step: int) -> None:
     rng = np.random.default_rng(step)
@@ -47,7 +46,7 @@ def test_global_gain_equals_reference(step: int) -> None:
         m = _core.BackgroundModel()
         m.set_background(bg)
         assert m.global_gain(frame, step) == pytest.approx(
-            global_gain_reference(frame, bg, step), rel=0, abs=1e-12
+            frame_gain(frame, bg, step), rel=0, abs=1e-12
         )
     m = _core.BackgroundModel()
     m.set_background(np.zeros((8, 8, 3), np.float32))
@@ -75,7 +74,7 @@ def test_threshold_scale_equals_reference(kw: dict[str, float]) -> None:
     for k, frame in enumerate(frames):
         if k > 0:
             gain = model.global_gain(frame)
-            assert gain == global_gain_reference(frame, ref.background)
+            assert gain == frame_gain(frame, ref.background, 4)
             model.scale(gain)
             ref.background = scale_reference(ref.background, gain)
             model.set_threshold_scale(model.threshold_scale * gain)

@@ -202,20 +202,6 @@ def close_mask_reference(mask: np.ndarray, element: np.ndarray) -> np.ndarray:
     return morphology_reference(morphology_reference(mask, element, "dilate"), element, "erode")
 
 
-def global_gain_reference(
-    frame: np.ndarray, background: np.ndarray, step: int = 4, min_sum: float = 30.0
-) -> float:
-    """BackgroundModel.global_gain: median of sum(frame) / sum(background) over every `step`-th
-    row and column, pixels whose background sum is >= min_sum (and > 0); 1 when none."""
-    b = background[::step, ::step].astype(np.float64)
-    sb = b[..., 0] + b[..., 1] + b[..., 2]
-    si = frame[::step, ::step].astype(np.float64).sum(axis=2)
-    keep = (sb >= min_sum) & (sb > 0)
-    if not keep.any():
-        return 1.0
-    return float(np.median(si[keep] / sb[keep]))
-
-
 def scale_reference(background: np.ndarray, gain: float) -> np.ndarray:
     """BackgroundModel.scale: background * float32(gain), clipped to 255, in float32."""
     return np.minimum(background.astype(np.float32) * np.float32(gain), np.float32(255))

@@ -120,7 +120,7 @@ def looks_grey(frames: Iterable[NDArray[np.uint8]], tolerance: float = 3.0) -> b
 
 def frame_gain(
     frame: NDArray[np.uint8],
-    reference: NDArray[np.uint8],
+    reference: NDArray[np.uint8] | NDArray[np.float32],
     step: int | None = None,
     min_sum: float = 30.0,
 ) -> float:
@@ -128,11 +128,15 @@ def frame_gain(
 
     The median, over every `step`-th pixel of every `step`-th row whose reference sum
     ``R_b + R_g + R_r`` is at least `min_sum`, of ``sum(I) / sum(R)``; 1 when none qualifies.
+    With a model's float background as `reference` it is the NumPy reference the tests hold
+    the C++ measure to.
 
     Parameters
     ----------
-    frame, reference : (H, W, 3) ndarray of uint8
-        Two BGR frames of one size.
+    frame : (H, W, 3) ndarray of uint8
+        A BGR frame.
+    reference : (H, W, 3) ndarray of uint8 or float32
+        A BGR frame of the same size, or a background (``BackgroundModel.background``).
     step : int, optional
         Sampling step in rows and columns (default: :func:`sample_step` of the frame).
     min_sum : float
