@@ -10,6 +10,7 @@ it is reported once confirmed, and while coasting only as long as its colour sti
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import overload
@@ -221,26 +222,29 @@ class LiveTrack:
             return self.time_since_update <= rules.max_coast
         return self.missed <= rules.tentative_coast and self.time_since_update <= rules.max_coast
 
-    def speed(self, frame_index: int, centre: F64, height: float, span: int) -> float | None:
+    def speed(
+        self, frame_index: int, centre: Sequence[float], height: float, span: int
+    ) -> float | None:
         """Record a matched detection; return the track's speed over `span` frames or more.
 
-        In heights per frame: the distance from the oldest recorded detection at least `span`
+        In heights per frame: the distance from the newest recorded detection at least `span`
         frames back to this one, over the mean height and the frames between (None while there
-        is none). Over several frames, the detections' jitter counts for little.
+        is none). Over several frames, the detections' jitter counts for little. Detections
+        older than that one are forgotten.
         """
+        cx, cy = float(centre[0]), float(centre[1])
         trail = self.trail
-        trail.append((frame_index, float(centre[0]), float(centre[1]), height))
-        out = None
+        trail.append((frame_index, cx, cy, height))
         k = -1
-        for i, (f, *_rest) in enumerate(trail):
-            if frame_index - f >= span:
-                k = i
-        if k >= 0:
-            f, x, y, h = trail[k]
-            dist = float(np.hypot(centre[0] - x, centre[1] - y))
-            out = dist / (0.5 * (h + height)) / (frame_index - f)
-            del trail[:k]
-        return out
+        for i, entry in enumerate(trail):  # by frame: the last one `span` or more back
+            if frame_index - entry[0] < span:
+                break
+            k = i
+        if k < 0:
+            return None
+        f, x, y, h = trail[k]
+        del trail[:k]
+        return math.hypot(cx - x, cy - y) / (0.5 * (h + height)) / (frame_index - f)
 
     def report(self, frame_index: int, early: bool, rules: LifecycleConfig) -> Track | None:
         """What to report for frame `frame_index` (None: nothing yet, or not any more).

@@ -504,12 +504,18 @@ class MultiObjectTracker:
         self, followed: list[tuple[int, int]], boxes: F64, cfg: TrackerConfig
     ) -> None:
         """Speed samples of the confirmed tracks that followed a detection; the new gain."""
+        if not followed:
+            self._gain = self.motion_gain()
+            return
         n = cfg.lifecycle.min_hits
         span = cfg.motion.speed_span
-        for ti, di in followed:
+        dis = [di for _, di in followed]
+        b = boxes[dis]
+        centres = (b[:, :2] + b[:, 2:4] / 2).tolist()
+        heights = b[:, 3].tolist()
+        for (ti, _), centre, h in zip(followed, centres, heights, strict=True):
             t = self.tracks[ti]
-            b = boxes[di]
-            v = t.speed(self.frame_index, b[:2] + b[2:] / 2, float(b[3]), span)
+            v = t.speed(self.frame_index, centre, h, span)
             if v is not None and t.hits >= n:
                 self._speeds.add(v)
         self._gain = self.motion_gain()
