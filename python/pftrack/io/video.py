@@ -309,7 +309,7 @@ def _frame_order(
     def missing(number: int, width: int, why: str) -> ValueError:
         return ValueError(f"{folder}: image {str(number).zfill(width)} is missing ({why})")
 
-    if sequence is not None and numbers[0] != 1:
+    if numbers[0] != 1:
         if numbers[0] > 1:
             raise missing(1, len(first), f"{names}; frame 1 of a MOTChallenge sequence is image 1")
         raise ValueError(
@@ -324,7 +324,7 @@ def _frame_order(
             )
         if numbers[k] != numbers[k - 1] + 1:
             raise missing(numbers[k - 1] + 1, len(ordered[k - 1].stem), names)
-    length = sequence.length if sequence is not None else None
+    length = sequence.length
     if length is not None and len(ordered) < length:
         raise missing(numbers[-1] + 1, len(last), f"{names}; seqinfo.ini says seqLength={length}")
     if length is not None and len(ordered) > length:
