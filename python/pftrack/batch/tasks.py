@@ -366,6 +366,7 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     from pftrack.recovery import LinkConfig
     from pftrack.recovery.linking import gate_for_rows
     from pftrack.tracking import smooth_tracks
+    from pftrack.tracking.offline import smoothed_copies
 
     t0 = time.perf_counter()
     rows = read_tracks(path)
@@ -379,6 +380,4 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
         "rows_out": len(result),
         "seconds": time.perf_counter() - t0,
     }
-    kept = np.zeros(result.shape, dtype=bool)
-    kept[:, 6:] = True  # conf and columns 8-10 are the rows' own, as `pftrack smooth` writes them
-    return TaskResult(result, {}, info, exact=kept)
+    return TaskResult(result, {}, info, exact=smoothed_copies(result))

@@ -53,6 +53,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.recovery import LinkConfig
     from pftrack.recovery.linking import gate_for_rows, read_tracks
     from pftrack.tracking import smooth_tracks
+    from pftrack.tracking.offline import smoothed_copies
 
     src, out = Path(args.tracks), Path(args.out)
     if out.exists() and src.exists() and os.path.samefile(out, src):
@@ -61,9 +62,7 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(src)
     link = None if args.no_link else gate_for_rows(LinkConfig(max_gap=args.max_gap), rows)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
-    kept = np.zeros(result.shape, dtype=bool)
-    kept[:, 6:] = True  # conf and columns 8-10 are the rows' own: written with all their digits
-    write_mot(args.out, result, exact=kept)
+    write_mot(args.out, result, exact=smoothed_copies(result))  # given values: all digits
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
     print(

@@ -44,6 +44,7 @@ __all__ = [
     "drop_nested",
     "repair_crossings",
     "smooth_tracks",
+    "smoothed_copies",
     "split_refound",
 ]
 
@@ -430,6 +431,19 @@ def _after_nll(
         nll += np.where(counts[t], 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
         mean, cov = cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
     return nll
+
+
+def smoothed_copies(rows: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Which values of :func:`smooth_tracks`' `rows` (M, 10) are copies of given values.
+
+    The ``conf`` and columns 8-10 of every row (a filled row's: a neighbour's ``conf``, then the
+    filled mark); the boxes are the smoother's. ``write_mot(path, rows,
+    exact=smoothed_copies(rows))`` writes the given values with all their digits, as
+    ``pftrack smooth`` does.
+    """
+    mask = np.zeros(np.shape(rows), dtype=bool)
+    mask[:, 6:] = True
+    return mask
 
 
 def smooth_tracks(
