@@ -12,8 +12,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
-from pftrack._typing import PathLike
+from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write
+from pftrack.io.mot import read_mot
 
 REPO = Path(__file__).resolve().parents[1]
 """The repository root (the folder holding ``experiments/``)."""
@@ -31,6 +32,14 @@ class Source:
 
 PETS = Source("pets09-s2l1", "video.avi", 0.625)
 TUD = Source("tud-campus", "video.mp4", 1.0)
+
+
+def frame_truth(src: Source, data: Path) -> F64:
+    """The ground truth of `src` under `data` in its video's pixels, zero-marked rows left out."""
+    gt = read_mot(data / src.name / "gt.txt")
+    gt = gt[gt[:, 6] != 0]
+    gt[:, 2:6] *= src.scale
+    return gt
 
 
 def data_root(arg: PathLike | None = None) -> Path:

@@ -34,10 +34,17 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import PETS, TUD, Source, data_root, experiment_parser, tee_stdout
+from experiments._common import (
+    PETS,
+    TUD,
+    Source,
+    data_root,
+    experiment_parser,
+    frame_truth,
+    tee_stdout,
+)
 from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
-from pftrack.io.mot import read_mot
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene, make_scene
 
@@ -96,9 +103,7 @@ def real_case(name: str, variant: str, data: Path, out: Path) -> tuple[Path, F64
     seq = data / src.name
     if not (seq / src.video).is_file():
         return None
-    gt = read_mot(seq / "gt.txt")
-    gt = gt[gt[:, 6] != 0]
-    gt[:, 2:6] *= src.scale
+    gt = frame_truth(src, data)
     folder = out / "frames" / f"{name}_{variant}" / "img1"
     frames: list[Frame] | None = None
     if variant == "crop" or not folder.is_dir() or not any(folder.iterdir()):

@@ -27,12 +27,12 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
+from experiments._common import PETS, TUD, data_root, experiment_parser, frame_truth, tee_stdout
 from pftrack._typing import F64
 from pftrack.boxes import iou_xywh
 from pftrack.detection import PaperDetector, make_detector
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
-from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.mot import group_by_frame
 from pftrack.io.video import read_frames, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 
@@ -58,9 +58,7 @@ def load_sequence(name: str, data: Path) -> tuple[list[np.ndarray], F64, float] 
     seq = data / src.name
     if not (seq / src.video).is_file():
         return None
-    gt = read_mot(seq / "gt.txt")
-    gt = gt[gt[:, 6] != 0]
-    gt[:, 2:6] *= src.scale
+    gt = frame_truth(src, data)
     fps = read_seqinfo(seq).frame_rate
     if fps is None:
         raise ValueError(f"{seq}: seqinfo.ini has no frameRate")

@@ -37,13 +37,19 @@ import numpy as np
 from numpy.typing import NDArray
 
 from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
-from experiments.public_detections import NO_VIDEO, BlackFrames, noisy_detections, override
+from experiments.public_detections import (
+    NO_VIDEO,
+    BlackFrames,
+    add_settings,
+    noisy_detections,
+    settings_config,
+)
 from pftrack._typing import F64
 from pftrack.eval import SequenceScores, evaluate_sequence
 from pftrack.io.mot import read_mot
 from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
-from pftrack.tracking import TrackerConfig, load_detections, track_frames
+from pftrack.tracking import load_detections, track_frames
 
 VERSIONS = ("full", "half", "third", "odd")
 STRIDE = {"full": 1, "half": 2, "third": 3, "odd": 2}
@@ -154,18 +160,9 @@ def main(argv: list[str] | None = None) -> int:
         "--sequences", nargs="+", default=[], metavar="NAME",
         help="run only these sequences (default: every one found, and the synthetic scenes)",
     )  # fmt: skip
-    p.add_argument(
-        "--set", action="append", default=[], metavar="SECTION.FIELD=VALUE", dest="settings",
-        help="change one TrackerConfig field, e.g. lifecycle.min_hits=3 (repeatable; "
-        "default: none, every default as is)",
-    )  # fmt: skip
+    add_settings(p, "lifecycle.min_hits=3")
     args = p.parse_args(argv)
-    config = TrackerConfig()
-    for setting in args.settings:
-        try:
-            config = override(config, setting)
-        except ValueError as e:
-            p.error(str(e))
+    config = settings_config(p, args.settings)
     data = data_root(args.data)
     table: list[str] = []
     with tee_stdout(args.out / "frame_rate.txt"):

@@ -31,6 +31,7 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -154,6 +155,26 @@ def line(name: str, s: SequenceScores) -> str:
     )
 
 
+def add_settings(p: argparse.ArgumentParser, example: str) -> None:
+    """The ``--set SECTION.FIELD=VALUE`` option of the experiments (:func:`settings_config`)."""
+    p.add_argument(
+        "--set", action="append", default=[], metavar="SECTION.FIELD=VALUE", dest="settings",
+        help=f"change one TrackerConfig field, e.g. {example} (repeatable; "
+        "default: none, every default as is)",
+    )  # fmt: skip
+
+
+def settings_config(p: argparse.ArgumentParser, settings: Sequence[str]) -> TrackerConfig:
+    """``TrackerConfig()`` with every ``--set`` applied (:func:`override`); a bad one: exit 2."""
+    config = TrackerConfig()
+    for setting in settings:
+        try:
+            config = override(config, setting)
+        except ValueError as e:
+            p.error(str(e))
+    return config
+
+
 def override(config: TrackerConfig, setting: str) -> TrackerConfig:
     """`config` with one field changed, from ``"SECTION.FIELD=VALUE"`` (or ``"FIELD=VALUE"``).
 
@@ -216,20 +237,11 @@ def main(argv: list[str] | None = None) -> int:
         help="scale every sequence's frames, detections and truth by FACTOR, as footage of "
         "the same scene at another resolution (default: 1.0, as they are)",
     )  # fmt: skip
-    p.add_argument(
-        "--set", action="append", default=[], metavar="SECTION.FIELD=VALUE", dest="settings",
-        help="change one TrackerConfig field, e.g. motion.colour_noise=0.2 (repeatable; "
-        "default: none, every default as is)",
-    )  # fmt: skip
+    add_settings(p, "motion.colour_noise=0.2")
     args = p.parse_args(argv)
     if not (np.isfinite(args.upscale) and 0.1 <= args.upscale <= 8):
         p.error(f"--upscale is {args.upscale}, expected a factor in [0.1, 8]")
-    config = TrackerConfig()
-    for setting in args.settings:
-        try:
-            config = override(config, setting)
-        except ValueError as e:
-            p.error(str(e))
+    config = settings_config(p, args.settings)
     data = data_root(args.data)
     with tee_stdout(args.out / "public_detections.txt"):
         for seed in args.seeds:
