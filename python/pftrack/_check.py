@@ -7,7 +7,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64
 
-__all__ = ["MAX_COORD", "MAX_FRAME", "bgr_frame", "flag", "real_array"]
+__all__ = ["MAX_COORD", "MAX_FRAME", "bgr_frame", "flag", "number", "real_array"]
 
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
 #: wide, and splines and Kalman filters square and multiply them (1e308 overflows).
@@ -74,3 +74,24 @@ def flag(value: object, what: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise TypeError(f"{what} must be True or False, got {type(value).__name__} {value!r}")
     return bool(value)
+
+
+def number(value: object, what: str) -> float:
+    """`value` as a finite float, refusing what is not a real number (text, bools, None).
+
+    ``float("0.5")`` would otherwise take a string, and ``float(True)`` a flag.
+
+    Raises
+    ------
+    TypeError
+        Not an int or float (NumPy's too).
+    ValueError
+        NaN or infinite.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
+        raise TypeError(f"{what} must be a number, got {type(value).__name__} {value!r}")
+    if not np.isfinite(value):
+        raise ValueError(f"{what} is {value}, expected a finite number")
+    return float(value)

@@ -157,7 +157,8 @@ def test_unsure_detections_do_not_start_tracks():
     assert [t.detection_index for t in tracks] == [0]
     # scores that are not confidences in [0, 1] (e.g. raw detector margins) never gate births
     raw = dets * [1, 1, 1, 1, 10]
-    assert len(MultiObjectTracker(config, rng=0).update(frame, raw)) == 2
+    with pytest.warns(UserWarning, match=r"score is 9\.5 \(frame 1\): scores above 1 .*own scale"):
+        assert len(MultiObjectTracker(config, rng=0).update(frame, raw)) == 2
 
 
 def test_new_track_reports_its_unconfirmed_boxes_once():

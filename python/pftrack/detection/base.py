@@ -189,7 +189,7 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
         Boxes wholly outside the frame (usually a wrong coordinate scale) are dropped.
     """
     d = real_array(detections, "detections")
-    if d.size == 0:
+    if d.shape == (0,) or (d.ndim == 2 and d.shape[0] == 0 and d.shape[1] in (4, 5)):
         return np.zeros((0, 4)), np.zeros(0)
     if d.ndim != 2 or d.shape[1] not in (4, 5):
         raise ValueError(

@@ -21,6 +21,7 @@ depend on container metadata. Motion noise levels (particle and centre filters) 
 
 from __future__ import annotations
 
+import itertools
 import warnings
 from collections.abc import Iterable
 from dataclasses import replace
@@ -29,7 +30,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, flag
+from pftrack._check import bgr_frame, flag, number
 from pftrack._typing import F64, RngLike
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
@@ -135,7 +136,7 @@ def check_boxes_xyxy(
     if d.dtype.kind not in "iuf":
         raise TypeError(f"dets must be an array of numbers, got dtype {d.dtype}")
     d = d.astype(np.float64)
-    if d.size == 0:
+    if d.shape == (0,) or (d.ndim == 2 and d.shape[0] == 0 and d.shape[1] in (4, 5, 6)):
         return np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64), False
     if d.ndim != 2 or d.shape[1] not in (4, 5, 6):
         raise ValueError(
@@ -316,8 +317,8 @@ class Tracker:
                     if max_coast is None
                     else _frames(max_coast, frame_rate, "max_coast")
                 ),
-                min_score=float(min_conf),
-                birth_score=float(birth_score),
+                min_score=number(min_conf, "min_conf"),
+                birth_score=number(birth_score, "birth_score"),
                 birth_quantile=birth_quantile,
             ),
         )
@@ -465,13 +466,20 @@ class Tracker:
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start the background model from the median of `frames` (before the first update).
 
-        ``pftrack track`` reads its first ``prime_frames`` frames ahead this way (with the
-        built-in detector, or with detections when box refinement is on, the default); a loop
-        that does the same gets the command's rows. Detectors without a background ignore it.
+        Reads at most :attr:`prime_frames` of `frames` (the first ones; a longer iterable is
+        not read on). ``pftrack track`` primes this way with the built-in detector, or with
+        detections when box refinement is on (the default): with detections, its first
+        ``prime_frames`` frames; with the built-in detector, ``prime_frames`` frames spread
+        over the file (``pftrack.detection.bootstrap.bootstrap_frames(source,
+        tracker.prime_frames)``). A loop that primes with the same frames gets the command's
+        rows. Detectors without a background ignore it.
         """
         if self.frame_count:
             raise ValueError("prime() must come before the first update()")
-        self._tracker.prime([self.working_frame(bgr_frame(f, "prime frame")) for f in frames])
+        first = itertools.islice(frames, self.prime_frames)  # no more: a whole video is big
+        picked = [self.working_frame(bgr_frame(f, "prime frame")) for f in first]
+        if picked:
+            self._tracker.prime(picked)
 
     def update(self, dets: ArrayLike | None, frame: ArrayLike) -> F64:
         """Track one frame.
@@ -513,7 +521,6 @@ class Tracker:
             reports = self._tracker.update(work, None)
         else:
             xywh, cls, kept, clipped = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
-            self._given = True
             if clipped and not self._clip_warned:
                 self._clip_warned = True
                 warnings.warn(
@@ -522,15 +529,17 @@ class Tracker:
                     stacklevel=2,
                 )
             if len(xywh):
-                self._max_conf = max(self._max_conf, float(xywh[:, 4].max()))
                 low = float(xywh[:, 4].min())
                 if low < 0.0 and low < self.config.lifecycle.min_score:
                     self._warn_negative(low)
+            confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
             if self._scale is not None:
                 xywh[:, :4] *= self._scale
             # inside the frame as checked: the tracker need not check them again (scaled
             # boxes are, in case a box's scaled edge rounds past the working frame's)
             reports = self._tracker.update(work, xywh, cls, checked=self._scale is None)
+            self._given = True  # once the frame is taken (an update that raises changes nothing)
+            self._max_conf = max(self._max_conf, confidence)
         self.frame_count += 1
         # the offline pass sees a still camera: boxes in the first frame's coordinates
         self._stabiliser.add(self._tracker.camera_step.apply)

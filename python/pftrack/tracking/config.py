@@ -117,8 +117,9 @@ class LifecycleConfig:
     birth_score : float
         An external detection starts a track only with at least this score (a detection too
         unsure to start a track can still keep one alive, as in ByteTrack). Applied while every
-        score seen lies in [0, 1], i.e. scores are confidences; a detector with other scores,
-        and the built-in detector, start tracks from any detection. With `birth_quantile`
+        score kept (at least `min_score`) lies in [0, 1], i.e. scores are confidences (a
+        warning says when they stop being: from then on a detector with other scores starts
+        tracks from any detection it keeps, as the built-in detector does). With `birth_quantile`
         this is a cap: the threshold is relative to the detector (see there).
     birth_quantile : float or None
         Make the birth threshold relative to the detector: ``min(birth_score, q)`` where ``q``
@@ -217,8 +218,11 @@ class LifecycleConfig:
             )
         if self.birth_quantile is not None:
             _in_unit_interval("LifecycleConfig", birth_quantile=self.birth_quantile)
-        if not np.isfinite(self.min_score):
-            raise ValueError(f"LifecycleConfig: min_score is {self.min_score}, expected a number")
+        for name in ("min_score", "birth_score"):
+            if not np.isfinite(getattr(self, name)):
+                raise ValueError(
+                    f"LifecycleConfig: {name} is {getattr(self, name)}, expected a finite number"
+                )
         if not (np.isfinite(self.min_area) and self.min_area >= 0):
             raise ValueError(
                 f"LifecycleConfig: min_area is {self.min_area}, expected a finite value >= 0"

@@ -58,6 +58,12 @@ class JointTracker:
         self.config = config
         self._rng = rng
         self._filter: RJMCMCFilter | None = None
+        self._ids: set[int] = set()  # every id the sampler has estimated
+
+    @property
+    def started(self) -> int:
+        """Objects the sampler has estimated so far (each with its own id)."""
+        return len(self._ids)
 
     def step(self, frame_index: int, binned: BinnedImage, mask: NDArray[np.uint8], boxes: F64,
              scores: F64, index: NDArray[np.intp]) -> list[Track]:  # fmt: skip
@@ -65,6 +71,7 @@ class JointTracker:
         if self._filter is None:
             self._filter = RJMCMCFilter(joint_config(self.config), rng=self._rng)
         estimates = self._filter.step(binned, mask, xywh_to_cxcywh(boxes))
+        self._ids.update(int(e.id) for e in estimates)
         ebox = np.array([cxcywh_to_xywh(e.box_cxcywh) for e in estimates]).reshape(-1, 4)
         iou = iou_xywh(ebox, boxes) if len(boxes) else np.zeros((len(estimates), 0))
         out = []

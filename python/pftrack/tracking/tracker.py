@@ -18,6 +18,7 @@ import bisect
 import inspect
 import itertools
 import math
+import warnings
 from collections import deque
 from collections.abc import Iterable
 from typing import Any
@@ -50,6 +51,9 @@ __all__ = ["MultiObjectTracker"]
 MIN_SPEED_SAMPLES = 20
 #: The most recent speed samples kept.
 MAX_SPEED_SAMPLES = 5000
+#: How far above 1 a confidence may lie (float rounding, e.g. a float32 1.0 summed) before the
+#: scores count as a detector's own scale rather than confidences.
+CONFIDENCE_SLACK = 1e-6
 
 
 class RollingMedian:
@@ -136,6 +140,7 @@ class MultiObjectTracker:
         self._given_config = self.config  # tracks of given detections (given_particles), too
         self.pixel_scale = 1.0
         self._scores_are_confidences = True
+        self._primed_shape: tuple[int, ...] = ()  # of the frames given to prime()
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
         self._birth_level = np.inf
         self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
@@ -159,10 +164,11 @@ class MultiObjectTracker:
         """
         detector = self._ensure_detector()
         if hasattr(detector, "prime"):
-            if self.config.camera_motion != "off":  # a moving camera has no empty scene
-                frames = list(frames)
-                if self.camera.check_frames(frames):
-                    return
+            frames = list(frames)
+            if frames:
+                self._primed_shape = np.shape(frames[0])
+            if self.config.camera_motion != "off" and self.camera.check_frames(frames):
+                return  # a moving camera has no empty scene
             detector.prime(frames)
 
     @property
@@ -190,15 +196,39 @@ class MultiObjectTracker:
             self._detector = make_detector(self.config.detector, hsv=self.config.binning, **extra)
         return self._detector
 
-    def _detections(self, frame: NDArray[np.uint8], detections: ArrayLike | None,
-                    checked: bool = False) -> tuple[F64, F64, BinnedImage]:  # fmt: skip
+    def _check_given(self, frame: NDArray[np.uint8], detections: ArrayLike | None,
+                     classes: ArrayLike | None, checked: bool
+                     ) -> tuple[F64, F64, NDArray[np.int64]] | None:  # fmt: skip
+        """The caller's boxes, scores and class ids, checked (None: the built-in detector).
+
+        Raises what :meth:`update` raises for bad detections or classes, before any state
+        changes (`checked`: see :meth:`update`).
+        """
+        if detections is None:
+            return None
+        if checked:  # what check_detections returns for them (views: never written to)
+            d = np.asarray(detections)
+            boxes, scores = d[:, :4], d[:, 4]
+        else:
+            boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
+        labels = np.zeros(len(boxes), np.int64)
+        if classes is not None:
+            labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
+            if len(labels) != len(boxes):
+                raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
+        if self.config.sampler == "rjmcmc" and len(np.unique(labels)) > 1:
+            raise ValueError("sampler 'rjmcmc' tracks one class; got several class ids")
+        return boxes, scores, labels
+
+    def _detections(self, frame: NDArray[np.uint8], given: tuple[F64, F64] | None
+                    ) -> tuple[F64, F64, BinnedImage]:  # fmt: skip
         """Return this frame's boxes, scores and bins.
 
-        The built-in detector's (with foreground-only bins), or the caller's detections,
-        refined, with full-frame bins (`checked`: see :meth:`update`).
+        The built-in detector's (with foreground-only bins), or the caller's checked boxes and
+        scores (`given`), refined, with full-frame bins.
         """
         cfg = self.config
-        if detections is None:
+        if given is None:
             det = self._ensure_detector().detect(frame)
             self._mask, self._mask_shaded = det.mask, False
             boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
@@ -208,13 +238,7 @@ class MultiObjectTracker:
                 if binned is None:  # binned on demand: only the pixels the boxes read
                     binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)
             return boxes, np.asarray(det.scores, dtype=np.float64), binned
-        if checked:  # what check_detections returns for them (views: never written to)
-            d = np.asarray(detections)
-            boxes, scores = d[:, :4], d[:, 4]
-        else:
-            boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
-        if np.any((scores < 0) | (scores > 1)):
-            self._scores_are_confidences = False
+        boxes, scores = given
         mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
             mask, binned, shaded = self._foreground(frame)
@@ -328,7 +352,7 @@ class MultiObjectTracker:
     @property
     def tracks_started(self) -> int:
         """Tracks started so far, confirmed or not (each with a new id)."""
-        return self._n_started
+        return self._n_started + self._joint.started
 
     def never_confirmed(self) -> set[int]:
         """Ids of start-up tracks that never reached ``min_hits`` matches.
@@ -376,6 +400,15 @@ class MultiObjectTracker:
                 f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames {w}x{h} (one "
                 "size per run: a new tracker for a new video)"
             )
+        if cfg is None and self._primed_shape and f.shape != self._primed_shape:
+            h, w = self._primed_shape[:2]
+            raise ValueError(
+                f"frame is {f.shape[1]}x{f.shape[0]}, the frames given to prime() {w}x{h} (one "
+                "size per run)"
+            )
+        # every check before the state changes: an update that raises leaves the tracker as
+        # it was, so a caller may skip the frame and go on
+        given = self._check_given(f, detections, classes, checked)
         if cfg is None:
             self._frame_shape = f.shape
             self.pixel_scale = self.config.pixel_scale(f.shape[1], f.shape[0])
@@ -389,20 +422,27 @@ class MultiObjectTracker:
             warp_tracks(self.tracks, step.apply)
         self._background_ok = step.background_ok
         self.camera_step = step
-        boxes, scores, binned = self._detections(f, detections, checked)
-        labels = np.zeros(len(boxes), np.int64)
-        if classes is not None and detections is not None:
-            labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
-            if len(labels) != len(boxes):
-                raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
+        boxes, scores, binned = self._detections(f, None if given is None else given[:2])
+        labels = np.zeros(len(boxes), np.int64) if given is None else given[2]
         index = (
             (scores >= cfg.lifecycle.min_score)
             & ~tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
         ).nonzero()[0]
         boxes, scores, labels = boxes[index], scores[index], labels[index]
+        if given is not None and len(scores) and self._scores_are_confidences:
+            # kept scores outside [0, 1] are a detector's own scale, not confidences: below 0
+            # only with a min_score the caller set below 0; above 1 is said once
+            high = float(scores.max())
+            if scores.min() < 0.0 or high > 1.0 + CONFIDENCE_SLACK:
+                self._scores_are_confidences = False
+            if high > 1.0 + CONFIDENCE_SLACK:
+                warnings.warn(
+                    f"a detection score is {high:.3g} (frame {self.frame_index}): scores above "
+                    "1 are taken as a detector's own scale, not confidences, so birth_score no "
+                    "longer applies (min_conf still does)",
+                    stacklevel=3,
+                )
         if cfg.sampler == "rjmcmc":
-            if len(np.unique(labels)) > 1:
-                raise ValueError("sampler 'rjmcmc' tracks one class; got several class ids")
             mask = self.last_mask
             if mask is None or mask.shape != f.shape[:2] or not self._background_ok:
                 mask = np.full(f.shape[:2], 255, np.uint8)  # no background model: all foreground
