@@ -684,3 +684,12 @@ def test_joint_sampler_counts_the_objects_it_started(scene):
     for d, f in zip(scene_dets(scene)[:6], scene.frames[:6], strict=True):
         tracker.update(d, f)
     assert tracker.tracker.tracks_started > 0
+
+
+def test_no_track_warning_of_the_joint_sampler_does_not_blame_confidences():
+    tracker = pftrack.Tracker(sampler="rjmcmc")
+    frame = np.zeros((200, 300, 3), np.uint8)
+    tracker.update(np.array([[10, 20, 50, 120, 0.95]]), frame)
+    tracker.update(None, frame)
+    with pytest.warns(RuntimeWarning, match=r"joint sampler \(rjmcmc\) kept no object"):
+        tracker.finalize()

@@ -610,6 +610,11 @@ class Tracker:
             )
         if not self._given:
             return "the built-in detector found no object (no detection was given)"
+        if self.config.sampler == "rjmcmc" and np.isfinite(self._max_conf):
+            return (  # its births take every detection kept (min_conf), confident or not
+                "the joint sampler (rjmcmc) kept no object of the detections given (each is "
+                "proposed as a birth; too few frames, or no colour to weigh them?)"
+            )
         if np.isfinite(self._max_conf):
             return (
                 f"the highest detection confidence was {self._max_conf:.3g} (min_conf "
