@@ -8,7 +8,13 @@ import pytest
 
 from pftrack import _core
 from pftrack.detection import PaperConfig, PaperDetector
-from pftrack.detection.light import channel_spread, frame_gain, level_frames, looks_grey
+from pftrack.detection.light import (
+    channel_spread,
+    frame_gain,
+    is_dark,
+    level_frames,
+    looks_grey,
+)
 from pftrack.eval import evaluate_mot
 from pftrack.synthetic import make_scene
 from pftrack.tracking import track_frames
@@ -312,3 +318,53 @@ def test_a_colour_video_is_told_from_its_first_frame() -> None:
     grey = np.repeat(rng.integers(0, 255, (48, 64, 1), dtype=np.uint8), 3, axis=2)
     assert not looks_grey([colour, grey, grey])
     assert looks_grey([grey, grey]) and not looks_grey([grey, colour])
+
+
+# -- dark frames: a dropout or a fade to black (a trial find: "gain is 0" ended the run) --------
+def test_is_dark() -> None:
+    frame = np.full((36, 48, 3), 9, np.uint8)
+    assert not is_dark(frame)
+    assert is_dark(frame // 2) and is_dark(np.zeros((36, 48, 3), np.uint8))
+
+
+@pytest.mark.parametrize("where", [0, 20, 39])
+def test_black_frames_are_tracked_through(where: int) -> None:
+    """A black frame at the start, in the middle or at the end: no error, no foreground on
+    it, and the other frames detected as without it (the background is left as it was)."""
+    scene = make_scene(n_frames=40, rng=2)
+    black = np.zeros_like(scene.frames[0])
+    frames = list(scene.frames)
+    frames[where] = black
+    plain, dropped = PaperDetector(), PaperDetector()
+    plain.prime(scene.frames[::4])
+    dropped.prime(scene.frames[::4])
+    for k, (f, g) in enumerate(zip(scene.frames, frames, strict=True)):
+        got = dropped.detect(g)
+        if k == where:
+            assert not got.mask.any() and len(got.boxes) == 0
+            continue
+        want = plain.detect(f)
+        if k < where:
+            np.testing.assert_array_equal(got.mask, want.mask)
+    # the whole run, with box refinement of given detections too
+    assert len(track_frames(frames, rng=0, show_progress=False).rows)
+    dets = {k: scene.truth[scene.truth[:, 0] == k][:, 2:7] for k in range(1, 41)}
+    assert len(track_frames(frames, detections=dets, rng=0, show_progress=False).rows)
+
+
+def test_dark_frames_neither_prime_nor_start_the_background() -> None:
+    scene = make_scene(n_frames=20, rng=3)
+    black = np.zeros_like(scene.frames[0])
+    det = PaperDetector()
+    det.prime([black, *scene.frames[::5], black])
+    ref = PaperDetector()
+    ref.prime(scene.frames[::5])
+    np.testing.assert_array_equal(det.model.background, ref.model.background)
+    # all dark: no background yet; the first lit frame starts it, as without priming
+    det, ref = PaperDetector(), PaperDetector()
+    det.prime([black, black])
+    assert not det.model.initialized
+    det.detect(black)
+    assert not det.model.initialized
+    for f in scene.frames[:5]:
+        np.testing.assert_array_equal(det.detect(f).mask, ref.detect(f).mask)

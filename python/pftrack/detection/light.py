@@ -8,6 +8,11 @@ Two rules of `PaperDetector` (docs/detection.md, "Grey video and changing light"
   dark clothes vanish from the mask. :func:`looks_grey` tells such a video from its first
   frames; the detector then uses ``PaperConfig.grey_shadow_lo`` as the bound (1: no shadow
   test).
+* **Dark frames.** A black frame (a dropout, a cut or fade to black) has no light to compare:
+  its gain against the background is 0 and scaling the background by it would erase the
+  model. A frame whose mean level is at most :data:`DARK_LEVEL` (:func:`is_dark`) is neither
+  learnt nor compared: the detector reports no foreground on it, leaves the background as it
+  was, and does not start or prime a background from it.
 * **Global gain.** A background learnt at one brightness reads a whole frame taken at another
   as foreground, and the selective update (slow where foreground) does not catch up.
   ``BackgroundModel.global_gain`` measures the frame's gain against the background (median
@@ -27,11 +32,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = [
+    "DARK_LEVEL",
     "GAIN_SAMPLE_STEP",
     "GREY_SAMPLE_STEP",
     "MIN_CONTENT",
     "channel_spread",
     "frame_gain",
+    "is_dark",
     "level_frames",
     "looks_grey",
     "sample_step",
@@ -58,6 +65,26 @@ def sample_step(shape: tuple[int, ...], base: int = GREY_SAMPLE_STEP) -> int:
     """
     pixels = int(shape[0]) * int(shape[1])
     return max(base, round(base * math.sqrt(pixels / _STEP_PIXELS)))
+
+
+DARK_LEVEL = 8.0
+"""Mean level (0-255, over the sampled pixels and channels) at or below which a frame is dark
+(:func:`is_dark`): PETS09 and TUD-Campus frames lie near 100, a fade to black passes it in its
+last frames, a dropout's black frame is 0."""
+
+
+def is_dark(frame: NDArray[np.uint8], step: int | None = None) -> bool:
+    """Tell whether `frame` is dark: the mean of its sampled levels is at most `DARK_LEVEL`.
+
+    Parameters
+    ----------
+    frame : (H, W, 3) ndarray of uint8
+        A BGR frame.
+    step : int, optional
+        Sampling step in rows and columns (default: :func:`sample_step` of the frame).
+    """
+    step = sample_step(frame.shape) if step is None else step
+    return float(frame[::step, ::step].mean()) <= DARK_LEVEL
 
 
 MIN_CONTENT = 8.0

@@ -19,7 +19,13 @@ from pftrack.detection.base import (
     median_frame,
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
-from pftrack.detection.light import GAIN_SAMPLE_STEP, level_frames, looks_grey, sample_step
+from pftrack.detection.light import (
+    GAIN_SAMPLE_STEP,
+    is_dark,
+    level_frames,
+    looks_grey,
+    sample_step,
+)
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning, hsv_bins
 
@@ -90,7 +96,9 @@ class PaperConfig:
         column up to 640x480, sparser on larger frames: `pftrack.detection.light.sample_step`)
         is measured; outside ``[1 - gain_band, 1 + gain_band]`` the whole background is
         scaled by it (``BackgroundModel.scale``). `prime` also brings its frames to the first
-        one's brightness first (`pftrack.detection.light.level_frames`). 0 turns both off.
+        one's brightness first (`pftrack.detection.light.level_frames`). Dark frames
+        (`pftrack.detection.light.is_dark`) are neither compared nor learnt, and do not prime
+        or start the background. 0 turns all three off.
     gain_thresholds : bool
         With the gain rule, scale the grey-level threshold bounds `t_min`, `t_max` by the
         accumulated gain since the first frame (``BackgroundModel.set_threshold_scale``):
@@ -218,11 +226,19 @@ class PaperDetector:
         self, frame: NDArray[np.uint8], bins: bool
     ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
         """The C++ pass, after the grey test (first frame) or the global gain (later ones)."""
+        step = sample_step(frame.shape, GAIN_SAMPLE_STEP)
+        if self.config.gain_band > 0 and is_dark(frame, step):
+            # no light to compare or learn (light.is_dark): no foreground, the model as it was
+            binned = hsv_bins(frame, None, self.config.hsv) if bins else None
+            return binned, np.zeros(frame.shape[:2], np.uint8)
         if not self._model.initialized:
             if self._grey is None:
                 self._decide_grey([frame])
         elif self.config.gain_band > 0:
-            gain = self._model.global_gain(frame, sample_step(frame.shape, GAIN_SAMPLE_STEP))
+            gain = self._model.global_gain(frame, step)
+            if gain <= 0.0:  # over half the sampled pixels black (not dark as a whole)
+                binned = hsv_bins(frame, None, self.config.hsv) if bins else None
+                return binned, np.zeros(frame.shape[:2], np.uint8)
             if abs(gain - 1.0) > self.config.gain_band:
                 self._model.scale(gain)
                 if self.config.gain_thresholds and self._model.frame_count > 0:
@@ -260,6 +276,12 @@ class PaperDetector:
         # numpy.median(stack, axis=0)'s values, in C++ without stacking the frames (tests hold
         # the two equal): 0.23 s instead of 1.4-1.7 s for 30 frames of 1280x720, no stack
         frames = list(frames)
+        if self.config.gain_band > 0 and frames:
+            lit = [f for f in frames if not is_dark(check_frame(f, "PaperDetector.prime"))]
+            if not lit:  # no light to start from: the first frame that has some starts it
+                self._model.reset()
+                return
+            frames = lit  # a black frame (dropout, fade) is no picture of the empty scene
         # under a light change, the median of frames at their own brightness is biased where
         # people stand often: the frames are brought to the first one's light
         median = median_frame(level_frames(frames, self.config.gain_band), "PaperDetector.prime")
