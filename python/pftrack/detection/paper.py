@@ -183,6 +183,7 @@ class PaperDetector:
         self._blobs = BlobExtractor(self.config.blobs)
         self._ghost: NDArray[np.uint8] | None = None  # pixels of ghosts still being learnt
         self._grey: bool | None = None  # decided on the priming frames, else the first frame
+        self._shape: tuple[int, ...] | None = None  # of the video's frames (the first seen)
 
     def _new_model(self, shadow_lo: float) -> _core.BackgroundModel:
         c = self.config
@@ -226,6 +227,13 @@ class PaperDetector:
         self, frame: NDArray[np.uint8], bins: bool
     ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
         """The C++ pass, after the grey test (first frame) or the global gain (later ones)."""
+        if self._shape is None:
+            self._shape = frame.shape
+        elif frame.shape != self._shape:  # as the model says for a lit frame, for a dark one too
+            raise ValueError(
+                f"PaperDetector: frame shape is {frame.shape}, expected {self._shape} (one size "
+                "per video: reset() between videos)"
+            )
         step = sample_step(frame.shape, GAIN_SAMPLE_STEP)
         if self.config.gain_band > 0 and is_dark(frame, step):
             # no light to compare or learn (light.is_dark): no foreground, the model as it was
@@ -264,6 +272,7 @@ class PaperDetector:
         self._blobs.reset()
         self._ghost = None
         self._grey = None
+        self._shape = None
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start from the per-pixel median of `frames` (e.g. frames spread over the video).
@@ -289,6 +298,7 @@ class PaperDetector:
             self._decide_grey(frames)
         self._model.reset()
         self._model.set_background(median)
+        self._shape = median.shape
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
         """Detect the moving objects of one frame.
