@@ -294,6 +294,41 @@ def test_resume_redoes_a_sequence_whose_truth_or_images_changed(
     assert last["status"] == "done" and last["frames"] == len(images) - 1
 
 
+def test_resume_redoes_an_image_folder_whose_images_were_renamed(
+    data: Path, tmp_path: Path
+) -> None:
+    """Two images' names swapped: the same count, total size and newest time, other frames.
+
+    The fingerprint was those three figures, so the stale tracks were kept ("skipped")."""
+    folder = tmp_path / "plain"
+    shutil.copytree(data / "plain", folder)
+    out = tmp_path / "out"
+    options = TrackOptions(config=_config())
+    assert track_many(folder, out, options=options, n_workers=0).entries[0]["status"] == "done"
+    before = (out / "plain.txt").read_bytes()
+    images = sorted(folder.iterdir(), key=lambda p: int(p.stem))
+    a, b = images[5], images[20]
+    assert a.stat().st_size != b.stat().st_size  # else only their mtime_ns could tell
+    a.rename(folder / "swap.png")  # renames keep each file's size and mtime
+    b.rename(a)
+    (folder / "swap.png").rename(b)
+    again = track_many(folder, out, options=options, n_workers=0).entries[0]
+    assert again["status"] == "done"
+    assert again["note"] == f"redone: {folder} changed since the last run"
+    single = tmp_path / "single.txt"
+    assert main(["track", str(folder), "--out", str(single), *FAST]) == 0
+    assert (out / "plain.txt").read_bytes() == single.read_bytes() != before
+    unchanged = track_many(folder, out, options=options, n_workers=0).entries[0]
+    assert unchanged["status"] == "skipped"
+    # a sidecar from before the listing was fingerprinted: redone once, and said so
+    sidecar = json.loads((out / "plain.json").read_text())
+    del sidecar["fingerprint"][0]["listing"]
+    (out / "plain.json").write_text(json.dumps(sidecar))
+    older = track_many(folder, out, options=options, n_workers=0).entries[0]
+    assert older["status"] == "done"
+    assert older["note"] == f"redone: its sidecar records an older kind of fingerprint of {folder}"
+
+
 @pytest.fixture
 def connect_timeout_1s() -> Iterator[None]:
     """Dask's connect timeout (``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``) at 1 s."""

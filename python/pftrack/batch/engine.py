@@ -5,9 +5,10 @@ complete, writes each result as it arrives (``DIR/NAME.txt``, extra files, then 
 ``DIR/NAME.json``, each atomically), and writes ``DIR/summary.json`` at the end.
 
 *Complete* means: the sidecar exists, names the same inputs and settings, records the same
-fingerprint of each input (:func:`fingerprint`: size and modification time), and every output it
-lists exists. The sidecar is written last, and every file atomically, so a run stopped at any
-point leaves each output either complete or absent; a re-run skips the complete ones.
+fingerprint of each input (:func:`fingerprint`: size and modification time; for an image folder,
+those of every image by name), and every output it lists exists. The sidecar is written last,
+and every file atomically, so a run stopped at any point leaves each output either complete or
+absent; a re-run skips the complete ones.
 
 Where the tasks run (a scheduler to connect to, or a local cluster to start) is settled before
 ``DIR`` is created or any file written: a scheduler that cannot be reached changes nothing.
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import hashlib
 import json
 import logging
 import math
@@ -26,7 +28,7 @@ import threading
 import time
 import traceback
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -368,8 +370,11 @@ def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
     -------
     list of dict
         Per input: ``path``, and for a file its ``size`` and ``mtime_ns``; for a folder (of
-        images) the number of its image files (``files``), their total ``size`` and the newest
-        ``mtime_ns``; ``missing`` when it cannot be read (the task then fails on its own).
+        images) the number of its image files (``files``), their total ``size``, the newest
+        ``mtime_ns`` and ``listing``, a SHA-256 of every image's name, size and ``mtime_ns`` in
+        name order (so renamed or reordered images count as a change, which the three figures
+        before it do not see); ``missing`` when it cannot be read (the task then fails on its
+        own).
     """
     out: list[dict[str, Any]] = []
     for path in paths:
@@ -377,14 +382,15 @@ def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
         try:
             st = path.stat()
             if path.is_dir():
-                images = [
-                    e.stat()
+                images = sorted(
+                    (e.name, e.stat())
                     for e in os.scandir(path)
                     if e.is_file() and os.path.splitext(e.name)[1].lower() in IMAGE_SUFFIXES
-                ]
+                )
                 entry["files"] = len(images)
-                entry["size"] = sum(s.st_size for s in images)
-                entry["mtime_ns"] = max((s.st_mtime_ns for s in images), default=0)
+                entry["size"] = sum(s.st_size for _, s in images)
+                entry["mtime_ns"] = max((s.st_mtime_ns for _, s in images), default=0)
+                entry["listing"] = _listing_hash((n, s.st_size, s.st_mtime_ns) for n, s in images)
             else:
                 entry["size"] = st.st_size
                 entry["mtime_ns"] = st.st_mtime_ns
@@ -392,6 +398,14 @@ def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
             entry["missing"] = True
         out.append(entry)
     return out
+
+
+def _listing_hash(listing: Iterable[tuple[str, int, int]]) -> str:
+    """SHA-256 (hex) of a folder's (name, size, mtime_ns) triples, in the order given."""
+    digest = hashlib.sha256()
+    for name, size, mtime_ns in listing:
+        digest.update(f"{name}\0{size}\0{mtime_ns}\n".encode("utf-8", "surrogateescape"))
+    return digest.hexdigest()
 
 
 def _sidecar(out_dir: Path, name: str) -> Path:
@@ -433,8 +447,11 @@ def _complete(
     if earlier != prints:
         if not isinstance(earlier, list) or len(earlier) != len(prints):
             return None, "redone: its sidecar records no input sizes and times (an older run)"
-        changed = [p["path"] for p, q in zip(prints, earlier, strict=True) if p != q]
-        return None, f"redone: {', '.join(changed)} changed since the last run"
+        changed = [(p, q) for p, q in zip(prints, earlier, strict=True) if p != q]
+        paths = ", ".join(p["path"] for p, _ in changed)
+        if all(_older_print(p, q) for p, q in changed):
+            return None, f"redone: its sidecar records an older kind of fingerprint of {paths}"
+        return None, f"redone: {paths} changed since the last run"
     return entry, None
 
 
@@ -461,6 +478,21 @@ def _write(
     with atomic_write(_sidecar(out_dir, job.name)) as fh:
         fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
     return entry
+
+
+def _older_print(now: dict[str, Any], earlier: Any) -> bool:
+    """Whether `earlier` is the same input's fingerprint taken by an older pftrack (other keys).
+
+    An image folder's ``listing`` was added later: a sidecar without it is redone once, with
+    a note that says so rather than that the folder changed.
+    """
+    return (
+        isinstance(earlier, dict)
+        and earlier.get("path") == now["path"]
+        and "missing" not in now
+        and "missing" not in earlier
+        and set(earlier) != set(now)
+    )
 
 
 def _one_line(exc: BaseException) -> str:
