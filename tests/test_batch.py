@@ -26,7 +26,9 @@ import pytest
 
 from pftrack.batch import (
     Job,
+    RecoverOptions,
     SequenceInput,
+    SmoothOptions,
     TaskResult,
     TrackOptions,
     dask_client,
@@ -118,6 +120,44 @@ def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message:
     tops = sorted({tmp_path / rel.split("/")[0] for rel in layout if "/" in rel}) or [tmp_path]
     with pytest.raises(ValueError, match=message):
         find_sequences(tops)
+
+
+@pytest.mark.parametrize(
+    ("options", "kwargs", "error", "message"),
+    [
+        (TrackOptions, {"iou": 2.0}, ValueError, r"iou is 2.0, expected a number in \(0, 1\]"),
+        (TrackOptions, {"iou": float("nan")}, ValueError, "iou is nan"),
+        (TrackOptions, {"iou": "0.5"}, TypeError, "iou must be a number"),
+        (TrackOptions, {"seed": -1}, ValueError, "seed is -1, expected an integer >= 0"),
+        (TrackOptions, {"seed": 1.5}, TypeError, "seed must be an integer"),
+        (TrackOptions, {"fill": "zzz"}, ValueError, "fill is 'zzz', expected 'linear' or 'pf'"),
+        (TrackOptions, {"smooth": "no"}, TypeError, "smooth must be True or False"),
+        (TrackOptions, {"link": None}, TypeError, "link must be True or False"),
+        (TrackOptions, {"det_scale": 1e-4}, ValueError, r"det_scale is 0.0001, .* \[0.001, 1000\]"),
+        (TrackOptions, {"det_scale": "auto"}, TypeError, "det_scale must be a number"),
+        (TrackOptions, {"config": {}}, TypeError, "config must be a TrackerConfig"),
+        (RecoverOptions, {"method": "zzz"}, ValueError, "method is 'zzz', expected one of auto"),
+        (RecoverOptions, {"max_gap": 0}, ValueError, r"max_gap is 0, expected an integer in 1\.\."),
+        (RecoverOptions, {"max_gap": 30.0}, TypeError, "max_gap must be an integer"),
+        (RecoverOptions, {"seed": -1}, ValueError, "seed is -1"),
+        (RecoverOptions, {"link": "yes"}, TypeError, "link must be True or False"),
+        (RecoverOptions, {"max_distance": 0.0}, ValueError, "max_distance is 0.0, expected"),
+        (SmoothOptions, {"max_gap": 100_001}, ValueError, "max_gap is 100001"),
+        (SmoothOptions, {"link": 1}, TypeError, "link must be True or False"),
+    ],
+)
+def test_options_are_checked_before_any_work(
+    tmp_path: Path, options: Any, kwargs: dict[str, Any], error: type[Exception], message: str
+) -> None:
+    """A bad option failed every sequence one by one, or (``iou``) only after tracking them all,
+    with a message that did not always name it (NumPy's for a negative seed)."""
+    with pytest.raises(error, match=message):
+        options(**kwargs)
+    # the ends of each range are accepted
+    TrackOptions(iou=1, det_scale=1e-3, seed=np.int64(3), fill="pf", smooth=False, link=False)
+    TrackOptions(iou=1e-9, det_scale=1e3)
+    RecoverOptions(method="linear", max_gap=100_000, seed=0, link=True, max_distance=0.5)
+    SmoothOptions(max_gap=1, link=False)
 
 
 def test_workers_are_single_threaded(client: Any) -> None:
