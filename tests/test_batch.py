@@ -246,6 +246,38 @@ def test_failing_sequence_is_reported_and_the_others_finish(
     assert single.read_bytes() == (out / "MOT-01.txt").read_bytes()
 
 
+def test_a_truth_that_cannot_be_scored_keeps_the_tracks(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Scoring ran before the task returned its rows: a bad gt.txt lost the tracked rows."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    good = (seq / "gt" / "gt.txt").read_bytes()
+    (seq / "gt" / "gt.txt").write_text("1,1,10,10,20,40,1,1,1\nnot,a,row\n")
+    out = tmp_path / "out"
+    argv = ["batch", str(seq), "--out", str(out), "--workers", "0", *FAST]
+    assert main(argv) == 1  # some sequence failed
+    text = capsys.readouterr().out
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["status"] == "failed" and entry["frames"] == 30 and entry["metrics"] is None
+    assert entry["error"].startswith(f"scoring against {seq / 'gt' / 'gt.txt'} (the tracks are")
+    assert "gt.txt:2: ground truth line has 3 fields" in entry["error"]
+    assert "Traceback" in entry["traceback"] and f"MOT-01: error: {entry['error']}" in text
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq), "--out", str(single), *FAST]) == 0
+    assert (out / "MOT-01.txt").read_bytes() == single.read_bytes()
+    assert json.loads((out / "MOT-01.json").read_text())["status"] == "failed"
+    # not complete: a re-run tries again; with the truth mended, scored, then skipped
+    assert main(argv) == 1
+    (seq / "gt" / "gt.txt").write_bytes(good)
+    assert main(argv) == 0
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["status"] == "done" and entry["metrics"]["mota"] is not None
+    assert "error" not in entry
+    assert main(argv) == 0
+    assert json.loads((out / "summary.json").read_text())["counts"]["skipped"] == 1
+
+
 def test_resume_skips_complete_outputs_and_force_redoes(
     data: Path, client: Any, tmp_path: Path
 ) -> None:

@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from pftrack._progress import Bar, enabled, progress
-from pftrack.batch.tasks import TaskResult, reporting_frames
+from pftrack.batch.tasks import TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
@@ -463,7 +463,11 @@ def _write(
     settings: dict[str, Any],
     prints: list[dict[str, Any]],
 ) -> dict[str, Any]:
-    """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry."""
+    """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry.
+
+    A result with an `error` is written too, and its entry and sidecar say ``failed``: not
+    complete for a re-run.
+    """
     outputs = [f"{job.name}.txt"]
     write_mot(
         out_dir / outputs[0], result.rows, exact=False if result.exact is None else result.exact
@@ -472,7 +476,10 @@ def _write(
         outputs.append(f"{job.name}{suffix}")
         with atomic_write(out_dir / outputs[-1], "wb", suffix=suffix) as fh:
             fh.write(data)
-    entry = {"name": job.name, "status": "done", **result.info, "outputs": outputs}
+    status = "done" if result.error is None else "failed"  # failed: after its outputs were made
+    entry = {"name": job.name, "status": status, **result.info, "outputs": outputs}
+    if result.error is not None:
+        entry.update(error=result.error, traceback=result.traceback)
     inputs = [str(p) for p in job.reads]
     sidecar = {"kind": kind, "settings": settings, "inputs": inputs, "fingerprint": prints, **entry}
     with atomic_write(_sidecar(out_dir, job.name)) as fh:
@@ -493,16 +500,6 @@ def _older_print(now: dict[str, Any], earlier: Any) -> bool:
         and "missing" not in earlier
         and set(earlier) != set(now)
     )
-
-
-def _one_line(exc: BaseException) -> str:
-    """The error as one line; the kind is named unless it is a plain input error."""
-    text = " ".join(str(exc).split())
-    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in text:
-        text = f"{text}: {exc.filename}"
-    if isinstance(exc, (ValueError, TypeError, OSError)) and text:
-        return text
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 #: Seconds between two frame counts a task on a Dask worker sends to the client.
@@ -552,7 +549,7 @@ def call_task(
         try:
             result = func(*args)
         except Exception as exc:  # noqa: BLE001 - reported per task
-            return None, _one_line(exc), traceback.format_exc()
+            return None, one_line(exc), traceback.format_exc()
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
@@ -802,7 +799,7 @@ def _run_on_dask(
                 record(job, fut.result())
             elif fut.status == "error":  # the worker died (KilledWorker) or the like
                 exc = fut.exception()
-                record(job, (None, _one_line(exc), None))
+                record(job, (None, one_line(exc), None))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
     except BaseException:
         c.cancel([f for f, _ in futures.values()], force=True)

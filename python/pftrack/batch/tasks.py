@@ -16,6 +16,7 @@ import os
 import socket
 import tempfile
 import time
+import traceback
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -93,12 +94,28 @@ class TaskResult:
     exact : (M, 10) ndarray of bool or None
         Values of `rows` written with all their digits (given values that ``recover`` and
         ``smooth`` copy, :func:`~pftrack.io.mot.write_mot`'s `exact`); None: 2 decimals.
+    error, traceback : str or None
+        Set when a step after the work failed (scoring the tracks against a ``gt.txt`` that
+        cannot be read): the outputs are still written, and the task counts as failed with
+        this one-line error and traceback (its sidecar too, so a re-run does it again).
     """
 
     rows: F64
     files: dict[str, bytes] = field(default_factory=dict)
     info: dict[str, Any] = field(default_factory=dict)
     exact: NDArray[np.bool_] | None = None
+    error: str | None = None
+    traceback: str | None = None
+
+
+def one_line(exc: BaseException) -> str:
+    """The error as one line; the kind is named unless it is a plain input error."""
+    text = " ".join(str(exc).split())
+    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in text:
+        text = f"{text}: {exc.filename}"
+    if isinstance(exc, (ValueError, TypeError, OSError)) and text:
+        return text
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 def _settings(options: object) -> dict[str, Any]:
@@ -280,7 +297,8 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     -------
     TaskResult
         The rows (byte-identical to ``pftrack track``'s file once written with
-        :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures.
+        :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures;
+        its `error` is set if the ground truth could not be scored (the rows are still there).
     """
     from pftrack.io.mot import read_mot
     from pftrack.io.video import FrameSource
@@ -312,10 +330,6 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         on_frame=None if report is None else lambda n, *_: report(n),
     )
     rows = run.rows
-    metrics = None
-    if seq.gt is not None:
-        gt = read_mot(seq.gt, what="ground truth")
-        metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
     files: dict[str, bytes] = {}
     if options.render is not None:
         from pftrack.render import write_annotated_video
@@ -324,6 +338,14 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
             target = Path(tmp) / f"{seq.name}{options.render}"
             write_annotated_video(target, FrameSource(seq.frames), rows, frames.fps)
             files[options.render] = target.read_bytes()
+    metrics = error = trace = None
+    if seq.gt is not None:  # last: a ground truth that cannot be scored loses no tracks
+        try:
+            gt = read_mot(seq.gt, what="ground truth")
+            metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
+        except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed
+            error = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"
+            trace = traceback.format_exc()
     info: dict[str, Any] = {
         "source": str(seq.frames),
         "frames": run.n_frames,
@@ -339,7 +361,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         "metrics": metrics,
         "host": socket.gethostname(),
     }
-    return TaskResult(rows, files, info)
+    return TaskResult(rows, files, info, error=error, traceback=trace)
 
 
 def read_tracks(path: PathLike) -> F64:
