@@ -758,6 +758,36 @@ def test_render_writes_a_video_per_sequence_and_counts_for_resume(
     )
 
 
+def test_render_into_the_input_folder_can_be_re_run(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--out`` the input folder with ``--render``: the second run took walk.mp4, the first
+    run's video, for an input named like walk.avi, and refused to run (exit 2)."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    seq = tmp_path / "seq"  # the shared data's layout: seqinfo.ini and one video
+    seq.mkdir()
+    shutil.copy2(data / "walk.avi", seq / "video.avi")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=192\nimHeight=144\n")
+    for folder, name in ((vids, "walk"), (seq, "seq")):
+        argv = ["batch", str(folder), "--out", str(folder), "--render", "--workers", "0", *FAST]
+        assert main(argv) == 0
+        assert (folder / f"{name}.mp4").is_file()
+        assert main(argv) == 0, capsys.readouterr().err
+        summary = json.loads((folder / "summary.json").read_text())
+        assert [(e["name"], e["status"]) for e in summary["sequences"]] == [(name, "skipped")]
+        # and without --render: the rendered video is still not an input
+        assert main(["batch", str(folder), "--out", str(tmp_path / "o"), "--workers", "0",
+                     *FAST]) == 0  # fmt: skip
+    # a video of the same name that no sidecar beside it lists is an input: refused, as before
+    (vids / "walk.json").unlink()
+    with pytest.raises(ValueError, match="both named 'walk'"):
+        find_sequences(vids)
+    # given by its own path, a rendered video is an input
+    assert [s.frames for s in find_sequences(seq / "seq.mp4")] == [seq / "seq.mp4"]
+
+
 def test_scheduler_address_from_the_environment(
     data: Path, client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
