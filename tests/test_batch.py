@@ -818,6 +818,27 @@ def test_pets_detections_and_truth_are_scaled_from_seqinfo(client: Any, tmp_path
     assert entry["metrics"]["hota"] == s.hota.hota and entry["metrics"]["benchmark"] == "MOT15"
 
 
+@pytest.mark.dataset
+@pytest.mark.slow
+def test_the_figures_docs_batch_md_quotes_are_the_batchs(client: Any, tmp_path: Path) -> None:
+    """docs/batch.md's table and PETS09 sentence quoted figures two tracker changes old."""
+    root = dataset("pets09-s2l1").parent
+    dataset("tud-campus")
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "batch.md").read_text()
+    summary = track_many(root, tmp_path, client, options=TrackOptions(detections="auto"))
+    rows = {line.split()[0]: line.split() for line in summary.table().splitlines()}
+    for name in ("pets09-s2l1", "tud-campus"):
+        (quoted,) = [line.split() for line in doc.splitlines() if line.startswith(f"{name}  ")]
+        got = rows[name]
+        assert quoted[:4] + quoted[5:] == got[:4] + got[5:], name  # frames/s aside
+    pets = next(e for e in summary.entries if e["name"] == "pets09-s2l1")["metrics"]
+    figures = (
+        f"HOTA {100 * pets['hota']:.1f}, MOTA {100 * pets['mota']:.1f}, "
+        f"IDF1 {100 * pets['idf1']:.1f}, {pets['id_switches']} switches"
+    )
+    assert figures in " ".join(doc.split())
+
+
 def test_a_sequences_warnings_come_back_to_the_summary(
     client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
