@@ -8,6 +8,7 @@ One ``LocalCluster`` with two single-threaded worker processes serves the module
 from __future__ import annotations
 
 import _thread
+import contextlib
 import json
 import os
 import shutil
@@ -399,6 +400,54 @@ def test_resume_redoes_an_image_folder_whose_images_were_renamed(
     older = track_many(folder, out, options=options, n_workers=0).entries[0]
     assert older["status"] == "done"
     assert older["note"] == f"redone: its sidecar records an older kind of fingerprint of {folder}"
+
+
+def test_a_run_stopped_while_writing_leaves_no_stale_complete_sequence(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Outputs were replaced before the sidecar: stopped in between, the old sidecar vouched
+    for the new NAME.txt (a re-run with the old settings skipped it), and a video rendered
+    before any sidecar was an input of the next scan of its folder."""
+    import pftrack.batch.engine as engine
+
+    out = tmp_path / "out"
+    first = TrackOptions(config=_config())
+    track_many(data / "plain", out, options=first, n_workers=0)
+    before = (out / "plain.txt").read_bytes()
+    real_write_mot = engine.write_mot
+
+    def write_then_stop(*args: Any, **kwargs: Any) -> None:
+        real_write_mot(*args, **kwargs)
+        raise KeyboardInterrupt  # Ctrl-C right after NAME.txt is replaced
+
+    monkeypatch.setattr(engine, "write_mot", write_then_stop)
+    other = TrackOptions(config=_config(), seed=1)
+    with pytest.raises(KeyboardInterrupt):
+        track_many(data / "plain", out, options=other, n_workers=0)
+    assert (out / "plain.txt").read_bytes() != before  # replaced; the sidecar not yet
+    monkeypatch.setattr(engine, "write_mot", real_write_mot)
+    again = track_many(data / "plain", out, options=first, n_workers=0).entries[0]
+    assert again["status"] == "done" and (out / "plain.txt").read_bytes() == before
+    # --out the input folder with --render, stopped once the video is written
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    real_atomic = engine.atomic_write
+
+    @contextlib.contextmanager
+    def stop_after_video(path: Path, *args: Any, **kwargs: Any) -> Iterator[Any]:
+        with real_atomic(path, *args, **kwargs) as fh:
+            yield fh
+        if Path(path).suffix == ".mp4":
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(engine, "atomic_write", stop_after_video)
+    render = TrackOptions(config=_config(), render=".mp4")
+    with pytest.raises(KeyboardInterrupt):
+        track_many(vids, vids, options=render, n_workers=0)
+    assert (vids / "walk.mp4").is_file()
+    monkeypatch.setattr(engine, "atomic_write", real_atomic)
+    assert track_many(vids, vids, options=render, n_workers=0).entries[0]["status"] == "done"
 
 
 @pytest.fixture

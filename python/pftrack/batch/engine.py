@@ -6,9 +6,9 @@ complete, writes each result as it arrives (``DIR/NAME.txt``, extra files, then 
 
 *Complete* means: the sidecar exists, names the same inputs and settings, records the same
 fingerprint of each input (:func:`fingerprint`: size and modification time; for an image folder,
-those of every image by name), and every output it lists exists. The sidecar is written last,
-and every file atomically, so a run stopped at any point leaves each output either complete or
-absent; a re-run skips the complete ones.
+those of every image by name), and every output it lists exists. The sidecar is first replaced
+by one that says ``writing``, then written last, and every file atomically, so a run stopped at
+any point leaves each output either complete or not; a re-run skips the complete ones.
 
 Where the tasks run (a scheduler to connect to, or a local cluster to start) is settled before
 ``DIR`` is created or any file written: a scheduler that cannot be reached changes nothing.
@@ -465,26 +465,33 @@ def _write(
 ) -> dict[str, Any]:
     """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry.
 
-    A result with an `error` is written too, and its entry and sidecar say ``failed``: not
-    complete for a re-run.
+    The sidecar is first replaced by one that says ``writing`` and names the outputs to come:
+    stopped before the last step, the sequence is not complete for a re-run (an earlier run's
+    sidecar would vouch for a ``NAME.txt`` already replaced), and its video is known as a
+    batch's output (:func:`~pftrack.batch.inputs.find_sequences` passes it over). A result with
+    an `error` is written too, and its entry and sidecar say ``failed``: not complete either.
     """
-    outputs = [f"{job.name}.txt"]
+    outputs = [f"{job.name}.txt", *(f"{job.name}{suffix}" for suffix in result.files)]
+    head = {"kind": kind, "settings": settings, "inputs": [str(p) for p in job.reads]}
+    writing = {**head, "name": job.name, "status": "writing", "outputs": outputs}
+    _write_sidecar(out_dir, job.name, writing)
     write_mot(
         out_dir / outputs[0], result.rows, exact=False if result.exact is None else result.exact
     )
     for suffix, data in result.files.items():
-        outputs.append(f"{job.name}{suffix}")
-        with atomic_write(out_dir / outputs[-1], "wb", suffix=suffix) as fh:
+        with atomic_write(out_dir / f"{job.name}{suffix}", "wb", suffix=suffix) as fh:
             fh.write(data)
     status = "done" if result.error is None else "failed"  # failed: after its outputs were made
     entry = {"name": job.name, "status": status, **result.info, "outputs": outputs}
     if result.error is not None:
         entry.update(error=result.error, traceback=result.traceback)
-    inputs = [str(p) for p in job.reads]
-    sidecar = {"kind": kind, "settings": settings, "inputs": inputs, "fingerprint": prints, **entry}
-    with atomic_write(_sidecar(out_dir, job.name)) as fh:
-        fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
+    _write_sidecar(out_dir, job.name, {**head, "fingerprint": prints, **entry})
     return entry
+
+
+def _write_sidecar(out_dir: Path, name: str, sidecar: dict[str, Any]) -> None:
+    with atomic_write(_sidecar(out_dir, name)) as fh:
+        fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
 
 
 def _older_print(now: dict[str, Any], earlier: Any) -> bool:
