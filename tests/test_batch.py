@@ -8,6 +8,7 @@ One ``LocalCluster`` with two single-threaded worker processes serves the module
 from __future__ import annotations
 
 import _thread
+import contextlib
 import json
 import os
 import shutil
@@ -26,7 +27,9 @@ import pytest
 
 from pftrack.batch import (
     Job,
+    RecoverOptions,
     SequenceInput,
+    SmoothOptions,
     TaskResult,
     TrackOptions,
     dask_client,
@@ -120,6 +123,44 @@ def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message:
         find_sequences(tops)
 
 
+@pytest.mark.parametrize(
+    ("options", "kwargs", "error", "message"),
+    [
+        (TrackOptions, {"iou": 2.0}, ValueError, r"iou is 2.0, expected a number in \(0, 1\]"),
+        (TrackOptions, {"iou": float("nan")}, ValueError, "iou is nan"),
+        (TrackOptions, {"iou": "0.5"}, TypeError, "iou must be a number"),
+        (TrackOptions, {"seed": -1}, ValueError, "seed is -1, expected an integer >= 0"),
+        (TrackOptions, {"seed": 1.5}, TypeError, "seed must be an integer"),
+        (TrackOptions, {"fill": "zzz"}, ValueError, "fill is 'zzz', expected 'linear' or 'pf'"),
+        (TrackOptions, {"smooth": "no"}, TypeError, "smooth must be True or False"),
+        (TrackOptions, {"link": None}, TypeError, "link must be True or False"),
+        (TrackOptions, {"det_scale": 1e-4}, ValueError, r"det_scale is 0.0001, .* \[0.001, 1000\]"),
+        (TrackOptions, {"det_scale": "auto"}, TypeError, "det_scale must be a number"),
+        (TrackOptions, {"config": {}}, TypeError, "config must be a TrackerConfig"),
+        (RecoverOptions, {"method": "zzz"}, ValueError, "method is 'zzz', expected one of auto"),
+        (RecoverOptions, {"max_gap": 0}, ValueError, r"max_gap is 0, expected an integer in 1\.\."),
+        (RecoverOptions, {"max_gap": 30.0}, TypeError, "max_gap must be an integer"),
+        (RecoverOptions, {"seed": -1}, ValueError, "seed is -1"),
+        (RecoverOptions, {"link": "yes"}, TypeError, "link must be True or False"),
+        (RecoverOptions, {"max_distance": 0.0}, ValueError, "max_distance is 0.0, expected"),
+        (SmoothOptions, {"max_gap": 100_001}, ValueError, "max_gap is 100001"),
+        (SmoothOptions, {"link": 1}, TypeError, "link must be True or False"),
+    ],
+)
+def test_options_are_checked_before_any_work(
+    tmp_path: Path, options: Any, kwargs: dict[str, Any], error: type[Exception], message: str
+) -> None:
+    """A bad option failed every sequence one by one, or (``iou``) only after tracking them all,
+    with a message that did not always name it (NumPy's for a negative seed)."""
+    with pytest.raises(error, match=message):
+        options(**kwargs)
+    # the ends of each range are accepted
+    TrackOptions(iou=1, det_scale=1e-3, seed=np.int64(3), fill="pf", smooth=False, link=False)
+    TrackOptions(iou=1e-9, det_scale=1e3)
+    RecoverOptions(method="linear", max_gap=100_000, seed=0, link=True, max_distance=0.5)
+    SmoothOptions(max_gap=1, link=False)
+
+
 def test_workers_are_single_threaded(client: Any) -> None:
     def threads() -> tuple[int, str | None, str | None, str | None, bool]:
         import cv2
@@ -204,6 +245,38 @@ def test_failing_sequence_is_reported_and_the_others_finish(
     assert main(["track", str(data / "MOT-01"), "--detections", str(det), "--out", str(single),
                  *FAST]) == 0  # fmt: skip
     assert single.read_bytes() == (out / "MOT-01.txt").read_bytes()
+
+
+def test_a_truth_that_cannot_be_scored_keeps_the_tracks(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Scoring ran before the task returned its rows: a bad gt.txt lost the tracked rows."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    good = (seq / "gt" / "gt.txt").read_bytes()
+    (seq / "gt" / "gt.txt").write_text("1,1,10,10,20,40,1,1,1\nnot,a,row\n")
+    out = tmp_path / "out"
+    argv = ["batch", str(seq), "--out", str(out), "--workers", "0", *FAST]
+    assert main(argv) == 1  # some sequence failed
+    text = capsys.readouterr().out
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["status"] == "failed" and entry["frames"] == 30 and entry["metrics"] is None
+    assert entry["error"].startswith(f"scoring against {seq / 'gt' / 'gt.txt'} (the tracks are")
+    assert "gt.txt:2: ground truth line has 3 fields" in entry["error"]
+    assert "Traceback" in entry["traceback"] and f"MOT-01: error: {entry['error']}" in text
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq), "--out", str(single), *FAST]) == 0
+    assert (out / "MOT-01.txt").read_bytes() == single.read_bytes()
+    assert json.loads((out / "MOT-01.json").read_text())["status"] == "failed"
+    # not complete: a re-run tries again; with the truth mended, scored, then skipped
+    assert main(argv) == 1
+    (seq / "gt" / "gt.txt").write_bytes(good)
+    assert main(argv) == 0
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["status"] == "done" and entry["metrics"]["mota"] is not None
+    assert "error" not in entry
+    assert main(argv) == 0
+    assert json.loads((out / "summary.json").read_text())["counts"]["skipped"] == 1
 
 
 def test_resume_skips_complete_outputs_and_force_redoes(
@@ -292,6 +365,89 @@ def test_resume_redoes_a_sequence_whose_truth_or_images_changed(
     images[-1].unlink()
     last = track_many(seq, tmp_path / "out", client, options=options).entries[0]
     assert last["status"] == "done" and last["frames"] == len(images) - 1
+
+
+def test_resume_redoes_an_image_folder_whose_images_were_renamed(
+    data: Path, tmp_path: Path
+) -> None:
+    """Two images' names swapped: the same count, total size and newest time, other frames.
+
+    The fingerprint was those three figures, so the stale tracks were kept ("skipped")."""
+    folder = tmp_path / "plain"
+    shutil.copytree(data / "plain", folder)
+    out = tmp_path / "out"
+    options = TrackOptions(config=_config())
+    assert track_many(folder, out, options=options, n_workers=0).entries[0]["status"] == "done"
+    before = (out / "plain.txt").read_bytes()
+    images = sorted(folder.iterdir(), key=lambda p: int(p.stem))
+    a, b = images[5], images[20]
+    assert a.stat().st_size != b.stat().st_size  # else only their mtime_ns could tell
+    a.rename(folder / "swap.png")  # renames keep each file's size and mtime
+    b.rename(a)
+    (folder / "swap.png").rename(b)
+    again = track_many(folder, out, options=options, n_workers=0).entries[0]
+    assert again["status"] == "done"
+    assert again["note"] == f"redone: {folder} changed since the last run"
+    single = tmp_path / "single.txt"
+    assert main(["track", str(folder), "--out", str(single), *FAST]) == 0
+    assert (out / "plain.txt").read_bytes() == single.read_bytes() != before
+    unchanged = track_many(folder, out, options=options, n_workers=0).entries[0]
+    assert unchanged["status"] == "skipped"
+    # a sidecar from before the listing was fingerprinted: redone once, and said so
+    sidecar = json.loads((out / "plain.json").read_text())
+    del sidecar["fingerprint"][0]["listing"]
+    (out / "plain.json").write_text(json.dumps(sidecar))
+    older = track_many(folder, out, options=options, n_workers=0).entries[0]
+    assert older["status"] == "done"
+    assert older["note"] == f"redone: its sidecar records an older kind of fingerprint of {folder}"
+
+
+def test_a_run_stopped_while_writing_leaves_no_stale_complete_sequence(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Outputs were replaced before the sidecar: stopped in between, the old sidecar vouched
+    for the new NAME.txt (a re-run with the old settings skipped it), and a video rendered
+    before any sidecar was an input of the next scan of its folder."""
+    import pftrack.batch.engine as engine
+
+    out = tmp_path / "out"
+    first = TrackOptions(config=_config())
+    track_many(data / "plain", out, options=first, n_workers=0)
+    before = (out / "plain.txt").read_bytes()
+    real_write_mot = engine.write_mot
+
+    def write_then_stop(*args: Any, **kwargs: Any) -> None:
+        real_write_mot(*args, **kwargs)
+        raise KeyboardInterrupt  # Ctrl-C right after NAME.txt is replaced
+
+    monkeypatch.setattr(engine, "write_mot", write_then_stop)
+    other = TrackOptions(config=_config(), seed=1)
+    with pytest.raises(KeyboardInterrupt):
+        track_many(data / "plain", out, options=other, n_workers=0)
+    assert (out / "plain.txt").read_bytes() != before  # replaced; the sidecar not yet
+    monkeypatch.setattr(engine, "write_mot", real_write_mot)
+    again = track_many(data / "plain", out, options=first, n_workers=0).entries[0]
+    assert again["status"] == "done" and (out / "plain.txt").read_bytes() == before
+    # --out the input folder with --render, stopped once the video is written
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    real_atomic = engine.atomic_write
+
+    @contextlib.contextmanager
+    def stop_after_video(path: Path, *args: Any, **kwargs: Any) -> Iterator[Any]:
+        with real_atomic(path, *args, **kwargs) as fh:
+            yield fh
+        if Path(path).suffix == ".mp4":
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(engine, "atomic_write", stop_after_video)
+    render = TrackOptions(config=_config(), render=".mp4")
+    with pytest.raises(KeyboardInterrupt):
+        track_many(vids, vids, options=render, n_workers=0)
+    assert (vids / "walk.mp4").is_file()
+    monkeypatch.setattr(engine, "atomic_write", real_atomic)
+    assert track_many(vids, vids, options=render, n_workers=0).entries[0]["status"] == "done"
 
 
 @pytest.fixture
@@ -651,6 +807,36 @@ def test_render_writes_a_video_per_sequence_and_counts_for_resume(
     )
 
 
+def test_render_into_the_input_folder_can_be_re_run(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--out`` the input folder with ``--render``: the second run took walk.mp4, the first
+    run's video, for an input named like walk.avi, and refused to run (exit 2)."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    seq = tmp_path / "seq"  # the shared data's layout: seqinfo.ini and one video
+    seq.mkdir()
+    shutil.copy2(data / "walk.avi", seq / "video.avi")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=192\nimHeight=144\n")
+    for folder, name in ((vids, "walk"), (seq, "seq")):
+        argv = ["batch", str(folder), "--out", str(folder), "--render", "--workers", "0", *FAST]
+        assert main(argv) == 0
+        assert (folder / f"{name}.mp4").is_file()
+        assert main(argv) == 0, capsys.readouterr().err
+        summary = json.loads((folder / "summary.json").read_text())
+        assert [(e["name"], e["status"]) for e in summary["sequences"]] == [(name, "skipped")]
+        # and without --render: the rendered video is still not an input
+        assert main(["batch", str(folder), "--out", str(tmp_path / "o"), "--workers", "0",
+                     *FAST]) == 0  # fmt: skip
+    # a video of the same name that no sidecar beside it lists is an input: refused, as before
+    (vids / "walk.json").unlink()
+    with pytest.raises(ValueError, match="both named 'walk'"):
+        find_sequences(vids)
+    # given by its own path, a rendered video is an input
+    assert [s.frames for s in find_sequences(seq / "seq.mp4")] == [seq / "seq.mp4"]
+
+
 def test_scheduler_address_from_the_environment(
     data: Path, client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -679,6 +865,27 @@ def test_pets_detections_and_truth_are_scaled_from_seqinfo(client: Any, tmp_path
     s = evaluate_sequence(read_mot(pets / "gt.txt"), read_mot(single), scale=0.625)
     assert entry["metrics"]["mota"] == s.mot.mota and entry["metrics"]["idf1"] == s.mot.idf1
     assert entry["metrics"]["hota"] == s.hota.hota and entry["metrics"]["benchmark"] == "MOT15"
+
+
+@pytest.mark.dataset
+@pytest.mark.slow
+def test_the_figures_docs_batch_md_quotes_are_the_batchs(client: Any, tmp_path: Path) -> None:
+    """docs/batch.md's table and PETS09 sentence quoted figures two tracker changes old."""
+    root = dataset("pets09-s2l1").parent
+    dataset("tud-campus")
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "batch.md").read_text()
+    summary = track_many(root, tmp_path, client, options=TrackOptions(detections="auto"))
+    rows = {line.split()[0]: line.split() for line in summary.table().splitlines()}
+    for name in ("pets09-s2l1", "tud-campus"):
+        (quoted,) = [line.split() for line in doc.splitlines() if line.startswith(f"{name}  ")]
+        got = rows[name]
+        assert quoted[:4] + quoted[5:] == got[:4] + got[5:], name  # frames/s aside
+    pets = next(e for e in summary.entries if e["name"] == "pets09-s2l1")["metrics"]
+    figures = (
+        f"HOTA {100 * pets['hota']:.1f}, MOTA {100 * pets['mota']:.1f}, "
+        f"IDF1 {100 * pets['idf1']:.1f}, {pets['id_switches']} switches"
+    )
+    assert figures in " ".join(doc.split())
 
 
 def test_a_sequences_warnings_come_back_to_the_summary(

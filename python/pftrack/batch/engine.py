@@ -5,9 +5,10 @@ complete, writes each result as it arrives (``DIR/NAME.txt``, extra files, then 
 ``DIR/NAME.json``, each atomically), and writes ``DIR/summary.json`` at the end.
 
 *Complete* means: the sidecar exists, names the same inputs and settings, records the same
-fingerprint of each input (:func:`fingerprint`: size and modification time), and every output it
-lists exists. The sidecar is written last, and every file atomically, so a run stopped at any
-point leaves each output either complete or absent; a re-run skips the complete ones.
+fingerprint of each input (:func:`fingerprint`: size and modification time; for an image folder,
+those of every image by name), and every output it lists exists. The sidecar is first replaced
+by one that says ``writing``, then written last, and every file atomically, so a run stopped at
+any point leaves each output either complete or not; a re-run skips the complete ones.
 
 Where the tasks run (a scheduler to connect to, or a local cluster to start) is settled before
 ``DIR`` is created or any file written: a scheduler that cannot be reached changes nothing.
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import hashlib
 import json
 import logging
 import math
@@ -26,13 +28,13 @@ import threading
 import time
 import traceback
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from pftrack._progress import Bar, enabled, progress
-from pftrack.batch.tasks import TaskResult, reporting_frames
+from pftrack.batch.tasks import TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
@@ -368,8 +370,11 @@ def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
     -------
     list of dict
         Per input: ``path``, and for a file its ``size`` and ``mtime_ns``; for a folder (of
-        images) the number of its image files (``files``), their total ``size`` and the newest
-        ``mtime_ns``; ``missing`` when it cannot be read (the task then fails on its own).
+        images) the number of its image files (``files``), their total ``size``, the newest
+        ``mtime_ns`` and ``listing``, a SHA-256 of every image's name, size and ``mtime_ns`` in
+        name order (so renamed or reordered images count as a change, which the three figures
+        before it do not see); ``missing`` when it cannot be read (the task then fails on its
+        own).
     """
     out: list[dict[str, Any]] = []
     for path in paths:
@@ -377,14 +382,15 @@ def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
         try:
             st = path.stat()
             if path.is_dir():
-                images = [
-                    e.stat()
+                images = sorted(
+                    (e.name, e.stat())
                     for e in os.scandir(path)
                     if e.is_file() and os.path.splitext(e.name)[1].lower() in IMAGE_SUFFIXES
-                ]
+                )
                 entry["files"] = len(images)
-                entry["size"] = sum(s.st_size for s in images)
-                entry["mtime_ns"] = max((s.st_mtime_ns for s in images), default=0)
+                entry["size"] = sum(s.st_size for _, s in images)
+                entry["mtime_ns"] = max((s.st_mtime_ns for _, s in images), default=0)
+                entry["listing"] = _listing_hash((n, s.st_size, s.st_mtime_ns) for n, s in images)
             else:
                 entry["size"] = st.st_size
                 entry["mtime_ns"] = st.st_mtime_ns
@@ -392,6 +398,14 @@ def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
             entry["missing"] = True
         out.append(entry)
     return out
+
+
+def _listing_hash(listing: Iterable[tuple[str, int, int]]) -> str:
+    """SHA-256 (hex) of a folder's (name, size, mtime_ns) triples, in the order given."""
+    digest = hashlib.sha256()
+    for name, size, mtime_ns in listing:
+        digest.update(f"{name}\0{size}\0{mtime_ns}\n".encode("utf-8", "surrogateescape"))
+    return digest.hexdigest()
 
 
 def _sidecar(out_dir: Path, name: str) -> Path:
@@ -433,8 +447,11 @@ def _complete(
     if earlier != prints:
         if not isinstance(earlier, list) or len(earlier) != len(prints):
             return None, "redone: its sidecar records no input sizes and times (an older run)"
-        changed = [p["path"] for p, q in zip(prints, earlier, strict=True) if p != q]
-        return None, f"redone: {', '.join(changed)} changed since the last run"
+        changed = [(p, q) for p, q in zip(prints, earlier, strict=True) if p != q]
+        paths = ", ".join(p["path"] for p, _ in changed)
+        if all(_older_print(p, q) for p, q in changed):
+            return None, f"redone: its sidecar records an older kind of fingerprint of {paths}"
+        return None, f"redone: {paths} changed since the last run"
     return entry, None
 
 
@@ -446,31 +463,50 @@ def _write(
     settings: dict[str, Any],
     prints: list[dict[str, Any]],
 ) -> dict[str, Any]:
-    """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry."""
-    outputs = [f"{job.name}.txt"]
+    """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry.
+
+    The sidecar is first replaced by one that says ``writing`` and names the outputs to come:
+    stopped before the last step, the sequence is not complete for a re-run (an earlier run's
+    sidecar would vouch for a ``NAME.txt`` already replaced), and its video is known as a
+    batch's output (:func:`~pftrack.batch.inputs.find_sequences` passes it over). A result with
+    an `error` is written too, and its entry and sidecar say ``failed``: not complete either.
+    """
+    outputs = [f"{job.name}.txt", *(f"{job.name}{suffix}" for suffix in result.files)]
+    head = {"kind": kind, "settings": settings, "inputs": [str(p) for p in job.reads]}
+    writing = {**head, "name": job.name, "status": "writing", "outputs": outputs}
+    _write_sidecar(out_dir, job.name, writing)
     write_mot(
         out_dir / outputs[0], result.rows, exact=False if result.exact is None else result.exact
     )
     for suffix, data in result.files.items():
-        outputs.append(f"{job.name}{suffix}")
-        with atomic_write(out_dir / outputs[-1], "wb", suffix=suffix) as fh:
+        with atomic_write(out_dir / f"{job.name}{suffix}", "wb", suffix=suffix) as fh:
             fh.write(data)
-    entry = {"name": job.name, "status": "done", **result.info, "outputs": outputs}
-    inputs = [str(p) for p in job.reads]
-    sidecar = {"kind": kind, "settings": settings, "inputs": inputs, "fingerprint": prints, **entry}
-    with atomic_write(_sidecar(out_dir, job.name)) as fh:
-        fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
+    status = "done" if result.error is None else "failed"  # failed: after its outputs were made
+    entry = {"name": job.name, "status": status, **result.info, "outputs": outputs}
+    if result.error is not None:
+        entry.update(error=result.error, traceback=result.traceback)
+    _write_sidecar(out_dir, job.name, {**head, "fingerprint": prints, **entry})
     return entry
 
 
-def _one_line(exc: BaseException) -> str:
-    """The error as one line; the kind is named unless it is a plain input error."""
-    text = " ".join(str(exc).split())
-    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in text:
-        text = f"{text}: {exc.filename}"
-    if isinstance(exc, (ValueError, TypeError, OSError)) and text:
-        return text
-    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+def _write_sidecar(out_dir: Path, name: str, sidecar: dict[str, Any]) -> None:
+    with atomic_write(_sidecar(out_dir, name)) as fh:
+        fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
+
+
+def _older_print(now: dict[str, Any], earlier: Any) -> bool:
+    """Whether `earlier` is the same input's fingerprint taken by an older pftrack (other keys).
+
+    An image folder's ``listing`` was added later: a sidecar without it is redone once, with
+    a note that says so rather than that the folder changed.
+    """
+    return (
+        isinstance(earlier, dict)
+        and earlier.get("path") == now["path"]
+        and "missing" not in now
+        and "missing" not in earlier
+        and set(earlier) != set(now)
+    )
 
 
 #: Seconds between two frame counts a task on a Dask worker sends to the client.
@@ -520,7 +556,7 @@ def call_task(
         try:
             result = func(*args)
         except Exception as exc:  # noqa: BLE001 - reported per task
-            return None, _one_line(exc), traceback.format_exc()
+            return None, one_line(exc), traceback.format_exc()
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
@@ -770,7 +806,7 @@ def _run_on_dask(
                 record(job, fut.result())
             elif fut.status == "error":  # the worker died (KilledWorker) or the like
                 exc = fut.exception()
-                record(job, (None, _one_line(exc), None))
+                record(job, (None, one_line(exc), None))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
     except BaseException:
         c.cancel([f for f, _ in futures.values()], force=True)

@@ -8,6 +8,7 @@ these is a folder of sequences: each entry in it that is a sequence is one (one 
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -78,6 +79,31 @@ def _first_file(folder: Path, *candidates: str) -> Path | None:
     return None
 
 
+def _batch_output(path: Path) -> bool:
+    """Whether the video `path` was written by a batch: the sidecar beside it lists it.
+
+    ``pftrack batch --render`` writes ``DIR/NAME.mp4`` with its sidecar ``DIR/NAME.json``
+    (:mod:`pftrack.batch.engine`), whose ``outputs`` name it. Such a video is not an input
+    when its folder is looked into: a batch whose ``--out`` is its input folder can be re-run.
+    """
+    sidecar = path.with_name(f"{path.stem}.json")
+    if not sidecar.is_file():
+        return False
+    try:
+        entry = json.loads(sidecar.read_text(encoding="utf-8"))
+    except (OSError, ValueError):  # not a sidecar of ours: the video is an input
+        return False
+    if not isinstance(entry, dict) or entry.get("kind") != "track":
+        return False
+    outputs = entry.get("outputs")
+    return isinstance(outputs, list) and path.name in outputs
+
+
+def _videos(folder: Path) -> list[Path]:
+    """The videos of a sequence folder, less those a batch rendered into it."""
+    return [p for p in video_files(folder) if not _batch_output(p)]
+
+
 def _has_images(folder: Path) -> bool:
     return any(p.suffix.lower() in IMAGE_SUFFIXES for p in folder.iterdir())
 
@@ -95,7 +121,7 @@ def _as_sequence(path: Path) -> SequenceInput | None:
         frames = path
     elif not marked:
         return None
-    elif len(videos := video_files(path)) == 1:  # the shared data's layout: SEQ/video.avi
+    elif len(videos := _videos(path)) == 1:  # the shared data's layout: SEQ/video.avi
         frames = videos[0]
     else:
         raise ValueError(
@@ -112,6 +138,10 @@ def _as_sequence(path: Path) -> SequenceInput | None:
 
 def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     """The sequences named by `inputs`, in order (a folder of sequences in natural order).
+
+    A video that a batch rendered (``NAME.mp4`` listed by the sidecar ``NAME.json`` beside it)
+    is passed over when a folder is looked into, so that ``--out`` may be the input folder;
+    given by its own path, it is an input.
 
     Parameters
     ----------
@@ -139,7 +169,9 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
         for entry in entries:
             if entry.name.startswith("."):
                 continue
-            if entry.is_file() and entry.suffix.lower() not in VIDEO_SUFFIXES:
+            if entry.is_file() and (
+                entry.suffix.lower() not in VIDEO_SUFFIXES or _batch_output(entry)
+            ):
                 continue
             child = _as_sequence(entry)
             if child is not None:

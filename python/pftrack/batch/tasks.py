@@ -16,6 +16,7 @@ import os
 import socket
 import tempfile
 import time
+import traceback
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -24,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import flag
 from pftrack._typing import F64, PathLike
 from pftrack.batch.inputs import SequenceInput
 
@@ -92,12 +94,28 @@ class TaskResult:
     exact : (M, 10) ndarray of bool or None
         Values of `rows` written with all their digits (given values that ``recover`` and
         ``smooth`` copy, :func:`~pftrack.io.mot.write_mot`'s `exact`); None: 2 decimals.
+    error, traceback : str or None
+        Set when a step after the work failed (scoring the tracks against a ``gt.txt`` that
+        cannot be read): the outputs are still written, and the task counts as failed with
+        this one-line error and traceback (its sidecar too, so a re-run does it again).
     """
 
     rows: F64
     files: dict[str, bytes] = field(default_factory=dict)
     info: dict[str, Any] = field(default_factory=dict)
     exact: NDArray[np.bool_] | None = None
+    error: str | None = None
+    traceback: str | None = None
+
+
+def one_line(exc: BaseException) -> str:
+    """The error as one line; the kind is named unless it is a plain input error."""
+    text = " ".join(str(exc).split())
+    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in text:
+        text = f"{text}: {exc.filename}"
+    if isinstance(exc, (ValueError, TypeError, OSError)) and text:
+        return text
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 def _settings(options: object) -> dict[str, Any]:
@@ -107,6 +125,32 @@ def _settings(options: object) -> dict[str, Any]:
     text = json.dumps(dataclasses.asdict(options), sort_keys=True, default=str)  # type: ignore[call-overload]
     value: dict[str, Any] = json.loads(text)
     return value
+
+
+def _check_int(value: object, what: str, lo: int, hi: int | None = None) -> None:
+    """Refuse `value` unless it is an integer in ``lo..hi`` (no upper bound when `hi` is None)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what} must be an integer, got {type(value).__name__} {value!r}")
+    if value < lo or (hi is not None and value > hi):
+        expected = f"an integer >= {lo}" if hi is None else f"an integer in {lo}..{hi}"
+        raise ValueError(f"{what} is {value!r}, expected {expected}")
+
+
+def _check_number(value: object, what: str) -> float:
+    """`value` as a float, refusing what is not a real number (a bool, a string, None)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{what} must be a number, got {type(value).__name__} {value!r}")
+    return float(value)
+
+
+def _check_choice(value: object, what: str, choices: tuple[str, ...]) -> None:
+    """Refuse `value` unless it is one of `choices`."""
+    if not isinstance(value, str) or value not in choices:
+        if len(choices) == 2:
+            expected = f"{choices[0]!r} or {choices[1]!r}"
+        else:
+            expected = f"one of {', '.join(choices)}"
+        raise ValueError(f"{what} is {value!r}, expected {expected}")
 
 
 def _default_config() -> TrackerConfig:
@@ -138,7 +182,14 @@ class TrackOptions:
     render : str or None
         Also write an annotated video ``DIR/NAME<render>`` (``".mp4"`` or ``".avi"``).
     iou : float
-        IoU threshold of a match for the metrics (where ground truth exists).
+        IoU threshold of a match for the metrics (where ground truth exists), in (0, 1].
+
+    Raises
+    ------
+    TypeError, ValueError
+        A field of the wrong type or out of its range (``seed`` < 0, ``iou`` outside (0, 1],
+        ``fill`` not ``"linear"`` or ``"pf"``, ...): refused here, so a batch stops before any
+        task runs rather than failing every sequence.
     """
 
     config: TrackerConfig = field(default_factory=_default_config)
@@ -152,13 +203,29 @@ class TrackOptions:
     iou: float = 0.5
 
     def __post_init__(self) -> None:
+        """Check every field, so that a bad value stops the batch before any task runs."""
+        from pftrack.tracking.config import TrackerConfig
+        from pftrack.tracking.run import DET_SCALE_RANGE
+
+        if not isinstance(self.config, TrackerConfig):
+            raise TypeError(f"config must be a TrackerConfig, got {type(self.config).__name__}")
+        _check_int(self.seed, "seed", 0)
         if self.detections not in (None, "auto"):
             raise ValueError(f"detections is {self.detections!r}, expected None or 'auto'")
-        scale = self.det_scale
-        if scale is not None and not (math.isfinite(scale) and scale > 0):
-            raise ValueError(f"det_scale is {self.det_scale}, expected a finite value > 0")
+        if self.det_scale is not None:
+            lo, hi = DET_SCALE_RANGE
+            if not lo <= _check_number(self.det_scale, "det_scale") <= hi:  # also refuses nan
+                raise ValueError(
+                    f"det_scale is {self.det_scale}, expected a number in [{lo:g}, {hi:g}] (or "
+                    "None: from seqinfo.ini)"
+                )
+        _check_choice(self.fill, "fill", ("linear", "pf"))
+        flag(self.smooth, "smooth")
+        flag(self.link, "link")
         if self.render not in (None, ".mp4", ".avi"):
             raise ValueError(f"render is {self.render!r}, expected None, '.mp4' or '.avi'")
+        if not 0 < _check_number(self.iou, "iou") <= 1:  # evaluate_mot's range; refuses nan
+            raise ValueError(f"iou is {self.iou}, expected a number in (0, 1]")
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""
@@ -230,7 +297,8 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     -------
     TaskResult
         The rows (byte-identical to ``pftrack track``'s file once written with
-        :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures.
+        :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures;
+        its `error` is set if the ground truth could not be scored (the rows are still there).
     """
     from pftrack.io.mot import read_mot
     from pftrack.io.video import FrameSource
@@ -262,10 +330,6 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         on_frame=None if report is None else lambda n, *_: report(n),
     )
     rows = run.rows
-    metrics = None
-    if seq.gt is not None:
-        gt = read_mot(seq.gt, what="ground truth")
-        metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
     files: dict[str, bytes] = {}
     if options.render is not None:
         from pftrack.render import write_annotated_video
@@ -274,6 +338,14 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
             target = Path(tmp) / f"{seq.name}{options.render}"
             write_annotated_video(target, FrameSource(seq.frames), rows, frames.fps)
             files[options.render] = target.read_bytes()
+    metrics = error = trace = None
+    if seq.gt is not None:  # last: a ground truth that cannot be scored loses no tracks
+        try:
+            gt = read_mot(seq.gt, what="ground truth")
+            metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
+        except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed
+            error = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"
+            trace = traceback.format_exc()
     info: dict[str, Any] = {
         "source": str(seq.frames),
         "frames": run.n_frames,
@@ -289,7 +361,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         "metrics": metrics,
         "host": socket.gethostname(),
     }
-    return TaskResult(rows, files, info)
+    return TaskResult(rows, files, info, error=error, traceback=trace)
 
 
 def read_tracks(path: PathLike) -> F64:
@@ -305,13 +377,37 @@ def read_tracks(path: PathLike) -> F64:
 
 @dataclass(frozen=True)
 class RecoverOptions:
-    """Settings of ``pftrack recover`` over several files (see its ``--help``)."""
+    """Settings of ``pftrack recover`` over several files (see its ``--help``).
+
+    Raises
+    ------
+    TypeError, ValueError
+        A field of the wrong type or out of its range (an unknown ``method``, ``max_gap``
+        outside 1..100000, ``seed`` < 0, ``max_distance`` not > 0), before any task runs.
+    """
 
     method: str = "auto"
     max_gap: int = 30
     seed: int = 0
     link: bool = False
     max_distance: float | None = None  # None: 50 px grown to the frame (gate_for_rows)
+
+    def __post_init__(self) -> None:
+        """Check every field, so that a bad value stops the batch before any task runs."""
+        from pftrack.recovery.fill import MAX_GAP_LIMIT
+        from pftrack.recovery.names import METHODS
+
+        _check_choice(self.method, "method", METHODS)
+        _check_int(self.max_gap, "max_gap", 1, MAX_GAP_LIMIT)
+        _check_int(self.seed, "seed", 0)
+        flag(self.link, "link")
+        if self.max_distance is not None:
+            d = _check_number(self.max_distance, "max_distance")
+            if not (math.isfinite(d) and d > 0):  # LinkConfig's rule
+                raise ValueError(
+                    f"max_distance is {self.max_distance}, expected a finite number > 0 (or "
+                    "None: 50 px grown to the frame)"
+                )
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""
@@ -351,10 +447,23 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
 
 @dataclass(frozen=True)
 class SmoothOptions:
-    """Settings of ``pftrack smooth`` over several files (see its ``--help``)."""
+    """Settings of ``pftrack smooth`` over several files (see its ``--help``).
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``max_gap`` not an integer in 1..100000, or ``link`` not a bool, before any task runs.
+    """
 
     max_gap: int = 30
     link: bool = True
+
+    def __post_init__(self) -> None:
+        """Check every field, so that a bad value stops the batch before any task runs."""
+        from pftrack.recovery.fill import MAX_GAP_LIMIT
+
+        _check_int(self.max_gap, "max_gap", 1, MAX_GAP_LIMIT)
+        flag(self.link, "link")
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""

@@ -98,7 +98,10 @@ def add_parser(sub: Any) -> None:
         "auto: the frame width over seqinfo.ini's imWidth where there is one (0.625 for "
         "PETS09-S2L1's video), else 1",
     )  # fmt: skip
-    p.add_argument("--render", action="store_true", help="also write DIR/NAME.mp4, annotated")
+    p.add_argument("--render", action="store_true",
+                   help="also write DIR/NAME.mp4, annotated; a later batch that scans DIR "
+                   "passes it over (its NAME.json lists it), so DIR may be the input "
+                   "folder")  # fmt: skip
     p.add_argument("--iou", type=iou_threshold, default=0.5,
                    help=f"{IOU_HELP}, for the metrics")  # fmt: skip
     add_tracker_options(p)

@@ -54,6 +54,10 @@ class TrackingRun:
         return self.n_frames / self.seconds if self.seconds > 0 else float("inf")
 
 
+#: The detection scales :func:`load_detections` accepts (``--det-scale``, ``TrackOptions``).
+DET_SCALE_RANGE = (1e-3, 1e3)
+
+
 def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     """Read a MOTChallenge detection file as ``{frame: (k, 5) [left, top, w, h, score]}``.
 
@@ -79,8 +83,9 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     """
     if isinstance(scale, bool) or not isinstance(scale, (int, float, np.integer, np.floating)):
         raise TypeError(f"detection scale must be a number, got {type(scale).__name__}")
-    if not (1e-3 <= scale <= 1e3):
-        raise ValueError(f"detection scale is {scale}, expected a number in [0.001, 1000]")
+    lo, hi = DET_SCALE_RANGE
+    if not (lo <= scale <= hi):
+        raise ValueError(f"detection scale is {scale}, expected a number in [{lo:g}, {hi:g}]")
     rows = read_mot(path, what="detection file")
     flat = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
     if flat.any():
