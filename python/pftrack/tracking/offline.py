@@ -505,7 +505,8 @@ def smooth_tracks(
     Returns
     -------
     (M', 10) ndarray
-        The rows, sorted by frame then id.
+        The rows, sorted by frame then id. A smoothed track's boxes, filled ones too, are
+        never narrower or shorter than half its smallest detected box (:class:`BoxSmoother`).
 
     Raises
     ------
@@ -568,6 +569,10 @@ def smooth_tracks(
                     fr = a[i:j, 0]
                     for c in range(4):
                         sm[nw, c] = z[i:j][nw, c] + np.interp(fr[nw], fr[~nw], shift[:, c])
+                    # the smoother's size floor (BoxSmoother): a size path that dips between
+                    # two ends the smoother shrank could otherwise cross zero
+                    floor = 0.5 * z[i:j][obs[i:j], 2:].min(axis=0)
+                    sm[nw, 2:] = np.maximum(sm[nw, 2:], floor)
                 a[i:j, 2:6] = sm
     out: F64 = a[np.lexsort((a[:, 1], a[:, 0]))]
     return out
