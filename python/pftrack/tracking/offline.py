@@ -30,6 +30,7 @@ from pftrack.recovery.fill import MAX_GAP_LIMIT, fill_rows
 from pftrack.recovery.linking import (
     MAX_ID,
     LinkConfig,
+    check_boxes,
     check_rows,
     check_unique,
     link_tracklets,
@@ -512,8 +513,10 @@ def smooth_tracks(
     ------
     ValueError
         Rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
-        id, a non-finite box, `observed` / `measurements` of the wrong shape, or `max_gap` not
-        None or an int in ``1..MAX_GAP_LIMIT``.
+        id, a non-finite box, a box (of the rows or `measurements`) that
+        :func:`pftrack.io.mot.read_mot` refuses (a negative width or height, a value beyond
+        ±1e9 px), `observed` / `measurements` of the wrong shape, or `max_gap` not None or an
+        int in ``1..MAX_GAP_LIMIT``.
     """
     if max_gap is not None and (
         isinstance(max_gap, bool)
@@ -536,6 +539,7 @@ def smooth_tracks(
         z = np.array(measurements, dtype=np.float64)
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
+    check_boxes(z, a, "smooth_tracks", "measurements")  # boxes of filled rows, as the rows'
     if relink_coast is not None and (
         isinstance(relink_coast, bool)
         or not isinstance(relink_coast, (int, np.integer))
