@@ -25,7 +25,7 @@ from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh_rows, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
-from pftrack.kalman import Cov, Mean, cv_predict, cv_update_where, rts_smooth
+from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
 from pftrack.recovery.fill import MAX_GAP_LIMIT, fill_rows
 from pftrack.recovery.linking import (
     MAX_ID,
@@ -426,11 +426,11 @@ def _after_nll(
     cov: Cov = (np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0))
     nll = np.zeros(m)
     for t in range(1, length):
-        mean, cov = cv_predict(mean, cov, q, dt[t][:, None])
+        mean, cov = _cv_predict(mean, cov, q, dt[t][:, None])
         s = cov[0] + r2
         e = zs[t] - mean[0]
         nll += np.where(counts[t], 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
-        mean, cov = cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
+        mean, cov = _cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
     return nll
 
 
