@@ -7,7 +7,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64
 
-__all__ = ["MAX_COORD", "MAX_FRAME", "bgr_frame", "flag", "number", "real_array"]
+__all__ = [
+    "BOX_VALUES",
+    "MAX_COORD",
+    "MAX_FRAME",
+    "bgr_frame",
+    "first_bad_box",
+    "flag",
+    "number",
+    "real_array",
+]
 
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
 #: wide, and splines and Kalman filters square and multiply them (1e308 overflows).
@@ -38,6 +47,41 @@ def real_array(values: ArrayLike, what: str) -> F64:
     if raw.dtype.kind not in "biuf":
         raise TypeError(f"{what} must hold real numbers, got dtype {raw.dtype}")
     return raw.astype(np.float64, copy=False)
+
+
+#: Names of the values of a box ``left, top, width, height`` (columns 3-6 of a MOTChallenge row).
+BOX_VALUES = ("left", "top", "width", "height")
+
+
+def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
+    """The first value of `boxes` that a MOTChallenge file may not hold, or None.
+
+    The rule of :func:`pftrack.io.mot.read_mot`, which every entry point that takes
+    MOTChallenge rows applies too: a width or height is never negative (0 is allowed), and no
+    value lies beyond ±:data:`MAX_COORD` px. Rows are taken in order; within a row, a negative
+    size is named before a far value. NaN breaks neither rule (callers refuse it first).
+
+    Parameters
+    ----------
+    boxes : (M, 4) array_like of float
+        ``left, top, width, height`` per row.
+
+    Returns
+    -------
+    (row, column, problem) or None
+        The first bad value's row, its column in `boxes` (0-3, :data:`BOX_VALUES`) and what is
+        wrong: ``"negative box width or height"`` or ``"a box value is beyond ±1e+09 px"``.
+    """
+    b = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
+    negative = b[:, 2:] < 0
+    far = np.abs(b) > MAX_COORD
+    bad = negative.any(axis=1) | far.any(axis=1)
+    if not bad.any():
+        return None
+    r = int(np.argmax(bad))
+    if negative[r].any():
+        return r, 2 + int(np.argmax(negative[r])), "negative box width or height"
+    return r, int(np.argmax(far[r])), f"a box value is beyond ±{MAX_COORD:g} px"
 
 
 def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:

@@ -24,6 +24,12 @@ Users
   goal-directed tracking): :func:`cv_transition`, :func:`wna_Q` (one axis, ``(2, 2)``),
   :func:`cv_transition_xy`, :func:`wna_Q_xy` (state ``(x, y, vx, vy)``, ``(4, 4)``).
 
+Every public function checks its noise and variance arguments (``q``, ``r2``, the covariance
+entries, ``dt``: finite, and ``> 0`` or ``>= 0`` as the equations need), with a one-line
+ValueError. The tracker runs :func:`cv_predict` and :func:`cv_update` for every track on every
+frame with values it made itself: it calls the unchecked ``_cv_predict``, ``_cv_update`` and
+``_cv_update_where``, which compute the same floats.
+
 The tracker and the box smoother once used the piecewise-constant discretisation
 ``q [[1/4, 1/2], [1/2, 1]]`` instead; with the same noise levels, the continuous one scores
 the same or better on every sequence measured (docs/tracking.md), so it is the only one.
@@ -38,6 +44,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack import _core
+from pftrack._check import real_array
 from pftrack._typing import F64
 
 __all__ = [
@@ -62,8 +69,55 @@ Mean: TypeAlias = "tuple[Value, Value]"
 Cov: TypeAlias = "tuple[Value, Value, Value]"
 
 
+def _require(fn: str, name: str, value: ArrayLike, bound: str = "") -> None:
+    """Raise a ValueError unless every entry of `value` is finite and ``> 0`` / ``>= 0``.
+
+    Parameters
+    ----------
+    fn, name : str
+        The function and the argument, for the message (``"cv_update"``, ``"r2"``).
+    value : float or array_like
+        The argument.
+    bound : {"", ">= 0", "> 0"}
+        What the entries must be beyond finite.
+
+    Raises
+    ------
+    TypeError
+        Not real numbers.
+    ValueError
+        ``fn: name is -1, expected finite and >= 0`` (``name[i]`` naming an array's entry).
+    """
+    v = real_array(value, f"{fn}: {name}")
+    ok = np.isfinite(v)
+    if bound == "> 0":
+        ok &= v > 0
+    elif bound == ">= 0":
+        ok &= v >= 0
+    if not ok.all():
+        k = np.unravel_index(int(np.argmin(ok)), v.shape)
+        at = f"[{', '.join(str(int(i)) for i in k)}]" if k else ""
+        want = f"finite and {bound}" if bound else "finite"
+        raise ValueError(f"{fn}: {name}{at} is {v[k]:g}, expected {want}")
+
+
+def _require_cov(fn: str, cov: Cov) -> None:
+    """:func:`_require` for a covariance ``(p00, p01, p11)``: variances ``>= 0``, p01 finite."""
+    if len(cov) != 3:
+        raise ValueError(f"{fn}: cov has {len(cov)} entries, expected 3 (p00, p01, p11)")
+    for name, value, bound in zip(("p00", "p01", "p11"), cov, (">= 0", "", ">= 0"), strict=True):
+        _require(fn, f"cov's {name}", value, bound)
+
+
 def cv_transition(dt: float = 1.0) -> F64:
-    """Transition ``F = [[1, dt], [0, 1]]`` of one axis' ``(position, velocity)``."""
+    """Transition ``F = [[1, dt], [0, 1]]`` of one axis' ``(position, velocity)``.
+
+    Raises
+    ------
+    ValueError
+        `dt` not finite.
+    """
+    _require("cv_transition", "dt", dt)
     return np.array([[1.0, dt], [0.0, 1.0]])
 
 
@@ -76,7 +130,19 @@ def wna_Q(q: float, dt: float = 1.0) -> F64:  # noqa: N802 - the usual name
         Spectral density of the white-noise acceleration (px²/frame³).
     dt : float
         Time step in frames.
+
+    Raises
+    ------
+    ValueError
+        `q` or `dt` not finite and ``>= 0``.
     """
+    _require("wna_Q", "q", q, ">= 0")
+    _require("wna_Q", "dt", dt, ">= 0")
+    return _wna_Q(q, dt)
+
+
+def _wna_Q(q: float, dt: float) -> F64:  # noqa: N802 - the usual name
+    """:func:`wna_Q` without its checks."""
     c = q * dt**2 / 2.0
     return np.array([[q * dt**3 / 3.0, c], [c, q * dt]])
 
@@ -92,7 +158,14 @@ def _xy_block(blocks: Sequence[F64]) -> F64:
 
 
 def cv_transition_xy(dt: float = 1.0) -> F64:
-    """Transition of the state ``(x, y, vx, vy)``, ``(4, 4)``."""
+    """Transition of the state ``(x, y, vx, vy)``, ``(4, 4)``.
+
+    Raises
+    ------
+    ValueError
+        `dt` not finite.
+    """
+    _require("cv_transition_xy", "dt", dt)
     f = cv_transition(dt)
     return _xy_block([f, f])
 
@@ -106,10 +179,17 @@ def wna_Q_xy(q: Sequence[float], dt: float = 1.0) -> F64:  # noqa: N802 - the us
         Spectral densities of the x and y accelerations (px²/frame³).
     dt : float
         Time step in frames.
+
+    Raises
+    ------
+    ValueError
+        Not 2 values in `q`, or `q` or `dt` not finite and ``>= 0``.
     """
     if len(q) != 2:
         raise ValueError(f"wna_Q_xy: q has {len(q)} values, expected 2 (x, y)")
-    return _xy_block([wna_Q(float(qi), dt) for qi in q])
+    _require("wna_Q_xy", "q", q, ">= 0")
+    _require("wna_Q_xy", "dt", dt, ">= 0")
+    return _xy_block([_wna_Q(float(qi), dt) for qi in q])
 
 
 def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, Cov]:
@@ -131,7 +211,20 @@ def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, C
     -------
     mean, cov
         The predicted state.
+
+    Raises
+    ------
+    ValueError
+        A variance of `cov` (p00, p11), `q` or `dt` not finite and ``>= 0``, or p01 not finite.
     """
+    _require_cov("cv_predict", cov)
+    _require("cv_predict", "q", q, ">= 0")
+    _require("cv_predict", "dt", dt, ">= 0")
+    return _cv_predict(mean, cov, q, dt)
+
+
+def _cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, Cov]:
+    """:func:`cv_predict` without its checks: the tracker's per-frame call."""
     p00, p01, p11 = cov
     # P' = F P F^T + Q with F = [[1, dt], [0, 1]] (dt = 1: products by 1.0 are exact, so one
     # frame gives the same floats as the one-frame formula)
@@ -158,7 +251,20 @@ def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
     -------
     mean, cov
         The filtered state.
+
+    Raises
+    ------
+    ValueError
+        A variance of `cov` (p00, p11) not finite and ``>= 0``, p01 not finite, or `r2` not
+        finite and ``> 0`` (as :func:`rts_smooth`'s).
     """
+    _require_cov("cv_update", cov)
+    _require("cv_update", "r2", r2, "> 0")
+    return _cv_update(mean, cov, z, r2)
+
+
+def _cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
+    """:func:`cv_update` without its checks: the tracker's per-frame call."""
     p00, p01, p11 = cov
     s = p00 + r2
     k0, k1 = p00 / s, p01 / s
@@ -173,13 +279,23 @@ def cv_update_where(
 
     `where` broadcasts against the state's arrays (e.g. (n,) over axes, or (K, 1) over rows
     of K tracks). All True is exactly :func:`cv_update`; all False returns `mean`, `cov`.
+    The arguments are checked as :func:`cv_update`'s, wherever `where` holds or not.
     """
+    _require_cov("cv_update_where", cov)
+    _require("cv_update_where", "r2", r2, "> 0")
+    return _cv_update_where(mean, cov, z, r2, where)
+
+
+def _cv_update_where(
+    mean: Mean, cov: Cov, z: Value, r2: Value, where: ArrayLike
+) -> tuple[Mean, Cov]:
+    """:func:`cv_update_where` without its checks: the tracker's per-frame call."""
     w = np.asarray(where, dtype=bool)
     if w.all():
-        return cv_update(mean, cov, z, r2)
+        return _cv_update(mean, cov, z, r2)
     if not w.any():
         return mean, cov
-    mu, cu = cv_update(mean, cov, z, r2)
+    mu, cu = _cv_update(mean, cov, z, r2)
     m0, m1 = (np.where(w, a, b) for a, b in zip(mu, mean, strict=True))
     c0, c1, c2 = (np.where(w, a, b) for a, b in zip(cu, cov, strict=True))
     return (m0, m1), (c0, c1, c2)

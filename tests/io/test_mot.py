@@ -48,6 +48,10 @@ def test_fast_read_equals_line_by_line(tmp_path: Path) -> None:
     assert mot.read_mot(p).shape == (1, 10)
     p.write_text("")
     assert mot.read_mot(p).shape == (0, 10)
+    p.write_text("# a comment\n")
+    assert mot.read_mot(p).shape == (0, 10)
+    p.write_text("# a comment\n1,2,3,4,0,0\n")  # zero sizes are read, as the fast path reads them
+    assert mot.read_mot(p)[0, 4:6].tolist() == [0.0, 0.0]
 
 
 @pytest.mark.parametrize(
@@ -61,6 +65,12 @@ def test_fast_read_equals_line_by_line(tmp_path: Path) -> None:
         ("1,2,1e300,4,5,6\n", r":1: a box value is beyond ±1e\+09 px"),  # was: read, then
         ("1,2,3,4,5,-1e300\n", ":1: negative box"),  # "x2 <= x1" (1e300 + 8 == 1e300)
         ("1,2,3,4,5,2e9\n", r":1: a box value is beyond ±1e\+09 px"),
+        # the line-by-line reader checks boxes after its loop: still the first bad line
+        ("# c\n1,2,3,4,-5,6\n2,x,3,4,5,6\n", r":2: negative box width or height: '1,2,3,4,-5,6'"),
+        ("# c\n1,2,3,4,5,6\n2,x,3,4,5,6\n3,2,3,4,-5,6\n", ":3: MOT file line has a non-number"),
+        ("# c\n1,2,3,4,5,6\n2,2,3,4,5,-0.5\n", ":3: negative box"),
+        ("# c\n1,2,3,4,5,6\n2,2,-2e9,4,-5,6\n", ":3: negative box"),  # size before far
+        ("# c\n1,2,3,4,5,6\n2,2,-2e9,4,5,6\n", r":3: a box value is beyond ±1e\+09 px: '2,2,"),
     ],
 )
 def test_bad_lines_still_named(tmp_path: Path, text: str, match: str) -> None:

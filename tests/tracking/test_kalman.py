@@ -81,6 +81,7 @@ def test_predict_over_dt_frames_matches_matrix_form():
 def test_predict_one_frame_is_the_one_frame_formula_bit_for_bit():
     rng = np.random.default_rng(6)
     m0, m1, p00, p01, p11, q = rng.normal(size=(6, 50))
+    p00, p11, q = abs(p00), abs(p11), abs(q)  # variances and noise: negative ones are refused
     (p, v), (a, b, c) = cv_predict((m0, m1), (p00, p01, p11), q)
     assert np.array_equal(p, m0 + m1) and np.array_equal(v, m1)
     assert np.array_equal(a, p00 + 2 * p01 + p11 + q / 3.0)
@@ -228,3 +229,70 @@ def test_rts_bad_input():
         rts_smooth(
             np.zeros((0, 2)), np.zeros(0, bool), [1, 1], [1, 1], velocity_sd=1.0, update_first=True
         )
+
+
+MEAN = (np.array([1.0, 2.0]), np.array([0.5, -0.5]))
+COV = (np.array([2.0, 3.0]), np.array([0.1, -0.2]), np.array([1.0, 4.0]))
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        # was: ZeroDivisionError: float division by zero
+        (lambda: cv_update((0.0, 1.0), (0.0, 0.0, 1.0), 1.0, 0.0), "cv_update: r2 is 0, expected"),
+        (lambda: cv_update(MEAN, COV, 1.0, np.array([1.0, -2.0])), r"r2\[1\] is -2, expected fin"),
+        (lambda: cv_update(MEAN, COV, 1.0, np.nan), "r2 is nan, expected finite and > 0"),
+        (lambda: cv_update((0.0, 1.0), (-1.0, 0.0, 1.0), 1.0, 1.0), "cov's p00 is -1, expected"),
+        (lambda: cv_update(MEAN, (COV[0], np.inf, COV[2]), 1.0, 1.0), "cov's p01 is inf, expected"),
+        (lambda: cv_update(MEAN, COV[:2], 1.0, 1.0), "cov has 2 entries, expected 3"),
+        # was: a velocity variance of 0.0 (1 - 1), silently
+        (lambda: cv_predict((0.0, 1.0), (1.0, 0.0, 1.0), -1.0), "cv_predict: q is -1, expected"),
+        (lambda: cv_predict(MEAN, COV, 1.0, -1.0), "cv_predict: dt is -1, expected finite and >="),
+        (lambda: cv_predict(MEAN, (1.0, 0.0, -1e-9), 1.0), "cov's p11 is -1e-09, expected"),
+        (lambda: cv_update_where(MEAN, COV, 1.0, 0.0, False), "cv_update_where: r2 is 0"),
+        # was: a negative "covariance"
+        (lambda: wna_Q(-1.0), "wna_Q: q is -1, expected finite and >= 0"),
+        (lambda: wna_Q(1.0, np.inf), "wna_Q: dt is inf, expected finite and >= 0"),
+        (lambda: wna_Q_xy((0.5, -1.0)), r"wna_Q_xy: q\[1\] is -1, expected finite and >= 0"),
+        (lambda: wna_Q_xy((0.5, 1.0), -2.0), "wna_Q_xy: dt is -2, expected finite and >= 0"),
+        (lambda: cv_transition(np.nan), "cv_transition: dt is nan, expected finite"),
+        (lambda: cv_transition_xy(np.inf), "cv_transition_xy: dt is inf, expected finite"),
+    ],
+)
+def test_helpers_refuse_bad_noise_levels(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+def test_helpers_refuse_what_is_not_real_numbers():
+    with pytest.raises(TypeError, match="cv_predict: q must hold real numbers"):
+        cv_predict(MEAN, COV, 1j)
+    with pytest.raises(TypeError, match="cv_update: r2 must hold real numbers"):
+        cv_update(MEAN, COV, 1.0, "1")
+
+
+def test_helpers_take_the_bounds_the_equations_allow():
+    # q = 0, dt = 0 and zero variances are a model; r2 > 0 keeps the update's division finite
+    assert cv_predict((0.0, 1.0), (0.0, 0.0, 0.0), 0.0, 0.0) == ((0.0, 1.0), (0.0, 0.0, 0.0))
+    (p, v), (a, b, c) = cv_update((0.0, 1.0), (0.0, 0.0, 1.0), 3.0, 5e-324)
+    assert (p, v, a, b, c) == (0.0, 1.0, 0.0, 0.0, 1.0)
+    np.testing.assert_array_equal(wna_Q(0.0, 0.0), np.zeros((2, 2)))
+    np.testing.assert_array_equal(cv_transition(-1.0), [[1.0, -1.0], [0.0, 1.0]])
+
+
+def test_the_trackers_unchecked_calls_give_the_same_floats():
+    """The tracker calls ``_cv_*`` every frame; the public functions check, then call them."""
+    from pftrack.kalman import _cv_predict, _cv_update, _cv_update_where
+
+    rng = np.random.default_rng(5)
+    z, r2, q = rng.normal(size=2), rng.uniform(0.5, 2.0, 2), rng.uniform(0.1, 1.0, 2)
+    where = np.array([True, False])
+    pairs = [
+        (cv_predict(MEAN, COV, q), _cv_predict(MEAN, COV, q)),
+        (cv_predict(MEAN, COV, q, 2.5), _cv_predict(MEAN, COV, q, 2.5)),
+        (cv_update(MEAN, COV, z, r2), _cv_update(MEAN, COV, z, r2)),
+        (cv_update_where(MEAN, COV, z, r2, where), _cv_update_where(MEAN, COV, z, r2, where)),
+    ]
+    for checked, unchecked in pairs:
+        for a, b in zip([*checked[0], *checked[1]], [*unchecked[0], *unchecked[1]], strict=True):
+            np.testing.assert_array_equal(a, b)

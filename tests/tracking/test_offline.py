@@ -416,3 +416,29 @@ def test_a_degenerate_track_is_kept_as_it_is_as_recover_keeps_it(tmp_path, capsy
         assert main([command, str(src), "--out", str(tmp_path / f"{command}.txt")]) == 0
     capsys.readouterr()
     assert "200,99,10,10,0,0,1,-1,-1,-1" in (tmp_path / "smooth.txt").read_text().splitlines()
+
+
+def test_smooth_tracks_filled_boxes_keep_the_smoothers_size_floor():
+    """Sizes jumping between ~10 and ~100 px around a 2-frame hole (seed found by search).
+
+    "auto" recovers a size path through the hole far below the line between its two ends, and
+    the smoother pulls both ends towards the small sizes around them: the filled boxes were
+    shifted by as much as the ends, to widths and heights below zero (-16.6 px).
+    """
+    from pftrack.recovery import fill_gaps
+    from pftrack.recovery.linking import FLAG_COLUMN
+
+    n = 40
+    rng = np.random.default_rng(136)
+    a, gap = rng.integers(3, n - 3), rng.integers(2, 6)
+    h = np.where(rng.random(n) < 0.3, rng.uniform(50, 200, n), rng.uniform(5, 15, n))
+    rows = np.zeros((n, 10))
+    rows[:, 0], rows[:, 1], rows[:, 2:4] = np.arange(1, n + 1), 1, 300
+    rows[:, 4], rows[:, 5], rows[:, 6], rows[:, 7:] = 0.4 * h, h, 1, -1
+    rows = np.delete(rows, np.s_[a : a + gap], axis=0)
+    out = smooth_tracks(rows)
+    filled = out[:, FLAG_COLUMN] == 1
+    assert filled.sum() == gap
+    floor = 0.5 * rows[:, 4:6].min(axis=0)
+    assert np.all(out[:, 4:6] >= floor - 1e-12)
+    fill_gaps(out)  # the rows pftrack wrote are rows it reads

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import MAX_COORD, MAX_FRAME
+from pftrack._check import MAX_FRAME, first_bad_box
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write
 
@@ -73,40 +73,54 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
     if fast is not None:
         return fast
     rows: list[list[float]] = []
+    numbers: list[int] = []  # the line of each row
+    error: str | None = None  # the first line that is no row, which ends the reading
     for lineno, text in _data_lines(p):
-        fields = text.replace(",", " ").split()
-        if len(fields) < 6:
-            raise ValueError(
-                f"{p}:{lineno}: {what} line has {len(fields)} fields, expected at least 6 "
-                f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
-            )
-        try:
-            values = [float(f) for f in fields[:10]]
-        except ValueError:
-            raise ValueError(f"{p}:{lineno}: {what} line has a non-number: {text[:80]!r}") from None
-        bad = [c for c, v in enumerate(values) if not np.isfinite(v)]
-        if bad:  # every column is used: conf as a score, columns 8-10 written back
-            raise ValueError(
-                f"{p}:{lineno}: {what} line has a non-finite value (NaN or inf) in column "
-                f"{bad[0] + 1} ({_NAMES[bad[0]]}): {text[:80]!r}"
-            )
-        frame = values[FRAME]
-        if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
-            raise ValueError(
-                f"{p}:{lineno}: frame is {fields[0]}, expected an integer in 1..{MAX_FRAME} "
-                "(frames count from 1)"
-            )
-        if values[WIDTH] < 0 or values[HEIGHT] < 0:
-            raise ValueError(f"{p}:{lineno}: negative box width or height: {text[:80]!r}")
-        if max(abs(v) for v in values[LEFT : HEIGHT + 1]) > MAX_COORD:
-            raise ValueError(
-                f"{p}:{lineno}: a box value is beyond ±{MAX_COORD:g} px: {text[:80]!r}"
-            )
-        values.extend(_DEFAULTS[len(values) :])
+        values = _parse_line(text, what)
+        if isinstance(values, str):
+            error = f"{p}:{lineno}: {values}"
+            break
         rows.append(values)
-    if not rows:
-        return np.zeros((0, 10))
-    return np.asarray(rows, dtype=np.float64)
+        numbers.append(lineno)
+    a = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+    # boxes after the loop, all at once (one NumPy call per line took 2/3 more time); a bad
+    # box on a line before `error`'s is the first bad line
+    bad_box = first_bad_box(a[:, LEFT : HEIGHT + 1])  # the rule of the API's rows too
+    if bad_box is not None:
+        lineno = numbers[bad_box[0]]
+        text = next(t for n, t in _data_lines(p) if n == lineno)
+        raise ValueError(f"{p}:{lineno}: {bad_box[2]}: {text[:80]!r}")
+    if error is not None:
+        raise ValueError(error)
+    return a
+
+
+def _parse_line(text: str, what: str) -> list[float] | str:
+    """The 10 values of a line of a MOTChallenge file, or what is wrong with it (boxes aside).
+
+    Missing columns get their defaults. The boxes are :func:`read_mot`'s to check.
+    """
+    fields = text.replace(",", " ").split()
+    if len(fields) < 6:
+        return (
+            f"{what} line has {len(fields)} fields, expected at least 6 "
+            f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
+        )
+    try:
+        values = [float(f) for f in fields[:10]]
+    except ValueError:
+        return f"{what} line has a non-number: {text[:80]!r}"
+    bad = [c for c, v in enumerate(values) if not np.isfinite(v)]
+    if bad:  # every column is used: conf as a score, columns 8-10 written back
+        return (
+            f"{what} line has a non-finite value (NaN or inf) in column "
+            f"{bad[0] + 1} ({_NAMES[bad[0]]}): {text[:80]!r}"
+        )
+    frame = values[FRAME]
+    if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
+        return f"frame is {fields[0]}, expected an integer in 1..{MAX_FRAME} (frames count from 1)"
+    values.extend(_DEFAULTS[len(values) :])
+    return values
 
 
 def _read_fast(p: Path) -> NDArray[np.float64] | None:
@@ -131,11 +145,11 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
     n = a.shape[1]
     if not 6 <= n <= 10:
         return None
-    fr, wh = a[:, FRAME], a[:, WIDTH : HEIGHT + 1]
+    fr = a[:, FRAME]
     finite = bool(np.all(np.isfinite(a)))  # every column: a NaN score too
-    if not (finite and np.all(fr >= 1) and np.all(fr == np.floor(fr))) or np.any(wh < 0):
+    if not (finite and np.all(fr >= 1) and np.all(fr == np.floor(fr))) or np.any(fr > MAX_FRAME):
         return None
-    if np.any(fr > MAX_FRAME) or np.any(np.abs(a[:, LEFT : HEIGHT + 1]) > MAX_COORD):
+    if first_bad_box(a[:, LEFT : HEIGHT + 1]) is not None:
         return None  # the line reader names the line
     if n < 10:
         a = np.hstack([a, np.tile(np.asarray(_DEFAULTS[n:]), (len(a), 1))])

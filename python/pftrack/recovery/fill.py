@@ -137,7 +137,8 @@ def fill_gaps(
     ValueError
         Unknown method, `max_gap` not an integer in ``1..MAX_GAP_LIMIT``, rows not
         ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer id, a
-        non-finite box or a duplicate (frame, id).
+        non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width or
+        height, a value beyond ±1e9 px) or a duplicate (frame, id).
     """
     new_rows, report = fill_rows(tracks, method, max_gap, noise, seed=seed, combine=combine)
     filled = np.vstack([np.asarray(tracks, dtype=np.float64), new_rows])

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_FRAME, real_array
+from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.particle_filter.colour import (
@@ -32,6 +32,7 @@ __all__ = [
     "FLAG_COLUMN",
     "LinkConfig",
     "box_centres",
+    "check_boxes",
     "check_rows",
     "check_unique",
     "filled_mask",
@@ -267,6 +268,12 @@ def link_tracklets(
         The rows with fragment ids replaced by the id of the first fragment of each chain.
     mapping : dict
         Old id -> new id for every relabelled fragment.
+
+    Raises
+    ------
+    ValueError
+        Bad rows (:func:`check_rows`: a box :func:`pftrack.io.mot.read_mot` refuses too) or a
+        (frame, id) seen twice.
     """
     from pftrack.assignment import linear_sum_assignment  # SciPy's pairs, without SciPy
 
@@ -299,8 +306,9 @@ def link_tracklets(
 def check_rows(rows: ArrayLike, what: str) -> F64:
     """The rows as an ``(M, 10)`` float64 array, checked; ValueError/TypeError naming the problem.
 
-    Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, and every
-    value finite. `what` names the caller in messages.
+    Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, every
+    value finite, and the boxes what :func:`pftrack.io.mot.read_mot` reads (:func:`check_boxes`:
+    no negative width or height, no value beyond ±1e9 px). `what` names the caller in messages.
     """
     a = real_array(rows, f"{what}: rows")
     if a.ndim != 2 or a.shape[1] != 10:
@@ -319,7 +327,35 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
     k = _first_bad_id(i)
     if k is not None:
         raise ValueError(f"{what}: {_bad_id_message(i[k])}")
+    check_boxes(a[:, 2:6], a, what)
     return a
+
+
+def check_boxes(boxes: F64, rows: F64, what: str, name: str = "") -> None:
+    """Refuse the boxes a MOTChallenge file may not hold, as :func:`pftrack.io.mot.read_mot` does.
+
+    Parameters
+    ----------
+    boxes : (M, 4) ndarray
+        ``left, top, width, height`` per row; the rule is :func:`pftrack._check.first_bad_box`'s
+        (no negative width or height, 0 allowed; no value beyond ±1e9 px).
+    rows : (M, 10) ndarray
+        The rows the boxes belong to, whose frame and id the message names.
+    what, name : str
+        The caller and, for boxes other than the rows' own, the argument (``"measurements"``).
+
+    Raises
+    ------
+    ValueError
+        ``what: [name ]row R (frame F, id I) has width -5: negative box width or height``.
+    """
+    bad = first_bad_box(boxes)
+    if bad is not None:
+        r, c, problem = bad
+        raise ValueError(
+            f"{what}: {name + ' ' if name else ''}row {r} (frame {rows[r, 0]:g}, id "
+            f"{rows[r, 1]:g}) has {BOX_VALUES[c]} {boxes[r, c]:g}: {problem}"
+        )
 
 
 def _first_bad_id(ids: F64) -> int | None:

@@ -6,7 +6,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack._typing import F64
-from pftrack.kalman import Cov, cv_predict, cv_update
+from pftrack.kalman import Cov, _cv_predict, _cv_update  # unchecked: every frame, every track
 
 __all__ = ["CentreKalman"]
 
@@ -54,12 +54,12 @@ class CentreKalman:
         `gain` multiplies `accel` (faster footage, :meth:`MultiObjectTracker.motion_gain`).
         """
         q = (self.accel * gain * height) ** 2
-        (p, v), self.cov = cv_predict((self.p, self.v), self.cov, q)
+        (p, v), self.cov = _cv_predict((self.p, self.v), self.cov, q)
         self.p, self.v = np.asarray(p), np.asarray(v)
 
     def update(self, z: ArrayLike, sigma: float) -> None:
         """Correct with a measured centre `z` of standard deviation `sigma` (pixels)."""
-        (p, v), self.cov = cv_update(
+        (p, v), self.cov = _cv_update(
             (self.p, self.v), self.cov, np.asarray(z, dtype=np.float64), sigma**2
         )
         self.p, self.v = np.asarray(p), np.asarray(v)

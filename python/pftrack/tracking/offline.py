@@ -25,11 +25,12 @@ from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh_rows, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
-from pftrack.kalman import Cov, Mean, cv_predict, cv_update_where, rts_smooth
+from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
 from pftrack.recovery.fill import MAX_GAP_LIMIT, fill_rows
 from pftrack.recovery.linking import (
     MAX_ID,
     LinkConfig,
+    check_boxes,
     check_rows,
     check_unique,
     link_tracklets,
@@ -425,11 +426,11 @@ def _after_nll(
     cov: Cov = (np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0))
     nll = np.zeros(m)
     for t in range(1, length):
-        mean, cov = cv_predict(mean, cov, q, dt[t][:, None])
+        mean, cov = _cv_predict(mean, cov, q, dt[t][:, None])
         s = cov[0] + r2
         e = zs[t] - mean[0]
         nll += np.where(counts[t], 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
-        mean, cov = cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
+        mean, cov = _cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
     return nll
 
 
@@ -505,14 +506,17 @@ def smooth_tracks(
     Returns
     -------
     (M', 10) ndarray
-        The rows, sorted by frame then id.
+        The rows, sorted by frame then id. A smoothed track's boxes, filled ones too, are
+        never narrower or shorter than half its smallest detected box (:class:`BoxSmoother`).
 
     Raises
     ------
     ValueError
         Rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
-        id, a non-finite box, `observed` / `measurements` of the wrong shape, or `max_gap` not
-        None or an int in ``1..MAX_GAP_LIMIT``.
+        id, a non-finite box, a box (of the rows or `measurements`) that
+        :func:`pftrack.io.mot.read_mot` refuses (a negative width or height, a value beyond
+        ±1e9 px), `observed` / `measurements` of the wrong shape, or `max_gap` not None or an
+        int in ``1..MAX_GAP_LIMIT``.
     """
     if max_gap is not None and (
         isinstance(max_gap, bool)
@@ -535,6 +539,7 @@ def smooth_tracks(
         z = np.array(measurements, dtype=np.float64)
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
+    check_boxes(z, a, "smooth_tracks", "measurements")  # boxes of filled rows, as the rows'
     if relink_coast is not None and (
         isinstance(relink_coast, bool)
         or not isinstance(relink_coast, (int, np.integer))
@@ -568,6 +573,10 @@ def smooth_tracks(
                     fr = a[i:j, 0]
                     for c in range(4):
                         sm[nw, c] = z[i:j][nw, c] + np.interp(fr[nw], fr[~nw], shift[:, c])
+                    # the smoother's size floor (BoxSmoother): a size path that dips between
+                    # two ends the smoother shrank could otherwise cross zero
+                    floor = 0.5 * z[i:j][obs[i:j], 2:].min(axis=0)
+                    sm[nw, 2:] = np.maximum(sm[nw, 2:], floor)
                 a[i:j, 2:6] = sm
     out: F64 = a[np.lexsort((a[:, 1], a[:, 0]))]
     return out

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
 from pftrack.boxes import xywh_to_cxcywh
-from pftrack.kalman import cv_predict, cv_update, cv_update_where
+from pftrack.kalman import _cv_predict, _cv_update, _cv_update_where  # unchecked: per frame
 from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
 from pftrack.particle_filter.filter import reinitialise_filters, step_filters_summary
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
@@ -314,10 +314,10 @@ def predict_tracks(
     if accel_gain != 1.0:
         accel = accel * accel_gain
     z = summary[:, 0:2]
-    mean, c = cv_predict((p, v), cov, (accel * h) ** 2)
+    mean, c = _cv_predict((p, v), cov, (accel * h) ** 2)
     # a flat likelihood is no measurement: those tracks keep the prediction
     evidence = colour_evidence(summary[:, 2:3], summary[:, 3:4])
-    mean, c = cv_update_where(mean, c, z, (colour_noise * h) ** 2, evidence)
+    mean, c = _cv_update_where(mean, c, z, (colour_noise * h) ** 2, evidence)
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     boxes = np.concatenate([p - size / 2, size], axis=1)
     covs = np.concatenate(c, axis=1).tolist()
@@ -353,7 +353,7 @@ def follow_tracks_motion(
     p, v, cov = _motion_state(tracks)
     centre = b[:, :2] + b[:, 2:] / 2
     sigma = config.motion.detection_noise * size[:, 1:2]
-    mean, c = cv_update((p, v), cov, centre, sigma**2)
+    mean, c = _cv_update((p, v), cov, centre, sigma**2)
     p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
     size = 0.7 * size + 0.3 * b[:, 2:]
     boxes = np.concatenate([p - size / 2, size], axis=1) if smooth else b.copy()
