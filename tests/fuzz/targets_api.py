@@ -101,6 +101,8 @@ def _tracker(frames: list[Any], dets: list[Any], particles: Any) -> Any:
     with warnings.catch_warnings():
         # boxes outside the frame are dropped with a warning by design (tested elsewhere)
         warnings.filterwarnings("ignore", message=r".*outside the .* frame", category=UserWarning)
+        # scores above 1 are said once by design (tested in tests/tracking)
+        warnings.filterwarnings("ignore", message=r"a detection score is", category=UserWarning)
         for f, d in zip(frames, dets, strict=False):
             out.append([t.box_xywh.tolist() for t in tracker.update(f, d)])
     return out
@@ -115,6 +117,7 @@ def _api_tracker(dets: list[Any], options: dict[str, Any]) -> Any:
         # by design: boxes outside the frame are dropped, and an empty run says so
         warnings.filterwarnings("ignore", message=r".*outside the .* frame", category=UserWarning)
         warnings.filterwarnings("ignore", message=r"no track over", category=RuntimeWarning)
+        warnings.filterwarnings("ignore", message=r"a detection score is", category=UserWarning)
         out = [tracker.update(d, frame) for d in dets]
         out.append(tracker.finalize())
     return out
