@@ -465,3 +465,76 @@ def test_out_dev_stdout_prints_the_rows_then_the_summary(
     assert lines[-1].startswith(f"{inputs['tracks']}: ") and len(lines) > 20
     assert all(line.count(",") == 9 for line in lines[:-1])
     assert (tmp_path / "stdout").is_symlink()
+
+
+@pytest.fixture(scope="module")
+def folders(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An image folder ``imgs``, a sequence ``seq`` (``img1/``) and one read from its video."""
+    d = tmp_path_factory.mktemp("folders")
+    scene = make_scene(n_frames=12, rng=1)
+    scene.write_images(d / "imgs")
+    ini = "[Sequence]\nname={}\nimDir=img1\nframeRate=10\nseqLength=12\n"
+    scene.write_images(d / "seq" / "img1")
+    (d / "seq" / "seqinfo.ini").write_text(ini.format("seq"))
+    (d / "vseq").mkdir()
+    (d / "seq" / "gt").mkdir()
+    scene.write_video(d / "vseq" / "video.avi")
+    (d / "vseq" / "seqinfo.ini").write_text(ini.format("vseq"))
+    write_mot(d / "vseq" / "det.txt", scene.truth)
+    write_mot(d / "tracks.txt", scene.truth)
+    write_mot(d / "seq" / "gt" / "gt.txt", scene.truth)
+    (d / "res").mkdir()
+    write_mot(d / "res" / "seq.txt", scene.truth)
+    return d
+
+
+# a run whose output is a file of an input folder (IN: the folder above; `link.*` a symbolic
+# link made in the test folder to the file named after the arrow)
+INPUT_FOLDER_CASES = {
+    "track --out an image": "track IN/imgs --out IN/imgs/000001.png",
+    "track --plot an image": "track IN/imgs --out o.txt --plot IN/imgs/000002.png",
+    "track --plot through ..": "track IN/imgs --out o.txt --plot IN/seq/../imgs/000002.png",
+    "track --render a link to an image":
+        "track IN/imgs --out o.txt --render link.mp4>imgs/000003.png",
+    "track --out seqinfo.ini": "track IN/vseq --detections auto --out IN/vseq/seqinfo.ini",
+    "track video --out seqinfo.ini": "track IN/vseq/video.avi --out IN/vseq/seqinfo.ini",
+    "track img1 --out seqinfo.ini": "track IN/seq/img1 --out IN/seq/seqinfo.ini",
+    "track seq --out an image": "track IN/seq --out IN/seq/img1/000012.png",
+    "track --out a link to an image": "track IN/seq --out link.txt>seq/img1/000005.png",
+    "recover --video": "recover IN/tracks.txt --link --video IN/imgs --out IN/imgs/000004.png",
+    "recover --video seq":
+        "recover IN/tracks.txt --link --video IN/seq --out link.txt>seq/seqinfo.ini",
+    "batch --out": "batch IN/imgs --workers 0 --out D link D/imgs.txt>imgs/000006.png",
+    "batch --out seqinfo.ini": "batch IN/seq --workers 0 --out D link D/seq.txt>seq/seqinfo.ini",
+    "eval --json": "eval --gt IN/seq --res IN/res --json link.json>seq/gt/gt.txt",
+    "eval --csv": "eval --gt IN/seq --res IN/res --csv link.csv>res/seq.txt",
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(INPUT_FOLDER_CASES))
+def test_a_file_of_an_input_folder_is_not_an_output(
+    case: str,
+    folders: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    no_work: None,
+) -> None:
+    """Was: exit 0, an input image (or seqinfo.ini) replaced by the tracks, plot or video."""
+    monkeypatch.chdir(tmp_path)
+    argv = []
+    for word in INPUT_FOLDER_CASES[case].split():
+        if ">" in word:  # a link in the test folder to a file of the input folders
+            name, target = word.split(">")
+            (tmp_path / name).parent.mkdir(exist_ok=True)
+            (tmp_path / name).symlink_to(folders / target)
+            word = name
+        argv.append(word.replace("IN/", f"{folders}/"))
+    if "link" in argv:  # batch: the link is made, not passed
+        argv = argv[: argv.index("link")]
+    before = {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()}
+    assert main(["-q", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.endswith("is an input of this run; write elsewhere\n"), err
+    assert {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()} == before
+    assert not [p for p in tmp_path.rglob("*") if p.is_file() and not p.is_symlink()]

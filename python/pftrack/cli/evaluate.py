@@ -171,12 +171,13 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import atomic_write, check_output
     from pftrack.io.mot import read_mot
 
-    inputs = (args.gt, args.res)
+    jobs = _jobs(args)
+    # every ground-truth and result file read (a link named s.json may lead to one)
+    inputs = (args.gt, args.res, *(p for _, seq, res in jobs for p in (seq.gt_path, res)))
     if args.json:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.csv:
         check_output(args.csv, what="--csv", suffixes=(".csv",), inputs=inputs)
-    jobs = _jobs(args)
     scales = _scales(args.scale or [], [name for name, _, _ in jobs])
 
     loaded = []

@@ -78,7 +78,11 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(
             f"--out {out} is the input file; pass --in-place to replace it (atomically)"
         )
-    check_output(args.out, what="--out", inputs=(args.video,) if args.video else ())
+    from pftrack.io.video import source_files
+
+    # the video, or every image of a folder and a sequence's seqinfo.ini
+    inputs = tuple(source_files(args.video)) if args.video else ()
+    check_output(args.out, what="--out", inputs=inputs)
     rows = read_tracks(src)
     n_links = 0
     if args.link:

@@ -135,16 +135,14 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output
-    from pftrack.io.video import find_sequence, sequence_video
+    from pftrack.io.video import find_sequence, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES
 
     given = [d for d in (args.detections,) if d and d != "auto"]
     for det in given:
         check_input_file(det, what="--detections")
-    inputs = tuple([args.source] if not live else []) + tuple(given)
-    if not live and Path(args.source).is_dir():
-        video = sequence_video(args.source)  # a sequence folder read from its one video
-        inputs += (video,) if video is not None else ()
+    # the video, or every image of a folder and a sequence's seqinfo.ini (or its one video)
+    inputs = tuple(source_files(args.source) if not live else []) + tuple(given)
     if not live and args.detections == "auto":  # the sequence's det.txt is an input too
         with contextlib.suppress(ValueError):  # a bad seqinfo.ini is refused when read
             seq = find_sequence(args.source)

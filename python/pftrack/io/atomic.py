@@ -25,7 +25,7 @@ import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -312,10 +312,32 @@ def check_output(
             raise PermissionError(f"{what} {target}: not writable")
     else:
         _check_folder(written, what, target)
-    for source in inputs:
-        if _same_file(target, Path(source)):
-            raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
+    if _one_of(target, inputs):
+        raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
     return target
+
+
+def _one_of(target: Path, files: Iterable[PathLike]) -> bool:
+    """Whether `target` is one of `files` (as :func:`_same_file`, one ``stat`` per file).
+
+    For the thousands of images of an input folder: the target is looked at once.
+    """
+    try:
+        st = os.stat(target)
+    except OSError:
+        st = None
+    resolved: Path | None = None
+    for f in files:
+        try:
+            other = os.stat(f)
+        except OSError:  # a missing input: compared by its resolved path
+            resolved = resolved or target.resolve()
+            if Path(f).resolve() == resolved:
+                return True
+            continue
+        if st is not None and (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
+            return True  # the same file: links, hard links, bind mounts, "..", "./"
+    return False
 
 
 def _check_folder(written: Path, what: str, target: Path) -> None:

@@ -49,6 +49,7 @@ __all__ = [
     "read_frames",
     "read_seqinfo",
     "sequence_video",
+    "source_files",
     "video_files",
 ]
 
@@ -335,6 +336,72 @@ def _frame_order(
     return ordered
 
 
+def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
+    """The folder whose images a folder source `path` (of `sequence`, if any) reads.
+
+    A sequence folder's ``imDir`` (ValueError if missing), else ``path/img1`` if it exists,
+    else `path` itself.
+    """
+    if sequence is not None and sequence.folder == path:
+        folder = path / sequence.image_dir
+        if not folder.is_dir():
+            raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
+        return folder
+    if (path / "img1").is_dir():
+        return path / "img1"
+    return path
+
+
+def _images_in(folder: Path) -> list[Path]:
+    """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order."""
+    return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
+
+
+def source_files(source: PathLike | int) -> list[Path]:
+    """Every file :class:`FrameSource` reads for `source`: what no output of a run may replace.
+
+    Parameters
+    ----------
+    source : str, int or os.PathLike
+        As :class:`FrameSource` takes it.
+
+    Returns
+    -------
+    list of Path
+        `source` itself; every ``seqinfo.ini`` it looks for that exists (in a folder `source`
+        and the folder above it; beside a file); for a folder, each image of the folder it
+        reads frames from (``imDir`` of a sequence, ``img1/``, or the folder), or a sequence
+        folder's one video. Nothing for a camera index or a stream URL. A ``seqinfo.ini`` that
+        cannot be parsed is listed all the same (it is read: the run fails on it), and so is
+        every image of a sequence folder's image folders it may name.
+    """
+    text = str(source)
+    if _camera_index(source) is not None or "://" in text:
+        return []
+    path = Path(text)
+    files = [path]
+    if not path.is_dir():
+        ini = path.parent / "seqinfo.ini"
+        return files + ([ini] if ini.is_file() else [])
+    files += [f / "seqinfo.ini" for f in (path, path.parent) if (f / "seqinfo.ini").is_file()]
+    try:
+        sequence = find_sequence(path)
+    except ValueError:  # an unreadable seqinfo.ini: refused when read; guard every image folder
+        folders = [path, path / "img1"]
+    else:
+        try:
+            video = sequence_video(path) if sequence is not None else None
+        except ValueError:  # no video, or several: refused when read
+            video = None
+        if video is not None:
+            return [*files, video]
+        try:
+            folders = [_image_folder(path, sequence)]
+        except ValueError:  # its image folder is missing: refused when read
+            folders = []
+    return files + [p for f in folders if f.is_dir() for p in _images_in(f)]
+
+
 def check_source(source: object) -> None:
     """Refuse what cannot name a frame source, before anything is opened.
 
@@ -495,14 +562,8 @@ class FrameSource:
             self._replay.append(first)
 
     def _open_folder(self, path: Path) -> tuple[NDArray[Any], int]:
-        folder = path
-        if self.sequence is not None and self.sequence.folder == path:
-            folder = path / self.sequence.image_dir
-            if not folder.is_dir():
-                raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
-        elif (path / "img1").is_dir():
-            folder = path / "img1"
-        images = [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
+        folder = _image_folder(path, self.sequence)
+        images = _images_in(folder)
         if not images:
             raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
         seq = self.sequence
