@@ -347,11 +347,9 @@ def _write_json(path: str, doc: dict[str, Any]) -> None:
 def _write_figure(path: str, image: Any) -> None:
     import cv2
 
-    from pftrack.io.atomic import atomic_path
+    from pftrack.io.opencv_io import write_image
 
-    with atomic_path(path) as tmp:
-        if not cv2.imwrite(str(tmp), image, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
-            raise ValueError(f"cannot write figure {path}")
+    write_image(path, image, [cv2.IMWRITE_PNG_COMPRESSION, 9])
 
 
 def _run_sequences(args: argparse.Namespace) -> int:

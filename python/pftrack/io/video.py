@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._typing import PathLike
+from pftrack.io.opencv_io import opencv_name, read_image, utf8_name
 
 __all__ = [
     "VIDEO_SUFFIXES",
@@ -76,11 +77,12 @@ def _file_capture(path: str) -> cv2.VideoCapture:
     beside the detector's and the tracker's, and a ``pftrack batch`` worker has one core. Falls
     back to OpenCV's default backend choice if FFmpeg cannot open the file.
     """
-    cap = cv2.VideoCapture(path, cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, 1])
-    if cap.isOpened():
-        return cap
-    cap.release()
-    return cv2.VideoCapture(path)
+    with opencv_name(path) as name:  # any file name (opencv_io); OpenCV keeps its own handle
+        cap = cv2.VideoCapture(name, cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, 1])
+        if cap.isOpened():
+            return cap
+        cap.release()
+        return cv2.VideoCapture(name)
 
 
 def _fourcc(cap: cv2.VideoCapture) -> str:
@@ -570,7 +572,7 @@ class FrameSource:
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
         self._images = numbered or sorted(images, key=lambda p: natural_key(p.name))
-        first = cv2.imread(str(self._images[0]), cv2.IMREAD_COLOR)
+        first = read_image(self._images[0])
         if first is None:
             raise ValueError(f"cannot read image {self._images[0]}")
         self._image_shape = (int(first.shape[0]), int(first.shape[1]))
@@ -599,8 +601,11 @@ class FrameSource:
         what = "camera" if isinstance(self._target, int) else "stream"
         if isinstance(self._target, int):
             cap = cv2.VideoCapture(self._target)
-        else:
-            cap = cv2.VideoCapture(self._target, cv2.CAP_FFMPEG)
+        elif "://" in self._target:  # a URL OpenCV's binding cannot take crashes it
+            cap = cv2.VideoCapture(utf8_name(self._target, "stream URL"), cv2.CAP_FFMPEG)
+        else:  # a named pipe, under any name (opencv_io)
+            with opencv_name(self._target) as name:
+                cap = cv2.VideoCapture(name, cv2.CAP_FFMPEG)
         ok, first = cap.read() if cap.isOpened() else (False, None)
         if not ok or first is None:
             cap.release()
@@ -616,7 +621,7 @@ class FrameSource:
 
     def _read_image(self, path: Path) -> NDArray[np.uint8]:
         """One image of a folder, resized; ValueError if unreadable or not the first's size."""
-        img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+        img = read_image(path)
         if img is None:
             raise ValueError(f"cannot read image {path}")
         if img.shape[:2] != self._image_shape:
