@@ -538,3 +538,54 @@ def test_a_file_of_an_input_folder_is_not_an_output(
     assert err.count("\n") == 1 and err.endswith("is an input of this run; write elsewhere\n"), err
     assert {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()} == before
     assert not [p for p in tmp_path.rglob("*") if p.is_file() and not p.is_symlink()]
+
+
+def test_sigterm_is_handled_as_ctrl_c(tmp_path: Path) -> None:
+    """``kill PID`` while rendering: exit 143, outputs as they were, no temporary file.
+
+    Was: killed where it stood (status -15, 143 in a shell), ``..t.<hex>.<hex>.mp4`` and
+    ``.t.<hex>.mp4`` left beside the outputs.
+    """
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    video = make_scene(n_frames=400, rng=0).write_video(tmp_path / "scene.avi")
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("t.txt", "t.mp4"):
+        (out / name).write_bytes(b"an earlier result\n")
+    before = _snapshot(out)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    argv = [sys.executable, "-m", "pftrack", "-q", "track", str(video), "--out", "t.txt",
+            "--render", "t.mp4"]  # fmt: skip
+    proc = subprocess.Popen(argv, cwd=out, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        while not [p for p in os.listdir(out) if p.startswith(".")]:  # rendering has started
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.01)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, err
+    assert err.strip() == "pftrack track: terminated (SIGTERM); no output was changed"
+    assert _snapshot(out) == before
+
+
+def test_sigterm_ends_a_batch_with_its_own_status(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The batch says it was terminated, exit 143 (Ctrl-C: interrupted, 130)."""
+    import pftrack.batch as batch
+    from pftrack.cli._signals import Terminated
+
+    def terminated(*args: Any, **kwargs: Any) -> Any:
+        raise Terminated
+
+    monkeypatch.setattr(batch, "track_many", terminated)
+    assert main(["batch", str(tmp_path), "--out", str(tmp_path / "o"), "--workers", "0"]) == 143
+    assert capsys.readouterr().err.startswith("pftrack batch: terminated (SIGTERM); ")

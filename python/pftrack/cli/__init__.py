@@ -18,6 +18,7 @@ from typing import Any
 from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
 from pftrack.cli._options import HelpFormatter
+from pftrack.cli._signals import Terminated, exit_status, sigterm_raises
 
 __all__ = ["build_parser", "main"]
 
@@ -167,7 +168,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         set_quiet(True)
     try:
-        with warnings.catch_warnings(), _quiet_opencv(), _names_on_stdout():
+        with warnings.catch_warnings(), _quiet_opencv(), _names_on_stdout(), sigterm_raises():
             warnings.showwarning = _one_line_warning(args.command)
             status = int(args.func(args))
         if sys.stdout is not None:  # a buffered stdout's last lines: a closed pipe fails here
@@ -182,9 +183,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError:
         print(f"pftrack {args.command}: error: out of memory", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:  # outputs are atomic: nothing half-written is left behind
-        print(f"\npftrack {args.command}: interrupted; no output was changed", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # outputs are atomic: nothing half-written is left behind
+        how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+        print(f"\npftrack {args.command}: {how}; no output was changed", file=sys.stderr)
+        return exit_status(exc)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -22,14 +22,13 @@ from pftrack.cli._options import (
     iou_threshold,
     non_negative_int,
 )
+from pftrack.cli._signals import Terminated, exit_status
 
 if TYPE_CHECKING:
     from pftrack.batch import BatchSummary
 
 #: Exit status when a batch ran but some of its tasks failed (2: bad usage, nothing ran).
 EXIT_SOME_FAILED = 1
-#: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
-EXIT_INTERRUPTED = 130
 #: ``--max-gap``'s upper bound (``recover``, ``smooth``, one file or a batch):
 #: :data:`pftrack.recovery.fill.MAX_GAP_LIMIT` and :class:`pftrack.recovery.LinkConfig`'s,
 #: stated here so that ``--help`` does not import the recovery code (a test checks they agree).
@@ -84,7 +83,7 @@ def add_parser(sub: Any) -> None:
         "sequence raised. Workers read the inputs by these paths; this process "
         "writes every output. A re-run skips sequences whose outputs are complete.\n\n"
         "exit status: 0 all done, 1 some sequences failed (the others' outputs are written), "
-        "2 bad usage (nothing ran), 130 interrupted.",
+        "2 bad usage (nothing ran), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).",
     )
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="video, image or sequence folder")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
@@ -114,13 +113,14 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
     """Run the batch; print its table, or what stopped it; return the exit status."""
     try:
         summary = call()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
+        how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         print(
-            f"pftrack {command}: interrupted; the outputs written so far are complete (re-run "
+            f"pftrack {command}: {how}; the outputs written so far are complete (re-run "
             "to finish the rest)",
             file=sys.stderr,
         )
-        return EXIT_INTERRUPTED
+        return exit_status(exc)
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
         hint = "; or --workers 0: in this process, without Dask" if exc.name in _DASK else ""
         print(f"pftrack {command}: error: {exc}{hint}", file=sys.stderr)

@@ -404,6 +404,21 @@ def check_distinct(outputs: Mapping[str, PathLike | None]) -> None:
         seen.append((what, target))
 
 
+def _remove_nested(tmp: Path) -> None:
+    """Remove the temporary files an atomic writer made beside staged file `tmp` for it.
+
+    A writer given a staged path writes it atomically in turn (``VideoWriter``:
+    ``..t.<hex>.<hex>.mp4`` for ``.t.<hex>.mp4``); interrupted between making its file and
+    handing it over (Ctrl-C, SIGTERM), nobody else knows that file. Its name starts with
+    ``.`` and `tmp`'s stem, whose random part no other file has.
+    """
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(tmp.parent):
+            if entry.name.startswith(f".{tmp.stem}."):
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+
+
 @contextlib.contextmanager
 def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
     """Several outputs of one run, all replaced at the end or none at all.
@@ -459,6 +474,7 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
         for tmp, _ in staged:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+            _remove_nested(Path(tmp))
         raise
     finally:
         if scratch:

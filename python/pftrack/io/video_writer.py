@@ -110,11 +110,11 @@ class VideoWriter:
         self.codec = "h264" if backend == "pyav" else ("mjpeg" if suffix == ".avi" else "")
         self.n_frames = 0
         self._size: tuple[int, int] | None = None  # (height, width) of the input frames
-        self._stack = contextlib.ExitStack()
-        self._tmp: Path = self._stack.enter_context(atomic_path(self.path))
         self._container: Any = None
         self._stream: Any = None
         self._cv: Any = None
+        self._stack = contextlib.ExitStack()
+        self._tmp: Path = self._stack.enter_context(atomic_path(self.path))
 
     def _open(self, height: int, width: int) -> None:
         self._size = (height, width)
