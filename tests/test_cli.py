@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -480,23 +481,43 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
 
 
 def test_library_warnings_are_one_line_for_every_command(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import warnings
 
-    cut = _truncated_video(tmp_path, np.random.default_rng(3), 12)
+    import pftrack.recovery as recovery
+
+    real = recovery.fill_gaps
+
+    def warning_fill(*args: Any, **kwargs: Any) -> Any:  # recover reads --video on demand
+        warnings.warn("a library warning\nin two lines", UserWarning, stacklevel=2)  # now: no
+        return real(*args, **kwargs)  # warning of a truncated video it does not decode whole
+
+    monkeypatch.setattr(recovery, "fill_gaps", warning_fill)
     src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
     with warnings.catch_warnings():
         warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
-        argv = ["-q", "recover", str(src), "--out", str(out), "--link", "--video", str(cut)]
-        assert main(argv) == 0
+        assert main(["-q", "recover", str(src), "--out", str(out), "--link"]) == 0
         before = warnings.showwarning
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [
-        f"pftrack recover: warning: {cut} ended after {err[0].split()[6]} frames but its header "
-        "says 12: a truncated or damaged file?"
-    ]
+    assert err == ["pftrack recover: warning: a library warning in two lines"]
     assert warnings.showwarning is before  # main restores the formatter it replaced
+
+
+def test_recover_on_a_truncated_video_says_where_it_ends(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The colour term needs frame 9, past the end of a video whose header says 12 frames."""
+    cut = _truncated_video(tmp_path, np.random.default_rng(3), 12)
+    src = tmp_path / "t.txt"
+    src.write_text("".join(f"{f},{1 if f < 5 else 2},{10 + f},10,8,16,1,-1,-1,-1\n"
+                           for f in (1, 2, 3, 9, 10)))  # fmt: skip
+    argv = ["recover", str(src), "--out", str(tmp_path / "o.txt"), "--link", "--video", str(cut)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    head = f"pftrack recover: error: {cut}: frame 9 cannot be decoded: the video ended after "
+    assert err.startswith(head) and err.endswith(" frames but its header says 12\n"), err
+    assert not (tmp_path / "o.txt").exists()
 
 
 @pytest.mark.parametrize(

@@ -22,11 +22,12 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import operator
 import os
 import re
 import stat
 import warnings
-from collections.abc import Generator, Iterable, Iterator
+from collections.abc import Generator, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +42,7 @@ from pftrack.io.opencv_io import opencv_name, read_image, utf8_name
 
 __all__ = [
     "VIDEO_SUFFIXES",
+    "FrameSequence",
     "FrameSource",
     "SequenceInfo",
     "check_source",
@@ -801,6 +803,87 @@ class FrameSource:
         self.close()
 
 
+class FrameSequence(Sequence[NDArray[np.uint8]]):
+    """The frames of a stored source as a sequence whose items are read when asked for.
+
+    Indexed in increasing order, a video file is decoded once, from its start to the last
+    frame asked for, holding one frame at a time (the frames in between are only grabbed, as
+    :meth:`FrameSource.frames_at` does); an index lower than the last one asked for starts a
+    new pass. An image folder reads only the images asked for. What
+    :func:`pftrack.recovery.link_tracklets` takes for its colour term, instead of every frame
+    of the video in memory (:func:`read_frames`).
+
+    Parameters
+    ----------
+    source : FrameSource, str or os.PathLike
+        A video file, an image folder or a sequence folder (not a live source).
+
+    Raises
+    ------
+    ValueError
+        A live source (it can be read only once, in order).
+
+    Notes
+    -----
+    The length is :attr:`FrameSource.n_frames`: a video's header count. A video that ends
+    before it fails on the first frame asked for past its end (ValueError naming both counts).
+    """
+
+    def __init__(self, source: FrameSource | PathLike) -> None:
+        self.source = source if isinstance(source, FrameSource) else FrameSource(source)
+        if self.source.live:
+            raise ValueError(f"live source {self.source.name} cannot be read at chosen frames")
+        self._cap: Any = None
+        self._at = 0  # the index of the frame self._cap reads next
+        self._last: tuple[int, NDArray[np.uint8]] | None = None
+
+    def __len__(self) -> int:
+        return self.source.n_frames
+
+    def __getitem__(self, index: Any) -> Any:
+        """The frame at 0-based `index` (an int; negative counts from the end)."""
+        if isinstance(index, slice):
+            raise TypeError("FrameSequence takes one index, not a slice")
+        i = operator.index(index)
+        n = len(self)
+        if i < 0:
+            i += n
+        if not 0 <= i < n:
+            raise IndexError(f"frame index {index} is out of range for {n} frames")
+        if self._last is not None and self._last[0] == i:
+            return self._last[1]
+        if self.source._images is not None:
+            frame = self.source._read_image(self.source._images[i])
+        else:
+            if self._cap is None or i < self._at:  # a new pass from the start
+                self.close()
+                self._cap = _file_capture(str(self.source.path))
+                self._at = 0
+            picked, _, self._at = self.source._read_at(self._cap, self._at, [i])
+            if not picked:
+                self.close()
+                raise ValueError(
+                    f"{self.source.name}: frame {i + 1} cannot be decoded: the video ended after "
+                    f"{self._at} frames but its header says {n}"
+                )
+            frame = picked[0]
+        self._last = (i, frame)
+        return frame
+
+    def close(self) -> None:
+        """Release the video file's decoder (a later item opens it again)."""
+        if self._cap is not None:
+            self._cap.release()
+            self._cap = None
+        self._at = 0
+
+    def __enter__(self) -> FrameSequence:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
 def read_frames(source: PathLike, *, scale: float = 1.0) -> list[NDArray[np.uint8]]:
-    """All frames of `source` in memory (fine for short sequences)."""
+    """All frames of `source` in memory (fine for short sequences; see :class:`FrameSequence`)."""
     return list(FrameSource(source, scale=scale))

@@ -21,7 +21,6 @@ from pftrack._check import MAX_FRAME, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.particle_filter.colour import (
-    BinnedImage,
     bhattacharyya_distance,
     box_histograms,
     hsv_bins,
@@ -175,22 +174,31 @@ def split_tracks(rows: F64) -> dict[int, F64]:
     return {int(r[i, 1]): r[i:j] for i, j in zip(starts, ends, strict=True)}
 
 
-class _Histograms:
-    """Colour histograms of fragment ends, each frame binned once (lazily: only gated pairs)."""
+def _end_histograms(
+    tracks: dict[int, F64], ends: Iterable[tuple[int, bool]], frames: Sequence[NDArray[np.uint8]]
+) -> dict[tuple[int, bool], F64 | None]:
+    """Colour histogram of the box at each fragment end of `ends` (id, last row or first).
 
-    def __init__(self, frames: Sequence[NDArray[np.uint8]]) -> None:
-        self.frames = frames
-        self.images: dict[int, BinnedImage] = {}
-
-    def of(self, row: F64) -> F64 | None:
-        """Histogram of the box of a row, None when there is no frame or nothing to count."""
-        f = int(row[0]) - 1
-        if not 0 <= f < len(self.frames):
-            return None
-        if f not in self.images:
-            self.images[f] = hsv_bins(self.frames[f])
-        hist = box_histograms(self.images[f], xywh_to_cxcywh(row[2:6])[None])[0]
-        return hist if hist.sum() > 0 else None
+    None where there is no frame or nothing to count. The frames are asked for in increasing
+    order, each once, and binned one at a time: a sequence that reads a video on demand
+    (:class:`pftrack.io.video.FrameSequence`) decodes it in one pass, holding one frame.
+    """
+    at: dict[int, list[tuple[int, bool]]] = {}
+    for key in ends:
+        tid, last = key
+        at.setdefault(int(tracks[tid][-1 if last else 0, 0]) - 1, []).append(key)
+    out: dict[tuple[int, bool], F64 | None] = {}
+    n = len(frames)
+    for f in sorted(at):
+        image = hsv_bins(frames[f]) if 0 <= f < n else None
+        for tid, last in at[f]:
+            if image is None:
+                out[tid, last] = None
+                continue
+            row = tracks[tid][-1 if last else 0]
+            hist = box_histograms(image, xywh_to_cxcywh(row[2:6])[None])[0]
+            out[tid, last] = hist if hist.sum() > 0 else None
+    return out
 
 
 def link_cost_matrix(
@@ -201,21 +209,16 @@ def link_cost_matrix(
     """Cost of joining the end of fragment i to the start of fragment j (``inf`` when gated).
 
     Returns the ids (row i and column j both index this list) and the ``(K, K)`` cost matrix.
-    `frames`, when given, is indexable by ``frame - 1`` (BGR images) and adds a colour term.
+    `frames`, when given, is indexable by ``frame - 1`` (BGR images) and adds a colour term:
+    only the frames of the fragment ends of pairs within the gates are read, in increasing
+    order, each once (a :class:`pftrack.io.video.FrameSequence` reads them from the video in
+    one pass).
     """
     ids = list(tracks)
     k = len(ids)
     cost = np.full((k, k), np.inf)
     cent = {t: box_centres(r) for t, r in tracks.items()}
-    colour = _Histograms(frames) if frames is not None else None
-    hists: dict[tuple[int, bool], F64 | None] = {}
-
-    def hist(tid: int, last: bool) -> F64 | None:
-        key = (tid, last)
-        if key not in hists and colour is not None:
-            hists[key] = colour.of(tracks[tid][-1 if last else 0])
-        return hists.get(key)
-
+    gated: list[tuple[int, int, float]] = []  # (i, j, the cost but its colour term)
     for i, ti in enumerate(ids):
         ci = cent[ti]
         end = ci[-1]
@@ -237,11 +240,16 @@ def link_cost_matrix(
             hi, hj = tracks[ti][-1, 5], tracks[tj][0, 5]
             if hi > 0 and hj > 0:
                 c += config.w_size * abs(float(np.log(hi / hj)))
-            if colour is not None and config.w_appearance > 0:
-                a, b = hist(ti, True), hist(tj, False)
-                if a is not None and b is not None:
-                    c += config.w_appearance * float(bhattacharyya_distance(a, b)[0])
-            cost[i, j] = c
+            gated.append((i, j, c))
+    hists: dict[tuple[int, bool], F64 | None] = {}
+    if frames is not None and config.w_appearance > 0:
+        ends = {(ids[i], True) for i, _, _ in gated} | {(ids[j], False) for _, j, _ in gated}
+        hists = _end_histograms(tracks, sorted(ends), frames)
+    for i, j, c in gated:
+        a, b = hists.get((ids[i], True)), hists.get((ids[j], False))
+        if a is not None and b is not None:
+            c += config.w_appearance * float(bhattacharyya_distance(a, b)[0])
+        cost[i, j] = c
     return ids, cost
 
 
