@@ -589,3 +589,22 @@ def test_sigterm_ends_a_batch_with_its_own_status(
     monkeypatch.setattr(batch, "track_many", terminated)
     assert main(["batch", str(tmp_path), "--out", str(tmp_path / "o"), "--workers", "0"]) == 143
     assert capsys.readouterr().err.startswith("pftrack batch: terminated (SIGTERM); ")
+
+
+def test_no_tracks_into_a_device_or_pipe_is_an_empty_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """As a regular file gets an empty file (was: ``nothing was written for /dev/null``, 2)."""
+    import threading
+
+    video = make_scene(n_frames=3, rng=0).write_video(tmp_path / "short.avi")  # no track lives
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    for out in (tmp_path / "regular.txt", Path(os.devnull), fifo):
+        assert main(["-q", "track", str(video), "--out", str(out), "--particles", "20"]) == 0
+        assert "0 tracks, 0 boxes in " in capsys.readouterr().out
+    reader.join(30)
+    assert got == [b""] and (tmp_path / "regular.txt").read_bytes() == b""

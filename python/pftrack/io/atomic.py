@@ -244,9 +244,15 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         raise
 
 
-def _copy_through(tmp: Path, target: _Target) -> None:
-    """Write the finished file `tmp` into the written-through `target`."""
+def _copy_through(tmp: Path, target: _Target, *, empty_ok: bool = False) -> None:
+    """Write the finished file `tmp` into the written-through `target`.
+
+    OSError when `tmp` is missing or empty, unless `empty_ok` (then nothing is written).
+    """
     if not tmp.exists() or tmp.stat().st_size == 0:
+        if empty_ok:
+            with _open_through(target, "wb"):  # opened as a regular file would be replaced
+                return
         raise OSError(f"nothing was written for {target.path}")
     with tmp.open("rb") as src, _open_through(target, "wb") as dst:
         shutil.copyfileobj(src, dst)
@@ -469,7 +475,7 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
         for tmp, target in staged:
             os.replace(tmp, target)
         for tmp_path, resolved in through:  # last: a FIFO waits for its reader
-            _copy_through(tmp_path, resolved)
+            _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
     except BaseException:
         for tmp, _ in staged:
             with contextlib.suppress(OSError):
