@@ -608,3 +608,48 @@ def test_no_tracks_into_a_device_or_pipe_is_an_empty_output(
         assert "0 tracks, 0 boxes in " in capsys.readouterr().out
     reader.join(30)
     assert got == [b""] and (tmp_path / "regular.txt").read_bytes() == b""
+
+
+@pytest.mark.parametrize(
+    ("argv", "magic"),
+    [
+        ("track VIDEO --out t.txt --render OUT --plot /dev/null --particles 20", b"ftyp"),
+        ("track VIDEO --out t.txt --plot OUT --render /dev/null --particles 20", b"\x89PNG"),
+        ("eval --gt GT --res TRACKS --json OUT --csv /dev/null", b'{\n  "hota"'),
+        ("eval --gt GT --res TRACKS --csv OUT --json /dev/null", b"sequence,"),
+        ("experiment gaps --gt WALKERS --figure OUT --json /dev/null --methods linear "
+         "--repeat 1 --max-positions 1", b"\x89PNG"),
+    ],
+    ids=["track --render", "track --plot", "eval --json", "eval --csv", "experiment --figure"],
+)  # fmt: skip
+def test_a_device_or_pipe_takes_the_default_format(
+    argv: str, magic: bytes, inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """``--render /dev/stdout`` is an MP4, ``--plot`` a PNG (was: ``unsupported extension
+    '(none)'``, exit 2, though the docs said devices were accepted)."""
+    import threading
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    names = {"VIDEO": inputs["video"], "GT": inputs["gt"], "TRACKS": inputs["tracks"],
+             "OUT": fifo, "t.txt": tmp_path / "t.txt"}  # fmt: skip
+    if "WALKERS" in argv:
+        names["WALKERS"] = _walkers(tmp_path / "A")
+    assert main(["-q", *(str(names.get(a, a)) for a in argv.split())]) == 0
+    reader.join(60)
+    assert got and magic in got[0][:16]
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+
+
+def test_a_regular_file_without_extension_is_still_refused(
+    inputs: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str], no_work: None
+) -> None:
+    argv = ["track", str(inputs["video"]), "--out", str(tmp_path / "t.txt"), "--render",
+            str(tmp_path / "video")]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err.endswith(
+        "video: unsupported extension '(none)', expected one of .mp4, .avi\n"
+    )

@@ -10,6 +10,8 @@ from pftrack.cli._options import add_command, bounded_float, non_negative_int, p
 from pftrack.recovery.names import METHODS
 
 MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this are refused
+#: ``--figure``'s formats; the first is a device's (``--figure /dev/stdout``).
+FIGURE_SUFFIXES = (".png", ".jpg")
 #: Options of the one-sequence sweep (one --gt, no --auto-masks): refused in the other mode.
 SINGLE_ONLY = ("mask", "size", "grid", "trajectories", "gaps", "min_gaps", "repeat",
                "max_positions", "figure")  # fmt: skip
@@ -205,7 +207,7 @@ def run_gaps(args: argparse.Namespace) -> int:
     if args.json:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.figure:
-        check_output(args.figure, what="--figure", suffixes=(".png", ".jpg"), inputs=inputs)
+        check_output(args.figure, what="--figure", suffixes=FIGURE_SUFFIXES, inputs=inputs)
     if multi:
         return _run_sequences(args)
     import numpy as np
@@ -347,9 +349,11 @@ def _write_json(path: str, doc: dict[str, Any]) -> None:
 def _write_figure(path: str, image: Any) -> None:
     import cv2
 
+    from pftrack.io.atomic import output_format
     from pftrack.io.opencv_io import write_image
 
-    write_image(path, image, [cv2.IMWRITE_PNG_COMPRESSION, 9])
+    ext = output_format(path, FIGURE_SUFFIXES)  # a device (/dev/stdout): .png
+    write_image(path, image, [cv2.IMWRITE_PNG_COMPRESSION, 9], ext=ext)
 
 
 def _run_sequences(args: argparse.Namespace) -> int:

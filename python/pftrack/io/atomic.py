@@ -306,11 +306,8 @@ def check_output(
     if target.is_dir():
         raise ValueError(f"{what} {target} is a folder; give a file name")
     _refuse_folder_name(text, what)
-    if suffixes is not None and target.suffix.lower() not in suffixes:
-        raise ValueError(
-            f"{what} {text}: unsupported extension {target.suffix or '(none)'!r}, expected "
-            f"one of {', '.join(suffixes)}"
-        )
+    if suffixes is not None:
+        output_format(text, suffixes, what)  # a device without extension: the first
     resolved = _resolve(text)
     written = resolved.path
     if resolved.through:
@@ -344,6 +341,29 @@ def _one_of(target: Path, files: Iterable[PathLike]) -> bool:
         if st is not None and (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
             return True  # the same file: links, hard links, bind mounts, "..", "./"
     return False
+
+
+def output_format(path: PathLike, suffixes: tuple[str, ...], what: str = "output") -> str:
+    """The format output `path` is written in: its extension, one of `suffixes` (lower case).
+
+    A device, pipe or descriptor without an extension (``/dev/null``, ``/dev/stdout``, a named
+    pipe ``fifo``) takes the first of `suffixes`, the default format: its name cannot say one.
+
+    Raises
+    ------
+    ValueError
+        Any other extension that is not one of `suffixes`.
+    """
+    text = os.fsdecode(os.fspath(path))
+    suffix = Path(text).suffix.lower()
+    if suffix in suffixes:
+        return suffix
+    if not suffix and _resolve(text).through:
+        return suffixes[0]
+    raise ValueError(
+        f"{what} {text}: unsupported extension {Path(text).suffix or '(none)'!r}, expected "
+        f"one of {', '.join(suffixes)}"
+    )
 
 
 def _check_folder(written: Path, what: str, target: Path) -> None:
@@ -426,11 +446,12 @@ def _remove_nested(tmp: Path) -> None:
 
 
 @contextlib.contextmanager
-def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
+def staged_outputs() -> Iterator[Callable[..., Path]]:
     """Several outputs of one run, all replaced at the end or none at all.
 
-    Yields ``stage(path) -> Path``: a temporary path beside `path`, with its extension, for a
-    writer to fill. When the block ends normally every staged file is renamed over its target;
+    Yields ``stage(path, suffix=None) -> Path``: a temporary path beside `path`, with its
+    extension (or `suffix`: the format of a device, :func:`output_format`), for a writer to
+    fill. When the block ends normally every staged file is renamed over its target;
     when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
     target is left as it was, so an interrupted run never leaves a new tracks file beside an old
     video, or a half-written file anywhere. A symbolic link replaces the file it leads to; a
@@ -446,10 +467,10 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
     through: list[tuple[Path, _Target]] = []  # devices, FIFOs, descriptors: written at the end
     scratch: list[str] = []  # the temporary folder of their files, made when first needed
 
-    def stage(path: PathLike) -> Path:
+    def stage(path: PathLike, suffix: str | None = None) -> Path:
         _refuse_folder_name(path)
         resolved = _resolve(path)
-        suffix = Path(path).suffix
+        suffix = Path(path).suffix if suffix is None else suffix
         if resolved.through:
             if not scratch:
                 scratch.append(tempfile.mkdtemp(prefix="pftrack-"))
