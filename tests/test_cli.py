@@ -504,6 +504,74 @@ def test_library_warnings_are_one_line_for_every_command(
     assert warnings.showwarning is before  # main restores the formatter it replaced
 
 
+@pytest.mark.parametrize("command", ["track", "batch"])
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ("--det-scale 7", "--det-scale 7 scales the boxes of --detections; the built-in "
+                          "detector's are in the frame's pixels: drop it, or give --detections"),
+        ("--birth-score 0.5", "--birth-score 0.5 gates the births of --detections; the built-in "
+                              "detector starts a track from any blob: drop it, or give "
+                              "--detections"),
+        ("--min-conf -5", "--min-conf -5: the built-in detector's scores are the share of "
+                          "foreground pixels in a blob's box, in [0, 1]; give a value in "
+                          "[0, 1], or --detections"),
+        ("--min-conf 1.5", "--min-conf 1.5: the built-in detector's scores"),
+    ],
+)  # fmt: skip
+def test_options_the_built_in_detector_never_uses_are_refused(
+    command: str,
+    option: str,
+    message: str,
+    video: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Were: accepted and ignored (the same tracks), as ``--crossings on --no-smooth`` was."""
+    import pftrack.tracking as tracking
+
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("work started")
+
+    monkeypatch.setattr(tracking, "track_frames", refuse)
+    out = tmp_path / ("o.txt" if command == "track" else "o")
+    argv = [command, str(video), "--out", str(out), *option.split()]
+    assert main([*argv, "--workers", "0"] if command == "batch" else argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pftrack {command}: error: {message}") and err.count("\n") == 1, err
+    assert not out.exists()
+
+
+def test_options_of_given_detections_are_taken_with_them(video: Path, tmp_path: Path) -> None:
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import DEFAULT_BIRTH_SCORE, tracker_config
+    from pftrack.tracking import LifecycleConfig
+
+    assert DEFAULT_BIRTH_SCORE == LifecycleConfig().birth_score
+    parse = build_parser().parse_args
+    det = ["--detections", "d.txt"]
+    cfg = tracker_config(parse(["track", "v", "--out", "o", *det, "--min-conf", "-5",
+                                "--birth-score", "0.5", "--det-scale", "2"]))  # fmt: skip
+    assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (-5, 0.5)
+    cfg = tracker_config(parse(["track", "v", "--out", "o", "--min-conf", "0.5"]))  # built-in
+    assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (0.5, DEFAULT_BIRTH_SCORE)
+    with pytest.raises(ValueError, match=r"LifecycleConfig: birth_score is 1.5, expected a value"):
+        LifecycleConfig(birth_score=1.5)
+
+
+def test_fill_help_says_what_it_does_with_smoothing(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--fill pf`` changes the smoothed output too (it guides linking): was documented as an
+    option of ``--no-smooth`` only."""
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert (
+        "written as they are with --no-smooth; with smoothing the smoother's boxes replace "
+        "them, and they only guide the offline linking (and --crossings)" in text
+    )
+
+
 def test_recover_on_a_truncated_video_says_where_it_ends(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -589,7 +657,15 @@ def test_crossings_without_the_smoother_are_refused(
         ),
         (
             ["track", "V", "--out", "O", "--birth-score", "nan"],
-            "argument --birth-score: expected a finite number, got nan",
+            "argument --birth-score: expected a number in [0, 1], got nan",
+        ),
+        (  # was: accepted with --detections, though scores are confidences in [0, 1]
+            ["track", "V", "--out", "O", "--detections", "T", "--birth-score", "-1"],
+            "argument --birth-score: expected a number in [0, 1], got -1",
+        ),
+        (
+            ["batch", "V", "--out", "O", "--detections", "auto", "--birth-score", "5"],
+            "argument --birth-score: expected a number in [0, 1], got 5",
         ),
         (
             ["smooth", "T", "--out", "O", "--max-gap", "100000000"],

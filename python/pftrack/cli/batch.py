@@ -95,7 +95,7 @@ def add_parser(sub: Any) -> None:
         "--det-scale", type=det_scale, default="auto", metavar="S",
         help=f"multiply detection boxes by S ({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}); "
         "auto: the frame width over seqinfo.ini's imWidth where there is one (0.625 for "
-        "PETS09-S2L1's video), else 1",
+        "PETS09-S2L1's video), else 1; a number only with --detections auto",
     )  # fmt: skip
     p.add_argument("--render", action="store_true", help="also write DIR/NAME.mp4, annotated")
     p.add_argument("--iou", type=iou_threshold, default=0.5,

@@ -62,7 +62,7 @@ def add_parser(sub: Any) -> None:
         help="multiply detection boxes by S to reach the video's pixels "
         f"({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}; 0.625 for PETS09 det.txt on its "
         "480x360 video); auto: for the sequence's own detections, the frame width over "
-        "seqinfo.ini's imWidth, else 1",
+        "seqinfo.ini's imWidth, else 1; a number only with --detections",
     )  # fmt: skip
     p.add_argument(
         "--fps", type=bounded_float(0.01, 1000.0), metavar="FPS",
