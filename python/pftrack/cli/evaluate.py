@@ -58,7 +58,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--scale", type=scale_spec, action="append", default=None, metavar="[NAME=]S",
         help="multiply ground-truth boxes by S, for every sequence or for sequence NAME "
-        "(repeat the option); 0.625 for PETS09 gt on its 480x360 video; None: 1 everywhere",
+        "(repeat the option for other sequences; twice for the same ones is refused); 0.625 "
+        "for PETS09 gt on its 480x360 video; None: 1 everywhere",
     )  # fmt: skip
     p.add_argument("--iou", type=iou_threshold, default=0.5, help=IOU_HELP)
     p.add_argument(
@@ -80,6 +81,24 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--json", default=None, help="also write all metrics to this JSON file")
     p.add_argument("--csv", default=None, help="also write the table's scores to this CSV file")
     p.set_defaults(func=run)
+
+
+def _check_scales(specs: list[tuple[str | None, float]]) -> None:
+    """Refuse a ``--scale`` given twice for every sequence, or twice for one NAME.
+
+    The option is repeated to give sequences their own scales: a second value for the same
+    sequences would silently win over the first.
+    """
+    seen: dict[str | None, float] = {}
+    for name, value in specs:
+        if name in seen:
+            which = "every sequence" if name is None else f"sequence {name}"
+            given = f"{seen[name]:g}, then {value:g}"
+            raise ValueError(
+                f"--scale is given twice for {which} ({given}); give it once (repeat it only "
+                "for other sequences: --scale NAME=S)"
+            )
+        seen[name] = value
 
 
 def _scales(specs: list[tuple[str | None, float]], names: list[str]) -> dict[str, float]:
@@ -171,6 +190,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import atomic_write, check_output
     from pftrack.io.mot import read_mot
 
+    _check_scales(args.scale or [])
     jobs = _jobs(args)
     # every ground-truth and result file read (a link named s.json may lead to one)
     inputs = (args.gt, args.res, *(p for _, seq, res in jobs for p in (seq.gt_path, res)))
