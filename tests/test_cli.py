@@ -284,6 +284,25 @@ def test_experiment_gaps_refuses_the_other_modes_options_before_work(
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("spelling", ["same", "dot", "link"])
+def test_experiment_gaps_refuses_one_ground_truth_given_twice(
+    spelling: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: one sequence counted twice (two rows, its gaps twice in the pooled MMAE)."""
+    gt = _walkers(tmp_path / "gt.txt")
+    (tmp_path / "other.txt").symlink_to(gt)
+    again = {"same": str(gt), "dot": f"{tmp_path}/./gt.txt", "link": str(tmp_path / "other.txt")}
+    argv = ["experiment", "gaps", "--gt", str(gt), str(again[spelling]), "--image-size",
+            "768x576", "--json", str(tmp_path / "e.json")]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"pftrack experiment: error: --gt {gt} and {again[spelling]} are the same file; give "
+        "each sequence once\n"
+    )
+    assert not (tmp_path / "e.json").exists()
+
+
 @pytest.mark.parametrize("command", ["eval", "batch"])
 @pytest.mark.parametrize("iou", ["1.5", "0", "-0.5", "nan", "inf"])
 def test_iou_is_refused_alike_by_eval_and_batch(

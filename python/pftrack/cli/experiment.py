@@ -48,7 +48,7 @@ def add_parser(sub: Any) -> None:
     )
     g.add_argument("--gt", required=True, nargs="+",
                    help="ground truth file(s) (MOTChallenge); one: the one-sequence sweep, "
-                   "several: the multi-sequence protocol")  # fmt: skip
+                   "several (each file once): the multi-sequence protocol")  # fmt: skip
     g.add_argument("--auto-masks", action="store_true",
                    help="the multi-sequence protocol, even for one --gt")  # fmt: skip
     g.add_argument("--n-masks", type=positive_int, default=None, metavar="N",
@@ -194,11 +194,34 @@ def _check_mode(args: argparse.Namespace) -> bool:
     return bool(multi)
 
 
+def _check_distinct_gt(paths: list[str]) -> None:
+    """Refuse one ground-truth file given twice (``A/gt.txt A/./gt.txt``, a link to it).
+
+    It would be one sequence counted twice: two rows, and its gaps twice in the pooled MMAE.
+    """
+    from pathlib import Path
+
+    seen: dict[object, str] = {}
+    for path in paths:
+        p = Path(path)
+        try:
+            st = p.stat()
+            key: object = (st.st_dev, st.st_ino)
+        except OSError:  # missing: refused when read; compared by name meanwhile
+            key = p.resolve()
+        if key in seen:
+            raise ValueError(
+                f"--gt {seen[key]} and {path} are the same file; give each sequence once"
+            )
+        seen[key] = path
+
+
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
     from pftrack.io.atomic import check_output
 
     multi = _check_mode(args)  # before any other check: the options a mode does not use
+    _check_distinct_gt(args.gt)
     inputs = tuple(args.gt)
     if args.mask:
         _parse_mask(args.mask)  # bad options are refused before any work
