@@ -189,6 +189,7 @@ def run(args: argparse.Namespace) -> int:
     )
     from pftrack.io.atomic import atomic_write, check_output
     from pftrack.io.mot import read_mot
+    from pftrack.recovery.linking import check_file_ids
 
     _check_scales(args.scale or [])
     jobs = _jobs(args)
@@ -204,6 +205,8 @@ def run(args: argparse.Namespace) -> int:
     for name, seq, path in jobs:  # read and check everything before scoring anything
         gt = read_mot(seq.gt_path, what="ground truth")
         res = read_mot(path, what="result file")
+        check_file_ids(gt, seq.gt_path)  # 1.5 is refused, as recover does (was: scored as 1)
+        check_file_ids(res, path)
         if not args.no_scale_check:
             check_scale(gt, res, scale=scales[name], name=f"{path}")
         loaded.append((name, seq, gt, res))

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_FRAME, real_array
+from pftrack._check import MAX_FRAME, MAX_ID, bad_id_message, first_bad_id, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.particle_filter.colour import (
@@ -29,8 +29,10 @@ from pftrack.particle_filter.colour import (
 __all__ = [
     "FILLED_MARK",
     "FLAG_COLUMN",
+    "MAX_ID",
     "LinkConfig",
     "box_centres",
+    "check_file_ids",
     "check_rows",
     "check_unique",
     "filled_mask",
@@ -47,8 +49,6 @@ FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTCha
 FILLED_MARK = (1.0, -1.0, -1.0)
 #: Frames up to this diagonal (640x480) take pixel settings as given; larger ones scale them.
 REFERENCE_DIAGONAL = 800.0
-#: Largest absolute track id accepted.
-MAX_ID = MAX_FRAME
 
 
 @dataclass(frozen=True)
@@ -324,20 +324,23 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
         raise ValueError(
             f"{what}: frame {f[bad][0]:g} is not an integer in 1..{MAX_FRAME} (refused)"
         )
-    k = _first_bad_id(i)
+    k = first_bad_id(i)
     if k is not None:
-        raise ValueError(f"{what}: {_bad_id_message(i[k])}")
+        raise ValueError(f"{what}: {bad_id_message(i[k])}")
     return a
 
 
-def _first_bad_id(ids: F64) -> int | None:
-    """Index of the first id that is not an integer with ``|id| <= MAX_ID``, or None."""
-    bad = (np.abs(ids) > MAX_ID) | (ids != np.floor(ids))
-    return int(np.flatnonzero(bad)[0]) if bad.any() else None
+def check_file_ids(rows: F64, path: PathLike) -> None:
+    """Refuse rows read from file `path` whose ids are not integers: ``FILE:LINE: track id ...``.
 
+    :func:`check_rows`' test of the ids (:func:`pftrack._check.first_bad_id`), named by the
+    file's line: what ``pftrack recover``, ``smooth``, ``experiment gaps`` and ``eval`` read.
+    """
+    from pftrack.io.mot import data_line_numbers
 
-def _bad_id_message(value: float) -> str:
-    return f"track id {value:g} is not an integer with |id| <= {MAX_ID}"
+    k = first_bad_id(rows[:, 1])
+    if k is not None:
+        raise ValueError(f"{path}:{data_line_numbers(path)[k]}: {bad_id_message(rows[k, 1])}")
 
 
 def check_unique(
@@ -378,9 +381,7 @@ def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
     from pftrack.io.mot import data_line_numbers, read_mot
 
     rows = read_mot(path, what=what)
-    k = _first_bad_id(rows[:, 1])
-    if k is not None:  # check_rows' test, with the file's line, as read_mot's own checks
-        raise ValueError(f"{path}:{data_line_numbers(path)[k]}: {_bad_id_message(rows[k, 1])}")
+    check_file_ids(rows, path)  # check_rows' test, with the file's line, as read_mot's own
     try:
         check_unique(rows)
     except ValueError:
