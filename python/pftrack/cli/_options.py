@@ -160,7 +160,8 @@ def check_input_file(path: str, *, what: str) -> None:
     FileNotFoundError
         It does not exist.
     ValueError
-        It is a folder.
+        It is a folder, or not a regular file (``/dev/null``, a named pipe: read twice to name
+        a bad line).
     PermissionError
         It cannot be read.
     """
@@ -172,6 +173,8 @@ def check_input_file(path: str, *, what: str) -> None:
         raise ValueError(f"{what} {path}: is a folder, not a file")
     if not p.exists():
         raise FileNotFoundError(f"{what} {path}: no such file")
+    if not p.is_file():
+        raise ValueError(f"{what} {path}: is not a regular file (a device, pipe or socket)")
     if not os.access(p, os.R_OK):
         raise PermissionError(f"{what} {path}: not readable")
 

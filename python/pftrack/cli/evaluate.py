@@ -121,6 +121,9 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
     from pftrack.eval.sequences import result_file
 
     gt, res = Path(args.gt), Path(args.res)
+    for what, given in (("--gt", gt), ("--res", res)):
+        if given.exists() and not (given.is_file() or given.is_dir()):  # /dev/null: read twice
+            raise ValueError(f"{what} {given} is not a regular file or a folder (a device or pipe)")
     if gt.is_file():
         if res.is_dir():
             raise ValueError(
