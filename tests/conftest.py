@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -30,3 +31,18 @@ def textured_frame(rng: np.random.Generator) -> np.ndarray:
     frame[10:40, 20:40] = (30, 40, 200)  # a red block (BGR)
     frame[40:70, 50:80] = (200, 120, 20)  # a blue block
     return frame
+
+
+@pytest.fixture(autouse=True)
+def _not_quiet() -> Iterator[None]:
+    """``main(["-q", ...])`` silences the process's bars (``set_quiet``); not the next test's.
+
+    Was: a test that reads what is said when no bar is drawn failed after any ``-q`` run in
+    the same process (``test_experiment_gaps_one_sequence_writes_json`` after
+    ``tests/test_cli_outputs.py``).
+    """
+    from pftrack._progress import quiet, set_quiet
+
+    before = quiet()
+    yield
+    set_quiet(before)

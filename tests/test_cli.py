@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -283,6 +284,25 @@ def test_experiment_gaps_refuses_the_other_modes_options_before_work(
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("spelling", ["same", "dot", "link"])
+def test_experiment_gaps_refuses_one_ground_truth_given_twice(
+    spelling: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: one sequence counted twice (two rows, its gaps twice in the pooled MMAE)."""
+    gt = _walkers(tmp_path / "gt.txt")
+    (tmp_path / "other.txt").symlink_to(gt)
+    again = {"same": str(gt), "dot": f"{tmp_path}/./gt.txt", "link": str(tmp_path / "other.txt")}
+    argv = ["experiment", "gaps", "--gt", str(gt), str(again[spelling]), "--image-size",
+            "768x576", "--json", str(tmp_path / "e.json")]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"pftrack experiment: error: --gt {gt} and {again[spelling]} are the same file; give "
+        "each sequence once\n"
+    )
+    assert not (tmp_path / "e.json").exists()
+
+
 @pytest.mark.parametrize("command", ["eval", "batch"])
 @pytest.mark.parametrize("iou", ["1.5", "0", "-0.5", "nan", "inf"])
 def test_iou_is_refused_alike_by_eval_and_batch(
@@ -480,23 +500,111 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
 
 
 def test_library_warnings_are_one_line_for_every_command(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import warnings
 
-    cut = _truncated_video(tmp_path, np.random.default_rng(3), 12)
+    import pftrack.recovery as recovery
+
+    real = recovery.fill_gaps
+
+    def warning_fill(*args: Any, **kwargs: Any) -> Any:  # recover reads --video on demand
+        warnings.warn("a library warning\nin two lines", UserWarning, stacklevel=2)  # now: no
+        return real(*args, **kwargs)  # warning of a truncated video it does not decode whole
+
+    monkeypatch.setattr(recovery, "fill_gaps", warning_fill)
     src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
     with warnings.catch_warnings():
         warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
-        argv = ["-q", "recover", str(src), "--out", str(out), "--link", "--video", str(cut)]
-        assert main(argv) == 0
+        assert main(["-q", "recover", str(src), "--out", str(out), "--link"]) == 0
         before = warnings.showwarning
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [
-        f"pftrack recover: warning: {cut} ended after {err[0].split()[6]} frames but its header "
-        "says 12: a truncated or damaged file?"
-    ]
+    assert err == ["pftrack recover: warning: a library warning in two lines"]
     assert warnings.showwarning is before  # main restores the formatter it replaced
+
+
+@pytest.mark.parametrize("command", ["track", "batch"])
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ("--det-scale 7", "--det-scale 7 scales the boxes of --detections; the built-in "
+                          "detector's are in the frame's pixels: drop it, or give --detections"),
+        ("--birth-score 0.5", "--birth-score 0.5 gates the births of --detections; the built-in "
+                              "detector starts a track from any blob: drop it, or give "
+                              "--detections"),
+        ("--min-conf -5", "--min-conf -5: the built-in detector's scores are the share of "
+                          "foreground pixels in a blob's box, in [0, 1]; give a value in "
+                          "[0, 1], or --detections"),
+        ("--min-conf 1.5", "--min-conf 1.5: the built-in detector's scores"),
+    ],
+)  # fmt: skip
+def test_options_the_built_in_detector_never_uses_are_refused(
+    command: str,
+    option: str,
+    message: str,
+    video: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Were: accepted and ignored (the same tracks), as ``--crossings on --no-smooth`` was."""
+    import pftrack.tracking as tracking
+
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("work started")
+
+    monkeypatch.setattr(tracking, "track_frames", refuse)
+    out = tmp_path / ("o.txt" if command == "track" else "o")
+    argv = [command, str(video), "--out", str(out), *option.split()]
+    assert main([*argv, "--workers", "0"] if command == "batch" else argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pftrack {command}: error: {message}") and err.count("\n") == 1, err
+    assert not out.exists()
+
+
+def test_options_of_given_detections_are_taken_with_them(video: Path, tmp_path: Path) -> None:
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import DEFAULT_BIRTH_SCORE, tracker_config
+    from pftrack.tracking import LifecycleConfig
+
+    assert DEFAULT_BIRTH_SCORE == LifecycleConfig().birth_score
+    parse = build_parser().parse_args
+    det = ["--detections", "d.txt"]
+    cfg = tracker_config(parse(["track", "v", "--out", "o", *det, "--min-conf", "-5",
+                                "--birth-score", "0.5", "--det-scale", "2"]))  # fmt: skip
+    assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (-5, 0.5)
+    cfg = tracker_config(parse(["track", "v", "--out", "o", "--min-conf", "0.5"]))  # built-in
+    assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (0.5, DEFAULT_BIRTH_SCORE)
+    with pytest.raises(ValueError, match=r"LifecycleConfig: birth_score is 1.5, expected a value"):
+        LifecycleConfig(birth_score=1.5)
+
+
+def test_fill_help_says_what_it_does_with_smoothing(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--fill pf`` changes the smoothed output too (it guides linking): was documented as an
+    option of ``--no-smooth`` only."""
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert (
+        "written as they are with --no-smooth; with smoothing the smoother's boxes replace "
+        "them, and they only guide the offline linking (and --crossings)" in text
+    )
+
+
+def test_recover_on_a_truncated_video_says_where_it_ends(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The colour term needs frame 9, past the end of a video whose header says 12 frames."""
+    cut = _truncated_video(tmp_path, np.random.default_rng(3), 12)
+    src = tmp_path / "t.txt"
+    src.write_text("".join(f"{f},{1 if f < 5 else 2},{10 + f},10,8,16,1,-1,-1,-1\n"
+                           for f in (1, 2, 3, 9, 10)))  # fmt: skip
+    argv = ["recover", str(src), "--out", str(tmp_path / "o.txt"), "--link", "--video", str(cut)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    head = f"pftrack recover: error: {cut}: frame 9 cannot be decoded: the video ended after "
+    assert err.startswith(head) and err.endswith(" frames but its header says 12\n"), err
+    assert not (tmp_path / "o.txt").exists()
 
 
 @pytest.mark.parametrize(
@@ -568,7 +676,15 @@ def test_crossings_without_the_smoother_are_refused(
         ),
         (
             ["track", "V", "--out", "O", "--birth-score", "nan"],
-            "argument --birth-score: expected a finite number, got nan",
+            "argument --birth-score: expected a number in [0, 1], got nan",
+        ),
+        (  # was: accepted with --detections, though scores are confidences in [0, 1]
+            ["track", "V", "--out", "O", "--detections", "T", "--birth-score", "-1"],
+            "argument --birth-score: expected a number in [0, 1], got -1",
+        ),
+        (
+            ["batch", "V", "--out", "O", "--detections", "auto", "--birth-score", "5"],
+            "argument --birth-score: expected a number in [0, 1], got 5",
         ),
         (
             ["smooth", "T", "--out", "O", "--max-gap", "100000000"],
@@ -621,6 +737,8 @@ def test_bad_option_values_are_named_in_one_line(
     [
         ("nosuch.txt", "--detections nosuch.txt: no such file"),
         ("folder", "--detections folder: is a folder, not a file"),
+        # was "detection file not found: /dev/null"
+        ("/dev/null", "--detections /dev/null: is not a regular file (a device, pipe or socket)"),
     ],
 )
 def test_a_detection_file_that_is_not_a_file_is_named(

@@ -465,3 +465,191 @@ def test_out_dev_stdout_prints_the_rows_then_the_summary(
     assert lines[-1].startswith(f"{inputs['tracks']}: ") and len(lines) > 20
     assert all(line.count(",") == 9 for line in lines[:-1])
     assert (tmp_path / "stdout").is_symlink()
+
+
+@pytest.fixture(scope="module")
+def folders(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An image folder ``imgs``, a sequence ``seq`` (``img1/``) and one read from its video."""
+    d = tmp_path_factory.mktemp("folders")
+    scene = make_scene(n_frames=12, rng=1)
+    scene.write_images(d / "imgs")
+    ini = "[Sequence]\nname={}\nimDir=img1\nframeRate=10\nseqLength=12\n"
+    scene.write_images(d / "seq" / "img1")
+    (d / "seq" / "seqinfo.ini").write_text(ini.format("seq"))
+    (d / "vseq").mkdir()
+    (d / "seq" / "gt").mkdir()
+    scene.write_video(d / "vseq" / "video.avi")
+    (d / "vseq" / "seqinfo.ini").write_text(ini.format("vseq"))
+    write_mot(d / "vseq" / "det.txt", scene.truth)
+    write_mot(d / "tracks.txt", scene.truth)
+    write_mot(d / "seq" / "gt" / "gt.txt", scene.truth)
+    (d / "res").mkdir()
+    write_mot(d / "res" / "seq.txt", scene.truth)
+    return d
+
+
+# a run whose output is a file of an input folder (IN: the folder above; `link.*` a symbolic
+# link made in the test folder to the file named after the arrow)
+INPUT_FOLDER_CASES = {
+    "track --out an image": "track IN/imgs --out IN/imgs/000001.png",
+    "track --plot an image": "track IN/imgs --out o.txt --plot IN/imgs/000002.png",
+    "track --plot through ..": "track IN/imgs --out o.txt --plot IN/seq/../imgs/000002.png",
+    "track --render a link to an image":
+        "track IN/imgs --out o.txt --render link.mp4>imgs/000003.png",
+    "track --out seqinfo.ini": "track IN/vseq --detections auto --out IN/vseq/seqinfo.ini",
+    "track video --out seqinfo.ini": "track IN/vseq/video.avi --out IN/vseq/seqinfo.ini",
+    "track img1 --out seqinfo.ini": "track IN/seq/img1 --out IN/seq/seqinfo.ini",
+    "track seq --out an image": "track IN/seq --out IN/seq/img1/000012.png",
+    "track --out a link to an image": "track IN/seq --out link.txt>seq/img1/000005.png",
+    "recover --video": "recover IN/tracks.txt --link --video IN/imgs --out IN/imgs/000004.png",
+    "recover --video seq":
+        "recover IN/tracks.txt --link --video IN/seq --out link.txt>seq/seqinfo.ini",
+    "batch --out": "batch IN/imgs --workers 0 --out D link D/imgs.txt>imgs/000006.png",
+    "batch --out seqinfo.ini": "batch IN/seq --workers 0 --out D link D/seq.txt>seq/seqinfo.ini",
+    "eval --json": "eval --gt IN/seq --res IN/res --json link.json>seq/gt/gt.txt",
+    "eval --csv": "eval --gt IN/seq --res IN/res --csv link.csv>res/seq.txt",
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(INPUT_FOLDER_CASES))
+def test_a_file_of_an_input_folder_is_not_an_output(
+    case: str,
+    folders: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    no_work: None,
+) -> None:
+    """Was: exit 0, an input image (or seqinfo.ini) replaced by the tracks, plot or video."""
+    monkeypatch.chdir(tmp_path)
+    argv = []
+    for word in INPUT_FOLDER_CASES[case].split():
+        if ">" in word:  # a link in the test folder to a file of the input folders
+            name, target = word.split(">")
+            (tmp_path / name).parent.mkdir(exist_ok=True)
+            (tmp_path / name).symlink_to(folders / target)
+            word = name
+        argv.append(word.replace("IN/", f"{folders}/"))
+    if "link" in argv:  # batch: the link is made, not passed
+        argv = argv[: argv.index("link")]
+    before = {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()}
+    assert main(["-q", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.endswith("is an input of this run; write elsewhere\n"), err
+    assert {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()} == before
+    assert not [p for p in tmp_path.rglob("*") if p.is_file() and not p.is_symlink()]
+
+
+def test_sigterm_is_handled_as_ctrl_c(tmp_path: Path) -> None:
+    """``kill PID`` while rendering: exit 143, outputs as they were, no temporary file.
+
+    Was: killed where it stood (status -15, 143 in a shell), ``..t.<hex>.<hex>.mp4`` and
+    ``.t.<hex>.mp4`` left beside the outputs.
+    """
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    video = make_scene(n_frames=400, rng=0).write_video(tmp_path / "scene.avi")
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("t.txt", "t.mp4"):
+        (out / name).write_bytes(b"an earlier result\n")
+    before = _snapshot(out)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    argv = [sys.executable, "-m", "pftrack", "-q", "track", str(video), "--out", "t.txt",
+            "--render", "t.mp4"]  # fmt: skip
+    proc = subprocess.Popen(argv, cwd=out, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        while not [p for p in os.listdir(out) if p.startswith(".")]:  # rendering has started
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.01)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, err
+    assert err.strip() == "pftrack track: terminated (SIGTERM); no output was changed"
+    assert _snapshot(out) == before
+
+
+def test_sigterm_ends_a_batch_with_its_own_status(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The batch says it was terminated, exit 143 (Ctrl-C: interrupted, 130)."""
+    import pftrack.batch as batch
+    from pftrack.cli._signals import Terminated
+
+    def terminated(*args: Any, **kwargs: Any) -> Any:
+        raise Terminated
+
+    monkeypatch.setattr(batch, "track_many", terminated)
+    assert main(["batch", str(tmp_path), "--out", str(tmp_path / "o"), "--workers", "0"]) == 143
+    assert capsys.readouterr().err.startswith("pftrack batch: terminated (SIGTERM); ")
+
+
+def test_no_tracks_into_a_device_or_pipe_is_an_empty_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """As a regular file gets an empty file (was: ``nothing was written for /dev/null``, 2)."""
+    import threading
+
+    video = make_scene(n_frames=3, rng=0).write_video(tmp_path / "short.avi")  # no track lives
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    for out in (tmp_path / "regular.txt", Path(os.devnull), fifo):
+        assert main(["-q", "track", str(video), "--out", str(out), "--particles", "20"]) == 0
+        assert "0 tracks, 0 boxes in " in capsys.readouterr().out
+    reader.join(30)
+    assert got == [b""] and (tmp_path / "regular.txt").read_bytes() == b""
+
+
+@pytest.mark.parametrize(
+    ("argv", "magic"),
+    [
+        ("track VIDEO --out t.txt --render OUT --plot /dev/null --particles 20", b"ftyp"),
+        ("track VIDEO --out t.txt --plot OUT --render /dev/null --particles 20", b"\x89PNG"),
+        ("eval --gt GT --res TRACKS --json OUT --csv /dev/null", b'{\n  "hota"'),
+        ("eval --gt GT --res TRACKS --csv OUT --json /dev/null", b"sequence,"),
+        ("experiment gaps --gt WALKERS --figure OUT --json /dev/null --methods linear "
+         "--repeat 1 --max-positions 1", b"\x89PNG"),
+    ],
+    ids=["track --render", "track --plot", "eval --json", "eval --csv", "experiment --figure"],
+)  # fmt: skip
+def test_a_device_or_pipe_takes_the_default_format(
+    argv: str, magic: bytes, inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """``--render /dev/stdout`` is an MP4, ``--plot`` a PNG (was: ``unsupported extension
+    '(none)'``, exit 2, though the docs said devices were accepted)."""
+    import threading
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()), daemon=True)
+    reader.start()
+    names = {"VIDEO": inputs["video"], "GT": inputs["gt"], "TRACKS": inputs["tracks"],
+             "OUT": fifo, "t.txt": tmp_path / "t.txt"}  # fmt: skip
+    if "WALKERS" in argv:
+        names["WALKERS"] = _walkers(tmp_path / "A")
+    assert main(["-q", *(str(names.get(a, a)) for a in argv.split())]) == 0
+    reader.join(60)
+    assert got and magic in got[0][:16]
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+
+
+def test_a_regular_file_without_extension_is_still_refused(
+    inputs: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str], no_work: None
+) -> None:
+    argv = ["track", str(inputs["video"]), "--out", str(tmp_path / "t.txt"), "--render",
+            str(tmp_path / "video")]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err.endswith(
+        "video: unsupported extension '(none)', expected one of .mp4, .avi\n"
+    )

@@ -11,8 +11,11 @@ __all__ = [
     "BOX_VALUES",
     "MAX_COORD",
     "MAX_FRAME",
+    "MAX_ID",
+    "bad_id_message",
     "bgr_frame",
     "first_bad_box",
+    "first_bad_id",
     "flag",
     "number",
     "real_array",
@@ -23,6 +26,25 @@ __all__ = [
 MAX_COORD = 1e9
 #: The largest frame number anywhere (a 32-bit int: 2.3 years of video at 30 frames/s).
 MAX_FRAME = 2**31 - 1
+#: Largest absolute track id accepted (as frames: ids are cast to 32- or 64-bit integers).
+MAX_ID = MAX_FRAME
+
+
+def first_bad_id(ids: ArrayLike) -> int | None:
+    """Index of the first id that is not an integer with ``|id| <= MAX_ID``, or None.
+
+    One test for every reader of track ids (``recover``, ``smooth``, ``eval``): an id such as
+    1.5 is refused, never truncated to 1.
+    """
+    a = np.asarray(ids, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.abs(a) <= MAX_ID) | (a != np.floor(a))
+    return int(np.flatnonzero(bad)[0]) if bad.any() else None
+
+
+def bad_id_message(value: float) -> str:
+    """What is wrong with track id `value` (one :func:`first_bad_id` found)."""
+    return f"track id {value:g} is not an integer with |id| <= {MAX_ID}"
 
 
 def real_array(values: ArrayLike, what: str) -> F64:

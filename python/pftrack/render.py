@@ -15,8 +15,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._typing import PathLike
-from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import group_by_frame
+from pftrack.io.opencv_io import write_image
 from pftrack.io.video_writer import VideoWriter
 
 __all__ = [
@@ -302,8 +302,4 @@ def plot_trajectories(
         cv2.putText(
             canvas, title, (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA
         )
-    target = Path(path)
-    with atomic_path(target) as tmp:
-        if not cv2.imwrite(str(tmp), canvas):
-            raise ValueError(f"OpenCV cannot write image {target}")
-    return target
+    return write_image(path, canvas)  # any name (pftrack.io.opencv_io)

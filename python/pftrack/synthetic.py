@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
+from pftrack.io.opencv_io import opencv_name, write_image
 
 __all__ = [
     "BUSY_SCENES",
@@ -136,8 +137,8 @@ class Scene:
         """
         p = Path(path)
         fourcc = cv2.VideoWriter.fourcc(*("MJPG" if p.suffix.lower() == ".avi" else "mp4v"))
-        with atomic_path(p) as tmp:
-            writer = cv2.VideoWriter(str(tmp), fourcc, self.fps, (self.width, self.height))
+        with atomic_path(p) as tmp, opencv_name(tmp) as name:  # any name (pftrack.io.opencv_io)
+            writer = cv2.VideoWriter(name, fourcc, self.fps, (self.width, self.height))
             if not writer.isOpened():
                 raise ValueError(f"write_video: OpenCV cannot write {p.suffix!r} video to {p}")
             try:
@@ -155,9 +156,10 @@ class Scene:
         d = Path(folder)
         d.mkdir(parents=True, exist_ok=True)
         for k, frame in enumerate(self.frames, start=1):
-            with atomic_path(d / f"{k:06d}{ext}") as tmp:
-                if not cv2.imwrite(str(tmp), frame):
-                    raise ValueError(f"write_images: OpenCV cannot write {ext!r} images")
+            try:
+                write_image(d / f"{k:06d}{ext}", frame)
+            except ValueError:
+                raise ValueError(f"write_images: OpenCV cannot write {ext!r} images") from None
         return d
 
     def write_truth(self, path: PathLike) -> Path:

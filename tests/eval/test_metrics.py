@@ -133,6 +133,29 @@ def test_bad_input():
         evaluate_mot(HAND_GT, HAND_RES, image_size=(0, 10))
 
 
+def test_fractional_ids_and_frames_are_refused_not_truncated(tmp_path, capsys):
+    """Ids 1.5 and 1.7 were cast to 1: 'result has id 1 more than once in frame 1'."""
+    from pftrack.eval import evaluate_hota
+
+    res = HAND_RES.copy()
+    res[res[:, 1] == res[0, 1], 1] += 0.5
+    for evaluate in (evaluate_mot, evaluate_hota):
+        with pytest.raises(ValueError, match=r"result row 0: track id [\d.]+ is not an integer"):
+            evaluate(HAND_GT, res)
+        with pytest.raises(ValueError, match=r"(gt|truth) row \d+ has frame 2.5, expected an"):
+            evaluate(np.vstack([HAND_GT, [2.5, 9, 0, 0, 5, 5, 1, -1, -1, -1]]), HAND_RES)
+    lines = "1,1.5,10,10,5,5,1,-1,-1,-1\n1,1.7,30,10,5,5,1,-1,-1,-1\n"
+    (tmp_path / "frac.txt").write_text(lines)
+    write_mot(tmp_path / "gt.txt", HAND_GT)
+    for gt, res_file in (("frac.txt", "gt.txt"), ("gt.txt", "frac.txt")):
+        argv = ["eval", "--gt", str(tmp_path / gt), "--res", str(tmp_path / res_file)]
+        assert main([*argv, "--no-scale-check"]) == 2
+        assert capsys.readouterr().err == (  # as pftrack recover says it
+            f"pftrack eval: error: {tmp_path / 'frac.txt'}:1: track id 1.5 is not an integer "
+            "with |id| <= 2147483647\n"
+        )
+
+
 def test_empty_result_and_format():
     m = evaluate_mot(HAND_GT, np.zeros((0, 10)))
     assert m.mota == 0.0 and m.misses == 14 and m.mostly_lost == 3

@@ -149,6 +149,13 @@ def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     assert "extension" in error("--csv", str(tmp_path / "x.txt"))
     assert "no sequence 'C'" in error("--seqs", "C")
     assert "no sequence 'C'" in error("--scale", "C=0.5")
+    # was: the last value won silently (MOTA -106 for PETS09 with 0.625 then 0.5)
+    assert "--scale is given twice for every sequence (0.625, then 0.5); give it once" in error(
+        "--scale", "0.625", "--scale", "0.5"
+    )
+    assert "--scale is given twice for sequence A (0.5, then 2)" in error(
+        "--scale", "A=0.5", "--scale", "B=1", "--scale", "A=2"
+    )
     (res_root / "B.txt").unlink()
     assert "no result for sequence B" in error()
     write_mot(res_root / "B.txt", cases["B"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])

@@ -81,6 +81,21 @@ def test_staged_outputs_replace_all_or_none(tmp_path: Path, umask) -> None:
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.png"]
 
 
+def test_staged_outputs_remove_a_writers_own_temporary_file(tmp_path: Path) -> None:
+    """A writer stopped after making its temporary file beside a staged one, before anyone held
+    it (SIGTERM in ``VideoWriter.__init__``): was left behind, ``..v.<hex>.<hex>.mp4``."""
+    from pftrack.io.atomic import staged_outputs
+
+    (tmp_path / "v.mp4").write_bytes(b"old")
+    (tmp_path / ".v.keep.mp4").write_bytes(b"not ours")
+    with pytest.raises(KeyboardInterrupt), staged_outputs() as stage:
+        held = atomic_path(stage(tmp_path / "v.mp4"))  # entered, never left (kept alive here:
+        held.__enter__()  # a collected generator would clean up after itself)
+        assert len(list(tmp_path.iterdir())) == 4
+        raise KeyboardInterrupt
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".v.keep.mp4", "v.mp4"]
+
+
 @pytest.mark.parametrize("mode", [0o600, 0o640])
 def test_replacing_a_file_keeps_its_permissions(tmp_path: Path, umask, mode: int) -> None:
     """A file the user restricted stays restricted: not reset to the umask's 0o644."""

@@ -80,6 +80,35 @@ def test_bad_lines_still_named(tmp_path: Path, text: str, match: str) -> None:
         mot.read_mot(p)
 
 
+def test_a_device_or_pipe_is_not_a_regular_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'detection file not found: /dev/null' (it exists: it is no regular file)."""
+    import os
+
+    from pftrack.cli import main
+
+    os.mkfifo(tmp_path / "fifo")
+    for path in (os.devnull, tmp_path / "fifo"):
+        with pytest.raises(ValueError, match=r"detection file .* is not a regular file \(a"):
+            mot.read_mot(path, what="detection file")
+    with pytest.raises(ValueError, match=r"tracks file .* is a folder, not a file"):
+        mot.read_mot(tmp_path, what="tracks file")
+    with pytest.raises(FileNotFoundError, match=r"tracks file not found: "):
+        mot.read_mot(tmp_path / "nosuch.txt", what="tracks file")
+    out = ["--out", str(tmp_path / "o.txt")]
+    for argv, message in (
+        (["recover", os.devnull, *out], f"tracks file {os.devnull} is not a regular file"),
+        (["smooth", str(tmp_path / "fifo"), *out], "tracks file "),
+        (["eval", "--gt", os.devnull, "--res", os.devnull], f"--gt {os.devnull} is not a regular"),
+        (["experiment", "gaps", "--gt", os.devnull], f"ground truth {os.devnull} is not a regular"),
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert message in err and "not found" not in err and err.count("\n") == 1, err
+    assert sorted(os.listdir(tmp_path)) == ["fifo"]
+
+
 def test_write_refuses_non_finite(tmp_path: Path) -> None:
     a = np.ones((2, 10))
     a[1, 3] = np.nan

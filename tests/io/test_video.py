@@ -578,3 +578,42 @@ def test_a_split_pass_whose_seek_raises_reads_on_from_the_first_half(
 def test_dataset_frames_equal_the_default_capture(name: str) -> None:
     folder, file = name.split("/")
     _assert_same_pixels_as_default_capture(dataset(folder) / file)
+
+
+def test_frame_sequence_reads_on_demand_in_one_pass(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The frames ``recover --link --video`` asks for, one decode pass, one frame held."""
+    from pftrack.io.video import FrameSequence, read_frames
+
+    scene = make_scene(n_frames=12, rng=0)
+    path = scene.write_video(tmp_path / "v.avi")
+    folder = scene.write_images(tmp_path / "imgs")
+    opened: list[str] = []
+    real = video._file_capture
+    monkeypatch.setattr(video, "_file_capture", lambda p: opened.append(p) or real(p))
+    for source, expected in ((path, read_frames(path)), (folder, scene.frames)):
+        frames = FrameSequence(source)
+        opened.clear()  # FrameSource probes the file when made
+        with frames:
+            assert len(frames) == 12
+            for i in (0, 3, 3, 7, -1):  # increasing (and the last one again): one pass
+                assert np.array_equal(frames[i], expected[i])
+            assert len(opened) == (1 if source == path else 0)
+            assert np.array_equal(frames[2], expected[2])  # back: a new pass
+            assert len(opened) == (2 if source == path else 0)
+            with pytest.raises(IndexError):
+                frames[12]
+
+
+def test_frame_sequence_says_where_a_truncated_video_ends(tmp_path: Path) -> None:
+    from pftrack.io.video import FrameSequence
+
+    full = make_scene(n_frames=20, rng=0).write_video(tmp_path / "full.avi")
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])
+    frames = FrameSequence(cut)
+    assert len(frames) == 20
+    with pytest.raises(ValueError, match=r"cut.avi: frame 20 cannot be decoded: the video ended "
+                       r"after \d+ frames but its header says 20"):  # fmt: skip
+        frames[19]

@@ -95,7 +95,7 @@ def test_repeated_rows_are_named_by_file_and_line_as_recover_names_them(
     errors = []
     for argv in (
         ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576"],
-        ["experiment", "gaps", "--gt", str(gt), str(gt), "--image-size", "768x576"],
+        ["experiment", "gaps", "--gt", str(gt), "--auto-masks", "--image-size", "768x576"],
         ["recover", str(gt), "--out", str(tmp_path / "out.txt")],
     ):
         assert main(argv) == 2

@@ -291,3 +291,92 @@ def test_cli_gate_follows_the_frame(command, tmp_path, capsys):
         out = tmp_path / "b.txt"
         assert main([command, str(src), "--out", str(out), "--link", "--max-distance", "50"]) == 0
         assert set(read_mot(out)[:, 1].astype(int)) == {1, 2, 3}
+
+
+class _ForwardOnly:
+    """Frames that may be asked for only in increasing order, each once (as a video is read)."""
+
+    def __init__(self, frames):
+        self.frames, self.asked = frames, []
+
+    def __len__(self):
+        return len(self.frames)
+
+    def __getitem__(self, i):
+        assert not self.asked or i > self.asked[-1], f"frame {i} asked after {self.asked}"
+        self.asked.append(i)
+        return self.frames[i]
+
+
+def test_colour_term_reads_the_frames_of_fragment_ends_once_in_order():
+    """Was: frames asked for in the order of the pairs, so a video had to be held whole."""
+    rows = np.vstack(  # object A: ids 1 then 3; object B, far away: ids 2 then 4
+        [
+            walker(1, range(1, 61), 100, 100, 2.0, 0.5),
+            walker(3, range(65, 91), 100, 100, 2.0, 0.5),
+            walker(2, range(1, 21), 500, 400, -1.0, 0.2),
+            walker(4, range(25, 51), 500, 400, -1.0, 0.2),
+        ]
+    )
+    cfg = LinkConfig(max_gap=20, max_distance=30)
+    colours = {1: (0, 0, 255), 3: (0, 0, 255), 2: (255, 0, 0), 4: (0, 255, 0)}
+    frames = _frames_with_colours(rows, colours)
+    per_id = {t: rows[rows[:, 1] == t] for t in np.unique(rows[:, 1]).astype(int)}
+    forward = _ForwardOnly(frames)
+    ids, cost = link_cost_matrix(per_id, cfg, forward)
+    assert forward.asked == [19, 24, 59, 64]  # the ends of the two gated pairs (was 59 first)
+    assert np.array_equal(cost, link_cost_matrix(per_id, cfg, frames)[1])
+    assert np.isfinite(cost).sum() == 2
+
+
+def _scene_video(path, n_frames=100, size=(600, 700)):
+    from pftrack.io.video_writer import VideoWriter
+
+    rows = scene()
+    colours = {1: (0, 0, 255), 5: (0, 0, 255), 2: (255, 0, 0), 7: (0, 255, 0)}
+    with VideoWriter(path, 10.0) as writer:
+        for frame in _frames_with_colours(rows, colours, n_frames=max(n_frames, 90))[:n_frames]:
+            writer.write(np.ascontiguousarray(frame[: size[0], : size[1]]))
+    return path
+
+
+def test_cli_recover_reads_the_video_lazily(tmp_path, capsys, monkeypatch):
+    """Was: every frame of --video in memory (2.5 GB for 400 frames of 1080p)."""
+    import pftrack.io.video as video
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the whole video was read into memory")
+
+    monkeypatch.setattr(video, "read_frames", refuse)
+    tracks = tmp_path / "t.txt"
+    write_mot(tracks, scene())
+    v = _scene_video(tmp_path / "v.avi")
+    out = tmp_path / "o.txt"
+    argv = ["recover", str(tracks), "--link", "--video", str(v), "--out", str(out)]
+    assert main([*argv, "--method", "linear"]) == 0
+    assert "1 fragments linked" in capsys.readouterr().out
+    assert set(np.unique(read_mot(out)[:, 1]).astype(int)) == {1, 2, 7}
+
+
+@pytest.mark.parametrize(
+    ("n_frames", "size", "message"),
+    [
+        (50, (600, 700), r"has 50 frames but .*t\.txt has rows up to frame 89: not the video"),
+        (100, (150, 200), r"is 200x150 px but .*t\.txt has a box with left \d+ \(frame \d+, "
+                          r"id \d+\), past its right edge"),
+    ],
+)  # fmt: skip
+def test_cli_recover_refuses_a_video_that_is_not_the_tracks_own(
+    tmp_path, capsys, n_frames, size, message
+):
+    """Was: accepted, the colour term silently dropped where frames were missing."""
+    import re
+
+    tracks = tmp_path / "t.txt"
+    write_mot(tracks, scene())
+    v = _scene_video(tmp_path / "v.avi", n_frames, size)
+    out = tmp_path / "o.txt"
+    assert main(["recover", str(tracks), "--link", "--video", str(v), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and re.search(message, err), err
+    assert not out.exists()

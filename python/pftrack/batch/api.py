@@ -18,6 +18,7 @@ from pftrack.batch.tasks import (
     smooth_file,
     track_sequence,
 )
+from pftrack.io.video import source_files
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -75,7 +76,14 @@ def track_many(
     opts = options if options is not None else TrackOptions()
     seqs = find_sequences(inputs)
     jobs = [
-        Job(s.name, track_sequence, (s, opts), s.files, functools.partial(sequence_length, s))
+        Job(
+            s.name,
+            track_sequence,
+            (s, opts),
+            s.files,
+            functools.partial(sequence_length, s),
+            guards=tuple(source_files(s.frames)),  # every image read, seqinfo.ini
+        )
         for s in seqs
     ]
     return run_jobs(

@@ -73,6 +73,9 @@ class Job:
         For the progress bar: returns how many frames the task will report (through
         :func:`~pftrack.batch.tasks.reporting_frames`), None if unknown. Called on the client
         before the tasks run, and only when a bar is drawn.
+    guards : tuple of Path
+        The files inside `reads` the task reads too, which outputs may not be either (the
+        images of a folder, a sequence's ``seqinfo.ini``); not fingerprinted.
     """
 
     name: str
@@ -80,6 +83,7 @@ class Job:
     args: tuple[Any, ...]
     reads: tuple[Path, ...]
     count: Callable[[], int | None] | None = None
+    guards: tuple[Path, ...] = ()
 
 
 @dataclass
@@ -568,13 +572,23 @@ def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) 
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file; give a folder")
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
+    guarded = {_file_id(p) for job in jobs for p in job.guards} - {None}  # images: by inode
     names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]
     for name in [SUMMARY_NAME, *names]:
         target = out_dir / name
-        if target.resolve() in reads:
+        if target.resolve() in reads or _file_id(target) in guarded:
             raise ValueError(f"--out {target} is an input of this run; write elsewhere")
         if target.is_dir():
             raise ValueError(f"--out {target} is a folder; it would be an output of this run")
+
+
+def _file_id(path: Path) -> tuple[int, int] | None:
+    """The ``(st_dev, st_ino)`` of the file `path` names (links followed); None if none."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
 
 
 def _make_out_dir(out_dir: Path) -> None:

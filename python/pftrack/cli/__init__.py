@@ -18,6 +18,7 @@ from typing import Any
 from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
 from pftrack.cli._options import HelpFormatter
+from pftrack.cli._signals import Terminated, exit_status, sigterm_raises
 
 __all__ = ["build_parser", "main"]
 
@@ -56,20 +57,32 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _shown(text: str) -> str:
+    r"""`text` on one line, a file name's bytes that are not UTF-8 as ``\xfe`` escapes.
+
+    Python keeps such bytes of a name as surrogate escapes (``'vid\udcfe.mp4'``).
+    """
+    line = " ".join(text.split())
+    try:
+        return line.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # another lone surrogate
+        return line.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
 def _one_line(exc: BaseException) -> str:
     """The error as one line: OSErrors name their file, messages lose their line breaks."""
     if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in str(exc.strerror):
         text = f"{exc.strerror or exc}: {exc.filename}"
     else:
         text = str(exc)
-    return " ".join(text.split())
+    return _shown(text)
 
 
 def _one_line_warning(command: str) -> Callable[..., None]:
     """A ``warnings.showwarning`` printing ``pftrack CMD: warning: ...`` (no source line)."""
 
     def show(message: Warning | str, *_: object, **__: object) -> None:
-        print(f"pftrack {command}: warning: {' '.join(str(message).split())}", file=sys.stderr)
+        print(f"pftrack {command}: warning: {_shown(str(message))}", file=sys.stderr)
 
     return show
 
@@ -79,6 +92,32 @@ def _one_line_warning(command: str) -> Callable[..., None]:
 #: cannot open: off for the command's process, unless the environment sets them. OpenCV reads
 #: its variable when cv2 is imported, FFmpeg's when OpenCV first opens a file or stream.
 QUIET_OPENCV = {"OPENCV_LOG_LEVEL": "SILENT", "OPENCV_FFMPEG_LOGLEVEL": "-8"}  # -8: AV_LOG_QUIET
+
+
+@contextlib.contextmanager
+def _names_on_stdout() -> Iterator[None]:
+    r"""While a command runs, stdout writes a file name's bytes that are not UTF-8 as they are.
+
+    Python keeps them as surrogate escapes, which a UTF-8 stdout refuses (``errors="strict"``
+    outside the C locale): ``track ... --out $'x\xfe.txt'`` failed on its summary line, after
+    writing its outputs. ``ls`` and the shell print the bytes; so does pftrack.
+    """
+    stream = sys.stdout
+    reconfigure = getattr(stream, "reconfigure", None)
+    errors = getattr(stream, "errors", None)
+    if reconfigure is None or errors is None or errors == "surrogateescape":
+        yield
+        return
+    try:
+        reconfigure(errors="surrogateescape")
+    except (AttributeError, OSError, ValueError):  # a stream that cannot change
+        yield
+        return
+    try:
+        yield
+    finally:
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            stream.reconfigure(errors=errors)  # type: ignore[union-attr]
 
 
 @contextlib.contextmanager
@@ -129,7 +168,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         set_quiet(True)
     try:
-        with warnings.catch_warnings(), _quiet_opencv():
+        with warnings.catch_warnings(), _quiet_opencv(), _names_on_stdout(), sigterm_raises():
             warnings.showwarning = _one_line_warning(args.command)
             status = int(args.func(args))
         if sys.stdout is not None:  # a buffered stdout's last lines: a closed pipe fails here
@@ -144,9 +183,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError:
         print(f"pftrack {args.command}: error: out of memory", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:  # outputs are atomic: nothing half-written is left behind
-        print(f"\npftrack {args.command}: interrupted; no output was changed", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # outputs are atomic: nothing half-written is left behind
+        how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+        print(f"\npftrack {args.command}: {how}; no output was changed", file=sys.stderr)
+        return exit_status(exc)
 
 
 if __name__ == "__main__":  # pragma: no cover

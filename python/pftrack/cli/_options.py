@@ -15,6 +15,9 @@ DEFAULT_MAX_SIDE = 0
 #: ``--crossings``' default: :attr:`pftrack.tracking.CrossingConfig.enabled` ("on" for True),
 #: stated here for the same reason (a test checks they agree).
 DEFAULT_CROSSINGS = "off"
+#: ``--birth-score``'s default: :attr:`pftrack.tracking.LifecycleConfig.birth_score`, stated
+#: here for the same reason (a test checks they agree).
+DEFAULT_BIRTH_SCORE = 0.9
 #: ``--det-scale``'s range (``track`` and ``batch``): the one
 #: :func:`pftrack.tracking.load_detections` accepts, stated here for the same reason (a test
 #: checks they agree).
@@ -157,7 +160,8 @@ def check_input_file(path: str, *, what: str) -> None:
     FileNotFoundError
         It does not exist.
     ValueError
-        It is a folder.
+        It is a folder, or not a regular file (``/dev/null``, a named pipe: read twice to name
+        a bad line).
     PermissionError
         It cannot be read.
     """
@@ -169,6 +173,8 @@ def check_input_file(path: str, *, what: str) -> None:
         raise ValueError(f"{what} {path}: is a folder, not a file")
     if not p.exists():
         raise FileNotFoundError(f"{what} {path}: no such file")
+    if not p.is_file():
+        raise ValueError(f"{what} {path}: is not a regular file (a device, pipe or socket)")
     if not os.access(p, os.R_OK):
         raise PermissionError(f"{what} {path}: not readable")
 
@@ -226,18 +232,24 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
                    "frames/s: pftrack.Tracker's max_coast is in seconds)")  # fmt: skip
     p.add_argument(
         "--min-conf", type=finite_float, default=0.0, metavar="C",
-        help="ignore detections whose score is below C",
+        help="ignore detections whose score is below C; the built-in detector's score is the "
+        "share of foreground pixels in a blob's box, in [0, 1], so C must lie in [0, 1] "
+        "without --detections",
     )  # fmt: skip
     p.add_argument(
-        "--birth-score", type=finite_float, default=0.9, metavar="S",
-        help="a detection starts a track with a score of at least min(S, the lower quartile of "
-        "the scores of the first 50 frames) (scores in [0, 1] only; other scores never gate "
-        "births)",
+        "--birth-score", type=bounded_float(0.0, 1.0), default=None, metavar="S",
+        help="with --detections: a detection starts a track with a score of at least min(S, "
+        "the lower quartile of the scores of the first 50 frames), S in [0, 1] (applied while "
+        "every score lies in [0, 1]; other scores never gate births); refused without "
+        f"--detections: the built-in detector starts a track from any blob (default: "
+        f"{DEFAULT_BIRTH_SCORE:g})",
     )  # fmt: skip
     p.add_argument(
         "--fill", choices=("linear", "pf"), default="linear",
-        help="with --no-smooth, boxes of a gap the filter bridged: interpolated, or the "
-        "filter's own",
+        help="boxes of a gap the filter bridged: interpolated between the detections at its "
+        "ends, or the filter's own; written as they are with --no-smooth; with smoothing the "
+        "smoother's boxes replace them, and they only guide the offline linking (and "
+        "--crossings)",
     )  # fmt: skip
     p.add_argument(
         "--no-smooth", action="store_true",
@@ -271,7 +283,9 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
     Raises
     ------
     ValueError
-        Options that contradict each other (``--crossings on`` with ``--no-smooth``).
+        Options that contradict each other (``--crossings on`` with ``--no-smooth``), or an
+        option of given detections without them (``--det-scale S``, ``--birth-score``, and a
+        ``--min-conf`` outside the built-in detector's scores, [0, 1]).
     """
     from dataclasses import replace
 
@@ -279,6 +293,23 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         raise ValueError(
             "--crossings on needs the smoother, which --no-smooth turns off; drop one of them"
         )
+    if not getattr(args, "detections", None):  # the built-in detector: options it never uses
+        if getattr(args, "det_scale", None) is not None:
+            raise ValueError(
+                f"--det-scale {args.det_scale:g} scales the boxes of --detections; the built-in "
+                "detector's are in the frame's pixels: drop it, or give --detections"
+            )
+        if args.birth_score is not None:
+            raise ValueError(
+                f"--birth-score {args.birth_score:g} gates the births of --detections; the "
+                "built-in detector starts a track from any blob: drop it, or give --detections"
+            )
+        if not 0.0 <= args.min_conf <= 1.0:
+            raise ValueError(
+                f"--min-conf {args.min_conf:g}: the built-in detector's scores are the share of "
+                "foreground pixels in a blob's box, in [0, 1]; give a value in [0, 1], or "
+                "--detections"
+            )
 
     from pftrack.tracking import TrackerConfig
 
@@ -300,7 +331,7 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
             base.lifecycle,
             max_coast=args.max_coast,
             min_score=args.min_conf,
-            birth_score=args.birth_score,
+            birth_score=DEFAULT_BIRTH_SCORE if args.birth_score is None else args.birth_score,
         ),
     )
 

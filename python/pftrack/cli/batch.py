@@ -22,14 +22,13 @@ from pftrack.cli._options import (
     iou_threshold,
     non_negative_int,
 )
+from pftrack.cli._signals import Terminated, exit_status
 
 if TYPE_CHECKING:
     from pftrack.batch import BatchSummary
 
 #: Exit status when a batch ran but some of its tasks failed (2: bad usage, nothing ran).
 EXIT_SOME_FAILED = 1
-#: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
-EXIT_INTERRUPTED = 130
 #: ``--max-gap``'s upper bound (``recover``, ``smooth``, one file or a batch):
 #: :data:`pftrack.recovery.fill.MAX_GAP_LIMIT` and :class:`pftrack.recovery.LinkConfig`'s,
 #: stated here so that ``--help`` does not import the recovery code (a test checks they agree).
@@ -84,7 +83,7 @@ def add_parser(sub: Any) -> None:
         "sequence raised. Workers read the inputs by these paths; this process "
         "writes every output. A re-run skips sequences whose outputs are complete.\n\n"
         "exit status: 0 all done, 1 some sequences failed (the others' outputs are written), "
-        "2 bad usage (nothing ran), 130 interrupted.",
+        "2 bad usage (nothing ran), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).",
     )
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="video, image or sequence folder")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
@@ -96,7 +95,7 @@ def add_parser(sub: Any) -> None:
         "--det-scale", type=det_scale, default="auto", metavar="S",
         help=f"multiply detection boxes by S ({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}); "
         "auto: the frame width over seqinfo.ini's imWidth where there is one (0.625 for "
-        "PETS09-S2L1's video), else 1",
+        "PETS09-S2L1's video), else 1; a number only with --detections auto",
     )  # fmt: skip
     p.add_argument("--render", action="store_true",
                    help="also write DIR/NAME.mp4, annotated; a later batch that scans DIR "
@@ -117,13 +116,14 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
     """Run the batch; print its table, or what stopped it; return the exit status."""
     try:
         summary = call()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
+        how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         print(
-            f"pftrack {command}: interrupted; the outputs written so far are complete (re-run "
+            f"pftrack {command}: {how}; the outputs written so far are complete (re-run "
             "to finish the rest)",
             file=sys.stderr,
         )
-        return EXIT_INTERRUPTED
+        return exit_status(exc)
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
         hint = "; or --workers 0: in this process, without Dask" if exc.name in _DASK else ""
         print(f"pftrack {command}: error: {exc}{hint}", file=sys.stderr)

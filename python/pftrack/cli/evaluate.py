@@ -58,7 +58,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--scale", type=scale_spec, action="append", default=None, metavar="[NAME=]S",
         help="multiply ground-truth boxes by S, for every sequence or for sequence NAME "
-        "(repeat the option); 0.625 for PETS09 gt on its 480x360 video; None: 1 everywhere",
+        "(repeat the option for other sequences; twice for the same ones is refused); 0.625 "
+        "for PETS09 gt on its 480x360 video; None: 1 everywhere",
     )  # fmt: skip
     p.add_argument("--iou", type=iou_threshold, default=0.5, help=IOU_HELP)
     p.add_argument(
@@ -82,6 +83,24 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _check_scales(specs: list[tuple[str | None, float]]) -> None:
+    """Refuse a ``--scale`` given twice for every sequence, or twice for one NAME.
+
+    The option is repeated to give sequences their own scales: a second value for the same
+    sequences would silently win over the first.
+    """
+    seen: dict[str | None, float] = {}
+    for name, value in specs:
+        if name in seen:
+            which = "every sequence" if name is None else f"sequence {name}"
+            given = f"{seen[name]:g}, then {value:g}"
+            raise ValueError(
+                f"--scale is given twice for {which} ({given}); give it once (repeat it only "
+                "for other sequences: --scale NAME=S)"
+            )
+        seen[name] = value
+
+
 def _scales(specs: list[tuple[str | None, float]], names: list[str]) -> dict[str, float]:
     """Scale per sequence name from the ``--scale`` options."""
     default = 1.0
@@ -102,6 +121,9 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
     from pftrack.eval.sequences import result_file
 
     gt, res = Path(args.gt), Path(args.res)
+    for what, given in (("--gt", gt), ("--res", res)):
+        if given.exists() and not (given.is_file() or given.is_dir()):  # /dev/null: read twice
+            raise ValueError(f"{what} {given} is not a regular file or a folder (a device or pipe)")
     if gt.is_file():
         if res.is_dir():
             raise ValueError(
@@ -170,19 +192,24 @@ def run(args: argparse.Namespace) -> int:
     )
     from pftrack.io.atomic import atomic_write, check_output
     from pftrack.io.mot import read_mot
+    from pftrack.recovery.linking import check_file_ids
 
-    inputs = (args.gt, args.res)
+    _check_scales(args.scale or [])
+    jobs = _jobs(args)
+    # every ground-truth and result file read (a link named s.json may lead to one)
+    inputs = (args.gt, args.res, *(p for _, seq, res in jobs for p in (seq.gt_path, res)))
     if args.json:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.csv:
         check_output(args.csv, what="--csv", suffixes=(".csv",), inputs=inputs)
-    jobs = _jobs(args)
     scales = _scales(args.scale or [], [name for name, _, _ in jobs])
 
     loaded = []
     for name, seq, path in jobs:  # read and check everything before scoring anything
         gt = read_mot(seq.gt_path, what="ground truth")
         res = read_mot(path, what="result file")
+        check_file_ids(gt, seq.gt_path)  # 1.5 is refused, as recover does (was: scored as 1)
+        check_file_ids(res, path)
         if not args.no_scale_check:
             check_scale(gt, res, scale=scales[name], name=f"{path}")
         loaded.append((name, seq, gt, res))

@@ -10,6 +10,8 @@ from pftrack.cli._options import add_command, bounded_float, non_negative_int, p
 from pftrack.recovery.names import METHODS
 
 MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this are refused
+#: ``--figure``'s formats; the first is a device's (``--figure /dev/stdout``).
+FIGURE_SUFFIXES = (".png", ".jpg")
 #: Options of the one-sequence sweep (one --gt, no --auto-masks): refused in the other mode.
 SINGLE_ONLY = ("mask", "size", "grid", "trajectories", "gaps", "min_gaps", "repeat",
                "max_positions", "figure")  # fmt: skip
@@ -46,7 +48,7 @@ def add_parser(sub: Any) -> None:
     )
     g.add_argument("--gt", required=True, nargs="+",
                    help="ground truth file(s) (MOTChallenge); one: the one-sequence sweep, "
-                   "several: the multi-sequence protocol")  # fmt: skip
+                   "several (each file once): the multi-sequence protocol")  # fmt: skip
     g.add_argument("--auto-masks", action="store_true",
                    help="the multi-sequence protocol, even for one --gt")  # fmt: skip
     g.add_argument("--n-masks", type=positive_int, default=None, metavar="N",
@@ -192,11 +194,34 @@ def _check_mode(args: argparse.Namespace) -> bool:
     return bool(multi)
 
 
+def _check_distinct_gt(paths: list[str]) -> None:
+    """Refuse one ground-truth file given twice (``A/gt.txt A/./gt.txt``, a link to it).
+
+    It would be one sequence counted twice: two rows, and its gaps twice in the pooled MMAE.
+    """
+    from pathlib import Path
+
+    seen: dict[object, str] = {}
+    for path in paths:
+        p = Path(path)
+        try:
+            st = p.stat()
+            key: object = (st.st_dev, st.st_ino)
+        except OSError:  # missing: refused when read; compared by name meanwhile
+            key = p.resolve()
+        if key in seen:
+            raise ValueError(
+                f"--gt {seen[key]} and {path} are the same file; give each sequence once"
+            )
+        seen[key] = path
+
+
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
     from pftrack.io.atomic import check_output
 
     multi = _check_mode(args)  # before any other check: the options a mode does not use
+    _check_distinct_gt(args.gt)
     inputs = tuple(args.gt)
     if args.mask:
         _parse_mask(args.mask)  # bad options are refused before any work
@@ -205,7 +230,7 @@ def run_gaps(args: argparse.Namespace) -> int:
     if args.json:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.figure:
-        check_output(args.figure, what="--figure", suffixes=(".png", ".jpg"), inputs=inputs)
+        check_output(args.figure, what="--figure", suffixes=FIGURE_SUFFIXES, inputs=inputs)
     if multi:
         return _run_sequences(args)
     import numpy as np
@@ -347,11 +372,11 @@ def _write_json(path: str, doc: dict[str, Any]) -> None:
 def _write_figure(path: str, image: Any) -> None:
     import cv2
 
-    from pftrack.io.atomic import atomic_path
+    from pftrack.io.atomic import output_format
+    from pftrack.io.opencv_io import write_image
 
-    with atomic_path(path) as tmp:
-        if not cv2.imwrite(str(tmp), image, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
-            raise ValueError(f"cannot write figure {path}")
+    ext = output_format(path, FIGURE_SUFFIXES)  # a device (/dev/stdout): .png
+    write_image(path, image, [cv2.IMWRITE_PNG_COMPRESSION, 9], ext=ext)
 
 
 def _run_sequences(args: argparse.Namespace) -> int:

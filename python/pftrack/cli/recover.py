@@ -45,8 +45,11 @@ def add_parser(sub: Any) -> None:
                    help="linking gate on the motion-prediction distance (pixels, 0.001 to 1e6; "
                    "default: 50 px, times the diagonal of the boxes' extent over 800 when it is "
                    "larger than 640x480)")  # fmt: skip
-    p.add_argument("--video", help="video or image folder for the colour term of --link "
-                   "(default: none, motion and size only)")  # fmt: skip
+    p.add_argument("--video", help="video or image folder for the colour term of --link: "
+                   "only the frames of fragment ends are read, in one pass; refused when it "
+                   "has fewer frames than the tracks, or boxes start more than a tenth of "
+                   "its width or height past its right or bottom edge (default: none, motion "
+                   "and size only)")  # fmt: skip
     p.add_argument("--in-place", action="store_true",
                    help="allow --out to be the input file (it is replaced atomically)")  # fmt: skip
     batch.add_batch_options(p)
@@ -78,21 +81,30 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(
             f"--out {out} is the input file; pass --in-place to replace it (atomically)"
         )
-    check_output(args.out, what="--out", inputs=(args.video,) if args.video else ())
+    from pftrack.io.video import source_files
+
+    # the video, or every image of a folder and a sequence's seqinfo.ini
+    inputs = tuple(source_files(args.video)) if args.video else ()
+    check_output(args.out, what="--out", inputs=inputs)
     rows = read_tracks(src)
     n_links = 0
     if args.link:
         frames = None
         if args.video:
-            from pftrack.io.video import read_frames
+            from pftrack.io.video import FrameSequence
 
-            frames = read_frames(args.video)
+            frames = FrameSequence(args.video)  # read when the colour term asks, in one pass
+            check_video(args.video, frames, rows, src)
         cfg = LinkConfig(max_gap=args.max_gap)
         if args.max_distance is None:  # 50 px grown to the frame (gate_for_rows)
             cfg = gate_for_rows(cfg, rows)
         else:
             cfg = replace(cfg, max_distance=args.max_distance)
-        rows, mapping = link_tracklets(rows, cfg, frames)
+        try:
+            rows, mapping = link_tracklets(rows, cfg, frames)
+        finally:
+            if frames is not None:
+                frames.close()
         n_links = len(mapping)
     t0 = time.perf_counter()
     filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
@@ -106,6 +118,42 @@ def run(args: argparse.Namespace) -> int:
     if args.explain:
         print(rep.describe(args.method))
     return 0
+
+
+#: How far past the video's right or bottom edge a box may start, as a share of the frame's
+#: width or height, before ``recover --video`` refuses the video as not the tracks' own.
+EDGE_SLACK = 0.1
+
+
+def check_video(video: str, frames: Any, rows: Any, src: Path) -> None:
+    """Refuse a ``--video`` that cannot be the video of the tracks `rows` (of file `src`).
+
+    Raises
+    ------
+    ValueError
+        The video has fewer frames (by its header, or an image folder's count) than the
+        tracks' last frame, or a box starts more than :data:`EDGE_SLACK` of the frame past its
+        right or bottom edge (tracks of another video, or in another pixel scale).
+    """
+    if len(rows) == 0:
+        return
+    source = frames.source
+    last = int(rows[:, 0].max())
+    if 0 < len(frames) < last:
+        raise ValueError(
+            f"--video {video} has {len(frames)} frames but {src} has rows up to frame {last}: "
+            "not the video of these tracks"
+        )
+    for axis, size, edge in ((2, source.width, "right"), (3, source.height, "bottom")):
+        k = int(rows[:, axis].argmax())
+        start = float(rows[k, axis])
+        if start > size * (1 + EDGE_SLACK):
+            what = "left" if axis == 2 else "top"
+            raise ValueError(
+                f"--video {video} is {source.width}x{source.height} px but {src} has a box with "
+                f"{what} {start:g} (frame {int(rows[k, 0])}, id {int(rows[k, 1])}), past its "
+                f"{edge} edge: not the video of these tracks, or boxes in another pixel scale"
+            )
 
 
 def flag_note(rows: Any) -> str:

@@ -19,6 +19,9 @@ from pftrack.cli._options import (
     tracker_config,
 )
 
+#: ``--plot``'s formats; the first is a device's (``--plot /dev/stdout``).
+PLOT_SUFFIXES = (".png", ".jpg", ".jpeg")
+
 
 def add_parser(sub: Any) -> None:
     """Register ``track`` on `sub` (from ``add_subparsers``)."""
@@ -59,7 +62,7 @@ def add_parser(sub: Any) -> None:
         help="multiply detection boxes by S to reach the video's pixels "
         f"({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}; 0.625 for PETS09 det.txt on its "
         "480x360 video); auto: for the sequence's own detections, the frame width over "
-        "seqinfo.ini's imWidth, else 1",
+        "seqinfo.ini's imWidth, else 1; a number only with --detections",
     )  # fmt: skip
     p.add_argument(
         "--fps", type=bounded_float(0.01, 1000.0), metavar="FPS",
@@ -69,10 +72,12 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--render", metavar="VIDEO",
         help="write an annotated video while tracking: .mp4 (H.264, plays in browsers) or "
-        ".avi (MJPG); boxes, ids and trails as tracked online (default: none)",
+        ".avi (MJPG; a device or pipe without extension, e.g. /dev/stdout: .mp4); boxes, ids "
+        "and trails as tracked online (default: none)",
     )  # fmt: skip
     p.add_argument("--plot", metavar="PNG",
-                   help="write a trajectory plot (.png) (default: none)")  # fmt: skip
+                   help="write a trajectory plot: .png, .jpg (a device or pipe without "
+                   "extension: .png) (default: none)")  # fmt: skip
     add_tracker_options(p)
     p.set_defaults(func=run)
 
@@ -135,16 +140,14 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output
-    from pftrack.io.video import find_sequence, sequence_video
+    from pftrack.io.video import find_sequence, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES
 
     given = [d for d in (args.detections,) if d and d != "auto"]
     for det in given:
         check_input_file(det, what="--detections")
-    inputs = tuple([args.source] if not live else []) + tuple(given)
-    if not live and Path(args.source).is_dir():
-        video = sequence_video(args.source)  # a sequence folder read from its one video
-        inputs += (video,) if video is not None else ()
+    # the video, or every image of a folder and a sequence's seqinfo.ini (or its one video)
+    inputs = tuple(source_files(args.source) if not live else []) + tuple(given)
     if not live and args.detections == "auto":  # the sequence's det.txt is an input too
         with contextlib.suppress(ValueError):  # a bad seqinfo.ini is refused when read
             seq = find_sequence(args.source)
@@ -154,7 +157,7 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     if args.render:
         check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
     if args.plot:
-        check_output(args.plot, what="--plot", suffixes=(".png", ".jpg", ".jpeg"), inputs=inputs)
+        check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--render": args.render, "--plot": args.plot})
 
 
@@ -169,9 +172,10 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from pftrack.cli._options import opencv_single_threaded
-    from pftrack.io.atomic import atomic_write, staged_outputs, writes_through
+    from pftrack.io.atomic import atomic_write, output_format, staged_outputs, writes_through
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, check_source, is_live_source
+    from pftrack.io.video_writer import VIDEO_SUFFIXES
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections, track_frames
@@ -194,7 +198,9 @@ def run(args: argparse.Namespace) -> int:
                 if det_path
                 else None
             )
-            renderer = TrackRenderer(stage(args.render), source.fps) if args.render else None
+            if args.render:  # a device (/dev/null, /dev/stdout) takes the default format, .mp4
+                video = stage(args.render, output_format(args.render, VIDEO_SUFFIXES))
+                renderer = TrackRenderer(video, source.fps)
             first: list[Any] = []
             stream: IO[str] | None = None
 
@@ -252,7 +258,8 @@ def run(args: argparse.Namespace) -> int:
                 name = (
                     source.sequence.name if source.sequence is not None else Path(args.source).name
                 )
-                plot_trajectories(stage(args.plot), result.rows, background=first[0], title=name)
+                plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))  # device: .png
+                plot_trajectories(plot, result.rows, background=first[0], title=name)
                 said.append(f"trajectory plot -> {args.plot}")
     except BaseException:
         if renderer is not None:

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from pftrack._check import MAX_FRAME, real_array
+from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, real_array
 from pftrack.boxes import iou_xywh
 from pftrack.io.mot import CONF, FRAME, ID, LEFT
 
@@ -199,8 +199,9 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
 def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     """Scored MOT rows as an ``(M, 10)`` float64 array; TypeError/ValueError named by `what`.
 
-    Real numbers, ``(M, 6..10)``, the first 6 columns finite, frames and ids within
-    ``MAX_FRAME`` (they are cast to int); missing columns padded. Shared by
+    Real numbers, ``(M, 6..10)``, the first 6 columns finite, frames and ids integers within
+    ``MAX_FRAME`` (they are cast to int: an id 1.5 is refused, not scored as 1, the test
+    ``pftrack recover`` makes); missing columns padded. Shared by
     :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`.
     """
     a = real_array(rows, what)
@@ -214,6 +215,13 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     if huge.any():
         k = int(np.flatnonzero(huge.any(axis=1))[0])
         raise ValueError(f"{what} row {k} has frame or id {a[k, :2].tolist()} beyond {MAX_FRAME}")
+    frac = a[:, 0] != np.floor(a[:, 0])
+    if frac.any():  # cast to int, 1.5 would be scored as frame 1
+        k = int(np.flatnonzero(frac)[0])
+        raise ValueError(f"{what} row {k} has frame {a[k, 0]:g}, expected an integer")
+    k_id = first_bad_id(a[:, 1])
+    if k_id is not None:  # cast to int, 1.5 and 1.7 would be one id: refused as recover does
+        raise ValueError(f"{what} row {k_id}: {bad_id_message(a[k_id, 1])}")
     if a.shape[1] < 10:
         pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
         a = np.hstack([a, pad])

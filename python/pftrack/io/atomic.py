@@ -25,7 +25,7 @@ import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -244,9 +244,15 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         raise
 
 
-def _copy_through(tmp: Path, target: _Target) -> None:
-    """Write the finished file `tmp` into the written-through `target`."""
+def _copy_through(tmp: Path, target: _Target, *, empty_ok: bool = False) -> None:
+    """Write the finished file `tmp` into the written-through `target`.
+
+    OSError when `tmp` is missing or empty, unless `empty_ok` (then nothing is written).
+    """
     if not tmp.exists() or tmp.stat().st_size == 0:
+        if empty_ok:
+            with _open_through(target, "wb"):  # opened as a regular file would be replaced
+                return
         raise OSError(f"nothing was written for {target.path}")
     with tmp.open("rb") as src, _open_through(target, "wb") as dst:
         shutil.copyfileobj(src, dst)
@@ -300,11 +306,8 @@ def check_output(
     if target.is_dir():
         raise ValueError(f"{what} {target} is a folder; give a file name")
     _refuse_folder_name(text, what)
-    if suffixes is not None and target.suffix.lower() not in suffixes:
-        raise ValueError(
-            f"{what} {text}: unsupported extension {target.suffix or '(none)'!r}, expected "
-            f"one of {', '.join(suffixes)}"
-        )
+    if suffixes is not None:
+        output_format(text, suffixes, what)  # a device without extension: the first
     resolved = _resolve(text)
     written = resolved.path
     if resolved.through:
@@ -312,10 +315,55 @@ def check_output(
             raise PermissionError(f"{what} {target}: not writable")
     else:
         _check_folder(written, what, target)
-    for source in inputs:
-        if _same_file(target, Path(source)):
-            raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
+    if _one_of(target, inputs):
+        raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
     return target
+
+
+def _one_of(target: Path, files: Iterable[PathLike]) -> bool:
+    """Whether `target` is one of `files` (as :func:`_same_file`, one ``stat`` per file).
+
+    For the thousands of images of an input folder: the target is looked at once.
+    """
+    try:
+        st = os.stat(target)
+    except OSError:
+        st = None
+    resolved: Path | None = None
+    for f in files:
+        try:
+            other = os.stat(f)
+        except OSError:  # a missing input: compared by its resolved path
+            resolved = resolved or target.resolve()
+            if Path(f).resolve() == resolved:
+                return True
+            continue
+        if st is not None and (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
+            return True  # the same file: links, hard links, bind mounts, "..", "./"
+    return False
+
+
+def output_format(path: PathLike, suffixes: tuple[str, ...], what: str = "output") -> str:
+    """The format output `path` is written in: its extension, one of `suffixes` (lower case).
+
+    A device, pipe or descriptor without an extension (``/dev/null``, ``/dev/stdout``, a named
+    pipe ``fifo``) takes the first of `suffixes`, the default format: its name cannot say one.
+
+    Raises
+    ------
+    ValueError
+        Any other extension that is not one of `suffixes`.
+    """
+    text = os.fsdecode(os.fspath(path))
+    suffix = Path(text).suffix.lower()
+    if suffix in suffixes:
+        return suffix
+    if not suffix and _resolve(text).through:
+        return suffixes[0]
+    raise ValueError(
+        f"{what} {text}: unsupported extension {Path(text).suffix or '(none)'!r}, expected "
+        f"one of {', '.join(suffixes)}"
+    )
 
 
 def _check_folder(written: Path, what: str, target: Path) -> None:
@@ -382,12 +430,28 @@ def check_distinct(outputs: Mapping[str, PathLike | None]) -> None:
         seen.append((what, target))
 
 
+def _remove_nested(tmp: Path) -> None:
+    """Remove the temporary files an atomic writer made beside staged file `tmp` for it.
+
+    A writer given a staged path writes it atomically in turn (``VideoWriter``:
+    ``..t.<hex>.<hex>.mp4`` for ``.t.<hex>.mp4``); interrupted between making its file and
+    handing it over (Ctrl-C, SIGTERM), nobody else knows that file. Its name starts with
+    ``.`` and `tmp`'s stem, whose random part no other file has.
+    """
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(tmp.parent):
+            if entry.name.startswith(f".{tmp.stem}."):
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+
+
 @contextlib.contextmanager
-def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
+def staged_outputs() -> Iterator[Callable[..., Path]]:
     """Several outputs of one run, all replaced at the end or none at all.
 
-    Yields ``stage(path) -> Path``: a temporary path beside `path`, with its extension, for a
-    writer to fill. When the block ends normally every staged file is renamed over its target;
+    Yields ``stage(path, suffix=None) -> Path``: a temporary path beside `path`, with its
+    extension (or `suffix`: the format of a device, :func:`output_format`), for a writer to
+    fill. When the block ends normally every staged file is renamed over its target;
     when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
     target is left as it was, so an interrupted run never leaves a new tracks file beside an old
     video, or a half-written file anywhere. A symbolic link replaces the file it leads to; a
@@ -403,10 +467,10 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
     through: list[tuple[Path, _Target]] = []  # devices, FIFOs, descriptors: written at the end
     scratch: list[str] = []  # the temporary folder of their files, made when first needed
 
-    def stage(path: PathLike) -> Path:
+    def stage(path: PathLike, suffix: str | None = None) -> Path:
         _refuse_folder_name(path)
         resolved = _resolve(path)
-        suffix = Path(path).suffix
+        suffix = Path(path).suffix if suffix is None else suffix
         if resolved.through:
             if not scratch:
                 scratch.append(tempfile.mkdtemp(prefix="pftrack-"))
@@ -432,11 +496,12 @@ def staged_outputs() -> Iterator[Callable[[PathLike], Path]]:
         for tmp, target in staged:
             os.replace(tmp, target)
         for tmp_path, resolved in through:  # last: a FIFO waits for its reader
-            _copy_through(tmp_path, resolved)
+            _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
     except BaseException:
         for tmp, _ in staged:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+            _remove_nested(Path(tmp))
         raise
     finally:
         if scratch:

@@ -60,14 +60,19 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
     FileNotFoundError
         If `path` does not exist.
     ValueError
-        On a malformed line, naming the file and the 1-based line number: fewer than 6 fields,
-        a non-number, a non-finite value in any of the first 10 columns (a NaN score too), a
-        frame that is not an integer in ``1..2**31-1``, a
-        negative width or height, or a box value beyond ±1e9 px. A UTF-8 byte-order mark is
-        skipped.
+        If it is a folder, or not a regular file (a device such as ``/dev/null``, a named pipe,
+        a socket: the file may be read twice, to name a bad line). On a malformed line,
+        naming the file and the 1-based line number: fewer than 6 fields, a non-number, a
+        non-finite value in any of the first 10 columns (a NaN score too), a frame that is not
+        an integer in ``1..2**31-1``, a negative width or height, or a box value beyond ±1e9
+        px. A UTF-8 byte-order mark is skipped.
     """
     p = Path(path)
     if not p.is_file():
+        if p.is_dir():
+            raise ValueError(f"{what} {p} is a folder, not a file")
+        if p.exists():
+            raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket)")
         raise FileNotFoundError(f"{what} not found: {p}")
     fast = _read_fast(p)
     if fast is not None:

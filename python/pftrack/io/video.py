@@ -22,11 +22,12 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import operator
 import os
 import re
 import stat
 import warnings
-from collections.abc import Generator, Iterable, Iterator
+from collections.abc import Generator, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,9 +38,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._typing import PathLike
+from pftrack.io.opencv_io import opencv_name, read_image, utf8_name
 
 __all__ = [
     "VIDEO_SUFFIXES",
+    "FrameSequence",
     "FrameSource",
     "SequenceInfo",
     "check_source",
@@ -49,6 +52,7 @@ __all__ = [
     "read_frames",
     "read_seqinfo",
     "sequence_video",
+    "source_files",
     "video_files",
 ]
 
@@ -75,11 +79,12 @@ def _file_capture(path: str) -> cv2.VideoCapture:
     beside the detector's and the tracker's, and a ``pftrack batch`` worker has one core. Falls
     back to OpenCV's default backend choice if FFmpeg cannot open the file.
     """
-    cap = cv2.VideoCapture(path, cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, 1])
-    if cap.isOpened():
-        return cap
-    cap.release()
-    return cv2.VideoCapture(path)
+    with opencv_name(path) as name:  # any file name (opencv_io); OpenCV keeps its own handle
+        cap = cv2.VideoCapture(name, cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, 1])
+        if cap.isOpened():
+            return cap
+        cap.release()
+        return cv2.VideoCapture(name)
 
 
 def _fourcc(cap: cv2.VideoCapture) -> str:
@@ -335,6 +340,72 @@ def _frame_order(
     return ordered
 
 
+def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
+    """The folder whose images a folder source `path` (of `sequence`, if any) reads.
+
+    A sequence folder's ``imDir`` (ValueError if missing), else ``path/img1`` if it exists,
+    else `path` itself.
+    """
+    if sequence is not None and sequence.folder == path:
+        folder = path / sequence.image_dir
+        if not folder.is_dir():
+            raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
+        return folder
+    if (path / "img1").is_dir():
+        return path / "img1"
+    return path
+
+
+def _images_in(folder: Path) -> list[Path]:
+    """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order."""
+    return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
+
+
+def source_files(source: PathLike | int) -> list[Path]:
+    """Every file :class:`FrameSource` reads for `source`: what no output of a run may replace.
+
+    Parameters
+    ----------
+    source : str, int or os.PathLike
+        As :class:`FrameSource` takes it.
+
+    Returns
+    -------
+    list of Path
+        `source` itself; every ``seqinfo.ini`` it looks for that exists (in a folder `source`
+        and the folder above it; beside a file); for a folder, each image of the folder it
+        reads frames from (``imDir`` of a sequence, ``img1/``, or the folder), or a sequence
+        folder's one video. Nothing for a camera index or a stream URL. A ``seqinfo.ini`` that
+        cannot be parsed is listed all the same (it is read: the run fails on it), and so is
+        every image of a sequence folder's image folders it may name.
+    """
+    text = str(source)
+    if _camera_index(source) is not None or "://" in text:
+        return []
+    path = Path(text)
+    files = [path]
+    if not path.is_dir():
+        ini = path.parent / "seqinfo.ini"
+        return files + ([ini] if ini.is_file() else [])
+    files += [f / "seqinfo.ini" for f in (path, path.parent) if (f / "seqinfo.ini").is_file()]
+    try:
+        sequence = find_sequence(path)
+    except ValueError:  # an unreadable seqinfo.ini: refused when read; guard every image folder
+        folders = [path, path / "img1"]
+    else:
+        try:
+            video = sequence_video(path) if sequence is not None else None
+        except ValueError:  # no video, or several: refused when read
+            video = None
+        if video is not None:
+            return [*files, video]
+        try:
+            folders = [_image_folder(path, sequence)]
+        except ValueError:  # its image folder is missing: refused when read
+            folders = []
+    return files + [p for f in folders if f.is_dir() for p in _images_in(f)]
+
+
 def check_source(source: object) -> None:
     """Refuse what cannot name a frame source, before anything is opened.
 
@@ -495,21 +566,15 @@ class FrameSource:
             self._replay.append(first)
 
     def _open_folder(self, path: Path) -> tuple[NDArray[Any], int]:
-        folder = path
-        if self.sequence is not None and self.sequence.folder == path:
-            folder = path / self.sequence.image_dir
-            if not folder.is_dir():
-                raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
-        elif (path / "img1").is_dir():
-            folder = path / "img1"
-        images = [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
+        folder = _image_folder(path, self.sequence)
+        images = _images_in(folder)
         if not images:
             raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
         seq = self.sequence
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
         self._images = numbered or sorted(images, key=lambda p: natural_key(p.name))
-        first = cv2.imread(str(self._images[0]), cv2.IMREAD_COLOR)
+        first = read_image(self._images[0])
         if first is None:
             raise ValueError(f"cannot read image {self._images[0]}")
         self._image_shape = (int(first.shape[0]), int(first.shape[1]))
@@ -538,8 +603,11 @@ class FrameSource:
         what = "camera" if isinstance(self._target, int) else "stream"
         if isinstance(self._target, int):
             cap = cv2.VideoCapture(self._target)
-        else:
-            cap = cv2.VideoCapture(self._target, cv2.CAP_FFMPEG)
+        elif "://" in self._target:  # a URL OpenCV's binding cannot take crashes it
+            cap = cv2.VideoCapture(utf8_name(self._target, "stream URL"), cv2.CAP_FFMPEG)
+        else:  # a named pipe, under any name (opencv_io)
+            with opencv_name(self._target) as name:
+                cap = cv2.VideoCapture(name, cv2.CAP_FFMPEG)
         ok, first = cap.read() if cap.isOpened() else (False, None)
         if not ok or first is None:
             cap.release()
@@ -555,7 +623,7 @@ class FrameSource:
 
     def _read_image(self, path: Path) -> NDArray[np.uint8]:
         """One image of a folder, resized; ValueError if unreadable or not the first's size."""
-        img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+        img = read_image(path)
         if img is None:
             raise ValueError(f"cannot read image {path}")
         if img.shape[:2] != self._image_shape:
@@ -735,6 +803,87 @@ class FrameSource:
         self.close()
 
 
+class FrameSequence(Sequence[NDArray[np.uint8]]):
+    """The frames of a stored source as a sequence whose items are read when asked for.
+
+    Indexed in increasing order, a video file is decoded once, from its start to the last
+    frame asked for, holding one frame at a time (the frames in between are only grabbed, as
+    :meth:`FrameSource.frames_at` does); an index lower than the last one asked for starts a
+    new pass. An image folder reads only the images asked for. What
+    :func:`pftrack.recovery.link_tracklets` takes for its colour term, instead of every frame
+    of the video in memory (:func:`read_frames`).
+
+    Parameters
+    ----------
+    source : FrameSource, str or os.PathLike
+        A video file, an image folder or a sequence folder (not a live source).
+
+    Raises
+    ------
+    ValueError
+        A live source (it can be read only once, in order).
+
+    Notes
+    -----
+    The length is :attr:`FrameSource.n_frames`: a video's header count. A video that ends
+    before it fails on the first frame asked for past its end (ValueError naming both counts).
+    """
+
+    def __init__(self, source: FrameSource | PathLike) -> None:
+        self.source = source if isinstance(source, FrameSource) else FrameSource(source)
+        if self.source.live:
+            raise ValueError(f"live source {self.source.name} cannot be read at chosen frames")
+        self._cap: Any = None
+        self._at = 0  # the index of the frame self._cap reads next
+        self._last: tuple[int, NDArray[np.uint8]] | None = None
+
+    def __len__(self) -> int:
+        return self.source.n_frames
+
+    def __getitem__(self, index: Any) -> Any:
+        """The frame at 0-based `index` (an int; negative counts from the end)."""
+        if isinstance(index, slice):
+            raise TypeError("FrameSequence takes one index, not a slice")
+        i = operator.index(index)
+        n = len(self)
+        if i < 0:
+            i += n
+        if not 0 <= i < n:
+            raise IndexError(f"frame index {index} is out of range for {n} frames")
+        if self._last is not None and self._last[0] == i:
+            return self._last[1]
+        if self.source._images is not None:
+            frame = self.source._read_image(self.source._images[i])
+        else:
+            if self._cap is None or i < self._at:  # a new pass from the start
+                self.close()
+                self._cap = _file_capture(str(self.source.path))
+                self._at = 0
+            picked, _, self._at = self.source._read_at(self._cap, self._at, [i])
+            if not picked:
+                self.close()
+                raise ValueError(
+                    f"{self.source.name}: frame {i + 1} cannot be decoded: the video ended after "
+                    f"{self._at} frames but its header says {n}"
+                )
+            frame = picked[0]
+        self._last = (i, frame)
+        return frame
+
+    def close(self) -> None:
+        """Release the video file's decoder (a later item opens it again)."""
+        if self._cap is not None:
+            self._cap.release()
+            self._cap = None
+        self._at = 0
+
+    def __enter__(self) -> FrameSequence:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
 def read_frames(source: PathLike, *, scale: float = 1.0) -> list[NDArray[np.uint8]]:
-    """All frames of `source` in memory (fine for short sequences)."""
+    """All frames of `source` in memory (fine for short sequences; see :class:`FrameSequence`)."""
     return list(FrameSource(source, scale=scale))

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
+from pftrack.io.opencv_io import opencv_name
 
 __all__ = ["VIDEO_SUFFIXES", "X264_PRESETS", "VideoWriter", "pyav_available"]
 
@@ -109,11 +110,11 @@ class VideoWriter:
         self.codec = "h264" if backend == "pyav" else ("mjpeg" if suffix == ".avi" else "")
         self.n_frames = 0
         self._size: tuple[int, int] | None = None  # (height, width) of the input frames
-        self._stack = contextlib.ExitStack()
-        self._tmp: Path = self._stack.enter_context(atomic_path(self.path))
         self._container: Any = None
         self._stream: Any = None
         self._cv: Any = None
+        self._stack = contextlib.ExitStack()
+        self._tmp: Path = self._stack.enter_context(atomic_path(self.path))
 
     def _open(self, height: int, width: int) -> None:
         self._size = (height, width)
@@ -136,10 +137,8 @@ class VideoWriter:
             return
         candidates = ("MJPG",) if self.path.suffix.lower() == ".avi" else ("avc1", "mp4v")
         for fourcc in candidates:
-            with contextlib.suppress(cv2.error):
-                writer = cv2.VideoWriter(
-                    str(self._tmp), cv2.VideoWriter.fourcc(*fourcc), self.fps, (w, h)
-                )
+            with contextlib.suppress(cv2.error), opencv_name(self._tmp) as name:  # any name
+                writer = cv2.VideoWriter(name, cv2.VideoWriter.fourcc(*fourcc), self.fps, (w, h))
                 if writer.isOpened():
                     self._cv = writer
                     self.codec = {"MJPG": "mjpeg", "avc1": "h264"}.get(fourcc, fourcc)

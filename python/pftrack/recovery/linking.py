@@ -17,11 +17,18 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box, real_array
+from pftrack._check import (
+    BOX_VALUES,
+    MAX_FRAME,
+    MAX_ID,
+    bad_id_message,
+    first_bad_box,
+    first_bad_id,
+    real_array,
+)
 from pftrack._typing import F64, PathLike
 from pftrack.boxes import xywh_to_cxcywh
 from pftrack.particle_filter.colour import (
-    BinnedImage,
     bhattacharyya_distance,
     box_histograms,
     hsv_bins,
@@ -30,9 +37,11 @@ from pftrack.particle_filter.colour import (
 __all__ = [
     "FILLED_MARK",
     "FLAG_COLUMN",
+    "MAX_ID",
     "LinkConfig",
     "box_centres",
     "check_boxes",
+    "check_file_ids",
     "check_rows",
     "check_unique",
     "filled_mask",
@@ -49,8 +58,6 @@ FLAG_COLUMN = 7  #: 0-based index of the interpolated flag (column 8 of a MOTCha
 FILLED_MARK = (1.0, -1.0, -1.0)
 #: Frames up to this diagonal (640x480) take pixel settings as given; larger ones scale them.
 REFERENCE_DIAGONAL = 800.0
-#: Largest absolute track id accepted.
-MAX_ID = MAX_FRAME
 
 
 @dataclass(frozen=True)
@@ -176,22 +183,31 @@ def split_tracks(rows: F64) -> dict[int, F64]:
     return {int(r[i, 1]): r[i:j] for i, j in zip(starts, ends, strict=True)}
 
 
-class _Histograms:
-    """Colour histograms of fragment ends, each frame binned once (lazily: only gated pairs)."""
+def _end_histograms(
+    tracks: dict[int, F64], ends: Iterable[tuple[int, bool]], frames: Sequence[NDArray[np.uint8]]
+) -> dict[tuple[int, bool], F64 | None]:
+    """Colour histogram of the box at each fragment end of `ends` (id, last row or first).
 
-    def __init__(self, frames: Sequence[NDArray[np.uint8]]) -> None:
-        self.frames = frames
-        self.images: dict[int, BinnedImage] = {}
-
-    def of(self, row: F64) -> F64 | None:
-        """Histogram of the box of a row, None when there is no frame or nothing to count."""
-        f = int(row[0]) - 1
-        if not 0 <= f < len(self.frames):
-            return None
-        if f not in self.images:
-            self.images[f] = hsv_bins(self.frames[f])
-        hist = box_histograms(self.images[f], xywh_to_cxcywh(row[2:6])[None])[0]
-        return hist if hist.sum() > 0 else None
+    None where there is no frame or nothing to count. The frames are asked for in increasing
+    order, each once, and binned one at a time: a sequence that reads a video on demand
+    (:class:`pftrack.io.video.FrameSequence`) decodes it in one pass, holding one frame.
+    """
+    at: dict[int, list[tuple[int, bool]]] = {}
+    for key in ends:
+        tid, last = key
+        at.setdefault(int(tracks[tid][-1 if last else 0, 0]) - 1, []).append(key)
+    out: dict[tuple[int, bool], F64 | None] = {}
+    n = len(frames)
+    for f in sorted(at):
+        image = hsv_bins(frames[f]) if 0 <= f < n else None
+        for tid, last in at[f]:
+            if image is None:
+                out[tid, last] = None
+                continue
+            row = tracks[tid][-1 if last else 0]
+            hist = box_histograms(image, xywh_to_cxcywh(row[2:6])[None])[0]
+            out[tid, last] = hist if hist.sum() > 0 else None
+    return out
 
 
 def link_cost_matrix(
@@ -202,21 +218,16 @@ def link_cost_matrix(
     """Cost of joining the end of fragment i to the start of fragment j (``inf`` when gated).
 
     Returns the ids (row i and column j both index this list) and the ``(K, K)`` cost matrix.
-    `frames`, when given, is indexable by ``frame - 1`` (BGR images) and adds a colour term.
+    `frames`, when given, is indexable by ``frame - 1`` (BGR images) and adds a colour term:
+    only the frames of the fragment ends of pairs within the gates are read, in increasing
+    order, each once (a :class:`pftrack.io.video.FrameSequence` reads them from the video in
+    one pass).
     """
     ids = list(tracks)
     k = len(ids)
     cost = np.full((k, k), np.inf)
     cent = {t: box_centres(r) for t, r in tracks.items()}
-    colour = _Histograms(frames) if frames is not None else None
-    hists: dict[tuple[int, bool], F64 | None] = {}
-
-    def hist(tid: int, last: bool) -> F64 | None:
-        key = (tid, last)
-        if key not in hists and colour is not None:
-            hists[key] = colour.of(tracks[tid][-1 if last else 0])
-        return hists.get(key)
-
+    gated: list[tuple[int, int, float]] = []  # (i, j, the cost but its colour term)
     for i, ti in enumerate(ids):
         ci = cent[ti]
         end = ci[-1]
@@ -238,11 +249,16 @@ def link_cost_matrix(
             hi, hj = tracks[ti][-1, 5], tracks[tj][0, 5]
             if hi > 0 and hj > 0:
                 c += config.w_size * abs(float(np.log(hi / hj)))
-            if colour is not None and config.w_appearance > 0:
-                a, b = hist(ti, True), hist(tj, False)
-                if a is not None and b is not None:
-                    c += config.w_appearance * float(bhattacharyya_distance(a, b)[0])
-            cost[i, j] = c
+            gated.append((i, j, c))
+    hists: dict[tuple[int, bool], F64 | None] = {}
+    if frames is not None and config.w_appearance > 0:
+        ends = {(ids[i], True) for i, _, _ in gated} | {(ids[j], False) for _, j, _ in gated}
+        hists = _end_histograms(tracks, sorted(ends), frames)
+    for i, j, c in gated:
+        a, b = hists.get((ids[i], True)), hists.get((ids[j], False))
+        if a is not None and b is not None:
+            c += config.w_appearance * float(bhattacharyya_distance(a, b)[0])
+        cost[i, j] = c
     return ids, cost
 
 
@@ -324,9 +340,9 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
         raise ValueError(
             f"{what}: frame {f[bad][0]:g} is not an integer in 1..{MAX_FRAME} (refused)"
         )
-    k = _first_bad_id(i)
+    k = first_bad_id(i)
     if k is not None:
-        raise ValueError(f"{what}: {_bad_id_message(i[k])}")
+        raise ValueError(f"{what}: {bad_id_message(i[k])}")
     check_boxes(a[:, 2:6], a, what)
     return a
 
@@ -358,14 +374,17 @@ def check_boxes(boxes: F64, rows: F64, what: str, name: str = "") -> None:
         )
 
 
-def _first_bad_id(ids: F64) -> int | None:
-    """Index of the first id that is not an integer with ``|id| <= MAX_ID``, or None."""
-    bad = (np.abs(ids) > MAX_ID) | (ids != np.floor(ids))
-    return int(np.flatnonzero(bad)[0]) if bad.any() else None
+def check_file_ids(rows: F64, path: PathLike) -> None:
+    """Refuse rows read from file `path` whose ids are not integers: ``FILE:LINE: track id ...``.
 
+    :func:`check_rows`' test of the ids (:func:`pftrack._check.first_bad_id`), named by the
+    file's line: what ``pftrack recover``, ``smooth``, ``experiment gaps`` and ``eval`` read.
+    """
+    from pftrack.io.mot import data_line_numbers
 
-def _bad_id_message(value: float) -> str:
-    return f"track id {value:g} is not an integer with |id| <= {MAX_ID}"
+    k = first_bad_id(rows[:, 1])
+    if k is not None:
+        raise ValueError(f"{path}:{data_line_numbers(path)[k]}: {bad_id_message(rows[k, 1])}")
 
 
 def check_unique(
@@ -406,9 +425,7 @@ def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
     from pftrack.io.mot import data_line_numbers, read_mot
 
     rows = read_mot(path, what=what)
-    k = _first_bad_id(rows[:, 1])
-    if k is not None:  # check_rows' test, with the file's line, as read_mot's own checks
-        raise ValueError(f"{path}:{data_line_numbers(path)[k]}: {_bad_id_message(rows[k, 1])}")
+    check_file_ids(rows, path)  # check_rows' test, with the file's line, as read_mot's own
     try:
         check_unique(rows)
     except ValueError:

@@ -206,7 +206,7 @@ class Tracker:
     min_conf : float
         Detections with a lower confidence are ignored.
     birth_score : float
-        Cap of the confidence a detection needs to start a track.
+        Cap of the confidence a detection needs to start a track, in [0, 1].
     birth_quantile : float or None
         The birth threshold is ``min(birth_score, quantile)`` of the confidences seen in the
         first 2 s, so a detector whose scores are all low still starts tracks (None: always

@@ -115,12 +115,12 @@ class LifecycleConfig:
         with this rule, as without the speckle; docs/tracking.md). A small box touching the
         border is kept: an object entering or leaving the frame. 0 keeps every box.
     birth_score : float
-        An external detection starts a track only with at least this score (a detection too
-        unsure to start a track can still keep one alive, as in ByteTrack). Applied while every
-        score kept (at least `min_score`) lies in [0, 1], i.e. scores are confidences (a
-        warning says when they stop being: from then on a detector with other scores starts
-        tracks from any detection it keeps, as the built-in detector does). With `birth_quantile`
-        this is a cap: the threshold is relative to the detector (see there).
+        In [0, 1]. An external detection starts a track only with at least this score (a
+        detection too unsure to start a track can still keep one alive, as in ByteTrack). Applied
+        while every score kept (at least `min_score`) lies in [0, 1], i.e. scores are
+        confidences (a warning says when they stop being: from then on a detector with other
+        scores starts tracks from any detection it keeps, as the built-in detector does). With
+        `birth_quantile` this is a cap: the threshold is relative to the detector (see there).
     birth_quantile : float or None
         Make the birth threshold relative to the detector: ``min(birth_score, q)`` where ``q``
         is this quantile of the scores (at least `min_score`) seen over the first
@@ -196,7 +196,9 @@ class LifecycleConfig:
         _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
         if self.relink_coast is not None:
             _integers_at_least("LifecycleConfig", 1, self, "relink_coast")
-        _in_unit_interval("LifecycleConfig", coast_min_rho=self.coast_min_rho)
+        _in_unit_interval(
+            "LifecycleConfig", coast_min_rho=self.coast_min_rho, birth_score=self.birth_score
+        )
         if self.nested_inside is not None and not 0.0 < self.nested_inside <= 1.0:
             raise ValueError(
                 f"LifecycleConfig: nested_inside is {self.nested_inside}, expected a value in "

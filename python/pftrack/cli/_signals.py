@@ -1,0 +1,54 @@
+"""Ctrl-C and ``kill``: a command stopped by SIGTERM unwinds as one stopped by Ctrl-C.
+
+Every output is staged and renamed at the end (:mod:`pftrack.io.atomic`), and each writer
+removes its temporary file when an exception passes through it: a ``KeyboardInterrupt`` leaves
+the user's files as they were and no temporary file. SIGTERM (``kill PID``, a service manager,
+``timeout``) killed the process where it stood, leaving the temporary files of the video being
+rendered (``..t.<hex>.<hex>.mp4``, ``.t.<hex>.mp4``). While a command runs, SIGTERM raises
+:class:`Terminated`, a ``KeyboardInterrupt``, so it takes the same path.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+from typing import Any
+
+__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "Terminated", "exit_status", "sigterm_raises"]
+
+#: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
+EXIT_INTERRUPTED = 130
+#: Exit status after SIGTERM (128 + SIGTERM, as shells report a process it killed).
+EXIT_TERMINATED = 143
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread where the command stands (see the module's notes)."""
+
+
+def exit_status(exc: KeyboardInterrupt) -> int:
+    """143 when `exc` came from SIGTERM, else 130 (Ctrl-C)."""
+    return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    raise Terminated
+
+
+@contextlib.contextmanager
+def sigterm_raises() -> Iterator[None]:
+    """While the block runs, SIGTERM raises :class:`Terminated`; the previous handler after.
+
+    Only in the main thread (Python runs signal handlers there; another thread cannot set
+    one), and only where the platform has SIGTERM.
+    """
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "SIGTERM"):
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

@@ -1,0 +1,139 @@
+r"""Files through OpenCV under any name the file system allows, bytes that are not UTF-8 too.
+
+OpenCV's Python binding converts a ``str`` path to UTF-8. A name that is not valid UTF-8 (a
+Latin-1 ``vid\xfe.mp4`` made on another system: Python keeps such bytes as surrogate escapes,
+``os.fsdecode(b"vid\xfe.mp4")``) crashes the process in ``cv2.VideoCapture``,
+``cv2.imread``, ``cv2.imwrite`` and ``cv2.VideoWriter`` (a segmentation fault, OpenCV 5.0).
+pftrack never hands OpenCV such a name:
+
+- images are read and written through memory (:func:`read_image`: ``numpy.fromfile`` and
+  ``cv2.imdecode``; :func:`write_image`: ``cv2.imencode`` and an atomic write);
+- videos are opened through a symbolic link with an ASCII name in the system's temporary
+  folder (:func:`opencv_name`), removed as soon as OpenCV has opened the file: OpenCV keeps
+  its own handle;
+- a stream URL that is not valid UTF-8 is refused (:func:`utf8_name`).
+
+A name that is valid UTF-8, which is almost every name, goes to OpenCV as it is.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from pftrack._typing import PathLike
+from pftrack.io.atomic import atomic_write
+
+__all__ = ["is_utf8", "opencv_name", "printable", "read_image", "utf8_name", "write_image"]
+
+
+def is_utf8(path: PathLike) -> bool:
+    """Whether the bytes of `path` are valid UTF-8 (OpenCV's binding can take it)."""
+    try:
+        os.fsencode(os.fspath(path)).decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return True
+
+
+def printable(path: PathLike) -> str:
+    r"""`path` for a message: bytes that are not UTF-8 shown as ``\xfe`` escapes."""
+    return os.fsencode(os.fspath(path)).decode("utf-8", "backslashreplace")
+
+
+def utf8_name(path: PathLike, what: str = "path") -> str:
+    """`path` as a ``str`` OpenCV can take; ValueError if it is not valid UTF-8."""
+    if not is_utf8(path):
+        raise ValueError(
+            f"{what} {printable(path)} is not valid UTF-8, which OpenCV's binding cannot take"
+        )
+    return os.fsdecode(os.fspath(path))
+
+
+@contextlib.contextmanager
+def opencv_name(path: PathLike) -> Iterator[str]:
+    """A name OpenCV can open for file `path`, valid while the block runs.
+
+    `path` itself when it is valid UTF-8; else a symbolic link to it with an ASCII name (and
+    `path`'s extension, when that is ASCII) in a new folder of the system's temporary folder,
+    removed with its folder when the block ends. Open the file (``cv2.VideoCapture``,
+    ``cv2.VideoWriter``) inside the block: OpenCV keeps its own handle afterwards.
+
+    Raises
+    ------
+    ValueError
+        `path` is not valid UTF-8 and neither is the temporary folder.
+    """
+    text = os.fsdecode(os.fspath(path))
+    if is_utf8(text):
+        yield text
+        return
+    scratch = tempfile.mkdtemp(prefix="pftrack-")
+    try:
+        suffix = Path(text).suffix
+        link = os.path.join(scratch, "file" + (suffix if suffix.isascii() else ""))
+        utf8_name(link, "temporary folder")
+        os.symlink(os.path.abspath(text), link)
+        yield link
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+def read_image(path: PathLike, flags: int = cv2.IMREAD_COLOR) -> NDArray[np.uint8] | None:
+    """The image at `path` as ``cv2.imread`` reads it (any name); None if it cannot be read."""
+    if is_utf8(path):
+        image: Any = cv2.imread(os.fsdecode(os.fspath(path)), flags)
+        return None if image is None else np.asarray(image, dtype=np.uint8)
+    try:
+        data = np.fromfile(os.fspath(path), dtype=np.uint8)
+    except (OSError, ValueError):
+        return None
+    image = cv2.imdecode(data, flags) if data.size else None
+    return None if image is None else np.asarray(image, dtype=np.uint8)
+
+
+def write_image(
+    path: PathLike, image: NDArray[Any], params: Sequence[int] = (), *, ext: str | None = None
+) -> Path:
+    """Write `image` as ``cv2.imwrite`` would (the same bytes), atomically; return `path`.
+
+    Encoded in memory (``cv2.imencode``), then written by :func:`~pftrack.io.atomic.atomic_write`:
+    any name, and a device or descriptor (``/dev/stdout``) is written through.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+    image : ndarray
+        What ``cv2.imwrite`` takes (BGR uint8, ...).
+    params : sequence of int
+        Encoder parameters (``[cv2.IMWRITE_PNG_COMPRESSION, 9]``).
+    ext : str, optional
+        The format (``".png"``); default: `path`'s extension.
+
+    Raises
+    ------
+    ValueError
+        OpenCV has no encoder for the format, or cannot encode `image` in it.
+    """
+    suffix = Path(path).suffix if ext is None else ext
+    try:
+        ok, buf = cv2.imencode(suffix, image, list(params))
+    except cv2.error:
+        ok = False
+    if not ok:
+        raise ValueError(
+            f"OpenCV cannot write image {printable(path)} (format {suffix or '(none)'!r})"
+        )
+    with atomic_write(path, "wb") as fh:
+        fh.write(buf.tobytes())
+    return Path(path)

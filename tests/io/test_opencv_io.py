@@ -1,0 +1,120 @@
+"""File names that are not valid UTF-8 reach OpenCV never as such: no crash, the same pixels.
+
+OpenCV's binding crashes the process (a segmentation fault) on ``cv2.VideoCapture``,
+``cv2.imread``, ``cv2.imwrite`` and ``cv2.VideoWriter`` given such a name; the command-line
+test runs ``pftrack`` in a subprocess, where a crash is an exit status of -11.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from pftrack.io.opencv_io import is_utf8, opencv_name, printable, read_image, write_image
+from pftrack.io.video import FrameSource
+from pftrack.io.video_writer import VideoWriter
+from pftrack.synthetic import make_scene
+
+
+def _latin1(folder: Path, name: bytes) -> Path:
+    """`folder`/`name` (bytes that are not UTF-8); skip where the file system refuses them."""
+    path = Path(os.fsdecode(os.path.join(os.fsencode(folder), name)))
+    try:
+        path.touch()
+        path.unlink()
+    except OSError:  # e.g. macOS: names must be UTF-8
+        pytest.skip("this file system takes only UTF-8 names")
+    return path
+
+
+def _pftrack_scratch() -> set[str]:
+    return {n for n in os.listdir(tempfile.gettempdir()) if n.startswith("pftrack-")}
+
+
+def test_names_are_told_apart_and_shown_with_escapes(tmp_path: Path) -> None:
+    bad = _latin1(tmp_path, b"vid\xfe.mp4")
+    assert is_utf8(tmp_path / "vidé.mp4") and not is_utf8(bad)
+    assert printable(bad).endswith("vid\\xfe.mp4")
+
+
+def test_images_are_written_and_read_under_any_name(tmp_path: Path) -> None:
+    image = make_scene(n_frames=1, rng=0).frames[0]
+    good, bad = tmp_path / "a.png", _latin1(tmp_path, b"b\xe9.png")
+    assert cv2.imwrite(str(good), image)
+    write_image(bad, image)
+    assert bad.read_bytes() == good.read_bytes()  # cv2.imwrite's bytes
+    got = read_image(bad)
+    assert got is not None and np.array_equal(got, image)
+    assert read_image(_latin1(tmp_path, b"missing\xe9.png")) is None
+    assert len(os.listdir(tmp_path)) == 2  # no temporary file
+
+
+def test_a_video_and_an_image_folder_under_any_name_give_the_same_frames(
+    tmp_path: Path,
+) -> None:
+    scene = make_scene(n_frames=6, rng=0)
+    before = _pftrack_scratch()
+    video = scene.write_video(_latin1(tmp_path, b"v\xfe.avi"))
+    folder = scene.write_images(_latin1(tmp_path, b"imgs\xe9"))
+    good = scene.write_video(tmp_path / "v.avi")
+    expected = list(FrameSource(good))
+    for source, want in ((video, expected), (folder, scene.frames)):
+        frames = list(FrameSource(source))
+        assert len(frames) == 6
+        assert all(np.array_equal(a, b) for a, b in zip(frames, want, strict=True))
+    assert len(FrameSource(video).frames_at([1, 4])) == 2
+    assert _pftrack_scratch() == before  # the links to the files are gone
+
+
+def test_video_writer_writes_avi_under_any_name(tmp_path: Path) -> None:
+    frames = make_scene(n_frames=4, rng=0).frames
+    out = _latin1(tmp_path, b"r\xfe.avi")
+    with VideoWriter(out, 10.0) as writer:
+        for frame in frames:
+            writer.write(frame)
+    assert len(list(FrameSource(out))) == 4
+    assert sorted(os.listdir(tmp_path)) == [os.path.basename(out)]
+
+
+def test_opencv_name_is_the_path_itself_when_it_is_utf8(tmp_path: Path) -> None:
+    with opencv_name(tmp_path / "vidé.avi") as name:
+        assert name == str(tmp_path / "vidé.avi")
+
+
+def test_track_reads_and_writes_names_that_are_not_utf8(tmp_path: Path) -> None:
+    """Was: a segmentation fault (exit status -11, 139 in a shell) for each of these."""
+    scene = make_scene(n_frames=8, rng=0)
+    video = scene.write_video(tmp_path / "v.avi")
+    folder = scene.write_images(tmp_path / "imgs")
+    bad_video = _latin1(tmp_path, b"vid\xfe.avi")
+    bad_video.write_bytes(video.read_bytes())
+    bad_folder = _latin1(tmp_path, b"imgs\xe9")
+    folder.rename(bad_folder)
+    plot, render, out = (_latin1(tmp_path, n) for n in (b"p\xfe.png", b"r\xfe.avi", b"d\xfe.txt"))
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path), "PYTHONIOENCODING": "utf-8"}
+    runs = {
+        "video": [bad_video, "--out", "a.txt"],
+        "image folder": [bad_folder, "--out", "b.txt"],
+        "plot and render": [video, "--out", "c.txt", "--plot", plot, "--render", render],
+        "summary on a strict stdout": [video, "--out", out],
+    }
+    for case, args in runs.items():
+        argv = [sys.executable, "-m", "pftrack", "-q", "track", *map(str, args)]
+        run = subprocess.run(argv, cwd=tmp_path, env=env, capture_output=True, timeout=120,
+                             check=False)  # fmt: skip
+        assert run.returncode == 0, (case, run.returncode, run.stderr)
+    assert all(p.stat().st_size > 0 for p in (plot, render, out))
+    assert {"a.txt", "b.txt", "c.txt"} <= set(os.listdir(tmp_path))
+    assert not [n for n in os.listdir(tmp_path) if n.startswith(".")]  # no temporary file
+
+
+def test_a_stream_url_that_is_not_utf8_is_refused() -> None:
+    with pytest.raises(ValueError, match=r"stream URL rtsp://host/\\xfe is not valid UTF-8"):
+        FrameSource(os.fsdecode(b"rtsp://host/\xfe"))
