@@ -142,22 +142,23 @@ def flag(value: object, what: str) -> bool:
     return bool(value)
 
 
-def number(value: object, what: str) -> float:
-    """`value` as a finite float, refusing what is not a real number (text, bools, None).
+def number(value: object, what: str, *, finite: bool = True) -> float:
+    """`value` as a float, refusing what is not a real number (text, bools, None).
 
-    ``float("0.5")`` would otherwise take a string, and ``float(True)`` a flag.
+    ``float("0.5")`` would otherwise take a string, and ``float(True)`` a flag. With `finite`
+    False, NaN and infinities pass (for a caller whose range check names them).
 
     Raises
     ------
     TypeError
         Not an int or float (NumPy's too).
     ValueError
-        NaN or infinite.
+        NaN or infinite (with `finite`).
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(
         value, (int, float, np.integer, np.floating)
     ):
         raise TypeError(f"{what} must be a number, got {type(value).__name__} {value!r}")
-    if not np.isfinite(value):
+    if finite and not np.isfinite(value):
         raise ValueError(f"{what} is {value}, expected a finite number")
     return float(value)

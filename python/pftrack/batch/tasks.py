@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import flag
+from pftrack._check import flag, number
 from pftrack._typing import F64, PathLike
 from pftrack.batch.inputs import SequenceInput
 
@@ -136,13 +136,6 @@ def _check_int(value: object, what: str, lo: int, hi: int | None = None) -> None
         raise ValueError(f"{what} is {value!r}, expected {expected}")
 
 
-def _check_number(value: object, what: str) -> float:
-    """`value` as a float, refusing what is not a real number (a bool, a string, None)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TypeError(f"{what} must be a number, got {type(value).__name__} {value!r}")
-    return float(value)
-
-
 def _check_choice(value: object, what: str, choices: tuple[str, ...]) -> None:
     """Refuse `value` unless it is one of `choices`."""
     if not isinstance(value, str) or value not in choices:
@@ -214,7 +207,7 @@ class TrackOptions:
             raise ValueError(f"detections is {self.detections!r}, expected None or 'auto'")
         if self.det_scale is not None:
             lo, hi = DET_SCALE_RANGE
-            if not lo <= _check_number(self.det_scale, "det_scale") <= hi:  # also refuses nan
+            if not lo <= number(self.det_scale, "det_scale") <= hi:
                 raise ValueError(
                     f"det_scale is {self.det_scale}, expected a number in [{lo:g}, {hi:g}] (or "
                     "None: from seqinfo.ini)"
@@ -224,7 +217,7 @@ class TrackOptions:
         flag(self.link, "link")
         if self.render not in (None, ".mp4", ".avi"):
             raise ValueError(f"render is {self.render!r}, expected None, '.mp4' or '.avi'")
-        if not 0 < _check_number(self.iou, "iou") <= 1:  # evaluate_mot's range; refuses nan
+        if not 0 < number(self.iou, "iou") <= 1:  # evaluate_mot's range
             raise ValueError(f"iou is {self.iou}, expected a number in (0, 1]")
 
     def settings(self) -> dict[str, Any]:
@@ -402,8 +395,7 @@ class RecoverOptions:
         _check_int(self.seed, "seed", 0)
         flag(self.link, "link")
         if self.max_distance is not None:
-            d = _check_number(self.max_distance, "max_distance")
-            if not (math.isfinite(d) and d > 0):  # LinkConfig's rule
+            if not number(self.max_distance, "max_distance") > 0:  # LinkConfig's rule
                 raise ValueError(
                     f"max_distance is {self.max_distance}, expected a finite number > 0 (or "
                     "None: 50 px grown to the frame)"

@@ -273,15 +273,11 @@ class Tracker:
         prime: float | None = None,
         max_side: int | None = TrackerConfig.max_side,
     ) -> None:
-        if isinstance(frame_rate, bool) or not isinstance(
-            frame_rate, (int, float, np.integer, np.floating)
-        ):
-            raise TypeError(f"frame_rate must be a number, got {type(frame_rate).__name__}")
         if seed is not None and (
             isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0
         ):
             raise ValueError(f"seed is {seed!r}, expected None or an integer >= 0")
-        if not (np.isfinite(frame_rate) and 0 < frame_rate <= MAX_FRAME_RATE):
+        if not 0 < number(frame_rate, "frame_rate") <= MAX_FRAME_RATE:
             raise ValueError(
                 f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
             )

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import flag
+from pftrack._check import flag, number
 from pftrack._progress import progress
 from pftrack._typing import F64, PathLike, RngLike
 from pftrack.detection.bootstrap import bootstrap_frames
@@ -81,10 +81,8 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     UserWarning
         Boxes of zero width or height are left out (a box with no area cannot be tracked).
     """
-    if isinstance(scale, bool) or not isinstance(scale, (int, float, np.integer, np.floating)):
-        raise TypeError(f"detection scale must be a number, got {type(scale).__name__}")
     lo, hi = DET_SCALE_RANGE
-    if not (lo <= scale <= hi):
+    if not (lo <= number(scale, "detection scale", finite=False) <= hi):
         raise ValueError(f"detection scale is {scale}, expected a number in [{lo:g}, {hi:g}]")
     rows = read_mot(path, what="detection file")
     flat = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
