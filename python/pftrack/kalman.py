@@ -118,6 +118,11 @@ def cv_transition(dt: float = 1.0) -> F64:
         `dt` not finite.
     """
     _require("cv_transition", "dt", dt)
+    return _cv_transition(dt)
+
+
+def _cv_transition(dt: float) -> F64:
+    """:func:`cv_transition` without its check."""
     return np.array([[1.0, dt], [0.0, 1.0]])
 
 
@@ -166,7 +171,7 @@ def cv_transition_xy(dt: float = 1.0) -> F64:
         `dt` not finite.
     """
     _require("cv_transition_xy", "dt", dt)
-    f = cv_transition(dt)
+    f = _cv_transition(dt)
     return _xy_block([f, f])
 
 
