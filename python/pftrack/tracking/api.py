@@ -396,7 +396,6 @@ class Tracker:
         self._stabiliser = Stabiliser()
         self._reports: list[Track] = []
         self._clip_warned = False
-        self._negative_warned = False
         self._max_conf = -np.inf
         self._given = False  # some update() of the run had detections
         # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
@@ -524,10 +523,6 @@ class Tracker:
                     "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
                     stacklevel=2,
                 )
-            if len(xywh):
-                low = float(xywh[:, 4].min())
-                if low < 0.0 and low < self.config.lifecycle.min_score:
-                    self._warn_negative(low)
             confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
             if self._scale is not None:
                 xywh[:, :4] *= self._scale
@@ -558,18 +553,6 @@ class Tracker:
             else:
                 out[:, 7] = -1
         return out
-
-    def _warn_negative(self, low: float) -> None:
-        """Warn once that negative confidences (logits?) fall below ``min_conf``."""
-        if self._negative_warned:
-            return
-        self._negative_warned = True
-        cut = self.config.lifecycle.min_score
-        warnings.warn(
-            f"a detection confidence is {low:.3g}: confidences below min_conf {cut:.3g} are "
-            "ignored (logits? give probabilities in [0, 1], or set min_conf)",
-            stacklevel=3,
-        )
 
     @property
     def last_reports(self) -> list[Track]:

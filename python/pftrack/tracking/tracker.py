@@ -140,6 +140,7 @@ class MultiObjectTracker:
         self._given_config = self.config  # tracks of given detections (given_particles), too
         self.pixel_scale = 1.0
         self._scores_are_confidences = True
+        self._negative_warned = False  # scores below 0 and min_score were said
         self._primed_shape: tuple[int, ...] = ()  # of the frames given to prime()
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
         self._birth_level = np.inf
@@ -429,6 +430,16 @@ class MultiObjectTracker:
             & ~tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
         ).nonzero()[0]
         boxes, scores, labels = boxes[index], scores[index], labels[index]
+        if given is not None and len(given[1]) and not self._negative_warned:
+            low = float(given[1].min())
+            if low < 0.0 and low < cfg.lifecycle.min_score:  # said once a run
+                self._negative_warned = True
+                warnings.warn(
+                    f"a detection confidence is {low:.3g}: confidences below min_conf "
+                    f"{cfg.lifecycle.min_score:.3g} are ignored (logits? give probabilities in "
+                    "[0, 1], or set min_conf)",
+                    stacklevel=3,
+                )
         if given is not None and len(scores) and self._scores_are_confidences:
             # kept scores outside [0, 1] are a detector's own scale, not confidences: below 0
             # only with a min_score the caller set below 0; above 1 is said once
