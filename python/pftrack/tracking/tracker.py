@@ -555,9 +555,6 @@ class MultiObjectTracker:
         self, followed: list[tuple[int, int]], boxes: F64, cfg: TrackerConfig
     ) -> None:
         """Speed samples of the confirmed tracks that followed a detection; the new gain."""
-        if not followed:
-            self._gain = self.motion_gain()
-            return
         n = cfg.lifecycle.min_hits
         span = cfg.motion.speed_span
         dis = [di for _, di in followed]
