@@ -236,17 +236,14 @@ class PaperDetector:
             )
         step = sample_step(frame.shape, GAIN_SAMPLE_STEP)
         if self.config.gain_band > 0 and is_dark(frame, step):
-            # no light to compare or learn (light.is_dark): no foreground, the model as it was
-            binned = hsv_bins(frame, None, self.config.hsv) if bins else None
-            return binned, np.zeros(frame.shape[:2], np.uint8)
+            return self._unlit(frame, bins)  # no light to compare or learn (light.is_dark)
         if not self._model.initialized:
             if self._grey is None:
                 self._decide_grey([frame])
         elif self.config.gain_band > 0:
             gain = self._model.global_gain(frame, step)
             if gain <= 0.0:  # over half the sampled pixels black (not dark as a whole)
-                binned = hsv_bins(frame, None, self.config.hsv) if bins else None
-                return binned, np.zeros(frame.shape[:2], np.uint8)
+                return self._unlit(frame, bins)
             if abs(gain - 1.0) > self.config.gain_band:
                 self._model.scale(gain)
                 if self.config.gain_thresholds and self._model.frame_count > 0:
@@ -255,6 +252,13 @@ class PaperDetector:
                     # first gain corrects the median's brightness, not a change of light)
                     self._model.set_threshold_scale(self._model.threshold_scale * gain)
         return self._model.apply(frame, bins=bins)
+
+    def _unlit(
+        self, frame: NDArray[np.uint8], bins: bool
+    ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
+        """:meth:`_apply`'s result for a frame without light: no foreground, nothing learnt."""
+        binned = hsv_bins(frame, None, self.config.hsv) if bins else None
+        return binned, np.zeros(frame.shape[:2], np.uint8)
 
     @property
     def model(self) -> _core.BackgroundModel:
