@@ -212,3 +212,63 @@ def test_sis_step_10x200(benchmark: BenchmarkFixture, frame_480: NDArray[np.uint
             f.step(image)
 
     benchmark(frame_step)
+
+
+def _large_box_filters(
+    image: BinnedImage, min_samples: int, black: bool
+) -> list[tuple[F64, F64, F64]]:
+    """15 objects x 200 particles with 100x250 base boxes on a 1920x1080 frame, as the arrays
+    sis_step_batch steps; on a black frame after 25 steps, once the particles, without colour
+    evidence, have spread and grown (the state of a track on a frame that tells nothing)."""
+    rng = np.random.default_rng(4)
+    out = []
+    for k in range(15):
+        c = (120 + 120 * k, 540 + rng.normal(0, 40))
+        p = np.empty((200, 6))
+        p[:, :2] = c + rng.normal(0, 4, (200, 2))
+        p[:, 2] = 1.0
+        p[:, 3:] = p[:, :3]
+        out.append((p, np.full(200, 1 / 200), np.array([[*c, 1.0], [*c, 1.0]])))
+    if black:
+        for s in range(25):
+            _sis_batch(image, out, min_samples, s)
+    return out
+
+
+def _sis_batch(
+    image: BinnedImage, filters: list[tuple[F64, F64, F64]], min_samples: int, step: int
+) -> None:
+    k = len(filters)
+    ref = np.full(image.n_bins, 1.0 / image.n_bins)
+    _core.sis_step_batch(
+        [f[0] for f in filters], [f[1] for f in filters], [f[2] for f in filters], image,
+        [ref] * k, np.full(k, 100.0), np.full(k, 250.0), np.full(3, 2.0), np.full(3, -1.0),
+        np.array([6.0, 6.0, 0.03]), 0.2, 3.0, False, 20.0, "uniform", True, list(range(k)),
+        [step] * k, float(min_samples),
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("min_samples", [0, 2048], ids=["every pixel", "lattice 2048"])
+@pytest.mark.parametrize("scene", ["PETS09 upscaled", "black"])
+def test_sis_batch_1080p_large_boxes(
+    benchmark: BenchmarkFixture, frame_480: NDArray[np.uint8], scene: str, min_samples: int
+) -> None:
+    """FilterConfig.min_samples: one step of 15 objects x 200 particles, 100x250 boxes, at
+    1920x1080 (the PETS09 frame upscaled, or black), counting every pixel or on the lattice."""
+    import cv2
+
+    if scene == "black":
+        frame = np.zeros((1080, 1920, 3), np.uint8)
+    else:
+        frame = cv2.resize(frame_480, (1920, 1080), interpolation=cv2.INTER_LINEAR)
+    image = hsv_bins(frame)
+    start = _large_box_filters(image, min_samples, scene == "black")
+    benchmark.group = f"sis_step_batch 15x200, 100x250 boxes, 1920x1080 {scene}"
+
+    def setup() -> tuple[tuple[list[tuple[F64, F64, F64]]], dict[str, object]]:
+        return ([tuple(a.copy() for a in f) for f in start],), {}  # type: ignore[misc]
+
+    benchmark.pedantic(
+        lambda filters: _sis_batch(image, filters, min_samples, 25),
+        setup=setup, rounds=20, iterations=1,
+    )  # fmt: skip

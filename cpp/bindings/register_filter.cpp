@@ -108,9 +108,11 @@ void register_filter(py::module_& m) {
            Eigen::Ref<const Eigen::VectorXd> ref, double w0, double h0,
            const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
            double s_min, double s_max, bool use_means, double lam, const std::string& kernel,
-           bool resample, std::uint64_t seed, std::uint64_t step) {
-            const SisParams prm = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means,
-                                                         lam, kernel, resample, "sis_step");
+           bool resample, std::uint64_t seed, std::uint64_t step, double min_samples) {
+            SisParams prm = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means,
+                                                   lam, kernel, resample, "sis_step");
+            prm.min_samples = min_samples;
+            prm.validate("sis_step");
             SisResult r;
             {
                 py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
@@ -122,9 +124,11 @@ void register_filter(py::module_& m) {
         py::arg("means").noconvert(), py::arg("image"), py::arg("ref"), py::arg("w0"),
         py::arg("h0"), py::arg("a"), py::arg("b"), py::arg("sigma"), py::arg("s_min"),
         py::arg("s_max"), py::arg("use_means"), py::arg("lam"), py::arg("kernel"),
-        py::arg("resample"), py::arg("seed"), py::arg("step"),
+        py::arg("resample"), py::arg("seed"), py::arg("step"), py::arg("min_samples") = 0.0,
         "Resample, propagate, histogram, weigh, estimate; particles (N, 6), weights (N,), "
-        "means (2, 3) updated in place.");
+        "means (2, 3) updated in place. min_samples > 0 counts boxes of at least 4 min_samples "
+        "pixels on a lattice (every k-th pixel, k = floor(sqrt(area / min_samples)), the area of "
+        "the previous mean state's box).");
 
     m.def(
         "sis_step_batch",
@@ -134,7 +138,7 @@ void register_filter(py::module_& m) {
            const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
            double s_min, double s_max, bool use_means, double lam, const std::string& kernel,
            bool resample, const std::vector<std::uint64_t>& seeds,
-           const std::vector<std::uint64_t>& steps) {
+           const std::vector<std::uint64_t>& steps, double min_samples) {
             const char* fn = "sis_step_batch";
             const auto k = static_cast<py::ssize_t>(particles.size());
             require(static_cast<py::ssize_t>(weights.size()) == k &&
@@ -163,6 +167,7 @@ void register_filter(py::module_& m) {
                 keep.push_back(r);
                 prms.push_back(bind::make_step_params(w0(i), h0(i), a, b, sigma, s_min, s_max,
                                                       use_means, lam, kernel, resample, fn));
+                prms.back().min_samples = min_samples;
                 prms.back().validate(fn);
             }
             using MatMap = Eigen::Map<RowMatrixXd>;
@@ -196,7 +201,7 @@ void register_filter(py::module_& m) {
         py::arg("refs"), py::arg("w0"), py::arg("h0"), py::arg("a"), py::arg("b"),
         py::arg("sigma"), py::arg("s_min"), py::arg("s_max"), py::arg("use_means"),
         py::arg("lam"), py::arg("kernel"), py::arg("resample"), py::arg("seeds"),
-        py::arg("steps"),
+        py::arg("steps"), py::arg("min_samples") = 0.0,
         "sis_step for K objects on one image in one call (the GIL released): lists of K "
         "particles (N_k, 6), weights (N_k,), means (2, 3) updated in place, K refs; w0, h0, seeds, "
         "steps (K,). Returns (K, 11): mean (3), map (3), map_index, ess, rho_max, rho_mean, "

@@ -169,21 +169,26 @@ void register_histogram(py::module_& m) {
         "box_weights",
         [](const BinnedImage& image, Eigen::Ref<const RowMatrixXd> boxes,
            Eigen::Ref<const Eigen::VectorXd> ref, double lam, const std::string& kernel,
-           const std::string& method) {
+           const std::string& method, Index step) {
             const char* fn = "box_weights";
             check_boxes(boxes, fn, "boxes");
             check_lambda(lam, fn);
             const Kernel k = parse_kernel(kernel, fn);
             const BoxPath path = parse_method(method, fn);
+            require(step >= 1 && step <= kMaxLatticeStep, fn, "step", step, "in [1, 64]");
             py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
             require(boxes.rows() > 0, fn, "boxes rows", boxes.rows(), ">= 1");
             const Eigen::VectorXd sq = sqrt_reference(ref, image.n_bins, fn);
-            return weights_from_rho(box_coefficients(image.lazy_view(), boxes, sq, k, path), lam, fn);
+            Eigen::VectorXd rho(boxes.rows()), counted(boxes.rows());
+            box_coefficients(image.lazy_view(), boxes, sq.data(), k, path, rho.data(),
+                             counted.data(), step);
+            return weights_from_rho(rho, lam, fn);
         },
         py::arg("image"), py::arg("boxes"), py::arg("ref"), py::arg("lam") = 20.0,
-        py::arg("kernel") = "uniform", py::arg("method") = "auto",
+        py::arg("kernel") = "uniform", py::arg("method") = "auto", py::arg("step") = 1,
         "Weights (K,) ~ exp(-lam D^2) of boxes (K, 4) against ref (B,): box_histograms + "
         "bhattacharyya_weights fused, no (K, B) matrix. method: 'auto', 'direct' or 'integral' "
         "(uniform-kernel counts from integral histograms of groups of overlapping boxes; same "
-        "result).");
+        "result). step > 1: only the pixels whose column and row are multiples of step count "
+        "(each box directly; method is then ignored).");
 }

@@ -214,7 +214,8 @@ def box_histograms(
 
 # boxes (K, 4), ref (B,) -> (K,) weights ~ exp(-lam D^2), summing to 1 (fused histograms);
 # method "auto" | "direct" | "integral" (uniform-kernel counts from integral histograms of
-# groups of overlapping boxes; the same weights on every path)
+# groups of overlapping boxes; the same weights on every path); step > 1: only the pixels whose
+# column and row are multiples of step are counted
 def box_weights(
     image: BinnedImage,
     boxes: _F64,
@@ -222,6 +223,7 @@ def box_weights(
     lam: float = 20.0,
     kernel: str = "uniform",
     method: str = "auto",
+    step: int = 1,
 ) -> _F64: ...
 
 # hists (K, B) float64, ref (B,) -> (K,)
@@ -317,6 +319,7 @@ def sis_step(
     resample: bool,
     seed: int,
     step: int,
+    min_samples: float = 0.0,
 ) -> dict[str, Any]: ...
 
 # sis_step for K objects on one image, one call (GIL released): lists of K particles (N_k, 6),
@@ -341,6 +344,7 @@ def sis_step_batch(
     resample: bool,
     seeds: list[int],
     steps: list[int],
+    min_samples: float = 0.0,
 ) -> _F64: ...
 def mh_step(
     particles: _F64,

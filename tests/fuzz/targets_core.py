@@ -99,6 +99,7 @@ def _model_kwargs() -> dict[str, st.SearchStrategy[Any]]:
         "lam": maybe(fl(0, 50)),
         "kernel": maybe(st.sampled_from(["uniform", "epanechnikov", "gaussian"])),
         "resample": st.booleans(),
+        "min_samples": maybe(fl(0, 50)),
     }
 
 
@@ -424,6 +425,7 @@ TARGETS: list[Target] = [
                 maybe(fl(0, 100)),
                 maybe(st.sampled_from(["uniform", "epanechnikov"])),
                 maybe(st.sampled_from(["auto", "direct", "integral"])),
+                maybe(ints(1, 8)),
             )
         ),
     ),  # fmt: skip

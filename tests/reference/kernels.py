@@ -38,18 +38,31 @@ def box_range(cx, cy, w, h, rows, cols):
     return x0, x1, y0, y1
 
 
-def box_histograms(bins, n_bins, boxes, kernel="uniform"):
+def lattice_step(w, h, min_samples):
+    """floor(sqrt(w h / min_samples)) from 4 min_samples pixels on, else 1; at most 64."""
+    area = w * h
+    if min_samples <= 0 or not area >= 4 * min_samples or not np.isfinite(area):
+        return 1
+    return min(64, int(np.floor(np.sqrt(area / min_samples))))
+
+
+def box_histograms(bins, n_bins, boxes, kernel="uniform", step=1):
+    """Histograms of the boxes' pixels; with `step` > 1 of the pixels whose column and row are
+    multiples of `step` only."""
     rows, cols = bins.shape
     out = np.zeros((len(boxes), n_bins))
     for i, (cx, cy, w, h) in enumerate(boxes):
         x0, x1, y0, y1 = box_range(cx, cy, w, h, rows, cols)
         if x0 >= x1 or y0 >= y1:
             continue
-        patch = bins[y0:y1, x0:x1].astype(np.int64)
+        x0, y0 = -(-x0 // step) * step, -(-y0 // step) * step  # the first lattice column, row
+        patch = bins[y0:y1:step, x0:x1:step].astype(np.int64)
+        if patch.size == 0:
+            continue
         if kernel == "uniform":
             wts = np.ones(patch.shape)
         else:
-            ys, xs = np.mgrid[y0:y1, x0:x1].astype(np.float64)
+            ys, xs = np.mgrid[y0:y1:step, x0:x1:step].astype(np.float64)
             dx = (xs - cx) * (2.0 / w if w > 0 else 0.0)
             dy = (ys - cy) * (2.0 / h if h > 0 else 0.0)
             wts = np.maximum(0.0, 1.0 - dy * dy - dx * dx)
@@ -145,14 +158,16 @@ def sis_step(
     kernel,
     u0,
     normals,
+    min_samples=0,
 ):
     """One SIS step given the draws (u0 for resampling, (N, 3) normals)."""
     idx = systematic_resample(weights, u0)
     p = particles[idx]
     n = len(p)
+    step = lattice_step(means[0][2] * w0, means[0][2] * h0, min_samples)
     p = propagate(p, normals, a, b, sigma, s_min, s_max, use_means, means[0], means[1])
     boxes = np.column_stack([p[:, 0], p[:, 1], p[:, 2] * w0, p[:, 2] * h0])
-    hists = box_histograms(bins, n_bins, boxes, kernel)
+    hists = box_histograms(bins, n_bins, boxes, kernel, step)
     rho = bhattacharyya_coefficient(hists, ref)
     logw = np.log(np.full(n, 1.0 / n)) - lam * (1.0 - np.clip(rho, 0, 1))
     w = np.exp(logw - logw.max())

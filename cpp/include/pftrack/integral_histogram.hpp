@@ -343,16 +343,17 @@ inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Deri
 
 /// Coefficients rho (K,) and counted pixels (K,) of K boxes (rows (cx, cy, w, h)) against
 /// `sqrt_ref`. Uniform kernel: for_each_box_count (bit-identical to counting each box);
-/// Epanechnikov: each box directly.
+/// Epanechnikov: each box directly. With `step` > 1 each box is counted directly on the lattice
+/// of that step (HistogramScratch::coefficient): a cost per box of its points, not its pixels.
 template <class Derived>
 inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
                              const double* sqrt_ref, Kernel kernel, BoxPath path, double* rho,
-                             double* counted) {
+                             double* counted, Index step = 1) {
     HistogramScratch scratch(img.n_bins);
-    if (kernel != Kernel::kUniform) {
+    if (kernel != Kernel::kUniform || step > 1) {
         for (Index i = 0; i < boxes.rows(); ++i)
             rho[i] = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3),
-                                         kernel, sqrt_ref, counted[i]);
+                                         kernel, sqrt_ref, counted[i], step);
         return;
     }
     for_each_box_count(

@@ -55,12 +55,17 @@ struct SisParams {
     double w0 = 1.0;  // base box size: box = (cx, cy, s*w0, s*h0)
     double h0 = 1.0;
     bool resample = true;
+    // Count each box on a lattice that keeps at least this many points of the box of the
+    // previous mean state (lattice_step); 0: every pixel.
+    double min_samples = 0.0;
 
     void validate(const char* fn) const {
         model.validate(fn);
         check_lambda(lambda, fn);
         require(std::isfinite(w0) && std::isfinite(h0) && w0 > 0.0 && h0 > 0.0, fn,
                 "base box size (w0, h0) must be finite and > 0");
+        require(std::isfinite(min_samples) && min_samples >= 0.0, fn,
+                "min_samples must be finite and >= 0");
     }
 };
 
@@ -100,8 +105,12 @@ inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::V
         const double s = particles(i, 2);
         boxes.row(i) << particles(i, 0), particles(i, 1), s * prm.w0, s * prm.h0;
     }
+    //    Large boxes are counted on a lattice, one step for all particles (from the box of the
+    //    previous mean state): the cost per particle stays near min_samples points.
+    const Index lattice = lattice_step(m1(2) * prm.w0, m1(2) * prm.h0, prm.min_samples);
     Eigen::VectorXd rho(n), counted(n), logw(n);
-    box_coefficients(img, boxes, sqref.data(), prm.kernel, BoxPath::kAuto, rho.data(), counted.data());
+    box_coefficients(img, boxes, sqref.data(), prm.kernel, BoxPath::kAuto, rho.data(),
+                     counted.data(), lattice);
     for (Index i = 0; i < n; ++i) {
         const double d = bhattacharyya_distance_from_rho(rho(i));
         logw(i) = std::log(weights(i)) - prm.lambda * d * d;
