@@ -90,21 +90,17 @@ public:
 
     /// Writes the normalised histogram of one box to `out` (n_bins values).
     /// Returns the total counted weight (0 for an empty box).
-    /// With `step` > 1 only the pixels of the lattice of that step are counted (lattice_points),
-    /// and the returned weight is scaled by step^2 (an estimate of the full box's).
     double compute(const BinImage& img, double cx, double cy, double w, double h, Kernel kernel,
-                   double* out, Index step = 1) {
+                   double* out) {
         const PixelRange r = box_pixels(cx, cy, w, h, img.rows, img.cols);
         std::fill(out, out + n_bins_, 0.0);
         if (r.empty()) return 0.0;
-        const double area = static_cast<double>(step * step);
-        return area * (kernel == Kernel::kUniform ? uniform(img, r, step, out)
-                                                  : epanechnikov(img, r, step, cx, cy, w, h, out));
+        return kernel == Kernel::kUniform ? uniform(img, r, out) : epanechnikov(img, r, cx, cy, w, h, out);
     }
 
 private:
-    double uniform(const BinImage& img, const PixelRange& r, Index step, double* out) {
-        const std::int64_t total = count(img, r, step);
+    double uniform(const BinImage& img, const PixelRange& r, double* out) {
+        const std::int64_t total = count(img, r);
         if (total == 0) return 0.0;
         const double inv = 1.0 / static_cast<double>(total);
         const std::int32_t* c = counts_.data() + 1;
@@ -113,28 +109,45 @@ private:
     }
 
 public:
+    /// Counts the box's pixels per bin (uniform kernel) into counts(); returns the total counted.
+    std::int64_t count_box(const BinImage& img, double cx, double cy, double w, double h) {
+        const PixelRange r = box_pixels(cx, cy, w, h, img.rows, img.cols);
+        if (r.empty()) return 0;
+        return count(img, r);
+    }
+    /// Per-bin counts of the last count_box (n_bins values).
+    const std::int32_t* counts() const { return counts_.data() + 1; }
 
     /// Bhattacharyya coefficient of one box's normalised histogram with the reference whose
     /// square roots are `sqrt_ref`, without writing the histogram out. For the uniform kernel
     /// straight from the integer counts: rho = sum_k sqrt(c_k) sqrt(q_k) / sqrt(n). `counted`
     /// gets the counted weight (pixels, for the uniform kernel); an empty box has rho = 0.
-    /// With `step` > 1 the box's lattice points are counted (compute()).
     double coefficient(const BinImage& img, double cx, double cy, double w, double h, Kernel kernel,
-                       const double* sqrt_ref, double& counted, Index step = 1) {
-        if (kernel == Kernel::kUniform)
-            return coefficient_of_range(img, box_pixels(cx, cy, w, h, img.rows, img.cols),
-                                        sqrt_ref, counted, step);
-        counted = compute(img, cx, cy, w, h, kernel, hist_.data(), step);
+                       const double* sqrt_ref, double& counted) {
+        if (kernel == Kernel::kUniform) {
+            const std::int64_t total = count_box(img, cx, cy, w, h);
+            counted = static_cast<double>(total);
+            return coefficient_of_counts(counts(), total, sqrt_ref);
+        }
+        counted = compute(img, cx, cy, w, h, kernel, hist_.data());
         return bhattacharyya_coefficient_row(hist_.data(), sqrt_ref, n_bins_);
     }
 
-    /// Uniform-kernel coefficient of the pixels of `r` (already clipped, as box_pixels gives),
-    /// or of its lattice points when `step` > 1 (`counted`: the points counted times step^2).
+    /// Epanechnikov-kernel coefficient of the pixels of `r` (already clipped) for the box
+    /// (cx, cy, w, h) in the same pixels; `counted` gets the counted weight.
+    double epanechnikov_coefficient(const BinImage& img, const PixelRange& r, double cx, double cy,
+                                    double w, double h, const double* sqrt_ref, double& counted) {
+        std::fill(hist_.begin(), hist_.end(), 0.0);
+        counted = r.empty() ? 0.0 : epanechnikov(img, r, cx, cy, w, h, hist_.data());
+        return bhattacharyya_coefficient_row(hist_.data(), sqrt_ref, n_bins_);
+    }
+
+    /// Uniform-kernel coefficient of the pixels of `r` (already clipped, as box_pixels gives).
     double coefficient_of_range(const BinImage& img, const PixelRange& r, const double* sqrt_ref,
-                                double& counted, Index step = 1) {
-        const std::int64_t total = r.empty() ? 0 : count(img, r, step);
-        counted = static_cast<double>(total * step * step);
-        return coefficient_of_counts(counts_.data() + 1, total, sqrt_ref);
+                                double& counted) {
+        const std::int64_t total = r.empty() ? 0 : count(img, r);
+        counted = static_cast<double>(total);
+        return coefficient_of_counts(counts(), total, sqrt_ref);
     }
 
     /// rho = sum_k sqrt(c_k) sqrt(q_k) / sqrt(total) of integer counts c (n_bins values summing
@@ -174,42 +187,28 @@ private:
         return sqrt_counts_.data();
     }
 
-    /// Counts the range's pixels (its lattice points when `step` > 1) per bin into counts_
-    /// (slot 0: background); returns the total counted.
-    std::int64_t count(const BinImage& img, const PixelRange& r, Index step = 1) {
+    /// Counts the range's pixels per bin into counts_ (slot 0: background); returns the total.
+    std::int64_t count(const BinImage& img, const PixelRange& r) {
         img.ensure(r.x0, r.x1, r.y0, r.y1);  // a lazy image bins the range first
-        if (step > 1) {
-            const PixelRange p = lattice_points(r, step);
-            if (p.empty()) {
-                std::fill(counts_.begin(), counts_.end(), 0);
-                return 0;
-            }
-            const Index points = (p.x1 - p.x0) * (p.y1 - p.y0);
-            return points < 65536 ? count_copies<std::uint16_t, true>(img, p, step, counts16_.data(), stride16_)
-                                  : count_copies<std::int32_t, true>(img, p, step, counts_.data(), stride_);
-        }
         const Index area = (r.x1 - r.x0) * (r.y1 - r.y0);
-        return area < 65536 ? count_copies<std::uint16_t, false>(img, r, 1, counts16_.data(), stride16_)
-                            : count_copies<std::int32_t, false>(img, r, 1, counts_.data(), stride_);
+        return area < 65536 ? count_copies(img, r, counts16_.data(), stride16_)
+                            : count_copies(img, r, counts_.data(), stride_);
     }
 
     /// kCopies interleaved copies of type T (uint16 when no count can reach 65536: half the
-    /// bytes to clear and add up per box), summed into counts_. With kLattice, `r` is in
-    /// lattice units and the pixel (x step, y step) is counted for each of its points.
-    template <class T, bool kLattice>
-    std::int64_t count_copies(const BinImage& img, const PixelRange& r, Index step, T* base,
-                              int stride) {
+    /// bytes to clear and add up per box), summed into counts_.
+    template <class T>
+    std::int64_t count_copies(const BinImage& img, const PixelRange& r, T* base, int stride) {
         std::fill(base, base + kCopies * static_cast<size_t>(stride), T(0));
         T* c[kCopies];
         for (int q = 0; q < kCopies; ++q) c[q] = base + 1 + q * stride;  // +1: bin -1 in slot 0
         const Index w = r.x1 - r.x0;
-        const Index dx = kLattice ? step : 1;  // a constant 1 without the lattice
         for (Index y = r.y0; y < r.y1; ++y) {
-            const std::int16_t* b = img.row(y * dx) + r.x0 * dx;
+            const std::int16_t* b = img.row(y) + r.x0;
             Index x = 0;
             for (; x + kCopies <= w; x += kCopies)
-                for (int q = 0; q < kCopies; ++q) ++c[q][b[(x + q) * dx]];
-            for (int q = 0; x < w; ++x, ++q) ++c[q][b[x * dx]];
+                for (int q = 0; q < kCopies; ++q) ++c[q][b[x + q]];
+            for (int q = 0; x < w; ++x, ++q) ++c[q][b[x]];
         }
         std::int32_t* out = counts_.data() + 1;
         const int nb = n_bins_;  // a local: stores through `out` (int32) could alias n_bins_
@@ -223,35 +222,31 @@ private:
         return (r.x1 - r.x0) * (r.y1 - r.y0) - background;
     }
 
-    // Epanechnikov profile k(r^2) = max(0, 1 - r^2), r^2 = ((x-cx)/(w/2))^2 + ((y-cy)/(h/2))^2,
-    // over the pixels of `r` (its lattice points when `step` > 1).
-    double epanechnikov(const BinImage& img, const PixelRange& r, Index step, double cx, double cy,
-                        double w, double h, double* out) {
+    // Epanechnikov profile k(r^2) = max(0, 1 - r^2), r^2 = ((x-cx)/(w/2))^2 + ((y-cy)/(h/2))^2.
+    double epanechnikov(const BinImage& img, const PixelRange& r, double cx, double cy, double w,
+                        double h, double* out) {
         img.ensure(r.x0, r.x1, r.y0, r.y1);  // a lazy image bins the range first
         std::fill(weights_.begin(), weights_.end(), 0.0);
         double* a0 = weights_.data() + 1;
         double* a1 = a0 + stride_;
         const double ix = w > 0.0 ? 2.0 / w : 0.0;
         const double iy = h > 0.0 ? 2.0 / h : 0.0;
-        const PixelRange p = lattice_points(r, step);  // r itself when step is 1
-        const Index n = std::max<Index>(0, p.x1 - p.x0);
-        rowk_.resize(static_cast<size_t>(n));
-        for (Index i = 0; i < n; ++i) {
-            const double dx = (static_cast<double>((p.x0 + i) * step) - cx) * ix;
-            rowk_[static_cast<size_t>(i)] = dx * dx;
+        rowk_.resize(static_cast<size_t>(r.x1 - r.x0));
+        for (Index x = r.x0; x < r.x1; ++x) {
+            const double dx = (static_cast<double>(x) - cx) * ix;
+            rowk_[static_cast<size_t>(x - r.x0)] = dx * dx;
         }
-        for (Index j = p.y0; j < p.y1; ++j) {
-            const Index y = j * step;
+        for (Index y = r.y0; y < r.y1; ++y) {
             const double dy = (static_cast<double>(y) - cy) * iy;
             const double base = 1.0 - dy * dy;
             if (base <= 0.0) continue;
-            const std::int16_t* b = img.row(y) + p.x0 * step;
-            Index i = 0;
-            for (; i + 2 <= n; i += 2) {
-                a0[b[i * step]] += std::max(0.0, base - rowk_[static_cast<size_t>(i)]);
-                a1[b[(i + 1) * step]] += std::max(0.0, base - rowk_[static_cast<size_t>(i + 1)]);
+            const std::int16_t* b = img.row(y);
+            Index x = r.x0;
+            for (; x + 2 <= r.x1; x += 2) {
+                a0[b[x]] += std::max(0.0, base - rowk_[static_cast<size_t>(x - r.x0)]);
+                a1[b[x + 1]] += std::max(0.0, base - rowk_[static_cast<size_t>(x + 1 - r.x0)]);
             }
-            for (; i < n; ++i) a0[b[i * step]] += std::max(0.0, base - rowk_[static_cast<size_t>(i)]);
+            for (; x < r.x1; ++x) a0[b[x]] += std::max(0.0, base - rowk_[static_cast<size_t>(x - r.x0)]);
         }
         double total = 0.0;
         for (int k = 0; k < n_bins_; ++k) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -232,13 +233,13 @@ struct BoxCostModel {
 /// Calls `from_counts(i, c, total)` with box i's counts c[0 .. n_bins) (c[-1]: background) and
 /// counted pixels for boxes counted from a table, and `direct(i, r)` with the clipped pixel
 /// range of every other box (empty ones included). Scratch is local to the call.
-template <class Derived, class FromCounts, class Direct>
-inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
-                               BoxPath path, FromCounts&& from_counts, Direct&& direct) {
-    const Index n = boxes.rows();
+/// for_each_box_count of boxes given as clipped pixel ranges of `img` (as box_pixels gives).
+template <class FromCounts, class Direct>
+inline void for_each_range_count(const BinImage& img, const std::vector<PixelRange>& ranges,
+                                 BoxPath path, FromCounts&& from_counts, Direct&& direct) {
+    const Index n = static_cast<Index>(ranges.size());
     if (path == BoxPath::kDirect) {
-        for (Index i = 0; i < n; ++i)
-            direct(i, box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols));
+        for (Index i = 0; i < n; ++i) direct(i, ranges[static_cast<size_t>(i)]);
         return;
     }
     // Table size cap (uint16 entries: 8 MB); regions of more pixels than the cap allows at the
@@ -255,11 +256,9 @@ inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Deri
     };
     std::vector<Group> groups;
     std::vector<size_t> open;  // indices into groups, most recently joined first
-    std::vector<PixelRange> ranges(static_cast<size_t>(n));
     std::vector<std::int32_t> group_of(static_cast<size_t>(n), -1);
     for (Index i = 0; i < n; ++i) {
-        const PixelRange r = box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols);
-        ranges[static_cast<size_t>(i)] = r;
+        const PixelRange r = ranges[static_cast<size_t>(i)];
         const Index a = pixel_count(r);
         // Direct: empty boxes, boxes whose uint16 counts could wrap, and (unless forced) boxes so
         // small that a table lookup saves less than the grouping costs.
@@ -341,19 +340,114 @@ inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Deri
     }
 }
 
+/// Uniform-kernel counts of K boxes (rows (cx, cy, w, h)): for_each_range_count of their
+/// clipped pixel ranges.
+template <class Derived, class FromCounts, class Direct>
+inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
+                               BoxPath path, FromCounts&& from_counts, Direct&& direct) {
+    std::vector<PixelRange> ranges(static_cast<size_t>(boxes.rows()));
+    for (Index i = 0; i < boxes.rows(); ++i)
+        ranges[static_cast<size_t>(i)] =
+            box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols);
+    for_each_range_count(img, ranges, path, std::forward<FromCounts>(from_counts),
+                         std::forward<Direct>(direct));
+}
+
+/// The points of the lattice of step `step` (the pixels whose column and row are multiples of
+/// it) under a set of boxes, gathered into an image of their own: point (i, j) of the image is
+/// the pixel ((x0 + i) step, (y0 + j) step) of the frame, (x0, y0) the first point of the
+/// boxes' union. Boxes become ranges of points (lattice_points, shifted), so every counting
+/// path (direct, or an integral histogram of a group) works on the lattice unchanged.
+class LatticeImage {
+public:
+    /// Gathers the points under the rows of `boxes` (cx, cy, w, h) of `img`; `ranges` gets each
+    /// box's points in this image's pixels (empty for a box without a point).
+    template <class Derived>
+    LatticeImage(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes, Index step,
+                 std::vector<PixelRange>& ranges)
+        : step_(step) {
+        ranges.resize(static_cast<size_t>(boxes.rows()));
+        PixelRange u{0, 0, 0, 0};
+        bool any = false;
+        for (Index i = 0; i < boxes.rows(); ++i) {
+            const PixelRange p = lattice_points(
+                box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols), step);
+            ranges[static_cast<size_t>(i)] = p;
+            if (p.empty()) continue;
+            u = any ? bounding_union(u, p) : p;
+            any = true;
+        }
+        x0_ = u.x0;
+        y0_ = u.y0;
+        const Index cols = u.x1 - u.x0, rows = u.y1 - u.y0;
+        view_ = BinImage{nullptr, rows, cols, cols, img.n_bins, nullptr};
+        if (!any) return;
+        img.ensure(u.x0 * step, (u.x1 - 1) * step + 1, u.y0 * step, (u.y1 - 1) * step + 1);
+        bins_.resize(static_cast<size_t>(rows * cols));
+        for (Index j = 0; j < rows; ++j) {
+            const std::int16_t* src = img.row((u.y0 + j) * step) + u.x0 * step;
+            std::int16_t* dst = bins_.data() + j * cols;
+            for (Index i = 0; i < cols; ++i) dst[i] = src[i * step];
+        }
+        view_.data = bins_.data();
+        for (PixelRange& p : ranges)
+            p = p.empty() ? PixelRange{0, 0, 0, 0}
+                          : PixelRange{p.x0 - u.x0, p.x1 - u.x0, p.y0 - u.y0, p.y1 - u.y0};
+    }
+
+    const BinImage& view() const { return view_; }
+    Index step() const { return step_; }
+    /// A frame coordinate in this image's pixels (the point of lattice column/row `v` / step).
+    double x(double frame_x) const { return frame_x / static_cast<double>(step_) - static_cast<double>(x0_); }
+    double y(double frame_y) const { return frame_y / static_cast<double>(step_) - static_cast<double>(y0_); }
+
+private:
+    Index step_;
+    Index x0_ = 0, y0_ = 0;
+    std::vector<std::int16_t> bins_;
+    BinImage view_;
+};
+
 /// Coefficients rho (K,) and counted pixels (K,) of K boxes (rows (cx, cy, w, h)) against
 /// `sqrt_ref`. Uniform kernel: for_each_box_count (bit-identical to counting each box);
-/// Epanechnikov: each box directly. With `step` > 1 each box is counted directly on the lattice
-/// of that step (HistogramScratch::coefficient): a cost per box of its points, not its pixels.
+/// Epanechnikov: each box directly. With `step` > 1 only the points of the lattice of that step
+/// are counted (LatticeImage; `counted` is then the points counted times step^2).
 template <class Derived>
 inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
                              const double* sqrt_ref, Kernel kernel, BoxPath path, double* rho,
                              double* counted, Index step = 1) {
     HistogramScratch scratch(img.n_bins);
-    if (kernel != Kernel::kUniform || step > 1) {
+    if (step > 1) {
+        std::vector<PixelRange> ranges;
+        const LatticeImage lattice(img, boxes, step, ranges);
+        const BinImage& points = lattice.view();
+        const double area = static_cast<double>(step * step);
+        if (kernel != Kernel::kUniform) {
+            for (Index i = 0; i < boxes.rows(); ++i) {
+                rho[i] = scratch.epanechnikov_coefficient(
+                    points, ranges[static_cast<size_t>(i)], lattice.x(boxes(i, 0)),
+                    lattice.y(boxes(i, 1)), boxes(i, 2) / static_cast<double>(step),
+                    boxes(i, 3) / static_cast<double>(step), sqrt_ref, counted[i]);
+                counted[i] *= area;
+            }
+            return;
+        }
+        for_each_range_count(
+            points, ranges, path,
+            [&](Index i, const std::int32_t* c, std::int64_t total) {
+                counted[i] = static_cast<double>(total) * area;
+                rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref);
+            },
+            [&](Index i, const PixelRange& r) {
+                rho[i] = scratch.coefficient_of_range(points, r, sqrt_ref, counted[i]);
+                counted[i] *= area;
+            });
+        return;
+    }
+    if (kernel != Kernel::kUniform) {
         for (Index i = 0; i < boxes.rows(); ++i)
             rho[i] = scratch.coefficient(img, boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3),
-                                         kernel, sqrt_ref, counted[i], step);
+                                         kernel, sqrt_ref, counted[i]);
         return;
     }
     for_each_box_count(
