@@ -687,6 +687,40 @@ def _tracks_files(folder: Path) -> list[Path]:
     return paths
 
 
+def test_rows_that_cannot_be_written_fail_their_task_not_the_batch(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Smoothing moves a box at the bound (left -1e9) past it: that file fails, the others run.
+
+    Were: the one-file command wrote a file ``read_mot`` refuses (``pftrack recover`` of it:
+    "a box value is beyond ±1e+09 px"); once ``write_mot`` refused such rows, a batch stopped
+    at the client's write, its remaining tasks cancelled.
+    """
+    f = np.arange(1.0, 21.0)
+    w = np.where(f % 2 == 0, 10.0, 1000.0)  # the smoothed centre and width put left past -1e9
+    edge = np.column_stack([f, np.ones(20), np.full(20, -1e9), np.zeros(20), w,
+                            np.full(20, 100.0), np.ones(20), -np.ones((20, 3))])  # fmt: skip
+    folder = tmp_path / "tracks"
+    folder.mkdir()
+    write_mot(folder / "edge.txt", edge)  # readable: every box is within the bound
+    fine = edge.copy()
+    fine[:, 2] = 100.0
+    write_mot(folder / "fine.txt", fine)
+    message = "write_mot: row 2 (frame 3, id 1) has left -1e+09: a box value is beyond ±1e+09 px"
+    single = tmp_path / "single.txt"
+    single.write_text("earlier\n")
+    assert main(["smooth", str(folder / "edge.txt"), "--out", str(single)]) == 2
+    assert capsys.readouterr().err == f"pftrack smooth: error: {message}\n"
+    assert single.read_text() == "earlier\n"
+    out = tmp_path / "out"
+    assert main(["smooth", str(folder), "--out", str(out), "--workers", "0"]) == 1  # some failed
+    assert f"\nedge: error: {message}\n" in capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    assert {e["name"]: e["status"] for e in summary["files"]} == {"edge": "failed", "fine": "done"}
+    assert sorted(p.name for p in out.iterdir()) == ["fine.json", "fine.txt", "summary.json"]
+    read_mot(out / "fine.txt")
+
+
 @pytest.mark.parametrize(
     ("command", "extra"),
     [("recover", ["--method", "auto", "--link"]), ("smooth", []), ("smooth", ["--no-link"])],
