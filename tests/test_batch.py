@@ -590,15 +590,26 @@ def _group(pgid: int) -> dict[int, str]:
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="lists processes in /proc")
-@pytest.mark.parametrize(("whom", "wait"), [("group", 0.0), ("group", 0.4), ("parent", 0.4)])
+@pytest.mark.parametrize(
+    ("whom", "wait", "sig"),
+    [
+        ("group", 0.0, "SIGINT"),
+        ("group", 0.4, "SIGINT"),
+        ("parent", 0.4, "SIGINT"),
+        ("group", 0.4, "SIGTERM"),
+    ],
+)
 def test_ctrl_c_while_the_cluster_starts_is_one_line(
-    data: Path, tmp_path: Path, whom: str, wait: float
+    data: Path, tmp_path: Path, whom: str, wait: float, sig: str
 ) -> None:
     """Ctrl-C while the local cluster starts: exit 130, one line on stderr, no process left.
 
     The signal is sent `wait` seconds after the first worker process appears, while the
     workers start Python and import Dask (a second or more): to the whole process group, as
-    a terminal does (the workers are in it), or to the batch process alone.
+    a terminal does (the workers are in it), or to the batch process alone. SIGTERM (``kill``,
+    a service manager, which may signal the whole group) is held the same way: exit 143.
+    Was: SIGTERM stopped the cluster's start where it stood, exit 143 with a traceback from
+    Dask's exit hook (``AssertionError: Status.init``) and nannies that failed to start.
     """
     out = tmp_path / "out"
     argv = [sys.executable, "-c", _PFTRACK_WITH_CTRL_C, "batch", str(data), "--out", str(out),
@@ -616,19 +627,20 @@ def test_ctrl_c_while_the_cluster_starts_is_one_line(
         time.sleep(wait)
         assert proc.poll() is None, proc.communicate()[1].decode()
         if whom == "group":
-            os.killpg(proc.pid, signal.SIGINT)
+            os.killpg(proc.pid, getattr(signal, sig))
         else:
-            proc.send_signal(signal.SIGINT)
+            proc.send_signal(getattr(signal, sig))
         _, stderr = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
     text = stderr.decode()
-    assert proc.returncode == 130, text
+    status, how = (130, "interrupted") if sig == "SIGINT" else (143, "terminated (SIGTERM)")
+    assert proc.returncode == status, text
     assert text.splitlines() == [
-        "pftrack batch: interrupted; the outputs written so far are complete (re-run to "
-        "finish the rest)"
+        f"pftrack batch: {how}; the outputs written so far are complete (re-run to finish the "
+        "rest)"
     ]
     deadline = time.monotonic() + 20  # the workers end with the cluster, closed on the way out
     while _group(proc.pid) and time.monotonic() < deadline:
@@ -640,6 +652,33 @@ def test_ctrl_c_while_the_cluster_starts_is_one_line(
         assert name == "summary.json" or name.endswith((".txt", ".json")), names
         if name.endswith(".json") and name != "summary.json":
             assert name.replace(".json", ".txt") in names
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX signal masks")
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_signal_while_the_cluster_starts_is_raised_once_it_has_started(sig: str) -> None:
+    """The hold around the cluster's start: the signal's exception comes at its end, not inside.
+
+    Was: SIGTERM (:class:`~pftrack.cli._signals.Terminated` under ``pftrack``) was raised in
+    the middle of the start, leaving a half-started cluster.
+    """
+    from pftrack.batch.engine import _interrupts_held
+    from pftrack.cli._signals import Terminated, sigterm_raises
+
+    expected = KeyboardInterrupt if sig == "SIGINT" else Terminated
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, set())
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    reached = []
+    try:
+        with sigterm_raises(), pytest.raises(expected):
+            with _interrupts_held():
+                signal.pthread_kill(threading.get_ident(), getattr(signal, sig))  # this thread
+                time.sleep(0.05)  # a signal not held would be handled by now
+                reached.append(True)
+    finally:
+        signal.signal(signal.SIGINT, before)
+    assert reached == [True]
+    assert signal.pthread_sigmask(signal.SIG_BLOCK, set()) == mask  # unblocked again
 
 
 def test_cli_interrupt_exits_130(
