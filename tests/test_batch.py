@@ -639,8 +639,7 @@ def test_ctrl_c_while_the_cluster_starts_is_one_line(
     status, how = (130, "interrupted") if sig == "SIGINT" else (143, "terminated (SIGTERM)")
     assert proc.returncode == status, text
     assert text.splitlines() == [
-        f"pftrack batch: {how}; the outputs written so far are complete (re-run to finish the "
-        "rest)"
+        f"pftrack batch: {how}; the outputs written so far are complete (re-run to finish the rest)"
     ]
     deadline = time.monotonic() + 20  # the workers end with the cluster, closed on the way out
     while _group(proc.pid) and time.monotonic() < deadline:
