@@ -347,6 +347,13 @@ def _interrupts_held() -> Iterator[None]:
     cancels the tasks and closes the cluster instead. A held SIGTERM that no handler turns into
     an exception (a library caller of :func:`dask_client`) ends the process on unblocking, as
     it would have a moment earlier.
+
+    A signal mask is per thread: threads started before the hold (OpenBLAS's and OpenCV's,
+    started when NumPy and cv2 load) take a signal sent to the process, and Python then runs its
+    handler in the main thread at the next chance, inside the hold (measured: as Dask's wait
+    for the cluster wakes, in ``SpecCluster.__init__``). In the main thread the handlers are
+    therefore replaced too, by one that notes the signal; each one noted is sent again, to the
+    handler it was meant for, at the end.
     """
     if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
         yield
@@ -357,12 +364,21 @@ def _interrupts_held() -> Iterator[None]:
     from multiprocessing import resource_tracker
 
     resource_tracker.ensure_running()
+    noted: list[int] = []
+    handlers: dict[int, Any] = {}
+    if threading.current_thread() is threading.main_thread():
+        for signum in _HELD_SIGNALS:
+            if signal.getsignal(signum) is not None:  # None: set outside Python, left alone
+                handlers[signum] = signal.signal(signum, lambda n, _: noted.append(n))
     old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD_SIGNALS)
     try:
         yield
     finally:
-        # unblocking delivers a held signal at once: KeyboardInterrupt (Terminated) from here
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a signal held in this thread: noted
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
+        for signum in dict.fromkeys(noted):  # KeyboardInterrupt (Terminated) from here
+            signal.raise_signal(signum)
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:
