@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from bench.recovery_file import synthetic_tracks
 from experiments._common import data_root
+from pftrack.io.opencv_io import opencv_name
 
 
 @pytest.fixture(scope="session")
@@ -38,7 +39,8 @@ def pets_frame(data: Path, size: tuple[int, int]) -> NDArray[np.uint8]:
     video = data / "pets09-s2l1" / "video.avi"
     frame = None
     if video.is_file():
-        cap = cv2.VideoCapture(str(video))
+        with opencv_name(video) as name:  # any name (pftrack.io.opencv_io)
+            cap = cv2.VideoCapture(name)
         cap.set(cv2.CAP_PROP_POS_FRAMES, 100)
         ok, frame = cap.read()
         cap.release()

@@ -20,6 +20,7 @@ from pytest_benchmark.fixture import BenchmarkFixture
 
 from pftrack import _core
 from pftrack.detection import make_detector
+from pftrack.io.opencv_io import opencv_name
 from tests.reference.blobs import blob_boxes as blob_reference
 from tests.reference.blobs import theil_sen as theil_sen_reference
 from tests.reference.detection import BackgroundReference
@@ -36,7 +37,8 @@ def load_frames(data: Path, size: tuple[int, int]) -> list[Frame]:
     video = data / "pets09-s2l1" / "video.avi"
     frames: list[Frame] = []
     if video.is_file():
-        cap = cv2.VideoCapture(str(video))
+        with opencv_name(video) as name:  # any name (pftrack.io.opencv_io)
+            cap = cv2.VideoCapture(name)
         while len(frames) < N_FRAMES:
             ok, f = cap.read()
             if not ok:

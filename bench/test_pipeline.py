@@ -41,6 +41,7 @@ from pytest_benchmark.fixture import BenchmarkFixture
 
 from experiments.cost_per_object import make_crowd
 from pftrack._typing import F64
+from pftrack.io.opencv_io import opencv_name
 from pftrack.io.video_writer import VideoWriter
 from pftrack.render import TrackRenderer
 from pftrack.tracking import TrackerConfig, track_frames
@@ -68,7 +69,8 @@ def sources(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[st
     pets = data_dir / "pets09-s2l1"
     if (pets / "video.avi").is_file() and (pets / "det.txt").is_file():
         out["pets 480x360"] = (pets / "video.avi", load_detections(pets / "det.txt", 0.625))
-        cap = cv2.VideoCapture(str(pets / "video.avi"))
+        with opencv_name(pets / "video.avi") as name:  # any name (pftrack.io.opencv_io)
+            cap = cv2.VideoCapture(name)
 
         def upscaled() -> Any:
             for _ in range(N_720):
@@ -98,7 +100,8 @@ def sources(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[st
 
 
 def _decode(video: Path) -> int:
-    cap = cv2.VideoCapture(str(video))
+    with opencv_name(video) as name:
+        cap = cv2.VideoCapture(name)
     n = 0
     while True:
         ok, _ = cap.read()

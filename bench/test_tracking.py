@@ -18,6 +18,7 @@ import cv2
 import pytest
 from pytest_benchmark.fixture import BenchmarkFixture
 
+from pftrack.io.opencv_io import opencv_name
 from pftrack.tracking import TrackerConfig, track_frames
 
 SIZES = {"480x360": (480, 360), "768x576": (768, 576)}
@@ -39,8 +40,9 @@ def video(
     if size == (480, 360):
         return request.param, pets_video
     out = tmp_path_factory.mktemp("video") / f"pets_{request.param}.avi"
-    cap = cv2.VideoCapture(str(pets_video))
-    writer = cv2.VideoWriter(str(out), cv2.VideoWriter.fourcc(*"MJPG"), 7.0, size)
+    with opencv_name(pets_video) as src, opencv_name(out) as dst:  # any name (opencv_io)
+        cap = cv2.VideoCapture(src)
+        writer = cv2.VideoWriter(dst, cv2.VideoWriter.fourcc(*"MJPG"), 7.0, size)
     while True:
         ok, frame = cap.read()
         if not ok:

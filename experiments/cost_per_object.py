@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 import pftrack
 from experiments._common import experiment_parser, tee_stdout, write_text
 from pftrack._typing import F64
-from pftrack.io.atomic import atomic_path
+from pftrack.io.opencv_io import write_image
 from pftrack.tracking import tracker as tracker_module
 from pftrack.tracking.track import LiveTrack
 
@@ -238,9 +238,7 @@ def plot(rows: list[dict[str, float]], path: Path) -> None:
         cv2.line(img, (margin + 20, 55 + 22 * k), (margin + 50, 55 + 22 * k), colour, 2)
         cv2.putText(img, label, (margin + 58, 60 + 22 * k), font, 0.5, colour, 1, cv2.LINE_AA)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        if not cv2.imwrite(str(tmp), img):
-            raise OSError(f"could not write {path}")
+    write_image(path, img)  # any name, atomically (pftrack.io.opencv_io)
 
 
 def main(argv: Sequence[str] | None = None, measure_fn: Callable[..., list] = measure) -> None:

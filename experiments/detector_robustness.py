@@ -45,6 +45,7 @@ from experiments._common import (
 )
 from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
+from pftrack.io.opencv_io import write_image
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene, make_scene
 
@@ -116,7 +117,7 @@ def real_case(name: str, variant: str, data: Path, out: Path) -> tuple[Path, F64
         assert frames is not None
         folder.mkdir(parents=True, exist_ok=True)
         for k, f in enumerate(transform(frames, variant), start=1):
-            cv2.imwrite(str(folder / f"{k:06d}.jpg"), f, [cv2.IMWRITE_JPEG_QUALITY, 95])
+            write_image(folder / f"{k:06d}.jpg", f, [cv2.IMWRITE_JPEG_QUALITY, 95])  # any name
     return folder, gt
 
 

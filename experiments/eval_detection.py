@@ -143,6 +143,8 @@ def figure(
     completed). Ground truth green, boxes red. Written as JPEG."""
     import cv2
 
+    from pftrack.io.opencv_io import write_image
+
     def draw(boxes: F64, label: str) -> np.ndarray:
         img = frames[frame_no - 1].copy()
         for row in gt[gt[:, 0] == frame_no]:
@@ -169,7 +171,7 @@ def figure(
     out = np.hstack(panels)
     scale = 320 * len(panels) / out.shape[1]
     out = cv2.resize(out, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
-    cv2.imwrite(str(path), out, [cv2.IMWRITE_JPEG_QUALITY, 80])
+    write_image(path, out, [cv2.IMWRITE_JPEG_QUALITY, 80])  # any name (pftrack.io.opencv_io)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -37,8 +37,8 @@ from experiments._common import PETS, REPO, TUD, Source, data_root, experiment_p
 from pftrack._typing import F64
 from pftrack.cli import main as pftrack_main
 from pftrack.eval import evaluate_mot
-from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import read_mot, write_mot
+from pftrack.io.opencv_io import write_image
 from pftrack.io.video import read_frames
 from pftrack.synthetic import camera_path, warp_frame, warp_rows
 
@@ -74,9 +74,8 @@ def make_version(seq: Source, root: Path, out: Path, version: str) -> Path:
     images = folder / "img1"
     images.mkdir(parents=True, exist_ok=True)
     for k, (frame, a) in enumerate(zip(frames, affines, strict=True), start=1):
-        with atomic_path(images / f"{k:06d}.jpg") as tmp:
-            if not cv2.imwrite(str(tmp), warp_frame(frame, a), [cv2.IMWRITE_JPEG_QUALITY, 95]):
-                raise OSError(f"cannot write {images / f'{k:06d}.jpg'}")
+        # any name, atomically (pftrack.io.opencv_io)
+        write_image(images / f"{k:06d}.jpg", warp_frame(frame, a), [cv2.IMWRITE_JPEG_QUALITY, 95])
     src = root / seq.name
     write_mot(folder / "gt.txt", warp_rows(scaled_rows(src / "gt.txt", seq.scale), affines, size))
     write_mot(folder / "det.txt", warp_rows(scaled_rows(src / "det.txt", seq.scale), affines, size))

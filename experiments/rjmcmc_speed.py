@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack import _core
 from pftrack._typing import F64
+from pftrack.io.opencv_io import opencv_name
 
 FIRST, N_FRAMES = 100, 40
 
@@ -45,7 +46,8 @@ def pets_sequence(data: Path, first: int = FIRST, n: int = N_FRAMES) -> Frames:
     video = data / "pets09-s2l1" / "video.avi"
     if not video.is_file():
         return synthetic_sequence(n)
-    cap = cv2.VideoCapture(str(video))
+    with opencv_name(video) as name:  # any name (pftrack.io.opencv_io)
+        cap = cv2.VideoCapture(name)
     mog = cv2.createBackgroundSubtractorMOG2(history=200, varThreshold=25, detectShadows=False)
     det = np.loadtxt(data / "pets09-s2l1" / "det.txt", delimiter=",")
     kernel = np.ones((3, 3), np.uint8)

@@ -46,6 +46,7 @@ from experiments.cost_per_object import make_crowd
 from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.opencv_io import opencv_name
 from pftrack.io.video import FrameSource
 from pftrack.tracking import TrackerConfig, track_frames
 
@@ -68,7 +69,8 @@ def _write(path: Path, frames: Iterable[NDArray[np.uint8]], fps: float = 25.0) -
     for f in frames:
         if writer is None:
             fourcc = cv2.VideoWriter.fourcc(*"MJPG")
-            writer = cv2.VideoWriter(str(path), fourcc, fps, (f.shape[1], f.shape[0]))
+            with opencv_name(path) as name:  # any name (pftrack.io.opencv_io)
+                writer = cv2.VideoWriter(name, fourcc, fps, (f.shape[1], f.shape[0]))
             writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 95)
         writer.write(f)
     if writer is not None:

@@ -532,6 +532,8 @@ def test_library_warnings_are_one_line_for_every_command(
         ("--birth-score 0.5", "--birth-score 0.5 gates the births of --detections; the built-in "
                               "detector starts a track from any blob: drop it, or give "
                               "--detections"),
+        ("--no-refine", "--no-refine takes the boxes of --detections as given; the built-in "
+                        "detector's boxes are not refined: drop it, or give --detections"),
         ("--min-conf -5", "--min-conf -5: the built-in detector's scores are the share of "
                           "foreground pixels in a blob's box, in [0, 1]; give a value in "
                           "[0, 1], or --detections"),
@@ -571,8 +573,10 @@ def test_options_of_given_detections_are_taken_with_them(video: Path, tmp_path: 
     parse = build_parser().parse_args
     det = ["--detections", "d.txt"]
     cfg = tracker_config(parse(["track", "v", "--out", "o", *det, "--min-conf", "-5",
-                                "--birth-score", "0.5", "--det-scale", "2"]))  # fmt: skip
+                                "--birth-score", "0.5", "--det-scale", "2",
+                                "--no-refine"]))  # fmt: skip
     assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (-5, 0.5)
+    assert not cfg.refine.enabled
     cfg = tracker_config(parse(["track", "v", "--out", "o", "--min-conf", "0.5"]))  # built-in
     assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (0.5, DEFAULT_BIRTH_SCORE)
     with pytest.raises(ValueError, match=r"LifecycleConfig: birth_score is 1.5, expected a value"):

@@ -96,6 +96,53 @@ def test_staged_outputs_remove_a_writers_own_temporary_file(tmp_path: Path) -> N
     assert sorted(p.name for p in tmp_path.iterdir()) == [".v.keep.mp4", "v.mp4"]
 
 
+def _interrupted_as_created(monkeypatch: pytest.MonkeyPatch, folder: Path) -> None:
+    """``os.open`` creates the file in `folder`, then a Ctrl-C is raised before it returns.
+
+    As Python raises a signal's ``KeyboardInterrupt`` once a call returns, before its result
+    is stored: the file exists, and the writer has not got its name or descriptor.
+    """
+    real = os.open
+
+    def open_then_interrupted(path: str, flags: int, mode: int = 0o777) -> int:
+        fd = real(path, flags, mode)
+        if os.path.dirname(os.fsdecode(path)) == str(folder):
+            os.close(fd)
+            raise KeyboardInterrupt
+        return fd
+
+    monkeypatch.setattr(os, "open", open_then_interrupted)
+
+
+@pytest.mark.parametrize("writer", ["atomic_write", "atomic_path", "staged_outputs", "check"])
+def test_a_signal_as_the_temporary_file_is_created_leaves_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, writer: str
+) -> None:
+    """Was: the file made between its creation and the writer's try was left behind
+    (``.out.<hex>.txt``; ``staged_outputs`` too, whose clean-up had not listed it yet)."""
+    from pftrack.io.atomic import check_output, staged_outputs
+
+    target = tmp_path / "out.txt"
+    target.write_text("old\n")
+    (tmp_path / ".out.keep.txt").write_text("not ours\n")
+    _interrupted_as_created(monkeypatch, tmp_path)
+    with pytest.raises(KeyboardInterrupt):
+        if writer == "atomic_write":
+            with atomic_write(target) as fh:
+                fh.write("new\n")
+        elif writer == "atomic_path":
+            with atomic_path(target) as tmp:
+                tmp.write_text("new\n")
+        elif writer == "staged_outputs":
+            with staged_outputs() as stage:
+                stage(target).write_text("new\n")
+        else:  # the writable-folder probe of check_output
+            check_output(target)
+    monkeypatch.undo()
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".out.keep.txt", "out.txt"]
+    assert target.read_text() == "old\n"
+
+
 @pytest.mark.parametrize("mode", [0o600, 0o640])
 def test_replacing_a_file_keeps_its_permissions(tmp_path: Path, umask, mode: int) -> None:
     """A file the user restricted stays restricted: not reset to the umask's 0o644."""

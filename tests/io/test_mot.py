@@ -26,10 +26,11 @@ def test_write_equals_format_mot_row(tmp_path: Path) -> None:
     )
     digits = rng.integers(0, 4, (n, 8))
     a[:, 2:] = np.round(a[:, 2:] * 10.0**digits) / 10.0**digits
+    a[:, 4:6] = np.abs(a[:, 4:6])  # sizes as read_mot reads them (write_mot refuses others)
     a[::7, 2] = -0.0
-    a[::11, 3] = 1e16
+    a[::11, 7] = 1e16
     a[::13, 4] = 3.999
-    a[::17, 5] = -2.004
+    a[::17, 3] = -2.004
     mot.write_mot(tmp_path / "t.txt", a)
     o = a[np.lexsort((a[:, 1], a[:, 0]))]
     want = "".join(mot.format_mot_row(r) + "\n" for r in o)
@@ -115,6 +116,50 @@ def test_write_refuses_non_finite(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="row 1 has (a non-finite value|NaN or inf)"):
         mot.write_mot(tmp_path / "t.txt", a)
     assert not (tmp_path / "t.txt").exists()
+
+
+@pytest.mark.parametrize(
+    ("col", "value", "match"),
+    [
+        (4, -5.0, r"row 1 \(frame 2, id 3\) has width -5: negative box width or height"),
+        (5, -0.001, r"row 1 \(frame 2, id 3\) has height -0.001: negative box width or height"),
+        (2, 2e9, r"row 1 \(frame 2, id 3\) has left 2e\+09: a box value is beyond ±1e\+09 px"),
+        (3, -1e300, r"row 1 \(frame 2, id 3\) has top -1e\+300: a box value is beyond"),
+        (0, 0.0, r"row 1 has frame 0, expected an integer in 1\.\.2147483647"),
+        (0, 2.0**31, r"row 1 has frame 2\.14748e\+09, expected an integer in 1\.\."),
+    ],
+)
+def test_write_refuses_what_read_refuses(
+    tmp_path: Path, col: int, value: float, match: str
+) -> None:
+    """Was: written, then refused by read_mot (``pftrack recover`` of the file, ``eval``)."""
+    a = np.array([[1, 1, 10, 20, 30, 40, 1, -1, -1, -1], [2, 3, 10, 20, 30, 40, 1, -1, -1, -1]])
+    p = tmp_path / "t.txt"
+    p.write_text("earlier\n")
+    bad = a.astype(np.float64)
+    bad[1, col] = value
+    for write in (
+        lambda: mot.write_mot(p, bad),
+        lambda: mot.write_mot(p, bad[:, :6], exact=True),
+    ):
+        with pytest.raises(ValueError, match=f"^write_mot: {match}"):
+            write()
+    assert p.read_text() == "earlier\n"  # refused before anything is written
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["t.txt"]  # no temporary left
+    with pytest.raises(ValueError, match=f"^mot_text: {match}"):
+        mot.mot_text(bad)
+    with pytest.raises(ValueError, match="^format_mot_row: row 0 "):
+        mot.format_mot_row(bad[1])
+    p.write_text(",".join(map(repr, bad[1].tolist())) + "\n")  # the same row, as a file
+    with pytest.raises(ValueError, match=r"t\.txt:1: (frame is|negative box|a box value)"):
+        mot.read_mot(p)
+
+
+def test_write_takes_what_read_takes(tmp_path: Path) -> None:
+    """The edges of the rule: sizes of 0, values of exactly ±1e9 px, frame 2**31 - 1."""
+    a = np.array([[1, 1, -1e9, 1e9, 0, 0], [2**31 - 1, -4, 0, 0, 1e9, 1e9]], dtype=np.float64)
+    mot.write_mot(tmp_path / "t.txt", a)
+    np.testing.assert_array_equal(mot.read_mot(tmp_path / "t.txt")[:, :6], a)
 
 
 def test_a_byte_order_mark_is_not_a_field(tmp_path: Path) -> None:

@@ -379,7 +379,8 @@ def test_no_refine_takes_the_boxes_as_given(scene, tmp_path):
     from pftrack.cli import build_parser
     from pftrack.cli._options import tracker_config
 
-    args = build_parser().parse_args(["track", "v.avi", "--out", "t.txt", "--no-refine"])
+    argv = ["track", "v.avi", "--out", "t.txt", "--detections", "d.txt", "--no-refine"]
+    args = build_parser().parse_args(argv)
     config = tracker_config(args)
     assert pftrack.Tracker(refine=False).config == config
     assert not config.refine.enabled and config.refine.leg_fill == TrackerConfig().refine.leg_fill

@@ -305,7 +305,7 @@ def dask_client(
         return
     n = n_workers if n_workers is not None else (os.cpu_count() or 1)
     with contextlib.ExitStack() as stack:
-        with _ctrl_c_held():  # the cluster starts whole, its workers deaf to the terminal's Ctrl-C
+        with _interrupts_held():  # the cluster starts whole; its workers deaf to Ctrl-C, SIGTERM
             stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
             cluster = stack.enter_context(
                 LocalCluster(
@@ -320,38 +320,65 @@ def dask_client(
             )
             c = stack.enter_context(Client(cluster))
             c.register_plugin(SingleThreaded(ignore_interrupt=True))
-        # a Ctrl-C held while the cluster started is raised on leaving _ctrl_c_held: the stack
-        # then closes the client and the whole cluster
+        # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
+        # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
 
 
-@contextlib.contextmanager
-def _ctrl_c_held() -> Iterator[None]:
-    """Hold Ctrl-C (SIGINT) in this thread meanwhile; a Ctrl-C held is raised at the end.
+#: What :func:`_interrupts_held` holds: Ctrl-C, and SIGTERM, which the command turns into a
+#: ``KeyboardInterrupt`` too (:mod:`pftrack.cli._signals`).
+_HELD_SIGNALS = frozenset(
+    getattr(signal, name) for name in ("SIGINT", "SIGTERM") if hasattr(signal, name)
+)
 
-    While a local cluster starts: a ``KeyboardInterrupt`` in the middle would leave it half
-    started (nannies that fail to start, Dask's exit hook asserting on the cluster's state, a
-    traceback each). And the threads started meanwhile (Dask's event loop, then the threads
-    that spawn the worker processes) inherit the blocked signal, as do the worker processes
-    they spawn (a signal mask survives fork and exec): the workers, in the terminal's process
-    group, never see its Ctrl-C, not even while Python starts in them. This process, whose main
-    thread unblocks it here, cancels the tasks and closes the cluster instead.
+
+@contextlib.contextmanager
+def _interrupts_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) and SIGTERM in this thread meanwhile; one held is raised at the end.
+
+    While a local cluster starts: a ``KeyboardInterrupt`` in the middle (Ctrl-C, or SIGTERM
+    under ``pftrack``: :class:`~pftrack.cli._signals.Terminated`) would leave it half started
+    (nannies that fail to start, Dask's exit hook asserting on the cluster's state, a traceback
+    each). And the threads started meanwhile (Dask's event loop, then the threads that spawn
+    the worker processes) inherit the blocked signals, as do the worker processes they spawn (a
+    signal mask survives fork and exec): the workers, in the terminal's process group, never
+    see its Ctrl-C, nor a SIGTERM sent to the group (``kill -TERM -PGID``, a service manager),
+    not even while Python starts in them. This process, whose main thread unblocks them here,
+    cancels the tasks and closes the cluster instead. A held SIGTERM that no handler turns into
+    an exception (a library caller of :func:`dask_client`) ends the process on unblocking, as
+    it would have a moment earlier.
+
+    A signal mask is per thread: threads started before the hold (OpenBLAS's and OpenCV's,
+    started when NumPy and cv2 load) take a signal sent to the process, and Python then runs its
+    handler in the main thread at the next chance, inside the hold (measured: as Dask's wait
+    for the cluster wakes, in ``SpecCluster.__init__``). In the main thread the handlers are
+    therefore replaced too, by one that notes the signal; each one noted is sent again, to the
+    handler it was meant for, at the end.
     """
     if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
         yield
         return
     # multiprocessing's resource tracker, started with the first worker process, unblocks
-    # SIGINT in the thread that starts it (resource_tracker.ensure_running): started now,
+    # SIGINT and SIGTERM in the thread that starts it (resource_tracker.ensure_running): now,
     # before the hold, it is not started again in the thread that spawns the workers
     from multiprocessing import resource_tracker
 
     resource_tracker.ensure_running()
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    noted: list[int] = []
+    handlers: dict[int, Any] = {}
+    if threading.current_thread() is threading.main_thread():
+        for signum in _HELD_SIGNALS:
+            if signal.getsignal(signum) is not None:  # None: set outside Python, left alone
+                handlers[signum] = signal.signal(signum, lambda n, _: noted.append(n))
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD_SIGNALS)
     try:
         yield
     finally:
-        # unblocking delivers a held SIGINT at once: KeyboardInterrupt raised from here
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a signal held in this thread: noted
+        for signum, handler in handlers.items():
+            signal.signal(signum, handler)
+        for signum in dict.fromkeys(noted):  # KeyboardInterrupt (Terminated) from here
+            signal.raise_signal(signum)
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:

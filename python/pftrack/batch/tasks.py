@@ -98,6 +98,12 @@ class TaskResult:
         Set when a step after the work failed (scoring the tracks against a ``gt.txt`` that
         cannot be read): the outputs are still written, and the task counts as failed with
         this one-line error and traceback (its sidecar too, so a re-run does it again).
+
+    Raises
+    ------
+    ValueError
+        `rows` that :func:`~pftrack.io.mot.write_mot` refuses (a box value beyond ±1e9 px that
+        smoothing or filling moved past the bound, ...): the task fails, not the batch.
     """
 
     rows: F64
@@ -106,6 +112,16 @@ class TaskResult:
     exact: NDArray[np.bool_] | None = None
     error: str | None = None
     traceback: str | None = None
+
+    def __post_init__(self) -> None:
+        """Refuse rows that the client's :func:`~pftrack.io.mot.write_mot` would refuse.
+
+        Here, in the task: the task fails and the batch goes on (was: the client's write
+        raised, and stopped the batch with every task not yet written cancelled).
+        """
+        from pftrack.io.mot import check_mot_rows
+
+        check_mot_rows(self.rows, "write_mot")
 
 
 def one_line(exc: BaseException) -> str:

@@ -268,7 +268,7 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "--no-refine", action="store_true",
         help="with --detections, take the boxes as given instead of shrinking each to the "
         "foreground of a background model (for a detector with tight boxes; no background "
-        "model runs, no frames are read ahead for it)",
+        "model runs, no frames are read ahead for it); refused without --detections",
     )  # fmt: skip
     p.add_argument(
         "--no-link", action="store_true",
@@ -284,8 +284,8 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
     ------
     ValueError
         Options that contradict each other (``--crossings on`` with ``--no-smooth``), or an
-        option of given detections without them (``--det-scale S``, ``--birth-score``, and a
-        ``--min-conf`` outside the built-in detector's scores, [0, 1]).
+        option of given detections without them (``--det-scale S``, ``--birth-score``,
+        ``--no-refine``, and a ``--min-conf`` outside the built-in detector's scores, [0, 1]).
     """
     from dataclasses import replace
 
@@ -303,6 +303,11 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
             raise ValueError(
                 f"--birth-score {args.birth_score:g} gates the births of --detections; the "
                 "built-in detector starts a track from any blob: drop it, or give --detections"
+            )
+        if args.no_refine:
+            raise ValueError(
+                "--no-refine takes the boxes of --detections as given; the built-in "
+                "detector's boxes are not refined: drop it, or give --detections"
             )
         if not 0.0 <= args.min_conf <= 1.0:
             raise ValueError(

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import MAX_FRAME, first_bad_box
+from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write
 
@@ -254,7 +254,12 @@ def _lines(a: F64, exact: NDArray[np.bool_] | None = None) -> str:
 
 
 def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) -> F64:
-    """`rows` (M, 6..10) as (M, 10) float64 with the default columns added, or a ValueError."""
+    """`rows` (M, 6..10) as (M, 10) float64 with the default columns added, or a ValueError.
+
+    Refused: what :func:`read_mot` refuses of a file, so that every file written reads back
+    (frames in ``1..2**31-1``; boxes by its rule, :func:`pftrack._check.first_bad_box`,
+    applied to the values given, before any rounding); ids must be integers too.
+    """
     a = np.asarray(rows, dtype=np.float64)
     if a.size == 0:
         a = np.zeros((0, 10))
@@ -268,10 +273,45 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
         k = int(np.flatnonzero(np.any((ids != np.round(ids)) | (np.abs(ids) > 2**53), axis=1))[0])
         raise ValueError(f"{who}: row {k} has a frame or id that is not an integer: "
                          f"{a[k, :2].tolist()}")  # fmt: skip
+    fr = a[:, FRAME]
+    if np.any((fr < 1) | (fr > MAX_FRAME)):
+        k = int(np.flatnonzero((fr < 1) | (fr > MAX_FRAME))[0])
+        raise ValueError(
+            f"{who}: row {k} has frame {fr[k]:g}, expected an integer in 1..{MAX_FRAME} "
+            "(frames count from 1)"
+        )
+    bad = first_bad_box(a[:, LEFT : HEIGHT + 1])  # what read_mot refuses is never written
+    if bad is not None:
+        k, c, problem = bad
+        raise ValueError(
+            f"{who}: row {k} (frame {a[k, FRAME]:g}, id {a[k, ID]:g}) has {BOX_VALUES[c]} "
+            f"{a[k, LEFT + c]:g}: {problem}"
+        )
     if a.shape[1] < 10:
         pad = np.tile(np.asarray(_DEFAULTS[a.shape[1] :]), (a.shape[0], 1))
         a = np.hstack([a, pad])
     return a
+
+
+def check_mot_rows(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) -> None:
+    """Refuse, as :func:`write_mot` would, rows that could not be written or read back.
+
+    For a caller that writes the rows later, elsewhere (a batch task, whose client writes its
+    outputs): the refusal then comes where the rows are made.
+
+    Parameters
+    ----------
+    rows : (M, 6..10) array_like
+        The rows.
+    who : str
+        How the error names the caller.
+
+    Raises
+    ------
+    ValueError
+        What :func:`write_mot` refuses (see :func:`mot_text`), naming the first bad row.
+    """
+    _checked(rows, who)
 
 
 #: What `exact` of :func:`mot_text` and :func:`write_mot` may be.
@@ -321,7 +361,8 @@ def mot_text(rows: NDArray[np.float64] | Iterable[Iterable[float]], *, exact: Ex
     ------
     ValueError
         Rows not ``(M, 6..10)``, a NaN or infinite value, a frame or id that is not an
-        integer, or `exact` of another shape.
+        integer, a frame outside ``1..2**31-1`` or a box :func:`read_mot` refuses (a negative
+        width or height, a value beyond ±1e9 px), or `exact` of another shape.
     """
     a = _checked(rows, "mot_text")
     return _lines(a, _exact_mask(exact, len(a), "mot_text"))
@@ -342,7 +383,10 @@ def write_mot(
     """Write rows (M, 6..10) as a MOTChallenge file, atomically, sorted by (frame, id).
 
     Columns beyond those given get the defaults ``conf=1, x=y=z=-1``. Every value must be
-    finite and frames and ids integers (a ValueError names the first bad row otherwise).
+    finite, frames and ids integers, frames in ``1..2**31-1`` and boxes such as
+    :func:`read_mot` reads (no negative width or height, no value beyond ±1e9 px:
+    :func:`pftrack._check.first_bad_box`); a ValueError names the first bad row otherwise,
+    before anything is written (an existing file at `path` is left as it was).
     Values are written as :func:`mot_text` writes them: a value of at most
     :data:`EXACT_DIGITS` significant digits (every value of a file written with up to 10
     digits, as MOTChallenge files and trackers write them) comes out unchanged, in its
