@@ -110,6 +110,41 @@ def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     assert "outside" in capsys.readouterr().err
 
 
+def test_sequence_of_another_shape_than_its_seqinfo_is_refused(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: boxes scaled by the width's ratio on both axes, tracks far off, exit 0 (a 4:3
+    sequence whose video was re-encoded to 16:9 scored MOTA -108)."""
+    seq = tmp_path / "WIDE"
+    (seq / "det").mkdir(parents=True)
+    (seq / "img1").symlink_to(sequence / "img1")
+    (seq / "seqinfo.ini").write_text(
+        f"[Sequence]\nimWidth={2 * scene.width}\nimHeight={3 * scene.height}\n"
+    )
+    (seq / "det" / "det.txt").write_bytes((sequence / "det" / "det.txt").read_bytes())
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "another shape" in err and not out.exists()
+    assert f"the frames are {scene.width}x{scene.height}" in err
+    assert f"seqinfo.ini says {2 * scene.width}x{3 * scene.height}" in err
+    # the same sequence with seqinfo.ini's height within 1 % of the width's ratio is scaled
+    (seq / "seqinfo.ini").write_text(
+        f"[Sequence]\nimWidth={2 * scene.width}\nimHeight={2 * scene.height + 1}\n"
+    )
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 0
+
+
+def test_info_scale() -> None:
+    from pftrack.io.video import info_scale
+
+    assert info_scale((480, 360), (768, 576), "s") == 0.625
+    assert info_scale((480, 360), (768, None), "s") == 0.625
+    assert info_scale((480, 360), (None, None), "s") == 1.0
+    with pytest.raises(ValueError, match=r"^s: the frames are 1280x720 but seqinfo.ini says 768"):
+        info_scale((1280, 720), (768, 576), "s")
+
+
 def _copy_sequence(sequence: Path, seq: Path, *, skip: str = "") -> Path:
     """`sequence` at `seq`: its images linked (all but `skip`), seqinfo.ini and det/ copied."""
     (seq / "img1").mkdir(parents=True)

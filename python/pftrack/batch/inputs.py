@@ -47,9 +47,9 @@ class SequenceInput:
         The sequence's detection file (``det/det.txt`` or ``det.txt``), if any.
     gt : Path or None
         Its ground truth (``gt/gt.txt`` or ``gt.txt``), if any.
-    image_width : int or None
-        ``imWidth`` of its ``seqinfo.ini``: the size the detection and ground-truth boxes are
-        given in (PETS09's are 768 px wide for a 480 px video).
+    image_width, image_height : int or None
+        ``imWidth`` and ``imHeight`` of its ``seqinfo.ini``: the size the detection and
+        ground-truth boxes are given in (PETS09's are 768x576 for a 480x360 video).
     """
 
     name: str
@@ -57,6 +57,7 @@ class SequenceInput:
     detections: Path | None = None
     gt: Path | None = None
     image_width: int | None = None
+    image_height: int | None = None
 
     @property
     def files(self) -> tuple[Path, ...]:
@@ -127,12 +128,14 @@ def _as_sequence(path: Path) -> SequenceInput | None:
         raise ValueError(
             f"sequence folder {path} has no img1/ and not exactly one video ({len(videos)} found)"
         )
+    info = read_seqinfo(path) if marked else None
     return SequenceInput(
         path.name,
         frames,
         _first_file(path, "det/det.txt", "det.txt"),
         _first_file(path, "gt/gt.txt", "gt.txt"),
-        read_seqinfo(path).width if marked else None,
+        info.width if info else None,
+        info.height if info else None,
     )
 
 

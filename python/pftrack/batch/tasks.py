@@ -310,13 +310,16 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         its `error` is set if the ground truth could not be scored (the rows are still there).
     """
     from pftrack.io.mot import read_mot
-    from pftrack.io.video import FrameSource
+    from pftrack.io.video import FrameSource, info_scale
     from pftrack.tracking.run import track_path
 
     cpu = time.process_time()
     report = _report_frames
     frames = FrameSource(seq.frames)
-    auto_scale = frames.width / seq.image_width if seq.image_width else 1.0
+    # the boxes of det.txt and gt.txt are in seqinfo.ini's pixels
+    auto_scale = info_scale(
+        (frames.width, frames.height), (seq.image_width, seq.image_height), seq.name
+    )
     det = None
     if options.detections == "auto":
         if seq.detections is None:

@@ -126,9 +126,13 @@ def _det_scale(args: argparse.Namespace, source: Any, det_path: str, said: list[
     own = seq.detections if seq is not None else None
     if own is None or seq.width is None or not own.samefile(det_path):
         return 1.0
-    if seq.width == source.width:
+    from pftrack.io.video import info_scale
+
+    scale = info_scale(
+        (source.width, source.height), (seq.width, seq.height), seq.folder / "seqinfo.ini"
+    )
+    if scale == 1.0:
         return 1.0
-    scale = float(source.width / seq.width)
     said.append(
         f"detections scaled by {scale:g}: frames are {source.width} px wide, "
         f"{seq.folder / 'seqinfo.ini'} says imWidth={seq.width} (--det-scale overrides)"

@@ -47,6 +47,7 @@ __all__ = [
     "SequenceInfo",
     "check_source",
     "find_sequence",
+    "info_scale",
     "is_live_source",
     "natural_key",
     "read_frames",
@@ -148,6 +149,49 @@ class SequenceInfo:
             if path.is_file():
                 return path
         return None
+
+
+def info_scale(
+    frame_size: tuple[int, int], info_size: tuple[int | None, int | None], where: object
+) -> float:
+    """The factor from a sequence's ``seqinfo.ini`` pixels to its frames' pixels.
+
+    MOTChallenge detection and ground-truth boxes are given in ``imWidth`` x ``imHeight``
+    pixels; frames of another size (a re-encoded or downscaled video) take them scaled by
+    the width's ratio, which must be the height's too: one factor cannot map boxes onto frames
+    of another shape.
+
+    Parameters
+    ----------
+    frame_size : (width, height)
+        The frames' size.
+    info_size : (imWidth, imHeight)
+        ``seqinfo.ini``'s size (None where it is not given: the width alone decides).
+    where : object
+        The ``seqinfo.ini`` (or sequence) named in the error.
+
+    Returns
+    -------
+    float
+        ``width / imWidth`` (1.0 without an ``imWidth``).
+
+    Raises
+    ------
+    ValueError
+        The two ratios differ by more than 1 % (a 4:3 sequence stored as 16:9, for instance).
+    """
+    (w, h), (iw, ih) = frame_size, info_size
+    if not iw:
+        return 1.0
+    sx = w / iw
+    if ih and abs(sx * ih - h) > 0.01 * h:
+        raise ValueError(
+            f"{where}: the frames are {w}x{h} but seqinfo.ini says {iw}x{ih}, another shape "
+            f"(x{sx:.4g} across, x{h / ih:.4g} down), so its boxes cannot be scaled onto the "
+            "frames by one factor: give frames of seqinfo.ini's shape, or the boxes' scale "
+            "yourself (pftrack track --det-scale)"
+        )
+    return float(sx)
 
 
 def read_seqinfo(path: PathLike) -> SequenceInfo:
