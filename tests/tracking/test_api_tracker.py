@@ -234,6 +234,31 @@ def test_finalize_never_links_two_classes(scene, second_class):
         assert before == after  # linked: one identity
     else:
         assert before != after  # two classes: two identities, as update() gave
+    # each final id's class (finalize() renumbers ids; the rows have no class column)
+    (b,), (a,) = before, after
+    assert tracker.classes == {b: 0, a: second_class}
+    tracker.reset()
+    assert tracker.classes == {}
+
+
+def test_classes_of_final_ids_follow_the_detections(scene):
+    """Two classes by the side of the frame a detection is on: each id finalize() returns has
+    the class of the detections it was made of (was: the rows said no class, and the ids
+    were renumbered)."""
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    w = scene.frames[0].shape[1]
+    for f, dets in enumerate(scene_dets(scene), start=1):
+        if len(dets):
+            side = ((dets[:, 0] + dets[:, 2]) / 2 > w / 2).astype(float)
+            dets = np.column_stack([dets[:, :5], side])
+        tracker.update(dets, scene.frames[f - 1])
+    rows = tracker.finalize()
+    assert set(tracker.classes) == set(rows[:, 1].astype(int).tolist())
+    assert set(tracker.classes.values()) == {0, 1}
+    for i, c in tracker.classes.items():
+        r = rows[(rows[:, 1] == i) & (rows[:, 7] != 1)]  # not the rows filled in holes
+        centre = r[:, 2] + r[:, 4] / 2
+        assert np.mean((centre > w / 2) == bool(c)) > 0.8
 
 
 def test_merged_blob_rows_name_the_blob():
@@ -300,6 +325,21 @@ def test_xyxy_file_where_xywh_is_expected_is_refused(scene):
     as_file = {n: v for n, v in enumerate(d, start=1) if len(v)}  # x1, y1, x2, y2 "as xywh"
     with pytest.raises(ValueError, match="look like x1, y1, x2, y2"):
         track_frames(scene.frames, detections=as_file, rng=0)
+
+
+def test_detections_in_a_smaller_frames_pixels_are_said(scene):
+    """Was silent: a 1440x1080 video given its 640x480 det.txt tracked in the top-left corner
+    only (boxes too large for the frame are clipped, and said)."""
+    d = scene_dets(scene)
+    xywh = {n: np.column_stack([v[:, :2], v[:, 2:4] - v[:, :2], v[:, 4:]]) for n, v in
+            enumerate(d, start=1) if len(v)}  # fmt: skip
+    small = {n: np.column_stack([v[:, :4] * 0.4, v[:, 4:]]) for n, v in xywh.items()}
+    frames = scene.frames[:20]
+    with pytest.warns(UserWarning, match="top-left .* of the 480x360 frames"):
+        track_frames(frames, detections={n: v for n, v in small.items() if n <= 20}, rng=0)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message=".*top-left")
+        track_frames(frames, detections={n: v for n, v in xywh.items() if n <= 20}, rng=0)
 
 
 def test_boxes_outside_the_frame_are_clipped_once(scene):

@@ -209,7 +209,7 @@ class Tracker:
         Cap of the confidence a detection needs to start a track, in [0, 1].
     birth_quantile : float or None
         The birth threshold is ``min(birth_score, quantile)`` of the confidences seen in the
-        first 2 s, so a detector whose scores are all low still starts tracks (None: always
+        first 50 frames, so a detector whose scores are all low still starts tracks (None: always
         `birth_score`). See :class:`~pftrack.tracking.LifecycleConfig`.
     camera_motion : {"auto", "on", "off"}
         Camera-motion compensation (:attr:`TrackerConfig.camera_motion`).
@@ -221,7 +221,7 @@ class Tracker:
         Boxes of a gap the particle filter bridged, before smoothing.
     smooth, link : bool
         The offline pass of :meth:`finalize`: smooth each track's boxes, join fragments of one
-        object across gaps of up to 1.2 s.
+        object across gaps of up to 30 frames (at any `frame_rate`: the module's notes).
     crossings : bool
         With `smooth`, :meth:`finalize` also gives back the tails of two tracks the tracker
         swapped where they crossed (:class:`~pftrack.tracking.CrossingConfig`, motion and
@@ -393,6 +393,8 @@ class Tracker:
         self._tracker = MultiObjectTracker(self.config, rng=self.seed)
         self._writer = TrackWriter(*self._writer_args)
         self.frame_count = 0
+        #: The class (``cls`` of the detections; 0 without) of each id :meth:`finalize` returned.
+        self.classes: dict[int, int] = {}
         self._stabiliser = Stabiliser()
         self._reports: list[Track] = []
         self._clip_warned = False
@@ -622,6 +624,9 @@ class Tracker:
             to the detector's expected person (``LifecycleConfig.amodal_share``). With the
             smoother on and ``TrackerConfig.crossings.enabled``, tracks swapped where they
             crossed are exchanged back after linking (:func:`~.offline.repair_crossings`).
+            :attr:`classes` maps each id of the rows to its class (the ``cls`` column of the
+            detections its track was made of; the offline pass renumbers ids, and never joins
+            two classes).
         """
         smoothed = self._writer_args[2] is not None
         crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
@@ -665,6 +670,8 @@ class Tracker:
             x, y = rows[:, 2], rows[:, 3]
             inside = (x < w) & (y < h) & (x + rows[:, 4] > 0) & (y + rows[:, 5] > 0)
             rows = rows[inside]
+        kept = set(rows[:, 1].astype(int).tolist())
+        self.classes = {i: c for i, c in self._writer.classes.items() if i in kept}
         if len(rows) == 0 and self.frame_count:
             n = self.frame_count
             warnings.warn(

@@ -234,11 +234,17 @@ def track_frames(
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
 
 
+SMALL_LAYOUT_BOXES = 20  # boxes a file needs before its extent says anything about its pixels
+
+
 def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
-    """Refuse detections that read as x1, y1, x2, y2 where left, top, w, h are expected.
+    """Refuse x1, y1, x2, y2 boxes given as left, top, w, h; warn about a smaller frame's boxes.
 
     Decided on the whole file: more than half of the boxes, read as ``left, top, w, h``, reach
     past the frame's right or bottom edge, while every box read as ``x1, y1, x2, y2`` lies in it.
+    The warning: at least :data:`SMALL_LAYOUT_BOXES` boxes, and none reaches past half the
+    frame's width or height (boxes too large for the frame are clipped, with a warning, by
+    the tracker).
     """
     d = np.concatenate([v[:, :4] for v in detections.values() if len(v)] or [np.zeros((0, 4))])
     if len(d) == 0:
@@ -246,6 +252,14 @@ def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
     rows, cols = shape[0], shape[1]
     past = (d[:, 0] + d[:, 2] > cols) | (d[:, 1] + d[:, 3] > rows)
     as_xyxy = (d[:, 2] > d[:, 0]) & (d[:, 3] > d[:, 1]) & (d[:, 2] <= cols) & (d[:, 3] <= rows)
+    right, bottom = float(np.max(d[:, 0] + d[:, 2])), float(np.max(d[:, 1] + d[:, 3]))
+    if len(d) >= SMALL_LAYOUT_BOXES and right < 0.5 * cols and bottom < 0.5 * rows:
+        warnings.warn(
+            f"all {len(d)} detection boxes lie in the top-left {right:.0f}x{bottom:.0f} pixels "
+            f"of the {cols}x{rows} frames: are they in a smaller frame's pixels? (scale them "
+            "with --det-scale / load_detections(scale=...))",
+            stacklevel=3,
+        )
     if past.mean() > 0.5 and as_xyxy.all():
         raise ValueError(
             f"{past.sum()} of {len(d)} detection boxes reach past the {cols}x{rows} frame as "

@@ -58,6 +58,7 @@ class TrackWriter:
         self._pending: dict[int, list[list[float]]] = {}
         self._last: dict[int, list[float]] = {}
         self._cls: dict[int, int] = {}  # class of each track id
+        self.classes: dict[int, int] = {}  # class of each id of the last result()
 
     def _append(self, row: list[float], measured: F64 | None) -> None:
         self.rows.append(row)
@@ -98,7 +99,9 @@ class TrackWriter:
         least that many coasted frames is cut there before linking
         (:func:`~.offline.split_refound`). With `crossings` (enabled), tracks swapped where
         they crossed are exchanged back after linking (:func:`~.offline.repair_crossings`).
+        :attr:`classes` gets the class of each id of the result.
         """
+        self.classes = {}
         a = np.asarray(self.rows, np.float64).reshape(-1, 10)
         observed = np.array([m is not None for m in self._measured], bool)
         measured = self._measured
@@ -114,10 +117,13 @@ class TrackWriter:
         cls = np.array([self._cls.get(int(i), 0) for i in a[:, 1]], np.int64)
         classes = np.unique(cls)
         if len(classes) == 1:
-            return smooth_tracks(
+            rows = smooth_tracks(
                 a, observed, self.smoother, self.link, z, crossings=crossings,
                 relink_coast=relink_coast,
             )  # fmt: skip
+            ids = np.unique(rows[:, 1]).astype(int).tolist()
+            self.classes = dict.fromkeys(ids, int(classes[0]))
+            return rows
         # classes never share an identity: each class's tracks are linked among themselves, and
         # an id a pass makes (a cut piece) is renumbered above every id of the run
         parts = []
@@ -136,5 +142,6 @@ class TrackWriter:
                 out[:, 1] = ids
                 fresh += len(new)
             parts.append(out)
+            self.classes.update(dict.fromkeys(np.unique(out[:, 1]).astype(int).tolist(), int(c)))
         rows = np.vstack(parts)
         return rows[np.lexsort((rows[:, 1], rows[:, 0]))]
