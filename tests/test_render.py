@@ -70,3 +70,21 @@ def test_write_annotated_video_from_rows(tmp_path: Path) -> None:
     # foot points along y = 26 from x = 16 to 34; the last box spans x 30..38
     assert got[-1][26, 17:28].max(axis=1).min() > 100
     assert got[0][26, 22:28].max() < 30
+
+
+def test_labels_grow_with_the_frame() -> None:
+    """Was: 0.4-scale labels and 1-2 px lines at any size, about 10 px tall at 1920x1080."""
+    from pftrack.render import draw_tracks, ink_scale
+
+    assert [ink_scale(s) for s in [(360, 480), (720, 1280), (1080, 1920), (2160, 3840)]] == [
+        1,
+        1,
+        2,
+        4,
+    ]
+    row = np.array([[1, 7, 100, 100, 60, 150, 1, -1, -1, -1]], float)
+    inked = []
+    for size in [(360, 480), (1080, 1920)]:
+        out = draw_tracks(np.zeros((*size, 3), np.uint8), row)
+        inked.append(int(np.count_nonzero(out.any(axis=2))))
+    assert inked[1] > 1.5 * inked[0]  # twice the line width, and a twice larger label

@@ -24,6 +24,7 @@ __all__ = [
     "colour_of",
     "draw_tracks",
     "draw_trails",
+    "ink_scale",
     "plot_trajectories",
     "write_annotated_video",
 ]
@@ -41,39 +42,56 @@ def colour_of(track_id: int) -> tuple[int, int, int]:
     return int(b), int(g), int(r)
 
 
+def ink_scale(shape: tuple[int, ...]) -> int:
+    """How much thicker lines and larger labels are drawn on a frame of `shape` (H, W, ...).
+
+    One step per 540 pixels of the shorter side, at least 1: 1 up to 1280x720 (as they always
+    looked), 2 at 1920x1080, 4 at 3840x2160, so that labels stay readable when a large video
+    is shown scaled down.
+    """
+    return max(1, min(shape[0], shape[1]) // 540)
+
+
 def draw_tracks(
     frame: NDArray[np.uint8], rows: NDArray[np.float64], label: str = ""
 ) -> NDArray[np.uint8]:
-    """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids (dashed if filled)."""
+    """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids (dashed if filled).
+
+    Lines and labels grow with the frame (:func:`ink_scale`).
+    """
     out: NDArray[np.uint8] = frame.copy()
+    k = ink_scale(out.shape)
     for r in rows:
         tid = int(r[1])
         x, y, w, h = (int(round(v)) for v in r[2:6])
         c = colour_of(tid)
-        cv2.rectangle(out, (x, y), (x + w, y + h), c, 1 if len(r) > 7 and r[7] == 1 else 2)
+        cv2.rectangle(out, (x, y), (x + w, y + h), c, k * (1 if len(r) > 7 and r[7] == 1 else 2))
         cv2.putText(
-            out, str(tid), (x, max(10, y - 3)), cv2.FONT_HERSHEY_SIMPLEX, 0.4, c, 1, cv2.LINE_AA
-        )
+            out, str(tid), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, c, k,
+            cv2.LINE_AA,
+        )  # fmt: skip
     if label:
         cv2.putText(
-            out, label, (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA
-        )
+            out, label, (5 * k, 15 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k, (255, 255, 255), k,
+            cv2.LINE_AA,
+        )  # fmt: skip
     return out
-
-
-def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
-    """Bottom centre of an ``[left, top, width, height]`` box: where a walker stands."""
-    return float(box[0] + box[2] / 2), float(box[1] + box[3])
 
 
 def draw_trails(
     frame: NDArray[np.uint8], trails: Mapping[int, Sequence[tuple[float, float]]]
 ) -> None:
     """Draw each id's recent foot points on `frame` in place, as a line in the id's colour."""
+    k = ink_scale(frame.shape)
     for tid, pts in trails.items():
         if len(pts) > 1:
             line = np.round(np.asarray(pts, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
-            cv2.polylines(frame, [line], False, colour_of(tid), 1, cv2.LINE_AA)
+            cv2.polylines(frame, [line], False, colour_of(tid), k, cv2.LINE_AA)
+
+
+def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
+    """Bottom centre of an ``[left, top, width, height]`` box: where a walker stands."""
+    return float(box[0] + box[2] / 2), float(box[1] + box[3])
 
 
 def write_annotated_video(
