@@ -230,6 +230,28 @@ def test_scale_mismatch_refused(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert "-" in capsys.readouterr().out.split("\n")[2]  # a negative MOTA, as asked
 
 
+def test_scale_mismatch_within_a_quarter_refused() -> None:
+    """Was: ratios within 0.8-1.25 were never checked (960x720 results on 768x576 ground
+    truth scored MOTA -27 without a word)."""
+    gt = spread_scene(0)
+    res = perturbed(gt, 1)
+    res[:, 2:6] *= 1.25
+    with pytest.raises(ValueError, match=r"--scale S.*about 1\.2"):
+        check_scale(gt, res)
+    check_scale(gt, res, scale=1.25)
+
+
+def test_stretched_result_refused() -> None:
+    """A result on a 4:3 sequence stretched to 1920x1080 (x2.5 across, x1.875 down): no one
+    factor fits, and the message says so (was: scored as given, MOTA -28)."""
+    gt = spread_scene(0)
+    res = perturbed(gt, 1)
+    res[:, [2, 4]] *= 2.5
+    res[:, [3, 5]] *= 1.875
+    with pytest.raises(ValueError, match=r"2\.5\d? times .* across and 1\.88 times down"):
+        check_scale(gt, res)
+
+
 @pytest.mark.dataset
 def test_cli_on_real_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """../shared/data as a MOTChallenge folder (SEQ/gt.txt), PETS results on the video's scale."""

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._typing import PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark, mot_iou
 from pftrack.eval.metrics import MotMetrics, combine_mot, evaluate_mot
-from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT
+from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, WIDTH
 
 __all__ = [
     "COMBINED",
@@ -174,15 +174,24 @@ def result_file(results: PathLike, name: str) -> Path | None:
 
 # Factors tried around the box-height ratio by check_scale.
 _AROUND = np.geomspace(1 / 1.3, 1.3, 27)
+_AROUND_AXIS = np.geomspace(1 / 1.15, 1.15, 9)
 
 
 def _matched_fraction(
-    gt: NDArray[np.float64], res: NDArray[np.float64], scale: float, frames: NDArray[np.int64]
+    gt: NDArray[np.float64],
+    res: NDArray[np.float64],
+    scale: float | tuple[float, float],
+    frames: NDArray[np.int64],
 ) -> float:
-    """Fraction of the gt boxes of `frames` that some result box overlaps with IoU >= 0.5."""
+    """Fraction of the gt boxes of `frames` that some result box overlaps with IoU >= 0.5.
+
+    The ground truth is scaled by `scale`, one factor or (across, down).
+    """
+    sx, sy = (scale, scale) if isinstance(scale, (int, float)) else scale
+    factor = np.array([sx, sy, sx, sy])
     hit = total = 0
     for f in frames:
-        g = gt[gt[:, FRAME] == f, LEFT : LEFT + 4] * scale
+        g = gt[gt[:, FRAME] == f, LEFT : LEFT + 4] * factor
         r = res[res[:, FRAME] == f, LEFT : LEFT + 4]
         total += len(g)
         if len(g) and len(r):
@@ -195,12 +204,14 @@ def check_scale(
 ) -> None:
     """Refuse a result whose boxes are in another pixel scale than the (scaled) ground truth.
 
-    The median box height of the result and of the ground truth (times `scale`) are compared;
-    when they differ by more than 25 %, the share of ground-truth boxes that a result box
-    overlaps with IoU >= 0.5 is measured on up to 40 frames, as given and with the ground
-    truth rescaled by factors within 30 % of the height ratio. If the best of them more than
-    doubles that share (and reaches 30 %), the coordinate systems differ: typically PETS09
-    ground truth (768x576) against results on its 480x360 video, which needs ``scale=0.625``.
+    The share of ground-truth boxes (times `scale`) that a result box overlaps with IoU >= 0.5
+    is measured on up to 40 frames, as given and, unless half of them match already, with the
+    ground truth rescaled by factors within 30 % of the ratio of the median box heights, and
+    (when the median widths' ratio differs from the heights' by more than 10 %) by factors
+    across and down within 15 % of the two ratios. If the best of them more than doubles that
+    share (and reaches 30 %), the coordinate systems differ: typically PETS09 ground truth
+    (768x576) against results on its 480x360 video, which needs ``scale=0.625``, or results
+    on a video of another shape (a 4:3 sequence stretched to 16:9), which one factor cannot fix.
 
     Raises
     ------
@@ -218,28 +229,48 @@ def check_scale(
         g = g[g[:, CONF] != 0]
     g_h = float(np.median(g[:, HEIGHT])) * scale
     r_h = float(np.median(r[:, HEIGHT]))
-    if g_h <= 0 or r_h <= 0:
+    g_w = float(np.median(g[:, WIDTH])) * scale
+    r_w = float(np.median(r[:, WIDTH]))
+    if g_h <= 0 or r_h <= 0 or g_w <= 0 or r_w <= 0:
         return
     ratio = r_h / g_h
-    if 0.8 <= ratio <= 1.25:
-        return
     common = np.intersect1d(g[:, FRAME], r[:, FRAME]).astype(np.int64)
     if len(common) == 0:
         return
     sample = common[np.linspace(0, len(common) - 1, min(40, len(common))).astype(np.int64)]
     as_given = _matched_fraction(g, r, scale, sample)
+    if as_given >= 0.5:
+        return
     # Box heights give the ratio roughly; positions need it closer (a 5 % error moves a box
     # at x = 600 by 30 px), so try factors around it and keep the best.
     best, fit = max(
         ((_matched_fraction(g, r, scale * k, sample), scale * k) for k in ratio * _AROUND),
         key=lambda t: t[0],
     )
+    across = r_w / g_w
+    if abs(across / ratio - 1) > 0.1:  # another shape: a factor across and one down
+        stretched, (fx, fy) = max(
+            (
+                (_matched_fraction(g, r, (scale * a, scale * d), sample), (scale * a, scale * d))
+                for a in across * _AROUND_AXIS
+                for d in ratio * _AROUND_AXIS
+            ),
+            key=lambda t: t[0],
+        )
+        if stretched >= 0.3 and stretched > 2 * max(as_given, best):
+            raise ValueError(
+                f"{name}: its boxes look {fx / scale:.3g} times the ground truth's across and "
+                f"{fy / scale:.3g} times down ({as_given:.0%} of ground-truth boxes matched, "
+                f"{stretched:.0%} with the ground truth so stretched): the result is of a video "
+                "of another shape than the ground truth's images, which no --scale fixes; "
+                "rescale one of them per axis, or --no-scale-check"
+            )
     if best >= 0.3 and best > 2 * as_given:
         raise ValueError(
             f"{name}: its boxes look {fit / scale:.3g} times the ground truth's (median height "
             f"{r_h:.0f} vs {g_h:.0f} px; {as_given:.0%} of ground-truth boxes matched, "
-            f"{best:.0%} with the ground truth scaled by {fit:.2g}): pass --scale S, S the ratio "
-            f"of the image sizes (about {fit:.2g} here; 0.625 for PETS09 ground truth on its "
+            f"{best:.0%} with the ground truth scaled by {fit:.3g}): pass --scale S, S the ratio "
+            f"of the image sizes (about {fit:.3g} here; 0.625 for PETS09 ground truth on its "
             "480x360 video), or --no-scale-check"
         )
 
