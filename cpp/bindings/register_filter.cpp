@@ -111,8 +111,7 @@ void register_filter(py::module_& m) {
            bool resample, std::uint64_t seed, std::uint64_t step, double min_samples) {
             SisParams prm = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means,
                                                    lam, kernel, resample, "sis_step");
-            prm.min_samples = min_samples;
-            prm.validate("sis_step");
+            prm.min_samples = min_samples;  // checked by sis_step, with the other parameters
             SisResult r;
             {
                 py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
