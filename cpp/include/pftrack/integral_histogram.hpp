@@ -396,7 +396,6 @@ public:
     }
 
     const BinImage& view() const { return view_; }
-    Index step() const { return step_; }
     /// A frame coordinate in this image's pixels (the point of lattice column/row `v` / step).
     double x(double frame_x) const { return frame_x / static_cast<double>(step_) - static_cast<double>(x0_); }
     double y(double frame_y) const { return frame_y / static_cast<double>(step_) - static_cast<double>(y0_); }
