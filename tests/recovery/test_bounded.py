@@ -239,3 +239,29 @@ def test_segments_need_whole_frames_and_sizes_not_negative(
         recover_gap(a, b, method=method)
     with pytest.raises(ValueError, match="recover_gaps: " + match.replace(" row", " of gap 0 row")):
         recover_gaps([(a, b)], method)
+
+
+@pytest.mark.parametrize("method", ["linear", "rts", "linear-nb", "gdt", "gdt-mix", "auto"])
+def test_a_gap_longer_than_the_fill_limit_is_refused(method: str) -> None:
+    # was: np.arange over the gap's 2e9 frames (16 GB; the process was killed), or bad_alloc
+    from pftrack.recovery import recover_gap, recover_gaps
+
+    a = np.array([[1.0, 0, 0], [2, 1, 0]])
+    b = np.array([[2e9, 5, 0], [2e9 + 1, 6, 0]])
+    match = f"the gap from frame 2 to 2000000000 misses 1999999997 frames, more than {100_000}"
+    with pytest.raises(ValueError, match="recover_gap: " + match):
+        _bounded(lambda: recover_gap(a, b, method=method), seconds=5.0)
+    with pytest.raises(ValueError, match="recover_gaps: gap 0: " + match):
+        _bounded(lambda: recover_gaps([(a, b)], method), seconds=5.0)
+    ok = np.array([[MAX_GAP_LIMIT + 3.0, 9, 0], [MAX_GAP_LIMIT + 4.0, 9, 0]])
+    assert recover_gap(a, ok, frames=[3], method=method).shape == (1, 2)  # the limit itself
+
+
+def test_recover_gap_frames_must_be_real_integers() -> None:
+    from pftrack.recovery import recover_gap
+
+    a, b = np.array([[1.0, 0, 0]]), np.array([[9.0, 8, 0]])
+    with pytest.raises(TypeError, match="recover_gap: frames must hold real numbers"):
+        recover_gap(a, b, frames=np.array([3 + 1j]), method="linear")  # was a ComplexWarning
+    with pytest.raises(ValueError, match="recover_gap: frames must lie strictly between 1 and 9"):
+        recover_gap(a, b, frames=[1e300], method="linear")  # was a cast of 1e300 to int64

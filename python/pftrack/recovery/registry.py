@@ -66,7 +66,7 @@ from pftrack.recovery.neighbours import (
 )
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, distinct_runs, gap_frames
+from pftrack.recovery.segments import as_segment, distinct_runs, gap_ends, gap_frames
 
 __all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS", "recover_gap", "recover_gaps"]
 
@@ -146,11 +146,7 @@ def _checked_pairs(gaps: Sequence[tuple[ArrayLike, ArrayLike]]) -> list[tuple[F6
     pairs = []
     for k, (a, b) in enumerate(gaps):
         sa, sb = _gap_segment(a, "segment_a", k), _gap_segment(b, "segment_b", k)
-        if sb[0, 0] <= sa[-1, 0]:
-            raise ValueError(
-                f"recover_gaps: gap {k}: segment_b starts at frame {sb[0, 0]:g}, expected after "
-                f"segment_a's end {sa[-1, 0]:g}"
-            )
+        gap_ends(sa, sb, "recover_gaps", f"gap {k}: ")
         pairs.append((sa, sb))
     return pairs
 

@@ -15,12 +15,18 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import MAX_COORD, MAX_FRAME, real_array
 from pftrack._typing import F64
 
+#: Most frames a gap may miss (a longer one is refused, not filled): what one call fills is
+#: bounded, as ``fill_gaps``' `max_gap` (:data:`pftrack.recovery.fill.MAX_GAP_LIMIT`) is.
+MAX_GAP_LIMIT = 100_000
+
 __all__ = [
+    "MAX_GAP_LIMIT",
     "as_segment",
     "consecutive_runs",
     "contiguous_head",
     "contiguous_tail",
     "distinct_runs",
+    "gap_ends",
     "gap_frames",
 ]
 
@@ -98,29 +104,56 @@ def as_segment(seg: ArrayLike, name: str, fn: str = "recover_gap") -> F64:
     return np.ascontiguousarray(a)
 
 
+def gap_ends(seg_a: F64, seg_b: F64, fn: str = "recover_gap", gap: str = "") -> tuple[int, int]:
+    """Last frame of segment A and first of segment B, checked segments around one gap.
+
+    Parameters
+    ----------
+    seg_a, seg_b : (k, 3+) ndarray
+        Checked segments (:func:`as_segment`).
+    fn, gap : str
+        How errors name the function called and the gap (``"recover_gaps"``, ``"gap 3: "``).
+
+    Raises
+    ------
+    ValueError
+        Segment B does not start after segment A ends, or the gap misses more than
+        :data:`MAX_GAP_LIMIT` frames (its path would not fit in memory long before 2**31
+        frames: refused, not cut short).
+    """
+    f0, f1 = int(seg_a[-1, 0]), int(seg_b[0, 0])
+    if f1 <= f0:
+        raise ValueError(
+            f"{fn}: {gap}segment_b starts at frame {f1}, expected after segment_a's end {f0}"
+        )
+    if f1 - f0 - 1 > MAX_GAP_LIMIT:
+        raise ValueError(
+            f"{fn}: {gap}the gap from frame {f0} to {f1} misses {f1 - f0 - 1} frames, more than "
+            f"{MAX_GAP_LIMIT} (refused)"
+        )
+    return f0, f1
+
+
 def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.int64]:
     """Frames to fill between two checked segments (default: every frame of the gap).
 
     Raises
     ------
+    TypeError
+        `frames` holds what is not real numbers.
     ValueError
-        Segment B does not start after segment A ends, or `frames` is not 1-D integers strictly
-        inside the gap.
+        The gap :func:`gap_ends` refuses, or `frames` is not 1-D integers strictly inside the
+        gap.
     """
-    f0, f1 = int(seg_a[-1, 0]), int(seg_b[0, 0])
-    if f1 <= f0:
-        raise ValueError(
-            f"recover_gap: segment_b starts at frame {f1}, expected after segment_a's end {f0}"
-        )
+    f0, f1 = gap_ends(seg_a, seg_b)
     if frames is None:
         return np.arange(f0 + 1, f1, dtype=np.int64)
-    fr = np.asarray(frames)
-    if fr.ndim != 1 or (fr.size and not np.all(fr == np.round(fr))):
+    fr = real_array(frames, "recover_gap: frames")
+    if fr.ndim != 1 or not np.all(fr == np.round(fr)):
         raise ValueError("recover_gap: frames must be a 1-D array of integers")
-    fr = fr.astype(np.int64)
     if fr.size and (fr.min() <= f0 or fr.max() >= f1):
         raise ValueError(f"recover_gap: frames must lie strictly between {f0} and {f1}")
-    return fr
+    return fr.astype(np.int64)
 
 
 def consecutive_runs(segments: Sequence[ArrayLike], min_points: int) -> list[F64]:
