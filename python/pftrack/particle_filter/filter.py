@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _core
 from pftrack._check import MAX_COORD, number, real_array
 from pftrack._typing import F64, RngLike
+from pftrack.particle_filter.colour import not_binned
 from pftrack.particle_filter.dynamics import Ar2Model
 
 __all__ = [
@@ -172,13 +173,9 @@ def _step_argument_error(image: object, *filters: ColourParticleFilter) -> TypeE
     Asked only once the core has refused the arguments (pybind11's list of signatures), so
     the step itself pays nothing for it.
     """
-    if not isinstance(image, _core.BinnedImage):
-        hint = ""
-        if isinstance(image, np.ndarray) and image.ndim == 3:
-            hint = " (a raw frame? bin it first)"
-        return TypeError(
-            f"image must be a BinnedImage from hsv_bins(frame), got {type(image).__name__}{hint}"
-        )
+    error = not_binned(image, "image")
+    if error is not None:
+        return error
     for f in filters:
         for name in ("particles", "weights", "means"):
             a = getattr(f, name)
