@@ -14,6 +14,7 @@ __all__ = [
     "MAX_ID",
     "bad_id_message",
     "bgr_frame",
+    "bool_array",
     "first_bad_box",
     "first_bad_id",
     "flag",
@@ -140,6 +141,32 @@ def flag(value: object, what: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise TypeError(f"{what} must be True or False, got {type(value).__name__} {value!r}")
     return bool(value)
+
+
+def bool_array(values: ArrayLike, what: str) -> NDArray[np.bool_]:
+    """`values` as a bool array, refusing entries other than True and False (or 1 and 0).
+
+    ``np.asarray(values, dtype=bool)`` would take NaN, 2 and any non-empty string (``"no"``,
+    ``"False"``) as True.
+
+    Raises
+    ------
+    TypeError
+        Text, complex numbers or objects.
+    ValueError
+        A number other than 0 and 1 (NaN included); the message names the first.
+    """
+    raw = np.asarray(values)
+    if raw.dtype == np.bool_:
+        return raw
+    if raw.dtype.kind not in "iuf":
+        raise TypeError(f"{what} must hold True or False (or 1 or 0), got dtype {raw.dtype}")
+    bad = (raw != 0) & (raw != 1)
+    if bad.any():
+        k = np.unravel_index(int(np.argmax(bad)), raw.shape)
+        at = f"[{', '.join(str(int(i)) for i in k)}]" if k else ""
+        raise ValueError(f"{what}{at} is {raw[k]}, expected True or False (or 1 or 0)")
+    return raw.astype(np.bool_)
 
 
 def number(value: object, what: str, *, finite: bool = True) -> float:

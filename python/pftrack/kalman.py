@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack import _core
-from pftrack._check import real_array
+from pftrack._check import bool_array, flag, number, real_array
 from pftrack._typing import F64
 
 __all__ = [
@@ -107,6 +107,39 @@ def _require_cov(fn: str, cov: Cov) -> None:
         raise ValueError(f"{fn}: cov has {len(cov)} entries, expected 3 (p00, p01, p11)")
     for name, value, bound in zip(("p00", "p01", "p11"), cov, (">= 0", "", ">= 0"), strict=True):
         _require(fn, f"cov's {name}", value, bound)
+
+
+def _require_mean(fn: str, mean: Mean) -> None:
+    """:func:`_require` for a mean ``(position, velocity)``: both finite."""
+    if len(mean) != 2:
+        raise ValueError(f"{fn}: mean has {len(mean)} entries, expected 2 (position, velocity)")
+    for name, value in zip(("position", "velocity"), mean, strict=True):
+        _require(fn, f"mean's {name}", value)
+
+
+def _require_state(fn: str, mean: Mean, cov: Cov, **others: ArrayLike) -> None:
+    """Check a state (:func:`_require_mean`, :func:`_require_cov`) and its arrays' shapes.
+
+    The entries of `mean` and `cov` and the arrays of `others` (``q``, ``z``, ...) are one
+    value per axis: their shapes must broadcast together, or the state comes out ragged
+    (a mean over 3 axes beside a covariance over 4).
+    """
+    _require_mean(fn, mean)
+    _require_cov(fn, cov)
+    named: dict[str, ArrayLike] = {"mean's position": mean[0], "mean's velocity": mean[1]}
+    named.update({"cov's p00": cov[0], "cov's p01": cov[1], "cov's p11": cov[2], **others})
+    shapes = {name: np.shape(value) for name, value in named.items()}
+    seen: dict[str, tuple[int, ...]] = {}
+    for name, shape in shapes.items():
+        for other, got in seen.items():
+            try:
+                np.broadcast_shapes(got, shape)
+            except ValueError:
+                raise ValueError(
+                    f"{fn}: {other} has shape {got} and {name} {shape}, which do not broadcast "
+                    "together (one value per axis)"
+                ) from None
+        seen[name] = shape
 
 
 def cv_transition(dt: float = 1.0) -> F64:
@@ -219,10 +252,13 @@ def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, C
 
     Raises
     ------
+    TypeError
+        Values that are not real numbers.
     ValueError
-        A variance of `cov` (p00, p11), `q` or `dt` not finite and ``>= 0``, or p01 not finite.
+        A variance of `cov` (p00, p11), `q` or `dt` not finite and ``>= 0``, p01 or `mean`
+        not finite, or arrays whose shapes do not broadcast together.
     """
-    _require_cov("cv_predict", cov)
+    _require_state("cv_predict", mean, cov, q=q, dt=dt)
     _require("cv_predict", "q", q, ">= 0")
     _require("cv_predict", "dt", dt, ">= 0")
     return _cv_predict(mean, cov, q, dt)
@@ -259,11 +295,15 @@ def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
 
     Raises
     ------
+    TypeError
+        Values that are not real numbers.
     ValueError
-        A variance of `cov` (p00, p11) not finite and ``>= 0``, p01 not finite, or `r2` not
-        finite and ``> 0`` (as :func:`rts_smooth`'s).
+        A variance of `cov` (p00, p11) not finite and ``>= 0``, p01, `mean` or `z` not finite,
+        `r2` not finite and ``> 0`` (as :func:`rts_smooth`'s), or arrays whose shapes do not
+        broadcast together.
     """
-    _require_cov("cv_update", cov)
+    _require_state("cv_update", mean, cov, z=z, r2=r2)
+    _require("cv_update", "z", z)
     _require("cv_update", "r2", r2, "> 0")
     return _cv_update(mean, cov, z, r2)
 
@@ -284,11 +324,29 @@ def cv_update_where(
 
     `where` broadcasts against the state's arrays (e.g. (n,) over axes, or (K, 1) over rows
     of K tracks). All True is exactly :func:`cv_update`; all False returns `mean`, `cov`.
-    The arguments are checked as :func:`cv_update`'s, wherever `where` holds or not.
+    The arguments are checked as :func:`cv_update`'s, wherever `where` holds or not, but for
+    `z`, which may hold anything (NaN included) where `where` does not hold.
+
+    Raises
+    ------
+    TypeError
+        Values that are not real numbers, or a `where` that is not bools (``"no"`` would
+        count as True).
+    ValueError
+        What :func:`cv_update` refuses (`z` only where `where` holds), or a `where` entry
+        other than True and False (or 1 and 0; NaN would count as True).
     """
-    _require_cov("cv_update_where", cov)
-    _require("cv_update_where", "r2", r2, "> 0")
-    return _cv_update_where(mean, cov, z, r2, where)
+    fn = "cv_update_where"
+    w = bool_array(where, f"{fn}: where")
+    _require_state(fn, mean, cov, z=z, r2=r2, where=w)
+    zz, ww = np.broadcast_arrays(real_array(z, f"{fn}: z"), w)
+    missing = ww & ~np.isfinite(zz)
+    if missing.any():
+        k = np.unravel_index(int(np.argmax(missing)), zz.shape)
+        at = f"[{', '.join(str(int(i)) for i in k)}]" if k else ""
+        raise ValueError(f"{fn}: z{at} is {zz[k]:g} where `where` holds, expected finite")
+    _require(fn, "r2", r2, "> 0")
+    return _cv_update_where(mean, cov, z, r2, w)
 
 
 def _cv_update_where(
@@ -339,11 +397,23 @@ def rts_smooth(
     -------
     (T, n) ndarray
         Mean of each position given every measurement.
+
+    Raises
+    ------
+    TypeError
+        `z`, `q`, `r2` not real numbers, `has` not bools (``NaN`` or ``2`` would count as
+        observed), `velocity_sd` not a number or `update_first` not a bool (``"no"`` would
+        be True).
+    ValueError
+        Shapes that do not match, a first frame without a measurement, a measured `z` not
+        finite, `q` or `velocity_sd` not finite and ``>= 0``, `r2` not finite and ``> 0``.
     """
     # one C++ loop over frames per axis (tests/reference/smoothing.py holds the NumPy loop it
     # equals), which checks the shapes, the first frame and every value it reads; rows without
     # a measurement are never read
-    zz, hh = np.asarray(z, dtype=np.float64), np.asarray(has, dtype=bool)
-    q2, rr = np.asarray(q, dtype=np.float64), np.asarray(r2, dtype=np.float64)
-    out: F64 = _core.rts_smooth(zz, hh, q2, rr, float(velocity_sd), bool(update_first))
+    fn = "rts_smooth"
+    zz, hh = real_array(z, f"{fn}: z"), bool_array(has, f"{fn}: has")
+    q2, rr = real_array(q, f"{fn}: q"), real_array(r2, f"{fn}: r2")
+    sd = number(velocity_sd, f"{fn}: velocity_sd", finite=False)  # the core names NaN, < 0
+    out: F64 = _core.rts_smooth(zz, hh, q2, rr, sd, flag(update_first, f"{fn}: update_first"))
     return out

@@ -8,9 +8,12 @@ import pytest
 from pftrack import _core
 from pftrack.particle_filter import (
     Ar2Model,
+    BinnedImage,
     ColourParticleFilter,
     FilterConfig,
     HsvBinning,
+    bhattacharyya_coefficient,
+    bhattacharyya_distance,
     bhattacharyya_weights,
     box_histograms,
     hsv_bins,
@@ -94,7 +97,7 @@ def test_likelihood_bad_inputs():
     h = np.full((2, 4), 0.25)
     with pytest.raises(ValueError, match="ref size is 3, expected 4"):
         bhattacharyya_weights(h, np.ones(3))
-    with pytest.raises(ValueError, match="ref sum to 0"):
+    with pytest.raises(ValueError, match="ref sums to 0"):
         bhattacharyya_weights(h, np.zeros(4))
     with pytest.raises(ValueError, match=r"ref sum is not finite \(overflow"):
         bhattacharyya_weights(h, np.full(4, 1e308))
@@ -157,3 +160,97 @@ def test_arrays_through_pickle_are_accepted():
     assert _core.refine_boxes(boxes, mask, 0.05, 0.1).shape == (1, 4)
     with pytest.raises(ValueError, match="frame dtype is >u2"):
         _core.hsv_bins(np.zeros((8, 8, 3), ">u2"), None)
+
+
+IMAGE = hsv_bins(np.zeros((8, 8, 3), np.uint8))
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        # each was pybind11's list of box_histograms' signatures
+        (
+            lambda: box_histograms(np.zeros((8, 8, 3), np.uint8), [[1, 1, 2, 2]]),
+            TypeError,
+            r"box_histograms: image must be a BinnedImage from hsv_bins\(frame\), got ndarray "
+            r"\(a frame\? bin it first\)",
+        ),
+        (lambda: box_histograms(None, [[1, 1, 2, 2]]), TypeError, "got NoneType"),
+        (
+            lambda: box_histograms(IMAGE, np.ones((2, 2, 4))),
+            ValueError,
+            r"box_histograms: boxes must have shape \(K, 4\) \(cx, cy, w, h\), got \(2, 2, 4\)",
+        ),
+        # was cast to its real part with a ComplexWarning; "could not convert string to float"
+        (lambda: box_histograms(IMAGE, np.ones((1, 4)) + 0j), TypeError, "boxes must hold real"),
+        (lambda: box_histograms(IMAGE, [["a"] * 4]), TypeError, "boxes must hold real numbers"),
+        # was "expected finite (cx, cy, w, h) with w, h >= 0", not saying the limit
+        (
+            lambda: box_histograms(IMAGE, [[20, 20, 1e12, 10]]),
+            ValueError,
+            r"boxes\[0\] is \(20, 20, 1e\+12, 10\), expected .* within ±1e\+09 px",
+        ),
+        # was pybind11's list of signatures
+        (
+            lambda: bhattacharyya_weights(np.ones((2, 4)), np.ones((2, 4))),
+            ValueError,
+            r"bhattacharyya_weights: ref must have shape \(B,\), one histogram, got \(2, 4\)",
+        ),
+        # each began "bhattacharyya_coefficient:", the core's inner function
+        (
+            lambda: bhattacharyya_distance(np.ones((2, 4)), np.ones(3)),
+            ValueError,
+            "^bhattacharyya_distance: ref size is 3, expected 4",
+        ),
+        (
+            lambda: bhattacharyya_weights([[1.0, -1.0]], np.ones(2)),
+            ValueError,
+            r"^bhattacharyya_weights: hists\[0, 1\] is -1",
+        ),
+        # was "ref sum to 0 (all weights are 0: ... every particle outside the image?)"
+        (
+            lambda: bhattacharyya_distance(np.ones((2, 4)), np.zeros(4)),
+            ValueError,
+            r"^bhattacharyya_distance: ref sums to 0 \(an empty reference histogram",
+        ),
+        (
+            lambda: bhattacharyya_coefficient(np.ones((2, 4)), np.zeros(4)),
+            ValueError,
+            "^bhattacharyya_coefficient: ref sums to 0",
+        ),
+        # was the wrapped int16 value 4464; 1.5 was read as 1
+        (
+            lambda: BinnedImage(np.full((2, 2), 70000, np.int32), 110),
+            ValueError,
+            r"BinnedImage: bins value is 70000, expected in \[-1, n_bins\)",
+        ),
+        (
+            lambda: BinnedImage(np.array([[0, 64000]], np.uint16), 5),
+            ValueError,
+            "bins value is 64000",
+        ),
+        (lambda: BinnedImage(np.array([[0.0, 1.5]]), 5), ValueError, "bins value is 1.5"),
+        (lambda: BinnedImage(np.array([["a"]]), 5), TypeError, "bins must hold bin indices"),
+        # was AttributeError: 'str' object has no attribute 'n_h'
+        (
+            lambda: hsv_bins(np.zeros((4, 4, 3), np.uint8), binning="x"),
+            TypeError,
+            "hsv_bins: binning must be an HsvBinning, got str 'x'",
+        ),
+    ],
+)
+def test_colour_entry_points_name_the_argument(call, error, match):
+    with pytest.raises(error, match=match):
+        call()
+
+
+def test_box_histograms_takes_an_empty_list_as_no_box():
+    # was "boxes cols is 0", where np.zeros((0, 4)) was taken
+    assert box_histograms(IMAGE, []).shape == (0, IMAGE.n_bins)
+    assert box_histograms(IMAGE, np.zeros((0, 4))).shape == (0, IMAGE.n_bins)
+
+
+def test_binned_image_from_wider_integers_keeps_the_bins():
+    bins = np.array([[0, 4, -1]], np.int64)
+    np.testing.assert_array_equal(BinnedImage(bins, 5).bins, bins)
+    np.testing.assert_array_equal(BinnedImage(bins.astype(float), 5).bins, bins)

@@ -186,3 +186,96 @@ def test_filter_survives_an_empty_frame_region():
     s = f.step(image)
     assert np.isfinite(s.box_cxcywh).all() and s.rho == 0.0
     assert np.allclose(f.weights, 1 / len(f.weights))
+
+
+REF = np.ones(110)
+BOX = [20.0, 20.0, 10.0, 10.0]
+
+
+def _filter(**kw) -> ColourParticleFilter:
+    return ColourParticleFilter(kw.pop("box", BOX), kw.pop("reference", REF), rng=0, **kw)
+
+
+def _reinitialised(**kw) -> None:
+    _filter().reinitialise(BOX, **kw)
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        # was taken: the third value dropped; (1,) gave an IndexError
+        (lambda: _filter(velocity=(1, 2, 3)), ValueError, r"velocity must have shape \(2,\)"),
+        (lambda: _filter(velocity=(1,)), ValueError, r"velocity must have shape \(2,\) \(vx, vy\)"),
+        # was taken, then refused by box_histograms at the first step
+        (lambda: _filter(box=[1e300, 20, 10, 10]), ValueError, r"box is \[1e\+300, .*within ±1e"),
+        (
+            lambda: _filter(box=[20, 20, 1e12, 10]),
+            ValueError,
+            r"box is .*, each value within ±1e\+09",
+        ),
+        # was taken; "a" failed inside NumPy
+        (
+            lambda: _reinitialised(spread=-5),
+            ValueError,
+            "spread is -5, expected a finite number >=",
+        ),
+        (lambda: _reinitialised(spread="a"), TypeError, "spread must be a number, got str 'a'"),
+        # NaN was refused at the next step(), as "particles" with a non-finite value
+        (lambda: _reinitialised(spread=np.nan), ValueError, "spread is nan, expected a finite"),
+        (lambda: _reinitialised(velocity=(np.nan, 0)), ValueError, r"velocity is \[nan, 0.0\]"),
+        (lambda: _filter(velocity=(0, np.inf)), ValueError, r"velocity is \[0.0, inf\], expected"),
+        # "could not convert string to float"
+        (lambda: _filter(reference=["a"] * 110), TypeError, "reference must hold real numbers"),
+        (lambda: _filter(velocity=("a", "b")), TypeError, "velocity must hold real numbers"),
+        (lambda: _filter(box=["a", 1, 2, 3]), TypeError, "box must hold real numbers"),
+    ],
+)
+def test_filter_refuses_bad_arguments_at_once(call, error, match):
+    with pytest.raises(error, match=match):
+        call()
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a = a.copy()
+    a.setflags(write=False)
+    return a
+
+
+@pytest.mark.parametrize("sampler", ["sis", "mh"])  # sis_step_batch names them itself
+@pytest.mark.parametrize(
+    ("name", "value", "match"),
+    [  # each was pybind11's list of sis_step's signatures
+        (
+            "particles",
+            lambda p: p.astype(np.float32),
+            r"particles must be .* float64 .*got float32",
+        ),
+        ("particles", np.asfortranarray, r"particles must be a C-contiguous.*not C-contiguous"),
+        ("particles", _read_only, r"particles must be .*writeable.*read-only"),
+        ("particles", lambda p: p.tolist(), r"particles must be .*float64 array.*got list"),
+        ("weights", lambda w: w.astype(np.float32), r"weights must be .*float64.*got float32"),
+        ("means", lambda m: m.astype(np.float32), r"means must be .*float64.*got float32"),
+        ("reference", lambda r: np.vstack([r, r]), r"reference must be a \(B,\) float64 array"),
+    ],
+)
+def test_step_names_what_it_cannot_update(sampler, name, value, match):
+    from pftrack.particle_filter import MHColourParticleFilter
+
+    image = hsv_bins(np.zeros((40, 40, 3), np.uint8))
+    f = (MHColourParticleFilter if sampler == "mh" else ColourParticleFilter)(BOX, REF, rng=0)
+    setattr(f, name, value(getattr(f, name)))
+    with pytest.raises(TypeError, match=f"{type(f).__name__}.{match}"):
+        f.step(image)
+
+
+@pytest.mark.parametrize("frame", [np.zeros((40, 40, 3), np.uint8), None, "frame.png"])
+def test_step_wants_binned_image(frame):
+    from pftrack.particle_filter import MHColourParticleFilter
+    from pftrack.particle_filter.filter import step_filters
+
+    match = "image must be a BinnedImage from hsv_bins\\(frame\\), got " + type(frame).__name__
+    for f in (_filter(), MHColourParticleFilter(BOX, REF, rng=0)):
+        with pytest.raises(TypeError, match=match):
+            f.step(frame)
+    with pytest.raises(TypeError, match=match):
+        step_filters([_filter()], frame)

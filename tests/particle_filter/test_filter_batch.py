@@ -274,8 +274,18 @@ def test_reinitialise_filters_equals_one_at_a_time():
 
 def test_reinitialise_filters_checks_its_input():
     fs = [ColourParticleFilter([40.0, 30.0, 12.0, 30.0], np.ones(110), rng=k) for k in range(2)]
-    with pytest.raises(ValueError, match="2 boxes and 1 velocities for 2 filters"):
+    match = r"boxes_cxcywh \(2, 4\) and velocities \(1, 2\) for 2 filters, expected"
+    with pytest.raises(ValueError, match=match):
         reinitialise_filters(fs, np.ones((2, 4)), np.zeros((1, 2)))
+    # was taken: (2, 3) velocities read as (3, 2) for 3 filters
+    with pytest.raises(ValueError, match=r"velocities \(2, 3\) for 3 filters"):
+        reinitialise_filters([*fs, fs[0]], np.ones((3, 4)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="velocity is \\[nan, 0.0\\], expected finite"):
+        reinitialise_filters(fs, np.ones((2, 4)), [[0.0, 0.0], [np.nan, 0.0]])
+    with pytest.raises(ValueError, match="spread is -1, expected a finite number >= 0"):
+        reinitialise_filters(fs, np.ones((2, 4)), np.zeros((2, 2)), spread=-1)
+    with pytest.raises(ValueError, match=r"box is \[1e\+300, 1.0, 5.0, 5.0\], expected finite"):
+        reinitialise_filters(fs, [[1.0, 1, 5, 5], [1e300, 1, 5, 5]], np.zeros((2, 2)))
     with pytest.raises(ValueError, match=r"expected finite \(cx, cy, w, h\)"):
         reinitialise_filters(fs, [[1.0, 1, 5, 5], [1.0, 1, 0, 5]], np.zeros((2, 2)))
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 import tracemalloc
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 import pytest
@@ -205,3 +205,63 @@ def test_recover_gap_refuses_far_coordinates(method: str) -> None:
         recover_gap(a5, np.array([[5.0, 0, 0, 10, 20]]), None, method)
     got = recover_gap(a, np.array([[20.0, 1e9, 0], [21, 0, 0]]), None, method)
     assert np.all(np.isfinite(got))  # the bound itself is accepted
+
+
+SEG_A = [[1.0, 10, 20, 5, 4], [2, 12, 21, 5, 4]]
+SEG_B = [[7.0, 24, 27, 5, 4], [9, 26, 28, 5, 4]]
+
+
+def _seg(seg: list[list[float]], row: int, col: int, value: float) -> np.ndarray:
+    s = np.array(seg)
+    s[row, col] = value
+    return s
+
+
+@pytest.mark.parametrize("method", ["linear", "rts", "gdt", "gdt-bi", "gdt-mix", "auto"])
+@pytest.mark.parametrize(
+    ("a", "b", "match"),
+    [
+        # were taken: frames must be whole, as recover_gap's own `frames` and fill_gaps' rows
+        (_seg(SEG_A, 0, 0, 1.5), SEG_B, r"segment_a row 0 has frame 1.5, expected an integer"),
+        (SEG_A, _seg(SEG_B, 0, 0, 7.5), r"segment_b row 0 has frame 7.5, expected an integer"),
+        (SEG_A, _seg(SEG_B, 1, 0, 3e9), r"segment_b row 1 has frame 3e\+09, expected an integer"),
+        # was taken: a negative size, which read_mot and fill_gaps refuse
+        (_seg(SEG_A, 1, 3, -5), SEG_B, r"segment_a row 1 has w = -5: negative box width"),
+        (SEG_A, _seg(SEG_B, 0, 4, -1e-9), r"segment_b row 0 has h = -1e-09: negative box width"),
+    ],
+)
+def test_segments_need_whole_frames_and_sizes_not_negative(
+    method: str, a: Any, b: Any, match: str
+) -> None:
+    from pftrack.recovery import recover_gap, recover_gaps
+
+    with pytest.raises(ValueError, match="recover_gap: " + match):
+        recover_gap(a, b, method=method)
+    with pytest.raises(ValueError, match="recover_gaps: " + match.replace(" row", " of gap 0 row")):
+        recover_gaps([(a, b)], method)
+
+
+@pytest.mark.parametrize("method", ["linear", "rts", "linear-nb", "gdt", "gdt-mix", "auto"])
+def test_a_gap_longer_than_the_fill_limit_is_refused(method: str) -> None:
+    # was: np.arange over the gap's 2e9 frames (16 GB; the process was killed), or bad_alloc
+    from pftrack.recovery import recover_gap, recover_gaps
+
+    a = np.array([[1.0, 0, 0], [2, 1, 0]])
+    b = np.array([[2e9, 5, 0], [2e9 + 1, 6, 0]])
+    match = f"the gap from frame 2 to 2000000000 misses 1999999997 frames, more than {100_000}"
+    with pytest.raises(ValueError, match="recover_gap: " + match):
+        _bounded(lambda: recover_gap(a, b, method=method), seconds=5.0)
+    with pytest.raises(ValueError, match="recover_gaps: gap 0: " + match):
+        _bounded(lambda: recover_gaps([(a, b)], method), seconds=5.0)
+    ok = np.array([[MAX_GAP_LIMIT + 3.0, 9, 0], [MAX_GAP_LIMIT + 4.0, 9, 0]])
+    assert recover_gap(a, ok, frames=[3], method=method).shape == (1, 2)  # the limit itself
+
+
+def test_recover_gap_frames_must_be_real_integers() -> None:
+    from pftrack.recovery import recover_gap
+
+    a, b = np.array([[1.0, 0, 0]]), np.array([[9.0, 8, 0]])
+    with pytest.raises(TypeError, match="recover_gap: frames must hold real numbers"):
+        recover_gap(a, b, frames=np.array([3 + 1j]), method="linear")  # was a ComplexWarning
+    with pytest.raises(ValueError, match="recover_gap: frames must lie strictly between 1 and 9"):
+        recover_gap(a, b, frames=[1e300], method="linear")  # was a cast of 1e300 to int64

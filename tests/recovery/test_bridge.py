@@ -277,3 +277,31 @@ def test_paper_model_is_the_constant_velocity_model_of_eq_19():
     np.testing.assert_array_equal(m.A, cv_transition_xy(m.dt))
     np.testing.assert_array_equal(m.H, np.hstack([np.eye(2), np.zeros((2, 2))]))
     np.testing.assert_array_equal(np.diag(m.Q), m.q)
+
+
+@pytest.mark.parametrize("fn", ["goal_directed_path", "sample_goal_directed_paths"])
+def test_options_and_matrices_of_the_wrong_type_are_refused(fn):
+    from pftrack.recovery import sample_goal_directed_paths
+
+    p = problem(np.random.default_rng(5), T=4)
+    call = goal_directed_path if fn == "goal_directed_path" else sample_goal_directed_paths
+    extra = {} if fn == "goal_directed_path" else {"n_samples": 2, "rng": 0}
+    # was True: a non-empty string is truthy
+    with pytest.raises(TypeError, match=f"{fn}: start_conditioned must be True or False, got str"):
+        call(**p, **extra, start_conditioned="no")
+    # was cast to its real part with a ComplexWarning
+    with pytest.raises(TypeError, match="goal_directed_path: Q must hold real numbers"):
+        call(**{**p, "Q": p["Q"] + 0j}, **extra)
+    with pytest.raises(TypeError, match="goal_directed_path: y_T must hold real numbers"):
+        call(**{**p, "y_T": ["a", "b"]}, **extra)
+    got = call(**p, **extra, start_conditioned=np.False_)  # NumPy's bools are bools
+    want = call(**p, **extra, start_conditioned=False)
+    np.testing.assert_array_equal(getattr(got, "path", got), getattr(want, "path", want))
+
+
+def test_sample_count_must_be_an_int():
+    from pftrack.recovery import sample_goal_directed_paths
+
+    p = problem(np.random.default_rng(5), T=4)
+    with pytest.raises(TypeError, match="n_samples must be an int, got str"):
+        sample_goal_directed_paths(**p, n_samples="3")  # was "'<=' not supported"

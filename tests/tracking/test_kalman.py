@@ -296,3 +296,63 @@ def test_the_trackers_unchecked_calls_give_the_same_floats():
     for checked, unchecked in pairs:
         for a, b in zip([*checked[0], *checked[1]], [*unchecked[0], *unchecked[1]], strict=True):
             np.testing.assert_array_equal(a, b)
+
+
+Z3 = np.array([[1.0], [2.0], [3.0]])
+
+
+def _rts(**kw):
+    args = {"z": Z3, "has": [True] * 3, "q": [1.0], "r2": [1.0], "velocity_sd": 10.0}
+    args.update(kw)
+    return rts_smooth(**{"update_first": True, **args})
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        # each was taken: "no" as True, "10" as 10, NaN and 2 as observed, complex cast with a
+        # ComplexWarning, "no" and "False" as a bool that updates, a ragged (3,) / (4,) state
+        (lambda: _rts(update_first="no"), TypeError, "rts_smooth: update_first must be True or"),
+        (lambda: _rts(velocity_sd="10"), TypeError, "rts_smooth: velocity_sd must be a number"),
+        (lambda: _rts(has=[1.0, np.nan, 1.0]), ValueError, r"rts_smooth: has\[1\] is nan, expec"),
+        (lambda: _rts(has=[1, 2, 1]), ValueError, r"rts_smooth: has\[1\] is 2, expected True"),
+        (lambda: _rts(has=["yes"] * 3), TypeError, "rts_smooth: has must hold True or False"),
+        (lambda: _rts(z=Z3 + 1j), TypeError, "rts_smooth: z must hold real numbers"),
+        (lambda: _rts(q=["a"]), TypeError, "rts_smooth: q must hold real numbers"),
+        (lambda: cv_update_where(MEAN, COV, 1.0, 1.0, "no"), TypeError, "where must hold True"),
+        (lambda: cv_update_where(MEAN, COV, 1.0, 1.0, "False"), TypeError, "where must hold Tru"),
+        (lambda: cv_update_where(MEAN, COV, 1.0, 1.0, np.nan), ValueError, "where is nan, expec"),
+        (
+            lambda: cv_predict((np.zeros(3),) * 2, (np.ones(4), np.zeros(4), np.ones(4)), 1.0),
+            ValueError,
+            r"cv_predict: mean's position has shape \(3,\) and cov's p00 \(4,\), which do not",
+        ),
+        (
+            lambda: cv_update(MEAN, COV, np.zeros(3), 1.0),
+            ValueError,
+            r"cv_update: mean's position has shape \(2,\) and z \(3,\), which do not broadcast",
+        ),
+        (lambda: cv_predict((1.0, 2.0, 3.0), COV, 1.0), ValueError, "mean has 3 entries, expec"),
+        # NaN in the state or a measurement: refused by the checked helpers (NaN came out)
+        (lambda: cv_predict((np.nan, 0.0), COV, 1.0), ValueError, "mean's position is nan, exp"),
+        (lambda: cv_update((0.0, np.inf), COV, 1.0, 1.0), ValueError, "mean's velocity is inf"),
+        (lambda: cv_update(MEAN, COV, np.nan, 1.0), ValueError, "cv_update: z is nan, expected"),
+        (lambda: cv_update(MEAN, COV, 1j, 1.0), TypeError, "cv_update: z must hold real numbers"),
+        (
+            lambda: cv_update_where(MEAN, COV, [1.0, np.nan], 1.0, [False, True]),
+            ValueError,
+            r"cv_update_where: z\[1\] is nan where `where` holds, expected finite",
+        ),
+    ],
+)
+def test_helpers_refuse_what_would_be_taken_wrongly(call, error, match):
+    with pytest.raises(error, match=match):
+        call()
+
+
+def test_update_where_takes_anything_in_z_where_it_does_not_update():
+    got = cv_update_where(MEAN, COV, [np.nan, 1.0], 1.0, [0, 1])  # 0/1 count as bools
+    want = cv_update_where(MEAN, COV, [0.0, 1.0], 1.0, [False, True])
+    for a, b in zip([*got[0], *got[1]], [*want[0], *want[1]], strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert np.isfinite(_rts(has=np.array([1, 0, 1]), z=[[1.0], [np.nan], [3.0]])).all()

@@ -21,9 +21,35 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import real_array
+from pftrack._check import MAX_COORD, real_array
 
 BinnedImage = _core.BinnedImage
+_core_binned_image_init = BinnedImage.__init__
+
+
+def _binned_image_init(self: BinnedImage, bins: ArrayLike, n_bins: int) -> None:
+    # The core casts `bins` to int16 before it checks them, so a wider array's 70000 would be
+    # reported as 4464 and a float's 1.5 read as 1: such arrays are checked as given first.
+    # (The docstring stays the core's: its signature line is what help() and the stub test read.)
+    raw = np.asarray(bins)
+    if raw.dtype != np.int16:
+        if raw.dtype.kind not in "biuf":
+            raise TypeError(f"BinnedImage: bins must hold bin indices (integers), got {raw.dtype}")
+        if isinstance(n_bins, (int, np.integer)) and not isinstance(n_bins, bool):
+            bad = ~((raw >= -1) & (raw < n_bins))
+            if raw.dtype.kind == "f":
+                bad |= raw != np.floor(raw)
+            if bad.any():
+                v = raw.flat[int(np.argmax(bad))]
+                raise ValueError(f"BinnedImage: bins value is {v}, expected in [-1, n_bins)")
+    _core_binned_image_init(self, bins, n_bins)
+
+
+# the one class hsv_bins returns, checked when built by hand (pybind11 classes take a Python
+# __init__; it calls the core's)
+_binned_image_init.__doc__ = _core_binned_image_init.__doc__
+_binned_image_init.__name__, _binned_image_init.__qualname__ = "__init__", "BinnedImage.__init__"
+BinnedImage.__init__ = _binned_image_init  # type: ignore[method-assign]
 
 __all__ = [
     "BinnedImage",
@@ -109,6 +135,10 @@ def hsv_bins(
     BinnedImage
         ``.bins`` is the (H, W) int16 bin index per pixel, ``.n_bins`` the bin count.
     """
+    if not isinstance(binning, HsvBinning):
+        raise TypeError(
+            f"hsv_bins: binning must be an HsvBinning, got {type(binning).__name__} {binning!r}"
+        )
     f = _frame(frame)
     m = None
     if mask is not None:
@@ -147,6 +177,15 @@ def box_histograms(
         Rows sum to 1; a box with nothing to count (outside the image, or only background)
         gets an all-zero row, whose Bhattacharyya coefficient with any reference is 0.
 
+    Raises
+    ------
+    TypeError
+        `image` is not a :class:`BinnedImage` (the frame itself: bin it with
+        :func:`hsv_bins`), or the boxes are not real numbers.
+    ValueError
+        Boxes not of shape (K, 4) (an empty list is 0 boxes), a value not finite or beyond
+        ±1e9 px, a negative width or height, an unknown kernel.
+
     Notes
     -----
     With the uniform kernel, the counts of many overlapping boxes (one object's particles) may
@@ -158,17 +197,76 @@ def box_histograms(
     .. [1] Porikli, F. (2005). Integral histogram: a fast way to extract histograms in
        Cartesian spaces. CVPR 2005, 829-836.
     """
-    b = np.ascontiguousarray(np.atleast_2d(np.asarray(boxes_cxcywh, dtype=np.float64)))
-    return _core.box_histograms(image, b, kernel)
+    fn = "box_histograms"
+    error = not_binned(image, f"{fn}: image")
+    if error is not None:
+        raise error
+    return _core.box_histograms(image, _boxes(boxes_cxcywh, fn), kernel)
+
+
+def not_binned(image: object, what: str) -> TypeError | None:
+    """The error to raise when `image` is not a :class:`BinnedImage`, or None when it is.
+
+    A frame given as it is read is the likely mistake: the message says to bin it.
+    """
+    if isinstance(image, BinnedImage):
+        return None
+    hint = ""
+    if isinstance(image, np.ndarray) and image.ndim == 3:
+        hint = " (a frame? bin it first)"
+    return TypeError(
+        f"{what} must be a BinnedImage from hsv_bins(frame), got {type(image).__name__}{hint}"
+    )
+
+
+def _boxes(boxes_cxcywh: ArrayLike, fn: str) -> NDArray[np.float64]:
+    """Boxes as a row-major (K, 4) float64 array the core takes (one box (4,) is K = 1).
+
+    The core's rule, said with its limit: every value finite and within ±1e9 px, w, h >= 0.
+    """
+    b = real_array(boxes_cxcywh, f"{fn}: boxes")
+    if b.ndim == 1 and b.size == 0:
+        return np.zeros((0, 4))  # [] is no box, as np.zeros((0, 4))
+    b = np.atleast_2d(b)
+    if b.ndim != 2:
+        raise ValueError(f"{fn}: boxes must have shape (K, 4) (cx, cy, w, h), got {b.shape}")
+    if b.shape[1] != 4:
+        raise ValueError(f"{fn}: boxes cols is {b.shape[1]}, expected 4 (cx, cy, w, h)")
+    bad = ~((np.abs(b) < MAX_COORD).all(axis=1) & (b[:, 2] >= 0) & (b[:, 3] >= 0))  # NaN: bad
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"{fn}: boxes[{i}] is ({', '.join(f'{v:g}' for v in b[i])}), expected finite "
+            f"(cx, cy, w, h) with w, h >= 0, each value within ±{MAX_COORD:g} px"
+        )
+    return np.ascontiguousarray(b)
 
 
 def _histograms(hists: ArrayLike, fn: str) -> NDArray[np.float64]:
     """`hists` as a row-major (K, B) float64 array (the core normalises each row and checks it)."""
-    return np.ascontiguousarray(np.atleast_2d(real_array(hists, f"{fn}: hists")))
+    h = np.atleast_2d(real_array(hists, f"{fn}: hists"))
+    if h.ndim != 2:
+        raise ValueError(
+            f"{fn}: hists must have shape (K, B), one histogram per row, got {h.shape}"
+        )
+    return np.ascontiguousarray(h)
 
 
 def _reference(ref: ArrayLike, fn: str) -> NDArray[np.float64]:
-    return np.ascontiguousarray(real_array(ref, f"{fn}: ref"))
+    """`ref` as a (B,) float64 array, refusing one that sums to 0 (the core checks the rest)."""
+    r = real_array(ref, f"{fn}: ref")
+    if r.ndim != 1:
+        raise ValueError(f"{fn}: ref must have shape (B,), one histogram, got {r.shape}")
+    if r.size and not r.any():
+        raise ValueError(f"{fn}: ref sums to 0 (an empty reference histogram: no bin counted)")
+    return np.ascontiguousarray(r)
+
+
+def _named(fn: str, error: ValueError) -> ValueError:
+    """`error` of the core's ``bhattacharyya_coefficient``, named after `fn`, the one called."""
+    inner = "bhattacharyya_coefficient: "
+    message = str(error)
+    return ValueError(fn + ": " + message[len(inner) :] if message.startswith(inner) else message)
 
 
 def bhattacharyya_coefficient(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float64]:
@@ -187,7 +285,11 @@ def bhattacharyya_distance(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float
     Rows and `ref` normalised as by :func:`bhattacharyya_coefficient`.
     """
     fn = "bhattacharyya_distance"
-    return _core.bhattacharyya_distance(_histograms(hists, fn), _reference(ref, fn))
+    h, r = _histograms(hists, fn), _reference(ref, fn)
+    try:
+        return _core.bhattacharyya_distance(h, r)
+    except ValueError as e:
+        raise _named(fn, e) from None
 
 
 def bhattacharyya_weights(
@@ -216,12 +318,16 @@ def bhattacharyya_weights(
     TypeError
         `lam` is not a real number (a string, None, a bool), or the histograms hold no numbers.
     ValueError
-        `lam` is not finite and > 0; shapes that do not match; a negative or non-finite
-        entry; `ref` all zeros.
+        `lam` is not finite and > 0; shapes that do not match (`ref` not 1-D); a negative or
+        non-finite entry; `ref` all zeros.
     """
     fn = "bhattacharyya_weights"
     if isinstance(lam, bool) or not isinstance(lam, numbers.Real):
         raise TypeError(f"{fn}: lam must be a real number, got {type(lam).__name__} {lam!r}")
     if not (np.isfinite(lam) and lam > 0):
         raise ValueError(f"{fn}: lam is {lam}, expected a finite number > 0")
-    return _core.bhattacharyya_weights(_histograms(hists, fn), _reference(ref, fn), float(lam))
+    h, r = _histograms(hists, fn), _reference(ref, fn)
+    try:
+        return _core.bhattacharyya_weights(h, r, float(lam))
+    except ValueError as e:
+        raise _named(fn, e) from None

@@ -10,7 +10,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import MAX_COORD, number, real_array
 from pftrack._typing import F64, RngLike
+from pftrack.particle_filter.colour import not_binned
 from pftrack.particle_filter.dynamics import Ar2Model
 
 __all__ = [
@@ -112,10 +114,92 @@ class FilterState:
 
 
 def _box(box_cxcywh: ArrayLike) -> NDArray[np.float64]:
-    b = np.asarray(box_cxcywh, dtype=np.float64).reshape(-1)
-    if b.shape != (4,) or not np.isfinite(b).all() or b[2] <= 0 or b[3] <= 0:
-        raise ValueError(f"box is {b.tolist()}, expected finite (cx, cy, w, h) with w, h > 0")
+    """A box ``(cx, cy, w, h)`` the filter can follow: :func:`box_histograms`' rule, w, h > 0.
+
+    Raises
+    ------
+    TypeError
+        Not real numbers.
+    ValueError
+        Not 4 values, a non-finite one, w or h <= 0, or a value beyond ±1e9 px (which
+        :func:`~pftrack.particle_filter.box_histograms` refuses at the first step).
+    """
+    b = real_array(box_cxcywh, "box").reshape(-1)
+    if b.shape != (4,) or not (_bounded(b) and b[2] > 0 and b[3] > 0):
+        raise ValueError(
+            f"box is {b.tolist()}, expected finite (cx, cy, w, h) with w, h > 0, each value "
+            f"within ±{MAX_COORD:g} px"
+        )
     return b
+
+
+def _bounded(values: NDArray[np.float64]) -> bool:
+    """Every value finite and within ``±MAX_COORD`` (strictly, as the core's box rule)."""
+    return bool((np.abs(values) < MAX_COORD).all())  # NaN fails
+
+
+def _velocity(velocity: ArrayLike) -> NDArray[np.float64]:
+    """A velocity ``(vx, vy)`` in pixels per frame: 2 finite values within ``±MAX_COORD``.
+
+    Raises
+    ------
+    TypeError
+        Not real numbers.
+    ValueError
+        Not shape (2,) (a third value would be dropped), or a value not finite or beyond
+        ±1e9 px per frame.
+    """
+    v = real_array(velocity, "velocity")
+    if v.shape != (2,):
+        raise ValueError(f"velocity must have shape (2,) (vx, vy), got {v.shape}: {v.tolist()}")
+    if not _bounded(v):
+        raise ValueError(
+            f"velocity is {v.tolist()}, expected finite (vx, vy) within ±{MAX_COORD:g} px per frame"
+        )
+    return v
+
+
+def _spread(spread: object) -> float:
+    """`spread` of :meth:`ColourParticleFilter.reinitialise`: a finite number >= 0."""
+    s = number(spread, "spread")
+    if s < 0:
+        raise ValueError(f"spread is {s:g}, expected a finite number >= 0")
+    return s
+
+
+def _step_argument_error(image: object, *filters: ColourParticleFilter) -> TypeError | None:
+    """What the core could not take in a step of `filters` on `image` (None: nothing found).
+
+    Asked only once the core has refused the arguments (pybind11's list of signatures), so
+    the step itself pays nothing for it.
+    """
+    error = not_binned(image, "image")
+    if error is not None:
+        return error
+    for f in filters:
+        for name in ("particles", "weights", "means"):
+            a = getattr(f, name)
+            if not isinstance(a, np.ndarray):
+                got = type(a).__name__
+            elif a.dtype != np.float64 or not a.flags.c_contiguous or not a.flags.writeable:
+                order = "C-contiguous" if a.flags.c_contiguous else "not C-contiguous"
+                got = f"{a.dtype} {a.shape}, {order}{'' if a.flags.writeable else ', read-only'}"
+            else:
+                continue
+            return TypeError(
+                f"{type(f).__name__}.{name} must be a C-contiguous, writeable float64 array "
+                f"(the step updates it in place), got {got}"
+            )
+        ref = f.reference
+        if not (isinstance(ref, np.ndarray) and ref.dtype == np.float64 and ref.ndim == 1):
+            got = type(ref).__name__
+            if isinstance(ref, np.ndarray):
+                got = f"{ref.dtype} {ref.shape}"
+            return TypeError(
+                f"{type(f).__name__}.reference must be a (B,) float64 array (set_reference), "
+                f"got {got}"
+            )
+    return None
 
 
 class ColourParticleFilter:
@@ -137,6 +221,16 @@ class ColourParticleFilter:
         Seeds the filter: same seed, same particles, whatever the thread count.
     velocity : (2,) array_like, optional
         Initial velocity (pixels per frame) of the centre.
+
+    Raises
+    ------
+    TypeError
+        A box, reference or velocity that is not real numbers.
+    ValueError
+        A box that is not 4 finite values with w, h > 0, or a velocity that is not 2 finite
+        values, any value beyond ±1e9 px (the rule of
+        :func:`~pftrack.particle_filter.box_histograms`); a reference that is negative, not
+        finite or all zero.
 
     References
     ----------
@@ -194,8 +288,16 @@ class ColourParticleFilter:
         self._last, self._last_row = state, None
 
     def set_reference(self, reference: ArrayLike) -> None:
-        """Replace the reference histogram (e.g. a slow blend with the current appearance)."""
-        r = np.ascontiguousarray(reference, dtype=np.float64).reshape(-1)
+        """Replace the reference histogram (e.g. a slow blend with the current appearance).
+
+        Raises
+        ------
+        TypeError
+            Not real numbers.
+        ValueError
+            A value not finite or negative, or all zero.
+        """
+        r = np.ascontiguousarray(real_array(reference, "reference")).reshape(-1)
         if not np.all(np.isfinite(r)) or np.any(r < 0) or r.sum() <= 0:
             raise ValueError("reference histogram must be finite, >= 0 and not all zero")
         self.reference = r / r.sum()
@@ -212,10 +314,18 @@ class ColourParticleFilter:
         velocity : (2,) array_like, optional
             Velocity to give the particles; by default the filter's current velocity estimate.
         spread : float
-            Position spread as a multiple of ``model.sigma_xy``.
+            Position spread as a multiple of ``model.sigma_xy`` (a finite number >= 0).
+
+        Raises
+        ------
+        TypeError
+            A box or velocity that is not real numbers, a spread that is not a number.
+        ValueError
+            A box or velocity the filter cannot follow (see the class), a spread < 0 or NaN.
         """
         b = _box(box_cxcywh)
-        v = self.velocity if velocity is None else np.asarray(velocity, dtype=np.float64)
+        v = self.velocity if velocity is None else _velocity(velocity)
+        spread = _spread(spread)
         s = math.sqrt(float((b[2] / self.w0) * (b[3] / self.h0)))
         m = self.config.model
         s = min(max(s, m.s_min), m.s_max)  # np.clip's value, without its call overhead
@@ -244,14 +354,31 @@ class ColourParticleFilter:
         return np.array([cx, cy, s * self.w0, s * self.h0])
 
     def step(self, image: _core.BinnedImage) -> FilterState:
-        """Advance one frame: resample, propagate, weigh against `image`, estimate."""
+        """Advance one frame: resample, propagate, weigh against `image`, estimate.
+
+        Raises
+        ------
+        TypeError
+            `image` is not a :class:`~pftrack.particle_filter.BinnedImage` (a raw frame: bin
+            it with :func:`~pftrack.particle_filter.hsv_bins`), or ``particles``, ``weights``
+            or ``means`` were replaced by arrays the step cannot update in place (not
+            float64, not C-contiguous, read-only).
+        ValueError
+            Arrays of the wrong shape, non-finite particles.
+        """
         m = self.config.model
-        r = _core.sis_step(
-            self.particles, self.weights, self.means, image, self.reference,
-            self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-            self.config.lam, self.config.kernel, True, self._seed, self._step,
-            float(self.config.min_samples),
-        )  # fmt: skip
+        try:
+            r = _core.sis_step(
+                self.particles, self.weights, self.means, image, self.reference,
+                self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+                self.config.lam, self.config.kernel, True, self._seed, self._step,
+                float(self.config.min_samples),
+            )  # fmt: skip
+        except TypeError:
+            error = _step_argument_error(image, self)
+            if error is None:
+                raise
+            raise error from None
         self._step += 1
         cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
         state = FilterState(
@@ -316,12 +443,19 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
     if batch:
         fs = [filters[k] for k in batch]
         m = cfg.model
-        out = _core.sis_step_batch(
-            [f.particles for f in fs], [f.weights for f in fs], [f.means for f in fs], image,
-            [f.reference for f in fs], np.array([f.w0 for f in fs]), np.array([f.h0 for f in fs]),
-            m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means, cfg.lam, cfg.kernel, True,
-            [f._seed for f in fs], [f._step for f in fs], float(cfg.min_samples),
-        )  # fmt: skip
+        try:
+            out = _core.sis_step_batch(
+                [f.particles for f in fs], [f.weights for f in fs], [f.means for f in fs],
+                image, [f.reference for f in fs], np.array([f.w0 for f in fs]),
+                np.array([f.h0 for f in fs]), m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+                cfg.lam, cfg.kernel, True, [f._seed for f in fs], [f._step for f in fs],
+                float(cfg.min_samples),
+            )  # fmt: skip
+        except TypeError:
+            error = _step_argument_error(image, *fs)
+            if error is None:
+                raise
+            raise error from None
         col = 3 if cfg.estimate == "map" else 0
         at = slice(None) if len(batch) == len(filters) else batch
         summary[at, 0:2] = out[:, col : col + 2]
@@ -360,26 +494,36 @@ def reinitialise_filters(
     velocities : (K, 2) array_like
         Velocity to give each filter's particles, pixels per frame.
     spread : float
-        Position spread as a multiple of ``model.sigma_xy``.
+        Position spread as a multiple of ``model.sigma_xy`` (a finite number >= 0).
 
     Raises
     ------
+    TypeError
+        Boxes or velocities that are not real numbers, a spread that is not a number.
     ValueError
-        Not one finite box (w, h > 0) and one velocity per filter.
+        Not one box (K, 4) and one velocity (K, 2) per filter, each as
+        :meth:`ColourParticleFilter.reinitialise` takes it; a spread < 0 or NaN.
     """
     k = len(filters)
-    b = np.asarray(boxes_cxcywh, dtype=np.float64).reshape(-1, 4)
-    v = np.asarray(velocities, dtype=np.float64).reshape(-1, 2)
-    if len(b) != k or len(v) != k:
-        raise ValueError(f"{len(b)} boxes and {len(v)} velocities for {k} filters")
-    if k == 0:
+    b = real_array(boxes_cxcywh, "boxes_cxcywh")
+    v = real_array(velocities, "velocities")
+    spread = _spread(spread)
+    if k == 0 and b.size == 0 and v.size == 0:
         return
+    if b.shape != (k, 4) or v.shape != (k, 2):
+        raise ValueError(
+            f"boxes_cxcywh {b.shape} and velocities {v.shape} for {k} filters, expected "
+            f"({k}, 4) and ({k}, 2)"
+        )
+    bad_v = ~(np.abs(v) < MAX_COORD).all(axis=1)
+    if bad_v.any():
+        _velocity(v[int(np.flatnonzero(bad_v)[0])])  # raises, naming the velocity
     cfg = filters[0].config
     if not all(f.config is cfg or f.config == cfg for f in filters):
         for f, box, vel in zip(filters, b, v, strict=True):
             f.reinitialise(box, velocity=vel, spread=spread)
         return
-    bad = ~(np.isfinite(b).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0))
+    bad = ~((np.abs(b) < MAX_COORD).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0))
     if bad.any():
         _box(b[int(np.flatnonzero(bad)[0])])  # raises, naming the box
     m = cfg.model

@@ -18,7 +18,12 @@ from numpy.typing import ArrayLike
 
 from pftrack import _core
 from pftrack._typing import RngLike
-from pftrack.particle_filter.filter import ColourParticleFilter, FilterConfig, FilterState
+from pftrack.particle_filter.filter import (
+    ColourParticleFilter,
+    FilterConfig,
+    FilterState,
+    _step_argument_error,
+)
 
 __all__ = ["MHColourParticleFilter"]
 
@@ -69,13 +74,19 @@ class MHColourParticleFilter(ColourParticleFilter):
     def step(self, image: _core.BinnedImage) -> FilterState:
         """Advance one frame with MH moves; records ``acceptance``."""
         m = self.config.model
-        r = _core.mh_step(
-            self.particles, self.weights, self.means, image, self.reference,
-            self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-            self.config.lam, self.config.kernel, True, self._seed, self._step,
-            n_iter=self.n_iter, burn_in=0, proposal="dynamics",
-            rw_sigma=np.array([2.0, 2.0, 0.01]),
-        )  # fmt: skip
+        try:
+            r = _core.mh_step(
+                self.particles, self.weights, self.means, image, self.reference,
+                self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+                self.config.lam, self.config.kernel, True, self._seed, self._step,
+                n_iter=self.n_iter, burn_in=0, proposal="dynamics",
+                rw_sigma=np.array([2.0, 2.0, 0.01]),
+            )  # fmt: skip
+        except TypeError:  # as ColourParticleFilter.step: say which argument
+            error = _step_argument_error(image, self)
+            if error is None:
+                raise
+            raise error from None
         self._step += 1
         self.acceptance = float(r["acceptance"])
         cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]

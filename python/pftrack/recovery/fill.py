@@ -30,6 +30,7 @@ from pftrack.recovery.mixture import MotionFit, fit_motion
 from pftrack.recovery.names import NEIGHBOUR_METHODS
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, recover_gaps
+from pftrack.recovery.segments import MAX_GAP_LIMIT  # Largest `max_gap` accepted
 
 __all__ = [
     "DEFAULT_MAX_GAP",
@@ -45,8 +46,6 @@ __all__ = [
 #: ``smooth``, the tracker's offline pass): longer holes stay holes, so work and memory are
 #: bounded by the number of rows whatever the frame numbers.
 DEFAULT_MAX_GAP = 30
-#: Largest `max_gap` accepted: a hole longer than this is never filled (refused, not capped).
-MAX_GAP_LIMIT = 100_000
 #: Methods ``"auto"`` scores for box sizes ``(w, h)``, calibrated like the centres.
 SIZE_CANDIDATES = ("linear", "rts")
 #: At most this many artificial gaps calibrate the box sizes.

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
+from pftrack._check import flag, real_array
 from pftrack._typing import F64, RngLike
 from pftrack.kalman import cv_transition_xy
 
@@ -68,7 +69,7 @@ class GdtModel:
 
 
 def _as_stack(a: ArrayLike, name: str) -> F64:
-    arr = np.ascontiguousarray(a, dtype=np.float64)
+    arr = np.ascontiguousarray(_real(a, name))
     if arr.ndim not in (2, 3):
         raise ValueError(f"goal_directed_path: {name} must be (n, n) or (T, n, n), got {arr.shape}")
     return arr
@@ -122,16 +123,20 @@ def _model_arrays(
     y_T: ArrayLike,  # noqa: N803
 ) -> tuple[F64, F64, F64, F64, F64, F64, F64]:
     """The model as the float64 arrays ``gdt_solve``/``gdt_sample`` take (A, Q stacked per step)."""
-    f64 = np.float64
     return (
         _as_stack(A, "A"),
         _as_stack(Q, "Q"),
-        np.atleast_2d(np.asarray(H_T, dtype=f64)),
-        np.atleast_2d(np.asarray(Pi_T, dtype=f64)),
-        np.asarray(m0, dtype=f64),
-        np.atleast_2d(np.asarray(Pi_0, dtype=f64)),
-        np.asarray(y_T, dtype=f64),
+        np.atleast_2d(_real(H_T, "H_T")),
+        np.atleast_2d(_real(Pi_T, "Pi_T")),
+        _real(m0, "m0"),
+        np.atleast_2d(_real(Pi_0, "Pi_0")),
+        _real(y_T, "y_T"),
     )
+
+
+def _real(a: ArrayLike, name: str) -> F64:
+    """`a` as float64, refusing complex numbers (cast with a warning) and text."""
+    return real_array(a, f"goal_directed_path: {name}")
 
 
 def goal_directed_path(
@@ -184,6 +189,8 @@ def goal_directed_path(
 
     Raises
     ------
+    TypeError
+        `T` not an int, `start_conditioned` not a bool (``"no"`` would be True).
     ValueError
         T <= 0, mismatched dimensions, NaN, non-symmetric or non-PSD ``Q``, singular or non-PD
         ``Pi_0``/``Pi_T``, ``H_T`` unfit for `form`.
@@ -197,12 +204,8 @@ def goal_directed_path(
     """
     T = _check_T(T)
     _check_form(form)
-    r = _core.gdt_solve(
-        *_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T),
-        T,
-        form,
-        bool(start_conditioned),
-    )
+    conditioned = flag(start_conditioned, "goal_directed_path: start_conditioned")
+    r = _core.gdt_solve(*_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T), T, form, conditioned)
     return GdtSolution(r["path"], r["eps"], r["cov"], r["x0_mean"], r["x0_cov"])
 
 
@@ -228,8 +231,12 @@ def sample_goal_directed_paths(
     """
     T = _check_T(T)
     _check_form(form)
+    fn = "sample_goal_directed_paths"
+    if isinstance(n_samples, bool) or not isinstance(n_samples, (int, np.integer)):
+        raise TypeError(f"{fn}: n_samples must be an int, got {type(n_samples).__name__}")
     if n_samples <= 0:
-        raise ValueError(f"sample_goal_directed_paths: n_samples is {n_samples}, expected > 0")
+        raise ValueError(f"{fn}: n_samples is {n_samples}, expected > 0")
+    conditioned = flag(start_conditioned, f"{fn}: start_conditioned")
     seed = int(np.random.default_rng(rng).integers(2**63))
     out: F64 = _core.gdt_sample(
         *_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T),
@@ -237,6 +244,6 @@ def sample_goal_directed_paths(
         int(n_samples),
         seed,
         form,
-        bool(start_conditioned),
+        conditioned,
     )
     return out

@@ -47,6 +47,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pftrack._check import real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
@@ -65,7 +66,7 @@ from pftrack.recovery.neighbours import (
 )
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, distinct_runs, gap_frames
+from pftrack.recovery.segments import as_segment, distinct_runs, gap_ends, gap_frames
 
 __all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS", "recover_gap", "recover_gaps"]
 
@@ -109,8 +110,9 @@ def recover_gap(
         `frames` is a string: a method given positionally, as :func:`recover_gaps` and
         :func:`~pftrack.recovery.fill.fill_gaps` take it (second); here it goes by keyword.
     ValueError
-        Empty or malformed segments, NaN, overlapping segments, frames outside the gap or an
-        unknown method.
+        Empty or malformed segments (:func:`~pftrack.recovery.segments.as_segment`: NaN, a
+        frame that is not an integer, a negative width or height, a value beyond ±1e9 px),
+        overlapping segments, frames outside the gap or an unknown method.
     """
     if isinstance(frames, str):  # recover_gap(a, b, "linear"): frames come third here
         hint = f"; the method goes by keyword: method={frames!r}" if frames in METHODS else ""
@@ -135,11 +137,28 @@ def recover_gap(
 
 
 def _checked_pairs(gaps: Sequence[tuple[ArrayLike, ArrayLike]]) -> list[tuple[F64, F64]]:
-    """The gaps as checked ``(segment_a, segment_b)`` arrays, each B after its A."""
-    pairs = [(as_segment(a, "segment_a"), as_segment(b, "segment_b")) for a, b in gaps]
-    for a, b in pairs:
-        gap_frames(a, b, None)
+    """The gaps as checked ``(segment_a, segment_b)`` arrays, each B after its A.
+
+    Every method's segments meet the same rules (:func:`as_segment`, errors naming
+    ``recover_gaps`` and the gap); a segment of other than 3 or 5 columns is taken by its
+    ``frame, x, y``, the only columns :func:`recover_gaps` reads.
+    """
+    pairs = []
+    for k, (a, b) in enumerate(gaps):
+        sa, sb = _gap_segment(a, "segment_a", k), _gap_segment(b, "segment_b", k)
+        gap_ends(sa, sb, "recover_gaps", f"gap {k}: ")
+        pairs.append((sa, sb))
     return pairs
+
+
+def _gap_segment(seg: ArrayLike, name: str, k: int) -> F64:
+    """Segment `name` of gap `k`, checked by :func:`as_segment` (see :func:`_checked_pairs`)."""
+    s = real_array(seg, f"recover_gaps: {name} of gap {k}")
+    if s.ndim != 2 or s.shape[1] < 3 or s.shape[0] == 0:
+        raise ValueError(
+            f"recover_gaps: {name} of gap {k} must have shape (k, 3|5), non-empty; got {s.shape}"
+        )
+    return as_segment(s if s.shape[1] in (3, 5) else s[:, :3], f"{name} of gap {k}", "recover_gaps")
 
 
 def recover_gaps(
@@ -184,6 +203,12 @@ def recover_gaps(
     list of (T_g - 1, 2) ndarray
         ``(x, y)`` of every frame inside each gap.
 
+    Raises
+    ------
+    ValueError
+        An unknown method, or segments :func:`recover_gap` refuses, whatever the method (the
+        message names the gap).
+
     Notes
     -----
     ``"gdt"`` and ``"gdt-bi"`` filter the segments and solve every gap in one C++ call with
@@ -192,10 +217,10 @@ def recover_gaps(
     """
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
-    if method == "rts" and gaps:  # one vectorised pass over all gaps
-        return rts_batch(_checked_pairs(gaps))
+    pairs = _checked_pairs(gaps)
+    if method == "rts" and pairs:  # one vectorised pass over all gaps
+        return rts_batch(pairs)
     if method in NEIGHBOUR_METHODS:
-        pairs = _checked_pairs(gaps)
         runs = distinct_runs([s for p in pairs for s in p] if observed is None else observed)
         base = method.removesuffix(NB_SUFFIX)
 
@@ -204,35 +229,18 @@ def recover_gaps(
 
         return correct_by_neighbours(recover, pairs, Neighbourhood(runs))
     if method not in GOAL_DIRECTED_METHODS:
-        return [
-            recover_gap(a, b, method=method, noise=noise)[:, :2]
-            for a, b in progress(gaps, desc=method, unit="gap")
+        return [  # recover_gap's path, without checking the checked pairs again
+            BASELINES[method](a, b, fr) if fr.size else np.zeros((0, 2))
+            for a, b in progress(pairs, desc=method, unit="gap")
+            for fr in (gap_frames(a, b, None),)
         ]
-    if not gaps:
+    if not pairs:
         return []
-    seg_a = [np.asarray(a, dtype=np.float64) for a, _ in gaps]
-    seg_b = [np.asarray(b, dtype=np.float64) for _, b in gaps]
-    for k, s in enumerate(seg_a + seg_b):
-        if s.ndim != 2 or s.shape[1] < 3 or s.shape[0] == 0:
-            name = "segment_a" if k < len(gaps) else "segment_b"
-            raise ValueError(
-                f"recover_gaps: {name} of gap {k % len(gaps)} must have shape (k, 3|5), "
-                f"non-empty; got {s.shape}"
-            )
     if method == "auto":
-        pairs = list(zip(seg_a, seg_b, strict=True))
         return recover_auto(pairs, observed, noise, motion, seed=seed, combine=combine)[0]
+    seg_a = [a for a, _ in pairs]
+    seg_b = [b for _, b in pairs]
     if method == "gdt-mix":
-        pairs = [
-            (as_segment(a, "segment_a"), as_segment(b, "segment_b"))
-            for a, b in zip(seg_a, seg_b, strict=True)
-        ]
-        for k, (a, b) in enumerate(pairs):
-            if b[0, 0] <= a[-1, 0]:
-                raise ValueError(
-                    f"recover_gaps: gap {k}: segment_b starts at frame {b[0, 0]:g}, expected "
-                    f"after segment_a's end {a[-1, 0]:g}"
-                )
         if motion is None:
             motion = fit_motion(seg_a + seg_b, noise)
         return recover_mixture_gaps(pairs, motion)

@@ -12,20 +12,26 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_COORD, real_array
+from pftrack._check import MAX_COORD, MAX_FRAME, real_array
 from pftrack._typing import F64
 
+#: Most frames a gap may miss (a longer one is refused, not filled): what one call fills is
+#: bounded, as ``fill_gaps``' `max_gap` (:data:`pftrack.recovery.fill.MAX_GAP_LIMIT`) is.
+MAX_GAP_LIMIT = 100_000
+
 __all__ = [
+    "MAX_GAP_LIMIT",
     "as_segment",
     "consecutive_runs",
     "contiguous_head",
     "contiguous_tail",
     "distinct_runs",
+    "gap_ends",
     "gap_frames",
 ]
 
 
-def as_segment(seg: ArrayLike, name: str) -> F64:
+def as_segment(seg: ArrayLike, name: str, fn: str = "recover_gap") -> F64:
     """Check and convert one segment to a C-contiguous ``(k, 3|5)`` float64 array.
 
     Parameters
@@ -34,6 +40,8 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
         Rows ``(frame, x, y[, w, h])``.
     name : str
         How error messages name the segment (``"segment_a"``, ...).
+    fn : str
+        How they name the function called (``"recover_gaps"``, ...).
 
     Returns
     -------
@@ -44,26 +52,86 @@ def as_segment(seg: ArrayLike, name: str) -> F64:
     TypeError
         Values that are not real numbers (complex, text, objects).
     ValueError
-        Wrong shape, no row, a non-finite value, a position or size beyond ``MAX_COORD``
-        (1e9 px) or frames that do not increase strictly.
+        Wrong shape, no row, a non-finite value, a frame that is not an integer with
+        ``|frame| <= MAX_FRAME`` (whole frames only, as `frames` and
+        :func:`~pftrack.recovery.fill.fill_gaps` take them), a negative width or height (as
+        :func:`pftrack.io.mot.read_mot`), a position or size beyond ``MAX_COORD`` (1e9 px) or
+        frames that do not increase strictly.
     """
-    a = real_array(seg, f"recover_gap: {name}")
+    a = real_array(seg, f"{fn}: {name}")
     if a.ndim != 2 or a.shape[1] not in (3, 5):
-        raise ValueError(f"recover_gap: {name} must have shape (k, 3) or (k, 5), got {a.shape}")
+        raise ValueError(f"{fn}: {name} must have shape (k, 3) or (k, 5), got {a.shape}")
     if a.shape[0] == 0:
-        raise ValueError(f"recover_gap: {name} is empty")
+        raise ValueError(f"{fn}: {name} is empty")
+    # every rule in a few passes, then the checks below name what is wrong only when something
+    # is (frames that increase are within ±MAX_FRAME when their ends are)
+    f = a[:, 0]
+    if (
+        np.isfinite(a).all()
+        and (np.diff(f) > 0).all()
+        and -MAX_FRAME <= f[0]
+        and f[-1] <= MAX_FRAME
+        and (f == np.floor(f)).all()
+        and (a.shape[1] == 3 or a[:, 3:].min() >= 0)
+        and np.abs(a[:, 1:]).max() <= MAX_COORD
+    ):
+        return np.ascontiguousarray(a)
     if not np.all(np.isfinite(a)):
-        raise ValueError(f"recover_gap: {name} has a non-finite value")
+        raise ValueError(f"{fn}: {name} has a non-finite value")
+    f = a[:, 0]
+    fractional = (np.abs(f) > MAX_FRAME) | (f != np.floor(f))
+    if fractional.any():
+        r = int(np.argmax(fractional))
+        raise ValueError(
+            f"{fn}: {name} row {r} has frame {f[r]:g}, expected an integer with "
+            f"|frame| <= {MAX_FRAME} (refused)"
+        )
+    if a.shape[1] == 5 and (a[:, 3:] < 0).any():
+        r, c = np.argwhere(a[:, 3:] < 0)[0]
+        raise ValueError(
+            f"{fn}: {name} row {r} has {('w', 'h')[c]} = {a[r, c + 3]:g}: negative box "
+            "width or height (refused)"
+        )
     far = np.abs(a[:, 1:]) > MAX_COORD
     if far.any():
         r, c = np.argwhere(far)[0]
         raise ValueError(
-            f"recover_gap: {name} row {r} has {('x', 'y', 'w', 'h')[c]} = {a[r, c + 1]:g}, "
+            f"{fn}: {name} row {r} has {('x', 'y', 'w', 'h')[c]} = {a[r, c + 1]:g}, "
             f"beyond ±{MAX_COORD:g} px (refused)"
         )
     if np.any(np.diff(a[:, 0]) <= 0):
-        raise ValueError(f"recover_gap: {name} frames must increase strictly")
+        raise ValueError(f"{fn}: {name} frames must increase strictly")
     return np.ascontiguousarray(a)
+
+
+def gap_ends(seg_a: F64, seg_b: F64, fn: str = "recover_gap", gap: str = "") -> tuple[int, int]:
+    """Last frame of segment A and first of segment B, checked segments around one gap.
+
+    Parameters
+    ----------
+    seg_a, seg_b : (k, 3+) ndarray
+        Checked segments (:func:`as_segment`).
+    fn, gap : str
+        How errors name the function called and the gap (``"recover_gaps"``, ``"gap 3: "``).
+
+    Raises
+    ------
+    ValueError
+        Segment B does not start after segment A ends, or the gap misses more than
+        :data:`MAX_GAP_LIMIT` frames (its path would not fit in memory long before 2**31
+        frames: refused, not cut short).
+    """
+    f0, f1 = int(seg_a[-1, 0]), int(seg_b[0, 0])
+    if f1 <= f0:
+        raise ValueError(
+            f"{fn}: {gap}segment_b starts at frame {f1}, expected after segment_a's end {f0}"
+        )
+    if f1 - f0 - 1 > MAX_GAP_LIMIT:
+        raise ValueError(
+            f"{fn}: {gap}the gap from frame {f0} to {f1} misses {f1 - f0 - 1} frames, more than "
+            f"{MAX_GAP_LIMIT} (refused)"
+        )
+    return f0, f1
 
 
 def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.int64]:
@@ -71,24 +139,21 @@ def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.i
 
     Raises
     ------
+    TypeError
+        `frames` holds what is not real numbers.
     ValueError
-        Segment B does not start after segment A ends, or `frames` is not 1-D integers strictly
-        inside the gap.
+        The gap :func:`gap_ends` refuses, or `frames` is not 1-D integers strictly inside the
+        gap.
     """
-    f0, f1 = int(seg_a[-1, 0]), int(seg_b[0, 0])
-    if f1 <= f0:
-        raise ValueError(
-            f"recover_gap: segment_b starts at frame {f1}, expected after segment_a's end {f0}"
-        )
+    f0, f1 = gap_ends(seg_a, seg_b)
     if frames is None:
         return np.arange(f0 + 1, f1, dtype=np.int64)
-    fr = np.asarray(frames)
-    if fr.ndim != 1 or (fr.size and not np.all(fr == np.round(fr))):
+    fr = real_array(frames, "recover_gap: frames")
+    if fr.ndim != 1 or not np.all(fr == np.round(fr)):
         raise ValueError("recover_gap: frames must be a 1-D array of integers")
-    fr = fr.astype(np.int64)
     if fr.size and (fr.min() <= f0 or fr.max() >= f1):
         raise ValueError(f"recover_gap: frames must lie strictly between {f0} and {f1}")
-    return fr
+    return fr.astype(np.int64)
 
 
 def consecutive_runs(segments: Sequence[ArrayLike], min_points: int) -> list[F64]:
