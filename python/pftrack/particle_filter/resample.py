@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import generator
 from pftrack._typing import RngLike
 
 __all__ = [
@@ -65,7 +66,7 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
        state space models. Journal of Computational and Graphical Statistics 5(1), 1-25.
     """
     w = _weights(weights)
-    return _core.systematic_resample(w, np.random.default_rng(rng).random())
+    return _core.systematic_resample(w, generator(rng, "systematic_resample: rng").random())
 
 
 def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
@@ -88,7 +89,7 @@ def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
        particle filtering. ISPA 2005, 64-69.
     """
     w = _weights(weights)
-    return _core.stratified_resample(w, np.random.default_rng(rng).random(len(w)))
+    return _core.stratified_resample(w, generator(rng, "stratified_resample: rng").random(len(w)))
 
 
 def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
@@ -113,7 +114,7 @@ def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.
        Bayesian state estimation. IEE Proceedings F 140(2), 107-113.
     """
     w = _weights(weights)
-    return _core.multinomial_resample(w, np.random.default_rng(rng).random(len(w)))
+    return _core.multinomial_resample(w, generator(rng, "multinomial_resample: rng").random(len(w)))
 
 
 def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
@@ -139,4 +140,4 @@ def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int
        JASA 93(443), 1032-1044.
     """
     w = _weights(weights)
-    return _core.residual_resample(w, np.random.default_rng(rng).random(len(w)))
+    return _core.residual_resample(w, generator(rng, "residual_resample: rng").random(len(w)))
