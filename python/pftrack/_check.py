@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._typing import F64
+from pftrack._typing import F64, RngLike
 
 __all__ = [
     "BOX_VALUES",
@@ -18,8 +18,10 @@ __all__ = [
     "first_bad_box",
     "first_bad_id",
     "flag",
+    "generator",
     "number",
     "real_array",
+    "seed",
 ]
 
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
@@ -189,3 +191,46 @@ def number(value: object, what: str, *, finite: bool = True) -> float:
     if finite and not np.isfinite(value):
         raise ValueError(f"{what} is {value}, expected a finite number")
     return float(value)
+
+
+def seed(value: object, what: str) -> int:
+    """`value` as a seed: an int >= 0 (NumPy's, not a bool).
+
+    NumPy's own refusals (``"unrecognized seed string"``, ``"expected non-negative integer"``)
+    do not name the argument.
+
+    Raises
+    ------
+    TypeError
+        Not an int (a string, a float, None, a bool).
+    ValueError
+        Negative.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what} must be an int >= 0, got {type(value).__name__} {value!r}")
+    if value < 0:
+        raise ValueError(f"{what} is {value}, expected an int >= 0")
+    return int(value)
+
+
+def generator(rng: RngLike, what: str) -> np.random.Generator:
+    """``numpy.random.default_rng(rng)``, whose errors name the argument.
+
+    A Generator is returned as it is; NumPy's refusals (``"SeedSequence expects int or
+    sequence of ints for entropy not abc"``, ``"expected non-negative integer"``) do not say
+    which argument was wrong.
+
+    Raises
+    ------
+    TypeError
+        Not a Generator, a seed or None (a string, a float).
+    ValueError
+        A negative seed.
+    """
+    try:
+        return np.random.default_rng(rng)
+    except (TypeError, ValueError) as e:
+        raise type(e)(
+            f"{what} must be a numpy.random.Generator, an int >= 0 or None, got "
+            f"{type(rng).__name__} {rng!r}"
+        ) from None

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, real_array
+from pftrack._check import MAX_COORD, number, real_array
 
 BinnedImage = _core.BinnedImage
 _core_binned_image_init = BinnedImage.__init__
@@ -87,7 +87,7 @@ class HsvBinning:
             if not (isinstance(v, (int, np.integer)) and 1 <= v <= 64):
                 raise ValueError(f"{name} is {v!r}, expected an int in [1, 64]")
         for name in ("s_min", "v_min"):
-            v = getattr(self, name)
+            v = number(getattr(self, name), f"HsvBinning: {name}", finite=False)
             if not (0.0 <= v <= 1.0):
                 raise ValueError(f"{name} is {v!r}, expected a value in [0, 1]")
 

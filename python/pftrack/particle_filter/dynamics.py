@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import number
 
 __all__ = ["Ar2Model", "estimate", "propagate"]
 
@@ -52,7 +53,7 @@ class Ar2Model:
 
     def __post_init__(self) -> None:
         for name in ("sigma_xy", "sigma_s", "velocity_gain", "scale_gain", "s_min", "s_max"):
-            v = getattr(self, name)
+            v = number(getattr(self, name), f"Ar2Model: {name}", finite=False)
             if not np.isfinite(v) or v < 0:
                 raise ValueError(f"Ar2Model: {name} is {v}, expected a finite value >= 0")
         if not 0 < self.s_min <= self.s_max:

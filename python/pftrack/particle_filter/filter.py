@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, number, real_array
+from pftrack._check import MAX_COORD, generator, number, real_array
 from pftrack._typing import F64, RngLike
 from pftrack.particle_filter.colour import not_binned
 from pftrack.particle_filter.dynamics import Ar2Model
@@ -71,8 +71,9 @@ class FilterConfig:
             raise ValueError(
                 f"n_particles is {self.n_particles!r}, expected an integer in [1, {MAX_PARTICLES}]"
             )
-        if not (np.isfinite(self.lam) and self.lam >= 0):
-            raise ValueError(f"lam is {self.lam}, expected a finite value >= 0")
+        lam = number(self.lam, "FilterConfig: lam", finite=False)
+        if not (np.isfinite(lam) and lam >= 0):
+            raise ValueError(f"lam is {lam}, expected a finite value >= 0")
         if self.kernel not in ("uniform", "epanechnikov"):
             raise ValueError(f"kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'")
         if self.estimate not in ("mean", "map"):
@@ -247,7 +248,7 @@ class ColourParticleFilter:
         velocity: ArrayLike = (0.0, 0.0),
     ) -> None:
         self.config = config if config is not None else FilterConfig()
-        self._rng = np.random.default_rng(rng)
+        self._rng = generator(rng, "rng")
         self._seed = int(self._rng.integers(2**63))
         self._step = 0
         b = _box(box_cxcywh)

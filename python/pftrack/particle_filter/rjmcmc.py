@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import generator
 from pftrack._typing import RngLike
 
 
@@ -156,7 +157,7 @@ class RJMCMCFilter:
                 "expected 'uniform' or 'epanechnikov'"
             )
         self._core = _core.RJMCMCTracker(**self.config.core_kwargs())
-        self.seed = int(np.random.default_rng(rng).integers(2**63))
+        self.seed = int(generator(rng, "RJMCMCFilter: rng").integers(2**63))
         self.n_steps = 0
         self.last: dict[str, Any] = {}
 

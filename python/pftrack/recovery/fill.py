@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack import _check
 from pftrack._typing import F64
 from pftrack.recovery.calibrate import Calibration, recover_auto
 from pftrack.recovery.linking import (
@@ -133,11 +134,13 @@ def fill_gaps(
 
     Raises
     ------
+    TypeError
+        `combine` not a bool, `seed` not an int.
     ValueError
-        Unknown method, `max_gap` not an integer in ``1..MAX_GAP_LIMIT``, rows not
-        ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer id, a
-        non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width or
-        height, a value beyond ±1e9 px) or a duplicate (frame, id).
+        Unknown method, a negative `seed`, `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
+        rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
+        id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
+        or height, a value beyond ±1e9 px) or a duplicate (frame, id).
     """
     new_rows, report = fill_rows(tracks, method, max_gap, noise, seed=seed, combine=combine)
     filled = np.vstack([np.asarray(tracks, dtype=np.float64), new_rows])
@@ -162,6 +165,7 @@ def fill_rows(
         raise ValueError(f"fill_gaps: method is {method!r}, expected one of {METHODS}")
     if not isinstance(combine, (bool, np.bool_)):
         raise TypeError(f"fill_gaps: combine must be a bool, got {type(combine).__name__}")
+    seed = _check.seed(seed, "fill_gaps: seed")  # NumPy's refusal named no argument
     if (
         not isinstance(max_gap, (int, np.integer))
         or isinstance(max_gap, bool)

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import flag, real_array
+from pftrack._check import flag, generator, real_array
 from pftrack._typing import F64, RngLike
 from pftrack.kalman import cv_transition_xy
 
@@ -237,7 +237,7 @@ def sample_goal_directed_paths(
     if n_samples <= 0:
         raise ValueError(f"{fn}: n_samples is {n_samples}, expected > 0")
     conditioned = flag(start_conditioned, f"{fn}: start_conditioned")
-    seed = int(np.random.default_rng(rng).integers(2**63))
+    seed = int(generator(rng, f"{fn}: rng").integers(2**63))
     out: F64 = _core.gdt_sample(
         *_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T),
         T,

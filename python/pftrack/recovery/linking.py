@@ -287,12 +287,18 @@ def link_tracklets(
 
     Raises
     ------
+    TypeError
+        `config` is not a :class:`LinkConfig`.
     ValueError
         Bad rows (:func:`check_rows`: a box :func:`pftrack.io.mot.read_mot` refuses too) or a
         (frame, id) seen twice.
     """
     from pftrack.assignment import linear_sum_assignment  # SciPy's pairs, without SciPy
 
+    if not isinstance(config, LinkConfig):  # a string failed on a missing attribute
+        raise TypeError(
+            f"link_tracklets: config must be a LinkConfig, got {type(config).__name__} {config!r}"
+        )
     rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
     check_unique(rows)  # a track seen twice in one frame has no velocity to link with
     if len(rows) == 0:

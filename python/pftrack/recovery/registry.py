@@ -47,6 +47,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pftrack import _check
 from pftrack._check import real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
@@ -144,7 +145,14 @@ def _checked_pairs(gaps: Sequence[tuple[ArrayLike, ArrayLike]]) -> list[tuple[F6
     ``frame, x, y``, the only columns :func:`recover_gaps` reads.
     """
     pairs = []
-    for k, (a, b) in enumerate(gaps):
+    for k, gap in enumerate(gaps):
+        if isinstance(gap, (str, bytes)) or len(gap) != 2:  # "not enough values to unpack"
+            n = len(gap) if hasattr(gap, "__len__") else None
+            got = type(gap).__name__ if n is None else f"{n} value{'' if n == 1 else 's'}"
+            raise ValueError(
+                f"recover_gaps: gap {k} must be a pair (segment_a, segment_b), got {got}"
+            )
+        a, b = gap
         sa, sb = _gap_segment(a, "segment_a", k), _gap_segment(b, "segment_b", k)
         gap_ends(sa, sb, "recover_gaps", f"gap {k}: ")
         pairs.append((sa, sb))
@@ -205,9 +213,11 @@ def recover_gaps(
 
     Raises
     ------
+    TypeError
+        A `seed` that is not an int.
     ValueError
-        An unknown method, or segments :func:`recover_gap` refuses, whatever the method (the
-        message names the gap).
+        An unknown method, a gap that is not a pair of segments, segments :func:`recover_gap`
+        refuses, whatever the method (the message names the gap), or a negative `seed`.
 
     Notes
     -----
@@ -217,6 +227,7 @@ def recover_gaps(
     """
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
+    seed = _check.seed(seed, "recover_gaps: seed")
     pairs = _checked_pairs(gaps)
     if method == "rts" and pairs:  # one vectorised pass over all gaps
         return rts_batch(pairs)

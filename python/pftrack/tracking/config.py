@@ -9,6 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from pftrack._check import number
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
 from pftrack.particle_filter.filter import MAX_PARTICLES
@@ -37,9 +38,20 @@ PIXEL_DIAGONAL = REFERENCE_DIAGONAL
 GIVEN_PARTICLES = 200
 
 
+def _numbers(owner: str, config: object, *names: str) -> None:
+    """Refuse the named settings unless numbers or None, with a TypeError naming them.
+
+    Text failed at a comparison without a name (``'<=' not supported``), or was taken.
+    """
+    for name in names:
+        v = getattr(config, name)
+        if v is not None:
+            number(v, f"{owner}: {name}", finite=False)
+
+
 def _in_unit_interval(owner: str, **values: float) -> None:
     for name, v in values.items():
-        if not 0.0 <= v <= 1.0:
+        if not 0.0 <= number(v, f"{owner}: {name}", finite=False) <= 1.0:
             raise ValueError(f"{owner}: {name} is {v}, expected a value in [0, 1]")
 
 
@@ -89,6 +101,8 @@ class AssociationConfig:
     merge_ratio: float = 1.8
 
     def __post_init__(self) -> None:
+        names = ("match_iou", "match_distance", "colour_weight", "unmatched_cost", "merge_ratio")
+        _numbers("AssociationConfig", self, *names)
         if not self.unmatched_cost > 0:  # NaN fails too
             raise ValueError(
                 f"AssociationConfig: unmatched_cost is {self.unmatched_cost}, expected a value > 0 "
@@ -193,6 +207,9 @@ class LifecycleConfig:
     amodal_anchor: str = "side"
 
     def __post_init__(self) -> None:
+        _numbers("LifecycleConfig", self, "min_score", "min_area", "birth_score", "birth_quantile")
+        _numbers("LifecycleConfig", self, "coast_min_rho", "nested_inside", "nested_area")
+        _numbers("LifecycleConfig", self, "amodal_share")
         _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
         if self.relink_coast is not None:
             _integers_at_least("LifecycleConfig", 1, self, "relink_coast")
@@ -272,6 +289,8 @@ class MotionConfig:
     speed_span: int = 4
 
     def __post_init__(self) -> None:
+        names = ("accel", "detection_noise", "colour_noise", "speed_reference")
+        _numbers("MotionConfig", self, *names)
         _integers_at_least("MotionConfig", 1, self, "speed_span")
         v = self.speed_reference
         if v is not None and not (np.isfinite(v) and v > 0):
@@ -317,6 +336,7 @@ class RefineConfig:
     min_height: float = 0.6
 
     def __post_init__(self) -> None:
+        _numbers("RefineConfig", self, "fraction", "leg_fill", "min_height")
         if self.leg_fill is not None:
             _in_unit_interval("RefineConfig", leg_fill=self.leg_fill)
         _in_unit_interval("RefineConfig", min_height=self.min_height)
@@ -374,7 +394,7 @@ class CameraConfig:
         _integers_at_least("CameraConfig", 1, self, *names, "refresh_frames")
         _integers_at_least("CameraConfig", 0, self, "settle_frames", "still_features")
         for name in ("ransac_threshold", "threshold"):
-            v = getattr(self, name)
+            v = number(getattr(self, name), f"CameraConfig: {name}", finite=False)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"CameraConfig: {name} is {v}, expected a finite value > 0")
 

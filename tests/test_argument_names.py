@@ -1,0 +1,165 @@
+"""Settings, seeds and generators of the wrong type are refused naming the argument.
+
+Each call here failed with a message that named nothing (NumPy's ``ufunc 'isfinite' not
+supported``, ``'<=' not supported``, ``unrecognized seed string``, ``expected non-negative
+integer``, an AttributeError, ``not enough values to unpack``), or was taken.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack.particle_filter import (
+    Ar2Model,
+    ColourParticleFilter,
+    FilterConfig,
+    HsvBinning,
+    RJMCMCFilter,
+    multinomial_resample,
+    residual_resample,
+    stratified_resample,
+    systematic_resample,
+)
+from pftrack.recovery import fill_gaps, link_tracklets, recover_gaps
+from pftrack.tracking.config import (
+    AssociationConfig,
+    CameraConfig,
+    MotionConfig,
+    RefineConfig,
+    TrackerConfig,
+)
+
+ROWS = np.array(
+    [[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [4, 1, 11, 10, 5, 5, 1, -1, -1, -1.0]]
+)  # fmt: skip
+SEG = np.array([[1.0, 10, 20], [2, 12, 21]])
+
+CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
+    "FilterConfig(lam='a')": (
+        lambda: FilterConfig(lam="a"),
+        TypeError,
+        "FilterConfig: lam must be a number, got str 'a'",
+    ),
+    "Ar2Model(sigma_xy='4')": (
+        lambda: Ar2Model(sigma_xy="4"),
+        TypeError,
+        "Ar2Model: sigma_xy must be a number, got str '4'",
+    ),
+    "HsvBinning(v_min='0.2')": (
+        lambda: HsvBinning(v_min="0.2"),
+        TypeError,
+        "HsvBinning: v_min must be a number",
+    ),
+    "Tracker(birth_quantile='0.2')": (
+        lambda: pftrack.Tracker(birth_quantile="0.2"),
+        TypeError,
+        "LifecycleConfig: birth_quantile must be a number, got str '0.2'",
+    ),
+    "AssociationConfig(unmatched_cost='1')": (
+        lambda: AssociationConfig(unmatched_cost="1"),
+        TypeError,
+        "AssociationConfig: unmatched_cost must be a number",
+    ),
+    "MotionConfig(speed_reference='x')": (
+        lambda: MotionConfig(speed_reference="x"),
+        TypeError,
+        "MotionConfig: speed_reference must be a number",
+    ),
+    "RefineConfig(min_height='x')": (
+        lambda: RefineConfig(min_height="x"),
+        TypeError,
+        "RefineConfig: min_height must be a number",
+    ),
+    "CameraConfig(threshold='x')": (
+        lambda: CameraConfig(threshold="x"),
+        TypeError,
+        "CameraConfig: threshold must be a number",
+    ),
+    "TrackerConfig(reference_rate=None)": (
+        lambda: TrackerConfig(reference_rate=None),
+        TypeError,
+        "TrackerConfig: reference_rate must be a number, got NoneType",
+    ),
+    "link_tracklets(rows, 'x')": (
+        lambda: link_tracklets(ROWS, "x"),
+        TypeError,
+        "link_tracklets: config must be a LinkConfig, got str 'x'",
+    ),
+    "recover_gaps([(a,)])": (
+        lambda: recover_gaps([(SEG,)]),
+        ValueError,
+        r"recover_gaps: gap 0 must be a pair \(segment_a, segment_b\), got 1 value$",
+    ),
+    "recover_gaps([(a, b, c)], 'linear')": (
+        lambda: recover_gaps([(SEG, SEG + 9, SEG + 20)], "linear"),
+        ValueError,
+        "recover_gaps: gap 0 must be a pair .*, got 3 values",
+    ),
+    "fill_gaps(seed='abc')": (
+        lambda: fill_gaps(ROWS, seed="abc"),
+        TypeError,
+        "fill_gaps: seed must be an int >= 0, got str 'abc'",
+    ),
+    "fill_gaps(seed=-1)": (
+        lambda: fill_gaps(ROWS, seed=-1),
+        ValueError,
+        "fill_gaps: seed is -1, expected an int >= 0",
+    ),
+    "fill_gaps('linear', seed=1.5)": (  # the seed was never read: taken
+        lambda: fill_gaps(ROWS, "linear", seed=1.5),
+        TypeError,
+        "fill_gaps: seed must be an int >= 0, got float 1.5",
+    ),
+    "recover_gaps(seed=-1)": (
+        lambda: recover_gaps([(SEG, SEG + 9)], seed=-1),
+        ValueError,
+        "recover_gaps: seed is -1, expected an int >= 0",
+    ),
+    "ColourParticleFilter(rng='abc')": (
+        lambda: ColourParticleFilter([5, 5, 4, 4], np.ones(110), rng="abc"),
+        TypeError,
+        "rng must be a numpy.random.Generator, an int >= 0 or None, got str 'abc'",
+    ),
+    "RJMCMCFilter(rng=-1)": (
+        lambda: RJMCMCFilter(rng=-1),
+        ValueError,
+        "RJMCMCFilter: rng must be a numpy.random.Generator, an int >= 0 or None, got int -1",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_named_in_the_message(name: str) -> None:
+    call, error, match = CASES[name]
+    with pytest.raises(error, match=match):
+        call()
+
+
+@pytest.mark.parametrize(
+    "fn", [systematic_resample, stratified_resample, multinomial_resample, residual_resample]
+)
+@pytest.mark.parametrize(
+    ("rng", "error", "got"), [("abc", TypeError, "str 'abc'"), (-1, ValueError, "int -1")]
+)
+def test_resamplers_name_their_rng(
+    fn: Callable[..., object], rng: object, error: type[Exception], got: str
+) -> None:
+    match = f"{fn.__name__}: rng must be a numpy.random.Generator, an int >= 0 or None, got {got}"
+    with pytest.raises(error, match=match):
+        fn([0.5, 0.5], rng=rng)
+
+
+def test_generators_and_seeds_are_taken_as_before() -> None:
+    w = np.array([0.1, 0.2, 0.7])
+    gen = np.random.default_rng(4)
+    np.testing.assert_array_equal(
+        systematic_resample(w, rng=np.random.default_rng(4)), systematic_resample(w, rng=gen)
+    )
+    np.testing.assert_array_equal(systematic_resample(w, rng=4), systematic_resample(w, rng=4))
+    a, _ = fill_gaps(ROWS, "linear", seed=np.int64(3))
+    b, _ = fill_gaps(ROWS, "linear", seed=3)
+    np.testing.assert_array_equal(a, b)
