@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <mutex>
@@ -54,19 +55,31 @@ BoxPath parse_method(const std::string& name, const char* fn) {
 void register_histogram(py::module_& m) {
     py::class_<BinnedImage, std::shared_ptr<BinnedImage>>(
         m, "BinnedImage", "A frame's colour-bin index per pixel (-1: never counted).")
-        .def(py::init([](py::array_t<std::int16_t, py::array::c_style | py::array::forcecast> bins,
-                         int n_bins) {
+        .def(py::init([](const py::array& given, int n_bins) {
                  const char* fn = "BinnedImage";
-                 require(bins.ndim() == 2, fn, "bins ndim", bins.ndim(), 2);
-                 require(bins.shape(0) > 0 && bins.shape(1) > 0, fn, "bins is empty");
+                 const char kind = given.dtype().kind();
+                 if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
+                     throw py::type_error(std::string(fn) + ": bins must hold bin indices "
+                                          "(integers), got " + bind::dtype_name(given));
+                 require(given.ndim() == 2, fn, "bins ndim", given.ndim(), 2);
+                 require(given.shape(0) > 0 && given.shape(1) > 0, fn, "bins is empty");
                  require(n_bins >= 1 && n_bins <= 32767, fn, "n_bins", n_bins, "in [1, 32767]");
-                 auto img = std::make_shared<BinnedImage>(bins.shape(0), bins.shape(1), n_bins);
-                 const std::int16_t* src = bins.data();
-                 for (size_t i = 0; i < img->data.size(); ++i) {
-                     require(src[i] >= -1 && src[i] < n_bins, fn, "bins value", src[i],
-                             "in [-1, n_bins)");
-                     img->data[i] = src[i];
-                 }
+                 auto img = std::make_shared<BinnedImage>(given.shape(0), given.shape(1), n_bins);
+                 // int16 as it comes; any other array checked as given before it becomes int16
+                 // (a cast first would wrap 70000 to 4464 and read 1.5 as 1)
+                 const auto copy = [&](const auto& bins) {
+                     const auto* src = bins.data();
+                     for (size_t i = 0; i < img->data.size(); ++i) {
+                         const auto v = src[i];
+                         require(v >= -1 && v < n_bins && v == std::floor(v), fn, "bins value", v,
+                                 "in [-1, n_bins)");
+                         img->data[i] = static_cast<std::int16_t>(v);
+                     }
+                 };
+                 if (given.dtype().is(py::dtype::of<std::int16_t>()))
+                     copy(py::array_t<std::int16_t, py::array::c_style | py::array::forcecast>::ensure(given));
+                 else
+                     copy(py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(given));
                  return img;
              }),
              py::arg("bins"), py::arg("n_bins"))

@@ -20,7 +20,7 @@ void register_likelihood(py::module_& m) {
         "bhattacharyya_distance",
         [](Eigen::Ref<const RowMatrixXd> hists, Eigen::Ref<const Eigen::VectorXd> ref) {
             py::gil_scoped_release nogil;  // safe: Eigen views only
-            Eigen::VectorXd d = bhattacharyya_coefficient(hists, ref);
+            Eigen::VectorXd d = bhattacharyya_coefficient(hists, ref, "bhattacharyya_distance");
             for (Index i = 0; i < d.size(); ++i) d(i) = bhattacharyya_distance_from_rho(d(i));
             return d;
         },
@@ -34,7 +34,7 @@ void register_likelihood(py::module_& m) {
             check_lambda(lambda, fn);
             py::gil_scoped_release nogil;  // safe: Eigen views only
             require(hists.rows() > 0, fn, "hists rows", hists.rows(), ">= 1");
-            return weights_from_rho(bhattacharyya_coefficient(hists, ref), lambda, fn);
+            return weights_from_rho(bhattacharyya_coefficient(hists, ref, fn), lambda, fn);
         },
         py::arg("hists"), py::arg("ref"), py::arg("lam") = 20.0,
         "Normalised weights (K,) ~ exp(-lam D^2).");

@@ -57,9 +57,10 @@ inline void require_finite(const Eigen::DenseBase<Derived>& a, const char* fn, c
 }
 
 /// Weights: non-empty, finite, non-negative, positive finite sum. Returns the sum.
+/// `if_zero` says what a zero sum means for these values (default: the particle weights').
 template <class Derived>
 inline double require_weights(const Eigen::DenseBase<Derived>& w, const char* fn,
-                              const char* what = "weights") {
+                              const char* what = "weights", const char* if_zero = nullptr) {
     require(w.size() > 0, fn, std::string(what) + " is empty");
     double sum = 0.0;
     for (Eigen::Index i = 0; i < w.size(); ++i) {
@@ -75,6 +76,7 @@ inline double require_weights(const Eigen::DenseBase<Derived>& w, const char* fn
         fail(fn, std::string(what) + " sum is not finite (overflow: the weights are finite but "
                                      "their total exceeds the largest double, 1.8e308; scale "
                                      "them down, e.g. divide by their maximum)");
+    if (!(sum > 0.0) && if_zero != nullptr) fail(fn, std::string(what) + " sums to 0 (" + if_zero + ")");
     if (!(sum > 0.0))
         fail(fn, std::string(what) + " sum to 0 (all weights are 0: reference histogram empty, "
                                      "or every particle outside the image?)");

@@ -288,7 +288,7 @@ inline void check_boxes(const Eigen::MatrixBase<Derived>& boxes, const char* fn,
             std::ostringstream s;
             s << what << "[" << i << "] is (" << boxes(i, 0) << ", " << boxes(i, 1) << ", "
               << boxes(i, 2) << ", " << boxes(i, 3)
-              << "), expected finite (cx, cy, w, h) with w, h >= 0";
+              << "), expected finite (cx, cy, w, h) with w, h >= 0, each value within ±1e+09 px";
             fail(fn, s.str());
         }
 }

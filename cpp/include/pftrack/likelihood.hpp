@@ -52,7 +52,8 @@ template <class Derived>
 inline Eigen::VectorXd sqrt_reference(const Eigen::MatrixBase<Derived>& ref, Index n_bins,
                                       const char* fn) {
     require(ref.size() == n_bins, fn, "ref size", ref.size(), n_bins);
-    const double sum = require_weights(ref, fn, "ref");
+    const double sum =
+        require_weights(ref, fn, "ref", "an empty reference histogram: no bin counted");
     return (ref.derived().array() / sum).sqrt().matrix();
 }
 
@@ -73,10 +74,11 @@ inline void check_histograms(const Eigen::MatrixBase<Derived>& h, const char* fn
 /// rho_i = sum_k sqrt(h_ik q_k) / sqrt(sum_k h_ik), so counts and frequencies give the same rho,
 /// and a row of zeros (no pixel counted) has rho 0. `hists` maps row-major rows without a copy
 /// (a column-major argument gets one temporary copy from Eigen::Ref).
+/// `fn` names the caller in errors.
 template <class DerivedRef>
 inline Eigen::VectorXd bhattacharyya_coefficient(const Eigen::Ref<const RowMatrixXd>& h,
-                                                 const Eigen::MatrixBase<DerivedRef>& ref) {
-    const char* fn = "bhattacharyya_coefficient";
+                                                 const Eigen::MatrixBase<DerivedRef>& ref,
+                                                 const char* fn = "bhattacharyya_coefficient") {
     const Eigen::VectorXd sq = sqrt_reference(ref, h.cols(), fn);
     const int n = static_cast<int>(h.cols());
     Eigen::VectorXd rho(h.rows());
