@@ -16,6 +16,7 @@ __all__ = [
     "bgr_frame",
     "bool_array",
     "first_bad_box",
+    "first_at",
     "first_bad_id",
     "flag",
     "generator",
@@ -145,6 +146,15 @@ def flag(value: object, what: str) -> bool:
     return bool(value)
 
 
+def first_at(mask: NDArray[np.bool_]) -> tuple[tuple[int, ...], str]:
+    """The index of `mask`'s first True entry (C order), and how a message names it.
+
+    ``((1, 2), "[1, 2]")`` for a 2-D mask, ``((), "")`` for a 0-D one (a scalar argument).
+    """
+    k = tuple(int(i) for i in np.unravel_index(int(np.argmax(mask)), mask.shape))
+    return k, f"[{', '.join(str(i) for i in k)}]" if k else ""
+
+
 def bool_array(values: ArrayLike, what: str) -> NDArray[np.bool_]:
     """`values` as a bool array, refusing entries other than True and False (or 1 and 0).
 
@@ -165,8 +175,7 @@ def bool_array(values: ArrayLike, what: str) -> NDArray[np.bool_]:
         raise TypeError(f"{what} must hold True or False (or 1 or 0), got dtype {raw.dtype}")
     bad = (raw != 0) & (raw != 1)
     if bad.any():
-        k = np.unravel_index(int(np.argmax(bad)), raw.shape)
-        at = f"[{', '.join(str(int(i)) for i in k)}]" if k else ""
+        k, at = first_at(bad)
         raise ValueError(f"{what}{at} is {raw[k]}, expected True or False (or 1 or 0)")
     return raw.astype(np.bool_)
 

@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack import _core
-from pftrack._check import bool_array, flag, number, real_array
+from pftrack._check import bool_array, first_at, flag, number, real_array
 from pftrack._typing import F64
 
 __all__ = [
@@ -95,8 +95,7 @@ def _require(fn: str, name: str, value: ArrayLike, bound: str = "") -> None:
     elif bound == ">= 0":
         ok &= v >= 0
     if not ok.all():
-        k = np.unravel_index(int(np.argmin(ok)), v.shape)
-        at = f"[{', '.join(str(int(i)) for i in k)}]" if k else ""
+        k, at = first_at(~ok)
         want = f"finite and {bound}" if bound else "finite"
         raise ValueError(f"{fn}: {name}{at} is {v[k]:g}, expected {want}")
 
@@ -342,8 +341,7 @@ def cv_update_where(
     zz, ww = np.broadcast_arrays(real_array(z, f"{fn}: z"), w)
     missing = ww & ~np.isfinite(zz)
     if missing.any():
-        k = np.unravel_index(int(np.argmax(missing)), zz.shape)
-        at = f"[{', '.join(str(int(i)) for i in k)}]" if k else ""
+        k, at = first_at(missing)
         raise ValueError(f"{fn}: z{at} is {zz[k]:g} where `where` holds, expected finite")
     _require(fn, "r2", r2, "> 0")
     return _cv_update_where(mean, cov, z, r2, w)
