@@ -20,6 +20,7 @@ __all__ = [
     "first_bad_id",
     "flag",
     "generator",
+    "integer",
     "number",
     "real_array",
     "seed",
@@ -200,6 +201,22 @@ def number(value: object, what: str, *, finite: bool = True) -> float:
     if finite and not np.isfinite(value):
         raise ValueError(f"{what} is {value}, expected a finite number")
     return float(value)
+
+
+def integer(value: object, what: str, lo: int, hi: int) -> int:
+    """`value` as an int in ``[lo, hi]`` (NumPy's too; not a bool, not a float such as 2.0).
+
+    Raises
+    ------
+    ValueError
+        ``{what} is {value!r}, expected an integer in [lo, hi]``, whatever the reason (a
+        setting's one message).
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not (
+        lo <= value <= hi
+    ):
+        raise ValueError(f"{what} is {value!r}, expected an integer in [{lo}, {hi}]")
+    return int(value)
 
 
 def seed(value: object, what: str) -> int:

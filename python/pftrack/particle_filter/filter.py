@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, generator, number, real_array
+from pftrack._check import MAX_COORD, generator, integer, number, real_array
 from pftrack._typing import F64, RngLike
 from pftrack.particle_filter.colour import not_binned
 from pftrack.particle_filter.dynamics import Ar2Model
@@ -63,14 +63,8 @@ class FilterConfig:
     min_samples: int = 2048
 
     def __post_init__(self) -> None:
-        if (
-            not isinstance(self.n_particles, (int, np.integer))
-            or isinstance(self.n_particles, bool)
-            or not 1 <= self.n_particles <= MAX_PARTICLES
-        ):
-            raise ValueError(
-                f"n_particles is {self.n_particles!r}, expected an integer in [1, {MAX_PARTICLES}]"
-            )
+        integer(self.n_particles, "n_particles", 1, MAX_PARTICLES)
+        integer(self.min_samples, "min_samples", 0, 2**31 - 1)  # 0: every pixel
         lam = number(self.lam, "FilterConfig: lam", finite=False)
         if not (np.isfinite(lam) and lam >= 0):
             raise ValueError(f"lam is {lam}, expected a finite value >= 0")
@@ -78,14 +72,6 @@ class FilterConfig:
             raise ValueError(f"kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'")
         if self.estimate not in ("mean", "map"):
             raise ValueError(f"estimate is {self.estimate!r}, expected 'mean' or 'map'")
-        if (
-            not isinstance(self.min_samples, (int, np.integer))
-            or isinstance(self.min_samples, bool)
-            or not 0 <= self.min_samples <= 2**31 - 1
-        ):
-            raise ValueError(
-                f"min_samples is {self.min_samples!r}, expected an integer >= 0 (0: every pixel)"
-            )
 
 
 @dataclass(frozen=True)
