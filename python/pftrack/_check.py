@@ -212,8 +212,10 @@ def integer(value: object, what: str, lo: int, hi: int) -> int:
         ``{what} is {value!r}, expected an integer in [lo, hi]``, whatever the reason (a
         setting's one message).
     """
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not (
-        lo <= value <= hi
+    if (
+        isinstance(value, (bool, np.bool_))
+        or not isinstance(value, (int, np.integer))
+        or not (lo <= value <= hi)
     ):
         raise ValueError(f"{what} is {value!r}, expected an integer in [{lo}, {hi}]")
     return int(value)
