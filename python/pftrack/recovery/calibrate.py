@@ -90,7 +90,7 @@ COMBINE_SHRINK = 20
 #: Bootstrap resamples of the validation gaps the choice is bagged over (:func:`calibrate`):
 #: the rule runs on each resample and the methods' weights are averaged; 0: the rule runs once
 #: on the validation gaps as drawn.
-BAGS = 0
+BAGS = 32
 
 
 def bucket_of(length: int) -> int:
