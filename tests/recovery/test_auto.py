@@ -476,3 +476,67 @@ def test_explain_says_a_blend_is_compared_with_the_chosen_method_only() -> None:
     better = (("linear", 5.6), ("rts", 5.5))  # the blend beats both parts: nothing to explain
     cal = Calibration((BucketChoice((1, 1), "linear+rts", 9, 60, better, mix, 5.421),), "linear")
     assert cal.describe().splitlines()[-1].endswith("by the paired test")
+
+
+def test_bagging_is_the_default_and_keeps_straight_lines_straight() -> None:
+    """Every resample of straight jittered data keeps linear: the fill is exactly a line."""
+    import inspect
+
+    from pftrack.recovery.calibrate import BAGS
+
+    assert BAGS > 0
+    for fn in (calibrate, recover_auto):
+        assert inspect.signature(fn).parameters["bags"].default == BAGS, fn.__name__
+    tracks = _straight_tracks(np.random.default_rng(0))
+    cal = calibrate(tracks, [5, 12, 25])
+    assert cal.bags == BAGS
+    assert all(c.weights == () and c.method == "linear" for c in cal.buckets), cal.describe()
+    assert cal.weights_for(12) == (("linear", 1.0),)
+
+
+def test_bagging_averages_the_choices_of_the_resamples(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The weights are the share of resamples choosing each method, for buckets and file."""
+    import pftrack.recovery.calibrate as cal_mod
+
+    calls: list[object] = []
+    real_choose = cal_mod._choose
+
+    def fake(stacked, weights, names, combine, blends, idx=None):  # type: ignore[no-untyped-def]
+        real_choose(stacked, weights, names, combine, blends, idx)  # the resample is valid
+        calls.append(idx)
+        m = "rts" if idx is not None and len(calls) % 4 == 0 else "linear"  # 1 in 4 resamples
+        return m, {b: ((m, 1.0),) for b in stacked}
+
+    monkeypatch.setattr(cal_mod, "_choose", fake)
+    tracks = _manoeuvring_tracks(np.random.default_rng(1), n=12)
+    cal = calibrate(tracks, [3, 20], candidates=("linear", "rts"), bags=8)
+    assert len(calls) == 9 and calls[0] is None  # the rule as drawn, then 8 resamples
+    for c in cal.buckets:
+        assert c.weights == (("linear", 0.75), ("rts", 0.25)), cal.describe()
+        assert c.method == "linear+rts" and c.combined_mmae is not None
+    assert cal.pooled == "linear"  # the rule on the gaps as drawn
+    assert cal.pooled_weights == (("linear", 0.75), ("rts", 0.25))
+    assert cal.weights_for(300) == cal.pooled_weights  # an unseen bucket takes the file's
+    assert "mean of the choices on 8 bootstrap resamples" in cal.describe()
+
+
+def test_bagging_is_seeded_and_reported() -> None:
+    """The same seed gives the same bagged choice and fill; bags=0 is recorded as no bagging."""
+    tracks = _manoeuvring_tracks(np.random.default_rng(4), n=10)
+    pairs = _cut(tracks, 6)
+    p1, c1 = recover_auto(pairs, tracks, seed=3)
+    p2, c2 = recover_auto(pairs, tracks, seed=3)
+    assert c1 == c2
+    for a, b in zip(p1, p2, strict=True):
+        np.testing.assert_array_equal(a, b)
+    _, single = recover_auto(pairs, tracks, seed=3, bags=0)
+    assert single.bags == 0 and c1.bags > 0
+    for c in c1.buckets:
+        mix = c.weights or ((c.method, 1.0),)
+        assert abs(sum(w for _, w in mix) - 1.0) < 1e-12
+
+
+def test_bags_must_not_be_negative() -> None:
+    tracks = _straight_tracks(np.random.default_rng(0), n=5)
+    with pytest.raises(ValueError, match="bags is -1, expected >= 0"):
+        calibrate(tracks, [5], bags=-1)

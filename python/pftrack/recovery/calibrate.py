@@ -46,6 +46,7 @@ __all__ = [
     "COMBINE_SHRINK",
     "LINEAR_MARGIN",
     "MAX_CALIBRATION_GAPS",
+    "BAGS",
     "BucketChoice",
     "Calibration",
     "bucket_of",
@@ -86,6 +87,10 @@ COMBINE_GRID = np.linspace(0.0, 1.0, 21)
 #: A combination's fitted weight ``a`` is shrunk toward the chosen method as ``a n / (n + S)``
 #: (``n`` validation gaps): a prior worth this many gaps on the chosen method alone.
 COMBINE_SHRINK = 20
+#: Bootstrap resamples of the validation gaps the choice is bagged over (:func:`calibrate`):
+#: the rule runs on each resample and the methods' weights are averaged; 0: the rule runs once
+#: on the validation gaps as drawn.
+BAGS = 32
 
 
 def bucket_of(length: int) -> int:
@@ -142,10 +147,18 @@ class Calibration:
         The file's choice (every bucket's validation gaps, weighted by its real gaps): used by
         buckets without enough validation gaps, and kept by the others unless their own best
         beats it by a paired test.
+    pooled_weights : tuple of (str, float)
+        With bagging (:data:`BAGS`), the file's choice as methods and weights (the share of
+        resamples choosing each), used by buckets without enough validation gaps; empty when
+        every resample chose :attr:`pooled` or without bagging.
+    bags : int
+        Bootstrap resamples the weights were averaged over (0: one choice, no bagging).
     """
 
     buckets: tuple[BucketChoice, ...]
     pooled: str = "linear"
+    pooled_weights: tuple[tuple[str, float], ...] = ()
+    bags: int = 0
 
     def method_for(self, length: int) -> str:
         """The method chosen for a gap of `length` missing frames (:attr:`pooled` if unseen).
@@ -156,7 +169,7 @@ class Calibration:
         for c in self.buckets:
             if c.lengths == lo_hi:
                 return c.method
-        return self.pooled
+        return "+".join(m for m, _ in self.pooled_weights) or self.pooled
 
     def weights_for(self, length: int) -> tuple[tuple[str, float], ...]:
         """Methods and weights (summing to 1) used for a gap of `length` missing frames."""
@@ -164,7 +177,7 @@ class Calibration:
         for c in self.buckets:
             if c.lengths == lo_hi:
                 return c.weights or ((c.method, 1.0),)
-        return ((self.pooled, 1.0),)
+        return self.pooled_weights or ((self.pooled, 1.0),)
 
     def describe(self) -> str:
         """A table: per bucket, the chosen method, each candidate's validation MMAE, counts."""
@@ -190,21 +203,27 @@ class Calibration:
                 lo, hi = c.lengths
                 span = f"{lo}" if lo == hi else f"{lo}-{hi}"
                 mix = " + ".join(f"{w:.2f} {m}" for m, w in c.weights)
+                if c.combined_mmae is None:  # no validation gaps: the file's weights
+                    lines.append(f"gap length {span}: combination {mix}, the file's choice")
+                    continue
                 lines.append(
                     f"gap length {span}: combination {mix}, validation MMAE "
-                    f"{c.combined_mmae:.3f}{_blend_note(c)}"
+                    f"{c.combined_mmae:.3f}{_blend_note(c, self.bags)}"
                 )
         return "\n".join(lines)
 
 
-def _blend_note(c: BucketChoice) -> str:
+def _blend_note(c: BucketChoice, bags: int = 0) -> str:
     """Why a blend is used: it beat the chosen method; a better part alone did not.
 
     The blend is tested against the bucket's chosen method only (and shrunk toward it), not
     against every candidate, so its other part alone may score lower on the validation gaps:
-    that part alone did not beat the chosen method by the paired test.
+    that part alone did not beat the chosen method by the paired test. With bagging (`bags`
+    resamples) the weights are the mean of each resample's choice.
     """
     vals = dict(c.mmae)
+    if bags > 0:
+        return f"; mean of the choices on {bags} bootstrap resamples of the validation gaps"
     (chosen, _), (other, _) = c.weights
     if chosen not in vals or other not in vals or c.combined_mmae is None:
         return ""
@@ -390,6 +409,7 @@ def calibrate(
     spans: Sequence[float] | None = None,
     contexts: Sequence[tuple[int, int]] | None = None,
     combine: bool = True,
+    bags: int = BAGS,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -419,6 +439,10 @@ def calibrate(
         Let a bucket use a convex combination of its chosen method and the best other
         candidate when it beats the chosen method by the paired test (:func:`_combine`;
         default). False: one method per bucket.
+    bags : int
+        Bootstrap resamples of each bucket's validation gaps (>= 0, seeded by `seed`): the
+        choice (file, bucket, combination) is made on each and the methods' weights are
+        averaged (:data:`BAGS`). 0: one choice on the validation gaps as drawn.
 
     Returns
     -------
@@ -435,6 +459,8 @@ def calibrate(
         raise ValueError(f"calibrate: gap lengths must be >= 1, got {min(lengths)}")
     if max_gaps < 1:
         raise ValueError(f"calibrate: max_gaps is {max_gaps}, expected >= 1")
+    if bags < 0:
+        raise ValueError(f"calibrate: bags is {bags}, expected >= 0")
     for m in candidates:
         if m not in CANDIDATES:
             raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
@@ -494,35 +520,137 @@ def calibrate(
             errors[b][m] = _gap_errors(paths, truth)
             found[b][m] = paths
     weights = {b: len(by_bucket[b]) for b in errors}
-    pooled = _pooled_choice(errors, weights, scored)
+    blends = _Blends(found, truths)
+    stacked = {b: np.stack([errors[b][m] for m in scored]) for b in errors}
+    pooled, chosen = _choose(stacked, weights, scored, combine, blends)
+    pooled_mix: tuple[tuple[str, float], ...] = ()
+    if bags > 0:
+        rng = np.random.default_rng([seed, 0xBA6])
+        runs_of = []
+        for _ in range(bags):
+            idx = {b: rng.integers(len(truths[b]), size=len(truths[b])) for b in sorted(errors)}
+            runs_of.append(_choose(stacked, weights, scored, combine, blends, idx))
+        pooled_mix = _average([((p, 1.0),) for p, _ in runs_of])
+        chosen = {b: _average([c[b] for _, c in runs_of]) for b in errors}
     choices = []
     for b in sorted(by_bucket):
         mmae: tuple[tuple[str, float], ...] = ()
-        method = pooled
+        mix = chosen.get(b, pooled_mix or ((pooled, 1.0),))
         if b in errors:
-            e = errors[b]
-            mmae = tuple((m, float(e[m].mean())) for m in scored)
-            best = min(scored, key=lambda m: float(e[m].mean()))
-            if best != pooled and _better(e[best], e[pooled]):
-                method = best
-            if combine and len(scored) > 1:
-                other = min((m for m in scored if m != method), key=lambda m: float(e[m].mean()))
-                w, err = _combine(found[b][method], found[b][other], truths[b])
-                if 0.0 < w and _better(err, e[method]):
-                    choices.append(
-                        BucketChoice(
-                            _bucket_range(b),
-                            f"{method}+{other}",
-                            len(by_bucket[b]),
-                            n_cut[b],
-                            mmae,
-                            ((method, 1.0 - w), (other, w)),
-                            float(err.mean()),
-                        )
-                    )
-                    continue
-        choices.append(BucketChoice(_bucket_range(b), method, len(by_bucket[b]), n_cut[b], mmae))
-    return Calibration(tuple(choices), pooled)
+            mmae = tuple((m, float(errors[b][m].mean())) for m in scored)
+        if len(mix) == 1:
+            choices.append(
+                BucketChoice(_bucket_range(b), mix[0][0], len(by_bucket[b]), n_cut[b], mmae)
+            )
+            continue
+        err = _mix_errors(mix, found[b], truths[b]) if b in errors else None
+        choices.append(
+            BucketChoice(
+                _bucket_range(b),
+                "+".join(m for m, _ in mix),
+                len(by_bucket[b]),
+                n_cut[b],
+                mmae,
+                mix,
+                None if err is None else float(err.mean()),
+            )
+        )
+    return Calibration(tuple(choices), pooled, pooled_mix if len(pooled_mix) > 1 else (), bags)
+
+
+class _Blends:
+    """Per-gap validation errors of ``(1 - w) first + w second``, cached per bucket and pair.
+
+    For a bucket of `n` validation gaps, row ``k`` of ``fit`` holds the errors with the
+    weight ``COMBINE_GRID[k]`` and row ``k`` of ``shrunk`` those with that weight shrunk as in
+    :func:`_combine`, so a resample of the gaps (same `n`) only indexes columns.
+    """
+
+    def __init__(self, found: dict[int, dict[str, list[F64]]], truths: dict[int, list[F64]]):
+        self.found = found
+        self.truths = truths
+        self.cache: dict[tuple[int, str, str], tuple[F64, F64]] = {}
+
+    def __call__(self, b: int, first: str, second: str) -> tuple[F64, F64]:
+        key = (b, first, second)
+        if key not in self.cache:
+            truth = self.truths[b]
+            n = len(truth)
+            p1 = np.concatenate(self.found[b][first])
+            p2 = np.concatenate(self.found[b][second])
+            t = np.concatenate([v[:, 1:3] for v in truth])
+            sizes = np.array([len(v) for v in truth])
+            starts = np.r_[0, np.cumsum(sizes)[:-1]]
+
+            def errors(w: float) -> F64:
+                d = (1.0 - w) * p1 + w * p2 - t
+                out: F64 = np.add.reduceat(np.hypot(d[:, 0], d[:, 1]), starts) / sizes
+                return out
+
+            fit = np.array([errors(float(w)) for w in COMBINE_GRID])
+            shrink = n / (n + COMBINE_SHRINK)
+            shrunk = np.array([errors(float(w) * shrink) for w in COMBINE_GRID])
+            self.cache[key] = (fit, shrunk)
+        return self.cache[key]
+
+
+def _choose(
+    stacked: dict[int, F64],
+    weights: dict[int, int],
+    names: Sequence[str],
+    combine: bool,
+    blends: _Blends,
+    idx: dict[int, NDArray[np.int64]] | None = None,
+) -> tuple[str, dict[int, tuple[tuple[str, float], ...]]]:
+    """The file's choice and, per bucket with validation gaps, its methods and weights.
+
+    `stacked` holds, per bucket, the validation errors of `names` (one row each, one column
+    per gap); `idx` (optional), per bucket, the validation gaps to use (a resample, with
+    repeats).
+    """
+    if idx is not None:
+        stacked = {b: v[:, idx[b]] for b, v in stacked.items()}
+    errors = {b: dict(zip(names, v, strict=True)) for b, v in stacked.items()}
+    pooled = _pooled_choice(errors, weights, names)
+    out: dict[int, tuple[tuple[str, float], ...]] = {}
+    for b, e in errors.items():
+        means = dict(zip(names, stacked[b].mean(axis=1).tolist(), strict=True))
+        method = pooled
+        best = min(names, key=lambda m: means[m])
+        if best != pooled and _better(e[best], e[pooled]):
+            method = best
+        out[b] = ((method, 1.0),)
+        if combine and len(names) > 1:
+            other = min((m for m in names if m != method), key=lambda m: means[m])
+            fit, shrunk = blends(b, method, other)
+            if idx is not None:
+                fit, shrunk = fit[:, idx[b]], shrunk[:, idx[b]]
+            k = int(np.argmin(fit.mean(axis=1)))
+            w = float(COMBINE_GRID[k]) * fit.shape[1] / (fit.shape[1] + COMBINE_SHRINK)
+            if 0.0 < w and _better(shrunk[k], e[method]):
+                out[b] = ((method, 1.0 - w), (other, w))
+    return pooled, out
+
+
+def _average(
+    mixes: Sequence[tuple[tuple[str, float], ...]],
+) -> tuple[tuple[str, float], ...]:
+    """Mean weight of every method over `mixes`, heaviest first (ties: in order of appearance)."""
+    total: dict[str, float] = {}
+    for mix in mixes:
+        for m, w in mix:
+            total[m] = total.get(m, 0.0) + w / len(mixes)
+    kept = [(m, w) for m, w in total.items() if w > 0.0]
+    kept.sort(key=lambda mw: -mw[1])
+    return tuple(kept)
+
+
+def _mix_errors(
+    mix: tuple[tuple[str, float], ...], found: dict[str, list[F64]], truth: Sequence[F64]
+) -> F64:
+    """Per-gap validation errors of the weighted sum of the methods' paths."""
+    paths = [np.sum([w * found[m][k] for m, w in mix], axis=0) for k in range(len(truth))]
+    return _gap_errors(paths, truth)
 
 
 def _combine(
@@ -611,6 +739,7 @@ def recover_auto(
     candidates: Sequence[str] = CANDIDATES,
     max_gaps: int = MAX_CALIBRATION_GAPS,
     combine: bool = True,
+    bags: int = BAGS,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -633,6 +762,8 @@ def recover_auto(
     combine : bool
         Allow a convex combination of two candidates per bucket (:func:`calibrate`; default).
         False: one method per bucket.
+    bags : int
+        Bootstrap resamples the choice is averaged over (:func:`calibrate`; >= 0).
 
     Returns
     -------
@@ -681,6 +812,7 @@ def recover_auto(
         candidates=candidates,
         max_gaps=max_gaps,
         combine=combine,
+        bags=bags,
     )
     mixes = [cal.weights_for(L) if L > 0 else (("linear", 1.0),) for L in lengths]
     groups: dict[str, list[int]] = {}  # each method once, over every gap that uses it
