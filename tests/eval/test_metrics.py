@@ -306,3 +306,16 @@ def test_agrees_with_motmetrics(seed):
 def test_metrics_type():
     assert isinstance(evaluate_mot(HAND_GT, HAND_GT), MotMetrics)
     assert evaluate_mot(HAND_GT, HAND_GT).mota == 1.0
+
+
+def test_one_id_twice_in_a_frame_is_refused_as_pftrack_eval_refuses_it():
+    """evaluate_mot scored a result with id 1 twice in frame 1 (one of them a false positive)
+    where evaluate_hota and `pftrack eval` refused it."""
+    from pftrack.eval import evaluate_hota
+
+    twice = np.vstack([HAND_RES, HAND_RES[:1] + [0, 0, 2, 0, 0, 0, 0, 0, 0, 0]])
+    for evaluate in (evaluate_mot, evaluate_hota):
+        with pytest.raises(ValueError, match="result has id .* more than once in frame"):
+            evaluate(HAND_GT, twice)
+        with pytest.raises(ValueError, match="(gt|ground truth) has id .* more than once"):
+            evaluate(twice, HAND_RES)

@@ -617,3 +617,25 @@ def test_frame_sequence_says_where_a_truncated_video_ends(tmp_path: Path) -> Non
     with pytest.raises(ValueError, match=r"cut.avi: frame 20 cannot be decoded: the video ended "
                        r"after \d+ frames but its header says 20"):  # fmt: skip
         frames[19]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        ({"scale": "0.5"}, TypeError, "scale must be a number, got str '0.5'"),
+        ({"scale": True}, TypeError, "scale must be a number, got bool"),
+        ({"scale": 0.0}, ValueError, "scale is 0.0, expected a finite value > 0"),
+        ({"scale": float("nan")}, ValueError, "scale is nan"),
+        ({"fps": "7"}, TypeError, "fps must be a number, got str '7'"),
+        ({"fps": -1.0}, ValueError, "fps is -1.0, expected a finite value > 0"),
+    ],
+)
+def test_scale_and_fps_of_the_wrong_kind_are_named(
+    tmp_path: Path, kwargs: dict[str, object], error: type[Exception], message: str
+) -> None:
+    """`FrameSource(scale='0.5')` was NumPy's "ufunc 'isfinite' not supported" TypeError."""
+    folder = make_scene(n_frames=2, width=64, height=64, n_walkers=1, rng=0).write_images(
+        tmp_path / "seq"
+    )
+    with pytest.raises(error, match=re.escape(message)):
+        FrameSource(folder, **kwargs)  # type: ignore[arg-type]

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from pftrack.eval.metrics import check_eval_rows
+from pftrack.eval.metrics import check_eval_rows, check_unique_ids
 from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
 
 __all__ = [
@@ -79,16 +79,6 @@ def mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     union[union <= _EPS] = 1
     out: NDArray[np.float64] = inter / union
     return out
-
-
-def _check_unique(frames: dict[int, NDArray[np.float64]], name: str) -> None:
-    for f, r in frames.items():
-        ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
-        if np.any(counts > 1):
-            raise ValueError(
-                f"{name} has id {int(ids[counts > 1][0])} more than once in frame {f} "
-                "(ids must be unique within a frame)"
-            )
 
 
 def guess_benchmark(gt: ArrayLike) -> str:
@@ -160,8 +150,8 @@ def prepare_mot(
                 f"{num_frames} frames (seqLength)"
             )
     gf, rf = group_by_frame(g), group_by_frame(r)
-    _check_unique(gf, "ground truth")
-    _check_unique(rf, "result")
+    check_unique_ids(gf, "ground truth")
+    check_unique_ids(rf, "result")
     with_classes = benchmark != "MOT15"
     if with_classes and len(g):
         cls = g[:, _CLASS]

@@ -228,6 +228,21 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     return a
 
 
+def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
+    """Refuse rows of one id twice in one frame (ValueError naming `name`, the id and frame).
+
+    `frames`: rows grouped by frame. Shared by :func:`evaluate_mot` and
+    :func:`~pftrack.eval.hota.evaluate_hota`, so both refuse what ``pftrack eval`` refuses.
+    """
+    for f, r in frames.items():
+        ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
+        if np.any(counts > 1):
+            raise ValueError(
+                f"{name} has id {int(ids[counts > 1][0])} more than once in frame {f} "
+                "(ids must be unique within a frame)"
+            )
+
+
 def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
     if len(rows) == 0:
         return {}
@@ -310,6 +325,8 @@ def evaluate_mot(
     g[:, LEFT : LEFT + 4] *= scale
     gt_frames = _split(g)
     res_frames = _split(r)
+    check_unique_ids(gt_frames, "evaluate_mot: gt")
+    check_unique_ids(res_frames, "evaluate_mot: result")
     frames = sorted(set(gt_frames) | set(res_frames))
     empty = np.zeros((0, 10))
 

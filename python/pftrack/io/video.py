@@ -37,6 +37,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import number
 from pftrack._typing import PathLike
 from pftrack.io.opencv_io import opencv_name, read_image, utf8_name
 
@@ -558,11 +559,14 @@ class FrameSource:
         self, source: PathLike | int, *, scale: float = 1.0, fps: float | None = None
     ) -> None:
         check_source(source)
+        scale = number(scale, "scale", finite=False)  # text, bools, None: a TypeError naming it
         if not (np.isfinite(scale) and scale > 0):
             raise ValueError(f"scale is {scale}, expected a finite value > 0")
-        if fps is not None and not (np.isfinite(fps) and fps > 0):
-            raise ValueError(f"fps is {fps}, expected a finite value > 0")
-        self.scale = float(scale)
+        if fps is not None:
+            fps = number(fps, "fps", finite=False)
+            if not (np.isfinite(fps) and fps > 0):
+                raise ValueError(f"fps is {fps}, expected a finite value > 0")
+        self.scale = scale
         self.name = str(source)
         self.live = is_live_source(source)
         self.sequence: SequenceInfo | None = None
