@@ -190,8 +190,12 @@ def fit_singer(runs: Sequence[F64], axis: int, levels: int = 4) -> tuple[float, 
     for _ in range(levels):
         axes = [np.linspace(lo[i], hi[i], 7) for i in range(3)]
         g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-        q, r, tau = 10.0 ** g[:, 0], 10.0 ** g[:, 1], 10.0 ** g[:, 2]
-        F, Q = singer_model(q, tau)
+        r = 10.0 ** g[:, 1]
+        # F and Q do not depend on r: the 7 x 7 distinct (q, tau), each repeated over the 7 r
+        # of the grid (rows ordered q, r, tau), instead of 343 matrix exponentials.
+        F, Q = singer_model(10.0 ** axes[0][:, None], 10.0 ** axes[2][None, :])
+        F = np.repeat(F.reshape(7, 1, 7, 3, 3), 7, axis=1)
+        Q = np.repeat(Q.reshape(7, 1, 7, 3, 3), 7, axis=1)
         ll = _core.state_loglik_batch(
             z,
             lengths,

@@ -130,14 +130,21 @@ def correct_by_neighbours(
         return base
     got = recover([(a, b) for a, b, _ in flat])
     errors = [t[:, 1:3] - p for (_, _, t), p in zip(flat, got, strict=True)]
-    out: list[F64] = []
+    # The median of each gap's neighbours' errors: one np.median per group of gaps with as
+    # many neighbours and frames (each lane's median is the same as gap by gap).
+    groups: dict[tuple[int, int], tuple[list[int], list[int]]] = {}
     k = 0
-    for path, ws in zip(base, wins, strict=True):
+    for g, (path, ws) in enumerate(zip(base, wins, strict=True)):
         n = len(ws)
-        if n == 0:
-            out.append(path)
-            continue
-        shared: NDArray[np.float64] = np.median(np.stack(errors[k : k + n]), axis=0)
-        out.append(path + shared * (n / (n + 1.0)))
+        if n:
+            gaps, starts = groups.setdefault((n, len(path)), ([], []))
+            gaps.append(g)
+            starts.append(k)
         k += n
+    out = list(base)
+    for (n, _), (gaps, starts) in groups.items():
+        stack = np.stack([np.stack(errors[k : k + n]) for k in starts])
+        shared: NDArray[np.float64] = np.median(stack, axis=1)
+        for g, row in zip(gaps, shared, strict=True):
+            out[g] = base[g] + row * (n / (n + 1.0))
     return out
