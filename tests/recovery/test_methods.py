@@ -222,3 +222,19 @@ def test_noise_loglik_grid_matches_reference():
         np.testing.assert_allclose(got, ref.loglik_grid(runs, axis, q, r), rtol=1e-12)
     with pytest.raises(ValueError, match="q and r must be finite and > 0"):
         _core.noise_loglik_grid(z, np.array([len(z)], np.int32), np.array([0.0]), np.array([1.0]))
+
+
+def test_noise_loglik_grid_long_runs_match_reference():
+    """Runs far longer than the covariance takes to settle (the steps after it reuse it)."""
+    from pftrack import _core
+
+    rng = np.random.default_rng(9)
+    runs = [
+        np.column_stack([np.arange(n), np.cumsum(rng.normal(0, 1, (n, 2)), axis=0)])
+        for n in (1200, 5, 300)
+    ]
+    q = np.array([0.01, 1.0, 1e-5])
+    r = np.array([0.5, 2.0, 50.0])
+    z = np.concatenate([run[:, 1] for run in runs])
+    got = _core.noise_loglik_grid(z, np.array([len(x) for x in runs], np.int32), q, r)
+    np.testing.assert_allclose(got, ref.loglik_grid(runs, 0, q, r), rtol=1e-12)

@@ -10,14 +10,15 @@
 // velocity of variance v2 starts. (-1, -1) is "walks through the gap".
 //
 // For every hypothesis one Kalman filter and Rauch-Tung-Striebel smoother run over the window
-// (the filter over the part before the gap is shared); the result is the smoothed positions
-// inside the gap and the log-likelihood of the window's observations, so that the caller can
-// weight the hypotheses by their evidence. For a linear-Gaussian model the smoothed mean inside
+// (the filter over the part before the gap, and the smoother gains where hypotheses agree, are
+// shared); the result is the smoothed positions inside the gap and the log-likelihood of the
+// window's observations, so that the caller can weight the hypotheses by their evidence. For a linear-Gaussian model the smoothed mean inside
 // the gap is the goal-directed path conditioned on the filtered states at both ends.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <type_traits>
@@ -127,6 +128,14 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
     std::vector<Vec> mp(len), ms(len);
     std::vector<Mat> Pp(len), Ps(len);
     std::vector<const Mat*> Fs(len, &F);
+    // Smoother gains C_j = Ps[j] F_{j+1}' pinv(Pp[j+1]) depend on covariances only, which do not
+    // depend on the observed values. Before gap step t1 every hypothesis has the walking filter's
+    // (walk_gain, computed once); while standing (t1 <= j < t2) they depend on (t1, j) only
+    // (stand_gain, kept for the last t1 seen: hypotheses come grouped by t1). The same
+    // expression on the same operands: the same bits as computing them per hypothesis.
+    std::vector<Mat> walk_gain(len), stand_gain(len);
+    std::vector<char> have_walk(len, 0);
+    std::vector<int> stand_t1(len, -2);
     for (Index h = 0; h < H; ++h) {
         const int t1 = t1s(h), t2 = t2s(h);
         const Index first = t1 < 0 ? len : t1 + 1;  // first step that differs from walking
@@ -158,8 +167,25 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
             Ps[j] = Ph;
         }
         for (Index j = len - 2; j >= 1; --j) {
-            const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
-            ms[j] += C * (ms[j + 1] - mp[j + 1]);
+            const auto u = static_cast<std::size_t>(j);
+            if (j + 1 < first) {  // walking up to here: Ps[j], Pp[j + 1], Fs[j + 1] are walk's
+                if (!have_walk[u]) {
+                    const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
+                    walk_gain[u] = C;
+                    have_walk[u] = 1;
+                }
+                ms[j] += walk_gain[u] * (ms[j + 1] - mp[j + 1]);
+            } else if (j < t2) {  // standing from t1 + 1 to j + 1 <= t2: depends on (t1, j)
+                if (stand_t1[u] != t1) {
+                    const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
+                    stand_gain[u] = C;
+                    stand_t1[u] = t1;
+                }
+                ms[j] += stand_gain[u] * (ms[j + 1] - mp[j + 1]);
+            } else {
+                const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
+                ms[j] += C * (ms[j + 1] - mp[j + 1]);
+            }
         }
         for (Index j = 1; j < T; ++j) out.paths(h, j - 1) = ms[j](0);
         out.loglik(h) = ll;
@@ -255,8 +281,12 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
             const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
             const double rk = r(k);
             Mat P = Mat::Identity() * big;
+            // Once the filtered covariance repeats exactly, every later step repeats the last
+            // one: steps from `fixed` on reuse its s, log s and gain.
+            Index fixed = longest;
             for (Index i = 0; i < longest; ++i) {
                 const auto u = static_cast<std::size_t>(i);
+                const Mat before = P;
                 if (i > 0) P = Fk * P * Fk.transpose() + Qk;
                 const double s = P(0, 0) + rk;
                 S[u] = s;
@@ -265,6 +295,10 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                 G[u] = g;
                 P -= g * P.row(0);
                 P = 0.5 * (P + P.transpose()).eval();
+                if (i > 0 && P == before) {
+                    fixed = i;
+                    break;
+                }
             }
             double total = 0.0;
             Index start = 0;
@@ -276,7 +310,7 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                 Vec m = Vec::Zero();
                 m(0) = zz[0];
                 for (Index i = 0; i < len; ++i) {
-                    const auto u = static_cast<std::size_t>(i);
+                    const auto u = static_cast<std::size_t>(std::min(i, fixed));
                     if (i > 0) m = Fk * m;
                     const double v = zz[i] - m(0);
                     if (i >= D) total -= 0.5 * (logS[u] + v * v / S[u]);
