@@ -12,8 +12,9 @@
 // For every hypothesis one Kalman filter and Rauch-Tung-Striebel smoother run over the window
 // (the filter over the part before the gap, and the smoother gains where hypotheses agree, are
 // shared); the result is the smoothed positions inside the gap and the log-likelihood of the
-// window's observations, so that the caller can weight the hypotheses by their evidence. For a linear-Gaussian model the smoothed mean inside
-// the gap is the goal-directed path conditioned on the filtered states at both ends.
+// window's observations, so that the caller can weight the hypotheses by their evidence. For a
+// linear-Gaussian model the smoothed mean inside the gap is the goal-directed path conditioned
+// on the filtered states at both ends.
 #pragma once
 
 #include <algorithm>

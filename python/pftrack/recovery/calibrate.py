@@ -39,7 +39,7 @@ from pftrack.recovery.neighbours import (
 )
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, distinct_runs
+from pftrack.recovery.segments import as_segment, distinct_runs, split_rows
 
 __all__ = [
     "CANDIDATES",
@@ -283,7 +283,7 @@ def recover_with(
         xy = (1.0 - s) * np.repeat(ends_a[:, 1:3], n, axis=0) + s * np.repeat(
             ends_b[:, 1:3], n, axis=0
         )
-        return np.split(xy, np.cumsum(n)[:-1])
+        return split_rows(xy, n)
     if method == "rts":
         return rts_batch(pairs)
     if method in BASELINES:
