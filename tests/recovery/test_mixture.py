@@ -139,6 +139,28 @@ def test_state_loglik_batch_long_runs_match_numpy() -> None:
     np.testing.assert_allclose(got, want, rtol=1e-10)
 
 
+@pytest.mark.parametrize("d", [2, 3])
+def test_state_loglik_batch_blocks_are_exact(d: int) -> None:
+    """Models filtered together in blocks (the last one partial) give each model's own bits."""
+    rng = np.random.default_rng(6)
+    runs = [np.cumsum(rng.normal(1.0, 0.5, k)) for k in (3, 50, 7, 120)]
+    z, lengths = np.concatenate(runs), np.array([len(v) for v in runs], np.int32)
+    K = 7
+    if d == 3:
+        F, Q = singer_model(10.0 ** rng.uniform(-3, 1, K), 10.0 ** rng.uniform(-1, 2, K))
+    else:
+        F = np.repeat(cv_transition()[None], K, axis=0)
+        Q = np.stack([wna_Q(q) for q in 10.0 ** rng.uniform(-3, 1, K)])
+    F, Q = np.ascontiguousarray(F.reshape(-1, d)), np.ascontiguousarray(Q.reshape(-1, d))
+    r = 10.0 ** rng.uniform(-2, 1, K)
+    got = _core.state_loglik_batch(z, lengths, F, Q, r, 1e4)
+    for k in range(K):
+        one = _core.state_loglik_batch(
+            z, lengths, F[k * d : (k + 1) * d], Q[k * d : (k + 1) * d], r[k : k + 1], 1e4
+        )
+        assert one[0] == got[k]
+
+
 @pytest.mark.parametrize("q,tau", [(0.5, 0.3), (0.07, 2.9), (1.0, 40.0)])
 def test_singer_model_matches_quadrature(q: float, tau: float) -> None:
     F, Q = singer_model(q, tau)

@@ -275,50 +275,69 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
         using Vec = Eigen::Matrix<double, D, 1>;
         // Every run starts from the same covariance, so the innovation variances s_i and gains
         // g_i depend on the model and the step only: computed once per model, shared by the runs.
-        std::vector<double> S(static_cast<std::size_t>(std::max<Index>(longest, 0)));
-        std::vector<double> logS(S.size());
-        std::vector<Vec, Eigen::aligned_allocator<Vec>> G(S.size());
-        for (Index k = 0; k < K; ++k) {
-            const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
-            const double rk = r(k);
-            Mat P = Mat::Identity() * big;
-            // Once the filtered covariance repeats exactly, every later step repeats the last
-            // one: steps from `fixed` on reuse its s, log s and gain.
-            Index fixed = longest;
-            for (Index i = 0; i < longest; ++i) {
-                const auto u = static_cast<std::size_t>(i);
-                const Mat before = P;
-                if (i > 0) P = Fk * P * Fk.transpose() + Qk;
-                const double s = P(0, 0) + rk;
-                S[u] = s;
-                logS[u] = std::log(detail::kTwoPi * s);
-                const Vec g = P.col(0) / s;
-                G[u] = g;
-                P -= g * P.row(0);
-                P = 0.5 * (P + P.transpose()).eval();
-                if (i > 0 && P == before) {
-                    fixed = i;
-                    break;
+        // The models are filtered B at a time over each run: B independent chains of dependent
+        // operations the CPU overlaps, each with its own operations in its own order (the same
+        // bits as one model at a time). A last, partial block repeats model k0 (not kept).
+        constexpr Index B = 4;
+        const auto steps = static_cast<std::size_t>(std::max<Index>(longest, 0));
+        std::vector<double> S(B * steps), logS(B * steps);
+        std::vector<Vec, Eigen::aligned_allocator<Vec>> G(B * steps);
+        for (Index k0 = 0; k0 < K; k0 += B) {
+            Mat Fb[B];
+            Index fixed[B];
+            for (Index b = 0; b < B; ++b) {
+                const Index k = k0 + b < K ? k0 + b : k0;
+                const std::size_t at = static_cast<std::size_t>(b) * steps;
+                const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
+                const double rk = r(k);
+                Fb[b] = Fk;
+                Mat P = Mat::Identity() * big;
+                // Once the filtered covariance repeats exactly, every later step repeats the
+                // last one: steps from `fixed` on reuse its s, log s and gain.
+                fixed[b] = longest;
+                for (Index i = 0; i < longest; ++i) {
+                    const auto u = at + static_cast<std::size_t>(i);
+                    const Mat before = P;
+                    if (i > 0) P = Fk * P * Fk.transpose() + Qk;
+                    const double s = P(0, 0) + rk;
+                    S[u] = s;
+                    logS[u] = std::log(detail::kTwoPi * s);
+                    const Vec g = P.col(0) / s;
+                    G[u] = g;
+                    P -= g * P.row(0);
+                    P = 0.5 * (P + P.transpose()).eval();
+                    if (i > 0 && P == before) {
+                        fixed[b] = i;
+                        break;
+                    }
                 }
             }
-            double total = 0.0;
+            double total[B] = {};
             Index start = 0;
             for (Index run = 0; run < lengths.size(); ++run) {
                 const Index len = lengths(run);
                 const double* zz = z.data() + start;
                 start += len;
                 if (len < D + 2) continue;
-                Vec m = Vec::Zero();
-                m(0) = zz[0];
+                Vec m[B];
+                for (Index b = 0; b < B; ++b) {
+                    m[b] = Vec::Zero();
+                    m[b](0) = zz[0];
+                }
                 for (Index i = 0; i < len; ++i) {
-                    const auto u = static_cast<std::size_t>(std::min(i, fixed));
-                    if (i > 0) m = Fk * m;
-                    const double v = zz[i] - m(0);
-                    if (i >= D) total -= 0.5 * (logS[u] + v * v / S[u]);
-                    m += G[u] * v;
+                    for (Index b = 0; b < B; ++b) {
+                        const auto u = static_cast<std::size_t>(b) * steps +
+                                       static_cast<std::size_t>(std::min(i, fixed[b]));
+                        if (i > 0) m[b] = Fb[b] * m[b];
+                        const double v = zz[i] - m[b](0);
+                        if (i >= D) total[b] -= 0.5 * (logS[u] + v * v / S[u]);
+                        m[b] += G[u] * v;
+                    }
                 }
             }
-            ll(k) = std::isfinite(total) ? total : -std::numeric_limits<double>::infinity();
+            for (Index b = 0; b < B && k0 + b < K; ++b)
+                ll(k0 + b) =
+                    std::isfinite(total[b]) ? total[b] : -std::numeric_limits<double>::infinity();
         }
     };
     if (d == 2) run_all(std::integral_constant<int, 2>{});
