@@ -212,9 +212,11 @@ inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, 
     require(F.cols() == d, fn, "F cols", F.cols(), d);
     require(Q.rows() == d && Q.cols() == d, fn, "Q must be (d, d) like F");
     require(p0.size() == d, fn, "len(p0)", p0.size(), d);
-    require(0 <= fa && fa < fb && fb < n, fn,
-            "need 0 <= fa < fb < len(z), got fa=" + std::to_string(fa) +
-                ", fb=" + std::to_string(fb) + ", len(z)=" + std::to_string(n));
+    // messages are built only on failure (a string per call, or per hypothesis, costs more
+    // than the checks)
+    if (!(0 <= fa && fa < fb && fb < n))
+        fail(fn, "need 0 <= fa < fb < len(z), got fa=" + std::to_string(fa) +
+                     ", fb=" + std::to_string(fb) + ", len(z)=" + std::to_string(n));
     require(fb - fa >= 2, fn, "the gap has no lost step (fb - fa must be >= 2)");
     require(std::isfinite(z(0)) && std::isfinite(z(fa)) && std::isfinite(z(fb)), fn,
             "z[0], z[fa] and z[fb] must be observed (finite)");
@@ -233,10 +235,10 @@ inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, 
     for (Index h = 0; h < t1s.size(); ++h) {
         const int t1 = t1s(h), t2 = t2s(h);
         const bool none = t1 == -1 && t2 == -1;
-        require(none || (0 <= t1 && t1 < t2 && t2 <= T - 1), fn,
-                "hypothesis " + std::to_string(h) + " is (" + std::to_string(t1) + ", " +
-                    std::to_string(t2) + "), expected (-1, -1) or 0 <= t1 < t2 <= T-1 = " +
-                    std::to_string(T - 1));
+        if (!(none || (0 <= t1 && t1 < t2 && t2 <= T - 1)))
+            fail(fn, "hypothesis " + std::to_string(h) + " is (" + std::to_string(t1) + ", " +
+                         std::to_string(t2) + "), expected (-1, -1) or 0 <= t1 < t2 <= T-1 = " +
+                         std::to_string(T - 1));
     }
     if (d == 2) return detail::gap_mixture<2>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
     return detail::gap_mixture<3>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);

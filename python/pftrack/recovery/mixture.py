@@ -276,6 +276,25 @@ def _stand_hypotheses(T: int, grid: int) -> tuple[NDArray[np.int32], NDArray[np.
     return t1, t2
 
 
+_WALK_ONLY = np.array([-1], dtype=np.int32)
+_WALK_ONLY.setflags(write=False)
+
+
+@lru_cache(maxsize=1024)
+def _hypotheses(T: int, grid: int, rate: float) -> tuple[NDArray[np.int32], NDArray[np.int32], F64]:
+    """Stand hypotheses of a gap of ``T`` steps and their log prior (read-only, shared)."""
+    if rate > 0.0:
+        t1, t2 = stand_hypotheses(T, grid)
+        n_stand = len(t1) - 1
+        log_prior = np.full(len(t1), np.log(-np.expm1(-rate * T) / max(n_stand, 1)))
+        log_prior[0] = -rate * T
+    else:
+        t1 = t2 = _WALK_ONLY
+        log_prior = np.zeros(1)
+    log_prior.setflags(write=False)
+    return t1, t2, log_prior
+
+
 def recover_mixture(
     seg_a: F64, seg_b: F64, fit: MotionFit, grid: int = GRID, window: int = WINDOW
 ) -> F64:
@@ -287,14 +306,7 @@ def recover_mixture(
     T = fb - fa
     if T < 2:
         return np.zeros((0, 2))
-    if fit.stand_rate > 0.0:
-        t1, t2 = stand_hypotheses(T, grid)
-        n_stand = len(t1) - 1
-        log_prior = np.full(len(t1), np.log(-np.expm1(-fit.stand_rate * T) / max(n_stand, 1)))
-        log_prior[0] = -fit.stand_rate * T
-    else:
-        t1 = t2 = np.array([-1], dtype=np.int32)
-        log_prior = np.zeros(1)
+    t1, t2, log_prior = _hypotheses(T, grid, fit.stand_rate)
     ia, ib = (a[:, 0] - f0).astype(int), (b[:, 0] - f0).astype(int)
     paths, loglik = [], log_prior.copy()
     for axis, model in enumerate(fit.axes):
