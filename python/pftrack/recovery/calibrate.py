@@ -578,19 +578,27 @@ class _Blends:
         self.truths = truths
         self.cache: dict[tuple[int, str, str], F64] = {}
         self.rows: dict[tuple[int, str, str, int], F64] = {}
+        self.inputs: dict[tuple[int, str, str], tuple[tuple[F64, ...], F64, F64]] = {}
 
     def _errors(self, b: int, first: str, second: str, w: F64) -> F64:
         """Rows of per-gap errors, one per weight of `w`."""
-        truth = self.truths[b]
-        p1 = np.concatenate(self.found[b][first])
-        p2 = np.concatenate(self.found[b][second])
-        t = np.concatenate([v[:, 1:3] for v in truth])
-        sizes = np.array([len(v) for v in truth])
-        starts = np.r_[0, np.cumsum(sizes)[:-1]]
+        key = (b, first, second)
+        if key not in self.inputs:
+            truth = self.truths[b]
+            sizes = np.array([len(v) for v in truth])
+            p1 = np.concatenate(self.found[b][first])
+            p2 = np.concatenate(self.found[b][second])
+            t = np.concatenate([v[:, 1:3] for v in truth])
+            self.inputs[key] = (  # x and y apart: contiguous rows below
+                tuple(np.ascontiguousarray(a[:, i]) for a in (p1, p2, t) for i in (0, 1)),
+                np.r_[0, np.cumsum(sizes)[:-1]],
+                sizes,
+            )
+        (x1, y1, x2, y2, xt, yt), starts, sizes = self.inputs[key]
         # every weight at once, (weights, points): the same operations per element as one
         # weight at a time; the sums per gap stay one 1-D reduceat per weight
-        d = (1.0 - w)[:, None, None] * p1 + w[:, None, None] * p2 - t
-        dist = np.hypot(d[..., 0], d[..., 1])
+        a, c = (1.0 - w)[:, None], w[:, None]
+        dist = np.hypot(a * x1 + c * x2 - xt, a * y1 + c * y2 - yt)
         out: F64 = np.array([np.add.reduceat(row, starts) for row in dist]) / sizes
         return out
 
