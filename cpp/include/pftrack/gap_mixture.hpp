@@ -140,13 +140,10 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
     for (Index h = 0; h < H; ++h) {
         const int t1 = t1s(h), t2 = t2s(h);
         const Index first = t1 < 0 ? len : t1 + 1;  // first step that differs from walking
-        for (Index j = 0; j < first; ++j) {
-            ms[j] = walk_m[j];
-            Ps[j] = walk_P[j];
-            Pp[j] = walk_Pp[j];
-            mp[j] = walk_mp[j];
-            Fs[j] = &F;
-        }
+        // Before `first` the walking filter's arrays are read directly (walk_*); only the
+        // last walking step, where the hypothesis branches off, is copied.
+        ms[first - 1] = walk_m[first - 1];
+        Ps[first - 1] = walk_P[first - 1];
         Vec mh = ms[first - 1];
         Mat Ph = Ps[first - 1];
         double ll = walk_ll[first - 1];
@@ -171,11 +168,12 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
             const auto u = static_cast<std::size_t>(j);
             if (j + 1 < first) {  // walking up to here: Ps[j], Pp[j + 1], Fs[j + 1] are walk's
                 if (!have_walk[u]) {
-                    const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
+                    const Mat C = walk_P[j] * F.transpose() * psd_pinv<D>(walk_Pp[j + 1]);
                     walk_gain[u] = C;
                     have_walk[u] = 1;
                 }
-                ms[j] += walk_gain[u] * (ms[j + 1] - mp[j + 1]);
+                ms[j] = walk_m[j];
+                ms[j] += walk_gain[u] * (ms[j + 1] - walk_mp[j + 1]);
             } else if (j < t2) {  // standing from t1 + 1 to j + 1 <= t2: depends on (t1, j)
                 if (stand_t1[u] != t1) {
                     const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);

@@ -166,6 +166,12 @@ class MotionFit:
         parts.append(f"velocity variance {self.v2[0]:.3g}, {self.v2[1]:.3g} px^2/frame^2")
         return "; ".join(parts)
 
+    @cached_property
+    def priors(self) -> tuple[F64, F64]:
+        """:meth:`AxisModel.prior` of each axis with its restart velocity variance (once)."""
+        px, py = (m.prior(v2) for m, v2 in zip(self.axes, self.v2, strict=True))
+        return px, py
+
     @property
     def is_gdt_bi(self) -> bool:
         """No stand seen and white-noise acceleration on both axes: the ``gdt-bi`` model."""
@@ -307,14 +313,14 @@ def recover_mixture(
     if T < 2:
         return np.zeros((0, 2))
     t1, t2, log_prior = _hypotheses(T, grid, fit.stand_rate)
-    ia, ib = (a[:, 0] - f0).astype(int), (b[:, 0] - f0).astype(int)
+    z = np.full((2, n), np.nan)  # one row per axis
+    z[:, (a[:, 0] - f0).astype(int)] = a[:, 1:3].T
+    z[:, (b[:, 0] - f0).astype(int)] = b[:, 1:3].T
     paths, loglik = [], log_prior.copy()
     for axis, model in enumerate(fit.axes):
-        z = np.full(n, np.nan)
-        z[ia], z[ib] = a[:, 1 + axis], b[:, 1 + axis]
         F, Q = model.matrices
         p, ll = _core.gap_mixture(
-            z, fa, fb, F, Q, model.r, model.prior(fit.v2[axis]), t1, t2, fit.v2[axis]
+            z[axis], fa, fb, F, Q, model.r, fit.priors[axis], t1, t2, fit.v2[axis]
         )
         paths.append(p)
         loglik += ll

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._typing import F64
+from pftrack.recovery.segments import split_rows
 
 __all__ = [
     "MAX_NEIGHBOURS",
@@ -129,7 +130,9 @@ def correct_by_neighbours(
     if not flat:
         return base
     got = recover([(a, b) for a, b, _ in flat])
-    errors = [t[:, 1:3] - p for (_, _, t), p in zip(flat, got, strict=True)]
+    # every neighbour's error in one subtraction (rows of the windows' truths and paths)
+    diff = np.concatenate([t[:, 1:3] for _, _, t in flat]) - np.concatenate(got)
+    errors = split_rows(diff, [len(p) for p in got])
     # The median of each gap's neighbours' errors: one np.median per group of gaps with as
     # many neighbours and frames (each lane's median is the same as gap by gap).
     groups: dict[tuple[int, int], tuple[list[int], list[int]]] = {}
