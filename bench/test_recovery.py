@@ -34,8 +34,8 @@ from pftrack._typing import F64
 from pftrack.kalman import cv_transition, rts_smooth, wna_Q
 from pftrack.recovery import fill_gaps
 from pftrack.recovery.baselines import rts_batch
-from pftrack.recovery.mixture import DIFFUSE, singer_model
 from pftrack.recovery.calibrate import _fit_sample
+from pftrack.recovery.mixture import DIFFUSE, singer_model
 from pftrack.recovery.segments import distinct_runs
 from tests.reference import bridge as ref_bridge
 from tests.reference import mixture as ref_mix

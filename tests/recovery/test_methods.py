@@ -14,9 +14,9 @@ from pftrack.recovery import (
     recover_gap,
     recover_gaps,
 )
+from pftrack.recovery.calibrate import fixed_noise_model
 from pftrack.recovery.demo import demo_report
 from pftrack.recovery.gdt import GdtModel
-from pftrack.recovery.calibrate import fixed_noise_model
 from pftrack.recovery.noise import DEFAULT_NOISE, NoiseEstimate
 from pftrack.recovery.problems import GdtProblem, SegmentModel, gdt_bi_problem, gdt_problem
 from tests.reference import bridge as ref

@@ -578,7 +578,9 @@ class _Blends:
         self.truths = truths
         self.cache: dict[tuple[int, str, str], F64] = {}
         self.rows: dict[tuple[int, str, str, int], F64] = {}
-        self.inputs: dict[tuple[int, str, str], tuple[tuple[F64, ...], F64, F64]] = {}
+        self.inputs: dict[
+            tuple[int, str, str], tuple[tuple[F64, ...], NDArray[np.int64], NDArray[np.int64]]
+        ] = {}
 
     def _errors(self, b: int, first: str, second: str, w: F64) -> F64:
         """Rows of per-gap errors, one per weight of `w`."""
