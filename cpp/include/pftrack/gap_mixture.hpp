@@ -277,16 +277,18 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
         // g_i depend on the model and the step only: computed once per model, shared by the runs.
         // The models are filtered B at a time over each run: B independent chains of dependent
         // operations the CPU overlaps, each with its own operations in its own order (the same
-        // bits as one model at a time). A last, partial block repeats model k0 (not kept).
+        // bits as one model at a time); the last K % B models one at a time.
         constexpr Index B = 4;
         const auto steps = static_cast<std::size_t>(std::max<Index>(longest, 0));
         std::vector<double> S(B * steps), logS(B * steps);
         std::vector<Vec, Eigen::aligned_allocator<Vec>> G(B * steps);
-        for (Index k0 = 0; k0 < K; k0 += B) {
-            Mat Fb[B];
-            Index fixed[B];
-            for (Index b = 0; b < B; ++b) {
-                const Index k = k0 + b < K ? k0 + b : k0;
+        // models k0 .. k0 + NB - 1 together (NB = B, then 1 for the last K % B models)
+        auto block = [&](Index k0, auto nb) {
+            constexpr Index NB = decltype(nb)::value;
+            Mat Fb[NB];
+            Index fixed[NB];
+            for (Index b = 0; b < NB; ++b) {
+                const Index k = k0 + b;
                 const std::size_t at = static_cast<std::size_t>(b) * steps;
                 const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
                 const double rk = r(k);
@@ -312,20 +314,20 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                     }
                 }
             }
-            double total[B] = {};
+            double total[NB] = {};
             Index start = 0;
             for (Index run = 0; run < lengths.size(); ++run) {
                 const Index len = lengths(run);
                 const double* zz = z.data() + start;
                 start += len;
                 if (len < D + 2) continue;
-                Vec m[B];
-                for (Index b = 0; b < B; ++b) {
+                Vec m[NB];
+                for (Index b = 0; b < NB; ++b) {
                     m[b] = Vec::Zero();
                     m[b](0) = zz[0];
                 }
                 for (Index i = 0; i < len; ++i) {
-                    for (Index b = 0; b < B; ++b) {
+                    for (Index b = 0; b < NB; ++b) {
                         const auto u = static_cast<std::size_t>(b) * steps +
                                        static_cast<std::size_t>(std::min(i, fixed[b]));
                         if (i > 0) m[b] = Fb[b] * m[b];
@@ -335,10 +337,13 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                     }
                 }
             }
-            for (Index b = 0; b < B && k0 + b < K; ++b)
+            for (Index b = 0; b < NB; ++b)
                 ll(k0 + b) =
                     std::isfinite(total[b]) ? total[b] : -std::numeric_limits<double>::infinity();
-        }
+        };
+        Index k0 = 0;
+        for (; k0 + B <= K; k0 += B) block(k0, std::integral_constant<Index, B>{});
+        for (; k0 < K; ++k0) block(k0, std::integral_constant<Index, 1>{});
     };
     if (d == 2) run_all(std::integral_constant<int, 2>{});
     else run_all(std::integral_constant<int, 3>{});
