@@ -9,6 +9,11 @@
   time.
 * ``singer loglik``: the C++ likelihood behind ``fit_motion`` against
   ``tests/reference/mixture.py``.
+* ``noise loglik grid``: the likelihood grid behind ``estimate_noise`` (``_core.noise_loglik_grid``,
+  81 ``(q, r)`` pairs over the runs of the 500-track file's fit sample, about 1000 points)
+  against its NumPy reference (``tests/reference/bridge.py``, vectorised over the pairs).
+* ``state loglik, 343 models``: one level of ``fit_singer``'s grid (``_core.state_loglik_batch``,
+  the models filtered 4 at a time) against the same call one model at a time.
 * ``rts smooth, 500 tracks``: :func:`pftrack.kalman.rts_smooth` (one C++ call ``_core.rts_smooth``
   per track, what the offline pass and ``pftrack smooth`` run for every track's box) against
   the NumPy loop it replaced (``rts_smooth_numpy``), over the 500 tracks of
@@ -29,7 +34,10 @@ from pftrack._typing import F64
 from pftrack.kalman import cv_transition, rts_smooth, wna_Q
 from pftrack.recovery import fill_gaps
 from pftrack.recovery.baselines import rts_batch
+from pftrack.recovery.calibrate import _fit_sample
 from pftrack.recovery.mixture import DIFFUSE, singer_model
+from pftrack.recovery.segments import distinct_runs
+from tests.reference import bridge as ref_bridge
 from tests.reference import mixture as ref_mix
 from tests.reference.smoothing import dense_kalman_rts, rts_batch_numpy, rts_smooth_numpy
 
@@ -126,6 +134,75 @@ def test_singer_loglik_numpy(benchmark: BenchmarkFixture, singer_runs: list[F64]
     benchmark.group = "singer loglik"
     F, Q = singer_model(0.1, 3.0)
     benchmark(ref_mix.state_loglik, singer_runs, F[0], Q[0], 0.5, DIFFUSE)
+
+
+@pytest.fixture(scope="module")
+def fit_runs(tracks_500: F64) -> list[F64]:
+    """The runs ``auto`` fits noise and motion to on the 500-track file (box centres)."""
+    centres = tracks_500[:, [0, 2, 3]].copy()
+    centres[:, 1:] += 0.5 * tracks_500[:, 4:6]
+    ids = tracks_500[:, 1]
+    runs = distinct_runs([centres[ids == i] for i in np.unique(ids)])
+    return _fit_sample([r for r in runs if len(r) >= 4], 0)
+
+
+_GRID_Q, _GRID_R = (
+    10.0 ** g.ravel() for g in np.meshgrid(np.linspace(-5, 2, 9), np.linspace(-3, 2, 9))
+)
+
+
+def test_noise_loglik_grid_core(benchmark: BenchmarkFixture, fit_runs: list[F64]) -> None:
+    benchmark.group = "noise loglik grid"
+    z = np.ascontiguousarray(np.concatenate([r[:, 1] for r in fit_runs]))
+    lengths = np.array([len(r) for r in fit_runs], dtype=np.int32)
+    got = benchmark(_core.noise_loglik_grid, z, lengths, _GRID_Q, _GRID_R)
+    want = ref_bridge.loglik_grid(fit_runs, 0, _GRID_Q, _GRID_R)
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+
+
+def test_noise_loglik_grid_numpy(benchmark: BenchmarkFixture, fit_runs: list[F64]) -> None:
+    benchmark.group = "noise loglik grid"
+    benchmark.pedantic(
+        ref_bridge.loglik_grid, args=(fit_runs, 0, _GRID_Q, _GRID_R), rounds=3, iterations=1
+    )
+
+
+def _singer_grid() -> tuple[F64, F64, F64]:
+    """fit_singer's first grid: log10 q, r, tau."""
+    axes = [np.linspace(lo, hi, 7) for lo, hi in ((-5.0, 3.0), (-3.0, 3.0), (-1.5, 2.5))]
+    g = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3)
+    F, Q = singer_model(10.0 ** g[:, 0], 10.0 ** g[:, 2])
+    return F, Q, 10.0 ** g[:, 1]
+
+
+@pytest.mark.parametrize("batched", [True, False])
+def test_state_loglik_343_models(
+    benchmark: BenchmarkFixture, fit_runs: list[F64], batched: bool
+) -> None:
+    benchmark.group = "state loglik, 343 models"
+    F, Q, r = _singer_grid()
+    z = np.ascontiguousarray(np.concatenate([v[:, 1] for v in fit_runs]))
+    lengths = np.array([len(v) for v in fit_runs], dtype=np.int32)
+    Fs = [np.ascontiguousarray(f) for f in F]
+    Qs = [np.ascontiguousarray(q) for q in Q]
+
+    def one_by_one() -> F64:
+        return np.array(
+            [
+                _core.state_loglik_batch(z, lengths, Fs[k], Qs[k], r[k : k + 1], DIFFUSE)[0]
+                for k in range(len(r))
+            ]
+        )
+
+    def batch() -> F64:
+        out: F64 = _core.state_loglik_batch(
+            z, lengths, np.ascontiguousarray(F.reshape(-1, 3)),
+            np.ascontiguousarray(Q.reshape(-1, 3)), r, DIFFUSE,
+        )  # fmt: skip
+        return out
+
+    got = benchmark(batch if batched else one_by_one)
+    np.testing.assert_array_equal(got, (one_by_one if batched else batch)())
 
 
 _Q, _R = np.array([0.5, 0.5, 0.1, 0.1]), np.array([4.0, 4.0, 9.0, 9.0])

@@ -126,6 +126,28 @@ def test_recover_gaps_auto_matches_recover_auto() -> None:
         np.testing.assert_array_equal(a, b)
 
 
+def test_pairs_checked_at_once_or_one_by_one_agree() -> None:
+    """Float64 arrays (checked in one pass) and lists of (frame, x, y, w, h) rows (checked pair
+    by pair) give the same bits; a bad pair among good ones is still named."""
+    tracks = _manoeuvring_tracks(np.random.default_rng(6), n=8)
+    pairs = _cut(tracks, 9)
+    want, cal = recover_auto(pairs, tracks)
+    wide = [
+        (np.column_stack([a, a[:, 1:3]]).tolist(), np.column_stack([b, b[:, 1:3]]).tolist())
+        for a, b in pairs
+    ]
+    got, cal2 = recover_auto(wide, tracks)
+    assert cal == cal2
+    for x, y in zip(got, want, strict=True):
+        np.testing.assert_array_equal(x, y)
+    late = pairs[:3] + [(pairs[3][0], pairs[3][0][-1:])] + pairs[4:]
+    with pytest.raises(ValueError, match="gap 3: segment_b starts at frame"):
+        recover_auto(late, tracks)
+    jumpy = [(pairs[0][0][::-1], pairs[0][1])] + pairs[1:]
+    with pytest.raises(ValueError, match="segment_a frames must increase strictly"):
+        recover_auto(jumpy, tracks)
+
+
 def test_no_runs_long_enough_falls_back_to_linear() -> None:
     a = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
     b = np.array([[10.0, 10.0, 10.0], [11.0, 11.0, 11.0]])

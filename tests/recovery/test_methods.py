@@ -14,10 +14,11 @@ from pftrack.recovery import (
     recover_gap,
     recover_gaps,
 )
+from pftrack.recovery.calibrate import fixed_noise_model
 from pftrack.recovery.demo import demo_report
 from pftrack.recovery.gdt import GdtModel
-from pftrack.recovery.noise import DEFAULT_NOISE
-from pftrack.recovery.problems import GdtProblem, gdt_bi_problem, gdt_problem
+from pftrack.recovery.noise import DEFAULT_NOISE, NoiseEstimate
+from pftrack.recovery.problems import GdtProblem, SegmentModel, gdt_bi_problem, gdt_problem
 from tests.reference import bridge as ref
 
 
@@ -222,3 +223,45 @@ def test_noise_loglik_grid_matches_reference():
         np.testing.assert_allclose(got, ref.loglik_grid(runs, axis, q, r), rtol=1e-12)
     with pytest.raises(ValueError, match="q and r must be finite and > 0"):
         _core.noise_loglik_grid(z, np.array([len(z)], np.int32), np.array([0.0]), np.array([1.0]))
+
+
+def test_noise_loglik_grid_long_runs_match_reference():
+    """Runs far longer than the covariance takes to settle (the steps after it reuse it)."""
+    from pftrack import _core
+
+    rng = np.random.default_rng(9)
+    runs = [
+        np.column_stack([np.arange(n), np.cumsum(rng.normal(0, 1, (n, 2)), axis=0)])
+        for n in (1200, 5, 300)
+    ]
+    q = np.array([0.01, 1.0, 1e-5])
+    r = np.array([0.5, 2.0, 50.0])
+    z = np.concatenate([run[:, 1] for run in runs])
+    got = _core.noise_loglik_grid(z, np.array([len(x) for x in runs], np.int32), q, r)
+    np.testing.assert_allclose(got, ref.loglik_grid(runs, 0, q, r), rtol=1e-12)
+
+
+@pytest.mark.parametrize("history", [None, 4])
+@pytest.mark.parametrize(
+    "model",
+    [
+        SegmentModel.two_sided(NoiseEstimate(q=(0.3, 0.05), r=(2.0, 0.5))),
+        SegmentModel.paper(),
+        fixed_noise_model(),
+    ],
+)
+def test_gdt_recover_batch_shared_gains_are_exact(model: SegmentModel, history: int | None):
+    """Gains shared by the gaps of one call (the segments' filter, the goal's path per Pi_T)
+    give every gap the bits of a call of its own, whatever the order of lengths."""
+    rng = np.random.default_rng(12)
+    seg_a, seg_b = [], []
+    for na, nb, T in [(5, 7, 9), (12, 7, 3), (5, 2, 15), (30, 7, 9), (1, 1, 2), (8, 30, 15)]:
+        xy = np.cumsum(rng.normal(0, 2, (na + T - 1 + nb, 2)), axis=0)
+        fr = np.arange(len(xy), dtype=float)
+        rows = np.column_stack([fr, xy])
+        seg_a.append(rows[:na])
+        seg_b.append(rows[na + T - 1 :])
+    together = model.recover(seg_a, seg_b, history)
+    for k in range(len(seg_a)):
+        alone = model.recover(seg_a[k : k + 1], seg_b[k : k + 1], history)[0]
+        assert np.array_equal(alone, together[k])

@@ -49,6 +49,29 @@ def test_gap_mixture_matches_numpy(d: int, seed: int) -> None:
     np.testing.assert_allclose(vec_ll, ref_ll, rtol=1e-10, atol=1e-8)
 
 
+@pytest.mark.parametrize("d", [2, 3])
+def test_gap_mixture_shared_gains_are_exact(d: int) -> None:
+    """Smoother gains shared by hypotheses (walking before t1, standing by t1) change no bit.
+
+    Each hypothesis alone (nothing shared) and the hypotheses in another order (t1 not grouped)
+    give the same bits as one call over the grouped hypotheses.
+    """
+    rng = np.random.default_rng(11)
+    n, fa, fb = 70, 25, 45
+    z = _window(rng, n, fa, fb, holes=3)
+    F, Q = singer_model(0.3, 2.5) if d == 3 else (cv_transition()[None], wna_Q(0.2)[None])
+    F, Q = F[0], Q[0]
+    t1, t2 = stand_hypotheses(fb - fa, grid=8)
+    p0 = np.array([1e4, 4.0, 0.5][:d])
+    all_p, all_ll = _core.gap_mixture(z, fa, fb, F, Q, 0.3, p0, t1, t2, 4.0)
+    for h in range(len(t1)):
+        p, ll = _core.gap_mixture(z, fa, fb, F, Q, 0.3, p0, t1[h : h + 1], t2[h : h + 1], 4.0)
+        assert np.array_equal(p[0], all_p[h]) and ll[0] == all_ll[h]
+    order = rng.permutation(len(t1))
+    p, ll = _core.gap_mixture(z, fa, fb, F, Q, 0.3, p0, t1[order], t2[order], 4.0)
+    assert np.array_equal(p, all_p[order]) and np.array_equal(ll, all_ll[order])
+
+
 def test_gap_mixture_walk_hypothesis_is_the_gaussian_conditional() -> None:
     """No stand: the smoothed gap equals E[x_gap | observations] of the joint Gaussian."""
     rng = np.random.default_rng(5)
@@ -96,6 +119,46 @@ def test_state_loglik_batch_matches_numpy() -> None:
     )
     want = [state_loglik(runs, F[k], Q[k], r[k], 1e4) for k in range(2)]
     np.testing.assert_allclose(got, want, rtol=1e-10)
+
+
+def test_state_loglik_batch_long_runs_match_numpy() -> None:
+    """Runs far longer than the covariance takes to settle (the steps after it reuse it)."""
+    rng = np.random.default_rng(4)
+    runs = [np.cumsum(rng.normal(1.0, 0.5, k)) for k in (1500, 6, 300)]
+    F, Q = singer_model([0.1, 2.0, 1e-4], [3.0, 0.5, 80.0])
+    r = np.array([0.2, 1.5, 10.0])
+    got = _core.state_loglik_batch(
+        np.concatenate(runs),
+        np.array([len(z) for z in runs], np.int32),
+        np.ascontiguousarray(F.reshape(-1, 3)),
+        np.ascontiguousarray(Q.reshape(-1, 3)),
+        r,
+        1e4,
+    )
+    want = [state_loglik(runs, F[k], Q[k], r[k], 1e4) for k in range(3)]
+    np.testing.assert_allclose(got, want, rtol=1e-10)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_state_loglik_batch_blocks_are_exact(d: int) -> None:
+    """Models filtered together in blocks (the last one partial) give each model's own bits."""
+    rng = np.random.default_rng(6)
+    runs = [np.cumsum(rng.normal(1.0, 0.5, k)) for k in (3, 50, 7, 120)]
+    z, lengths = np.concatenate(runs), np.array([len(v) for v in runs], np.int32)
+    K = 7
+    if d == 3:
+        F, Q = singer_model(10.0 ** rng.uniform(-3, 1, K), 10.0 ** rng.uniform(-1, 2, K))
+    else:
+        F = np.repeat(cv_transition()[None], K, axis=0)
+        Q = np.stack([wna_Q(q) for q in 10.0 ** rng.uniform(-3, 1, K)])
+    F, Q = np.ascontiguousarray(F.reshape(-1, d)), np.ascontiguousarray(Q.reshape(-1, d))
+    r = 10.0 ** rng.uniform(-2, 1, K)
+    got = _core.state_loglik_batch(z, lengths, F, Q, r, 1e4)
+    for k in range(K):
+        one = _core.state_loglik_batch(
+            z, lengths, F[k * d : (k + 1) * d], Q[k * d : (k + 1) * d], r[k : k + 1], 1e4
+        )
+        assert one[0] == got[k]
 
 
 @pytest.mark.parametrize("q,tau", [(0.5, 0.3), (0.07, 2.9), (1.0, 40.0)])

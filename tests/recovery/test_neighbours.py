@@ -196,3 +196,33 @@ def test_deterministic(seed: int) -> None:
     assert c1 == c2
     for a, b in zip(p1, p2, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_windows_many_is_windows_pair_by_pair() -> None:
+    """The vectorised search finds the same windows, in the same order, as one pair at a time
+    (excluded runs, no neighbour, a repeated pair, fewer neighbours than the cap)."""
+    rng = np.random.default_rng(4)
+    tracks = _carried_camera_tracks(rng, n=15)
+    tracks.append(tracks[2].copy())  # a run twice: distinct_runs keeps one
+    tracks += [tr[20:90] for tr in tracks[5:8]]  # shorter runs: some gaps have fewer
+    runs = distinct_runs(tracks)
+    pairs, excludes = [], []
+    for k in range(40):
+        i = int(rng.integers(len(runs)))
+        r = runs[i]
+        s, L = int(rng.integers(1, len(r) - 10)), int(rng.integers(1, 8))
+        pairs.append((r[:s], r[s + L :]))
+        excludes.append(i if k % 3 else -1)
+    pairs.append(pairs[0])
+    excludes.append(excludes[0])
+    pairs.append((runs[0][:5] + [0.0, 0.0, 0.0], runs[0][-5:] + [500.0, 0.0, 0.0]))
+    excludes.append(-1)
+    got = Neighbourhood(runs).windows_many(pairs, excludes)
+    want_hood = Neighbourhood(runs)
+    for ws, (a, b), e in zip(got, pairs, excludes, strict=True):
+        want = want_hood.windows(a, b, e)
+        assert len(ws) == len(want)
+        for w, v in zip(ws, want, strict=True):
+            for x, y in zip(w, v, strict=True):
+                np.testing.assert_array_equal(x, y)
+    assert got[-1] == []

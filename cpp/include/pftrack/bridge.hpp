@@ -9,8 +9,10 @@
 // Phi(T,t) = Phi(T,t+1) A_{t+1}: O(T) per gap, no matrix powers.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -502,13 +504,55 @@ inline KalmanEstimate filter_run(const RowMatrixXd& z, const SegmentModel& model
 
 namespace detail {
 
+/// Gains of the fixed-size Kalman filter of a segment run (initialised like filter_run). The
+/// covariances do not depend on the measurements and every run starts from the same one, so
+/// step k's gain and filtered covariance are computed once per call for all runs (forward over
+/// A, backward over B), with the operations of the per-run filter: the same bits.
+template <int N, int M>
+struct KalmanGainsFixed {
+    using MatN = Eigen::Matrix<double, N, N>;
+    MatN A, Q;
+    Eigen::Matrix<double, M, N> H;
+    Eigen::Matrix<double, M, M> R;
+    MatN P_init;
+    std::vector<Eigen::Matrix<double, N, M>> K;  // gain of step k
+    std::vector<MatN> P;                         // filtered covariance after step k
+
+    KalmanGainsFixed(const MatN& A_, const MatN& Q_, const Eigen::Matrix<double, M, N>& H_,
+                     const Eigen::Matrix<double, M, M>& R_, double p_vel)
+        : A(A_), Q(Q_), H(H_), R(R_) {
+        P_init.setZero();
+        P_init.template topLeftCorner<M, M>() = R;
+        P_init.template bottomRightCorner<N - M, N - M>().diagonal().setConstant(p_vel);
+    }
+
+    /// Steps 0 .. len - 1 available.
+    void extend(Index len) {
+        const MatN I = MatN::Identity();
+        while (static_cast<Index>(K.size()) < len) {
+            MatN Pk = K.empty() ? P_init : P.back();
+            if (!K.empty()) Pk = A * Pk * A.transpose() + Q;
+            const Eigen::Matrix<double, M, M> S = H * Pk * H.transpose() + R;
+            Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
+            require(llt.info() == Eigen::Success, "gdt_recover_batch",
+                    "innovation covariance is not positive definite");
+            const Eigen::Matrix<double, N, M> Kk =
+                (llt.solve((Pk * H.transpose()).transpose())).transpose();
+            const MatN IKH = I - Kk * H;
+            Pk = IKH * Pk * IKH.transpose() + Kk * R * Kk.transpose();
+            Pk = 0.5 * (Pk + Pk.transpose()).eval();
+            K.push_back(Kk);
+            P.push_back(Pk);
+        }
+    }
+};
+
 /// Fixed-size Kalman filter over rows [r0, r1) of `seg` (columns 1..M), optionally in reverse
-/// order, initialised like filter_run. Same maths as kalman_filter, without heap allocations.
+/// order, initialised like filter_run, with the shared gains `g`. Same maths as kalman_filter,
+/// without heap allocations.
 template <int N, int M>
 void kalman_run_fixed(const Eigen::Ref<const RowMatrixXd>& seg, Index r0, Index r1, bool reverse,
-                      const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<double, N, N>& Q,
-                      const Eigen::Matrix<double, M, N>& H, const Eigen::Matrix<double, M, M>& R,
-                      double p_vel, Eigen::Matrix<double, N, 1>& m,
+                      KalmanGainsFixed<N, M>& g, Eigen::Matrix<double, N, 1>& m,
                       Eigen::Matrix<double, N, N>& P) {
     using VecM = Eigen::Matrix<double, M, 1>;
     const Index len = r1 - r0;
@@ -516,63 +560,76 @@ void kalman_run_fixed(const Eigen::Ref<const RowMatrixXd>& seg, Index r0, Index 
         const Index r = reverse ? r1 - 1 - k : r0 + k;
         return seg.block(r, 1, 1, M).transpose();
     };
+    g.extend(len);
     m.setZero();
     m.template head<M>() = z(0);
     if (len > 1) m.template tail<N - M>() = z(1) - z(0);
-    P.setZero();
-    P.template topLeftCorner<M, M>() = R;
-    P.template bottomRightCorner<N - M, N - M>().diagonal().setConstant(p_vel);
-    const Eigen::Matrix<double, N, N> I = Eigen::Matrix<double, N, N>::Identity();
     for (Index k = 0; k < len; ++k) {
-        if (k > 0) {
-            m = A * m;
-            P = A * P * A.transpose() + Q;
-        }
-        const Eigen::Matrix<double, M, M> S = H * P * H.transpose() + R;
-        Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
-        require(llt.info() == Eigen::Success, "gdt_recover_batch",
-                "innovation covariance is not positive definite");
-        const Eigen::Matrix<double, N, M> K =
-            (llt.solve((P * H.transpose()).transpose())).transpose();
-        m += K * (z(k) - H * m);
-        const Eigen::Matrix<double, N, N> IKH = I - K * H;
-        P = IKH * P * IKH.transpose() + K * R * K.transpose();
-        P = 0.5 * (P + P.transpose()).eval();
+        if (k > 0) m = g.A * m;
+        m += g.K[static_cast<size_t>(k)] * (z(k) - g.H * m);
     }
+    P = g.P[static_cast<size_t>(len - 1)];
 }
 
-/// Fixed-size goal-directed mean path (general form, eqs. 7 and 10) of one gap; writes the
-/// positions of x_1 .. x_{T-1} into out rows [row, row + T - 1).
+/// Gains of the fixed-size goal-directed mean path (general form, eqs. 7 and 10) for one goal
+/// covariance Pi_T. They depend on the number of steps s = T - t to the goal only, not on T:
+/// computed once, for the longest gap, and shared by every gap with this Pi_T (the loop of the
+/// per-gap computation, run once: the same bits). Also the M^-1 of each s (eq. 9 at s = T - 1).
 template <int N, int MG>
-void gdt_path_fixed(const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<double, N, N>& Q,
-                    const Eigen::Matrix<double, MG, N>& H, const Eigen::Matrix<double, MG, MG>& PiT,
-                    const Eigen::Matrix<double, N, 1>& m0, const Eigen::Matrix<double, N, N>& P0,
-                    const Eigen::Matrix<double, MG, 1>& y, int T, bool start_conditioned,
-                    std::vector<Eigen::Matrix<double, N, MG>>& K,
-                    std::vector<Eigen::Matrix<double, MG, N>>& G, RowMatrixXd& out, Index row) {
+struct GoalGainsFixed {
     using MatN = Eigen::Matrix<double, N, N>;
     using MatG = Eigen::Matrix<double, MG, MG>;
-    const char* fn = "gdt_recover_batch";
-    K.resize(static_cast<size_t>(T));
-    G.resize(static_cast<size_t>(T));
-    MatN Phi = MatN::Identity();
+    MatN A, Q;
+    Eigen::Matrix<double, MG, N> H;
+    MatG PiT;
+    MatN Phi = MatN::Identity();  // Phi(T, T - s) for the next s
     MatN S = MatN::Zero();
-    MatG Minv;
-    for (int t = T; t >= 1; --t) {
-        // S_t = Phi(T,t) Q Phi(T,t)^T + S_{t+1};  M_t = Pi_T + H S_t H^T
-        S.noalias() += Phi * Q * Phi.transpose();
-        const MatG M = PiT + H * S * H.transpose();
-        Eigen::LLT<MatG> llt(0.5 * (M + M.transpose()));
-        require(llt.info() == Eigen::Success, fn, "Pi_T + H S H^T is not positive definite");
-        Minv = llt.solve(MatG::Identity());
-        const Eigen::Matrix<double, MG, N> HPhi = H * Phi;
-        K[static_cast<size_t>(t - 1)] = Q * HPhi.transpose() * Minv;  // eq. 7
-        Phi = Phi * A;                                                  // Phi(T, t-1)
-        G[static_cast<size_t>(t - 1)] = H * Phi;
+    std::vector<Eigen::Matrix<double, N, MG>> K;  // K_t, t = T - s
+    std::vector<Eigen::Matrix<double, MG, N>> G;  // H Phi(T, t - 1)
+    std::vector<MatG> Minv;
+
+    GoalGainsFixed(const MatN& A_, const MatN& Q_, const Eigen::Matrix<double, MG, N>& H_,
+                   const MatG& PiT_)
+        : A(A_), Q(Q_), H(H_), PiT(PiT_) {}
+
+    /// s = 0 .. T - 1 available.
+    void extend(int T) {
+        const char* fn = "gdt_recover_batch";
+        while (static_cast<int>(K.size()) < T) {
+            // S_t = Phi(T,t) Q Phi(T,t)^T + S_{t+1};  M_t = Pi_T + H S_t H^T
+            S.noalias() += Phi * Q * Phi.transpose();
+            const MatG M = PiT + H * S * H.transpose();
+            Eigen::LLT<MatG> llt(0.5 * (M + M.transpose()));
+            require(llt.info() == Eigen::Success, fn, "Pi_T + H S H^T is not positive definite");
+            MatG Mi;
+            Mi = llt.solve(MatG::Identity());
+            const Eigen::Matrix<double, MG, N> HPhi = H * Phi;
+            Eigen::Matrix<double, N, MG> Kt;
+            Kt = Q * HPhi.transpose() * Mi;  // eq. 7
+            Phi = Phi * A;                   // Phi(T, t-1)
+            Eigen::Matrix<double, MG, N> Gt;
+            Gt = H * Phi;
+            K.push_back(Kt);
+            G.push_back(Gt);
+            Minv.push_back(Mi);
+        }
     }
+};
+
+/// Fixed-size goal-directed mean path of one gap of T steps with the gains `g` of its Pi_T;
+/// writes the positions of x_1 .. x_{T-1} into out rows [row, row + T - 1).
+template <int N, int MG>
+void gdt_path_fixed(GoalGainsFixed<N, MG>& g, const Eigen::Matrix<double, N, 1>& m0,
+                    const Eigen::Matrix<double, N, N>& P0, const Eigen::Matrix<double, MG, 1>& y,
+                    int T, bool start_conditioned, RowMatrixXd& out, Index row) {
+    using MatN = Eigen::Matrix<double, N, N>;
+    const char* fn = "gdt_recover_batch";
+    g.extend(T);
+    const auto last = static_cast<size_t>(T - 1);
     Eigen::Matrix<double, N, 1> x = m0;
     if (start_conditioned) {
-        const Eigen::Matrix<double, MG, N> F = H * Phi;  // H Phi(T, 0)
+        const Eigen::Matrix<double, MG, N>& F = g.G[last];  // H Phi(T, 0)
+        const Eigen::Matrix<double, MG, MG>& Minv = g.Minv[last];
         Eigen::LLT<MatN> l0(P0);
         require(l0.info() == Eigen::Success, fn, "Pi_0 is not positive definite");
         const MatN info = l0.solve(MatN::Identity()) + F.transpose() * Minv * F;  // eq. 9
@@ -581,8 +638,8 @@ void gdt_path_fixed(const Eigen::Matrix<double, N, N>& A, const Eigen::Matrix<do
         x = m0 + l1.solve(F.transpose() * Minv * (y - F * m0));  // eq. 10
     }
     for (int t = 1; t < T; ++t) {
-        const size_t k = static_cast<size_t>(t - 1);
-        x = A * x + K[k] * (y - G[k] * x);  // eq. 3 (mean)
+        const auto s = static_cast<size_t>(T - t);
+        x = g.A * x + g.K[s] * (y - g.G[s] * x);  // eq. 3 (mean)
         out.row(row++) = x.template head<N / 2>().transpose();
     }
 }
@@ -603,9 +660,13 @@ RowMatrixXd gdt_recover_batch_fixed(const Eigen::Ref<const RowMatrixXd>& seg_a,
     MatN J = MatN::Identity();
     J.template bottomRightCorner<M, M>() *= -1.0;  // time reversal flips velocities
     RowMatrixXd out(total, M);
-    std::vector<Eigen::Matrix<double, N, M>> K2;
-    std::vector<Eigen::Matrix<double, M, N>> G2;
-    std::vector<Eigen::Matrix<double, N, N>> K4, G4;
+    // Gains shared by the gaps: the segments' filter, the goal's path (one Pi_T for the first
+    // point of B; one per length of B's filtered run for its backward state).
+    KalmanGainsFixed<N, M> filt(A, Q, H, R, model.p_init_velocity);
+    GoalGainsFixed<N, M> to_point(A, Q, H, R);
+    std::map<Index, GoalGainsFixed<N, N>> to_state;
+    constexpr Index kMaxCachedSteps = Index(1) << 17;  // steps of to_state kept (~50 MB at most)
+    Index cached = 0;
     Index ia = 0, ib = 0, row = 0;
     for (Index g = 0; g < a_len.size(); ++g) {
         const int T = Ts[static_cast<size_t>(g)];
@@ -613,18 +674,33 @@ RowMatrixXd gdt_recover_batch_fixed(const Eigen::Ref<const RowMatrixXd>& seg_a,
         gap_run(seg_a, ia, ia + a_len(g), true, history, r0, r1);
         Eigen::Matrix<double, N, 1> m0;
         MatN P0;
-        kalman_run_fixed<N, M>(seg_a, r0, r1, false, A, Q, H, R, model.p_init_velocity, m0, P0);
+        kalman_run_fixed<N, M>(seg_a, r0, r1, false, filt, m0, P0);
         if (goal == GoalKind::first_point) {
             const Eigen::Matrix<double, M, 1> y = seg_b.block(ib, 1, 1, M).transpose();
-            gdt_path_fixed<N, M>(A, Q, H, R, m0, P0, y, T, start_conditioned, K2, G2, out, row);
+            gdt_path_fixed<N, M>(to_point, m0, P0, y, T, start_conditioned, out, row);
         } else {
             gap_run(seg_b, ib, ib + b_len(g), false, history, r0, r1);
             Eigen::Matrix<double, N, 1> mb;
             MatN Pb;
-            kalman_run_fixed<N, M>(seg_b, r0, r1, true, A, Q, H, R, model.p_init_velocity, mb, Pb);
-            const MatN PiT = J * Pb * J;
-            gdt_path_fixed<N, N>(A, Q, MatN::Identity(), 0.5 * (PiT + PiT.transpose()), m0, P0,
-                                 J * mb, T, start_conditioned, K4, G4, out, row);
+            kalman_run_fixed<N, M>(seg_b, r0, r1, true, filt, mb, Pb);
+            auto it = to_state.find(r1 - r0);  // Pb depends on the run's length only
+            const Index more = it == to_state.end()
+                                   ? T
+                                   : std::max<Index>(T - static_cast<Index>(it->second.K.size()), 0);
+            if (cached + more > kMaxCachedSteps) {  // bounded memory: start again (same bits)
+                to_state.clear();
+                cached = 0;
+                it = to_state.end();
+            }
+            if (it == to_state.end()) {
+                const MatN PiT = J * Pb * J;
+                it = to_state
+                         .emplace(r1 - r0, GoalGainsFixed<N, N>(A, Q, MatN::Identity(),
+                                                                0.5 * (PiT + PiT.transpose())))
+                         .first;
+            }
+            cached += std::max<Index>(T - static_cast<Index>(it->second.K.size()), 0);
+            gdt_path_fixed<N, N>(it->second, m0, P0, J * mb, T, start_conditioned, out, row);
         }
         row += T - 1;
         ia += a_len(g);

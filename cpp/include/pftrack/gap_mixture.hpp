@@ -10,14 +10,16 @@
 // velocity of variance v2 starts. (-1, -1) is "walks through the gap".
 //
 // For every hypothesis one Kalman filter and Rauch-Tung-Striebel smoother run over the window
-// (the filter over the part before the gap is shared); the result is the smoothed positions
-// inside the gap and the log-likelihood of the window's observations, so that the caller can
-// weight the hypotheses by their evidence. For a linear-Gaussian model the smoothed mean inside
-// the gap is the goal-directed path conditioned on the filtered states at both ends.
+// (the filter over the part before the gap, and the smoother gains where hypotheses agree, are
+// shared); the result is the smoothed positions inside the gap and the log-likelihood of the
+// window's observations, so that the caller can weight the hypotheses by their evidence. For a
+// linear-Gaussian model the smoothed mean inside the gap is the goal-directed path conditioned
+// on the filtered states at both ends.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <type_traits>
@@ -127,16 +129,21 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
     std::vector<Vec> mp(len), ms(len);
     std::vector<Mat> Pp(len), Ps(len);
     std::vector<const Mat*> Fs(len, &F);
+    // Smoother gains C_j = Ps[j] F_{j+1}' pinv(Pp[j+1]) depend on covariances only, which do not
+    // depend on the observed values. Before gap step t1 every hypothesis has the walking filter's
+    // (walk_gain, computed once); while standing (t1 <= j < t2) they depend on (t1, j) only
+    // (stand_gain, kept for the last t1 seen: hypotheses come grouped by t1). The same
+    // expression on the same operands: the same bits as computing them per hypothesis.
+    std::vector<Mat> walk_gain(len), stand_gain(len);
+    std::vector<char> have_walk(len, 0);
+    std::vector<int> stand_t1(len, -2);
     for (Index h = 0; h < H; ++h) {
         const int t1 = t1s(h), t2 = t2s(h);
         const Index first = t1 < 0 ? len : t1 + 1;  // first step that differs from walking
-        for (Index j = 0; j < first; ++j) {
-            ms[j] = walk_m[j];
-            Ps[j] = walk_P[j];
-            Pp[j] = walk_Pp[j];
-            mp[j] = walk_mp[j];
-            Fs[j] = &F;
-        }
+        // Before `first` the walking filter's arrays are read directly (walk_*); only the
+        // last walking step, where the hypothesis branches off, is copied.
+        ms[first - 1] = walk_m[first - 1];
+        Ps[first - 1] = walk_P[first - 1];
         Vec mh = ms[first - 1];
         Mat Ph = Ps[first - 1];
         double ll = walk_ll[first - 1];
@@ -158,8 +165,26 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
             Ps[j] = Ph;
         }
         for (Index j = len - 2; j >= 1; --j) {
-            const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
-            ms[j] += C * (ms[j + 1] - mp[j + 1]);
+            const auto u = static_cast<std::size_t>(j);
+            if (j + 1 < first) {  // walking up to here: Ps[j], Pp[j + 1], Fs[j + 1] are walk's
+                if (!have_walk[u]) {
+                    const Mat C = walk_P[j] * F.transpose() * psd_pinv<D>(walk_Pp[j + 1]);
+                    walk_gain[u] = C;
+                    have_walk[u] = 1;
+                }
+                ms[j] = walk_m[j];
+                ms[j] += walk_gain[u] * (ms[j + 1] - walk_mp[j + 1]);
+            } else if (j < t2) {  // standing from t1 + 1 to j + 1 <= t2: depends on (t1, j)
+                if (stand_t1[u] != t1) {
+                    const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
+                    stand_gain[u] = C;
+                    stand_t1[u] = t1;
+                }
+                ms[j] += stand_gain[u] * (ms[j + 1] - mp[j + 1]);
+            } else {
+                const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
+                ms[j] += C * (ms[j + 1] - mp[j + 1]);
+            }
         }
         for (Index j = 1; j < T; ++j) out.paths(h, j - 1) = ms[j](0);
         out.loglik(h) = ll;
@@ -185,9 +210,11 @@ inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, 
     require(F.cols() == d, fn, "F cols", F.cols(), d);
     require(Q.rows() == d && Q.cols() == d, fn, "Q must be (d, d) like F");
     require(p0.size() == d, fn, "len(p0)", p0.size(), d);
-    require(0 <= fa && fa < fb && fb < n, fn,
-            "need 0 <= fa < fb < len(z), got fa=" + std::to_string(fa) +
-                ", fb=" + std::to_string(fb) + ", len(z)=" + std::to_string(n));
+    // messages are built only on failure (a string per call, or per hypothesis, costs more
+    // than the checks)
+    if (!(0 <= fa && fa < fb && fb < n))
+        fail(fn, "need 0 <= fa < fb < len(z), got fa=" + std::to_string(fa) +
+                     ", fb=" + std::to_string(fb) + ", len(z)=" + std::to_string(n));
     require(fb - fa >= 2, fn, "the gap has no lost step (fb - fa must be >= 2)");
     require(std::isfinite(z(0)) && std::isfinite(z(fa)) && std::isfinite(z(fb)), fn,
             "z[0], z[fa] and z[fb] must be observed (finite)");
@@ -206,10 +233,10 @@ inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, 
     for (Index h = 0; h < t1s.size(); ++h) {
         const int t1 = t1s(h), t2 = t2s(h);
         const bool none = t1 == -1 && t2 == -1;
-        require(none || (0 <= t1 && t1 < t2 && t2 <= T - 1), fn,
-                "hypothesis " + std::to_string(h) + " is (" + std::to_string(t1) + ", " +
-                    std::to_string(t2) + "), expected (-1, -1) or 0 <= t1 < t2 <= T-1 = " +
-                    std::to_string(T - 1));
+        if (!(none || (0 <= t1 && t1 < t2 && t2 <= T - 1)))
+            fail(fn, "hypothesis " + std::to_string(h) + " is (" + std::to_string(t1) + ", " +
+                         std::to_string(t2) + "), expected (-1, -1) or 0 <= t1 < t2 <= T-1 = " +
+                         std::to_string(T - 1));
     }
     if (d == 2) return detail::gap_mixture<2>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
     return detail::gap_mixture<3>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
@@ -248,43 +275,75 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
         using Vec = Eigen::Matrix<double, D, 1>;
         // Every run starts from the same covariance, so the innovation variances s_i and gains
         // g_i depend on the model and the step only: computed once per model, shared by the runs.
-        std::vector<double> S(static_cast<std::size_t>(std::max<Index>(longest, 0)));
-        std::vector<double> logS(S.size());
-        std::vector<Vec, Eigen::aligned_allocator<Vec>> G(S.size());
-        for (Index k = 0; k < K; ++k) {
-            const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
-            const double rk = r(k);
-            Mat P = Mat::Identity() * big;
-            for (Index i = 0; i < longest; ++i) {
-                const auto u = static_cast<std::size_t>(i);
-                if (i > 0) P = Fk * P * Fk.transpose() + Qk;
-                const double s = P(0, 0) + rk;
-                S[u] = s;
-                logS[u] = std::log(detail::kTwoPi * s);
-                const Vec g = P.col(0) / s;
-                G[u] = g;
-                P -= g * P.row(0);
-                P = 0.5 * (P + P.transpose()).eval();
+        // The models are filtered B at a time over each run: B independent chains of dependent
+        // operations the CPU overlaps, each with its own operations in its own order (the same
+        // bits as one model at a time); the last K % B models one at a time.
+        constexpr Index B = 4;
+        const auto steps = static_cast<std::size_t>(std::max<Index>(longest, 0));
+        std::vector<double> S(B * steps), logS(B * steps);
+        std::vector<Vec, Eigen::aligned_allocator<Vec>> G(B * steps);
+        // models k0 .. k0 + NB - 1 together (NB = B, then 1 for the last K % B models)
+        auto block = [&](Index k0, auto nb) {
+            constexpr Index NB = decltype(nb)::value;
+            Mat Fb[NB];
+            Index fixed[NB];
+            for (Index b = 0; b < NB; ++b) {
+                const Index k = k0 + b;
+                const std::size_t at = static_cast<std::size_t>(b) * steps;
+                const Mat Fk = F.block(k * D, 0, D, D), Qk = Q.block(k * D, 0, D, D);
+                const double rk = r(k);
+                Fb[b] = Fk;
+                Mat P = Mat::Identity() * big;
+                // Once the filtered covariance repeats exactly, every later step repeats the
+                // last one: steps from `fixed` on reuse its s, log s and gain.
+                fixed[b] = longest;
+                for (Index i = 0; i < longest; ++i) {
+                    const auto u = at + static_cast<std::size_t>(i);
+                    const Mat before = P;
+                    if (i > 0) P = Fk * P * Fk.transpose() + Qk;
+                    const double s = P(0, 0) + rk;
+                    S[u] = s;
+                    logS[u] = std::log(detail::kTwoPi * s);
+                    const Vec g = P.col(0) / s;
+                    G[u] = g;
+                    P -= g * P.row(0);
+                    P = 0.5 * (P + P.transpose()).eval();
+                    if (i > 0 && P == before) {
+                        fixed[b] = i;
+                        break;
+                    }
+                }
             }
-            double total = 0.0;
+            double total[NB] = {};
             Index start = 0;
             for (Index run = 0; run < lengths.size(); ++run) {
                 const Index len = lengths(run);
                 const double* zz = z.data() + start;
                 start += len;
                 if (len < D + 2) continue;
-                Vec m = Vec::Zero();
-                m(0) = zz[0];
+                Vec m[NB];
+                for (Index b = 0; b < NB; ++b) {
+                    m[b] = Vec::Zero();
+                    m[b](0) = zz[0];
+                }
                 for (Index i = 0; i < len; ++i) {
-                    const auto u = static_cast<std::size_t>(i);
-                    if (i > 0) m = Fk * m;
-                    const double v = zz[i] - m(0);
-                    if (i >= D) total -= 0.5 * (logS[u] + v * v / S[u]);
-                    m += G[u] * v;
+                    for (Index b = 0; b < NB; ++b) {
+                        const auto u = static_cast<std::size_t>(b) * steps +
+                                       static_cast<std::size_t>(std::min(i, fixed[b]));
+                        if (i > 0) m[b] = Fb[b] * m[b];
+                        const double v = zz[i] - m[b](0);
+                        if (i >= D) total[b] -= 0.5 * (logS[u] + v * v / S[u]);
+                        m[b] += G[u] * v;
+                    }
                 }
             }
-            ll(k) = std::isfinite(total) ? total : -std::numeric_limits<double>::infinity();
-        }
+            for (Index b = 0; b < NB; ++b)
+                ll(k0 + b) =
+                    std::isfinite(total[b]) ? total[b] : -std::numeric_limits<double>::infinity();
+        };
+        Index k0 = 0;
+        for (; k0 + B <= K; k0 += B) block(k0, std::integral_constant<Index, B>{});
+        for (; k0 < K; ++k0) block(k0, std::integral_constant<Index, 1>{});
     };
     if (d == 2) run_all(std::integral_constant<int, 2>{});
     else run_all(std::integral_constant<int, 3>{});

@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from pftrack import _core
 from pftrack._typing import F64
 from pftrack.kalman import rts_smooth
+from pftrack.recovery.segments import split_rows
 
 __all__ = [
     "BASELINES",
@@ -220,7 +221,7 @@ def rts_batch(
     n_before = np.array([len(a) for a, _ in wins], dtype=np.int32)
     out = _core.rts_gaps_batch(points, offsets, n_before, q, r, 100.0)
     lengths = np.array([b[0, 0] - a[-1, 0] - 1 for a, b in wins], dtype=np.int64)
-    return np.split(out, np.cumsum(lengths)[:-1])
+    return split_rows(out, lengths)
 
 
 #: The baselines by method name (read-only).

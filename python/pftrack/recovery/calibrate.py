@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import MAX_COORD, MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, rts_batch
@@ -39,7 +40,7 @@ from pftrack.recovery.neighbours import (
 )
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, distinct_runs
+from pftrack.recovery.segments import as_segment, distinct_runs, split_rows
 
 __all__ = [
     "CANDIDATES",
@@ -283,7 +284,7 @@ def recover_with(
         xy = (1.0 - s) * np.repeat(ends_a[:, 1:3], n, axis=0) + s * np.repeat(
             ends_b[:, 1:3], n, axis=0
         )
-        return np.split(xy, np.cumsum(n)[:-1])
+        return split_rows(xy, n)
     if method == "rts":
         return rts_batch(pairs)
     if method in BASELINES:
@@ -364,6 +365,7 @@ def _artificial_gaps(
     sizes, offset, xy = _flat(runs) if flat is None else flat
     out: list[tuple[F64, F64, F64, int]] = []
     used: set[tuple[int, int, int]] = set()
+    places: dict[int, tuple[NDArray[np.int64], NDArray[np.int64], int]] = {}
     order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
     for attempt in range(4 * n):
         if len(out) >= n or not len(order):
@@ -373,9 +375,12 @@ def _artificial_gaps(
         n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
         ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
         ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
-        slots = np.maximum(sizes - L - ctx_a - ctx_b + 1, 0)
-        cum = np.cumsum(slots)
-        total = int(cum[-1]) if len(cum) else 0
+        span = L + ctx_a + ctx_b  # the places depend on it only: computed once per span
+        if span not in places:
+            slots_of = np.maximum(sizes - span + 1, 0)
+            cum_of = np.cumsum(slots_of)
+            places[span] = (slots_of, cum_of, int(cum_of[-1]) if len(cum_of) else 0)
+        slots, cum, total = places[span]
         if total == 0:
             continue
         ks = rng.integers(total, size=MATCH_DRAWS)
@@ -561,37 +566,58 @@ def calibrate(
 class _Blends:
     """Per-gap validation errors of ``(1 - w) first + w second``, cached per bucket and pair.
 
-    For a bucket of `n` validation gaps, row ``k`` of ``fit`` holds the errors with the
-    weight ``COMBINE_GRID[k]`` and row ``k`` of ``shrunk`` those with that weight shrunk as in
-    :func:`_combine`, so a resample of the gaps (same `n`) only indexes columns.
+    For a bucket of `n` validation gaps, row ``k`` of ``blends(b, first, second)`` holds the
+    errors with the weight ``COMBINE_GRID[k]``, and ``blends.shrunk(b, first, second, k)``
+    those with that weight shrunk as in :func:`_combine` (only the row of the fitted weight is
+    ever needed: computed when asked), so a resample of the gaps (same `n`) only indexes
+    columns.
     """
 
     def __init__(self, found: dict[int, dict[str, list[F64]]], truths: dict[int, list[F64]]):
         self.found = found
         self.truths = truths
-        self.cache: dict[tuple[int, str, str], tuple[F64, F64]] = {}
+        self.cache: dict[tuple[int, str, str], F64] = {}
+        self.rows: dict[tuple[int, str, str, int], F64] = {}
+        self.inputs: dict[
+            tuple[int, str, str], tuple[tuple[F64, ...], NDArray[np.int64], NDArray[np.int64]]
+        ] = {}
 
-    def __call__(self, b: int, first: str, second: str) -> tuple[F64, F64]:
+    def _errors(self, b: int, first: str, second: str, w: F64) -> F64:
+        """Rows of per-gap errors, one per weight of `w`."""
         key = (b, first, second)
-        if key not in self.cache:
+        if key not in self.inputs:
             truth = self.truths[b]
-            n = len(truth)
+            sizes = np.array([len(v) for v in truth])
             p1 = np.concatenate(self.found[b][first])
             p2 = np.concatenate(self.found[b][second])
             t = np.concatenate([v[:, 1:3] for v in truth])
-            sizes = np.array([len(v) for v in truth])
-            starts = np.r_[0, np.cumsum(sizes)[:-1]]
+            self.inputs[key] = (  # x and y apart: contiguous rows below
+                tuple(np.ascontiguousarray(a[:, i]) for a in (p1, p2, t) for i in (0, 1)),
+                np.r_[0, np.cumsum(sizes)[:-1]],
+                sizes,
+            )
+        (x1, y1, x2, y2, xt, yt), starts, sizes = self.inputs[key]
+        # every weight at once, (weights, points): the same operations per element as one
+        # weight at a time; the sums per gap stay one 1-D reduceat per weight
+        a, c = (1.0 - w)[:, None], w[:, None]
+        dist = np.hypot(a * x1 + c * x2 - xt, a * y1 + c * y2 - yt)
+        out: F64 = np.array([np.add.reduceat(row, starts) for row in dist]) / sizes
+        return out
 
-            def errors(w: float) -> F64:
-                d = (1.0 - w) * p1 + w * p2 - t
-                out: F64 = np.add.reduceat(np.hypot(d[:, 0], d[:, 1]), starts) / sizes
-                return out
-
-            fit = np.array([errors(float(w)) for w in COMBINE_GRID])
-            shrink = n / (n + COMBINE_SHRINK)
-            shrunk = np.array([errors(float(w) * shrink) for w in COMBINE_GRID])
-            self.cache[key] = (fit, shrunk)
+    def __call__(self, b: int, first: str, second: str) -> F64:
+        key = (b, first, second)
+        if key not in self.cache:
+            self.cache[key] = self._errors(b, first, second, COMBINE_GRID)
         return self.cache[key]
+
+    def shrunk(self, b: int, first: str, second: str, k: int) -> F64:
+        """Errors with the weight ``COMBINE_GRID[k]`` shrunk as in :func:`_combine`."""
+        key = (b, first, second, k)
+        if key not in self.rows:
+            n = len(self.truths[b])
+            w = float(COMBINE_GRID[k]) * (n / (n + COMBINE_SHRINK))
+            self.rows[key] = self._errors(b, first, second, np.array([w]))[0]
+        return self.rows[key]
 
 
 def _choose(
@@ -622,13 +648,15 @@ def _choose(
         out[b] = ((method, 1.0),)
         if combine and len(names) > 1:
             other = min((m for m in names if m != method), key=lambda m: means[m])
-            fit, shrunk = blends(b, method, other)
+            fit = blends(b, method, other)
             if idx is not None:
-                fit, shrunk = fit[:, idx[b]], shrunk[:, idx[b]]
+                fit = fit[:, idx[b]]
             k = int(np.argmin(fit.mean(axis=1)))
             w = float(COMBINE_GRID[k]) * fit.shape[1] / (fit.shape[1] + COMBINE_SHRINK)
-            if 0.0 < w and _better(shrunk[k], e[method]):
-                out[b] = ((method, 1.0 - w), (other, w))
+            if 0.0 < w:
+                shrunk = blends.shrunk(b, method, other, k)
+                if _better(shrunk if idx is None else shrunk[idx[b]], e[method]):
+                    out[b] = ((method, 1.0 - w), (other, w))
     return pooled, out
 
 
@@ -729,6 +757,41 @@ _NO_NOISE = NoiseEstimate(q=(0.1, 0.1), r=(1.0, 1.0))
 _NO_MOTION: MotionFit = None  # type: ignore[assignment]
 
 
+def _checked_at_once(pairs: Sequence[tuple[F64, F64]]) -> list[tuple[F64, F64]] | None:
+    """``frame, x, y`` of every pair as :func:`recover_auto` checks them, in one pass.
+
+    The arrays :func:`~pftrack.recovery.segments.as_segment` would give (contiguous float64
+    copies of the first three columns) when every segment is a float64 ndarray that passes
+    its checks and every segment B starts after its segment A; None otherwise (the caller
+    checks pair by pair and names what is wrong).
+    """
+    segs = [s for pair in pairs for s in pair]
+    if not segs or not all(
+        type(s) is np.ndarray and s.dtype == np.float64 and s.ndim == 2 and s.shape[1] >= 3
+        for s in segs
+    ):
+        return None
+    sizes = np.array([len(s) for s in segs], dtype=np.int64)
+    if sizes.min() == 0:
+        return None
+    X = np.concatenate([s[:, :3] for s in segs])
+    f = X[:, 0]
+    ends = np.cumsum(sizes)
+    inside = np.ones(len(f) - 1, dtype=bool)  # consecutive rows of one segment
+    inside[ends[:-1] - 1] = False
+    if not (
+        np.isfinite(X).all()
+        and (np.diff(f)[inside] > 0).all()
+        and np.abs(f).max() <= MAX_FRAME
+        and (f == np.floor(f)).all()
+        and np.abs(X[:, 1:]).max() <= MAX_COORD
+        and (f[ends[1::2] - sizes[1::2]] > f[ends[0::2] - 1]).all()
+    ):
+        return None
+    parts = split_rows(X, sizes)
+    return list(zip(parts[0::2], parts[1::2], strict=True))
+
+
 def recover_auto(
     pairs: Sequence[tuple[F64, F64]],
     observed: Sequence[F64] | None = None,
@@ -777,18 +840,20 @@ def recover_auto(
     ValueError
         Malformed segments or a segment B that does not start after its segment A.
     """
-    checked = []
-    for k, (a, b) in enumerate(pairs):
-        sa, sb = (
-            as_segment(np.asarray(a)[:, :3], "segment_a"),
-            as_segment(np.asarray(b)[:, :3], "segment_b"),
-        )
-        if sb[0, 0] <= sa[-1, 0]:
-            raise ValueError(
-                f"recover_gaps: gap {k}: segment_b starts at frame {sb[0, 0]:g}, expected after "
-                f"segment_a's end {sa[-1, 0]:g}"
+    checked = _checked_at_once(pairs)
+    if checked is None:  # something to refuse (or not float64 arrays): pair by pair
+        checked = []
+        for k, (a, b) in enumerate(pairs):
+            sa, sb = (
+                as_segment(np.asarray(a)[:, :3], "segment_a"),
+                as_segment(np.asarray(b)[:, :3], "segment_b"),
             )
-        checked.append((sa, sb))
+            if sb[0, 0] <= sa[-1, 0]:
+                raise ValueError(
+                    f"recover_gaps: gap {k}: segment_b starts at frame {sb[0, 0]:g}, expected "
+                    f"after segment_a's end {sa[-1, 0]:g}"
+                )
+            checked.append((sa, sb))
     if observed is None:
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]

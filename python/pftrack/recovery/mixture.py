@@ -166,6 +166,12 @@ class MotionFit:
         parts.append(f"velocity variance {self.v2[0]:.3g}, {self.v2[1]:.3g} px^2/frame^2")
         return "; ".join(parts)
 
+    @cached_property
+    def priors(self) -> tuple[F64, F64]:
+        """:meth:`AxisModel.prior` of each axis with its restart velocity variance (once)."""
+        px, py = (m.prior(v2) for m, v2 in zip(self.axes, self.v2, strict=True))
+        return px, py
+
     @property
     def is_gdt_bi(self) -> bool:
         """No stand seen and white-noise acceleration on both axes: the ``gdt-bi`` model."""
@@ -190,8 +196,12 @@ def fit_singer(runs: Sequence[F64], axis: int, levels: int = 4) -> tuple[float, 
     for _ in range(levels):
         axes = [np.linspace(lo[i], hi[i], 7) for i in range(3)]
         g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-        q, r, tau = 10.0 ** g[:, 0], 10.0 ** g[:, 1], 10.0 ** g[:, 2]
-        F, Q = singer_model(q, tau)
+        r = 10.0 ** g[:, 1]
+        # F and Q do not depend on r: the 7 x 7 distinct (q, tau), each repeated over the 7 r
+        # of the grid (rows ordered q, r, tau), instead of 343 matrix exponentials.
+        F, Q = singer_model(10.0 ** axes[0][:, None], 10.0 ** axes[2][None, :])
+        F = np.repeat(F.reshape(7, 1, 7, 3, 3), 7, axis=1)
+        Q = np.repeat(Q.reshape(7, 1, 7, 3, 3), 7, axis=1)
         ll = _core.state_loglik_batch(
             z,
             lengths,
@@ -272,6 +282,25 @@ def _stand_hypotheses(T: int, grid: int) -> tuple[NDArray[np.int32], NDArray[np.
     return t1, t2
 
 
+_WALK_ONLY = np.array([-1], dtype=np.int32)
+_WALK_ONLY.setflags(write=False)
+
+
+@lru_cache(maxsize=1024)
+def _hypotheses(T: int, grid: int, rate: float) -> tuple[NDArray[np.int32], NDArray[np.int32], F64]:
+    """Stand hypotheses of a gap of ``T`` steps and their log prior (read-only, shared)."""
+    if rate > 0.0:
+        t1, t2 = stand_hypotheses(T, grid)
+        n_stand = len(t1) - 1
+        log_prior = np.full(len(t1), np.log(-np.expm1(-rate * T) / max(n_stand, 1)))
+        log_prior[0] = -rate * T
+    else:
+        t1 = t2 = _WALK_ONLY
+        log_prior = np.zeros(1)
+    log_prior.setflags(write=False)
+    return t1, t2, log_prior
+
+
 def recover_mixture(
     seg_a: F64, seg_b: F64, fit: MotionFit, grid: int = GRID, window: int = WINDOW
 ) -> F64:
@@ -283,22 +312,15 @@ def recover_mixture(
     T = fb - fa
     if T < 2:
         return np.zeros((0, 2))
-    if fit.stand_rate > 0.0:
-        t1, t2 = stand_hypotheses(T, grid)
-        n_stand = len(t1) - 1
-        log_prior = np.full(len(t1), np.log(-np.expm1(-fit.stand_rate * T) / max(n_stand, 1)))
-        log_prior[0] = -fit.stand_rate * T
-    else:
-        t1 = t2 = np.array([-1], dtype=np.int32)
-        log_prior = np.zeros(1)
-    ia, ib = (a[:, 0] - f0).astype(int), (b[:, 0] - f0).astype(int)
+    t1, t2, log_prior = _hypotheses(T, grid, fit.stand_rate)
+    z = np.full((2, n), np.nan)  # one row per axis
+    z[:, (a[:, 0] - f0).astype(int)] = a[:, 1:3].T
+    z[:, (b[:, 0] - f0).astype(int)] = b[:, 1:3].T
     paths, loglik = [], log_prior.copy()
     for axis, model in enumerate(fit.axes):
-        z = np.full(n, np.nan)
-        z[ia], z[ib] = a[:, 1 + axis], b[:, 1 + axis]
         F, Q = model.matrices
         p, ll = _core.gap_mixture(
-            z, fa, fb, F, Q, model.r, model.prior(fit.v2[axis]), t1, t2, fit.v2[axis]
+            z[axis], fa, fb, F, Q, model.r, fit.priors[axis], t1, t2, fit.v2[axis]
         )
         paths.append(p)
         loglik += ll

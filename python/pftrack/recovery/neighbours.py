@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._typing import F64
+from pftrack.recovery.segments import split_rows
 
 __all__ = [
     "MAX_NEIGHBOURS",
@@ -92,6 +93,59 @@ class Neighbourhood:
         self._cache[key] = out
         return out
 
+    def windows_many(
+        self, pairs: Sequence[tuple[F64, F64]], excludes: Sequence[int]
+    ) -> list[list[Window]]:
+        """:meth:`windows` of every pair (with its run to leave out), the search vectorised.
+
+        The same windows in the same order: candidate runs of every pair not seen before are
+        found and ordered (distance, then run) in a few array operations, in blocks of pairs.
+        """
+        keys = []
+        todo: dict[tuple[float, ...], int] = {}
+        for (a, b), e in zip(pairs, excludes, strict=True):
+            key = (
+                float(a[-1, 0]), float(b[0, 0]), float(a[-1, 1]), float(a[-1, 2]),
+                float(len(a)), float(len(b)), float(e),
+            )  # fmt: skip
+            keys.append(key)
+            if key not in self._cache and key not in todo:
+                todo[key] = len(todo)
+        pending = list(todo)
+        n_runs = len(self.runs)
+        block = max(1, (1 << 22) // max(n_runs, 1))  # pairs x runs per block: bounded memory
+        for lo in range(0, len(pending), block):
+            self._search([k for k in pending[lo : lo + block]])
+        return [self._cache[k] for k in keys]
+
+    def _search(self, keys: list[tuple[float, ...]]) -> None:
+        """Fill the cache for `keys` ``(fa, fb, x, y, len_a, len_b, exclude)``."""
+        K = np.array(keys, dtype=np.float64).reshape(len(keys), 7)
+        fa, fb, x, y = K[:, 0], K[:, 1], K[:, 2], K[:, 3]
+        ok = (self.first[None, :] <= fa[:, None]) & (self.last[None, :] >= fb[:, None])
+        ok &= np.arange(len(self.runs))[None, :] != K[:, 6].astype(np.int64)[:, None]
+        pair, idx = np.nonzero(ok)  # row-major: by pair, then run
+        at = (fa[pair] - self.first[idx]).astype(np.int64)
+        on = self._frame[self._offset[idx] + at] == fa[pair]
+        pair, idx, at = pair[on], idx[on], at[on]
+        xy = self._xy[self._offset[idx] + at]
+        d = np.hypot(xy[:, 0] - x[pair], xy[:, 1] - y[pair])
+        order = np.lexsort((idx, d, pair))
+        pair, idx, at = pair[order], idx[order], at[order]
+        starts = np.searchsorted(pair, np.arange(len(keys) + 1))
+        for p, key in enumerate(keys):
+            n_a, n_b = int(key[4]), int(key[5])
+            n_gap = int(key[1] - key[0]) - 1
+            out: list[Window] = []
+            for k in range(
+                int(starts[p]), min(int(starts[p + 1]), int(starts[p]) + MAX_NEIGHBOURS)
+            ):
+                r, i = self.runs[int(idx[k])], int(at[k])
+                lo = max(0, i + 1 - n_a)
+                hi = i + 1 + n_gap + n_b
+                out.append((r[lo : i + 1], r[i + 1 + n_gap : hi], r[i + 1 : i + 1 + n_gap]))
+            self._cache[key] = out
+
 
 def correct_by_neighbours(
     recover: Callable[[list[tuple[F64, F64]]], list[F64]],
@@ -124,20 +178,29 @@ def correct_by_neighbours(
     pairs = list(pairs)
     skip = [-1] * len(pairs) if excludes is None else [int(e) for e in excludes]
     base = recover(pairs) if base is None else list(base)
-    wins = [hood.windows(a, b, e) for (a, b), e in zip(pairs, skip, strict=True)]
+    wins = hood.windows_many(pairs, skip)
     flat = [w for ws in wins for w in ws]
     if not flat:
         return base
     got = recover([(a, b) for a, b, _ in flat])
-    errors = [t[:, 1:3] - p for (_, _, t), p in zip(flat, got, strict=True)]
-    out: list[F64] = []
+    # every neighbour's error in one subtraction (rows of the windows' truths and paths)
+    diff = np.concatenate([t[:, 1:3] for _, _, t in flat]) - np.concatenate(got)
+    errors = split_rows(diff, [len(p) for p in got])
+    # The median of each gap's neighbours' errors: one np.median per group of gaps with as
+    # many neighbours and frames (each lane's median is the same as gap by gap).
+    groups: dict[tuple[int, int], tuple[list[int], list[int]]] = {}
     k = 0
-    for path, ws in zip(base, wins, strict=True):
+    for g, (path, ws) in enumerate(zip(base, wins, strict=True)):
         n = len(ws)
-        if n == 0:
-            out.append(path)
-            continue
-        shared: NDArray[np.float64] = np.median(np.stack(errors[k : k + n]), axis=0)
-        out.append(path + shared * (n / (n + 1.0)))
+        if n:
+            gaps, starts = groups.setdefault((n, len(path)), ([], []))
+            gaps.append(g)
+            starts.append(k)
         k += n
+    out = list(base)
+    for (n, _), (gaps, starts) in groups.items():
+        stack = np.stack([np.stack(errors[k : k + n]) for k in starts])
+        shared: NDArray[np.float64] = np.median(stack, axis=1)
+        for g, row in zip(gaps, shared, strict=True):
+            out[g] = base[g] + row * (n / (n + 1.0))
     return out

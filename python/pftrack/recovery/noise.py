@@ -59,23 +59,21 @@ def _moments_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> N
     return NoiseEstimate(q=(float(q[0]), float(q[1])), r=(float(r[0]), float(r[1])))
 
 
-def _loglik_grid(runs: Sequence[F64], axis: int, q: F64, r: F64) -> F64:
-    """Kalman log-likelihood of one axis of every run, for each (q, r) pair (C++)."""
-    z = np.ascontiguousarray(np.concatenate([run[:, 1 + axis] for run in runs]))
-    lengths = np.array([len(run) for run in runs], dtype=np.int32)
-    out: F64 = _core.noise_loglik_grid(z, lengths, np.ascontiguousarray(q), np.ascontiguousarray(r))
-    return out
-
-
 def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseEstimate:
     qs, rs = [], []
+    lengths = np.array([len(run) for run in segments], dtype=np.int32)
     for axis in range(2):
+        # the runs' values, stacked once for the three levels of the grid
+        z = np.ascontiguousarray(np.concatenate([run[:, 1 + axis] for run in segments]))
         lq_lo, lq_hi, lr_lo, lr_hi = np.log10(floor_q), 2.0, np.log10(floor_r), 2.0
         best = (0.0, 0.0)
         for _ in range(3):  # coarse-to-fine grid on log10 q, log10 r
             lq, lr = np.meshgrid(np.linspace(lq_lo, lq_hi, 9), np.linspace(lr_lo, lr_hi, 9))
             q, r = 10.0 ** lq.ravel(), 10.0 ** lr.ravel()
-            i = int(np.argmax(_loglik_grid(segments, axis, q, r)))
+            ll = _core.noise_loglik_grid(
+                z, lengths, np.ascontiguousarray(q), np.ascontiguousarray(r)
+            )
+            i = int(np.argmax(ll))
             best = (float(q[i]), float(r[i]))
             dq, dr = (lq_hi - lq_lo) / 8.0, (lr_hi - lr_lo) / 8.0
             lq_lo, lq_hi = max(np.log10(q[i]) - dq, np.log10(floor_q)), np.log10(q[i]) + dq

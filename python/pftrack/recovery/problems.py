@@ -32,7 +32,7 @@ from pftrack._typing import F64
 from pftrack.kalman import cv_transition_xy, wna_Q_xy
 from pftrack.recovery.gdt import Form, GdtModel, GdtSolution, goal_directed_path
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
-from pftrack.recovery.segments import contiguous_head, contiguous_tail
+from pftrack.recovery.segments import contiguous_head, contiguous_tail, split_rows
 
 __all__ = ["GdtProblem", "Goal", "SegmentModel", "gdt_bi_problem", "gdt_problem"]
 
@@ -244,4 +244,4 @@ class SegmentModel:
             self.start_conditioned,
         )
         T = (b[np.cumsum(b_len) - b_len, 0] - a[np.cumsum(a_len) - 1, 0]).astype(np.int64)
-        return np.split(out, np.cumsum(T - 1)[:-1])
+        return split_rows(out, T - 1)

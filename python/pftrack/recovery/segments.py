@@ -28,6 +28,7 @@ __all__ = [
     "distinct_runs",
     "gap_ends",
     "gap_frames",
+    "split_rows",
 ]
 
 
@@ -154,6 +155,15 @@ def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.i
     if fr.size and (fr.min() <= f0 or fr.max() >= f1):
         raise ValueError(f"recover_gap: frames must lie strictly between {f0} and {f1}")
     return fr.astype(np.int64)
+
+
+def split_rows(a: F64, sizes: ArrayLike) -> list[F64]:
+    """Consecutive blocks of `sizes` rows of `a` (views): ``np.split(a, cumsum(sizes)[:-1])``.
+
+    The same arrays, by plain slicing (``np.split`` costs a Python call per piece).
+    """
+    ends = np.cumsum(np.asarray(sizes, dtype=np.int64)).tolist()
+    return [a[s:e] for s, e in zip([0, *ends[:-1]], ends, strict=True)]
 
 
 def consecutive_runs(segments: Sequence[ArrayLike], min_points: int) -> list[F64]:
