@@ -265,3 +265,47 @@ def test_recover_gap_frames_must_be_real_integers() -> None:
         recover_gap(a, b, frames=np.array([3 + 1j]), method="linear")  # was a ComplexWarning
     with pytest.raises(ValueError, match="recover_gap: frames must lie strictly between 1 and 9"):
         recover_gap(a, b, frames=[1e300], method="linear")  # was a cast of 1e300 to int64
+
+
+def test_gsi_fills_a_long_gap_in_blocks_with_the_numbers_of_one_solve() -> None:
+    """`--method gsi` solved one GP over every frame of a gap: 12.6 GB for 20 000 frames, out
+    of memory for 100 000. Beyond GSI_BLOCK frames it goes block by block, each from the points
+    within 3 length scales of it, which gives the one solve's numbers."""
+    from pftrack.recovery import baselines as B
+
+    rng = np.random.default_rng(0)
+    fa, fb = np.arange(1.0, 41), np.arange(3041.0, 3081)
+    a = np.column_stack([fa, 10 + 0.5 * fa + rng.normal(0, 1, 40), 5 + 0.2 * fa])
+    b = np.column_stack([fb, 40 + 0.5 * fb + rng.normal(0, 1, 40), 5 + 0.2 * fb])
+    frames = np.arange(41, 3041)
+    assert len(frames) > 2 * B.GSI_BLOCK  # three blocks
+    t_all = np.concatenate([a[:, 0], frames, b[:, 0]])
+    xy = np.vstack([a[:, 1:3], B.linear(a, b, frames), b[:, 1:3]])
+    ls = float(np.clip(10 * np.log(1000 / len(t_all)), 0.1, 100))
+    whole = B._gp_smooth(t_all, xy, frames, ls)  # the one solve over every frame
+    np.testing.assert_allclose(B.gsi(a, b, frames), whole, rtol=0, atol=1e-9)
+    # a gap of one block is the one solve itself
+    short = np.arange(41, 41 + B.GSI_BLOCK)
+    b2 = b.copy()
+    b2[:, 0] -= 3041 - (41 + B.GSI_BLOCK)
+    t2 = np.concatenate([a[:, 0], short, b2[:, 0]])
+    xy2 = np.vstack([a[:, 1:3], B.linear(a, b2, short), b2[:, 1:3]])
+    ls2 = float(np.clip(10 * np.log(1000 / len(t2)), 0.1, 100))
+    np.testing.assert_array_equal(B.gsi(a, b2, short), B._gp_smooth(t2, xy2, short, ls2))
+
+
+def test_gsi_memory_does_not_grow_with_the_square_of_the_gap() -> None:
+    import tracemalloc
+
+    from pftrack.recovery import recover_gap
+
+    a = np.array([[1.0, 10, 10], [2, 11, 10]])
+    b = np.array([[6003.0, 20, 10], [6004, 21, 10]])
+    tracemalloc.start()
+    try:
+        got = recover_gap(a, b, None, "gsi")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert got.shape == (6000, 2)
+    assert peak < 100e6  # one solve: three 6004 x 6004 float64 matrices, about 0.9 GB

@@ -126,17 +126,37 @@ def bspline(
     return out
 
 
+#: Gap frames :func:`gsi` solves at once; a longer gap is filled in blocks of this many frames,
+#: each from the points within 3 length scales of it, so work grows with the gap's length and
+#: memory stays bounded (one solve of a 100 000-frame gap needed 80 GB).
+GSI_BLOCK = 1024
+
+
 def gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) -> F64:
     """StrongSORT's Gaussian-smoothed interpolation.
 
     Linear interpolation, then Gaussian-process regression (RBF kernel, fixed length
     ``clip(tau log(tau^3 / n), 1/tau, tau^2)`` for a track of ``n`` points) over the whole
-    track; here over the points within 3 length scales of the gap.
+    track; here over the points within 3 length scales of the gap, and for a gap of more than
+    :data:`GSI_BLOCK` frames block by block, each block over the points within 3 length
+    scales of it (the same numbers up to the points' weight beyond them: tested).
     """
     t_all = np.concatenate([seg_a[:, 0], frames, seg_b[:, 0]])
     xy_all = np.vstack([seg_a[:, 1:3], linear(seg_a, seg_b, frames), seg_b[:, 1:3]])
     n_track = len(t_all)
     ls = float(np.clip(tau * np.log(tau**3 / n_track), 1.0 / tau, tau**2))
+    if len(frames) <= GSI_BLOCK:
+        return _gp_smooth(t_all, xy_all, frames, ls)
+    return np.vstack(
+        [
+            _gp_smooth(t_all, xy_all, frames[k : k + GSI_BLOCK], ls)
+            for k in range(0, len(frames), GSI_BLOCK)
+        ]
+    )
+
+
+def _gp_smooth(t_all: F64, xy_all: F64, frames: NDArray[np.int64], ls: float) -> F64:
+    """GP posterior mean at `frames` from the points of `t_all` within 3 `ls` of them."""
     keep = (t_all >= frames[0] - 3 * ls - 1) & (t_all <= frames[-1] + 3 * ls + 1)
     t, xy = t_all[keep], xy_all[keep]
     K = np.exp(-0.5 * ((t[:, None] - t[None, :]) / ls) ** 2)
