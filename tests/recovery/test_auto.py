@@ -162,7 +162,7 @@ def test_buckets() -> None:
 
 def test_bad_input() -> None:
     tracks = _straight_tracks(np.random.default_rng(5), n=3)
-    with pytest.raises(ValueError, match="gap lengths must be >= 1"):
+    with pytest.raises(ValueError, match=r"a gap length is 0, expected an integer in \[1, "):
         calibrate(tracks, [0])
     with pytest.raises(ValueError, match="max_gaps"):
         calibrate(tracks, [3], max_gaps=0)
@@ -170,7 +170,7 @@ def test_bad_input() -> None:
         calibrate(tracks, [3], candidates=["spline9"])
     with pytest.raises(ValueError, match="1 contexts for 2 gap lengths"):
         calibrate(tracks, [3, 4], contexts=[(3, 3)])
-    with pytest.raises(ValueError, match="contexts must be >= 1, got 0"):
+    with pytest.raises(ValueError, match=r"a context is 0, expected an integer in \[1, "):
         calibrate(tracks, [3], contexts=[(0, 3)])
     a = np.array([[5.0, 0.0, 0.0]])
     with pytest.raises(ValueError, match="segment_b starts at frame"):
@@ -560,5 +560,80 @@ def test_bagging_is_seeded_and_reported() -> None:
 
 def test_bags_must_not_be_negative() -> None:
     tracks = _straight_tracks(np.random.default_rng(0), n=5)
-    with pytest.raises(ValueError, match="bags is -1, expected >= 0"):
+    with pytest.raises(ValueError, match=r"bags is -1, expected an integer in \[0, "):
         calibrate(tracks, [5], bags=-1)
+
+
+_RUN = np.column_stack([np.arange(1.0, 40), np.arange(39.0) * 2, np.arange(39.0)])
+_A, _B = _RUN[:10], _RUN[15:]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        # each was taken, or failed deep inside without the argument's name
+        ({"bags": 1.5}, ValueError, r"calibrate: bags is 1.5, expected an integer in \[0, 10000\]"),
+        ({"bags": None}, ValueError, "calibrate: bags is None"),
+        ({"bags": True}, ValueError, "calibrate: bags is True"),
+        ({"seed": -1}, ValueError, "calibrate: seed is -1, expected an int >= 0"),
+        ({"seed": None}, TypeError, "calibrate: seed must be an int >= 0"),
+        ({"seed": True}, TypeError, "calibrate: seed must be an int >= 0"),
+        ({"max_gaps": 1.5}, ValueError, "calibrate: max_gaps is 1.5"),
+        ({"max_gaps": True}, ValueError, "calibrate: max_gaps is True"),
+        ({"combine": 1}, TypeError, "calibrate: combine"),
+        ({"spans": [np.nan]}, ValueError, "calibrate: spans must be finite"),
+        ({"contexts": [(1.5, 2)]}, ValueError, "calibrate: a context is 1.5"),
+    ],
+)
+def test_calibrate_names_a_bad_setting(kwargs: dict, error: type, match: str) -> None:
+    from pftrack.recovery.calibrate import calibrate
+
+    with pytest.raises(error, match=match):
+        calibrate([_RUN], [3], **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("observed", "lengths", "error", "match"),
+    [
+        ([_RUN], [2.7], ValueError, "calibrate: a gap length is 2.7"),  # was truncated to 2
+        ([_RUN], ["3"], ValueError, "calibrate: a gap length is '3'"),
+        ([np.where(np.arange(39)[:, None] == 5, np.nan, _RUN)], [3], ValueError,
+         r"calibrate: observed run 0 has a non-finite frame, x or y"),  # was left out silently
+        ([np.zeros((30, 2))], [3], ValueError, r"observed\[0\] has shape \(30, 2\)"),
+        ("abc", [3], TypeError, "calibrate: observed must be a sequence"),
+        ([["a", "b", "c"]], [3], TypeError, r"calibrate: observed\[0\] must hold real numbers"),
+    ],
+)  # fmt: skip
+def test_calibrate_names_bad_observed_runs(observed, lengths, error, match) -> None:
+    from pftrack.recovery.calibrate import calibrate
+
+    with pytest.raises(error, match=match):
+        calibrate(observed, lengths)
+
+
+def test_recover_auto_and_recover_gaps_name_bad_settings() -> None:
+    from pftrack.recovery import recover_gaps
+    from pftrack.recovery.calibrate import recover_auto
+
+    with pytest.raises(ValueError, match="recover_auto: bags is -1"):
+        recover_auto([(_A, _B)], bags=-1)
+    with pytest.raises(TypeError, match="recover_auto: seed must be an int"):
+        recover_auto([(_A, _B)], seed="0")
+    with pytest.raises(TypeError, match="recover_auto: combine"):
+        recover_auto([(_A, _B)], combine="yes")
+    with pytest.raises(ValueError, match=r"recover_auto: observed run 0 has a non-finite"):
+        recover_auto([(_A, _B)], observed=[np.where(_RUN == 4, np.nan, _RUN)])
+    # history 1.5 acted as 1, "2" and True were taken; combine=1 was taken
+    for history in (1.5, "2", True, 0):
+        with pytest.raises(ValueError, match="recover_gaps: history is"):
+            recover_gaps([(_A, _B)], "gdt", history=history)
+    with pytest.raises(TypeError, match="recover_gaps: combine"):
+        recover_gaps([(_A, _B)], combine=1)
+    for method in ("linear-nb", "auto"):
+        with pytest.raises(ValueError, match=r"observed\[0\] has shape \(30, 2\)"):
+            recover_gaps([(_A, _B)], method, observed=[np.zeros((30, 2))])
+    with pytest.raises(TypeError, match="observed must be a sequence"):
+        recover_gaps([(_A, _B)], "linear-nb", observed="abc")
+    # the same calls with good settings work
+    assert recover_gaps([(_A, _B)], "gdt", history=5)[0].shape == (5, 2)
+    assert recover_gaps([(_A, _B)], "linear-nb", observed=[_RUN])[0].shape == (5, 2)

@@ -21,12 +21,14 @@ names both methods and their weights. ``combine=False`` gives the single-method 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack import _check
 from pftrack._check import MAX_COORD, MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64
@@ -455,31 +457,40 @@ def calibrate(
 
     Raises
     ------
+    TypeError
+        A `seed` that is not an int, a `combine` that is not a bool, `observed` that is not a
+        sequence of arrays of real numbers.
     ValueError
-        A gap length < 1, `max_gaps` < 1, an unknown candidate, a context < 1 or `spans` /
-        `contexts` of another length than `gap_lengths`.
+        A gap length or context that is not an integer >= 1, `max_gaps` not an integer >= 1,
+        `bags` not an integer >= 0, a negative `seed`, an unknown candidate, non-finite
+        `spans`, `spans` / `contexts` of another length than `gap_lengths`, an observed run
+        that is not (k, 3+) or has a non-finite frame, x or y.
     """
-    lengths = [int(v) for v in gap_lengths]
-    if any(v < 1 for v in lengths):
-        raise ValueError(f"calibrate: gap lengths must be >= 1, got {min(lengths)}")
-    if max_gaps < 1:
-        raise ValueError(f"calibrate: max_gaps is {max_gaps}, expected >= 1")
-    if bags < 0:
-        raise ValueError(f"calibrate: bags is {bags}, expected >= 0")
+    lengths = [_check.integer(v, "calibrate: a gap length", 1, MAX_FRAME) for v in gap_lengths]
+    max_gaps, bags, seed = _settings("calibrate", max_gaps, bags, seed)
+    combine = _check.flag(combine, "calibrate: combine")
     for m in candidates:
         if m not in CANDIDATES:
             raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
     names = tuple(m for m in CANDIDATES if m in candidates or m == "linear")
     dists = [-1.0] * len(lengths) if spans is None else [float(v) for v in spans]
+    if not all(math.isfinite(v) for v in dists):
+        raise ValueError(f"calibrate: spans must be finite, got {dists}")
     if len(dists) != len(lengths):
         raise ValueError(f"calibrate: {len(dists)} spans for {len(lengths)} gap lengths")
     sides = (
-        [(-1, -1)] * len(lengths) if contexts is None else [(int(a), int(b)) for a, b in contexts]
+        [(-1, -1)] * len(lengths)
+        if contexts is None
+        else [
+            (
+                _check.integer(a, "calibrate: a context", 1, MAX_FRAME),
+                _check.integer(b, "calibrate: a context", 1, MAX_FRAME),
+            )
+            for a, b in contexts
+        ]
     )
     if len(sides) != len(lengths):
         raise ValueError(f"calibrate: {len(sides)} contexts for {len(lengths)} gap lengths")
-    if contexts is not None and any(min(c) < 1 for c in sides):
-        raise ValueError(f"calibrate: contexts must be >= 1, got {min(min(c) for c in sides)}")
     by_bucket: dict[int, list[int]] = {}
     targets: dict[int, list[tuple[int, float, int, int]]] = {}
     for v, dv, (na, nb) in zip(lengths, dists, sides, strict=True):
@@ -487,7 +498,7 @@ def calibrate(
         targets.setdefault(bucket_of(v), []).append((v, dv, na, nb))
     if not by_bucket:
         return Calibration(())
-    runs = distinct_runs(observed)
+    runs = distinct_runs(observed, strict="calibrate")
     whole = _fit_sample([r for r in runs if len(r) >= 4], seed)
     if noise is None and ("gdt-bi" in names or "gdt-mix" in names):
         noise = estimate_noise(whole) if whole else None
@@ -792,6 +803,15 @@ def _checked_at_once(pairs: Sequence[tuple[F64, F64]]) -> list[tuple[F64, F64]] 
     return list(zip(parts[0::2], parts[1::2], strict=True))
 
 
+def _settings(who: str, max_gaps: object, bags: object, seed: object) -> tuple[int, int, int]:
+    """`max_gaps`, `bags` and `seed` checked, or an error naming the one that is wrong."""
+    return (
+        _check.integer(max_gaps, f"{who}: max_gaps", 1, 10**7),
+        _check.integer(bags, f"{who}: bags", 0, 10**4),
+        _check.seed(seed, f"{who}: seed"),
+    )
+
+
 def recover_auto(
     pairs: Sequence[tuple[F64, F64]],
     observed: Sequence[F64] | None = None,
@@ -837,9 +857,16 @@ def recover_auto(
 
     Raises
     ------
+    TypeError
+        A `seed` that is not an int, a `combine` that is not a bool, `observed` that is not a
+        sequence of arrays of real numbers.
     ValueError
-        Malformed segments or a segment B that does not start after its segment A.
+        Malformed segments, a segment B that does not start after its segment A, settings
+        :func:`calibrate` refuses, an observed run that is not (k, 3+) or has a non-finite
+        frame, x or y.
     """
+    _, bags, seed = _settings("recover_auto", max_gaps, bags, seed)
+    combine = _check.flag(combine, "recover_auto: combine")
     checked = _checked_at_once(pairs)
     if checked is None:  # something to refuse (or not float64 arrays): pair by pair
         checked = []
@@ -857,7 +884,7 @@ def recover_auto(
     if observed is None:
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
-    all_runs = distinct_runs(observed)
+    all_runs = distinct_runs(observed, strict="recover_auto")
     runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:
         needs = "gdt-bi" in candidates or "gdt-mix" in candidates

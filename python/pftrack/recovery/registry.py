@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack import _check
-from pftrack._check import real_array
+from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
@@ -228,11 +228,18 @@ def recover_gaps(
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
     seed = _check.seed(seed, "recover_gaps: seed")
+    combine = _check.flag(combine, "recover_gaps: combine")
+    if history is not None:
+        history = _check.integer(history, "recover_gaps: history", 1, MAX_FRAME)
     pairs = _checked_pairs(gaps)
     if method == "rts" and pairs:  # one vectorised pass over all gaps
         return rts_batch(pairs)
     if method in NEIGHBOUR_METHODS:
-        runs = distinct_runs([s for p in pairs for s in p] if observed is None else observed)
+        runs = (
+            distinct_runs([s for p in pairs for s in p])
+            if observed is None
+            else distinct_runs(observed, strict="recover_gaps")
+        )
         base = method.removesuffix(NB_SUFFIX)
 
         def recover(ps: list[tuple[F64, F64]]) -> list[F64]:

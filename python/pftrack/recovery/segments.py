@@ -7,7 +7,7 @@ of segment A and the first frame of segment B. Time is measured in frames.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -182,17 +182,38 @@ def consecutive_runs(segments: Sequence[ArrayLike], min_points: int) -> list[F64
     return runs
 
 
-def distinct_runs(observed: Sequence[F64]) -> list[F64]:
+def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F64]:
     """Distinct runs of consecutive frames (rows ``frame, x, y``), in a canonical order.
 
     Each array of `observed` is split where a frame is skipped, as :func:`consecutive_runs`
     does, but in one vectorised pass over all of them (files of many tracks) and keeping only
     ``frame, x, y``; runs with a non-finite value are left out, and a run given twice (a
     segment shared by two gaps) is kept once.
+
+    With `strict` (the caller's name, for the message) nothing is left out silently:
+    `observed` must be a sequence of (k, 3+) arrays of real numbers whose frames, x and y are
+    finite, and a TypeError or ValueError names the first entry that is not.
     """
+    if strict is not None and (
+        isinstance(observed, (str, bytes))
+        or not isinstance(observed, Iterable)
+        or (isinstance(observed, np.ndarray) and observed.ndim == 0)
+    ):
+        raise TypeError(
+            f"{strict}: observed must be a sequence of (k, 3+) arrays, got "
+            f"{type(observed).__name__}"
+        )
     arrs = []
-    for s in observed:
-        a = np.asarray(s, dtype=np.float64)
+    for k, s in enumerate(observed):
+        if strict is None:
+            a = np.asarray(s, dtype=np.float64)
+        else:
+            a = real_array(s, f"{strict}: observed[{k}]")
+            if a.ndim != 2 or a.shape[1] < 3:
+                raise ValueError(
+                    f"{strict}: observed[{k}] has shape {a.shape}, expected (k, 3+) rows "
+                    "frame, x, y"
+                )
         if a.ndim == 2 and a.shape[1] >= 3 and len(a):
             arrs.append(a[:, :3])
     if not arrs:
@@ -203,6 +224,12 @@ def distinct_runs(observed: Sequence[F64]) -> list[F64]:
     brk = np.flatnonzero(bound[1:] | (np.diff(X[:, 0]) != 1)) + 1
     starts, ends = np.r_[0, brk], np.r_[brk, len(X)]
     ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
+    if strict is not None and not ok.all():
+        row = int(np.flatnonzero(~np.isfinite(X).all(axis=1))[0])
+        k = int(np.searchsorted(np.cumsum([len(a) for a in arrs]), row, side="right"))
+        raise ValueError(
+            f"{strict}: observed run {k} has a non-finite frame, x or y: {X[row].tolist()}"
+        )
     starts, ends = starts[ok], ends[ok]
     if not len(starts):
         return []
