@@ -319,3 +319,23 @@ def test_one_id_twice_in_a_frame_is_refused_as_pftrack_eval_refuses_it():
             evaluate(HAND_GT, twice)
         with pytest.raises(ValueError, match="(gt|ground truth) has id .* more than once"):
             evaluate(twice, HAND_RES)
+
+
+def test_a_threshold_of_1_matches_identical_boxes():
+    """The IoU of identical boxes came out just under 1 (31.03 px wide): ground truth scored
+    against itself at --iou 1 gave MOTA -100."""
+    g = np.array(
+        [[1, 1, 499, 158, 31.03, 75.17, 1, -1, -1, -1], [2, 1, 500, 158, 0.1, 75.17, 1, -1, -1, -1]]
+    )
+    m = evaluate_mot(g, g, iou_threshold=1.0)
+    assert (m.mota, m.idf1, m.false_positives, m.misses) == (1.0, 1.0, 0, 0)
+    moved = g.copy()
+    moved[:, 2] += 1e-6  # a box that moved is not identical: no match at 1
+    assert evaluate_mot(g, moved, iou_threshold=1.0).num_matches == 0
+
+
+def test_scale_and_threshold_of_the_wrong_type_are_named():
+    with pytest.raises(TypeError, match="evaluate_mot: scale must be a number, got str"):
+        evaluate_mot(HAND_GT, HAND_RES, scale="2")
+    with pytest.raises(TypeError, match="evaluate_mot: iou_threshold must be a number"):
+        evaluate_mot(HAND_GT, HAND_RES, iou_threshold=None)

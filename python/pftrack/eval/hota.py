@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
+from pftrack._check import MAX_FRAME, integer, number
 from pftrack.eval.metrics import check_eval_rows, check_unique_ids
 from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
 
@@ -138,8 +139,11 @@ def prepare_mot(
     """
     if benchmark not in BENCHMARKS:
         raise ValueError(f"benchmark is {benchmark!r}, expected one of {', '.join(BENCHMARKS)}")
+    scale = number(scale, "scale", finite=False)
     if not (math.isfinite(scale) and scale > 0):
         raise ValueError(f"scale is {scale}, expected a finite value > 0")
+    if num_frames is not None:
+        num_frames = integer(num_frames, "num_frames", 1, MAX_FRAME)
     g = check_eval_rows(gt, "ground truth").copy()
     r = check_eval_rows(result, "result")
     g[:, LEFT : LEFT + 4] *= scale

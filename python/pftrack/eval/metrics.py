@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, real_array
+from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, number, real_array
 from pftrack.boxes import iou_xywh
 from pftrack.io.mot import CONF, FRAME, ID, LEFT
 
@@ -228,6 +228,11 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     return a
 
 
+#: IoU this much below the threshold still reaches it (rounding: the IoU of two identical boxes
+#: can be computed as 1 - 1e-16, which a threshold of 1 would refuse).
+IOU_ROUNDING = 1e-12
+
+
 def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
     """Refuse rows of one id twice in one frame (ValueError naming `name`, the id and frame).
 
@@ -311,10 +316,15 @@ def evaluate_mot(
     .. [3] Smith, K., Gatica-Perez, D., Odobez, J.-M. & Ba, S. (2005). Evaluating multi-object
        tracking. CVPR workshop on empirical evaluation methods in computer vision.
     """
+    iou_threshold = number(iou_threshold, "evaluate_mot: iou_threshold", finite=False)
     if not (math.isfinite(iou_threshold) and 0.0 < iou_threshold <= 1.0):
         raise ValueError(f"evaluate_mot: iou_threshold is {iou_threshold}, expected in (0, 1]")
+    scale = number(scale, "evaluate_mot: scale", finite=False)
     if not (math.isfinite(scale) and scale > 0):
         raise ValueError(f"evaluate_mot: scale is {scale}, expected a finite value > 0")
+    # pairs reach the threshold up to rounding: identical boxes' IoU may come out 1 - 1e-16,
+    # and with a threshold of 1 they must still match
+    reach = iou_threshold - IOU_ROUNDING
     if image_size is not None:
         if len(image_size) != 2 or min(image_size) <= 0:
             raise ValueError(
@@ -348,7 +358,7 @@ def evaluate_mot(
         n_ign_gt += int(ignore.sum())
         if ignore.any() and len(rf):
             iou_all = iou_xywh(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])
-            cost = np.where(iou_all >= iou_threshold, 1.0 - iou_all, _FORBIDDEN)
+            cost = np.where(iou_all >= reach, 1.0 - iou_all, _FORBIDDEN)
             drop = {j for i, j in _assign(cost) if ignore[i]}
             if drop:
                 keep = np.array([j not in drop for j in range(len(rf))])
@@ -364,7 +374,7 @@ def evaluate_mot(
         for h in rids:
             res_count[int(h)] = res_count.get(int(h), 0) + 1
         iou = iou_xywh(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])
-        ok = iou >= iou_threshold
+        ok = iou >= reach
 
         # Identity and Smith measures look at every overlapping (gt, result) pair.
         if len(gids) and len(rids):
@@ -407,7 +417,7 @@ def evaluate_mot(
         rj = np.flatnonzero(~r_used)
         if len(gi) and len(rj):
             sub = iou[np.ix_(gi, rj)]
-            cost = np.where(sub >= iou_threshold, 1.0 - sub, _FORBIDDEN)
+            cost = np.where(sub >= reach, 1.0 - sub, _FORBIDDEN)
             for a, b in _assign(cost):
                 i, j = int(gi[a]), int(rj[b])
                 o, h = int(gids[i]), int(rids[j])
