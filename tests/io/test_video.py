@@ -639,3 +639,19 @@ def test_scale_and_fps_of_the_wrong_kind_are_named(
     )
     with pytest.raises(error, match=re.escape(message)):
         FrameSource(folder, **kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("scale", "size"), [(1e-4, "0x0"), (1e6, "64000000x64000000")])
+def test_a_scale_that_makes_frames_of_no_or_too_many_pixels_is_refused(
+    tmp_path: Path, scale: float, size: str
+) -> None:
+    """scale=1e-4 failed on the first frame in OpenCV's resize ('inv_scale_x > 0'), 1e6 tried
+    to allocate 5e17 bytes."""
+    folder = make_scene(n_frames=2, width=64, height=64, n_walkers=1, rng=0).write_images(
+        tmp_path / "seq"
+    )
+    with pytest.raises(
+        ValueError, match=re.escape(f"{scale:g} makes the 64x64 frames") + f".* {size} pix"
+    ):
+        FrameSource(folder, scale=scale)
+    assert FrameSource(folder, scale=0.5).width == 32

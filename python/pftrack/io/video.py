@@ -500,6 +500,10 @@ def is_live_source(source: PathLike | int) -> bool:
     return stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)
 
 
+#: Largest side of a frame that `FrameSource(scale=...)` may make (OpenCV's image limit).
+MAX_SCALED_SIDE = 32767
+
+
 class FrameSource:
     """Iterate over BGR uint8 frames of a video, image folder, sequence, camera or stream.
 
@@ -608,6 +612,15 @@ class FrameSource:
             self.fps, self.fps_origin = float(header_fps), "container"
         else:
             self.fps, self.fps_origin = DEFAULT_FPS, "default"
+        h, w = first.shape[:2]
+        size = (round(w * self.scale), round(h * self.scale))
+        if min(size) < 1 or max(size) > MAX_SCALED_SIDE:
+            if self._cap is not None:
+                self._cap.release()
+            raise ValueError(
+                f"scale {self.scale:g} makes the {w}x{h} frames of {self.name} {size[0]}x"
+                f"{size[1]} pixels; expected 1 to {MAX_SCALED_SIDE} pixels a side"
+            )
         first = self._resize(first)
         self.height, self.width = int(first.shape[0]), int(first.shape[1])
         if self.live:
