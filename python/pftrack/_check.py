@@ -52,7 +52,7 @@ def bad_id_message(value: float) -> str:
     return f"track id {value:g} is not an integer with |id| <= {MAX_ID}"
 
 
-def real_array(values: ArrayLike, what: str) -> F64:
+def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
     """`values` as a float64 array, refusing what is not real numbers.
 
     NumPy would cast complex numbers to their real part with only a warning, and fail on text
@@ -64,14 +64,17 @@ def real_array(values: ArrayLike, what: str) -> F64:
         Booleans, integers or floats.
     what : str
         How the error names the argument (``"detections"``, ...).
+    booleans : bool
+        Whether booleans are taken (as 0 and 1); False for values that are never flags (MOT
+        rows, track segments).
 
     Raises
     ------
     TypeError
-        Complex numbers, text, or objects that are not numbers.
+        Complex numbers, text, or objects that are not numbers; booleans without `booleans`.
     """
     raw = np.asarray(values)
-    if raw.dtype.kind not in "biuf":
+    if raw.dtype.kind not in ("biuf" if booleans else "iuf"):
         raise TypeError(f"{what} must hold real numbers, got dtype {raw.dtype}")
     return raw.astype(np.float64, copy=False)
 

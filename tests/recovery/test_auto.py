@@ -637,3 +637,11 @@ def test_recover_auto_and_recover_gaps_name_bad_settings() -> None:
     # the same calls with good settings work
     assert recover_gaps([(_A, _B)], "gdt", history=5)[0].shape == (5, 2)
     assert recover_gaps([(_A, _B)], "linear-nb", observed=[_RUN])[0].shape == (5, 2)
+
+
+def test_explain_prints_a_small_weight_as_what_it_is() -> None:
+    """A bagged bucket of 0.998 linear + 0.002 rts was printed 'combination 1.00 linear +
+    0.00 rts'."""
+    from pftrack.recovery.calibrate import _weight
+
+    assert [_weight(w) for w in (0.998, 0.0016, 0.25, 1.0)] == ["1.00", "0.0016", "0.25", "1.00"]

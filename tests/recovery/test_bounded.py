@@ -265,6 +265,9 @@ def test_recover_gap_frames_must_be_real_integers() -> None:
         recover_gap(a, b, frames=np.array([3 + 1j]), method="linear")  # was a ComplexWarning
     with pytest.raises(ValueError, match="recover_gap: frames must lie strictly between 1 and 9"):
         recover_gap(a, b, frames=[1e300], method="linear")  # was a cast of 1e300 to int64
+    for frames in ([5, 5], [6, 4]):  # were rows given twice, or out of order
+        with pytest.raises(ValueError, match="recover_gap: frames must increase strictly"):
+            recover_gap(a, b, frames=frames, method="linear")
 
 
 def test_gsi_fills_a_long_gap_in_blocks_with_the_numbers_of_one_solve() -> None:
@@ -309,3 +312,16 @@ def test_gsi_memory_does_not_grow_with_the_square_of_the_gap() -> None:
         tracemalloc.stop()
     assert got.shape == (6000, 2)
     assert peak < 100e6  # one solve: three 6004 x 6004 float64 matrices, about 0.9 GB
+
+
+def test_rows_and_segments_of_booleans_are_refused() -> None:
+    """Boolean rows were read as 0 and 1: fill_gaps said 'duplicate rows for frame 1, id 1',
+    recover_gap 'frames must increase strictly'."""
+    from pftrack.recovery import fill_gaps, recover_gap
+
+    rows = np.array([[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [5, 1, 14, 10, 5, 5, 1, -1, -1, -1.0]])
+    with pytest.raises(TypeError, match="fill_gaps: rows must hold real numbers, got dtype bool"):
+        fill_gaps(rows.astype(bool))
+    seg = rows[:, [0, 2, 3]]
+    with pytest.raises(TypeError, match="segment_a must hold real numbers, got dtype bool"):
+        recover_gap(seg[:1].astype(bool), seg[1:], None, "linear")

@@ -195,12 +195,18 @@ def test_classes_never_share_an_identity():
     assert len(one) == 1
 
 
-@pytest.mark.parametrize("cls", [0.7, -0.5, 1e20, 2.0**31 + 1])
+@pytest.mark.parametrize("cls", [0.7, -0.5, 1e20, 2.0**31 + 1, 2.0**31, -(2.0**31) - 1])
 def test_class_ids_must_be_integers(cls):
     frame = np.zeros((80, 100, 3), np.uint8)
     dets = np.array([[30.0, 20.0, 50.0, 60.0, 0.9, 0.0], [60.0, 20.0, 80.0, 60.0, 0.9, cls]])
-    with pytest.raises(ValueError, match=r"dets row 1 has class id .*, expected an integer"):
+    with pytest.raises(
+        ValueError,
+        match=r"dets row 1 has class id .*, expected an integer in \[-2147483648, 2147483647\]",
+    ):
         pftrack.Tracker().update(dets, frame)
+    for edge in (2.0**31 - 1, -(2.0**31)):  # int32's own bounds are class ids
+        dets[1, 5] = edge
+        assert pftrack.Tracker().update(dets, frame).shape[1] == 8
     dets[1, 5] = 3.0  # an integer held as a float is a class id
     assert pftrack.Tracker().update(dets, frame).shape[1] == 8
 

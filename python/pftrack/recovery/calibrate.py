@@ -205,7 +205,7 @@ class Calibration:
             if c.weights:
                 lo, hi = c.lengths
                 span = f"{lo}" if lo == hi else f"{lo}-{hi}"
-                mix = " + ".join(f"{w:.2f} {m}" for m, w in c.weights)
+                mix = " + ".join(f"{_weight(w)} {m}" for m, w in c.weights)
                 if c.combined_mmae is None:  # no validation gaps: the file's weights
                     lines.append(f"gap length {span}: combination {mix}, the file's choice")
                     continue
@@ -214,6 +214,11 @@ class Calibration:
                     f"{c.combined_mmae:.3f}{_blend_note(c, self.bags)}"
                 )
         return "\n".join(lines)
+
+
+def _weight(w: float) -> str:
+    """A blend weight as ``--explain`` prints it: 2 decimals, more when they would read 0.00."""
+    return f"{w:.2f}" if round(w, 2) > 0 else f"{w:.2g}"
 
 
 def _blend_note(c: BucketChoice, bags: int = 0) -> str:

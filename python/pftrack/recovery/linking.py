@@ -332,7 +332,7 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
     value finite, and the boxes what :func:`pftrack.io.mot.read_mot` reads (:func:`check_boxes`:
     no negative width or height, no value beyond ±1e9 px). `what` names the caller in messages.
     """
-    a = real_array(rows, f"{what}: rows")
+    a = real_array(rows, f"{what}: rows", booleans=False)
     if a.ndim != 2 or a.shape[1] != 10:
         raise ValueError(f"{what}: rows must have shape (M, 10) (10 columns), got {a.shape}")
     f, i = a[:, 0], a[:, 1]

@@ -59,7 +59,7 @@ def as_segment(seg: ArrayLike, name: str, fn: str = "recover_gap") -> F64:
         :func:`pftrack.io.mot.read_mot`), a position or size beyond ``MAX_COORD`` (1e9 px) or
         frames that do not increase strictly.
     """
-    a = real_array(seg, f"{fn}: {name}")
+    a = real_array(seg, f"{fn}: {name}", booleans=False)
     if a.ndim != 2 or a.shape[1] not in (3, 5):
         raise ValueError(f"{fn}: {name} must have shape (k, 3) or (k, 5), got {a.shape}")
     if a.shape[0] == 0:
@@ -144,7 +144,7 @@ def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.i
         `frames` holds what is not real numbers.
     ValueError
         The gap :func:`gap_ends` refuses, or `frames` is not 1-D integers strictly inside the
-        gap.
+        gap, in increasing order.
     """
     f0, f1 = gap_ends(seg_a, seg_b)
     if frames is None:
@@ -154,6 +154,11 @@ def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.i
         raise ValueError("recover_gap: frames must be a 1-D array of integers")
     if fr.size and (fr.min() <= f0 or fr.max() >= f1):
         raise ValueError(f"recover_gap: frames must lie strictly between {f0} and {f1}")
+    if np.any(np.diff(fr) <= 0):  # one row per frame, in order (gsi reads the first and last)
+        k = int(np.flatnonzero(np.diff(fr) <= 0)[0])
+        raise ValueError(
+            f"recover_gap: frames must increase strictly, got {fr[k]:g} then {fr[k + 1]:g}"
+        )
     return fr.astype(np.int64)
 
 

@@ -59,8 +59,8 @@ MAX_SPAN_FRAMES = 100_000
 #: The highest frame rate :class:`Tracker` accepts (as ``pftrack track --fps``).
 MAX_FRAME_RATE = 1000.0
 
-#: Largest class id (in absolute value) :meth:`Tracker.update` takes.
-MAX_CLASS = 2**31
+#: Largest class id :meth:`Tracker.update` takes (a 32-bit signed integer: -2**31 to 2**31 - 1).
+MAX_CLASS = 2**31 - 1
 #: Columns of :meth:`Tracker.update`'s output.
 TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
 
@@ -128,7 +128,7 @@ def check_boxes_xyxy(
     TypeError
         Not numbers.
     ValueError
-        Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31]``, or
+        Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31 - 1]``, or
         a box with ``x2 <= x1`` or ``y2 <= y1`` (the message says when the rows look like
         ``x, y, w, h`` instead).
     """
@@ -148,12 +148,12 @@ def check_boxes_xyxy(
         raise ValueError(f"dets row {k} contains NaN or inf: {d[k].tolist()}")
     if d.shape[1] == 6:
         c = d[:, 5]
-        odd = (c != np.round(c)) | (np.abs(c) > MAX_CLASS)
+        odd = (c != np.round(c)) | (c < -MAX_CLASS - 1) | (c > MAX_CLASS)
         if odd.any():
             k = int(np.flatnonzero(odd)[0])
             raise ValueError(
-                f"dets row {k} has class id {c[k]:g}, expected an integer in "
-                f"[-{MAX_CLASS}, {MAX_CLASS}] (column 6: x1, y1, x2, y2, conf, cls)"
+                f"dets row {k} has class id {c[k]:.17g}, expected an integer in "
+                f"[{-MAX_CLASS - 1}, {MAX_CLASS}] (column 6: x1, y1, x2, y2, conf, cls)"
             )
     bad = (d[:, 2] <= d[:, 0]) | (d[:, 3] <= d[:, 1])
     if bad.any():
