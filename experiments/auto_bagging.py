@@ -21,36 +21,15 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 import pftrack.recovery.calibrate as cal_mod
 from experiments._common import data_root, experiment_parser, tee_stdout
-from experiments.auto_seeds import FIXED, SEQUENCES, SeedRow, format_rows
+from experiments.auto_seeds import FIXED, SEQUENCES, SeedRow, format_rows, scenes
 from pftrack._typing import F64
-from pftrack.io.mot import read_mot
-from pftrack.io.video import read_seqinfo
-from pftrack.recovery.experiment import auto_masks, run_mask, trajectories
-from pftrack.synthetic import make_scene
-
-
-def scenes(root: Path) -> list[tuple[str, dict[int, F64], float, float]]:
-    """The five development sequences (those present) and the three synthetic scenes."""
-    out = []
-    for name, sub in SEQUENCES:
-        folder = root / sub
-        if (folder / "gt.txt").is_file():
-            info = read_seqinfo(folder)
-            if info.width is None or info.height is None:
-                raise ValueError(f"{folder}/seqinfo.ini: no imWidth/imHeight")
-            trajs = trajectories(read_mot(folder / "gt.txt"))
-            out.append((name, trajs, float(info.width), float(info.height)))
-    for k in range(3):
-        truth = make_scene(n_frames=300, n_walkers=12, rng=k).truth
-        out.append((f"syn{k}", trajectories(truth), 480.0, 360.0))
-    return out
+from pftrack.recovery.experiment import auto_masks, run_mask
 
 
 def gap_errors(

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
@@ -60,6 +61,26 @@ class SeedRow:
         """The best fixed method and its MMAE."""
         m = min(self.fixed, key=lambda k: self.fixed[k])
         return m, self.fixed[m]
+
+
+def scenes(root: Path) -> list[tuple[str, dict[int, F64], float, float]]:
+    """The five development sequences (those present) and the three synthetic scenes.
+
+    Each as ``(name, trajectories, width, height)``.
+    """
+    out = []
+    for name, sub in SEQUENCES:
+        folder = root / sub
+        if (folder / "gt.txt").is_file():
+            info = read_seqinfo(folder)
+            if info.width is None or info.height is None:
+                raise ValueError(f"{folder}/seqinfo.ini: no imWidth/imHeight")
+            trajs = trajectories(read_mot(folder / "gt.txt"))
+            out.append((name, trajs, float(info.width), float(info.height)))
+    for k in range(3):
+        truth = make_scene(n_frames=300, n_walkers=12, rng=k).truth
+        out.append((f"syn{k}", trajectories(truth), 480.0, 360.0))
+    return out
 
 
 def seed_row(
@@ -135,21 +156,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.seeds < 1:
         ap.error(f"--seeds is {args.seeds}, expected >= 1")
     seeds = list(range(args.seeds))
-    root = data_root(args.data)
-    rows = []
-    for name, sub in SEQUENCES:
-        folder = root / sub
-        if (folder / "gt.txt").is_file():
-            info = read_seqinfo(folder)
-            if info.width is None or info.height is None:
-                raise ValueError(f"{folder}/seqinfo.ini: no imWidth/imHeight")
-            trajs = trajectories(read_mot(folder / "gt.txt"))
-            w, h = float(info.width), float(info.height)
-            rows.append(seed_row(name, trajs, w, h, seeds, combine=args.combine))
-    for k in range(3):
-        truth = make_scene(n_frames=300, n_walkers=12, rng=k).truth
-        syn = trajectories(truth)
-        rows.append(seed_row(f"syn{k}", syn, 480.0, 360.0, seeds, combine=args.combine))
+    rows = [
+        seed_row(name, trajs, w, h, seeds, combine=args.combine)
+        for name, trajs, w, h in scenes(data_root(args.data))
+    ]
     with tee_stdout(args.out / "seeds.txt"):
         print(format_rows(rows, seeds, [n for n, _ in SEQUENCES]))
     return 0

@@ -29,16 +29,20 @@ def _window(rng: np.random.Generator, n: int, fa: int, fb: int, holes: int) -> n
     return z
 
 
+def _case(rng: np.random.Generator, d: int, n: int, fa: int, fb: int, holes: int, grid: int):
+    """A window of `n` points with a gap (fa, fb), a d-state model and the stand hypotheses."""
+    z = _window(rng, n, fa, fb, holes=holes)
+    F, Q = singer_model(0.3, 2.5) if d == 3 else (cv_transition()[None], wna_Q(0.2)[None])
+    t1, t2 = stand_hypotheses(fb - fa, grid=grid)
+    return z, F[0], Q[0], t1, t2, np.array([1e4, 4.0, 0.5][:d])
+
+
 @pytest.mark.parametrize("d", [2, 3])
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_gap_mixture_matches_numpy(d: int, seed: int) -> None:
     rng = np.random.default_rng(seed)
-    n, fa, fb = 60, 22, 41
-    z = _window(rng, n, fa, fb, holes=4)
-    F, Q = singer_model(0.3, 2.5) if d == 3 else (cv_transition()[None], wna_Q(0.2)[None])
-    F, Q = F[0], Q[0]
-    t1, t2 = stand_hypotheses(fb - fa, grid=7)
-    p0 = np.array([1e4, 4.0, 0.5][:d])
+    fa, fb = 22, 41
+    z, F, Q, t1, t2, p0 = _case(rng, d, 60, fa, fb, holes=4, grid=7)
     got_p, got_ll = _core.gap_mixture(z, fa, fb, F, Q, 0.3, p0, t1, t2, 4.0)
     ref_p, ref_ll = ref_gap_mixture(z, fa, fb, F, Q, 0.3, p0, t1, t2, 4.0)
     assert got_p.shape == (len(t1), fb - fa - 1)
@@ -57,12 +61,8 @@ def test_gap_mixture_shared_gains_are_exact(d: int) -> None:
     give the same bits as one call over the grouped hypotheses.
     """
     rng = np.random.default_rng(11)
-    n, fa, fb = 70, 25, 45
-    z = _window(rng, n, fa, fb, holes=3)
-    F, Q = singer_model(0.3, 2.5) if d == 3 else (cv_transition()[None], wna_Q(0.2)[None])
-    F, Q = F[0], Q[0]
-    t1, t2 = stand_hypotheses(fb - fa, grid=8)
-    p0 = np.array([1e4, 4.0, 0.5][:d])
+    fa, fb = 25, 45
+    z, F, Q, t1, t2, p0 = _case(rng, d, 70, fa, fb, holes=3, grid=8)
     all_p, all_ll = _core.gap_mixture(z, fa, fb, F, Q, 0.3, p0, t1, t2, 4.0)
     for h in range(len(t1)):
         p, ll = _core.gap_mixture(z, fa, fb, F, Q, 0.3, p0, t1[h : h + 1], t2[h : h + 1], 4.0)
@@ -104,11 +104,19 @@ def test_gap_mixture_walk_hypothesis_is_the_gaussian_conditional() -> None:
     np.testing.assert_allclose(got[0], want, rtol=1e-7, atol=1e-6)
 
 
-def test_state_loglik_batch_matches_numpy() -> None:
-    rng = np.random.default_rng(3)
-    runs = [np.cumsum(rng.normal(1.0, 0.5, k)) for k in (4, 9, 40, 17)]
-    F, Q = singer_model([0.1, 2.0], [3.0, 0.5])
-    r = np.array([0.2, 1.5])
+@pytest.mark.parametrize(
+    ("seed", "lengths", "q", "tau", "r"),
+    [
+        (3, (4, 9, 40, 17), [0.1, 2.0], [3.0, 0.5], [0.2, 1.5]),
+        # runs far longer than the covariance takes to settle (the steps after it reuse it)
+        (4, (1500, 6, 300), [0.1, 2.0, 1e-4], [3.0, 0.5, 80.0], [0.2, 1.5, 10.0]),
+    ],
+)
+def test_state_loglik_batch_matches_numpy(seed, lengths, q, tau, r) -> None:
+    rng = np.random.default_rng(seed)
+    runs = [np.cumsum(rng.normal(1.0, 0.5, k)) for k in lengths]
+    F, Q = singer_model(q, tau)
+    r = np.array(r)
     got = _core.state_loglik_batch(
         np.concatenate(runs),
         np.array([len(z) for z in runs], np.int32),
@@ -117,25 +125,7 @@ def test_state_loglik_batch_matches_numpy() -> None:
         r,
         1e4,
     )
-    want = [state_loglik(runs, F[k], Q[k], r[k], 1e4) for k in range(2)]
-    np.testing.assert_allclose(got, want, rtol=1e-10)
-
-
-def test_state_loglik_batch_long_runs_match_numpy() -> None:
-    """Runs far longer than the covariance takes to settle (the steps after it reuse it)."""
-    rng = np.random.default_rng(4)
-    runs = [np.cumsum(rng.normal(1.0, 0.5, k)) for k in (1500, 6, 300)]
-    F, Q = singer_model([0.1, 2.0, 1e-4], [3.0, 0.5, 80.0])
-    r = np.array([0.2, 1.5, 10.0])
-    got = _core.state_loglik_batch(
-        np.concatenate(runs),
-        np.array([len(z) for z in runs], np.int32),
-        np.ascontiguousarray(F.reshape(-1, 3)),
-        np.ascontiguousarray(Q.reshape(-1, 3)),
-        r,
-        1e4,
-    )
-    want = [state_loglik(runs, F[k], Q[k], r[k], 1e4) for k in range(3)]
+    want = [state_loglik(runs, F[k], Q[k], r[k], 1e4) for k in range(len(q))]
     np.testing.assert_allclose(got, want, rtol=1e-10)
 
 
