@@ -12,7 +12,8 @@ runs a fresh tracker over the same frames; the first frames (births, start-up) a
 process, not what other processes take from the cores) of one ``update``: for each timed frame
 the least of its rounds (every round computes the same; the least is the one other processes
 disturbed least), averaged over the frames. ``extra_info["wall_ms_per_frame"]`` is the same
-for the wall-clock time. "default" includes the background
+for the wall-clock time; "opencv 1 thread" runs with ``cv2.setNumThreads(1)``, as ``pftrack
+track`` does (the library leaves OpenCV's setting to the caller). "default" includes the background
 model behind box refinement (on by default with detections) and the camera-motion check
 (``"auto"``); "no refine" is the tracker without the background model.
 """
@@ -38,8 +39,26 @@ def scene_dets() -> tuple[list[np.ndarray], list[np.ndarray]]:
     return python_share.scene_dets()
 
 
+@pytest.mark.parametrize("opencv_threads", [None, 1], ids=["opencv default", "opencv 1 thread"])
 @pytest.mark.parametrize("refine", [True, False], ids=["default", "no refine"])
 def test_update_10_objects(
+    benchmark: BenchmarkFixture,
+    scene_dets: tuple[list[np.ndarray], list[np.ndarray]],
+    refine: bool,
+    opencv_threads: int | None,
+) -> None:
+    import cv2
+
+    before = cv2.getNumThreads()
+    if opencv_threads is not None:  # as `pftrack track` runs, and a caller may
+        cv2.setNumThreads(opencv_threads)
+    try:
+        _update_10_objects(benchmark, scene_dets, refine)
+    finally:
+        cv2.setNumThreads(before)
+
+
+def _update_10_objects(
     benchmark: BenchmarkFixture, scene_dets: tuple[list[np.ndarray], list[np.ndarray]], refine: bool
 ) -> None:
     frames, dets = scene_dets
