@@ -408,7 +408,7 @@ def test_experiment_gaps_refuses_absurd_masks_and_sizes_before_work(
     argv = ["experiment", "gaps", "--gt", str(tmp_path / "none.txt"), option, value]
     try:
         status = main(argv)
-    except SystemExit as exc:  # argparse's own refusal: usage, then the one error line
+    except SystemExit as exc:  # argparse's own refusal: the one error line
         status = exc.code
     assert status == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -939,5 +939,27 @@ def test_an_unknown_option_is_named_by_its_command(
         main(argv)
     assert exc.value.code == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"usage: pftrack {command} ")
-    assert err.splitlines()[-1].startswith(f"pftrack {command}: error: unrecognized arguments: ")
+    assert len(err.splitlines()) == 1  # one line, not argparse's usage block before it
+    assert err.startswith(f"pftrack {command}: error: unrecognized arguments: ")
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["track", "v.avi", "--out", "o.txt", "--max-side", "10"],
+        ["track", "v.avi", "--out", "o.txt", "--fps", "0"],
+        ["track", "v.avi", "--out", "o.txt", "--seed", "1.5"],
+        ["batch", "v.avi", "--out", "o", "--workers", "-1"],
+        ["demo", "--frames", "0"],
+        [],
+    ],
+)
+def test_a_bad_option_value_is_one_line(
+    argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A value argparse refuses printed the command's 14-line usage before the error."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and err.startswith("pftrack") and ": error: " in err

@@ -13,7 +13,7 @@ import os
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from typing import Any
+from typing import Any, NoReturn
 
 from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
@@ -36,9 +36,22 @@ examples:
 """
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse's parser, refusing bad usage in one line (``pftrack track: error: ...``).
+
+    argparse prints the command's whole usage before the error line; ``--help`` still shows
+    it. Sub-commands' parsers are of this class too (``add_subparsers`` makes them of the
+    parser's own class).
+    """
+
+    def error(self, message: str) -> NoReturn:
+        """Print ``PROG: error: MESSAGE`` and exit with status 2."""
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="pftrack",
         description="Track many people or objects in video with one colour particle filter "
         "each, and recover the parts of their paths that tracking lost.",
