@@ -740,3 +740,14 @@ def test_no_track_warning_of_the_joint_sampler_does_not_blame_confidences():
     tracker.update(None, frame)
     with pytest.warns(RuntimeWarning, match=r"joint sampler \(rjmcmc\) kept no object"):
         tracker.finalize()
+
+
+def test_a_detection_file_without_scores_is_said(tmp_path):
+    """Six fields a row (no score) gave every box the score 1 silently: --birth-score was then
+    a no-op."""
+    (tmp_path / "six.txt").write_text("1,-1,10,10,20,40\n2,-1,11,10,20,40\n")
+    with pytest.warns(UserWarning, match="six.txt: no score column .* every detection scores 1"):
+        got = load_detections(tmp_path / "six.txt")
+    assert [float(r[0, 4]) for r in got.values()] == [1.0, 1.0]
+    (tmp_path / "seven.txt").write_text("1,-1,10,10,20,40,0.8\n")
+    assert float(load_detections(tmp_path / "seven.txt")[1][0, 4]) == 0.8  # no warning

@@ -35,6 +35,12 @@ def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
                 yield lineno, text
 
 
+def first_row_fields(path: PathLike) -> int:
+    """How many fields the file's first row has (0 without a row): 6 means no score column."""
+    first = next(_data_lines(Path(path)), None)
+    return 0 if first is None else len(first[1].replace(",", " ").split())
+
+
 def data_line_numbers(path: PathLike) -> list[int]:
     """The file's line number of each row :func:`read_mot` returns, for error messages."""
     return [n for n, _ in _data_lines(Path(path))]

@@ -17,7 +17,7 @@ from pftrack._check import flag, number
 from pftrack._progress import progress
 from pftrack._typing import F64, PathLike, RngLike
 from pftrack.detection.bootstrap import bootstrap_frames
-from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource
 from pftrack.recovery.linking import LinkConfig
@@ -79,12 +79,19 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     Warns
     -----
     UserWarning
-        Boxes of zero width or height are left out (a box with no area cannot be tracked).
+        Boxes of zero width or height are left out (a box with no area cannot be tracked); a
+        file without a score column (6 fields a row) gives every box the score 1.
     """
     lo, hi = DET_SCALE_RANGE
     if not (lo <= number(scale, "detection scale", finite=False) <= hi):
         raise ValueError(f"detection scale is {scale}, expected a number in [{lo:g}, {hi:g}]")
     rows = read_mot(path, what="detection file")
+    if len(rows) and first_row_fields(path) == 6:
+        warnings.warn(
+            f"{path}: no score column (6 fields a row): every detection scores 1, so "
+            "birth_score and min_conf gate none of them",
+            stacklevel=2,
+        )
     flat = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
     if flat.any():
         warnings.warn(
