@@ -963,3 +963,15 @@ def test_a_bad_option_value_is_one_line(
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and err.startswith("pftrack") and ": error: " in err
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+def test_a_folder_where_no_file_can_be_made_is_said_so(
+    video: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """/proc exists and looks writable to root: 'folder /proc is not writable (No such file or
+    directory)' contradicted itself."""
+    assert main(["track", str(video), "--out", "/proc/pftrack-test.txt"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("pftrack track: error: --out /proc/pftrack-test.txt: ")
+    assert "no file can be made in folder /proc (" in err or "not writable" in err

@@ -399,7 +399,7 @@ def _check_folder(written: Path, what: str, target: Path) -> None:
         os.close(fd)
     except OSError as exc:
         raise PermissionError(
-            f"{what} {target}: folder {folder} is not writable ({exc.strerror or exc})"
+            f"{what} {target}: no file can be made in folder {folder} ({exc.strerror or exc})"
         ) from None
     finally:
         _remove(made)
