@@ -655,3 +655,18 @@ def test_a_scale_that_makes_frames_of_no_or_too_many_pixels_is_refused(
     ):
         FrameSource(folder, scale=scale)
     assert FrameSource(folder, scale=0.5).width == 32
+
+
+def test_two_images_of_one_number_in_a_plain_folder_are_refused(tmp_path: Path) -> None:
+    """1.png and 01.png (or 2.png and 002.png) were two frames in the file system's order; a
+    sequence folder already refused them."""
+    scene = make_scene(n_frames=3, width=64, height=64, n_walkers=1, rng=0)
+    src = scene.write_images(tmp_path / "src")
+    folder = tmp_path / "plain"
+    folder.mkdir()
+    for k, name in enumerate(["1.png", "01.png", "2.png"]):
+        (folder / name).write_bytes(sorted(src.glob("*.png"))[k].read_bytes())
+    with pytest.raises(ValueError, match="images 01.png and 1.png in folder .* the same number"):
+        FrameSource(folder)
+    (folder / "01.png").unlink()
+    assert len(list(FrameSource(folder))) == 2

@@ -22,6 +22,7 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import itertools
 import operator
 import os
 import re
@@ -312,6 +313,21 @@ def _same_folder(a: Path, b: Path) -> bool:
         return a == b or a.samefile(b)
     except OSError:
         return False
+
+
+def _natural_order(folder: Path, images: list[Path]) -> list[Path]:
+    """`images` in :func:`natural_key` order; two names of one key (``1.png``, ``01.png``) refused.
+
+    Their order would be the file system's, not the names': frames swapped silently.
+    """
+    keyed = sorted((natural_key(p.name), p.name, p) for p in images)
+    for (k1, n1, _), (k2, n2, _) in itertools.pairwise(keyed):
+        if k1 == k2:
+            raise ValueError(
+                f"images {n1} and {n2} in folder {folder} have the same number: which comes "
+                "first is not known (rename one)"
+            )
+    return [p for _, _, p in keyed]
 
 
 def _frame_order(
@@ -634,7 +650,7 @@ class FrameSource:
         seq = self.sequence
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
-        self._images = numbered or sorted(images, key=lambda p: natural_key(p.name))
+        self._images = numbered or _natural_order(folder, images)
         first = read_image(self._images[0])
         if first is None:
             raise ValueError(f"cannot read image {self._images[0]}")
