@@ -751,3 +751,17 @@ def test_a_detection_file_without_scores_is_said(tmp_path):
     assert [float(r[0, 4]) for r in got.values()] == [1.0, 1.0]
     (tmp_path / "seven.txt").write_text("1,-1,10,10,20,40,0.8\n")
     assert float(load_detections(tmp_path / "seven.txt")[1][0, 4]) == 0.8  # no warning
+
+
+def test_detections_after_a_video_that_ended_early_are_said():
+    """A truncated video (its header promised more frames) ended the run with its detections of
+    the frames never decoded dropped without a word."""
+    frame = np.full((120, 160, 3), 90, np.uint8)
+    box = np.array([[40.0, 30.0, 20.0, 40.0, 0.9]])
+    dets = {1: box, 2: box, 3: box}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        run = track_frames([frame], detections=dets)
+    said = [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
+    assert any("detections of 2 frames after the video's last frame 1" in m for m in said)
+    assert run.n_frames == 1

@@ -238,6 +238,14 @@ def track_frames(
                 on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
     if n == 0:
         raise ValueError(f"no frame could be read from {source}")
+    if detections:
+        unused = [f for f in detections if f > n and len(detections[f])]
+        if unused:  # the video ended early (a truncated file): say what was not tracked
+            warnings.warn(
+                f"detections of {len(unused)} frames after the video's last frame {n} were not "
+                f"used (frames {min(unused)}-{max(unused)})",
+                stacklevel=2,
+            )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
 
 
