@@ -635,6 +635,21 @@ class _Blends:
             self.rows[key] = self._errors(b, first, second, np.array([w]))[0]
         return self.rows[key]
 
+    def fit(
+        self, b: int, first: str, second: str, idx: NDArray[np.int64] | None = None
+    ) -> tuple[float, F64]:
+        """The shrunk weight of `second` and the per-gap errors it gives (:func:`_combine`).
+
+        On the validation gaps `idx` of bucket `b` (a resample, with repeats; None: all).
+        """
+        fit = self(b, first, second)
+        if idx is not None:
+            fit = fit[:, idx]
+        k = int(np.argmin(fit.mean(axis=1)))  # the first of equal minima, as min() takes it
+        w = float(COMBINE_GRID[k]) * fit.shape[1] / (fit.shape[1] + COMBINE_SHRINK)
+        err = self.shrunk(b, first, second, k)
+        return w, err if idx is None else err[idx]
+
 
 def _choose(
     stacked: dict[int, F64],
@@ -664,15 +679,9 @@ def _choose(
         out[b] = ((method, 1.0),)
         if combine and len(names) > 1:
             other = min((m for m in names if m != method), key=lambda m: means[m])
-            fit = blends(b, method, other)
-            if idx is not None:
-                fit = fit[:, idx[b]]
-            k = int(np.argmin(fit.mean(axis=1)))
-            w = float(COMBINE_GRID[k]) * fit.shape[1] / (fit.shape[1] + COMBINE_SHRINK)
-            if 0.0 < w:
-                shrunk = blends.shrunk(b, method, other, k)
-                if _better(shrunk if idx is None else shrunk[idx[b]], e[method]):
-                    out[b] = ((method, 1.0 - w), (other, w))
+            w, err = blends.fit(b, method, other, None if idx is None else idx[b])
+            if 0.0 < w and _better(err, e[method]):
+                out[b] = ((method, 1.0 - w), (other, w))
     return pooled, out
 
 
@@ -704,21 +713,10 @@ def _combine(
 
     `w` minimises the validation MMAE over :data:`COMBINE_GRID` and is then shrunk toward 0
     (`first` alone) as ``w n / (n + COMBINE_SHRINK)`` for `n` validation gaps, so few gaps
-    give a combination close to the chosen method.
+    give a combination close to the chosen method. (:meth:`_Blends.fit` on one bucket: the
+    rule :func:`calibrate` applies.)
     """
-    n = np.array([len(t) for t in truth])
-    starts = np.r_[0, np.cumsum(n)[:-1]]
-    p1, p2 = np.concatenate(first), np.concatenate(second)
-    t = np.concatenate([v[:, 1:3] for v in truth])
-
-    def errors(w: float) -> F64:
-        d = (1.0 - w) * p1 + w * p2 - t
-        out: F64 = np.add.reduceat(np.hypot(d[:, 0], d[:, 1]), starts) / n
-        return out
-
-    fit = min(COMBINE_GRID, key=lambda w: float(errors(float(w)).mean()))
-    w = float(fit) * len(n) / (len(n) + COMBINE_SHRINK)
-    return w, errors(w)
+    return _Blends({0: {"a": list(first), "b": list(second)}}, {0: list(truth)}).fit(0, "a", "b")
 
 
 def _gap_errors(paths: Sequence[F64], truth: Sequence[F64]) -> F64:
