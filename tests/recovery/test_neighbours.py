@@ -13,6 +13,7 @@ from pftrack.recovery.neighbours import (
     correct_by_neighbours,
 )
 from pftrack.recovery.segments import distinct_runs
+from tests.reference.neighbours import windows as reference_windows
 
 
 def _bob(t: np.ndarray) -> np.ndarray:
@@ -199,8 +200,9 @@ def test_deterministic(seed: int) -> None:
 
 
 def test_windows_many_is_windows_pair_by_pair() -> None:
-    """The vectorised search finds the same windows, in the same order, as one pair at a time
-    (excluded runs, no neighbour, a repeated pair, fewer neighbours than the cap)."""
+    """The vectorised search finds the same windows, in the same order, as the reference's one
+    run at a time (excluded runs, no neighbour, a repeated pair, fewer neighbours than the
+    cap)."""
     rng = np.random.default_rng(4)
     tracks = _carried_camera_tracks(rng, n=15)
     tracks.append(tracks[2].copy())  # a run twice: distinct_runs keeps one
@@ -218,9 +220,8 @@ def test_windows_many_is_windows_pair_by_pair() -> None:
     pairs.append((runs[0][:5] + [0.0, 0.0, 0.0], runs[0][-5:] + [500.0, 0.0, 0.0]))
     excludes.append(-1)
     got = Neighbourhood(runs).windows_many(pairs, excludes)
-    want_hood = Neighbourhood(runs)
     for ws, (a, b), e in zip(got, pairs, excludes, strict=True):
-        want = want_hood.windows(a, b, e)
+        want = reference_windows(runs, a, b, e, MAX_NEIGHBOURS)
         assert len(ws) == len(want)
         for w, v in zip(ws, want, strict=True):
             for x, y in zip(w, v, strict=True):

@@ -4,5 +4,6 @@ One module per wing: ``kernels`` (HSV bins, histograms, Bhattacharyya, resamplin
 ``fused`` (vectorised NumPy peers for the benchmarks), ``mcmc`` (MH and RJ-MCMC), ``detection``
 (background model), ``refine`` (box refinement), ``blobs`` (the blob pass and
 the size model's kernels), ``smoothing`` (constant-velocity posterior),
-``bridge`` (goal-directed recovery), ``mixture`` (stand/walk gap mixture).
+``bridge`` (goal-directed recovery), ``mixture`` (stand/walk gap mixture), ``neighbours``
+(the `-nb` methods' neighbour search).
 """

@@ -66,32 +66,10 @@ class Neighbourhood:
         from) observed on every frame from the gap's last point before to its first point
         after. It is cut into as many points before and after as the gap has (fewer where
         the run is shorter) and the points between, its truth. At most
-        :data:`MAX_NEIGHBOURS`, nearest first to the gap's last point before.
+        :data:`MAX_NEIGHBOURS`, nearest first to the gap's last point before (ties: run
+        order). :meth:`windows_many` of one pair.
         """
-        fa, fb = float(segment_a[-1, 0]), float(segment_b[0, 0])
-        x, y = float(segment_a[-1, 1]), float(segment_a[-1, 2])
-        key = (fa, fb, x, y, float(len(segment_a)), float(len(segment_b)), float(exclude))
-        if key in self._cache:
-            return self._cache[key]
-        idx = np.flatnonzero((self.first <= fa) & (self.last >= fb))
-        idx = idx[idx != exclude]
-        if not len(idx):
-            self._cache[key] = []
-            return []
-        at = (fa - self.first[idx]).astype(np.int64)
-        on = self._frame[self._offset[idx] + at] == fa  # frames off the gap's (fractional)
-        idx, at = idx[on], at[on]
-        d = np.hypot(*(self._xy[self._offset[idx] + at] - (x, y)).T)
-        order = np.lexsort((idx, d))[:MAX_NEIGHBOURS]  # ties: run order (deterministic)
-        n_gap = int(fb - fa) - 1
-        out: list[Window] = []
-        for k in order:
-            r, i = self.runs[int(idx[k])], int(at[k])
-            lo = max(0, i + 1 - len(segment_a))
-            hi = i + 1 + n_gap + len(segment_b)
-            out.append((r[lo : i + 1], r[i + 1 + n_gap : hi], r[i + 1 : i + 1 + n_gap]))
-        self._cache[key] = out
-        return out
+        return self.windows_many([(segment_a, segment_b)], [exclude])[0]
 
     def windows_many(
         self, pairs: Sequence[tuple[F64, F64]], excludes: Sequence[int]
@@ -104,6 +82,7 @@ class Neighbourhood:
         keys = []
         todo: dict[tuple[float, ...], int] = {}
         for (a, b), e in zip(pairs, excludes, strict=True):
+            # the gap's ends, its last point before, the points each side, the run left out
             key = (
                 float(a[-1, 0]), float(b[0, 0]), float(a[-1, 1]), float(a[-1, 2]),
                 float(len(a)), float(len(b)), float(e),
