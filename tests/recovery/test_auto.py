@@ -645,3 +645,12 @@ def test_explain_prints_a_small_weight_as_what_it_is() -> None:
     from pftrack.recovery.calibrate import _weight
 
     assert [_weight(w) for w in (0.998, 0.0016, 0.25, 1.0)] == ["1.00", "0.0016", "0.25", "1.00"]
+
+
+def test_a_bad_observed_run_is_named_by_its_place_in_observed() -> None:
+    """An empty run before it shifted the number: the third run was named 'run 1'."""
+    from pftrack.recovery.calibrate import calibrate
+
+    bad = np.where(np.arange(39)[:, None] == 5, np.nan, _RUN)
+    with pytest.raises(ValueError, match="calibrate: observed run 2 has a non-finite"):
+        calibrate([_RUN, np.zeros((0, 3)), bad], [3])

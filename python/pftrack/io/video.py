@@ -629,7 +629,7 @@ class FrameSource:
         else:
             self.fps, self.fps_origin = DEFAULT_FPS, "default"
         h, w = first.shape[:2]
-        size = (round(w * self.scale), round(h * self.scale))
+        size = self._scaled_size(first)
         if min(size) < 1 or max(size) > MAX_SCALED_SIDE:
             if self._cap is not None:
                 self._cap.release()
@@ -692,10 +692,13 @@ class FrameSource:
         self._cap = cap
         return first, float(cap.get(cv2.CAP_PROP_FPS)), 0
 
+    def _scaled_size(self, frame: NDArray[Any]) -> tuple[int, int]:
+        """(width, height) of `frame` at :attr:`scale`."""
+        return round(frame.shape[1] * self.scale), round(frame.shape[0] * self.scale)
+
     def _resize(self, frame: NDArray[Any]) -> NDArray[np.uint8]:
         if self.scale != 1.0:
-            size = (round(frame.shape[1] * self.scale), round(frame.shape[0] * self.scale))
-            frame = cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR)
+            frame = cv2.resize(frame, self._scaled_size(frame), interpolation=cv2.INTER_LINEAR)
         return np.asarray(frame, dtype=np.uint8)  # OpenCV's colour reads are uint8: no copy
 
     def _read_image(self, path: Path) -> NDArray[np.uint8]:

@@ -209,6 +209,7 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
             f"{type(observed).__name__}"
         )
     arrs = []
+    where = []  # the place in `observed` of each array kept, for the messages
     for k, s in enumerate(observed):
         if strict is None:
             a = np.asarray(s, dtype=np.float64)
@@ -221,6 +222,7 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
                 )
         if a.ndim == 2 and a.shape[1] >= 3 and len(a):
             arrs.append(a[:, :3])
+            where.append(k)
     if not arrs:
         return []
     X = np.vstack(arrs)
@@ -231,7 +233,7 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
     ok = np.add.reduceat((~np.isfinite(X)).any(axis=1), starts) == 0
     if strict is not None and not ok.all():
         row = int(np.flatnonzero(~np.isfinite(X).all(axis=1))[0])
-        k = int(np.searchsorted(np.cumsum([len(a) for a in arrs]), row, side="right"))
+        k = where[int(np.searchsorted(np.cumsum([len(a) for a in arrs]), row, side="right"))]
         raise ValueError(
             f"{strict}: observed run {k} has a non-finite frame, x or y: {X[row].tolist()}"
         )
