@@ -35,10 +35,15 @@ def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
                 yield lineno, text
 
 
+def _fields(text: str) -> list[str]:
+    """The fields of a row: separated by commas, spaces or both."""
+    return text.replace(",", " ").split()
+
+
 def first_row_fields(path: PathLike) -> int:
     """How many fields the file's first row has (0 without a row): 6 means no score column."""
     first = next(_data_lines(Path(path)), None)
-    return 0 if first is None else len(first[1].replace(",", " ").split())
+    return 0 if first is None else len(_fields(first[1]))
 
 
 def data_line_numbers(path: PathLike) -> list[int]:
@@ -111,7 +116,7 @@ def _parse_line(text: str, what: str) -> list[float] | str:
 
     Missing columns get their defaults. The boxes are :func:`read_mot`'s to check.
     """
-    fields = text.replace(",", " ").split()
+    fields = _fields(text)
     if len(fields) < 6:
         return (
             f"{what} line has {len(fields)} fields, expected at least 6 "
