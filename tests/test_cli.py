@@ -499,6 +499,29 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
     assert main(["recover", str(src), "--out", str(out), "--seed", "3"]) == 0  # auto: used
 
 
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_one_file_refuses_the_batch_options(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:  # fmt: skip
+    src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
+    # was: --workers, --scheduler and --force silently ignored with one file
+    for extra, named in (
+        (["--workers", "0"], "--workers applies"),
+        (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler applies"),
+        (["--force", "--workers", "2"], "--workers, --force apply"),
+    ):
+        assert main([command, str(src), "--out", str(out), *extra]) == 2
+        assert capsys.readouterr().err.strip() == (
+            f"pftrack {command}: error: {named} to a batch (several files or a folder); one "
+            "file runs in this process and --out is always written: drop it"
+        )
+        assert not out.exists()
+    # the environment's scheduler is for batches: one file does not refuse it
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "tcp://127.0.0.1:1")
+    assert main([command, str(src), "--out", str(out)]) == 0
+
+
 def test_library_warnings_are_one_line_for_every_command(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -47,20 +47,50 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     """Where a batch runs, and resuming: shared by ``batch``, ``recover`` and ``smooth``."""
     g = p.add_argument_group("batch (several inputs)")
     g.add_argument(
-        "--scheduler", metavar="ADDRESS", default=os.environ.get("DASK_SCHEDULER_ADDRESS"),
-        help="a running Dask scheduler, tcp://HOST:8786 (also read from "
-        "$DASK_SCHEDULER_ADDRESS), connected to before --out is written; waits up to Dask's "
-        "connect timeout (30 s; $DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT); without it a "
-        "local cluster is started for the run and closed at the end",
+        "--scheduler", metavar="ADDRESS", default=None,
+        help="a running Dask scheduler, tcp://HOST:8786, connected to before --out is "
+        "written; waits up to Dask's connect timeout (30 s; "
+        "$DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT) (default: $DASK_SCHEDULER_ADDRESS, "
+        "else none: a local cluster is started for the run and closed at the end)",
     )  # fmt: skip
     g.add_argument(
-        "--workers", type=non_negative_int, default=os.cpu_count() or 1, metavar="N",
-        help="worker processes of the local cluster, one thread each (one per core unless "
-        "given; not used with --scheduler); 0 runs in this process without Dask",
+        "--workers", type=non_negative_int, default=None, metavar="N",
+        help="worker processes of the local cluster, one thread each (default: one per core, "
+        f"{_cores()} here; not used with --scheduler); 0 runs in this process without Dask",
     )  # fmt: skip
     g.add_argument("--force", action="store_true",
                    help="redo inputs whose outputs are complete, instead of skipping "
                    "them")  # fmt: skip
+
+
+def _cores() -> int:
+    return os.cpu_count() or 1
+
+
+#: The options of :func:`add_batch_options`, which a command given one file does not use.
+BATCH_ONLY = ("scheduler", "workers", "force")
+
+
+def refuse_batch_options(args: argparse.Namespace) -> None:
+    """Refuse the batch options on a command given one file (they would do nothing).
+
+    Raises
+    ------
+    ValueError
+        ``--scheduler``, ``--workers`` or ``--force`` was given (``$DASK_SCHEDULER_ADDRESS``
+        is not: it is read only by a batch).
+    """
+    given = [
+        f"--{n}"
+        for n in BATCH_ONLY
+        if getattr(args, n) is not None and getattr(args, n) is not False
+    ]
+    if given:
+        raise ValueError(
+            f"{', '.join(given)} {'applies' if len(given) == 1 else 'apply'} to a batch "
+            "(several files or a folder); one file runs in this process and --out is always "
+            "written: drop it"
+        )
 
 
 def is_batch(paths: list[str]) -> bool:
@@ -137,7 +167,9 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
 
 
 def _where(args: argparse.Namespace) -> dict[str, Any]:
-    return {"scheduler": args.scheduler or None, "n_workers": args.workers, "force": args.force}
+    scheduler = args.scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS") or None
+    workers = args.workers if args.workers is not None else _cores()
+    return {"scheduler": scheduler, "n_workers": workers, "force": args.force}
 
 
 def run(args: argparse.Namespace) -> int:

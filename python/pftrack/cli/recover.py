@@ -66,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
     args.seed = args.seed or 0
     if batch.is_batch(args.tracks):
         return batch.run_recover(args)
+    batch.refuse_batch_options(args)
     if args.video and not args.link:
         raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]

@@ -44,6 +44,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``pftrack smooth``; return the exit status."""
     if batch.is_batch(args.tracks):
         return batch.run_smooth(args)
+    batch.refuse_batch_options(args)
     args.tracks = args.tracks[0]
     import numpy as np
 
