@@ -5,7 +5,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <mutex>
+#include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 #include "pftrack/check.hpp"
 
@@ -57,5 +60,45 @@ inline void check_mask(const py::array& m, py::ssize_t rows, py::ssize_t cols, c
     if (!(m.strides(1) == 1 && m.strides(0) > 0))
         fail(fn, "mask must be packed along rows (use numpy.ascontiguousarray)");
 }
+
+/// One object in one thread at a time: a method that releases the GIL, or that could run while
+/// another thread is inside such a method of the same object (and would see its buffers being
+/// reallocated), holds this for its whole call; methods that only read (`shared`) may run
+/// together. A thread that would overlap a writer raises RuntimeError instead of corrupting
+/// the object or crashing the process (a Tracker shared by two threads).
+class InUse {
+public:
+    InUse(const void* object, const char* fn, bool shared = false) : object_(object) {
+        std::lock_guard<std::mutex> lock(mutex());
+        auto [it, fresh] = held().try_emplace(object, 0);
+        // count: readers inside (> 0), or a writer (-1)
+        if (shared ? it->second < 0 : !fresh)
+            throw std::runtime_error(std::string(fn) +
+                                     ": the object is in use by another thread (use one per "
+                                     "thread, or a lock around it)");
+        it->second = shared ? it->second + 1 : -1;
+    }
+    ~InUse() {
+        std::lock_guard<std::mutex> lock(mutex());
+        auto it = held().find(object_);
+        if (it->second > 1)
+            --it->second;
+        else
+            held().erase(it);
+    }
+    InUse(const InUse&) = delete;
+    InUse& operator=(const InUse&) = delete;
+
+private:
+    const void* object_;
+    static std::mutex& mutex() {
+        static std::mutex m;
+        return m;
+    }
+    static std::unordered_map<const void*, int>& held() {
+        static std::unordered_map<const void*, int> objects;
+        return objects;
+    }
+};
 
 }  // namespace pftrack::bind

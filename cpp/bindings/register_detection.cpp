@@ -69,6 +69,7 @@ void register_detection(py::module_& m) {
             "apply",
             [](BackgroundModel& self, py::array frame, bool bins) {
                 const char* fn = "BackgroundModel.apply";
+                const bind::InUse busy(&self, fn);
                 bind::check_bgr_image(frame, fn, "frame");
                 const Index rows = frame.shape(0), cols = frame.shape(1);
                 if (self.initialized())
@@ -98,6 +99,7 @@ void register_detection(py::module_& m) {
             "blend",
             [](BackgroundModel& self, py::array frame, py::array mask, double rate) {
                 const char* fn = "BackgroundModel.blend";
+                const bind::InUse busy(&self, fn);
                 check_frame_and_mask(self, frame, mask, fn);
                 const auto* src = static_cast<const std::uint8_t*>(frame.data());
                 const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
@@ -113,6 +115,7 @@ void register_detection(py::module_& m) {
             "global_gain",
             [](BackgroundModel& self, py::array frame, Index step, double min_sum) {
                 const char* fn = "BackgroundModel.global_gain";
+                const bind::InUse busy(&self, fn);
                 bind::check_bgr_image(frame, fn, "frame");
                 require(self.initialized(), fn, "the model has no background yet");
                 require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
@@ -129,7 +132,11 @@ void register_detection(py::module_& m) {
             "whose background sum is >= min_sum): the frame's global gain.")
         .def(
             "scale",
-            [](BackgroundModel& self, double gain) { self.scale(gain); }, py::arg("gain"),
+            [](BackgroundModel& self, double gain) {
+                const bind::InUse busy(&self, "BackgroundModel.scale");
+                self.scale(gain);
+            },
+            py::arg("gain"),
             "background *= gain (float32, clipped to 255): follow a global illumination change.")
         .def(
             "edge_support",
@@ -137,6 +144,7 @@ void register_detection(py::module_& m) {
                py::array_t<double, py::array::c_style | py::array::forcecast> boxes,
                const std::string& statistic) {
                 const char* fn = "BackgroundModel.edge_support";
+                const bind::InUse busy(&self, fn, true);  // reads only
                 require(statistic == "ratio" || statistic == "vote", fn,
                         "statistic is '" + statistic + "', expected 'ratio' or 'vote'");
                 const auto stat =
@@ -170,6 +178,7 @@ void register_detection(py::module_& m) {
             "set_background",
             [](BackgroundModel& self, py::array_t<float, py::array::c_style | py::array::forcecast> bg) {
                 const char* fn = "BackgroundModel.set_background";
+                const bind::InUse busy(&self, fn);
                 require(bg.ndim() == 3 && bg.shape(2) == 3, fn,
                         "background must have shape (H, W, 3), got " + shape_str(bg));
                 require(bg.shape(0) > 0 && bg.shape(1) > 0, fn, "background is empty");
@@ -181,12 +190,38 @@ void register_detection(py::module_& m) {
             },
             py::arg("background"),
             "Initialise from a (H, W, 3) BGR image (e.g. a median of frames) instead of the first frame.")
-        .def("reset", &BackgroundModel::reset, "Forget the background: the next frame initialises it.")
+        .def(
+            "__copy__",
+            [](const BackgroundModel& self) {
+                const bind::InUse busy(&self, "BackgroundModel.__copy__", true);
+                return BackgroundModel(self);
+            },
+            "An independent copy (copy.copy and copy.deepcopy: a checkpoint of the model).")
+        .def(
+            "__deepcopy__",
+            [](const BackgroundModel& self, const py::dict&) {
+                const bind::InUse busy(&self, "BackgroundModel.__deepcopy__", true);
+                return BackgroundModel(self);
+            },
+            py::arg("memo"))
+        .def(
+            "reset",
+            [](BackgroundModel& self) {
+                const bind::InUse busy(&self, "BackgroundModel.reset");
+                self.reset();
+            },
+            "Forget the background: the next frame initialises it.")
         .def_property_readonly("initialized", &BackgroundModel::initialized)
         .def_property_readonly("frame_count", &BackgroundModel::frame_count)
         .def_property_readonly("threshold", &BackgroundModel::threshold,
                                "Threshold the next frame will use (grey levels).")
-        .def("set_threshold_scale", &BackgroundModel::set_threshold_scale, py::arg("s"),
+        .def(
+            "set_threshold_scale",
+            [](BackgroundModel& self, double s) {
+                const bind::InUse busy(&self, "BackgroundModel.set_threshold_scale");
+                self.set_threshold_scale(s);
+            },
+            py::arg("s"),
              "Threshold bounds become [s t_min, s t_max] (at most 255); the current threshold is "
              "scaled by s / the previous s and clamped to them. reset() sets 1.")
         .def_property_readonly("threshold_scale", &BackgroundModel::threshold_scale,
@@ -200,6 +235,7 @@ void register_detection(py::module_& m) {
         .def_property_readonly(
             "background",
             [](const BackgroundModel& s) -> py::object {
+                const bind::InUse busy(&s, "BackgroundModel.background", true);
                 if (!s.initialized()) return py::none();
                 py::array_t<float> a({static_cast<py::ssize_t>(s.rows()),
                                       static_cast<py::ssize_t>(s.cols()), py::ssize_t(3)});

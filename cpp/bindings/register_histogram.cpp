@@ -83,6 +83,19 @@ void register_histogram(py::module_& m) {
                  return img;
              }),
              py::arg("bins"), py::arg("n_bins"))
+        .def(
+            "__copy__", [](const BinnedImage& b) { return std::make_shared<BinnedImage>(b); },
+            "A copy with every bin computed (copy.copy and copy.deepcopy).")
+        .def(
+            "__deepcopy__",
+            [](const BinnedImage& b, const py::dict&) { return std::make_shared<BinnedImage>(b); },
+            py::arg("memo"))
+        .def(
+            "__reduce__",
+            [](const py::object& self) {  // pickled as BinnedImage(bins, n_bins)
+                return py::make_tuple(py::type::of(self),
+                                      py::make_tuple(self.attr("bins"), self.attr("n_bins")));
+            })
         .def_property_readonly("n_bins", [](const BinnedImage& b) { return b.n_bins; })
         .def_property_readonly("shape", [](const BinnedImage& b) { return py::make_tuple(b.rows, b.cols); })
         .def_property_readonly(

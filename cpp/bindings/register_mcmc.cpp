@@ -189,6 +189,7 @@ void register_mcmc(py::module_& m) {
                Eigen::Ref<const RowMatrixXd> candidates, std::optional<RowMatrixXd> candidate_hists,
                std::uint64_t seed, std::uint64_t step) {
                 const char* fn = "rjmcmc_step";
+                const bind::InUse busy(&self, fn);
                 FgIntegral fg = make_fg(mask, image, fn);
                 const RowMatrixXd hists = optional_hists(candidate_hists, fn);
                 RjStepResult r;
@@ -214,6 +215,7 @@ void register_mcmc(py::module_& m) {
         .def_property_readonly(
             "tracks",
             [](const PyRjTracker& self) {
+                const bind::InUse busy(&self, "RJMCMCTracker.tracks", true);
                 py::list out;
                 for (const auto& t : self.tracker.tracks()) {
                     py::dict d;
@@ -233,6 +235,7 @@ void register_mcmc(py::module_& m) {
             "prepare",
             [](PyRjTracker& self, const BinnedImage& image, const py::array& mask,
                Eigen::Ref<const RowMatrixXd> candidates, std::optional<RowMatrixXd> candidate_hists) {
+                const bind::InUse busy(&self, "RJMCMCTracker.prepare");
                 const char* fn = "prepare";
                 FgIntegral fg = make_fg(mask, image, fn);
                 self.image = std::make_shared<BinnedImage>(image);
@@ -245,6 +248,7 @@ void register_mcmc(py::module_& m) {
         .def(
             "slots",
             [](PyRjTracker& self) {
+                const bind::InUse busy(&self, "RJMCMCTracker.slots");
                 py::list out;
                 for (const RjIdentity& id : self.prepared("slots").identities()) {
                     py::dict d;
@@ -265,6 +269,7 @@ void register_mcmc(py::module_& m) {
             "log_target",
             [](PyRjTracker& self, Eigen::Ref<const Eigen::VectorXi> slots,
                Eigen::Ref<const RowMatrixXd> states) {
+                const bind::InUse busy(&self, "RJMCMCTracker.log_target");
                 RjFrame& f = self.prepared("log_target");
                 return f.log_target(self.config(f, slots, states, "log_target"));
             },
@@ -274,6 +279,7 @@ void register_mcmc(py::module_& m) {
             [](PyRjTracker& self, const std::string& move, Eigen::Ref<const Eigen::VectorXi> slots,
                Eigen::Ref<const RowMatrixXd> states, Eigen::Ref<const Eigen::VectorXi> to_slots,
                Eigen::Ref<const RowMatrixXd> to_states, int slot) {
+                const bind::InUse busy(&self, "RJMCMCTracker.log_acceptance");
                 const char* fn = "log_acceptance";
                 RjFrame& f = self.prepared(fn);
                 const RjMove mv = parse_move(move, fn);
@@ -289,6 +295,7 @@ void register_mcmc(py::module_& m) {
             [](PyRjTracker& self, const std::string& move, Eigen::Ref<const Eigen::VectorXi> slots,
                Eigen::Ref<const RowMatrixXd> states, std::uint64_t seed, std::uint64_t step,
                std::uint64_t k) -> py::object {
+                const bind::InUse busy(&self, "RJMCMCTracker.propose");
                 const char* fn = "propose";
                 RjFrame& f = self.prepared(fn);
                 const RjMove mv = parse_move(move, fn);

@@ -399,12 +399,13 @@ def rts_smooth(
     Raises
     ------
     TypeError
-        `z`, `q`, `r2` not real numbers, `has` not bools (``NaN`` or ``2`` would count as
-        observed), `velocity_sd` not a number or `update_first` not a bool (``"no"`` would
-        be True).
+        `z`, `q`, `r2` not real numbers, `has` not of bools or numbers, `velocity_sd` not a
+        number or `update_first` not a bool (``"no"`` would be True).
     ValueError
-        Shapes that do not match, a first frame without a measurement, a measured `z` not
-        finite, `q` or `velocity_sd` not finite and ``>= 0``, `r2` not finite and ``> 0``.
+        Shapes that do not match, a value of `has` other than True, False, 1 or 0 (``NaN``
+        or ``2`` would count as observed), a first frame without a measurement, a measured
+        `z` not finite, `q` or `velocity_sd` not finite and ``>= 0``, `r2` not finite and
+        ``> 0``.
     """
     # one C++ loop over frames per axis (tests/reference/smoothing.py holds the NumPy loop it
     # equals), which checks the shapes, the first frame and every value it reads; rows without

@@ -765,3 +765,118 @@ def test_detections_after_a_video_that_ended_early_are_said():
     said = [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
     assert any("detections of 2 frames after the video's last frame 1" in m for m in said)
     assert run.n_frames == 1
+
+
+def test_one_tracker_in_two_threads_at_once_raises_not_crashes(scene):
+    # was: a segfault (the C++ background model reallocated under another thread) or a mix of
+    # two runs' frames ("duplicate rows" from finalize)
+    import threading
+
+    dets = scene_dets(scene)
+    tracker = pftrack.Tracker()
+    inside, leave = threading.Event(), threading.Event()
+    real = tracker._tracker.update
+
+    def held(*args, **kwargs):  # the first thread waits inside update
+        inside.set()
+        leave.wait(10)
+        return real(*args, **kwargs)
+
+    tracker._tracker.update = held
+    first = threading.Thread(target=tracker.update, args=(dets[0], scene.frames[0]))
+    first.start()
+    assert inside.wait(10)
+    for method, args in (
+        ("update", (dets[0], scene.frames[0])),
+        ("finalize", ()),
+        ("reset", ()),
+        ("prime", ([scene.frames[0]],)),
+    ):
+        with pytest.raises(RuntimeError, match=rf"^Tracker\.{method}: this Tracker is in use by "):
+            getattr(tracker, method)(*args)
+    leave.set()
+    first.join()
+    del tracker._tracker.update
+    assert tracker.frame_count == 1  # the first thread's frame went in, the refused ones not
+    tracker.update(dets[1], scene.frames[1])  # free again
+    assert tracker.frame_count == 2
+
+
+def test_background_model_refuses_a_second_thread():
+    # the C++ guard under every path that shares a model (PaperDetector, MultiObjectTracker)
+    import threading
+
+    from pftrack._core import BackgroundModel
+
+    rng = np.random.default_rng(0)
+    frames = [rng.integers(0, 256, (720, 1280, 3), dtype=np.uint8) for _ in range(2)]
+    model = BackgroundModel()
+    model.apply(frames[0])
+    errors: list[str] = []
+
+    def work() -> None:
+        for k in range(150):
+            try:
+                model.apply(frames[k % 2], bins=False)
+            except RuntimeError as e:
+                errors.append(str(e))
+
+    threads = [threading.Thread(target=work) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors  # the two threads met inside apply (its pass runs without the GIL)
+    assert set(errors) == {
+        "BackgroundModel.apply: the object is in use by another thread (use one per thread, "
+        "or a lock around it)"
+    }
+    model.apply(frames[0])  # still usable
+    assert model.background.shape == (720, 1280, 3)
+
+
+def test_a_tracker_copies_and_pickles_before_its_first_update(scene):
+    import copy
+    import pickle
+
+    dets = scene_dets(scene)
+    for clone in (copy.deepcopy, lambda t: pickle.loads(pickle.dumps(t))):
+        a = pftrack.Tracker()
+        b = clone(a)
+        for k in range(5):
+            np.testing.assert_array_equal(
+                a.update(dets[k], scene.frames[k]), b.update(dets[k], scene.frames[k])
+            )
+
+
+@pytest.mark.parametrize("options", [{}, {"sampler": "mh"}, {"refine": False}])
+def test_a_deep_copy_mid_run_is_a_checkpoint(scene, options):
+    # was: TypeError (the C++ background model and bins could not be copied) after one update
+    import copy
+
+    dets = scene_dets(scene)
+    for given in (True, False):
+        a = pftrack.Tracker(**options)
+        for k in range(12):
+            a.update(dets[k] if given else None, scene.frames[k])
+        b = copy.deepcopy(a)
+        for k in range(12, len(scene.frames)):
+            np.testing.assert_array_equal(
+                a.update(dets[k] if given else None, scene.frames[k]),
+                b.update(dets[k] if given else None, scene.frames[k]),
+            )
+        np.testing.assert_array_equal(a.finalize(), b.finalize())
+
+
+def test_bins_copy_and_pickle():
+    import copy
+    import pickle
+
+    from pftrack._core import BinnedImage
+
+    bins = np.random.default_rng(0).integers(-1, 110, (30, 40)).astype(np.int16)
+    image = BinnedImage(bins, 110)
+    for clone in (copy.copy, copy.deepcopy, lambda b: pickle.loads(pickle.dumps(b))):
+        c = clone(image)
+        assert c is not image and c.n_bins == 110
+        np.testing.assert_array_equal(c.bins, bins)

@@ -111,10 +111,25 @@ def test_frame_rate_of_the_wrong_kind(rate):
         pftrack.Tracker(frame_rate=rate)
 
 
-@pytest.mark.parametrize("seed", [-1, True, 2.5, "0"])
-def test_bad_seed(seed):
-    with pytest.raises(ValueError, match="seed is"):
+@pytest.mark.parametrize("seed", [True, 2.5, "0"])
+def test_seed_of_the_wrong_kind(seed):
+    # was ValueError, where Tracker.from_config said TypeError
+    with pytest.raises(TypeError, match=f"^seed must be an int >= 0, got {type(seed).__name__}"):
         pftrack.Tracker(seed=seed)
+
+
+def test_negative_seed():
+    with pytest.raises(ValueError, match=r"^seed is -1, expected an int >= 0"):
+        pftrack.Tracker(seed=-1)
+
+
+@pytest.mark.parametrize("name", ["max_coast", "prime"])
+@pytest.mark.parametrize("value", ["1", [1], True])
+def test_seconds_of_the_wrong_kind(name, value):
+    # was NumPy's "ufunc 'isfinite' not supported" or "'>=' not supported"
+    kind = type(value).__name__
+    with pytest.raises(TypeError, match=f"^{name} must be a number, got {kind}"):
+        pftrack.Tracker(**{name: value})
 
 
 @pytest.mark.parametrize("name", ["refine", "smooth", "link", "crossings"])

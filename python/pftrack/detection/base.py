@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import real_array
+from pftrack._check import MAX_COORD, real_array
 from pftrack._typing import F64
 from pftrack.detection.size_model import PersonSizeModel
 
@@ -181,7 +181,7 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
     TypeError
         Values that are not real numbers (complex, text).
     ValueError
-        Wrong shape, NaN or inf, or a box with no area.
+        Wrong shape, NaN or inf, a box with no area, or a value beyond ±1e9 px.
 
     Warns
     -----
@@ -200,6 +200,10 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
     if np.any(d[:, 2] <= 0) or np.any(d[:, 3] <= 0):
         k = int(np.flatnonzero((d[:, 2] <= 0) | (d[:, 3] <= 0))[0])
         raise ValueError(f"detection {k} has width or height <= 0: {d[k].tolist()}")
+    far = np.abs(d[:, :4]) > MAX_COORD
+    if far.any():  # the kernels' bound on pixels (their message would name a converted box)
+        k = int(np.flatnonzero(far.any(axis=1))[0])
+        raise ValueError(f"detection {k} has a value beyond +-{MAX_COORD:g} px: {d[k].tolist()}")
     rows, cols = shape
     outside = (
         (d[:, 0] >= cols) | (d[:, 1] >= rows) | (d[:, 0] + d[:, 2] <= 0) | (d[:, 1] + d[:, 3] <= 0)

@@ -233,6 +233,10 @@ class ColourParticleFilter:
         rng: RngLike = None,
         velocity: ArrayLike = (0.0, 0.0),
     ) -> None:
+        if config is not None and not isinstance(config, FilterConfig):
+            raise TypeError(
+                f"ColourParticleFilter: config must be a FilterConfig, got {type(config).__name__}"
+            )
         self.config = config if config is not None else FilterConfig()
         self._rng = generator(rng, "rng")
         self._seed = int(self._rng.integers(2**63))
@@ -282,9 +286,11 @@ class ColourParticleFilter:
         TypeError
             Not real numbers.
         ValueError
-            A value not finite or negative, or all zero.
+            Not one dimension (B,), a value not finite or negative, or all zero.
         """
-        r = np.ascontiguousarray(real_array(reference, "reference")).reshape(-1)
+        r = np.ascontiguousarray(real_array(reference, "reference"))
+        if r.ndim != 1:  # a (1, B) or (K, B) array would be taken as one long histogram
+            raise ValueError(f"reference has shape {r.shape}, expected (B,) bins")
         if not np.all(np.isfinite(r)) or np.any(r < 0) or r.sum() <= 0:
             raise ValueError("reference histogram must be finite, >= 0 and not all zero")
         self.reference = r / r.sum()
@@ -421,6 +427,11 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
     summary = np.empty((len(filters), 4))
     if not filters:
         return summary
+    for k, f in enumerate(filters):
+        if not isinstance(f, ColourParticleFilter):
+            raise TypeError(
+                f"step_filters: filters[{k}] is {type(f).__name__}, expected a ColourParticleFilter"
+            )
     cfg = filters[0].config
     batch = [
         k

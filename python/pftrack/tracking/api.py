@@ -22,15 +22,19 @@ depend on container metadata. Motion noise levels (particle and centre filters) 
 from __future__ import annotations
 
 import itertools
+import threading
 import warnings
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import replace
+from typing import Any
 
 import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import bgr_frame, flag, number
+from pftrack._check import seed as check_seed
 from pftrack._typing import F64, RngLike
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
@@ -66,8 +70,8 @@ TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
 
 
 def _frames(seconds: float, frame_rate: float, name: str) -> int:
-    """`seconds` as a whole number of frames at `frame_rate`."""
-    if not (np.isfinite(seconds) and seconds >= 0):
+    """`seconds` as a whole number of frames at `frame_rate` (TypeError: not a number)."""
+    if not (np.isfinite(number(seconds, name, finite=False)) and seconds >= 0):
         raise ValueError(f"{name} is {seconds} s, expected a finite number of seconds >= 0")
     n = seconds * frame_rate
     if n > MAX_SPAN_FRAMES:
@@ -238,9 +242,20 @@ class Tracker:
     ------
     TypeError
         A flag (`refine`, `smooth`, `link`, `crossings`) that is not ``True`` or ``False``
-        (``refine="no"`` would turn refinement on), or a `frame_rate` that is not a number.
+        (``refine="no"`` would turn refinement on), a `frame_rate`, `max_coast`, `prime`,
+        `min_conf` or `birth_score` that is not a number, a `seed` that is not an int.
     ValueError
         A value out of its range.
+
+    Notes
+    -----
+    One tracker is one run: use one per video and per thread. A second thread calling a
+    method while another is inside one raises RuntimeError (as does the C++ background model
+    under any other path). ``copy.deepcopy(tracker)`` is a checkpoint at any point of a run
+    with the built-in ``"paper"`` detector and the ``"sis"`` or ``"mh"`` sampler (the copy goes
+    on exactly as the original); OpenCV's MOG2/KNN and the RJ-MCMC chain cannot be copied
+    once they have seen a frame. Pickling works before the first ``update`` only (the C++
+    background model has no pickled form: TypeError).
 
     Examples
     --------
@@ -273,10 +288,8 @@ class Tracker:
         prime: float | None = None,
         max_side: int | None = TrackerConfig.max_side,
     ) -> None:
-        if seed is not None and (
-            isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0
-        ):
-            raise ValueError(f"seed is {seed!r}, expected None or an integer >= 0")
+        if seed is not None:
+            seed = check_seed(seed, "seed")
         if not 0 < number(frame_rate, "frame_rate") <= MAX_FRAME_RATE:
             raise ValueError(
                 f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
@@ -386,25 +399,55 @@ class Tracker:
         self.prime_frames = int(prime_frames)
         self._writer_args = (coasting, fill, smoother, link)
         TrackWriter(*self._writer_args)  # check the writer's options now
+        self._busy = threading.Lock()
         self.reset()
+
+    @contextmanager
+    def _alone(self, method: str) -> Iterator[None]:
+        """Hold the tracker for one call: a second thread raises instead of mixing two runs.
+
+        A tracker is one run's state; two threads calling ``update`` on it at once would
+        interleave their frames (and share the C++ background model, which refuses a second
+        thread too). Not blocking: waiting would hide the mistake, not make the rows right.
+        """
+        if not self._busy.acquire(blocking=False):
+            raise RuntimeError(
+                f"Tracker.{method}: this Tracker is in use by another thread (use one Tracker "
+                "per thread, or a lock around it)"
+            )
+        try:
+            yield
+        finally:
+            self._busy.release()
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        del state["_busy"]  # a lock is not copied or pickled: a copy is free
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._busy = threading.Lock()
 
     def reset(self) -> None:
         """Forget every track and frame: the tracker is as new (same settings and seed)."""
-        self._tracker = MultiObjectTracker(self.config, rng=self.seed)
-        self._writer = TrackWriter(*self._writer_args)
-        self.frame_count = 0
-        #: The class (``cls`` of the detections; 0 without) of each id :meth:`finalize` returned.
-        self.classes: dict[int, int] = {}
-        self._stabiliser = Stabiliser()
-        self._reports: list[Track] = []
-        self._clip_warned = False
-        self._max_conf = -np.inf
-        self._given = False  # some update() of the run had detections
-        # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
-        # with the run's first frame (None: tracked at the frame's own size)
-        self._scale: F64 | None = None
-        self._shape: tuple[int, ...] | None = None  # the run's frame shape, with max_side
-        self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
+        with self._alone("reset"):
+            self._tracker = MultiObjectTracker(self.config, rng=self.seed)
+            self._writer = TrackWriter(*self._writer_args)
+            self.frame_count = 0
+            #: The class (``cls`` of the detections; 0 without) of each id :meth:`finalize`
+            #: returned.
+            self.classes: dict[int, int] = {}
+            self._stabiliser = Stabiliser()
+            self._reports: list[Track] = []
+            self._clip_warned = False
+            self._max_conf = -np.inf
+            self._given = False  # some update() of the run had detections
+            # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
+            # with the run's first frame (None: tracked at the frame's own size)
+            self._scale: F64 | None = None
+            self._shape: tuple[int, ...] | None = None  # the run's frame shape, with max_side
+            self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
 
     @property
     def tracker(self) -> MultiObjectTracker:
@@ -471,12 +514,13 @@ class Tracker:
         tracker.prime_frames)``). A loop that primes with the same frames gets the command's
         rows. Detectors without a background ignore it.
         """
-        if self.frame_count:
-            raise ValueError("prime() must come before the first update()")
-        first = itertools.islice(frames, self.prime_frames)  # no more: a whole video is big
-        picked = [self.working_frame(bgr_frame(f, "prime frame")) for f in first]
-        if picked:
-            self._tracker.prime(picked)
+        with self._alone("prime"):
+            if self.frame_count:
+                raise ValueError("prime() must come before the first update()")
+            first = itertools.islice(frames, self.prime_frames)  # no more: a whole video is big
+            picked = [self.working_frame(bgr_frame(f, "prime frame")) for f in first]
+            if picked:
+                self._tracker.prime(picked)
 
     def update(self, dets: ArrayLike | None, frame: ArrayLike) -> F64:
         """Track one frame.
@@ -498,63 +542,66 @@ class Tracker:
             track was matched to (a merged blob's row for each track inside it; -1 with
             ``dets=None``). Boxes are the track's filtered boxes, ``conf`` the detection's.
         """
-        f = bgr_frame(frame)
-        if self.config.max_side is not None:  # one scale for the whole run's rows
-            if self._shape is None:
-                self._shape = f.shape
-                size = working_size(f.shape, self.config.max_side)
-                if size is not None:
-                    sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
-                    self._scale = np.array([sx, sy, sx, sy])
-            elif f.shape != self._shape:
-                raise ValueError(
-                    f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
-                    f"{self._shape[1]}x{self._shape[0]} (max_side scales one size per run; "
-                    "call reset() before a new video)"
-                )
-        work = self._working(f)
-        if dets is None:
-            kept = None
-            reports = self._tracker.update(work, None)
-        else:
-            xywh, cls, kept, clipped = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
-            if clipped and not self._clip_warned:
-                self._clip_warned = True
-                warnings.warn(
-                    f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
-                    "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
-                    stacklevel=2,
-                )
-            confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
-            if self._scale is not None:
-                xywh[:, :4] *= self._scale
-            # inside the frame as checked: the tracker need not check them again (scaled
-            # boxes are, in case a box's scaled edge rounds past the working frame's)
-            reports = self._tracker.update(work, xywh, cls, checked=self._scale is None)
-            self._given = True  # once the frame is taken (an update that raises changes nothing)
-            self._max_conf = max(self._max_conf, confidence)
-        self.frame_count += 1
-        # the offline pass sees a still camera: boxes in the first frame's coordinates
-        self._stabiliser.add(self._tracker.camera_step.apply)
-        self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
-        self._reports = reports
-        # coasting tracks (carried by the particle filter alone) are held back
-        live = [t for t in reports if t.time_since_update == 0]
-        out = np.zeros((len(live), 8))
-        if live:
-            b = np.array([t.box_xywh for t in live])
-            if self._scale is not None:
-                b = b / self._scale
-            out[:, 0:2] = b[:, 0:2]
-            out[:, 2:4] = b[:, 0:2] + b[:, 2:4]
-            out[:, 4:7] = [(t.id, t.score, t.cls) for t in live]
-            if kept is not None:
-                out[:, 7] = [
-                    -1 if t.detection_index is None else kept[t.detection_index] for t in live
-                ]
+        with self._alone("update"):
+            f = bgr_frame(frame)
+            if self.config.max_side is not None:  # one scale for the whole run's rows
+                if self._shape is None:
+                    self._shape = f.shape
+                    size = working_size(f.shape, self.config.max_side)
+                    if size is not None:
+                        sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
+                        self._scale = np.array([sx, sy, sx, sy])
+                elif f.shape != self._shape:
+                    raise ValueError(
+                        f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
+                        f"{self._shape[1]}x{self._shape[0]} (max_side scales one size per run; "
+                        "call reset() before a new video)"
+                    )
+            work = self._working(f)
+            if dets is None:
+                kept = None
+                reports = self._tracker.update(work, None)
             else:
-                out[:, 7] = -1
-        return out
+                xywh, cls, kept, clipped = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
+                if clipped and not self._clip_warned:
+                    self._clip_warned = True
+                    warnings.warn(
+                        f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
+                        "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
+                        stacklevel=2,
+                    )
+                confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
+                if self._scale is not None:
+                    xywh[:, :4] *= self._scale
+                # inside the frame as checked: the tracker need not check them again (scaled
+                # boxes are, in case a box's scaled edge rounds past the working frame's)
+                reports = self._tracker.update(work, xywh, cls, checked=self._scale is None)
+                self._given = (
+                    True  # once the frame is taken (an update that raises changes nothing)
+                )
+                self._max_conf = max(self._max_conf, confidence)
+            self.frame_count += 1
+            # the offline pass sees a still camera: boxes in the first frame's coordinates
+            self._stabiliser.add(self._tracker.camera_step.apply)
+            self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
+            self._reports = reports
+            # coasting tracks (carried by the particle filter alone) are held back
+            live = [t for t in reports if t.time_since_update == 0]
+            out = np.zeros((len(live), 8))
+            if live:
+                b = np.array([t.box_xywh for t in live])
+                if self._scale is not None:
+                    b = b / self._scale
+                out[:, 0:2] = b[:, 0:2]
+                out[:, 2:4] = b[:, 0:2] + b[:, 2:4]
+                out[:, 4:7] = [(t.id, t.score, t.cls) for t in live]
+                if kept is not None:
+                    out[:, 7] = [
+                        -1 if t.detection_index is None else kept[t.detection_index] for t in live
+                    ]
+                else:
+                    out[:, 7] = -1
+            return out
 
     @property
     def last_reports(self) -> list[Track]:
@@ -628,55 +675,58 @@ class Tracker:
             detections its track was made of; the offline pass renumbers ids, and never joins
             two classes).
         """
-        smoothed = self._writer_args[2] is not None
-        crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
-        link = self._writer_args[3]
-        smoother = self._writer_args[2]
-        gain = self._tracker.motion_gain()  # faster footage: more acceleration per frame
-        if smoother is not None:
-            self._writer.smoother = replace(
-                smoother, accel=smoother.accel * gain, size_accel=smoother.size_accel * gain
-            )
-        if link is not None:  # its pixel gate grows with the frame (TrackerConfig.pixel_diagonal)
-            scale = self._tracker.pixel_scale
-            self._writer.link = replace(link, max_distance=link.max_distance * scale)
-        # given detections only: the built-in detector's tracks coast through merged blobs
-        relink = self.config.lifecycle.relink_coast if smoothed and self._given else None
-        rows = self._stabiliser.restore(
-            self._writer.result(
-                drop=self._tracker.never_confirmed(), crossings=crossings, relink_coast=relink
-            )
-        )
-        life = self.config.lifecycle
-        if smoothed and not self._given and life.nested_inside is not None and len(rows):
-            # the built-in detector's fragments (LifecycleConfig.nested_inside)
-            rows = drop_nested(rows, life.nested_inside, life.nested_area)
-        if smoothed and not self._given and life.amodal_share is not None and len(rows):
-            # partly seen people completed to the size model's person (amodal_share)
-            size = getattr(self._tracker.detector, "size_model", None)
-            if isinstance(size, PersonSizeModel) and size.coefficients is not None:
-                rows = complete_boxes(
-                    rows,
-                    size.coefficients,
-                    life.amodal_share,
-                    life.amodal_anchor,
-                    size.config.split_ratio,
+        with self._alone("finalize"):
+            smoothed = self._writer_args[2] is not None
+            crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
+            link = self._writer_args[3]
+            smoother = self._writer_args[2]
+            gain = self._tracker.motion_gain()  # faster footage: more acceleration per frame
+            if smoother is not None:
+                self._writer.smoother = replace(
+                    smoother, accel=smoother.accel * gain, size_accel=smoother.size_accel * gain
                 )
-        n_tracked = len(rows)  # before the rows wholly outside the frame are left out
-        if len(rows) and len(self._tracker.frame_shape) >= 2:
-            # a track carried past the frame's edge (coasting, or the smoother's extrapolation
-            # at a track's end) leaves no row wholly outside the frame
-            h, w = self._tracker.frame_shape[:2]
-            x, y = rows[:, 2], rows[:, 3]
-            inside = (x < w) & (y < h) & (x + rows[:, 4] > 0) & (y + rows[:, 5] > 0)
-            rows = rows[inside]
-        kept = set(rows[:, 1].astype(int).tolist())
-        self.classes = {i: c for i, c in self._writer.classes.items() if i in kept}
-        if len(rows) == 0 and self.frame_count:
-            n = self.frame_count
-            warnings.warn(
-                f"no track over {n} frame{'s' * (n != 1)}: {self._no_track_cause(n_tracked)}",
-                RuntimeWarning,
-                stacklevel=2,
+            if (
+                link is not None
+            ):  # its pixel gate grows with the frame (TrackerConfig.pixel_diagonal)
+                scale = self._tracker.pixel_scale
+                self._writer.link = replace(link, max_distance=link.max_distance * scale)
+            # given detections only: the built-in detector's tracks coast through merged blobs
+            relink = self.config.lifecycle.relink_coast if smoothed and self._given else None
+            rows = self._stabiliser.restore(
+                self._writer.result(
+                    drop=self._tracker.never_confirmed(), crossings=crossings, relink_coast=relink
+                )
             )
-        return self._restore_rows(rows)
+            life = self.config.lifecycle
+            if smoothed and not self._given and life.nested_inside is not None and len(rows):
+                # the built-in detector's fragments (LifecycleConfig.nested_inside)
+                rows = drop_nested(rows, life.nested_inside, life.nested_area)
+            if smoothed and not self._given and life.amodal_share is not None and len(rows):
+                # partly seen people completed to the size model's person (amodal_share)
+                size = getattr(self._tracker.detector, "size_model", None)
+                if isinstance(size, PersonSizeModel) and size.coefficients is not None:
+                    rows = complete_boxes(
+                        rows,
+                        size.coefficients,
+                        life.amodal_share,
+                        life.amodal_anchor,
+                        size.config.split_ratio,
+                    )
+            n_tracked = len(rows)  # before the rows wholly outside the frame are left out
+            if len(rows) and len(self._tracker.frame_shape) >= 2:
+                # a track carried past the frame's edge (coasting, or the smoother's extrapolation
+                # at a track's end) leaves no row wholly outside the frame
+                h, w = self._tracker.frame_shape[:2]
+                x, y = rows[:, 2], rows[:, 3]
+                inside = (x < w) & (y < h) & (x + rows[:, 4] > 0) & (y + rows[:, 5] > 0)
+                rows = rows[inside]
+            kept = set(rows[:, 1].astype(int).tolist())
+            self.classes = {i: c for i, c in self._writer.classes.items() if i in kept}
+            if len(rows) == 0 and self.frame_count:
+                n = self.frame_count
+                warnings.warn(
+                    f"no track over {n} frame{'s' * (n != 1)}: {self._no_track_cause(n_tracked)}",
+                    RuntimeWarning,
+                    stacklevel=2,
+                )
+            return self._restore_rows(rows)

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame
+from pftrack._check import bgr_frame, generator
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack.boxes import xywh_to_cxcywh
@@ -121,8 +121,12 @@ class MultiObjectTracker:
 
     def __init__(self, config: TrackerConfig | None = None, rng: RngLike = None,
                  detector: Any = None) -> None:  # fmt: skip
+        if config is not None and not isinstance(config, TrackerConfig):
+            raise TypeError(
+                f"MultiObjectTracker: config must be a TrackerConfig, got {type(config).__name__}"
+            )
         self.config = config if config is not None else TrackerConfig()
-        self._rng = np.random.default_rng(rng)
+        self._rng = generator(rng, "MultiObjectTracker: rng")
         self._ids = itertools.count(1)
         self._detector = detector
         self.tracks: list[LiveTrack] = []
