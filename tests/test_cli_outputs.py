@@ -446,7 +446,7 @@ def test_out_dev_null_and_a_link_to_it_discard(
     assert (tmp_path / "v.mp4").is_symlink() and sorted(os.listdir(tmp_path)) == ["v.mp4"]
 
 
-def test_out_dev_stdout_prints_the_rows_then_the_summary(
+def test_out_dev_stdout_prints_the_rows_and_the_summary_on_stderr(
     inputs: dict[str, Path], tmp_path: Path
 ) -> None:
     """Through a link to /dev/stdout in the test folder (a bug would replace only the link)."""
@@ -462,8 +462,8 @@ def test_out_dev_stdout_prints_the_rows_then_the_summary(
                              check=False, timeout=120)  # fmt: skip
     assert run.returncode == 0, run.stderr
     lines = (tmp_path / "captured.txt").read_text().splitlines()
-    assert lines[-1].startswith(f"{inputs['tracks']}: ") and len(lines) > 20
-    assert all(line.count(",") == 9 for line in lines[:-1])
+    assert len(lines) > 20 and all(line.count(",") == 9 for line in lines)  # rows only
+    assert run.stderr.startswith(f"{inputs['tracks']}: ")
     assert (tmp_path / "stdout").is_symlink()
 
 
@@ -653,3 +653,40 @@ def test_a_regular_file_without_extension_is_still_refused(
     assert capsys.readouterr().err.endswith(
         "video: unsupported extension '(none)', expected one of .mp4, .avi\n"
     )
+
+
+def test_rows_written_to_stdout_carry_no_report(tmp_path: Path) -> None:
+    # was: `--out /dev/stdout` mixed the summary line (and --explain's tables) into the rows,
+    # so the piped file could not be read back
+    import subprocess
+    import sys
+
+    from pftrack.io.mot import read_mot
+    from pftrack.synthetic import make_scene
+
+    src = tmp_path / "t.txt"
+    src.write_text("1,1,10,10,20,40\n5,1,30,10,20,40\n")
+    folder = tmp_path / "img"
+    make_scene(n_frames=3, width=64, height=64, n_walkers=1, rng=0).write_images(folder)
+    runs = {
+        "recover": ["recover", str(src), "--out", "/dev/stdout", "--explain"],
+        "smooth": ["smooth", str(src), "--out", "/dev/stdout"],
+        "track": ["track", str(folder), "--out", "/dev/stdout"],
+        "eval": ["eval", "--gt", str(src), "--res", str(src), "--json", "/dev/stdout"],
+    }
+    for name, argv in runs.items():
+        out = tmp_path / f"{name}.out"
+        with out.open("wb") as fh:
+            done = subprocess.run(
+                [sys.executable, "-m", "pftrack", "-q", *argv],
+                stdout=fh, stderr=subprocess.PIPE, text=True, check=False,
+            )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        if name == "eval":
+            import json
+
+            assert json.loads(out.read_text())["mota"] == 1.0
+            assert "MOTA" in done.stderr  # the table went to stderr
+        else:
+            read_mot(out)  # rows only: reads back
+            assert str(src) in done.stderr or name == "track"

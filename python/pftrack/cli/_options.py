@@ -353,3 +353,37 @@ def opencv_single_threaded() -> None:
     import cv2
 
     cv2.setNumThreads(1)
+
+
+def is_stdout(*paths: str | None) -> bool:
+    """Whether one of `paths` is where this process's standard output goes.
+
+    ``--out /dev/stdout`` (or ``/dev/fd/1``, or the very file stdout is redirected to): the
+    rows go there, so a command's own report (summary lines, tables) must not. Compared by
+    device and inode, so a pipe or a redirected file is recognised under any name.
+    """
+    import os
+    import sys
+
+    try:
+        fd = sys.stdout.fileno()
+        target = os.fstat(fd)
+    except (AttributeError, OSError, ValueError):  # no real stdout (a test's capture)
+        return False
+    for path in paths:
+        if not path:
+            continue
+        try:
+            st = os.stat(path)
+        except OSError:
+            continue
+        if (st.st_dev, st.st_ino) == (target.st_dev, target.st_ino):
+            return True
+    return False
+
+
+def report_stream(*outputs: str | None) -> Any:
+    """Where a command prints its report: stderr when an output is stdout, else stdout."""
+    import sys
+
+    return sys.stderr if is_stdout(*outputs) else sys.stdout

@@ -6,7 +6,13 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from pftrack.cli._options import IOU_HELP, add_command, bounded_int, iou_threshold
+from pftrack.cli._options import (
+    IOU_HELP,
+    add_command,
+    bounded_int,
+    iou_threshold,
+    report_stream,
+)
 
 #: ``--image-size``'s largest side (px), as ``experiment gaps``' MAX_SIDE.
 MAX_IMAGE_SIDE = 100_000
@@ -243,5 +249,6 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         with atomic_write(args.csv) as fh:
             fh.write(scores_csv(scores, combined))
-    print(format_scores(scores, combined))  # after the files: a closed stdout cannot lose them
+    # after the files: a closed stdout cannot lose them; not into a file written to stdout
+    print(format_scores(scores, combined), file=report_stream(args.json, args.csv))
     return 0

@@ -6,7 +6,13 @@ import argparse
 from dataclasses import asdict
 from typing import Any
 
-from pftrack.cli._options import add_command, bounded_float, non_negative_int, positive_int
+from pftrack.cli._options import (
+    add_command,
+    bounded_float,
+    non_negative_int,
+    positive_int,
+    report_stream,
+)
 from pftrack.recovery.names import METHODS
 
 MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this are refused
@@ -293,7 +299,7 @@ def run_gaps(args: argparse.Namespace) -> int:
         if args.json:
             _write_json(args.json, doc)
             said.append(f"json: {args.json}")
-        print("\n".join(said))
+        print("\n".join(said), file=report_stream(args.json))
         return 0
     said.append(E.format_table(run.scores))
     if run.noise is not None:
@@ -336,7 +342,8 @@ def run_gaps(args: argparse.Namespace) -> int:
     if args.json:
         _write_json(args.json, doc)
         said.append(f"json: {args.json}")
-    print("\n".join(said))  # after the files: a closed stdout cannot lose them
+    # after the files: a closed stdout cannot lose them; not into a file written to stdout
+    print("\n".join(said), file=report_stream(args.json, args.figure))
     return 0
 
 
@@ -432,12 +439,16 @@ def _run_sequences(args: argparse.Namespace) -> int:
             "mmae": {m: (sum(v) / len(v) if v else None) for m, v in pooled.items()},
         }
         _write_json(args.json, doc)
+    to = report_stream(args.json)  # not into a JSON file written to stdout
     for r in results:  # printed once the JSON is written: a closed stdout cannot lose it
         masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks)
-        print(f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}")
-    print()
-    print("MMAE (px, mean over gaps of the mean Euclidean error); * = best of the row")
-    print(E.format_sequences(results, methods))
+        print(
+            f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}",
+            file=to,
+        )
+    print(file=to)
+    print("MMAE (px, mean over gaps of the mean Euclidean error); * = best of the row", file=to)
+    print(E.format_sequences(results, methods), file=to)
     if args.json:
-        print(f"json: {args.json}")
+        print(f"json: {args.json}", file=to)
     return 0

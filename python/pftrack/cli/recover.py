@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, bounded_float, non_negative_int
+from pftrack.cli._options import add_command, bounded_float, non_negative_int, report_stream
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 
@@ -111,13 +111,15 @@ def run(args: argparse.Namespace) -> int:
     filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
     dt = time.perf_counter() - t0
     write_mot(args.out, filled, exact=copied_values(rows, filled))  # given values: all digits
+    to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report on stderr
     print(
         f"{src}: {len(rows)} rows, {n_links} fragments linked, {rep.n_gaps} gaps filled with "
         f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "
-        f"({flag_note(rows)})"
+        f"({flag_note(rows)})",
+        file=to,
     )
     if args.explain:
-        print(rep.describe(args.method))
+        print(rep.describe(args.method), file=to)
     return 0
 
 

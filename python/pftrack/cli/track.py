@@ -16,6 +16,7 @@ from pftrack.cli._options import (
     add_tracker_options,
     bounded_float,
     det_scale,
+    report_stream,
     tracker_config,
 )
 
@@ -273,6 +274,7 @@ def run(args: argparse.Namespace) -> int:
         source.close()
     for line in warned:
         print(line, file=sys.stderr)
+    to = report_stream(args.out, args.render, args.plot)  # none of them on stdout's rows
     for line in said:
-        print(line)
+        print(line, file=to)
     return 0
