@@ -83,14 +83,15 @@ def test_hand_computed_case():
     assert m.idf1 == pytest.approx(0.3)
     assert m.idp == pytest.approx(0.5) and m.idr == pytest.approx(3 / 14)
     assert m.precision == pytest.approx(5 / 6) and m.recall == pytest.approx(5 / 14)
-    # Smith: A's assigned track overlaps it in 2 of 5 frames (10 and 11 tie; 10 kept), B 1 of 4,
-    # C 0 -> mean (0.4 + 0.25 + 0) / 3; same for the strict variant here.
+    # Smith: A's assigned track overlaps it in 2 of 5 frames (10 and 11 tie in frames and in
+    # matches; 11, 2 px off in all, is nearer than 10, 3 px), B 1 of 4, C 0 -> mean
+    # (0.4 + 0.25 + 0) / 3; same for the strict variant here.
     assert m.success_per_object == ((1, 0.4, 0.4), (2, 0.25, 0.25), (3, 0.0, 0.0))
     assert m.success_rate == pytest.approx(0.65 / 3)
     assert m.success_rate_strict == pytest.approx(0.65 / 3)
-    # Centroid distances: A-10 at frames 1, 2 -> 0, 3 px; B-20 at frame 1 -> 0 -> mean 1 px.
-    assert m.centroid_distance_px == pytest.approx(1.0)
-    assert m.centroid_distance_ratio == pytest.approx(1.0 / (400 * 300))
+    # Centroid distances: A-11 at frames 4, 5 -> 0, 2 px; B-20 at frame 1 -> 0 -> mean 2/3 px.
+    assert m.centroid_distance_px == pytest.approx(2 / 3)
+    assert m.centroid_distance_ratio == pytest.approx(2 / 3 / (400 * 300))
     assert m.num_unique_objects == 3 and m.num_frames == 5
 
 
@@ -339,3 +340,19 @@ def test_scale_and_threshold_of_the_wrong_type_are_named():
         evaluate_mot(HAND_GT, HAND_RES, scale="2")
     with pytest.raises(TypeError, match="evaluate_mot: iou_threshold must be a number"):
         evaluate_mot(HAND_GT, HAND_RES, iou_threshold=None)
+
+
+def test_truth_scored_against_itself_has_centroid_distance_zero():
+    # was 2.5 px: object 2 touched track 1 in as many frames as its own track 2, and the tie
+    # went to the smaller id (TUD-Campus's gt.txt against itself: 3.167 px)
+    truth = np.array(
+        [[f, i, x, 0, 10, 10, 1, -1, -1, -1] for f in (1, 2) for i, x in ((1, 0), (2, 5))],
+        dtype=float,
+    )
+    m = evaluate_mot(truth, truth)
+    assert m.centroid_distance_px == 0.0
+    assert m.success_rate == m.success_rate_strict == 1.0
+    # the nearer of two tracks that both match the object equally often is its track
+    near = truth.copy()
+    near[near[:, 1] == 2, 2] += 1.0  # track 2 one pixel right of object 2
+    assert evaluate_mot(truth, near).centroid_distance_px == pytest.approx(0.5)

@@ -468,20 +468,24 @@ def evaluate_mot(
     idp = idtp / (idtp + idfp) if (idtp + idfp) else float("nan")
     idr = idtp / (idtp + idfn) if (idtp + idfn) else float("nan")
 
-    # Smith et al.: per object, the result id overlapping it most often.
+    # Smith et al.: per object, the result id overlapping it most often; ties go to the id
+    # matching it (IoU >= threshold) more often, then to the nearer one (a neighbour touching
+    # the object in as many frames is not its track: was the smaller id, so a result equal to
+    # the truth had a centroid distance above 0)
     per_object: list[tuple[int, float, float]] = []
     dists: list[float] = []
     for o in oids:
         touch = {h: c for (oo, h), c in pair_touch.items() if oo == o}
         hits = {h: c for (oo, h), c in pair_hits.items() if oo == o}
+        far = {h: sum(centroid[(o, h)]) for h in touch}
         loose = 0.0
         strict = 0.0
         if touch:
-            best = max(touch, key=lambda h: (touch[h], -h))
+            best = max(touch, key=lambda h: (touch[h], hits.get(h, 0), -far[h], -h))
             loose = touch[best] / gt_count[o]
             dists.extend(centroid[(o, best)])
         if hits:
-            best_s = max(hits, key=lambda h: (hits[h], -h))
+            best_s = max(hits, key=lambda h: (hits[h], touch[h], -far[h], -h))
             strict = hits[best_s] / gt_count[o]
         per_object.append((o, loose, strict))
     cd = float(np.mean(dists)) if dists else float("nan")
