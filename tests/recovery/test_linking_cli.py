@@ -287,10 +287,36 @@ def test_cli_gate_follows_the_frame(command, tmp_path, capsys):
     link = ["--link"] if command == "recover" else []
     assert main([command, str(src), "--out", str(tmp_path / "a.txt"), *link]) == 0
     assert set(read_mot(tmp_path / "a.txt")[:, 1].astype(int)) == {1, 3}
-    if command == "recover":  # a gate given in pixels is taken as it is
-        out = tmp_path / "b.txt"
-        assert main([command, str(src), "--out", str(out), "--link", "--max-distance", "50"]) == 0
-        assert set(read_mot(out)[:, 1].astype(int)) == {1, 2, 3}
+    # a gate given in pixels is taken as it is (smooth had no --max-distance)
+    out = tmp_path / "b.txt"
+    assert main([command, str(src), "--out", str(out), *link, "--max-distance", "50"]) == 0
+    assert set(read_mot(out)[:, 1].astype(int)) == {1, 2, 3}
+
+
+def test_a_stray_row_does_not_widen_the_gate():
+    # was: one box at x = 2500 in a 768x576 file made the gate 3.6 times wider, and fragments
+    # of different people were joined
+    from pftrack.recovery.linking import gate_for_rows
+
+    cfg = LinkConfig()
+    rows = jumped(2.0)
+    rows = np.vstack([rows] * 60)  # enough rows for a 1 % tail
+    rows[:, 0] = np.arange(1, len(rows) + 1)
+    want = gate_for_rows(cfg, rows)
+    stray = np.vstack([rows, [[len(rows) + 1, 999, 2500, 1500, 40, 80, 1, -1, -1, -1]]])
+    said = r"^1 row\(s\) reach far past the others \(the first: frame 2461, id 999, right "
+    with pytest.warns(UserWarning, match=said):
+        assert gate_for_rows(cfg, stray) == want
+
+
+def test_smooth_refuses_a_gate_without_linking(tmp_path, capsys):
+    src = tmp_path / "t.txt"
+    write_mot(src, jumped(1.0))
+    argv = ["smooth", str(src), "--out", str(tmp_path / "o.txt"), "--no-link"]
+    assert main([*argv, "--max-distance", "5"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "pftrack smooth: error: --max-distance is the linking gate: drop it or --no-link"
+    )
 
 
 class _ForwardOnly:

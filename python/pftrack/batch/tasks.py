@@ -413,16 +413,20 @@ class RecoverOptions:
         _check_int(self.max_gap, "max_gap", 1, MAX_GAP_LIMIT)
         _check_int(self.seed, "seed", 0)
         flag(self.link, "link")
-        if self.max_distance is not None:
-            if not number(self.max_distance, "max_distance") > 0:  # LinkConfig's rule
-                raise ValueError(
-                    f"max_distance is {self.max_distance}, expected a finite number > 0 (or "
-                    "None: 50 px grown to the frame)"
-                )
+        _check_distance(self.max_distance)
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""
         return _settings(self)
+
+
+def _check_distance(value: float | None) -> None:
+    """A linking gate: None (grown to the frame) or a finite number > 0 (LinkConfig's rule)."""
+    if value is not None and not number(value, "max_distance") > 0:
+        raise ValueError(
+            f"max_distance is {value}, expected a finite number > 0 (or None: 50 px grown to "
+            "the frame)"
+        )
 
 
 def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
@@ -468,6 +472,7 @@ class SmoothOptions:
 
     max_gap: int = 30
     link: bool = True
+    max_distance: float | None = None  # None: 50 px grown to the frame (gate_for_rows)
 
     def __post_init__(self) -> None:
         """Check every field, so that a bad value stops the batch before any task runs."""
@@ -475,6 +480,7 @@ class SmoothOptions:
 
         _check_int(self.max_gap, "max_gap", 1, MAX_GAP_LIMIT)
         flag(self.link, "link")
+        _check_distance(self.max_distance)
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""
@@ -483,14 +489,13 @@ class SmoothOptions:
 
 def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     """Link, fill and smooth one tracks file as ``pftrack smooth FILE`` does."""
-    from pftrack.recovery import LinkConfig
-    from pftrack.recovery.linking import gate_for_rows
+    from pftrack.recovery.linking import link_config_for
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import smoothed_copies
 
     t0 = time.perf_counter()
     rows = read_tracks(path)
-    link = gate_for_rows(LinkConfig(max_gap=options.max_gap), rows) if options.link else None
+    link = link_config_for(rows, options.max_gap, options.max_distance) if options.link else None
     result = smooth_tracks(rows, link=link, max_gap=options.max_gap)
     info: dict[str, Any] = {
         "source": str(path),

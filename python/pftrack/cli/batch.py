@@ -219,6 +219,8 @@ def run_smooth(args: argparse.Namespace) -> int:
     """``pftrack smooth`` with several files or a folder: one task per file."""
     from pftrack.batch import SmoothOptions, smooth_many
 
-    options = SmoothOptions(max_gap=args.max_gap, link=not args.no_link)
+    options = SmoothOptions(
+        max_gap=args.max_gap, link=not args.no_link, max_distance=args.max_distance
+    )
     where = _where(args)
     return _run("smooth", lambda: smooth_many(args.tracks, args.out, options=options, **where))

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, report_stream
+from pftrack.cli._options import add_command, bounded_float, report_stream
 
 
 def add_parser(sub: Any) -> None:
@@ -36,12 +36,18 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--no-link", action="store_true",
                    help="join no fragments: fill the holes inside each id and smooth each id "
                    "as it is")  # fmt: skip
+    p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=None, metavar="PX",
+                   help="linking gate on the motion-prediction distance (pixels, 0.001 to 1e6; "
+                   "default: 50 px, times the diagonal of the boxes' extent over 800 when it is "
+                   "larger than 640x480)")  # fmt: skip
     batch.add_batch_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack smooth``; return the exit status."""
+    if args.no_link and args.max_distance is not None:
+        raise ValueError("--max-distance is the linking gate: drop it or --no-link")
     if batch.is_batch(args.tracks):
         return batch.run_smooth(args)
     batch.refuse_batch_options(args)
@@ -51,8 +57,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
-    from pftrack.recovery import LinkConfig
-    from pftrack.recovery.linking import gate_for_rows, read_tracks
+    from pftrack.recovery.linking import link_config_for, read_tracks
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import smoothed_copies
 
@@ -61,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
     check_output(args.out, what="--out")
     rows = read_tracks(src)
-    link = None if args.no_link else gate_for_rows(LinkConfig(max_gap=args.max_gap), rows)
+    link = None if args.no_link else link_config_for(rows, args.max_gap, args.max_distance)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
     write_mot(args.out, result, exact=smoothed_copies(result))  # given values: all digits
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
