@@ -406,3 +406,26 @@ def test_cli_recover_refuses_a_video_that_is_not_the_tracks_own(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and re.search(message, err), err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("tail", [",0.9,1", ",0.9,1,-1"])
+def test_padded_columns_that_look_filled_are_said(tail, tmp_path, capsys):
+    # was: an 8- or 9-column file with a class 1 in column 8 read as rows pftrack filled, and
+    # the output's filled rows could not be told from them, without a word
+    import warnings
+
+    src = tmp_path / "c.txt"
+    src.write_text(f"1,1,10,10,20,40{tail}\n5,1,30,10,20,40{tail}\n")
+    full = tmp_path / "f.txt"  # ten columns: the mark is the file's own, nothing to say
+    full.write_text("1,1,10,10,20,40,0.9,1,-1,-1\n5,1,30,10,20,40,0.9,1,-1,-1\n")
+    fields = tail.count(",") + 6
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")  # as outside the test suite (which makes them errors)
+        assert main(["recover", str(src), "--out", str(tmp_path / "o.txt")]) == 0
+        err = capsys.readouterr().err
+        assert main(["recover", str(full), "--out", str(tmp_path / "o2.txt")]) == 0
+        assert "warning" not in capsys.readouterr().err
+    assert (
+        f"pftrack recover: warning: {src}: 2 row(s) have 1 in column 8 and {fields} columns "
+        "(the missing ones padded with -1)" in err
+    )

@@ -472,4 +472,25 @@ def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
         check_unique(rows)
     except ValueError:
         check_unique(rows, data_line_numbers(path), path)
+    _warn_padded_flags(rows, path)
     return rows
+
+
+def _warn_padded_flags(rows: F64, path: PathLike) -> None:
+    """Warn when a file's missing columns, padded with -1, make its rows look filled.
+
+    An 8- or 9-column file whose column 8 is 1 (a class, as MOT17's ground truth has) reads
+    as ``1, -1, -1``: pftrack's mark of a filled row, so the output's filled rows could not be
+    told from those by the flag.
+    """
+    from pftrack.io.mot import first_row_fields
+
+    n = int(filled_mask(rows).sum()) if len(rows) else 0
+    fields = first_row_fields(path) if n else 10
+    if n and fields < 10:
+        warnings.warn(
+            f"{path}: {n} row(s) have 1 in column 8 and {fields} columns (the missing ones "
+            "padded with -1): they carry pftrack's mark of a filled row (column 8 = 1, columns "
+            "9-10 = -1), so in the output the filled rows cannot be told from them by that mark",
+            stacklevel=3,
+        )
