@@ -495,8 +495,16 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
         "pftrack recover: error: --seed is used only by --method auto (its calibration gaps), "
         "not linear; drop it"
     )
+    # was: --max-distance silently ignored without --link, with one file and in a batch
+    for given in ([str(src)], [str(src), str(_tracks(tmp_path / "t2.txt"))]):
+        assert main(["recover", *given, "--out", str(out), "--max-distance", "5"]) == 2
+        assert capsys.readouterr().err.strip() == (
+            "pftrack recover: error: --max-distance is used only by --link (its linking gate); "
+            "add --link or drop it"
+        )
     assert not out.exists()
     assert main(["recover", str(src), "--out", str(out), "--seed", "3"]) == 0  # auto: used
+    assert main(["recover", str(src), "--out", str(out), "--link", "--max-distance", "5"]) == 0
 
 
 @pytest.mark.parametrize("command", ["recover", "smooth"])

@@ -64,6 +64,10 @@ def run(args: argparse.Namespace) -> int:
             "drop it"
         )
     args.seed = args.seed or 0
+    if args.max_distance is not None and not args.link:  # one file and a batch alike
+        raise ValueError(
+            "--max-distance is used only by --link (its linking gate); add --link or drop it"
+        )
     if batch.is_batch(args.tracks):
         return batch.run_recover(args)
     batch.refuse_batch_options(args)
