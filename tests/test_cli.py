@@ -554,6 +554,27 @@ def test_library_warnings_are_one_line_for_every_command(
     assert warnings.showwarning is before  # main restores the formatter it replaced
 
 
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_columns_past_10_are_dropped_with_a_warning(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import warnings
+
+    src, wide = _tracks(tmp_path / "t.txt"), tmp_path / "wide.txt"
+    wide.write_text("".join(f"{line},7,8\n" for line in src.read_text().splitlines()))
+    assert main(["-q", command, str(src), "--out", str(tmp_path / "a.txt")]) == 0
+    capsys.readouterr()
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
+        assert main(["-q", command, str(wide), "--out", str(tmp_path / "b.txt")]) == 0
+    # was: columns 11 and 12 dropped without a word
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"pftrack {command}: warning: tracks file {wide} has lines of 12 columns: columns past "
+        "10 are not kept"
+    ]
+    assert (tmp_path / "b.txt").read_bytes() == (tmp_path / "a.txt").read_bytes()
+
+
 @pytest.mark.parametrize("command", ["track", "batch"])
 @pytest.mark.parametrize(
     ("option", "message"),

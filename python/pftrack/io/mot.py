@@ -10,6 +10,7 @@ decimals (values pftrack computed) unless marked ``exact`` (values read from a f
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -51,7 +52,9 @@ def data_line_numbers(path: PathLike) -> list[int]:
     return [n for n, _ in _data_lines(Path(path))]
 
 
-def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
+def read_mot(
+    path: PathLike, *, what: str = "MOT file", warn_extra: bool = False
+) -> NDArray[np.float64]:
     """Read a MOTChallenge file into an ``(M, 10)`` float64 array.
 
     Parameters
@@ -60,6 +63,8 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         The file. Blank lines and lines starting with ``#`` are skipped.
     what : str
         How errors name the file ("detection file", "ground truth", ...).
+    warn_extra : bool
+        Warn when lines have more than 10 columns (they are read, the rest dropped).
 
     Returns
     -------
@@ -77,6 +82,12 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         non-finite value in any of the first 10 columns (a NaN score too), a frame that is not
         an integer in ``1..2**31-1``, a negative width or height, or a box value beyond ±1e9
         px. A UTF-8 byte-order mark is skipped.
+
+    Warns
+    -----
+    UserWarning
+        With `warn_extra`, once, naming the file and its most columns on a line, when that is
+        more than 10: columns 11 and beyond are not kept.
     """
     p = Path(path)
     if not p.is_file():
@@ -91,7 +102,10 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
     rows: list[list[float]] = []
     numbers: list[int] = []  # the line of each row
     error: str | None = None  # the first line that is no row, which ends the reading
+    most = 0  # the most columns on a line, with warn_extra (the fast reader takes <= 10)
     for lineno, text in _data_lines(p):
+        if warn_extra:
+            most = max(most, len(_fields(text)))
         values = _parse_line(text, what)
         if isinstance(values, str):
             error = f"{p}:{lineno}: {values}"
@@ -108,6 +122,12 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         raise ValueError(f"{p}:{lineno}: {bad_box[2]}: {text[:80]!r}")
     if error is not None:
         raise ValueError(error)
+    if most > 10:
+        warnings.warn(
+            f"{what} {p} has lines of {most} columns: columns past 10 are not kept",
+            UserWarning,
+            stacklevel=2,
+        )
     return a
 
 
