@@ -575,6 +575,21 @@ def test_columns_past_10_are_dropped_with_a_warning(
     assert (tmp_path / "b.txt").read_bytes() == (tmp_path / "a.txt").read_bytes()
 
 
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
+def test_a_write_error_names_the_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    src = _tracks(tmp_path / "t.txt")
+    for argv in (
+        ["recover", str(src), "--out", "/dev/full"],
+        ["smooth", str(src), "--out", "/dev/full"],
+        ["eval", "--gt", str(src), "--res", str(src), "--json", "/dev/full"],
+    ):
+        assert main(["-q", *argv]) == 2
+        # was: "error: [Errno 28] No space left on device", no file named
+        assert capsys.readouterr().err.strip() == (
+            f"pftrack {argv[0]}: error: No space left on device: /dev/full"
+        )
+
+
 @pytest.mark.parametrize("command", ["track", "batch"])
 @pytest.mark.parametrize(
     ("option", "message"),
