@@ -171,6 +171,11 @@ def test_cli_recover_reports_bad_rows_with_line_number(tmp_path, capsys):
         assert main([command, str(src), "--out", str(tmp_path / "o.txt")]) == 2
         err = capsys.readouterr().err  # was: "fill_gaps: track id 19.5 ..." without the line
         assert "bad.txt:3: track id 19.5 is not an integer" in err and "fill_gaps" not in err
+    for big, shown in (("2147483648", "2147483648"), ("1e300", "1e+300")):
+        src.write_text(f"1,{big},1,1,2,2\n")
+        assert main(["recover", str(src), "--out", str(tmp_path / "o.txt")]) == 2
+        err = capsys.readouterr().err  # was: "track id 2.14748e+09", not the value
+        assert f"bad.txt:1: track id {shown} is not an integer with |id| <= 2147483647" in err
     assert not (tmp_path / "o.txt").exists()
 
 
