@@ -110,6 +110,34 @@ def test_a_device_or_pipe_is_not_a_regular_file(
     assert sorted(os.listdir(tmp_path)) == ["fifo"]
 
 
+def test_a_compressed_or_binary_file_is_named_as_such(tmp_path: Path) -> None:
+    """Was: "line has a non-number: '\\x1f\\x8b...'" (the bytes of the compressed file)."""
+    import bz2
+    import gzip
+    import lzma
+    import zipfile
+
+    text = b"1,1,10,10,5,5,1,-1,-1,-1\n"
+    (tmp_path / "t.txt.gz").write_bytes(gzip.compress(text))
+    (tmp_path / "t.txt.bz2").write_bytes(bz2.compress(text))
+    (tmp_path / "t.txt.xz").write_bytes(lzma.compress(text))
+    with zipfile.ZipFile(tmp_path / "t.zip", "w") as z:
+        z.writestr("t.txt", text)
+    (tmp_path / "nul.txt").write_bytes(text + b"\0\0")
+    (tmp_path / "utf16.txt").write_bytes(text.decode().encode("utf-16"))
+    for name, message in (
+        ("t.txt.gz", "is gzip-compressed, not text; decompress it first"),
+        ("t.txt.bz2", "is bzip2-compressed, not text; decompress it first"),
+        ("t.txt.xz", "is xz-compressed, not text; decompress it first"),
+        ("t.zip", "is zip-compressed, not text; decompress it first"),
+        ("nul.txt", "is not a text file (it holds NUL bytes)"),
+        ("utf16.txt", "is not a text file (it holds NUL bytes)"),
+    ):
+        with pytest.raises(ValueError) as exc:
+            mot.read_mot(tmp_path / name, what="tracks file")
+        assert str(exc.value) == f"tracks file {tmp_path / name} {message}"
+
+
 def test_write_refuses_non_finite(tmp_path: Path) -> None:
     a = np.ones((2, 10))
     a[1, 3] = np.nan

@@ -27,6 +27,27 @@ _DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 1.0, -1.0, -1.0, -1
 _NAMES = ("frame", "id", "left", "top", "width", "height", "conf", "x", "y", "z")
 
 
+#: The first bytes of compressed files, and the compression's name (bzip2: "BZh" and a level).
+_COMPRESSED = (
+    (b"\x1f\x8b", "gzip"),
+    (b"PK\x03\x04", "zip"),
+    (b"\xfd7zXZ\x00", "xz"),
+    (b"\x28\xb5\x2f\xfd", "zstd"),
+    *((b"BZh" + bytes([c]), "bzip2") for c in b"123456789"),
+)
+
+
+def _refuse_binary(p: Path, what: str) -> None:
+    """ValueError when `p` is compressed or not text (its first 8 KiB hold a NUL byte)."""
+    with p.open("rb") as fh:
+        head = fh.read(8192)
+    for magic, kind in _COMPRESSED:
+        if head.startswith(magic):
+            raise ValueError(f"{what} {p} is {kind}-compressed, not text; decompress it first")
+    if b"\0" in head:
+        raise ValueError(f"{what} {p} is not a text file (it holds NUL bytes)")
+
+
 def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
     """(1-based line number, stripped text) of every line that holds a row."""
     with path.open("r", encoding="utf-8-sig", errors="replace") as fh:  # -sig: a BOM is no field
@@ -81,7 +102,8 @@ def read_mot(
         naming the file and the 1-based line number: fewer than 6 fields, a non-number, a
         non-finite value in any of the first 10 columns (a NaN score too), a frame that is not
         an integer in ``1..2**31-1``, a negative width or height, or a box value beyond ±1e9
-        px. A UTF-8 byte-order mark is skipped.
+        px. A UTF-8 byte-order mark is skipped. A compressed file (gzip, zip, bzip2, xz, zstd)
+        or one with NUL bytes in its first 8 KiB (not text), naming the file.
 
     Warns
     -----
@@ -96,6 +118,7 @@ def read_mot(
         if p.exists():
             raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket)")
         raise FileNotFoundError(f"{what} not found: {p}")
+    _refuse_binary(p, what)
     fast = _read_fast(p)
     if fast is not None:
         return fast
