@@ -575,6 +575,22 @@ def test_columns_past_10_are_dropped_with_a_warning(
     assert (tmp_path / "b.txt").read_bytes() == (tmp_path / "a.txt").read_bytes()
 
 
+def test_summary_lines_count_in_the_singular_and_plural(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    src, out, again = tmp_path / "t.txt", tmp_path / "o.txt", tmp_path / "o2.txt"
+    src.write_text("1,1,10,20,30,40,1,-1,-1,-1\n3,1,12,20,30,40,1,-1,-1,-1\n")
+    assert main(["recover", str(src), "--out", str(out), "--method", "linear"]) == 0
+    line = capsys.readouterr().out.strip()  # was: "1 gaps filled with 1 rows"
+    assert line.startswith(f"{src}: 2 rows, 0 fragments linked, 1 gap filled with 1 row (linear, ")
+    assert main(["recover", str(out), "--out", str(again), "--method", "linear"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert line.endswith("; 1 input row had it already, kept as observed)")
+    assert main(["smooth", str(src), "--out", str(out)]) == 0
+    line = capsys.readouterr().out  # was: "1 ids, 2 rows -> 1 ids, 3 rows"
+    assert line.startswith(f"{src}: 1 id, 2 rows -> 1 id, 3 rows (")
+
+
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
 def test_a_write_error_names_the_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     src = _tracks(tmp_path / "t.txt")

@@ -359,7 +359,7 @@ def test_cli_recover_reads_the_video_lazily(tmp_path, capsys, monkeypatch):
     out = tmp_path / "o.txt"
     argv = ["recover", str(tracks), "--link", "--video", str(v), "--out", str(out)]
     assert main([*argv, "--method", "linear"]) == 0
-    assert "1 fragments linked" in capsys.readouterr().out
+    assert "1 fragment linked" in capsys.readouterr().out  # was: "1 fragments linked"
     assert set(np.unique(read_mot(out)[:, 1]).astype(int)) == {1, 2, 7}
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, bounded_float, non_negative_int
+from pftrack.cli._options import add_command, bounded_float, counted, non_negative_int
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 
@@ -116,9 +116,9 @@ def run(args: argparse.Namespace) -> int:
     dt = time.perf_counter() - t0
     write_mot(args.out, filled, exact=copied_values(rows, filled))  # given values: all digits
     print(
-        f"{src}: {len(rows)} rows, {n_links} fragments linked, {rep.n_gaps} gaps filled with "
-        f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "
-        f"({flag_note(rows)})"
+        f"{src}: {counted(len(rows), 'row')}, {counted(n_links, 'fragment')} linked, "
+        f"{counted(rep.n_gaps, 'gap')} filled with {counted(rep.n_filled_rows, 'row')} "
+        f"({args.method}, {1e3 * dt:.1f} ms) -> {out} ({flag_note(rows)})"
     )
     if args.explain:
         print(rep.describe(args.method))
@@ -167,4 +167,4 @@ def flag_note(rows: Any) -> str:
 
     note = "interpolated flag: column 8 = 1, columns 9-10 = -1"
     n = int(filled_mask(rows).sum())
-    return note + (f"; {n} input rows had it already, kept as observed" if n else "")
+    return note + (f"; {counted(n, 'input row')} had it already, kept as observed" if n else "")
