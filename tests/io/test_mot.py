@@ -236,6 +236,24 @@ def test_values_read_are_written_unchanged_and_writing_is_a_fixed_point(tmp_path
     assert all(len(f.partition(".")[2]) <= 2 for f in fields)
 
 
+def test_huge_values_are_written_short_and_read_back_equal(tmp_path: Path) -> None:
+    """Was: a conf of 1e308 written as a 309-digit integer (``%.0f``)."""
+    a = np.array(
+        [
+            [1, 1, 10, 20, 30, 40, 1e308, -1e20, 2.0**52, 123456789012345678.0],
+            [2, 1, 10, 20, 30, 40, 9999999999999998.0, 1e16, 0.5, -1],
+        ]
+    )
+    q = tmp_path / "out.txt"
+    for exact in (False, True):
+        mot.write_mot(q, a, exact=exact)
+        assert q.read_text().splitlines() == [
+            "1,1,10,20,30,40,1e+308,-1e+20,4503599627370496,1.2345678901234568e+17",
+            "2,1,10,20,30,40,9999999999999998,1e+16,0.5,-1",  # under 1e16: an integer still
+        ]
+        np.testing.assert_array_equal(mot.read_mot(q), a)
+
+
 def test_values_of_any_length_are_written_exactly_when_marked(tmp_path: Path) -> None:
     """Regression: values of more than 10 significant digits (``np.savetxt``'s ``%.18e``) were
     rounded to 2 decimals even where they were read from a file (499.1234567891234 -> 499.12).

@@ -261,7 +261,8 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
     """The values written for columns 3-10 of `a` (M, 10) and the decimals of each.
 
     A value with at most :data:`EXACT_DIGITS` significant digits is written exactly, with the
-    fewest decimals; so is any value `exact` (M, 10) marks, in its shortest round-trip form
+    fewest decimals (a value of 1e16 or more, always an integer, in its shortest round-trip
+    form: ``1e+308``); so is any value `exact` (M, 10) marks, in its shortest round-trip form
     (code :data:`_REPR`: ``%r``, the digits Python's ``repr`` gives) when it needs more; any
     other is rounded to 2 decimals as ``%.2f`` rounds it, then written with the fewest
     decimals that value needs. So a file read back writes the same text (``88.00`` is written
@@ -270,7 +271,9 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
     v = a[:, 2:].ravel()
     d = _decimals(v, 10.0**EXACT_DIGITS, len(_POW10) - 1)
     whole = np.abs(v) >= 2.0**52  # every such double is an integer (and v * 100 may overflow)
-    d[whole & (d < 0)] = 0
+    huge = np.abs(v) >= 1e16  # 17 digits or more as an integer: 1e+308, not 309 digits
+    d[whole & ~huge & (d < 0)] = 0
+    d[huge] = _REPR
     if exact is not None:
         d[exact[:, 2:].ravel() & (d < 0)] = _REPR
     rest = d < 0
