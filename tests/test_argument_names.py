@@ -24,7 +24,7 @@ from pftrack.particle_filter import (
     stratified_resample,
     systematic_resample,
 )
-from pftrack.recovery import fill_gaps, link_tracklets, recover_gaps
+from pftrack.recovery import fill_gaps, link_tracklets, recover_gap, recover_gaps
 from pftrack.tracking.config import (
     AssociationConfig,
     CameraConfig,
@@ -113,6 +113,28 @@ CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
         lambda: fill_gaps(ROWS, "linear", seed=1.5),
         TypeError,
         "fill_gaps: seed must be an int >= 0, got float 1.5",
+    ),
+    "fill_gaps(noise='x')": (  # was: AttributeError: 'str' object has no attribute 'q'
+        lambda: fill_gaps(ROWS, "gdt-bi", noise="x"),
+        TypeError,
+        r"fill_gaps: noise must be a NoiseEstimate \(pftrack.recovery.estimate_noise\) or None, "
+        "got str$",
+    ),
+    "fill_gaps('linear', noise='x')": (  # was: taken (linear uses no noise)
+        lambda: fill_gaps(ROWS, "linear", noise="x"),
+        TypeError,
+        "fill_gaps: noise must be a NoiseEstimate",
+    ),
+    "recover_gaps('gdt-mix', motion='x')": (  # was: AttributeError: ... no attribute 'is_gdt_bi'
+        lambda: recover_gaps([(SEG, SEG + 9)], "gdt-mix", motion="x"),
+        TypeError,
+        r"recover_gaps: motion must be a MotionFit \(pftrack.recovery.fit_motion\) or None, "
+        "got str$",
+    ),
+    "recover_gap(noise=..., method='gdt-bi')": (
+        lambda: recover_gap(SEG, SEG + 9, method="gdt-bi", noise={"q": 1}),
+        TypeError,
+        "recover_gap: noise must be a NoiseEstimate .* got dict$",
     ),
     "recover_gaps(seed=-1)": (
         lambda: recover_gaps([(SEG, SEG + 9)], seed=-1),

@@ -495,8 +495,16 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
         "pftrack recover: error: --seed is used only by --method auto (its calibration gaps), "
         "not linear; drop it"
     )
+    # was: --max-distance silently ignored without --link, with one file and in a batch
+    for given in ([str(src)], [str(src), str(_tracks(tmp_path / "t2.txt"))]):
+        assert main(["recover", *given, "--out", str(out), "--max-distance", "5"]) == 2
+        assert capsys.readouterr().err.strip() == (
+            "pftrack recover: error: --max-distance is used only by --link (its linking gate); "
+            "add --link or drop it"
+        )
     assert not out.exists()
     assert main(["recover", str(src), "--out", str(out), "--seed", "3"]) == 0  # auto: used
+    assert main(["recover", str(src), "--out", str(out), "--link", "--max-distance", "5"]) == 0
 
 
 @pytest.mark.parametrize("command", ["recover", "smooth"])
@@ -544,6 +552,58 @@ def test_library_warnings_are_one_line_for_every_command(
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["pftrack recover: warning: a library warning in two lines"]
     assert warnings.showwarning is before  # main restores the formatter it replaced
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_columns_past_10_are_dropped_with_a_warning(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import warnings
+
+    src, wide = _tracks(tmp_path / "t.txt"), tmp_path / "wide.txt"
+    wide.write_text("".join(f"{line},7,8\n" for line in src.read_text().splitlines()))
+    assert main(["-q", command, str(src), "--out", str(tmp_path / "a.txt")]) == 0
+    capsys.readouterr()
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
+        assert main(["-q", command, str(wide), "--out", str(tmp_path / "b.txt")]) == 0
+    # was: columns 11 and 12 dropped without a word
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"pftrack {command}: warning: tracks file {wide} has lines of 12 columns: columns past "
+        "10 are not kept"
+    ]
+    assert (tmp_path / "b.txt").read_bytes() == (tmp_path / "a.txt").read_bytes()
+
+
+def test_summary_lines_count_in_the_singular_and_plural(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    src, out, again = tmp_path / "t.txt", tmp_path / "o.txt", tmp_path / "o2.txt"
+    src.write_text("1,1,10,20,30,40,1,-1,-1,-1\n3,1,12,20,30,40,1,-1,-1,-1\n")
+    assert main(["recover", str(src), "--out", str(out), "--method", "linear"]) == 0
+    line = capsys.readouterr().out.strip()  # was: "1 gaps filled with 1 rows"
+    assert line.startswith(f"{src}: 2 rows, 0 fragments linked, 1 gap filled with 1 row (linear, ")
+    assert main(["recover", str(out), "--out", str(again), "--method", "linear"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert line.endswith("; 1 input row had it already, kept as observed)")
+    assert main(["smooth", str(src), "--out", str(out)]) == 0
+    line = capsys.readouterr().out  # was: "1 ids, 2 rows -> 1 ids, 3 rows"
+    assert line.startswith(f"{src}: 1 id, 2 rows -> 1 id, 3 rows (")
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
+def test_a_write_error_names_the_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    src = _tracks(tmp_path / "t.txt")
+    for argv in (
+        ["recover", str(src), "--out", "/dev/full"],
+        ["smooth", str(src), "--out", "/dev/full"],
+        ["eval", "--gt", str(src), "--res", str(src), "--json", "/dev/full"],
+    ):
+        assert main(["-q", *argv]) == 2
+        # was: "error: [Errno 28] No space left on device", no file named
+        assert capsys.readouterr().err.strip() == (
+            f"pftrack {argv[0]}: error: No space left on device: /dev/full"
+        )
 
 
 @pytest.mark.parametrize("command", ["track", "batch"])

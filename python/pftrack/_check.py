@@ -48,8 +48,10 @@ def first_bad_id(ids: ArrayLike) -> int | None:
 
 
 def bad_id_message(value: float) -> str:
-    """What is wrong with track id `value` (one :func:`first_bad_id` found)."""
-    return f"track id {value:g} is not an integer with |id| <= {MAX_ID}"
+    """What is wrong with track id `value` (one :func:`first_bad_id` found), shown exactly."""
+    v = float(value)
+    shown = str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)  # not 2.14748e+09
+    return f"track id {shown} is not an integer with |id| <= {MAX_ID}"
 
 
 def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:

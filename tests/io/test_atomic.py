@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
 import threading
@@ -304,3 +305,23 @@ def test_dash_is_refused_as_an_output_name(tmp_path: Path, monkeypatch) -> None:
     with pytest.raises(ValueError, match=r"^--out -: standard output .* /dev/stdout$"):
         check_output("-", what="--out")
     assert not any(tmp_path.iterdir())
+
+
+def test_a_write_error_names_the_output(tmp_path: Path, monkeypatch) -> None:
+    def full(fd: int) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    target = tmp_path / "out.txt"
+    monkeypatch.setattr(os, "fsync", full)
+    with pytest.raises(OSError) as exc, atomic_write(target) as fh:  # was: no file name
+        fh.write("1,1,0,0,10,10,1,-1,-1,-1\n")
+    assert (exc.value.errno, exc.value.filename) == (errno.ENOSPC, str(target))
+    assert not target.exists() and not list(tmp_path.iterdir())
+    monkeypatch.undo()
+    if os.path.exists("/dev/full"):  # written through
+        with pytest.raises(OSError) as exc, atomic_write("/dev/full") as fh:
+            fh.write("x" * 100_000)
+        assert (exc.value.errno, exc.value.filename) == (errno.ENOSPC, "/dev/full")
+        with pytest.raises(OSError) as exc, atomic_path("/dev/full") as tmp:
+            tmp.write_bytes(b"x")
+        assert (exc.value.errno, exc.value.filename) == (errno.ENOSPC, "/dev/full")

@@ -110,6 +110,34 @@ def test_a_device_or_pipe_is_not_a_regular_file(
     assert sorted(os.listdir(tmp_path)) == ["fifo"]
 
 
+def test_a_compressed_or_binary_file_is_named_as_such(tmp_path: Path) -> None:
+    """Was: "line has a non-number: '\\x1f\\x8b...'" (the bytes of the compressed file)."""
+    import bz2
+    import gzip
+    import lzma
+    import zipfile
+
+    text = b"1,1,10,10,5,5,1,-1,-1,-1\n"
+    (tmp_path / "t.txt.gz").write_bytes(gzip.compress(text))
+    (tmp_path / "t.txt.bz2").write_bytes(bz2.compress(text))
+    (tmp_path / "t.txt.xz").write_bytes(lzma.compress(text))
+    with zipfile.ZipFile(tmp_path / "t.zip", "w") as z:
+        z.writestr("t.txt", text)
+    (tmp_path / "nul.txt").write_bytes(text + b"\0\0")
+    (tmp_path / "utf16.txt").write_bytes(text.decode().encode("utf-16"))
+    for name, message in (
+        ("t.txt.gz", "is gzip-compressed, not text; decompress it first"),
+        ("t.txt.bz2", "is bzip2-compressed, not text; decompress it first"),
+        ("t.txt.xz", "is xz-compressed, not text; decompress it first"),
+        ("t.zip", "is zip-compressed, not text; decompress it first"),
+        ("nul.txt", "is not a text file (it holds NUL bytes)"),
+        ("utf16.txt", "is not a text file (it holds NUL bytes)"),
+    ):
+        with pytest.raises(ValueError) as exc:
+            mot.read_mot(tmp_path / name, what="tracks file")
+        assert str(exc.value) == f"tracks file {tmp_path / name} {message}"
+
+
 def test_write_refuses_non_finite(tmp_path: Path) -> None:
     a = np.ones((2, 10))
     a[1, 3] = np.nan
@@ -206,6 +234,24 @@ def test_values_read_are_written_unchanged_and_writing_is_a_fixed_point(tmp_path
     fields = first.decode().replace("\n", ",").split(",")
     assert "-0" not in fields and not any(f.endswith((".00", ".0")) for f in fields)
     assert all(len(f.partition(".")[2]) <= 2 for f in fields)
+
+
+def test_huge_values_are_written_short_and_read_back_equal(tmp_path: Path) -> None:
+    """Was: a conf of 1e308 written as a 309-digit integer (``%.0f``)."""
+    a = np.array(
+        [
+            [1, 1, 10, 20, 30, 40, 1e308, -1e20, 2.0**52, 123456789012345678.0],
+            [2, 1, 10, 20, 30, 40, 9999999999999998.0, 1e16, 0.5, -1],
+        ]
+    )
+    q = tmp_path / "out.txt"
+    for exact in (False, True):
+        mot.write_mot(q, a, exact=exact)
+        assert q.read_text().splitlines() == [
+            "1,1,10,20,30,40,1e+308,-1e+20,4503599627370496,1.2345678901234568e+17",
+            "2,1,10,20,30,40,9999999999999998,1e+16,0.5,-1",  # under 1e16: an integer still
+        ]
+        np.testing.assert_array_equal(mot.read_mot(q), a)
 
 
 def test_values_of_any_length_are_written_exactly_when_marked(tmp_path: Path) -> None:

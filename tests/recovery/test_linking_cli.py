@@ -171,6 +171,11 @@ def test_cli_recover_reports_bad_rows_with_line_number(tmp_path, capsys):
         assert main([command, str(src), "--out", str(tmp_path / "o.txt")]) == 2
         err = capsys.readouterr().err  # was: "fill_gaps: track id 19.5 ..." without the line
         assert "bad.txt:3: track id 19.5 is not an integer" in err and "fill_gaps" not in err
+    for big, shown in (("2147483648", "2147483648"), ("1e300", "1e+300")):
+        src.write_text(f"1,{big},1,1,2,2\n")
+        assert main(["recover", str(src), "--out", str(tmp_path / "o.txt")]) == 2
+        err = capsys.readouterr().err  # was: "track id 2.14748e+09", not the value
+        assert f"bad.txt:1: track id {shown} is not an integer with |id| <= 2147483647" in err
     assert not (tmp_path / "o.txt").exists()
 
 
@@ -380,7 +385,7 @@ def test_cli_recover_reads_the_video_lazily(tmp_path, capsys, monkeypatch):
     out = tmp_path / "o.txt"
     argv = ["recover", str(tracks), "--link", "--video", str(v), "--out", str(out)]
     assert main([*argv, "--method", "linear"]) == 0
-    assert "1 fragments linked" in capsys.readouterr().out
+    assert "1 fragment linked" in capsys.readouterr().out  # was: "1 fragments linked"
     assert set(np.unique(read_mot(out)[:, 1]).astype(int)) == {1, 2, 7}
 
 

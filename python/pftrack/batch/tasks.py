@@ -18,7 +18,7 @@ import tempfile
 import time
 import traceback
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -431,18 +431,14 @@ def _check_distance(value: float | None) -> None:
 
 def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
     """Fill the gaps of one tracks file as ``pftrack recover FILE`` does (no ``--video``)."""
-    from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
+    from pftrack.recovery import fill_gaps, link_tracklets
     from pftrack.recovery.fill import copied_values
-    from pftrack.recovery.linking import gate_for_rows
+    from pftrack.recovery.linking import link_config_for
 
     rows = read_tracks(path)
     n_links = 0
     if options.link:
-        cfg = LinkConfig(max_gap=options.max_gap)
-        if options.max_distance is None:
-            cfg = gate_for_rows(cfg, rows)
-        else:
-            cfg = replace(cfg, max_distance=options.max_distance)
+        cfg = link_config_for(rows, options.max_gap, options.max_distance)
         rows, mapping = link_tracklets(rows, cfg, None)
         n_links = len(mapping)
     t0 = time.perf_counter()

@@ -55,6 +55,11 @@ def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
     return parser
 
 
+def counted(n: int, noun: str) -> str:
+    """``n noun`` with the noun's plural ``s`` unless `n` is 1 (``1 row``, ``2 rows``)."""
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
 def int_at_least(lo: int) -> Any:
     """Argument type: an integer >= `lo`."""
 

@@ -5,12 +5,17 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, bounded_float, non_negative_int, report_stream
+from pftrack.cli._options import (
+    add_command,
+    bounded_float,
+    counted,
+    non_negative_int,
+    report_stream,
+)
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 
@@ -64,6 +69,10 @@ def run(args: argparse.Namespace) -> int:
             "drop it"
         )
     args.seed = args.seed or 0
+    if args.max_distance is not None and not args.link:  # one file and a batch alike
+        raise ValueError(
+            "--max-distance is used only by --link (its linking gate); add --link or drop it"
+        )
     if batch.is_batch(args.tracks):
         return batch.run_recover(args)
     batch.refuse_batch_options(args)
@@ -72,9 +81,9 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
-    from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
+    from pftrack.recovery import fill_gaps, link_tracklets
     from pftrack.recovery.fill import copied_values
-    from pftrack.recovery.linking import gate_for_rows, read_tracks
+    from pftrack.recovery.linking import link_config_for, read_tracks
 
     src = Path(args.tracks)
     out = Path(args.out)
@@ -96,11 +105,7 @@ def run(args: argparse.Namespace) -> int:
 
             frames = FrameSequence(args.video)  # read when the colour term asks, in one pass
             check_video(args.video, frames, rows, src)
-        cfg = LinkConfig(max_gap=args.max_gap)
-        if args.max_distance is None:  # 50 px grown to the frame (gate_for_rows)
-            cfg = gate_for_rows(cfg, rows)
-        else:
-            cfg = replace(cfg, max_distance=args.max_distance)
+        cfg = link_config_for(rows, args.max_gap, args.max_distance)
         try:
             rows, mapping = link_tracklets(rows, cfg, frames)
         finally:
@@ -113,9 +118,9 @@ def run(args: argparse.Namespace) -> int:
     write_mot(args.out, filled, exact=copied_values(rows, filled))  # given values: all digits
     to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report on stderr
     print(
-        f"{src}: {len(rows)} rows, {n_links} fragments linked, {rep.n_gaps} gaps filled with "
-        f"{rep.n_filled_rows} rows ({args.method}, {1e3 * dt:.1f} ms) -> {out} "
-        f"({flag_note(rows)})",
+        f"{src}: {counted(len(rows), 'row')}, {counted(n_links, 'fragment')} linked, "
+        f"{counted(rep.n_gaps, 'gap')} filled with {counted(rep.n_filled_rows, 'row')} "
+        f"({args.method}, {1e3 * dt:.1f} ms) -> {out} ({flag_note(rows)})",
         file=to,
     )
     if args.explain:
@@ -165,4 +170,4 @@ def flag_note(rows: Any) -> str:
 
     note = "interpolated flag: column 8 = 1, columns 9-10 = -1"
     n = int(filled_mask(rows).sum())
-    return note + (f"; {n} input rows had it already, kept as observed" if n else "")
+    return note + (f"; {counted(n, 'input row')} had it already, kept as observed" if n else "")

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, bounded_float, report_stream
+from pftrack.cli._options import add_command, bounded_float, counted, report_stream
 
 
 def add_parser(sub: Any) -> None:
@@ -72,8 +72,8 @@ def run(args: argparse.Namespace) -> int:
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
     print(
-        f"{src}: {ids_in} ids, {len(rows)} rows -> {ids_out} ids, {len(result)} rows "
-        f"({flag_note(rows)}) -> {out}",
+        f"{src}: {counted(ids_in, 'id')}, {counted(len(rows), 'row')} -> "
+        f"{counted(ids_out, 'id')}, {counted(len(result), 'row')} ({flag_note(rows)}) -> {out}",
         file=report_stream(args.out),  # rows on stdout (--out /dev/stdout): the report not
     )
     return 0

@@ -170,6 +170,17 @@ def _keep_mode(tmp: str | int, target: Path) -> None:
 
 
 @contextlib.contextmanager
+def _named(path: PathLike) -> Iterator[None]:
+    """Name output `path` in an OSError that names no file (a full disk: ``[Errno 28] ...``)."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno is None or exc.filename is not None:
+            raise
+        raise OSError(exc.errno, exc.strerror, os.fsdecode(os.fspath(path))) from exc
+
+
+@contextlib.contextmanager
 def atomic_write(
     path: PathLike, mode: str = "w", *, suffix: str | None = None
 ) -> Iterator[IO[Any]]:
@@ -202,7 +213,7 @@ def atomic_write(
     _refuse_folder_name(path)
     resolved = _resolve(path)
     if resolved.through:
-        with _open_through(resolved, mode) as fh:
+        with _named(path), _open_through(resolved, mode) as fh:
             yield fh
         return
     target = resolved.path
@@ -213,7 +224,7 @@ def atomic_write(
     try:  # the file is made inside: removed whenever the block is left by an exception
         fd, tmp = _create_beside(folder, f".{target.name}.", suffix or ".tmp", made)
         _keep_mode(fd, target)
-        with os.fdopen(fd, mode) as fh:
+        with _named(path), os.fdopen(fd, mode) as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
@@ -239,7 +250,8 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         with tempfile.TemporaryDirectory(prefix="pftrack-") as scratch:
             tmp_path = Path(scratch) / f"out{Path(path).suffix}"
             yield tmp_path
-            _copy_through(tmp_path, resolved)
+            with _named(path):
+                _copy_through(tmp_path, resolved)
         return
     target = resolved.path
     folder = target.parent if str(target.parent) else Path(".")

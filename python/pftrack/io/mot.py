@@ -10,6 +10,7 @@ decimals (values pftrack computed) unless marked ``exact`` (values read from a f
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -24,6 +25,27 @@ from pftrack.io.atomic import atomic_write
 FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
 _DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 1.0, -1.0, -1.0, -1.0)
 _NAMES = ("frame", "id", "left", "top", "width", "height", "conf", "x", "y", "z")
+
+
+#: The first bytes of compressed files, and the compression's name (bzip2: "BZh" and a level).
+_COMPRESSED = (
+    (b"\x1f\x8b", "gzip"),
+    (b"PK\x03\x04", "zip"),
+    (b"\xfd7zXZ\x00", "xz"),
+    (b"\x28\xb5\x2f\xfd", "zstd"),
+    *((b"BZh" + bytes([c]), "bzip2") for c in b"123456789"),
+)
+
+
+def _refuse_binary(p: Path, what: str) -> None:
+    """ValueError when `p` is compressed or not text (its first 8 KiB hold a NUL byte)."""
+    with p.open("rb") as fh:
+        head = fh.read(8192)
+    for magic, kind in _COMPRESSED:
+        if head.startswith(magic):
+            raise ValueError(f"{what} {p} is {kind}-compressed, not text; decompress it first")
+    if b"\0" in head:
+        raise ValueError(f"{what} {p} is not a text file (it holds NUL bytes)")
 
 
 def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
@@ -51,7 +73,9 @@ def data_line_numbers(path: PathLike) -> list[int]:
     return [n for n, _ in _data_lines(Path(path))]
 
 
-def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
+def read_mot(
+    path: PathLike, *, what: str = "MOT file", warn_extra: bool = False
+) -> NDArray[np.float64]:
     """Read a MOTChallenge file into an ``(M, 10)`` float64 array.
 
     Parameters
@@ -60,6 +84,8 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         The file. Blank lines and lines starting with ``#`` are skipped.
     what : str
         How errors name the file ("detection file", "ground truth", ...).
+    warn_extra : bool
+        Warn when lines have more than 10 columns (they are read, the rest dropped).
 
     Returns
     -------
@@ -76,7 +102,14 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         naming the file and the 1-based line number: fewer than 6 fields, a non-number, a
         non-finite value in any of the first 10 columns (a NaN score too), a frame that is not
         an integer in ``1..2**31-1``, a negative width or height, or a box value beyond ±1e9
-        px. A UTF-8 byte-order mark is skipped.
+        px. A UTF-8 byte-order mark is skipped. A compressed file (gzip, zip, bzip2, xz, zstd)
+        or one with NUL bytes in its first 8 KiB (not text), naming the file.
+
+    Warns
+    -----
+    UserWarning
+        With `warn_extra`, once, naming the file and its most columns on a line, when that is
+        more than 10: columns 11 and beyond are not kept.
     """
     p = Path(path)
     if not p.is_file():
@@ -85,13 +118,17 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         if p.exists():
             raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket)")
         raise FileNotFoundError(f"{what} not found: {p}")
+    _refuse_binary(p, what)
     fast = _read_fast(p)
     if fast is not None:
         return fast
     rows: list[list[float]] = []
     numbers: list[int] = []  # the line of each row
     error: str | None = None  # the first line that is no row, which ends the reading
+    most = 0  # the most columns on a line, with warn_extra (the fast reader takes <= 10)
     for lineno, text in _data_lines(p):
+        if warn_extra:
+            most = max(most, len(_fields(text)))
         values = _parse_line(text, what)
         if isinstance(values, str):
             error = f"{p}:{lineno}: {values}"
@@ -108,6 +145,12 @@ def read_mot(path: PathLike, *, what: str = "MOT file") -> NDArray[np.float64]:
         raise ValueError(f"{p}:{lineno}: {bad_box[2]}: {text[:80]!r}")
     if error is not None:
         raise ValueError(error)
+    if most > 10:
+        warnings.warn(
+            f"{what} {p} has lines of {most} columns: columns past 10 are not kept",
+            UserWarning,
+            stacklevel=2,
+        )
     return a
 
 
@@ -218,7 +261,8 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
     """The values written for columns 3-10 of `a` (M, 10) and the decimals of each.
 
     A value with at most :data:`EXACT_DIGITS` significant digits is written exactly, with the
-    fewest decimals; so is any value `exact` (M, 10) marks, in its shortest round-trip form
+    fewest decimals (a value of 1e16 or more, always an integer, in its shortest round-trip
+    form: ``1e+308``); so is any value `exact` (M, 10) marks, in its shortest round-trip form
     (code :data:`_REPR`: ``%r``, the digits Python's ``repr`` gives) when it needs more; any
     other is rounded to 2 decimals as ``%.2f`` rounds it, then written with the fewest
     decimals that value needs. So a file read back writes the same text (``88.00`` is written
@@ -227,7 +271,9 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
     v = a[:, 2:].ravel()
     d = _decimals(v, 10.0**EXACT_DIGITS, len(_POW10) - 1)
     whole = np.abs(v) >= 2.0**52  # every such double is an integer (and v * 100 may overflow)
-    d[whole & (d < 0)] = 0
+    huge = np.abs(v) >= 1e16  # 17 digits or more as an integer: 1e+308, not 309 digits
+    d[whole & ~huge & (d < 0)] = 0
+    d[huge] = _REPR
     if exact is not None:
         d[exact[:, 2:].ravel() & (d < 0)] = _REPR
     rest = d < 0

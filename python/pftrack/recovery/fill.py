@@ -27,7 +27,7 @@ from pftrack.recovery.linking import (
     check_unique,
     split_tracks,
 )
-from pftrack.recovery.mixture import MotionFit, fit_motion
+from pftrack.recovery.mixture import MotionFit, check_models, fit_motion
 from pftrack.recovery.names import NEIGHBOUR_METHODS
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
 from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, recover_gaps
@@ -135,7 +135,7 @@ def fill_gaps(
     Raises
     ------
     TypeError
-        `combine` not a bool, `seed` not an int.
+        `combine` not a bool, `seed` not an int, `noise` not a NoiseEstimate.
     ValueError
         Unknown method, a negative `seed`, `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
         rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
@@ -166,6 +166,7 @@ def fill_rows(
     if not isinstance(combine, (bool, np.bool_)):
         raise TypeError(f"fill_gaps: combine must be a bool, got {type(combine).__name__}")
     seed = _check.seed(seed, "fill_gaps: seed")  # NumPy's refusal named no argument
+    check_models(noise, None, "fill_gaps")
     if (
         not isinstance(max_gap, (int, np.integer))
         or isinstance(max_gap, bool)

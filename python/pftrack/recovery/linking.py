@@ -462,11 +462,12 @@ def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
     (``FILE:LINE``), then :func:`check_unique` (``FILE:LINE: duplicate rows ...``); the file
     is read a second time, for its line numbers, only when a pair repeats. What ``pftrack
     recover`` and ``pftrack smooth`` read, one file or many, and ``pftrack experiment gaps``
-    its ground truth (``what="ground truth"``).
+    its ground truth (``what="ground truth"``). Lines of more than 10 columns give one
+    UserWarning naming the file: columns past 10 are not kept.
     """
     from pftrack.io.mot import data_line_numbers, read_mot
 
-    rows = read_mot(path, what=what)
+    rows = read_mot(path, what=what, warn_extra=True)  # columns past 10 are not written back
     check_file_ids(rows, path)  # check_rows' test, with the file's line, as read_mot's own
     try:
         check_unique(rows)

@@ -48,6 +48,7 @@ __all__ = [
     "WINDOW",
     "AxisModel",
     "MotionFit",
+    "check_models",
     "fit_motion",
     "fit_singer",
     "recover_mixture",
@@ -178,6 +179,28 @@ class MotionFit:
         return self.stand_rate == 0.0 and all(m.kind == "wna" for m in self.axes)
 
 
+def check_models(noise: object, motion: object, who: str) -> None:
+    """Refuse a `noise` that is not a :class:`NoiseEstimate` or a `motion` not a :class:`MotionFit`.
+
+    None passes (estimated from the data). Anything else would fail deep inside (``'str'
+    object has no attribute 'q'``).
+
+    Raises
+    ------
+    TypeError
+        Naming `who`, the parameter and the type expected.
+    """
+    for name, value, kind, maker in (
+        ("noise", noise, NoiseEstimate, "estimate_noise"),
+        ("motion", motion, MotionFit, "fit_motion"),
+    ):
+        if value is not None and not isinstance(value, kind):
+            raise TypeError(
+                f"{who}: {name} must be a {kind.__name__} (pftrack.recovery.{maker}) or None, "
+                f"got {type(value).__name__}"
+            )
+
+
 def _stack_runs(runs: Sequence[F64], axis: int) -> tuple[F64, NDArray[np.int32]]:
     z = np.ascontiguousarray(np.concatenate([r[:, 1 + axis] for r in runs]))
     return z, np.array([len(r) for r in runs], dtype=np.int32)
@@ -242,6 +265,7 @@ def fit_motion(segments: Sequence[F64], noise: NoiseEstimate | None = None) -> M
     ``noise``: the white-noise-acceleration estimate used as fallback and for the stand rate;
     default :func:`estimate_noise` of the same segments.
     """
+    check_models(noise, None, "fit_motion")
     runs = consecutive_runs(segments, 6)
     if noise is None:
         noise = estimate_noise(runs)

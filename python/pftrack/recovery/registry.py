@@ -53,7 +53,7 @@ from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
 from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
-from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
+from pftrack.recovery.mixture import MotionFit, check_models, fit_motion, recover_mixture_gaps
 from pftrack.recovery.names import (
     DEFAULT_METHOD,
     GOAL_DIRECTED_METHODS,
@@ -110,6 +110,7 @@ def recover_gap(
     TypeError
         `frames` is a string: a method given positionally, as :func:`recover_gaps` and
         :func:`~pftrack.recovery.fill.fill_gaps` take it (second); here it goes by keyword.
+        `noise` not a NoiseEstimate or `motion` not a MotionFit.
     ValueError
         Empty or malformed segments (:func:`~pftrack.recovery.segments.as_segment`: NaN, a
         frame that is not an integer, a negative width or height, a value beyond ±1e9 px),
@@ -126,6 +127,7 @@ def recover_gap(
     fr = gap_frames(a, b, frames)
     if method not in METHODS:
         raise ValueError(f"recover_gap: method is {method!r}, expected one of {METHODS}")
+    check_models(noise, motion, "recover_gap")
     if fr.size == 0:
         return np.zeros((0, 4 if a.shape[1] == 5 and b.shape[1] == 5 else 2))
     if method in GOAL_DIRECTED_METHODS or method in NEIGHBOUR_METHODS:
@@ -214,7 +216,7 @@ def recover_gaps(
     Raises
     ------
     TypeError
-        A `seed` that is not an int.
+        A `seed` that is not an int, `noise` not a NoiseEstimate or `motion` not a MotionFit.
     ValueError
         An unknown method, a gap that is not a pair of segments, segments :func:`recover_gap`
         refuses, whatever the method (the message names the gap), or a negative `seed`.
@@ -228,6 +230,7 @@ def recover_gaps(
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
     seed = _check.seed(seed, "recover_gaps: seed")
+    check_models(noise, motion, "recover_gaps")
     combine = _check.flag(combine, "recover_gaps: combine")
     if history is not None:
         history = _check.integer(history, "recover_gaps: history", 1, MAX_FRAME)
