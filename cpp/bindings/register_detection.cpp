@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -190,6 +191,59 @@ void register_detection(py::module_& m) {
             },
             py::arg("background"),
             "Initialise from a (H, W, 3) BGR image (e.g. a median of frames) instead of the first frame.")
+        .def(py::pickle(
+            [](const BackgroundModel& self) {  // settings, then what the model has learnt
+                const bind::InUse busy(&self, "BackgroundModel.__getstate__", true);
+                const BackgroundConfig& c = self.config();
+                const HsvBinning& h = self.binning();
+                const BackgroundModel::State s = self.state();
+                const auto bytes = [](const void* p, size_t n) {
+                    return py::bytes(static_cast<const char*>(p), n);
+                };
+                return py::make_tuple(
+                    py::make_tuple(c.alpha, c.alpha_fg, c.n_learn, c.k_noise, c.t_min, c.t_max,
+                                   c.low_ratio, c.shadow_lo, c.shadow_chroma),
+                    py::make_tuple(h.n_h, h.n_s, h.n_v, h.s_min, h.v_min),
+                    py::make_tuple(s.rows, s.cols, s.frame_count, s.learning, s.threshold,
+                                   s.threshold_scale),
+                    bytes(s.background.data(), s.background.size() * sizeof(float)),
+                    bytes(s.previous.data(), s.previous.size()),
+                    bytes(s.hist.data(), s.hist.size() * sizeof(std::int64_t)));
+            },
+            [](const py::tuple& t) {
+                const char* fn = "BackgroundModel.__setstate__";
+                require(t.size() == 6, fn, "state size", t.size(), 6);
+                const auto c = t[0].cast<py::tuple>(), h = t[1].cast<py::tuple>(),
+                           k = t[2].cast<py::tuple>();
+                require(c.size() == 9 && h.size() == 5 && k.size() == 6, fn,
+                        "the state is not a pickled BackgroundModel's");
+                BackgroundConfig config{c[0].cast<double>(), c[1].cast<double>(),
+                                        c[2].cast<int>(),    c[3].cast<double>(),
+                                        c[4].cast<double>(), c[5].cast<double>(),
+                                        c[6].cast<double>(), c[7].cast<double>(),
+                                        c[8].cast<double>()};
+                HsvBinning binning{h[0].cast<int>(), h[1].cast<int>(), h[2].cast<int>(),
+                                   h[3].cast<double>(), h[4].cast<double>()};
+                BackgroundModel model(config, binning);  // checks the settings
+                BackgroundModel::State s;
+                s.rows = k[0].cast<Index>();
+                s.cols = k[1].cast<Index>();
+                s.frame_count = k[2].cast<long>();
+                s.learning = k[3].cast<bool>();
+                s.threshold = k[4].cast<double>();
+                s.threshold_scale = k[5].cast<double>();
+                const std::string bg = t[3].cast<std::string>(), prev = t[4].cast<std::string>(),
+                                  hist = t[5].cast<std::string>();
+                require(bg.size() % sizeof(float) == 0 &&
+                            hist.size() == s.hist.size() * sizeof(std::int64_t),
+                        fn, "the state is not a pickled BackgroundModel's");
+                s.background.resize(bg.size() / sizeof(float));
+                std::memcpy(s.background.data(), bg.data(), bg.size());
+                s.previous.assign(prev.begin(), prev.end());
+                std::memcpy(s.hist.data(), hist.data(), hist.size());
+                model.restore(std::move(s));
+                return model;
+            }))
         .def(
             "__copy__",
             [](const BackgroundModel& self) {

@@ -188,3 +188,44 @@ def test_threads_give_serial_result():
     for r in results:
         for a, b in zip(r, serial, strict=True):
             np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("how", ["copy", "deepcopy", "pickle"])
+def test_a_copied_model_goes_on_as_the_original(how):
+    import copy
+    import pickle
+
+    rng = np.random.default_rng(5)
+    frames = [rng.integers(0, 256, (24, 32, 3), dtype=np.uint8) for _ in range(12)]
+    clone = {"copy": copy.copy, "deepcopy": copy.deepcopy}.get(
+        how, lambda m: pickle.loads(pickle.dumps(m))
+    )
+    a = _core.BackgroundModel(alpha=0.07, n_learn=4, shadow_lo=0.6, n_h=8)
+    assert clone(a).shape is None  # before any frame too
+    for f in frames[:6]:
+        a.apply(f)
+    a.set_threshold_scale(1.3)
+    b = clone(a)
+    assert (b.alpha, b.n_learn, b.shadow_lo, b.n_bins) == (0.07, 4, 0.6, a.n_bins)
+    assert (b.frame_count, b.threshold, b.threshold_scale) == (
+        a.frame_count, a.threshold, a.threshold_scale,
+    )  # fmt: skip
+    np.testing.assert_array_equal(b.background, a.background)
+    for f in frames[6:]:
+        (bins_a, mask_a), (bins_b, mask_b) = a.apply(f), b.apply(f)
+        np.testing.assert_array_equal(mask_a, mask_b)
+        np.testing.assert_array_equal(bins_a.bins, bins_b.bins)
+    np.testing.assert_array_equal(a.background, b.background)
+    np.testing.assert_array_equal(a.difference_histogram, b.difference_histogram)
+
+
+def test_a_bad_pickled_state_is_refused():
+    model = _core.BackgroundModel.__new__(_core.BackgroundModel)
+    with pytest.raises(ValueError, match="^BackgroundModel.__setstate__: state size is 2"):
+        model.__setstate__((1, 2))
+    good = _core.BackgroundModel()
+    good.apply(np.zeros((4, 5, 3), np.uint8))
+    state = list(good.__getstate__())
+    state[3] = state[3][:-4]  # a background one float short
+    with pytest.raises(ValueError, match="^BackgroundModel.__setstate__: background size is 59"):
+        _core.BackgroundModel.__new__(_core.BackgroundModel).__setstate__(tuple(state))

@@ -850,16 +850,18 @@ def test_a_tracker_copies_and_pickles_before_its_first_update(scene):
 
 
 @pytest.mark.parametrize("options", [{}, {"sampler": "mh"}, {"refine": False}])
-def test_a_deep_copy_mid_run_is_a_checkpoint(scene, options):
+@pytest.mark.parametrize("how", ["deepcopy", "pickle"])
+def test_a_copy_mid_run_is_a_checkpoint(scene, options, how):
     # was: TypeError (the C++ background model and bins could not be copied) after one update
     import copy
+    import pickle
 
     dets = scene_dets(scene)
     for given in (True, False):
         a = pftrack.Tracker(**options)
         for k in range(12):
             a.update(dets[k] if given else None, scene.frames[k])
-        b = copy.deepcopy(a)
+        b = copy.deepcopy(a) if how == "deepcopy" else pickle.loads(pickle.dumps(a))
         for k in range(12, len(scene.frames)):
             np.testing.assert_array_equal(
                 a.update(dets[k] if given else None, scene.frames[k]),

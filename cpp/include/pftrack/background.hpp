@@ -454,6 +454,45 @@ public:
         ++frame_count_;
     }
 
+    /// Everything a model has learnt (not its settings, not per-call scratch): what a pickled
+    /// model carries. `restore` checks a state's sizes before taking it.
+    struct State {
+        Index rows = 0, cols = 0;
+        long frame_count = 0;
+        bool learning = false;
+        double threshold = 0.0, threshold_scale = 1.0;
+        std::vector<float> background;
+        std::vector<std::uint8_t> previous;
+        std::array<std::int64_t, 256> hist{};
+    };
+
+    State state() const {
+        return State{rows_,     cols_,       frame_count_, learning_, threshold_,
+                     threshold_scale_, background_, previous_,    hist_};
+    }
+
+    void restore(State s) {
+        const char* fn = "BackgroundModel.__setstate__";
+        require(s.rows >= 0 && s.cols >= 0 && (s.rows == 0) == (s.cols == 0), fn, "size",
+                s.rows * s.cols, "rows and cols both 0 or both > 0");
+        const auto n = static_cast<size_t>(s.rows * s.cols * 3);
+        require(s.background.size() == n && s.previous.size() == n, fn, "background size",
+                s.background.size(), n);
+        require(s.frame_count >= 0, fn, "frame_count", s.frame_count, ">= 0");
+        require(std::isfinite(s.threshold) && std::isfinite(s.threshold_scale) &&
+                    s.threshold_scale > 0.0,
+                fn, "threshold scale", s.threshold_scale, "finite and > 0");
+        rows_ = s.rows;
+        cols_ = s.cols;
+        frame_count_ = s.frame_count;
+        learning_ = s.learning;
+        threshold_ = s.threshold;
+        threshold_scale_ = s.threshold_scale;
+        background_ = std::move(s.background);
+        previous_ = std::move(s.previous);
+        hist_ = s.hist;
+    }
+
 private:
     void allocate(Index rows, Index cols) {
         rows_ = rows;

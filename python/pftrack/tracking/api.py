@@ -251,11 +251,10 @@ class Tracker:
     -----
     One tracker is one run: use one per video and per thread. A second thread calling a
     method while another is inside one raises RuntimeError (as does the C++ background model
-    under any other path). ``copy.deepcopy(tracker)`` is a checkpoint at any point of a run
-    with the built-in ``"paper"`` detector and the ``"sis"`` or ``"mh"`` sampler (the copy goes
-    on exactly as the original); OpenCV's MOG2/KNN and the RJ-MCMC chain cannot be copied
-    once they have seen a frame. Pickling works before the first ``update`` only (the C++
-    background model has no pickled form: TypeError).
+    under any other path). ``copy.deepcopy(tracker)`` or a pickle of it is a checkpoint at any
+    point of a run with the built-in ``"paper"`` detector and the ``"sis"`` or ``"mh"``
+    sampler: the copy goes on exactly as the original. OpenCV's MOG2/KNN and the RJ-MCMC
+    chain cannot be copied once they have seen a frame (TypeError).
 
     Examples
     --------
