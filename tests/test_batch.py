@@ -934,6 +934,12 @@ def test_render_into_the_input_folder_can_be_re_run(
         # and without --render: the rendered video is still not an input
         assert main(["batch", str(folder), "--out", str(tmp_path / "o"), "--workers", "0",
                      *FAST]) == 0  # fmt: skip
+        # re-run into the folder itself without --render (other settings: redone), then
+        # again, with and without --render: was "two inputs are both named ..." (exit 2), the
+        # new sidecar no longer naming the first run's video
+        plain = [a for a in argv if a != "--render"]
+        for again in (plain, plain, argv, plain):
+            assert main(again) == 0, capsys.readouterr().err
     # a video of the same name that no sidecar beside it lists is an input: refused, as before
     (vids / "walk.json").unlink()
     with pytest.raises(ValueError, match="both named 'walk'"):

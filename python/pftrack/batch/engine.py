@@ -503,7 +503,12 @@ def _write(
     an `error` is written too, and its entry and sidecar say ``failed``: not complete either.
     """
     outputs = [f"{job.name}.txt", *(f"{job.name}{suffix}" for suffix in result.files)]
-    head = {"kind": kind, "settings": settings, "inputs": [str(p) for p in job.reads]}
+    head: dict[str, Any] = {
+        "kind": kind, "settings": settings, "inputs": [str(p) for p in job.reads],
+    }  # fmt: skip
+    left = [o for o in _earlier_outputs(out_dir, job.name, kind) if o not in outputs]
+    if left:  # an earlier run's video, not made again: still a batch's, never an input
+        head["earlier_outputs"] = left
     writing = {**head, "name": job.name, "status": "writing", "outputs": outputs}
     _write_sidecar(out_dir, job.name, writing)
     write_mot(
@@ -518,6 +523,24 @@ def _write(
         entry.update(error=result.error, traceback=result.traceback)
     _write_sidecar(out_dir, job.name, {**head, "fingerprint": prints, **entry})
     return entry
+
+
+def _earlier_outputs(out_dir: Path, name: str, kind: str) -> list[str]:
+    """The files an earlier run's sidecar lists (outputs and earlier ones) that are still there.
+
+    A batch rendered into its input folder and then run without ``--render`` leaves the
+    earlier ``NAME.mp4``; its new sidecar keeps naming it (``earlier_outputs``), or the video
+    would count as an input of every later batch of that folder (``two inputs are both named
+    NAME``).
+    """
+    try:
+        entry = json.loads(_sidecar(out_dir, name).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return []
+    if not isinstance(entry, dict) or entry.get("kind") != kind:
+        return []
+    listed = [*(entry.get("outputs") or []), *(entry.get("earlier_outputs") or [])]
+    return [o for o in dict.fromkeys(listed) if isinstance(o, str) and (out_dir / o).is_file()]
 
 
 def _write_sidecar(out_dir: Path, name: str, sidecar: dict[str, Any]) -> None:

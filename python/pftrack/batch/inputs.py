@@ -84,7 +84,8 @@ def _batch_output(path: Path) -> bool:
     """Whether the video `path` was written by a batch: the sidecar beside it lists it.
 
     ``pftrack batch --render`` writes ``DIR/NAME.mp4`` with its sidecar ``DIR/NAME.json``
-    (:mod:`pftrack.batch.engine`), whose ``outputs`` name it. Such a video is not an input
+    (:mod:`pftrack.batch.engine`), whose ``outputs`` name it (or, after a later run without
+    ``--render``, its ``earlier_outputs``). Such a video is not an input
     when its folder is looked into: a batch whose ``--out`` is its input folder can be re-run.
     """
     sidecar = path.with_name(f"{path.stem}.json")
@@ -96,8 +97,8 @@ def _batch_output(path: Path) -> bool:
         return False
     if not isinstance(entry, dict) or entry.get("kind") != "track":
         return False
-    outputs = entry.get("outputs")
-    return isinstance(outputs, list) and path.name in outputs
+    listed = [entry.get("outputs"), entry.get("earlier_outputs")]  # earlier: a run since
+    return any(isinstance(v, list) and path.name in v for v in listed)
 
 
 def _videos(folder: Path) -> list[Path]:
