@@ -742,6 +742,14 @@ def test_bad_usage_exits_2_before_any_work(
     assert "is an input of this run" in capsys.readouterr().err
     assert main(["recover", str(tracks), "--out", str(tmp_path / "o"), "--video", "v.avi"]) == 2
     assert "--video takes one tracks file" in capsys.readouterr().err
+    # a rendered video over an input video is --render's doing (was: named as --out)
+    mp4s = tmp_path / "mp4s"
+    mp4s.mkdir()
+    shutil.copy2(data / "walk.avi", mp4s / "port.mp4")
+    assert main(["batch", str(mp4s), "--out", str(mp4s), "--render", "--workers", "0"]) == 2
+    assert f"error: --render's output {mp4s / 'port.mp4'} is an input of this run" in (
+        capsys.readouterr().err
+    )
 
 
 def _tracks_files(folder: Path) -> list[Path]:

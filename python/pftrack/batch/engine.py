@@ -627,7 +627,10 @@ def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) 
     for name in [SUMMARY_NAME, *names]:
         target = out_dir / name
         if target.resolve() in reads or _file_id(target) in guarded:
-            raise ValueError(f"--out {target} is an input of this run; write elsewhere")
+            # which option makes it: a rendered video is --render's (was: always --out)
+            rendered = any(name.endswith(s) for s in suffixes)
+            what = f"--render's output {target}" if rendered else f"--out {target}"
+            raise ValueError(f"{what} is an input of this run; write elsewhere")
         if target.is_dir():
             raise ValueError(f"--out {target} is a folder; it would be an output of this run")
 
