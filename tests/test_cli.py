@@ -647,6 +647,28 @@ def test_options_the_built_in_detector_never_uses_are_refused(
     assert not out.exists()
 
 
+def test_background_options_with_no_refine_are_refused() -> None:
+    # was: --no-refine --detector knn --open-size 9 --bootstrap first wrote the same bytes as
+    # --no-refine alone (no background model runs)
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+
+    parse = build_parser().parse_args
+    given = ["track", "v", "--out", "o", "--detections", "d.txt", "--no-refine"]
+    with pytest.raises(ValueError, match=(
+        r"^--bootstrap first, --detector knn, --open-size 9: with --no-refine no background "
+        r"model runs, so they do nothing: drop them, or --no-refine$"
+    )):  # fmt: skip
+        tracker_config(parse([*given, "--detector", "knn", "--open-size", "9",
+                              "--bootstrap", "first"]))  # fmt: skip
+    with pytest.raises(ValueError, match=r"^--detector mog2: with --no-refine .* so it does "):
+        tracker_config(parse([*given, "--detector", "mog2"]))
+    # the joint sampler reads the detector's foreground: taken
+    cfg = tracker_config(parse([*given, "--detector", "mog2", "--sampler", "rjmcmc"]))
+    assert cfg.detector == "mog2" and not cfg.refine.enabled
+    tracker_config(parse([*given, "--detector", "paper"]))  # the defaults, named: taken
+
+
 def test_options_of_given_detections_are_taken_with_them(video: Path, tmp_path: Path) -> None:
     from pftrack.cli import build_parser
     from pftrack.cli._options import DEFAULT_BIRTH_SCORE, tracker_config

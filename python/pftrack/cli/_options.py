@@ -321,6 +321,23 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
                 "--detections"
             )
 
+    elif args.no_refine:  # no background model runs: the options of one do nothing
+        unused = [
+            f"{flag} {value}"
+            for flag, value, default, used in (
+                ("--bootstrap", getattr(args, "bootstrap", "auto"), "auto", False),
+                ("--detector", args.detector, "paper", args.sampler == "rjmcmc"),
+                ("--open-size", args.open_size, 0, args.sampler == "rjmcmc"),
+            )
+            if value != default and not used  # RJ-MCMC reads the detector's foreground
+        ]
+        if unused:
+            raise ValueError(
+                f"{', '.join(unused)}: with --no-refine no background model runs, so "
+                f"{'it does' if len(unused) == 1 else 'they do'} nothing: drop "
+                f"{'it' if len(unused) == 1 else 'them'}, or --no-refine"
+            )
+
     from pftrack.tracking import TrackerConfig
 
     base = TrackerConfig()
