@@ -7,6 +7,8 @@ with ``pftrack.eval.evaluate_sequence`` (HOTA, MOTA, IDF1, FP, FN, IDSW). Varian
 ``ident``  the frames as they are (real sequences: re-encoded as JPEG, quality 95)
 ``grey``   every pixel set to its grey level (B = G = R, ``cv2.COLOR_BGR2GRAY``)
 ``ramp``   brightness multiplied by ``1 - 0.6 k / (N - 1)`` at the k-th of N frames (to 40 %)
+``step``   brightness multiplied by 1.4 from the frame a third of the way in (clipped at 255):
+           a light switched on, the second user trial's clip
 ``crop``   the bottom-right 240x240 pixels of a real video; ground-truth boxes clipped to it,
            kept when at least half their area is inside (synthetic scenes: skipped)
 
@@ -51,7 +53,8 @@ from pftrack.synthetic import BUSY_SCENES, make_busy_scene, make_scene
 
 REAL: dict[str, Source] = {"pets": PETS, "tud": TUD}
 SYNTHETIC = ("walkers", *BUSY_SCENES)
-VARIANTS = ("ident", "grey", "ramp", "crop")
+VARIANTS = ("ident", "grey", "ramp", "step", "crop")
+STEP_GAIN = 1.4  # the ``step`` variant's brightening
 CROP = 240  # side of the bottom-right crop, in video pixels
 
 Frame = NDArray[np.uint8]
@@ -67,6 +70,13 @@ def ramp(frame: Frame, k: int, n: int, floor: float = 0.4) -> Frame:
     """The k-th (0-based) of `n` frames darkened linearly: gain 1 at the first, `floor` at the
     last (the trial's ``variants.py``: float32 product, clipped, truncated)."""
     gain = 1.0 - (1.0 - floor) * k / max(n - 1, 1)
+    return np.clip(frame.astype(np.float32) * gain, 0, 255).astype(np.uint8)
+
+
+def step(frame: Frame, k: int, n: int, gain: float = STEP_GAIN) -> Frame:
+    """The k-th (0-based) of `n` frames, brightened by `gain` from frame ``n // 3`` on."""
+    if k < n // 3:
+        return frame
     return np.clip(frame.astype(np.float32) * gain, 0, 255).astype(np.uint8)
 
 
@@ -92,6 +102,8 @@ def transform(frames: Sequence[Frame], variant: str) -> list[Frame]:
         return [grey(f) for f in frames]
     if variant == "ramp":
         return [ramp(f, k, n) for k, f in enumerate(frames)]
+    if variant == "step":
+        return [step(f, k, n) for k, f in enumerate(frames)]
     if variant == "crop":
         return [np.ascontiguousarray(f[-CROP:, -CROP:]) for f in frames]
     raise ValueError(f"unknown variant {variant!r}")

@@ -8,11 +8,13 @@ import pytest
 
 from pftrack import _core
 from pftrack.detection import PaperConfig, PaperDetector
+from pftrack.detection.base import median_frame
 from pftrack.detection.light import (
     channel_spread,
     frame_gain,
     is_dark,
     level_frames,
+    levelled_median,
     looks_grey,
 )
 from pftrack.eval import evaluate_mot
@@ -282,6 +284,65 @@ def test_prime_is_not_biased_by_a_person_standing_under_a_ramp() -> None:
         outside = bg[:10].sum() / ground[:10].sum()
         assert (abs(ratio - 1.0) < 0.05) == ok, (band, ratio)
         assert (abs(ratio - outside) < 0.05) == ok, (band, ratio, outside)
+
+
+def _saturating_step(
+    n: int = 30, gain: float = 1.4, lo: int = 190
+) -> tuple[list[np.ndarray], np.ndarray]:
+    """Frames of a bright ground (lo-249) that a light multiplies by `gain` from n // 3 on."""
+    rng = np.random.default_rng(3)
+    ground = rng.integers(lo, 250, (48, 64, 3)).astype(np.float32)
+    frames = [
+        np.clip(ground * (gain if k >= n // 3 else 1.0), 0, 255).astype(np.uint8) for k in range(n)
+    ]
+    return frames, ground
+
+
+def masked_median_reference(frames, band):
+    """NumPy: levelled frames, a brighter frame's saturated pixels left out of the median."""
+    levelled = level_frames(frames, band)
+    stack = np.stack(levelled).astype(np.float64)
+    for k, (a, b) in enumerate(zip(frames, levelled, strict=True)):
+        if a is not b and frame_gain(a, frames[0]) > 1.0:
+            stack[k][(a == 255).any(axis=2)] = np.nan
+    whole = np.median(np.stack(levelled).astype(np.float64), axis=0)
+    kept = np.nanmedian(stack, axis=0)
+    return np.where(np.isnan(kept), whole, kept)
+
+
+def test_levelled_median_leaves_out_the_saturated_pixels_of_brighter_frames() -> None:
+    # was: 255 / 1.4 = 182 where the ground is 190-239: the frames before the light came on
+    # read as foreground at every saturated pixel
+    frames, ground = _saturating_step()
+    got = levelled_median(frames, 0.03, "test")
+    np.testing.assert_allclose(got, masked_median_reference(frames, 0.03), atol=1e-4)
+    np.testing.assert_allclose(got, ground, atol=1.0)  # the first frames' light
+    plain = median_frame(level_frames(frames, 0.03), "test")
+    assert np.abs(plain - ground).max() > 20  # what the levelled frames alone give
+    # more rows than one chunk, a person in some frames: the same as the reference
+    big = [np.repeat(f, 3, axis=0) for f in frames]
+    for k in range(0, 30, 4):
+        big[k][20:90, 10:20] = 30
+    np.testing.assert_allclose(
+        levelled_median(big, 0.03, "test"), masked_median_reference(big, 0.03), atol=1e-4
+    )
+
+
+def test_levelled_median_of_steady_or_darkening_video_is_the_median() -> None:
+    scene = make_scene(n_frames=30, rng=0)
+    for frames in (scene.frames[::3], ramped(scene.frames[::3])):
+        np.testing.assert_array_equal(
+            levelled_median(frames, 0.03, "test"),
+            median_frame(level_frames(frames, 0.03), "test"),
+        )
+
+
+def test_a_light_switched_on_leaves_the_first_frames_clean() -> None:
+    # was: 11 % of the first frame foreground (the levelled median alone)
+    frames, _ = _saturating_step(lo=170)
+    det = PaperDetector()
+    det.prime(frames)
+    assert (det.detect(frames[0]).mask > 0).mean() < 0.01
 
 
 def test_detector_thresholds_follow_the_light() -> None:

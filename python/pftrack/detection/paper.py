@@ -16,13 +16,12 @@ from pftrack.detection.base import (
     BlobExtractor,
     Detections,
     check_frame,
-    median_frame,
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
 from pftrack.detection.light import (
     GAIN_SAMPLE_STEP,
     is_dark,
-    level_frames,
+    levelled_median,
     looks_grey,
     sample_step,
 )
@@ -96,7 +95,8 @@ class PaperConfig:
         column up to 640x480, sparser on larger frames: `pftrack.detection.light.sample_step`)
         is measured; outside ``[1 - gain_band, 1 + gain_band]`` the whole background is
         scaled by it (``BackgroundModel.scale``). `prime` also brings its frames to the first
-        one's brightness first (`pftrack.detection.light.level_frames`). Dark frames
+        one's brightness first, leaving out what a brighter frame saturated
+        (`pftrack.detection.light.levelled_median`). Dark frames
         (`pftrack.detection.light.is_dark`) are neither compared nor learnt, and do not prime
         or start the background. 0 turns all three off.
     gain_thresholds : bool
@@ -297,7 +297,7 @@ class PaperDetector:
             frames = lit  # a black frame (dropout, fade) is no picture of the empty scene
         # under a light change, the median of frames at their own brightness is biased where
         # people stand often: the frames are brought to the first one's light
-        median = median_frame(level_frames(frames, self.config.gain_band), "PaperDetector.prime")
+        median = levelled_median(frames, self.config.gain_band, "PaperDetector.prime")
         if self._grey is None:
             self._decide_grey(frames)
         self._model.reset()
