@@ -24,8 +24,7 @@ from __future__ import annotations
 import itertools
 import threading
 import warnings
-from collections.abc import Iterable, Iterator
-from contextlib import contextmanager
+from collections.abc import Iterable
 from dataclasses import replace
 from typing import Any
 
@@ -182,6 +181,28 @@ def check_boxes_xyxy(
     xywh[:, 2:4] = box[:, 2:] - box[:, :2]
     xywh[:, 4] = conf
     return xywh, cls, kept, clipped
+
+
+class _Alone:
+    """``with``: take `lock` without waiting (RuntimeError naming ``Tracker.method`` if held).
+
+    A class, not ``contextlib.contextmanager``: 0.4 us a call instead of 2.8 on ``update``.
+    """
+
+    __slots__ = ("lock", "method")
+
+    def __init__(self, lock: threading.Lock, method: str) -> None:
+        self.lock, self.method = lock, method
+
+    def __enter__(self) -> None:
+        if not self.lock.acquire(blocking=False):
+            raise RuntimeError(
+                f"Tracker.{self.method}: this Tracker is in use by another thread (use one "
+                "Tracker per thread, or a lock around it)"
+            )
+
+    def __exit__(self, *exc: object) -> None:
+        self.lock.release()
 
 
 class Tracker:
@@ -401,23 +422,14 @@ class Tracker:
         self._busy = threading.Lock()
         self.reset()
 
-    @contextmanager
-    def _alone(self, method: str) -> Iterator[None]:
+    def _alone(self, method: str) -> _Alone:
         """Hold the tracker for one call: a second thread raises instead of mixing two runs.
 
         A tracker is one run's state; two threads calling ``update`` on it at once would
         interleave their frames (and share the C++ background model, which refuses a second
         thread too). Not blocking: waiting would hide the mistake, not make the rows right.
         """
-        if not self._busy.acquire(blocking=False):
-            raise RuntimeError(
-                f"Tracker.{method}: this Tracker is in use by another thread (use one Tracker "
-                "per thread, or a lock around it)"
-            )
-        try:
-            yield
-        finally:
-            self._busy.release()
+        return _Alone(self._busy, method)
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
