@@ -882,6 +882,13 @@ def test_option_bounds_stated_for_help_are_the_librarys(tmp_path: Path) -> None:
             load_detections(empty, outside)
 
 
+def test_fps_range_is_seqinfos_frame_rate_range() -> None:
+    from pftrack.cli._options import FPS_RANGE
+    from pftrack.io.video import FRAME_RATE_RANGE
+
+    assert FPS_RANGE == FRAME_RATE_RANGE
+
+
 def test_help_shows_the_bounds_of_det_scale_and_max_gap(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

@@ -89,6 +89,23 @@ def test_fps_overrides_seqinfo(sequence: Path, tmp_path: Path) -> None:
     assert _video_info(video)[2:] == (12.5, 60)
 
 
+def test_a_seqinfo_frame_rate_outside_the_range_of_fps_is_refused(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: exit 0, an MP4 at 1e9 fps
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=1e9\n")
+    out, video = tmp_path / "t.txt", tmp_path / "r.mp4"
+    assert main(["track", str(seq), "--out", str(out), "--render", str(video)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: frameRate is '1e9', expected a frame rate "
+        "in [0.01, 1000] frames per second\n"
+    )
+    assert not out.exists() and not video.exists()
+
+
 def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -158,6 +158,18 @@ def test_bad_seqinfo_is_one_clear_error(tmp_path: Path, text: str, message: str)
         read_seqinfo(tmp_path)
 
 
+@pytest.mark.parametrize("rate", ["1e9", "1000.5", "0.001", "0.0099"])
+def test_a_frame_rate_outside_the_range_of_fps_is_refused(tmp_path: Path, rate: str) -> None:
+    # was: taken (1e9: an MP4 at 1e9 fps; 0.001: 100 frames made a 28-hour video)
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\nframeRate={rate}\n")
+    message = rf"seqinfo.ini: frameRate is '{rate}', expected a frame rate in \[0.01, 1000\] "
+    with pytest.raises(ValueError, match=message):
+        read_seqinfo(tmp_path)
+    for rate in ("0.01", "1000"):  # the bounds are in
+        (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\nframeRate={rate}\n")
+        assert read_seqinfo(tmp_path).frame_rate == float(rate)
+
+
 def test_seqinfo_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
     """Notepad's UTF-8 starts the file with a BOM; det/gt/results already skip it."""
     (tmp_path / "seqinfo.ini").write_bytes(b"\xef\xbb\xbf[Sequence]\nframeRate=7\nseqLength=3\n")

@@ -63,6 +63,9 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
 #: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 DEFAULT_FPS = 25.0
+#: The frame rates ``seqinfo.ini``'s ``frameRate`` may give, as ``pftrack track --fps`` (frames per
+#: second): 1e9 wrote an MP4 at 1e9 fps, 0.001 made 100 frames a 28-hour video.
+FRAME_RATE_RANGE = (0.01, 1000.0)
 #: The codec FFmpeg's ``tty`` demuxer reports: it opens text files (``.txt``, ``.nfo``, ``.asc``,
 #: ...) as ANSI art, 640x400 frames of rendered characters. A text file is not a video.
 TEXT_FOURCC = "ansi"
@@ -202,7 +205,8 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
     Raises
     ------
     ValueError
-        No ``[Sequence]`` section, or a field that is not a positive number.
+        No ``[Sequence]`` section, a field that is not a positive number, or a ``frameRate``
+        outside :data:`FRAME_RATE_RANGE`.
     """
     ini = Path(path)
     if ini.is_dir():
@@ -232,10 +236,17 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         value = number(key)
         return None if value is None else round(value)
 
+    frame_rate = number("frameRate")
+    lo, hi = FRAME_RATE_RANGE
+    if frame_rate is not None and not lo <= frame_rate <= hi:
+        raise ValueError(
+            f"{ini}: frameRate is {sec['frameRate'].strip()!r}, expected a frame rate in "
+            f"[{lo:g}, {hi:g}] frames per second"
+        )
     return SequenceInfo(
         folder=ini.parent,
         name=sec.get("name", ini.parent.name),
-        frame_rate=number("frameRate"),
+        frame_rate=frame_rate,
         image_dir=sec.get("imDir", "img1") or "img1",
         width=integer("imWidth"),
         height=integer("imHeight"),
