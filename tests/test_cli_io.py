@@ -106,6 +106,21 @@ def test_a_seqinfo_frame_rate_outside_the_range_of_fps_is_refused(
     assert not out.exists() and not video.exists()
 
 
+def test_a_seqinfo_key_given_twice_is_named(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: "SEQ/seqinfo.ini: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nframeRate=8\n")
+    assert main(["track", str(seq), "--out", str(tmp_path / "t.txt")]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: key frameRate in [Sequence] is given twice "
+        "(lines 2 and 3); give it once\n"
+    )
+
+
 def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -158,6 +158,24 @@ def test_bad_seqinfo_is_one_clear_error(tmp_path: Path, text: str, message: str)
         read_seqinfo(tmp_path)
 
 
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[Sequence]\nframeRate=7\nframeRate=8\n", r"key frameRate in \[Sequence\] is given "
+         r"twice \(lines 2 and 3\); give it once$"),
+        ("[Sequence]\nimWidth=7\nname=a\nIMWIDTH : 8\n", r"key imWidth in \[Sequence\] is "
+         r"given twice \(lines 2 and 4\)"),
+        ("\n[Sequence]\nframeRate=7\n[Sequence]\nseqLength=3\n", r"section \[Sequence\] is "
+         r"given twice \(lines 2 and 4\)"),
+    ],
+)  # fmt: skip
+def test_a_key_given_twice_is_named(tmp_path: Path, text: str, message: str) -> None:
+    # was: "SEQ/seqinfo.ini: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
+    (tmp_path / "seqinfo.ini").write_text(text)
+    with pytest.raises(ValueError, match=rf"^{re.escape(str(tmp_path))}/seqinfo.ini: {message}"):
+        read_seqinfo(tmp_path)
+
+
 @pytest.mark.parametrize("rate", ["1e9", "1000.5", "0.001", "0.0099"])
 def test_a_frame_rate_outside_the_range_of_fps_is_refused(tmp_path: Path, rate: str) -> None:
     # was: taken (1e9: an MP4 at 1e9 fps; 0.001: 100 frames made a 28-hour video)

@@ -199,14 +199,46 @@ def info_scale(
     return float(sx)
 
 
+def _duplicate(
+    ini: Path, exc: configparser.DuplicateOptionError | configparser.DuplicateSectionError
+) -> str:
+    """The message of a key or section `ini` gives twice, with the lines it is on.
+
+    configparser gives the line of the second one only (and the key in lower case): the file is
+    read again to find the first and the key as written.
+    """
+    option = getattr(exc, "option", None)  # None: a section given twice
+    section: str | None = None
+    lines: list[int] = []
+    written = option
+    try:
+        text = ini.read_text(encoding="utf-8-sig", errors="replace").splitlines()
+    except OSError:
+        text = []
+    for at, line in enumerate(text[: exc.lineno], start=1):
+        stripped = line.strip()
+        if stripped.startswith("[") and "]" in stripped:
+            section = stripped[1 : stripped.index("]")]
+            if option is None and section == exc.section:
+                lines.append(at)
+        elif option is not None and section == exc.section:
+            key = re.split(r"[=:]", stripped, maxsplit=1)[0].strip()
+            if key.lower() == option:
+                written = key if not lines else written  # as written the first time
+                lines.append(at)
+    where = f"lines {lines[0]} and {lines[-1]}" if len(lines) > 1 else f"line {exc.lineno}"
+    what = f"section [{exc.section}]" if option is None else f"key {written} in [{exc.section}]"
+    return f"{ini}: {what} is given twice ({where}); give it once"
+
+
 def read_seqinfo(path: PathLike) -> SequenceInfo:
     """Read a MOTChallenge ``seqinfo.ini`` (or the one in folder `path`).
 
     Raises
     ------
     ValueError
-        No ``[Sequence]`` section, a field that is not a positive number, or a ``frameRate``
-        outside :data:`FRAME_RATE_RANGE`.
+        No ``[Sequence]`` section, a key or section given twice, a field that is not a positive
+        number, or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`.
     """
     ini = Path(path)
     if ini.is_dir():
@@ -215,6 +247,8 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
     try:
         parser.read(ini, encoding="utf-8-sig")  # -sig: skips a byte-order mark (Notepad)
         sec = parser["Sequence"]
+    except (configparser.DuplicateOptionError, configparser.DuplicateSectionError) as exc:
+        raise ValueError(_duplicate(ini, exc)) from None
     except (configparser.Error, KeyError):
         raise ValueError(
             f"{ini}: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
