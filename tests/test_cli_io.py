@@ -121,6 +121,20 @@ def test_a_seqinfo_key_given_twice_is_named(
     )
 
 
+def test_a_seqinfo_fractional_width_is_refused_as_written(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: exit 0, imWidth=0.4 rounded to 0 and taken as absent (scale 1)
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nimWidth=0.4\n")
+    assert main(["track", str(seq), "--out", str(tmp_path / "t.txt")]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: imWidth is '0.4', expected an integer > 0\n"
+    )
+
+
 def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

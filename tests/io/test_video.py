@@ -176,6 +176,19 @@ def test_a_key_given_twice_is_named(tmp_path: Path, text: str, message: str) -> 
         read_seqinfo(tmp_path)
 
 
+@pytest.mark.parametrize("key", ["imWidth", "imHeight", "seqLength"])
+@pytest.mark.parametrize("value", ["0.4", "0.3", "768.5", "1e-3"])
+def test_a_fractional_size_or_length_is_refused(tmp_path: Path, key: str, value: str) -> None:
+    # was: rounded silently (imWidth=0.4 became 0, taken as absent; seqLength=0.3 was refused
+    # quoting "seqLength=0", a value the file does not hold)
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\n{key} = {value}\n")
+    with pytest.raises(ValueError, match=rf"seqinfo.ini: {key} is '{value}', expected an integer"):
+        read_seqinfo(tmp_path)
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\n{key}=768.0\n")  # a whole number
+    info = read_seqinfo(tmp_path)
+    assert {"imWidth": info.width, "imHeight": info.height, "seqLength": info.length}[key] == 768
+
+
 @pytest.mark.parametrize("rate", ["1e9", "1000.5", "0.001", "0.0099"])
 def test_a_frame_rate_outside_the_range_of_fps_is_refused(tmp_path: Path, rate: str) -> None:
     # was: taken (1e9: an MP4 at 1e9 fps; 0.001: 100 frames made a 28-hour video)

@@ -238,7 +238,8 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
     ------
     ValueError
         No ``[Sequence]`` section, a key or section given twice, a field that is not a positive
-        number, or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`.
+        number (``imWidth``, ``imHeight``, ``seqLength``: an integer), or a ``frameRate``
+        outside :data:`FRAME_RATE_RANGE`.
     """
     ini = Path(path)
     if ini.is_dir():
@@ -268,7 +269,9 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
 
     def integer(key: str) -> int | None:
         value = number(key)
-        return None if value is None else round(value)
+        if value is not None and not value.is_integer():  # was rounded: 0.4 to 0, an absent size
+            raise ValueError(f"{ini}: {key} is {sec[key].strip()!r}, expected an integer > 0")
+        return None if value is None else int(value)
 
     frame_rate = number("frameRate")
     lo, hi = FRAME_RATE_RANGE
