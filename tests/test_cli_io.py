@@ -276,6 +276,20 @@ def test_a_sequence_folder_with_one_video_tracks_as_its_video(
     assert (seq / "det.txt").read_bytes() == det
 
 
+def test_a_sequence_video_of_another_length_than_seqlength_is_tracked_with_a_warning(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: exit 0 and no word (an image folder of another length is refused)
+    seq = _video_sequence(sequence, scene, tmp_path / "SEQ")
+    n = len(scene.frames)
+    (seq / "seqinfo.ini").write_text(f"[Sequence]\nframeRate=7\nseqLength={n + 40}\n")
+    assert main(["-q", "track", str(seq), "--out", str(tmp_path / "t.txt"), "--no-link"]) == 0
+    assert capsys.readouterr().err == (
+        f"pftrack track: warning: {seq}/video.avi ended after {n} frames but "
+        f"{seq}/seqinfo.ini says seqLength={n + 40}\n"
+    )
+
+
 def test_a_sequence_folder_with_two_videos_is_refused(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -499,6 +499,39 @@ def test_a_video_that_ends_before_its_header_says_warns_once(tmp_path: Path) -> 
     assert sum(1 for _ in FrameSource(full)) == 20  # whole: no warning (warnings are errors)
 
 
+@pytest.mark.parametrize("length", [4, 9])
+def test_a_sequence_video_of_another_length_than_seqlength_warns_once(
+    tmp_path: Path, length: int
+) -> None:
+    # was: silent (an image folder of another length is refused; a video's header may be wrong)
+    seq = _video_sequence(tmp_path / "SEQ", 6)
+    ini = seq / "seqinfo.ini"
+    ini.write_text(ini.read_text().replace("seqLength=6", f"seqLength={length}"))
+    for src in (FrameSource(seq), FrameSource(seq / "video.avi")):  # the video beside it too
+        assert len(src) == 6  # the header's count: nothing decoded twice to count
+        message = rf"^{re.escape(str(seq))}/video.avi ended after 6 frames but "
+        message += rf"{re.escape(str(ini))} says seqLength={length}$"
+        with pytest.warns(UserWarning, match=message) as caught:
+            assert sum(1 for _ in src) == 6
+        assert len(caught) == 1
+        assert sum(1 for _ in src) == 6  # a second pass: no second warning (they are errors)
+        assert len(list(itertools.islice(FrameSource(seq), 3))) == 3  # stopped early: none
+    ini.write_text(ini.read_text().replace(f"seqLength={length}", "seqLength=6"))
+    assert sum(1 for _ in FrameSource(seq)) == 6  # as long as it says: no warning
+
+
+def test_a_truncated_sequence_video_names_its_header_and_seqlength(tmp_path: Path) -> None:
+    seq = _video_sequence(tmp_path / "SEQ", 0)
+    full = _mjpg(tmp_path / "full.avi", 20, np.random.default_rng(0))
+    data = full.read_bytes()
+    (seq / "video.avi").write_bytes(data[: len(data) // 2])  # the header still says 20 frames
+    ini = seq / "seqinfo.ini"
+    ini.write_text(ini.read_text().replace("seqLength=0", "seqLength=20"))
+    message = r"video.avi ended after \d+ frames but its header says 20 and .*seqinfo.ini says "
+    with pytest.warns(UserWarning, match=message + "seqLength=20: a truncated or damaged file"):
+        sum(1 for _ in FrameSource(seq))
+
+
 def test_an_image_of_another_size_in_a_folder_is_named(tmp_path: Path) -> None:
     rng = np.random.default_rng(1)
     for k in range(1, 6):

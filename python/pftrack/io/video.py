@@ -615,6 +615,12 @@ class FrameSource:
         sequence's image folder, also numbers that do not start at 1 or a count other than
         ``seqLength``).
 
+    Warns
+    -----
+    UserWarning
+        Once, when a video read to its end had fewer frames than its header says, or a number
+        other than its sequence's ``seqLength`` (counted as read: no pass of its own).
+
     Notes
     -----
     A file or folder can be iterated any number of times. A live source can be iterated once,
@@ -640,7 +646,7 @@ class FrameSource:
         self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
         self._image_shape = (0, 0)  # (height, width) of a folder's first image
-        self._warned_short = False  # a video that ended before its header's frame count
+        self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._cap: Any = None
         self._replay: list[NDArray[np.uint8]] = []
         self._read_past_replay = False
@@ -892,14 +898,31 @@ class FrameSource:
                 yield self._resize(frame)
         finally:
             cap.release()
-        if decoded < self.n_frames and not self._warned_short:  # read to the end (a stopped
-            self._warned_short = True  # reader never gets here); once, not on every pass
-            warnings.warn(
-                f"{self.name} ended after {decoded} frames but its header says "
-                f"{self.n_frames}: a truncated or damaged file?",
-                UserWarning,
-                stacklevel=2,
-            )
+        if not self._warned_short:  # read to the end (a stopped reader never gets here)
+            self._warn_frame_count(decoded)
+
+    def _warn_frame_count(self, decoded: int) -> None:
+        """Warn, once, if a video read to its end had other than its header's or seqLength's frames.
+
+        A sequence's ``seqLength`` is checked against the frames read only for a video (an image
+        folder's count is checked when it is opened): a video's header count may be wrong, and
+        a second decoding pass to count its frames would cost as much as the run.
+        """
+        said = []
+        if decoded < self.n_frames:
+            said.append(f"its header says {self.n_frames}")
+        seq = self.sequence
+        if seq is not None and seq.length is not None and decoded != seq.length:
+            said.append(f"{seq.folder / 'seqinfo.ini'} says seqLength={seq.length}")
+        if not said:
+            return
+        self._warned_short = True  # once, not on every pass
+        damaged = ": a truncated or damaged file?" if decoded < self.n_frames else ""
+        warnings.warn(
+            f"{self.path} ended after {decoded} frames but {' and '.join(said)}{damaged}",
+            UserWarning,
+            stacklevel=3,
+        )
 
     def _iter_live(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._read_past_replay:
