@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import signal
 import stat
@@ -337,6 +338,63 @@ def test_ctrl_c_on_a_file_aborts_and_keeps_the_old_outputs(
     assert "interrupted" in capsys.readouterr().err
     assert out.read_text() == "keep\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]  # no partial video
+
+
+#: A subprocess whose import of module MODULE raises KeyboardInterrupt, as Ctrl-C in its first
+#: 0.05 s did (deterministic: no race with a timer), then runs the ``pftrack`` console script's
+#: entry point (pyproject.toml's [project.scripts]) or ``python -m pftrack``.
+_INTERRUPTED_IMPORT = """
+import importlib, runpy, sys, tomllib
+class Interrupt:
+    def find_spec(self, name, path=None, target=None):
+        if name == MODULE:
+            raise KeyboardInterrupt
+        return None
+sys.meta_path.insert(0, Interrupt())
+sys.argv = ["pftrack", *ARGV]
+if HOW == "script":
+    with open("pyproject.toml", "rb") as f:
+        module, _, name = tomllib.load(f)["project"]["scripts"]["pftrack"].partition(":")
+    sys.exit(getattr(importlib.import_module(module), name)())
+runpy.run_module(HOW, run_name="__main__", alter_sys=True)
+"""
+
+
+@pytest.mark.parametrize(
+    ("how", "module"),
+    [
+        *itertools.product(
+            ["script", "pftrack"],
+            ["pftrack.cli", "pftrack.cli.track", "pftrack.cli._options", "pftrack._progress"],
+        ),
+        # python -m pftrack.cli imports its package before any of its code runs: from there on
+        ("pftrack.cli", "pftrack._progress"),
+    ],
+)
+def test_ctrl_c_during_start_up_is_one_line_and_130(
+    sequence: Path, tmp_path: Path, how: str, module: str
+) -> None:
+    # was: exit 130 with a KeyboardInterrupt traceback from an import (pftrack._progress: from
+    # main's "-q", before its handler)
+    out = tmp_path / "t.txt"
+    argv = ["-q", "track", str(sequence), "--out", str(out)]
+    code = f"MODULE, ARGV, HOW = {module!r}, {argv!r}, {how!r}\n{_INTERRUPTED_IMPORT}"
+    root = Path(__file__).parents[1]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
+    )
+    assert (proc.returncode, proc.stderr, proc.stdout) == (
+        130, "\npftrack track: interrupted; no output was changed\n", ""
+    )  # fmt: skip
+    assert not out.exists()
+
+
+def test_the_console_scripts_exit_status_is_the_clis() -> None:
+    from pftrack._console import EXIT_INTERRUPTED
+    from pftrack.cli._signals import EXIT_INTERRUPTED as CLI_EXIT_INTERRUPTED
+
+    assert EXIT_INTERRUPTED == CLI_EXIT_INTERRUPTED
 
 
 def _rows(path: Path) -> int:
