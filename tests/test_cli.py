@@ -606,6 +606,47 @@ def test_a_write_error_names_the_output(tmp_path: Path, capsys: pytest.CaptureFi
         )
 
 
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
+@pytest.mark.parametrize("option", ["--out", "--plot"])
+def test_a_track_write_error_names_the_output(
+    video: Path, tmp_path: Path, option: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "t.txt"
+    argv = ["-q", "track", str(video), "--out", str(out), "--particles", "40", "--no-link"]
+    assert main([*argv, option, "/dev/full"]) == 2
+    # was: "pftrack track: error: [Errno 28] No space left on device", no file named
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (
+        "pftrack track: error: No space left on device: /dev/full"
+    )
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["track", "VIDEO", "--out", "loopA"],
+        ["track", "VIDEO", "--out", "t.txt", "--render", "loopA"],
+        ["track", "VIDEO", "--out", "t.txt", "--plot", "loopA"],
+        ["smooth", "TRACKS", "--out", "loopA"],
+        ["eval", "--gt", "TRACKS", "--res", "TRACKS", "--json", "loopA"],
+    ],
+)
+def test_an_output_of_links_that_lead_to_each_other_names_its_option(
+    video: Path, tmp_path: Path, argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "loopA").symlink_to("loopB")
+    (tmp_path / "loopB").symlink_to("loopA")
+    tracks = _tracks(tmp_path / "tracks.txt")
+    names = {"VIDEO": str(video), "TRACKS": str(tracks)}
+    argv = [names.get(a, str(tmp_path / a) if a.startswith(("loop", "t.")) else a) for a in argv]
+    assert main(["-q", *argv]) == 2
+    option = argv[argv.index(str(tmp_path / "loopA")) - 1]
+    # was: "pftrack track: error: Too many levels of symbolic links: loopA", no option named
+    assert capsys.readouterr().err == (
+        f"pftrack {argv[0]}: error: {option} {tmp_path}/loopA: Too many levels of symbolic links\n"
+    )
+    assert not (tmp_path / "t.txt").exists()
+
+
 @pytest.mark.parametrize("command", ["track", "batch"])
 @pytest.mark.parametrize(
     ("option", "message"),
@@ -902,6 +943,13 @@ def test_option_bounds_stated_for_help_are_the_librarys(tmp_path: Path) -> None:
     for outside in (lo * 0.999, hi * 1.001):
         with pytest.raises(ValueError, match="detection scale"):
             load_detections(empty, outside)
+
+
+def test_fps_range_is_seqinfos_frame_rate_range() -> None:
+    from pftrack.cli._options import FPS_RANGE
+    from pftrack.io.video import FRAME_RATE_RANGE
+
+    assert FPS_RANGE == FRAME_RATE_RANGE
 
 
 def test_help_shows_the_bounds_of_det_scale_and_max_gap(

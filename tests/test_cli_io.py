@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import signal
 import stat
@@ -87,6 +88,52 @@ def test_fps_overrides_seqinfo(sequence: Path, tmp_path: Path) -> None:
             "--render", str(video), "--fps", "12.5", "--no-link"]  # fmt: skip
     assert main(argv) == 0
     assert _video_info(video)[2:] == (12.5, 60)
+
+
+def test_a_seqinfo_frame_rate_outside_the_range_of_fps_is_refused(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: exit 0, an MP4 at 1e9 fps
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=1e9\n")
+    out, video = tmp_path / "t.txt", tmp_path / "r.mp4"
+    assert main(["track", str(seq), "--out", str(out), "--render", str(video)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: frameRate is '1e9', expected a frame rate "
+        "in [0.01, 1000] frames per second\n"
+    )
+    assert not out.exists() and not video.exists()
+
+
+def test_a_seqinfo_key_given_twice_is_named(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: "SEQ/seqinfo.ini: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nframeRate=8\n")
+    assert main(["track", str(seq), "--out", str(tmp_path / "t.txt")]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: key frameRate in [Sequence] is given twice "
+        "(lines 2 and 3); give it once\n"
+    )
+
+
+def test_a_seqinfo_fractional_width_is_refused_as_written(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: exit 0, imWidth=0.4 rounded to 0 and taken as absent (scale 1)
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nimWidth=0.4\n")
+    assert main(["track", str(seq), "--out", str(tmp_path / "t.txt")]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: imWidth is '0.4', expected an integer > 0\n"
+    )
 
 
 def test_sequence_detections_in_seqinfo_pixels_are_scaled(
@@ -230,6 +277,20 @@ def test_a_sequence_folder_with_one_video_tracks_as_its_video(
     assert (seq / "det.txt").read_bytes() == det
 
 
+def test_a_sequence_video_of_another_length_than_seqlength_is_tracked_with_a_warning(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: exit 0 and no word (an image folder of another length is refused)
+    seq = _video_sequence(sequence, scene, tmp_path / "SEQ")
+    n = len(scene.frames)
+    (seq / "seqinfo.ini").write_text(f"[Sequence]\nframeRate=7\nseqLength={n + 40}\n")
+    assert main(["-q", "track", str(seq), "--out", str(tmp_path / "t.txt"), "--no-link"]) == 0
+    assert capsys.readouterr().err == (
+        f"pftrack track: warning: {seq}/video.avi ended after {n} frames but "
+        f"{seq}/seqinfo.ini says seqLength={n + 40}\n"
+    )
+
+
 def test_a_sequence_folder_with_two_videos_is_refused(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -277,6 +338,63 @@ def test_ctrl_c_on_a_file_aborts_and_keeps_the_old_outputs(
     assert "interrupted" in capsys.readouterr().err
     assert out.read_text() == "keep\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]  # no partial video
+
+
+#: A subprocess whose import of module MODULE raises KeyboardInterrupt, as Ctrl-C in its first
+#: 0.05 s did (deterministic: no race with a timer), then runs the ``pftrack`` console script's
+#: entry point (pyproject.toml's [project.scripts]) or ``python -m pftrack``.
+_INTERRUPTED_IMPORT = """
+import importlib, runpy, sys, tomllib
+class Interrupt:
+    def find_spec(self, name, path=None, target=None):
+        if name == MODULE:
+            raise KeyboardInterrupt
+        return None
+sys.meta_path.insert(0, Interrupt())
+sys.argv = ["pftrack", *ARGV]
+if HOW == "script":
+    with open("pyproject.toml", "rb") as f:
+        module, _, name = tomllib.load(f)["project"]["scripts"]["pftrack"].partition(":")
+    sys.exit(getattr(importlib.import_module(module), name)())
+runpy.run_module(HOW, run_name="__main__", alter_sys=True)
+"""
+
+
+@pytest.mark.parametrize(
+    ("how", "module"),
+    [
+        *itertools.product(
+            ["script", "pftrack"],
+            ["pftrack.cli", "pftrack.cli.track", "pftrack.cli._options", "pftrack._progress"],
+        ),
+        # python -m pftrack.cli imports its package before any of its code runs: from there on
+        ("pftrack.cli", "pftrack._progress"),
+    ],
+)
+def test_ctrl_c_during_start_up_is_one_line_and_130(
+    sequence: Path, tmp_path: Path, how: str, module: str
+) -> None:
+    # was: exit 130 with a KeyboardInterrupt traceback from an import (pftrack._progress: from
+    # main's "-q", before its handler)
+    out = tmp_path / "t.txt"
+    argv = ["-q", "track", str(sequence), "--out", str(out)]
+    code = f"MODULE, ARGV, HOW = {module!r}, {argv!r}, {how!r}\n{_INTERRUPTED_IMPORT}"
+    root = Path(__file__).parents[1]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
+    )
+    assert (proc.returncode, proc.stderr, proc.stdout) == (
+        130, "\npftrack track: interrupted; no output was changed\n", ""
+    )  # fmt: skip
+    assert not out.exists()
+
+
+def test_the_console_scripts_exit_status_is_the_clis() -> None:
+    from pftrack._console import EXIT_INTERRUPTED
+    from pftrack.cli._signals import EXIT_INTERRUPTED as CLI_EXIT_INTERRUPTED
+
+    assert EXIT_INTERRUPTED == CLI_EXIT_INTERRUPTED
 
 
 def _rows(path: Path) -> int:

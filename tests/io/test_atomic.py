@@ -221,6 +221,12 @@ def test_a_symlink_loop_is_an_error(tmp_path: Path) -> None:
     (tmp_path / "b").symlink_to("a")
     with pytest.raises(OSError, match="symbolic links"), atomic_write(tmp_path / "a"):
         pass
+    from pftrack.io.atomic import check_output
+
+    for suffixes in (None, (".txt",)):  # was: "Too many levels of symbolic links", no option
+        message = rf"^--out {tmp_path}/a: Too many levels of symbolic links$"
+        with pytest.raises(OSError, match=message):
+            check_output(tmp_path / "a", what="--out", suffixes=suffixes)
 
 
 def test_a_named_pipe_is_written_through_not_replaced(tmp_path: Path) -> None:
@@ -324,4 +330,9 @@ def test_a_write_error_names_the_output(tmp_path: Path, monkeypatch) -> None:
         assert (exc.value.errno, exc.value.filename) == (errno.ENOSPC, "/dev/full")
         with pytest.raises(OSError) as exc, atomic_path("/dev/full") as tmp:
             tmp.write_bytes(b"x")
+        assert (exc.value.errno, exc.value.filename) == (errno.ENOSPC, "/dev/full")
+        from pftrack.io.atomic import staged_outputs
+
+        with pytest.raises(OSError) as exc, staged_outputs() as stage:  # was: no file name
+            stage("/dev/full").write_bytes(b"x")
         assert (exc.value.errno, exc.value.filename) == (errno.ENOSPC, "/dev/full")

@@ -158,6 +158,49 @@ def test_bad_seqinfo_is_one_clear_error(tmp_path: Path, text: str, message: str)
         read_seqinfo(tmp_path)
 
 
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[Sequence]\nframeRate=7\nframeRate=8\n", r"key frameRate in \[Sequence\] is given "
+         r"twice \(lines 2 and 3\); give it once$"),
+        ("[Sequence]\nimWidth=7\nname=a\nIMWIDTH : 8\n", r"key imWidth in \[Sequence\] is "
+         r"given twice \(lines 2 and 4\)"),
+        ("\n[Sequence]\nframeRate=7\n[Sequence]\nseqLength=3\n", r"section \[Sequence\] is "
+         r"given twice \(lines 2 and 4\)"),
+    ],
+)  # fmt: skip
+def test_a_key_given_twice_is_named(tmp_path: Path, text: str, message: str) -> None:
+    # was: "SEQ/seqinfo.ini: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
+    (tmp_path / "seqinfo.ini").write_text(text)
+    with pytest.raises(ValueError, match=rf"^{re.escape(str(tmp_path))}/seqinfo.ini: {message}"):
+        read_seqinfo(tmp_path)
+
+
+@pytest.mark.parametrize("key", ["imWidth", "imHeight", "seqLength"])
+@pytest.mark.parametrize("value", ["0.4", "0.3", "768.5", "1e-3"])
+def test_a_fractional_size_or_length_is_refused(tmp_path: Path, key: str, value: str) -> None:
+    # was: rounded silently (imWidth=0.4 became 0, taken as absent; seqLength=0.3 was refused
+    # quoting "seqLength=0", a value the file does not hold)
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\n{key} = {value}\n")
+    with pytest.raises(ValueError, match=rf"seqinfo.ini: {key} is '{value}', expected an integer"):
+        read_seqinfo(tmp_path)
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\n{key}=768.0\n")  # a whole number
+    info = read_seqinfo(tmp_path)
+    assert {"imWidth": info.width, "imHeight": info.height, "seqLength": info.length}[key] == 768
+
+
+@pytest.mark.parametrize("rate", ["1e9", "1000.5", "0.001", "0.0099"])
+def test_a_frame_rate_outside_the_range_of_fps_is_refused(tmp_path: Path, rate: str) -> None:
+    # was: taken (1e9: an MP4 at 1e9 fps; 0.001: 100 frames made a 28-hour video)
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\nframeRate={rate}\n")
+    message = rf"seqinfo.ini: frameRate is '{rate}', expected a frame rate in \[0.01, 1000\] "
+    with pytest.raises(ValueError, match=message):
+        read_seqinfo(tmp_path)
+    for rate in ("0.01", "1000"):  # the bounds are in
+        (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\nframeRate={rate}\n")
+        assert read_seqinfo(tmp_path).frame_rate == float(rate)
+
+
 def test_seqinfo_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
     """Notepad's UTF-8 starts the file with a BOM; det/gt/results already skip it."""
     (tmp_path / "seqinfo.ini").write_bytes(b"\xef\xbb\xbf[Sequence]\nframeRate=7\nseqLength=3\n")
@@ -454,6 +497,39 @@ def test_a_video_that_ends_before_its_header_says_warns_once(tmp_path: Path) -> 
     assert sum(1 for _ in src) == n  # a second pass: the same frames, no second warning
     assert len(list(itertools.islice(FrameSource(cut), 3))) == 3  # stopped early: no warning
     assert sum(1 for _ in FrameSource(full)) == 20  # whole: no warning (warnings are errors)
+
+
+@pytest.mark.parametrize("length", [4, 9])
+def test_a_sequence_video_of_another_length_than_seqlength_warns_once(
+    tmp_path: Path, length: int
+) -> None:
+    # was: silent (an image folder of another length is refused; a video's header may be wrong)
+    seq = _video_sequence(tmp_path / "SEQ", 6)
+    ini = seq / "seqinfo.ini"
+    ini.write_text(ini.read_text().replace("seqLength=6", f"seqLength={length}"))
+    for src in (FrameSource(seq), FrameSource(seq / "video.avi")):  # the video beside it too
+        assert len(src) == 6  # the header's count: nothing decoded twice to count
+        message = rf"^{re.escape(str(seq))}/video.avi ended after 6 frames but "
+        message += rf"{re.escape(str(ini))} says seqLength={length}$"
+        with pytest.warns(UserWarning, match=message) as caught:
+            assert sum(1 for _ in src) == 6
+        assert len(caught) == 1
+        assert sum(1 for _ in src) == 6  # a second pass: no second warning (they are errors)
+        assert len(list(itertools.islice(FrameSource(seq), 3))) == 3  # stopped early: none
+    ini.write_text(ini.read_text().replace(f"seqLength={length}", "seqLength=6"))
+    assert sum(1 for _ in FrameSource(seq)) == 6  # as long as it says: no warning
+
+
+def test_a_truncated_sequence_video_names_its_header_and_seqlength(tmp_path: Path) -> None:
+    seq = _video_sequence(tmp_path / "SEQ", 0)
+    full = _mjpg(tmp_path / "full.avi", 20, np.random.default_rng(0))
+    data = full.read_bytes()
+    (seq / "video.avi").write_bytes(data[: len(data) // 2])  # the header still says 20 frames
+    ini = seq / "seqinfo.ini"
+    ini.write_text(ini.read_text().replace("seqLength=0", "seqLength=20"))
+    message = r"video.avi ended after \d+ frames but its header says 20 and .*seqinfo.ini says "
+    with pytest.warns(UserWarning, match=message + "seqLength=20: a truncated or damaged file"):
+        sum(1 for _ in FrameSource(seq))
 
 
 def test_an_image_of_another_size_in_a_folder_is_named(tmp_path: Path) -> None:

@@ -4,6 +4,6 @@ from __future__ import annotations
 
 import sys
 
-from pftrack.cli import main
+from pftrack._console import main
 
 sys.exit(main())

@@ -22,6 +22,10 @@ DEFAULT_BIRTH_SCORE = 0.9
 #: :func:`pftrack.tracking.load_detections` accepts, stated here for the same reason (a test
 #: checks they agree).
 DET_SCALE_RANGE = (1e-3, 1e3)
+#: ``--fps``'s range (``track``): :data:`pftrack.io.video.FRAME_RATE_RANGE`, the one
+#: ``seqinfo.ini``'s ``frameRate`` may give, stated here for the same reason (a test checks they
+#: agree).
+FPS_RANGE = (0.01, 1000.0)
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):

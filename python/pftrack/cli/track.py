@@ -12,6 +12,7 @@ from typing import IO, Any
 
 from pftrack.cli._options import (
     DET_SCALE_RANGE,
+    FPS_RANGE,
     add_command,
     add_tracker_options,
     bounded_float,
@@ -66,9 +67,10 @@ def add_parser(sub: Any) -> None:
         "seqinfo.ini's imWidth, else 1; a number only with --detections",
     )  # fmt: skip
     p.add_argument(
-        "--fps", type=bounded_float(0.01, 1000.0), metavar="FPS",
-        help="frame rate of SOURCE, for --render, 0.01 to 1000 (default: seqinfo.ini's "
-        "frameRate, else the container's header, else 25)",
+        "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
+        help=f"frame rate of SOURCE, for --render, {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} "
+        "(default: seqinfo.ini's frameRate, in the same range, else the container's header, "
+        "else 25)",
     )  # fmt: skip
     p.add_argument(
         "--render", metavar="VIDEO",

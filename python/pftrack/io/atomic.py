@@ -319,6 +319,8 @@ def check_output(
     PermissionError
         Its folder (or the existing file) is not writable: checked by creating (and removing)
         a file beside it.
+    OSError
+        Its symbolic links cannot be followed (a loop: ``a`` to ``b`` to ``a``), naming `what`.
 
     Notes
     -----
@@ -336,9 +338,12 @@ def check_output(
     if target.is_dir():
         raise ValueError(f"{what} {target} is a folder; give a file name")
     _refuse_folder_name(text, what)
+    try:
+        resolved = _resolve(text)
+    except OSError as exc:  # links that lead to each other: was "Too many levels ...: loopA"
+        raise OSError(f"{what} {target}: {exc.strerror or exc}") from None
     if suffixes is not None:
         output_format(text, suffixes, what)  # a device without extension: the first
-    resolved = _resolve(text)
     written = resolved.path
     if resolved.through:
         if resolved.fd is None and not os.access(written, os.W_OK):
@@ -542,7 +547,8 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
         for tmp, target in staged:
             os.replace(tmp, target)
         for tmp_path, resolved in through:  # last: a FIFO waits for its reader
-            _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
+            with _named(resolved.path):  # /dev/full: "No space left on device" named no file
+                _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
     except BaseException:
         _remove(made)
         for tmp in made:

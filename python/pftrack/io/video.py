@@ -63,6 +63,9 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
 #: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 DEFAULT_FPS = 25.0
+#: The frame rates ``seqinfo.ini``'s ``frameRate`` may give, as ``pftrack track --fps`` (frames per
+#: second): 1e9 wrote an MP4 at 1e9 fps, 0.001 made 100 frames a 28-hour video.
+FRAME_RATE_RANGE = (0.01, 1000.0)
 #: The codec FFmpeg's ``tty`` demuxer reports: it opens text files (``.txt``, ``.nfo``, ``.asc``,
 #: ...) as ANSI art, 640x400 frames of rendered characters. A text file is not a video.
 TEXT_FOURCC = "ansi"
@@ -196,13 +199,47 @@ def info_scale(
     return float(sx)
 
 
+def _duplicate(
+    ini: Path, exc: configparser.DuplicateOptionError | configparser.DuplicateSectionError
+) -> str:
+    """The message of a key or section `ini` gives twice, with the lines it is on.
+
+    configparser gives the line of the second one only (and the key in lower case): the file is
+    read again to find the first and the key as written.
+    """
+    option = getattr(exc, "option", None)  # None: a section given twice
+    section: str | None = None
+    lines: list[int] = []
+    written = option
+    try:
+        text = ini.read_text(encoding="utf-8-sig", errors="replace").splitlines()
+    except OSError:
+        text = []
+    for at, line in enumerate(text[: exc.lineno], start=1):
+        stripped = line.strip()
+        if stripped.startswith("[") and "]" in stripped:
+            section = stripped[1 : stripped.index("]")]
+            if option is None and section == exc.section:
+                lines.append(at)
+        elif option is not None and section == exc.section:
+            key = re.split(r"[=:]", stripped, maxsplit=1)[0].strip()
+            if key.lower() == option:
+                written = key if not lines else written  # as written the first time
+                lines.append(at)
+    where = f"lines {lines[0]} and {lines[-1]}" if len(lines) > 1 else f"line {exc.lineno}"
+    what = f"section [{exc.section}]" if option is None else f"key {written} in [{exc.section}]"
+    return f"{ini}: {what} is given twice ({where}); give it once"
+
+
 def read_seqinfo(path: PathLike) -> SequenceInfo:
     """Read a MOTChallenge ``seqinfo.ini`` (or the one in folder `path`).
 
     Raises
     ------
     ValueError
-        No ``[Sequence]`` section, or a field that is not a positive number.
+        No ``[Sequence]`` section, a key or section given twice, a field that is not a positive
+        number (``imWidth``, ``imHeight``, ``seqLength``: an integer), or a ``frameRate``
+        outside :data:`FRAME_RATE_RANGE`.
     """
     ini = Path(path)
     if ini.is_dir():
@@ -211,6 +248,8 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
     try:
         parser.read(ini, encoding="utf-8-sig")  # -sig: skips a byte-order mark (Notepad)
         sec = parser["Sequence"]
+    except (configparser.DuplicateOptionError, configparser.DuplicateSectionError) as exc:
+        raise ValueError(_duplicate(ini, exc)) from None
     except (configparser.Error, KeyError):
         raise ValueError(
             f"{ini}: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
@@ -230,12 +269,21 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
 
     def integer(key: str) -> int | None:
         value = number(key)
-        return None if value is None else round(value)
+        if value is not None and not value.is_integer():  # was rounded: 0.4 to 0, an absent size
+            raise ValueError(f"{ini}: {key} is {sec[key].strip()!r}, expected an integer > 0")
+        return None if value is None else int(value)
 
+    frame_rate = number("frameRate")
+    lo, hi = FRAME_RATE_RANGE
+    if frame_rate is not None and not lo <= frame_rate <= hi:
+        raise ValueError(
+            f"{ini}: frameRate is {sec['frameRate'].strip()!r}, expected a frame rate in "
+            f"[{lo:g}, {hi:g}] frames per second"
+        )
     return SequenceInfo(
         folder=ini.parent,
         name=sec.get("name", ini.parent.name),
-        frame_rate=number("frameRate"),
+        frame_rate=frame_rate,
         image_dir=sec.get("imDir", "img1") or "img1",
         width=integer("imWidth"),
         height=integer("imHeight"),
@@ -567,6 +615,12 @@ class FrameSource:
         sequence's image folder, also numbers that do not start at 1 or a count other than
         ``seqLength``).
 
+    Warns
+    -----
+    UserWarning
+        Once, when a video read to its end had fewer frames than its header says, or a number
+        other than its sequence's ``seqLength`` (counted as read: no pass of its own).
+
     Notes
     -----
     A file or folder can be iterated any number of times. A live source can be iterated once,
@@ -592,7 +646,7 @@ class FrameSource:
         self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
         self._image_shape = (0, 0)  # (height, width) of a folder's first image
-        self._warned_short = False  # a video that ended before its header's frame count
+        self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._cap: Any = None
         self._replay: list[NDArray[np.uint8]] = []
         self._read_past_replay = False
@@ -844,14 +898,31 @@ class FrameSource:
                 yield self._resize(frame)
         finally:
             cap.release()
-        if decoded < self.n_frames and not self._warned_short:  # read to the end (a stopped
-            self._warned_short = True  # reader never gets here); once, not on every pass
-            warnings.warn(
-                f"{self.name} ended after {decoded} frames but its header says "
-                f"{self.n_frames}: a truncated or damaged file?",
-                UserWarning,
-                stacklevel=2,
-            )
+        if not self._warned_short:  # read to the end (a stopped reader never gets here)
+            self._warn_frame_count(decoded)
+
+    def _warn_frame_count(self, decoded: int) -> None:
+        """Warn, once, if a video read to its end had other than its header's or seqLength's frames.
+
+        A sequence's ``seqLength`` is checked against the frames read only for a video (an image
+        folder's count is checked when it is opened): a video's header count may be wrong, and
+        a second decoding pass to count its frames would cost as much as the run.
+        """
+        said = []
+        if decoded < self.n_frames:
+            said.append(f"its header says {self.n_frames}")
+        seq = self.sequence
+        if seq is not None and seq.length is not None and decoded != seq.length:
+            said.append(f"{seq.folder / 'seqinfo.ini'} says seqLength={seq.length}")
+        if not said:
+            return
+        self._warned_short = True  # once, not on every pass
+        damaged = ": a truncated or damaged file?" if decoded < self.n_frames else ""
+        warnings.warn(
+            f"{self.path} ended after {decoded} frames but {' and '.join(said)}{damaged}",
+            UserWarning,
+            stacklevel=3,
+        )
 
     def _iter_live(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._read_past_replay:

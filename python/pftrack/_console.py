@@ -1,0 +1,48 @@
+"""The ``pftrack`` console script and ``python -m pftrack``: :func:`pftrack.cli.main`, wrapped.
+
+Ctrl-C while the command line is imported (its first 0.05-0.1 s) raised a ``KeyboardInterrupt``
+outside :func:`pftrack.cli.main`, which prints a traceback; here it ends as an interrupted
+command does, in one line with exit status 130. Nothing is imported before the ``try`` but
+this module: whatever is interrupted may be half loaded, so the handler loads nothing either.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+__all__ = ["main"]
+
+#: :data:`pftrack.cli._signals.EXIT_INTERRUPTED`, stated here: the module that states it may be
+#: what was interrupted (a test checks they agree).
+EXIT_INTERRUPTED = 130
+
+
+def _command(argv: Sequence[str]) -> str:
+    """``pftrack CMD`` for the command `argv` names (its first non-option word), or ``pftrack``."""
+    word = next((a for a in argv if not a.startswith("-")), None)
+    return "pftrack" if word is None else f"pftrack {word}"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``pftrack`` command (:func:`pftrack.cli.main`); return its exit status.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The command's exit status; 130 after Ctrl-C before the command handles it itself
+        (while the command line is imported or its arguments parsed).
+    """
+    try:
+        from pftrack.cli import main as run
+
+        return run(argv)
+    except KeyboardInterrupt:  # before the command's own handler: nothing was written yet
+        words = sys.argv[1:] if argv is None else argv
+        print(f"\n{_command(words)}: interrupted; no output was changed", file=sys.stderr)
+        return EXIT_INTERRUPTED
