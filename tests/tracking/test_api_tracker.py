@@ -614,13 +614,18 @@ def test_no_track_warning_of_the_built_in_detector_blames_it():
     [
         ("no box", "the detections given held no box"),
         ("outside", r"no detection lay inside the frame \(wrong coordinate scale\?\)"),
+        # was: "the highest detection confidence was 0.95 (... birth_score 0.9)", not the cause
+        ("tiny", r"every detection inside the frame was under min_area=64 pixels \(40 left out; "
+                 r"LifecycleConfig.min_area\)"),
     ],
-)
+)  # fmt: skip
 def test_no_track_warning_says_what_the_detections_were(scene, where, hint):
     # was "no external detection was given" for both: detections were given
     w = scene.frames[0].shape[1]
     far = np.array([[w + 10.0, 10.0, w + 30.0, 50.0, 1.0]])
-    dets = [np.zeros((0, 5)) if where == "no box" else far] * len(scene.frames)
+    tiny = np.array([[100.0, 100.0, 105.0, 105.0, 0.95]])
+    box = {"no box": np.zeros((0, 5)), "outside": far, "tiny": tiny}[where]
+    dets = [box] * len(scene.frames)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         _, rows = run_loop(pftrack.Tracker(seed=0), scene.frames, dets)

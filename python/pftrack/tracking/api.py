@@ -654,6 +654,12 @@ class Tracker:
                 "the joint sampler (rjmcmc) kept no object of the detections given (each is "
                 "proposed as a birth; too few frames, or no colour to weigh them?)"
             )
+        tiny, kept = self._tracker.tiny_given, self._tracker.kept_given
+        if tiny and not kept:  # not the confidences: every box was too small to track
+            return (
+                f"every detection inside the frame was under min_area={cfg.min_area:g} pixels "
+                f"({tiny} left out; LifecycleConfig.min_area)"
+            )
         if np.isfinite(self._max_conf):
             return (
                 f"the highest detection confidence was {self._max_conf:.3g} (min_conf "

@@ -132,6 +132,10 @@ class MultiObjectTracker:
         self.tracks: list[LiveTrack] = []
         self._ended_unconfirmed: set[int] = set()
         self._n_started = 0  # tracks started so far (see tracks_started)
+        #: Given detections left out for their size (under ``LifecycleConfig.min_area`` pixels
+        #: clear of the frame's border), and given ones kept, over the run: why no track, said.
+        self.tiny_given = 0
+        self.kept_given = 0
         self.frame_index = 0
         self._mask: NDArray[np.uint8] | None = None  # the last frame's, see last_mask
         self._mask_shaded = False  # whether _mask still has its shadow pixels (127)
@@ -429,11 +433,12 @@ class MultiObjectTracker:
         self.camera_step = step
         boxes, scores, binned = self._detections(f, None if given is None else given[:2])
         labels = np.zeros(len(boxes), np.int64) if given is None else given[2]
-        index = (
-            (scores >= cfg.lifecycle.min_score)
-            & ~tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
-        ).nonzero()[0]
+        tiny = tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
+        index = ((scores >= cfg.lifecycle.min_score) & ~tiny).nonzero()[0]
         boxes, scores, labels = boxes[index], scores[index], labels[index]
+        if given is not None:
+            self.tiny_given += int(tiny.sum())
+            self.kept_given += len(index)
         if given is not None and len(given[1]) and not self._negative_warned:
             low = float(given[1].min())
             if low < 0.0 and low < cfg.lifecycle.min_score:  # said once a run
