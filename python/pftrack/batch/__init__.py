@@ -17,6 +17,7 @@ Dask itself is imported only when a cluster is used.
 
 from __future__ import annotations
 
+from pftrack._lazy import lazy_exports
 from pftrack.batch.api import recover_many, smooth_many, track_many
 from pftrack.batch.engine import BatchSummary, Job, dask_client, fingerprint, run_jobs
 from pftrack.batch.inputs import SequenceInput, find_sequences, find_track_files
@@ -52,3 +53,6 @@ __all__ = [
     "track_many",
     "track_sequence",
 ]
+
+# a public submodule loads on first use after a bare ``import pftrack`` (``pftrack.batch.x``)
+_, __getattr__, __dir__ = lazy_exports(__name__, {}, globals())

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from pftrack._lazy import lazy_exports
 from pftrack.detection.base import BlobConfig, Detections, Detector, check_detections, check_frame
 from pftrack.detection.opencv_bg import KnnConfig, KnnDetector, Mog2Config, Mog2Detector
 from pftrack.detection.paper import PaperConfig, PaperDetector
@@ -82,3 +83,7 @@ def make_detector(name: str, **config: Any) -> PaperDetector | Mog2Detector | Kn
     if name == "knn":
         return KnnDetector(_split(KnnConfig, config, name))
     raise ValueError(f"make_detector: name is {name!r}, expected one of {', '.join(DETECTORS)}")
+
+
+# a public submodule loads on first use after a bare ``import pftrack`` (``pftrack.detection.x``)
+_, __getattr__, __dir__ = lazy_exports(__name__, {}, globals())

@@ -7,6 +7,7 @@ reads a MOTChallenge folder of sequences.
 
 from __future__ import annotations
 
+from pftrack._lazy import lazy_exports
 from pftrack.eval.hota import (
     ALPHAS,
     HotaMetrics,
@@ -46,3 +47,6 @@ __all__ = [
     "mot_iou",
     "prepare_mot",
 ]
+
+# a public submodule loads on first use after a bare ``import pftrack`` (``pftrack.eval.x``)
+_, __getattr__, __dir__ = lazy_exports(__name__, {}, globals())

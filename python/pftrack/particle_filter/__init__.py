@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pftrack._lazy import lazy_exports
 from pftrack.particle_filter.colour import (
     BinnedImage,
     HsvBinning,
@@ -45,3 +46,6 @@ __all__ = [
     "stratified_resample",
     "systematic_resample",
 ]
+
+# public submodules load on first use after a bare ``import pftrack``
+_, __getattr__, __dir__ = lazy_exports(__name__, {}, globals())

@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+from pftrack._lazy import lazy_exports
 from pftrack.tracking.api import Tracker
 from pftrack.tracking.config import (
     AssociationConfig,
@@ -47,3 +48,6 @@ __all__ = [
     "smooth_tracks",
     "track_frames",
 ]
+
+# a public submodule loads on first use after a bare ``import pftrack`` (``pftrack.tracking.x``)
+_, __getattr__, __dir__ = lazy_exports(__name__, {}, globals())
