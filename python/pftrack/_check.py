@@ -74,8 +74,15 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
     ------
     TypeError
         Complex numbers, text, or objects that are not numbers; booleans without `booleans`.
+    ValueError
+        Nested sequences of different lengths (ragged rows).
     """
-    raw = np.asarray(values)
+    try:
+        raw = np.asarray(values)
+    except ValueError:  # NumPy: "setting an array element with a sequence ... inhomogeneous"
+        raise ValueError(
+            f"{what} must be a rectangular array of numbers, got rows of different lengths"
+        ) from None
     if raw.dtype.kind not in ("biuf" if booleans else "iuf"):
         raise TypeError(f"{what} must hold real numbers, got dtype {raw.dtype}")
     return raw.astype(np.float64, copy=False)

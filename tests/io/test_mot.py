@@ -146,6 +146,16 @@ def test_write_refuses_non_finite(tmp_path: Path) -> None:
     assert not (tmp_path / "t.txt").exists()
 
 
+def test_write_refuses_ragged_rows_and_text(tmp_path: Path) -> None:
+    # was NumPy's "setting an array element with a sequence. The requested array has an
+    # inhomogeneous shape after 1 dimensions..."
+    with pytest.raises(ValueError, match=r"^write_mot: rows must be a rectangular array of "):
+        mot.write_mot(tmp_path / "t.txt", [[1, 1, 1, 1, 1, 1, 1, -1, -1, -1], [2, 1, 1, 1]])
+    with pytest.raises(TypeError, match=r"^write_mot: rows must hold real numbers, got dtype"):
+        mot.write_mot(tmp_path / "t.txt", [["1", "1", "1", "1", "1", "1"]])
+    assert not (tmp_path / "t.txt").exists()
+
+
 @pytest.mark.parametrize(
     ("col", "value", "match"),
     [

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -540,6 +542,21 @@ def test_bagging_averages_the_choices_of_the_resamples(monkeypatch: pytest.Monke
     assert cal.pooled_weights == (("linear", 0.75), ("rts", 0.25))
     assert cal.weights_for(300) == cal.pooled_weights  # an unseen bucket takes the file's
     assert "mean of the choices on 8 bootstrap resamples" in cal.describe()
+    # the header says the weights too (was "file's choice linear" above a bucket line calling
+    # "0.75 linear + 0.25 rts" the file's choice)
+    assert (
+        cal.describe()
+        .splitlines()[0]
+        .endswith("file's choice linear (0.75 linear + 0.25 rts over 8 bootstrap resamples)")
+    )
+    unseen = dataclasses.replace(
+        cal.buckets[0], mmae=(), weights=cal.pooled_weights, combined_mmae=None
+    )
+    said = dataclasses.replace(cal, buckets=(unseen,)).describe().splitlines()[-1]
+    assert said.endswith(
+        "combination 0.75 linear + 0.25 rts, the file's choice over the resamples (no "
+        "validation gap of this length)"
+    )
 
 
 def test_bagging_is_seeded_and_reported() -> None:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box
+from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write
 
@@ -317,7 +317,7 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
     (frames in ``1..2**31-1``; boxes by its rule, :func:`pftrack._check.first_bad_box`,
     applied to the values given, before any rounding); ids must be integers too.
     """
-    a = np.asarray(rows, dtype=np.float64)
+    a = real_array(rows, f"{who}: rows")  # ragged rows or text: one line naming them
     if a.size == 0:
         a = np.zeros((0, 10))
     if a.ndim != 2 or not 6 <= a.shape[1] <= 10:

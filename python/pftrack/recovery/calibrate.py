@@ -190,9 +190,13 @@ class Calibration:
         wide = max([10] + [len(c.method) + 1 for c in self.buckets])
         head = f"{'gap length':<12}{'gaps':>6}{'val.':>6}  {'chosen':<{wide}}"
         head += "".join(f"{m:>11}" for m in names)
+        over = ""
+        if self.pooled_weights:  # the weights a bucket without validation gaps takes
+            mix = " + ".join(f"{_weight(w)} {m}" for m, w in self.pooled_weights)
+            over = f" ({mix} over {self.bags} bootstrap resamples)"
         lines = [
             "auto: validation MMAE (px) on artificial gaps cut into observed runs; file's "
-            f"choice {self.pooled}",
+            f"choice {self.pooled}{over}",
             head,
         ]
         for c in self.buckets:
@@ -207,7 +211,10 @@ class Calibration:
                 span = f"{lo}" if lo == hi else f"{lo}-{hi}"
                 mix = " + ".join(f"{_weight(w)} {m}" for m, w in c.weights)
                 if c.combined_mmae is None:  # no validation gaps: the file's weights
-                    lines.append(f"gap length {span}: combination {mix}, the file's choice")
+                    lines.append(  # was "the file's choice", the header naming one method
+                        f"gap length {span}: combination {mix}, the file's choice over the "
+                        "resamples (no validation gap of this length)"
+                    )
                     continue
                 lines.append(
                     f"gap length {span}: combination {mix}, validation MMAE "
