@@ -90,50 +90,30 @@ def test_fps_overrides_seqinfo(sequence: Path, tmp_path: Path) -> None:
     assert _video_info(video)[2:] == (12.5, 60)
 
 
-def test_a_seqinfo_frame_rate_outside_the_range_of_fps_is_refused(
-    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize(
+    ("ini", "said"),
+    [
+        # was: exit 0, an MP4 at 1e9 fps
+        ("frameRate=1e9\n", "frameRate is '1e9', expected a frame rate in [0.01, 1000] frames "
+                            "per second"),
+        # was: "SEQ/seqinfo.ini: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
+        ("frameRate=7\nframeRate=8\n", "key frameRate in [Sequence] is given twice (lines 2 "
+                                       "and 3); give it once"),
+        # was: exit 0, imWidth=0.4 rounded to 0 and taken as absent (scale 1)
+        ("frameRate=7\nimWidth=0.4\n", "imWidth is '0.4', expected an integer > 0"),
+    ],
+)  # fmt: skip
+def test_a_bad_seqinfo_is_refused_before_any_output(
+    ini: str, said: str, sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # was: exit 0, an MP4 at 1e9 fps
     seq = tmp_path / "SEQ"
     seq.mkdir()
     (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
-    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=1e9\n")
+    (seq / "seqinfo.ini").write_text("[Sequence]\n" + ini)
     out, video = tmp_path / "t.txt", tmp_path / "r.mp4"
     assert main(["track", str(seq), "--out", str(out), "--render", str(video)]) == 2
-    assert capsys.readouterr().err == (
-        f"pftrack track: error: {seq}/seqinfo.ini: frameRate is '1e9', expected a frame rate "
-        "in [0.01, 1000] frames per second\n"
-    )
+    assert capsys.readouterr().err == f"pftrack track: error: {seq}/seqinfo.ini: {said}\n"
     assert not out.exists() and not video.exists()
-
-
-def test_a_seqinfo_key_given_twice_is_named(
-    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    # was: "SEQ/seqinfo.ini: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
-    seq = tmp_path / "SEQ"
-    seq.mkdir()
-    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
-    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nframeRate=8\n")
-    assert main(["track", str(seq), "--out", str(tmp_path / "t.txt")]) == 2
-    assert capsys.readouterr().err == (
-        f"pftrack track: error: {seq}/seqinfo.ini: key frameRate in [Sequence] is given twice "
-        "(lines 2 and 3); give it once\n"
-    )
-
-
-def test_a_seqinfo_fractional_width_is_refused_as_written(
-    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    # was: exit 0, imWidth=0.4 rounded to 0 and taken as absent (scale 1)
-    seq = tmp_path / "SEQ"
-    seq.mkdir()
-    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
-    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nimWidth=0.4\n")
-    assert main(["track", str(seq), "--out", str(tmp_path / "t.txt")]) == 2
-    assert capsys.readouterr().err == (
-        f"pftrack track: error: {seq}/seqinfo.ini: imWidth is '0.4', expected an integer > 0\n"
-    )
 
 
 def test_sequence_detections_in_seqinfo_pixels_are_scaled(
