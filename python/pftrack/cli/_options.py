@@ -401,6 +401,8 @@ def is_stdout(*paths: str | None) -> bool:
             continue
         try:
             st = os.stat(path)
+            if os.path.samefile(path, os.devnull):  # discarded: nothing there to keep apart
+                continue
         except OSError:
             continue
         if (st.st_dev, st.st_ino) == (target.st_dev, target.st_ino):
