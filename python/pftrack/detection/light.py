@@ -221,14 +221,18 @@ def levelled_median(frames: list[NDArray[np.uint8]], band: float, fn: str) -> ND
 
     :func:`level_frames`, then :func:`~pftrack.detection.base.median_frame`, except where a
     frame brighter than the first was saturated: a channel at 255 there says only that the
-    value lies at or above it, and divided by the frame's gain it would read as a darker
-    value than the first frame shows. Such a pixel of such a frame is left out of its median
-    (when any frame is left for it). Without it, a light that rose by 1.4 a third of the way
-    into PETS09 made most of the priming frames bright, their saturated pixels came back as
-    255 / 1.4 = 182 where the first frames show 200 or more, and the frames before the change
-    filled with false foreground (MOTA 71.3 against 80.7; docs/detection.md). Frames darker
-    than the first lose nothing that matters (a value scaled past 255 is one the first frame
-    saturates too). Steady video and darkening gives exactly ``median_frame(level_frames(...))``.
+    value lies at or above it, and divided by the frame's gain it reads as a darker value than
+    the first frame shows. There the median is the larger of the levelled frames' median (a
+    lower bound where the frame's gain is measured right, i.e. most of it is not saturated:
+    every censored value is at least its levelled one) and the median of the
+    frames that were not saturated at that pixel (the estimate, which people standing in the
+    few dark frames can drag down; when every frame is saturated, the bound alone). Without
+    it, a light that rose by 1.4 a third of the way into PETS09 made most of the priming frames
+    bright, their saturated pixels came back as 255 / 1.4 = 182 where the first frames show
+    200 or more, and the frames before the change filled with false foreground (MOTA 71.3
+    against 80.9; docs/detection.md). Frames darker than the first lose nothing that matters
+    (a value scaled past 255 is one the first frame saturates too). Steady and darkening video
+    give exactly ``median_frame(level_frames(...))``.
     """
     from pftrack.detection.base import median_frame
 
@@ -251,6 +255,6 @@ def levelled_median(frames: list[NDArray[np.uint8]], band: float, fn: str) -> ND
         stack = np.stack([f[rows] for f in levelled]).astype(np.float32)
         kept = ~lost.all(axis=0)  # pixels with some frame left
         stack[lost] = np.nan
-        sub = median[rows]  # a view: written into the median
-        sub[kept] = np.nanmedian(stack[:, kept], axis=0)
+        sub = median[rows]  # a view: written into the median, never below its bound
+        sub[kept] = np.maximum(sub[kept], np.nanmedian(stack[:, kept], axis=0))
     return median
