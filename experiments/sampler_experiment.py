@@ -432,6 +432,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--skip-timing", action="store_true")
     p.add_argument("--skip-figure", action="store_true")
     args = p.parse_args(argv)
+    if not (args.skip_timing and args.skip_figure):  # the two figures: before any work
+        import importlib.util
+
+        missing = [m for m in ("matplotlib", "PIL") if importlib.util.find_spec(m) is None]
+        if missing:  # was: the whole table run, then ModuleNotFoundError: No module named 'PIL'
+            p.error(
+                f"the figures need {' and '.join(missing)}, which pftrack does not install: "
+                "pip install matplotlib, or pass --skip-timing --skip-figure"
+            )
 
     data = data_root(args.data)
     runs = real_sequences(data, args.max_frames)

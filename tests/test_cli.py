@@ -113,7 +113,7 @@ def test_help_shows_defaults(capsys: pytest.CaptureFixture[str]) -> None:
     assert exc.value.code == 0
     text = " ".join(capsys.readouterr().out.split())
     assert "(default: paper)" in text and "(default: 0)" in text
-    assert "200 with --detections, 100 with the built-in detector (default: 0)" in text
+    assert "0: 200 with --detections for sis and mh, else 100 (default: 0)" in text
 
 
 def test_every_row_is_inside_the_scene(video: Path, scene: Scene, tmp_path: Path) -> None:
@@ -688,6 +688,23 @@ def test_options_the_built_in_detector_never_uses_are_refused(
     assert not out.exists()
 
 
+def test_options_the_joint_sampler_never_reads_are_refused() -> None:
+    # was: --sampler rjmcmc with --max-coast 0, 100 or --birth-score 0 wrote the same bytes
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+
+    parse = build_parser().parse_args
+    joint = ["track", "v", "--out", "o", "--detections", "d.txt", "--sampler", "rjmcmc"]
+    with pytest.raises(ValueError, match=(
+        r"^--max-coast 0, --birth-score 0: the joint sampler \(--sampler rjmcmc\) keeps and "
+        r"starts tracks by its own existence probabilities, so they do nothing: drop them, or "
+        r"use --sampler sis or mh$"
+    )):  # fmt: skip
+        tracker_config(parse([*joint, "--max-coast", "0", "--birth-score", "0"]))
+    tracker_config(parse([*joint, "--max-coast", "10"]))  # the default, named: taken
+    tracker_config(parse([*joint[:-2], "--max-coast", "0"]))  # sis: taken
+
+
 def test_background_options_with_no_refine_are_refused() -> None:
     # was: --no-refine --detector knn --open-size 9 --bootstrap first wrote the same bytes as
     # --no-refine alone (no background model runs)
@@ -712,10 +729,11 @@ def test_background_options_with_no_refine_are_refused() -> None:
 
 def test_options_of_given_detections_are_taken_with_them(video: Path, tmp_path: Path) -> None:
     from pftrack.cli import build_parser
-    from pftrack.cli._options import DEFAULT_BIRTH_SCORE, tracker_config
+    from pftrack.cli._options import DEFAULT_BIRTH_SCORE, DEFAULT_MAX_COAST, tracker_config
     from pftrack.tracking import LifecycleConfig
 
     assert DEFAULT_BIRTH_SCORE == LifecycleConfig().birth_score
+    assert DEFAULT_MAX_COAST == LifecycleConfig().max_coast
     parse = build_parser().parse_args
     det = ["--detections", "d.txt"]
     cfg = tracker_config(parse(["track", "v", "--out", "o", *det, "--min-conf", "-5",

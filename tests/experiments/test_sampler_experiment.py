@@ -90,3 +90,26 @@ def test_real_sequences_first_frames() -> None:
         particles=30,
     )
     assert res.metrics.num_objects == len(tud["gt"]) and res.n_tracks >= 1
+
+
+def test_the_figures_need_matplotlib_and_say_so_before_any_work(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # was: the whole table run, then "ModuleNotFoundError: No module named 'PIL'"
+    import importlib.util
+
+    from experiments import sampler_experiment
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "PIL" else real(name, *a)
+    )
+    monkeypatch.setattr(sampler_experiment, "real_sequences", _no_work)
+    with pytest.raises(SystemExit) as exc:
+        sampler_experiment.main(["--skip-timing"])
+    assert exc.value.code == 2
+    assert "the figures need PIL, which pftrack does not install" in capsys.readouterr().err
+
+
+def _no_work(*args: object) -> list[object]:
+    raise AssertionError("work started")

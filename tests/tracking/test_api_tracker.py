@@ -887,3 +887,20 @@ def test_bins_copy_and_pickle():
         c = clone(image)
         assert c is not image and c.n_bins == 110
         np.testing.assert_array_equal(c.bins, bins)
+
+
+def test_crossings_without_the_smoother_are_refused():
+    # was: accepted silently, where the CLI refuses --crossings on --no-smooth
+    with pytest.raises(ValueError, match=r"^crossings=True needs the smoother"):
+        pftrack.Tracker(crossings=True, smooth=False)
+    pftrack.Tracker(crossings=False, smooth=False)
+
+
+def test_the_joint_sampler_counts_ids_from_1(scene):
+    # was: id 0 in the rows (MOTChallenge ids count from 1, as the other samplers' do)
+    dets = scene_dets(scene)
+    tracker = pftrack.Tracker(sampler="rjmcmc")
+    for k in range(20):
+        tracker.update(dets[k], scene.frames[k])
+    rows = tracker.finalize()
+    assert len(rows) and rows[:, 1].min() >= 1

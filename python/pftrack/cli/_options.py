@@ -18,6 +18,8 @@ DEFAULT_CROSSINGS = "off"
 #: ``--birth-score``'s default: :attr:`pftrack.tracking.LifecycleConfig.birth_score`, stated
 #: here for the same reason (a test checks they agree).
 DEFAULT_BIRTH_SCORE = 0.9
+#: ``LifecycleConfig.max_coast``, ``--max-coast``'s default, stated here for the same reason.
+DEFAULT_MAX_COAST = 10
 #: ``--det-scale``'s range (``track`` and ``batch``): the one
 #: :func:`pftrack.tracking.load_detections` accepts, stated here for the same reason (a test
 #: checks they agree).
@@ -192,8 +194,8 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
     """The tracker's options, shared by ``track`` (and any command that tracks)."""
     p.add_argument(
         "--particles", type=bounded_int(0, 100_000), default=0, metavar="N",
-        help="particles per object (1 to 100000); 0: 200 with --detections, 100 with the "
-        "built-in detector",
+        help="particles per object (1 to 100000; with --sampler rjmcmc, the joint chain's "
+        "kept samples); 0: 200 with --detections for sis and mh, else 100",
     )  # fmt: skip
     p.add_argument("--seed", type=non_negative_int, default=0,
                    help="random seed, an integer >= 0: same seed, same tracks")  # fmt: skip
@@ -236,9 +238,11 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "it from the frame's rows (3 at 360 rows, 5 at 480): raise it when touching people "
         "stay joined, lower it when thin people break apart",
     )  # fmt: skip
-    p.add_argument("--max-coast", type=bounded_int(0, 100_000), default=10, metavar="FRAMES",
-                   help="frames a track survives on its particle filter alone (0.4 s at 25 "
-                   "frames/s: pftrack.Tracker's max_coast is in seconds)")  # fmt: skip
+    p.add_argument("--max-coast", type=bounded_int(0, 100_000), default=DEFAULT_MAX_COAST,
+                   metavar="FRAMES", help="frames a track survives on its particle filter alone "
+                   "(0.4 s at 25 frames/s: pftrack.Tracker's max_coast is in seconds); refused "
+                   "with --sampler rjmcmc, whose chain keeps tracks by their existence "
+                   "probability")  # fmt: skip
     p.add_argument(
         "--min-conf", type=finite_float, default=0.0, metavar="C",
         help="ignore detections whose score is below C; the built-in detector's score is the "
@@ -340,6 +344,23 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
                 f"{', '.join(unused)}: with --no-refine no background model runs, so "
                 f"{'it does' if len(unused) == 1 else 'they do'} nothing: drop "
                 f"{'it' if len(unused) == 1 else 'them'}, or --no-refine"
+            )
+
+    if args.sampler == "rjmcmc":  # the joint chain's own existence and births decide
+        unused = [
+            f"{flag} {value:g}"
+            for flag, value, default in (
+                ("--max-coast", args.max_coast, DEFAULT_MAX_COAST),
+                ("--birth-score", args.birth_score, None),
+            )
+            if value is not None and value != default
+        ]
+        if unused:
+            raise ValueError(
+                f"{', '.join(unused)}: the joint sampler (--sampler rjmcmc) keeps and starts "
+                "tracks by its own existence probabilities, so "
+                f"{'it does' if len(unused) == 1 else 'they do'} nothing: drop "
+                f"{'it' if len(unused) == 1 else 'them'}, or use --sampler sis or mh"
             )
 
     from pftrack.tracking import TrackerConfig

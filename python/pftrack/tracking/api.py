@@ -266,7 +266,8 @@ class Tracker:
         (``refine="no"`` would turn refinement on), a `frame_rate`, `max_coast`, `prime`,
         `min_conf` or `birth_score` that is not a number, a `seed` that is not an int.
     ValueError
-        A value out of its range.
+        A value out of its range, or ``crossings=True`` with ``smooth=False`` (the repair is
+        part of the smoothing pass).
 
     Notes
     -----
@@ -318,6 +319,10 @@ class Tracker:
             flag(refine, "refine"), flag(smooth, "smooth"), flag(link, "link"),
             flag(crossings, "crossings"),
         )  # fmt: skip
+        if crossings and not smooth:  # as the CLI refuses --crossings on --no-smooth
+            raise ValueError(
+                "crossings=True needs the smoother, which smooth=False turns off; drop one"
+            )
         if dynamics not in ("ar2", "ar2-mean"):
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
         if particles is not None and (

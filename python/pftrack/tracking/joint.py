@@ -80,7 +80,7 @@ class JointTracker:
             matched = j >= 0 and iou[k, j] >= 0.5
             out.append(
                 Track(
-                    id=int(e.id),
+                    id=int(e.id) + 1,  # MOTChallenge ids count from 1, as sis and mh's do
                     box_xywh=ebox[k].copy(),
                     score=float(scores[j]) if matched else float(e.score),
                     detection_index=int(index[j]) if matched else None,
