@@ -13,9 +13,10 @@ from __future__ import annotations
 import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
+from typing import cast
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box, real_array
 from pftrack._typing import F64, PathLike
@@ -317,7 +318,8 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
     (frames in ``1..2**31-1``; boxes by its rule, :func:`pftrack._check.first_bad_box`,
     applied to the values given, before any rounding); ids must be integers too.
     """
-    a = real_array(rows, f"{who}: rows")  # ragged rows or text: one line naming them
+    # ragged rows or text: one line naming them (any iterable of rows, as np.asarray takes)
+    a = real_array(cast("ArrayLike", rows), f"{who}: rows")
     if a.size == 0:
         a = np.zeros((0, 10))
     if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
