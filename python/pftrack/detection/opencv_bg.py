@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
+from pftrack._check import integer, number
 from pftrack.detection.base import (
     BlobConfig,
     BlobExtractor,
@@ -29,13 +30,21 @@ class Mog2Config:
     Attributes
     ----------
     history : int
-        Frames that shape the mixture.
+        Frames that shape the mixture, in [1, 2147483647] (OpenCV's int).
     var_threshold : float
-        Squared Mahalanobis distance above which a pixel is foreground.
+        Squared Mahalanobis distance above which a pixel is foreground; finite and > 0.
     learning_rate : float
-        -1 lets OpenCV choose (1 / min(frames seen, history)).
+        -1 lets OpenCV choose (1 / min(frames seen, history)); else in [0, 1] (0: the model
+        is never updated, 1: it is the last frame).
     blobs, hsv : BlobConfig, HsvBinning
         As for `PaperDetector`.
+
+    Raises
+    ------
+    TypeError
+        `var_threshold` or `learning_rate` not a number.
+    ValueError
+        A setting out of its range above (NaN included; `history` not an int, a bool).
     """
 
     history: int = 500
@@ -43,6 +52,9 @@ class Mog2Config:
     learning_rate: float = -1.0
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
+
+    def __post_init__(self) -> None:
+        _check_subtractor(self, "Mog2Config", "var_threshold")
 
 
 @dataclass(frozen=True)
@@ -52,13 +64,20 @@ class KnnConfig:
     Attributes
     ----------
     history : int
-        Frames kept as samples.
+        Frames kept as samples, in [1, 2147483647] (OpenCV's int).
     dist2_threshold : float
-        Squared distance under which a sample counts as near.
+        Squared distance under which a sample counts as near; finite and > 0.
     learning_rate : float
-        -1 lets OpenCV choose.
+        -1 lets OpenCV choose; else in [0, 1].
     blobs, hsv : BlobConfig, HsvBinning
         As for `PaperDetector`.
+
+    Raises
+    ------
+    TypeError
+        `dist2_threshold` or `learning_rate` not a number.
+    ValueError
+        A setting out of its range above (NaN included; `history` not an int, a bool).
     """
 
     history: int = 500
@@ -66,6 +85,26 @@ class KnnConfig:
     learning_rate: float = -1.0
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
+
+    def __post_init__(self) -> None:
+        _check_subtractor(self, "KnnConfig", "dist2_threshold")
+
+
+def _check_subtractor(config: Mog2Config | KnnConfig, owner: str, threshold: str) -> None:
+    """The settings OpenCV takes without a word but cannot use (or refuses unnamed).
+
+    A negative `history` or a NaN threshold ran; a learning rate of NaN or above 1 found
+    nothing; a float `history` failed in OpenCV's argument parsing.
+    """
+    integer(config.history, f"{owner}: history", 1, 2**31 - 1)
+    t = number(getattr(config, threshold), f"{owner}: {threshold}", finite=False)
+    if not (np.isfinite(t) and t > 0):
+        raise ValueError(f"{owner}: {threshold} is {t}, expected a finite value > 0")
+    rate = number(config.learning_rate, f"{owner}: learning_rate", finite=False)
+    if not (rate == -1 or 0 <= rate <= 1):
+        raise ValueError(
+            f"{owner}: learning_rate is {rate}, expected -1 (OpenCV's choice) or a value in [0, 1]"
+        )
 
 
 class _OpenCvDetector:

@@ -17,9 +17,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import number
+from pftrack._check import flag, number
 
 __all__ = ["Ar2Model", "estimate", "propagate"]
+
+#: Largest ``Ar2Model.sigma_xy`` (pixels per frame): ten times the widest working frame
+#: (``TrackerConfig.max_side`` is at most 100 000 px) and a thousandth of the ±1e9 px that
+#: boxes may span (:data:`pftrack._check.MAX_COORD`).
+MAX_SIGMA_XY = 1e6
+#: Largest ``Ar2Model.s_max``: an object a thousand times its first size.
+MAX_SCALE = 1e3
 
 
 @dataclass(frozen=True)
@@ -29,18 +36,39 @@ class Ar2Model:
     Attributes
     ----------
     sigma_xy : float
-        Standard deviation of the centre noise, pixels per frame.
+        Standard deviation of the centre noise, pixels per frame; in [0, 1e6]
+        (:data:`MAX_SIGMA_XY`).
     sigma_s : float
-        Standard deviation of the scale noise per frame.
+        Standard deviation of the scale noise per frame; finite and >= 0 (the scale is
+        clamped to [`s_min`, `s_max`]).
     velocity_gain : float
         ``A = 1 + g``, ``B = -g`` for the centre: 1 is the paper's constant velocity, 0 a random
-        walk, values in between damp the velocity.
+        walk, values in between damp the velocity. In [0, 1]: the AR(2) recursion's roots are 1
+        and `g`, so a gain above 1 makes every particle's velocity grow as ``g**t`` (1e6 took
+        a filter's estimate to 1e293 px in 50 frames).
     scale_gain : float
-        The same for the scale (1: the paper's AR(2) on scale too; 0: a random walk).
+        The same for the scale (1: the paper's AR(2) on scale too; 0: a random walk), in [0, 1].
     s_min, s_max : float
-        Bounds on the scale relative to the track's base size.
+        Bounds on the scale relative to the track's base size: ``0 < s_min <= s_max <= 1000``
+        (:data:`MAX_SCALE`).
     use_means : bool
         eq. 8 (particle-set means) instead of eq. 7.
+
+    Raises
+    ------
+    TypeError
+        A number that is not a number (text, a bool), `use_means` not a bool.
+    ValueError
+        A value out of its range above (NaN and infinities included).
+
+    Notes
+    -----
+    The bounds keep a filter's boxes in the domain its constructor accepts (each value within
+    ±1e9 px, :data:`pftrack._check.MAX_COORD`): one step moves a particle by a few `sigma_xy`
+    (at most ~8.6 standard deviations, the largest draw of the core's normals), under 1e7 px,
+    and a box grows to at most 1000 times its first size. A lost object's particles still
+    drift as a random walk, so the bound is not a guarantee over an unlimited number of
+    frames; ``sigma_xy=1e12`` or ``s_max=1e300`` left the domain within a step.
     """
 
     sigma_xy: float = 4.0
@@ -58,6 +86,16 @@ class Ar2Model:
                 raise ValueError(f"Ar2Model: {name} is {v}, expected a finite value >= 0")
         if not 0 < self.s_min <= self.s_max:
             raise ValueError(f"Ar2Model: need 0 < s_min <= s_max, got {self.s_min}, {self.s_max}")
+        for name, span, hi in (
+            ("sigma_xy", "[0", MAX_SIGMA_XY),
+            ("s_max", "(0", MAX_SCALE),
+            ("velocity_gain", "[0", 1.0),
+            ("scale_gain", "[0", 1.0),
+        ):
+            v = getattr(self, name)
+            if v > hi:
+                raise ValueError(f"Ar2Model: {name} is {v}, expected a value in {span}, {hi:g}]")
+        flag(self.use_means, "Ar2Model: use_means")
 
     @property
     def a(self) -> NDArray[np.float64]:

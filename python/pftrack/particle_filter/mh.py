@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack import _core
+from pftrack._check import integer
 from pftrack._typing import RngLike
 from pftrack.particle_filter.filter import (
     ColourParticleFilter,
@@ -40,8 +41,16 @@ class MHColourParticleFilter(ColourParticleFilter):
     box_cxcywh, reference, config, rng, velocity
         As for :class:`~pftrack.particle_filter.ColourParticleFilter`.
     n_iter : int
-        MH iterations per particle and frame (>= 1); a step evaluates the likelihood
-        ``n_particles * (n_iter + 1)`` times.
+        MH iterations per particle and frame, in [1, 2147483647] (the core's 32-bit int); a
+        step evaluates the likelihood ``n_particles * (n_iter + 1)`` times.
+
+    Raises
+    ------
+    ValueError
+        `n_iter` not an int (a bool, a float) in [1, 2147483647]; else as
+        :class:`~pftrack.particle_filter.ColourParticleFilter`.
+    TypeError
+        As :class:`~pftrack.particle_filter.ColourParticleFilter`.
 
     Attributes
     ----------
@@ -63,10 +72,7 @@ class MHColourParticleFilter(ColourParticleFilter):
         velocity: ArrayLike = (0.0, 0.0),
         n_iter: int = 1,
     ) -> None:
-        if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
-            raise ValueError(
-                f"MHColourParticleFilter: n_iter is {n_iter!r}, expected an integer >= 1"
-            )
+        integer(n_iter, "MHColourParticleFilter: n_iter", 1, 2**31 - 1)
         super().__init__(box_cxcywh, reference, config, rng, velocity)
         self.n_iter = int(n_iter)
         self.acceptance = float("nan")

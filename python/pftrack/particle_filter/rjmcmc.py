@@ -16,8 +16,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import generator
+from pftrack._check import generator, integer, number, real_array
 from pftrack._typing import RngLike
+
+#: Kernels of the colour histograms (``RJMCMCConfig.kernel``).
+KERNELS = ("uniform", "epanechnikov")
+#: Largest chain length a frame may have (``burn_in + n_samples``): the core's iteration count
+#: is a 32-bit int.
+MAX_ITERATIONS = 2**31 - 1
 
 
 @dataclass(frozen=True)
@@ -62,6 +68,21 @@ class RJMCMCConfig:
         (the detections support the identities they overlap; 0: off).
     min_existence : float
         ``step`` reports identities whose existence probability is at least this.
+
+    Raises
+    ------
+    TypeError
+        A number setting that is not a number (text, a bool, None), or `a`, `b`, `sigma` not
+        real numbers.
+    ValueError
+        A setting out of the range the core takes (checked here, not at the first step):
+        `burn_in` an int >= 0 and `n_samples` an int >= 1, with ``burn_in + n_samples`` at most
+        2147483647; move probabilities finite and >= 0, not all 0, `p_birth` and `p_death`
+        both > 0 or both 0; `a`, `b` 3 finite values and `sigma` 3 finite values > 0; finite
+        ``0 < s_min <= s_max``; `lam`, `interaction`, `coverage`, `background_penalty`,
+        `detection` finite and >= 0; `birth_prior`, `birth_sigma_xy`, `birth_sigma_s`,
+        `birth_eps`, `birth_gate` finite and > 0; `survival` in (0, 1]; `min_existence` in
+        [0, 1]; `kernel` not "uniform" or "epanechnikov".
     """
 
     burn_in: int = 50
@@ -88,6 +109,56 @@ class RJMCMCConfig:
     birth_gate: float = 0.1
     detection: float = 20.0
     min_existence: float = 0.5
+
+    def __post_init__(self) -> None:
+        own = "RJMCMCConfig"
+        integer(self.burn_in, f"{own}: burn_in", 0, MAX_ITERATIONS)
+        integer(self.n_samples, f"{own}: n_samples", 1, MAX_ITERATIONS)
+        if self.burn_in + self.n_samples > MAX_ITERATIONS:
+            raise ValueError(
+                f"{own}: burn_in + n_samples is {self.burn_in} + {self.n_samples}, expected at "
+                f"most {MAX_ITERATIONS}"
+            )
+        moves = ("p_birth", "p_death", "p_update", "p_swap")
+        for name in moves:
+            _at_least(self, name, 0.0)
+        if sum(getattr(self, name) for name in moves) <= 0:
+            raise ValueError(f"{own}: p_birth, p_death, p_update and p_swap are all 0")
+        if (self.p_birth > 0) != (self.p_death > 0):
+            raise ValueError(
+                f"{own}: p_birth is {self.p_birth} and p_death {self.p_death}, expected both > 0 "
+                "or both 0 (reversibility)"
+            )
+        for name in ("a", "b", "sigma"):
+            v = real_array(getattr(self, name), f"{own}: {name}", booleans=False)
+            positive = name != "sigma" or bool((v > 0).all())
+            if v.shape != (3,) or not (np.isfinite(v).all() and positive):
+                more = " > 0" if name == "sigma" else ""
+                raise ValueError(
+                    f"{own}: {name} is {v.tolist()}, expected 3 finite values{more} (cx, cy, s)"
+                )
+        for name in ("s_min", "s_max"):
+            number(getattr(self, name), f"{own}: {name}", finite=False)
+        if not (0 < self.s_min < np.inf):
+            raise ValueError(f"{own}: s_min is {self.s_min}, expected a finite value > 0")
+        if not (self.s_min <= self.s_max < np.inf):
+            raise ValueError(
+                f"{own}: s_max is {self.s_max}, expected a finite value >= s_min ({self.s_min})"
+            )
+        for name in ("lam", "interaction", "coverage", "background_penalty", "detection"):
+            _at_least(self, name, 0.0)
+        for name in ("birth_prior", "birth_sigma_xy", "birth_sigma_s", "birth_eps", "birth_gate"):
+            _at_least(self, name, 0.0, strict=True)
+        survival = number(self.survival, f"{own}: survival", finite=False)
+        if not 0 < survival <= 1:
+            raise ValueError(f"{own}: survival is {survival}, expected a value in (0, 1]")
+        existence = number(self.min_existence, f"{own}: min_existence", finite=False)
+        if not 0 <= existence <= 1:
+            raise ValueError(f"{own}: min_existence is {existence}, expected a value in [0, 1]")
+        if not isinstance(self.kernel, str) or self.kernel not in KERNELS:
+            raise ValueError(
+                f"{own}: kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'"
+            )
 
     def core_kwargs(self) -> dict[str, Any]:
         """Keyword arguments of ``pftrack._core.RJMCMCTracker``."""
@@ -119,6 +190,15 @@ class RJMCMCConfig:
         for k in ("a", "b", "sigma"):
             out[k] = np.asarray(getattr(self, k), dtype=np.float64)
         return out
+
+
+def _at_least(config: RJMCMCConfig, name: str, lo: float, *, strict: bool = False) -> None:
+    """`config.name` must be a finite number >= `lo` (> `lo` with `strict`)."""
+    v = number(getattr(config, name), f"RJMCMCConfig: {name}", finite=False)
+    if not (np.isfinite(v) and (v > lo if strict else v >= lo)):
+        raise ValueError(
+            f"RJMCMCConfig: {name} is {v}, expected a finite value {'>' if strict else '>='} {lo:g}"
+        )
 
 
 class RJTrack(NamedTuple):

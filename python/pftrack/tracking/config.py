@@ -9,12 +9,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from pftrack._check import number
+from pftrack._check import MAX_FRAME, flag, integer, number
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
 from pftrack.particle_filter.filter import MAX_PARTICLES
 from pftrack.recovery.linking import REFERENCE_DIAGONAL, pixel_scale
-from pftrack.tracking.offline import AMODAL_ANCHORS, CrossingConfig
+from pftrack.tracking.offline import AMODAL_ANCHORS, NOISE_MAX, NOISE_MIN, CrossingConfig
 
 __all__ = [
     "AssociationConfig",
@@ -62,6 +62,24 @@ def _integers_at_least(owner: str, lo: int, config: object, *names: str) -> None
             raise ValueError(f"{owner}: {name} is {v!r}, expected an integer >= {lo}")
 
 
+def _in_range(
+    owner: str, name: str, v: float, lo: float, hi: float = np.inf, *, low_open: bool = False
+) -> None:
+    """Refuse `v` (a number, checked by :func:`_numbers`) outside ``[lo, hi]`` (``(lo, hi]``).
+
+    NaN fails; an infinite `hi` is excluded (``hi=np.inf``: a finite value >= (>) `lo`).
+    """
+    above = lo < v if low_open else lo <= v
+    if not (above and v <= hi and np.isfinite(v)):
+        bound = f"> {lo:g}" if low_open else f">= {lo:g}"
+        expected = (
+            f"a finite value {bound}"
+            if hi == np.inf
+            else (f"a value in {'(' if low_open else '['}{lo:g}, {hi:g}]")
+        )
+        raise ValueError(f"{owner}: {name} is {v}, expected {expected}")
+
+
 def _none_or_int_in(config: object, name: str, lo: int, hi: int) -> None:
     """`config.name` must be None or an int (not a bool) in [lo, hi]."""
     v = getattr(config, name)
@@ -80,9 +98,10 @@ class AssociationConfig:
     match_iou : float
         Minimum overlap (IoU) for a track-detection pair, unless the centres are close.
     match_distance : float
-        Maximum centre distance of a pair, in track heights (grows with the time coasted).
+        Maximum centre distance of a pair, in track heights (grows with the time coasted); finite
+        and > 0 (the cost divides by it).
     colour_weight : float
-        Weight of colour dissimilarity ``1 - rho`` in the association cost.
+        Weight of colour dissimilarity ``1 - rho`` in the association cost; finite and >= 0.
     unmatched_cost : float
         What leaving a track or a detection unassigned costs: a pair is made only when its cost
         is below twice this, not merely because it passed the gate. The default 1.5 refuses a
@@ -91,7 +110,15 @@ class AssociationConfig:
     merge_ratio : float
         A matched detection this many times larger than its track, that also covers another
         track, is a merged blob: it does not re-seed the track's particles (the colour filter
-        carries the track through the merge).
+        carries the track through the merge). At least 1 (a smaller detection is no merge);
+        ``inf``: off.
+
+    Raises
+    ------
+    TypeError
+        A setting that is not a number.
+    ValueError
+        A setting out of its range above (NaN included).
     """
 
     match_iou: float = 0.1
@@ -109,6 +136,13 @@ class AssociationConfig:
                 "(inf: off)"
             )
         _in_unit_interval("AssociationConfig", match_iou=self.match_iou)
+        _in_range("AssociationConfig", "match_distance", self.match_distance, 0.0, low_open=True)
+        _in_range("AssociationConfig", "colour_weight", self.colour_weight, 0.0)
+        if not (self.merge_ratio >= 1.0):  # NaN fails too; inf: off
+            raise ValueError(
+                f"AssociationConfig: merge_ratio is {self.merge_ratio}, expected a value >= 1 "
+                "(inf: off)"
+            )
 
 
 @dataclass(frozen=True)
@@ -145,18 +179,18 @@ class LifecycleConfig:
         tracks from its upper three quarters (measured in docs/tracking.md; 0.25 scored better
         than the median on both sequences). None: `birth_score` as is.
     birth_window : int
-        Frames over which the score distribution is learned (2 s at 25 frames/s).
+        Frames over which the score distribution is learned (2 s at 25 frames/s), >= 1.
     min_hits : int
         Matched frames before a new track is reported (tracks born in the first `min_hits`
-        frames are reported at once).
+        frames are reported at once), >= 0.
     max_coast : int
-        Frames a track goes on from its particle filter alone before it ends.
+        Frames a track goes on from its particle filter alone before it ends, >= 0.
     tentative_coast : int
         Frames with detections a not yet confirmed track may go without one of them before it
         is dropped. A frame without any detection (the detector did not run, or saw nothing)
         does not count: with a detector run every other frame, no track was confirmed before
         (docs/tracking.md, "Lower frame rates and sparse detections"). It still ends after
-        `max_coast` frames without a match.
+        `max_coast` frames without a match. At least 0.
     coast_min_rho : float
         A coasting track is reported only while its colour match ``rho`` stays above this.
     relink_coast : int or None
@@ -167,7 +201,7 @@ class LifecycleConfig:
         long may have drifted onto another person, whose detection then re-found the track. A
         kept join gets the frames back, filled as any hole. The built-in detector's tracks are
         left alone: they coast through merged blobs, where the colour filter is what carries
-        them. None: off.
+        them. None: off; else at least 1.
     nested_inside, nested_area : float or None
         With the built-in detector, the offline pass leaves out every box that lies by more than
         `nested_inside` of its area inside a box of the same frame more than `nested_area`
@@ -189,6 +223,14 @@ class LifecycleConfig:
         Which edge a widened box keeps: ``"side"`` grows it towards the one side that lies
         inside another box (the hidden side), else about its centre; ``"centre"`` always about
         its centre.
+
+    Raises
+    ------
+    TypeError
+        A number setting that is not a number.
+    ValueError
+        A setting out of its range above; a frame count that is not an int (not a bool) in
+        [lo, 2147483647].
     """
 
     min_score: float = 0.0
@@ -210,9 +252,11 @@ class LifecycleConfig:
         _numbers("LifecycleConfig", self, "min_score", "min_area", "birth_score", "birth_quantile")
         _numbers("LifecycleConfig", self, "coast_min_rho", "nested_inside", "nested_area")
         _numbers("LifecycleConfig", self, "amodal_share")
-        _integers_at_least("LifecycleConfig", 0, self, "max_coast", "min_hits", "birth_window")
+        for name, lo in (("max_coast", 0), ("min_hits", 0), ("tentative_coast", 0),
+                         ("birth_window", 1)):  # fmt: skip
+            integer(getattr(self, name), f"LifecycleConfig: {name}", lo, MAX_FRAME)
         if self.relink_coast is not None:
-            _integers_at_least("LifecycleConfig", 1, self, "relink_coast")
+            integer(self.relink_coast, "LifecycleConfig: relink_coast", 1, MAX_FRAME)
         _in_unit_interval(
             "LifecycleConfig", coast_min_rho=self.coast_min_rho, birth_score=self.birth_score
         )
@@ -259,7 +303,10 @@ class MotionConfig:
         acceleration, per frame^1.5), and the standard deviations of a detection's centre and of
         the colour filter's estimate (the measurement while the track
         coasts, and a second opinion before association; not a measurement when the frame's
-        colour carries no evidence, :func:`pftrack.tracking.track.colour_evidence`).
+        colour carries no evidence, :func:`pftrack.tracking.track.colour_evidence`). `accel` lies
+        in [0, 1e6] (0: a constant velocity), the two noises in [1e-6, 1e6] (the Kalman
+        update divides by their variance; :class:`~pftrack.tracking.offline.BoxSmoother`'s
+        range).
     smooth_external : bool
         With external detections, report a matched track's filtered box (Kalman centre,
         smoothed size) rather than the detection's own box, which jitters from frame to frame.
@@ -279,6 +326,13 @@ class MotionConfig:
     speed_span : int
         Frames over which a track's speed is measured (the detections' jitter counts less over
         more frames).
+
+    Raises
+    ------
+    TypeError
+        A number setting that is not a number; `smooth_external` not a bool.
+    ValueError
+        A setting out of its range above (NaN included).
     """
 
     accel: float = 0.01
@@ -291,7 +345,11 @@ class MotionConfig:
     def __post_init__(self) -> None:
         names = ("accel", "detection_noise", "colour_noise", "speed_reference")
         _numbers("MotionConfig", self, *names)
+        flag(self.smooth_external, "MotionConfig: smooth_external")
         _integers_at_least("MotionConfig", 1, self, "speed_span")
+        _in_range("MotionConfig", "accel", self.accel, 0.0, NOISE_MAX)
+        for name in ("detection_noise", "colour_noise"):
+            _in_range("MotionConfig", name, getattr(self, name), NOISE_MIN, NOISE_MAX)
         v = self.speed_reference
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(
@@ -313,7 +371,7 @@ class RefineConfig:
         often loose). A box with too little foreground is left as it is.
     fraction : float
         A row or column belongs to the object when its foreground fraction exceeds this share of
-        the box's densest row or column.
+        the box's densest row or column; in [0, 1) (``refine_boxes``' range).
     leg_fill : float or None
         Shadow pixels are not foreground, but a refined box grows down through rows where
         foreground or shadow fills at least this share of its columns, no further than the
@@ -328,6 +386,13 @@ class RefineConfig:
         object's height is still refined. Over seeds 0-2 it lifts the synthetic busy scenes
         from 42.2 / 66.3 / 96.6 MOTA to 85.5 / 78.8 / 96.6 and leaves PETS09-S2L1 and
         TUD-Campus as they were (docs/tracking.md, "Refined height kept above 0.6").
+
+    Raises
+    ------
+    TypeError
+        A setting that is not a number (`enabled`: not a bool).
+    ValueError
+        A setting out of its range (NaN included).
     """
 
     enabled: bool = True
@@ -336,7 +401,12 @@ class RefineConfig:
     min_height: float = 0.6
 
     def __post_init__(self) -> None:
+        flag(self.enabled, "RefineConfig: enabled")
         _numbers("RefineConfig", self, "fraction", "leg_fill", "min_height")
+        if not 0.0 <= self.fraction < 1.0:  # NaN fails too
+            raise ValueError(
+                f"RefineConfig: fraction is {self.fraction}, expected a value in [0, 1)"
+            )
         if self.leg_fill is not None:
             _in_unit_interval("RefineConfig", leg_fill=self.leg_fill)
         _in_unit_interval("RefineConfig", min_height=self.min_height)
