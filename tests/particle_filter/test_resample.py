@@ -88,6 +88,17 @@ def test_expected_copies(name):
     assert np.all(np.abs(mean - n * w) < 5 * se + 1e-12)
 
 
+@pytest.mark.parametrize("n", [9, 11, 49, 100, 1000, 4097])
+def test_residual_keeps_every_particle_of_equal_weights(n):
+    # 1/N summed N times is 1 + a few ulps (or N * (1/N) < 1): N w_i falls just below 1, and a
+    # plain floor() would give no deterministic copy at all, drawing all N at random
+    for w in (np.full(n, 1.0 / n), np.full(n, 0.1)):
+        np.testing.assert_array_equal(residual_resample(w, rng=0), np.arange(n))
+    w = np.tile([2.0 / n, 0.0], n // 2)  # two copies each of every other particle
+    if n % 2 == 0:
+        np.testing.assert_array_equal(residual_resample(w, rng=0), np.repeat(np.arange(0, n, 2), 2))
+
+
 @pytest.mark.parametrize("name", ["systematic", "residual"])
 def test_low_variance_schemes_copy_floor_or_ceil(name):
     rng = np.random.default_rng(3)

@@ -119,7 +119,8 @@ def residual_resample(weights, u):
     w = np.asarray(weights, dtype=np.float64)
     n = len(w)
     nw = n * w / np.cumsum(w)[-1]
-    copies = np.floor(nw).astype(np.int64)
+    # N w_i within the sum's round-off (about N ulps) of an integer counts as that integer
+    copies = np.floor(nw * (1.0 + (n + 2) * np.finfo(np.float64).eps)).astype(np.int64)
     idx = np.repeat(np.arange(n), copies)
     rest = n - len(idx)
     if rest > 0:

@@ -392,9 +392,13 @@ inline IndexVector residual_resample(const Eigen::Ref<const Eigen::VectorXd>& we
     IndexVector idx(n);
     Eigen::VectorXd residual(n);
     Index k = 0;
+    // N w_i / sum w carries the round-off of the sum (up to about N ulps): a weight that is an
+    // integer multiple of 1/N up to that round-off (1/N itself, summed N times to 1 + 1e-16)
+    // must still get its copies, or equal weights would be drawn at random
+    const double up = 1.0 + static_cast<double>(n + 2) * std::numeric_limits<double>::epsilon();
     for (Index i = 0; i < n; ++i) {
         const double nw = static_cast<double>(n) * weights(i) / sum;
-        Index copies = static_cast<Index>(std::floor(nw));
+        Index copies = static_cast<Index>(std::floor(nw * up));
         copies = std::min(copies, n - k);
         for (Index c = 0; c < copies; ++c) idx(k++) = static_cast<int>(i);
         residual(i) = std::max(0.0, nw - static_cast<double>(copies));

@@ -127,7 +127,9 @@ def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int
     """Indices kept by residual resampling.
 
     ``floor(N w_i)`` copies of each particle, then the remaining ``R`` drawn multinomially from
-    the residuals ``N w_i - floor(N w_i)``.
+    the residuals ``N w_i - floor(N w_i)``. ``N w_i`` within the round-off of normalising the
+    weights (about ``N`` ulps) below an integer counts as that integer: equal weights keep every
+    particle once, as they do in exact arithmetic.
 
     Parameters
     ----------
