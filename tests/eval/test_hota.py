@@ -24,6 +24,7 @@ from pftrack.eval.hota import (
     mot_iou,
     prepare_mot,
 )
+from pftrack.eval.metrics import combine_mot, evaluate_mot
 from pftrack.io.mot import read_mot
 from tests.conftest import dataset
 from tests.eval.cases import perturbed, write_rows
@@ -38,8 +39,17 @@ OURS = ("hota_alpha", "det_a_alpha", "ass_a", "det_re_alpha", "det_pr_alpha", "a
         "ass_pr", "loc_a")  # fmt: skip
 
 
-def trackeval_hota(tmp: Path, seqs: dict[str, tuple[np.ndarray, np.ndarray]], benchmark: str):
-    """TrackEval's HOTA per sequence and combined, through its MotChallenge2DBox dataset."""
+def trackeval_hota(
+    tmp: Path,
+    seqs: dict[str, tuple[np.ndarray, np.ndarray]],
+    benchmark: str,
+    metrics: tuple[str, ...] = ("HOTA",),
+):
+    """TrackEval's `metrics` per sequence and combined, through its MotChallenge2DBox dataset.
+
+    Each sequence's (and ``"COMBINED"``'s) entry holds every metric's fields in one dict
+    (their names do not collide: ``HOTA``, ``MOTA``, ``CLR_FP``, ``IDF1``, ...).
+    """
     gt_root, tr_root = tmp / "gt", tmp / "trackers"
     lengths = {}
     for name, (gt, res) in seqs.items():
@@ -59,13 +69,18 @@ def trackeval_hota(tmp: Path, seqs: dict[str, tuple[np.ndarray, np.ndarray]], be
     }
     with contextlib.redirect_stdout(io.StringIO()):
         data = trackeval.datasets.MotChallenge2DBox(config)
-        metric = trackeval.metrics.HOTA()
-        out = {}
+        scorers = [getattr(trackeval.metrics, m)() for m in metrics]
+        per: dict[str, dict[str, dict]] = {m: {} for m in metrics}
         for name in seqs:
             raw = data.get_raw_seq_data("t", name)
             pre = data.get_preprocessed_seq_data(raw, "pedestrian")
-            out[name] = metric.eval_sequence(pre)
-        out["COMBINED"] = metric.combine_sequences({k: out[k] for k in seqs})
+            for m, scorer in zip(metrics, scorers, strict=True):
+                per[m][name] = scorer.eval_sequence(pre)
+        out: dict[str, dict] = {name: {} for name in [*seqs, "COMBINED"]}
+        for m, scorer in zip(metrics, scorers, strict=True):
+            for name in seqs:
+                out[name].update(per[m][name])
+            out["COMBINED"].update(scorer.combine_sequences(per[m]))
     return out
 
 
@@ -142,6 +157,59 @@ def test_equals_trackeval_with_scale_and_perturbed_truth(tmp_path: Path) -> None
     ours = evaluate_hota(gt, r, scale=0.625)
     np.testing.assert_allclose(ours.hota_alpha, ref["pets"]["HOTA"], rtol=0, atol=1e-9)
     assert ours.hota > 0.4
+
+
+#: TrackEval's CLEAR and Identity fields -> MotMetrics' (TrackEval's MOTP is the mean IoU of the
+#: matches, as motp_iou).
+CLEAR_FIELDS = {
+    "MOTA": "mota", "MOTP": "motp_iou", "IDF1": "idf1", "IDP": "idp", "IDR": "idr",
+    "CLR_FP": "false_positives", "CLR_FN": "misses", "IDSW": "num_switches",
+    "CLR_TP": "num_matches", "MT": "mostly_tracked", "PT": "partially_tracked",
+    "ML": "mostly_lost", "Frag": "num_fragmentations", "IDTP": "idtp", "IDFP": "idfp",
+    "IDFN": "idfn",
+}  # fmt: skip
+
+
+def assert_same_clear(ours, ref) -> None:
+    """CLEAR-MOT and IDF1 as TrackEval computes them."""
+    for field, attr in CLEAR_FIELDS.items():
+        assert getattr(ours, attr) == pytest.approx(float(ref[field]), rel=0, abs=1e-12), field
+
+
+@pytest.mark.dataset
+def test_clear_and_identity_equal_trackeval_on_real_sequences(tmp_path: Path) -> None:
+    """One set of scored rows for HOTA and CLEAR: MOTA, IDF1, ... are TrackEval's too.
+
+    PETS09-S2L1 has 174 conf-0 ground-truth rows; under MOT15 rules the result boxes on them
+    are false positives (they were once dropped here, which TrackEval does not do).
+    """
+    cases = real_cases()
+    gt = read_mot(dataset("pets09-s2l1") / "gt.txt")
+    cases["pets-perturbed"] = (gt, perturbed(gt, 4))
+    ref = trackeval_hota(tmp_path, cases, "MOT15", ("HOTA", "CLEAR", "Identity"))
+    ours = {}
+    for name in cases:
+        g = read_mot(tmp_path / "gt" / name / "gt" / "gt.txt")
+        r = read_mot(tmp_path / "trackers" / "t" / "data" / f"{name}.txt")
+        ours[name] = evaluate_mot(g, r)
+        assert 0.1 < ours[name].mota < 0.95 and ours[name].num_switches > 0, name
+        assert_same_clear(ours[name], ref[name])
+    assert sum(m.num_ignored_gt for m in ours.values()) > 0  # the rule is exercised
+    assert_same_clear(combine_mot(list(ours.values())), ref["COMBINED"])
+
+
+@pytest.mark.parametrize("bench_name", ["MOT17", "MOT20"])
+@pytest.mark.parametrize("seed", range(3))
+def test_clear_and_identity_equal_trackeval_mot17(
+    tmp_path: Path, bench_name: str, seed: int
+) -> None:
+    gt, res = mot17_case(seed)
+    ref = trackeval_hota(tmp_path, {"s": (gt, res)}, bench_name, ("CLEAR", "Identity"))
+    g = read_mot(tmp_path / "gt" / "s" / "gt" / "gt.txt")
+    r = read_mot(tmp_path / "trackers" / "t" / "data" / "s.txt")
+    m = evaluate_mot(g, r, benchmark=bench_name)
+    assert m.num_ignored_predictions > 0  # distractor matches were left out
+    assert_same_clear(m, ref["s"])
 
 
 def mot17_case(seed: int) -> tuple[np.ndarray, np.ndarray]:

@@ -51,12 +51,12 @@ def add_parser(sub: Any) -> None:
         "sequences (GT/SEQ/gt/gt.txt or GT/SEQ/gt.txt, with GT/SEQ/seqinfo.ini), or a folder of "
         "them, with one row per sequence and a combined row; TrackEval's tree is read as it is "
         "(--gt gt/mot_challenge/MOT17-train --res trackers/mot_challenge/MOT17-train/NAME). "
-        "Reports HOTA, DetA, AssA and LocA exactly as TrackEval computes them (its "
-        "MOTChallenge ground-truth rules: zero-marked rows dropped; for MOT16/17/20 only "
-        "pedestrians scored and result boxes on distractors removed), CLEAR-MOT (MOTA, MOTP as "
-        "mean IoU of matches, FP, FN, IDSW, Frag, MT/PT/ML) and IDF1/IDP/IDR as py-motmetrics "
-        "computes them (ground-truth rows with conf 0 not scored, result boxes on them dropped), "
-        "and Smith et al.'s success rate. The combined row sums counts, as TrackEval does.",
+        "Reports HOTA, DetA, AssA and LocA, CLEAR-MOT (MOTA, MOTP as mean IoU of matches, FP, "
+        "FN, IDSW, Frag, MT/PT/ML) and IDF1/IDP/IDR exactly as TrackEval computes them, on the "
+        "rows its MOTChallenge rules score (zero-marked ground-truth rows dropped, the result "
+        "boxes on them false positives; for MOT16/17/20 only pedestrians scored and result boxes "
+        "on distractors removed), and Smith et al.'s success rate. The combined row sums counts, "
+        "as TrackEval does.",
         epilog=EXAMPLES,
     )
     p.add_argument("--gt", required=True, help="ground truth: a MOTChallenge file or folder")

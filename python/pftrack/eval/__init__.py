@@ -1,8 +1,9 @@
 """Evaluation of tracking results: HOTA, CLEAR-MOT, IDF1 and Smith et al.'s measures.
 
-:func:`evaluate_hota` reproduces TrackEval's HOTA; :func:`evaluate_mot` CLEAR-MOT and IDF1 as
-py-motmetrics computes them; :func:`evaluate_sequence` does both, and :func:`find_sequences`
-reads a MOTChallenge folder of sequences.
+:func:`evaluate_hota` reproduces TrackEval's HOTA; :func:`evaluate_mot` its CLEAR-MOT and IDF1
+(on the same rows, chosen by its MOTChallenge rules: :func:`prepare_mot`);
+:func:`evaluate_sequence` does both, and :func:`find_sequences` reads a MOTChallenge folder of
+sequences.
 """
 
 from __future__ import annotations

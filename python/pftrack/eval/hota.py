@@ -322,7 +322,7 @@ def evaluate_hota(
     gt: ArrayLike,
     result: ArrayLike,
     *,
-    benchmark: str = "MOT15",
+    benchmark: str = "auto",
     scale: float = 1.0,
     num_frames: int | None = None,
 ) -> HotaMetrics:
@@ -332,7 +332,10 @@ def evaluate_hota(
     ----------
     gt, result : (M, 6..10) array_like of float
         Ground-truth and result MOT rows, as read by :func:`pftrack.io.mot.read_mot`.
-    benchmark, scale, num_frames
+    benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
+        Passed to :func:`prepare_mot`; ``"auto"`` (the default, as :func:`evaluate_sequence`
+        and ``pftrack eval``) guesses MOT15 or MOT17 from the columns (:func:`guess_benchmark`).
+    scale, num_frames
         Passed to :func:`prepare_mot`, which chooses the rows that are scored.
 
     Returns
@@ -356,6 +359,8 @@ def evaluate_hota(
        tracking. International Journal of Computer Vision 129, 548-578.
     .. [2] Luiten, J. & Hoffhues, A. (2020). TrackEval. (``trackeval.metrics.HOTA``)
     """
+    if benchmark == "auto":
+        benchmark = guess_benchmark(gt)
     g, r = prepare_mot(gt, result, benchmark=benchmark, scale=scale, num_frames=num_frames)
     if len(r) == 0 or len(g) == 0:
         return _empty(len(g), len(r))

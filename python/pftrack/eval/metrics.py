@@ -17,13 +17,14 @@ from scipy.optimize import linear_sum_assignment
 
 from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, number, real_array
 from pftrack.boxes import iou_xywh
-from pftrack.io.mot import CONF, FRAME, ID, LEFT
+from pftrack.io.mot import FRAME, ID, LEFT
 
 __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_xywh"]
 
 # Cost of a forbidden pair in the per-frame assignment: larger than any sum of admissible
 # costs (each is at most 1), so the solver first maximises the number of admissible pairs.
 _FORBIDDEN = 1e6
+_EPS = float(np.finfo(np.float64).eps)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,8 +61,9 @@ class MotMetrics:
     num_unique_objects, num_frames : int
         Scored ground-truth ids; frames seen in either input.
     num_ignored_gt, num_ignored_predictions : int
-        Ground-truth boxes with ``conf == 0`` (not scored) and result boxes discarded because they
-        covered one of them.
+        Ground-truth rows left out by MOTChallenge's rules (``conf`` 0, and for MOT16/17/20 other
+        classes than pedestrian) and result boxes left out (MOT16/17/20 only: those on a
+        distractor); :func:`pftrack.eval.prepare_mot`.
     precision, recall : float
         ``matches / num_predictions`` and ``matches / num_objects``.
     success_rate : float
@@ -273,6 +275,8 @@ def evaluate_mot(
     iou_threshold: float = 0.5,
     scale: float = 1.0,
     image_size: tuple[int, int] | None = None,
+    benchmark: str = "auto",
+    num_frames: int | None = None,
 ) -> MotMetrics:
     """Score a tracking result against ground truth.
 
@@ -289,6 +293,11 @@ def evaluate_mot(
         for PETS09 ground truth (768x576) against a tracker run on the 480x360 video.
     image_size : (width, height), optional
         Image size for the centroid-distance ratio (NaN without it).
+    benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
+        Which MOTChallenge rules choose the scored rows (:func:`pftrack.eval.prepare_mot`);
+        ``"auto"`` guesses MOT15 or MOT17 from the columns (:func:`pftrack.eval.guess_benchmark`).
+    num_frames : int, optional
+        The sequence length (``seqLength``); a row in a later frame is an error.
 
     Returns
     -------
@@ -302,10 +311,13 @@ def evaluate_mot(
     algorithm on ``1 - IoU`` among admissible pairs (maximum number of pairs first). A match to
     a different id than the object's last match is an identity switch, however long ago.
 
-    Ground-truth rows with ``conf == 0`` (MOTChallenge's "do not score") are ignore regions:
-    in each frame the result boxes are first assigned (Hungarian on IoU >= `iou_threshold`)
-    to all ground-truth boxes, scored and ignored alike; result boxes that land on an ignored
-    box are dropped, and the ignored boxes take no further part (no FN, no FP, no IDs).
+    The rows scored are those HOTA scores, chosen by TrackEval's MOTChallenge preprocessing
+    (:func:`pftrack.eval.prepare_mot`): ground-truth rows whose ``conf`` (the "consider" flag)
+    truncates to 0 are left out; for MOT16/17/20 also other classes than pedestrian, and result
+    boxes matched to a distractor (a static person, a reflection, ...). Under MOT15 rules a
+    result box on a left-out ground-truth box stays, as a false positive. The figures are
+    TrackEval's ``CLEAR`` and ``Identity`` on the same files
+    (``tests/eval/test_hota.py``), and py-motmetrics' on the rows scored.
 
     References
     ----------
@@ -330,41 +342,46 @@ def evaluate_mot(
             raise ValueError(
                 f"evaluate_mot: image_size is {image_size!r}, expected (width, height) > 0"
             )
-    g = check_eval_rows(gt, "evaluate_mot: gt").copy()
-    r = check_eval_rows(result, "evaluate_mot: result")
-    g[:, LEFT : LEFT + 4] *= scale
+    from pftrack.eval.hota import (  # (imports this)
+        BENCHMARKS,
+        guess_benchmark,
+        mot_iou,
+        prepare_mot,
+    )
+
+    if benchmark != "auto" and benchmark not in BENCHMARKS:
+        raise ValueError(
+            f"evaluate_mot: benchmark is {benchmark!r}, expected 'auto' or one of "
+            f"{', '.join(BENCHMARKS)}"
+        )
+    g0 = check_eval_rows(gt, "evaluate_mot: gt")
+    r0 = check_eval_rows(result, "evaluate_mot: result")
+    check_unique_ids(_split(g0), "evaluate_mot: gt")
+    check_unique_ids(_split(r0), "evaluate_mot: result")
+    mark = guess_benchmark(g0) if benchmark == "auto" else benchmark
+    g, r = prepare_mot(g0, r0, benchmark=mark, scale=scale, num_frames=num_frames)
+    n_ign_gt, n_ign_res = len(g0) - len(g), len(r0) - len(r)
     gt_frames = _split(g)
     res_frames = _split(r)
-    check_unique_ids(gt_frames, "evaluate_mot: gt")
-    check_unique_ids(res_frames, "evaluate_mot: result")
     frames = sorted(set(gt_frames) | set(res_frames))
+    n_frames = len(set(g0[:, FRAME].tolist()) | set(r0[:, FRAME].tolist()))
     empty = np.zeros((0, 10))
 
-    last_match: dict[int, int] = {}  # gt id -> result id of its latest match
-    # Per gt id: list of (tracked?) over its frames, for MT/PT/ML and fragmentations.
-    tracked: dict[int, list[bool]] = {}
+    last_match: dict[int, int] = {}  # gt id -> result id of its latest match (switches)
+    previous: dict[int, int] = {}  # gt id -> result id matched at the last scored frame
+    matched_count: dict[int, int] = {}  # gt id -> frames matched (MT/PT/ML)
+    runs: dict[int, int] = {}  # gt id -> tracked runs begun (fragmentations)
     pair_hits: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU >= thr
     pair_touch: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU > 0
     centroid: dict[tuple[int, int], list[float]] = {}  # (gt id, res id) -> distances
-    gt_count: dict[int, int] = {}
+    gt_count: dict[int, int] = {}  # gt id -> frames it is scored in
     res_count: dict[int, int] = {}
-    n_fp = n_fn = n_sw = n_match = n_gt = n_res = n_ign_gt = n_ign_res = 0
+    n_fp = n_fn = n_sw = n_match = n_gt = n_res = 0
     iou_sum = 0.0
 
     for f in frames:
         gf = gt_frames.get(f, empty)
         rf = res_frames.get(f, empty)
-        ignore = gf[:, CONF] == 0
-        n_ign_gt += int(ignore.sum())
-        if ignore.any() and len(rf):
-            iou_all = iou_xywh(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])
-            cost = np.where(iou_all >= reach, 1.0 - iou_all, _FORBIDDEN)
-            drop = {j for i, j in _assign(cost) if ignore[i]}
-            if drop:
-                keep = np.array([j not in drop for j in range(len(rf))])
-                n_ign_res += len(drop)
-                rf = rf[keep]
-        gf = gf[~ignore]
         gids = gf[:, ID].astype(np.int64)
         rids = rf[:, ID].astype(np.int64)
         n_gt += len(gids)
@@ -373,7 +390,7 @@ def evaluate_mot(
             gt_count[int(o)] = gt_count.get(int(o), 0) + 1
         for h in rids:
             res_count[int(h)] = res_count.get(int(h), 0) + 1
-        iou = iou_xywh(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])
+        iou = mot_iou(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])  # TrackEval's IoU
         ok = iou >= reach
 
         # Identity and Smith measures look at every overlapping (gt, result) pair.
@@ -400,55 +417,44 @@ def evaluate_mot(
             for key in hit_f:
                 pair_hits[key] = pair_hits.get(key, 0) + 1
 
-        # CLEAR-MOT: 1) keep last correspondences still admissible.
-        g_used = np.zeros(len(gids), dtype=bool)
-        r_used = np.zeros(len(rids), dtype=bool)
-        matches: list[tuple[int, int]] = []
-        for i, o in enumerate(gids):
-            h = last_match.get(int(o))
-            if h is None:
-                continue
-            js = np.flatnonzero((rids == h) & ~r_used)
-            if len(js) and ok[i, js[0]]:
-                g_used[i] = r_used[js[0]] = True
-                matches.append((i, int(js[0])))
-        # 2) Hungarian on the rest.
-        gi = np.flatnonzero(~g_used)
-        rj = np.flatnonzero(~r_used)
-        if len(gi) and len(rj):
-            sub = iou[np.ix_(gi, rj)]
-            cost = np.where(sub >= reach, 1.0 - sub, _FORBIDDEN)
-            for a, b in _assign(cost):
-                i, j = int(gi[a]), int(rj[b])
-                o, h = int(gids[i]), int(rids[j])
-                if o in last_match and last_match[o] != h:
-                    n_sw += 1
-                g_used[i] = r_used[j] = True
-                matches.append((i, j))
+        # CLEAR-MOT, TrackEval's arithmetic: one assignment maximising 1000 per pair that goes
+        # on from the last scored frame, plus its IoU, among pairs that reach the threshold
+        if len(gids) == 0 or len(rids) == 0:
+            n_fp += len(rids)
+            n_fn += len(gids)
+            continue  # no frame to go on from: `previous` stays as it was
+        goes_on = np.array([[previous.get(int(o)) == int(h) for h in rids] for o in gids])
+        score = np.where(ok, 1000.0 * goes_on + iou, 0.0)
+        rows_m, cols_m = linear_sum_assignment(-score)
+        hit = score[rows_m, cols_m] > _EPS
+        matches = list(zip(rows_m[hit].tolist(), cols_m[hit].tolist(), strict=True))
+        now: dict[int, int] = {}
         for i, j in matches:
-            last_match[int(gids[i])] = int(rids[j])
+            o, h = int(gids[i]), int(rids[j])
+            if o in last_match and last_match[o] != h:
+                n_sw += 1
+            last_match[o] = now[o] = h
+            matched_count[o] = matched_count.get(o, 0) + 1
+            if o not in previous:
+                runs[o] = runs.get(o, 0) + 1
             iou_sum += float(iou[i, j])
-        for i, o in enumerate(gids):
-            tracked.setdefault(int(o), []).append(bool(g_used[i]))
+        previous = now
         n_match += len(matches)
-        n_fn += int((~g_used).sum())
-        n_fp += int((~r_used).sum())
+        n_fn += len(gids) - len(matches)
+        n_fp += len(rids) - len(matches)
 
-    # Mostly tracked / lost and fragmentations.
-    mt = pt = ml = frag = 0
-    for seq in tracked.values():
-        s = np.asarray(seq, dtype=bool)
-        ratio = s.mean()
-        if ratio >= 0.8:
+    # Mostly tracked (above 80 % of its frames) / lost (below 20 %), fragmentations (tracked
+    # runs after the first), as TrackEval counts them
+    mt = pt = ml = 0
+    for o, n in gt_count.items():
+        ratio = matched_count.get(o, 0) / n
+        if ratio > 0.8:
             mt += 1
         elif ratio >= 0.2:
             pt += 1
         else:
             ml += 1
-        on = np.flatnonzero(s)
-        if len(on):
-            span = s[on[0] : on[-1] + 1]
-            frag += int(np.count_nonzero(span[:-1] & ~span[1:]))
+    frag = sum(k - 1 for k in runs.values())
 
     # Identity: global assignment maximising the frames where a pair overlaps >= threshold.
     oids = sorted(gt_count)
@@ -512,7 +518,7 @@ def evaluate_mot(
         num_objects=n_gt,
         num_predictions=n_res,
         num_unique_objects=len(oids),
-        num_frames=len(frames),
+        num_frames=n_frames,
         num_ignored_gt=n_ign_gt,
         num_ignored_predictions=n_ign_res,
         precision=n_match / n_res if n_res else nan,

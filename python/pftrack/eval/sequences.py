@@ -331,14 +331,18 @@ def evaluate_sequence(
         As in :func:`~pftrack.eval.evaluate_mot` (HOTA has no IoU threshold: it averages
         over 0.05...0.95).
     benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
-        Ground-truth conventions of HOTA (:func:`~pftrack.eval.prepare_mot`); ``"auto"``
+        Ground-truth conventions (:func:`~pftrack.eval.prepare_mot`), the same for HOTA and
+        CLEAR-MOT/IDF1; ``"auto"``
         guesses MOT15 or MOT17 from the columns (:func:`~pftrack.eval.guess_benchmark`).
     num_frames : int, optional
         The sequence length; later frames are an error.
     """
     mark = guess_benchmark(gt) if benchmark == "auto" else benchmark
     h = evaluate_hota(gt, result, benchmark=mark, scale=scale, num_frames=num_frames)
-    m = evaluate_mot(gt, result, iou_threshold=iou_threshold, scale=scale, image_size=image_size)
+    m = evaluate_mot(
+        gt, result, iou_threshold=iou_threshold, scale=scale, image_size=image_size,
+        benchmark=mark, num_frames=num_frames,
+    )  # fmt: skip
     return SequenceScores(mot=m, hota=h, benchmark=mark)
 
 
