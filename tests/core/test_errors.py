@@ -116,7 +116,7 @@ def test_likelihood_bad_inputs():
 def test_propagate_bad_inputs():
     p = np.zeros((5, 6))
     p[:, 2] = p[:, 5] = 1
-    with pytest.raises(ValueError, match="noise rows is 4, expected 5"):
+    with pytest.raises(ValueError, match=r"noise shape is \(4, 3\), expected \(5, 3\)"):
         propagate(p, np.zeros((4, 3)))
     with pytest.raises(ValueError, match=r"particles has a non-finite value nan at \[0, 0\]"):
         q = p.copy()
@@ -126,12 +126,101 @@ def test_propagate_bad_inputs():
         propagate(np.asfortranarray(p), np.zeros((5, 3)))
     with pytest.raises(TypeError, match="float64"):
         propagate(p.astype(np.float32), np.zeros((5, 3)))
-    with pytest.raises(ValueError, match="particles cols is 5"):
+    with pytest.raises(ValueError, match=r"particles shape is \(5, 5\), expected \(N, 6\)"):
         propagate(np.zeros((5, 5)), np.zeros((5, 3)))
     with pytest.raises(ValueError, match="means are required"):
         propagate(p, np.zeros((5, 3)), Ar2Model(use_means=True))
     with pytest.raises(ValueError, match="sigma_xy is -1"):
         Ar2Model(sigma_xy=-1)
+
+
+def _read_only(shape: tuple[int, ...]) -> np.ndarray:
+    a = np.ones(shape)
+    a.flags.writeable = False
+    return a
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        # was pybind11's "incompatible function arguments" with every signature (20 lines)
+        (
+            lambda: propagate(_read_only((3, 6)), np.zeros((3, 3))),
+            ValueError,
+            r"^propagate: particles must be a C-contiguous, writeable float64 array \(updated in "
+            r"place, never copied\), got a read-only one$",
+        ),
+        (
+            lambda: propagate(np.ones((1, 6, 1)), np.zeros((1, 3))),
+            ValueError,
+            r"^propagate: particles shape is \(1, 6, 1\), expected \(N, 6\)",
+        ),
+        (lambda: propagate([[1.0] * 6], np.zeros((1, 3))), TypeError, "particles must be a C-"),
+        # was "particles cols is 1, expected 6"
+        (
+            lambda: propagate(np.ones(6), np.zeros((1, 3))),
+            ValueError,
+            r"^propagate: particles shape is \(6,\), expected \(N, 6\) with N >= 1",
+        ),
+        # was AttributeError: 'NoneType' object has no attribute 'use_means'
+        (
+            lambda: propagate(np.ones((1, 6)), np.zeros((1, 3)), None),
+            TypeError,
+            "^propagate: model must be an Ar2Model, got NoneType None$",
+        ),
+        # was NumPy's "could not convert string to float: 'a'"
+        (
+            lambda: propagate(np.ones((3, 6)), [["a"] * 3] * 3),
+            TypeError,
+            "^propagate: noise must hold real numbers, got dtype <U1$",
+        ),
+        (
+            lambda: propagate(np.ones((1, 6)), np.zeros((1, 3)), means=[["a"] * 3] * 2),
+            TypeError,
+            "^propagate: means must hold real numbers",
+        ),
+        # was "noise rows is 3, expected 1"
+        (
+            lambda: propagate(np.ones((1, 6)), np.zeros(3)),
+            ValueError,
+            r"^propagate: noise shape is \(3,\), expected \(1, 3\)",
+        ),
+    ],
+)
+def test_propagate_names_the_bad_argument(call, error, match):
+    with pytest.raises(error, match=match):
+        call()
+
+
+@pytest.mark.parametrize(
+    ("particles", "model", "means", "match"),
+    [
+        # was [[inf 0 1 1e308 0 1]], silently
+        ([[1e308, 0, 1, -1e308, 0, 1]], Ar2Model(), None, "particle 0's new cx is inf"),
+        (
+            [[1, 0, 1, 1, 0, 1], [0, 1e308, 1, 0, -1e308, 1]],
+            Ar2Model(),
+            None,
+            "particle 1's new cy is inf",
+        ),
+        (
+            [[1, 0, 1, 1, 0, 1]],
+            Ar2Model(use_means=True),
+            [[1e308] * 3, [-1e308] * 3],
+            "particle 0's new cx is inf",
+        ),
+    ],
+)
+def test_propagate_refuses_an_overflow_and_leaves_the_particles(particles, model, means, match):
+    p = np.array(particles, dtype=np.float64)
+    before = p.copy()
+    with pytest.raises(ValueError, match=f"^propagate: {match}: the step overflowed"):
+        propagate(p, np.zeros((len(p), 3)), model, means)
+    np.testing.assert_array_equal(p, before)
+    # the same particles one step later than the largest finite ones: still a step
+    p[np.abs(p) == 1e308] /= 4
+    propagate(p, np.zeros((len(p), 3)), model, None if means is None else np.array(means) / 4)
+    assert np.isfinite(p).all()
 
 
 def test_filter_bad_inputs():
