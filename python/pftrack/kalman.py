@@ -25,10 +25,11 @@ Users
   :func:`cv_transition_xy`, :func:`wna_Q_xy` (state ``(x, y, vx, vy)``, ``(4, 4)``).
 
 Every public function checks its noise and variance arguments (``q``, ``r2``, the covariance
-entries, ``dt``: finite, and ``> 0`` or ``>= 0`` as the equations need), with a one-line
-ValueError. The tracker runs :func:`cv_predict` and :func:`cv_update` for every track on every
-frame with values it made itself: it calls the unchecked ``_cv_predict``, ``_cv_update`` and
-``_cv_update_where``, which compute the same floats.
+entries, ``dt``: finite, and ``> 0`` or ``>= 0`` as the equations need; a covariance positive
+semi-definite, ``p01² <= p00 p11`` up to round-off), with a one-line ValueError. The tracker
+runs :func:`cv_predict` and :func:`cv_update` for every track on every frame with values it
+made itself: it calls the unchecked ``_cv_predict``, ``_cv_update`` and ``_cv_update_where``,
+which compute the same floats.
 
 The tracker and the box smoother once used the piecewise-constant discretisation
 ``q [[1/4, 1/2], [1/2, 1]]`` instead; with the same noise levels, the continuous one scores
@@ -139,6 +140,33 @@ def _require_state(fn: str, mean: Mean, cov: Cov, **others: ArrayLike) -> None:
                     "together (one value per axis)"
                 ) from None
         seen[name] = shape
+    _require_psd(fn, cov)
+
+
+#: Round-off :func:`_require_psd` forgives: ``|p01|`` up to ``sqrt(p00 p11)`` times
+#: ``1 + PSD_RTOL``, plus the smallest normal float (p01 of a covariance whose variances
+#: underflowed to 0).
+PSD_RTOL = 1e-9
+
+
+def _require_psd(fn: str, cov: Cov) -> None:
+    """Raise a ValueError unless the covariance ``(p00, p01, p11)`` is positive semi-definite.
+
+    A 2x2 covariance with variances ``>= 0`` (checked first, by :func:`_require_cov`) is PSD
+    when ``p01² <= p00 p11``; the test is ``|p01| <= sqrt(p00) sqrt(p11) (1 + PSD_RTOL) +
+    tiny``, which never overflows (``p01²`` does from 1.4e154) and forgives the round-off of
+    a predict or update. Per axis: the first bad one is named.
+    """
+    p00, p01, p11 = np.broadcast_arrays(*(np.asarray(c, dtype=np.float64) for c in cov))
+    bound = np.sqrt(p00) * np.sqrt(p11) * (1.0 + PSD_RTOL) + np.finfo(np.float64).tiny
+    bad = np.abs(p01) > bound
+    if bad.any():
+        k, at = first_at(bad)
+        shown = ", ".join(str(float(c[k])) for c in (p00, p01, p11))  # 1.00000001, not 1
+        raise ValueError(
+            f"{fn}: cov{at} (p00, p01, p11) = ({shown}) is not positive semi-definite: "
+            "expected p01² <= p00 * p11"
+        )
 
 
 def cv_transition(dt: float = 1.0) -> F64:
@@ -255,7 +283,8 @@ def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, C
         Values that are not real numbers.
     ValueError
         A variance of `cov` (p00, p11), `q` or `dt` not finite and ``>= 0``, p01 or `mean`
-        not finite, or arrays whose shapes do not broadcast together.
+        not finite, `cov` not positive semi-definite (``p01² > p00 p11`` beyond a relative
+        round-off of 1e-9), or arrays whose shapes do not broadcast together.
     """
     _require_state("cv_predict", mean, cov, q=q, dt=dt)
     _require("cv_predict", "q", q, ">= 0")
@@ -298,8 +327,8 @@ def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
         Values that are not real numbers.
     ValueError
         A variance of `cov` (p00, p11) not finite and ``>= 0``, p01, `mean` or `z` not finite,
-        `r2` not finite and ``> 0`` (as :func:`rts_smooth`'s), or arrays whose shapes do not
-        broadcast together.
+        `cov` not positive semi-definite (as :func:`cv_predict`'s), `r2` not finite and ``> 0``
+        (as :func:`rts_smooth`'s), or arrays whose shapes do not broadcast together.
     """
     _require_state("cv_update", mean, cov, z=z, r2=r2)
     _require("cv_update", "z", z)

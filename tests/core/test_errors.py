@@ -116,7 +116,7 @@ def test_likelihood_bad_inputs():
 def test_propagate_bad_inputs():
     p = np.zeros((5, 6))
     p[:, 2] = p[:, 5] = 1
-    with pytest.raises(ValueError, match="noise rows is 4, expected 5"):
+    with pytest.raises(ValueError, match=r"noise shape is \(4, 3\), expected \(5, 3\)"):
         propagate(p, np.zeros((4, 3)))
     with pytest.raises(ValueError, match=r"particles has a non-finite value nan at \[0, 0\]"):
         q = p.copy()
@@ -126,12 +126,101 @@ def test_propagate_bad_inputs():
         propagate(np.asfortranarray(p), np.zeros((5, 3)))
     with pytest.raises(TypeError, match="float64"):
         propagate(p.astype(np.float32), np.zeros((5, 3)))
-    with pytest.raises(ValueError, match="particles cols is 5"):
+    with pytest.raises(ValueError, match=r"particles shape is \(5, 5\), expected \(N, 6\)"):
         propagate(np.zeros((5, 5)), np.zeros((5, 3)))
     with pytest.raises(ValueError, match="means are required"):
         propagate(p, np.zeros((5, 3)), Ar2Model(use_means=True))
     with pytest.raises(ValueError, match="sigma_xy is -1"):
         Ar2Model(sigma_xy=-1)
+
+
+def _read_only(shape: tuple[int, ...]) -> np.ndarray:
+    a = np.ones(shape)
+    a.flags.writeable = False
+    return a
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "match"),
+    [
+        # was pybind11's "incompatible function arguments" with every signature (20 lines)
+        (
+            lambda: propagate(_read_only((3, 6)), np.zeros((3, 3))),
+            ValueError,
+            r"^propagate: particles must be a C-contiguous, writeable float64 array \(updated in "
+            r"place, never copied\), got a read-only one$",
+        ),
+        (
+            lambda: propagate(np.ones((1, 6, 1)), np.zeros((1, 3))),
+            ValueError,
+            r"^propagate: particles shape is \(1, 6, 1\), expected \(N, 6\)",
+        ),
+        (lambda: propagate([[1.0] * 6], np.zeros((1, 3))), TypeError, "particles must be a C-"),
+        # was "particles cols is 1, expected 6"
+        (
+            lambda: propagate(np.ones(6), np.zeros((1, 3))),
+            ValueError,
+            r"^propagate: particles shape is \(6,\), expected \(N, 6\) with N >= 1",
+        ),
+        # was AttributeError: 'NoneType' object has no attribute 'use_means'
+        (
+            lambda: propagate(np.ones((1, 6)), np.zeros((1, 3)), None),
+            TypeError,
+            "^propagate: model must be an Ar2Model, got NoneType None$",
+        ),
+        # was NumPy's "could not convert string to float: 'a'"
+        (
+            lambda: propagate(np.ones((3, 6)), [["a"] * 3] * 3),
+            TypeError,
+            "^propagate: noise must hold real numbers, got dtype <U1$",
+        ),
+        (
+            lambda: propagate(np.ones((1, 6)), np.zeros((1, 3)), means=[["a"] * 3] * 2),
+            TypeError,
+            "^propagate: means must hold real numbers",
+        ),
+        # was "noise rows is 3, expected 1"
+        (
+            lambda: propagate(np.ones((1, 6)), np.zeros(3)),
+            ValueError,
+            r"^propagate: noise shape is \(3,\), expected \(1, 3\)",
+        ),
+    ],
+)
+def test_propagate_names_the_bad_argument(call, error, match):
+    with pytest.raises(error, match=match):
+        call()
+
+
+@pytest.mark.parametrize(
+    ("particles", "model", "means", "match"),
+    [
+        # was [[inf 0 1 1e308 0 1]], silently
+        ([[1e308, 0, 1, -1e308, 0, 1]], Ar2Model(), None, "particle 0's new cx is inf"),
+        (
+            [[1, 0, 1, 1, 0, 1], [0, 1e308, 1, 0, -1e308, 1]],
+            Ar2Model(),
+            None,
+            "particle 1's new cy is inf",
+        ),
+        (
+            [[1, 0, 1, 1, 0, 1]],
+            Ar2Model(use_means=True),
+            [[1e308] * 3, [-1e308] * 3],
+            "particle 0's new cx is inf",
+        ),
+    ],
+)
+def test_propagate_refuses_an_overflow_and_leaves_the_particles(particles, model, means, match):
+    p = np.array(particles, dtype=np.float64)
+    before = p.copy()
+    with pytest.raises(ValueError, match=f"^propagate: {match}: the step overflowed"):
+        propagate(p, np.zeros((len(p), 3)), model, means)
+    np.testing.assert_array_equal(p, before)
+    # the same particles one step later than the largest finite ones: still a step
+    p[np.abs(p) == 1e308] /= 4
+    propagate(p, np.zeros((len(p), 3)), model, None if means is None else np.array(means) / 4)
+    assert np.isfinite(p).all()
 
 
 def test_filter_bad_inputs():
@@ -231,6 +320,27 @@ IMAGE = hsv_bins(np.zeros((8, 8, 3), np.uint8))
         ),
         (lambda: BinnedImage(np.array([[0.0, 1.5]]), 5), ValueError, "bins value is 1.5"),
         (lambda: BinnedImage(np.array([["a"]]), 5), TypeError, "bins must hold bin indices"),
+        # each was pybind11's "__init__(): incompatible constructor arguments" and signatures
+        (
+            lambda: BinnedImage(np.zeros((4, 4), np.int16), 2**31),
+            ValueError,
+            r"^BinnedImage: n_bins is 2147483648, expected an integer in \[1, 32767\]$",
+        ),
+        (lambda: BinnedImage(np.zeros((4, 4), np.int16), 5.0), ValueError, "n_bins is 5.0, exp"),
+        (lambda: BinnedImage(np.zeros((4, 4), np.int16), "5"), ValueError, "n_bins is '5', exp"),
+        (
+            lambda: BinnedImage([[0, 1], [0]], 5),
+            ValueError,
+            r"^BinnedImage: bins must be a rectangular \(H, W\) array, got rows of different",
+        ),
+        # was taken as n_bins = 1
+        (lambda: BinnedImage(np.zeros((4, 4), np.int16), True), ValueError, "n_bins is True, e"),
+        # the core's own check, with the same words
+        (
+            lambda: BinnedImage(np.zeros((4, 4), np.int16), 10**9),
+            ValueError,
+            r"^BinnedImage: n_bins is 1000000000, expected an integer in \[1, 32767\]$",
+        ),
         # was AttributeError: 'str' object has no attribute 'n_h'
         (
             lambda: hsv_bins(np.zeros((4, 4, 3), np.uint8), binning="x"),
@@ -254,3 +364,12 @@ def test_binned_image_from_wider_integers_keeps_the_bins():
     bins = np.array([[0, 4, -1]], np.int64)
     np.testing.assert_array_equal(BinnedImage(bins, 5).bins, bins)
     np.testing.assert_array_equal(BinnedImage(bins.astype(float), 5).bins, bins)
+
+
+def test_binned_image_is_the_cores_class_and_takes_lists():
+    # the constructor's checks keep the class itself: hsv_bins' images are BinnedImages
+    assert BinnedImage is _core.BinnedImage
+    assert isinstance(hsv_bins(np.zeros((2, 2, 3), np.uint8)), BinnedImage)
+    image = BinnedImage([[0, 4, -1]], np.int64(5))  # was the signature dump (a list)
+    np.testing.assert_array_equal(image.bins, [[0, 4, -1]])
+    assert image.n_bins == 5

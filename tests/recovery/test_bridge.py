@@ -95,9 +95,9 @@ def test_pseudo_inverse_form_agrees_for_tall_H_with_isotropic_goal_noise():
 def test_forms_reject_what_they_cannot_handle():
     rng = np.random.default_rng(4)
     p = problem(rng, n=4, m=2, T=5)
-    with pytest.raises(ValueError, match="H must be square"):
+    with pytest.raises(ValueError, match="^goal_directed_path: H_T must be square"):
         goal_directed_path(**p, form="invertible")
-    with pytest.raises(ValueError, match="H\\^T H is singular"):
+    with pytest.raises(ValueError, match="^goal_directed_path: H_T\\^T H_T is singular"):
         goal_directed_path(**p, form="pseudo_inverse")
     p4 = problem(rng, n=4, m=4, T=5)
     p4["A"] = np.zeros((4, 4))
@@ -165,9 +165,9 @@ def test_bad_input_names_the_problem():
         goal_directed_path(**{**p, "T": 0})
     with pytest.raises(ValueError, match="T is -3"):
         goal_directed_path(**{**p, "T": -3})
-    with pytest.raises(ValueError, match="H shape"):
+    with pytest.raises(ValueError, match=r"H_T has shape \(2, 3\), expected \(2, 4\)"):
         goal_directed_path(**{**p, "H_T": np.ones((2, 3))})
-    with pytest.raises(ValueError, match="number of A matrices"):
+    with pytest.raises(ValueError, match="A holds 3 matrices, expected 1 or T = 4"):
         goal_directed_path(**{**p, "A": np.stack([np.eye(4)] * 3)})
     with pytest.raises(ValueError, match="Pi_0 is not positive definite"):
         goal_directed_path(**{**p, "Pi_0": np.zeros((4, 4))})
@@ -179,14 +179,57 @@ def test_bad_input_names_the_problem():
         goal_directed_path(**{**p, "Q": -np.eye(4)})
     bad = p["m0"].copy()
     bad[1] = np.nan
-    with pytest.raises(ValueError, match="m0 has a non-finite value"):
+    with pytest.raises(ValueError, match=r"m0\[1\] is nan, expected finite"):
         goal_directed_path(**{**p, "m0": bad})
-    with pytest.raises(ValueError, match="y has a non-finite value"):
+    with pytest.raises(ValueError, match=r"y_T\[0\] is inf, expected finite"):
         goal_directed_path(**{**p, "y_T": np.array([np.inf, 0.0])})
     with pytest.raises(ValueError, match="form is"):
         goal_directed_path(**p, form="nope")  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="T must be an int"):
         goal_directed_path(**{**p, "T": 2.5})
+
+
+N4 = np.eye(4)
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        # was "gdt_solve: A[0] shape is (4, 4), expected (3, 3)": the state size is A's
+        ({"m0": np.zeros(3)}, r"m0 has 3 entries, expected 4 \(A is 4x4\)$"),
+        ({"m0": np.zeros((1, 4))}, r"m0 has shape \(1, 4\), expected 4 \(A is 4x4\)$"),
+        ({"Q": np.eye(3)}, r"Q has shape \(3, 3\), expected \(4, 4\) or \(T, 4, 4\) \(A is"),
+        ({"Pi_0": np.eye(5)}, r"Pi_0 has shape \(5, 5\), expected \(4, 4\) \(A is 4x4\)$"),
+        ({"A": np.ones((4, 3))}, r"A has shape \(4, 3\), expected \(n, n\) or \(T, n, n\)"),
+        ({"Q": np.stack([N4] * 2)}, "Q holds 2 matrices, expected 1 or T = 10$"),
+        ({"y_T": np.zeros(3)}, r"H_T has shape \(4, 4\), expected \(3, 4\) \(y_T has 3 entr"),
+        ({"Pi_T": np.eye(3)}, r"Pi_T has shape \(3, 3\), expected \(4, 4\) \(y_T has 4 ent"),
+        ({"y_T": np.zeros((2, 2))}, r"y_T has shape \(2, 2\), expected \(m,\) with m >= 1"),
+        ({"A": np.full((4, 4), np.nan)}, r"A\[0, 0\] is nan, expected finite$"),
+        # the core's own refusals, under the caller's name (was "gdt_solve: ...")
+        ({"A": 1e200 * N4}, "the result is not finite: A is unstable"),
+        ({"Q": -N4}, r"Q\[0\] is not positive semi-definite$"),
+        # was pybind11's "incompatible function arguments" and its signatures
+        ({"T": 2**40}, r"T is 1099511627776, expected an int in \[1, 2147483647\]$"),
+    ],
+)
+@pytest.mark.parametrize("fn", ["goal_directed_path", "sample_goal_directed_paths"])
+def test_shapes_are_checked_against_A_and_messages_name_the_function(fn, change, match):
+    args = dict(A=N4, Q=0.1 * N4, H_T=N4, Pi_T=N4, m0=np.zeros(4), Pi_0=N4, y_T=np.zeros(4), T=10)
+    args.update(change)
+    if fn == "goal_directed_path":
+        call = goal_directed_path
+    else:
+        call, args = sample_goal_directed_paths, {**args, "n_samples": 2, "rng": 0}
+    with pytest.raises(ValueError, match=f"^{fn}: {match}"):
+        call(**args)
+
+
+def test_sample_count_is_bounded():
+    p = problem(np.random.default_rng(5), T=4)
+    # was pybind11's "incompatible function arguments" and its signatures
+    with pytest.raises(ValueError, match=r"n_samples is 4294967296, expected an int in \[1, "):
+        sample_goal_directed_paths(**p, n_samples=2**32)
 
 
 def test_batch_equals_single_and_threads_equal_serial():
@@ -290,9 +333,9 @@ def test_options_and_matrices_of_the_wrong_type_are_refused(fn):
     with pytest.raises(TypeError, match=f"{fn}: start_conditioned must be True or False, got str"):
         call(**p, **extra, start_conditioned="no")
     # was cast to its real part with a ComplexWarning
-    with pytest.raises(TypeError, match="goal_directed_path: Q must hold real numbers"):
+    with pytest.raises(TypeError, match=f"{fn}: Q must hold real numbers"):
         call(**{**p, "Q": p["Q"] + 0j}, **extra)
-    with pytest.raises(TypeError, match="goal_directed_path: y_T must hold real numbers"):
+    with pytest.raises(TypeError, match=f"{fn}: y_T must hold real numbers"):
         call(**{**p, "y_T": ["a", "b"]}, **extra)
     got = call(**p, **extra, start_conditioned=np.False_)  # NumPy's bools are bools
     want = call(**p, **extra, start_conditioned=False)

@@ -80,8 +80,9 @@ def test_predict_over_dt_frames_matches_matrix_form():
 
 def test_predict_one_frame_is_the_one_frame_formula_bit_for_bit():
     rng = np.random.default_rng(6)
-    m0, m1, p00, p01, p11, q = rng.normal(size=(6, 50))
+    m0, m1, p00, p11, q = rng.normal(size=(5, 50))
     p00, p11, q = abs(p00), abs(p11), abs(q)  # variances and noise: negative ones are refused
+    p01 = rng.uniform(-1, 1, 50) * np.sqrt(p00 * p11)  # and covariances that are not PSD
     (p, v), (a, b, c) = cv_predict((m0, m1), (p00, p01, p11), q)
     assert np.array_equal(p, m0 + m1) and np.array_equal(v, m1)
     assert np.array_equal(a, p00 + 2 * p01 + p11 + q / 3.0)
@@ -250,6 +251,23 @@ COV = (np.array([2.0, 3.0]), np.array([0.1, -0.2]), np.array([1.0, 4.0]))
         (lambda: cv_predict(MEAN, COV, 1.0, -1.0), "cv_predict: dt is -1, expected finite and >="),
         (lambda: cv_predict(MEAN, (1.0, 0.0, -1e-9), 1.0), "cov's p11 is -1e-09, expected"),
         (lambda: cv_update_where(MEAN, COV, 1.0, 0.0, False), "cv_update_where: r2 is 0"),
+        # was accepted: a "covariance" with p01² > p00 p11 (a negative variance along a
+        # direction), which the update took on
+        (
+            lambda: cv_predict((0.0, 1.0), (1.0, 5.0, 1.0), 1.0),
+            r"^cv_predict: cov \(p00, p01, p11\) = \(1.0, 5.0, 1.0\) is not positive semi-def",
+        ),
+        (
+            lambda: cv_update(MEAN, (COV[0], np.array([0.1, -3.5]), COV[2]), 1.0, 1.0),
+            r"^cv_update: cov\[1\] \(p00, p01, p11\) = \(3.0, -3.5, 4.0\) is not positive",
+        ),
+        # wherever `where` holds or not
+        (
+            lambda: cv_update_where(MEAN, (1.0, 1.0 + 1e-8, 1.0), 1.0, 1.0, False),
+            r"^cv_update_where: cov \(p00, p01, p11\) = \(1.0, 1.00000001, 1.0\) is not",
+        ),
+        # p00 p11 overflows to inf, but p01² = 1e320 > 1e310 all the same
+        (lambda: cv_predict(MEAN, (1e300, 1e160, 1e10), 1.0), "cv_predict: cov .* is not posit"),
         # was: a negative "covariance"
         (lambda: wna_Q(-1.0), "wna_Q: q is -1, expected finite and >= 0"),
         (lambda: wna_Q(1.0, np.inf), "wna_Q: dt is inf, expected finite and >= 0"),
@@ -278,6 +296,24 @@ def test_helpers_take_the_bounds_the_equations_allow():
     assert (p, v, a, b, c) == (0.0, 1.0, 0.0, 0.0, 1.0)
     np.testing.assert_array_equal(wna_Q(0.0, 0.0), np.zeros((2, 2)))
     np.testing.assert_array_equal(cv_transition(-1.0), [[1.0, -1.0], [0.0, 1.0]])
+
+
+def test_covariances_on_the_psd_boundary_are_taken():
+    # p01² = p00 p11 (a singular covariance, e.g. no velocity of its own), its round-off, and
+    # products that overflow: still covariances
+    for cov in [(1.0, 1.0, 1.0), (2.0, -np.sqrt(2.0 * 3.0), 3.0), (1.0, 1.0 + 1e-12, 1.0)]:
+        cv_predict((0.0, 1.0), cov, 1.0)
+        cv_update((0.0, 1.0), cov, 1.0, 1.0)
+    assert cv_predict((0.0, 0.0), (1e300, 1e300, 1e300), 0.0, 0.0)[1] == (1e300, 1e300, 1e300)
+    # a long run of checked predicts and updates (noise levels over many decades) is never
+    # refused for the round-off of its own covariances
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        mean, cov = (0.0, 0.0), (rng.uniform(0, 10), 0.0, rng.uniform(0, 10))
+        q = 10 ** rng.uniform(-12, 6)
+        for _ in range(100):
+            mean, cov = cv_predict(mean, cov, q, rng.choice([0.0, 1e-3, 1.0, 2.5]))
+            mean, cov = cv_update(mean, cov, rng.normal(), 10 ** rng.uniform(-300, 8))
 
 
 def test_the_trackers_unchecked_calls_give_the_same_floats():

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import flag, number
+from pftrack._check import first_at, flag, number, real_array
 
 __all__ = ["Ar2Model", "estimate", "propagate"]
 
@@ -125,36 +125,82 @@ def propagate(
 
     Parameters
     ----------
-    particles : (N, 6) ndarray of float64, C-contiguous
-        Updated in place (it must be float64 and C-contiguous; it is never copied).
+    particles : (N, 6) ndarray of float64, C-contiguous and writeable
+        Updated in place (it is never copied, so it must be such an array already).
     noise : (N, 3) array_like of float
         Standard-normal draws, e.g. ``rng.standard_normal((N, 3))``.
     model : Ar2Model
         Dynamics.
     means : (2, 3) array_like, optional
         Particle-set means at t-1 and t-2, needed when ``model.use_means``.
+
+    Raises
+    ------
+    TypeError
+        `particles` not a float64 array, `noise` or `means` not real numbers, `model` not an
+        :class:`Ar2Model`.
+    ValueError
+        `particles` not C-contiguous, read-only or not of shape (N, 6) with N >= 1; `noise`
+        not (N, 3) or `means` not (2, 3); a value that is not finite; ``model.use_means``
+        without `means`; a new state that is not finite (the step overflowed: states or
+        noise near 1e308). `particles` is left as it was whenever an error is raised.
     """
-    if not isinstance(particles, np.ndarray) or particles.dtype != np.float64:
-        raise TypeError("particles must be a float64 numpy array (updated in place)")
-    if not particles.flags.c_contiguous:
-        raise ValueError("particles must be C-contiguous (updated in place, never copied)")
-    m = np.zeros((2, 3)) if means is None else np.asarray(means, dtype=np.float64)
-    if m.shape != (2, 3):
-        raise ValueError(f"means shape is {m.shape}, expected (2, 3)")
+    fn = "propagate"
+    error = _particles_error(particles, fn)
+    if error is not None:
+        raise error
+    if not isinstance(model, Ar2Model):
+        raise TypeError(f"{fn}: model must be an Ar2Model, got {type(model).__name__} {model!r}")
+    w = np.ascontiguousarray(real_array(noise, f"{fn}: noise", booleans=False))
+    if w.shape != (len(particles), 3):
+        raise ValueError(
+            f"{fn}: noise shape is {w.shape}, expected ({len(particles)}, 3): one standard-normal "
+            "draw of (cx, cy, s) per particle"
+        )
     if model.use_means and means is None:
-        raise ValueError("means are required with use_means=True (eq. 8)")
+        raise ValueError(f"{fn}: means are required with use_means=True (eq. 8)")
+    m = np.zeros((2, 3)) if means is None else real_array(means, f"{fn}: means", booleans=False)
+    if m.shape != (2, 3):
+        raise ValueError(f"{fn}: means shape is {m.shape}, expected (2, 3)")
+    # the core writes the new state over the previous one (columns 3-5) after moving the
+    # current one (columns 0-2) there: keeping the previous one is enough to undo a step
+    previous = particles[:, 3:].copy()
     _core.propagate(
-        particles,
-        np.ascontiguousarray(noise, dtype=np.float64),
-        model.a,
-        model.b,
-        model.sigma,
-        model.s_min,
-        model.s_max,
-        model.use_means,
-        m[0],
-        m[1],
-    )
+        particles, w, model.a, model.b, model.sigma, model.s_min, model.s_max,
+        model.use_means, m[0], m[1],
+    )  # fmt: skip
+    bad = ~np.isfinite(particles[:, :3])
+    if bad.any():
+        (row, col), _ = first_at(bad)
+        value = particles[row, col]
+        particles[:, :3] = particles[:, 3:]
+        particles[:, 3:] = previous
+        raise ValueError(
+            f"{fn}: particle {row}'s new {('cx', 'cy', 's')[col]} is {value}: the step "
+            "overflowed (states, means or noise too large); particles are left as they were"
+        )
+
+
+def _particles_error(particles: object, fn: str) -> TypeError | ValueError | None:
+    """Why the core cannot update `particles` in place, or None when it can.
+
+    The core takes only a C-contiguous, writeable float64 array of shape (N, 6), N >= 1; any
+    other (a read-only one too) got pybind11's list of signatures instead of a message.
+    """
+    what = "a C-contiguous, writeable float64 array (updated in place, never copied)"
+    if not isinstance(particles, np.ndarray):
+        return TypeError(f"{fn}: particles must be {what}, got {type(particles).__name__}")
+    if particles.dtype != np.float64:
+        return TypeError(f"{fn}: particles must be {what}, got dtype {particles.dtype}")
+    if not particles.flags.c_contiguous or not particles.flags.writeable:
+        got = "a read-only one" if particles.flags.c_contiguous else "one not C-contiguous"
+        return ValueError(f"{fn}: particles must be {what}, got {got}")
+    if particles.ndim != 2 or particles.shape[1] != 6 or particles.shape[0] == 0:
+        return ValueError(
+            f"{fn}: particles shape is {particles.shape}, expected (N, 6) with N >= 1: one row "
+            "(cx, cy, s, previous cx, cy, s) per particle"
+        )
+    return None
 
 
 def estimate(

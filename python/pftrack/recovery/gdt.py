@@ -6,6 +6,7 @@ arguments, converts them and documents the maths.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Literal, TypeAlias
 
@@ -13,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import flag, generator, real_array
+from pftrack._check import MAX_FRAME, first_at, flag, generator, real_array
 from pftrack._typing import F64, RngLike
 from pftrack.kalman import cv_transition_xy
 
@@ -68,13 +69,6 @@ class GdtModel:
         return np.diag(np.asarray(self.r, dtype=np.float64))
 
 
-def _as_stack(a: ArrayLike, name: str) -> F64:
-    arr = np.ascontiguousarray(_real(a, name))
-    if arr.ndim not in (2, 3):
-        raise ValueError(f"goal_directed_path: {name} must be (n, n) or (T, n, n), got {arr.shape}")
-    return arr
-
-
 @dataclass(frozen=True)
 class GdtSolution:
     """Result of :func:`goal_directed_path`.
@@ -100,20 +94,22 @@ class GdtSolution:
     x0_cov: F64
 
 
-def _check_T(T: object) -> int:
-    if isinstance(T, bool) or not isinstance(T, (int, np.integer)):
-        raise TypeError(f"goal_directed_path: T must be an int, got {type(T).__name__}")
-    if T <= 0:
-        raise ValueError(f"goal_directed_path: T is {T}, expected > 0")
+def _check_T(T: object, fn: str) -> int:
+    """`T` as an int in ``[1, MAX_FRAME]`` (the core takes a 32-bit int)."""
+    if isinstance(T, (bool, np.bool_)) or not isinstance(T, (int, np.integer)):
+        raise TypeError(f"{fn}: T must be an int, got {type(T).__name__}")
+    if not 0 < T <= MAX_FRAME:
+        raise ValueError(f"{fn}: T is {T}, expected an int in [1, {MAX_FRAME}]")
     return int(T)
 
 
-def _check_form(form: str) -> None:
+def _check_form(form: str, fn: str) -> None:
     if form not in _FORMS:
-        raise ValueError(f"goal_directed_path: form is {form!r}, expected one of {_FORMS}")
+        raise ValueError(f"{fn}: form is {form!r}, expected one of {_FORMS}")
 
 
 def _model_arrays(
+    fn: str,
     A: ArrayLike,  # noqa: N803 - the paper's names
     Q: ArrayLike,  # noqa: N803
     H_T: ArrayLike,  # noqa: N803
@@ -121,22 +117,81 @@ def _model_arrays(
     m0: ArrayLike,
     Pi_0: ArrayLike,  # noqa: N803
     y_T: ArrayLike,  # noqa: N803
+    T: int,  # noqa: N803
 ) -> tuple[F64, F64, F64, F64, F64, F64, F64]:
-    """The model as the float64 arrays ``gdt_solve``/``gdt_sample`` take (A, Q stacked per step)."""
-    return (
-        _as_stack(A, "A"),
-        _as_stack(Q, "Q"),
-        np.atleast_2d(_real(H_T, "H_T")),
-        np.atleast_2d(_real(Pi_T, "Pi_T")),
-        _real(m0, "m0"),
-        np.atleast_2d(_real(Pi_0, "Pi_0")),
-        _real(y_T, "y_T"),
-    )
+    """The model as the float64 arrays ``gdt_solve``/``gdt_sample`` take (A, Q stacked per step).
+
+    The state size n is A's; every other shape is checked against it (and the goal's size
+    m, ``len(y_T)``) here, so that a message names the argument that does not fit and `fn`
+    (the core would blame ``A[0]`` for a short `m0`, under its own name).
+
+    Raises
+    ------
+    TypeError
+        An argument that is not real numbers.
+    ValueError
+        A shape that does not fit n or m, more than one but not T matrices in `A` or `Q`, a
+        value that is not finite.
+    """
+    a = _real(A, "A", fn)
+    if a.ndim not in (2, 3) or a.shape[-1] != a.shape[-2] or a.shape[-1] == 0:
+        raise ValueError(f"{fn}: A has shape {a.shape}, expected (n, n) or (T, n, n) with n >= 1")
+    n = a.shape[-1]
+    size = f"(A is {n}x{n})"
+    q = _real(Q, "Q", fn)
+    if q.ndim not in (2, 3) or q.shape[-2:] != (n, n):
+        raise ValueError(
+            f"{fn}: Q has shape {q.shape}, expected ({n}, {n}) or (T, {n}, {n}) {size}"
+        )
+    for name, stack in (("A", a), ("Q", q)):
+        if stack.ndim == 3 and len(stack) not in (1, T):
+            raise ValueError(f"{fn}: {name} holds {len(stack)} matrices, expected 1 or T = {T}")
+    m0_ = _real(m0, "m0", fn)
+    if m0_.shape != (n,):
+        got = f"{m0_.size} entries" if m0_.ndim == 1 else f"shape {m0_.shape}"
+        raise ValueError(f"{fn}: m0 has {got}, expected {n} {size}")
+    pi_0 = np.atleast_2d(_real(Pi_0, "Pi_0", fn))
+    if pi_0.shape != (n, n):
+        raise ValueError(f"{fn}: Pi_0 has shape {pi_0.shape}, expected ({n}, {n}) {size}")
+    y = _real(y_T, "y_T", fn)
+    if y.ndim != 1 or y.size == 0:
+        raise ValueError(f"{fn}: y_T has shape {y.shape}, expected (m,) with m >= 1 (the goal)")
+    m = y.size
+    h = np.atleast_2d(_real(H_T, "H_T", fn))
+    if h.shape != (m, n):
+        raise ValueError(
+            f"{fn}: H_T has shape {h.shape}, expected ({m}, {n}) (y_T has {m} entries, A is "
+            f"{n}x{n})"
+        )
+    pi_t = np.atleast_2d(_real(Pi_T, "Pi_T", fn))
+    if pi_t.shape != (m, m):
+        raise ValueError(
+            f"{fn}: Pi_T has shape {pi_t.shape}, expected ({m}, {m}) (y_T has {m} entries)"
+        )
+    arrays = {"A": a, "Q": q, "H_T": h, "Pi_T": pi_t, "m0": m0_, "Pi_0": pi_0, "y_T": y}
+    for name, arr in arrays.items():
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            k, at = first_at(bad)
+            raise ValueError(f"{fn}: {name}{at} is {arr[k]}, expected finite")
+    return (np.ascontiguousarray(a), np.ascontiguousarray(q), h, pi_t, m0_, pi_0, y)
 
 
-def _real(a: ArrayLike, name: str) -> F64:
+def _real(a: ArrayLike, name: str, fn: str) -> F64:
     """`a` as float64, refusing complex numbers (cast with a warning) and text."""
-    return real_array(a, f"goal_directed_path: {name}")
+    return real_array(a, f"{fn}: {name}")
+
+
+def _core_error(error: ValueError, core: str, fn: str) -> ValueError:
+    """The core's refusal (a non-PSD ``Q``, a singular ``H``, ...) under the name `fn`.
+
+    The core names its own function (``gdt_solve``) and the goal's matrix ``H``; the caller
+    knows `fn` and ``H_T``.
+    """
+    message = str(error)
+    if not message.startswith(f"{core}: "):
+        return error
+    return ValueError(f"{fn}: " + re.sub(r"\bH\b", "H_T", message[len(core) + 2 :]))
 
 
 def goal_directed_path(
@@ -173,7 +228,7 @@ def goal_directed_path(
     y_T : (m,) array_like
         The goal.
     T : int
-        Steps from ``x_0`` to the goal's state ``x_T`` (> 0).
+        Steps from ``x_0`` to the goal's state ``x_T``, in [1, 2**31 - 1].
     form : {"general", "invertible", "pseudo_inverse"}
         Eqs. 7-10 (any ``H_T``), 11-15 (square invertible ``H_T``) or 16-18 (``H_T`` of full
         column rank; the paper's eq. 17 reads ``H^+ Pi_T H^+T`` with ``H^+ = (H^T H)^-1 H^T``,
@@ -192,8 +247,10 @@ def goal_directed_path(
     TypeError
         `T` not an int, `start_conditioned` not a bool (``"no"`` would be True).
     ValueError
-        T <= 0, mismatched dimensions, NaN, non-symmetric or non-PSD ``Q``, singular or non-PD
-        ``Pi_0``/``Pi_T``, ``H_T`` unfit for `form`.
+        `T` not in [1, 2**31 - 1]; a shape that does not fit the state size n of `A` (or the
+        goal's size, ``len(y_T)``), named with it (``m0 has 3 entries, expected 4 (A is
+        4x4)``); NaN or infinities, non-symmetric or non-PSD ``Q``, singular or non-PD
+        ``Pi_0``/``Pi_T``, ``H_T`` unfit for `form`, a model whose path is not finite.
 
     References
     ----------
@@ -202,10 +259,15 @@ def goal_directed_path(
     .. [2] Srinivasan, L. et al. (2006). A state-space analysis for reconstruction of
        goal-directed movements using neural signals. Neural Computation 18(10).
     """
-    T = _check_T(T)
-    _check_form(form)
-    conditioned = flag(start_conditioned, "goal_directed_path: start_conditioned")
-    r = _core.gdt_solve(*_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T), T, form, conditioned)
+    fn = "goal_directed_path"
+    T = _check_T(T, fn)
+    _check_form(form, fn)
+    conditioned = flag(start_conditioned, f"{fn}: start_conditioned")
+    arrays = _model_arrays(fn, A, Q, H_T, Pi_T, m0, Pi_0, y_T, T)
+    try:
+        r = _core.gdt_solve(*arrays, T, form, conditioned)
+    except ValueError as e:
+        raise _core_error(e, "gdt_solve", fn) from None
     return GdtSolution(r["path"], r["eps"], r["cov"], r["x0_mean"], r["x0_cov"])
 
 
@@ -226,24 +288,22 @@ def sample_goal_directed_paths(
 ) -> F64:
     """Random paths ``(n_samples, T+1, n)`` of the goal-directed process with ``eps_t`` noise.
 
-    Arguments as :func:`goal_directed_path`; `rng` gives one 63-bit seed for the C++
-    counter-based generator, so results do not depend on thread count.
+    Arguments as :func:`goal_directed_path`, and its errors (named
+    ``sample_goal_directed_paths``); `n_samples` is an int in [1, 2**31 - 1]. `rng` gives one
+    63-bit seed for the C++ counter-based generator, so results do not depend on thread count.
     """
-    T = _check_T(T)
-    _check_form(form)
     fn = "sample_goal_directed_paths"
-    if isinstance(n_samples, bool) or not isinstance(n_samples, (int, np.integer)):
+    T = _check_T(T, fn)
+    _check_form(form, fn)
+    if isinstance(n_samples, (bool, np.bool_)) or not isinstance(n_samples, (int, np.integer)):
         raise TypeError(f"{fn}: n_samples must be an int, got {type(n_samples).__name__}")
-    if n_samples <= 0:
-        raise ValueError(f"{fn}: n_samples is {n_samples}, expected > 0")
+    if not 0 < n_samples <= 2**31 - 1:
+        raise ValueError(f"{fn}: n_samples is {n_samples}, expected an int in [1, {2**31 - 1}]")
     conditioned = flag(start_conditioned, f"{fn}: start_conditioned")
     seed = int(generator(rng, f"{fn}: rng").integers(2**63))
-    out: F64 = _core.gdt_sample(
-        *_model_arrays(A, Q, H_T, Pi_T, m0, Pi_0, y_T),
-        T,
-        int(n_samples),
-        seed,
-        form,
-        conditioned,
-    )
+    arrays = _model_arrays(fn, A, Q, H_T, Pi_T, m0, Pi_0, y_T, T)
+    try:
+        out: F64 = _core.gdt_sample(*arrays, T, int(n_samples), seed, form, conditioned)
+    except ValueError as e:
+        raise _core_error(e, "gdt_sample", fn) from None
     return out
