@@ -54,11 +54,7 @@ def _binned_image_init(self: BinnedImage, bins: ArrayLike, n_bins: int) -> None:
 
 
 # the class stays the core's own (what hsv_bins returns, what isinstance checks, what pickles
-# name): only its constructor gains the checks above. Its docstring still opens with the
-# binding's signature line, which help() shows and tests/core/test_stubs.py reads.
-if _core_binned_image_init.__doc__ and _binned_image_init.__doc__:  # None under python -OO
-    _binned_image_init.__doc__ = f"{_core_binned_image_init.__doc__}\n{_binned_image_init.__doc__}"
-_binned_image_init.__qualname__ = "BinnedImage.__init__"
+# name): only its constructor gains the checks above
 setattr(BinnedImage, "__init__", _binned_image_init)  # noqa: B010 - mypy refuses a method assign
 
 __all__ = [
