@@ -21,41 +21,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import integer, number, real_array
+from pftrack._check import number, real_array
 
 BinnedImage = _core.BinnedImage
-_core_binned_image_init = BinnedImage.__init__
-
-
-def _binned_image_init(self: BinnedImage, bins: ArrayLike, n_bins: int) -> None:
-    """``BinnedImage(bins, n_bins)``, with the arguments checked before the core sees them.
-
-    The core's constructor takes only a NumPy array and an `n_bins` that fits a C int: a list
-    or ``n_bins=2**31`` got pybind11's "incompatible constructor arguments" and its list of
-    signatures instead of a message. The core checks the rest (the bins' dtype, shape and
-    values).
-
-    Raises
-    ------
-    TypeError
-        `bins` not of integers (text, objects).
-    ValueError
-        `n_bins` not an int in [1, 32767] (a bool or a float too); `bins` ragged, not 2-D,
-        empty, or with a value outside ``[-1, n_bins)``.
-    """
-    n = integer(n_bins, "BinnedImage: n_bins", 1, 32767)
-    try:
-        b = bins if isinstance(bins, np.ndarray) else np.asarray(bins)
-    except ValueError:  # NumPy: "setting an array element with a sequence ... inhomogeneous"
-        raise ValueError(
-            "BinnedImage: bins must be a rectangular (H, W) array, got rows of different lengths"
-        ) from None
-    _core_binned_image_init(self, b, n)
-
-
-# the class stays the core's own (what hsv_bins returns, what isinstance checks, what pickles
-# name): only its constructor gains the checks above
-setattr(BinnedImage, "__init__", _binned_image_init)  # noqa: B010 - mypy refuses a method assign
 
 __all__ = [
     "BinnedImage",
