@@ -15,8 +15,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, number, real_array
+from pftrack._check import number
 from pftrack.boxes import iou_xywh
+from pftrack.eval.rows import (  # check_*: here too, as before
+    IOU_ROUNDING,
+    check_eval_rows,
+    check_unique_ids,
+)
 from pftrack.io.mot import FRAME, ID, LEFT
 
 __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_xywh"]
@@ -196,58 +201,6 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
         f"CD = mean centroid distance)"
     )
     return "\n".join(lines)
-
-
-def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
-    """Scored MOT rows as an ``(M, 10)`` float64 array; TypeError/ValueError named by `what`.
-
-    Real numbers, ``(M, 6..10)``, the first 6 columns finite, frames and ids integers within
-    ``MAX_FRAME`` (they are cast to int: an id 1.5 is refused, not scored as 1, the test
-    ``pftrack recover`` makes); missing columns padded. Shared by
-    :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`.
-    """
-    a = real_array(rows, what)
-    if a.size == 0:
-        return np.zeros((0, 10))
-    if a.ndim != 2 or a.shape[1] < 6:
-        raise ValueError(f"{what} has shape {a.shape}, expected (M, 6..10) MOT rows")
-    if not np.all(np.isfinite(a[:, :6])):
-        raise ValueError(f"{what} has non-finite values in its first 6 columns")
-    huge = np.abs(a[:, :2]) > MAX_FRAME
-    if huge.any():
-        k = int(np.flatnonzero(huge.any(axis=1))[0])
-        raise ValueError(f"{what} row {k} has frame or id {a[k, :2].tolist()} beyond {MAX_FRAME}")
-    frac = a[:, 0] != np.floor(a[:, 0])
-    if frac.any():  # cast to int, 1.5 would be scored as frame 1
-        k = int(np.flatnonzero(frac)[0])
-        raise ValueError(f"{what} row {k} has frame {a[k, 0]:g}, expected an integer")
-    k_id = first_bad_id(a[:, 1])
-    if k_id is not None:  # cast to int, 1.5 and 1.7 would be one id: refused as recover does
-        raise ValueError(f"{what} row {k_id}: {bad_id_message(a[k_id, 1])}")
-    if a.shape[1] < 10:
-        pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
-        a = np.hstack([a, pad])
-    return a
-
-
-#: IoU this much below the threshold still reaches it (rounding: the IoU of two identical boxes
-#: can be computed as 1 - 1e-16, which a threshold of 1 would refuse).
-IOU_ROUNDING = 1e-12
-
-
-def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
-    """Refuse rows of one id twice in one frame (ValueError naming `name`, the id and frame).
-
-    `frames`: rows grouped by frame. Shared by :func:`evaluate_mot` and
-    :func:`~pftrack.eval.hota.evaluate_hota`, so both refuse what ``pftrack eval`` refuses.
-    """
-    for f, r in frames.items():
-        ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
-        if np.any(counts > 1):
-            raise ValueError(
-                f"{name} has id {int(ids[counts > 1][0])} more than once in frame {f} "
-                "(ids must be unique within a frame)"
-            )
 
 
 def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:

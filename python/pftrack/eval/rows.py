@@ -1,0 +1,233 @@
+"""The rows a MOTChallenge evaluation scores: checks, TrackEval's preprocessing and IoU.
+
+Shared by HOTA (:mod:`pftrack.eval.hota`) and CLEAR-MOT/IDF1 (:mod:`pftrack.eval.metrics`), so
+that both score the same rows.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linear_sum_assignment
+
+from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, integer, number, real_array
+from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
+
+__all__ = [
+    "BENCHMARKS",
+    "IOU_ROUNDING",
+    "check_eval_rows",
+    "check_unique_ids",
+    "guess_benchmark",
+    "mot_iou",
+    "prepare_mot",
+]
+
+Benchmark = Literal["MOT15", "MOT16", "MOT17", "MOT20"]
+#: Ground-truth conventions :func:`prepare_mot` knows (MOT16 and MOT17 are the same).
+BENCHMARKS: tuple[str, ...] = ("MOT15", "MOT16", "MOT17", "MOT20")
+
+_EPS = float(np.finfo(float).eps)
+# MOTChallenge 16/17/20 class numbers (column 8 of ground truth).
+_PEDESTRIAN = 1
+_DISTRACTORS = (2, 7, 8, 12)  # person_on_vehicle, static_person, distractor, reflection
+_NON_MOT_VEHICLE = 6  # a distractor in MOT20 only
+_N_CLASSES = 13
+_CLASS, _VISIBILITY = 7, 8  # columns of MOT16+ ground truth
+
+
+def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
+    """Scored MOT rows as an ``(M, 10)`` float64 array; TypeError/ValueError named by `what`.
+
+    Real numbers, ``(M, 6..10)``, the first 6 columns finite, frames and ids integers within
+    ``MAX_FRAME`` (they are cast to int: an id 1.5 is refused, not scored as 1, the test
+    ``pftrack recover`` makes); missing columns padded. Shared by
+    :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`.
+    """
+    a = real_array(rows, what)
+    if a.size == 0:
+        return np.zeros((0, 10))
+    if a.ndim != 2 or a.shape[1] < 6:
+        raise ValueError(f"{what} has shape {a.shape}, expected (M, 6..10) MOT rows")
+    if not np.all(np.isfinite(a[:, :6])):
+        raise ValueError(f"{what} has non-finite values in its first 6 columns")
+    huge = np.abs(a[:, :2]) > MAX_FRAME
+    if huge.any():
+        k = int(np.flatnonzero(huge.any(axis=1))[0])
+        raise ValueError(f"{what} row {k} has frame or id {a[k, :2].tolist()} beyond {MAX_FRAME}")
+    frac = a[:, 0] != np.floor(a[:, 0])
+    if frac.any():  # cast to int, 1.5 would be scored as frame 1
+        k = int(np.flatnonzero(frac)[0])
+        raise ValueError(f"{what} row {k} has frame {a[k, 0]:g}, expected an integer")
+    k_id = first_bad_id(a[:, 1])
+    if k_id is not None:  # cast to int, 1.5 and 1.7 would be one id: refused as recover does
+        raise ValueError(f"{what} row {k_id}: {bad_id_message(a[k_id, 1])}")
+    if a.shape[1] < 10:
+        pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
+        a = np.hstack([a, pad])
+    return a
+
+
+#: IoU this much below the threshold still reaches it (rounding: the IoU of two identical boxes
+#: can be computed as 1 - 1e-16, which a threshold of 1 would refuse).
+IOU_ROUNDING = 1e-12
+
+
+def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
+    """Refuse rows of one id twice in one frame (ValueError naming `name`, the id and frame).
+
+    `frames`: rows grouped by frame. Shared by :func:`evaluate_mot` and
+    :func:`~pftrack.eval.hota.evaluate_hota`, so both refuse what ``pftrack eval`` refuses.
+    """
+    for f, r in frames.items():
+        ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
+        if np.any(counts > 1):
+            raise ValueError(
+                f"{name} has id {int(ids[counts > 1][0])} more than once in frame {f} "
+                "(ids must be unique within a frame)"
+            )
+
+
+def mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """IoU of every box of `a` with every box of `b`, with TrackEval's arithmetic.
+
+    Boxes are MOTChallenge ``left, top, width, height``. The corners are formed first and areas
+    taken from them (``(x1 - x0) * (y1 - y0)``), exactly as TrackEval does, so that a match at
+    a threshold is decided the same way to the last bit. A box with no area overlaps nothing,
+    and an empty union gives 0.
+
+    Parameters
+    ----------
+    a : (n, 4) array_like of float
+    b : (m, 4) array_like of float
+
+    Returns
+    -------
+    (n, m) ndarray of float64
+    """
+    p = np.array(a, dtype=np.float64).reshape(-1, 4)
+    q = np.array(b, dtype=np.float64).reshape(-1, 4)
+    p[:, 2:] += p[:, :2]
+    q[:, 2:] += q[:, :2]
+    lo = np.minimum(p[:, None, :], q[None, :, :])
+    hi = np.maximum(p[:, None, :], q[None, :, :])
+    inter = np.maximum(lo[..., 2] - hi[..., 0], 0) * np.maximum(lo[..., 3] - hi[..., 1], 0)
+    area_p = (p[:, 2] - p[:, 0]) * (p[:, 3] - p[:, 1])
+    area_q = (q[:, 2] - q[:, 0]) * (q[:, 3] - q[:, 1])
+    union = area_p[:, None] + area_q[None, :] - inter
+    inter[area_p <= _EPS, :] = 0
+    inter[:, area_q <= _EPS] = 0
+    inter[union <= _EPS] = 0
+    union[union <= _EPS] = 1
+    out: NDArray[np.float64] = inter / union
+    return out
+
+
+def guess_benchmark(gt: ArrayLike) -> str:
+    """``"MOT17"`` if `gt` looks like MOT16/17/20 ground truth, else ``"MOT15"``.
+
+    MOT16+ ground truth has ``frame, id, left, top, w, h, flag, class, visibility``: the class
+    column holds integers 1-13 and the visibility column values in [0, 1]. MOT15 ground truth
+    has world coordinates (or -1) there. MOT20's one extra distractor class is not guessed:
+    name ``"MOT20"`` explicitly.
+    """
+    g = check_eval_rows(gt, "ground truth")
+    if len(g) == 0:
+        return "MOT15"
+    cls, vis = g[:, _CLASS], g[:, _VISIBILITY]
+    integral = np.all(cls == np.round(cls)) and np.all((cls >= 1) & (cls <= _N_CLASSES))
+    return "MOT17" if integral and np.all((vis >= 0) & (vis <= 1)) else "MOT15"
+
+
+def prepare_mot(
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    benchmark: str = "MOT15",
+    scale: float = 1.0,
+    num_frames: int | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The ground-truth and result rows that are scored, by MOTChallenge's rules.
+
+    This is TrackEval's ``MotChallenge2DBox`` preprocessing (``DO_PREPROC`` on):
+
+    * Ground-truth rows whose ``conf`` column (the "consider" flag), truncated to an integer,
+      is 0 are removed ("zero-marked").
+    * MOT16/17/20 only: ground-truth rows of another class than pedestrian (1) are removed,
+      and, in each frame first, result boxes matched to a *distractor* ground-truth box are
+      removed. The match is the Hungarian assignment maximising IoU among pairs with
+      IoU >= 0.5; distractors are person on vehicle (2), static person (7), distractor (8),
+      reflection (12) and, for MOT20, non-MOT vehicle (6). Every class must be 1-13.
+    * MOT15 has no classes: result boxes on zero-marked boxes stay, and are false positives.
+    * No visibility threshold is applied (TrackEval applies none).
+
+    Parameters
+    ----------
+    gt, result : (M, 6..10) array_like of float
+        MOT rows. Ids must be unique within a frame. The class of result rows is not looked at.
+    benchmark : {"MOT15", "MOT16", "MOT17", "MOT20"}
+        Which conventions (see :func:`guess_benchmark`).
+    scale : float
+        Multiplies the ground-truth boxes first (e.g. 0.625 for PETS09 ground truth against
+        results on the 480x360 video).
+    num_frames : int, optional
+        The sequence length (``seqLength``); a row in a later frame is an error, as in TrackEval.
+
+    Returns
+    -------
+    gt, result : ndarray of float64
+        The scored rows, each sorted by frame (file order within a frame), gt boxes scaled.
+    """
+    if benchmark not in BENCHMARKS:
+        raise ValueError(f"benchmark is {benchmark!r}, expected one of {', '.join(BENCHMARKS)}")
+    scale = number(scale, "scale", finite=False)
+    if not (math.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale is {scale}, expected a finite value > 0")
+    if num_frames is not None:
+        num_frames = integer(num_frames, "num_frames", 1, MAX_FRAME)
+    g = check_eval_rows(gt, "ground truth").copy()
+    r = check_eval_rows(result, "result")
+    g[:, LEFT : LEFT + 4] *= scale
+    for rows, name in ((g, "ground truth"), (r, "result")):
+        if num_frames is not None and len(rows) and rows[:, FRAME].max() > num_frames:
+            raise ValueError(
+                f"{name} has frame {int(rows[:, FRAME].max())}, beyond the sequence's "
+                f"{num_frames} frames (seqLength)"
+            )
+    gf, rf = group_by_frame(g), group_by_frame(r)
+    check_unique_ids(gf, "ground truth")
+    check_unique_ids(rf, "result")
+    with_classes = benchmark != "MOT15"
+    if with_classes and len(g):
+        cls = g[:, _CLASS]
+        bad = (cls != np.round(cls)) | (cls < 1) | (cls > _N_CLASSES)
+        if np.any(bad):
+            raise ValueError(
+                f"ground truth has class {g[bad][0, _CLASS]:g} (frame {int(g[bad][0, FRAME])}), "
+                f"expected 1-13 for {benchmark}; MOT15-style files need benchmark MOT15"
+            )
+    distractors = _DISTRACTORS + ((_NON_MOT_VEHICLE,) if benchmark == "MOT20" else ())
+    keep_g: list[NDArray[np.float64]] = []
+    keep_r: list[NDArray[np.float64]] = []
+    empty = np.zeros((0, 10))
+    for f in sorted(set(gf) | set(rf)):
+        gt_f, res_f = gf.get(f, empty), rf.get(f, empty)
+        if with_classes and len(gt_f) and len(res_f):
+            score = mot_iou(gt_f[:, LEFT : LEFT + 4], res_f[:, LEFT : LEFT + 4])
+            score[score < 0.5 - _EPS] = 0
+            rows_m, cols_m = linear_sum_assignment(-score)
+            hit = score[rows_m, cols_m] > _EPS
+            rows_m, cols_m = rows_m[hit], cols_m[hit]
+            drop = cols_m[np.isin(gt_f[rows_m, _CLASS].astype(np.int64), distractors)]
+            res_f = np.delete(res_f, drop, axis=0)
+        keep = gt_f[:, CONF].astype(np.int64) != 0
+        if with_classes:
+            keep &= gt_f[:, _CLASS].astype(np.int64) == _PEDESTRIAN
+        keep_g.append(gt_f[keep])
+        keep_r.append(res_f)
+    if not keep_g:
+        return np.zeros((0, 10)), np.zeros((0, 10))
+    return np.concatenate(keep_g), np.concatenate(keep_r)
