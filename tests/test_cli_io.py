@@ -200,6 +200,25 @@ def test_a_missing_image_of_a_sequence_is_one_line_not_a_shift(
     assert not out.exists()
 
 
+def test_a_missing_image_of_a_plain_numbered_folder_is_one_line_not_a_shift(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The README's ``track seq/img1 --detections det.txt`` on a folder without seqinfo.ini.
+
+    Was: exit 0, image 11 written as frame 10 and given frame 10's detections, and so on.
+    """
+    seq = _copy_sequence(sequence, tmp_path / "SEQ", skip="10.png")
+    (seq / "seqinfo.ini").unlink()
+    out = tmp_path / "t.txt"
+    argv = ["track", str(seq / "img1"), "--detections", str(seq / "det" / "det.txt"),
+            "--out", str(out)]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers)\n"
+    )
+    assert not out.exists()
+
+
 def test_a_seqinfo_with_a_byte_order_mark_is_read(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -32,11 +32,11 @@ def add_parser(sub: Any) -> None:
         "track",
         help="track a video, image folder, camera or stream; MOTChallenge output",
         description="Track every object in SOURCE: a video file, a folder of images (natural "
-        "order: 2.jpg before 10.jpg), a MOTChallenge sequence folder (seqinfo.ini gives the "
-        "frame rate and image folder, det/det.txt or det.txt the detections of --detections "
-        "auto; its image names that are all digits are frame numbers, and a missing one is an "
-        "error; without its image folder, the one video file beside seqinfo.ini is read, as "
-        "pftrack batch does), a "
+        "order: 2.jpg before 10.jpg; names that are all digits are frame numbers, and a "
+        "missing one is an error: frame 1 is the lowest, or image 1 in a sequence), a "
+        "MOTChallenge sequence folder (seqinfo.ini gives the frame rate and image folder, "
+        "det/det.txt or det.txt the detections of --detections auto; without its image "
+        "folder, the one video file beside seqinfo.ini is read, as pftrack batch does), a "
         "camera index (0) or a stream URL (rtsp://, http://, ...). Without --detections, "
         "objects come from background subtraction; with a MOTChallenge det.txt the tracker is "
         "a drop-in backend for any detector. Output: MOTChallenge rows "
