@@ -594,6 +594,32 @@ def test_live_run_into_a_named_pipe_streams_its_rows_there(
     assert stat.S_ISFIFO(fifo.stat().st_mode)
 
 
+def test_render_of_an_odd_sized_source_is_even_and_its_help_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """321x241 frames give a 322x242 video: --help and the README say so (was: only a
+    docstring of io/video_writer.py); the summary names --fps as --fps (was: 'from given')."""
+    frames = make_scene(n_frames=4, width=321, height=241, n_walkers=1, rng=0).frames
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k, frame in enumerate(frames, start=1):
+        cv2.imwrite(str(folder / f"{k}.png"), frame)
+    video = tmp_path / "r.mp4"
+    argv = ["-q", "track", str(folder), "--out", str(tmp_path / "t.txt"), "--render",
+            str(video), "--fps", "29.97"]  # fmt: skip
+    assert main(argv) == 0
+    assert f"(h264, 29.97 fps from --fps) -> {video}" in capsys.readouterr().out
+    with av.open(str(video)) as container:
+        ctx = container.streams.video[0].codec_context
+        assert (ctx.width, ctx.height) == (322, 242)
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "a 321x241 source gives a 322x242 video" in text
+    readme = " ".join((Path(__file__).parents[1] / "README.md").read_text().split())
+    assert "(321x241 gives 322x242;" in readme
+
+
 def test_quiet_silences_the_progress_bar(
     sequence: Path,
     tmp_path: Path,

@@ -757,3 +757,19 @@ def test_two_images_of_one_number_in_a_plain_folder_are_refused(tmp_path: Path) 
         FrameSource(folder)
     (folder / "f01.png").unlink()
     assert len(list(FrameSource(folder))) == 2
+
+
+@pytest.mark.parametrize("key", ["frameRate", "imWidth", "imHeight", "seqLength", "imDir", "name"])
+def test_a_key_given_empty_is_refused_not_taken_as_absent(tmp_path: Path, key: str) -> None:
+    """Was: ``frameRate=`` read as no frame rate (the container's was used, silently), while
+    ``frameRate=0`` was an error; every key pftrack reads alike."""
+    other = "" if key == "frameRate" else "frameRate=7\n"
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\n{other}{key} =  \n")
+    message = rf"^{re.escape(str(tmp_path))}/seqinfo.ini: {key} is empty; give a value or leave"
+    with pytest.raises(ValueError, match=message):
+        read_seqinfo(tmp_path)
+    (tmp_path / "seqinfo.ini").write_text("[Sequence]\n")  # left out: the defaults
+    info = read_seqinfo(tmp_path)
+    assert (info.name, info.image_dir, info.frame_rate, info.width) == (
+        tmp_path.name, "img1", None, None
+    )  # fmt: skip

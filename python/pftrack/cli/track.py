@@ -81,7 +81,9 @@ def add_parser(sub: Any) -> None:
         "--render", metavar="VIDEO",
         help="write an annotated video while tracking: .mp4 (H.264, plays in browsers) or "
         ".avi (MJPG; a device or pipe without extension, e.g. /dev/stdout: .mp4); boxes, ids "
-        "and trails as tracked online (default: none)",
+        "and trails as tracked online. Its size is the source's, made even (H.264's 4:2:0 "
+        "needs it): an odd width or height gets one copied column or row at the right or "
+        "bottom, so a 321x241 source gives a 322x242 video (default: none)",
     )  # fmt: skip
     p.add_argument("--plot", metavar="PNG",
                    help="write a trajectory plot: .png, .jpg (a device or pipe without "

@@ -234,12 +234,17 @@ def _duplicate(
 def read_seqinfo(path: PathLike) -> SequenceInfo:
     """Read a MOTChallenge ``seqinfo.ini`` (or the one in folder `path`).
 
+    A key left out takes its default (``name``: the folder's name, ``imDir``: ``img1``; the
+    numbers: unknown); a key given with an empty value (``frameRate=``) is an error, as one
+    of ``0`` is: it would otherwise fall back silently (the container's frame rate for an
+    empty ``frameRate``).
+
     Raises
     ------
     ValueError
-        No ``[Sequence]`` section, a key or section given twice, a field that is not a positive
-        number (``imWidth``, ``imHeight``, ``seqLength``: an integer), or a ``frameRate``
-        outside :data:`FRAME_RATE_RANGE`.
+        No ``[Sequence]`` section, a key or section given twice, a key pftrack reads given
+        empty, a field that is not a positive number (``imWidth``, ``imHeight``,
+        ``seqLength``: an integer), or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`.
     """
     ini = Path(path)
     if ini.is_dir():
@@ -255,9 +260,15 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
             f"{ini}: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
         ) from None
 
-    def number(key: str) -> float | None:
+    def text_of(key: str) -> str | None:
         text = sec.get(key)
-        if text is None or not text.strip():
+        if text is not None and not text.strip():
+            raise ValueError(f"{ini}: {key} is empty; give a value or leave the key out")
+        return text
+
+    def number(key: str) -> float | None:
+        text = text_of(key)
+        if text is None:
             return None
         try:
             value = float(text)
@@ -282,9 +293,9 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         )
     return SequenceInfo(
         folder=ini.parent,
-        name=sec.get("name", ini.parent.name),
+        name=text_of("name") or ini.parent.name,
         frame_rate=frame_rate,
-        image_dir=sec.get("imDir", "img1") or "img1",
+        image_dir=text_of("imDir") or "img1",
         width=integer("imWidth"),
         height=integer("imHeight"),
         length=integer("seqLength"),
