@@ -12,6 +12,7 @@ import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import av
 import cv2
@@ -19,6 +20,7 @@ import pytest
 
 from pftrack import _progress
 from pftrack.cli import build_parser, main
+from pftrack.cli._signals import Terminated
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.synthetic import Scene, make_scene
@@ -198,6 +200,25 @@ def test_a_missing_image_of_a_sequence_is_one_line_not_a_shift(
     assert not out.exists()
 
 
+def test_a_missing_image_of_a_plain_numbered_folder_is_one_line_not_a_shift(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The README's ``track seq/img1 --detections det.txt`` on a folder without seqinfo.ini.
+
+    Was: exit 0, image 11 written as frame 10 and given frame 10's detections, and so on.
+    """
+    seq = _copy_sequence(sequence, tmp_path / "SEQ", skip="10.png")
+    (seq / "seqinfo.ini").unlink()
+    out = tmp_path / "t.txt"
+    argv = ["track", str(seq / "img1"), "--detections", str(seq / "det" / "det.txt"),
+            "--out", str(out)]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers)\n"
+    )
+    assert not out.exists()
+
+
 def test_a_seqinfo_with_a_byte_order_mark_is_read(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -315,9 +336,13 @@ def test_ctrl_c_on_a_file_aborts_and_keeps_the_old_outputs(
     monkeypatch.setattr("pftrack.tracking.track_frames", interrupted)
     argv = ["track", str(sequence), "--out", str(out), "--render", str(video)]
     assert main(argv) == 130
-    assert "interrupted" in capsys.readouterr().err
+    # was: a blank line first, also into a file (it ends a progress bar's line on a terminal)
+    assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
     assert out.read_text() == "keep\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]  # no partial video
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # as on a terminal
+    assert main(argv) == 130
+    assert capsys.readouterr().err == "\npftrack track: interrupted; no output was changed\n"
 
 
 #: A subprocess whose import of module MODULE raises KeyboardInterrupt, as Ctrl-C in its first
@@ -365,8 +390,9 @@ def test_ctrl_c_during_start_up_is_one_line_and_130(
         [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
     )
     assert (proc.returncode, proc.stderr, proc.stdout) == (
-        130, "\npftrack track: interrupted; no output was changed\n", ""
+        130, "pftrack track: interrupted; no output was changed\n", ""
     )  # fmt: skip
+    # no leading line break: stderr is not a terminal (there is no progress bar to end)
     assert not out.exists()
 
 
@@ -393,6 +419,7 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
     det[:, 1], det[:, 6] = -1, 1.0
     write_mot(tmp_path / "det.txt", det)
     out, video = tmp_path / "live.txt", tmp_path / "live.mp4"
+    out.write_text("an earlier run\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     with serve_stream(scene.frames, pace=0.05) as server:  # 10 s of video
         argv = [sys.executable, "-m", "pftrack.cli", "track", server.url, "--out", str(out),
@@ -401,10 +428,17 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
         proc = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         try:
             deadline = time.monotonic() + 60
-            while _rows(out) < 20 and time.monotonic() < deadline and proc.poll() is None:
+            side: list[Path] = []
+            while time.monotonic() < deadline and proc.poll() is None:
+                side = sorted(tmp_path.glob(".live.txt.*.part"))
+                if side and _rows(side[0]) >= 20:
+                    break
                 time.sleep(0.1)
-            assert _rows(out) >= 20, proc.stderr.read().decode() if proc.poll() else "no rows"
+            assert side and _rows(side[0]) >= 20, (
+                proc.stderr.read().decode() if proc.poll() else "no rows"  # type: ignore[union-attr]
+            )
             assert server.sent < len(scene.frames)  # rows came while the stream went on
+            assert out.read_text() == "an earlier run\n"  # replaced at the end only
             proc.send_signal(signal.SIGINT)
             stdout, stderr = proc.communicate(timeout=60)
         finally:
@@ -425,6 +459,105 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
     os.umask(mask)
     for path in (out, video):
         assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask, path.name
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["det.txt", "live.mp4", "live.txt"]
+
+
+def _rows_then(abort: BaseException, n_frames: int = 5) -> Any:
+    """A ``track_frames`` that settles 2 rows a frame for `n_frames` frames, then raises `abort`."""
+    import numpy as np
+
+    def track_frames(source: Any, *, on_frame: Any, **kwargs: Any) -> Any:
+        for n in range(1, n_frames + 1):
+            rows = np.array([[n, i, 10 * i, 20, 30, 40, 0.9, -1, -1, -1] for i in (1, 2)], float)
+            on_frame(n, next(iter(source)), [], rows)
+        raise abort
+
+    return track_frames
+
+
+@pytest.mark.parametrize(
+    ("abort", "status", "how"),
+    [
+        (KeyboardInterrupt(), 130, "interrupted;"),
+        (Terminated(), 143, "terminated (SIGTERM);"),
+        (ValueError("a frame could not be decoded"), 2, "error: a frame could not be decoded;"),
+    ],
+)
+def test_an_aborted_live_run_keeps_out_and_says_where_its_rows_are(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    abort: BaseException,
+    status: int,
+    how: str,
+) -> None:
+    """A second Ctrl-C (SIGTERM, an error) in a live run: --out as it was, the rows kept.
+
+    Was: --out truncated at the start and filled with the online rows, then "interrupted; no
+    output was changed" (the user's earlier file lost).
+    """
+    out = tmp_path / "live.txt"
+    out.write_text("precious\n")
+    out.chmod(0o600)
+    monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(abort))
+    scene = make_scene(n_frames=5, rng=0)
+    with serve_stream(scene.frames) as server:
+        argv = ["-q", "track", server.url, "--out", str(out), "--fps", "25"]
+        assert main(argv) == status
+        kept = tmp_path / "live.partial.txt"
+        err = capsys.readouterr().err
+        assert err == (
+            f"pftrack track: {how} no output was changed; the 10 online rows tracked so far "
+            f"are kept in {kept}\n"
+        )
+        assert out.read_text() == "precious\n"
+        rows = read_mot(kept)
+        assert rows.shape == (10, 10) and rows[:, 0].tolist() == [1, 1, 2, 2, 3, 3, 4, 4, 5, 5]
+        assert stat.S_IMODE(kept.stat().st_mode) == 0o600  # as private as --out
+        # a second abort never replaces the first one's rows
+        assert main(argv) == status
+        again = tmp_path / "live.partial-2.txt"
+        assert capsys.readouterr().err.endswith(f"are kept in {again}\n")
+        assert read_mot(again).shape == (10, 10) and kept.read_bytes() == again.read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "live.partial-2.txt", "live.partial.txt", "live.txt"
+    ]  # fmt: skip
+
+
+def test_a_live_run_aborted_before_any_row_leaves_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "live.txt"
+    out.write_text("precious\n")
+    monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(KeyboardInterrupt(), 0))
+    with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
+        assert main(["-q", "track", server.url, "--out", str(out), "--fps", "25"]) == 130
+    assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["live.txt"]
+    assert out.read_text() == "precious\n"
+
+
+def test_an_aborted_live_run_into_a_pipe_says_its_rows_went_there(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Written through, the online rows are out already: the message says so (was: "no output
+    was changed")."""
+    import threading
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(KeyboardInterrupt(), 3))
+    with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
+        assert main(["-q", "track", server.url, "--out", str(fifo), "--fps", "25"]) == 130
+    reader.join(30)
+    assert capsys.readouterr().err == (
+        f"pftrack track: interrupted; the 6 online rows tracked so far were written to {fifo}; "
+        "no other output was changed\n"
+    )
+    assert len(got[0].splitlines()) == 6
 
 
 def test_live_run_into_a_named_pipe_streams_its_rows_there(
@@ -459,6 +592,32 @@ def test_live_run_into_a_named_pipe_streams_its_rows_there(
     keys = [tuple(line.split(",")[:2]) for line in lines]
     assert len(set(keys)) == len(keys)  # each (frame, id) once: no second, finished copy
     assert stat.S_ISFIFO(fifo.stat().st_mode)
+
+
+def test_render_of_an_odd_sized_source_is_even_and_its_help_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """321x241 frames give a 322x242 video: --help and the README say so (was: only a
+    docstring of io/video_writer.py); the summary names --fps as --fps (was: 'from given')."""
+    frames = make_scene(n_frames=4, width=321, height=241, n_walkers=1, rng=0).frames
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k, frame in enumerate(frames, start=1):
+        cv2.imwrite(str(folder / f"{k}.png"), frame)
+    video = tmp_path / "r.mp4"
+    argv = ["-q", "track", str(folder), "--out", str(tmp_path / "t.txt"), "--render",
+            str(video), "--fps", "29.97"]  # fmt: skip
+    assert main(argv) == 0
+    assert f"(h264, 29.97 fps from --fps) -> {video}" in capsys.readouterr().out
+    with av.open(str(video)) as container:
+        ctx = container.streams.video[0].codec_context
+        assert (ctx.width, ctx.height) == (322, 242)
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "a 321x241 source gives a 322x242 video" in text
+    readme = " ".join((Path(__file__).parents[1] / "README.md").read_text().split())
+    assert "(321x241 gives 322x242;" in readme
 
 
 def test_quiet_silences_the_progress_bar(

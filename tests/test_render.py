@@ -4,11 +4,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
-from pftrack.render import TrackRenderer, colour_of, write_annotated_video
+from pftrack.render import TrackRenderer, colour_of, plot_trajectories, write_annotated_video
 from tests.io.decode import decode
 
 
@@ -88,3 +89,56 @@ def test_labels_grow_with_the_frame() -> None:
         out = draw_tracks(np.zeros((*size, 3), np.uint8), row)
         inked.append(int(np.count_nonzero(out.any(axis=2))))
     assert inked[1] > 1.5 * inked[0]  # twice the line width, and a twice larger label
+
+
+_ROWS = np.array([[k, i, 10 + 20 * k, 30 * i, 10, 20, 1, -1, -1, -1]
+                  for k in range(1, 6) for i in (1, 2)], float)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda p: plot_trajectories(p, _ROWS[:, :5]),
+         r"plot_trajectories: rows has shape \(10, 5\), expected \(M, 6\+\) MOT rows: frame, id, "
+         r"left, top, width, height\[, \.\.\.\]$"),
+        (lambda p: plot_trajectories(p, _ROWS, truth=_ROWS[:, 0]),
+         r"plot_trajectories: truth has shape \(10,\), expected \(M, 6\+\) MOT rows: frame"),
+        (lambda p: plot_trajectories(p, np.where(_ROWS == 50, np.nan, _ROWS)),
+         r"plot_trajectories: rows row 2 has NaN or inf in frame, id, left, top, width, height$"),
+        (lambda p: plot_trajectories(p, _ROWS, size=(0, 10)),
+         r"plot_trajectories: size is \(0, 10\), expected \(width, height\), whole numbers"),
+        (lambda p: plot_trajectories(p, _ROWS * [1, 1, 1e6, 1, 1, 1, 1, 1, 1, 1]),
+         r"plot_trajectories: the boxes reach .* beyond 32767 px a side; give a background"),
+        (lambda p: write_annotated_video(p, [np.zeros((8, 8, 3), np.uint8)], _ROWS[:, :5], 25),
+         r"write_annotated_video: rows has shape \(10, 5\), expected \(M, 6\+\) MOT rows"),
+        (lambda p: write_annotated_video(p, [], _ROWS, 25),
+         r"write_annotated_video: frames is empty; no frame to write$"),
+        (lambda p: write_annotated_video(p, iter(()), _ROWS, 25),
+         r"write_annotated_video: frames is empty; no frame to write$"),
+    ],
+)  # fmt: skip
+def test_pictures_refuse_bad_arguments_in_one_line(tmp_path: Path, call: Any, message: str) -> None:
+    """Was: a raw IndexError (5 columns), and OSError "nothing was written" (no frame)."""
+    with pytest.raises(ValueError, match=message):
+        call(tmp_path / "out.png")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_plot_without_background_has_axes_in_image_coordinates(tmp_path: Path) -> None:
+    """Was: a canvas of the boxes' extent and no axis: coordinates could not be read."""
+    import cv2
+
+    path = plot_trajectories(tmp_path / "p.png", _ROWS, title="two walkers")
+    image = cv2.imread(str(path))
+    w, h = int((_ROWS[:, 2] + _ROWS[:, 4]).max()) + 10, int((_ROWS[:, 3] + _ROWS[:, 5]).max()) + 10
+    assert image.shape[0] > h and image.shape[1] > w  # margins for the labels
+    grey = (image == 170).all(axis=2)
+    # the frame: one grey column (left edge) and one grey row (bottom edge) as long as the canvas
+    assert grey.sum(axis=0).max() >= h and grey.sum(axis=1).max() >= w
+    # track 2's path: y = 60 + 20 (its foot) is drawn below track 1's (y = 30 + 20): y down
+    ys = {tid: np.flatnonzero((image == colour_of(tid)).all(axis=2).any(axis=1)) for tid in (1, 2)}
+    assert ys[2].mean() > ys[1].mean()
+    # with a background: the background's size, no margins
+    bg = np.full((120, 200, 3), 80, np.uint8)
+    framed = cv2.imread(str(plot_trajectories(tmp_path / "b.png", _ROWS, background=bg)))
+    assert framed.shape == (120, 200, 3)

@@ -44,5 +44,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return run(argv)
     except KeyboardInterrupt:  # before the command's own handler: nothing was written yet
         words = sys.argv[1:] if argv is None else argv
-        print(f"\n{_command(words)}: interrupted; no output was changed", file=sys.stderr)
+        try:  # a line break ends a progress bar's line, drawn only on a terminal
+            end = "\n" if sys.stderr.isatty() else ""
+        except (AttributeError, OSError, ValueError):  # no stderr, or a closed one
+            end = ""
+        print(f"{end}{_command(words)}: interrupted; no output was changed", file=sys.stderr)
         return EXIT_INTERRUPTED

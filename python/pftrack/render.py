@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import itertools
 import queue
 import threading
 from collections import deque
@@ -12,9 +13,10 @@ from typing import Protocol
 
 import cv2
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from pftrack._typing import PathLike
+from pftrack._check import bgr_frame, real_array
+from pftrack._typing import F64, PathLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import write_image
 from pftrack.io.video_writer import VideoWriter
@@ -94,6 +96,32 @@ def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
     return float(box[0] + box[2] / 2), float(box[1] + box[3])
 
 
+#: The columns of a MOT row that the pictures read.
+ROW_COLUMNS = "frame, id, left, top, width, height"
+#: Largest side of a plot's canvas in pixels (OpenCV's image limit).
+MAX_CANVAS = 32767
+
+
+def _track_rows(rows: ArrayLike, who: str, what: str = "rows") -> F64:
+    """MOT rows (M, 6+) as float64, their first six columns finite; TypeError/ValueError.
+
+    Named by `who` (the function) and `what` (the argument): ``plot_trajectories: rows has
+    shape (4, 5), expected (M, 6+) MOT rows: frame, id, left, top, width, height[, ...]``.
+    """
+    a = real_array(rows, f"{who}: {what}", booleans=False)
+    if a.size == 0:
+        return np.zeros((0, 10))
+    if a.ndim != 2 or a.shape[1] < 6:
+        raise ValueError(
+            f"{who}: {what} has shape {a.shape}, expected (M, 6+) MOT rows: {ROW_COLUMNS}[, ...]"
+        )
+    finite = np.isfinite(a[:, :6])
+    if not finite.all():
+        k = int(np.flatnonzero(~finite.all(axis=1))[0])
+        raise ValueError(f"{who}: {what} row {k} has NaN or inf in {ROW_COLUMNS}")
+    return a
+
+
 def write_annotated_video(
     path: PathLike,
     frames: Iterable[NDArray[np.uint8]],
@@ -107,12 +135,25 @@ def write_annotated_video(
 
     ``.mp4`` is H.264 (see :class:`~pftrack.io.video_writer.VideoWriter`, whose x264 `preset`
     this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames.
+
+    Raises
+    ------
+    ValueError
+        `frames` is empty (nothing is written); `rows` are not (M, 6+) MOT rows (frame, id,
+        left, top, width, height, ...) with those six values finite.
+    TypeError
+        `rows` are not real numbers.
     """
+    rows = _track_rows(rows, "write_annotated_video")
+    it = iter(frames)
+    first = next(it, None)
+    if first is None:
+        raise ValueError("write_annotated_video: frames is empty; no frame to write")
     by_frame = group_by_frame(rows)
     empty = np.zeros((0, 10))
     trails: dict[int, deque[tuple[float, float]]] = {}
     with VideoWriter(path, fps, preset=preset) as writer:
-        for k, frame in enumerate(frames, start=1):
+        for k, frame in enumerate(itertools.chain([first], it), start=1):
             here = by_frame.get(k, empty)
             for r in here:
                 trails.setdefault(int(r[1]), deque(maxlen=max(trail, 1))).append(_foot(r[2:6]))
@@ -258,6 +299,49 @@ class TrackRenderer:
         return self.writer.n_frames
 
 
+def _nice_step(span: float, ticks: int = 6) -> int:
+    """A tick step of 1, 2 or 5 times a power of ten giving about `ticks` ticks over `span`."""
+    raw = max(span / ticks, 1.0)
+    power = 10 ** int(np.floor(np.log10(raw)))
+    return int(next(m * power for m in (1, 2, 5, 10) if m * power >= raw))
+
+
+def _with_axes(canvas: NDArray[np.uint8], title: str) -> NDArray[np.uint8]:
+    """`canvas` framed, with ticks and labels in its pixel coordinates (x right, y down).
+
+    The frame's margins take the labels (x below, y on the left) and `title` (above).
+    """
+    h, w = canvas.shape[:2]
+    font, scale, ink, grey = cv2.FONT_HERSHEY_SIMPLEX, 0.35, 1, (170, 170, 170)
+    step = _nice_step(max(w, h))
+
+    def size(text: str) -> tuple[int, int]:
+        (tw, th), _ = cv2.getTextSize(text, font, scale, ink)
+        return tw, th
+
+    xs, ys = range(0, w, step), range(0, h, step)
+    left = max(size(str(y))[0] for y in ys) + 10
+    right = max(10, size(str(xs[-1]))[0] // 2 + 4)
+    top = 24 if title else 10
+    bottom = size("0")[1] + 14
+    out = np.full((h + top + bottom, w + left + right, 3), 20, np.uint8)
+    out[top : top + h, left : left + w] = canvas
+    cv2.rectangle(out, (left - 1, top - 1), (left + w, top + h), grey, 1)
+    for x in xs:
+        cv2.line(out, (left + x, top + h), (left + x, top + h + 4), grey, 1)
+        tw, th = size(str(x))
+        org = (left + x - tw // 2, top + h + 6 + th)
+        cv2.putText(out, str(x), org, font, scale, grey, ink, cv2.LINE_AA)
+    for y in ys:
+        cv2.line(out, (left - 5, top + y), (left - 1, top + y), grey, 1)
+        tw, th = size(str(y))
+        org = (left - 7 - tw, top + y + th // 2)
+        cv2.putText(out, str(y), org, font, scale, grey, ink, cv2.LINE_AA)
+    if title:
+        cv2.putText(out, title, (left, 16), font, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+    return out
+
+
 def plot_trajectories(
     path: PathLike,
     rows: NDArray[np.float64],
@@ -273,21 +357,62 @@ def plot_trajectories(
     path : str or os.PathLike
         Output image (``.png``).
     rows : (M, 6+) ndarray
-        MOT rows of the tracks.
+        MOT rows of the tracks: frame, id, left, top, width, height, ...
     background : (H, W, 3) ndarray of uint8, optional
-        Image to draw on (e.g. the first frame), dimmed.
+        Image to draw on (e.g. the first frame), dimmed; the picture is its size.
     size : (W, H), optional
-        Canvas size when there is no background.
+        Canvas size when there is no background (default: the boxes' extent, and 10 px).
     truth : (M, 6+) ndarray, optional
         Ground truth, drawn thin and grey under the tracks.
     title : str
         Caption.
+
+    Returns
+    -------
+    Path
+        `path`.
+
+    Raises
+    ------
+    ValueError
+        `rows` or `truth` are not (M, 6+) MOT rows with finite frame, id and box; `size`
+        is not two whole numbers from 1 to 32767, or the boxes reach beyond 32767 px.
+    TypeError
+        `rows` or `truth` are not real numbers; `background` is not a (H, W, 3) uint8 image.
+
+    Notes
+    -----
+    Without a background the canvas is framed by axes in image coordinates (pixels, x to the
+    right, y down, as the boxes are given), with tick labels in margins around it: the PNG
+    is larger than the canvas by them.
     """
+    who = "plot_trajectories"
+    rows = _track_rows(rows, who)
+    truth = None if truth is None else _track_rows(truth, who, "truth")
     if background is not None:
+        background = bgr_frame(background, f"{who}: background")
         canvas = (background.astype(np.float32) * 0.45).astype(np.uint8)
     else:
-        w, h = size or (int(np.nanmax(rows[:, 2] + rows[:, 4], initial=320)) + 10,
-                        int(np.nanmax(rows[:, 3] + rows[:, 5], initial=240)) + 10)  # fmt: skip
+        if size is None:
+            both = rows if truth is None else np.vstack([rows[:, :6], truth[:, :6]])
+            w = int(np.ceil(np.max(both[:, 2] + both[:, 4], initial=320))) + 10
+            h = int(np.ceil(np.max(both[:, 3] + both[:, 5], initial=240))) + 10
+            if max(w, h) > MAX_CANVAS:
+                raise ValueError(
+                    f"{who}: the boxes reach {w - 10}x{h - 10} px, beyond {MAX_CANVAS} px a "
+                    "side; give a background or a size"
+                )
+        else:
+            try:
+                w, h = (int(v) for v in size)
+                ok = (w, h) == tuple(size) and 1 <= min(w, h) and max(w, h) <= MAX_CANVAS
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise ValueError(
+                    f"{who}: size is {size!r}, expected (width, height), whole numbers from 1 "
+                    f"to {MAX_CANVAS}"
+                )
         canvas = np.full((h, w, 3), 30, np.uint8)
 
     def paths(r: NDArray[np.float64]) -> dict[int, NDArray[np.int32]]:
@@ -296,7 +421,7 @@ def plot_trajectories(
             t = r[r[:, 1] == tid]
             t = t[np.argsort(t[:, 0])]
             pts = np.column_stack([t[:, 2] + t[:, 4] / 2, t[:, 3] + t[:, 5]])
-            out[tid] = np.round(pts).astype(np.int32)
+            out[tid] = np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
         return out
 
     if truth is not None and len(truth):
@@ -316,7 +441,9 @@ def plot_trajectories(
             1,
             cv2.LINE_AA,
         )
-    if title:
+    if background is None:
+        canvas = _with_axes(canvas, title)
+    elif title:
         cv2.putText(
             canvas, title, (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA
         )

@@ -336,3 +336,58 @@ def test_a_write_error_names_the_output(tmp_path: Path, monkeypatch) -> None:
         with pytest.raises(OSError) as exc, staged_outputs() as stage:  # was: no file name
             stage("/dev/full").write_bytes(b"x")
         assert (exc.value.errno, exc.value.filename) == (errno.ENOSPC, "/dev/full")
+
+
+def test_a_side_file_is_removed_when_its_block_ends(tmp_path: Path) -> None:
+    """A run's lines as they come, beside its output; the output itself is not touched."""
+    from pftrack.io.atomic import side_file
+
+    out = tmp_path / "t.txt"
+    out.write_text("earlier\n")
+    with side_file(out) as side:
+        side.write_lines(["1,1", "1,2"])
+        assert side.path.parent == tmp_path and side.path.name.startswith(".t.txt.")
+        assert side.path.read_text() == "1,1\n1,2\n"  # flushed: readable while the run goes on
+        assert out.read_text() == "earlier\n"
+    assert side.kept is None and side.lines == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
+    with pytest.raises(KeyboardInterrupt), side_file(out):  # no line: nothing to keep
+        raise KeyboardInterrupt
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
+
+
+def test_a_side_file_with_lines_is_kept_under_a_new_name_when_its_block_raises(
+    tmp_path: Path,
+) -> None:
+    from pftrack.io.atomic import side_file
+
+    out = tmp_path / "t.txt"
+    out.write_text("earlier\n")
+    out.chmod(0o600)
+    kept = []
+    for k in range(3):
+        with pytest.raises(KeyboardInterrupt), side_file(out) as side:
+            side.write_lines([f"run {k}"])
+            raise KeyboardInterrupt
+        kept.append(side.kept)
+    names = ["t.partial.txt", "t.partial-2.txt", "t.partial-3.txt"]  # never one replaced
+    assert kept == [tmp_path / n for n in names]
+    assert [(tmp_path / n).read_text() for n in names] == ["run 0\n", "run 1\n", "run 2\n"]
+    assert all(stat.S_IMODE((tmp_path / n).stat().st_mode) == 0o600 for n in names)
+    assert out.read_text() == "earlier\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*names, "t.txt"])
+
+
+def test_a_side_file_keeps_its_hidden_name_when_every_name_is_taken(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from pftrack.io import atomic
+
+    monkeypatch.setattr(atomic, "PARTIAL_NAMES", 1)
+    (tmp_path / "t.partial.txt").write_text("a user's file\n")
+    with pytest.raises(RuntimeError), atomic.side_file(tmp_path / "t.txt") as side:
+        side.write_lines(["row"])
+        raise RuntimeError
+    assert side.kept is not None and side.kept.name.startswith(".t.txt.")
+    assert side.kept.read_text() == "row\n"
+    assert (tmp_path / "t.partial.txt").read_text() == "a user's file\n"

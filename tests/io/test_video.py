@@ -230,8 +230,15 @@ def test_a_missing_numbered_image_is_refused_not_shifted(tmp_path: Path) -> None
     _numbered(seq / "img1", ["000002.png"])
     with pytest.raises(ValueError, match=r"images 000002.png and 2.png are both frame 2"):
         FrameSource(seq)
-    # a folder that is not a sequence's keeps its natural order, holes and all
-    plain = _numbered(tmp_path / "plain", ["5.png", "10.png", "15.png"])
+    # a folder that is not a sequence's alike (was: 000031 read as frame 30, and so on)
+    plain = _numbered(tmp_path / "plain", names)
+    with pytest.raises(ValueError, match=message.replace("img1", "plain")):
+        FrameSource(plain)
+    _numbered(tmp_path / "every5", ["5.png", "10.png", "15.png"])
+    with pytest.raises(ValueError, match=r"every5: image 6 is missing \(names 5\.\.15 are frame"):
+        FrameSource(tmp_path / "every5")
+    # names with anything but digits: natural order, gaps and all
+    plain = _numbered(tmp_path / "named", ["f5.png", "f10.png", "f15.png"])
     assert [int(f[0, 0, 0]) for f in FrameSource(plain)] == [1, 2, 3]
 
 
@@ -742,7 +749,27 @@ def test_two_images_of_one_number_in_a_plain_folder_are_refused(tmp_path: Path) 
     folder.mkdir()
     for k, name in enumerate(["1.png", "01.png", "2.png"]):
         (folder / name).write_bytes(sorted(src.glob("*.png"))[k].read_bytes())
-    with pytest.raises(ValueError, match="images 01.png and 1.png in folder .* the same number"):
+    with pytest.raises(ValueError, match=r"plain: images 01.png and 1.png are both frame 1 \("):
+        FrameSource(folder)  # as in a sequence (names that are numbers are frame numbers)
+    for name in ("1.png", "01.png", "2.png"):  # not all numbers: natural order
+        (folder / name).rename(folder / f"f{name}")
+    with pytest.raises(ValueError, match="images f01.png and f1.png in folder .* the same number"):
         FrameSource(folder)
-    (folder / "01.png").unlink()
+    (folder / "f01.png").unlink()
     assert len(list(FrameSource(folder))) == 2
+
+
+@pytest.mark.parametrize("key", ["frameRate", "imWidth", "imHeight", "seqLength", "imDir", "name"])
+def test_a_key_given_empty_is_refused_not_taken_as_absent(tmp_path: Path, key: str) -> None:
+    """Was: ``frameRate=`` read as no frame rate (the container's was used, silently), while
+    ``frameRate=0`` was an error; every key pftrack reads alike."""
+    other = "" if key == "frameRate" else "frameRate=7\n"
+    (tmp_path / "seqinfo.ini").write_text(f"[Sequence]\n{other}{key} =  \n")
+    message = rf"^{re.escape(str(tmp_path))}/seqinfo.ini: {key} is empty; give a value or leave"
+    with pytest.raises(ValueError, match=message):
+        read_seqinfo(tmp_path)
+    (tmp_path / "seqinfo.ini").write_text("[Sequence]\n")  # left out: the defaults
+    info = read_seqinfo(tmp_path)
+    assert (info.name, info.image_dir, info.frame_rate, info.width) == (
+        tmp_path.name, "img1", None, None
+    )  # fmt: skip

@@ -145,7 +145,23 @@ def test_cli_max_side(scene, tmp_path, capsys):
 
 
 def test_cli_default_is_the_config_default():
-    from pftrack.cli._options import DEFAULT_MAX_SIDE
+    from pftrack.cli._options import DEFAULT_MAX_SIDE, MAX_SIDE_RANGE
+    from pftrack.tracking.config import MAX_SIDE, MIN_SIDE
 
     assert (DEFAULT_MAX_SIDE or None) == TrackerConfig().max_side
     assert pftrack.Tracker().config.max_side == TrackerConfig().max_side
+    assert MAX_SIDE_RANGE == (MIN_SIDE, MAX_SIDE)
+
+
+def test_max_side_help_states_the_range_its_error_enforces(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Was: the help named no minimum; ``--max-side 32`` was refused for one (64)."""
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "PX from 64 to 100000, or 0 to track at the frame's own size" in text
+    with pytest.raises(SystemExit) as exit_:
+        main(["track", "v.avi", "--out", "t.txt", "--max-side", "32"])
+    assert exit_.value.code == 2
+    assert "expected 0 (full size) or an integer in [64, 100000], got 32" in capsys.readouterr().err

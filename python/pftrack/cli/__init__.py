@@ -18,7 +18,14 @@ from typing import Any, NoReturn
 from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
 from pftrack.cli._options import HelpFormatter
-from pftrack.cli._signals import Terminated, exit_status, sigterm_raises
+from pftrack.cli._signals import (
+    NOTHING_CHANGED,
+    Terminated,
+    exit_status,
+    line_end,
+    outcome,
+    sigterm_raises,
+)
 
 __all__ = ["build_parser", "main"]
 
@@ -191,14 +198,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
     except (OSError, ValueError, TypeError) as exc:  # OSError: missing, unwritable, full disk
-        print(f"pftrack {args.command}: error: {_one_line(exc)}", file=sys.stderr)
+        left = outcome(exc)  # a live track run's rows so far: where they are
+        said = f"; {_shown(left)}" if left else ""
+        print(f"pftrack {args.command}: error: {_one_line(exc)}{said}", file=sys.stderr)
         return 2
-    except MemoryError:
-        print(f"pftrack {args.command}: error: out of memory", file=sys.stderr)
+    except MemoryError as exc:
+        left = outcome(exc)
+        said = f"; {_shown(left)}" if left else ""
+        print(f"pftrack {args.command}: error: out of memory{said}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:  # outputs are atomic: nothing half-written is left behind
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
-        print(f"\npftrack {args.command}: {how}; no output was changed", file=sys.stderr)
+        left = _shown(outcome(exc) or NOTHING_CHANGED)
+        # the line break ends a progress bar's line, drawn only on a terminal
+        print(f"{line_end()}pftrack {args.command}: {how}; {left}", file=sys.stderr)
         return exit_status(exc)
 
 

@@ -12,6 +12,9 @@ if TYPE_CHECKING:
 #: ``--max-side``'s default: :attr:`pftrack.tracking.TrackerConfig.max_side` (0: None). Stated
 #: here, not imported, so that ``--help`` does not import the tracker; a test checks they agree.
 DEFAULT_MAX_SIDE = 0
+#: ``--max-side``'s range besides 0: :data:`pftrack.tracking.config.MIN_SIDE` and ``MAX_SIDE``,
+#: stated here for the same reason (a test checks they agree).
+MAX_SIDE_RANGE = (64, 100_000)
 #: ``--crossings``' default: :attr:`pftrack.tracking.CrossingConfig.enabled` ("on" for True),
 #: stated here for the same reason (a test checks they agree).
 DEFAULT_CROSSINGS = "off"
@@ -228,9 +231,9 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--max-side", type=max_side, default=DEFAULT_MAX_SIDE, metavar="PX",
-        help="working resolution: frames whose longer side is larger are scaled down to PX "
-        "pixels for detection and tracking, boxes written in the frame's pixels; 0 tracks at "
-        "the frame's own size",
+        help=f"working resolution: frames whose longer side is larger are scaled down to PX "
+        f"pixels for detection and tracking, boxes written in the frame's pixels; PX from "
+        f"{MAX_SIDE_RANGE[0]} to {MAX_SIDE_RANGE[1]}, or 0 to track at the frame's own size",
     )  # fmt: skip
     p.add_argument(
         "--open-size", type=bounded_int(0, 255), default=0, metavar="PX",

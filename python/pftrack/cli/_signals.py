@@ -12,11 +12,21 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from typing import Any
 
-__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "Terminated", "exit_status", "sigterm_raises"]
+__all__ = [
+    "EXIT_INTERRUPTED",
+    "EXIT_TERMINATED",
+    "Terminated",
+    "exit_status",
+    "line_end",
+    "outcome",
+    "set_outcome",
+    "sigterm_raises",
+]
 
 #: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
@@ -31,6 +41,35 @@ class Terminated(KeyboardInterrupt):
 def exit_status(exc: KeyboardInterrupt) -> int:
     """143 when `exc` came from SIGTERM, else 130 (Ctrl-C)."""
     return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
+
+
+#: What an interrupted command says it left, unless it says otherwise (:func:`set_outcome`).
+NOTHING_CHANGED = "no output was changed"
+
+
+def set_outcome(exc: BaseException, text: str | None) -> None:
+    """Say what the command that `exc` ends left behind, in place of "no output was changed".
+
+    ``main`` prints it after ``interrupted;`` (or ``terminated (SIGTERM);``), and after an
+    error's message. A live ``pftrack track`` run has written rows before it ends: the
+    message says where they are. None says nothing (the default stands).
+    """
+    if text is not None:
+        exc.pftrack_outcome = text  # type: ignore[attr-defined]
+
+
+def outcome(exc: BaseException) -> str | None:
+    """What :func:`set_outcome` said for `exc`; None when nothing was."""
+    text = getattr(exc, "pftrack_outcome", None)
+    return text if isinstance(text, str) else None
+
+
+def line_end() -> str:
+    """A line break when stderr is a terminal (to end a progress bar's line first), else ``""``."""
+    try:
+        return "\n" if sys.stderr is not None and sys.stderr.isatty() else ""
+    except (AttributeError, OSError, ValueError):  # a replaced or closed stream
+        return ""
 
 
 def _raise_terminated(signum: int, frame: Any) -> None:

@@ -128,9 +128,10 @@ def add_parser(sub: Any) -> None:
         "PETS09-S2L1's video), else 1; a number only with --detections auto",
     )  # fmt: skip
     p.add_argument("--render", action="store_true",
-                   help="also write DIR/NAME.mp4, annotated; a later batch that scans DIR "
-                   "passes it over (its NAME.json lists it), so DIR may be the input "
-                   "folder")  # fmt: skip
+                   help="also write DIR/NAME.mp4, annotated (an odd width or height made "
+                   "even by one copied column or row, as track --render); a later batch "
+                   "that scans DIR passes it over (its NAME.json lists it), so DIR may be "
+                   "the input folder")  # fmt: skip
     p.add_argument("--iou", type=iou_threshold, default=0.5,
                    help=f"{IOU_HELP}, for the metrics")  # fmt: skip
     add_tracker_options(p)

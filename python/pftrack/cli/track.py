@@ -32,22 +32,27 @@ def add_parser(sub: Any) -> None:
         "track",
         help="track a video, image folder, camera or stream; MOTChallenge output",
         description="Track every object in SOURCE: a video file, a folder of images (natural "
-        "order: 2.jpg before 10.jpg), a MOTChallenge sequence folder (seqinfo.ini gives the "
-        "frame rate and image folder, det/det.txt or det.txt the detections of --detections "
-        "auto; its image names that are all digits are frame numbers, and a missing one is an "
-        "error; without its image folder, the one video file beside seqinfo.ini is read, as "
-        "pftrack batch does), a "
+        "order: 2.jpg before 10.jpg; names that are all digits are frame numbers, and a "
+        "missing one is an error: frame 1 is the lowest, or image 1 in a sequence), a "
+        "MOTChallenge sequence folder (seqinfo.ini gives the frame rate and image folder, "
+        "det/det.txt or det.txt the detections of --detections auto; without its image "
+        "folder, the one video file beside seqinfo.ini is read, as pftrack batch does), a "
         "camera index (0) or a stream URL (rtsp://, http://, ...). Without --detections, "
         "objects come from background subtraction; with a MOTChallenge det.txt the tracker is "
         "a drop-in backend for any detector. Output: MOTChallenge rows "
         "frame,id,left,top,width,height,score,flag,-1,-1 (1-based frames, pixels of SOURCE; "
         "flag 1 on a box the offline pass filled in a hole, else -1), "
         "written atomically.\n\n"
-        "Live sources (camera, stream URL, named pipe): --out grows as the tracker settles "
-        "rows (online boxes, flushed every frame); Ctrl-C stops after the current frame, and "
-        "--out is then replaced by the finished tracks (linked and smoothed, unless --no-link "
-        "/ --no-smooth) with exit status 0; a second Ctrl-C aborts (exit 130). On a file "
-        "source, Ctrl-C aborts and leaves --out as it was (exit 130).",
+        "Live sources (camera, stream URL, named pipe): the rows the tracker settles (online "
+        "boxes, flushed every frame) go to a hidden file beside --out (.NAME.<hex>.part), and "
+        "--out is left as it was until the run ends; Ctrl-C stops after the current frame, "
+        "and --out is then replaced by the finished tracks (linked and smoothed, unless "
+        "--no-link / --no-smooth) with exit status 0; a second Ctrl-C aborts (exit 130): "
+        "--out stays as it was, and the online rows so far are kept beside it in a new "
+        "STEM.partial.SUFFIX (tracks.partial.txt for tracks.txt; tracks.partial-2.txt if that "
+        "exists, ...), as the last message says; SIGTERM or an error likewise. A device or "
+        "pipe --out (/dev/stdout) gets the online rows themselves, and no finished tracks. On "
+        "a file source, Ctrl-C aborts and leaves --out as it was (exit 130).",
     )
     p.add_argument(
         "source",
@@ -76,7 +81,9 @@ def add_parser(sub: Any) -> None:
         "--render", metavar="VIDEO",
         help="write an annotated video while tracking: .mp4 (H.264, plays in browsers) or "
         ".avi (MJPG; a device or pipe without extension, e.g. /dev/stdout: .mp4); boxes, ids "
-        "and trails as tracked online (default: none)",
+        "and trails as tracked online. Its size is the source's, made even (H.264's 4:2:0 "
+        "needs it): an odd width or height gets one copied column or row at the right or "
+        "bottom, so a 321x241 source gives a 322x242 video (default: none)",
     )  # fmt: skip
     p.add_argument("--plot", metavar="PNG",
                    help="write a trajectory plot: .png, .jpg (a device or pipe without "
@@ -96,7 +103,9 @@ class _StopOnCtrlC:
         if self.source.stopped:
             raise KeyboardInterrupt
         self.source.stop()
-        print("\nstopping after this frame (Ctrl-C again to abort)", file=sys.stderr)
+        from pftrack.cli._signals import line_end
+
+        print(f"{line_end()}stopping after this frame (Ctrl-C again to abort)", file=sys.stderr)
 
     def __enter__(self) -> _StopOnCtrlC:
         self._previous = signal.signal(signal.SIGINT, self._handler)
@@ -104,6 +113,36 @@ class _StopOnCtrlC:
 
     def __exit__(self, *exc: object) -> None:
         signal.signal(signal.SIGINT, self._previous)
+
+
+def _abort_note(out: str, side: Any, streamed: int | None, committed: bool) -> str | None:
+    """What a live run that failed or was aborted left, for ``main``'s last line; None: nothing.
+
+    Parameters
+    ----------
+    out : str
+        ``--out``.
+    side : SideFile or None
+        The side file of a run into a file (:func:`pftrack.io.atomic.side_file`), its block
+        left already: :attr:`~pftrack.io.atomic.SideFile.kept` says where its rows are.
+    streamed : int or None
+        Rows written through into ``--out`` (a device, pipe or descriptor); None if not one.
+    committed : bool
+        Whether every output had been renamed into place.
+    """
+    if committed:
+        return "every output was written"
+    if streamed:
+        return (
+            f"the {streamed} online rows tracked so far were written to {out}; no other "
+            "output was changed"
+        )
+    if side is not None and side.kept is not None:
+        return (
+            f"no output was changed; the {side.lines} online rows tracked so far are kept in "
+            f"{side.kept}"
+        )
+    return None
 
 
 def _resolve_detections(args: argparse.Namespace, source: Any) -> str | None:
@@ -174,12 +213,18 @@ def run(args: argparse.Namespace) -> int:
     What it has to say (warnings on stderr, the summary on stdout) is printed once every output
     is written: a closed stdout (``| head``) then costs the messages, never the files.
     """
-    import contextlib
-
     import numpy as np
 
     from pftrack.cli._options import opencv_single_threaded
-    from pftrack.io.atomic import atomic_write, output_format, staged_outputs, writes_through
+    from pftrack.cli._signals import set_outcome
+    from pftrack.io.atomic import (
+        SideFile,
+        atomic_write,
+        output_format,
+        side_file,
+        staged_outputs,
+        writes_through,
+    )
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, check_source, is_live_source
     from pftrack.io.video_writer import VIDEO_SUFFIXES
@@ -197,80 +242,97 @@ def run(args: argparse.Namespace) -> int:
     renderer: TrackRenderer | None = None
     said: list[str] = []  # stdout, after the outputs are written
     warned: list[str] = []  # stderr, likewise
+    # a live run into a device, pipe or descriptor (/dev/stdout) streams its rows there and
+    # only there: the finished tracks cannot replace what was written already. Into a file,
+    # its rows go to a hidden side file beside --out, which the finished tracks replace at
+    # the end; --out is not touched before then (an abort keeps the rows: see _abort_note)
+    streamed = live and writes_through(args.out)
+    online: IO[str] | None = None  # where the streamed rows go
+    n_online = [0]  # rows streamed so far
+    side: SideFile | None = None
+    committed = False  # every staged output renamed into place
     try:
-        with staged_outputs() as stage:  # every output replaced at the end, or none
-            det_path = _resolve_detections(args, source)
-            dets = (
-                load_detections(det_path, _det_scale(args, source, det_path, said))
-                if det_path
-                else None
-            )
-            if args.render:  # a device (/dev/null, /dev/stdout) takes the default format, .mp4
-                video = stage(args.render, output_format(args.render, VIDEO_SUFFIXES))
-                renderer = TrackRenderer(video, source.fps)
-            first: list[Any] = []
-            stream: IO[str] | None = None
-
-            def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
-                if n == 1:
-                    first.append(frame)
-                if renderer is not None:
-                    renderer.add(frame, tracks)
-                if stream is not None:
-                    for r in rows:
-                        stream.write(format_mot_row(r) + "\n")
-                    stream.flush()
-
-            # a live run into a device, pipe or descriptor (/dev/stdout) streams its rows there
-            # and only there: the finished tracks cannot replace what was written already
-            streamed = live and writes_through(args.out)
-            with contextlib.ExitStack() as stack:
-                if streamed:
-                    stream = stack.enter_context(atomic_write(args.out))  # written through
-                elif live:  # --out grows while tracking; replaced by the finished tracks below
-                    stream = stack.enter_context(open(args.out, "w", encoding="utf-8"))  # noqa: SIM115
-                    stack.enter_context(_StopOnCtrlC(source))
-                caught = stack.enter_context(warnings.catch_warnings(record=True))
-                warnings.simplefilter("always")
-                result = track_frames(
-                    source,
-                    detections=dets,
-                    config=config,
-                    rng=args.seed,
-                    fill=args.fill,
-                    bootstrap=args.bootstrap,
-                    smoother=None if args.no_smooth else BoxSmoother(),
-                    link=None if args.no_link else LinkConfig(),
-                    on_frame=on_frame,
+        with contextlib.ExitStack() as keep:
+            if live and not streamed:
+                side = keep.enter_context(side_file(args.out))
+            with staged_outputs() as stage:  # every output replaced at the end, or none
+                det_path = _resolve_detections(args, source)
+                dets = (
+                    load_detections(det_path, _det_scale(args, source, det_path, said))
+                    if det_path
+                    else None
                 )
-            # clipped boxes, a run without any track: said, not fatal
-            warned.extend(f"pftrack track: warning: {w.message}" for w in caught)
-            if not streamed:
-                write_mot(stage(args.out), result.rows)
-            n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
-            stopped = " (stopped by Ctrl-C)" if source.stopped else ""
-            online = " (online rows, as they settled)" if streamed else ""
-            said.append(
-                f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} boxes in "
-                f"{result.seconds:.2f} s ({result.fps:.0f} frames/s), seed {args.seed} -> "
-                f"{args.out}{online}"
-            )
-            if renderer is not None:
-                renderer.close()
+                if args.render:  # a device (/dev/null, /dev/stdout) takes the default, .mp4
+                    video = stage(args.render, output_format(args.render, VIDEO_SUFFIXES))
+                    renderer = TrackRenderer(video, source.fps)
+                first: list[Any] = []
+
+                def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
+                    if n == 1:
+                        first.append(frame)
+                    if renderer is not None:
+                        renderer.add(frame, tracks)
+                    if side is not None:
+                        side.write_lines(format_mot_row(r) for r in rows)
+                    elif online is not None:
+                        for r in rows:
+                            online.write(format_mot_row(r) + "\n")
+                        online.flush()
+                        n_online[0] += len(rows)
+
+                with contextlib.ExitStack() as stack:
+                    if streamed:
+                        online = stack.enter_context(atomic_write(args.out))  # written through
+                    if live and not streamed:
+                        stack.enter_context(_StopOnCtrlC(source))
+                    caught = stack.enter_context(warnings.catch_warnings(record=True))
+                    warnings.simplefilter("always")
+                    result = track_frames(
+                        source,
+                        detections=dets,
+                        config=config,
+                        rng=args.seed,
+                        fill=args.fill,
+                        bootstrap=args.bootstrap,
+                        smoother=None if args.no_smooth else BoxSmoother(),
+                        link=None if args.no_link else LinkConfig(),
+                        on_frame=on_frame,
+                    )
+                # clipped boxes, a run without any track: said, not fatal
+                warned.extend(f"pftrack track: warning: {w.message}" for w in caught)
+                if not streamed:
+                    write_mot(stage(args.out), result.rows)
+                n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
+                stopped = " (stopped by Ctrl-C)" if source.stopped else ""
+                how = " (online rows, as they settled)" if streamed else ""
                 said.append(
-                    f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
-                    f"{source.fps_origin}) -> {args.render}"
+                    f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} "
+                    f"boxes in {result.seconds:.2f} s ({result.fps:.0f} frames/s), seed "
+                    f"{args.seed} -> {args.out}{how}"
                 )
-            if args.plot:
-                name = (
-                    source.sequence.name if source.sequence is not None else Path(args.source).name
-                )
-                plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))  # device: .png
-                plot_trajectories(plot, result.rows, background=first[0], title=name)
-                said.append(f"trajectory plot -> {args.plot}")
-    except BaseException:
+                if renderer is not None:
+                    renderer.close()
+                    origin = "--fps" if source.fps_origin == "given" else source.fps_origin
+                    said.append(
+                        f"annotated video ({renderer.writer.codec}, {source.fps:g} fps from "
+                        f"{origin}) -> {args.render}"
+                    )
+                if args.plot:
+                    name = (
+                        source.sequence.name
+                        if source.sequence is not None
+                        else Path(args.source).name
+                    )
+                    plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))  # device: png
+                    plot_trajectories(plot, result.rows, background=first[0], title=name)
+                    said.append(f"trajectory plot -> {args.plot}")
+            committed = True
+    except BaseException as exc:
         if renderer is not None:
             renderer.abort()  # no half-written video (a finished one stays)
+        if live:
+            rows = n_online[0] if streamed else None
+            set_outcome(exc, _abort_note(args.out, side, rows, committed))
         raise
     finally:
         source.close()

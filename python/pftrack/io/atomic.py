@@ -274,6 +274,127 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         raise
 
 
+@dataclass
+class SideFile:
+    """A hidden text file beside an output, holding what a run has so far (:func:`side_file`).
+
+    Attributes
+    ----------
+    path : Path
+        Where the lines are: the hidden file while the block runs; once it has raised, the
+        file they were kept in (see :attr:`kept`).
+    lines : int
+        Lines written so far (:meth:`write_lines`).
+    kept : Path or None
+        After the block raised with lines written: the file that holds them. None otherwise
+        (the side file is then removed).
+    """
+
+    file: IO[str]
+    path: Path
+    lines: int = 0
+    kept: Path | None = None
+
+    def write_lines(self, lines: Iterable[str]) -> None:
+        """Append `lines` (without their line ends), then flush them to the file.
+
+        An OSError that names no file (a full disk) names the side file.
+        """
+        with _named(self.path):
+            for line in lines:
+                self.file.write(line + "\n")
+                self.lines += 1
+            self.file.flush()
+
+
+#: Names :func:`side_file` tries for the lines of a failed run before keeping its hidden name.
+PARTIAL_NAMES = 100
+
+
+def partial_name(path: PathLike, k: int = 1) -> Path:
+    """The `k`-th name :func:`side_file` tries for a failed run's lines, beside output `path`.
+
+    ``tracks.txt`` gives ``tracks.partial.txt``, then (``k`` = 2, 3, ...)
+    ``tracks.partial-2.txt``, ...; a symbolic link's target names the folder.
+    """
+    target = _resolve(path).path
+    tag = "partial" if k == 1 else f"partial-{k}"
+    return target.with_name(f"{target.stem}.{tag}{target.suffix}")
+
+
+def _keep(tmp: Path, path: PathLike) -> Path:
+    """Give the side file `tmp` the first free :func:`partial_name` of `path`; return its name.
+
+    A hard link then the removal of `tmp`: an existing file is never replaced. Where links
+    cannot be made (some file systems), or every name is taken, `tmp` keeps its own name.
+    """
+    for k in range(1, PARTIAL_NAMES + 1):
+        wanted = partial_name(path, k)
+        try:
+            os.link(tmp, wanted)
+        except FileExistsError:
+            continue
+        except OSError:
+            return tmp
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        return wanted
+    return tmp
+
+
+@contextlib.contextmanager
+def side_file(path: PathLike, suffix: str = ".part") -> Iterator[SideFile]:
+    """A new hidden text file beside output `path` for a run's lines as they come; see below.
+
+    The file, ``.NAME.<hex>.part``, is made in the folder `path` is written to (the end of
+    its symbolic links) with the permission bits of an existing `path`, as
+    :func:`atomic_write`'s temporary file; `path` itself is not touched. When the block ends
+    normally, the file is removed (the caller has written its finished output by then). When
+    it raises (an error, Ctrl-C, SIGTERM), a file holding lines is kept, under the first
+    :func:`partial_name` no file has (``tracks.partial.txt``, ``tracks.partial-2.txt``, ...;
+    no existing file is replaced), else under its hidden name; :attr:`SideFile.kept` says
+    which. One without lines is removed.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output the lines stand in for. Not a device, pipe or descriptor (those are written
+        through: :func:`writes_through`).
+    suffix : str
+        Suffix of the hidden file.
+
+    Raises
+    ------
+    ValueError
+        `path` can only name a folder (a trailing slash, ``.``), or is written through.
+    FileNotFoundError
+        Its folder does not exist.
+    """
+    _refuse_folder_name(path)
+    resolved = _resolve(path)
+    if resolved.through:
+        raise ValueError(f"{os.fsdecode(os.fspath(path))} is written through; no side file")
+    target = resolved.path
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise FileNotFoundError(f"output folder does not exist: {folder}")
+    made: list[str] = []
+    side: SideFile | None = None
+    try:  # the file is made inside: removed whenever the block is left without lines
+        fd, tmp = _create_beside(folder, f".{target.name}.", suffix, made)
+        _keep_mode(fd, target)
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            side = SideFile(fh, Path(tmp))
+            yield side
+    except BaseException:
+        if side is not None and side.lines:
+            side.kept = side.path = _keep(side.path, path)
+        else:
+            _remove(made)
+        raise
+    _remove(made)
+
+
 def _copy_through(tmp: Path, target: _Target, *, empty_ok: bool = False) -> None:
     """Write the finished file `tmp` into the written-through `target`.
 

@@ -234,12 +234,17 @@ def _duplicate(
 def read_seqinfo(path: PathLike) -> SequenceInfo:
     """Read a MOTChallenge ``seqinfo.ini`` (or the one in folder `path`).
 
+    A key left out takes its default (``name``: the folder's name, ``imDir``: ``img1``; the
+    numbers: unknown); a key given with an empty value (``frameRate=``) is an error, as one
+    of ``0`` is: it would otherwise fall back silently (the container's frame rate for an
+    empty ``frameRate``).
+
     Raises
     ------
     ValueError
-        No ``[Sequence]`` section, a key or section given twice, a field that is not a positive
-        number (``imWidth``, ``imHeight``, ``seqLength``: an integer), or a ``frameRate``
-        outside :data:`FRAME_RATE_RANGE`.
+        No ``[Sequence]`` section, a key or section given twice, a key pftrack reads given
+        empty, a field that is not a positive number (``imWidth``, ``imHeight``,
+        ``seqLength``: an integer), or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`.
     """
     ini = Path(path)
     if ini.is_dir():
@@ -255,9 +260,15 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
             f"{ini}: expected a [Sequence] section (MOTChallenge seqinfo.ini)"
         ) from None
 
-    def number(key: str) -> float | None:
+    def text_of(key: str) -> str | None:
         text = sec.get(key)
-        if text is None or not text.strip():
+        if text is not None and not text.strip():
+            raise ValueError(f"{ini}: {key} is empty; give a value or leave the key out")
+        return text
+
+    def number(key: str) -> float | None:
+        text = text_of(key)
+        if text is None:
             return None
         try:
             value = float(text)
@@ -282,9 +293,9 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         )
     return SequenceInfo(
         folder=ini.parent,
-        name=sec.get("name", ini.parent.name),
+        name=text_of("name") or ini.parent.name,
         frame_rate=frame_rate,
-        image_dir=sec.get("imDir", "img1") or "img1",
+        image_dir=text_of("imDir") or "img1",
         width=integer("imWidth"),
         height=integer("imHeight"),
         length=integer("seqLength"),
@@ -381,14 +392,14 @@ def _natural_order(folder: Path, images: list[Path]) -> list[Path]:
 def _frame_order(
     folder: Path, images: list[Path], sequence: SequenceInfo | None
 ) -> list[Path] | None:
-    """A MOTChallenge sequence's images in frame order if their names are frame numbers.
+    """A folder's images in frame order if their names are frame numbers.
 
     The names are frame numbers when every stem is all digits (``000001.jpg``, ``1.png``: the
-    MOTChallenge convention). A frame is its image's position, so in a sequence, whose
-    ``det.txt`` and ``gt.txt`` count frames by those numbers, a hole in the numbering would
-    silently shift every later frame onto the wrong detections and ground truth. A folder that
-    is not a sequence's (`sequence` None) keeps its natural order, holes and all: a dump of
-    every fifth frame tracks as it is.
+    MOTChallenge convention). A frame is its image's position, so a hole in the numbering
+    would silently shift every later frame onto the wrong detections (``--detections``, whose
+    frames are those numbers) and ground truth: it is an error, in any folder. A folder that
+    is not a sequence's (`sequence` None) may start at any number (``000000.png`` of a 0-based
+    dump, a cut of a longer one): frame 1 is its lowest.
 
     Parameters
     ----------
@@ -403,8 +414,8 @@ def _frame_order(
     Returns
     -------
     list of Path or None
-        The images by number; None outside a sequence or when some name is not a number
-        (their order is left to the caller).
+        The images by number; None when some name is not a number (their order is left to
+        the caller).
 
     Raises
     ------
@@ -413,7 +424,7 @@ def _frame_order(
         its ``seqLength``), two images have one number, or a sequence has more images than
         its ``seqLength``.
     """
-    if sequence is None or not all(p.stem.isascii() and p.stem.isdigit() for p in images):
+    if not all(p.stem.isascii() and p.stem.isdigit() for p in images):
         return None
     ordered = sorted(images, key=lambda p: (int(p.stem), p.name))
     numbers = [int(p.stem) for p in ordered]
@@ -423,7 +434,7 @@ def _frame_order(
     def missing(number: int, width: int, why: str) -> ValueError:
         return ValueError(f"{folder}: image {str(number).zfill(width)} is missing ({why})")
 
-    if numbers[0] != 1:
+    if sequence is not None and numbers[0] != 1:
         if numbers[0] > 1:
             raise missing(1, len(first), f"{names}; frame 1 of a MOTChallenge sequence is image 1")
         raise ValueError(
@@ -438,7 +449,7 @@ def _frame_order(
             )
         if numbers[k] != numbers[k - 1] + 1:
             raise missing(numbers[k - 1] + 1, len(ordered[k - 1].stem), names)
-    length = sequence.length
+    length = sequence.length if sequence is not None else None
     if length is not None and len(ordered) < length:
         raise missing(numbers[-1] + 1, len(last), f"{names}; seqinfo.ini says seqLength={length}")
     if length is not None and len(ordered) > length:
