@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import queue
 import threading
+import unicodedata
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -26,8 +27,29 @@ __all__ = [
     "draw_trails",
     "ink_scale",
     "plot_trajectories",
+    "text_for_opencv",
     "write_annotated_video",
 ]
+
+
+def text_for_opencv(text: str) -> str:
+    r"""`text` as printable ASCII, all that ``cv2.putText`` can draw: give it nothing else.
+
+    ``cv2.putText`` crashes the process (a segmentation fault, OpenCV 5.0) on a ``str`` that
+    cannot be encoded as UTF-8, such as a file name whose bytes are not UTF-8 (Python keeps
+    them as surrogate escapes: ``os.fsdecode(b"v\xe9deo.mp4")``). Such bytes are shown as
+    ``\xe9`` escapes (as in messages: :func:`pftrack.io.opencv_io.printable`), accents are
+    dropped (``"vidé"``: ``"vide"``), and any other character that is not printable ASCII is
+    drawn as ``?`` (as the font would draw it).
+    """
+    try:  # surrogate escapes back to the bytes they stand for
+        raw = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:  # a lone surrogate that escapes no byte
+        raw = text.encode("utf-8", "backslashreplace")
+    folded = unicodedata.normalize("NFKD", raw.decode("utf-8", "backslashreplace"))
+    return "".join(
+        c if " " <= c <= "~" else "" if unicodedata.combining(c) else "?" for c in folded
+    )
 
 
 @functools.lru_cache(maxsize=4096)
@@ -67,13 +89,13 @@ def draw_tracks(
         c = colour_of(tid)
         cv2.rectangle(out, (x, y), (x + w, y + h), c, k * (1 if len(r) > 7 and r[7] == 1 else 2))
         cv2.putText(
-            out, str(tid), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, c, k,
-            cv2.LINE_AA,
+            out, text_for_opencv(str(tid)), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX,
+            0.4 * k, c, k, cv2.LINE_AA,
         )  # fmt: skip
     if label:
         cv2.putText(
-            out, label, (5 * k, 15 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k, (255, 255, 255), k,
-            cv2.LINE_AA,
+            out, text_for_opencv(label), (5 * k, 15 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k,
+            (255, 255, 255), k, cv2.LINE_AA,
         )  # fmt: skip
     return out
 
@@ -308,7 +330,7 @@ def plot_trajectories(
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
         cv2.putText(
             canvas,
-            str(tid),
+            text_for_opencv(str(tid)),
             tuple(int(v) for v in pts[0]),
             cv2.FONT_HERSHEY_SIMPLEX,
             0.4,
@@ -318,6 +340,7 @@ def plot_trajectories(
         )
     if title:
         cv2.putText(
-            canvas, title, (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA
-        )
+            canvas, text_for_opencv(title), (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
+            (255, 255, 255), 1, cv2.LINE_AA,
+        )  # fmt: skip
     return write_image(path, canvas)  # any name (pftrack.io.opencv_io)
