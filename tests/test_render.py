@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pftrack.render import TrackRenderer, colour_of, text_for_opencv, write_annotated_video
+from pftrack.io.opencv_io import text_for_opencv
+from pftrack.render import TrackRenderer, colour_of, write_annotated_video
 from tests.io.decode import decode
 
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 import functools
 import queue
 import threading
-import unicodedata
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -17,7 +16,7 @@ from numpy.typing import NDArray
 
 from pftrack._typing import PathLike
 from pftrack.io.mot import group_by_frame
-from pftrack.io.opencv_io import write_image
+from pftrack.io.opencv_io import text_for_opencv, write_image
 from pftrack.io.video_writer import VideoWriter
 
 __all__ = [
@@ -27,29 +26,8 @@ __all__ = [
     "draw_trails",
     "ink_scale",
     "plot_trajectories",
-    "text_for_opencv",
     "write_annotated_video",
 ]
-
-
-def text_for_opencv(text: str) -> str:
-    r"""`text` as printable ASCII, all that ``cv2.putText`` can draw: give it nothing else.
-
-    ``cv2.putText`` crashes the process (a segmentation fault, OpenCV 5.0) on a ``str`` that
-    cannot be encoded as UTF-8, such as a file name whose bytes are not UTF-8 (Python keeps
-    them as surrogate escapes: ``os.fsdecode(b"v\xe9deo.mp4")``). Such bytes are shown as
-    ``\xe9`` escapes (as in messages: :func:`pftrack.io.opencv_io.printable`), accents are
-    dropped (``"vidé"``: ``"vide"``), and any other character that is not printable ASCII is
-    drawn as ``?`` (as the font would draw it).
-    """
-    try:  # surrogate escapes back to the bytes they stand for
-        raw = text.encode("utf-8", "surrogateescape")
-    except UnicodeEncodeError:  # a lone surrogate that escapes no byte
-        raw = text.encode("utf-8", "backslashreplace")
-    folded = unicodedata.normalize("NFKD", raw.decode("utf-8", "backslashreplace"))
-    return "".join(
-        c if " " <= c <= "~" else "" if unicodedata.combining(c) else "?" for c in folded
-    )
 
 
 @functools.lru_cache(maxsize=4096)

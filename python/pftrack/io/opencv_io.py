@@ -11,7 +11,9 @@ pftrack never hands OpenCV such a name:
 - videos are opened through a symbolic link with an ASCII name in the system's temporary
   folder (:func:`opencv_name`), removed as soon as OpenCV has opened the file: OpenCV keeps
   its own handle;
-- a stream URL that is not valid UTF-8 is refused (:func:`utf8_name`).
+- a stream URL that is not valid UTF-8 is refused (:func:`utf8_name`);
+- text drawn with ``cv2.putText`` (a plot's title: the video's file name) is made printable
+  ASCII first (:func:`text_for_opencv`).
 
 A name that is valid UTF-8, which is almost every name, goes to OpenCV as the text its bytes
 spell in UTF-8 (:func:`utf8_name`), which is not always the ``str`` Python made of them: under a
@@ -26,6 +28,7 @@ import contextlib
 import os
 import shutil
 import tempfile
+import unicodedata
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -37,7 +40,15 @@ from numpy.typing import NDArray
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_write
 
-__all__ = ["is_utf8", "opencv_name", "printable", "read_image", "utf8_name", "write_image"]
+__all__ = [
+    "is_utf8",
+    "opencv_name",
+    "printable",
+    "read_image",
+    "text_for_opencv",
+    "utf8_name",
+    "write_image",
+]
 
 
 def is_utf8(path: PathLike) -> bool:
@@ -72,6 +83,26 @@ def utf8_name(path: PathLike, what: str = "path") -> str:
         raise ValueError(
             f"{what} {printable(path)} is not valid UTF-8, which OpenCV's binding cannot take"
         ) from None
+
+
+def text_for_opencv(text: str) -> str:
+    r"""`text` as printable ASCII, all that ``cv2.putText`` can draw: give it nothing else.
+
+    ``cv2.putText`` crashes the process (a segmentation fault, OpenCV 5.0) on a ``str`` that
+    cannot be encoded as UTF-8, such as a file name whose bytes are not UTF-8 (Python keeps
+    them as surrogate escapes: ``os.fsdecode(b"v\xe9deo.mp4")``). Such bytes are shown as
+    ``\xe9`` escapes (as in messages: :func:`printable`), accents are
+    dropped (``"vidé"``: ``"vide"``), and any other character that is not printable ASCII is
+    drawn as ``?`` (as the font would draw it).
+    """
+    try:  # surrogate escapes back to the bytes they stand for
+        raw = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:  # a lone surrogate that escapes no byte
+        raw = text.encode("utf-8", "backslashreplace")
+    folded = unicodedata.normalize("NFKD", raw.decode("utf-8", "backslashreplace"))
+    return "".join(
+        c if " " <= c <= "~" else "" if unicodedata.combining(c) else "?" for c in folded
+    )
 
 
 @contextlib.contextmanager

@@ -367,7 +367,7 @@ def draw_figure(
     """
     import cv2
 
-    from pftrack.render import text_for_opencv
+    from pftrack.io.opencv_io import text_for_opencv
 
     w, h = size
     s_full = height / float(h)
