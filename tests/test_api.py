@@ -27,6 +27,14 @@ def test_all_lists_exactly_the_lazy_names() -> None:
     assert sorted(pftrack.__all__) == sorted(["__version__", *pftrack._MODULE_OF])
 
 
+def test_the_evaluation_entry_points_are_top_level() -> None:
+    """``evaluate_sequence`` (what ``pftrack eval`` scores) and ``evaluate_hota`` were only in
+    ``pftrack.eval``, beside the top-level ``evaluate_mot``."""
+    for name in ("evaluate_sequence", "evaluate_hota", "evaluate_mot"):
+        assert name in pftrack.__all__
+        assert getattr(pftrack, name) is getattr(pftrack.eval, name)
+
+
 def test_unknown_name_is_an_attribute_error() -> None:
     with pytest.raises(AttributeError, match="no_such_thing"):
         pftrack.no_such_thing  # noqa: B018

@@ -13,7 +13,8 @@ The public API, importable from the top level; each name loads its module on fir
   :class:`SequenceInfo`, :class:`VideoWriter` (H.264 MP4);
 - pictures: :class:`TrackRenderer` (annotated video while tracking),
   :func:`write_annotated_video`, :func:`plot_trajectories`;
-- evaluation: :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
+- evaluation: :func:`evaluate_sequence` (HOTA and CLEAR-MOT/IDF1), :func:`evaluate_hota`,
+  :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
 - kernels: :class:`ColourParticleFilter`, :func:`systematic_resample`, :func:`hsv_bins`,
   :func:`box_histograms`, :func:`bhattacharyya_weights`;
 - :func:`make_scene`, a synthetic scene with known truth.
@@ -54,7 +55,13 @@ if TYPE_CHECKING:
     from pftrack import render as render
     from pftrack import synthetic as synthetic
     from pftrack import tracking as tracking
-    from pftrack.eval import MotMetrics, evaluate_mot, format_metrics
+    from pftrack.eval import (
+        MotMetrics,
+        evaluate_hota,
+        evaluate_mot,
+        evaluate_sequence,
+        format_metrics,
+    )
     from pftrack.io.mot import read_mot, write_mot
     from pftrack.io.video import FrameSource, SequenceInfo, read_seqinfo
     from pftrack.io.video_writer import VideoWriter
@@ -113,7 +120,13 @@ _HOME = {
     "pftrack.io.video": ("FrameSource", "SequenceInfo", "read_seqinfo"),
     "pftrack.io.video_writer": ("VideoWriter",),
     "pftrack.render": ("TrackRenderer", "plot_trajectories", "write_annotated_video"),
-    "pftrack.eval": ("MotMetrics", "evaluate_mot", "format_metrics"),
+    "pftrack.eval": (
+        "MotMetrics",
+        "evaluate_hota",
+        "evaluate_mot",
+        "evaluate_sequence",
+        "format_metrics",
+    ),
     "pftrack.particle_filter": (
         "ColourParticleFilter",
         "bhattacharyya_weights",
@@ -141,7 +154,9 @@ __all__ = [
     "VideoWriter",
     "bhattacharyya_weights",
     "box_histograms",
+    "evaluate_hota",
     "evaluate_mot",
+    "evaluate_sequence",
     "fill_gaps",
     "format_metrics",
     "goal_directed_path",
