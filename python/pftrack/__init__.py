@@ -30,13 +30,40 @@ from typing import TYPE_CHECKING
 
 from pftrack._lazy import lazy_exports
 
-if importlib.util.find_spec("pftrack._core") is None:  # pragma: no cover - only without a build
-    # found, not imported: loading it (and NumPy) waits for the first name that needs it,
-    # so `pftrack --help` stays fast
-    raise ImportError(
+
+def _no_core_message() -> str:
+    """Why ``pftrack._core`` cannot be found: no build, or a source checkout before the install.
+
+    A source checkout (``python/pftrack`` on ``sys.path``: the current folder, ``PYTHONPATH``)
+    hides an installed pftrack whose core is built; building is then not the fix.
+    """
+    import importlib.metadata
+    import os
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    try:
+        dist = importlib.metadata.distribution("pftrack")
+        init = os.path.abspath(str(dist.locate_file("pftrack/__init__.py")))
+        version = dist.version
+    except (importlib.metadata.PackageNotFoundError, OSError, ValueError):
+        init, version = __file__, ""
+    installed = os.path.dirname(init)
+    if installed != here and os.path.isfile(init):  # not an editable install's redirect
+        return (
+            f"a source checkout at {here} is shadowing the installed pftrack {version} "
+            f"({installed}), and its compiled core (pftrack._core) is not built: run from "
+            "another folder (or take the checkout off PYTHONPATH)"
+        )
+    return (
         "pftrack's compiled core (pftrack._core) is not built: install with `pip install .` "
         "or, for development, `pip install --no-build-isolation -ve .`"
     )
+
+
+# found, not imported: loading it (and NumPy) waits for the first name that needs it, so
+# `pftrack --help` stays fast
+if importlib.util.find_spec("pftrack._core") is None:
+    raise ImportError(_no_core_message())
 
 if TYPE_CHECKING:
     # the subpackages and modules, for type checkers: at run time __getattr__ loads them
