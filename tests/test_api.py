@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import inspect
+import os
 import re
 import subprocess
 import sys
@@ -25,6 +26,58 @@ def test_every_public_name_resolves_to_its_home(name: str) -> None:
 
 def test_all_lists_exactly_the_lazy_names() -> None:
     assert sorted(pftrack.__all__) == sorted(["__version__", *pftrack._MODULE_OF])
+
+
+def test_the_evaluation_entry_points_are_top_level() -> None:
+    """``evaluate_sequence`` (what ``pftrack eval`` scores) and ``evaluate_hota`` were only in
+    ``pftrack.eval``, beside the top-level ``evaluate_mot``."""
+    for name in ("evaluate_sequence", "evaluate_hota", "evaluate_mot"):
+        assert name in pftrack.__all__
+        assert getattr(pftrack, name) is getattr(pftrack.eval, name)
+
+
+def _import_without_core(tmp_path: Path, installed: bool) -> str:
+    """The error of ``import pftrack`` from a source checkout whose core is not built, with or
+    without an installed pftrack (a dist-info and its package) after it on ``sys.path``.
+
+    ``python -S``: site-packages, where CI installs pftrack, is not on the path.
+    """
+    checkout = tmp_path / "checkout" / "python" / "pftrack"
+    checkout.mkdir(parents=True)
+    package = Path(pftrack.__file__).parent
+    for name in ("__init__.py", "_lazy.py"):
+        (checkout / name).write_bytes((package / name).read_bytes())
+    path = [str(checkout.parent)]
+    if installed:
+        site = tmp_path / "site"
+        (site / "pftrack").mkdir(parents=True)
+        (site / "pftrack" / "__init__.py").write_text("")
+        info = site / "pftrack-0.1.0.dist-info"
+        info.mkdir()
+        (info / "METADATA").write_text("Metadata-Version: 2.1\nName: pftrack\nVersion: 0.1.0\n")
+        path.append(str(site))
+    run = subprocess.run([sys.executable, "-S", "-c", "import pftrack"], capture_output=True,
+                         text=True, env={"PYTHONPATH": os.pathsep.join(path)}, cwd=tmp_path,
+                         check=False)  # fmt: skip
+    assert run.returncode == 1
+    return run.stderr.strip().splitlines()[-1]
+
+
+def test_a_source_checkout_shadowing_the_installed_package_says_so(tmp_path: Path) -> None:
+    """Was: "compiled core is not built: install with `pip install .`" though it was."""
+    checkout = tmp_path / "checkout" / "python" / "pftrack"
+    assert _import_without_core(tmp_path, installed=True) == (
+        f"ImportError: a source checkout at {checkout} is shadowing the installed pftrack "
+        f"0.1.0 ({tmp_path / 'site' / 'pftrack'}), and its compiled core (pftrack._core) is "
+        "not built: run from another folder (or take the checkout off PYTHONPATH)"
+    )
+
+
+def test_a_source_checkout_alone_says_to_build_it(tmp_path: Path) -> None:
+    assert _import_without_core(tmp_path, installed=False) == (
+        "ImportError: pftrack's compiled core (pftrack._core) is not built: install with "
+        "`pip install .` or, for development, `pip install --no-build-isolation -ve .`"
+    )
 
 
 def test_unknown_name_is_an_attribute_error() -> None:

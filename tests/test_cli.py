@@ -235,6 +235,32 @@ def test_experiment_gaps_one_sequence_writes_json(
     assert sum(sweep["median"]["best_at"].values()) == 2
 
 
+@pytest.mark.parametrize("size", [["768x576"], ["768", "576"], ["768X576"]])
+def test_experiment_gaps_takes_the_image_size_as_eval_does_or_as_wxh(
+    tmp_path: Path, size: list[str]
+) -> None:
+    """``pftrack eval --image-size W H``; ``experiment gaps`` took only ``WxH``."""
+    import json
+
+    gt, out = _walkers(tmp_path / "gt.txt"), tmp_path / "e.json"
+    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", *size, "--methods", "linear",
+            "--repeat", "1", "--max-positions", "1", "--json", str(out)]  # fmt: skip
+    assert main(["-q", *argv]) == 0
+    assert json.loads(out.read_text())["image_size"] == [768, 576]
+
+
+@pytest.mark.parametrize("size", [["768"], ["768", "576", "1"], ["768x", "576"]])
+def test_experiment_gaps_refuses_an_image_size_of_neither_form(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], size: list[str]
+) -> None:
+    argv = ["experiment", "gaps", "--gt", str(tmp_path / "none.txt"), "--image-size", *size]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"pftrack experiment: error: --image-size is {' '.join(size)!r}, expected W H or WxH"
+    )
+
+
 def _walkers(path: Path) -> Path:
     """Ground truth of 15 random walkers over 150 frames of a 768x576 scene."""
     rng = np.random.default_rng(4)

@@ -690,3 +690,24 @@ def test_rows_written_to_stdout_carry_no_report(tmp_path: Path) -> None:
         else:
             read_mot(out)  # rows only: reads back
             assert str(src) in done.stderr or name == "track"
+
+
+def test_names_the_terminal_cannot_encode_are_escaped(
+    inputs: dict[str, Path], tmp_path: Path
+) -> None:
+    """``PYTHONIOENCODING=ascii pftrack recover tö.txt --out rö.txt``: was exit status 2 ("'ascii'
+    codec can't encode character") after writing its output; a name's bytes that are not UTF-8
+    are still written as they are (as ``ls`` does)."""
+    import subprocess
+    import sys
+
+    (tmp_path / "tö.txt").write_bytes(inputs["tracks"].read_bytes())
+    latin1 = os.fsdecode(b"r\xfe.txt")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path), "PYTHONIOENCODING": "ascii"}
+    for out, shown in (("rö.txt", b"-> r\\xf6.txt"), (latin1, b"-> r\xfe.txt")):
+        run = subprocess.run([sys.executable, "-m", "pftrack", "recover", "tö.txt", "--out", out],
+                             cwd=tmp_path, capture_output=True, env=env, check=False,
+                             timeout=120)  # fmt: skip
+        assert run.returncode == 0 and run.stderr == b"", run.stderr
+        assert shown in run.stdout and b"t\\xf6.txt" in run.stdout
+        assert (tmp_path / out).stat().st_size > 0

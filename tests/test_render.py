@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import ast
+import os
+import subprocess
+import sys
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -9,6 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from pftrack.io.opencv_io import text_for_opencv
 from pftrack.render import TrackRenderer, colour_of, plot_trajectories, write_annotated_video
 from tests.io.decode import decode
 
@@ -142,3 +148,55 @@ def test_a_plot_without_background_has_axes_in_image_coordinates(tmp_path: Path)
     bg = np.full((120, 200, 3), 80, np.uint8)
     framed = cv2.imread(str(plot_trajectories(tmp_path / "b.png", _ROWS, background=bg)))
     assert framed.shape == (120, 200, 3)
+
+
+def test_text_for_opencv_is_printable_ascii() -> None:
+    assert text_for_opencv("frame 12") == "frame 12"
+    assert text_for_opencv(os.fsdecode(b"v\xe9deo.mp4")) == "v\\xe9deo.mp4"  # not UTF-8
+    assert text_for_opencv("vid\udcc3\udca9o") == "video"  # UTF-8 bytes, escaped (C locale)
+    assert text_for_opencv("vidéo 東京\n\t\x00\ud800") == "video ?????\\ud800"
+    assert all(" " <= c <= "~" for c in text_for_opencv("".join(map(chr, range(0x3000)))))
+
+
+def test_a_title_that_is_not_utf8_is_drawn(tmp_path: Path) -> None:
+    """Was: a segmentation fault in ``cv2.putText`` (``pftrack track --plot`` on a Latin-1 file
+    name); run in a subprocess, where a crash is an exit status, not the end of the tests."""
+    code = textwrap.dedent(
+        """
+        import os, sys
+        import numpy as np
+        from pftrack.render import draw_tracks, plot_trajectories
+        rows = np.array([[k, 3, 10 + 2 * k, 10, 8, 16, 1, -1, -1, -1] for k in (1, 2)], float)
+        name = os.fsdecode(b"v\\xe9deo.mp4")
+        plot_trajectories(sys.argv[1], rows, size=(64, 48), title=name)
+        draw_tracks(np.zeros((48, 64, 3), np.uint8), rows[:1], label=name)
+        """
+    )
+    out = tmp_path / "p.png"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    run = subprocess.run([sys.executable, "-c", code, str(out)], env=env, capture_output=True,
+                         timeout=60, check=False)  # fmt: skip
+    assert run.returncode == 0, (run.returncode, run.stderr)
+    assert out.stat().st_size > 0
+
+
+def test_every_text_the_package_draws_goes_through_text_for_opencv() -> None:
+    """``cv2.putText`` crashes on some ``str`` (:func:`text_for_opencv`): none reaches it raw."""
+    package = Path(__file__).resolve().parents[1] / "python" / "pftrack"
+    raw, calls = [], 0
+    for path in sorted(package.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (
+                isinstance(node, ast.Call)
+                and isinstance(node.func, ast.Attribute)
+                and (node.func.attr == "putText")
+            ):
+                calls += 1
+                text = node.args[1] if len(node.args) > 1 else None
+                if not (
+                    isinstance(text, ast.Call)
+                    and isinstance(text.func, ast.Name)
+                    and text.func.id == "text_for_opencv"
+                ):
+                    raw.append(f"{path.relative_to(package)}:{node.lineno}")
+    assert calls >= 4 and raw == []

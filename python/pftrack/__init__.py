@@ -13,7 +13,8 @@ The public API, importable from the top level; each name loads its module on fir
   :class:`SequenceInfo`, :class:`VideoWriter` (H.264 MP4);
 - pictures: :class:`TrackRenderer` (annotated video while tracking),
   :func:`write_annotated_video`, :func:`plot_trajectories`;
-- evaluation: :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
+- evaluation: :func:`evaluate_sequence` (HOTA and CLEAR-MOT/IDF1), :func:`evaluate_hota`,
+  :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
 - kernels: :class:`ColourParticleFilter`, :func:`systematic_resample`, :func:`hsv_bins`,
   :func:`box_histograms`, :func:`bhattacharyya_weights`;
 - :func:`make_scene`, a synthetic scene with known truth.
@@ -29,13 +30,40 @@ from typing import TYPE_CHECKING
 
 from pftrack._lazy import lazy_exports
 
-if importlib.util.find_spec("pftrack._core") is None:  # pragma: no cover - only without a build
-    # found, not imported: loading it (and NumPy) waits for the first name that needs it,
-    # so `pftrack --help` stays fast
-    raise ImportError(
+
+def _no_core_message() -> str:
+    """Why ``pftrack._core`` cannot be found: no build, or a source checkout before the install.
+
+    A source checkout (``python/pftrack`` on ``sys.path``: the current folder, ``PYTHONPATH``)
+    hides an installed pftrack whose core is built; building is then not the fix.
+    """
+    import importlib.metadata
+    import os
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    try:
+        dist = importlib.metadata.distribution("pftrack")
+        init = os.path.abspath(str(dist.locate_file("pftrack/__init__.py")))
+        version = dist.version
+    except (importlib.metadata.PackageNotFoundError, OSError, ValueError):
+        init, version = __file__, ""
+    installed = os.path.dirname(init)
+    if installed != here and os.path.isfile(init):  # not an editable install's redirect
+        return (
+            f"a source checkout at {here} is shadowing the installed pftrack {version} "
+            f"({installed}), and its compiled core (pftrack._core) is not built: run from "
+            "another folder (or take the checkout off PYTHONPATH)"
+        )
+    return (
         "pftrack's compiled core (pftrack._core) is not built: install with `pip install .` "
         "or, for development, `pip install --no-build-isolation -ve .`"
     )
+
+
+# found, not imported: loading it (and NumPy) waits for the first name that needs it, so
+# `pftrack --help` stays fast
+if importlib.util.find_spec("pftrack._core") is None:
+    raise ImportError(_no_core_message())
 
 if TYPE_CHECKING:
     # the subpackages and modules, for type checkers: at run time __getattr__ loads them
@@ -54,7 +82,13 @@ if TYPE_CHECKING:
     from pftrack import render as render
     from pftrack import synthetic as synthetic
     from pftrack import tracking as tracking
-    from pftrack.eval import MotMetrics, evaluate_mot, format_metrics
+    from pftrack.eval import (
+        MotMetrics,
+        evaluate_hota,
+        evaluate_mot,
+        evaluate_sequence,
+        format_metrics,
+    )
     from pftrack.io.mot import read_mot, write_mot
     from pftrack.io.video import FrameSource, SequenceInfo, read_seqinfo
     from pftrack.io.video_writer import VideoWriter
@@ -113,7 +147,13 @@ _HOME = {
     "pftrack.io.video": ("FrameSource", "SequenceInfo", "read_seqinfo"),
     "pftrack.io.video_writer": ("VideoWriter",),
     "pftrack.render": ("TrackRenderer", "plot_trajectories", "write_annotated_video"),
-    "pftrack.eval": ("MotMetrics", "evaluate_mot", "format_metrics"),
+    "pftrack.eval": (
+        "MotMetrics",
+        "evaluate_hota",
+        "evaluate_mot",
+        "evaluate_sequence",
+        "format_metrics",
+    ),
     "pftrack.particle_filter": (
         "ColourParticleFilter",
         "bhattacharyya_weights",
@@ -141,7 +181,9 @@ __all__ = [
     "VideoWriter",
     "bhattacharyya_weights",
     "box_histograms",
+    "evaluate_hota",
     "evaluate_mot",
+    "evaluate_sequence",
     "fill_gaps",
     "format_metrics",
     "goal_directed_path",

@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import bgr_frame, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.io.mot import group_by_frame
-from pftrack.io.opencv_io import write_image
+from pftrack.io.opencv_io import text_for_opencv, write_image
 from pftrack.io.video_writer import VideoWriter
 
 __all__ = [
@@ -69,13 +69,13 @@ def draw_tracks(
         c = colour_of(tid)
         cv2.rectangle(out, (x, y), (x + w, y + h), c, k * (1 if len(r) > 7 and r[7] == 1 else 2))
         cv2.putText(
-            out, str(tid), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, c, k,
-            cv2.LINE_AA,
+            out, text_for_opencv(str(tid)), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX,
+            0.4 * k, c, k, cv2.LINE_AA,
         )  # fmt: skip
     if label:
         cv2.putText(
-            out, label, (5 * k, 15 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k, (255, 255, 255), k,
-            cv2.LINE_AA,
+            out, text_for_opencv(label), (5 * k, 15 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k,
+            (255, 255, 255), k, cv2.LINE_AA,
         )  # fmt: skip
     return out
 
@@ -433,7 +433,7 @@ def plot_trajectories(
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
         cv2.putText(
             canvas,
-            str(tid),
+            text_for_opencv(str(tid)),
             tuple(int(v) for v in pts[0]),
             cv2.FONT_HERSHEY_SIMPLEX,
             0.4,
@@ -445,6 +445,7 @@ def plot_trajectories(
         canvas = _with_axes(canvas, title)
     elif title:
         cv2.putText(
-            canvas, title, (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA
-        )
+            canvas, text_for_opencv(title), (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
+            (255, 255, 255), 1, cv2.LINE_AA,
+        )  # fmt: skip
     return write_image(path, canvas)  # any name (pftrack.io.opencv_io)

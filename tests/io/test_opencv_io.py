@@ -17,7 +17,14 @@ import cv2
 import numpy as np
 import pytest
 
-from pftrack.io.opencv_io import is_utf8, opencv_name, printable, read_image, write_image
+from pftrack.io.opencv_io import (
+    is_utf8,
+    opencv_name,
+    printable,
+    read_image,
+    utf8_name,
+    write_image,
+)
 from pftrack.io.video import FrameSource
 from pftrack.io.video_writer import VideoWriter
 from pftrack.synthetic import make_scene
@@ -100,7 +107,7 @@ def test_track_reads_and_writes_names_that_are_not_utf8(tmp_path: Path) -> None:
     plot, render, out = (_latin1(tmp_path, n) for n in (b"p\xfe.png", b"r\xfe.avi", b"d\xfe.txt"))
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path), "PYTHONIOENCODING": "utf-8"}
     runs = {
-        "video": [bad_video, "--out", "a.txt"],
+        "video, its name the plot's title": [bad_video, "--out", "a.txt", "--plot", "a.png"],
         "image folder": [bad_folder, "--out", "b.txt"],
         "plot and render": [video, "--out", "c.txt", "--plot", plot, "--render", render],
         "summary on a strict stdout": [video, "--out", out],
@@ -111,10 +118,86 @@ def test_track_reads_and_writes_names_that_are_not_utf8(tmp_path: Path) -> None:
                              check=False)  # fmt: skip
         assert run.returncode == 0, (case, run.returncode, run.stderr)
     assert all(p.stat().st_size > 0 for p in (plot, render, out))
-    assert {"a.txt", "b.txt", "c.txt"} <= set(os.listdir(tmp_path))
+    assert {"a.txt", "a.png", "b.txt", "c.txt"} <= set(os.listdir(tmp_path))
     assert not [n for n in os.listdir(tmp_path) if n.startswith(".")]  # no temporary file
 
 
 def test_a_stream_url_that_is_not_utf8_is_refused() -> None:
     with pytest.raises(ValueError, match=r"stream URL rtsp://host/\\xfe is not valid UTF-8"):
         FrameSource(os.fsdecode(b"rtsp://host/\xfe"))
+
+
+def _escaped(path: Path) -> str:
+    """`path` as Python spells it under ``LC_ALL=C``: its UTF-8 bytes as surrogate escapes.
+
+    As in the child of the subprocess test below, which makes its names itself.
+    """
+    return os.fsencode(path).decode("ascii", "surrogateescape")
+
+
+def test_opencv_gets_the_utf8_text_of_a_name_spelt_with_surrogate_escapes(tmp_path: Path) -> None:
+    good = tmp_path / "vidé o.avi"
+    assert _escaped(good) != str(good) and is_utf8(_escaped(good))
+    assert utf8_name(_escaped(good)) == str(good)
+    with opencv_name(_escaped(good)) as name:
+        assert name == str(good)
+    with pytest.raises(ValueError, match=r"not valid UTF-8"):
+        utf8_name(os.fsdecode(b"vid\xfe.avi"))
+    with pytest.raises(ValueError, match=r"cannot write image .*\(format '\.p\\udcfeng'\)"):
+        write_image(os.fsdecode(b"p.p\xfeng"), np.zeros((4, 4, 3), np.uint8))  # was: a crash
+
+
+def test_files_named_with_surrogate_escapes_of_utf8_are_read_and_written(tmp_path: Path) -> None:
+    """Was: a segmentation fault in ``cv2.VideoCapture``, ``cv2.imread`` (under ``LC_ALL=C``,
+    ``pftrack track "vidé o.avi"`` gets ``"vid\\udcc3\\udca9 o.avi"``); run in a subprocess,
+    where a crash is an exit status, not the end of the tests."""
+    scene = make_scene(n_frames=4, rng=0)
+    scene.write_video(tmp_path / "vidé o.avi")
+    scene.write_images(tmp_path / "imgé")
+    code = (  # the names made in the child: an argument reaches it decoded anew
+        "import os, sys\n"
+        "from pftrack.io.opencv_io import read_image, write_image\n"
+        "from pftrack.io.video import FrameSource\n"
+        "from pftrack.io.video_writer import VideoWriter\n"
+        "def escaped(name):\n"
+        "    path = os.fsencode(os.path.join(sys.argv[1], name))\n"
+        "    return path.decode('ascii', 'surrogateescape')\n"
+        "video, folder, image, out, written = map(escaped, sys.argv[2:])\n"
+        "assert '\\udcc3\\udca9' in video\n"
+        "frames = list(FrameSource(video))\n"
+        "assert len(frames) == 4 and len(list(FrameSource(folder))) == 4\n"
+        "assert read_image(image) is not None\n"
+        "write_image(written, frames[0])\n"
+        "with VideoWriter(out, 10.0, backend='opencv') as writer:\n"
+        "    writer.write(frames[0])\n"
+    )
+    names = ["vidé o.avi", "imgé", "imgé/000001.png", "outé.avi", "writtené.png"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    run = subprocess.run(
+        [sys.executable, "-c", code, str(tmp_path), *names],
+        env=env,
+        capture_output=True,
+        timeout=60,
+        check=False,
+    )
+    assert run.returncode == 0, (run.returncode, run.stderr)
+    assert (tmp_path / "outé.avi").stat().st_size > 0
+    assert (tmp_path / "writtené.png").stat().st_size > 0
+
+
+def test_track_under_the_c_locale_reads_a_utf8_name(tmp_path: Path) -> None:
+    """Was: exit status 139 for ``LC_ALL=C pftrack track "vidé o.avi" --out t.txt``."""
+    make_scene(n_frames=6, rng=0).write_video(tmp_path / "vidé o.avi")
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(sys.path),
+        "LC_ALL": "C",
+        "PYTHONUTF8": "0",
+        "PYTHONCOERCECLOCALE": "0",
+    }
+    env.pop("PYTHONIOENCODING", None)
+    argv = [sys.executable, "-m", "pftrack", "-q", "track", "vidé o.avi".encode(), "--out", "t.txt"]
+    run = subprocess.run(argv, cwd=tmp_path, env=env, capture_output=True, timeout=120,
+                         check=False)  # fmt: skip
+    assert run.returncode == 0, (run.returncode, run.stderr)
+    assert (tmp_path / "t.txt").stat().st_size > 0

@@ -8,6 +8,7 @@ imported only when a command runs.
 from __future__ import annotations
 
 import argparse
+import codecs
 import contextlib
 import os
 import sys
@@ -114,22 +115,45 @@ def _one_line_warning(command: str) -> Callable[..., None]:
 QUIET_OPENCV = {"OPENCV_LOG_LEVEL": "SILENT", "OPENCV_FFMPEG_LOGLEVEL": "-8"}  # -8: AV_LOG_QUIET
 
 
+#: The error handler of stdout while a command runs (:func:`_names_on_stdout`).
+NAMES_ON_STDOUT = "pftrack.names"
+
+
+def _write_names(exc: UnicodeError) -> tuple[bytes, int]:
+    r"""Encode what stdout's encoding cannot: surrogate escapes as their bytes, else ``\xf6``."""
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    out = bytearray()
+    for c in exc.object[exc.start : exc.end]:
+        if "\udc80" <= c <= "\udcff":  # a byte of a file name that is not UTF-8
+            out.append(ord(c) - 0xDC00)
+        else:
+            out += c.encode("ascii", "backslashreplace")
+    return bytes(out), exc.end
+
+
+codecs.register_error(NAMES_ON_STDOUT, _write_names)
+
+
 @contextlib.contextmanager
 def _names_on_stdout() -> Iterator[None]:
-    r"""While a command runs, stdout writes a file name's bytes that are not UTF-8 as they are.
+    r"""While a command runs, stdout writes any file name, whatever its encoding.
 
-    Python keeps them as surrogate escapes, which a UTF-8 stdout refuses (``errors="strict"``
-    outside the C locale): ``track ... --out $'x\xfe.txt'`` failed on its summary line, after
-    writing its outputs. ``ls`` and the shell print the bytes; so does pftrack.
+    A name's bytes that are not UTF-8, which Python keeps as surrogate escapes, are written as
+    they are: a UTF-8 stdout refuses them (``errors="strict"`` outside the C locale), and
+    ``track ... --out $'x\xfe.txt'`` failed on its summary line, after writing its outputs;
+    ``ls`` and the shell print the bytes, and so does pftrack. A character that stdout's
+    encoding has not (``PYTHONIOENCODING=ascii``: ``rö.txt``) is written as a ``\xf6`` escape:
+    ``recover tö.txt --out rö.txt`` failed likewise (exit status 2).
     """
     stream = sys.stdout
     reconfigure = getattr(stream, "reconfigure", None)
     errors = getattr(stream, "errors", None)
-    if reconfigure is None or errors is None or errors == "surrogateescape":
+    if reconfigure is None or errors not in ("strict", "surrogateescape"):
         yield
         return
     try:
-        reconfigure(errors="surrogateescape")
+        reconfigure(errors=NAMES_ON_STDOUT)
     except (AttributeError, OSError, ValueError):  # a stream that cannot change
         yield
         return

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
 
@@ -77,10 +78,11 @@ def add_parser(sub: Any) -> None:
     g.add_argument("--grid", type=bounded_float(0.1, MAX_SIDE), default=None, metavar="PX",
                    help=f"one sequence: mask position step of the sweep (px, 0.1 to "
                    f"{MAX_SIDE:g}; default: {DEFAULTS['grid']:g})")  # fmt: skip
-    g.add_argument("--image-size", metavar="WxH",
-                   help="image size of the ground-truth coordinates (default: the ground "
-                   "truth's extent; multi-sequence: used only for sequences without "
-                   "seqinfo.ini, which need it)")  # fmt: skip
+    g.add_argument("--image-size", nargs="+", metavar=("W", "H"),
+                   help="image size of the ground-truth coordinates, W H (as pftrack eval "
+                   "takes it) or WxH (px, each in (0, 100000]) (default: the ground truth's "
+                   "extent; multi-sequence: used only for sequences without seqinfo.ini, "
+                   "which need it)")  # fmt: skip
     g.add_argument("--trajectories", type=non_negative_int, metavar="N",
                    help="one sequence: keep positions with exactly this many (default: any "
                    "number)")  # fmt: skip
@@ -120,12 +122,15 @@ def _parse_mask(text: str) -> tuple[float, float, float, float]:
     return vals[0], vals[1], vals[2], vals[3]
 
 
-def _parse_size(text: str) -> tuple[float, float]:
+def _parse_size(values: Sequence[str]) -> tuple[float, float]:
+    """``--image-size``: ``W H`` (two words, as ``pftrack eval`` takes it) or ``WxH`` (one)."""
+    text = " ".join(values)
+    parts = values[0].lower().split("x") if len(values) == 1 else list(values)
     try:
-        w_s, h_s = text.lower().split("x")
+        w_s, h_s = parts
         w, h = float(w_s), float(h_s)
     except ValueError:
-        raise ValueError(f"--image-size is {text!r}, expected WxH") from None
+        raise ValueError(f"--image-size is {text!r}, expected W H or WxH") from None
     if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
         raise ValueError(f"--image-size is {text!r}, expected W and H in (0, {MAX_SIDE:g}] px")
     return w, h

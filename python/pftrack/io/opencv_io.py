@@ -11,9 +11,15 @@ pftrack never hands OpenCV such a name:
 - videos are opened through a symbolic link with an ASCII name in the system's temporary
   folder (:func:`opencv_name`), removed as soon as OpenCV has opened the file: OpenCV keeps
   its own handle;
-- a stream URL that is not valid UTF-8 is refused (:func:`utf8_name`).
+- a stream URL that is not valid UTF-8 is refused (:func:`utf8_name`);
+- text drawn with ``cv2.putText`` (a plot's title: the video's file name) is made printable
+  ASCII first (:func:`text_for_opencv`).
 
-A name that is valid UTF-8, which is almost every name, goes to OpenCV as it is.
+A name that is valid UTF-8, which is almost every name, goes to OpenCV as the text its bytes
+spell in UTF-8 (:func:`utf8_name`), which is not always the ``str`` Python made of them: under a
+locale that is not UTF-8 (``LC_ALL=C``), ``"vidé.avi"`` on the command line is
+``"vid\udcc3\udca9.avi"`` (its UTF-8 bytes as surrogate escapes), and that ``str`` crashes
+OpenCV too.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ import contextlib
 import os
 import shutil
 import tempfile
+import unicodedata
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -33,7 +40,15 @@ from numpy.typing import NDArray
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_write
 
-__all__ = ["is_utf8", "opencv_name", "printable", "read_image", "utf8_name", "write_image"]
+__all__ = [
+    "is_utf8",
+    "opencv_name",
+    "printable",
+    "read_image",
+    "text_for_opencv",
+    "utf8_name",
+    "write_image",
+]
 
 
 def is_utf8(path: PathLike) -> bool:
@@ -51,22 +66,54 @@ def printable(path: PathLike) -> str:
 
 
 def utf8_name(path: PathLike, what: str = "path") -> str:
-    """`path` as a ``str`` OpenCV can take; ValueError if it is not valid UTF-8."""
-    if not is_utf8(path):
+    """`path` as the ``str`` OpenCV's binding takes: the UTF-8 text of its bytes.
+
+    Not ``os.fsdecode(path)``: under a locale that is not UTF-8, Python keeps the bytes of
+    ``"vidé"`` as surrogate escapes, a ``str`` that crashes OpenCV; its bytes are UTF-8 all
+    the same, and their text names the same file.
+
+    Raises
+    ------
+    ValueError
+        The bytes of `path` are not valid UTF-8.
+    """
+    try:
+        return os.fsencode(os.fspath(path)).decode("utf-8")
+    except UnicodeDecodeError:
         raise ValueError(
             f"{what} {printable(path)} is not valid UTF-8, which OpenCV's binding cannot take"
-        )
-    return os.fsdecode(os.fspath(path))
+        ) from None
+
+
+def text_for_opencv(text: str) -> str:
+    r"""`text` as printable ASCII, all that ``cv2.putText`` can draw: give it nothing else.
+
+    ``cv2.putText`` crashes the process (a segmentation fault, OpenCV 5.0) on a ``str`` that
+    cannot be encoded as UTF-8, such as a file name whose bytes are not UTF-8 (Python keeps
+    them as surrogate escapes: ``os.fsdecode(b"v\xe9deo.mp4")``). Such bytes are shown as
+    ``\xe9`` escapes (as in messages: :func:`printable`), accents are
+    dropped (``"vidé"``: ``"vide"``), and any other character that is not printable ASCII is
+    drawn as ``?`` (as the font would draw it).
+    """
+    try:  # surrogate escapes back to the bytes they stand for
+        raw = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:  # a lone surrogate that escapes no byte
+        raw = text.encode("utf-8", "backslashreplace")
+    folded = unicodedata.normalize("NFKD", raw.decode("utf-8", "backslashreplace"))
+    return "".join(
+        c if " " <= c <= "~" else "" if unicodedata.combining(c) else "?" for c in folded
+    )
 
 
 @contextlib.contextmanager
 def opencv_name(path: PathLike) -> Iterator[str]:
     """A name OpenCV can open for file `path`, valid while the block runs.
 
-    `path` itself when it is valid UTF-8; else a symbolic link to it with an ASCII name (and
-    `path`'s extension, when that is ASCII) in a new folder of the system's temporary folder,
-    removed with its folder when the block ends. Open the file (``cv2.VideoCapture``,
-    ``cv2.VideoWriter``) inside the block: OpenCV keeps its own handle afterwards.
+    `path` itself when it is valid UTF-8 (its text, :func:`utf8_name`); else a symbolic link to
+    it with an ASCII name (and `path`'s extension, when that is ASCII) in a new folder of the
+    system's temporary folder, removed with its folder when the block ends. Open the file
+    (``cv2.VideoCapture``, ``cv2.VideoWriter``) inside the block: OpenCV keeps its own handle
+    afterwards.
 
     Raises
     ------
@@ -75,15 +122,15 @@ def opencv_name(path: PathLike) -> Iterator[str]:
     """
     text = os.fsdecode(os.fspath(path))
     if is_utf8(text):
-        yield text
+        yield utf8_name(text)
         return
     scratch = tempfile.mkdtemp(prefix="pftrack-")
     try:
         suffix = Path(text).suffix
         link = os.path.join(scratch, "file" + (suffix if suffix.isascii() else ""))
-        utf8_name(link, "temporary folder")
+        name = utf8_name(link, "temporary folder")
         os.symlink(os.path.abspath(text), link)
-        yield link
+        yield name
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
 
@@ -91,7 +138,7 @@ def opencv_name(path: PathLike) -> Iterator[str]:
 def read_image(path: PathLike, flags: int = cv2.IMREAD_COLOR) -> NDArray[np.uint8] | None:
     """The image at `path` as ``cv2.imread`` reads it (any name); None if it cannot be read."""
     if is_utf8(path):
-        image: Any = cv2.imread(os.fsdecode(os.fspath(path)), flags)
+        image: Any = cv2.imread(utf8_name(path), flags)
         return None if image is None else np.asarray(image, dtype=np.uint8)
     try:
         data = np.fromfile(os.fspath(path), dtype=np.uint8)
@@ -126,8 +173,8 @@ def write_image(
         OpenCV has no encoder for the format, or cannot encode `image` in it.
     """
     suffix = Path(path).suffix if ext is None else ext
-    try:
-        ok, buf = cv2.imencode(suffix, image, list(params))
+    try:  # no format's name is not ASCII ("."), and a surrogate escape would crash OpenCV
+        ok, buf = cv2.imencode(suffix if suffix.isascii() else ".", image, list(params))
     except cv2.error:
         ok = False
     if not ok:

@@ -367,6 +367,8 @@ def draw_figure(
     """
     import cv2
 
+    from pftrack.io.opencv_io import text_for_opencv
+
     w, h = size
     s_full = height / float(h)
     left = _draw_panel(
@@ -383,7 +385,7 @@ def draw_figure(
     for k, m in enumerate(methods):
         cv2.putText(
             img,
-            m,
+            text_for_opencv(m),
             (8, 18 + 18 * k),
             cv2.FONT_HERSHEY_SIMPLEX,
             0.5,
@@ -393,7 +395,7 @@ def draw_figure(
         )
     cv2.putText(
         img,
-        "ground truth (dots: lost points)",
+        text_for_opencv("ground truth (dots: lost points)"),
         (8, 18 + 18 * len(methods)),
         cv2.FONT_HERSHEY_SIMPLEX,
         0.5,
