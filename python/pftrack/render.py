@@ -331,14 +331,16 @@ def _with_axes(canvas: NDArray[np.uint8], title: str) -> NDArray[np.uint8]:
         cv2.line(out, (left + x, top + h), (left + x, top + h + 4), grey, 1)
         tw, th = size(str(x))
         org = (left + x - tw // 2, top + h + 6 + th)
-        cv2.putText(out, str(x), org, font, scale, grey, ink, cv2.LINE_AA)
+        cv2.putText(out, text_for_opencv(str(x)), org, font, scale, grey, ink, cv2.LINE_AA)
     for y in ys:
         cv2.line(out, (left - 5, top + y), (left - 1, top + y), grey, 1)
         tw, th = size(str(y))
         org = (left - 7 - tw, top + y + th // 2)
-        cv2.putText(out, str(y), org, font, scale, grey, ink, cv2.LINE_AA)
+        cv2.putText(out, text_for_opencv(str(y)), org, font, scale, grey, ink, cv2.LINE_AA)
     if title:
-        cv2.putText(out, title, (left, 16), font, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+        cv2.putText(
+            out, text_for_opencv(title), (left, 16), font, 0.45, (255, 255, 255), 1, cv2.LINE_AA
+        )
     return out
 
 
