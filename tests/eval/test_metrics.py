@@ -170,6 +170,24 @@ def test_bad_input():
         evaluate_mot(HAND_GT, HAND_RES, image_size=(0, 10))
 
 
+def test_rows_read_mot_refuses_are_refused_by_the_array_api_too():
+    # negative sizes scored MOTA -1 and frames from 0 scored 0.955, silently (the CLI refused)
+    from pftrack.eval import evaluate_hota, evaluate_sequence
+
+    flipped = HAND_RES.copy()
+    flipped[2, 4] *= -1
+    early = HAND_RES - [1, 0, 0, 0, 0, 0, 0, 0, 0, 0]
+    for fn in (evaluate_mot, evaluate_hota, evaluate_sequence):
+        with pytest.raises(ValueError, match="result row 2 has a negative box width or height"):
+            fn(HAND_GT, flipped)
+        with pytest.raises(ValueError, match=r"frame 0, expected >= 1 \(frames count from 1\)"):
+            fn(HAND_GT, early)
+        with pytest.raises(
+            ValueError, match="gt row 0 has a negative box|ground truth row 0 has a negative box"
+        ):
+            fn(flipped[2:], HAND_RES)
+
+
 def test_fractional_ids_and_frames_are_refused_not_truncated(tmp_path, capsys):
     """Ids 1.5 and 1.7 were cast to 1: 'result has id 1 more than once in frame 1'."""
     from pftrack.eval import evaluate_hota

@@ -44,7 +44,8 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
 
     Real numbers, ``(M, 6..10)``, the first 6 columns finite, frames and ids integers within
     ``MAX_FRAME`` (they are cast to int: an id 1.5 is refused, not scored as 1, the test
-    ``pftrack recover`` makes); missing columns padded. Shared by
+    ``pftrack recover`` makes), frames from 1 and no negative width or height (as
+    :func:`~pftrack.io.mot.read_mot` refuses them); missing columns padded. Shared by
     :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`.
     """
     a = real_array(rows, what)
@@ -62,6 +63,18 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     if frac.any():  # cast to int, 1.5 would be scored as frame 1
         k = int(np.flatnonzero(frac)[0])
         raise ValueError(f"{what} row {k} has frame {a[k, 0]:g}, expected an integer")
+    early = a[:, 0] < 1
+    if early.any():  # as read_mot refuses it: MOTChallenge frames count from 1
+        k = int(np.flatnonzero(early)[0])
+        raise ValueError(
+            f"{what} row {k} has frame {a[k, 0]:g}, expected >= 1 (frames count from 1)"
+        )
+    negative = (a[:, 4] < 0) | (a[:, 5] < 0)
+    if negative.any():  # as read_mot refuses it: such a box overlaps nothing, silently
+        k = int(np.flatnonzero(negative)[0])
+        raise ValueError(
+            f"{what} row {k} has a negative box width or height ({a[k, 4]:g} x {a[k, 5]:g})"
+        )
     k_id = first_bad_id(a[:, 1])
     if k_id is not None:  # cast to int, 1.5 and 1.7 would be one id: refused as recover does
         raise ValueError(f"{what} row {k_id}: {bad_id_message(a[k_id, 1])}")
