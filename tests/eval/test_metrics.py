@@ -170,6 +170,15 @@ def test_bad_input():
         evaluate_mot(HAND_GT, HAND_RES, image_size=(0, 10))
 
 
+def test_a_detections_file_scored_as_tracks_is_named():
+    det = HAND_RES.copy()
+    det[:, 1] = -1
+    with pytest.raises(
+        ValueError, match="id -1 more than once in frame 1: is it a detections file"
+    ):
+        evaluate_mot(HAND_GT, det)
+
+
 def test_rows_read_mot_refuses_are_refused_by_the_array_api_too():
     # negative sizes scored MOTA -1 and frames from 0 scored 0.955, silently (the CLI refused)
     from pftrack.eval import evaluate_hota, evaluate_sequence

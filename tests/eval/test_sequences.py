@@ -159,12 +159,39 @@ def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     write_mot(res_root / "B.txt", cases["B"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
     assert "B: result has frame" in error()  # beyond seqLength
     assert main(["eval", "--gt", str(tmp_path / "nothing"), "--res", str(res_root)]) == 2
-    assert "ground-truth folder not found" in capsys.readouterr().err
+    assert "ground truth not found: " in capsys.readouterr().err
+    assert main(["eval", "--gt", str(tmp_path / "nope.txt"), "--res", str(res_root)]) == 2
+    assert "ground truth not found: " in capsys.readouterr().err  # was "ground-truth folder"
     (tmp_path / "empty").mkdir()
     assert main(["eval", "--gt", str(tmp_path / "empty"), "--res", str(res_root)]) == 2
     assert "no sequence in" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main([*argv, "--scale", "A=-1"])
+    with pytest.raises(SystemExit):  # was taken as a scale for every sequence
+        main([*argv, "--scale", "=0.5"])
+    assert "NAME is empty" in capsys.readouterr().err
+
+
+def test_one_file_reads_the_seqinfo_of_its_sequence_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """SEQ/gt/gt.txt given alone scores as SEQ does: seqLength checked, image size read."""
+    cases = {"A": random_case(0)}
+    gt_root, res_root = make_layout(tmp_path, cases)
+    late = res_root / "late.txt"
+    write_mot(late, cases["A"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
+    for gt in (gt_root / "A", gt_root / "A" / "gt" / "gt.txt"):
+        assert main(["eval", "--gt", str(gt), "--res", str(late)]) == 2
+        assert "beyond the sequence's" in capsys.readouterr().err  # was scored from one file
+    out = tmp_path / "one.json"
+    argv = ["eval", "--gt", str(gt_root / "A" / "gt" / "gt.txt"), "--res", str(res_root / "A.txt")]
+    assert main([*argv, "--json", str(out)]) == 0
+    ratio = json.loads(out.read_text())["centroid_distance_ratio"]
+    assert ratio is not None and ratio > 0  # imWidth x imHeight from seqinfo.ini (was null)
+    loose = tmp_path / "loose"
+    loose.mkdir()
+    write_mot(loose / "gt.txt", cases["A"][0])  # no seqinfo.ini beside it: as before
+    assert main(["eval", "--gt", str(loose / "gt.txt"), "--res", str(late)]) == 0
 
 
 def test_seqinfo_with_a_byte_order_mark_is_read(

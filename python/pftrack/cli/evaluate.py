@@ -28,7 +28,9 @@ examples:
 
 def scale_spec(text: str) -> tuple[str | None, float]:
     """Argument type of ``--scale``: ``S`` (every sequence) or ``NAME=S`` (one sequence)."""
-    name, _, value = text.rpartition("=")
+    name, eq, value = text.rpartition("=")
+    if eq and not name.strip():
+        raise argparse.ArgumentTypeError(f"expected S or NAME=S, got {text!r}: NAME is empty")
     try:
         v = float(value)
     except ValueError:
@@ -65,7 +67,7 @@ def add_parser(sub: Any) -> None:
         "--scale", type=scale_spec, action="append", default=None, metavar="[NAME=]S",
         help="multiply ground-truth boxes by S, for every sequence or for sequence NAME "
         "(repeat the option for other sequences; twice for the same ones is refused); 0.625 "
-        "for PETS09 gt on its 480x360 video; None: 1 everywhere",
+        "for PETS09 gt on its 480x360 video (default: 1 everywhere)",
     )  # fmt: skip
     p.add_argument("--iou", type=iou_threshold, default=0.5, help=IOU_HELP)
     p.add_argument(
@@ -123,10 +125,12 @@ def _scales(specs: list[tuple[str | None, float]], names: list[str]) -> dict[str
 
 def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
     """(name, SequenceInfo, result file) of every sequence to score, checked before work."""
-    from pftrack.eval import SequenceInfo, find_sequences
-    from pftrack.eval.sequences import result_file
+    from pftrack.eval import find_sequences
+    from pftrack.eval.sequences import result_file, sequence_of_file
 
     gt, res = Path(args.gt), Path(args.res)
+    if not gt.exists():
+        raise FileNotFoundError(f"ground truth not found: {gt} (a MOTChallenge file or folder)")
     for what, given in (("--gt", gt), ("--res", res)):
         if given.exists() and not (given.is_file() or given.is_dir()):  # /dev/null: read twice
             raise ValueError(f"{what} {given} is not a regular file or a folder (a device or pipe)")
@@ -140,7 +144,7 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
             raise FileNotFoundError(f"result file not found: {res}")
         if args.seqs:
             raise ValueError("--seqs needs a ground-truth folder, not a file")
-        return [(res.stem, SequenceInfo(res.stem, gt), res)]
+        return [(res.stem, sequence_of_file(gt, res.stem), res)]
     seqs = find_sequences(gt)
     if args.seqs:
         known = {s.name for s in seqs}

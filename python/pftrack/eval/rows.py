@@ -98,10 +98,14 @@ def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
     for f, r in frames.items():
         ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
         if np.any(counts > 1):
-            raise ValueError(
-                f"{name} has id {int(ids[counts > 1][0])} more than once in frame {f} "
-                "(ids must be unique within a frame)"
+            twice = int(ids[counts > 1][0])
+            hint = (
+                ": is it a detections file (det.txt has id -1 on every row)? Score tracks, "
+                "with one id per object"
+                if twice == -1
+                else " (ids must be unique within a frame)"
             )
+            raise ValueError(f"{name} has id {twice} more than once in frame {f}{hint}")
 
 
 def mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:

@@ -111,6 +111,22 @@ def _sequence(folder: Path) -> SequenceInfo | None:
     )
 
 
+def sequence_of_file(gt_file: PathLike, name: str) -> SequenceInfo:
+    """A ground-truth file as sequence `name`, with the ``seqinfo.ini`` of its folder if any.
+
+    ``SEQ/gt/gt.txt`` and ``SEQ/gt.txt`` read ``SEQ/seqinfo.ini`` (length and image size), as
+    :func:`find_sequences` does for the folder, so that a sequence scores the same whether its
+    folder or its file is given; any other file has no length or size.
+    """
+    path = Path(gt_file)
+    parent = path.parent
+    for folder in (parent.parent, parent) if parent.name == "gt" else (parent,):
+        seq = _sequence(folder)
+        if seq is not None and seq.gt_path.resolve() == path.resolve():
+            return dataclasses.replace(seq, name=name)
+    return SequenceInfo(name, path)
+
+
 def find_sequences(root: PathLike) -> list[SequenceInfo]:
     """The sequences of a MOTChallenge ground-truth folder, by name.
 
