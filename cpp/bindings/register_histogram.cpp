@@ -55,8 +55,29 @@ BoxPath parse_method(const std::string& name, const char* fn) {
 void register_histogram(py::module_& m) {
     py::class_<BinnedImage, std::shared_ptr<BinnedImage>>(
         m, "BinnedImage", "A frame's colour-bin index per pixel (-1: never counted).")
-        .def(py::init([](const py::array& given, int n_bins) {
+        .def(py::init([](const py::object& bins_in, const py::object& n_in) {
                  const char* fn = "BinnedImage";
+                 // n_bins: any integer (not a bool), checked here rather than by pybind11's
+                 // conversion to int, whose refusal of 2**31 lists every signature instead
+                 if (py::isinstance<py::bool_>(n_in) || !PyIndex_Check(n_in.ptr()))
+                     throw py::type_error(std::string(fn) + ": n_bins must be an int, got " +
+                                          py::str(py::type::of(n_in).attr("__name__")).cast<std::string>());
+                 const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(n_in.ptr()));
+                 if (!index) throw py::error_already_set();
+                 int overflow = 0;
+                 const long long wide = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+                 if (overflow != 0 || wide < 1 || wide > 32767)
+                     throw py::value_error(std::string(fn) + ": n_bins is " +
+                                           py::str(index).cast<std::string>() +
+                                           ", expected an integer in [1, 32767]");
+                 const int n_bins = static_cast<int>(wide);
+                 // bins: an array, or what NumPy makes one of (a list of rows)
+                 const py::array given = py::array::ensure(bins_in);
+                 if (!given)
+                     throw py::value_error(std::string(fn) + ": bins must be an (H, W) array of "
+                                           "bin indices, got a " +
+                                           py::str(py::type::of(bins_in).attr("__name__")).cast<std::string>() +
+                                           " NumPy cannot make one of");
                  const char kind = given.dtype().kind();
                  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')
                      throw py::type_error(std::string(fn) + ": bins must hold bin indices "

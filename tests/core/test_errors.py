@@ -93,6 +93,25 @@ def test_binned_image_rejects_out_of_range_bins():
         _core.BinnedImage(np.array([[0, -2]], np.int16), 5)
 
 
+def test_binned_image_names_a_bad_n_bins_or_bins():
+    # were pybind11's "incompatible constructor arguments" and its list of signatures (2**31,
+    # a list), and n_bins=True taken as 1 bin
+    bins = np.zeros((2, 2), np.int16)
+    with pytest.raises(
+        ValueError, match=r"n_bins is 2147483648, expected an integer in \[1, 32767\]"
+    ):
+        _core.BinnedImage(bins, 2**31)
+    with pytest.raises(ValueError, match="n_bins is 10{30}, expected"):
+        _core.BinnedImage(bins, 10**30)
+    for bad, kind in ((True, "bool"), (2.0, "float"), ("3", "str")):
+        with pytest.raises(TypeError, match=f"BinnedImage: n_bins must be an int, got {kind}"):
+            _core.BinnedImage(bins, bad)
+    with pytest.raises(ValueError, match="bins must be an \\(H, W\\) array .* got a list"):
+        _core.BinnedImage([[0, 1], [1]], 3)
+    listed = _core.BinnedImage([[0, 1], [2, -1]], np.int64(3))  # a list, a NumPy integer
+    assert listed.n_bins == 3
+
+
 def test_likelihood_bad_inputs():
     h = np.full((2, 4), 0.25)
     with pytest.raises(ValueError, match="ref size is 3, expected 4"):
