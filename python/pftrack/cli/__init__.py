@@ -1,6 +1,6 @@
 """The ``pftrack`` command line: parses arguments and wires the library together.
 
-One module per sub-command (``demo``, ``track``, ``smooth``, ``eval``, ``recover``,
+One module per sub-command (``demo``, ``track``, ``render``, ``smooth``, ``eval``, ``recover``,
 ``experiment``), each with ``add_parser(sub)`` and a ``run(args) -> int``; the library is
 imported only when a command runs.
 """
@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import Any, NoReturn
 
 from pftrack import __version__
-from pftrack.cli import batch, demo, evaluate, experiment, recover, smooth, track
+from pftrack.cli import batch, demo, evaluate, experiment, recover, render, smooth, track
 from pftrack.cli._options import HelpFormatter
 from pftrack.cli._signals import (
     NOTHING_CHANGED,
@@ -41,6 +41,7 @@ examples:
   pftrack eval --gt gt.txt --res tracks.txt --scale 0.625
   pftrack recover tracks.txt --out filled.txt --link                # default method: auto
   pftrack smooth bytetrack.txt --out smoothed.txt                   # any tracker's output
+  pftrack render video.avi smoothed.txt --out smoothed.mp4          # any tracks file, drawn
 """
 
 
@@ -73,7 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"pftrack {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for command in (demo, track, batch, smooth, evaluate, recover, experiment):
+    for command in (demo, track, render, batch, smooth, evaluate, recover, experiment):
         command.add_parser(sub)
     return parser
 

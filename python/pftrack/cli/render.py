@@ -1,0 +1,157 @@
+"""``pftrack render``: any MOTChallenge tracks file drawn on its video, and its trajectory plot.
+
+``pftrack track --render`` draws the tracker's online boxes while it tracks; the file it writes
+is the offline pass's (linked ids, filled and smoothed boxes). This command draws a file as it
+is: ``pftrack track``'s, ``smooth``'s or ``recover``'s output, another tracker's, or the
+ground truth.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+from typing import Any
+
+from pftrack.cli._options import add_command, bounded_float, check_input_file, report_stream
+
+#: ``--fps`` range, as ``pftrack track``'s.
+FPS_RANGE = (0.1, 1000.0)
+#: ``--plot``'s formats; the first is a device's.
+PLOT_SUFFIXES = (".png", ".jpg", ".jpeg")
+#: A file whose boxes mostly lie outside the frame is in another frame's pixels: warned.
+OUTSIDE_SHARE = 0.5
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``render`` on `sub` (from ``add_subparsers``)."""
+    p = add_command(
+        sub,
+        "render",
+        help="draw a MOTChallenge tracks file on its video (any tracker's output, or truth)",
+        description="Draw the boxes, ids and trails of a MOTChallenge tracks file on the frames "
+        "of its video, image folder or sequence folder, and write an annotated video and, "
+        "with --plot, a trajectory plot on the first frame. Row frame k is drawn on the "
+        "video's k-th frame. pftrack track --render shows the boxes as tracked online; this "
+        "shows a file as it is: pftrack track's final tracks, the output of pftrack smooth "
+        "or recover (filled rows too), another tracker's, or the ground truth.",
+    )
+    p.add_argument("source", help="video file, image folder, or MOTChallenge sequence folder")
+    p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,...)")
+    p.add_argument(
+        "--out", required=True, metavar="VIDEO",
+        help=".mp4 (H.264, plays in browsers) or .avi (MJPG); a device or pipe without "
+        "extension (/dev/stdout): .mp4. Written atomically. An odd width or height gets one "
+        "copied column or row (4:2:0), as pftrack track --render",
+    )  # fmt: skip
+    p.add_argument(
+        "--scale", type=bounded_float(1e-3, 1e3), default=1.0, metavar="S",
+        help="multiply the file's boxes by S to reach the video's pixels (0.625 for PETS09 "
+        "ground truth, 768x576, on its 480x360 video)",
+    )  # fmt: skip
+    p.add_argument(
+        "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
+        help=f"frame rate of the video written, {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} (default: "
+        "seqinfo.ini's frameRate, else the container's header, else 25)",
+    )  # fmt: skip
+    p.add_argument(
+        "--trail",
+        type=int,
+        default=40,
+        metavar="FRAMES",
+        help="foot points of the last FRAMES frames drawn behind each track (0: none)",
+    )
+    p.add_argument("--plot", metavar="PNG",
+                   help="also write a trajectory plot on the first frame: .png, .jpg "
+                   "(default: none)")  # fmt: skip
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``pftrack render``; return the exit status."""
+    import numpy as np
+
+    from pftrack.cli._options import opencv_single_threaded
+    from pftrack.io.atomic import check_distinct, check_output, output_format, staged_outputs
+    from pftrack.io.video import FrameSource, check_source, is_live_source, source_files
+    from pftrack.io.video_writer import VIDEO_SUFFIXES
+    from pftrack.recovery.linking import read_tracks
+    from pftrack.render import plot_trajectories, write_annotated_video
+
+    if not 0 <= args.trail <= 100_000:
+        raise ValueError(f"--trail is {args.trail}, expected 0 to 100000 frames")
+    opencv_single_threaded()
+    check_source(args.source)
+    if is_live_source(args.source):
+        raise ValueError(f"{args.source} is a live source: render reads a video file or folder")
+    check_input_file(args.tracks, what="tracks file")
+    inputs = (*source_files(args.source), args.tracks)
+    check_output(args.out, what="--out", suffixes=VIDEO_SUFFIXES, inputs=inputs)
+    if args.plot:
+        check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
+    check_distinct({"--out": args.out, "--plot": args.plot})
+    rows = read_tracks(args.tracks)
+    rows[:, 2:6] *= args.scale
+    source = FrameSource(args.source, fps=args.fps)
+    n_frames = len(source)
+    out = report_stream(args.out, args.plot)
+    drawn = [0]
+
+    def counted() -> Any:
+        for frame in source:
+            drawn[0] += 1
+            yield frame
+
+    # what it has to say is printed once the outputs are written (a closed stdout or stderr
+    # then costs the messages, never the files), as pftrack track does
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with staged_outputs() as stage:  # both outputs replaced at the end, or neither
+            video = stage(args.out, output_format(args.out, VIDEO_SUFFIXES))
+            write_annotated_video(video, _progress(counted(), n_frames), rows, source.fps,
+                                  trail=args.trail)  # fmt: skip
+            if args.plot:
+                first = next(iter(FrameSource(args.source)))
+                plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))
+                plot_trajectories(plot, rows, background=first, title=source.name)
+    late = rows[rows[:, 0] > drawn[0]]
+    notes = [str(w.message) for w in caught] + _outside(rows, source.width, source.height)
+    if len(late):
+        notes.append(
+            f"{len(late)} rows of frames {int(late[:, 0].min())}-{int(late[:, 0].max())} are "
+            f"past the video's last frame {drawn[0]}: not drawn"
+        )
+    for note in notes:
+        print(f"pftrack render: warning: {note}", file=sys.stderr)
+    ids = len(np.unique(rows[:, 1])) if len(rows) else 0
+    print(
+        f"{drawn[0]} frames, {ids} tracks, {len(rows)} boxes, {source.fps:g} fps "
+        f"({source.fps_origin if source.fps_origin != 'given' else '--fps'}) -> {args.out}"
+        + (f"; trajectory plot -> {args.plot}" if args.plot else ""),
+        file=out,
+    )
+    return 0
+
+
+def _progress(frames: Any, total: int) -> Any:
+    from pftrack._progress import progress
+
+    return progress(frames, total=total or None, desc="rendering", unit="frame")
+
+
+def _outside(rows: Any, width: int, height: int) -> list[str]:
+    """A warning when most boxes do not overlap the frame: another frame's pixels (--scale)."""
+    import numpy as np
+
+    if not len(rows):
+        return []
+    x0, y0 = rows[:, 2], rows[:, 3]
+    x1, y1 = x0 + rows[:, 4], y0 + rows[:, 5]
+    outside = (x0 >= width) | (y0 >= height) | (x1 <= 0) | (y1 <= 0)
+    right, bottom = float(np.max(x1)), float(np.max(y1))
+    if outside.mean() <= OUTSIDE_SHARE:
+        return []
+    return [
+        f"{int(outside.sum())} of {len(rows)} boxes lie outside the {width}x{height} frame "
+        f"(they reach {right:.0f}x{bottom:.0f}): are they in another frame's pixels? (--scale S)"
+    ]

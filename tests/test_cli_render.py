@@ -1,0 +1,91 @@
+"""``pftrack render``: a tracks file drawn on its video, as the library's writer draws it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pftrack.cli import main
+from pftrack.io.mot import read_mot, write_mot
+from pftrack.io.video import FrameSource
+from pftrack.render import write_annotated_video
+from pftrack.synthetic import Scene, make_scene
+from tests.io.decode import decode
+
+
+@pytest.fixture(scope="module")
+def scene_files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Scene, Path, Path]:
+    folder = tmp_path_factory.mktemp("render")
+    scene = make_scene(n_frames=30, n_walkers=3, rng=0)
+    video = scene.write_video(folder / "scene.avi")
+    truth = folder / "truth.txt"
+    write_mot(truth, scene.truth)
+    return scene, video, truth
+
+
+def test_the_file_is_drawn_as_write_annotated_video_draws_it(
+    scene_files: tuple[Scene, Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, video, truth = scene_files
+    out, plot = tmp_path / "drawn.mp4", tmp_path / "paths.png"
+    assert main(["render", str(video), str(truth), "--out", str(out), "--plot", str(plot),
+                 "--fps", "12"]) == 0  # fmt: skip
+    said = capsys.readouterr().out
+    assert f"30 frames, 3 tracks, {len(read_mot(truth))} boxes, 12 fps (--fps)" in said
+    ref = write_annotated_video(tmp_path / "ref.mp4", FrameSource(video), read_mot(truth), 12.0)
+    info, frames = decode(out)
+    _, expected = decode(ref)
+    assert info.codec == "h264" and len(frames) == 30
+    assert all(np.array_equal(a, b) for a, b in zip(frames, expected, strict=True))
+    assert not np.array_equal(frames[10], decode(video)[1][10])  # something was drawn
+    assert plot.stat().st_size > 0
+
+
+def test_scale_rows_past_the_end_and_boxes_off_the_frame(
+    scene_files: tuple[Scene, Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene, video, _ = scene_files
+    big = scene.truth.copy()
+    big[:, 2:6] *= 4  # the truth in a frame 4 times as large
+    late = np.vstack([big, big[-1:] + [5, 0, 0, 0, 0, 0, 0, 0, 0, 0]])
+    tracks = tmp_path / "big.txt"
+    write_mot(tracks, late)
+    argv = ["render", str(video), str(tracks)]
+    assert main([*argv, "--out", str(tmp_path / "a.mp4")]) == 0
+    err = capsys.readouterr().err
+    assert "lie outside the" in err and "(--scale S)" in err
+    assert "1 rows of frames 35-35 are past the video's last frame 30: not drawn" in err
+    assert main([*argv, "--scale", "0.25", "--out", str(tmp_path / "b.mp4")]) == 0
+    assert "outside" not in capsys.readouterr().err
+    _, drawn = decode(tmp_path / "b.mp4")
+    rows = read_mot(tracks)
+    rows[:, 2:6] *= 0.25
+    src = FrameSource(video)
+    ref = write_annotated_video(tmp_path / "ref.mp4", src, rows, src.fps)
+    assert all(np.array_equal(a, b) for a, b in zip(drawn, decode(ref)[1], strict=True))
+
+
+def test_bad_input_is_one_line_and_nothing_is_lost(
+    scene_files: tuple[Scene, Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _, video, truth = scene_files
+    kept = tmp_path / "kept.mp4"
+    kept.write_bytes(b"earlier")
+
+    def error(*argv: str) -> str:
+        assert main(["render", *argv]) == 2
+        text = capsys.readouterr().err.strip()
+        assert text.count("\n") == 0 and text.startswith("pftrack render: error: "), text
+        return text
+
+    assert "no such file" in error(str(video), str(tmp_path / "none.txt"), "--out", str(kept))
+    assert ".webm" in error(str(video), str(truth), "--out", str(tmp_path / "v.webm"))
+    assert "--trail is -1" in error(str(video), str(truth), "--out", str(kept), "--trail", "-1")
+    bad = tmp_path / "bad.txt"
+    bad.write_text("1,1,0,0,-5,10,1,-1,-1,-1\n")
+    assert "negative" in error(str(video), str(bad), "--out", str(kept))
+    before = video.read_bytes()
+    assert "is an input" in error(str(video), str(truth), "--out", str(video))  # never the input
+    assert kept.read_bytes() == b"earlier" and video.read_bytes() == before
