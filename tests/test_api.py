@@ -205,15 +205,40 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         "pftrack.fill_gaps(1, method=2)\n"
         "pftrack.batch.track_many(1)\n"
         "reveal_type(pftrack.recovery.filled_mask)\n"
+        "pftrack.Tracker(detector='mog3', camera_motion='of')\n"
+        "pftrack.recover_gap([], [], method='lineer')\n"
+        "pftrack.Tracker(detector='mog2', sampler='mh', dynamics='ar2-mean', fill='gsi')\n"
     )
     out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
     assert status == 1, out  # the bad call is caught, so the names are not Any
     assert 'Revealed type is "def (path: ' in out
     assert 'Revealed type is "float"' in out or 'Revealed type is "builtins.float"' in out
-    assert 'Argument "method" to "fill_gaps" has incompatible type "int"' in out
+    assert 'Argument "method" to "fill_gaps" has incompatible type "Literal[2]"' in out
     # the subpackages too (pftrack.batch.track_many was Any)
     assert 'Argument 1 to "track_many" has incompatible type "int"' in out
     assert 'Revealed type is "def (rows: ' in out, out
+    # names from a fixed set are Literal types: a typo is caught before the run
+    assert 'Argument "detector" to "Tracker" has incompatible type "Literal[\'mog3\']"' in out
+    assert 'Argument "camera_motion" to "Tracker" has incompatible type' in out
+    assert 'Argument "method" to "recover_gap" has incompatible type "Literal[\'lineer\']"' in out
+    assert "use.py:10:" not in out, out  # every valid name is accepted
+
+
+def test_the_literal_types_list_the_names_the_runtime_takes() -> None:
+    from typing import get_args
+
+    from pftrack import _typing
+    from pftrack.detection import DETECTORS
+    from pftrack.recovery import METHODS
+    from pftrack.tracking.config import CAMERA_MOTION, SAMPLERS
+
+    assert get_args(_typing.RecoveryMethod) == METHODS
+    assert get_args(_typing.DetectorName) == DETECTORS
+    assert get_args(_typing.SamplerName) == SAMPLERS
+    assert get_args(_typing.CameraMotion) == CAMERA_MOTION
+    with pytest.raises(ValueError, match="dynamics is 'ar3', expected 'ar2' or 'ar2-mean'"):
+        pftrack.Tracker(dynamics="ar3")  # type: ignore[arg-type]
+    assert get_args(_typing.DynamicsName) == ("ar2", "ar2-mean")
 
 
 API_DOC = Path(__file__).resolve().parents[1] / "docs" / "api.md"

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from typing import TypeAlias
+from typing import Literal, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,4 +17,31 @@ PathLike: TypeAlias = str | os.PathLike[str]
 F64: TypeAlias = NDArray[np.float64]
 """A float64 array (shapes are given in each docstring)."""
 
-__all__ = ["F64", "PathLike", "RngLike"]
+RecoveryMethod: TypeAlias = Literal[
+    "auto", "gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "linear", "cubic", "bspline", "gsi", "rts",
+    "linear-nb", "rts-nb",
+]  # fmt: skip
+"""A recovery method's name (:data:`pftrack.recovery.METHODS`, the same values)."""
+
+DetectorName: TypeAlias = Literal["paper", "mog2", "knn"]
+"""A built-in detector (:data:`pftrack.detection.DETECTORS`)."""
+
+SamplerName: TypeAlias = Literal["sis", "mh", "rjmcmc"]
+"""A sampler of the tracker (:data:`pftrack.tracking.config.SAMPLERS`)."""
+
+DynamicsName: TypeAlias = Literal["ar2", "ar2-mean"]
+"""The particles' AR(2) model: on each particle's states, or on the particle set's means."""
+
+CameraMotion: TypeAlias = Literal["auto", "on", "off"]
+"""Camera-motion compensation (:data:`pftrack.tracking.config.CAMERA_MOTION`)."""
+
+__all__ = [
+    "F64",
+    "CameraMotion",
+    "DetectorName",
+    "DynamicsName",
+    "PathLike",
+    "RecoveryMethod",
+    "RngLike",
+    "SamplerName",
+]

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import flag, number
-from pftrack._typing import F64, PathLike
+from pftrack._typing import F64, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
 
 if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover needs none of it
@@ -398,7 +398,7 @@ class RecoverOptions:
         outside 1..100000, ``seed`` < 0, ``max_distance`` not > 0), before any task runs.
     """
 
-    method: str = "auto"
+    method: RecoveryMethod = "auto"
     max_gap: int = 30
     seed: int = 0
     link: bool = False

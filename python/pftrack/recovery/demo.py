@@ -7,7 +7,7 @@ import time
 import numpy as np
 from numpy.typing import ArrayLike
 
-from pftrack._typing import RngLike
+from pftrack._typing import RecoveryMethod, RngLike
 from pftrack.recovery.noise import estimate_noise
 from pftrack.recovery.registry import METHODS, recover_gaps
 
@@ -20,7 +20,7 @@ def demo_report(
     *,
     n_gaps: int = 20,
     gap_range: tuple[int, int] = (5, 25),
-    methods: tuple[str, ...] = METHODS,
+    methods: tuple[RecoveryMethod, ...] = METHODS,
 ) -> str:
     """Cut random gaps into tracks, recover them with every method and tabulate the errors.
 

@@ -13,12 +13,13 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._progress import progress
-from pftrack._typing import F64
+from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.linking import check_unique
 from pftrack.recovery.mixture import MotionFit, fit_motion
 from pftrack.recovery.names import NEIGHBOUR_METHODS
@@ -174,7 +175,7 @@ def observed_runs(trajs: dict[int, F64], mask: Sequence[float]) -> list[F64]:
 
 def score(
     gaps: Sequence[Gap],
-    method: str,
+    method: RecoveryMethod,
     repeat: int = 1,
     noise: NoiseEstimate | None = None,
     motion: MotionFit | None = None,
@@ -269,14 +270,15 @@ def run_mask(
                 motion = fit_motion(runs, noise)
                 motion_ms = 1e3 * (time.perf_counter() - t0)
         for m in methods:
+            name = cast("RecoveryMethod", m)  # recover_gaps refuses a name that is not one
             if m == "auto":  # calibrates itself, from the observed points only
                 scores[m], paths[m] = score(
-                    gaps, m, repeat, observed=runs, seed=seed, combine=combine
+                    gaps, name, repeat, observed=runs, seed=seed, combine=combine
                 )
             elif m in NEIGHBOUR_METHODS:  # corrected by the other tracks outside the mask
-                scores[m], paths[m] = score(gaps, m, repeat, observed=runs)
+                scores[m], paths[m] = score(gaps, name, repeat, observed=runs)
             else:
-                scores[m], paths[m] = score(gaps, m, repeat, noise, motion)
+                scores[m], paths[m] = score(gaps, name, repeat, noise, motion)
     mk = tuple(float(v) for v in mask)
     return MaskRun(
         (mk[0], mk[1], mk[2], mk[3]),

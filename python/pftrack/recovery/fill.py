@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _check
-from pftrack._typing import F64
+from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.calibrate import Calibration, recover_auto
 from pftrack.recovery.linking import (
     FILLED_MARK,
@@ -90,7 +90,7 @@ class FillReport:
 
 def fill_gaps(
     tracks: F64,
-    method: str = DEFAULT_METHOD,
+    method: RecoveryMethod = DEFAULT_METHOD,
     max_gap: int = DEFAULT_MAX_GAP,
     noise: NoiseEstimate | None = None,
     *,
@@ -150,7 +150,7 @@ def fill_gaps(
 
 def fill_rows(
     rows: F64,
-    method: str = DEFAULT_METHOD,
+    method: RecoveryMethod = DEFAULT_METHOD,
     max_gap: int = DEFAULT_MAX_GAP,
     noise: NoiseEstimate | None = None,
     *,

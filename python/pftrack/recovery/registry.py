@@ -43,6 +43,7 @@ Box sizes (``w, h``), when given, are interpolated linearly by every method.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -50,7 +51,7 @@ from numpy.typing import ArrayLike
 from pftrack import _check
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
-from pftrack._typing import F64
+from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
 from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, check_models, fit_motion, recover_mixture_gaps
@@ -76,7 +77,7 @@ def recover_gap(
     segment_a: ArrayLike,
     segment_b: ArrayLike,
     frames: ArrayLike | None = None,
-    method: str = DEFAULT_METHOD,
+    method: RecoveryMethod = DEFAULT_METHOD,
     *,
     noise: NoiseEstimate | None = None,
     motion: MotionFit | None = None,
@@ -173,7 +174,7 @@ def _gap_segment(seg: ArrayLike, name: str, k: int) -> F64:
 
 def recover_gaps(
     gaps: Sequence[tuple[ArrayLike, ArrayLike]],
-    method: str = DEFAULT_METHOD,
+    method: RecoveryMethod = DEFAULT_METHOD,
     *,
     noise: NoiseEstimate | None = None,
     history: int | None = None,
@@ -243,7 +244,7 @@ def recover_gaps(
             if observed is None
             else distinct_runs(observed, strict="recover_gaps")
         )
-        base = method.removesuffix(NB_SUFFIX)
+        base = cast("RecoveryMethod", method.removesuffix(NB_SUFFIX))  # rts-nb -> rts
 
         def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
             return recover_gaps(ps, base)

@@ -34,7 +34,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import bgr_frame, flag, number
 from pftrack._check import seed as check_seed
-from pftrack._typing import F64, RngLike
+from pftrack._typing import (
+    F64,
+    CameraMotion,
+    DetectorName,
+    DynamicsName,
+    RecoveryMethod,
+    RngLike,
+    SamplerName,
+)
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
@@ -292,17 +300,17 @@ class Tracker:
         frame_rate: float = REFERENCE_RATE,
         *,
         seed: int | None = 0,
-        detector: str = "paper",
-        sampler: str = "sis",
+        detector: DetectorName = "paper",
+        sampler: SamplerName = "sis",
         particles: int | None = None,
-        dynamics: str = "ar2",
+        dynamics: DynamicsName = "ar2",
         max_coast: float | None = None,
         min_conf: float = 0.0,
         birth_score: float = 0.9,
         birth_quantile: float | None = 0.25,
-        camera_motion: str = "auto",
+        camera_motion: CameraMotion = "auto",
         refine: bool = True,
-        fill: str = "linear",
+        fill: RecoveryMethod = "linear",
         smooth: bool = True,
         link: bool = True,
         crossings: bool = CrossingConfig.enabled,

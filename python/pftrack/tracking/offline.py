@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
-from pftrack._typing import F64
+from pftrack._typing import F64, RecoveryMethod
 from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh_rows, xywh_to_cxcywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
@@ -454,7 +454,7 @@ def smooth_tracks(
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
     measurements: ArrayLike | None = None,
     *,
-    fill_method: str = DEFAULT_METHOD,
+    fill_method: RecoveryMethod = DEFAULT_METHOD,
     seed: int = 0,
     crossings: CrossingConfig | None = None,
     relink_coast: int | None = None,
@@ -794,7 +794,7 @@ def split_refound(
 
 
 def _add_hole_rows(
-    a: F64, obs: NDArray[np.bool_], z: F64, max_gap: int, method: str, seed: int
+    a: F64, obs: NDArray[np.bool_], z: F64, max_gap: int, method: RecoveryMethod, seed: int
 ) -> tuple[F64, NDArray[np.bool_], F64, NDArray[np.bool_]]:
     """Add a flagged row for every frame missing inside a track, recovered by `method`.
 
