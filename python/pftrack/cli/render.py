@@ -13,12 +13,15 @@ import sys
 import warnings
 from typing import Any
 
-from pftrack.cli._options import add_command, bounded_float, check_input_file, report_stream
+from pftrack.cli._options import (
+    FPS_RANGE,
+    add_command,
+    bounded_float,
+    check_input_file,
+    report_stream,
+)
+from pftrack.cli.track import PLOT_SUFFIXES
 
-#: ``--fps`` range, as ``pftrack track``'s.
-FPS_RANGE = (0.1, 1000.0)
-#: ``--plot``'s formats; the first is a device's.
-PLOT_SUFFIXES = (".png", ".jpg", ".jpeg")
 #: A file whose boxes mostly lie outside the frame is in another frame's pixels: warned.
 OUTSIDE_SHARE = 0.5
 
@@ -46,8 +49,8 @@ def add_parser(sub: Any) -> None:
     )  # fmt: skip
     p.add_argument(
         "--scale", type=bounded_float(1e-3, 1e3), default=1.0, metavar="S",
-        help="multiply the file's boxes by S to reach the video's pixels (0.625 for PETS09 "
-        "ground truth, 768x576, on its 480x360 video)",
+        help="multiply the file's boxes by S to reach the video's pixels (0.001 to 1000; "
+        "0.625 for PETS09 ground truth, 768x576, on its 480x360 video)",
     )  # fmt: skip
     p.add_argument(
         "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
