@@ -18,9 +18,13 @@ from scipy.optimize import linear_sum_assignment
 from pftrack._check import number
 from pftrack.boxes import iou_xywh
 from pftrack.eval.rows import (  # check_*: here too, as before
+    BENCHMARKS,
     IOU_ROUNDING,
     check_eval_rows,
     check_unique_ids,
+    guess_benchmark,
+    mot_iou,
+    prepare_mot,
 )
 from pftrack.io.mot import FRAME, ID, LEFT
 
@@ -28,7 +32,6 @@ __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_x
 
 # Cost of a forbidden pair in the per-frame assignment: larger than any sum of admissible
 # costs (each is at most 1), so the solver first maximises the number of admissible pairs.
-_FORBIDDEN = 1e6
 _EPS = float(np.finfo(np.float64).eps)
 
 
@@ -213,14 +216,6 @@ def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
     return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}
 
 
-def _assign(cost: NDArray[np.float64]) -> list[tuple[int, int]]:
-    """Min-cost pairs of a cost matrix where ``_FORBIDDEN`` marks forbidden pairs."""
-    if cost.size == 0:
-        return []
-    r, c = linear_sum_assignment(cost)
-    return [(int(i), int(j)) for i, j in zip(r, c, strict=True) if cost[i, j] < _FORBIDDEN]
-
-
 def evaluate_mot(
     gt: ArrayLike,
     result: ArrayLike,
@@ -295,13 +290,6 @@ def evaluate_mot(
             raise ValueError(
                 f"evaluate_mot: image_size is {image_size!r}, expected (width, height) > 0"
             )
-    from pftrack.eval.hota import (  # (imports this)
-        BENCHMARKS,
-        guess_benchmark,
-        mot_iou,
-        prepare_mot,
-    )
-
     if benchmark != "auto" and benchmark not in BENCHMARKS:
         raise ValueError(
             f"evaluate_mot: benchmark is {benchmark!r}, expected 'auto' or one of "
