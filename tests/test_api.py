@@ -207,7 +207,11 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         "reveal_type(pftrack.recovery.filled_mask)\n"
         "pftrack.Tracker(detector='mog3', camera_motion='of')\n"
         "pftrack.recover_gap([], [], method='lineer')\n"
-        "pftrack.Tracker(detector='mog2', sampler='mh', dynamics='ar2-mean', fill='gsi')\n"
+        "pftrack.Tracker(detector='mog2', sampler='mh', dynamics='ar2-mean', fill='pf')\n"
+        "pftrack.Tracker(fill='cubic')\n"
+        "pftrack.TrackerConfig(detector='mog3', sampler='gibbs', camera_motion='yes')\n"
+        "pftrack.evaluate_sequence([], [], benchmark='MOT18')\n"
+        "pftrack.track_frames([], bootstrap='sprad')\n"
     )
     out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
     assert status == 1, out  # the bad call is caught, so the names are not Any
@@ -221,7 +225,12 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
     assert 'Argument "detector" to "Tracker" has incompatible type "Literal[\'mog3\']"' in out
     assert 'Argument "camera_motion" to "Tracker" has incompatible type' in out
     assert 'Argument "method" to "recover_gap" has incompatible type "Literal[\'lineer\']"' in out
-    assert "use.py:10:" not in out, out  # every valid name is accepted
+    assert "use.py:9:" not in out, out  # every valid name is accepted (line 9)
+    assert 'Argument "fill" to "Tracker" has incompatible type "Literal[\'cubic\']"' in out
+    for arg in ("detector", "sampler", "camera_motion"):
+        assert f'Argument "{arg}" to "TrackerConfig" has incompatible type' in out, arg
+    assert 'Argument "benchmark" to "evaluate_sequence" has incompatible type' in out
+    assert 'Argument "bootstrap" to "track_frames" has incompatible type' in out
 
 
 def test_the_literal_types_list_the_names_the_runtime_takes() -> None:
@@ -239,6 +248,14 @@ def test_the_literal_types_list_the_names_the_runtime_takes() -> None:
     with pytest.raises(ValueError, match="dynamics is 'ar3', expected 'ar2' or 'ar2-mean'"):
         pftrack.Tracker(dynamics="ar3")  # type: ignore[arg-type]
     assert get_args(_typing.DynamicsName) == ("ar2", "ar2-mean")
+    from pftrack.detection.bootstrap import BOOTSTRAPS
+    from pftrack.eval.rows import BENCHMARKS
+
+    assert get_args(_typing.BootstrapMode) == ("auto", *BOOTSTRAPS)
+    assert get_args(_typing.BenchmarkName) == ("auto", *BENCHMARKS)
+    with pytest.raises(ValueError, match="fill is 'cubic', expected 'linear' or 'pf'"):
+        pftrack.Tracker(fill="cubic")  # type: ignore[arg-type]
+    assert get_args(_typing.FillMode) == ("linear", "pf")
 
 
 API_DOC = Path(__file__).resolve().parents[1] / "docs" / "api.md"

@@ -35,11 +35,23 @@ DynamicsName: TypeAlias = Literal["ar2", "ar2-mean"]
 CameraMotion: TypeAlias = Literal["auto", "on", "off"]
 """Camera-motion compensation (:data:`pftrack.tracking.config.CAMERA_MOTION`)."""
 
+FillMode: TypeAlias = Literal["linear", "pf"]
+"""How a tracker fills a track's coasted frames: interpolated, or the particle filter's boxes."""
+
+BootstrapMode: TypeAlias = Literal["auto", "spread", "first", "none"]
+"""Which frames prime the background model (:func:`pftrack.tracking.track_frames`)."""
+
+BenchmarkName: TypeAlias = Literal["auto", "MOT15", "MOT16", "MOT17", "MOT20"]
+"""MOTChallenge ground-truth rules of an evaluation (``"auto"``: guessed from the columns)."""
+
 __all__ = [
     "F64",
+    "BenchmarkName",
+    "BootstrapMode",
     "CameraMotion",
     "DetectorName",
     "DynamicsName",
+    "FillMode",
     "PathLike",
     "RecoveryMethod",
     "RngLike",

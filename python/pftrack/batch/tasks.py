@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import flag, number
-from pftrack._typing import F64, PathLike, RecoveryMethod
+from pftrack._typing import F64, FillMode, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
 
 if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover needs none of it
@@ -205,7 +205,7 @@ class TrackOptions:
     seed: int = 0
     detections: str | None = None
     det_scale: float | None = None
-    fill: str = "linear"
+    fill: FillMode = "linear"
     smooth: bool = True
     link: bool = True
     render: str | None = None

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
+from pftrack._typing import BenchmarkName
 from pftrack.eval.rows import (  # the scored rows; here too, as before
     BENCHMARKS,
     guess_benchmark,
@@ -172,7 +173,7 @@ def evaluate_hota(
     gt: ArrayLike,
     result: ArrayLike,
     *,
-    benchmark: str = "auto",
+    benchmark: BenchmarkName = "auto",
     scale: float = 1.0,
     num_frames: int | None = None,
 ) -> HotaMetrics:

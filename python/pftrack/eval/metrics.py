@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
 from pftrack._check import number
+from pftrack._typing import BenchmarkName
 from pftrack.boxes import iou_xywh
 from pftrack.eval.rows import (  # check_*: here too, as before
     BENCHMARKS,
@@ -223,7 +224,7 @@ def evaluate_mot(
     iou_threshold: float = 0.5,
     scale: float = 1.0,
     image_size: tuple[int, int] | None = None,
-    benchmark: str = "auto",
+    benchmark: BenchmarkName = "auto",
     num_frames: int | None = None,
 ) -> MotMetrics:
     """Score a tracking result against ground truth.

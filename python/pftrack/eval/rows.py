@@ -143,7 +143,7 @@ def mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     return out
 
 
-def guess_benchmark(gt: ArrayLike) -> str:
+def guess_benchmark(gt: ArrayLike) -> Literal["MOT15", "MOT17"]:
     """``"MOT17"`` if `gt` looks like MOT16/17/20 ground truth, else ``"MOT15"``.
 
     MOT16+ ground truth has ``frame, id, left, top, w, h, flag, class, visibility``: the class

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._typing import PathLike
+from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark, mot_iou
 from pftrack.eval.metrics import MotMetrics, combine_mot, evaluate_mot
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, WIDTH
@@ -334,7 +334,7 @@ def evaluate_sequence(
     iou_threshold: float = 0.5,
     scale: float = 1.0,
     image_size: tuple[int, int] | None = None,
-    benchmark: str = "auto",
+    benchmark: BenchmarkName = "auto",
     num_frames: int | None = None,
 ) -> SequenceScores:
     """Score one result against its ground truth: HOTA family and CLEAR-MOT/IDF1.

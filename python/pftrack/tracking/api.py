@@ -39,7 +39,7 @@ from pftrack._typing import (
     CameraMotion,
     DetectorName,
     DynamicsName,
-    RecoveryMethod,
+    FillMode,
     RngLike,
     SamplerName,
 )
@@ -310,7 +310,7 @@ class Tracker:
         birth_quantile: float | None = 0.25,
         camera_motion: CameraMotion = "auto",
         refine: bool = True,
-        fill: RecoveryMethod = "linear",
+        fill: FillMode = "linear",
         smooth: bool = True,
         link: bool = True,
         crossings: bool = CrossingConfig.enabled,

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pftrack._check import MAX_FRAME, flag, integer, number
+from pftrack._typing import CameraMotion, DetectorName, SamplerName
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
 from pftrack.particle_filter.filter import MAX_PARTICLES
@@ -542,15 +543,15 @@ class TrackerConfig:
         )
     )
     binning: HsvBinning = field(default_factory=HsvBinning)
-    sampler: str = "sis"
+    sampler: SamplerName = "sis"
     rjmcmc: RJMCMCConfig = field(default_factory=RJMCMCConfig)
-    detector: str = "paper"
+    detector: DetectorName = "paper"
     reference_rate: float = 0.05
     refine: RefineConfig = field(default_factory=RefineConfig)
     association: AssociationConfig = field(default_factory=AssociationConfig)
     motion: MotionConfig = field(default_factory=MotionConfig)
     lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
-    camera_motion: str = "auto"
+    camera_motion: CameraMotion = "auto"
     camera: CameraConfig = field(default_factory=CameraConfig)
     crossings: CrossingConfig = field(default_factory=CrossingConfig)
     max_side: int | None = None

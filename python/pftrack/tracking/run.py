@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from pftrack._check import flag, number
 from pftrack._progress import progress
-from pftrack._typing import F64, PathLike, RngLike
+from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
 from pftrack.detection.bootstrap import bootstrap_frames
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
@@ -112,10 +112,10 @@ def track_frames(
     config: TrackerConfig | None = None,
     rng: RngLike = 0,
     coasting: str = "confirmed",
-    fill: str = "linear",
+    fill: FillMode = "linear",
     show_progress: bool | None = None,
     prime_frames: int = 30,
-    bootstrap: str = "auto",
+    bootstrap: BootstrapMode = "auto",
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
     on_frame: Callable[[int, NDArray[np.uint8], list[Track], F64], None] | None = None,
@@ -290,7 +290,7 @@ def track_path(
     det_scale: float = 1.0,
     config: TrackerConfig | None = None,
     seed: int = 0,
-    fill: str = "linear",
+    fill: FillMode = "linear",
     smooth: bool = True,
     link: bool = True,
     show_progress: bool | None = None,
