@@ -326,6 +326,23 @@ def test_xywh_given_as_xyxy_is_refused(scene):
         pftrack.Tracker().update(xywh, scene.frames[0])
 
 
+def test_a_box_without_area_among_good_ones_is_dropped_with_a_warning(scene):
+    # a box trimmed to zero width at the frame's edge refused the whole frame, saying the
+    # boxes looked like x, y, w, h (a user trial with TUD-Campus's det.txt)
+    k = next(k for k, d in enumerate(scene_dets(scene)) if len(d) >= 3)
+    d = scene_dets(scene)[k]
+    h, w = scene.frames[k].shape[:2]
+    dets = np.vstack([d, [[w, 10, w, 60, 0.95]], [[30, 40, 20, 90, 0.95]]])
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    with pytest.warns(UserWarning, match="2 detection boxes without area"):
+        out = tracker.update(dets, scene.frames[k])
+    assert not np.isin(out[:, 7], [len(d), len(d) + 1]).any()  # never matched
+    ref = pftrack.Tracker(seed=0, prime=0).update(d, scene.frames[k])
+    np.testing.assert_array_equal(out, ref)  # the rest as without them
+    _, _, kept, _, empty = check_boxes_xyxy(dets, (h, w))
+    assert empty == 2 and list(kept) == list(range(len(d)))
+
+
 def test_xyxy_file_where_xywh_is_expected_is_refused(scene):
     d = scene_dets(scene)
     as_file = {n: v for n, v in enumerate(d, start=1) if len(v)}  # x1, y1, x2, y2 "as xywh"
@@ -362,8 +379,8 @@ def test_boxes_outside_the_frame_are_clipped_once(scene):
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # warned once per tracker
         tracker.update(dets, scene.frames[1])
-    xywh, cls, kept, clipped = check_boxes_xyxy(dets, (h, w))
-    assert clipped and kept[0] == 1 and 0 not in kept
+    xywh, cls, kept, clipped, empty = check_boxes_xyxy(dets, (h, w))
+    assert clipped and kept[0] == 1 and 0 not in kept and empty == 0
     np.testing.assert_array_equal(xywh[0], [0, h - 30, 15, 30, 1.0])  # clipped at x = 0, y = h
     inside = np.all((d[:, :2] >= 0) & (d[:, 2:4] <= [w, h]), axis=1)
     assert inside.any()

@@ -114,7 +114,7 @@ def working_size(shape: tuple[int, ...], max_side: int | None) -> tuple[int, int
 
 def check_boxes_xyxy(
     dets: ArrayLike, shape: tuple[int, int]
-) -> tuple[F64, NDArray[np.int64], NDArray[np.int64], bool]:
+) -> tuple[F64, NDArray[np.int64], NDArray[np.int64], bool, int]:
     """Check detections ``[x1, y1, x2, y2(, conf(, cls))]`` and clip them to the frame.
 
     Parameters
@@ -130,9 +130,13 @@ def check_boxes_xyxy(
         The boxes inside the frame as ``[left, top, w, h, conf]``, clipped to it.
     classes : (K,) ndarray of int
     kept : (K,) ndarray of int
-        Row of `dets` each kept box comes from (boxes wholly outside the frame are dropped).
+        Row of `dets` each kept box comes from (boxes wholly outside the frame, and boxes
+        without area, are dropped).
     clipped : bool
         Whether any box reached outside the frame.
+    empty : int
+        Boxes without area (``x2 <= x1`` or ``y2 <= y1``: a detector's box trimmed to nothing
+        at the frame's edge) dropped, when they are at most half the rows.
 
     Raises
     ------
@@ -140,15 +144,15 @@ def check_boxes_xyxy(
         Not numbers.
     ValueError
         Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31 - 1]``, or
-        a box with ``x2 <= x1`` or ``y2 <= y1`` (the message says when the rows look like
-        ``x, y, w, h`` instead).
+        more than half the boxes with ``x2 <= x1`` or ``y2 <= y1`` (a layout mistake, not a
+        detector's stray box; the message says when the rows look like ``x, y, w, h``).
     """
     d = np.asarray(dets)
     if d.dtype.kind not in "iuf":
         raise TypeError(f"dets must be an array of numbers, got dtype {d.dtype}")
     d = d.astype(np.float64)
     if d.shape == (0,) or (d.ndim == 2 and d.shape[0] == 0 and d.shape[1] in (4, 5, 6)):
-        return np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64), False
+        return np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64), False, 0
     if d.ndim != 2 or d.shape[1] not in (4, 5, 6):
         raise ValueError(
             f"dets must have shape (N, 4), (N, 5) or (N, 6) [x1, y1, x2, y2(, conf(, cls))], "
@@ -167,7 +171,7 @@ def check_boxes_xyxy(
                 f"[{-MAX_CLASS - 1}, {MAX_CLASS}] (column 6: x1, y1, x2, y2, conf, cls)"
             )
     bad = (d[:, 2] <= d[:, 0]) | (d[:, 3] <= d[:, 1])
-    if bad.any():
+    if bad.mean() > 0.5:  # most rows: the layout is wrong (a few: boxes without area, dropped)
         k = int(np.flatnonzero(bad)[0])
         if np.all(d[bad, 2:4] > 0):  # positive as widths and heights: x, y, w, h rows
             raise ValueError(
@@ -179,7 +183,7 @@ def check_boxes_xyxy(
     limit = np.array([cols, rows, cols, rows], np.float64)
     box = np.clip(d[:, :4], 0.0, limit)
     clipped = bool((box != d[:, :4]).any())
-    inside = (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1])
+    inside = (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1]) & ~bad
     kept = inside.nonzero()[0].astype(np.int64)
     box = box[kept]
     conf = d[kept, 4] if d.shape[1] >= 5 else np.ones(len(kept))
@@ -188,7 +192,7 @@ def check_boxes_xyxy(
     xywh[:, 0:2] = box[:, :2]
     xywh[:, 2:4] = box[:, 2:] - box[:, :2]
     xywh[:, 4] = conf
-    return xywh, cls, kept, clipped
+    return xywh, cls, kept, clipped, int(bad.sum())
 
 
 class _Alone:
@@ -465,6 +469,7 @@ class Tracker:
             self._stabiliser = Stabiliser()
             self._reports: list[Track] = []
             self._clip_warned = False
+            self._empty_warned = False
             self._max_conf = -np.inf
             self._given = False  # some update() of the run had detections
             # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
@@ -586,7 +591,14 @@ class Tracker:
                 kept = None
                 reports = self._tracker.update(work, None)
             else:
-                xywh, cls, kept, clipped = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
+                xywh, cls, kept, clipped, empty = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
+                if empty and not self._empty_warned:
+                    self._empty_warned = True
+                    warnings.warn(
+                        f"{empty} detection box{'es' if empty > 1 else ''} without area "
+                        "(x2 <= x1 or y2 <= y1) ignored; later ones are ignored silently",
+                        stacklevel=2,
+                    )
                 if clipped and not self._clip_warned:
                     self._clip_warned = True
                     warnings.warn(
