@@ -52,6 +52,25 @@ def test_update_with_detections_sets_tracker_id_like_the_tracker(scene):
     assert adapter.tracker.frame_count == 0
 
 
+def test_prime_is_the_plain_loops(scene):
+    # the adapter had no prime(): its users could not reach the command's rows
+    adapter = SupervisionTracker(frame_rate=10.0, seed=1)
+    plain = pftrack.Tracker(frame_rate=10.0, seed=1)
+    unprimed = SupervisionTracker(frame_rate=10.0, seed=1)
+    adapter.prime(iter(scene.frames))
+    plain.prime(iter(scene.frames))
+    for n, frame in enumerate(scene.frames, start=1):
+        dets = frame_detections(scene, n)
+        adapter.update_with_detections(dets, frame)
+        unprimed.update_with_detections(dets, frame)
+        plain.update(np.column_stack([dets.xyxy, dets.confidence, dets.class_id]), frame)
+    rows = adapter.finalize()
+    np.testing.assert_array_equal(rows, plain.finalize())
+    assert not np.array_equal(rows, unprimed.finalize())  # priming changed something
+    with pytest.raises(ValueError, match="before the first update"):
+        adapter.prime(iter(scene.frames))
+
+
 def test_ids_follow_the_truth(scene):
     adapter = SupervisionTracker(frame_rate=10.0)
     pairs = set()

@@ -10,10 +10,11 @@ repairs it).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import F64
 from pftrack.tracking.api import Tracker
@@ -48,6 +49,7 @@ class SupervisionTracker:
     Examples
     --------
     >>> tracker = SupervisionTracker(frame_rate=25.0)                 # doctest: +SKIP
+    >>> tracker.prime(first_frames)   # the background behind box refinement  # doctest: +SKIP
     >>> for frame in frames:                                           # doctest: +SKIP
     ...     detections = sv.Detections.from_ultralytics(model(frame)[0])
     ...     detections = tracker.update_with_detections(detections, frame)
@@ -95,6 +97,16 @@ class SupervisionTracker:
         out.tracker_id = tracks[:, 4].astype(int)
         result: sv.Detections = out
         return result
+
+    def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
+        """Start the background behind box refinement from `frames` (:meth:`pftrack.Tracker.prime`).
+
+        Before the first update, with the video's first frames (``tracker.prime_frames`` of
+        them are read), as ``pftrack track`` does: then the adapter's rows are the command's,
+        as the plain loop's are (unprimed, the first frames' boxes are refined against a
+        background still being learnt).
+        """
+        self.tracker.prime(frames)
 
     def finalize(self) -> F64:
         """The run's MOTChallenge rows after the offline pass (:meth:`pftrack.Tracker.finalize`)."""
