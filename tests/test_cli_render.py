@@ -33,7 +33,7 @@ def test_the_file_is_drawn_as_write_annotated_video_draws_it(
     assert main(["render", str(video), str(truth), "--out", str(out), "--plot", str(plot),
                  "--fps", "12"]) == 0  # fmt: skip
     said = capsys.readouterr().out
-    assert f"30 frames, 3 tracks, {len(read_mot(truth))} boxes, 12 fps (--fps)" in said
+    assert f"30 frames, 3 tracks, {len(read_mot(truth))} boxes drawn, 12 fps (--fps)" in said
     ref = write_annotated_video(tmp_path / "ref.mp4", FrameSource(video), read_mot(truth), 12.0)
     info, frames = decode(out)
     _, expected = decode(ref)
@@ -55,10 +55,18 @@ def test_scale_rows_past_the_end_and_boxes_off_the_frame(
     argv = ["render", str(video), str(tracks)]
     assert main([*argv, "--out", str(tmp_path / "a.mp4")]) == 0
     err = capsys.readouterr().err
-    assert "lie outside the" in err and "(--scale S)" in err
+    assert "reach outside the" in err and "(--scale S)" in err
     assert "1 rows of frames 35-35 are past the video's last frame 30: not drawn" in err
     assert main([*argv, "--scale", "0.25", "--out", str(tmp_path / "b.mp4")]) == 0
     assert "outside" not in capsys.readouterr().err
+    # boxes 1.6 times too large mostly cross the frame's edge without lying wholly outside
+    assert main([*argv, "--scale", "0.4", "--out", str(tmp_path / "c.mp4")]) == 0
+    assert "reach outside the" in capsys.readouterr().err
+    # every row past the video: the summary says nothing was drawn
+    past = tmp_path / "past.txt"
+    write_mot(past, scene.truth + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
+    assert main(["render", str(video), str(past), "--out", str(tmp_path / "d.mp4")]) == 0
+    assert "30 frames, 0 tracks, 0 boxes drawn" in capsys.readouterr().out
     _, drawn = decode(tmp_path / "b.mp4")
     rows = read_mot(tracks)
     rows[:, 2:6] *= 0.25
