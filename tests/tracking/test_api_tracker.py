@@ -921,3 +921,12 @@ def test_the_joint_sampler_counts_ids_from_1(scene):
         tracker.update(dets[k], scene.frames[k])
     rows = tracker.finalize()
     assert len(rows) and rows[:, 1].min() >= 1
+
+
+def test_track_frames_names_every_bootstrap_it_takes():
+    # the message left out "auto", the default; prime_frames=0 took any name
+    from pftrack.tracking import track_frames
+
+    for prime in (30, 0):
+        with pytest.raises(ValueError, match="bootstrap is 'sprad', expected one of auto, spread"):
+            track_frames([], bootstrap="sprad", prime_frames=prime)  # type: ignore[arg-type]

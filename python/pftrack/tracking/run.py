@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from pftrack._check import flag, number
 from pftrack._progress import progress
 from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
-from pftrack.detection.bootstrap import bootstrap_frames
+from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource
@@ -179,6 +179,10 @@ def track_frames(
     the detector inside ``update``, byte for byte, and a detector error is raised from
     ``update`` on its frame as there.
     """
+    if bootstrap not in ("auto", *BOOTSTRAPS):
+        raise ValueError(
+            f"bootstrap is {bootstrap!r}, expected one of auto, {', '.join(BOOTSTRAPS)}"
+        )
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
     if detections is not None and len(detections) and max(detections) > max(len(frames), 1) > 1:
