@@ -18,6 +18,7 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -35,6 +36,7 @@ from pftrack.batch import (
     dask_client,
     find_sequences,
     run_jobs,
+    smooth_many,
     track_many,
 )
 from pftrack.cli import main
@@ -1023,3 +1025,198 @@ def test_a_sequences_warnings_come_back_to_the_summary(
     # in this process too, whatever the warning filters say (pytest makes them errors here)
     serial = track_many(tmp_path / "in", tmp_path / "serial", n_workers=0)
     assert serial.entries[0]["warnings"] == entry["warnings"]
+
+
+# --- where a batch runs: the address, the client, a cluster without workers ----------------
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--scheduler", "tcp://127.0.0.1:8786x"], "--scheduler 'tcp://127.0.0.1:8786x': port "
+         "'8786x' is not a number (expected tcp://HOST:PORT, PORT in 1..65535)"),
+        (["--scheduler", "tcp://127.0.0.1:99999"], "--scheduler 'tcp://127.0.0.1:99999': port "
+         "99999 is out of range"),
+        (["--scheduler", "http://127.0.0.1:8786"], "unknown protocol http://"),
+        (["--scheduler", "tcp://127.0.0.1"], "--scheduler 'tcp://127.0.0.1': no port"),
+        (["--scheduler", "tcp://:8786"], "no host"),
+        (["--scheduler", "::1:8786"], "an IPv6 address goes in brackets"),
+        (["--scheduler", ""], "--scheduler is empty: give a running Dask scheduler's address"),
+        (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "0"],
+         "--scheduler and --workers contradict each other"),
+        (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "2"],
+         "--scheduler and --workers contradict each other"),
+    ],
+)  # fmt: skip
+def test_scheduler_address_is_checked_before_anything(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], extra: list[str], message: str
+) -> None:
+    """Was: Dask's "invalid literal for int()", the connect timeout waited out for port 99999,
+    an empty address or one given with --workers silently ignored (a local cluster, or this
+    process), and no check at all when every output was complete already."""
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out)]
+    start = time.monotonic()
+    assert main([*argv, *extra]) == 2
+    assert time.monotonic() - start < 5  # no connect timeout waited out
+    err = capsys.readouterr().err
+    assert err.startswith("pftrack smooth: error: ") and err.count("\n") == 1
+    assert message in err and "--scheduler" in err
+    assert not out.exists()
+    # every output complete: checked all the same
+    assert main([*argv, "--workers", "0"]) == 0
+    capsys.readouterr()
+    assert main([*argv, *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err
+
+
+def test_scheduler_address_from_the_environment_is_checked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", "tcp://127.0.0.1:8786x")
+    assert main(argv) == 2
+    assert "error: $DASK_SCHEDULER_ADDRESS 'tcp://127.0.0.1:8786x': port '8786x'" in (
+        capsys.readouterr().err
+    )
+    # an explicit --workers runs here (the environment's address is a default, not an order)
+    assert main([*argv, "--workers", "0"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["workers"] == 0 and summary["scheduler"] is None
+    # in Python: Dask's scheduler-address setting is checked too, and named
+    with (
+        dask.config.set({"scheduler-address": "tcp://127.0.0.1:0"}),
+        pytest.raises(
+            ValueError, match=r"^\$DASK_SCHEDULER_ADDRESS \(Dask's scheduler-address\) 'tcp://"
+        ),
+    ):
+        smooth_many(tmp_path / "tracks", tmp_path / "o2")
+
+
+def test_where_to_run_is_refused_when_contradictory_or_not_a_client(
+    data: Path, tmp_path: Path, client: Any
+) -> None:
+    """``client="tcp://..."`` failed in Dask: "'str' object has no attribute 'register_plugin'"."""
+    address = client.scheduler.address
+    with pytest.raises(TypeError, match=(
+        r"^client must be a distributed.Client or None, got str: to connect to a running "
+        rf"scheduler by its address, pass scheduler='{address}'"
+    )):  # fmt: skip
+        track_many(data / "plain", tmp_path / "o", client=address)
+    with pytest.raises(TypeError, match="client must be a distributed.Client or None, got int$"):
+        track_many(data / "plain", tmp_path / "o", client=3)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="client must be a distributed.Client"):
+        with dask_client(address):  # type: ignore[arg-type]
+            pass
+    for kwargs, named in (
+        ({"client": client, "n_workers": 0}, "client and n_workers are both given"),
+        ({"client": client, "scheduler": address}, "client and scheduler are both given"),
+        ({"scheduler": address, "n_workers": 2}, "scheduler and n_workers are both given"),
+    ):
+        with pytest.raises(ValueError, match=named):
+            track_many(data / "plain", tmp_path / "o", **kwargs)
+    with pytest.raises(ValueError, match=r"^scheduler is empty"):
+        track_many(data / "plain", tmp_path / "o", scheduler=" ")
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.fixture
+def no_workers_timeout_1s() -> Iterator[None]:
+    """Dask's ``distributed.scheduler.no-workers-timeout``, the batch's wait for a worker: 1 s."""
+    import dask
+
+    with dask.config.set({"distributed.scheduler.no-workers-timeout": "1s"}):
+        yield
+
+
+@pytest.mark.filterwarnings("always:the scheduler at")
+def test_a_scheduler_without_workers_is_said_at_once_then_an_error(
+    tmp_path: Path, no_workers_timeout_1s: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``dask scheduler`` alone: the batch waited forever, saying nothing."""
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    with distributed.LocalCluster(
+        n_workers=0, host="127.0.0.1", dashboard_address=None, processes=True
+    ) as bare:
+        address = bare.scheduler_address
+        start = time.monotonic()
+        assert main(["smooth", str(tmp_path / "tracks"), "--out", str(out),
+                     "--scheduler", address]) == 2  # fmt: skip
+        assert time.monotonic() - start < 10
+    assert capsys.readouterr().err.splitlines() == [
+        f"pftrack smooth: warning: the scheduler at {address} has no workers; waiting up to "
+        f"1 s for one (start one: dask worker {address})",
+        f"pftrack smooth: error: the scheduler at {address} has no workers: none came within "
+        f"1 s (start them with: dask worker {address}; the wait is Dask's "
+        "distributed.scheduler.no-workers-timeout, "
+        "$DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT)",
+    ]
+    assert not out.exists()  # nothing written, as for a scheduler that cannot be reached
+
+
+def test_the_help_states_the_engines_wait_for_a_worker(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from pftrack.batch.engine import NO_WORKERS_WAIT, no_workers_timeout
+    from pftrack.cli import batch
+
+    assert batch.NO_WORKERS_WAIT == NO_WORKERS_WAIT == no_workers_timeout()
+    with pytest.raises(SystemExit):
+        main(["batch", "--help"])
+    assert f"waits up to {NO_WORKERS_WAIT:g} s for one" in " ".join(capsys.readouterr().out.split())
+
+
+def _close_my_worker(k: int) -> TaskResult:
+    """A task that closes its worker (and the worker's nanny) and returns a moment later."""
+    worker = distributed.get_worker()
+    worker.loop.add_callback(worker.close, nanny=True, reason="test: workers lost")
+    time.sleep(0.3)
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+
+
+@pytest.mark.parametrize("setting_on_the_scheduler", [False, True])
+def test_workers_lost_mid_run_fail_the_tasks_left(
+    tmp_path: Path, setting_on_the_scheduler: bool
+) -> None:
+    """Every worker gone mid-run: the batch waited forever for the tasks left.
+
+    The wait is Dask's ``no-workers-timeout`` as this process reads it; a scheduler that has the
+    setting itself fails the tasks first (``NoWorkerError``): the same error is reported.
+    """
+    import dask
+
+    jobs = [Job("first", _close_my_worker, (0,), ()), *(Job(f"slow{k}", _slow, (k,), ())
+                                                        for k in range(2))]  # fmt: skip
+    setting = {"distributed.scheduler.no-workers-timeout": "1s"}
+    with contextlib.ExitStack() as stack:
+        if setting_on_the_scheduler:
+            stack.enter_context(dask.config.set(setting))
+        cluster = stack.enter_context(distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+        ))  # fmt: skip
+        stack.enter_context(dask.config.set(setting))
+        address = cluster.scheduler_address
+        start = time.monotonic()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            summary = run_jobs(jobs, tmp_path, kind="smooth", settings={}, scheduler=address)
+        assert time.monotonic() - start < 15
+    if not setting_on_the_scheduler:  # this process saw them go
+        said = [str(w.message) for w in caught]
+        assert said == [f"the scheduler at {address} has lost all its workers; waiting up to "
+                        f"1 s for one (start one: dask worker {address})"]  # fmt: skip
+    status = {e["name"]: e["status"] for e in summary.entries}
+    assert status["slow0"] == status["slow1"] == "failed"
+    for e in summary.failed:
+        assert e["error"] == (
+            f"no worker on the scheduler at {address} for 1 s: its workers were lost before "
+            f"this file ran or finished (start some: dask worker {address}; a re-run does the "
+            "rest)"
+        )
+    assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] >= 2

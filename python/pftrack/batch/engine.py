@@ -42,7 +42,14 @@ from pftrack.io.video import IMAGE_SUFFIXES
 if TYPE_CHECKING:
     from distributed import Client
 
-__all__ = ["BatchSummary", "Job", "dask_client", "fingerprint", "run_jobs"]
+__all__ = [
+    "BatchSummary",
+    "Job",
+    "check_scheduler_address",
+    "dask_client",
+    "fingerprint",
+    "run_jobs",
+]
 
 SUMMARY_NAME = "summary.json"
 
@@ -267,14 +274,21 @@ def dask_client(
     client : distributed.Client, optional
         Use this client (left open).
     scheduler : str, optional
-        Address of a running scheduler (``tcp://HOST:8786``); default: Dask's
-        ``scheduler-address`` setting (``DASK_SCHEDULER_ADDRESS``), else a new cluster.
+        Address of a running scheduler (``tcp://HOST:8786``), checked first
+        (:func:`check_scheduler_address`).
     n_workers : int, optional
-        Workers of the new ``LocalCluster`` (default: one per core), each a process with one
-        thread.
+        Workers of a new ``LocalCluster``, each a process with one thread. Given, a local
+        cluster is started even where Dask's ``scheduler-address`` setting
+        (``DASK_SCHEDULER_ADDRESS``) names a scheduler. Default: that setting's scheduler,
+        else a local cluster of one worker per core.
 
     Raises
     ------
+    TypeError
+        `client` is not a ``distributed.Client`` (an address goes in `scheduler`).
+    ValueError
+        A malformed or empty address; `client`, `scheduler` and `n_workers` that contradict
+        each other (more than one given, or ``n_workers`` < 1).
     OSError
         The scheduler cannot be reached within Dask's ``distributed.comm.timeouts.connect``
         (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``): one line naming the
@@ -286,11 +300,13 @@ def dask_client(
 
     from pftrack.batch._plugin import SingleThreaded
 
+    address = where_to_run(client, scheduler, n_workers)
+    if n_workers is not None and n_workers < 1:
+        raise ValueError(f"n_workers is {n_workers}, expected >= 1 for a cluster")
     if client is not None:
         client.register_plugin(SingleThreaded())
         yield client
         return
-    address = scheduler_address(scheduler)
     if address:
         try:
             connected = Client(address)  # timeout: distributed.comm.timeouts.connect
@@ -382,11 +398,151 @@ def _interrupts_held() -> Iterator[None]:
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:
-    """The scheduler a batch connects to: `scheduler`, else Dask's ``scheduler-address``."""
-    import dask
+    """The scheduler a batch connects to: `scheduler`, else Dask's ``scheduler-address``.
 
-    address = scheduler or dask.config.get("scheduler-address", None)
-    return str(address) if address else None
+    Both are checked (:func:`check_scheduler_address`); an empty setting counts as none.
+    """
+    if scheduler is not None:
+        return check_scheduler_address(scheduler, "scheduler")
+    try:
+        import dask
+    except ImportError:  # no Dask, no setting: the batch says how to install it if it needs it
+        return None
+    address = dask.config.get("scheduler-address", None)
+    if address is None or address == "":
+        return None
+    return check_scheduler_address(address, "$DASK_SCHEDULER_ADDRESS (Dask's scheduler-address)")
+
+
+#: Dask's comm protocols whose addresses are ``PROTOCOL://HOST:PORT`` (``inproc://`` is taken
+#: as it is: a scheduler in this very process).
+SCHEDULER_PROTOCOLS = ("tcp", "tls", "ws", "wss", "ucx")
+
+
+def check_scheduler_address(address: object, what: str = "scheduler") -> str:
+    """`address` if it is a scheduler's address, ``tcp://HOST:PORT``; else a one-line error.
+
+    Checked before anything connects or runs (a re-run whose outputs are all complete too):
+    ``tcp://127.0.0.1:8786x`` failed in Dask with "invalid literal for int()", port 99999 waited
+    out the connect timeout, an empty address started a local cluster instead.
+
+    Parameters
+    ----------
+    address : str
+        ``PROTOCOL://HOST:PORT`` (protocol ``tcp``, ``tls``, ``ws``, ``wss`` or ``ucx``; none:
+        ``tcp``), ``HOST`` a name, an IPv4 address or a bracketed IPv6 one (``[::1]``), ``PORT``
+        in 1..65535. Spaces around it are dropped.
+    what : str
+        Names the address in the error (``"--scheduler"``, ``"scheduler"``, ...).
+
+    Returns
+    -------
+    str
+        The address, stripped.
+
+    Raises
+    ------
+    TypeError
+        `address` is not a str.
+    ValueError
+        It is empty, or not of that form (the part that is wrong named).
+    """
+    if not isinstance(address, str):
+        raise TypeError(
+            f"{what} must be a str, tcp://HOST:PORT, got {type(address).__name__} {address!r}"
+        )
+    text = address.strip()
+    if not text:
+        raise ValueError(
+            f"{what} is empty: give a running Dask scheduler's address, tcp://HOST:PORT"
+        )
+    expected = "expected tcp://HOST:PORT, PORT in 1..65535"
+    named = f"{what} {text!r}"
+    protocol, sep, rest = text.partition("://")
+    if not sep:
+        protocol, rest = "tcp", text
+    if protocol == "inproc":
+        return text
+    if protocol not in SCHEDULER_PROTOCOLS:
+        known = ", ".join(f"{p}://" for p in SCHEDULER_PROTOCOLS)
+        raise ValueError(f"{named}: unknown protocol {protocol}:// ({known}; {expected})")
+    host, colon, port = rest.rpartition(":")
+    if host.startswith("[") and host.endswith("]"):
+        bare = host[1:-1]
+        bad_host = not bare or any(c not in "0123456789abcdefABCDEF:." for c in bare)
+    elif ":" in host and not any(c in "[]/" for c in host):
+        raise ValueError(f"{named}: an IPv6 address goes in brackets, tcp://[::1]:8786")
+    else:
+        bad_host = not host or any(c.isspace() or c in "/?#@[]:" for c in host)
+    if not colon or (not port and not bad_host):
+        raise ValueError(f"{named}: no port ({expected})")
+    if bad_host:
+        problem = f"host {host!r} is not a host name or address" if host else "no host"
+        raise ValueError(f"{named}: {problem} ({expected})")
+    if not (port.isascii() and port.isdigit()):
+        raise ValueError(f"{named}: port {port!r} is not a number ({expected})")
+    if not 1 <= int(port) <= 65535:
+        raise ValueError(f"{named}: port {int(port)} is out of range ({expected})")
+    return text
+
+
+def check_client(client: object) -> None:
+    """Refuse a `client` that is not a ``distributed.Client`` (None passes).
+
+    Raises
+    ------
+    TypeError
+        Naming `client`, and how to connect to an address (``scheduler=``): a string address
+        failed deep in Dask with "'str' object has no attribute 'register_plugin'".
+    """
+    if client is None:
+        return
+    try:
+        from distributed import Client
+    except ImportError:  # no Dask: whatever it is, it is not a Client
+        Client = None  # type: ignore[assignment,misc]  # noqa: N806
+    if Client is not None and isinstance(client, Client):
+        return
+    hint = (
+        f": to connect to a running scheduler by its address, pass scheduler={client!r} "
+        "(or distributed.Client(ADDRESS) as client)"
+        if isinstance(client, (str, os.PathLike))
+        else ""
+    )
+    raise TypeError(
+        f"client must be a distributed.Client or None, got {type(client).__name__}{hint}"
+    )
+
+
+def where_to_run(client: Client | None, scheduler: str | None, n_workers: int | None) -> str | None:
+    """Check where a batch is to run; the address of the scheduler to connect to, if any.
+
+    One of: `client` (its cluster), `scheduler` (checked with :func:`check_scheduler_address`),
+    `n_workers` (a local cluster, or this process for 0), or none of them: Dask's
+    ``scheduler-address`` setting (``DASK_SCHEDULER_ADDRESS``) if it names one, else a local
+    cluster. Returns None but for a scheduler to connect to.
+
+    Raises
+    ------
+    TypeError
+        `client` is not a ``distributed.Client``.
+    ValueError
+        Two of them given (``n_workers`` would have been ignored, silently), or a bad address.
+    """
+    check_client(client)
+    given = [
+        name
+        for name, value in (("client", client), ("scheduler", scheduler), ("n_workers", n_workers))
+        if value is not None
+    ]
+    if len(given) > 1:
+        raise ValueError(
+            f"{' and '.join(given)} are both given: the tasks run on a client's cluster, on a "
+            "scheduler's, or on a local cluster of n_workers (0: in this process); give one"
+        )
+    if client is not None or n_workers is not None:
+        return None
+    return scheduler_address(scheduler)
 
 
 def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
@@ -682,8 +838,11 @@ def run_jobs(
     suffixes : sequence of str
         Extra outputs per job (``".mp4"``), checked before any work.
     client, scheduler, n_workers
-        Where the tasks run (see :func:`dask_client`); ``n_workers=0`` runs them one after the
-        other in this process, without Dask.
+        Where the tasks run, one of them at most (see :func:`dask_client`); ``n_workers=0``
+        runs them one after the other in this process, without Dask. A cluster whose workers
+        are all gone while tasks wait (none at the start, or all lost on the way) is waited for
+        up to :func:`no_workers_timeout` seconds, with a warning at once; then the batch stops
+        (none at the start: ``TimeoutError``) or the tasks left fail (lost on the way).
     force : bool
         Redo jobs whose outputs are complete.
     show_progress : bool, optional
@@ -700,15 +859,22 @@ def run_jobs(
     ImportError
         Tasks are to run on Dask (`n_workers` is not 0) and Dask distributed is not installed
         (the message says how to install it); raised before any task runs or file is written.
+    TypeError
+        `client` is not a ``distributed.Client`` (an address goes in `scheduler`).
+    ValueError
+        A bad `scheduler` address (or Dask's ``scheduler-address`` setting), or more than one
+        of `client`, `scheduler` and `n_workers` given; checked before anything else.
     OSError
-        The scheduler cannot be reached (see :func:`dask_client`); raised before `out_dir` is
-        created or any file written.
+        The scheduler cannot be reached (see :func:`dask_client`), or it has no worker and none
+        comes within :func:`no_workers_timeout` (a ``TimeoutError``); raised before `out_dir`
+        is created or any file written.
     KeyboardInterrupt
         After cancelling the tasks still running and closing the cluster this started; the
         outputs written so far are complete.
     """
     if n_workers is not None and n_workers < 0:
         raise ValueError(f"n_workers is {n_workers}, expected >= 0")
+    address = where_to_run(client, scheduler, n_workers)  # checked even when nothing is to run
     out = Path(out_dir)
     start = time.perf_counter()
     _check_outputs(jobs, out, suffixes)
@@ -754,21 +920,24 @@ def run_jobs(
     with contextlib.ExitStack() as stack:
         c = None
         if on_dask:  # connected (or the local cluster started) before --out is touched
-            n = n_workers if n_workers is not None else (os.cpu_count() or 1)
-            n = min(n, len(pending))  # a local cluster: no idle worker to start
-            c = stack.enter_context(dask_client(client, scheduler, n))
+            if client is not None or address:
+                c = stack.enter_context(dask_client(client, address))
+            else:  # a local cluster: no idle worker to start
+                n = n_workers if n_workers is not None else (os.cpu_count() or 1)
+                c = stack.enter_context(dask_client(n_workers=min(n, len(pending))))
             info = c.scheduler_info()
-            summary.workers = len(info.get("workers", {}))
-            given = None if client is not None else scheduler_address(scheduler)
             reported = str(info.get("address")) if info.get("address") else None
-            summary.scheduler = given or reported  # the user's spelling of the address
+            summary.scheduler = address or reported  # the user's spelling of the address
+            summary.workers = _wait_for_workers(c, summary.scheduler or "?", no_workers_timeout())
         if pending and enabled(show_progress) and all(job.count is not None for job in pending):
             # frames over all sequences; the clock starts once the cluster runs
             frames = stack.enter_context(_Frames(pending, desc, show_progress))
         _make_out_dir(out)
         try:
             if c is not None:
-                _run_on_dask(c, pending, record, summary.kind, bar, frames)
+                wait = no_workers_timeout()
+                where = summary.scheduler or "?"
+                _run_on_dask(c, pending, record, summary.kind, bar, frames, where, wait)
             elif frames is not None:
                 for job in pending:
                     record(job, call_task(job.func, job.args, frames.reporter(job.name)))
@@ -784,6 +953,125 @@ def run_jobs(
             with atomic_write(out / SUMMARY_NAME) as fh:
                 fh.write(summary.to_json() + "\n")
     return summary
+
+
+#: Seconds a batch waits for a worker on a cluster that has none, unless Dask's
+#: ``distributed.scheduler.no-workers-timeout`` says otherwise (:func:`no_workers_timeout`).
+NO_WORKERS_WAIT = 60.0
+#: Seconds between two counts of a cluster's workers while tasks wait on it.
+WORKERS_POLL = 1.0
+#: Seconds between two looks for finished tasks.
+COMPLETED_POLL = 0.05
+
+
+def no_workers_timeout() -> float:
+    """How long a batch waits for a worker on a cluster that has none, in seconds.
+
+    Dask's ``distributed.scheduler.no-workers-timeout`` (a scheduler's setting, read here in
+    this process: ``DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT=120s``) when set, else
+    :data:`NO_WORKERS_WAIT` (Dask's own default, none, waits forever).
+
+    Raises
+    ------
+    ValueError
+        The setting is not a duration.
+    """
+    import dask
+    from dask.utils import parse_timedelta
+
+    key = "distributed.scheduler.no-workers-timeout"
+    value = dask.config.get(key, None)
+    if value is None:
+        return NO_WORKERS_WAIT
+    try:
+        seconds = float(parse_timedelta(value, default="s"))
+    except (TypeError, ValueError, KeyError):
+        seconds = math.nan
+    if not seconds >= 0 or math.isinf(seconds):
+        raise ValueError(f"{key} is {value!r}, expected a duration such as '60s'")
+    return seconds
+
+
+def _n_workers(c: Client) -> int:
+    return len(c.scheduler_info().get("workers", {}))
+
+
+def _no_workers(address: str, wait: float) -> str:
+    return f"waiting up to {wait:g} s for one (start one: dask worker {address})"
+
+
+def _wait_for_workers(c: Client, address: str, wait: float) -> int:
+    """The cluster's workers, once it has one: none yet is said at once, and waited for.
+
+    Raises
+    ------
+    TimeoutError
+        None came within `wait` seconds.
+    """
+    n = _n_workers(c)
+    if n:
+        return n
+    warnings.warn(
+        f"the scheduler at {address} has no workers; {_no_workers(address, wait)}", stacklevel=4
+    )
+    deadline = time.monotonic() + wait
+    while not (n := _n_workers(c)):
+        if time.monotonic() >= deadline:
+            raise TimeoutError(
+                f"the scheduler at {address} has no workers: none came within {wait:g} s "
+                f"(start them with: dask worker {address}; the wait is Dask's "
+                "distributed.scheduler.no-workers-timeout, "
+                "$DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT)"
+            )
+        time.sleep(min(0.2, wait))
+    return n
+
+
+class _WorkersWatch:
+    """While tasks wait on a cluster: tells when it has been without workers for too long."""
+
+    def __init__(self, c: Client, address: str, wait: float) -> None:
+        self.c, self.address, self.wait = c, address, wait
+        self.since: float | None = None  # when the workers were last seen gone
+        self._checked = -math.inf
+
+    def given_up(self) -> bool:
+        """True once the cluster has had no worker for `wait` seconds (warns when they go)."""
+        now = time.monotonic()
+        if now - self._checked < WORKERS_POLL:
+            return False
+        self._checked = now
+        if _n_workers(self.c):
+            self.since = None
+            return False
+        if self.since is None:
+            self.since = now
+            warnings.warn(
+                f"the scheduler at {self.address} has lost all its workers; "
+                f"{_no_workers(self.address, self.wait)}",
+                stacklevel=2,
+            )
+        return now - self.since >= self.wait
+
+    def error(self, noun: str) -> str:
+        """The error of a task left waiting when :meth:`given_up`."""
+        return (
+            f"no worker on the scheduler at {self.address} for {self.wait:g} s: its workers "
+            f"were lost before this {noun} ran or finished (start some: dask worker "
+            f"{self.address}; a re-run does the rest)"
+        )
+
+
+def _completed(futures: Any, given_up: Callable[[], bool]) -> Iterator[Any]:
+    """The futures of `futures` (``as_completed``) as they finish; stops early on `given_up`."""
+    while True:
+        ready = futures.next_batch(block=False)
+        if ready:
+            yield from ready
+        elif futures.is_empty() or given_up():
+            return
+        else:
+            time.sleep(COMPLETED_POLL)
 
 
 class _Frames:
@@ -847,10 +1135,13 @@ def _run_on_dask(
     kind: str,
     bar: dict[str, Any],
     frames: _Frames | None = None,
+    address: str = "?",
+    wait: float = NO_WORKERS_WAIT,
 ) -> None:
     """Submit `pending` to Dask and record each result as it completes.
 
-    With `frames`, the tasks' frame counts come as Dask events on a topic of this run.
+    With `frames`, the tasks' frame counts come as Dask events on a topic of this run. A
+    cluster without workers for `wait` seconds (at `address`) fails the tasks left.
     """
     from distributed import as_completed
 
@@ -863,7 +1154,9 @@ def _run_on_dask(
         where = (topic, job.name) if frames is not None else None
         fut = c.submit(call_task, job.func, job.args, where, key=key, pure=False)
         futures[fut.key] = (fut, job)
-    done = as_completed([f for f, _ in futures.values()])
+    watch = _WorkersWatch(c, address, wait)
+    noun = "sequence" if kind == "track" else "file"
+    done = _completed(as_completed([f for f, _ in futures.values()]), watch.given_up)
     try:
         for fut in progress(done, **bar) if frames is None else done:
             _, job = futures.pop(fut.key)
@@ -873,8 +1166,17 @@ def _run_on_dask(
                 record(job, fut.result())
             elif fut.status == "error":  # the worker died (KilledWorker) or the like
                 exc = fut.exception()
-                record(job, (None, one_line(exc), None))
+                # the scheduler's own no-workers-timeout: said as this process's watch says it
+                lost = type(exc).__name__ == "NoWorkerError"
+                record(job, (None, watch.error(noun) if lost else one_line(exc), None))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
+        if futures:  # given up: no worker for too long
+            c.cancel([f for f, _ in futures.values()], force=True)
+            for _, job in list(futures.values()):
+                if frames is not None:
+                    frames.finish(job.name)
+                record(job, (None, watch.error(noun), None))
+            futures.clear()
     except BaseException:
         c.cancel([f for f, _ in futures.values()], force=True)
         raise

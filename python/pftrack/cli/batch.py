@@ -33,6 +33,10 @@ EXIT_SOME_FAILED = 1
 #: :data:`pftrack.recovery.fill.MAX_GAP_LIMIT` and :class:`pftrack.recovery.LinkConfig`'s,
 #: stated here so that ``--help`` does not import the recovery code (a test checks they agree).
 MAX_GAP = 100_000
+#: Seconds a batch waits for a worker on a scheduler that has none:
+#: :data:`pftrack.batch.engine.NO_WORKERS_WAIT`, stated here so that ``--help`` does not import
+#: the engine (a test checks they agree).
+NO_WORKERS_WAIT = 60
 
 
 def max_gap(text: str) -> int:
@@ -48,15 +52,21 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("batch (several inputs)")
     g.add_argument(
         "--scheduler", metavar="ADDRESS", default=None,
-        help="a running Dask scheduler, tcp://HOST:8786, connected to before --out is "
-        "written; waits up to Dask's connect timeout (30 s; "
-        "$DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT) (default: $DASK_SCHEDULER_ADDRESS, "
-        "else none: a local cluster is started for the run and closed at the end)",
+        help="a running Dask scheduler, tcp://HOST:PORT, checked first (protocol, host, port "
+        "1-65535; not with --workers), connected to before --out is written; waits up to "
+        "Dask's connect timeout to reach it (30 s; $DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT), "
+        "and while it has no worker, at the start or after losing them all, says so at once "
+        f"and waits up to {NO_WORKERS_WAIT} s for one "
+        "($DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT), "
+        "then fails: at the start with exit status 2, nothing written; mid-run the tasks left "
+        "fail (default: $DASK_SCHEDULER_ADDRESS, else none: a local cluster is started for "
+        "the run and closed at the end)",
     )  # fmt: skip
     g.add_argument(
         "--workers", type=non_negative_int, default=None, metavar="N",
         help="worker processes of the local cluster, one thread each (default: one per core, "
-        f"{_cores()} here; not used with --scheduler); 0 runs in this process without Dask",
+        f"{_cores()} here); 0 runs in this process without Dask; not with --scheduler (and "
+        "given, a local run even where $DASK_SCHEDULER_ADDRESS is set)",
     )  # fmt: skip
     g.add_argument("--force", action="store_true",
                    help="redo inputs whose outputs are complete, instead of skipping "
@@ -128,10 +138,12 @@ def add_parser(sub: Any) -> None:
         "PETS09-S2L1's video), else 1; a number only with --detections auto",
     )  # fmt: skip
     p.add_argument("--render", action="store_true",
-                   help="also write DIR/NAME.mp4, annotated (an odd width or height made "
-                   "even by one copied column or row, as track --render); a later batch "
-                   "that scans DIR passes it over (its NAME.json lists it), so DIR may be "
-                   "the input folder")  # fmt: skip
+                   help="also write DIR/NAME.mp4: the final tracks of DIR/NAME.txt (linked, "
+                   "filled and smoothed) drawn on the frames, boxes, ids and trails, as "
+                   "pftrack render INPUT DIR/NAME.txt draws them; not the boxes as tracked "
+                   "online that track --render draws. An odd width or height is made even by "
+                   "one copied column or row; a later batch that scans DIR passes the video "
+                   "over (its NAME.json lists it), so DIR may be the input folder")  # fmt: skip
     p.add_argument("--iou", type=iou_threshold, default=0.5,
                    help=f"{IOU_HELP}, for the metrics")  # fmt: skip
     add_tracker_options(p)
@@ -168,9 +180,27 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
 
 
 def _where(args: argparse.Namespace) -> dict[str, Any]:
-    scheduler = args.scheduler or os.environ.get("DASK_SCHEDULER_ADDRESS") or None
-    workers = args.workers if args.workers is not None else _cores()
-    return {"scheduler": scheduler, "n_workers": workers, "force": args.force}
+    """Where the batch runs, checked before anything runs (the keywords of ``track_many``).
+
+    ``--scheduler`` (checked: an empty or malformed address is refused) or ``--workers``, not
+    both; with neither, ``$DASK_SCHEDULER_ADDRESS`` if set, else a local cluster. An explicit
+    ``--workers`` runs locally even where ``$DASK_SCHEDULER_ADDRESS`` is set.
+    """
+    from pftrack.batch.engine import check_scheduler_address
+
+    where: dict[str, Any] = {"scheduler": None, "n_workers": args.workers, "force": args.force}
+    if args.scheduler is not None:
+        if args.workers is not None:
+            raise ValueError(
+                "--scheduler and --workers contradict each other: --workers sizes the local "
+                "cluster (0: this process), which --scheduler replaces; give one"
+            )
+        where["scheduler"] = check_scheduler_address(args.scheduler, "--scheduler")
+    elif args.workers is None and os.environ.get("DASK_SCHEDULER_ADDRESS"):
+        where["scheduler"] = check_scheduler_address(
+            os.environ["DASK_SCHEDULER_ADDRESS"], "$DASK_SCHEDULER_ADDRESS"
+        )
+    return where
 
 
 def run(args: argparse.Namespace) -> int:
@@ -191,7 +221,8 @@ def run(args: argparse.Namespace) -> int:
         render=".mp4" if args.render else None,
         iou=args.iou,
     )
-    return _run("batch", lambda: track_many(args.inputs, args.out, options=options, **_where(args)))
+    where = _where(args)
+    return _run("batch", lambda: track_many(args.inputs, args.out, options=options, **where))
 
 
 def run_recover(args: argparse.Namespace) -> int:
