@@ -514,8 +514,8 @@ def test_tasks_on_workers_report_their_frames(client: Any, data: Path) -> None:
     try:
         options = TrackOptions(config=_config())
         fut = client.submit(call_task, track_sequence, (seq, options), (topic, "walk"), pure=False)
-        result, error, _ = fut.result()
-        assert error is None and result is not None
+        outcome = fut.result()
+        assert outcome.error is None and outcome.result is not None
         deadline = time.monotonic() + 10
         while not got and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -640,9 +640,14 @@ def test_ctrl_c_while_the_cluster_starts_is_one_line(
     text = stderr.decode()
     status, how = (130, "interrupted") if sig == "SIGINT" else (143, "terminated (SIGTERM)")
     assert proc.returncode == status, text
-    assert text.splitlines() == [
-        f"pftrack batch: {how}; the outputs written so far are complete (re-run to finish the rest)"
-    ]
+    # what it left, said truthfully (was: "the outputs written so far are complete" with
+    # nothing written): the signal is held while the cluster starts, so nothing is, as a rule
+    assert text.splitlines() in (
+        [f"pftrack batch: {how}; nothing was written: it stopped before the run began (--out "
+         f"{out} untouched)"],
+        [f"pftrack batch: {how}; no sequence was finished; {out / 'summary.json'} lists them as "
+         "cancelled (re-run to run them)"],
+    ) or text.startswith(f"pftrack batch: {how}; the outputs of the "), text  # fmt: skip
     deadline = time.monotonic() + 20  # the workers end with the cluster, closed on the way out
     while _group(proc.pid) and time.monotonic() < deadline:
         time.sleep(0.1)
@@ -1169,7 +1174,11 @@ def test_the_help_states_the_engines_wait_for_a_worker(
     assert batch.NO_WORKERS_WAIT == NO_WORKERS_WAIT == no_workers_timeout()
     with pytest.raises(SystemExit):
         main(["batch", "--help"])
-    assert f"waits up to {NO_WORKERS_WAIT:g} s for one" in " ".join(capsys.readouterr().out.split())
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"waits up to {NO_WORKERS_WAIT:g} s for one" in text
+    # --render: the final tracks, not track --render's online boxes (was: "as track --render")
+    assert "--render also write DIR/NAME.mp4: the final tracks of DIR/NAME.txt" in text
+    assert "not the boxes as tracked online that track --render draws" in text
 
 
 def _close_my_worker(k: int) -> TaskResult:
@@ -1220,3 +1229,169 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
             "rest)"
         )
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] >= 2
+
+
+# --- inputs a worker cannot see, broken links, the same input twice, listing order ----------
+
+
+def _track_unseen(seq: SequenceInput, options: TrackOptions) -> TaskResult:
+    """``track_sequence`` on a worker that cannot see ``seq.frames`` (a share not mounted there)."""
+    from pftrack.batch.tasks import track_sequence
+
+    real = Path.exists
+
+    def exists(self: Path, *args: Any, **kwargs: Any) -> bool:
+        return False if self == seq.frames else real(self, *args, **kwargs)
+
+    Path.exists = exists  # type: ignore[method-assign]
+    try:
+        return track_sequence(seq, options)
+    finally:
+        Path.exists = real  # type: ignore[method-assign]
+
+
+def test_a_path_a_worker_cannot_see_is_said_so(data: Path, client: Any, tmp_path: Path) -> None:
+    """Was: "video source not found: PATH", as if it did not exist, and no host named."""
+    (seq,) = [s for s in find_sequences(data) if s.name == "walk"]
+    job = Job(seq.name, _track_unseen, (seq, TrackOptions(config=_config())), seq.files)
+    summary = run_jobs([job], tmp_path / "out", kind="track", settings={}, client=client)
+    (entry,) = summary.entries
+    host = socket.gethostname()
+    assert entry["status"] == "failed" and entry["host"] == host
+    assert entry["error"] == (
+        f"{seq.frames}: not found on worker {host} (the client sees it: workers must see the "
+        "same paths)"
+    )
+    written = json.loads((tmp_path / "out" / "summary.json").read_text())["sequences"][0]
+    assert written["host"] == host and written["error"] == entry["error"]
+    # a file missing for the client too is reported as the task said it
+    gone = SequenceInput("gone", tmp_path / "gone.avi")
+    job = Job("gone", _track_unseen, (gone, TrackOptions(config=_config())), gone.files)
+    (entry,) = run_jobs([job], tmp_path / "o2", kind="track", settings={}, client=client).entries
+    assert entry["error"] == f"video source not found: {gone.frames}" and entry["host"] == host
+
+
+def test_a_broken_link_in_a_scanned_folder_fails_alone(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: the whole batch stopped with "No such file or directory" (exit 2)."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    (vids / "gone.avi").symlink_to(tmp_path / "moved.avi")
+    (vids / "seq").symlink_to(tmp_path / "moved-folder")
+    (vids / "notes.txt").symlink_to(tmp_path / "moved.txt")  # not a video: passed over
+    assert [s.name for s in find_sequences(vids)] == ["gone", "seq", "walk"]
+    out = tmp_path / "out"
+    assert main(["batch", str(vids), "--out", str(out), "--workers", "0", *FAST]) == 1
+    text = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    status = {e["name"]: (e["status"], e.get("error")) for e in summary["sequences"]}
+    assert status == {
+        "gone": ("failed", f"broken symbolic link: {vids / 'gone.avi'} -> {tmp_path}/moved.avi"),
+        "seq": ("failed", f"broken symbolic link: {vids / 'seq'} -> {tmp_path / 'moved-folder'}"),
+        "walk": ("done", None),
+    }
+    assert f"gone: error: broken symbolic link: {vids / 'gone.avi'}" in text
+    # given by its own path: refused, named as a broken link
+    assert main(["batch", str(vids / "gone.avi"), "--out", str(tmp_path / "o2")]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack batch: error: input not found: {vids / 'gone.avi'} is a broken symbolic link "
+        f"(to {tmp_path / 'moved.avi'})\n"
+    )
+    # tracks files too
+    paths = _tracks_files(tmp_path / "tracks")
+    (tmp_path / "tracks" / "run9.txt").symlink_to(tmp_path / "moved.txt")
+    out = tmp_path / "filled"
+    assert main(["recover", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]) == 1
+    files = json.loads((out / "summary.json").read_text())["files"]
+    assert [(f["name"], f["status"]) for f in files] == [
+        *((p.stem, "done") for p in paths),
+        ("run9", "failed"),
+    ]
+    assert files[-1]["error"] == (
+        f"broken symbolic link: {tmp_path / 'tracks' / 'run9.txt'} -> {tmp_path / 'moved.txt'}"
+    )
+
+
+def test_the_same_input_twice_is_said_so(tmp_path: Path) -> None:
+    """Was: "two inputs are both named 'tud' (A and A)"."""
+    video = tmp_path / "vids" / "tud.mp4"
+    video.parent.mkdir()
+    video.write_text("")
+    with pytest.raises(ValueError, match=(
+        rf"^{video} is the same input, given twice \(the same path once links are resolved\): "
+        "give each input once$"
+    )):  # fmt: skip
+        find_sequences([video, video])
+    with pytest.raises(ValueError, match="is the same input, given twice"):
+        find_sequences([tmp_path / "vids", video])  # the folder's entry, then the file again
+    (tmp_path / "alias").symlink_to(tmp_path / "vids")
+    with pytest.raises(ValueError, match=rf"^{video} and {tmp_path / 'alias' / 'tud.mp4'} are "):
+        find_sequences([video, tmp_path / "alias" / "tud.mp4"])
+    other = tmp_path / "other" / "tud.mp4"  # another file of the same name: as before
+    other.parent.mkdir()
+    other.write_text("")
+    with pytest.raises(ValueError, match="two inputs are both named 'tud'"):
+        find_sequences([video, other])
+
+
+def test_a_folder_is_listed_in_natural_order_of_its_names(tmp_path: Path) -> None:
+    """Was: tud2.mp4 before tud.mp4 (the natural key of the whole name: 'tud' < 'tud.mp4')."""
+    (tmp_path / "v").mkdir()
+    for name in ("tud10.mp4", "tud2.mp4", "tud.mp4", "a.avi", "B.avi", "tud1.avi"):
+        (tmp_path / "v" / name).write_text("")
+    (tmp_path / "t").mkdir()
+    for name in ("run10.txt", "run2.txt", "run.txt"):
+        (tmp_path / "t" / name).write_text("")
+    names = [s.name for s in find_sequences(tmp_path / "v")]
+    assert names == ["a", "B", "tud", "tud1", "tud2", "tud10"]
+    from pftrack.batch import find_track_files
+
+    assert [p.stem for p in find_track_files(tmp_path / "t")] == ["run", "run2", "run10"]
+
+
+def test_ctrl_c_says_what_was_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: "the outputs written so far are complete" with nothing written at all."""
+    import pftrack.batch.engine as engine
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out)]
+
+    @contextlib.contextmanager
+    def connecting(*args: Any, **kwargs: Any) -> Iterator[Any]:
+        raise KeyboardInterrupt  # Ctrl-C while connecting, or while the local cluster starts
+        yield
+
+    monkeypatch.setattr(engine, "dask_client", connecting)
+    assert main(argv) == 130
+    assert capsys.readouterr().err == (
+        f"pftrack smooth: interrupted; nothing was written: it stopped before the run began "
+        f"(--out {out} untouched)\n"
+    )
+    assert not out.exists()
+    # in this process: after one file, and before any
+    calls = []
+    real = engine.call_task
+
+    def stop_at_the_second(*args: Any, **kwargs: Any) -> Any:
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(engine, "call_task", stop_at_the_second)
+    assert main([*argv, "--workers", "0"]) == 130
+    assert capsys.readouterr().err == (
+        "pftrack smooth: interrupted; the outputs of the 1 file finished are written and "
+        f"complete; {out / 'summary.json'} lists the rest as cancelled (re-run to finish them)\n"
+    )
+    calls[:] = [1]  # the next run stops at its first file
+    assert main([*argv, "--workers", "0", "--force"]) == 130
+    assert capsys.readouterr().err == (
+        f"pftrack smooth: interrupted; no file was finished; {out / 'summary.json'} lists them "
+        "as cancelled (re-run to run them)\n"
+    )

@@ -24,6 +24,7 @@ import logging
 import math
 import os
 import signal
+import socket
 import threading
 import time
 import traceback
@@ -31,7 +32,7 @@ import warnings
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._progress import Bar, enabled, progress
 from pftrack.batch.tasks import TaskResult, one_line, reporting_frames
@@ -743,11 +744,36 @@ def _worker_reporter(topic: str, name: str) -> Callable[[int], None] | None:
     return report
 
 
+class Outcome(NamedTuple):
+    """What :func:`call_task` sends back: the task's result, or its failure as data.
+
+    Attributes
+    ----------
+    result : TaskResult or None
+        None when the task failed.
+    error, traceback : str or None
+        The failure's one line and traceback.
+    host : str or None
+        The host the task ran on (a failed entry of ``summary.json`` names it, as a done one
+        does).
+    missing : str or None
+        The task failed on a file it could not find (``FileNotFoundError``): the file's name
+        if the error carries one, else ``""``. The client tells a file its worker cannot see
+        from one that does not exist (:func:`_failure`).
+    """
+
+    result: TaskResult | None
+    error: str | None = None
+    traceback: str | None = None
+    host: str | None = None
+    missing: str | None = None
+
+
 def call_task(
     func: Callable[..., TaskResult],
     args: tuple[Any, ...],
     progress: Callable[[int], None] | tuple[str, str] | None = None,
-) -> tuple[TaskResult | None, str | None, str | None]:
+) -> Outcome:
     """Run one task; an exception comes back as data (its line and traceback), not raised.
 
     So a failing input is reported in the summary without Dask logging it as a failed
@@ -766,11 +792,45 @@ def call_task(
         try:
             result = func(*args)
         except Exception as exc:  # noqa: BLE001 - reported per task
-            return None, one_line(exc), traceback.format_exc()
+            missing = None
+            if isinstance(exc, FileNotFoundError):
+                missing = str(exc.filename) if exc.filename else ""
+            return Outcome(None, one_line(exc), traceback.format_exc(), _host(), missing)
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
-    return result, None, None
+    return Outcome(result)
+
+
+def _host() -> str:
+    return socket.gethostname()
+
+
+#: How the client words a file that a worker could not find but the client can.
+UNSEEN = "not found on worker {host} (the client sees it: workers must see the same paths)"
+
+
+def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
+    """The error of a failed task as the client can tell it.
+
+    A read path that is a broken symbolic link here is named as one (was: "No such file or
+    directory", or "video source not found"). A file the task could not find on a worker
+    (`remote`) while this process sees it is the worker's view that differs: said so, with
+    the worker's host (was: "video source not found: PATH", as if it did not exist).
+    """
+    broken = [p for p in job.reads if p.is_symlink() and not p.exists()]
+    if broken:
+        return f"broken symbolic link: {broken[0]} -> {os.readlink(broken[0])}"
+    if not remote or outcome.missing is None or outcome.host is None or outcome.error is None:
+        return outcome.error
+    if outcome.missing:
+        named = [Path(outcome.missing)]
+    else:  # the path in the message (FrameSource's "video source not found: PATH")
+        named = [p for p in (*job.reads, *job.guards) if str(p) in outcome.error]
+    seen = [p for p in named if p.exists()]
+    if not seen:
+        return outcome.error  # missing here too: the error as the task said it
+    return f"{seen[0]}: {UNSEEN.format(host=outcome.host)}"
 
 
 def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) -> None:
@@ -896,18 +956,25 @@ def run_jobs(
             keep = {k: v for k, v in earlier.items() if k not in drop}
             entries[job.name] = {**keep, "status": "skipped"}
 
-    def record(job: Job, outcome: tuple[TaskResult | None, str | None, str | None]) -> None:
-        result, error, trace = outcome
-        if result is not None:
-            entries[job.name] = _write(out, job, result, kind, settings, prints[job.name])
+    remote = False  # the tasks run on Dask workers: set once connected
+    touched = False  # --out created (summary.json is written on the way out, whatever happens)
+    written = 0  # tasks whose outputs this run wrote
+
+    def record(job: Job, outcome: Outcome) -> None:
+        nonlocal written
+        if outcome.result is not None:
+            entries[job.name] = _write(out, job, outcome.result, kind, settings, prints[job.name])
+            written += 1
         else:
             entries[job.name] = {
                 "name": job.name,
                 "status": "failed",
                 "source": str(job.reads[0]) if job.reads else None,
-                "error": error,
-                "traceback": trace,
+                "error": _failure(job, outcome, remote),
+                "traceback": outcome.traceback,
             }
+            if outcome.host is not None:  # where it failed, as a done entry says where it ran
+                entries[job.name]["host"] = outcome.host
         if job.name in notes:
             entries[job.name]["note"] = notes[job.name]
 
@@ -917,42 +984,75 @@ def run_jobs(
     desc = "sequences" if kind == "track" else "files"
     bar = {"total": len(pending), "desc": desc, "enable": show_progress}
     frames: _Frames | None = None
-    with contextlib.ExitStack() as stack:
-        c = None
-        if on_dask:  # connected (or the local cluster started) before --out is touched
-            if client is not None or address:
-                c = stack.enter_context(dask_client(client, address))
-            else:  # a local cluster: no idle worker to start
-                n = n_workers if n_workers is not None else (os.cpu_count() or 1)
-                c = stack.enter_context(dask_client(n_workers=min(n, len(pending))))
-            info = c.scheduler_info()
-            reported = str(info.get("address")) if info.get("address") else None
-            summary.scheduler = address or reported  # the user's spelling of the address
-            summary.workers = _wait_for_workers(c, summary.scheduler or "?", no_workers_timeout())
-        if pending and enabled(show_progress) and all(job.count is not None for job in pending):
-            # frames over all sequences; the clock starts once the cluster runs
-            frames = stack.enter_context(_Frames(pending, desc, show_progress))
-        _make_out_dir(out)
-        try:
-            if c is not None:
-                wait = no_workers_timeout()
-                where = summary.scheduler or "?"
-                _run_on_dask(c, pending, record, summary.kind, bar, frames, where, wait)
-            elif frames is not None:
-                for job in pending:
-                    record(job, call_task(job.func, job.args, frames.reporter(job.name)))
-                    frames.finish(job.name)
-            elif pending:
-                for job in progress(pending, **bar):  # type: ignore[arg-type]
-                    record(job, call_task(job.func, job.args))
-        finally:
-            for job in jobs:
-                entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
-            summary.entries = [entries[job.name] for job in jobs]
-            summary.seconds = time.perf_counter() - start
-            with atomic_write(out / SUMMARY_NAME) as fh:
-                fh.write(summary.to_json() + "\n")
+    try:
+        with contextlib.ExitStack() as stack:
+            c = None
+            if on_dask:  # connected (or the local cluster started) before --out is touched
+                if client is not None or address:
+                    c = stack.enter_context(dask_client(client, address))
+                else:  # a local cluster: no idle worker to start
+                    n = n_workers if n_workers is not None else (os.cpu_count() or 1)
+                    c = stack.enter_context(dask_client(n_workers=min(n, len(pending))))
+                remote = True
+                info = c.scheduler_info()
+                reported = str(info.get("address")) if info.get("address") else None
+                summary.scheduler = address or reported  # the user's spelling of the address
+                summary.workers = _wait_for_workers(
+                    c, summary.scheduler or "?", no_workers_timeout()
+                )
+            if pending and enabled(show_progress) and all(job.count is not None for job in pending):
+                # frames over all sequences; the clock starts once the cluster runs
+                frames = stack.enter_context(_Frames(pending, desc, show_progress))
+            _make_out_dir(out)
+            touched = True
+            try:
+                if c is not None:
+                    wait = no_workers_timeout()
+                    where = summary.scheduler or "?"
+                    _run_on_dask(c, pending, record, summary.kind, bar, frames, where, wait)
+                elif frames is not None:
+                    for job in pending:
+                        record(job, call_task(job.func, job.args, frames.reporter(job.name)))
+                        frames.finish(job.name)
+                elif pending:
+                    for job in progress(pending, **bar):  # type: ignore[arg-type]
+                        record(job, call_task(job.func, job.args))
+            finally:
+                for job in jobs:
+                    entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
+                summary.entries = [entries[job.name] for job in jobs]
+                summary.seconds = time.perf_counter() - start
+                with atomic_write(out / SUMMARY_NAME) as fh:
+                    fh.write(summary.to_json() + "\n")
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM: say what it left, truthfully
+        _say_interrupted(exc, out, kind, written if touched else None)
+        raise
     return summary
+
+
+def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int | None) -> None:
+    """Attach what an interrupted batch left to `exc` (printed by the command).
+
+    `written`: the tasks whose outputs this run wrote; None when ``--out`` was not touched yet
+    (stopped while connecting, or while the local cluster started). Was: "the outputs written
+    so far are complete" whatever was written, nothing at all included.
+    """
+    from pftrack.cli._signals import set_outcome
+
+    noun = "sequence" if kind == "track" else "file"
+    if written is None:
+        text = f"nothing was written: it stopped before the run began (--out {out} untouched)"
+    elif written == 0:
+        text = (
+            f"no {noun} was finished; {out / SUMMARY_NAME} lists them as cancelled (re-run to "
+            "run them)"
+        )
+    else:
+        text = (
+            f"the outputs of the {_count(written, noun)} finished are written and complete; "
+            f"{out / SUMMARY_NAME} lists the rest as cancelled (re-run to finish them)"
+        )
+    set_outcome(exc, text)
 
 
 #: Seconds a batch waits for a worker on a cluster that has none, unless Dask's
@@ -1131,7 +1231,7 @@ class _Frames:
 def _run_on_dask(
     c: Client,
     pending: Sequence[Job],
-    record: Callable[[Job, tuple[TaskResult | None, str | None, str | None]], None],
+    record: Callable[[Job, Outcome], None],
     kind: str,
     bar: dict[str, Any],
     frames: _Frames | None = None,
@@ -1168,14 +1268,14 @@ def _run_on_dask(
                 exc = fut.exception()
                 # the scheduler's own no-workers-timeout: said as this process's watch says it
                 lost = type(exc).__name__ == "NoWorkerError"
-                record(job, (None, watch.error(noun) if lost else one_line(exc), None))
+                record(job, Outcome(None, watch.error(noun) if lost else one_line(exc)))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
         if futures:  # given up: no worker for too long
             c.cancel([f for f, _ in futures.values()], force=True)
             for _, job in list(futures.values()):
                 if frames is not None:
                     frames.finish(job.name)
-                record(job, (None, watch.error(noun), None))
+                record(job, Outcome(None, watch.error(noun)))
             futures.clear()
     except BaseException:
         c.cancel([f for f, _ in futures.values()], force=True)

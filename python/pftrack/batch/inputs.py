@@ -155,24 +155,30 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     Raises
     ------
     FileNotFoundError
-        An input does not exist.
+        An input does not exist (a broken symbolic link is named as one). A broken link met in
+        a scanned folder is not refused: it is a sequence whose task fails, named so.
     ValueError
-        No sequence is found, or two have the same name (their outputs would collide).
+        No sequence is found, or two have the same name (their outputs would collide), or one
+        input is given twice (the same path once links are resolved).
     """
     paths = _absolute(inputs)
     found: list[SequenceInput] = []
     for path in paths:
-        if not path.exists():
-            raise FileNotFoundError(f"input not found: {path}")
+        _check_exists(path)
         seq = _as_sequence(path)
         if seq is not None:
             found.append(seq)
             continue
-        entries = sorted(path.iterdir(), key=lambda p: natural_key(p.name))
+        entries = sorted(path.iterdir(), key=_listing_key)
         before = len(found)
         for entry in entries:
             if entry.name.startswith("."):
                 continue
+            if _broken_link(entry):  # its task fails, named so; the others run
+                if entry.suffix.lower() in VIDEO_SUFFIXES or not entry.suffix:
+                    name = entry.stem if entry.suffix else entry.name
+                    found.append(SequenceInput(name, entry))
+                continue  # notes.txt -> nowhere: passed over, as a file of that kind would be
             if entry.is_file() and (
                 entry.suffix.lower() not in VIDEO_SUFFIXES or _batch_output(entry)
             ):
@@ -195,21 +201,26 @@ def find_track_files(inputs: Inputs) -> list[Path]:
     Raises
     ------
     FileNotFoundError
-        An input does not exist.
+        An input does not exist (a broken symbolic link is named as one; one met in a folder is
+        listed: its task fails, named so).
     ValueError
-        A folder holds no ``.txt`` file, or two files have the same name.
+        A folder holds no ``.txt`` file, or two files have the same name, or one is given
+        twice.
     """
     paths = _absolute(inputs)
     found: list[Path] = []
     for path in paths:
-        if not path.exists():
-            raise FileNotFoundError(f"input not found: {path}")
+        _check_exists(path)
         if path.is_file():
             found.append(path)
             continue
         files = sorted(
-            (p for p in path.iterdir() if p.is_file() and p.suffix == ".txt"),
-            key=lambda p: natural_key(p.name),
+            (
+                p
+                for p in path.iterdir()
+                if (p.is_file() or _broken_link(p)) and p.suffix == ".txt"  # broken: its task fails
+            ),
+            key=_listing_key,
         )
         files = [p for p in files if not p.name.startswith(".")]
         if not files:
@@ -219,14 +230,57 @@ def find_track_files(inputs: Inputs) -> list[Path]:
     return found
 
 
+def _broken_link(path: Path) -> bool:
+    """Whether `path` is a symbolic link to nothing (a target moved or deleted)."""
+    return path.is_symlink() and not path.exists()
+
+
+def _check_exists(path: Path) -> None:
+    """Refuse an input that does not exist, naming a broken symbolic link as one."""
+    if _broken_link(path):
+        raise FileNotFoundError(
+            f"input not found: {path} is a broken symbolic link (to {os.readlink(path)})"
+        )
+    if not path.exists():
+        raise FileNotFoundError(f"input not found: {path}")
+
+
+def _listing_key(path: Path) -> tuple[object, ...]:
+    """The order of a folder's entries: natural order of the name before its extension.
+
+    So ``tud.mp4``, ``tud2.mp4``, ``tud10.mp4``, as ``ls -v`` lists them (was: ``tud2.mp4``
+    first, the natural key of the whole name putting the text ``tud`` before ``tud.mp4``);
+    digit runs compare as numbers (:func:`~pftrack.io.video.natural_key`, as for an image
+    folder's frames: ``9.jpg`` before ``10.jpg``).
+    """
+    stem, dot, suffix = path.name.rpartition(".")
+    if not dot or not stem:  # no extension (a folder), or a name like ".x"
+        stem, suffix = path.name, ""
+    return natural_key(stem), suffix.lower(), path.name
+
+
 def _check_names(names: list[str], sources: list[Path]) -> None:
     seen: dict[str, Path] = {}
     for name, source in zip(names, sources, strict=True):
         if name in RESERVED_NAMES:
             raise ValueError(f"{source}: the name {name!r} is reserved for the batch's own file")
+        if name in seen and _same_file(seen[name], source):  # was: "both named" A and A
+            given = f"{source} is" if seen[name] == source else f"{seen[name]} and {source} are"
+            raise ValueError(
+                f"{given} the same input, given twice (the same path once links are resolved): "
+                "give each input once"
+            )
         if name in seen:
             raise ValueError(
                 f"two inputs are both named {name!r} ({seen[name]} and {source}): their outputs "
                 "would collide; run them in separate batches"
             )
         seen[name] = source
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether `a` and `b` name the same file or folder (links and ``..`` resolved)."""
+    try:
+        return a == b or a.resolve() == b.resolve() or os.path.samefile(a, b)
+    except OSError:
+        return False

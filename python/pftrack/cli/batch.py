@@ -22,7 +22,7 @@ from pftrack.cli._options import (
     iou_threshold,
     non_negative_int,
 )
-from pftrack.cli._signals import Terminated, exit_status
+from pftrack.cli._signals import Terminated, exit_status, line_end, outcome
 
 if TYPE_CHECKING:
     from pftrack.batch import BatchSummary
@@ -161,11 +161,8 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
         summary = call()
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
-        print(
-            f"pftrack {command}: {how}; the outputs written so far are complete (re-run "
-            "to finish the rest)",
-            file=sys.stderr,
-        )
+        left = outcome(exc) or "the outputs written so far are complete (re-run to finish the rest)"
+        print(f"{line_end()}pftrack {command}: {how}; {left}", file=sys.stderr)
         return exit_status(exc)
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
         hint = "; or --workers 0: in this process, without Dask" if exc.name in _DASK else ""
