@@ -1395,3 +1395,64 @@ def test_ctrl_c_says_what_was_written(
         f"pftrack smooth: interrupted; no file was finished; {out / 'summary.json'} lists them "
         "as cancelled (re-run to run them)\n"
     )
+
+
+# --- a cancelled task stops itself ----------------------------------------------------------
+
+
+def test_track_sequence_calls_the_stop_check_every_25_frames(data: Path) -> None:
+    """The check runs while tracking and while rendering, and its exception ends the task."""
+    from pftrack.batch.tasks import TaskCancelled, reporting_frames, track_sequence
+
+    (seq,) = [s for s in find_sequences(data) if s.name == "walk"]  # 30 frames
+    options = TrackOptions(config=_config(), render=".mp4")
+    checks: list[int] = []
+    frames: list[int] = []
+    with reporting_frames(frames.append, lambda: checks.append(len(frames))):
+        track_sequence(seq, options)
+    assert frames == list(range(1, 31)) and checks == [25, 30]  # tracking's 25th, rendering's
+
+    def stop() -> None:
+        raise TaskCancelled("cancelled while it ran (the batch was interrupted)")
+
+    frames.clear()
+    with reporting_frames(frames.append, stop), pytest.raises(TaskCancelled):
+        track_sequence(seq, options)
+    assert frames == list(range(1, 26))  # stopped at frame 25
+
+
+def _track_until_stopped(seq: SequenceInput, options: TrackOptions) -> TaskResult:
+    """Track `seq` over and over for up to 30 s: a long sequence."""
+    from pftrack.batch.tasks import track_sequence
+
+    deadline = time.monotonic() + 30
+    while True:
+        result = track_sequence(seq, options)
+        if time.monotonic() > deadline:
+            return result
+
+
+def _busy_threads(dask_worker: Any) -> int:
+    return len(dask_worker.active_threads)
+
+
+def test_ctrl_c_stops_the_tasks_running_on_the_workers(
+    data: Path, client: Any, tmp_path: Path, ctrl_c_raises: None
+) -> None:
+    """``Client.cancel`` cannot stop a running thread: on an external cluster the tasks of an
+    interrupted batch ran to their end, keeping the workers busy. They stop themselves now."""
+    (seq,) = [s for s in find_sequences(data) if s.name == "walk"]
+    options = TrackOptions(config=_config())
+    jobs = [Job(f"long{k}", _track_until_stopped, (seq, options), ()) for k in range(2)]
+    timer = threading.Timer(1.5, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_jobs(jobs, tmp_path, kind="track", settings={}, client=client)
+    finally:
+        timer.cancel()
+    deadline = time.monotonic() + 10
+    while sum(client.run(_busy_threads).values()) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert sum(client.run(_busy_threads).values()) == 0  # both workers free (was: 30 s busy)
+    assert time.monotonic() < deadline

@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._progress import Bar, enabled, progress
-from pftrack.batch.tasks import TaskResult, one_line, reporting_frames
+from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
@@ -769,6 +769,33 @@ class Outcome(NamedTuple):
     missing: str | None = None
 
 
+def _worker_stop() -> Callable[[], None] | None:
+    """On a Dask worker, ``stop()``: raises once the running task's future is cancelled.
+
+    It raises :class:`~pftrack.batch.tasks.TaskCancelled`; None off a worker.
+    Dask cannot stop a running thread: ``Client.cancel`` (the batch's Ctrl-C) and a client that
+    goes away release the task, and the worker marks it ``cancelled`` but lets it run to its
+    end, busy for nothing. The task looks at its own state in the worker (a dict look-up, no
+    message to the scheduler: measured ~0.1 µs, every 25 frames) and stops. Dask internals
+    (``Worker.state.tasks``, the running task's key): if they are not there, no check.
+    """
+    try:
+        from dask.context import thread_state  # distributed.utils.thread_state is this one
+        from distributed import get_worker
+
+        tasks = get_worker().state.tasks
+        key = thread_state.key
+    except (ImportError, ValueError, AttributeError):  # not on a worker, or another Dask
+        return None
+
+    def stop() -> None:
+        ts = tasks.get(key)
+        if ts is None or ts.state in ("cancelled", "released", "forgotten"):
+            raise TaskCancelled("cancelled while it ran (the batch was interrupted)")
+
+    return stop
+
+
 def call_task(
     func: Callable[..., TaskResult],
     args: tuple[Any, ...],
@@ -785,9 +812,14 @@ def call_task(
     `progress` receives the frames tracked so far (:func:`~pftrack.batch.tasks.reporting_frames`):
     a function (in this process), or ``(topic, name)`` on a Dask worker, whose counts then go
     to the client as Dask events (``Worker.log_event``) twice a second at most.
+
+    On a Dask worker the task also stops itself once its future is cancelled (Ctrl-C on the
+    client): every 25 frames it looks (:func:`_worker_stop`), and ends with
+    :class:`~pftrack.batch.tasks.TaskCancelled`, its worker free for other work.
     """
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
-    with warnings.catch_warnings(record=True) as caught, reporting_frames(report):
+    stop = _worker_stop()
+    with warnings.catch_warnings(record=True) as caught, reporting_frames(report, stop):
         warnings.simplefilter("always")
         try:
             result = func(*args)

@@ -17,7 +17,7 @@ import socket
 import tempfile
 import time
 import traceback
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -35,6 +35,7 @@ if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover
 __all__ = [
     "RecoverOptions",
     "SmoothOptions",
+    "TaskCancelled",
     "TaskResult",
     "TrackOptions",
     "read_tracks",
@@ -51,21 +52,47 @@ __all__ = [
 #: Where the running task reports the frames it has tracked (``report(n)``): set by the
 #: batch engine around a task (:func:`reporting_frames`), None otherwise.
 _report_frames: Callable[[int], None] | None = None
+#: What the running task calls every :data:`STOP_CHECK_EVERY` frames, which raises
+#: :class:`TaskCancelled` to stop it: set by the batch engine around a task on a Dask worker.
+_stop_check: Callable[[], None] | None = None
+#: Frames between two calls of the stop check (tracking, then rendering).
+STOP_CHECK_EVERY = 25
+
+
+class TaskCancelled(Exception):
+    """The task was cancelled while it ran (its batch interrupted, its client gone): it stops.
+
+    Dask cannot stop a running thread: a task whose future is cancelled would track to its
+    end, keeping its worker busy. The task checks every :data:`STOP_CHECK_EVERY` frames.
+    """
 
 
 @contextlib.contextmanager
-def reporting_frames(report: Callable[[int], None] | None) -> Iterator[None]:
+def reporting_frames(
+    report: Callable[[int], None] | None, stop: Callable[[], None] | None = None
+) -> Iterator[None]:
     """While the block runs, :func:`track_sequence` calls ``report(n)`` after frame `n`.
 
     How a batch shows progress within its sequences: the engine passes a function that moves
-    its bar (in this process) or sends the count to the client (on a Dask worker).
+    its bar (in this process) or sends the count to the client (on a Dask worker). `stop` is
+    called every :data:`STOP_CHECK_EVERY` frames tracked or rendered, and raises
+    (:class:`TaskCancelled`) to end the task.
     """
-    global _report_frames
-    before, _report_frames = _report_frames, report
+    global _report_frames, _stop_check
+    before = _report_frames, _stop_check
+    _report_frames, _stop_check = report, stop
     try:
         yield
     finally:
-        _report_frames = before
+        _report_frames, _stop_check = before
+
+
+def _checked(frames: Iterable[Any], stop: Callable[[], None] | None) -> Iterator[Any]:
+    """`frames`, with ``stop()`` called every :data:`STOP_CHECK_EVERY` of them."""
+    for n, frame in enumerate(frames, start=1):
+        if stop is not None and n % STOP_CHECK_EVERY == 0:
+            stop()
+        yield frame
 
 
 def sequence_length(seq: SequenceInput) -> int | None:
@@ -314,7 +341,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     from pftrack.tracking.run import track_path
 
     cpu = time.process_time()
-    report = _report_frames
+    report, stop = _report_frames, _stop_check
     frames = FrameSource(seq.frames)
     # the boxes of det.txt and gt.txt are in seqinfo.ini's pixels
     auto_scale = info_scale(
@@ -339,7 +366,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         link=options.link,
         show_progress=False,
         threads=tracking_threads(),
-        on_frame=None if report is None else lambda n, *_: report(n),
+        on_frame=None if report is None and stop is None else _on_frame(report, stop),
     )
     rows = run.rows
     files: dict[str, bytes] = {}
@@ -348,7 +375,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
 
         with tempfile.TemporaryDirectory(prefix="pftrack-render-") as tmp:
             target = Path(tmp) / f"{seq.name}{options.render}"
-            write_annotated_video(target, FrameSource(seq.frames), rows, frames.fps)
+            write_annotated_video(target, _checked(FrameSource(seq.frames), stop), rows, frames.fps)
             files[options.render] = target.read_bytes()
     metrics = error = trace = None
     if seq.gt is not None:  # last: a ground truth that cannot be scored loses no tracks
@@ -374,6 +401,20 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         "host": socket.gethostname(),
     }
     return TaskResult(rows, files, info, error=error, traceback=trace)
+
+
+def _on_frame(
+    report: Callable[[int], None] | None, stop: Callable[[], None] | None
+) -> Callable[..., None]:
+    """``track_path``'s `on_frame`: report frame `n`; every few frames, the stop check."""
+
+    def on_frame(n: int, *_: Any) -> None:
+        if report is not None:
+            report(n)
+        if stop is not None and n % STOP_CHECK_EVERY == 0:
+            stop()
+
+    return on_frame
 
 
 def read_tracks(path: PathLike) -> F64:
