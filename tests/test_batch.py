@@ -1456,3 +1456,28 @@ def test_ctrl_c_stops_the_tasks_running_on_the_workers(
         time.sleep(0.1)
     assert sum(client.run(_busy_threads).values()) == 0  # both workers free (was: 30 s busy)
     assert time.monotonic() < deadline
+
+
+def test_a_scheduler_lost_mid_run_fails_the_tasks_left(client: Any, tmp_path: Path) -> None:
+    """The connection to the scheduler lost mid-run (the scheduler stopped, the network failed):
+    Dask cancels every future; they were left ``cancelled``, and the batch exited 0. Here the
+    connection breaks once (the client reconnects); a scheduler that stops takes the same path,
+    and its client's attempts to reconnect are not logged with a traceback (checked by hand)."""
+    with distributed.Client(client.scheduler.address) as own:
+        jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(2)]
+
+        def cut() -> None:
+            own.loop.add_callback(own.scheduler_comm.comm.abort)
+
+        timer = threading.Timer(0.5, cut)
+        timer.start()
+        try:
+            summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={}, client=own)
+        finally:
+            timer.cancel()
+        address = own.scheduler.address
+    assert [e["status"] for e in summary.entries] == ["failed", "failed"]
+    assert {e["error"] for e in summary.entries} == {
+        f"the connection to the scheduler at {address} was lost before this file finished (the "
+        "scheduler stopped, or the network failed; a re-run does the rest)"
+    }

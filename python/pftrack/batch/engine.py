@@ -316,9 +316,14 @@ def dask_client(
             if address not in text:
                 text = f"{text} ({address})"
             raise OSError(f"cannot connect to the Dask scheduler: {text}") from None
-        with connected as c:
+        quiet = contextlib.ExitStack()
+        with quiet, connected as c:  # `quiet` ends after the client is closed
             c.register_plugin(SingleThreaded())
-            yield c
+            try:
+                yield c
+            finally:
+                if c.status != "running":  # the scheduler went away: its end said by the batch
+                    quiet.enter_context(_silenced(*_CLIENT_LOGGERS))
         return
     n = n_workers if n_workers is not None else (os.cpu_count() or 1)
     with contextlib.ExitStack() as stack:
@@ -340,6 +345,25 @@ def dask_client(
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
+
+
+#: The loggers through which Dask reports, with a traceback, the end of a client's attempts to
+#: reconnect to a scheduler that went away when the client is closed.
+_CLIENT_LOGGERS = ("distributed.client", "distributed.utils")
+
+
+@contextlib.contextmanager
+def _silenced(*names: str) -> Iterator[None]:
+    """The loggers `names` say nothing meanwhile."""
+    loggers = [logging.getLogger(name) for name in names]
+    before = [lg.disabled for lg in loggers]
+    for lg in loggers:
+        lg.disabled = True
+    try:
+        yield
+    finally:
+        for lg, was in zip(loggers, before, strict=True):
+            lg.disabled = was
 
 
 #: What :func:`_interrupts_held` holds: Ctrl-C, and SIGTERM, which the command turns into a
@@ -1194,6 +1218,34 @@ class _WorkersWatch:
         )
 
 
+def _scheduler_lost(address: str, noun: str) -> str:
+    """The error of a task whose future Dask cancelled because the scheduler went away.
+
+    Was: left ``cancelled``, and a batch whose every task was lost so exited 0.
+    """
+    return (
+        f"the connection to the scheduler at {address} was lost before this {noun} finished "
+        "(the scheduler stopped, or the network failed; a re-run does the rest)"
+    )
+
+
+def _connection_lost(c: Client, fut: Any) -> bool:
+    """Whether Dask cancelled the future `fut` because `c` lost its scheduler (not a cancel).
+
+    Dask's reason for it (``scheduler-connection-lost``; a client that has reconnected since
+    says so too), else, with a Dask that gives none, the client not connected.
+    """
+    try:
+        fut.result(timeout=5)
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # noqa: BLE001 - Dask's FutureCancelledError: asyncio's kind
+        reason = getattr(exc, "reason", None)
+        if reason is not None:
+            return bool(reason == "scheduler-connection-lost")
+    return bool(c.status != "running")
+
+
 def _completed(futures: Any, given_up: Callable[[], bool]) -> Iterator[Any]:
     """The futures of `futures` (``as_completed``) as they finish; stops early on `given_up`."""
     while True:
@@ -1301,6 +1353,8 @@ def _run_on_dask(
                 # the scheduler's own no-workers-timeout: said as this process's watch says it
                 lost = type(exc).__name__ == "NoWorkerError"
                 record(job, Outcome(None, watch.error(noun) if lost else one_line(exc)))
+            elif fut.status == "cancelled" and _connection_lost(c, fut):  # Dask cancels them all
+                record(job, Outcome(None, _scheduler_lost(address, noun)))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
         if futures:  # given up: no worker for too long
             c.cancel([f for f, _ in futures.values()], force=True)
