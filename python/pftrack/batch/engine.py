@@ -986,7 +986,8 @@ def run_jobs(
         is created or any file written.
     KeyboardInterrupt
         After cancelling the tasks still running and closing the cluster this started; the
-        outputs written so far are complete.
+        outputs written so far are complete. What the batch left (nothing, or how many tasks'
+        outputs) is attached: :func:`interrupted_left`.
     """
     if n_workers is not None and n_workers < 0:
         raise ValueError(f"n_workers is {n_workers}, expected >= 0")
@@ -1093,8 +1094,6 @@ def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int 
     (stopped while connecting, or while the local cluster started). Was: "the outputs written
     so far are complete" whatever was written, nothing at all included.
     """
-    from pftrack.cli._signals import set_outcome
-
     noun = "sequence" if kind == "track" else "file"
     if written is None:
         text = f"nothing was written: it stopped before the run began (--out {out} untouched)"
@@ -1108,7 +1107,13 @@ def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int 
             f"the outputs of the {_count(written, noun)} finished are written and complete; "
             f"{out / SUMMARY_NAME} lists the rest as cancelled (re-run to finish them)"
         )
-    set_outcome(exc, text)
+    exc.pftrack_batch_left = text  # type: ignore[attr-defined]
+
+
+def interrupted_left(exc: BaseException) -> str | None:
+    """What an interrupted batch left, as :func:`run_jobs` attached it to `exc` (or None)."""
+    text = getattr(exc, "pftrack_batch_left", None)
+    return text if isinstance(text, str) else None
 
 
 #: Seconds a batch waits for a worker on a cluster that has none, unless Dask's

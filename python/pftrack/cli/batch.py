@@ -22,7 +22,7 @@ from pftrack.cli._options import (
     iou_threshold,
     non_negative_int,
 )
-from pftrack.cli._signals import Terminated, exit_status, line_end, outcome
+from pftrack.cli._signals import Terminated, exit_status, line_end
 
 if TYPE_CHECKING:
     from pftrack.batch import BatchSummary
@@ -161,7 +161,10 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
         summary = call()
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
-        left = outcome(exc) or "the outputs written so far are complete (re-run to finish the rest)"
+        from pftrack.batch.engine import interrupted_left
+
+        # none said: it stopped before the batch's run (scanning the inputs, ...)
+        left = interrupted_left(exc) or "nothing was written: it stopped before the run began"
         print(f"{line_end()}pftrack {command}: {how}; {left}", file=sys.stderr)
         return exit_status(exc)
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
