@@ -928,5 +928,7 @@ def test_track_frames_names_every_bootstrap_it_takes():
     from pftrack.tracking import track_frames
 
     for prime in (30, 0):
-        with pytest.raises(ValueError, match="bootstrap is 'sprad', expected one of auto, spread"):
+        with pytest.raises(
+            ValueError, match="bootstrap mode is 'sprad', expected one of auto, spread"
+        ):
             track_frames([], bootstrap="sprad", prime_frames=prime)  # type: ignore[arg-type]

@@ -181,7 +181,7 @@ def track_frames(
     """
     if bootstrap not in ("auto", *BOOTSTRAPS):
         raise ValueError(
-            f"bootstrap is {bootstrap!r}, expected one of auto, {', '.join(BOOTSTRAPS)}"
+            f"bootstrap mode is {bootstrap!r}, expected one of auto, {', '.join(BOOTSTRAPS)}"
         )
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
