@@ -212,6 +212,8 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         "pftrack.TrackerConfig(detector='mog3', sampler='gibbs', camera_motion='yes')\n"
         "pftrack.evaluate_sequence([], [], benchmark='MOT18')\n"
         "pftrack.track_frames([], bootstrap='sprad')\n"
+        "from pftrack.integrations.supervision import SupervisionTracker\n"
+        "SupervisionTracker(frame_rate=25.0, sed=1, detector='mog3')\n"
     )
     out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
     assert status == 1, out  # the bad call is caught, so the names are not Any
@@ -231,6 +233,9 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         assert f'Argument "{arg}" to "TrackerConfig" has incompatible type' in out, arg
     assert 'Argument "benchmark" to "evaluate_sequence" has incompatible type' in out
     assert 'Argument "bootstrap" to "track_frames" has incompatible type' in out
+    # the supervision adapter's **options are the Tracker's (they were Any)
+    assert 'Unexpected keyword argument "sed" for "SupervisionTracker"' in out
+    assert 'Argument "detector" to "SupervisionTracker" has incompatible type' in out
 
 
 def test_the_literal_types_list_the_names_the_runtime_takes() -> None:

@@ -96,3 +96,15 @@ def test_supervision_is_imported_lazily():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_the_adapters_options_are_the_trackers():
+    """``SupervisionTracker(**options)`` is typed by TrackerOptions: the Tracker's own options."""
+    import inspect
+
+    from pftrack.integrations.supervision import TrackerOptions
+
+    params = inspect.signature(pftrack.Tracker.__init__).parameters
+    theirs = {n: str(p.annotation) for n, p in params.items() if p.kind is p.KEYWORD_ONLY}
+    ours = {n: getattr(t, "__forward_arg__", t) for n, t in TrackerOptions.__annotations__.items()}
+    assert ours == theirs

@@ -11,18 +11,44 @@ repairs it).
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._typing import F64
+from pftrack._typing import F64, CameraMotion, DetectorName, DynamicsName, FillMode, SamplerName
 from pftrack.tracking.api import Tracker
 
 if TYPE_CHECKING:
     import supervision as sv
+    from typing_extensions import Unpack  # typing's from Python 3.11; the checker's own here
 
-__all__ = ["SupervisionTracker"]
+__all__ = ["SupervisionTracker", "TrackerOptions"]
+
+
+class TrackerOptions(TypedDict, total=False):
+    """The keyword options of :class:`pftrack.Tracker`, typed for ``SupervisionTracker(**...)``.
+
+    ``tests/integrations/test_supervision.py`` holds the names and types equal to the Tracker's.
+    """
+
+    seed: int | None
+    detector: DetectorName
+    sampler: SamplerName
+    particles: int | None
+    dynamics: DynamicsName
+    max_coast: float | None
+    min_conf: float
+    birth_score: float
+    birth_quantile: float | None
+    camera_motion: CameraMotion
+    refine: bool
+    fill: FillMode
+    smooth: bool
+    link: bool
+    crossings: bool
+    prime: float | None
+    max_side: int | None
 
 
 def _detections_class() -> Any:
@@ -56,7 +82,7 @@ class SupervisionTracker:
     ...     print(detections.tracker_id)
     """
 
-    def __init__(self, frame_rate: float = 25.0, **options: Any) -> None:
+    def __init__(self, frame_rate: float = 25.0, **options: Unpack[TrackerOptions]) -> None:
         self.tracker = Tracker(frame_rate, **options)
 
     def update_with_detections(self, detections: sv.Detections, frame: ArrayLike) -> sv.Detections:
