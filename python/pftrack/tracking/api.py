@@ -468,8 +468,7 @@ class Tracker:
             self.classes: dict[int, int] = {}
             self._stabiliser = Stabiliser()
             self._reports: list[Track] = []
-            self._clip_warned = False
-            self._empty_warned = False
+            self._warned: set[str] = set()  # the run's once-only warnings given so far
             self._max_conf = -np.inf
             self._given = False  # some update() of the run had detections
             # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
@@ -506,6 +505,11 @@ class Tracker:
         detector's result belongs to it) instead of scaling `frame` again.
         """
         self._prepared = (frame, working)
+
+    def _warn_once(self, key: str, message: str) -> None:
+        """Warn `message` from ``update``'s caller, the first time `key` comes up in a run."""
+        self._warned.add(key)
+        warnings.warn(message, stacklevel=3)  # 1 here, 2 update, 3 its caller
 
     def _working(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         prepared, self._prepared = self._prepared, None
@@ -592,19 +596,17 @@ class Tracker:
                 reports = self._tracker.update(work, None)
             else:
                 xywh, cls, kept, clipped, empty = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
-                if empty and not self._empty_warned:
-                    self._empty_warned = True
-                    warnings.warn(
+                if empty and "empty" not in self._warned:
+                    self._warn_once(
+                        "empty",
                         f"{empty} detection box{'es' if empty > 1 else ''} without area "
                         "(x2 <= x1 or y2 <= y1) ignored; later ones are ignored silently",
-                        stacklevel=2,
                     )
-                if clipped and not self._clip_warned:
-                    self._clip_warned = True
-                    warnings.warn(
+                if clipped and "clipped" not in self._warned:
+                    self._warn_once(
+                        "clipped",
                         f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
                         "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
-                        stacklevel=2,
                     )
                 confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
                 if self._scale is not None:
@@ -690,7 +692,7 @@ class Tracker:
                 f"the highest detection confidence was {self._max_conf:.3g} (min_conf "
                 f"{cfg.min_score:.3g}, birth_score {cfg.birth_score:.3g})"
             )
-        if self._clip_warned:  # boxes were given, every one wholly outside the frame
+        if "clipped" in self._warned:  # boxes were given, every one wholly outside the frame
             return "no detection lay inside the frame (wrong coordinate scale?)"
         return "the detections given held no box"
 
