@@ -100,9 +100,12 @@ def run(args: argparse.Namespace) -> int:
     n_frames = len(source)
     out = report_stream(args.out, args.plot)
     drawn = [0]
+    kept: list[Any] = []  # the first frame, the plot's background (the video read once)
 
     def counted() -> Any:
         for frame in source:
+            if not kept:
+                kept.append(frame.copy())
             drawn[0] += 1
             yield frame
 
@@ -115,9 +118,8 @@ def run(args: argparse.Namespace) -> int:
             write_annotated_video(video, _progress(counted(), n_frames), rows, source.fps,
                                   trail=args.trail)  # fmt: skip
             if args.plot:
-                first = next(iter(FrameSource(args.source)))
                 plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))
-                plot_trajectories(plot, rows, background=first, title=source.name)
+                plot_trajectories(plot, rows, background=kept[0], title=source.name)
     late = rows[rows[:, 0] > drawn[0]]
     notes = [str(w.message) for w in caught] + _outside(rows, source.width, source.height)
     if len(late):
