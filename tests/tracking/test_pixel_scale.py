@@ -2,7 +2,9 @@
 
 The particle filter's centre noise and the offline linker's gate are given in pixels; on frames
 larger than 640x480 they grow with the diagonal, so that footage of one scene at a higher
-resolution is tracked with the same settings relative to the image.
+resolution is tracked with the same settings relative to the image. On frames smaller than
+480x360 the filter's noise shrinks with the diagonal (TrackerConfig.noise_scale); the gate does
+not.
 """
 
 from __future__ import annotations
@@ -28,6 +30,24 @@ def test_pixel_scale_is_the_diagonal_over_800_above_640x480(width, height, scale
     )
 
 
+@pytest.mark.parametrize(
+    ("width", "height", "scale"),
+    [(240, 180, 0.5), (360, 270, 0.75), (480, 360, 1.0), (640, 480, 1.0), (1280, 960, 2.0)],
+)
+def test_noise_scale_shrinks_below_480x360_and_grows_above_640x480(width, height, scale):
+    config = TrackerConfig()
+    assert config.noise_scale(width, height) == pytest.approx(scale)
+    assert config.pixel_scale(width, height) == pytest.approx(max(1.0, scale))
+    assert TrackerConfig(pixel_diagonal=None).noise_scale(width, height) == 1.0
+
+
+def test_noise_scale_with_a_small_pixel_diagonal_is_the_diagonal_over_it():
+    config = TrackerConfig(pixel_diagonal=400)  # 320x240: settings hold at 400 px and below
+    assert config.noise_scale(320, 240) == pytest.approx(1.0)
+    assert config.noise_scale(160, 120) == pytest.approx(0.5)
+    assert config.noise_scale(480, 360) == pytest.approx(1.5)  # grows above it, as before
+
+
 def test_scaled_pixels_changes_only_the_particle_noise():
     config = TrackerConfig()
     assert config.scaled_pixels(1.0) is config
@@ -43,7 +63,9 @@ def test_bad_pixel_diagonal_is_refused(value):
         TrackerConfig(pixel_diagonal=value)
 
 
-@pytest.mark.parametrize(("height", "width", "sigma"), [(480, 640, 3.0), (960, 1280, 6.0)])
+@pytest.mark.parametrize(
+    ("height", "width", "sigma"), [(180, 240, 1.5), (480, 640, 3.0), (960, 1280, 6.0)]
+)
 def test_the_tracks_filters_get_the_scaled_noise(height, width, sigma):
     tracker = MultiObjectTracker(rng=0)
     assert tracker.pixel_scale == 1.0
@@ -51,7 +73,8 @@ def test_the_tracks_filters_get_the_scaled_noise(height, width, sigma):
     k = width / 640
     box = np.array([[100.0, 100.0, 40.0, 100.0, 1.0]]) * [k, k, k, k, 1]
     tracker.update(frame, box)
-    assert tracker.pixel_scale == pytest.approx(width / 640)
+    assert tracker.pixel_scale == pytest.approx(max(1.0, width / 640))
+    assert tracker.noise_scale == pytest.approx(sigma / 3.0)
     assert [t.filter.config.model.sigma_xy for t in tracker.tracks] == [pytest.approx(sigma)]
     assert tracker.config == TrackerConfig()  # the user's settings are left as given
 

@@ -110,6 +110,9 @@ class MultiObjectTracker:
     pixel_scale : float
         The factor of the pixel settings on this run's frames
         (:meth:`TrackerConfig.pixel_scale` of the first frame's size; 1 before it).
+    noise_scale : float
+        The factor of the particle filter's position noise on this run's frames
+        (:meth:`TrackerConfig.noise_scale` of the first frame's size; 1 before it).
 
     Examples
     --------
@@ -147,6 +150,7 @@ class MultiObjectTracker:
         self._frame_shape: tuple[int, ...] = ()  # the first frame's, set with _effective
         self._given_config = self.config  # tracks of given detections (given_particles), too
         self.pixel_scale = 1.0
+        self.noise_scale = 1.0
         self._scores_are_confidences = True
         self._negative_warned = False  # scores below 0 and min_score were said
         self._primed_shape: tuple[int, ...] = ()  # of the frames given to prime()
@@ -421,7 +425,8 @@ class MultiObjectTracker:
         if cfg is None:
             self._frame_shape = f.shape
             self.pixel_scale = self.config.pixel_scale(f.shape[1], f.shape[0])
-            cfg = self._effective = self.config.scaled_pixels(self.pixel_scale)
+            self.noise_scale = self.config.noise_scale(f.shape[1], f.shape[0])
+            cfg = self._effective = self.config.scaled_pixels(self.noise_scale)
             self._given_config = cfg.for_given()  # one object: the filters' configs compare by id
             self._joint.config = cfg
         self.frame_index += 1
