@@ -17,6 +17,11 @@ paths (the chosen method and the best other one; :func:`_combine`): the weight i
 bucket's validation gaps, shrunk toward the chosen method, and the combination replaces the
 chosen method only if it beats it by the same paired test. The :class:`Calibration` then
 names both methods and their weights. ``combine=False`` gives the single-method choice.
+
+Two rules hold whatever the rule above chooses: the real gaps are matched in a canonical order
+(sorted), so the same tracks under other ids are filled alike; and a bucket whose choice does
+worse than ``linear`` on its own validation gaps uses ``linear``
+(:attr:`BucketChoice.replaced` keeps what it replaced).
 """
 
 from __future__ import annotations
@@ -127,6 +132,10 @@ class BucketChoice:
         empty when one method is used.
     combined_mmae : float or None
         The combination's validation MMAE (px), when one was chosen.
+    replaced : (str, float) or None
+        The choice the rule made (a method or ``"a+b"``) and its validation MMAE, when it did
+        worse than ``linear`` on the bucket's validation gaps and ``linear`` was used instead;
+        None otherwise.
     """
 
     lengths: tuple[int, int]
@@ -136,6 +145,7 @@ class BucketChoice:
     mmae: tuple[tuple[str, float], ...]
     weights: tuple[tuple[str, float], ...] = ()
     combined_mmae: float | None = None
+    replaced: tuple[str, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -206,6 +216,14 @@ class Calibration:
             cells = "".join(f"{vals[m]:>11.3f}" if m in vals else f"{'-':>11}" for m in names)
             lines.append(f"{span:<12}{c.n_gaps:>6}{c.n_validation:>6}  {c.method:<{wide}}{cells}")
         for c in self.buckets:
+            if c.replaced is not None:
+                lo, hi = c.lengths
+                span = f"{lo}" if lo == hi else f"{lo}-{hi}"
+                lines.append(
+                    f"gap length {span}: linear, because the rule's choice {c.replaced[0]} "
+                    f"(validation MMAE {c.replaced[1]:.3f}) did worse than linear "
+                    f"({dict(c.mmae)['linear']:.3f}) on this length's validation gaps"
+                )
             if c.weights:
                 lo, hi = c.lengths
                 span = f"{lo}" if lo == hi else f"{lo}-{hi}"
@@ -508,6 +526,8 @@ def calibrate(
     for v, dv, (na, nb) in zip(lengths, dists, sides, strict=True):
         by_bucket.setdefault(bucket_of(v), []).append(v)
         targets.setdefault(bucket_of(v), []).append((v, dv, na, nb))
+    for t in targets.values():  # the gaps' order (the file's id order) must not matter
+        t.sort()
     if not by_bucket:
         return Calibration(())
     runs = distinct_runs(observed, strict="calibrate")
@@ -563,12 +583,19 @@ def calibrate(
     choices = []
     for b in sorted(by_bucket):
         mmae: tuple[tuple[str, float], ...] = ()
+        replaced: tuple[str, float] | None = None
         mix = chosen.get(b, pooled_mix or ((pooled, 1.0),))
         if b in errors:
             mmae = tuple((m, float(errors[b][m].mean())) for m in scored)
+            # never worse than a straight line on the bucket's own validation gaps
+            mixed = float(_mix_errors(mix, found[b], truths[b]).mean())
+            if mixed > errors[b]["linear"].mean():
+                replaced = ("+".join(m for m, _ in mix), mixed)
+                mix = (("linear", 1.0),)
         if len(mix) == 1:
+            span = _bucket_range(b)
             choices.append(
-                BucketChoice(_bucket_range(b), mix[0][0], len(by_bucket[b]), n_cut[b], mmae)
+                BucketChoice(span, mix[0][0], len(by_bucket[b]), n_cut[b], mmae, replaced=replaced)
             )
             continue
         err = _mix_errors(mix, found[b], truths[b]) if b in errors else None
