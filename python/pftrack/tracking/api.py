@@ -269,7 +269,7 @@ class Tracker:
     max_side : int or None
         Working resolution (:attr:`TrackerConfig.max_side`): larger frames are scaled down to
         this longer side for detection and tracking; boxes in and out stay in the frame's
-        pixels. None: the frame's own size.
+        pixels, in [64, 100000]. None or 0 (as ``--max-side 0``): the frame's own size.
 
     Raises
     ------
