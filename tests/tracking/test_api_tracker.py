@@ -846,6 +846,39 @@ def test_cli_refuses_detections_of_a_longer_video_for_a_1_frame_video(tmp_path, 
     assert len(err.splitlines()) == 1 and not out.exists()
 
 
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_output_boxes_may_reach_past_the_frame_as_documented():
+    """A user trial found boxes out of the frame (x2 = 482.7 on a 480-wide video) while the
+    input is clipped: the output is the filters' estimate, documented so (with the clip to do
+    before cropping), not clipped (that would change the tracking numbers)."""
+    scene = make_scene(n_frames=60, rng=2)
+    h, w = scene.frames[0].shape[:2]
+    tracker = pftrack.Tracker()
+    by_frame = group_by_frame(scene.truth)
+    for k, frame in enumerate(scene.frames, start=1):
+        r = by_frame.get(k, np.zeros((0, 10)))
+        tracker.update(xywh_to_xyxy_dets(np.column_stack([r[:, 2:6], np.ones(len(r))])), frame)
+    rows = tracker.finalize()
+    x1, y1 = rows[:, 2], rows[:, 3]
+    x2, y2 = x1 + rows[:, 4], y1 + rows[:, 5]
+    past = (x1 < 0) | (y1 < 0) | (x2 > w) | (y2 > h)
+    assert past.any()  # as documented: not clipped
+    assert ((x1 < w) & (y1 < h) & (x2 > 0) & (y2 > 0)).all()  # none wholly outside
+    # the documented clip keeps every box inside, with area
+    cx1, cx2 = np.clip(x1, 0, w), np.clip(x2, 0, w)
+    cy1, cy2 = np.clip(y1, 0, h), np.clip(y2, 0, h)
+    assert ((cx2 > cx1) & (cy2 > cy1)).all()
+    from pftrack.integrations.supervision import SupervisionTracker
+
+    for doc in (
+        pftrack.Tracker.update.__doc__,
+        pftrack.Tracker.finalize.__doc__,
+        SupervisionTracker.update_with_detections.__doc__,
+        SupervisionTracker.finalize.__doc__,
+    ):
+        assert "not clipped" in " ".join(str(doc).split())
+
+
 def test_one_tracker_in_two_threads_at_once_raises_not_crashes(scene):
     # was: a segfault (the C++ background model reallocated under another thread) or a mix of
     # two runs' frames ("duplicate rows" from finalize)

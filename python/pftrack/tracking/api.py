@@ -574,6 +574,10 @@ class Tracker:
             detection this frame (BoxMOT's convention): ``det_ind`` is the row of `dets` the
             track was matched to (a merged blob's row for each track inside it; -1 with
             ``dets=None``). Boxes are the track's filtered boxes, ``conf`` the detection's.
+            The boxes are the filters' estimates and are not clipped to the frame (only
+            `dets` are): near an edge they may reach past it by a few pixels, as ground-truth
+            boxes do. Clip them before cropping, e.g. ``np.clip(out[:, [0, 2]], 0, W)`` and
+            ``np.clip(out[:, [1, 3]], 0, H)``.
         """
         with self._alone("update"):
             f = bgr_frame(frame)
@@ -704,7 +708,11 @@ class Tracker:
         (R, 10) ndarray of float
             ``frame, id, left, top, width, height, conf, flag, -1, -1`` (``flag`` 1 on a row the
             offline pass filled in a hole, else -1), frames from 1 (one per
-            ``update``), sorted by frame then id; no row lies wholly outside the frame. Warns
+            ``update``), sorted by frame then id; no row lies wholly outside the frame, but a
+            box, the filters' and the smoother's estimate, is not clipped to it and may reach
+            past its edge by a few pixels, as ground-truth boxes do (clip ``left`` and
+            ``left + width`` to [0, W], ``top`` and ``top + height`` to [0, H] before
+            cropping, e.g. with ``np.clip``). Warns
             when there is no row at all, naming the first cause that holds: tracks started
             but none reached ``min_hits`` matches, the built-in detector found nothing, the
             detections' confidences were below the birth threshold, or lay outside the frame,
