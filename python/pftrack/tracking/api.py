@@ -254,6 +254,9 @@ class Tracker:
         Shrink given detection boxes to the foreground of a background model (the default;
         :class:`~pftrack.tracking.RefineConfig`). False takes the boxes as given and runs no
         background model: for a detector with tight boxes, and about 0.5 ms less a frame.
+        Refinement (like the built-in detector) assumes upright people: use False for
+        sideways or overhead-rotated footage (docs/detection.md, "Known limit: upright
+        people").
     fill : {"linear", "pf"}
         Boxes of a gap the particle filter bridged, before smoothing.
     smooth, link : bool

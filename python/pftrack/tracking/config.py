@@ -372,7 +372,9 @@ class RefineConfig:
     enabled : bool
         With external detections, also run the background model and shrink each detection box
         to the rows and columns where its foreground is (static cameras: detector boxes are
-        often loose). A box with too little foreground is left as it is.
+        often loose). A box with too little foreground is left as it is. It assumes upright
+        people (legs grow downwards, `leg_fill`, `min_height`): turn it off for sideways or
+        overhead-rotated footage.
     fraction : float
         A row or column belongs to the object when its foreground fraction exceeds this share of
         the box's densest row or column; in [0, 1) (``refine_boxes``' range).
