@@ -785,6 +785,32 @@ def test_fill_help_says_what_it_does_with_smoothing(capsys: pytest.CaptureFixtur
     )
 
 
+@pytest.mark.parametrize("command", ["track", "batch"])
+def test_no_refine_help_says_refinement_assumes_upright_people(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: PETS09 turned 90 degrees with its detections scored MOTA 43.7 refined,
+    66.8 with --no-refine, and nothing said that refinement assumes upright people."""
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split()).replace("- ", "-")  # argparse's wraps
+    assert (
+        "Use it too for sideways or overhead-rotated footage: refinement, like the built-in "
+        "detector, assumes upright people" in text
+    )
+
+
+def test_track_help_says_output_boxes_are_not_clipped(capsys: pytest.CaptureFixture[str]) -> None:
+    """A user trial found output boxes past the frame's edge (input boxes are clipped)."""
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert (
+        "The boxes are the filters' estimates, not clipped to the frame: near its edge one may "
+        "reach past it by a few pixels, as ground-truth boxes do (clip them before cropping)."
+    ) in text
+
+
 def test_recover_on_a_truncated_video_says_where_it_ends(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import re
+import warnings
+
 import cv2
 import numpy as np
 import pytest
 
+import pftrack
 from pftrack import _core
 from pftrack.detection import PaperConfig, PaperDetector
 from pftrack.detection.base import median_frame
@@ -18,8 +22,10 @@ from pftrack.detection.light import (
     looks_grey,
 )
 from pftrack.eval import evaluate_mot
+from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import make_scene
 from pftrack.tracking import track_frames
+from pftrack.tracking.api import xywh_to_xyxy_dets
 from tests.detection.test_background_model import random_scene
 from tests.reference.detection import (
     BackgroundReference,
@@ -188,6 +194,60 @@ def test_grey_warns_once_and_decides_on_the_first_frame() -> None:
     det = PaperDetector(PaperConfig(grey_tolerance=0))
     det.detect(grey[0])
     assert det.grey is False and det.model.shadow_lo == 0.5
+
+
+DETECTOR_GREY = (
+    "the video is grey (its colour channels are equal): the shadow test is off (every darker "
+    "pixel has the background's grey chromaticity, dark clothes too), real shadows may be "
+    "detected; without colour, people as bright as the background are missed and the trackers "
+    "tell people apart by brightness alone"
+)
+REFINE_GREY = (
+    "the video is grey (its colour channels are equal): box refinement's shadow test is off, "
+    "and the trackers tell people apart by brightness alone"
+)
+
+
+def _said(caught: list[warnings.WarningMessage]) -> list[str]:
+    return [str(w.message) for w in caught if "the video is grey" in str(w.message)]
+
+
+def test_grey_warning_says_what_the_background_model_is_for() -> None:
+    """Was: with given detections (the model only refines their boxes) the detector's warning,
+    'people as bright as the background are missed', which is not so: nobody is missed."""
+    grey = [to_grey(f) for f in dark_walker(4)]
+    for call, expected in (("detect", DETECTOR_GREY), ("foreground", REFINE_GREY)):
+        det = PaperDetector()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            det.prime(grey)  # decides, says nothing yet: it cannot tell what it is for
+            assert _said(caught) == []
+            getattr(det, call)(grey[0])
+            getattr(det, call)(grey[1])
+        assert _said(caught) == [expected]  # once
+        det.reset()  # a new video: said again
+        with pytest.warns(UserWarning, match=re.escape(expected)):
+            getattr(det, call)(grey[0])
+
+
+def test_grey_warning_of_a_run_with_and_without_detections() -> None:
+    """The same words from ``track_frames`` (the detector on its thread ahead) and a loop."""
+    scene = make_scene(n_frames=8, rng=0)
+    frames = [to_grey(f) for f in scene.frames]
+    dets = {f: r[:, 2:7] for f, r in group_by_frame(scene.truth).items()}
+    for given, expected in ((None, DETECTOR_GREY), (dets, REFINE_GREY)):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            track_frames(frames, detections=given)
+        assert _said(caught) == [expected]
+        tracker = pftrack.Tracker()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            tracker.prime(frames)
+            for k, frame in enumerate(frames, start=1):
+                boxes = None if given is None else xywh_to_xyxy_dets(given.get(k, np.zeros((0, 5))))
+                tracker.update(boxes, frame)
+        assert _said(caught) == [expected]
 
 
 def test_config_checks() -> None:

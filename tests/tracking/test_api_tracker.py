@@ -775,18 +775,108 @@ def test_a_detection_file_without_scores_is_said(tmp_path):
     assert float(load_detections(tmp_path / "seven.txt")[1][0, 4]) == 0.8  # no warning
 
 
-def test_detections_after_a_video_that_ended_early_are_said():
+def test_detections_after_a_video_that_ended_early_are_said(tmp_path):
     """A truncated video (its header promised more frames) ended the run with its detections of
-    the frames never decoded dropped without a word."""
-    frame = np.full((120, 160, 3), 90, np.uint8)
+    the frames never decoded dropped without a word.
+
+    (This test used a 1-frame list of frames, which the frame-count check let through; a real
+    truncated file is what the warning is for.)"""
+    full = make_scene(n_frames=20, rng=0).write_video(tmp_path / "full.avi")
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size // 2])  # the header still says 20
     box = np.array([[40.0, 30.0, 20.0, 40.0, 0.9]])
-    dets = {1: box, 2: box, 3: box}
+    dets = {f: box for f in range(1, 21)}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        run = track_frames([frame], detections=dets)
+        run = track_frames(FrameSource(cut), detections=dets)
     said = [str(w.message) for w in caught if issubclass(w.category, UserWarning)]
-    assert any("detections of 2 frames after the video's last frame 1" in m for m in said)
+    n = run.n_frames
+    assert 1 < n < 20
+    assert any(f"detections of {20 - n} frames after the video's last frame {n}" in m for m in said)
+
+
+@pytest.mark.filterwarnings("ignore:no track over:RuntimeWarning")
+@pytest.mark.parametrize("n", [1, 2, 5])
+def test_detections_past_the_frame_count_are_refused_at_every_length(n):
+    """Was: a 1-frame video ran with a warning (exit 0), 2 frames and more were refused, and
+    the message did not say what to do."""
+    frames = [np.full((120, 160, 3), 90, np.uint8)] * n
+    box = np.array([[40.0, 30.0, 20.0, 40.0, 0.9]])
+    dets = {f: box for f in range(1, 201)}
+    which = "frame 1" if n == 1 else f"frames 1-{n}"
+    message = (
+        f"detections go up to frame 200 but the video has {n} frame{'s' * (n > 1)}: they belong "
+        f"to a longer video; keep only the rows of {which} (e.g. awk -F, '$1<={n}' det.txt"
+    )
+    with pytest.raises(ValueError, match="^" + re.escape(message)):
+        track_frames(frames, detections=dets)
+    # the rows of frames 1..n (and empty frames after them) are taken
+    dets = {f: box if f <= n else np.zeros((0, 5)) for f in range(1, 201)}
+    assert track_frames(frames, detections=dets).n_frames == n
+
+
+class _UnknownLength(list):
+    """Frames whose count is unknown, as a camera's or a raw stream's (``len`` 0)."""
+
+    def __len__(self) -> int:
+        return 0
+
+
+@pytest.mark.filterwarnings("ignore:no track over:RuntimeWarning")
+def test_detections_of_a_source_of_unknown_length_are_not_checked_up_front():
+    frame = np.full((120, 160, 3), 90, np.uint8)
+    box = np.array([[40.0, 30.0, 20.0, 40.0, 0.9]])
+    with pytest.warns(UserWarning, match="detections of 2 frames after the video's last frame 1"):
+        run = track_frames(_UnknownLength([frame]), detections={1: box, 2: box, 3: box})
     assert run.n_frames == 1
+
+
+def test_cli_refuses_detections_of_a_longer_video_for_a_1_frame_video(tmp_path, capsys):
+    """The trial's ``track pets_short1.avi --detections det_200.txt``: was a warning, exit 0."""
+    video = make_scene(n_frames=1, rng=0).write_video(tmp_path / "one.avi")
+    det = tmp_path / "det.txt"
+    det.write_text("".join(f"{f},-1,40,30,20,40,0.9\n" for f in range(1, 201)))
+    out = tmp_path / "t.txt"
+    assert main(["-q", "track", str(video), "--detections", str(det), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(
+        "pftrack track: error: detections go up to frame 200 but the video has 1 frame: they "
+        "belong to a longer video; keep only the rows of frame 1 (e.g. awk -F, '$1<=1' det.txt"
+    ), err
+    assert len(err.splitlines()) == 1 and not out.exists()
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_output_boxes_may_reach_past_the_frame_as_documented():
+    """A user trial found boxes out of the frame (x2 = 482.7 on a 480-wide video) while the
+    input is clipped: the output is the filters' estimate, documented so (with the clip to do
+    before cropping), not clipped (that would change the tracking numbers)."""
+    scene = make_scene(n_frames=60, rng=2)
+    h, w = scene.frames[0].shape[:2]
+    tracker = pftrack.Tracker()
+    by_frame = group_by_frame(scene.truth)
+    for k, frame in enumerate(scene.frames, start=1):
+        r = by_frame.get(k, np.zeros((0, 10)))
+        tracker.update(xywh_to_xyxy_dets(np.column_stack([r[:, 2:6], np.ones(len(r))])), frame)
+    rows = tracker.finalize()
+    x1, y1 = rows[:, 2], rows[:, 3]
+    x2, y2 = x1 + rows[:, 4], y1 + rows[:, 5]
+    past = (x1 < 0) | (y1 < 0) | (x2 > w) | (y2 > h)
+    assert past.any()  # as documented: not clipped
+    assert ((x1 < w) & (y1 < h) & (x2 > 0) & (y2 > 0)).all()  # none wholly outside
+    # the documented clip keeps every box inside, with area
+    cx1, cx2 = np.clip(x1, 0, w), np.clip(x2, 0, w)
+    cy1, cy2 = np.clip(y1, 0, h), np.clip(y2, 0, h)
+    assert ((cx2 > cx1) & (cy2 > cy1)).all()
+    from pftrack.integrations.supervision import SupervisionTracker
+
+    for doc in (
+        pftrack.Tracker.update.__doc__,
+        pftrack.Tracker.finalize.__doc__,
+        SupervisionTracker.update_with_detections.__doc__,
+        SupervisionTracker.finalize.__doc__,
+    ):
+        assert "not clipped" in " ".join(str(doc).split())
 
 
 def test_one_tracker_in_two_threads_at_once_raises_not_crashes(scene):

@@ -113,10 +113,25 @@ def test_a_frame_of_another_size_is_refused(scene):
     tracker.update(None, scene.frames[1])  # a new run may have another size
 
 
-@pytest.mark.parametrize("side", [10, 0, True, 640.0, "640"])
+@pytest.mark.parametrize("side", [10, -1, True, False, 640.0, 0.0, "640", "0"])
 def test_bad_max_side_is_refused(side):
-    with pytest.raises(ValueError, match="max_side"):
+    with pytest.raises(ValueError, match=r"max_side is .*, expected None \(or 0: off\) or an int"):
         TrackerConfig(max_side=side)
+    with pytest.raises(ValueError, match="max_side"):
+        pftrack.Tracker(max_side=side)
+
+
+@pytest.mark.parametrize("zero", [0, np.int64(0)])
+def test_max_side_0_is_off_as_on_the_command_line(zero, scene):
+    """Was: ``Tracker(max_side=0)`` raised 'max_side is 0, expected None or an int in [64,
+    100000]' while ``--max-side 0`` (the CLI's default) means the frame's own size."""
+    config = TrackerConfig(max_side=zero)
+    assert config.max_side is None  # stored as None: equal to the default, the same hash
+    assert config == TrackerConfig() == TrackerConfig(max_side=None)
+    assert hash(config) == hash(TrackerConfig())
+    tracker = pftrack.Tracker(max_side=zero)
+    assert tracker.config == pftrack.Tracker().config
+    assert tracker.working_frame(doubled(scene.frames[0])).shape == (720, 960, 3)  # not scaled
 
 
 def test_cli_max_side(scene, tmp_path, capsys):

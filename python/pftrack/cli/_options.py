@@ -284,7 +284,9 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "--no-refine", action="store_true",
         help="with --detections, take the boxes as given instead of shrinking each to the "
         "foreground of a background model (for a detector with tight boxes; no background "
-        "model runs, no frames are read ahead for it); refused without --detections",
+        "model runs, no frames are read ahead for it); refused without --detections. Use it "
+        "too for sideways or overhead-rotated footage: refinement, like the built-in "
+        "detector, assumes upright people",
     )  # fmt: skip
     p.add_argument(
         "--no-link", action="store_true",

@@ -183,6 +183,7 @@ class PaperDetector:
         self._blobs = BlobExtractor(self.config.blobs)
         self._ghost: NDArray[np.uint8] | None = None  # pixels of ghosts still being learnt
         self._grey: bool | None = None  # decided on the priming frames, else the first frame
+        self._grey_unsaid = False  # a grey video's warning, given by the first detect/foreground
         self._shape: tuple[int, ...] | None = None  # of the video's frames (the first seen)
 
     def _new_model(self, shadow_lo: float) -> _core.BackgroundModel:
@@ -212,16 +213,32 @@ class PaperDetector:
         shadow_lo = c.grey_shadow_lo if self._grey else c.shadow_lo
         if self._model.shadow_lo != shadow_lo:  # before any frame: nothing learnt is lost
             self._model = self._new_model(shadow_lo)
-        if self._grey:
-            warnings.warn(
-                "the video is grey (its colour channels are equal): the shadow test is "
-                f"{'off' if shadow_lo >= 1 else f'bounded by {shadow_lo}'} (every darker "
-                "pixel has the background's grey chromaticity, dark clothes too), real shadows "
-                "may be detected; without colour, people as bright as the background are "
-                "missed and the trackers tell people apart by brightness alone",
-                UserWarning,
-                stacklevel=3,
+        # said by the first detect() or foreground(), in the words of what the model is for
+        self._grey_unsaid = bool(self._grey)
+
+    def _say_grey(self, detecting: bool, stacklevel: int) -> None:
+        """Warn, once, that the video is grey: what it costs the detector, or box refinement.
+
+        The detector (:meth:`detect`) misses people as bright as the background. The
+        foreground alone (:meth:`foreground`, which refines another detector's boxes) misses
+        nobody: only its shadow test is off.
+        """
+        self._grey_unsaid = False
+        lo = self.config.grey_shadow_lo
+        test = "off" if lo >= 1 else f"bounded by {lo}"
+        if detecting:
+            text = (
+                f"the video is grey (its colour channels are equal): the shadow test is {test} "
+                "(every darker pixel has the background's grey chromaticity, dark clothes too), "
+                "real shadows may be detected; without colour, people as bright as the "
+                "background are missed and the trackers tell people apart by brightness alone"
             )
+        else:
+            text = (
+                f"the video is grey (its colour channels are equal): box refinement's shadow "
+                f"test is {test}, and the trackers tell people apart by brightness alone"
+            )
+        warnings.warn(text, UserWarning, stacklevel=stacklevel + 1)
 
     def _apply(
         self, frame: NDArray[np.uint8], bins: bool
@@ -276,6 +293,7 @@ class PaperDetector:
         self._blobs.reset()
         self._ghost = None
         self._grey = None
+        self._grey_unsaid = False
         self._shape = None
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
@@ -315,9 +333,18 @@ class PaperDetector:
         Returns
         -------
         Detections
+
+        Warns
+        -----
+        UserWarning
+            Once, on the first call, when the video is grey (`grey_tolerance`): the shadow
+            test is off, people as bright as the background are missed, and trackers tell
+            people apart by brightness alone.
         """
         frame = check_frame(frame, "PaperDetector.detect")
         _, raw = self._apply(frame, bins=False)  # bins below, of the foreground only
+        if self._grey_unsaid:
+            self._say_grey(detecting=True, stacklevel=2)  # detect()'s caller
         shaded = self._blobs.clean(raw)
         mask = foreground_only(shaded)
         if self.config.ghost_support > 0 and self._ghost is not None:
@@ -379,6 +406,14 @@ class PaperDetector:
         With `shadows` the mask keeps the shadow pixels as 127 (255 foreground, 0 background).
         With `bins` False the background pass makes no bins (None in their place): for a
         caller that bins only the pixels it reads (``hsv_bins(..., lazy=True)``).
+
+        Warns
+        -----
+        UserWarning
+            Once, on the first call, when the video is grey (`grey_tolerance`): the shadow
+            test of box refinement is off, and trackers tell people apart by brightness alone
+            (the shorter warning: the boxes refined here come from another detector, so
+            nobody is missed for being as bright as the background).
         """
         shaded, binned = self._foreground(frame, "PaperDetector.foreground", bins)
         return (shaded if shadows else foreground_only(shaded)), binned
@@ -388,6 +423,8 @@ class PaperDetector:
     ) -> tuple[NDArray[np.uint8], _core.BinnedImage | None]:
         """The cleaned mask with shadows (255, 127, 0) and the frame's bins (None without)."""
         binned, raw = self._apply(check_frame(frame, fn), bins)
+        if self._grey_unsaid:
+            self._say_grey(detecting=False, stacklevel=3)  # foreground()'s caller
         return self._blobs.clean(raw), binned
 
 

@@ -102,7 +102,10 @@ class SupervisionTracker:
             As supervision's ByteTrack does: the detections matched to a confirmed track this
             frame, in track order, with ``tracker_id`` set and every other field (boxes, masks,
             data) taken from the input. Tracks sharing one detection (a blob of people who
-            merged) each get a row with that track's own box.
+            merged) each get a row with that track's own box: the filter's estimate, not
+            clipped to the frame, which may reach past its edge by a few pixels, as
+            ground-truth boxes do (clip ``xyxy`` before cropping, e.g. x1, x2 with
+            ``np.clip(..., 0, W)`` and y1, y2 with ``np.clip(..., 0, H)``).
         """
         detections_cls = _detections_class()
         if not isinstance(detections, detections_cls):
@@ -135,7 +138,11 @@ class SupervisionTracker:
         self.tracker.prime(frames)
 
     def finalize(self) -> F64:
-        """The run's MOTChallenge rows after the offline pass (:meth:`pftrack.Tracker.finalize`)."""
+        """The run's MOTChallenge rows after the offline pass (:meth:`pftrack.Tracker.finalize`).
+
+        Their boxes are the filters' estimates, not clipped to the frame: near an edge they may
+        reach past it by a few pixels (clip them before cropping).
+        """
         return self.tracker.finalize()
 
     def reset(self) -> None:

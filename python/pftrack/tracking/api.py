@@ -254,6 +254,9 @@ class Tracker:
         Shrink given detection boxes to the foreground of a background model (the default;
         :class:`~pftrack.tracking.RefineConfig`). False takes the boxes as given and runs no
         background model: for a detector with tight boxes, and about 0.5 ms less a frame.
+        Refinement (like the built-in detector) assumes upright people: use False for
+        sideways or overhead-rotated footage (docs/detection.md, "Known limit: upright
+        people").
     fill : {"linear", "pf"}
         Boxes of a gap the particle filter bridged, before smoothing.
     smooth, link : bool
@@ -269,7 +272,7 @@ class Tracker:
     max_side : int or None
         Working resolution (:attr:`TrackerConfig.max_side`): larger frames are scaled down to
         this longer side for detection and tracking; boxes in and out stay in the frame's
-        pixels. None: the frame's own size.
+        pixels, in [64, 100000]. None or 0 (as ``--max-side 0``): the frame's own size.
 
     Raises
     ------
@@ -574,6 +577,10 @@ class Tracker:
             detection this frame (BoxMOT's convention): ``det_ind`` is the row of `dets` the
             track was matched to (a merged blob's row for each track inside it; -1 with
             ``dets=None``). Boxes are the track's filtered boxes, ``conf`` the detection's.
+            The boxes are the filters' estimates and are not clipped to the frame (only
+            `dets` are): near an edge they may reach past it by a few pixels, as ground-truth
+            boxes do. Clip them before cropping, e.g. ``np.clip(out[:, [0, 2]], 0, W)`` and
+            ``np.clip(out[:, [1, 3]], 0, H)``.
         """
         with self._alone("update"):
             f = bgr_frame(frame)
@@ -704,7 +711,11 @@ class Tracker:
         (R, 10) ndarray of float
             ``frame, id, left, top, width, height, conf, flag, -1, -1`` (``flag`` 1 on a row the
             offline pass filled in a hole, else -1), frames from 1 (one per
-            ``update``), sorted by frame then id; no row lies wholly outside the frame. Warns
+            ``update``), sorted by frame then id; no row lies wholly outside the frame, but a
+            box, the filters' and the smoother's estimate, is not clipped to it and may reach
+            past its edge by a few pixels, as ground-truth boxes do (clip ``left`` and
+            ``left + width`` to [0, W], ``top`` and ``top + height`` to [0, H] before
+            cropping, e.g. with ``np.clip``). Warns
             when there is no row at all, naming the first cause that holds: tracks started
             but none reached ``min_hits`` matches, the built-in detector found nothing, the
             detections' confidences were below the birth threshold, or lay outside the frame,

@@ -84,13 +84,13 @@ def _in_range(
         raise ValueError(f"{owner}: {name} is {v}, expected {expected}")
 
 
-def _none_or_int_in(config: object, name: str, lo: int, hi: int) -> None:
-    """`config.name` must be None or an int (not a bool) in [lo, hi]."""
+def _none_or_int_in(config: object, name: str, lo: int, hi: int, none: str = "None") -> None:
+    """`config.name` must be None or an int (not a bool) in [lo, hi] (`none`: None's name)."""
     v = getattr(config, name)
     if v is not None and (
         isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi
     ):
-        raise ValueError(f"{name} is {v!r}, expected None or an int in [{lo}, {hi}]")
+        raise ValueError(f"{name} is {v!r}, expected {none} or an int in [{lo}, {hi}]")
 
 
 @dataclass(frozen=True)
@@ -372,7 +372,9 @@ class RefineConfig:
     enabled : bool
         With external detections, also run the background model and shrink each detection box
         to the rows and columns where its foreground is (static cameras: detector boxes are
-        often loose). A box with too little foreground is left as it is.
+        often loose). A box with too little foreground is left as it is. It assumes upright
+        people (legs grow downwards, `leg_fill`, `min_height`): turn it off for sideways or
+        overhead-rotated footage.
     fraction : float
         A row or column belongs to the object when its foreground fraction exceeds this share of
         the box's densest row or column; in [0, 1) (``refine_boxes``' range).
@@ -522,7 +524,8 @@ class TrackerConfig:
         ``INTER_AREA``) to this longer side before detection and tracking, and every box the
         tracker reports is scaled back to the frame's pixels (:class:`~pftrack.Tracker`; the
         inner :class:`~pftrack.tracking.MultiObjectTracker` works in the scaled pixels). None
-        tracks at the frame's own size.
+        tracks at the frame's own size; 0 means the same (``--max-side 0``) and is stored as
+        None, so ``TrackerConfig(max_side=0) == TrackerConfig()``. Else an int in [64, 100000].
     open_size : int or None
         Side (pixels) of the built-in detector's opening element (``BlobConfig.open_size``).
         None: from the frame's rows, ``max(3, round(rows / 120))`` made odd (3 at 360 rows, 5
@@ -567,7 +570,10 @@ class TrackerConfig:
     def __post_init__(self) -> None:
         _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
         _none_or_int_in(self, "open_size", 1, MAX_OPEN_SIZE)
-        _none_or_int_in(self, "max_side", MIN_SIDE, MAX_SIDE)
+        side = self.max_side
+        if isinstance(side, (int, np.integer)) and not isinstance(side, bool) and side == 0:
+            object.__setattr__(self, "max_side", None)  # 0 is off, as --max-side 0: stored None
+        _none_or_int_in(self, "max_side", MIN_SIDE, MAX_SIDE, "None (or 0: off)")
         if self.pixel_diagonal is not None and not (
             isinstance(self.pixel_diagonal, (int, float, np.integer, np.floating))
             and not isinstance(self.pixel_diagonal, bool)

@@ -170,6 +170,18 @@ def track_frames(
         has one task per core, such as a worker of ``pftrack batch``, where the extra threads
         only cost CPU.
 
+    Raises
+    ------
+    ValueError
+        `detections` of frames after the video's last, by its frame count (one rule for every
+        length; a source of unknown length, count 0, is not checked), or no frame could be
+        read.
+
+    Warns
+    -----
+    UserWarning
+        A video that ended before its header's count left detections of later frames unused.
+
     Notes
     -----
     Three threads share the work: one decodes (:func:`~pftrack.io.prefetch.prefetch`), one runs
@@ -185,10 +197,8 @@ def track_frames(
         )
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
-    if detections is not None and len(detections) and max(detections) > max(len(frames), 1) > 1:
-        raise ValueError(
-            f"detections go up to frame {max(detections)} but the video has {len(frames)} frames"
-        )
+    if detections:
+        _check_last_frame(detections, len(frames))
     seed = (
         rng
         if rng is None or isinstance(rng, (int, np.integer))
@@ -251,6 +261,25 @@ def track_frames(
                 stacklevel=2,
             )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+
+
+def _check_last_frame(detections: dict[int, F64], n_frames: int) -> None:
+    """Refuse detections of frames after the video's last, by the video's frame count.
+
+    One rule for every length, a 1-frame video too. A count of 0 is unknown (a camera, a
+    stream, a raw ``.h264`` file whose header has none) and is not checked; a video that ends
+    before its header's count is found out while reading (:func:`track_frames` then warns
+    about the detections it did not use).
+    """
+    last = max((f for f, d in detections.items() if len(d)), default=0)
+    if n_frames <= 0 or last <= n_frames:
+        return
+    frames = "frame 1" if n_frames == 1 else f"frames 1-{n_frames}"
+    raise ValueError(
+        f"detections go up to frame {last} but the video has {n_frames} "
+        f"frame{'s' * (n_frames != 1)}: they belong to a longer video; keep only the rows of "
+        f"{frames} (e.g. awk -F, '$1<={n_frames}' det.txt > short.txt) or give the whole video"
+    )
 
 
 SMALL_LAYOUT_BOXES = 20  # boxes a file needs before its extent says anything about its pixels
