@@ -225,7 +225,7 @@ def fill_rows(
             f"fill_gaps: max_gap is {max_gap!r}, expected an integer in 1..{MAX_GAP_LIMIT}"
         )
     rows = check_rows(rows, "fill_gaps")
-    check_unique(rows)
+    check_unique(rows, who="fill_gaps")
     per_id = split_tracks(rows)
     segs: list[tuple[F64, F64]] = []
     meta: list[tuple[int, F64, F64]] = []
