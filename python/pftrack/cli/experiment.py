@@ -6,6 +6,7 @@ import argparse
 import warnings
 from collections.abc import Sequence
 from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 from pftrack.cli._options import (
@@ -137,37 +138,40 @@ def _parse_size(values: Sequence[str]) -> tuple[float, float]:
     return w, h
 
 
-def _seqinfo(gt_path: str) -> tuple[str, float, float, str] | None:
-    """Name, image size and path of the ``seqinfo.ini`` beside the ground truth or one folder up.
+def _seqinfo_file(gt_path: str) -> Path | None:
+    """The ``seqinfo.ini`` beside the ground truth or one folder up (None: there is none)."""
+    gt = Path(gt_path).resolve()
+    for folder in (gt.parent, gt.parent.parent):
+        if (folder / "seqinfo.ini").is_file():
+            return folder / "seqinfo.ini"
+    return None
+
+
+def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
+    """Name and image size from ``seqinfo.ini`` beside the ground truth or one folder up.
 
     Read by :func:`pftrack.io.video.read_seqinfo` (its errors name the file, the key and its
     value: ``imWidth is '0', expected a number > 0``); ``imWidth`` and ``imHeight`` must be
     given, and at most :data:`MAX_SIDE` px (the bound of ``--image-size``).
     """
-    from pathlib import Path
-
     from pftrack.io.video import read_seqinfo
 
-    gt = Path(gt_path).resolve()
-    for folder in (gt.parent, gt.parent.parent):
-        ini = folder / "seqinfo.ini"
-        if ini.is_file():
-            info = read_seqinfo(ini)
-            sizes = (("imWidth", info.width), ("imHeight", info.height))
-            for key, value in sizes:
-                if value is None:
-                    raise ValueError(
-                        f"{ini}: no {key} in [Sequence]; the image size of the ground truth "
-                        "needs imWidth and imHeight"
-                    )
-                if value > MAX_SIDE:
-                    raise ValueError(
-                        f"{ini}: {key} is {value}, expected at most {MAX_SIDE:g} px (as "
-                        "--image-size)"
-                    )
-            assert info.width is not None and info.height is not None  # checked above
-            return info.name, float(info.width), float(info.height), str(ini)
-    return None
+    ini = _seqinfo_file(gt_path)
+    if ini is None:
+        return None
+    info = read_seqinfo(ini)
+    for key, value in (("imWidth", info.width), ("imHeight", info.height)):
+        if value is None:
+            raise ValueError(
+                f"{ini}: no {key} in [Sequence]; the image size of the ground truth needs "
+                "imWidth and imHeight"
+            )
+        if value > MAX_SIDE:
+            raise ValueError(
+                f"{ini}: {key} is {value}, expected at most {MAX_SIDE:g} px (as --image-size)"
+            )
+    assert info.width is not None and info.height is not None  # checked above
+    return info.name, float(info.width), float(info.height)
 
 
 def _methods(text: str) -> list[str]:
@@ -225,8 +229,6 @@ def _check_distinct_gt(paths: list[str]) -> None:
 
     It would be one sequence counted twice: two rows, and its gaps twice in the pooled MMAE.
     """
-    from pathlib import Path
-
     seen: dict[object, str] = {}
     for path in paths:
         p = Path(path)
@@ -408,8 +410,6 @@ def _write_figure(path: str, image: Any) -> None:
 
 def _run_sequences(args: argparse.Namespace) -> int:
     """The multi-sequence protocol with automatic masks (``--gt A B ...`` or ``--auto-masks``)."""
-    from pathlib import Path
-
     from pftrack._progress import progress
     from pftrack.recovery import experiment as E
     from pftrack.recovery.linking import read_tracks
@@ -422,8 +422,8 @@ def _run_sequences(args: argparse.Namespace) -> int:
             raise ValueError(f"ground truth {path} is empty")
         info = _seqinfo(path)
         if info is not None:
-            name, width, height, ini = info
-            where = f"{ini}: imWidth x imHeight"
+            name, width, height = info
+            where = f"{_seqinfo_file(path)}: imWidth x imHeight"
         elif args.image_size:
             width, height = _parse_size(args.image_size)
             p = Path(path).resolve()  # SEQ/gt/gt.txt or SEQ/gt.txt: the sequence; else the file
