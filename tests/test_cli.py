@@ -196,7 +196,9 @@ def test_experiment_reads_a_seqinfo_with_a_byte_order_mark(tmp_path: Path) -> No
     ini.write_bytes(b"\xef\xbb\xbf[Sequence]\nname=S\nimWidth=768\nimHeight=576\n")
     assert _seqinfo(str(gt)) == ("S", 768.0, 576.0)
     ini.write_text("no section\n")  # was configparser's MissingSectionHeaderError: a traceback
-    with pytest.raises(ValueError, match=r"seqinfo.ini: expected \[Sequence\] imWidth"):
+    # read_seqinfo's message, as track and eval say it (was "expected [Sequence] imWidth and
+    # imHeight", also for imWidth=abc)
+    with pytest.raises(ValueError, match=r"seqinfo.ini: expected a \[Sequence\] section"):
         _seqinfo(str(gt))
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -315,3 +316,97 @@ def test_a_non_finite_value_in_any_column_is_named_by_file_and_line(
     name = ("conf", "x", "y", "z")[column - 7]
     with pytest.raises(ValueError, match=rf"t.txt:2: .*non-finite .*column {column} \({name}\)"):
         mot.read_mot(p, what="detection file")
+
+
+_LATER = (
+    "before a value in a later column (optional columns may be left empty only at the end of "
+    "a line)"
+)
+
+
+@pytest.mark.parametrize(
+    ("text", "column"),
+    [
+        ("1,,7,10,10,20,40\n3,,7,12,10,20,40\n", "column 2 (id), which needs a number"),
+        (",1,10,10,20,40\n", "column 1 (frame), which needs a number"),
+        ("1,1,10,10,20,,0.9\n", "column 6 (height), which needs a number"),
+        ("1,1,10,10,20,\n", "column 6 (height), which needs a number"),  # was: "5 fields"
+        ("1, 1 , ,10,20,40\n", "column 3 (left), which needs a number"),
+        # MOT17's 9 columns with an empty conf: the class was read as conf
+        ("1,7,10,10,20,40,,1,0.5\n", f"column 7 (conf) {_LATER}"),
+        ("3,1,12,10,20,40,,0.5,,\n", f"column 7 (conf) {_LATER}"),
+        ("1,1,10,10,20,40,0.9,,,,5\n", f"column 8 (x) {_LATER}"),
+    ],
+)
+def test_an_empty_field_is_refused_never_skipped(tmp_path: Path, text: str, column: str) -> None:
+    """Regression: empty fields were dropped and the values after them shifted left, silently
+    (``1,,7,10,...`` read as frame 1, id 7, left 10): comma-separated lines keep them now."""
+    p = tmp_path / "t.txt"
+    p.write_text("# c\n" + text)  # the line-by-line reader (the fast one refuses them too)
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p, what="tracks file")
+    first = text.splitlines()[0]
+    assert str(exc.value) == f"{p}:2: tracks file line has an empty {column}: {first!r}"
+    p.write_text(text)
+    with pytest.raises(ValueError, match=f"^{p}:1: tracks file line has an empty column "):
+        mot.read_mot(p, what="tracks file")
+
+
+@pytest.mark.parametrize(
+    ("text", "want"),
+    [
+        ("1,2,10,10,20,40,\n", [1, 2, 10, 10, 20, 40, 1, -1, -1, -1]),  # a trailing comma
+        ("1,2,10,10,20,40,,,,\n", [1, 2, 10, 10, 20, 40, 1, -1, -1, -1]),
+        ("1,2,10,10,20,40,0.5,-1,,,\n", [1, 2, 10, 10, 20, 40, 0.5, -1, -1, -1]),
+        ("1,2,10,10,20,40,0.5,3, , \n", [1, 2, 10, 10, 20, 40, 0.5, 3, -1, -1]),
+        ("1, 2 ,10 , 10,20,40 , \r\n", [1, 2, 10, 10, 20, 40, 1, -1, -1, -1]),
+        ("1,2 10,10 20,40\n", [1, 2, 10, 10, 20, 40, 1, -1, -1, -1]),  # commas and spaces
+        ("1\t2\t10\t10\t20\t40\t0.5\n", [1, 2, 10, 10, 20, 40, 0.5, -1, -1, -1]),
+        ("1  2   1e3 10 20 40\r", [1, 2, 1000, 10, 20, 40, 1, -1, -1, -1]),
+        ("1,2,10,10,20,40,0.5,1,2,3,,9\n", [1, 2, 10, 10, 20, 40, 0.5, 1, 2, 3]),  # past 10
+    ],
+)
+def test_empty_fields_at_the_end_of_a_line_are_absent_columns(
+    tmp_path: Path, text: str, want: list[float]
+) -> None:
+    """Trailing commas and empty optional columns at the end get the defaults; no shift."""
+    p = tmp_path / "t.txt"
+    p.write_bytes(b"\xef\xbb\xbf\n" + text.encode())  # a BOM and a blank line: kept working
+    assert mot.read_mot(p).tolist() == [want]
+
+
+def test_every_command_refuses_an_empty_field_by_file_line_and_column(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: exit 0, the row read with its values shifted one column left."""
+    from pftrack.cli import main
+    from pftrack.synthetic import make_scene
+
+    seq = tmp_path / "SEQ"
+    make_scene(n_frames=5, rng=0).write_images(seq / "img1")
+    (seq / "det").mkdir()
+    (seq / "det" / "det.txt").write_text("1,-1,10,10,20,40,1\n2,-1,,10,20,40,1\n")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=960\n")
+    (tmp_path / "good.txt").write_text("1,1,10,10,20,40\n3,1,12,10,20,40\n")
+    (tmp_path / "eid.txt").write_text("1,,7,10,10,20,40\n3,,7,12,10,20,40\n")
+    monkeypatch.chdir(tmp_path)
+    eid = "eid.txt:1: {} line has an empty column 2 (id), which needs a number: "
+    size = ["--image-size", "768x576"]
+    for argv, message in (
+        (["track", "SEQ", "--detections", "auto", "--out", "o.txt"], "SEQ/det/det.txt:2: "
+         "detection file line has an empty column 3 (left), which needs a number: "),
+        (["recover", "eid.txt", "--out", "o.txt"], eid.format("tracks file")),
+        (["smooth", "eid.txt", "--out", "o.txt"], eid.format("tracks file")),
+        (["eval", "--gt", "eid.txt", "--res", "good.txt"], eid.format("ground truth")),
+        (["eval", "--gt", "good.txt", "--res", "eid.txt"], eid.format("result file")),
+        (["render", "SEQ", "eid.txt", "--out", "o.mp4"], eid.format("tracks file")),
+        (["experiment", "gaps", "--gt", "eid.txt", *size], eid.format("ground truth")),
+        (["experiment", "gaps", "--gt", "good.txt", "eid.txt", *size], eid.format("ground truth")),
+    ):  # fmt: skip
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.startswith(f"pftrack {argv[0]}: error: {message}") and err.count("\n") == 1
+    assert sorted(os.listdir(tmp_path)) == ["SEQ", "eid.txt", "good.txt"]
+    # many files: the file fails by name, as any bad file of a batch (the others are done)
+    assert main(["batch", "SEQ", "--detections", "auto", "--out", "b", "-q"]) == 1
+    assert "det.txt:2: detection file line has an empty column 3 (left)" in capsys.readouterr().out

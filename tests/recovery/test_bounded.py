@@ -325,3 +325,61 @@ def test_rows_and_segments_of_booleans_are_refused() -> None:
     seg = rows[:, [0, 2, 3]]
     with pytest.raises(TypeError, match="segment_a must hold real numbers, got dtype bool"):
         recover_gap(seg[:1].astype(bool), seg[1:], None, "linear")
+
+
+def test_holes_longer_than_max_gap_are_counted() -> None:
+    """Regression: they were left unfilled without a word (``0 gaps filled with 0 rows``)."""
+    from pftrack.recovery.fill import long_holes, unfilled_note
+
+    rows = _rows([1, 2, 40, 41, 100, 1, 5], [1, 1, 1, 1, 1, 2, 2])  # holes of 37, 58 and 3
+    _, rep = fill_gaps(rows, "linear", max_gap=30)
+    assert (rep.n_gaps, rep.n_long_holes, rep.longest_hole) == (1, 2, 58)
+    assert long_holes(rows, 30) == (2, 58)
+    _, rep = fill_gaps(rows, "linear", max_gap=58)  # at most max_gap: filled, not counted
+    assert (rep.n_gaps, rep.n_long_holes, rep.longest_hole) == (3, 0, 0)
+    assert long_holes(rows, 58) == (0, 0)
+    _, rep = fill_gaps(FAR, "auto")
+    assert (rep.n_long_holes, rep.longest_hole) == (1, 9_999_996)
+    assert long_holes(smooth_tracks(FAR), DEFAULT_MAX_GAP) == (1, 9_999_996)
+    assert unfilled_note(3, 9_999_998, 30) == (
+        "3 holes longer than --max-gap 30 left unfilled (longest 9999998 frames)"
+    )
+    assert unfilled_note(1, 31, 30) == "1 hole longer than --max-gap 30 left unfilled (31 frames)"
+    assert unfilled_note(0, 0, 30) == ""
+
+
+def test_cli_says_how_many_holes_were_left_unfilled(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    import json
+
+    from pftrack.cli import main
+
+    huge = tmp_path / "huge.txt"
+    huge.write_text("1,1,10,10,20,40\n2,1,11,10,20,40\n10000000,1,20,10,20,40\n"
+                    "10000001,1,21,10,20,40\n")  # fmt: skip
+    two = tmp_path / "two.txt"
+    two.write_text("1,1,10,10,20,40\n40,1,11,10,20,40\n100,1,12,10,20,40\n1,2,10,10,20,40\n")
+    note = "2 holes longer than --max-gap 30 left unfilled (longest 59 frames)"
+    one = "1 hole longer than --max-gap 30 left unfilled (9999997 frames)"
+    for argv, line in (
+        (["recover", str(huge), "--explain"], f"{huge}: {one}"),  # was: "auto: no gap to fill"
+        (["-q", "smooth", str(huge)], f"{huge}: {one}"),  # printed as the summary line is
+        (["recover", str(two)], f"{two}: {note}"),
+        (["smooth", str(two), "--no-link"], f"{two}: {note}"),
+    ):
+        assert main([*argv, "--out", str(tmp_path / "o.txt")]) == 0
+        out = capsys.readouterr().out.splitlines()
+        assert out[1] == line, out
+    for argv in (["recover", str(two), "--max-gap", "59"], ["smooth", str(two), "--max-gap", "59"]):
+        assert main([*argv, "--out", str(tmp_path / "o.txt")]) == 0
+        assert "left unfilled" not in capsys.readouterr().out  # none: no line
+    (tmp_path / "in").mkdir()
+    for p in (huge, two):
+        p.rename(tmp_path / "in" / p.name)
+    for cmd in ("recover", "smooth"):  # the batch's summary: one line per file that has some
+        argv = [cmd, str(tmp_path / "in"), "--out", str(tmp_path / cmd), "--workers", "0"]
+        assert main(argv) == 0
+        out = capsys.readouterr().out
+        assert f"\nhuge: {one}\n" in out
+        assert f"\ntwo: {note}\n" in out
+        files = json.loads((tmp_path / cmd / "summary.json").read_text())["files"]
+        assert [(f["long_holes"], f["longest_hole"]) for f in files] == [(1, 9999997), (2, 59)]

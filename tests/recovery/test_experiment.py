@@ -106,3 +106,129 @@ def test_repeated_rows_are_named_by_file_and_line_as_recover_names_them(
     assert errors[0].startswith(f"{gt}:91: duplicate rows for frame 2, id 2 (lines 5 and 91)")
     with pytest.raises(ValueError, match="duplicate rows for frame 5, id 1"):
         E.trajectories(np.vstack([_walkers(3, 30), _walkers(3, 30)[4:5]]))
+
+
+@pytest.mark.parametrize(
+    ("ini", "message"),
+    [
+        # was "auto_masks: image size is 0x370, expected > 0" (an internal function, no file)
+        ("imWidth=0\nimHeight=370", "imWidth is '0', expected a number > 0"),
+        # was "auto_masks: mask side 1.30208e+08 px exceeds the image 1e+09x370"
+        ("imWidth=1e9\nimHeight=370", "imWidth is 1000000000, expected at most 100000 px"),
+        # was "expected [Sequence] imWidth and imHeight", though both keys are there
+        ("imWidth=abc\nimHeight=370", "imWidth is 'abc', expected a number > 0"),
+        ("imWidth=768\nimHeight=", "imHeight is empty; give a value or leave the key out"),
+        ("imWidth=768", "no imHeight in [Sequence]; the image size of the ground truth needs"),
+        ("imWidth=1000\nimHeight=50", "imWidth x imHeight 1000x50 cannot hold the masks: their "
+                                      "side is round(100 W/768) = 130 px"),
+    ],
+)  # fmt: skip
+def test_a_bad_seqinfo_is_named_with_its_key_and_value(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], ini: str, message: str
+) -> None:
+    seq = tmp_path / "SEQ"
+    (seq / "gt").mkdir(parents=True)
+    write_mot(seq / "gt" / "gt.txt", _walkers(n_ids=3, n_frames=30))
+    (seq / "seqinfo.ini").write_text(f"[Sequence]\n{ini}\n")  # one folder up: read too
+    assert main(["experiment", "gaps", "--gt", str(seq / "gt" / "gt.txt"), "--auto-masks"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pftrack experiment: error: {seq / 'seqinfo.ini'}: {message}"), err
+    assert err.count("\n") == 1
+
+
+def test_too_small_an_image_size_is_named_for_its_sequence(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    gt = tmp_path / "walk.txt"
+    write_mot(gt, _walkers(n_ids=3, n_frames=30))
+    argv = ["experiment", "gaps", "--gt", str(gt), "--auto-masks", "--image-size", "768x50"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack experiment: error: {gt}: --image-size 768x50 cannot hold the masks: their "
+        "side is round(100 W/768) = 100 px\n"
+    )
+
+
+def test_a_sequence_without_a_gap_says_so_and_the_pooled_figures_leave_it_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: a row of nan for the sequence, exit 0, nothing said."""
+    import json
+    import warnings
+
+    walk, tiny = tmp_path / "walk.txt", tmp_path / "tiny.txt"
+    write_mot(walk, _walkers(n_ids=6, n_frames=60))
+    tiny.write_text("1,1,10,10,20,40\n5,1,20,10,20,40\n")  # one track of two rows: no gap
+    out = tmp_path / "o.json"
+    argv = ["experiment", "gaps", "--gt", str(walk), str(tiny), "--image-size", "768x576",
+            "--methods", "linear,rts", "--json", str(out)]  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
+        assert main(argv) == 0
+    said = capsys.readouterr()
+    assert "nan" not in said.out
+    assert said.err == (
+        "pftrack experiment: warning: tiny: no gap under any mask (no mask position cuts a "
+        "trajectory that is observed on both sides of it): no MMAE, and nothing of it in the "
+        "pooled figures\n"
+    )
+    lines = said.out.splitlines()
+    assert "tiny (768x576): 0 gaps, masks none" in lines
+    row = {line.split()[0]: line for line in lines if line.startswith(("walk", "tiny", "pooled"))}
+    assert row["tiny"].split(None, 2)[1:] == ["0", E.NO_GAPS]
+    assert row["pooled"].split()[1:] == row["walk"].split()[1:]  # the gaps of walk alone
+    doc = json.loads(out.read_text())
+    assert doc["sequences"][1]["mmae"] == {"linear": None, "rts": None}
+    assert doc["pooled"]["mmae"] == doc["sequences"][0]["mmae"]
+    argv = ["experiment", "gaps", "--gt", str(tiny), "--auto-masks", "--image-size", "768x576"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        assert main(argv) == 0
+    said = capsys.readouterr()
+    assert "pooled           0  no gaps in any sequence: no MMAE" in said.out
+    assert said.err.startswith("pftrack experiment: warning: tiny: no gap under any mask")
+
+
+def test_python_errors_name_the_function_and_argument() -> None:
+    """Was: "fill_gaps: method is 'nope'" from smooth_tracks, and no prefix on duplicates."""
+    from pftrack.recovery import fill_gaps, link_tracklets
+    from pftrack.recovery.linking import LinkConfig
+    from pftrack.tracking import smooth_tracks
+
+    rows = _walkers(n_ids=2, n_frames=10)
+    with pytest.raises(ValueError, match=r"^smooth_tracks: fill_method is 'nope', expected one"):
+        smooth_tracks(rows[rows[:, 0] != 5], fill_method="nope")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^smooth_tracks: fill_method is 'nope'"):
+        smooth_tracks(rows, link=None, fill_method="nope")  # type: ignore[arg-type]
+    twice = np.vstack([rows, rows[3:4]])
+    for who, call in (
+        ("fill_gaps", lambda: fill_gaps(twice)),
+        ("smooth_tracks", lambda: smooth_tracks(twice)),
+        ("smooth_tracks", lambda: smooth_tracks(twice, link=None)),  # was BoxSmoother.smooth's
+        ("link_tracklets", lambda: link_tracklets(twice, LinkConfig())),
+        ("trajectories", lambda: E.trajectories(twice)),
+    ):
+        with pytest.raises(ValueError, match=rf"^{who}: duplicate rows for frame 4, id 1: each"):
+            call()
+    dets = rows.copy()
+    dets[:, 1] = -1
+    with pytest.raises(
+        ValueError,
+        match=r"^fill_gaps: duplicate rows for frame 1, id -1: .*; "
+        r"every id is -1: this looks like untracked detections \(a det\.txt\)",
+    ):
+        fill_gaps(dets)
+
+
+def test_recover_of_a_detection_file_says_it_needs_tracks(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    det = tmp_path / "det.txt"
+    det.write_text("1,-1,10,10,20,40,0.9\n1,-1,50,10,20,40,0.8\n2,-1,11,10,20,40,0.9\n")
+    assert main(["recover", str(det), "--out", str(tmp_path / "o.txt")]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack recover: error: {det}:2: duplicate rows for frame 1, id -1 (lines 1 and 2): "
+        "each (frame, id) may appear once; every id is -1: this looks like untracked "
+        "detections (a det.txt), not tracks (pftrack track SOURCE --detections FILE makes "
+        "tracks of them)\n"
+    )

@@ -184,6 +184,11 @@ class BatchSummary:
         for e in self.entries:
             if e.get("note"):
                 text.append(f"{e['name']}: {e['note']}")
+            if e.get("long_holes"):  # recover, smooth: holes longer than --max-gap
+                from pftrack.recovery.fill import unfilled_note
+
+                note = unfilled_note(e["long_holes"], e["longest_hole"], self.settings["max_gap"])
+                text.append(f"{e['name']}: {note}")
             text.extend(f"{e['name']}: warning: {w}" for w in e.get("warnings", ()))
         for e in self.failed:
             text.append(f"{e['name']}: error: {e['error']}")

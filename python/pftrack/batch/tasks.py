@@ -490,6 +490,8 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
         "fragments_linked": n_links,
         "gaps": rep.n_gaps,
         "filled_rows": rep.n_filled_rows,
+        "long_holes": rep.n_long_holes,  # longer than max_gap: left unfilled
+        "longest_hole": rep.longest_hole,
         "rows_out": len(filled),
         "seconds": time.perf_counter() - t0,
         "explain": rep.describe(options.method),
@@ -526,6 +528,7 @@ class SmoothOptions:
 
 def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     """Link, fill and smooth one tracks file as ``pftrack smooth FILE`` does."""
+    from pftrack.recovery.fill import long_holes
     from pftrack.recovery.linking import link_config_for
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import smoothed_copies
@@ -534,12 +537,15 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     rows = read_tracks(path)
     link = link_config_for(rows, options.max_gap, options.max_distance) if options.link else None
     result = smooth_tracks(rows, link=link, max_gap=options.max_gap)
+    n_long, longest = long_holes(result, options.max_gap)  # every shorter hole was filled
     info: dict[str, Any] = {
         "source": str(path),
         "ids_in": int(len(np.unique(rows[:, 1]))) if len(rows) else 0,
         "rows_in": len(rows),
         "ids_out": int(len(np.unique(result[:, 1]))) if len(result) else 0,
         "rows_out": len(result),
+        "long_holes": n_long,  # longer than max_gap: left unfilled
+        "longest_hole": longest,
         "seconds": time.perf_counter() - t0,
     }
     return TaskResult(result, {}, info, exact=smoothed_copies(result))

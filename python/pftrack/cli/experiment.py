@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import warnings
 from collections.abc import Sequence
 from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 from pftrack.cli._options import (
@@ -136,23 +138,40 @@ def _parse_size(values: Sequence[str]) -> tuple[float, float]:
     return w, h
 
 
-def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
-    """Name and image size from ``seqinfo.ini`` beside the ground truth or one folder up."""
-    import configparser
-    from pathlib import Path
-
+def _seqinfo_file(gt_path: str) -> Path | None:
+    """The ``seqinfo.ini`` beside the ground truth or one folder up (None: there is none)."""
     gt = Path(gt_path).resolve()
     for folder in (gt.parent, gt.parent.parent):
-        ini = folder / "seqinfo.ini"
-        if ini.is_file():
-            cp = configparser.ConfigParser()
-            try:
-                cp.read(ini, encoding="utf-8-sig")
-                sec = cp["Sequence"]
-                return sec.get("name", folder.name), float(sec["imWidth"]), float(sec["imHeight"])
-            except (configparser.Error, KeyError, ValueError):
-                raise ValueError(f"{ini}: expected [Sequence] imWidth and imHeight") from None
+        if (folder / "seqinfo.ini").is_file():
+            return folder / "seqinfo.ini"
     return None
+
+
+def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
+    """Name and image size from ``seqinfo.ini`` beside the ground truth or one folder up.
+
+    Read by :func:`pftrack.io.video.read_seqinfo` (its errors name the file, the key and its
+    value: ``imWidth is '0', expected a number > 0``); ``imWidth`` and ``imHeight`` must be
+    given, and at most :data:`MAX_SIDE` px (the bound of ``--image-size``).
+    """
+    from pftrack.io.video import read_seqinfo
+
+    ini = _seqinfo_file(gt_path)
+    if ini is None:
+        return None
+    info = read_seqinfo(ini)
+    for key, value in (("imWidth", info.width), ("imHeight", info.height)):
+        if value is None:
+            raise ValueError(
+                f"{ini}: no {key} in [Sequence]; the image size of the ground truth needs "
+                "imWidth and imHeight"
+            )
+        if value > MAX_SIDE:
+            raise ValueError(
+                f"{ini}: {key} is {value}, expected at most {MAX_SIDE:g} px (as --image-size)"
+            )
+    assert info.width is not None and info.height is not None  # checked above
+    return info.name, float(info.width), float(info.height)
 
 
 def _methods(text: str) -> list[str]:
@@ -210,8 +229,6 @@ def _check_distinct_gt(paths: list[str]) -> None:
 
     It would be one sequence counted twice: two rows, and its gaps twice in the pooled MMAE.
     """
-    from pathlib import Path
-
     seen: dict[object, str] = {}
     for path in paths:
         p = Path(path)
@@ -393,8 +410,6 @@ def _write_figure(path: str, image: Any) -> None:
 
 def _run_sequences(args: argparse.Namespace) -> int:
     """The multi-sequence protocol with automatic masks (``--gt A B ...`` or ``--auto-masks``)."""
-    from pathlib import Path
-
     from pftrack._progress import progress
     from pftrack.recovery import experiment as E
     from pftrack.recovery.linking import read_tracks
@@ -408,13 +423,21 @@ def _run_sequences(args: argparse.Namespace) -> int:
         info = _seqinfo(path)
         if info is not None:
             name, width, height = info
+            where = f"{_seqinfo_file(path)}: imWidth x imHeight"
         elif args.image_size:
             width, height = _parse_size(args.image_size)
             p = Path(path).resolve()  # SEQ/gt/gt.txt or SEQ/gt.txt: the sequence; else the file
             name = p.parent.name if p.stem == "gt" else p.stem
+            where = f"{path}: --image-size"  # the sequence named: the size is for it
         else:
             raise ValueError(
                 f"{path}: no seqinfo.ini beside it or one folder up; pass --image-size"
+            )
+        side = E.auto_mask_side(width)
+        if side > width or side > height:  # was: "auto_masks: mask side ... exceeds the image"
+            raise ValueError(
+                f"{where} {width:g}x{height:g} cannot hold the masks: their side is "
+                f"round(100 W/768) = {side:g} px"
             )
         jobs.append((name, E.trajectories(gt, args.point), width, height))
     results = [
@@ -446,11 +469,18 @@ def _run_sequences(args: argparse.Namespace) -> int:
         _write_json(args.json, doc)
     to = report_stream(args.json)  # not into a JSON file written to stdout
     for r in results:  # printed once the JSON is written: a closed stdout cannot lose it
-        masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks)
+        masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks) or "none"
         print(
             f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}",
             file=to,
         )
+        if not r.n_gaps:  # was: a row of nan, and nothing said
+            warnings.warn(
+                f"{r.name}: no gap under any mask (no mask position cuts a trajectory that is "
+                "observed on both sides of it): no MMAE, and nothing of it in the pooled "
+                "figures",
+                stacklevel=2,
+            )
     print(file=to)
     print("MMAE (px, mean over gaps of the mean Euclidean error); * = best of the row", file=to)
     print(E.format_sequences(results, methods), file=to)

@@ -38,7 +38,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--method", default=DEFAULT_METHOD, choices=METHODS, help="recovery method")
     p.add_argument("--max-gap", type=batch.max_gap, default=30, metavar="FRAMES",
                    help=f"longest hole filled, in frames (1 to {batch.MAX_GAP}; longer holes "
-                   "stay holes: bounded work)")  # fmt: skip
+                   "stay holes: bounded work; their number and the longest are "
+                   "printed)")  # fmt: skip
     p.add_argument("--explain", action="store_true",
                    help="with auto: print the method chosen per gap length (or the two methods "
                    "it blends, with their weights) and its validation MMAE")  # fmt: skip
@@ -82,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
-    from pftrack.recovery.fill import copied_values
+    from pftrack.recovery.fill import copied_values, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
 
     src = Path(args.tracks)
@@ -123,6 +124,8 @@ def run(args: argparse.Namespace) -> int:
         f"({args.method}, {1e3 * dt:.1f} ms) -> {out} ({flag_note(rows)})",
         file=to,
     )
+    if rep.n_long_holes:  # bounded work, said: was silent ("0 gaps filled")
+        print(f"{src}: {unfilled_note(rep.n_long_holes, rep.longest_hole, args.max_gap)}", file=to)
     if args.explain:
         print(rep.describe(args.method), file=to)
     return 0

@@ -32,7 +32,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--out", required=True, help="output file (written atomically; never the input)")
     p.add_argument("--max-gap", type=batch.max_gap, default=30, metavar="FRAMES",
                    help=f"longest gap joined and filled, in frames (1 to {batch.MAX_GAP}; longer "
-                   "holes stay holes: bounded work)")  # fmt: skip
+                   "holes stay holes: bounded work; their number and the longest are "
+                   "printed)")  # fmt: skip
     p.add_argument("--no-link", action="store_true",
                    help="join no fragments: fill the holes inside each id and smooth each id "
                    "as it is")  # fmt: skip
@@ -57,6 +58,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
+    from pftrack.recovery.fill import long_holes, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import smoothed_copies
@@ -71,9 +73,13 @@ def run(args: argparse.Namespace) -> int:
     write_mot(args.out, result, exact=smoothed_copies(result))  # given values: all digits
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
+    to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report not
     print(
         f"{src}: {counted(ids_in, 'id')}, {counted(len(rows), 'row')} -> "
         f"{counted(ids_out, 'id')}, {counted(len(result), 'row')} ({flag_note(rows)}) -> {out}",
-        file=report_stream(args.out),  # rows on stdout (--out /dev/stdout): the report not
+        file=to,
     )
+    n_long, longest = long_holes(result, args.max_gap)  # every shorter hole was filled
+    if n_long:  # bounded work, said: was silent
+        print(f"{src}: {unfilled_note(n_long, longest, args.max_gap)}", file=to)
     return 0

@@ -1,11 +1,12 @@
 """MOTChallenge text files: ``frame,id,left,top,width,height,conf,x,y,z`` one box a line.
 
 Frames count from 1. Detection files use id -1. pftrack reads comma- or whitespace-separated
-files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``) and always writes 10:
-values of up to 10 significant digits (what MOTChallenge files and trackers hold) come out
-unchanged, in their shortest form (``88.00`` as ``88``); longer values are rounded to 2
-decimals (values pftrack computed) unless marked ``exact`` (values read from a file such as
-``np.savetxt``'s, written in their shortest round-trip form; :func:`mot_text`).
+files with 6 to 10 columns (missing columns become ``conf=1, x=y=z=-1``; so do empty ones at
+the end of a line, ``...,0.9,,,``; an empty field anywhere else is refused, never skipped) and
+always writes 10: values of up to 10 significant digits (what MOTChallenge files and trackers
+hold) come out unchanged, in their shortest form (``88.00`` as ``88``); longer values are
+rounded to 2 decimals (values pftrack computed) unless marked ``exact`` (values read from a
+file such as ``np.savetxt``'s, written in their shortest round-trip form; :func:`mot_text`).
 """
 
 from __future__ import annotations
@@ -58,9 +59,34 @@ def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
                 yield lineno, text
 
 
+def _split(text: str) -> list[str]:
+    """The fields of a row, empty ones kept: separated by commas, spaces or both.
+
+    A comma ends a field, so two commas in a row (or a comma at either end) hold an empty
+    field (``""``); a run of spaces or tabs is one separator (aligned columns), and spaces
+    around a comma are none. Trailing empty fields (``1,1,10,10,20,40,``) are kept too:
+    :func:`_fields` drops them.
+    """
+    if "," not in text:
+        return text.split()
+    parts = text.split(",")
+    if " " not in text and "\t" not in text:
+        return parts  # the common case: one split
+    fields: list[str] = []
+    for part in parts:
+        fields.extend(part.split() or [""])
+    return fields
+
+
 def _fields(text: str) -> list[str]:
-    """The fields of a row: separated by commas, spaces or both."""
-    return text.replace(",", " ").split()
+    """The fields of a row, without the empty ones that end it (trailing commas).
+
+    An empty field before a non-empty one stays (``""``): :func:`_parse_line` refuses it.
+    """
+    fields = _split(text)
+    while fields and not fields[-1]:
+        fields.pop()
+    return fields
 
 
 def first_row_fields(path: PathLike) -> int:
@@ -100,11 +126,14 @@ def read_mot(
     ValueError
         If it is a folder, or not a regular file (a device such as ``/dev/null``, a named pipe,
         a socket: the file may be read twice, to name a bad line). On a malformed line,
-        naming the file and the 1-based line number: fewer than 6 fields, a non-number, a
-        non-finite value in any of the first 10 columns (a NaN score too), a frame that is not
-        an integer in ``1..2**31-1``, a negative width or height, or a box value beyond ±1e9
-        px. A UTF-8 byte-order mark is skipped. A compressed file (gzip, zip, bzip2, xz, zstd)
-        or one with NUL bytes in its first 8 KiB (not text), naming the file.
+        naming the file and the 1-based line number: fewer than 6 fields, an empty field
+        (``1,,7,...``: two commas in a row) in the first 6 columns or before a non-empty one
+        (empty fields at the end of a line, ``...,0.9,,,`` or a trailing comma, are absent
+        columns: their defaults), a non-number, a non-finite value in any of the first 10
+        columns (a NaN score too), a frame that is not an integer in ``1..2**31-1``, a
+        negative width or height, or a box value beyond ±1e9 px. A UTF-8 byte-order mark is
+        skipped. A compressed file (gzip, zip, bzip2, xz, zstd) or one with NUL bytes in its
+        first 8 KiB (not text), naming the file.
 
     Warns
     -----
@@ -161,6 +190,19 @@ def _parse_line(text: str, what: str) -> list[float] | str:
     Missing columns get their defaults. The boxes are :func:`read_mot`'s to check.
     """
     fields = _fields(text)
+    # an empty field is refused, never skipped (the values after it would shift into its
+    # column): in the first 6 columns (a trailing comma there too), or before a value
+    # (columns past 10 are not kept: theirs do not matter)
+    kept = fields[:10] if len(fields) >= 6 else _split(text)[:6]
+    if "" in kept:
+        c = kept.index("")
+        why = (
+            ", which needs a number"
+            if c < 6
+            else " before a value in a later column (optional columns may be left empty only "
+            "at the end of a line)"
+        )
+        return f"{what} line has an empty column {c + 1} ({_NAMES[c]}){why}: {text[:80]!r}"
     if len(fields) < 6:
         return (
             f"{what} line has {len(fields)} fields, expected at least 6 "

@@ -93,7 +93,7 @@ def trajectories(gt: F64, point: str = "centre") -> dict[int, F64]:
     """
     if point not in ("centre", "center", "foot"):
         raise ValueError(f"trajectories: point is {point!r}, expected 'centre' or 'foot'")
-    check_unique(gt)
+    check_unique(gt, who="trajectories")
     out: dict[int, F64] = {}
     for tid in np.unique(gt[:, 1]).astype(int):
         r = gt[gt[:, 1] == tid]
@@ -517,6 +517,14 @@ def format_median(ms: MedianScores) -> str:
     return text + "\n" + f"{'best at':<14}" + "".join(f"{ms.wins[m]:>{width}d}" for m in methods)
 
 
+def auto_mask_side(width: float) -> float:
+    """The side of :func:`auto_masks`' squares on an image `width` px wide: ``round(100 W/768)``.
+
+    The image must hold it: at least that high (and wide, from 1 px up).
+    """
+    return float(round(100.0 * width / 768.0))
+
+
 def auto_masks(
     trajs: dict[int, F64], width: float, height: float, n: int = 3
 ) -> list[tuple[float, float, float, float]]:
@@ -537,7 +545,7 @@ def auto_masks(
         raise ValueError(f"auto_masks: image size is {width:g}x{height:g}, expected > 0")
     if n < 1:
         raise ValueError(f"auto_masks: n is {n}, expected >= 1")
-    size = float(round(100.0 * width / 768.0))
+    size = auto_mask_side(width)
     step = float(max(1, round(4.0 * width / 768.0)))
     if size > width or size > height:
         raise ValueError(
@@ -613,8 +621,16 @@ def run_sequence(
     )
 
 
+#: What :func:`format_sequences` shows in place of the MMAEs of a sequence without a gap.
+NO_GAPS = "no gaps: no mask cuts a trajectory (no MMAE; nothing pooled)"
+
+
 def format_sequences(results: Sequence[SequenceResult], methods: Sequence[str]) -> str:
-    """Per-sequence and pooled MMAE (px), one column per method; ``*`` marks each row's best."""
+    """Per-sequence and pooled MMAE (px), one column per method; ``*`` marks each row's best.
+
+    A sequence without a gap under its masks (so no error to average) shows :data:`NO_GAPS`
+    instead of a row of NaN; the pooled row averages the gaps of the others.
+    """
     width = max(10, *(len(m) + 3 for m in methods))
     name_w = max(12, *(len(r.name) + 2 for r in results)) if results else 12
     head = f"{'sequence':<{name_w}}{'gaps':>6}" + "".join(f"{m:>{width}}" for m in methods)
@@ -625,7 +641,11 @@ def format_sequences(results: Sequence[SequenceResult], methods: Sequence[str]) 
     rows.append(
         ("pooled", n_all, {m: float(np.mean(v)) if v else float("nan") for m, v in pooled.items()})
     )
-    for label, n, vals in rows:
+    for k, (label, n, vals) in enumerate(rows):
+        if not n:  # the last row is the pooled one: then no sequence has a gap
+            said = NO_GAPS if k < len(results) else "no gaps in any sequence: no MMAE"
+            lines.append(f"{label:<{name_w}}{n:>6}  {said}")
+            continue
         finite = [v for v in vals.values() if np.isfinite(v)]
         best = min(finite) if finite else float("nan")
         cells = "".join(

@@ -41,6 +41,8 @@ __all__ = [
     "copied_values",
     "fill_gaps",
     "fill_rows",
+    "long_holes",
+    "unfilled_note",
 ]
 
 #: Longest hole filled by default, in frames, everywhere pftrack fills holes (``recover``,
@@ -57,10 +59,13 @@ SIZE_GAPS = 120
 class FillReport:
     """What :func:`fill_gaps` did.
 
+    ``n_gaps``, ``n_filled_rows``: the holes filled and the rows added;
     ``calibration``: with ``"auto"``, the method chosen per gap-length bucket and the
     validation MMAE of every candidate (:class:`~pftrack.recovery.calibrate.Calibration`);
     ``size_calibration``: the same for the box sizes ``(w, h)`` (candidates
-    :data:`SIZE_CANDIDATES`).
+    :data:`SIZE_CANDIDATES`); ``n_long_holes``: the holes of more than ``max_gap`` missing
+    frames, left unfilled (bounded work), and ``longest_hole`` the missing frames of the
+    longest of them (0 without one; :func:`long_holes`, :func:`unfilled_note`).
     """
 
     n_gaps: int
@@ -68,6 +73,8 @@ class FillReport:
     noise: NoiseEstimate | None
     calibration: Calibration | None = None
     size_calibration: Calibration | None = None
+    n_long_holes: int = 0
+    longest_hole: int = 0
 
     def describe(self, method: str) -> str:
         """What ``pftrack recover --explain`` prints for a fill by `method`.
@@ -86,6 +93,47 @@ class FillReport:
         else:
             parts.append(f"--explain: {method} was given, nothing was chosen")
         return "\n".join(parts)
+
+
+def long_holes(rows: F64, max_gap: int) -> tuple[int, int]:
+    """The holes of more than `max_gap` missing frames inside the ids' tracks of `rows`.
+
+    What :func:`fill_gaps` and :func:`pftrack.tracking.smooth_tracks` leave unfilled (every
+    shorter hole is filled): of their output, these are its only holes.
+
+    Parameters
+    ----------
+    rows : (M, >=2) ndarray
+        Rows ``frame, id, ...``, each (frame, id) at most once, in any order.
+    max_gap : int
+        Longest hole filled, in frames.
+
+    Returns
+    -------
+    count : int
+        How many holes are longer than `max_gap`.
+    longest : int
+        The missing frames of the longest of them (0 without one).
+    """
+    a = np.asarray(rows, dtype=np.float64)
+    if len(a) < 2:
+        return 0, 0
+    a = a[np.lexsort((a[:, 0], a[:, 1]))]  # by id, then frame
+    missing = np.diff(a[:, 0]) - 1
+    missing = missing[(a[1:, 1] == a[:-1, 1]) & (missing > max_gap)]
+    return len(missing), int(missing.max()) if len(missing) else 0
+
+
+def unfilled_note(count: int, longest: int, max_gap: int) -> str:
+    """What ``pftrack recover`` and ``smooth`` say of the holes longer than ``--max-gap``.
+
+    ``"3 holes longer than --max-gap 30 left unfilled (longest 9999998 frames)"`` (a `count`
+    of 1: ``"1 hole ... (9999998 frames)"``); empty when `count` is 0.
+    """
+    if not count:
+        return ""
+    holes, longest_ = ("1 hole", "") if count == 1 else (f"{count} holes", "longest ")
+    return f"{holes} longer than --max-gap {max_gap} left unfilled ({longest_}{longest} frames)"
 
 
 def fill_gaps(
@@ -129,8 +177,9 @@ def fill_gaps(
         (column 8, :data:`FLAG_COLUMN`) and no world ``y``, ``z`` (:data:`FILLED_MARK`).
         Observed rows are returned unchanged.
     report : FillReport
-        How many holes and rows were filled; with ``"auto"``, what was chosen
-        (``report.calibration``).
+        How many holes and rows were filled, how many holes were longer than `max_gap` (left
+        unfilled: ``report.n_long_holes``, ``report.longest_hole``); with ``"auto"``, what
+        was chosen (``report.calibration``).
 
     Raises
     ------
@@ -176,11 +225,12 @@ def fill_rows(
             f"fill_gaps: max_gap is {max_gap!r}, expected an integer in 1..{MAX_GAP_LIMIT}"
         )
     rows = check_rows(rows, "fill_gaps")
-    check_unique(rows)
+    check_unique(rows, who="fill_gaps")
     per_id = split_tracks(rows)
     segs: list[tuple[F64, F64]] = []
     meta: list[tuple[int, F64, F64]] = []
     whole: list[F64] = []  # every track's centres (frame, x, y): noise, motion, calibration
+    n_long = longest = 0  # holes longer than max_gap, left unfilled
     for tid, r in per_id.items():
         c = box_centres(r)
         whole.append(c)
@@ -189,6 +239,8 @@ def fill_rows(
         for h in holes:
             missing = int(r[h + 1, 0] - r[h, 0] - 1)
             if missing > max_gap:  # bounded work: longer holes stay holes
+                n_long += 1
+                longest = max(longest, missing)
                 continue
             segs.append((seg[: h + 1], seg[h + 1 :]))
             meta.append((tid, r[h], r[h + 1]))
@@ -240,7 +292,7 @@ def fill_rows(
             out[:, FLAG_COLUMN : FLAG_COLUMN + 3] = FILLED_MARK
             new_rows.append(out)
     added = np.vstack(new_rows) if new_rows else np.zeros((0, 10))
-    return added, FillReport(len(segs), len(added), noise, calibration, size_cal)
+    return added, FillReport(len(segs), len(added), noise, calibration, size_cal, n_long, longest)
 
 
 def copied_values(rows: F64, filled: F64) -> NDArray[np.bool_]:

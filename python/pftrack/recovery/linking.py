@@ -336,7 +336,7 @@ def link_tracklets(
             f"link_tracklets: config must be a LinkConfig, got {type(config).__name__} {config!r}"
         )
     rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
-    check_unique(rows)  # a track seen twice in one frame has no velocity to link with
+    check_unique(rows, who="link_tracklets")  # a track seen twice has no velocity to link
     if len(rows) == 0:
         return rows, {}
     per_id = split_tracks(rows)
@@ -430,12 +430,18 @@ def check_file_ids(rows: F64, path: PathLike) -> None:
 
 
 def check_unique(
-    rows: F64, line_numbers: Iterable[int] | None = None, path: PathLike | None = None
+    rows: F64,
+    line_numbers: Iterable[int] | None = None,
+    path: PathLike | None = None,
+    *,
+    who: str | None = None,
 ) -> None:
     """Raise ValueError naming the first duplicate (frame, id) pair (and its lines if known).
 
     With `line_numbers` (the file's line of each row) and `path`, the message starts with
-    ``FILE:LINE:`` (the pair's second line) and names both lines.
+    ``FILE:LINE:`` (the pair's second line) and names both lines; else with ``WHO:`` when
+    `who` (the function checking) is given. When every id is -1 (a MOTChallenge detection
+    file: untracked boxes), it says so: tracks are needed.
     """
     if len(rows) == 0:
         return
@@ -444,14 +450,21 @@ def check_unique(
     dup = np.flatnonzero(np.diff(key[order]) == 0)
     if len(dup):
         i, j = order[dup[0]], order[dup[0] + 1]
-        where = head = ""
+        where = ""
+        head = "" if who is None else f"{who}: "
         if line_numbers is not None:
             ln = list(line_numbers)
             where = f" (lines {ln[i]} and {ln[j]})"
-            head = "" if path is None else f"{path}:{ln[j]}: "
+            head = head if path is None else f"{path}:{ln[j]}: "
+        hint = ""
+        if np.all(rows[:, 1] == -1):  # was: only the duplicate, for a whole det.txt
+            hint = (
+                "; every id is -1: this looks like untracked detections (a det.txt), not "
+                "tracks (pftrack track SOURCE --detections FILE makes tracks of them)"
+            )
         raise ValueError(
             f"{head}duplicate rows for frame {int(rows[i, 0])}, id {int(rows[i, 1])}{where}: "
-            "each (frame, id) may appear once"
+            f"each (frame, id) may appear once{hint}"
         )
 
 

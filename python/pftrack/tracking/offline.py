@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack import _check
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
@@ -35,7 +36,7 @@ from pftrack.recovery.linking import (
     check_unique,
     link_tracklets,
 )
-from pftrack.recovery.names import DEFAULT_METHOD
+from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 __all__ = [
     "AMODAL_ANCHORS",
@@ -305,7 +306,7 @@ def repair_crossings(
         raise ValueError(
             f"repair_crossings: measurements has shape {z.shape}, expected finite ({n}, 4)"
         )
-    check_unique(a)
+    check_unique(a, who="repair_crossings")
     if n < 2:
         return a
     perm = np.argsort(a[:, 0], kind="stable")  # rows by frame: every selection in time order
@@ -526,7 +527,13 @@ def smooth_tracks(
         raise ValueError(
             f"smooth_tracks: max_gap is {max_gap!r}, expected None or an int in 1..{MAX_GAP_LIMIT}"
         )
+    if fill_method not in METHODS:  # was named as fill_gaps' method, and only with holes
+        raise ValueError(
+            f"smooth_tracks: fill_method is {fill_method!r}, expected one of {METHODS}"
+        )
+    seed = _check.seed(seed, "smooth_tracks: seed")
     a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "smooth_tracks")
+    check_unique(a, who="smooth_tracks")  # was: BoxSmoother.smooth's "frames must be ..."
     a = a.copy()
     obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
     if obs.shape != (len(a),):
