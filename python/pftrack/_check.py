@@ -263,10 +263,16 @@ def generator(rng: RngLike, what: str) -> np.random.Generator:
     Raises
     ------
     TypeError
-        Not a Generator, a seed or None (a string, a float).
+        Not a Generator, a seed or None (a string, a float, a bool: NumPy would take True as
+        the seed 1, as other settings refuse a bool for a number).
     ValueError
         A negative seed.
     """
+    if isinstance(rng, (bool, np.bool_)):
+        raise TypeError(
+            f"{what} must be a numpy.random.Generator, an int >= 0 or None, got "
+            f"{type(rng).__name__} {rng!r}"
+        )
     try:
         return np.random.default_rng(rng)
     except (TypeError, ValueError) as e:

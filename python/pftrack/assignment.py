@@ -11,17 +11,24 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import flag
 
 __all__ = ["linear_sum_assignment"]
 
 
-def linear_sum_assignment(cost: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """Pair rows with columns of `cost` at the least total cost.
+def linear_sum_assignment(
+    cost: ArrayLike, maximize: bool = False
+) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Pair rows with columns of `cost` at the least total cost (the greatest with `maximize`).
 
     Parameters
     ----------
     cost : (R, C) array_like of real numbers
-        The cost of each pair; ``+inf`` forbids a pair. NaN and ``-inf`` are refused.
+        The cost of each pair; ``+inf`` forbids a pair (``-inf`` with `maximize`). NaN and
+        ``-inf`` (``+inf`` with `maximize`) are refused.
+    maximize : bool
+        Maximise the total instead, as SciPy's ``maximize=True``: the least total of
+        ``-cost``, so the same pairs as SciPy, ties included.
 
     Returns
     -------
@@ -31,15 +38,23 @@ def linear_sum_assignment(cost: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np
     Raises
     ------
     TypeError
-        When `cost` is not real (complex, object, strings).
+        When `cost` is not real (complex, object, strings), or `maximize` is not a bool.
     ValueError
-        When `cost` is not two-dimensional, holds NaN or ``-inf``, or allows no assignment at
-        finite cost.
+        When `cost` is not two-dimensional, holds NaN or ``-inf`` (``+inf`` with `maximize`),
+        or allows no assignment at finite cost.
     """
+    fn = "linear_sum_assignment"
+    if maximize is not False:  # the tracker's per-frame call pays nothing for the check
+        maximize = flag(maximize, f"{fn}: maximize")
     a = np.asarray(cost)
     if a.dtype.kind not in "biuf":
-        raise TypeError(f"linear_sum_assignment: cost dtype is {a.dtype}, expected real numbers")
+        raise TypeError(f"{fn}: cost dtype is {a.dtype}, expected real numbers")
     if a.ndim != 2:
-        raise ValueError(f"linear_sum_assignment: cost must be 2-D, got shape {a.shape}")
-    rows, cols = _core.linear_sum_assignment(np.ascontiguousarray(a, dtype=np.float64))
+        raise ValueError(f"{fn}: cost must be 2-D, got shape {a.shape}")
+    c = np.ascontiguousarray(a, dtype=np.float64)
+    if maximize:
+        if np.isposinf(c).any():  # -inf once negated: the core's message would name -inf
+            raise ValueError(f"{fn}: cost has a +inf entry, which maximize cannot take")
+        c = -c
+    rows, cols = _core.linear_sum_assignment(c)
     return rows.astype(np.intp), cols.astype(np.intp)

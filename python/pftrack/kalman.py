@@ -26,7 +26,8 @@ Users
 
 Every public function checks its noise and variance arguments (``q``, ``r2``, the covariance
 entries, ``dt``: finite, and ``> 0`` or ``>= 0`` as the equations need; a covariance positive
-semi-definite, ``p01² <= p00 p11`` up to round-off), with a one-line ValueError. The tracker
+semi-definite, ``p01² <= p00 p11`` up to round-off), and its result (finite; an update's
+``p00 + r2`` too), with a one-line ValueError. The tracker
 runs :func:`cv_predict` and :func:`cv_update` for every track on every frame with values it
 made itself: it calls the unchecked ``_cv_predict``, ``_cv_update`` and ``_cv_update_where``,
 which compute the same floats.
@@ -38,7 +39,8 @@ the same or better on every sequence measured (docs/tracking.md), so it is the o
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Callable, Sequence
 from typing import TypeAlias
 
 import numpy as np
@@ -63,11 +65,11 @@ __all__ = [
 ]
 
 #: One axis quantity (or one per axis): a float or an array over axes.
-Value: TypeAlias = "float | F64"
+Value: TypeAlias = float | F64
 #: Mean of the state: ``(position, velocity)``.
-Mean: TypeAlias = "tuple[Value, Value]"
+Mean: TypeAlias = tuple[Value, Value]
 #: Covariance of the state, as its entries ``(p00, p01, p11)``.
-Cov: TypeAlias = "tuple[Value, Value, Value]"
+Cov: TypeAlias = tuple[Value, Value, Value]
 
 
 def _require(fn: str, name: str, value: ArrayLike, bound: str = "") -> None:
@@ -167,6 +169,41 @@ def _require_psd(fn: str, cov: Cov) -> None:
             f"{fn}: cov{at} (p00, p01, p11) = ({shown}) is not positive semi-definite: "
             "expected p01² <= p00 * p11"
         )
+
+
+def _require_innovation(fn: str, cov: Cov, r2: Value, where: ArrayLike) -> None:
+    """Refuse an innovation variance ``p00 + r2`` that overflows where `where` holds.
+
+    The gain ``p00 / (p00 + r2)`` would be 0: the measurement silently ignored (p00 and r2
+    of 1e308 each), with a filtered state that still looks finite.
+    """
+    with np.errstate(over="ignore"):
+        s = np.asarray(cov[0], dtype=np.float64) + np.asarray(r2, dtype=np.float64)
+    bad = np.broadcast_to(where, np.broadcast_shapes(np.shape(where), s.shape)) & ~np.isfinite(s)
+    if bad.any():
+        raise ValueError(
+            f"{fn}: cov's p00 + r2 (the innovation variance) overflows: p00 or r2 too extreme "
+            "(the measurement would be ignored)"
+        )
+
+
+def _finite_result(
+    fn: str, what: str, causes: str, step: Callable[..., tuple[Mean, Cov]], *args: object
+) -> tuple[Mean, Cov]:
+    """``step(*args)``, refused with a ValueError naming `fn` unless every entry is finite.
+
+    The checks of the arguments bound each one, not their products: a mean of 1e308 moving
+    at 1e308 px a frame would come out infinite (as :func:`rts_smooth` refuses it).
+    """
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = step(*args)
+    except OverflowError:  # a Python float's ``dt**3``
+        out = ((math.inf, math.inf), (math.inf, math.inf, math.inf))
+    (m0, m1), (c0, c1, c2) = out
+    if not all(np.all(np.isfinite(v)) for v in (m0, m1, c0, c1, c2)):
+        raise ValueError(f"{fn}: the {what} state is not finite ({causes} too extreme)")
+    return out
 
 
 def cv_transition(dt: float = 1.0) -> F64:
@@ -284,12 +321,14 @@ def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, C
     ValueError
         A variance of `cov` (p00, p11), `q` or `dt` not finite and ``>= 0``, p01 or `mean`
         not finite, `cov` not positive semi-definite (``p01² > p00 p11`` beyond a relative
-        round-off of 1e-9), or arrays whose shapes do not broadcast together.
+        round-off of 1e-9), arrays whose shapes do not broadcast together, or a predicted
+        state that is not finite (values too extreme: a position of 1e308 moving at 1e308).
     """
-    _require_state("cv_predict", mean, cov, q=q, dt=dt)
-    _require("cv_predict", "q", q, ">= 0")
-    _require("cv_predict", "dt", dt, ">= 0")
-    return _cv_predict(mean, cov, q, dt)
+    fn = "cv_predict"
+    _require_state(fn, mean, cov, q=q, dt=dt)
+    _require(fn, "q", q, ">= 0")
+    _require(fn, "dt", dt, ">= 0")
+    return _finite_result(fn, "predicted", "mean, cov, q or dt", _cv_predict, mean, cov, q, dt)
 
 
 def _cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, Cov]:
@@ -328,12 +367,15 @@ def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
     ValueError
         A variance of `cov` (p00, p11) not finite and ``>= 0``, p01, `mean` or `z` not finite,
         `cov` not positive semi-definite (as :func:`cv_predict`'s), `r2` not finite and ``> 0``
-        (as :func:`rts_smooth`'s), or arrays whose shapes do not broadcast together.
+        (as :func:`rts_smooth`'s), arrays whose shapes do not broadcast together, ``p00 + r2``
+        overflowing (the measurement would be ignored) or a filtered state that is not finite.
     """
-    _require_state("cv_update", mean, cov, z=z, r2=r2)
-    _require("cv_update", "z", z)
-    _require("cv_update", "r2", r2, "> 0")
-    return _cv_update(mean, cov, z, r2)
+    fn = "cv_update"
+    _require_state(fn, mean, cov, z=z, r2=r2)
+    _require(fn, "z", z)
+    _require(fn, "r2", r2, "> 0")
+    _require_innovation(fn, cov, r2, True)
+    return _finite_result(fn, "filtered", "mean, cov, z or r2", _cv_update, mean, cov, z, r2)
 
 
 def _cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
@@ -361,8 +403,8 @@ def cv_update_where(
         Values that are not real numbers, or a `where` that is not bools (``"no"`` would
         count as True).
     ValueError
-        What :func:`cv_update` refuses (`z` only where `where` holds), or a `where` entry
-        other than True and False (or 1 and 0; NaN would count as True).
+        What :func:`cv_update` refuses (`z` and ``p00 + r2`` only where `where` holds), or a
+        `where` entry other than True and False (or 1 and 0; NaN would count as True).
     """
     fn = "cv_update_where"
     w = bool_array(where, f"{fn}: where")
@@ -373,7 +415,10 @@ def cv_update_where(
         k, at = first_at(missing)
         raise ValueError(f"{fn}: z{at} is {zz[k]:g} where `where` holds, expected finite")
     _require(fn, "r2", r2, "> 0")
-    return _cv_update_where(mean, cov, z, r2, w)
+    _require_innovation(fn, cov, r2, w)
+    return _finite_result(
+        fn, "filtered", "mean, cov, z or r2", _cv_update_where, mean, cov, z, r2, w
+    )
 
 
 def _cv_update_where(

@@ -61,3 +61,51 @@ def test_accepts_integer_and_strided_input():
 def test_bad_input_is_refused_with_a_message(cost, error, match):
     with pytest.raises(error, match=match):
         linear_sum_assignment(cost)
+
+
+def _outcome_max(fn, cost):
+    try:
+        rows, cols = fn(cost, maximize=True)
+    except ValueError:
+        return "refused"
+    return rows.tolist(), cols.tolist()
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    shape=st.tuples(st.integers(0, 9), st.integers(0, 9)),
+    levels=st.integers(1, 4),
+    forbid=st.floats(0.0, 0.6),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_maximize_gives_scipys_pairs_with_ties_and_forbidden_pairs(shape, levels, forbid, seed):
+    # maximize= was missing (SciPy has it); -inf forbids a pair when maximising
+    rng = np.random.default_rng(seed)
+    cost = rng.integers(0, levels, shape).astype(float)
+    cost[rng.random(shape) < forbid] = -np.inf
+    assert _outcome_max(linear_sum_assignment, cost) == _outcome_max(scipy_lsa, cost)
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (5, 5), (3, 40), (40, 3), (60, 60)])
+def test_maximize_on_continuous_and_integer_costs(shape):
+    rng = np.random.default_rng(sum(shape))
+    for cost in (rng.normal(size=shape), rng.integers(-5, 5, shape), rng.random(shape) > 0.5):
+        got = linear_sum_assignment(cost, maximize=True)
+        want = scipy_lsa(cost, maximize=True)
+        np.testing.assert_array_equal(np.stack(got), np.stack(want))
+        assert got[0].dtype == np.intp
+    cost = rng.normal(size=shape)
+    np.testing.assert_array_equal(  # the default is to minimise, as before
+        np.stack(linear_sum_assignment(cost)), np.stack(linear_sum_assignment(-cost, True))
+    )
+
+
+def test_maximize_refusals():
+    with pytest.raises(ValueError, match=r"cost has a \+inf entry, which maximize cannot take"):
+        linear_sum_assignment([[np.inf, 1.0], [1.0, 1.0]], maximize=True)
+    with pytest.raises(ValueError):  # SciPy refuses it too
+        scipy_lsa([[np.inf, 1.0], [1.0, 1.0]], maximize=True)
+    with pytest.raises(ValueError, match="NaN"):
+        linear_sum_assignment([[np.nan, 1.0]], maximize=True)
+    with pytest.raises(TypeError, match="maximize must be True or False, got str 'yes'"):
+        linear_sum_assignment(np.eye(2), maximize="yes")  # type: ignore[arg-type]

@@ -331,3 +331,44 @@ def test_num_frames_and_scale_of_the_wrong_kind_are_named() -> None:
     with pytest.raises(TypeError, match="scale must be a number, got str '2'"):
         evaluate_hota(g, g, scale="2")
     assert evaluate_hota(g, g, num_frames=1).hota == pytest.approx(1.0)
+
+
+def _empty_cases() -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    gt = np.array([[1, 1, 0, 0, 10, 10], [2, 1, 1, 0, 10, 10], [2, 2, 40, 0, 10, 10]], float)
+    gt = np.c_[gt, np.tile([1.0, -1, -1, -1], (len(gt), 1))]
+    res = gt + [0, 4, 1, 0, 0, 0, 0, 0, 0, 0]
+    none = np.zeros((0, 10))
+    return {
+        "no_gt": (none, res),
+        "no_res": (gt, none),
+        "neither": (none, none),
+        "apart": (gt, res + [0, 0, 100, 0, 0, 0, 0, 0, 0, 0]),  # common frames, no overlap
+    }
+
+
+@pytest.mark.parametrize(
+    "names", [("no_gt", "no_res", "neither", "apart"), ("no_gt",), ("neither",), ("apart",)]
+)
+def test_empty_ground_truth_and_results_equal_trackeval(
+    tmp_path: Path, names: tuple[str, ...]
+) -> None:
+    # MOTA was NaN without ground truth (TrackEval: 0), MOTP, IDP, IDR NaN (TrackEval: 0)
+    from pftrack.eval import evaluate_sequence
+    from pftrack.eval.sequences import SequenceScores
+
+    cases = {k: v for k, v in _empty_cases().items() if k in names}
+    ref = trackeval_hota(tmp_path, cases, "MOT15", ("HOTA", "CLEAR", "Identity"))
+    parts = []
+    for name, (gt, res) in cases.items():
+        s = evaluate_sequence(gt, res, benchmark="MOT15")
+        assert_same_clear(s.mot, ref[name])
+        assert_same(s.hota, ref[name])
+        for field in ("MOTA", "MOTP", "IDF1", "IDP", "IDR", "CLR_Pr", "CLR_Re"):
+            assert np.isfinite(ref[name][field]), field
+        assert s.mot.precision == ref[name]["CLR_Pr"] and s.mot.recall == ref[name]["CLR_Re"]
+        parts.append(s)
+    both = SequenceScores.combine(parts)
+    assert_same_clear(both.mot, ref["COMBINED"])
+    assert_same(both.hota, ref["COMBINED"])
+    assert both.mot.precision == pytest.approx(float(ref["COMBINED"]["CLR_Pr"]), abs=1e-12)
+    assert both.mot.recall == pytest.approx(float(ref["COMBINED"]["CLR_Re"]), abs=1e-12)

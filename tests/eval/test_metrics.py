@@ -223,10 +223,11 @@ def test_fractional_ids_and_frames_are_refused_not_truncated(tmp_path, capsys):
 def test_empty_result_and_format():
     m = evaluate_mot(HAND_GT, np.zeros((0, 10)))
     assert m.mota == 0.0 and m.misses == 14 and m.mostly_lost == 3
-    assert math.isnan(m.motp_iou) and m.idf1 == 0.0
+    assert m.motp_iou == 0.0 and m.idf1 == 0.0  # TrackEval's 0 over no match, not NaN
     text = format_metrics({"a": m, "b": evaluate_mot(HAND_GT, HAND_RES)})
     assert "MOTA" in text and "IDF1" in text and text.count("\n") == 3
-    assert json.loads(m.to_json())["motp_iou"] is None
+    assert math.isnan(m.centroid_distance_px)
+    assert json.loads(m.to_json())["centroid_distance_px"] is None
     with pytest.raises(dataclasses_error()):
         m.mota = 1.0  # type: ignore[misc]
 
@@ -431,3 +432,60 @@ def test_truth_scored_against_itself_has_centroid_distance_zero():
     near = truth.copy()
     near[near[:, 1] == 2, 2] += 1.0  # track 2 one pixel right of object 2
     assert evaluate_mot(truth, near).centroid_distance_px == pytest.approx(0.5)
+
+
+def test_empty_ground_truth_or_results_score_as_trackeval():
+    # MOTA was NaN without ground truth where TrackEval's CLEAR gives 0; MOTP, IDP, IDR NaN
+    # (tests/eval/test_hota.py holds every figure equal to TrackEval's)
+    from pftrack.eval import combine_mot, evaluate_sequence, format_scores
+
+    none = np.zeros((0, 10))
+    for gt, res in ((none, HAND_RES), (HAND_GT, none), (none, none)):
+        s = evaluate_sequence(gt, res)
+        m = s.mot
+        assert (m.mota, m.motp_iou, m.idf1, m.idp, m.idr) == (0.0, 0.0, 0.0, 0.0, 0.0)
+        assert (m.precision, m.recall) == (0.0, 0.0)
+        assert s.hota.hota == 0.0 and s.hota.loc_a_mean == 1.0
+        assert "nan" not in format_scores({"s": s}).split("\n")[1].split()[:-1]  # Succ: none
+    no_gt = evaluate_mot(none, HAND_RES)
+    # combined as TrackEval's combine_sequences: (TP - FP - IDSW) / max(1, TP + FN)
+    assert combine_mot([no_gt]).mota == -float(no_gt.false_positives)
+    assert combine_mot([no_gt, evaluate_mot(HAND_GT, none)]).mota == pytest.approx(
+        1 - (no_gt.false_positives + 14) / 14
+    )
+
+
+def test_format_metrics_names_the_formatter_of_sequence_scores():
+    # raised "TypeError: 'SequenceScores' object is not iterable"
+    from pftrack.eval import evaluate_sequence, format_scores
+
+    s = evaluate_sequence(HAND_GT, HAND_RES)
+    hint = r"evaluate_sequence's SequenceScores are formatted by pftrack.eval.format_scores"
+    with pytest.raises(TypeError, match=rf"^format_metrics: m is SequenceScores, .*: {hint}"):
+        format_metrics(s)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=rf"^format_metrics: m\['a'\] is SequenceScores.*{hint}"):
+        format_metrics({"a": s})  # type: ignore[dict-item]
+    with pytest.raises(TypeError, match=rf"^format_metrics: m is list, .*{hint}"):
+        format_metrics([s])  # type: ignore[arg-type]
+    assert "HOTA" in format_scores({"a": s}) and format_metrics(s.mot) == s.mot.table()
+    with pytest.raises(TypeError, match=r"format_metrics: m is str, expected MotMetrics: pass a"):
+        format_metrics("result")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="format_metrics: no result to format"):
+        format_metrics({})
+
+
+def test_hota_metrics_docstring_says_which_fields_are_arrays():
+    # det_a is a float, ass_a the per-threshold array (ass_a_mean its float)
+    from pftrack.eval import HotaMetrics, evaluate_hota
+
+    h = evaluate_hota(HAND_GT, HAND_RES)
+    doc = HotaMetrics.__doc__ or ""
+    floats = ("hota", "det_a", "det_re", "det_pr", "ass_a_mean", "ass_re_mean", "ass_pr_mean",
+              "loc_a_mean", "hota0")  # fmt: skip
+    arrays = ("hota_alpha", "det_a_alpha", "det_re_alpha", "det_pr_alpha", "ass_a", "ass_re",
+              "ass_pr", "loc_a", "tp", "fn", "fp")  # fmt: skip
+    for name in floats:
+        assert type(getattr(h, name)) is float and f"``{name}``" in doc, name
+    for name in arrays:
+        assert getattr(h, name).shape == (19,) and f"``{name}``" in doc, name
+    assert "float (mean over the 19 thresholds)" in doc

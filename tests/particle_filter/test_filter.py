@@ -279,3 +279,65 @@ def test_step_wants_binned_image(frame):
             f.step(frame)
     with pytest.raises(TypeError, match=match):
         step_filters([_filter()], frame)
+
+
+def test_spread_keeps_the_particles_within_the_box_bound():
+    # spread=1e300 was taken: particles at 1e301 px
+    from pftrack.particle_filter.filter import reinitialise_filters
+
+    f = _filter()
+    before = f.particles.copy()
+    match = (
+        r"spread is 1e\+300, expected at most 250000: the particles' position spread, "
+        r"spread \* model.sigma_xy \(4 px\), is at most 1e\+06 px"
+    )
+    with pytest.raises(ValueError, match=match):
+        f.reinitialise([30.0, 20, 10, 10], spread=1e300)
+    with pytest.raises(ValueError, match=match):
+        reinitialise_filters([f], [[30.0, 20, 10, 10]], [[0.0, 0.0]], spread=1e300)
+    np.testing.assert_array_equal(f.particles, before)  # refused before any change
+    with pytest.raises(ValueError, match="spread is 2.5e\\+06, expected at most 250000"):
+        reinitialise_filters([f], [[30.0, 20, 10, 10]], [[0.0, 0.0]], spread=2.5e6)
+    f.reinitialise([30.0, 20, 10, 10], spread=250_000.0)  # the bound itself is taken
+    assert np.abs(f.particles[:, :2]).max() < 1e7
+    still = ColourParticleFilter(BOX, REF, FilterConfig(model=Ar2Model(sigma_xy=0.0)), rng=0)
+    still.reinitialise(BOX, spread=1e300)  # no position spread at all: nothing to bound
+    assert np.all(still.particles[:, :2] == BOX[:2])
+
+
+def test_mixed_filters_are_refused_a_spread_before_any_is_reseeded():
+    from pftrack.particle_filter.filter import reinitialise_filters
+
+    wide = ColourParticleFilter(BOX, REF, FilterConfig(model=Ar2Model(sigma_xy=1e3)), rng=0)
+    a = _filter()
+    before = a.particles.copy()
+    with pytest.raises(ValueError, match=r"spread is 5000, expected at most 1000"):
+        reinitialise_filters([a, wide], [BOX, BOX], [[0.0, 0.0]] * 2, spread=5000.0)
+    np.testing.assert_array_equal(a.particles, before)
+
+
+def test_reference_length_is_the_filters_binning():
+    from pftrack.particle_filter import HsvBinning, MHColourParticleFilter
+
+    f = _filter()
+    # was taken, then refused at the next step: "sis_step: ref size is 3, expected 110"
+    with pytest.raises(ValueError, match=r"reference has 3 bins, expected 110 \(the filter's"):
+        f.set_reference(np.ones(3))
+    np.testing.assert_array_equal(f.reference, REF / REF.sum())  # unchanged
+    f.set_reference(np.arange(110.0))
+    small = HsvBinning(n_h=4, n_s=4, n_v=4)
+    for cls in (ColourParticleFilter, MHColourParticleFilter):
+        with pytest.raises(ValueError, match=r"reference has 3 bins, expected 110 \(the binning"):
+            cls(BOX, np.ones(3), binning=HsvBinning())
+        with pytest.raises(TypeError, match=f"{cls.__name__}: binning must be an HsvBinning"):
+            cls(BOX, REF, binning=110)
+        g = cls(BOX, np.ones(20), rng=0, binning=small)
+        g.step(hsv_bins(_scene(), binning=small))
+        with pytest.raises(ValueError, match="reference has 110 bins, expected 20"):
+            g.set_reference(REF)
+
+
+def test_propagate_documents_the_particle_columns():
+    # help() said only "(N, 6)"
+    doc = propagate.__doc__ or ""
+    assert "cx, cy, s, cx', cy', s'" in doc and "previous frame's" in doc

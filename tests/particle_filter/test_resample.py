@@ -212,3 +212,24 @@ def test_stratified_matches_reference_at_scale(kind, u_kind):
         "eighths": lambda: rng.integers(0, 8, n) / 8,
     }[u_kind]()
     np.testing.assert_array_equal(_core.stratified_resample(w, u), ref.stratified_resample(w, u))
+
+
+@pytest.mark.parametrize("fn", list(RESAMPLERS.values()))
+@pytest.mark.parametrize("flag", [True, False, np.True_])
+def test_rng_refuses_a_bool(fn, flag):
+    # True was taken as the seed 1: other settings refuse a bool for a number
+    match = (
+        f"{fn.__name__}: rng must be a numpy.random.Generator, an int >= 0 or None, got "
+        f"{type(flag).__name__} {flag!r}"
+    )
+    with pytest.raises(TypeError, match=match.replace("(", r"\(").replace(")", r"\)")):
+        fn([0.5, 0.5], flag)
+
+
+def test_other_rngs_refuse_a_bool_too():
+    from pftrack.particle_filter import ColourParticleFilter, RJMCMCFilter
+
+    with pytest.raises(TypeError, match="rng must be .*, got bool True"):
+        ColourParticleFilter([20.0, 20, 10, 10], np.ones(110), rng=True)
+    with pytest.raises(TypeError, match="RJMCMCFilter: rng must be .*, got bool False"):
+        RJMCMCFilter(rng=False)

@@ -265,3 +265,49 @@ def test_without_gate_and_detection_term_identities_churn():
     # box, tight prior on it) out-scores the kept identity, so death + birth renew the ids.
     ids = _identities_over(dict(birth_gate=2.0, detection=0.0), 0)
     assert len(set().union(*ids)) >= 10
+
+
+def test_step_refuses_what_the_core_would_misread():
+    frame, mask = scene(0)
+    img = _core.hsv_bins(frame, mask)
+    f = RJMCMCFilter(RJMCMCConfig(**{**PARAMS, "burn_in": 2, "n_samples": 5}), rng=0)
+    # a raw frame gave pybind11's "incompatible function arguments" with the array printed
+    with pytest.raises(
+        TypeError,
+        match=r"^binned must be a BinnedImage from hsv_bins\(frame\), got ndarray \(a frame\? "
+        r"bin it first\)$",
+    ):
+        f.step(frame, mask, boxes())
+    # (4, 3) ran as 3 boxes of scrambled values
+    with pytest.raises(
+        ValueError, match=r"RJMCMCFilter.step: candidates_cxcywh must have shape \(K, 4\).*\(4, 3\)"
+    ):
+        f.step(img, mask, np.ones((4, 3)) * 10)
+    with pytest.raises(ValueError, match=r"got \(3, 5\)"):
+        f.step(img, mask, np.ones((3, 5)) * 10)
+    # negative histograms returned [] silently (NaN was refused)
+    with pytest.raises(
+        ValueError,
+        match=r"RJMCMCFilter.step: candidate_hists\[0, 0\] is -1, expected a finite value >= 0",
+    ):
+        f.step(img, mask, boxes(), -np.ones((3, img.n_bins)))
+    with pytest.raises(ValueError, match=r"candidate_hists\[1, 2\] is nan"):
+        hists = np.ones((3, img.n_bins))
+        hists[1, 2] = np.nan
+        f.step(img, mask, boxes(), hists)
+    with pytest.raises(TypeError, match="candidates_cxcywh must hold real numbers"):
+        f.step(img, mask, [["a", "b", "c", "d"]])
+    assert f.n_steps == 0  # nothing ran
+
+
+def test_step_takes_no_candidate_and_one_candidate():
+    frame, mask = scene(0)
+    img = _core.hsv_bins(frame, mask)
+    cfg = RJMCMCConfig(**{**PARAMS, "burn_in": 2, "n_samples": 5})
+    a, b = RJMCMCFilter(cfg, rng=3), RJMCMCFilter(cfg, rng=3)
+    assert a.step(img, mask, []) == []
+    b.step(img, mask, np.zeros((0, 4)))
+    one = boxes()[0]
+    ta, tb = a.step(img, mask, one), b.step(img, mask, one[None, :])  # (4,) is one box
+    assert a.n_steps == b.n_steps == 2 and len(ta) == len(tb) == 1
+    np.testing.assert_array_equal(ta[0].box_cxcywh, tb[0].box_cxcywh)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -392,3 +394,66 @@ def test_update_where_takes_anything_in_z_where_it_does_not_update():
     for a, b in zip([*got[0], *got[1]], [*want[0], *want[1]], strict=True):
         np.testing.assert_array_equal(a, b)
     assert np.isfinite(_rts(has=np.array([1, 0, 1]), z=[[1.0], [np.nan], [3.0]])).all()
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        # p00 + r2 overflowed: the gain was 0 and the measurement ignored, the state finite
+        (
+            lambda: cv_update((0.0, 0.0), (1e308, 0.0, 1e308), 1e308, 1e308),
+            r"^cv_update: cov's p00 \+ r2 \(the innovation variance\) overflows",
+        ),
+        (
+            lambda: cv_update_where(
+                (np.zeros(2), np.zeros(2)),
+                (np.array([1.0, 1e308]), 0.0, 1.0),
+                1.0,
+                np.array([1.0, 1e308]),
+                [False, True],
+            ),
+            r"^cv_update_where: cov's p00 \+ r2 .* overflows",
+        ),
+        # inf came out
+        (
+            lambda: cv_predict((1e308, 1e308), (1.0, 0.0, 1.0), 1.0),
+            r"^cv_predict: the predicted state is not finite \(mean, cov, q or dt too extreme\)$",
+        ),
+        (
+            lambda: cv_predict((np.zeros(2), np.array([0.0, 1e308])), COV, 1.0, 3.0),
+            r"^cv_predict: the predicted state is not finite",
+        ),
+        (  # a Python float's dt**3 raised OverflowError
+            lambda: cv_predict((0.0, 0.0), (1.0, 0.0, 1.0), 1.0, 1e200),
+            r"^cv_predict: the predicted state is not finite",
+        ),
+        (
+            lambda: cv_update((-1e308, 0.0), (1.0, 0.0, 1.0), 1e308, 1.0),
+            r"^cv_update: the filtered state is not finite \(mean, cov, z or r2 too extreme\)$",
+        ),
+    ],
+)
+def test_helpers_refuse_values_whose_result_overflows(call, match):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nor any overflow warning on the way
+        with pytest.raises(ValueError, match=match):
+            call()
+
+
+def test_update_where_takes_an_overflow_where_it_does_not_update():
+    mean, cov = (np.zeros(2), np.zeros(2)), (np.array([1e308, 1.0]), np.zeros(2), np.ones(2))
+    (m0, _), (c0, _, _) = cv_update_where(mean, cov, 1.0, np.array([1e308, 1.0]), [False, True])
+    np.testing.assert_array_equal(m0, [0.0, 0.5])
+    np.testing.assert_array_equal(c0, [1e308, 0.5])
+
+
+def test_type_aliases_are_types_at_run_time():
+    # Value, Mean and Cov were the strings "float | F64", ... in __all__
+    import typing
+
+    import pftrack.kalman as kalman
+
+    for name in ("Value", "Mean", "Cov"):
+        assert name in kalman.__all__ and not isinstance(getattr(kalman, name), str), name
+    assert typing.get_origin(kalman.Mean) is tuple and len(typing.get_args(kalman.Cov)) == 3
+    assert float in typing.get_args(kalman.Value)

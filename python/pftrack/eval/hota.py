@@ -17,6 +17,7 @@ from scipy.optimize import linear_sum_assignment
 from pftrack._typing import BenchmarkName
 from pftrack.eval.rows import (  # the scored rows; here too, as before
     BENCHMARKS,
+    _mot_iou,
     guess_benchmark,
     mot_iou,
     prepare_mot,
@@ -47,14 +48,34 @@ class HotaMetrics:
     Each array has one value per localisation threshold in :data:`ALPHAS`; the scalar
     properties are their means over the thresholds, as TrackEval reports them.
 
+    Mind the names: the fields ``ass_a``, ``ass_re``, ``ass_pr`` and ``loc_a`` are the
+    (19,) arrays, and their means (the figures TrackEval prints) are the floats
+    ``ass_a_mean``, ``ass_re_mean``, ``ass_pr_mean`` and ``loc_a_mean``; the detection
+    figures are the other way round: ``det_a``, ``det_re``, ``det_pr`` (and ``hota``) are
+    floats, their arrays ``det_a_alpha``, ``det_re_alpha``, ``det_pr_alpha`` (and
+    ``hota_alpha``).
+
+    ================================================  ==================================
+    float (mean over the 19 thresholds)               (19,) array, one per threshold
+    ================================================  ==================================
+    ``hota``                                          ``hota_alpha``
+    ``det_a``, ``det_re``, ``det_pr``                 ``det_a_alpha``, ``det_re_alpha``,
+                                                      ``det_pr_alpha``
+    ``ass_a_mean``, ``ass_re_mean``, ``ass_pr_mean``  ``ass_a``, ``ass_re``, ``ass_pr``
+    ``loc_a_mean``                                    ``loc_a``
+    ``hota0`` (HOTA at alpha 0.05)                    ``tp``, ``fn``, ``fp`` (counts)
+    ================================================  ==================================
+
     Attributes
     ----------
     tp, fn, fp : (19,) ndarray of float64
         Detection true positives, false negatives and false positives (counts) per threshold.
     ass_a, ass_re, ass_pr : (19,) ndarray of float64
-        Association accuracy, recall and precision per threshold.
+        Association accuracy, recall and precision per threshold (arrays, unlike ``det_a``:
+        their means are ``ass_a_mean``, ``ass_re_mean``, ``ass_pr_mean``).
     loc_a : (19,) ndarray of float64
-        Mean IoU of the matched pairs per threshold (1 when there is no match).
+        Mean IoU of the matched pairs per threshold (1 when there is no match); its mean is
+        ``loc_a_mean``.
     """
 
     tp: NDArray[np.float64]
@@ -226,7 +247,7 @@ def evaluate_hota(
     for f in sorted(set(gf) & set(rf)):
         gi = np.searchsorted(g_ids, gf[f][:, ID].astype(np.int64))
         ri = np.searchsorted(r_ids, rf[f][:, ID].astype(np.int64))
-        both.append((gi, ri, mot_iou(gf[f][:, LEFT : LEFT + 4], rf[f][:, LEFT : LEFT + 4])))
+        both.append((gi, ri, _mot_iou(gf[f][:, LEFT : LEFT + 4], rf[f][:, LEFT : LEFT + 4])))
 
     # Soft match counts of id pairs (ids are unique within a frame: plain fancy-index add).
     potential = np.zeros((len(g_ids), len(r_ids)))

@@ -21,9 +21,9 @@ from pftrack.boxes import iou_xywh
 from pftrack.eval.rows import (
     BENCHMARKS,
     IOU_ROUNDING,
+    _mot_iou,
     check_eval_rows,
     guess_benchmark,
-    mot_iou,
     prepare_mot,
 )
 from pftrack.io.mot import FRAME, ID, LEFT
@@ -45,13 +45,16 @@ class MotMetrics:
     Attributes
     ----------
     mota : float
-        ``1 - (FN + FP + IDSW) / num_objects`` (a fraction; can be negative).
+        ``1 - (FN + FP + IDSW) / num_objects`` (a fraction; can be negative); 0 without any
+        ground-truth box, as TrackEval scores such a sequence.
     motp_iou : float
-        Mean IoU of the matched pairs. This is "MOTP as overlap" (higher is better); py-motmetrics
-        reports the mean distance ``1 - IoU`` instead, i.e. ``1 - motp_iou``.
+        Mean IoU of the matched pairs (0 without a match, as TrackEval's MOTP). This is "MOTP
+        as overlap" (higher is better); py-motmetrics reports the mean distance ``1 - IoU``
+        instead, i.e. ``1 - motp_iou``.
     idf1, idp, idr : float
         Identity F1, precision and recall after the global one-to-one assignment of ground-truth
-        trajectories to result trajectories that maximises the identity true positives.
+        trajectories to result trajectories that maximises the identity true positives (0,
+        not NaN, over no box: TrackEval's ``max(1, denominator)``).
     idtp, idfp, idfn : int
         Identity true positives, false positives and false negatives (boxes).
     num_switches : int
@@ -73,7 +76,8 @@ class MotMetrics:
         classes than pedestrian) and result boxes left out (MOT16/17/20 only: those on a
         distractor); :func:`pftrack.eval.prepare_mot`.
     precision, recall : float
-        ``matches / num_predictions`` and ``matches / num_objects``.
+        ``matches / num_predictions`` and ``matches / num_objects`` (0 over no box, as
+        TrackEval's CLR_Pr and CLR_Re).
     success_rate : float
         Smith et al.'s tracking success rate, mean over objects: for each ground-truth object,
         the fraction of its frames in which its assigned result track overlaps it (IoU > 0). The
@@ -154,9 +158,31 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
     """Text table of one result, or of several results keyed by name (one row each).
 
     Percentages for MOTA, MOTP (mean IoU of matches), IDF1, IDP, IDR, precision, recall and the
-    success rates; counts for the rest.
+    success rates; counts for the rest. This is the table of :class:`MotMetrics`
+    (:func:`evaluate_mot`); the one ``pftrack eval`` prints, of
+    :func:`~pftrack.eval.evaluate_sequence`'s :class:`~pftrack.eval.SequenceScores` (HOTA
+    first), is :func:`~pftrack.eval.format_scores`'s.
+
+    Raises
+    ------
+    TypeError
+        `m` is not a MotMetrics or a mapping of names to MotMetrics (a SequenceScores: the
+        message names :func:`~pftrack.eval.format_scores`).
+    ValueError
+        An empty mapping.
     """
-    rows = {"result": m} if isinstance(m, MotMetrics) else dict(m)
+    fn = "format_metrics"
+    if isinstance(m, MotMetrics):
+        rows = {"result": m}
+    elif isinstance(m, Mapping):
+        rows = dict(m)
+    else:
+        raise TypeError(_not_mot_metrics(fn, "m", m))
+    if not rows:
+        raise ValueError(f"{fn}: no result to format")
+    for name, r in rows.items():
+        if not isinstance(r, MotMetrics):
+            raise TypeError(_not_mot_metrics(fn, f"m[{name!r}]", r))
     cols: list[tuple[str, Callable[[MotMetrics], str]]] = [
         ("MOTA", lambda r: _pct(r.mota)),
         ("MOTP(IoU)", lambda r: _pct(r.motp_iou)),
@@ -204,6 +230,18 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
         f"CD = mean centroid distance)"
     )
     return "\n".join(lines)
+
+
+def _not_mot_metrics(fn: str, what: str, value: object) -> str:
+    """Why `value` is no MotMetrics, saying what formats evaluate_sequence's scores."""
+    hint = "pass a MotMetrics (evaluate_mot) or a dict {name: MotMetrics}"
+    scores = hasattr(value, "mot") and hasattr(value, "hota")  # a SequenceScores, or a list
+    if scores or (isinstance(value, (list, tuple)) and any(hasattr(v, "mot") for v in value)):
+        hint = (
+            "evaluate_sequence's SequenceScores are formatted by pftrack.eval.format_scores "
+            "({name: scores}), the table `pftrack eval` prints; or pass scores.mot"
+        )
+    return f"{fn}: {what} is {type(value).__name__}, expected MotMetrics: {hint}"
 
 
 def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
@@ -329,7 +367,7 @@ def evaluate_mot(
             gt_count[int(o)] = gt_count.get(int(o), 0) + 1
         for h in rids:
             res_count[int(h)] = res_count.get(int(h), 0) + 1
-        iou = mot_iou(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])  # TrackEval's IoU
+        iou = _mot_iou(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])  # TrackEval's IoU
         ok = iou >= reach
 
         # Identity and Smith measures look at every overlapping (gt, result) pair.
@@ -411,9 +449,10 @@ def evaluate_mot(
         idtp = int(w[a, b].sum())
     idfn = n_gt - idtp
     idfp = n_res - idtp
-    idf1 = 2 * idtp / (2 * idtp + idfp + idfn) if (2 * idtp + idfp + idfn) else float("nan")
-    idp = idtp / (idtp + idfp) if (idtp + idfp) else float("nan")
-    idr = idtp / (idtp + idfn) if (idtp + idfn) else float("nan")
+    # TrackEval's max(1, denominator): 0, not NaN, without ground truth or results
+    idf1 = 2 * idtp / (2 * idtp + idfp + idfn) if (2 * idtp + idfp + idfn) else 0.0
+    idp = idtp / (idtp + idfp) if (idtp + idfp) else 0.0
+    idr = idtp / (idtp + idfn) if (idtp + idfn) else 0.0
 
     # Smith et al.: per object, the result id overlapping it most often; ties go to the id
     # matching it (IoU >= threshold) more often, then to the nearer one (a neighbour touching
@@ -440,8 +479,9 @@ def evaluate_mot(
 
     nan = float("nan")
     return MotMetrics(
-        mota=1.0 - (n_fn + n_fp + n_sw) / n_gt if n_gt else nan,
-        motp_iou=iou_sum / n_match if n_match else nan,
+        # TrackEval's CLEAR scores a sequence without ground truth (or results) as all 0
+        mota=1.0 - (n_fn + n_fp + n_sw) / n_gt if n_gt else 0.0,
+        motp_iou=iou_sum / n_match if n_match else 0.0,
         idf1=idf1,
         idp=idp,
         idr=idr,
@@ -462,8 +502,8 @@ def evaluate_mot(
         num_frames=n_frames,
         num_ignored_gt=n_ign_gt,
         num_ignored_predictions=n_ign_res,
-        precision=n_match / n_res if n_res else nan,
-        recall=n_match / n_gt if n_gt else nan,
+        precision=n_match / n_res if n_res else 0.0,
+        recall=n_match / n_gt if n_gt else 0.0,
         success_rate=float(np.mean([p[1] for p in per_object])) if per_object else nan,
         success_rate_strict=float(np.mean([p[2] for p in per_object])) if per_object else nan,
         success_per_object=tuple(per_object),
@@ -483,6 +523,11 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
     Smith et al.'s success rates are the means over all objects of all sequences. The centroid
     distances are NaN (a mean over pairs that is not kept per sequence) and
     `success_per_object` is empty (ids repeat across sequences).
+
+    Ratios over no box are 0, as TrackEval's ``combine_sequences`` computes them (``x / max(1,
+    n)``); so is MOTA's, ``(TP - FP - IDSW) / max(1, TP + FN)``, which is ``-(FP + IDSW)``
+    when no sequence has a ground-truth box (while each such sequence's own MOTA is 0: TrackEval
+    scores an empty sequence before its formulas).
 
     Parameters
     ----------
@@ -511,14 +556,16 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
     nan = float("nan")
 
     def ratio(num: float, den: float) -> float:
-        return num / den if den else nan
+        """TrackEval's ``num / max(1, den)`` (den is a count: 0 or >= 1)."""
+        return num / den if den else 0.0
 
     def over_objects(name: str) -> float:
         weighted = [(getattr(p, name), p.num_unique_objects) for p in parts if p.num_unique_objects]
-        return ratio(sum(v * n for v, n in weighted), n_obj)
+        return sum(v * n for v, n in weighted) / n_obj if n_obj else nan
 
     return MotMetrics(
-        mota=1.0 - (fn + fp + sw) / n_gt if n_gt else nan,
+        # TrackEval's (TP - FP - IDSW) / max(1, TP + FN): -(FP + IDSW) without ground truth
+        mota=1.0 - (fn + fp + sw) / n_gt if n_gt else float(-(fp + sw)),
         motp_iou=ratio(iou_sum, n_match),
         idf1=ratio(2 * idtp, 2 * idtp + idfp + idfn),
         idp=ratio(idtp, idtp + idfp),

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
 from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, integer, number, real_array
+from pftrack.boxes import _box_rows
 from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
 
 __all__ = [
@@ -119,12 +120,27 @@ def mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     Parameters
     ----------
     a : (n, 4) array_like of float
+        Boxes ``left, top, width, height``; one box may be given as (4,).
     b : (m, 4) array_like of float
+        Boxes ``left, top, width, height``; one box may be given as (4,).
 
     Returns
     -------
     (n, m) ndarray of float64
+
+    Raises
+    ------
+    TypeError
+        Boxes that are not real numbers.
+    ValueError
+        Boxes not of shape (n, 4) or (4,) (MOT rows: pass ``rows[:, 2:6]``), a value not finite
+        or beyond ±1e9 px, a negative width or height (as :func:`~pftrack.boxes.iou_xywh`).
     """
+    return _mot_iou(_box_rows(a, "mot_iou", "a"), _box_rows(b, "mot_iou", "b"))
+
+
+def _mot_iou(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """:func:`mot_iou` without its checks: the scorers' per-frame call on checked rows."""
     p = np.array(a, dtype=np.float64).reshape(-1, 4)
     q = np.array(b, dtype=np.float64).reshape(-1, 4)
     p[:, 2:] += p[:, :2]
@@ -233,7 +249,7 @@ def prepare_mot(
     for f in sorted(set(gf) | set(rf)):
         gt_f, res_f = gf.get(f, empty), rf.get(f, empty)
         if with_classes and len(gt_f) and len(res_f):
-            score = mot_iou(gt_f[:, LEFT : LEFT + 4], res_f[:, LEFT : LEFT + 4])
+            score = _mot_iou(gt_f[:, LEFT : LEFT + 4], res_f[:, LEFT : LEFT + 4])
             score[score < 0.5 - _EPS] = 0
             rows_m, cols_m = linear_sum_assignment(-score)
             hit = score[rows_m, cols_m] > _EPS

@@ -22,8 +22,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import BenchmarkName, PathLike
-from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark, mot_iou
+from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, combine_mot, evaluate_mot
+from pftrack.eval.rows import _mot_iou
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, WIDTH
 
 __all__ = [
@@ -211,7 +212,7 @@ def _matched_fraction(
         r = res[res[:, FRAME] == f, LEFT : LEFT + 4]
         total += len(g)
         if len(g) and len(r):
-            hit += int(np.count_nonzero(mot_iou(g, r).max(axis=1) >= 0.5))
+            hit += int(np.count_nonzero(_mot_iou(g, r).max(axis=1) >= 0.5))
     return hit / total if total else 0.0
 
 

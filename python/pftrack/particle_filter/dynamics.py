@@ -123,16 +123,26 @@ def propagate(
 ) -> None:
     """Advance particles one frame in place.
 
+    Each row ``[x, x']``, ``x = (cx, cy, s)``, becomes ``[A x + B x' + C w, x]`` (eq. 7; with
+    ``model.use_means``, eq. 8: the means ``m[0]``, ``m[1]`` stand for ``x``, ``x'`` in the
+    sum), the new scale clamped to ``[s_min, s_max]``.
+
     Parameters
     ----------
     particles : (N, 6) ndarray of float64, C-contiguous and writeable
-        Updated in place (it is never copied, so it must be such an array already).
+        One row per particle, ``cx, cy, s, cx', cy', s'``: the current state (box centre in
+        pixels, scale relative to the track's base size ``(w0, h0)``, so the box is ``(cx, cy,
+        s*w0, s*h0)``), then the previous frame's. Updated in place (it is never copied, so it
+        must be such an array already): columns 0-2 get the new state, 3-5 the one it moved
+        from.
     noise : (N, 3) array_like of float
-        Standard-normal draws, e.g. ``rng.standard_normal((N, 3))``.
+        Standard-normal draws of ``(cx, cy, s)`` per particle, e.g.
+        ``rng.standard_normal((N, 3))``; ``C = (sigma_xy, sigma_xy, sigma_s)`` scales them.
     model : Ar2Model
         Dynamics.
     means : (2, 3) array_like, optional
-        Particle-set means at t-1 and t-2, needed when ``model.use_means``.
+        Particle-set means ``(cx, cy, s)`` at t-1 (row 0) and t-2 (row 1), needed when
+        ``model.use_means``.
 
     Raises
     ------

@@ -12,8 +12,8 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _core
 from pftrack._check import MAX_COORD, generator, integer, number, real_array
 from pftrack._typing import F64, RngLike
-from pftrack.particle_filter.colour import not_binned
-from pftrack.particle_filter.dynamics import Ar2Model
+from pftrack.particle_filter.colour import HsvBinning, not_binned
+from pftrack.particle_filter.dynamics import MAX_SIGMA_XY, Ar2Model
 
 __all__ = [
     "ColourParticleFilter",
@@ -146,11 +146,23 @@ def _velocity(velocity: ArrayLike) -> NDArray[np.float64]:
     return v
 
 
-def _spread(spread: object) -> float:
-    """`spread` of :meth:`ColourParticleFilter.reinitialise`: a finite number >= 0."""
+def _spread(spread: object, model: Ar2Model) -> float:
+    """`spread` of :meth:`ColourParticleFilter.reinitialise`, checked against `model`.
+
+    A finite number >= 0 whose position spread ``spread * model.sigma_xy`` is at most
+    :data:`MAX_SIGMA_XY` px, the bound of ``Ar2Model.sigma_xy`` itself: re-seeded particles
+    stay within a few 1e6 px of their box, so within the ±1e9 px a filter's boxes may span
+    (``spread=1e300`` put them at 1e301 px).
+    """
     s = number(spread, "spread")
     if s < 0:
         raise ValueError(f"spread is {s:g}, expected a finite number >= 0")
+    if s * model.sigma_xy > MAX_SIGMA_XY:
+        raise ValueError(
+            f"spread is {s:g}, expected at most {MAX_SIGMA_XY / model.sigma_xy:g}: the "
+            f"particles' position spread, spread * model.sigma_xy ({model.sigma_xy:g} px), is "
+            f"at most {MAX_SIGMA_XY:g} px"
+        )
     return s
 
 
@@ -208,16 +220,22 @@ class ColourParticleFilter:
         Seeds the filter: same seed, same particles, whatever the thread count.
     velocity : (2,) array_like, optional
         Initial velocity (pixels per frame) of the centre.
+    binning : HsvBinning, optional
+        The binning of the images the filter will step on (keyword only): the reference must
+        then have its ``n_bins`` bins, checked here rather than at the first step. Without
+        it, the first reference's length is the filter's bin count, which
+        :meth:`set_reference` holds later references to.
 
     Raises
     ------
     TypeError
-        A box, reference or velocity that is not real numbers.
+        A box, reference or velocity that is not real numbers, a `binning` that is not an
+        HsvBinning.
     ValueError
         A box that is not 4 finite values with w, h > 0, or a velocity that is not 2 finite
         values, any value beyond ±1e9 px (the rule of
         :func:`~pftrack.particle_filter.box_histograms`); a reference that is negative, not
-        finite or all zero.
+        finite or all zero, or whose length is not `binning`'s ``n_bins``.
 
     References
     ----------
@@ -232,10 +250,17 @@ class ColourParticleFilter:
         config: FilterConfig | None = None,
         rng: RngLike = None,
         velocity: ArrayLike = (0.0, 0.0),
+        *,
+        binning: HsvBinning | None = None,
     ) -> None:
         if config is not None and not isinstance(config, FilterConfig):
             raise TypeError(
                 f"ColourParticleFilter: config must be a FilterConfig, got {type(config).__name__}"
+            )
+        if binning is not None and not isinstance(binning, HsvBinning):
+            raise TypeError(
+                f"{type(self).__name__}: binning must be an HsvBinning, got "
+                f"{type(binning).__name__} {binning!r}"
             )
         self.config = config if config is not None else FilterConfig()
         self._rng = generator(rng, "rng")
@@ -243,7 +268,11 @@ class ColourParticleFilter:
         self._step = 0
         b = _box(box_cxcywh)
         self.w0, self.h0 = float(b[2]), float(b[3])
-        self.set_reference(reference)
+        self._set_reference(
+            reference,
+            None if binning is None else binning.n_bins,
+            "the binning's n_h * n_s + n_v",
+        )
         n = self.config.n_particles
         self.particles = np.empty((n, 6))
         self.weights = np.full(n, 1.0 / n)
@@ -286,11 +315,24 @@ class ColourParticleFilter:
         TypeError
             Not real numbers.
         ValueError
-            Not one dimension (B,), a value not finite or negative, or all zero.
+            Not one dimension (B,), not as many bins as the filter's reference (the filter's
+            binning: a histogram of another binning would be refused only at the next step),
+            a value not finite or negative, or all zero.
         """
+        have = getattr(self, "reference", None)
+        n_bins = len(have) if isinstance(have, np.ndarray) and have.ndim == 1 else None
+        self._set_reference(reference, n_bins, "the filter's bin count")
+
+    def _set_reference(self, reference: ArrayLike, n_bins: int | None, source: str) -> None:
+        """:meth:`set_reference`, holding the length to `n_bins` (None: any), named `source`."""
         r = np.ascontiguousarray(real_array(reference, "reference"))
         if r.ndim != 1:  # a (1, B) or (K, B) array would be taken as one long histogram
             raise ValueError(f"reference has shape {r.shape}, expected (B,) bins")
+        if n_bins is not None and len(r) != n_bins:
+            raise ValueError(
+                f"reference has {len(r)} bins, expected {n_bins} ({source}; a histogram of "
+                "another HsvBinning?)"
+            )
         if not np.all(np.isfinite(r)) or np.any(r < 0) or r.sum() <= 0:
             raise ValueError("reference histogram must be finite, >= 0 and not all zero")
         self.reference = r / r.sum()
@@ -307,20 +349,23 @@ class ColourParticleFilter:
         velocity : (2,) array_like, optional
             Velocity to give the particles; by default the filter's current velocity estimate.
         spread : float
-            Position spread as a multiple of ``model.sigma_xy`` (a finite number >= 0).
+            Position spread as a multiple of ``model.sigma_xy``: a finite number >= 0 with
+            ``spread * model.sigma_xy`` at most 1e6 px (the bound of ``Ar2Model.sigma_xy``,
+            which keeps the particles within ±1e9 px).
 
         Raises
         ------
         TypeError
             A box or velocity that is not real numbers, a spread that is not a number.
         ValueError
-            A box or velocity the filter cannot follow (see the class), a spread < 0 or NaN.
+            A box or velocity the filter cannot follow (see the class), a spread < 0, NaN,
+            infinite or above ``1e6 / model.sigma_xy``.
         """
         b = _box(box_cxcywh)
         v = self.velocity if velocity is None else _velocity(velocity)
-        spread = _spread(spread)
-        s = math.sqrt(float((b[2] / self.w0) * (b[3] / self.h0)))
         m = self.config.model
+        spread = _spread(spread, m)
+        s = math.sqrt(float((b[2] / self.w0) * (b[3] / self.h0)))
         s = min(max(s, m.s_min), m.s_max)  # np.clip's value, without its call overhead
         n = self.config.n_particles
         noise = self._rng.standard_normal((n, 3))
@@ -492,7 +537,8 @@ def reinitialise_filters(
     velocities : (K, 2) array_like
         Velocity to give each filter's particles, pixels per frame.
     spread : float
-        Position spread as a multiple of ``model.sigma_xy`` (a finite number >= 0).
+        Position spread as a multiple of ``model.sigma_xy``, as
+        :meth:`ColourParticleFilter.reinitialise` takes it.
 
     Raises
     ------
@@ -500,12 +546,13 @@ def reinitialise_filters(
         Boxes or velocities that are not real numbers, a spread that is not a number.
     ValueError
         Not one box (K, 4) and one velocity (K, 2) per filter, each as
-        :meth:`ColourParticleFilter.reinitialise` takes it; a spread < 0 or NaN.
+        :meth:`ColourParticleFilter.reinitialise` takes it; a spread it refuses (< 0, NaN,
+        infinite, above ``1e6 / model.sigma_xy``).
     """
     k = len(filters)
     b = real_array(boxes_cxcywh, "boxes_cxcywh")
     v = real_array(velocities, "velocities")
-    spread = _spread(spread)
+    spread = _spread(spread, filters[0].config.model if k else Ar2Model())
     if k == 0 and b.size == 0 and v.size == 0:
         return
     if b.shape != (k, 4) or v.shape != (k, 2):
@@ -518,6 +565,8 @@ def reinitialise_filters(
         _velocity(v[int(np.flatnonzero(bad_v)[0])])  # raises, naming the velocity
     cfg = filters[0].config
     if not all(f.config is cfg or f.config == cfg for f in filters):
+        for f in filters:  # every filter's own bound, before any is re-seeded
+            _spread(spread, f.config.model)
         for f, box, vel in zip(filters, b, v, strict=True):
             f.reinitialise(box, velocity=vel, spread=spread)
         return

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 from pftrack import _core
 from pftrack._check import integer
 from pftrack._typing import RngLike
+from pftrack.particle_filter.colour import HsvBinning
 from pftrack.particle_filter.filter import (
     ColourParticleFilter,
     FilterConfig,
@@ -38,7 +39,7 @@ class MHColourParticleFilter(ColourParticleFilter):
 
     Parameters
     ----------
-    box_cxcywh, reference, config, rng, velocity
+    box_cxcywh, reference, config, rng, velocity, binning
         As for :class:`~pftrack.particle_filter.ColourParticleFilter`.
     n_iter : int
         MH iterations per particle and frame, in [1, 2147483647] (the core's 32-bit int); a
@@ -71,9 +72,11 @@ class MHColourParticleFilter(ColourParticleFilter):
         rng: RngLike = None,
         velocity: ArrayLike = (0.0, 0.0),
         n_iter: int = 1,
+        *,
+        binning: HsvBinning | None = None,
     ) -> None:
         integer(n_iter, "MHColourParticleFilter: n_iter", 1, 2**31 - 1)
-        super().__init__(box_cxcywh, reference, config, rng, velocity)
+        super().__init__(box_cxcywh, reference, config, rng, velocity, binning=binning)
         self.n_iter = int(n_iter)
         self.acceptance = float("nan")
 

@@ -16,8 +16,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import generator, integer, number, real_array
+from pftrack._check import first_at, generator, integer, number, real_array
 from pftrack._typing import RngLike
+from pftrack.particle_filter.colour import not_binned
 
 #: Kernels of the colour histograms (``RJMCMCConfig.kernel``).
 KERNELS = ("uniform", "epanechnikov")
@@ -257,7 +258,8 @@ class RJMCMCFilter:
         mask : (H, W) array_like of uint8 or bool
             Foreground mask of the background subtraction (non-zero = foreground).
         candidates_cxcywh : (K, 4) array_like of float
-            Birth candidates (cx, cy, w, h), e.g. the detector's boxes; may be empty.
+            Birth candidates (cx, cy, w, h), e.g. the detector's boxes; may be empty (``[]``),
+            one may be given as (4,). Any other shape is refused ((4, 3) is not 3 boxes).
         candidate_hists : (K, B) array_like of float, optional
             Their reference histograms; computed from ``binned`` when omitted. A candidate without
             any counted pixel cannot be born.
@@ -267,17 +269,46 @@ class RJMCMCFilter:
         list of RJTrack
             Identities whose existence probability is at least ``config.min_existence``, with their
             mean box over the kept samples containing them.
+
+        Raises
+        ------
+        TypeError
+            `binned` is not a :class:`~pftrack.particle_filter.BinnedImage` (a raw frame: bin
+            it with :func:`~pftrack.particle_filter.hsv_bins`); candidates or histograms that
+            are not real numbers.
+        ValueError
+            A mask not of the frame's shape; candidates not of shape (K, 4) or (4,), or a
+            candidate not finite, beyond ±1e9 px or with w or h < 0;
+            `candidate_hists` not (K, B) with the image's B bins, or a value not finite or
+            negative (as :func:`~pftrack.particle_filter.bhattacharyya_coefficient` refuses).
         """
+        fn = "RJMCMCFilter.step"
+        error = not_binned(binned, "binned")
+        if error is not None:
+            raise error
         m = np.asarray(mask)
         if m.dtype == bool:
             m = m.view(np.uint8)
         m = np.ascontiguousarray(m)
-        cands = np.ascontiguousarray(np.asarray(candidates_cxcywh, dtype=np.float64).reshape(-1, 4))
-        hists = (
-            None
-            if candidate_hists is None
-            else np.ascontiguousarray(candidate_hists, dtype=np.float64)
-        )
+        cands = real_array(candidates_cxcywh, f"{fn}: candidates_cxcywh")
+        if cands.ndim == 1 and cands.size == 0:
+            cands = np.zeros((0, 4))  # [] is no candidate, as np.zeros((0, 4))
+        elif cands.shape == (4,):
+            cands = cands[None, :]  # one candidate, as box_histograms takes one box
+        if cands.ndim != 2 or cands.shape[1] != 4:
+            raise ValueError(
+                f"{fn}: candidates_cxcywh must have shape (K, 4) (cx, cy, w, h), got {cands.shape}"
+            )
+        cands = np.ascontiguousarray(cands)
+        hists = None
+        if candidate_hists is not None:
+            hists = np.ascontiguousarray(real_array(candidate_hists, f"{fn}: candidate_hists"))
+            bad = ~(np.isfinite(hists) & (hists >= 0))
+            if bad.any():
+                k, at = first_at(bad)
+                raise ValueError(
+                    f"{fn}: candidate_hists{at} is {hists[k]:g}, expected a finite value >= 0"
+                )
         r = self._core.step(binned, m, cands, hists, seed=self.seed, step=self.n_steps)
         self.n_steps += 1
         self.last = dict(r)

@@ -28,7 +28,7 @@ from pftrack._check import (
     real_array,
 )
 from pftrack._typing import F64, PathLike
-from pftrack.boxes import xywh_to_cxcywh
+from pftrack.boxes import _to_cxcywh
 from pftrack.particle_filter.colour import (
     bhattacharyya_distance,
     box_histograms,
@@ -241,7 +241,7 @@ def _end_histograms(
                 out[tid, last] = None
                 continue
             row = tracks[tid][-1 if last else 0]
-            hist = box_histograms(image, xywh_to_cxcywh(row[2:6])[None])[0]
+            hist = box_histograms(image, _to_cxcywh(row[2:6])[None])[0]
             out[tid, last] = hist if hist.sum() > 0 else None
     return out
 

@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from pftrack._typing import F64
 from pftrack.assignment import linear_sum_assignment
-from pftrack.boxes import iou_xywh
+from pftrack.boxes import _iou_matrix
 from pftrack.tracking.config import AssociationConfig
 
 __all__ = ["Association", "associate", "covers_another"]
@@ -73,7 +73,7 @@ def associate(
     nt, nd = len(track_boxes), len(boxes)
     if nt == 0 or nd == 0:
         return Association([], list(range(nt)), list(range(nd)))
-    iou = iou_xywh(track_boxes, boxes)
+    iou = _iou_matrix(track_boxes, boxes)
     tc = track_boxes[:, :2] + track_boxes[:, 2:] / 2
     dc = boxes[:, :2] + boxes[:, 2:] / 2
     dx, dy = tc[:, 0:1] - dc[:, 0], tc[:, 1:2] - dc[:, 1]

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
-from pftrack.boxes import cxcywh_to_xywh, iou_xywh, xywh_to_cxcywh
+from pftrack.boxes import _iou_matrix, _to_cxcywh, _to_xywh
 from pftrack.particle_filter import RJMCMCConfig, RJMCMCFilter
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.track import Track
@@ -70,10 +70,10 @@ class JointTracker:
         """One frame: `boxes` (xywh) are the birth candidates, `index` their input positions."""
         if self._filter is None:
             self._filter = RJMCMCFilter(joint_config(self.config), rng=self._rng)
-        estimates = self._filter.step(binned, mask, xywh_to_cxcywh(boxes))
+        estimates = self._filter.step(binned, mask, _to_cxcywh(boxes))
         self._ids.update(int(e.id) for e in estimates)
-        ebox = np.array([cxcywh_to_xywh(e.box_cxcywh) for e in estimates]).reshape(-1, 4)
-        iou = iou_xywh(ebox, boxes) if len(boxes) else np.zeros((len(estimates), 0))
+        ebox = np.array([_to_xywh(e.box_cxcywh) for e in estimates]).reshape(-1, 4)
+        iou = _iou_matrix(ebox, boxes) if len(boxes) else np.zeros((len(estimates), 0))
         out = []
         for k, e in enumerate(estimates):
             j = int(np.argmax(iou[k])) if iou.shape[1] else -1

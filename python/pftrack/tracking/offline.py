@@ -24,7 +24,7 @@ from pftrack import _check
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
-from pftrack.boxes import cxcywh_to_xywh, intersection_xywh, iou_xywh_rows, xywh_to_cxcywh
+from pftrack.boxes import _intersection_matrix, _iou_rows, _to_cxcywh, _to_xywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
 from pftrack.recovery.fill import MAX_GAP_LIMIT, fill_rows
@@ -156,7 +156,7 @@ class BoxSmoother:
                 if obs[i:j].any():
                     out_p[i:j] = self.smooth(f[i:j], b[i:j], obs[i:j])
             return out_p
-        z = xywh_to_cxcywh(b)
+        z = _to_cxcywh(b)
         height = float(np.median(b[obs, 3]))
         if not height > 0:  # no scale to smooth in: the track is kept as it is, as recover does
             return np.array(b, dtype=np.float64)  # a copy
@@ -178,7 +178,7 @@ class BoxSmoother:
         mean = height * rts_smooth(zt, has, q * q, r * r, velocity_sd=10.0, update_first=False)
         np.maximum(mean[:, 2:], 0.5 * z[obs, 2:].min(axis=0), out=mean[:, 2:])
         out: F64 = b.copy()
-        out[first:] = cxcywh_to_xywh(mean[f[first:] - f[first]])
+        out[first:] = _to_xywh(mean[f[first:] - f[first]])
         return out  # rows before the first detection keep their own boxes
 
 
@@ -311,7 +311,7 @@ def repair_crossings(
         return a
     perm = np.argsort(a[:, 0], kind="stable")  # rows by frame: every selection in time order
     fr, lab = a[perm, 0], a[perm, 1].copy()
-    ob, cz = obs[perm], xywh_to_cxcywh(z[perm])
+    ob, cz = obs[perm], _to_cxcywh(z[perm])
     pairs = _overlapping_pairs(a[perm], config.min_iou)
     wins = _windows(pairs, lab, config.join_gap)
     k = 0
@@ -358,7 +358,7 @@ def _overlapping_pairs(a: F64, min_iou: float) -> F64:
         return np.zeros((0, 4))
     p = np.repeat(np.arange(n), later)
     q = p + 1 + np.arange(total) - np.repeat(np.cumsum(later) - later, later)
-    iou = iou_xywh_rows(a[p, 2:6], a[q, 2:6])
+    iou = _iou_rows(a[p, 2:6], a[q, 2:6])
     keep = iou >= min_iou
     return np.column_stack([fr[p[keep]], p[keep], q[keep], iou[keep]])
 
@@ -629,7 +629,7 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
         if len(idx) < 2:
             continue
         box = a[idx, 2:6]
-        overlap = intersection_xywh(box, box)  # [i, j]: area of box i inside box j
+        overlap = _intersection_matrix(box, box)  # [i, j]: area of box i inside box j
         area = box[:, 2] * box[:, 3]
         covered = (overlap > inside * area[:, None]) & (area[None, :] > area_ratio * area[:, None])
         drop[idx] = covered.any(axis=1)

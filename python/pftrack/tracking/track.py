@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
-from pftrack.boxes import xywh_to_cxcywh
+from pftrack.boxes import _to_cxcywh
 from pftrack.kalman import _cv_predict, _cv_update, _cv_update_where  # unchecked: per frame
 from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
 from pftrack.particle_filter.filter import reinitialise_filters, step_filters_summary
@@ -126,7 +126,7 @@ class LiveTrack:
         self.id = track_id
         cls = MHColourParticleFilter if config.sampler == "mh" else ColourParticleFilter
         self.filter: ColourParticleFilter = cls(
-            xywh_to_cxcywh(box_xywh), reference, config.filter, rng=seed
+            _to_cxcywh(box_xywh), reference, config.filter, rng=seed
         )
         self.box = box_xywh.copy()
         self.size = box_xywh[2:].copy()  # smoothed detection size
@@ -390,9 +390,7 @@ def reseed_tracks(
     if not tracks:
         return
     filters = [t.filter for t in tracks]
-    reinitialise_filters(
-        filters, xywh_to_cxcywh(boxes_xywh), np.array([t.motion.v for t in tracks])
-    )
+    reinitialise_filters(filters, _to_cxcywh(boxes_xywh), np.array([t.motion.v for t in tracks]))
     rate = config.reference_rate
     if rate <= 0:
         return

@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import bgr_frame, generator
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
-from pftrack.boxes import xywh_to_cxcywh
+from pftrack.boxes import _to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
@@ -478,7 +478,7 @@ class MultiObjectTracker:
 
         # 2. association
         if len(boxes):
-            hists = box_histograms(binned, xywh_to_cxcywh(boxes), "uniform")
+            hists = box_histograms(binned, _to_cxcywh(boxes), "uniform")
         else:
             hists = np.zeros((0, binned.n_bins))
         tracks = self.tracks
