@@ -1,11 +1,12 @@
 """pftrack behind supervision's tracker interface (``update_with_detections``).
 
 supervision is imported lazily, when a tracker is first updated; install it with
-``pip install "pftrack[supervision]"``. That extra installs supervision's ``opencv-python`` next to
-pftrack's ``opencv-python-headless``: both wheels of one OpenCV release write the same ``cv2``
-package, so either works (see the README); do not uninstall one of the two afterwards, which
-removes ``cv2`` for both (``pip install --force-reinstall --no-deps opencv-python-headless``
-repairs it).
+``pip install "pftrack[supervision]"``. Current supervision (0.31, what that extra installs today)
+needs no OpenCV, so only pftrack's ``opencv-python-headless`` is installed. Releases up to 0.26
+require ``opencv-python``: pip then installs it next to the headless wheel, and both wheels of one
+OpenCV release write the same ``cv2`` package, so either works (see the README); do not uninstall
+one of the two afterwards, which removes ``cv2`` for both (``pip install --force-reinstall
+--no-deps opencv-python-headless`` repairs it).
 """
 
 from __future__ import annotations
@@ -148,3 +149,10 @@ class SupervisionTracker:
     def reset(self) -> None:
         """Forget every track (:meth:`pftrack.Tracker.reset`)."""
         self.tracker.reset()
+
+    def __copy__(self) -> SupervisionTracker:
+        """Refused: a shallow copy would share the run's :class:`pftrack.Tracker`."""
+        raise TypeError(
+            "copy.copy(SupervisionTracker) would share the run's state with the original; use "
+            "copy.deepcopy(tracker) for an independent copy"
+        )

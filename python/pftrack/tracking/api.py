@@ -21,12 +21,15 @@ depend on container metadata. Motion noise levels (particle and centre filters) 
 
 from __future__ import annotations
 
+import copy
 import itertools
+import operator
+import pickle
 import threading
 import warnings
 from collections.abc import Iterable
 from dataclasses import replace
-from typing import Any
+from typing import Any, SupportsIndex
 
 import cv2
 import numpy as np
@@ -74,6 +77,13 @@ MAX_FRAME_RATE = 1000.0
 MAX_CLASS = 2**31 - 1
 #: Columns of :meth:`Tracker.update`'s output.
 TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
+
+
+def _unpickle_tracker(cls: type[Tracker], data: bytes) -> Tracker:
+    """A pickled :class:`Tracker` (:meth:`Tracker.__reduce_ex__`) back."""
+    tracker = cls.__new__(cls)
+    tracker.__setstate__(pickle.loads(data))  # noqa: S301 - the caller's own pickle
+    return tracker
 
 
 def _frames(seconds: float, frame_rate: float, name: str) -> int:
@@ -451,10 +461,66 @@ class Tracker:
         """
         return _Alone(self._busy, method)
 
-    def __getstate__(self) -> dict[str, Any]:
+    def _refuse_copy(self) -> None:
+        """TypeError naming the option when the run holds state that cannot be copied.
+
+        The RJ-MCMC chain (from the first frame) and OpenCV's background subtractors (from
+        :meth:`prime` or the first frame that uses them) live outside Python: pickle would
+        otherwise say only ``cannot pickle 'cv2.BackgroundSubtractorMOG2' object``.
+        """
+        joint = getattr(self._tracker, "_joint", None)
+        if getattr(joint, "_filter", None) is not None:
+            raise TypeError(
+                "sampler='rjmcmc' cannot be checkpointed (pickle/deepcopy) once it has seen a "
+                "frame: its chain lives in the C++ core; use 'sis' or 'mh'"
+            )
+        detector = getattr(self._tracker, "_detector", None)
+        if isinstance(getattr(detector, "_sub", None), cv2.BackgroundSubtractor):
+            raise TypeError(
+                f"detector={self.config.detector!r} cannot be checkpointed (pickle/deepcopy) "
+                "once primed or given a frame: OpenCV's background subtractors cannot be "
+                "pickled; use detector='paper'"
+            )
+
+    def _state(self) -> dict[str, Any]:
+        """The run's state to copy (call holding the tracker: :meth:`_alone`)."""
+        self._refuse_copy()
         state = self.__dict__.copy()
         del state["_busy"]  # a lock is not copied or pickled: a copy is free
         return state
+
+    def __getstate__(self) -> dict[str, Any]:
+        # the state is the live objects: pickle and deepcopy go through __reduce_ex__ and
+        # __deepcopy__, which copy them while still holding the tracker
+        with self._alone("__getstate__"):
+            return self._state()
+
+    def __reduce_ex__(self, protocol: SupportsIndex) -> tuple[Any, ...]:
+        """Pickle the run whole while holding the tracker (RuntimeError when in use).
+
+        Pickle walks the state after ``__reduce_ex__`` returns, so the state is pickled here,
+        inside the guard: an ``update`` on another thread can neither mix into the
+        checkpoint nor start while it is taken.
+        """
+        with self._alone("__reduce_ex__ (pickle)"):
+            data = pickle.dumps(self._state(), protocol=operator.index(protocol))
+        return (_unpickle_tracker, (type(self), data))
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> Tracker:
+        """An independent copy of the run (a checkpoint), taken while holding the tracker."""
+        with self._alone("__deepcopy__ (copy.deepcopy)"):
+            new = type(self).__new__(type(self))
+            memo[id(self)] = new
+            new.__dict__.update(copy.deepcopy(self._state(), memo))
+        new._busy = threading.Lock()
+        return new
+
+    def __copy__(self) -> Tracker:
+        """Refused: a shallow copy would share the run's state with the original."""
+        raise TypeError(
+            "copy.copy(Tracker) would share the run's state (tracks, background, rows) with the "
+            "original; use copy.deepcopy(tracker) for an independent copy"
+        )
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
@@ -477,7 +543,7 @@ class Tracker:
             # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
             # with the run's first frame (None: tracked at the frame's own size)
             self._scale: F64 | None = None
-            self._shape: tuple[int, ...] | None = None  # the run's frame shape, with max_side
+            self._shape: tuple[int, ...] | None = None  # the run's frame shape
             self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
 
     @property
@@ -554,7 +620,18 @@ class Tracker:
             if self.frame_count:
                 raise ValueError("prime() must come before the first update()")
             first = itertools.islice(frames, self.prime_frames)  # no more: a whole video is big
-            picked = [self.working_frame(bgr_frame(f, "prime frame")) for f in first]
+            picked = []
+            shape: tuple[int, ...] | None = None
+            for i, frame in enumerate(first):
+                f = bgr_frame(frame, "prime frame")
+                if shape is None:
+                    shape = f.shape
+                elif f.shape != shape:  # checked before the median of mixed sizes is taken
+                    raise ValueError(
+                        f"prime frame {i} is {f.shape[1]}x{f.shape[0]}, frame 0 "
+                        f"{shape[1]}x{shape[0]} (the frames of one run are one size)"
+                    )
+                picked.append(self.working_frame(f))
             if picked:
                 self._tracker.prime(picked)
 
@@ -584,19 +661,20 @@ class Tracker:
         """
         with self._alone("update"):
             f = bgr_frame(frame)
-            if self.config.max_side is not None:  # one scale for the whole run's rows
-                if self._shape is None:
-                    self._shape = f.shape
-                    size = working_size(f.shape, self.config.max_side)
-                    if size is not None:
-                        sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
-                        self._scale = np.array([sx, sy, sx, sy])
-                elif f.shape != self._shape:
-                    raise ValueError(
-                        f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
-                        f"{self._shape[1]}x{self._shape[0]} (max_side scales one size per run; "
-                        "call reset() before a new video)"
-                    )
+            if self._shape is None:
+                size = working_size(f.shape, self.config.max_side)
+                self._scale = None  # one scale for the whole run's rows
+                if size is not None:
+                    sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
+                    self._scale = np.array([sx, sy, sx, sy])
+            elif f.shape != self._shape:
+                scales = self.config.max_side is not None
+                why = "max_side scales one size per run" if scales else "one size per run"
+                raise ValueError(
+                    f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
+                    f"{self._shape[1]}x{self._shape[0]} ({why}; call reset() or use a new "
+                    "Tracker before a new video)"
+                )
             work = self._working(f)
             if dets is None:
                 kept = None
@@ -626,6 +704,7 @@ class Tracker:
                 )
                 self._max_conf = max(self._max_conf, confidence)
             self.frame_count += 1
+            self._shape = f.shape  # the run's size, once its first frame is taken
             # the offline pass sees a still camera: boxes in the first frame's coordinates
             self._stabiliser.add(self._tracker.camera_step.apply)
             self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))

@@ -1,0 +1,208 @@
+"""pftrack.Tracker checkpoints (pickle, copy) under threads, refused copies and prime's frames."""
+
+from __future__ import annotations
+
+import copy
+import pickle
+import re
+import threading
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack.integrations.supervision import SupervisionTracker
+from pftrack.io.mot import group_by_frame
+from pftrack.synthetic import make_scene
+from pftrack.tracking.api import xywh_to_xyxy_dets
+
+IN_USE = r"this Tracker is in use by another thread"
+CLONES: dict[str, Callable[[Any], Any]] = {
+    "deepcopy": copy.deepcopy,
+    "pickle": lambda t: pickle.loads(pickle.dumps(t)),
+}
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return make_scene(n_frames=30, rng=1)
+
+
+def scene_dets(scene) -> list[np.ndarray]:
+    by_frame = group_by_frame(scene.truth)
+    return [
+        xywh_to_xyxy_dets(
+            np.column_stack([r[:, 2:6], np.ones(len(r))])
+            if len(r := by_frame.get(f, np.zeros((0, 10))))
+            else np.zeros((0, 5))
+        )
+        for f in range(1, len(scene.frames) + 1)
+    ]
+
+
+class Held:
+    """Holds the inner tracker's ``update`` open on another thread until released."""
+
+    def __init__(self, tracker: pftrack.Tracker, dets: np.ndarray, frame: np.ndarray) -> None:
+        self.inside, self.leave = threading.Event(), threading.Event()
+        real = tracker._tracker.update
+
+        def held(*args: Any, **kwargs: Any) -> Any:
+            self.inside.set()
+            assert self.leave.wait(10)
+            return real(*args, **kwargs)
+
+        tracker._tracker.update = held
+        self.tracker = tracker
+        self.thread = threading.Thread(target=tracker.update, args=(dets, frame))
+
+    def __enter__(self) -> Held:
+        self.thread.start()
+        assert self.inside.wait(10)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.leave.set()
+        self.thread.join()
+        del self.tracker._tracker.update
+
+
+@pytest.mark.parametrize("how", sorted(CLONES))
+def test_a_checkpoint_is_refused_while_update_runs_on_another_thread(scene, how):
+    # was: a checkpoint of frame_count 76 with the inner tracker at 77, and the copy failed in
+    # finalize much later (smooth_tracks: duplicate rows)
+    dets = scene_dets(scene)
+    a = pftrack.Tracker()
+    for k in range(10):
+        a.update(dets[k], scene.frames[k])
+    with Held(a, dets[10], scene.frames[10]):
+        with pytest.raises(RuntimeError, match=rf"^Tracker\.__\w+__ \(.*\): {IN_USE}"):
+            CLONES[how](a)
+        with pytest.raises(RuntimeError, match=rf"^Tracker\.__getstate__: {IN_USE}"):
+            a.__getstate__()
+    assert a.frame_count == 11
+    b = CLONES[how](a)  # free again: a consistent checkpoint that goes on as the original
+    for k in range(11, len(scene.frames)):
+        np.testing.assert_array_equal(
+            a.update(dets[k], scene.frames[k]), b.update(dets[k], scene.frames[k])
+        )
+    np.testing.assert_array_equal(a.finalize(), b.finalize())
+
+
+class Blocking:
+    """An attribute whose copy or pickle waits: a checkpoint caught half taken."""
+
+    def __init__(self) -> None:
+        self.inside, self.leave = threading.Event(), threading.Event()
+
+    def _wait(self) -> None:
+        self.inside.set()
+        assert self.leave.wait(10)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        self._wait()
+        return (object, ())
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> object:
+        self._wait()
+        return object()
+
+
+@pytest.mark.parametrize("how", sorted(CLONES))
+def test_update_is_refused_while_a_checkpoint_is_being_taken(scene, how):
+    # the state is walked inside the guard, not only handed out by __getstate__
+    dets = scene_dets(scene)
+    a = pftrack.Tracker()
+    a.update(dets[0], scene.frames[0])
+    a._probe = probe = Blocking()
+    taking = threading.Thread(target=CLONES[how], args=(a,))
+    taking.start()
+    try:
+        assert probe.inside.wait(10)
+        with pytest.raises(RuntimeError, match=rf"^Tracker\.update: {IN_USE}"):
+            a.update(dets[1], scene.frames[1])
+    finally:
+        probe.leave.set()
+        taking.join()
+    assert a.frame_count == 1
+    a.update(dets[1], scene.frames[1])
+
+
+def test_a_shallow_copy_is_refused(scene):
+    # was: copy.copy shared the inner tracker, writer and background, with a lock of its own
+    a = pftrack.Tracker()
+    a.update(scene_dets(scene)[0], scene.frames[0])
+    with pytest.raises(TypeError, match=r"^copy\.copy\(Tracker\) would share .*copy\.deepcopy"):
+        copy.copy(a)
+    s = SupervisionTracker()
+    with pytest.raises(TypeError, match=r"^copy\.copy\(SupervisionTracker\) would share"):
+        copy.copy(s)
+    assert copy.deepcopy(s).tracker is not s.tracker
+
+
+def test_a_deep_copy_keeps_shared_references(scene):
+    # deepcopy's memo is kept: an object referring to the tracker gets the copy's
+    a = pftrack.Tracker()
+    a.update(scene_dets(scene)[0], scene.frames[0])
+    pair = copy.deepcopy([a, a])
+    assert pair[0] is pair[1] and pair[0] is not a
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"sampler": "rjmcmc"}, "sampler='rjmcmc' cannot be checkpointed (pickle/deepcopy) once"),
+        ({"detector": "mog2"}, "detector='mog2' cannot be checkpointed (pickle/deepcopy) once"),
+        ({"detector": "knn"}, "detector='knn' cannot be checkpointed (pickle/deepcopy) once"),
+    ],
+)
+@pytest.mark.parametrize("how", sorted(CLONES))
+def test_an_uncopyable_run_names_its_option(scene, options, message, how):
+    # was: TypeError: cannot pickle 'pftrack._core.RJMCMCTracker' object (or cv2's subtractor)
+    a = pftrack.Tracker(**options)
+    CLONES[how](a)  # before the first frame: copied
+    a.update(None, scene.frames[0])
+    with pytest.raises(TypeError, match="^" + re.escape(message)):
+        CLONES[how](a)
+    a.update(None, scene.frames[1])  # the refusal left the run as it was
+
+
+@pytest.mark.parametrize("detector", ["mog2", "knn"])
+def test_a_primed_opencv_background_names_its_option(scene, detector):
+    a = pftrack.Tracker(detector=detector)
+    a.prime(scene.frames[:3])
+    with pytest.raises(TypeError, match=rf"^detector='{detector}' cannot be checkpointed"):
+        pickle.dumps(a)
+
+
+def test_prime_refuses_frames_of_two_sizes(scene):
+    # was: a 100x100 frame accepted silently; a cropped one an IndexError in frame_gain
+    a = scene.frames[0]
+    for odd in (np.zeros((100, 100, 3), np.uint8), a[:, :400]):
+        t = pftrack.Tracker()
+        frames: Iterator[np.ndarray] = iter([a, a, odd])
+        h, w = odd.shape[:2]
+        with pytest.raises(
+            ValueError,
+            match=rf"^prime frame 2 is {w}x{h}, frame 0 480x360 \(the frames of one run are one "
+            r"size\)$",
+        ):
+            t.prime(frames)
+        t.prime([a, a])  # nothing was taken: prime is still open
+        t.update(None, a)
+
+
+@pytest.mark.parametrize("max_side", [None, 64])
+def test_a_new_frame_size_names_reset(scene, max_side):
+    t = pftrack.Tracker(max_side=max_side)
+    t.update(None, scene.frames[0])
+    with pytest.raises(
+        ValueError,
+        match=r"^frame is 100x100, the run's earlier frames 480x360 \(.*one size per run; call "
+        r"reset\(\) or use a new Tracker before a new video\)$",
+    ):
+        t.update(None, np.zeros((100, 100, 3), np.uint8))
+    t.reset()
+    t.update(None, np.zeros((100, 100, 3), np.uint8))
