@@ -301,7 +301,17 @@ class Tracker:
     under any other path). ``copy.deepcopy(tracker)`` or a pickle of it is a checkpoint at any
     point of a run with the built-in ``"paper"`` detector and the ``"sis"`` or ``"mh"``
     sampler: the copy goes on exactly as the original. OpenCV's MOG2/KNN and the RJ-MCMC
-    chain cannot be copied once they have seen a frame (TypeError).
+    chain cannot be copied once they have seen a frame (TypeError naming the option); a
+    checkpoint taken while another thread is inside a method raises RuntimeError, and
+    ``copy.copy`` (which would share the run's state) raises TypeError.
+
+    Memory grows with the run: every online row is kept until :meth:`finalize` (its offline
+    pass needs the whole run), about 0.6 KB a row (measured with ``tracemalloc`` on a
+    synthetic scene: some 55 MB per person tracked for an hour at 25 frames/s). For an
+    unbounded stream, read :meth:`settled_rows` from the last :attr:`n_settled` as you go,
+    and end a segment now and then with :meth:`finalize` and :meth:`reset`, which frees the
+    rows (ids and frame numbers start again; tracks are not linked across segments):
+    docs/robustness.md, "Memory of a long Tracker run".
 
     Examples
     --------
