@@ -154,8 +154,15 @@ class BatchSummary:
         """JSON text of :meth:`as_dict`."""
         return json.dumps(self.as_dict(), indent=2)
 
-    def table(self) -> str:
-        """A text table: one line per task, then the totals."""
+    def table(self, problems: bool = True) -> str:
+        """A text table: one line per task, then the totals, the notes and the problems.
+
+        Parameters
+        ----------
+        problems : bool
+            End with :meth:`problems`' lines (each task's warnings and errors); ``pftrack``
+            prints the table without them on stdout, and them on stderr.
+        """
         cols = _COLUMNS[self.kind]
         head = ["name", "status"] + [c for c, _, _ in cols]
         lines = [head]
@@ -189,10 +196,15 @@ class BatchSummary:
 
                 note = unfilled_note(e["long_holes"], e["longest_hole"], self.settings["max_gap"])
                 text.append(f"{e['name']}: {note}")
-            text.extend(f"{e['name']}: warning: {w}" for w in e.get("warnings", ()))
-        for e in self.failed:
-            text.append(f"{e['name']}: error: {e['error']}")
+        if problems:
+            text.extend(self.problems())
         return "\n".join(text)
+
+    def problems(self) -> list[str]:
+        """The tasks' warnings (``NAME: warning: ...``), then their errors (``NAME: error: ...``)."""
+        text = [f"{e['name']}: warning: {w}" for e in self.entries for w in e.get("warnings", ())]
+        text.extend(f"{e['name']}: error: {e['error']}" for e in self.failed)
+        return text
 
 
 _STATUSES = ("done", "skipped", "failed", "cancelled")
