@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._progress import Bar, enabled, progress
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
-from pftrack.io.atomic import atomic_write, check_output
+from pftrack.io.atomic import atomic_write, check_output, refuse_dash
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
 
@@ -908,6 +908,7 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
 
 def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) -> None:
     """Before any work, writing nothing: no output overwrites an input or is a folder."""
+    refuse_dash(out_dir, "--out", output=True, name="folder")
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file; give a folder")
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large

@@ -186,6 +186,9 @@ def check_input_file(path: str, *, what: str) -> None:
     if p.is_dir():
         raise ValueError(f"{what} {path}: is a folder, not a file")
     if not p.exists():
+        from pftrack.io.atomic import refuse_dash
+
+        refuse_dash(path, what)
         raise FileNotFoundError(f"{what} {path}: no such file")
     if not p.is_file():
         raise ValueError(f"{what} {path}: is not a regular file (a device, pipe or socket)")
