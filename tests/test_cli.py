@@ -259,7 +259,7 @@ def test_experiment_gaps_refuses_an_image_size_of_neither_form(
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        f"pftrack experiment: error: --image-size is {' '.join(size)!r}, expected W H or WxH"
+        f"pftrack experiment gaps: error: --image-size is {' '.join(size)!r}, expected W H or WxH"
     )
 
 
@@ -308,7 +308,7 @@ def test_experiment_gaps_refuses_the_other_modes_options_before_work(
     argv = ["experiment", "gaps", "--gt", *(f"none{k}.txt" for k in range(gts)), *options]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"pftrack experiment: error: {message}") and err.count("\n") == 1
+    assert err.startswith(f"pftrack experiment gaps: error: {message}") and err.count("\n") == 1
     assert list(tmp_path.iterdir()) == []
 
 
@@ -325,7 +325,7 @@ def test_experiment_gaps_refuses_one_ground_truth_given_twice(
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err == (
-        f"pftrack experiment: error: --gt {gt} and {again[spelling]} are the same file; give "
+        f"pftrack experiment gaps: error: --gt {gt} and {again[spelling]} are the same file; give "
         "each sequence once\n"
     )
     assert not (tmp_path / "e.json").exists()
@@ -452,7 +452,7 @@ def test_experiment_gaps_refuses_a_sweep_of_too_many_positions(
     argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "100000x100000", "--grid", "1"]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("pftrack experiment: error: sweep: a 1 px grid over 100000 x 100000")
+    assert err.startswith("pftrack experiment gaps: error: sweep: a 1 px grid over 100000 x 100000")
     assert "more than the limit of 1000000; use a coarser grid" in err and "\n" not in err
 
 
