@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from pftrack.cli import main
+from pftrack.cli import build_parser, main
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.synthetic import Scene, make_scene
@@ -249,6 +249,47 @@ def test_experiment_gaps_takes_the_image_size_as_eval_does_or_as_wxh(
             "--repeat", "1", "--max-positions", "1", "--json", str(out)]  # fmt: skip
     assert main(["-q", *argv]) == 0
     assert json.loads(out.read_text())["image_size"] == [768, 576]
+
+
+def test_experiment_gaps_one_sequence_reads_the_seqinfo_beside_its_ground_truth(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: the ground truth's extent, the seqinfo.ini beside it passed over (as eval reads it)."""
+    import json
+
+    (tmp_path / "SEQ" / "gt").mkdir(parents=True)
+    gt, out = _walkers(tmp_path / "SEQ" / "gt" / "gt.txt"), tmp_path / "e.json"
+    (tmp_path / "SEQ" / "seqinfo.ini").write_text("[Sequence]\nimWidth=900\nimHeight=700\n")
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--methods", "linear", "--repeat", "1",
+            "--max-positions", "1", "--json", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    assert json.loads(out.read_text())["image_size"] == [900, 700]
+    assert f"{gt}: 15 trajectories, centre point, 900x700\n" in capsys.readouterr().out
+    assert main([*argv, "--image-size", "768x576"]) == 0  # given: it wins
+    assert json.loads(out.read_text())["image_size"] == [768, 576]
+
+
+@pytest.mark.parametrize("size", [["640x480"], ["640", "480"], ["640X480"]])
+def test_eval_takes_the_image_size_as_w_h_or_wxh(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], size: list[str]
+) -> None:
+    """Was: ``--image-size 640x480`` refused by eval (``expected 2 arguments``)."""
+    gt = _walkers(tmp_path / "gt.txt")
+    assert main(["eval", "--gt", str(gt), "--res", str(gt), "--image-size", *size]) == 0
+    assert "100.0" in capsys.readouterr().out
+    assert build_parser().parse_args(
+        ["eval", "--gt", "g", "--res", "r", "--image-size", *size]
+    ).image_size == (640, 480)
+
+
+@pytest.mark.parametrize("command", [["eval", "--gt", "G", "--res", "R"], ["experiment", "gaps"]])
+def test_image_size_usage_reads_w_h(command: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """Was ``--image-size W [H ...]`` for experiment gaps (nargs="+")."""
+    with pytest.raises(SystemExit):
+        main([*command[:2], "--help"] if command[0] == "experiment" else [command[0], "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "[--image-size W H]" in text and "W H or WxH" in text and "None" not in text
+    assert "[H ...]" not in text
 
 
 @pytest.mark.parametrize("size", [["768"], ["768", "576", "1"], ["768x", "576"]])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -52,6 +53,57 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
         ):
             return text
         return f"{text} (default: {'none' if action.default is None else '%(default)s'})"
+
+    def _format_args(self, action: argparse.Action, default_metavar: str) -> str:
+        if isinstance(action, WidthHeight):  # was "W [H ...]": nargs="+" takes W H or WxH
+            return "W H"
+        return super()._format_args(action, default_metavar)
+
+
+class WidthHeight(argparse.Action):
+    """``--image-size``: ``W H`` (two words) or ``WxH`` (one); shown as ``W H`` in the usage.
+
+    With `number` (an argument type such as :func:`bounded_int`'s), the value is stored as a
+    ``(W, H)`` tuple of its results, a bad one refused as argparse refuses a bad type
+    (``argument --image-size: expected an integer in [1, 100000], got 0``); without, the
+    words as given, for the command to check.
+    """
+
+    def __init__(
+        self,
+        option_strings: Sequence[str],
+        dest: str,
+        number: Callable[[str], Any] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        kwargs.setdefault("metavar", ("W", "H"))
+        super().__init__(option_strings, dest, nargs="+", **kwargs)
+        self.number = number
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
+        words = [str(v) for v in (values or ())]
+        if self.number is None:
+            setattr(namespace, self.dest, words)
+            return
+        parts = words[0].lower().split("x") if len(words) == 1 else words
+        if len(parts) != 2:
+            raise argparse.ArgumentError(self, f"expected W H or WxH, got {' '.join(words)!r}")
+        size = []
+        for part in parts:
+            try:
+                size.append(self.number(part))
+            except argparse.ArgumentTypeError as exc:
+                raise argparse.ArgumentError(self, str(exc)) from None
+            except (TypeError, ValueError):
+                name = getattr(self.number, "__name__", "number")
+                raise argparse.ArgumentError(self, f"invalid {name} value: {part!r}") from None
+        setattr(namespace, self.dest, tuple(size))
 
 
 def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
