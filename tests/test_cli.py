@@ -998,10 +998,10 @@ def test_bad_option_values_are_named_in_one_line(
 @pytest.mark.parametrize(
     ("detections", "message"),
     [
-        ("nosuch.txt", "--detections nosuch.txt: no such file"),
-        ("folder", "--detections folder: is a folder, not a file"),
+        ("nosuch.txt", "--detections not found: nosuch.txt"),
+        ("folder", "--detections folder is a folder, not a file"),
         # was "detection file not found: /dev/null"
-        ("/dev/null", "--detections /dev/null: is not a regular file (a device, pipe or socket)"),
+        ("/dev/null", "--detections /dev/null is not a regular file (a device, pipe or socket)"),
     ],
 )
 def test_a_detection_file_that_is_not_a_file_is_named(

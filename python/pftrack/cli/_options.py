@@ -236,16 +236,16 @@ def check_input_file(path: str, *, what: str) -> None:
 
     p = Path(path)
     if p.is_dir():
-        raise ValueError(f"{what} {path}: is a folder, not a file")
+        raise ValueError(f"{what} {path} is a folder, not a file")
     if not p.exists():
         from pftrack.io.atomic import refuse_dash
 
         refuse_dash(path, what)
-        raise FileNotFoundError(f"{what} {path}: no such file")
+        raise FileNotFoundError(f"{what} not found: {path}")
     if not p.is_file():
-        raise ValueError(f"{what} {path}: is not a regular file (a device, pipe or socket)")
+        raise ValueError(f"{what} {path} is not a regular file (a device, pipe or socket)")
     if not os.access(p, os.R_OK):
-        raise PermissionError(f"{what} {path}: not readable")
+        raise PermissionError(f"{what} {path} is not readable")
 
 
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
@@ -292,7 +292,8 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--open-size", type=bounded_int(0, 255), default=0, metavar="PX",
-        help="built-in detector: side of the opening that cleans its mask, in pixels; 0 takes "
+        help="built-in detector: side of the opening that cleans its mask, in pixels (0 to "
+        "255); 0 takes "
         "it from the frame's rows (3 at 360 rows, 5 at 480): raise it when touching people "
         "stay joined, lower it when thin people break apart",
     )  # fmt: skip
