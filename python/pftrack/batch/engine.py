@@ -201,7 +201,7 @@ class BatchSummary:
         return "\n".join(text)
 
     def problems(self) -> list[str]:
-        """The tasks' warnings (``NAME: warning: ...``), then their errors (``NAME: error: ...``)."""
+        """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``)."""
         text = [f"{e['name']}: warning: {w}" for e in self.entries for w in e.get("warnings", ())]
         text.extend(f"{e['name']}: error: {e['error']}" for e in self.failed)
         return text

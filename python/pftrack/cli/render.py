@@ -63,8 +63,7 @@ def add_parser(sub: Any) -> None:
         type=int,
         default=40,
         metavar="FRAMES",
-        help="foot points of the last FRAMES frames drawn behind each track (0 to 100000; 0: "
-        "none)",
+        help="foot points of the last FRAMES frames drawn behind each track (0 to 100000; 0: none)",
     )
     p.add_argument("--plot", metavar="PNG",
                    help="also write a trajectory plot on the first frame: .png, .jpg "
