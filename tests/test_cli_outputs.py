@@ -176,7 +176,8 @@ def test_bad_output_is_refused_before_any_work(
     assert main(COMMANDS[command](inputs, out, tmp_path)) == 2
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"pftrack {command.split()[0]}: error: "), err
+    prog = "experiment gaps" if command.startswith("experiment") else command.split()[0]
+    assert len(lines) == 1 and lines[0].startswith(f"pftrack {prog}: error: "), err
     assert _snapshot(tmp_path) == before  # nothing changed, nothing left behind
     assert {k: p.read_bytes() for k, p in inputs.items()} == before_inputs
 
