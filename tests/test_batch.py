@@ -27,6 +27,7 @@ import numpy as np
 import pytest
 
 from pftrack.batch import (
+    BatchSummary,
     Job,
     RecoverOptions,
     SequenceInput,
@@ -232,7 +233,8 @@ def test_failing_sequence_is_reported_and_the_others_finish(
     out = tmp_path / "out"
     argv = ["batch", str(data), str(broken), "--out", str(out), "--detections", "auto", *FAST]
     assert main([*argv, "--scheduler", client.scheduler.address]) == 1
-    text = capsys.readouterr().out
+    out_text, text = capsys.readouterr()  # errors on stderr: stdout's table stays parseable
+    assert ": error:" not in out_text and "broken  " in out_text
     summary = json.loads((out / "summary.json").read_text())
     status = {s["name"]: s["status"] for s in summary["sequences"]}
     # walk.avi and plain/ have no det.txt: with --detections auto they fail too, by name
@@ -260,7 +262,7 @@ def test_a_truth_that_cannot_be_scored_keeps_the_tracks(
     out = tmp_path / "out"
     argv = ["batch", str(seq), "--out", str(out), "--workers", "0", *FAST]
     assert main(argv) == 1  # some sequence failed
-    text = capsys.readouterr().out
+    text = capsys.readouterr().err
     (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
     assert entry["status"] == "failed" and entry["frames"] == 30 and entry["metrics"] is None
     assert entry["error"].startswith(f"scoring against {seq / 'gt' / 'gt.txt'} (the tracks are")
@@ -803,7 +805,7 @@ def test_rows_that_cannot_be_written_fail_their_task_not_the_batch(
     assert single.read_text() == "earlier\n"
     out = tmp_path / "out"
     assert main(["smooth", str(folder), "--out", str(out), "--workers", "0"]) == 1  # some failed
-    assert f"\nedge: error: {message}\n" in capsys.readouterr().out
+    assert capsys.readouterr().err == f"edge: error: {message}\n"
     summary = json.loads((out / "summary.json").read_text())
     assert {e["name"]: e["status"] for e in summary["files"]} == {"edge": "failed", "fine": "done"}
     assert sorted(p.name for p in out.iterdir()) == ["fine.json", "fine.txt", "summary.json"]
@@ -1029,7 +1031,9 @@ def test_a_sequences_warnings_come_back_to_the_summary(
     (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
     assert entry["status"] == "done"
     assert len(entry["warnings"]) == 1 and entry["warnings"][0].startswith("no track over 3")
-    assert f"short: warning: {entry['warnings'][0]}" in capsys.readouterr().out
+    printed = capsys.readouterr()
+    assert printed.err == f"short: warning: {entry['warnings'][0]}\n"  # not on stdout's table
+    assert ": warning:" not in printed.out and printed.out.startswith("name ")
     # in this process too, whatever the warning filters say (pytest makes them errors here)
     serial = track_many(tmp_path / "in", tmp_path / "serial", n_workers=0)
     assert serial.entries[0]["warnings"] == entry["warnings"]
@@ -1287,7 +1291,7 @@ def test_a_broken_link_in_a_scanned_folder_fails_alone(
     assert [s.name for s in find_sequences(vids)] == ["gone", "seq", "walk"]
     out = tmp_path / "out"
     assert main(["batch", str(vids), "--out", str(out), "--workers", "0", *FAST]) == 1
-    text = capsys.readouterr().out
+    text = capsys.readouterr().err
     summary = json.loads((out / "summary.json").read_text())
     status = {e["name"]: (e["status"], e.get("error")) for e in summary["sequences"]}
     assert status == {
@@ -1484,3 +1488,28 @@ def test_a_scheduler_lost_mid_run_fails_the_tasks_left(client: Any, tmp_path: Pa
         f"the connection to the scheduler at {address} was lost before this file finished (the "
         "scheduler stopped, or the network failed; a re-run does the rest)"
     }
+
+
+def test_the_table_leaves_the_problems_to_stderr(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Warnings and errors were printed among stdout's table: a script parsing it broke."""
+    summary = BatchSummary(kind="smooth", out_dir=tmp_path, settings={"max_gap": 10})
+    summary.entries = [
+        {"name": "a", "status": "done", "ids_in": 2, "warnings": ["odd", "odder"]},
+        {"name": "b", "status": "failed", "error": "cannot read"},
+    ]
+    problems = ["a: warning: odd", "a: warning: odder", "b: error: cannot read"]
+    assert summary.problems() == problems
+    assert summary.table().splitlines()[-3:] == problems  # the library's table keeps them
+    assert summary.table(problems=False).splitlines() == summary.table().splitlines()[:-3]
+    # a recover batch prints them on stderr, its table alone on stdout
+    folder = tmp_path / "in"
+    folder.mkdir()
+    (folder / "bad.txt").write_text("not,a,row\n")
+    write_mot(folder / "fine.txt", np.array([[1, 1, 10, 10, 20, 40, 1, -1, -1, -1]], float))
+    out = tmp_path / "out"
+    assert main(["recover", str(folder), "--out", str(out), "--workers", "0"]) == 1
+    printed = capsys.readouterr()
+    assert printed.err.startswith("bad: error: ") and printed.err.count("\n") == 1
+    assert ": error:" not in printed.out and printed.out.startswith("name ")

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from pftrack.cli import main
+from pftrack.cli import build_parser, main
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.synthetic import Scene, make_scene
@@ -251,6 +251,47 @@ def test_experiment_gaps_takes_the_image_size_as_eval_does_or_as_wxh(
     assert json.loads(out.read_text())["image_size"] == [768, 576]
 
 
+def test_experiment_gaps_one_sequence_reads_the_seqinfo_beside_its_ground_truth(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: the ground truth's extent, the seqinfo.ini beside it passed over (as eval reads it)."""
+    import json
+
+    (tmp_path / "SEQ" / "gt").mkdir(parents=True)
+    gt, out = _walkers(tmp_path / "SEQ" / "gt" / "gt.txt"), tmp_path / "e.json"
+    (tmp_path / "SEQ" / "seqinfo.ini").write_text("[Sequence]\nimWidth=900\nimHeight=700\n")
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--methods", "linear", "--repeat", "1",
+            "--max-positions", "1", "--json", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    assert json.loads(out.read_text())["image_size"] == [900, 700]
+    assert f"{gt}: 15 trajectories, centre point, 900x700\n" in capsys.readouterr().out
+    assert main([*argv, "--image-size", "768x576"]) == 0  # given: it wins
+    assert json.loads(out.read_text())["image_size"] == [768, 576]
+
+
+@pytest.mark.parametrize("size", [["640x480"], ["640", "480"], ["640X480"]])
+def test_eval_takes_the_image_size_as_w_h_or_wxh(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], size: list[str]
+) -> None:
+    """Was: ``--image-size 640x480`` refused by eval (``expected 2 arguments``)."""
+    gt = _walkers(tmp_path / "gt.txt")
+    assert main(["eval", "--gt", str(gt), "--res", str(gt), "--image-size", *size]) == 0
+    assert "100.0" in capsys.readouterr().out
+    assert build_parser().parse_args(
+        ["eval", "--gt", "g", "--res", "r", "--image-size", *size]
+    ).image_size == (640, 480)
+
+
+@pytest.mark.parametrize("command", [["eval", "--gt", "G", "--res", "R"], ["experiment", "gaps"]])
+def test_image_size_usage_reads_w_h(command: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """Was ``--image-size W [H ...]`` for experiment gaps (nargs="+")."""
+    with pytest.raises(SystemExit):
+        main([*command[:2], "--help"] if command[0] == "experiment" else [command[0], "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "[--image-size W H]" in text and "W H or WxH" in text and "None" not in text
+    assert "[H ...]" not in text
+
+
 @pytest.mark.parametrize("size", [["768"], ["768", "576", "1"], ["768x", "576"]])
 def test_experiment_gaps_refuses_an_image_size_of_neither_form(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], size: list[str]
@@ -259,7 +300,7 @@ def test_experiment_gaps_refuses_an_image_size_of_neither_form(
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        f"pftrack experiment: error: --image-size is {' '.join(size)!r}, expected W H or WxH"
+        f"pftrack experiment gaps: error: --image-size is {' '.join(size)!r}, expected W H or WxH"
     )
 
 
@@ -308,7 +349,7 @@ def test_experiment_gaps_refuses_the_other_modes_options_before_work(
     argv = ["experiment", "gaps", "--gt", *(f"none{k}.txt" for k in range(gts)), *options]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"pftrack experiment: error: {message}") and err.count("\n") == 1
+    assert err.startswith(f"pftrack experiment gaps: error: {message}") and err.count("\n") == 1
     assert list(tmp_path.iterdir()) == []
 
 
@@ -325,7 +366,7 @@ def test_experiment_gaps_refuses_one_ground_truth_given_twice(
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err == (
-        f"pftrack experiment: error: --gt {gt} and {again[spelling]} are the same file; give "
+        f"pftrack experiment gaps: error: --gt {gt} and {again[spelling]} are the same file; give "
         "each sequence once\n"
     )
     assert not (tmp_path / "e.json").exists()
@@ -452,7 +493,7 @@ def test_experiment_gaps_refuses_a_sweep_of_too_many_positions(
     argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "100000x100000", "--grid", "1"]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("pftrack experiment: error: sweep: a 1 px grid over 100000 x 100000")
+    assert err.startswith("pftrack experiment gaps: error: sweep: a 1 px grid over 100000 x 100000")
     assert "more than the limit of 1000000; use a coarser grid" in err and "\n" not in err
 
 
@@ -957,10 +998,10 @@ def test_bad_option_values_are_named_in_one_line(
 @pytest.mark.parametrize(
     ("detections", "message"),
     [
-        ("nosuch.txt", "--detections nosuch.txt: no such file"),
-        ("folder", "--detections folder: is a folder, not a file"),
+        ("nosuch.txt", "--detections not found: nosuch.txt"),
+        ("folder", "--detections folder is a folder, not a file"),
         # was "detection file not found: /dev/null"
-        ("/dev/null", "--detections /dev/null: is not a regular file (a device, pipe or socket)"),
+        ("/dev/null", "--detections /dev/null is not a regular file (a device, pipe or socket)"),
     ],
 )
 def test_a_detection_file_that_is_not_a_file_is_named(

@@ -670,3 +670,57 @@ def test_every_option_shows_its_default(capsys: pytest.CaptureFixture[str]) -> N
     text = " ".join(capsys.readouterr().out.split())
     assert "recovery method (default: auto)" in text and "(default: 30)" in text
     assert "--link join fragments of one object first --max-distance" in text  # flags: no noise
+
+
+LATE_CTRL_C = """
+import os, signal, sys
+import pftrack.cli.{module} as command
+from pftrack._console import main
+
+real = command.{hook}
+
+def late(*args, **kwargs):  # once the outputs are in place: Ctrl-C
+    os.kill(os.getpid(), signal.SIGINT)
+    return real(*args, **kwargs)
+
+command.{hook} = late
+sys.argv = ["pftrack", *{argv!r}]
+sys.exit(main())
+"""
+
+
+@pytest.mark.parametrize("command", ["track", "render", "smooth", "recover"])
+def test_ctrl_c_after_the_outputs_are_written_does_not_fail_the_run(
+    scene: Scene, tmp_path: Path, command: str
+) -> None:
+    """Was: exit status 130 and no word after the output was written (or "no output was
+    changed", when it was). The run finishes: exit status 0, its summary."""
+    video = scene.write_video(tmp_path / "scene.avi")
+    tracks = scene.write_truth(tmp_path / "gt.txt")
+    out = tmp_path / ("o.mp4" if command == "render" else "o.txt")
+    argv = {
+        "track": ["track", str(video), "--out", str(out), "--particles", "20"],
+        "render": ["render", str(video), str(tracks), "--out", str(out)],
+        "smooth": ["smooth", str(tracks), "--out", str(out)],
+        "recover": ["recover", str(tracks), "--out", str(out)],
+    }[command]
+    hook = "_outside" if command == "render" else "report_stream"
+    code = LATE_CTRL_C.format(module=command, hook=hook, argv=argv)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+        timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "interrupted" not in proc.stderr and f"-> {out}" in proc.stdout
+    assert out.stat().st_size > 0
+
+
+def test_held_interrupts_are_restored_when_the_command_returns(
+    scene: Scene, tmp_path: Path
+) -> None:
+    """In a process that goes on (a caller of main), Ctrl-C works again after the command."""
+    tracks = scene.write_truth(tmp_path / "gt.txt")
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    assert main(["smooth", str(tracks), "--out", str(tmp_path / "o.txt")]) == 0
+    assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before

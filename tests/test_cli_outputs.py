@@ -176,7 +176,8 @@ def test_bad_output_is_refused_before_any_work(
     assert main(COMMANDS[command](inputs, out, tmp_path)) == 2
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"pftrack {command.split()[0]}: error: "), err
+    prog = "experiment gaps" if command.startswith("experiment") else command.split()[0]
+    assert len(lines) == 1 and lines[0].startswith(f"pftrack {prog}: error: "), err
     assert _snapshot(tmp_path) == before  # nothing changed, nothing left behind
     assert {k: p.read_bytes() for k, p in inputs.items()} == before_inputs
 
@@ -711,3 +712,65 @@ def test_names_the_terminal_cannot_encode_are_escaped(
         assert run.returncode == 0 and run.stderr == b"", run.stderr
         assert shown in run.stdout and b"t\\xf6.txt" in run.stdout
         assert (tmp_path / out).stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["demo", "--out-dir", "-", "--frames", "5"], ["batch", "{video}", "--out", "-"],
+     ["recover", "{tracks}", "{gt}", "--out", "-"], ["smooth", "{tracks}", "{gt}", "--out", "-"]],
+)  # fmt: skip
+def test_dash_as_an_output_folder_is_refused(
+    argv: list[str],
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Was: a folder named ``-`` created and written (output files refused ``-`` already)."""
+    monkeypatch.chdir(tmp_path)
+    argv = [a.format(**{k: str(p) for k, p in inputs.items()}) for a in argv]
+    assert main([*argv, *(["--workers", "0"] if argv[0] != "demo" else [])]) == 2
+    what = "--out-dir" if argv[0] == "demo" else "--out"
+    assert capsys.readouterr().err == (
+        f"pftrack {argv[0]}: error: {what} -: standard output is not supported by name '-'; "
+        "give a folder name\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("argv", "what"),
+    [(["track", "-", "--out", "o.txt"], "video source"),
+     (["render", "-", "{tracks}", "--out", "o.mp4"], "video source"),
+     (["render", "{video}", "-", "--out", "o.mp4"], "tracks file"),
+     (["recover", "-", "--out", "o.txt"], "tracks file"),
+     (["smooth", "-", "--out", "o.txt"], "tracks file"),
+     (["eval", "--gt", "-", "--res", "{tracks}"], "--gt"),
+     (["eval", "--gt", "{gt}", "--res", "-"], "--res"),
+     (["batch", "-", "--out", "o", "--workers", "0"], "input"),
+     (["smooth", "-", "{tracks}", "--out", "o", "--workers", "0"], "input")],
+)  # fmt: skip
+def test_dash_as_an_input_says_standard_input_is_not_read(
+    argv: list[str],
+    what: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Was: ``tracks file not found: -``, ``video source not found: -``, as if a file was meant."""
+    monkeypatch.chdir(tmp_path)
+    assert main([a.format(**{k: str(p) for k, p in inputs.items()}) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pftrack {argv[0]}: error: {what} -: standard input is not ")
+    assert "supported by name '-'; give a " in err and err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_file_named_dash_is_still_read(
+    inputs: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "-").write_bytes(inputs["tracks"].read_bytes())
+    assert main(["smooth", "-", "--out", "o.txt"]) == 0
+    assert (tmp_path / "o.txt").stat().st_size > 0

@@ -88,7 +88,15 @@ def test_bad_input_is_one_line_and_nothing_is_lost(
         assert text.count("\n") == 0 and text.startswith("pftrack render: error: "), text
         return text
 
-    assert "no such file" in error(str(video), str(tmp_path / "none.txt"), "--out", str(kept))
+    # as recover and smooth word it (was "tracks file PATH: no such file")
+    none = tmp_path / "none.txt"
+    assert error(str(video), str(none), "--out", str(kept)).endswith(
+        f"error: tracks file not found: {none}"
+    )
+    # was "tracks file /dev/stdin: is not a regular file" (a stray colon)
+    assert error(str(video), "/dev/null", "--out", str(kept)).endswith(
+        "error: tracks file /dev/null is not a regular file (a device, pipe or socket)"
+    )
     assert ".webm" in error(str(video), str(truth), "--out", str(tmp_path / "v.webm"))
     assert "--trail is -1" in error(str(video), str(truth), "--out", str(kept), "--trail", "-1")
     bad = tmp_path / "bad.txt"
@@ -97,3 +105,23 @@ def test_bad_input_is_one_line_and_nothing_is_lost(
     before = video.read_bytes()
     assert "is an input" in error(str(video), str(truth), "--out", str(video))  # never the input
     assert kept.read_bytes() == b"earlier" and video.read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    ("command", "option", "limits"),
+    [(["render", "V", "T", "--out", "O"], "--trail", "0 to 100000"),
+     (["demo"], "--particles", "1 to 100000"),
+     (["track", "V", "--out", "O"], "--open-size", "0 to 255")],
+)  # fmt: skip
+def test_help_states_the_limits_it_enforces(
+    command: list[str], option: str, limits: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit):
+        main([command[0], "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert limits in text.split(f"{option} ")[-1].split(" --")[0]  # its help, not the usage
+    try:  # enforced: refused by argparse (SystemExit) or by the command (exit status 2)
+        status = main([*command, option, "100001" if "100000" in limits else "256"])
+    except SystemExit as exc:
+        status = exc.code  # type: ignore[assignment]
+    assert status == 2

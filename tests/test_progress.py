@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import io
+import os
+import select
+import struct
 import sys
+from collections.abc import Callable
 
 import pytest
 
@@ -69,3 +73,48 @@ def test_bar_moved_by_hand(monkeypatch: pytest.MonkeyPatch) -> None:
         assert not bar.enabled
         bar.set(5)  # nothing drawn, no error
     set_quiet(False)
+
+
+def _on_a_terminal(
+    monkeypatch: pytest.MonkeyPatch, rows: int, cols: int, draw: Callable[[], None]
+) -> str:
+    """What `draw` writes on stderr when it is a pseudo-terminal of `rows` x `cols` (0: unset)."""
+    pty = pytest.importorskip("pty")
+    fcntl = pytest.importorskip("fcntl")
+    termios = pytest.importorskip("termios")
+    master, slave = pty.openpty()
+    try:
+        fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", rows, cols, 0, 0))
+        err = open(slave, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+        monkeypatch.setattr(sys, "stderr", err)
+        assert err.isatty()
+        draw()
+        err.flush()
+        out = b""
+        while select.select([master], [], [], 0.2)[0]:
+            out += os.read(master, 65536)
+        return out.decode("utf-8", "replace")
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+@pytest.mark.parametrize(("rows", "cols"), [(0, 0), (0, 120), (30, 0), (30, 120)])
+def test_bar_is_drawn_on_a_terminal_of_any_size(
+    monkeypatch: pytest.MonkeyPatch, rows: int, cols: int
+) -> None:
+    """A terminal whose size is unset (``script``'s, CI runners') hid every bar: -1 lines."""
+
+    def draw() -> None:
+        with _progress.Bar(795, desc="0/1 sequences", unit="frame") as bar:
+            for n in [*range(0, 795, 100), 795]:
+                bar.set(n)
+        assert list(progress(range(5), desc="work", unit="gap")) == list(range(5))
+
+    text = _on_a_terminal(monkeypatch, rows, cols, draw)
+    assert "0/1 sequences" in text and "795/795" in text and "frame/s" in text
+    assert "5/5" in text and "gap/s" in text and "more hidden" not in text
+
+
+def test_screen_shape_of_an_unset_terminal_is_unknown() -> None:
+    assert _progress.screen_shape(io.StringIO()) == (None, None)  # not a terminal

@@ -39,8 +39,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         (while the command line is imported or its arguments parsed).
     """
     try:
+        from pftrack.cli import _signals
         from pftrack.cli import main as run
 
+        # the process ends with the command: a Ctrl-C once its outputs are in place is ignored
+        # to the exit (was: exit status 130, no word, after the output was written)
+        _signals.PROCESS_ENDS = argv is None
         return run(argv)
     except KeyboardInterrupt:  # before the command's own handler: nothing was written yet
         words = sys.argv[1:] if argv is None else argv

@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import threading
 from collections.abc import Iterable, Iterator
@@ -78,7 +79,7 @@ def _tqdm(items: Iterable[Any] | None = None, **kwargs: Any) -> Any:
     """
     from tqdm import tqdm
 
-    return tqdm(
+    bar = tqdm(
         items,
         file=sys.stderr,
         dynamic_ncols=True,
@@ -87,6 +88,26 @@ def _tqdm(items: Iterable[Any] | None = None, **kwargs: Any) -> Any:
         delay=DELAY,
         **kwargs,
     )
+    if bar.dynamic_ncols:  # tqdm's own reads a terminal of 0 lines as "no room for a bar"
+        bar.dynamic_ncols = screen_shape
+        bar.ncols, bar.nrows = screen_shape(bar.fp)
+    return bar
+
+
+def screen_shape(stream: Any) -> tuple[int | None, int | None]:
+    """The ``(columns, lines)`` a bar on `stream` may use; None where the terminal does not say.
+
+    tqdm's size check. A terminal whose size is unset reports 0 columns and 0 lines (the
+    pseudo-terminal of ``script``, of some CI runners and containers): tqdm took that as -1
+    lines and hid every bar as if it were below the screen's last line (`pftrack batch`
+    drew nothing). An unknown size is None here: tqdm's defaults (a bar of 10 characters,
+    20 lines).
+    """
+    try:
+        cols, lines = os.get_terminal_size(stream.fileno())
+    except (AttributeError, OSError, ValueError):  # not a terminal, closed, replaced
+        return None, None
+    return (cols - 1 if cols > 1 else None), (lines - 1 if lines > 1 else None)
 
 
 class Bar:

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from pftrack.eval import evaluate_mot, format_metrics
-from pftrack.io.atomic import check_output, staged_outputs
+from pftrack.io.atomic import check_output, refuse_dash, staged_outputs
 from pftrack.io.mot import write_mot
 from pftrack.recovery.demo import demo_report
 from pftrack.render import plot_trajectories, write_annotated_video
@@ -25,6 +25,7 @@ def run_demo(out_dir: Path, *, seed: int = 0, n_frames: int = 150, particles: in
     """
     from dataclasses import replace
 
+    refuse_dash(out_dir, "--out-dir", output=True, name="folder")
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out-dir {out_dir} is a file; give a folder")
     try:

@@ -446,7 +446,9 @@ def test_empty_ground_truth_or_results_score_as_trackeval():
         assert (m.mota, m.motp_iou, m.idf1, m.idp, m.idr) == (0.0, 0.0, 0.0, 0.0, 0.0)
         assert (m.precision, m.recall) == (0.0, 0.0)
         assert s.hota.hota == 0.0 and s.hota.loc_a_mean == 1.0
-        assert "nan" not in format_scores({"s": s}).split("\n")[1].split()[:-1]  # Succ: none
+        line = format_scores({"s": s}).split("\n")[1].split()
+        assert "nan" not in line and "-" not in line[:-1]  # Succ: none without ground truth
+        assert line[-1] == ("-" if len(gt) == 0 else "0.0")  # was "nan"; JSON: null
     no_gt = evaluate_mot(none, HAND_RES)
     # combined as TrackEval's combine_sequences: (TP - FP - IDSW) / max(1, TP + FN)
     assert combine_mot([no_gt]).mota == -float(no_gt.false_positives)
@@ -489,3 +491,13 @@ def test_hota_metrics_docstring_says_which_fields_are_arrays():
     for name in arrays:
         assert getattr(h, name).shape == (19,) and f"``{name}``" in doc, name
     assert "float (mean over the 19 thresholds)" in doc
+
+
+def test_a_missing_value_reads_dash_in_the_text_tables():
+    """Was ``nan`` (the JSON keeps null): CD/px without an image size, Succ without truth."""
+    from pftrack.eval import evaluate_sequence, format_scores
+
+    line = format_metrics(evaluate_mot(HAND_GT, HAND_RES)).splitlines()[1].split()
+    assert line[-1] == "-" and "nan" not in line  # CD/px: no image size given
+    row = format_scores({"s": evaluate_sequence(np.zeros((0, 10)), HAND_RES)}).splitlines()[1]
+    assert row.split()[-1] == "-" and "nan" not in row

@@ -405,8 +405,9 @@ def test_every_command_refuses_an_empty_field_by_file_line_and_column(
     ):  # fmt: skip
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
-        assert err.startswith(f"pftrack {argv[0]}: error: {message}") and err.count("\n") == 1
+        prog = " ".join(argv[:2]) if argv[0] == "experiment" else argv[0]  # its sub-command
+        assert err.startswith(f"pftrack {prog}: error: {message}") and err.count("\n") == 1
     assert sorted(os.listdir(tmp_path)) == ["SEQ", "eid.txt", "good.txt"]
     # many files: the file fails by name, as any bad file of a batch (the others are done)
     assert main(["batch", "SEQ", "--detections", "auto", "--out", "b", "-q"]) == 1
-    assert "det.txt:2: detection file line has an empty column 3 (left)" in capsys.readouterr().out
+    assert "det.txt:2: detection file line has an empty column 3 (left)" in capsys.readouterr().err

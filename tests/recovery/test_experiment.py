@@ -132,7 +132,7 @@ def test_a_bad_seqinfo_is_named_with_its_key_and_value(
     (seq / "seqinfo.ini").write_text(f"[Sequence]\n{ini}\n")  # one folder up: read too
     assert main(["experiment", "gaps", "--gt", str(seq / "gt" / "gt.txt"), "--auto-masks"]) == 2
     err = capsys.readouterr().err
-    assert err.startswith(f"pftrack experiment: error: {seq / 'seqinfo.ini'}: {message}"), err
+    assert err.startswith(f"pftrack experiment gaps: error: {seq / 'seqinfo.ini'}: {message}"), err
     assert err.count("\n") == 1
 
 
@@ -144,7 +144,7 @@ def test_too_small_an_image_size_is_named_for_its_sequence(
     argv = ["experiment", "gaps", "--gt", str(gt), "--auto-masks", "--image-size", "768x50"]
     assert main(argv) == 2
     assert capsys.readouterr().err == (
-        f"pftrack experiment: error: {gt}: --image-size 768x50 cannot hold the masks: their "
+        f"pftrack experiment gaps: error: {gt}: --image-size 768x50 cannot hold the masks: their "
         "side is round(100 W/768) = 100 px\n"
     )
 
@@ -168,7 +168,7 @@ def test_a_sequence_without_a_gap_says_so_and_the_pooled_figures_leave_it_out(
     said = capsys.readouterr()
     assert "nan" not in said.out
     assert said.err == (
-        "pftrack experiment: warning: tiny: no gap under any mask (no mask position cuts a "
+        "pftrack experiment gaps: warning: tiny: no gap under any mask (no mask position cuts a "
         "trajectory that is observed on both sides of it): no MMAE, and nothing of it in the "
         "pooled figures\n"
     )
@@ -186,7 +186,7 @@ def test_a_sequence_without_a_gap_says_so_and_the_pooled_figures_leave_it_out(
         assert main(argv) == 0
     said = capsys.readouterr()
     assert "pooled           0  no gaps in any sequence: no MMAE" in said.out
-    assert said.err.startswith("pftrack experiment: warning: tiny: no gap under any mask")
+    assert said.err.startswith("pftrack experiment gaps: warning: tiny: no gap under any mask")
 
 
 def test_python_errors_name_the_function_and_argument() -> None:

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._progress import Bar, enabled, progress
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
-from pftrack.io.atomic import atomic_write, check_output
+from pftrack.io.atomic import atomic_write, check_output, refuse_dash
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
 
@@ -154,8 +154,15 @@ class BatchSummary:
         """JSON text of :meth:`as_dict`."""
         return json.dumps(self.as_dict(), indent=2)
 
-    def table(self) -> str:
-        """A text table: one line per task, then the totals."""
+    def table(self, problems: bool = True) -> str:
+        """A text table: one line per task, then the totals, the notes and the problems.
+
+        Parameters
+        ----------
+        problems : bool
+            End with :meth:`problems`' lines (each task's warnings and errors); ``pftrack``
+            prints the table without them on stdout, and them on stderr.
+        """
         cols = _COLUMNS[self.kind]
         head = ["name", "status"] + [c for c, _, _ in cols]
         lines = [head]
@@ -189,10 +196,15 @@ class BatchSummary:
 
                 note = unfilled_note(e["long_holes"], e["longest_hole"], self.settings["max_gap"])
                 text.append(f"{e['name']}: {note}")
-            text.extend(f"{e['name']}: warning: {w}" for w in e.get("warnings", ()))
-        for e in self.failed:
-            text.append(f"{e['name']}: error: {e['error']}")
+        if problems:
+            text.extend(self.problems())
         return "\n".join(text)
+
+    def problems(self) -> list[str]:
+        """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``)."""
+        text = [f"{e['name']}: warning: {w}" for e in self.entries for w in e.get("warnings", ())]
+        text.extend(f"{e['name']}: error: {e['error']}" for e in self.failed)
+        return text
 
 
 _STATUSES = ("done", "skipped", "failed", "cancelled")
@@ -896,6 +908,7 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
 
 def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) -> None:
     """Before any work, writing nothing: no output overwrites an input or is a folder."""
+    refuse_dash(out_dir, "--out", output=True, name="folder")
     if out_dir.exists() and not out_dir.is_dir():
         raise ValueError(f"--out {out_dir} is a file; give a folder")
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pftrack._typing import PathLike
+from pftrack.io.atomic import refuse_dash
 from pftrack.io.video import (
     IMAGE_SUFFIXES,
     VIDEO_SUFFIXES,
@@ -70,6 +71,8 @@ def _absolute(inputs: Inputs) -> list[Path]:
     paths = [inputs] if isinstance(inputs, (str, os.PathLike)) else list(inputs)
     if not paths:
         raise ValueError("no input given")
+    for p in paths:  # was: "input not found: /cwd/-"
+        refuse_dash(p, "input", name="file or folder")
     return [Path(os.path.abspath(p)) for p in paths]
 
 

@@ -100,11 +100,14 @@ def _one_line(exc: BaseException) -> str:
     return _shown(text)
 
 
-def _one_line_warning(command: str) -> Callable[..., None]:
-    """A ``warnings.showwarning`` printing ``pftrack CMD: warning: ...`` (no source line)."""
+def _one_line_warning(prog: str) -> Callable[..., None]:
+    """A ``warnings.showwarning`` printing ``PROG: warning: ...`` (no source line).
+
+    `prog` names the command as its parser does: ``pftrack track``, ``pftrack experiment gaps``.
+    """
 
     def show(message: Warning | str, *_: object, **__: object) -> None:
-        print(f"pftrack {command}: warning: {_shown(str(message))}", file=sys.stderr)
+        print(f"{prog}: warning: {_shown(str(message))}", file=sys.stderr)
 
     return show
 
@@ -206,15 +209,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pftrack`` script; returns the exit status."""
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
+    command = _command_parser(parser, args)
     if extra:  # named by the command's own parser: its usage, "pftrack smooth: error: ..."
-        _command_parser(parser, args).error(f"unrecognized arguments: {' '.join(extra)}")
+        command.error(f"unrecognized arguments: {' '.join(extra)}")
+    # "pftrack experiment gaps: error: ..." as argparse names it (was: "pftrack experiment")
+    prog = str(command.prog)
     if args.quiet:
         from pftrack._progress import set_quiet
 
         set_quiet(True)
     try:
         with warnings.catch_warnings(), _quiet_opencv(), _names_on_stdout(), sigterm_raises():
-            warnings.showwarning = _one_line_warning(args.command)
+            warnings.showwarning = _one_line_warning(prog)
             status = int(args.func(args))
         if sys.stdout is not None:  # a buffered stdout's last lines: a closed pipe fails here
             sys.stdout.flush()
@@ -225,18 +231,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (OSError, ValueError, TypeError) as exc:  # OSError: missing, unwritable, full disk
         left = outcome(exc)  # a live track run's rows so far: where they are
         said = f"; {_shown(left)}" if left else ""
-        print(f"pftrack {args.command}: error: {_one_line(exc)}{said}", file=sys.stderr)
+        print(f"{prog}: error: {_one_line(exc)}{said}", file=sys.stderr)
         return 2
     except MemoryError as exc:
         left = outcome(exc)
         said = f"; {_shown(left)}" if left else ""
-        print(f"pftrack {args.command}: error: out of memory{said}", file=sys.stderr)
+        print(f"{prog}: error: out of memory{said}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:  # outputs are atomic: nothing half-written is left behind
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         left = _shown(outcome(exc) or NOTHING_CHANGED)
         # the line break ends a progress bar's line, drawn only on a terminal
-        print(f"{line_end()}pftrack {args.command}: {how}; {left}", file=sys.stderr)
+        print(f"{line_end()}{prog}: {how}; {left}", file=sys.stderr)
         return exit_status(exc)
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -52,6 +53,57 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
         ):
             return text
         return f"{text} (default: {'none' if action.default is None else '%(default)s'})"
+
+    def _format_args(self, action: argparse.Action, default_metavar: str) -> str:
+        if isinstance(action, WidthHeight):  # was "W [H ...]": nargs="+" takes W H or WxH
+            return "W H"
+        return super()._format_args(action, default_metavar)
+
+
+class WidthHeight(argparse.Action):
+    """``--image-size``: ``W H`` (two words) or ``WxH`` (one); shown as ``W H`` in the usage.
+
+    With `number` (an argument type such as :func:`bounded_int`'s), the value is stored as a
+    ``(W, H)`` tuple of its results, a bad one refused as argparse refuses a bad type
+    (``argument --image-size: expected an integer in [1, 100000], got 0``); without, the
+    words as given, for the command to check.
+    """
+
+    def __init__(
+        self,
+        option_strings: Sequence[str],
+        dest: str,
+        number: Callable[[str], Any] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        kwargs.setdefault("metavar", ("W", "H"))
+        super().__init__(option_strings, dest, nargs="+", **kwargs)
+        self.number = number
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
+        words = [str(v) for v in (values or ())]
+        if self.number is None:
+            setattr(namespace, self.dest, words)
+            return
+        parts = words[0].lower().split("x") if len(words) == 1 else words
+        if len(parts) != 2:
+            raise argparse.ArgumentError(self, f"expected W H or WxH, got {' '.join(words)!r}")
+        size = []
+        for part in parts:
+            try:
+                size.append(self.number(part))
+            except argparse.ArgumentTypeError as exc:
+                raise argparse.ArgumentError(self, str(exc)) from None
+            except (TypeError, ValueError):
+                name = getattr(self.number, "__name__", "number")
+                raise argparse.ArgumentError(self, f"invalid {name} value: {part!r}") from None
+        setattr(namespace, self.dest, tuple(size))
 
 
 def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
@@ -184,13 +236,16 @@ def check_input_file(path: str, *, what: str) -> None:
 
     p = Path(path)
     if p.is_dir():
-        raise ValueError(f"{what} {path}: is a folder, not a file")
+        raise ValueError(f"{what} {path} is a folder, not a file")
     if not p.exists():
-        raise FileNotFoundError(f"{what} {path}: no such file")
+        from pftrack.io.atomic import refuse_dash
+
+        refuse_dash(path, what)
+        raise FileNotFoundError(f"{what} not found: {path}")
     if not p.is_file():
-        raise ValueError(f"{what} {path}: is not a regular file (a device, pipe or socket)")
+        raise ValueError(f"{what} {path} is not a regular file (a device, pipe or socket)")
     if not os.access(p, os.R_OK):
-        raise PermissionError(f"{what} {path}: not readable")
+        raise PermissionError(f"{what} {path} is not readable")
 
 
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
@@ -237,7 +292,8 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument(
         "--open-size", type=bounded_int(0, 255), default=0, metavar="PX",
-        help="built-in detector: side of the opening that cleans its mask, in pixels; 0 takes "
+        help="built-in detector: side of the opening that cleans its mask, in pixels (0 to "
+        "255); 0 takes "
         "it from the frame's rows (3 at 360 rows, 5 at 480): raise it when touching people "
         "stay joined, lower it when thin people break apart",
     )  # fmt: skip

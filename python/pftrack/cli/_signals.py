@@ -22,6 +22,7 @@ __all__ = [
     "EXIT_TERMINATED",
     "Terminated",
     "exit_status",
+    "hold_interrupts",
     "line_end",
     "outcome",
     "set_outcome",
@@ -76,18 +77,53 @@ def _raise_terminated(signum: int, frame: Any) -> None:
     raise Terminated
 
 
+#: Set by the ``pftrack`` console script (:mod:`pftrack._console`): the process ends with the
+#: command, so interrupts held by :func:`hold_interrupts` stay ignored until it exits.
+PROCESS_ENDS = False
+_held = [False]  # hold_interrupts was called in this command
+
+
+def _stopping_signals() -> list[signal.Signals]:
+    return [getattr(signal, name) for name in ("SIGINT", "SIGTERM") if hasattr(signal, name)]
+
+
+def hold_interrupts() -> None:
+    """From here to the command's end, Ctrl-C and SIGTERM are ignored: its work is done.
+
+    A command calls it just before its outputs are put in place (the end of its
+    :func:`~pftrack.io.atomic.staged_outputs` block), or once its one output is: what is left
+    is renaming, printing the summary and exiting. A late Ctrl-C ended such a run with exit
+    status 130 and no word after the output was written (or "no output was changed" when it
+    was); now the run finishes, exit status 0 with its summary. :func:`sigterm_raises`
+    restores the handlers when the command ends, unless :data:`PROCESS_ENDS`. Only in the
+    main thread (elsewhere it does nothing).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for sig in _stopping_signals():
+        signal.signal(sig, signal.SIG_IGN)
+    _held[0] = True
+
+
 @contextlib.contextmanager
 def sigterm_raises() -> Iterator[None]:
-    """While the block runs, SIGTERM raises :class:`Terminated`; the previous handler after.
+    """While the block runs, SIGTERM raises :class:`Terminated`; the previous handlers after.
 
     Only in the main thread (Python runs signal handlers there; another thread cannot set
-    one), and only where the platform has SIGTERM.
+    one), and only where the platform has SIGTERM. SIGINT's handler is restored too, after
+    :func:`hold_interrupts` (not when :data:`PROCESS_ENDS`: then they stay ignored to the end).
     """
     if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "SIGTERM"):
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    previous = {sig: signal.getsignal(sig) for sig in _stopping_signals()}
+    signal.signal(signal.SIGTERM, _raise_terminated)
+    _held[0] = False
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        if not (_held[0] and PROCESS_ENDS):
+            for sig, handler in previous.items():
+                if handler is not None:  # None: set outside Python, cannot be restored
+                    signal.signal(sig, handler)
+        _held[0] = False

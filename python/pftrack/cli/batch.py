@@ -174,7 +174,11 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
     for e in summary.entries if explain else ():
         if e.get("explain"):
             print(f"{e['name']}:\n{e['explain']}")
-    print(summary.table())
+    print(summary.table(problems=False))
+    problems = summary.problems()
+    if problems:  # on stderr: stdout's table stays parseable
+        sys.stdout.flush()
+        print("\n".join(problems), file=sys.stderr)
     print(f"summary -> {summary.out_dir / 'summary.json'}")
     return EXIT_SOME_FAILED if summary.failed else 0
 

@@ -27,7 +27,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--frames", type=bounded_int(1, 1000), default=150,
                    help="scene length (1 to 1000: the scene is held in memory)")  # fmt: skip
     p.add_argument("--particles", type=bounded_int(1, 100_000), default=100,
-                   help="particles per object")  # fmt: skip
+                   help="particles per object (1 to 100000)")  # fmt: skip
     p.set_defaults(func=run)
 
 

@@ -8,6 +8,7 @@ from typing import Any
 
 from pftrack.cli._options import (
     IOU_HELP,
+    WidthHeight,
     add_command,
     bounded_int,
     iou_threshold,
@@ -76,12 +77,13 @@ def add_parser(sub: Any) -> None:
         "visibilities, else MOT15",
     )  # fmt: skip
     p.add_argument("--seqs", nargs="+", metavar="NAME", default=None,
-                   help="score only these sequences of a folder; None: all")  # fmt: skip
-    p.add_argument("--image-size", type=bounded_int(1, MAX_IMAGE_SIDE), nargs=2,
-                   metavar=("W", "H"), default=None,
-                   help=f"image size for the centroid-distance ratio (px, 1 to "
-                   f"{MAX_IMAGE_SIDE}); None: seqinfo.ini's size times the scale, if "
-                   "any")  # fmt: skip
+                   help="score only these sequences of a folder (default: all of "
+                   "them)")  # fmt: skip
+    p.add_argument("--image-size", action=WidthHeight, number=bounded_int(1, MAX_IMAGE_SIDE),
+                   default=None,
+                   help=f"image size for the centroid-distance ratio, W H or WxH (px, 1 to "
+                   f"{MAX_IMAGE_SIDE}; default: seqinfo.ini's size times the scale, where there "
+                   "is one)")  # fmt: skip
     p.add_argument(
         "--no-scale-check", action="store_true",
         help="score even when result boxes look like another pixel scale than the ground truth",
@@ -127,8 +129,11 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
     """(name, SequenceInfo, result file) of every sequence to score, checked before work."""
     from pftrack.eval import find_sequences
     from pftrack.eval.sequences import result_file, sequence_of_file
+    from pftrack.io.atomic import refuse_dash
 
     gt, res = Path(args.gt), Path(args.res)
+    refuse_dash(args.gt, "--gt", name="file or folder")
+    refuse_dash(args.res, "--res", name="file or folder")
     if not gt.exists():
         raise FileNotFoundError(f"ground truth not found: {gt} (a MOTChallenge file or folder)")
     for what, given in (("--gt", gt), ("--res", res)):

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli._options import (
+    WidthHeight,
     add_command,
     bounded_float,
     non_negative_int,
@@ -80,11 +81,12 @@ def add_parser(sub: Any) -> None:
     g.add_argument("--grid", type=bounded_float(0.1, MAX_SIDE), default=None, metavar="PX",
                    help=f"one sequence: mask position step of the sweep (px, 0.1 to "
                    f"{MAX_SIDE:g}; default: {DEFAULTS['grid']:g})")  # fmt: skip
-    g.add_argument("--image-size", nargs="+", metavar=("W", "H"),
-                   help="image size of the ground-truth coordinates, W H (as pftrack eval "
-                   "takes it) or WxH (px, each in (0, 100000]) (default: the ground truth's "
-                   "extent; multi-sequence: used only for sequences without seqinfo.ini, "
-                   "which need it)")  # fmt: skip
+    g.add_argument("--image-size", action=WidthHeight,
+                   help="image size of the ground-truth coordinates, W H or WxH, as pftrack "
+                   "eval takes it (px, each in (0, 100000]) (default: imWidth x imHeight of "
+                   "the seqinfo.ini beside the ground truth or one folder up, else the ground "
+                   "truth's extent; multi-sequence: used only for sequences without "
+                   "seqinfo.ini, which need it)")  # fmt: skip
     g.add_argument("--trajectories", type=non_negative_int, metavar="N",
                    help="one sequence: keep positions with exactly this many (default: any "
                    "number)")  # fmt: skip
@@ -271,8 +273,11 @@ def run_gaps(args: argparse.Namespace) -> int:
     if len(gt) == 0:
         raise ValueError(f"ground truth {args.gt} is empty")
     methods = _methods(args.methods)
+    info = None if args.image_size else _seqinfo(args.gt)  # as eval and multi-sequence read it
     if args.image_size:
         width, height = _parse_size(args.image_size)
+    elif info is not None:  # was: the ground truth's extent, seqinfo.ini passed over
+        _, width, height = info
     else:
         width = float(np.ceil(np.max(gt[:, 2] + gt[:, 4])))
         height = float(np.ceil(np.max(gt[:, 3] + gt[:, 5])))

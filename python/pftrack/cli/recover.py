@@ -80,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     if args.video and not args.link:
         raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
+    from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
@@ -117,6 +118,7 @@ def run(args: argparse.Namespace) -> int:
     filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
     dt = time.perf_counter() - t0
     write_mot(args.out, filled, exact=copied_values(rows, filled))  # given values: all digits
+    hold_interrupts()  # --out is written: a late Ctrl-C does not fail the run
     to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report on stderr
     print(
         f"{src}: {counted(len(rows), 'row')}, {counted(n_links, 'fragment')} linked, "

@@ -63,7 +63,7 @@ def add_parser(sub: Any) -> None:
         type=int,
         default=40,
         metavar="FRAMES",
-        help="foot points of the last FRAMES frames drawn behind each track (0: none)",
+        help="foot points of the last FRAMES frames drawn behind each track (0 to 100000; 0: none)",
     )
     p.add_argument("--plot", metavar="PNG",
                    help="also write a trajectory plot on the first frame: .png, .jpg "
@@ -76,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from pftrack.cli._options import opencv_single_threaded
+    from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_distinct, check_output, output_format, staged_outputs
     from pftrack.io.video import FrameSource, check_source, is_live_source, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES
@@ -120,6 +121,7 @@ def run(args: argparse.Namespace) -> int:
             if args.plot:
                 plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))
                 plot_trajectories(plot, rows, background=kept[0], title=source.name)
+            hold_interrupts()  # the work is done: the outputs are put in place whatever comes
     late = rows[rows[:, 0] > drawn[0]]
     notes = [str(w.message) for w in caught] + _outside(rows, source.width, source.height)
     if len(late):

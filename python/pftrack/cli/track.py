@@ -218,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from pftrack.cli._options import opencv_single_threaded
-    from pftrack.cli._signals import set_outcome
+    from pftrack.cli._signals import hold_interrupts, set_outcome
     from pftrack.io.atomic import (
         SideFile,
         atomic_write,
@@ -328,6 +328,7 @@ def run(args: argparse.Namespace) -> int:
                     plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))  # device: png
                     plot_trajectories(plot, result.rows, background=first[0], title=name)
                     said.append(f"trajectory plot -> {args.plot}")
+                hold_interrupts()  # the work is done: the outputs are put in place whatever comes
             committed = True
     except BaseException as exc:
         if renderer is not None:

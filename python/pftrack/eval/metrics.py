@@ -151,7 +151,7 @@ class MotMetrics:
 
 
 def _pct(x: float) -> str:
-    return "nan" if not math.isfinite(x) else f"{100.0 * x:.1f}"
+    return "-" if not math.isfinite(x) else f"{100.0 * x:.1f}"  # "-": no value (JSON: null)
 
 
 def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
@@ -204,7 +204,7 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
         (
             "CD(px)",
             lambda r: (
-                "nan"
+                "-"
                 if not math.isfinite(r.centroid_distance_px)
                 else f"{r.centroid_distance_px:.1f}"
             ),
@@ -212,7 +212,7 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
         (
             "CD/px",
             lambda r: (
-                "nan"
+                "-"
                 if not math.isfinite(r.centroid_distance_ratio)
                 else f"{r.centroid_distance_ratio:.2e}"
             ),

@@ -364,7 +364,7 @@ def evaluate_sequence(
 
 
 def _pct(x: float) -> str:
-    return "nan" if not math.isfinite(x) else f"{100.0 * x:.1f}"
+    return "-" if not math.isfinite(x) else f"{100.0 * x:.1f}"  # "-": no value (JSON: null)
 
 
 _COLUMNS: list[tuple[str, Callable[[SequenceScores], str]]] = [

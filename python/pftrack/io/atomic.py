@@ -409,6 +409,36 @@ def _copy_through(tmp: Path, target: _Target, *, empty_ok: bool = False) -> None
         shutil.copyfileobj(src, dst)
 
 
+def refuse_dash(path: PathLike, what: str, *, output: bool = False, name: str = "file") -> None:
+    """Refuse ``-`` for an output folder, or for an input that does not exist by that name.
+
+    Output files refuse it in :func:`check_output`; a folder cannot be standard output, and
+    the inputs are read by name (a tracks file twice, to name a bad line). Was: a folder named
+    ``-`` created, or ``tracks file not found: -``. An input file that is named ``-`` is read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        What was given.
+    what : str
+        How the message names it (``"--out"``, ``"tracks file"``).
+    output : bool
+        An output folder (standard output), else an input (standard input).
+    name : str
+        What to give instead (``"folder"``, ``"file"``, ``"video, image folder or sequence
+        folder"``).
+
+    Raises
+    ------
+    ValueError
+        `path` is ``-`` (as an input: and no such file exists).
+    """
+    if os.fsdecode(os.fspath(path)) != "-" or (not output and os.path.lexists("-")):
+        return
+    stream = "standard output" if output else "standard input"
+    raise ValueError(f"{what} -: {stream} is not supported by name '-'; give a {name} name")
+
+
 def check_output(
     path: PathLike,
     *,

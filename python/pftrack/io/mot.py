@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box, real_array
 from pftrack._typing import F64, PathLike
-from pftrack.io.atomic import atomic_write
+from pftrack.io.atomic import atomic_write, refuse_dash
 
 #: Column indices of a MOTChallenge row.
 FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
@@ -147,6 +147,7 @@ def read_mot(
             raise ValueError(f"{what} {p} is a folder, not a file")
         if p.exists():
             raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket)")
+        refuse_dash(p, what)
         raise FileNotFoundError(f"{what} not found: {p}")
     _refuse_binary(p, what)
     fast = _read_fast(p)

@@ -672,6 +672,9 @@ class FrameSource:
         else:
             self.path = Path(text)
             if not self.path.exists():
+                from pftrack.io.atomic import refuse_dash
+
+                refuse_dash(text, "video source", name="video, image folder or sequence folder")
                 raise FileNotFoundError(f"video source not found: {self.path}")
             self.sequence = find_sequence(self.path)
             if self.sequence is not None and self.path.is_dir():
