@@ -14,9 +14,9 @@ import pytest
 
 import pftrack
 from pftrack.integrations.supervision import SupervisionTracker
-from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import make_scene
-from pftrack.tracking.api import xywh_to_xyxy_dets
+
+from .test_working_resolution import truth_dets
 
 IN_USE = r"this Tracker is in use by another thread"
 CLONES: dict[str, Callable[[Any], Any]] = {
@@ -28,18 +28,6 @@ CLONES: dict[str, Callable[[Any], Any]] = {
 @pytest.fixture(scope="module")
 def scene():
     return make_scene(n_frames=30, rng=1)
-
-
-def scene_dets(scene) -> list[np.ndarray]:
-    by_frame = group_by_frame(scene.truth)
-    return [
-        xywh_to_xyxy_dets(
-            np.column_stack([r[:, 2:6], np.ones(len(r))])
-            if len(r := by_frame.get(f, np.zeros((0, 10))))
-            else np.zeros((0, 5))
-        )
-        for f in range(1, len(scene.frames) + 1)
-    ]
 
 
 class Held:
@@ -73,7 +61,7 @@ class Held:
 def test_a_checkpoint_is_refused_while_update_runs_on_another_thread(scene, how):
     # was: a checkpoint of frame_count 76 with the inner tracker at 77, and the copy failed in
     # finalize much later (smooth_tracks: duplicate rows)
-    dets = scene_dets(scene)
+    dets = truth_dets(scene)
     a = pftrack.Tracker()
     for k in range(10):
         a.update(dets[k], scene.frames[k])
@@ -113,7 +101,7 @@ class Blocking:
 @pytest.mark.parametrize("how", sorted(CLONES))
 def test_update_is_refused_while_a_checkpoint_is_being_taken(scene, how):
     # the state is walked inside the guard, not only handed out by __getstate__
-    dets = scene_dets(scene)
+    dets = truth_dets(scene)
     a = pftrack.Tracker()
     a.update(dets[0], scene.frames[0])
     a._probe = probe = Blocking()
@@ -133,7 +121,7 @@ def test_update_is_refused_while_a_checkpoint_is_being_taken(scene, how):
 def test_a_shallow_copy_is_refused(scene):
     # was: copy.copy shared the inner tracker, writer and background, with a lock of its own
     a = pftrack.Tracker()
-    a.update(scene_dets(scene)[0], scene.frames[0])
+    a.update(truth_dets(scene)[0], scene.frames[0])
     with pytest.raises(TypeError, match=r"^copy\.copy\(Tracker\) would share .*copy\.deepcopy"):
         copy.copy(a)
     s = SupervisionTracker()
@@ -145,7 +133,7 @@ def test_a_shallow_copy_is_refused(scene):
 def test_a_deep_copy_keeps_shared_references(scene):
     # deepcopy's memo is kept: an object referring to the tracker gets the copy's
     a = pftrack.Tracker()
-    a.update(scene_dets(scene)[0], scene.frames[0])
+    a.update(truth_dets(scene)[0], scene.frames[0])
     pair = copy.deepcopy([a, a])
     assert pair[0] is pair[1] and pair[0] is not a
 
