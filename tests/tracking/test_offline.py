@@ -442,3 +442,49 @@ def test_smooth_tracks_filled_boxes_keep_the_smoothers_size_floor():
     floor = 0.5 * rows[:, 4:6].min(axis=0)
     assert np.all(out[:, 4:6] >= floor - 1e-12)
     fill_gaps(out)  # the rows pftrack wrote are rows it reads
+
+
+def test_writer_rows_in_blocks_read_back_from_any_row() -> None:
+    """The writer's row store (float64 blocks): every row and detection box read back as
+    written, from any start, across block boundaries (blocks of 3 here)."""
+    from pftrack.tracking.writer import _Rows
+
+    class Small(_Rows):
+        BLOCK = 3
+
+    store = Small()
+    rows, boxes = [], []
+    for i in range(11):
+        row = [float(i), 1.0, i + 0.25, 2.0, 3.0, 4.0, 0.5, -1.0, -1.0, -1.0]
+        box = None if i % 3 == 0 else np.array([i + 0.5, 1.0, 2.0, 3.0])
+        store.append(row, box)
+        rows.append(row)
+        boxes.append(box)
+        for start in range(i + 3):  # past the end too: nothing
+            got, got_boxes, has = store.arrays(start)
+            np.testing.assert_array_equal(got, np.array(rows[start:]).reshape(-1, 10))
+            assert has.tolist() == [b is not None for b in boxes[start:]]
+            for k in np.flatnonzero(has):
+                np.testing.assert_array_equal(got_boxes[k], boxes[start + k])
+    assert len(store) == 11
+
+
+def test_a_writer_checkpointed_with_list_rows_loads() -> None:
+    """A pickle of a writer made before its rows went into blocks (lists of floats and a
+    list of detection boxes) loads and gives the same result as the writer it was."""
+    import copy
+
+    from pftrack.tracking.writer import TrackWriter
+
+    writer = TrackWriter(smoother=None, link=None)
+    for i in range(5):
+        writer._append([float(i + 1), 1.0, 10.0 + i, 20.0, 5.0, 10.0, 0.9, -1, -1, -1],
+                       None if i == 2 else np.array([10.0 + i, 20.0, 5.0, 10.0]))  # fmt: skip
+    rows, boxes, has = writer.rows.arrays()
+    state = copy.copy(writer.__dict__)
+    state["rows"] = rows.tolist()  # the old layout
+    state["_measured"] = [b.copy() if h else None for b, h in zip(boxes, has, strict=True)]
+    old = TrackWriter.__new__(TrackWriter)
+    old.__setstate__(state)
+    np.testing.assert_array_equal(old.result(), writer.result())
+    assert len(old.rows) == 5

@@ -306,8 +306,8 @@ class Tracker:
     ``copy.copy`` (which would share the run's state) raises TypeError.
 
     Memory grows with the run: every online row is kept until :meth:`finalize` (its offline
-    pass needs the whole run), about 0.6 KB a row (measured with ``tracemalloc`` on a
-    synthetic scene: some 55 MB per person tracked for an hour at 25 frames/s). For an
+    pass needs the whole run), about 0.2 KB a row (measured with ``tracemalloc`` on a
+    synthetic scene: some 19 MB per person tracked for an hour at 25 frames/s). For an
     unbounded stream, read :meth:`settled_rows` from the last :attr:`n_settled` as you go,
     and end a segment now and then with :meth:`finalize` and :meth:`reset`, which frees the
     rows (ids and frame numbers start again; tracks are not linked across segments):
@@ -756,7 +756,7 @@ class Tracker:
         writes them as they come. A gap bridged by a particle filter is settled when the track
         is detected again.
         """
-        rows = np.asarray(self._writer.rows[start:], np.float64).reshape(-1, 10)
+        rows = self._writer.rows.arrays(start)[0]
         return self._restore_rows(self._stabiliser.restore(rows))
 
     def _no_track_cause(self, n_tracked: int) -> str:

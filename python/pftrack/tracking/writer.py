@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Collection
+from typing import Any
 
 import numpy as np
 
@@ -12,6 +13,53 @@ from pftrack.tracking.offline import BoxSmoother, CrossingConfig, smooth_tracks
 from pftrack.tracking.track import Track
 
 __all__ = ["TrackWriter"]
+
+
+class _Rows:
+    """Rows of 10 floats, each with an optional detection box, in float64 blocks.
+
+    A run keeps every row it writes until its offline pass. As Python lists a row took about
+    600 bytes (ten float objects, the list, the box's array); in blocks of :data:`BLOCK` rows it
+    takes 10 + 4 floats and a flag, 113 bytes, and the values are the same float64 numbers.
+    """
+
+    BLOCK = 1024
+
+    def __init__(self) -> None:
+        self._done: list[tuple[F64, F64, np.ndarray]] = []  # full blocks: rows, boxes, has-box
+        self._new()
+
+    def _new(self) -> None:
+        self._rows = np.empty((self.BLOCK, 10))
+        self._boxes = np.zeros((self.BLOCK, 4))
+        self._has = np.zeros(self.BLOCK, bool)
+        self._n = 0
+
+    def append(self, row: list[float], box: F64 | None) -> None:
+        if self._n == self.BLOCK:
+            self._done.append((self._rows, self._boxes, self._has))
+            self._new()
+        self._rows[self._n] = row
+        if box is not None:
+            self._boxes[self._n] = box
+            self._has[self._n] = True
+        self._n += 1
+
+    def __len__(self) -> int:
+        return self.BLOCK * len(self._done) + self._n
+
+    def arrays(self, start: int = 0) -> tuple[F64, F64, np.ndarray]:
+        """Rows ``(M, 10)``, boxes ``(M, 4)`` and whether each has one, from row `start` on.
+
+        Only the blocks holding those rows are read (a live run asks for its newest rows every
+        frame); the arrays returned are copies.
+        """
+        first = min(max(start, 0) // self.BLOCK, len(self._done))  # blocks before it: skipped
+        parts = [*self._done[first:], (self._rows[: self._n], self._boxes[: self._n],
+                                       self._has[: self._n])]  # fmt: skip
+        rows, boxes, has = (np.concatenate([p[k] for p in parts]) for k in range(3))
+        cut = max(start, 0) - first * self.BLOCK
+        return rows[cut:], boxes[cut:], has[cut:]
 
 
 class TrackWriter:
@@ -53,16 +101,23 @@ class TrackWriter:
         self.fill = fill
         self.smoother = smoother
         self.link = link
-        self.rows: list[list[float]] = []
-        self._measured: list[F64 | None] = []  # per row: the detection box
+        self.rows = _Rows()  # with each row's detection box, if it has one
         self._pending: dict[int, list[list[float]]] = {}
         self._last: dict[int, list[float]] = {}
         self._cls: dict[int, int] = {}  # class of each track id
         self.classes: dict[int, int] = {}  # class of each id of the last result()
 
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        rows = state.get("rows")
+        if isinstance(rows, list):  # a checkpoint made before stop 36: rows as Python lists
+            store = _Rows()
+            for row, box in zip(rows, state.pop("_measured"), strict=True):
+                store.append(row, None if box is None else np.asarray(box, np.float64))
+            state["rows"] = store
+        self.__dict__.update(state)
+
     def _append(self, row: list[float], measured: F64 | None) -> None:
-        self.rows.append(row)
-        self._measured.append(measured)
+        self.rows.append(row, measured)
 
     def add(self, frame: int, tracks: list[Track]) -> None:
         """Record the tracks reported for `frame` (1-based)."""
@@ -102,18 +157,14 @@ class TrackWriter:
         :attr:`classes` gets the class of each id of the result.
         """
         self.classes = {}
-        a = np.asarray(self.rows, np.float64).reshape(-1, 10)
-        observed = np.array([m is not None for m in self._measured], bool)
-        measured = self._measured
+        a, boxes, observed = self.rows.arrays()
         if len(drop):
             keep = ~np.isin(a[:, 1], np.fromiter(drop, np.float64))
-            a, observed = a[keep], observed[keep]
-            measured = [m for m, k in zip(measured, keep, strict=True) if k]
+            a, boxes, observed = a[keep], boxes[keep], observed[keep]
         if len(a) == 0:
             return np.zeros((0, 10))
         z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
-        if observed.any():
-            z[observed] = [m for m in measured if m is not None]
+        z[observed] = boxes[observed]
         cls = np.array([self._cls.get(int(i), 0) for i in a[:, 1]], np.int64)
         classes = np.unique(cls)
         if len(classes) == 1:
