@@ -584,32 +584,27 @@ def calibrate(
     for b in sorted(by_bucket):
         mmae: tuple[tuple[str, float], ...] = ()
         replaced: tuple[str, float] | None = None
+        mixed: float | None = None  # the choice's validation MMAE
         mix = chosen.get(b, pooled_mix or ((pooled, 1.0),))
         if b in errors:
             mmae = tuple((m, float(errors[b][m].mean())) for m in scored)
+            mixed = (
+                dict(mmae)[mix[0][0]]
+                if len(mix) == 1
+                else float(_mix_errors(mix, found[b], truths[b]).mean())
+            )
             # never worse than a straight line on the bucket's own validation gaps
-            mixed = float(_mix_errors(mix, found[b], truths[b]).mean())
             if mixed > errors[b]["linear"].mean():
                 replaced = ("+".join(m for m, _ in mix), mixed)
                 mix = (("linear", 1.0),)
+        span = _bucket_range(b)
         if len(mix) == 1:
-            span = _bucket_range(b)
             choices.append(
                 BucketChoice(span, mix[0][0], len(by_bucket[b]), n_cut[b], mmae, replaced=replaced)
             )
             continue
-        err = _mix_errors(mix, found[b], truths[b]) if b in errors else None
-        choices.append(
-            BucketChoice(
-                _bucket_range(b),
-                "+".join(m for m, _ in mix),
-                len(by_bucket[b]),
-                n_cut[b],
-                mmae,
-                mix,
-                None if err is None else float(err.mean()),
-            )
-        )
+        name = "+".join(m for m, _ in mix)
+        choices.append(BucketChoice(span, name, len(by_bucket[b]), n_cut[b], mmae, mix, mixed))
     return Calibration(tuple(choices), pooled, pooled_mix if len(pooled_mix) > 1 else (), bags)
 
 
