@@ -409,7 +409,9 @@ def _copy_through(tmp: Path, target: _Target, *, empty_ok: bool = False) -> None
         shutil.copyfileobj(src, dst)
 
 
-def refuse_dash(path: PathLike, what: str, *, output: bool = False, name: str = "file") -> None:
+def refuse_dash(
+    path: PathLike, what: str, *, output: bool = False, name: str = "file", or_else: str = ""
+) -> None:
     """Refuse ``-`` for an output folder, or for an input that does not exist by that name.
 
     Output files refuse it in :func:`check_output`; a folder cannot be standard output, and
@@ -427,6 +429,8 @@ def refuse_dash(path: PathLike, what: str, *, output: bool = False, name: str = 
     name : str
         What to give instead (``"folder"``, ``"file"``, ``"video, image folder or sequence
         folder"``).
+    or_else : str
+        Added to the message (``", or /dev/stdout"`` for an output file).
 
     Raises
     ------
@@ -436,7 +440,9 @@ def refuse_dash(path: PathLike, what: str, *, output: bool = False, name: str = 
     if os.fsdecode(os.fspath(path)) != "-" or (not output and os.path.lexists("-")):
         return
     stream = "standard output" if output else "standard input"
-    raise ValueError(f"{what} -: {stream} is not supported by name '-'; give a {name} name")
+    raise ValueError(
+        f"{what} -: {stream} is not supported by name '-'; give a {name} name{or_else}"
+    )
 
 
 def check_output(
@@ -481,11 +487,7 @@ def check_output(
     """
     text = os.fsdecode(os.fspath(path))
     target = Path(path)
-    if text == "-":
-        raise ValueError(
-            f"{what} -: standard output is not supported by name '-'; give a file name, or "
-            "/dev/stdout"
-        )
+    refuse_dash(text, what, output=True, or_else=", or /dev/stdout")
     if target.is_dir():
         raise ValueError(f"{what} {target} is a folder; give a file name")
     _refuse_folder_name(text, what)

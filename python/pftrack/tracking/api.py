@@ -587,8 +587,9 @@ class Tracker:
 
     def _warn_once(self, key: str, message: str) -> None:
         """Warn `message` from ``update``'s caller, the first time `key` comes up in a run."""
-        self._warned.add(key)
-        warnings.warn(message, stacklevel=3)  # 1 here, 2 update, 3 its caller
+        if key not in self._warned:
+            self._warned.add(key)
+            warnings.warn(message, stacklevel=3)  # 1 here, 2 update, 3 its caller
 
     def _working(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         prepared, self._prepared = self._prepared, None
@@ -671,18 +672,20 @@ class Tracker:
         """
         with self._alone("update"):
             f = bgr_frame(frame)
-            if self._shape is None:
+            shape = self._shape  # None until the run's first frame is taken
+            first = shape is None
+            if shape is None:
                 size = working_size(f.shape, self.config.max_side)
                 self._scale = None  # one scale for the whole run's rows
                 if size is not None:
                     sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
                     self._scale = np.array([sx, sy, sx, sy])
-            elif f.shape != self._shape:
+            elif f.shape != shape:
                 scales = self.config.max_side is not None
                 why = "max_side scales one size per run" if scales else "one size per run"
                 raise ValueError(
                     f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
-                    f"{self._shape[1]}x{self._shape[0]} ({why}; call reset() or use a new "
+                    f"{shape[1]}x{shape[0]} ({why}; call reset() or use a new "
                     "Tracker before a new video)"
                 )
             work = self._working(f)
@@ -691,13 +694,13 @@ class Tracker:
                 reports = self._tracker.update(work, None)
             else:
                 xywh, cls, kept, clipped, empty = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
-                if empty and "empty" not in self._warned:
+                if empty:
                     self._warn_once(
                         "empty",
                         f"{empty} detection box{'es' if empty > 1 else ''} without area "
                         "(x2 <= x1 or y2 <= y1) ignored; later ones are ignored silently",
                     )
-                if clipped and "clipped" not in self._warned:
+                if clipped:
                     self._warn_once(
                         "clipped",
                         f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
@@ -714,7 +717,8 @@ class Tracker:
                 )
                 self._max_conf = max(self._max_conf, confidence)
             self.frame_count += 1
-            self._shape = f.shape  # the run's size, once its first frame is taken
+            if first:  # the run's size, once its first frame is taken
+                self._shape = f.shape
             # the offline pass sees a still camera: boxes in the first frame's coordinates
             self._stabiliser.add(self._tracker.camera_step.apply)
             self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
