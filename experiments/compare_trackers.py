@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import itertools
 import sys
 import time
 import warnings
@@ -221,33 +220,37 @@ def make_motpy(seq: Sequence) -> Step:
 class PftrackStep:
     """pftrack as ``pftrack track`` runs it, as a step that reports nothing until the end.
 
-    The background is primed from the first 30 frames (:meth:`prime`); output goes through
-    :class:`~pftrack.tracking.TrackWriter` (bridged gaps written once the track is re-detected, a
-    new track's first boxes once it is confirmed), whose offline pass links fragments and smooths
-    each track over the whole run; ``offline=False`` (``pftrack-online``,
-    ``pftrack track --no-smooth --no-link``) writes each frame's boxes as reported. The rows are
-    read with :meth:`result`.
+    The public :class:`pftrack.Tracker` with the command's defaults and seed 0, primed as
+    :func:`~pftrack.tracking.track_frames` primes it (:meth:`prime`): the built-in detector's
+    background from 30 frames spread over the whole video, box refinement's from the first 30
+    frames. Its :meth:`~pftrack.Tracker.finalize` links fragments and smooths each track over
+    the whole run, so the rows are those ``pftrack track`` writes for the same video and
+    detections; ``offline=False`` (``pftrack-online``, ``pftrack track --no-smooth --no-link``)
+    keeps each frame's boxes as reported. The rows are read with :meth:`result`.
     """
 
     def __init__(self, offline: bool = True) -> None:
-        from pftrack.tracking import MultiObjectTracker, TrackWriter
+        import pftrack
 
-        self._trk = MultiObjectTracker(rng=0)
-        self._writer = TrackWriter() if offline else TrackWriter(smoother=None, link=None)
-        self._count = itertools.count(1)
+        self._trk = pftrack.Tracker(smooth=offline, link=offline)
 
     def __call__(self, frame: Frame, boxes: Boxes | None) -> list[Track]:
-        dets = None if boxes is None else np.asarray(boxes, dtype=np.float64).reshape(-1, 5)
-        self._writer.add(next(self._count), self._trk.update(frame, detections=dets))
+        if boxes is None:
+            self._trk.update(None, frame)
+        else:  # left, top, w, h, score -> x1, y1, x2, y2, score
+            b = np.asarray(boxes, dtype=np.float64).reshape(-1, 5)
+            self._trk.update(np.column_stack([b[:, :2], b[:, :2] + b[:, 2:4], b[:, 4]]), frame)
         return []
 
-    def prime(self, frames: list[Frame]) -> None:
-        """Start the background model from the first 30 frames."""
-        self._trk.prime(frames[:30])
+    def prime(self, frames: list[Frame], own: bool) -> None:
+        """Start the background as ``pftrack track`` does (`own`: the built-in detector)."""
+        from pftrack.detection.bootstrap import bootstrap_frames
+
+        self._trk.prime(bootstrap_frames(frames, 30, "spread" if own else "first"))
 
     def result(self) -> NDArray[np.float64]:
-        """Every row written, after the offline pass (MOTChallenge layout)."""
-        return self._writer.result()
+        """Every row, after the offline pass (MOTChallenge layout): ``Tracker.finalize()``."""
+        return self._trk.finalize()
 
 
 def make_pftrack(seq: Sequence, offline: bool = True) -> Step:
@@ -352,7 +355,7 @@ def main(argv: list[str] | None = None) -> int:
                     continue
                 feed: Iterable[Boxes | None] = [None] * len(frames) if own else dets
                 if isinstance(step, PftrackStep):
-                    step.prime(frames)
+                    step.prime(frames, own)
                 with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
                     warnings.simplefilter("ignore")
                     res, fps = run_one(step, frames, feed)
