@@ -1014,7 +1014,7 @@ def test_the_figures_docs_batch_md_quotes_are_the_batchs(client: Any, tmp_path: 
     pets = next(e for e in summary.entries if e["name"] == "pets09-s2l1")["metrics"]
     figures = (
         f"HOTA {100 * pets['hota']:.1f}, MOTA {100 * pets['mota']:.1f}, "
-        f"IDF1 {100 * pets['idf1']:.1f}, {pets['id_switches']} switches"
+        f"IDF1 {100 * pets['idf1']:.1f}, {pets['num_switches']} switches"
     )
     assert figures in " ".join(doc.split())
 

@@ -231,7 +231,7 @@ _COLUMNS: dict[str, list[tuple[str, str, Callable[[Any], str]]]] = {
         ("HOTA%", "metrics.hota", _pct),
         ("MOTA%", "metrics.mota", _pct),
         ("IDF1%", "metrics.idf1", _pct),
-        ("IDsw", "metrics.id_switches", _int),
+        ("IDsw", "metrics.num_switches", _int),
     ],
     "recover": [
         ("rows in", "rows_in", _int),

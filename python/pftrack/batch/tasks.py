@@ -289,7 +289,7 @@ def sequence_metrics(
         "mota": m.mota,
         "idf1": m.idf1,
         "motp_iou": m.motp_iou,
-        "id_switches": m.num_switches,
+        "num_switches": m.num_switches,
         "false_positives": m.false_positives,
         "misses": m.misses,
         "benchmark": s.benchmark,
