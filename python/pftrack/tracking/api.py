@@ -298,12 +298,14 @@ class Tracker:
     -----
     One tracker is one run: use one per video and per thread. A second thread calling a
     method while another is inside one raises RuntimeError (as does the C++ background model
-    under any other path). ``copy.deepcopy(tracker)`` or a pickle of it is a checkpoint at any
-    point of a run with the built-in ``"paper"`` detector and the ``"sis"`` or ``"mh"``
-    sampler: the copy goes on exactly as the original. OpenCV's MOG2/KNN and the RJ-MCMC
-    chain cannot be copied once they have seen a frame (TypeError naming the option); a
-    checkpoint taken while another thread is inside a method raises RuntimeError, and
-    ``copy.copy`` (which would share the run's state) raises TypeError.
+    under any other path). ``copy.deepcopy(tracker)`` or a pickle of it (at any protocol, 0
+    to 5) is a checkpoint at any point of a run with the built-in ``"paper"`` detector and the
+    ``"sis"`` or ``"mh"`` sampler: the copy goes on exactly as the original. OpenCV's MOG2/KNN
+    and the RJ-MCMC chain cannot be copied once they have seen a frame (TypeError naming the
+    option); a checkpoint taken while another thread is inside a method raises RuntimeError,
+    and ``copy.copy`` (which would share the run's state) raises TypeError. To keep a
+    checkpoint in a file, ``pickle.dumps`` it first and write the bytes atomically (a refused
+    pickle then leaves the last file whole; docs/api.md).
 
     Memory grows with the run: every online row is kept until :meth:`finalize` (its offline
     pass needs the whole run), about 0.2 KB a row (measured with ``tracemalloc`` on a
