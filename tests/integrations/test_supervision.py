@@ -90,6 +90,22 @@ def test_empty_and_bad_input(scene):
         adapter.update_with_detections(np.zeros((0, 5)), scene.frames[0])
 
 
+def test_boxes_without_area_and_inverted_boxes(scene):
+    # a frame whose only box had no area raised "the boxes look like x, y, w, h": supervision's
+    # boxes are always x1, y1, x2, y2, and a box without area is dropped (one warning)
+    adapter = SupervisionTracker()
+    flat = sv.Detections(xyxy=np.array([[320.0, 10, 320, 50]]), confidence=np.array([0.4]))
+    with pytest.warns(UserWarning, match="^1 detection box without area"):
+        assert len(adapter.update_with_detections(flat, scene.frames[0])) == 0
+    inverted = sv.Detections(xyxy=np.array([[60.0, 10, 20, 90], [200, 40, 150, 120]]))
+    message = (
+        r"^detections row 0 \[60.0, 10.0, 20.0, 90.0\] has x2 < x1 or y2 < y1, as have 2 of the "
+        r"2 boxes given \(x1, y1, x2, y2 expected\)$"  # no x, y, w, h hint
+    )
+    with pytest.raises(ValueError, match=message):
+        adapter.update_with_detections(inverted, scene.frames[1])
+
+
 def test_supervision_is_imported_lazily():
     code = (
         "import sys, pftrack.integrations.supervision as m, pftrack; pftrack.Tracker; "
