@@ -715,7 +715,8 @@ class Tracker:
             Inverted boxes that are most of the run's are refused, ValueError (x, y, w, h rows:
             :func:`check_boxes_xyxy`). None runs the built-in background-subtraction detector.
         frame : (H, W, 3) array_like of uint8
-            BGR frame.
+            BGR frame (TypeError for another dtype; ValueError for another shape, naming
+            ``cv2.cvtColor``'s conversion of a grey or BGRA frame).
 
         Returns
         -------
