@@ -45,6 +45,33 @@ def test_resample_bad_weights(fn, weights, match):
         fn(weights, rng=0)
 
 
+@pytest.mark.parametrize("fn", RESAMPLERS)
+def test_resample_messages_name_the_function_and_no_particle_filter(fn):
+    # was "weights sum to 0 (all weights are 0: reference histogram empty, or every particle
+    # outside the image?)", the particle filter's hint, for any caller of the resamplers; and
+    # the 1-D and dtype errors had no "systematic_resample: " in front, as the others have
+    name = fn.__name__
+    with pytest.raises(
+        ValueError,
+        match=rf"^{name}: weights sum to 0 \(every value is 0; at least one must be > 0\)$",
+    ):
+        fn([0, 0, 0], rng=0)
+    with pytest.raises(
+        ValueError, match=rf"^{name}: weights must be 1-D \(N,\), got shape \(1, 2\)$"
+    ):
+        fn([[0.5, 0.5]], rng=0)
+    with pytest.raises(TypeError, match=rf"^{name}: weights must be numeric, got dtype <U1$"):
+        fn(["a", "b"], rng=0)
+    with pytest.raises(TypeError, match=rf"^{name}: weights must be real, got dtype complex128$"):
+        fn([1j, 1], rng=0)
+
+
+def test_the_particle_filter_keeps_its_zero_weights_hint():
+    hint = r"weights sum to 0 \(all weights are 0: reference histogram empty, or every particle"
+    with pytest.raises(ValueError, match=rf"^estimate: {hint}"):
+        _core.estimate(np.zeros((3, 6)), np.zeros(3))
+
+
 def test_resample_wrong_type():
     with pytest.raises(TypeError, match="numeric"):
         systematic_resample(["a", "b"])
