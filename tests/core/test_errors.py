@@ -269,6 +269,22 @@ def test_propagate_refuses_an_overflow_and_leaves_the_particles(particles, model
     assert np.isfinite(p).all()
 
 
+@pytest.mark.parametrize("lam", [0.0, -1.0, np.inf, np.nan])
+def test_filter_config_and_bhattacharyya_weights_agree_on_lam(lam):
+    # FilterConfig(lam=0) was accepted (a filter blind to colour: every particle weighs the
+    # same) while bhattacharyya_weights(..., lam=0) was refused
+    with pytest.raises(
+        ValueError, match=f"^FilterConfig: lam is {lam}, expected a finite number > 0"
+    ):
+        FilterConfig(lam=lam)
+    with pytest.raises(
+        ValueError, match=f"^bhattacharyya_weights: lam is {lam}, expected a finite number > 0$"
+    ):
+        bhattacharyya_weights(np.ones((2, 4)), np.ones(4), lam=lam)
+    FilterConfig(lam=1e-9)  # any positive lam is a colour likelihood
+    bhattacharyya_weights(np.ones((2, 4)), np.ones(4), lam=1e-9)
+
+
 def test_filter_bad_inputs():
     ref = np.ones(110)
     with pytest.raises(ValueError, match="box is"):
