@@ -698,6 +698,8 @@ def test_no_track_warning_of_the_built_in_detector_blames_it():
     [
         ("no box", "the detections given held no box"),
         ("outside", r"no detection lay inside the frame \(wrong coordinate scale\?\)"),
+        # was "the detections given held no box": boxes were given, every one without area
+        ("flat", "every detection given was without area or had x2 < x1 or y2 < y1"),
         # was: "the highest detection confidence was 0.95 (... birth_score 0.9)", not the cause
         ("tiny", r"every detection inside the frame was under min_area=64 pixels \(40 left out; "
                  r"LifecycleConfig.min_area\)"),
@@ -708,7 +710,8 @@ def test_no_track_warning_says_what_the_detections_were(scene, where, hint):
     w = scene.frames[0].shape[1]
     far = np.array([[w + 10.0, 10.0, w + 30.0, 50.0, 1.0]])
     tiny = np.array([[100.0, 100.0, 105.0, 105.0, 0.95]])
-    box = {"no box": np.zeros((0, 5)), "outside": far, "tiny": tiny}[where]
+    flat = np.array([[w, 10.0, w, 50.0, 0.9], [30.0, 40.0, 60.0, 40.0, 0.9]])
+    box = {"no box": np.zeros((0, 5)), "outside": far, "tiny": tiny, "flat": flat}[where]
     dets = [box] * len(scene.frames)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
