@@ -36,6 +36,19 @@ def test_the_evaluation_entry_points_are_top_level() -> None:
         assert getattr(pftrack, name) is getattr(pftrack.eval, name)
 
 
+def test_the_kernels_docs_api_lists_are_top_level() -> None:
+    """docs/api.md says ``import pftrack`` gives every name it lists: the resamplers other than
+    ``systematic_resample`` and the Bhattacharyya coefficient and distance were only in
+    ``pftrack.particle_filter``."""
+    names = (
+        "stratified_resample", "multinomial_resample", "residual_resample",
+        "bhattacharyya_coefficient", "bhattacharyya_distance",
+    )  # fmt: skip
+    for name in names:
+        assert name in pftrack.__all__
+        assert getattr(pftrack, name) is getattr(pftrack.particle_filter, name)
+
+
 def _import_without_core(tmp_path: Path, installed: bool) -> str:
     """The error of ``import pftrack`` from a source checkout whose core is not built, with or
     without an installed pftrack (a dist-info and its package) after it on ``sys.path``.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "arrays.hpp"
+#include "pickling.hpp"
 #include "pftrack/background.hpp"
 #include "pftrack/ghost.hpp"
 #include "pftrack/morphology.hpp"
@@ -244,6 +245,8 @@ void register_detection(py::module_& m) {
                 model.restore(std::move(s));
                 return model;
             }))
+        .def("__reduce__", &bind::reduce_by_state,
+             "Pickled at every protocol as BackgroundModel.__new__ + __setstate__ (pickling.hpp).")
         .def(
             "__copy__",
             [](const BackgroundModel& self) {

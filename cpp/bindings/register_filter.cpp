@@ -91,7 +91,7 @@ void register_filter(py::module_& m) {
             check_particles(particles, fn);
             require(weights.size() == particles.rows(), fn, "weights size", weights.size(),
                     particles.rows());
-            require_weights(weights, fn);
+            require_weights(weights, fn, "weights", kParticleWeightsZero);
             Estimate e;
             {
                 py::gil_scoped_release nogil;  // safe: Eigen views only

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "arrays.hpp"
+#include "pickling.hpp"
 #include "pftrack/mh.hpp"
 #include "pftrack/rjmcmc.hpp"
 #include "step_args.hpp"
@@ -183,6 +184,9 @@ void register_mcmc(py::module_& m) {
              py::arg("birth_sigma_xy") = 3.0, py::arg("birth_sigma_s") = 0.05,
              py::arg("birth_eps") = 0.02, py::arg("birth_gate") = 0.1,
              py::arg("detection") = 20.0)
+        .def("__reduce__",
+             bind::refuse_pickle("RJMCMCTracker", "its chain has no pickled form (a run "
+                                                  "checkpoints with the 'sis' or 'mh' sampler)"))
         .def(
             "step",
             [](PyRjTracker& self, const BinnedImage& image, const py::array& mask,

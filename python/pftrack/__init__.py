@@ -15,8 +15,11 @@ The public API, importable from the top level; each name loads its module on fir
   :func:`write_annotated_video`, :func:`plot_trajectories`;
 - evaluation: :func:`evaluate_sequence` (HOTA and CLEAR-MOT/IDF1), :func:`evaluate_hota`,
   :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
-- kernels: :class:`ColourParticleFilter`, :func:`systematic_resample`, :func:`hsv_bins`,
-  :func:`box_histograms`, :func:`bhattacharyya_weights`;
+- kernels: :class:`ColourParticleFilter`, the resamplers (drop-in for
+  ``filterpy.monte_carlo``) :func:`systematic_resample`, :func:`stratified_resample`,
+  :func:`multinomial_resample`, :func:`residual_resample`, and :func:`hsv_bins`,
+  :func:`box_histograms`, :func:`bhattacharyya_weights`, :func:`bhattacharyya_coefficient`,
+  :func:`bhattacharyya_distance`;
 - :func:`make_scene`, a synthetic scene with known truth.
 
 Subpackages and modules are attributes too, loaded on first use like the names above:
@@ -94,9 +97,14 @@ if TYPE_CHECKING:
     from pftrack.io.video_writer import VideoWriter
     from pftrack.particle_filter import (
         ColourParticleFilter,
+        bhattacharyya_coefficient,
+        bhattacharyya_distance,
         bhattacharyya_weights,
         box_histograms,
         hsv_bins,
+        multinomial_resample,
+        residual_resample,
+        stratified_resample,
         systematic_resample,
     )
     from pftrack.recovery import (
@@ -156,9 +164,14 @@ _HOME = {
     ),
     "pftrack.particle_filter": (
         "ColourParticleFilter",
+        "bhattacharyya_coefficient",
+        "bhattacharyya_distance",
         "bhattacharyya_weights",
         "box_histograms",
         "hsv_bins",
+        "multinomial_resample",
+        "residual_resample",
+        "stratified_resample",
         "systematic_resample",
     ),
     "pftrack.synthetic": ("make_scene",),
@@ -179,6 +192,8 @@ __all__ = [
     "TrackerConfig",
     "TrackingRun",
     "VideoWriter",
+    "bhattacharyya_coefficient",
+    "bhattacharyya_distance",
     "bhattacharyya_weights",
     "box_histograms",
     "evaluate_hota",
@@ -191,12 +206,15 @@ __all__ = [
     "link_tracklets",
     "load_detections",
     "make_scene",
+    "multinomial_resample",
     "plot_trajectories",
     "read_mot",
     "read_seqinfo",
     "recover_gap",
     "recover_gaps",
+    "residual_resample",
     "smooth_tracks",
+    "stratified_resample",
     "systematic_resample",
     "track_frames",
     "write_annotated_video",

@@ -13,8 +13,10 @@ __all__ = [
     "MAX_FRAME",
     "MAX_ID",
     "bad_id_message",
+    "bgr_array",
     "bgr_frame",
     "bool_array",
+    "colour_hint",
     "first_bad_box",
     "first_at",
     "first_bad_id",
@@ -123,6 +125,38 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
     return r, int(np.argmax(far[r])), f"a box value is beyond ±{MAX_COORD:g} px"
 
 
+def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
+    """`frame` as a (H, W, 3) uint8 array (``numpy.asarray``: not copied when it is one).
+
+    Raises
+    ------
+    TypeError
+        Not an array of uint8 (float frames; ``None``).
+    ValueError
+        Not of shape (H, W, 3): a grey (2-D or one-channel) or a BGRA frame's message names
+        the ``cv2.cvtColor`` conversion that makes it BGR.
+    """
+    f = np.asarray(frame)
+    if f.dtype == object:
+        raise TypeError(f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array")
+    if f.dtype != np.uint8:
+        raise TypeError(f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
+    if f.ndim != 3 or f.shape[2] != 3:
+        raise ValueError(
+            f"{what} must have shape (H, W, 3) (BGR), got {f.shape}{colour_hint(f.shape)}"
+        )
+    return f
+
+
+def colour_hint(shape: tuple[int, ...]) -> str:
+    """The end of a message refusing a frame of `shape`: the conversion to BGR, if one fits."""
+    if len(shape) == 2 or (len(shape) == 3 and shape[2] == 1):
+        return ": a grey frame? cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR) makes it BGR"
+    if len(shape) == 3 and shape[2] == 4:
+        return ": a BGRA frame? cv2.cvtColor(frame, cv2.COLOR_BGRA2BGR) makes it BGR"
+    return ""
+
+
 def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     """`frame` as a C-contiguous (H, W, 3) uint8 array with at least one pixel.
 
@@ -132,13 +166,12 @@ def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     Raises
     ------
     TypeError
-        Not a (H, W, 3) uint8 array (grey, BGRA, float frames; ``None``).
+        Not an array of uint8 (float frames; ``None``).
     ValueError
-        A frame with no pixel (height or width 0).
+        Not of shape (H, W, 3) (grey or BGRA frames: the message names the ``cv2.cvtColor``
+        conversion), or a frame with no pixel (height or width 0).
     """
-    f = np.asarray(frame)
-    if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
-        raise TypeError(f"{what} must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+    f = bgr_array(frame, what)
     if f.shape[0] == 0 or f.shape[1] == 0:
         raise ValueError(f"{what} is {f.shape[1]}x{f.shape[0]} pixels, expected at least 1x1")
     return np.ascontiguousarray(f)

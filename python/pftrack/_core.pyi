@@ -5,8 +5,8 @@
 # float64 and is written without a copy.
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import Any, Literal, overload
+from collections.abc import Callable, Sequence
+from typing import Any, Literal, NoReturn, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,9 +53,15 @@ class BackgroundModel:
     ) -> None: ...
     def __copy__(self) -> BackgroundModel: ...  # an independent copy
     def __deepcopy__(self, memo: dict[int, object]) -> BackgroundModel: ...
-    # pickled: settings, then what it has learnt (size, counts, threshold, background, ...)
+    # pickled: settings, then what it has learnt (size, counts, threshold, background, ...);
+    # __reduce__ gives copyreg.__newobj__ and that state, at every protocol (0 to 5)
     def __getstate__(self, /) -> tuple[object, ...]: ...
     def __setstate__(self, arg0: tuple[object, ...], /) -> None: ...
+    def __reduce__(
+        self,
+    ) -> tuple[
+        Callable[..., BackgroundModel], tuple[type[BackgroundModel]], tuple[object, ...]
+    ]: ...
     # frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8:
     # 255 foreground, 127 shadow, 0 background)
     # bins=False: no bins (None), for a caller that bins only the pixels it keeps (hsv_bins)
@@ -157,6 +163,7 @@ class RJMCMCTracker:
         birth_gate: float = 0.1,  # no newborn on a candidate overlapping a kept identity this much
         detection: float = 20.0,  # weight of an object's best IoU with a candidate in log π
     ) -> None: ...
+    def __reduce__(self) -> NoReturn: ...  # TypeError: the chain cannot be pickled
     # mask (H, W) uint8/bool; candidates (K, 4) cx, cy, w, h; candidate_hists (K, B) or None.
     # seed and step have no default (pass them by keyword).
     def step(

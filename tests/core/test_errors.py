@@ -45,6 +45,33 @@ def test_resample_bad_weights(fn, weights, match):
         fn(weights, rng=0)
 
 
+@pytest.mark.parametrize("fn", RESAMPLERS)
+def test_resample_messages_name_the_function_and_no_particle_filter(fn):
+    # was "weights sum to 0 (all weights are 0: reference histogram empty, or every particle
+    # outside the image?)", the particle filter's hint, for any caller of the resamplers; and
+    # the 1-D and dtype errors had no "systematic_resample: " in front, as the others have
+    name = fn.__name__
+    with pytest.raises(
+        ValueError,
+        match=rf"^{name}: weights sum to 0 \(every value is 0; at least one must be > 0\)$",
+    ):
+        fn([0, 0, 0], rng=0)
+    with pytest.raises(
+        ValueError, match=rf"^{name}: weights must be 1-D \(N,\), got shape \(1, 2\)$"
+    ):
+        fn([[0.5, 0.5]], rng=0)
+    with pytest.raises(TypeError, match=rf"^{name}: weights must be numeric, got dtype <U1$"):
+        fn(["a", "b"], rng=0)
+    with pytest.raises(TypeError, match=rf"^{name}: weights must be real, got dtype complex128$"):
+        fn([1j, 1], rng=0)
+
+
+def test_the_particle_filter_keeps_its_zero_weights_hint():
+    hint = r"weights sum to 0 \(all weights are 0: reference histogram empty, or every particle"
+    with pytest.raises(ValueError, match=rf"^estimate: {hint}"):
+        _core.estimate(np.zeros((3, 6)), np.zeros(3))
+
+
 def test_resample_wrong_type():
     with pytest.raises(TypeError, match="numeric"):
         systematic_resample(["a", "b"])
@@ -240,6 +267,22 @@ def test_propagate_refuses_an_overflow_and_leaves_the_particles(particles, model
     p[np.abs(p) == 1e308] /= 4
     propagate(p, np.zeros((len(p), 3)), model, None if means is None else np.array(means) / 4)
     assert np.isfinite(p).all()
+
+
+@pytest.mark.parametrize("lam", [0.0, -1.0, np.inf, np.nan])
+def test_filter_config_and_bhattacharyya_weights_agree_on_lam(lam):
+    # FilterConfig(lam=0) was accepted (a filter blind to colour: every particle weighs the
+    # same) while bhattacharyya_weights(..., lam=0) was refused
+    with pytest.raises(
+        ValueError, match=f"^FilterConfig: lam is {lam}, expected a finite number > 0"
+    ):
+        FilterConfig(lam=lam)
+    with pytest.raises(
+        ValueError, match=f"^bhattacharyya_weights: lam is {lam}, expected a finite number > 0$"
+    ):
+        bhattacharyya_weights(np.ones((2, 4)), np.ones(4), lam=lam)
+    FilterConfig(lam=1e-9)  # any positive lam is a colour likelihood
+    bhattacharyya_weights(np.ones((2, 4)), np.ones(4), lam=1e-9)
 
 
 def test_filter_bad_inputs():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pickle
 import subprocess
 import sys
 
@@ -89,6 +90,22 @@ def test_empty_and_bad_input(scene):
         adapter.update_with_detections(np.zeros((0, 5)), scene.frames[0])
 
 
+def test_boxes_without_area_and_inverted_boxes(scene):
+    # a frame whose only box had no area raised "the boxes look like x, y, w, h": supervision's
+    # boxes are always x1, y1, x2, y2, and a box without area is dropped (one warning)
+    adapter = SupervisionTracker()
+    flat = sv.Detections(xyxy=np.array([[320.0, 10, 320, 50]]), confidence=np.array([0.4]))
+    with pytest.warns(UserWarning, match="^1 detection box without area"):
+        assert len(adapter.update_with_detections(flat, scene.frames[0])) == 0
+    inverted = sv.Detections(xyxy=np.array([[60.0, 10, 20, 90], [200, 40, 150, 120]]))
+    message = (
+        r"^detections row 0 \[60.0, 10.0, 20.0, 90.0\] has x2 < x1 or y2 < y1, as have 2 of the "
+        r"2 boxes given \(x1, y1, x2, y2 expected\)$"  # no x, y, w, h hint
+    )
+    with pytest.raises(ValueError, match=message):
+        adapter.update_with_detections(inverted, scene.frames[1])
+
+
 def test_supervision_is_imported_lazily():
     code = (
         "import sys, pftrack.integrations.supervision as m, pftrack; pftrack.Tracker; "
@@ -108,3 +125,49 @@ def test_the_adapters_options_are_the_trackers():
     theirs = {n: str(p.annotation) for n, p in params.items() if p.kind is p.KEYWORD_ONLY}
     ours = {n: getattr(t, "__forward_arg__", t) for n, t in TrackerOptions.__annotations__.items()}
     assert ours == theirs
+
+
+# As tests/tracking/test_api_checkpoint.py's: in a child process, where protocols 0 and 1
+# aborted the interpreter once the background model existed.
+ADAPTER_AT_EVERY_PROTOCOL = """
+import pickle
+import numpy as np
+import supervision as sv
+from pftrack.integrations.supervision import SupervisionTracker
+from pftrack.synthetic import make_scene
+
+scene = make_scene(n_frames=20, rng=2)
+truth = scene.truth
+
+def dets(k):
+    r = truth[truth[:, 0] == k + 1]
+    xyxy = np.column_stack([r[:, 2:4], r[:, 2:4] + r[:, 4:6]])
+    return sv.Detections(xyxy=xyxy, confidence=np.full(len(r), 0.95),
+                         class_id=np.zeros(len(r), int))
+
+for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+    a = SupervisionTracker()
+    a.prime(scene.frames[:5])
+    for k in range(6):
+        a.update_with_detections(dets(k), scene.frames[k])
+    b = pickle.loads(pickle.dumps(a, protocol=protocol))
+    for k in range(6, len(scene.frames)):
+        out_a = a.update_with_detections(dets(k), scene.frames[k])
+        out_b = b.update_with_detections(dets(k), scene.frames[k])
+        assert out_a.xyxy.tobytes() == out_b.xyxy.tobytes(), (protocol, k)
+        assert out_a.tracker_id.tolist() == out_b.tracker_id.tolist(), (protocol, k)
+    rows = a.finalize()
+    assert len(rows) and rows.tobytes() == b.finalize().tobytes(), protocol
+    print(protocol, "resumed", flush=True)
+"""
+
+
+def test_a_checkpoint_at_every_pickle_protocol_resumes_byte_for_byte():
+    run = subprocess.run(
+        [sys.executable, "-c", ADAPTER_AT_EVERY_PROTOCOL], capture_output=True, text=True,
+        timeout=600,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split("\n")[:-1] == [
+        f"{p} resumed" for p in range(pickle.HIGHEST_PROTOCOL + 1)
+    ]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import copy
 import pickle
 import re
+import subprocess
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -194,3 +196,48 @@ def test_a_new_frame_size_names_reset(scene, max_side):
         t.update(None, np.zeros((100, 100, 3), np.uint8))
     t.reset()
     t.update(None, np.zeros((100, 100, 3), np.uint8))
+
+
+# A run checkpointed at each pickle protocol and resumed, in a child process: pickle at
+# protocols 0 and 1 aborted the interpreter (SIGABRT, pybind11's "instance allocation failed:
+# new instance has no pybind11-registered base types") once the background model existed,
+# which would take pytest down with it.
+RESUME_AT_EVERY_PROTOCOL = """
+import pickle
+import numpy as np
+import pftrack
+from pftrack.synthetic import make_scene
+
+scene = make_scene(n_frames=24, rng=1)
+truth = scene.truth
+
+def dets(k):
+    r = truth[truth[:, 0] == k + 1]
+    return np.column_stack([r[:, 2:4], r[:, 2:4] + r[:, 4:6], np.full(len(r), 0.95)])
+
+for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+    for primed, at in ((True, 0), (False, 8)):  # after prime(); after the first updates
+        a = pftrack.Tracker()
+        if primed:
+            a.prime(scene.frames[:5])
+        for k in range(at):
+            a.update(dets(k), scene.frames[k])
+        b = pickle.loads(pickle.dumps(a, protocol=protocol))
+        for k in range(at, len(scene.frames)):
+            out_a, out_b = a.update(dets(k), scene.frames[k]), b.update(dets(k), scene.frames[k])
+            assert out_a.tobytes() == out_b.tobytes(), (protocol, primed, k)
+        rows = a.finalize()
+        assert len(rows) and rows.tobytes() == b.finalize().tobytes(), (protocol, primed)
+    print(protocol, "resumed", flush=True)
+"""
+
+
+def test_a_checkpoint_at_every_pickle_protocol_resumes_byte_for_byte():
+    run = subprocess.run(
+        [sys.executable, "-c", RESUME_AT_EVERY_PROTOCOL], capture_output=True, text=True,
+        timeout=600,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split("\n")[:-1] == [
+        f"{p} resumed" for p in range(pickle.HIGHEST_PROTOCOL + 1)
+    ]

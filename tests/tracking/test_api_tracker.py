@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import itertools
 import re
@@ -318,12 +319,31 @@ def test_cli_warns_when_no_track(scene, tmp_path, capsys):
 
 
 # -- inputs ----------------------------------------------------------------------------------
-def test_xywh_given_as_xyxy_is_refused(scene):
-    d = scene_dets(scene)[0]
+def as_xywh(d: np.ndarray) -> np.ndarray:
     xywh = d.copy()
     xywh[:, 2:4] = d[:, 2:4] - d[:, :2]
-    with pytest.raises(ValueError, match="look like x, y, w, h"):
-        pftrack.Tracker().update(xywh, scene.frames[0])
+    return xywh
+
+
+def test_xywh_given_as_xyxy_is_refused(scene):
+    # the scene's first frame holds one box: a lone inverted box is dropped (a stray box),
+    # the second frame's make all of the run's boxes inverted, and the run is refused
+    d = scene_dets(scene)
+    assert len(d[0]) == 1
+    tracker = pftrack.Tracker()
+    with pytest.warns(UserWarning, match=r"^1 detection box with x2 < x1 or y2 < y1 ignored"):
+        tracker.update(as_xywh(d[0]), scene.frames[0])
+    n = 1 + len(d[1])
+    message = (
+        rf"^dets row 0 .* has x2 < x1 or y2 < y1, as have {n} of the {n} boxes given so far: "
+        r"the boxes look like x, y, w, h; give x1, y1, x2, y2 \(x2 = x \+ w, y2 = y \+ h\)$"
+    )
+    with pytest.raises(ValueError, match=message):
+        tracker.update(as_xywh(d[1]), scene.frames[1])
+    assert tracker.frame_count == 1  # the refused frame changed nothing
+    k = next(k for k, v in enumerate(d) if len(v) >= 3)  # several in one frame: at once
+    with pytest.raises(ValueError, match=r"^dets row 0 .* boxes given: the boxes look like x, y"):
+        pftrack.Tracker().update(as_xywh(d[k]), scene.frames[k])
 
 
 def test_a_box_without_area_among_good_ones_is_dropped_with_a_warning(scene):
@@ -334,13 +354,54 @@ def test_a_box_without_area_among_good_ones_is_dropped_with_a_warning(scene):
     h, w = scene.frames[k].shape[:2]
     dets = np.vstack([d, [[w, 10, w, 60, 0.95]], [[30, 40, 20, 90, 0.95]]])
     tracker = pftrack.Tracker(seed=0, prime=0)
-    with pytest.warns(UserWarning, match="2 detection boxes without area"):
+    with pytest.warns(UserWarning) as caught:
         out = tracker.update(dets, scene.frames[k])
+    assert [str(c.message).split(";")[0] for c in caught] == [
+        "1 detection box without area (x2 == x1 or y2 == y1) ignored",
+        "1 detection box with x2 < x1 or y2 < y1 ignored (x1, y1, x2, y2 expected)",
+    ]
     assert not np.isin(out[:, 7], [len(d), len(d) + 1]).any()  # never matched
     ref = pftrack.Tracker(seed=0, prime=0).update(d, scene.frames[k])
     np.testing.assert_array_equal(out, ref)  # the rest as without them
-    _, _, kept, _, empty = check_boxes_xyxy(dets, (h, w))
-    assert empty == 2 and list(kept) == list(range(len(d)))
+    checked = check_boxes_xyxy(dets, (h, w))
+    assert (checked.flat, checked.inverted, checked.extent) == (1, 1, len(d) + 1)
+    assert list(checked.kept) == list(range(len(d)))
+
+
+@pytest.mark.parametrize("n", [1, 3])
+def test_a_frame_of_boxes_without_area_only_is_dropped_with_a_warning(scene, n):
+    # a frame whose only detection had no area raised "the boxes look like x, y, w, h" (more
+    # than half its rows were bad), while 1 of 2 or 3 was dropped: now any number is dropped
+    d = scene_dets(scene)
+    h, w = scene.frames[0].shape[:2]
+    a = pftrack.Tracker()
+    for k in range(3):
+        a.update(d[k], scene.frames[k])
+    b = copy.deepcopy(a)
+    flat = np.array([[w, 10, w, 50, 0.4], [10, 20, 30, 20, 0.9], [5, 5, 5, 5, 0.9]])[:n]
+    with pytest.warns(UserWarning, match=f"^{n} detection box(es)? without area"):
+        out = a.update(flat, scene.frames[3])
+    np.testing.assert_array_equal(out, b.update(np.zeros((0, 5)), scene.frames[3]))
+    for k in range(4, 12):  # the run goes on as without them
+        np.testing.assert_array_equal(
+            a.update(d[k], scene.frames[k]), b.update(d[k], scene.frames[k])
+        )
+    np.testing.assert_array_equal(a.finalize(), b.finalize())
+
+
+def test_a_stray_inverted_box_never_refuses_a_run(scene):
+    d = scene_dets(scene)
+    tracker = pftrack.Tracker()
+    for k in range(6):
+        tracker.update(d[k], scene.frames[k])
+    stray = np.array([[40.0, 10, 20, 60, 0.9]])  # x2 < x1
+    with pytest.warns(UserWarning, match="^1 detection box with x2 < x1"):
+        tracker.update(stray, scene.frames[6])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # warned once a run
+        tracker.update(stray, scene.frames[7])  # two of the run's boxes, not most of them
+        tracker.update(np.vstack([d[8], stray]), scene.frames[8])
+    assert tracker._layout[0] == 3
 
 
 def test_xyxy_file_where_xywh_is_expected_is_refused(scene):
@@ -379,8 +440,8 @@ def test_boxes_outside_the_frame_are_clipped_once(scene):
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # warned once per tracker
         tracker.update(dets, scene.frames[1])
-    xywh, cls, kept, clipped, empty = check_boxes_xyxy(dets, (h, w))
-    assert clipped and kept[0] == 1 and 0 not in kept and empty == 0
+    xywh, cls, kept, clipped, flat, inverted, _ = check_boxes_xyxy(dets, (h, w))
+    assert clipped and kept[0] == 1 and 0 not in kept and flat == inverted == 0
     np.testing.assert_array_equal(xywh[0], [0, h - 30, 15, 30, 1.0])  # clipped at x = 0, y = h
     inside = np.all((d[:, :2] >= 0) & (d[:, 2:4] <= [w, h]), axis=1)
     assert inside.any()
@@ -398,7 +459,13 @@ def test_boxes_outside_the_frame_are_clipped_once(scene):
         (np.zeros((0, 7)), ValueError, r"got \(0, 7\)"),
         (np.array([[1.0, 2, np.nan, 4]]), ValueError, "NaN or inf"),
         (np.array([["a", "b", "c", "d"]]), TypeError, "numbers"),
-        (np.array([[10.0, 10, 5, -4]]), ValueError, "x2 <= x1"),
+        # two inverted boxes (one alone is dropped with a warning)
+        (
+            np.array([[10.0, 10, 5, -4], [20, 20, 15, 8]]),
+            ValueError,
+            r"^dets row 0 \[10.0, 10.0, 5.0, -4.0\] has x2 < x1 or y2 < y1, as have 2 of the 2 "
+            r"boxes given \(x1, y1, x2, y2 expected\)$",
+        ),
     ],
 )
 def test_bad_detections_are_one_line_errors(dets, error, match):
@@ -631,6 +698,8 @@ def test_no_track_warning_of_the_built_in_detector_blames_it():
     [
         ("no box", "the detections given held no box"),
         ("outside", r"no detection lay inside the frame \(wrong coordinate scale\?\)"),
+        # was "the detections given held no box": boxes were given, every one without area
+        ("flat", "every detection given was without area or had x2 < x1 or y2 < y1"),
         # was: "the highest detection confidence was 0.95 (... birth_score 0.9)", not the cause
         ("tiny", r"every detection inside the frame was under min_area=64 pixels \(40 left out; "
                  r"LifecycleConfig.min_area\)"),
@@ -641,7 +710,8 @@ def test_no_track_warning_says_what_the_detections_were(scene, where, hint):
     w = scene.frames[0].shape[1]
     far = np.array([[w + 10.0, 10.0, w + 30.0, 50.0, 1.0]])
     tiny = np.array([[100.0, 100.0, 105.0, 105.0, 0.95]])
-    box = {"no box": np.zeros((0, 5)), "outside": far, "tiny": tiny}[where]
+    flat = np.array([[w, 10.0, w, 50.0, 0.9], [30.0, 40.0, 60.0, 40.0, 0.9]])
+    box = {"no box": np.zeros((0, 5)), "outside": far, "tiny": tiny, "flat": flat}[where]
     dets = [box] * len(scene.frames)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -15,8 +15,10 @@ import pytest
 
 import pftrack
 from pftrack._check import bgr_frame
+from pftrack.detection import make_detector
 from pftrack.synthetic import make_scene
 from pftrack.tracking import MultiObjectTracker, load_detections
+from pftrack.tracking.camera import estimate_motion
 from tests.conftest import dataset
 
 
@@ -68,10 +70,53 @@ def test_a_thin_image_folder_tracks_on_the_command_line(tmp_path, capsys):
     assert "10 frames" in capsys.readouterr().out and out.exists()
 
 
-@pytest.mark.parametrize("bad", [None, np.zeros((4, 4), np.uint8), np.zeros((4, 4, 3))])
-def test_prime_refuses_what_is_not_a_frame(bad):
-    with pytest.raises(TypeError, match="prime frame must be a"):
+@pytest.mark.parametrize(
+    ("bad", "error", "message"),
+    [
+        (None, TypeError, r"^prime frame is NoneType, expected a \(H, W, 3\) uint8 BGR array$"),
+        (np.zeros((4, 4, 3)), TypeError, "^prime frame dtype is float64, expected uint8"),
+        (np.zeros((4, 4), np.uint8), ValueError, r"^prime frame must have shape \(H, W, 3\)"),
+    ],
+)
+def test_prime_refuses_what_is_not_a_frame(bad, error, message):
+    with pytest.raises(error, match=message):
         pftrack.Tracker().prime([bad])
+
+
+GREY = np.zeros((6, 8), np.uint8)
+GREY_1 = np.zeros((6, 8, 1), np.uint8)
+BGRA = np.zeros((6, 8, 4), np.uint8)
+TO_BGR = {
+    id(GREY): "cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)",
+    id(GREY_1): "cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)",
+    id(BGRA): "cv2.cvtColor(frame, cv2.COLOR_BGRA2BGR)",
+}
+ENTRY_POINTS = {
+    "Tracker.update": lambda f: pftrack.Tracker().update(np.zeros((0, 5)), f),
+    "Tracker.update(None)": lambda f: pftrack.Tracker().update(None, f),
+    "Tracker.prime": lambda f: pftrack.Tracker().prime([f]),
+    "MultiObjectTracker.update": lambda f: MultiObjectTracker(rng=0).update(f),
+    "hsv_bins": lambda f: pftrack.hsv_bins(f),
+    "PaperDetector.detect": lambda f: make_detector("paper").detect(f),
+    "MOG2Detector.prime": lambda f: make_detector("mog2").prime([f]),
+    "estimate_motion": lambda f: estimate_motion(f, f),
+}
+
+
+@pytest.mark.parametrize("frame", [GREY, GREY_1, BGRA], ids=["grey", "grey1", "bgra"])
+@pytest.mark.parametrize("entry", sorted(ENTRY_POINTS))
+def test_a_grey_or_bgra_frame_is_a_value_error_naming_the_conversion(entry, frame):
+    # was: TypeError "frame must be a (H, W, 3) uint8 BGR array" from Tracker.update and
+    # prime, ValueError "frame must have shape (H, W, 3)" from hsv_bins
+    with pytest.raises(ValueError, match=r"must have shape \(H, W, 3\) \(BGR\), got \(6, 8") as e:
+        ENTRY_POINTS[entry](frame)
+    assert str(e.value).endswith(f"? {TO_BGR[id(frame)]} makes it BGR")
+
+
+@pytest.mark.parametrize("entry", sorted(ENTRY_POINTS))
+def test_a_frame_of_the_wrong_dtype_is_a_type_error(entry):
+    with pytest.raises(TypeError, match="frame dtype is float32, expected uint8"):
+        ENTRY_POINTS[entry](np.zeros((6, 8, 3), np.float32))
 
 
 def test_unpacked_views_track_as_their_packed_copies(frames):
@@ -197,3 +242,11 @@ def test_a_non_finite_detection_score_is_named_by_file_and_line_before_tracking(
     p.write_text("1,-1,10,10,20,40,0.9,-1,-1,-1\n2,-1,12,10,20,40,nan,-1,-1,-1\n")
     with pytest.raises(ValueError, match=r"det.txt:2: detection file line .*column 7 \(conf\)"):
         load_detections(p)
+
+
+@pytest.mark.parametrize("frame", [GREY, BGRA], ids=["grey", "bgra"])
+def test_video_writer_names_the_conversion_too(tmp_path, frame):
+    writer = pftrack.VideoWriter(tmp_path / "v.avi", 10.0)
+    with pytest.raises(ValueError, match=r"^frame has shape \(6, 8(, 4)?\), expected") as e:
+        writer.write(frame)
+    assert str(e.value).endswith(f"? {TO_BGR[id(frame)]} makes it BGR")

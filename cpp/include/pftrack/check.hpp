@@ -56,8 +56,14 @@ inline void require_finite(const Eigen::DenseBase<Derived>& a, const char* fn, c
             }
 }
 
+/// What particle weights summing to 0 mean inside the particle filter (sis_step, mh_step,
+/// estimate): every particle's likelihood underflowed or was never counted.
+inline constexpr const char* kParticleWeightsZero =
+    "all weights are 0: reference histogram empty, or every particle outside the image?";
+
 /// Weights: non-empty, finite, non-negative, positive finite sum. Returns the sum.
-/// `if_zero` says what a zero sum means for these values (default: the particle weights').
+/// `if_zero` says what a zero sum means for these values (default: only that every value is 0;
+/// the particle filter passes kParticleWeightsZero, a resampler called by a user none).
 template <class Derived>
 inline double require_weights(const Eigen::DenseBase<Derived>& w, const char* fn,
                               const char* what = "weights", const char* if_zero = nullptr) {
@@ -76,10 +82,12 @@ inline double require_weights(const Eigen::DenseBase<Derived>& w, const char* fn
         fail(fn, std::string(what) + " sum is not finite (overflow: the weights are finite but "
                                      "their total exceeds the largest double, 1.8e308; scale "
                                      "them down, e.g. divide by their maximum)");
-    if (!(sum > 0.0) && if_zero != nullptr) fail(fn, std::string(what) + " sums to 0 (" + if_zero + ")");
-    if (!(sum > 0.0))
-        fail(fn, std::string(what) + " sum to 0 (all weights are 0: reference histogram empty, "
-                                     "or every particle outside the image?)");
+    if (!(sum > 0.0)) {
+        const std::string name(what);
+        fail(fn, name + (name == "weights" ? " sum" : " sums") + " to 0 (" +
+                     (if_zero != nullptr ? if_zero : "every value is 0; at least one must be > 0") +
+                     ")");
+    }
     return sum;
 }
 

@@ -31,7 +31,7 @@ inline void check_particle_set(const Eigen::Ref<const RowMatrixXd>& particles,
     check_particles(particles, fn);
     require(weights.size() == particles.rows(), fn, "weights size", weights.size(),
             particles.rows());
-    require_weights(weights, fn);
+    require_weights(weights, fn, "weights", kParticleWeightsZero);
     require(means.rows() == 2 && means.cols() == kStateDim, fn,
             "means must be (2, 3): particle-set means at t-1 and t-2");
     require_finite(means, fn, "means");

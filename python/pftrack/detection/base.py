@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, real_array
+from pftrack._check import MAX_COORD, bgr_array, real_array
 from pftrack._typing import F64
 from pftrack.detection.size_model import PersonSizeModel
 
@@ -135,14 +135,16 @@ class BlobConfig:
 
 
 def check_frame(frame: object, fn: str) -> NDArray[np.uint8]:
-    """Return `frame` as a (H, W, 3) uint8 array, or raise naming the argument."""
+    """Return `frame` as a (H, W, 3) uint8 array, or raise naming the argument.
+
+    TypeError for what is not a uint8 array, ValueError for a wrong shape (:func:`bgr_array`).
+    """
     if not isinstance(frame, np.ndarray):
         raise TypeError(f"{fn}: frame is {type(frame).__name__}, expected a numpy.ndarray")
-    if frame.dtype != np.uint8:
-        raise ValueError(f"{fn}: frame dtype is {frame.dtype}, expected uint8 (BGR)")
-    if frame.ndim != 3 or frame.shape[2] != 3 or frame.shape[0] == 0 or frame.shape[1] == 0:
-        raise ValueError(f"{fn}: frame shape is {frame.shape}, expected (H, W, 3) with H, W > 0")
-    return frame
+    f = bgr_array(frame, f"{fn}: frame")  # the same array
+    if f.shape[0] == 0 or f.shape[1] == 0:
+        raise ValueError(f"{fn}: frame shape is {f.shape}, expected (H, W, 3) with H, W > 0")
+    return f
 
 
 def median_frame(frames: Iterable[NDArray[np.uint8]], fn: str) -> NDArray[np.float32]:

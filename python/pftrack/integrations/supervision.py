@@ -85,6 +85,9 @@ class SupervisionTracker:
 
     def __init__(self, frame_rate: float = 25.0, **options: Unpack[TrackerOptions]) -> None:
         self.tracker = Tracker(frame_rate, **options)
+        # supervision's boxes are always x1, y1, x2, y2: messages name them, without the hint
+        # that the rows look like x, y, w, h
+        self.tracker._box_source = "detections"
 
     def update_with_detections(self, detections: sv.Detections, frame: ArrayLike) -> sv.Detections:
         """Track one frame's detections; return those that belong to a track, with its id.

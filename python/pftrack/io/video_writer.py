@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import colour_hint
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
@@ -149,7 +150,9 @@ class VideoWriter:
     def write(self, frame: NDArray[np.uint8]) -> None:
         """Append one BGR uint8 frame (H, W, 3)."""
         if frame.ndim != 3 or frame.shape[2] != 3:
-            raise ValueError(f"frame has shape {frame.shape}, expected (H, W, 3) BGR")
+            raise ValueError(
+                f"frame has shape {frame.shape}, expected (H, W, 3) BGR{colour_hint(frame.shape)}"
+            )
         if self._size is None:
             self._open(int(frame.shape[0]), int(frame.shape[1]))
         h, w = self._size if self._size is not None else (0, 0)

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import number, real_array
+from pftrack._check import bgr_array, number, real_array
 
 BinnedImage = _core.BinnedImage
 
@@ -72,11 +72,7 @@ class HsvBinning:
 
 
 def _frame(frame: ArrayLike, name: str = "frame") -> NDArray[np.uint8]:
-    f = np.asarray(frame)
-    if f.dtype != np.uint8:
-        raise TypeError(f"{name} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
-    if f.ndim != 3 or f.shape[2] != 3:
-        raise ValueError(f"{name} must have shape (H, W, 3), got {f.shape}")
+    f = bgr_array(frame, name)
     if f.strides[2] != 1 or f.strides[1] != 3:
         f = np.ascontiguousarray(f)
     return f
@@ -108,6 +104,15 @@ def hsv_bins(
     -------
     BinnedImage
         ``.bins`` is the (H, W) int16 bin index per pixel, ``.n_bins`` the bin count.
+
+    Raises
+    ------
+    TypeError
+        A frame that is not uint8, a mask that is not uint8 or bool, a `binning` that is not
+        an :class:`HsvBinning`.
+    ValueError
+        A frame not of shape (H, W, 3) (a grey or BGRA frame's message names the
+        ``cv2.cvtColor`` conversion), or a mask of another size.
     """
     if not isinstance(binning, HsvBinning):
         raise TypeError(

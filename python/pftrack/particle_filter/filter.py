@@ -40,7 +40,8 @@ class FilterConfig:
     model : Ar2Model
         Dynamic model (eq. 7, or eq. 8 with ``use_means``).
     lam : float
-        λ of the likelihood ``exp(-λ D²)``.
+        λ > 0 of the likelihood ``exp(-λ D²)`` (as :func:`bhattacharyya_weights`: λ = 0 would
+        weigh every particle the same, and the filter would not follow colour).
     kernel : {"uniform", "epanechnikov"}
         Pixel weighting inside a box.
     estimate : {"mean", "map"}
@@ -66,8 +67,11 @@ class FilterConfig:
         integer(self.n_particles, "n_particles", 1, MAX_PARTICLES)
         integer(self.min_samples, "min_samples", 0, 2**31 - 1)  # 0: every pixel
         lam = number(self.lam, "FilterConfig: lam", finite=False)
-        if not (np.isfinite(lam) and lam >= 0):
-            raise ValueError(f"lam is {lam}, expected a finite value >= 0")
+        if not (np.isfinite(lam) and lam > 0):  # as bhattacharyya_weights: 0 ignores colour
+            raise ValueError(
+                f"FilterConfig: lam is {lam}, expected a finite number > 0 (0 would give every "
+                "particle the same weight: the filter would not follow colour)"
+            )
         if self.kernel not in ("uniform", "epanechnikov"):
             raise ValueError(f"kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'")
         if self.estimate not in ("mean", "map"):

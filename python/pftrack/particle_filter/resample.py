@@ -28,14 +28,15 @@ __all__ = [
 ]
 
 
-def _weights(weights: ArrayLike) -> NDArray[np.float64]:
+def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
+    """`weights` as a C-contiguous float64 array; errors start with `fn`, as the core's do."""
     w = np.asarray(weights)
     if w.dtype == object or not (np.issubdtype(w.dtype, np.number) or w.dtype == bool):
-        raise TypeError(f"weights must be numeric, got dtype {w.dtype}")
+        raise TypeError(f"{fn}: weights must be numeric, got dtype {w.dtype}")
     if np.iscomplexobj(w):
-        raise TypeError(f"weights must be real, got dtype {w.dtype}")
+        raise TypeError(f"{fn}: weights must be real, got dtype {w.dtype}")
     if w.ndim != 1:
-        raise ValueError(f"weights must be 1-D (N,), got shape {w.shape}")
+        raise ValueError(f"{fn}: weights must be 1-D (N,), got shape {w.shape}")
     return np.ascontiguousarray(w, dtype=np.float64)
 
 
@@ -71,7 +72,7 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     .. [1] Kitagawa, G. (1996). Monte Carlo filter and smoother for non-Gaussian nonlinear
        state space models. Journal of Computational and Graphical Statistics 5(1), 1-25.
     """
-    w = _weights(weights)
+    w = _weights(weights, "systematic_resample")
     return _core.systematic_resample(w, generator(rng, "systematic_resample: rng").random())
 
 
@@ -94,7 +95,7 @@ def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     .. [1] Douc, R., Cappé, O. & Moulines, E. (2005). Comparison of resampling schemes for
        particle filtering. ISPA 2005, 64-69.
     """
-    w = _weights(weights)
+    w = _weights(weights, "stratified_resample")
     return _core.stratified_resample(w, generator(rng, "stratified_resample: rng").random(len(w)))
 
 
@@ -119,7 +120,7 @@ def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.
     .. [1] Gordon, N., Salmond, D. & Smith, A. (1993). Novel approach to nonlinear/non-Gaussian
        Bayesian state estimation. IEE Proceedings F 140(2), 107-113.
     """
-    w = _weights(weights)
+    w = _weights(weights, "multinomial_resample")
     return _core.multinomial_resample(w, generator(rng, "multinomial_resample: rng").random(len(w)))
 
 
@@ -158,5 +159,5 @@ def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int
     .. [1] Liu, J. S. & Chen, R. (1998). Sequential Monte Carlo methods for dynamic systems.
        JASA 93(443), 1032-1044.
     """
-    w = _weights(weights)
+    w = _weights(weights, "residual_resample")
     return _core.residual_resample(w, generator(rng, "residual_resample: rng").random(len(w)))

@@ -29,7 +29,7 @@ import threading
 import warnings
 from collections.abc import Iterable
 from dataclasses import replace
-from typing import Any, SupportsIndex
+from typing import Any, NamedTuple, SupportsIndex
 
 import cv2
 import numpy as np
@@ -57,6 +57,7 @@ from pftrack.tracking.writer import TrackWriter
 
 __all__ = [
     "REFERENCE_RATE",
+    "CheckedBoxes",
     "Tracker",
     "check_boxes_xyxy",
     "working_size",
@@ -122,9 +123,26 @@ def working_size(shape: tuple[int, ...], max_side: int | None) -> tuple[int, int
     return max(1, round(cols * s)), max(1, round(rows * s))
 
 
+class CheckedBoxes(NamedTuple):
+    """What :func:`check_boxes_xyxy` returns (a tuple: ``xywh, cls, kept, ... = ...``)."""
+
+    xywh_score: F64
+    classes: NDArray[np.int64]
+    kept: NDArray[np.int64]
+    clipped: bool
+    flat: int
+    inverted: int
+    extent: int
+
+
 def check_boxes_xyxy(
-    dets: ArrayLike, shape: tuple[int, int]
-) -> tuple[F64, NDArray[np.int64], NDArray[np.int64], bool, int]:
+    dets: ArrayLike,
+    shape: tuple[int, int],
+    *,
+    name: str = "dets",
+    xywh_hint: bool = True,
+    seen: tuple[int, int] = (0, 0),
+) -> CheckedBoxes:
     """Check detections ``[x1, y1, x2, y2(, conf(, cls))]`` and clip them to the frame.
 
     Parameters
@@ -133,9 +151,19 @@ def check_boxes_xyxy(
         Boxes in pixels, optionally with confidence (default 1) and class id (default 0).
     shape : (int, int)
         The frame's rows and columns.
+    name : str
+        What the messages call `dets`.
+    xywh_hint : bool
+        Whether the refusal of inverted boxes may say they look like ``x, y, w, h`` (False
+        where the boxes come from a library that always gives ``x1, y1, x2, y2``).
+    seen : (int, int)
+        Inverted boxes and boxes with an extent (not without area) of the run's earlier
+        frames: the evidence of a layout mistake adds up over a run (:meth:`Tracker.update`).
 
     Returns
     -------
+    CheckedBoxes
+        A named tuple of:
     xywh_score : (K, 5) ndarray
         The boxes inside the frame as ``[left, top, w, h, conf]``, clipped to it.
     classes : (K,) ndarray of int
@@ -144,56 +172,73 @@ def check_boxes_xyxy(
         without area, are dropped).
     clipped : bool
         Whether any box reached outside the frame.
-    empty : int
-        Boxes without area (``x2 <= x1`` or ``y2 <= y1``: a detector's box trimmed to nothing
-        at the frame's edge) dropped, when they are at most half the rows.
+    flat : int
+        Boxes without area (``x2 == x1`` or ``y2 == y1``: a detector's box trimmed to nothing
+        at the frame's edge) dropped, however many there are.
+    inverted : int
+        Boxes with ``x2 < x1`` or ``y2 < y1`` (inverted) dropped: a detector's stray box.
+    extent : int
+        Boxes that are not without area (inverted ones too): with `inverted`, what to add to
+        `seen` for the next frame.
 
     Raises
     ------
     TypeError
         Not numbers.
     ValueError
-        Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31 - 1]``, or
-        more than half the boxes with ``x2 <= x1`` or ``y2 <= y1`` (a layout mistake, not a
-        detector's stray box; the message says when the rows look like ``x, y, w, h``).
+        Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31 - 1]``,
+        or a layout mistake: inverted boxes in this frame, and, with those of `seen`, at least
+        two and more than half of the boxes with an extent (the message says when the rows
+        look like ``x, y, w, h``). One stray box never trips it, nor do boxes without area,
+        which are no evidence of a layout.
     """
     d = np.asarray(dets)
     if d.dtype.kind not in "iuf":
-        raise TypeError(f"dets must be an array of numbers, got dtype {d.dtype}")
+        raise TypeError(f"{name} must be an array of numbers, got dtype {d.dtype}")
     d = d.astype(np.float64)
     if d.shape == (0,) or (d.ndim == 2 and d.shape[0] == 0 and d.shape[1] in (4, 5, 6)):
-        return np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64), False, 0
+        return CheckedBoxes(np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64),
+                            False, 0, 0, 0)  # fmt: skip
     if d.ndim != 2 or d.shape[1] not in (4, 5, 6):
         raise ValueError(
-            f"dets must have shape (N, 4), (N, 5) or (N, 6) [x1, y1, x2, y2(, conf(, cls))], "
+            f"{name} must have shape (N, 4), (N, 5) or (N, 6) [x1, y1, x2, y2(, conf(, cls))], "
             f"got {d.shape}"
         )
     if not np.isfinite(d).all():
         k = int(np.flatnonzero(~np.isfinite(d).all(axis=1))[0])
-        raise ValueError(f"dets row {k} contains NaN or inf: {d[k].tolist()}")
+        raise ValueError(f"{name} row {k} contains NaN or inf: {d[k].tolist()}")
     if d.shape[1] == 6:
         c = d[:, 5]
         odd = (c != np.round(c)) | (c < -MAX_CLASS - 1) | (c > MAX_CLASS)
         if odd.any():
             k = int(np.flatnonzero(odd)[0])
             raise ValueError(
-                f"dets row {k} has class id {c[k]:.17g}, expected an integer in "
+                f"{name} row {k} has class id {c[k]:.17g}, expected an integer in "
                 f"[{-MAX_CLASS - 1}, {MAX_CLASS}] (column 6: x1, y1, x2, y2, conf, cls)"
             )
-    bad = (d[:, 2] <= d[:, 0]) | (d[:, 3] <= d[:, 1])
-    if bad.mean() > 0.5:  # most rows: the layout is wrong (a few: boxes without area, dropped)
-        k = int(np.flatnonzero(bad)[0])
-        if np.all(d[bad, 2:4] > 0):  # positive as widths and heights: x, y, w, h rows
+    inverted = (d[:, 2] < d[:, 0]) | (d[:, 3] < d[:, 1])
+    flat = ~inverted & ((d[:, 2] == d[:, 0]) | (d[:, 3] == d[:, 1]))
+    n_inverted, n_flat = int(inverted.sum()), int(flat.sum())
+    # inverted boxes, at least two and most of the run's boxes with an extent: the layout is
+    # wrong (a stray one among good ones is dropped; boxes without area are no evidence)
+    bad, extent = seen[0] + n_inverted, seen[1] + len(d) - n_flat
+    if n_inverted and bad >= 2 and bad > extent / 2:
+        k = int(np.flatnonzero(inverted)[0])
+        which = (
+            f"{name} row {k} {d[k, :4].tolist()} has x2 < x1 or y2 < y1, as have {bad} of "
+            f"the {extent} boxes given{' so far' if seen[1] else ''}"
+        )
+        if xywh_hint and np.all(d[inverted, 2:4] > 0):  # positive as widths and heights
             raise ValueError(
-                f"dets row {k} {d[k, :4].tolist()} has x2 <= x1 or y2 <= y1: the boxes look "
-                "like x, y, w, h; give x1, y1, x2, y2 (x2 = x + w, y2 = y + h)"
+                f"{which}: the boxes look like x, y, w, h; give x1, y1, x2, y2 "
+                "(x2 = x + w, y2 = y + h)"
             )
-        raise ValueError(f"dets row {k} {d[k, :4].tolist()} has x2 <= x1 or y2 <= y1")
+        raise ValueError(f"{which} (x1, y1, x2, y2 expected)")
     rows, cols = shape
     limit = np.array([cols, rows, cols, rows], np.float64)
     box = np.clip(d[:, :4], 0.0, limit)
     clipped = bool((box != d[:, :4]).any())
-    inside = (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1]) & ~bad
+    inside = (box[:, 2] > box[:, 0]) & (box[:, 3] > box[:, 1]) & ~inverted & ~flat
     kept = inside.nonzero()[0].astype(np.int64)
     box = box[kept]
     conf = d[kept, 4] if d.shape[1] >= 5 else np.ones(len(kept))
@@ -202,7 +247,7 @@ def check_boxes_xyxy(
     xywh[:, 0:2] = box[:, :2]
     xywh[:, 2:4] = box[:, 2:] - box[:, :2]
     xywh[:, 4] = conf
-    return xywh, cls, kept, clipped, int(bad.sum())
+    return CheckedBoxes(xywh, cls, kept, clipped, n_flat, n_inverted, len(d) - n_flat)
 
 
 class _Alone:
@@ -298,12 +343,14 @@ class Tracker:
     -----
     One tracker is one run: use one per video and per thread. A second thread calling a
     method while another is inside one raises RuntimeError (as does the C++ background model
-    under any other path). ``copy.deepcopy(tracker)`` or a pickle of it is a checkpoint at any
-    point of a run with the built-in ``"paper"`` detector and the ``"sis"`` or ``"mh"``
-    sampler: the copy goes on exactly as the original. OpenCV's MOG2/KNN and the RJ-MCMC
-    chain cannot be copied once they have seen a frame (TypeError naming the option); a
-    checkpoint taken while another thread is inside a method raises RuntimeError, and
-    ``copy.copy`` (which would share the run's state) raises TypeError.
+    under any other path). ``copy.deepcopy(tracker)`` or a pickle of it (at any protocol, 0
+    to 5) is a checkpoint at any point of a run with the built-in ``"paper"`` detector and the
+    ``"sis"`` or ``"mh"`` sampler: the copy goes on exactly as the original. OpenCV's MOG2/KNN
+    and the RJ-MCMC chain cannot be copied once they have seen a frame (TypeError naming the
+    option); a checkpoint taken while another thread is inside a method raises RuntimeError,
+    and ``copy.copy`` (which would share the run's state) raises TypeError. To keep a
+    checkpoint in a file, ``pickle.dumps`` it first and write the bytes atomically (a refused
+    pickle then leaves the last file whole; docs/api.md).
 
     Memory grows with the run: every online row is kept until :meth:`finalize` (its offline
     pass needs the whole run), about 0.2 KB a row (measured with ``tracemalloc`` on a
@@ -321,6 +368,14 @@ class Tracker:
     ...     tracks = tracker.update(dets, frame)            # (M, 8) x1..y2, id, conf, cls, det_ind
     >>> rows = tracker.finalize()                           # doctest: +SKIP
     """
+
+    #: What messages about the boxes given to :meth:`update` call them; an adapter whose boxes
+    #: are always ``x1, y1, x2, y2`` names its own (and gets no ``x, y, w, h`` hint).
+    _box_source = "dets"
+    #: Inverted boxes (``x2 < x1`` or ``y2 < y1``) and boxes with an extent the run was given:
+    #: the evidence of x, y, w, h rows (:func:`check_boxes_xyxy`). A class default for a
+    #: checkpoint pickled before it was kept.
+    _layout: tuple[int, int] = (0, 0)
 
     def __init__(
         self,
@@ -550,6 +605,7 @@ class Tracker:
             self._warned: set[str] = set()  # the run's once-only warnings given so far
             self._max_conf = -np.inf
             self._given = False  # some update() of the run had detections
+            self._layout = (0, 0)  # inverted boxes, boxes with an extent (check_boxes_xyxy)
             # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
             # with the run's first frame (None: tracked at the frame's own size)
             self._scale: F64 | None = None
@@ -654,9 +710,13 @@ class Tracker:
         dets : (N, 6), (N, 5) or (N, 4) array_like of float, or None
             ``x1, y1, x2, y2, conf, cls`` in pixels (conf default 1, cls default 0); boxes
             reaching outside the frame are clipped to it (with one warning), boxes wholly
-            outside are ignored. None runs the built-in background-subtraction detector.
+            outside are ignored, and so are boxes without area (``x2 == x1`` or ``y2 == y1``)
+            and stray inverted ones (``x2 < x1`` or ``y2 < y1``), with one warning a run each.
+            Inverted boxes that are most of the run's are refused, ValueError (x, y, w, h rows:
+            :func:`check_boxes_xyxy`). None runs the built-in background-subtraction detector.
         frame : (H, W, 3) array_like of uint8
-            BGR frame.
+            BGR frame (TypeError for another dtype; ValueError for another shape, naming
+            ``cv2.cvtColor``'s conversion of a grey or BGRA frame).
 
         Returns
         -------
@@ -693,12 +753,22 @@ class Tracker:
                 kept = None
                 reports = self._tracker.update(work, None)
             else:
-                xywh, cls, kept, clipped, empty = check_boxes_xyxy(dets, (f.shape[0], f.shape[1]))
-                if empty:
+                xywh, cls, kept, clipped, flat, inverted, extent = check_boxes_xyxy(
+                    dets, (f.shape[0], f.shape[1]), name=self._box_source,
+                    xywh_hint=self._box_source == "dets", seen=self._layout,
+                )  # fmt: skip
+                if flat:
                     self._warn_once(
                         "empty",
-                        f"{empty} detection box{'es' if empty > 1 else ''} without area "
-                        "(x2 <= x1 or y2 <= y1) ignored; later ones are ignored silently",
+                        f"{flat} detection box{'es' if flat > 1 else ''} without area "
+                        "(x2 == x1 or y2 == y1) ignored; later ones are ignored silently",
+                    )
+                if inverted:
+                    self._warn_once(
+                        "inverted",
+                        f"{inverted} detection box{'es' if inverted > 1 else ''} with x2 < x1 "
+                        "or y2 < y1 ignored (x1, y1, x2, y2 expected); later ones are ignored "
+                        "silently",
                     )
                 if clipped:
                     self._warn_once(
@@ -715,6 +785,7 @@ class Tracker:
                 self._given = (
                     True  # once the frame is taken (an update that raises changes nothing)
                 )
+                self._layout = (self._layout[0] + inverted, self._layout[1] + extent)
                 self._max_conf = max(self._max_conf, confidence)
             self.frame_count += 1
             if first:  # the run's size, once its first frame is taken
@@ -794,6 +865,8 @@ class Tracker:
             )
         if "clipped" in self._warned:  # boxes were given, every one wholly outside the frame
             return "no detection lay inside the frame (wrong coordinate scale?)"
+        if self._warned & {"empty", "inverted"}:  # every box given had x2 <= x1 or y2 <= y1
+            return "every detection given was without area or had x2 < x1 or y2 < y1"
         return "the detections given held no box"
 
     def finalize(self) -> F64:

@@ -40,6 +40,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import bgr_array
 from pftrack._typing import F64
 from pftrack.tracking.config import CAMERA_MOTION, CameraConfig
 from pftrack.tracking.track import LiveTrack, Track
@@ -184,9 +185,7 @@ class _Measure:
         self.config = config
 
     def grey(self, frame: NDArray[np.uint8]) -> tuple[float, NDArray[np.uint8]]:
-        f = np.asarray(frame)
-        if f.dtype != np.uint8 or f.ndim != 3 or f.shape[2] != 3:
-            raise TypeError(f"frame must be a (H, W, 3) uint8 BGR array, got {f.dtype} {f.shape}")
+        f = bgr_array(frame)
         factor = min(1.0, self.config.max_side / max(f.shape[:2]))
         return factor, _grey(f, factor)
 
