@@ -117,6 +117,11 @@ def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> 
         return f"{tmp / 'newdir'}/"
     if case == "-":  # was: a file named `-` written (the test runs in `tmp`)
         return "-"
+    if case == "empty":  # was: "--out . is a folder; give a file name", or (--render, --plot,
+        # --json, --csv, --figure) nothing written and nothing said
+        return ""
+    if case == "under a file":  # was: "folder t_ok.txt does not exist" (it does, as a file)
+        return tmp / "t_ok.txt" / name
     if case == "existing folder":
         (tmp / name).mkdir()
         return tmp / name
@@ -139,7 +144,12 @@ def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> 
 
 
 CASES = ["existing folder", "missing folder", "unwritable folder", "unsupported extension",
-         "an input", "new folder with a trailing slash", "-"]  # fmt: skip
+         "an input", "new folder with a trailing slash", "-", "empty", "under a file"]  # fmt: skip
+#: The whole message of a case, after ``pftrack CMD: error: `` (OPTION, OUT, TMP filled in).
+MESSAGES = {
+    "empty": "{option} is empty; give a file name",
+    "under a file": "{option} {out}: {tmp}/t_ok.txt is a file, not a folder",
+}
 
 
 def _snapshot(folder: Path) -> dict[str, bytes | None]:
@@ -178,6 +188,9 @@ def test_bad_output_is_refused_before_any_work(
     lines = err.strip().splitlines()
     prog = "experiment gaps" if command.startswith("experiment") else command.split()[0]
     assert len(lines) == 1 and lines[0].startswith(f"pftrack {prog}: error: "), err
+    if case in MESSAGES:
+        said = MESSAGES[case].format(option=command.split()[1], out=out, tmp=tmp_path)
+        assert lines[0] == f"pftrack {prog}: error: {said}"
     assert _snapshot(tmp_path) == before  # nothing changed, nothing left behind
     assert {k: p.read_bytes() for k, p in inputs.items()} == before_inputs
 
@@ -191,9 +204,44 @@ def test_demo_refuses_a_file_as_its_folder_and_a_folder_as_an_output(
     assert capsys.readouterr().err.startswith("pftrack demo: error: --out-dir")
     (tmp_path / "d" / "annotated.mp4").mkdir(parents=True)
     assert main(["demo", "--out-dir", str(tmp_path / "d"), "--frames", "5"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("pftrack demo: error: ") and "is a folder" in err
+    # the folder in the way is named inside --out-dir; was "--out-dir d/annotated.mp4 is a
+    # folder; give a file name", a name the user cannot give
+    d = tmp_path / "d"
+    assert capsys.readouterr().err == (
+        f"pftrack demo: error: --out-dir {d}: {d}/annotated.mp4 is a folder, where this "
+        "command writes a file; move it, or give another --out-dir\n"
+    )
     assert sorted(p.name for p in (tmp_path / "d").iterdir()) == ["annotated.mp4"]
+
+
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+@pytest.mark.parametrize("where", ["tracking", "writing"])
+def test_interrupted_demo_removes_the_folder_it_made(
+    where: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Was: Ctrl-C left the new --out-dir behind, empty, while saying no output was changed."""
+    import pftrack.demo as demo
+
+    def interrupt(*args: Any, **kwargs: Any) -> Any:
+        raise KeyboardInterrupt
+
+    def interrupt_after_writing(path: Any, *args: Any, **kwargs: Any) -> None:
+        Path(path).write_bytes(b"half a plot")  # a staged file: removed with the others
+        raise KeyboardInterrupt
+
+    if where == "tracking":
+        monkeypatch.setattr(demo, "track_frames", interrupt)
+    else:
+        monkeypatch.setattr(demo, "plot_trajectories", interrupt_after_writing)
+    (tmp_path / "old").mkdir()
+    for out_dir in (tmp_path / "new" / "deeper", tmp_path / "old"):
+        assert main(["demo", "--out-dir", str(out_dir), "--frames", "5"]) == 130
+        assert capsys.readouterr().err.endswith("interrupted; no output was changed\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old"]  # new/deeper: both removed
+    assert list((tmp_path / "old").iterdir()) == []  # there before: kept
 
 
 def test_recover_in_place_needs_the_flag(
@@ -736,6 +784,39 @@ def test_dash_as_an_output_folder_is_refused(
         "give a folder name\n"
     )
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["demo", "--out-dir", "{out}", "--frames", "5"], ["batch", "{video}", "--out", "{out}"],
+     ["recover", "{tracks}", "{gt}", "--out", "{out}"],
+     ["smooth", "{tracks}", "{gt}", "--out", "{out}"]],
+)  # fmt: skip
+@pytest.mark.parametrize("case", ["empty", "under a file"])
+def test_an_empty_output_folder_or_one_under_a_file_is_refused(
+    argv: list[str],
+    case: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Was: ``--out ""`` wrote into the current folder (``Path("")`` is ``.``); a folder under a
+    file: "cannot create the folder (Not a directory)"."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "notes.txt").write_text("x")
+    out = "" if case == "empty" else "notes.txt/o"
+    names = {k: str(p) for k, p in inputs.items()}
+    argv = [a.format(out=out, **names) for a in argv]
+    assert main([*argv, *(["--workers", "0"] if argv[0] != "demo" else [])]) == 2
+    what = "--out-dir" if argv[0] == "demo" else "--out"
+    said = (
+        f"{what} is empty; give a folder name"
+        if case == "empty"
+        else f"{what} notes.txt/o: notes.txt is a file, not a folder"
+    )
+    assert capsys.readouterr().err == f"pftrack {argv[0]}: error: {said}\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
 
 
 @pytest.mark.parametrize(

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from pathlib import Path
+import os
 
 import numpy as np
 
 from pftrack.eval import evaluate_mot, format_metrics
-from pftrack.io.atomic import check_output, refuse_dash, staged_outputs
+from pftrack.io.atomic import check_output, check_output_folder, made_folder, staged_outputs
 from pftrack.io.mot import write_mot
 from pftrack.recovery.demo import demo_report
 from pftrack.render import plot_trajectories, write_annotated_video
@@ -17,37 +17,36 @@ from pftrack.tracking import TrackerConfig, track_frames
 __all__ = ["run_demo"]
 
 
-def run_demo(out_dir: Path, *, seed: int = 0, n_frames: int = 150, particles: int = 100) -> int:
+def run_demo(
+    out_dir: str | os.PathLike[str], *, seed: int = 0, n_frames: int = 150, particles: int = 100
+) -> int:
     """Track a synthetic scene, score it, render it, and show trajectory recovery.
 
     Writes ``tracks.txt``, ``truth.txt``, ``annotated.mp4`` and ``trajectories.png`` into
-    `out_dir` and prints MOTA, IDF1 and the rest against the scene's known truth.
+    `out_dir` (created if missing; removed again, when it was created and is still empty, if
+    the run stops before writing them) and prints MOTA, IDF1 and the rest against the scene's
+    known truth.
     """
     from dataclasses import replace
 
-    refuse_dash(out_dir, "--out-dir", output=True, name="folder")
-    if out_dir.exists() and not out_dir.is_dir():
-        raise ValueError(f"--out-dir {out_dir} is a file; give a folder")
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:  # a read-only or special file system, a file on the way
-        raise ValueError(
-            f"--out-dir {out_dir}: cannot create the folder ({exc.strerror})"
-        ) from None
+    out_dir = check_output_folder(out_dir, "--out-dir")
     names = ("tracks.txt", "truth.txt", "annotated.mp4", "trajectories.png")
-    for name in names:  # before any work: every output can be written
-        check_output(out_dir / name, what="--out-dir")
-    scene = make_scene(n_frames=n_frames, rng=seed)
-    base = TrackerConfig()
-    config = replace(base, filter=replace(base.filter, n_particles=particles))
-    run = track_frames(scene.frames, config=config, rng=seed)
-    with staged_outputs() as stage:  # the four files are replaced together, or not at all
-        write_mot(stage(out_dir / "tracks.txt"), run.rows)
-        scene.write_truth(stage(out_dir / "truth.txt"))
-        write_annotated_video(stage(out_dir / "annotated.mp4"), scene.frames, run.rows, scene.fps)
-        plot_trajectories(stage(out_dir / "trajectories.png"), run.rows,
-                          background=scene.background, truth=scene.truth,
-                          title="tracks (colour) over truth (grey)")  # fmt: skip
+    with made_folder(out_dir, "--out-dir"):
+        for name in names:  # before any work: every output can be written
+            check_output(out_dir / name, what="--out-dir", within=out_dir)
+        scene = make_scene(n_frames=n_frames, rng=seed)
+        base = TrackerConfig()
+        config = replace(base, filter=replace(base.filter, n_particles=particles))
+        run = track_frames(scene.frames, config=config, rng=seed)
+        with staged_outputs() as stage:  # the four files are replaced together, or not at all
+            write_mot(stage(out_dir / "tracks.txt"), run.rows)
+            scene.write_truth(stage(out_dir / "truth.txt"))
+            write_annotated_video(
+                stage(out_dir / "annotated.mp4"), scene.frames, run.rows, scene.fps
+            )
+            plot_trajectories(stage(out_dir / "trajectories.png"), run.rows,
+                              background=scene.background, truth=scene.truth,
+                              title="tracks (colour) over truth (grey)")  # fmt: skip
     metrics = evaluate_mot(scene.truth, run.rows, image_size=(scene.width, scene.height))
     print(f"pftrack demo: synthetic scene, {n_frames} frames {scene.width}x{scene.height}, "
           f"{len(np.unique(scene.truth[:, 1]))} walkers, seed {seed}")  # fmt: skip

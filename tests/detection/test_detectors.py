@@ -274,3 +274,70 @@ def test_paper_foreground_without_bins_is_the_same_pass():
         assert none is None
         np.testing.assert_array_equal(mask_b, mask)
         np.testing.assert_array_equal(hsv_bins(f, lazy=True).bins, frame_bins.bins)
+
+
+def _knn_masks(det: KnnDetector, frames: list[np.ndarray]) -> list[np.ndarray]:
+    det.prime(frames[:10])
+    return [det.foreground(f, shadows=True)[0] for f in frames]
+
+
+def _moving_frames(n: int = 60) -> list[np.ndarray]:
+    # KNN's random draws decide at which frame each pixel's sample lists take a new sample:
+    # pixel noise near its distance threshold makes the samples taken matter
+    rng = np.random.default_rng(3)
+    out = []
+    for f, _ in moving_rectangle(n, empty=10, seed=3):
+        noise = rng.normal(0.0, 12.0, f.shape)
+        out.append(np.clip(f + noise, 0, 255).astype(np.uint8))
+    return out
+
+
+def test_knn_masks_depend_on_the_seed_alone() -> None:
+    """OpenCV's KNN draws from the calling thread's OpenCV generator, which nothing seeded.
+
+    Was: the same frames gave other masks after other OpenCV draws on the thread (a second
+    run in the process, another detector before), so ``pftrack batch`` and a Python loop
+    differed from ``pftrack track`` with the same seed. Now each apply is seeded from the
+    detector's seed: the same masks after unrelated draws, on another thread, with any number
+    of OpenCV threads, and after ``reset``.
+    """
+    import threading
+
+    frames = _moving_frames()
+    expected = _knn_masks(KnnDetector(seed=7), frames)
+    cv2.randu(np.zeros((100, 100), np.uint8), 0, 255)  # someone else's draws on this thread
+    det = KnnDetector(seed=7)
+    assert all(np.array_equal(a, b) for a, b in zip(_knn_masks(det, frames), expected, strict=True))
+    det.reset()
+    assert all(np.array_equal(a, b) for a, b in zip(_knn_masks(det, frames), expected, strict=True))
+    threads = cv2.getNumThreads()
+    try:
+        for n in (1, 4):
+            cv2.setNumThreads(n)
+            got = _knn_masks(KnnDetector(seed=7), frames)
+            assert all(np.array_equal(a, b) for a, b in zip(got, expected, strict=True)), n
+    finally:
+        cv2.setNumThreads(threads)
+    # two detectors of one seed interleaved on two threads: each as alone
+    out: dict[int, list[np.ndarray]] = {}
+
+    def run(k: int) -> None:
+        out[k] = _knn_masks(KnnDetector(seed=7), frames)
+
+    workers = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join()
+    for k in range(2):
+        assert all(np.array_equal(a, b) for a, b in zip(out[k], expected, strict=True)), k
+    other = _knn_masks(KnnDetector(seed=8), frames)
+    assert any(not np.array_equal(a, b) for a, b in zip(other, expected, strict=True))
+
+
+def test_knn_seed_is_checked() -> None:
+    with pytest.raises(ValueError, match=r"KnnDetector: seed is -1, expected an int >= 0"):
+        KnnDetector(seed=-1)
+    with pytest.raises(TypeError, match=r"KnnDetector: seed must be an int >= 0, got float"):
+        KnnDetector(seed=1.5)  # type: ignore[arg-type]
+    assert make_detector("knn", seed=3).seed == 3

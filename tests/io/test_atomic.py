@@ -391,3 +391,32 @@ def test_a_side_file_keeps_its_hidden_name_when_every_name_is_taken(
     assert side.kept is not None and side.kept.name.startswith(".t.txt.")
     assert side.kept.read_text() == "row\n"
     assert (tmp_path / "t.partial.txt").read_text() == "a user's file\n"
+
+
+@pytest.mark.parametrize("writer", ["atomic_write", "atomic_path", "side_file", "stage"])
+def test_a_folder_that_is_a_file_is_named_so(writer: str, tmp_path: Path) -> None:
+    """Was: ``output folder does not exist: notes.txt``; it exists, as a file."""
+    from pftrack.io import atomic
+
+    notes = tmp_path / "notes.txt"
+    notes.write_text("x")
+    target = notes / "sub" / "x.txt"
+
+    def write(path: Path) -> None:
+        if writer == "stage":
+            with atomic.staged_outputs() as stage:
+                stage(path)
+        else:
+            with getattr(atomic, writer)(path):
+                pass
+
+    with pytest.raises(
+        NotADirectoryError, match=rf"^output {target}: {notes} is a file, not a folder$"
+    ):
+        write(target)
+    missing = tmp_path / "no" / "x.txt"
+    with pytest.raises(
+        FileNotFoundError, match=rf"^output folder does not exist: {tmp_path / 'no'}$"
+    ):
+        write(missing)
+    assert notes.read_text() == "x" and sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import threading
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -54,8 +55,13 @@ def test_builtin_detector_ahead_gives_the_loops_rows(scene, camera):
     # "on": the background is never trusted, the tracker reads the detector's full-frame bins
     frames = move_camera(scene).frames if camera == "on" else scene.frames
     config = replace(TrackerConfig(), camera_motion=camera)
-    run = track_frames(frames, config=config, rng=4)
-    expected = loop_rows(frames, config, 4)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        run = track_frames(frames, config=config, rng=4)
+        expected = loop_rows(frames, config, 4)
+    # the built-in detector on a moving camera is said once a run, in both
+    moving = [str(w.message) for w in said if "the camera counts as moving" in str(w.message)]
+    assert len(moving) == (2 if camera == "on" else 0) and len(said) == len(moving), moving
     assert len(expected) > 0
     np.testing.assert_array_equal(run.rows, expected)
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import functools
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from pftrack._typing import PathLike
@@ -88,7 +87,7 @@ def track_many(
     ]
     return run_jobs(
         jobs,
-        Path(out_dir),
+        out_dir,  # as given: run_jobs refuses an empty one (Path("") is ".")
         kind="track",
         settings=opts.settings(),
         suffixes=(opts.render,) if opts.render else (),
@@ -120,7 +119,7 @@ def recover_many(
     jobs = [Job(p.stem, recover_file, (p, opts), (p,)) for p in find_track_files(inputs)]
     return run_jobs(
         jobs,
-        Path(out_dir),
+        out_dir,  # as given: run_jobs refuses an empty one (Path("") is ".")
         kind="recover",
         settings=opts.settings(),
         client=client,
@@ -151,7 +150,7 @@ def smooth_many(
     jobs = [Job(p.stem, smooth_file, (p, opts), (p,)) for p in find_track_files(inputs)]
     return run_jobs(
         jobs,
-        Path(out_dir),
+        out_dir,  # as given: run_jobs refuses an empty one (Path("") is ".")
         kind="smooth",
         settings=opts.settings(),
         client=client,

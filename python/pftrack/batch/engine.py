@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._progress import Bar, enabled, progress
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
-from pftrack.io.atomic import atomic_write, check_output, refuse_dash
+from pftrack.io.atomic import atomic_write, check_output, check_output_folder
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
 
@@ -906,11 +906,15 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     return f"{seen[0]}: {UNSEEN.format(host=outcome.host)}"
 
 
-def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) -> None:
-    """Before any work, writing nothing: no output overwrites an input or is a folder."""
-    refuse_dash(out_dir, "--out", output=True, name="folder")
-    if out_dir.exists() and not out_dir.is_dir():
-        raise ValueError(f"--out {out_dir} is a file; give a folder")
+def _check_outputs(
+    jobs: Sequence[Job], out_dir: str | os.PathLike[str], suffixes: Sequence[str]
+) -> Path:
+    """Before any work, writing nothing: no output overwrites an input or is a folder.
+
+    Returns `out_dir` as a Path (checked as given: an empty one is refused, not taken for the
+    current folder).
+    """
+    out_dir = check_output_folder(out_dir, "--out")
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
     guarded = {_file_id(p) for job in jobs for p in job.guards} - {None}  # images: by inode
     names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]
@@ -923,6 +927,7 @@ def _check_outputs(jobs: Sequence[Job], out_dir: Path, suffixes: Sequence[str]) 
             raise ValueError(f"{what} is an input of this run; write elsewhere")
         if target.is_dir():
             raise ValueError(f"--out {target} is a folder; it would be an output of this run")
+    return out_dir
 
 
 def _file_id(path: Path) -> tuple[int, int] | None:
@@ -1010,9 +1015,8 @@ def run_jobs(
     if n_workers is not None and n_workers < 0:
         raise ValueError(f"n_workers is {n_workers}, expected >= 0")
     address = where_to_run(client, scheduler, n_workers)  # checked even when nothing is to run
-    out = Path(out_dir)
     start = time.perf_counter()
-    _check_outputs(jobs, out, suffixes)
+    out = _check_outputs(jobs, out_dir, suffixes)
     summary = BatchSummary(kind, out, settings=settings)
     entries: dict[str, dict[str, Any]] = {}
     notes: dict[str, str] = {}

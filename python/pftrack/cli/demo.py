@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
 
 from pftrack.cli._options import add_command, bounded_int, non_negative_int
@@ -38,6 +37,4 @@ def run(args: argparse.Namespace) -> int:
 
     opencv_single_threaded()
 
-    return run_demo(
-        Path(args.out_dir), seed=args.seed, n_frames=args.frames, particles=args.particles
-    )
+    return run_demo(args.out_dir, seed=args.seed, n_frames=args.frames, particles=args.particles)

@@ -213,9 +213,9 @@ def run(args: argparse.Namespace) -> int:
     jobs = _jobs(args)
     # every ground-truth and result file read (a link named s.json may lead to one)
     inputs = (args.gt, args.res, *(p for _, seq, res in jobs for p in (seq.gt_path, res)))
-    if args.json:
+    if args.json is not None:  # "" too: refused as empty (was: nothing written, silently)
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
-    if args.csv:
+    if args.csv is not None:
         check_output(args.csv, what="--csv", suffixes=(".csv",), inputs=inputs)
     scales = _scales(args.scale or [], [name for name, _, _ in jobs])
 

@@ -257,9 +257,9 @@ def run_gaps(args: argparse.Namespace) -> int:
         _parse_mask(args.mask)  # bad options are refused before any work
     if args.image_size:
         _parse_size(args.image_size)
-    if args.json:
+    if args.json is not None:  # "" too: refused as empty (was: nothing written, silently)
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
-    if args.figure:
+    if args.figure is not None:
         check_output(args.figure, what="--figure", suffixes=FIGURE_SUFFIXES, inputs=inputs)
     if multi:
         return _run_sequences(args)

@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     check_input_file(args.tracks, what="tracks file")
     inputs = (*source_files(args.source), args.tracks)
     check_output(args.out, what="--out", suffixes=VIDEO_SUFFIXES, inputs=inputs)
-    if args.plot:
+    if args.plot is not None:  # "" too: refused as empty (was: no plot, without a word)
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--plot": args.plot})
     rows = read_tracks(args.tracks)

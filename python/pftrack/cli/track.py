@@ -202,9 +202,9 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
             found = seq.detections if seq is not None else None
             inputs += (found,) if found is not None else ()
     check_output(args.out, what="--out", inputs=inputs)
-    if args.render:
+    if args.render is not None:  # "" too: refused as empty (was: no video, without a word)
         check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
-    if args.plot:
+    if args.plot is not None:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--render": args.render, "--plot": args.plot})
 

@@ -54,13 +54,18 @@ def _split(cls: type, config: dict[str, Any], name: str) -> Any:
     return cls(**{k: v for k, v in config.items() if k in own}, blobs=blobs, hsv=hsv)
 
 
-def make_detector(name: str, **config: Any) -> PaperDetector | Mog2Detector | KnnDetector:
+def make_detector(
+    name: str, *, seed: int = 0, **config: Any
+) -> PaperDetector | Mog2Detector | KnnDetector:
     """Build a detector by name.
 
     Parameters
     ----------
     name : {"paper", "mog2", "knn"}
         The paper's detector (C++ pass), or OpenCV's MOG2 / KNN subtractors.
+    seed : int
+        Seed of KNN's random sample updates (`KnnDetector`); the paper's detector and MOG2
+        draw no random numbers and ignore it.
     **config
         Fields of `PaperConfig` / `Mog2Config` / `KnnConfig`, of `BlobConfig` (``min_area`` …)
         and of `HsvBinning` (``n_h`` …), flat; or ``blobs=`` / ``hsv=`` config objects.
@@ -81,7 +86,7 @@ def make_detector(name: str, **config: Any) -> PaperDetector | Mog2Detector | Kn
     if name == "mog2":
         return Mog2Detector(_split(Mog2Config, config, name))
     if name == "knn":
-        return KnnDetector(_split(KnnConfig, config, name))
+        return KnnDetector(_split(KnnConfig, config, name), seed=seed)
     raise ValueError(f"make_detector: name is {name!r}, expected one of {', '.join(DETECTORS)}")
 
 

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack._check import integer, number
+from pftrack._check import seed as check_seed
 from pftrack.detection.base import (
     BlobConfig,
     BlobExtractor,
@@ -133,6 +134,10 @@ class _OpenCvDetector:
         self._blobs.reset()
         self._shape = None
 
+    def _apply(self, image: NDArray[np.uint8], learning_rate: float) -> Any:
+        """One frame (or a priming image) through the subtractor: its raw mask."""
+        return self._sub.apply(image, learningRate=learning_rate)
+
     def prime(self, frames: Iterable[NDArray[np.uint8]], repeats: int = 30) -> None:
         """Start from the per-pixel median of `frames`, shown `repeats` times to a new subtractor.
 
@@ -153,7 +158,7 @@ class _OpenCvDetector:
         median = median_f.round().astype(np.uint8)  # numpy.median's values
         self.reset()
         for _ in range(repeats):
-            self._sub.apply(median)
+            self._apply(median, -1.0)
         self._shape = median.shape
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
@@ -182,7 +187,7 @@ class _OpenCvDetector:
         self._shape = frame.shape
         # 255 = foreground, 127 = shadow: kept with `shadows` (the grey-level cleaning keeps
         # both), else shadows are background
-        raw = np.asarray(self._sub.apply(frame, learningRate=self._learning_rate), np.uint8)
+        raw = np.asarray(self._apply(frame, self._learning_rate), np.uint8)
         if not shadows:
             raw = np.where(raw == 255, np.uint8(255), np.uint8(0))
         return self._blobs.clean(raw), None
@@ -217,6 +222,26 @@ class KnnDetector(_OpenCvDetector):
     Parameters
     ----------
     config : KnnConfig, optional
+    seed : int
+        Seed of the subtractor's random sample updates (an int >= 0): the same seed and
+        frames give the same masks, on any thread and with any number of OpenCV threads.
+
+    Raises
+    ------
+    TypeError, ValueError
+        `seed` not an int >= 0.
+
+    Notes
+    -----
+    OpenCV's KNN model picks at random, every few frames, the frame at which each pixel's
+    sample lists are next updated, drawing from OpenCV's random generator of the calling
+    thread (``cv::theRNG()``), which nothing seeds: the same frames gave other masks after
+    other OpenCV work on the thread, or on another thread. Before each ``apply`` (priming
+    included) that generator is seeded from `seed` and the number of images the model has
+    seen since its last reset, so a run's masks depend on `seed` and its frames alone (the
+    draws come after OpenCV's parallel per-row pass, on the calling thread: the masks are the
+    same with one OpenCV thread or many). The calling thread's OpenCV generator is left
+    seeded: code that draws from it afterwards (``cv2.randu``) gets a state set here.
 
     References
     ----------
@@ -224,9 +249,22 @@ class KnnDetector(_OpenCvDetector):
        image pixel for the task of background subtraction. Pattern Recognition Letters 27(7).
     """
 
-    def __init__(self, config: KnnConfig | None = None) -> None:
+    def __init__(self, config: KnnConfig | None = None, seed: int = 0) -> None:
         self.config = config if config is not None else KnnConfig()
+        self.seed = check_seed(seed, "KnnDetector: seed")
+        self._seen = 0  # images applied since the model was made: the next one's seed
         super().__init__(self.config.blobs, self.config.hsv, self.config.learning_rate)
+
+    def reset(self) -> None:
+        """Forget the background model (its random draws start again from `seed`)."""
+        super().reset()
+        self._seen = 0
+
+    def _apply(self, image: NDArray[np.uint8], learning_rate: float) -> Any:
+        cv2.setRNGSeed(apply_seed(self.seed, self._seen))
+        raw = self._sub.apply(image, learningRate=learning_rate)
+        self._seen += 1
+        return raw
 
     def _make(self) -> Any:
         return cv2.createBackgroundSubtractorKNN(
@@ -234,3 +272,18 @@ class KnnDetector(_OpenCvDetector):
             dist2Threshold=self.config.dist2_threshold,
             detectShadows=True,
         )
+
+
+_MASK64 = (1 << 64) - 1
+
+
+def apply_seed(seed: int, n: int) -> int:
+    """The OpenCV seed (in [0, 2**31 - 1]) of image `n` (from 0) of a `KnnDetector` of `seed`.
+
+    SplitMix64's finaliser of ``seed + (n + 1) * golden ratio`` (mod 2**64): neighbouring
+    images and seeds get unrelated streams.
+    """
+    z = (seed + (n + 1) * 0x9E3779B97F4A7C15) & _MASK64
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK64
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK64
+    return (z ^ (z >> 31)) & 0x7FFFFFFF

@@ -120,6 +120,38 @@ def _refuse_folder_name(path: PathLike, what: str = "output") -> None:
         raise ValueError(f"{what} {text} names a folder; give a file name")
 
 
+def _blocking(folder: Path) -> Path | None:
+    """What stops `folder` from being a folder: a file at its place or above it, or None.
+
+    The path itself or its nearest existing parent, when that is not a folder (``notes.txt``
+    of ``notes.txt/x``). None when `folder` is a folder, or only missing (its nearest existing
+    parent is one).
+    """
+    p = folder
+    while not os.path.lexists(p) and p.parent != p:
+        p = p.parent
+    return None if os.path.isdir(p) else p
+
+
+def _not_a_folder(path: Path) -> str:
+    """``PATH is a file, not a folder`` (``is not a folder``: a device, a broken link)."""
+    return f"{path} is a file, not a folder" if path.is_file() else f"{path} is not a folder"
+
+
+def _missing_folder(folder: Path, target: PathLike) -> OSError:
+    """The error of output `target`, whose `folder` is not a folder: missing, or a file.
+
+    Was: ``output folder does not exist: notes.txt`` for ``notes.txt/x.txt``, where
+    ``notes.txt`` exists, as a file.
+    """
+    blocker = _blocking(folder)
+    if blocker is not None:
+        return NotADirectoryError(
+            f"output {os.fsdecode(os.fspath(target))}: {_not_a_folder(blocker)}"
+        )
+    return FileNotFoundError(f"output folder does not exist: {folder}")
+
+
 def _create_beside(folder: Path, prefix: str, suffix: str, made: list[str]) -> tuple[int, str]:
     """Create a new, unique file in `folder`; the kernel applies the umask to ``0o666``.
 
@@ -219,7 +251,7 @@ def atomic_write(
     target = resolved.path
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
-        raise FileNotFoundError(f"output folder does not exist: {folder}")
+        raise _missing_folder(folder, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
         fd, tmp = _create_beside(folder, f".{target.name}.", suffix or ".tmp", made)
@@ -256,7 +288,7 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
     target = resolved.path
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
-        raise FileNotFoundError(f"output folder does not exist: {folder}")
+        raise _missing_folder(folder, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
         fd, tmp = _create_beside(folder, f".{target.stem}.", Path(path).suffix, made)
@@ -377,7 +409,7 @@ def side_file(path: PathLike, suffix: str = ".part") -> Iterator[SideFile]:
     target = resolved.path
     folder = target.parent if str(target.parent) else Path(".")
     if not folder.is_dir():
-        raise FileNotFoundError(f"output folder does not exist: {folder}")
+        raise _missing_folder(folder, path)
     made: list[str] = []
     side: SideFile | None = None
     try:  # the file is made inside: removed whenever the block is left without lines
@@ -445,12 +477,76 @@ def refuse_dash(
     )
 
 
+def check_output_folder(path: PathLike, what: str) -> Path:
+    """Check, before any work, an output folder option (``--out-dir``); return it as a Path.
+
+    The folder need not exist (:func:`made_folder` creates it).
+
+    Raises
+    ------
+    ValueError
+        It is empty (``Path("")`` is the current folder: was, the outputs written there), ``-``
+        (standard output), or an existing file.
+    NotADirectoryError
+        It lies under a file (``notes.txt/out``).
+    """
+    text = os.fsdecode(os.fspath(path))
+    if not text:
+        raise ValueError(f"{what} is empty; give a folder name")
+    refuse_dash(text, what, output=True, name="folder")
+    target = Path(text)
+    if target.exists() and not target.is_dir():
+        raise ValueError(f"{what} {target} is a file; give a folder")
+    blocker = _blocking(target)
+    if blocker is not None:  # was "cannot create the folder (Not a directory)"
+        raise NotADirectoryError(f"{what} {target}: {_not_a_folder(blocker)}")
+    return target
+
+
+def _remove_empty(folders: Iterable[Path]) -> None:
+    """Remove `folders` (deepest first) while they are empty; stop at the first that is not."""
+    for folder in folders:
+        try:
+            os.rmdir(folder)
+        except OSError:
+            return
+
+
+@contextlib.contextmanager
+def made_folder(path: PathLike, what: str) -> Iterator[Path]:
+    """Create output folder `path` (its missing parents too) for the block's outputs.
+
+    When the block raises (an error, Ctrl-C, SIGTERM), the folders created here that are still
+    empty are removed again, so a run that wrote nothing leaves nothing (a folder that existed
+    before is kept). Was: ``pftrack demo`` interrupted left its new ``--out-dir`` behind, empty,
+    while saying that no output was changed.
+
+    Raises
+    ------
+    ValueError
+        The folder cannot be created (a read-only file system), naming `what`.
+    """
+    target = Path(path)
+    new = [p for p in (target, *target.parents) if not os.path.lexists(p)]  # deepest first
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # a read-only or special file system, a file on the way
+        _remove_empty(new)
+        raise ValueError(f"{what} {target}: cannot create the folder ({exc.strerror})") from None
+    try:
+        yield target
+    except BaseException:
+        _remove_empty(new)
+        raise
+
+
 def check_output(
     path: PathLike,
     *,
     what: str = "output",
     suffixes: tuple[str, ...] | None = None,
     inputs: tuple[PathLike, ...] = (),
+    within: PathLike | None = None,
 ) -> Path:
     """Check, before any work, that `path` can be written; return it as a :class:`Path`.
 
@@ -464,15 +560,21 @@ def check_output(
         Accepted extensions, lower case with the dot (e.g. ``(".mp4", ".avi")``).
     inputs : tuple of paths
         Files the run reads: the output must not be one of them.
+    within : str or os.PathLike, optional
+        The output folder `what` names, when `path` is a file the command names in it
+        (``pftrack demo --out-dir DIR``'s ``DIR/tracks.txt``): a folder in the way is then
+        blamed on the path inside `within`, not taken for the user's file name.
 
     Raises
     ------
     ValueError
-        The extension is not supported; the path is a folder, or can only name one (a trailing
-        slash: ``newdir/``); it is ``-`` (standard output: give ``/dev/stdout``); or it names
-        an input.
+        The path is empty; the extension is not supported; the path is a folder, or can only
+        name one (a trailing slash: ``newdir/``); it is ``-`` (standard output: give
+        ``/dev/stdout``); or it names an input.
     FileNotFoundError
         Its folder does not exist.
+    NotADirectoryError
+        Its folder is a file (``notes.txt/x.txt``), or lies under one.
     PermissionError
         Its folder (or the existing file) is not writable: checked by creating (and removing)
         a file beside it.
@@ -486,9 +588,17 @@ def check_output(
     through (see the module's notes): it must be writable itself, its folder need not be.
     """
     text = os.fsdecode(os.fspath(path))
+    if not text:  # Path("") is ".": was "--out . is a folder; give a file name"
+        raise ValueError(f"{what} is empty; give a file name")
     target = Path(path)
     refuse_dash(text, what, output=True, or_else=", or /dev/stdout")
     if target.is_dir():
+        if within is not None:  # not the user's name: was "--out-dir d/tracks.txt is a folder;
+            # give a file name"
+            raise ValueError(
+                f"{what} {os.fsdecode(os.fspath(within))}: {target} is a folder, where this "
+                f"command writes a file; move it, or give another {what}"
+            )
         raise ValueError(f"{what} {target} is a folder; give a file name")
     _refuse_folder_name(text, what)
     try:
@@ -558,6 +668,9 @@ def _check_folder(written: Path, what: str, target: Path) -> None:
     """`written`'s folder exists and takes a new file (the atomic write's temporary file)."""
     folder = written.parent if str(written.parent) else Path(".")
     if not folder.is_dir():
+        blocker = _blocking(folder)
+        if blocker is not None:  # was "folder notes.txt does not exist": it does, as a file
+            raise NotADirectoryError(f"{what} {target}: {_not_a_folder(blocker)}")
         raise FileNotFoundError(f"{what} {target}: folder {folder} does not exist")
     if not os.access(folder, os.W_OK | os.X_OK) or (
         written.exists() and not os.access(written, os.W_OK)
@@ -684,7 +797,7 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
         target = resolved.path
         folder = target.parent if str(target.parent) else Path(".")
         if not folder.is_dir():
-            raise FileNotFoundError(f"output folder does not exist: {folder}")
+            raise _missing_folder(folder, path)
         fd, tmp = _create_beside(folder, f".{target.stem}.", suffix or ".tmp", made)
         staged.append((tmp, target))
         try:

@@ -641,11 +641,38 @@ class Tracker:
         """
         self._prepared = (frame, working)
 
-    def _warn_once(self, key: str, message: str) -> None:
-        """Warn `message` from ``update``'s caller, the first time `key` comes up in a run."""
+    def _warn_once(self, key: str, message: str, stacklevel: int = 3) -> None:
+        """Warn `message` from ``update``'s caller, the first time `key` comes up in a run.
+
+        `stacklevel` as ``warnings.warn``'s, counted from here: 1 here, 2 ``update``, 3 its
+        caller (one more from a helper of ``update``).
+        """
         if key not in self._warned:
             self._warned.add(key)
-            warnings.warn(message, stacklevel=3)  # 1 here, 2 update, 3 its caller
+            warnings.warn(message, stacklevel=stacklevel)
+
+    def _warn_moving_camera(self) -> None:
+        """Say once a run that the built-in detector runs on a moving camera.
+
+        Background subtraction takes the whole moving scene for foreground: walls and grass
+        become tracks (docs/tracking.md, "A moving camera"). The camera is found moving on
+        this frame (``camera_motion`` "auto": after ``CameraConfig.on_frames`` moving frames
+        in a row, the first of which the message names; "on": on every frame).
+        """
+        if "moving camera" in self._warned:
+            return
+        camera = self._tracker.camera
+        if camera.mode == "auto":
+            first = max(1, self.frame_count + 1 - camera.config.on_frames + 1)
+            moves = f"the camera moves (from frame {first})"
+        else:
+            moves = "the camera counts as moving (camera_motion 'on')"
+        self._warn_once(
+            "moving camera",
+            f"{moves}: the built-in background-subtraction detector is unreliable on a moving "
+            "camera; give detections (pftrack track --detections, Tracker.update(dets, frame))",
+            stacklevel=4,
+        )
 
     def _working(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         prepared, self._prepared = self._prepared, None
@@ -729,6 +756,13 @@ class Tracker:
             `dets` are): near an edge they may reach past it by a few pixels, as ground-truth
             boxes do. Clip them before cropping, e.g. ``np.clip(out[:, [0, 2]], 0, W)`` and
             ``np.clip(out[:, [1, 3]], 0, H)``.
+
+        Warns
+        -----
+        UserWarning
+            Once a run each: boxes clipped to the frame, boxes without area dropped, and, with
+            ``dets=None``, a camera found moving (``camera_motion`` "auto" or "on"): background
+            subtraction is unreliable there, give detections.
         """
         with self._alone("update"):
             f = bgr_frame(frame)
@@ -752,6 +786,8 @@ class Tracker:
             if dets is None:
                 kept = None
                 reports = self._tracker.update(work, None)
+                if self._tracker.camera_step.moving:
+                    self._warn_moving_camera()
             else:
                 xywh, cls, kept, clipped, flat, inverted, extent = check_boxes_xyxy(
                     dets, (f.shape[0], f.shape[1]), name=self._box_source,

@@ -47,6 +47,8 @@ from pftrack.tracking.track import (
 
 __all__ = ["MultiObjectTracker"]
 
+#: The built-in detectors that draw random numbers: each gets a seed from the tracker's own.
+SEEDED_DETECTORS = ("knn",)
 #: Speed samples before :meth:`MultiObjectTracker.motion_gain` leaves 1.
 MIN_SPEED_SAMPLES = 20
 #: The most recent speed samples kept.
@@ -201,11 +203,15 @@ class MultiObjectTracker:
         """Return the detector, made on first use.
 
         It gets the tracker's own HSV binning, so that its foreground bins and the tracker's
-        histograms always share one layout.
+        histograms always share one layout. KNN, whose OpenCV model draws random numbers,
+        gets its seed from the tracker's generator (one draw, when it is made); the other
+        built-in detectors draw none, and take nothing from it.
         """
         if self._detector is None:
             size = self.config.open_size
-            extra = {} if size is None else {"open_size": size}
+            extra: dict[str, Any] = {} if size is None else {"open_size": size}
+            if self.config.detector in SEEDED_DETECTORS:
+                extra["seed"] = int(self._rng.integers(2**63))
             self._detector = make_detector(self.config.detector, hsv=self.config.binning, **extra)
         return self._detector
 
