@@ -212,6 +212,36 @@ def test_clear_and_identity_equal_trackeval_mot17(
     assert_same_clear(m, ref["s"])
 
 
+def test_clear_breaks_exact_ties_in_file_order_as_trackeval(tmp_path: Path) -> None:
+    """Two result tracks on exactly the same box: the assignment takes the one written first.
+
+    pftrack sorted each frame's rows by id first, so the other track won the tie: IDSW 0 and
+    MOTA 0.5 below, where TrackEval (which keeps the file's order) has IDSW 1 and MOTA 0.4.
+    """
+    box = [100.0, 100.0, 50.0, 100.0, 1.0, -1.0, -1.0, -1.0]
+    gt = np.array([[f, 1, *box] for f in range(1, 11)])
+    res = np.array([[f, i, *box] for f in range(1, 11) for i in ((7, 5) if f <= 5 else (5,))])
+    ref = trackeval_hota(tmp_path / "one", {"s": (gt, res)}, "MOT15", ("CLEAR", "Identity"))
+    m = evaluate_mot(gt, res)
+    assert (m.num_switches, m.mota) == (1, pytest.approx(0.4))
+    assert_same_clear(m, ref["s"])
+    # many ties: a random case with a third of its boxes copied under new ids, the copies
+    # written first in their frames, or last
+    from tests.eval.test_metrics import random_case
+
+    cases = {}
+    for seed in range(4):
+        g, r = random_case(seed)
+        rng = np.random.default_rng(seed)
+        copies = r[rng.random(len(r)) < 0.35].copy()
+        copies[:, 1] += 5000
+        both = np.vstack([copies, r] if seed % 2 else [r, copies])
+        cases[f"s{seed}"] = (g, both[np.argsort(both[:, 0], kind="stable")])
+    ref = trackeval_hota(tmp_path / "many", cases, "MOT15", ("CLEAR", "Identity"))
+    for name, (g, r) in cases.items():
+        assert_same_clear(evaluate_mot(g, r), ref[name])
+
+
 def mot17_case(seed: int) -> tuple[np.ndarray, np.ndarray]:
     """MOT17-style gt (flag, class, visibility) with distractors and zero-marked rows."""
     rng = np.random.default_rng(seed)

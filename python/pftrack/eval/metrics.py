@@ -12,7 +12,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.optimize import linear_sum_assignment
 
 from pftrack._check import number
@@ -26,7 +26,7 @@ from pftrack.eval.rows import (
     guess_benchmark,
     prepare_mot,
 )
-from pftrack.io.mot import FRAME, ID, LEFT
+from pftrack.io.mot import FRAME, ID, LEFT, group_by_frame
 
 __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_xywh"]
 
@@ -244,16 +244,6 @@ def _not_mot_metrics(fn: str, what: str, value: object) -> str:
     return f"{fn}: {what} is {type(value).__name__}, expected MotMetrics: {hint}"
 
 
-def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
-    if len(rows) == 0:
-        return {}
-    order = np.lexsort((rows[:, ID], rows[:, FRAME]))
-    r = rows[order]
-    frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
-    ends = list(starts[1:]) + [len(r)]
-    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}
-
-
 def evaluate_mot(
     gt: ArrayLike,
     result: ArrayLike,
@@ -338,8 +328,11 @@ def evaluate_mot(
     mark = guess_benchmark(g0) if benchmark == "auto" else benchmark
     g, r = prepare_mot(g0, r0, benchmark=mark, scale=scale, num_frames=num_frames)  # ids too
     n_ign_gt, n_ign_res = len(g0) - len(g), len(r0) - len(r)
-    gt_frames = _split(g)
-    res_frames = _split(r)
+    # each frame's rows in file order, as TrackEval reads them: on exact ties (two result boxes
+    # equally good for an object) the assignment goes by that order (was sorted by id, which
+    # scored other switches than TrackEval's)
+    gt_frames = group_by_frame(g)
+    res_frames = group_by_frame(r)
     frames = sorted(set(gt_frames) | set(res_frames))
     n_frames = len(set(g0[:, FRAME].tolist()) | set(r0[:, FRAME].tolist()))
     empty = np.zeros((0, 10))
