@@ -242,6 +242,31 @@ def test_clear_breaks_exact_ties_in_file_order_as_trackeval(tmp_path: Path) -> N
         assert_same_clear(evaluate_mot(g, r), ref[name])
 
 
+def test_clear_and_identity_decide_the_threshold_as_trackeval(tmp_path: Path) -> None:
+    """A pair just under the IoU threshold: TrackEval's CLEAR takes it within eps, Identity not.
+
+    pftrack took any pair within 1e-12 of the threshold, in CLEAR and Identity both: a result
+    box at IoU 0.5 - 5e-13 scored MOTA 1 and IDF1 1 where TrackEval (and pftrack's own HOTA)
+    scores no match, MOTA -1 and IDF1 0.
+    """
+    eps = np.finfo(float).eps
+    gt = np.array([[f, 1, 0, 0, 100, 100, 1, -1, -1, -1] for f in (1, 2)], dtype=float)
+    cases = {}
+    for name, height in (("below", 50 - 5e-11), ("within_eps", np.nextafter(50.0, 0))):
+        res = gt.copy()
+        res[:, 5] = height
+        cases[name] = (gt, res)
+    iou = {name: mot_iou(gt[0, 2:6], res[0, 2:6])[0, 0] for name, (_, res) in cases.items()}
+    assert 0.5 - 1e-12 < iou["below"] < 0.5 - eps <= iou["within_eps"] < 0.5
+    ref = trackeval_hota(tmp_path, cases, "MOT15", ("CLEAR", "Identity"))
+    below, within = (evaluate_mot(*cases[name]) for name in ("below", "within_eps"))
+    assert (below.mota, below.idf1, below.num_matches) == (-1.0, 0.0, 0)
+    assert (within.mota, within.idf1, within.num_matches) == (1.0, 0.0, 2)  # CLEAR's eps only
+    assert_same_clear(below, ref["below"])
+    assert_same_clear(within, ref["within_eps"])
+    assert evaluate_hota(*cases["below"]).tp[9] == 0  # HOTA at alpha 0.5: no match either
+
+
 def mot17_case(seed: int) -> tuple[np.ndarray, np.ndarray]:
     """MOT17-style gt (flag, class, visibility) with distractors and zero-marked rows."""
     rng = np.random.default_rng(seed)

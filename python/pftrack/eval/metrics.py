@@ -20,7 +20,6 @@ from pftrack._typing import BenchmarkName
 from pftrack.boxes import iou_xywh
 from pftrack.eval.rows import (
     BENCHMARKS,
-    IOU_ROUNDING,
     _mot_iou,
     check_eval_rows,
     guess_benchmark,
@@ -30,8 +29,8 @@ from pftrack.io.mot import FRAME, ID, LEFT, group_by_frame
 
 __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_xywh"]
 
-# Cost of a forbidden pair in the per-frame assignment: larger than any sum of admissible
-# costs (each is at most 1), so the solver first maximises the number of admissible pairs.
+# TrackEval's np.finfo(float).eps: how far below the threshold CLEAR still takes a pair, and
+# the score a pair of the assignment must exceed to be a match.
 _EPS = float(np.finfo(np.float64).eps)
 
 
@@ -310,9 +309,10 @@ def evaluate_mot(
     scale = number(scale, "evaluate_mot: scale", finite=False)
     if not (math.isfinite(scale) and scale > 0):
         raise ValueError(f"evaluate_mot: scale is {scale}, expected a finite value > 0")
-    # pairs reach the threshold up to rounding: identical boxes' IoU may come out 1 - 1e-16,
-    # and with a threshold of 1 they must still match
-    reach = iou_threshold - IOU_ROUNDING
+    # TrackEval's two rules, to the last bit: CLEAR takes a pair unless its IoU is below the
+    # threshold by more than eps, Identity (and here Smith's strict success) needs IoU >= it.
+    # (Identical boxes have IoU exactly 1 in mot_iou's arithmetic: a threshold of 1 matches them.)
+    clear_reach = iou_threshold - _EPS
     if image_size is not None:
         if len(image_size) != 2 or min(image_size) <= 0:
             raise ValueError(
@@ -361,7 +361,7 @@ def evaluate_mot(
         for h in rids:
             res_count[int(h)] = res_count.get(int(h), 0) + 1
         iou = _mot_iou(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])  # TrackEval's IoU
-        ok = iou >= reach
+        ok = iou >= iou_threshold  # Identity's and Smith's strict rule
 
         # Identity and Smith measures look at every overlapping (gt, result) pair.
         if len(gids) and len(rids):
@@ -396,7 +396,7 @@ def evaluate_mot(
         # each object's result id at the last scored frame (NaN: none, equal to no id)
         before = np.array([previous.get(int(o), np.nan) for o in gids], dtype=np.float64)
         goes_on = before[:, None] == rids[None, :]
-        score = np.where(ok, 1000.0 * goes_on + iou, 0.0)
+        score = np.where(iou >= clear_reach, 1000.0 * goes_on + iou, 0.0)
         rows_m, cols_m = linear_sum_assignment(-score)
         hit = score[rows_m, cols_m] > _EPS
         matches = list(zip(rows_m[hit].tolist(), cols_m[hit].tolist(), strict=True))

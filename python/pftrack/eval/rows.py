@@ -19,7 +19,6 @@ from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
 
 __all__ = [
     "BENCHMARKS",
-    "IOU_ROUNDING",
     "check_eval_rows",
     "check_unique_ids",
     "guess_benchmark",
@@ -83,11 +82,6 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
         pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
         a = np.hstack([a, pad])
     return a
-
-
-#: IoU this much below the threshold still reaches it (rounding: the IoU of two identical boxes
-#: can be computed as 1 - 1e-16, which a threshold of 1 would refuse).
-IOU_ROUNDING = 1e-12
 
 
 def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
