@@ -44,12 +44,17 @@ class MotMetrics:
     Attributes
     ----------
     mota : float
-        ``1 - (FN + FP + IDSW) / num_objects`` (a fraction; can be negative); 0 without any
+        ``1 - (FN + FP + IDSW) / num_objects`` (a fraction; can be negative), computed as
+        TrackEval's ``(TP - FP - IDSW) / num_objects`` (the same bits); 0 without any
         ground-truth box, as TrackEval scores such a sequence.
     motp_iou : float
         Mean IoU of the matched pairs (0 without a match, as TrackEval's MOTP). This is "MOTP
         as overlap" (higher is better); py-motmetrics reports the mean distance ``1 - IoU``
         instead, i.e. ``1 - motp_iou``.
+    iou_sum : float
+        Sum of the matched pairs' IoU, added up as TrackEval's ``MOTP_sum`` (each frame's sum,
+        then over frames): ``motp_iou = iou_sum / num_matches``. :func:`combine_mot` sums it,
+        so that a combined MOTP is TrackEval's to the last bit.
     idf1, idp, idr : float
         Identity F1, precision and recall after the global one-to-one assignment of ground-truth
         trajectories to result trajectories that maximises the identity true positives (0,
@@ -98,6 +103,7 @@ class MotMetrics:
 
     mota: float
     motp_iou: float
+    iou_sum: float
     idf1: float
     idp: float
     idr: float
@@ -401,6 +407,8 @@ def evaluate_mot(
         hit = score[rows_m, cols_m] > _EPS
         matches = list(zip(rows_m[hit].tolist(), cols_m[hit].tolist(), strict=True))
         now: dict[int, int] = {}
+        if matches:  # TrackEval's MOTP_sum: the frame's sum, then added (the same bits)
+            iou_sum += float(sum(iou[rows_m[hit], cols_m[hit]]))
         for i, j in matches:
             o, h = int(gids[i]), int(rids[j])
             if o in last_match and last_match[o] != h:
@@ -409,7 +417,6 @@ def evaluate_mot(
             matched_count[o] = matched_count.get(o, 0) + 1
             if o not in previous:
                 runs[o] = runs.get(o, 0) + 1
-            iou_sum += float(iou[i, j])
         previous = now
         n_match += len(matches)
         n_fn += len(gids) - len(matches)
@@ -473,8 +480,10 @@ def evaluate_mot(
     nan = float("nan")
     return MotMetrics(
         # TrackEval's CLEAR scores a sequence without ground truth (or results) as all 0
-        mota=1.0 - (n_fn + n_fp + n_sw) / n_gt if n_gt else 0.0,
+        # TrackEval's (TP - FP - IDSW) / GT, not 1 - (FN + FP + IDSW) / GT: the last bit differs
+        mota=(n_match - n_fp - n_sw) / n_gt if n_gt else 0.0,
         motp_iou=iou_sum / n_match if n_match else 0.0,
+        iou_sum=iou_sum,
         idf1=idf1,
         idp=idp,
         idr=idr,
@@ -544,7 +553,9 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
     fn, fp, sw = total("misses"), total("false_positives"), total("num_switches")
     idtp, idfp, idfn = total("idtp"), total("idfp"), total("idfn")
     n_obj = total("num_unique_objects")
-    iou_sum = sum(p.motp_iou * p.num_matches for p in parts if p.num_matches)
+    iou_sum = 0.0
+    for p in parts:  # TrackEval's sum of MOTP_sum over sequences, term by term
+        iou_sum += p.iou_sum
     scales = {p.scale for p in parts}
     nan = float("nan")
 
@@ -558,8 +569,9 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
 
     return MotMetrics(
         # TrackEval's (TP - FP - IDSW) / max(1, TP + FN): -(FP + IDSW) without ground truth
-        mota=1.0 - (fn + fp + sw) / n_gt if n_gt else float(-(fp + sw)),
+        mota=(n_match - fp - sw) / max(1, n_gt),
         motp_iou=ratio(iou_sum, n_match),
+        iou_sum=iou_sum,
         idf1=ratio(2 * idtp, 2 * idtp + idfp + idfn),
         idp=ratio(idtp, idtp + idfp),
         idr=ratio(idtp, idtp + idfn),
