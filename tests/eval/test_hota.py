@@ -231,7 +231,7 @@ def test_clear_breaks_exact_ties_in_file_order_as_trackeval(tmp_path: Path) -> N
     assert_same_clear(m, ref["s"])
     # many ties: a random case with a third of its boxes copied under new ids, the copies
     # written first in their frames, or last
-    from tests.eval.test_metrics import random_case
+    from tests.eval.test_metrics import crowd_case, random_case
 
     cases = {}
     for seed in range(4):
@@ -241,6 +241,7 @@ def test_clear_breaks_exact_ties_in_file_order_as_trackeval(tmp_path: Path) -> N
         copies[:, 1] += 5000
         both = np.vstack([copies, r] if seed % 2 else [r, copies])
         cases[f"s{seed}"] = (g, both[np.argsort(both[:, 0], kind="stable")])
+        cases[f"crowd{seed}"] = crowd_case(seed)  # overlapping boxes on integer pixels
     ref = trackeval_hota(tmp_path / "many", cases, "MOT15", ("CLEAR", "Identity"))
     for name, (g, r) in cases.items():
         assert_same_clear(evaluate_mot(g, r), ref[name])

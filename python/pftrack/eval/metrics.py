@@ -12,7 +12,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
 from pftrack._check import number
@@ -25,7 +25,7 @@ from pftrack.eval.rows import (
     guess_benchmark,
     prepare_mot,
 )
-from pftrack.io.mot import FRAME, ID, LEFT, group_by_frame
+from pftrack.io.mot import FRAME, ID, LEFT
 
 __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_xywh"]
 
@@ -249,6 +249,11 @@ def _not_mot_metrics(fn: str, what: str, value: object) -> str:
     return f"{fn}: {what} is {type(value).__name__}, expected MotMetrics: {hint}"
 
 
+def _concat(parts: list[NDArray[np.int64]]) -> NDArray[np.int64]:
+    out: NDArray[np.int64] = np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+    return out
+
+
 def evaluate_mot(
     gt: ArrayLike,
     result: ArrayLike,
@@ -337,114 +342,83 @@ def evaluate_mot(
     # each frame's rows in file order, as TrackEval reads them: on exact ties (two result boxes
     # equally good for an object) the assignment goes by that order (was sorted by id, which
     # scored other switches than TrackEval's)
-    gt_frames = group_by_frame(g)
-    res_frames = group_by_frame(r)
-    frames = sorted(set(gt_frames) | set(res_frames))
+    g = g[np.argsort(g[:, FRAME], kind="stable")]  # prepare_mot's order already
+    r = r[np.argsort(r[:, FRAME], kind="stable")]
     n_frames = len(set(g0[:, FRAME].tolist()) | set(r0[:, FRAME].tolist()))
-    empty = np.zeros((0, 10))
+    oids, g_idx = np.unique(g[:, ID].astype(np.int64), return_inverse=True)
+    hids, r_idx = np.unique(r[:, ID].astype(np.int64), return_inverse=True)
+    n_o, n_h = len(oids), len(hids)
+    gt_count = np.bincount(g_idx, minlength=n_o)  # frames each object is scored in
+    g_frame = g[:, FRAME].astype(np.int64)
+    r_frame = r[:, FRAME].astype(np.int64)
+    g_box, r_box = g[:, LEFT : LEFT + 4], r[:, LEFT : LEFT + 4]
+    frames = np.union1d(g_frame, r_frame)
+    g_lo, g_hi = np.searchsorted(g_frame, frames), np.searchsorted(g_frame, frames, "right")
+    r_lo, r_hi = np.searchsorted(r_frame, frames), np.searchsorted(r_frame, frames, "right")
 
-    last_match: dict[int, int] = {}  # gt id -> result id of its latest match (switches)
-    previous: dict[int, int] = {}  # gt id -> result id matched at the last scored frame
-    matched_count: dict[int, int] = {}  # gt id -> frames matched (MT/PT/ML)
-    runs: dict[int, int] = {}  # gt id -> tracked runs begun (fragmentations)
-    pair_hits: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU >= thr
-    pair_touch: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU > 0
-    centroid: dict[tuple[int, int], list[float]] = {}  # (gt id, res id) -> distances
-    gt_count: dict[int, int] = {}  # gt id -> frames it is scored in
-    res_count: dict[int, int] = {}
-    n_fp = n_fn = n_sw = n_match = n_gt = n_res = 0
+    # CLEAR-MOT state, TrackEval's, per object index (NaN: none)
+    last_match = np.full(n_o, np.nan)  # result index of its latest match (switches)
+    previous = np.full(n_o, np.nan)  # result index matched at the last scored frame
+    matched_count = np.zeros(n_o, dtype=np.int64)  # frames matched (MT/PT/ML)
+    runs = np.zeros(n_o, dtype=np.int64)  # tracked runs begun (fragmentations)
+    touch_keys: list[NDArray[np.int64]] = []  # object * n_h + result: a frame with IoU > 0
+    hit_keys: list[NDArray[np.int64]] = []  # ... with IoU >= threshold (Identity, Smith)
+    n_fp = n_fn = n_sw = n_match = 0
     iou_sum = 0.0
 
-    for f in frames:
-        gf = gt_frames.get(f, empty)
-        rf = res_frames.get(f, empty)
-        gids = gf[:, ID].astype(np.int64)
-        rids = rf[:, ID].astype(np.int64)
-        n_gt += len(gids)
-        n_res += len(rids)
-        for o in gids:
-            gt_count[int(o)] = gt_count.get(int(o), 0) + 1
-        for h in rids:
-            res_count[int(h)] = res_count.get(int(h), 0) + 1
-        iou = _mot_iou(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])  # TrackEval's IoU
-        ok = iou >= iou_threshold  # Identity's and Smith's strict rule
-
-        # Identity and Smith measures look at every overlapping (gt, result) pair.
-        if len(gids) and len(rids):
-            cg = gf[:, LEFT : LEFT + 2] + 0.5 * gf[:, LEFT + 2 : LEFT + 4]
-            cr = rf[:, LEFT : LEFT + 2] + 0.5 * rf[:, LEFT + 2 : LEFT + 4]
-            dist = np.hypot(cg[:, None, 0] - cr[None, :, 0], cg[:, None, 1] - cr[None, :, 1])
-            # A pair counts once per frame even if an id appears twice (ids should be unique).
-            near: dict[tuple[int, int], float] = {}
-            touch_f: set[tuple[int, int]] = set()
-            hit_f: set[tuple[int, int]] = set()
-            for i, o in enumerate(gids):
-                for j, h in enumerate(rids):
-                    key = (int(o), int(h))
-                    near[key] = min(near.get(key, math.inf), float(dist[i, j]))
-                    if iou[i, j] > 0:
-                        touch_f.add(key)
-                    if ok[i, j]:
-                        hit_f.add(key)
-            for key, d in near.items():
-                centroid.setdefault(key, []).append(d)
-            for key in touch_f:
-                pair_touch[key] = pair_touch.get(key, 0) + 1
-            for key in hit_f:
-                pair_hits[key] = pair_hits.get(key, 0) + 1
+    for k in range(len(frames)):
+        gs, rs = slice(g_lo[k], g_hi[k]), slice(r_lo[k], r_hi[k])
+        gi, ri = g_idx[gs], r_idx[rs]
+        if len(gi) == 0 or len(ri) == 0:
+            n_fp += len(ri)
+            n_fn += len(gi)
+            continue  # no frame to go on from: `previous` stays as it was
+        iou = _mot_iou(g_box[gs], r_box[rs])  # TrackEval's IoU
+        # Identity and Smith measures count every (gt, result) pair overlapping in a frame
+        a, b = np.nonzero(iou > 0)
+        touch_keys.append(gi[a] * n_h + ri[b])
+        a, b = np.nonzero(iou >= iou_threshold)  # Identity's and Smith's strict rule
+        hit_keys.append(gi[a] * n_h + ri[b])
 
         # CLEAR-MOT, TrackEval's arithmetic: one assignment maximising 1000 per pair that goes
         # on from the last scored frame, plus its IoU, among pairs that reach the threshold
-        if len(gids) == 0 or len(rids) == 0:
-            n_fp += len(rids)
-            n_fn += len(gids)
-            continue  # no frame to go on from: `previous` stays as it was
-        # each object's result id at the last scored frame (NaN: none, equal to no id)
-        before = np.array([previous.get(int(o), np.nan) for o in gids], dtype=np.float64)
-        goes_on = before[:, None] == rids[None, :]
+        goes_on = previous[gi][:, None] == ri[None, :]  # NaN: no pair goes on
         score = np.where(iou >= clear_reach, 1000.0 * goes_on + iou, 0.0)
         rows_m, cols_m = linear_sum_assignment(-score)
         hit = score[rows_m, cols_m] > _EPS
-        matches = list(zip(rows_m[hit].tolist(), cols_m[hit].tolist(), strict=True))
-        now: dict[int, int] = {}
-        if matches:  # TrackEval's MOTP_sum: the frame's sum, then added (the same bits)
-            iou_sum += float(sum(iou[rows_m[hit], cols_m[hit]]))
-        for i, j in matches:
-            o, h = int(gids[i]), int(rids[j])
-            if o in last_match and last_match[o] != h:
-                n_sw += 1
-            last_match[o] = now[o] = h
-            matched_count[o] = matched_count.get(o, 0) + 1
-            if o not in previous:
-                runs[o] = runs.get(o, 0) + 1
-        previous = now
-        n_match += len(matches)
-        n_fn += len(gids) - len(matches)
-        n_fp += len(rids) - len(matches)
+        rows_m, cols_m = rows_m[hit], cols_m[hit]
+        mo, mh = gi[rows_m], ri[cols_m]
+        if len(mo):  # TrackEval's MOTP_sum: the frame's sum, then added (the same bits)
+            iou_sum += float(sum(iou[rows_m, cols_m]))
+        before = last_match[mo]
+        n_sw += int(np.count_nonzero(~np.isnan(before) & (before != mh)))
+        last_match[mo] = mh
+        matched_count[mo] += 1
+        runs[mo] += np.isnan(previous[mo])
+        previous[:] = np.nan
+        previous[mo] = mh
+        n_match += len(mo)
+        n_fn += len(gi) - len(mo)
+        n_fp += len(ri) - len(mo)
+    n_gt, n_res = len(g), len(r)
 
     # Mostly tracked (above 80 % of its frames) / lost (below 20 %), fragmentations (tracked
     # runs after the first), as TrackEval counts them
-    mt = pt = ml = 0
-    for o, n in gt_count.items():
-        ratio = matched_count.get(o, 0) / n
-        if ratio > 0.8:
-            mt += 1
-        elif ratio >= 0.2:
-            pt += 1
-        else:
-            ml += 1
-    frag = sum(k - 1 for k in runs.values())
+    tracked = matched_count / np.maximum(gt_count, 1)
+    mt = int(np.count_nonzero(tracked > 0.8))
+    ml = int(np.count_nonzero(tracked < 0.2))
+    pt = n_o - mt - ml
+    frag = int(np.sum(np.maximum(runs - 1, 0)))
+
+    # pairs that overlap: (object, result) index and frames, as sorted keys
+    touch_k, touch_n = np.unique(_concat(touch_keys), return_counts=True)
+    hit_k, hit_n = np.unique(_concat(hit_keys), return_counts=True)
 
     # Identity: global assignment maximising the frames where a pair overlaps >= threshold.
-    oids = sorted(gt_count)
-    hids = sorted(res_count)
     idtp = 0
-    if oids and hids:
-        oi = {o: k for k, o in enumerate(oids)}
-        hi = {h: k for k, h in enumerate(hids)}
-        w = np.zeros((len(oids), len(hids)))
-        for (o, h), c in pair_hits.items():
-            w[oi[o], hi[h]] = c
+    if n_o and n_h:
+        w = np.zeros((n_o, n_h))
+        w[hit_k // n_h, hit_k % n_h] = hit_n
         a, b = linear_sum_assignment(-w)
         idtp = int(w[a, b].sum())
     idfn = n_gt - idtp
@@ -457,23 +431,45 @@ def evaluate_mot(
     # Smith et al.: per object, the result id overlapping it most often; ties go to the id
     # matching it (IoU >= threshold) more often, then to the nearer one (a neighbour touching
     # the object in as many frames is not its track: was the smaller id, so a result equal to
-    # the truth had a centroid distance above 0)
+    # the truth had a centroid distance above 0). Centroid distances only for the pairs that
+    # overlap somewhere (each over every frame holding both), not for every pair of every frame.
+    centre_g = g_box[:, :2] + 0.5 * g_box[:, 2:]
+    centre_r = r_box[:, :2] + 0.5 * r_box[:, 2:]
+    by_o = np.argsort(g_idx, kind="stable")  # each object's rows, in frame order
+    by_h = np.argsort(r_idx, kind="stable")
+    o_lo = np.searchsorted(g_idx[by_o], np.arange(n_o + 1))
+    h_lo = np.searchsorted(r_idx[by_h], np.arange(n_h + 1))
+
+    def distances(o: int, h: int) -> list[float]:
+        """Centroid distance of object `o` and result `h` in each frame holding both."""
+        ga, rb = by_o[o_lo[o] : o_lo[o + 1]], by_h[h_lo[h] : h_lo[h + 1]]
+        _, i, j = np.intersect1d(g_frame[ga], r_frame[rb], assume_unique=True, return_indices=True)
+        d = centre_g[ga[i]] - centre_r[rb[j]]
+        out: list[float] = np.hypot(d[:, 0], d[:, 1]).tolist()
+        return out
+
+    t_lo = np.searchsorted(touch_k // n_h, np.arange(n_o + 1)) if n_h else np.zeros(n_o + 1, int)
+    hit_of = dict(zip(hit_k.tolist(), hit_n.tolist(), strict=True))
     per_object: list[tuple[int, float, float]] = []
     dists: list[float] = []
-    for o in oids:
-        touch = {h: c for (oo, h), c in pair_touch.items() if oo == o}
-        hits = {h: c for (oo, h), c in pair_hits.items() if oo == o}
-        far = {h: sum(centroid[(o, h)]) for h in touch}
+    for o in range(n_o):
+        keys = touch_k[t_lo[o] : t_lo[o + 1]].tolist()
+        touch = {
+            key % n_h: int(c) for key, c in zip(keys, touch_n[t_lo[o] : t_lo[o + 1]], strict=True)
+        }
+        hits = {h: hit_of[o * n_h + h] for h in touch if o * n_h + h in hit_of}
+        near = {h: distances(o, h) for h in touch}
+        far = {h: sum(near[h]) for h in touch}
         loose = 0.0
         strict = 0.0
         if touch:
-            best = max(touch, key=lambda h: (touch[h], hits.get(h, 0), -far[h], -h))
-            loose = touch[best] / gt_count[o]
-            dists.extend(centroid[(o, best)])
+            best = max(touch, key=lambda h: (touch[h], hits.get(h, 0), -far[h], -int(hids[h])))
+            loose = touch[best] / int(gt_count[o])
+            dists.extend(near[best])
         if hits:
-            best_s = max(hits, key=lambda h: (hits[h], touch[h], -far[h], -h))
-            strict = hits[best_s] / gt_count[o]
-        per_object.append((o, loose, strict))
+            best_s = max(hits, key=lambda h: (hits[h], touch[h], -far[h], -int(hids[h])))
+            strict = hits[best_s] / int(gt_count[o])
+        per_object.append((int(oids[o]), loose, strict))
     cd = float(np.mean(dists)) if dists else float("nan")
     ratio = cd / (image_size[0] * image_size[1]) if image_size is not None else float("nan")
 
@@ -500,7 +496,7 @@ def evaluate_mot(
         num_matches=n_match,
         num_objects=n_gt,
         num_predictions=n_res,
-        num_unique_objects=len(oids),
+        num_unique_objects=n_o,
         num_frames=n_frames,
         num_ignored_gt=n_ign_gt,
         num_ignored_predictions=n_ign_res,
