@@ -179,6 +179,20 @@ def test_a_detections_file_scored_as_tracks_is_named():
         evaluate_mot(HAND_GT, det)
 
 
+def test_cli_names_the_file_a_scoring_error_is_about(tmp_path, capsys):
+    """`--gt det.txt --res gt.txt` said "gt: ground truth has id -1 ...": the result's stem."""
+    det = HAND_RES.copy()
+    det[:, 1] = -1
+    write_mot(tmp_path / "det.txt", det)
+    write_mot(tmp_path / "gt.txt", HAND_GT)
+    argv = ["eval", "--gt", str(tmp_path / "det.txt"), "--res", str(tmp_path / "gt.txt")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err.startswith(
+        f"pftrack eval: error: {tmp_path / 'det.txt'}: ground truth has id -1 more than once in "
+        "frame 1: is it a detections file"
+    )
+
+
 def test_rows_read_mot_refuses_are_refused_by_the_array_api_too():
     # negative sizes scored MOTA -1 and frames from 0 scored 0.955, silently (the CLI refused)
     from pftrack.eval import evaluate_hota, evaluate_sequence

@@ -157,7 +157,8 @@ def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     (res_root / "B.txt").unlink()
     assert "no result for sequence B" in error()
     write_mot(res_root / "B.txt", cases["B"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
-    assert "B: result has frame" in error()  # beyond seqLength
+    # beyond seqLength: led by the file (was by the sequence's name, "B: result has frame")
+    assert f"error: {res_root / 'B.txt'}: result has frame" in error()
     assert main(["eval", "--gt", str(tmp_path / "nothing"), "--res", str(res_root)]) == 2
     assert "ground truth not found: " in capsys.readouterr().err
     assert main(["eval", "--gt", str(tmp_path / "nope.txt"), "--res", str(res_root)]) == 2

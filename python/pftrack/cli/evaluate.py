@@ -192,6 +192,19 @@ def _no_result(res: Path, missing: list[str], n_seqs: int) -> str:
     )
 
 
+def _in_file(message: str, gt: Path, res: Path) -> str:
+    """A scorer's message ("ground truth has ...", "result has ...") led by the file it is about.
+
+    Was led by the sequence's name, for one file the result file's stem: ``--gt det.txt --res
+    gt.txt`` said "gt: ground truth has id -1 more than once ...", naming the other file.
+    """
+    if message.startswith("ground truth"):
+        return f"{gt}: {message}"
+    if message.startswith("result"):
+        return f"{res}: {message}"
+    return f"{gt} against {res}: {message}"
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack eval``: optionally write JSON/CSV, then print the table; return the status."""
     import json
@@ -246,7 +259,7 @@ def run(args: argparse.Namespace) -> int:
                 num_frames=seq.length,
             )
         except ValueError as exc:
-            raise ValueError(f"{name}: {exc}") from None
+            raise ValueError(_in_file(str(exc), seq.gt_path, path)) from None
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
     if args.json:
         if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
