@@ -670,3 +670,70 @@ def test_vectorised_scores_equal_the_straightforward_ones(seed):
     assert evaluate_mot(g, r).num_switches > 0 and any(
         len(set(map(int, r[r[:, 0] == f, 2]))) < (r[:, 0] == f).sum() for f in range(1, 30)
     )  # the crowd case has switches and boxes at one place under two ids
+
+
+def test_the_api_names_its_argument_when_given_the_wrong_kind():
+    """Were a bare StopIteration, Python's dict, AttributeError and '<' messages; NaN passed."""
+    from pftrack.eval import (
+        SequenceScores,
+        combine_hota,
+        combine_mot,
+        evaluate_hota,
+        evaluate_sequence,
+        format_scores,
+    )
+    from pftrack.eval.sequences import scores_csv, scores_json
+
+    s = evaluate_sequence(HAND_GT, HAND_RES)
+    with pytest.raises(ValueError, match=r"^format_scores: no sequence to format$"):
+        format_scores({})
+    with pytest.raises(TypeError, match=r"^format_scores: rows is list, expected a mapping of "):
+        format_scores([s])  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"rows\['a'\] is MotMetrics, .*by pftrack.eval.format_m"):
+        format_scores({"a": s.mot})  # type: ignore[dict-item]
+    with pytest.raises(TypeError, match=r"^format_scores: combined is MotMetrics, expected Seq"):
+        format_scores({"a": s}, s.mot)  # type: ignore[arg-type]
+    for fn in (scores_csv, scores_json):
+        with pytest.raises(ValueError, match=rf"^{fn.__name__}: no sequence to format$"):
+            fn({}, None)
+    assert "COMBINED" in format_scores({"a": s}, s)
+
+    mot, hota = evaluate_mot(HAND_GT, HAND_GT), evaluate_hota(HAND_GT, HAND_GT)
+    with pytest.raises(
+        TypeError,
+        match=r"^SequenceScores.combine: parts\[0\] is MotMetrics, expected SequenceScores; "
+        r"MotMetrics are combined by pftrack.eval.combine_mot$",
+    ):
+        SequenceScores.combine([mot])  # type: ignore[list-item]
+    with pytest.raises(ValueError, match=r"^SequenceScores.combine: no sequences to combine$"):
+        SequenceScores.combine([])
+    with pytest.raises(TypeError, match=r"^SequenceScores.combine: parts is SequenceScores, "):
+        SequenceScores.combine(s)  # type: ignore[arg-type]
+    with pytest.raises(
+        TypeError,
+        match=r"^combine_mot: parts\[1\] is HotaMetrics, expected MotMetrics; HotaMetrics are "
+        r"combined by pftrack.eval.combine_hota$",
+    ):
+        combine_mot([mot, hota])  # type: ignore[list-item]
+    with pytest.raises(TypeError, match=r"combine_mot: parts\[0\] is SequenceScores.*\[s.mot for"):
+        combine_mot([s])  # type: ignore[list-item]
+    with pytest.raises(TypeError, match=r"^combine_mot: parts is MotMetrics, expected a list"):
+        combine_mot(mot)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"^combine_hota: parts\[0\] is MotMetrics, expected Hot"):
+        combine_hota([mot])  # type: ignore[list-item]
+    assert SequenceScores.combine([s, s]).mot.num_objects == 2 * s.mot.num_objects
+
+    for size, error, message in (
+        ((640, None), TypeError, r"image_size\[1\] must be a number, got NoneType"),
+        (640, TypeError, r"image_size is int 640, expected \(width, height\)"),
+        ("640x480", TypeError, r"image_size is str '640x480', expected \(width, height\)"),
+        ((640, 480, 3), ValueError, r"image_size is \(640, 480, 3\), expected .* 2 values"),
+        ((math.nan, 480), ValueError, r"image_size is \(nan, 480\), expected .* finite and > 0"),
+        ((640, -1), ValueError, r"image_size is \(640, -1\), expected .* finite and > 0"),
+    ):
+        with pytest.raises(error, match=rf"^evaluate_mot: {message}"):
+            evaluate_mot(HAND_GT, HAND_RES, image_size=size)  # type: ignore[arg-type]
+        with pytest.raises(error, match=rf"^evaluate_sequence: {message}"):
+            evaluate_sequence(HAND_GT, HAND_RES, image_size=size)  # type: ignore[arg-type]
+    ratio = evaluate_mot(HAND_GT, HAND_RES, image_size=np.array([400, 300]))
+    assert ratio.centroid_distance_ratio == pytest.approx(2 / 3 / (400 * 300))

@@ -20,6 +20,7 @@ from pftrack.eval.rows import (  # the scored rows; here too, as before
     _mot_iou,
     guess_benchmark,
     mot_iou,
+    not_parts_message,
     prepare_mot,
 )
 from pftrack.io.mot import ID, LEFT, group_by_frame
@@ -304,9 +305,14 @@ def combine_hota(parts: Iterable[HotaMetrics] | Sequence[HotaMetrics]) -> HotaMe
     TP, FN and FP are summed per threshold; AssA, AssRe, AssPr and LocA are the TP-weighted
     means of the sequences' values, so DetA and HOTA are those of the summed counts.
     """
+    if isinstance(parts, HotaMetrics):
+        raise TypeError("combine_hota: parts is HotaMetrics, expected a list of HotaMetrics")
     items = list(parts)
     if not items:
         raise ValueError("combine_hota: no sequences to combine")
+    for k, p in enumerate(items):
+        if not isinstance(p, HotaMetrics):
+            raise TypeError(not_parts_message("combine_hota", k, p, "HotaMetrics"))
     tp = np.sum([p.tp for p in items], axis=0)
     w = np.maximum(1.0, tp)
 

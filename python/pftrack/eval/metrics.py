@@ -23,6 +23,7 @@ from pftrack.eval.rows import (
     _mot_iou,
     check_eval_rows,
     guess_benchmark,
+    not_parts_message,
     prepare_mot,
 )
 from pftrack.io.mot import FRAME, ID, LEFT
@@ -249,6 +250,31 @@ def _not_mot_metrics(fn: str, what: str, value: object) -> str:
     return f"{fn}: {what} is {type(value).__name__}, expected MotMetrics: {hint}"
 
 
+def check_image_size(image_size: object, fn: str) -> tuple[float, float] | None:
+    """`image_size` as ``(width, height)`` floats, or None; errors name `fn` and the argument.
+
+    Raises
+    ------
+    TypeError
+        Not a pair (an int, a string), or a side that is not a number (None, text, a bool).
+    ValueError
+        Not two values, or a side not finite or not > 0.
+    """
+    if image_size is None:
+        return None
+    what = f"{fn}: image_size"
+    if isinstance(image_size, (str, bytes)) or not isinstance(image_size, (Sequence, np.ndarray)):
+        raise TypeError(
+            f"{what} is {type(image_size).__name__} {image_size!r}, expected (width, height)"
+        )
+    if len(image_size) != 2:
+        raise ValueError(f"{what} is {image_size!r}, expected (width, height), 2 values")
+    w, h = (number(v, f"{what}[{k}]", finite=False) for k, v in enumerate(image_size))
+    if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
+        raise ValueError(f"{what} is {image_size!r}, expected (width, height) finite and > 0")
+    return w, h
+
+
 def _concat(parts: list[NDArray[np.int64]]) -> NDArray[np.int64]:
     out: NDArray[np.int64] = np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
     return out
@@ -278,7 +304,7 @@ def evaluate_mot(
         Multiplies the ground-truth boxes (left, top, width, height) before scoring, e.g. 0.625
         for PETS09 ground truth (768x576) against a tracker run on the 480x360 video.
     image_size : (width, height), optional
-        Image size for the centroid-distance ratio (NaN without it).
+        Image size for the centroid-distance ratio (NaN without it): two finite numbers > 0.
     benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
         Which MOTChallenge rules choose the scored rows (:func:`pftrack.eval.prepare_mot`);
         ``"auto"`` guesses MOT15 or MOT17 from the columns (:func:`pftrack.eval.guess_benchmark`).
@@ -324,11 +350,7 @@ def evaluate_mot(
     # threshold by more than eps, Identity (and here Smith's strict success) needs IoU >= it.
     # (Identical boxes have IoU exactly 1 in mot_iou's arithmetic: a threshold of 1 matches them.)
     clear_reach = iou_threshold - _EPS
-    if image_size is not None:
-        if len(image_size) != 2 or min(image_size) <= 0:
-            raise ValueError(
-                f"evaluate_mot: image_size is {image_size!r}, expected (width, height) > 0"
-            )
+    size = check_image_size(image_size, "evaluate_mot")
     if benchmark != "auto" and benchmark not in BENCHMARKS:
         raise ValueError(
             f"evaluate_mot: benchmark is {benchmark!r}, expected 'auto' or one of "
@@ -471,7 +493,7 @@ def evaluate_mot(
             strict = hits[best_s] / int(gt_count[o])
         per_object.append((int(oids[o]), loose, strict))
     cd = float(np.mean(dists)) if dists else float("nan")
-    ratio = cd / (image_size[0] * image_size[1]) if image_size is not None else float("nan")
+    ratio = cd / (size[0] * size[1]) if size is not None else float("nan")
 
     nan = float("nan")
     return MotMetrics(
@@ -536,8 +558,15 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
     -------
     MotMetrics
     """
+    if isinstance(parts, MotMetrics) or not isinstance(parts, Sequence):
+        raise TypeError(
+            f"combine_mot: parts is {type(parts).__name__}, expected a list of MotMetrics"
+        )
     if not parts:
         raise ValueError("combine_mot: no sequences to combine")
+    for k, p in enumerate(parts):
+        if not isinstance(p, MotMetrics):
+            raise TypeError(not_parts_message("combine_mot", k, p, "MotMetrics"))
     thresholds = {p.iou_threshold for p in parts}
     if len(thresholds) != 1:
         raise ValueError(f"combine_mot: IoU thresholds differ: {sorted(thresholds)}")

@@ -84,6 +84,29 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     return a
 
 
+#: What combines each kind of scores (named when a list holds another kind).
+_COMBINERS = {
+    "MotMetrics": "pftrack.eval.combine_mot",
+    "HotaMetrics": "pftrack.eval.combine_hota",
+    "SequenceScores": "SequenceScores.combine",
+}
+
+
+def not_parts_message(fn: str, k: int, value: object, expected: str) -> str:
+    """Why `value`, item `k` of `fn`'s parts, is no `expected`: naming what combines it.
+
+    Shared by :func:`~pftrack.eval.combine_mot`, :func:`~pftrack.eval.combine_hota` and
+    :meth:`~pftrack.eval.SequenceScores.combine`, whose parts are easily mixed up (each raised
+    an AttributeError on another kind).
+    """
+    kind = type(value).__name__
+    hint = f"; {kind} are combined by {_COMBINERS[kind]}" if kind in _COMBINERS else ""
+    if kind == "SequenceScores" and expected != kind:
+        part = "mot" if expected == "MotMetrics" else "hota"
+        hint += f" (or pass [s.{part} for s in scores])"
+    return f"{fn}: parts[{k}] is {kind}, expected {expected}{hint}"
+
+
 def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
     """Refuse rows of one id twice in one frame (ValueError naming `name`, the id and frame).
 
