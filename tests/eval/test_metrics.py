@@ -737,3 +737,31 @@ def test_the_api_names_its_argument_when_given_the_wrong_kind():
             evaluate_sequence(HAND_GT, HAND_RES, image_size=size)  # type: ignore[arg-type]
     ratio = evaluate_mot(HAND_GT, HAND_RES, image_size=np.array([400, 300]))
     assert ratio.centroid_distance_ratio == pytest.approx(2 / 3 / (400 * 300))
+
+
+def test_negative_ids_are_refused_as_trackeval_refuses_them(tmp_path, capsys):
+    """A result with id -5 was scored as any other id (MOTA 1); TrackEval fails on it."""
+    from pftrack.eval import evaluate_hota, evaluate_sequence
+
+    neg = HAND_RES.copy()
+    neg[neg[:, 1] == 11, 1] = -5  # frames 4 and 5
+    one = HAND_RES.copy()
+    one[0, 1] = -1  # one id -1: a detections file's id, named so
+    for fn in (evaluate_mot, evaluate_hota, evaluate_sequence):
+        with pytest.raises(ValueError, match=r"^result has id -5 in frame 4: ids must be >= 0, as"):
+            fn(HAND_GT, neg)
+        with pytest.raises(ValueError, match=r"^ground truth has id -5 in frame 4: ids must be"):
+            fn(neg, HAND_RES)
+        with pytest.raises(ValueError, match=r"id -1 in frame 1: .*: is it a detections file"):
+            fn(HAND_GT, one)
+    zero = HAND_RES.copy()
+    zero[:, 1] -= 10  # ids from 0: TrackEval scores them
+    assert evaluate_mot(HAND_GT, zero).num_switches == 1
+    write_mot(tmp_path / "gt.txt", HAND_GT)
+    write_mot(tmp_path / "res.txt", neg)
+    argv = ["eval", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack eval: error: {tmp_path / 'res.txt'}: result has id -5 in frame 4: ids must be "
+        ">= 0, as TrackEval requires\n"
+    )

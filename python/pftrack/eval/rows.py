@@ -84,6 +84,29 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     return a
 
 
+_DETECTIONS_HINT = (
+    ": is it a detections file (det.txt has id -1 on every row)? Score tracks, with one id per "
+    "object"
+)
+
+
+def check_ids_not_negative(rows: NDArray[np.float64], name: str) -> None:
+    """Refuse a negative id (ValueError naming `name`, the id and its frame), as TrackEval does.
+
+    TrackEval fails on one (an IndexError or "negative dimensions"); pftrack scored it as any
+    other id. Id -1 is what detection files hold: the message asks whether it is one.
+    """
+    negative = rows[:, ID] < 0
+    if np.any(negative):
+        k = int(np.flatnonzero(negative)[0])
+        bad = int(rows[k, ID])
+        hint = _DETECTIONS_HINT if bad == -1 else ""
+        raise ValueError(
+            f"{name} has id {bad} in frame {int(rows[k, FRAME])}: ids must be >= 0, as "
+            f"TrackEval requires{hint}"
+        )
+
+
 #: What combines each kind of scores (named when a list holds another kind).
 _COMBINERS = {
     "MotMetrics": "pftrack.eval.combine_mot",
@@ -117,12 +140,7 @@ def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
         ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
         if np.any(counts > 1):
             twice = int(ids[counts > 1][0])
-            hint = (
-                ": is it a detections file (det.txt has id -1 on every row)? Score tracks, "
-                "with one id per object"
-                if twice == -1
-                else " (ids must be unique within a frame)"
-            )
+            hint = _DETECTIONS_HINT if twice == -1 else " (ids must be unique within a frame)"
             raise ValueError(f"{name} has id {twice} more than once in frame {f}{hint}")
 
 
@@ -218,7 +236,8 @@ def prepare_mot(
     Parameters
     ----------
     gt, result : (M, 6..10) array_like of float
-        MOT rows. Ids must be unique within a frame. The class of result rows is not looked at.
+        MOT rows. Ids must be unique within a frame and >= 0 (TrackEval's rules). The class of
+        result rows is not looked at.
     benchmark : {"MOT15", "MOT16", "MOT17", "MOT20"}
         Which conventions (see :func:`guess_benchmark`).
     scale : float
@@ -251,6 +270,8 @@ def prepare_mot(
     gf, rf = group_by_frame(g), group_by_frame(r)
     check_unique_ids(gf, "ground truth")
     check_unique_ids(rf, "result")
+    check_ids_not_negative(g, "ground truth")  # after: det.txt has id -1 twice in a frame
+    check_ids_not_negative(r, "result")
     with_classes = benchmark != "MOT15"
     if with_classes and len(g):
         cls = g[:, _CLASS]
