@@ -240,6 +240,8 @@ def test_scale_mismatch_refused(tmp_path: Path, capsys: pytest.CaptureFixture[st
     res[:, 2:6] *= 0.625  # the result lives in a 480x360 image
     with pytest.raises(ValueError, match=r"--scale S.*about 0\.6"):
         check_scale(gt, res)
+    with pytest.raises(ValueError, match=r"pass --scale A=S, S the ratio .*about 0\.6"):
+        check_scale(gt, res, sequence="A")
     check_scale(gt, res, scale=0.625)  # the right scale passes
     check_scale(gt, perturbed(gt, 2))  # same scale passes
     small = res.copy()
@@ -294,7 +296,12 @@ def test_cli_on_real_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
             "tud-campus"]  # fmt: skip
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert "pets09-s2l1.txt: its boxes look 0.6" in err and "--scale" in err
+    assert "pets09-s2l1.txt: its boxes look 0.6" in err
+    assert "pass --scale pets09-s2l1=S, S the ratio" in err  # was --scale S, for every sequence
+    # a global scale meant for PETS09 scales TUD-Campus too: the hint names its own scale
+    assert main([*argv, "--scale", "0.625"]) == 2
+    err = capsys.readouterr().err
+    assert "tud-campus.txt: its boxes look 1.6" in err and "pass --scale tud-campus=S" in err
     out = tmp_path / "s.json"
     assert main([*argv, "--scale", "pets09-s2l1=0.625", "--json", str(out)]) == 0
     doc = json.loads(out.read_text())

@@ -239,7 +239,9 @@ def run(args: argparse.Namespace) -> int:
         check_file_ids(gt, seq.gt_path)  # 1.5 is refused, as recover does (was: scored as 1)
         check_file_ids(res, path)
         if not args.no_scale_check:
-            check_scale(gt, res, scale=scales[name], name=f"{path}")
+            # several sequences: the fix is this one's scale, --scale NAME=S (was --scale S)
+            several = name if len(jobs) > 1 else None
+            check_scale(gt, res, scale=scales[name], name=f"{path}", sequence=several)
         loaded.append((name, seq, gt, res))
 
     scores: dict[str, SequenceScores] = {}

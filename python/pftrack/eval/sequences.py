@@ -217,7 +217,12 @@ def _matched_fraction(
 
 
 def check_scale(
-    gt: ArrayLike, result: ArrayLike, *, scale: float = 1.0, name: str = "result"
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    scale: float = 1.0,
+    name: str = "result",
+    sequence: str | None = None,
 ) -> None:
     """Refuse a result whose boxes are in another pixel scale than the (scaled) ground truth.
 
@@ -229,6 +234,10 @@ def check_scale(
     share (and reaches 30 %), the coordinate systems differ: typically PETS09 ground truth
     (768x576) against results on its 480x360 video, which needs ``scale=0.625``, or results
     on a video of another shape (a 4:3 sequence stretched to 16:9), which one factor cannot fix.
+
+    `name` leads the message (``pftrack eval`` gives the result file); with `sequence`, one of
+    several sequences scored, the fix it names is ``--scale SEQUENCE=S`` (``--scale S`` would
+    scale every sequence's ground truth).
 
     Raises
     ------
@@ -283,10 +292,11 @@ def check_scale(
                 "rescale one of them per axis, or --no-scale-check"
             )
     if best >= 0.3 and best > 2 * as_given:
+        option = "--scale S" if sequence is None else f"--scale {sequence}=S"
         raise ValueError(
             f"{name}: its boxes look {fit / scale:.3g} times the ground truth's (median height "
             f"{r_h:.0f} vs {g_h:.0f} px; {as_given:.0%} of ground-truth boxes matched, "
-            f"{best:.0%} with the ground truth scaled by {fit:.3g}): pass --scale S, S the ratio "
+            f"{best:.0%} with the ground truth scaled by {fit:.3g}): pass {option}, S the ratio "
             f"of the image sizes (about {fit:.3g} here; 0.625 for PETS09 ground truth on its "
             "480x360 video), or --no-scale-check"
         )
