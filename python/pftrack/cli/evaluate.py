@@ -73,8 +73,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--iou", type=iou_threshold, default=0.5, help=IOU_HELP)
     p.add_argument(
         "--benchmark", choices=("auto", "MOT15", "MOT16", "MOT17", "MOT20"), default="auto",
-        help="ground-truth rules for HOTA; auto: MOT17 when columns 8-9 hold classes 1-13 and "
-        "visibilities, else MOT15",
+        help="ground-truth rules: which rows HOTA, CLEAR-MOT and IDF1 score; auto: MOT17 when "
+        "columns 8-9 hold classes 1-13 and visibilities, else MOT15",
     )  # fmt: skip
     p.add_argument("--seqs", nargs="+", metavar="NAME", default=None,
                    help="score only these sequences of a folder (default: all of "

@@ -167,8 +167,9 @@ class HotaMetrics:
         }
 
     def as_dict(self) -> dict[str, object]:
-        """:meth:`summary` plus the per-threshold arrays as lists (JSON-ready)."""
+        """:meth:`summary`, ``hota0``, then the per-threshold arrays as lists (JSON-ready)."""
         out: dict[str, object] = dict(self.summary())
+        out["hota0"] = self.hota0  # a scalar too (was left out of the JSON and CSV)
         out["alphas"] = [round(float(a), 2) for a in ALPHAS]
         for name in ("hota_alpha", "det_a_alpha", "ass_a", "loc_a", "tp", "fn", "fp"):
             out[f"{name.removesuffix('_alpha')}_per_alpha"] = [

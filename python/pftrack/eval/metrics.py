@@ -69,7 +69,8 @@ class MotMetrics:
         Times a ground-truth trajectory goes from tracked to untracked, counted between its first
         and last tracked frame.
     mostly_tracked, partially_tracked, mostly_lost : int
-        Objects tracked in >= 80 %, in [20 %, 80 %), and in < 20 % of their frames.
+        Objects tracked in more than 80 %, in [20 %, 80 %], and in under 20 % of their frames
+        (TrackEval's rule; py-motmetrics counts exactly 80 % as mostly tracked).
     false_positives, misses, num_matches : int
         CLEAR-MOT FP, FN and matches (switches included in the matches).
     num_objects, num_predictions : int
@@ -317,11 +318,16 @@ def evaluate_mot(
 
     Notes
     -----
-    Per-frame matching follows CLEAR-MOT as implemented by py-motmetrics: each ground-truth
-    object first keeps the result id it was last matched to if that box is present and its IoU is
-    still >= `iou_threshold`; the remaining objects and boxes are paired by the Hungarian
-    algorithm on ``1 - IoU`` among admissible pairs (maximum number of pairs first). A match to
-    a different id than the object's last match is an identity switch, however long ago.
+    Per-frame matching is TrackEval's ``CLEAR`` (the MOTChallenge server's): in each frame
+    holding both ground-truth and result boxes, one Hungarian assignment maximises, over the
+    pairs whose IoU reaches `iou_threshold` (less ``eps``, 2.2e-16, as TrackEval), 1000 for each
+    pair that goes on from the last such frame (the object was matched to that result id there)
+    plus the pair's IoU: a track goes on where it can, and IoU decides the rest. Exact ties go
+    by the order of the rows in the frame, as TrackEval reads them from the file. A match to a
+    different id than the object's last match, however long ago, is an identity switch.
+    (py-motmetrics differs: it keeps a match after any gap and pairs the rest separately.)
+    Identity (IDF1) counts the frames where a pair's IoU is >= `iou_threshold`, as TrackEval's
+    ``Identity``.
 
     The rows scored are those HOTA scores, chosen by TrackEval's MOTChallenge preprocessing
     (:func:`pftrack.eval.prepare_mot`): ground-truth rows whose ``conf`` (the "consider" flag)
