@@ -157,7 +157,8 @@ def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     (res_root / "B.txt").unlink()
     assert "no result for sequence B" in error()
     write_mot(res_root / "B.txt", cases["B"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
-    assert "B: result has frame" in error()  # beyond seqLength
+    # beyond seqLength: led by the file (was by the sequence's name, "B: result has frame")
+    assert f"error: {res_root / 'B.txt'}: result has frame" in error()
     assert main(["eval", "--gt", str(tmp_path / "nothing"), "--res", str(res_root)]) == 2
     assert "ground truth not found: " in capsys.readouterr().err
     assert main(["eval", "--gt", str(tmp_path / "nope.txt"), "--res", str(res_root)]) == 2
@@ -239,6 +240,8 @@ def test_scale_mismatch_refused(tmp_path: Path, capsys: pytest.CaptureFixture[st
     res[:, 2:6] *= 0.625  # the result lives in a 480x360 image
     with pytest.raises(ValueError, match=r"--scale S.*about 0\.6"):
         check_scale(gt, res)
+    with pytest.raises(ValueError, match=r"pass --scale A=S, S the ratio .*about 0\.6"):
+        check_scale(gt, res, sequence="A")
     check_scale(gt, res, scale=0.625)  # the right scale passes
     check_scale(gt, perturbed(gt, 2))  # same scale passes
     small = res.copy()
@@ -293,7 +296,12 @@ def test_cli_on_real_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
             "tud-campus"]  # fmt: skip
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert "pets09-s2l1.txt: its boxes look 0.6" in err and "--scale" in err
+    assert "pets09-s2l1.txt: its boxes look 0.6" in err
+    assert "pass --scale pets09-s2l1=S, S the ratio" in err  # was --scale S, for every sequence
+    # a global scale meant for PETS09 scales TUD-Campus too: the hint names its own scale
+    assert main([*argv, "--scale", "0.625"]) == 2
+    err = capsys.readouterr().err
+    assert "tud-campus.txt: its boxes look 1.6" in err and "pass --scale tud-campus=S" in err
     out = tmp_path / "s.json"
     assert main([*argv, "--scale", "pets09-s2l1=0.625", "--json", str(out)]) == 0
     doc = json.loads(out.read_text())
@@ -342,3 +350,50 @@ def test_cli_reads_trackevals_tree(tmp_path: Path, capsys: pytest.CaptureFixture
     assert "--seqs" in error(gt_root, trackers / "mine")
     shutil.copytree(gt_split, gt_root / "MOT16-train")  # the same names twice
     assert "sequence A is both in" in error(gt_root, trackers / "mine")
+
+
+def test_json_layouts_and_every_scalar_as_docs_eval_md_gives_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A file: metrics at the top level; a folder, even of one sequence: under "sequences".
+
+    ``hota0`` (HOTA at alpha 0.05) was in neither the JSON nor the CSV, which the docs said
+    hold every scalar.
+    """
+    from pftrack.eval import MotMetrics
+
+    cases = {"A": random_case(0)}
+    gt_root, res_root = make_layout(tmp_path, cases)
+    docs = {}
+    for key, gt in (("file", gt_root / "A" / "gt" / "gt.txt"), ("folder", gt_root)):
+        out, table = tmp_path / f"{key}.json", tmp_path / f"{key}.csv"
+        argv = ["eval", "--gt", str(gt), "--res", str(res_root / "A.txt")]
+        assert main([*argv, "--json", str(out), "--csv", str(table)]) == 0
+        docs[key] = json.loads(out.read_text())
+        rows = list(csv.DictReader(table.read_text().splitlines()))
+        assert len(rows) == 1 and rows[0]["sequence"] == "A" and "hota0" in rows[0]
+    capsys.readouterr()
+    assert list(docs["folder"]) == ["sequences"]  # one sequence: no "combined"
+    assert docs["folder"]["sequences"]["A"] == docs["file"]
+    metrics = docs["file"]
+    h = evaluate_hota(*(read_mot(p) for p in (gt_root / "A/gt/gt.txt", res_root / "A.txt")))
+    assert metrics["hota0"] == h.hota0
+    scalars = [*h.summary(), "hota0"]
+    fields = list(MotMetrics.__dataclass_fields__)
+    assert list(metrics) == [*scalars, *fields, "benchmark", "per_alpha"]
+    per_alpha = ["hota", "det_a", "ass_a", "loc_a", "tp", "fn", "fp"]
+    assert list(metrics["per_alpha"]) == ["alphas", *(f"{k}_per_alpha" for k in per_alpha)]
+    text = (Path(__file__).parents[2] / "docs" / "eval.md").read_text()
+    section = text[text.index("**`--json` layout.**") : text.index("```python")]
+    for name in [*metrics, *metrics["per_alpha"]]:
+        assert f"`{name}`" in section, name  # each key is documented
+
+
+def test_benchmark_help_names_every_measure_its_rules_apply_to(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """It said 'ground-truth rules for HOTA': they choose CLEAR-MOT's and IDF1's rows too."""
+    with pytest.raises(SystemExit):
+        main(["eval", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "ground-truth rules: which rows HOTA, CLEAR-MOT and IDF1 score" in help_text

@@ -73,8 +73,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--iou", type=iou_threshold, default=0.5, help=IOU_HELP)
     p.add_argument(
         "--benchmark", choices=("auto", "MOT15", "MOT16", "MOT17", "MOT20"), default="auto",
-        help="ground-truth rules for HOTA; auto: MOT17 when columns 8-9 hold classes 1-13 and "
-        "visibilities, else MOT15",
+        help="ground-truth rules: which rows HOTA, CLEAR-MOT and IDF1 score; auto: MOT17 when "
+        "columns 8-9 hold classes 1-13 and visibilities, else MOT15",
     )  # fmt: skip
     p.add_argument("--seqs", nargs="+", metavar="NAME", default=None,
                    help="score only these sequences of a folder (default: all of "
@@ -192,6 +192,19 @@ def _no_result(res: Path, missing: list[str], n_seqs: int) -> str:
     )
 
 
+def _in_file(message: str, gt: Path, res: Path) -> str:
+    """A scorer's message ("ground truth has ...", "result has ...") led by the file it is about.
+
+    Was led by the sequence's name, for one file the result file's stem: ``--gt det.txt --res
+    gt.txt`` said "gt: ground truth has id -1 more than once ...", naming the other file.
+    """
+    if message.startswith("ground truth"):
+        return f"{gt}: {message}"
+    if message.startswith("result"):
+        return f"{res}: {message}"
+    return f"{gt} against {res}: {message}"
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack eval``: optionally write JSON/CSV, then print the table; return the status."""
     import json
@@ -226,7 +239,9 @@ def run(args: argparse.Namespace) -> int:
         check_file_ids(gt, seq.gt_path)  # 1.5 is refused, as recover does (was: scored as 1)
         check_file_ids(res, path)
         if not args.no_scale_check:
-            check_scale(gt, res, scale=scales[name], name=f"{path}")
+            # several sequences: the fix is this one's scale, --scale NAME=S (was --scale S)
+            several = name if len(jobs) > 1 else None
+            check_scale(gt, res, scale=scales[name], name=f"{path}", sequence=several)
         loaded.append((name, seq, gt, res))
 
     scores: dict[str, SequenceScores] = {}
@@ -246,7 +261,7 @@ def run(args: argparse.Namespace) -> int:
                 num_frames=seq.length,
             )
         except ValueError as exc:
-            raise ValueError(f"{name}: {exc}") from None
+            raise ValueError(_in_file(str(exc), seq.gt_path, path)) from None
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
     if args.json:
         if Path(args.gt).is_file():  # one file: its metrics at the top level, as before

@@ -20,6 +20,7 @@ from pftrack.eval.rows import (  # the scored rows; here too, as before
     _mot_iou,
     guess_benchmark,
     mot_iou,
+    not_parts_message,
     prepare_mot,
 )
 from pftrack.io.mot import ID, LEFT, group_by_frame
@@ -166,8 +167,9 @@ class HotaMetrics:
         }
 
     def as_dict(self) -> dict[str, object]:
-        """:meth:`summary` plus the per-threshold arrays as lists (JSON-ready)."""
+        """:meth:`summary`, ``hota0``, then the per-threshold arrays as lists (JSON-ready)."""
         out: dict[str, object] = dict(self.summary())
+        out["hota0"] = self.hota0  # a scalar too (was left out of the JSON and CSV)
         out["alphas"] = [round(float(a), 2) for a in ALPHAS]
         for name in ("hota_alpha", "det_a_alpha", "ass_a", "loc_a", "tp", "fn", "fp"):
             out[f"{name.removesuffix('_alpha')}_per_alpha"] = [
@@ -304,9 +306,14 @@ def combine_hota(parts: Iterable[HotaMetrics] | Sequence[HotaMetrics]) -> HotaMe
     TP, FN and FP are summed per threshold; AssA, AssRe, AssPr and LocA are the TP-weighted
     means of the sequences' values, so DetA and HOTA are those of the summed counts.
     """
+    if isinstance(parts, HotaMetrics):
+        raise TypeError("combine_hota: parts is HotaMetrics, expected a list of HotaMetrics")
     items = list(parts)
     if not items:
         raise ValueError("combine_hota: no sequences to combine")
+    for k, p in enumerate(items):
+        if not isinstance(p, HotaMetrics):
+            raise TypeError(not_parts_message("combine_hota", k, p, "HotaMetrics"))
     tp = np.sum([p.tp for p in items], axis=0)
     w = np.maximum(1.0, tp)
 

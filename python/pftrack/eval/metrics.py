@@ -20,18 +20,18 @@ from pftrack._typing import BenchmarkName
 from pftrack.boxes import iou_xywh
 from pftrack.eval.rows import (
     BENCHMARKS,
-    IOU_ROUNDING,
     _mot_iou,
     check_eval_rows,
     guess_benchmark,
+    not_parts_message,
     prepare_mot,
 )
 from pftrack.io.mot import FRAME, ID, LEFT
 
 __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_xywh"]
 
-# Cost of a forbidden pair in the per-frame assignment: larger than any sum of admissible
-# costs (each is at most 1), so the solver first maximises the number of admissible pairs.
+# TrackEval's np.finfo(float).eps: how far below the threshold CLEAR still takes a pair, and
+# the score a pair of the assignment must exceed to be a match.
 _EPS = float(np.finfo(np.float64).eps)
 
 
@@ -45,12 +45,17 @@ class MotMetrics:
     Attributes
     ----------
     mota : float
-        ``1 - (FN + FP + IDSW) / num_objects`` (a fraction; can be negative); 0 without any
+        ``1 - (FN + FP + IDSW) / num_objects`` (a fraction; can be negative), computed as
+        TrackEval's ``(TP - FP - IDSW) / num_objects`` (the same bits); 0 without any
         ground-truth box, as TrackEval scores such a sequence.
     motp_iou : float
         Mean IoU of the matched pairs (0 without a match, as TrackEval's MOTP). This is "MOTP
         as overlap" (higher is better); py-motmetrics reports the mean distance ``1 - IoU``
         instead, i.e. ``1 - motp_iou``.
+    iou_sum : float
+        Sum of the matched pairs' IoU, added up as TrackEval's ``MOTP_sum`` (each frame's sum,
+        then over frames): ``motp_iou = iou_sum / num_matches``. :func:`combine_mot` sums it,
+        so that a combined MOTP is TrackEval's to the last bit.
     idf1, idp, idr : float
         Identity F1, precision and recall after the global one-to-one assignment of ground-truth
         trajectories to result trajectories that maximises the identity true positives (0,
@@ -64,7 +69,8 @@ class MotMetrics:
         Times a ground-truth trajectory goes from tracked to untracked, counted between its first
         and last tracked frame.
     mostly_tracked, partially_tracked, mostly_lost : int
-        Objects tracked in >= 80 %, in [20 %, 80 %), and in < 20 % of their frames.
+        Objects tracked in more than 80 %, in [20 %, 80 %], and in under 20 % of their frames
+        (TrackEval's rule; py-motmetrics counts exactly 80 % as mostly tracked).
     false_positives, misses, num_matches : int
         CLEAR-MOT FP, FN and matches (switches included in the matches).
     num_objects, num_predictions : int
@@ -99,6 +105,7 @@ class MotMetrics:
 
     mota: float
     motp_iou: float
+    iou_sum: float
     idf1: float
     idp: float
     idr: float
@@ -244,14 +251,34 @@ def _not_mot_metrics(fn: str, what: str, value: object) -> str:
     return f"{fn}: {what} is {type(value).__name__}, expected MotMetrics: {hint}"
 
 
-def _split(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
-    if len(rows) == 0:
-        return {}
-    order = np.lexsort((rows[:, ID], rows[:, FRAME]))
-    r = rows[order]
-    frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
-    ends = list(starts[1:]) + [len(r)]
-    return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}
+def check_image_size(image_size: object, fn: str) -> tuple[float, float] | None:
+    """`image_size` as ``(width, height)`` floats, or None; errors name `fn` and the argument.
+
+    Raises
+    ------
+    TypeError
+        Not a pair (an int, a string), or a side that is not a number (None, text, a bool).
+    ValueError
+        Not two values, or a side not finite or not > 0.
+    """
+    if image_size is None:
+        return None
+    what = f"{fn}: image_size"
+    if isinstance(image_size, (str, bytes)) or not isinstance(image_size, (Sequence, np.ndarray)):
+        raise TypeError(
+            f"{what} is {type(image_size).__name__} {image_size!r}, expected (width, height)"
+        )
+    if len(image_size) != 2:
+        raise ValueError(f"{what} is {image_size!r}, expected (width, height), 2 values")
+    w, h = (number(v, f"{what}[{k}]", finite=False) for k, v in enumerate(image_size))
+    if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
+        raise ValueError(f"{what} is {image_size!r}, expected (width, height) finite and > 0")
+    return w, h
+
+
+def _concat(parts: list[NDArray[np.int64]]) -> NDArray[np.int64]:
+    out: NDArray[np.int64] = np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+    return out
 
 
 def evaluate_mot(
@@ -278,7 +305,7 @@ def evaluate_mot(
         Multiplies the ground-truth boxes (left, top, width, height) before scoring, e.g. 0.625
         for PETS09 ground truth (768x576) against a tracker run on the 480x360 video.
     image_size : (width, height), optional
-        Image size for the centroid-distance ratio (NaN without it).
+        Image size for the centroid-distance ratio (NaN without it): two finite numbers > 0.
     benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
         Which MOTChallenge rules choose the scored rows (:func:`pftrack.eval.prepare_mot`);
         ``"auto"`` guesses MOT15 or MOT17 from the columns (:func:`pftrack.eval.guess_benchmark`).
@@ -291,11 +318,16 @@ def evaluate_mot(
 
     Notes
     -----
-    Per-frame matching follows CLEAR-MOT as implemented by py-motmetrics: each ground-truth
-    object first keeps the result id it was last matched to if that box is present and its IoU is
-    still >= `iou_threshold`; the remaining objects and boxes are paired by the Hungarian
-    algorithm on ``1 - IoU`` among admissible pairs (maximum number of pairs first). A match to
-    a different id than the object's last match is an identity switch, however long ago.
+    Per-frame matching is TrackEval's ``CLEAR`` (the MOTChallenge server's): in each frame
+    holding both ground-truth and result boxes, one Hungarian assignment maximises, over the
+    pairs whose IoU reaches `iou_threshold` (less ``eps``, 2.2e-16, as TrackEval), 1000 for each
+    pair that goes on from the last such frame (the object was matched to that result id there)
+    plus the pair's IoU: a track goes on where it can, and IoU decides the rest. Exact ties go
+    by the order of the rows in the frame, as TrackEval reads them from the file. A match to a
+    different id than the object's last match, however long ago, is an identity switch.
+    (py-motmetrics differs: it keeps a match after any gap and pairs the rest separately.)
+    Identity (IDF1) counts the frames where a pair's IoU is >= `iou_threshold`, as TrackEval's
+    ``Identity``.
 
     The rows scored are those HOTA scores, chosen by TrackEval's MOTChallenge preprocessing
     (:func:`pftrack.eval.prepare_mot`): ground-truth rows whose ``conf`` (the "consider" flag)
@@ -320,14 +352,11 @@ def evaluate_mot(
     scale = number(scale, "evaluate_mot: scale", finite=False)
     if not (math.isfinite(scale) and scale > 0):
         raise ValueError(f"evaluate_mot: scale is {scale}, expected a finite value > 0")
-    # pairs reach the threshold up to rounding: identical boxes' IoU may come out 1 - 1e-16,
-    # and with a threshold of 1 they must still match
-    reach = iou_threshold - IOU_ROUNDING
-    if image_size is not None:
-        if len(image_size) != 2 or min(image_size) <= 0:
-            raise ValueError(
-                f"evaluate_mot: image_size is {image_size!r}, expected (width, height) > 0"
-            )
+    # TrackEval's two rules, to the last bit: CLEAR takes a pair unless its IoU is below the
+    # threshold by more than eps, Identity (and here Smith's strict success) needs IoU >= it.
+    # (Identical boxes have IoU exactly 1 in mot_iou's arithmetic: a threshold of 1 matches them.)
+    clear_reach = iou_threshold - _EPS
+    size = check_image_size(image_size, "evaluate_mot")
     if benchmark != "auto" and benchmark not in BENCHMARKS:
         raise ValueError(
             f"evaluate_mot: benchmark is {benchmark!r}, expected 'auto' or one of "
@@ -338,113 +367,86 @@ def evaluate_mot(
     mark = guess_benchmark(g0) if benchmark == "auto" else benchmark
     g, r = prepare_mot(g0, r0, benchmark=mark, scale=scale, num_frames=num_frames)  # ids too
     n_ign_gt, n_ign_res = len(g0) - len(g), len(r0) - len(r)
-    gt_frames = _split(g)
-    res_frames = _split(r)
-    frames = sorted(set(gt_frames) | set(res_frames))
+    # each frame's rows in file order, as TrackEval reads them: on exact ties (two result boxes
+    # equally good for an object) the assignment goes by that order (was sorted by id, which
+    # scored other switches than TrackEval's)
+    g = g[np.argsort(g[:, FRAME], kind="stable")]  # prepare_mot's order already
+    r = r[np.argsort(r[:, FRAME], kind="stable")]
     n_frames = len(set(g0[:, FRAME].tolist()) | set(r0[:, FRAME].tolist()))
-    empty = np.zeros((0, 10))
+    oids, g_idx = np.unique(g[:, ID].astype(np.int64), return_inverse=True)
+    hids, r_idx = np.unique(r[:, ID].astype(np.int64), return_inverse=True)
+    n_o, n_h = len(oids), len(hids)
+    gt_count = np.bincount(g_idx, minlength=n_o)  # frames each object is scored in
+    g_frame = g[:, FRAME].astype(np.int64)
+    r_frame = r[:, FRAME].astype(np.int64)
+    g_box, r_box = g[:, LEFT : LEFT + 4], r[:, LEFT : LEFT + 4]
+    frames = np.union1d(g_frame, r_frame)
+    g_lo, g_hi = np.searchsorted(g_frame, frames), np.searchsorted(g_frame, frames, "right")
+    r_lo, r_hi = np.searchsorted(r_frame, frames), np.searchsorted(r_frame, frames, "right")
 
-    last_match: dict[int, int] = {}  # gt id -> result id of its latest match (switches)
-    previous: dict[int, int] = {}  # gt id -> result id matched at the last scored frame
-    matched_count: dict[int, int] = {}  # gt id -> frames matched (MT/PT/ML)
-    runs: dict[int, int] = {}  # gt id -> tracked runs begun (fragmentations)
-    pair_hits: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU >= thr
-    pair_touch: dict[tuple[int, int], int] = {}  # (gt id, res id) -> frames with IoU > 0
-    centroid: dict[tuple[int, int], list[float]] = {}  # (gt id, res id) -> distances
-    gt_count: dict[int, int] = {}  # gt id -> frames it is scored in
-    res_count: dict[int, int] = {}
-    n_fp = n_fn = n_sw = n_match = n_gt = n_res = 0
+    # CLEAR-MOT state, TrackEval's, per object index (NaN: none)
+    last_match = np.full(n_o, np.nan)  # result index of its latest match (switches)
+    previous = np.full(n_o, np.nan)  # result index matched at the last scored frame
+    matched_count = np.zeros(n_o, dtype=np.int64)  # frames matched (MT/PT/ML)
+    runs = np.zeros(n_o, dtype=np.int64)  # tracked runs begun (fragmentations)
+    touch_keys: list[NDArray[np.int64]] = []  # object * n_h + result: a frame with IoU > 0
+    hit_keys: list[NDArray[np.int64]] = []  # ... with IoU >= threshold (Identity, Smith)
+    n_fp = n_fn = n_sw = n_match = 0
     iou_sum = 0.0
 
-    for f in frames:
-        gf = gt_frames.get(f, empty)
-        rf = res_frames.get(f, empty)
-        gids = gf[:, ID].astype(np.int64)
-        rids = rf[:, ID].astype(np.int64)
-        n_gt += len(gids)
-        n_res += len(rids)
-        for o in gids:
-            gt_count[int(o)] = gt_count.get(int(o), 0) + 1
-        for h in rids:
-            res_count[int(h)] = res_count.get(int(h), 0) + 1
-        iou = _mot_iou(gf[:, LEFT : LEFT + 4], rf[:, LEFT : LEFT + 4])  # TrackEval's IoU
-        ok = iou >= reach
-
-        # Identity and Smith measures look at every overlapping (gt, result) pair.
-        if len(gids) and len(rids):
-            cg = gf[:, LEFT : LEFT + 2] + 0.5 * gf[:, LEFT + 2 : LEFT + 4]
-            cr = rf[:, LEFT : LEFT + 2] + 0.5 * rf[:, LEFT + 2 : LEFT + 4]
-            dist = np.hypot(cg[:, None, 0] - cr[None, :, 0], cg[:, None, 1] - cr[None, :, 1])
-            # A pair counts once per frame even if an id appears twice (ids should be unique).
-            near: dict[tuple[int, int], float] = {}
-            touch_f: set[tuple[int, int]] = set()
-            hit_f: set[tuple[int, int]] = set()
-            for i, o in enumerate(gids):
-                for j, h in enumerate(rids):
-                    key = (int(o), int(h))
-                    near[key] = min(near.get(key, math.inf), float(dist[i, j]))
-                    if iou[i, j] > 0:
-                        touch_f.add(key)
-                    if ok[i, j]:
-                        hit_f.add(key)
-            for key, d in near.items():
-                centroid.setdefault(key, []).append(d)
-            for key in touch_f:
-                pair_touch[key] = pair_touch.get(key, 0) + 1
-            for key in hit_f:
-                pair_hits[key] = pair_hits.get(key, 0) + 1
+    for k in range(len(frames)):
+        gs, rs = slice(g_lo[k], g_hi[k]), slice(r_lo[k], r_hi[k])
+        gi, ri = g_idx[gs], r_idx[rs]
+        if len(gi) == 0 or len(ri) == 0:
+            n_fp += len(ri)
+            n_fn += len(gi)
+            continue  # no frame to go on from: `previous` stays as it was
+        iou = _mot_iou(g_box[gs], r_box[rs])  # TrackEval's IoU
+        # Identity and Smith measures count every (gt, result) pair overlapping in a frame
+        a, b = np.nonzero(iou > 0)
+        touch_keys.append(gi[a] * n_h + ri[b])
+        a, b = np.nonzero(iou >= iou_threshold)  # Identity's and Smith's strict rule
+        hit_keys.append(gi[a] * n_h + ri[b])
 
         # CLEAR-MOT, TrackEval's arithmetic: one assignment maximising 1000 per pair that goes
         # on from the last scored frame, plus its IoU, among pairs that reach the threshold
-        if len(gids) == 0 or len(rids) == 0:
-            n_fp += len(rids)
-            n_fn += len(gids)
-            continue  # no frame to go on from: `previous` stays as it was
-        # each object's result id at the last scored frame (NaN: none, equal to no id)
-        before = np.array([previous.get(int(o), np.nan) for o in gids], dtype=np.float64)
-        goes_on = before[:, None] == rids[None, :]
-        score = np.where(ok, 1000.0 * goes_on + iou, 0.0)
+        goes_on = previous[gi][:, None] == ri[None, :]  # NaN: no pair goes on
+        score = np.where(iou >= clear_reach, 1000.0 * goes_on + iou, 0.0)
         rows_m, cols_m = linear_sum_assignment(-score)
         hit = score[rows_m, cols_m] > _EPS
-        matches = list(zip(rows_m[hit].tolist(), cols_m[hit].tolist(), strict=True))
-        now: dict[int, int] = {}
-        for i, j in matches:
-            o, h = int(gids[i]), int(rids[j])
-            if o in last_match and last_match[o] != h:
-                n_sw += 1
-            last_match[o] = now[o] = h
-            matched_count[o] = matched_count.get(o, 0) + 1
-            if o not in previous:
-                runs[o] = runs.get(o, 0) + 1
-            iou_sum += float(iou[i, j])
-        previous = now
-        n_match += len(matches)
-        n_fn += len(gids) - len(matches)
-        n_fp += len(rids) - len(matches)
+        rows_m, cols_m = rows_m[hit], cols_m[hit]
+        mo, mh = gi[rows_m], ri[cols_m]
+        if len(mo):  # TrackEval's MOTP_sum: the frame's sum, then added (the same bits)
+            iou_sum += float(sum(iou[rows_m, cols_m]))
+        before = last_match[mo]
+        n_sw += int(np.count_nonzero(~np.isnan(before) & (before != mh)))
+        last_match[mo] = mh
+        matched_count[mo] += 1
+        runs[mo] += np.isnan(previous[mo])
+        previous[:] = np.nan
+        previous[mo] = mh
+        n_match += len(mo)
+        n_fn += len(gi) - len(mo)
+        n_fp += len(ri) - len(mo)
+    n_gt, n_res = len(g), len(r)
 
     # Mostly tracked (above 80 % of its frames) / lost (below 20 %), fragmentations (tracked
     # runs after the first), as TrackEval counts them
-    mt = pt = ml = 0
-    for o, n in gt_count.items():
-        ratio = matched_count.get(o, 0) / n
-        if ratio > 0.8:
-            mt += 1
-        elif ratio >= 0.2:
-            pt += 1
-        else:
-            ml += 1
-    frag = sum(k - 1 for k in runs.values())
+    tracked = matched_count / np.maximum(gt_count, 1)
+    mt = int(np.count_nonzero(tracked > 0.8))
+    ml = int(np.count_nonzero(tracked < 0.2))
+    pt = n_o - mt - ml
+    frag = int(np.sum(np.maximum(runs - 1, 0)))
+
+    # pairs that overlap: (object, result) index and frames, as sorted keys
+    touch_k, touch_n = np.unique(_concat(touch_keys), return_counts=True)
+    hit_k, hit_n = np.unique(_concat(hit_keys), return_counts=True)
 
     # Identity: global assignment maximising the frames where a pair overlaps >= threshold.
-    oids = sorted(gt_count)
-    hids = sorted(res_count)
     idtp = 0
-    if oids and hids:
-        oi = {o: k for k, o in enumerate(oids)}
-        hi = {h: k for k, h in enumerate(hids)}
-        w = np.zeros((len(oids), len(hids)))
-        for (o, h), c in pair_hits.items():
-            w[oi[o], hi[h]] = c
+    if n_o and n_h:
+        w = np.zeros((n_o, n_h))
+        w[hit_k // n_h, hit_k % n_h] = hit_n
         a, b = linear_sum_assignment(-w)
         idtp = int(w[a, b].sum())
     idfn = n_gt - idtp
@@ -457,31 +459,55 @@ def evaluate_mot(
     # Smith et al.: per object, the result id overlapping it most often; ties go to the id
     # matching it (IoU >= threshold) more often, then to the nearer one (a neighbour touching
     # the object in as many frames is not its track: was the smaller id, so a result equal to
-    # the truth had a centroid distance above 0)
+    # the truth had a centroid distance above 0). Centroid distances only for the pairs that
+    # overlap somewhere (each over every frame holding both), not for every pair of every frame.
+    centre_g = g_box[:, :2] + 0.5 * g_box[:, 2:]
+    centre_r = r_box[:, :2] + 0.5 * r_box[:, 2:]
+    by_o = np.argsort(g_idx, kind="stable")  # each object's rows, in frame order
+    by_h = np.argsort(r_idx, kind="stable")
+    o_lo = np.searchsorted(g_idx[by_o], np.arange(n_o + 1))
+    h_lo = np.searchsorted(r_idx[by_h], np.arange(n_h + 1))
+
+    def distances(o: int, h: int) -> list[float]:
+        """Centroid distance of object `o` and result `h` in each frame holding both."""
+        ga, rb = by_o[o_lo[o] : o_lo[o + 1]], by_h[h_lo[h] : h_lo[h + 1]]
+        _, i, j = np.intersect1d(g_frame[ga], r_frame[rb], assume_unique=True, return_indices=True)
+        d = centre_g[ga[i]] - centre_r[rb[j]]
+        out: list[float] = np.hypot(d[:, 0], d[:, 1]).tolist()
+        return out
+
+    t_lo = np.searchsorted(touch_k // n_h, np.arange(n_o + 1)) if n_h else np.zeros(n_o + 1, int)
+    hit_of = dict(zip(hit_k.tolist(), hit_n.tolist(), strict=True))
     per_object: list[tuple[int, float, float]] = []
     dists: list[float] = []
-    for o in oids:
-        touch = {h: c for (oo, h), c in pair_touch.items() if oo == o}
-        hits = {h: c for (oo, h), c in pair_hits.items() if oo == o}
-        far = {h: sum(centroid[(o, h)]) for h in touch}
+    for o in range(n_o):
+        keys = touch_k[t_lo[o] : t_lo[o + 1]].tolist()
+        touch = {
+            key % n_h: int(c) for key, c in zip(keys, touch_n[t_lo[o] : t_lo[o + 1]], strict=True)
+        }
+        hits = {h: hit_of[o * n_h + h] for h in touch if o * n_h + h in hit_of}
+        near = {h: distances(o, h) for h in touch}
+        far = {h: sum(near[h]) for h in touch}
         loose = 0.0
         strict = 0.0
         if touch:
-            best = max(touch, key=lambda h: (touch[h], hits.get(h, 0), -far[h], -h))
-            loose = touch[best] / gt_count[o]
-            dists.extend(centroid[(o, best)])
+            best = max(touch, key=lambda h: (touch[h], hits.get(h, 0), -far[h], -int(hids[h])))
+            loose = touch[best] / int(gt_count[o])
+            dists.extend(near[best])
         if hits:
-            best_s = max(hits, key=lambda h: (hits[h], touch[h], -far[h], -h))
-            strict = hits[best_s] / gt_count[o]
-        per_object.append((o, loose, strict))
+            best_s = max(hits, key=lambda h: (hits[h], touch[h], -far[h], -int(hids[h])))
+            strict = hits[best_s] / int(gt_count[o])
+        per_object.append((int(oids[o]), loose, strict))
     cd = float(np.mean(dists)) if dists else float("nan")
-    ratio = cd / (image_size[0] * image_size[1]) if image_size is not None else float("nan")
+    ratio = cd / (size[0] * size[1]) if size is not None else float("nan")
 
     nan = float("nan")
     return MotMetrics(
         # TrackEval's CLEAR scores a sequence without ground truth (or results) as all 0
-        mota=1.0 - (n_fn + n_fp + n_sw) / n_gt if n_gt else 0.0,
+        # TrackEval's (TP - FP - IDSW) / GT, not 1 - (FN + FP + IDSW) / GT: the last bit differs
+        mota=(n_match - n_fp - n_sw) / n_gt if n_gt else 0.0,
         motp_iou=iou_sum / n_match if n_match else 0.0,
+        iou_sum=iou_sum,
         idf1=idf1,
         idp=idp,
         idr=idr,
@@ -498,7 +524,7 @@ def evaluate_mot(
         num_matches=n_match,
         num_objects=n_gt,
         num_predictions=n_res,
-        num_unique_objects=len(oids),
+        num_unique_objects=n_o,
         num_frames=n_frames,
         num_ignored_gt=n_ign_gt,
         num_ignored_predictions=n_ign_res,
@@ -538,8 +564,15 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
     -------
     MotMetrics
     """
+    if isinstance(parts, MotMetrics) or not isinstance(parts, Sequence):
+        raise TypeError(
+            f"combine_mot: parts is {type(parts).__name__}, expected a list of MotMetrics"
+        )
     if not parts:
         raise ValueError("combine_mot: no sequences to combine")
+    for k, p in enumerate(parts):
+        if not isinstance(p, MotMetrics):
+            raise TypeError(not_parts_message("combine_mot", k, p, "MotMetrics"))
     thresholds = {p.iou_threshold for p in parts}
     if len(thresholds) != 1:
         raise ValueError(f"combine_mot: IoU thresholds differ: {sorted(thresholds)}")
@@ -551,7 +584,9 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
     fn, fp, sw = total("misses"), total("false_positives"), total("num_switches")
     idtp, idfp, idfn = total("idtp"), total("idfp"), total("idfn")
     n_obj = total("num_unique_objects")
-    iou_sum = sum(p.motp_iou * p.num_matches for p in parts if p.num_matches)
+    iou_sum = 0.0
+    for p in parts:  # TrackEval's sum of MOTP_sum over sequences, term by term
+        iou_sum += p.iou_sum
     scales = {p.scale for p in parts}
     nan = float("nan")
 
@@ -565,8 +600,9 @@ def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:
 
     return MotMetrics(
         # TrackEval's (TP - FP - IDSW) / max(1, TP + FN): -(FP + IDSW) without ground truth
-        mota=1.0 - (fn + fp + sw) / n_gt if n_gt else float(-(fp + sw)),
+        mota=(n_match - fp - sw) / max(1, n_gt),
         motp_iou=ratio(iou_sum, n_match),
+        iou_sum=iou_sum,
         idf1=ratio(2 * idtp, 2 * idtp + idfp + idfn),
         idp=ratio(idtp, idtp + idfp),
         idr=ratio(idtp, idtp + idfn),

@@ -23,8 +23,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
-from pftrack.eval.metrics import MotMetrics, combine_mot, evaluate_mot
-from pftrack.eval.rows import _mot_iou
+from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
+from pftrack.eval.rows import _mot_iou, not_parts_message
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, WIDTH
 
 __all__ = [
@@ -217,7 +217,12 @@ def _matched_fraction(
 
 
 def check_scale(
-    gt: ArrayLike, result: ArrayLike, *, scale: float = 1.0, name: str = "result"
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    scale: float = 1.0,
+    name: str = "result",
+    sequence: str | None = None,
 ) -> None:
     """Refuse a result whose boxes are in another pixel scale than the (scaled) ground truth.
 
@@ -229,6 +234,10 @@ def check_scale(
     share (and reaches 30 %), the coordinate systems differ: typically PETS09 ground truth
     (768x576) against results on its 480x360 video, which needs ``scale=0.625``, or results
     on a video of another shape (a 4:3 sequence stretched to 16:9), which one factor cannot fix.
+
+    `name` leads the message (``pftrack eval`` gives the result file); with `sequence`, one of
+    several sequences scored, the fix it names is ``--scale SEQUENCE=S`` (``--scale S`` would
+    scale every sequence's ground truth).
 
     Raises
     ------
@@ -283,10 +292,11 @@ def check_scale(
                 "rescale one of them per axis, or --no-scale-check"
             )
     if best >= 0.3 and best > 2 * as_given:
+        option = "--scale S" if sequence is None else f"--scale {sequence}=S"
         raise ValueError(
             f"{name}: its boxes look {fit / scale:.3g} times the ground truth's (median height "
             f"{r_h:.0f} vs {g_h:.0f} px; {as_given:.0%} of ground-truth boxes matched, "
-            f"{best:.0%} with the ground truth scaled by {fit:.3g}): pass --scale S, S the ratio "
+            f"{best:.0%} with the ground truth scaled by {fit:.3g}): pass {option}, S the ratio "
             f"of the image sizes (about {fit:.3g} here; 0.625 for PETS09 ground truth on its "
             "480x360 video), or --no-scale-check"
         )
@@ -319,7 +329,26 @@ class SequenceScores:
 
     @staticmethod
     def combine(parts: Sequence[SequenceScores]) -> SequenceScores:
-        """Sequences combined as TrackEval combines them (see :func:`combine_hota`)."""
+        """Sequences combined as TrackEval combines them (see :func:`combine_hota`).
+
+        Raises
+        ------
+        TypeError
+            `parts` is not a list of SequenceScores (the message names what combines
+            MotMetrics, :func:`~pftrack.eval.combine_mot`, or HotaMetrics).
+        ValueError
+            No parts.
+        """
+        fn = "SequenceScores.combine"
+        if isinstance(parts, SequenceScores) or not isinstance(parts, Sequence):
+            raise TypeError(
+                f"{fn}: parts is {type(parts).__name__}, expected a list of SequenceScores"
+            )
+        if not parts:
+            raise ValueError(f"{fn}: no sequences to combine")
+        for k, p in enumerate(parts):
+            if not isinstance(p, SequenceScores):
+                raise TypeError(not_parts_message(fn, k, p, "SequenceScores"))
         marks = {p.benchmark for p in parts}
         return SequenceScores(
             mot=combine_mot([p.mot for p in parts]),
@@ -354,6 +383,7 @@ def evaluate_sequence(
     num_frames : int, optional
         The sequence length; later frames are an error.
     """
+    check_image_size(image_size, "evaluate_sequence")  # before HOTA's work
     mark = guess_benchmark(gt) if benchmark == "auto" else benchmark
     h = evaluate_hota(gt, result, benchmark=mark, scale=scale, num_frames=num_frames)
     m = evaluate_mot(
@@ -389,6 +419,46 @@ _COLUMNS: list[tuple[str, Callable[[SequenceScores], str]]] = [
 ]
 
 
+def _named_scores(fn: str, rows: object, combined: object) -> dict[str, SequenceScores]:
+    """`rows`, then `combined` as ``COMBINED``, checked: TypeError/ValueError naming `fn`.
+
+    (``format_scores({})`` raised a bare StopIteration, ``format_scores([scores])`` Python's
+    "dictionary update sequence element #0 ...".)
+    """
+    if not isinstance(rows, Mapping):
+        hint = "pass {name: scores}"
+        if isinstance(rows, SequenceScores):
+            hint = 'pass {"name": scores}'
+        elif isinstance(rows, MotMetrics):
+            hint = "evaluate_mot's MotMetrics are formatted by pftrack.eval.format_metrics"
+        raise TypeError(
+            f"{fn}: rows is {type(rows).__name__}, expected a mapping of names to "
+            f"SequenceScores (evaluate_sequence): {hint}"
+        )
+    named: dict[str, SequenceScores] = {}
+    for name, s in rows.items():
+        if not isinstance(s, SequenceScores):
+            hint = (
+                ": evaluate_mot's MotMetrics are formatted by pftrack.eval.format_metrics"
+                if isinstance(s, MotMetrics)
+                else ""
+            )
+            raise TypeError(
+                f"{fn}: rows[{name!r}] is {type(s).__name__}, expected SequenceScores{hint}"
+            )
+        named[str(name)] = s
+    if combined is not None:
+        if not isinstance(combined, SequenceScores):
+            raise TypeError(
+                f"{fn}: combined is {type(combined).__name__}, expected SequenceScores "
+                "(SequenceScores.combine) or None"
+            )
+        named[COMBINED] = combined
+    if not named:
+        raise ValueError(f"{fn}: no sequence to format")
+    return named
+
+
 def format_scores(
     rows: Mapping[str, SequenceScores], combined: SequenceScores | None = None
 ) -> str:
@@ -396,10 +466,16 @@ def format_scores(
 
     Percentages for HOTA, DetA, AssA, LocA (means over the 19 HOTA thresholds), MOTA, IDF1, IDP,
     IDR, MOTP (mean IoU of matches) and Smith et al.'s success rate; counts for the rest.
+
+    Raises
+    ------
+    TypeError
+        `rows` is not a mapping of names to SequenceScores (a list, MotMetrics: the message
+        names :func:`~pftrack.eval.format_metrics`), or `combined` is not a SequenceScores.
+    ValueError
+        Nothing to format.
     """
-    named = dict(rows)
-    if combined is not None:
-        named[COMBINED] = combined
+    named = _named_scores("format_scores", rows, combined)
     header = ["sequence"] + [c for c, _ in _COLUMNS]
     body = [[name] + [fn(s) for _, fn in _COLUMNS] for name, s in named.items()]
     widths = [max(len(r[i]) for r in [header, *body]) for i in range(len(header))]
@@ -416,6 +492,7 @@ def format_scores(
 
 def scores_json(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
     """JSON text: ``{"sequences": {name: scores}, "combined": scores}`` (NaN as null)."""
+    _named_scores("scores_json", rows, combined)
     doc: dict[str, object] = {"sequences": {k: v.as_dict() for k, v in rows.items()}}
     if combined is not None:
         doc["combined"] = combined.as_dict()
@@ -424,9 +501,7 @@ def scores_json(rows: Mapping[str, SequenceScores], combined: SequenceScores | N
 
 def scores_csv(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
     """CSV text: a header, one line per sequence, then ``COMBINED``; scalar scores only."""
-    named = dict(rows)
-    if combined is not None:
-        named[COMBINED] = combined
+    named = _named_scores("scores_csv", rows, combined)
     flat = {
         name: {k: v for k, v in s.as_dict().items() if not isinstance(v, (list, dict))}
         for name, s in named.items()
