@@ -9,6 +9,7 @@ import pytest
 
 from pftrack.recovery import DEFAULT_METHOD, fill_gaps, recover_gaps
 from pftrack.recovery.calibrate import (
+    BAGS,
     BucketChoice,
     Calibration,
     bucket_of,
@@ -509,8 +510,11 @@ def test_bagging_is_the_default_and_keeps_straight_lines_straight() -> None:
     from pftrack.recovery.calibrate import BAGS
 
     assert BAGS > 0
-    for fn in (calibrate, recover_auto):
-        assert inspect.signature(fn).parameters["bags"].default == BAGS, fn.__name__
+    from pftrack.recovery.fill import fill_rows
+
+    for fn in (calibrate, recover_auto, recover_gaps, fill_gaps, fill_rows):
+        # None: BAGS with the default combine=True (0 with combine=False)
+        assert inspect.signature(fn).parameters["bags"].default is None, fn.__name__
     tracks = _straight_tracks(np.random.default_rng(0))
     cal = calibrate(tracks, [5, 12, 25])
     assert cal.bags == BAGS
@@ -575,6 +579,38 @@ def test_bagging_is_seeded_and_reported() -> None:
         assert abs(sum(w for _, w in mix) - 1.0) < 1e-12
 
 
+def test_combine_false_is_one_method_per_bucket_without_bagging() -> None:
+    """Regression (user trial): ``fill_gaps(rows, combine=False)`` came back with buckets such
+    as ``gdt-mix+rts`` (KITTI-17: ``gdt-bi+gdt-mix+rts+linear``): bagging, on by default,
+    averaged the single methods 32 resamples chose into a blend. combine=False now means no
+    bagging (``bags=None``: 32 with combine, 0 without) and refuses ``bags > 0``."""
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(3)))
+    f = full[:, 0]
+    cut = full[~(((f >= 40) & (f < 42)) | ((f >= 80) & (f < 85)) | ((f >= 120) & (f < 132)))]
+    _, rep = fill_gaps(cut, combine=False)
+    for cal in (rep.calibration, rep.size_calibration):
+        assert cal is not None and cal.bags == 0 and cal.pooled_weights == ()
+        assert all("+" not in c.method and c.weights == () for c in cal.buckets), cal.describe()
+    _, bagged = fill_gaps(cut)  # the default: blends allowed, bagged
+    assert bagged.calibration is not None and bagged.calibration.bags == BAGS
+    _, also_bagged = fill_gaps(cut, bags=8)
+    assert also_bagged.calibration is not None and also_bagged.calibration.bags == 8
+    for call, who in (
+        (lambda: fill_gaps(cut, combine=False, bags=8), "fill_gaps"),
+        (lambda: calibrate(_straight_tracks(np.random.default_rng(0), n=5), [5], combine=False,
+                           bags=8), "calibrate"),
+        (lambda: recover_auto([(_A, _B)], combine=False, bags=1), "recover_auto"),
+        (lambda: recover_gaps([(_A, _B)], combine=False, bags=2), "recover_gaps"),
+    ):  # fmt: skip
+        with pytest.raises(ValueError, match=rf"^{who}: bags is \d+ with combine=False"):
+            call()
+    with pytest.raises(ValueError, match=r"fill_gaps: bags is -1, expected an integer"):
+        fill_gaps(cut, bags=-1)
+    tracks = _straight_tracks(np.random.default_rng(0), n=5)
+    assert calibrate(tracks, [5], combine=False).bags == 0
+    assert calibrate(tracks, [5]).bags == BAGS
+
+
 def test_bags_must_not_be_negative() -> None:
     tracks = _straight_tracks(np.random.default_rng(0), n=5)
     with pytest.raises(ValueError, match=r"bags is -1, expected an integer in \[0, "):
@@ -590,7 +626,7 @@ _A, _B = _RUN[:10], _RUN[15:]
     [
         # each was taken, or failed deep inside without the argument's name
         ({"bags": 1.5}, ValueError, r"calibrate: bags is 1.5, expected an integer in \[0, 10000\]"),
-        ({"bags": None}, ValueError, "calibrate: bags is None"),
+        ({"bags": "32"}, ValueError, "calibrate: bags is '32'"),
         ({"bags": True}, ValueError, "calibrate: bags is True"),
         ({"seed": -1}, ValueError, "calibrate: seed is -1, expected an int >= 0"),
         ({"seed": None}, TypeError, "calibrate: seed must be an int >= 0"),

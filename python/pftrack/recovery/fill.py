@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from pftrack import _check
 from pftrack._typing import F64, RecoveryMethod
-from pftrack.recovery.calibrate import Calibration, recover_auto
+from pftrack.recovery.calibrate import Calibration, bags_for, recover_auto
 from pftrack.recovery.linking import (
     FILLED_MARK,
     FLAG_COLUMN,
@@ -144,6 +144,7 @@ def fill_gaps(
     *,
     seed: int = 0,
     combine: bool = True,
+    bags: int | None = None,
 ) -> tuple[F64, FillReport]:
     """Fill every hole of at most `max_gap` missing frames inside each id's track.
 
@@ -165,7 +166,13 @@ def fill_gaps(
     combine : bool
         For ``"auto"``: a gap-length bucket may use a convex combination of two methods when
         it beats the single best on the validation gaps (default;
-        :func:`~pftrack.recovery.calibrate.calibrate`). False: one method per bucket.
+        :func:`~pftrack.recovery.calibrate.calibrate`). False: one method per bucket, for the
+        box centres and sizes (and no bagging, which would blend the resamples' choices).
+    bags : int or None
+        For ``"auto"``: bootstrap resamples of the validation gaps the choice is averaged over
+        (:func:`~pftrack.recovery.calibrate.calibrate`; 0: one choice). None (default):
+        :data:`~pftrack.recovery.calibrate.BAGS` with `combine`, 0 without; more than 0 with
+        ``combine=False`` is refused.
 
     Returns
     -------
@@ -186,12 +193,15 @@ def fill_gaps(
     TypeError
         `combine` not a bool, `seed` not an int, `noise` not a NoiseEstimate.
     ValueError
-        Unknown method, a negative `seed`, `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
+        Unknown method, a negative `seed`, `bags` not None or an integer in ``0..10000`` (or
+        more than 0 with ``combine=False``), `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
         rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
         or height, a value beyond ±1e9 px) or a duplicate (frame, id).
     """
-    new_rows, report = fill_rows(tracks, method, max_gap, noise, seed=seed, combine=combine)
+    new_rows, report = fill_rows(
+        tracks, method, max_gap, noise, seed=seed, combine=combine, bags=bags
+    )
     filled = np.vstack([np.asarray(tracks, dtype=np.float64), new_rows])
     order = np.lexsort((filled[:, 1], filled[:, 0]))
     return filled[order], report
@@ -205,6 +215,7 @@ def fill_rows(
     *,
     seed: int = 0,
     combine: bool = True,
+    bags: int | None = None,
 ) -> tuple[F64, FillReport]:
     """The rows :func:`fill_gaps` adds (flagged, in no particular order), and its report.
 
@@ -215,6 +226,7 @@ def fill_rows(
     if not isinstance(combine, (bool, np.bool_)):
         raise TypeError(f"fill_gaps: combine must be a bool, got {type(combine).__name__}")
     seed = _check.seed(seed, "fill_gaps: seed")  # NumPy's refusal named no argument
+    bags = bags_for(bags, bool(combine), "fill_gaps")
     check_models(noise, None, "fill_gaps")
     if (
         not isinstance(max_gap, (int, np.integer))
@@ -257,7 +269,7 @@ def fill_rows(
         wh_paths: list[F64] | None = None
         if method == "auto":
             paths, calibration = recover_auto(
-                segs, whole, noise, motion, seed=seed, combine=combine
+                segs, whole, noise, motion, seed=seed, combine=combine, bags=bags
             )
             sizes = [r[:, [0, 4, 5]] for r in per_id.values()]
             size_segs = [(a[:, [0, 3, 4]], b[:, [0, 3, 4]]) for a, b in segs]
@@ -268,6 +280,7 @@ def fill_rows(
                 candidates=SIZE_CANDIDATES,
                 max_gaps=SIZE_GAPS,
                 combine=combine,
+                bags=bags,
             )
         else:
             observed = whole if method in NEIGHBOUR_METHODS else None
