@@ -294,6 +294,29 @@ def test_box_sizes_are_calibrated_too() -> None:
     assert np.all(out[:, 4:6] > 0)
 
 
+def test_fill_report_records_its_method() -> None:
+    """Regression (user trial): ``FillReport.describe(method)`` trusted its argument:
+    ``fill_gaps(rows, "linear")[1].describe("auto")`` said "auto: no gap to fill" of 22 gaps
+    filled, ``fill_gaps(rows)[1].describe("linear")`` printed auto's table, and a named
+    method's line spoke of ``--explain`` from Python."""
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(5), n=8))
+    cut = full[~((full[:, 0] >= 60) & (full[:, 0] < 66))]
+    _, lin = fill_gaps(cut, "linear")
+    assert lin.method == "linear" and lin.n_gaps == 8
+    said = lin.describe()
+    assert said == "linear: 8 gaps filled by the method given, nothing was chosen (auto " \
+        "chooses a method per gap length)"  # fmt: skip
+    assert lin.describe("linear") == said  # the argument, kept for compatibility, agrees
+    with pytest.raises(ValueError, match="FillReport.describe: the fill used 'linear', not 'auto'"):
+        lin.describe("auto")
+    _, auto = fill_gaps(cut)
+    assert auto.method == "auto" and auto.describe().startswith("box centres (x, y):")
+    with pytest.raises(ValueError, match="the fill used 'auto', not 'linear'"):
+        auto.describe("linear")
+    _, none = fill_gaps(full)  # no hole
+    assert none.method == "auto" and none.describe() == "auto: no gap to fill"
+
+
 def test_cli_explain_prints_centres_and_sizes(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
     from pftrack.cli import main
     from pftrack.io.mot import write_mot

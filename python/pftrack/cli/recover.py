@@ -129,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
     if rep.n_long_holes:  # bounded work, said: was silent ("0 gaps filled")
         print(f"{src}: {unfilled_note(rep.n_long_holes, rep.longest_hole, args.max_gap)}", file=to)
     if args.explain:
-        print(rep.describe(args.method), file=to)
+        print(rep.describe(), file=to)
     return 0
 
 

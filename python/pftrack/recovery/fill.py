@@ -65,7 +65,8 @@ class FillReport:
     ``size_calibration``: the same for the box sizes ``(w, h)`` (candidates
     :data:`SIZE_CANDIDATES`); ``n_long_holes``: the holes of more than ``max_gap`` missing
     frames, left unfilled (bounded work), and ``longest_hole`` the missing frames of the
-    longest of them (0 without one; :func:`long_holes`, :func:`unfilled_note`).
+    longest of them (0 without one; :func:`long_holes`, :func:`unfilled_note`); ``method``:
+    the method of the fill (:meth:`describe` tells what it chose).
     """
 
     n_gaps: int
@@ -75,23 +76,44 @@ class FillReport:
     size_calibration: Calibration | None = None
     n_long_holes: int = 0
     longest_hole: int = 0
+    method: RecoveryMethod = DEFAULT_METHOD
 
-    def describe(self, method: str) -> str:
-        """What ``pftrack recover --explain`` prints for a fill by `method`.
+    def describe(self, method: str | None = None) -> str:
+        """What was chosen: what ``pftrack recover --explain`` prints.
 
         With ``"auto"``, the choice for the box centres, then for the box sizes
         (:meth:`~pftrack.recovery.calibrate.Calibration.describe`), or that there was no gap
-        to fill; with a named method, that nothing was chosen.
+        to fill; with a named method, that it filled every gap and nothing was chosen.
+
+        Parameters
+        ----------
+        method : str, optional
+            Only for compatibility (the report records its method, :attr:`method`): a
+            method other than the fill's is refused.
+
+        Raises
+        ------
+        ValueError
+            `method` given and not the fill's.
         """
+        if method is not None and method != self.method:
+            raise ValueError(
+                f"FillReport.describe: the fill used {self.method!r}, not {method!r} (the "
+                "report records its method: call describe() without one)"
+            )
         parts = []
         if self.calibration is not None:
             parts += ["box centres (x, y):", self.calibration.describe()]
         if self.size_calibration is not None:
             parts += ["box sizes (w, h):", self.size_calibration.describe()]
-        elif method == "auto":
+        elif self.method == "auto":
             parts.append("auto: no gap to fill")
         else:
-            parts.append(f"--explain: {method} was given, nothing was chosen")
+            gaps = "1 gap" if self.n_gaps == 1 else f"{self.n_gaps} gaps"
+            parts.append(
+                f"{self.method}: {gaps} filled by the method given, nothing was chosen (auto "
+                "chooses a method per gap length)"
+            )
         return "\n".join(parts)
 
 
@@ -305,7 +327,9 @@ def fill_rows(
             out[:, FLAG_COLUMN : FLAG_COLUMN + 3] = FILLED_MARK
             new_rows.append(out)
     added = np.vstack(new_rows) if new_rows else np.zeros((0, 10))
-    return added, FillReport(len(segs), len(added), noise, calibration, size_cal, n_long, longest)
+    return added, FillReport(
+        len(segs), len(added), noise, calibration, size_cal, n_long, longest, method
+    )
 
 
 def copied_values(rows: F64, filled: F64) -> NDArray[np.bool_]:
