@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -577,7 +578,7 @@ def test_bagging_averages_the_choices_of_the_resamples(monkeypatch: pytest.Monke
         .endswith("file's choice linear (0.75 linear + 0.25 rts over 8 bootstrap resamples)")
     )
     unseen = dataclasses.replace(
-        cal.buckets[0], mmae=(), weights=cal.pooled_weights, combined_mmae=None
+        cal.buckets[0], n_validation=0, mmae=(), weights=cal.pooled_weights, combined_mmae=None
     )
     said = dataclasses.replace(cal, buckets=(unseen,)).describe().splitlines()[-1]
     assert said.endswith(
@@ -632,6 +633,36 @@ def test_combine_false_is_one_method_per_bucket_without_bagging() -> None:
     tracks = _straight_tracks(np.random.default_rng(0), n=5)
     assert calibrate(tracks, [5], combine=False).bags == 0
     assert calibrate(tracks, [5]).bags == BAGS
+
+
+def test_explain_says_why_a_bucket_without_validation_gaps_takes_the_files_choice() -> None:
+    """Regression (user trial): a bucket with ``val. 0`` (gaps longer than every observed run
+    less its context) printed a row saying ``linear`` and no reason."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for k in range(12):
+        n = 45 if k == 0 else 20  # id 1: a 25-frame hole; every run shorter than 25 + 6
+        t = np.arange(n, dtype=np.float64)
+        keep = np.ones(n, bool)
+        keep[10:35] = k != 0
+        keep[8:11] &= k not in (1, 2, 3)  # three 3-frame holes
+        xy = np.column_stack([100 + 3 * t, 200 + 30 * k + 0 * t]) + rng.normal(0, 0.5, (n, 2))
+        rows.append(np.column_stack([1 + t, np.full(n, k + 1), xy, np.full((n, 2), (20.0, 40.0)),
+                                     np.ones(n), -np.ones((n, 3))])[keep])  # fmt: skip
+    _, rep = fill_gaps(np.vstack(rows))
+    assert rep.size_calibration is not None
+    sizes = {c.lengths: c for c in rep.size_calibration.buckets}
+    assert sizes[17, 32].n_validation == 0 and sizes[17, 32].method == "linear"
+    said = rep.describe()
+    assert "gap length 17-32: linear, the file's choice (no validation gap of this length)" in said
+    assert re.search(
+        r"gap length 3-4: linear, the file's choice \(only [1-4] validation gaps? of this "
+        r"length, fewer than the 5 a bucket needs\)",
+        said,
+    )
+    # the centres' bucket too, whatever the file's choice (one method or the resamples' mix)
+    why = r"gap length 17-32: .*the file's choice.*\(no validation gap of this length\)$"
+    assert len(re.findall(why, said, flags=re.M)) == 2, said
 
 
 def test_bags_must_not_be_negative() -> None:

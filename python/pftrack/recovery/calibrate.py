@@ -226,6 +226,10 @@ class Calibration:
                     f"(validation MMAE {c.replaced[1]:.3f}) did worse than linear "
                     f"({dict(c.mmae)['linear']:.3f}) on this length's validation gaps"
                 )
+            if not c.mmae and not c.weights:  # was: a row naming a method, no reason
+                lo, hi = c.lengths
+                span = f"{lo}" if lo == hi else f"{lo}-{hi}"
+                lines.append(f"gap length {span}: {c.method}, the file's choice{_unscored(c)}")
             if c.weights:
                 lo, hi = c.lengths
                 span = f"{lo}" if lo == hi else f"{lo}-{hi}"
@@ -233,7 +237,7 @@ class Calibration:
                 if c.combined_mmae is None:  # no validation gaps: the file's weights
                     lines.append(  # was "the file's choice", the header naming one method
                         f"gap length {span}: combination {mix}, the file's choice over the "
-                        "resamples (no validation gap of this length)"
+                        f"resamples{_unscored(c)}"
                     )
                     continue
                 lines.append(
@@ -241,6 +245,14 @@ class Calibration:
                     f"{c.combined_mmae:.3f}{_blend_note(c, self.bags)}"
                 )
         return "\n".join(lines)
+
+
+def _unscored(c: BucketChoice) -> str:
+    """Why a bucket takes the file's choice: too few validation gaps of its lengths."""
+    if c.n_validation == 0:
+        return " (no validation gap of this length)"
+    gaps = "1 validation gap" if c.n_validation == 1 else f"{c.n_validation} validation gaps"
+    return f" (only {gaps} of this length, fewer than the {MIN_VALIDATION_GAPS} a bucket needs)"
 
 
 def _weight(w: float) -> str:
