@@ -14,6 +14,10 @@
   against its NumPy reference (``tests/reference/bridge.py``, vectorised over the pairs).
 * ``state loglik, 343 models``: one level of ``fit_singer``'s grid (``_core.state_loglik_batch``,
   the models filtered 4 at a time) against the same call one model at a time.
+* ``link fragments``: :func:`pftrack.recovery.link_tracklets` over the pairs within the time
+  gate (8000 one-row fragments ten frames apart, the user trial's file, and 1000 of them)
+  against the former dense ``(K, K)`` loop and assignment (``tests/reference/linking.py``, on
+  the 1000 only: 8000 took 34 s and 1.6 GB).
 * ``rts smooth, 500 tracks``: :func:`pftrack.kalman.rts_smooth` (one C++ call ``_core.rts_smooth``
   per track, what the offline pass and ``pftrack smooth`` run for every track's box) against
   the NumPy loop it replaced (``rts_smooth_numpy``), over the 500 tracks of
@@ -32,13 +36,14 @@ from bench.recovery_file import synthetic_tracks
 from pftrack import _core
 from pftrack._typing import F64
 from pftrack.kalman import cv_transition, rts_smooth, wna_Q
-from pftrack.recovery import fill_gaps
+from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
 from pftrack.recovery.baselines import rts_batch
 from pftrack.recovery.calibrate import _fit_sample
 from pftrack.recovery.mixture import DIFFUSE, singer_model
 from pftrack.recovery.segments import distinct_runs
 from tests.reference import bridge as ref_bridge
 from tests.reference import mixture as ref_mix
+from tests.reference.linking import dense_link_tracklets
 from tests.reference.smoothing import dense_kalman_rts, rts_batch_numpy, rts_smooth_numpy
 
 
@@ -232,3 +237,27 @@ def test_rts_smooth_numpy(
         rounds=3,
         iterations=1,
     )
+
+
+def _sparse_fragments(k: int) -> F64:
+    """`k` one-row fragments, one every 10 frames, cycling through 50 places 5 px apart."""
+    i = np.arange(k, dtype=np.float64)
+    return np.column_stack([1 + 10 * i, i + 1, 100 + (i % 50) * 5, np.full(k, 100.0),
+                            np.full((k, 2), (20.0, 40.0)), np.full(k, 0.9),
+                            -np.ones((k, 3))])  # fmt: skip
+
+
+@pytest.mark.parametrize("k", [1000, 8000])
+def test_link_fragments(benchmark: BenchmarkFixture, k: int) -> None:
+    benchmark.group = "link fragments"
+    rows = _sparse_fragments(k)
+    _, mapping = benchmark.pedantic(link_tracklets, args=(rows, LinkConfig()), rounds=3)
+    assert len(mapping) == k - k // 50
+
+
+def test_link_fragments_dense_reference(benchmark: BenchmarkFixture) -> None:
+    benchmark.group = "link fragments"
+    rows = _sparse_fragments(1000)
+    out, mapping = benchmark.pedantic(dense_link_tracklets, args=(rows, LinkConfig()), rounds=1)
+    assert len(mapping) == 980
+    np.testing.assert_array_equal(out, link_tracklets(rows, LinkConfig())[0])

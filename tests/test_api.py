@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import importlib
 import inspect
 import os
 import re
@@ -20,8 +21,20 @@ import pftrack
 @pytest.mark.parametrize("name", [n for n in pftrack.__all__ if n != "__version__"])
 def test_every_public_name_resolves_to_its_home(name: str) -> None:
     obj = getattr(pftrack, name)
-    assert obj.__module__.startswith("pftrack.")
+    home = importlib.import_module(pftrack._MODULE_OF[name])
+    assert obj is getattr(home, name)
+    if not isinstance(obj, tuple):  # METHODS, a tuple of names, has no __module__
+        assert obj.__module__.startswith("pftrack.")
     assert name in dir(pftrack)
+
+
+def test_the_recovery_names_the_readme_uses_are_top_level() -> None:
+    """Regression (user trial): the README says public names are importable from the top
+    level, but ``pftrack.filled_mask``, ``pftrack.FillReport`` and ``pftrack.METHODS`` (in
+    ``pftrack.recovery.__all__``, used beside ``pftrack.fill_gaps``) were AttributeErrors."""
+    for name in ("filled_mask", "FillReport", "METHODS"):
+        assert name in pftrack.__all__
+        assert getattr(pftrack, name) is getattr(pftrack.recovery, name)
 
 
 def test_all_lists_exactly_the_lazy_names() -> None:

@@ -155,6 +155,18 @@ def test_recover_explain_prints_the_choice(
     assert len(read_mot(out)) == sum(len(r) for r in rows) + 6 * 8
 
 
+def test_recover_help_does_not_say_two_blended_methods(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Regression (user trial): ``--explain`` was said to print "the two methods it blends";
+    with bagging (the default) a bucket may blend up to every candidate."""
+    with pytest.raises(SystemExit):
+        main(["recover", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "two methods" not in text
+    assert "or more when bagging averages the resamples' choices" in text
+
+
 def test_experiment_gaps_several_sequences_writes_json(tmp_path: Path) -> None:
     import json
 

@@ -6,8 +6,9 @@ The public API, importable from the top level; each name loads its module on fir
 - tracking: :class:`Tracker` (the drop-in ``update(dets, frame)`` / ``finalize()`` API),
   :class:`MultiObjectTracker`, :class:`TrackerConfig`, :class:`Track`, :func:`track_frames`,
   :class:`TrackingRun`, :func:`load_detections`, :func:`smooth_tracks`, :class:`BoxSmoother`;
-- recovery: :func:`recover_gap`, :func:`recover_gaps`, :func:`fill_gaps`,
-  :func:`link_tracklets`, :class:`LinkConfig`, :func:`goal_directed_path`;
+- recovery: :func:`recover_gap`, :func:`recover_gaps`, :func:`fill_gaps` (its
+  :class:`FillReport`), :func:`filled_mask`, :data:`METHODS`, :func:`link_tracklets`,
+  :class:`LinkConfig`, :func:`goal_directed_path`;
 - MOTChallenge files and video: :func:`read_mot`, :func:`write_mot`, :class:`FrameSource`
   (files, image folders, sequences, cameras, streams), :func:`read_seqinfo`,
   :class:`SequenceInfo`, :class:`VideoWriter` (H.264 MP4);
@@ -108,8 +109,11 @@ if TYPE_CHECKING:
         systematic_resample,
     )
     from pftrack.recovery import (
+        METHODS,
+        FillReport,
         LinkConfig,
         fill_gaps,
+        filled_mask,
         goal_directed_path,
         link_tracklets,
         recover_gap,
@@ -144,8 +148,11 @@ _HOME = {
         "track_frames",
     ),
     "pftrack.recovery": (
+        "FillReport",
         "LinkConfig",
+        "METHODS",
         "fill_gaps",
+        "filled_mask",
         "goal_directed_path",
         "link_tracklets",
         "recover_gap",
@@ -181,8 +188,10 @@ __all__ = [
     "__version__",
     "BoxSmoother",
     "ColourParticleFilter",
+    "FillReport",
     "FrameSource",
     "LinkConfig",
+    "METHODS",
     "MotMetrics",
     "MultiObjectTracker",
     "SequenceInfo",
@@ -200,6 +209,7 @@ __all__ = [
     "evaluate_mot",
     "evaluate_sequence",
     "fill_gaps",
+    "filled_mask",
     "format_metrics",
     "goal_directed_path",
     "hsv_bins",

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 
 from pftrack.recovery import DEFAULT_METHOD, fill_gaps, recover_gaps
 from pftrack.recovery.calibrate import (
+    BAGS,
     BucketChoice,
     Calibration,
     bucket_of,
@@ -293,6 +295,29 @@ def test_box_sizes_are_calibrated_too() -> None:
     assert np.all(out[:, 4:6] > 0)
 
 
+def test_fill_report_records_its_method() -> None:
+    """Regression (user trial): ``FillReport.describe(method)`` trusted its argument:
+    ``fill_gaps(rows, "linear")[1].describe("auto")`` said "auto: no gap to fill" of 22 gaps
+    filled, ``fill_gaps(rows)[1].describe("linear")`` printed auto's table, and a named
+    method's line spoke of ``--explain`` from Python."""
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(5), n=8))
+    cut = full[~((full[:, 0] >= 60) & (full[:, 0] < 66))]
+    _, lin = fill_gaps(cut, "linear")
+    assert lin.method == "linear" and lin.n_gaps == 8
+    said = lin.describe()
+    assert said == "linear: 8 gaps filled by the method given, nothing was chosen (auto " \
+        "chooses a method per gap length)"  # fmt: skip
+    assert lin.describe("linear") == said  # the argument, kept for compatibility, agrees
+    with pytest.raises(ValueError, match="FillReport.describe: the fill used 'linear', not 'auto'"):
+        lin.describe("auto")
+    _, auto = fill_gaps(cut)
+    assert auto.method == "auto" and auto.describe().startswith("box centres (x, y):")
+    with pytest.raises(ValueError, match="the fill used 'auto', not 'linear'"):
+        auto.describe("linear")
+    _, none = fill_gaps(full)  # no hole
+    assert none.method == "auto" and none.describe() == "auto: no gap to fill"
+
+
 def test_cli_explain_prints_centres_and_sizes(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
     from pftrack.cli import main
     from pftrack.io.mot import write_mot
@@ -509,8 +534,11 @@ def test_bagging_is_the_default_and_keeps_straight_lines_straight() -> None:
     from pftrack.recovery.calibrate import BAGS
 
     assert BAGS > 0
-    for fn in (calibrate, recover_auto):
-        assert inspect.signature(fn).parameters["bags"].default == BAGS, fn.__name__
+    from pftrack.recovery.fill import fill_rows
+
+    for fn in (calibrate, recover_auto, recover_gaps, fill_gaps, fill_rows):
+        # None: BAGS with the default combine=True (0 with combine=False)
+        assert inspect.signature(fn).parameters["bags"].default is None, fn.__name__
     tracks = _straight_tracks(np.random.default_rng(0))
     cal = calibrate(tracks, [5, 12, 25])
     assert cal.bags == BAGS
@@ -550,7 +578,7 @@ def test_bagging_averages_the_choices_of_the_resamples(monkeypatch: pytest.Monke
         .endswith("file's choice linear (0.75 linear + 0.25 rts over 8 bootstrap resamples)")
     )
     unseen = dataclasses.replace(
-        cal.buckets[0], mmae=(), weights=cal.pooled_weights, combined_mmae=None
+        cal.buckets[0], n_validation=0, mmae=(), weights=cal.pooled_weights, combined_mmae=None
     )
     said = dataclasses.replace(cal, buckets=(unseen,)).describe().splitlines()[-1]
     assert said.endswith(
@@ -575,6 +603,68 @@ def test_bagging_is_seeded_and_reported() -> None:
         assert abs(sum(w for _, w in mix) - 1.0) < 1e-12
 
 
+def test_combine_false_is_one_method_per_bucket_without_bagging() -> None:
+    """Regression (user trial): ``fill_gaps(rows, combine=False)`` came back with buckets such
+    as ``gdt-mix+rts`` (KITTI-17: ``gdt-bi+gdt-mix+rts+linear``): bagging, on by default,
+    averaged the single methods 32 resamples chose into a blend. combine=False now means no
+    bagging (``bags=None``: 32 with combine, 0 without) and refuses ``bags > 0``."""
+    full = _mot_rows(_manoeuvring_tracks(np.random.default_rng(3)))
+    f = full[:, 0]
+    cut = full[~(((f >= 40) & (f < 42)) | ((f >= 80) & (f < 85)) | ((f >= 120) & (f < 132)))]
+    _, rep = fill_gaps(cut, combine=False)
+    for cal in (rep.calibration, rep.size_calibration):
+        assert cal is not None and cal.bags == 0 and cal.pooled_weights == ()
+        assert all("+" not in c.method and c.weights == () for c in cal.buckets), cal.describe()
+    _, bagged = fill_gaps(cut)  # the default: blends allowed, bagged
+    assert bagged.calibration is not None and bagged.calibration.bags == BAGS
+    _, also_bagged = fill_gaps(cut, bags=8)
+    assert also_bagged.calibration is not None and also_bagged.calibration.bags == 8
+    for call, who in (
+        (lambda: fill_gaps(cut, combine=False, bags=8), "fill_gaps"),
+        (lambda: calibrate(_straight_tracks(np.random.default_rng(0), n=5), [5], combine=False,
+                           bags=8), "calibrate"),
+        (lambda: recover_auto([(_A, _B)], combine=False, bags=1), "recover_auto"),
+        (lambda: recover_gaps([(_A, _B)], combine=False, bags=2), "recover_gaps"),
+    ):  # fmt: skip
+        with pytest.raises(ValueError, match=rf"^{who}: bags is \d+ with combine=False"):
+            call()
+    with pytest.raises(ValueError, match=r"fill_gaps: bags is -1, expected an integer"):
+        fill_gaps(cut, bags=-1)
+    tracks = _straight_tracks(np.random.default_rng(0), n=5)
+    assert calibrate(tracks, [5], combine=False).bags == 0
+    assert calibrate(tracks, [5]).bags == BAGS
+
+
+def test_explain_says_why_a_bucket_without_validation_gaps_takes_the_files_choice() -> None:
+    """Regression (user trial): a bucket with ``val. 0`` (gaps longer than every observed run
+    less its context) printed a row saying ``linear`` and no reason."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for k in range(12):
+        n = 45 if k == 0 else 20  # id 1: a 25-frame hole; every run shorter than 25 + 6
+        t = np.arange(n, dtype=np.float64)
+        keep = np.ones(n, bool)
+        keep[10:35] = k != 0
+        keep[8:11] &= k not in (1, 2, 3)  # three 3-frame holes
+        xy = np.column_stack([100 + 3 * t, 200 + 30 * k + 0 * t]) + rng.normal(0, 0.5, (n, 2))
+        rows.append(np.column_stack([1 + t, np.full(n, k + 1), xy, np.full((n, 2), (20.0, 40.0)),
+                                     np.ones(n), -np.ones((n, 3))])[keep])  # fmt: skip
+    _, rep = fill_gaps(np.vstack(rows))
+    assert rep.size_calibration is not None
+    sizes = {c.lengths: c for c in rep.size_calibration.buckets}
+    assert sizes[17, 32].n_validation == 0 and sizes[17, 32].method == "linear"
+    said = rep.describe()
+    assert "gap length 17-32: linear, the file's choice (no validation gap of this length)" in said
+    assert re.search(
+        r"gap length 3-4: linear, the file's choice \(only [1-4] validation gaps? of this "
+        r"length, fewer than the 5 a bucket needs\)",
+        said,
+    )
+    # the centres' bucket too, whatever the file's choice (one method or the resamples' mix)
+    why = r"gap length 17-32: .*the file's choice.*\(no validation gap of this length\)$"
+    assert len(re.findall(why, said, flags=re.M)) == 2, said
+
+
 def test_bags_must_not_be_negative() -> None:
     tracks = _straight_tracks(np.random.default_rng(0), n=5)
     with pytest.raises(ValueError, match=r"bags is -1, expected an integer in \[0, "):
@@ -590,7 +680,7 @@ _A, _B = _RUN[:10], _RUN[15:]
     [
         # each was taken, or failed deep inside without the argument's name
         ({"bags": 1.5}, ValueError, r"calibrate: bags is 1.5, expected an integer in \[0, 10000\]"),
-        ({"bags": None}, ValueError, "calibrate: bags is None"),
+        ({"bags": "32"}, ValueError, "calibrate: bags is '32'"),
         ({"bags": True}, ValueError, "calibrate: bags is True"),
         ({"seed": -1}, ValueError, "calibrate: seed is -1, expected an int >= 0"),
         ({"seed": None}, TypeError, "calibrate: seed must be an int >= 0"),

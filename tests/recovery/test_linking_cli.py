@@ -314,6 +314,54 @@ def test_a_stray_row_does_not_widen_the_gate():
         assert gate_for_rows(cfg, stray) == want
 
 
+def _smoothed_bytes(rows: np.ndarray, path) -> bytes:  # type: ignore[no-untyped-def]
+    from pftrack.tracking.offline import smoothed_copies
+
+    write_mot(path, rows, exact=smoothed_copies(rows))  # as pftrack smooth writes
+    return path.read_bytes()
+
+
+def test_smooth_tracks_is_pftrack_smooth_on_large_frames(tmp_path, capsys):
+    """Regression (user trial): ``smooth_tracks(rows)`` kept the 50 px gate where ``pftrack
+    smooth`` grows it with the frame (a split ADL-Rundle-6, 1920x1080: 32 ids from the command,
+    34 from the function). Its default, ``link="auto"``, is now the command's gate; a
+    LinkConfig is used as given (the tracker passes its own)."""
+    from pftrack.tracking import smooth_tracks
+
+    rows = jumped(3.0)  # 1920x1440: a gate of 150 px; the walker is 120 px off its motion
+    src = tmp_path / "big.txt"
+    write_mot(src, rows)
+    for args, kwargs in (([], {}), (["--max-gap", "5"], {"max_gap": 5})):
+        cli = tmp_path / "cli.txt"
+        assert main(["-q", "smooth", str(src), "--out", str(cli), *args]) == 0
+        got = smooth_tracks(read_mot(src), **kwargs)
+        assert _smoothed_bytes(got, tmp_path / "fn.txt") == cli.read_bytes(), args
+    assert set(smooth_tracks(rows)[:, 1].astype(int)) == {1, 3}  # joined, as the command
+    assert set(smooth_tracks(rows, max_gap=5)[:, 1].astype(int)) == {1, 2, 3}  # a 10-frame gap
+    assert set(smooth_tracks(rows, link=LinkConfig())[:, 1].astype(int)) == {1, 2, 3}  # 50 px
+    with pytest.raises(TypeError, match="smooth_tracks: link must be a LinkConfig, 'auto' or "):
+        smooth_tracks(rows, link="big")  # type: ignore[arg-type]
+
+
+@pytest.mark.dataset
+def test_smooth_tracks_is_pftrack_smooth_on_adl_rundle_6(tmp_path, capsys):
+    """The trial's case: ADL-Rundle-6's ground truth (1920x1080) split at every 40th frame."""
+    from pftrack.tracking import smooth_tracks
+
+    from ..conftest import dataset
+
+    gt = read_mot(dataset("mot15-gt") / "ADL-Rundle-6" / "gt.txt")
+    gt = gt[(gt[:, 0] % 40 != 0) & (gt[:, 0] % 40 != 1)]  # holes of 2 frames
+    gt[:, 1] = gt[:, 1] * 100 + gt[:, 0] // 40  # a new id after each hole
+    gt[:, 6:] = (1, -1, -1, -1)
+    src = tmp_path / "split.txt"
+    write_mot(src, gt)
+    cli = tmp_path / "cli.txt"
+    assert main(["-q", "smooth", str(src), "--out", str(cli)]) == 0
+    got = smooth_tracks(read_mot(src))
+    assert _smoothed_bytes(got, tmp_path / "fn.txt") == cli.read_bytes()
+
+
 def test_smooth_refuses_a_gate_without_linking(tmp_path, capsys):
     src = tmp_path / "t.txt"
     write_mot(src, jumped(1.0))

@@ -177,7 +177,7 @@ def test_batch_explain_prints_what_one_file_prints(
     # a named method: nothing chosen, as for one file
     assert main(["recover", str(folder), "--out", str(tmp_path / "l"), "--workers", "0",
                  "--method", "linear", "--explain"]) == 0  # fmt: skip
-    assert capsys.readouterr().out.count("--explain: linear was given, nothing was chosen") == 2
+    assert capsys.readouterr().out.count("filled by the method given, nothing was chosen") == 2
 
 
 @pytest.mark.dataset

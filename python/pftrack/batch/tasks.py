@@ -494,7 +494,7 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
         "longest_hole": rep.longest_hole,
         "rows_out": len(filled),
         "seconds": time.perf_counter() - t0,
-        "explain": rep.describe(options.method),
+        "explain": rep.describe(),
     }
     return TaskResult(filled, {}, info, exact=copied_values(rows, filled))
 

@@ -41,8 +41,10 @@ def add_parser(sub: Any) -> None:
                    "stay holes: bounded work; their number and the longest are "
                    "printed)")  # fmt: skip
     p.add_argument("--explain", action="store_true",
-                   help="with auto: print the method chosen per gap length (or the two methods "
-                   "it blends, with their weights) and its validation MMAE")  # fmt: skip
+                   help="with auto: print the method chosen per gap length (or the methods it "
+                   "blends, with their weights: two, or more when bagging averages the "
+                   "resamples' choices) and its validation MMAE, for box centres and "
+                   "sizes")  # fmt: skip
     p.add_argument("--seed", type=non_negative_int, default=None,
                    help="auto: seed of the artificial calibration gaps, an integer >= 0 "
                    "(default: 0; refused with another --method)")  # fmt: skip
@@ -129,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     if rep.n_long_holes:  # bounded work, said: was silent ("0 gaps filled")
         print(f"{src}: {unfilled_note(rep.n_long_holes, rep.longest_hole, args.max_gap)}", file=to)
     if args.explain:
-        print(rep.describe(args.method), file=to)
+        print(rep.describe(), file=to)
     return 0
 
 

@@ -16,7 +16,8 @@ By default (``combine=True``) a bucket may instead use a convex combination of t
 paths (the chosen method and the best other one; :func:`_combine`): the weight is fitted to the
 bucket's validation gaps, shrunk toward the chosen method, and the combination replaces the
 chosen method only if it beats it by the same paired test. The :class:`Calibration` then
-names both methods and their weights. ``combine=False`` gives the single-method choice.
+names both methods and their weights. ``combine=False`` gives the single-method choice (and
+no bagging by default: averaging the resamples' choices would blend methods again).
 
 Two rules hold whatever the rule above chooses: the real gaps are matched in a canonical order
 (sorted), so the same tracks under other ids are filled alike; and a bucket whose choice does
@@ -58,6 +59,7 @@ __all__ = [
     "BucketChoice",
     "Calibration",
     "bucket_of",
+    "bags_for",
     "bucket_quotas",
     "calibrate",
     "fixed_noise_model",
@@ -224,6 +226,10 @@ class Calibration:
                     f"(validation MMAE {c.replaced[1]:.3f}) did worse than linear "
                     f"({dict(c.mmae)['linear']:.3f}) on this length's validation gaps"
                 )
+            if not c.mmae and not c.weights:  # was: a row naming a method, no reason
+                lo, hi = c.lengths
+                span = f"{lo}" if lo == hi else f"{lo}-{hi}"
+                lines.append(f"gap length {span}: {c.method}, the file's choice{_unscored(c)}")
             if c.weights:
                 lo, hi = c.lengths
                 span = f"{lo}" if lo == hi else f"{lo}-{hi}"
@@ -231,7 +237,7 @@ class Calibration:
                 if c.combined_mmae is None:  # no validation gaps: the file's weights
                     lines.append(  # was "the file's choice", the header naming one method
                         f"gap length {span}: combination {mix}, the file's choice over the "
-                        "resamples (no validation gap of this length)"
+                        f"resamples{_unscored(c)}"
                     )
                     continue
                 lines.append(
@@ -239,6 +245,14 @@ class Calibration:
                     f"{c.combined_mmae:.3f}{_blend_note(c, self.bags)}"
                 )
         return "\n".join(lines)
+
+
+def _unscored(c: BucketChoice) -> str:
+    """Why a bucket takes the file's choice: too few validation gaps of its lengths."""
+    if c.n_validation == 0:
+        return " (no validation gap of this length)"
+    gaps = "1 validation gap" if c.n_validation == 1 else f"{c.n_validation} validation gaps"
+    return f" (only {gaps} of this length, fewer than the {MIN_VALIDATION_GAPS} a bucket needs)"
 
 
 def _weight(w: float) -> str:
@@ -446,7 +460,7 @@ def calibrate(
     spans: Sequence[float] | None = None,
     contexts: Sequence[tuple[int, int]] | None = None,
     combine: bool = True,
-    bags: int = BAGS,
+    bags: int | None = None,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -475,11 +489,13 @@ def calibrate(
     combine : bool
         Let a bucket use a convex combination of its chosen method and the best other
         candidate when it beats the chosen method by the paired test (:func:`_combine`;
-        default). False: one method per bucket.
-    bags : int
+        default). False: one method per bucket (then `bags` is 0).
+    bags : int or None
         Bootstrap resamples of each bucket's validation gaps (>= 0, seeded by `seed`): the
         choice (file, bucket, combination) is made on each and the methods' weights are
-        averaged (:data:`BAGS`). 0: one choice on the validation gaps as drawn.
+        averaged, which blends the methods different resamples chose. 0: one choice on the
+        validation gaps as drawn. None (default): :data:`BAGS` with `combine`, 0 without
+        (:func:`bags_for`; more than 0 with ``combine=False`` is refused).
 
     Returns
     -------
@@ -492,13 +508,15 @@ def calibrate(
         sequence of arrays of real numbers.
     ValueError
         A gap length or context that is not an integer >= 1, `max_gaps` not an integer >= 1,
-        `bags` not an integer >= 0, a negative `seed`, an unknown candidate, non-finite
-        `spans`, `spans` / `contexts` of another length than `gap_lengths`, an observed run
-        that is not (k, 3+) or has a non-finite frame, x or y.
+        `bags` not None or an integer >= 0 (or > 0 with ``combine=False``), a negative `seed`,
+        an unknown candidate, non-finite `spans`, `spans` / `contexts` of another length than
+        `gap_lengths`, an observed run that is not (k, 3+) or has a non-finite frame, x or y.
     """
     lengths = [_check.integer(v, "calibrate: a gap length", 1, MAX_FRAME) for v in gap_lengths]
-    max_gaps, bags, seed = _settings("calibrate", max_gaps, bags, seed)
     combine = _check.flag(combine, "calibrate: combine")
+    max_gaps, bags, seed = _settings(
+        "calibrate", max_gaps, bags_for(bags, combine, "calibrate"), seed
+    )
     for m in candidates:
         if m not in CANDIDATES:
             raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
@@ -835,6 +853,30 @@ def _checked_at_once(pairs: Sequence[tuple[F64, F64]]) -> list[tuple[F64, F64]] 
     return list(zip(parts[0::2], parts[1::2], strict=True))
 
 
+def bags_for(bags: object, combine: bool, who: str) -> int:
+    """The bootstrap resamples of a calibration: `bags` checked, or its default for `combine`.
+
+    None gives :data:`BAGS` with `combine` and 0 without: bagging averages the methods the
+    resamples chose, a blend, so one method per bucket (``combine=False``) means no bagging.
+
+    Raises
+    ------
+    ValueError
+        `bags` not None or an integer in ``0..10000``, or more than 0 with ``combine=False``;
+        the message starts with `who` (the function called, e.g. ``"fill_gaps"``).
+    """
+    if bags is None:
+        return BAGS if combine else 0
+    n = _check.integer(bags, f"{who}: bags", 0, 10**4)
+    if n and not combine:
+        raise ValueError(
+            f"{who}: bags is {n} with combine=False: bagging averages the methods the "
+            "resamples choose (a blend), combine=False is one method per bucket; pass bags=0 "
+            "or None with combine=False"
+        )
+    return n
+
+
 def _settings(who: str, max_gaps: object, bags: object, seed: object) -> tuple[int, int, int]:
     """`max_gaps`, `bags` and `seed` checked, or an error naming the one that is wrong."""
     return (
@@ -854,7 +896,7 @@ def recover_auto(
     candidates: Sequence[str] = CANDIDATES,
     max_gaps: int = MAX_CALIBRATION_GAPS,
     combine: bool = True,
-    bags: int = BAGS,
+    bags: int | None = None,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -877,8 +919,9 @@ def recover_auto(
     combine : bool
         Allow a convex combination of two candidates per bucket (:func:`calibrate`; default).
         False: one method per bucket.
-    bags : int
-        Bootstrap resamples the choice is averaged over (:func:`calibrate`; >= 0).
+    bags : int or None
+        Bootstrap resamples the choice is averaged over (:func:`calibrate`; >= 0). None
+        (default): :data:`BAGS` with `combine`, 0 without (:func:`bags_for`).
 
     Returns
     -------
@@ -897,8 +940,10 @@ def recover_auto(
         :func:`calibrate` refuses, an observed run that is not (k, 3+) or has a non-finite
         frame, x or y.
     """
-    _, bags, seed = _settings("recover_auto", max_gaps, bags, seed)
     combine = _check.flag(combine, "recover_auto: combine")
+    _, bags, seed = _settings(
+        "recover_auto", max_gaps, bags_for(bags, combine, "recover_auto"), seed
+    )
     checked = _checked_at_once(pairs)
     if checked is None:  # something to refuse (or not float64 arrays): pair by pair
         checked = []

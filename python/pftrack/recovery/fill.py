@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from pftrack import _check
 from pftrack._typing import F64, RecoveryMethod
-from pftrack.recovery.calibrate import Calibration, recover_auto
+from pftrack.recovery.calibrate import Calibration, bags_for, recover_auto
 from pftrack.recovery.linking import (
     FILLED_MARK,
     FLAG_COLUMN,
@@ -65,7 +65,8 @@ class FillReport:
     ``size_calibration``: the same for the box sizes ``(w, h)`` (candidates
     :data:`SIZE_CANDIDATES`); ``n_long_holes``: the holes of more than ``max_gap`` missing
     frames, left unfilled (bounded work), and ``longest_hole`` the missing frames of the
-    longest of them (0 without one; :func:`long_holes`, :func:`unfilled_note`).
+    longest of them (0 without one; :func:`long_holes`, :func:`unfilled_note`); ``method``:
+    the method of the fill (:meth:`describe` tells what it chose).
     """
 
     n_gaps: int
@@ -75,23 +76,44 @@ class FillReport:
     size_calibration: Calibration | None = None
     n_long_holes: int = 0
     longest_hole: int = 0
+    method: RecoveryMethod = DEFAULT_METHOD
 
-    def describe(self, method: str) -> str:
-        """What ``pftrack recover --explain`` prints for a fill by `method`.
+    def describe(self, method: str | None = None) -> str:
+        """What was chosen: what ``pftrack recover --explain`` prints.
 
         With ``"auto"``, the choice for the box centres, then for the box sizes
         (:meth:`~pftrack.recovery.calibrate.Calibration.describe`), or that there was no gap
-        to fill; with a named method, that nothing was chosen.
+        to fill; with a named method, that it filled every gap and nothing was chosen.
+
+        Parameters
+        ----------
+        method : str, optional
+            Only for compatibility (the report records its method, :attr:`method`): a
+            method other than the fill's is refused.
+
+        Raises
+        ------
+        ValueError
+            `method` given and not the fill's.
         """
+        if method is not None and method != self.method:
+            raise ValueError(
+                f"FillReport.describe: the fill used {self.method!r}, not {method!r} (the "
+                "report records its method: call describe() without one)"
+            )
         parts = []
         if self.calibration is not None:
             parts += ["box centres (x, y):", self.calibration.describe()]
         if self.size_calibration is not None:
             parts += ["box sizes (w, h):", self.size_calibration.describe()]
-        elif method == "auto":
+        elif self.method == "auto":
             parts.append("auto: no gap to fill")
         else:
-            parts.append(f"--explain: {method} was given, nothing was chosen")
+            gaps = "1 gap" if self.n_gaps == 1 else f"{self.n_gaps} gaps"
+            parts.append(
+                f"{self.method}: {gaps} filled by the method given, nothing was chosen (auto "
+                "chooses a method per gap length)"
+            )
         return "\n".join(parts)
 
 
@@ -144,6 +166,7 @@ def fill_gaps(
     *,
     seed: int = 0,
     combine: bool = True,
+    bags: int | None = None,
 ) -> tuple[F64, FillReport]:
     """Fill every hole of at most `max_gap` missing frames inside each id's track.
 
@@ -165,7 +188,13 @@ def fill_gaps(
     combine : bool
         For ``"auto"``: a gap-length bucket may use a convex combination of two methods when
         it beats the single best on the validation gaps (default;
-        :func:`~pftrack.recovery.calibrate.calibrate`). False: one method per bucket.
+        :func:`~pftrack.recovery.calibrate.calibrate`). False: one method per bucket, for the
+        box centres and sizes (and no bagging, which would blend the resamples' choices).
+    bags : int or None
+        For ``"auto"``: bootstrap resamples of the validation gaps the choice is averaged over
+        (:func:`~pftrack.recovery.calibrate.calibrate`; 0: one choice). None (default):
+        :data:`~pftrack.recovery.calibrate.BAGS` with `combine`, 0 without; more than 0 with
+        ``combine=False`` is refused.
 
     Returns
     -------
@@ -186,12 +215,15 @@ def fill_gaps(
     TypeError
         `combine` not a bool, `seed` not an int, `noise` not a NoiseEstimate.
     ValueError
-        Unknown method, a negative `seed`, `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
+        Unknown method, a negative `seed`, `bags` not None or an integer in ``0..10000`` (or
+        more than 0 with ``combine=False``), `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
         rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
         or height, a value beyond ±1e9 px) or a duplicate (frame, id).
     """
-    new_rows, report = fill_rows(tracks, method, max_gap, noise, seed=seed, combine=combine)
+    new_rows, report = fill_rows(
+        tracks, method, max_gap, noise, seed=seed, combine=combine, bags=bags
+    )
     filled = np.vstack([np.asarray(tracks, dtype=np.float64), new_rows])
     order = np.lexsort((filled[:, 1], filled[:, 0]))
     return filled[order], report
@@ -205,6 +237,7 @@ def fill_rows(
     *,
     seed: int = 0,
     combine: bool = True,
+    bags: int | None = None,
 ) -> tuple[F64, FillReport]:
     """The rows :func:`fill_gaps` adds (flagged, in no particular order), and its report.
 
@@ -215,6 +248,7 @@ def fill_rows(
     if not isinstance(combine, (bool, np.bool_)):
         raise TypeError(f"fill_gaps: combine must be a bool, got {type(combine).__name__}")
     seed = _check.seed(seed, "fill_gaps: seed")  # NumPy's refusal named no argument
+    bags = bags_for(bags, bool(combine), "fill_gaps")
     check_models(noise, None, "fill_gaps")
     if (
         not isinstance(max_gap, (int, np.integer))
@@ -257,7 +291,7 @@ def fill_rows(
         wh_paths: list[F64] | None = None
         if method == "auto":
             paths, calibration = recover_auto(
-                segs, whole, noise, motion, seed=seed, combine=combine
+                segs, whole, noise, motion, seed=seed, combine=combine, bags=bags
             )
             sizes = [r[:, [0, 4, 5]] for r in per_id.values()]
             size_segs = [(a[:, [0, 3, 4]], b[:, [0, 3, 4]]) for a, b in segs]
@@ -268,6 +302,7 @@ def fill_rows(
                 candidates=SIZE_CANDIDATES,
                 max_gaps=SIZE_GAPS,
                 combine=combine,
+                bags=bags,
             )
         else:
             observed = whole if method in NEIGHBOUR_METHODS else None
@@ -292,7 +327,9 @@ def fill_rows(
             out[:, FLAG_COLUMN : FLAG_COLUMN + 3] = FILLED_MARK
             new_rows.append(out)
     added = np.vstack(new_rows) if new_rows else np.zeros((0, 10))
-    return added, FillReport(len(segs), len(added), noise, calibration, size_cal, n_long, longest)
+    return added, FillReport(
+        len(segs), len(added), noise, calibration, size_cal, n_long, longest, method
+    )
 
 
 def copied_values(rows: F64, filled: F64) -> NDArray[np.bool_]:

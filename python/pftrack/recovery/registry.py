@@ -53,7 +53,7 @@ from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
-from pftrack.recovery.calibrate import fixed_noise_model, recover_auto
+from pftrack.recovery.calibrate import bags_for, fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, check_models, fit_motion, recover_mixture_gaps
 from pftrack.recovery.names import (
     DEFAULT_METHOD,
@@ -182,6 +182,7 @@ def recover_gaps(
     observed: Sequence[F64] | None = None,
     seed: int = 0,
     combine: bool = True,
+    bags: int | None = None,
 ) -> list[F64]:
     """Recover many gaps at once.
 
@@ -205,9 +206,10 @@ def recover_gaps(
         and ``"rts-nb"``: the tracks whose errors correct the paths. Default: the segments
         given (:func:`pftrack.recovery.calibrate.recover_auto`, which also returns what was
         chosen).
-    seed, combine
-        For ``"auto"``: the calibration's seed and whether a bucket may blend two methods
-        (:func:`~pftrack.recovery.calibrate.recover_auto`).
+    seed, combine, bags
+        For ``"auto"``: the calibration's seed, whether a bucket may blend two methods and the
+        bootstrap resamples the choice is averaged over (None: 32 with `combine`, 0 without;
+        :func:`~pftrack.recovery.calibrate.recover_auto`).
 
     Returns
     -------
@@ -220,7 +222,8 @@ def recover_gaps(
         A `seed` that is not an int, `noise` not a NoiseEstimate or `motion` not a MotionFit.
     ValueError
         An unknown method, a gap that is not a pair of segments, segments :func:`recover_gap`
-        refuses, whatever the method (the message names the gap), or a negative `seed`.
+        refuses, whatever the method (the message names the gap), a negative `seed`, or
+        `bags` not None or an integer in ``0..10000`` (or more than 0 with ``combine=False``).
 
     Notes
     -----
@@ -233,6 +236,7 @@ def recover_gaps(
     seed = _check.seed(seed, "recover_gaps: seed")
     check_models(noise, motion, "recover_gaps")
     combine = _check.flag(combine, "recover_gaps: combine")
+    bags = bags_for(bags, combine, "recover_gaps")
     if history is not None:
         history = _check.integer(history, "recover_gaps: history", 1, MAX_FRAME)
     pairs = _checked_pairs(gaps)
@@ -259,7 +263,9 @@ def recover_gaps(
     if not pairs:
         return []
     if method == "auto":
-        return recover_auto(pairs, observed, noise, motion, seed=seed, combine=combine)[0]
+        return recover_auto(pairs, observed, noise, motion, seed=seed, combine=combine, bags=bags)[
+            0
+        ]
     seg_a = [a for a, _ in pairs]
     seg_b = [b for _, b in pairs]
     if method == "gdt-mix":

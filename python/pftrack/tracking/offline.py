@@ -16,6 +16,7 @@ the smoothed boxes match the annotation far more often than the detections thems
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,13 +28,14 @@ from pftrack._typing import F64, RecoveryMethod
 from pftrack.boxes import _intersection_matrix, _iou_rows, _to_cxcywh, _to_xywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
-from pftrack.recovery.fill import MAX_GAP_LIMIT, fill_rows
+from pftrack.recovery.fill import DEFAULT_MAX_GAP, MAX_GAP_LIMIT, fill_rows
 from pftrack.recovery.linking import (
     MAX_ID,
     LinkConfig,
     check_boxes,
     check_rows,
     check_unique,
+    link_config_for,
     link_tracklets,
 )
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
@@ -452,7 +454,7 @@ def smooth_tracks(
     rows: ArrayLike,
     observed: ArrayLike | None = None,
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
-    link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
+    link: LinkConfig | Literal["auto"] | None = "auto",
     measurements: ArrayLike | None = None,
     *,
     fill_method: RecoveryMethod = DEFAULT_METHOD,
@@ -472,9 +474,15 @@ def smooth_tracks(
         interpolated by the smoother. Default: every row.
     smoother : BoxSmoother or None
         None links only (and fills nothing).
-    link : LinkConfig or None
-        Join fragments of one object first (:func:`pftrack.recovery.linking.link_tracklets`);
-        with a smoother, frames missing inside a track (holes of at most ``link.max_gap``
+    link : LinkConfig, "auto" or None
+        Join fragments of one object first (:func:`pftrack.recovery.linking.link_tracklets`)
+        with these gates. ``"auto"`` (default): those of ``pftrack smooth``,
+        ``LinkConfig(max_gap=max_gap)`` (30 when `max_gap` is None) with the 50 px gate grown
+        to the frame the rows' boxes span (:func:`pftrack.recovery.linking.link_config_for`,
+        :func:`~pftrack.recovery.linking.gate_for_rows`: as given up to 640x480, in proportion
+        to the diagonal above), so ``smooth_tracks(rows)`` is the command's pass; a LinkConfig
+        is used as given (:class:`TrackWriter` passes the tracker's, scaled by the frames it
+        saw). With a smoother, frames missing inside a track (holes of at most ``link.max_gap``
         frames; longer holes stay holes, so work and memory are bounded by the number of rows)
         are added as rows recovered by `fill_method`
         (:func:`pftrack.recovery.fill.fill_rows`, the default of ``pftrack recover``), shifted
@@ -512,6 +520,8 @@ def smooth_tracks(
 
     Raises
     ------
+    TypeError
+        `link` not a LinkConfig, ``"auto"`` or None.
     ValueError
         Rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box (of the rows or `measurements`) that
@@ -532,6 +542,13 @@ def smooth_tracks(
             f"smooth_tracks: fill_method is {fill_method!r}, expected one of {METHODS}"
         )
     seed = _check.seed(seed, "smooth_tracks: seed")
+    if not (
+        link is None or isinstance(link, LinkConfig) or (isinstance(link, str) and link == "auto")
+    ):
+        raise TypeError(
+            "smooth_tracks: link must be a LinkConfig, 'auto' or None, got "
+            f"{type(link).__name__} {link!r}"
+        )
     a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "smooth_tracks")
     check_unique(a, who="smooth_tracks")  # was: BoxSmoother.smooth's "frames must be ..."
     a = a.copy()
@@ -555,6 +572,8 @@ def smooth_tracks(
         raise ValueError(
             f"smooth_tracks: relink_coast is {relink_coast!r}, expected None or an int >= 1"
         )
+    if isinstance(link, str):  # "auto": pftrack smooth's gate, grown to the rows' frame
+        link = link_config_for(a, DEFAULT_MAX_GAP if max_gap is None else max_gap)
     fill_gap = max_gap if max_gap is not None else None if link is None else link.max_gap
     if link is not None and relink_coast is not None:
         a, obs, z = split_refound(a, obs, z, relink_coast)
