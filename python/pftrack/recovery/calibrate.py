@@ -149,6 +149,12 @@ class BucketChoice:
     combined_mmae: float | None = None
     replaced: tuple[str, float] | None = None
 
+    @property
+    def span(self) -> str:
+        """The bucket's gap lengths as ``--explain`` writes them: ``"2"``, ``"3-4"``."""
+        lo, hi = self.lengths
+        return f"{lo}" if lo == hi else f"{lo}-{hi}"
+
 
 @dataclass(frozen=True)
 class Calibration:
@@ -212,27 +218,21 @@ class Calibration:
             head,
         ]
         for c in self.buckets:
-            lo, hi = c.lengths
-            span = f"{lo}" if lo == hi else f"{lo}-{hi}"
+            span = c.span
             vals = dict(c.mmae)
             cells = "".join(f"{vals[m]:>11.3f}" if m in vals else f"{'-':>11}" for m in names)
             lines.append(f"{span:<12}{c.n_gaps:>6}{c.n_validation:>6}  {c.method:<{wide}}{cells}")
         for c in self.buckets:
+            span = c.span
             if c.replaced is not None:
-                lo, hi = c.lengths
-                span = f"{lo}" if lo == hi else f"{lo}-{hi}"
                 lines.append(
                     f"gap length {span}: linear, because the rule's choice {c.replaced[0]} "
                     f"(validation MMAE {c.replaced[1]:.3f}) did worse than linear "
                     f"({dict(c.mmae)['linear']:.3f}) on this length's validation gaps"
                 )
             if not c.mmae and not c.weights:  # was: a row naming a method, no reason
-                lo, hi = c.lengths
-                span = f"{lo}" if lo == hi else f"{lo}-{hi}"
                 lines.append(f"gap length {span}: {c.method}, the file's choice{_unscored(c)}")
             if c.weights:
-                lo, hi = c.lengths
-                span = f"{lo}" if lo == hi else f"{lo}-{hi}"
                 mix = " + ".join(f"{_weight(w)} {m}" for m, w in c.weights)
                 if c.combined_mmae is None:  # no validation gaps: the file's weights
                     lines.append(  # was "the file's choice", the header naming one method
@@ -514,9 +514,7 @@ def calibrate(
     """
     lengths = [_check.integer(v, "calibrate: a gap length", 1, MAX_FRAME) for v in gap_lengths]
     combine = _check.flag(combine, "calibrate: combine")
-    max_gaps, bags, seed = _settings(
-        "calibrate", max_gaps, bags_for(bags, combine, "calibrate"), seed
-    )
+    max_gaps, bags, seed = _settings("calibrate", max_gaps, bags, seed, combine)
     for m in candidates:
         if m not in CANDIDATES:
             raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
@@ -877,11 +875,13 @@ def bags_for(bags: object, combine: bool, who: str) -> int:
     return n
 
 
-def _settings(who: str, max_gaps: object, bags: object, seed: object) -> tuple[int, int, int]:
-    """`max_gaps`, `bags` and `seed` checked, or an error naming the one that is wrong."""
+def _settings(
+    who: str, max_gaps: object, bags: object, seed: object, combine: bool
+) -> tuple[int, int, int]:
+    """`max_gaps`, `bags` (:func:`bags_for`) and `seed` checked, or an error naming the one."""
     return (
         _check.integer(max_gaps, f"{who}: max_gaps", 1, 10**7),
-        _check.integer(bags, f"{who}: bags", 0, 10**4),
+        bags_for(bags, combine, who),
         _check.seed(seed, f"{who}: seed"),
     )
 
@@ -941,9 +941,7 @@ def recover_auto(
         frame, x or y.
     """
     combine = _check.flag(combine, "recover_auto: combine")
-    _, bags, seed = _settings(
-        "recover_auto", max_gaps, bags_for(bags, combine, "recover_auto"), seed
-    )
+    _, bags, seed = _settings("recover_auto", max_gaps, bags, seed, combine)
     checked = _checked_at_once(pairs)
     if checked is None:  # something to refuse (or not float64 arrays): pair by pair
         checked = []

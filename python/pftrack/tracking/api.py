@@ -27,7 +27,7 @@ import operator
 import pickle
 import threading
 import warnings
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import replace
 from typing import Any, NamedTuple, SupportsIndex
 
@@ -641,15 +641,16 @@ class Tracker:
         """
         self._prepared = (frame, working)
 
-    def _warn_once(self, key: str, message: str, stacklevel: int = 3) -> None:
+    def _warn_once(self, key: str, message: str | Callable[[], str], stacklevel: int = 3) -> None:
         """Warn `message` from ``update``'s caller, the first time `key` comes up in a run.
 
-        `stacklevel` as ``warnings.warn``'s, counted from here: 1 here, 2 ``update``, 3 its
-        caller (one more from a helper of ``update``).
+        `message` may be a function that makes it, called only then (a per-frame caller builds
+        no text). `stacklevel` as ``warnings.warn``'s, counted from here: 1 here, 2
+        ``update``, 3 its caller (one more from a helper of ``update``).
         """
         if key not in self._warned:
             self._warned.add(key)
-            warnings.warn(message, stacklevel=stacklevel)
+            warnings.warn(message if isinstance(message, str) else message(), stacklevel=stacklevel)
 
     def _warn_moving_camera(self) -> None:
         """Say once a run that the built-in detector runs on a moving camera.
@@ -659,20 +660,21 @@ class Tracker:
         this frame (``camera_motion`` "auto": after ``CameraConfig.on_frames`` moving frames
         in a row, the first of which the message names; "on": on every frame).
         """
-        if "moving camera" in self._warned:
-            return
-        camera = self._tracker.camera
-        if camera.mode == "auto":
-            first = max(1, self.frame_count + 1 - camera.config.on_frames + 1)
-            moves = f"the camera moves (from frame {first})"
-        else:
-            moves = "the camera counts as moving (camera_motion 'on')"
-        self._warn_once(
-            "moving camera",
-            f"{moves}: the built-in background-subtraction detector is unreliable on a moving "
-            "camera; give detections (pftrack track --detections, Tracker.update(dets, frame))",
-            stacklevel=4,
-        )
+
+        def message() -> str:
+            camera = self._tracker.camera
+            if camera.mode == "auto":
+                first = max(1, self.frame_count + 1 - camera.config.on_frames + 1)
+                moves = f"the camera moves (from frame {first})"
+            else:
+                moves = "the camera counts as moving (camera_motion 'on')"
+            return (
+                f"{moves}: the built-in background-subtraction detector is unreliable on a "
+                "moving camera; give detections (pftrack track --detections, "
+                "Tracker.update(dets, frame))"
+            )
+
+        self._warn_once("moving camera", message, stacklevel=4)
 
     def _working(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         prepared, self._prepared = self._prepared, None
