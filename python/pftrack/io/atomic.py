@@ -495,10 +495,10 @@ def check_output_folder(path: PathLike, what: str) -> Path:
         raise ValueError(f"{what} is empty; give a folder name")
     refuse_dash(text, what, output=True, name="folder")
     target = Path(text)
-    if target.exists() and not target.is_dir():
-        raise ValueError(f"{what} {target} is a file; give a folder")
     blocker = _blocking(target)
-    if blocker is not None:  # was "cannot create the folder (Not a directory)"
+    if blocker == target and target.exists():  # its own place holds a file (not a folder)
+        raise ValueError(f"{what} {target} is a file; give a folder")
+    if blocker is not None:  # a file above it: was "cannot create the folder (Not a directory)"
         raise NotADirectoryError(f"{what} {target}: {_not_a_folder(blocker)}")
     return target
 
