@@ -9,6 +9,7 @@ acceptance ratios next to the equations, is cpp/include/pftrack/rjmcmc.hpp; see 
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -19,6 +20,7 @@ from pftrack import _core
 from pftrack._check import first_at, generator, integer, number, real_array
 from pftrack._typing import RngLike
 from pftrack.particle_filter.colour import not_binned
+from pftrack.particle_filter.filter import _in_use
 
 #: Kernels of the colour histograms (``RJMCMCConfig.kernel``).
 KERNELS = ("uniform", "epanechnikov")
@@ -241,6 +243,9 @@ class RJMCMCFilter:
         self.seed = int(generator(rng, "RJMCMCFilter: rng").integers(2**63))
         self.n_steps = 0
         self.last: dict[str, Any] = {}
+        # held by a step: the core refuses a second thread only while inside, and the step
+        # number would be read twice between the two
+        self._busy = threading.Lock()
 
     def step(
         self,
@@ -281,6 +286,8 @@ class RJMCMCFilter:
             candidate not finite, beyond ±1e9 px or with w or h < 0;
             `candidate_hists` not (K, B) with the image's B bins, or a value not finite or
             negative (as :func:`~pftrack.particle_filter.bhattacharyya_coefficient` refuses).
+        RuntimeError
+            Another thread is inside this filter's ``step`` (one filter in one thread at a time).
         """
         fn = "RJMCMCFilter.step"
         error = not_binned(binned, "binned")
@@ -309,9 +316,14 @@ class RJMCMCFilter:
                 raise ValueError(
                     f"{fn}: candidate_hists{at} is {hists[k]:g}, expected a finite value >= 0"
                 )
-        r = self._core.step(binned, m, cands, hists, seed=self.seed, step=self.n_steps)
-        self.n_steps += 1
-        self.last = dict(r)
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, "RJMCMCFilter.step")
+        try:
+            r = self._core.step(binned, m, cands, hists, seed=self.seed, step=self.n_steps)
+            self.n_steps += 1
+            self.last = dict(r)
+        finally:
+            self._busy.release()
         out = []
         for row in r["estimates"]:
             if row[5] >= self.config.min_existence:
