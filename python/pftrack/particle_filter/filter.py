@@ -55,6 +55,15 @@ class FilterConfig:
         pixels on. The default 2048 keeps more pixels per box than a walker of PETS09-S2L1
         (about 30x80 at 480x360) has in full, so those boxes are counted in full. 0 counts
         every pixel of every box.
+
+    Raises
+    ------
+    TypeError
+        `n_particles` or `min_samples` not an int (a string, a float, a bool), `lam` not a
+        number.
+    ValueError
+        `n_particles` not in [1, 1000000], `min_samples` negative, `lam` not finite and >= 0,
+        an unknown `kernel` or `estimate`.
     """
 
     n_particles: int = 100

@@ -48,11 +48,12 @@ class MHColourParticleFilter(ColourParticleFilter):
 
     Raises
     ------
-    ValueError
-        `n_iter` not an int (a bool, a float) in [1, 2147483647]; else as
-        :class:`~pftrack.particle_filter.ColourParticleFilter`.
     TypeError
-        As :class:`~pftrack.particle_filter.ColourParticleFilter`.
+        `n_iter` not an int (a string, a float, a bool); else as
+        :class:`~pftrack.particle_filter.ColourParticleFilter`.
+    ValueError
+        `n_iter` not in [1, 2147483647]; else as
+        :class:`~pftrack.particle_filter.ColourParticleFilter`.
 
     Attributes
     ----------

@@ -225,6 +225,14 @@ class RJMCMCFilter:
     rng : numpy.random.Generator, int or None
         Source of the seed of the C++ counter-based draws.
 
+    Raises
+    ------
+    TypeError
+        A `config` that is not an RJMCMCConfig, an `rng` that is not a Generator, a seed or
+        None.
+    ValueError
+        A negative seed.
+
     References
     ----------
     .. [1] Smith, K., Gatica-Perez, D., Odobez, J.-M. (2005). Using particles to track varying
@@ -236,6 +244,11 @@ class RJMCMCFilter:
     """
 
     def __init__(self, config: RJMCMCConfig | None = None, rng: RngLike = None) -> None:
+        if config is not None and not isinstance(config, RJMCMCConfig):
+            raise TypeError(
+                f"RJMCMCFilter: config must be an RJMCMCConfig, got {type(config).__name__} "
+                f"{config!r}"
+            )
         self.config = config if config is not None else RJMCMCConfig()
         if self.config.kernel not in ("uniform", "epanechnikov"):
             raise ValueError(
@@ -282,8 +295,8 @@ class RJMCMCFilter:
         ------
         TypeError
             `binned` is not a :class:`~pftrack.particle_filter.BinnedImage` (a raw frame: bin
-            it with :func:`~pftrack.particle_filter.hsv_bins`); candidates or histograms that
-            are not real numbers.
+            it with :func:`~pftrack.particle_filter.hsv_bins`); a mask whose dtype is not
+            uint8 or bool; candidates or histograms that are not real numbers.
         ValueError
             A mask not of the frame's shape; candidates not of shape (K, 4) or (4,), or a
             candidate not finite, beyond ±1e9 px or with w or h < 0;
@@ -299,6 +312,8 @@ class RJMCMCFilter:
         m = np.asarray(mask)
         if m.dtype == bool:
             m = m.view(np.uint8)
+        elif m.dtype != np.uint8:  # as hsv_bins refuses it (the core said ValueError)
+            raise TypeError(f"{fn}: mask dtype is {m.dtype}, expected uint8 or bool")
         m = np.ascontiguousarray(m)
         cands = real_array(candidates_cxcywh, f"{fn}: candidates_cxcywh")
         if cands.ndim == 1 and cands.size == 0:

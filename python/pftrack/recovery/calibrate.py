@@ -488,11 +488,11 @@ def calibrate(
     Raises
     ------
     TypeError
-        A `seed` that is not an int, a `combine` that is not a bool, `observed` that is not a
-        sequence of arrays of real numbers.
+        A `seed`, gap length, context, `max_gaps` or `bags` that is not an int, a `combine`
+        that is not a bool, `observed` that is not a sequence of arrays of real numbers.
     ValueError
-        A gap length or context that is not an integer >= 1, `max_gaps` not an integer >= 1,
-        `bags` not an integer >= 0, a negative `seed`, an unknown candidate, non-finite
+        A gap length or context < 1, `max_gaps` < 1, `bags` < 0 (or beyond their bounds, 10**7
+        and 10**4), a negative `seed`, an unknown candidate, non-finite
         `spans`, `spans` / `contexts` of another length than `gap_lengths`, an observed run
         that is not (k, 3+) or has a non-finite frame, x or y.
     """
