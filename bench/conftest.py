@@ -1,8 +1,10 @@
 """Shared fixtures of the benchmarks: where the data is, and PETS09-S2L1 frames.
 
 The data folder is the experiments' (:func:`experiments._common.data_root`: ``$PFTRACK_DATA``
-or ``../shared/data``); a benchmark that needs a real sequence skips when it is absent, the
-frame fixtures fall back to synthetic frames.
+or ``../shared/data``); a benchmark that needs a real sequence skips when it is absent. The frame
+fixtures fall back to a random-noise frame, another workload (the histogram kernels run ~4x
+slower on it than on PETS09's frame): :func:`frame_source` names the frame they hold, and the
+benchmarks that use them put it in their group's name and in ``extra_info["frame"]``.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import cv2
 import numpy as np
 import pytest
 from numpy.typing import NDArray
+from pytest_benchmark.fixture import BenchmarkFixture
 
 from bench.recovery_file import synthetic_tracks
 from experiments._common import data_root
@@ -34,10 +37,19 @@ def pets_dir(data_dir: Path) -> Path:
     return folder
 
 
-def pets_frame(data: Path, size: tuple[int, int]) -> NDArray[np.uint8]:
-    """Frame 100 of PETS09-S2L1 resized to `size` (W, H), or a synthetic textured frame."""
+#: :func:`frame_source` of PETS09-S2L1's frame 100 (the frame fixtures' own frame).
+PETS_FRAME = "PETS09-S2L1 frame 100"
+
+
+def pets_frame(data: Path, size: tuple[int, int]) -> tuple[NDArray[np.uint8], str]:
+    """Frame 100 of PETS09-S2L1 resized to `size` (W, H), or a random-noise frame; and its name.
+
+    The name is :data:`PETS_FRAME`, or ``"random noise (...)"`` saying why the video's frame
+    was not read: a benchmark on it measures another workload and must say so.
+    """
     video = data / "pets09-s2l1" / "video.avi"
     frame = None
+    source = f"random noise (no PETS09-S2L1 video at {video})"
     if video.is_file():
         with opencv_name(video) as name:  # any name (pftrack.io.opencv_io)
             cap = cv2.VideoCapture(name)
@@ -45,20 +57,36 @@ def pets_frame(data: Path, size: tuple[int, int]) -> NDArray[np.uint8]:
         ok, frame = cap.read()
         cap.release()
         frame = frame if ok else None
+        source = PETS_FRAME if ok else f"random noise ({video} has no frame 100)"
     if frame is None:
         rng = np.random.default_rng(0)
         frame = rng.integers(0, 256, (360, 480, 3), dtype=np.uint8)
-    return np.asarray(cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR), dtype=np.uint8)
+    resized = cv2.resize(frame, size, interpolation=cv2.INTER_LINEAR)
+    return np.asarray(resized, dtype=np.uint8), source
 
 
 @pytest.fixture(scope="session")
 def frame_480(data_dir: Path) -> NDArray[np.uint8]:
-    return pets_frame(data_dir, (480, 360))
+    return pets_frame(data_dir, (480, 360))[0]
 
 
 @pytest.fixture(scope="session")
 def frame_720(data_dir: Path) -> NDArray[np.uint8]:
-    return pets_frame(data_dir, (1280, 720))
+    return pets_frame(data_dir, (1280, 720))[0]
+
+
+@pytest.fixture(scope="session")
+def frame_source(data_dir: Path) -> str:
+    """What `frame_480` and `frame_720` show: :data:`PETS_FRAME` or ``"random noise (why)"``."""
+    return pets_frame(data_dir, (48, 36))[1]
+
+
+def label_frame(benchmark: BenchmarkFixture, group: str, source: str) -> None:
+    """Set `benchmark`'s group, marked ``[random-noise frame]`` unless `source` is PETS09's,
+    and ``extra_info["frame"]``: a group never holds another frame under the same name."""
+    tag = "" if source == PETS_FRAME else " [random-noise frame]"
+    benchmark.group = group + tag
+    benchmark.extra_info["frame"] = source
 
 
 @pytest.fixture(scope="session")

@@ -1,6 +1,12 @@
 """Kernel speed: the C++ core against the NumPy baselines (and filterpy) in the same groups.
 
 Run: pytest bench --benchmark-only --benchmark-group-by=group --benchmark-columns=mean,median,ops
+
+Each group's speed-ups over its baselines, measured in the same run (medians), are recorded in
+``extra_info["x_<baseline>"]`` of the later of the two benchmarks. Where a floor is documented
+(:data:`FLOORS`: far below what is measured, so that only a real regression fails, not the noise
+of a shared machine) the benchmark asserts it; the other ratios are only recorded. The
+histogram groups assert only on PETS09's frame, the workload the floors were measured on.
 """
 
 from __future__ import annotations
@@ -10,12 +16,62 @@ import pytest
 from numpy.typing import NDArray
 from pytest_benchmark.fixture import BenchmarkFixture
 
+from bench.conftest import PETS_FRAME, label_frame
 from pftrack import _core
 from pftrack._typing import F64
-from pftrack.particle_filter import BinnedImage, box_histograms, hsv_bins
+from pftrack.particle_filter import (
+    BinnedImage,
+    bhattacharyya_weights,
+    box_histograms,
+    hsv_bins,
+)
 from tests.reference import fused as npb
 
-Case = tuple[str, BinnedImage, F64, F64, int]  # name, binned frame, boxes, reference, pixels
+Case = tuple[str, BinnedImage, F64, F64, int, str]  # name, frame, boxes, ref, pixels, source
+
+#: Least speed-up of pftrack's call over a baseline in the same run: (group prefix, pftrack
+#: role, baseline) -> floor. Measured (README, docs/results.md#kernels): histograms + weights
+#: 36-327x NumPy's per-box loop (the public two calls; 67-327x fused), resampling 66-119x
+#: filterpy. A floor about a third of the least measured ratio or below.
+FLOORS = {
+    ("histograms+weights", "fused", "numpy"): 10.0,
+    ("histograms+weights", "core", "numpy"): 10.0,
+    ("histograms+weights", "public", "numpy"): 10.0,
+    ("systematic resample", "core", "filterpy"): 20.0,
+    ("systematic resample", "api", "filterpy"): 20.0,
+    ("stratified resample", "core", "filterpy"): 20.0,
+}
+BASELINES = ("numpy", "filterpy")
+_MEDIANS: dict[str, dict[str, float]] = {}  # group -> role -> median seconds, this run
+
+
+def _compare(benchmark: BenchmarkFixture, role: str, *, check: bool = True) -> None:
+    """Keep this benchmark's median as `role` of its group, and compare it with the group's.
+
+    Each (pftrack role, baseline) pair of the group measured so far gets its ratio
+    ``baseline / pftrack`` in ``extra_info["x_<baseline>"]`` of the later benchmark, which
+    asserts :data:`FLOORS` (with `check`). Nothing with ``--benchmark-disable`` (no timing).
+    """
+    if not benchmark.stats:
+        return
+    medians = _MEDIANS.setdefault(benchmark.group, {})
+    medians[role] = benchmark.stats.stats.median
+    ours = [r for r in medians if r not in BASELINES] if role in BASELINES else [role]
+    for base in [role] if role in BASELINES else [b for b in BASELINES if b in medians]:
+        for r in ours:
+            ratio = medians[base] / medians[r]
+            key = f"x_{base}" if role not in BASELINES else f"x_{base}_{r}"
+            benchmark.extra_info[key] = round(ratio, 1)
+            floor = next(
+                (f for (g, p, b), f in FLOORS.items()
+                 if benchmark.group.startswith(g) and p == r and b == base),
+                None,
+            )  # fmt: skip
+            if check and floor is not None:
+                assert ratio >= floor, (
+                    f"{benchmark.group}: {r} is {ratio:.1f}x {base}, below the floor {floor:g}x "
+                    f"({1e3 * medians[r]:.3f} ms against {1e3 * medians[base]:.3f} ms)"
+                )
 
 
 def _boxes(
@@ -47,7 +103,7 @@ CASES = {
 
 
 @pytest.fixture(params=list(CASES), scope="module")
-def case(request: pytest.FixtureRequest) -> Case:
+def case(request: pytest.FixtureRequest, frame_source: str) -> Case:
     name = request.param
     fixture, n_obj, n_part, w, h = CASES[name]
     frame = request.getfixturevalue(fixture)
@@ -55,66 +111,97 @@ def case(request: pytest.FixtureRequest) -> Case:
     image = hsv_bins(frame)
     boxes = _boxes(rng, n_obj, n_part, w, h, frame.shape)
     ref = box_histograms(image, boxes[:1])[0] + 1e-6
-    return name, image, boxes, ref, n_part * n_obj * w * h
+    return name, image, boxes, ref, n_part * n_obj * w * h, frame_source
+
+
+def _hist_group(benchmark: BenchmarkFixture, case: Case) -> None:
+    name, _, _, _, pixels, source = case
+    label_frame(benchmark, f"histograms+weights {name}", source)
+    benchmark.extra_info["pixels"] = pixels
 
 
 def _core_hist_weights(image: BinnedImage, boxes: F64, ref: F64) -> F64:
     return _core.bhattacharyya_weights(_core.box_histograms(image, boxes, "uniform"), ref, 20.0)
 
 
+def _public_hist_weights(image: BinnedImage, boxes: F64, ref: F64) -> F64:
+    return bhattacharyya_weights(box_histograms(image, boxes), ref, 20.0)
+
+
+def test_histograms_weights_public(benchmark: BenchmarkFixture, case: Case) -> None:
+    """The public calls: ``bhattacharyya_weights(box_histograms(image, boxes), ref)``."""
+    _, image, boxes, ref, _, source = case
+    _hist_group(benchmark, case)
+    w = benchmark(_public_hist_weights, image, boxes, ref)
+    np.testing.assert_allclose(
+        w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300
+    )
+    _compare(benchmark, "public", check=source == PETS_FRAME)
+
+
 def test_histograms_weights_core(benchmark: BenchmarkFixture, case: Case) -> None:
-    name, image, boxes, ref, pixels = case
-    benchmark.group = f"histograms+weights {name}"
-    benchmark.extra_info["pixels"] = pixels
+    """The core's two calls under the public ones (without their Python checks)."""
+    _, image, boxes, ref, _, source = case
+    _hist_group(benchmark, case)
     w = benchmark(_core_hist_weights, image, boxes, ref)
     np.testing.assert_allclose(
         w, npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref), rtol=1e-8, atol=1e-300
     )
+    _compare(benchmark, "core", check=source == PETS_FRAME)
 
 
 def test_histograms_weights_core_fused(benchmark: BenchmarkFixture, case: Case) -> None:
-    """The same weights from one call that never builds the (K, B) histogram matrix."""
-    name, image, boxes, ref, pixels = case
-    benchmark.group = f"histograms+weights {name}"
-    benchmark.extra_info["pixels"] = pixels
+    """The same weights from one private call (``_core.box_weights``, the filters' path) that
+    never builds the (K, B) histogram matrix."""
+    _, image, boxes, ref, _, source = case
+    _hist_group(benchmark, case)
     w = benchmark(_core.box_weights, image, boxes, ref, 20.0)
     want = npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref)
     np.testing.assert_allclose(w, want, rtol=1e-8, atol=1e-300)
+    _compare(benchmark, "fused", check=source == PETS_FRAME)
 
 
 def test_histograms_weights_numpy(benchmark: BenchmarkFixture, case: Case) -> None:
-    name, image, boxes, ref, pixels = case
-    benchmark.group = f"histograms+weights {name}"
-    benchmark.extra_info["pixels"] = pixels
+    """NumPy's fastest formulation found (tests/reference/fused.py): a Python loop over the
+    boxes with one ``np.bincount`` each, then the weights of all boxes vectorised."""
+    _, image, boxes, ref, _, source = case
+    _hist_group(benchmark, case)
     args = (image.bins, image.n_bins, boxes, ref)
     if len(boxes) > 2000:
         benchmark.pedantic(npb.histograms_and_weights, args=args, rounds=2, iterations=1)
     else:
         benchmark(npb.histograms_and_weights, *args)
+    _compare(benchmark, "numpy", check=source == PETS_FRAME)
 
 
 @pytest.mark.parametrize("size", ["frame_480", "frame_720"])
 def test_hsv_bins_core(
-    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str
+    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str, frame_source: str
 ) -> None:
     frame = request.getfixturevalue(size)
-    benchmark.group = f"hsv bins {frame.shape[1]}x{frame.shape[0]}"
+    label_frame(benchmark, f"hsv bins {frame.shape[1]}x{frame.shape[0]}", frame_source)
     benchmark(_core.hsv_bins, frame)
+    _compare(benchmark, "core")
 
 
 @pytest.mark.parametrize("size", ["frame_480", "frame_720"])
 def test_hsv_bins_opencv_numpy(
-    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str
+    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str, frame_source: str
 ) -> None:
     frame = request.getfixturevalue(size)
-    benchmark.group = f"hsv bins {frame.shape[1]}x{frame.shape[0]}"
+    label_frame(benchmark, f"hsv bins {frame.shape[1]}x{frame.shape[0]}", frame_source)
     benchmark(npb.hsv_bins, frame)
+    _compare(benchmark, "numpy")
 
 
 @pytest.mark.parametrize("lazy", [False, True], ids=["eager", "lazy"])
 @pytest.mark.parametrize("size", ["frame_480", "frame_720"])
 def test_frame_bins_and_weights_10_objects(
-    benchmark: BenchmarkFixture, request: pytest.FixtureRequest, size: str, lazy: bool
+    benchmark: BenchmarkFixture,
+    request: pytest.FixtureRequest,
+    size: str,
+    lazy: bool,
+    frame_source: str,
 ) -> None:
     """A tracker's frame: full-frame bins, then the weights of 10 objects' particles.
 
@@ -126,7 +213,9 @@ def test_frame_bins_and_weights_10_objects(
     w, h = (20, 50) if cols < 1000 else (60, 150)
     boxes = _boxes(np.random.default_rng(1), 10, 200, w, h, frame.shape)
     ref = box_histograms(hsv_bins(frame), boxes[:1])[0] + 1e-6
-    benchmark.group = f"frame bins + weights, 10 objects x 200 particles, {cols}x{rows}"
+    label_frame(
+        benchmark, f"frame bins + weights, 10 objects x 200 particles, {cols}x{rows}", frame_source
+    )
 
     def one_frame() -> list[F64]:
         image = hsv_bins(frame, lazy=lazy)
@@ -150,6 +239,7 @@ def weights_10k() -> F64:
 @pytest.mark.benchmark(group="systematic resample N=10000")
 def test_resample_core(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     benchmark(_core.systematic_resample, weights_10k, 0.37)
+    _compare(benchmark, "core")
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
@@ -159,17 +249,20 @@ def test_resample_python_api(benchmark: BenchmarkFixture, weights_10k: F64) -> N
 
     rng = np.random.default_rng(4)
     benchmark(systematic_resample, weights_10k, rng)
+    _compare(benchmark, "api")
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
 def test_resample_numpy(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     benchmark(npb.systematic_resample, weights_10k, 0.37)
+    _compare(benchmark, "numpy")
 
 
 @pytest.mark.benchmark(group="systematic resample N=10000")
 def test_resample_filterpy(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     mc = pytest.importorskip("filterpy.monte_carlo")
     benchmark(mc.systematic_resample, weights_10k)
+    _compare(benchmark, "filterpy")
 
 
 @pytest.fixture(scope="module")
@@ -180,23 +273,28 @@ def uniforms_10k() -> F64:
 @pytest.mark.benchmark(group="stratified resample N=10000")
 def test_stratified_core(benchmark: BenchmarkFixture, weights_10k: F64, uniforms_10k: F64) -> None:
     benchmark(_core.stratified_resample, weights_10k, uniforms_10k)
+    _compare(benchmark, "core")
 
 
 @pytest.mark.benchmark(group="stratified resample N=10000")
 def test_stratified_numpy(benchmark: BenchmarkFixture, weights_10k: F64, uniforms_10k: F64) -> None:
     benchmark(npb.stratified_resample, weights_10k, uniforms_10k)
+    _compare(benchmark, "numpy")
 
 
 @pytest.mark.benchmark(group="stratified resample N=10000")
 def test_stratified_filterpy(benchmark: BenchmarkFixture, weights_10k: F64) -> None:
     mc = pytest.importorskip("filterpy.monte_carlo")
     benchmark(mc.stratified_resample, weights_10k)
+    _compare(benchmark, "filterpy")
 
 
-@pytest.mark.benchmark(group="sis_step 10 objects x 200 particles, 20x50, 480x360")
-def test_sis_step_10x200(benchmark: BenchmarkFixture, frame_480: NDArray[np.uint8]) -> None:
+def test_sis_step_10x200(
+    benchmark: BenchmarkFixture, frame_480: NDArray[np.uint8], frame_source: str
+) -> None:
     from pftrack.particle_filter import ColourParticleFilter, FilterConfig
 
+    label_frame(benchmark, "sis_step 10 objects x 200 particles, 20x50, 480x360", frame_source)
     image = hsv_bins(frame_480)
     rng = np.random.default_rng(3)
     boxes = _boxes(rng, 10, 1, 20, 50, frame_480.shape)
@@ -251,7 +349,11 @@ def _sis_batch(
 @pytest.mark.parametrize("min_samples", [0, 2048], ids=["every pixel", "lattice 2048"])
 @pytest.mark.parametrize("scene", ["PETS09 upscaled", "black"])
 def test_sis_batch_1080p_large_boxes(
-    benchmark: BenchmarkFixture, frame_480: NDArray[np.uint8], scene: str, min_samples: int
+    benchmark: BenchmarkFixture,
+    frame_480: NDArray[np.uint8],
+    frame_source: str,
+    scene: str,
+    min_samples: int,
 ) -> None:
     """FilterConfig.min_samples: one step of 15 objects x 200 particles, 100x250 boxes, at
     1920x1080 (the PETS09 frame upscaled, or black), counting every pixel or on the lattice."""
@@ -263,7 +365,11 @@ def test_sis_batch_1080p_large_boxes(
         frame = cv2.resize(frame_480, (1920, 1080), interpolation=cv2.INTER_LINEAR)
     image = hsv_bins(frame)
     start = _large_box_filters(image, min_samples, scene == "black")
-    benchmark.group = f"sis_step_batch 15x200, 100x250 boxes, 1920x1080 {scene}"
+    group = f"sis_step_batch 15x200, 100x250 boxes, 1920x1080 {scene}"
+    if scene == "black":
+        benchmark.group = group
+    else:
+        label_frame(benchmark, group, frame_source)
 
     def setup() -> tuple[tuple[list[tuple[F64, F64, F64]]], dict[str, object]]:
         return ([tuple(a.copy() for a in f) for f in start],), {}  # type: ignore[misc]

@@ -786,6 +786,29 @@ def test_options_the_joint_sampler_never_reads_are_refused() -> None:
     tracker_config(parse([*joint[:-2], "--max-coast", "0"]))  # sis: taken
 
 
+def test_joint_sampler_particles_are_capped(capsys: pytest.CaptureFixture[str]) -> None:
+    # was: --sampler rjmcmc --particles 100000 taken, about 6 minutes a frame (the chain's cost
+    # grows as the square of its samples)
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import RJMCMC_MAX_SAMPLES, tracker_config
+
+    parse = build_parser().parse_args
+    joint = ["track", "v", "--out", "o", "--sampler", "rjmcmc", "--particles"]
+    with pytest.raises(ValueError, match=(
+        r"^--particles 10001 with --sampler rjmcmc: at most 10000\. The joint chain's cost per "
+        r"frame grows as the square of its samples .*, 1\.4 s at 32000$"
+    )):  # fmt: skip
+        tracker_config(parse([*joint, "10001"]))
+    assert RJMCMC_MAX_SAMPLES == 10_000
+    assert tracker_config(parse([*joint, "10000"])).filter.n_particles == 10_000
+    sis = tracker_config(parse([*joint[:-3], "--particles", "100000"]))  # sis: linear, taken
+    assert sis.filter.n_particles == 100_000
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "kept samples, 1 to 10000: its cost per frame grows as N squared" in text
+
+
 def test_background_options_with_no_refine_are_refused() -> None:
     # was: --no-refine --detector knn --open-size 9 --bootstrap first wrote the same bytes as
     # --no-refine alone (no background model runs)

@@ -92,8 +92,12 @@ void register_histogram(py::module_& m) {
                      const auto* src = bins.data();
                      for (size_t i = 0; i < img->data.size(); ++i) {
                          const auto v = src[i];
-                         require(v >= -1 && v < n_bins && v == std::floor(v), fn, "bins value", v,
-                                 "in [-1, n_bins)");
+                         // 1.5 said "expected in [-1, n_bins)", which 1.5 is: say it is no index
+                         if (!(v == std::floor(v)))
+                             require(false, fn, "bins value", v,
+                                     "an integer: bins must be an integer array of bin indices "
+                                     "in [-1, n_bins)");
+                         require(v >= -1 && v < n_bins, fn, "bins value", v, "in [-1, n_bins)");
                          img->data[i] = static_cast<std::int16_t>(v);
                      }
                  };

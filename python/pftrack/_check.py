@@ -253,15 +253,17 @@ def integer(value: object, what: str, lo: int, hi: int) -> int:
 
     Raises
     ------
+    TypeError
+        Not an int (a string, a float, None, a bool): ``{what} must be an integer in [lo, hi],
+        got str '5'``, as :func:`number` refuses what is not a number.
     ValueError
-        ``{what} is {value!r}, expected an integer in [lo, hi]``, whatever the reason (a
-        setting's one message).
+        An int outside ``[lo, hi]``: ``{what} is {value}, expected an integer in [lo, hi]``.
     """
-    if (
-        isinstance(value, (bool, np.bool_))
-        or not isinstance(value, (int, np.integer))
-        or not (lo <= value <= hi)
-    ):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(
+            f"{what} must be an integer in [{lo}, {hi}], got {type(value).__name__} {value!r}"
+        )
+    if not lo <= value <= hi:
         raise ValueError(f"{what} is {value!r}, expected an integer in [{lo}, {hi}]")
     return int(value)
 

@@ -284,14 +284,19 @@ def wna_Q_xy(q: Sequence[float], dt: float = 1.0) -> F64:  # noqa: N802 - the us
 
     Raises
     ------
+    TypeError
+        `q` or `dt` not real numbers.
     ValueError
-        Not 2 values in `q`, or `q` or `dt` not finite and ``>= 0``.
+        Not 2 values in `q` (one number is refused: which axis would it be?), or `q` or `dt`
+        not finite and ``>= 0``.
     """
-    if len(q) != 2:
-        raise ValueError(f"wna_Q_xy: q has {len(q)} values, expected 2 (x, y)")
-    _require("wna_Q_xy", "q", q, ">= 0")
+    v = real_array(q, "wna_Q_xy: q")
+    if v.shape != (2,):
+        got = f"is {v.item():g}" if v.ndim == 0 else f"has shape {v.shape}"
+        raise ValueError(f"wna_Q_xy: q {got}, expected 2 values (x, y): one density per axis")
+    _require("wna_Q_xy", "q", v, ">= 0")
     _require("wna_Q_xy", "dt", dt, ">= 0")
-    return _xy_block([_wna_Q(float(qi), dt) for qi in q])
+    return _xy_block([_wna_Q(float(qi), dt) for qi in v])
 
 
 def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, Cov]:

@@ -19,9 +19,10 @@ REFUSED = [
     # was: ran (history=-1, var_threshold=-1, dist2_threshold=nan)
     ("mog2", "history", -1, ValueError, r"integer in \[1, 2147483647\]"),
     ("knn", "history", 0, ValueError, r"integer in \[1, 2147483647\]"),
-    # was: OpenCV's TypeError, not naming the setting
-    ("knn", "history", 1.5, ValueError, r"integer in \[1, 2147483647\]"),
-    ("mog2", "history", True, ValueError, r"integer in \[1, 2147483647\]"),
+    # was: OpenCV's TypeError, not naming the setting (then ValueError: a wrong type is a
+    # TypeError, as a number setting's)
+    ("knn", "history", 1.5, TypeError, r"integer in \[1, 2147483647\], got float 1.5"),
+    ("mog2", "history", True, TypeError, r"integer in \[1, 2147483647\], got bool True"),
     ("mog2", "var_threshold", -1.0, ValueError, "expected a finite value > 0"),
     ("mog2", "var_threshold", NAN, ValueError, "expected a finite value > 0"),
     ("knn", "dist2_threshold", NAN, ValueError, "expected a finite value > 0"),

@@ -385,9 +385,12 @@ def test_equals_trackeval_on_pftrack_track_output(tmp_path: Path) -> None:
 def test_num_frames_and_scale_of_the_wrong_kind_are_named() -> None:
     """num_frames=-1 said 'beyond the sequence's -1 frames'; scale='2' was Python's message."""
     g = np.array([[1, 1, 10, 10, 5, 5, 1, -1, -1, -1.0]])
-    for bad in (-1, 0, 2.5, True):
+    for bad in (-1, 0):
         with pytest.raises(ValueError, match=r"num_frames is .*, expected an integer in \[1, "):
             evaluate_hota(g, g, num_frames=bad)
+    for wrong in (2.5, True):  # a wrong type: TypeError (was ValueError), as scale's
+        with pytest.raises(TypeError, match=r"num_frames must be an integer in \[1, .*, got "):
+            evaluate_hota(g, g, num_frames=wrong)
     with pytest.raises(TypeError, match="scale must be a number, got str '2'"):
         evaluate_hota(g, g, scale="2")
     assert evaluate_hota(g, g, num_frames=1).hota == pytest.approx(1.0)

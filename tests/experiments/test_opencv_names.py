@@ -129,7 +129,7 @@ eval_detection.figure(scene.frames, truth, 2, root / "figure.jpg")  # cv2.imwrit
 
 from bench import conftest
 
-assert conftest.pets_frame(root, (48, 36)).shape == (36, 48, 3)  # cv2.VideoCapture
+assert conftest.pets_frame(root, (48, 36))[0].shape == (36, 48, 3)  # cv2.VideoCapture
 
 from bench import test_pipeline
 

@@ -7,21 +7,29 @@ signature dump, or gave no estimate at all.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
 
+from pftrack.kalman import wna_Q_xy
 from pftrack.particle_filter import (
     Ar2Model,
+    BinnedImage,
     ColourParticleFilter,
     FilterConfig,
     MHColourParticleFilter,
     RJMCMCConfig,
+    RJMCMCFilter,
+    box_histograms,
+    estimate,
     hsv_bins,
 )
+from pftrack.tracking import CameraConfig
 
 NAN = math.nan
 INT = r"expected an integer in \[{}, 2147483647\]"
+INT_TYPE = r"must be an integer in \[{}, 2147483647\], got"
 
 # (field, value, error, message); "# was: ..." what happened before the check
 RJ_REFUSED = [
@@ -29,9 +37,10 @@ RJ_REFUSED = [
     ("burn_in", -1, ValueError, INT.format(0)),
     # was: pybind11's "incompatible constructor arguments" (10**12, 1.5)
     ("burn_in", 10**12, ValueError, INT.format(0)),
-    ("burn_in", 1.5, ValueError, INT.format(0)),
+    ("burn_in", 1.5, TypeError, INT_TYPE.format(0)),  # a wrong type: TypeError (was ValueError)
     # was: accepted (True counts as 1 sample)
-    ("n_samples", True, ValueError, INT.format(1)),
+    ("n_samples", True, TypeError, INT_TYPE.format(1)),
+    ("n_samples", "200", TypeError, INT_TYPE.format(1) + " str '200'"),
     ("n_samples", 0, ValueError, INT.format(1)),
     ("p_birth", NAN, ValueError, "expected a finite value >= 0"),
     ("p_birth", -1.0, ValueError, "expected a finite value >= 0"),
@@ -116,8 +125,74 @@ def test_ar2_model_bounds_are_taken_and_keep_a_filter_in_its_domain():
     assert np.abs(f.particles).max() < 1e9
 
 
-@pytest.mark.parametrize("n_iter", [10**12, True, 1.0, 0])
+@pytest.mark.parametrize("n_iter", [10**12, 0])
 def test_mh_filter_refuses_n_iter_outside_the_cores_int(n_iter):
-    # was: 10**12 a pybind11 "incompatible function arguments" dump at the step; True accepted
+    # was: 10**12 a pybind11 "incompatible function arguments" dump at the step
     with pytest.raises(ValueError, match=r"MHColourParticleFilter: n_iter is .*\[1, 2147483647\]"):
         MHColourParticleFilter([40, 30, 12, 20], np.ones(110), n_iter=n_iter)
+
+
+@pytest.mark.parametrize("n_iter", [True, 1.0, "2"])
+def test_mh_filter_refuses_an_n_iter_that_is_not_an_int(n_iter):
+    # was: True accepted, then ValueError for True, 1.0 and "2" (TypeError: a wrong type, as
+    # Ar2Model(sigma_xy="4") and RJMCMCConfig(lam="1") refuse theirs)
+    with pytest.raises(
+        TypeError,
+        match=rf"^MHColourParticleFilter: n_iter must be an integer in \[1, 2147483647\], got "
+        rf"{type(n_iter).__name__} {re.escape(repr(n_iter))}$",
+    ):
+        MHColourParticleFilter([40, 30, 12, 20], np.ones(110), n_iter=n_iter)
+
+
+_IM = hsv_bins(np.zeros((8, 10, 3), np.uint8))
+_MASK = np.ones((8, 10), np.uint8)
+_PARTS = np.ones((3, 6))
+
+# (call, error, message): the whole message, one line; "# was: ..." what happened before
+WRONG_KIND = [
+    # was ValueError for these wrong types, where a number setting ("4") gave TypeError
+    (lambda: FilterConfig(n_particles="5"), TypeError,
+     "n_particles must be an integer in [1, 1000000], got str '5'"),
+    (lambda: FilterConfig(n_particles=5.0), TypeError,
+     "n_particles must be an integer in [1, 1000000], got float 5.0"),
+    (lambda: FilterConfig(n_particles=0), ValueError,
+     "n_particles is 0, expected an integer in [1, 1000000]"),
+    # the tracker's integer settings likewise (was ValueError)
+    (lambda: CameraConfig(refresh_frames=2.5), TypeError,
+     "CameraConfig: refresh_frames must be an integer >= 1, got float 2.5"),
+    (lambda: CameraConfig(refresh_frames=0), ValueError,
+     "CameraConfig: refresh_frames is 0, expected an integer >= 1"),
+    # was AttributeError: 'str' object has no attribute 'kernel'
+    (lambda: RJMCMCFilter("x"), TypeError,
+     "RJMCMCFilter: config must be an RJMCMCConfig, got str 'x'"),
+    # was ValueError (the core's "rjmcmc_step: mask dtype is float32"), hsv_bins' TypeError
+    (lambda: RJMCMCFilter(rng=0).step(_IM, _MASK.astype(np.float32), []), TypeError,
+     "RJMCMCFilter.step: mask dtype is float32, expected uint8 or bool"),
+    # was pybind11's list of signatures, over several lines
+    (lambda: box_histograms(_IM, [5, 4, 2, 2], kernel=None), TypeError,
+     "box_histograms: kernel must be 'uniform' or 'epanechnikov', got NoneType None"),
+    # was NumPy's "could not convert string to float: np.str_('a')", no function named
+    (lambda: estimate(_PARTS, np.array(["a", "b", "c"])), TypeError,
+     "estimate: weights must hold real numbers, got dtype <U1"),
+    # was "estimate: particles cols is 1" for one (6,) row
+    (lambda: estimate(_PARTS[0], [1.0]), ValueError,
+     "estimate: particles shape is (6,), expected (N, 6) with N >= 1: one row (cx, cy, s, "
+     "previous cx, cy, s) per particle"),
+    (lambda: estimate(_PARTS, [1.0, 2.0]), ValueError,
+     "estimate: weights shape is (2,), expected (3,): one weight per particle"),
+    # was TypeError: object of type 'float' has no len()
+    (lambda: wna_Q_xy(1.0), ValueError,
+     "wna_Q_xy: q is 1, expected 2 values (x, y): one density per axis"),
+    # was "bins value is 1.5, expected in [-1, n_bins)" (which 1.5 is)
+    (lambda: BinnedImage(np.full((2, 2), 1.5), 110), ValueError,
+     "BinnedImage: bins value is 1.5, expected an integer: bins must be an integer array of "
+     "bin indices in [-1, n_bins)"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("call", "error", "message"), WRONG_KIND)
+def test_a_wrong_type_is_a_type_error_and_every_message_one_line(call, error, message):
+    with pytest.raises(error, match=f"^{re.escape(message)}$"):
+        call()
+    assert estimate(_PARTS, [1.0, 1.0, 1.0])[0].tolist() == [1.0, 1.0, 1.0]  # still taken
+    assert wna_Q_xy([1.0, 0.5]).shape == (4, 4)

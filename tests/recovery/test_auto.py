@@ -679,19 +679,21 @@ _A, _B = _RUN[:10], _RUN[15:]
     ("kwargs", "error", "match"),
     [
         # each was taken, or failed deep inside without the argument's name
-        ({"bags": 1.5}, ValueError, r"calibrate: bags is 1.5, expected an integer in \[0, 10000\]"),
-        ({"bags": "32"}, ValueError, "calibrate: bags is '32'"),
-        ({"bags": True}, ValueError, "calibrate: bags is True"),
+        # a wrong type is a TypeError, an int out of range a ValueError
+        ({"bags": 1.5}, TypeError,
+         r"calibrate: bags must be an integer in \[0, 10000\], got float 1.5"),
+        ({"bags": True}, TypeError, "calibrate: bags must be an integer .*, got bool True"),
+        ({"bags": -1}, ValueError, r"calibrate: bags is -1, expected an integer in \[0, 10000\]"),
         ({"seed": -1}, ValueError, "calibrate: seed is -1, expected an int >= 0"),
         ({"seed": None}, TypeError, "calibrate: seed must be an int >= 0"),
         ({"seed": True}, TypeError, "calibrate: seed must be an int >= 0"),
-        ({"max_gaps": 1.5}, ValueError, "calibrate: max_gaps is 1.5"),
-        ({"max_gaps": True}, ValueError, "calibrate: max_gaps is True"),
+        ({"max_gaps": 1.5}, TypeError, "calibrate: max_gaps must be an integer .*, got float"),
+        ({"max_gaps": True}, TypeError, "calibrate: max_gaps must be an integer .*, got bool"),
         ({"combine": 1}, TypeError, "calibrate: combine"),
         ({"spans": [np.nan]}, ValueError, "calibrate: spans must be finite"),
-        ({"contexts": [(1.5, 2)]}, ValueError, "calibrate: a context is 1.5"),
+        ({"contexts": [(1.5, 2)]}, TypeError, "calibrate: a context must be an integer .* 1.5"),
     ],
-)
+)  # fmt: skip
 def test_calibrate_names_a_bad_setting(kwargs: dict, error: type, match: str) -> None:
     from pftrack.recovery.calibrate import calibrate
 
@@ -702,8 +704,9 @@ def test_calibrate_names_a_bad_setting(kwargs: dict, error: type, match: str) ->
 @pytest.mark.parametrize(
     ("observed", "lengths", "error", "match"),
     [
-        ([_RUN], [2.7], ValueError, "calibrate: a gap length is 2.7"),  # was truncated to 2
-        ([_RUN], ["3"], ValueError, "calibrate: a gap length is '3'"),
+        ([_RUN], [2.7], TypeError, "calibrate: a gap length must be an integer .*, got float 2.7"),
+        ([_RUN], ["3"], TypeError, "calibrate: a gap length must be an integer .*, got str '3'"),
+        ([_RUN], [0], ValueError, r"calibrate: a gap length is 0, expected an integer in \[1, "),
         ([np.where(np.arange(39)[:, None] == 5, np.nan, _RUN)], [3], ValueError,
          r"calibrate: observed run 0 has a non-finite frame, x or y"),  # was left out silently
         ([np.zeros((30, 2))], [3], ValueError, r"observed\[0\] has shape \(30, 2\)"),
@@ -731,9 +734,11 @@ def test_recover_auto_and_recover_gaps_name_bad_settings() -> None:
     with pytest.raises(ValueError, match=r"recover_auto: observed run 0 has a non-finite"):
         recover_auto([(_A, _B)], observed=[np.where(_RUN == 4, np.nan, _RUN)])
     # history 1.5 acted as 1, "2" and True were taken; combine=1 was taken
-    for history in (1.5, "2", True, 0):
-        with pytest.raises(ValueError, match="recover_gaps: history is"):
+    for history in (1.5, "2", True):  # a wrong type: TypeError (was ValueError)
+        with pytest.raises(TypeError, match="recover_gaps: history must be an integer in"):
             recover_gaps([(_A, _B)], "gdt", history=history)
+    with pytest.raises(ValueError, match="recover_gaps: history is 0"):
+        recover_gaps([(_A, _B)], "gdt", history=0)
     with pytest.raises(TypeError, match="recover_gaps: combine"):
         recover_gaps([(_A, _B)], combine=1)
     for method in ("linear-nb", "auto"):

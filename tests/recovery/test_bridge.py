@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pftrack import _core
-from pftrack.kalman import cv_transition_xy
+from pftrack.kalman import cv_transition_xy, wna_Q_xy
 from pftrack.recovery import GdtModel, goal_directed_path, sample_goal_directed_paths
 from tests.reference import bridge as ref
 
@@ -272,6 +272,37 @@ def test_samples_reproducible_and_centred_on_the_mean_path():
     assert not np.array_equal(a[:10], c)
     with pytest.raises(ValueError, match="n_samples"):
         sample_goal_directed_paths(**p, n_samples=0)
+
+
+@pytest.mark.parametrize("form", ["general", "invertible"])
+@pytest.mark.parametrize("start_conditioned", [True, False], ids=["conditioned", "prior"])
+def test_samples_are_distributed_as_the_solution_says(start_conditioned, form):
+    # was (start_conditioned=False): every sample started at m0 exactly (sample covariance 0
+    # at t = 0 where cov[0] is Pi_0, and 2.37 where cov[4] says 3.545); now x_0 ~ N(m0, Pi_0)
+    p = dict(
+        A=cv_transition_xy(1.0),
+        Q=wna_Q_xy([0.5, 0.2]),
+        H_T=np.eye(4) if form == "invertible" else np.eye(4)[:2],
+        Pi_T=0.5 * np.eye(4 if form == "invertible" else 2),
+        m0=np.array([0.0, 0.0, 1.0, 0.5]),
+        Pi_0=np.diag([1.0, 1.0, 0.3, 0.3]),
+        y_T=np.array([12.0, 3.0, 1.5, 0.4])[: 4 if form == "invertible" else 2],
+        T=8,
+    )
+    n = 20_000
+    sol = goal_directed_path(**p, form=form, start_conditioned=start_conditioned)
+    paths = sample_goal_directed_paths(
+        **p, n_samples=n, rng=0, form=form, start_conditioned=start_conditioned
+    )
+    var = np.einsum("tii->ti", sol.cov)
+    # standard errors of a sample mean and of a sample covariance entry (Gaussian samples)
+    se_mean = np.sqrt(var / n)
+    se_cov = np.sqrt((var[:, :, None] * var[:, None, :] + sol.cov**2) / n)
+    assert np.all(np.abs(paths.mean(axis=0) - sol.path) < 5 * se_mean)
+    cov = np.array([np.cov(paths[:, t].T) for t in range(p["T"] + 1)])
+    assert np.all(np.abs(cov - sol.cov) < 5 * se_cov), np.abs(cov - sol.cov).max()
+    x0 = sol.x0_cov if start_conditioned else p["Pi_0"]
+    np.testing.assert_array_equal(sol.cov[0], x0)
 
 
 def test_kalman_filter_matches_reference():

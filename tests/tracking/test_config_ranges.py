@@ -41,10 +41,11 @@ REFUSED = [
     (MotionConfig, "smooth_external", "no", TypeError, "must be True or False"),
     # was: 0 rows (-5), a TypeError mid-run ("x"), the birth quantile never learned (0)
     (LifecycleConfig, "tentative_coast", -5, ValueError, r"integer in \[0, 2147483647\]"),
-    (LifecycleConfig, "tentative_coast", "x", ValueError, r"integer in \[0, 2147483647\]"),
-    (LifecycleConfig, "tentative_coast", 1.0, ValueError, r"integer in \[0, 2147483647\]"),
+    # a wrong type: TypeError (was ValueError)
+    (LifecycleConfig, "tentative_coast", "x", TypeError, r"integer in \[0, 2147483647\], got str"),
+    (LifecycleConfig, "tentative_coast", 1.0, TypeError, r"integer in \[0, 2147483647\], got"),
     (LifecycleConfig, "birth_window", 0, ValueError, r"integer in \[1, 2147483647\]"),
-    (LifecycleConfig, "min_hits", True, ValueError, r"integer in \[0, 2147483647\]"),
+    (LifecycleConfig, "min_hits", True, TypeError, r"integer in \[0, 2147483647\], got bool"),
     (LifecycleConfig, "max_coast", 2**31, ValueError, r"integer in \[0, 2147483647\]"),
     (LifecycleConfig, "relink_coast", 0, ValueError, r"integer in \[1, 2147483647\]"),
     # was: refused only at run time (5), accepted (NaN, negative)

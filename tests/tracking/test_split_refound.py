@@ -90,7 +90,9 @@ def test_split_refound_bad_count(k, error):
 
 @pytest.mark.parametrize("value", [0, -1, 2.0, True, "7"])
 def test_relink_coast_is_checked(value):
-    with pytest.raises(ValueError, match="relink_coast"):
+    # LifecycleConfig: a wrong type is a TypeError (was ValueError), an int < 1 a ValueError
+    error = ValueError if isinstance(value, int) and not isinstance(value, bool) else TypeError
+    with pytest.raises(error, match="relink_coast"):
         LifecycleConfig(relink_coast=value)
     rows, obs = walker_rows(1, range(1, 5), 100, 2.0)
     with pytest.raises(ValueError, match="smooth_tracks: relink_coast"):
@@ -195,5 +197,5 @@ def test_frame_counts_refuse_a_bool(owner, field):
     from pftrack.tracking import CameraConfig
 
     cls = LifecycleConfig if owner == "lifecycle" else CameraConfig
-    with pytest.raises(ValueError, match=field):
+    with pytest.raises(TypeError, match=rf"{field} must be an integer .*, got bool True"):
         cls(**{field: True})

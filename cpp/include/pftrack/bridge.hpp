@@ -372,9 +372,10 @@ inline MatrixXd psd_factor(const MatrixXd& c) {
 }
 
 /// `n_samples` random paths of the goal-directed process x_t = A_t x_{t-1} + u_t + eps_t noise,
-/// x_0 ~ N(E[x0|yT], cov(x0|yT)) (or x_0 = m_0 when not `start_conditioned`). Returns
-/// (n_samples * (T + 1), n): sample s occupies rows s (T+1) .. s (T+1) + T. Draw k of sample s
-/// is CounterRng(seed, s).normal(k), so results do not depend on threads or order.
+/// x_0 ~ N(E[x0|yT], cov(x0|yT)), or x_0 ~ N(m_0, Pi_0) when not `start_conditioned`: the
+/// distribution whose mean and covariances gdt_solve gives for the same flag (path, cov).
+/// Returns (n_samples * (T + 1), n): sample s occupies rows s (T+1) .. s (T+1) + T. Draw k of
+/// sample s is CounterRng(seed, s).normal(k), so results do not depend on threads or order.
 inline RowMatrixXd gdt_sample(const GdtProblem& p, GdtForm form, bool start_conditioned,
                               int n_samples, std::uint64_t seed) {
     gdt_check(p, form, "gdt_sample");
@@ -384,17 +385,17 @@ inline RowMatrixXd gdt_sample(const GdtProblem& p, GdtForm form, bool start_cond
     const int T = p.T;
     std::vector<MatrixXd> F(static_cast<size_t>(T));
     for (int t = 0; t < T; ++t) F[static_cast<size_t>(t)] = psd_factor(s.eps[static_cast<size_t>(t)]);
-    const MatrixXd F0 = psd_factor(s.x0_cov);
+    // x_0's distribution: the conditioned one, or the prior N(m_0, Pi_0) (was x_0 = m_0, whose
+    // paths had covariance 0 at t = 0 where gdt_solve's cov[0] is Pi_0)
+    const MatrixXd F0 = psd_factor(start_conditioned ? s.x0_cov : p.Pi_0);
+    const VectorXd& x0 = start_conditioned ? s.x0_mean : p.m0;
     RowMatrixXd out(static_cast<Index>(n_samples) * (T + 1), n);
     VectorXd z(n);
     for (int smp = 0; smp < n_samples; ++smp) {
         const CounterRng rng(seed, static_cast<std::uint64_t>(smp));
         std::uint64_t k = 0;
-        VectorXd x = p.m0;
-        if (start_conditioned) {
-            for (Index j = 0; j < n; ++j) z(j) = rng.normal(k++);
-            x = s.x0_mean + F0 * z;
-        }
+        for (Index j = 0; j < n; ++j) z(j) = rng.normal(k++);
+        VectorXd x = x0 + F0 * z;
         const Index base = static_cast<Index>(smp) * (T + 1);
         out.row(base) = x.transpose();
         for (int t = 1; t <= T; ++t) {

@@ -67,6 +67,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -142,16 +143,34 @@ struct RjIdentity {
     double log_omega = 0.0;    // log prior odds of presence
     RowMatrixXd parents;       // (N_i, 6) previous kept states of this identity (x, x')
     RowMatrixXd mu;            // (N_i, 3) AR2 predictions A x + B x'
+    std::vector<Index> runs;   // lengths of the runs of equal consecutive rows of mu (sum N_i)
     double anchor[4] = {0, 0, 0, 0};  // box for the birth weight
 };
 
-/// One object of a configuration; `unary` caches its single-object log-target term.
+/// One object of a configuration; `unary` caches its single-object log-target term and
+/// `log_prior` the log P_slot(x) inside it (the proposal density of the move ratios).
 struct RjObject {
     int slot = 0;
     double x[3] = {0, 0, 1};
     double prev[3] = {0, 0, 1};
     double unary = 0.0;
+    double log_prior = 0.0;
 };
+
+/// Lengths of the runs of equal consecutive rows of `mu` (bit for bit). The kept samples repeat
+/// an identity's state until a move changes it (a rejected move, a move of another object), so
+/// an identity's N_i predictions hold far fewer distinct rows than N_i.
+inline std::vector<Index> equal_row_runs(const RowMatrixXd& mu) {
+    std::vector<Index> runs;
+    const auto bytes = static_cast<size_t>(mu.cols()) * sizeof(double);
+    for (Index n = 0; n < mu.rows(); ++n) {
+        if (n > 0 && std::memcmp(mu.row(n).data(), mu.row(n - 1).data(), bytes) == 0)
+            ++runs.back();
+        else
+            runs.push_back(1);
+    }
+    return runs;
+}
 using RjConfig = std::vector<RjObject>;  // sorted by slot, at most one object per slot
 
 /// Integral image of a foreground mask: S(y, x) = #fg pixels in rows < y, columns < x.
@@ -232,22 +251,30 @@ public:
             }
             return lp;
         }
-        // log (1/N_i) sum_n N(x; mu_n, C^2), by log-sum-exp
+        // log (1/N_i) sum_n N(x; mu_n, C^2), by log-sum-exp. Equal rows give equal terms: each
+        // run of them is evaluated once (its exp added once per row, in the same order, so the
+        // sum is the same double as row by row). An evaluation costs O(distinct rows) exps and
+        // O(N_i) additions.
         const double norm = -std::log(m.sigma[0] * m.sigma[1] * m.sigma[2]) - 1.5 * kLog2Pi -
                             std::log(static_cast<double>(id.mu.rows()));
         double mx = kNegInf;
-        lse_.resize(static_cast<size_t>(id.mu.rows()));
-        for (Index n = 0; n < id.mu.rows(); ++n) {
+        lse_.resize(id.runs.size());
+        Index n = 0;
+        for (size_t r = 0; r < id.runs.size(); ++r) {
             double q = 0.0;
             for (int d = 0; d < 3; ++d) {
                 const double z = (x[d] - id.mu(n, d)) / m.sigma[d];
                 q -= 0.5 * z * z;
             }
-            lse_[static_cast<size_t>(n)] = q;
+            lse_[r] = q;
             mx = std::max(mx, q);
+            n += id.runs[r];
         }
         double sum = 0.0;
-        for (double q : lse_) sum += std::exp(q - mx);
+        for (size_t r = 0; r < id.runs.size(); ++r) {
+            const double e = std::exp(lse_[r] - mx);
+            for (Index j = 0; j < id.runs[r]; ++j) sum += e;
+        }
         return norm + mx + std::log(sum);
     }
 
@@ -277,12 +304,17 @@ public:
         return prm_.detection * best;
     }
 
-    /// The single-object term of log pi (-inf outside the scale bounds).
-    double unary(int slot, const double* x) {
-        const double lp = log_prior_pos(slot, x);
+    /// The single-object term of log pi (-inf outside the scale bounds), given lp = log P_slot(x).
+    double unary(int slot, const double* x, double lp) {
         if (!std::isfinite(lp)) return kNegInf;
         return log_colour(slot, x) + lp + ids_[static_cast<size_t>(slot)].log_omega +
                coverage_of(box(slot, x)) + detection_of(slot, x);
+    }
+
+    /// Fills o's cached terms (unary and log_prior) for its slot and state.
+    void score(RjObject& o) {
+        o.log_prior = log_prior_pos(o.slot, o.x);
+        o.unary = unary(o.slot, o.x, o.log_prior);
     }
 
     /// The pairwise term of log pi for two objects.
@@ -296,7 +328,7 @@ public:
     }
 
     void fill_unary(RjConfig& c) {
-        for (RjObject& o : c) o.unary = unary(o.slot, o.x);
+        for (RjObject& o : c) score(o);
     }
 
     /// log pi(X) from the cached unary terms.
@@ -335,7 +367,8 @@ public:
     }
 
     /// log r of the move X -> Xp (before min(1, .)); `slot` is the object born / killed / updated,
-    /// unused for a swap. Both configurations must have their unary terms filled.
+    /// unused for a swap. Both configurations must have their cached terms filled (score): the
+    /// P_o terms are the objects' log_prior, computed once per proposed state.
     double log_acceptance_ratio(RjMove m, const RjConfig& x, const RjConfig& xp, int slot) const {
         const double lt = log_target(x), ltp = log_target(xp);
         if (!std::isfinite(ltp)) return kNegInf;
@@ -344,20 +377,20 @@ public:
         switch (m) {
             case RjMove::kBirth: {
                 // r_birth = pi(X') p_d (1/|X'|) / [pi(X) p_b q_b(o|X) P_o(x)]
-                const double lpo = log_prior_pos(slot, find(xp, slot).x);
+                const double lpo = find(xp, slot).log_prior;
                 return ltp - lt + lpd - std::log(static_cast<double>(xp.size())) -
                        (lpb + log_birth_choice(slot, x) + lpo);
             }
             case RjMove::kDeath: {
                 // r_death = pi(X') p_b q_b(o|X') P_o(x_o) / [pi(X) p_d (1/|X|)]
-                const double lpo = log_prior_pos(slot, find(x, slot).x);
+                const double lpo = find(x, slot).log_prior;
                 return ltp - lt + lpb + log_birth_choice(slot, xp) + lpo -
                        (lpd - std::log(static_cast<double>(x.size())));
             }
             case RjMove::kUpdate: {
                 // r_update = pi(X') p_u (1/|X|) P_o(x_o) / [pi(X) p_u (1/|X|) P_o(x*)]
-                const double lq_rev = log_prior_pos(slot, find(x, slot).x);
-                const double lq_fwd = log_prior_pos(slot, find(xp, slot).x);
+                const double lq_rev = find(x, slot).log_prior;
+                const double lq_fwd = find(xp, slot).log_prior;
                 return ltp - lt + lq_rev - lq_fwd;
             }
             case RjMove::kSwap:
@@ -418,7 +451,7 @@ public:
                 RjObject o;
                 o.slot = slot;
                 draw_state(slot, u2, w, o.x, o.prev);
-                o.unary = unary(slot, o.x);
+                score(o);
                 out = c;
                 out.insert(std::upper_bound(out.begin(), out.end(), o,
                                             [](const RjObject& a, const RjObject& b) { return a.slot < b.slot; }),
@@ -439,7 +472,7 @@ public:
                 slot = c[j].slot;
                 out = c;
                 draw_state(slot, u2, w, out[j].x, out[j].prev);
-                out[j].unary = unary(slot, out[j].x);
+                score(out[j]);
                 return true;
             }
             case RjMove::kSwap: {
@@ -457,8 +490,8 @@ public:
                     std::swap(out[a].x[d], out[b].x[d]);
                     std::swap(out[a].prev[d], out[b].prev[d]);
                 }
-                out[a].unary = unary(out[a].slot, out[a].x);
-                out[b].unary = unary(out[b].slot, out[b].x);
+                score(out[a]);
+                score(out[b]);
                 slot = out[a].slot;
                 return true;
             }
@@ -587,6 +620,7 @@ public:
                     id.mu(n, d) = m.a[d] * t.parents(n, d) + m.b[d] * t.parents(n, 3 + d);
                     mean[d] += id.mu(n, d);
                 }
+            id.runs = equal_row_runs(id.mu);
             mean /= static_cast<double>(std::max<Index>(1, t.parents.rows()));
             const double s = std::clamp(mean[2], m.s_min, m.s_max);
             id.anchor[0] = mean[0];

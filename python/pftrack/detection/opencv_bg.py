@@ -43,9 +43,9 @@ class Mog2Config:
     Raises
     ------
     TypeError
-        `var_threshold` or `learning_rate` not a number.
+        `var_threshold` or `learning_rate` not a number, `history` not an int (a bool).
     ValueError
-        A setting out of its range above (NaN included; `history` not an int, a bool).
+        A setting out of its range above (NaN included).
     """
 
     history: int = 500
@@ -76,9 +76,9 @@ class KnnConfig:
     Raises
     ------
     TypeError
-        `dist2_threshold` or `learning_rate` not a number.
+        `dist2_threshold` or `learning_rate` not a number, `history` not an int (a bool).
     ValueError
-        A setting out of its range above (NaN included; `history` not an int, a bool).
+        A setting out of its range above (NaN included).
     """
 
     history: int = 500

@@ -160,7 +160,7 @@ def box_histograms(
     ------
     TypeError
         `image` is not a :class:`BinnedImage` (the frame itself: bin it with
-        :func:`hsv_bins`), or the boxes are not real numbers.
+        :func:`hsv_bins`), the boxes are not real numbers, `kernel` is not a string.
     ValueError
         Boxes not of shape (K, 4) (an empty list is 0 boxes), a value not finite or beyond
         ±1e9 px, a negative width or height, an unknown kernel.
@@ -180,6 +180,11 @@ def box_histograms(
     error = not_binned(image, f"{fn}: image")
     if error is not None:
         raise error
+    if not isinstance(kernel, str):  # pybind11 would list its signatures
+        raise TypeError(
+            f"{fn}: kernel must be 'uniform' or 'epanechnikov', got {type(kernel).__name__} "
+            f"{kernel!r}"
+        )
     return _core.box_histograms(image, _boxes(boxes_cxcywh, fn), kernel)
 
 

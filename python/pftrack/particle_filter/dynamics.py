@@ -216,7 +216,39 @@ def _particles_error(particles: object, fn: str) -> TypeError | ValueError | Non
 def estimate(
     particles: ArrayLike, weights: ArrayLike
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Weighted mean and maximum-weight (eq. 2) estimates of ``(cx, cy, s)``."""
-    p = np.ascontiguousarray(particles, dtype=np.float64)
-    mean, map_, _ = _core.estimate(p, np.asarray(weights, dtype=np.float64))
+    """Weighted mean and maximum-weight (eq. 2) estimates of ``(cx, cy, s)``.
+
+    Parameters
+    ----------
+    particles : (N, 6) array_like of float
+        One row ``(cx, cy, s, previous cx, cy, s)`` per particle, N >= 1.
+    weights : (N,) array_like of float
+        One weight per particle: finite, >= 0, not all 0 (need not be normalised).
+
+    Returns
+    -------
+    mean, map : (3,) ndarray
+        The weighted mean of ``(cx, cy, s)``, and the maximum-weight particle's.
+
+    Raises
+    ------
+    TypeError
+        `particles` or `weights` not real numbers (text, objects).
+    ValueError
+        `particles` not of shape (N, 6) with N >= 1, `weights` not (N,); a weight negative or
+        not finite, or all 0.
+    """
+    fn = "estimate"
+    p = np.ascontiguousarray(real_array(particles, f"{fn}: particles", booleans=False))
+    if p.ndim != 2 or p.shape[1] != 6 or p.shape[0] == 0:
+        raise ValueError(
+            f"{fn}: particles shape is {p.shape}, expected (N, 6) with N >= 1: one row "
+            "(cx, cy, s, previous cx, cy, s) per particle"
+        )
+    w = np.ascontiguousarray(real_array(weights, f"{fn}: weights"))
+    if w.shape != (len(p),):
+        raise ValueError(
+            f"{fn}: weights shape is {w.shape}, expected ({len(p)},): one weight per particle"
+        )
+    mean, map_, _ = _core.estimate(p, w)
     return mean, map_

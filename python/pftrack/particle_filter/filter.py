@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -54,6 +56,15 @@ class FilterConfig:
         pixels on. The default 2048 keeps more pixels per box than a walker of PETS09-S2L1
         (about 30x80 at 480x360) has in full, so those boxes are counted in full. 0 counts
         every pixel of every box.
+
+    Raises
+    ------
+    TypeError
+        `n_particles` or `min_samples` not an int (a string, a float, a bool), `lam` not a
+        number.
+    ValueError
+        `n_particles` not in [1, 1000000], `min_samples` negative, `lam` not finite and >= 0,
+        an unknown `kernel` or `estimate`.
     """
 
     n_particles: int = 100
@@ -170,6 +181,50 @@ def _spread(spread: object, model: Ar2Model) -> float:
     return s
 
 
+def _in_use(owner: object, method: str, what: str | None = None) -> RuntimeError:
+    """The error of a second thread that would use `owner` while another thread is inside it.
+
+    Worded as :class:`pftrack.Tracker`'s: ``ColourParticleFilter.step: this
+    ColourParticleFilter is in use by another thread (...)``; `what` names the object otherwise
+    (``step_filters: filters[1] is in use ...``).
+    """
+    kind = type(owner).__name__
+    return RuntimeError(
+        f"{method}: {what or f'this {kind}'} is in use by another thread (use one {kind} per "
+        "thread, or a lock around it)"
+    )
+
+
+def _take(filters: Sequence[ColourParticleFilter], fn: str) -> None:
+    """Take every filter's lock without waiting, or none of them (RuntimeError naming `fn`).
+
+    A step runs in the core without the GIL and updates the filter's arrays in place: a second
+    thread inside the same filter would mix two steps' particles and reuse a step number.
+    """
+    for k, f in enumerate(filters):
+        if not f._busy.acquire(blocking=False):
+            for g in filters[:k]:
+                g._busy.release()
+            raise _in_use(f, fn, f"filters[{k}]")
+
+
+def _release(filters: Sequence[ColourParticleFilter]) -> None:
+    for f in filters:
+        f._busy.release()
+
+
+def _once(filters: Sequence[object], fn: str) -> None:
+    """Each filter at most once in `filters` (a repeat would step it twice on the same arrays)."""
+    seen: dict[int, int] = {}
+    for k, f in enumerate(filters):
+        j = seen.setdefault(id(f), k)
+        if j != k:
+            raise ValueError(
+                f"{fn}: filters[{k}] is filters[{j}], the same filter twice (each filter steps "
+                "once per frame)"
+            )
+
+
 def _step_argument_error(image: object, *filters: ColourParticleFilter) -> TypeError | None:
     """What the core could not take in a step of `filters` on `image` (None: nothing found).
 
@@ -267,6 +322,7 @@ class ColourParticleFilter:
                 f"{type(binning).__name__} {binning!r}"
             )
         self.config = config if config is not None else FilterConfig()
+        self._busy = threading.Lock()  # held by a step (one thread at a time; see _in_use)
         self._rng = generator(rng, "rng")
         self._seed = int(self._rng.integers(2**63))
         self._step = 0
@@ -285,6 +341,21 @@ class ColourParticleFilter:
         self._last: FilterState | None = None  # see last
         # (row of sis_step_batch's output, the estimate's column, w0, h0) not yet made a state
         self._last_row: tuple[list[float], int, float, float] | None = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The filter's state for pickle and ``copy`` (not while another thread steps it)."""
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, f"{type(self).__name__}.__getstate__")
+        try:
+            state = self.__dict__.copy()
+        finally:
+            self._busy.release()
+        del state["_busy"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._busy = threading.Lock()
 
     @property
     def last(self) -> FilterState | None:
@@ -364,11 +435,22 @@ class ColourParticleFilter:
         ValueError
             A box or velocity the filter cannot follow (see the class), a spread < 0, NaN,
             infinite or above ``1e6 / model.sigma_xy``.
+        RuntimeError
+            Another thread is inside this filter's ``step`` or ``reinitialise``.
         """
         b = _box(box_cxcywh)
-        v = self.velocity if velocity is None else _velocity(velocity)
+        v = None if velocity is None else _velocity(velocity)
+        spread = _spread(spread, self.config.model)
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, f"{type(self).__name__}.reinitialise")
+        try:
+            self._reseed(b, self.velocity if v is None else v, spread)
+        finally:
+            self._busy.release()
+
+    def _reseed(self, b: F64, v: F64, spread: float) -> None:
+        """:meth:`reinitialise` of checked arguments, the filter's lock held."""
         m = self.config.model
-        spread = _spread(spread, m)
         s = math.sqrt(float((b[2] / self.w0) * (b[3] / self.h0)))
         s = min(max(s, m.s_min), m.s_max)  # np.clip's value, without its call overhead
         n = self.config.n_particles
@@ -407,30 +489,38 @@ class ColourParticleFilter:
             float64, not C-contiguous, read-only).
         ValueError
             Arrays of the wrong shape, non-finite particles.
+        RuntimeError
+            Another thread is inside this filter's ``step`` or ``reinitialise`` (one filter
+            in one thread at a time: the step updates the arrays in place without the GIL).
         """
         m = self.config.model
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, f"{type(self).__name__}.step")
         try:
-            r = _core.sis_step(
-                self.particles, self.weights, self.means, image, self.reference,
-                self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-                self.config.lam, self.config.kernel, True, self._seed, self._step,
-                float(self.config.min_samples),
-            )  # fmt: skip
-        except TypeError:
-            error = _step_argument_error(image, self)
-            if error is None:
-                raise
-            raise error from None
-        self._step += 1
-        cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
-        state = FilterState(
-            box_cxcywh=np.array([cx, cy, s * self.w0, s * self.h0]),
-            rho=float(r["rho_mean"]),
-            rho_max=float(r["rho_max"]),
-            ess=float(r["ess"]),
-            foreground=float(r["fg_mean"]),
-        )
-        self.last = state
+            try:
+                r = _core.sis_step(
+                    self.particles, self.weights, self.means, image, self.reference,
+                    self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+                    self.config.lam, self.config.kernel, True, self._seed, self._step,
+                    float(self.config.min_samples),
+                )  # fmt: skip
+            except TypeError:
+                error = _step_argument_error(image, self)
+                if error is None:
+                    raise
+                raise error from None
+            self._step += 1
+            cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
+            state = FilterState(
+                box_cxcywh=np.array([cx, cy, s * self.w0, s * self.h0]),
+                rho=float(r["rho_mean"]),
+                rho_max=float(r["rho_max"]),
+                ess=float(r["ess"]),
+                foreground=float(r["fg_mean"]),
+            )
+            self.last = state
+        finally:
+            self._busy.release()
         return state
 
 
@@ -456,6 +546,16 @@ def step_filters(
     -------
     list of FilterState
         One per filter, in order.
+
+    Raises
+    ------
+    TypeError
+        An element that is not a ColourParticleFilter.
+    ValueError
+        The same filter twice in `filters`.
+    RuntimeError
+        Another thread is inside one of the filters (``step_filters: filters[k] is in use by
+        another thread``); then no filter has stepped.
     """
     step_filters_summary(filters, image)
     return [f.last for f in filters if f.last is not None]
@@ -481,6 +581,7 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
             raise TypeError(
                 f"step_filters: filters[{k}] is {type(f).__name__}, expected a ColourParticleFilter"
             )
+    _once(filters, "step_filters")
     cfg = filters[0].config
     batch = [
         k
@@ -489,28 +590,18 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
     ]
     if batch:
         fs = [filters[k] for k in batch]
-        m = cfg.model
-        try:
-            out = _core.sis_step_batch(
-                [f.particles for f in fs], [f.weights for f in fs], [f.means for f in fs],
-                image, [f.reference for f in fs], np.array([f.w0 for f in fs]),
-                np.array([f.h0 for f in fs]), m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-                cfg.lam, cfg.kernel, True, [f._seed for f in fs], [f._step for f in fs],
-                float(cfg.min_samples),
-            )  # fmt: skip
-        except TypeError:
-            error = _step_argument_error(image, *fs)
-            if error is None:
-                raise
-            raise error from None
         col = 3 if cfg.estimate == "map" else 0
+        _take(fs, "step_filters")
+        try:
+            out = _step_batch(fs, cfg, image)
+            for f, row in zip(fs, out.tolist(), strict=True):
+                f._last, f._last_row = None, (row, col, f.w0, f.h0)
+        finally:
+            _release(fs)
         at = slice(None) if len(batch) == len(filters) else batch
         summary[at, 0:2] = out[:, col : col + 2]
         summary[at, 2] = out[:, 9]
         summary[at, 3] = out[:, 8]
-        for f, row in zip(fs, out.tolist(), strict=True):
-            f._step += 1
-            f._last, f._last_row = None, (row, col, f.w0, f.h0)
     if len(batch) < len(filters):
         done = set(batch)
         for k, f in enumerate(filters):
@@ -518,6 +609,29 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
                 st = f.step(image)
                 summary[k] = (st.box_cxcywh[0], st.box_cxcywh[1], st.rho, st.rho_max)
     return summary
+
+
+def _step_batch(
+    fs: Sequence[ColourParticleFilter], cfg: FilterConfig, image: _core.BinnedImage
+) -> F64:
+    """``sis_step_batch`` of filters of configuration `cfg`, their locks held; counts the step."""
+    m = cfg.model
+    try:
+        out: F64 = _core.sis_step_batch(
+            [f.particles for f in fs], [f.weights for f in fs], [f.means for f in fs],
+            image, [f.reference for f in fs], np.array([f.w0 for f in fs]),
+            np.array([f.h0 for f in fs]), m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+            cfg.lam, cfg.kernel, True, [f._seed for f in fs], [f._step for f in fs],
+            float(cfg.min_samples),
+        )  # fmt: skip
+    except TypeError:
+        error = _step_argument_error(image, *fs)
+        if error is None:
+            raise
+        raise error from None
+    for f in fs:
+        f._step += 1
+    return out
 
 
 def reinitialise_filters(
@@ -552,6 +666,8 @@ def reinitialise_filters(
         Not one box (K, 4) and one velocity (K, 2) per filter, each as
         :meth:`ColourParticleFilter.reinitialise` takes it; a spread it refuses (< 0, NaN,
         infinite, above ``1e6 / model.sigma_xy``).
+    RuntimeError
+        Another thread is inside one of the filters; then no filter has been re-seeded.
     """
     k = len(filters)
     b = real_array(boxes_cxcywh, "boxes_cxcywh")
@@ -568,15 +684,30 @@ def reinitialise_filters(
     if bad_v.any():
         _velocity(v[int(np.flatnonzero(bad_v)[0])])  # raises, naming the velocity
     cfg = filters[0].config
-    if not all(f.config is cfg or f.config == cfg for f in filters):
+    one_config = all(f.config is cfg or f.config == cfg for f in filters)
+    if not one_config:
         for f in filters:  # every filter's own bound, before any is re-seeded
             _spread(spread, f.config.model)
-        for f, box, vel in zip(filters, b, v, strict=True):
-            f.reinitialise(box, velocity=vel, spread=spread)
-        return
     bad = ~((np.abs(b) < MAX_COORD).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0))
     if bad.any():
         _box(b[int(np.flatnonzero(bad)[0])])  # raises, naming the box
+    held = list({id(f): f for f in filters}.values())  # a filter given twice: one lock
+    _take(held, "reinitialise_filters")
+    try:
+        if one_config:
+            _reseed_batch(filters, cfg, b, v, spread)
+        else:
+            for f, box, vel in zip(filters, b, v, strict=True):
+                f._reseed(box, vel, spread)
+    finally:
+        _release(held)
+
+
+def _reseed_batch(
+    filters: Sequence[ColourParticleFilter], cfg: FilterConfig, b: F64, v: F64, spread: float
+) -> None:
+    """:func:`reinitialise_filters` of checked arguments, one configuration, the locks held."""
+    k = len(filters)
     m = cfg.model
     n = cfg.n_particles
     w0 = np.array([f.w0 for f in filters])

@@ -24,6 +24,7 @@ from pftrack.particle_filter.filter import (
     ColourParticleFilter,
     FilterConfig,
     FilterState,
+    _in_use,
     _step_argument_error,
 )
 
@@ -47,11 +48,12 @@ class MHColourParticleFilter(ColourParticleFilter):
 
     Raises
     ------
-    ValueError
-        `n_iter` not an int (a bool, a float) in [1, 2147483647]; else as
-        :class:`~pftrack.particle_filter.ColourParticleFilter`.
     TypeError
-        As :class:`~pftrack.particle_filter.ColourParticleFilter`.
+        `n_iter` not an int (a string, a float, a bool); else as
+        :class:`~pftrack.particle_filter.ColourParticleFilter`.
+    ValueError
+        `n_iter` not in [1, 2147483647]; else as
+        :class:`~pftrack.particle_filter.ColourParticleFilter`.
 
     Attributes
     ----------
@@ -81,25 +83,40 @@ class MHColourParticleFilter(ColourParticleFilter):
         self.acceptance = float("nan")
 
     def step(self, image: _core.BinnedImage) -> FilterState:
-        """Advance one frame with MH moves; records ``acceptance``."""
+        """Advance one frame with MH moves; records ``acceptance``.
+
+        Raises as :meth:`ColourParticleFilter.step
+        <pftrack.particle_filter.ColourParticleFilter.step>` (RuntimeError: another thread is
+        inside this filter).
+        """
         m = self.config.model
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, f"{type(self).__name__}.step")
         try:
-            r = _core.mh_step(
-                self.particles, self.weights, self.means, image, self.reference,
-                self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-                self.config.lam, self.config.kernel, True, self._seed, self._step,
-                n_iter=self.n_iter, burn_in=0, proposal="dynamics",
-                rw_sigma=np.array([2.0, 2.0, 0.01]),
-            )  # fmt: skip
-        except TypeError:  # as ColourParticleFilter.step: say which argument
-            error = _step_argument_error(image, self)
-            if error is None:
-                raise
-            raise error from None
-        self._step += 1
-        self.acceptance = float(r["acceptance"])
-        cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
-        state = FilterState(np.array([cx, cy, s * self.w0, s * self.h0]), float(r["rho_mean"]),
-                            float(r["rho_max"]), float(r["ess"]), float(r["fg_mean"]))  # fmt: skip
-        self.last = state
+            try:
+                r = _core.mh_step(
+                    self.particles, self.weights, self.means, image, self.reference,
+                    self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+                    self.config.lam, self.config.kernel, True, self._seed, self._step,
+                    n_iter=self.n_iter, burn_in=0, proposal="dynamics",
+                    rw_sigma=np.array([2.0, 2.0, 0.01]),
+                )  # fmt: skip
+            except TypeError:  # as ColourParticleFilter.step: say which argument
+                error = _step_argument_error(image, self)
+                if error is None:
+                    raise
+                raise error from None
+            self._step += 1
+            self.acceptance = float(r["acceptance"])
+            cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
+            state = FilterState(
+                np.array([cx, cy, s * self.w0, s * self.h0]),
+                float(r["rho_mean"]),
+                float(r["rho_max"]),
+                float(r["ess"]),
+                float(r["fg_mean"]),
+            )
+            self.last = state
+        finally:
+            self._busy.release()
         return state

@@ -504,8 +504,8 @@ def calibrate(
     Raises
     ------
     TypeError
-        A `seed` that is not an int, a `combine` that is not a bool, `observed` that is not a
-        sequence of arrays of real numbers.
+        A `seed`, gap length, context, `max_gaps` or `bags` that is not an int, a `combine`
+        that is not a bool, `observed` that is not a sequence of arrays of real numbers.
     ValueError
         A gap length or context that is not an integer >= 1, `max_gaps` not an integer >= 1,
         `bags` not None or an integer >= 0 (or > 0 with ``combine=False``), a negative `seed`,

@@ -291,6 +291,11 @@ def sample_goal_directed_paths(
     Arguments as :func:`goal_directed_path`, and its errors (named
     ``sample_goal_directed_paths``); `n_samples` is an int in [1, 2**31 - 1]. `rng` gives one
     63-bit seed for the C++ counter-based generator, so results do not depend on thread count.
+
+    The paths are distributed as :func:`goal_directed_path` with the same `start_conditioned`
+    describes them (mean ``path[t]``, covariance ``cov[t]``): ``x_0 ~ N(E[x_0 | y_T],
+    cov(x_0 | y_T))``, or ``x_0 ~ N(m0, Pi_0)`` when not `start_conditioned`, then
+    ``x_t = A_t x_{t-1} + u_t + eps_t``.
     """
     fn = "sample_goal_directed_paths"
     T = _check_T(T, fn)

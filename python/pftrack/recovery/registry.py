@@ -219,7 +219,8 @@ def recover_gaps(
     Raises
     ------
     TypeError
-        A `seed` that is not an int, `noise` not a NoiseEstimate or `motion` not a MotionFit.
+        A `seed` or `history` that is not an int, `noise` not a NoiseEstimate or `motion` not
+        a MotionFit.
     ValueError
         An unknown method, a gap that is not a pair of segments, segments :func:`recover_gap`
         refuses, whatever the method (the message names the gap), a negative `seed`, or

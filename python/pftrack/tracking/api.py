@@ -289,7 +289,9 @@ class Tracker:
         Particle filter per object (sis, the paper's; mh) or one joint RJ-MCMC chain.
     particles : int or None
         Particles per object. None: 200 for tracks born from given detections, 100 for the
-        built-in detector's (``TrackerConfig.given_particles``).
+        built-in detector's (``TrackerConfig.given_particles``). With ``sampler="rjmcmc"``,
+        the joint chain's kept samples N, whose cost per frame grows as N² (about 8 ms at
+        2000 and 0.15 s at 10000 with 5 objects; ``pftrack track`` takes at most 10000).
     dynamics : {"ar2", "ar2-mean"}
         AR(2) model per particle, or from the particle-set means.
     max_coast : float or None

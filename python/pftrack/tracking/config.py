@@ -60,9 +60,22 @@ def _in_unit_interval(owner: str, **values: float) -> None:
 
 
 def _integers_at_least(owner: str, lo: int, config: object, *names: str) -> None:
+    """Each field an int >= `lo`: TypeError for another type (as ``_check.integer``).
+
+    Raises
+    ------
+    TypeError
+        A field that is not an int (a float, a string, a bool).
+    ValueError
+        An int < `lo`.
+    """
     for name in names:
         v = getattr(config, name)
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
+            raise TypeError(
+                f"{owner}: {name} must be an integer >= {lo}, got {type(v).__name__} {v!r}"
+            )
+        if v < lo:
             raise ValueError(f"{owner}: {name} is {v!r}, expected an integer >= {lo}")
 
 
