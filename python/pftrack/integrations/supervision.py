@@ -50,6 +50,7 @@ class TrackerOptions(TypedDict, total=False):
     crossings: bool
     prime: float | None
     max_side: int | None
+    record: bool
 
 
 def _detections_class() -> Any:

@@ -330,11 +330,16 @@ class Tracker:
         Working resolution (:attr:`TrackerConfig.max_side`): larger frames are scaled down to
         this longer side for detection and tracking; boxes in and out stay in the frame's
         pixels, in [64, 100000]. None or 0 (as ``--max-side 0``): the frame's own size.
+    record : bool
+        Keep every online row for :meth:`finalize`'s offline pass (the default). False: a
+        purely online tracker for an unbounded stream, whose memory stays flat: ``update``
+        returns the same tracks, nothing is kept, and :meth:`finalize` and
+        :meth:`settled_rows` raise RuntimeError.
 
     Raises
     ------
     TypeError
-        A flag (`refine`, `smooth`, `link`, `crossings`) that is not ``True`` or ``False``
+        A flag (`refine`, `smooth`, `link`, `crossings`, `record`) that is not ``True`` or ``False``
         (``refine="no"`` would turn refinement on), a `frame_rate`, `max_coast`, `prime`,
         `min_conf` or `birth_score` that is not a number, a `seed` that is not an int.
     ValueError
@@ -357,9 +362,10 @@ class Tracker:
     Memory grows with the run: every online row is kept until :meth:`finalize` (its offline
     pass needs the whole run), about 0.2 KB a row (measured with ``tracemalloc`` on a
     synthetic scene: some 19 MB per person tracked for an hour at 25 frames/s). For an
-    unbounded stream, read :meth:`settled_rows` from the last :attr:`n_settled` as you go,
-    and end a segment now and then with :meth:`finalize` and :meth:`reset`, which frees the
-    rows (ids and frame numbers start again; tracks are not linked across segments):
+    unbounded stream, either track online only (``record=False``: nothing is kept, no
+    offline pass), or read :meth:`settled_rows` from the last :attr:`n_settled` as you go and
+    end a segment now and then with :meth:`finalize` and :meth:`reset`, which frees the rows
+    (ids and frame numbers start again; tracks are not linked across segments):
     docs/robustness.md, "Memory of a long Tracker run".
 
     Examples
@@ -378,6 +384,9 @@ class Tracker:
     #: the evidence of x, y, w, h rows (:func:`check_boxes_xyxy`). A class default for a
     #: checkpoint pickled before it was kept.
     _layout: tuple[int, int] = (0, 0)
+    #: Whether the run keeps its rows for :meth:`finalize` (the constructor's `record`; a class
+    #: default for a checkpoint pickled before it was an option).
+    record: bool = True
 
     def __init__(
         self,
@@ -400,6 +409,7 @@ class Tracker:
         crossings: bool = CrossingConfig.enabled,
         prime: float | None = None,
         max_side: int | None = TrackerConfig.max_side,
+        record: bool = True,
     ) -> None:
         if seed is not None:
             seed = check_seed(seed, "seed")
@@ -407,9 +417,9 @@ class Tracker:
             raise ValueError(
                 f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
             )
-        refine, smooth, link, crossings = (
+        refine, smooth, link, crossings, record = (
             flag(refine, "refine"), flag(smooth, "smooth"), flag(link, "link"),
-            flag(crossings, "crossings"),
+            flag(crossings, "crossings"), flag(record, "record"),
         )  # fmt: skip
         if crossings and not smooth:  # as the CLI refuses --crossings on --no-smooth
             raise ValueError(
@@ -457,6 +467,7 @@ class Tracker:
             smoother=BoxSmoother() if smooth else None,
             link=link_config if link else None,
             prime_frames=PRIME_FRAMES if prime is None else _frames(prime, frame_rate, "prime"),
+            record=record,
         )
 
     @classmethod
@@ -505,7 +516,7 @@ class Tracker:
 
     def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: float, fill: str,
                smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: int,
-               coasting: str = "confirmed") -> None:  # fmt: skip
+               coasting: str = "confirmed", record: bool = True) -> None:  # fmt: skip
         if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
             raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")
         if not isinstance(prime_frames, (int, np.integer)) or prime_frames < 0:
@@ -514,6 +525,7 @@ class Tracker:
         self.frame_rate = frame_rate
         self.seed = seed
         self.prime_frames = int(prime_frames)
+        self.record = record
         self._writer_args = (coasting, fill, smoother, link)
         TrackWriter(*self._writer_args)  # check the writer's options now
         self._busy = threading.Lock()
@@ -830,9 +842,10 @@ class Tracker:
             self.frame_count += 1
             if first:  # the run's size, once its first frame is taken
                 self._shape = f.shape
-            # the offline pass sees a still camera: boxes in the first frame's coordinates
-            self._stabiliser.add(self._tracker.camera_step.apply)
-            self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
+            if self.record:
+                # the offline pass sees a still camera: boxes in the first frame's coordinates
+                self._stabiliser.add(self._tracker.camera_step.apply)
+                self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
             self._reports = reports
             # coasting tracks (carried by the particle filter alone) are held back
             live = [t for t in reports if t.time_since_update == 0]
@@ -869,10 +882,19 @@ class Tracker:
 
         These are the rows before the offline pass (no linking or smoothing): a live source
         writes them as they come. A gap bridged by a particle filter is settled when the track
-        is detected again.
+        is detected again. RuntimeError with ``record=False``, which keeps none.
         """
+        self._check_recorded("settled_rows")
         rows = self._writer.rows.arrays(start)[0]
         return self._restore_rows(self._stabiliser.restore(rows))
+
+    def _check_recorded(self, method: str) -> None:
+        if not self.record:
+            raise RuntimeError(
+                f"Tracker.{method}: this tracker was made with record=False, which keeps no "
+                "rows (an online tracker: use update()'s output; record=True for the offline "
+                "pass)"
+            )
 
     def _no_track_cause(self, n_tracked: int) -> str:
         """Why :meth:`finalize` has no row: the first cause that holds, in the run's order."""
@@ -935,7 +957,13 @@ class Tracker:
             :attr:`classes` maps each id of the rows to its class (the ``cls`` column of the
             detections its track was made of; the offline pass renumbers ids, and never joins
             two classes).
+
+        Raises
+        ------
+        RuntimeError
+            The tracker was made with ``record=False`` (it kept no rows to pass over).
         """
+        self._check_recorded("finalize")
         with self._alone("finalize"):
             smoothed = self._writer_args[2] is not None
             crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
