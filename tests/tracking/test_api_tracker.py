@@ -426,6 +426,24 @@ def test_detections_in_a_smaller_frames_pixels_are_said(scene):
         track_frames(frames, detections={n: v for n, v in xywh.items() if n <= 20}, rng=0)
 
 
+def test_detections_in_a_larger_frames_pixels_are_refused(scene):
+    """Was a warning only: PETS09's 768x576 det.txt on its 480x360 video, without --det-scale,
+    lost half its boxes (wholly outside the frame) and clipped the others, exit 0."""
+    d = scene_dets(scene)
+    xywh = {n: np.column_stack([v[:, :2], v[:, 2:4] - v[:, :2], v[:, 4:]]) for n, v in
+            enumerate(d, start=1) if len(v)}  # fmt: skip
+    large = {n: np.column_stack([v[:, :4] * 2.0, v[:, 4:]]) for n, v in xywh.items()}
+    with pytest.raises(ValueError, match=r"wholly outside the 480x360 frames .* about 0\.5"):
+        track_frames(scene.frames, detections=large, rng=0)
+    # a few boxes past the edge (a detector's boxes of people leaving) are no such evidence
+    few = {n: v.copy() for n, v in xywh.items()}
+    for v in list(few.values())[:5]:
+        v[0, 0] = 500.0
+    with pytest.warns(UserWarning, match="clipped"):
+        run = track_frames(scene.frames[:10], detections={n: v for n, v in few.items() if n <= 10})
+    assert run.n_frames == 10
+
+
 def test_boxes_outside_the_frame_are_clipped_once(scene):
     frame = scene.frames[0]
     h, w = frame.shape[:2]

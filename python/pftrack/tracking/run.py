@@ -285,11 +285,18 @@ def _check_last_frame(detections: dict[int, F64], n_frames: int) -> None:
 SMALL_LAYOUT_BOXES = 20  # boxes a file needs before its extent says anything about its pixels
 
 
+#: Share of a file's boxes wholly outside the frame that says they are a larger frame's pixels.
+OUTSIDE_SHARE = 0.1
+
+
 def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
-    """Refuse x1, y1, x2, y2 boxes given as left, top, w, h; warn about a smaller frame's boxes.
+    """Refuse x1, y1, x2, y2 boxes as left, top, w, h and a larger frame's; warn of a smaller's.
 
     Decided on the whole file: more than half of the boxes, read as ``left, top, w, h``, reach
     past the frame's right or bottom edge, while every box read as ``x1, y1, x2, y2`` lies in it.
+    A larger frame's pixels: at least :data:`SMALL_LAYOUT_BOXES` boxes, more than
+    :data:`OUTSIDE_SHARE` of them wholly outside the frame (the tracker would drop them and
+    clip the rest: PETS09's 768x576 det.txt on its 480x360 video loses half its boxes so).
     The warning: at least :data:`SMALL_LAYOUT_BOXES` boxes, and none reaches past half the
     frame's width or height (boxes too large for the frame are clipped, with a warning, by
     the tracker).
@@ -307,6 +314,15 @@ def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
             f"of the {cols}x{rows} frames: are they in a smaller frame's pixels? (scale them "
             "with --det-scale / load_detections(scale=...))",
             stacklevel=3,
+        )
+    outside = (d[:, 0] >= cols) | (d[:, 1] >= rows)
+    if len(d) >= SMALL_LAYOUT_BOXES and outside.mean() > OUTSIDE_SHARE and not as_xyxy.all():
+        scale = min(cols / right, rows / bottom)
+        raise ValueError(
+            f"{outside.sum()} of {len(d)} detection boxes lie wholly outside the {cols}x{rows} "
+            f"frames (they reach {right:.0f}x{bottom:.0f}): are they in a larger frame's "
+            f"pixels? Scale them with --det-scale / load_detections(scale=...), about "
+            f"{scale:.3g} here"
         )
     if past.mean() > 0.5 and as_xyxy.all():
         raise ValueError(
