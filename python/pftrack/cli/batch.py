@@ -108,6 +108,35 @@ def is_batch(paths: list[str]) -> bool:
     return len(paths) > 1 or any(Path(p).is_dir() for p in paths)
 
 
+def _as_batch(command: str, paths: list[str], out: str, where: dict[str, Any]) -> None:
+    """Say why `command` runs as a batch before its batch-only errors (folder out, Dask).
+
+    A folder given where one tracks file was meant (``pftrack recover SEQ --out f.txt``) ran
+    a batch: with ``--out f.txt`` it made a folder named like a file, and without Dask the
+    user read about Dask, not about the folder.
+    """
+    if len(paths) == 1 and Path(paths[0]).is_dir():
+        why = f"{paths[0]} is a folder: pftrack {command} runs the tracks files in it"
+    else:
+        why = f"{len(paths)} inputs: pftrack {command} runs them"
+    if Path(out).suffix.lower() == ".txt" and not Path(out).is_dir():
+        raise ValueError(
+            f"{why} as a batch, whose --out is a folder for one output per file, not {out}; "
+            f"give one tracks file for --out {out}"
+        )
+    if where.get("n_workers") != 0:
+        from pftrack.batch.engine import _require_dask
+
+        try:
+            _require_dask()
+        except ImportError as exc:
+            raise ValueError(
+                f"{why} as a batch, on Dask by default, which cannot be imported "
+                f"({exc.name}): pip install 'pftrack[dask]', or --workers 0 to run them one "
+                "after another in this process"
+            ) from exc
+
+
 def add_parser(sub: Any) -> None:
     """Register ``batch`` on `sub` (from ``add_subparsers``)."""
     p = add_command(
@@ -244,6 +273,7 @@ def run_recover(args: argparse.Namespace) -> int:
         max_distance=args.max_distance,
     )
     where = _where(args)
+    _as_batch("recover", args.tracks, args.out, where)
     return _run(
         "recover",
         lambda: recover_many(args.tracks, args.out, options=options, **where),
@@ -259,4 +289,5 @@ def run_smooth(args: argparse.Namespace) -> int:
         max_gap=args.max_gap, link=not args.no_link, max_distance=args.max_distance
     )
     where = _where(args)
+    _as_batch("smooth", args.tracks, args.out, where)
     return _run("smooth", lambda: smooth_many(args.tracks, args.out, options=options, **where))

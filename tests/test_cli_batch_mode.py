@@ -1,0 +1,52 @@
+"""``recover`` and ``smooth`` given a folder or several files: why they run as a batch, first."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pftrack.batch.engine
+from pftrack.cli import main
+from pftrack.io.mot import write_mot
+
+
+@pytest.fixture()
+def folder(tmp_path: Path) -> Path:
+    seq = tmp_path / "seq"
+    seq.mkdir()
+    rows = np.array([[f, 1, 10.0 + f, 20.0, 30.0, 60.0, 1, -1, -1, -1] for f in (1, 2, 5, 6)])
+    write_mot(seq / "a.txt", rows)
+    write_mot(seq / "b.txt", rows)
+    return seq
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_a_folder_with_a_file_out_is_refused(folder, tmp_path, capsys, command):
+    """Was: --workers 0 made a folder named f.txt; without Dask the message was Dask's only."""
+    out = tmp_path / "f.txt"
+    assert main([command, str(folder), "--out", str(out), "--workers", "0"]) == 2
+    err = capsys.readouterr().err
+    assert f"{folder} is a folder: pftrack {command} runs the tracks files in it" in err
+    assert "--out is a folder" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+    assert main([command, str(folder / "a.txt"), str(folder / "b.txt"), "--out", str(out)]) == 2
+    assert "2 inputs: pftrack" in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_without_dask_the_message_names_the_folder(folder, tmp_path, capsys, monkeypatch,
+                                                   command):  # fmt: skip
+    def missing() -> None:
+        raise ImportError("No module named 'distributed'", name="distributed")
+
+    monkeypatch.setattr(pftrack.batch.engine, "_require_dask", missing)
+    assert main([command, str(folder), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{folder} is a folder" in err and "--workers 0" in err
+    assert not (tmp_path / "out").exists()
+    # --workers 0 needs no Dask: the batch runs in this process
+    assert main([command, str(folder), "--out", str(tmp_path / "out"), "--workers", "0"]) == 0
+    assert sorted(p.name for p in (tmp_path / "out").glob("*.txt")) == ["a.txt", "b.txt"]
