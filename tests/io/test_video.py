@@ -277,6 +277,54 @@ def test_numbered_and_named_folders_keep_their_order(tmp_path: Path) -> None:
     assert [int(f[0, 0, 0]) for f in FrameSource(named)] == [4, 2, 3, 1]
 
 
+def _levels(folder: Path) -> list[int]:
+    return [int(f[0, 0, 0]) for f in FrameSource(folder)]
+
+
+def test_names_that_are_decimal_numbers_are_read_by_value(tmp_path: Path) -> None:
+    """Was: 10.1, 10.2, 10.3, 10.4, 10.15, 10.25, ... (the digits after the point compared as
+    whole numbers), silently."""
+    times = ["10.1", "10.15", "10.2", "10.25", "10.3", "10.35", "10.4", "10.45"]
+    assert _levels(_numbered(tmp_path / "s", [f"{t}.png" for t in times])) == list(range(1, 9))
+    # with a prefix and a suffix all names share, and numbers of any length
+    names = [f"t_{t}_left.png" for t in ("9.5", "9.75", "10", "10.125", "10.2", "100")]
+    assert _levels(_numbered(tmp_path / "fix", names)) == list(range(1, 7))
+    names = ["-1.5.png", "-1.25.png", "-1.png", "0.5.png"]  # decimals, signed
+    assert _levels(_numbered(tmp_path / "neg", names)) == [1, 2, 3, 4]
+    _numbered(tmp_path / "same", ["1.1.png", "1.10.png", "1.2.png"])  # 1.1 = 1.10
+    with pytest.raises(ValueError, match="images 1.1.png and 1.10.png in folder .* the same"):
+        FrameSource(tmp_path / "same")
+
+
+def test_names_whose_numbers_read_two_ways_are_refused(tmp_path: Path) -> None:
+    """cam1.2 and cam1.10: camera 1's frames 2 and 10, or times 1.2 and 1.10 of camera cam?"""
+    _numbered(tmp_path / "two", ["cam1.2.png", "cam1.10.png", "cam1.3.png"])
+    message = (
+        r"images cam1\.2\.png and cam1\.10\.png in folder .*two come in one order if the "
+        r"digits around a point in their names are two numbers and in the other if they are "
+        r"one decimal number: which comes first is not known \(rename them"
+    )
+    with pytest.raises(ValueError, match=message):
+        FrameSource(tmp_path / "two")
+    # padded, both readings agree: read
+    assert _levels(_numbered(tmp_path / "pad", ["cam1.02.png", "cam1.10.png"])) == [1, 2]
+
+
+def test_a_leading_minus_of_a_name_that_is_a_number_is_its_sign(tmp_path: Path) -> None:
+    """Was: 0, 1, -1 (the text '-' after every digit). In a name with text before the number,
+    '-' is a separator: frame-2 is frame 2."""
+    assert _levels(_numbered(tmp_path / "n", ["-2.png", "-1.png", "0.png", "1.png"])) == [
+        1, 2, 3, 4
+    ]  # fmt: skip
+    names = ["frame-1.png", "frame-2.png", "frame-10.png"]
+    assert _levels(_numbered(tmp_path / "f", names)) == [1, 2, 3]
+    # in a sequence, -1 is no frame (its frames start at 1)
+    seq = _sequence(tmp_path / "SEQ", n=3)
+    _numbered(seq / "img1", ["-1.png"])
+    with pytest.raises(ValueError, match=r"SEQ/img1: image -1 is not a frame \(names -1\.\.3"):
+        FrameSource(seq)
+
+
 def test_seqinfo_of_pets_gives_its_true_frame_rate() -> None:
     folder = dataset("pets09-s2l1")
     src = FrameSource(folder / "video.avi")

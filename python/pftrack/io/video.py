@@ -4,9 +4,10 @@ Sources, as :class:`FrameSource` takes them:
 
 - a video file OpenCV can decode (a text file is refused, though FFmpeg would decode it as
   ANSI art: :data:`TEXT_FOURCC`);
-- a folder of images, read in natural order (``2.jpg`` before ``10.jpg``); when every name is
-  a number (``000001.jpg``, the MOTChallenge convention) the names are frame numbers, and a
-  missing one is refused rather than shifting every later frame;
+- a folder of images, read in the order of the numbers in their names (``2.jpg`` before
+  ``10.jpg``; decimals by value, ``10.15.png`` before ``10.2.png``: :func:`_natural_order`);
+  when every name is an integer (``000001.jpg``, the MOTChallenge convention) the names are
+  frame numbers, and a missing one is refused rather than shifting every later frame;
 - a MOTChallenge sequence folder: ``seqinfo.ini`` gives the frame rate and the image folder
   (``imDir``, default ``img1``); ``det/det.txt`` (or ``det.txt``) is its public detection
   file. When the image folder does not exist and the sequence folder holds exactly one video
@@ -31,6 +32,7 @@ import warnings
 from collections.abc import Generator, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -374,18 +376,101 @@ def _same_folder(a: Path, b: Path) -> bool:
         return False
 
 
-def _natural_order(folder: Path, images: list[Path]) -> list[Path]:
-    """`images` in :func:`natural_key` order; two names of one key (``1.png``, ``01.png``) refused.
+#: A number in an image's name: digits, and a decimal fraction (``10.15``) where there is one.
+_NUMBER = re.compile(r"\d+(?:\.\d+)?", re.ASCII)
+#: The same with a sign: in names that are numbers alone (``-1``), a leading ``-`` is one.
+_SIGNED = re.compile(r"-?\d+(?:\.\d+)?", re.ASCII)
+#: A name that is an integer alone (``000001``, ``7``, ``-1``): a frame number.
+_INTEGER = re.compile(r"-?\d+", re.ASCII)
 
-    Their order would be the file system's, not the names': frames swapped silently.
+
+def _numbered(stems: Sequence[str]) -> tuple[str, list[str], str] | None:
+    """The numbers `stems` spell between a prefix and a suffix they all share, if they do.
+
+    ``frame_1``, ``frame_6``: ``("frame_", ["1", "6"], "")``; ``10.1``, ``10.15``:
+    ``("", ["10.1", "10.15"], "")``; ``-1``, ``0``: ``("", ["-1", "0"], "")``. The prefix ends
+    in no digit, nor in digits and a point (``10.`` is part of the numbers ``10.1`` and
+    ``10.15``), and the suffix starts in neither. A ``-`` is a sign only in names that are
+    numbers alone (``frame-1`` is frame 1). Two names at least.
+
+    Returns
+    -------
+    tuple of (str, list of str, str) or None
+        The prefix, each stem's number as written, and the suffix. None when some stem is not
+        the prefix, a number and the suffix, and when numbers with a decimal point follow a
+        prefix ending in a letter or a digit (``cam1.2``, ``cam1.10``: camera 1's frames 2 and
+        10, or the times 1.2 and 1.10 of camera ``cam``?).
     """
-    keyed = sorted((natural_key(p.name), p.name, p) for p in images)
+    if len(stems) < 2:
+        return None
+    prefix = re.sub(r"(?:\d+\.)?\d*\Z", "", os.path.commonprefix(list(stems)), flags=re.ASCII)
+    prefix = "" if prefix == "-" else prefix
+    suffix = os.path.commonprefix([s[::-1] for s in stems])[::-1]
+    suffix = re.sub(r"\A\d*(?:\.\d+)?", "", suffix, flags=re.ASCII)
+    number = _NUMBER if prefix else _SIGNED
+    texts = [s[len(prefix) : len(s) - len(suffix)] for s in stems]
+    if any(
+        len(prefix) + len(suffix) > len(s) or not number.fullmatch(t)
+        for s, t in zip(stems, texts, strict=True)
+    ):
+        return None
+    if prefix[-1:].isalnum() and any("." in t for t in texts):
+        return None
+    return prefix, texts, suffix
+
+
+def _decimal_key(name: str) -> tuple[tuple[int, Decimal | str], ...]:
+    """:func:`natural_key` reading digits around a point as one number (``10.15 < 10.2``)."""
+    return tuple(
+        (0, Decimal(part)) if _NUMBER.fullmatch(part) else (1, part.lower())
+        for part in re.split(r"(\d+(?:\.\d+)?)", name, flags=re.ASCII)
+        if part
+    )
+
+
+def _read_two_ways(names: list[str]) -> tuple[str, str] | None:
+    """Two of `names` (in :func:`natural_key` order) that :func:`_decimal_key` orders otherwise.
+
+    None when both keys give one order (as when no name has digits around a point).
+    """
+    if not any(re.search(r"\d\.\d", n, re.ASCII) for n in names):
+        return None
+    as_decimals = sorted(names, key=lambda n: (_decimal_key(n), n))
+    return next(((a, b) for a, b in zip(names, as_decimals, strict=True) if a != b), None)
+
+
+def _natural_order(folder: Path, images: list[Path]) -> list[Path]:
+    """`images` in the order of their names' numbers; two names of one number refused.
+
+    Names that are numbers, integers or decimals, between a prefix and a suffix they all share
+    (``10.1.png``, ``10.15.png``, ``10.2.png``; ``frame_9.png``, ``frame_10.png``; ``-1.png``,
+    ``0.png``) are in the order of those numbers; other names in :func:`natural_key` order,
+    unless reading the digits around a point as one decimal number orders them otherwise
+    (``cam1.2.png``, ``cam1.10.png``): which is meant is not known, and that is refused. Two
+    names of one number (``1.png``, ``01.png``; ``1.1.png``, ``1.10.png``) are refused too:
+    their order would be the file system's, not the names', frames swapped silently.
+    """
+    numbered = _numbered([p.stem for p in images])
+    keys: list[Any] = (
+        [(Decimal(text),) for text in numbered[1]]
+        if numbered is not None
+        else [natural_key(p.name) for p in images]
+    )
+    keyed = sorted(zip(keys, (p.name for p in images), images, strict=True))
     for (k1, n1, _), (k2, n2, _) in itertools.pairwise(keyed):
         if k1 == k2:
             raise ValueError(
                 f"images {n1} and {n2} in folder {folder} have the same number: which comes "
                 "first is not known (rename one)"
             )
+    pair = _read_two_ways([n for _, n, _ in keyed]) if numbered is None else None
+    if pair is not None:
+        raise ValueError(
+            f"images {pair[0]} and {pair[1]} in folder {folder} come in one order if the "
+            "digits around a point in their names are two numbers and in the other if they "
+            "are one decimal number: which comes first is not known (rename them: zero-padded "
+            "numbers, or names that are numbers alone)"
+        )
     return [p for _, _, p in keyed]
 
 
@@ -394,12 +479,12 @@ def _frame_order(
 ) -> list[Path] | None:
     """A folder's images in frame order if their names are frame numbers.
 
-    The names are frame numbers when every stem is all digits (``000001.jpg``, ``1.png``: the
-    MOTChallenge convention). A frame is its image's position, so a hole in the numbering
-    would silently shift every later frame onto the wrong detections (``--detections``, whose
-    frames are those numbers) and ground truth: it is an error, in any folder. A folder that
-    is not a sequence's (`sequence` None) may start at any number (``000000.png`` of a 0-based
-    dump, a cut of a longer one): frame 1 is its lowest.
+    The names are frame numbers when every stem is an integer (``000001.jpg``, ``1.png``: the
+    MOTChallenge convention; ``-1.png``, a negative one). A frame is its image's position, so a
+    hole in the numbering would silently shift every later frame onto the wrong detections
+    (``--detections``, whose frames are those numbers) and ground truth: it is an error, in any
+    folder. A folder that is not a sequence's (`sequence` None) may start at any number
+    (``000000.png`` of a 0-based dump, a cut of a longer one): frame 1 is its lowest.
 
     Parameters
     ----------
@@ -424,7 +509,7 @@ def _frame_order(
         its ``seqLength``), two images have one number, or a sequence has more images than
         its ``seqLength``.
     """
-    if not all(p.stem.isascii() and p.stem.isdigit() for p in images):
+    if not all(_INTEGER.fullmatch(p.stem) for p in images):
         return None
     ordered = sorted(images, key=lambda p: (int(p.stem), p.name))
     numbers = [int(p.stem) for p in ordered]
