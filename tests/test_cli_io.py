@@ -16,6 +16,7 @@ from typing import Any
 
 import av
 import cv2
+import numpy as np
 import pytest
 
 from pftrack import _progress
@@ -217,6 +218,32 @@ def test_a_missing_image_of_a_plain_numbered_folder_is_one_line_not_a_shift(
         f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers)\n"
     )
     assert not out.exists()
+
+
+def test_a_folder_of_12_bit_pngs_tracks_as_its_8_bit_frames_with_one_warning(
+    scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 12-bit camera's 16-bit PNGs (8-bit level v stored as 16 v + 0..15). Was: frames read
+    as value / 256, 0-15, almost black, without a word: 0 tracks."""
+    eight, twelve = tmp_path / "eight", tmp_path / "twelve"
+    scene.write_images(eight)
+    twelve.mkdir()
+    noise = np.random.default_rng(0)
+    for k, frame in enumerate(scene.frames, start=1):
+        low = noise.integers(0, 16, frame.shape, dtype=np.uint16)
+        cv2.imwrite(str(twelve / f"{k:06d}.png"), frame.astype(np.uint16) * 16 + low)
+    outs = [tmp_path / "8.txt", tmp_path / "12.txt"]
+    for folder, out in zip((eight, twelve), outs, strict=True):
+        assert main(["track", str(folder), "--out", str(out), "--quiet"]) == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    top = int(cv2.imread(str(twelve / "000001.png"), cv2.IMREAD_UNCHANGED).max())
+    assert warned == [
+        f"pftrack track: warning: {twelve}: its 16-bit images hold 12-bit values (000001.png "
+        f"goes up to {top} of 65535): read as 12-bit data, each value / 16 to 8 bits (not / "
+        "256, which makes them almost black)"
+    ]
+    assert outs[1].read_bytes() == outs[0].read_bytes()  # the same frames: the same tracks
+    assert len(read_mot(outs[0])) > 0
 
 
 def test_a_seqinfo_with_a_byte_order_mark_is_read(

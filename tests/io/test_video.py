@@ -325,6 +325,68 @@ def test_a_leading_minus_of_a_name_that_is_a_number_is_its_sign(tmp_path: Path) 
         FrameSource(seq)
 
 
+def _sixteen_bit(folder: Path, tops: list[int]) -> list[np.ndarray]:
+    """16-bit PNGs 1.png, 2.png, ... of a gradient up to each of `tops`; their pixels."""
+    folder.mkdir(parents=True)
+    ramp = np.linspace(0, 1, 40)[None, :, None] * np.linspace(0.5, 1, 3)[None, None, :]
+    images = [np.repeat(np.round(ramp * top), 8, axis=0).astype(np.uint16) for top in tops]
+    for k, image in enumerate(images, start=1):
+        cv2.imwrite(str(folder / f"{k}.png"), image)
+    return images
+
+
+def test_16_bit_images_of_12_bit_data_are_read_at_their_depth(tmp_path: Path) -> None:
+    """Was: values / 256, 0-15 for 12-bit data: almost black frames, without a word."""
+    images = _sixteen_bit(tmp_path / "d12", [4000, 4095, 2000])
+    src = FrameSource(tmp_path / "d12")
+    assert src.bits == 12
+    message = (
+        r"d12: its 16-bit images hold 12-bit values \(1\.png goes up to 4000 of 65535\): read "
+        r"as 12-bit data, each value / 16 to 8 bits \(not / 256, which makes them almost black\)$"
+    )
+    with pytest.warns(UserWarning, match=message) as said:
+        frames = list(src)
+    assert len(said) == 1  # once for the folder
+    assert all(np.array_equal(f, i >> 4) for f, i in zip(frames, images, strict=True))
+    assert frames[1].max() == 255
+    # frames read at chosen indices and on demand alike (the bootstrap, the colour term)
+    again = FrameSource(tmp_path / "d12")
+    with pytest.warns(UserWarning, match="12-bit values"):
+        assert np.array_equal(again.frames_at([2])[0], images[2] >> 4)
+    # 10-bit data: / 4
+    images = _sixteen_bit(tmp_path / "d10", [1000, 1023])
+    with pytest.warns(UserWarning, match=r"10-bit values .* each value / 4 to 8 bits"):
+        frames = list(FrameSource(tmp_path / "d10"))
+    assert all(np.array_equal(f, i >> 2) for f, i in zip(frames, images, strict=True))
+
+
+def test_a_later_image_brighter_than_the_first_ones_depth_is_clipped_with_a_warning(
+    tmp_path: Path,
+) -> None:
+    images = _sixteen_bit(tmp_path / "d", [1000, 4000, 3000])  # 10 bits decided, then 12
+    with pytest.warns(UserWarning) as said:
+        frames = list(FrameSource(tmp_path / "d"))
+    assert [str(w.message) for w in said][1:] == [
+        f"image {tmp_path / 'd' / '2.png'} goes up to 4000, past the 10 bits its folder's 16-bit "
+        "images are read at (from the first's values): its brighter pixels are clipped to white"
+    ]  # once, not for 3.png too
+    assert np.array_equal(frames[1], np.minimum(images[1], 1023) >> 2)
+
+
+def test_8_bit_and_full_range_16_bit_images_are_read_as_opencv_reads_them(
+    tmp_path: Path,
+) -> None:
+    """The same pixels as cv2.imread's colour read (warnings are errors: none is given)."""
+    _sixteen_bit(tmp_path / "full", [65535, 60000])
+    scene = make_scene(n_frames=3, width=64, height=64, n_walkers=2, rng=0)
+    for folder in (tmp_path / "full", scene.write_images(tmp_path / "eight")):
+        src = FrameSource(folder)
+        assert src.bits is None
+        paths = sorted(folder.iterdir())
+        expected = [cv2.imread(str(p), cv2.IMREAD_COLOR) for p in paths]
+        assert all(np.array_equal(f, e) for f, e in zip(src, expected, strict=True))
+
+
 def test_seqinfo_of_pets_gives_its_true_frame_rate() -> None:
     folder = dataset("pets09-s2l1")
     src = FrameSource(folder / "video.avi")

@@ -7,7 +7,8 @@ Sources, as :class:`FrameSource` takes them:
 - a folder of images, read in the order of the numbers in their names (``2.jpg`` before
   ``10.jpg``; decimals by value, ``10.15.png`` before ``10.2.png``: :func:`_natural_order`);
   when every name is an integer (``000001.jpg``, the MOTChallenge convention) the names are
-  frame numbers, and a missing one is refused rather than shifting every later frame;
+  frame numbers, and a missing one is refused rather than shifting every later frame; 16-bit
+  images of 10- to 14-bit data are read at their depth (:attr:`FrameSource.bits`);
 - a MOTChallenge sequence folder: ``seqinfo.ini`` gives the frame rate and the image folder
   (``imDir``, default ``img1``); ``det/det.txt`` (or ``det.txt``) is its public detection
   file. When the image folder does not exist and the sequence folder holds exactly one video
@@ -42,7 +43,7 @@ from numpy.typing import NDArray
 
 from pftrack._check import number
 from pftrack._typing import PathLike
-from pftrack.io.opencv_io import opencv_name, read_image, utf8_name
+from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
 
 __all__ = [
     "VIDEO_SUFFIXES",
@@ -73,6 +74,17 @@ FRAME_RATE_RANGE = (0.01, 1000.0)
 TEXT_FOURCC = "ansi"
 REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
+
+
+def _bit_depth(top: int) -> int:
+    """The bit depth of 16-bit image data whose largest value is `top`: 8, 10, 12, 14 or 16.
+
+    The fewest bits that hold `top`, rounded up to an even number (cameras give 10, 12 or 14
+    bits; rounding up leaves room for brighter pixels than the image's): 4000 is 12 bits, 4096
+    14, 255 8 (8-bit data in a 16-bit file).
+    """
+    bits = max(8, int(top).bit_length())
+    return min(16, bits + bits % 2)
 
 
 def _file_capture(path: str) -> cv2.VideoCapture:
@@ -697,6 +709,13 @@ class FrameSource:
         :func:`sequence_video`); None for a camera or a stream URL.
     width, height : int
         Frame size after `scale`.
+    bits : int or None
+        For an image folder whose first image is 16-bit with values of fewer bits (10- or
+        12-bit camera data: :func:`_bit_depth` of its largest value, 10, 12 or 14; 8 for 8-bit
+        data), the depth every 16-bit image of the folder is read at: each value divided by
+        ``2 ** (bits - 8)`` (a value past it white), not by 256 as OpenCV reads them, which
+        makes such images almost black. None: images read as OpenCV reads them (8-bit images,
+        full-range 16-bit ones), a video, a camera or a stream.
 
     Raises
     ------
@@ -715,7 +734,9 @@ class FrameSource:
     -----
     UserWarning
         Once, when a video read to its end had fewer frames than its header says, or a number
-        other than its sequence's ``seqLength`` (counted as read: no pass of its own).
+        other than its sequence's ``seqLength`` (counted as read: no pass of its own). At the
+        first image read, when a folder's 16-bit images are read at :attr:`bits`; once, when
+        a later one is brighter than that depth holds (its brighter pixels clipped to white).
 
     Notes
     -----
@@ -742,6 +763,10 @@ class FrameSource:
         self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
         self._image_shape = (0, 0)  # (height, width) of a folder's first image
+        # a folder's 16-bit images of fewer bits (from its first image): read at that depth
+        self.bits: int | None = None
+        self._depth_note: str | None = None  # the warning saying so, given at the first read
+        self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._cap: Any = None
         self._replay: list[NDArray[np.uint8]] = []
@@ -804,11 +829,55 @@ class FrameSource:
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
         self._images = numbered or _natural_order(folder, images)
-        first = read_image(self._images[0])
-        if first is None:
-            raise ValueError(f"cannot read image {self._images[0]}")
+        first = self._open_depth(folder, self._images[0])
         self._image_shape = (int(first.shape[0]), int(first.shape[1]))
         return first, len(self._images)
+
+    def _open_depth(self, folder: Path, path: Path) -> NDArray[Any]:
+        """A folder's first image, 8-bit; sets :attr:`bits` when it is 16-bit of fewer bits.
+
+        16-bit images whose values use only the low bits (10- or 12-bit camera data) become
+        almost black as OpenCV reads them in colour (value / 256): they are read at the depth
+        of the first, :func:`_bit_depth` of its largest value, for the whole folder. 8-bit and
+        full-range 16-bit images are read as OpenCV reads them, the same pixels as ever.
+        """
+        first = read_image_depth(path)
+        if first is None:
+            raise ValueError(f"cannot read image {path}")
+        if first.dtype == np.uint8:  # the pixels read_image gives
+            return first
+        top = int(first.max()) if first.dtype == np.uint16 else 65535
+        bits = _bit_depth(top)
+        if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
+            again = read_image(path)
+            if again is None:
+                raise ValueError(f"cannot read image {path}")
+            return again
+        self.bits = bits
+        self._depth_note = (
+            f"{folder}: its 16-bit images hold {bits}-bit values ({path.name} goes up to {top} "
+            f"of 65535): read as {bits}-bit data, each value / {1 << (bits - 8)} to 8 bits "
+            "(not / 256, which makes them almost black)"
+        )
+        return self._to_8_bits(first, path)
+
+    def _to_8_bits(self, image: NDArray[Any], path: Path) -> NDArray[np.uint8]:
+        """A 16-bit `image` of :attr:`bits` bits as 8 bits; brighter pixels white (said once)."""
+        bits = self.bits or 16
+        limit = (1 << bits) - 1
+        top = int(image.max())
+        if top > limit:
+            image = np.minimum(image, limit)
+            if not self._clipped:
+                self._clipped = True
+                warnings.warn(
+                    f"image {path} goes up to {top}, past the {bits} bits its folder's 16-bit "
+                    f"images are read at (from the first's values): its brighter pixels are "
+                    "clipped to white",
+                    UserWarning,
+                    stacklevel=4,
+                )
+        return np.asarray(np.right_shift(image, bits - 8), dtype=np.uint8)
 
     @staticmethod
     def _probe_file(path: Path) -> tuple[NDArray[Any], float, int]:
@@ -855,8 +924,22 @@ class FrameSource:
         return np.asarray(frame, dtype=np.uint8)  # OpenCV's colour reads are uint8: no copy
 
     def _read_image(self, path: Path) -> NDArray[np.uint8]:
-        """One image of a folder, resized; ValueError if unreadable or not the first's size."""
-        img = read_image(path)
+        """One image of a folder, resized; ValueError if unreadable or not the first's size.
+
+        At :attr:`bits` when the folder's first image set it (the first read says so, once).
+        """
+        if self._depth_note is not None:
+            note, self._depth_note = self._depth_note, None
+            warnings.warn(note, UserWarning, stacklevel=3)
+        img: NDArray[Any] | None
+        if self.bits is None:
+            img = read_image(path)
+        else:
+            img = read_image_depth(path)
+            if img is not None and img.dtype == np.uint16:
+                img = self._to_8_bits(img, path)
+            elif img is not None and img.dtype != np.uint8:
+                img = read_image(path)
         if img is None:
             raise ValueError(f"cannot read image {path}")
         if img.shape[:2] != self._image_shape:
