@@ -216,13 +216,16 @@ def _numbered(folder: Path, names: list[str]) -> Path:
     return folder
 
 
-def test_a_missing_numbered_image_is_refused_not_shifted(tmp_path: Path) -> None:
+def test_a_missing_numbered_image_of_a_sequence_is_refused_not_shifted(tmp_path: Path) -> None:
     """In a sequence, image 000011 must not become frame 10: a hole is an error."""
     seq = tmp_path / "SEQ"
     names = [f"{k:06d}.png" for k in range(1, 61) if k != 10]
     _numbered(seq / "img1", names)
     (seq / "seqinfo.ini").write_text("[Sequence]\nimDir=img1\nframeRate=7\nseqLength=60\n")
-    message = r"img1: image 000010 is missing \(names 000001\.\.000060 are frame numbers\)$"
+    message = (
+        r"img1: image 000010 is missing \(names 000001\.\.000060 are frame numbers; restore it: "
+        r"the sequence's detections and ground truth number its frames by them\)$"
+    )
     for source in (seq, seq / "img1"):
         with pytest.raises(ValueError, match=message):
             FrameSource(source)
@@ -230,16 +233,43 @@ def test_a_missing_numbered_image_is_refused_not_shifted(tmp_path: Path) -> None
     _numbered(seq / "img1", ["000002.png"])
     with pytest.raises(ValueError, match=r"images 000002.png and 2.png are both frame 2"):
         FrameSource(seq)
-    # a folder that is not a sequence's alike (was: 000031 read as frame 30, and so on)
-    plain = _numbered(tmp_path / "plain", names)
-    with pytest.raises(ValueError, match=message.replace("img1", "plain")):
-        FrameSource(plain)
-    _numbered(tmp_path / "every5", ["5.png", "10.png", "15.png"])
-    with pytest.raises(ValueError, match=r"every5: image 6 is missing \(names 5\.\.15 are frame"):
-        FrameSource(tmp_path / "every5")
-    # names with anything but digits: natural order, gaps and all
-    plain = _numbered(tmp_path / "named", ["f5.png", "f10.png", "f15.png"])
-    assert [int(f[0, 0, 0]) for f in FrameSource(plain)] == [1, 2, 3]
+
+
+def test_a_plain_folder_whose_names_skip_numbers_is_read_in_their_order(tmp_path: Path) -> None:
+    """Camera dumps named by millisecond time stamps, every fifth frame: was refused outright
+    ('image 1690000000001 is missing'), while frame_1.png, frame_6.png, ... were read. Both are
+    read now, frames 1..N in the names' order, and `gap` says what detections would be refused
+    for."""
+    stamps = [1690000000000 + 33 * k + k % 2 for k in range(6)]
+    names = [f"{t}.png" for t in reversed(stamps)]  # image i (0-based) of level i + 1
+    ms = _numbered(tmp_path / "ms", names)
+    src = FrameSource(ms)
+    assert _levels(ms) == [6, 5, 4, 3, 2, 1] and len(src) == 6
+    assert src.gap == (
+        f"{ms}: image 1690000000001 is missing (names 1690000000000..{stamps[-1]} skip numbers)"
+    )
+    cases = {
+        "every5": (["1.png", "6.png", "11.png"], "image 2 is missing (names 1..11"),
+        "padded": (["00001.png", "00003.png"], "image 00002 is missing (names 00001..00003"),
+        "named": (["f5.png", "f10.png", "f15.png"], "image f6 is missing (names f5..f15"),
+        "both": (["c_07_l.png", "c_09_l.png"], "image c_08_l is missing (names c_07_l..c_09_l"),
+        "signed": (["-3.png", "0.png"], "image -2 is missing (names -3..0"),
+    }
+    for folder, (names, gap) in cases.items():
+        src = FrameSource(_numbered(tmp_path / folder, names))
+        assert _levels(tmp_path / folder) == [1, 2, 3][: len(names)]
+        assert src.gap == f"{tmp_path / folder}: {gap} skip numbers)"
+    # numbers that skip none, names that are not numbers, decimals (no frame numbers): no gap
+    for folder, names in {
+        "whole": ["0.png", "1.png", "2.png"],
+        "frames": ["frame_9.png", "frame_10.png"],
+        "mixed": ["cover.png", "frame_1.png", "frame_3.png"],
+        "times": ["10.1.png", "10.3.png"],
+        "one": ["7.png"],
+    }.items():
+        assert FrameSource(_numbered(tmp_path / folder, names)).gap is None, folder
+    # a MOTChallenge sequence's own image folder has none: a gap there is an error (above)
+    assert FrameSource(_sequence(tmp_path / "SEQ", n=3)).gap is None
 
 
 def test_a_sequence_image_folder_is_numbered_from_1_to_seqlength(tmp_path: Path) -> None:

@@ -5,13 +5,15 @@ Sources, as :class:`FrameSource` takes them:
 - a video file OpenCV can decode (a text file is refused, though FFmpeg would decode it as
   ANSI art: :data:`TEXT_FOURCC`);
 - a folder of images, read in the order of the numbers in their names (``2.jpg`` before
-  ``10.jpg``; decimals by value, ``10.15.png`` before ``10.2.png``: :func:`_natural_order`);
-  when every name is an integer (``000001.jpg``, the MOTChallenge convention) the names are
-  frame numbers, and a missing one is refused rather than shifting every later frame; 16-bit
-  images of 10- to 14-bit data are read at their depth (:attr:`FrameSource.bits`);
+  ``10.jpg``; decimals by value, ``10.15.png`` before ``10.2.png``: :func:`_natural_order`),
+  frames 1..N in that order; names that skip numbers (``1.png, 6.png``) are read, and
+  detections refused with them (:attr:`FrameSource.gap`); 16-bit images of 10- to 14-bit data
+  are read at their depth (:attr:`FrameSource.bits`);
 - a MOTChallenge sequence folder: ``seqinfo.ini`` gives the frame rate and the image folder
   (``imDir``, default ``img1``); ``det/det.txt`` (or ``det.txt``) is its public detection
-  file. When the image folder does not exist and the sequence folder holds exactly one video
+  file. Integer image names (``000001.jpg``, the MOTChallenge convention) are frame numbers
+  there, image 1 frame 1, and a missing one is refused rather than shifting every later
+  frame. When the image folder does not exist and the sequence folder holds exactly one video
   file (``SEQ/video.mp4``: the layout of ``pftrack batch`` and the shared data), that video is
   read, with the sequence's frame rate and detections;
 - a camera index (``"0"``), or a stream URL (anything with ``://``: ``rtsp://``, ``http://``,
@@ -492,11 +494,13 @@ def _frame_order(
     """A folder's images in frame order if their names are frame numbers.
 
     The names are frame numbers when every stem is an integer (``000001.jpg``, ``1.png``: the
-    MOTChallenge convention; ``-1.png``, a negative one). A frame is its image's position, so a
-    hole in the numbering would silently shift every later frame onto the wrong detections
-    (``--detections``, whose frames are those numbers) and ground truth: it is an error, in any
-    folder. A folder that is not a sequence's (`sequence` None) may start at any number
-    (``000000.png`` of a 0-based dump, a cut of a longer one): frame 1 is its lowest.
+    MOTChallenge convention; ``-1.png``, a negative one). A frame is its image's position, so in
+    a MOTChallenge sequence's image folder a hole in the numbering would silently shift every
+    later frame onto the wrong detections and ground truth (whose frames are those numbers):
+    it is an error there. A folder that is not a sequence's (`sequence` None) may start at any
+    number (``000000.png`` of a 0-based dump, a cut of a longer one) and skip numbers (camera
+    time stamps, every fifth frame): frame 1 is its lowest, frame k its k-th image; detections
+    are refused with such a folder (:attr:`FrameSource.gap`).
 
     Parameters
     ----------
@@ -506,7 +510,8 @@ def _frame_order(
         Its images, in any order.
     sequence : SequenceInfo or None
         The MOTChallenge sequence `folder` is the image folder of: frame 1 is then image 1,
-        and there are ``seqLength`` images when ``seqinfo.ini`` says so. None: not checked.
+        no number is skipped, and there are ``seqLength`` images when ``seqinfo.ini`` says so.
+        None: not checked.
 
     Returns
     -------
@@ -517,8 +522,8 @@ def _frame_order(
     Raises
     ------
     ValueError
-        A number is missing (a hole, or a sequence's images do not start at 1 or end before
-        its ``seqLength``), two images have one number, or a sequence has more images than
+        Two images have one number, or, in a sequence, a number is missing (a hole, images
+        that do not start at 1 or end before its ``seqLength``) or there are more images than
         its ``seqLength``.
     """
     if not all(_INTEGER.fullmatch(p.stem) for p in images):
@@ -544,8 +549,13 @@ def _frame_order(
                 f"{folder}: images {ordered[k - 1].name} and {ordered[k].name} are both "
                 f"frame {numbers[k]} (names that are numbers are frame numbers)"
             )
-        if numbers[k] != numbers[k - 1] + 1:
-            raise missing(numbers[k - 1] + 1, len(ordered[k - 1].stem), names)
+        if sequence is not None and numbers[k] != numbers[k - 1] + 1:
+            raise missing(
+                numbers[k - 1] + 1,
+                len(ordered[k - 1].stem),
+                f"{names}; restore it: the sequence's detections and ground truth number its "
+                "frames by them",
+            )
     length = sequence.length if sequence is not None else None
     if length is not None and len(ordered) < length:
         raise missing(numbers[-1] + 1, len(last), f"{names}; seqinfo.ini says seqLength={length}")
@@ -555,6 +565,26 @@ def _frame_order(
             f"seqLength={length}"
         )
     return ordered
+
+
+def _gap(folder: Path, images: list[Path]) -> str | None:
+    """The first number that `images`' names skip, as :attr:`FrameSource.gap` says it.
+
+    For names that are integers between a prefix and a suffix they share (``1.png``,
+    ``6.png``; ``frame_1.png``, ``frame_6.png``: :func:`_numbered`), given in order; None when
+    they skip none, or are not such names (decimal numbers are no frame numbers).
+    """
+    stems = [p.stem for p in images]
+    numbered = _numbered(stems)
+    if numbered is None or any("." in text for text in numbered[1]):
+        return None
+    prefix, texts, suffix = numbered
+    for before, after in itertools.pairwise(texts):
+        if int(after) != int(before) + 1:
+            width = 0 if before.startswith("-") else len(before)
+            name = f"{prefix}{str(int(before) + 1).zfill(width)}{suffix}"
+            return f"{folder}: image {name} is missing (names {stems[0]}..{stems[-1]} skip numbers)"
+    return None
 
 
 def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
@@ -709,6 +739,14 @@ class FrameSource:
         :func:`sequence_video`); None for a camera or a stream URL.
     width, height : int
         Frame size after `scale`.
+    gap : str or None
+        For an image folder whose names are numbered with a gap (``1.png, 6.png, 11.png``,
+        ``1690000000000.png, 1690000000033.png``, ``frame_1.png, frame_6.png``; outside a
+        MOTChallenge sequence's image folder, where a gap is an error), what is missing:
+        ``"imgs: image 2 is missing (names 1..11 skip numbers)"``. The frames are still
+        numbered 1..N in the names' order; detections, whose frame numbers could count the
+        images by name or by position, are refused with it (:func:`pftrack.track_frames`).
+        None otherwise.
     bits : int or None
         For an image folder whose first image is 16-bit with values of fewer bits (10- or
         12-bit camera data: :func:`_bit_depth` of its largest value, 10, 12 or 14; 8 for 8-bit
@@ -725,10 +763,9 @@ class FrameSource:
         If `source` is not a path, a string or an int (a bool is refused).
     ValueError
         If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
-        no frame; or if the images of a folder are
-        named by number and one is missing (a hole in the numbering; in a MOTChallenge
-        sequence's image folder, also numbers that do not start at 1 or a count other than
-        ``seqLength``).
+        no frame; if two images of a folder have one number; or if a MOTChallenge sequence's
+        image folder is named by number and one is missing (a hole in the numbering, numbers
+        that do not start at 1 or a count other than ``seqLength``).
 
     Warns
     -----
@@ -765,6 +802,7 @@ class FrameSource:
         self._image_shape = (0, 0)  # (height, width) of a folder's first image
         # a folder's 16-bit images of fewer bits (from its first image): read at that depth
         self.bits: int | None = None
+        self.gap: str | None = None  # an image folder's names skip a number
         self._depth_note: str | None = None  # the warning saying so, given at the first read
         self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
@@ -829,6 +867,7 @@ class FrameSource:
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
         self._images = numbered or _natural_order(folder, images)
+        self.gap = _gap(folder, self._images)
         first = self._open_depth(folder, self._images[0])
         self._image_shape = (int(first.shape[0]), int(first.shape[1]))
         return first, len(self._images)
