@@ -287,6 +287,40 @@ def test_a_folder_of_12_bit_pngs_tracks_as_its_8_bit_frames_with_one_warning(
     assert len(read_mot(outs[0])) > 0
 
 
+def test_a_folder_of_videos_given_to_track_names_them_and_batch(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'no images (.jpg, ...) in folder vids', with no word of the videos it holds."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    for name in ("b.avi", "a.mp4", "notes.txt"):
+        (vids / name).write_bytes(b"")  # listed by name: never opened
+    out = tmp_path / "t.txt"
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {vids} holds 2 videos (a.mp4, b.avi) and no images: give "
+        f"one of them ({vids / 'a.mp4'}), or track them all with pftrack batch {vids}\n"
+    )
+    for name in ("c.mkv", "d.mov"):
+        (vids / name).write_bytes(b"")
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert "holds 4 videos (a.mp4, b.avi, c.mkv, ...) and no images" in capsys.readouterr().err
+    for name in ("a.mp4", "c.mkv", "d.mov"):
+        (vids / name).unlink()
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {vids} holds a video (b.avi) and no images: give it "
+        f"({vids / 'b.avi'})\n"
+    )
+    (vids / "b.avi").unlink()  # nothing to track: as before
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: no images (.jpg, .jpeg, .png, .bmp, .tif, .tiff, .webp) in folder "
+        f"{vids}\n"
+    )
+    assert not out.exists()
+
+
 def test_a_seqinfo_with_a_byte_order_mark_is_read(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

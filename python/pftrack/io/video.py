@@ -603,6 +603,20 @@ def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
     return path
 
 
+def _no_images(folder: Path) -> str:
+    """The message for a folder source without images; one of videos says how to track them."""
+    videos = video_files(folder)
+    if not videos:
+        return f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+    names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
+    if len(videos) == 1:
+        return f"folder {folder} holds a video ({names}) and no images: give it ({videos[0]})"
+    return (
+        f"folder {folder} holds {len(videos)} videos ({names}) and no images: give one of them "
+        f"({videos[0]}), or track them all with pftrack batch {folder}"
+    )
+
+
 def _images_in(folder: Path) -> list[Path]:
     """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order."""
     return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
@@ -862,7 +876,7 @@ class FrameSource:
         folder = _image_folder(path, self.sequence)
         images = _images_in(folder)
         if not images:
-            raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
+            raise ValueError(_no_images(folder))
         seq = self.sequence
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
