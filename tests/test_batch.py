@@ -279,6 +279,36 @@ def test_failing_sequence_is_reported_and_the_others_finish(
     assert single.read_bytes() == (out / "MOT-01.txt").read_bytes()
 
 
+def test_an_image_folder_whose_names_skip_numbers_is_tracked_but_not_matched_to_files(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Images 1.png, 6.png, 11.png, ... beside det.txt and gt.txt, no seqinfo.ini: was refused
+    outright ('image 2 is missing'). Tracked now, frames 1..N in the names' order; its
+    detections and ground truth, which may count the images by name, are not matched to them."""
+    seq = tmp_path / "FIVE"
+    seq.mkdir()
+    for k, image in enumerate(sorted((data / "MOT-01" / "img1").iterdir())):
+        shutil.copy(image, seq / f"{1 + 5 * k}.jpg")
+    shutil.copy(data / "MOT-01" / "gt" / "gt.txt", seq / "gt.txt")
+    shutil.copy(data / "MOT-01" / "det" / "det.txt", seq / "det.txt")
+    out = tmp_path / "out"
+    argv = ["batch", str(seq), "--out", str(out), "--workers", "0", *FAST]
+    assert main(argv) == 1
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["frames"] == 30 and entry["metrics"] is None and (out / "FIVE.txt").is_file()
+    assert entry["error"] == (
+        f"scoring against {seq / 'gt.txt'} (the tracks are written): {seq}: image 2 is missing "
+        "(names 1..146 skip numbers): the ground truth's frame numbers may be the names or the "
+        "images' positions; rename the images 1..N in their order and number the ground "
+        "truth's frames alike"
+    )
+    assert main([*argv, "--detections", "auto", "--out", str(tmp_path / "det")]) == 1
+    (entry,) = json.loads((tmp_path / "det" / "summary.json").read_text())["sequences"]
+    assert entry["error"].startswith(f"{seq}: image 2 is missing (names 1..146 skip numbers): ")
+    assert "detections cannot be matched to these images" in entry["error"]
+    capsys.readouterr()
+
+
 def test_a_truth_that_cannot_be_scored_keeps_the_tracks(
     data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

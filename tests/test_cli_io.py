@@ -16,6 +16,7 @@ from typing import Any
 
 import av
 import cv2
+import numpy as np
 import pytest
 
 from pftrack import _progress
@@ -195,9 +196,13 @@ def test_a_missing_image_of_a_sequence_is_one_line_not_a_shift(
     out = tmp_path / "t.txt"
     assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 2
     assert capsys.readouterr().err == (
-        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers)\n"
+        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers; "
+        "restore it: the sequence's detections and ground truth number its frames by them)\n"
     )
     assert not out.exists()
+    # without detections too: its ground truth counts frames by name
+    assert main(["track", str(seq), "--out", str(out)]) == 2
+    assert "image 10 is missing" in capsys.readouterr().err and not out.exists()
 
 
 def test_a_missing_image_of_a_plain_numbered_folder_is_one_line_not_a_shift(
@@ -206,15 +211,112 @@ def test_a_missing_image_of_a_plain_numbered_folder_is_one_line_not_a_shift(
     """The README's ``track seq/img1 --detections det.txt`` on a folder without seqinfo.ini.
 
     Was: exit 0, image 11 written as frame 10 and given frame 10's detections, and so on.
+    Names of text and a number (frame_11.png) alike: were tracked, frame_11 given frame 10's
+    detections.
     """
     seq = _copy_sequence(sequence, tmp_path / "SEQ", skip="10.png")
     (seq / "seqinfo.ini").unlink()
     out = tmp_path / "t.txt"
     argv = ["track", str(seq / "img1"), "--detections", str(seq / "det" / "det.txt"),
             "--out", str(out)]  # fmt: skip
+    remedy = (
+        "skip numbers): detections cannot be matched to these images (their frame numbers may "
+        "be the names or the images' positions); rename the images 1..N in their order and "
+        "number the detections' frames alike (frame k: the k-th image), or track without "
+        "detections (frames 1..N in the names' order)\n"
+    )
     assert main(argv) == 2
     assert capsys.readouterr().err == (
-        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers)\n"
+        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 {remedy}"
+    )
+    assert not out.exists()
+    for image in (seq / "img1").iterdir():
+        image.rename(image.with_name(f"frame_{image.name}"))
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/img1: image frame_10 is missing (names frame_1..frame_60 "
+        f"{remedy}"
+    )
+    assert not out.exists()
+
+
+def test_a_plain_folder_whose_names_skip_numbers_tracks_its_images_in_order(
+    scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Millisecond time stamps or every fifth frame, without detections: was refused ('image 2
+    is missing (names ... are frame numbers)', exit 2). Frames are numbered 1..N in the names'
+    order: the same rows as the images named 1..N."""
+    consecutive, stamps, fifth = tmp_path / "n", tmp_path / "ms", tmp_path / "five"
+    for folder in (consecutive, stamps, fifth):
+        folder.mkdir()
+    for k, frame in enumerate(scene.frames):
+        cv2.imwrite(str(consecutive / f"{k + 1}.png"), frame)
+        cv2.imwrite(str(stamps / f"{1690000000000 + 33 * k + k % 3}.png"), frame)
+        cv2.imwrite(str(fifth / f"{1 + 5 * k}.png"), frame)
+    outs = [tmp_path / f"{folder.name}.txt" for folder in (consecutive, stamps, fifth)]
+    for folder, out in zip((consecutive, stamps, fifth), outs, strict=True):
+        assert main(["track", str(folder), "--out", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
+    assert outs[0].read_bytes() == outs[1].read_bytes() == outs[2].read_bytes()
+    assert read_mot(outs[0])[:, 0].max() == len(scene.frames)
+
+
+def test_a_folder_of_12_bit_pngs_tracks_as_its_8_bit_frames_with_one_warning(
+    scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 12-bit camera's 16-bit PNGs (8-bit level v stored as 16 v + 0..15). Was: frames read
+    as value / 256, 0-15, almost black, without a word: 0 tracks."""
+    eight, twelve = tmp_path / "eight", tmp_path / "twelve"
+    scene.write_images(eight)
+    twelve.mkdir()
+    noise = np.random.default_rng(0)
+    for k, frame in enumerate(scene.frames, start=1):
+        low = noise.integers(0, 16, frame.shape, dtype=np.uint16)
+        cv2.imwrite(str(twelve / f"{k:06d}.png"), frame.astype(np.uint16) * 16 + low)
+    outs = [tmp_path / "8.txt", tmp_path / "12.txt"]
+    for folder, out in zip((eight, twelve), outs, strict=True):
+        assert main(["track", str(folder), "--out", str(out), "--quiet"]) == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    top = int(cv2.imread(str(twelve / "000001.png"), cv2.IMREAD_UNCHANGED).max())
+    assert warned == [
+        f"pftrack track: warning: {twelve}: its 16-bit images hold 12-bit values (000001.png "
+        f"goes up to {top} of 65535): read as 12-bit data, each value / 16 to 8 bits (not / "
+        "256, which makes them almost black)"
+    ]
+    assert outs[1].read_bytes() == outs[0].read_bytes()  # the same frames: the same tracks
+    assert len(read_mot(outs[0])) > 0
+
+
+def test_a_folder_of_videos_given_to_track_names_them_and_batch(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'no images (.jpg, ...) in folder vids', with no word of the videos it holds."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    for name in ("b.avi", "a.mp4", "notes.txt"):
+        (vids / name).write_bytes(b"")  # listed by name: never opened
+    out = tmp_path / "t.txt"
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {vids} holds 2 videos (a.mp4, b.avi) and no images: give "
+        f"one of them ({vids / 'a.mp4'}), or track them all with pftrack batch {vids}\n"
+    )
+    for name in ("c.mkv", "d.mov"):
+        (vids / name).write_bytes(b"")
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert "holds 4 videos (a.mp4, b.avi, c.mkv, ...) and no images" in capsys.readouterr().err
+    for name in ("a.mp4", "c.mkv", "d.mov"):
+        (vids / name).unlink()
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {vids} holds a video (b.avi) and no images: give it "
+        f"({vids / 'b.avi'})\n"
+    )
+    (vids / "b.avi").unlink()  # nothing to track: as before
+    assert main(["track", str(vids), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: no images (.jpg, .jpeg, .png, .bmp, .tif, .tiff, .webp) in folder "
+        f"{vids}\n"
     )
     assert not out.exists()
 

@@ -216,13 +216,16 @@ def _numbered(folder: Path, names: list[str]) -> Path:
     return folder
 
 
-def test_a_missing_numbered_image_is_refused_not_shifted(tmp_path: Path) -> None:
+def test_a_missing_numbered_image_of_a_sequence_is_refused_not_shifted(tmp_path: Path) -> None:
     """In a sequence, image 000011 must not become frame 10: a hole is an error."""
     seq = tmp_path / "SEQ"
     names = [f"{k:06d}.png" for k in range(1, 61) if k != 10]
     _numbered(seq / "img1", names)
     (seq / "seqinfo.ini").write_text("[Sequence]\nimDir=img1\nframeRate=7\nseqLength=60\n")
-    message = r"img1: image 000010 is missing \(names 000001\.\.000060 are frame numbers\)$"
+    message = (
+        r"img1: image 000010 is missing \(names 000001\.\.000060 are frame numbers; restore it: "
+        r"the sequence's detections and ground truth number its frames by them\)$"
+    )
     for source in (seq, seq / "img1"):
         with pytest.raises(ValueError, match=message):
             FrameSource(source)
@@ -230,16 +233,43 @@ def test_a_missing_numbered_image_is_refused_not_shifted(tmp_path: Path) -> None
     _numbered(seq / "img1", ["000002.png"])
     with pytest.raises(ValueError, match=r"images 000002.png and 2.png are both frame 2"):
         FrameSource(seq)
-    # a folder that is not a sequence's alike (was: 000031 read as frame 30, and so on)
-    plain = _numbered(tmp_path / "plain", names)
-    with pytest.raises(ValueError, match=message.replace("img1", "plain")):
-        FrameSource(plain)
-    _numbered(tmp_path / "every5", ["5.png", "10.png", "15.png"])
-    with pytest.raises(ValueError, match=r"every5: image 6 is missing \(names 5\.\.15 are frame"):
-        FrameSource(tmp_path / "every5")
-    # names with anything but digits: natural order, gaps and all
-    plain = _numbered(tmp_path / "named", ["f5.png", "f10.png", "f15.png"])
-    assert [int(f[0, 0, 0]) for f in FrameSource(plain)] == [1, 2, 3]
+
+
+def test_a_plain_folder_whose_names_skip_numbers_is_read_in_their_order(tmp_path: Path) -> None:
+    """Camera dumps named by millisecond time stamps, every fifth frame: was refused outright
+    ('image 1690000000001 is missing'), while frame_1.png, frame_6.png, ... were read. Both are
+    read now, frames 1..N in the names' order, and `gap` says what detections would be refused
+    for."""
+    stamps = [1690000000000 + 33 * k + k % 2 for k in range(6)]
+    names = [f"{t}.png" for t in reversed(stamps)]  # image i (0-based) of level i + 1
+    ms = _numbered(tmp_path / "ms", names)
+    src = FrameSource(ms)
+    assert _levels(ms) == [6, 5, 4, 3, 2, 1] and len(src) == 6
+    assert src.gap == (
+        f"{ms}: image 1690000000001 is missing (names 1690000000000..{stamps[-1]} skip numbers)"
+    )
+    cases = {
+        "every5": (["1.png", "6.png", "11.png"], "image 2 is missing (names 1..11"),
+        "padded": (["00001.png", "00003.png"], "image 00002 is missing (names 00001..00003"),
+        "named": (["f5.png", "f10.png", "f15.png"], "image f6 is missing (names f5..f15"),
+        "both": (["c_07_l.png", "c_09_l.png"], "image c_08_l is missing (names c_07_l..c_09_l"),
+        "signed": (["-3.png", "0.png"], "image -2 is missing (names -3..0"),
+    }
+    for folder, (names, gap) in cases.items():
+        src = FrameSource(_numbered(tmp_path / folder, names))
+        assert _levels(tmp_path / folder) == [1, 2, 3][: len(names)]
+        assert src.gap == f"{tmp_path / folder}: {gap} skip numbers)"
+    # numbers that skip none, names that are not numbers, decimals (no frame numbers): no gap
+    for folder, names in {
+        "whole": ["0.png", "1.png", "2.png"],
+        "frames": ["frame_9.png", "frame_10.png"],
+        "mixed": ["cover.png", "frame_1.png", "frame_3.png"],
+        "times": ["10.1.png", "10.3.png"],
+        "one": ["7.png"],
+    }.items():
+        assert FrameSource(_numbered(tmp_path / folder, names)).gap is None, folder
+    # a MOTChallenge sequence's own image folder has none: a gap there is an error (above)
+    assert FrameSource(_sequence(tmp_path / "SEQ", n=3)).gap is None
 
 
 def test_a_sequence_image_folder_is_numbered_from_1_to_seqlength(tmp_path: Path) -> None:
@@ -275,6 +305,116 @@ def test_numbered_and_named_folders_keep_their_order(tmp_path: Path) -> None:
     # names that are not all numbers: natural order, gaps and all
     named = _numbered(tmp_path / "f", ["frame_10.png", "frame_2.png", "frame_5.png", "cover.png"])
     assert [int(f[0, 0, 0]) for f in FrameSource(named)] == [4, 2, 3, 1]
+
+
+def _levels(folder: Path) -> list[int]:
+    return [int(f[0, 0, 0]) for f in FrameSource(folder)]
+
+
+def test_names_that_are_decimal_numbers_are_read_by_value(tmp_path: Path) -> None:
+    """Was: 10.1, 10.2, 10.3, 10.4, 10.15, 10.25, ... (the digits after the point compared as
+    whole numbers), silently."""
+    times = ["10.1", "10.15", "10.2", "10.25", "10.3", "10.35", "10.4", "10.45"]
+    assert _levels(_numbered(tmp_path / "s", [f"{t}.png" for t in times])) == list(range(1, 9))
+    # with a prefix and a suffix all names share, and numbers of any length
+    names = [f"t_{t}_left.png" for t in ("9.5", "9.75", "10", "10.125", "10.2", "100")]
+    assert _levels(_numbered(tmp_path / "fix", names)) == list(range(1, 7))
+    names = ["-1.5.png", "-1.25.png", "-1.png", "0.5.png"]  # decimals, signed
+    assert _levels(_numbered(tmp_path / "neg", names)) == [1, 2, 3, 4]
+    _numbered(tmp_path / "same", ["1.1.png", "1.10.png", "1.2.png"])  # 1.1 = 1.10
+    with pytest.raises(ValueError, match="images 1.1.png and 1.10.png in folder .* the same"):
+        FrameSource(tmp_path / "same")
+
+
+def test_names_whose_numbers_read_two_ways_are_refused(tmp_path: Path) -> None:
+    """cam1.2 and cam1.10: camera 1's frames 2 and 10, or times 1.2 and 1.10 of camera cam?"""
+    _numbered(tmp_path / "two", ["cam1.2.png", "cam1.10.png", "cam1.3.png"])
+    message = (
+        r"images cam1\.2\.png and cam1\.10\.png in folder .*two come in one order if the "
+        r"digits around a point in their names are two numbers and in the other if they are "
+        r"one decimal number: which comes first is not known \(rename them"
+    )
+    with pytest.raises(ValueError, match=message):
+        FrameSource(tmp_path / "two")
+    # padded, both readings agree: read
+    assert _levels(_numbered(tmp_path / "pad", ["cam1.02.png", "cam1.10.png"])) == [1, 2]
+
+
+def test_a_leading_minus_of_a_name_that_is_a_number_is_its_sign(tmp_path: Path) -> None:
+    """Was: 0, 1, -1 (the text '-' after every digit). In a name with text before the number,
+    '-' is a separator: frame-2 is frame 2."""
+    assert _levels(_numbered(tmp_path / "n", ["-2.png", "-1.png", "0.png", "1.png"])) == [
+        1, 2, 3, 4
+    ]  # fmt: skip
+    names = ["frame-1.png", "frame-2.png", "frame-10.png"]
+    assert _levels(_numbered(tmp_path / "f", names)) == [1, 2, 3]
+    # in a sequence, -1 is no frame (its frames start at 1)
+    seq = _sequence(tmp_path / "SEQ", n=3)
+    _numbered(seq / "img1", ["-1.png"])
+    with pytest.raises(ValueError, match=r"SEQ/img1: image -1 is not a frame \(names -1\.\.3"):
+        FrameSource(seq)
+
+
+def _sixteen_bit(folder: Path, tops: list[int]) -> list[np.ndarray]:
+    """16-bit PNGs 1.png, 2.png, ... of a gradient up to each of `tops`; their pixels."""
+    folder.mkdir(parents=True)
+    ramp = np.linspace(0, 1, 40)[None, :, None] * np.linspace(0.5, 1, 3)[None, None, :]
+    images = [np.repeat(np.round(ramp * top), 8, axis=0).astype(np.uint16) for top in tops]
+    for k, image in enumerate(images, start=1):
+        cv2.imwrite(str(folder / f"{k}.png"), image)
+    return images
+
+
+def test_16_bit_images_of_12_bit_data_are_read_at_their_depth(tmp_path: Path) -> None:
+    """Was: values / 256, 0-15 for 12-bit data: almost black frames, without a word."""
+    images = _sixteen_bit(tmp_path / "d12", [4000, 4095, 2000])
+    src = FrameSource(tmp_path / "d12")
+    assert src.bits == 12
+    message = (
+        r"d12: its 16-bit images hold 12-bit values \(1\.png goes up to 4000 of 65535\): read "
+        r"as 12-bit data, each value / 16 to 8 bits \(not / 256, which makes them almost black\)$"
+    )
+    with pytest.warns(UserWarning, match=message) as said:
+        frames = list(src)
+    assert len(said) == 1  # once for the folder
+    assert all(np.array_equal(f, i >> 4) for f, i in zip(frames, images, strict=True))
+    assert frames[1].max() == 255
+    # frames read at chosen indices and on demand alike (the bootstrap, the colour term)
+    again = FrameSource(tmp_path / "d12")
+    with pytest.warns(UserWarning, match="12-bit values"):
+        assert np.array_equal(again.frames_at([2])[0], images[2] >> 4)
+    # 10-bit data: / 4
+    images = _sixteen_bit(tmp_path / "d10", [1000, 1023])
+    with pytest.warns(UserWarning, match=r"10-bit values .* each value / 4 to 8 bits"):
+        frames = list(FrameSource(tmp_path / "d10"))
+    assert all(np.array_equal(f, i >> 2) for f, i in zip(frames, images, strict=True))
+
+
+def test_a_later_image_brighter_than_the_first_ones_depth_is_clipped_with_a_warning(
+    tmp_path: Path,
+) -> None:
+    images = _sixteen_bit(tmp_path / "d", [1000, 4000, 3000])  # 10 bits decided, then 12
+    with pytest.warns(UserWarning) as said:
+        frames = list(FrameSource(tmp_path / "d"))
+    assert [str(w.message) for w in said][1:] == [
+        f"image {tmp_path / 'd' / '2.png'} goes up to 4000, past the 10 bits its folder's 16-bit "
+        "images are read at (from the first's values): its brighter pixels are clipped to white"
+    ]  # once, not for 3.png too
+    assert np.array_equal(frames[1], np.minimum(images[1], 1023) >> 2)
+
+
+def test_8_bit_and_full_range_16_bit_images_are_read_as_opencv_reads_them(
+    tmp_path: Path,
+) -> None:
+    """The same pixels as cv2.imread's colour read (warnings are errors: none is given)."""
+    _sixteen_bit(tmp_path / "full", [65535, 60000])
+    scene = make_scene(n_frames=3, width=64, height=64, n_walkers=2, rng=0)
+    for folder in (tmp_path / "full", scene.write_images(tmp_path / "eight")):
+        src = FrameSource(folder)
+        assert src.bits is None
+        paths = sorted(folder.iterdir())
+        expected = [cv2.imread(str(p), cv2.IMREAD_COLOR) for p in paths]
+        assert all(np.array_equal(f, e) for f, e in zip(src, expected, strict=True))
 
 
 def test_seqinfo_of_pets_gives_its_true_frame_rate() -> None:

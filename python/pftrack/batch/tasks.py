@@ -380,6 +380,12 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     metrics = error = trace = None
     if seq.gt is not None:  # last: a ground truth that cannot be scored loses no tracks
         try:
+            if frames.gap is not None:  # frame k is the k-th image: the names may be gt's
+                raise ValueError(
+                    f"{frames.gap}: the ground truth's frame numbers may be the names or the "
+                    "images' positions; rename the images 1..N in their order and number the "
+                    "ground truth's frames alike"
+                )
             gt = read_mot(seq.gt, what="ground truth")
             metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
         except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed

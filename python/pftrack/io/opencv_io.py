@@ -6,8 +6,9 @@ Latin-1 ``vid\xfe.mp4`` made on another system: Python keeps such bytes as surro
 ``cv2.imread``, ``cv2.imwrite`` and ``cv2.VideoWriter`` (a segmentation fault, OpenCV 5.0).
 pftrack never hands OpenCV such a name:
 
-- images are read and written through memory (:func:`read_image`: ``numpy.fromfile`` and
-  ``cv2.imdecode``; :func:`write_image`: ``cv2.imencode`` and an atomic write);
+- images are read and written through memory (:func:`read_image`, :func:`read_image_depth`:
+  ``numpy.fromfile`` and ``cv2.imdecode``; :func:`write_image`: ``cv2.imencode`` and an
+  atomic write);
 - videos are opened through a symbolic link with an ASCII name in the system's temporary
   folder (:func:`opencv_name`), removed as soon as OpenCV has opened the file: OpenCV keeps
   its own handle;
@@ -45,6 +46,7 @@ __all__ = [
     "opencv_name",
     "printable",
     "read_image",
+    "read_image_depth",
     "text_for_opencv",
     "utf8_name",
     "write_image",
@@ -135,17 +137,32 @@ def opencv_name(path: PathLike) -> Iterator[str]:
         shutil.rmtree(scratch, ignore_errors=True)
 
 
-def read_image(path: PathLike, flags: int = cv2.IMREAD_COLOR) -> NDArray[np.uint8] | None:
-    """The image at `path` as ``cv2.imread`` reads it (any name); None if it cannot be read."""
+def _decode(path: PathLike, flags: int) -> Any:
+    """``cv2.imread(path, flags)`` under any name: the array, or None if it cannot be read."""
     if is_utf8(path):
-        image: Any = cv2.imread(utf8_name(path), flags)
-        return None if image is None else np.asarray(image, dtype=np.uint8)
+        return cv2.imread(utf8_name(path), flags)
     try:
         data = np.fromfile(os.fspath(path), dtype=np.uint8)
     except (OSError, ValueError):
         return None
-    image = cv2.imdecode(data, flags) if data.size else None
+    return cv2.imdecode(data, flags) if data.size else None
+
+
+def read_image(path: PathLike, flags: int = cv2.IMREAD_COLOR) -> NDArray[np.uint8] | None:
+    """The image at `path` as ``cv2.imread`` reads it (any name); None if it cannot be read."""
+    image = _decode(path, flags)
     return None if image is None else np.asarray(image, dtype=np.uint8)
+
+
+def read_image_depth(path: PathLike) -> NDArray[Any] | None:
+    """The image at `path` in BGR at the depth it is stored in (any name); None if unreadable.
+
+    ``cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH``: a 16-bit PNG or TIFF is uint16 (``cv2.imread``'s
+    colour read keeps its high byte); an 8-bit image is uint8, the pixels :func:`read_image`
+    gives.
+    """
+    image = _decode(path, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+    return None if image is None else np.asarray(image)
 
 
 def write_image(

@@ -4,12 +4,16 @@ Sources, as :class:`FrameSource` takes them:
 
 - a video file OpenCV can decode (a text file is refused, though FFmpeg would decode it as
   ANSI art: :data:`TEXT_FOURCC`);
-- a folder of images, read in natural order (``2.jpg`` before ``10.jpg``); when every name is
-  a number (``000001.jpg``, the MOTChallenge convention) the names are frame numbers, and a
-  missing one is refused rather than shifting every later frame;
+- a folder of images, read in the order of the numbers in their names (``2.jpg`` before
+  ``10.jpg``; decimals by value, ``10.15.png`` before ``10.2.png``: :func:`_natural_order`),
+  frames 1..N in that order; names that skip numbers (``1.png, 6.png``) are read, and
+  detections refused with them (:attr:`FrameSource.gap`); 16-bit images of 10- to 14-bit data
+  are read at their depth (:attr:`FrameSource.bits`);
 - a MOTChallenge sequence folder: ``seqinfo.ini`` gives the frame rate and the image folder
   (``imDir``, default ``img1``); ``det/det.txt`` (or ``det.txt``) is its public detection
-  file. When the image folder does not exist and the sequence folder holds exactly one video
+  file. Integer image names (``000001.jpg``, the MOTChallenge convention) are frame numbers
+  there, image 1 frame 1, and a missing one is refused rather than shifting every later
+  frame. When the image folder does not exist and the sequence folder holds exactly one video
   file (``SEQ/video.mp4``: the layout of ``pftrack batch`` and the shared data), that video is
   read, with the sequence's frame rate and detections;
 - a camera index (``"0"``), or a stream URL (anything with ``://``: ``rtsp://``, ``http://``,
@@ -31,6 +35,7 @@ import warnings
 from collections.abc import Generator, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -40,7 +45,7 @@ from numpy.typing import NDArray
 
 from pftrack._check import number
 from pftrack._typing import PathLike
-from pftrack.io.opencv_io import opencv_name, read_image, utf8_name
+from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
 
 __all__ = [
     "VIDEO_SUFFIXES",
@@ -71,6 +76,17 @@ FRAME_RATE_RANGE = (0.01, 1000.0)
 TEXT_FOURCC = "ansi"
 REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
+
+
+def _bit_depth(top: int) -> int:
+    """The bit depth of 16-bit image data whose largest value is `top`: 8, 10, 12, 14 or 16.
+
+    The fewest bits that hold `top`, rounded up to an even number (cameras give 10, 12 or 14
+    bits; rounding up leaves room for brighter pixels than the image's): 4000 is 12 bits, 4096
+    14, 255 8 (8-bit data in a 16-bit file).
+    """
+    bits = max(8, int(top).bit_length())
+    return min(16, bits + bits % 2)
 
 
 def _file_capture(path: str) -> cv2.VideoCapture:
@@ -374,18 +390,101 @@ def _same_folder(a: Path, b: Path) -> bool:
         return False
 
 
-def _natural_order(folder: Path, images: list[Path]) -> list[Path]:
-    """`images` in :func:`natural_key` order; two names of one key (``1.png``, ``01.png``) refused.
+#: A number in an image's name: digits, and a decimal fraction (``10.15``) where there is one.
+_NUMBER = re.compile(r"\d+(?:\.\d+)?", re.ASCII)
+#: The same with a sign: in names that are numbers alone (``-1``), a leading ``-`` is one.
+_SIGNED = re.compile(r"-?\d+(?:\.\d+)?", re.ASCII)
+#: A name that is an integer alone (``000001``, ``7``, ``-1``): a frame number.
+_INTEGER = re.compile(r"-?\d+", re.ASCII)
 
-    Their order would be the file system's, not the names': frames swapped silently.
+
+def _numbered(stems: Sequence[str]) -> tuple[str, list[str], str] | None:
+    """The numbers `stems` spell between a prefix and a suffix they all share, if they do.
+
+    ``frame_1``, ``frame_6``: ``("frame_", ["1", "6"], "")``; ``10.1``, ``10.15``:
+    ``("", ["10.1", "10.15"], "")``; ``-1``, ``0``: ``("", ["-1", "0"], "")``. The prefix ends
+    in no digit, nor in digits and a point (``10.`` is part of the numbers ``10.1`` and
+    ``10.15``), and the suffix starts in neither. A ``-`` is a sign only in names that are
+    numbers alone (``frame-1`` is frame 1). Two names at least.
+
+    Returns
+    -------
+    tuple of (str, list of str, str) or None
+        The prefix, each stem's number as written, and the suffix. None when some stem is not
+        the prefix, a number and the suffix, and when numbers with a decimal point follow a
+        prefix ending in a letter or a digit (``cam1.2``, ``cam1.10``: camera 1's frames 2 and
+        10, or the times 1.2 and 1.10 of camera ``cam``?).
     """
-    keyed = sorted((natural_key(p.name), p.name, p) for p in images)
+    if len(stems) < 2:
+        return None
+    prefix = re.sub(r"(?:\d+\.)?\d*\Z", "", os.path.commonprefix(list(stems)), flags=re.ASCII)
+    prefix = "" if prefix == "-" else prefix
+    suffix = os.path.commonprefix([s[::-1] for s in stems])[::-1]
+    suffix = re.sub(r"\A\d*(?:\.\d+)?", "", suffix, flags=re.ASCII)
+    number = _NUMBER if prefix else _SIGNED
+    texts = [s[len(prefix) : len(s) - len(suffix)] for s in stems]
+    if any(
+        len(prefix) + len(suffix) > len(s) or not number.fullmatch(t)
+        for s, t in zip(stems, texts, strict=True)
+    ):
+        return None
+    if prefix[-1:].isalnum() and any("." in t for t in texts):
+        return None
+    return prefix, texts, suffix
+
+
+def _decimal_key(name: str) -> tuple[tuple[int, Decimal | str], ...]:
+    """:func:`natural_key` reading digits around a point as one number (``10.15 < 10.2``)."""
+    return tuple(
+        (0, Decimal(part)) if _NUMBER.fullmatch(part) else (1, part.lower())
+        for part in re.split(r"(\d+(?:\.\d+)?)", name, flags=re.ASCII)
+        if part
+    )
+
+
+def _read_two_ways(names: list[str]) -> tuple[str, str] | None:
+    """Two of `names` (in :func:`natural_key` order) that :func:`_decimal_key` orders otherwise.
+
+    None when both keys give one order (as when no name has digits around a point).
+    """
+    if not any(re.search(r"\d\.\d", n, re.ASCII) for n in names):
+        return None
+    as_decimals = sorted(names, key=lambda n: (_decimal_key(n), n))
+    return next(((a, b) for a, b in zip(names, as_decimals, strict=True) if a != b), None)
+
+
+def _natural_order(folder: Path, images: list[Path]) -> list[Path]:
+    """`images` in the order of their names' numbers; two names of one number refused.
+
+    Names that are numbers, integers or decimals, between a prefix and a suffix they all share
+    (``10.1.png``, ``10.15.png``, ``10.2.png``; ``frame_9.png``, ``frame_10.png``; ``-1.png``,
+    ``0.png``) are in the order of those numbers; other names in :func:`natural_key` order,
+    unless reading the digits around a point as one decimal number orders them otherwise
+    (``cam1.2.png``, ``cam1.10.png``): which is meant is not known, and that is refused. Two
+    names of one number (``1.png``, ``01.png``; ``1.1.png``, ``1.10.png``) are refused too:
+    their order would be the file system's, not the names', frames swapped silently.
+    """
+    numbered = _numbered([p.stem for p in images])
+    keys: list[Any] = (
+        [(Decimal(text),) for text in numbered[1]]
+        if numbered is not None
+        else [natural_key(p.name) for p in images]
+    )
+    keyed = sorted(zip(keys, (p.name for p in images), images, strict=True))
     for (k1, n1, _), (k2, n2, _) in itertools.pairwise(keyed):
         if k1 == k2:
             raise ValueError(
                 f"images {n1} and {n2} in folder {folder} have the same number: which comes "
                 "first is not known (rename one)"
             )
+    pair = _read_two_ways([n for _, n, _ in keyed]) if numbered is None else None
+    if pair is not None:
+        raise ValueError(
+            f"images {pair[0]} and {pair[1]} in folder {folder} come in one order if the "
+            "digits around a point in their names are two numbers and in the other if they "
+            "are one decimal number: which comes first is not known (rename them: zero-padded "
+            "numbers, or names that are numbers alone)"
+        )
     return [p for _, _, p in keyed]
 
 
@@ -394,12 +493,14 @@ def _frame_order(
 ) -> list[Path] | None:
     """A folder's images in frame order if their names are frame numbers.
 
-    The names are frame numbers when every stem is all digits (``000001.jpg``, ``1.png``: the
-    MOTChallenge convention). A frame is its image's position, so a hole in the numbering
-    would silently shift every later frame onto the wrong detections (``--detections``, whose
-    frames are those numbers) and ground truth: it is an error, in any folder. A folder that
-    is not a sequence's (`sequence` None) may start at any number (``000000.png`` of a 0-based
-    dump, a cut of a longer one): frame 1 is its lowest.
+    The names are frame numbers when every stem is an integer (``000001.jpg``, ``1.png``: the
+    MOTChallenge convention; ``-1.png``, a negative one). A frame is its image's position, so in
+    a MOTChallenge sequence's image folder a hole in the numbering would silently shift every
+    later frame onto the wrong detections and ground truth (whose frames are those numbers):
+    it is an error there. A folder that is not a sequence's (`sequence` None) may start at any
+    number (``000000.png`` of a 0-based dump, a cut of a longer one) and skip numbers (camera
+    time stamps, every fifth frame): frame 1 is its lowest, frame k its k-th image; detections
+    are refused with such a folder (:attr:`FrameSource.gap`).
 
     Parameters
     ----------
@@ -409,7 +510,8 @@ def _frame_order(
         Its images, in any order.
     sequence : SequenceInfo or None
         The MOTChallenge sequence `folder` is the image folder of: frame 1 is then image 1,
-        and there are ``seqLength`` images when ``seqinfo.ini`` says so. None: not checked.
+        no number is skipped, and there are ``seqLength`` images when ``seqinfo.ini`` says so.
+        None: not checked.
 
     Returns
     -------
@@ -420,11 +522,11 @@ def _frame_order(
     Raises
     ------
     ValueError
-        A number is missing (a hole, or a sequence's images do not start at 1 or end before
-        its ``seqLength``), two images have one number, or a sequence has more images than
+        Two images have one number, or, in a sequence, a number is missing (a hole, images
+        that do not start at 1 or end before its ``seqLength``) or there are more images than
         its ``seqLength``.
     """
-    if not all(p.stem.isascii() and p.stem.isdigit() for p in images):
+    if not all(_INTEGER.fullmatch(p.stem) for p in images):
         return None
     ordered = sorted(images, key=lambda p: (int(p.stem), p.name))
     numbers = [int(p.stem) for p in ordered]
@@ -447,8 +549,13 @@ def _frame_order(
                 f"{folder}: images {ordered[k - 1].name} and {ordered[k].name} are both "
                 f"frame {numbers[k]} (names that are numbers are frame numbers)"
             )
-        if numbers[k] != numbers[k - 1] + 1:
-            raise missing(numbers[k - 1] + 1, len(ordered[k - 1].stem), names)
+        if sequence is not None and numbers[k] != numbers[k - 1] + 1:
+            raise missing(
+                numbers[k - 1] + 1,
+                len(ordered[k - 1].stem),
+                f"{names}; restore it: the sequence's detections and ground truth number its "
+                "frames by them",
+            )
     length = sequence.length if sequence is not None else None
     if length is not None and len(ordered) < length:
         raise missing(numbers[-1] + 1, len(last), f"{names}; seqinfo.ini says seqLength={length}")
@@ -458,6 +565,26 @@ def _frame_order(
             f"seqLength={length}"
         )
     return ordered
+
+
+def _gap(folder: Path, images: list[Path]) -> str | None:
+    """The first number that `images`' names skip, as :attr:`FrameSource.gap` says it.
+
+    For names that are integers between a prefix and a suffix they share (``1.png``,
+    ``6.png``; ``frame_1.png``, ``frame_6.png``: :func:`_numbered`), given in order; None when
+    they skip none, or are not such names (decimal numbers are no frame numbers).
+    """
+    stems = [p.stem for p in images]
+    numbered = _numbered(stems)
+    if numbered is None or any("." in text for text in numbered[1]):
+        return None
+    prefix, texts, suffix = numbered
+    for before, after in itertools.pairwise(texts):
+        if int(after) != int(before) + 1:
+            width = 0 if before.startswith("-") else len(before)
+            name = f"{prefix}{str(int(before) + 1).zfill(width)}{suffix}"
+            return f"{folder}: image {name} is missing (names {stems[0]}..{stems[-1]} skip numbers)"
+    return None
 
 
 def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
@@ -474,6 +601,20 @@ def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
     if (path / "img1").is_dir():
         return path / "img1"
     return path
+
+
+def _no_images(folder: Path) -> str:
+    """The message for a folder source without images; one of videos says how to track them."""
+    videos = video_files(folder)
+    if not videos:
+        return f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+    names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
+    if len(videos) == 1:
+        return f"folder {folder} holds a video ({names}) and no images: give it ({videos[0]})"
+    return (
+        f"folder {folder} holds {len(videos)} videos ({names}) and no images: give one of them "
+        f"({videos[0]}), or track them all with pftrack batch {folder}"
+    )
 
 
 def _images_in(folder: Path) -> list[Path]:
@@ -612,6 +753,21 @@ class FrameSource:
         :func:`sequence_video`); None for a camera or a stream URL.
     width, height : int
         Frame size after `scale`.
+    gap : str or None
+        For an image folder whose names are numbered with a gap (``1.png, 6.png, 11.png``,
+        ``1690000000000.png, 1690000000033.png``, ``frame_1.png, frame_6.png``; outside a
+        MOTChallenge sequence's image folder, where a gap is an error), what is missing:
+        ``"imgs: image 2 is missing (names 1..11 skip numbers)"``. The frames are still
+        numbered 1..N in the names' order; detections, whose frame numbers could count the
+        images by name or by position, are refused with it (:func:`pftrack.track_frames`).
+        None otherwise.
+    bits : int or None
+        For an image folder whose first image is 16-bit with values of fewer bits (10- or
+        12-bit camera data: :func:`_bit_depth` of its largest value, 10, 12 or 14; 8 for 8-bit
+        data), the depth every 16-bit image of the folder is read at: each value divided by
+        ``2 ** (bits - 8)`` (a value past it white), not by 256 as OpenCV reads them, which
+        makes such images almost black. None: images read as OpenCV reads them (8-bit images,
+        full-range 16-bit ones), a video, a camera or a stream.
 
     Raises
     ------
@@ -621,16 +777,17 @@ class FrameSource:
         If `source` is not a path, a string or an int (a bool is refused).
     ValueError
         If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
-        no frame; or if the images of a folder are
-        named by number and one is missing (a hole in the numbering; in a MOTChallenge
-        sequence's image folder, also numbers that do not start at 1 or a count other than
-        ``seqLength``).
+        no frame; if two images of a folder have one number; or if a MOTChallenge sequence's
+        image folder is named by number and one is missing (a hole in the numbering, numbers
+        that do not start at 1 or a count other than ``seqLength``).
 
     Warns
     -----
     UserWarning
         Once, when a video read to its end had fewer frames than its header says, or a number
-        other than its sequence's ``seqLength`` (counted as read: no pass of its own).
+        other than its sequence's ``seqLength`` (counted as read: no pass of its own). At the
+        first image read, when a folder's 16-bit images are read at :attr:`bits`; once, when
+        a later one is brighter than that depth holds (its brighter pixels clipped to white).
 
     Notes
     -----
@@ -657,6 +814,11 @@ class FrameSource:
         self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
         self._image_shape = (0, 0)  # (height, width) of a folder's first image
+        # a folder's 16-bit images of fewer bits (from its first image): read at that depth
+        self.bits: int | None = None
+        self.gap: str | None = None  # an image folder's names skip a number
+        self._depth_note: str | None = None  # the warning saying so, given at the first read
+        self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._cap: Any = None
         self._replay: list[NDArray[np.uint8]] = []
@@ -714,16 +876,61 @@ class FrameSource:
         folder = _image_folder(path, self.sequence)
         images = _images_in(folder)
         if not images:
-            raise ValueError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}")
+            raise ValueError(_no_images(folder))
         seq = self.sequence
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
         self._images = numbered or _natural_order(folder, images)
-        first = read_image(self._images[0])
-        if first is None:
-            raise ValueError(f"cannot read image {self._images[0]}")
+        self.gap = _gap(folder, self._images)
+        first = self._open_depth(folder, self._images[0])
         self._image_shape = (int(first.shape[0]), int(first.shape[1]))
         return first, len(self._images)
+
+    def _open_depth(self, folder: Path, path: Path) -> NDArray[Any]:
+        """A folder's first image, 8-bit; sets :attr:`bits` when it is 16-bit of fewer bits.
+
+        16-bit images whose values use only the low bits (10- or 12-bit camera data) become
+        almost black as OpenCV reads them in colour (value / 256): they are read at the depth
+        of the first, :func:`_bit_depth` of its largest value, for the whole folder. 8-bit and
+        full-range 16-bit images are read as OpenCV reads them, the same pixels as ever.
+        """
+        first = read_image_depth(path)
+        if first is None:
+            raise ValueError(f"cannot read image {path}")
+        if first.dtype == np.uint8:  # the pixels read_image gives
+            return first
+        top = int(first.max()) if first.dtype == np.uint16 else 65535
+        bits = _bit_depth(top)
+        if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
+            again = read_image(path)
+            if again is None:
+                raise ValueError(f"cannot read image {path}")
+            return again
+        self.bits = bits
+        self._depth_note = (
+            f"{folder}: its 16-bit images hold {bits}-bit values ({path.name} goes up to {top} "
+            f"of 65535): read as {bits}-bit data, each value / {1 << (bits - 8)} to 8 bits "
+            "(not / 256, which makes them almost black)"
+        )
+        return self._to_8_bits(first, path)
+
+    def _to_8_bits(self, image: NDArray[Any], path: Path) -> NDArray[np.uint8]:
+        """A 16-bit `image` of :attr:`bits` bits as 8 bits; brighter pixels white (said once)."""
+        bits = self.bits or 16
+        limit = (1 << bits) - 1
+        top = int(image.max())
+        if top > limit:
+            image = np.minimum(image, limit)
+            if not self._clipped:
+                self._clipped = True
+                warnings.warn(
+                    f"image {path} goes up to {top}, past the {bits} bits its folder's 16-bit "
+                    f"images are read at (from the first's values): its brighter pixels are "
+                    "clipped to white",
+                    UserWarning,
+                    stacklevel=4,
+                )
+        return np.asarray(np.right_shift(image, bits - 8), dtype=np.uint8)
 
     @staticmethod
     def _probe_file(path: Path) -> tuple[NDArray[Any], float, int]:
@@ -770,8 +977,22 @@ class FrameSource:
         return np.asarray(frame, dtype=np.uint8)  # OpenCV's colour reads are uint8: no copy
 
     def _read_image(self, path: Path) -> NDArray[np.uint8]:
-        """One image of a folder, resized; ValueError if unreadable or not the first's size."""
-        img = read_image(path)
+        """One image of a folder, resized; ValueError if unreadable or not the first's size.
+
+        At :attr:`bits` when the folder's first image set it (the first read says so, once).
+        """
+        if self._depth_note is not None:
+            note, self._depth_note = self._depth_note, None
+            warnings.warn(note, UserWarning, stacklevel=3)
+        img: NDArray[Any] | None
+        if self.bits is None:
+            img = read_image(path)
+        else:
+            img = read_image_depth(path)
+            if img is not None and img.dtype == np.uint16:
+                img = self._to_8_bits(img, path)
+            elif img is not None and img.dtype != np.uint8:
+                img = read_image(path)
         if img is None:
             raise ValueError(f"cannot read image {path}")
         if img.shape[:2] != self._image_shape:

@@ -174,8 +174,9 @@ def track_frames(
     ------
     ValueError
         `detections` of frames after the video's last, by its frame count (one rule for every
-        length; a source of unknown length, count 0, is not checked), or no frame could be
-        read.
+        length; a source of unknown length, count 0, is not checked); `detections` for an image
+        folder whose names skip numbers (:attr:`FrameSource.gap`: whether the detections count
+        frames by name or by position is not known); or no frame could be read.
 
     Warns
     -----
@@ -198,6 +199,7 @@ def track_frames(
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
     if detections:
+        _check_numbering(frames)
         _check_last_frame(detections, len(frames))
     seed = (
         rng
@@ -261,6 +263,23 @@ def track_frames(
                 stacklevel=2,
             )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+
+
+def _check_numbering(frames: object) -> None:
+    """Refuse detections for an image folder whose names skip numbers (:attr:`FrameSource.gap`).
+
+    Detection frame k is the k-th image; a detector run over such a folder may have numbered
+    its frames by the names instead (``6.png`` as frame 6), and nothing tells which: every frame
+    after the first gap would get another image's boxes, silently.
+    """
+    gap = frames.gap if isinstance(frames, FrameSource) else None
+    if gap is not None:
+        raise ValueError(
+            f"{gap}: detections cannot be matched to these images (their frame numbers may be "
+            "the names or the images' positions); rename the images 1..N in their order and "
+            "number the detections' frames alike (frame k: the k-th image), or track without "
+            "detections (frames 1..N in the names' order)"
+        )
 
 
 def _check_last_frame(detections: dict[int, F64], n_frames: int) -> None:
