@@ -172,7 +172,8 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     Raises
     ------
     TypeError
-        Not an array of uint8 (float frames; ``None``).
+        Not an array of uint8 (float frames; ``None``; a list, named as one, not by the dtype
+        NumPy gives it).
     ValueError
         Not of shape (H, W, 3): a grey (2-D or one-channel) or a BGRA frame's message names
         the ``cv2.cvtColor`` conversion that makes it BGR.
@@ -180,6 +181,12 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     f = np.asarray(frame)
     if f.dtype == object:
         raise TypeError(f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array")
+    if f.dtype != np.uint8 and not isinstance(frame, np.ndarray):
+        # a list (``frame.tolist()``) is int64 to NumPy: its dtype is not what the user gave
+        raise TypeError(
+            f"{what} is {type(frame).__name__}, expected a NumPy uint8 array (H, W, 3) (BGR, "
+            "as cv2 reads it)"
+        )
     if f.dtype != np.uint8:
         raise TypeError(f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
     if f.ndim != 3 or f.shape[2] != 3:
