@@ -316,6 +316,32 @@ def test_experiment_gaps_refuses_an_image_size_of_neither_form(
     )
 
 
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        (["--image-size", "10x"], "argument --image-size: expected W H or WxH with W and H "
+         "integers, got '10x'"),  # was: invalid int value: ''
+        (["--image-size", "10xab"], "argument --image-size: expected W H or WxH with W and H "
+         "integers, got '10xab'"),
+        (["--image-size", "640", "4.5"], "argument --image-size: expected W H or WxH with W and "
+         "H integers, got '640 4.5'"),
+        (["--image-size", "1x2x3"], "argument --image-size: expected W H or WxH, got '1x2x3'"),
+        (["--scale", "inf"], "argument --scale: expected a finite scale > 0, got inf"),
+        (["--scale", "A=nan"], "argument --scale: expected a finite scale > 0, got nan"),
+        (["--scale", "0"], "argument --scale: expected a finite scale > 0, got 0.0"),
+    ],
+)  # fmt: skip
+def test_eval_names_the_form_of_a_bad_image_size_or_scale(
+    option: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Were ``argument --image-size: invalid int value: ''`` and ``expected a scale > 0, got
+    inf`` (inf is > 0: what is wrong is that it is not finite)."""
+    with pytest.raises(SystemExit) as e:
+        main(["eval", "--gt", "G", "--res", "R", *option])
+    assert e.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1] == f"pftrack eval: error: {message}"
+
+
 def _walkers(path: Path) -> Path:
     """Ground truth of 15 random walkers over 150 frames of a 768x576 scene."""
     rng = np.random.default_rng(4)

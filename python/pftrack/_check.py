@@ -12,6 +12,7 @@ __all__ = [
     "MAX_COORD",
     "MAX_FRAME",
     "MAX_ID",
+    "MOT_DEFAULTS",
     "bad_id_message",
     "bgr_array",
     "bgr_frame",
@@ -23,6 +24,7 @@ __all__ = [
     "flag",
     "generator",
     "integer",
+    "mot_rows",
     "number",
     "real_array",
     "seed",
@@ -90,6 +92,45 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
     return raw.astype(np.float64, copy=False)
 
 
+#: Columns 7-10 of a MOTChallenge row (conf, x, y, z) where rows have fewer: the values
+#: :func:`pftrack.io.mot.read_mot` gives a line of 6 to 9 fields.
+MOT_DEFAULTS = (1.0, -1.0, -1.0, -1.0)
+
+
+def mot_rows(rows: ArrayLike, what: str) -> F64:
+    """MOTChallenge rows (M, 6..10) as an (M, 10) float64 array, the missing columns added.
+
+    The first check of every function that takes rows (``fill_gaps``, ``smooth_tracks``,
+    ``link_tracklets``, ``write_mot``, ...), so that they take the same arrays with the same
+    messages, and the arrays the commands take as files: 6 to 10 columns ``frame, id, left,
+    top, width, height[, conf, x, y, z]``, the missing ones :data:`MOT_DEFAULTS` (conf 1,
+    x, y, z -1), as :func:`pftrack.io.mot.read_mot` reads a shorter line. An array without
+    values (``[]``, ``np.zeros((0,))``, ``np.zeros((0, 10))``) is no rows. Only the layout is
+    checked here; the callers check the values.
+
+    Raises
+    ------
+    TypeError
+        Not real numbers (text, complex numbers, booleans).
+    ValueError
+        Ragged rows, or not of shape (M, 6..10):
+        ``{what}: rows must have shape (M, 6..10) (6 to 10 columns: frame, id, left, top,
+        width, height[, conf, x, y, z]), got (2, 3)``.
+    """
+    a = real_array(rows, f"{what}: rows", booleans=False)
+    if a.size == 0:
+        return np.zeros((0, 10))
+    if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
+        raise ValueError(
+            f"{what}: rows must have shape (M, 6..10) (6 to 10 columns: frame, id, left, top, "
+            f"width, height[, conf, x, y, z]), got {a.shape}"
+        )
+    if a.shape[1] < 10:
+        pad = np.tile(np.asarray(MOT_DEFAULTS[a.shape[1] - 6 :]), (len(a), 1))
+        a = np.hstack([a, pad])
+    return a
+
+
 #: Names of the values of a box ``left, top, width, height`` (columns 3-6 of a MOTChallenge row).
 BOX_VALUES = ("left", "top", "width", "height")
 
@@ -131,7 +172,8 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     Raises
     ------
     TypeError
-        Not an array of uint8 (float frames; ``None``).
+        Not an array of uint8 (float frames; ``None``; a list, named as one, not by the dtype
+        NumPy gives it).
     ValueError
         Not of shape (H, W, 3): a grey (2-D or one-channel) or a BGRA frame's message names
         the ``cv2.cvtColor`` conversion that makes it BGR.
@@ -139,6 +181,12 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     f = np.asarray(frame)
     if f.dtype == object:
         raise TypeError(f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array")
+    if f.dtype != np.uint8 and not isinstance(frame, np.ndarray):
+        # a list (``frame.tolist()``) is int64 to NumPy: its dtype is not what the user gave
+        raise TypeError(
+            f"{what} is {type(frame).__name__}, expected a NumPy uint8 array (H, W, 3) (BGR, "
+            "as cv2 reads it)"
+        )
     if f.dtype != np.uint8:
         raise TypeError(f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
     if f.ndim != 3 or f.shape[2] != 3:

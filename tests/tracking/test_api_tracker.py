@@ -919,6 +919,73 @@ def test_detections_of_a_source_of_unknown_length_are_not_checked_up_front():
     assert run.n_frames == 1
 
 
+_BOX = np.array([[40.0, 30.0, 20.0, 40.0, 0.9]])
+
+
+@pytest.mark.parametrize(
+    ("detections", "error", "message"),
+    [
+        ("det.txt", TypeError, "detections is a path ('det.txt'), expected the dict {frame: "
+         "(k, 5) [left, top, w, h, score]} of its boxes: load the file first with "
+         "pftrack.load_detections(path)"),
+        (Path("det.txt"), TypeError, "detections is a path ('det.txt')"),
+        ([_BOX], TypeError, "detections must be a dict {frame: (k, 5) [left, top, w, h, score] "
+         "array}, as pftrack.load_detections returns, got list"),
+        ({1: _BOX[:, :3]}, ValueError, "detections[1] must have shape (k, 5) [left, top, w, h, "
+         "score] (or (k, 4)), got (1, 3)"),
+        ({1: _BOX[0]}, ValueError, "detections[1] must have shape (k, 5) "),
+        ({"1": _BOX}, TypeError, "detections key '1' is str, expected an int frame number"),
+        ({1.0: _BOX}, TypeError, "detections key 1.0 is float, expected an int frame number"),
+        ({True: _BOX}, TypeError, "detections key True is bool"),
+        ({0: _BOX, 1: _BOX}, ValueError, "detections key 0 is not a frame number in "
+         "1..2147483647: frames are 1-based, as in det.txt and load_detections (0-based keys "
+         "would put every box one frame late; add 1 to each)"),
+        ({-3: _BOX}, ValueError, "detections key -3 is not a frame number in 1..2147483647: "),
+        ({2: _BOX, 1: [[1, 2, 3], [1, 2]]}, ValueError, "detections[1] must be a rectangular "
+         "array of numbers"),
+        ({1: [["a", "b", "c", "d"]]}, TypeError, "detections[1] must hold real numbers"),
+        ({1: np.array([[40.0, 30, np.nan, 40, 0.9]])}, ValueError, "detections[1] row 0 "
+         "contains NaN or inf"),
+        ({1: np.array([[40.0, 30, -20, 40, 0.9]])}, ValueError, "detections[1] row 0 [40.0, "
+         "30.0, -20.0, 40.0]: negative box width or height (left, top, w, h)"),
+    ],
+)  # fmt: skip
+def test_track_frames_checks_detections_first(detections, error, message):
+    """Were: AttributeError ('str' object has no attribute 'items') for a path or a list,
+    IndexError for a (k, 3) array, a TypeError from ``<=`` for string keys, and 0-based or
+    negative keys accepted silently, every box one frame late (frame 0's dropped)."""
+    frames = [np.full((120, 160, 3), 90, np.uint8)] * 3
+
+    def no_frames():  # the checks come before any frame is read
+        raise AssertionError("a frame was read")
+        yield
+
+    for source in (frames, no_frames()):
+        with pytest.raises(error, match="^" + re.escape(message)):
+            track_frames(source, detections=detections)
+
+
+@pytest.mark.filterwarnings("ignore:no track over:RuntimeWarning")
+def test_track_frames_takes_detections_as_load_detections_gives_them(tmp_path):
+    """NumPy int keys, lists, (k, 4) rows without score, empty values: the rows of the file."""
+    scene = make_scene(n_frames=12, rng=0)
+    det = tmp_path / "det.txt"
+    write_mot(det, scene.truth)
+    loaded = load_detections(det)
+    expected = track_frames(scene.frames, detections=loaded, rng=0).rows
+    as_lists = {np.int64(f): v.tolist() for f, v in loaded.items()}
+    as_lists[len(scene.frames) + 5] = []  # an empty frame past the end is no box
+    np.testing.assert_array_equal(
+        track_frames(scene.frames, detections=as_lists, rng=0).rows, expected
+    )
+    scored_1 = {f: np.column_stack([v[:, :4], np.ones(len(v))]) for f, v in loaded.items()}
+    np.testing.assert_array_equal(
+        track_frames(scene.frames, detections={f: v[:, :4] for f, v in loaded.items()},
+                     rng=0).rows,
+        track_frames(scene.frames, detections=scored_1, rng=0).rows,
+    )  # fmt: skip
+
+
 def test_cli_refuses_detections_of_a_longer_video_for_a_1_frame_video(tmp_path, capsys):
     """The trial's ``track pets_short1.avi --detections det_200.txt``: was a warning, exit 0."""
     video = make_scene(n_frames=1, rng=0).write_video(tmp_path / "one.avi")

@@ -122,6 +122,15 @@ def test_a_frame_of_the_wrong_dtype_is_a_type_error(entry):
         ENTRY_POINTS[entry](np.zeros((6, 8, 3), np.float32))
 
 
+@pytest.mark.parametrize("entry", sorted(ENTRY_POINTS))
+def test_a_frame_given_as_a_list_is_named_as_one(entry):
+    """Was ``frame dtype is int64``: the dtype NumPy gives ``frame.tolist()``, not the user's
+    (the detectors' own check already said ``frame is list, expected a numpy.ndarray``)."""
+    expected = r"frame is list, expected a (NumPy uint8 array \(H, W, 3\)|numpy\.ndarray)"
+    with pytest.raises(TypeError, match=expected):
+        ENTRY_POINTS[entry](np.zeros((6, 8, 3), np.uint8).tolist())
+
+
 def test_unpacked_views_track_as_their_packed_copies(frames):
     rgb = [np.ascontiguousarray(f[..., ::-1]) for f in frames]  # a user's RGB frames
     views = [f[..., ::-1] for f in rgb]  # the usual RGB -> BGR view

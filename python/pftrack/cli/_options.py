@@ -100,9 +100,13 @@ class WidthHeight(argparse.Action):
                 size.append(self.number(part))
             except argparse.ArgumentTypeError as exc:
                 raise argparse.ArgumentError(self, str(exc)) from None
-            except (TypeError, ValueError):
-                name = getattr(self.number, "__name__", "number")
-                raise argparse.ArgumentError(self, f"invalid {name} value: {part!r}") from None
+            except (TypeError, ValueError):  # was "invalid int value: ''" for "10x"
+                kind = {"int": "integers", "float": "numbers"}.get(
+                    getattr(self.number, "__name__", ""), "numbers"
+                )
+                raise argparse.ArgumentError(
+                    self, f"expected W H or WxH with W and H {kind}, got {' '.join(words)!r}"
+                ) from None
         setattr(namespace, self.dest, tuple(size))
 
 

@@ -39,7 +39,7 @@ def scale_spec(text: str) -> tuple[str | None, float]:
             f"expected S or NAME=S with S a number, got {text!r}"
         ) from None
     if not 0 < v < float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a scale > 0, got {v}")
+        raise argparse.ArgumentTypeError(f"expected a finite scale > 0, got {v}")
     return (name or None), v
 
 

@@ -19,13 +19,13 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import BOX_VALUES, MAX_FRAME, first_bad_box, real_array
+from pftrack._check import BOX_VALUES, MAX_FRAME, MOT_DEFAULTS, first_bad_box, mot_rows
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write, refuse_dash
 
 #: Column indices of a MOTChallenge row.
 FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
-_DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, 1.0, -1.0, -1.0, -1.0)
+_DEFAULTS = (np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, *MOT_DEFAULTS)
 _NAMES = ("frame", "id", "left", "top", "width", "height", "conf", "x", "y", "z")
 
 
@@ -361,12 +361,9 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
     (frames in ``1..2**31-1``; boxes by its rule, :func:`pftrack._check.first_bad_box`,
     applied to the values given, before any rounding); ids must be integers too.
     """
-    # ragged rows or text: one line naming them (any iterable of rows, as np.asarray takes)
-    a = real_array(cast("ArrayLike", rows), f"{who}: rows")
-    if a.size == 0:
-        a = np.zeros((0, 10))
-    if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
-        raise ValueError(f"{who}: rows must have shape (M, 6..10), got {a.shape}")
+    # ragged rows or text: one line naming them (any iterable of rows, as np.asarray takes);
+    # the layout as every function taking rows checks it, the default columns added
+    a = mot_rows(cast("ArrayLike", rows), who)
     if not np.all(np.isfinite(a)):
         k = int(np.flatnonzero(~np.all(np.isfinite(a), axis=1))[0])
         raise ValueError(f"{who}: row {k} has NaN or inf: {a[k].tolist()}")
@@ -389,9 +386,6 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
             f"{who}: row {k} (frame {a[k, FRAME]:g}, id {a[k, ID]:g}) has {BOX_VALUES[c]} "
             f"{a[k, LEFT + c]:g}: {problem}"
         )
-    if a.shape[1] < 10:
-        pad = np.tile(np.asarray(_DEFAULTS[a.shape[1] :]), (a.shape[0], 1))
-        a = np.hstack([a, pad])
     return a
 
 

@@ -18,6 +18,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import mot_rows
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.linking import check_unique
@@ -93,6 +94,7 @@ def trajectories(gt: F64, point: str = "centre") -> dict[int, F64]:
     """
     if point not in ("centre", "center", "foot"):
         raise ValueError(f"trajectories: point is {point!r}, expected 'centre' or 'foot'")
+    gt = mot_rows(gt, "trajectories")
     check_unique(gt, who="trajectories")
     out: dict[int, F64] = {}
     for tid in np.unique(gt[:, 1]).astype(int):

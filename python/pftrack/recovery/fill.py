@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
 from pftrack._typing import F64, RecoveryMethod
@@ -159,7 +159,7 @@ def unfilled_note(count: int, longest: int, max_gap: int) -> str:
 
 
 def fill_gaps(
-    tracks: F64,
+    tracks: ArrayLike,
     method: RecoveryMethod = DEFAULT_METHOD,
     max_gap: int = DEFAULT_MAX_GAP,
     noise: NoiseEstimate | None = None,
@@ -172,8 +172,11 @@ def fill_gaps(
 
     Parameters
     ----------
-    tracks : (M, 10) ndarray
-        MOTChallenge rows; each (frame, id) at most once.
+    tracks : (M, 6..10) array_like
+        MOTChallenge rows; each (frame, id) at most once. Rows of fewer than 10 columns get
+        the columns a file's shorter lines get (conf 1, x, y, z -1:
+        :func:`pftrack._check.mot_rows`), as ``pftrack recover`` reads them; an empty array
+        (``[]``) is no rows.
     method : str
         One of :data:`~pftrack.recovery.registry.METHODS`; default ``"auto"`` (calibrated on
         the file's own observed tracks, :mod:`pftrack.recovery.calibrate`).
@@ -204,7 +207,7 @@ def fill_gaps(
         never below half the smaller end size), else by linear interpolation; ``conf`` = the
         smaller of the two neighbours' and columns 8-10 ``1, -1, -1``: the interpolated flag
         (column 8, :data:`FLAG_COLUMN`) and no world ``y``, ``z`` (:data:`FILLED_MARK`).
-        Observed rows are returned unchanged.
+        Observed rows are returned unchanged (with 10 columns).
     report : FillReport
         How many holes and rows were filled, how many holes were longer than `max_gap` (left
         unfilled: ``report.n_long_holes``, ``report.longest_hole``); with ``"auto"``, what
@@ -213,24 +216,26 @@ def fill_gaps(
     Raises
     ------
     TypeError
-        `combine` not a bool, `seed` not an int, `noise` not a NoiseEstimate.
+        Rows that are not real numbers, `combine` not a bool, `seed` not an int, `noise` not a
+        NoiseEstimate.
     ValueError
         Unknown method, a negative `seed`, `bags` not None or an integer in ``0..10000`` (or
         more than 0 with ``combine=False``), `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
-        rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
+        rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
         or height, a value beyond ±1e9 px) or a duplicate (frame, id).
     """
+    rows = _check.mot_rows(tracks, "fill_gaps")  # (M, 6..10), [] too, as smooth_tracks
     new_rows, report = fill_rows(
-        tracks, method, max_gap, noise, seed=seed, combine=combine, bags=bags
+        rows, method, max_gap, noise, seed=seed, combine=combine, bags=bags
     )
-    filled = np.vstack([np.asarray(tracks, dtype=np.float64), new_rows])
+    filled = np.vstack([rows, new_rows])
     order = np.lexsort((filled[:, 1], filled[:, 0]))
     return filled[order], report
 
 
 def fill_rows(
-    rows: F64,
+    rows: ArrayLike,
     method: RecoveryMethod = DEFAULT_METHOD,
     max_gap: int = DEFAULT_MAX_GAP,
     noise: NoiseEstimate | None = None,

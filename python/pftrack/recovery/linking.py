@@ -26,7 +26,7 @@ from pftrack._check import (
     bad_id_message,
     first_bad_box,
     first_bad_id,
-    real_array,
+    mot_rows,
 )
 from pftrack._typing import F64, PathLike
 from pftrack.boxes import _to_cxcywh
@@ -124,7 +124,7 @@ def gate_for_rows(config: LinkConfig, rows: ArrayLike) -> LinkConfig:
     at x = 2500 in a 768x576 file made the gate 3.6 times wider, and fragments of different
     people were joined). On the files we have every edge lies within 1.03 times that one.
     """
-    a = np.asarray(rows, np.float64).reshape(-1, 10) if np.size(rows) else np.zeros((0, 10))
+    a = mot_rows(rows, "gate_for_rows")
     if len(a) == 0:
         return config
     edges = (a[:, 2] + a[:, 4], a[:, 3] + a[:, 5])  # right, bottom
@@ -168,9 +168,9 @@ def filled_mask(rows: ArrayLike) -> NDArray[np.bool_]:
 
     Parameters
     ----------
-    rows : (M, 10) array_like
+    rows : (M, 6..10) array_like
         MOTChallenge rows, e.g. :func:`pftrack.io.mot.read_mot` of a ``pftrack recover`` or
-        ``pftrack smooth`` output.
+        ``pftrack smooth`` output (fewer than 10 columns: no row is filled, as in a file).
 
     Returns
     -------
@@ -182,14 +182,12 @@ def filled_mask(rows: ArrayLike) -> NDArray[np.bool_]:
 
     Raises
     ------
+    TypeError
+        Not real numbers.
     ValueError
-        If `rows` is not ``(M, 10)``.
+        If `rows` is not ``(M, 6..10)`` (:func:`pftrack._check.mot_rows`).
     """
-    a = np.asarray(rows, dtype=np.float64)
-    if a.size == 0:
-        return np.zeros(0, dtype=bool)
-    if a.ndim != 2 or a.shape[1] != 10:
-        raise ValueError(f"filled_mask: rows must have shape (M, 10), got {a.shape}")
+    a = mot_rows(rows, "filled_mask")
     mark = np.asarray(FILLED_MARK)
     out: NDArray[np.bool_] = np.all(a[:, FLAG_COLUMN : FLAG_COLUMN + 3] == mark, axis=1)
     return out
@@ -464,7 +462,7 @@ def _sparse_assignment(
 
 
 def link_tracklets(
-    tracks: F64,
+    tracks: ArrayLike,
     config: LinkConfig = LinkConfig(),
     frames: Sequence[NDArray[np.uint8]] | None = None,
 ) -> tuple[F64, dict[int, int]]:
@@ -481,8 +479,9 @@ def link_tracklets(
 
     Parameters
     ----------
-    tracks : (M, 10) ndarray
-        MOTChallenge rows of a tracker's output.
+    tracks : (M, 6..10) array_like
+        MOTChallenge rows of a tracker's output (fewer than 10 columns: those of a file's
+        shorter lines added, conf 1, x, y, z -1, :func:`pftrack._check.mot_rows`).
     config : LinkConfig
         Gates and weights.
     frames : sequence of (H, W, 3) uint8, optional
@@ -537,13 +536,14 @@ def link_tracklets(
 def check_rows(rows: ArrayLike, what: str) -> F64:
     """The rows as an ``(M, 10)`` float64 array, checked; ValueError/TypeError naming the problem.
 
+    Their layout first, as every function taking rows checks it (:func:`pftrack._check.
+    mot_rows`): ``(M, 6..10)``, the missing columns as a file's (conf 1, x, y, z -1), and any
+    array without values (``[]``) no rows; then the values.
     Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, every
     value finite, and the boxes what :func:`pftrack.io.mot.read_mot` reads (:func:`check_boxes`:
     no negative width or height, no value beyond ±1e9 px). `what` names the caller in messages.
     """
-    a = real_array(rows, f"{what}: rows", booleans=False)
-    if a.ndim != 2 or a.shape[1] != 10:
-        raise ValueError(f"{what}: rows must have shape (M, 10) (10 columns), got {a.shape}")
+    a = mot_rows(rows, what)
     f, i = a[:, 0], a[:, 1]
     finite = np.isfinite(a)
     if not finite.all():
@@ -603,7 +603,7 @@ def check_file_ids(rows: F64, path: PathLike) -> None:
 
 
 def check_unique(
-    rows: F64,
+    rows: ArrayLike,
     line_numbers: Iterable[int] | None = None,
     path: PathLike | None = None,
     *,
@@ -616,6 +616,7 @@ def check_unique(
     `who` (the function checking) is given. When every id is -1 (a MOTChallenge detection
     file: untracked boxes), it says so: tracks are needed.
     """
+    rows = mot_rows(rows, who or "check_unique")
     if len(rows) == 0:
         return
     key = rows[:, 0].astype(np.int64) * (1 << 32) + rows[:, 1].astype(np.int64)

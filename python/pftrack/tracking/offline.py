@@ -276,9 +276,10 @@ def repair_crossings(
 
     Parameters
     ----------
-    rows : (M, 10) array_like
+    rows : (M, 6..10) array_like
         MOTChallenge rows ``frame, id, left, top, width, height, ...``, at most one per
-        (frame, id). Their boxes decide which tracks overlap.
+        (frame, id) (fewer than 10 columns: completed as a file's lines,
+        :func:`pftrack._check.mot_rows`). Their boxes decide which tracks overlap.
     observed : (M,) array_like of bool, optional
         Which rows are detections (the evidence); default every row.
     config : CrossingConfig
@@ -297,7 +298,7 @@ def repair_crossings(
     ValueError
         Bad rows, a (frame, id) seen twice, or `observed` / `measurements` of the wrong shape.
     """
-    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "repair_crossings")
+    a: F64 = check_rows(rows, "repair_crossings")
     a = a.copy()
     n = len(a)
     obs = np.ones(n, dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
@@ -467,8 +468,11 @@ def smooth_tracks(
 
     Parameters
     ----------
-    rows : (M, 10) array_like
+    rows : (M, 6..10) array_like
         ``frame, id, left, top, width, height, conf, x, y, z`` rows, one per (frame, id).
+        Rows of 6 to 9 columns get the columns a file's shorter lines get (conf 1, x, y,
+        z -1: :func:`pftrack._check.mot_rows`), as ``pftrack smooth`` reads them; an empty
+        array (``[]``) is no rows.
     observed : (M,) array_like of bool, optional
         Which rows are detections; the others (e.g. a tracker's coasting boxes) are
         interpolated by the smoother. Default: every row.
@@ -523,8 +527,8 @@ def smooth_tracks(
     TypeError
         `link` not a LinkConfig, ``"auto"`` or None.
     ValueError
-        Rows not ``(M, 10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
-        id, a non-finite box, a box (of the rows or `measurements`) that
+        Rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a
+        non-integer id, a non-finite box, a box (of the rows or `measurements`) that
         :func:`pftrack.io.mot.read_mot` refuses (a negative width or height, a value beyond
         ±1e9 px), `observed` / `measurements` of the wrong shape, or `max_gap` not None or an
         int in ``1..MAX_GAP_LIMIT``.
@@ -549,7 +553,7 @@ def smooth_tracks(
             "smooth_tracks: link must be a LinkConfig, 'auto' or None, got "
             f"{type(link).__name__} {link!r}"
         )
-    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "smooth_tracks")
+    a: F64 = check_rows(rows, "smooth_tracks")
     check_unique(a, who="smooth_tracks")  # was: BoxSmoother.smooth's "frames must be ..."
     a = a.copy()
     obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
@@ -620,8 +624,9 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
 
     Parameters
     ----------
-    rows : (M, 10) array_like
-        MOTChallenge rows ``frame, id, left, top, width, height, ...``.
+    rows : (M, 6..10) array_like
+        MOTChallenge rows ``frame, id, left, top, width, height, ...`` (fewer than 10
+        columns: completed as a file's lines, :func:`pftrack._check.mot_rows`).
     inside : float
         Share of a box's area, in (0, 1].
     area_ratio : float
@@ -642,7 +647,7 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
         raise ValueError(f"drop_nested: inside is {inside}, expected a value in (0, 1]")
     if not 1.0 <= area_ratio < np.inf:
         raise ValueError(f"drop_nested: area_ratio is {area_ratio}, expected a finite value >= 1")
-    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "drop_nested")
+    a: F64 = check_rows(rows, "drop_nested")
     drop = np.zeros(len(a), dtype=bool)
     for idx in _frame_groups(a[:, 0]):
         if len(idx) < 2:
@@ -684,8 +689,9 @@ def complete_boxes(
 
     Parameters
     ----------
-    rows : (M, 10) array_like
-        MOTChallenge rows ``frame, id, left, top, width, height, ...``.
+    rows : (M, 6..10) array_like
+        MOTChallenge rows ``frame, id, left, top, width, height, ...`` (fewer than 10
+        columns: completed as a file's lines, :func:`pftrack._check.mot_rows`).
     lines : (2, 2) array_like
         ``[[h_slope, h_intercept], [w_slope, w_intercept]]`` in the foot row.
     share : float
@@ -717,7 +723,7 @@ def complete_boxes(
             f"complete_boxes: lines must be a finite (2, 2) array [[h_slope, h_intercept], "
             f"[w_slope, w_intercept]], got shape {coef.shape}"
         )
-    a: F64 = check_rows(np.zeros((0, 10)) if np.size(rows) == 0 else rows, "complete_boxes").copy()
+    a: F64 = check_rows(rows, "complete_boxes").copy()
     if coef[0, 0] == 1.0 or len(a) == 0:  # h_slope = 1: no head row gives a height
         return a
     x, y, w, h = (a[:, c].copy() for c in range(2, 6))

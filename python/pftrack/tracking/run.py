@@ -5,15 +5,15 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from contextlib import closing, nullcontext
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import flag, number
+from pftrack._check import MAX_FRAME, first_bad_box, flag, number, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
@@ -108,7 +108,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
 def track_frames(
     source: PathLike | FrameSource | Sequence[NDArray[np.uint8]],
     *,
-    detections: dict[int, F64] | None = None,
+    detections: Mapping[int, ArrayLike] | None = None,
     config: TrackerConfig | None = None,
     rng: RngLike = 0,
     coasting: str = "confirmed",
@@ -132,7 +132,10 @@ def track_frames(
     source : path, FrameSource or sequence of frames
         Video file or image folder, or BGR uint8 frames in memory.
     detections : dict, optional
-        Per-frame detections from :func:`load_detections`; None uses the built-in detector.
+        Per-frame detections ``{frame: (k, 5) [left, top, w, h, score]}`` (or (k, 4), every
+        score 1) with 1-based int frames, as :func:`load_detections` returns them (a file's
+        path is refused: load it with ``pftrack.load_detections(path)``, or call
+        :func:`track_path`); None uses the built-in detector.
     config : TrackerConfig, optional
         Tracker settings (default ``TrackerConfig()``).
     rng : numpy.random.Generator, int or None
@@ -172,7 +175,12 @@ def track_frames(
 
     Raises
     ------
+    TypeError
+        `detections` is not a dict (a path, a list), a key is not an int, or a value does not
+        hold real numbers.
     ValueError
+        A key below 1 (frames are 1-based: 0-based keys would put every box one frame late),
+        a value not of shape (k, 5) or (k, 4), NaN, inf, a negative width or height;
         `detections` of frames after the video's last, by its frame count (one rule for every
         length; a source of unknown length, count 0, is not checked); `detections` for an image
         folder whose names skip numbers (:attr:`FrameSource.gap`: whether the detections count
@@ -196,6 +204,8 @@ def track_frames(
         raise ValueError(
             f"bootstrap mode is {bootstrap!r}, expected one of auto, {', '.join(BOOTSTRAPS)}"
         )
+    if detections is not None:
+        detections = _check_detections(detections)
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
     if detections:
@@ -280,6 +290,72 @@ def _check_numbering(frames: object) -> None:
             "number the detections' frames alike (frame k: the k-th image), or track without "
             "detections (frames 1..N in the names' order)"
         )
+
+
+def _check_detections(detections: object, what: str = "detections") -> dict[int, F64]:
+    """`detections` as ``{frame: (k, 5) or (k, 4) float64 array}``, checked value by value.
+
+    What :func:`track_frames` takes: the dict of :func:`load_detections`, 1-based int frames
+    (NumPy's too, not bools) to ``[left, top, w, h(, score)]`` rows; an empty value is any
+    array without rows (``[]``, ``np.zeros((0, 5))``). The box rule of a detection file holds
+    (:func:`pftrack._check.first_bad_box`: no negative width or height, nothing beyond ±1e9
+    px), and every value is finite.
+
+    Raises
+    ------
+    TypeError
+        Not a mapping (a file's path: the message says to load it with ``load_detections``),
+        a key that is not an int, a value that does not hold real numbers.
+    ValueError
+        A key outside 1..2**31-1, a value of another shape, NaN or inf, a bad box.
+    """
+    if isinstance(detections, (str, bytes, os.PathLike)):
+        raise TypeError(
+            f"{what} is a path ({os.fsdecode(detections)!r}), expected the dict "
+            "{frame: (k, 5) [left, top, w, h, score]} of its boxes: load the file first with "
+            "pftrack.load_detections(path), or call "
+            "pftrack.tracking.run.track_path(source, detections=path)"
+        )
+    if not isinstance(detections, Mapping):
+        raise TypeError(
+            f"{what} must be a dict {{frame: (k, 5) [left, top, w, h, score] array}}, as "
+            f"pftrack.load_detections returns, got {type(detections).__name__}"
+        )
+    checked: dict[int, F64] = {}
+    for key, value in detections.items():
+        if isinstance(key, (bool, np.bool_)) or not isinstance(key, (int, np.integer)):
+            raise TypeError(
+                f"{what} key {key!r} is {type(key).__name__}, expected an int frame number "
+                "(1-based)"
+            )
+        f = int(key)
+        if not 1 <= f <= MAX_FRAME:
+            hint = (
+                ": frames are 1-based, as in det.txt and load_detections (0-based keys would "
+                "put every box one frame late; add 1 to each)"
+                if f <= 0
+                else ""
+            )
+            raise ValueError(f"{what} key {f} is not a frame number in 1..{MAX_FRAME}{hint}")
+        name = f"{what}[{f}]"
+        d = real_array(value, name, booleans=False)
+        if d.ndim >= 1 and d.shape[0] == 0:
+            checked[f] = np.zeros((0, 5))
+            continue
+        if d.ndim != 2 or d.shape[1] not in (4, 5):
+            raise ValueError(
+                f"{name} must have shape (k, 5) [left, top, w, h, score] (or (k, 4)), got {d.shape}"
+            )
+        finite = np.isfinite(d).all(axis=1)
+        if not finite.all():
+            r = int(np.argmin(finite))
+            raise ValueError(f"{name} row {r} contains NaN or inf: {d[r].tolist()}")
+        bad = first_bad_box(d[:, :4])
+        if bad is not None:
+            r, _, problem = bad
+            raise ValueError(f"{name} row {r} {d[r, :4].tolist()}: {problem} (left, top, w, h)")
+        checked[f] = d
+    return checked
 
 
 def _check_last_frame(detections: dict[int, F64], n_frames: int) -> None:

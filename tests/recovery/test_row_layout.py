@@ -1,0 +1,132 @@
+"""Every function taking MOTChallenge rows checks their layout first, one way, one message.
+
+Regressions: ``fill_gaps(np.zeros((0,)))`` said ``rows must have shape (M, 10)`` where
+``smooth_tracks`` of the same array returned no rows; ``smooth_tracks([[1, 2, 3], [1, 2]])``
+(and ``filled_mask``, ``repair_crossings``, ``drop_nested``, ``gate_for_rows``) answered with
+NumPy's "setting an array element with a sequence ... inhomogeneous shape" where
+``fill_gaps`` said ``rows must be a rectangular array of numbers``; and ``fill_gaps``,
+``smooth_tracks`` and ``link_tracklets`` refused the (M, 6..9) arrays that ``write_mot`` and
+``evaluate_mot`` take and that ``pftrack recover`` and ``pftrack smooth`` take as files.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from pftrack.io.mot import mot_text, read_mot, write_mot
+from pftrack.recovery import check_unique, fill_gaps, filled_mask, link_tracklets
+from pftrack.recovery.experiment import trajectories
+from pftrack.recovery.linking import LinkConfig, gate_for_rows
+from pftrack.tracking import repair_crossings, smooth_tracks
+from pftrack.tracking.offline import complete_boxes, drop_nested
+
+#: Each entry point, with what it returns as rows (None: it returns no rows).
+ENTRY_POINTS: dict[str, tuple[Callable[[Any], Any], Callable[[Any], Any] | None]] = {
+    "fill_gaps": (fill_gaps, lambda out: out[0]),
+    "smooth_tracks": (smooth_tracks, lambda out: out),
+    "link_tracklets": (link_tracklets, lambda out: out[0]),
+    "repair_crossings": (repair_crossings, lambda out: out),
+    "drop_nested": (drop_nested, lambda out: out),
+    "complete_boxes": (
+        lambda r: complete_boxes(r, [[0.5, 10.0], [0.2, 5.0]], 0.8),
+        lambda out: out,
+    ),
+    "filled_mask": (filled_mask, None),
+    "mot_text": (mot_text, None),
+    "gate_for_rows": (lambda r: gate_for_rows(LinkConfig(), r), None),
+    "check_unique": (lambda r: check_unique(r, who="check_unique"), None),
+    "trajectories": (trajectories, None),
+}
+
+LAYOUT = "(6 to 10 columns: frame, id, left, top, width, height[, conf, x, y, z])"
+
+ROWS = np.array(  # sorted by (frame, id), as write_mot writes them
+    [
+        [1, 1, 10, 10, 20, 40, 0.9, -1, -1, -1],
+        [1, 2, 90, 10, 20, 40, 1, -1, -1, -1],
+        [2, 1, 12, 10, 20, 40, 0.8, -1, -1, -1],
+        [4, 2, 96, 10, 20, 40, 1, -1, -1, -1],
+        [6, 1, 20, 10, 20, 40, 0.9, -1, -1, -1],
+        [7, 1, 22, 10, 20, 40, 0.7, -1, -1, -1.0],
+    ]
+)
+
+
+@pytest.mark.parametrize("name", list(ENTRY_POINTS))
+@pytest.mark.parametrize(
+    "empty",
+    [[], np.zeros((0,)), np.zeros((0, 10)), np.zeros((0, 6)), np.zeros((0, 10), np.int64)],
+    ids=["list", "0", "0x10", "0x6", "int"],
+)
+def test_an_array_without_values_is_no_rows_everywhere(name: str, empty: Any) -> None:
+    call, rows_of = ENTRY_POINTS[name]
+    out = call(empty)
+    if rows_of is not None:
+        assert rows_of(out).shape == (0, 10)
+
+
+@pytest.mark.parametrize("name", list(ENTRY_POINTS))
+def test_ragged_rows_are_named(name: str) -> None:
+    message = f"{name}: rows must be a rectangular array of numbers, got rows of different lengths"
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        ENTRY_POINTS[name][0]([[1, 2, 3], [1, 2]])
+
+
+@pytest.mark.parametrize("name", list(ENTRY_POINTS))
+@pytest.mark.parametrize(
+    "rows", [[["a"] * 10], ROWS.astype(complex), ROWS > 0], ids=["text", "complex", "bool"]
+)
+def test_rows_that_are_not_real_numbers_are_named(name: str, rows: Any) -> None:
+    with pytest.raises(TypeError, match=f"^{name}: rows must hold real numbers, got dtype "):
+        ENTRY_POINTS[name][0](rows)
+
+
+@pytest.mark.parametrize("name", list(ENTRY_POINTS))
+@pytest.mark.parametrize("shape", [(10,), (2, 3), (2, 5), (2, 11), (1, 1, 10)])
+def test_a_wrong_shape_has_one_message(name: str, shape: tuple[int, ...]) -> None:
+    message = f"{name}: rows must have shape (M, 6..10) {LAYOUT}, got {shape}"
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        ENTRY_POINTS[name][0](np.ones(shape))
+
+
+@pytest.mark.parametrize("name", [n for n, (_, rows_of) in ENTRY_POINTS.items() if rows_of])
+@pytest.mark.parametrize("columns", [6, 7, 9])
+def test_short_rows_are_the_rows_of_a_file_of_them(tmp_path: Path, name: str, columns: int) -> None:
+    """(M, 6..9) rows give what the same rows read from a file give (``pftrack recover`` and
+    ``pftrack smooth`` read them so): the missing columns conf 1, x, y, z -1."""
+    short = ROWS[:, :columns]
+    path = tmp_path / "short.txt"
+    write_mot(path, short)
+    read = read_mot(path)
+    assert read.shape == (len(ROWS), 10)
+    call, rows_of = ENTRY_POINTS[name]
+    assert rows_of is not None
+    expected = rows_of(call(read))
+    got = rows_of(call(short))
+    np.testing.assert_array_equal(got, expected)
+    assert got.shape[1] == 10
+
+
+def test_fill_gaps_fills_short_rows_as_recover_fills_their_file(tmp_path: Path) -> None:
+    from pftrack.cli import main
+
+    path, out = tmp_path / "six.txt", tmp_path / "out.txt"
+    write_mot(path, ROWS[:, :6])
+    assert main(["-q", "recover", str(path), "--out", str(out)]) == 0
+    filled, report = fill_gaps(ROWS[:, :6])
+    assert report.n_filled_rows > 0
+    assert out.read_text() == mot_text(filled)
+
+
+def test_filled_mask_of_short_rows_marks_none() -> None:
+    """Padded as a file's lines (x, y, z -1), a row of 6 to 9 columns is never a filled one."""
+    filled, _ = fill_gaps(ROWS)
+    assert filled_mask(filled).any()
+    assert not filled_mask(filled[:, :7]).any()
+    np.testing.assert_array_equal(filled_mask(filled[:, :9]), filled_mask(filled))
