@@ -1206,12 +1206,17 @@ def test_a_batch_without_dask_says_how_to_install_it(
     assert main([command, *inputs, "--out", str(out), "--workers", "1"]) == 2
     err = capsys.readouterr().err
     # was: "pftrack batch: error: No module named 'distributed'", the hint never reached
-    assert err.startswith(f"pftrack {command}: error: batches run on Dask, which cannot be "
-                          "imported (")  # fmt: skip
-    assert err.endswith(
-        "pip install 'pftrack[dask]' (dask[distributed]); or --workers 0: in this process, "
-        "without Dask\n"
-    )
+    if command == "batch":
+        assert err.startswith("pftrack batch: error: batches run on Dask, which cannot be "
+                              "imported (")  # fmt: skip
+        assert err.endswith(
+            "pip install 'pftrack[dask]' (dask[distributed]); or --workers 0: in this process, "
+            "without Dask\n"
+        )
+    else:  # first why smooth runs a batch at all (two files given)
+        assert err.startswith("pftrack smooth: error: 2 inputs: pftrack smooth runs them as a "
+                              "batch, on Dask by default, which cannot be imported (")  # fmt: skip
+        assert err.endswith("or --workers 0 to run them one after another in this process\n")
     assert err.count("\n") == 1 and not out.exists()  # nothing run, not even --out created
 
 

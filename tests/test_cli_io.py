@@ -134,10 +134,13 @@ def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 0
     assert "detections scaled by 0.5" in capsys.readouterr().out
     assert evaluate_mot(scene.truth, read_mot(out)).mota > 0.8
-    # --det-scale wins: 1 leaves the boxes too large; they are clipped, and the tracker says so
+    # --det-scale wins: 1 leaves the boxes too large, half of them wholly outside the frames,
+    # which is refused before any work (it was a clipping warning, exit 0), naming the scale
+    out.unlink()
     argv = ["track", str(seq), "--detections", "auto", "--det-scale", "1", "--out", str(out)]
-    assert main(argv) == 0
-    assert "outside" in capsys.readouterr().err
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "wholly outside" in err and "about 0.5" in err and not out.exists()
 
 
 def test_sequence_of_another_shape_than_its_seqinfo_is_refused(
