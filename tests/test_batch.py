@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import _thread
 import contextlib
+import hashlib
 import json
 import os
 import shutil
@@ -373,6 +374,87 @@ def test_resume_redoes_a_file_whose_content_changed(
     assert {e["status"] for e in entries().values()} == {"skipped"}
     assert main([*argv, "--force"]) == 0
     assert {e["status"] for e in entries().values()} == {"done"}
+
+
+def test_resume_redoes_an_output_truncated_emptied_or_replaced(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An output only had to exist: truncated, emptied or replaced by another file of the same
+    size, it counted as complete and a re-run skipped it with the earlier figures (exit 0)."""
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]
+    assert main(argv) == 0
+    good = {name: (out / f"{name}.txt").read_bytes() for name in ("run0", "run1", "run2")}
+    sidecar = json.loads((out / "run0.json").read_text())
+    assert sidecar["output_prints"] == [
+        {"name": "run0.txt", "size": len(good["run0"]),
+         "sha256": hashlib.sha256(good["run0"]).hexdigest()}
+    ]  # fmt: skip
+
+    def rerun() -> dict[str, str]:
+        capsys.readouterr()
+        assert main(argv) == 0
+        summary = json.loads((out / "summary.json").read_text())
+        assert "output_prints" not in summary["files"][0]
+        return {f["name"]: f["status"] for f in summary["files"]}
+
+    (out / "run0.txt").write_bytes(good["run0"][:100])  # truncated
+    (out / "run1.txt").write_bytes(b"")  # emptied
+    same_size = bytearray(good["run2"])
+    same_size[-5] = ord("7") if same_size[-5] != ord("7") else ord("8")
+    (out / "run2.txt").write_bytes(bytes(same_size))  # replaced: the same size
+    assert rerun() == {"run0": "done", "run1": "done", "run2": "done"}
+    said = capsys.readouterr().out  # the table, then its notes
+    summary = json.loads((out / "summary.json").read_text())
+    notes = {f["name"]: f["note"] for f in summary["files"]}
+    assert notes == {
+        "run0": f"redone: its output {out / 'run0.txt'} changed since the last run wrote it "
+        f"(100 bytes, written {len(good['run0'])})",
+        "run1": f"redone: its output {out / 'run1.txt'} changed since the last run wrote it "
+        f"(0 bytes, written {len(good['run1'])})",
+        "run2": f"redone: its output {out / 'run2.txt'} changed since the last run wrote it "
+        "(the same size, other content)",
+    }
+    assert [line for line in said.splitlines() if "redone" in line] == [
+        f"{name}: {note}" for name, note in notes.items()
+    ]
+    assert {n: (out / f"{n}.txt").read_bytes() for n in good} == good
+    # the same bytes with a new time (touch): still complete; a removed output: said so
+    os.utime(out / "run0.txt", ns=(0, 0))
+    (out / "run1.txt").unlink()
+    assert rerun() == {"run0": "skipped", "run1": "done", "run2": "skipped"}
+    assert json.loads((out / "summary.json").read_text())["files"][1]["note"] == (
+        f"redone: its output {out / 'run1.txt'} is missing"
+    )
+    # a sidecar of an older pftrack, which recorded no output fingerprint: redone once
+    old = json.loads((out / "run2.json").read_text())
+    del old["output_prints"]
+    (out / "run2.json").write_text(json.dumps(old))
+    assert rerun() == {"run0": "skipped", "run1": "skipped", "run2": "done"}
+    assert json.loads((out / "summary.json").read_text())["files"][2]["note"] == (
+        "redone: its sidecar records no fingerprint of its outputs (an older run)"
+    )
+    assert rerun() == {"run0": "skipped", "run1": "skipped", "run2": "skipped"}
+
+
+def test_a_large_output_is_fingerprinted_by_its_size_and_ends(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A rendered video past HASHED_WHOLE: its size and first and last HASHED_ENDS bytes."""
+    import pftrack.batch.engine as engine
+
+    monkeypatch.setattr(engine, "HASHED_WHOLE", 64)
+    monkeypatch.setattr(engine, "HASHED_ENDS", 16)
+    data = bytes(range(200))
+    (tmp_path / "v.mp4").write_bytes(data)
+    got = engine.output_print(tmp_path / "v.mp4")
+    assert got == {"name": "v.mp4", "size": 200,
+                   "sha256": hashlib.sha256(data[:16] + data[-16:]).hexdigest()}  # fmt: skip
+    (tmp_path / "s.txt").write_bytes(data[:64])
+    assert engine.output_print(tmp_path / "s.txt")["sha256"] == (
+        hashlib.sha256(data[:64]).hexdigest()
+    )
 
 
 def test_resume_redoes_a_sequence_whose_truth_or_images_changed(
