@@ -12,6 +12,7 @@ import contextlib
 import hashlib
 import json
 import os
+import re
 import shutil
 import signal
 import socket
@@ -1280,6 +1281,101 @@ def test_a_scheduler_without_workers_is_said_at_once_then_an_error(
         "$DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT)",
     ]
     assert not out.exists()  # nothing written, as for a scheduler that cannot be reached
+
+
+#: A Dask preload script: the process it runs in cannot import pftrack, as on a machine where
+#: it is not installed (``dask scheduler --preload``, a worker's ``preload``).
+HIDE_PFTRACK = """import sys
+for name in [n for n in sys.modules if n == "pftrack" or n.startswith("pftrack.")]:
+    sys.modules[name] = None
+sys.modules["pftrack"] = None
+"""
+
+
+def test_workers_without_pftrack_are_one_line_before_anything(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: an 80-line traceback from register_plugin (exit 1), then on a re-run (the plugin
+    registered) every task failing with Dask's "Error during deserialization of the task
+    graph", or the worker dying on it; pftrack never named."""
+    _tracks_files(tmp_path / "tracks")
+    (tmp_path / "hide_pftrack.py").write_text(HIDE_PFTRACK)
+    out = tmp_path / "out"
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+        preload=[str(tmp_path / "hide_pftrack.py")],
+    ) as cluster:  # fmt: skip
+        address = cluster.scheduler_address
+        argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--scheduler", address]
+        for _ in range(2):  # the re-run too
+            assert main(argv) == 2
+            err = capsys.readouterr().err
+            assert err.count("\n") == 1, err
+            assert re.fullmatch(
+                rf"pftrack smooth: error: the workers at {re.escape(address)} cannot import "
+                r"pftrack \(ModuleNotFoundError: .*'pftrack.*\): install pftrack where the "
+                r"scheduler and every worker run\n",
+                err,
+            ), err
+        assert not out.exists()
+        with distributed.Client(cluster) as c, pytest.raises(ImportError) as caught:
+            smooth_many(tmp_path / "tracks", out, c)
+        assert caught.value.name == "pftrack" and "the workers at" in str(caught.value)
+    # a worker that comes while the batch waits for one is checked too
+    with distributed.LocalCluster(
+        n_workers=0, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+        preload=[str(tmp_path / "hide_pftrack.py")],
+    ) as late:  # fmt: skip
+        threading.Timer(0.5, late.scale, (1,)).start()
+        with warnings.catch_warnings(record=True) as caught_warnings:
+            warnings.simplefilter("always")
+            with pytest.raises(ImportError, match=r"^the workers at .* cannot import pftrack"):
+                smooth_many(tmp_path / "tracks", out, scheduler=late.scheduler_address)
+        assert [str(w.message).split(";")[0] for w in caught_warnings] == [
+            f"the scheduler at {late.scheduler_address} has no workers"
+        ]
+    assert not out.exists()
+
+
+def test_a_scheduler_without_pftrack_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The scheduler unpickles the tasks: without pftrack, every task failed with Dask's
+    "Error during deserialization of the task graph" (exit 1)."""
+    dask = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    if dask is None:
+        pytest.skip("the dask command is not installed")
+    _tracks_files(tmp_path / "tracks")
+    (tmp_path / "hide_pftrack.py").write_text(HIDE_PFTRACK)
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    cmd = [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard",
+           "--preload", str(tmp_path / "hide_pftrack.py")]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    with (tmp_path / "log.txt").open("w") as log:
+        proc = subprocess.Popen(cmd, stdout=log, stderr=log, env=env, cwd=tmp_path)
+    try:
+        with distributed.Client(address, timeout="30s"):
+            pass  # it is up
+        out = tmp_path / "out"
+        argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--scheduler", address]
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1, err
+        assert re.fullmatch(
+            rf"pftrack smooth: error: the scheduler at {re.escape(address)} cannot import "
+            r"pftrack \(ModuleNotFoundError: .*'pftrack.*\): install pftrack where the "
+            r"scheduler and every worker run\n",
+            err,
+        ), err
+        assert not out.exists()
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
 
 
 def test_the_help_states_the_engines_wait_for_a_worker(

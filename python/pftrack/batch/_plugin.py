@@ -5,12 +5,20 @@ from __future__ import annotations
 import logging
 import os
 import signal
+import sys
 import threading
 from typing import Any
 
+import cloudpickle  # type: ignore[import-untyped]  # distributed's; no type information
 from distributed.diagnostics.plugin import WorkerPlugin
 
 __all__ = ["SingleThreaded"]
+
+# The plugin goes to the workers by value, not by name: a worker that cannot import pftrack
+# then fails in `setup` (logged, the worker runs on, and the batch names the problem:
+# engine.check_pftrack) instead of failing to unpickle it, which leaves a worker that joins
+# later stuck "closing" (Dask 2026.8), the batch waiting on it with no word of pftrack.
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
 #: Thread-count variables read by BLAS and OpenMP libraries at load time.
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")

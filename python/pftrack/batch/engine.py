@@ -47,6 +47,7 @@ if TYPE_CHECKING:
 __all__ = [
     "BatchSummary",
     "Job",
+    "check_pftrack",
     "check_scheduler_address",
     "dask_client",
     "fingerprint",
@@ -325,7 +326,8 @@ def dask_client(
     if n_workers is not None and n_workers < 1:
         raise ValueError(f"n_workers is {n_workers}, expected >= 1 for a cluster")
     if client is not None:
-        client.register_plugin(SingleThreaded())
+        check_pftrack(client, _address_of(client))
+        _register(client, SingleThreaded(), _address_of(client))
         yield client
         return
     if address:
@@ -338,7 +340,8 @@ def dask_client(
             raise OSError(f"cannot connect to the Dask scheduler: {text}") from None
         quiet = contextlib.ExitStack()
         with quiet, connected as c:  # `quiet` ends after the client is closed
-            c.register_plugin(SingleThreaded())
+            check_pftrack(c, address)
+            _register(c, SingleThreaded(), address)
             try:
                 yield c
             finally:
@@ -365,6 +368,86 @@ def dask_client(
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
+
+
+#: What a scheduler imports to load a batch's tasks, and a worker to run them (the worker
+#: plugin's module too): run by :func:`check_pftrack` with ``exec``, a built-in, which Dask
+#: pickles by name (a function of pftrack's could not even be unpickled where it is missing).
+PFTRACK_IMPORTS = "import pftrack.batch.engine, pftrack.batch.tasks, pftrack.batch._plugin"
+#: The end of the error of a scheduler or workers that cannot import pftrack.
+INSTALL_EVERYWHERE = "install pftrack where the scheduler and every worker run"
+
+
+def _address_of(c: Client) -> str:
+    return str(getattr(c.scheduler, "address", None) or "?")
+
+
+def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
+    """Refuse a cluster whose scheduler or workers cannot import pftrack.
+
+    The scheduler unpickles a batch's tasks (their functions and options are pftrack's) and
+    the workers run them: without pftrack, registering the worker plugin failed with an
+    80-line traceback, and a re-run (the plugin already registered) with every task failing
+    with Dask's "Error during deserialization of the task graph", pftrack never named, or with
+    the workers dying on the task. Checked with one round trip to the scheduler and one to the
+    workers (those that have joined: later ones are checked by :func:`run_jobs` once it has
+    waited for them).
+
+    Parameters
+    ----------
+    c : distributed.Client
+        Connected to the cluster.
+    address : str
+        The scheduler's address, as the error names it.
+    scheduler : bool
+        Check the scheduler too (else the workers only).
+
+    Raises
+    ------
+    ImportError
+        One line naming the scheduler's address (and the workers that failed), the import
+        error, and what to do (``name`` is ``"pftrack"``).
+    """
+    if scheduler:
+        try:
+            c.run_on_scheduler(exec, PFTRACK_IMPORTS)
+        except ImportError as exc:
+            raise ImportError(
+                f"the scheduler at {address} cannot import pftrack ({one_line(exc)}): "
+                f"{INSTALL_EVERYWHERE}",
+                name="pftrack",
+            ) from None
+    answers = c.run(exec, PFTRACK_IMPORTS, on_error="return")
+    failed = {w: e for w, e in answers.items() if isinstance(e, BaseException)}
+    if failed:
+        first = next(iter(failed.values()))
+        which = (
+            "the workers"
+            if len(failed) == len(answers)
+            else f"{len(failed)} of the {len(answers)} workers ({', '.join(sorted(failed))})"
+        )
+        raise ImportError(
+            f"{which} at {address} cannot import pftrack ({one_line(first)}): {INSTALL_EVERYWHERE}",
+            name="pftrack",
+        )
+
+
+def _register(c: Client, plugin: Any, address: str) -> None:
+    """Register the worker `plugin`; a failure (a worker's setup raised) is one line.
+
+    Raises
+    ------
+    ImportError
+        Naming the scheduler's address and the workers' error (Dask's text), and what to do.
+    """
+    try:
+        c.register_plugin(plugin)
+    except Exception as exc:  # noqa: BLE001 - Dask re-raises a worker's error as Exception(TEXT)
+        raise ImportError(
+            f"the workers at {address} cannot set up pftrack's worker plugin ({one_line(exc)}): "
+            f"{INSTALL_EVERYWHERE}",
+            name="pftrack",
+        ) from None
 
 
 #: The loggers through which Dask reports, with a traceback, the end of a client's attempts to
@@ -1271,10 +1354,15 @@ def _no_workers(address: str, wait: float) -> str:
 def _wait_for_workers(c: Client, address: str, wait: float) -> int:
     """The cluster's workers, once it has one: none yet is said at once, and waited for.
 
+    Workers that come after a wait are checked as :func:`dask_client` checks those there at
+    the start: they can import pftrack (:func:`check_pftrack`).
+
     Raises
     ------
     TimeoutError
         None came within `wait` seconds.
+    ImportError
+        The workers that came cannot import pftrack.
     """
     n = _n_workers(c)
     if n:
@@ -1292,6 +1380,7 @@ def _wait_for_workers(c: Client, address: str, wait: float) -> int:
                 "$DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT)"
             )
         time.sleep(min(0.2, wait))
+    check_pftrack(c, address, scheduler=False)
     return n
 
 
