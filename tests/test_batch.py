@@ -1283,6 +1283,10 @@ def test_a_scheduler_without_workers_is_said_at_once_then_an_error(
     assert not out.exists()  # nothing written, as for a scheduler that cannot be reached
 
 
+#: A cluster's scheduler with its HTTP routes on a free port, as dask_client starts it: on 8787,
+#: taken by another run, Dask warns ("Port 8787 is already in use"), an error in these tests.
+NO_DASHBOARD = {"dashboard_address": "127.0.0.1:0"}
+
 #: A Dask preload script: the process it runs in cannot import pftrack, as on a machine where
 #: it is not installed (``dask scheduler --preload``, a worker's ``preload``).
 HIDE_PFTRACK = """import sys
@@ -1303,7 +1307,7 @@ def test_workers_without_pftrack_are_one_line_before_anything(
     out = tmp_path / "out"
     with distributed.LocalCluster(
         n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
-        preload=[str(tmp_path / "hide_pftrack.py")],
+        scheduler_kwargs=NO_DASHBOARD, preload=[str(tmp_path / "hide_pftrack.py")],
     ) as cluster:  # fmt: skip
         address = cluster.scheduler_address
         argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--scheduler", address]
@@ -1324,7 +1328,7 @@ def test_workers_without_pftrack_are_one_line_before_anything(
     # a worker that comes while the batch waits for one is checked too
     with distributed.LocalCluster(
         n_workers=0, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
-        preload=[str(tmp_path / "hide_pftrack.py")],
+        scheduler_kwargs=NO_DASHBOARD, preload=[str(tmp_path / "hide_pftrack.py")],
     ) as late:  # fmt: skip
         threading.Timer(0.5, late.scale, (1,)).start()
         with warnings.catch_warnings(record=True) as caught_warnings:
@@ -1392,6 +1396,31 @@ def test_the_help_states_the_engines_wait_for_a_worker(
     # --render: the final tracks, not track --render's online boxes (was: "as track --render")
     assert "--render also write DIR/NAME.mp4: the final tracks of DIR/NAME.txt" in text
     assert "not the boxes as tracked online that track --render draws" in text
+
+
+def test_the_workers_are_counted_by_the_scheduler_not_a_stale_cache(
+    client: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The client's periodic refresh of ``scheduler_info`` lists no worker (Dask 2026.8): taken
+    for the count, it said "the scheduler has lost all its workers" while they ran (2 runs of
+    15 in a user's trial; 134 of 1098 counts at a 5 ms refresh)."""
+    import dask
+
+    import pftrack.batch.engine as engine
+
+    monkeypatch.setattr(engine, "WORKERS_POLL", 0.0)  # the watch counts at every call
+    with (
+        dask.config.set({"distributed.client.scheduler-info-interval": "5ms"}),
+        distributed.Client(client.scheduler.address) as c,
+    ):
+        watch = engine._WorkersWatch(c, client.scheduler.address, 60.0)
+        counts = []
+        deadline = time.monotonic() + 1.5
+        while time.monotonic() < deadline:
+            counts.append(engine._n_workers(c))
+            assert not watch.given_up()  # and no warning: an error in this module
+        assert set(counts) == {2} and len(counts) > 100
+        assert engine._wait_for_workers(c, client.scheduler.address, 1.0) == 2
 
 
 def _close_my_worker(k: int) -> TaskResult:
