@@ -52,6 +52,10 @@ distributed = pytest.importorskip("distributed")
 
 FAST = ["--particles", "30"]  # every run of this module: fewer particles, same code path
 
+#: A cluster's scheduler with its HTTP routes on a free port, as dask_client starts it: on 8787,
+#: taken by another run, Dask warns ("Port 8787 is already in use"), an error in these tests.
+NO_DASHBOARD = {"dashboard_address": "127.0.0.1:0"}
+
 
 @pytest.fixture(scope="module")
 def data(tmp_path_factory: pytest.TempPathFactory) -> Path:
@@ -1165,6 +1169,9 @@ def test_a_sequences_warnings_come_back_to_the_summary(
         (["--scheduler", "tcp://:8786"], "no host"),
         (["--scheduler", "::1:8786"], "an IPv6 address goes in brackets"),
         (["--scheduler", ""], "--scheduler is empty: give a running Dask scheduler's address"),
+        (["--scheduler", "inproc://x"], "--scheduler 'inproc://x': inproc:// names a scheduler "
+         "inside one process, which a batch cannot reach by address; give a running "
+         "scheduler's tcp://HOST:PORT"),
         (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "0"],
          "--scheduler and --workers contradict each other"),
         (["--scheduler", "tcp://127.0.0.1:8786", "--workers", "2"],
@@ -1193,6 +1200,70 @@ def test_scheduler_address_is_checked_before_anything(
     assert main([*argv, *extra]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err
+
+
+@pytest.mark.parametrize(
+    ("protocol", "hint"),
+    [
+        ("tls", "(tls:// needs Dask's TLS settings where pftrack runs: the CA file, and the "
+         "client's certificate and key: $DASK_DISTRIBUTED__COMM__TLS__CA_FILE, "),
+        ("wss", "(wss:// needs Dask's TLS settings where pftrack runs"),
+        ("ucx", ""),  # what Dask says of it depends on its version (2026.8: an abstract class)
+    ],
+)  # fmt: skip
+def test_an_address_dask_cannot_connect_by_is_one_line_naming_it(
+    tmp_path: Path, connect_timeout_1s: None, capsys: pytest.CaptureFixture[str],
+    protocol: str, hint: str,
+) -> None:  # fmt: skip
+    """Were Dask's own words, neither --scheduler nor the address named: "TLS expects a
+    `ssl_context` argument ...", "Can't instantiate abstract class UCXConnector ..."."""
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    address = f"{protocol}://127.0.0.1:{_free_port()}"
+    with dask.config.set({"distributed.comm.tls.ca-file": None}):  # none where this runs
+        assert main(["smooth", str(tmp_path / "tracks"), "--out", str(out),
+                     "--scheduler", address]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert err.startswith(
+        f"pftrack smooth: error: cannot connect to the Dask scheduler at {address}: "
+    )
+    assert hint in err
+    assert not out.exists()
+
+
+def test_tls_runs_with_dasks_tls_settings(tmp_path: Path) -> None:
+    """What docs/batch.md says a tls:// scheduler needs: Dask's CA file, client cert and key."""
+    import dask
+    from distributed.security import Security
+
+    openssl = shutil.which("openssl")
+    if openssl is None:
+        pytest.skip("no openssl to make a certificate")
+    crt, key = str(tmp_path / "tls.crt"), str(tmp_path / "tls.key")
+    subprocess.run([openssl, "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", key,
+                    "-out", crt, "-days", "1", "-subj", "/CN=localhost", "-addext",
+                    "subjectAltName=IP:127.0.0.1"], check=True, capture_output=True)  # fmt: skip
+    security = Security(
+        tls_ca_file=crt, tls_scheduler_cert=crt, tls_scheduler_key=key, tls_worker_cert=crt,
+        tls_worker_key=key, tls_client_cert=crt, tls_client_key=key, require_encryption=True,
+    )  # fmt: skip
+    paths = _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", protocol="tls://",
+        security=security, dashboard_address=None, scheduler_kwargs=NO_DASHBOARD,
+    ) as cluster:  # fmt: skip
+        address = cluster.scheduler_address
+        assert address.startswith("tls://")
+        settings = {"distributed.comm.tls.ca-file": crt, "distributed.comm.tls.client.cert": crt,
+                    "distributed.comm.tls.client.key": key}  # fmt: skip
+        with dask.config.set(settings):
+            assert main(["smooth", str(tmp_path / "tracks"), "--out", str(out),
+                         "--scheduler", address]) == 0  # fmt: skip
+    assert sorted(p.name for p in out.glob("*.txt")) == [p.name for p in paths]
 
 
 def test_scheduler_address_from_the_environment_is_checked(
@@ -1282,10 +1353,6 @@ def test_a_scheduler_without_workers_is_said_at_once_then_an_error(
     ]
     assert not out.exists()  # nothing written, as for a scheduler that cannot be reached
 
-
-#: A cluster's scheduler with its HTTP routes on a free port, as dask_client starts it: on 8787,
-#: taken by another run, Dask warns ("Port 8787 is already in use"), an error in these tests.
-NO_DASHBOARD = {"dashboard_address": "127.0.0.1:0"}
 
 #: A Dask preload script: the process it runs in cannot import pftrack, as on a machine where
 #: it is not installed (``dask scheduler --preload``, a worker's ``preload``).

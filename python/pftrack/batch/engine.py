@@ -313,8 +313,13 @@ def dask_client(
         each other (more than one given, or ``n_workers`` < 1).
     OSError
         The scheduler cannot be reached within Dask's ``distributed.comm.timeouts.connect``
-        (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``): one line naming the
-        address.
+        (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``), or Dask cannot
+        connect by the address's protocol here (``tls://`` without Dask's TLS settings,
+        ``ucx://`` without the package that provides it): one line naming the address (was:
+        Dask's own message, "TLS expects a `ssl_context` argument", "Can't instantiate abstract
+        class UCXConnector", naming neither).
+    ImportError
+        The scheduler or the workers cannot import pftrack (:func:`check_pftrack`).
     """
     _require_dask()
     import dask
@@ -333,11 +338,9 @@ def dask_client(
     if address:
         try:
             connected = Client(address)  # timeout: distributed.comm.timeouts.connect
-        except OSError as exc:  # TimeoutError, refused, unknown host: one line, the address named
-            text = " ".join(str(exc).split())
-            if address not in text:
-                text = f"{text} ({address})"
-            raise OSError(f"cannot connect to the Dask scheduler: {text}") from None
+        except Exception as exc:  # noqa: BLE001 - whatever Dask raised: one line, the address
+            problem = _connect_problem(address, exc)
+            raise OSError(f"cannot connect to the Dask scheduler at {address}: {problem}") from None
         quiet = contextlib.ExitStack()
         with quiet, connected as c:  # `quiet` ends after the client is closed
             check_pftrack(c, address)
@@ -368,6 +371,37 @@ def dask_client(
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
+
+
+#: Dask's settings of a TLS client (``tls://``, ``wss://``), as environment variables.
+TLS_SETTINGS = (
+    "$DASK_DISTRIBUTED__COMM__TLS__CA_FILE, $DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT and "
+    "$DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY"
+)
+
+
+def _connect_problem(address: str, exc: Exception) -> str:
+    """Why ``Client(address)`` failed, in one line, with what to do where that is known."""
+    import dask
+
+    text = one_line(exc)
+    protocol = address.partition("://")[0] if "://" in address else "tcp"
+    unset = dask.config.get("distributed.comm.tls.ca-file", None) is None
+    if protocol in ("tls", "wss") and (unset or not isinstance(exc, OSError)):
+        # tls: Dask's "TLS expects a `ssl_context` argument"; wss: timed out
+        return (
+            f"{text} ({protocol}:// needs Dask's TLS settings where pftrack runs: the CA file, "
+            f"and the client's certificate and key: {TLS_SETTINGS}, or distributed.comm.tls "
+            "in a Dask configuration file)"
+        )
+    if isinstance(exc, OSError):  # timed out, refused, unknown host, a TLS handshake
+        return text
+    if protocol == "ucx":
+        return (
+            f"{text} (ucx:// needs the distributed-ucxx package: this Dask has no UCX "
+            "comm of its own)"
+        )
+    return text
 
 
 #: What a scheduler imports to load a batch's tasks, and a worker to run them (the worker
@@ -542,8 +576,9 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     return check_scheduler_address(address, "$DASK_SCHEDULER_ADDRESS (Dask's scheduler-address)")
 
 
-#: Dask's comm protocols whose addresses are ``PROTOCOL://HOST:PORT`` (``inproc://`` is taken
-#: as it is: a scheduler in this very process).
+#: Dask's comm protocols whose addresses are ``PROTOCOL://HOST:PORT``. ``tls`` and ``wss``
+#: need Dask's TLS settings, ``ucx`` the distributed-ucxx package (:func:`dask_client` says so
+#: when they are missing); ``inproc://`` is refused: a scheduler inside one process.
 SCHEDULER_PROTOCOLS = ("tcp", "tls", "ws", "wss", "ucx")
 
 
@@ -558,8 +593,8 @@ def check_scheduler_address(address: object, what: str = "scheduler") -> str:
     ----------
     address : str
         ``PROTOCOL://HOST:PORT`` (protocol ``tcp``, ``tls``, ``ws``, ``wss`` or ``ucx``; none:
-        ``tcp``), ``HOST`` a name, an IPv4 address or a bracketed IPv6 one (``[::1]``), ``PORT``
-        in 1..65535. Spaces around it are dropped.
+        ``tcp``; not ``inproc``), ``HOST`` a name, an IPv4 address or a bracketed IPv6 one
+        (``[::1]``), ``PORT`` in 1..65535. Spaces around it are dropped.
     what : str
         Names the address in the error (``"--scheduler"``, ``"scheduler"``, ...).
 
@@ -589,8 +624,12 @@ def check_scheduler_address(address: object, what: str = "scheduler") -> str:
     protocol, sep, rest = text.partition("://")
     if not sep:
         protocol, rest = "tcp", text
-    if protocol == "inproc":
-        return text
+    if protocol == "inproc":  # was: taken, then Dask's "not enough values to unpack"
+        raise ValueError(
+            f"{named}: inproc:// names a scheduler inside one process, which a batch cannot "
+            "reach by address; give a running scheduler's tcp://HOST:PORT (in Python, pass "
+            "a client of an in-process cluster as client=)"
+        )
     if protocol not in SCHEDULER_PROTOCOLS:
         known = ", ".join(f"{p}://" for p in SCHEDULER_PROTOCOLS)
         raise ValueError(f"{named}: unknown protocol {protocol}:// ({known}; {expected})")
