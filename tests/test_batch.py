@@ -38,6 +38,7 @@ from pftrack.batch import (
     TrackOptions,
     dask_client,
     find_sequences,
+    recover_many,
     run_jobs,
     smooth_many,
     track_many,
@@ -1290,6 +1291,62 @@ def test_scheduler_address_from_the_environment_is_checked(
         ),
     ):
         smooth_many(tmp_path / "tracks", tmp_path / "o2")
+
+
+def test_the_entry_points_refuse_another_options_class_before_any_task(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Were: recover_many(options=TrackOptions()) failed every file with an AttributeError,
+    smooth_many(options=RecoverOptions(...)) ran with its settings (link=False) and recorded
+    them, track_many(options="seed=1") raised an AttributeError."""
+    import pftrack.batch.api as api
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    monkeypatch.setattr(api, "run_jobs", None)  # nothing may get as far as running
+    cases = [
+        (lambda: recover_many(tmp_path / "tracks", out, options=TrackOptions(), n_workers=0),
+         "recover_many: options must be a RecoverOptions or None, got TrackOptions "
+         "(TrackOptions is track_many's)"),
+        (lambda: smooth_many(tmp_path / "tracks", out,
+                             options=RecoverOptions(method="linear"), n_workers=0),
+         "smooth_many: options must be a SmoothOptions or None, got RecoverOptions "
+         "(RecoverOptions is recover_many's)"),
+        (lambda: track_many(data / "walk.avi", out, options="seed=1", n_workers=0),  # type: ignore[arg-type]
+         "track_many: options must be a TrackOptions or None, got str 'seed=1'"),
+        (lambda: track_many(tmp_path / "nowhere", out, options=SmoothOptions()),  # type: ignore[arg-type]
+         "track_many: options must be a TrackOptions or None, got SmoothOptions "
+         "(SmoothOptions is smooth_many's)"),
+    ]  # fmt: skip
+    for call, message in cases:
+        with pytest.raises(TypeError) as caught:
+            call()
+        assert str(caught.value) == message
+    assert not out.exists()
+
+
+def test_python_names_out_dir_and_the_command_out(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """track_many("a.avi", "b.avi") said "--out b.avi is a file": a CLI option, in Python."""
+    video = tmp_path / "b.avi"
+    shutil.copy2(data / "walk.avi", video)
+    with pytest.raises(ValueError, match=rf"^out_dir {re.escape(str(video))} is a file; give a"):
+        track_many(data / "walk.avi", video, n_workers=0)
+    assert main(["batch", str(data / "walk.avi"), "--out", str(video), "--workers", "0"]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack batch: error: --out {video} is a file; give a folder\n"
+    )
+    (tmp_path / "o" / "walk.txt").mkdir(parents=True)
+    with pytest.raises(ValueError, match=r"^out_dir .*walk.txt is a folder; it would be an output"):
+        track_many(data / "walk.avi", tmp_path / "o", n_workers=0)
+    assert main(["batch", str(data / "walk.avi"), "--out", str(tmp_path / "o"),
+                 "--workers", "0"]) == 2  # fmt: skip
+    assert capsys.readouterr().err.startswith(
+        f"pftrack batch: error: --out {tmp_path / 'o' / 'walk.txt'} is a folder;"
+    )
+    with pytest.raises(ValueError, match=r"^options.render's output .*b.avi is an input of this"):
+        track_many(video, tmp_path, options=TrackOptions(render=".avi"), n_workers=0)
 
 
 def test_where_to_run_is_refused_when_contradictory_or_not_a_client(

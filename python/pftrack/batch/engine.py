@@ -18,6 +18,7 @@ Where the tasks run (a scheduler to connect to, or a local cluster to start) is 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import dataclasses
 import hashlib
 import json
@@ -1113,6 +1114,25 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     return f"{seen[0]}: {UNSEEN.format(host=outcome.host)}"
 
 
+#: How the messages name the output folder and a rendered video: the Python parameters
+#: (``out_dir``, ``options.render``), or the options while a command runs the batch
+#: (:func:`named_as_options`). Was ``--out`` from Python too (``track_many("a.avi", "b.avi")``:
+#: "--out b.avi is a file").
+_OUT_NAMES: contextvars.ContextVar[tuple[str, str]] = contextvars.ContextVar(
+    "pftrack_batch_out_names", default=("out_dir", "options.render")
+)
+
+
+@contextlib.contextmanager
+def named_as_options() -> Iterator[None]:
+    """Meanwhile, a batch's messages name ``--out`` and ``--render`` (``pftrack`` commands)."""
+    token = _OUT_NAMES.set(("--out", "--render"))
+    try:
+        yield
+    finally:
+        _OUT_NAMES.reset(token)
+
+
 def _check_outputs(
     jobs: Sequence[Job], out_dir: str | os.PathLike[str], suffixes: Sequence[str]
 ) -> Path:
@@ -1121,7 +1141,8 @@ def _check_outputs(
     Returns `out_dir` as a Path (checked as given: an empty one is refused, not taken for the
     current folder).
     """
-    out_dir = check_output_folder(out_dir, "--out")
+    out_name, render_name = _OUT_NAMES.get()
+    out_dir = check_output_folder(out_dir, out_name)
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
     guarded = {_file_id(p) for job in jobs for p in job.guards} - {None}  # images: by inode
     names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]
@@ -1130,10 +1151,10 @@ def _check_outputs(
         if target.resolve() in reads or _file_id(target) in guarded:
             # which option makes it: a rendered video is --render's (was: always --out)
             rendered = any(name.endswith(s) for s in suffixes)
-            what = f"--render's output {target}" if rendered else f"--out {target}"
+            what = f"{render_name}'s output {target}" if rendered else f"{out_name} {target}"
             raise ValueError(f"{what} is an input of this run; write elsewhere")
         if target.is_dir():
-            raise ValueError(f"--out {target} is a folder; it would be an output of this run")
+            raise ValueError(f"{out_name} {target} is a folder; it would be an output of this run")
     return out_dir
 
 
@@ -1148,11 +1169,14 @@ def _file_id(path: Path) -> tuple[int, int] | None:
 
 def _make_out_dir(out_dir: Path) -> None:
     """Create the output folder and check that it is writable (once the tasks can run)."""
+    out_name = _OUT_NAMES.get()[0]
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:  # a read-only or special file system, a file on the way
-        raise ValueError(f"--out {out_dir}: cannot create the folder ({exc.strerror})") from None
-    check_output(out_dir / SUMMARY_NAME, what="--out")  # the folder is writable
+        raise ValueError(
+            f"{out_name} {out_dir}: cannot create the folder ({exc.strerror})"
+        ) from None
+    check_output(out_dir / SUMMARY_NAME, what=out_name)  # the folder is writable
 
 
 def run_jobs(
@@ -1325,7 +1349,10 @@ def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int 
     """
     noun = "sequence" if kind == "track" else "file"
     if written is None:
-        text = f"nothing was written: it stopped before the run began (--out {out} untouched)"
+        text = (
+            f"nothing was written: it stopped before the run began ({_OUT_NAMES.get()[0]} "
+            f"{out} untouched)"
+        )
     elif written == 0:
         text = (
             f"no {noun} was finished; {out / SUMMARY_NAME} lists them as cancelled (re-run to "
