@@ -195,6 +195,28 @@ def test_workers_are_single_threaded(client: Any) -> None:
     assert tracking_threads()  # this process (serial runs) keeps them
 
 
+def _bars_drawn() -> TaskResult:
+    """Whether a progress bar asked for here would be drawn on a terminal (as a task sees it)."""
+    from pftrack import _progress
+
+    return TaskResult(np.zeros((0, 10)), {}, {"quiet": _progress.quiet()})
+
+
+def test_tasks_draw_no_bars_of_their_own(
+    client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A local cluster's workers share the terminal: the bars of what a task calls ("auto:
+    calibrating: 100%|...| 1/1 bucket", "smoothing") were drawn over the batch's own."""
+    from pftrack import _progress
+
+    assert set(client.run(_progress.quiet).values()) == {True}
+    monkeypatch.setattr(_progress, "_quiet", False)
+    summary = run_jobs([Job("a", _bars_drawn, (), ())], tmp_path / "o", kind="smooth",
+                       settings={}, n_workers=0)  # fmt: skip
+    assert summary.entries[0]["quiet"] is True  # in this process too, while a task runs
+    assert not _progress.quiet()  # and no longer
+
+
 def test_cluster_equals_serial_and_pftrack_track(data: Path, client: Any, tmp_path: Path) -> None:
     options = TrackOptions(config=_config(), detections=None)
     on_dask = track_many(data, tmp_path / "dask", client, options=options)

@@ -29,6 +29,11 @@ class SingleThreaded(WorkerPlugin):
 
     Tracking in a worker uses no read-ahead or detector thread (`tracking_threads`).
 
+    No progress bar either: the worker's tasks draw none (:func:`pftrack._progress.set_quiet`).
+    A local cluster's workers share the terminal, where the bars of the code a task calls
+    (``auto: calibrating``, ``smoothing``) were drawn over the batch's own; a remote worker's
+    go to its log.
+
     OpenCV gets ``cv2.setNumThreads(1)`` when the plugin is set up. BLAS and OpenMP read their
     thread counts when they load, so those come from the environment the worker starts with:
     Dask's nanny sets ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` and ``MKL_NUM_THREADS`` to 1
@@ -60,6 +65,9 @@ class SingleThreaded(WorkerPlugin):
         """
         import cv2
 
+        from pftrack._progress import set_quiet
+
+        set_quiet(True)  # the batch's bar, on the client, is the only one
         for var in THREAD_VARIABLES:
             os.environ.setdefault(var, "1")
         cv2.setNumThreads(1)

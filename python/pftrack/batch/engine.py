@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from pftrack._progress import Bar, enabled, progress
+from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder
 from pftrack.io.mot import write_mot
@@ -1322,11 +1322,15 @@ def run_jobs(
                     _run_on_dask(c, pending, record, summary.kind, bar, frames, where, wait)
                 elif frames is not None:
                     for job in pending:
-                        record(job, call_task(job.func, job.args, frames.reporter(job.name)))
+                        with _no_bars():
+                            outcome = call_task(job.func, job.args, frames.reporter(job.name))
+                        record(job, outcome)
                         frames.finish(job.name)
                 elif pending:
                     for job in progress(pending, **bar):  # type: ignore[arg-type]
-                        record(job, call_task(job.func, job.args))
+                        with _no_bars():
+                            outcome = call_task(job.func, job.args)
+                        record(job, outcome)
             finally:
                 for job in jobs:
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
@@ -1338,6 +1342,21 @@ def run_jobs(
         _say_interrupted(exc, out, kind, written if touched else None)
         raise
     return summary
+
+
+@contextlib.contextmanager
+def _no_bars() -> Iterator[None]:
+    """Meanwhile, no new progress bar (a task run in this process: the batch's bar is drawn).
+
+    As the worker plugin makes the workers quiet (:mod:`pftrack.batch._plugin`): the bars of
+    the code a task calls (``auto: calibrating``, ``smoothing``) were drawn under the batch's.
+    """
+    was = quiet()
+    set_quiet(True)
+    try:
+        yield
+    finally:
+        set_quiet(was)
 
 
 def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int | None) -> None:
