@@ -5,12 +5,20 @@ from __future__ import annotations
 import logging
 import os
 import signal
+import sys
 import threading
 from typing import Any
 
+import cloudpickle  # type: ignore[import-untyped]  # distributed's; no type information
 from distributed.diagnostics.plugin import WorkerPlugin
 
 __all__ = ["SingleThreaded"]
+
+# The plugin goes to the workers by value, not by name: a worker that cannot import pftrack
+# then fails in `setup` (logged, the worker runs on, and the batch names the problem:
+# engine.check_pftrack) instead of failing to unpickle it, which leaves a worker that joins
+# later stuck "closing" (Dask 2026.8), the batch waiting on it with no word of pftrack.
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
 #: Thread-count variables read by BLAS and OpenMP libraries at load time.
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -20,6 +28,11 @@ class SingleThreaded(WorkerPlugin):
     """Make each worker process single-threaded: one sequence per core, no oversubscription.
 
     Tracking in a worker uses no read-ahead or detector thread (`tracking_threads`).
+
+    No progress bar either: the worker's tasks draw none (:func:`pftrack._progress.set_quiet`).
+    A local cluster's workers share the terminal, where the bars of the code a task calls
+    (``auto: calibrating``, ``smoothing``) were drawn over the batch's own; a remote worker's
+    go to its log.
 
     OpenCV gets ``cv2.setNumThreads(1)`` when the plugin is set up. BLAS and OpenMP read their
     thread counts when they load, so those come from the environment the worker starts with:
@@ -52,6 +65,9 @@ class SingleThreaded(WorkerPlugin):
         """
         import cv2
 
+        from pftrack._progress import set_quiet
+
+        set_quiet(True)  # the batch's bar, on the client, is the only one
         for var in THREAD_VARIABLES:
             os.environ.setdefault(var, "1")
         cv2.setNumThreads(1)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 from pftrack._typing import PathLike
 from pftrack.batch.engine import BatchSummary, Job, run_jobs
@@ -23,6 +23,36 @@ if TYPE_CHECKING:
     from distributed import Client
 
 __all__ = ["recover_many", "smooth_many", "track_many"]
+
+_Options = TypeVar("_Options", TrackOptions, RecoverOptions, SmoothOptions)
+
+#: Which entry point takes which options class (named when another one is given).
+_TAKEN_BY = {
+    TrackOptions: "track_many",
+    RecoverOptions: "recover_many",
+    SmoothOptions: "smooth_many",
+}
+
+
+def _options(options: object, kind: type[_Options], func: str) -> _Options:
+    """`options`, or ``kind()`` for None; anything else is refused before any task runs.
+
+    Raises
+    ------
+    TypeError
+        `options` is not a `kind` (was: ``recover_many(..., options=TrackOptions())`` failed
+        every file with an AttributeError, ``smooth_many(..., options=RecoverOptions(...))``
+        ran with the wrong class's settings, ``options="seed=1"`` raised an AttributeError).
+    """
+    if options is None:
+        return kind()
+    if isinstance(options, kind):
+        return options
+    other = _TAKEN_BY.get(type(options))
+    hint = f" ({type(options).__name__} is {other}'s)" if other else f" {options!r}"
+    raise TypeError(
+        f"{func}: options must be a {kind.__name__} or None, got {type(options).__name__}{hint}"
+    )
 
 
 def track_many(
@@ -71,8 +101,17 @@ def track_many(
     BatchSummary
         Frames, tracks, frames/s and metrics (where ``gt/gt.txt`` exists) per sequence; failed
         sequences with their error.
+
+    Raises
+    ------
+    TypeError
+        `options` is not a :class:`TrackOptions` (nor None), before anything else; `client`
+        is not a ``distributed.Client``.
+    ValueError
+        Bad inputs, or an `out_dir` that is a file or would overwrite an input (named
+        ``out_dir``), before any task runs; see :func:`~pftrack.batch.run_jobs` for the rest.
     """
-    opts = options if options is not None else TrackOptions()
+    opts = _options(options, TrackOptions, "track_many")
     seqs = find_sequences(inputs)
     jobs = [
         Job(
@@ -114,8 +153,13 @@ def recover_many(
 
     As :func:`track_many`; each ``out_dir/NAME.txt`` equals ``pftrack recover FILE`` with the
     same settings.
+
+    Raises
+    ------
+    TypeError
+        `options` is not a :class:`RecoverOptions` (nor None), before anything else.
     """
-    opts = options if options is not None else RecoverOptions()
+    opts = _options(options, RecoverOptions, "recover_many")
     jobs = [Job(p.stem, recover_file, (p, opts), (p,)) for p in find_track_files(inputs)]
     return run_jobs(
         jobs,
@@ -145,8 +189,13 @@ def smooth_many(
 
     As :func:`track_many`; each ``out_dir/NAME.txt`` equals ``pftrack smooth FILE`` with the
     same settings.
+
+    Raises
+    ------
+    TypeError
+        `options` is not a :class:`SmoothOptions` (nor None), before anything else.
     """
-    opts = options if options is not None else SmoothOptions()
+    opts = _options(options, SmoothOptions, "smooth_many")
     jobs = [Job(p.stem, smooth_file, (p, opts), (p,)) for p in find_track_files(inputs)]
     return run_jobs(
         jobs,

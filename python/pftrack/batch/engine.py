@@ -6,7 +6,8 @@ complete, writes each result as it arrives (``DIR/NAME.txt``, extra files, then 
 
 *Complete* means: the sidecar exists, names the same inputs and settings, records the same
 fingerprint of each input (:func:`fingerprint`: size and modification time; for an image folder,
-those of every image by name), and every output it lists exists. The sidecar is first replaced
+those of every image by name), and every output it lists is still the file it wrote (the same
+size and SHA-256: :func:`output_print`). The sidecar is first replaced
 by one that says ``writing``, then written last, and every file atomically, so a run stopped at
 any point leaves each output either complete or not; a re-run skips the complete ones.
 
@@ -17,6 +18,7 @@ Where the tasks run (a scheduler to connect to, or a local cluster to start) is 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import dataclasses
 import hashlib
 import json
@@ -34,7 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from pftrack._progress import Bar, enabled, progress
+from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder
 from pftrack.io.mot import write_mot
@@ -46,9 +48,11 @@ if TYPE_CHECKING:
 __all__ = [
     "BatchSummary",
     "Job",
+    "check_pftrack",
     "check_scheduler_address",
     "dask_client",
     "fingerprint",
+    "output_print",
     "run_jobs",
 ]
 
@@ -107,7 +111,8 @@ class BatchSummary:
     entries : list of dict
         Per task: ``name``, ``status`` (``"done"``, ``"skipped"``: complete from an earlier run,
         ``"failed"``, ``"cancelled"``), ``error`` (one line, failed only), ``note`` (why a task
-        complete from an earlier run was redone: ``"redone: PATH changed since the last run"``),
+        complete from an earlier run was redone: ``"redone: PATH changed since the last run"``,
+        ``"redone: its output PATH changed since the last run wrote it (...)"``),
         and the task's figures (``frames``, ``tracks``, ``fps``, ``metrics`` ... for tracking).
     seconds : float
         Wall time of the batch (cluster start included).
@@ -309,8 +314,13 @@ def dask_client(
         each other (more than one given, or ``n_workers`` < 1).
     OSError
         The scheduler cannot be reached within Dask's ``distributed.comm.timeouts.connect``
-        (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``): one line naming the
-        address.
+        (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``), or Dask cannot
+        connect by the address's protocol here (``tls://`` without Dask's TLS settings,
+        ``ucx://`` without the package that provides it): one line naming the address (was:
+        Dask's own message, "TLS expects a `ssl_context` argument", "Can't instantiate abstract
+        class UCXConnector", naming neither).
+    ImportError
+        The scheduler or the workers cannot import pftrack (:func:`check_pftrack`).
     """
     _require_dask()
     import dask
@@ -322,20 +332,20 @@ def dask_client(
     if n_workers is not None and n_workers < 1:
         raise ValueError(f"n_workers is {n_workers}, expected >= 1 for a cluster")
     if client is not None:
-        client.register_plugin(SingleThreaded())
+        check_pftrack(client, _address_of(client))
+        _register(client, SingleThreaded(), _address_of(client))
         yield client
         return
     if address:
         try:
             connected = Client(address)  # timeout: distributed.comm.timeouts.connect
-        except OSError as exc:  # TimeoutError, refused, unknown host: one line, the address named
-            text = " ".join(str(exc).split())
-            if address not in text:
-                text = f"{text} ({address})"
-            raise OSError(f"cannot connect to the Dask scheduler: {text}") from None
+        except Exception as exc:  # noqa: BLE001 - whatever Dask raised: one line, the address
+            problem = _connect_problem(address, exc)
+            raise OSError(f"cannot connect to the Dask scheduler at {address}: {problem}") from None
         quiet = contextlib.ExitStack()
         with quiet, connected as c:  # `quiet` ends after the client is closed
-            c.register_plugin(SingleThreaded())
+            check_pftrack(c, address)
+            _register(c, SingleThreaded(), address)
             try:
                 yield c
             finally:
@@ -362,6 +372,117 @@ def dask_client(
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
+
+
+#: Dask's settings of a TLS client (``tls://``, ``wss://``), as environment variables.
+TLS_SETTINGS = (
+    "$DASK_DISTRIBUTED__COMM__TLS__CA_FILE, $DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT and "
+    "$DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY"
+)
+
+
+def _connect_problem(address: str, exc: Exception) -> str:
+    """Why ``Client(address)`` failed, in one line, with what to do where that is known."""
+    import dask
+
+    text = one_line(exc)
+    protocol = address.partition("://")[0] if "://" in address else "tcp"
+    unset = dask.config.get("distributed.comm.tls.ca-file", None) is None
+    if protocol in ("tls", "wss") and (unset or not isinstance(exc, OSError)):
+        # tls: Dask's "TLS expects a `ssl_context` argument"; wss: timed out
+        return (
+            f"{text} ({protocol}:// needs Dask's TLS settings where pftrack runs: the CA file, "
+            f"and the client's certificate and key: {TLS_SETTINGS}, or distributed.comm.tls "
+            "in a Dask configuration file)"
+        )
+    if isinstance(exc, OSError):  # timed out, refused, unknown host, a TLS handshake
+        return text
+    if protocol == "ucx":
+        return (
+            f"{text} (ucx:// needs the distributed-ucxx package: this Dask has no UCX "
+            "comm of its own)"
+        )
+    return text
+
+
+#: What a scheduler imports to load a batch's tasks, and a worker to run them (the worker
+#: plugin's module too): run by :func:`check_pftrack` with ``exec``, a built-in, which Dask
+#: pickles by name (a function of pftrack's could not even be unpickled where it is missing).
+PFTRACK_IMPORTS = "import pftrack.batch.engine, pftrack.batch.tasks, pftrack.batch._plugin"
+#: The end of the error of a scheduler or workers that cannot import pftrack.
+INSTALL_EVERYWHERE = "install pftrack where the scheduler and every worker run"
+
+
+def _address_of(c: Client) -> str:
+    return str(getattr(c.scheduler, "address", None) or "?")
+
+
+def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
+    """Refuse a cluster whose scheduler or workers cannot import pftrack.
+
+    The scheduler unpickles a batch's tasks (their functions and options are pftrack's) and
+    the workers run them: without pftrack, registering the worker plugin failed with an
+    80-line traceback, and a re-run (the plugin already registered) with every task failing
+    with Dask's "Error during deserialization of the task graph", pftrack never named, or with
+    the workers dying on the task. Checked with one round trip to the scheduler and one to the
+    workers (those that have joined: later ones are checked by :func:`run_jobs` once it has
+    waited for them).
+
+    Parameters
+    ----------
+    c : distributed.Client
+        Connected to the cluster.
+    address : str
+        The scheduler's address, as the error names it.
+    scheduler : bool
+        Check the scheduler too (else the workers only).
+
+    Raises
+    ------
+    ImportError
+        One line naming the scheduler's address (and the workers that failed), the import
+        error, and what to do (``name`` is ``"pftrack"``).
+    """
+    if scheduler:
+        try:
+            c.run_on_scheduler(exec, PFTRACK_IMPORTS)
+        except ImportError as exc:
+            raise ImportError(
+                f"the scheduler at {address} cannot import pftrack ({one_line(exc)}): "
+                f"{INSTALL_EVERYWHERE}",
+                name="pftrack",
+            ) from None
+    answers = c.run(exec, PFTRACK_IMPORTS, on_error="return")
+    failed = {w: e for w, e in answers.items() if isinstance(e, BaseException)}
+    if failed:
+        first = next(iter(failed.values()))
+        which = (
+            "the workers"
+            if len(failed) == len(answers)
+            else f"{len(failed)} of the {len(answers)} workers ({', '.join(sorted(failed))})"
+        )
+        raise ImportError(
+            f"{which} at {address} cannot import pftrack ({one_line(first)}): {INSTALL_EVERYWHERE}",
+            name="pftrack",
+        )
+
+
+def _register(c: Client, plugin: Any, address: str) -> None:
+    """Register the worker `plugin`; a failure (a worker's setup raised) is one line.
+
+    Raises
+    ------
+    ImportError
+        Naming the scheduler's address and the workers' error (Dask's text), and what to do.
+    """
+    try:
+        c.register_plugin(plugin)
+    except Exception as exc:  # noqa: BLE001 - Dask re-raises a worker's error as Exception(TEXT)
+        raise ImportError(
+            f"the workers at {address} cannot set up pftrack's worker plugin ({one_line(exc)}): "
+            f"{INSTALL_EVERYWHERE}",
+            name="pftrack",
+        ) from None
 
 
 #: The loggers through which Dask reports, with a traceback, the end of a client's attempts to
@@ -456,8 +577,9 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     return check_scheduler_address(address, "$DASK_SCHEDULER_ADDRESS (Dask's scheduler-address)")
 
 
-#: Dask's comm protocols whose addresses are ``PROTOCOL://HOST:PORT`` (``inproc://`` is taken
-#: as it is: a scheduler in this very process).
+#: Dask's comm protocols whose addresses are ``PROTOCOL://HOST:PORT``. ``tls`` and ``wss``
+#: need Dask's TLS settings, ``ucx`` the distributed-ucxx package (:func:`dask_client` says so
+#: when they are missing); ``inproc://`` is refused: a scheduler inside one process.
 SCHEDULER_PROTOCOLS = ("tcp", "tls", "ws", "wss", "ucx")
 
 
@@ -472,8 +594,8 @@ def check_scheduler_address(address: object, what: str = "scheduler") -> str:
     ----------
     address : str
         ``PROTOCOL://HOST:PORT`` (protocol ``tcp``, ``tls``, ``ws``, ``wss`` or ``ucx``; none:
-        ``tcp``), ``HOST`` a name, an IPv4 address or a bracketed IPv6 one (``[::1]``), ``PORT``
-        in 1..65535. Spaces around it are dropped.
+        ``tcp``; not ``inproc``), ``HOST`` a name, an IPv4 address or a bracketed IPv6 one
+        (``[::1]``), ``PORT`` in 1..65535. Spaces around it are dropped.
     what : str
         Names the address in the error (``"--scheduler"``, ``"scheduler"``, ...).
 
@@ -503,8 +625,12 @@ def check_scheduler_address(address: object, what: str = "scheduler") -> str:
     protocol, sep, rest = text.partition("://")
     if not sep:
         protocol, rest = "tcp", text
-    if protocol == "inproc":
-        return text
+    if protocol == "inproc":  # was: taken, then Dask's "not enough values to unpack"
+        raise ValueError(
+            f"{named}: inproc:// names a scheduler inside one process, which a batch cannot "
+            "reach by address; give a running scheduler's tcp://HOST:PORT (in Python, pass "
+            "a client of an in-process cluster as client=)"
+        )
     if protocol not in SCHEDULER_PROTOCOLS:
         known = ", ".join(f"{p}://" for p in SCHEDULER_PROTOCOLS)
         raise ValueError(f"{named}: unknown protocol {protocol}:// ({known}; {expected})")
@@ -637,6 +763,82 @@ def _listing_hash(listing: Iterable[tuple[str, int, int]]) -> str:
     return digest.hexdigest()
 
 
+#: Outputs up to this size are hashed whole by :func:`output_print`; a larger one (a rendered
+#: video) by its first and last :data:`HASHED_ENDS` bytes. SHA-256 ran at 300-400 MB/s here
+#: (SHA-NI; BLAKE2b 150 MB/s): 64 MiB took 0.13 s, a NAME.txt of 8 KB 0.07 ms.
+HASHED_WHOLE = 64 << 20
+#: Bytes hashed at each end of an output larger than :data:`HASHED_WHOLE`.
+HASHED_ENDS = 1 << 20
+
+
+def output_print(path: Path) -> dict[str, Any]:
+    """What a re-run compares to tell whether an output is still the file a batch wrote.
+
+    Parameters
+    ----------
+    path : Path
+        An output (``DIR/NAME.txt``, ``DIR/NAME.mp4``).
+
+    Returns
+    -------
+    dict
+        ``name`` (the file's name in its folder), ``size`` and ``sha256``: the SHA-256 (hex) of
+        the whole file when it has at most :data:`HASHED_WHOLE` bytes, else of its first and
+        last :data:`HASHED_ENDS` bytes (with its size, a truncated, emptied or replaced video
+        is told apart without reading it all).
+
+    Raises
+    ------
+    OSError
+        The file cannot be read.
+    """
+    digest = hashlib.sha256()
+    with path.open("rb") as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if size <= HASHED_WHOLE:
+            while chunk := fh.read(HASHED_ENDS):
+                digest.update(chunk)
+        else:
+            digest.update(fh.read(HASHED_ENDS))
+            fh.seek(size - HASHED_ENDS)
+            digest.update(fh.read(HASHED_ENDS))
+    return {"name": path.name, "size": size, "sha256": digest.hexdigest()}
+
+
+def _outputs_changed(out_dir: Path, outputs: list[str], written: Any) -> str | None:
+    """Why the outputs of a complete-looking sidecar are not the files it wrote (None: they are).
+
+    `written` is the sidecar's ``output_prints`` (:func:`output_print` of each output when it
+    was written). Was: an output only had to exist, so one truncated, emptied or replaced by
+    another file counted as complete, and a re-run skipped it with the earlier figures.
+    """
+    for name in outputs:
+        if not (out_dir / name).is_file():
+            return f"redone: its output {out_dir / name} is missing"
+    if (
+        not isinstance(written, list)
+        or [w.get("name") if isinstance(w, dict) else None for w in written] != outputs
+    ):
+        return "redone: its sidecar records no fingerprint of its outputs (an older run)"
+    for name, was in zip(outputs, written, strict=True):
+        path = out_dir / name
+        try:
+            now = output_print(path)
+        except OSError as exc:
+            return f"redone: its output {path} cannot be read ({exc.strerror or exc})"
+        if now["size"] != was.get("size"):
+            return (
+                f"redone: its output {path} changed since the last run wrote it ({now['size']} "
+                f"bytes, written {was.get('size')})"
+            )
+        if now["sha256"] != was.get("sha256"):
+            return (
+                f"redone: its output {path} changed since the last run wrote it (the same size, "
+                "other content)"
+            )
+    return None
+
+
 def _sidecar(out_dir: Path, name: str) -> Path:
     return out_dir / f"{name}.json"
 
@@ -651,8 +853,10 @@ def _complete(
     entry : dict or None
         The sidecar, or None: the job is to run.
     note : str or None
-        Why a job whose outputs are otherwise complete is to run again: its inputs changed
-        (their `prints`, from :func:`fingerprint`, differ from the sidecar's).
+        Why a job done by an earlier run with these settings is to run again: its inputs
+        changed (their `prints`, from :func:`fingerprint`, differ from the sidecar's), or its
+        outputs did (missing, or no longer the size and SHA-256 the sidecar records:
+        :func:`output_print`).
     """
     path = _sidecar(out_dir, job.name)
     try:
@@ -668,9 +872,7 @@ def _complete(
         and entry.get("status") == "done"
     )
     outputs = entry.get("outputs")
-    if not same or not isinstance(outputs, list):
-        return None, None
-    if not all((out_dir / str(o)).is_file() for o in outputs):
+    if not same or not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
         return None, None
     earlier = entry.get("fingerprint")
     if earlier != prints:
@@ -681,6 +883,9 @@ def _complete(
         if all(_older_print(p, q) for p, q in changed):
             return None, f"redone: its sidecar records an older kind of fingerprint of {paths}"
         return None, f"redone: {paths} changed since the last run"
+    note = _outputs_changed(out_dir, outputs, entry.get("output_prints"))
+    if note is not None:
+        return None, note
     return entry, None
 
 
@@ -719,7 +924,10 @@ def _write(
     entry = {"name": job.name, "status": status, **result.info, "outputs": outputs}
     if result.error is not None:
         entry.update(error=result.error, traceback=result.traceback)
-    _write_sidecar(out_dir, job.name, {**head, "fingerprint": prints, **entry})
+    written = [output_print(out_dir / o) for o in outputs]  # what a re-run checks they still are
+    _write_sidecar(
+        out_dir, job.name, {**head, "fingerprint": prints, **entry, "output_prints": written}
+    )
     return entry
 
 
@@ -906,6 +1114,25 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     return f"{seen[0]}: {UNSEEN.format(host=outcome.host)}"
 
 
+#: How the messages name the output folder and a rendered video: the Python parameters
+#: (``out_dir``, ``options.render``), or the options while a command runs the batch
+#: (:func:`named_as_options`). Was ``--out`` from Python too (``track_many("a.avi", "b.avi")``:
+#: "--out b.avi is a file").
+_OUT_NAMES: contextvars.ContextVar[tuple[str, str]] = contextvars.ContextVar(
+    "pftrack_batch_out_names", default=("out_dir", "options.render")
+)
+
+
+@contextlib.contextmanager
+def named_as_options() -> Iterator[None]:
+    """Meanwhile, a batch's messages name ``--out`` and ``--render`` (``pftrack`` commands)."""
+    token = _OUT_NAMES.set(("--out", "--render"))
+    try:
+        yield
+    finally:
+        _OUT_NAMES.reset(token)
+
+
 def _check_outputs(
     jobs: Sequence[Job], out_dir: str | os.PathLike[str], suffixes: Sequence[str]
 ) -> Path:
@@ -914,7 +1141,8 @@ def _check_outputs(
     Returns `out_dir` as a Path (checked as given: an empty one is refused, not taken for the
     current folder).
     """
-    out_dir = check_output_folder(out_dir, "--out")
+    out_name, render_name = _OUT_NAMES.get()
+    out_dir = check_output_folder(out_dir, out_name)
     reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
     guarded = {_file_id(p) for job in jobs for p in job.guards} - {None}  # images: by inode
     names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]
@@ -923,10 +1151,10 @@ def _check_outputs(
         if target.resolve() in reads or _file_id(target) in guarded:
             # which option makes it: a rendered video is --render's (was: always --out)
             rendered = any(name.endswith(s) for s in suffixes)
-            what = f"--render's output {target}" if rendered else f"--out {target}"
+            what = f"{render_name}'s output {target}" if rendered else f"{out_name} {target}"
             raise ValueError(f"{what} is an input of this run; write elsewhere")
         if target.is_dir():
-            raise ValueError(f"--out {target} is a folder; it would be an output of this run")
+            raise ValueError(f"{out_name} {target} is a folder; it would be an output of this run")
     return out_dir
 
 
@@ -941,11 +1169,14 @@ def _file_id(path: Path) -> tuple[int, int] | None:
 
 def _make_out_dir(out_dir: Path) -> None:
     """Create the output folder and check that it is writable (once the tasks can run)."""
+    out_name = _OUT_NAMES.get()[0]
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:  # a read-only or special file system, a file on the way
-        raise ValueError(f"--out {out_dir}: cannot create the folder ({exc.strerror})") from None
-    check_output(out_dir / SUMMARY_NAME, what="--out")  # the folder is writable
+        raise ValueError(
+            f"{out_name} {out_dir}: cannot create the folder ({exc.strerror})"
+        ) from None
+    check_output(out_dir / SUMMARY_NAME, what=out_name)  # the folder is writable
 
 
 def run_jobs(
@@ -1031,7 +1262,7 @@ def run_jobs(
         if earlier is None:
             pending.append(job)
         else:
-            drop = ("kind", "settings", "inputs", "fingerprint")
+            drop = ("kind", "settings", "inputs", "fingerprint", "output_prints")
             keep = {k: v for k, v in earlier.items() if k not in drop}
             entries[job.name] = {**keep, "status": "skipped"}
 
@@ -1091,11 +1322,15 @@ def run_jobs(
                     _run_on_dask(c, pending, record, summary.kind, bar, frames, where, wait)
                 elif frames is not None:
                     for job in pending:
-                        record(job, call_task(job.func, job.args, frames.reporter(job.name)))
+                        with _no_bars():
+                            outcome = call_task(job.func, job.args, frames.reporter(job.name))
+                        record(job, outcome)
                         frames.finish(job.name)
                 elif pending:
                     for job in progress(pending, **bar):  # type: ignore[arg-type]
-                        record(job, call_task(job.func, job.args))
+                        with _no_bars():
+                            outcome = call_task(job.func, job.args)
+                        record(job, outcome)
             finally:
                 for job in jobs:
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
@@ -1109,6 +1344,21 @@ def run_jobs(
     return summary
 
 
+@contextlib.contextmanager
+def _no_bars() -> Iterator[None]:
+    """Meanwhile, no new progress bar (a task run in this process: the batch's bar is drawn).
+
+    As the worker plugin makes the workers quiet (:mod:`pftrack.batch._plugin`): the bars of
+    the code a task calls (``auto: calibrating``, ``smoothing``) were drawn under the batch's.
+    """
+    was = quiet()
+    set_quiet(True)
+    try:
+        yield
+    finally:
+        set_quiet(was)
+
+
 def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int | None) -> None:
     """Attach what an interrupted batch left to `exc` (printed by the command).
 
@@ -1118,7 +1368,10 @@ def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int 
     """
     noun = "sequence" if kind == "track" else "file"
     if written is None:
-        text = f"nothing was written: it stopped before the run began (--out {out} untouched)"
+        text = (
+            f"nothing was written: it stopped before the run began ({_OUT_NAMES.get()[0]} "
+            f"{out} untouched)"
+        )
     elif written == 0:
         text = (
             f"no {noun} was finished; {out / SUMMARY_NAME} lists them as cancelled (re-run to "
@@ -1176,7 +1429,25 @@ def no_workers_timeout() -> float:
 
 
 def _n_workers(c: Client) -> int:
-    return len(c.scheduler_info().get("workers", {}))
+    """The scheduler's workers now, as the scheduler counts them (its ``identity``).
+
+    Not ``len(c.scheduler_info()["workers"])``: the client refreshes that cache every 2 s
+    (``distributed.client.scheduler-info-interval``) with an identity that lists no worker
+    (Dask 2026.8), and one such refresh between ``scheduler_info``'s own fetch and its return
+    gave an empty list (134 of 1098 calls at a 5 ms interval with 2 workers running): "the
+    scheduler has lost all its workers" while they ran. The ``n_workers`` key, where the Dask
+    has it, counts them all; an older Dask lists them all. With the connection going (an
+    OSError), what the client last heard.
+    """
+    rpc = c.scheduler
+    try:
+        info = c.sync(rpc.identity) if rpc is not None else c.scheduler_info()
+    except OSError:
+        info = c.scheduler_info()
+    n = info.get("n_workers")
+    if isinstance(n, int) and n >= 0:
+        return n
+    return len(info.get("workers") or {})
 
 
 def _no_workers(address: str, wait: float) -> str:
@@ -1186,10 +1457,15 @@ def _no_workers(address: str, wait: float) -> str:
 def _wait_for_workers(c: Client, address: str, wait: float) -> int:
     """The cluster's workers, once it has one: none yet is said at once, and waited for.
 
+    Workers that come after a wait are checked as :func:`dask_client` checks those there at
+    the start: they can import pftrack (:func:`check_pftrack`).
+
     Raises
     ------
     TimeoutError
         None came within `wait` seconds.
+    ImportError
+        The workers that came cannot import pftrack.
     """
     n = _n_workers(c)
     if n:
@@ -1207,6 +1483,7 @@ def _wait_for_workers(c: Client, address: str, wait: float) -> int:
                 "$DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT)"
             )
         time.sleep(min(0.2, wait))
+    check_pftrack(c, address, scheduler=False)
     return n
 
 

@@ -186,8 +186,11 @@ _DASK = ("dask", "distributed")
 
 def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
     """Run the batch; print its table, or what stopped it; return the exit status."""
+    from pftrack.batch.engine import named_as_options
+
     try:
-        summary = call()
+        with named_as_options():  # --out, --render; from Python: out_dir, options.render
+            summary = call()
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         from pftrack.batch.engine import interrupted_left
