@@ -890,6 +890,40 @@ def test_a_signal_taken_by_an_earlier_thread_is_held_too(sig: str) -> None:
     assert reached == [True]
 
 
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX signal masks")
+def test_a_ctrl_c_while_the_cluster_closes_is_raised_once_it_has_closed(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Was: a Ctrl-C during the close (a second one after the batch's own, or one as a finished
+    batch closed) stopped it half-way; Dask's exit hook then waited up to 10 s on the cluster
+    and, interrupted again, printed "Exception ignored in atexit callback: close_clusters"."""
+    from distributed.deploy.spec import SpecCluster
+
+    closing = []
+    real_close = SpecCluster.close
+
+    def close_with_ctrl_c(self: Any, *args: Any, **kwargs: Any) -> Any:
+        if not closing:
+            closing.append(self)
+            signal.pthread_kill(threading.get_ident(), signal.SIGINT)  # Ctrl-C, now
+            time.sleep(0.05)  # a signal not held would be raised here
+        return real_close(self, *args, **kwargs)
+
+    monkeypatch.setattr(SpecCluster, "close", close_with_ctrl_c)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    left = []
+    try:
+        with pytest.raises(KeyboardInterrupt), dask_client(n_workers=1):
+            pass
+    finally:
+        signal.signal(signal.SIGINT, before)
+        left = [c.status.name for c in closing]  # what Dask's exit hook would find
+        for cluster in closing:
+            if cluster.status.name != "closed":
+                real_close(cluster)
+    assert left == ["closed"]
+
+
 def test_cli_interrupt_exits_130(
     data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -353,7 +353,8 @@ def dask_client(
                     quiet.enter_context(_silenced(*_CLIENT_LOGGERS))
         return
     n = n_workers if n_workers is not None else (os.cpu_count() or 1)
-    with contextlib.ExitStack() as stack:
+    stack = contextlib.ExitStack()
+    try:
         with _interrupts_held():  # the cluster starts whole; its workers deaf to Ctrl-C, SIGTERM
             stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
             cluster = stack.enter_context(
@@ -372,6 +373,13 @@ def dask_client(
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
+    finally:
+        # and it closes whole too: a Ctrl-C in the middle (a second one, after the batch's
+        # own, or one as a finished batch closes) left it half closed, for Dask's exit hook
+        # to wait up to 10 s on and print a traceback when interrupted again; it is raised
+        # once the cluster is closed
+        with _interrupts_held():
+            stack.close()
 
 
 #: Dask's settings of a TLS client (``tls://``, ``wss://``), as environment variables.
