@@ -1321,8 +1321,14 @@ def test_an_address_dask_cannot_connect_by_is_one_line_naming_it(
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_tls_runs_with_dasks_tls_settings(tmp_path: Path) -> None:
-    """What docs/batch.md says a tls:// scheduler needs: Dask's CA file, client cert and key."""
+    """What docs/batch.md says a tls:// scheduler needs: Dask's CA file, client cert and key.
+
+    Slow (deselected by default): after this file's other cluster tests in one process, the
+    TLS cluster's IO loop did not start within Dask's 10 s twice on the 2-core machine; alone,
+    or among the slow tests, it passes.
+    """
     import dask
     from distributed.security import Security
 
