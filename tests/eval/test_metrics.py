@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import warnings
@@ -765,3 +766,28 @@ def test_negative_ids_are_refused_as_trackeval_refuses_them(tmp_path, capsys):
         f"pftrack eval: error: {tmp_path / 'res.txt'}: result has id -5 in frame 4: ids must be "
         ">= 0, as TrackEval requires\n"
     )
+
+
+@pytest.mark.parametrize("n_cols", [6, 7, 8, 9])
+def test_short_rows_score_as_their_file(tmp_path, n_cols):
+    """An (M, 6..9) array scores as the file it is written to: read_mot's defaults fill it.
+
+    Before, an 8-column ground truth (frame, id, box, flag, class) got visibility 1 where the
+    file read gives -1: the array was taken for MOT17 (the box of class 2, a distractor, left
+    out with the result box on it), the file for MOT15 (no classes: that box matched).
+    """
+    gt = np.array(
+        [[1, 1, 10, 10, 20, 40, 1, 1, 1, 1], [1, 2, 60, 10, 20, 40, 1, 2, 1, 1],
+         [2, 1, 12, 10, 20, 40, 1, 1, 1, 1], [2, 2, 62, 10, 20, 40, 1, 2, 1, 1]],
+        dtype=np.float64,
+    )  # fmt: skip
+    result = rows((1, 7, 10, 10, 20, 40), (1, 8, 60, 10, 20, 40), (2, 7, 12, 10, 20, 40))
+    short = gt[:, :n_cols]
+    path = tmp_path / "gt.txt"
+    path.write_text("".join(",".join(f"{v:g}" for v in r) + "\n" for r in short))
+    from_array = evaluate_mot(short, result)
+    from_file = evaluate_mot(read_mot(path), result)
+    np.testing.assert_equal(dataclasses.astuple(from_array), dataclasses.astuple(from_file))
+    # MOT15's rules up to 8 columns (3 matches, the distractor's second box missed); with the
+    # visibility column MOT17's, which leave the distractor and the result box on it out
+    assert from_array.num_matches == (3 if n_cols < 9 else 2)

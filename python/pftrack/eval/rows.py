@@ -13,7 +13,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from pftrack._check import MAX_FRAME, bad_id_message, first_bad_id, integer, number, real_array
+from pftrack._check import (
+    MAX_FRAME,
+    MOT_DEFAULTS,
+    bad_id_message,
+    first_bad_id,
+    integer,
+    number,
+    real_array,
+)
 from pftrack.boxes import _box_rows
 from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
 
@@ -45,13 +53,15 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     Real numbers, ``(M, 6..10)``, the first 6 columns finite, frames and ids integers within
     ``MAX_FRAME`` (they are cast to int: an id 1.5 is refused, not scored as 1, the test
     ``pftrack recover`` makes), frames from 1 and no negative width or height (as
-    :func:`~pftrack.io.mot.read_mot` refuses them); missing columns padded. Shared by
+    :func:`~pftrack.io.mot.read_mot` refuses them); missing columns padded with what
+    ``read_mot`` gives a shorter line (:data:`~pftrack._check.MOT_DEFAULTS`: conf 1, x, y, z
+    -1), so an array and the file it was written to score the same. Shared by
     :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`.
     """
     a = real_array(rows, what)
     if a.size == 0:
         return np.zeros((0, 10))
-    if a.ndim != 2 or a.shape[1] < 6:
+    if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
         raise ValueError(f"{what} has shape {a.shape}, expected (M, 6..10) MOT rows")
     if not np.all(np.isfinite(a[:, :6])):
         raise ValueError(f"{what} has non-finite values in its first 6 columns")
@@ -78,8 +88,8 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     k_id = first_bad_id(a[:, 1])
     if k_id is not None:  # cast to int, 1.5 and 1.7 would be one id: refused as recover does
         raise ValueError(f"{what} row {k_id}: {bad_id_message(a[k_id, 1])}")
-    if a.shape[1] < 10:
-        pad = np.tile([1.0, -1.0, -1.0, -1.0][: 10 - a.shape[1]], (a.shape[0], 1))
+    if a.shape[1] < 10:  # the columns a shorter line of a file is read with (read_mot)
+        pad = np.tile(np.asarray(MOT_DEFAULTS[a.shape[1] - 6 :]), (a.shape[0], 1))
         a = np.hstack([a, pad])
     return a
 
