@@ -671,6 +671,29 @@ def test_progress_counts_frames_within_the_sequences(
     assert len(set(seen) - {30, 60, 90}) > 80
 
 
+def test_progress_keeps_its_total_when_a_video_is_unreadable(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: one unreadable video (its length None, as an unknown one's) took the bar's total
+    and time left away (``90frame [00:01, ...]``). It counts 0 frames and is named."""
+    from pftrack import _progress
+    from pftrack.batch.tasks import sequence_length
+
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(_progress, "_quiet", False)
+    broken = tmp_path / "broken.avi"
+    broken.write_bytes(b"\x00\x01 not a video \xfe\xff")
+    (seq,) = find_sequences(broken)
+    assert sequence_length(seq) == 0
+    options = TrackOptions(config=_config())
+    summary = track_many(
+        [data, broken], tmp_path / "out", options=options, n_workers=0, show_progress=True
+    )
+    err = capsys.readouterr().err
+    assert "4/4 sequences, 1 unreadable" in err and "90/90" in err and "frame/s" in err
+    assert [e["status"] for e in summary.entries].count("failed") == 1
+
+
 def test_tasks_on_workers_report_their_frames(client: Any, data: Path) -> None:
     """On Dask, each task sends its frame count to the client as events on a topic."""
     from pftrack.batch.engine import call_task

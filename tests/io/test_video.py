@@ -371,7 +371,7 @@ def test_16_bit_images_of_12_bit_data_are_read_at_their_depth(tmp_path: Path) ->
     src = FrameSource(tmp_path / "d12")
     assert src.bits == 12
     message = (
-        r"d12: its 16-bit images hold 12-bit values \(1\.png goes up to 4000 of 65535\): read "
+        r"d12: its 16-bit images hold 12-bit values \(2\.png goes up to 4095 of 65535\): read "
         r"as 12-bit data, each value / 16 to 8 bits \(not / 256, which makes them almost black\)$"
     )
     with pytest.warns(UserWarning, match=message) as said:
@@ -390,17 +390,52 @@ def test_16_bit_images_of_12_bit_data_are_read_at_their_depth(tmp_path: Path) ->
     assert all(np.array_equal(f, i >> 2) for f, i in zip(frames, images, strict=True))
 
 
-def test_a_later_image_brighter_than_the_first_ones_depth_is_clipped_with_a_warning(
+def test_a_dark_first_image_does_not_decide_the_depth_alone(tmp_path: Path) -> None:
+    """12-bit data whose first image is dark (a lens cap, a night start: up to 700, 10 bits).
+
+    Was: read at 10 bits, the first image's, and every later, brighter image clipped to white
+    (one warning): the scene ruined. The depth is that of the brightest of the first, the last
+    and up to seven images evenly spaced between.
+    """
+    tops = [700] + [4000] * 19
+    images = _sixteen_bit(tmp_path / "d", tops)
+    src = FrameSource(tmp_path / "d")
+    assert src.bits == 12
+    with pytest.warns(UserWarning) as said:
+        frames = list(src)
+    assert [str(w.message) for w in said] == [
+        f"{tmp_path / 'd'}: its 16-bit images hold 12-bit values (3.png goes up to 4000 of "
+        "65535): read as 12-bit data, each value / 16 to 8 bits (not / 256, which makes them "
+        "almost black)"
+    ]  # no clipping warning
+    assert all(np.array_equal(f, i >> 4) for f, i in zip(frames, images, strict=True))
+    # the images looked at: the first, the last, evenly spaced between; a bounded number
+    assert video._depth_sample(20) == [0, 2, 5, 7, 10, 12, 14, 17, 19]
+    assert video._depth_sample(3) == [0, 1, 2]
+    assert len(video._depth_sample(100_000)) == 9
+    assert video._depth_sample(100_000)[-1] == 99_999
+
+
+def test_an_image_brighter_than_the_depth_decided_is_clipped_with_a_warning(
     tmp_path: Path,
 ) -> None:
-    images = _sixteen_bit(tmp_path / "d", [1000, 4000, 3000])  # 10 bits decided, then 12
+    # 10 bits decided from images 1, 3, 6, ... (2.png and 4.png are not among them)
+    images = _sixteen_bit(tmp_path / "d", [1000, 4000, 1000, 3000] + [1000] * 16)
     with pytest.warns(UserWarning) as said:
         frames = list(FrameSource(tmp_path / "d"))
     assert [str(w.message) for w in said][1:] == [
         f"image {tmp_path / 'd' / '2.png'} goes up to 4000, past the 10 bits its folder's 16-bit "
-        "images are read at (from the first's values): its brighter pixels are clipped to white"
-    ]  # once, not for 3.png too
+        "images are read at (from the values of 9 of its 20 images): its brighter pixels are "
+        "clipped to white"
+    ]  # once, not for 4.png too
     assert np.array_equal(frames[1], np.minimum(images[1], 1023) >> 2)
+    assert np.array_equal(frames[3], np.minimum(images[3], 1023) >> 2)
+    # a folder of three: all three decide, nothing clipped (was: 10 bits, from 1.png alone)
+    images = _sixteen_bit(tmp_path / "three", [1000, 4000, 3000])
+    with pytest.warns(UserWarning, match=r"12-bit values \(2\.png goes up to 4000") as said:
+        frames = list(FrameSource(tmp_path / "three"))
+    assert len(said) == 1
+    assert all(np.array_equal(f, i >> 4) for f, i in zip(frames, images, strict=True))
 
 
 def test_8_bit_and_full_range_16_bit_images_are_read_as_opencv_reads_them(
@@ -408,11 +443,13 @@ def test_8_bit_and_full_range_16_bit_images_are_read_as_opencv_reads_them(
 ) -> None:
     """The same pixels as cv2.imread's colour read (warnings are errors: none is given)."""
     _sixteen_bit(tmp_path / "full", [65535, 60000])
+    _sixteen_bit(tmp_path / "late", [4000] * 9 + [65535] * 3)  # the last image: full range
     scene = make_scene(n_frames=3, width=64, height=64, n_walkers=2, rng=0)
-    for folder in (tmp_path / "full", scene.write_images(tmp_path / "eight")):
+    folders = [tmp_path / "full", tmp_path / "late", scene.write_images(tmp_path / "eight")]
+    for folder in folders:
         src = FrameSource(folder)
         assert src.bits is None
-        paths = sorted(folder.iterdir())
+        paths = sorted(folder.iterdir(), key=lambda p: natural_key(p.name))
         expected = [cv2.imread(str(p), cv2.IMREAD_COLOR) for p in paths]
         assert all(np.array_equal(f, e) for f, e in zip(src, expected, strict=True))
 

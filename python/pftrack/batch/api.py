@@ -92,7 +92,8 @@ def track_many(
     show_progress : bool, optional
         Progress bar on stderr (default: when stderr is a terminal): the frames tracked over
         all the sequences, with the time left where every sequence's length is known (a
-        video's header, an image folder; else the count and rate), and the sequences done.
+        video's header, an image folder; else the count and rate; one that cannot be opened
+        counts 0 frames, named in the label: ``1 unreadable``), and the sequences done.
         The tasks report their frames as they go, from Dask workers too (as Dask events,
         twice a second at most).
 

@@ -83,8 +83,10 @@ class Job:
         Files and folders the task reads (outputs may not be one of them).
     count : callable, optional
         For the progress bar: returns how many frames the task will report (through
-        :func:`~pftrack.batch.tasks.reporting_frames`), None if unknown. Called on the client
-        before the tasks run, and only when a bar is drawn.
+        :func:`~pftrack.batch.tasks.reporting_frames`), None if unknown; 0 for an input that
+        cannot be read (the task will fail without a frame: the bar says so and keeps the
+        others' total). Called on the client before the tasks run, and only when a bar is
+        drawn.
     guards : tuple of Path
         The files inside `reads` the task reads too, which outputs may not be either (the
         images of a folder, a sequence's ``seqinfo.ini``); not fingerprinted.
@@ -1575,13 +1577,16 @@ class _Frames:
 
     Each task reports the frames it has tracked (in this process, or as Dask events from a
     worker); a finished task counts for all its frames (a failed one too: none are left to do),
-    so that the time left is that of the work left.
+    so that the time left is that of the work left. An input that cannot be read counts 0
+    frames and is named in the label (``0/2 sequences, 1 unreadable``): the total stays that
+    of the others (was: no total, no time left, for one unreadable video).
     """
 
     def __init__(self, pending: Sequence[Job], noun: str, enable: bool | None) -> None:
         self._counts = {job.name: job.count() if job.count is not None else None for job in pending}
         known = [n for n in self._counts.values() if n is not None]
         total = sum(known) if len(known) == len(self._counts) else None  # else no ETA
+        self._unreadable = sum(n == 0 for n in known)
         self._noun = noun
         self._done: dict[str, int] = {}
         self._sum = 0
@@ -1590,7 +1595,8 @@ class _Frames:
         self.bar = Bar(total, desc=self._desc(), enable=enable, unit="frame")
 
     def _desc(self) -> str:
-        return f"{self._finished}/{len(self._counts)} {self._noun}"
+        unreadable = f", {self._unreadable} unreadable" if self._unreadable else ""
+        return f"{self._finished}/{len(self._counts)} {self._noun}{unreadable}"
 
     def report(self, name: str, n: int) -> None:
         """Task `name` has tracked `n` frames."""

@@ -96,13 +96,18 @@ def _checked(frames: Iterable[Any], stop: Callable[[], None] | None) -> Iterator
 
 
 def sequence_length(seq: SequenceInput) -> int | None:
-    """The number of frames of `seq` if its header or folder says (None: unknown, unreadable)."""
+    """The number of frames of `seq` if its header or folder says it; None if unknown.
+
+    0 when `seq` cannot be opened (not a video, no frame, a missing image): its task fails
+    with its own message before tracking a frame, and the batch's bar keeps the total of the
+    others (was: None, and one unreadable video took the bar's total and time left away).
+    """
     from pftrack.io.video import FrameSource
 
     try:
         n = len(FrameSource(seq.frames))
     except (OSError, ValueError):  # the task then fails with its own message
-        return None
+        return 0
     return n if n > 0 else None
 
 

@@ -82,11 +82,29 @@ def _bit_depth(top: int) -> int:
     """The bit depth of 16-bit image data whose largest value is `top`: 8, 10, 12, 14 or 16.
 
     The fewest bits that hold `top`, rounded up to an even number (cameras give 10, 12 or 14
-    bits; rounding up leaves room for brighter pixels than the image's): 4000 is 12 bits, 4096
+    bits; rounding up leaves room for brighter pixels than the images'): 4000 is 12 bits, 4096
     14, 255 8 (8-bit data in a 16-bit file).
     """
     bits = max(8, int(top).bit_length())
     return min(16, bits + bits % 2)
+
+
+#: The images of a folder whose largest value decides the depth its 16-bit images are read at.
+DEPTH_SAMPLE = 9
+
+
+def _depth_sample(n: int) -> list[int]:
+    """The indices of the images of an `n`-image folder that decide its depth (:func:`_bit_depth`).
+
+    The first, then up to :data:`DEPTH_SAMPLE` - 1 others evenly spaced up to the last: a
+    bounded cost whatever the folder's length, the same images on every read. 20 images:
+    ``[0, 2, 5, 7, 10, 12, 14, 17, 19]``; 3 images: all three.
+    """
+    if n <= DEPTH_SAMPLE:
+        return list(range(n))
+    return sorted(
+        {(k * (n - 1) + (DEPTH_SAMPLE - 1) // 2) // (DEPTH_SAMPLE - 1) for k in range(DEPTH_SAMPLE)}
+    )
 
 
 def _file_capture(path: str) -> cv2.VideoCapture:
@@ -763,9 +781,10 @@ class FrameSource:
         None otherwise.
     bits : int or None
         For an image folder whose first image is 16-bit with values of fewer bits (10- or
-        12-bit camera data: :func:`_bit_depth` of its largest value, 10, 12 or 14; 8 for 8-bit
-        data), the depth every 16-bit image of the folder is read at: each value divided by
-        ``2 ** (bits - 8)`` (a value past it white), not by 256 as OpenCV reads them, which
+        12-bit camera data: :func:`_bit_depth` of the largest value of its first image, its
+        last and up to seven evenly spaced between, :func:`_depth_sample`, 10, 12 or 14; 8 for
+        8-bit data), the depth every 16-bit image of the folder is read at: each value divided
+        by ``2 ** (bits - 8)`` (a value past it white), not by 256 as OpenCV reads them, which
         makes such images almost black. None: images read as OpenCV reads them (8-bit images,
         full-range 16-bit ones), a video, a camera or a stream.
 
@@ -787,7 +806,8 @@ class FrameSource:
         Once, when a video read to its end had fewer frames than its header says, or a number
         other than its sequence's ``seqLength`` (counted as read: no pass of its own). At the
         first image read, when a folder's 16-bit images are read at :attr:`bits`; once, when
-        a later one is brighter than that depth holds (its brighter pixels clipped to white).
+        an image it was not decided from is brighter than that depth holds (its brighter
+        pixels clipped to white).
 
     Notes
     -----
@@ -814,10 +834,11 @@ class FrameSource:
         self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
         self._image_shape = (0, 0)  # (height, width) of a folder's first image
-        # a folder's 16-bit images of fewer bits (from its first image): read at that depth
+        # a folder's 16-bit images of fewer bits (from a few of its images): read at that depth
         self.bits: int | None = None
         self.gap: str | None = None  # an image folder's names skip a number
         self._depth_note: str | None = None  # the warning saying so, given at the first read
+        self._depth_from = ""  # the images `bits` was decided from, for the clipping warning
         self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._cap: Any = None
@@ -891,7 +912,9 @@ class FrameSource:
 
         16-bit images whose values use only the low bits (10- or 12-bit camera data) become
         almost black as OpenCV reads them in colour (value / 256): they are read at the depth
-        of the first, :func:`_bit_depth` of its largest value, for the whole folder. 8-bit and
+        of the largest value of the images :func:`_depth_sample` picks (the first, the last and
+        up to seven evenly spaced between), :func:`_bit_depth` of it, for the whole folder: a
+        dark first image (a lens cap, a night start) does not decide it alone. 8-bit and
         full-range 16-bit images are read as OpenCV reads them, the same pixels as ever.
         """
         first = read_image_depth(path)
@@ -900,6 +923,15 @@ class FrameSource:
         if first.dtype == np.uint8:  # the pixels read_image gives
             return first
         top = int(first.max()) if first.dtype == np.uint16 else 65535
+        brightest = path
+        images = self._images or [path]
+        sample = _depth_sample(len(images))
+        for k in sample[1:]:
+            if _bit_depth(top) == 16:
+                break
+            other = read_image_depth(images[k])  # unreadable: refused when read, as ever
+            if other is not None and other.dtype == np.uint16 and int(other.max()) > top:
+                top, brightest = int(other.max()), images[k]
         bits = _bit_depth(top)
         if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
             again = read_image(path)
@@ -907,10 +939,15 @@ class FrameSource:
                 raise ValueError(f"cannot read image {path}")
             return again
         self.bits = bits
+        self._depth_from = (
+            "from the first's values"
+            if len(sample) == 1
+            else f"from the values of {len(sample)} of its {len(images)} images"
+        )
         self._depth_note = (
-            f"{folder}: its 16-bit images hold {bits}-bit values ({path.name} goes up to {top} "
-            f"of 65535): read as {bits}-bit data, each value / {1 << (bits - 8)} to 8 bits "
-            "(not / 256, which makes them almost black)"
+            f"{folder}: its 16-bit images hold {bits}-bit values ({brightest.name} goes up to "
+            f"{top} of 65535): read as {bits}-bit data, each value / {1 << (bits - 8)} to 8 "
+            "bits (not / 256, which makes them almost black)"
         )
         return self._to_8_bits(first, path)
 
@@ -925,8 +962,8 @@ class FrameSource:
                 self._clipped = True
                 warnings.warn(
                     f"image {path} goes up to {top}, past the {bits} bits its folder's 16-bit "
-                    f"images are read at (from the first's values): its brighter pixels are "
-                    "clipped to white",
+                    f"images are read at ({self._depth_from}): its brighter pixels are clipped "
+                    "to white",
                     UserWarning,
                     stacklevel=4,
                 )
@@ -979,7 +1016,7 @@ class FrameSource:
     def _read_image(self, path: Path) -> NDArray[np.uint8]:
         """One image of a folder, resized; ValueError if unreadable or not the first's size.
 
-        At :attr:`bits` when the folder's first image set it (the first read says so, once).
+        At :attr:`bits` when the folder's images set it (the first read says so, once).
         """
         if self._depth_note is not None:
             note, self._depth_note = self._depth_note, None
