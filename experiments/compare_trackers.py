@@ -186,7 +186,9 @@ def make_norfair(seq: Sequence) -> Step:
         objs = trk.update(detections=dets)
         out = []
         for o in objs:
-            (x0, y0), (x1, y1) = o.estimate
+            # the two corners are filtered apart: early in a track they may cross (a box of
+            # negative width, which evaluate_mot refuses); a user takes the box they span
+            (x0, x1), (y0, y1) = sorted(o.estimate[:, 0]), sorted(o.estimate[:, 1])
             out.append((int(o.id or 0), x0, y0, x1 - x0, y1 - y0))  # id is set once initialised
         return out
 

@@ -152,11 +152,11 @@ _PARTS = np.ones((3, 6))
 WRONG_KIND = [
     # was ValueError for these wrong types, where a number setting ("4") gave TypeError
     (lambda: FilterConfig(n_particles="5"), TypeError,
-     "n_particles must be an integer in [1, 1000000], got str '5'"),
+     "FilterConfig: n_particles must be an integer in [1, 1000000], got str '5'"),
     (lambda: FilterConfig(n_particles=5.0), TypeError,
-     "n_particles must be an integer in [1, 1000000], got float 5.0"),
+     "FilterConfig: n_particles must be an integer in [1, 1000000], got float 5.0"),
     (lambda: FilterConfig(n_particles=0), ValueError,
-     "n_particles is 0, expected an integer in [1, 1000000]"),
+     "FilterConfig: n_particles is 0, expected an integer in [1, 1000000]"),
     # the tracker's integer settings likewise (was ValueError)
     (lambda: CameraConfig(refresh_frames=2.5), TypeError,
      "CameraConfig: refresh_frames must be an integer >= 1, got float 2.5"),

@@ -161,10 +161,10 @@ def test_batch_equals_one_by_one_on_a_lattice(big_frame):
 
 
 def test_min_samples_is_checked():
-    with pytest.raises(ValueError, match=r"^min_samples is -1, expected an integer in \[0, "):
+    with pytest.raises(ValueError, match=r"^FilterConfig: min_samples is -1, expected an int"):
         FilterConfig(min_samples=-1)
     for bad in (1.5, True, "2048"):  # a wrong type: TypeError as a number's (was ValueError)
-        with pytest.raises(TypeError, match=r"^min_samples must be an integer in \[0, 2147"):
+        with pytest.raises(TypeError, match=r"^FilterConfig: min_samples must be an integer in"):
             FilterConfig(min_samples=bad)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="min_samples"):
         _core.sis_step(

@@ -75,8 +75,8 @@ class FilterConfig:
     min_samples: int = 2048
 
     def __post_init__(self) -> None:
-        integer(self.n_particles, "n_particles", 1, MAX_PARTICLES)
-        integer(self.min_samples, "min_samples", 0, 2**31 - 1)  # 0: every pixel
+        integer(self.n_particles, "FilterConfig: n_particles", 1, MAX_PARTICLES)
+        integer(self.min_samples, "FilterConfig: min_samples", 0, 2**31 - 1)  # 0: every pixel
         lam = number(self.lam, "FilterConfig: lam", finite=False)
         if not (np.isfinite(lam) and lam > 0):  # as bhattacharyya_weights: 0 ignores colour
             raise ValueError(
@@ -84,9 +84,13 @@ class FilterConfig:
                 "particle the same weight: the filter would not follow colour)"
             )
         if self.kernel not in ("uniform", "epanechnikov"):
-            raise ValueError(f"kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'")
+            raise ValueError(
+                f"FilterConfig: kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'"
+            )
         if self.estimate not in ("mean", "map"):
-            raise ValueError(f"estimate is {self.estimate!r}, expected 'mean' or 'map'")
+            raise ValueError(
+                f"FilterConfig: estimate is {self.estimate!r}, expected 'mean' or 'map'"
+            )
 
 
 @dataclass(frozen=True)
