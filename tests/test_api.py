@@ -201,14 +201,18 @@ def test_cli_parser_loads_no_scipy() -> None:
 
 
 def test_recover_loads_no_tracker(tmp_path: Path) -> None:
-    """``pftrack recover`` runs without importing the tracker (about 0.14 s of imports)."""
+    """``pftrack recover`` runs without importing the tracker (about 0.14 s of imports).
+
+    Nor OpenCV and the video module without ``--video`` (they took 64 ms of a 500-track file's
+    1.1 s: ``from pftrack.io.video import source_files`` ran for every file).
+    """
     tracks = tmp_path / "t.txt"
     tracks.write_text("1,1,10,10,5,5,1,-1,-1,-1\n4,1,13,10,5,5,1,-1,-1,-1\n")
     code = (
         "import sys; from pftrack.cli import main; "
         f"status = main(['-q', 'recover', {str(tracks)!r}, '--out', {str(tmp_path / 'o.txt')!r}]); "
         "print(status, sorted(m for m in sys.modules if m.startswith(('pftrack.tracking', "
-        "'pftrack.detection'))))"
+        "'pftrack.detection', 'pftrack.io.video', 'cv2'))))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip().splitlines()[-1] == "0 []"

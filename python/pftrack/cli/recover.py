@@ -95,10 +95,11 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(
             f"--out {out} is the input file; pass --in-place to replace it (atomically)"
         )
-    from pftrack.io.video import source_files
+    inputs: tuple[Path, ...] = ()
+    if args.video:  # the video, or every image of a folder and a sequence's seqinfo.ini
+        from pftrack.io.video import source_files  # OpenCV: only with a video
 
-    # the video, or every image of a folder and a sequence's seqinfo.ini
-    inputs = tuple(source_files(args.video)) if args.video else ()
+        inputs = tuple(source_files(args.video))
     check_output(args.out, what="--out", inputs=inputs)
     rows = read_tracks(src)
     n_links = 0
