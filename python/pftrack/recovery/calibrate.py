@@ -990,7 +990,7 @@ def recover_auto(
         (default): :data:`BAGS` with `combine`, 0 without (:func:`bags_for`).
     contexts : sequence of (int, int), optional
         Observed points before and after each gap in its track, when `pairs` hold only the
-        points next to the gaps that the candidates read (:func:`gap_window`; the artificial
+        points next to the gaps that the candidates read (:func:`gap_windows`; the artificial
         gaps keep as many, :func:`calibrate`); default: the segments' lengths. With it, pass
         `observed`: the calibration runs on the whole tracks, not on the windows.
 
