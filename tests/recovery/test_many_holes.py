@@ -3,8 +3,9 @@
 A user trial: ``fill_gaps`` (``"auto"``) on one track seen every other frame (8000 holes) took
 4.1 GB, because every hole's segments held the whole track before and after it and were copied
 (checked, their sizes cut out, stacked for the ``gdt`` batch): the track's length times its
-holes. Now each hole's segments are cut to the points the candidates read
-(:func:`pftrack.recovery.calibrate.gap_windows`), with the same bits.
+holes (the ``gdt`` methods' batch stacked them too). Now each hole's segments are cut to the
+points the methods read (:func:`pftrack.recovery.calibrate.gap_windows`; not for ``gsi``),
+with the same bits.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import pytest
 
 from pftrack.recovery import fill, fill_gaps
 from pftrack.recovery.calibrate import WINDOW_POINTS, GapWindows, gap_windows, recover_auto
+from pftrack.recovery.registry import METHODS
 
 
 def _one_track(n_holes: int, seed: int = 0) -> np.ndarray:
@@ -55,16 +57,24 @@ def _tracks(seed: int = 0) -> np.ndarray:
     return np.vstack(out)
 
 
-def test_one_track_of_many_holes_is_bounded_in_memory() -> None:
+def _whole(frames: np.ndarray, ids: np.ndarray) -> GapWindows:
+    """:func:`gap_windows` with every window the whole track: the segments as they were."""
+    w = gap_windows(frames, ids)
+    return GapWindows(w.holes, w.first, w.end, w.first, w.end)
+
+
+@pytest.mark.parametrize("method", ["auto", "gdt-bi", "gdt-mix"])
+def test_one_track_of_many_holes_is_bounded_in_memory(method: str) -> None:
     rows = _one_track(1000)
     tracemalloc.start()
     try:
-        out, rep = fill_gaps(rows)
+        out, rep = fill_gaps(rows, method)  # type: ignore[arg-type]
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
     assert rep.n_gaps == 1000 and len(out) == len(rows) + 1000
-    # 64 MB before (the track's length per hole: 4.1 GB for 8000 holes); 6 MB now
+    # auto 64 MB before, gdt-bi 42 MB (the track's length per hole: auto 4.1 GB for 8000
+    # holes); 6 MB now
     assert peak < 25 * 2**20, f"peak {peak / 2**20:.0f} MB"
 
 
@@ -95,15 +105,22 @@ def test_windows_change_no_bit(monkeypatch: pytest.MonkeyPatch) -> None:
             chosen |= {m for b in cal.buckets for m, _ in (b.weights or ((b.method, 1.0),))}
     assert chosen - {"linear"}  # more than straight lines: the other candidates ran
 
-    def whole(frames: np.ndarray, ids: np.ndarray) -> GapWindows:
-        w = gap_windows(frames, ids)
-        return GapWindows(w.holes, w.first, w.end, w.first, w.end)
-
-    monkeypatch.setattr(fill, "gap_windows", whole)  # the segments as they were: whole
+    monkeypatch.setattr(fill, "gap_windows", _whole)  # the segments as they were: whole
     want = [fill_gaps(rows, seed=s, **kw) for s, kw in ((0, {}), (1, {"combine": False}))]
     for (a, ra), (b, rb) in zip(got, want, strict=True):
         assert a.tobytes() == b.tobytes()
         assert ra.describe() == rb.describe()
+
+
+@pytest.mark.parametrize("method", sorted(set(METHODS) - {"auto", *fill.WHOLE_SEGMENT_METHODS}))
+def test_named_methods_on_the_windows_change_no_bit(
+    method: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rows = _tracks(1)
+    got, rep = fill_gaps(rows, method)  # type: ignore[arg-type]
+    assert rep.n_gaps > 40
+    monkeypatch.setattr(fill, "gap_windows", _whole)
+    assert got.tobytes() == fill_gaps(rows, method)[0].tobytes()  # type: ignore[arg-type]
 
 
 def test_gap_windows_hold_the_runs_next_to_each_hole() -> None:
@@ -129,15 +146,16 @@ def test_gap_windows_hold_the_runs_next_to_each_hole() -> None:
         assert all(len(v) == 0 for v in gap_windows(frames))
 
 
-def test_far_centre_outside_the_window_still_refused() -> None:
+@pytest.mark.parametrize("method", ["auto", "gdt-bi"])
+def test_far_centre_outside_the_window_still_refused(method: str) -> None:
     """A centre beyond 1e9 px far from the hole is refused as before (whole segments then)."""
     fr = np.r_[1:80, 85:200].astype(np.float64)
     k = len(fr)
     box = np.column_stack([10 + fr, np.full(k, 20.0), np.full((k, 2), (20.0, 40.0))])
     rows = np.column_stack([fr, np.ones(k), box, np.ones(k), -np.ones((k, 3))])
     rows[0, 2], rows[0, 4] = 9.9e8, 9e8  # its centre: 1.44e9 px, 78 rows before the hole
-    with pytest.raises(ValueError, match=r"segment_a row 0 has x = 1.44e\+09, beyond"):
-        fill_gaps(rows)
+    with pytest.raises(ValueError, match=r"segment_a (of gap 0 )?row 0 has x = 1.44e\+09, beyond"):
+        fill_gaps(rows, method)  # type: ignore[arg-type]
 
 
 def test_recover_auto_refuses_contexts_of_another_length() -> None:

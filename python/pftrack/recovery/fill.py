@@ -55,6 +55,9 @@ DEFAULT_MAX_GAP = 30
 SIZE_CANDIDATES = ("linear", "rts")
 #: At most this many artificial gaps calibrate the box sizes.
 SIZE_GAPS = 120
+#: Methods that read the whole track around a hole (``gsi``'s kernel length depends on the
+#: track's length): their segments are not cut to :func:`~pftrack.recovery.calibrate.gap_windows`.
+WHOLE_SEGMENT_METHODS = ("gsi",)
 
 
 @dataclass(frozen=True)
@@ -281,11 +284,13 @@ def fill_rows(
     too_long = missing > max_gap  # bounded work: longer holes stay holes
     n_long = int(too_long.sum())
     longest = int(missing[too_long].max()) if n_long else 0
-    # "auto" gets only the points each hole's candidates read (gap_windows; the whole
-    # segments' lengths go as contexts): memory about the tracks' length, not a track's length
-    # per hole. A centre beyond MAX_COORD keeps the whole segments: recover_auto refuses them
-    # naming the row, as it did (any far centre: then every track's, the same bits anyway).
-    cut = method == "auto" and (not len(c) or np.abs(c[:, 1:3]).max() <= MAX_COORD)
+    # Every method but gsi gets only the points each hole's recovery reads (gap_windows; for
+    # "auto" the whole segments' lengths go as contexts): memory about the tracks' length, not
+    # a track's length per hole. A centre beyond MAX_COORD keeps the whole segments: they are
+    # refused naming the row, as they were (any far centre: every track's, the same bits).
+    cut = method not in WHOLE_SEGMENT_METHODS and (
+        not len(c) or np.abs(c[:, 1:3]).max() <= MAX_COORD
+    )
     lo, hi = (win.lo, win.hi) if cut else (win.first, win.end)
     keep = ~too_long
     segs: list[tuple[F64, F64]] = []
