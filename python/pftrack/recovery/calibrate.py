@@ -105,9 +105,9 @@ COMBINE_SHRINK = 20
 #: the rule runs on each resample and the methods' weights are averaged; 0: the rule runs once
 #: on the validation gaps as drawn.
 BAGS = 32
-#: Points of a segment next to its gap that a candidate reads besides the run of consecutive
+#: Points of a segment next to its gap that a method reads besides the run of consecutive
 #: frames there (which the ``gdt`` filters read whole): ``rts``' history and ``gdt-mix``'s
-#: window (:func:`gap_windows`).
+#: window (``cubic`` and ``bspline`` read 30 and 12; ``gsi`` the whole track: :func:`gap_windows`).
 WINDOW_POINTS = max(RTS_HISTORY, WINDOW)
 
 
@@ -884,7 +884,7 @@ def bags_for(bags: object, combine: bool, who: str) -> int:
 
 
 class GapWindows(NamedTuple):
-    """The holes of tracks and the rows around each that :func:`recover_auto` reads.
+    """The holes of tracks and the rows around each that the recovery methods read.
 
     Indices into the rows given to :func:`gap_windows`, one entry per hole: hole ``j`` lies
     after row ``holes[j]``, in the track of rows ``first[j] : end[j]``; its segments may be cut
@@ -899,12 +899,13 @@ class GapWindows(NamedTuple):
 
 
 def gap_windows(frames: NDArray[np.float64], ids: NDArray[np.float64] | None = None) -> GapWindows:
-    """Every hole of the tracks and the rows of its segments any ``auto`` candidate reads.
+    """Every hole of the tracks and the rows of its segments the recovery methods read.
 
     A window holds the run of consecutive frames next to the hole on each side and at least
-    :data:`WINDOW_POINTS` points (fewer where the track has fewer): all that any candidate
-    reads of a gap's segments, besides their lengths, which the calibration and the ``"-nb"``
-    windows read and which go as `contexts` to :func:`recover_auto`. So the segments of a
+    :data:`WINDOW_POINTS` points (fewer where the track has fewer): all that any method but
+    ``gsi`` reads of a gap's segments, and for ``"auto"`` all but their lengths, which the
+    calibration and the ``"-nb"`` windows read and which go as `contexts` to
+    :func:`recover_auto`. So the segments of a
     track with many holes hold about its length plus ``2 WINDOW_POINTS`` points per hole in
     all, not its length per hole (``fill_gaps`` on one track of 8000 holes took 4 GB with
     whole segments).
