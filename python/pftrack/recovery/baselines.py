@@ -42,6 +42,7 @@ from pftrack.recovery.segments import split_rows
 
 __all__ = [
     "BASELINES",
+    "RTS_HISTORY",
     "Baseline",
     "bspline",
     "cubic",
@@ -54,6 +55,8 @@ __all__ = [
 
 #: A baseline: ``(segment_a, segment_b, frames) -> (F, 2)`` positions.
 Baseline: TypeAlias = Callable[[F64, F64, NDArray[np.int64]], F64]
+#: Points of each segment next to the gap :func:`rts` and :func:`rts_batch` use by default.
+RTS_HISTORY = 30
 
 
 def interpolate_sizes(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64 | None:
@@ -178,7 +181,7 @@ def rts(
     frames: NDArray[np.int64],
     q: float = 0.1,
     r: float = 1.0,
-    history: int = 30,
+    history: int = RTS_HISTORY,
 ) -> F64:
     """Kalman filter + RTS smoother over `history` points on each side and the gap.
 
@@ -220,7 +223,7 @@ def rts(
 
 
 def rts_batch(
-    pairs: Sequence[tuple[F64, F64]], q: float = 0.1, r: float = 1.0, history: int = 30
+    pairs: Sequence[tuple[F64, F64]], q: float = 0.1, r: float = 1.0, history: int = RTS_HISTORY
 ) -> list[F64]:
     """:func:`rts` for many gaps at once: every frame inside each gap, ``(x, y)``.
 

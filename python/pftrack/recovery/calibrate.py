@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,9 +39,9 @@ from pftrack import _check
 from pftrack._check import MAX_COORD, MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64
-from pftrack.recovery.baselines import BASELINES, rts_batch
+from pftrack.recovery.baselines import BASELINES, RTS_HISTORY, rts_batch
 from pftrack.recovery.gdt import GdtModel
-from pftrack.recovery.mixture import MotionFit, fit_motion, recover_mixture_gaps
+from pftrack.recovery.mixture import WINDOW, MotionFit, fit_motion, recover_mixture_gaps
 from pftrack.recovery.neighbours import (
     NB_SUFFIX,
     Neighbourhood,
@@ -53,9 +54,11 @@ from pftrack.recovery.segments import as_segment, distinct_runs, split_rows
 __all__ = [
     "CANDIDATES",
     "COMBINE_SHRINK",
+    "GapWindows",
     "LINEAR_MARGIN",
     "MAX_CALIBRATION_GAPS",
     "BAGS",
+    "WINDOW_POINTS",
     "BucketChoice",
     "Calibration",
     "bucket_of",
@@ -63,6 +66,7 @@ __all__ = [
     "bucket_quotas",
     "calibrate",
     "fixed_noise_model",
+    "gap_windows",
     "recover_auto",
     "recover_with",
 ]
@@ -101,6 +105,10 @@ COMBINE_SHRINK = 20
 #: the rule runs on each resample and the methods' weights are averaged; 0: the rule runs once
 #: on the validation gaps as drawn.
 BAGS = 32
+#: Points of a segment next to its gap that a method reads besides the run of consecutive
+#: frames there (which the ``gdt`` filters read whole): ``rts``' history and ``gdt-mix``'s
+#: window (``cubic`` and ``bspline`` read 30 and 12; ``gsi`` the whole track: :func:`gap_windows`).
+WINDOW_POINTS = max(RTS_HISTORY, WINDOW)
 
 
 def bucket_of(length: int) -> int:
@@ -875,6 +883,64 @@ def bags_for(bags: object, combine: bool, who: str) -> int:
     return n
 
 
+class GapWindows(NamedTuple):
+    """The holes of tracks and the rows around each that the recovery methods read.
+
+    Indices into the rows given to :func:`gap_windows`, one entry per hole: hole ``j`` lies
+    after row ``holes[j]``, in the track of rows ``first[j] : end[j]``; its segments may be cut
+    to rows ``lo[j] : holes[j] + 1`` and ``holes[j] + 1 : hi[j]``.
+    """
+
+    holes: NDArray[np.int64]
+    lo: NDArray[np.int64]
+    hi: NDArray[np.int64]
+    first: NDArray[np.int64]
+    end: NDArray[np.int64]
+
+
+def gap_windows(frames: NDArray[np.float64], ids: NDArray[np.float64] | None = None) -> GapWindows:
+    """Every hole of the tracks and the rows of its segments the recovery methods read.
+
+    A window holds the run of consecutive frames next to the hole on each side and at least
+    :data:`WINDOW_POINTS` points (fewer where the track has fewer): all that any method but
+    ``gsi`` reads of a gap's segments, and for ``"auto"`` all but their lengths, which the
+    calibration and the ``"-nb"`` windows read and which go as `contexts` to
+    :func:`recover_auto`. So the segments of a
+    track with many holes hold about its length plus ``2 WINDOW_POINTS`` points per hole in
+    all, not its length per hole (``fill_gaps`` on one track of 8000 holes took 4 GB with
+    whole segments).
+
+    Parameters
+    ----------
+    frames : (n,) ndarray
+        Frames of one track, increasing strictly, or of several tracks one after the other.
+    ids : (n,) ndarray, optional
+        The track of each row (rows of a track together), for several tracks.
+
+    Returns
+    -------
+    GapWindows
+        The holes of every track (of any length), their windows and their tracks' rows.
+    """
+    n = len(frames)
+    step = np.diff(frames)
+    same = np.ones(max(n - 1, 0), dtype=bool) if ids is None else ids[1:] == ids[:-1]
+    bounds = np.flatnonzero((step != 1) | ~same)  # the last row of each run but the last run
+    k = np.flatnonzero((step[bounds] > 1) & same[bounds])
+    holes = bounds[k]
+    prev = np.r_[-1, bounds][k]  # the last row before the run that ends at each hole
+    after = np.r_[bounds, n - 1][k + 1]  # the last row of the run that starts after it
+    starts = np.flatnonzero(np.r_[True, ~same])  # every track's first row
+    t = np.searchsorted(starts, holes, side="right") - 1
+    first, end = starts[t], np.r_[starts[1:], n][t]
+    lo = np.maximum(first, np.minimum(holes + 1 - WINDOW_POINTS, prev + 1))
+    hi = np.minimum(end, np.maximum(holes + 1 + WINDOW_POINTS, after + 1))
+    i64 = np.int64
+    return GapWindows(
+        holes.astype(i64), lo.astype(i64), hi.astype(i64), first.astype(i64), end.astype(i64)
+    )
+
+
 def _settings(
     who: str, max_gaps: object, bags: object, seed: object, combine: bool
 ) -> tuple[int, int, int]:
@@ -897,6 +963,7 @@ def recover_auto(
     max_gaps: int = MAX_CALIBRATION_GAPS,
     combine: bool = True,
     bags: int | None = None,
+    contexts: Sequence[tuple[int, int]] | None = None,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -922,6 +989,11 @@ def recover_auto(
     bags : int or None
         Bootstrap resamples the choice is averaged over (:func:`calibrate`; >= 0). None
         (default): :data:`BAGS` with `combine`, 0 without (:func:`bags_for`).
+    contexts : sequence of (int, int), optional
+        Observed points before and after each gap in its track, when `pairs` hold only the
+        points next to the gaps that the candidates read (:func:`gap_windows`; the artificial
+        gaps keep as many, :func:`calibrate`); default: the segments' lengths. With it, pass
+        `observed`: the calibration runs on the whole tracks, not on the windows.
 
     Returns
     -------
@@ -938,10 +1010,12 @@ def recover_auto(
     ValueError
         Malformed segments, a segment B that does not start after its segment A, settings
         :func:`calibrate` refuses, an observed run that is not (k, 3+) or has a non-finite
-        frame, x or y.
+        frame, x or y, `contexts` of another length than `pairs`.
     """
     combine = _check.flag(combine, "recover_auto: combine")
     _, bags, seed = _settings("recover_auto", max_gaps, bags, seed, combine)
+    if contexts is not None and len(contexts) != len(pairs):
+        raise ValueError(f"recover_auto: {len(contexts)} contexts for {len(pairs)} pairs")
     checked = _checked_at_once(pairs)
     if checked is None:  # something to refuse (or not float64 arrays): pair by pair
         checked = []
@@ -975,7 +1049,10 @@ def recover_auto(
         motion,
         seed=seed,
         spans=[spans[k] for k in keep],
-        contexts=[(len(checked[k][0]), len(checked[k][1])) for k in keep],
+        contexts=[
+            (len(checked[k][0]), len(checked[k][1])) if contexts is None else contexts[k]
+            for k in keep
+        ],
         candidates=candidates,
         max_gaps=max_gaps,
         combine=combine,

@@ -12,13 +12,15 @@ so running the fill twice changes nothing more.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
+from pftrack._check import MAX_COORD
 from pftrack._typing import F64, RecoveryMethod
-from pftrack.recovery.calibrate import Calibration, bags_for, recover_auto
+from pftrack.recovery.calibrate import Calibration, bags_for, gap_windows, recover_auto
 from pftrack.recovery.linking import (
     FILLED_MARK,
     FLAG_COLUMN,
@@ -53,6 +55,9 @@ DEFAULT_MAX_GAP = 30
 SIZE_CANDIDATES = ("linear", "rts")
 #: At most this many artificial gaps calibrate the box sizes.
 SIZE_GAPS = 120
+#: Methods that read the whole track around a hole (``gsi``'s kernel length depends on the
+#: track's length): their segments are not cut to :func:`~pftrack.recovery.calibrate.gap_windows`.
+WHOLE_SEGMENT_METHODS = ("gsi",)
 
 
 @dataclass(frozen=True)
@@ -266,23 +271,37 @@ def fill_rows(
     rows = check_rows(rows, "fill_gaps")
     check_unique(rows, who="fill_gaps")
     per_id = split_tracks(rows)
+    # every track's rows one after the other (by id, then frame), its centres and segment rows
+    r = np.concatenate(list(per_id.values())) if per_id else np.zeros((0, 10))
+    c = box_centres(r)
+    seg = np.column_stack([c, r[:, 4], r[:, 5]])
+    ends = np.cumsum([len(v) for v in per_id.values()]).tolist()
+    # every track's centres (frame, x, y): noise, motion, calibration
+    bounds = list(pairwise([0, *ends]))
+    whole: list[F64] = [c[i:j] for i, j in bounds]
+    win = gap_windows(r[:, 0], r[:, 1])
+    missing = (r[win.holes + 1, 0] - r[win.holes, 0] - 1).astype(np.int64)
+    too_long = missing > max_gap  # bounded work: longer holes stay holes
+    n_long = int(too_long.sum())
+    longest = int(missing[too_long].max()) if n_long else 0
+    # Every method but gsi gets only the points each hole's recovery reads (gap_windows; for
+    # "auto" the whole segments' lengths go as contexts): memory about the tracks' length, not
+    # a track's length per hole. A centre beyond MAX_COORD keeps the whole segments: they are
+    # refused naming the row, as they were (any far centre: every track's, the same bits).
+    cut = method not in WHOLE_SEGMENT_METHODS and (
+        not len(c) or np.abs(c[:, 1:3]).max() <= MAX_COORD
+    )
+    lo, hi = (win.lo, win.hi) if cut else (win.first, win.end)
+    keep = ~too_long
     segs: list[tuple[F64, F64]] = []
+    contexts: list[tuple[int, int]] = []  # the observed points before and after each hole
     meta: list[tuple[int, F64, F64]] = []
-    whole: list[F64] = []  # every track's centres (frame, x, y): noise, motion, calibration
-    n_long = longest = 0  # holes longer than max_gap, left unfilled
-    for tid, r in per_id.items():
-        c = box_centres(r)
-        whole.append(c)
-        seg = np.column_stack([c, r[:, 4], r[:, 5]])
-        holes = np.flatnonzero(np.diff(r[:, 0]) > 1)
-        for h in holes:
-            missing = int(r[h + 1, 0] - r[h, 0] - 1)
-            if missing > max_gap:  # bounded work: longer holes stay holes
-                n_long += 1
-                longest = max(longest, missing)
-                continue
-            segs.append((seg[: h + 1], seg[h + 1 :]))
-            meta.append((tid, r[h], r[h + 1]))
+    for e, a0, b1, t0, t1 in zip(  # e: the hole's last row before
+        *(v[keep].tolist() for v in (win.holes, lo, hi, win.first, win.end)), strict=True
+    ):
+        segs.append((seg[a0 : e + 1], seg[e + 1 : b1]))
+        contexts.append((e + 1 - t0, t1 - e - 1))
+        meta.append((int(r[e, 1]), r[e], r[e + 1]))
     motion: MotionFit | None = None
     calibration: Calibration | None = None
     if method in ("gdt-bi", "gdt-mix") and segs:
@@ -296,9 +315,10 @@ def fill_rows(
         wh_paths: list[F64] | None = None
         if method == "auto":
             paths, calibration = recover_auto(
-                segs, whole, noise, motion, seed=seed, combine=combine, bags=bags
+                segs, whole, noise, motion, seed=seed, combine=combine, bags=bags, contexts=contexts
             )
-            sizes = [r[:, [0, 4, 5]] for r in per_id.values()]
+            wh = r[:, [0, 4, 5]]
+            sizes = [wh[i:j] for i, j in bounds]
             size_segs = [(a[:, [0, 3, 4]], b[:, [0, 3, 4]]) for a, b in segs]
             wh_paths, size_cal = recover_auto(
                 size_segs,
@@ -308,6 +328,7 @@ def fill_rows(
                 max_gaps=SIZE_GAPS,
                 combine=combine,
                 bags=bags,
+                contexts=contexts,
             )
         else:
             observed = whole if method in NEIGHBOUR_METHODS else None
