@@ -152,8 +152,37 @@ def recover_many(
 ) -> BatchSummary:
     """Fill the gaps of every tracks file of `inputs` (files or folders of ``*.txt``).
 
-    As :func:`track_many`; each ``out_dir/NAME.txt`` equals ``pftrack recover FILE`` with the
-    same settings.
+    As :func:`track_many`, for tracks files instead of sequences.
+
+    Parameters
+    ----------
+    inputs : path or sequence of paths
+        MOTChallenge tracks files, or folders of ``*.txt`` (see
+        :func:`~pftrack.batch.find_track_files`).
+    out_dir : path
+        Output folder (created if missing): ``NAME.txt`` for each ``NAME.txt`` of `inputs`,
+        equal to ``pftrack recover FILE`` with the same settings, its sidecar ``NAME.json`` and
+        ``summary.json``.
+    client : distributed.Client, optional
+        Run on this client's cluster (left open). Default: `scheduler`, else a new
+        ``LocalCluster`` with `n_workers` workers, closed at the end.
+    options : RecoverOptions, optional
+        The command's settings (default ``RecoverOptions()``).
+    scheduler : str, optional
+        Address of a running Dask scheduler (also read from ``DASK_SCHEDULER_ADDRESS``).
+    n_workers : int, optional
+        Workers of the local cluster (default: one per core); 0 runs in this process, one
+        file after the other, without Dask.
+    force : bool
+        Redo files whose outputs are already complete.
+    show_progress : bool, optional
+        Progress bar over the files on stderr (default: when stderr is a terminal).
+
+    Returns
+    -------
+    BatchSummary
+        Per file: rows in and out, fragments linked, gaps and rows filled, holes left
+        unfilled (longer than ``max_gap``), what ``auto`` chose; failed files with their error.
 
     Raises
     ------
@@ -188,8 +217,37 @@ def smooth_many(
 ) -> BatchSummary:
     """Link, fill and smooth every tracks file of `inputs` (files or folders of ``*.txt``).
 
-    As :func:`track_many`; each ``out_dir/NAME.txt`` equals ``pftrack smooth FILE`` with the
-    same settings.
+    As :func:`track_many`, for tracks files instead of sequences.
+
+    Parameters
+    ----------
+    inputs : path or sequence of paths
+        MOTChallenge tracks files, or folders of ``*.txt`` (see
+        :func:`~pftrack.batch.find_track_files`).
+    out_dir : path
+        Output folder (created if missing): ``NAME.txt`` for each ``NAME.txt`` of `inputs`,
+        equal to ``pftrack smooth FILE`` with the same settings, its sidecar ``NAME.json`` and
+        ``summary.json``.
+    client : distributed.Client, optional
+        Run on this client's cluster (left open). Default: `scheduler`, else a new
+        ``LocalCluster`` with `n_workers` workers, closed at the end.
+    options : SmoothOptions, optional
+        The command's settings (default ``SmoothOptions()``).
+    scheduler : str, optional
+        Address of a running Dask scheduler (also read from ``DASK_SCHEDULER_ADDRESS``).
+    n_workers : int, optional
+        Workers of the local cluster (default: one per core); 0 runs in this process, one
+        file after the other, without Dask.
+    force : bool
+        Redo files whose outputs are already complete.
+    show_progress : bool, optional
+        Progress bar over the files on stderr (default: when stderr is a terminal).
+
+    Returns
+    -------
+    BatchSummary
+        Per file: ids and rows in and out, holes left unfilled (longer than ``max_gap``);
+        failed files with their error.
 
     Raises
     ------
