@@ -154,11 +154,26 @@ def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     assert "--scale is given twice for sequence A (0.5, then 2)" in error(
         "--scale", "A=0.5", "--scale", "B=1", "--scale", "A=2"
     )
+    # one result file against a folder of several sequences: was "results folder not found: ..."
+    # of a file that exists
+    one = ["eval", "--gt", str(gt_root), "--res", str(res_root / "A.txt")]
+    assert main(one) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack eval: error: --res {res_root / 'A.txt'} is a file, but --gt {gt_root} holds 2 "
+        "sequences: give a folder of SEQ.txt results (or pick one sequence with --seqs NAME)\n"
+    )
+    assert main([*one, "--seqs", "A"]) == 0
+    capsys.readouterr()
     (res_root / "B.txt").unlink()
     assert "no result for sequence B" in error()
     write_mot(res_root / "B.txt", cases["B"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
     # beyond seqLength: led by the file (was by the sequence's name, "B: result has frame")
     assert f"error: {res_root / 'B.txt'}: result has frame" in error()
+    # the first sequence's: led by its own file (was by the last sequence's, B.txt)
+    write_mot(res_root / "B.txt", cases["B"][1])
+    write_mot(res_root / "A.txt", cases["A"][1] + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
+    assert f"error: {res_root / 'A.txt'}: result has frame" in error()
+    write_mot(res_root / "A.txt", cases["A"][1])
     assert main(["eval", "--gt", str(tmp_path / "nothing"), "--res", str(res_root)]) == 2
     assert "ground truth not found: " in capsys.readouterr().err
     assert main(["eval", "--gt", str(tmp_path / "nope.txt"), "--res", str(res_root)]) == 2

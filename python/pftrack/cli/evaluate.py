@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -73,8 +74,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--iou", type=iou_threshold, default=0.5, help=IOU_HELP)
     p.add_argument(
         "--benchmark", choices=("auto", "MOT15", "MOT16", "MOT17", "MOT20"), default="auto",
-        help="ground-truth rules: which rows HOTA, CLEAR-MOT and IDF1 score; auto: MOT17 when "
-        "columns 8-9 hold classes 1-13 and visibilities, else MOT15",
+        help="ground-truth rules: which rows HOTA, CLEAR-MOT and IDF1 score; auto: the "
+        "benchmark a TrackEval folder of the ground truth names (gt/mot_challenge/MOT20-train/"
+        "...: MOT20), else MOT17 when column 8 holds classes 1-13 (and column 9 visibilities, or "
+        "nothing), else MOT15",
     )  # fmt: skip
     p.add_argument("--seqs", nargs="+", metavar="NAME", default=None,
                    help="score only these sequences of a folder (default: all of "
@@ -159,6 +162,11 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
         seqs = [s for s in seqs if s.name in args.seqs]
     if res.is_file() and len(seqs) == 1:
         return [(seqs[0].name, seqs[0], res)]
+    if res.is_file():  # was "results folder not found", of a file that exists
+        raise ValueError(
+            f"--res {res} is a file, but --gt {gt} holds {len(seqs)} sequences: give a folder "
+            "of SEQ.txt results (or pick one sequence with --seqs NAME)"
+        )
     if not res.is_dir():
         raise FileNotFoundError(
             f"results folder not found: {res} (a ground-truth folder of {len(seqs)} sequences "
@@ -210,8 +218,10 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from pftrack._progress import progress
+    from pftrack.eval.rows import result_class_note
     from pftrack.eval.sequences import (
         SequenceScores,
+        benchmark_of_path,
         check_scale,
         evaluate_sequence,
         format_scores,
@@ -242,14 +252,18 @@ def run(args: argparse.Namespace) -> int:
             # several sequences: the fix is this one's scale, --scale NAME=S (was --scale S)
             several = name if len(jobs) > 1 else None
             check_scale(gt, res, scale=scales[name], name=f"{path}", sequence=several)
-        loaded.append((name, seq, gt, res))
+        loaded.append((name, seq, gt, res, path))
 
     scores: dict[str, SequenceScores] = {}
-    for name, seq, gt, res in progress(loaded, total=len(loaded), desc="eval"):
+    notes: list[str] = []
+    for name, seq, gt, res, path in progress(loaded, total=len(loaded), desc="eval"):
         s = scales[name]
         size = tuple(args.image_size) if args.image_size else None
         if size is None and seq.width and seq.height:
             size = (round(seq.width * s), round(seq.height * s))
+        # auto: the benchmark of TrackEval's folder (MOT20-train/SEQ), as TrackEval scores it;
+        # else guessed from the columns (was: always guessed, MOT20-train scored as MOT17)
+        folder = benchmark_of_path(seq.gt_path) if args.benchmark == "auto" else None
         try:
             scores[name] = evaluate_sequence(
                 gt,
@@ -257,11 +271,17 @@ def run(args: argparse.Namespace) -> int:
                 iou_threshold=args.iou,
                 scale=s,
                 image_size=size,
-                benchmark=args.benchmark,
+                benchmark=folder[0] if folder else args.benchmark,
                 num_frames=seq.length,
             )
         except ValueError as exc:
-            raise ValueError(_in_file(str(exc), seq.gt_path, path)) from None
+            message = _in_file(str(exc), seq.gt_path, path)
+            if folder and "MOT15-style" in message:  # say where MOT17 rules came from
+                message += f" (--benchmark auto took {folder[0]} from its folder {folder[1]})"
+            raise ValueError(message) from None
+        note = result_class_note(res, scores[name].benchmark)
+        if note:
+            notes.append(f"{path}: {note}")
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
     if args.json:
         if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
@@ -273,6 +293,8 @@ def run(args: argparse.Namespace) -> int:
     if args.csv:
         with atomic_write(args.csv) as fh:
             fh.write(scores_csv(scores, combined))
+    for note in notes:  # once the files are written, as pftrack render says its warnings
+        print(f"pftrack eval: warning: {note}", file=sys.stderr)
     # after the files: a closed stdout cannot lose them; not into a file written to stdout
     print(format_scores(scores, combined), file=report_stream(args.json, args.csv))
     return 0

@@ -207,8 +207,9 @@ def evaluate_hota(
     gt, result : (M, 6..10) array_like of float
         Ground-truth and result MOT rows, as read by :func:`pftrack.io.mot.read_mot`.
     benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
-        Passed to :func:`prepare_mot`; ``"auto"`` (the default, as :func:`evaluate_sequence`
-        and ``pftrack eval``) guesses MOT15 or MOT17 from the columns (:func:`guess_benchmark`).
+        Passed to :func:`prepare_mot`; ``"auto"`` (the default, as :func:`evaluate_sequence`)
+        guesses MOT15 or MOT17 from the columns (:func:`guess_benchmark`; ``pftrack eval``
+        first takes the benchmark a TrackEval folder names, ``MOT20-train``).
     scale, num_frames
         Passed to :func:`prepare_mot`, which chooses the rows that are scored.
 

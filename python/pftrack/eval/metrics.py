@@ -91,7 +91,9 @@ class MotMetrics:
     success_rate_strict : float
         The same with "overlaps" meaning IoU >= `iou_threshold` (assignment by the same rule).
     success_per_object : tuple of (int, float, float)
-        ``(gt id, success, strict success)`` per object, in id order.
+        ``(gt id, success, strict success)`` per object, in id order; empty in a combination
+        (:func:`combine_mot`: ids repeat across sequences), so the ``combined`` object of
+        ``pftrack eval --json`` has ``"success_per_object": []``.
     centroid_distance_px : float
         Mean Euclidean distance (pixels, after `scale`) between the centroid of each ground-truth
         box and that of its assigned result track (loose assignment), over the frames where both

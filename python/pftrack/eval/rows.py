@@ -32,6 +32,7 @@ __all__ = [
     "guess_benchmark",
     "mot_iou",
     "prepare_mot",
+    "result_class_note",
 ]
 
 Benchmark = Literal["MOT15", "MOT16", "MOT17", "MOT20"]
@@ -209,16 +210,51 @@ def guess_benchmark(gt: ArrayLike) -> Literal["MOT15", "MOT17"]:
     """``"MOT17"`` if `gt` looks like MOT16/17/20 ground truth, else ``"MOT15"``.
 
     MOT16+ ground truth has ``frame, id, left, top, w, h, flag, class, visibility``: the class
-    column holds integers 1-13 and the visibility column values in [0, 1]. MOT15 ground truth
-    has world coordinates (or -1) there. MOT20's one extra distractor class is not guessed:
-    name ``"MOT20"`` explicitly.
+    column holds integers 1-13 on every row and the visibility column values in [0, 1] on every
+    row, or -1 on every row (no visibility column: 8-column files, which TrackEval scores as
+    MOT17 too). MOT15 ground truth has world coordinates there, normally -1 -1 -1. MOT20's one
+    extra distractor class is not guessed: name ``"MOT20"`` explicitly (``pftrack eval`` takes
+    it from TrackEval's folder name, ``MOT20-train``:
+    :func:`~pftrack.eval.sequences.benchmark_of_path`).
     """
     g = check_eval_rows(gt, "ground truth")
     if len(g) == 0:
         return "MOT15"
     cls, vis = g[:, _CLASS], g[:, _VISIBILITY]
     integral = np.all(cls == np.round(cls)) and np.all((cls >= 1) & (cls <= _N_CLASSES))
-    return "MOT17" if integral and np.all((vis >= 0) & (vis <= 1)) else "MOT15"
+    visibility = np.all((vis >= 0) & (vis <= 1)) or np.all(vis == -1)  # -1: column missing
+    return "MOT17" if integral and visibility else "MOT15"
+
+
+def result_class_note(result: ArrayLike, benchmark: str) -> str | None:
+    """What is odd in the class column (8) of `result` under `benchmark`'s rules, or None.
+
+    Under MOT16/17/20 rules TrackEval refuses a result with a class above 1 (pedestrian) in
+    column 8 ("Evaluation is only valid for pedestrian class"); pftrack scores every result box
+    as a pedestrian, and says so when some rows hold integers other than 1 and -1 there (-1:
+    no class, what most results hold; values that are not integers are world coordinates, of
+    MOT15-style rows). The note names the count and the classes, most frequent first:
+    ``"12 result boxes have class 3 in column 8: scored as pedestrians; TrackEval refuses such
+    a file"``. MOT15 rules have no classes: None.
+    """
+    if benchmark == "MOT15":
+        return None
+    r = check_eval_rows(result, "result")
+    cls = r[:, _CLASS]
+    other = (cls == np.round(cls)) & (cls != _PEDESTRIAN) & (cls != -1)
+    if not np.any(other):
+        return None
+    values, counts = np.unique(cls[other].astype(np.int64), return_counts=True)
+    order = np.argsort(-counts, kind="stable")
+    values, counts = values[order], counts[order]
+    n = int(counts.sum())
+    if len(values) == 1:
+        which = f"class {values[0]}"
+    else:
+        which = "classes " + ", ".join(f"{v} ({c})" for v, c in zip(values, counts, strict=True))
+    refused = "; TrackEval refuses such a file" if np.any(values > _PEDESTRIAN) else ""
+    boxes = "1 result box has" if n == 1 else f"{n} result boxes have"
+    return f"{boxes} {which} in column 8: scored as pedestrians{refused}"
 
 
 def prepare_mot(

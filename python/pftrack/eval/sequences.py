@@ -4,7 +4,8 @@ A MOTChallenge ground-truth folder holds one folder per sequence, ``SEQ/gt/gt.tx
 ``SEQ/gt.txt``) with ``SEQ/seqinfo.ini``; results are ``RESULTS/SEQ.txt``, as TrackEval reads
 them. TrackEval's own tree is read too: ground truth ``gt/mot_challenge/BENCH-SPLIT/SEQ/...``
 (a folder of benchmark-split folders, :func:`find_sequences`), results
-``trackers/mot_challenge/BENCH-SPLIT/TRACKER/data/SEQ.txt`` (:func:`result_file`).
+``trackers/mot_challenge/BENCH-SPLIT/TRACKER/data/SEQ.txt`` (:func:`result_file`), and
+``pftrack eval`` scores it by the rules of the benchmark BENCH (:func:`benchmark_of_path`).
 """
 
 from __future__ import annotations
@@ -15,8 +16,10 @@ import dataclasses
 import io
 import json
 import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -31,6 +34,7 @@ __all__ = [
     "COMBINED",
     "SequenceInfo",
     "SequenceScores",
+    "benchmark_of_path",
     "check_scale",
     "evaluate_sequence",
     "find_sequences",
@@ -174,6 +178,31 @@ def _folders(base: Path) -> list[Path]:
 
 def _sequences_in(base: Path) -> list[SequenceInfo]:
     return [s for d in _folders(base) if (s := _sequence(d)) is not None]
+
+
+#: TrackEval's benchmark-split folder: BENCHMARK + "-" + SPLIT_TO_EVAL (``MOT17-train``,
+#: ``MOT20-test``, ``MOT15-all``, ``MOT17-train_half``); a split starts with a letter, so that
+#: sequence names (``MOT17-02-FRCNN``, ``MOT20-01``) are not read as one.
+_BENCH_SPLIT = re.compile(r"(MOT15|MOT16|MOT17|MOT20)-[A-Za-z]\w*")
+
+
+def benchmark_of_path(gt_file: PathLike) -> tuple[BenchmarkName, str] | None:
+    """The benchmark a TrackEval folder holding `gt_file` names, and that folder's name, or None.
+
+    TrackEval reads ground truth from ``gt/mot_challenge/BENCH-SPLIT/SEQ/gt/gt.txt`` and scores
+    it by BENCH's rules: ``("MOT20", "MOT20-train")`` for
+    ``.../MOT20-train/MOT20-01/gt/gt.txt``. The folders of `gt_file` (made absolute, so that a
+    relative path given from inside the tree counts) are looked at from the nearest one up; the
+    first named ``MOT15``, ``MOT16``, ``MOT17`` or ``MOT20``, a hyphen and a split (a word
+    starting with a letter: ``train``, ``test``, ``all``, ...) gives the benchmark.
+    ``pftrack eval --benchmark auto`` takes it before guessing from the columns
+    (:func:`~pftrack.eval.guess_benchmark`).
+    """
+    for folder in reversed(Path(gt_file).absolute().parent.parts):
+        match = _BENCH_SPLIT.fullmatch(folder)
+        if match:
+            return cast("BenchmarkName", match.group(1)), folder
+    return None
 
 
 def result_file(results: PathLike, name: str) -> Path | None:
@@ -516,7 +545,10 @@ def format_scores(
 
 
 def scores_json(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
-    """JSON text: ``{"sequences": {name: scores}, "combined": scores}`` (NaN as null)."""
+    """JSON text: ``{"sequences": {name: scores}, "combined": scores}`` (NaN as null).
+
+    The combined scores' ``success_per_object`` is ``[]``: per-object rates are per sequence.
+    """
     _named_scores("scores_json", rows, combined)
     doc: dict[str, object] = {"sequences": {k: v.as_dict() for k, v in rows.items()}}
     if combined is not None:
