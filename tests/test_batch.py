@@ -1987,3 +1987,30 @@ def test_the_table_leaves_the_problems_to_stderr(
     printed = capsys.readouterr()
     assert printed.err.startswith("bad: error: ") and printed.err.count("\n") == 1
     assert ": error:" not in printed.out and printed.out.startswith("name ")
+
+
+def test_track_sequence_scores_by_the_benchmark_its_trackeval_folder_names(
+    tmp_path: Path,
+) -> None:
+    """A sequence under TrackEval's ``MOT20-train`` is scored by MOT20's rules, as ``pftrack
+    eval`` scores it (was: guessed from the columns, MOT17 for 9-column ground truth)."""
+    from pftrack.batch.tasks import track_sequence
+
+    scene = make_scene(n_frames=20, width=160, height=120, n_walkers=2, rng=0)
+    gt = scene.truth.copy()
+    gt[:, 7] = 1.0  # class: pedestrian
+    gt[:, 8] = 1.0  # visibility: MOT16/17/20 ground truth by its columns
+    for split in ("MOT20-train", "plain"):
+        seq = tmp_path / split / "SEQ-01"
+        scene.write_images(seq / "img1", ext=".png")
+        (seq / "gt").mkdir()
+        write_mot(seq / "gt" / "gt.txt", gt[:, :9])
+        (seq / "seqinfo.ini").write_text("[Sequence]\nname=SEQ-01\nimWidth=160\nimHeight=120\n")
+        (found,) = find_sequences(seq)
+        result = track_sequence(found, TrackOptions(config=_config()))
+        assert result.error is None
+        expected = "MOT20" if split == "MOT20-train" else "MOT17"
+        assert result.info["metrics"]["benchmark"] == expected
+        rows = read_mot(seq / "gt" / "gt.txt")  # the figures are pftrack eval's under those rules
+        want = evaluate_sequence(rows, result.rows, benchmark=expected)
+        assert result.info["metrics"]["idf1"] == pytest.approx(want.mot.idf1, abs=0.01)

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import flag, number
-from pftrack._typing import F64, FillMode, PathLike, RecoveryMethod
+from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
 
 if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover needs none of it
@@ -274,17 +274,22 @@ class TrackOptions:
 
 
 def sequence_metrics(
-    gt: F64, rows: F64, *, scale: float = 1.0, iou: float = 0.5
+    gt: F64,
+    rows: F64,
+    *,
+    scale: float = 1.0,
+    iou: float = 0.5,
+    benchmark: BenchmarkName = "auto",
 ) -> dict[str, float | int | str | None]:
     """The figures of one sequence's tracks against its ground truth, for the summary.
 
-    HOTA, DetA, AssA and LocA (TrackEval's, with the benchmark guessed from `gt`'s columns),
-    then MOTA, IDF1 and their counts: :func:`pftrack.eval.evaluate_sequence`, what
-    ``pftrack eval`` prints for the same files.
+    HOTA, DetA, AssA and LocA (TrackEval's, under `benchmark`'s ground-truth rules; ``"auto"``
+    guesses them from `gt`'s columns), then MOTA, IDF1 and their counts:
+    :func:`pftrack.eval.evaluate_sequence`, what ``pftrack eval`` prints for the same files.
     """
     from pftrack.eval import evaluate_sequence
 
-    s = evaluate_sequence(gt, rows, iou_threshold=iou, scale=scale)
+    s = evaluate_sequence(gt, rows, iou_threshold=iou, scale=scale, benchmark=benchmark)
     m, h = s.mot, s.hota
     out: dict[str, float | int | str | None] = {
         "hota": h.hota,
@@ -341,6 +346,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures;
         its `error` is set if the ground truth could not be scored (the rows are still there).
     """
+    from pftrack.eval.sequences import benchmark_of_path
     from pftrack.io.mot import read_mot
     from pftrack.io.video import FrameSource, info_scale
     from pftrack.tracking.run import track_path
@@ -392,7 +398,15 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                     "ground truth's frames alike"
                 )
             gt = read_mot(seq.gt, what="ground truth")
-            metrics = sequence_metrics(gt, _as_written(rows), scale=auto_scale, iou=options.iou)
+            # the benchmark a TrackEval tree's BENCH-SPLIT folder names, as pftrack eval takes it
+            named = benchmark_of_path(seq.gt)
+            metrics = sequence_metrics(
+                gt,
+                _as_written(rows),
+                scale=auto_scale,
+                iou=options.iou,
+                benchmark="auto" if named is None else named[0],
+            )
         except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed
             error = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"
             trace = traceback.format_exc()
