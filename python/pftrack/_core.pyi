@@ -492,3 +492,11 @@ def rts_smooth(
     velocity_sd: float,
     update_first: bool,
 ) -> _F64: ...
+
+# --- MOTChallenge text ------------------------------------------------------------------------
+# ids (M, 2) float64 integral frame, id; values (M, 8) float64 finite; decimals (M, 8) int64,
+# 0..22 ("%.{d}f") or 31 (repr) -> "frame,id,v1,...,v8\n" lines, as Python's % writes them.
+# Dtypes are not converted (TypeError); strided arrays are copied once.
+def mot_lines(
+    ids: NDArray[np.float64], values: NDArray[np.float64], decimals: NDArray[np.int64]
+) -> str: ...

@@ -5,5 +5,5 @@ One module per wing: ``kernels`` (HSV bins, histograms, Bhattacharyya, resamplin
 (background model), ``refine`` (box refinement), ``blobs`` (the blob pass and
 the size model's kernels), ``smoothing`` (constant-velocity posterior),
 ``bridge`` (goal-directed recovery), ``mixture`` (stand/walk gap mixture), ``neighbours``
-(the `-nb` methods' neighbour search).
+(the `-nb` methods' neighbour search), ``text`` (MOTChallenge lines, Python's ``%``).
 """

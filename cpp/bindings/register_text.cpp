@@ -1,0 +1,59 @@
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <string>
+
+#include "pftrack/mot_text.hpp"
+#include "arrays.hpp"
+
+namespace py = pybind11;
+using namespace pftrack;
+
+namespace {
+
+/// `a` as a C-contiguous (rows, cols) array of T (one copy only when strided), after a
+/// TypeError for another dtype and a ValueError for another shape.
+template <typename T>
+py::array_t<T, py::array::c_style> table(const py::array& a, const char* fn, const char* what,
+                                         py::ssize_t rows, py::ssize_t cols, const char* dtype) {
+    if (!bind::is_dtype<T>(a.dtype()))
+        throw py::type_error(std::string(fn) + ": " + what + " dtype is " + bind::dtype_name(a) +
+                             ", expected " + dtype);
+    if (!(a.ndim() == 2 && a.shape(0) == rows && a.shape(1) == cols)) {
+        std::string got = "(";
+        for (py::ssize_t k = 0; k < a.ndim(); ++k)
+            got += (k ? ", " : "") + std::to_string(a.shape(k));
+        got += a.ndim() == 1 ? ",)" : ")";
+        fail(fn, std::string(what) + " has shape " + got + ", expected (" + std::to_string(rows) +
+                     ", " + std::to_string(cols) + ")");
+    }
+    return py::array_t<T, py::array::c_style>::ensure(a);
+}
+
+}  // namespace
+
+void register_text(py::module_& m) {
+    m.def(
+        "mot_lines",
+        [](const py::array& ids, const py::array& values, const py::array& decimals) {
+            const char* fn = "mot_lines";
+            require(ids.ndim() == 2, fn, "ids must be a (M, 2) array of frame and id");
+            const py::ssize_t rows = ids.shape(0);
+            const auto i = table<double>(ids, fn, "ids", rows, 2, "float64");
+            const auto v = table<double>(values, fn, "values", rows, 8, "float64");
+            const auto d = table<std::int64_t>(decimals, fn, "decimals", rows, 8, "int64");
+            std::string text;
+            {
+                py::gil_scoped_release nogil;  // safe: plain buffers, kept alive by i, v, d
+                text = mot_lines(i.data(), v.data(), d.data(), static_cast<std::int64_t>(rows));
+            }
+            // ASCII only: the fastest decode into a str
+            PyObject* s = PyUnicode_DecodeASCII(text.data(), static_cast<py::ssize_t>(text.size()),
+                                                nullptr);
+            if (!s) throw py::error_already_set();
+            return py::reinterpret_steal<py::str>(s);
+        },
+        py::arg("ids"), py::arg("values"), py::arg("decimals"),
+        "MOTChallenge lines of ids (M, 2) float64, values (M, 8) float64, decimals (M, 8) int64.");
+}
