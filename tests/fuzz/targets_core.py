@@ -308,6 +308,17 @@ def _gap_mixture(draw: st.DrawFn) -> Any:
     ))  # fmt: skip
 
 
+@st.composite
+def _mot_lines(draw: st.DrawFn) -> Any:
+    k = draw(N)
+    ids = np.round(draw(floats_array((k, 2), -1e6, 1e6)))  # sometimes a special value
+    codes = np.asarray(draw(hnp.arrays(np.int64, (k, 8), elements=st.integers(-2, 33))))
+    return draw(call(
+        _core.mot_lines, maybe(st.just(ids)), maybe(floats_array((k, 8), -1e300, 1e300)),
+        maybe(layout(codes)),
+    ))  # fmt: skip
+
+
 def _kalman() -> st.SearchStrategy[Any]:
     F = np.array([[1.0, 1.0], [0.0, 1.0]])
     return N.flatmap(lambda k: call(
@@ -552,6 +563,7 @@ TARGETS: list[Target] = [
     Target("noise_loglik_grid", _noise_grid()),
     Target("state_loglik_batch", _state_loglik()),
     Target("gap_mixture", _gap_mixture()),
+    Target("mot_lines", _mot_lines()),
     Target("rts_gaps_batch", _rts_gaps()),
     Target("rts_smooth", _rts_smooth()),
     Target("BackgroundModel", _background_calls()),
