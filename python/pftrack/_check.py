@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -24,8 +27,10 @@ __all__ = [
     "flag",
     "generator",
     "integer",
+    "materialised",
     "mot_rows",
     "number",
+    "path_refused",
     "real_array",
     "seed",
 ]
@@ -97,6 +102,28 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
 MOT_DEFAULTS = (1.0, -1.0, -1.0, -1.0)
 
 
+def path_refused(value: object, what: str, reader: str) -> None:
+    """TypeError when `value` is a path (str, bytes, os.PathLike) where an array was expected.
+
+    NumPy takes a path for a 0-d array of text, refused by its dtype (``got dtype <U36``),
+    which does not say that the file must be read first:
+    ``{what} is a path ('gt.txt'); read it with {reader}``.
+    """
+    if isinstance(value, (str, bytes, os.PathLike)):
+        raise TypeError(f"{what} is a path ({os.fsdecode(value)!r}); read it with {reader}")
+
+
+def materialised(rows: ArrayLike) -> ArrayLike:
+    """`rows` as a list when it is an iterator (a generator, ``map``), else `rows` itself.
+
+    NumPy takes an iterator for a 0-d object array; its rows (a generator of generators too)
+    are read once, into lists. Arrays and sequences are returned as they are.
+    """
+    if not isinstance(rows, Iterator):
+        return rows
+    return [list(r) if isinstance(r, Iterator) else r for r in rows]
+
+
 def mot_rows(rows: ArrayLike, what: str) -> F64:
     """MOTChallenge rows (M, 6..10) as an (M, 10) float64 array, the missing columns added.
 
@@ -105,19 +132,22 @@ def mot_rows(rows: ArrayLike, what: str) -> F64:
     messages, and the arrays the commands take as files: 6 to 10 columns ``frame, id, left,
     top, width, height[, conf, x, y, z]``, the missing ones :data:`MOT_DEFAULTS` (conf 1,
     x, y, z -1), as :func:`pftrack.io.mot.read_mot` reads a shorter line. An array without
-    values (``[]``, ``np.zeros((0,))``, ``np.zeros((0, 10))``) is no rows. Only the layout is
-    checked here; the callers check the values.
+    values (``[]``, ``np.zeros((0,))``, ``np.zeros((0, 10))``) is no rows. Any iterable of
+    rows is taken: an iterator (a generator, ``map(list, rows)``) is read once
+    (:func:`materialised`). Only the layout is checked here; the callers check the values.
 
     Raises
     ------
     TypeError
-        Not real numbers (text, complex numbers, booleans).
+        Not real numbers (text, complex numbers, booleans); a path (read it with
+        :func:`pftrack.io.mot.read_mot` first).
     ValueError
         Ragged rows, or not of shape (M, 6..10):
         ``{what}: rows must have shape (M, 6..10) (6 to 10 columns: frame, id, left, top,
         width, height[, conf, x, y, z]), got (2, 3)``.
     """
-    a = real_array(rows, f"{what}: rows", booleans=False)
+    path_refused(rows, f"{what}: rows", "pftrack.read_mot(path)")
+    a = real_array(materialised(rows), f"{what}: rows", booleans=False)
     if a.size == 0:
         return np.zeros((0, 10))
     if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
