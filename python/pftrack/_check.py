@@ -197,26 +197,32 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
 
 
 def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
-    """`frame` as a (H, W, 3) uint8 array (``numpy.asarray``: not copied when it is one).
+    """`frame` itself, checked to be a NumPy (H, W, 3) uint8 array (never converted, nor copied).
 
     Raises
     ------
     TypeError
-        Not an array of uint8 (float frames; ``None``; a list, named as one, not by the dtype
-        NumPy gives it).
+        Not an array of uint8 (float frames; ``None``); not a NumPy array at all (a list, a
+        PIL image, named by their type, not by the dtype NumPy gives them: a list of ints is
+        int64, a PIL image uint8 but RGB).
     ValueError
         Not of shape (H, W, 3): a grey (2-D or one-channel) or a BGRA frame's message names
         the ``cv2.cvtColor`` conversion that makes it BGR.
     """
-    f = np.asarray(frame)
-    if f.dtype == object:
-        raise TypeError(f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array")
-    if f.dtype != np.uint8 and not isinstance(frame, np.ndarray):
-        # a list (``frame.tolist()``) is int64 to NumPy: its dtype is not what the user gave
+    if not isinstance(frame, np.ndarray):
+        # a list (``frame.tolist()``) is int64 to NumPy, and a PIL image uint8 but RGB: both
+        # refused alike (a PIL image was taken, its red read as blue)
+        if np.asarray(frame).dtype == object:
+            raise TypeError(
+                f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array"
+            )
+        pil = type(frame).__module__.split(".")[0] == "PIL"
         raise TypeError(
             f"{what} is {type(frame).__name__}, expected a NumPy uint8 array (H, W, 3) (BGR, "
             "as cv2 reads it)"
+            + ("; a PIL image is RGB: np.asarray(img)[..., ::-1] gives BGR" if pil else "")
         )
+    f = frame
     if f.dtype != np.uint8:
         raise TypeError(f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
     if f.ndim != 3 or f.shape[2] != 3:
