@@ -372,30 +372,31 @@ def seed(value: object, what: str) -> int:
     return int(value)
 
 
-def generator(rng: RngLike, what: str) -> np.random.Generator:
+def generator(rng: RngLike | np.random.RandomState, what: str) -> np.random.Generator:
     """``numpy.random.default_rng(rng)``, whose errors name the argument.
 
-    A Generator is returned as it is; NumPy's refusals (``"SeedSequence expects int or
-    sequence of ints for entropy not abc"``, ``"expected non-negative integer"``) do not say
-    which argument was wrong.
+    A Generator is returned as it is; a ``numpy.random.RandomState`` is wrapped (its bit
+    generator, whose state the two then share: filterpy's draws). NumPy's refusals
+    (``"SeedSequence expects int or sequence of ints for entropy not abc"``, ``"expected
+    non-negative integer"``) do not say which argument was wrong.
 
     Raises
     ------
     TypeError
-        Not a Generator, a seed or None (a string, a float, a bool: NumPy would take True as
-        the seed 1, as other settings refuse a bool for a number).
+        Not a Generator, a RandomState, a seed or None (a string, a float, a bool: NumPy would
+        take True as the seed 1, as other settings refuse a bool for a number).
     ValueError
         A negative seed.
     """
     if isinstance(rng, (bool, np.bool_)):
         raise TypeError(
-            f"{what} must be a numpy.random.Generator, an int >= 0 or None, got "
+            f"{what} must be a numpy.random.Generator (or RandomState), an int >= 0 or None, got "
             f"{type(rng).__name__} {rng!r}"
         )
     try:
         return np.random.default_rng(rng)
     except (TypeError, ValueError) as e:
         raise type(e)(
-            f"{what} must be a numpy.random.Generator, an int >= 0 or None, got "
+            f"{what} must be a numpy.random.Generator (or RandomState), an int >= 0 or None, got "
             f"{type(rng).__name__} {rng!r}"
         ) from None

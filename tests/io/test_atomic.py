@@ -345,9 +345,7 @@ def test_dash_is_refused_as_an_output_name(tmp_path: Path, monkeypatch) -> None:
 
 
 @pytest.mark.parametrize("writer", ["write_mot", "atomic_path"])
-@pytest.mark.parametrize(
-    ("code", "cls"), [(errno.EROFS, OSError), (errno.EACCES, PermissionError)]
-)
+@pytest.mark.parametrize(("code", "cls"), [(errno.EROFS, OSError), (errno.EACCES, PermissionError)])
 def test_a_temporary_file_that_cannot_be_made_names_the_output(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, writer: str, code: int, cls: type
 ) -> None:

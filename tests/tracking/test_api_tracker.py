@@ -873,7 +873,8 @@ def test_no_track_warning_of_the_joint_sampler_does_not_blame_confidences():
     tracker = pftrack.Tracker(sampler="rjmcmc")
     frame = np.zeros((200, 300, 3), np.uint8)
     tracker.update(np.array([[10, 20, 50, 120, 0.95]]), frame)
-    tracker.update(None, frame)
+    with pytest.warns(UserWarning, match="dets=None runs the built-in"):  # on purpose
+        tracker.update(None, frame)
     with pytest.warns(RuntimeWarning, match=r"joint sampler \(rjmcmc\) kept no object"):
         tracker.finalize()
 
