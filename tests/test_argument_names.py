@@ -144,12 +144,14 @@ CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
     "ColourParticleFilter(rng='abc')": (
         lambda: ColourParticleFilter([5, 5, 4, 4], np.ones(110), rng="abc"),
         TypeError,
-        "rng must be a numpy.random.Generator, an int >= 0 or None, got str 'abc'",
+        r"rng must be a numpy.random.Generator \(or RandomState\), an int >= 0 or None, got str "
+        "'abc'",
     ),
     "RJMCMCFilter(rng=-1)": (
         lambda: RJMCMCFilter(rng=-1),
         ValueError,
-        "RJMCMCFilter: rng must be a numpy.random.Generator, an int >= 0 or None, got int -1",
+        r"RJMCMCFilter: rng must be a numpy.random.Generator \(or RandomState\), an int >= 0 or "
+        "None, got int -1",
     ),
 }
 
@@ -170,7 +172,10 @@ def test_named_in_the_message(name: str) -> None:
 def test_resamplers_name_their_rng(
     fn: Callable[..., object], rng: object, error: type[Exception], got: str
 ) -> None:
-    match = f"{fn.__name__}: rng must be a numpy.random.Generator, an int >= 0 or None, got {got}"
+    match = (
+        rf"{fn.__name__}: rng must be a numpy.random.Generator \(or RandomState\), an int >= 0 "
+        f"or None, got {got}"
+    )
     with pytest.raises(error, match=match):
         fn([0.5, 0.5], rng=rng)
 

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -24,8 +27,10 @@ __all__ = [
     "flag",
     "generator",
     "integer",
+    "materialised",
     "mot_rows",
     "number",
+    "path_refused",
     "real_array",
     "seed",
 ]
@@ -97,6 +102,28 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
 MOT_DEFAULTS = (1.0, -1.0, -1.0, -1.0)
 
 
+def path_refused(value: object, what: str, reader: str) -> None:
+    """TypeError when `value` is a path (str, bytes, os.PathLike) where an array was expected.
+
+    NumPy takes a path for a 0-d array of text, refused by its dtype (``got dtype <U36``),
+    which does not say that the file must be read first:
+    ``{what} is a path ('gt.txt'); read it with {reader}``.
+    """
+    if isinstance(value, (str, bytes, os.PathLike)):
+        raise TypeError(f"{what} is a path ({os.fsdecode(value)!r}); read it with {reader}")
+
+
+def materialised(rows: ArrayLike) -> ArrayLike:
+    """`rows` as a list when it is an iterator (a generator, ``map``), else `rows` itself.
+
+    NumPy takes an iterator for a 0-d object array; its rows (a generator of generators too)
+    are read once, into lists. Arrays and sequences are returned as they are.
+    """
+    if not isinstance(rows, Iterator):
+        return rows
+    return [list(r) if isinstance(r, Iterator) else r for r in rows]
+
+
 def mot_rows(rows: ArrayLike, what: str) -> F64:
     """MOTChallenge rows (M, 6..10) as an (M, 10) float64 array, the missing columns added.
 
@@ -105,19 +132,22 @@ def mot_rows(rows: ArrayLike, what: str) -> F64:
     messages, and the arrays the commands take as files: 6 to 10 columns ``frame, id, left,
     top, width, height[, conf, x, y, z]``, the missing ones :data:`MOT_DEFAULTS` (conf 1,
     x, y, z -1), as :func:`pftrack.io.mot.read_mot` reads a shorter line. An array without
-    values (``[]``, ``np.zeros((0,))``, ``np.zeros((0, 10))``) is no rows. Only the layout is
-    checked here; the callers check the values.
+    values (``[]``, ``np.zeros((0,))``, ``np.zeros((0, 10))``) is no rows. Any iterable of
+    rows is taken: an iterator (a generator, ``map(list, rows)``) is read once
+    (:func:`materialised`). Only the layout is checked here; the callers check the values.
 
     Raises
     ------
     TypeError
-        Not real numbers (text, complex numbers, booleans).
+        Not real numbers (text, complex numbers, booleans); a path (read it with
+        :func:`pftrack.io.mot.read_mot` first).
     ValueError
         Ragged rows, or not of shape (M, 6..10):
         ``{what}: rows must have shape (M, 6..10) (6 to 10 columns: frame, id, left, top,
         width, height[, conf, x, y, z]), got (2, 3)``.
     """
-    a = real_array(rows, f"{what}: rows", booleans=False)
+    path_refused(rows, f"{what}: rows", "pftrack.read_mot(path)")
+    a = real_array(materialised(rows), f"{what}: rows", booleans=False)
     if a.size == 0:
         return np.zeros((0, 10))
     if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
@@ -167,26 +197,32 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
 
 
 def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
-    """`frame` as a (H, W, 3) uint8 array (``numpy.asarray``: not copied when it is one).
+    """`frame` itself, checked to be a NumPy (H, W, 3) uint8 array (never converted, nor copied).
 
     Raises
     ------
     TypeError
-        Not an array of uint8 (float frames; ``None``; a list, named as one, not by the dtype
-        NumPy gives it).
+        Not an array of uint8 (float frames; ``None``); not a NumPy array at all (a list, a
+        PIL image, named by their type, not by the dtype NumPy gives them: a list of ints is
+        int64, a PIL image uint8 but RGB).
     ValueError
         Not of shape (H, W, 3): a grey (2-D or one-channel) or a BGRA frame's message names
         the ``cv2.cvtColor`` conversion that makes it BGR.
     """
-    f = np.asarray(frame)
-    if f.dtype == object:
-        raise TypeError(f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array")
-    if f.dtype != np.uint8 and not isinstance(frame, np.ndarray):
-        # a list (``frame.tolist()``) is int64 to NumPy: its dtype is not what the user gave
+    if not isinstance(frame, np.ndarray):
+        # a list (``frame.tolist()``) is int64 to NumPy, and a PIL image uint8 but RGB: both
+        # refused alike (a PIL image was taken, its red read as blue)
+        if np.asarray(frame).dtype == object:
+            raise TypeError(
+                f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array"
+            )
+        pil = type(frame).__module__.split(".")[0] == "PIL"
         raise TypeError(
             f"{what} is {type(frame).__name__}, expected a NumPy uint8 array (H, W, 3) (BGR, "
             "as cv2 reads it)"
+            + ("; a PIL image is RGB: np.asarray(img)[..., ::-1] gives BGR" if pil else "")
         )
+    f = frame
     if f.dtype != np.uint8:
         raise TypeError(f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
     if f.ndim != 3 or f.shape[2] != 3:
@@ -336,30 +372,31 @@ def seed(value: object, what: str) -> int:
     return int(value)
 
 
-def generator(rng: RngLike, what: str) -> np.random.Generator:
+def generator(rng: RngLike | np.random.RandomState, what: str) -> np.random.Generator:
     """``numpy.random.default_rng(rng)``, whose errors name the argument.
 
-    A Generator is returned as it is; NumPy's refusals (``"SeedSequence expects int or
-    sequence of ints for entropy not abc"``, ``"expected non-negative integer"``) do not say
-    which argument was wrong.
+    A Generator is returned as it is; a ``numpy.random.RandomState`` is wrapped (its bit
+    generator, whose state the two then share: filterpy's draws). NumPy's refusals
+    (``"SeedSequence expects int or sequence of ints for entropy not abc"``, ``"expected
+    non-negative integer"``) do not say which argument was wrong.
 
     Raises
     ------
     TypeError
-        Not a Generator, a seed or None (a string, a float, a bool: NumPy would take True as
-        the seed 1, as other settings refuse a bool for a number).
+        Not a Generator, a RandomState, a seed or None (a string, a float, a bool: NumPy would
+        take True as the seed 1, as other settings refuse a bool for a number).
     ValueError
         A negative seed.
     """
     if isinstance(rng, (bool, np.bool_)):
         raise TypeError(
-            f"{what} must be a numpy.random.Generator, an int >= 0 or None, got "
+            f"{what} must be a numpy.random.Generator (or RandomState), an int >= 0 or None, got "
             f"{type(rng).__name__} {rng!r}"
         )
     try:
         return np.random.default_rng(rng)
     except (TypeError, ValueError) as e:
         raise type(e)(
-            f"{what} must be a numpy.random.Generator, an int >= 0 or None, got "
+            f"{what} must be a numpy.random.Generator (or RandomState), an int >= 0 or None, got "
             f"{type(rng).__name__} {rng!r}"
         ) from None

@@ -171,6 +171,27 @@ def test_bad_input():
         evaluate_mot(HAND_GT, HAND_RES, image_size=(0, 10))
 
 
+def test_a_path_is_refused_with_the_reader_to_use(tmp_path):
+    """Was ``evaluate_mot: gt must hold real numbers, got dtype <U36``."""
+    from pathlib import Path
+
+    from pftrack.eval import evaluate_hota, evaluate_sequence
+
+    for gt, res, bad, path in (
+        ("gt.txt", HAND_RES, "gt", "gt.txt"),
+        (HAND_GT, Path("res.txt"), "result", "res.txt"),
+    ):
+        with pytest.raises(
+            TypeError,
+            match=rf"^evaluate_mot: {bad} is a path \('{path}'\); read it with "
+            r"pftrack\.read_mot\(path\)$",
+        ):
+            evaluate_mot(gt, res)  # type: ignore[arg-type]
+        for fn in (evaluate_hota, evaluate_sequence):
+            with pytest.raises(TypeError, match=rf"is a path \('{path}'\); read it with pftrack"):
+                fn(gt, res)  # type: ignore[arg-type]
+
+
 def test_a_detections_file_scored_as_tracks_is_named():
     det = HAND_RES.copy()
     det[:, 1] = -1

@@ -304,6 +304,37 @@ def test_a_name_that_can_only_be_a_folder_is_refused(tmp_path: Path, name: str) 
     assert not any(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("writer", ["write_mot", "atomic_write", "atomic_path", "stage", "link"])
+def test_an_existing_folder_is_refused_before_writing(tmp_path: Path, writer: str) -> None:
+    """Was ``IsADirectoryError: [Errno 21] Is a directory: '/x/.io.<hex>.tmp' -> '/x/io'``,
+    naming the hidden temporary file, once the file had been written."""
+    from pftrack.io.atomic import staged_outputs
+
+    folder = tmp_path / "io"
+    folder.mkdir()
+    (folder / "keep.txt").write_text("x")
+    target = folder
+    if writer == "link":  # a link to a folder is refused as the folder
+        target = tmp_path / "link"
+        target.symlink_to(folder)
+    with pytest.raises(ValueError, match=rf"^output {target} is a folder; give a file name$"):
+        if writer in ("write_mot", "link"):
+            write_mot(target, [[1, 1, 10, 10, 5, 5]])
+        elif writer == "atomic_write":
+            with atomic_write(target) as fh:
+                fh.write("x")
+        elif writer == "atomic_path":
+            with atomic_path(target) as tmp:
+                tmp.write_text("x")
+        else:
+            with staged_outputs() as stage:
+                stage(target).write_text("x")
+    assert sorted(p.name for p in folder.iterdir()) == ["keep.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["io"] + (["link"] if writer == "link" else [])
+    )
+
+
 def test_dash_is_refused_as_an_output_name(tmp_path: Path, monkeypatch) -> None:
     from pftrack.io.atomic import check_output
 
@@ -311,6 +342,77 @@ def test_dash_is_refused_as_an_output_name(tmp_path: Path, monkeypatch) -> None:
     with pytest.raises(ValueError, match=r"^--out -: standard output .* /dev/stdout$"):
         check_output("-", what="--out")
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("writer", ["write_mot", "atomic_path"])
+@pytest.mark.parametrize(("code", "cls"), [(errno.EROFS, OSError), (errno.EACCES, PermissionError)])
+def test_a_temporary_file_that_cannot_be_made_names_the_output(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, writer: str, code: int, cls: type
+) -> None:
+    """Was ``OSError: [Errno 30] Read-only file system: '/x/.old.txt.f806e9cd1123.tmp'``.
+
+    A read-only file system (or, for a user other than root, a folder without write
+    permission), made here by ``os.open`` refusing every file in the folder, as root's
+    permissions would not.
+    """
+    real = os.open
+
+    def refused(path: str, flags: int, mode: int = 0o777) -> int:
+        if os.path.dirname(os.fsdecode(path)) == str(tmp_path) and flags & os.O_CREAT:
+            raise OSError(code, os.strerror(code), path)
+        return real(path, flags, mode)
+
+    target = tmp_path / "old.txt"
+    target.write_text("old\n")
+    monkeypatch.setattr(os, "open", refused)
+    with pytest.raises(OSError) as exc:
+        if writer == "write_mot":
+            write_mot(target, [[1, 1, 10, 10, 5, 5]])
+        else:
+            with atomic_path(target) as tmp:
+                tmp.write_text("new\n")
+    monkeypatch.undo()
+    assert type(exc.value) is cls
+    assert (exc.value.errno, exc.value.filename) == (code, str(target))
+    assert str(exc.value) == f"[Errno {code}] {os.strerror(code)}: '{target}'"
+    assert target.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.txt"]
+
+
+def test_a_failed_rename_names_the_output(tmp_path: Path, monkeypatch) -> None:
+    """Was the hidden temporary file and the target, ``'/x/.t.<hex>.tmp' -> '/x/t.txt'``."""
+
+    def busy(src: str, dst: str) -> None:
+        raise OSError(errno.EBUSY, os.strerror(errno.EBUSY), src, None, dst)
+
+    target = tmp_path / "t.txt"
+    target.write_text("old\n")
+    monkeypatch.setattr(os, "replace", busy)
+    with pytest.raises(OSError) as exc, atomic_write(target) as fh:
+        fh.write("new\n")
+    monkeypatch.undo()
+    assert (exc.value.errno, exc.value.filename, exc.value.filename2) == (
+        errno.EBUSY,
+        str(target),
+        None,
+    )
+    assert target.read_text() == "old\n" and [p.name for p in tmp_path.iterdir()] == ["t.txt"]
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a folder without write bits")
+def test_a_folder_without_write_permission_names_the_output(tmp_path: Path) -> None:
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    target = folder / "old.txt"
+    target.write_text("old\n")
+    folder.chmod(0o555)
+    try:
+        with pytest.raises(PermissionError) as exc:
+            write_mot(target, [[1, 1, 10, 10, 5, 5]])
+    finally:
+        folder.chmod(0o755)
+    assert exc.value.filename == str(target) and ".old.txt." not in str(exc.value)
+    assert target.read_text() == "old\n"
 
 
 def test_a_write_error_names_the_output(tmp_path: Path, monkeypatch) -> None:

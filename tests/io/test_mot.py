@@ -157,6 +157,38 @@ def test_write_refuses_ragged_rows_and_text(tmp_path: Path) -> None:
     assert not (tmp_path / "t.txt").exists()
 
 
+def test_rows_may_come_from_an_iterator(tmp_path: Path) -> None:
+    """Was ``write_mot: rows must hold real numbers, got dtype object``: NumPy takes an
+    iterator for one object; the hint is ``Iterable[Iterable[float]]``."""
+    from pftrack.recovery.linking import filled_mask
+
+    rows = [[1, 1, 10, 10, 5, 5], [2, 1, 11, 10, 5, 5.5]]
+    want = tmp_path / "want.txt"
+    mot.write_mot(want, rows)
+    for k, given in enumerate(
+        [
+            (r for r in rows),
+            map(list, rows),
+            (iter(r) for r in rows),  # rows that are iterators too
+            map(np.asarray, rows),
+        ]
+    ):
+        out = tmp_path / f"{k}.txt"
+        mot.write_mot(out, given)
+        assert out.read_bytes() == want.read_bytes()
+    assert mot.mot_text(r for r in rows) == want.read_text()
+    assert filled_mask(r for r in rows).tolist() == [False, False]  # _check.mot_rows
+    mot.write_mot(tmp_path / "none.txt", iter([]))
+    assert (tmp_path / "none.txt").read_text() == ""
+
+
+def test_a_path_given_for_rows_says_to_read_it(tmp_path: Path) -> None:
+    with pytest.raises(
+        TypeError, match=r"^mot_text: rows is a path \('t\.txt'\); read it with pftrack\.read_mot"
+    ):
+        mot.mot_text("t.txt")  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize(
     ("col", "value", "match"),
     [

@@ -143,6 +143,22 @@ def test_drop_in_for_filterpy(name):
     np.testing.assert_array_equal(mine, theirs)
 
 
+@pytest.mark.parametrize("name", ["systematic", "stratified", "multinomial"])
+def test_a_random_state_gives_filterpys_draws(name):
+    """What docs/api.md promises: ``rng=np.random.RandomState(s)`` is filterpy after
+    ``np.random.seed(s)``, through the public functions (residual resampling differs)."""
+    mc = pytest.importorskip("filterpy.monte_carlo")
+    w = np.random.default_rng(12).random(200)
+    w /= w.sum()
+    state = np.random.get_state()
+    try:
+        np.random.seed(8)
+        theirs = getattr(mc, f"{name}_resample")(w)
+    finally:
+        np.random.set_state(state)
+    np.testing.assert_array_equal(RESAMPLERS[name](w, rng=np.random.RandomState(8)), theirs)
+
+
 def test_seeded_results_are_reproducible():
     w = np.random.default_rng(0).random(500)
     for fn in RESAMPLERS.values():
@@ -219,8 +235,8 @@ def test_stratified_matches_reference_at_scale(kind, u_kind):
 def test_rng_refuses_a_bool(fn, flag):
     # True was taken as the seed 1: other settings refuse a bool for a number
     match = (
-        f"{fn.__name__}: rng must be a numpy.random.Generator, an int >= 0 or None, got "
-        f"{type(flag).__name__} {flag!r}"
+        f"{fn.__name__}: rng must be a numpy.random.Generator (or RandomState), an int >= 0 or "
+        f"None, got {type(flag).__name__} {flag!r}"
     )
     with pytest.raises(TypeError, match=match.replace("(", r"\(").replace(")", r"\)")):
         fn([0.5, 0.5], flag)

@@ -571,6 +571,32 @@ def test_builtin_detector_when_dets_is_none(scene):
         tracker.prime(scene.frames[:3])
 
 
+def test_none_after_detections_warns_once_naming_the_frame(scene):
+    """Was silent: a loop passing None for "no detections" switched that frame to the
+    built-in background-subtraction detector."""
+    dets = scene_dets(scene)
+    tracker = pftrack.Tracker(seed=0)
+    for k in range(10):
+        tracker.update(dets[k], scene.frames[k])
+    with pytest.warns(UserWarning) as record:
+        tracker.update(None, scene.frames[10])
+    (w,) = record
+    assert str(w.message) == (
+        "frame 11: dets=None runs the built-in background-subtraction detector for this "
+        "frame, after frames with detections; for a frame without detections give [] or "
+        "np.zeros((0, 6))"
+    )
+    assert w.filename == __file__  # the caller's line
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # once a run
+        tracker.update(None, scene.frames[11])
+        tracker.update(np.zeros((0, 6)), scene.frames[12])  # no detections: no warning
+        tracker.update([], scene.frames[13])
+        tracker.reset()  # a new run: None from the start is the built-in detector, silently
+        for f in scene.frames[:3]:
+            tracker.update(None, f)
+
+
 def test_track_frames_is_the_tracker_loop(scene):
     """track_frames (the CLI's library) and a loop over Tracker agree (priming included)."""
     d = scene_dets(scene)
@@ -847,7 +873,8 @@ def test_no_track_warning_of_the_joint_sampler_does_not_blame_confidences():
     tracker = pftrack.Tracker(sampler="rjmcmc")
     frame = np.zeros((200, 300, 3), np.uint8)
     tracker.update(np.array([[10, 20, 50, 120, 0.95]]), frame)
-    tracker.update(None, frame)
+    with pytest.warns(UserWarning, match="dets=None runs the built-in"):  # on purpose
+        tracker.update(None, frame)
     with pytest.warns(RuntimeWarning, match=r"joint sampler \(rjmcmc\) kept no object"):
         tracker.finalize()
 

@@ -8,6 +8,7 @@ its packed copy.
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
@@ -86,6 +87,25 @@ def test_prime_refuses_what_is_not_a_frame(bad, error, message):
         pftrack.Tracker().prime([bad])
 
 
+@pytest.mark.parametrize("shape", [(6, 8, 3), (6, 8)])
+def test_prime_refuses_one_frame_for_an_iterable_of_frames(frames, shape):
+    """Was ``prime frame must have shape (H, W, 3) (BGR), got (8, 3): a grey frame?``: one
+    frame, iterated, gives its rows."""
+    one = np.zeros(shape, np.uint8)
+    with pytest.raises(
+        TypeError,
+        match=rf"^prime takes an iterable of frames \(a list, or a \(K, H, W, 3\) array\), "
+        rf"got one {re.escape(str(shape))} frame: prime\(\[frame\]\)$",
+    ):
+        pftrack.Tracker().prime(one)
+    stacked, listed = pftrack.Tracker(seed=1), pftrack.Tracker(seed=1)
+    stacked.prime(np.stack(frames[:4]))  # a (K, H, W, 3) array still primes
+    listed.prime(frames[:4])
+    dets = np.array([[40.0, 40.0, 70.0, 120.0, 0.9]])
+    for f in frames:
+        np.testing.assert_array_equal(stacked.update(dets, f), listed.update(dets, f))
+
+
 GREY = np.zeros((6, 8), np.uint8)
 GREY_1 = np.zeros((6, 8, 1), np.uint8)
 BGRA = np.zeros((6, 8, 4), np.uint8)
@@ -131,6 +151,41 @@ def test_a_frame_given_as_a_list_is_named_as_one(entry):
         ENTRY_POINTS[entry](np.zeros((6, 8, 3), np.uint8).tolist())
 
 
+class _ArrayLikeFrame:
+    """Not a NumPy array, but NumPy makes one of it: a uint8 (H, W, 3) frame, as a PIL image."""
+
+    def __init__(self, a: np.ndarray) -> None:
+        self._a = a
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        return self._a
+
+
+@pytest.mark.parametrize("entry", sorted(ENTRY_POINTS))
+def test_a_frame_that_is_not_a_numpy_array_is_refused_whatever_its_dtype(entry):
+    """Was taken when NumPy made a uint8 array of it (a PIL image: RGB, read as BGR), while a
+    list was refused."""
+    frame = _ArrayLikeFrame(np.zeros((6, 8, 3), np.uint8))
+    expected = r"frame is _ArrayLikeFrame, expected a (NumPy uint8 array \(H, W, 3\)|numpy\.nd)"
+    with pytest.raises(TypeError, match=expected):
+        ENTRY_POINTS[entry](frame)
+
+
+def test_a_pil_image_is_refused_with_the_conversion_to_bgr():
+    image = pytest.importorskip("PIL.Image")
+    pil = image.fromarray(np.zeros((6, 8, 3), np.uint8))
+    for call in (
+        lambda: pftrack.Tracker().update(np.zeros((0, 6)), pil),
+        lambda: pftrack.Tracker().prime([pil]),
+    ):
+        with pytest.raises(TypeError) as e:
+            call()
+        assert str(e.value).endswith(
+            "frame is Image, expected a NumPy uint8 array (H, W, 3) (BGR, as cv2 reads it); "
+            "a PIL image is RGB: np.asarray(img)[..., ::-1] gives BGR"
+        )
+
+
 def test_unpacked_views_track_as_their_packed_copies(frames):
     rgb = [np.ascontiguousarray(f[..., ::-1]) for f in frames]  # a user's RGB frames
     views = [f[..., ::-1] for f in rgb]  # the usual RGB -> BGR view
@@ -140,7 +195,9 @@ def test_unpacked_views_track_as_their_packed_copies(frames):
 
     def run(seq):
         t = pftrack.Tracker()
-        out = [t.update(dets, f) for f in seq] + [t.update(None, f) for f in seq]
+        out = [t.update(dets, f) for f in seq]
+        with pytest.warns(UserWarning, match="dets=None runs the built-in"):  # on purpose
+            out += [t.update(None, f) for f in seq]
         return out, t.finalize()
 
     base = run(frames)

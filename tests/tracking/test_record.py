@@ -53,6 +53,26 @@ def test_finalize_and_settled_rows_refuse(scene):
     tracker.update(truth_dets(scene)[1], scene.frames[1])
 
 
+def test_settled_rows_start_is_an_int_from_0(scene):
+    """Was ``slice indices must be integers`` for 1.5, and every row for -1."""
+    tracker = pftrack.Tracker(25.0, seed=4)
+    for d, frame in zip(truth_dets(scene)[:20], scene.frames[:20], strict=True):
+        tracker.update(d, frame)
+    n = tracker.n_settled
+    assert n > 2
+    assert len(tracker.settled_rows()) == n
+    assert len(tracker.settled_rows(np.int64(2))) == n - 2
+    assert len(tracker.settled_rows(n)) == len(tracker.settled_rows(n + 5)) == 0
+    for bad, error, message in (
+        (1.5, TypeError, r" must be an int >= 0, got float 1\.5$"),
+        (True, TypeError, r" must be an int >= 0, got bool True$"),
+        ("2", TypeError, r" must be an int >= 0, got str '2'$"),
+        (-1, ValueError, r" is -1, expected an int >= 0$"),
+    ):
+        with pytest.raises(error, match=rf"^Tracker\.settled_rows: start{message}"):
+            tracker.settled_rows(bad)  # type: ignore[arg-type]
+
+
 def test_record_is_a_flag():
     with pytest.raises(TypeError, match="record"):
         pftrack.Tracker(record="no")  # type: ignore[arg-type]

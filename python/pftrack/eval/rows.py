@@ -20,6 +20,7 @@ from pftrack._check import (
     first_bad_id,
     integer,
     number,
+    path_refused,
     real_array,
 )
 from pftrack.boxes import _box_rows
@@ -57,8 +58,10 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     :func:`~pftrack.io.mot.read_mot` refuses them); missing columns padded with what
     ``read_mot`` gives a shorter line (:data:`~pftrack._check.MOT_DEFAULTS`: conf 1, x, y, z
     -1), so an array and the file it was written to score the same. Shared by
-    :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`.
+    :func:`evaluate_mot` and :func:`~pftrack.eval.hota.evaluate_hota`. A path is refused,
+    TypeError: ``{what} is a path ('gt.txt'); read it with pftrack.read_mot(path)``.
     """
+    path_refused(rows, what, "pftrack.read_mot(path)")
     a = real_array(rows, what)
     if a.size == 0:
         return np.zeros((0, 10))

@@ -114,10 +114,30 @@ def _open_through(target: _Target, mode: str) -> IO[Any]:
 
 
 def _refuse_folder_name(path: PathLike, what: str = "output") -> None:
-    """ValueError when `path` can only name a folder (``newdir/``): a file would be written."""
+    """ValueError when `path` can only name a folder (``newdir/``), or is one (or a link to one).
+
+    Checked before anything is written: a file would be written as ``newdir``, and renaming
+    the temporary file over a folder failed with ``IsADirectoryError: [Errno 21] Is a
+    directory: '/x/.io.b3faca0eaadd.tmp' -> '/x/io'``, naming the hidden file.
+    """
     text = os.fsdecode(os.fspath(path))
     if _names_folder(text):
         raise ValueError(f"{what} {text} names a folder; give a file name")
+    if os.path.isdir(text):
+        raise ValueError(f"{what} {text} is a folder; give a file name")
+
+
+def _about_output(exc: OSError, path: PathLike) -> OSError:
+    """`exc` (an error making, filling or renaming the hidden temporary file) naming `path`.
+
+    Was: ``OSError: [Errno 30] Read-only file system: '/x/.old.txt.f806e9cd1123.tmp'``, a name
+    the user never gave; now ``[Errno 30] Read-only file system: '/x/old.txt'``. The class
+    follows the errno, as ``OSError(errno, ...)`` picks it (``PermissionError`` for EACCES,
+    ``OSError`` for EROFS): that of `exc`. An error without errno is returned as it is.
+    """
+    if exc.errno is None:
+        return exc
+    return OSError(exc.errno, exc.strerror, os.fsdecode(os.fspath(path)))
 
 
 def _blocking(folder: Path) -> Path | None:
@@ -240,7 +260,11 @@ def atomic_write(
     Raises
     ------
     ValueError
-        `path` can only name a folder (a trailing slash, ``.``).
+        `path` can only name a folder (a trailing slash, ``.``), or is an existing folder.
+    OSError
+        The temporary file cannot be made, written or renamed (a read-only file system, a
+        folder without write permission, a full disk): the error names `path`, never the
+        temporary file, and `path` is left as it was.
     """
     _refuse_folder_name(path)
     resolved = _resolve(path)
@@ -254,14 +278,20 @@ def atomic_write(
         raise _missing_folder(folder, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
-        fd, tmp = _create_beside(folder, f".{target.name}.", suffix or ".tmp", made)
-        _keep_mode(fd, target)
+        try:
+            fd, tmp = _create_beside(folder, f".{target.name}.", suffix or ".tmp", made)
+            _keep_mode(fd, target)
+        except OSError as exc:  # a read-only file system, a folder without write permission
+            raise _about_output(exc, path) from None
         with _named(path), os.fdopen(fd, mode) as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
-        _keep_mode(tmp, target)
-        os.replace(tmp, target)
+        try:
+            _keep_mode(tmp, target)
+            os.replace(tmp, target)
+        except OSError as exc:
+            raise _about_output(exc, path) from None
     except BaseException:
         _remove(made)
         raise
@@ -291,16 +321,22 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         raise _missing_folder(folder, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
-        fd, tmp = _create_beside(folder, f".{target.stem}.", Path(path).suffix, made)
         try:
-            _keep_mode(fd, target)
-        finally:
-            os.close(fd)
+            fd, tmp = _create_beside(folder, f".{target.stem}.", Path(path).suffix, made)
+            try:
+                _keep_mode(fd, target)
+            finally:
+                os.close(fd)
+        except OSError as exc:  # a read-only file system, a folder without write permission
+            raise _about_output(exc, path) from None
         yield Path(tmp)
         if not Path(tmp).exists() or Path(tmp).stat().st_size == 0:
             raise OSError(f"nothing was written for {target}")
-        _keep_mode(tmp, target)  # again: a writer may have made the file anew
-        os.replace(tmp, target)
+        try:
+            _keep_mode(tmp, target)  # again: a writer may have made the file anew
+            os.replace(tmp, target)
+        except OSError as exc:
+            raise _about_output(exc, path) from None
     except BaseException:
         _remove(made)
         raise

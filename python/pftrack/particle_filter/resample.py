@@ -9,6 +9,13 @@ Given the same uniform draws, :func:`systematic_resample`, :func:`stratified_res
 purpose: filterpy 2.0.0 draws the remainder from ``weights - floor(N*weights)`` where Liu &
 Chen's residuals are ``N*weights - floor(N*weights)`` (see its Notes), so only the
 ``floor(N*w_i)`` deterministic copies agree.
+
+Randomness: filterpy draws from NumPy's global state (``np.random.seed``); these never do.
+With ``rng=None`` each call draws fresh OS entropy, so ``np.random.seed`` does not make them
+reproducible: pass `rng` (a seed or a Generator). A ``numpy.random.RandomState`` is taken
+too (``numpy.random.default_rng`` wraps its bit generator, sharing its state): the same
+draws as filterpy seeded alike, ``rng=np.random.RandomState(0)`` giving the indices of
+``np.random.seed(0)`` then filterpy's function (residual resampling aside).
 """
 
 from __future__ import annotations
@@ -40,7 +47,9 @@ def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
     return np.ascontiguousarray(w, dtype=np.float64)
 
 
-def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+def systematic_resample(
+    weights: ArrayLike, rng: RngLike | np.random.RandomState = None
+) -> NDArray[np.int32]:
     """Indices of the particles kept by systematic resampling.
 
     One uniform offset ``u0`` places N evenly spaced positions ``(i + u0) / N`` on the CDF;
@@ -51,7 +60,7 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     ----------
     weights : (N,) array_like of float
         Non-negative particle weights; need not sum to 1.
-    rng : numpy.random.Generator, int or None
+    rng : numpy.random.Generator, numpy.random.RandomState, int or None
         Source of the single uniform offset: ``default_rng(rng).random()`` (None: fresh OS
         entropy; pass a Generator when resampling often, it is cheaper than building one).
 
@@ -63,9 +72,11 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     Notes
     -----
     A seed or a Generator gives exactly ``default_rng(rng).random()`` as the offset, so results
-    are reproducible; there is no module-level generator. The kernel runs in O(N) without a
-    data-dependent branch per particle and returns the same indices as ``numpy.searchsorted`` on the
-    normalised cumulative sum (side="right", clamped to N-1), i.e. as filterpy.
+    are reproducible; there is no module-level generator (``np.random.seed`` does not reach
+    it: None is fresh OS entropy). A RandomState gives filterpy's offset for the same state.
+    The kernel runs in O(N) without a data-dependent branch per particle and returns the same
+    indices as ``numpy.searchsorted`` on the normalised cumulative sum (side="right", clamped
+    to N-1), i.e. as filterpy.
 
     References
     ----------
@@ -76,14 +87,16 @@ def systematic_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     return _core.systematic_resample(w, generator(rng, "systematic_resample: rng").random())
 
 
-def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+def stratified_resample(
+    weights: ArrayLike, rng: RngLike | np.random.RandomState = None
+) -> NDArray[np.int32]:
     """Indices kept by stratified resampling: one uniform draw in each of N equal strata.
 
     Parameters
     ----------
     weights : (N,) array_like of float
         Non-negative particle weights; need not sum to 1.
-    rng : numpy.random.Generator, int or None
+    rng : numpy.random.Generator, numpy.random.RandomState, int or None
         Source of the N uniform draws.
 
     Returns
@@ -99,7 +112,9 @@ def stratified_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.i
     return _core.stratified_resample(w, generator(rng, "stratified_resample: rng").random(len(w)))
 
 
-def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+def multinomial_resample(
+    weights: ArrayLike, rng: RngLike | np.random.RandomState = None
+) -> NDArray[np.int32]:
     """Indices kept by multinomial resampling: N independent draws from the weights.
 
     The indices come in the order of the draws (as in filterpy), not sorted.
@@ -108,7 +123,7 @@ def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.
     ----------
     weights : (N,) array_like of float
         Non-negative particle weights; need not sum to 1.
-    rng : numpy.random.Generator, int or None
+    rng : numpy.random.Generator, numpy.random.RandomState, int or None
         Source of the N uniform draws.
 
     Returns
@@ -124,7 +139,9 @@ def multinomial_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.
     return _core.multinomial_resample(w, generator(rng, "multinomial_resample: rng").random(len(w)))
 
 
-def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int32]:
+def residual_resample(
+    weights: ArrayLike, rng: RngLike | np.random.RandomState = None
+) -> NDArray[np.int32]:
     """Indices kept by residual resampling.
 
     ``floor(N w_i)`` copies of each particle, then the remaining ``R`` drawn multinomially from
@@ -136,7 +153,7 @@ def residual_resample(weights: ArrayLike, rng: RngLike = None) -> NDArray[np.int
     ----------
     weights : (N,) array_like of float
         Non-negative particle weights; need not sum to 1.
-    rng : numpy.random.Generator, int or None
+    rng : numpy.random.Generator, numpy.random.RandomState, int or None
         Source of the uniform draws for the residual part.
 
     Returns

@@ -725,7 +725,18 @@ class Tracker:
         over the file (``pftrack.detection.bootstrap.bootstrap_frames(source,
         tracker.prime_frames)``). A loop that primes with the same frames gets the command's
         rows. Detectors without a background ignore it.
+
+        `frames` is an iterable of (H, W, 3) uint8 BGR frames: a list, a generator, or a
+        (K, H, W, 3) array. One frame alone (an array of shape (H, W, 3) or (H, W)) is refused,
+        TypeError (iterated, it was taken for rows of a grey frame): ``prime([frame])``.
         """
+        if isinstance(frames, np.ndarray) and (
+            frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
+        ):
+            raise TypeError(
+                "prime takes an iterable of frames (a list, or a (K, H, W, 3) array), got one "
+                f"{frames.shape} frame: prime([frame])"
+            )
         with self._alone("prime"):
             if self.frame_count:
                 raise ValueError("prime() must come before the first update()")
@@ -756,10 +767,14 @@ class Tracker:
             outside are ignored, and so are boxes without area (``x2 == x1`` or ``y2 == y1``)
             and stray inverted ones (``x2 < x1`` or ``y2 < y1``), with one warning a run each.
             Inverted boxes that are most of the run's are refused, ValueError (x, y, w, h rows:
-            :func:`check_boxes_xyxy`). None runs the built-in background-subtraction detector.
-        frame : (H, W, 3) array_like of uint8
-            BGR frame (TypeError for another dtype; ValueError for another shape, naming
-            ``cv2.cvtColor``'s conversion of a grey or BGRA frame).
+            :func:`check_boxes_xyxy`). None runs the built-in background-subtraction detector
+            on this frame; a frame without detections is ``[]`` or ``np.zeros((0, 6))``
+            (None after frames with detections warns, see below).
+        frame : (H, W, 3) ndarray of uint8
+            BGR frame, as cv2 reads it (TypeError for another dtype, or for what is not a
+            NumPy array: a list, a PIL image, whose RGB ``np.asarray(img)[..., ::-1]`` makes
+            BGR; ValueError for another shape, naming ``cv2.cvtColor``'s conversion of a grey
+            or BGRA frame).
 
         Returns
         -------
@@ -778,7 +793,10 @@ class Tracker:
         UserWarning
             Once a run each: boxes clipped to the frame, boxes without area dropped, and, with
             ``dets=None``, a camera found moving (``camera_motion`` "auto" or "on"): background
-            subtraction is unreliable there, give detections.
+            subtraction is unreliable there, give detections. Once a run, ``dets=None`` after
+            a frame with detections, naming the frame: it runs the built-in detector on that
+            frame (as documented above), which a frame meant to have no detections (``[]``)
+            does not want.
         """
         with self._alone("update"):
             f = bgr_frame(frame)
@@ -800,6 +818,14 @@ class Tracker:
                 )
             work = self._working(f)
             if dets is None:
+                if self._given:  # was silent: a loop's "no detections" for this frame?
+                    self._warn_once(
+                        "none after dets",
+                        f"frame {self.frame_count + 1}: dets=None runs the built-in "
+                        "background-subtraction detector for this frame, after frames with "
+                        "detections; for a frame without detections give [] or "
+                        "np.zeros((0, 6))",
+                    )
                 kept = None
                 reports = self._tracker.update(work, None)
                 if self._tracker.camera_step.moving:
@@ -883,7 +909,16 @@ class Tracker:
         These are the rows before the offline pass (no linking or smoothing): a live source
         writes them as they come. A gap bridged by a particle filter is settled when the track
         is detected again. RuntimeError with ``record=False``, which keeps none.
+
+        Parameters
+        ----------
+        start : int
+            The first row returned, an int >= 0 (NumPy's too; not a bool): the
+            :attr:`n_settled` of an earlier call, to read only the rows settled since. At or
+            past :attr:`n_settled`: no row. TypeError for another type (``1.5``), ValueError
+            for a negative value (``-1`` was every row, as a slice reads it).
         """
+        start = check_seed(start, "Tracker.settled_rows: start")
         self._check_recorded("settled_rows")
         rows = self._writer.rows.arrays(start)[0]
         return self._restore_rows(self._stabiliser.restore(rows))
