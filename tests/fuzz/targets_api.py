@@ -121,6 +121,8 @@ def _api_tracker(dets: list[Any], options: dict[str, Any]) -> Any:
         # boxes without area or inverted are dropped with a warning by design (tests/tracking)
         warnings.filterwarnings("ignore", message=r".* without area", category=UserWarning)
         warnings.filterwarnings("ignore", message=r".* with x2 < x1", category=UserWarning)
+        # None after detections runs the built-in detector and says so once (tests/tracking)
+        warnings.filterwarnings("ignore", message=r"frame \d+: dets=None", category=UserWarning)
         out = [tracker.update(d, frame) for d in dets]
         out.append(tracker.finalize())
     return out
