@@ -63,24 +63,30 @@ class SeedRow:
         return m, self.fixed[m]
 
 
-def scenes(root: Path) -> list[tuple[str, dict[int, F64], float, float]]:
-    """The five development sequences (those present) and the three synthetic scenes.
+def sources(root: Path) -> list[tuple[str, F64, float, float, float]]:
+    """The five development sequences (those present) and the three synthetic scenes, as rows.
 
-    Each as ``(name, trajectories, width, height)``.
+    Each as ``(name, ground-truth rows, width, height, frames per second)``: every row of the
+    file, as ``pftrack experiment gaps`` reads it.
     """
     out = []
     for name, sub in SEQUENCES:
         folder = root / sub
         if (folder / "gt.txt").is_file():
             info = read_seqinfo(folder)
-            if info.width is None or info.height is None:
-                raise ValueError(f"{folder}/seqinfo.ini: no imWidth/imHeight")
-            trajs = trajectories(read_mot(folder / "gt.txt"))
-            out.append((name, trajs, float(info.width), float(info.height)))
+            if info.width is None or info.height is None or info.frame_rate is None:
+                raise ValueError(f"{folder}/seqinfo.ini: no imWidth/imHeight/frameRate")
+            rows = read_mot(folder / "gt.txt")
+            out.append((name, rows, float(info.width), float(info.height), info.frame_rate))
     for k in range(3):
-        truth = make_scene(n_frames=300, n_walkers=12, rng=k).truth
-        out.append((f"syn{k}", trajectories(truth), 480.0, 360.0))
+        scene = make_scene(n_frames=300, n_walkers=12, rng=k)
+        out.append((f"syn{k}", scene.truth, 480.0, 360.0, scene.fps))
     return out
+
+
+def scenes(root: Path) -> list[tuple[str, dict[int, F64], float, float]]:
+    """:func:`sources` as ``(name, trajectories, width, height)``."""
+    return [(name, trajectories(rows), w, h) for name, rows, w, h, _ in sources(root)]
 
 
 def seed_row(

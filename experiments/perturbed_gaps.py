@@ -38,12 +38,9 @@ from pathlib import Path
 import numpy as np
 
 from experiments._common import data_root, experiment_parser, tee_stdout
-from experiments.auto_seeds import FIXED, SEQUENCES
+from experiments.auto_seeds import FIXED, sources
 from pftrack._typing import F64
-from pftrack.io.mot import read_mot
-from pftrack.io.video import read_seqinfo
 from pftrack.recovery.experiment import SequenceResult, run_sequence, trajectories
-from pftrack.synthetic import make_scene
 
 #: One perturbation: (rows, width, height, fps, rng) -> perturbed rows.
 Perturb = Callable[[F64, float, float, float, np.random.Generator], F64]
@@ -86,27 +83,6 @@ PERTURBATIONS: dict[str, Perturb] = {
     "halffps": _half_fps,
     "jitter": _jitter,
 }
-
-
-def sources(root: Path) -> list[tuple[str, F64, float, float, float]]:
-    """The development sequences present and the synthetic scenes, as ground-truth rows.
-
-    Each as ``(name, rows, width, height, fps)``; rows marked 0 in column 7 are left out.
-    """
-    out = []
-    for name, sub in SEQUENCES:
-        folder = root / sub
-        if (folder / "gt.txt").is_file():
-            info = read_seqinfo(folder)
-            if info.width is None or info.height is None or info.frame_rate is None:
-                raise ValueError(f"{folder}/seqinfo.ini: no imWidth/imHeight/frameRate")
-            rows = read_mot(folder / "gt.txt")
-            out.append((name, rows[rows[:, 6] != 0], float(info.width), float(info.height),
-                        float(info.frame_rate)))  # fmt: skip
-    for k in range(3):
-        scene = make_scene(n_frames=300, n_walkers=12, rng=k)
-        out.append((f"syn{k}", scene.truth, 480.0, 360.0, scene.fps))
-    return out
 
 
 def perturbed(
