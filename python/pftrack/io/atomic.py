@@ -127,19 +127,6 @@ def _refuse_folder_name(path: PathLike, what: str = "output") -> None:
         raise ValueError(f"{what} {text} is a folder; give a file name")
 
 
-def _about_output(exc: OSError, path: PathLike) -> OSError:
-    """`exc` (an error making, filling or renaming the hidden temporary file) naming `path`.
-
-    Was: ``OSError: [Errno 30] Read-only file system: '/x/.old.txt.f806e9cd1123.tmp'``, a name
-    the user never gave; now ``[Errno 30] Read-only file system: '/x/old.txt'``. The class
-    follows the errno, as ``OSError(errno, ...)`` picks it (``PermissionError`` for EACCES,
-    ``OSError`` for EROFS): that of `exc`. An error without errno is returned as it is.
-    """
-    if exc.errno is None:
-        return exc
-    return OSError(exc.errno, exc.strerror, os.fsdecode(os.fspath(path)))
-
-
 def _blocking(folder: Path) -> Path | None:
     """What stops `folder` from being a folder: a file at its place or above it, or None.
 
@@ -222,14 +209,21 @@ def _keep_mode(tmp: str | int, target: Path) -> None:
 
 
 @contextlib.contextmanager
-def _named(path: PathLike) -> Iterator[None]:
-    """Name output `path` in an OSError that names no file (a full disk: ``[Errno 28] ...``)."""
+def _named(path: PathLike, *, hidden: bool = False) -> Iterator[None]:
+    """Name output `path` in an OSError that names no file (a full disk: ``[Errno 28] ...``).
+
+    With `hidden` (making, or renaming, the hidden temporary file), in any OSError with an
+    errno: it names that file, a name the user never gave (was ``[Errno 30] Read-only file
+    system: '/x/.old.txt.f806e9cd1123.tmp'``, now ``'/x/old.txt'``). The class follows the
+    errno, as ``OSError(errno, ...)`` picks it (``PermissionError`` for EACCES).
+    """
     try:
         yield
     except OSError as exc:
-        if exc.errno is None or exc.filename is not None:
+        if exc.errno is None or (exc.filename is not None and not hidden):
             raise
-        raise OSError(exc.errno, exc.strerror, os.fsdecode(os.fspath(path))) from exc
+        named = OSError(exc.errno, exc.strerror, os.fsdecode(os.fspath(path)))
+        raise named from (None if hidden else exc)
 
 
 @contextlib.contextmanager
@@ -278,20 +272,16 @@ def atomic_write(
         raise _missing_folder(folder, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
-        try:
+        with _named(path, hidden=True):  # a read-only file system, a folder not writable
             fd, tmp = _create_beside(folder, f".{target.name}.", suffix or ".tmp", made)
             _keep_mode(fd, target)
-        except OSError as exc:  # a read-only file system, a folder without write permission
-            raise _about_output(exc, path) from None
         with _named(path), os.fdopen(fd, mode) as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
-        try:
+        with _named(path, hidden=True):
             _keep_mode(tmp, target)
             os.replace(tmp, target)
-        except OSError as exc:
-            raise _about_output(exc, path) from None
     except BaseException:
         _remove(made)
         raise
@@ -321,22 +311,18 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         raise _missing_folder(folder, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
-        try:
+        with _named(path, hidden=True):  # a read-only file system, a folder not writable
             fd, tmp = _create_beside(folder, f".{target.stem}.", Path(path).suffix, made)
             try:
                 _keep_mode(fd, target)
             finally:
                 os.close(fd)
-        except OSError as exc:  # a read-only file system, a folder without write permission
-            raise _about_output(exc, path) from None
         yield Path(tmp)
         if not Path(tmp).exists() or Path(tmp).stat().st_size == 0:
             raise OSError(f"nothing was written for {target}")
-        try:
+        with _named(path, hidden=True):
             _keep_mode(tmp, target)  # again: a writer may have made the file anew
             os.replace(tmp, target)
-        except OSError as exc:
-            raise _about_output(exc, path) from None
     except BaseException:
         _remove(made)
         raise
