@@ -13,7 +13,11 @@
   81 ``(q, r)`` pairs over the runs of the 500-track file's fit sample, about 1000 points)
   against its NumPy reference (``tests/reference/bridge.py``, vectorised over the pairs).
 * ``state loglik, 343 models``: one level of ``fit_singer``'s grid (``_core.state_loglik_batch``,
-  the models filtered 4 at a time) against the same call one model at a time.
+  the models filtered 4 at a time, on one thread and on :func:`pftrack._threads.kernel_threads`)
+  against the same call one model at a time.
+* ``gdt-mix, 400 gaps``: :func:`~pftrack.recovery.mixture.recover_mixture_gaps` (one C++ call,
+  ``_core.gap_mixture_many``, on one thread and on ``kernel_threads()``) against one
+  :func:`~pftrack.recovery.mixture.recover_mixture` call per gap, the same bits.
 * ``link fragments``: :func:`pftrack.recovery.link_tracklets` over the pairs within the time
   gate (8000 one-row fragments ten frames apart, the user trial's file, and 1000 of them)
   against the former dense ``(K, K)`` loop and assignment (``tests/reference/linking.py``, on
@@ -34,12 +38,19 @@ from pytest_benchmark.fixture import BenchmarkFixture
 
 from bench.recovery_file import synthetic_tracks
 from pftrack import _core
+from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.kalman import cv_transition, rts_smooth, wna_Q
 from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
 from pftrack.recovery.baselines import rts_batch
 from pftrack.recovery.calibrate import _fit_sample
-from pftrack.recovery.mixture import DIFFUSE, singer_model
+from pftrack.recovery.mixture import (
+    DIFFUSE,
+    fit_motion,
+    recover_mixture,
+    recover_mixture_gaps,
+    singer_model,
+)
 from pftrack.recovery.segments import distinct_runs
 from tests.reference import bridge as ref_bridge
 from tests.reference import mixture as ref_mix
@@ -180,9 +191,30 @@ def _singer_grid() -> tuple[F64, F64, F64]:
     return F, Q, 10.0 ** g[:, 1]
 
 
+@pytest.mark.parametrize("threads", [1, kernel_threads()])
+@pytest.mark.parametrize("method", ["batch", "per gap"])
+def test_gdt_mix_400_gaps(benchmark: BenchmarkFixture, method: str, threads: int) -> None:
+    benchmark.group = "gdt-mix, 400 gaps"
+    pairs = _gaps()
+    fit = fit_motion([seg for pair in pairs for seg in pair])
+    assert not fit.is_gdt_bi  # the mixture itself runs, not gdt-bi's smoother
+
+    def per_gap() -> list[F64]:
+        return [recover_mixture(a, b, fit) for a, b in pairs]
+
+    if method == "per gap" and threads > 1:
+        pytest.skip("one call per gap runs on one thread")
+    run = per_gap if method == "per gap" else (lambda: recover_mixture_gaps(pairs, fit, threads))
+    got = benchmark(run)
+    want = per_gap() if method == "batch" else recover_mixture_gaps(pairs, fit)
+    for g, w in zip(got, want, strict=True):
+        np.testing.assert_array_equal(g, w)
+
+
+@pytest.mark.parametrize("threads", [1, kernel_threads()])
 @pytest.mark.parametrize("batched", [True, False])
 def test_state_loglik_343_models(
-    benchmark: BenchmarkFixture, fit_runs: list[F64], batched: bool
+    benchmark: BenchmarkFixture, fit_runs: list[F64], batched: bool, threads: int
 ) -> None:
     benchmark.group = "state loglik, 343 models"
     F, Q, r = _singer_grid()
@@ -202,10 +234,12 @@ def test_state_loglik_343_models(
     def batch() -> F64:
         out: F64 = _core.state_loglik_batch(
             z, lengths, np.ascontiguousarray(F.reshape(-1, 3)),
-            np.ascontiguousarray(Q.reshape(-1, 3)), r, DIFFUSE,
+            np.ascontiguousarray(Q.reshape(-1, 3)), r, DIFFUSE, threads,
         )  # fmt: skip
         return out
 
+    if not batched and threads > 1:
+        pytest.skip("one call per model runs on one thread")
     got = benchmark(batch if batched else one_by_one)
     np.testing.assert_array_equal(got, (one_by_one if batched else batch)())
 

@@ -172,10 +172,10 @@ def test_options_are_checked_before_any_work(
 
 
 def test_workers_are_single_threaded(client: Any) -> None:
-    def threads() -> tuple[int, str | None, str | None, str | None, bool]:
+    def threads() -> tuple[int, str | None, str | None, str | None, bool, int]:
         import cv2
 
-        from pftrack.batch.tasks import tracking_threads
+        from pftrack._threads import kernel_threads, tracking_threads
 
         env = os.environ.get
         return (
@@ -184,15 +184,17 @@ def test_workers_are_single_threaded(client: Any) -> None:
             env("OMP_NUM_THREADS"),
             env("MALLOC_TRIM_THRESHOLD_"),
             tracking_threads(),
+            kernel_threads(),
         )
 
     result = client.run(threads)
     # and no MALLOC_TRIM_THRESHOLD_: Dask's default makes tracking ~1.5x slower (engine.py);
-    # no read-ahead or detector thread in a worker: it has one core already
-    assert len(result) == 2 and set(result.values()) == {(1, "1", "1", None, False)}
-    from pftrack.batch.tasks import tracking_threads
+    # no read-ahead, detector or kernel thread in a worker: it has one core already
+    assert len(result) == 2 and set(result.values()) == {(1, "1", "1", None, False, 1)}
+    from pftrack._threads import kernel_threads, tracking_threads
 
     assert tracking_threads()  # this process (serial runs) keeps them
+    assert kernel_threads() == min(len(os.sched_getaffinity(0)), 4)
 
 
 def _bars_drawn() -> TaskResult:

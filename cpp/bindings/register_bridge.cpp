@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "pftrack/bridge.hpp"
@@ -273,13 +274,75 @@ void register_bridge(py::module_& m) {
         py::arg("p0"), py::arg("t1"), py::arg("t2"), py::arg("v2"),
         "Smoothed gap positions (H, T-1) and window log-likelihoods (H,) per stand hypothesis.");
     m.def(
+        "gap_mixture_many",
+        [](const py::sequence& jobs, const py::sequence& F, const py::sequence& Q,
+           const std::vector<double>& r, const py::sequence& p0, const std::vector<double>& v2,
+           int threads) {
+            const char* fn = "gap_mixture_many";
+            // everything is copied into C++ objects while the GIL is held
+            auto as = [&](const py::handle& item, const std::string& what, auto* out) {
+                using T = std::remove_pointer_t<decltype(out)>;
+                try {
+                    *out = item.cast<T>();
+                } catch (const py::cast_error&) {
+                    throw py::type_error(std::string(fn) + ": " + what + " is " +
+                                         std::string(py::str(py::type::of(item).attr("__name__"))) +
+                                         ", expected an array of numbers of the right shape");
+                }
+            };
+            GapMixtureModels models;
+            models.r = r;
+            models.v2 = v2;
+            const auto K = r.size();
+            require(py::len(F) == K && py::len(Q) == K && py::len(p0) == K && v2.size() == K, fn,
+                    "F, Q, r, p0 and v2 must have one entry per model");
+            models.F.resize(K);
+            models.Q.resize(K);
+            models.p0.resize(K);
+            for (std::size_t k = 0; k < K; ++k) {
+                const std::string at = "[" + std::to_string(k) + "]";
+                as(F[k], "F" + at, &models.F[k]);
+                as(Q[k], "Q" + at, &models.Q[k]);
+                as(p0[k], "p0" + at, &models.p0[k]);
+            }
+            std::vector<GapMixtureJob> batch(py::len(jobs));
+            for (std::size_t j = 0; j < batch.size(); ++j) {
+                const std::string what = "jobs[" + std::to_string(j) + "]";
+                const py::object item = jobs[j];
+                require(py::isinstance<py::tuple>(item) && py::len(item) == 6, fn,
+                        what + " must be a tuple (z, fa, fb, model, t1, t2)");
+                const auto t = item.cast<py::tuple>();
+                GapMixtureJob& g = batch[j];
+                as(t[0], what + ".z", &g.z);
+                as(t[1], what + ".fa", &g.fa);
+                as(t[2], what + ".fb", &g.fb);
+                as(t[3], what + ".model", &g.model);
+                as(t[4], what + ".t1", &g.t1s);
+                as(t[5], what + ".t2", &g.t2s);
+            }
+            std::vector<GapMixtureResult> res;
+            {
+                py::gil_scoped_release nogil;  // safe: C++ copies only
+                res = gap_mixture_many(batch, models, threads);
+            }
+            py::list out;
+            for (auto& g : res) out.append(py::make_tuple(std::move(g.paths), std::move(g.loglik)));
+            return out;
+        },
+        py::arg("jobs"), py::arg("F"), py::arg("Q"), py::arg("r"), py::arg("p0"), py::arg("v2"),
+        py::arg("threads"),
+        "gap_mixture of every job (z, fa, fb, model, t1, t2) on up to `threads` threads: a list "
+        "of (paths, loglik), the same as one gap_mixture call per job.");
+    m.def(
         "state_loglik_batch",
         [](Eigen::Ref<const Eigen::VectorXd> z, Eigen::Ref<const Eigen::VectorXi> lengths,
            Eigen::Ref<const RowMatrixXd> F, Eigen::Ref<const RowMatrixXd> Q,
-           Eigen::Ref<const Eigen::VectorXd> r, double big) {
+           Eigen::Ref<const Eigen::VectorXd> r, double big, int threads) {
             py::gil_scoped_release nogil;  // safe: Eigen views only
-            return state_loglik_batch(z, lengths, F, Q, r, big);
+            return state_loglik_batch(z, lengths, F, Q, r, big, threads);
         },
         py::arg("z"), py::arg("lengths"), py::arg("F"), py::arg("Q"), py::arg("r"), py::arg("big"),
-        "Kalman log-likelihood (K,) of runs z (stacked, lengths) under K models (F, Q stacked).");
+        py::arg("threads") = 1,
+        "Kalman log-likelihood (K,) of runs z (stacked, lengths) under K models (F, Q stacked), "
+        "on up to `threads` threads (the same values with any number).");
 }

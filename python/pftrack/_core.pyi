@@ -471,9 +471,23 @@ def gap_mixture(
     v2: float,
 ) -> tuple[_F64, _F64]: ...
 
+# jobs: (z, fa, fb, model, t1, t2) as gap_mixture's arguments, model an index into F, Q, r, p0,
+# v2 (one entry per model); on up to `threads` threads -> [(paths, loglik)] as gap_mixture gives
+def gap_mixture_many(
+    jobs: Sequence[tuple[_F64, int, int, int, _I32, _I32]],
+    F: Sequence[_F64],
+    Q: Sequence[_F64],
+    r: Sequence[float],
+    p0: Sequence[_F64],
+    v2: Sequence[float],
+    threads: int,
+) -> list[tuple[_F64, _F64]]: ...
+
 # z stacked runs (sum lengths,), lengths (R,) int32; F, Q (K * d, d) stacked models, r (K,)
-# -> (K,) log-likelihoods
-def state_loglik_batch(z: _F64, lengths: _I32, F: _F64, Q: _F64, r: _F64, big: float) -> _F64: ...
+# -> (K,) log-likelihoods (the same on any number of threads)
+def state_loglik_batch(
+    z: _F64, lengths: _I32, F: _F64, Q: _F64, r: _F64, big: float, threads: int = 1
+) -> _F64: ...
 
 # rts_gaps.hpp (register_smoothing.cpp)
 # points (P, 3) float64 rows (frame, x, y); offsets (G + 1,) int32 window bounds; n_before (G,)

@@ -254,7 +254,36 @@ def _state_loglik() -> st.SearchStrategy[Any]:
     return st.tuples(_runs(), st.integers(1, 3)).flatmap(lambda rk: call(
         _core.state_loglik_batch, maybe(st.just(rk[0][0])), maybe(st.just(rk[0][1])),
         maybe(st.just(np.vstack([F] * rk[1]))), maybe(st.just(np.vstack([np.eye(2)] * rk[1]))),
-        maybe(floats_array((rk[1],), 1e-3, 10)), maybe(fl(1, 1e6)),
+        maybe(floats_array((rk[1],), 1e-3, 10)), maybe(fl(1, 1e6)), maybe(st.integers(1, 4)),
+    ))  # fmt: skip
+
+
+@st.composite
+def _gap_mixture_many(draw: st.DrawFn) -> Any:
+    jobs = []
+    for _ in range(draw(st.integers(0, 4))):
+        (_, (z, fa, fb, *_rest, t1, t2, _v2), _kw) = draw(_gap_mixture())
+        jobs.append(
+            draw(
+                maybe(
+                    st.tuples(
+                        st.just(z),
+                        st.just(fa),
+                        st.just(fb),
+                        st.integers(-1, 2),
+                        st.just(t1),
+                        st.just(t2),
+                    )
+                )
+            )
+        )
+    k = draw(st.integers(0, 2))
+    F = np.array([[1.0, 1.0], [0.0, 1.0]])
+    return draw(call(
+        _core.gap_mixture_many, maybe(st.just(jobs)), maybe(st.just([F] * k)),
+        maybe(st.just([np.eye(2)] * k)), maybe(st.lists(fl(1e-3, 10), min_size=k, max_size=k)),
+        maybe(st.lists(floats_array((2,), 1e-3, 100), min_size=k, max_size=k)),
+        maybe(st.lists(fl(0, 10), min_size=k, max_size=k)), maybe(st.integers(0, 4)),
     ))  # fmt: skip
 
 
@@ -563,6 +592,7 @@ TARGETS: list[Target] = [
     Target("noise_loglik_grid", _noise_grid()),
     Target("state_loglik_batch", _state_loglik()),
     Target("gap_mixture", _gap_mixture()),
+    Target("gap_mixture_many", _gap_mixture_many()),
     Target("mot_lines", _mot_lines()),
     Target("rts_gaps_batch", _rts_gaps()),
     Target("rts_smooth", _rts_smooth()),

@@ -13,6 +13,7 @@ from pftrack.recovery.mixture import (
     fit_motion,
     fit_singer,
     recover_mixture,
+    recover_mixture_gaps,
     singer_model,
     stand_hypotheses,
 )
@@ -149,6 +150,85 @@ def test_state_loglik_batch_blocks_are_exact(d: int) -> None:
             z, lengths, F[k * d : (k + 1) * d], Q[k * d : (k + 1) * d], r[k : k + 1], 1e4
         )
         assert one[0] == got[k]
+
+
+@pytest.mark.parametrize("threads", [2, 3, 8])
+def test_state_loglik_batch_threads_change_no_bit(threads: int) -> None:
+    """Blocks of models on several threads: each model's own bits, whatever the split."""
+    rng = np.random.default_rng(8)
+    runs = [np.cumsum(rng.normal(1.0, 0.5, k)) for k in (9, 60, 33)]
+    z, lengths = np.concatenate(runs), np.array([len(v) for v in runs], np.int32)
+    K = 23  # 5 blocks of 4, then 3 models one at a time
+    F, Q = singer_model(10.0 ** rng.uniform(-3, 1, K), 10.0 ** rng.uniform(-1, 2, K))
+    F, Q = np.ascontiguousarray(F.reshape(-1, 3)), np.ascontiguousarray(Q.reshape(-1, 3))
+    r = 10.0 ** rng.uniform(-2, 1, K)
+    one = _core.state_loglik_batch(z, lengths, F, Q, r, 1e4)
+    assert np.array_equal(_core.state_loglik_batch(z, lengths, F, Q, r, 1e4, threads), one)
+    with pytest.raises(ValueError, match="threads is 0"):
+        _core.state_loglik_batch(z, lengths, F, Q, r, 1e4, 0)
+
+
+def _mixture_jobs(rng: np.random.Generator, n_jobs: int):
+    """Jobs of both state dimensions (models 0: d = 2, 1: d = 3) and the batch's models."""
+    F2, Q2 = cv_transition(), wna_Q(0.2)
+    F3, Q3 = singer_model(0.3, 2.5)
+    p0 = [np.array([1e4, 4.0]), np.array([1e4, 4.0, 0.5])]
+    models = ([F2, F3[0]], [Q2, Q3[0]], [0.3, 0.7], p0, [4.0, 2.0])
+    jobs = []
+    for j in range(n_jobs):
+        n = int(rng.integers(12, 60))
+        fa = int(rng.integers(2, n - 6))
+        fb = int(rng.integers(fa + 2, n - 2))
+        t1, t2 = stand_hypotheses(fb - fa, grid=int(rng.integers(1, 9)))
+        jobs.append((_window(rng, n, fa, fb, holes=0), fa, fb, j % 2, t1, t2))
+    return jobs, models
+
+
+@pytest.mark.parametrize("threads", [1, 2, 5])
+def test_gap_mixture_many_is_gap_mixture_per_job(threads: int) -> None:
+    """The batch gives every job the bits of its own gap_mixture call, in the jobs' order."""
+    jobs, models = _mixture_jobs(np.random.default_rng(3), 17)
+    got = _core.gap_mixture_many(jobs, *models, threads)
+    assert len(got) == len(jobs)
+    F, Q, r, p0, v2 = models
+    for (z, fa, fb, k, t1, t2), (paths, ll) in zip(jobs, got, strict=True):
+        want_p, want_ll = _core.gap_mixture(z, fa, fb, F[k], Q[k], r[k], p0[k], t1, t2, v2[k])
+        assert np.array_equal(paths, want_p) and np.array_equal(ll, want_ll)
+    assert _core.gap_mixture_many([], *models, threads) == []
+
+
+@pytest.mark.parametrize(
+    "change, error, match",
+    [
+        (lambda j, m: (j[:1] + [j[1][:3] + (2,) + j[1][4:]], m), ValueError, "job 1: uses model 2"),
+        (lambda j, m: (j[:2] + [(j[2][0], 9, 9) + j[2][3:]], m), ValueError, "job 2: need 0 <= fa"),
+        (lambda j, m: ([j[0][:5]], m), ValueError, "jobs\\[0\\] must be a tuple"),
+        (lambda j, m: ([("text",) + j[0][1:]], m), TypeError, "jobs\\[0\\].z is str"),
+        (lambda j, m: (j, (m[0][:1],) + m[1:]), ValueError, "one entry per model"),
+        (lambda j, m: (j, m[:2] + ([0.3, -1.0],) + m[3:]), ValueError, "job 1: r is -1"),
+    ],
+)
+def test_gap_mixture_many_bad_input(change, error, match) -> None:
+    """Every job is checked, naming it, before any runs; nothing runs on bad input."""
+    jobs, models = change(*_mixture_jobs(np.random.default_rng(4), 3))
+    with pytest.raises(error, match=match):
+        _core.gap_mixture_many(jobs, *models, 2)
+    with pytest.raises(ValueError, match="threads is 0"):
+        _core.gap_mixture_many([], *_mixture_jobs(np.random.default_rng(4), 0)[1], 0)
+
+
+@pytest.mark.parametrize("threads", [1, 3])
+def test_recover_mixture_gaps_is_recover_mixture(threads: int) -> None:
+    """The batched method gives each gap the bits :func:`recover_mixture` gives it alone."""
+    runs = _walkers(np.random.default_rng(12), n=6, length=140, stand=(60, 75))
+    fit = fit_motion(runs)
+    assert not fit.is_gdt_bi
+    gaps = [(r[: 40 + 7 * k], r[52 + 9 * k :]) for k, r in enumerate(runs)]
+    gaps.append((runs[0][:50], runs[0][50:]))  # no lost step
+    got = recover_mixture_gaps(gaps, fit, threads=threads)
+    for (a, b), path in zip(gaps, got, strict=True):
+        assert np.array_equal(path, recover_mixture(a, b, fit))
+    assert got[-1].shape == (0, 2) and got[0].shape == (12, 2)  # frames 40-51
 
 
 @pytest.mark.parametrize("q,tau", [(0.5, 0.3), (0.07, 2.9), (1.0, 40.0)])

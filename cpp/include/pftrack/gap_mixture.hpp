@@ -29,6 +29,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "pftrack/check.hpp"
+#include "pftrack/parallel.hpp"
 #include "pftrack/types.hpp"
 
 namespace pftrack {
@@ -194,17 +195,14 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
 
 }  // namespace detail
 
-/// Smoothed gap positions and window log-likelihood under each walk/stand hypothesis (see the
-/// file comment). F, Q: (d, d) with d = 2 or 3; p0: (d,) prior variances of the state at z_0
-/// (mean (z_0, 0, ...)); t1s, t2s: (H,) stand intervals, (-1, -1) for none; v2: variance of the
-/// velocity after standing. The first d observations are not counted in the log-likelihood.
-inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index fa, Index fb,
-                                    const Eigen::Ref<const RowMatrixXd>& F,
-                                    const Eigen::Ref<const RowMatrixXd>& Q, double r,
-                                    const Eigen::Ref<const Eigen::VectorXd>& p0,
-                                    const Eigen::Ref<const Eigen::VectorXi>& t1s,
-                                    const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2) {
-    const char* fn = "gap_mixture";
+/// Checks the arguments of `gap_mixture` (see there); raises ValueError naming `fn`.
+inline void check_gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index fa, Index fb,
+                              const Eigen::Ref<const RowMatrixXd>& F,
+                              const Eigen::Ref<const RowMatrixXd>& Q, double r,
+                              const Eigen::Ref<const Eigen::VectorXd>& p0,
+                              const Eigen::Ref<const Eigen::VectorXi>& t1s,
+                              const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2,
+                              const char* fn = "gap_mixture") {
     const Index n = z.size(), d = F.rows();
     require(d == 2 || d == 3, fn, "state dimension (rows of F)", d, "2 or 3");
     require(F.cols() == d, fn, "F cols", F.cols(), d);
@@ -238,8 +236,74 @@ inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, 
                          std::to_string(t2) + "), expected (-1, -1) or 0 <= t1 < t2 <= T-1 = " +
                          std::to_string(T - 1));
     }
-    if (d == 2) return detail::gap_mixture<2>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
+}
+
+/// Smoothed gap positions and window log-likelihood under each walk/stand hypothesis (see the
+/// file comment). F, Q: (d, d) with d = 2 or 3; p0: (d,) prior variances of the state at z_0
+/// (mean (z_0, 0, ...)); t1s, t2s: (H,) stand intervals, (-1, -1) for none; v2: variance of the
+/// velocity after standing. The first d observations are not counted in the log-likelihood.
+inline GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index fa, Index fb,
+                                    const Eigen::Ref<const RowMatrixXd>& F,
+                                    const Eigen::Ref<const RowMatrixXd>& Q, double r,
+                                    const Eigen::Ref<const Eigen::VectorXd>& p0,
+                                    const Eigen::Ref<const Eigen::VectorXi>& t1s,
+                                    const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2) {
+    check_gap_mixture(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
+    if (F.rows() == 2) return detail::gap_mixture<2>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
     return detail::gap_mixture<3>(z, fa, fb, F, Q, r, p0, t1s, t2s, v2);
+}
+
+/// One `gap_mixture` problem of a batch: a window of one coordinate, its gap, its hypotheses,
+/// and which of the batch's models (F, Q, r, p0, v2) it uses.
+struct GapMixtureJob {
+    Eigen::VectorXd z;
+    Index fa = 0, fb = 0;
+    Index model = 0;
+    Eigen::VectorXi t1s, t2s;
+};
+
+/// The models of a batch, indexed by `GapMixtureJob::model`.
+struct GapMixtureModels {
+    std::vector<RowMatrixXd> F, Q;
+    std::vector<double> r, v2;
+    std::vector<Eigen::VectorXd> p0;
+};
+
+/// `gap_mixture` of every job, on up to `threads` threads: the results are those of one
+/// `gap_mixture` call per job, in the jobs' order, whatever the number of threads. Every job is
+/// checked (naming it) before any runs.
+inline std::vector<GapMixtureResult> gap_mixture_many(const std::vector<GapMixtureJob>& jobs,
+                                                      const GapMixtureModels& models,
+                                                      int threads) {
+    const char* fn = "gap_mixture_many";
+    const auto K = static_cast<Index>(models.r.size());
+    require(models.F.size() == models.r.size() && models.Q.size() == models.r.size() &&
+                models.p0.size() == models.r.size() && models.v2.size() == models.r.size(),
+            fn, "F, Q, r, p0 and v2 must have one entry per model");
+    require(threads >= 1, fn, "threads", threads, ">= 1");
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+        const GapMixtureJob& g = jobs[j];
+        const std::string what = std::string(fn) + ", job " + std::to_string(j);
+        if (!(0 <= g.model && g.model < K))
+            fail(what.c_str(), "uses model " + std::to_string(g.model) + ", expected 0 <= model < " +
+                         std::to_string(K));
+        const auto k = static_cast<std::size_t>(g.model);
+        check_gap_mixture(g.z, g.fa, g.fb, models.F[k], models.Q[k], models.r[k], models.p0[k],
+                          g.t1s, g.t2s, models.v2[k], what.c_str());
+    }
+    std::vector<GapMixtureResult> out(jobs.size());
+    parallel_for(static_cast<Index>(jobs.size()), threads, [&](Index j) {
+        const GapMixtureJob& g = jobs[static_cast<std::size_t>(j)];
+        const auto k = static_cast<std::size_t>(g.model);
+        const RowMatrixXd& F = models.F[k];
+        out[static_cast<std::size_t>(j)] =
+            F.rows() == 2
+                ? detail::gap_mixture<2>(g.z, g.fa, g.fb, F, models.Q[k], models.r[k],
+                                         models.p0[k], g.t1s, g.t2s, models.v2[k])
+                : detail::gap_mixture<3>(g.z, g.fa, g.fb, F, models.Q[k], models.r[k],
+                                         models.p0[k], g.t1s, g.t2s, models.v2[k]);
+    });
+    return out;
 }
 
 /// Kalman prediction-error log-likelihood of one coordinate of many runs, for K models
@@ -250,7 +314,8 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                                           const Eigen::Ref<const Eigen::VectorXi>& lengths,
                                           const Eigen::Ref<const RowMatrixXd>& F,
                                           const Eigen::Ref<const RowMatrixXd>& Q,
-                                          const Eigen::Ref<const Eigen::VectorXd>& r, double big) {
+                                          const Eigen::Ref<const Eigen::VectorXd>& r, double big,
+                                          int threads = 1) {
     const char* fn = "state_loglik_batch";
     const Index K = r.size();
     require(K > 0, fn, "no model given (r is empty)");
@@ -267,6 +332,7 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
         require(std::isfinite(r(k)) && r(k) > 0.0, fn,
                 "r must be finite and > 0 (model " + std::to_string(k) + ")");
     require(std::isfinite(big) && big > 0.0, fn, "big", big, "a finite value > 0");
+    require(threads >= 1, fn, "threads", threads, ">= 1");
     Eigen::VectorXd ll(K);
     const Index longest = lengths.size() ? lengths.maxCoeff() : 0;
     auto run_all = [&](auto dim) {
@@ -278,13 +344,15 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
         // The models are filtered B at a time over each run: B independent chains of dependent
         // operations the CPU overlaps, each with its own operations in its own order (the same
         // bits as one model at a time); the last K % B models one at a time.
+        // The blocks are independent (each writes its own ll entries): they run on up to
+        // `threads` threads, each block with its own scratch.
         constexpr Index B = 4;
         const auto steps = static_cast<std::size_t>(std::max<Index>(longest, 0));
-        std::vector<double> S(B * steps), logS(B * steps);
-        std::vector<Vec, Eigen::aligned_allocator<Vec>> G(B * steps);
         // models k0 .. k0 + NB - 1 together (NB = B, then 1 for the last K % B models)
         auto block = [&](Index k0, auto nb) {
             constexpr Index NB = decltype(nb)::value;
+            std::vector<double> S(NB * steps), logS(NB * steps);
+            std::vector<Vec, Eigen::aligned_allocator<Vec>> G(NB * steps);
             Mat Fb[NB];
             Index fixed[NB];
             for (Index b = 0; b < NB; ++b) {
@@ -341,9 +409,11 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
                 ll(k0 + b) =
                     std::isfinite(total[b]) ? total[b] : -std::numeric_limits<double>::infinity();
         };
-        Index k0 = 0;
-        for (; k0 + B <= K; k0 += B) block(k0, std::integral_constant<Index, B>{});
-        for (; k0 < K; ++k0) block(k0, std::integral_constant<Index, 1>{});
+        const Index full = K / B;  // blocks of B models, then the last K % B one at a time
+        parallel_for(full + K % B, threads, [&](Index i) {
+            if (i < full) block(i * B, std::integral_constant<Index, B>{});
+            else block(full * B + (i - full), std::integral_constant<Index, 1>{});
+        });
     };
     if (d == 2) run_all(std::integral_constant<int, 2>{});
     else run_all(std::integral_constant<int, 3>{});

@@ -27,7 +27,8 @@ THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"
 class SingleThreaded(WorkerPlugin):
     """Make each worker process single-threaded: one sequence per core, no oversubscription.
 
-    Tracking in a worker uses no read-ahead or detector thread (`tracking_threads`).
+    Tracking in a worker uses no read-ahead or detector thread, and the C++ kernels one thread
+    (:mod:`pftrack._threads`).
 
     No progress bar either: the worker's tasks draw none (:func:`pftrack._progress.set_quiet`).
     A local cluster's workers share the terminal, where the bars of the code a task calls
@@ -71,9 +72,9 @@ class SingleThreaded(WorkerPlugin):
         for var in THREAD_VARIABLES:
             os.environ.setdefault(var, "1")
         cv2.setNumThreads(1)
-        from pftrack.batch.tasks import WORKER_THREADS_VARIABLE
+        from pftrack._threads import WORKER_THREADS_VARIABLE
 
-        os.environ[WORKER_THREADS_VARIABLE] = "0"  # no read-ahead or detector thread either
+        os.environ[WORKER_THREADS_VARIABLE] = "0"  # no read-ahead, detector or kernel thread either
         import pftrack.eval
         import pftrack.io.video
         import pftrack.recovery

@@ -12,7 +12,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
-import os
 import socket
 import tempfile
 import time
@@ -26,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import flag, number
+from pftrack._threads import tracking_threads
 from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
 
@@ -313,20 +313,6 @@ def _as_written(rows: F64) -> F64:
 
     lines = [line.split(",") for line in mot_text(rows).splitlines()]
     return np.array(lines, dtype=np.float64).reshape(len(rows), 10)
-
-
-#: Set to "0" by the worker plugin (:mod:`pftrack.batch._plugin`) in every Dask worker.
-WORKER_THREADS_VARIABLE = "PFTRACK_TRACKING_THREADS"
-
-
-def tracking_threads() -> bool:
-    """Whether tracking here decodes and detects on threads ahead of the tracker.
-
-    Yes in an ordinary process (``pftrack track``, ``pftrack batch --workers 0``); no in a
-    Dask worker of a batch, which already has one task per core: the threads would only cost
-    CPU there (the rows are the same either way).
-    """
-    return os.environ.get(WORKER_THREADS_VARIABLE, "1") != "0"
 
 
 def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
