@@ -56,4 +56,28 @@ void register_text(py::module_& m) {
         },
         py::arg("ids"), py::arg("values"), py::arg("decimals"),
         "MOTChallenge lines of ids (M, 2) float64, values (M, 8) float64, decimals (M, 8) int64.");
+    m.def(
+        "fewest_decimals",
+        [](const py::array& values, double limit, int most) {
+            const char* fn = "fewest_decimals";
+            if (!bind::is_dtype<double>(values.dtype()))
+                throw py::type_error(std::string(fn) + ": values dtype is " +
+                                     bind::dtype_name(values) + ", expected float64");
+            require(values.ndim() == 1, fn, "values must be a 1-D array");
+            require(limit > 0.0 && limit <= 9007199254740992.0, fn, "limit", limit,
+                    "in (0, 2**53]");
+            require(0 <= most && most <= kMostDecimals, fn, "most", most, "in 0..22");
+            const auto v = py::array_t<double, py::array::c_style>::ensure(values);
+            const py::ssize_t n = v.shape(0);
+            py::array_t<std::int64_t> out(n);
+            std::int64_t* o = out.mutable_data();
+            {
+                py::gil_scoped_release nogil;  // safe: plain buffers, kept alive by v, out
+                fewest_decimals(v.data(), static_cast<std::int64_t>(n), limit, most, o);
+            }
+            return out;
+        },
+        py::arg("values"), py::arg("limit"), py::arg("most"),
+        "Fewest decimals d <= most (int64, -1: none) printing each float64 value exactly with "
+        "|rint(v 10^d)| < limit.");
 }

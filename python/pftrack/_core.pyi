@@ -514,3 +514,7 @@ def rts_smooth(
 def mot_lines(
     ids: NDArray[np.float64], values: NDArray[np.float64], decimals: NDArray[np.int64]
 ) -> str: ...
+
+# values (n,) float64 -> (n,) int64: the fewest decimals d <= most (0..22) with
+# rint(v 10^d) / 10^d == v and |rint(v 10^d)| < limit (<= 2**53), else -1
+def fewest_decimals(values: NDArray[np.float64], limit: float, most: int) -> NDArray[np.int64]: ...

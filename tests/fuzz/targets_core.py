@@ -593,6 +593,15 @@ TARGETS: list[Target] = [
     Target("state_loglik_batch", _state_loglik()),
     Target("gap_mixture", _gap_mixture()),
     Target("gap_mixture_many", _gap_mixture_many()),
+    Target(
+        "fewest_decimals",
+        call(
+            _core.fewest_decimals,
+            maybe(N.flatmap(lambda n: floats_array((n,), -1e20, 1e20))),
+            maybe(fl(1e-3, 2.0**53)),
+            maybe(st.integers(0, 22)),
+        ),
+    ),  # fmt: skip
     Target("mot_lines", _mot_lines()),
     Target("rts_gaps_batch", _rts_gaps()),
     Target("rts_smooth", _rts_smooth()),

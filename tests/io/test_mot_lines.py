@@ -207,3 +207,45 @@ def test_threads_give_the_serial_result() -> None:
     for t in threads:
         t.join()
     assert got == [want] * 4
+
+
+@pytest.mark.parametrize(
+    "limit, most", [(1e10, mot.MOST_DECIMALS), (1e15, 2), (2.0**53, 22), (1.0, 0), (1e3, 5)]
+)
+def test_fewest_decimals_is_the_numpy_search(limit: float, most: int) -> None:
+    """``_core.fewest_decimals`` against the NumPy search ``_decimals`` ran before it."""
+    rng = np.random.default_rng(6)
+    x = np.concatenate([_doubles(rng, 150_000), [np.nan, np.inf, -np.inf]])
+    x = x[rng.permutation(x.size)]
+    got = _core.fewest_decimals(x, limit, most)
+    want = reference.decimals(x, limit, most)
+    bad = np.flatnonzero(got != want)
+    assert not bad.size, f"{bad.size} differ, first {x[bad[0]]!r}: {got[bad[0]]} != {want[bad[0]]}"
+    assert got.dtype == np.int64 and set(np.unique(got).tolist()) <= set(range(-1, most + 1))
+    if most == mot.MOST_DECIMALS:  # every decimal count is met, and values beyond the limit
+        assert set(np.unique(got).tolist()) == set(range(-1, most + 1))
+    # a strided view is read as its values
+    assert np.array_equal(_core.fewest_decimals(x[::3], limit, most), got[::3])
+
+
+def test_fewest_decimals_of_what_files_hold() -> None:
+    held = np.array([88.0, 12.5, 0.1, 53.485, -0.0, 1 / 3])
+    assert _core.fewest_decimals(held, 1e10, 22).tolist() == [0, 1, 1, 3, 0, -1]
+    assert _core.fewest_decimals(np.zeros(0), 1e10, 22).shape == (0,)
+
+
+@pytest.mark.parametrize(
+    "args, error, match",
+    [
+        ((np.zeros(3, np.float32), 1e10, 2), TypeError, "values dtype is float32"),
+        ((np.zeros((2, 2)), 1e10, 2), ValueError, "values must be a 1-D array"),
+        ((np.zeros(3), 0.0, 2), ValueError, "limit is 0"),
+        ((np.zeros(3), 2.0**54, 2), ValueError, "limit is"),
+        ((np.zeros(3), np.nan, 2), ValueError, "limit is nan"),
+        ((np.zeros(3), 1e10, 23), ValueError, "most is 23"),
+        ((np.zeros(3), 1e10, -1), ValueError, "most is -1"),
+    ],
+)
+def test_fewest_decimals_bad_arguments(args: tuple, error: type, match: str) -> None:
+    with pytest.raises(error, match=f"^fewest_decimals: {match}"):
+        _core.fewest_decimals(*args)

@@ -1,7 +1,8 @@
-"""Python's ``%`` formatting of MOTChallenge lines: the reference of ``_core.mot_lines``.
+"""Python's ``%`` formatting of MOTChallenge lines: the reference of ``_core.mot_lines``, and
+the NumPy search for the fewest decimals: the reference of ``_core.fewest_decimals``.
 
-This is the code ``pftrack.io.mot._lines`` ran before the C++ kernel, kept to hold the kernel
-to it byte for byte.
+This is the code ``pftrack.io.mot._lines`` and ``_decimals`` ran before the C++ kernels, kept
+to hold the kernels to it byte for byte.
 """
 
 from __future__ import annotations
@@ -12,6 +13,34 @@ from numpy.typing import NDArray
 from pftrack.io.mot import _REPR, _printable
 
 F64 = NDArray[np.float64]
+
+
+_POW10 = np.array([float(f"1e{k}") for k in range(23)])  # exact doubles
+
+
+def decimals(v: F64, limit: float, most: int) -> NDArray[np.int64]:
+    """The fewest decimals ``d <= most`` that print each of `v` exactly, or -1 (in NumPy)."""
+    x = v.ravel()
+    d = np.full(x.size, -1, np.int64)
+    idx: NDArray[np.intp] | None = None  # where x is in v; None: everywhere
+    for k in range(most + 1):
+        if k:
+            n = x * _POW10[k]
+            np.rint(n, out=n)
+            small = np.abs(n) < limit
+            n /= _POW10[k]
+        else:  # the same, without multiplying and dividing by 1
+            n = np.rint(x)
+            small = np.abs(n) < limit
+        ok = n == x
+        ok &= small
+        d[ok if idx is None else idx[ok]] = k
+        small &= ~ok  # the rest: |n| only grows with k
+        idx = np.flatnonzero(small) if idx is None else idx[small]
+        if not idx.size:
+            break
+        x = x[small]
+    return d
 
 
 def _fmt(d: int) -> str:

@@ -16,7 +16,7 @@ namespace pftrack {
 
 /// Decimals code of a value written in its shortest round-trip form (mot.py's `_REPR`).
 constexpr std::int64_t kReprCode = 31;
-/// Most decimals of a "%.{d}f" code (mot.py's `_POW10` has 23 powers: 0..22).
+/// Most decimals of a "%.{d}f" code (mot.py's MOST_DECIMALS: 10^22 is the largest exact power).
 constexpr std::int64_t kMostDecimals = 22;
 
 namespace detail {
@@ -104,6 +104,32 @@ inline char* write_fixed(char* out, double x, int d) {
 }
 
 }  // namespace detail
+
+/// The fewest decimals d <= `most` (at most kMostDecimals) that print each of the `n` values
+/// exactly, or -1, into `out` (mot.py's `_decimals`, the same operations in the same order):
+/// d prints v exactly when v == rint(v * 10^d) / 10^d (in double; 10^d exact) and
+/// |rint(v * 10^d)| < `limit`. The first d that fails the bound ends the search (|rint| only
+/// grows with d). NaN gives -1.
+inline void fewest_decimals(const double* v, std::int64_t n, double limit, int most,
+                            std::int64_t* out) {
+    static constexpr double kPow10[kMostDecimals + 1] = {
+        1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+        1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    for (std::int64_t i = 0; i < n; ++i) {
+        const double x = v[i];
+        std::int64_t d = -1;
+        for (int k = 0; k <= most; ++k) {
+            double r = std::nearbyint(k ? x * kPow10[k] : x);
+            if (!(std::fabs(r) < limit)) break;
+            if (k) r /= kPow10[k];
+            if (r == x) {
+                d = k;
+                break;
+            }
+        }
+        out[i] = d;
+    }
+}
 
 /// The lines of M rows: `ids` (M, 2) frame and id, integral doubles with |v| <= 2^53; `values`
 /// (M, 8) finite doubles; `decimals` (M, 8) codes, 0..22 ("%.{d}f") or kReprCode (repr). All

@@ -265,7 +265,9 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
 #: and a computed value that happens to be that short, such as the midpoint 53.485 of two
 #: 2-decimal sizes); others (what pftrack computes) are rounded to 2 decimals.
 EXACT_DIGITS = 10
-_POW10 = np.array([float(f"1e{k}") for k in range(23)])  # exact doubles
+MOST_DECIMALS = 22
+"""Most decimals a value is written with: ``10**22`` is the largest power of ten a double holds
+exactly."""
 
 
 def _decimals(v: F64, limit: float, most: int) -> NDArray[np.int64]:
@@ -274,28 +276,10 @@ def _decimals(v: F64, limit: float, most: int) -> NDArray[np.int64]:
     ``d`` prints ``v`` exactly when ``v`` is the double nearest to ``n / 10**d`` for the integer
     ``n = rint(v * 10**d)`` and ``|n| < limit`` (<= 2**52, so ``%.{d}f`` prints the digits of
     ``n``): the division of two exact doubles is correctly rounded, as is parsing the text back.
+    One C++ call (``_core.fewest_decimals``; its NumPy statement is ``tests/reference/text.py``).
     """
-    x = v.ravel()
-    d = np.full(x.size, -1, np.int64)
-    idx: NDArray[np.intp] | None = None  # where x is in v; None: everywhere
-    for k in range(most + 1):
-        if k:
-            n = x * _POW10[k]
-            np.rint(n, out=n)
-            small = np.abs(n) < limit
-            n /= _POW10[k]
-        else:  # the same, without multiplying and dividing by 1
-            n = np.rint(x)
-            small = np.abs(n) < limit
-        ok = n == x
-        ok &= small
-        d[ok if idx is None else idx[ok]] = k
-        small &= ~ok  # the rest: |n| only grows with k
-        idx = np.flatnonzero(small) if idx is None else idx[small]
-        if not idx.size:
-            break
-        x = x[small]
-    return d
+    flat = np.ascontiguousarray(v, dtype=np.float64).ravel()
+    return _core.fewest_decimals(flat, limit, most)
 
 
 #: The "decimals" code of a value written in its shortest round-trip form (``%r``).
@@ -314,7 +298,7 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
     ``88`` the first time already) and the values a file held are written unchanged.
     """
     v = a[:, 2:].ravel()
-    d = _decimals(v, 10.0**EXACT_DIGITS, len(_POW10) - 1)
+    d = _decimals(v, 10.0**EXACT_DIGITS, MOST_DECIMALS)
     whole = np.abs(v) >= 2.0**52  # every such double is an integer (and v * 100 may overflow)
     huge = np.abs(v) >= 1e16  # 17 digits or more as an integer: 1e+308, not 309 digits
     d[whole & ~huge & (d < 0)] = 0
