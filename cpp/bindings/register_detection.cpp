@@ -12,6 +12,7 @@
 #include "pftrack/background.hpp"
 #include "pftrack/ghost.hpp"
 #include "pftrack/morphology.hpp"
+#include "pftrack/parallel.hpp"
 
 namespace py = pybind11;
 using namespace pftrack;
@@ -322,8 +323,9 @@ void register_detection(py::module_& m) {
 
     m.def(
         "median_frames",
-        [](const py::sequence& frames) {
+        [](const py::sequence& frames, int threads) {
             const char* fn = "median_frames";
+            require(threads >= 1, fn, "threads", threads, ">= 1");
             const auto m = static_cast<Index>(py::len(frames));
             require(m >= 1, fn, "frames is empty, expected at least one frame");
             require(m <= 65535, fn, "frames holds", m, "at most 65535 frames");
@@ -347,7 +349,7 @@ void register_detection(py::module_& m) {
             const Index rows = keep[0].shape(0), cols = keep[0].shape(1), n = 3 * cols;
             py::array_t<float> out({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols),
                                     py::ssize_t(3)});
-            std::vector<const std::uint8_t*> base(static_cast<size_t>(m)), row(static_cast<size_t>(m));
+            std::vector<const std::uint8_t*> base(static_cast<size_t>(m));
             std::vector<Index> stride(static_cast<size_t>(m));
             for (Index f = 0; f < m; ++f) {
                 base[static_cast<size_t>(f)] = static_cast<const std::uint8_t*>(keep[static_cast<size_t>(f)].data());
@@ -357,25 +359,32 @@ void register_detection(py::module_& m) {
             {
                 // safe: the frames are held in `keep`, the output is owned here
                 py::gil_scoped_release nogil;
-                std::vector<std::uint8_t> lo(static_cast<size_t>(n)), hi(static_cast<size_t>(n)),
-                    cand(static_cast<size_t>(n));
-                std::vector<std::uint16_t> count(static_cast<size_t>(n));
                 // chunks of a row small enough that the m frames' pieces stay in L1 over the
                 // 8 (or 16) passes of the selection
                 const Index chunk = std::max(Index(64), Index(16384) / m);
-                for (Index y = 0; y < rows; ++y)
-                    for (Index x0 = 0; x0 < n; x0 += chunk) {
-                        const Index len = std::min(chunk, n - x0);
-                        for (size_t f = 0; f < base.size(); ++f)
-                            row[f] = base[f] + y * stride[f] + x0;
-                        median_u8(row.data(), m, len, optr + y * n + x0, lo.data(), hi.data(),
-                                  cand.data(), count.data());
-                    }
+                // bands of rows on up to `threads` threads, each with its own scratch: every
+                // pixel's median is its own, so the values do not depend on the split
+                const Index bands = std::min<Index>(rows, 4 * Index(threads));
+                parallel_for(bands, threads, [&](Index b) {
+                    std::vector<std::uint8_t> lo(static_cast<size_t>(n)),
+                        hi(static_cast<size_t>(n)), cand(static_cast<size_t>(n));
+                    std::vector<std::uint16_t> count(static_cast<size_t>(n));
+                    std::vector<const std::uint8_t*> at(static_cast<size_t>(m));
+                    for (Index y = rows * b / bands; y < rows * (b + 1) / bands; ++y)
+                        for (Index x0 = 0; x0 < n; x0 += chunk) {
+                            const Index len = std::min(chunk, n - x0);
+                            for (size_t f = 0; f < base.size(); ++f)
+                                at[f] = base[f] + y * stride[f] + x0;
+                            median_u8(at.data(), m, len, optr + y * n + x0, lo.data(), hi.data(),
+                                      cand.data(), count.data());
+                        }
+                });
             }
             return out;
         },
-        py::arg("frames"),
-        "Per-pixel median (H, W, 3) float32 of a sequence of (H, W, 3) uint8 frames.");
+        py::arg("frames"), py::arg("threads") = 1,
+        "Per-pixel median (H, W, 3) float32 of a sequence of (H, W, 3) uint8 frames, on up to "
+        "`threads` threads (the same values with any number).");
 
     m.def(
         "mask_bins",

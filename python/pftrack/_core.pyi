@@ -213,8 +213,9 @@ def hsv_bins(
     lazy: bool = False,  # tiles binned when first read (same bins); .bins bins the rest
 ) -> BinnedImage: ...
 
-# per-pixel median (H, W, 3) float32 of (H, W, 3) uint8 frames (numpy.median's values)
-def median_frames(frames: Sequence[NDArray[np.uint8]]) -> NDArray[np.float32]: ...
+# per-pixel median (H, W, 3) float32 of (H, W, 3) uint8 frames (numpy.median's values), in bands
+# of rows on up to `threads` threads (the same values with any number)
+def median_frames(frames: Sequence[NDArray[np.uint8]], threads: int = 1) -> NDArray[np.float32]: ...
 def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # mask (H, W)
 
 # closing of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are single runs,

@@ -21,6 +21,20 @@ def test_median_frames_matches_reference_and_numpy(m: int) -> None:
     np.testing.assert_array_equal(got, np.median(np.stack(frames), axis=0).astype(np.float32))
 
 
+@pytest.mark.parametrize("threads", [2, 3, 8, 64])
+def test_median_frames_threads_give_the_same_values(threads: int) -> None:
+    """Bands of rows on threads (more threads than rows too): the one-thread values."""
+    rng = np.random.default_rng(threads)
+    for rows in (1, 5, 37):
+        frames = [rng.integers(0, 256, (rows, 23, 3), dtype=np.uint8) for _ in range(9)]
+        frames[3] = np.repeat(frames[3], 2, axis=0)[::2]  # a view with strided rows among them
+        np.testing.assert_array_equal(
+            _core.median_frames(frames, threads), _core.median_frames(frames)
+        )
+    with pytest.raises(ValueError, match="threads is 0"):
+        _core.median_frames(frames, 0)
+
+
 def test_median_frames_of_views_and_ties() -> None:
     rng = np.random.default_rng(5)
     big = rng.integers(0, 256, (4, 12, 20, 3), dtype=np.uint8)

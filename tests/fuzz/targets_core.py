@@ -434,7 +434,12 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target(
-        "median_frames", call(_core.median_frames, maybe(st.lists(maybe(frames()), max_size=4)))
+        "median_frames",
+        call(
+            _core.median_frames,
+            maybe(st.lists(maybe(frames()), max_size=4)),
+            maybe(st.integers(1, 5)),
+        ),
     ),
     Target(
         "BinnedImage",

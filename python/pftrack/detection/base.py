@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
 from pftrack._check import MAX_COORD, bgr_array, real_array
+from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.detection.size_model import PersonSizeModel
 
@@ -151,15 +152,16 @@ def median_frame(frames: Iterable[NDArray[np.uint8]], fn: str) -> NDArray[np.flo
     """Per-pixel median (H, W, 3) float32 of `frames` (numpy.median's values), checked.
 
     The start of a background (the detectors' ``prime``): computed in C++ without stacking
-    the frames. Raises naming `fn` when `frames` is empty, or holds a frame that is not
-    (H, W, 3) uint8 or not of the first one's size.
+    the frames, in bands of rows on :func:`pftrack._threads.kernel_threads` threads. Raises
+    naming `fn` when `frames` is empty, or holds a frame that is not (H, W, 3) uint8 or not of
+    the first one's size.
     """
     stack = [check_frame(f, fn) for f in frames]
     if not stack:
         raise ValueError(f"{fn}: frames is empty, expected at least one frame")
     if any(f.shape != stack[0].shape for f in stack):
         raise ValueError(f"{fn}: frames differ in shape, expected one size")
-    median: NDArray[np.float32] = _core.median_frames(stack)
+    median: NDArray[np.float32] = _core.median_frames(stack, kernel_threads())
     return median
 
 
