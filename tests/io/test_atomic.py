@@ -97,6 +97,22 @@ def test_staged_outputs_remove_a_writers_own_temporary_file(tmp_path: Path) -> N
     assert sorted(p.name for p in tmp_path.iterdir()) == [".v.keep.mp4", "v.mp4"]
 
 
+def _write_through(writer: str, target: Path, text: str) -> None:
+    """Write `text` to `target` with `writer`: atomic_write, atomic_path or staged_outputs."""
+    from pftrack.io.atomic import staged_outputs
+
+    if writer == "atomic_write":
+        with atomic_write(target) as fh:
+            fh.write(text)
+    elif writer == "atomic_path":
+        with atomic_path(target) as tmp:
+            tmp.write_text(text)
+    else:
+        assert writer == "staged_outputs", writer
+        with staged_outputs() as stage:
+            stage(target).write_text(text)
+
+
 def _interrupted_as_created(monkeypatch: pytest.MonkeyPatch, folder: Path) -> None:
     """``os.open`` creates the file in `folder`, then a Ctrl-C is raised before it returns.
 
@@ -121,24 +137,17 @@ def test_a_signal_as_the_temporary_file_is_created_leaves_nothing(
 ) -> None:
     """Was: the file made between its creation and the writer's try was left behind
     (``.out.<hex>.txt``; ``staged_outputs`` too, whose clean-up had not listed it yet)."""
-    from pftrack.io.atomic import check_output, staged_outputs
+    from pftrack.io.atomic import check_output
 
     target = tmp_path / "out.txt"
     target.write_text("old\n")
     (tmp_path / ".out.keep.txt").write_text("not ours\n")
     _interrupted_as_created(monkeypatch, tmp_path)
     with pytest.raises(KeyboardInterrupt):
-        if writer == "atomic_write":
-            with atomic_write(target) as fh:
-                fh.write("new\n")
-        elif writer == "atomic_path":
-            with atomic_path(target) as tmp:
-                tmp.write_text("new\n")
-        elif writer == "staged_outputs":
-            with staged_outputs() as stage:
-                stage(target).write_text("new\n")
-        else:  # the writable-folder probe of check_output
+        if writer == "check":  # the writable-folder probe of check_output
             check_output(target)
+        else:
+            _write_through(writer, target, "new\n")
     monkeypatch.undo()
     assert sorted(p.name for p in tmp_path.iterdir()) == [".out.keep.txt", "out.txt"]
     assert target.read_text() == "old\n"
@@ -304,11 +313,12 @@ def test_a_name_that_can_only_be_a_folder_is_refused(tmp_path: Path, name: str) 
     assert not any(tmp_path.iterdir())
 
 
-@pytest.mark.parametrize("writer", ["write_mot", "atomic_write", "atomic_path", "stage", "link"])
+@pytest.mark.parametrize(
+    "writer", ["write_mot", "atomic_write", "atomic_path", "staged_outputs", "link"]
+)
 def test_an_existing_folder_is_refused_before_writing(tmp_path: Path, writer: str) -> None:
     """Was ``IsADirectoryError: [Errno 21] Is a directory: '/x/.io.<hex>.tmp' -> '/x/io'``,
     naming the hidden temporary file, once the file had been written."""
-    from pftrack.io.atomic import staged_outputs
 
     folder = tmp_path / "io"
     folder.mkdir()
@@ -320,15 +330,8 @@ def test_an_existing_folder_is_refused_before_writing(tmp_path: Path, writer: st
     with pytest.raises(ValueError, match=rf"^output {target} is a folder; give a file name$"):
         if writer in ("write_mot", "link"):
             write_mot(target, [[1, 1, 10, 10, 5, 5]])
-        elif writer == "atomic_write":
-            with atomic_write(target) as fh:
-                fh.write("x")
-        elif writer == "atomic_path":
-            with atomic_path(target) as tmp:
-                tmp.write_text("x")
         else:
-            with staged_outputs() as stage:
-                stage(target).write_text("x")
+            _write_through(writer, target, "x")
     assert sorted(p.name for p in folder.iterdir()) == ["keep.txt"]
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         ["io"] + (["link"] if writer == "link" else [])

@@ -111,16 +111,27 @@ def test_low_variance_schemes_copy_floor_or_ceil(name):
             assert np.all(c <= np.ceil(64 * w))
 
 
+def _filterpy_draws(mc, name: str, w: np.ndarray, seed: int) -> np.ndarray:
+    """filterpy's `name` resampling of `w` after ``np.random.seed(seed)``; the global state is
+    restored afterwards."""
+    state = np.random.get_state()
+    try:
+        np.random.seed(seed)
+        out: np.ndarray = getattr(mc, f"{name}_resample")(w)
+        return out
+    finally:
+        np.random.set_state(state)
+
+
 @pytest.mark.parametrize("name", RESAMPLERS)
 def test_drop_in_for_filterpy(name):
     """Same semantics as filterpy.monte_carlo: given the same uniform draws, the same indices."""
     mc = pytest.importorskip("filterpy.monte_carlo")
     w = np.random.default_rng(11).random(300)
     w /= w.sum()
+    theirs = _filterpy_draws(mc, name, w, 5)
     state = np.random.get_state()
     try:
-        np.random.seed(5)
-        theirs = getattr(mc, f"{name}_resample")(w)
         np.random.seed(5)
         if name == "systematic":
             mine = _core.systematic_resample(w, np.random.random())
@@ -150,12 +161,7 @@ def test_a_random_state_gives_filterpys_draws(name):
     mc = pytest.importorskip("filterpy.monte_carlo")
     w = np.random.default_rng(12).random(200)
     w /= w.sum()
-    state = np.random.get_state()
-    try:
-        np.random.seed(8)
-        theirs = getattr(mc, f"{name}_resample")(w)
-    finally:
-        np.random.set_state(state)
+    theirs = _filterpy_draws(mc, name, w, 8)
     np.testing.assert_array_equal(RESAMPLERS[name](w, rng=np.random.RandomState(8)), theirs)
 
 

@@ -21,6 +21,11 @@ constexpr std::int64_t kMostDecimals = 22;
 
 namespace detail {
 
+/// 10^d for d = 0 .. kMostDecimals, each exact in double (the literals are exact).
+inline constexpr double kPow10[kMostDecimals + 1] = {
+    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
 /// Python's repr(x) of a finite double at `out` (room for 32 chars); returns the end.
 /// The shortest round-trip digits (std::to_chars, Ryu) laid out as float_repr_style "short"
 /// does: fixed notation when the decimal exponent e of d.ddd x 10^e is in -4..15 (a trailing
@@ -73,9 +78,6 @@ inline char* write_repr(char* out, double x) {
 /// rint(p) is the correctly rounded digits. A product that is a tie in double (the exact one
 /// may lie on either side) or too large goes to std::to_chars (Ryu printf).
 inline char* write_fixed(char* out, double x, int d) {
-    static constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                          1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                          1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
     const double p = x * kPow10[d];
     const double n = std::nearbyint(p);
     if (!(std::fabs(p) < 4503599627370496.0) || std::fabs(p - n) == 0.5)
@@ -112,16 +114,13 @@ inline char* write_fixed(char* out, double x, int d) {
 /// grows with d). NaN gives -1.
 inline void fewest_decimals(const double* v, std::int64_t n, double limit, int most,
                             std::int64_t* out) {
-    static constexpr double kPow10[kMostDecimals + 1] = {
-        1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
-        1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
     for (std::int64_t i = 0; i < n; ++i) {
         const double x = v[i];
         std::int64_t d = -1;
         for (int k = 0; k <= most; ++k) {
-            double r = std::nearbyint(k ? x * kPow10[k] : x);
+            double r = std::nearbyint(k ? x * detail::kPow10[k] : x);
             if (!(std::fabs(r) < limit)) break;
-            if (k) r /= kPow10[k];
+            if (k) r /= detail::kPow10[k];
             if (r == x) {
                 d = k;
                 break;

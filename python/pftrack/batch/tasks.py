@@ -45,7 +45,6 @@ __all__ = [
     "sequence_metrics",
     "smooth_file",
     "track_sequence",
-    "tracking_threads",
 ]
 
 

@@ -325,8 +325,9 @@ def _lines(a: F64, exact: NDArray[np.bool_] | None = None) -> str:
     The values and decimals come from :func:`_printable`; the text from the C++ kernel
     ``_core.mot_lines``, byte for byte what Python's ``%`` gives with ``%d`` for frame and id
     and ``%.{d}f`` or ``%r`` (code :data:`_REPR`) for each value (held to it by
-    ``tests/reference/text.py``): 7 ms for the 500-track file's 61 981 rows, which the ``%``
-    took about 120 ms to format (:func:`_printable` takes 20 ms more).
+    ``tests/reference/text.py``): 8 ms for the 69 120 rows of the 500-track file once
+    recovered, and 10 ms more for :func:`_printable` (timeit, best of 7, 3 December); the ``%``
+    took about 120 ms to format the 61 981 rows of the file before recovery.
     """
     if not len(a):
         return ""
