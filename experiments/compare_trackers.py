@@ -9,7 +9,9 @@ Detector modes
 --------------
 public
     The sequence's ``det.txt`` (Faster R-CNN boxes published with SORT), PETS boxes scaled by
-    0.625 onto the 480x360 video. pftrack gets the same boxes.
+    0.625 onto the 480x360 video. pftrack gets the same boxes. ADL-Rundle-6, ETH-Sunnyday and
+    KITTI-17 (``mot15-gt/``) ship without video: only this mode, and pftrack sees black frames
+    of their size, where its colour filters and box refinement have nothing to use.
 mog2
     OpenCV MOG2 background subtraction on the video (shadows off), opening + closing, connected
     components with a minimum area; every blob is a detection with score 1. pftrack runs its own
@@ -23,7 +25,7 @@ skipped peers are also written to ``trackers.md`` in ``--out`` (default ``out/co
 
 Usage (from the repository root)::
 
-    python -m experiments.compare_trackers [--data ../shared/data] [--seq pets09-s2l1 tud-campus]
+    python -m experiments.compare_trackers [--data ../shared/data] [--seq pets09-s2l1 ...]
         [--detector public mog2] [--tracker sort bytetrack norfair motpy pftrack]
         [--smooth-peers] [--out out/compare_trackers]
 """
@@ -36,6 +38,7 @@ import sys
 import time
 import warnings
 from collections.abc import Callable, Iterable
+from collections.abc import Sequence as SequenceOf
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeAlias
@@ -45,12 +48,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from experiments._common import data_root, experiment_parser, write_text
+from experiments.public_detections import black_frames
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.mot import group_by_frame, read_mot
 from pftrack.io.video import read_frames
 
 Boxes: TypeAlias = NDArray[np.float64]  # (K, 5) left, top, w, h, score
 Frame: TypeAlias = NDArray[np.uint8]  # (H, W, 3) BGR
+Frames: TypeAlias = SequenceOf[Frame]  # a video's frames, or black_frames
 Track: TypeAlias = tuple[int, float, float, float, float]  # id, left, top, w, h
 Step: TypeAlias = Callable[[Frame, "Boxes | None"], list[Track]]
 """One tracker: (frame, detections or None) -> the tracks it reports for that frame."""
@@ -59,17 +64,23 @@ Step: TypeAlias = Callable[[Frame, "Boxes | None"], list[Track]]
 @dataclass(frozen=True)
 class Sequence:
     name: str
-    video: str
+    video: str | None  # None: no video ships (black frames of seqinfo.ini's size)
     scale: float  # ground truth / det.txt -> video pixels
     fps: float
     mog2_history: int = 500
     mog2_var_threshold: float = 100.0
+    folder: str = ""  # below the data folder (default: the name)
 
 
 SEQUENCES = {
     "pets09-s2l1": Sequence("pets09-s2l1", "video.avi", 0.625, 7.0),
     # 71 frames of people in view from frame 1: a short memory and a low threshold do best.
     "tud-campus": Sequence("tud-campus", "video.mp4", 1.0, 25.0, 100, 16.0),
+    # MOT15 sequences without video: public detections only; pftrack sees black frames, where
+    # its colour filters and box refinement have nothing to use (as experiments.public_detections)
+    "ADL-Rundle-6": Sequence("ADL-Rundle-6", None, 1.0, 30.0, folder="mot15-gt/ADL-Rundle-6"),
+    "ETH-Sunnyday": Sequence("ETH-Sunnyday", None, 1.0, 14.0, folder="mot15-gt/ETH-Sunnyday"),
+    "KITTI-17": Sequence("KITTI-17", None, 1.0, 10.0, folder="mot15-gt/KITTI-17"),
 }
 
 
@@ -244,7 +255,7 @@ class PftrackStep:
             self._trk.update(np.column_stack([b[:, :2], b[:, :2] + b[:, 2:4], b[:, 4]]), frame)
         return []
 
-    def prime(self, frames: list[Frame], own: bool) -> None:
+    def prime(self, frames: Frames, own: bool) -> None:
         """Start the background as ``pftrack track`` does (`own`: the built-in detector)."""
         from pftrack.detection.bootstrap import bootstrap_frames
 
@@ -282,7 +293,7 @@ class Row:
 
 
 def run_one(
-    step: Step, frames: list[NDArray[np.uint8]], dets: Iterable[Boxes | None]
+    step: Step, frames: Frames, dets: Iterable[Boxes | None]
 ) -> tuple[NDArray[np.float64], float]:
     rows = []
     elapsed = 0.0
@@ -336,16 +347,20 @@ def main(argv: list[str] | None = None) -> int:
     notes: list[str] = []
     for name in args.seq:
         seq = SEQUENCES[name]
-        folder = root / name
-        frames = read_frames(folder / seq.video)
+        folder = root / (seq.folder or name)
+        video = None if seq.video is None else folder / seq.video
+        frames: Frames = black_frames(folder) if video is None else read_frames(video)
         gt = read_mot(folder / "gt.txt", what="ground truth")
         size = (frames[0].shape[1], frames[0].shape[0])
         for detector in args.detector:
             dets: list[Boxes] | None = None
+            if detector == "mog2" and seq.video is None:
+                notes.append(f"{name}: no video, so no mog2 detections")
+                continue
             if detector == "public":
                 dets = public_detections(folder, seq, len(frames))
             else:
-                dets = mog2_detections(frames, seq)
+                dets = mog2_detections(list(frames), seq)
             for tname in args.tracker:
                 own = tname == "pftrack" and detector == "mog2"
                 try:
