@@ -829,3 +829,42 @@ def test_held_interrupts_are_restored_when_the_command_returns(
     before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     assert main(["smooth", str(tracks), "--out", str(tmp_path / "o.txt")]) == 0
     assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+
+
+BLAS_PROBE = """
+import os, sys
+import pftrack.cli
+
+def run(argv):  # the command, as far as BLAS goes: NumPy loads once the command runs
+    import numpy  # noqa: F401
+    print(os.environ.get("OPENBLAS_NUM_THREADS"), os.environ.get("MKL_NUM_THREADS"))
+    return 0
+
+pftrack.cli.main = run
+from pftrack._console import main
+sys.exit(main({argv}))
+"""
+
+
+@pytest.mark.parametrize(
+    ("argv", "given", "expected"),
+    [
+        (None, None, "1 1"),  # the console script: BLAS at one thread
+        (None, "3", "3 1"),  # a user's setting stands
+        (["track"], None, "None None"),  # a library call leaves the process alone
+    ],
+)
+def test_the_command_runs_blas_at_one_thread(
+    argv: list[str] | None, given: str | None, expected: str
+) -> None:
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+    }
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    env["PYTHONPATH"] = os.pathsep.join(sys.path)
+    proc = subprocess.run(
+        [sys.executable, "-c", BLAS_PROBE.format(argv=argv)], env=env, capture_output=True,
+        text=True, timeout=60,
+    )  # fmt: skip
+    assert proc.returncode == 0 and proc.stdout.strip() == expected, proc.stderr
