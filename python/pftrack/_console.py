@@ -42,7 +42,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     Parameters
     ----------
     argv : sequence of str, optional
-        The arguments (default: ``sys.argv[1:]``).
+        The arguments (default: ``sys.argv[1:]``). Without them the process is the command's
+        own: BLAS is kept at one thread (:data:`BLAS_THREAD_VARIABLES`) and the process ends
+        with the command.
 
     Returns
     -------
