@@ -8,26 +8,14 @@ this module: whatever is interrupted may be half loaded, so the handler loads no
 
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Sequence
 
-__all__ = ["BLAS_THREAD_VARIABLES", "main"]
+__all__ = ["main"]
 
 #: :data:`pftrack.cli._signals.EXIT_INTERRUPTED`, stated here: the module that states it may be
 #: what was interrupted (a test checks they agree).
 EXIT_INTERRUPTED = 130
-
-#: Set to 1 in the command's own process, unless the user set them: BLAS (NumPy's OpenBLAS, or
-#: MKL) then starts no thread pool. pftrack's BLAS calls are small (a Kalman step, a
-#: trajectory's smoothing), and an idle pool's threads spin on the cores the tracker's own
-#: threads need: ``pftrack recover`` of a 500-track file took 0.78-0.84 s of user CPU with one
-#: thread against 0.87-0.99 s with the default two, ``pftrack experiment gaps`` on five
-#: sequences 6.4-7.5 s against 8.1-8.2 s (3 December, 2 cores). It also keeps the `gsi`
-#: baseline's values (a Cholesky solve, whose sums a pool splits) from depending on the number
-#: of cores. Library calls leave the caller's process alone. BLAS reads them when NumPy loads,
-#: so they are set before anything imports it.
-BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def _command(argv: Sequence[str]) -> str:
@@ -43,8 +31,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ----------
     argv : sequence of str, optional
         The arguments (default: ``sys.argv[1:]``). Without them the process is the command's
-        own: BLAS is kept at one thread (:data:`BLAS_THREAD_VARIABLES`) and the process ends
-        with the command.
+        own: BLAS is kept at one thread (:func:`pftrack._threads.one_blas_thread`; library
+        calls leave the caller's process alone) and the process ends with the command.
 
     Returns
     -------
@@ -52,10 +40,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         The command's exit status; 130 after Ctrl-C before the command handles it itself
         (while the command line is imported or its arguments parsed).
     """
-    if argv is None:  # this process is the command (the console script, python -m pftrack)
-        for name in BLAS_THREAD_VARIABLES:
-            os.environ.setdefault(name, "1")
     try:
+        if argv is None:  # this process is the command (the console script, python -m pftrack)
+            from pftrack._threads import one_blas_thread
+
+            one_blas_thread()  # before anything loads NumPy
         from pftrack.cli import _signals
         from pftrack.cli import main as run
 

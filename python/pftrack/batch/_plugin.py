@@ -20,9 +20,6 @@ __all__ = ["SingleThreaded"]
 # later stuck "closing" (Dask 2026.8), the batch waiting on it with no word of pftrack.
 cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
-#: Thread-count variables read by BLAS and OpenMP libraries at load time.
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-
 
 class SingleThreaded(WorkerPlugin):
     """Make each worker process single-threaded: one sequence per core, no oversubscription.
@@ -69,10 +66,10 @@ class SingleThreaded(WorkerPlugin):
         from pftrack._progress import set_quiet
 
         set_quiet(True)  # the batch's bar, on the client, is the only one
-        for var in THREAD_VARIABLES:
-            os.environ.setdefault(var, "1")
         cv2.setNumThreads(1)
-        from pftrack._threads import WORKER_THREADS_VARIABLE
+        from pftrack._threads import WORKER_THREADS_VARIABLE, one_blas_thread
+
+        one_blas_thread()
 
         os.environ[WORKER_THREADS_VARIABLE] = "0"  # no read-ahead, detector or kernel thread either
         import pftrack.eval
