@@ -468,10 +468,15 @@ def test_black_frames_are_tracked_through(where: int) -> None:
         want = plain.detect(f)
         if k < where:
             np.testing.assert_array_equal(got.mask, want.mask)
-    # the whole run, with box refinement of given detections too
-    assert len(track_frames(frames, rng=0, show_progress=False).rows)
+    # the whole run, with box refinement of given detections too; a run that opens on a black
+    # frame says so (pftrack.Tracker.update), one that meets it later does not
     dets = {k: scene.truth[scene.truth[:, 0] == k][:, 2:7] for k in range(1, 41)}
-    assert len(track_frames(frames, detections=dets, rng=0, show_progress=False).rows)
+    for given in (None, dets):
+        with warnings.catch_warnings(record=True) as record:
+            warnings.simplefilter("always")
+            assert len(track_frames(frames, detections=given, rng=0, show_progress=False).rows)
+        blank = [w for w in record if "frame 1 is blank" in str(w.message)]
+        assert len(blank) == (where == 0)
 
 
 def test_dark_frames_neither_prime_nor_start_the_background() -> None:

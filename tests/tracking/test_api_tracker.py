@@ -25,6 +25,9 @@ from pftrack.tracking.api import check_boxes_xyxy, xywh_to_xyxy_dets
 from pftrack.tracking.offline import complete_boxes, drop_nested
 from tests.conftest import dataset
 
+# Many contract tests feed placeholder frames (np.zeros): the warning they give is tested below.
+pytestmark = pytest.mark.filterwarnings("ignore:frame 1 is blank")
+
 
 @pytest.fixture(scope="module")
 def scene():
@@ -767,6 +770,7 @@ def test_no_track_warning_says_what_the_detections_were(scene, where, hint):
 
 def test_negative_confidences_warn_once_and_min_conf_keeps_them() -> None:
     frame = np.zeros((60, 80, 3), np.uint8)
+    frame[::2] = 90  # not blank: the checks below want no other warning
     dets = np.array([[10.0, 10.0, 20.0, 40.0, -1.5], [40.0, 10.0, 50.0, 40.0, 0.8]])
     tracker = pftrack.Tracker(frame_rate=10.0)
     with pytest.warns(UserWarning, match=r"confidence is -1\.5: .*below min_conf 0 .*logits"):
@@ -1204,3 +1208,39 @@ def test_track_frames_names_every_bootstrap_it_takes():
             ValueError, match="bootstrap mode is 'sprad', expected one of auto, spread"
         ):
             track_frames([], bootstrap="sprad", prime_frames=prime)  # type: ignore[arg-type]
+
+
+def _blank_messages(record: list[warnings.WarningMessage]) -> list[str]:
+    return [str(w.message) for w in record if "is blank" in str(w.message)]
+
+
+def test_a_blank_first_frame_warns_once_a_run() -> None:
+    dets = np.array([[10.0, 10.0, 50.0, 90.0, 0.9]])
+    tracker = pftrack.Tracker(frame_rate=25.0)
+    # an encoded black frame is not all zeros: levels within 2 of each other count as blank
+    grey = np.zeros((120, 160, 3), np.uint8)
+    grey[::2] = 2
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        for _ in range(3):
+            tracker.update(dets, grey)
+    (message,) = _blank_messages(record)
+    assert message.startswith("frame 1 is blank (every pixel within 2 levels")
+    assert "colour filters and box refinement have nothing to see" in message
+    tracker.reset()  # a new run: said again
+    with pytest.warns(UserWarning, match="frame 1 is blank"):
+        tracker.update(dets, np.zeros((120, 160, 3), np.uint8))
+
+
+def test_a_picture_or_a_later_blank_frame_does_not_warn(scene) -> None:
+    dets = np.array([[10.0, 10.0, 50.0, 90.0, 0.9]])
+    dim = np.zeros((120, 160, 3), np.uint8)
+    dim[60:, :, 1] = 3  # a dark frame with one step of 3 levels: a picture, not a placeholder
+    runs = {"scene": [scene.frames[0], np.zeros_like(scene.frames[0])], "dim": [dim]}
+    for frames in runs.values():
+        tracker = pftrack.Tracker(frame_rate=25.0)
+        with warnings.catch_warnings(record=True) as record:
+            warnings.simplefilter("always")
+            for frame in frames:  # the scene's second frame is black: only frame 1 is looked at
+                tracker.update(dets, frame)
+        assert _blank_messages(record) == []

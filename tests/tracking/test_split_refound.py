@@ -159,6 +159,7 @@ def coasting_run(config: TrackerConfig) -> np.ndarray:
     return tracker.finalize()
 
 
+@pytest.mark.filterwarnings("ignore:frame 1 is blank")  # black frames: boxes only
 def test_the_tracker_cuts_coasts_before_linking(monkeypatch):
     from pftrack.tracking import offline
 

@@ -272,6 +272,19 @@ class _Alone:
         self.lock.release()
 
 
+BLANK_LEVELS = 2
+"""Largest spread of a frame's sampled levels that :meth:`Tracker.update` calls blank."""
+
+
+def _blank(frame: NDArray[np.uint8]) -> bool:
+    """Whether `frame` is one flat level (a placeholder: ``np.zeros``, a black frame).
+
+    Every pixel is read (it is done for a run's first frame only): a real picture is never
+    within :data:`BLANK_LEVELS` levels everywhere, a blank frame (encoded or not) always is.
+    """
+    return int(frame.max()) - int(frame.min()) <= BLANK_LEVELS
+
+
 class Tracker:
     """pftrack as a drop-in multi-object tracker: one ``update`` per frame, then ``finalize``.
 
@@ -796,7 +809,9 @@ class Tracker:
             subtraction is unreliable there, give detections. Once a run, ``dets=None`` after
             a frame with detections, naming the frame: it runs the built-in detector on that
             frame (as documented above), which a frame meant to have no detections (``[]``)
-            does not want.
+            does not want. Once, when the run's first frame is blank (one flat level, as
+            ``np.zeros`` placeholders are): the colour filters and box refinement then have
+            nothing to use.
         """
         with self._alone("update"):
             f = bgr_frame(frame)
@@ -817,6 +832,14 @@ class Tracker:
                     "Tracker before a new video)"
                 )
             work = self._working(f)
+            if first and _blank(f):
+                self._warn_once(
+                    "blank",
+                    f"frame 1 is blank (every pixel within {BLANK_LEVELS} levels of the others): "
+                    "on blank frames the colour filters and box refinement have nothing to see, "
+                    "and tracks follow their detections and motion alone (placeholder frames? "
+                    "give the real ones)",
+                )
             if dets is None:
                 if self._given:  # was silent: a loop's "no detections" for this frame?
                     self._warn_once(
