@@ -84,6 +84,26 @@ SEQUENCES = {
 }
 
 
+@dataclass(frozen=True)
+class Loaded:
+    """One sequence of :data:`SEQUENCES` read from the data folder."""
+
+    seq: Sequence
+    folder: Path
+    frames: Frames  # the video's, or black frames of seqinfo.ini's size
+    gt: NDArray[np.float64]
+    size: tuple[int, int]  # width, height
+
+
+def load(root: Path, name: str) -> Loaded:
+    """The sequence `name` under the data folder `root`: frames, ground truth and size."""
+    seq = SEQUENCES[name]
+    folder = root / (seq.folder or name)
+    frames: Frames = black_frames(folder) if seq.video is None else read_frames(folder / seq.video)
+    gt = read_mot(folder / "gt.txt", what="ground truth")
+    return Loaded(seq, folder, frames, gt, (frames[0].shape[1], frames[0].shape[0]))
+
+
 # ---- detectors -------------------------------------------------------------------------------
 
 
@@ -346,12 +366,14 @@ def main(argv: list[str] | None = None) -> int:
     rows: list[Row] = []
     notes: list[str] = []
     for name in args.seq:
-        seq = SEQUENCES[name]
-        folder = root / (seq.folder or name)
-        video = None if seq.video is None else folder / seq.video
-        frames: Frames = black_frames(folder) if video is None else read_frames(video)
-        gt = read_mot(folder / "gt.txt", what="ground truth")
-        size = (frames[0].shape[1], frames[0].shape[0])
+        loaded = load(root, name)
+        seq, folder, frames, gt, size = (
+            loaded.seq,
+            loaded.folder,
+            loaded.frames,
+            loaded.gt,
+            loaded.size,
+        )
         for detector in args.detector:
             dets: list[Boxes] | None = None
             if detector == "mog2" and seq.video is None:

@@ -43,15 +43,14 @@ from experiments.compare_trackers import (
     Boxes,
     Frames,
     Sequence,
+    load,
     make_sort,
     public_detections,
 )
-from experiments.public_detections import black_frames
 from pftrack._typing import F64
 from pftrack.boxes import iou_xywh
 from pftrack.eval import evaluate_mot
-from pftrack.io.mot import group_by_frame, read_mot
-from pftrack.io.video import read_frames
+from pftrack.io.mot import group_by_frame
 from pftrack.tracking import smooth_tracks
 
 STEPS = ("online", "smoother", "smoother+fill", "link", "offline", "finalize")
@@ -149,13 +148,9 @@ def main(argv: list[str] | None = None) -> int:
     lines = ["| sequence | tracker | " + " | ".join(STEPS) + " |", "|---" * (len(STEPS) + 2) + "|"]
     holes = ["| sequence | tracker | same | other | one | neither |", "|---" * 6 + "|"]
     for name in args.seq:
-        seq = SEQUENCES[name]
-        folder = root / (seq.folder or name)
-        video = None if seq.video is None else folder / seq.video
-        frames: Frames = black_frames(folder) if video is None else read_frames(video)
-        gt = read_mot(folder / "gt.txt", what="ground truth")
-        size = (frames[0].shape[1], frames[0].shape[0])
-        dets = public_detections(folder, seq, len(frames))
+        loaded = load(root, name)
+        seq, frames, gt, size = loaded.seq, loaded.frames, loaded.gt, loaded.size
+        dets = public_detections(loaded.folder, seq, len(frames))
         for tracker in trackers:
             with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
                 warnings.simplefilter("ignore")
