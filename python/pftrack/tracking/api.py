@@ -273,14 +273,15 @@ class _Alone:
 
 
 BLANK_LEVELS = 2
-"""Largest spread of a frame's sampled levels that :meth:`Tracker.update` calls blank."""
+"""Largest spread of a frame's levels (max - min) that :meth:`Tracker.update` calls blank."""
 
 
 def _blank(frame: NDArray[np.uint8]) -> bool:
     """Whether `frame` is one flat level (a placeholder: ``np.zeros``, a black frame).
 
-    Every pixel is read (it is done for a run's first frame only): a real picture is never
-    within :data:`BLANK_LEVELS` levels everywhere, a blank frame (encoded or not) always is.
+    Every pixel is read (it is done for a run's first frame only): a picture of a scene is
+    never within :data:`BLANK_LEVELS` levels everywhere; a placeholder always is, and so is a
+    black frame unless compression left more than that of noise in it.
     """
     return int(frame.max()) - int(frame.min()) <= BLANK_LEVELS
 
