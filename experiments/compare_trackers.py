@@ -41,7 +41,7 @@ from collections.abc import Callable, Iterable
 from collections.abc import Sequence as SequenceOf
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeAlias
+from typing import NamedTuple, TypeAlias
 
 import cv2
 import numpy as np
@@ -84,8 +84,7 @@ SEQUENCES = {
 }
 
 
-@dataclass(frozen=True)
-class Loaded:
+class Loaded(NamedTuple):
     """One sequence of :data:`SEQUENCES` read from the data folder."""
 
     seq: Sequence
@@ -251,7 +250,8 @@ def make_motpy(seq: Sequence) -> Step:
 
 
 class PftrackStep:
-    """pftrack as ``pftrack track`` runs it, as a step that reports nothing until the end.
+    """pftrack as ``pftrack track`` runs it: each frame, what ``Tracker.update`` returns; at the
+    end (:meth:`result`), what the command writes.
 
     The public :class:`pftrack.Tracker` with the command's defaults and seed 0, primed as
     :func:`~pftrack.tracking.track_frames` primes it (:meth:`prime`): the built-in detector's
@@ -259,7 +259,8 @@ class PftrackStep:
     frames. Its :meth:`~pftrack.Tracker.finalize` links fragments and smooths each track over
     the whole run, so the rows are those ``pftrack track`` writes for the same video and
     detections; ``offline=False`` (``pftrack-online``, ``pftrack track --no-smooth --no-link``)
-    keeps each frame's boxes as reported. The rows are read with :meth:`result`.
+    keeps each frame's boxes as reported. :func:`run_one` scores :meth:`result`; a step's own
+    returns are BoxMOT's online rows (confirmed tracks matched to a detection that frame).
     """
 
     def __init__(self, offline: bool = True) -> None:
@@ -269,11 +270,13 @@ class PftrackStep:
 
     def __call__(self, frame: Frame, boxes: Boxes | None) -> list[Track]:
         if boxes is None:
-            self._trk.update(None, frame)
+            out = self._trk.update(None, frame)
         else:  # left, top, w, h, score -> x1, y1, x2, y2, score
             b = np.asarray(boxes, dtype=np.float64).reshape(-1, 5)
-            self._trk.update(np.column_stack([b[:, :2], b[:, :2] + b[:, 2:4], b[:, 4]]), frame)
-        return []
+            xyxy = np.column_stack([b[:, :2], b[:, :2] + b[:, 2:4], b[:, 4]])
+            out = self._trk.update(xyxy, frame)
+        # (M, 8) x1, y1, x2, y2, id, conf, cls, det_ind
+        return [(int(r[4]), r[0], r[1], r[2] - r[0], r[3] - r[1]) for r in out]
 
     def prime(self, frames: Frames, own: bool) -> None:
         """Start the background as ``pftrack track`` does (`own`: the built-in detector)."""
@@ -312,9 +315,10 @@ class Row:
     fps: float
 
 
-def run_one(
+def online_rows(
     step: Step, frames: Frames, dets: Iterable[Boxes | None]
 ) -> tuple[NDArray[np.float64], float]:
+    """What `step` returned frame by frame (MOTChallenge rows), and its frames per second."""
     rows = []
     elapsed = 0.0
     for f, (frame, boxes) in enumerate(zip(frames, dets, strict=True), start=1):
@@ -323,9 +327,17 @@ def run_one(
         elapsed += time.perf_counter() - t0
         rows += [(f, i, x, y, w, h, 1.0, -1.0, -1.0, -1.0) for i, x, y, w, h in out]
     res = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+    return res, len(frames) / elapsed if elapsed > 0 else float("inf")
+
+
+def run_one(
+    step: Step, frames: Frames, dets: Iterable[Boxes | None]
+) -> tuple[NDArray[np.float64], float]:
+    """The rows a tracker gives a user: its online rows, pftrack's after its offline pass."""
+    res, fps = online_rows(step, frames, dets)
     if isinstance(step, PftrackStep):  # writes its rows at the end
         res = step.result()
-    return res, len(frames) / elapsed if elapsed > 0 else float("inf")
+    return res, fps
 
 
 def markdown(rows: list[Row]) -> str:
@@ -366,14 +378,7 @@ def main(argv: list[str] | None = None) -> int:
     rows: list[Row] = []
     notes: list[str] = []
     for name in args.seq:
-        loaded = load(root, name)
-        seq, folder, frames, gt, size = (
-            loaded.seq,
-            loaded.folder,
-            loaded.frames,
-            loaded.gt,
-            loaded.size,
-        )
+        seq, folder, frames, gt, size = load(root, name)
         for detector in args.detector:
             dets: list[Boxes] | None = None
             if detector == "mog2" and seq.video is None:

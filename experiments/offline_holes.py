@@ -40,11 +40,10 @@ import numpy as np
 from experiments._common import data_root, experiment_parser, write_text
 from experiments.compare_trackers import (
     SEQUENCES,
-    Boxes,
-    Frames,
-    Sequence,
+    PftrackStep,
     load,
     make_sort,
+    online_rows,
     public_detections,
 )
 from pftrack._typing import F64
@@ -54,30 +53,6 @@ from pftrack.io.mot import group_by_frame
 from pftrack.tracking import smooth_tracks
 
 STEPS = ("online", "smoother", "smoother+fill", "link", "offline", "finalize")
-
-
-def run_pftrack(frames: Frames, dets: list[Boxes]) -> tuple[F64, F64]:
-    """pftrack's rows: every row ``update`` returned, and ``finalize()``."""
-    import pftrack
-    from pftrack.detection.bootstrap import bootstrap_frames
-
-    trk = pftrack.Tracker()
-    trk.prime(bootstrap_frames(frames, 30, "first"))
-    out = []
-    for f, (frame, b) in enumerate(zip(frames, dets, strict=True), start=1):
-        xyxy = np.column_stack([b[:, :2], b[:, :2] + b[:, 2:4], b[:, 4]])
-        t = trk.update(xyxy, frame)  # (M, 8) x1, y1, x2, y2, id, conf, cls, det_ind
-        out += [(f, r[4], r[0], r[1], r[2] - r[0], r[3] - r[1], 1, -1, -1, -1) for r in t]
-    return np.asarray(out, dtype=np.float64).reshape(-1, 10), trk.finalize()
-
-
-def run_sort(seq: Sequence, frames: Frames, dets: list[Boxes]) -> F64:
-    """SORT's rows (its reports are all matched boxes)."""
-    step = make_sort(seq)
-    out = []
-    for f, (frame, b) in enumerate(zip(frames, dets, strict=True), start=1):
-        out += [(f, i, x, y, w, h, 1.0, -1.0, -1.0, -1.0) for i, x, y, w, h in step(frame, b)]
-    return np.asarray(out, dtype=np.float64).reshape(-1, 10)
 
 
 def steps(online: F64, final: F64 | None) -> dict[str, F64]:
@@ -148,17 +123,17 @@ def main(argv: list[str] | None = None) -> int:
     lines = ["| sequence | tracker | " + " | ".join(STEPS) + " |", "|---" * (len(STEPS) + 2) + "|"]
     holes = ["| sequence | tracker | same | other | one | neither |", "|---" * 6 + "|"]
     for name in args.seq:
-        loaded = load(root, name)
-        seq, frames, gt, size = loaded.seq, loaded.frames, loaded.gt, loaded.size
-        dets = public_detections(loaded.folder, seq, len(frames))
+        seq, folder, frames, gt, size = load(root, name)
+        dets = public_detections(folder, seq, len(frames))
         for tracker in trackers:
             with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
                 warnings.simplefilter("ignore")
                 if tracker == "pftrack":
-                    online, final = run_pftrack(frames, dets)
-                    runs = steps(online, final)
+                    pf = PftrackStep()
+                    pf.prime(frames, own=False)
+                    runs = steps(online_rows(pf, frames, dets)[0], pf.result())
                 else:
-                    runs = steps(run_sort(seq, frames, dets), None)
+                    runs = steps(online_rows(make_sort(seq), frames, dets)[0], None)
             cells = []
             for step in STEPS:
                 if step not in runs:
