@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from pftrack import _progress
+from pftrack._threads import BLAS_THREAD_VARIABLES
 from pftrack.cli import build_parser, main
 from pftrack.cli._signals import Terminated
 from pftrack.eval import evaluate_mot
@@ -837,7 +838,8 @@ import pftrack.cli
 
 def run(argv):  # the command, as far as BLAS goes: NumPy loads once the command runs
     import numpy  # noqa: F401
-    print(os.environ.get("OPENBLAS_NUM_THREADS"), os.environ.get("MKL_NUM_THREADS"))
+    names = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")
+    print(*(os.environ.get(v) for v in names))
     return 0
 
 pftrack.cli.main = run
@@ -849,17 +851,15 @@ sys.exit(main({argv}))
 @pytest.mark.parametrize(
     ("argv", "given", "expected"),
     [
-        (None, None, "1 1"),  # the console script: BLAS at one thread
-        (None, "3", "3 1"),  # a user's setting stands
-        (["track"], None, "None None"),  # a library call leaves the process alone
+        (None, None, "1 1 1"),  # the console script: BLAS (and OpenMP) at one thread
+        (None, "3", "3 1 1"),  # a user's setting stands
+        (["track"], None, "None None None"),  # a library call leaves the process alone
     ],
 )
 def test_the_command_runs_blas_at_one_thread(
     argv: list[str] | None, given: str | None, expected: str
 ) -> None:
-    env = {
-        k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-    }
+    env = {k: v for k, v in os.environ.items() if k not in BLAS_THREAD_VARIABLES}
     if given is not None:
         env["OPENBLAS_NUM_THREADS"] = given
     env["PYTHONPATH"] = os.pathsep.join(sys.path)
