@@ -16,6 +16,7 @@ from pftrack.detection.base import median_frame
 from pftrack.detection.light import (
     channel_spread,
     frame_gain,
+    is_blank,
     is_dark,
     level_frames,
     levelled_median,
@@ -447,6 +448,17 @@ def test_is_dark() -> None:
     frame = np.full((36, 48, 3), 9, np.uint8)
     assert not is_dark(frame)
     assert is_dark(frame // 2) and is_dark(np.zeros((36, 48, 3), np.uint8))
+
+
+def test_is_blank_is_one_flat_level_not_a_dark_picture() -> None:
+    zeros = np.zeros((36, 48, 3), np.uint8)
+    assert is_blank(zeros) and is_blank(np.full_like(zeros, 255))  # white is blank, not dark
+    step = zeros.copy()
+    step[18:, :, 2] = 2
+    assert is_blank(step)  # within BLANK_LEVELS: an encoded black frame's noise
+    step[18:, :, 2] = 3
+    assert not is_blank(step) and is_dark(step)  # a dark picture: dark, not blank
+    assert not is_blank(make_scene(n_frames=1, rng=0).frames[0])
 
 
 @pytest.mark.parametrize("where", [0, 20, 39])

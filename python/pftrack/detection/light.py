@@ -12,7 +12,9 @@ Two rules of `PaperDetector` (docs/detection.md, "Grey video and changing light"
   its gain against the background is 0 and scaling the background by it would erase the
   model. A frame whose mean level is at most :data:`DARK_LEVEL` (:func:`is_dark`) is neither
   learnt nor compared: the detector reports no foreground on it, leaves the background as it
-  was, and does not start or prime a background from it.
+  was, and does not start or prime a background from it. A blank frame (:func:`is_blank`: one
+  flat level, as ``np.zeros`` placeholders are) gives the colour filters nothing either;
+  ``pftrack.Tracker.update`` says so when a run opens on one.
 * **Global gain.** A background learnt at one brightness reads a whole frame taken at another
   as foreground, and the selective update (slow where foreground) does not catch up.
   ``BackgroundModel.global_gain`` measures the frame's gain against the background (median
@@ -32,12 +34,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = [
+    "BLANK_LEVELS",
     "DARK_LEVEL",
     "GAIN_SAMPLE_STEP",
     "GREY_SAMPLE_STEP",
     "MIN_CONTENT",
     "channel_spread",
     "frame_gain",
+    "is_blank",
     "is_dark",
     "level_frames",
     "looks_grey",
@@ -85,6 +89,26 @@ def is_dark(frame: NDArray[np.uint8], step: int | None = None) -> bool:
     """
     step = sample_step(frame.shape) if step is None else step
     return float(frame[::step, ::step].mean()) <= DARK_LEVEL
+
+
+BLANK_LEVELS = 2
+"""Largest spread of a frame's levels (max - min) that :func:`is_blank` calls blank."""
+
+
+def is_blank(frame: NDArray[np.uint8]) -> bool:
+    """Tell whether `frame` is one flat level (a placeholder: ``np.zeros``, a black frame).
+
+    Unlike :func:`is_dark` (a low mean), a flat white or grey frame is blank too, and a dark
+    scene with any content is not. Every pixel is read (call it once, not per frame): a picture
+    of a scene is never within :data:`BLANK_LEVELS` levels everywhere; a placeholder always is,
+    and so is a black frame unless compression left more than that of noise in it.
+
+    Parameters
+    ----------
+    frame : (H, W, 3) ndarray of uint8
+        A BGR frame.
+    """
+    return int(frame.max()) - int(frame.min()) <= BLANK_LEVELS
 
 
 MIN_CONTENT = 8.0

@@ -46,6 +46,7 @@ from pftrack._typing import (
     RngLike,
     SamplerName,
 )
+from pftrack.detection.light import BLANK_LEVELS, is_blank
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
@@ -270,20 +271,6 @@ class _Alone:
 
     def __exit__(self, *exc: object) -> None:
         self.lock.release()
-
-
-BLANK_LEVELS = 2
-"""Largest spread of a frame's levels (max - min) that :meth:`Tracker.update` calls blank."""
-
-
-def _blank(frame: NDArray[np.uint8]) -> bool:
-    """Whether `frame` is one flat level (a placeholder: ``np.zeros``, a black frame).
-
-    Every pixel is read (it is done for a run's first frame only): a picture of a scene is
-    never within :data:`BLANK_LEVELS` levels everywhere; a placeholder always is, and so is a
-    black frame unless compression left more than that of noise in it.
-    """
-    return int(frame.max()) - int(frame.min()) <= BLANK_LEVELS
 
 
 class Tracker:
@@ -833,7 +820,7 @@ class Tracker:
                     "Tracker before a new video)"
                 )
             work = self._working(f)
-            if first and _blank(f):
+            if first and is_blank(f):
                 self._warn_once(
                     "blank",
                     f"frame 1 is blank (every pixel within {BLANK_LEVELS} levels of the others): "
