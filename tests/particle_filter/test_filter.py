@@ -268,6 +268,33 @@ def test_step_names_what_it_cannot_update(sampler, name, value, match):
         f.step(image)
 
 
+@pytest.mark.parametrize("sampler", ["sis", "mh"])
+def test_step_refuses_particles_beyond_the_box_bound(sampler):
+    """A user trial: particles set to 1e300 were stepped, and the filter's box was 2e300 px
+    (the constructor's bound is ±1e9 px, as every box's)."""
+    from pftrack.particle_filter import MHColourParticleFilter
+    from pftrack.particle_filter.filter import step_filters
+
+    image = hsv_bins(np.zeros((40, 40, 3), np.uint8))
+    f = (MHColourParticleFilter if sampler == "mh" else ColourParticleFilter)(BOX, REF, rng=0)
+    f.particles[3, 0] = 1e300
+    with pytest.raises(ValueError, match=r"particles has a value 1e\+300 at \[3, 0\] beyond"):
+        f.step(image)
+    with pytest.raises(ValueError, match=r"particles has a value 1e\+300 at \[3, 0\] beyond"):
+        step_filters([f], image)
+
+
+def test_weights_of_no_histograms_are_refused_by_name():
+    """``box_histograms`` of no boxes gives (0, B): its coefficients are empty, its weights
+    (summing to 1) cannot be; the message was the core's "hists rows is 0"."""
+    from pftrack.particle_filter import bhattacharyya_coefficient, bhattacharyya_weights
+
+    empty = box_histograms(hsv_bins(np.zeros((40, 40, 3), np.uint8)), np.zeros((0, 4)))
+    assert bhattacharyya_coefficient(empty, REF).shape == (0,)
+    with pytest.raises(ValueError, match="bhattacharyya_weights: hists has no rows"):
+        bhattacharyya_weights(empty, REF)
+
+
 @pytest.mark.parametrize("frame", [np.zeros((40, 40, 3), np.uint8), None, "frame.png"])
 def test_step_wants_binned_image(frame):
     from pftrack.particle_filter import MHColourParticleFilter

@@ -82,6 +82,21 @@ def test_colour_term_uses_the_hsv_histograms():
     assert link_tracklets(rows, cfg, same)[1] == {5: 1}
 
 
+def test_frames_must_be_a_sequence_and_cover_the_rows():
+    """A user trial: a generator failed on ``len``; three frames for rows of 24 frames left
+    the colour term out of later ends without a word."""
+    rows = scene()
+    cfg = LinkConfig(max_gap=20, max_distance=30)
+    frames = _frames_with_colours(
+        rows, {1: (0, 0, 255), 5: (0, 0, 255), 2: (255, 0, 0), 7: (0, 255, 0)}
+    )
+    with pytest.raises(TypeError, match="frames must be a sequence indexable by frame - 1"):
+        link_tracklets(rows, cfg, iter(frames))  # type: ignore[arg-type]
+    last = int(rows[:, 0].max())
+    with pytest.warns(UserWarning, match=f"frames holds 3 frames, the rows reach frame {last}"):
+        link_tracklets(rows, cfg, frames[:3])
+
+
 def test_fill_gaps_flags_rows_and_is_exact_on_straight_walkers():
     rows, _ = link_tracklets(scene(), LinkConfig(max_gap=20, max_distance=30))
     filled, rep = fill_gaps(rows, "gdt-bi", max_gap=20)

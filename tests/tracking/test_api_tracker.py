@@ -834,6 +834,72 @@ def test_an_update_that_raises_leaves_the_tracker_as_it_was(scene):
     assert joint.frame_count == joint.tracker.frame_index == 1
 
 
+def test_an_update_cut_short_stops_the_run_but_keeps_its_rows(scene):
+    """A user trial: Ctrl-C inside ``update`` (a notebook's stop button) after the tracker
+    inside had taken the frame left ``frame_count`` one behind; going on from it made
+    ``finalize()`` fail on a duplicate (frame, id) and lost the run."""
+    dets = scene_dets(scene)
+    tracker = pftrack.Tracker(frame_rate=10.0)
+    for d, f in zip(dets[:5], scene.frames[:5], strict=True):
+        tracker.update(d, f)
+    kept = tracker.finalize()
+    inner = tracker.tracker.update
+
+    def interrupted(*args, **kwargs):
+        inner(*args, **kwargs)
+        raise KeyboardInterrupt
+
+    tracker.tracker.update = interrupted  # type: ignore[method-assign]
+    with pytest.raises(KeyboardInterrupt):
+        tracker.update(dets[5], scene.frames[5])
+    del tracker.tracker.update
+    with pytest.raises(RuntimeError, match=r"frame 6 was interrupted .* frames 1-5, reset\(\)"):
+        tracker.update(dets[6], scene.frames[6])
+    np.testing.assert_array_equal(tracker.finalize(), kept)
+    tracker.reset()
+    _, plain = run_loop(pftrack.Tracker(frame_rate=10.0), scene.frames, dets)
+    _, again = run_loop(tracker, scene.frames, dets)
+    np.testing.assert_array_equal(again, plain)
+
+
+def test_normalised_boxes_are_said_once(scene):
+    """A user trial: a detector's x1y1x2y2n boxes (0..1) were tracked as sub-pixel boxes in
+    the frame's corner, without a word."""
+    dets = scene_dets(scene)
+    h, w = scene.frames[0].shape[:2]
+    tracker = pftrack.Tracker(frame_rate=10.0)
+    match = r"frame 1: every detection box lies within \[0, 1\]"
+    with pytest.warns(UserWarning, match=match) as rec:
+        for d, f in zip(dets[:5], scene.frames[:5], strict=True):
+            tracker.update(d / [w, h, w, h, 1.0], f)
+    assert sum("normalised" in str(r.message) for r in rec) == 1
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message=".*normalised")
+        run_loop(pftrack.Tracker(frame_rate=10.0), scene.frames[:5], dets[:5])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"link": "x"}, TypeError, "link must be a LinkConfig or None, got str"),
+        ({"smoother": "x"}, TypeError, "smoother must be a BoxSmoother or None, got str"),
+        ({"config": {}}, TypeError, "config must be a TrackerConfig, got dict"),
+        ({"frame_rate": -5}, ValueError, r"frame_rate is -5, expected a number in \(0, "),
+        ({"frame_rate": "25"}, TypeError, "frame_rate must be a number"),
+        ({"prime_frames": True}, ValueError, "prime_frames is True"),
+    ],
+)
+def test_from_config_checks_its_arguments_at_once(kwargs, error, match):
+    """Were accepted: ``link="x"`` failed at ``finalize()`` on a missing attribute."""
+    with pytest.raises(error, match=match):
+        pftrack.Tracker.from_config(**kwargs)
+
+
+def test_prime_of_what_is_not_iterable_is_a_type_error():
+    with pytest.raises(TypeError, match="prime takes an iterable of frames .* got NoneType"):
+        pftrack.Tracker().prime(None)  # type: ignore[arg-type]
+
+
 def test_prime_reads_no_more_than_prime_frames(scene):
     read = []
 

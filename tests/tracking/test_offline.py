@@ -195,6 +195,13 @@ def test_smooth_tracks_on_any_trackers_output():
     assert len(smooth_tracks(np.zeros((0, 10)))) == 0
     with pytest.raises(ValueError, match="observed has shape"):
         smooth_tracks(rows, observed=np.ones(3, bool))
+    # a user trial: these were taken (0.5 and NaN read as True) or failed deep inside
+    with pytest.raises(TypeError, match="observed must be an array of bool, got dtype float64"):
+        smooth_tracks(rows, observed=np.full(len(rows), 0.5))
+    with pytest.raises(TypeError, match="crossings must be a CrossingConfig or None, got str"):
+        smooth_tracks(rows, crossings="x")  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="smoother must be a BoxSmoother or None, got str"):
+        smooth_tracks(rows, smoother="x")  # type: ignore[arg-type]
 
 
 def test_cli_smooth_links_fills_and_refuses_its_input(tmp_path, capsys):

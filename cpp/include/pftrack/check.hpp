@@ -56,6 +56,22 @@ inline void require_finite(const Eigen::DenseBase<Derived>& a, const char* fn, c
             }
 }
 
+/// Every value of `a` finite and within +-`limit` (strictly): coordinates a box may have.
+template <typename Derived>
+inline void require_bounded(const Eigen::DenseBase<Derived>& a, double limit, const char* fn,
+                            const char* what) {
+    require_finite(a, fn, what);
+    for (Eigen::Index i = 0; i < a.rows(); ++i)
+        for (Eigen::Index j = 0; j < a.cols(); ++j)
+            if (!(std::abs(static_cast<double>(a(i, j))) < limit)) {
+                std::ostringstream s;
+                s << what << " has a value " << a(i, j) << " at [" << i;
+                if (a.cols() > 1) s << ", " << j;
+                s << "] beyond +-" << limit << " px";
+                fail(fn, s.str());
+            }
+}
+
 /// What particle weights summing to 0 mean inside the particle filter (sis_step, mh_step,
 /// estimate): every particle's likelihood underflowed or was never counted.
 inline constexpr const char* kParticleWeightsZero =

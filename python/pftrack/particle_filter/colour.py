@@ -282,12 +282,15 @@ def bhattacharyya_weights(
     TypeError
         `lam` is not a real number (a string, None, a bool), or the histograms hold no numbers.
     ValueError
-        `lam` is not finite and > 0; shapes that do not match (`ref` not 1-D); a negative or
-        non-finite entry; `ref` all zeros.
+        `lam` is not finite and > 0; no rows in `hists`; shapes that do not match (`ref` not
+        1-D); a negative or non-finite entry; `ref` all zeros.
     """
     fn = "bhattacharyya_weights"
     if isinstance(lam, bool) or not isinstance(lam, numbers.Real):
         raise TypeError(f"{fn}: lam must be a real number, got {type(lam).__name__} {lam!r}")
     if not (np.isfinite(lam) and lam > 0):
         raise ValueError(f"{fn}: lam is {lam}, expected a finite number > 0")
-    return _core.bhattacharyya_weights(_histograms(hists, fn), _reference(ref, fn), float(lam))
+    h = _histograms(hists, fn)
+    if len(h) == 0:  # box_histograms of no boxes: a coefficient each, but no weights to sum to 1
+        raise ValueError(f"{fn}: hists has no rows: weights that sum to 1 need a particle")
+    return _core.bhattacharyya_weights(h, _reference(ref, fn), float(lam))

@@ -506,10 +506,22 @@ def link_tracklets(
         raise TypeError(
             f"link_tracklets: config must be a LinkConfig, got {type(config).__name__} {config!r}"
         )
+    if frames is not None and not (hasattr(frames, "__len__") and hasattr(frames, "__getitem__")):
+        raise TypeError(
+            "link_tracklets: frames must be a sequence indexable by frame - 1 (a list, an "
+            f"array, a FrameSequence) or None, got {type(frames).__name__}"
+        )
     rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
     check_unique(rows, who="link_tracklets")  # a track seen twice has no velocity to link
     if len(rows) == 0:
         return rows, {}
+    if frames is not None and len(frames) < rows[:, 0].max():
+        warnings.warn(
+            f"link_tracklets: frames holds {len(frames)} frames, the rows reach frame "
+            f"{int(rows[:, 0].max())}: fragment ends after frame {len(frames)} are linked "
+            "without the colour term",
+            stacklevel=2,
+        )
     per_id = split_tracks(rows)
     ids, i, j, cost = link_costs(per_id, config, frames)
     nxt = {ids[a]: ids[b] for a, b in _assign(i, j, cost)}

@@ -101,6 +101,14 @@ def _frames(seconds: float, frame_rate: float, name: str) -> int:
     return int(round(n))
 
 
+def _check_rate(frame_rate: object) -> None:
+    """TypeError or ValueError unless `frame_rate` is a number in ``(0, MAX_FRAME_RATE]``."""
+    if not 0 < number(frame_rate, "frame_rate") <= MAX_FRAME_RATE:
+        raise ValueError(
+            f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
+        )
+
+
 def xywh_to_xyxy_dets(dets: ArrayLike) -> F64:
     """``[left, top, w, h, ...]`` rows as ``[x1, y1, x2, y2, ...]`` (other columns kept)."""
     d = np.asarray(dets, dtype=np.float64)
@@ -414,10 +422,7 @@ class Tracker:
     ) -> None:
         if seed is not None:
             seed = check_seed(seed, "seed")
-        if not 0 < number(frame_rate, "frame_rate") <= MAX_FRAME_RATE:
-            raise ValueError(
-                f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
-            )
+        _check_rate(frame_rate)
         refine, smooth, link, crossings, record = (
             flag(refine, "refine"), flag(smooth, "smooth"), flag(link, "link"),
             flag(crossings, "crossings"), flag(record, "record"),
@@ -520,10 +525,17 @@ class Tracker:
                coasting: str = "confirmed", record: bool = True) -> None:  # fmt: skip
         if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
             raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")
-        if not isinstance(prime_frames, (int, np.integer)) or prime_frames < 0:
+        if not isinstance(config, TrackerConfig):
+            raise TypeError(f"config must be a TrackerConfig, got {type(config).__name__}")
+        if (
+            isinstance(prime_frames, (bool, np.bool_))
+            or not isinstance(prime_frames, (int, np.integer))
+            or prime_frames < 0
+        ):
             raise ValueError(f"prime_frames is {prime_frames!r}, expected an integer >= 0")
+        _check_rate(frame_rate)
         self.config = config
-        self.frame_rate = frame_rate
+        self.frame_rate = float(frame_rate)
         self.seed = seed
         self.prime_frames = int(prime_frames)
         self.record = record
@@ -626,6 +638,8 @@ class Tracker:
             self._scale: F64 | None = None
             self._shape: tuple[int, ...] | None = None  # the run's frame shape
             self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
+            # the frame whose update was cut short after it changed the tracker (0: none)
+            self._torn = 0
 
     @property
     def tracker(self) -> MultiObjectTracker:
@@ -738,10 +752,17 @@ class Tracker:
                 "prime takes an iterable of frames (a list, or a (K, H, W, 3) array), got one "
                 f"{frames.shape} frame: prime([frame])"
             )
+        try:
+            iterator = iter(frames)
+        except TypeError:
+            raise TypeError(
+                f"prime takes an iterable of frames (a list, a generator or a (K, H, W, 3) "
+                f"array), got {type(frames).__name__}"
+            ) from None
         with self._alone("prime"):
             if self.frame_count:
                 raise ValueError("prime() must come before the first update()")
-            first = itertools.islice(frames, self.prime_frames)  # no more: a whole video is big
+            first = itertools.islice(iterator, self.prime_frames)  # no more: a whole video is big
             picked = []
             shape: tuple[int, ...] | None = None
             for i, frame in enumerate(first):
@@ -800,8 +821,22 @@ class Tracker:
             does not want. Once, when the run's first frame is blank (one flat level, as
             ``np.zeros`` placeholders are): the colour filters and box refinement then have
             nothing to use.
+
+        Raises
+        ------
+        RuntimeError
+            An earlier ``update`` of the run was cut short (KeyboardInterrupt, or an error
+            inside the tracker) after it had changed the tracker: the run cannot go on, but
+            :meth:`finalize` returns the frames before it and :meth:`reset` starts a new run.
         """
         with self._alone("update"):
+            if self._torn:
+                raise RuntimeError(
+                    f"Tracker.update: the update of frame {self._torn} was interrupted "
+                    "(KeyboardInterrupt, or an error inside the tracker) after it had changed "
+                    "the tracker, which no longer holds a whole frame; finalize() still returns "
+                    f"the rows of frames 1-{self._torn - 1}, reset() starts a new run"
+                )
             f = bgr_frame(frame)
             shape = self._shape  # None until the run's first frame is taken
             first = shape is None
@@ -838,6 +873,7 @@ class Tracker:
                         "np.zeros((0, 6))",
                     )
                 kept = None
+                self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
                 reports = self._tracker.update(work, None)
                 if self._tracker.camera_step.moving:
                     self._warn_moving_camera()
@@ -866,10 +902,24 @@ class Tracker:
                         "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
                     )
                 confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
+                if (
+                    self._max_conf == -np.inf and len(xywh) and min(f.shape[:2]) > 2
+                    and (xywh[:, 0] + xywh[:, 2]).max() <= 1
+                    and (xywh[:, 1] + xywh[:, 3]).max() <= 1
+                ):  # fmt: skip
+                    # the run's first boxes, all inside one pixel: a detector's xyxyn output
+                    self._warn_once(
+                        "normalised",
+                        f"frame {self.frame_count + 1}: every detection box lies within "
+                        "[0, 1] x [0, 1] of a "
+                        f"{f.shape[1]}x{f.shape[0]} frame: normalised coordinates? give "
+                        "pixels (x times the width, y times the height)",
+                    )
                 if self._scale is not None:
                     xywh[:, :4] *= self._scale
                 # inside the frame as checked: the tracker need not check them again (scaled
                 # boxes are, in case a box's scaled edge rounds past the working frame's)
+                self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
                 reports = self._tracker.update(work, xywh, cls, checked=self._scale is None)
                 self._given = (
                     True  # once the frame is taken (an update that raises changes nothing)
@@ -884,6 +934,7 @@ class Tracker:
                 self._stabiliser.add(self._tracker.camera_step.apply)
                 self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
             self._reports = reports
+            self._torn = 0
             # coasting tracks (carried by the particle filter alone) are held back
             live = [t for t in reports if t.time_since_update == 0]
             out = np.zeros((len(live), 8))

@@ -525,7 +525,8 @@ def smooth_tracks(
     Raises
     ------
     TypeError
-        `link` not a LinkConfig, ``"auto"`` or None.
+        `link` not a LinkConfig, ``"auto"`` or None; `smoother` or `crossings` not a
+        BoxSmoother or CrossingConfig or None; `observed` not of bool.
     ValueError
         Rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a
         non-integer id, a non-finite box, a box (of the rows or `measurements`) that
@@ -553,10 +554,21 @@ def smooth_tracks(
             "smooth_tracks: link must be a LinkConfig, 'auto' or None, got "
             f"{type(link).__name__} {link!r}"
         )
+    if crossings is not None and not isinstance(crossings, CrossingConfig):
+        raise TypeError(
+            "smooth_tracks: crossings must be a CrossingConfig or None, got "
+            f"{type(crossings).__name__}"
+        )
+    if smoother is not None and not isinstance(smoother, BoxSmoother):
+        raise TypeError(
+            f"smooth_tracks: smoother must be a BoxSmoother or None, got {type(smoother).__name__}"
+        )
     a: F64 = check_rows(rows, "smooth_tracks")
     check_unique(a, who="smooth_tracks")  # was: BoxSmoother.smooth's "frames must be ..."
     a = a.copy()
-    obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed, dtype=bool)
+    obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed)
+    if obs.dtype != np.bool_:  # 0.5 or NaN would read as True
+        raise TypeError(f"smooth_tracks: observed must be an array of bool, got dtype {obs.dtype}")
     if obs.shape != (len(a),):
         raise ValueError(f"smooth_tracks: observed has shape {obs.shape}, expected ({len(a)},)")
     if len(a) == 0:

@@ -97,6 +97,12 @@ class TrackWriter:
             raise ValueError(f"coasting is {coasting!r}, expected 'confirmed', 'all' or 'none'")
         if fill not in ("linear", "pf"):
             raise ValueError(f"fill is {fill!r}, expected 'linear' or 'pf'")
+        if smoother is not None and not isinstance(smoother, BoxSmoother):
+            raise TypeError(
+                f"smoother must be a BoxSmoother or None, got {type(smoother).__name__}"
+            )
+        if link is not None and not isinstance(link, LinkConfig):
+            raise TypeError(f"link must be a LinkConfig or None, got {type(link).__name__}")
         self.coasting = coasting
         self.fill = fill
         self.smoother = smoother
