@@ -388,8 +388,9 @@ def test_resume_skips_complete_outputs_and_force_redoes(
     assert main([*argv, *FAST]) == 0
     assert set(statuses().values()) == {"skipped"}
     assert all(out.joinpath(n).stat().st_mtime_ns == t for n, t in stamp.items() if n[0] != "s")
-    # an interrupted sequence (outputs present, sidecar absent) is redone, alone
+    # a sequence whose outputs are gone is redone, alone
     (out / "plain.json").unlink()
+    (out / "plain.txt").unlink()
     assert main([*argv, *FAST]) == 0
     assert statuses() == {"walk": "skipped", "MOT-01": "skipped", "plain": "done"}
     # other settings: not complete for them
@@ -398,6 +399,38 @@ def test_resume_skips_complete_outputs_and_force_redoes(
     assert main([*argv, *FAST, "--force"]) == 0
     assert set(statuses().values()) == {"done"}
     assert _files(out) == before
+
+
+def test_files_no_batch_wrote_are_not_replaced_without_force(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``--out`` the input folder (as docs/batch.md allows) replaced the user's
+    own ``walk.txt`` (their annotations beside ``walk.avi``) with the tracks, exit 0."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    argv = ["batch", str(vids), "--out", str(vids), "--workers", "0", *FAST]
+    for name, text in (("walk.txt", "my annotations\n"), ("walk.json", "{}\n"),
+                       ("summary.json", "[1, 2]\n")):  # fmt: skip
+        (vids / name).write_text(text)
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(vids / name) in err, err
+        assert "this run would replace it: move it, write elsewhere, or give --force" in err
+        assert sorted(p.name for p in vids.iterdir()) == sorted(["walk.avi", name])
+        assert (vids / name).read_text() == text
+        if name != "summary.json":
+            (vids / name).unlink()
+    (vids / "summary.json").unlink()
+    assert main(argv) == 0  # nothing in the way
+    assert main(argv) == 0  # and its own outputs: skipped, or redone with other settings
+    assert main([*argv, "--particles", "31"]) == 0
+    (vids / "walk.txt").write_text("my annotations\n")  # replaced by the user: still a batch's
+    assert main([*argv, "--force"]) == 0
+    assert (vids / "walk.txt").read_text() != "my annotations\n"
+    with pytest.raises(ValueError, match=r"exists and no earlier batch .* give force=True"):
+        (vids / "walk.json").unlink()
+        track_many([vids], vids, n_workers=0)
 
 
 def test_resume_redoes_a_file_whose_content_changed(

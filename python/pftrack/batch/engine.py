@@ -1143,10 +1143,52 @@ def named_as_options() -> Iterator[None]:
         _OUT_NAMES.reset(token)
 
 
+def _batch_files(out_dir: Path, name: str) -> set[str] | None:
+    """The files of `out_dir` an earlier batch's sidecar ``NAME.json`` names, itself included.
+
+    None when ``NAME.json`` is missing; an empty set when it is not a batch's sidecar (a
+    user's own file of that name).
+    """
+    path = _sidecar(out_dir, name)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):
+        return set()
+    try:
+        entry = json.loads(text)
+    except ValueError:
+        return set()
+    if not (
+        isinstance(entry, dict)
+        and entry.get("name") == name
+        and entry.get("kind") in ("track", "recover", "smooth")
+        and isinstance(entry.get("outputs"), list)
+    ):
+        return set()
+    listed = [*entry["outputs"], *(entry.get("earlier_outputs") or [])]
+    return {path.name, *(o for o in listed if isinstance(o, str))}
+
+
+def _is_summary(path: Path) -> bool:
+    """Whether the file `path` is a batch's ``summary.json`` (:meth:`BatchSummary.as_dict`)."""
+    try:
+        entry = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(entry, dict) and {"kind", "counts", "settings"} <= set(entry)
+
+
 def _check_outputs(
-    jobs: Sequence[Job], out_dir: str | os.PathLike[str], suffixes: Sequence[str]
+    jobs: Sequence[Job],
+    out_dir: str | os.PathLike[str],
+    suffixes: Sequence[str],
+    force: bool = False,
 ) -> Path:
-    """Before any work, writing nothing: no output overwrites an input or is a folder.
+    """Before any work, writing nothing: no output overwrites an input or is a folder, and,
+    unless `force`, none replaces a file that no earlier batch wrote (a user's ``NAME.txt``
+    beside ``NAME.avi`` in a folder that is also ``--out``).
 
     Returns `out_dir` as a Path (checked as given: an empty one is refused, not taken for the
     current folder).
@@ -1165,6 +1207,28 @@ def _check_outputs(
             raise ValueError(f"{what} is an input of this run; write elsewhere")
         if target.is_dir():
             raise ValueError(f"{out_name} {target} is a folder; it would be an output of this run")
+    if force:
+        return out_dir
+    force_name = "--force" if out_name == "--out" else "force=True"
+    summary = out_dir / SUMMARY_NAME
+    if summary.exists() and not _is_summary(summary):
+        raise ValueError(
+            f"{out_name} {summary} exists and is not a batch's summary; this run would replace "
+            f"it: move it, write elsewhere, or give {force_name}"
+        )
+    for job in jobs:
+        ours = None  # read once a file of this job is found
+        for name in (f"{job.name}{s}" for s in (".txt", ".json", *suffixes)):
+            if not (out_dir / name).exists():
+                continue
+            if ours is None:
+                ours = _batch_files(out_dir, job.name) or set()
+            if name not in ours:
+                raise ValueError(
+                    f"{out_name} {out_dir / name} exists and no earlier batch wrote it (no "
+                    f"sidecar {job.name}.json of one names it); this run would replace it: "
+                    f"move it, write elsewhere, or give {force_name}"
+                )
     return out_dir
 
 
@@ -1257,7 +1321,7 @@ def run_jobs(
         raise ValueError(f"n_workers is {n_workers}, expected >= 0")
     address = where_to_run(client, scheduler, n_workers)  # checked even when nothing is to run
     start = time.perf_counter()
-    out = _check_outputs(jobs, out_dir, suffixes)
+    out = _check_outputs(jobs, out_dir, suffixes, force)
     summary = BatchSummary(kind, out, settings=settings)
     entries: dict[str, dict[str, Any]] = {}
     notes: dict[str, str] = {}

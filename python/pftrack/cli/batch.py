@@ -70,7 +70,8 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     g.add_argument("--force", action="store_true",
                    help="redo inputs whose outputs are complete, instead of skipping "
-                   "them")  # fmt: skip
+                   "them, and replace files of the outputs' names in DIR that no earlier "
+                   "batch wrote (refused without it)")  # fmt: skip
 
 
 def _cores() -> int:
