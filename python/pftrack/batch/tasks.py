@@ -365,13 +365,16 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         on_frame=None if report is None and stop is None else _on_frame(report, stop),
     )
     rows = run.rows
+    written = _as_written(rows)  # NAME.txt's values: what pftrack render and eval read
     files: dict[str, bytes] = {}
     if options.render is not None:
         from pftrack.render import write_annotated_video
 
         with tempfile.TemporaryDirectory(prefix="pftrack-render-") as tmp:
             target = Path(tmp) / f"{seq.name}{options.render}"
-            write_annotated_video(target, _checked(FrameSource(seq.frames), stop), rows, frames.fps)
+            write_annotated_video(
+                target, _checked(FrameSource(seq.frames), stop), written, frames.fps
+            )
             files[options.render] = target.read_bytes()
     metrics = error = trace = None
     if seq.gt is not None:  # last: a ground truth that cannot be scored loses no tracks
@@ -387,7 +390,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
             named = benchmark_of_path(seq.gt)
             metrics = sequence_metrics(
                 gt,
-                _as_written(rows),
+                written,
                 scale=auto_scale,
                 iou=options.iou,
                 benchmark="auto" if named is None else named[0],
