@@ -46,6 +46,7 @@ from pftrack.batch import (
 from pftrack.cli import main
 from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import read_mot, write_mot
+from pftrack.io.video import FrameSource
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
 
@@ -109,7 +110,14 @@ def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
         (seq / name).write_text("")
     (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=768\n")
     assert find_sequences(tmp_path) == [
-        SequenceInput("pets", seq / "video.avi", seq / "det.txt", seq / "gt.txt", 768)
+        SequenceInput(
+            "pets",
+            seq / "video.avi",
+            seq / "det.txt",
+            seq / "gt.txt",
+            768,
+            seqinfo=seq / "seqinfo.ini",
+        )  # fmt: skip
     ]
 
 
@@ -119,9 +127,6 @@ def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
         ({"a/x.avi": "", "b/x.avi": ""}, "both named 'x'"),
         ({"summary.avi": ""}, "reserved"),
         ({"notes.txt": ""}, "no sequence in folder"),
-        ({"s/seqinfo.ini": "", "s/a.avi": "", "s/b.avi": ""}, "not exactly one video"),
-        ({"s/seqinfo.ini": "", "s/a.avi": ""}, r"expected a \[Sequence\] section"),
-        ({"s/seqinfo.ini": "[Sequence]\nimWidth=wide\n", "s/a.avi": ""}, "imWidth is 'wide'"),
     ],
 )
 def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message: str) -> None:
@@ -131,6 +136,55 @@ def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message:
     tops = sorted({tmp_path / rel.split("/")[0] for rel in layout if "/" in rel}) or [tmp_path]
     with pytest.raises(ValueError, match=message):
         find_sequences(tops)
+
+
+@pytest.mark.parametrize(
+    ("files", "message"),
+    [
+        (
+            {"s/seqinfo.ini": "[Sequence]\nimDir=frames\n", "s/a.avi": "", "s/b.avi": ""},
+            r"image folder .*frames does not exist and .* 2 videos",
+        ),
+        ({}, r"seqinfo.ini: expected a \[Sequence\] section"),
+        ({"s/seqinfo.ini": "[Sequence]\nimWidth=wide\n"}, "imWidth is 'wide'"),
+        ({"s/seqinfo.ini": "[Sequence]\nframeRate=0\n"}, "frameRate is '0'"),
+        (
+            {"s/seqinfo.ini": "[Sequence]\nimWidth=1e300\n"},
+            r"imWidth is '1e300', expected an "
+            r"integer in 1\.\.100000",
+        ),  # fmt: skip
+        ({"s/seqinfo.ini": "[Sequence]\nimDir=nothere\n"}, r"image folder .*nothere does not"),
+    ],
+)
+def test_a_sequence_folder_pftrack_track_refuses_fails_alone(
+    data: Path, tmp_path: Path, files: dict[str, str], message: str
+) -> None:
+    """A user trial: one bad ``seqinfo.ini`` in a folder of sequences stopped the whole batch
+    (exit 2); ``imDir`` was not read (``pftrack track`` reads it)."""
+    root = tmp_path / "in"
+    shutil.copytree(data / "MOT-01", root / "good")
+    shutil.copytree(data / "MOT-01" / "img1", root / "s" / "img1")
+    for rel, text in {"s/seqinfo.ini": "", **files}.items():
+        (root / rel).write_text(text)
+    summary = track_many(root, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    status = {e["name"]: (e["status"], e.get("error")) for e in summary.entries}
+    assert status["good"] == ("done", None)
+    assert status["s"][0] == "failed" and re.search(message, status["s"][1]), status["s"]
+    with pytest.raises(ValueError, match=message):  # as pftrack track says it
+        FrameSource(root / "s")
+
+
+def test_a_sequence_folder_is_read_from_its_imdir(data: Path, tmp_path: Path) -> None:
+    seq = tmp_path / "SEQ"
+    shutil.copytree(data / "MOT-01", seq)
+    (seq / "img1").rename(seq / "frames")
+    (seq / "seqinfo.ini").write_text(
+        "[Sequence]\nname=MOT-01\nimDir=frames\nimWidth=192\nimHeight=144\n"
+    )
+    (found,) = find_sequences(seq)
+    assert found.frames == seq / "frames" and found.seqinfo == seq / "seqinfo.ini"
+    summary = track_many(seq, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    assert summary.entries[0]["status"] == "done"
 
 
 @pytest.mark.parametrize(
@@ -1177,7 +1231,6 @@ def test_scheduler_and_worker_started_as_processes(data: Path, tmp_path: Path) -
 def test_render_writes_a_video_per_sequence_and_counts_for_resume(
     data: Path, client: Any, tmp_path: Path
 ) -> None:
-    from pftrack.io.video import FrameSource
 
     options = TrackOptions(config=_config(), render=".mp4")
     first = track_many(data / "plain", tmp_path, client, options=options)

@@ -25,6 +25,7 @@ from pftrack.cli import build_parser, main
 from pftrack.cli._signals import Terminated
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
+from pftrack.io.video import read_seqinfo
 from pftrack.synthetic import Scene, make_scene
 from tests.conftest import dataset
 from tests.io.streaming import serve_stream
@@ -104,7 +105,9 @@ def test_fps_overrides_seqinfo(sequence: Path, tmp_path: Path) -> None:
         ("frameRate=7\nframeRate=8\n", "key frameRate in [Sequence] is given twice (lines 2 "
                                        "and 3); give it once"),
         # was: exit 0, imWidth=0.4 rounded to 0 and taken as absent (scale 1)
-        ("frameRate=7\nimWidth=0.4\n", "imWidth is '0.4', expected an integer > 0"),
+        ("frameRate=7\nimWidth=0.4\n", "imWidth is '0.4', expected an integer in 1..100000"),
+        # was taken, and a later message printed a 300-digit number
+        ("imWidth=1e300\n", "imWidth is '1e300', expected an integer in 1..100000"),
     ],
 )  # fmt: skip
 def test_a_bad_seqinfo_is_refused_before_any_output(
@@ -118,6 +121,17 @@ def test_a_bad_seqinfo_is_refused_before_any_output(
     assert main(["track", str(seq), "--out", str(out), "--render", str(video)]) == 2
     assert capsys.readouterr().err == f"pftrack track: error: {seq}/seqinfo.ini: {said}\n"
     assert not out.exists() and not video.exists()
+
+
+def test_a_seqinfo_that_is_not_utf8_is_read_for_its_numbers(sequence: Path, tmp_path: Path) -> None:
+    """A user trial: ``name=Caf\\xe9`` (Latin-1) stopped track, render, batch and experiment
+    with a decoder's message that named no file; the keys pftrack reads are ASCII."""
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "seqinfo.ini").write_bytes(b"[Sequence]\nname=Caf\xe9\nframeRate=7\nimWidth=9\n")
+    info = read_seqinfo(seq)
+    assert (info.name, info.frame_rate, info.width) == ("Caf\ufffd", 7.0, 9)
 
 
 def test_sequence_detections_in_seqinfo_pixels_are_scaled(

@@ -114,7 +114,7 @@ def test_repeated_rows_are_named_by_file_and_line_as_recover_names_them(
         # was "auto_masks: image size is 0x370, expected > 0" (an internal function, no file)
         ("imWidth=0\nimHeight=370", "imWidth is '0', expected a number > 0"),
         # was "auto_masks: mask side 1.30208e+08 px exceeds the image 1e+09x370"
-        ("imWidth=1e9\nimHeight=370", "imWidth is 1000000000, expected at most 100000 px"),
+        ("imWidth=1e9\nimHeight=370", "imWidth is '1e9', expected an integer in 1..100000"),
         # was "expected [Sequence] imWidth and imHeight", though both keys are there
         ("imWidth=abc\nimHeight=370", "imWidth is 'abc', expected a number > 0"),
         ("imWidth=768\nimHeight=", "imHeight is empty; give a value or leave the key out"),
@@ -134,6 +134,21 @@ def test_a_bad_seqinfo_is_named_with_its_key_and_value(
     err = capsys.readouterr().err
     assert err.startswith(f"pftrack experiment gaps: error: {seq / 'seqinfo.ini'}: {message}"), err
     assert err.count("\n") == 1
+
+
+def test_a_method_named_twice_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``--methods linear,linear`` counted each mask position twice."""
+    gt = tmp_path / "gt.txt"
+    write_mot(gt, _walkers(n_ids=3, n_frames=30))
+    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--methods",
+            "linear,auto,linear"]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "pftrack experiment gaps: error: --methods names linear more than once; name each once\n"
+    )
 
 
 def test_too_small_an_image_size_is_named_for_its_sequence(

@@ -89,7 +89,7 @@ class Job:
         drawn.
     guards : tuple of Path
         The files inside `reads` the task reads too, which outputs may not be either (the
-        images of a folder, a sequence's ``seqinfo.ini``); not fingerprinted.
+        images of a folder); not fingerprinted.
     """
 
     name: str
@@ -1186,9 +1186,10 @@ def _check_outputs(
     suffixes: Sequence[str],
     force: bool = False,
 ) -> Path:
-    """Before any work, writing nothing: no output overwrites an input or is a folder, and,
-    unless `force`, none replaces a file that no earlier batch wrote (a user's ``NAME.txt``
-    beside ``NAME.avi`` in a folder that is also ``--out``).
+    """Before any work, writing nothing: no output overwrites an input or is a folder.
+
+    Unless `force`, none replaces a file that no earlier batch wrote either (a user's
+    ``NAME.txt`` beside ``NAME.avi`` in a folder that is also ``--out``).
 
     Returns `out_dir` as a Path (checked as given: an empty one is refused, not taken for the
     current folder).

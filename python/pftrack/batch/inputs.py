@@ -59,11 +59,17 @@ class SequenceInput:
     gt: Path | None = None
     image_width: int | None = None
     image_height: int | None = None
+    seqinfo: Path | None = None
 
     @property
     def files(self) -> tuple[Path, ...]:
-        """Every file or folder the sequence reads."""
-        return tuple(p for p in (self.frames, self.detections, self.gt) if p is not None)
+        """Every file or folder the sequence reads.
+
+        ``seqinfo.ini`` too: its sizes scale the boxes, so a resumed batch redoes a sequence
+        whose ``seqinfo.ini`` changed.
+        """
+        paths = (self.frames, self.detections, self.gt, self.seqinfo)
+        return tuple(p for p in paths if p is not None)
 
 
 def _absolute(inputs: Inputs) -> list[Path]:
@@ -73,6 +79,8 @@ def _absolute(inputs: Inputs) -> list[Path]:
         raise ValueError("no input given")
     for p in paths:  # was: "input not found: /cwd/-"
         refuse_dash(p, "input", name="file or folder")
+        if os.fspath(p) == "":  # was: the current folder, tracked as an image folder
+            raise ValueError("an input is an empty path; give a file or folder")
     return [Path(os.path.abspath(p)) for p in paths]
 
 
@@ -119,27 +127,31 @@ def _as_sequence(path: Path) -> SequenceInput | None:
         return SequenceInput(path.stem, path)
     if path.name == "img1" and (path.parent / "seqinfo.ini").is_file():
         path = path.parent  # SEQ/img1 given: the sequence is SEQ
-    marked = (path / "seqinfo.ini").is_file()
-    if (path / "img1").is_dir():
-        frames = path / "img1"
-    elif _has_images(path):
-        frames = path
-    elif not marked:
-        return None
-    elif len(videos := _videos(path)) == 1:  # the shared data's layout: SEQ/video.avi
-        frames = videos[0]
-    else:
-        raise ValueError(
-            f"sequence folder {path} has no img1/ and not exactly one video ({len(videos)} found)"
-        )
-    info = read_seqinfo(path) if marked else None
+    ini = path / "seqinfo.ini"
+    if not ini.is_file():
+        if (path / "img1").is_dir():
+            return SequenceInput(path.name, path / "img1", *_annotations(path))
+        return SequenceInput(path.name, path, *_annotations(path)) if _has_images(path) else None
+    # a sequence folder, read as pftrack track reads it: its imDir, else its one video
+    try:
+        info = read_seqinfo(ini)
+    except ValueError:  # its task reads it again and fails, naming the fault; the others run
+        return SequenceInput(path.name, path, seqinfo=ini)
+    frames = path / info.image_dir
+    if not frames.is_dir():
+        videos = _videos(path)  # the shared data's layout: SEQ/video.avi
+        # none or several: the task fails, as pftrack track SEQ does, and the others run
+        frames = videos[0] if len(videos) == 1 else path
     return SequenceInput(
-        path.name,
-        frames,
-        _first_file(path, "det/det.txt", "det.txt"),
-        _first_file(path, "gt/gt.txt", "gt.txt"),
-        info.width if info else None,
-        info.height if info else None,
+        path.name, frames, *_annotations(path), info.width, info.height, seqinfo=ini
+    )
+
+
+def _annotations(folder: Path) -> tuple[Path | None, Path | None]:
+    """A sequence folder's detection and ground-truth files, if any."""
+    return (
+        _first_file(folder, "det/det.txt", "det.txt"),
+        _first_file(folder, "gt/gt.txt", "gt.txt"),
     )
 
 

@@ -153,8 +153,8 @@ def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
     """Name and image size from ``seqinfo.ini`` beside the ground truth or one folder up.
 
     Read by :func:`pftrack.io.video.read_seqinfo` (its errors name the file, the key and its
-    value: ``imWidth is '0', expected a number > 0``); ``imWidth`` and ``imHeight`` must be
-    given, and at most :data:`MAX_SIDE` px (the bound of ``--image-size``).
+    value: ``imWidth is '0', expected a number > 0``; at most ``MAX_IMAGE_SIDE`` px, the bound
+    of ``--image-size``); ``imWidth`` and ``imHeight`` must be given.
     """
     from pftrack.io.video import read_seqinfo
 
@@ -168,10 +168,6 @@ def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
                 f"{ini}: no {key} in [Sequence]; the image size of the ground truth needs "
                 "imWidth and imHeight"
             )
-        if value > MAX_SIDE:
-            raise ValueError(
-                f"{ini}: {key} is {value}, expected at most {MAX_SIDE:g} px (as --image-size)"
-            )
     assert info.width is not None and info.height is not None  # checked above
     return info.name, float(info.width), float(info.height)
 
@@ -183,6 +179,9 @@ def _methods(text: str) -> list[str]:
             raise ValueError(f"--methods: unknown method {m!r}, expected some of {METHODS}")
     if not methods:
         raise ValueError("--methods is empty")
+    twice = sorted({m for m in methods if methods.count(m) > 1})
+    if twice:  # was taken: each position counted once per copy ("median over 4 positions")
+        raise ValueError(f"--methods names {', '.join(twice)} more than once; name each once")
     return methods
 
 

@@ -86,19 +86,6 @@ def read_seqinfo(path: PathLike) -> dict[str, str]:
     return dict(parser["Sequence"])
 
 
-def _int_field(info: Mapping[str, str], key: str, path: Path) -> int | None:
-    text = info.get(key.lower())
-    if text is None:
-        return None
-    try:
-        value = int(text)
-    except ValueError:
-        raise ValueError(f"{path}: {key} is {text!r}, expected an integer") from None
-    if value < 1:
-        raise ValueError(f"{path}: {key} is {value}, expected >= 1")
-    return value
-
-
 def _sequence(folder: Path) -> SequenceInfo | None:
     gt = next((p for p in (folder / "gt" / "gt.txt", folder / "gt.txt") if p.is_file()), None)
     if gt is None:
@@ -106,14 +93,10 @@ def _sequence(folder: Path) -> SequenceInfo | None:
     ini = folder / "seqinfo.ini"
     if not ini.is_file():
         return SequenceInfo(folder.name, gt)
-    info = read_seqinfo(ini)
-    return SequenceInfo(
-        folder.name,
-        gt,
-        length=_int_field(info, "seqLength", ini),
-        width=_int_field(info, "imWidth", ini),
-        height=_int_field(info, "imHeight", ini),
-    )
+    from pftrack.io.video import read_seqinfo as read_info  # track's and batch's reader
+
+    info = read_info(ini)  # its errors name the file, key and value, as theirs do
+    return SequenceInfo(folder.name, gt, length=info.length, width=info.width, height=info.height)
 
 
 def sequence_of_file(gt_file: PathLike, name: str) -> SequenceInfo:

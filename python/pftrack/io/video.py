@@ -71,6 +71,9 @@ DEFAULT_FPS = 25.0
 #: The frame rates ``seqinfo.ini``'s ``frameRate`` may give, as ``pftrack track --fps`` (frames per
 #: second): 1e9 wrote an MP4 at 1e9 fps, 0.001 made 100 frames a 28-hour video.
 FRAME_RATE_RANGE = (0.01, 1000.0)
+#: Largest ``imWidth`` / ``imHeight`` a ``seqinfo.ini`` may give (px), as ``pftrack eval``'s
+#: ``--image-size``.
+MAX_IMAGE_SIDE = 100_000
 #: The codec FFmpeg's ``tty`` demuxer reports: it opens text files (``.txt``, ``.nfo``, ``.asc``,
 #: ...) as ANSI art, 640x400 frames of rendered characters. A text file is not a video.
 TEXT_FOURCC = "ansi"
@@ -285,7 +288,13 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         ini = ini / "seqinfo.ini"
     parser = configparser.ConfigParser(interpolation=None)
     try:
-        parser.read(ini, encoding="utf-8-sig")  # -sig: skips a byte-order mark (Notepad)
+        # -sig: skips a byte-order mark (Notepad); a name in Latin-1 (Caf\xe9) is no reason to
+        # refuse the numbers pftrack reads, which are ASCII: undecodable bytes are replaced
+        text = ini.read_text(encoding="utf-8-sig", errors="replace")
+    except OSError as exc:
+        raise ValueError(f"{ini}: cannot be read ({exc.strerror})") from None
+    try:
+        parser.read_string(text, source=str(ini))
         sec = parser["Sequence"]
     except (configparser.DuplicateOptionError, configparser.DuplicateSectionError) as exc:
         raise ValueError(_duplicate(ini, exc)) from None
@@ -312,10 +321,13 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
             raise ValueError(f"{ini}: {key} is {text!r}, expected a number > 0")
         return value
 
-    def integer(key: str) -> int | None:
+    def integer(key: str, limit: int) -> int | None:
         value = number(key)
-        if value is not None and not value.is_integer():  # was rounded: 0.4 to 0, an absent size
-            raise ValueError(f"{ini}: {key} is {sec[key].strip()!r}, expected an integer > 0")
+        # not an integer was rounded: 0.4 to 0, an absent size; 1e300 was taken
+        if value is not None and not (value.is_integer() and value <= limit):
+            raise ValueError(
+                f"{ini}: {key} is {sec[key].strip()!r}, expected an integer in 1..{limit}"
+            )
         return None if value is None else int(value)
 
     frame_rate = number("frameRate")
@@ -330,9 +342,9 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         name=text_of("name") or ini.parent.name,
         frame_rate=frame_rate,
         image_dir=text_of("imDir") or "img1",
-        width=integer("imWidth"),
-        height=integer("imHeight"),
-        length=integer("seqLength"),
+        width=integer("imWidth", MAX_IMAGE_SIDE),
+        height=integer("imHeight", MAX_IMAGE_SIDE),
+        length=integer("seqLength", 2**31 - 1),
     )
 
 
