@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import os
+import re
 import signal
 import stat
 import subprocess
@@ -25,7 +26,7 @@ from pftrack.cli import build_parser, main
 from pftrack.cli._signals import Terminated
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
-from pftrack.io.video import read_seqinfo
+from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import Scene, make_scene
 from tests.conftest import dataset
 from tests.io.streaming import serve_stream
@@ -655,6 +656,31 @@ def test_a_live_run_aborted_before_any_row_leaves_nothing(
     assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["live.txt"]
     assert out.read_text() == "precious\n"
+
+
+def test_ctrl_c_before_a_live_sources_first_frame_is_an_interrupt(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: Ctrl-C while a stream had sent no frame yet gave exit 2 and "no frame could
+    be read from <pftrack.io.video.FrameSource object at 0x...>"."""
+    import pftrack.tracking
+
+    real = pftrack.tracking.track_frames
+
+    def stopped_at_once(source: Any, **kwargs: Any) -> Any:
+        source.stop()  # as the first Ctrl-C does
+        return real(source, **kwargs)
+
+    out = tmp_path / "live.txt"
+    monkeypatch.setattr("pftrack.tracking.track_frames", stopped_at_once)
+    with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
+        assert main(["-q", "track", server.url, "--out", str(out), "--fps", "25"]) == 130
+        assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
+        source = FrameSource(server.url)
+        source.stop()
+        with pytest.raises(ValueError, match=f"^{re.escape(server.url)}: stopped before its first"):
+            real(source)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_an_aborted_live_run_into_a_pipe_says_its_rows_went_there(

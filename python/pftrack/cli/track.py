@@ -117,6 +117,22 @@ class _StopOnCtrlC:
         signal.signal(signal.SIGINT, self._previous)
 
 
+def _track(live: bool, first: list[Any], source: Any, **kwargs: Any) -> Any:
+    """``track_frames(source, **kwargs)``, with Ctrl-C before a live source's first frame.
+
+    That is an interrupt (exit 130), not the bad input "stopped before its first frame" (exit
+    2). `first` is the list the run's ``on_frame`` puts the first frame in.
+    """
+    from pftrack.tracking import track_frames
+
+    try:
+        return track_frames(source, **kwargs)
+    except ValueError:
+        if live and source.stopped and not first:
+            raise KeyboardInterrupt from None
+        raise
+
+
 def _abort_note(out: str, side: Any, streamed: int | None, committed: bool) -> str | None:
     """What a live run that failed or was aborted left, for ``main``'s last line; None: nothing.
 
@@ -232,7 +248,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.video_writer import VIDEO_SUFFIXES
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
-    from pftrack.tracking import BoxSmoother, load_detections, track_frames
+    from pftrack.tracking import BoxSmoother, load_detections
 
     opencv_single_threaded()
 
@@ -289,7 +305,9 @@ def run(args: argparse.Namespace) -> int:
                         stack.enter_context(_StopOnCtrlC(source))
                     caught = stack.enter_context(warnings.catch_warnings(record=True))
                     warnings.simplefilter("always")
-                    result = track_frames(
+                    result = _track(
+                        live,
+                        first,
                         source,
                         detections=dets,
                         config=config,

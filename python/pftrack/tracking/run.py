@@ -262,8 +262,10 @@ def track_frames(
                 tracker.update(xywh_to_xyxy_dets(dets), frame)
             if on_frame is not None:
                 on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
-    if n == 0:
-        raise ValueError(f"no frame could be read from {source}")
+    if n == 0:  # a FrameSource by its name, not its repr
+        if getattr(source, "stopped", False):
+            raise ValueError(f"{getattr(source, 'name', source)}: stopped before its first frame")
+        raise ValueError(f"no frame could be read from {getattr(source, 'name', source)}")
     if detections:
         unused = [f for f in detections if f > n and len(detections[f])]
         if unused:  # the video ended early (a truncated file): say what was not tracked
