@@ -59,6 +59,9 @@ class JointTracker:
         self._rng = rng
         self._filter: RJMCMCFilter | None = None
         self._ids: set[int] = set()  # every id the sampler has estimated
+        #: The last frame's estimated boxes ``(K, 4)`` (left, top, w, h): what the camera
+        #: check leaves out, as the per-object trackers' boxes are.
+        self.boxes: F64 = np.zeros((0, 4))
 
     @property
     def started(self) -> int:
@@ -73,6 +76,7 @@ class JointTracker:
         estimates = self._filter.step(binned, mask, _to_cxcywh(boxes))
         self._ids.update(int(e.id) for e in estimates)
         ebox = np.array([_to_xywh(e.box_cxcywh) for e in estimates]).reshape(-1, 4)
+        self.boxes = ebox
         iou = _iou_matrix(ebox, boxes) if len(boxes) else np.zeros((len(estimates), 0))
         out = []
         for k, e in enumerate(estimates):

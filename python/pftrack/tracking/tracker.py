@@ -437,7 +437,11 @@ class MultiObjectTracker:
             self._joint.config = cfg
         self.frame_index += 1
         # camera motion: move the tracks into this frame; no background model while it moves
-        step = self.camera.update(f, [t.box for t in self.tracks])
+        # the objects' own corners are no evidence of the camera's motion: the tracks', or the
+        # joint sampler's objects' (it has no tracks: every frame of a still camera over moving
+        # objects was taken for a moving one)
+        objects = self._joint.boxes if cfg.sampler == "rjmcmc" else [t.box for t in self.tracks]
+        step = self.camera.update(f, objects)
         if step.apply is not None:
             warp_tracks(self.tracks, step.apply)
         self._background_ok = step.background_ok
