@@ -1307,3 +1307,26 @@ def test_a_folder_where_no_file_can_be_made_is_said_so(
     err = capsys.readouterr().err.strip()
     assert err.startswith("pftrack track: error: --out /proc/pftrack-test.txt: ")
     assert "no file can be made in folder /proc (" in err or "not writable" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [
+        (["track", "v.avi", "--detections", "", "--out", "o.txt"], "--detections"),
+        (["recover", "", "--out", "o.txt"], "TRACKS"),
+        (["recover", "t.txt", "--link", "--video", "", "--out", "o.txt"], "--video"),
+        (["render", "v.avi", "", "--out", "r.mp4"], "TRACKS"),
+        (["eval", "--gt", "", "--res", "t.txt"], "--gt"),
+        (["batch", "", "--out", "o"], "INPUTS"),
+    ],
+)
+def test_an_empty_argument_is_refused_by_name(
+    argv: list[str], named: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    """A user trial: ``--detections ''`` was ignored (the built-in detector ran, exit 0), and
+    ``''`` as an input or ``--gt`` was the current folder."""
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"pftrack {argv[0]}: error: {named} is empty; give a value\n"
+    assert list(tmp_path.iterdir()) == []

@@ -205,6 +205,26 @@ def _command_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -
         parser = subs[0].choices[name]
 
 
+#: Options naming outputs, whose empty value their own check refuses.
+_OUTPUTS = frozenset({"out", "out_dir", "render", "plot", "json", "csv", "figure"})
+
+
+def _empty_argument(command: argparse.ArgumentParser, args: argparse.Namespace) -> str | None:
+    """The option (or positional argument) of `command` given as an empty string, if any.
+
+    No option of pftrack takes an empty value; a path given as ``''`` (an unset shell
+    variable) was the current folder, or an option silently left off. Outputs are left to
+    their own check (:func:`pftrack.io.atomic.check_output`: "give a file name").
+    """
+    for action in command._actions:
+        if action.dest in _OUTPUTS:
+            continue
+        value = getattr(args, action.dest, None)
+        if value == "" or (isinstance(value, list) and "" in value):
+            return action.option_strings[-1] if action.option_strings else action.dest.upper()
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pftrack`` script; returns the exit status."""
     parser = build_parser()
@@ -212,6 +232,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = _command_parser(parser, args)
     if extra:  # named by the command's own parser: its usage, "pftrack smooth: error: ..."
         command.error(f"unrecognized arguments: {' '.join(extra)}")
+    empty = _empty_argument(command, args)
+    if empty is not None:  # was: --detections '' ignored, '' as a folder the current one
+        print(f"{command.prog}: error: {empty} is empty; give a value", file=sys.stderr)
+        return 2
     # "pftrack experiment gaps: error: ..." as argparse names it (was: "pftrack experiment")
     prog = str(command.prog)
     if args.quiet:
