@@ -525,3 +525,40 @@ def test_a_folder_that_is_a_file_is_named_so(writer: str, tmp_path: Path) -> Non
     ):
         write(missing)
     assert notes.read_text() == "x" and sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+
+
+@pytest.mark.parametrize("name", ["b" * 251 + ".txt", "b" + "é" * 125 + ".txt"])  # 255 bytes
+def test_a_longest_valid_name_is_written(tmp_path: Path, name: str) -> None:
+    """A user trial: names of 240-255 bytes, which ``touch`` makes, were refused ("File name
+    too long"): the temporary name beside them was 14 bytes longer."""
+    from pftrack.cli import main
+    from pftrack.io.atomic import staged_outputs
+
+    assert len(os.fsencode(name)) == 255
+    for writer in (atomic_write, atomic_path):
+        with writer(tmp_path / name) as out:
+            if isinstance(out, Path):
+                out.write_text("x\n")
+            else:
+                out.write("x\n")
+        assert (tmp_path / name).read_text() == "x\n"
+    with staged_outputs() as stage:
+        stage(tmp_path / name).write_text("y\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]
+    rows = tmp_path / "t.txt"
+    write_mot(rows, [[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [3, 1, 14, 10, 5, 5, 1, -1, -1, -1]])
+    assert main(["-q", "recover", str(rows), "--out", str(tmp_path / name)]) == 0
+
+
+def test_a_writers_error_on_a_staged_file_names_the_output(tmp_path: Path) -> None:
+    """A user trial on a full disk: ``No space left on device: full/.o.2833ba0ccefe.txt``, a
+    name the user never gave."""
+    from pftrack.io.atomic import staged_outputs
+
+    target = tmp_path / "o.txt"
+    with pytest.raises(OSError, match=r"No space left on device: '.*/o\.txt'$") as exc:
+        with staged_outputs() as stage:
+            tmp = stage(target)
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(tmp))
+    assert exc.value.errno == errno.ENOSPC
+    assert list(tmp_path.iterdir()) == []

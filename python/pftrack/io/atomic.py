@@ -159,6 +159,25 @@ def _missing_folder(folder: Path, target: PathLike) -> OSError:
     return FileNotFoundError(f"output folder does not exist: {folder}")
 
 
+#: Longest file name (bytes) of the usual file systems (ext4, XFS, APFS, NTFS in UTF-16 units).
+NAME_MAX = 255
+
+
+def _temp_name(prefix: str, token: str, suffix: str) -> str:
+    """``prefix + token + suffix``, the prefix cut so that the name fits in :data:`NAME_MAX`.
+
+    The prefix holds the target's name: a target of 240-255 bytes, a valid name, made a
+    temporary name too long for the file system (was: "no file can be made in folder .
+    (File name too long)").
+    """
+    name = f"{prefix}{token}{suffix}"
+    excess = len(os.fsencode(name)) - NAME_MAX
+    if excess > 0:
+        cut = os.fsencode(prefix)[: max(1, len(os.fsencode(prefix)) - excess)]
+        name = f"{cut.decode('utf-8', errors='ignore') or '.'}{token}{suffix}"
+    return name
+
+
 def _create_beside(folder: Path, prefix: str, suffix: str, made: list[str]) -> tuple[int, str]:
     """Create a new, unique file in `folder`; the kernel applies the umask to ``0o666``.
 
@@ -169,7 +188,7 @@ def _create_beside(folder: Path, prefix: str, suffix: str, made: list[str]) -> t
     """
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
     for _ in range(100):
-        path = os.path.join(folder, f"{prefix}{secrets.token_hex(6)}{suffix}")
+        path = os.path.join(folder, _temp_name(prefix, secrets.token_hex(6), suffix))
         made.append(path)
         try:
             return os.open(path, flags, 0o666), path
@@ -783,6 +802,27 @@ def _remove_nested(tmp: Path) -> None:
                     os.unlink(entry.path)
 
 
+def _as_targets(exc: OSError, staged: Iterable[tuple[str, Path]]) -> OSError | None:
+    """`exc` naming the target of each staged temporary file it names; None if it names none.
+
+    A writer filling a staged file reports its own errors (``No space left on device:
+    'out/.o.2833ba0ccefe.txt'``) with a name the user never gave.
+    """
+    text = str(exc)
+    hit = False
+    for tmp, target in staged:
+        if tmp in text:
+            text, hit = text.replace(tmp, os.fsdecode(target)), True
+    if not hit:
+        return None
+    if exc.errno is not None and exc.filename is not None:
+        name = os.fsdecode(exc.filename)
+        for tmp, target in staged:
+            name = name.replace(tmp, os.fsdecode(target))
+        return OSError(exc.errno, exc.strerror, name)
+    return OSError(text)
+
+
 @contextlib.contextmanager
 def staged_outputs() -> Iterator[Callable[..., Path]]:
     """Several outputs of one run, all replaced at the end or none at all.
@@ -820,7 +860,8 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
         folder = target.parent if str(target.parent) else Path(".")
         if not folder.is_dir():
             raise _missing_folder(folder, path)
-        fd, tmp = _create_beside(folder, f".{target.stem}.", suffix or ".tmp", made)
+        with _named(path, hidden=True):  # a read-only file system, a folder not writable
+            fd, tmp = _create_beside(folder, f".{target.stem}.", suffix or ".tmp", made)
         staged.append((tmp, target))
         try:
             _keep_mode(fd, target)
@@ -837,10 +878,14 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
         for tmp_path, resolved in through:  # last: a FIFO waits for its reader
             with _named(resolved.path):  # /dev/full: "No space left on device" named no file
                 _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
-    except BaseException:
+    except BaseException as exc:
         _remove(made)
         for tmp in made:
             _remove_nested(Path(tmp))
+        if isinstance(exc, OSError):  # a writer's full disk names the file the user gave
+            renamed = _as_targets(exc, staged)
+            if renamed is not None:
+                raise renamed from None
         raise
     finally:
         if scratch:
