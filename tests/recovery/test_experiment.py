@@ -151,6 +151,22 @@ def test_a_method_named_twice_is_refused(
     )
 
 
+def test_a_mask_outside_the_image_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``--mask 10000,10000,5,5`` on a 768x576 image said "no gap under this
+    mask", exit 0, and skipped the sweep."""
+    gt = tmp_path / "gt.txt"
+    write_mot(gt, _walkers(n_ids=3, n_frames=30))
+    base = ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--methods", "linear"]
+    for mask in ("10000,10000,5,5", "700,0,100,100", "-1,0,10,10"):
+        assert main([*base, f"--mask={mask}"]) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack experiment gaps: error: --mask {mask} is not inside the 768x576 image "
+            "(x, y >= 0, x + w <= width, y + h <= height)\n"
+        )
+
+
 def test_too_small_an_image_size_is_named_for_its_sequence(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

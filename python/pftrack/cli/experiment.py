@@ -291,6 +291,12 @@ def run_gaps(args: argparse.Namespace) -> int:
     ]
     if args.mask:
         mask = _parse_mask(args.mask)
+        x, y, w, h = mask
+        if x < 0 or y < 0 or x + w > width or y + h > height:  # was: "no gap under this mask"
+            raise ValueError(
+                f"--mask {args.mask} is not inside the {width:g}x{height:g} image (x, y >= 0, "
+                "x + w <= width, y + h <= height)"
+            )
     elif len(sweep):
         mask = sweep.representative()
     else:
