@@ -32,8 +32,9 @@ def add_parser(sub: Any) -> None:
         "track",
         help="track a video, image folder, camera or stream; MOTChallenge output",
         description="Track every object in SOURCE: a video file, a folder of images (natural "
-        "order: 2.jpg before 10.jpg; names that are all digits are frame numbers, and a "
-        "missing one is an error: frame 1 is the lowest, or image 1 in a sequence), a "
+        "order: 2.jpg before 10.jpg, frame k the k-th image; names that skip numbers are "
+        "refused with detections, and in a MOTChallenge sequence's image folder, where "
+        "image 1 is frame 1), a "
         "MOTChallenge sequence folder (seqinfo.ini gives the frame rate and image folder, "
         "det/det.txt or det.txt the detections of --detections auto; without its image "
         "folder, the one video file beside seqinfo.ini is read, as pftrack batch does), a "
