@@ -740,6 +740,25 @@ def test_no_track_warning_of_the_built_in_detector_blames_it():
     ]
 
 
+def test_no_track_warning_says_min_conf_left_the_built_in_detectors_objects_out(scene):
+    """A user trial: ``--min-conf 1`` with the built-in detector said it "found no object",
+    though it found hundreds and min_conf left every one out."""
+    tracker = pftrack.Tracker(seed=0, min_conf=1.5)  # the paper detector's scores reach 1
+    tracker.prime(scene.frames)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for frame in scene.frames:
+            tracker.update(None, frame)
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert len(said) == 1
+    assert re.fullmatch(
+        r"no track over 40 frames: the built-in detector found \d+ objects over the run, "
+        r"scored at most [01](\.\d+)?: none reached min_conf 1\.5",
+        said[0],
+    ), said
+
+
 @pytest.mark.parametrize(
     ("where", "hint"),
     [

@@ -1004,6 +1004,12 @@ class Tracker:
                 f"{started} track{'s' * (started != 1)} started but none reached "
                 f"min_hits={cfg.min_hits} matched frames (shorter tracks are left out)"
             )
+        if not self._given and self._tracker.found_own:
+            return (
+                f"the built-in detector found {self._tracker.found_own} objects over the run, "
+                f"scored at most {self._tracker.best_own_score:.3g}: none reached min_conf "
+                f"{cfg.min_score:.3g}"
+            )
         if not self._given:
             return "the built-in detector found no object (no detection was given)"
         if self.config.sampler == "rjmcmc" and np.isfinite(self._max_conf):

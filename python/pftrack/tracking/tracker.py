@@ -141,6 +141,10 @@ class MultiObjectTracker:
         #: clear of the frame's border), and given ones kept, over the run: why no track, said.
         self.tiny_given = 0
         self.kept_given = 0
+        #: The built-in detector's objects over the run, and the highest score among them: a
+        #: run whose objects ``min_score`` left out says so (not "found no object").
+        self.found_own = 0
+        self.best_own_score = -np.inf
         self.frame_index = 0
         self._mask: NDArray[np.uint8] | None = None  # the last frame's, see last_mask
         self._mask_shaded = False  # whether _mask still has its shadow pixels (127)
@@ -450,10 +454,14 @@ class MultiObjectTracker:
         labels = np.zeros(len(boxes), np.int64) if given is None else given[2]
         tiny = tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
         index = ((scores >= cfg.lifecycle.min_score) & ~tiny).nonzero()[0]
+        scores_all = scores
         boxes, scores, labels = boxes[index], scores[index], labels[index]
         if given is not None:
             self.tiny_given += int(tiny.sum())
             self.kept_given += len(index)
+        elif len(tiny):  # the built-in detector's boxes, before min_score
+            self.found_own += len(tiny)
+            self.best_own_score = max(self.best_own_score, float(scores_all.max()))
         if given is not None and len(given[1]) and not self._negative_warned:
             low = float(given[1].min())
             if low < 0.0 and low < cfg.lifecycle.min_score:  # said once a run
