@@ -407,7 +407,7 @@ def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
     right, bottom = float(np.max(d[:, 0] + d[:, 2])), float(np.max(d[:, 1] + d[:, 3]))
     if len(d) >= SMALL_LAYOUT_BOXES and right < 0.5 * cols and bottom < 0.5 * rows:
         warnings.warn(
-            f"all {len(d)} detection boxes lie in the top-left {right:.0f}x{bottom:.0f} pixels "
+            f"all {len(d)} detection boxes lie in the top-left {right:.3g}x{bottom:.3g} pixels "
             f"of the {cols}x{rows} frames: are they in a smaller frame's pixels? (scale them "
             "with --det-scale / load_detections(scale=...))",
             stacklevel=3,
