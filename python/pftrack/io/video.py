@@ -1296,10 +1296,11 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
                 self._at = 0
             picked, _, self._at = self.source._read_at(self._cap, self._at, [i])
             if not picked:
+                ended = self._at  # before close() starts the count over
                 self.close()
                 raise ValueError(
                     f"{self.source.name}: frame {i + 1} cannot be decoded: the video ended after "
-                    f"{self._at} frames but its header says {n}"
+                    f"{ended} frames but its header says {n}"
                 )
             frame = picked[0]
         self._last = (i, frame)
