@@ -740,6 +740,34 @@ def test_an_unreachable_scheduler_writes_nothing(
     assert {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()} == before
 
 
+@pytest.mark.parametrize(
+    ("host", "said"),
+    [
+        ("127.0.0.1", "connection refused: nothing listens on port {port} of 127.0.0.1 (start "
+         "the scheduler there first: dask scheduler)"),
+        ("pftrack-nowhere.invalid", "host pftrack-nowhere.invalid not found (its name does not "
+         "resolve)"),
+    ],
+)  # fmt: skip
+def test_a_refused_or_unknown_scheduler_fails_at_once(
+    host: str, said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: each took Dask's whole 30 s connect timeout, then said only "Timed out
+    trying to connect"."""
+    _tracks_files(tmp_path / "tracks")
+    port = _free_port()
+    address = f"tcp://{host}:{port}"
+    start = time.monotonic()
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+    assert main([*argv, "--scheduler", address]) == 2
+    assert time.monotonic() - start < 10
+    assert capsys.readouterr().err == (
+        f"pftrack recover: error: cannot connect to the Dask scheduler at {address}: "
+        f"{said.format(port=port)}\n"
+    )
+    assert not (tmp_path / "out").exists()
+
+
 def test_progress_counts_frames_within_the_sequences(
     data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -339,6 +339,9 @@ def dask_client(
         yield client
         return
     if address:
+        refused = _refused(address)  # known at once: Dask would retry for its whole timeout
+        if refused is not None:
+            raise OSError(f"cannot connect to the Dask scheduler at {address}: {refused}")
         try:
             connected = Client(address)  # timeout: distributed.comm.timeouts.connect
         except Exception as exc:  # noqa: BLE001 - whatever Dask raised: one line, the address
@@ -389,6 +392,47 @@ TLS_SETTINGS = (
     "$DASK_DISTRIBUTED__COMM__TLS__CA_FILE, $DASK_DISTRIBUTED__COMM__TLS__CLIENT__CERT and "
     "$DASK_DISTRIBUTED__COMM__TLS__CLIENT__KEY"
 )
+
+
+#: Seconds a refused connection is tried again before :func:`dask_client` gives up (a
+#: scheduler started a moment before the batch may not listen yet).
+REFUSED_GRACE = 2.0
+
+
+def _refused(address: str) -> str | None:
+    """Why nothing can listen at the tcp:// `address`, if that is known at once.
+
+    A host name that does not resolve, or a port that refuses the connection for
+    :data:`REFUSED_GRACE` seconds; None otherwise (Dask's own connection, with its timeout,
+    decides: a firewall that drops packets, a scheduler that is slow to answer). Was: 30 s,
+    then "Timed out trying to connect".
+    """
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        protocol, location = parse_address(address)
+        if protocol != "tcp":  # tls: Dask's message says more (its settings, a handshake)
+            return None
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError):
+        return None
+    deadline = time.monotonic() + REFUSED_GRACE
+    while True:
+        try:
+            socket.create_connection((host, port), timeout=REFUSED_GRACE).close()
+        except socket.gaierror:
+            return f"host {host} not found (its name does not resolve)"
+        except ConnectionRefusedError:
+            if time.monotonic() < deadline:
+                time.sleep(0.2)
+                continue
+            return (
+                f"connection refused: nothing listens on port {port} of {host} (start the "
+                "scheduler there first: dask scheduler)"
+            )
+        except OSError:
+            return None
+        return None
 
 
 def _connect_problem(address: str, exc: Exception) -> str:

@@ -205,8 +205,9 @@ def _command_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -
         parser = subs[0].choices[name]
 
 
-#: Options naming outputs, whose empty value their own check refuses.
-_OUTPUTS = frozenset({"out", "out_dir", "render", "plot", "json", "csv", "figure"})
+#: Options whose empty value their own check refuses, saying more: outputs ("give a file
+#: name") and --scheduler ("give a running Dask scheduler's address").
+_OWN_CHECK = frozenset({"out", "out_dir", "render", "plot", "json", "csv", "figure", "scheduler"})
 
 
 def _empty_argument(command: argparse.ArgumentParser, args: argparse.Namespace) -> str | None:
@@ -217,7 +218,7 @@ def _empty_argument(command: argparse.ArgumentParser, args: argparse.Namespace) 
     their own check (:func:`pftrack.io.atomic.check_output`: "give a file name").
     """
     for action in command._actions:
-        if action.dest in _OUTPUTS:
+        if action.dest in _OWN_CHECK:
             continue
         value = getattr(args, action.dest, None)
         if value == "" or (isinstance(value, list) and "" in value):
