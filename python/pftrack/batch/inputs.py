@@ -288,7 +288,8 @@ def _check_names(names: list[str], sources: list[Path]) -> None:
         if name in seen:
             raise ValueError(
                 f"two inputs are both named {name!r} ({seen[name]} and {source}): their outputs "
-                "would collide; run them in separate batches"
+                "would collide; run them in separate batches, or give them distinct names "
+                f"(symbolic links: ln -s {source} NEWNAME{source.suffix})"
             )
         seen[name] = source
 
