@@ -954,3 +954,12 @@ def test_a_key_given_empty_is_refused_not_taken_as_absent(tmp_path: Path, key: s
     assert (info.name, info.image_dir, info.frame_rate, info.width) == (
         tmp_path.name, "img1", None, None
     )  # fmt: skip
+
+
+def test_an_image_folder_that_also_holds_a_video_says_so(tmp_path: Path) -> None:
+    """A user trial: the video in a folder of images was passed over without a word."""
+    scene = make_scene(n_frames=4, rng=0)
+    scene.write_images(tmp_path, ext=".png")
+    scene.write_video(tmp_path / "walk.avi")
+    with pytest.warns(UserWarning, match=r"holds 4 images and 1 video \(walk\.avi\): the images"):
+        assert len(list(FrameSource(tmp_path))) == 4

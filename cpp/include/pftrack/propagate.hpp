@@ -37,7 +37,7 @@ inline void check_particles(const Eigen::Ref<const RowMatrixXd>& p, const char* 
     require(p.rows() > 0, fn, "particles rows", p.rows(), ">= 1");
     require(p.cols() == kParticleCols, fn, "particles cols", p.cols(),
             "6 (cx, cy, s, previous cx, cy, s)");
-    require_bounded(p, 1e9, fn, "particles");  // the boxes' +-1e9 px (pftrack._check.MAX_COORD)
+    require_finite(p, fn, "particles");
 }
 
 /// One AR(2) step for particle row `row` with standard-normal draws `w` (3 values).

@@ -23,12 +23,14 @@ struct SisResult {
     double fg_mean = 0.0;   // weight-averaged counted pixels (foreground) per particle box
 };
 
-/// Checks shared by sis_step and mh_step: particles (N, 6) finite, weights (N,) valid,
-/// means (2, 3) finite.
+/// Checks shared by sis_step and mh_step: particles (N, 6) finite and within the boxes'
+/// +-1e9 px (pftrack._check.MAX_COORD: a filter's state is a box), weights (N,) valid, means
+/// (2, 3) finite.
 inline void check_particle_set(const Eigen::Ref<const RowMatrixXd>& particles,
                                const Eigen::Ref<const Eigen::VectorXd>& weights,
                                const Eigen::Ref<const RowMatrixXd>& means, const char* fn) {
     check_particles(particles, fn);
+    require_bounded(particles, 1e9, fn, "particles");
     require(weights.size() == particles.rows(), fn, "weights size", weights.size(),
             particles.rows());
     require_weights(weights, fn, "weights", kParticleWeightsZero);

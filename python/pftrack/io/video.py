@@ -910,6 +910,15 @@ class FrameSource:
         images = _images_in(folder)
         if not images:
             raise ValueError(_no_images(folder))
+        videos = video_files(folder)
+        if videos:  # was passed over without a word
+            names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
+            warnings.warn(
+                f"{folder} holds {len(images)} images and {len(videos)} video"
+                f"{'s' * (len(videos) != 1)} ({names}): the images are the frames; give a "
+                "video's own path to track it",
+                stacklevel=3,
+            )
         seq = self.sequence
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
         numbered = _frame_order(folder, images, seq if own else None)
