@@ -206,8 +206,10 @@ def _command_parser(parser: argparse.ArgumentParser, args: argparse.Namespace) -
 
 
 #: Options whose empty value their own check refuses, saying more: outputs ("give a file
-#: name") and --scheduler ("give a running Dask scheduler's address").
-_OWN_CHECK = frozenset({"out", "out_dir", "render", "plot", "json", "csv", "figure", "scheduler"})
+#: name"), --scheduler ("give a running Dask scheduler's address") and a video source.
+_OWN_CHECK = frozenset(
+    {"out", "out_dir", "render", "plot", "json", "csv", "figure", "scheduler", "source"}
+)
 
 
 def _empty_argument(command: argparse.ArgumentParser, args: argparse.Namespace) -> str | None:
