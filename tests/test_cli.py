@@ -956,6 +956,19 @@ def test_an_output_folder_that_cannot_be_created_is_one_line(
     assert "\n" not in err
 
 
+def test_fps_without_render_is_refused(
+    video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``--fps 5`` without ``--render`` was ignored (the same bytes), while every
+    other option that does nothing is refused."""
+    assert main(["track", str(video), "--out", str(tmp_path / "t.txt"), "--fps", "5"]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack track: error: --fps 5 is the frame rate of --render's video; without --render "
+        "nothing uses it (tracking counts frames): drop it, or give --render VIDEO\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("fps", ["1e-300", "1e308", "0.001", "nan"])
 def test_track_fps_is_bounded(
     fps: str, video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]

@@ -623,7 +623,7 @@ def test_an_aborted_live_run_keeps_out_and_says_where_its_rows_are(
     monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(abort))
     scene = make_scene(n_frames=5, rng=0)
     with serve_stream(scene.frames) as server:
-        argv = ["-q", "track", server.url, "--out", str(out), "--fps", "25"]
+        argv = ["-q", "track", server.url, "--out", str(out)]
         assert main(argv) == status
         kept = tmp_path / "live.partial.txt"
         err = capsys.readouterr().err
@@ -652,7 +652,7 @@ def test_a_live_run_aborted_before_any_row_leaves_nothing(
     out.write_text("precious\n")
     monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(KeyboardInterrupt(), 0))
     with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
-        assert main(["-q", "track", server.url, "--out", str(out), "--fps", "25"]) == 130
+        assert main(["-q", "track", server.url, "--out", str(out)]) == 130
     assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["live.txt"]
     assert out.read_text() == "precious\n"
@@ -674,7 +674,7 @@ def test_ctrl_c_before_a_live_sources_first_frame_is_an_interrupt(
     out = tmp_path / "live.txt"
     monkeypatch.setattr("pftrack.tracking.track_frames", stopped_at_once)
     with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
-        assert main(["-q", "track", server.url, "--out", str(out), "--fps", "25"]) == 130
+        assert main(["-q", "track", server.url, "--out", str(out)]) == 130
         assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
         source = FrameSource(server.url)
         source.stop()
@@ -697,7 +697,7 @@ def test_an_aborted_live_run_into_a_pipe_says_its_rows_went_there(
     reader.start()
     monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(KeyboardInterrupt(), 3))
     with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
-        assert main(["-q", "track", server.url, "--out", str(fifo), "--fps", "25"]) == 130
+        assert main(["-q", "track", server.url, "--out", str(fifo)]) == 130
     reader.join(30)
     assert capsys.readouterr().err == (
         f"pftrack track: interrupted; the 6 online rows tracked so far were written to {fifo}; "
@@ -728,7 +728,7 @@ def test_live_run_into_a_named_pipe_streams_its_rows_there(
     reader.start()
     with serve_stream(scene.frames, pace=0.0) as server:
         argv = ["-q", "track", server.url, "--out", str(fifo), "--detections",
-                str(tmp_path / "det.txt"), "--fps", "25"]  # fmt: skip
+                str(tmp_path / "det.txt")]  # fmt: skip
         assert main(argv) == 0
     reader.join(30)
     out = capsys.readouterr().out

@@ -256,6 +256,11 @@ def run(args: argparse.Namespace) -> int:
     check_source(args.source)  # "" would track the current folder
     live = is_live_source(args.source)
     config = tracker_config(args)  # contradictory options refused before any work
+    if args.fps is not None and not args.render:  # was ignored, as no other option is
+        raise ValueError(
+            f"--fps {args.fps:g} is the frame rate of --render's video; without --render "
+            "nothing uses it (tracking counts frames): drop it, or give --render VIDEO"
+        )
     _check_outputs(args, live)
     source = FrameSource(args.source, fps=args.fps)
     renderer: TrackRenderer | None = None
