@@ -963,3 +963,26 @@ def test_an_image_folder_that_also_holds_a_video_says_so(tmp_path: Path) -> None
     scene.write_video(tmp_path / "walk.avi")
     with pytest.warns(UserWarning, match=r"holds 4 images and 1 video \(walk\.avi\): the images"):
         assert len(list(FrameSource(tmp_path))) == 4
+
+
+def test_a_frame_that_fails_inside_a_video_is_stood_in_for_and_the_rest_read(
+    tmp_path: Path,
+) -> None:
+    """A user trial: a video damaged in the middle (bytes overwritten) ended at the damage, with
+    a warning and exit 0: the frames after it, which decode, were lost. Now the frame before
+    stands in for the one that fails, and the later frames keep their numbers (their time
+    stamps say which they are)."""
+    path = make_scene(n_frames=30, rng=0).write_video(tmp_path / "walk.avi")
+    good = list(FrameSource(path))
+    data = bytearray(path.read_bytes())
+    at = int(len(data) * 0.3)
+    data[at : at + 20000] = np.random.default_rng(1).bytes(20000)  # inside frame 10
+    damaged = tmp_path / "damaged.avi"
+    damaged.write_bytes(bytes(data))
+    with pytest.warns(UserWarning, match=r"damaged.avi: frame 10 could not be decoded .* the "
+                      "frame before stands in for each"):  # fmt: skip
+        frames = list(FrameSource(damaged))
+    assert len(frames) == 30
+    np.testing.assert_array_equal(frames[9], frames[8])
+    for k in (*range(9), *range(10, 30)):
+        np.testing.assert_array_equal(frames[k], good[k])

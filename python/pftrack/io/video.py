@@ -361,6 +361,45 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     return None
 
 
+#: Reads tried after a frame inside a video fails to decode, before the video counts as ended.
+RESUME_TRIES = 16
+
+
+def _stamp_index(cap: cv2.VideoCapture, rate: float) -> int:
+    """The index of the frame `cap` read last, from its time stamp and the file's frame rate."""
+    return round(float(cap.get(cv2.CAP_PROP_POS_MSEC)) * rate / 1000.0)
+
+
+def _resume(
+    cap: cv2.VideoCapture, rate: float, start: int, at: int, n_frames: int
+) -> tuple[int, NDArray[Any]] | None:
+    """The next frame that decodes after a failure at frame `at`, with its index.
+
+    A damaged packet in the middle of a file (bytes overwritten) fails one read, and FFmpeg
+    decodes on from the next frame: its time stamp (less the first frame's, `start`) says
+    which one it is. None when none of :data:`RESUME_TRIES` reads decodes, or its stamp is
+    not a later frame of the header's.
+    """
+    for _ in range(RESUME_TRIES):
+        ok, frame = cap.read()
+        if ok:
+            index = _stamp_index(cap, rate) - start
+            return (index, frame) if at <= index < max(n_frames, at + 1) else None
+    return None
+
+
+def _frame_list(indexes: list[int]) -> str:
+    """``frame 18`` or ``frames 18-20, 31`` (1-based) for 0-based `indexes`, in order."""
+    runs: list[list[int]] = []
+    for i in indexes:
+        if runs and i == runs[-1][1] + 1:
+            runs[-1][1] = i
+        else:
+            runs.append([i, i])
+    text = ", ".join(f"{a + 1}" if a == b else f"{a + 1}-{b + 1}" for a, b in runs)
+    return f"frame{'s' * (len(indexes) > 1)} {text}"
+
+
 def video_files(folder: Path) -> list[Path]:
     """The video files (:data:`VIDEO_SUFFIXES`) directly in `folder`, in natural order."""
     return sorted(
@@ -853,6 +892,7 @@ class FrameSource:
         self._depth_from = ""  # the images `bits` was decided from, for the clipping warning
         self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
+        self._warned_lost = False  # frames inside the video could not be decoded
         self._cap: Any = None
         self._replay: list[NDArray[np.uint8]] = []
         self._read_past_replay = False
@@ -1181,16 +1221,47 @@ class FrameSource:
                 yield self._read_image(p)
             return
         cap = _file_capture(str(self.path))
-        decoded = 0
+        decoded = 0  # frames yielded, stand-ins included: the next frame's index
+        rate = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
+        timed = rate > 0  # the frames' time stamps give their indexes, so far
+        start = 0  # the first frame's stamp, in frames (PETS09's is 2)
+        lost: list[int] = []
+        last: NDArray[np.uint8] | None = None
         try:
             while True:
                 ok, frame = cap.read()
+                # a frame's number is its place in the decoded order, as a detector's loop
+                # counts it; the stamps only say, after a frame that fails, where to go on
+                if ok and timed:
+                    stamp = _stamp_index(cap, rate)
+                    if decoded == 0:
+                        start = stamp
+                    elif stamp - start != decoded:
+                        timed = False  # not a constant-rate file: no resuming after damage
                 if not ok:
-                    break
+                    if not timed or last is None or decoded >= self.n_frames:
+                        break
+                    resumed = _resume(cap, rate, start, decoded, self.n_frames)
+                    if resumed is None:
+                        break
+                    index, frame = resumed
+                    for i in range(decoded, index):  # the damaged frames: the last good one
+                        lost.append(i)
+                        decoded += 1
+                        yield last
                 decoded += 1
-                yield self._resize(frame)
+                last = self._resize(frame)
+                yield last
         finally:
             cap.release()
+        if lost and not self._warned_lost:
+            self._warned_lost = True
+            warnings.warn(
+                f"{self.path}: {_frame_list(lost)} could not be decoded (a damaged file?): the "
+                "frame before stands in for each, so the later frames keep their numbers",
+                UserWarning,
+                stacklevel=2,
+            )
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded)
 
