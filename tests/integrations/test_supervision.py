@@ -40,10 +40,14 @@ def test_update_with_detections_sets_tracker_id_like_the_tracker(scene):
         dets = frame_detections(scene, n)
         out = adapter.update_with_detections(dets, frame)
         ref = plain.update(np.column_stack([dets.xyxy, dets.confidence, dets.class_id]), frame)
+        # in the input's order, as ByteTrack keeps it (a user trial: they were in track order,
+        # which the docstring said ByteTrack gives)
+        ref = ref[np.argsort(ref[:, 7], kind="stable")]
         assert isinstance(out, sv.Detections) and out.tracker_id is not None
         np.testing.assert_array_equal(out.tracker_id, ref[:, 4].astype(int))
         # the rows are the input detections the tracks were matched to, with all their fields
         rows = ref[:, 7].astype(int)
+        assert (np.diff(rows) >= 0).all()
         np.testing.assert_array_equal(out.xyxy, dets.xyxy[rows])
         np.testing.assert_array_equal(out.data["truth_id"], dets.data["truth_id"][rows])
         seen += len(out)
@@ -171,3 +175,21 @@ def test_a_checkpoint_at_every_pickle_protocol_resumes_byte_for_byte():
     assert run.stdout.split("\n")[:-1] == [
         f"{p} resumed" for p in range(pickle.HIGHEST_PROTOCOL + 1)
     ]
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.int32, np.float64])
+def test_tracks_sharing_a_detection_keep_the_inputs_order_and_dtype(dtype):
+    """A user trial: on frames where two tracks shared a detection (a blob) the boxes came back
+    float64 (float32 on every other frame), and in track order."""
+    adapter = SupervisionTracker()
+    rows = [[30, 10, 40, 40, 3, 0.9, 0, 1], [10, 10, 20, 40, 1, 0.9, 0, 0],
+            [15, 10, 25, 40, 2, 0.9, 0, 0]]  # fmt: skip
+    adapter.tracker.update = lambda dets, frame: np.array(rows, float)  # type: ignore[method-assign]
+    dets = sv.Detections(
+        xyxy=np.array([[10, 10, 25, 40], [30, 10, 40, 40]], dtype),
+        confidence=np.array([0.9, 0.9], np.float32),
+    )
+    out = adapter.update_with_detections(dets, np.zeros((100, 100, 3), np.uint8))
+    assert out.xyxy.dtype == dtype
+    assert out.tracker_id.tolist() == [1, 2, 3]  # detection 0's two tracks, then detection 1's
+    np.testing.assert_array_equal(out.xyxy, np.array([r[:4] for r in rows[1:] + rows[:1]], dtype))

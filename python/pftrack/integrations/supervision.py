@@ -105,12 +105,12 @@ class SupervisionTracker:
         -------
         supervision.Detections
             As supervision's ByteTrack does: the detections matched to a confirmed track this
-            frame, in track order, with ``tracker_id`` set and every other field (boxes, masks,
-            data) taken from the input. Tracks sharing one detection (a blob of people who
-            merged) each get a row with that track's own box: the filter's estimate, not
-            clipped to the frame, which may reach past its edge by a few pixels, as
-            ground-truth boxes do (clip ``xyxy`` before cropping, e.g. x1, x2 with
-            ``np.clip(..., 0, W)`` and y1, y2 with ``np.clip(..., 0, H)``).
+            frame, in their input order, with ``tracker_id`` set and every other field (boxes,
+            masks, data, the boxes' dtype) taken from the input. Tracks sharing one detection
+            (a blob of people who merged) each get a row with that track's own box: the
+            filter's estimate, not clipped to the frame, which may reach past its edge by a
+            few pixels, as ground-truth boxes do (clip ``xyxy`` before cropping, e.g. x1, x2
+            with ``np.clip(..., 0, W)`` and y1, y2 with ``np.clip(..., 0, H)``).
         """
         detections_cls = _detections_class()
         if not isinstance(detections, detections_cls):
@@ -122,12 +122,14 @@ class SupervisionTracker:
         cls = np.zeros(n) if detections.class_id is None else detections.class_id
         dets = np.column_stack([np.asarray(detections.xyxy, np.float64).reshape(n, 4), conf, cls])
         tracks = self.tracker.update(dets, frame)
+        # the input's order, as ByteTrack keeps it (a blob's tracks in track order)
+        tracks = tracks[np.argsort(tracks[:, 7], kind="stable")]
         rows = tracks[:, 7].astype(np.int64)
         out = detections[rows]
         shared = np.bincount(rows, minlength=n)[rows] > 1 if len(rows) else np.zeros(0, bool)
-        if shared.any():
-            out.xyxy = np.asarray(out.xyxy, np.float64).copy()
-            out.xyxy[shared] = tracks[shared, :4]
+        if shared.any():  # each track its own box, in the input's dtype
+            out.xyxy = np.array(out.xyxy, copy=True)
+            out.xyxy[shared] = tracks[shared, :4].astype(out.xyxy.dtype)
         out.tracker_id = tracks[:, 4].astype(int)
         result: sv.Detections = out
         return result
