@@ -76,6 +76,21 @@ def test_picks_linear_on_straight_jittered_segments() -> None:
     assert cal2.method_for(12) == "linear"
 
 
+@pytest.mark.parametrize("bags", [0, None])
+def test_a_tie_at_rounding_keeps_linear(bags: int | None) -> None:
+    """A user trial: constant box sizes (linear errs by 1e-15, rts by 0) chose rts, and
+    noise-free straight centres gdt-bi, by a paired test on rounding alone."""
+    rng = np.random.default_rng(3)
+    sizes = [np.column_stack([np.arange(80.0), np.full(80, w), np.full(80, 2.5 * w)])
+             for w in rng.uniform(10, 60, 30)]  # fmt: skip
+    cal = calibrate(sizes, [4, 10, 12, 20, 7, 5], candidates=("linear", "rts"), bags=bags)
+    assert cal.pooled == "linear" and {c.method for c in cal.buckets} == {"linear"}, cal.describe()
+    t = np.arange(80.0)
+    lines = [np.column_stack([t, 3.0 + 0.7 * t, 5.0 + 0.3 * t]) for _ in range(30)]
+    cal = calibrate(lines, [4, 10, 12, 20], bags=bags)
+    assert cal.pooled == "linear" and {c.method for c in cal.buckets} == {"linear"}, cal.describe()
+
+
 def test_picks_goal_directed_on_manoeuvring_data() -> None:
     tracks = _manoeuvring_tracks(np.random.default_rng(1))
     cal = calibrate(tracks, [20, 40])

@@ -77,6 +77,9 @@ __all__ = [
 CANDIDATES = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed", "linear-nb", "rts-nb")
 #: Linear is kept unless the best candidate's validation MMAE is lower by more than this share.
 LINEAR_MARGIN = 0.01
+#: A lower validation MMAE by less than this (px) is a tie, whatever the test says: rounding
+#: (straight, noise-free paths where linear errs by 1e-15 px and rts by 0 chose rts).
+TIE = 1e-6
 #: Artificial gaps per file, shared among the buckets in proportion to their real gaps
 #: (:func:`bucket_quotas`: at least MIN_VALIDATION_GAPS each, so a few more in all at most).
 MAX_CALIBRATION_GAPS = 300
@@ -785,7 +788,7 @@ def _better(cand: F64, ref: F64) -> bool:
     d = cand - ref
     se = float(np.std(d, ddof=1)) / np.sqrt(len(d)) if len(d) > 1 else np.inf
     mean = float(d.mean())
-    return mean < -PAIRED_Z * se and mean < -LINEAR_MARGIN * float(ref.mean())
+    return mean < -PAIRED_Z * se and mean < -max(LINEAR_MARGIN * float(ref.mean()), TIE)
 
 
 def _pooled_choice(
@@ -814,7 +817,7 @@ def _pooled_choice(
         / len(errors[b][best])
         for b in errors
     )
-    if diff < -PAIRED_Z * np.sqrt(var) and diff < -LINEAR_MARGIN * score("linear"):
+    if diff < -PAIRED_Z * np.sqrt(var) and diff < -max(LINEAR_MARGIN * score("linear"), TIE):
         return best
     return "linear"
 
