@@ -56,17 +56,22 @@ def test_scale_rows_past_the_end_and_boxes_off_the_frame(
     assert main([*argv, "--out", str(tmp_path / "a.mp4")]) == 0
     err = capsys.readouterr().err
     assert "reach outside the" in err and "(--scale S)" in err
-    assert "1 rows of frames 35-35 are past the video's last frame 30: not drawn" in err
+    assert "1 row of frame 35 is past the video's last frame 30: not drawn" in err
     assert main([*argv, "--scale", "0.25", "--out", str(tmp_path / "b.mp4")]) == 0
     assert "outside" not in capsys.readouterr().err
     # boxes 1.6 times too large mostly cross the frame's edge without lying wholly outside
     assert main([*argv, "--scale", "0.4", "--out", str(tmp_path / "c.mp4")]) == 0
     assert "reach outside the" in capsys.readouterr().err
-    # every row past the video: the summary says nothing was drawn
+    # every row past the video: another video's tracks, refused before any work (a user
+    # trial: exit 0 and a video with nothing drawn, said only by the summary)
     past = tmp_path / "past.txt"
     write_mot(past, scene.truth + [100, 0, 0, 0, 0, 0, 0, 0, 0, 0])
-    assert main(["render", str(video), str(past), "--out", str(tmp_path / "d.mp4")]) == 0
-    assert "30 frames, 0 tracks, 0 boxes drawn" in capsys.readouterr().out
+    assert main(["render", str(video), str(past), "--out", str(tmp_path / "d.mp4")]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack render: error: every row of {past} lies past the last frame of {video}, "
+        "which has 30 (the rows' frames are 101-130): the tracks of another video?\n"
+    )
+    assert not (tmp_path / "d.mp4").exists()
     _, drawn = decode(tmp_path / "b.mp4")
     rows = read_mot(tracks)
     rows[:, 2:6] *= 0.25

@@ -99,6 +99,12 @@ def run(args: argparse.Namespace) -> int:
     rows[:, 2:6] *= args.scale
     source = FrameSource(args.source, fps=args.fps)
     n_frames = len(source)
+    if n_frames and len(rows) and rows[:, 0].min() > n_frames:  # was: an empty video, exit 0
+        raise ValueError(
+            f"every row of {args.tracks} lies past the last frame of {source.name}, which has "
+            f"{n_frames} (the rows' frames are {int(rows[:, 0].min())}-"
+            f"{int(rows[:, 0].max())}): the tracks of another video?"
+        )
     out = report_stream(args.out, args.plot)
     drawn = [0]
     kept: list[Any] = []  # the first frame, the plot's background (the video read once)
@@ -125,9 +131,12 @@ def run(args: argparse.Namespace) -> int:
     late = rows[rows[:, 0] > drawn[0]]
     notes = [str(w.message) for w in caught] + _outside(rows, source.width, source.height)
     if len(late):
+        first, last = int(late[:, 0].min()), int(late[:, 0].max())
+        frames = f"frame {first}" if first == last else f"frames {first}-{last}"
         notes.append(
-            f"{len(late)} rows of frames {int(late[:, 0].min())}-{int(late[:, 0].max())} are "
-            f"past the video's last frame {drawn[0]}: not drawn"
+            f"{len(late)} row{'s' * (len(late) != 1)} of {frames} "
+            f"{'are' if len(late) != 1 else 'is'} past the video's last frame {drawn[0]}: not "
+            "drawn"
         )
     for note in notes:
         print(f"pftrack render: warning: {note}", file=sys.stderr)
