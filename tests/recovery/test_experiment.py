@@ -167,6 +167,18 @@ def test_a_mask_outside_the_image_is_refused(
         )
 
 
+def test_fewer_masks_than_asked_are_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``--n-masks 50`` placed 10 on TUD-Campus, without a word."""
+    gt = tmp_path / "gt.txt"
+    write_mot(gt, _walkers(n_ids=3, n_frames=30))
+    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--auto-masks",
+            "--n-masks", "50", "--methods", "linear"]  # fmt: skip
+    with pytest.warns(UserWarning, match=r": \d+ of the 50 masks asked for were placed"):
+        assert main(argv) == 0
+
+
 def test_too_small_an_image_size_is_named_for_its_sequence(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

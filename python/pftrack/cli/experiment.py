@@ -484,6 +484,12 @@ def _run_sequences(args: argparse.Namespace) -> int:
             f"{r.name} ({r.image_size[0]:g}x{r.image_size[1]:g}): {r.n_gaps} gaps, masks {masks}",
             file=to,
         )
+        if r.n_gaps and len(r.masks) < args.n_masks:  # was: fewer, without a word
+            warnings.warn(
+                f"{r.name}: {len(r.masks)} of the {args.n_masks} masks asked for were placed "
+                "(no more fit without overlapping, or none more cuts a gap)",
+                stacklevel=2,
+            )
         if not r.n_gaps:  # was: a row of nan, and nothing said
             warnings.warn(
                 f"{r.name}: no gap under any mask (no mask position cuts a trajectory that is "
