@@ -450,3 +450,12 @@ def test_benchmark_help_names_every_measure_its_rules_apply_to(
         main(["eval", "--help"])
     help_text = " ".join(capsys.readouterr().out.split())
     assert "ground-truth rules: which rows HOTA, CLEAR-MOT and IDF1 score" in help_text
+
+
+def test_a_percentage_that_rounds_to_zero_prints_without_a_sign() -> None:
+    """A user trial: a one-row result printed ``MOTA -0.0``."""
+    from pftrack.eval.sequences import _pct
+
+    assert [_pct(v) for v in (-1e-6, 0.0, 1e-6, -0.004, float("nan"))] == [
+        "0.0", "0.0", "0.0", "-0.4", "-",
+    ]  # fmt: skip

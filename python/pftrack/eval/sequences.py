@@ -431,7 +431,10 @@ def evaluate_sequence(
 
 
 def _pct(x: float) -> str:
-    return "-" if not math.isfinite(x) else f"{100.0 * x:.1f}"  # "-": no value (JSON: null)
+    if not math.isfinite(x):
+        return "-"  # no value (JSON: null)
+    text = f"{100.0 * x:.1f}"
+    return "0.0" if text == "-0.0" else text  # a MOTA of -0.0001 %: was "-0.0"
 
 
 _COLUMNS: list[tuple[str, Callable[[SequenceScores], str]]] = [
