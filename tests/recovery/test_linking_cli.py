@@ -497,3 +497,24 @@ def test_padded_columns_that_look_filled_are_said(tail, tmp_path, capsys):
         f"pftrack recover: warning: {src}: 2 row(s) have 1 in column 8 and {fields} columns "
         "(the missing ones padded with -1)" in err
     )
+
+
+def test_boxes_four_times_apart_in_area_are_not_linked(tmp_path, capsys):
+    """A user trial: two one-row fragments of ByteTrack's false positives on TUD-Campus, 4.1
+    times apart in area, were joined across 30 frames and 30 boxes filled between them."""
+    rows = np.array([
+        [7, 8, 66.5255, 212.778, 30.7028, 46.31, 0.685141, -1, -1, -1],
+        [38, 16, 34.3067, 166.579, 68.0333, 86.014, 0.588207, -1, -1, -1],
+    ])  # fmt: skip
+    assert link_tracklets(rows, LinkConfig())[1] == {}
+    assert link_tracklets(rows, LinkConfig(max_area_ratio=None))[1] == {16: 8}
+    twice = rows.copy()
+    twice[1, 4:6] = twice[0, 4:6] * 1.9  # 3.6 times the area: within the gate
+    assert link_tracklets(twice, LinkConfig())[1] == {16: 8}
+    src = tmp_path / "two.txt"
+    write_mot(src, rows)
+    assert main(["-q", "smooth", str(src), "--out", str(tmp_path / "s.txt")]) == 0
+    assert len(read_mot(tmp_path / "s.txt")) == 2
+    for bad in (0.5, float("nan"), True, "4"):
+        with pytest.raises(ValueError, match="LinkConfig.max_area_ratio is"):
+            LinkConfig(max_area_ratio=bad)  # type: ignore[arg-type]
