@@ -137,13 +137,19 @@ def test_a_bad_seqinfo_is_named_with_its_key_and_value(
     assert err.count("\n") == 1
 
 
-def test_a_method_named_twice_is_refused(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """A user trial: ``--methods linear,linear`` counted each mask position twice."""
+@pytest.fixture
+def walkers_gt(tmp_path: Path) -> Path:
+    """A ground-truth file of three walkers over 30 frames (768x576)."""
     gt = tmp_path / "gt.txt"
     write_mot(gt, _walkers(n_ids=3, n_frames=30))
-    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--methods",
+    return gt
+
+
+def test_a_method_named_twice_is_refused(
+    walkers_gt: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``--methods linear,linear`` counted each mask position twice."""
+    argv = ["experiment", "gaps", "--gt", str(walkers_gt), "--image-size", "768x576", "--methods",
             "linear,auto,linear"]  # fmt: skip
     assert main(argv) == 2
     err = capsys.readouterr().err
@@ -153,13 +159,12 @@ def test_a_method_named_twice_is_refused(
 
 
 def test_a_mask_outside_the_image_is_refused(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    walkers_gt: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A user trial: ``--mask 10000,10000,5,5`` on a 768x576 image said "no gap under this
     mask", exit 0, and skipped the sweep."""
-    gt = tmp_path / "gt.txt"
-    write_mot(gt, _walkers(n_ids=3, n_frames=30))
-    base = ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--methods", "linear"]
+    base = ["experiment", "gaps", "--gt", str(walkers_gt), "--image-size", "768x576", "--methods",
+            "linear"]  # fmt: skip
     for mask in ("10000,10000,5,5", "700,0,100,100", "-1,0,10,10"):
         assert main([*base, f"--mask={mask}"]) == 2
         assert capsys.readouterr().err == (
@@ -169,13 +174,11 @@ def test_a_mask_outside_the_image_is_refused(
 
 
 def test_fewer_masks_than_asked_are_said(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    walkers_gt: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A user trial: ``--n-masks 50`` placed 10 on TUD-Campus, without a word."""
-    gt = tmp_path / "gt.txt"
-    write_mot(gt, _walkers(n_ids=3, n_frames=30))
-    argv = ["experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--auto-masks",
-            "--n-masks", "50", "--methods", "linear"]  # fmt: skip
+    argv = ["experiment", "gaps", "--gt", str(walkers_gt), "--image-size", "768x576",
+            "--auto-masks", "--n-masks", "50", "--methods", "linear"]  # fmt: skip
     import warnings
 
     with warnings.catch_warnings():
@@ -183,8 +186,8 @@ def test_fewer_masks_than_asked_are_said(
         assert main(argv) == 0
     err = capsys.readouterr().err
     assert re.fullmatch(
-        rf"pftrack experiment gaps: warning: {tmp_path.name}: \d+ of the 50 masks asked for were "
-        r"placed \(no more fit without overlapping, or none more cuts a gap\)\n",
+        rf"pftrack experiment gaps: warning: {walkers_gt.parent.name}: \d+ of the 50 masks asked "
+        r"for were placed \(no more fit without overlapping, or none more cuts a gap\)\n",
         err,
     ), err
 
