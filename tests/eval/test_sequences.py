@@ -475,3 +475,17 @@ def test_a_percentage_that_rounds_to_zero_prints_without_a_sign() -> None:
     assert [_pct(v) for v in (-1e-6, 0.0, 1e-6, -0.004, float("nan"))] == [
         "0.0", "0.0", "0.0", "-0.4", "-",
     ]  # fmt: skip
+
+
+def test_seqs_does_not_read_the_other_sequences_seqinfo(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``eval --seqs A`` stopped on a ``seqinfo.ini`` key given twice in B, a
+    sequence it was not asked to score."""
+    gt_root, res_root = make_layout(tmp_path, {"A": random_case(1), "B": random_case(2)})
+    (gt_root / "B" / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nframeRate=8\n")
+    argv = ["eval", "--gt", str(gt_root), "--res", str(res_root)]
+    assert main([*argv, "--seqs", "A"]) == 0
+    assert "A" in capsys.readouterr().out
+    assert main(argv) == 2  # asked for, it is read, and refused
+    assert "key frameRate in [Sequence] is given twice" in capsys.readouterr().err

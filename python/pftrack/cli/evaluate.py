@@ -153,7 +153,7 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
         if args.seqs:
             raise ValueError("--seqs needs a ground-truth folder, not a file")
         return [(res.stem, sequence_of_file(gt, res.stem), res)]
-    seqs = find_sequences(gt)
+    seqs = find_sequences(gt, args.seqs or None)  # the others' seqinfo.ini is not read
     if args.seqs:
         known = {s.name for s in seqs}
         unknown = [n for n in args.seqs if n not in known]

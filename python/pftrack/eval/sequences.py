@@ -17,7 +17,7 @@ import io
 import json
 import math
 import re
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from pathlib import Path
 from typing import cast
 
@@ -86,12 +86,16 @@ def read_seqinfo(path: PathLike) -> dict[str, str]:
     return dict(parser["Sequence"])
 
 
-def _sequence(folder: Path) -> SequenceInfo | None:
+def _sequence(folder: Path, only: Collection[str] | None = None) -> SequenceInfo | None:
+    """The sequence of `folder`, None without a ground-truth file.
+
+    Its ``seqinfo.ini`` is read only when `only` is None or names it.
+    """
     gt = next((p for p in (folder / "gt" / "gt.txt", folder / "gt.txt") if p.is_file()), None)
     if gt is None:
         return None
     ini = folder / "seqinfo.ini"
-    if not ini.is_file():
+    if not ini.is_file() or (only is not None and folder.name not in only):
         return SequenceInfo(folder.name, gt)
     from pftrack.io.video import read_seqinfo as read_info  # track's and batch's reader
 
@@ -115,12 +119,14 @@ def sequence_of_file(gt_file: PathLike, name: str) -> SequenceInfo:
     return SequenceInfo(name, path)
 
 
-def find_sequences(root: PathLike) -> list[SequenceInfo]:
+def find_sequences(root: PathLike, only: Collection[str] | None = None) -> list[SequenceInfo]:
     """The sequences of a MOTChallenge ground-truth folder, by name.
 
     `root` is one sequence folder (it has ``gt/gt.txt`` or ``gt.txt``), a folder of them, or
     a folder of such folders (TrackEval's ``gt/mot_challenge/`` with ``MOT17-train/``, ...:
-    the sequences of all of them); folders without a ground-truth file are skipped.
+    the sequences of all of them); folders without a ground-truth file are skipped. With
+    `only` (``pftrack eval --seqs``), the ``seqinfo.ini`` of the sequences it does not name is
+    not read: a malformed one of a sequence not scored stopped the run.
 
     Raises
     ------
@@ -136,9 +142,9 @@ def find_sequences(root: PathLike) -> list[SequenceInfo]:
     own = _sequence(base)
     if own is not None:
         return [own]
-    found = _sequences_in(base)
+    found = _sequences_in(base, only)
     if not found:  # TrackEval: gt/mot_challenge/BENCH-SPLIT/SEQ
-        found = [s for d in _folders(base) for s in _sequences_in(d)]
+        found = [s for d in _folders(base) for s in _sequences_in(d, only)]
         seen: dict[str, Path] = {}
         for s in found:
             if s.name in seen:
@@ -159,8 +165,8 @@ def _folders(base: Path) -> list[Path]:
     return [d for d in sorted(base.iterdir()) if d.is_dir()]
 
 
-def _sequences_in(base: Path) -> list[SequenceInfo]:
-    return [s for d in _folders(base) if (s := _sequence(d)) is not None]
+def _sequences_in(base: Path, only: Collection[str] | None = None) -> list[SequenceInfo]:
+    return [s for d in _folders(base) if (s := _sequence(d, only)) is not None]
 
 
 #: TrackEval's benchmark-split folder: BENCHMARK + "-" + SPLIT_TO_EVAL (``MOT17-train``,
