@@ -114,7 +114,7 @@ def stratified_resample(
 
 def multinomial_resample(
     weights: ArrayLike, rng: RngLike | np.random.RandomState = None
-) -> NDArray[np.int32]:
+) -> NDArray[np.int64]:
     """Indices kept by multinomial resampling: N independent draws from the weights.
 
     The indices come in the order of the draws (as in filterpy), not sorted.
@@ -128,7 +128,8 @@ def multinomial_resample(
 
     Returns
     -------
-    (N,) ndarray of int32
+    (N,) ndarray of int64
+        As filterpy's (``np.searchsorted``); the other three schemes give int32, as theirs do.
 
     References
     ----------
@@ -136,7 +137,8 @@ def multinomial_resample(
        Bayesian state estimation. IEE Proceedings F 140(2), 107-113.
     """
     w = _weights(weights, "multinomial_resample")
-    return _core.multinomial_resample(w, generator(rng, "multinomial_resample: rng").random(len(w)))
+    u = generator(rng, "multinomial_resample: rng").random(len(w))
+    return _core.multinomial_resample(w, u).astype(np.int64)  # filterpy's dtype
 
 
 def residual_resample(
