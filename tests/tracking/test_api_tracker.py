@@ -510,6 +510,12 @@ def test_options_and_frames():
     assert pftrack.Tracker(max_coast=4000.0).config.lifecycle.max_coast == 100_000  # the bound
     with pytest.raises(ValueError, match="camera_motion"):
         pftrack.Tracker(camera_motion="sometimes")
+    # a user trial: "100" and 1.5 were ValueErrors, and 10**9 named FilterConfig's n_particles
+    for wrong in ("100", 1.5, True):
+        with pytest.raises(TypeError, match=r"^particles must be an integer in \[1, 1000000\]"):
+            pftrack.Tracker(particles=wrong)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^particles is 1000000000, expected an integer in"):
+        pftrack.Tracker(particles=10**9)
     with pytest.raises(TypeError, match="uint8"):
         pftrack.Tracker().update(None, np.zeros((30, 40, 3)))
     # the defaults are the command's frame counts at any rate; seconds given become frames

@@ -35,7 +35,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, flag, number
+from pftrack._check import bgr_frame, flag, integer, number
 from pftrack._check import seed as check_seed
 from pftrack._typing import (
     F64,
@@ -48,6 +48,7 @@ from pftrack._typing import (
 )
 from pftrack.detection.light import BLANK_LEVELS, is_blank
 from pftrack.detection.size_model import PersonSizeModel
+from pftrack.particle_filter.filter import MAX_PARTICLES
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import TrackerConfig
@@ -433,11 +434,8 @@ class Tracker:
             )
         if dynamics not in ("ar2", "ar2-mean"):
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
-        if particles is not None and (
-            isinstance(particles, bool) or not isinstance(particles, (int, np.integer))
-            or particles < 1
-        ):  # fmt: skip
-            raise ValueError(f"particles is {particles!r}, expected None or an integer >= 1")
+        if particles is not None:  # named as the option (was FilterConfig's n_particles)
+            particles = integer(particles, "particles", 1, MAX_PARTICLES)
         base = TrackerConfig()
         model = replace(base.filter.model, use_means=dynamics == "ar2-mean")
         config = replace(
