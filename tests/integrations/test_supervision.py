@@ -92,6 +92,9 @@ def test_empty_and_bad_input(scene):
     assert len(out) == 0
     with pytest.raises(TypeError, match="supervision.Detections"):
         adapter.update_with_detections(np.zeros((0, 5)), scene.frames[0])
+    # a user trial: "Tracker.__init__() got an unexpected keyword argument 'bogus'"
+    with pytest.raises(TypeError, match="^SupervisionTracker got an unknown option 'bogus'"):
+        SupervisionTracker(bogus=1)  # type: ignore[call-arg]
 
 
 def test_boxes_without_area_and_inverted_boxes(scene):

@@ -85,6 +85,12 @@ class SupervisionTracker:
     """
 
     def __init__(self, frame_rate: float = 25.0, **options: Unpack[TrackerOptions]) -> None:
+        unknown = sorted(set(options) - set(TrackerOptions.__annotations__))
+        if unknown:  # was: "Tracker.__init__() got an unexpected keyword argument"
+            raise TypeError(
+                f"SupervisionTracker got an unknown option {unknown[0]!r} (its options are "
+                "pftrack.Tracker's)"
+            )
         self.tracker = Tracker(frame_rate, **options)
         # supervision's boxes are always x1, y1, x2, y2: messages name them, without the hint
         # that the rows look like x, y, w, h
