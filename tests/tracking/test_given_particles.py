@@ -89,8 +89,10 @@ def test_an_explicit_count_holds_for_both_modes():
     assert tracker.config.filter.n_particles == 150 and tracker.config.given_particles is None
     default = pftrack.Tracker()
     assert default.config.filter.n_particles == 100 and default.config.given_particles == 200
-    for bad in (0, True, 2.5):
-        with pytest.raises(ValueError, match="particles"):
+    with pytest.raises(ValueError, match="particles is 0"):
+        pftrack.Tracker(particles=0)
+    for bad in (True, 2.5):  # not an integer: a TypeError, as for every option
+        with pytest.raises(TypeError, match="particles must be an integer"):
             pftrack.Tracker(particles=bad)
 
 
