@@ -897,6 +897,15 @@ def _sidecar(out_dir: Path, name: str) -> Path:
     return out_dir / f"{name}.json"
 
 
+def _read_sidecar(out_dir: Path, name: str) -> dict[str, Any] | None:
+    """The sidecar ``NAME.json`` as a dict; None when it is missing, unreadable or not one."""
+    try:
+        entry = json.loads(_sidecar(out_dir, name).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return entry if isinstance(entry, dict) else None
+
+
 def _complete(
     out_dir: Path, job: Job, kind: str, settings: dict[str, Any], prints: list[dict[str, Any]]
 ) -> tuple[dict[str, Any] | None, str | None]:
@@ -912,12 +921,8 @@ def _complete(
         outputs did (missing, or no longer the size and SHA-256 the sidecar records:
         :func:`output_print`).
     """
-    path = _sidecar(out_dir, job.name)
-    try:
-        entry = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None, None
-    if not isinstance(entry, dict):
+    entry = _read_sidecar(out_dir, job.name)
+    if entry is None:
         return None, None
     same = (
         entry.get("kind") == kind
@@ -993,11 +998,8 @@ def _earlier_outputs(out_dir: Path, name: str, kind: str) -> list[str]:
     would count as an input of every later batch of that folder (``two inputs are both named
     NAME``).
     """
-    try:
-        entry = json.loads(_sidecar(out_dir, name).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return []
-    if not isinstance(entry, dict) or entry.get("kind") != kind:
+    entry = _read_sidecar(out_dir, name)
+    if entry is None or entry.get("kind") != kind:
         return []
     listed = [*(entry.get("outputs") or []), *(entry.get("earlier_outputs") or [])]
     return [o for o in dict.fromkeys(listed) if isinstance(o, str) and (out_dir / o).is_file()]
@@ -1187,32 +1189,21 @@ def named_as_options() -> Iterator[None]:
         _OUT_NAMES.reset(token)
 
 
-def _batch_files(out_dir: Path, name: str) -> set[str] | None:
+def _batch_files(out_dir: Path, name: str) -> set[str]:
     """The files of `out_dir` an earlier batch's sidecar ``NAME.json`` names, itself included.
 
-    None when ``NAME.json`` is missing; an empty set when it is not a batch's sidecar (a
-    user's own file of that name).
+    Empty when there is no such sidecar (none, or a user's own file of that name).
     """
-    path = _sidecar(out_dir, name)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        return None
-    except (OSError, ValueError):
-        return set()
-    try:
-        entry = json.loads(text)
-    except ValueError:
-        return set()
+    entry = _read_sidecar(out_dir, name)
     if not (
-        isinstance(entry, dict)
+        entry is not None
         and entry.get("name") == name
         and entry.get("kind") in ("track", "recover", "smooth")
         and isinstance(entry.get("outputs"), list)
     ):
         return set()
     listed = [*entry["outputs"], *(entry.get("earlier_outputs") or [])]
-    return {path.name, *(o for o in listed if isinstance(o, str))}
+    return {_sidecar(out_dir, name).name, *(o for o in listed if isinstance(o, str))}
 
 
 def _is_summary(path: Path) -> bool:
@@ -1267,7 +1258,7 @@ def _check_outputs(
             if not (out_dir / name).exists():
                 continue
             if ours is None:
-                ours = _batch_files(out_dir, job.name) or set()
+                ours = _batch_files(out_dir, job.name)
             if name not in ours:
                 raise ValueError(
                     f"{out_name} {out_dir / name} exists and no earlier batch wrote it (no "

@@ -365,7 +365,8 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         on_frame=None if report is None and stop is None else _on_frame(report, stop),
     )
     rows = run.rows
-    written = _as_written(rows)  # NAME.txt's values: what pftrack render and eval read
+    # NAME.txt's values, what pftrack render and eval read: only for a video or a score
+    written = _as_written(rows) if options.render is not None or seq.gt is not None else rows
     files: dict[str, bytes] = {}
     if options.render is not None:
         from pftrack.render import write_annotated_video

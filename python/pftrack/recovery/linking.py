@@ -284,9 +284,9 @@ def _sizes_apart(a: F64, b: F64, ratio: float | None) -> NDArray[np.bool_]:
 
     `a`, `b`: ``(n, 2)`` heights and widths; a box without area is not compared.
     """
-    area_a, area_b = a[:, 0] * a[:, 1], b[:, 0] * b[:, 1]
     if ratio is None:
         return np.zeros(len(a), bool)
+    area_a, area_b = a[:, 0] * a[:, 1], b[:, 0] * b[:, 1]
     sized = (area_a > 0) & (area_b > 0)
     return sized & (np.maximum(area_a, area_b) > ratio * np.minimum(area_a, area_b))
 
