@@ -1177,6 +1177,42 @@ def test_recover_and_smooth_many_files_equal_one_by_one(
     assert [f["status"] for f in summary["files"]] == ["skipped"] * 3
 
 
+_UNGUARDED_SCRIPT = """
+import os, sys
+with open(sys.argv[3], "a") as log:  # one line each time this top level runs
+    log.write(f"{os.getpid()}\\n")
+from dataclasses import replace
+from pftrack.batch import TrackOptions, track_many
+from pftrack.tracking import TrackerConfig
+base = TrackerConfig()
+options = TrackOptions(config=replace(base, filter=replace(base.filter, n_particles=30)))
+summary = track_many([sys.argv[1]], sys.argv[2], n_workers=2, options=options)
+print(len(summary.entries), len(summary.failed), __file__ == os.path.abspath(sys.argv[0]))
+"""
+
+
+def test_a_script_without_a_main_guard_runs_once(data: Path, tmp_path: Path) -> None:
+    """``track_many`` at a script's top level, no ``if __name__ == "__main__":``: it runs.
+
+    The local cluster's workers no longer import the script (:func:`_main_left_out`). Was:
+    every worker ran the script again, whose call started a cluster inside a worker still
+    starting: exit 1 and about 500 lines of Dask's tracebacks.
+    """
+    script, log = tmp_path / "batch_script.py", tmp_path / "ran.txt"
+    script.write_text(_UNGUARDED_SCRIPT)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    out = subprocess.run(
+        [sys.executable, str(script), str(data), str(tmp_path / "out"), str(log)],
+        env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path,
+    )  # fmt: skip
+    assert (out.returncode, out.stderr) == (0, "")
+    assert out.stdout.split() == ["3", "0", "True"]  # __file__ is put back afterwards
+    assert len(log.read_text().split()) == 1
+    assert sorted(p.name for p in (tmp_path / "out").glob("*.txt")) == [
+        "MOT-01.txt", "plain.txt", "walk.txt"
+    ]  # fmt: skip
+
+
 def test_help_imports_no_dask() -> None:
     code = (
         "import sys\nfrom pftrack.cli import main\n"

@@ -360,7 +360,9 @@ def dask_client(
     n = n_workers if n_workers is not None else (os.cpu_count() or 1)
     stack = contextlib.ExitStack()
     try:
-        with _interrupts_held():  # the cluster starts whole; its workers deaf to Ctrl-C, SIGTERM
+        # the cluster starts whole; its workers deaf to Ctrl-C, SIGTERM, and not running the
+        # caller's script again
+        with _interrupts_held(), _main_left_out():
             stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
             cluster = stack.enter_context(
                 LocalCluster(
@@ -556,6 +558,40 @@ def _silenced(*names: str) -> Iterator[None]:
     finally:
         for lg, was in zip(loggers, before, strict=True):
             lg.disabled = was
+
+
+@contextlib.contextmanager
+def _main_left_out() -> Iterator[None]:
+    """Worker processes spawned meanwhile do not import this process's main module.
+
+    ``multiprocessing`` starts a worker of a local cluster as a new Python that imports the
+    parent's main module (a script by its path, ``python -m`` by its name) before it takes
+    work. A script without ``if __name__ == "__main__":`` then runs again in every worker, and
+    its call of :func:`track_many` starts a cluster inside a worker that is still starting:
+    every worker failed, with Dask's tracebacks over hundreds of lines. A guarded script's
+    workers only imported what its top level imports (a deep-learning framework, say) for
+    nothing: pftrack's tasks are functions of pftrack. Meanwhile the main module looks to
+    ``multiprocessing`` as ``python -c`` does (no ``__spec__``, no ``__file__``); both are
+    put back at the end.
+    """
+    import sys
+
+    main = sys.modules.get("__main__")
+    if main is None or (getattr(main, "__spec__", None) is None and not hasattr(main, "__file__")):
+        yield  # an interactive session, python -c: nothing is imported again anyway
+        return
+    spec = main.__spec__
+    had_file = "__file__" in vars(main)
+    file = vars(main).get("__file__")
+    main.__spec__ = None
+    if had_file:
+        del main.__file__
+    try:
+        yield
+    finally:
+        main.__spec__ = spec
+        if had_file:
+            main.__file__ = file
 
 
 #: What :func:`_interrupts_held` holds: Ctrl-C, and SIGTERM, which the command turns into a

@@ -789,7 +789,8 @@ class Tracker:
             Inverted boxes that are most of the run's are refused, ValueError (x, y, w, h rows:
             :func:`check_boxes_xyxy`). None runs the built-in background-subtraction detector
             on this frame; a frame without detections is ``[]`` or ``np.zeros((0, 6))``
-            (None after frames with detections warns, see below).
+            (None after frames with detections warns, see below). The rows' order does not
+            matter: the same rows in any order give the same tracks (``det_ind`` follows it).
         frame : (H, W, 3) ndarray of uint8
             BGR frame, as cv2 reads it (TypeError for another dtype, or for what is not a
             NumPy array: a list, a PIL image, whose RGB ``np.asarray(img)[..., ::-1]`` makes

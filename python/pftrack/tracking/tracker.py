@@ -399,7 +399,8 @@ class MultiObjectTracker:
             BGR frame.
         detections : (K, 4) or (K, 5) array_like, optional
             ``[left, top, width, height(, score)]`` from any detector; None runs the built-in
-            background-subtraction detector.
+            background-subtraction detector. Their order does not matter
+            (:func:`canonical_order`).
         classes : (K,) array_like of int, optional
             Class id of each detection: a track is only matched to detections of the class it
             was born with, so classes never share an identity (default: one class).
@@ -432,6 +433,12 @@ class MultiObjectTracker:
         # every check before the state changes: an update that raises leaves the tracker as
         # it was, so a caller may skip the frame and go on
         given = self._check_given(f, detections, classes, checked)
+        # the caller's rows in one order whatever order they came in (a detector's rows in
+        # another order give the same tracks): `rank` maps it back to the caller's rows
+        rank = None
+        if given is not None and len(given[1]) > 1:
+            rank = canonical_order(*given)
+            given = (given[0][rank], given[1][rank], given[2][rank])
         if cfg is None:
             self._frame_shape = f.shape
             self.pixel_scale = self.config.pixel_scale(f.shape[1], f.shape[0])
@@ -456,6 +463,8 @@ class MultiObjectTracker:
         index = ((scores >= cfg.lifecycle.min_score) & ~tiny).nonzero()[0]
         scores_all = scores
         boxes, scores, labels = boxes[index], scores[index], labels[index]
+        if rank is not None:
+            index = rank[index]  # the caller's row of each box
         if given is not None:
             self.tiny_given += int(tiny.sum())
             self.kept_given += len(index)
@@ -599,6 +608,20 @@ class MultiObjectTracker:
             if v is not None and t.hits >= n:
                 self._speeds.add(v)
         self._gain = self.motion_gain()
+
+
+def canonical_order(boxes: F64, scores: F64, labels: NDArray[np.int64]) -> NDArray[np.intp]:
+    """The order in which a frame's detections are taken, whatever order they were given in.
+
+    Highest score first (the order of a detector's output after non-maximum suppression, and
+    of MOTChallenge's detection files: for those the order is the file's), then by ``left``,
+    ``top``, ``w``, ``h`` and class id. Rows equal in all of these are alike to the tracker;
+    among them the given order is kept (a stable sort).
+    """
+    out: NDArray[np.intp] = np.lexsort(
+        (labels, boxes[:, 3], boxes[:, 2], boxes[:, 1], boxes[:, 0], -scores)
+    )
+    return out
 
 
 def tiny_inside(boxes: F64, shape: tuple[int, ...], min_area: float) -> NDArray[np.bool_]:
