@@ -106,9 +106,19 @@ def test_bad_shapes_ids_and_max_gap_refused() -> None:
     rows[0, 1] = 1e19
     with pytest.raises(ValueError, match="track id 1e\\+19"):
         smooth_tracks(rows)
-    for g in (0, MAX_GAP_LIMIT + 1, True, 2.0):
+    for g in (0, MAX_GAP_LIMIT + 1):
         with pytest.raises(ValueError, match="max_gap"):
-            fill_gaps(FAR, max_gap=g)  # type: ignore[arg-type]
+            fill_gaps(FAR, max_gap=g)
+    for bad in (True, 2.0, "5"):  # not an int: TypeError, as every integer argument
+        with pytest.raises(TypeError, match="fill_gaps: max_gap must be an integer"):
+            fill_gaps(FAR, max_gap=bad)  # type: ignore[arg-type]
+        with pytest.raises(TypeError, match="smooth_tracks: max_gap must be an integer"):
+            smooth_tracks(FAR, max_gap=bad)  # type: ignore[arg-type]
+        with pytest.raises(TypeError, match="BoxSmoother: max_hole must be an integer"):
+            BoxSmoother(max_hole=bad)  # type: ignore[arg-type]
+    for bad in ("x", True, None):
+        with pytest.raises(TypeError, match="BoxSmoother: noise must be a number"):
+            BoxSmoother(noise=bad)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="real"):
         fill_gaps(np.full((2, 10), 1 + 1j))
     with pytest.raises(ValueError, match="size_noise"):

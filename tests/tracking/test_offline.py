@@ -107,6 +107,10 @@ def test_smoother_bad_input():
 @pytest.mark.parametrize("name", ["accel", "noise", "size_accel", "size_noise"])
 @pytest.mark.parametrize("value", [0.0, 5e-324, 1e-7, 1.1e6, 1e308, np.inf, np.nan, True, "1"])
 def test_smoother_noise_levels_out_of_bounds_are_refused(name, value):
+    if isinstance(value, (bool, str)):  # not a number: TypeError, as every numeric argument
+        with pytest.raises(TypeError, match=rf"BoxSmoother: {name} must be a number"):
+            BoxSmoother(**{name: value})
+        return
     with pytest.raises(ValueError, match=rf"{name} is .*expected a number in \[1e-06, 1e\+06\]"):
         BoxSmoother(**{name: value})
 

@@ -221,11 +221,11 @@ def fill_gaps(
     Raises
     ------
     TypeError
-        Rows that are not real numbers, `combine` not a bool, `seed` not an int, `noise` not a
-        NoiseEstimate.
+        Rows that are not real numbers, `combine` not a bool, `seed` or `max_gap` not an int,
+        `noise` not a NoiseEstimate.
     ValueError
         Unknown method, a negative `seed`, `bags` not None or an integer in ``0..10000`` (or
-        more than 0 with ``combine=False``), `max_gap` not an integer in ``1..MAX_GAP_LIMIT``,
+        more than 0 with ``combine=False``), `max_gap` outside ``1..MAX_GAP_LIMIT``,
         rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
         or height, a value beyond ±1e9 px) or a duplicate (frame, id).
@@ -260,14 +260,7 @@ def fill_rows(
     seed = _check.seed(seed, "fill_gaps: seed")  # NumPy's refusal named no argument
     bags = bags_for(bags, bool(combine), "fill_gaps")
     check_models(noise, None, "fill_gaps")
-    if (
-        not isinstance(max_gap, (int, np.integer))
-        or isinstance(max_gap, bool)
-        or not 1 <= max_gap <= MAX_GAP_LIMIT
-    ):
-        raise ValueError(
-            f"fill_gaps: max_gap is {max_gap!r}, expected an integer in 1..{MAX_GAP_LIMIT}"
-        )
+    max_gap = _check.integer(max_gap, "fill_gaps: max_gap", 1, MAX_GAP_LIMIT)
     rows = check_rows(rows, "fill_gaps")
     check_unique(rows, who="fill_gaps")
     per_id = split_tracks(rows)

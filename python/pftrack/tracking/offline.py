@@ -60,9 +60,8 @@ NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the
 def _check_noise_levels(owner: str, config: object, unit: str) -> None:
     """`config`'s ``accel, noise, size_accel, size_noise``: numbers in [NOISE_MIN, NOISE_MAX]."""
     for name in ("accel", "noise", "size_accel", "size_noise"):
-        v = getattr(config, name)
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool)
-        if not (ok and NOISE_MIN <= v <= NOISE_MAX):
+        v = _check.number(getattr(config, name), f"{owner}: {name}", finite=False)
+        if not NOISE_MIN <= v <= NOISE_MAX:
             raise ValueError(
                 f"{owner}: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
                 f"{NOISE_MAX:g}] ({unit})"
@@ -104,9 +103,7 @@ class BoxSmoother:
 
     def __post_init__(self) -> None:
         _check_noise_levels("BoxSmoother", self, "track heights")
-        h = self.max_hole
-        if not isinstance(h, (int, np.integer)) or isinstance(h, bool) or h < 1:
-            raise ValueError(f"BoxSmoother: max_hole is {h!r}, expected an integer >= 1")
+        _check.integer(self.max_hole, "BoxSmoother: max_hole", 1, MAX_FRAME)
 
     def smooth(self, frames: ArrayLike, boxes_xywh: ArrayLike, observed: ArrayLike) -> F64:
         """Smooth one track.
@@ -531,17 +528,11 @@ def smooth_tracks(
         Rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a
         non-integer id, a non-finite box, a box (of the rows or `measurements`) that
         :func:`pftrack.io.mot.read_mot` refuses (a negative width or height, a value beyond
-        ±1e9 px), `observed` / `measurements` of the wrong shape, or `max_gap` not None or an
-        int in ``1..MAX_GAP_LIMIT``.
+        ±1e9 px), `observed` / `measurements` of the wrong shape, or `max_gap` outside
+        ``1..MAX_GAP_LIMIT`` (TypeError: not None or an int).
     """
-    if max_gap is not None and (
-        isinstance(max_gap, bool)
-        or not isinstance(max_gap, (int, np.integer))
-        or not 1 <= max_gap <= MAX_GAP_LIMIT
-    ):
-        raise ValueError(
-            f"smooth_tracks: max_gap is {max_gap!r}, expected None or an int in 1..{MAX_GAP_LIMIT}"
-        )
+    if max_gap is not None:
+        max_gap = _check.integer(max_gap, "smooth_tracks: max_gap", 1, MAX_GAP_LIMIT)
     if fill_method not in METHODS:  # was named as fill_gaps' method, and only with holes
         raise ValueError(
             f"smooth_tracks: fill_method is {fill_method!r}, expected one of {METHODS}"
