@@ -278,6 +278,11 @@ def test_recover_gap_frames_must_be_real_integers() -> None:
     for frames in ([5, 5], [6, 4]):  # were rows given twice, or out of order
         with pytest.raises(ValueError, match="recover_gap: frames must increase strictly"):
             recover_gap(a, b, frames=frames, method="linear")
+    with pytest.raises(TypeError, match="recover_gap: frames must hold real numbers"):
+        recover_gap(a, b, frames=[True, False], method="linear")  # were frames 1 and 0
+    far = np.array([[2.0**31, 0, 0]])
+    with pytest.raises(ValueError, match="row 0 has frame 2147483648, expected an integer"):
+        recover_gap(far, far + [9, 0, 0], method="linear")  # was printed as 2.14748e+09
 
 
 def test_gsi_fills_a_long_gap_in_blocks_with_the_numbers_of_one_solve() -> None:

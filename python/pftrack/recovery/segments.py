@@ -84,7 +84,7 @@ def as_segment(seg: ArrayLike, name: str, fn: str = "recover_gap") -> F64:
     if fractional.any():
         r = int(np.argmax(fractional))
         raise ValueError(
-            f"{fn}: {name} row {r} has frame {f[r]:g}, expected an integer with "
+            f"{fn}: {name} row {r} has frame {f[r]:.17g}, expected an integer with "
             f"|frame| <= {MAX_FRAME} (refused)"
         )
     if a.shape[1] == 5 and (a[:, 3:] < 0).any():
@@ -149,7 +149,7 @@ def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.i
     f0, f1 = gap_ends(seg_a, seg_b)
     if frames is None:
         return np.arange(f0 + 1, f1, dtype=np.int64)
-    fr = real_array(frames, "recover_gap: frames")
+    fr = real_array(frames, "recover_gap: frames", booleans=False)
     if fr.ndim != 1 or not np.all(fr == np.round(fr)):
         raise ValueError("recover_gap: frames must be a 1-D array of integers")
     if fr.size and (fr.min() <= f0 or fr.max() >= f1):
@@ -157,7 +157,7 @@ def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.i
     if np.any(np.diff(fr) <= 0):  # one row per frame, in order (gsi reads the first and last)
         k = int(np.flatnonzero(np.diff(fr) <= 0)[0])
         raise ValueError(
-            f"recover_gap: frames must increase strictly, got {fr[k]:g} then {fr[k + 1]:g}"
+            f"recover_gap: frames must increase strictly, got {fr[k]:.17g} then {fr[k + 1]:.17g}"
         )
     return fr.astype(np.int64)
 
