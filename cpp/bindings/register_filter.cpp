@@ -172,6 +172,22 @@ void register_filter(py::module_& m) {
             using MatMap = Eigen::Map<RowMatrixXd>;
             using VecMap = Eigen::Map<Eigen::VectorXd>;
             using ConstVecMap = Eigen::Map<const Eigen::VectorXd>;
+            // ... and the values sis_step checks (particles, weights, means, the reference
+            // against the image's bins), each named by its entry: sis_step checks them again,
+            // but only after the objects before it have stepped
+            check_bin_image(image.lazy_view(), fn);
+            for (py::ssize_t i = 0; i < k; ++i) {
+                const auto& pa = keep[static_cast<size_t>(4 * i)];
+                const auto& wa = keep[static_cast<size_t>(4 * i + 1)];
+                const auto& ma = keep[static_cast<size_t>(4 * i + 2)];
+                const auto& ra = keep[static_cast<size_t>(4 * i + 3)];
+                const std::string entry = std::string(fn) + ": entry " + std::to_string(i);
+                check_particle_set(
+                    Eigen::Map<const RowMatrixXd>(pa.data(), pa.shape(0), kParticleCols),
+                    ConstVecMap(wa.data(), wa.shape(0)),
+                    Eigen::Map<const RowMatrixXd>(ma.data(), 2, kStateDim), entry.c_str());
+                sqrt_reference(ConstVecMap(ra.data(), ra.shape(0)), image.n_bins, entry.c_str());
+            }
             // columns: mean (3), map (3), map_index, ess, rho_max, rho_mean, fg_mean
             RowMatrixXd out(k, 11);
             {

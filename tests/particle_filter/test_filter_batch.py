@@ -14,6 +14,7 @@ from pftrack.particle_filter import (
     Ar2Model,
     ColourParticleFilter,
     FilterConfig,
+    HsvBinning,
     MHColourParticleFilter,
     box_histograms,
     hsv_bins,
@@ -142,6 +143,14 @@ def test_batch_rejects_bad_input_and_changes_nothing(textured_frame, rng):
         call(ps, [ws[0], ws[1][:-1]], seeds)
     with pytest.raises(ValueError, match=r"particles\[0\] must be C-contiguous"):
         call([np.asfortranarray(ps[0]), ps[1]], ws, seeds)
+    # the values sis_step checks, in the entry after one that would step (were: entry 0 had
+    # stepped when entry 1 was refused)
+    nan = ps[1].copy()
+    nan[3, 0] = np.nan
+    with pytest.raises(ValueError, match="sis_step_batch: entry 1: .*finite"):
+        call([ps[0], nan], ws, seeds)
+    with pytest.raises(ValueError, match="sis_step_batch: entry 1: .*weights"):
+        call(ps, [ws[0], np.zeros_like(ws[1])], seeds)
     for o, b in zip(objs, before, strict=True):
         np.testing.assert_array_equal(o["p"], b["p"])
         np.testing.assert_array_equal(o["w"], b["w"])
@@ -149,6 +158,24 @@ def test_batch_rejects_bad_input_and_changes_nothing(textured_frame, rng):
                                  model.b, model.sigma, model.s_min, model.s_max, False, 20.0,
                                  "uniform", True, [], [])  # fmt: skip
     assert empty.shape == (0, 11)
+
+
+def test_step_filters_refuses_a_bad_filter_before_any_steps(textured_frame, rng):
+    """A reference of another binning than the image's: named, and no filter has stepped."""
+    image = hsv_bins(textured_frame)
+    coarse = hsv_bins(textured_frame, binning=HsvBinning(4, 4, 4))
+    box = np.array([20.0, 15.0, 30.0, 40.0])
+    good = ColourParticleFilter(box, box_histograms(image, [box])[0], rng=1)
+    twin = copy.deepcopy(good)
+    bad = ColourParticleFilter(box, box_histograms(coarse, [box])[0], rng=2)
+    with pytest.raises(ValueError, match=r"filters\[1\]: ref size is 20, expected 110"):
+        step_filters([good, bad], image)
+    np.testing.assert_array_equal(good.particles, twin.particles)
+    np.testing.assert_array_equal(good.weights, twin.weights)
+    # its random stream has not moved either: it steps as its untouched twin does
+    a, b = good.step(image), twin.step(image)
+    np.testing.assert_array_equal(a.box_cxcywh, b.box_cxcywh)
+    np.testing.assert_array_equal(good.particles, twin.particles)
 
 
 def _scene(shift: int = 0) -> np.ndarray:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -528,6 +529,10 @@ class ColourParticleFilter:
         return state
 
 
+#: How the core names a batch's bad entry: ``sis_step_batch: entry K: what is wrong``.
+_ENTRY = re.compile(r"sis_step_batch: entry (\d+): (.*)", re.DOTALL)
+
+
 def step_filters(
     filters: Sequence[ColourParticleFilter], image: _core.BinnedImage
 ) -> list[FilterState]:
@@ -556,7 +561,10 @@ def step_filters(
     TypeError
         An element that is not a ColourParticleFilter.
     ValueError
-        The same filter twice in `filters`.
+        The same filter twice in `filters`; a filter whose particles, weights or reference
+        the core refuses (``step_filters: filters[k]: ref size is 20, expected 1000``: a
+        reference of another binning than the image's), found before any filter of the batch
+        has stepped.
     RuntimeError
         Another thread is inside one of the filters (``step_filters: filters[k] is in use by
         another thread``); then no filter has stepped.
@@ -597,7 +605,14 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
         col = 3 if cfg.estimate == "map" else 0
         _take(fs, "step_filters")
         try:
-            out = _step_batch(fs, cfg, image)
+            try:
+                out = _step_batch(fs, cfg, image)
+            except ValueError as exc:  # a bad entry, found before any filter stepped
+                named = _ENTRY.match(str(exc))
+                if named is None:
+                    raise
+                k = batch[int(named.group(1))]
+                raise ValueError(f"step_filters: filters[{k}]: {named.group(2)}") from None
             for f, row in zip(fs, out.tolist(), strict=True):
                 f._last, f._last_row = None, (row, col, f.w0, f.h0)
         finally:
