@@ -310,6 +310,52 @@ def test_ramped_scene_with_the_auto_bootstrap() -> None:
     assert worst > 0.5 and fixed < 0.1, (worst, fixed)
 
 
+def faded_in(frames: list[np.ndarray], frames_to_full: int, start: float = 0.0) -> list[np.ndarray]:
+    """Brightness from `start` at the first frame up to 1 at `frames_to_full` and after."""
+    gains = [start + (1 - start) * min(1.0, k / frames_to_full) for k in range(len(frames))]
+    return [(f.astype(np.float32) * g).astype(np.uint8) for f, g in zip(frames, gains, strict=True)]
+
+
+@pytest.mark.slow
+def test_a_video_that_fades_in_is_tracked() -> None:
+    """A 2 s fade-in (10 fps): tracked nearly as the video without it.
+
+    Were: the thresholds followed the gain since the dim first frame up, to 12 times t_min,
+    and nothing was foreground again (0 tracks); without that, the size model learnt the
+    dim frames' fragments of people and cut everyone in two afterwards (MOTA -67)."""
+    scene = make_scene(150, 480, 360, rng=1)
+    plain = mota(scene.frames, scene.truth)
+    faded = mota(faded_in(scene.frames, 20, start=0.05), scene.truth)
+    assert plain > 0.9 and faded > 0.6, (plain, faded)
+
+
+def test_thresholds_do_not_rise_past_the_given_bounds_as_the_light_rises() -> None:
+    """The threshold scale follows the light down, never above 1 (the fade-in's defect)."""
+    scene = make_scene(40, 240, 180, rng=1)
+    det = PaperDetector()
+    scales = []
+    for f in faded_in(scene.frames, 20, start=0.1):
+        det.detect(f)
+        scales.append(det.model.threshold_scale)
+    assert max(scales) == 1.0
+    det = PaperDetector()
+    for f in ramped(scene.frames, 0.4):  # dimming: down with the light, as before
+        det.detect(f)
+    assert det.model.threshold_scale < 0.5
+
+
+def test_the_size_model_pauses_while_the_light_changes() -> None:
+    scene = make_scene(60, 240, 180, rng=1)
+    frames = faded_in(scene.frames, 20, start=0.1)
+    det = PaperDetector()
+    for f in frames[:25]:  # through the fade and a few frames after
+        det.detect(f)
+    assert det.size_model.n_samples == 0
+    for f in frames[25:]:
+        det.detect(f)
+    assert det.size_model.n_samples > 0
+
+
 # -- the priming median under a light change ------------------------------------------------------
 def test_level_frames_leaves_steady_video_alone_and_levels_a_ramp() -> None:
     scene = make_scene(n_frames=30, rng=0)

@@ -261,7 +261,9 @@ class BlobExtractor:
         closed: NDArray[np.uint8] = _core.close_mask(m, k_close)
         return closed
 
-    def boxes(self, mask: NDArray[np.uint8]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def boxes(
+        self, mask: NDArray[np.uint8], *, learn: bool = True
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Boxes (K, 4) left, top, w, h and scores (K,) of the blobs that pass the filters.
 
         A blob is an 8-connected foreground region that lies in no hole of another one (the
@@ -275,6 +277,7 @@ class BlobExtractor:
 
         The whole pass is one C++ call (``pftrack._core.blob_boxes``, the GIL released;
         ``tests/reference/blobs.py`` is the OpenCV/NumPy statement it equals bit for bit).
+        With `learn` False the person-size model does not learn from this mask's blobs.
         """
         cfg = self.config
         model = self.size_model
@@ -293,7 +296,7 @@ class BlobExtractor:
             sc.split_max_height,
             sc.merge_slack,
         )
-        if cfg.learn_size:
+        if cfg.learn_size and learn:
             model.observe(rects)
         order = np.lexsort((rects[:, 1], rects[:, 0]))  # deterministic: by left, then top
         return np.ascontiguousarray(rects[order]), np.ascontiguousarray(fill[order])
