@@ -44,7 +44,7 @@ void register_blobs(py::module_& m) {
         [](const py::array& mask, double min_area, double max_area, double min_aspect,
            double max_aspect, double min_fill, double person_aspect,
            std::optional<Eigen::Ref<const RowMatrixXd>> size_lines, double split_ratio,
-           double split_max_height, double merge_slack) {
+           double split_max_height, double merge_slack, double split_valley) {
             const char* fn = "blob_boxes";
             require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
             bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);  // uint8 or bool, packed
@@ -56,6 +56,8 @@ void register_blobs(py::module_& m) {
             require(min_fill >= 0.0 && min_fill <= 1.0, fn, "min_fill", min_fill, "in [0, 1]");
             require(std::isfinite(person_aspect) && person_aspect >= 0.0, fn, "person_aspect",
                     person_aspect, "a finite value >= 0");
+            require(std::isfinite(split_valley) && split_valley >= 0.0, fn, "split_valley",
+                    split_valley, "a finite value >= 0");
             std::optional<SizeLines> lines;
             if (size_lines) {
                 lines = to_lines(*size_lines, fn);
@@ -72,7 +74,7 @@ void register_blobs(py::module_& m) {
                 blob_boxes(data, rows, cols, stride,
                            {min_area, max_area, min_aspect, max_aspect, min_fill}, person_aspect,
                            lines ? &*lines : nullptr, split_ratio, split_max_height, merge_slack,
-                           rects, fill);
+                           rects, fill, split_valley);
             }
             RowMatrixXd out(static_cast<Index>(rects.size()), 4);
             Eigen::VectorXd f(static_cast<Index>(fill.size()));
@@ -86,8 +88,10 @@ void register_blobs(py::module_& m) {
         py::arg("mask"), py::arg("min_area"), py::arg("max_area"), py::arg("min_aspect"),
         py::arg("max_aspect"), py::arg("min_fill"), py::arg("person_aspect"),
         py::arg("size_lines"), py::arg("split_ratio"), py::arg("split_max_height"),
-        py::arg("merge_slack"),
-        "Boxes (K, 4) and fills (K,) of the blobs of mask (H, W) uint8, unsorted.");
+        py::arg("merge_slack"), py::arg("split_valley") = 1.0,
+        "Boxes (K, 4) and fills (K,) of the blobs of mask (H, W) uint8, unsorted; a group is "
+        "cut only where its column profile falls to split_valley times its sides' peaks "
+        "(>= 1: at every minimum).");
 
     m.def(
         "split_count",

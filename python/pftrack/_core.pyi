@@ -274,6 +274,7 @@ def blob_boxes(
     split_ratio: float,
     split_max_height: float,
     merge_slack: float,
+    split_valley: float = ...,
 ) -> tuple[_F64, _F64]: ...  # unsorted (outer contours' order)
 def split_count(
     boxes: _F64, size_lines: _F64, split_ratio: float, split_max_height: float

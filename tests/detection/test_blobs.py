@@ -42,9 +42,15 @@ def _scene(rng: np.random.Generator, rows: int, cols: int) -> np.ndarray:
     return np.ascontiguousarray(m)
 
 
-def _both(mask: np.ndarray, limits: tuple[float, ...], person_aspect: float, lines: object) -> None:
-    want = ref.blob_boxes(mask, *limits, person_aspect, lines, *SIZE)  # type: ignore[arg-type]
-    got = _core.blob_boxes(mask, *limits, person_aspect, lines, *SIZE)
+def _both(
+    mask: np.ndarray,
+    limits: tuple[float, ...],
+    person_aspect: float,
+    lines: object,
+    valley: float = 1.0,
+) -> None:
+    want = ref.blob_boxes(mask, *limits, person_aspect, lines, *SIZE, valley)  # type: ignore[arg-type]
+    got = _core.blob_boxes(mask, *limits, person_aspect, lines, *SIZE, valley)
     np.testing.assert_array_equal(got[0], want[0])
     np.testing.assert_array_equal(got[1], want[1])
 
@@ -57,7 +63,28 @@ def test_equals_reference_on_random_masks(seed: int) -> None:
     small = (0.0005, 0.5, 0.1, 10.0, 0.1)  # let most blobs through: the later steps run too
     for limits in (DEFAULTS, small, (0.0, 1.0, 1e-3, 1e3, 0.0)):
         for person_aspect, lines in ((2.8, None), (0.0, None), (2.8, LINES), (0.0, LINES * 0.5)):
-            _both(mask, limits, person_aspect, lines)
+            for valley in (1.0, 0.9, 0.5, 0.0):
+                _both(mask, limits, person_aspect, lines, valley)
+
+
+def test_a_group_is_cut_only_at_a_valley_of_its_column_profile() -> None:
+    """One wide person (a full-height torso over legs) is not cut; two people with a gap
+    between their bodies are, however wide the rule expects people to be."""
+    wide = np.zeros((100, 120), np.uint8)
+    wide[10:60, 20:70] = 255  # torso and arms (a coat, a bag), 50 px wide
+    wide[60:90, 33:57] = 255  # legs, together
+    pair = np.zeros((100, 120), np.uint8)
+    pair[10:90, 20:42] = 255  # two people, 22 px each, touching at the hands only
+    pair[10:90, 46:68] = 255
+    pair[40:45, 42:46] = 255
+    args = (0.0, 1.0, 0.1, 10.0, 0.0, 2.8, None, *SIZE)  # person_aspect: both are "groups"
+    assert len(_core.blob_boxes(wide, *args, 1.0)[0]) == 2  # the rule alone cut the person
+    assert len(_core.blob_boxes(wide, *args, 0.9)[0]) == 1
+    people = _core.blob_boxes(pair, *args, 0.9)[0]
+    assert len(people) == 2 and people[0].tolist() == [20, 10, 22, 80]
+    for valley in (1.0, 0.9, 0.0):  # the reference agrees
+        _both(wide, args[:5], 2.8, None, valley)
+        _both(pair, args[:5], 2.8, None, valley)
 
 
 def test_only_outer_regions_in_contour_order() -> None:

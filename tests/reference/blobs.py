@@ -112,7 +112,12 @@ def _merge(
 
 
 def _split(
-    mask: NDArray[np.uint8], rects: F64, fill: F64, counts: NDArray[np.int64], min_area: float
+    mask: NDArray[np.uint8],
+    rects: F64,
+    fill: F64,
+    counts: NDArray[np.int64],
+    min_area: float,
+    valley: float = 1.0,
 ) -> tuple[F64, F64]:
     min_pixels = min_area * mask.shape[0] * mask.shape[1]
     out_r: list[F64] = []
@@ -133,6 +138,16 @@ def _split(
             lo, hi = max(cuts[-1] + 1, c - half), min(w - 1, c + half + 1)
             cuts.append(lo + int(np.argmin(profile[lo:hi])) if hi > lo else c)
         cuts.append(w)
+        if valley < 1.0:  # a cut only at a valley: at most `valley` of both sides' peaks
+            kept = [0]
+            for k in range(1, len(cuts) - 1):
+                if not kept[-1] < cuts[k] < min(cuts[k + 1], w + 1) or cuts[k] >= w:
+                    continue  # no column on one side (a narrow box cut into many): no valley
+                left = profile[kept[-1] : cuts[k]].max()
+                right = profile[cuts[k] : cuts[k + 1]].max()
+                if profile[cuts[k]] <= valley * min(left, right):
+                    kept.append(cuts[k])
+            cuts = [*kept, w]
         for a, b in zip(cuts[:-1], cuts[1:], strict=True):
             part = roi[:, a:b]
             rows = np.flatnonzero(part.any(axis=1))
@@ -157,6 +172,7 @@ def blob_boxes(
     split_ratio: float = 1.6,
     split_max_height: float = 1.5,
     merge_slack: float = 1.2,
+    split_valley: float = 1.0,
 ) -> tuple[F64, F64]:
     """Boxes (K, 4) and fills (K,) of the blobs of a cleaned 0/255 mask, unsorted."""
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
@@ -177,12 +193,12 @@ def blob_boxes(
     if size_lines is not None and len(rects):
         rects, fill = _merge(mask, rects, fill, merge_fragments(rects, size_lines, merge_slack))
         counts = split_count(rects, size_lines, split_ratio, split_max_height)
-        rects, fill = _split(mask, rects, fill, counts, min_area)
+        rects, fill = _split(mask, rects, fill, counts, min_area, split_valley)
     elif person_aspect > 0 and len(rects):
         objects = rects[:, 2] * person_aspect / rects[:, 3]
         n = np.round(objects).astype(np.int64)
         n[objects < 1.5] = 1
-        rects, fill = _split(mask, rects, fill, n, min_area)
+        rects, fill = _split(mask, rects, fill, n, min_area, split_valley)
     return rects, fill
 
 

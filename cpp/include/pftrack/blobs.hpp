@@ -361,13 +361,16 @@ inline std::vector<BlobRect> outer_regions(const std::uint8_t* mask, Index rows,
 
 /// Cuts each box into counts[i] people at the minima of its column profile; parts with fewer
 /// than `min_pixels` foreground pixels are dropped, each kept part gets its tight box.
+/// With `valley` < 1 a cut is made only where the profile falls to at most `valley` times the
+/// lower of the two sides' peaks (the columns from the last cut made to it, and from it to the
+/// next minimum): one wide person's profile has no such valley.
 inline void split_groups(const std::uint8_t* mask, Index stride, std::vector<BlobRect>& rects,
                          std::vector<double>& fill, const std::vector<std::int64_t>& counts,
-                         double min_pixels) {
+                         double min_pixels, double valley = 1.0) {
     std::vector<BlobRect> out_r;
     std::vector<double> out_f;
     std::vector<std::int64_t> profile;
-    std::vector<Index> cuts;
+    std::vector<Index> cuts, kept;
     for (std::size_t i = 0; i < rects.size(); ++i) {
         const auto x = static_cast<Index>(rects[i].x), y = static_cast<Index>(rects[i].y);
         const auto w = static_cast<Index>(rects[i].w), h = static_cast<Index>(rects[i].h);
@@ -396,6 +399,22 @@ inline void split_groups(const std::uint8_t* mask, Index stride, std::vector<Blo
             }
         }
         cuts.push_back(w);
+        if (valley < 1.0) {
+            kept.assign(1, 0);
+            for (std::size_t k = 1; k + 1 < cuts.size(); ++k) {
+                // a cut with no column on one side (a narrow box cut into many) is no valley
+                if (!(kept.back() < cuts[k] && cuts[k] < cuts[k + 1] && cuts[k] < w)) continue;
+                const auto at = [&](Index j) { return profile[static_cast<std::size_t>(j)]; };
+                std::int64_t left = 0, right = 0;
+                for (Index j = kept.back(); j < cuts[k]; ++j) left = std::max(left, at(j));
+                for (Index j = cuts[k]; j < std::min(cuts[k + 1], w); ++j)
+                    right = std::max(right, at(j));
+                if (double(at(cuts[k])) <= valley * double(std::min(left, right)))
+                    kept.push_back(cuts[k]);
+            }
+            kept.push_back(w);
+            cuts.swap(kept);
+        }
         for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
             const Index a = std::max<Index>(cuts[k], 0), b = std::min(cuts[k + 1], w);
             if (b <= a) continue;
@@ -425,11 +444,13 @@ inline void split_groups(const std::uint8_t* mask, Index stride, std::vector<Blo
 /// The whole blob pass of one cleaned mask (BlobExtractor.boxes without the size model's
 /// update and the final sort): outer regions, area / aspect / fill filters, then, with `size`,
 /// fragments merged and groups split by the person-size model, else, with `person_aspect` > 0,
-/// groups split by that aspect. Returns boxes and fills in the reference's (unsorted) order.
+/// groups split by that aspect; a cut only at a valley of the column profile (`split_valley`,
+/// split_groups). Returns boxes and fills in the reference's (unsorted) order.
 inline void blob_boxes(const std::uint8_t* mask, Index rows, Index cols, Index stride,
                        const BlobLimits& lim, double person_aspect, const SizeLines* size,
                        double split_ratio, double split_max_height, double merge_slack,
-                       std::vector<BlobRect>& rects, std::vector<double>& fill) {
+                       std::vector<BlobRect>& rects, std::vector<double>& fill,
+                       double split_valley = 1.0) {
     const std::vector<BlobRect> all = outer_regions(mask, rows, cols, stride);
     const double frame_area = double(rows * cols);
     const double lo_area = lim.min_area * frame_area, hi_area = lim.max_area * frame_area;
@@ -482,14 +503,15 @@ inline void blob_boxes(const std::uint8_t* mask, Index rows, Index cols, Index s
             fill.swap(mf);
         }
         split_groups(mask, stride, rects, fill,
-                     split_count(rects, *size, split_ratio, split_max_height), min_pixels);
+                     split_count(rects, *size, split_ratio, split_max_height), min_pixels,
+                     split_valley);
     } else if (person_aspect > 0.0) {
         std::vector<std::int64_t> n(rects.size());
         for (std::size_t i = 0; i < rects.size(); ++i) {
             const double objects = rects[i].w * person_aspect / rects[i].h;
             n[i] = objects < 1.5 ? 1 : to_count(objects);
         }
-        split_groups(mask, stride, rects, fill, n, min_pixels);
+        split_groups(mask, stride, rects, fill, n, min_pixels, split_valley);
     }
 }
 
