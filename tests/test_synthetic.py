@@ -96,6 +96,20 @@ def test_writers(tmp_path):
     np.testing.assert_allclose(read_mot(tmp_path / "gt.txt"), s.truth, atol=1e-9)
 
 
+@pytest.mark.parametrize("suffix", [".avi", ".mp4"])
+def test_an_odd_sized_scene_is_written_whole(tmp_path, suffix):
+    """321x241: one copied column and row (were: OpenCV cropped to 320x240 without a word, so
+    the video no longer held the truth's last column and row)."""
+    s = make_scene(n_frames=3, width=321, height=241, rng=0)
+    src = FrameSource(s.write_video(tmp_path / f"odd{suffix}"))
+    frames = list(src)
+    assert (src.width, src.height) == (322, 242) and len(frames) == 3
+    err = np.abs(frames[0][:241, :321].astype(int) - s.frames[0].astype(int)).mean()
+    assert err < 8  # the scene itself, lossy compressed, not shifted or scaled
+    last, copy = frames[0][:, 320].astype(int), frames[0][:, 321].astype(int)
+    np.testing.assert_allclose(copy, last, atol=40)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [

@@ -128,7 +128,11 @@ class Scene:
     def write_video(self, path: PathLike) -> Path:
         """Write the frames as a video file, atomically.
 
-        ``.avi`` gets MJPG, anything else (``.mp4``) mp4v. Returns the path.
+        ``.avi`` gets MJPG, anything else (``.mp4``) mp4v. Returns the path. An odd width or
+        height gets one copied column or row at the right or bottom, as
+        :class:`pftrack.io.video_writer.VideoWriter` does: the codecs store even sizes only, and
+        OpenCV's writer otherwise drops the last column and row without a word (the truth's
+        boxes stay where they are either way).
 
         Raises
         ------
@@ -137,12 +141,16 @@ class Scene:
         """
         p = Path(path)
         fourcc = cv2.VideoWriter.fourcc(*("MJPG" if p.suffix.lower() == ".avi" else "mp4v"))
+        pad_x, pad_y = self.width % 2, self.height % 2
+        size = (self.width + pad_x, self.height + pad_y)
         with atomic_path(p) as tmp, opencv_name(tmp) as name:  # any name (pftrack.io.opencv_io)
-            writer = cv2.VideoWriter(name, fourcc, self.fps, (self.width, self.height))
+            writer = cv2.VideoWriter(name, fourcc, self.fps, size)
             if not writer.isOpened():
                 raise ValueError(f"write_video: OpenCV cannot write {p.suffix!r} video to {p}")
             try:
                 for frame in self.frames:
+                    if pad_x or pad_y:
+                        frame = np.pad(frame, ((0, pad_y), (0, pad_x), (0, 0)), mode="edge")
                     writer.write(frame)
             finally:
                 writer.release()

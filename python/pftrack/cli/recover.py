@@ -155,7 +155,7 @@ def check_video(video: str, frames: Any, rows: Any, src: Path) -> None:
         return
     source = frames.source
     last = int(rows[:, 0].max())
-    if 0 < len(frames) < last:
+    if 0 < len(frames) < last and source.count_known:  # not FFmpeg's estimate (Matroska)
         raise ValueError(
             f"--video {video} has {len(frames)} frames but {src} has rows up to frame {last}: "
             "not the video of these tracks"

@@ -99,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
     rows[:, 2:6] *= args.scale
     source = FrameSource(args.source, fps=args.fps)
     n_frames = len(source)
-    if n_frames and len(rows) and rows[:, 0].min() > n_frames:  # was: an empty video, exit 0
+    # was: an empty video, exit 0; by a count the container stores (Matroska's is an estimate)
+    if n_frames and source.count_known and len(rows) and rows[:, 0].min() > n_frames:
         raise ValueError(
             f"every row of {args.tracks} lies past the last frame of {source.name}, which has "
             f"{n_frames} (the rows' frames are {int(rows[:, 0].min())}-"

@@ -67,6 +67,11 @@ __all__ = [
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
 #: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
+#: Containers whose header holds the number of frames (AVI's frame total, MP4's sample table):
+#: OpenCV's count of any other (Matroska, WebM, MPEG streams) is FFmpeg's estimate from the
+#: duration and the frame rate, which a variable frame rate puts off either way (a Matroska file
+#: of 60 frames gave 53 and 276).
+COUNTED_SUFFIXES = (".avi", ".mp4", ".mov", ".m4v")
 DEFAULT_FPS = 25.0
 #: The frame rates ``seqinfo.ini``'s ``frameRate`` may give, as ``pftrack track --fps`` (frames per
 #: second): 1e9 wrote an MP4 at 1e9 fps, 0.001 made 100 frames a 28-hour video.
@@ -813,6 +818,11 @@ class FrameSource:
         Where `fps` came from: ``"given"``, ``"seqinfo.ini"``, ``"container"`` or ``"default"``.
     n_frames : int
         Frames expected (0 when unknown, as for live sources).
+    count_known : bool
+        Whether `n_frames` is the number of frames, not an estimate: an image folder's, or
+        the header count of a container that stores one (:data:`COUNTED_SUFFIXES`). Checks
+        that refuse frame numbers past the last frame, or warn of a video that ended early,
+        are made only then.
     live : bool
         A camera, stream or pipe: read once, frames as they arrive.
     sequence : SequenceInfo or None
@@ -922,6 +932,10 @@ class FrameSource:
             else:
                 first, header_fps, count = self._probe_file(self.path)
         self.n_frames = max(count, 0)
+        self.count_known = self.n_frames > 0 and (
+            self.path is not None
+            and (self.path.is_dir() or self.path.suffix.lower() in COUNTED_SUFFIXES)
+        )
         seq_fps = self.sequence.frame_rate if self.sequence is not None else None
         if fps is not None:
             self.fps, self.fps_origin = float(fps), "given"
@@ -1273,7 +1287,7 @@ class FrameSource:
         a second decoding pass to count its frames would cost as much as the run.
         """
         said = []
-        if decoded < self.n_frames:
+        if decoded < self.n_frames and self.count_known:  # not FFmpeg's estimate (Matroska)
             said.append(f"its header says {self.n_frames}")
         seq = self.sequence
         if seq is not None and seq.length is not None and decoded != seq.length:
@@ -1281,7 +1295,9 @@ class FrameSource:
         if not said:
             return
         self._warned_short = True  # once, not on every pass
-        damaged = ": a truncated or damaged file?" if decoded < self.n_frames else ""
+        damaged = (
+            ": a truncated or damaged file?" if decoded < self.n_frames and self.count_known else ""
+        )
         warnings.warn(
             f"{self.path} ended after {decoded} frames but {' and '.join(said)}{damaged}",
             UserWarning,

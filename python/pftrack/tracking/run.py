@@ -210,7 +210,8 @@ def track_frames(
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
     if detections:
         _check_numbering(frames)
-        _check_last_frame(detections, len(frames))
+        # by a count the container stores; FFmpeg's estimate (Matroska's) may be short
+        _check_last_frame(detections, len(frames) if getattr(frames, "count_known", True) else 0)
     seed = (
         rng
         if rng is None or isinstance(rng, (int, np.integer))

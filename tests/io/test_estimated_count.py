@@ -1,0 +1,81 @@
+"""A container whose frame count is FFmpeg's estimate (Matroska) is not held to it.
+
+A user trial's variable-frame-rate ``.mkv`` of 60 frames: OpenCV said 53, and ``pftrack track
+--detections`` refused the detections of frames 54-60 as "a longer video's"; another said 276,
+and every run warned of "a truncated or damaged file".
+"""
+
+from __future__ import annotations
+
+import fractions
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pftrack.cli import main
+from pftrack.io.mot import read_mot, write_mot
+from pftrack.io.video import FrameSource
+from pftrack.synthetic import Scene, make_scene
+
+av = pytest.importorskip("av")
+
+
+@pytest.fixture(scope="module")
+def scene() -> Scene:
+    return make_scene(60, 160, 120, n_walkers=2, rng=1)
+
+
+def write_vfr(path: Path, scene: Scene, gaps_ms: list[int], rate: int = 10) -> Path:
+    """H.264 in Matroska, frame k stamped at sum(gaps_ms[:k]) ms (`rate`: the stream's own)."""
+    out = av.open(str(path), "w")
+    stream = out.add_stream("libx264", rate=rate)
+    stream.width, stream.height, stream.pix_fmt = scene.width, scene.height, "yuv420p"
+    stream.time_base = fractions.Fraction(1, 1000)
+    t = 0
+    for frame, gap in zip(scene.frames, gaps_ms, strict=True):
+        f = av.VideoFrame.from_ndarray(frame, format="bgr24")
+        f.pts, f.time_base = t, stream.time_base
+        for packet in stream.encode(f):
+            out.mux(packet)
+        t += gap
+    for packet in stream.encode():
+        out.mux(packet)
+    out.close()
+    return path
+
+
+def test_detections_of_every_decoded_frame_are_taken(scene: Scene, tmp_path: Path) -> None:
+    video = write_vfr(tmp_path / "vfr.mkv", scene, [100] * 50 + [20] * 10)
+    source = FrameSource(video)
+    assert not source.count_known and 0 < source.n_frames < 60  # the estimate is short
+    assert sum(1 for _ in FrameSource(video)) == 60
+    det = scene.truth.copy()
+    det[:, 1] = -1
+    write_mot(tmp_path / "det.txt", det)
+    out = tmp_path / "t.txt"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no warning of a short or damaged file either
+        code = main(["-q", "track", str(video), "--detections", str(tmp_path / "det.txt"),
+                     "--out", str(out), "--particles", "30"])  # fmt: skip
+    assert code == 0
+    assert read_mot(out)[:, 0].max() > source.n_frames  # rows of the frames past the estimate
+
+
+def test_a_long_estimate_is_not_called_damage(scene: Scene, tmp_path: Path) -> None:
+    video = write_vfr(tmp_path / "long.mkv", scene, [20] * 50 + [500] * 10, rate=50)
+    source = FrameSource(video)
+    assert not source.count_known and source.n_frames > 60
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sum(1 for _ in source) == 60
+
+
+def test_counted_containers_and_folders_keep_their_count(scene: Scene, tmp_path: Path) -> None:
+    assert FrameSource(scene.write_video(tmp_path / "s.avi")).count_known
+    assert FrameSource(scene.write_video(tmp_path / "s.mp4")).count_known
+    assert FrameSource(scene.write_images(tmp_path / "img")).count_known
+    assert np.array_equal(
+        next(iter(FrameSource(tmp_path / "img"))), scene.frames[0]
+    )  # the folder is the scene's
