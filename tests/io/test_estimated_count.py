@@ -79,3 +79,35 @@ def test_counted_containers_and_folders_keep_their_count(scene: Scene, tmp_path:
     assert np.array_equal(
         next(iter(FrameSource(tmp_path / "img"))), scene.frames[0]
     )  # the folder is the scene's
+
+
+def test_a_rate_the_header_lacks_comes_from_the_time_stamps(
+    scene: Scene, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A header "rate" of 1000 (Matroska's time base, as OpenCV reports it for some files):
+    the frames' time stamps give the rate. Was: 25 fps, said only as "from default", and a
+    render of a 10 fps video played 2.5 times too fast."""
+    video = write_vfr(tmp_path / "ten.mkv", scene, [100] * 60)
+    probe = FrameSource._probe_file
+
+    def time_base_as_rate(path: Path) -> tuple[np.ndarray, float, int]:
+        first, _, count = probe(path)
+        return first, 1000.0, count
+
+    monkeypatch.setattr(FrameSource, "_probe_file", staticmethod(time_base_as_rate))
+    source = FrameSource(video)
+    assert (source.fps, source.fps_origin) == (pytest.approx(10.0), "time stamps")
+
+
+def test_a_rate_of_1000_or_more_is_said_not_taken_in_silence(tmp_path: Path) -> None:
+    import cv2
+
+    path = tmp_path / "fast.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), 1000.0, (64, 48))
+    for k in range(5):
+        writer.write(np.full((48, 64, 3), 40 * k, np.uint8))
+    writer.release()
+    with pytest.warns(UserWarning, match="frame rate 1000 is taken for none .* 25 fps assumed"):
+        source = FrameSource(path)
+    assert (source.fps, source.fps_origin) == (25.0, "default")
+    assert FrameSource(path, fps=1000.0).fps == 1000.0  # given: taken, without a word

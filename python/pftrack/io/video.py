@@ -115,6 +115,34 @@ def _depth_sample(n: int) -> list[int]:
     )
 
 
+#: Frames whose time stamps :func:`_stamped_rate` reads.
+STAMPED_FRAMES = 25
+
+
+def _stamped_rate(path: Path) -> float | None:
+    """A video's frame rate from its first frames' time stamps, when its header has none.
+
+    The median step between the time stamps of up to :data:`STAMPED_FRAMES` frames (grabbed:
+    decoded, not converted). OpenCV reports a Matroska file's time base as its rate when the
+    file says none (1000 "fps"), and 0 for a raw stream: a render of such a video played at
+    25 fps whatever its real rate (a variable-rate file of about 9 fps: 2.8 times too fast).
+    None when fewer than two frames have increasing stamps, or the rate is not in (0, 1000).
+    """
+    cap = _file_capture(str(path))
+    stamps: list[float] = []
+    try:
+        while len(stamps) < STAMPED_FRAMES and cap.grab():
+            stamps.append(float(cap.get(cv2.CAP_PROP_POS_MSEC)))
+    finally:
+        cap.release()
+    steps = np.diff(stamps)
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    if len(steps) == 0:
+        return None
+    rate = 1000.0 / float(np.median(steps))
+    return rate if 0 < rate < 1000 else None
+
+
 def _file_capture(path: str) -> cv2.VideoCapture:
     """A ``cv2.VideoCapture`` of a stored video file whose decoder runs on the calling thread.
 
@@ -815,7 +843,9 @@ class FrameSource:
     fps : float
         Frames per second (see `fps_origin`).
     fps_origin : str
-        Where `fps` came from: ``"given"``, ``"seqinfo.ini"``, ``"container"`` or ``"default"``.
+        Where `fps` came from: ``"given"``, ``"seqinfo.ini"``, ``"container"`` (a header
+        rate below 1000), ``"time stamps"`` (without one: the median step between the first
+        frames' time stamps, :func:`_stamped_rate`) or ``"default"``.
     n_frames : int
         Frames expected (0 when unknown, as for live sources).
     count_known : bool
@@ -943,8 +973,24 @@ class FrameSource:
             self.fps, self.fps_origin = float(seq_fps), "seqinfo.ini"
         elif header_fps and np.isfinite(header_fps) and 0 < header_fps < 1000:
             self.fps, self.fps_origin = float(header_fps), "container"
+        elif (
+            self.path is not None
+            and not self.path.is_dir()
+            and not self.live
+            and (stamped := _stamped_rate(self.path)) is not None
+        ):
+            # no rate in the header, or a time base given as one (Matroska's 1000 "fps")
+            self.fps, self.fps_origin = stamped, "time stamps"
         else:
             self.fps, self.fps_origin = DEFAULT_FPS, "default"
+            if header_fps and not (np.isfinite(header_fps) and 0 < header_fps < 1000):
+                warnings.warn(
+                    f"{self.name}: the header's frame rate {header_fps:g} is taken for none "
+                    f"(a time base, not a rate?), nor do its time stamps give one below 1000: "
+                    f"{DEFAULT_FPS:g} fps assumed; give the video's rate (--fps)",
+                    UserWarning,
+                    stacklevel=2,
+                )
         h, w = first.shape[:2]
         size = self._scaled_size(first)
         if min(size) < 1 or max(size) > MAX_SCALED_SIDE:
