@@ -161,8 +161,20 @@ def rts_smooth_numpy(
         u00, u01, u10, u11 = a + b, b, b + c, c
         x, y, w = pp[t + 1]
         det = x * w - y * y
-        c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
-        c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c00, c01 = (u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det
+            c10, c11 = (u10 * w - u11 * y) / det, (u11 * x - u10 * y) / det
+        # singular (no process noise, no initial velocity variance): the pseudo-inverse,
+        # M / trace(M)^2 at rank <= 1
+        single = ~(det > 0)
+        if np.any(single):
+            s = x + w
+            k = np.where(s > 0, 1.0 / np.where(s > 0, s * s, 1.0), 0.0)
+            ix, iy, iw = x * k, y * k, w * k
+            c00 = np.where(single, u00 * ix + u01 * iy, c00)
+            c01 = np.where(single, u00 * iy + u01 * iw, c01)
+            c10 = np.where(single, u10 * ix + u11 * iy, c10)
+            c11 = np.where(single, u10 * iy + u11 * iw, c11)
         d0, d1 = s0 - pm[t + 1, 0], s1 - pm[t + 1, 1]
         s0, s1 = fm[t, 0] + c00 * d0 + c01 * d1, fm[t, 1] + c10 * d0 + c11 * d1
         out[t] = s0

@@ -176,6 +176,22 @@ def test_rts_is_the_numpy_loop(seed, steps, n, per_axis, update_first):
     assert np.isfinite(got).all()
 
 
+@pytest.mark.parametrize("update_first", [True, False])
+@pytest.mark.parametrize("velocity_sd", [0.0, 1e-200])
+def test_rts_without_any_noise_is_a_constant(update_first: bool, velocity_sd: float) -> None:
+    """q = 0 and no initial velocity variance (or one that squares to 0): the position is one
+    constant, the measurements' mean (with z_0 twice when it is also an update). Was: NaN,
+    refused as "too extreme" (the smoother's gain divided by a singular covariance)."""
+    z = np.array([[1.0, 5.0], [2.0, 5.0], [3.0, 5.0], [6.0, 5.0]])
+    has = np.ones(4, bool)
+    got = rts_smooth(z, has, [0.0, 0.0], [1.0, 1.0], velocity_sd=velocity_sd,
+                     update_first=update_first)  # fmt: skip
+    mean = (1 + 1 + 2 + 3 + 6) / 5 if update_first else (1 + 2 + 3 + 6) / 4
+    np.testing.assert_allclose(got, [[mean, 5.0]] * 4, rtol=1e-12)
+    want = rts_smooth_numpy(z, has, np.zeros(2), np.ones(2), velocity_sd, update_first)
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+
+
 @pytest.mark.parametrize(
     ("args", "match"),
     [

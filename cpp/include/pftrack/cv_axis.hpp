@@ -42,6 +42,14 @@ inline SmootherGain smoother_gain(const Cov& filtered, const Cov& predicted_next
     const double u00 = a + b, u01 = b, u10 = b + c, u11 = c;
     const double x = predicted_next.p00, y = predicted_next.p01, w = predicted_next.p11;
     const double det = x * w - y * y;
+    if (!(det > 0.0)) {
+        // singular: one combination known exactly (no process noise, no initial velocity
+        // variance: a constant position): the pseudo-inverse, M / trace(M)^2 at rank <= 1
+        const double s = x + w, k = s > 0.0 ? 1.0 / (s * s) : 0.0;
+        const double ix = x * k, iy = y * k, iw = w * k;
+        return {u00 * ix + u01 * iy, u00 * iy + u01 * iw, u10 * ix + u11 * iy,
+                u10 * iy + u11 * iw};
+    }
     return {(u00 * w - u01 * y) / det, (u01 * x - u00 * y) / det, (u10 * w - u11 * y) / det,
             (u11 * x - u10 * y) / det};
 }
