@@ -97,10 +97,28 @@ def test_box_weights_refuses_a_bad_step(big_frame):
         (1e5, 1e5, 1, 64),  # capped
         (90, 240, 0, 1),  # 0: every pixel
         (float("nan"), 10, 2048, 1),
+        (22, 98, 1, 11),  # half the shorter side (was 46: 0-2 pixels of the box)
+        (3, 4000, 1, 1),
     ],
 )
 def test_lattice_step_rule(w, h, min_samples, step):
     assert ref.lattice_step(w, h, min_samples) == step
+
+
+def test_a_small_min_samples_still_sees_the_box() -> None:
+    """min_samples 1 on a 22x98 walker: on the frame its reference came from, the filter
+    scores it as every pixel does (was rho 0.54 against 0.99: 46-pixel steps)."""
+    from pftrack.particle_filter import box_histograms
+    from pftrack.synthetic import make_scene
+
+    frame = make_scene(n_frames=3, rng=0).frames[1]
+    image = hsv_bins(frame)
+    box = np.array([112.0, 201.0, 22.0, 98.0])
+    reference = box_histograms(image, box)[0]
+    every = ColourParticleFilter(box, reference, FilterConfig(min_samples=0), rng=0).step(image)
+    few = ColourParticleFilter(box, reference, FilterConfig(min_samples=1), rng=0).step(image)
+    assert every.rho > 0.95 and few.rho > 0.85, (every.rho, few.rho)
+    assert few.foreground < 1.2 * 22 * 98  # an estimate of the pixels counted (was 4230)
 
 
 @pytest.mark.parametrize("kernel", ["uniform", "epanechnikov"])

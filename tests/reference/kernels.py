@@ -39,11 +39,13 @@ def box_range(cx, cy, w, h, rows, cols):
 
 
 def lattice_step(w, h, min_samples):
-    """floor(sqrt(w h / min_samples)) from 4 min_samples pixels on, else 1; at most 64."""
+    """floor(sqrt(w h / min_samples)) from 4 min_samples pixels on, else 1; at most 64, and at
+    most half the shorter side (at least 1)."""
     area = w * h
     if min_samples <= 0 or not area >= 4 * min_samples or not np.isfinite(area):
         return 1
-    return min(64, int(np.floor(np.sqrt(area / min_samples))))
+    k = min(np.floor(np.sqrt(area / min_samples)), max(1.0, np.floor(0.5 * min(w, h))))
+    return min(64, int(k))
 
 
 def box_histograms(bins, n_bins, boxes, kernel="uniform", step=1):

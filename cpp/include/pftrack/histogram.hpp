@@ -59,12 +59,14 @@ constexpr Index kMaxLatticeStep = 64;
 
 /// The step of the lattice on which a box of `w` x `h` pixels is counted so that it keeps at
 /// least `min_samples` points: floor(sqrt(w h / min_samples)), at least 1 (every pixel) and at
-/// most kMaxLatticeStep. `min_samples` 0 (or a box of fewer than 4 min_samples pixels, or
-/// non-finite sizes) gives 1.
+/// most kMaxLatticeStep, nor more than half the box's shorter side (a few samples across it
+/// at least: a small `min_samples` on a narrow box kept 0-2 of its pixels). `min_samples` 0 (or
+/// a box of fewer than 4 min_samples pixels, or non-finite sizes) gives 1.
 inline Index lattice_step(double w, double h, double min_samples) {
     const double area = w * h;
     if (!(min_samples > 0.0) || !(area >= 4.0 * min_samples) || !std::isfinite(area)) return 1;
-    const double k = std::floor(std::sqrt(area / min_samples));
+    const double k = std::min(std::floor(std::sqrt(area / min_samples)),
+                              std::max(1.0, std::floor(0.5 * std::min(w, h))));
     return std::min<Index>(kMaxLatticeStep, static_cast<Index>(k));
 }
 
