@@ -861,6 +861,22 @@ def test_an_update_that_raises_leaves_the_tracker_as_it_was(scene):
     assert joint.frame_count == joint.tracker.frame_index == 1
 
 
+def test_the_joint_sampler_keeps_its_one_class_for_the_run(scene):
+    """A user trial: rjmcmc took one class per frame, so class 0 on even frames and 1 on odd
+    ones shared identities, and every row said class 0 whatever the class given."""
+    dets = scene_dets(scene)
+    joint = pftrack.Tracker(frame_rate=10.0, sampler="rjmcmc", particles=50)
+    outs = [joint.update(np.column_stack([d, np.full(len(d), 3)]), f)
+            for d, f in zip(dets, scene.frames, strict=True)]  # fmt: skip
+    classes = np.concatenate([o[:, 6] for o in outs])
+    assert len(classes) and set(classes.tolist()) == {3.0}
+    mixed = pftrack.Tracker(frame_rate=10.0, sampler="rjmcmc", particles=50)
+    mixed.update(np.column_stack([dets[0], np.zeros(len(dets[0]))]), scene.frames[0])
+    with pytest.raises(ValueError, match="class 1 after class 0 in earlier frames"):
+        mixed.update(np.column_stack([dets[1], np.ones(len(dets[1]))]), scene.frames[1])
+    assert mixed.frame_count == 1  # refused before it changed anything
+
+
 def test_an_update_cut_short_stops_the_run_but_keeps_its_rows(scene):
     """A user trial: Ctrl-C inside ``update`` (a notebook's stop button) after the tracker
     inside had taken the frame left ``frame_count`` one behind; going on from it made

@@ -15,6 +15,7 @@ one joint sampler replaces all of this (:mod:`.joint`).
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import inspect
 import itertools
 import math
@@ -159,6 +160,7 @@ class MultiObjectTracker:
         self.noise_scale = 1.0
         self._scores_are_confidences = True
         self._negative_warned = False  # scores below 0 and min_score were said
+        self._joint_class: int | None = None  # sampler "rjmcmc": the run's one class id
         self._primed_shape: tuple[int, ...] = ()  # of the frames given to prime()
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
         self._birth_level = np.inf
@@ -239,8 +241,19 @@ class MultiObjectTracker:
             labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
             if len(labels) != len(boxes):
                 raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
-        if self.config.sampler == "rjmcmc" and len(np.unique(labels)) > 1:
-            raise ValueError("sampler 'rjmcmc' tracks one class; got several class ids")
+        if self.config.sampler == "rjmcmc" and len(labels):
+            # one class a run, not only a frame: the joint sampler's objects have no class, and
+            # classes must never share an identity (was: a class per frame was taken, and the
+            # rows said class 0)
+            seen = np.unique(labels)
+            if len(seen) > 1:
+                raise ValueError("sampler 'rjmcmc' tracks one class; got several class ids")
+            if self._joint_class is not None and int(seen[0]) != self._joint_class:
+                raise ValueError(
+                    f"sampler 'rjmcmc' tracks one class a run: class {int(seen[0])} after class "
+                    f"{self._joint_class} in earlier frames (track each class with its own "
+                    "tracker, or use sampler 'sis' or 'mh')"
+                )
         return boxes, scores, labels
 
     def _detections(self, frame: NDArray[np.uint8], given: tuple[F64, F64] | None
@@ -498,7 +511,12 @@ class MultiObjectTracker:
             mask = self.last_mask
             if mask is None or mask.shape != f.shape[:2] or not self._background_ok:
                 mask = np.full(f.shape[:2], 255, np.uint8)  # no background model: all foreground
-            return self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
+            if given is not None and len(given[2]) and self._joint_class is None:
+                self._joint_class = int(given[2][0])
+            joint = self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
+            if self._joint_class:  # the run's class on every row (the sampler's objects have none)
+                joint = [dataclasses.replace(t, cls=self._joint_class) for t in joint]
+            return joint
 
         # 1. every track's particle filter looks at this frame, its centre filter predicts
         predict_tracks(self.tracks, binned, cfg.motion.colour_noise, self._gain)
