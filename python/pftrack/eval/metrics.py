@@ -236,7 +236,7 @@ def format_metrics(m: MotMetrics | Mapping[str, MotMetrics]) -> str:
     lines.append(
         f"(IoU threshold {first.iou_threshold:g}; MOTP = mean IoU of matches; "
         f"Succ: IoU > 0 with the assigned track, Succ@IoU: IoU >= threshold; "
-        f"CD = mean centroid distance)"
+        f"CD = mean centroid distance in px, CD/px: over the image's pixel count)"
     )
     return "\n".join(lines)
 
