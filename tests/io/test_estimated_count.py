@@ -18,6 +18,7 @@ from pftrack.cli import main
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import Scene, make_scene
+from tests.io.test_video import grey_mjpg
 
 av = pytest.importorskip("av")
 
@@ -100,13 +101,7 @@ def test_a_rate_the_header_lacks_comes_from_the_time_stamps(
 
 
 def test_a_rate_of_1000_or_more_is_said_not_taken_in_silence(tmp_path: Path) -> None:
-    import cv2
-
-    path = tmp_path / "fast.avi"
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), 1000.0, (64, 48))
-    for k in range(5):
-        writer.write(np.full((48, 64, 3), 40 * k, np.uint8))
-    writer.release()
+    path = grey_mjpg(tmp_path / "fast.avi", 1000.0, 64, 48)
     with pytest.warns(UserWarning, match="frame rate 1000 is taken for none .* 25 fps assumed"):
         source = FrameSource(path)
     assert (source.fps, source.fps_origin) == (25.0, "default")

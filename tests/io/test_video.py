@@ -69,13 +69,18 @@ def test_fps_given_beats_seqinfo_and_header(tmp_path: Path) -> None:
         FrameSource(seq, fps=0)
 
 
+def grey_mjpg(path: Path, fps: float, width: int = 16, height: int = 8) -> Path:
+    """Five flat frames (0, 40, ..., 160) as MJPG at a header rate of `fps`."""
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), fps, (width, height))
+    for k in range(5):
+        writer.write(np.full((height, width, 3), 40 * k, np.uint8))
+    writer.release()
+    return path
+
+
 def test_video_beside_seqinfo_takes_its_frame_rate(tmp_path: Path) -> None:
     """PETS09's header says 10 fps, its seqinfo.ini 7: the sequence file wins."""
-    video = tmp_path / "video.avi"
-    writer = cv2.VideoWriter(str(video), cv2.VideoWriter.fourcc(*"MJPG"), 10.0, (16, 8))
-    for k in range(5):
-        writer.write(np.full((8, 16, 3), 40 * k, np.uint8))
-    writer.release()
+    video = grey_mjpg(tmp_path / "video.avi", 10.0)
     assert (FrameSource(video).fps, FrameSource(video).fps_origin) == (10.0, "container")
     (tmp_path / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\n")
     assert (FrameSource(video).fps, FrameSource(video).fps_origin) == (7.0, "seqinfo.ini")
