@@ -64,6 +64,10 @@ def test_resample_messages_name_the_function_and_no_particle_filter(fn):
         fn(["a", "b"], rng=0)
     with pytest.raises(TypeError, match=rf"^{name}: weights must be real, got dtype complex128$"):
         fn([1j, 1], rng=0)
+    with pytest.raises(
+        TypeError, match=rf"^{name}: weights must be an array or a sequence, got generator"
+    ):
+        fn((w for w in [0.5, 0.5]), rng=0)  # was "must be numeric, got dtype object"
 
 
 def test_the_particle_filter_keeps_its_zero_weights_hint():

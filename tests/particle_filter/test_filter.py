@@ -59,6 +59,19 @@ def test_estimate_mean_and_map(rng):
     np.testing.assert_array_equal(map_, p[np.argmax(w), :3])
 
 
+def test_estimate_of_subnormal_weights_is_their_convex_combination(rng):
+    """Weights that need not be normalised, all subnormal: the same mean as the weights scaled
+    up (a kernel trial: one weight of 5e-324 gave a mean 0.3 px from the only weighted
+    particle, sum(w x) keeping a few bits)."""
+    p = _particles(rng, 50)
+    w = np.zeros(50)
+    w[0] = 5e-324
+    np.testing.assert_array_equal(estimate(p, w)[0], p[0, :3])
+    w[:3] = [1e-320, 3e-321, 7e-322]
+    scaled = w / w.max()  # exact: normal numbers again
+    np.testing.assert_allclose(estimate(p, w)[0], (scaled / scaled.sum()) @ p[:, :3], rtol=1e-12)
+
+
 @pytest.mark.parametrize("kernel", ["uniform", "epanechnikov"])
 @pytest.mark.parametrize("use_means", [False, True])
 def test_sis_step_matches_numpy_composition(textured_frame, rng, kernel, use_means):

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "check.hpp"
 #include "types.hpp"
@@ -91,10 +92,11 @@ inline Estimate estimate_state(const Eigen::Ref<const RowMatrixXd>& particles,
         }
     }
     e.mean /= sum;
-    if (!std::isfinite(sum) || !e.mean.allFinite()) {
-        // w * x or the sum overflowed (weights or states near 1e308): again as a convex
-        // combination, sum_i c_i x_i with c_i = (w_i / w_max) / sum_j (w_j / w_max), whose
-        // partial sums never exceed max |x_i|. Only then: other inputs keep their exact bits.
+    if (!std::isfinite(sum) || !e.mean.allFinite() || sum < std::numeric_limits<double>::min()) {
+        // w * x or the sum overflowed (weights or states near 1e308), or every weight is
+        // subnormal (w * x kept a few bits: 1e-3 px off): again as a convex combination,
+        // sum_i c_i x_i with c_i = (w_i / w_max) / sum_j (w_j / w_max), whose partial sums
+        // never exceed max |x_i|. Only then: other inputs keep their exact bits.
         const double w_max = weights.maxCoeff();
         double scaled_sum = 0.0;
         for (Index i = 0; i < particles.rows(); ++i) scaled_sum += weights(i) / w_max;

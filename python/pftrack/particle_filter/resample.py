@@ -20,6 +20,8 @@ draws as filterpy seeded alike, ``rng=np.random.RandomState(0)`` giving the indi
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -37,6 +39,11 @@ __all__ = [
 
 def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
     """`weights` as a C-contiguous float64 array; errors start with `fn`, as the core's do."""
+    if isinstance(weights, Iterator):  # NumPy makes a 0-d object array of it: "dtype object"
+        raise TypeError(
+            f"{fn}: weights must be an array or a sequence, got {type(weights).__name__} "
+            "(an iterator: make it a list or an array first)"
+        )
     w = np.asarray(weights)
     if w.dtype == object or not (np.issubdtype(w.dtype, np.number) or w.dtype == bool):
         raise TypeError(f"{fn}: weights must be numeric, got dtype {w.dtype}")
