@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -147,8 +148,8 @@ void register_filter(py::module_& m) {
                         static_cast<py::ssize_t>(steps.size()) == k,
                     fn, "particles, weights, means, refs, w0, h0, seeds and steps must all have "
                         "one entry per object");
-            // Every array is checked (and every parameter set validated) with the GIL held,
-            // before any object steps: a bad entry changes nothing.
+            // Every array is checked with the GIL held, before any object steps: a bad entry
+            // changes nothing.
             std::vector<py::array_t<double>> keep;
             keep.reserve(static_cast<size_t>(4 * k));
             std::vector<SisParams> prms;
@@ -167,44 +168,48 @@ void register_filter(py::module_& m) {
                 prms.push_back(bind::make_step_params(w0(i), h0(i), a, b, sigma, s_min, s_max,
                                                       use_means, lam, kernel, resample, fn));
                 prms.back().min_samples = min_samples;
-                prms.back().validate(fn);
             }
             using MatMap = Eigen::Map<RowMatrixXd>;
             using VecMap = Eigen::Map<Eigen::VectorXd>;
             using ConstVecMap = Eigen::Map<const Eigen::VectorXd>;
             // ... and the values sis_step checks (particles, weights, means, the reference
-            // against the image's bins), each named by its entry: sis_step checks them again,
-            // but only after the objects before it have stepped
-            check_bin_image(image.lazy_view(), fn);
+            // against the image's bins), each named by its entry, once: then every object
+            // steps unchecked (sis_step_checked)
+            const BinImage img = image.lazy_view();
+            std::vector<Eigen::VectorXd> sqrefs;
+            sqrefs.reserve(static_cast<size_t>(k));
             for (py::ssize_t i = 0; i < k; ++i) {
                 const auto& pa = keep[static_cast<size_t>(4 * i)];
                 const auto& wa = keep[static_cast<size_t>(4 * i + 1)];
                 const auto& ma = keep[static_cast<size_t>(4 * i + 2)];
                 const auto& ra = keep[static_cast<size_t>(4 * i + 3)];
-                const std::string entry = std::string(fn) + ": entry " + std::to_string(i);
-                check_particle_set(
-                    Eigen::Map<const RowMatrixXd>(pa.data(), pa.shape(0), kParticleCols),
-                    ConstVecMap(wa.data(), wa.shape(0)),
-                    Eigen::Map<const RowMatrixXd>(ma.data(), 2, kStateDim), entry.c_str());
-                sqrt_reference(ConstVecMap(ra.data(), ra.shape(0)), image.n_bins, entry.c_str());
+                try {
+                    sqrefs.push_back(sis_checked(
+                        Eigen::Map<const RowMatrixXd>(pa.data(), pa.shape(0), kParticleCols),
+                        ConstVecMap(wa.data(), wa.shape(0)),
+                        Eigen::Map<const RowMatrixXd>(ma.data(), 2, kStateDim), img,
+                        ConstVecMap(ra.data(), ra.shape(0)), prms[static_cast<size_t>(i)], fn));
+                } catch (const std::invalid_argument& e) {  // "fn: what" -> "fn: entry i: what"
+                    const std::string what = e.what(), head = std::string(fn) + ": ";
+                    fail(fn, "entry " + std::to_string(i) + ": " +
+                                 (what.rfind(head, 0) == 0 ? what.substr(head.size()) : what));
+                }
             }
             // columns: mean (3), map (3), map_index, ess, rho_max, rho_mean, fg_mean
             RowMatrixXd out(k, 11);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers kept alive by `keep`
-                const BinImage img = image.lazy_view();
                 for (py::ssize_t i = 0; i < k; ++i) {
                     auto& pa = keep[static_cast<size_t>(4 * i)];
                     auto& wa = keep[static_cast<size_t>(4 * i + 1)];
                     auto& ma = keep[static_cast<size_t>(4 * i + 2)];
-                    auto& ra = keep[static_cast<size_t>(4 * i + 3)];
                     MatMap p(pa.mutable_data(), pa.shape(0), kParticleCols);
                     VecMap w(wa.mutable_data(), wa.shape(0));
                     MatMap mm(ma.mutable_data(), 2, kStateDim);
-                    ConstVecMap ref(ra.data(), ra.shape(0));
-                    const SisResult r = sis_step(p, w, mm, img, ref, prms[static_cast<size_t>(i)],
-                                                 seeds[static_cast<size_t>(i)],
-                                                 steps[static_cast<size_t>(i)]);
+                    const SisResult r = sis_step_checked(
+                        p, w, mm, img, sqrefs[static_cast<size_t>(i)],
+                        prms[static_cast<size_t>(i)], seeds[static_cast<size_t>(i)],
+                        steps[static_cast<size_t>(i)]);
                     out.row(i) << r.estimate.mean.transpose(), r.estimate.map.transpose(),
                         static_cast<double>(r.estimate.map_index), r.ess, r.rho_max, r.rho_mean,
                         r.fg_mean;

@@ -71,19 +71,27 @@ struct SisParams {
     }
 };
 
-/// Advances one particle set by one frame. `particles` (N, 6), `weights` (N,) and `means` (2, 3):
-/// rows m_{t-1}, m_{t-2}) are updated in place. Draws come from CounterRng(seed, step).
-inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
-                          Eigen::Ref<RowMatrixXd> means, const BinImage& img,
-                          const Eigen::Ref<const Eigen::VectorXd>& ref, const SisParams& prm,
-                          std::uint64_t seed, std::uint64_t step) {
-    const char* fn = "sis_step";
+/// sis_step's checks of one object's values (`fn` names it in the errors): the square root
+/// of its reference histogram, which the step reads.
+inline Eigen::VectorXd sis_checked(const Eigen::Ref<const RowMatrixXd>& particles,
+                                   const Eigen::Ref<const Eigen::VectorXd>& weights,
+                                   const Eigen::Ref<const RowMatrixXd>& means, const BinImage& img,
+                                   const Eigen::Ref<const Eigen::VectorXd>& ref,
+                                   const SisParams& prm, const char* fn) {
     check_particle_set(particles, weights, means, fn);
-    const Index n = particles.rows();
     prm.validate(fn);
     check_bin_image(img, fn);
-    const Eigen::VectorXd sqref = sqrt_reference(ref, img.n_bins, fn);
+    return sqrt_reference(ref, img.n_bins, fn);
+}
 
+/// sis_step of values `sis_checked` accepted (`sqref`: what it returned).
+inline SisResult sis_step_checked(Eigen::Ref<RowMatrixXd> particles,
+                                  Eigen::Ref<Eigen::VectorXd> weights,
+                                  Eigen::Ref<RowMatrixXd> means, const BinImage& img,
+                                  const Eigen::VectorXd& sqref, const SisParams& prm,
+                                  std::uint64_t seed, std::uint64_t step) {
+    const char* fn = "sis_step";
+    const Index n = particles.rows();
     const CounterRng rng(seed, step);
     // 1. resample
     if (prm.resample) {
@@ -129,6 +137,16 @@ inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::V
     means.row(1) = means.row(0);
     means.row(0) = r.estimate.mean.transpose();
     return r;
+}
+
+/// Advances one particle set by one frame. `particles` (N, 6), `weights` (N,) and `means` (2, 3):
+/// rows m_{t-1}, m_{t-2}) are updated in place. Draws come from CounterRng(seed, step).
+inline SisResult sis_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
+                          Eigen::Ref<RowMatrixXd> means, const BinImage& img,
+                          const Eigen::Ref<const Eigen::VectorXd>& ref, const SisParams& prm,
+                          std::uint64_t seed, std::uint64_t step) {
+    const Eigen::VectorXd sqref = sis_checked(particles, weights, means, img, ref, prm, "sis_step");
+    return sis_step_checked(particles, weights, means, img, sqref, prm, seed, step);
 }
 
 }  // namespace pftrack
