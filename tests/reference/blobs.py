@@ -141,7 +141,7 @@ def _split(
         if valley < 1.0:  # a cut only at a valley: at most `valley` of both sides' peaks
             kept = [0]
             for k in range(1, len(cuts) - 1):
-                if not kept[-1] < cuts[k] < min(cuts[k + 1], w + 1) or cuts[k] >= w:
+                if not kept[-1] < cuts[k] < cuts[k + 1]:
                     continue  # no column on one side (a narrow box cut into many): no valley
                 left = profile[kept[-1] : cuts[k]].max()
                 right = profile[cuts[k] : cuts[k + 1]].max()

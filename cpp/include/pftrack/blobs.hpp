@@ -402,13 +402,13 @@ inline void split_groups(const std::uint8_t* mask, Index stride, std::vector<Blo
         if (valley < 1.0) {
             kept.assign(1, 0);
             for (std::size_t k = 1; k + 1 < cuts.size(); ++k) {
-                // a cut with no column on one side (a narrow box cut into many) is no valley
-                if (!(kept.back() < cuts[k] && cuts[k] < cuts[k + 1] && cuts[k] < w)) continue;
+                // a cut with no column on one side (a narrow box cut into many) is no valley;
+                // every cut lies in [0, w]
+                if (!(kept.back() < cuts[k] && cuts[k] < cuts[k + 1])) continue;
                 const auto at = [&](Index j) { return profile[static_cast<std::size_t>(j)]; };
                 std::int64_t left = 0, right = 0;
                 for (Index j = kept.back(); j < cuts[k]; ++j) left = std::max(left, at(j));
-                for (Index j = cuts[k]; j < std::min(cuts[k + 1], w); ++j)
-                    right = std::max(right, at(j));
+                for (Index j = cuts[k]; j < cuts[k + 1]; ++j) right = std::max(right, at(j));
                 if (double(at(cuts[k])) <= valley * double(std::min(left, right)))
                     kept.push_back(cuts[k]);
             }
