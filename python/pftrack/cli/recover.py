@@ -155,9 +155,10 @@ def check_video(video: str, frames: Any, rows: Any, src: Path) -> None:
         return
     source = frames.source
     last = int(rows[:, 0].max())
-    if 0 < len(frames) < last and source.count_known:  # not FFmpeg's estimate (Matroska)
+    counted = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
+    if 0 < counted < last:
         raise ValueError(
-            f"--video {video} has {len(frames)} frames but {src} has rows up to frame {last}: "
+            f"--video {video} has {counted} frames but {src} has rows up to frame {last}: "
             "not the video of these tracks"
         )
     for axis, size, edge in ((2, source.width, "right"), (3, source.height, "bottom")):

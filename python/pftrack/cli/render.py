@@ -99,11 +99,11 @@ def run(args: argparse.Namespace) -> int:
     rows[:, 2:6] *= args.scale
     source = FrameSource(args.source, fps=args.fps)
     n_frames = len(source)
-    # was: an empty video, exit 0; by a count the container stores (Matroska's is an estimate)
-    if n_frames and source.count_known and len(rows) and rows[:, 0].min() > n_frames:
+    known = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
+    if known and len(rows) and rows[:, 0].min() > known:  # was: an empty video, exit 0
         raise ValueError(
             f"every row of {args.tracks} lies past the last frame of {source.name}, which has "
-            f"{n_frames} (the rows' frames are {int(rows[:, 0].min())}-"
+            f"{known} (the rows' frames are {int(rows[:, 0].min())}-"
             f"{int(rows[:, 0].max())}): the tracks of another video?"
         )
     out = report_stream(args.out, args.plot)

@@ -1162,6 +1162,15 @@ class FrameSource:
             )
         return self._resize(img)
 
+    @property
+    def counted_frames(self) -> int:
+        """`n_frames` when it is the number of frames (`count_known`), else 0 (unknown).
+
+        What a check that refuses frames past the last one, or says a video ended early,
+        holds to.
+        """
+        return self.n_frames if self.count_known else 0
+
     def __len__(self) -> int:
         return self.n_frames
 
@@ -1333,17 +1342,16 @@ class FrameSource:
         a second decoding pass to count its frames would cost as much as the run.
         """
         said = []
-        if decoded < self.n_frames and self.count_known:  # not FFmpeg's estimate (Matroska)
-            said.append(f"its header says {self.n_frames}")
+        counted = self.counted_frames  # not FFmpeg's estimate (Matroska)
+        if decoded < counted:
+            said.append(f"its header says {counted}")
         seq = self.sequence
         if seq is not None and seq.length is not None and decoded != seq.length:
             said.append(f"{seq.folder / 'seqinfo.ini'} says seqLength={seq.length}")
         if not said:
             return
         self._warned_short = True  # once, not on every pass
-        damaged = (
-            ": a truncated or damaged file?" if decoded < self.n_frames and self.count_known else ""
-        )
+        damaged = ": a truncated or damaged file?" if decoded < counted else ""
         warnings.warn(
             f"{self.path} ended after {decoded} frames but {' and '.join(said)}{damaged}",
             UserWarning,

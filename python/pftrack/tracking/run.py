@@ -210,8 +210,8 @@ def track_frames(
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
     if detections:
         _check_numbering(frames)
-        # by a count the container stores; FFmpeg's estimate (Matroska's) may be short
-        _check_last_frame(detections, len(frames) if getattr(frames, "count_known", True) else 0)
+        # a FrameSource's count only when known: FFmpeg's estimate (Matroska's) may be short
+        _check_last_frame(detections, getattr(frames, "counted_frames", len(frames)))
     seed = (
         rng
         if rng is None or isinstance(rng, (int, np.integer))
