@@ -311,12 +311,20 @@ class PaperDetector:
 
     def reset(self) -> None:
         """Forget the background; the next frame initialises it."""
-        self._model.reset()
+        self._reset_model()
         self._blobs.reset()
         self._ghost = None
         self._grey = None
         self._grey_unsaid = False
         self._shape = None
+
+    def _reset_model(self) -> None:
+        """Forget the background model, and with it the light it has followed.
+
+        The model's threshold scale goes back to 1, so the gain since the first frame starts
+        again (and the size model's pause after a rise of the light ends).
+        """
+        self._model.reset()
         self._light = 1.0
         self._settling = 0
 
@@ -334,7 +342,7 @@ class PaperDetector:
         if self.config.gain_band > 0 and frames:
             lit = [f for f in frames if not is_dark(check_frame(f, "PaperDetector.prime"))]
             if not lit:  # no light to start from: the first frame that has some starts it
-                self._model.reset()
+                self._reset_model()
                 return
             frames = lit  # a black frame (dropout, fade) is no picture of the empty scene
         # under a light change, the median of frames at their own brightness is biased where
@@ -342,7 +350,7 @@ class PaperDetector:
         median = levelled_median(frames, self.config.gain_band, "PaperDetector.prime")
         if self._grey is None:
             self._decide_grey(frames)
-        self._model.reset()
+        self._reset_model()
         self._model.set_background(median)
         self._shape = median.shape
 
