@@ -134,6 +134,17 @@ def test_the_adapters_options_are_the_trackers():
     assert ours == theirs
 
 
+@pytest.mark.skipif(sys.version_info < (3, 11), reason="typing.Unpack is Python 3.11's")
+def test_the_adapters_hints_resolve_at_run_time():
+    """``typing.get_type_hints`` (what pydantic, typer and docs tools call) names no missing name."""
+    import typing
+
+    hints = typing.get_type_hints(SupervisionTracker.__init__)
+    assert hints["frame_rate"] is float
+    hints = typing.get_type_hints(SupervisionTracker.update_with_detections, localns={"sv": sv})
+    assert hints["return"] is sv.Detections
+
+
 # As tests/tracking/test_api_checkpoint.py's: in a child process, where protocols 0 and 1
 # aborted the interpreter once the background model existed.
 ADAPTER_AT_EVERY_PROTOCOL = """

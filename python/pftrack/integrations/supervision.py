@@ -11,6 +11,7 @@ one of the two afterwards, which removes ``cv2`` for both (``pip install --force
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any, TypedDict
 
@@ -20,9 +21,12 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._typing import F64, CameraMotion, DetectorName, DynamicsName, FillMode, SamplerName
 from pftrack.tracking.api import Tracker
 
+if sys.version_info >= (3, 11):  # at run time too: typing.get_type_hints resolves it
+    from typing import Unpack
+elif TYPE_CHECKING:
+    from typing_extensions import Unpack
 if TYPE_CHECKING:
     import supervision as sv
-    from typing_extensions import Unpack  # typing's from Python 3.11; the checker's own here
 
 __all__ = ["SupervisionTracker", "TrackerOptions"]
 
