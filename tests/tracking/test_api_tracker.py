@@ -859,6 +859,44 @@ def test_an_update_that_raises_leaves_the_tracker_as_it_was(scene):
     with pytest.raises(ValueError, match="tracks one class"):
         joint.update(two, scene.frames[1])
     assert joint.frame_count == joint.tracker.frame_index == 1
+    joint.update(dets[1], scene.frames[1])  # a user trial: the run was dead after a refusal
+    assert joint.frame_count == 2
+
+
+def test_a_refusal_from_inside_the_tracker_leaves_the_run_whole(scene):
+    """A user trial: inputs the tracker inside refuses (a frame of another size than the
+    primed ones; with rjmcmc, a second class) were refused, and then every later ``update``
+    said the run had been interrupted."""
+    dets = scene_dets(scene)
+    _, plain = run_loop(pftrack.Tracker(frame_rate=10.0), scene.frames, dets)
+    tracker = pftrack.Tracker(frame_rate=10.0)
+    small = np.ascontiguousarray(scene.frames[0][: scene.frames[0].shape[0] // 2])
+    tracker.prime([small])
+    with pytest.raises(ValueError, match="the frames given to prime"):
+        tracker.update(dets[0], scene.frames[0])
+    tracker.update(dets[0][:0], small)  # the primed size goes on
+    assert tracker.frame_count == 1
+    joint = pftrack.Tracker(frame_rate=10.0, sampler="rjmcmc", particles=50)
+    joint.update(np.column_stack([dets[0], np.zeros(len(dets[0]))]), scene.frames[0])
+    with pytest.raises(ValueError, match="class 1 after class 0"):
+        joint.update(np.column_stack([dets[1], np.ones(len(dets[1]))]), scene.frames[1])
+    for d, f in zip(dets[1:], scene.frames[1:], strict=True):
+        joint.update(np.column_stack([d, np.zeros(len(d))]), f)
+    assert joint.frame_count == len(scene.frames)
+
+
+def test_a_sliver_at_the_frames_edge_is_dropped_at_any_working_size():
+    """A user trial: with ``max_side``, a box inside the frame whose scaled top lands on the
+    working frame's bottom edge was dropped by the tracker inside after the classes were
+    matched to the rows: "classes has 2 entries, expected 1", and the run was dead."""
+    frame = np.full((480, 640, 3), 90, np.uint8)
+    good = [200.0, 150.0, 260.0, 300.0, 0.95]
+    for edge in ([100.0, np.nextafter(480.0, 0), 300.0, 480.0, 0.95],
+                 [0.0, 100.0, 5e-324, 200.0, 0.95]):  # fmt: skip
+        tracker = pftrack.Tracker(frame_rate=25.0, max_side=333)
+        for _ in range(6):
+            out = tracker.update(np.array([edge, good]), frame)
+        assert len(out) == 1 and out[0, 7] == 1  # the good box, by its row
 
 
 def test_the_joint_sampler_keeps_its_one_class_for_the_run(scene):

@@ -145,6 +145,24 @@ class CheckedBoxes(NamedTuple):
     extent: int
 
 
+def _inside_working(
+    xywh: F64, cls: NDArray[np.int64], kept: NDArray[np.int64], shape: tuple[int, ...]
+) -> tuple[F64, NDArray[np.int64], NDArray[np.int64]]:
+    """Scaled boxes without those the working frame of `shape` does not hold.
+
+    A box inside the frame, scaled to the working size (``max_side``), may end up with no
+    width or height, or with its near edge on the working frame's far edge: a sliver at the
+    frame's edge, dropped here as the tracker's own check would drop it (was: the tracker
+    dropped it after the classes had been matched to the rows, and refused the frame).
+    """
+    rows, cols = shape[0], shape[1]
+    x, y, w, h = xywh[:, 0], xywh[:, 1], xywh[:, 2], xywh[:, 3]
+    held = (w > 0) & (h > 0) & (x < cols) & (y < rows) & (x + w > 0) & (y + h > 0)
+    if held.all():
+        return xywh, cls, kept
+    return xywh[held], cls[held], kept[held]
+
+
 def check_boxes_xyxy(
     dets: ArrayLike,
     shape: tuple[int, int],
@@ -709,6 +727,17 @@ class Tracker:
             return prepared[1]
         return self.working_frame(frame)
 
+    def _untear(self, before: int) -> None:
+        """After the inner ``update`` raised: the run is whole if it was refused before it began.
+
+        The inner tracker checks its input before it changes anything, and its frame counter
+        moves once the checks are passed: an input it refused (`before`, the counter, unmoved)
+        leaves the run whole, so the caller may skip the frame and go on (was: every later
+        ``update`` said the run was interrupted).
+        """
+        if self._tracker.frame_index == before:
+            self._torn = 0
+
     def _restore_rows(self, rows: F64) -> F64:
         """MOTChallenge rows from working pixels to the frame's."""
         if self._scale is None or len(rows) == 0:
@@ -872,8 +901,13 @@ class Tracker:
                         "np.zeros((0, 6))",
                     )
                 kept = None
+                before = self._tracker.frame_index
                 self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
-                reports = self._tracker.update(work, None)
+                try:
+                    reports = self._tracker.update(work, None)
+                except BaseException:
+                    self._untear(before)
+                    raise
                 if self._tracker.camera_step.moving:
                     self._warn_moving_camera()
             else:
@@ -916,10 +950,15 @@ class Tracker:
                     )
                 if self._scale is not None:
                     xywh[:, :4] *= self._scale
-                # inside the frame as checked: the tracker need not check them again (scaled
-                # boxes are, in case a box's scaled edge rounds past the working frame's)
+                    xywh, cls, kept = _inside_working(xywh, cls, kept, work.shape)
+                # inside the frame as checked: the tracker need not check them again
+                before = self._tracker.frame_index
                 self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
-                reports = self._tracker.update(work, xywh, cls, checked=self._scale is None)
+                try:
+                    reports = self._tracker.update(work, xywh, cls, checked=True)
+                except BaseException:
+                    self._untear(before)
+                    raise
                 self._given = (
                     True  # once the frame is taken (an update that raises changes nothing)
                 )
