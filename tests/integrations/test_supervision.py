@@ -136,7 +136,7 @@ def test_the_adapters_options_are_the_trackers():
 
 @pytest.mark.skipif(sys.version_info < (3, 11), reason="typing.Unpack is Python 3.11's")
 def test_the_adapters_hints_resolve_at_run_time():
-    """``typing.get_type_hints`` (what pydantic, typer and docs tools call) names no missing name."""
+    """``typing.get_type_hints`` (pydantic, typer, docs tools) names no missing name."""
     import typing
 
     hints = typing.get_type_hints(SupervisionTracker.__init__)
