@@ -265,3 +265,26 @@ def test_gdt_recover_batch_shared_gains_are_exact(model: SegmentModel, history: 
     for k in range(len(seg_a)):
         alone = model.recover(seg_a[k : k + 1], seg_b[k : k + 1], history)[0]
         assert np.array_equal(alone, together[k])
+
+
+def test_a_coarse_scale_with_few_points_does_not_replace_the_fine_estimate():
+    """A user trial: on a file with many short holes, 5 points at scale 8 (one straight run)
+    replaced 316 at scale 1: q at its floor, r 64 px², and GDT's filled boxes 12 times
+    linear's error."""
+    rng = np.random.default_rng(0)
+    segments = []
+    for k in range(40):  # short jittery runs: scales 1, 2 see them, 8 does not
+        f = np.arange(10.0) + 20 * k
+        xy = 100 + np.cumsum(np.cumsum(rng.normal(0, 0.5, (10, 2)), axis=0), axis=0)
+        segments.append(np.column_stack([f, xy + rng.normal(0, 1.0, (10, 2))]))
+    f = np.arange(32.0) + 1000  # and one long straight run: 8 points at scale 8
+    segments.append(np.column_stack([f, 3 + 0.5 * f, 7 - 0.25 * f]))
+    assert estimate_noise(segments) == estimate_noise(segments, scales=(1, 2, 4))
+    assert estimate_noise(segments, scales=(1, 8)) == estimate_noise(segments, scales=(1,))
+    # with enough points a coarse scale does replace the fine one, as before
+    sway = [  # gait sway of 8 frames: wiggly frame to frame, straight every 8th frame
+        np.column_stack([f, 3 + 0.5 * f + 2 * np.sin(np.pi * f / 4), 7 - 0.25 * f])
+        for f in np.arange(300.0).reshape(3, -1)
+    ]
+    wide = estimate_noise(segments + sway, scales=(1, 8))
+    assert wide.q[0] < estimate_noise(segments + sway, scales=(1,)).q[0] / 2
