@@ -304,6 +304,25 @@ def test_a_sequence_image_folder_is_numbered_from_1_to_seqlength(tmp_path: Path)
     assert len(FrameSource(seq)) == 6
 
 
+def test_a_sequences_stray_and_hidden_images_are_no_frames(tmp_path: Path) -> None:
+    """A user trial: a cover.jpg in a sequence's img1/ became a 6th frame of a 5-frame sequence
+    (and pftrack eval then refused the rows of frame 6); a viewer's .thumb.png did the same; a
+    macOS ._1.png (no image) failed the folder."""
+    seq = _sequence(tmp_path / "SEQ", n=5)
+    cv2.imwrite(str(seq / "img1" / "cover.png"), np.full((8, 10, 3), 99, np.uint8))
+    cv2.imwrite(str(seq / "img1" / ".thumb.png"), np.full((8, 10, 3), 98, np.uint8))
+    (seq / "img1" / "._1.png").write_bytes(b"\x00\x05\x16\x07 AppleDouble")
+    with pytest.warns(
+        UserWarning,
+        match=r"img1: 1 image whose name is not a frame number left "
+        r"out \(cover.png\): a MOTChallenge sequence's frames are its numbered",
+    ):
+        assert _levels(seq) == [1, 2, 3, 4, 5]
+    # outside a sequence the names are no frame numbers: the cover is a frame, hidden files not
+    (seq / "seqinfo.ini").unlink()
+    assert len(FrameSource(seq)) == 6
+
+
 def test_numbered_and_named_folders_keep_their_order(tmp_path: Path) -> None:
     numbered = _numbered(tmp_path / "n", [f"{k:06d}.png" for k in (3, 1, 2)])
     assert [int(f[0, 0, 0]) for f in FrameSource(numbered)] == [2, 3, 1]  # 000001 is level 2

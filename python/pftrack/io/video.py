@@ -720,8 +720,37 @@ def _no_images(folder: Path) -> str:
 
 
 def _images_in(folder: Path) -> list[Path]:
-    """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order."""
-    return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
+    """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order.
+
+    Hidden files (names starting with a point) are left out, as ``ls`` leaves them: macOS's
+    ``._000001.jpg`` beside each image of a folder copied from its disks, a viewer's
+    ``.thumb.jpg`` (were: frames, or an image that could not be read; a user trial).
+    """
+    return [
+        p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."
+    ]
+
+
+def _frames_only(folder: Path, images: list[Path]) -> list[Path]:
+    """A MOTChallenge sequence's images without those whose names are not frame numbers.
+
+    In a sequence's image folder the names are frame numbers (``000001.jpg``): an image named
+    otherwise beside them (a ``cover.jpg``) is no frame, and is left out with a warning (was:
+    the numbers were no longer read as frames, the stray image became one more frame, and
+    ``pftrack eval`` refused the rows of a frame beyond ``seqLength``; a user trial). Images
+    none of whose names is a number are kept, in their names' order.
+    """
+    numbered = [p for p in images if _INTEGER.fullmatch(p.stem)]
+    if not numbered or len(numbered) == len(images):
+        return images
+    others = sorted(p.name for p in images if not _INTEGER.fullmatch(p.stem))
+    listed = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
+    warnings.warn(
+        f"{folder}: {len(others)} image{'s' * (len(others) > 1)} whose name is not a frame "
+        f"number left out ({listed}): a MOTChallenge sequence's frames are its numbered images",
+        stacklevel=4,
+    )
+    return numbered
 
 
 def source_files(source: PathLike | int) -> list[Path]:
@@ -1021,6 +1050,8 @@ class FrameSource:
             )
         seq = self.sequence
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
+        if own:
+            images = _frames_only(folder, images)
         numbered = _frame_order(folder, images, seq if own else None)
         self._images = numbered or _natural_order(folder, images)
         self.gap = _gap(folder, self._images)
