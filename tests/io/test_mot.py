@@ -73,6 +73,14 @@ def test_fast_read_equals_line_by_line(tmp_path: Path) -> None:
         ("# c\n1,2,3,4,5,6\n2,2,3,4,5,-0.5\n", ":3: negative box"),
         ("# c\n1,2,3,4,5,6\n2,2,-2e9,4,-5,6\n", ":3: negative box"),  # size before far
         ("# c\n1,2,3,4,5,6\n2,2,-2e9,4,5,6\n", r":3: a box value is beyond ±1e\+09 px: '2,2,"),
+        # a user trial: float() read 1_0 as 10, other scripts' digits, and 400 digits as "NaN or
+        # inf"
+        ("1,2,3,4,5,6\n1_0,2,3,4,5,6\n", r":2: MOT file line has a non-number: '1_0,"),
+        ("1,2,3,4,5,6\n\uff11,2,3,4,5,6\n", ":2: MOT file line has a non-number"),
+        (
+            "1,2,3,4,5,6\n2,2,3,4,5,6,1" + "0" * 400 + "\n",
+            r":2: .*\(beyond a float's range\) in column 7",
+        ),
     ],
 )
 def test_bad_lines_still_named(tmp_path: Path, text: str, match: str) -> None:

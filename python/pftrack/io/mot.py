@@ -11,6 +11,7 @@ file such as ``np.savetxt``'s, written in their shortest round-trip form; :func:
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -186,6 +187,14 @@ def read_mot(
     return a
 
 
+#: A number as MOTChallenge files write them: ASCII digits, a point, an exponent (``float()``
+#: alone also takes ``1_0`` for 10 and other scripts' digits, ``１００``: a user trial).
+_NUMBER = re.compile(
+    r"\s*[+-]?(?:\d+\.?\d*(?:e[+-]?\d+)?|\.\d+(?:e[+-]?\d+)?|inf(?:inity)?|nan)\s*",
+    re.ASCII | re.IGNORECASE,
+)
+
+
 def _parse_line(text: str, what: str) -> list[float] | str:
     """The 10 values of a line of a MOTChallenge file, or what is wrong with it (boxes aside).
 
@@ -210,15 +219,17 @@ def _parse_line(text: str, what: str) -> list[float] | str:
             f"{what} line has {len(fields)} fields, expected at least 6 "
             f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
         )
-    try:
-        values = [float(f) for f in fields[:10]]
-    except ValueError:
+    if not all(_NUMBER.fullmatch(f) for f in fields[:10]):
         return f"{what} line has a non-number: {text[:80]!r}"
+    values = [float(f) for f in fields[:10]]
     bad = [c for c, v in enumerate(values) if not np.isfinite(v)]
     if bad:  # every column is used: conf as a score, columns 8-10 written back
+        c = bad[0]
+        said = fields[c].strip().lower().lstrip("+-")
+        kind = "NaN or inf" if said[:1] in ("i", "n") else "beyond a float's range"
         return (
-            f"{what} line has a non-finite value (NaN or inf) in column "
-            f"{bad[0] + 1} ({_NAMES[bad[0]]}): {text[:80]!r}"
+            f"{what} line has a non-finite value ({kind}) in column {c + 1} ({_NAMES[c]}): "
+            f"{text[:80]!r}"
         )
     frame = values[FRAME]
     if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
