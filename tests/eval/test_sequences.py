@@ -147,6 +147,12 @@ def test_cli_folder_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     assert "extension" in error("--csv", str(tmp_path / "x.txt"))
     assert "no sequence 'C'" in error("--seqs", "C")
     assert "no sequence 'C'" in error("--scale", "C=0.5")
+    assert "no sequence 'C'" in error("--scale", "C=0.5", "--seqs", "A")
+    # a scale for a sequence that --seqs leaves out is not used (was: "no sequence 'B'", a user
+    # trial), and a scale for a scored one still is
+    assert main([*argv, "--seqs", "A", "--scale", "B=0.5"]) == 0
+    assert main([*argv, "--seqs", "A", "--scale", "A=7"]) == 2
+    capsys.readouterr()
     # was: the last value won silently (MOTA -106 for PETS09 with 0.625 then 0.5)
     assert "--scale is given twice for every sequence (0.625, then 0.5); give it once" in error(
         "--scale", "0.625", "--scale", "0.5"

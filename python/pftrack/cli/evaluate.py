@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Collection
 from pathlib import Path
 from typing import Any
 
@@ -114,18 +115,36 @@ def _check_scales(specs: list[tuple[str | None, float]]) -> None:
         seen[name] = value
 
 
-def _scales(specs: list[tuple[str | None, float]], names: list[str]) -> dict[str, float]:
-    """Scale per sequence name from the ``--scale`` options."""
+def _scales(
+    specs: list[tuple[str | None, float]], names: list[str], left_out: Collection[str] = ()
+) -> dict[str, float]:
+    """Scale per sequence name from the ``--scale`` options.
+
+    A scale for a sequence that ``--seqs`` leaves out (`left_out`) is not used (was: refused
+    as "no sequence", of a sequence that is there: a script that gives every sequence's scale
+    could not score a few of them; a user trial).
+    """
     default = 1.0
     per: dict[str, float] = {}
     for name, value in specs:
         if name is None:
             default = value
+        elif name in left_out:
+            continue
         elif name not in names:
             raise ValueError(f"--scale {name}={value:g}: no sequence {name!r} (have {names})")
         else:
             per[name] = value
     return {n: per.get(n, default) for n in names}
+
+
+def _left_out(args: argparse.Namespace, names: list[str]) -> set[str]:
+    """The sequences of the ground-truth folder that ``--seqs`` does not score."""
+    if not args.seqs or not Path(args.gt).is_dir():
+        return set()
+    from pftrack.eval import find_sequences
+
+    return {s.name for s in find_sequences(args.gt, args.seqs)} - set(names)
 
 
 def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
@@ -240,7 +259,8 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.csv is not None:
         check_output(args.csv, what="--csv", suffixes=(".csv",), inputs=inputs)
-    scales = _scales(args.scale or [], [name for name, _, _ in jobs])
+    names = [name for name, _, _ in jobs]
+    scales = _scales(args.scale or [], names, _left_out(args, names))
 
     loaded = []
     for name, seq, path in jobs:  # read and check everything before scoring anything
