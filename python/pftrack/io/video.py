@@ -726,9 +726,7 @@ def _images_in(folder: Path) -> list[Path]:
     ``._000001.jpg`` beside each image of a folder copied from its disks, a viewer's
     ``.thumb.jpg`` (were: frames, or an image that could not be read; a user trial).
     """
-    return [
-        p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."
-    ]
+    return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."]
 
 
 def _frames_only(folder: Path, images: list[Path]) -> list[Path]:
