@@ -833,7 +833,7 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
     when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
     target is left as it was, so an interrupted run never leaves a new tracks file beside an old
     video, or a half-written file anywhere. A symbolic link replaces the file it leads to; a
-    device, FIFO or descriptor gets its file's bytes written into it after the renames.
+    device, FIFO or descriptor gets its file's bytes written into it before the renames (one that fails leaves every target as it was).
 
     Examples
     --------
@@ -871,13 +871,16 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
 
     try:
         yield stage
+        # devices, FIFOs and descriptors first: one that fails (/dev/full, a closed pipe)
+        # leaves every file target as it was (were written last: --out was replaced by a run
+        # that then failed; a user trial). A FIFO waits for its reader before the renames.
+        for tmp_path, resolved in through:
+            with _named(resolved.path):  # /dev/full: "No space left on device" named no file
+                _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
         for tmp, target in staged:
             _keep_mode(tmp, target)  # again: a writer may have made the file anew
         for tmp, target in staged:
             os.replace(tmp, target)
-        for tmp_path, resolved in through:  # last: a FIFO waits for its reader
-            with _named(resolved.path):  # /dev/full: "No space left on device" named no file
-                _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
     except BaseException as exc:
         _remove(made)
         for tmp in made:
