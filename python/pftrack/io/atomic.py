@@ -833,7 +833,8 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
     when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
     target is left as it was, so an interrupted run never leaves a new tracks file beside an old
     video, or a half-written file anywhere. A symbolic link replaces the file it leads to; a
-    device, FIFO or descriptor gets its file's bytes written into it before the renames (one that fails leaves every target as it was).
+    device, FIFO or descriptor gets its file's bytes written into it before the renames (one
+    that fails leaves every target as it was).
 
     Examples
     --------
