@@ -16,4 +16,16 @@ void register_assignment(py::module_& m) {
         },
         py::arg("cost"),
         "Minimum-cost assignment of cost (R, C): (rows, cols) int32, as scipy.optimize's.");
+    m.def(
+        "sparse_assignment",
+        [](Eigen::Ref<const IndexVector> r, Eigen::Ref<const IndexVector> c,
+           Eigen::Ref<const Eigen::VectorXd> cost, std::int64_t n_ends, std::int64_t n_starts,
+           double unjoined) {
+            py::gil_scoped_release nogil;  // safe: Eigen views only
+            return sparse_assignment(r, c, cost, n_ends, n_starts, unjoined);
+        },
+        py::arg("r"), py::arg("c"), py::arg("cost"), py::arg("n_ends"), py::arg("n_starts"),
+        py::arg("unjoined"),
+        "Least-cost joins of ends r[k] to starts c[k] over these pairs only, each end also "
+        "left unjoined at `unjoined`: (ends, starts) int64 of the joins, ends ascending.");
 }

@@ -249,6 +249,9 @@ def bhattacharyya_weights(hists: _F64, ref: _F64, lam: float = 20.0) -> _F64: ..
 
 # --- assignment: cost (R, C) float64, +inf forbids a pair -> (rows, cols) int32 ----------
 def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascending
+def sparse_assignment(
+    r: ArrayLike, c: ArrayLike, cost: ArrayLike, n_ends: int, n_starts: int, unjoined: float
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]: ...  # ends ascending
 
 # --- box refinement: boxes (K, 4) left, top, w, h; mask (H, W) uint8 or bool -> (K, 4) -----
 def refine_boxes(

@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <functional>
+#include <string>
 #include <limits>
 #include <numeric>
 #include <utility>
@@ -129,6 +132,133 @@ inline std::pair<Eigen::VectorXi, Eigen::VectorXi> linear_sum_assignment(
         }
     }
     return {rows, cols};
+}
+
+using IndexVector = Eigen::Matrix<std::int64_t, Eigen::Dynamic, 1>;
+
+/// The least-cost assignment of ends to starts over the given pairs only (sparse): pair k joins
+/// end `r[k]` to start `c[k]` at `cost[k]`, and every end also has a start of its own at
+/// `unjoined` (left unjoined), so the most joins are made, then the least cost: what a dense
+/// (n_ends, n_starts) matrix with `unjoined` outside the pairs gives. Shortest augmenting
+/// paths by Dijkstra on reduced costs (Crouse's dual update, as linear_sum_assignment's), over
+/// the pairs a path visits: time and memory follow them, not n_ends * n_starts. The same
+/// operations in the same order as pftrack.recovery.linking's NumPy reference (a heap ordered
+/// by path cost, then column), so the two give the same joins, ties and all. Returns (ends,
+/// starts) of the joins, ends ascending.
+inline std::pair<IndexVector, IndexVector> sparse_assignment(const Eigen::Ref<const IndexVector>& r,
+                                                             const Eigen::Ref<const IndexVector>& c,
+                                                             const Eigen::Ref<const Eigen::VectorXd>& cost,
+                                                             std::int64_t n_ends, std::int64_t n_starts,
+                                                             double unjoined) {
+    constexpr const char* fn = "sparse_assignment";
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    const Eigen::Index n = r.size();
+    require(c.size() == n && cost.size() == n, fn,
+            "r, c and cost must have one length, got " + std::to_string(n) + ", " +
+                std::to_string(c.size()) + ", " + std::to_string(cost.size()));
+    require(n_ends >= 0 && n_starts >= 0 && n_ends <= (std::int64_t{1} << 40) &&
+                n_starts <= (std::int64_t{1} << 40),
+            fn, "n_ends and n_starts must be >= 0");
+    require(std::isfinite(unjoined), fn, "unjoined", unjoined, "finite");
+    for (Eigen::Index k = 0; k < n; ++k) {
+        require(r[k] >= 0 && r[k] < n_ends, fn,
+                "r[" + std::to_string(k) + "] is " + std::to_string(r[k]) + ", expected 0.." +
+                    std::to_string(n_ends - 1));
+        require(c[k] >= 0 && c[k] < n_starts, fn,
+                "c[" + std::to_string(k) + "] is " + std::to_string(c[k]) + ", expected 0.." +
+                    std::to_string(n_starts - 1));
+        require(std::isfinite(cost[k]), fn, "cost[" + std::to_string(k) + "] is not finite");
+    }
+    const auto ne = static_cast<std::size_t>(n_ends);
+    const std::size_t n_cols = static_cast<std::size_t>(n_starts) + ne;
+    // each end's pairs in the order given, then its own stand-in start
+    std::vector<std::size_t> first(ne + 1, 0);
+    for (Eigen::Index k = 0; k < n; ++k) ++first[static_cast<std::size_t>(r[k]) + 1];
+    for (std::size_t a = 0; a < ne; ++a) first[a + 1] += first[a] + 1;
+    std::vector<std::int64_t> col(first[ne]);
+    std::vector<double> weight(first[ne]);
+    {
+        std::vector<std::size_t> at(first.begin(), first.end() - 1);
+        for (Eigen::Index k = 0; k < n; ++k) {
+            const auto a = static_cast<std::size_t>(r[k]);
+            col[at[a]] = c[k];
+            weight[at[a]++] = cost[k];
+        }
+        for (std::size_t a = 0; a < ne; ++a) {
+            col[at[a]] = n_starts + static_cast<std::int64_t>(a);
+            weight[at[a]] = unjoined;
+        }
+    }
+    std::vector<double> u(ne, 0.0), v(n_cols, 0.0), dist(n_cols, inf);
+    std::vector<std::int64_t> row4col(n_cols, -1), col4row(ne, -1), pred(n_cols, -1);
+    std::vector<char> done(n_cols, 0);
+    std::vector<std::int64_t> done_order, touched;
+    using Entry = std::pair<double, std::int64_t>;
+    std::vector<Entry> heap;
+    const auto later = std::greater<Entry>();
+    for (std::int64_t cur = 0; cur < n_ends; ++cur) {
+        heap.clear();
+        std::int64_t i = cur, j = -1;
+        double base = 0.0;
+        while (true) {
+            const auto ui = static_cast<std::size_t>(i);
+            for (std::size_t e = first[ui]; e < first[ui + 1]; ++e) {
+                const std::int64_t jj = col[e];
+                const auto sj = static_cast<std::size_t>(jj);
+                const double d = base + weight[e] - u[ui] - v[sj];
+                if (!done[sj] && d < dist[sj]) {
+                    if (dist[sj] == inf) touched.push_back(jj);
+                    dist[sj] = d;
+                    pred[sj] = i;
+                    heap.emplace_back(d, jj);
+                    std::push_heap(heap.begin(), heap.end(), later);
+                }
+            }
+            while (true) {
+                require(!heap.empty(), fn, "no augmenting path (internal error)");
+                std::pop_heap(heap.begin(), heap.end(), later);
+                const Entry top = heap.back();
+                heap.pop_back();
+                base = top.first;
+                j = top.second;
+                const auto sj = static_cast<std::size_t>(j);
+                if (!done[sj] && base == dist[sj]) break;
+            }
+            done[static_cast<std::size_t>(j)] = 1;
+            done_order.push_back(j);
+            if (row4col[static_cast<std::size_t>(j)] == -1) break;  // a free start: the path ends
+            i = row4col[static_cast<std::size_t>(j)];
+        }
+        const std::int64_t sink = j;
+        for (const std::int64_t jj : done_order) {  // the dual update: reduced costs stay >= 0
+            const auto sj = static_cast<std::size_t>(jj);
+            if (jj != sink) u[static_cast<std::size_t>(row4col[sj])] += base - dist[sj];
+            v[sj] -= base - dist[sj];
+        }
+        u[static_cast<std::size_t>(cur)] += base;
+        j = sink;
+        while (true) {  // augment along the path
+            const std::int64_t ii = pred[static_cast<std::size_t>(j)];
+            row4col[static_cast<std::size_t>(j)] = ii;
+            std::swap(col4row[static_cast<std::size_t>(ii)], j);
+            if (ii == cur) break;
+        }
+        for (const std::int64_t jj : touched) {
+            dist[static_cast<std::size_t>(jj)] = inf;
+            done[static_cast<std::size_t>(jj)] = 0;
+        }
+        touched.clear();
+        done_order.clear();
+    }
+    std::vector<std::int64_t> rows;
+    for (std::int64_t a = 0; a < n_ends; ++a)
+        if (col4row[static_cast<std::size_t>(a)] < n_starts) rows.push_back(a);
+    IndexVector ends(static_cast<Eigen::Index>(rows.size())), starts(ends.size());
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+        ends[static_cast<Eigen::Index>(k)] = rows[k];
+        starts[static_cast<Eigen::Index>(k)] = col4row[static_cast<std::size_t>(rows[k])];
+    }
+    return {ends, starts};
 }
 
 }  // namespace pftrack

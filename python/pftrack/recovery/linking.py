@@ -11,14 +11,14 @@ three columns.
 
 from __future__ import annotations
 
-import math
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+import pftrack._core as _core
 from pftrack._check import (
     BOX_VALUES,
     MAX_FRAME,
@@ -291,23 +291,41 @@ def _sizes_apart(a: F64, b: F64, ratio: float | None) -> NDArray[np.bool_]:
     return sized & (np.maximum(area_a, area_b) > ratio * np.minimum(area_a, area_b))
 
 
-def _candidate_pairs(last: F64, first: F64, max_gap: int) -> tuple[NDArray[np.intp], ...]:
+#: Candidate pairs gated at once by :func:`link_costs`: memory stays bounded by the pairs that
+#: pass the gates, not by all those within the time gate (a file of 50000 one-row fragments,
+#: 10 a frame, has 15 million: 2.8 GB; a user trial).
+PAIR_BLOCK = 1 << 20
+
+
+def _candidate_pairs(
+    last: F64, first: F64, max_gap: int
+) -> Iterator[tuple[NDArray[np.intp], NDArray[np.intp]]]:
     """Pairs ``(i, j)`` where fragment j starts 1 to ``max_gap + 1`` frames after i ends.
 
-    `last`, `first`: each fragment's last and first frame. Sorted by i, then j; found by a
-    binary search over the sorted first frames, so the work follows the number of pairs
-    within the time gate, not the square of the number of fragments.
+    `last`, `first`: each fragment's last and first frame. Yielded in blocks of consecutive
+    i of about :data:`PAIR_BLOCK` pairs (one i's pairs are never split), each sorted by i,
+    then j: the blocks in turn are sorted by i, then j. Found by a binary search over the
+    sorted first frames, so the work follows the number of pairs within the time gate, not
+    the square of the number of fragments.
     """
     order = np.argsort(first, kind="stable")
     starts = first[order]
     lo = np.searchsorted(starts, last, side="right")  # starts after the end
     hi = np.searchsorted(starts, last + (max_gap + 1), side="right")  # at most max_gap missing
     counts = hi - lo
-    i = np.repeat(np.arange(len(last)), counts)
-    offset = np.arange(len(i)) - np.repeat(np.cumsum(counts) - counts, counts)
-    j = order[np.repeat(lo, counts) + offset]
-    keep = np.lexsort((j, i))
-    return i[keep], j[keep]
+    ends = np.cumsum(counts)
+    block = PAIR_BLOCK
+    a = 0
+    while a < len(last):
+        # the i of this block: as many as fit in `block` pairs, one at least
+        b = max(int(np.searchsorted(ends, ends[a] - counts[a] + block, side="right")), a + 1)
+        n = counts[a:b]
+        i = np.repeat(np.arange(a, b), n)
+        offset = np.arange(len(i)) - np.repeat(np.cumsum(n) - n, n)
+        j = order[np.repeat(lo[a:b], n) + offset]
+        keep = np.lexsort((j, i))
+        yield i[keep], j[keep]
+        a = b
 
 
 def link_costs(
@@ -327,17 +345,19 @@ def link_costs(
         empty = np.zeros(0, dtype=np.intp)
         return ids, empty, empty, np.zeros(0)
     tail, head = _fragment_ends(tracks, config.velocity_points)
-    i, j = _candidate_pairs(tail[:, 0], head[:, 0], config.max_gap)
-    end, vi, start, vj = tail[i, 1:3], tail[i, 3:5], head[j, 1:3], head[j, 3:5]
-    gap = head[j, 0] - tail[i, 0]
-    g = gap[:, None]
-    fwd = np.hypot(*(end + vi * g - start).T)
-    bwd = np.hypot(*(start - vj * g - end).T)
-    d = 0.5 * (fwd + bwd)
-    near = ~(d > config.max_distance) & ~_sizes_apart(
-        tail[i, 5:7], head[j, 5:7], config.max_area_ratio
-    )
-    i, j, d, gap = i[near], j[near], d[near], gap[near]
+    kept: list[tuple[NDArray[np.intp], NDArray[np.intp], F64, F64]] = []
+    for i, j in _candidate_pairs(tail[:, 0], head[:, 0], config.max_gap):
+        end, vi, start, vj = tail[i, 1:3], tail[i, 3:5], head[j, 1:3], head[j, 3:5]
+        gap = head[j, 0] - tail[i, 0]
+        g = gap[:, None]
+        fwd = np.hypot(*(end + vi * g - start).T)
+        bwd = np.hypot(*(start - vj * g - end).T)
+        d = 0.5 * (fwd + bwd)
+        near = ~(d > config.max_distance) & ~_sizes_apart(
+            tail[i, 5:7], head[j, 5:7], config.max_area_ratio
+        )
+        kept.append((i[near], j[near], d[near], gap[near]))
+    i, j, d, gap = (np.concatenate(parts) for parts in zip(*kept, strict=True))
     cost = d / config.max_distance + config.w_gap * (gap - 1) / max(config.max_gap, 1)
     hi, hj = tail[i, 5], head[j, 5]
     sized = (hi > 0) & (hj > 0)
@@ -377,8 +397,9 @@ def link_cost_matrix(
 FORBIDDEN = 1e6
 #: Components of the candidate pairs up to this many (ends x starts) cells are solved as a
 #: dense matrix by :func:`pftrack.assignment.linear_sum_assignment` (32 MB at most); larger
-#: ones by shortest augmenting paths over their pairs (:func:`_sparse_assignment`), so memory
-#: follows the candidate pairs whatever a component's size.
+#: ones by shortest augmenting paths over their pairs (``_core.sparse_assignment``, C++; its
+#: NumPy reference is ``tests/reference/linking.py``'s), so memory follows the candidate pairs
+#: whatever a component's size.
 DENSE_CELLS = 1 << 22
 
 
@@ -422,7 +443,7 @@ def _assign(i: NDArray[np.intp], j: NDArray[np.intp], cost: F64) -> list[tuple[i
         ends, r = np.unique(ci, return_inverse=True)
         starts, c = np.unique(cj, return_inverse=True)
         if len(ends) * len(starts) > DENSE_CELLS:
-            rows, cols = _sparse_assignment(r, c, cc, len(ends), len(starts))
+            rows, cols = _core.sparse_assignment(r, c, cc, len(ends), len(starts), FORBIDDEN)
         else:
             m = np.full((len(ends), len(starts)), FORBIDDEN)
             m[r, c] = cc
@@ -433,64 +454,6 @@ def _assign(i: NDArray[np.intp], j: NDArray[np.intp], cost: F64) -> list[tuple[i
             rows, cols = rows[keep], cols[keep]
         joins += zip(ends[rows].tolist(), starts[cols].tolist(), strict=True)
     return sorted(joins)
-
-
-def _sparse_assignment(
-    r: NDArray[np.intp], c: NDArray[np.intp], cost: F64, n_ends: int, n_starts: int
-) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """:func:`_assign`'s optimum for one component, over its pairs only (no dense matrix).
-
-    Shortest augmenting paths (Dijkstra on reduced costs, the dual update of
-    :func:`pftrack.assignment.linear_sum_assignment`, Crouse's) over the pairs ``(r, c)``
-    with their `cost`, and for every end a start of its own at :data:`FORBIDDEN` (not joined):
-    the same objective as the dense matrix, the most joins, then the least cost. Time and
-    memory follow the pairs an augmenting path visits, not ``n_ends * n_starts``.
-    """
-    import heapq
-
-    out: list[list[tuple[int, float]]] = [[] for _ in range(n_ends)]
-    for a, b, w in zip(r.tolist(), c.tolist(), cost.tolist(), strict=True):
-        out[a].append((b, w))
-    for a in range(n_ends):  # an end's own stand-in start: left unjoined
-        out[a].append((n_starts + a, FORBIDDEN))
-    n_cols = n_starts + n_ends
-    u, v = [0.0] * n_ends, [0.0] * n_cols
-    row4col, col4row = [-1] * n_cols, [-1] * n_ends
-    for cur in range(n_ends):
-        dist: dict[int, float] = {}  # columns reached: their path cost
-        pred: dict[int, int] = {}  # and the row they were reached from
-        done: dict[int, None] = {}  # columns whose path cost is final, in that order
-        heap: list[tuple[float, int]] = []
-        i, base = cur, 0.0
-        while True:
-            for j, w in out[i]:
-                d = base + w - u[i] - v[j]
-                if j not in done and d < dist.get(j, math.inf):
-                    dist[j], pred[j] = d, i
-                    heapq.heappush(heap, (d, j))
-            while True:
-                base, j = heapq.heappop(heap)
-                if j not in done and base == dist[j]:
-                    break
-            done[j] = None
-            if row4col[j] == -1:  # a free start: the path ends here
-                break
-            i = row4col[j]
-        sink = j
-        for j in done:  # the dual update: reduced costs stay >= 0
-            if j != sink:
-                u[row4col[j]] += base - dist[j]
-            v[j] -= base - dist[j]
-        u[cur] += base
-        j = sink
-        while True:  # augment along the path
-            i = pred[j]
-            row4col[j] = i
-            col4row[i], j = j, col4row[i]
-            if i == cur:
-                break
-    rows = [a for a in range(n_ends) if col4row[a] < n_starts]
-    return np.array(rows, dtype=np.intp), np.array([col4row[a] for a in rows], dtype=np.intp)
 
 
 def link_tracklets(
