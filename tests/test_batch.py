@@ -127,6 +127,13 @@ def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
         ({"a/x.avi": "", "b/x.avi": ""}, "both named 'x'"),
         ({"summary.avi": ""}, "reserved"),
         ({"notes.txt": ""}, "no sequence in folder"),
+        # a user trial: a stray image made a folder of videos, or of sequences, one sequence of
+        # one frame, the others passed over, exit status 0
+        (
+            {"thumbnail.jpg": "", "a.mp4": "", "b.avi": ""},
+            r"holds 1 image \(thumbnail.jpg\) "
+            r"and 2 videos or sequence folders \(a.mp4, b.avi\): whether it is one sequence",
+        ),
     ],
 )
 def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message: str) -> None:
@@ -136,6 +143,21 @@ def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message:
     tops = sorted({tmp_path / rel.split("/")[0] for rel in layout if "/" in rel}) or [tmp_path]
     with pytest.raises(ValueError, match=message):
         find_sequences(tops)
+
+
+def test_a_folder_of_sequences_with_a_stray_image_is_refused(tmp_path: Path) -> None:
+    """A user trial: train/ with SEQ-A, SEQ-B and an overview.png was one sequence of one frame."""
+    top = tmp_path / "train"
+    for rel in ("SEQ-A/seqinfo.ini", "SEQ-B/img1/1.png", "overview.png"):
+        (top / rel).parent.mkdir(parents=True, exist_ok=True)
+        (top / rel).write_text("")
+    message = r"holds 1 image \(overview.png\) and 2 videos or sequence folders \(SEQ-A, SEQ-B\)"
+    with pytest.raises(ValueError, match=message):
+        find_sequences(top)
+    (top / "overview.png").unlink()
+    assert [s.name for s in find_sequences(top)] == ["SEQ-A", "SEQ-B"]
+    (top / "SEQ-B" / "img1" / ".thumb.png").write_text("")  # hidden: no image of the folder
+    assert [s.name for s in find_sequences(top / "SEQ-B")] == ["SEQ-B"]
 
 
 @pytest.mark.parametrize(

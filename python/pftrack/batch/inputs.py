@@ -117,8 +117,52 @@ def _videos(folder: Path) -> list[Path]:
     return [p for p in video_files(folder) if not _batch_output(p)]
 
 
-def _has_images(folder: Path) -> bool:
-    return any(p.suffix.lower() in IMAGE_SUFFIXES for p in folder.iterdir())
+def _images(folder: Path) -> list[Path]:
+    """A folder's images, hidden files left out (as :class:`~pftrack.io.video.FrameSource`)."""
+    return [
+        p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."
+    ]
+
+
+def _sequences_beside(folder: Path) -> list[Path]:
+    """The videos and sequence-like folders in `folder` (sequences of their own)."""
+    out = []
+    for p in sorted(folder.iterdir(), key=_listing_key):
+        if p.name[0] == ".":
+            continue
+        if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES and not _batch_output(p):
+            out.append(p)
+        elif p.is_dir() and (
+            (p / "seqinfo.ini").is_file() or (p / "img1").is_dir() or _images(p) or _videos(p)
+        ):
+            out.append(p)
+    return out
+
+
+def _image_folder(path: Path) -> SequenceInput | None:
+    """A folder of images as one sequence; None without images.
+
+    Refused when it also holds videos or sequence folders: a stray ``thumbnail.jpg`` in a
+    folder of videos made the whole folder one sequence of one frame, the videos passed over
+    with exit status 0 (a user trial). Which was meant is not known.
+    """
+    images = _images(path)
+    if not images:
+        return None
+    others = _sequences_beside(path)
+    if others:
+        listed = ", ".join(p.name for p in others[:3]) + (", ..." if len(others) > 3 else "")
+        pictures = ", ".join(p.name for p in sorted(images)[:3]) + (
+            ", ..." if len(images) > 3 else ""
+        )
+        raise ValueError(
+            f"folder {path} holds {len(images)} image{'s' * (len(images) > 1)} ({pictures}) "
+            f"and {len(others)} video{'s' * (len(others) > 1)} or sequence folder"
+            f"{'s' * (len(others) > 1)} ({listed}): whether it is one sequence of images or a "
+            "folder of sequences is not known; move the images into a folder of their own, or "
+            "the others out"
+        )
+    return SequenceInput(path.name, path, *_annotations(path))
 
 
 def _as_sequence(path: Path) -> SequenceInput | None:
@@ -131,7 +175,7 @@ def _as_sequence(path: Path) -> SequenceInput | None:
     if not ini.is_file():
         if (path / "img1").is_dir():
             return SequenceInput(path.name, path / "img1", *_annotations(path))
-        return SequenceInput(path.name, path, *_annotations(path)) if _has_images(path) else None
+        return _image_folder(path)
     # a sequence folder, read as pftrack track reads it: its imDir, else its one video
     try:
         info = read_seqinfo(ini)
