@@ -386,6 +386,26 @@ def test_failing_sequence_is_reported_and_the_others_finish(
     assert single.read_bytes() == (out / "MOT-01.txt").read_bytes()
 
 
+def test_a_name_that_is_not_utf8_fails_alone_on_dask(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    """A user trial: caf\\xe9.avi (a Latin-1 name) beside ok.avi failed both tasks, each said to
+    have lost the scheduler: MessagePack sends text as UTF-8."""
+    root = tmp_path / "in"
+    root.mkdir()
+    shutil.copy(data / "walk.avi", root / "ok.avi")
+    shutil.copy(data / "walk.avi", root / os.fsdecode(b"caf\xe9.avi"))
+    out = tmp_path / "out"
+    track_many(root, out, client=client, options=TrackOptions(_config()), show_progress=False)
+    summary = json.loads((out / "summary.json").read_text())
+    status = {s["name"]: (s["status"], s.get("error")) for s in summary["sequences"]}
+    assert status["ok"] == ("done", None)
+    assert status[os.fsdecode(b"caf\xe9")][1].endswith(
+        "the name is not UTF-8, which Dask cannot send to a worker; rename it, or run this "
+        "batch in this process (--workers 0)"
+    )
+
+
 def test_an_image_folder_whose_names_skip_numbers_is_tracked_but_not_matched_to_files(
     data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

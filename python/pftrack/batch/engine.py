@@ -1766,6 +1766,38 @@ class _Frames:
             self.bar.describe(self._desc())
 
 
+def _not_utf8(job: Job) -> str | None:
+    r"""Why `job` cannot go to a Dask worker: a path whose name is not UTF-8, or None.
+
+    Dask sends a task's arguments as MessagePack, whose text is UTF-8: a file name of other
+    bytes (``caf\xe9.mp4`` from a Latin-1 disk, which Python holds with surrogate escapes)
+    broke the connection for every task of the batch, each said to have lost the scheduler (a
+    user trial). Such a task runs with ``--workers 0`` (in this process).
+    """
+
+    def names(value: Any) -> Iterator[str]:
+        if isinstance(value, (str, os.PathLike)):
+            yield os.fspath(value) if not isinstance(value, bytes) else ""
+        elif isinstance(value, (tuple, list)):
+            for v in value:
+                yield from names(v)
+        elif isinstance(value, dict):
+            for k, v in value.items():
+                yield from names(k)
+                yield from names(v)
+
+    for text in names((job.name, job.args, job.reads)):
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError:
+            shown = os.fsencode(text).decode("utf-8", "backslashreplace")
+            return (
+                f"{shown}: the name is not UTF-8, which Dask cannot send to a worker; rename "
+                "it, or run this batch in this process (--workers 0)"
+            )
+    return None
+
+
 def _run_on_dask(
     c: Client,
     pending: Sequence[Job],
@@ -1786,8 +1818,18 @@ def _run_on_dask(
     topic = f"pftrack-progress-{os.urandom(4).hex()}"
     if frames is not None:
         c.subscribe_topic(topic, frames.on_event)
-    futures = {}
+    sendable = []
     for job in pending:
+        unsent = _not_utf8(job)
+        if unsent is None:
+            sendable.append(job)
+        else:  # it alone fails (was: every task, "the connection to the scheduler was lost")
+            if frames is not None:
+                frames.finish(job.name)
+            record(job, Outcome(None, unsent))
+    bar = {**bar, "total": len(sendable)}
+    futures = {}
+    for job in sendable:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
         where = (topic, job.name) if frames is not None else None
         fut = c.submit(call_task, job.func, job.args, where, key=key, pure=False)
