@@ -810,6 +810,31 @@ def test_a_refused_or_unknown_scheduler_fails_at_once(
     assert not (tmp_path / "out").exists()
 
 
+def test_a_port_that_says_nothing_is_no_scheduler(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: a port that accepts the connection and never speaks (the dashboard's, an
+    HTTP server) held ``Client(address)`` for ever: Dask's connect timeout does not cover the
+    handshake."""
+    from pftrack.batch import engine
+
+    monkeypatch.setattr(engine, "GREETING_WAIT", 0.5)
+    _tracks_files(tmp_path / "tracks")
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(4)
+        address = f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+        start = time.monotonic()
+        argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+        assert main([*argv, "--scheduler", address]) == 2
+        assert time.monotonic() - start < 10
+    assert capsys.readouterr().err.endswith(
+        "accepted the connection but said nothing within 0.5 s, as no Dask scheduler does (the "
+        "dashboard's port? a scheduler listens on 8786 unless told otherwise)\n"
+    )
+    assert not (tmp_path / "out").exists()
+
+
 def test_progress_counts_frames_within_the_sequences(
     data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

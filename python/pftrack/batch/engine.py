@@ -421,7 +421,8 @@ def _refused(address: str) -> str | None:
     deadline = time.monotonic() + REFUSED_GRACE
     while True:
         try:
-            socket.create_connection((host, port), timeout=REFUSED_GRACE).close()
+            with socket.create_connection((host, port), timeout=REFUSED_GRACE) as sock:
+                return _silent(sock, host, port)
         except socket.gaierror:
             return f"host {host} not found (its name does not resolve)"
         except ConnectionRefusedError:
@@ -434,7 +435,30 @@ def _refused(address: str) -> str | None:
             )
         except OSError:
             return None
-        return None
+
+
+#: Seconds a tcp:// scheduler has to greet a new connection: a Dask server speaks first (its
+#: handshake, in milliseconds); a service that accepted the connection and says nothing (the
+#: dashboard's port, an HTTP server) held ``Client(address)`` for ever (a user trial: Dask's
+#: connect timeout does not cover the handshake).
+GREETING_WAIT = 10.0
+
+
+def _silent(sock: socket.socket, host: str, port: int) -> str | None:
+    """Why the server at the other end of `sock` is no Dask scheduler: it says nothing."""
+    sock.settimeout(GREETING_WAIT)
+    try:
+        if sock.recv(1):
+            return None
+        said = "closed the connection without a word"
+    except TimeoutError:
+        said = f"said nothing within {GREETING_WAIT:g} s"
+    except OSError:
+        return None  # reset, or the like: Dask's own connection says what it finds
+    return (
+        f"port {port} of {host} accepted the connection but {said}, as no Dask scheduler "
+        "does (the dashboard's port? a scheduler listens on 8786 unless told otherwise)"
+    )
 
 
 def _connect_problem(address: str, exc: Exception) -> str:

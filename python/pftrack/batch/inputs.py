@@ -119,9 +119,7 @@ def _videos(folder: Path) -> list[Path]:
 
 def _images(folder: Path) -> list[Path]:
     """A folder's images, hidden files left out (as :class:`~pftrack.io.video.FrameSource`)."""
-    return [
-        p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."
-    ]
+    return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."]
 
 
 def _sequences_beside(folder: Path) -> list[Path]:
