@@ -360,6 +360,26 @@ def _config() -> Any:
     return replace(base, filter=replace(base.filter, n_particles=30))
 
 
+def test_ground_truth_without_a_size_takes_the_detections_scale(tmp_path: Path) -> None:
+    """A user trial: seqinfo.ini without imWidth, boxes of twice the frames' size, --det-scale
+    0.5: the tracks were right, the ground truth was scored at scale 1 (MOTA -100)."""
+    scene = make_scene(n_frames=30, width=192, height=144, n_walkers=3, rng=1)
+    seq = tmp_path / "HALF"
+    scene.write_images(seq / "img1", ext=".png")
+    double = scene.truth.copy()
+    double[:, 2:6] *= 2
+    (seq / "gt").mkdir()
+    (seq / "det").mkdir()
+    write_mot(seq / "gt" / "gt.txt", double)
+    double[:, 1] = -1
+    write_mot(seq / "det" / "det.txt", double)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nname=HALF\nframeRate=10\n")
+    options = TrackOptions(_config(), detections="auto", det_scale=0.5)
+    summary = track_many(seq, tmp_path / "out", n_workers=0, options=options)
+    (entry,) = summary.entries
+    assert entry["gt_scale"] == 0.5 and entry["metrics"]["mota"] > 0.5, entry
+
+
 def test_failing_sequence_is_reported_and_the_others_finish(
     data: Path, client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

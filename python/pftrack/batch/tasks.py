@@ -214,7 +214,9 @@ class TrackOptions:
         ``det.txt``); a sequence without one fails.
     det_scale : float or None
         Multiplies detection boxes; None: the frame width over ``seqinfo.ini``'s ``imWidth``
-        when the sequence has one (0.625 for PETS09-S2L1's video), else 1.
+        when the sequence has one (0.625 for PETS09-S2L1's video), else 1. The ground truth
+        is scaled by ``seqinfo.ini``'s size where it gives one, else, with ``detections``
+        "auto", by this (a sequence's detections and ground truth share their pixels).
     fill : {"linear", "pf"}
         As ``pftrack track --fill``.
     smooth, link : bool
@@ -351,6 +353,11 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
             )
         det = seq.detections
     det_scale = options.det_scale if options.det_scale is not None else auto_scale
+    # the ground truth's pixels: seqinfo.ini's size when it gives one, else those of the given
+    # detections' scale (det.txt and gt.txt of one sequence share them; was: 1, and MOTA -100
+    # for ground truth of twice the frames' size, a user trial)
+    unsized = seq.image_width is None and seq.image_height is None
+    gt_scale = det_scale if unsized and det is not None else auto_scale
     run = track_path(
         frames,
         detections=det,
@@ -392,7 +399,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
             metrics = sequence_metrics(
                 gt,
                 written,
-                scale=auto_scale,
+                scale=gt_scale,
                 iou=options.iou,
                 benchmark="auto" if named is None else named[0],
             )
@@ -410,7 +417,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         "detections": None if det is None else str(det),
         "det_scale": det_scale,
         "gt": None if seq.gt is None else str(seq.gt),
-        "gt_scale": auto_scale if seq.gt is not None else None,
+        "gt_scale": gt_scale if seq.gt is not None else None,
         "metrics": metrics,
         "host": socket.gethostname(),
     }
