@@ -583,6 +583,18 @@ def test_resume_redoes_a_file_whose_content_changed(
     assert {e["status"] for e in entries().values()} == {"skipped"}
     assert main([*argv, "--force"]) == 0
     assert {e["status"] for e in entries().values()} == {"done"}
+    # made by another release (a user trial: skipped after an upgrade that tracks otherwise)
+    sidecar = out / "run1.json"
+    older = json.loads(sidecar.read_text())
+    older["pftrack"] = "0.0.1"
+    sidecar.write_text(json.dumps(older))
+    capsys.readouterr()
+    assert main(argv) == 0
+    assert [e["status"] for e in entries().values()] == ["skipped", "done", "skipped"]
+    import pftrack
+
+    said = f"run1: redone: made by pftrack 0.0.1, this is pftrack {pftrack.__version__}"
+    assert said in capsys.readouterr().out
 
 
 def test_resume_redoes_an_output_truncated_emptied_or_replaced(

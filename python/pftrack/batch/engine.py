@@ -966,6 +966,12 @@ def _read_sidecar(out_dir: Path, name: str) -> dict[str, Any] | None:
     return entry if isinstance(entry, dict) else None
 
 
+def _version() -> str:
+    from pftrack import __version__
+
+    return __version__
+
+
 def _complete(
     out_dir: Path, job: Job, kind: str, settings: dict[str, Any], prints: list[dict[str, Any]]
 ) -> tuple[dict[str, Any] | None, str | None]:
@@ -976,10 +982,10 @@ def _complete(
     entry : dict or None
         The sidecar, or None: the job is to run.
     note : str or None
-        Why a job done by an earlier run with these settings is to run again: its inputs
-        changed (their `prints`, from :func:`fingerprint`, differ from the sidecar's), or its
-        outputs did (missing, or no longer the size and SHA-256 the sidecar records:
-        :func:`output_print`).
+        Why a job done by an earlier run with these settings is to run again: another pftrack
+        release made it (the sidecar's ``pftrack``), its inputs changed (their `prints`, from
+        :func:`fingerprint`, differ from the sidecar's), or its outputs did (missing, or no
+        longer the size and SHA-256 the sidecar records: :func:`output_print`).
     """
     entry = _read_sidecar(out_dir, job.name)
     if entry is None:
@@ -993,6 +999,10 @@ def _complete(
     outputs = entry.get("outputs")
     if not same or not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
         return None, None
+    made_by = entry.get("pftrack")
+    if made_by != _version():  # another release may track otherwise (a user trial: skipped)
+        by = f"pftrack {made_by}" if isinstance(made_by, str) else "an older pftrack"
+        return None, f"redone: made by {by}, this is pftrack {_version()}"
     earlier = entry.get("fingerprint")
     if earlier != prints:
         if not isinstance(earlier, list) or len(earlier) != len(prints):
@@ -1027,6 +1037,7 @@ def _write(
     outputs = [f"{job.name}.txt", *(f"{job.name}{suffix}" for suffix in result.files)]
     head: dict[str, Any] = {
         "kind": kind, "settings": settings, "inputs": [str(p) for p in job.reads],
+        "pftrack": _version(),
     }  # fmt: skip
     left = [o for o in _earlier_outputs(out_dir, job.name, kind) if o not in outputs]
     if left:  # an earlier run's video, not made again: still a batch's, never an input
