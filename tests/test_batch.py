@@ -597,6 +597,34 @@ def test_resume_redoes_a_file_whose_content_changed(
     assert said in capsys.readouterr().out
 
 
+def test_an_output_that_cannot_be_written_fails_its_task_not_the_batch(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: a full disk stopped the batch (exit status 2, "nothing ran") after a task
+    was written, its table never printed, the task being written listed as cancelled."""
+    import errno
+
+    from pftrack.batch import engine
+
+    _tracks_files(tmp_path / "tracks")
+    real = engine.write_mot
+
+    def full(path: Any, *args: Any, **kwargs: Any) -> None:
+        if Path(path).name == "run1.txt":
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        real(path, *args, **kwargs)
+
+    monkeypatch.setattr(engine, "write_mot", full)
+    out = tmp_path / "out"
+    assert main(["recover", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]) == 1
+    files = json.loads((out / "summary.json").read_text())["files"]
+    assert [f["status"] for f in files] == ["done", "failed", "done"]
+    error = files[1]["error"]
+    assert error.startswith("writing its outputs: ") and "No space left on device" in error
+    assert str(out / "run1.txt") in error
+    assert "run1" in capsys.readouterr().out  # the table
+
+
 def test_resume_redoes_an_output_truncated_emptied_or_replaced(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

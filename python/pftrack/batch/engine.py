@@ -1454,8 +1454,20 @@ def run_jobs(
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
         if outcome.result is not None:
-            entries[job.name] = _write(out, job, outcome.result, kind, settings, prints[job.name])
-            written += 1
+            try:
+                entries[job.name] = _write(
+                    out, job, outcome.result, kind, settings, prints[job.name]
+                )
+                written += 1
+            except OSError as exc:  # a full disk: this task fails, the batch goes on (was:
+                # stopped with exit status 2, "nothing ran", the task "cancelled"; a user trial)
+                entries[job.name] = {
+                    "name": job.name,
+                    "status": "failed",
+                    "source": str(job.reads[0]) if job.reads else None,
+                    "error": f"writing its outputs: {one_line(exc)}",
+                    "traceback": traceback.format_exc(),
+                }
         else:
             entries[job.name] = {
                 "name": job.name,
