@@ -145,6 +145,22 @@ def test_find_sequences_rejects(tmp_path: Path, layout: dict[str, str], message:
         find_sequences(tops)
 
 
+def test_two_sequences_of_one_name_are_told_to_link_the_sequence_folder(tmp_path: Path) -> None:
+    """A user trial: for a/seq1 and b/seq1 the hint linked b/seq1/img1, which leaves the
+    sequence's det, gt and seqinfo.ini behind."""
+    for top in ("a", "b"):
+        (tmp_path / top / "seq1" / "img1").mkdir(parents=True)
+        (tmp_path / top / "seq1" / "img1" / "1.png").write_text("")
+    (tmp_path / "c").mkdir()
+    (tmp_path / "c" / "seq1.avi").write_text("")
+    second = tmp_path / "b" / "seq1"
+    with pytest.raises(ValueError, match=rf"\(symbolic links: ln -s {second} NEWNAME\)$"):
+        find_sequences([tmp_path / "a" / "seq1", second])
+    video = tmp_path / "c" / "seq1.avi"
+    with pytest.raises(ValueError, match=rf"\(symbolic links: ln -s {video} NEWNAME.avi\)$"):
+        find_sequences([tmp_path / "a" / "seq1", video])
+
+
 def test_a_folder_of_sequences_with_a_stray_image_is_refused(tmp_path: Path) -> None:
     """A user trial: train/ with SEQ-A, SEQ-B and an overview.png was one sequence of one frame."""
     top = tmp_path / "train"

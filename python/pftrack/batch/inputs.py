@@ -328,12 +328,27 @@ def _check_names(names: list[str], sources: list[Path]) -> None:
                 "give each input once"
             )
         if name in seen:
+            named = _named_by(name, source)
+            link = f"{named} NEWNAME{named.suffix if named.is_file() else ''}"
             raise ValueError(
                 f"two inputs are both named {name!r} ({seen[name]} and {source}): their outputs "
                 "would collide; run them in separate batches, or give them distinct names "
-                f"(symbolic links: ln -s {source} NEWNAME{source.suffix})"
+                f"(symbolic links: ln -s {link})"
             )
         seen[name] = source
+
+
+def _named_by(name: str, source: Path) -> Path:
+    """The file or folder that gives a sequence read from `source` its `name`.
+
+    A video's own path; for a sequence folder's ``img1/`` or its one video, the sequence
+    folder (a link to its ``img1/`` alone would leave its detections, ground truth and
+    ``seqinfo.ini`` behind; a user trial).
+    """
+    for path in (source, *source.parents):
+        if (path.stem if path.is_file() else path.name) == name:
+            return path
+    return source
 
 
 def _same_file(a: Path, b: Path) -> bool:
