@@ -1010,3 +1010,25 @@ def test_a_frame_that_fails_inside_a_video_is_stood_in_for_and_the_rest_read(
     np.testing.assert_array_equal(frames[9], frames[8])
     for k in (*range(9), *range(10, 30)):
         np.testing.assert_array_equal(frames[k], good[k])
+
+
+def test_a_video_that_cannot_be_opened_says_why(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A user trial: a video its user may not read was "not a video OpenCV can read, or empty"
+    (root reads every file: the permission is simulated)."""
+    path = tmp_path / "locked.avi"
+    path.write_bytes(b"\0" * 64)
+    real_open = Path.open
+
+    def refuse(self: Path, *args: object, **kwargs: object) -> object:
+        if self == path:
+            raise PermissionError(13, "Permission denied", str(self))
+        return real_open(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(Path, "open", refuse)
+    with pytest.raises(ValueError, match=rf"^cannot read {path}: Permission denied$"):
+        FrameSource(path)
+    monkeypatch.setattr(Path, "open", real_open)
+    with pytest.raises(ValueError, match="not a video OpenCV can read, or empty"):
+        FrameSource(path)

@@ -1133,6 +1133,10 @@ class FrameSource:
         finally:
             cap.release()
         if not ok or first is None:
+            try:  # a file that cannot be opened says why (was: "not a video", of a video the
+                path.open("rb").close()  # user may not read; a user trial)
+            except OSError as exc:
+                raise ValueError(f"cannot read {path}: {exc.strerror}") from None
             raise ValueError(
                 f"cannot decode a frame from {path}: not a video OpenCV can read, or empty"
             )
