@@ -1032,3 +1032,23 @@ def test_a_video_that_cannot_be_opened_says_why(
     monkeypatch.setattr(Path, "open", real_open)
     with pytest.raises(ValueError, match="not a video OpenCV can read, or empty"):
         FrameSource(path)
+
+
+def test_a_truncated_jpeg_in_a_folder_is_said_once(tmp_path: Path) -> None:
+    """A user trial: 20.jpg cut to a third was tracked, its lower part flat grey, and only
+    libjpeg's "Premature end of JPEG file" (no file named) said anything."""
+    folder = tmp_path / "jpg"
+    folder.mkdir()
+    rng = np.random.default_rng(0)
+    for k in range(1, 5):
+        cv2.imwrite(str(folder / f"{k}.jpg"), rng.integers(0, 255, (40, 60, 3), np.uint8))
+    for k in (2, 3):  # two cut files: said once
+        data = (folder / f"{k}.jpg").read_bytes()
+        (folder / f"{k}.jpg").write_bytes(data[: len(data) // 3])
+    with pytest.warns(UserWarning, match=r"2.jpg has no JPEG end marker \(a truncated file\?\)"):
+        assert len(list(FrameSource(folder))) == 4
+    # padded after its end marker, as some cameras write them: no warning
+    data = (folder / "1.jpg").read_bytes()
+    (folder / "2.jpg").write_bytes(data + b"\0" * 32)
+    (folder / "3.jpg").write_bytes(data)
+    assert len(list(FrameSource(folder))) == 4

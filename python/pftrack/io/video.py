@@ -719,6 +719,22 @@ def _no_images(folder: Path) -> str:
     )
 
 
+def _cut_jpeg(path: Path) -> bool:
+    """Whether the JPEG file `path` lacks its end marker (``FF D9``) in its last 64 bytes.
+
+    libjpeg decodes a truncated file without an error, the rest of the image grey, and says
+    only "Premature end of JPEG file" on stderr, naming no file (a user trial). Some cameras
+    pad after the marker: the last 64 bytes are searched.
+    """
+    try:
+        with path.open("rb") as fh:
+            fh.seek(0, os.SEEK_END)
+            fh.seek(max(fh.tell() - 64, 0))
+            return b"\xff\xd9" not in fh.read()
+    except OSError:
+        return False
+
+
 def _images_in(folder: Path) -> list[Path]:
     """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order.
 
@@ -958,6 +974,7 @@ class FrameSource:
         self._depth_note: str | None = None  # the warning saying so, given at the first read
         self._depth_from = ""  # the images `bits` was decided from, for the clipping warning
         self._clipped = False  # a later 16-bit image went past `bits`: said once
+        self._cut_said = False  # a JPEG without its end marker: said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_lost = False  # frames inside the video could not be decoded
         self._cap: Any = None
@@ -1186,6 +1203,14 @@ class FrameSource:
                 img = read_image(path)
         if img is None:
             raise ValueError(f"cannot read image {path}")
+        if not self._cut_said and path.suffix.lower() in (".jpg", ".jpeg") and _cut_jpeg(path):
+            self._cut_said = True
+            warnings.warn(
+                f"image {path} has no JPEG end marker (a truncated file?): what is missing is "
+                "decoded as flat grey, and tracked as it is (said once a run)",
+                UserWarning,
+                stacklevel=3,
+            )
         if img.shape[:2] != self._image_shape:
             h0, w0 = self._image_shape
             first = self._images[0].name if self._images else "the first image"
