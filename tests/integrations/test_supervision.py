@@ -145,6 +145,18 @@ def test_the_adapters_hints_resolve_at_run_time():
     assert hints["return"] is sv.Detections
 
 
+def test_the_adapters_warnings_name_the_callers_line(scene):
+    """A user trial: clipping, negative and above-1 confidences were said at the adapter's own
+    line, as if pftrack had called itself wrongly."""
+    tracker = SupervisionTracker(frame_rate=7.0)
+    boxes = np.array([[-10.0, 30, 40, 90], [60, 20, 90, 100]])
+    detections = sv.Detections(xyxy=boxes, confidence=np.array([5.0, -1.0]))
+    with pytest.warns(UserWarning) as caught:
+        tracker.update_with_detections(detections, scene.frames[0])
+    assert len(caught) >= 3
+    assert {w.filename for w in caught} == {__file__}
+
+
 # As tests/tracking/test_api_checkpoint.py's: in a child process, where protocols 0 and 1
 # aborted the interpreter once the background model existed.
 ADAPTER_AT_EVERY_PROTOCOL = """

@@ -99,6 +99,7 @@ class SupervisionTracker:
         # supervision's boxes are always x1, y1, x2, y2: messages name them, without the hint
         # that the rows look like x, y, w, h
         self.tracker._box_source = "detections"
+        self.tracker._caller_depth = 1  # warnings name the caller's line, not this module's
 
     def update_with_detections(self, detections: sv.Detections, frame: ArrayLike) -> sv.Detections:
         """Track one frame's detections; return those that belong to a track, with its id.

@@ -405,6 +405,11 @@ class Tracker:
     >>> rows = tracker.finalize()                           # doctest: +SKIP
     """
 
+    #: Calls between the user's code and ``update``: an adapter that calls ``update`` sets 1
+    #: (:class:`~pftrack.integrations.supervision.SupervisionTracker`), so that warnings name
+    #: the user's line, not the adapter's.
+    _caller_depth = 0
+
     #: What messages about the boxes given to :meth:`update` call them; an adapter whose boxes
     #: are always ``x1, y1, x2, y2`` names its own (and gets no ``x, y, w, h`` hint).
     _box_source = "dets"
@@ -695,7 +700,10 @@ class Tracker:
         """
         if key not in self._warned:
             self._warned.add(key)
-            warnings.warn(message if isinstance(message, str) else message(), stacklevel=stacklevel)
+            warnings.warn(
+                message if isinstance(message, str) else message(),
+                stacklevel=stacklevel + self._caller_depth,
+            )
 
     def _warn_moving_camera(self) -> None:
         """Say once a run that the built-in detector runs on a moving camera.
@@ -902,6 +910,7 @@ class Tracker:
                     )
                 kept = None
                 before = self._tracker.frame_index
+                self._tracker.caller_depth = self._caller_depth
                 self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
                 try:
                     reports = self._tracker.update(work, None)
@@ -953,6 +962,7 @@ class Tracker:
                     xywh, cls, kept = _inside_working(xywh, cls, kept, work.shape)
                 # inside the frame as checked: the tracker need not check them again
                 before = self._tracker.frame_index
+                self._tracker.caller_depth = self._caller_depth
                 self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
                 try:
                     reports = self._tracker.update(work, xywh, cls, checked=True)

@@ -125,6 +125,10 @@ class MultiObjectTracker:
     ...         print(t.id, t.box_xywh)
     """
 
+    #: Calls between ``update``'s caller and the code whose line a warning names: a wrapper
+    #: that calls ``update`` sets one more (:class:`pftrack.Tracker`, each frame, its own).
+    caller_depth = 0
+
     def __init__(self, config: TrackerConfig | None = None, rng: RngLike = None,
                  detector: Any = None) -> None:  # fmt: skip
         if config is not None and not isinstance(config, TrackerConfig):
@@ -492,7 +496,7 @@ class MultiObjectTracker:
                     f"a detection confidence is {low:.3g}: confidences below min_conf "
                     f"{cfg.lifecycle.min_score:.3g} are ignored (logits? give probabilities in "
                     "[0, 1], or set min_conf)",
-                    stacklevel=3,
+                    stacklevel=3 + self.caller_depth,
                 )
         if given is not None and len(scores) and self._scores_are_confidences:
             # kept scores outside [0, 1] are a detector's own scale, not confidences: below 0
@@ -505,7 +509,7 @@ class MultiObjectTracker:
                     f"a detection score is {high:.3g} (frame {self.frame_index}): scores above "
                     "1 are taken as a detector's own scale, not confidences, so birth_score no "
                     "longer applies (min_conf still does)",
-                    stacklevel=3,
+                    stacklevel=3 + self.caller_depth,
                 )
         if cfg.sampler == "rjmcmc":
             mask = self.last_mask
