@@ -170,7 +170,7 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
 
     The rule of :func:`pftrack.io.mot.read_mot`, which every entry point that takes
     MOTChallenge rows applies too: a width or height is never negative (0 is allowed), and no
-    value lies beyond ±:data:`MAX_COORD` px. Rows are taken in order; within a row, a negative
+    value, nor a box's right or bottom edge, lies beyond ±:data:`MAX_COORD` px. Rows are taken in order; within a row, a negative
     size is named before a far value. NaN breaks neither rule (callers refuse it first).
 
     Parameters
@@ -187,13 +187,22 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
     negative = b[:, 2:] < 0
     far = np.abs(b) > MAX_COORD
-    bad = negative.any(axis=1) | far.any(axis=1)
+    # the far edges too (was: left 1e9, width 20 read, then refused inside the recovery with
+    # a kernel's message naming no file or line; a user trial)
+    edge = np.abs(b[:, :2] + b[:, 2:]) > MAX_COORD
+    bad = negative.any(axis=1) | far.any(axis=1) | edge.any(axis=1)
     if not bad.any():
         return None
     r = int(np.argmax(bad))
     if negative[r].any():
         return r, 2 + int(np.argmax(negative[r])), "negative box width or height"
-    return r, int(np.argmax(far[r])), f"a box value is beyond ±{MAX_COORD:g} px"
+    if far[r].any():
+        return r, int(np.argmax(far[r])), f"a box value is beyond ±{MAX_COORD:g} px"
+    return (
+        r,
+        2 + int(np.argmax(edge[r])),
+        f"a box's right or bottom edge is beyond ±{MAX_COORD:g} px",
+    )
 
 
 def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
