@@ -170,8 +170,9 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
 
     The rule of :func:`pftrack.io.mot.read_mot`, which every entry point that takes
     MOTChallenge rows applies too: a width or height is never negative (0 is allowed), and no
-    value, nor a box's right or bottom edge, lies beyond ±:data:`MAX_COORD` px. Rows are taken in order; within a row, a negative
-    size is named before a far value. NaN breaks neither rule (callers refuse it first).
+    value, nor a box's right or bottom edge, lies beyond ±:data:`MAX_COORD` px. Rows are taken
+    in order; within a row, a negative size is named before a far value, and that before a far
+    edge. NaN breaks neither rule (callers refuse it first).
 
     Parameters
     ----------
