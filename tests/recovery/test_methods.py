@@ -288,3 +288,27 @@ def test_a_coarse_scale_with_few_points_does_not_replace_the_fine_estimate():
     ]
     wide = estimate_noise(segments + sway, scales=(1, 8))
     assert wide.q[0] < estimate_noise(segments + sway, scales=(1,)).q[0] / 2
+
+
+def test_fill_gaps_refuses_what_its_method_does_not_use():
+    """A user trial: ``fill_gaps(rows, "linear", noise=..., seed=5)`` ignored both silently,
+    while the command refuses ``--seed`` with a named method."""
+    rows = np.array([[1, 1, 10, 10, 5, 5], [5, 1, 20, 10, 5, 5]], float)
+    with pytest.raises(ValueError, match="seed is used by method 'auto' only, not 'linear'"):
+        fill_gaps(rows, "linear", seed=5)
+    with pytest.raises(ValueError, match=r"noise is used by methods auto, gdt-bi, gdt-mix, not"):
+        fill_gaps(rows, "rts", noise=DEFAULT_NOISE)
+    assert (
+        len(fill_gaps(rows, "auto", seed=5)[0])
+        == len(fill_gaps(rows, "gdt-bi", noise=DEFAULT_NOISE)[0])
+        == 5
+    )
+
+
+def test_explain_tells_two_close_errors_apart():
+    """A user trial: "did worse than linear (0.019)" after "validation MMAE 0.019"."""
+    from pftrack.recovery.calibrate import _apart
+
+    assert _apart(0.0191234, 0.0193) == ("0.0191", "0.0193")
+    assert _apart(1.5, 2.25) == ("1.500", "2.250")
+    assert _apart(1.0, 1.0) == ("1.000000000", "1.000000000")

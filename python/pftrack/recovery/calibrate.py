@@ -236,10 +236,11 @@ class Calibration:
         for c in self.buckets:
             span = c.span
             if c.replaced is not None:
+                chosen, line = _apart(c.replaced[1], dict(c.mmae)["linear"])
                 lines.append(
                     f"gap length {span}: linear, because the rule's choice {c.replaced[0]} "
-                    f"(validation MMAE {c.replaced[1]:.3f}) did worse than linear "
-                    f"({dict(c.mmae)['linear']:.3f}) on this length's validation gaps"
+                    f"(validation MMAE {chosen}) did worse than linear ({line}) on this "
+                    "length's validation gaps"
                 )
             if not c.mmae and not c.weights:  # was: a row naming a method, no reason
                 lines.append(f"gap length {span}: {c.method}, the file's choice{_unscored(c)}")
@@ -264,6 +265,19 @@ def _unscored(c: BucketChoice) -> str:
         return " (no validation gap of this length)"
     gaps = "1 validation gap" if c.n_validation == 1 else f"{c.n_validation} validation gaps"
     return f" (only {gaps} of this length, fewer than the {MIN_VALIDATION_GAPS} a bucket needs)"
+
+
+def _apart(a: float, b: float) -> tuple[str, str]:
+    """`a` and `b` with 3 decimals, or as many more (up to 9) as it takes to tell them apart.
+
+    (Was "did worse than linear ... (validation MMAE 0.019) ... (0.019)": two numbers that
+    differ, said alike; a user trial.)
+    """
+    for digits in range(3, 10):
+        x, y = f"{a:.{digits}f}", f"{b:.{digits}f}"
+        if x != y:
+            break
+    return x, y
 
 
 def _weight(w: float) -> str:

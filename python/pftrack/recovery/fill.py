@@ -163,6 +163,10 @@ def unfilled_note(count: int, longest: int, max_gap: int) -> str:
     return f"{holes} longer than --max-gap {max_gap} left unfilled ({longest_}{longest} frames)"
 
 
+#: The methods whose recovery uses :func:`fill_gaps`' `noise`.
+NOISE_METHODS = ("auto", "gdt-bi", "gdt-mix")
+
+
 def fill_gaps(
     tracks: ArrayLike,
     method: RecoveryMethod = DEFAULT_METHOD,
@@ -224,13 +228,24 @@ def fill_gaps(
         Rows that are not real numbers, `combine` not a bool, `seed` or `max_gap` not an int,
         `noise` not a NoiseEstimate.
     ValueError
-        Unknown method, a negative `seed`, `bags` not None or an integer in ``0..10000`` (or
+        Unknown method, a negative `seed`, a `seed` other than 0 with a method other than
+        ``"auto"`` or `noise` with a method that does not use it (neither would change
+        anything), `bags` not None or an integer in ``0..10000`` (or
         more than 0 with ``combine=False``), `max_gap` outside ``1..MAX_GAP_LIMIT``,
         rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
         or height, a value beyond ±1e9 px) or a duplicate (frame, id).
     """
     rows = _check.mot_rows(tracks, "fill_gaps")  # (M, 6..10), [] too, as smooth_tracks
+    # what the method does not use is refused, as the command refuses --seed (was ignored
+    # without a word; a user trial)
+    if noise is not None and method in METHODS and method not in NOISE_METHODS:
+        raise ValueError(
+            f"fill_gaps: noise is used by methods {', '.join(NOISE_METHODS)}, not {method!r}"
+        )
+    if not isinstance(seed, bool) and isinstance(seed, (int, np.integer)) and seed != 0:
+        if method in METHODS and method != "auto":
+            raise ValueError(f"fill_gaps: seed is used by method 'auto' only, not {method!r}")
     new_rows, report = fill_rows(
         rows, method, max_gap, noise, seed=seed, combine=combine, bags=bags
     )
