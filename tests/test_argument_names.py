@@ -187,6 +187,6 @@ def test_generators_and_seeds_are_taken_as_before() -> None:
         systematic_resample(w, rng=np.random.default_rng(4)), systematic_resample(w, rng=gen)
     )
     np.testing.assert_array_equal(systematic_resample(w, rng=4), systematic_resample(w, rng=4))
-    a, _ = fill_gaps(ROWS, "linear", seed=np.int64(3))
-    b, _ = fill_gaps(ROWS, "linear", seed=3)
+    a, _ = fill_gaps(ROWS, "auto", seed=np.int64(3))
+    b, _ = fill_gaps(ROWS, "auto", seed=3)
     np.testing.assert_array_equal(a, b)

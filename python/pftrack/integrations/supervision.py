@@ -16,7 +16,7 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from pftrack._typing import F64, CameraMotion, DetectorName, DynamicsName, FillMode, SamplerName
 from pftrack.tracking.api import Tracker
@@ -101,14 +101,16 @@ class SupervisionTracker:
         self.tracker._box_source = "detections"
         self.tracker._caller_depth = 1  # warnings name the caller's line, not this module's
 
-    def update_with_detections(self, detections: sv.Detections, frame: ArrayLike) -> sv.Detections:
+    def update_with_detections(
+        self, detections: sv.Detections, frame: NDArray[np.uint8]
+    ) -> sv.Detections:
         """Track one frame's detections; return those that belong to a track, with its id.
 
         Parameters
         ----------
         detections : supervision.Detections
             This frame's detections (``xyxy``; ``confidence`` and ``class_id`` when present).
-        frame : (H, W, 3) array_like of uint8
+        frame : (H, W, 3) ndarray of uint8
             The BGR frame: pftrack follows each object's colour, so unlike supervision's
             ByteTrack it needs the image.
 

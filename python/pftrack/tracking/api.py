@@ -813,7 +813,7 @@ class Tracker:
             if picked:
                 self._tracker.prime(picked)
 
-    def update(self, dets: ArrayLike | None, frame: ArrayLike) -> F64:
+    def update(self, dets: ArrayLike | None, frame: NDArray[np.uint8]) -> F64:
         """Track one frame.
 
         Parameters
