@@ -165,7 +165,7 @@ def mot_rows(rows: ArrayLike, what: str) -> F64:
 BOX_VALUES = ("left", "top", "width", "height")
 
 
-def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
+def first_bad_box(boxes: ArrayLike, *, edges: bool = True) -> tuple[int, int, str] | None:
     """The first value of `boxes` that a MOTChallenge file may not hold, or None.
 
     The rule of :func:`pftrack.io.mot.read_mot`, which every entry point that takes
@@ -178,6 +178,8 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
     ----------
     boxes : (M, 4) array_like of float
         ``left, top, width, height`` per row.
+    edges : bool
+        Whether the far edges are checked too (False for boxes given by their centres).
 
     Returns
     -------
@@ -190,7 +192,7 @@ def first_bad_box(boxes: ArrayLike) -> tuple[int, int, str] | None:
     far = np.abs(b) > MAX_COORD
     # the far edges too (was: left 1e9, width 20 read, then refused inside the recovery with
     # a kernel's message naming no file or line; a user trial)
-    edge = np.abs(b[:, :2] + b[:, 2:]) > MAX_COORD
+    edge = np.abs(b[:, :2] + b[:, 2:]) > MAX_COORD if edges else np.zeros((len(b), 2), bool)
     bad = negative.any(axis=1) | far.any(axis=1) | edge.any(axis=1)
     if not bad.any():
         return None

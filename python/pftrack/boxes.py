@@ -48,7 +48,7 @@ def _box_rows(boxes: ArrayLike, fn: str, what: str) -> F64:
     return b
 
 
-def _check_values(b: F64, fn: str, what: str) -> None:
+def _check_values(b: F64, fn: str, what: str, edges: bool = True) -> None:
     """Refuse a non-finite value, a negative width or height, or a value beyond ±MAX_COORD px.
 
     `b` holds boxes on its last axis (4 values), any leading shape; the message names the first
@@ -57,7 +57,7 @@ def _check_values(b: F64, fn: str, what: str) -> None:
     rows = b.reshape(-1, 4)
     finite = np.isfinite(rows).all(axis=1)
     if finite.all():
-        found = first_bad_box(rows)
+        found = first_bad_box(rows, edges=edges)
         if found is None:
             return
         r, _, problem = found
@@ -68,12 +68,16 @@ def _check_values(b: F64, fn: str, what: str) -> None:
     raise ValueError(f"{fn}: {what}{where} is {rows[r].tolist()}: {problem}")
 
 
-def _layout(boxes: ArrayLike, fn: str) -> F64:
-    """`boxes` for a layout conversion: any leading shape, 4 values on the last axis, checked."""
+def _layout(boxes: ArrayLike, fn: str, edges: bool = True) -> F64:
+    """`boxes` for a layout conversion: any leading shape, 4 values on the last axis, checked.
+
+    `edges`: whether their far edges are checked (False for centre-format boxes, whose far
+    edge is not ``x + w``).
+    """
     b = real_array(boxes, f"{fn}: boxes", booleans=False)
     if b.ndim == 0 or b.shape[-1] != 4:
         raise ValueError(f"{fn}: boxes must have 4 values on the last axis, got shape {b.shape}")
-    _check_values(b, fn, "boxes")
+    _check_values(b, fn, "boxes", edges)
     return b
 
 
@@ -233,7 +237,7 @@ def cxcywh_to_xywh(boxes: ArrayLike) -> F64:
         Not 4 values on the last axis, a value not finite or beyond ±1e9 px, a negative width
         or height.
     """
-    return _to_xywh(_layout(boxes, "cxcywh_to_xywh"))
+    return _to_xywh(_layout(boxes, "cxcywh_to_xywh", edges=False))
 
 
 def _to_xywh(boxes: ArrayLike) -> F64:

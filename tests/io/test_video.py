@@ -1047,8 +1047,14 @@ def test_a_truncated_jpeg_in_a_folder_is_said_once(tmp_path: Path) -> None:
         (folder / f"{k}.jpg").write_bytes(data[: len(data) // 3])
     with pytest.warns(UserWarning, match=r"2.jpg has no JPEG end marker \(a truncated file\?\)"):
         assert len(list(FrameSource(folder))) == 4
-    # padded after its end marker, as some cameras write them: no warning
+    # padded after its end marker, as some cameras write them, or with a long trailer (a
+    # phone's, a motion photo's video; the review of this change): no warning
     data = (folder / "1.jpg").read_bytes()
     (folder / "2.jpg").write_bytes(data + b"\0" * 32)
-    (folder / "3.jpg").write_bytes(data)
+    (folder / "3.jpg").write_bytes(data + bytes(range(256)) * 40)
     assert len(list(FrameSource(folder))) == 4
+    ok, progressive = cv2.imencode(".jpg", np.full((40, 60, 3), 90, np.uint8),
+                                   [cv2.IMWRITE_JPEG_PROGRESSIVE, 1])  # fmt: skip
+    (folder / "3.jpg").write_bytes(progressive.tobytes()[:-2])  # several scans, no end
+    with pytest.warns(UserWarning, match=r"3.jpg has no JPEG end marker"):
+        assert len(list(FrameSource(folder))) == 4

@@ -178,6 +178,20 @@ def test_step_filters_refuses_a_bad_filter_before_any_steps(textured_frame, rng)
     np.testing.assert_array_equal(good.particles, twin.particles)
 
 
+def test_a_shallow_copy_of_a_filter_is_refused(textured_frame):
+    """A user trial: copy.copy shared the particle arrays under a lock of its own, so two
+    threads stepped one particle set at once, and step_filters([f, copy.copy(f)]) stepped it
+    twice."""
+    image = hsv_bins(textured_frame)
+    box = np.array([20.0, 15.0, 30.0, 40.0])
+    f = ColourParticleFilter(box, box_histograms(image, [box])[0], rng=1)
+    with pytest.raises(TypeError, match=r"copy.copy\(ColourParticleFilter\) would share the"):
+        copy.copy(f)
+    twin = copy.deepcopy(f)
+    assert twin.particles is not f.particles
+    np.testing.assert_array_equal(twin.step(image).box_cxcywh, f.step(image).box_cxcywh)
+
+
 def _scene(shift: int = 0) -> np.ndarray:
     rng = np.random.default_rng(0)
     frame = rng.integers(60, 120, (120, 160, 3), dtype=np.uint8)

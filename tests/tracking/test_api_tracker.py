@@ -868,7 +868,6 @@ def test_a_refusal_from_inside_the_tracker_leaves_the_run_whole(scene):
     primed ones; with rjmcmc, a second class) were refused, and then every later ``update``
     said the run had been interrupted."""
     dets = scene_dets(scene)
-    _, plain = run_loop(pftrack.Tracker(frame_rate=10.0), scene.frames, dets)
     tracker = pftrack.Tracker(frame_rate=10.0)
     small = np.ascontiguousarray(scene.frames[0][: scene.frames[0].shape[0] // 2])
     tracker.prime([small])
@@ -891,9 +890,12 @@ def test_a_sliver_at_the_frames_edge_is_dropped_at_any_working_size():
     matched to the rows: "classes has 2 entries, expected 1", and the run was dead."""
     frame = np.full((480, 640, 3), 90, np.uint8)
     good = [200.0, 150.0, 260.0, 300.0, 0.95]
-    for edge in ([100.0, np.nextafter(480.0, 0), 300.0, 480.0, 0.95],
-                 [0.0, 100.0, 5e-324, 200.0, 0.95]):  # fmt: skip
-        tracker = pftrack.Tracker(frame_rate=25.0, max_side=333)
+    # its top on the working frame's bottom edge (scale 333/640); its width 0 once scaled
+    # (5e-324 times 256/640 rounds to 0)
+    for edge, side in (([100.0, np.nextafter(480.0, 0), 300.0, 480.0, 0.95], 333),
+                       ([0.0, 100.0, 5e-324, 200.0, 0.95], 256)):  # fmt: skip
+        assert 5e-324 * (256 / 640) == 0.0
+        tracker = pftrack.Tracker(frame_rate=25.0, max_side=side)
         for _ in range(6):
             out = tracker.update(np.array([edge, good]), frame)
         assert len(out) == 1 and out[0, 7] == 1  # the good box, by its row

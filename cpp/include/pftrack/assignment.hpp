@@ -158,7 +158,7 @@ inline std::pair<IndexVector, IndexVector> sparse_assignment(const Eigen::Ref<co
                 std::to_string(c.size()) + ", " + std::to_string(cost.size()));
     require(n_ends >= 0 && n_starts >= 0 && n_ends <= (std::int64_t{1} << 40) &&
                 n_starts <= (std::int64_t{1} << 40),
-            fn, "n_ends and n_starts must be >= 0");
+            fn, "n_ends and n_starts must be in 0..2^40");
     require(std::isfinite(unjoined), fn, "unjoined", unjoined, "finite");
     for (Eigen::Index k = 0; k < n; ++k) {
         require(r[k] >= 0 && r[k] < n_ends, fn,

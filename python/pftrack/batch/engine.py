@@ -437,22 +437,34 @@ def _refused(address: str) -> str | None:
             return None
 
 
-#: Seconds a tcp:// scheduler has to greet a new connection: a Dask server speaks first (its
+#: Seconds a tcp:// scheduler has to greet a new connection; None: Dask's connect timeout
+#: (``distributed.comm.timeouts.connect``, 30 s by default). A Dask server speaks first (its
 #: handshake, in milliseconds); a service that accepted the connection and says nothing (the
 #: dashboard's port, an HTTP server) held ``Client(address)`` for ever (a user trial: Dask's
 #: connect timeout does not cover the handshake).
-GREETING_WAIT = 10.0
+GREETING_WAIT: float | None = None
+
+
+def _greeting_wait() -> float:
+    if GREETING_WAIT is not None:
+        return GREETING_WAIT
+    import dask
+    from dask.utils import parse_timedelta
+
+    wait = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s")
+    return float(wait) if wait else 30.0
 
 
 def _silent(sock: socket.socket, host: str, port: int) -> str | None:
     """Why the server at the other end of `sock` is no Dask scheduler: it says nothing."""
-    sock.settimeout(GREETING_WAIT)
+    wait = _greeting_wait()
+    sock.settimeout(wait)
     try:
         if sock.recv(1):
             return None
         said = "closed the connection without a word"
     except TimeoutError:
-        said = f"said nothing within {GREETING_WAIT:g} s"
+        said = f"said nothing within {wait:g} s"
     except OSError:
         return None  # reset, or the like: Dask's own connection says what it finds
     return (

@@ -130,11 +130,25 @@ def _sequences_beside(folder: Path) -> list[Path]:
             continue
         if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES and not _batch_output(p):
             out.append(p)
-        elif p.is_dir() and (
-            (p / "seqinfo.ini").is_file() or (p / "img1").is_dir() or _images(p) or _videos(p)
-        ):
+        elif p.is_dir() and _sequence_like(p):
             out.append(p)
     return out
+
+
+def _sequence_like(folder: Path) -> bool:
+    """Whether `folder` looks like a sequence; False for one that cannot be listed.
+
+    (``lost+found`` at the top of a disk: its refusal must not refuse the folder around it.)
+    """
+    try:
+        return (
+            (folder / "seqinfo.ini").is_file()
+            or (folder / "img1").is_dir()
+            or bool(_images(folder))
+            or bool(_videos(folder))
+        )
+    except OSError:
+        return False
 
 
 def _image_folder(path: Path) -> SequenceInput | None:

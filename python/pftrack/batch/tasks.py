@@ -457,7 +457,8 @@ class RecoverOptions:
     ------
     TypeError, ValueError
         A field of the wrong type or out of its range (an unknown ``method``, ``max_gap``
-        outside 1..100000, ``seed`` < 0, ``max_distance`` not > 0), before any task runs.
+        outside 1..100000, ``seed`` < 0, a ``seed`` other than 0 with a ``method`` other than
+        "auto", ``max_distance`` not > 0), before any task runs.
     """
 
     method: RecoveryMethod = "auto"
@@ -474,6 +475,8 @@ class RecoverOptions:
         _check_choice(self.method, "method", METHODS)
         _check_int(self.max_gap, "max_gap", 1, MAX_GAP_LIMIT)
         _check_int(self.seed, "seed", 0)
+        if self.seed != 0 and self.method != "auto":  # fill_gaps' rule, before any task runs
+            raise ValueError(f"seed is used by method 'auto' only, not {self.method!r}")
         flag(self.link, "link")
         _check_distance(self.max_distance)
 

@@ -55,7 +55,7 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
         help="a running Dask scheduler, tcp://HOST:PORT, checked first (protocol, host, port "
         "1-65535; not with --workers), connected to before --out is written; waits up to "
         "Dask's connect timeout to reach it (30 s; $DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT), "
-        "a tcp:// port that says nothing 10 s (no Dask scheduler), "
+        "as long for a tcp:// port that says nothing (no Dask scheduler), "
         "and while it has no worker, at the start or after losing them all, says so at once "
         f"and waits up to {NO_WORKERS_WAIT} s for one "
         "($DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT), "

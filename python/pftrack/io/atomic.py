@@ -59,6 +59,15 @@ class _Target:
     fd: int | None = None
 
 
+def _is_stream(target: _Target) -> bool:
+    """Whether `target` is a pipe, FIFO or socket (a reader at its other end), not a device."""
+    try:
+        mode = os.fstat(target.fd).st_mode if target.fd is not None else target.path.stat().st_mode
+    except OSError:
+        return True  # unknown: as before, last
+    return stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)
+
+
 def _names_folder(text: str) -> bool:
     """Whether `text` can only name a folder: a trailing slash, or ``.`` or ``..`` last."""
     return text.endswith(("/", os.sep)) or os.path.basename(text) in ("", ".", "..")
@@ -833,8 +842,9 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
     when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
     target is left as it was, so an interrupted run never leaves a new tracks file beside an old
     video, or a half-written file anywhere. A symbolic link replaces the file it leads to; a
-    device, FIFO or descriptor gets its file's bytes written into it before the renames (one
-    that fails leaves every target as it was).
+    device, FIFO or descriptor gets its file's bytes written into it: a device before the
+    renames (one that fails, ``/dev/full``, leaves every target as it was), a pipe, FIFO or
+    socket after them (its reader may wait for the files, or stop early).
 
     Examples
     --------
@@ -872,16 +882,22 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
 
     try:
         yield stage
-        # devices, FIFOs and descriptors first: one that fails (/dev/full, a closed pipe)
-        # leaves every file target as it was (were written last: --out was replaced by a run
-        # that then failed; a user trial). A FIFO waits for its reader before the renames.
-        for tmp_path, resolved in through:
+        # devices first (/dev/full: one that fails leaves every file target as it was; were
+        # written last, and --out was replaced by a run that then failed: a user trial); pipes,
+        # FIFOs and sockets last, after the renames, as ever: their reader may wait for the
+        # files (a script that reads the tracks, then the FIFO), or stop early (| head), which
+        # must not lose the files
+        streams = [(t, r) for t, r in through if _is_stream(r)]
+        for tmp_path, resolved in (item for item in through if not _is_stream(item[1])):
             with _named(resolved.path):  # /dev/full: "No space left on device" named no file
                 _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
         for tmp, target in staged:
             _keep_mode(tmp, target)  # again: a writer may have made the file anew
         for tmp, target in staged:
             os.replace(tmp, target)
+        for tmp_path, resolved in streams:
+            with _named(resolved.path):
+                _copy_through(tmp_path, resolved, empty_ok=True)
     except BaseException as exc:
         _remove(made)
         for tmp in made:

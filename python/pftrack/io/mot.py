@@ -219,7 +219,7 @@ def _parse_line(text: str, what: str) -> list[float] | str:
             f"{what} line has {len(fields)} fields, expected at least 6 "
             f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
         )
-    if not all(_NUMBER.fullmatch(f) for f in fields[:10]):
+    if not all(_NUMBER.fullmatch(f.strip()) for f in fields[:10]):  # any space, as loadtxt
         return f"{what} line has a non-number: {text[:80]!r}"
     values = [float(f) for f in fields[:10]]
     bad = [c for c, v in enumerate(values) if not np.isfinite(v)]

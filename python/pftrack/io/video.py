@@ -720,19 +720,65 @@ def _no_images(folder: Path) -> str:
 
 
 def _cut_jpeg(path: Path) -> bool:
-    """Whether the JPEG file `path` lacks its end marker (``FF D9``) in its last 64 bytes.
+    """Whether the JPEG file `path` ends before its end marker (``FF D9``): a truncated file.
 
     libjpeg decodes a truncated file without an error, the rest of the image grey, and says
-    only "Premature end of JPEG file" on stderr, naming no file (a user trial). Some cameras
-    pad after the marker: the last 64 bytes are searched.
+    only "Premature end of JPEG file" on stderr, naming no file (a user trial). The marker is
+    looked for in the last 64 bytes; a file with more after it (a phone's trailer, a motion
+    photo's video) is walked segment by segment (:func:`_jpeg_ends`) before it is said to be
+    cut.
     """
     try:
         with path.open("rb") as fh:
             fh.seek(0, os.SEEK_END)
             fh.seek(max(fh.tell() - 64, 0))
-            return b"\xff\xd9" not in fh.read()
+            if b"\xff\xd9" in fh.read():
+                return False
+            fh.seek(0)
+            data = fh.read()
     except OSError:
         return False
+    return _jpeg_ends(data) is False
+
+
+def _jpeg_ends(data: bytes) -> bool | None:
+    """Whether the JPEG stream in `data` reaches its end marker; None if it cannot be told.
+
+    The segments are walked from the start (each marker's length), and each scan's
+    entropy-coded data to the next marker that is neither a stuffed ``FF 00`` nor a restart.
+    """
+    if data[:2] != b"\xff\xd8":
+        return None
+    i, n = 2, len(data)
+    while i + 1 < n:
+        if data[i] != 0xFF:
+            return None  # not a marker where one should be: damaged, not (only) cut
+        marker = data[i + 1]
+        if marker == 0xD9:
+            return True
+        if marker == 0xFF:  # fill byte
+            i += 1
+            continue
+        if 0xD0 <= marker <= 0xD7 or marker == 0x01:  # restarts, TEM: no length
+            i += 2
+            continue
+        if i + 4 > n:
+            return False
+        i += 2 + int.from_bytes(data[i + 2 : i + 4], "big")
+        if marker == 0xDA:  # a scan: entropy-coded data up to the next real marker
+            while True:
+                j = data.find(b"\xff", i)
+                if j < 0 or j + 1 >= n:
+                    return False
+                following = data[j + 1]
+                if following == 0x00 or 0xD0 <= following <= 0xD7:
+                    i = j + 2
+                elif following == 0xFF:
+                    i = j + 1
+                else:
+                    i = j
+                    break
+    return False
 
 
 def _images_in(folder: Path) -> list[Path]:
@@ -1209,7 +1255,7 @@ class FrameSource:
                 f"image {path} has no JPEG end marker (a truncated file?): what is missing is "
                 "decoded as flat grey, and tracked as it is (said once a run)",
                 UserWarning,
-                stacklevel=3,
+                stacklevel=4,  # the loop over the frames (through two generators)
             )
         if img.shape[:2] != self._image_shape:
             h0, w0 = self._image_shape

@@ -54,7 +54,8 @@ class FilterConfig:
         k for all particles of a step) that keeps at least this many of its pixels, so that a
         step costs about the same at 1920x1080 as at 480x360: k = floor(sqrt(area /
         min_samples)) for the box of the previous mean state, k > 1 from 4 ``min_samples``
-        pixels on. The default 2048 keeps more pixels per box than a walker of PETS09-S2L1
+        pixels on, at most 64 and at most half the box's shorter side (a thin box keeps
+        pixels across it). The default 2048 keeps more pixels per box than a walker of PETS09-S2L1
         (about 30x80 at 480x360) has in full, so those boxes are counted in full. 0 counts
         every pixel of every box.
 
@@ -361,6 +362,17 @@ class ColourParticleFilter:
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self._busy = threading.Lock()
+
+    def __copy__(self) -> ColourParticleFilter:
+        """Refused: a shallow copy would share the particle arrays with the original.
+
+        (Was: taken, each with a lock of its own, so two threads stepped one set of particles
+        at once, and ``step_filters([f, copy.copy(f)])`` stepped it twice; a user trial.)
+        """
+        raise TypeError(
+            f"copy.copy({type(self).__name__}) would share the particles, weights and means with "
+            "the original; use copy.deepcopy(filter) for an independent copy"
+        )
 
     @property
     def last(self) -> FilterState | None:

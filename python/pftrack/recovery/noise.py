@@ -35,11 +35,12 @@ class NoiseEstimate:
 #: Used when the segments are too short to estimate anything.
 DEFAULT_NOISE = NoiseEstimate(q=(0.1, 0.1), r=(1.0, 1.0))
 
-#: Second differences a coarser scale needs before it may replace a finer scale's estimate.
-#: ``q`` from n of them has a relative standard error of about ``sqrt(2 / n)``: "less than
-#: half" is two standard errors apart from 32 on. (Was: any 4, so 5 points at scale 8 replaced
-#: 316 at scale 1 on a file with many short holes: q at its floor, r 64 px², and GDT recovery
-#: 12 times linear's error; a user trial.)
+#: Terms of the likelihood a coarser scale needs before it may replace a finer scale's
+#: estimate (a run of k points sampled at that scale adds k - 3: its prediction errors after
+#: the first three). ``q`` from n of them has a relative standard error of about
+#: ``sqrt(2 / n)``: "less than half" is two standard errors apart from 32 on. (Was: any 4,
+#: so 5 points at scale 8 replaced 316 at scale 1 on a file with many short holes: q at its
+#: floor, r 64 px², and GDT recovery 12 times linear's error; a user trial.)
 MIN_SCALE_TERMS = 32
 
 
@@ -121,9 +122,9 @@ def estimate_noise(
         ``"ml"`` only: the model is fitted to the runs sampled every ``s`` frames for each
         ``s``; per axis, going from fine to coarse, a scale replaces the current estimate when
         its ``q`` (in per-frame units, ``q_s / s^3``) is less than half the current one, and
-        its ``r`` comes with it, if it has at least :data:`MIN_SCALE_TERMS` second
-        differences. White acceleration gives the same ``q`` at every scale (within
-        sampling error, hence the factor 2); jitter correlated over a few frames (gait sway,
+        its ``r`` comes with it, if it has at least :data:`MIN_SCALE_TERMS` terms. White
+        acceleration gives the same ``q`` at every scale (within sampling error, hence the
+        factor 2); jitter correlated over a few frames (gait sway,
         box annotation noise) inflates ``q`` at the finest scales and would make long
         predictions too wiggly.
 
