@@ -149,6 +149,25 @@ def _assignment() -> st.SearchStrategy[Any]:
     )
 
 
+@st.composite
+def _sparse_assignment(draw: st.DrawFn) -> Any:
+    """Pairs of ends and starts, some out of range; costs, some special; the counts."""
+    n_ends, n_starts, k = draw(N), draw(N), draw(st.integers(0, 20))
+    r = np.array(draw(st.lists(st.integers(-1, n_ends), min_size=k, max_size=k)), np.int64)
+    c = np.array(draw(st.lists(st.integers(-1, n_starts), min_size=k, max_size=k)), np.int64)
+    return draw(
+        call(
+            _core.sparse_assignment,
+            maybe(st.just(r)),
+            maybe(st.just(c)),
+            maybe(floats_array((k,), -10, 10)),
+            maybe(st.just(n_ends)),
+            maybe(st.just(n_starts)),
+            maybe(fl(-1e6, 1e6)),
+        )
+    )
+
+
 def _mh() -> st.SearchStrategy[Any]:
     def kw(n: int) -> dict[str, st.SearchStrategy[Any]]:
         k = _step_kwargs(n)
@@ -495,6 +514,7 @@ TARGETS: list[Target] = [
     Target("mh_step", _mh()),
     Target("sis_step_batch", _sis_batch()),
     Target("linear_sum_assignment", _assignment()),
+    Target("sparse_assignment", _sparse_assignment()),
     Target(
         "refine_boxes",
         call(

@@ -156,9 +156,11 @@ inline std::pair<IndexVector, IndexVector> sparse_assignment(const Eigen::Ref<co
     require(c.size() == n && cost.size() == n, fn,
             "r, c and cost must have one length, got " + std::to_string(n) + ", " +
                 std::to_string(c.size()) + ", " + std::to_string(cost.size()));
-    require(n_ends >= 0 && n_starts >= 0 && n_ends <= (std::int64_t{1} << 40) &&
-                n_starts <= (std::int64_t{1} << 40),
-            fn, "n_ends and n_starts must be in 0..2^40");
+    // 2^24 each: a component of 16 million fragments is past any tracks file (a cap, so that
+    // a wrong count is refused, not a MemoryError of gigabytes)
+    constexpr std::int64_t most = std::int64_t{1} << 24;
+    require(n_ends >= 0 && n_starts >= 0 && n_ends <= most && n_starts <= most, fn,
+            "n_ends and n_starts must be in 0..2^24");
     require(std::isfinite(unjoined), fn, "unjoined", unjoined, "finite");
     for (Eigen::Index k = 0; k < n; ++k) {
         require(r[k] >= 0 && r[k] < n_ends, fn,
