@@ -192,7 +192,8 @@ def first_bad_box(boxes: ArrayLike, *, edges: bool = True) -> tuple[int, int, st
     far = np.abs(b) > MAX_COORD
     # the far edges too (was: left 1e9, width 20 read, then refused inside the recovery with
     # a kernel's message naming no file or line; a user trial)
-    edge = np.abs(b[:, :2] + b[:, 2:]) > MAX_COORD if edges else np.zeros((len(b), 2), bool)
+    with np.errstate(over="ignore"):  # 1e308 + 1e308: far already, named as such
+        edge = np.abs(b[:, :2] + b[:, 2:]) > MAX_COORD if edges else np.zeros((len(b), 2), bool)
     bad = negative.any(axis=1) | far.any(axis=1) | edge.any(axis=1)
     if not bad.any():
         return None

@@ -77,6 +77,7 @@ def test_fast_read_equals_line_by_line(tmp_path: Path) -> None:
         # inf"
         ("1,2,3,4,5,6\n1_0,2,3,4,5,6\n", r":2: MOT file line has a non-number: '1_0,"),
         ("1,2,1e9,4,20,6\n", r":1: a box's right or bottom edge is beyond ±1e\+09 px"),
+        ("1,2,1e308,4,1e308,6\n", r":1: a box value is beyond ±1e\+09 px"),  # no overflow
         ("1,2,3,4,5,6\n\uff11,2,3,4,5,6\n", ":2: MOT file line has a non-number"),
         (
             "1,2,3,4,5,6\n2,2,3,4,5,6,1" + "0" * 400 + "\n",
