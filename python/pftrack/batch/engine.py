@@ -1473,14 +1473,9 @@ def run_jobs(
                 written += 1
             except OSError as exc:  # a full disk: this task fails, the batch goes on (was:
                 # stopped with exit status 2, "nothing ran", the task "cancelled"; a user trial)
-                entries[job.name] = {
-                    "name": job.name,
-                    "status": "failed",
-                    "source": str(job.reads[0]) if job.reads else None,
-                    "error": f"writing its outputs: {one_line(exc)}",
-                    "traceback": traceback.format_exc(),
-                }
-        else:
+                error = f"writing its outputs: {one_line(exc)}"
+                outcome = Outcome(None, error, traceback.format_exc())
+        if outcome.result is None:
             entries[job.name] = {
                 "name": job.name,
                 "status": "failed",

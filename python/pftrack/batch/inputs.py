@@ -16,8 +16,8 @@ from pathlib import Path
 from pftrack._typing import PathLike
 from pftrack.io.atomic import refuse_dash
 from pftrack.io.video import (
-    IMAGE_SUFFIXES,
     VIDEO_SUFFIXES,
+    image_files,
     natural_key,
     read_seqinfo,
     video_files,
@@ -117,11 +117,6 @@ def _videos(folder: Path) -> list[Path]:
     return [p for p in video_files(folder) if not _batch_output(p)]
 
 
-def _images(folder: Path) -> list[Path]:
-    """A folder's images, hidden files left out (as :class:`~pftrack.io.video.FrameSource`)."""
-    return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."]
-
-
 def _sequences_beside(folder: Path) -> list[Path]:
     """The videos and sequence-like folders in `folder` (sequences of their own)."""
     out = []
@@ -144,7 +139,7 @@ def _sequence_like(folder: Path) -> bool:
         return (
             (folder / "seqinfo.ini").is_file()
             or (folder / "img1").is_dir()
-            or bool(_images(folder))
+            or bool(image_files(folder))
             or bool(_videos(folder))
         )
     except OSError:
@@ -158,7 +153,7 @@ def _image_folder(path: Path) -> SequenceInput | None:
     folder of videos made the whole folder one sequence of one frame, the videos passed over
     with exit status 0 (a user trial). Which was meant is not known.
     """
-    images = _images(path)
+    images = image_files(path)
     if not images:
         return None
     others = _sequences_beside(path)

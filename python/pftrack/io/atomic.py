@@ -68,6 +68,13 @@ def _is_stream(target: _Target) -> bool:
     return stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)
 
 
+def _write_through(items: list[tuple[Path, _Target]]) -> None:
+    """Copy each staged file into its device, FIFO or descriptor."""
+    for tmp_path, resolved in items:
+        with _named(resolved.path):  # /dev/full: "No space left on device" named no file
+            _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
+
+
 def _names_folder(text: str) -> bool:
     """Whether `text` can only name a folder: a trailing slash, or ``.`` or ``..`` last."""
     return text.endswith(("/", os.sep)) or os.path.basename(text) in ("", ".", "..")
@@ -887,17 +894,13 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
         # FIFOs and sockets last, after the renames, as ever: their reader may wait for the
         # files (a script that reads the tracks, then the FIFO), or stop early (| head), which
         # must not lose the files
-        streams = [(t, r) for t, r in through if _is_stream(r)]
-        for tmp_path, resolved in (item for item in through if not _is_stream(item[1])):
-            with _named(resolved.path):  # /dev/full: "No space left on device" named no file
-                _copy_through(tmp_path, resolved, empty_ok=True)  # as a regular file: may be empty
+        streams = [_is_stream(resolved) for _, resolved in through]
+        _write_through([item for item, late in zip(through, streams, strict=True) if not late])
         for tmp, target in staged:
             _keep_mode(tmp, target)  # again: a writer may have made the file anew
         for tmp, target in staged:
             os.replace(tmp, target)
-        for tmp_path, resolved in streams:
-            with _named(resolved.path):
-                _copy_through(tmp_path, resolved, empty_ok=True)
+        _write_through([item for item, late in zip(through, streams, strict=True) if late])
     except BaseException as exc:
         _remove(made)
         for tmp in made:

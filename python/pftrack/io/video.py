@@ -54,6 +54,7 @@ __all__ = [
     "SequenceInfo",
     "check_source",
     "find_sequence",
+    "image_files",
     "info_scale",
     "is_live_source",
     "natural_key",
@@ -781,7 +782,7 @@ def _jpeg_ends(data: bytes) -> bool | None:
     return False
 
 
-def _images_in(folder: Path) -> list[Path]:
+def image_files(folder: Path) -> list[Path]:
     """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order.
 
     Hidden files (names starting with a point) are left out, as ``ls`` leaves them: macOS's
@@ -855,7 +856,7 @@ def source_files(source: PathLike | int) -> list[Path]:
             folders = [_image_folder(path, sequence)]
         except ValueError:  # its image folder is missing: refused when read
             folders = []
-    return files + [p for f in folders if f.is_dir() for p in _images_in(f)]
+    return files + [p for f in folders if f.is_dir() for p in image_files(f)]
 
 
 def check_source(source: object) -> None:
@@ -1097,7 +1098,7 @@ class FrameSource:
 
     def _open_folder(self, path: Path) -> tuple[NDArray[Any], int]:
         folder = _image_folder(path, self.sequence)
-        images = _images_in(folder)
+        images = image_files(folder)
         if not images:
             raise ValueError(_no_images(folder))
         videos = video_files(folder)

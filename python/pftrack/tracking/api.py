@@ -735,16 +735,26 @@ class Tracker:
             return prepared[1]
         return self.working_frame(frame)
 
-    def _untear(self, before: int) -> None:
-        """After the inner ``update`` raised: the run is whole if it was refused before it began.
+    def _step(
+        self, work: NDArray[np.uint8], xywh: F64 | None, cls: NDArray[np.int64] | None
+    ) -> list[Track]:
+        """The tracker inside's ``update`` of this frame; the run is torn while it may stop.
 
-        The inner tracker checks its input before it changes anything, and its frame counter
-        moves once the checks are passed: an input it refused (`before`, the counter, unmoved)
+        `xywh` (the checked boxes, inside the working frame: not checked again) or None for
+        the built-in detector. The tracker inside checks its input before it changes
+        anything, and its frame counter moves once the checks are passed: an input it refuses
         leaves the run whole, so the caller may skip the frame and go on (was: every later
         ``update`` said the run was interrupted).
         """
-        if self._tracker.frame_index == before:
-            self._torn = 0
+        before = self._tracker.frame_index
+        self._tracker.caller_depth = self._caller_depth + 1  # and this method
+        self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
+        try:
+            return self._tracker.update(work, xywh, cls, checked=xywh is not None)
+        except BaseException:
+            if self._tracker.frame_index == before:  # refused before any change
+                self._torn = 0
+            raise
 
     def _restore_rows(self, rows: F64) -> F64:
         """MOTChallenge rows from working pixels to the frame's."""
@@ -909,14 +919,7 @@ class Tracker:
                         "np.zeros((0, 6))",
                     )
                 kept = None
-                before = self._tracker.frame_index
-                self._tracker.caller_depth = self._caller_depth
-                self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
-                try:
-                    reports = self._tracker.update(work, None)
-                except BaseException:
-                    self._untear(before)
-                    raise
+                reports = self._step(work, None, None)
                 if self._tracker.camera_step.moving:
                     self._warn_moving_camera()
             else:
@@ -960,15 +963,7 @@ class Tracker:
                 if self._scale is not None:
                     xywh[:, :4] *= self._scale
                     xywh, cls, kept = _inside_working(xywh, cls, kept, work.shape)
-                # inside the frame as checked: the tracker need not check them again
-                before = self._tracker.frame_index
-                self._tracker.caller_depth = self._caller_depth
-                self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
-                try:
-                    reports = self._tracker.update(work, xywh, cls, checked=True)
-                except BaseException:
-                    self._untear(before)
-                    raise
+                reports = self._step(work, xywh, cls)
                 self._given = (
                     True  # once the frame is taken (an update that raises changes nothing)
                 )
