@@ -47,6 +47,13 @@ class HsvBinning:
     s_min, v_min : float
         A pixel goes to a colour bin only if its saturation > `s_min` and value > `v_min`
         (both on [0, 1]); otherwise to a grey bin.
+
+    Raises
+    ------
+    TypeError
+        A bin count that is not an int (a bool, a float, a string).
+    ValueError
+        A bin count outside [1, 64], `s_min` or `v_min` outside [0, 1].
     """
 
     n_h: int = 10
@@ -58,7 +65,9 @@ class HsvBinning:
     def __post_init__(self) -> None:
         for name in ("n_h", "n_s", "n_v"):
             v = getattr(self, name)
-            if not (isinstance(v, (int, np.integer)) and 1 <= v <= 64):
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
+                raise TypeError(f"HsvBinning: {name} is {v!r}, expected an int in [1, 64]")
+            if not 1 <= v <= 64:
                 raise ValueError(f"{name} is {v!r}, expected an int in [1, 64]")
         for name in ("s_min", "v_min"):
             v = number(getattr(self, name), f"HsvBinning: {name}", finite=False)
