@@ -228,14 +228,24 @@ def test_a_sequence_without_a_gap_says_so_and_the_pooled_figures_leave_it_out(
         "trajectory that is observed on both sides of it): no MMAE, and nothing of it in the "
         "pooled figures\n"
     )
-    lines = said.out.splitlines()
+    mmae, excess = said.out.split("\n\nlinear against the best other method of each row")
+    lines = mmae.splitlines()
     assert "tiny (768x576): 0 gaps, masks none" in lines
     row = {line.split()[0]: line for line in lines if line.startswith(("walk", "tiny", "pooled"))}
     assert row["tiny"].split(None, 2)[1:] == ["0", E.NO_GAPS]
     assert row["pooled"].split()[1:] == row["walk"].split()[1:]  # the gaps of walk alone
+    # linear against rts, on walk and pooled (the same gaps); nothing for tiny
+    n = row["walk"].split()[1]
+    assert [line.split()[:3] for line in excess.splitlines()[2:4]] == [
+        ["walk", n, "rts"], ["pooled", n, "rts"]]  # fmt: skip
     doc = json.loads(out.read_text())
     assert doc["sequences"][1]["mmae"] == {"linear": None, "rts": None}
     assert doc["pooled"]["mmae"] == doc["sequences"][0]["mmae"]
+    assert [(e["name"], e["method"], e["best"]) for e in doc["excess"]] == [
+        ("walk", "linear", "rts"), ("pooled", "linear", "rts")]  # fmt: skip
+    assert doc["excess"][0]["diff"] == pytest.approx(
+        doc["sequences"][0]["mmae"]["linear"] - doc["sequences"][0]["mmae"]["rts"]
+    )
     argv = ["experiment", "gaps", "--gt", str(tiny), "--auto-masks", "--image-size", "768x576"]
     with warnings.catch_warnings():
         warnings.simplefilter("default")
@@ -288,3 +298,27 @@ def test_recover_of_a_detection_file_says_it_needs_tracks(
         "detections (a det.txt), not tracks (pftrack track SOURCE --detections FILE makes "
         "tracks of them)\n"
     )
+
+
+def test_paired_excess_is_the_mean_difference_to_the_best_other_method_and_its_error() -> None:
+    """Worked numbers: per sequence and pooled, against the other method of lowest MMAE."""
+    a = E.SequenceResult("a", (768.0, 576.0), (), 3, {
+        "auto": (2.0, 3.0, 4.0), "linear": (1.0, 3.0, 2.0), "rts": (3.0, 3.0, 3.0)})  # fmt: skip
+    b = E.SequenceResult("b", (768.0, 576.0), (), 1, {
+        "auto": (1.0,), "linear": (4.0,), "rts": (2.0,)})  # fmt: skip
+    none = E.SequenceResult("none", (768.0, 576.0), (), 0, {"auto": (), "linear": (), "rts": ()})
+    got = E.paired_excess([a, none, b], "auto")
+    assert [(e.name, e.best, e.n_gaps) for e in got] == [
+        ("a", "linear", 3), ("b", "rts", 1), ("pooled", "linear", 4)]  # fmt: skip
+    d = np.array([1.0, 0.0, 2.0])  # auto less linear on a
+    assert got[0].diff == pytest.approx(1.0)
+    assert got[0].se == pytest.approx(d.std(ddof=1) / np.sqrt(3))
+    assert got[0].share == pytest.approx(1.0 / 2.0)
+    assert (got[1].diff, got[1].share) == (-1.0, -0.5) and np.isnan(got[1].se)  # one gap
+    pooled = np.array([2.0, 3.0, 4.0, 1.0]) - np.array([1.0, 3.0, 2.0, 4.0])  # linear 2.5 < 2.75
+    assert (got[2].diff, got[2].se) == pytest.approx((0.0, pooled.std(ddof=1) / 2))
+    table = E.format_excess(got).splitlines()
+    assert table[2].split() == ["a", "3", "linear", "+1.000", "±", "0.577", "+50.0", "%"]
+    assert table[3].split() == ["b", "1", "rts", "-1.000", "±", "-", "-50.0", "%"]  # not nan
+    with pytest.raises(ValueError, match=r"paired_excess: 'gdt' is not among the methods"):
+        E.paired_excess([a], "gdt")

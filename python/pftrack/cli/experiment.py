@@ -454,6 +454,7 @@ def _run_sequences(args: argparse.Namespace) -> int:
         E.run_sequence(name, trajs, width, height, methods, args.n_masks)
         for name, trajs, width, height in progress(jobs, total=len(jobs), desc="sequences")
     ]
+    excess = E.paired_excess(results, methods[0]) if len(methods) > 1 else []
     if args.json:
         doc: dict[str, Any] = {
             "protocol": "auto masks: side round(100W/768), grid round(4W/768), greedy, "
@@ -476,6 +477,10 @@ def _run_sequences(args: argparse.Namespace) -> int:
             "n_gaps": sum(r.n_gaps for r in results),
             "mmae": {m: (sum(v) / len(v) if v else None) for m, v in pooled.items()},
         }
+        doc["excess"] = [  # methods[0] against the best other method; no NaN in JSON
+            {k: (None if isinstance(v, float) and v != v else v) for k, v in asdict(e).items()}
+            for e in excess
+        ]
         _write_json(args.json, doc)
     to = report_stream(args.json)  # not into a JSON file written to stdout
     for r in results:  # printed once the JSON is written: a closed stdout cannot lose it
@@ -500,6 +505,9 @@ def _run_sequences(args: argparse.Namespace) -> int:
     print(file=to)
     print("MMAE (px, mean over gaps of the mean Euclidean error); * = best of the row", file=to)
     print(E.format_sequences(results, methods), file=to)
+    if len(methods) > 1 and any(r.n_gaps for r in results):
+        print(file=to)
+        print(E.format_excess(excess), file=to)
     if args.json:
         print(f"json: {args.json}", file=to)
     return 0
