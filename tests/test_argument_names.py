@@ -24,7 +24,7 @@ from pftrack.particle_filter import (
     stratified_resample,
     systematic_resample,
 )
-from pftrack.recovery import fill_gaps, link_tracklets, recover_gap, recover_gaps
+from pftrack.recovery import NoiseEstimate, fill_gaps, link_tracklets, recover_gap, recover_gaps
 from pftrack.tracking.config import (
     AssociationConfig,
     CameraConfig,
@@ -178,6 +178,65 @@ def test_resamplers_name_their_rng(
     )
     with pytest.raises(error, match=match):
         fn([0.5, 0.5], rng=rng)
+
+
+@pytest.mark.parametrize(
+    ("q", "r", "error", "message"),
+    [
+        # each was taken, and failed later naming an internal function (wna_Q_xy,
+        # gdt_recover_batch: "R is not positive definite") or was used (True as 1)
+        (
+            (-1, 1),
+            (1, 1),
+            ValueError,
+            "NoiseEstimate.q[0] is -1.0, expected a finite number >= 0 (px²/frame³)",
+        ),
+        (
+            (1, np.nan),
+            (1, 1),
+            ValueError,
+            "NoiseEstimate.q[1] is nan, expected a finite number >= 0",
+        ),
+        (
+            (1, 1),
+            (np.inf, 1),
+            ValueError,
+            "NoiseEstimate.r[0] is inf, expected a finite number > 0 (px²)",
+        ),
+        ((1, 1), (1, 0), ValueError, "NoiseEstimate.r[1] is 0.0, expected a finite number > 0"),
+        ((True, 1), (1, 1), TypeError, "NoiseEstimate.q[0] must be a number, got bool True"),
+        ((1, 1), (1, "2"), TypeError, "NoiseEstimate.r[1] must be a number, got str '2'"),
+        ("ab", (1, 1), TypeError, "NoiseEstimate.q must be 2 numbers (x, y), got str 'ab'"),
+        (0.5, (1, 1), TypeError, "NoiseEstimate.q must be 2 numbers (x, y), got float 0.5"),
+        ((1, 1), None, TypeError, "NoiseEstimate.r must be 2 numbers (x, y), got NoneType None"),
+        (
+            (1, 1, 1),
+            (1, 1),
+            ValueError,
+            "NoiseEstimate.q is (1, 1, 1): 3 values, expected 2 (x, y)",
+        ),
+        (
+            (1, 1),
+            np.ones((2, 2)),
+            ValueError,
+            "NoiseEstimate.r is an array of shape (2, 2), expected 2 numbers",
+        ),
+    ],
+)
+def test_noise_estimate_names_the_field_its_value_and_what_is_expected(
+    q: object, r: object, error: type[Exception], message: str
+) -> None:
+    with pytest.raises(error) as info:
+        NoiseEstimate(q=q, r=r)  # type: ignore[arg-type]
+    assert str(info.value).startswith(message), str(info.value)
+    assert "\n" not in str(info.value)
+
+
+def test_noise_estimate_takes_pairs_of_any_real_numbers_as_floats() -> None:
+    n = NoiseEstimate(q=np.array([0, 2]), r=[np.float32(0.5), 3])  # type: ignore[arg-type]
+    assert n == NoiseEstimate(q=(0.0, 2.0), r=(0.5, 3.0))
+    assert all(type(v) is float for v in (*n.q, *n.r))
+    hash(n)  # a tuple of floats, not an array
 
 
 def test_generators_and_seeds_are_taken_as_before() -> None:

@@ -714,6 +714,68 @@ def test_a_write_error_names_the_output(tmp_path: Path, capsys: pytest.CaptureFi
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
+def test_a_full_standard_output_is_named_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A user report: ``pftrack eval ... > /dev/full`` said ``[Errno 28] No space left on
+    device``, naming nothing: the user could not tell it from an output file's failure."""
+    import contextlib
+    import sys
+
+    src, out = _tracks(tmp_path / "t.txt"), tmp_path / "o.txt"
+    cases = [
+        (["eval", "--gt", str(src), "--res", str(src)], ""),
+        (["experiment", "gaps", "--gt", str(src), "--image-size", "100x100", "--methods",
+          "linear", "--repeat", "1", "--min-gaps", "0", "--max-positions", "1"], ""),
+        # the table comes after --out is in place: said, so that it is not taken for lost
+        (["recover", str(src), "--out", str(out), "--explain"],
+         "; the outputs were written before it"),
+    ]  # fmt: skip
+    for argv, left in cases:
+        full = open("/dev/full", "w")  # noqa: SIM115 - its close fails too (what is left)
+        monkeypatch.setattr(sys, "stdout", full)
+        try:
+            assert main(["-q", *argv]) == 2
+        finally:
+            monkeypatch.undo()
+            with contextlib.suppress(OSError):
+                full.close()
+        assert capsys.readouterr().err == (
+            f"pftrack {' '.join(argv[:2] if argv[0] == 'experiment' else argv[:1])}: error: "
+            f"cannot write to standard output (No space left on device){left}\n"
+        )
+    assert read_mot(out).shape[0] == 10  # recover's output, whole
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
+def test_the_command_on_a_full_device_or_a_closed_pipe_prints_no_traceback(
+    tmp_path: Path,
+) -> None:
+    """The process as a shell runs it: ``> /dev/full`` one line and exit status 2, ``| head``
+    (a pipe closed before the table) nothing at all, and neither a traceback at exit."""
+    import subprocess
+    import sys
+
+    src = _tracks(tmp_path / "t.txt")
+    argv = [sys.executable, "-m", "pftrack", "eval", "--gt", str(src), "--res", str(src)]
+    with open("/dev/full", "wb") as full:
+        run = subprocess.run(argv, stdout=full, stderr=subprocess.PIPE, text=True, check=False,
+                             timeout=120)  # fmt: skip
+    assert (run.returncode, run.stderr) == (
+        2,
+        "pftrack eval: error: cannot write to standard output (No space left on device)\n",
+    )
+    read, write = os.pipe()
+    os.close(read)  # closed before the command writes
+    try:
+        run = subprocess.run(argv, stdout=write, stderr=subprocess.PIPE, text=True, check=False,
+                             timeout=120)  # fmt: skip
+    finally:
+        os.close(write)
+    assert (run.returncode, run.stderr) == (1, "")
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
 @pytest.mark.parametrize("option", ["--out", "--plot"])
 def test_a_track_write_error_names_the_output(
     video: Path, tmp_path: Path, option: str, capsys: pytest.CaptureFixture[str]

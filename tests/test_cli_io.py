@@ -156,7 +156,29 @@ def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     argv = ["track", str(seq), "--detections", "auto", "--det-scale", "1", "--out", str(out)]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert "wholly outside" in err and "about 0.5" in err and not out.exists()
+    # the exact ratio: seqinfo.ini's (was "about 0.5", an estimate from the boxes' reach)
+    assert "wholly outside" in err and not out.exists()
+    assert err.endswith(f"0.5 here (480 px frames, imWidth=960 in {seq}/seqinfo.ini)\n")
+
+
+def test_det_scale_hint_is_the_exact_ratio_of_seqinfo(
+    sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user report: PETS09's det.txt with ``--det-scale 1`` was told "about 0.626" (its
+    boxes reach 767 of 768 px), where the documented factor is 480/768 = 0.625."""
+    seq = tmp_path / "PETS"
+    (seq / "det").mkdir(parents=True)
+    (seq / "img1").symlink_to(sequence / "img1")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=7\nimWidth=768\nimHeight=576\n")
+    det = read_mot(sequence / "det" / "det.txt")
+    det[:, 2:6] *= 1.6
+    write_mot(seq / "det" / "det.txt", det)
+    argv = ["track", str(seq), "--detections", "auto", "--det-scale", "1", "--out",
+            str(tmp_path / "t.txt")]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.endswith(f"--det-scale / load_detections(scale=...), 0.625 here (480 px frames, "
+                        f"imWidth=768 in {seq}/seqinfo.ini)\n"), err  # fmt: skip
 
 
 def test_sequence_of_another_shape_than_its_seqinfo_is_refused(

@@ -214,6 +214,22 @@ def test_demo_refuses_a_file_as_its_folder_and_a_folder_as_an_output(
     assert sorted(p.name for p in (tmp_path / "d").iterdir()) == ["annotated.mp4"]
 
 
+def test_demo_help_says_its_folder_is_created_with_its_parents_unlike_a_files_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user report: ``demo --out-dir a/b/c`` made a, b and c without a word, while ``track
+    --out missing/dir/t.txt`` is refused. Output folders are created (demo, batch), a file's
+    folder must exist; the help says so."""
+    for command in ("demo", "batch"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = " ".join(capsys.readouterr().out.split())
+        assert "(created, with any missing parent folders" in text
+    out = tmp_path / "missing" / "dir" / "t.txt"
+    assert main(["track", str(tmp_path / "v.mp4"), "--out", str(out)]) == 2
+    assert capsys.readouterr().err.endswith(f"folder {out.parent} does not exist\n")
+
+
 @pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
 @pytest.mark.parametrize("where", ["tracking", "writing"])
 def test_interrupted_demo_removes_the_folder_it_made(

@@ -483,6 +483,27 @@ def test_a_percentage_that_rounds_to_zero_prints_without_a_sign() -> None:
     ]  # fmt: skip
 
 
+def test_a_bad_frame_rate_no_score_uses_does_not_stop_eval(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user report: ``frameRate=0`` in ``seqinfo.ini`` refused ``eval``, which reads only
+    the length and image size; the scores are those of the file without the key."""
+    gt_root, res_root = make_layout(tmp_path, {"A": random_case(1)})
+    argv = ["eval", "--gt", str(gt_root), "--res", str(res_root)]
+    assert main(argv) == 0
+    before = capsys.readouterr().out
+    ini = gt_root / "A" / "seqinfo.ini"
+    ini.write_text(ini.read_text() + "frameRate=0\n")
+    assert main(argv) == 0, capsys.readouterr().err
+    assert capsys.readouterr().out == before
+    ini.write_text(ini.read_text().replace("imWidth=200", "imWidth=0"))  # used: still refused
+    assert main(argv) == 2
+    assert (
+        capsys.readouterr().err
+        == f"pftrack eval: error: {ini}: imWidth is '0', expected a number > 0\n"
+    )
+
+
 def test_seqs_does_not_read_the_other_sequences_seqinfo(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -206,6 +206,19 @@ def test_a_frame_rate_outside_the_range_of_fps_is_refused(tmp_path: Path, rate: 
         assert read_seqinfo(tmp_path).frame_rate == float(rate)
 
 
+def test_seqinfo_keys_the_caller_does_not_use_are_not_checked(tmp_path: Path) -> None:
+    """``pftrack eval`` and ``experiment gaps`` read the size only: ``frameRate=0`` refused them."""
+    (tmp_path / "seqinfo.ini").write_text("[Sequence]\nframeRate=0\nimWidth=768\nseqLength=x\n")
+    with pytest.raises(ValueError, match="frameRate is '0', expected a number > 0"):
+        read_seqinfo(tmp_path)
+    info = read_seqinfo(tmp_path, keys=("imWidth", "imHeight"))
+    assert (info.width, info.height, info.frame_rate, info.length) == (768, None, None, None)
+    with pytest.raises(ValueError, match="seqLength is 'x'"):
+        read_seqinfo(tmp_path, keys=("imWidth", "seqLength"))
+    with pytest.raises(ValueError, match="read_seqinfo: keys has 'width', expected some of name"):
+        read_seqinfo(tmp_path, keys=("width",))
+
+
 def test_seqinfo_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
     """Notepad's UTF-8 starts the file with a BOM; det/gt/results already skip it."""
     (tmp_path / "seqinfo.ini").write_bytes(b"\xef\xbb\xbf[Sequence]\nframeRate=7\nseqLength=3\n")

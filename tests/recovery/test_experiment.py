@@ -137,6 +137,27 @@ def test_a_bad_seqinfo_is_named_with_its_key_and_value(
     assert err.count("\n") == 1
 
 
+@pytest.mark.parametrize("multi", [False, True])
+@pytest.mark.parametrize("unused", ["frameRate=0", "seqLength=0.5"])
+def test_a_bad_value_the_experiment_does_not_use_does_not_stop_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], unused: str, multi: bool
+) -> None:
+    """A user report: ``frameRate=0`` beside the ground truth refused the experiment, which
+    uses only the name and image size of ``seqinfo.ini`` (the gaps are in frames)."""
+    seq = tmp_path / "SEQ"
+    (seq / "gt").mkdir(parents=True)
+    write_mot(seq / "gt" / "gt.txt", _walkers())
+    (seq / "seqinfo.ini").write_text(
+        f"[Sequence]\nname=WALK\nimWidth=768\nimHeight=576\n{unused}\n"
+    )
+    argv = ["experiment", "gaps", "--gt", str(seq / "gt" / "gt.txt"), "--methods", "linear"]
+    argv += ["--auto-masks"] if multi else ["--max-positions", "2", "--repeat", "1"]
+    assert main(argv) == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    assert "MMAE" in out
+    assert "768" in out  # the image size was read from seqinfo.ini all the same
+
+
 @pytest.fixture
 def walkers_gt(tmp_path: Path) -> Path:
     """A ground-truth file of three walkers over 30 frames (768x576)."""

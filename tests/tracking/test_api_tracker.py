@@ -429,6 +429,23 @@ def test_detections_in_a_smaller_frames_pixels_are_said(scene):
         track_frames(frames, detections={n: v for n, v in xywh.items() if n <= 20}, rng=0)
 
 
+@pytest.mark.parametrize(
+    ("reach", "hint"), [((767, 575), "about 0.625"), ((700, 500), "about 0.686")]
+)
+def test_larger_frames_scale_hint_is_a_round_ratio_just_below_the_estimate(
+    scene, reach: tuple[int, int], hint: str
+):
+    """A user report: PETS09's boxes (768x576 pixels) reach 767: the hint was "about 0.626",
+    480/767, where the ratio of the image sizes is 0.625. Without seqinfo.ini (frames in
+    memory) the estimate from the boxes' reach is an upper bound: a round ratio just below it
+    is the one meant; one far below is not named."""
+    right, bottom = reach
+    boxes = np.array([[600.0, 400, 50, 80, 1], [right - 40.0, bottom - 75.0, 40, 75, 1]])
+    dets = {n: boxes.copy() for n in range(1, 31)}  # all 60 boxes wholly outside 480x360
+    with pytest.raises(ValueError, match=rf"wholly outside .* {hint} here$"):
+        track_frames(scene.frames, detections=dets, rng=0)
+
+
 def test_detections_in_a_larger_frames_pixels_are_refused(scene):
     """Was a warning only: PETS09's 768x576 det.txt on its 480x360 video, without --det-scale,
     lost half its boxes (wholly outside the frame) and clipped the others, exit 0."""

@@ -23,8 +23,10 @@ from pftrack.cli._signals import (
     NOTHING_CHANGED,
     Terminated,
     exit_status,
+    interrupts_held,
     line_end,
     outcome,
+    set_outcome,
     sigterm_raises,
 )
 
@@ -168,6 +170,67 @@ def _names_on_stdout() -> Iterator[None]:
             stream.reconfigure(errors=errors)  # type: ignore[union-attr]
 
 
+class StdoutError(OSError):
+    """Standard output refused the command's report: ``cannot write to standard output ...``.
+
+    An OSError from a ``print`` names no file (``[Errno 28] No space left on device`` for
+    ``pftrack eval ... > /dev/full``): the user could not tell it from a failed output file.
+    A closed pipe (:class:`BrokenPipeError`) is not one of these: it ends the command quietly.
+    """
+
+
+class _NamedStdout:
+    """``sys.stdout`` while a command runs: a write or flush that fails raises StdoutError.
+
+    Everything else is the stream's own (``fileno``, ``isatty``, ``encoding``, ...).
+    """
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+
+    def _failed(self, exc: OSError) -> StdoutError:
+        error = StdoutError(f"cannot write to standard output ({exc.strerror or exc})")
+        error.errno = exc.errno
+        if interrupts_held():  # the report comes after the outputs (recover, smooth, track)
+            set_outcome(error, "the outputs were written before it")
+        return error
+
+    def write(self, text: str) -> int:
+        """Write `text` to the stream."""
+        try:
+            return int(self._stream.write(text))
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def flush(self) -> None:
+        """Flush the stream."""
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def _stdout_named() -> Iterator[None]:
+    """While a command runs, a failed write to stdout says so (:class:`StdoutError`)."""
+    stream = sys.stdout
+    if stream is None:
+        yield
+        return
+    sys.stdout = _NamedStdout(stream)
+    try:
+        yield
+    finally:
+        sys.stdout = stream
+
+
 @contextlib.contextmanager
 def _quiet_opencv() -> Iterator[None]:
     """While a command runs, OpenCV and FFmpeg log nothing (variables the user set are kept).
@@ -248,9 +311,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with warnings.catch_warnings(), _quiet_opencv(), _names_on_stdout(), sigterm_raises():
             warnings.showwarning = _one_line_warning(prog)
-            status = int(args.func(args))
-        if sys.stdout is not None:  # a buffered stdout's last lines: a closed pipe fails here
-            sys.stdout.flush()
+            with _stdout_named():
+                status = int(args.func(args))
+                if sys.stdout is not None:  # a buffered stdout's last lines: a closed pipe or
+                    sys.stdout.flush()  # a full device fails here
         return status
     except BrokenPipeError:  # output piped into `head` and the like: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

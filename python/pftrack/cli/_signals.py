@@ -23,6 +23,7 @@ __all__ = [
     "Terminated",
     "exit_status",
     "hold_interrupts",
+    "interrupts_held",
     "line_end",
     "outcome",
     "set_outcome",
@@ -103,6 +104,11 @@ def hold_interrupts() -> None:
     for sig in _stopping_signals():
         signal.signal(sig, signal.SIG_IGN)
     _held[0] = True
+
+
+def interrupts_held() -> bool:
+    """Whether the running command called :func:`hold_interrupts`: its outputs are in place."""
+    return _held[0]
 
 
 @contextlib.contextmanager

@@ -157,7 +157,8 @@ def add_parser(sub: Any) -> None:
         "2 bad usage (nothing ran), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).",
     )
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="video, image or sequence folder")
-    p.add_argument("--out", required=True, metavar="DIR", help="output folder (created)")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="output folder (created, with any missing parent folders)")  # fmt: skip
     p.add_argument(
         "--detections", choices=("auto",), default=None,
         help="auto: each sequence's det/det.txt (or det.txt) instead of the built-in detector",

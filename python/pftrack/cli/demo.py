@@ -20,7 +20,13 @@ def add_parser(sub: Any) -> None:
         "a trajectory plot, then cut gaps into the truth and print each recovery method's "
         "error. Needs no data and no download.",
     )
-    p.add_argument("--out-dir", default="pftrack-demo", help="folder for the outputs")
+    p.add_argument(
+        "--out-dir", default="pftrack-demo", metavar="DIR",
+        help="folder for the outputs (created, with any missing parent folders, as every "
+        "output folder is: pftrack batch --out; a file output such as track --out needs an "
+        "existing folder); the folders it created are removed again if it stops before "
+        "writing",
+    )  # fmt: skip
     p.add_argument("--seed", type=non_negative_int, default=0,
                    help="scene and tracker seed, an integer >= 0")  # fmt: skip
     p.add_argument("--frames", type=bounded_int(1, 1000), default=150,

@@ -154,14 +154,17 @@ def _seqinfo(gt_path: str) -> tuple[str, float, float] | None:
 
     Read by :func:`pftrack.io.video.read_seqinfo` (its errors name the file, the key and its
     value: ``imWidth is '0', expected a number > 0``; at most ``MAX_IMAGE_SIDE`` px, the bound
-    of ``--image-size``); ``imWidth`` and ``imHeight`` must be given.
+    of ``--image-size``); ``imWidth`` and ``imHeight`` must be given. Only ``name``,
+    ``imWidth`` and ``imHeight`` are read: the experiment has no use for the frame rate or
+    the length, whose values are not checked.
     """
     from pftrack.io.video import read_seqinfo
 
     ini = _seqinfo_file(gt_path)
     if ini is None:
         return None
-    info = read_seqinfo(ini)
+    # the experiment uses no other key: frameRate=0 or a bad seqLength does not stop it
+    info = read_seqinfo(ini, keys=("name", "imWidth", "imHeight"))
     for key, value in (("imWidth", info.width), ("imHeight", info.height)):
         if value is None:
             raise ValueError(

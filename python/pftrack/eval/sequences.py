@@ -99,7 +99,9 @@ def _sequence(folder: Path, only: Collection[str] | None = None) -> SequenceInfo
         return SequenceInfo(folder.name, gt)
     from pftrack.io.video import read_seqinfo as read_info  # track's and batch's reader
 
-    info = read_info(ini)  # its errors name the file, key and value, as theirs do
+    # its errors name the file, key and value, as theirs do; only the keys scoring uses are
+    # read (an invalid frameRate, which no score uses, does not refuse the sequence)
+    info = read_info(ini, keys=("seqLength", "imWidth", "imHeight"))
     return SequenceInfo(folder.name, gt, length=info.length, width=info.width, height=info.height)
 
 

@@ -32,7 +32,7 @@ import os
 import re
 import stat
 import warnings
-from collections.abc import Generator, Iterable, Iterator, Sequence
+from collections.abc import Collection, Generator, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from decimal import Decimal
@@ -302,7 +302,11 @@ def _duplicate(
     return f"{ini}: {what} is given twice ({where}); give it once"
 
 
-def read_seqinfo(path: PathLike) -> SequenceInfo:
+#: The keys of ``seqinfo.ini``'s ``[Sequence]`` that :func:`read_seqinfo` reads.
+SEQINFO_KEYS = ("name", "imDir", "frameRate", "seqLength", "imWidth", "imHeight")
+
+
+def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> SequenceInfo:
     """Read a MOTChallenge ``seqinfo.ini`` (or the one in folder `path`).
 
     A key left out takes its default (``name``: the folder's name, ``imDir``: ``img1``; the
@@ -310,13 +314,30 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
     of ``0`` is: it would otherwise fall back silently (the container's frame rate for an
     empty ``frameRate``).
 
+    Parameters
+    ----------
+    path : path-like
+        The file, or the folder holding it.
+    keys : collection of str, optional
+        The keys the caller uses (some of :data:`SEQINFO_KEYS`); the others are neither read
+        nor checked, and take their default as if left out, so that a value the caller does
+        not use (``frameRate=0`` for ``pftrack eval``, which needs only the image size and
+        length) does not refuse the file. None: all of them.
+
     Raises
     ------
     ValueError
         No ``[Sequence]`` section, a key or section given twice, a key pftrack reads given
         empty, a field that is not a positive number (``imWidth``, ``imHeight``,
-        ``seqLength``: an integer), or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`.
+        ``seqLength``: an integer), or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`;
+        a name in `keys` that is not one of :data:`SEQINFO_KEYS`.
     """
+    unknown = sorted(set(keys or ()) - set(SEQINFO_KEYS))
+    if unknown:
+        raise ValueError(
+            f"read_seqinfo: keys has {', '.join(map(repr, unknown))}, expected some of "
+            f"{', '.join(SEQINFO_KEYS)}"
+        )
     ini = Path(path)
     if ini.is_dir():
         ini = ini / "seqinfo.ini"
@@ -338,6 +359,8 @@ def read_seqinfo(path: PathLike) -> SequenceInfo:
         ) from None
 
     def text_of(key: str) -> str | None:
+        if keys is not None and key not in keys:
+            return None  # not used by the caller: not checked either
         text = sec.get(key)
         if text is not None and not text.strip():
             raise ValueError(f"{ini}: {key} is empty; give a value or leave the key out")

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
+from pftrack._check import number
 from pftrack._typing import F64
 from pftrack.recovery.segments import consecutive_runs
 
@@ -26,10 +27,44 @@ class NoiseEstimate:
     """Noise levels per axis (x, y).
 
     ``q``: white-noise-acceleration intensity (px²/frame³); ``r``: measurement variance (px²).
+    Each is 2 real numbers (a tuple, a list or an array; kept as a tuple of floats): ``q``
+    finite and ``>= 0``, ``r`` finite and ``> 0`` (a zero measurement variance makes the
+    filters' covariances singular).
+
+    Raises
+    ------
+    TypeError
+        A field that is not 2 numbers (text, a bool, None):
+        ``NoiseEstimate.q[0] must be a number, got bool True``.
+    ValueError
+        Not 2 values, or a value out of range:
+        ``NoiseEstimate.r[1] is -1.0, expected a finite number > 0 (px²)``.
     """
 
     q: tuple[float, float]
     r: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        for name, lo, unit in (("q", ">= 0", "px²/frame³"), ("r", "> 0", "px²")):
+            what = f"NoiseEstimate.{name}"
+            raw: object = getattr(self, name)
+            if isinstance(raw, (str, bytes)) or not isinstance(raw, (Sequence, np.ndarray)):
+                raise TypeError(
+                    f"{what} must be 2 numbers (x, y), got {type(raw).__name__} {raw!r}"
+                )
+            if isinstance(raw, np.ndarray) and raw.shape != (2,):
+                raise ValueError(
+                    f"{what} is an array of shape {raw.shape}, expected 2 numbers (x, y)"
+                )
+            if len(raw) != 2:
+                raise ValueError(f"{what} is {raw!r}: {len(raw)} values, expected 2 (x, y)")
+            pair = tuple(number(v, f"{what}[{i}]", finite=False) for i, v in enumerate(raw))
+            for i, v in enumerate(pair):
+                if not (np.isfinite(v) and (v >= 0 if name == "q" else v > 0)):
+                    raise ValueError(
+                        f"{what}[{i}] is {v!r}, expected a finite number {lo} ({unit})"
+                    )
+            object.__setattr__(self, name, pair)
 
 
 #: Used when the segments are too short to estimate anything.

@@ -19,7 +19,7 @@ from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
-from pftrack.io.video import FrameSource
+from pftrack.io.video import FrameSource, SequenceInfo
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.ahead import DetectAhead
 from pftrack.tracking.api import Tracker, xywh_to_xyxy_dets
@@ -259,7 +259,7 @@ def track_frames(
             else:
                 dets = detections.get(n, empty)
                 if n == 1:
-                    _check_layout(detections, frame.shape[:2])
+                    _check_layout(detections, frame.shape[:2], getattr(frames, "sequence", None))
                 tracker.update(xywh_to_xyxy_dets(dets), frame)
             if on_frame is not None:
                 on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
@@ -387,7 +387,41 @@ SMALL_LAYOUT_BOXES = 20  # boxes a file needs before its extent says anything ab
 OUTSIDE_SHARE = 0.1
 
 
-def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
+#: How far past ``seqinfo.ini``'s image size (a share of it) boxes may reach and still be taken
+#: for boxes in its pixels (detectors' boxes overhang the edge a little).
+SEQINFO_SLACK = 0.1
+#: Round ratios of image sizes the hint names in place of an estimate just above them (the
+#: boxes seldom reach the image's last pixel: PETS09's reach 767 of 768, 0.626 for 0.625).
+ROUND_RATIOS = (0.5, 0.25, 0.625, 0.75, 0.8, 1 / 3, 2 / 3)
+#: How far above a round ratio (a share of it) an estimate may be to be named by it.
+ROUND_RATIO_REACH = 0.02
+
+
+def _scale_hint(
+    cols: int, rows: int, right: float, bottom: float, sequence: SequenceInfo | None
+) -> str:
+    """The scale that brings boxes reaching `right` x `bottom` into `cols` x `rows` frames.
+
+    Exact where it is known: the frames' width over ``seqinfo.ini``'s ``imWidth``, when the
+    boxes fit that size (``0.625 here (480 px frames, imWidth=768 in SEQ/seqinfo.ini)``).
+    Else an estimate from the boxes' reach, which is an upper bound (the boxes seldom reach the
+    last pixel): a round ratio of :data:`ROUND_RATIOS` just below it, or it to 3 digits.
+    """
+    if sequence is not None and sequence.width is not None:
+        w, h = sequence.width, sequence.height
+        if right <= w * (1 + SEQINFO_SLACK) and (h is None or bottom <= h * (1 + SEQINFO_SLACK)):
+            return (
+                f"{cols / w:.4g} here ({cols} px frames, imWidth={w} in "
+                f"{sequence.folder / 'seqinfo.ini'})"
+            )
+    estimate = min(cols / right, rows / bottom)
+    near = [k for k in ROUND_RATIOS if k <= estimate <= k * (1 + ROUND_RATIO_REACH)]
+    return f"about {max(near):.4g} here" if near else f"about {estimate:.3g} here"
+
+
+def _check_layout(
+    detections: dict[int, F64], shape: tuple[int, ...], sequence: SequenceInfo | None = None
+) -> None:
     """Refuse x1, y1, x2, y2 boxes as left, top, w, h and a larger frame's; warn of a smaller's.
 
     Decided on the whole file: more than half of the boxes, read as ``left, top, w, h``, reach
@@ -397,7 +431,8 @@ def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
     clip the rest: PETS09's 768x576 det.txt on its 480x360 video loses half its boxes so).
     The warning: at least :data:`SMALL_LAYOUT_BOXES` boxes, and none reaches past half the
     frame's width or height (boxes too large for the frame are clipped, with a warning, by
-    the tracker).
+    the tracker). The scale the refusal suggests is :func:`_scale_hint`'s (`sequence`: the
+    source's ``seqinfo.ini``, if any).
     """
     d = np.concatenate([v[:, :4] for v in detections.values() if len(v)] or [np.zeros((0, 4))])
     if len(d) == 0:
@@ -415,12 +450,11 @@ def _check_layout(detections: dict[int, F64], shape: tuple[int, ...]) -> None:
         )
     outside = (d[:, 0] >= cols) | (d[:, 1] >= rows)
     if len(d) >= SMALL_LAYOUT_BOXES and outside.mean() > OUTSIDE_SHARE and not as_xyxy.all():
-        scale = min(cols / right, rows / bottom)
         raise ValueError(
             f"{outside.sum()} of {len(d)} detection boxes lie wholly outside the {cols}x{rows} "
             f"frames (they reach {right:.0f}x{bottom:.0f}): are they in a larger frame's "
-            f"pixels? Scale them with --det-scale / load_detections(scale=...), about "
-            f"{scale:.3g} here"
+            f"pixels? Scale them with --det-scale / load_detections(scale=...), "
+            f"{_scale_hint(cols, rows, right, bottom, sequence)}"
         )
     if past.mean() > 0.5 and as_xyxy.all():
         raise ValueError(
