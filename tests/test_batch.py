@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import _thread
 import contextlib
+import functools
 import hashlib
+import http.server
 import json
 import os
 import re
@@ -38,6 +40,7 @@ from pftrack.batch import (
     TrackOptions,
     dask_client,
     find_sequences,
+    find_track_files,
     recover_many,
     run_jobs,
     smooth_many,
@@ -46,7 +49,7 @@ from pftrack.batch import (
 from pftrack.cli import main
 from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import read_mot, write_mot
-from pftrack.io.video import FrameSource
+from pftrack.io.video import VIDEO_SUFFIXES, FrameSource
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
 
@@ -174,6 +177,54 @@ def test_a_folder_of_sequences_with_a_stray_image_is_refused(tmp_path: Path) -> 
     assert [s.name for s in find_sequences(top)] == ["SEQ-A", "SEQ-B"]
     (top / "SEQ-B" / "img1" / ".thumb.png").write_text("")  # hidden: no image of the folder
     assert [s.name for s in find_sequences(top / "SEQ-B")] == ["SEQ-B"]
+
+
+def _mot_sequence(folder: Path) -> None:
+    """A small MOTChallenge sequence folder: ``img1/`` and ``seqinfo.ini``."""
+    make_scene(n_frames=3, width=64, height=64, n_walkers=1, rng=0).write_images(folder / "img1")
+    (folder / "seqinfo.ini").write_text("[Sequence]\nimWidth=64\nimHeight=64\n")
+
+
+def test_sequences_deeper_than_one_level_are_named_not_passed_over(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: given DIR with DIR/train/SEQ/seqinfo.ini, "no sequence in folder DIR"
+    said nothing of DIR/train; with a video beside train/, its sequences were passed over
+    silently, exit status 0."""
+    top = tmp_path / "DIR"
+    train = top / "train"
+    for name in ("SEQ1", "SEQ2"):
+        _mot_sequence(train / name)
+    # annotations alone (as ../shared/data/mot15-gt/*): nothing to track, not named
+    (top / "annotations" / "ADL").mkdir(parents=True)
+    (top / "annotations" / "ADL" / "seqinfo.ini").write_text("[Sequence]\n")
+    held = f"{train} holds 2 sequences (SEQ1, SEQ2)"
+    error = (
+        f"no sequence in folder {top}: expected videos ({', '.join(VIDEO_SUFFIXES)}), image "
+        f"folders or MOTChallenge sequence folders in it; deeper, {held}: pass {train} instead "
+        "(a folder is looked into one level deep)"
+    )
+    with pytest.raises(ValueError, match=f"^{re.escape(error)}$"):
+        find_sequences(top)
+    out = tmp_path / "out"
+    assert main(["batch", str(top), "--out", str(out), "--workers", "0", *FAST]) == 2
+    assert capsys.readouterr().err == f"pftrack batch: error: {error}\n"
+    assert not out.exists()
+    # some found: the deeper ones are named in one warning
+    make_scene(n_frames=3, width=64, height=64, n_walkers=1, rng=0).write_video(top / "v.avi")
+    warning = (
+        f"folder {top}: 1 sequence tracked from it, not those deeper (a folder is looked into "
+        f"one level deep): {held}; pass {train} too to track them"
+    )
+    with pytest.warns(UserWarning, match=f"^{re.escape(warning)}$"):
+        assert [s.name for s in find_sequences(top)] == ["v"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as a user's shell: the command prints it
+        assert main(["batch", str(top), "--out", str(out), "--workers", "0", *FAST]) == 0
+    assert f"pftrack batch: warning: {warning}\n" in capsys.readouterr().err
+    # given as well, or instead: tracked, no warning (filterwarnings = error)
+    assert [s.name for s in find_sequences([top, train])] == ["v", "SEQ1", "SEQ2"]
+    assert [s.name for s in find_sequences(train)] == ["SEQ1", "SEQ2"]
 
 
 @pytest.mark.parametrize(
@@ -565,6 +616,90 @@ def test_files_no_batch_wrote_are_not_replaced_without_force(
         track_many([vids], vids, n_workers=0)
 
 
+def test_an_unwritable_out_is_refused_before_the_cluster_starts(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: refused only once the local cluster had started (or the scheduler answered),
+    seconds later; a folder to be made under one that takes none was "cannot create the folder
+    (No such file or directory)"."""
+    from pftrack.batch import engine
+
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    real = os.access
+
+    def access(path: Any, mode: int, *args: Any, **kwargs: Any) -> bool:
+        if Path(path) == locked and mode & os.W_OK:  # root writes anywhere: as a user here
+            return False
+        return real(path, mode, *args, **kwargs)
+
+    def no_cluster(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("a cluster was started for an --out that cannot be written")
+
+    monkeypatch.setattr(os, "access", access)
+    monkeypatch.setattr(engine, "dask_client", no_cluster)
+    try:
+        video = str(data / "walk.avi")
+        assert main(["batch", video, "--out", str(locked)]) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack batch: error: --out {locked}: the folder is not writable (Permission "
+            "denied): no output can be written in it; write elsewhere\n"
+        )
+        assert main(["batch", video, "--out", str(locked / "new" / "deeper")]) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack batch: error: --out {locked / 'new' / 'deeper'}: cannot create the "
+            f"folder: {locked} is not writable (Permission denied); write elsewhere\n"
+        )
+        with pytest.raises(PermissionError, match=f"^out_dir {locked}: the folder is not "):
+            track_many(video, locked, n_workers=0)
+        assert sorted(locked.iterdir()) == []
+    finally:
+        locked.chmod(0o700)
+
+
+def test_a_sidecar_cut_short_is_redone_with_a_note(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: a truncated ``NAME.json`` (a copy stopped half-way) refused the whole batch as a
+    file no batch wrote ("no sidecar walk.json of one names it", with one there), and the
+    remedy, --force, redid every sequence."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    out = tmp_path / "out"
+    argv = ["batch", str(vids), "--out", str(out), "--workers", "0", *FAST]
+    assert main(argv) == 0
+    sidecar = out / "walk.json"
+    for size in (100, 0):
+        sidecar.write_bytes(sidecar.read_bytes()[:size])
+        capsys.readouterr()
+        assert main(argv) == 0
+        note = f"redone: its sidecar {sidecar} was cut short ({size} bytes, not valid JSON: "
+        assert f"walk: {note}" in capsys.readouterr().out
+        (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+        assert entry["status"] == "done" and entry["note"].startswith(note)
+        assert json.loads(sidecar.read_text())["status"] == "done"  # whole again
+    assert main(argv) == 0  # complete: skipped
+    assert json.loads((out / "summary.json").read_text())["counts"]["skipped"] == 1
+    # a summary.json cut short: an earlier batch's, replaced
+    summary = out / "summary.json"
+    summary.write_bytes(summary.read_bytes()[:50])
+    assert main(argv) == 0
+    assert json.loads(summary.read_text())["counts"]["skipped"] == 1
+    # not the beginning of a sidecar: perhaps the user's; refused, said so, nothing changed
+    sidecar.write_text("garbage\n")
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    capsys.readouterr()
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack batch: error: --out {out / 'walk.txt'} exists and no earlier batch wrote it "
+        "(walk.json is not JSON, nor the beginning of a batch's sidecar); this run would "
+        "replace it: move it, write elsewhere, or give --force\n"
+    )
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
 def test_resume_redoes_a_file_whose_content_changed(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -909,6 +1044,66 @@ def test_a_port_that_says_nothing_is_no_scheduler(
         "dashboard's port? a scheduler listens on 8786 unless told otherwise)\n"
     )
     assert not (tmp_path / "out").exists()
+
+
+class _Quiet(http.server.SimpleHTTPRequestHandler):
+    """``python -m http.server``'s handler, without its log lines on stderr."""
+
+    def log_message(self, *args: Any) -> None:
+        pass
+
+
+def test_a_dashboard_a_web_server_or_a_worker_is_named_at_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: a web server's port (the dashboard's, 8787) waited Dask's whole connect timeout,
+    then guessed ("the dashboard's port?"); a worker's port said the worker's own complaint,
+    "Worker.identity() got an unexpected keyword argument 'n_workers'"."""
+    from pftrack.batch import engine
+
+    monkeypatch.setattr(engine, "GREETING_WAIT", 8.0)  # what the old code waited out
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(out)]
+
+    def refused(address: str) -> str:
+        start = time.monotonic()
+        assert main([*argv, "--scheduler", address]) == 2
+        assert time.monotonic() - start < 6
+        err = capsys.readouterr().err
+        prefix = f"pftrack recover: error: cannot connect to the Dask scheduler at {address}: "
+        assert err.startswith(prefix) and err.count("\n") == 1, err
+        assert not out.exists()
+        return err[len(prefix) : -1]
+
+    handler = functools.partial(_Quiet, directory=str(tmp_path))
+    with http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler) as web:
+        threading.Thread(target=web.serve_forever, daemon=True).start()
+        port = web.server_address[1]
+        try:
+            assert refused(f"tcp://127.0.0.1:{port}") == (
+                f"port {port} of 127.0.0.1 is an HTTP server (it answered 'HTTP/1.0 404 File not "
+                "found': a dashboard, a web server), not a Dask scheduler, which speaks Dask's "
+                "own protocol: give the scheduler's address (dask scheduler prints it as "
+                "'Scheduler at', port 8786 unless told otherwise)"
+            )
+        finally:
+            web.shutdown()
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",
+    ) as cluster:  # fmt: skip
+        scheduler = cluster.scheduler_address
+        dashboard = cluster.scheduler.services["dashboard"].port
+        assert refused(f"tcp://127.0.0.1:{dashboard}") == (
+            f"port {dashboard} of 127.0.0.1 is the web dashboard (HTTP) of the Dask scheduler at "
+            f"{scheduler}, not the scheduler itself: give {scheduler}"
+        )
+        (worker,) = cluster.workers.values()
+        assert refused(worker.address) == (
+            f"it is a Dask worker, not a scheduler (the worker's scheduler is at {scheduler}): "
+            f"give {scheduler}"
+        )
 
 
 def test_progress_counts_frames_within_the_sequences(
@@ -2096,6 +2291,49 @@ def test_a_broken_link_in_a_scanned_folder_fails_alone(
     assert files[-1]["error"] == (
         f"broken symbolic link: {tmp_path / 'tracks' / 'run9.txt'} -> {tmp_path / 'moved.txt'}"
     )
+
+
+def test_a_symbolic_link_loop_is_named_as_one(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: given, "input not found: a is a broken symbolic link (to b)" (b is there, a link
+    back to a); met in a scanned folder, a traceback (``RuntimeError: Symlink loop``)."""
+    (tmp_path / "a").symlink_to("b")
+    (tmp_path / "b").symlink_to("a")
+    loop = f"{tmp_path / 'a'} -> b -> a"
+    error = (
+        f"input {tmp_path / 'a'}: symbolic link loop ({loop}), which leads to no file or "
+        "folder; point the link at one"
+    )
+    with pytest.raises(ValueError, match=f"^{re.escape(error)}$"):
+        find_sequences(tmp_path / "a")
+    with pytest.raises(ValueError, match=f"^{re.escape(error)}$"):
+        find_track_files([tmp_path / "a"])
+    for command in ("batch", "recover"):
+        argv = [command, str(tmp_path / "a"), str(tmp_path / "b"), "--out", str(tmp_path / "o")]
+        assert main([*argv, "--workers", "0"]) == 2
+        assert capsys.readouterr().err == f"pftrack {command}: error: {error}\n"
+        assert not (tmp_path / "o").exists()
+    # met in a scanned folder: a sequence whose task fails, named so; the others run
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy2(data / "walk.avi", vids / "walk.avi")
+    (vids / "p.avi").symlink_to("q.avi")
+    (vids / "q.avi").symlink_to("p.avi")
+    (vids / "seq").symlink_to("seq")  # a folder's name, to itself
+    out = tmp_path / "out"
+    assert main(["batch", str(vids), "--out", str(out), "--workers", "0", *FAST]) == 1
+    err = capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    status = {e["name"]: (e["status"], e.get("error")) for e in summary["sequences"]}
+    assert status == {
+        "p": ("failed", f"symbolic link loop: {vids / 'p.avi'} -> q.avi -> p.avi"),
+        "q": ("failed", f"symbolic link loop: {vids / 'q.avi'} -> p.avi -> q.avi"),
+        "seq": ("failed", f"symbolic link loop: {vids / 'seq'} -> seq"),
+        "walk": ("done", None),
+    }
+    assert f"p: error: symbolic link loop: {vids / 'p.avi'} -> q.avi -> p.avi\n" in err
+    assert "Traceback" not in err
 
 
 def test_the_same_input_twice_is_said_so(tmp_path: Path) -> None:

@@ -111,6 +111,14 @@ def track_many(
     ValueError
         Bad inputs, or an `out_dir` that is a file or would overwrite an input (named
         ``out_dir``), before any task runs; see :func:`~pftrack.batch.run_jobs` for the rest.
+    PermissionError
+        An `out_dir` that cannot be written (or made), before the cluster starts.
+
+    Warns
+    -----
+    UserWarning
+        A folder of `inputs` has sequences deeper than the one level looked into: they are
+        not tracked (see :func:`~pftrack.batch.find_sequences`).
     """
     opts = _options(options, TrackOptions, "track_many")
     seqs = find_sequences(inputs)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import dataclasses
+import errno
 import hashlib
 import json
 import logging
@@ -27,6 +28,7 @@ import math
 import os
 import signal
 import socket
+import tempfile
 import threading
 import time
 import traceback
@@ -37,6 +39,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
+from pftrack.batch.inputs import link_loop
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder
 from pftrack.io.mot import write_mot
@@ -320,7 +323,9 @@ def dask_client(
         connect by the address's protocol here (``tls://`` without Dask's TLS settings,
         ``ucx://`` without the package that provides it): one line naming the address (was:
         Dask's own message, "TLS expects a `ssl_context` argument", "Can't instantiate abstract
-        class UCXConnector", naming neither).
+        class UCXConnector", naming neither). An address that is an HTTP server's (the
+        dashboard's) or a Dask worker's is said to be one, with the scheduler's address where
+        it tells it (:func:`_http_server`, :func:`_dask_server`).
     ImportError
         The scheduler or the workers cannot import pftrack (:func:`check_pftrack`).
     """
@@ -345,7 +350,10 @@ def dask_client(
         try:
             connected = Client(address)  # timeout: distributed.comm.timeouts.connect
         except Exception as exc:  # noqa: BLE001 - whatever Dask raised: one line, the address
-            problem = _connect_problem(address, exc)
+            # a Dask server that is no scheduler answers, then refuses the client's request (a
+            # worker: a TypeError); one not reached at all (an OSError) is not asked again
+            other = None if isinstance(exc, OSError) else _dask_server(address)
+            problem = other or _connect_problem(address, exc)
             raise OSError(f"cannot connect to the Dask scheduler at {address}: {problem}") from None
         quiet = contextlib.ExitStack()
         with quiet, connected as c:  # `quiet` ends after the client is closed
@@ -455,14 +463,36 @@ def _greeting_wait() -> float:
     return float(wait) if wait else 30.0
 
 
+#: Seconds of silence after which :func:`_silent` asks the port whether it speaks HTTP (a
+#: Dask server greets at once), and how long it waits for that answer.
+HTTP_ASK_AFTER = 1.0
+HTTP_WAIT = 2.0
+
+
 def _silent(sock: socket.socket, host: str, port: int) -> str | None:
-    """Why the server at the other end of `sock` is no Dask scheduler: it says nothing."""
+    """Why the server at the other end of `sock` is no Dask scheduler: it says nothing.
+
+    Silent for :data:`HTTP_ASK_AFTER` seconds, the port is asked, on a connection of its own,
+    whether it speaks HTTP (:func:`_http_server`): the dashboard's port, or any web server, is
+    then named as such at once (was: after Dask's whole connect timeout, 30 s, with a guess).
+    Otherwise the rest of the wait is waited for a greeting.
+    """
     wait = _greeting_wait()
-    sock.settimeout(wait)
+    start = time.monotonic()
+    sock.settimeout(min(wait, HTTP_ASK_AFTER))
     try:
-        if sock.recv(1):
-            return None
-        said = "closed the connection without a word"
+        try:
+            if sock.recv(1):
+                return None
+            said = "closed the connection without a word"
+        except TimeoutError:
+            http = _http_server(host, port, max(min(HTTP_WAIT, wait - HTTP_ASK_AFTER), 0.2))
+            if http is not None:
+                return http
+            sock.settimeout(max(wait - (time.monotonic() - start), 0.001))
+            if sock.recv(1):
+                return None
+            said = "closed the connection without a word"
     except TimeoutError:
         said = f"said nothing within {wait:g} s"
     except OSError:
@@ -470,6 +500,102 @@ def _silent(sock: socket.socket, host: str, port: int) -> str | None:
     return (
         f"port {port} of {host} accepted the connection but {said}, as no Dask scheduler "
         "does (the dashboard's port? a scheduler listens on 8786 unless told otherwise)"
+    )
+
+
+def _http_server(host: str, port: int, timeout: float = HTTP_WAIT) -> str | None:
+    """What the HTTP server at `port` of `host` is, as no Dask scheduler; None if it is none.
+
+    Asked for ``/json/identity.json``, which a Dask scheduler's dashboard answers with the
+    scheduler's own address: the message then gives it. `timeout`: seconds to wait for the
+    connection and for each part of the answer.
+    """
+    request = f"GET /json/identity.json HTTP/1.0\r\nHost: {host}:{port}\r\n\r\n".encode()
+    data = b""
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as http:
+            http.sendall(request)
+            while len(data) < 1 << 16:
+                chunk = http.recv(1 << 14)
+                if not chunk:
+                    break
+                data += chunk
+    except OSError:  # timed out (no HTTP server), reset: nothing known
+        if not data:
+            return None
+    if not data.startswith(b"HTTP/"):
+        return None
+    status = data.split(b"\r\n", 1)[0].decode("latin-1").strip()
+    body = data.partition(b"\r\n\r\n")[2]
+    try:
+        identity = json.loads(body) if status.split(" ")[1:2] == ["200"] else None
+    except ValueError:
+        identity = None
+    if isinstance(identity, dict) and identity.get("type") == "Scheduler":
+        address = identity.get("address")
+        if isinstance(address, str) and address:
+            return (
+                f"port {port} of {host} is the web dashboard (HTTP) of the Dask scheduler at "
+                f"{address}, not the scheduler itself: give {address}"
+            )
+    return (
+        f"port {port} of {host} is an HTTP server (it answered {status!r}: a dashboard, a web "
+        "server), not a Dask scheduler, which speaks Dask's own protocol: give the "
+        "scheduler's address (dask scheduler prints it as 'Scheduler at', port 8786 unless "
+        "told otherwise)"
+    )
+
+
+#: Seconds :func:`_dask_server` waits for a Dask server to say what it is.
+IDENTITY_WAIT = 5.0
+
+
+def _dask_server(address: str) -> str | None:
+    """What the Dask server at `address` is when it is not a scheduler (a worker), else None.
+
+    ``Client(address)`` on a worker's port failed with the worker's own complaint,
+    "Worker.identity() got an unexpected keyword argument 'n_workers'" (a user trial): the
+    server is asked what it is (Dask's ``identity``, on a connection of its own, in a thread
+    of its own: the caller may run an event loop), and a worker names its scheduler.
+    """
+    import asyncio
+
+    from distributed.core import rpc
+
+    async def ask() -> Any:
+        async with rpc(address, timeout=IDENTITY_WAIT) as server:
+            return await asyncio.wait_for(server.identity(), IDENTITY_WAIT)
+
+    answer: list[Any] = []
+
+    def run() -> None:
+        with contextlib.suppress(Exception):
+            answer.append(asyncio.run(ask()))
+
+    thread = threading.Thread(target=run, name="pftrack-identity", daemon=True)
+    thread.start()
+    thread.join(2 * IDENTITY_WAIT)
+    identity = answer[0] if answer else None
+    if not isinstance(identity, dict) or not isinstance(identity.get("type"), str):
+        return None
+    kind = identity["type"]
+    if kind == "Scheduler":
+        return None
+    if kind == "Worker":
+        scheduler = identity.get("scheduler")
+        if isinstance(scheduler, str) and scheduler:
+            return (
+                f"it is a Dask worker, not a scheduler (the worker's scheduler is at "
+                f"{scheduler}): give {scheduler}"
+            )
+    if kind == "Nanny":
+        return (
+            "it is a Dask nanny (the process that watches over a worker), not a scheduler: "
+            "give the scheduler's address (dask scheduler prints it as 'Scheduler at')"
+        )
+    return (
+        f"it is a Dask {kind}, not a scheduler: give the scheduler's address (dask scheduler "
+        "prints it as 'Scheduler at')"
     )
 
 
@@ -969,6 +1095,32 @@ def _sidecar(out_dir: Path, name: str) -> Path:
     return out_dir / f"{name}.json"
 
 
+#: How every record a batch writes begins (``json.dumps(..., indent=2)`` of a dict whose first
+#: key is ``kind``): a sidecar or ``summary.json`` whose text is cut short still begins so.
+RECORD_START = '{\n  "kind": "'
+
+
+def _cut_short(path: Path) -> str | None:
+    """Why the file `path` is a batch's record cut short (truncated), or None.
+
+    None when it is valid JSON, missing or unreadable, or when its text does not begin as a
+    batch's record does (:data:`RECORD_START`): not a batch's, then, and not to be replaced.
+    Batches write their records atomically, so one cut short was damaged afterwards (a copy
+    stopped half-way, a full disk on another machine, an edit).
+    """
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, ValueError):
+        return None
+    try:
+        json.loads(text)
+        return None
+    except ValueError as exc:
+        if text.startswith(RECORD_START) or RECORD_START.startswith(text):
+            return f"{len(text.encode())} bytes, not valid JSON: {one_line(exc)}"
+        return None
+
+
 def _read_sidecar(out_dir: Path, name: str) -> dict[str, Any] | None:
     """The sidecar ``NAME.json`` as a dict; None when it is missing, unreadable or not one."""
     try:
@@ -1001,6 +1153,10 @@ def _complete(
     """
     entry = _read_sidecar(out_dir, job.name)
     if entry is None:
+        sidecar = _sidecar(out_dir, job.name)
+        damaged = _cut_short(sidecar)
+        if damaged is not None:  # was: refused as a file no batch wrote (--force redid all)
+            return None, f"redone: its sidecar {sidecar} was cut short ({damaged})"
         return None, None
     same = (
         entry.get("kind") == kind
@@ -1239,6 +1395,9 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     the worker's host (was: "video source not found: PATH", as if it did not exist).
     """
     broken = [p for p in job.reads if p.is_symlink() and not p.exists()]
+    loop = link_loop(broken[0]) if broken else None
+    if loop is not None:  # was: "broken symbolic link: a -> b", b there, a link back to a
+        return f"symbolic link loop: {loop}"
     if broken:
         return f"broken symbolic link: {broken[0]} -> {os.readlink(broken[0])}"
     if not remote or outcome.missing is None or outcome.host is None or outcome.error is None:
@@ -1314,12 +1473,15 @@ def _check_outputs(
     """
     out_name, render_name = _OUT_NAMES.get()
     out_dir = check_output_folder(out_dir, out_name)
-    reads = {p.resolve() for job in jobs for p in job.reads}  # once: batches can be large
+    _check_writable(out_dir)
+    # once: batches can be large; realpath, not resolve: a link loop met in a scanned folder
+    # (a task that fails) made Python < 3.13's resolve raise RuntimeError, a traceback
+    reads = {Path(os.path.realpath(p)) for job in jobs for p in job.reads}
     guarded = {_file_id(p) for job in jobs for p in job.guards} - {None}  # images: by inode
     names = [f"{job.name}{s}" for job in jobs for s in (".txt", ".json", *suffixes)]
     for name in [SUMMARY_NAME, *names]:
         target = out_dir / name
-        if target.resolve() in reads or _file_id(target) in guarded:
+        if Path(os.path.realpath(target)) in reads or _file_id(target) in guarded:
             # which option makes it: a rendered video is --render's (was: always --out)
             rendered = any(name.endswith(s) for s in suffixes)
             what = f"{render_name}'s output {target}" if rendered else f"{out_name} {target}"
@@ -1330,7 +1492,7 @@ def _check_outputs(
         return out_dir
     force_name = "--force" if out_name == "--out" else "force=True"
     summary = out_dir / SUMMARY_NAME
-    if summary.exists() and not _is_summary(summary):
+    if summary.exists() and not _is_summary(summary) and _cut_short(summary) is None:
         raise ValueError(
             f"{out_name} {summary} exists and is not a batch's summary; this run would replace "
             f"it: move it, write elsewhere, or give {force_name}"
@@ -1342,13 +1504,57 @@ def _check_outputs(
                 continue
             if ours is None:
                 ours = _batch_files(out_dir, job.name)
+                if not ours and _cut_short(_sidecar(out_dir, job.name)) is not None:
+                    # an earlier batch's sidecar, damaged: the job is redone, with a note
+                    ours = {f"{job.name}{s}" for s in (".txt", ".json", *suffixes)}
             if name not in ours:
+                why = f"no sidecar {job.name}.json of one names it"
+                sidecar = _sidecar(out_dir, job.name)
+                if _read_sidecar(out_dir, job.name) is None and sidecar.is_file():
+                    # was: "no sidecar NAME.json", with one there
+                    why = f"{job.name}.json is not JSON, nor the beginning of a batch's sidecar"
                 raise ValueError(
-                    f"{out_name} {out_dir / name} exists and no earlier batch wrote it (no "
-                    f"sidecar {job.name}.json of one names it); this run would replace it: "
-                    f"move it, write elsewhere, or give {force_name}"
+                    f"{out_name} {out_dir / name} exists and no earlier batch wrote it ({why}); "
+                    f"this run would replace it: move it, write elsewhere, or give {force_name}"
                 )
     return out_dir
+
+
+def _check_writable(out_dir: Path) -> None:
+    """Refuse an output folder that cannot take new files, or cannot be made, before any work.
+
+    Checked where the folder is, or for a missing one where it is to be made (the nearest
+    folder above it that exists), by making a folder there and removing it (``access()`` says
+    yes to root on a read-only file system). Was: only once the local cluster had started or
+    the scheduler answered, seconds later; a missing folder under ``/proc/sys`` was "cannot
+    create the folder (No such file or directory)".
+
+    Raises
+    ------
+    PermissionError
+        Naming `out_dir` (as ``--out`` or ``out_dir``) and why.
+    """
+    out_name = _OUT_NAMES.get()[0]
+    folder = out_dir
+    while not folder.is_dir():
+        if folder.parent == folder:
+            return  # no folder above it at all: its creation says why
+        folder = folder.parent
+    try:
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+        os.rmdir(tempfile.mkdtemp(prefix=".pftrack-probe-", dir=folder))
+    except OSError as exc:
+        why = exc.strerror or one_line(exc)
+        if folder == out_dir:
+            raise PermissionError(
+                f"{out_name} {out_dir}: the folder is not writable ({why}): no output can be "
+                "written in it; write elsewhere"
+            ) from None
+        raise PermissionError(
+            f"{out_name} {out_dir}: cannot create the folder: {folder} is not writable ({why}); "
+            "write elsewhere"
+        ) from None
 
 
 def _file_id(path: Path) -> tuple[int, int] | None:
@@ -1427,6 +1633,9 @@ def run_jobs(
     ValueError
         A bad `scheduler` address (or Dask's ``scheduler-address`` setting), or more than one
         of `client`, `scheduler` and `n_workers` given; checked before anything else.
+    PermissionError
+        `out_dir` cannot take new files, or cannot be made (:func:`_check_writable`); checked
+        before the cluster starts or the scheduler is connected to.
     OSError
         The scheduler cannot be reached (see :func:`dask_client`), or it has no worker and none
         comes within :func:`no_workers_timeout` (a ``TimeoutError``); raised before `out_dir`

@@ -4,12 +4,18 @@ A *sequence* is one video file, one folder of images, or one MOTChallenge sequen
 (``SEQ/img1/`` or a single video in ``SEQ/``, with ``seqinfo.ini``, ``det/det.txt`` and
 ``gt/gt.txt``; ``SEQ/det.txt`` and ``SEQ/gt.txt`` are accepted too). A folder that is none of
 these is a folder of sequences: each entry in it that is a sequence is one (one level deep).
+Sequences deeper than that (``DIR/train/SEQ`` when ``DIR`` is given) are not tracked, but never
+passed over silently: with none found the error names the folders that hold them, with some a
+warning does.
 """
 
 from __future__ import annotations
 
+import errno
 import json
 import os
+import warnings
+from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -206,6 +212,90 @@ def _annotations(folder: Path) -> tuple[Path | None, Path | None]:
     )
 
 
+#: How far below a folder of sequences :func:`_deeper` looks for the sequences it passed over
+#: (``DIR/a/b/c/SEQ`` for ``DIR``), and how many folders it lists at most: a hint, not a scan.
+DEEPER_LEVELS = 3
+DEEPER_FOLDERS = 256
+
+
+def _has_frames(folder: Path) -> bool:
+    """Whether `folder` is a sequence with frames to track (False if it cannot be listed).
+
+    Stricter than :func:`_sequence_like`: a folder of annotations alone (``seqinfo.ini`` and
+    ``gt.txt``, no images or video, as ``../shared/data/mot15-gt/*``) is no sequence to point
+    a user at.
+    """
+    try:
+        ini = folder / "seqinfo.ini"
+        if ini.is_file():
+            try:
+                if (folder / read_seqinfo(ini).image_dir).is_dir():
+                    return True
+            except ValueError:  # refused when tracked; its img1/ or video still shows it
+                pass
+        return (folder / "img1").is_dir() or bool(image_files(folder)) or bool(_videos(folder))
+    except OSError:
+        return False
+
+
+def _deeper(folders: list[Path]) -> list[tuple[Path, list[str]]]:
+    """The folders below `folders` that hold sequences, with those sequences' names.
+
+    `folders` are the sub-folders a folder of sequences passed over (neither sequences nor
+    images). Looked into breadth first, :data:`DEEPER_LEVELS` levels down at most, each branch
+    stopping at the first folder that holds sequences (videos, or folders with frames:
+    :func:`_has_frames`); symbolic links to folders below `folders` are not followed (a loop),
+    hidden entries are passed over, as a folder of sequences passes them over.
+    """
+    found: list[tuple[Path, list[str]]] = []
+    queue = deque((f, 1) for f in folders)
+    listed = 0
+    while queue and listed < DEEPER_FOLDERS:
+        folder, level = queue.popleft()
+        listed += 1
+        try:
+            entries = sorted(folder.iterdir(), key=_listing_key)
+        except OSError:
+            continue
+        names: list[str] = []
+        below: list[Path] = []
+        for entry in entries:
+            if entry.name.startswith(".") or _broken_link(entry):
+                continue
+            try:
+                if entry.is_file():
+                    video = entry.suffix.lower() in VIDEO_SUFFIXES
+                    if video and not _batch_output(entry):
+                        names.append(entry.name)
+                elif entry.is_dir():
+                    if _has_frames(entry):
+                        names.append(entry.name)
+                    elif not entry.is_symlink():
+                        below.append(entry)
+            except OSError:
+                continue
+        if names:
+            found.append((folder, names))
+        elif level < DEEPER_LEVELS:
+            queue.extend((f, level + 1) for f in below)
+    return found
+
+
+def _held(deeper: list[tuple[Path, list[str]]]) -> str:
+    """``DIR/train holds 2 sequences (SEQ1, SEQ2)`` for each of `deeper`, joined."""
+
+    def one(folder: Path, names: list[str]) -> str:
+        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+        return f"{folder} holds {len(names)} sequence{'s' * (len(names) > 1)} ({shown})"
+
+    return "; ".join(one(f, n) for f, n in deeper[:3]) + ("; ..." if len(deeper) > 3 else "")
+
+
+def _pass(deeper: list[tuple[Path, list[str]]]) -> str:
+    """``pass DIR/train`` (or several) for the folders of `deeper`."""
+    return "pass " + " ".join(str(f) for f, _ in deeper[:3]) + (" ..." if len(deeper) > 3 else "")
+
+
 def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     """The sequences named by `inputs`, in order (a folder of sequences in natural order).
 
@@ -222,10 +312,18 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     ------
     FileNotFoundError
         An input does not exist (a broken symbolic link is named as one). A broken link met in
-        a scanned folder is not refused: it is a sequence whose task fails, named so.
+        a scanned folder is not refused: it is a sequence whose task fails, named so; so is a
+        link loop met there.
     ValueError
-        No sequence is found, or two have the same name (their outputs would collide), or one
-        input is given twice (the same path once links are resolved).
+        No sequence is found (the error names deeper folders that hold some), or two have the
+        same name (their outputs would collide), or one input is given twice (the same path
+        once links are resolved), or an input is a symbolic link loop (``a`` -> ``b`` -> ``a``).
+
+    Warns
+    -----
+    UserWarning
+        A folder of sequences has sequences deeper than one level (``DIR/train/SEQ`` for
+        ``DIR``): they are not tracked; the warning names the folders that hold them.
     """
     paths = _absolute(inputs)
     found: list[SequenceInput] = []
@@ -237,6 +335,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
             continue
         entries = sorted(path.iterdir(), key=_listing_key)
         before = len(found)
+        passed: list[Path] = []  # folders of sequences in `path`: not looked into
         for entry in entries:
             if entry.name.startswith("."):
                 continue
@@ -252,10 +351,29 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
             child = _as_sequence(entry)
             if child is not None:
                 found.append(child)
-        if len(found) == before:
+            elif entry.is_dir():  # a link to one too (train -> /mnt/train); not deeper ones
+                passed.append(entry)
+        given = {os.path.realpath(p) for p in paths}  # DIR and DIR/train both given: said of none
+        deeper = [d for d in _deeper(passed) if os.path.realpath(d[0]) not in given]
+        if len(found) == before:  # was: the same words with deeper sequences, not naming them
+            where = (
+                f"; deeper, {_held(deeper)}: {_pass(deeper)} instead (a folder is looked into "
+                "one level deep)"
+                if deeper
+                else ""
+            )
             raise ValueError(
                 f"no sequence in folder {path}: expected videos ({', '.join(VIDEO_SUFFIXES)}), "
-                "image folders or MOTChallenge sequence folders"
+                f"image folders or MOTChallenge sequence folders in it{where}"
+            )
+        if deeper:  # was: passed over silently
+            n = len(found) - before
+            warnings.warn(
+                f"folder {path}: {n} sequence{'s' * (n > 1)} tracked from it, not those deeper "
+                f"(a folder is looked into one level deep): {_held(deeper)}; {_pass(deeper)} "
+                "too to track them",
+                UserWarning,
+                stacklevel=2,
             )
     _check_names([s.name for s in found], [s.frames for s in found])
     return found
@@ -271,7 +389,7 @@ def find_track_files(inputs: Inputs) -> list[Path]:
         listed: its task fails, named so).
     ValueError
         A folder holds no ``.txt`` file, or two files have the same name, or one is given
-        twice.
+        twice, or an input is a symbolic link loop.
     """
     paths = _absolute(inputs)
     found: list[Path] = []
@@ -301,8 +419,40 @@ def _broken_link(path: Path) -> bool:
     return path.is_symlink() and not path.exists()
 
 
+def link_loop(path: Path) -> str | None:
+    """``a -> b -> a`` when `path`'s symbolic links lead to each other, else None.
+
+    The links `path` leads through, as ``readlink`` gives them, up to the first one met again;
+    for a loop on the way to `path` (a folder above it), that it lies beyond one.
+    """
+    try:
+        os.stat(path)
+        return None
+    except OSError as exc:
+        if exc.errno != errno.ELOOP:
+            return None
+    chain, seen, p = [str(path)], set(), path
+    while p.is_symlink() and len(chain) < 10:
+        key = os.path.abspath(p)
+        if key in seen:
+            return " -> ".join(chain)
+        seen.add(key)
+        target = os.readlink(p)
+        chain.append(target)
+        p = p.parent / target
+    if len(chain) > 1:
+        return " -> ".join([*chain, "..."])
+    return "a folder on its way is one"
+
+
 def _check_exists(path: Path) -> None:
-    """Refuse an input that does not exist, naming a broken symbolic link as one."""
+    """Refuse an input that does not exist, naming a broken symbolic link or a loop as one."""
+    loop = link_loop(path)
+    if loop is not None:  # was: "is a broken symbolic link (to b)", b there, a link itself
+        raise ValueError(
+            f"input {path}: symbolic link loop ({loop}), which leads to no file or folder; "
+            "point the link at one"
+        )
     if _broken_link(path):
         raise FileNotFoundError(
             f"input not found: {path} is a broken symbolic link (to {os.readlink(path)})"
@@ -364,5 +514,5 @@ def _same_file(a: Path, b: Path) -> bool:
     """Whether `a` and `b` name the same file or folder (links and ``..`` resolved)."""
     try:
         return a == b or a.resolve() == b.resolve() or os.path.samefile(a, b)
-    except OSError:
+    except (OSError, RuntimeError):  # RuntimeError: a link loop (Python < 3.13's resolve)
         return False
