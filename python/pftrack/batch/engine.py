@@ -465,7 +465,7 @@ def _greeting_wait() -> float:
 
 #: Seconds of silence after which :func:`_silent` asks the port whether it speaks HTTP (a
 #: Dask server greets at once), and how long it waits for that answer.
-HTTP_ASK_AFTER = 1.0
+HTTP_ASK_AFTER = 2.0
 HTTP_WAIT = 2.0
 
 
