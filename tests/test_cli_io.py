@@ -228,6 +228,30 @@ def _copy_sequence(sequence: Path, seq: Path, *, skip: str = "") -> Path:
     return seq
 
 
+def test_a_sequence_without_seqinfo_takes_its_own_detections_as_batch_does(
+    sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A README trial: ``pftrack batch SEQ --detections auto`` read SEQ/det/det.txt of a folder
+    without seqinfo.ini, ``pftrack track SEQ --detections auto`` refused it, so the batch's
+    file could not be made again with ``track``."""
+    seq = _copy_sequence(sequence, tmp_path / "SEQ")
+    (seq / "seqinfo.ini").unlink()
+    outs = [tmp_path / f"{k}.txt" for k in range(3)]
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(outs[0])]) == 0
+    assert main(["track", str(seq / "img1"), "--detections", "auto", "--out", str(outs[1])]) == 0
+    argv = ["track", str(seq / "img1"), "--detections", str(seq / "det" / "det.txt")]
+    assert main([*argv, "--out", str(outs[2])]) == 0
+    assert outs[0].read_bytes() == outs[1].read_bytes() == outs[2].read_bytes()
+    capsys.readouterr()
+    (seq / "img1").rename(seq / "frames")  # no longer laid out as a sequence
+    assert main(["track", str(seq / "frames"), "--detections", "auto", "--out", "x.txt"]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: --detections auto: {seq}/frames is not a MOTChallenge sequence "
+        "with det/det.txt (a folder with seqinfo.ini or img1/, or its img1/); give the detection "
+        "file\n"
+    )
+
+
 def test_a_missing_image_of_a_sequence_is_one_line_not_a_shift(
     sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -260,6 +284,14 @@ def test_a_missing_image_of_a_plain_numbered_folder_is_one_line_not_a_shift(
     out = tmp_path / "t.txt"
     argv = ["track", str(seq / "img1"), "--detections", str(seq / "det" / "det.txt"),
             "--out", str(out)]  # fmt: skip
+    # SEQ/img1 is a sequence's image folder even without seqinfo.ini (as pftrack batch takes it)
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 are frame numbers; "
+        "restore it: the sequence's detections and ground truth number its frames by them)\n"
+    )
+    (seq / "img1").rename(seq / "frames")  # a folder of no sequence
+    argv[1] = str(seq / "frames")
     remedy = (
         "skip numbers): detections cannot be matched to these images (their frame numbers may "
         "be the names or the images' positions); rename the images 1..N in their order and "
@@ -268,14 +300,14 @@ def test_a_missing_image_of_a_plain_numbered_folder_is_one_line_not_a_shift(
     )
     assert main(argv) == 2
     assert capsys.readouterr().err == (
-        f"pftrack track: error: {seq}/img1: image 10 is missing (names 1..60 {remedy}"
+        f"pftrack track: error: {seq}/frames: image 10 is missing (names 1..60 {remedy}"
     )
     assert not out.exists()
-    for image in (seq / "img1").iterdir():
+    for image in (seq / "frames").iterdir():
         image.rename(image.with_name(f"frame_{image.name}"))
     assert main(argv) == 2
     assert capsys.readouterr().err == (
-        f"pftrack track: error: {seq}/img1: image frame_10 is missing (names frame_1..frame_60 "
+        f"pftrack track: error: {seq}/frames: image frame_10 is missing (names frame_1..frame_60 "
         f"{remedy}"
     )
     assert not out.exists()

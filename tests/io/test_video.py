@@ -331,9 +331,13 @@ def test_a_sequences_stray_and_hidden_images_are_no_frames(tmp_path: Path) -> No
         r"out \(cover.png\): a MOTChallenge sequence's frames are its numbered",
     ):
         assert _levels(seq) == [1, 2, 3, 4, 5]
-    # outside a sequence the names are no frame numbers: the cover is a frame, hidden files not
+    # SEQ/img1 without seqinfo.ini is still laid out as a sequence's (pftrack batch takes it so)
     (seq / "seqinfo.ini").unlink()
-    assert len(FrameSource(seq)) == 6
+    with pytest.warns(UserWarning, match=r"img1: 1 image whose name is not a frame number"):
+        assert len(FrameSource(seq)) == 5
+    # outside a sequence the names are no frame numbers: the cover is a frame, hidden files not
+    (seq / "img1").rename(seq / "frames")
+    assert len(FrameSource(seq / "frames")) == 6
 
 
 def test_numbered_and_named_folders_keep_their_order(tmp_path: Path) -> None:
@@ -1071,3 +1075,25 @@ def test_a_truncated_jpeg_in_a_folder_is_said_once(tmp_path: Path) -> None:
     (folder / "3.jpg").write_bytes(progressive.tobytes()[:-2])  # several scans, no end
     with pytest.warns(UserWarning, match=r"3.jpg has no JPEG end marker"):
         assert len(list(FrameSource(folder))) == 4
+
+
+def test_a_sequence_folder_without_seqinfo_is_a_sequence_as_batch_takes_it(tmp_path: Path) -> None:
+    """A user trial: ``SEQ/img1`` + ``SEQ/det/det.txt`` without seqinfo.ini was a sequence to
+    ``pftrack batch`` (its det.txt read by ``--detections auto``) but not to ``pftrack track``
+    (refused), and a missing image there shifted every later frame silently."""
+    seq = _sequence(tmp_path / "SEQ", n=5)
+    (seq / "seqinfo.ini").unlink()
+    for source in (seq, seq / "img1"):
+        info = FrameSource(source).sequence
+        assert info is not None and (info.folder, info.name) == (seq, "SEQ")
+        assert (info.frame_rate, info.width, info.length) == (None, None, None)
+        assert info.detections == seq / "det" / "det.txt"
+    (seq / "img1" / "3.png").unlink()
+    with pytest.raises(ValueError, match=r"img1: image 3 is missing \(names 1..5 are frame"):
+        FrameSource(seq)
+    plain = tmp_path / "plain"  # images of no sequence: no sequence, names skipping numbers
+    plain.mkdir()
+    for k in (1, 2, 4):
+        cv2.imwrite(str(plain / f"{k}.png"), np.zeros((4, 4, 3), np.uint8))
+    source = FrameSource(plain)
+    assert source.sequence is None and len(source) == 3

@@ -171,7 +171,7 @@ def _resolve_detections(args: argparse.Namespace, source: Any) -> str | None:
     if found is None:
         raise ValueError(
             f"--detections auto: {args.source} is not a MOTChallenge sequence with det/det.txt "
-            "(seqinfo.ini beside it); give the detection file"
+            "(a folder with seqinfo.ini or img1/, or its img1/); give the detection file"
         )
     return str(found)
 

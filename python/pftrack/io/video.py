@@ -409,12 +409,23 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     """The MOTChallenge sequence `source` belongs to, from the ``seqinfo.ini`` nearest to it.
 
     Looks in `source` itself (a sequence folder), beside it (a video file, or an image folder
-    inside the sequence folder), in that order; None when there is none.
+    inside the sequence folder), in that order. Without one, a folder laid out as a sequence's,
+    ``SEQ/img1/`` (`source` is ``SEQ`` or ``SEQ/img1``), is that sequence all the same, with
+    nothing known but its name and image folder (no frame rate, size or length), as ``pftrack
+    batch`` takes it: its ``det/det.txt`` is its detections, and its images are frame numbers.
+    None otherwise.
     """
     path = Path(source)
-    for folder in (path, path.parent) if path.is_dir() else (path.parent,):
+    if not path.is_dir():
+        return read_seqinfo(path.parent) if (path.parent / "seqinfo.ini").is_file() else None
+    for folder in (path, path.parent):
         if (folder / "seqinfo.ini").is_file():
             return read_seqinfo(folder)
+    if (path / "img1").is_dir():
+        return SequenceInfo(path, path.resolve().name, None, "img1", None, None, None)
+    if path.resolve().name == "img1":  # SEQ/img1, or "." inside it
+        folder = path.parent if path.name == "img1" else path.resolve().parent
+        return SequenceInfo(folder, folder.resolve().name, None, "img1", None, None, None)
     return None
 
 
