@@ -105,7 +105,7 @@ void register_mcmc(py::module_& m) {
            const Eigen::Vector3d& b, const Eigen::Vector3d& sigma, double s_min, double s_max,
            bool use_means, double lam, const std::string& kernel, bool resample, std::uint64_t seed,
            std::uint64_t step, int n_iter, int burn_in, const std::string& proposal,
-           const Eigen::Vector3d& rw_sigma) {
+           const Eigen::Vector3d& rw_sigma, double min_samples) {
             const char* fn = "mh_step";
             MhParams prm;
             prm.base = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means, lam,
@@ -119,6 +119,7 @@ void register_mcmc(py::module_& m) {
             else
                 fail(fn, "proposal is '" + proposal + "', expected 'dynamics' or 'random_walk'");
             prm.rw_sigma = rw_sigma.array();
+            prm.base.min_samples = min_samples;  // checked by mh_step, as sis_step checks it
             MhResult r;
             {
                 py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only
@@ -134,9 +135,11 @@ void register_mcmc(py::module_& m) {
         py::arg("s_max"), py::arg("use_means"), py::arg("lam"), py::arg("kernel"),
         py::arg("resample"), py::arg("seed"), py::arg("step"), py::arg("n_iter") = 1,
         py::arg("burn_in") = 0, py::arg("proposal") = "dynamics",
-        py::arg("rw_sigma") = Eigen::Vector3d(2.0, 2.0, 0.01),
+        py::arg("rw_sigma") = Eigen::Vector3d(2.0, 2.0, 0.01), py::arg("min_samples") = 0.0,
         "Resample, then n_iter Metropolis-Hastings iterations per particle (eq. 5); particles "
-        "(N, 6), weights (N,), means (2, 3) updated in place; returns sis_step's dict + acceptance.");
+        "(N, 6), weights (N,), means (2, 3) updated in place; returns sis_step's dict + acceptance. "
+        "min_samples as sis_step's: boxes counted on the lattice sis_step would use (the step of "
+        "the previous mean state's box), 0 every pixel.");
 
     py::class_<PyRjTracker>(m, "RJMCMCTracker",
                             "Reversible-jump MCMC joint tracker (birth, death, update, swap).")

@@ -389,6 +389,7 @@ def mh_step(
     burn_in: int = 0,
     proposal: str = "dynamics",
     rw_sigma: ArrayLike = ...,  # (3,)
+    min_samples: float = 0.0,
 ) -> dict[str, Any]: ...
 
 # counter-based random streams (CounterRng), for tests and references: (n,) float64

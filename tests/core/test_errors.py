@@ -302,7 +302,9 @@ def test_filter_bad_inputs():
         FilterConfig(n_particles=0)
     f = ColourParticleFilter([5, 5, 4, 4], np.ones(7), rng=0)
     image = hsv_bins(np.zeros((10, 10, 3), np.uint8))
-    with pytest.raises(ValueError, match="sis_step: ref size is 7, expected 110"):
+    with pytest.raises(
+        ValueError, match=r"ColourParticleFilter.step: reference has 7 bins, the image 110"
+    ):
         f.step(image)
 
 
@@ -412,3 +414,18 @@ def test_binned_image_from_wider_integers_keeps_the_bins():
     bins = np.array([[0, 4, -1]], np.int64)
     np.testing.assert_array_equal(BinnedImage(bins, 5).bins, bins)
     np.testing.assert_array_equal(BinnedImage(bins.astype(float), 5).bins, bins)
+
+
+def test_mh_step_takes_and_checks_min_samples():
+    """mh_step takes sis_step's min_samples (was refused as an unknown argument, so the fuzz
+    target, which passes it, never reached the kernel) and checks it as sis_step does."""
+    image = _core.hsv_bins(np.zeros((20, 20, 3), np.uint8), None, 4, 4, 4)
+    args = (np.tile([10.0, 10, 1, 10, 10, 1], (4, 1)), np.full(4, 0.25),
+            np.tile([10.0, 10, 1], (2, 1)), image, np.ones(20), 4.0, 4.0, [2.0] * 3, [-1.0] * 3,
+            [1.0, 1.0, 0.01], 0.5, 2.0, False, 20.0, "uniform", True, 1, 0)  # fmt: skip
+    for bad in (np.nan, -1.0, np.inf):
+        with pytest.raises(ValueError, match="mh_step: min_samples must be finite and >= 0"):
+            _core.mh_step(*[a.copy() if isinstance(a, np.ndarray) else a for a in args],
+                          min_samples=bad)  # fmt: skip
+    out = _core.mh_step(*args, min_samples=3.0)
+    assert np.isfinite(out["rho_mean"])

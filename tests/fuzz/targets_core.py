@@ -75,7 +75,9 @@ def _resample(name: str) -> Target:
     return Target(name, calls)
 
 
-B = 64  # colour bins of the step targets' images (hsv_bins 4 x 4 x 4)
+# colour bins of the step targets' images: hsv_bins 4 x 4 x 4 gives 4 * 4 colour + 4 grey bins
+# (was 64, so every step call was refused for its reference's length before its kernel ran)
+B = 20
 
 
 def _object_kwargs(n: int) -> dict[str, st.SearchStrategy[Any]]:

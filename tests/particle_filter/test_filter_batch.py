@@ -168,7 +168,7 @@ def test_step_filters_refuses_a_bad_filter_before_any_steps(textured_frame, rng)
     good = ColourParticleFilter(box, box_histograms(image, [box])[0], rng=1)
     twin = copy.deepcopy(good)
     bad = ColourParticleFilter(box, box_histograms(coarse, [box])[0], rng=2)
-    with pytest.raises(ValueError, match=r"filters\[1\]: ref size is 20, expected 110"):
+    with pytest.raises(ValueError, match=r"filters\[1\]: reference has 20 bins, the image 110"):
         step_filters([good, bad], image)
     np.testing.assert_array_equal(good.particles, twin.particles)
     np.testing.assert_array_equal(good.weights, twin.weights)

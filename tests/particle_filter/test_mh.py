@@ -249,3 +249,132 @@ def test_filter_follows_a_moving_object(rng):
         assert 0.0 <= f.acceptance <= 1.0
     assert abs(state.box_cxcywh[0] - cx) < 4 and abs(state.box_cxcywh[1] - 30) < 4
     assert state.rho > 0.8
+
+
+# ---- large boxes on a lattice (FilterConfig.min_samples), as the SIS filter counts them ----
+
+
+def _big_scene(rng: np.random.Generator):
+    frame = rng.integers(0, 256, (240, 320, 3), dtype=np.uint8)
+    frame[40:200, 100:160] = (30, 40, 200)  # a red walker (BGR)
+    frame[120:200, 100:160] = (200, 120, 20)  # in blue trousers
+    mask = np.zeros(frame.shape[:2], np.uint8)
+    mask[20:220, 60:260] = 1
+    return _core.hsv_bins(frame, mask)
+
+
+def _big_call(p, w, m, img, r, min_samples=None, **kw):
+    extra = {} if min_samples is None else {"min_samples": float(min_samples)}
+    return _core.mh_step(
+        p, w, m, img, r, 60.0, 160.0, A, B, [3.0, 3.0, 0.02], 0.5, 2.0, False, 20.0,
+        "uniform", True, 11, 4, n_iter=kw.get("n_iter", 5), burn_in=2,
+        proposal=kw.get("proposal", "dynamics"), rw_sigma=np.array([2.0, 2.0, 0.01]), **extra,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("proposal", ["dynamics", "random_walk"])
+@pytest.mark.parametrize("min_samples", [0, 200, 1000, 3000])
+def test_min_samples_counts_the_lattice_of_the_sis_filter(rng, proposal, min_samples):
+    """mh_step counts each box on the lattice sis_step uses (lattice_step of the previous mean
+    state's box): the chains, the coefficients and the counted pixels of the NumPy reference
+    whose histograms are tests/reference/kernels.py::box_histograms(..., step) (was: every
+    pixel, whatever min_samples)."""
+    from tests.reference import kernels
+
+    img = _big_scene(rng)
+    r = kernels.box_histograms(img.bins, img.n_bins, [[130, 120, 60, 160]])[0] + 1e-3
+    n = 12
+    p = particles_at(n, 128.0, 121.0, vx=1.0)
+    p[:, 0] += np.arange(n) * 0.5
+    p[:, 2] = p[:, 5] = 1.02
+    w = np.full(n, 1 / n)
+    m = np.array([[130.0, 120.0, 1.02], [129.0, 119.0, 1.0]])
+    k = kernels.lattice_step(1.02 * 60, 1.02 * 160, min_samples)
+    assert k == {0: 1, 200: 7, 1000: 3, 3000: 1}[min_samples]
+    details: dict[str, list[float]] = {}
+    expect, mean, acc = ref.mh_step(
+        p, img.bins, img.n_bins, r, 60.0, 160.0, A, B, [3.0, 3.0, 0.02], 0.5, 2.0, 20.0, 11, 4,
+        5, 2, proposal, (2.0, 2.0, 0.01), lattice=k, details=details,
+    )  # fmt: skip
+    out = _big_call(p, w, m, img, r, min_samples, proposal=proposal)
+    np.testing.assert_allclose(p, expect, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(out["mean"], mean, atol=1e-9)
+    assert out["acceptance"] == pytest.approx(acc)
+    assert out["rho_max"] == pytest.approx(max(details["rho"]), rel=1e-12)
+    assert out["rho_mean"] == pytest.approx(np.mean(details["rho"]), rel=1e-12)
+    assert out["fg_mean"] == pytest.approx(np.mean(details["counted"]), rel=1e-12)
+
+
+def test_min_samples_box_coefficient_equals_the_sis_filters(rng):
+    """The same box on the same lattice has the same coefficient in mh_step as in sis_step: a
+    single particle, no noise, one rejected-or-not move back to the same state."""
+    img = _big_scene(rng)
+    r = _core.box_histograms(img, np.array([[130.0, 120, 60, 160]]))[0] + 1e-3
+    model = Ar2Model(sigma_xy=0.0, sigma_s=0.0, s_min=0.5, s_max=2.0)
+    got = {}
+    for name in ("sis", "mh"):
+        p = np.array([[131.3, 119.6, 1.1, 131.3, 119.6, 1.1]])
+        w, m = np.ones(1), np.array([[131.3, 119.6, 1.1], [131.3, 119.6, 1.1]])
+        args = (p, w, m, img, r, 60.0, 160.0, model.a, model.b, model.sigma, model.s_min,
+                model.s_max, False, 20.0, "uniform", True, 5, 0)  # fmt: skip
+        if name == "sis":
+            got[name] = _core.sis_step(*args, 1000.0)
+        else:
+            got[name] = _core.mh_step(*args, n_iter=1, min_samples=1000.0)
+    assert got["mh"]["rho_max"] == got["sis"]["rho_max"]  # bit for bit
+    assert got["mh"]["fg_mean"] == got["sis"]["fg_mean"]
+    full = _core.mh_step(
+        np.array([[131.3, 119.6, 1.1, 131.3, 119.6, 1.1]]), np.ones(1),
+        np.array([[131.3, 119.6, 1.1], [131.3, 119.6, 1.1]]), img, r, 60.0, 160.0, model.a,
+        model.b, model.sigma, model.s_min, model.s_max, False, 20.0, "uniform", True, 5, 0,
+    )  # fmt: skip
+    assert full["fg_mean"] != got["mh"]["fg_mean"]  # the lattice was used (step 3)
+
+
+def test_min_samples_zero_is_every_pixel_bit_for_bit(rng):
+    """min_samples=0 (and boxes under 4 min_samples pixels) leave mh_step as it was: the same
+    bits as without the argument, which counts every pixel."""
+    img = _big_scene(rng)
+    r = _core.box_histograms(img, np.array([[130.0, 120, 60, 160]]))[0] + 1e-3
+    runs = []
+    for ms in (None, 0, 1e6):  # 1e6: the 60x160 box is under 4 min_samples pixels: step 1
+        p = particles_at(20, 128.0, 121.0, vx=1.0)
+        p[:, 0] += np.arange(20) * 0.5
+        w, m = np.full(20, 1 / 20), np.array([[130.0, 120.0, 1.0], [129.0, 119.0, 1.0]])
+        out = _big_call(p, w, m, img, r, ms)
+        runs.append((p.tobytes(), m.tobytes(), repr(sorted(out.items(), key=lambda kv: kv[0]))))
+    assert runs[0] == runs[1] == runs[2]
+
+
+def test_filter_passes_min_samples(rng):
+    """MHColourParticleFilter steps with its FilterConfig.min_samples (was: every pixel, the
+    core's default), bit for bit the core's step given the same value."""
+    import dataclasses
+
+    from pftrack.particle_filter import hsv_bins
+
+    frame = rng.integers(0, 256, (240, 320, 3), dtype=np.uint8)
+    frame[40:200, 100:160] = (30, 40, 200)
+    img = hsv_bins(frame)
+    box = np.array([130.0, 120.0, 60.0, 160.0])
+    r = _core.box_histograms(img, box[None])[0] + 1e-3
+    rho = {}
+    for ms in (0, 300):
+        cfg = dataclasses.replace(FilterConfig(n_particles=30), min_samples=ms)
+        f = MHColourParticleFilter(box, r, cfg, rng=4)
+        g = MHColourParticleFilter(box, r, cfg, rng=4)
+        mm = g.config.model
+        rho[ms] = []
+        for _ in range(3):
+            st = f.step(img)
+            out = _core.mh_step(
+                g.particles, g.weights, g.means, img, g.reference, g.w0, g.h0, mm.a, mm.b,
+                mm.sigma, mm.s_min, mm.s_max, mm.use_means, g.config.lam, g.config.kernel, True,
+                g._seed, g._step, n_iter=1, burn_in=0, proposal="dynamics",
+                rw_sigma=np.array([2.0, 2.0, 0.01]), min_samples=float(ms),
+            )  # fmt: skip
+            g._step += 1
+            assert (out["fg_mean"], out["rho_mean"]) == (st.foreground, st.rho)
+            np.testing.assert_array_equal(f.particles, g.particles)
+            rho[ms].append(st.rho)
+    assert rho[0] != rho[300]  # 60x160 boxes: every pixel, or a lattice of step 5

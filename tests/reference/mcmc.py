@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 
+from tests.reference import kernels
+
 MASK64 = (1 << 64) - 1
 
 
@@ -94,9 +96,14 @@ def mh_step(
     burn_in,
     proposal,
     rw_sigma,
+    lattice=1,
+    details=None,
 ):
     """Returns (new particles, mean estimate, acceptance). Input weights must be equal
-    (systematic resampling then keeps every particle in order)."""
+    (systematic resampling then keeps every particle in order). `lattice` > 1 counts each box
+    on the lattice of that step (kernels.box_histograms(..., step), as the SIS reference does);
+    `details`, a dict, gets each final particle's "rho" and "counted" (pixels, or lattice
+    points times step^2)."""
     rng = CounterRng(seed, step)
     out = particles.copy()
     a, b, sigma, rw_sigma = (np.asarray(v, float) for v in (a, b, sigma, rw_sigma))
@@ -106,8 +113,25 @@ def mh_step(
             return -np.inf
         return -0.5 * np.sum(((x - mu) / sigma) ** 2)
 
+    def box_of(x):
+        return (x[0], x[1], x[2] * w0, x[2] * h0)
+
+    def rho_counted(x):
+        if lattice == 1:
+            h, counted = histogram(bins, n_bins, box_of(x))
+        else:
+            h = kernels.box_histograms(bins, n_bins, [box_of(x)], "uniform", lattice)[0]
+            x0, x1, y0, y1 = box_pixels(*box_of(x), *bins.shape)
+            x0, y0 = -(-x0 // lattice) * lattice, -(-y0 // lattice) * lattice
+            patch = bins[y0:y1:lattice, x0:x1:lattice]
+            counted = float(np.count_nonzero(patch >= 0)) * lattice**2
+        return float(np.sum(np.sqrt(h * ref / ref.sum()))), counted
+
     def loglik(x):
-        return colour_loglik(bins, n_bins, (x[0], x[1], x[2] * w0, x[2] * h0), ref, lam)
+        if lattice == 1:
+            return colour_loglik(bins, n_bins, box_of(x), ref, lam)
+        rho, _ = rho_counted(x)
+        return -lam * max(0.0, 1.0 - min(rho, 1.0))
 
     acc = prop = 0
     total = np.zeros(3)
@@ -145,6 +169,10 @@ def mh_step(
                 total += x
         out[i, 3:] = particles[par, :3]
         out[i, :3] = x
+        if details is not None:
+            rho, counted = rho_counted(x)
+            details.setdefault("rho", []).append(rho)
+            details.setdefault("counted", []).append(counted)
     return out, total / prop, acc / prop
 
 

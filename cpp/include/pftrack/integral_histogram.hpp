@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 #if defined(__SSE2__)
@@ -411,11 +412,14 @@ private:
 /// `sqrt_ref`. Uniform kernel: for_each_box_count (bit-identical to counting each box);
 /// Epanechnikov: each box directly. With `step` > 1 only the points of the lattice of that step
 /// are counted (LatticeImage; `counted` is then the points counted times step^2).
+/// `shared`: scratch space of the caller's to reuse (for img.n_bins bins), else a local one.
 template <class Derived>
 inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
                              const double* sqrt_ref, Kernel kernel, BoxPath path, double* rho,
-                             double* counted, Index step = 1) {
-    HistogramScratch scratch(img.n_bins);
+                             double* counted, Index step = 1, HistogramScratch* shared = nullptr) {
+    std::optional<HistogramScratch> own;
+    if (shared == nullptr) own.emplace(img.n_bins);
+    HistogramScratch& scratch = shared != nullptr ? *shared : *own;
     if (step > 1) {
         std::vector<PixelRange> ranges;
         const LatticeImage lattice(img, boxes, step, ranges);

@@ -27,6 +27,9 @@
 // Both are computed with every term of eq. 5 written out (log space), not with the reduced form.
 // The dynamics density is the Gaussian truncated to s in [s_min, s_max]: a proposal outside the
 // scale bounds has target 0 and is rejected. A component with C = 0 is deterministic.
+// Histograms: with base.min_samples > 0 every box of the step is counted on the lattice sis_step
+// uses (lattice_step of the previous mean state's box, one step for all evaluations of the
+// frame), so a box has the same coefficient as in sis_step; min_samples 0 counts every pixel.
 #pragma once
 
 #include <algorithm>
@@ -87,10 +90,20 @@ struct MhEval {
 };
 
 inline MhEval mh_evaluate(HistogramScratch& scratch, std::vector<double>& hist, const BinImage& img,
-                          const double* sqref, const double* x, const SisParams& p) {
+                          const double* sqref, const double* x, const SisParams& p,
+                          Index lattice) {
     MhEval e;
-    e.counted = scratch.compute(img, x[0], x[1], x[2] * p.w0, x[2] * p.h0, p.kernel, hist.data());
-    e.rho = bhattacharyya_coefficient_row(hist.data(), sqref, img.n_bins);
+    if (lattice > 1) {
+        // as sis_step counts a box on a lattice of step `lattice` (box_coefficients: the same
+        // points, the same coefficient of their counts, counted = points x step^2)
+        const Eigen::Matrix<double, 1, 4> box(x[0], x[1], x[2] * p.w0, x[2] * p.h0);
+        box_coefficients(img, box, sqref, p.kernel, BoxPath::kDirect, &e.rho, &e.counted, lattice,
+                         &scratch);
+    } else {  // every pixel
+        e.counted = scratch.compute(img, x[0], x[1], x[2] * p.w0, x[2] * p.h0, p.kernel,
+                                    hist.data());
+        e.rho = bhattacharyya_coefficient_row(hist.data(), sqref, img.n_bins);
+    }
     const double d = bhattacharyya_distance_from_rho(e.rho);
     e.loglik = -p.lambda * d * d;
     return e;
@@ -130,6 +143,10 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
 
     HistogramScratch scratch(img.n_bins);
     std::vector<double> hist(static_cast<size_t>(img.n_bins));
+    // Large boxes are counted on a lattice, as in sis_step: one step for every evaluation of the
+    // frame, from the box of the previous mean state (min_samples 0: every pixel, step 1).
+    const Index lattice =
+        lattice_step(means(0, 2) * prm.base.w0, means(0, 2) * prm.base.h0, prm.base.min_samples);
     const std::uint64_t per_particle = static_cast<std::uint64_t>(prm.n_iter) + 1;
     Eigen::Vector3d mean_sum = Eigen::Vector3d::Zero();
     Eigen::VectorXd rho(n), counted(n), logpost(n);
@@ -144,7 +161,7 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
         for (int d = 0; d < kStateDim; ++d)
             x[d] = mu(par, d) + model.sigma[d] * rng.normal(slot(0) + static_cast<std::uint64_t>(d));
         x[2] = std::clamp(x[2], model.s_min, model.s_max);
-        detail::MhEval cur = detail::mh_evaluate(scratch, hist, img, sqref.data(), x, prm.base);
+        detail::MhEval cur = detail::mh_evaluate(scratch, hist, img, sqref.data(), x, prm.base, lattice);
         double cur_lp = ar2_log_density(x, mu.row(par).data(), model);
         for (int it = 1; it <= prm.n_iter; ++it) {
             const std::uint64_t k = slot(static_cast<std::uint64_t>(it));
@@ -161,7 +178,7 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
             bool accept = false;
             detail::MhEval prop{};
             if (std::isfinite(prop_lp)) {
-                prop = detail::mh_evaluate(scratch, hist, img, sqref.data(), xs, prm.base);
+                prop = detail::mh_evaluate(scratch, hist, img, sqref.data(), xs, prm.base, lattice);
                 // log q(x | x*) - log q(x* | x): dynamics proposal -> (1/N) p(x|x_{t-1}^j) /
                 // [(1/N) p(x*|x_{t-1}^j*)]; random walk -> 0 (symmetric Gaussian, same parent).
                 const double log_q_ratio =

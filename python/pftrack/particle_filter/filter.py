@@ -57,7 +57,7 @@ class FilterConfig:
         pixels on, at most 64 and at most half the box's shorter side (a thin box keeps
         pixels across it). The default 2048 keeps more pixels per box than a walker of PETS09-S2L1
         (about 30x80 at 480x360) has in full, so those boxes are counted in full. 0 counts
-        every pixel of every box.
+        every pixel of every box. The Metropolis-Hastings filter counts on the same lattice.
 
     Raises
     ------
@@ -198,6 +198,35 @@ def _in_use(owner: object, method: str, what: str | None = None) -> RuntimeError
     return RuntimeError(
         f"{method}: {what or f'this {kind}'} is in use by another thread (use one {kind} per "
         "thread, or a lock around it)"
+    )
+
+
+#: The core's words for a reference of another length than the image's bins.
+_REF_SIZE = re.compile(r"ref size is (\d+), expected (\d+)")
+
+
+def _public_error(exc: ValueError, internal: str, public: str) -> ValueError | None:
+    """`exc` of the core's step `internal`, named by the public function that called it.
+
+    ``sis_step: what`` becomes ``ColourParticleFilter.step: what`` (`public`); None when `exc`
+    is not the core's step's. Asked only once the core has refused the arguments, so the step
+    itself pays nothing.
+    """
+    text = str(exc)
+    head = f"{internal}: "
+    if not text.startswith(head):
+        return None
+    return ValueError(f"{public}: {_plain(text[len(head) :])}")
+
+
+def _plain(what: str) -> str:
+    """A core message about the step's values, in the public API's words."""
+    return _REF_SIZE.sub(
+        lambda m: (
+            f"reference has {m[1]} bins, the image {m[2]} (a reference of another binning than "
+            "the image's: bin both with the same HsvBinning)"
+        ),
+        what,
     )
 
 
@@ -526,6 +555,11 @@ class ColourParticleFilter:
                 if error is None:
                     raise
                 raise error from None
+            except ValueError as exc:  # "sis_step: what" -> "ColourParticleFilter.step: what"
+                renamed = _public_error(exc, "sis_step", f"{type(self).__name__}.step")
+                if renamed is None:
+                    raise
+                raise renamed from None
             self._step += 1
             cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
             state = FilterState(
@@ -543,6 +577,8 @@ class ColourParticleFilter:
 
 #: How the core names a batch's bad entry: ``sis_step_batch: entry K: what is wrong``.
 _ENTRY = re.compile(r"sis_step_batch: entry (\d+): (.*)", re.DOTALL)
+#: ... and a bad array of one: ``sis_step_batch: weights[K] must have shape (N,), ...``.
+_ITEM = re.compile(r"sis_step_batch: (particles|weights|means|refs)\[(\d+)\] (.*)", re.DOTALL)
 
 
 def step_filters(
@@ -574,9 +610,10 @@ def step_filters(
         An element that is not a ColourParticleFilter.
     ValueError
         The same filter twice in `filters`; a filter whose particles, weights or reference
-        the core refuses (``step_filters: filters[k]: ref size is 20, expected 1000``: a
-        reference of another binning than the image's), found before any filter of the batch
-        has stepped.
+        the core refuses (``step_filters: filters[k]: reference has 20 bins, the image
+        110 (...)``: a reference of another binning than the image's), found before any filter
+        of the batch has stepped (a filter that steps one by one, e.g. a Metropolis-Hastings
+        one, is named the same way, after the filters before it have stepped).
     RuntimeError
         Another thread is inside one of the filters (``step_filters: filters[k] is in use by
         another thread``); then no filter has stepped.
@@ -620,11 +657,7 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
             try:
                 out = _step_batch(fs, cfg, image)
             except ValueError as exc:  # a bad entry, found before any filter stepped
-                named = _ENTRY.match(str(exc))
-                if named is None:
-                    raise
-                k = batch[int(named.group(1))]
-                raise ValueError(f"step_filters: filters[{k}]: {named.group(2)}") from None
+                raise _batch_error(exc, batch) from None
             for f, row in zip(fs, out.tolist(), strict=True):
                 f._last, f._last_row = None, (row, col, f.w0, f.h0)
         finally:
@@ -637,9 +670,33 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
         done = set(batch)
         for k, f in enumerate(filters):
             if k not in done:
-                st = f.step(image)
+                try:
+                    st = f.step(image)
+                except ValueError as exc:  # "X.step: what" -> "step_filters: filters[k]: what"
+                    renamed = _public_error(exc, f"{type(f).__name__}.step", "step_filters")
+                    if renamed is None:
+                        raise
+                    raise ValueError(
+                        str(renamed).replace("step_filters: ", f"step_filters: filters[{k}]: ", 1)
+                    ) from None
                 summary[k] = (st.box_cxcywh[0], st.box_cxcywh[1], st.rho, st.rho_max)
     return summary
+
+
+def _batch_error(exc: ValueError, batch: Sequence[int]) -> ValueError:
+    """``sis_step_batch``'s error `exc` as step_filters' (``step_filters: filters[k]: what``).
+
+    k is the filter's index in step_filters' argument; `batch` maps the batch's to it.
+    """
+    text = str(exc)
+    named = _ENTRY.match(text)
+    if named is not None:
+        return ValueError(f"step_filters: filters[{batch[int(named[1])]}]: {_plain(named[2])}")
+    item = _ITEM.match(text)
+    if item is not None:
+        name = "reference" if item[1] == "refs" else item[1]
+        return ValueError(f"step_filters: filters[{batch[int(item[2])]}].{name} {item[3]}")
+    return _public_error(exc, "sis_step_batch", "step_filters") or exc
 
 
 def _step_batch(

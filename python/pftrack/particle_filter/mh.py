@@ -25,6 +25,7 @@ from pftrack.particle_filter.filter import (
     FilterConfig,
     FilterState,
     _in_use,
+    _public_error,
     _step_argument_error,
 )
 
@@ -100,12 +101,18 @@ class MHColourParticleFilter(ColourParticleFilter):
                     self.config.lam, self.config.kernel, True, self._seed, self._step,
                     n_iter=self.n_iter, burn_in=0, proposal="dynamics",
                     rw_sigma=np.array([2.0, 2.0, 0.01]),
+                    min_samples=float(self.config.min_samples),
                 )  # fmt: skip
             except TypeError:  # as ColourParticleFilter.step: say which argument
                 error = _step_argument_error(image, self)
                 if error is None:
                     raise
                 raise error from None
+            except ValueError as exc:  # "mh_step: what" -> "MHColourParticleFilter.step: what"
+                renamed = _public_error(exc, "mh_step", f"{type(self).__name__}.step")
+                if renamed is None:
+                    raise
+                raise renamed from None
             self._step += 1
             self.acceptance = float(r["acceptance"])
             cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
