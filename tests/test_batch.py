@@ -556,7 +556,7 @@ def test_a_truth_that_cannot_be_scored_keeps_the_tracks(
 
 
 def test_resume_skips_complete_outputs_and_force_redoes(
-    data: Path, client: Any, tmp_path: Path
+    data: Path, client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "out"
     argv = ["batch", str(data), "--out", str(out), "--scheduler", client.scheduler.address]
@@ -568,8 +568,13 @@ def test_resume_skips_complete_outputs_and_force_redoes(
         summary = json.loads((out / "summary.json").read_text())
         return {s["name"]: s["status"] for s in summary["sequences"]}
 
+    capsys.readouterr()
     assert main([*argv, *FAST]) == 0
     assert set(statuses().values()) == {"skipped"}
+    # was "0.0 s, in this process" with --scheduler given (a README trial): nothing ran anywhere
+    assert re.search(
+        r"3 sequences: 3 skipped; \d+\.\d s, nothing to run\n", capsys.readouterr().out
+    )
     assert all(out.joinpath(n).stat().st_mtime_ns == t for n, t in stamp.items() if n[0] != "s")
     # a sequence whose outputs are gone is redone, alone
     (out / "plain.json").unlink()

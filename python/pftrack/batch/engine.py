@@ -194,6 +194,8 @@ class BatchSummary:
             f"{n} {s}" for s in _STATUSES if (n := sum(e["status"] == s for e in self.entries))
         )
         where = _count(self.workers, "worker") if self.workers else "in this process"
+        if not self.workers and all(e["status"] == "skipped" for e in self.entries):
+            where = "nothing to run"  # no cluster is started or asked for skipped inputs
         if self.scheduler:
             where += f" at {self.scheduler}"
         noun = "sequence" if self.kind == "track" else "file"
