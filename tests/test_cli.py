@@ -776,6 +776,35 @@ def test_the_command_on_a_full_device_or_a_closed_pipe_prints_no_traceback(
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
+@pytest.mark.parametrize(
+    ("words", "prog"),
+    [(["--help"], "pftrack"), (["track", "--help"], "pftrack track"), (["--version"], "pftrack")],
+)
+def test_help_and_version_on_a_full_device_say_so(words: list[str], prog: str) -> None:
+    """Was: ``pftrack --help > /dev/full`` printed nothing and exited 0 (argparse ignores a
+    failed write); a closed pipe still ends quietly with status 0, as ``| head`` expects."""
+    import subprocess
+    import sys
+
+    argv = [sys.executable, "-m", "pftrack", *words]
+    with open("/dev/full", "wb") as full:
+        run = subprocess.run(argv, stdout=full, stderr=subprocess.PIPE, text=True, check=False,
+                             timeout=60)  # fmt: skip
+    assert (run.returncode, run.stderr) == (
+        2,
+        f"{prog}: error: cannot write to standard output (No space left on device)\n",
+    )
+    read, write = os.pipe()
+    os.close(read)
+    try:
+        run = subprocess.run(argv, stdout=write, stderr=subprocess.PIPE, text=True, check=False,
+                             timeout=60)  # fmt: skip
+    finally:
+        os.close(write)
+    assert (run.returncode, run.stderr) == (0, "")
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
 @pytest.mark.parametrize("option", ["--out", "--plot"])
 def test_a_track_write_error_names_the_output(
     video: Path, tmp_path: Path, option: str, capsys: pytest.CaptureFixture[str]

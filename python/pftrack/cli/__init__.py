@@ -14,7 +14,7 @@ import os
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from pftrack import __version__
 from pftrack.cli import batch, demo, evaluate, experiment, recover, render, smooth, track
@@ -30,6 +30,9 @@ from pftrack.cli._signals import (
     sigterm_raises,
 )
 
+if TYPE_CHECKING:
+    from _typeshed import SupportsWrite
+
 __all__ = ["build_parser", "main"]
 
 EPILOG = """\
@@ -39,7 +42,7 @@ examples:
   pftrack track MOT17-04/ --detections auto --out tracks.txt        # a MOTChallenge sequence
   pftrack track 0 --out live.txt --render live.mp4                  # camera 0; Ctrl-C ends it
   pftrack track seq/img1 --detections det.txt --out tracks.txt      # drop-in for any detector
-  pftrack batch videos/ MOT17/train/ --out results/ --detections auto  # many, on Dask
+  pftrack batch MOT17/train/ --out results/ --detections auto       # many, on Dask
   pftrack eval --gt gt.txt --res tracks.txt --scale 0.625
   pftrack recover tracks.txt --out filled.txt --link                # default method: auto
   pftrack smooth bytetrack.txt --out smoothed.txt                   # any tracker's output
@@ -58,6 +61,29 @@ class Parser(argparse.ArgumentParser):
     def error(self, message: str) -> NoReturn:
         """Print ``PROG: error: MESSAGE`` and exit with status 2."""
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+    def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
+        """Print help, usage or the version; a failed write says so, as commands' output does.
+
+        argparse's own ignores it: ``pftrack --help > /dev/full`` printed nothing and exited
+        0. A closed pipe (``| head``) still ends quietly, as Unix tools do.
+        """
+        if not message:
+            return
+        stream: Any = file or sys.stderr  # a text stream (argparse passes sys.stdout or stderr)
+        try:
+            stream.write(message)
+            stream.flush()
+        except OSError as exc:
+            with contextlib.suppress(OSError, ValueError):  # nothing left to flush at exit
+                os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
+            if isinstance(exc, BrokenPipeError) or stream is sys.stderr:
+                return
+            print(
+                f"{self.prog}: error: cannot write to standard output ({exc.strerror or exc})",
+                file=sys.stderr,
+            )
+            sys.exit(2)
 
 
 def build_parser() -> argparse.ArgumentParser:
