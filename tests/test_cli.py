@@ -775,6 +775,39 @@ def test_the_command_on_a_full_device_or_a_closed_pipe_prints_no_traceback(
     assert (run.returncode, run.stderr) == (1, "")
 
 
+@pytest.mark.parametrize(
+    ("argv", "what"),
+    [
+        (["track", "L", "--out", "O"], "video source"),
+        (["render", "L", "T", "--out", "O.mp4"], "video source"),
+        (["track", "V", "--detections", "L", "--out", "O"], "--detections"),
+        (["recover", "L", "--out", "O"], "tracks file"),
+        (["smooth", "L", "--out", "O"], "tracks file"),
+        (["eval", "--gt", "T", "--res", "L"], "--res"),
+        (["experiment", "gaps", "--gt", "L", "--image-size", "768x576"], "ground truth"),
+    ],
+    ids=["track", "render", "detections", "recover", "smooth", "eval", "experiment"],
+)
+def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
+    argv: list[str], what: str, tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: a traceback (``RuntimeError: Symlink loop``, from ``Path.resolve`` while outputs
+    were checked against the inputs) for track, render and experiment gaps, and "not found"
+    for the others, though the link is there."""
+    loop = tmp_path / "a"
+    loop.symlink_to("b")
+    (tmp_path / "b").symlink_to("a")
+    tracks = _tracks(tmp_path / "t.txt")
+    names = {"L": str(loop), "T": str(tracks), "V": str(video), "O": str(tmp_path / "o.txt")}
+    names["O.mp4"] = str(tmp_path / "o.mp4")
+    assert main([names.get(x, x) for x in argv]) == 2
+    assert capsys.readouterr().err.endswith(
+        f"error: {what} {loop}: symbolic link loop ({loop} -> b -> a), which leads to no file "
+        "or folder; point the link at one\n"
+    )
+    assert not (tmp_path / "o.txt").exists() and not (tmp_path / "o.mp4").exists()
+
+
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
 @pytest.mark.parametrize(
     ("words", "prog"),

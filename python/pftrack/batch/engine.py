@@ -39,9 +39,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
-from pftrack.batch.inputs import link_loop
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
-from pftrack.io.atomic import atomic_write, check_output, check_output_folder
+from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
 

@@ -11,7 +11,6 @@ warning does.
 
 from __future__ import annotations
 
-import errno
 import json
 import os
 import warnings
@@ -20,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pftrack._typing import PathLike
-from pftrack.io.atomic import refuse_dash
+from pftrack.io.atomic import link_loop, refuse_dash, resolved
 from pftrack.io.video import (
     VIDEO_SUFFIXES,
     image_files,
@@ -419,32 +418,6 @@ def _broken_link(path: Path) -> bool:
     return path.is_symlink() and not path.exists()
 
 
-def link_loop(path: Path) -> str | None:
-    """``a -> b -> a`` when `path`'s symbolic links lead to each other, else None.
-
-    The links `path` leads through, as ``readlink`` gives them, up to the first one met again;
-    for a loop on the way to `path` (a folder above it), that it lies beyond one.
-    """
-    try:
-        os.stat(path)
-        return None
-    except OSError as exc:
-        if exc.errno != errno.ELOOP:
-            return None
-    chain, seen, p = [str(path)], set(), path
-    while p.is_symlink() and len(chain) < 10:
-        key = os.path.abspath(p)
-        if key in seen:
-            return " -> ".join(chain)
-        seen.add(key)
-        target = os.readlink(p)
-        chain.append(target)
-        p = p.parent / target
-    if len(chain) > 1:
-        return " -> ".join([*chain, "..."])
-    return "a folder on its way is one"
-
-
 def _check_exists(path: Path) -> None:
     """Refuse an input that does not exist, naming a broken symbolic link or a loop as one."""
     loop = link_loop(path)
@@ -513,6 +486,6 @@ def _named_by(name: str, source: Path) -> Path:
 def _same_file(a: Path, b: Path) -> bool:
     """Whether `a` and `b` name the same file or folder (links and ``..`` resolved)."""
     try:
-        return a == b or a.resolve() == b.resolve() or os.path.samefile(a, b)
+        return a == b or resolved(a) == resolved(b) or os.path.samefile(a, b)
     except (OSError, RuntimeError):  # RuntimeError: a link loop (Python < 3.13's resolve)
         return False

@@ -242,9 +242,10 @@ def check_input_file(path: str, *, what: str) -> None:
     if p.is_dir():
         raise ValueError(f"{what} {path} is a folder, not a file")
     if not p.exists():
-        from pftrack.io.atomic import refuse_dash
+        from pftrack.io.atomic import refuse_dash, refuse_loop
 
         refuse_dash(path, what)
+        refuse_loop(path, what)
         raise FileNotFoundError(f"{what} not found: {path}")
     if not p.is_file():
         raise ValueError(f"{what} {path} is not a regular file (a device, pipe or socket)")

@@ -151,11 +151,13 @@ def _jobs(args: argparse.Namespace) -> list[tuple[str, Any, Path]]:
     """(name, SequenceInfo, result file) of every sequence to score, checked before work."""
     from pftrack.eval import find_sequences
     from pftrack.eval.sequences import result_file, sequence_of_file
-    from pftrack.io.atomic import refuse_dash
+    from pftrack.io.atomic import refuse_dash, refuse_loop
 
     gt, res = Path(args.gt), Path(args.res)
     refuse_dash(args.gt, "--gt", name="file or folder")
     refuse_dash(args.res, "--res", name="file or folder")
+    for what, given in (("--gt", gt), ("--res", res)):
+        refuse_loop(given, what)
     if not gt.exists():
         raise FileNotFoundError(f"ground truth not found: {gt} (a MOTChallenge file or folder)")
     for what, given in (("--gt", gt), ("--res", res)):

@@ -142,7 +142,9 @@ def _parse_size(values: Sequence[str]) -> tuple[float, float]:
 
 def _seqinfo_file(gt_path: str) -> Path | None:
     """The ``seqinfo.ini`` beside the ground truth or one folder up (None: there is none)."""
-    gt = Path(gt_path).resolve()
+    from pftrack.io.atomic import resolved
+
+    gt = resolved(gt_path)
     for folder in (gt.parent, gt.parent.parent):
         if (folder / "seqinfo.ini").is_file():
             return folder / "seqinfo.ini"
@@ -233,6 +235,8 @@ def _check_distinct_gt(paths: list[str]) -> None:
 
     It would be one sequence counted twice: two rows, and its gaps twice in the pooled MMAE.
     """
+    from pftrack.io.atomic import resolved
+
     seen: dict[object, str] = {}
     for path in paths:
         p = Path(path)
@@ -240,7 +244,7 @@ def _check_distinct_gt(paths: list[str]) -> None:
             st = p.stat()
             key: object = (st.st_dev, st.st_ino)
         except OSError:  # missing: refused when read; compared by name meanwhile
-            key = p.resolve()
+            key = resolved(p)
         if key in seen:
             raise ValueError(
                 f"--gt {seen[key]} and {path} are the same file; give each sequence once"
@@ -424,6 +428,7 @@ def _write_figure(path: str, image: Any) -> None:
 def _run_sequences(args: argparse.Namespace) -> int:
     """The multi-sequence protocol with automatic masks (``--gt A B ...`` or ``--auto-masks``)."""
     from pftrack._progress import progress
+    from pftrack.io.atomic import resolved
     from pftrack.recovery import experiment as E
     from pftrack.recovery.linking import read_tracks
 
@@ -439,7 +444,7 @@ def _run_sequences(args: argparse.Namespace) -> int:
             where = f"{_seqinfo_file(path)}: imWidth x imHeight"
         elif args.image_size:
             width, height = _parse_size(args.image_size)
-            p = Path(path).resolve()  # SEQ/gt/gt.txt or SEQ/gt.txt: the sequence; else the file
+            p = resolved(path)  # SEQ/gt/gt.txt or SEQ/gt.txt: the sequence; else the file
             name = p.parent.name if p.stem == "gt" else p.stem
             where = f"{path}: --image-size"  # the sequence named: the size is for it
         else:

@@ -28,6 +28,7 @@ from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
 from pftrack.eval.rows import _mot_iou, not_parts_message
+from pftrack.io.atomic import resolved
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, WIDTH
 
 __all__ = [
@@ -116,7 +117,7 @@ def sequence_of_file(gt_file: PathLike, name: str) -> SequenceInfo:
     parent = path.parent
     for folder in (parent.parent, parent) if parent.name == "gt" else (parent,):
         seq = _sequence(folder)
-        if seq is not None and seq.gt_path.resolve() == path.resolve():
+        if seq is not None and resolved(seq.gt_path) == resolved(path):
             return dataclasses.replace(seq, name=name)
     return SequenceInfo(name, path)
 

@@ -498,6 +498,66 @@ def _copy_through(tmp: Path, target: _Target, *, empty_ok: bool = False) -> None
         shutil.copyfileobj(src, dst)
 
 
+def link_loop(path: PathLike) -> str | None:
+    """``a -> b -> a`` when `path`'s symbolic links lead to each other, else None.
+
+    The links `path` leads through, as ``readlink`` gives them, up to the first one met again;
+    for a loop on the way to `path` (a folder above it), that it lies beyond one.
+    """
+    path = Path(os.fspath(path))
+    try:
+        os.stat(path)
+        return None
+    except OSError as exc:
+        if exc.errno != errno.ELOOP:
+            return None
+    chain, seen, p = [str(path)], set(), path
+    while p.is_symlink() and len(chain) < 10:
+        key = os.path.abspath(p)
+        if key in seen:
+            return " -> ".join(chain)
+        seen.add(key)
+        target = os.readlink(p)
+        chain.append(target)
+        p = p.parent / target
+    if len(chain) > 1:
+        return " -> ".join([*chain, "..."])
+    return "a folder on its way is one"
+
+
+def refuse_loop(path: PathLike, what: str) -> None:
+    """Refuse an input `path` whose symbolic links lead to each other: it names nothing.
+
+    Was: ``video source not found: a`` for ``a -> b -> a`` (with ``b`` there, a link), or a
+    traceback where the path was resolved (``RuntimeError: Symlink loop``, from Python 3.11's
+    ``Path.resolve``).
+
+    Raises
+    ------
+    ValueError
+        ``WHAT PATH: symbolic link loop (a -> b -> a), ...``.
+    """
+    loop = link_loop(path)
+    if loop is not None:
+        raise ValueError(
+            f"{what} {os.fspath(path)}: symbolic link loop ({loop}), which leads to no file or "
+            "folder; point the link at one"
+        )
+
+
+def resolved(path: PathLike) -> Path:
+    """`path` with its symbolic links followed; made absolute only where a loop stops that.
+
+    ``Path.resolve`` raises RuntimeError on a loop in Python 3.11 (OSError later): for
+    comparing paths, a loop is just a path that names nothing.
+    """
+    p = Path(os.fspath(path))
+    try:
+        return p.resolve()
+    except (OSError, RuntimeError):
+        return Path(os.path.abspath(p))
+
+
 def refuse_dash(
     path: PathLike, what: str, *, output: bool = False, name: str = "file", or_else: str = ""
 ) -> None:
@@ -684,13 +744,13 @@ def _one_of(target: Path, files: Iterable[PathLike]) -> bool:
         st = os.stat(target)
     except OSError:
         st = None
-    resolved: Path | None = None
+    target_path: Path | None = None
     for f in files:
         try:
             other = os.stat(f)
         except OSError:  # a missing input: compared by its resolved path
-            resolved = resolved or target.resolve()
-            if Path(f).resolve() == resolved:
+            target_path = target_path or resolved(target)
+            if resolved(f) == target_path:
                 return True
             continue
         if st is not None and (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
@@ -749,7 +809,7 @@ def _same_file(a: Path, b: Path) -> bool:
     """Whether `a` and `b` name one file: the same path once resolved, or one file on disk."""
     if a.exists() and b.exists() and os.path.samefile(a, b):
         return True  # hard links, bind mounts
-    return a.resolve() == b.resolve()
+    return resolved(a) == resolved(b)
 
 
 def _is_devnull(path: Path) -> bool:

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _core
 from pftrack._check import BOX_VALUES, MAX_FRAME, MOT_DEFAULTS, first_bad_box, mot_rows
 from pftrack._typing import F64, PathLike
-from pftrack.io.atomic import atomic_write, refuse_dash
+from pftrack.io.atomic import atomic_write, refuse_dash, refuse_loop
 
 #: Column indices of a MOTChallenge row.
 FRAME, ID, LEFT, TOP, WIDTH, HEIGHT, CONF, X, Y, Z = range(10)
@@ -150,6 +150,7 @@ def read_mot(
         if p.exists():
             raise ValueError(f"{what} {p} is not a regular file (a device, pipe or socket)")
         refuse_dash(p, what)
+        refuse_loop(p, what)
         raise FileNotFoundError(f"{what} not found: {p}")
     _refuse_binary(p, what)
     fast = _read_fast(p)

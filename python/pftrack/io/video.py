@@ -1072,9 +1072,10 @@ class FrameSource:
         else:
             self.path = Path(text)
             if not self.path.exists():
-                from pftrack.io.atomic import refuse_dash
+                from pftrack.io.atomic import refuse_dash, refuse_loop
 
                 refuse_dash(text, "video source", name="video, image folder or sequence folder")
+                refuse_loop(text, "video source")
                 raise FileNotFoundError(f"video source not found: {self.path}")
             self.sequence = find_sequence(self.path)
             if self.sequence is not None and self.path.is_dir():
