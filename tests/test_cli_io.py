@@ -179,6 +179,19 @@ def test_det_scale_hint_is_the_exact_ratio_of_seqinfo(
     err = capsys.readouterr().err
     assert err.endswith(f"--det-scale / load_detections(scale=...), 0.625 here (480 px frames, "
                         f"imWidth=768 in {seq}/seqinfo.ini)\n"), err  # fmt: skip
+    # a wrong scale given: the hint is the whole scale to give, not a factor on top of it
+    # (was "about 0.313" with --det-scale 2, the right value being 0.625)
+    for given in ("2", "1.5"):
+        argv[argv.index("--det-scale") + 1] = given
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.endswith("load_detections(scale=...), 0.625 here (480 px frames, imWidth=768 "
+                            f"in {seq}/seqinfo.ini)\n"), err  # fmt: skip
+    (seq / "seqinfo.ini").unlink()  # no size known: the estimate, also whole
+    argv[1] = str(seq / "img1")
+    argv[argv.index("--detections") + 1] = str(seq / "det" / "det.txt")
+    assert main(argv) == 2
+    assert capsys.readouterr().err.endswith("load_detections(scale=...), about 0.625 here\n")
 
 
 def test_sequence_of_another_shape_than_its_seqinfo_is_refused(

@@ -100,9 +100,23 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
             stacklevel=2,
         )
         rows = rows[~flat]
-    return {
-        f: np.column_stack([r[:, 2:6] * scale, r[:, 6]]) for f, r in group_by_frame(rows).items()
-    }
+    return _Scaled(
+        {f: np.column_stack([r[:, 2:6] * scale, r[:, 6]]) for f, r in group_by_frame(rows).items()},
+        float(scale),
+    )
+
+
+class _Scaled(dict[int, F64]):
+    """:func:`load_detections`' dict, knowing the scale its boxes were multiplied by.
+
+    For the scale a refusal suggests (:func:`_scale_hint`): the file's boxes need the whole
+    factor, not a factor on top of ``--det-scale`` (``--det-scale 2`` on PETS09 suggested
+    0.313, where 0.625 is right).
+    """
+
+    def __init__(self, frames: dict[int, F64], scale: float) -> None:
+        super().__init__(frames)
+        self.scale = scale
 
 
 def track_frames(
@@ -358,7 +372,7 @@ def _check_detections(detections: object, what: str = "detections") -> dict[int,
             r, _, problem = bad
             raise ValueError(f"{name} row {r} {d[r, :4].tolist()}: {problem} (left, top, w, h)")
         checked[f] = d
-    return checked
+    return _Scaled(checked, detections.scale) if isinstance(detections, _Scaled) else checked
 
 
 def _check_last_frame(detections: dict[int, F64], n_frames: int) -> None:
@@ -398,15 +412,23 @@ ROUND_RATIO_REACH = 0.02
 
 
 def _scale_hint(
-    cols: int, rows: int, right: float, bottom: float, sequence: SequenceInfo | None
+    cols: int,
+    rows: int,
+    right: float,
+    bottom: float,
+    sequence: SequenceInfo | None,
+    applied: float = 1.0,
 ) -> str:
     """The scale that brings boxes reaching `right` x `bottom` into `cols` x `rows` frames.
 
-    Exact where it is known: the frames' width over ``seqinfo.ini``'s ``imWidth``, when the
-    boxes fit that size (``0.625 here (480 px frames, imWidth=768 in SEQ/seqinfo.ini)``).
-    Else an estimate from the boxes' reach, which is an upper bound (the boxes seldom reach the
-    last pixel): a round ratio of :data:`ROUND_RATIOS` just below it, or it to 3 digits.
+    `applied`: the scale the boxes were already multiplied by; the hint is the file's whole
+    scale (the value to give ``--det-scale``). Exact where it is known: the frames' width over
+    ``seqinfo.ini``'s ``imWidth``, when the file's boxes fit that size (``0.625 here (480 px
+    frames, imWidth=768 in SEQ/seqinfo.ini)``). Else an estimate from the boxes' reach, which
+    is an upper bound (the boxes seldom reach the last pixel): a round ratio of
+    :data:`ROUND_RATIOS` just below it, or it to 3 digits.
     """
+    right, bottom = right / applied, bottom / applied  # in the file's own pixels
     if sequence is not None and sequence.width is not None:
         w, h = sequence.width, sequence.height
         if right <= w * (1 + SEQINFO_SLACK) and (h is None or bottom <= h * (1 + SEQINFO_SLACK)):
@@ -420,7 +442,7 @@ def _scale_hint(
 
 
 def _check_layout(
-    detections: dict[int, F64], shape: tuple[int, ...], sequence: SequenceInfo | None = None
+    detections: Mapping[int, F64], shape: tuple[int, ...], sequence: SequenceInfo | None = None
 ) -> None:
     """Refuse x1, y1, x2, y2 boxes as left, top, w, h and a larger frame's; warn of a smaller's.
 
@@ -454,7 +476,7 @@ def _check_layout(
             f"{outside.sum()} of {len(d)} detection boxes lie wholly outside the {cols}x{rows} "
             f"frames (they reach {right:.0f}x{bottom:.0f}): are they in a larger frame's "
             f"pixels? Scale them with --det-scale / load_detections(scale=...), "
-            f"{_scale_hint(cols, rows, right, bottom, sequence)}"
+            f"{_scale_hint(cols, rows, right, bottom, sequence, getattr(detections, 'scale', 1.0))}"
         )
     if past.mean() > 0.5 and as_xyxy.all():
         raise ValueError(
