@@ -2560,3 +2560,24 @@ def test_track_sequence_scores_by_the_benchmark_its_trackeval_folder_names(
         rows = read_mot(seq / "gt" / "gt.txt")  # the figures are pftrack eval's under those rules
         want = evaluate_sequence(rows, result.rows, benchmark=expected)
         assert result.info["metrics"]["idf1"] == pytest.approx(want.mot.idf1, abs=0.01)
+
+
+def test_tracks_files_deeper_than_the_folder_are_named(tmp_path: Path) -> None:
+    """A trial's "left": ``pftrack recover trackers/`` with TrackEval's
+    ``trackers/NAME/data/SEQ.txt`` said only "no .txt file in folder trackers"."""
+    data = tmp_path / "trackers" / "mine" / "data"
+    data.mkdir(parents=True)
+    for name in ("a", "b", "c", "d"):
+        (data / f"{name}.txt").write_text("1,1,10,10,20,40,1,-1,-1,-1\n")
+    (tmp_path / "trackers" / ".hidden").mkdir()
+    (tmp_path / "trackers" / ".hidden" / "x.txt").write_text("")
+    with pytest.raises(
+        ValueError,
+        match=rf"^no \.txt file in folder {re.escape(str(tmp_path / 'trackers'))}; "
+        rf"{re.escape(str(data))} holds 4 \(a\.txt, b\.txt, c\.txt, \.\.\.\): pass it instead$",
+    ):
+        find_track_files([tmp_path / "trackers"])
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match=r"^no \.txt file in folder .*empty$"):
+        find_track_files([tmp_path / "empty"])
+    assert [p.stem for p in find_track_files([data])] == ["a", "b", "c", "d"]

@@ -407,10 +407,45 @@ def find_track_files(inputs: Inputs) -> list[Path]:
         )
         files = [p for p in files if not p.name.startswith(".")]
         if not files:
-            raise ValueError(f"no .txt file in folder {path}")
+            raise ValueError(f"no .txt file in folder {path}{_txt_below(path)}")
         found.extend(files)
     _check_names([p.stem for p in found], found)
     return found
+
+
+def _txt_below(folder: Path) -> str:
+    """``; DIR/data holds 3 (a.txt, b.txt, c.txt): pass it instead`` for tracks files deeper.
+
+    A tracker's results often sit a level or two down (TrackEval's
+    ``trackers/NAME/data/SEQ.txt``): was "no .txt file in folder DIR" alone. Breadth first,
+    :data:`DEEPER_LEVELS` levels and :data:`DEEPER_FOLDERS` folders at most, each branch
+    stopping at the first folder that holds ``.txt`` files; hidden entries and symbolic links
+    to folders are passed over. Empty when none is found.
+    """
+    found: list[tuple[Path, list[str]]] = []
+    queue = deque((f, 1) for f in [folder])
+    listed = 0
+    while queue and listed < DEEPER_FOLDERS:
+        here, level = queue.popleft()
+        listed += 1
+        try:
+            entries = sorted(here.iterdir(), key=_listing_key)
+        except OSError:
+            continue
+        visible = [e for e in entries if not e.name.startswith(".")]
+        names = [e.name for e in visible if e.suffix == ".txt" and e.is_file()]
+        if names and here != folder:
+            found.append((here, names))
+        elif level <= DEEPER_LEVELS:
+            queue.extend((e, level + 1) for e in visible if e.is_dir() and not e.is_symlink())
+    if not found:
+        return ""
+    held = "; ".join(
+        f"{f} holds {len(n)} ({', '.join(n[:3])}{', ...' if len(n) > 3 else ''})"
+        for f, n in found[:3]
+    )
+    more = f" and {len(found) - 3} more folders" if len(found) > 3 else ""
+    return f"; {held}{more}: pass {'it' if len(found) == 1 else 'them'} instead"
 
 
 def _broken_link(path: Path) -> bool:
