@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pftrack._typing import PathLike
-from pftrack.io.atomic import link_loop, refuse_dash, resolved
+from pftrack.io.atomic import refuse_dash, refuse_loop
 from pftrack.io.video import (
     VIDEO_SUFFIXES,
     image_files,
@@ -455,12 +455,7 @@ def _broken_link(path: Path) -> bool:
 
 def _check_exists(path: Path) -> None:
     """Refuse an input that does not exist, naming a broken symbolic link or a loop as one."""
-    loop = link_loop(path)
-    if loop is not None:  # was: "is a broken symbolic link (to b)", b there, a link itself
-        raise ValueError(
-            f"input {path}: symbolic link loop ({loop}), which leads to no file or folder; "
-            "point the link at one"
-        )
+    refuse_loop(path, "input")  # was: "is a broken symbolic link (to b)", b there, a link too
     if _broken_link(path):
         raise FileNotFoundError(
             f"input not found: {path} is a broken symbolic link (to {os.readlink(path)})"
@@ -521,6 +516,6 @@ def _named_by(name: str, source: Path) -> Path:
 def _same_file(a: Path, b: Path) -> bool:
     """Whether `a` and `b` name the same file or folder (links and ``..`` resolved)."""
     try:
-        return a == b or resolved(a) == resolved(b) or os.path.samefile(a, b)
-    except (OSError, RuntimeError):  # RuntimeError: a link loop (Python < 3.13's resolve)
+        return a == b or os.path.realpath(a) == os.path.realpath(b) or os.path.samefile(a, b)
+    except OSError:
         return False

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import warnings
 from collections.abc import Sequence
 from dataclasses import asdict
@@ -142,9 +143,7 @@ def _parse_size(values: Sequence[str]) -> tuple[float, float]:
 
 def _seqinfo_file(gt_path: str) -> Path | None:
     """The ``seqinfo.ini`` beside the ground truth or one folder up (None: there is none)."""
-    from pftrack.io.atomic import resolved
-
-    gt = resolved(gt_path)
+    gt = Path(os.path.realpath(gt_path))  # realpath: a link loop is refused when read
     for folder in (gt.parent, gt.parent.parent):
         if (folder / "seqinfo.ini").is_file():
             return folder / "seqinfo.ini"
@@ -235,8 +234,6 @@ def _check_distinct_gt(paths: list[str]) -> None:
 
     It would be one sequence counted twice: two rows, and its gaps twice in the pooled MMAE.
     """
-    from pftrack.io.atomic import resolved
-
     seen: dict[object, str] = {}
     for path in paths:
         p = Path(path)
@@ -244,7 +241,7 @@ def _check_distinct_gt(paths: list[str]) -> None:
             st = p.stat()
             key: object = (st.st_dev, st.st_ino)
         except OSError:  # missing: refused when read; compared by name meanwhile
-            key = resolved(p)
+            key = os.path.realpath(p)
         if key in seen:
             raise ValueError(
                 f"--gt {seen[key]} and {path} are the same file; give each sequence once"
@@ -428,7 +425,6 @@ def _write_figure(path: str, image: Any) -> None:
 def _run_sequences(args: argparse.Namespace) -> int:
     """The multi-sequence protocol with automatic masks (``--gt A B ...`` or ``--auto-masks``)."""
     from pftrack._progress import progress
-    from pftrack.io.atomic import resolved
     from pftrack.recovery import experiment as E
     from pftrack.recovery.linking import read_tracks
 
@@ -444,7 +440,9 @@ def _run_sequences(args: argparse.Namespace) -> int:
             where = f"{_seqinfo_file(path)}: imWidth x imHeight"
         elif args.image_size:
             width, height = _parse_size(args.image_size)
-            p = resolved(path)  # SEQ/gt/gt.txt or SEQ/gt.txt: the sequence; else the file
+            p = Path(
+                os.path.realpath(path)
+            )  # SEQ/gt/gt.txt or SEQ/gt.txt: the sequence; else the file
             name = p.parent.name if p.stem == "gt" else p.stem
             where = f"{path}: --image-size"  # the sequence named: the size is for it
         else:

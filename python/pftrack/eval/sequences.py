@@ -16,6 +16,7 @@ import dataclasses
 import io
 import json
 import math
+import os
 import re
 from collections.abc import Callable, Collection, Mapping, Sequence
 from pathlib import Path
@@ -28,7 +29,6 @@ from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
 from pftrack.eval.rows import _mot_iou, not_parts_message
-from pftrack.io.atomic import resolved
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, WIDTH
 
 __all__ = [
@@ -117,7 +117,7 @@ def sequence_of_file(gt_file: PathLike, name: str) -> SequenceInfo:
     parent = path.parent
     for folder in (parent.parent, parent) if parent.name == "gt" else (parent,):
         seq = _sequence(folder)
-        if seq is not None and resolved(seq.gt_path) == resolved(path):
+        if seq is not None and os.path.realpath(seq.gt_path) == os.path.realpath(path):
             return dataclasses.replace(seq, name=name)
     return SequenceInfo(name, path)
 

@@ -528,9 +528,9 @@ def link_loop(path: PathLike) -> str | None:
 def refuse_loop(path: PathLike, what: str) -> None:
     """Refuse an input `path` whose symbolic links lead to each other: it names nothing.
 
-    Was: ``video source not found: a`` for ``a -> b -> a`` (with ``b`` there, a link), or a
-    traceback where the path was resolved (``RuntimeError: Symlink loop``, from Python 3.11's
-    ``Path.resolve``).
+    Was: ``video source not found: a`` for ``a -> b -> a`` (with ``b`` there, a link). Paths
+    that may be such loops are compared with ``os.path.realpath``, which stops at a loop, not
+    ``Path.resolve``, which raised a RuntimeError there (a traceback) before Python 3.13.
 
     Raises
     ------
@@ -543,19 +543,6 @@ def refuse_loop(path: PathLike, what: str) -> None:
             f"{what} {os.fspath(path)}: symbolic link loop ({loop}), which leads to no file or "
             "folder; point the link at one"
         )
-
-
-def resolved(path: PathLike) -> Path:
-    """`path` with its symbolic links followed; made absolute only where a loop stops that.
-
-    ``Path.resolve`` raises RuntimeError on a loop in Python 3.11 (OSError later): for
-    comparing paths, a loop is just a path that names nothing.
-    """
-    p = Path(os.fspath(path))
-    try:
-        return p.resolve()
-    except (OSError, RuntimeError):
-        return Path(os.path.abspath(p))
 
 
 def refuse_dash(
@@ -744,13 +731,13 @@ def _one_of(target: Path, files: Iterable[PathLike]) -> bool:
         st = os.stat(target)
     except OSError:
         st = None
-    target_path: Path | None = None
+    target_path: str | None = None  # realpath: a link loop is a path, not an error
     for f in files:
         try:
             other = os.stat(f)
         except OSError:  # a missing input: compared by its resolved path
-            target_path = target_path or resolved(target)
-            if resolved(f) == target_path:
+            target_path = target_path or os.path.realpath(target)
+            if os.path.realpath(f) == target_path:
                 return True
             continue
         if st is not None and (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
@@ -809,7 +796,7 @@ def _same_file(a: Path, b: Path) -> bool:
     """Whether `a` and `b` name one file: the same path once resolved, or one file on disk."""
     if a.exists() and b.exists() and os.path.samefile(a, b):
         return True  # hard links, bind mounts
-    return resolved(a) == resolved(b)
+    return os.path.realpath(a) == os.path.realpath(b)
 
 
 def _is_devnull(path: Path) -> bool:

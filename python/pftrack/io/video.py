@@ -421,11 +421,12 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     for folder in (path, path.parent):
         if (folder / "seqinfo.ini").is_file():
             return read_seqinfo(folder)
+    real = Path(os.path.realpath(path))
     if (path / "img1").is_dir():
-        return SequenceInfo(path, path.resolve().name, None, "img1", None, None, None)
-    if path.resolve().name == "img1":  # SEQ/img1, or "." inside it
-        folder = path.parent if path.name == "img1" else path.resolve().parent
-        return SequenceInfo(folder, folder.resolve().name, None, "img1", None, None, None)
+        return SequenceInfo(path, real.name, None, "img1", None, None, None)
+    if real.name == "img1":  # SEQ/img1, or "." inside it
+        folder = path.parent if path.name == "img1" else real.parent
+        return SequenceInfo(folder, real.parent.name, None, "img1", None, None, None)
     return None
 
 
