@@ -20,7 +20,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import dataclasses
-import errno
 import hashlib
 import json
 import logging
@@ -28,7 +27,6 @@ import math
 import os
 import signal
 import socket
-import tempfile
 import threading
 import time
 import traceback
@@ -1473,8 +1471,7 @@ def _check_outputs(
     current folder).
     """
     out_name, render_name = _OUT_NAMES.get()
-    out_dir = check_output_folder(out_dir, out_name)
-    _check_writable(out_dir)
+    out_dir = check_output_folder(out_dir, out_name)  # writable, or can be made, too
     # once: batches can be large; realpath, not resolve: a link loop met in a scanned folder
     # (a task that fails) made Python < 3.13's resolve raise RuntimeError, a traceback
     reads = {Path(os.path.realpath(p)) for job in jobs for p in job.reads}
@@ -1519,43 +1516,6 @@ def _check_outputs(
                     f"this run would replace it: move it, write elsewhere, or give {force_name}"
                 )
     return out_dir
-
-
-def _check_writable(out_dir: Path) -> None:
-    """Refuse an output folder that cannot take new files, or cannot be made, before any work.
-
-    Checked where the folder is, or for a missing one where it is to be made (the nearest
-    folder above it that exists), by making a folder there and removing it (``access()`` says
-    yes to root on a read-only file system). Was: only once the local cluster had started or
-    the scheduler answered, seconds later; a missing folder under ``/proc/sys`` was "cannot
-    create the folder (No such file or directory)".
-
-    Raises
-    ------
-    PermissionError
-        Naming `out_dir` (as ``--out`` or ``out_dir``) and why.
-    """
-    out_name = _OUT_NAMES.get()[0]
-    folder = out_dir
-    while not folder.is_dir():
-        if folder.parent == folder:
-            return  # no folder above it at all: its creation says why
-        folder = folder.parent
-    try:
-        if not os.access(folder, os.W_OK | os.X_OK):
-            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
-        os.rmdir(tempfile.mkdtemp(prefix=".pftrack-probe-", dir=folder))
-    except OSError as exc:
-        why = exc.strerror or one_line(exc)
-        if folder == out_dir:
-            raise PermissionError(
-                f"{out_name} {out_dir}: the folder is not writable ({why}): no output can be "
-                "written in it; write elsewhere"
-            ) from None
-        raise PermissionError(
-            f"{out_name} {out_dir}: cannot create the folder: {folder} is not writable ({why}); "
-            "write elsewhere"
-        ) from None
 
 
 def _file_id(path: Path) -> tuple[int, int] | None:
@@ -1635,7 +1595,7 @@ def run_jobs(
         A bad `scheduler` address (or Dask's ``scheduler-address`` setting), or more than one
         of `client`, `scheduler` and `n_workers` given; checked before anything else.
     PermissionError
-        `out_dir` cannot take new files, or cannot be made (:func:`_check_writable`); checked
+        `out_dir` cannot take new files, or cannot be made (``check_output_folder``); checked
         before the cluster starts or the scheduler is connected to.
     OSError
         The scheduler cannot be reached (see :func:`dask_client`), or it has no worker and none

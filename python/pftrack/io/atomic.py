@@ -593,6 +593,9 @@ def check_output_folder(path: PathLike, what: str) -> Path:
         (standard output), or an existing file.
     NotADirectoryError
         It lies under a file (``notes.txt/out``).
+    PermissionError
+        It cannot take new files, or cannot be made where it is to be (the nearest existing
+        folder above it is not writable).
     """
     text = os.fsdecode(os.fspath(path))
     if not text:
@@ -604,7 +607,39 @@ def check_output_folder(path: PathLike, what: str) -> Path:
         raise ValueError(f"{what} {target} is a file; give a folder")
     if blocker is not None:  # a file above it: was "cannot create the folder (Not a directory)"
         raise NotADirectoryError(f"{what} {target}: {_not_a_folder(blocker)}")
+    _check_folder_writable(target, what)
     return target
+
+
+def _check_folder_writable(target: Path, what: str) -> None:
+    """Refuse output folder `target` if it cannot take new files, or cannot be made.
+
+    Checked where it is, or for a missing one where it is to be made (the nearest folder above
+    it that exists), by making a folder there and removing it (``access()`` says yes to root on
+    a read-only file system). Was: ``pftrack batch`` found out only once its local cluster had
+    started, seconds later, and a missing folder under ``/proc/sys`` was "cannot create the
+    folder (No such file or directory)".
+    """
+    folder = target
+    while not folder.is_dir():
+        if folder.parent == folder:
+            return  # no folder above it at all: its creation says why
+        folder = folder.parent
+    try:
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+        os.rmdir(tempfile.mkdtemp(prefix=".pftrack-probe-", dir=folder))
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+        if folder == target:
+            raise PermissionError(
+                f"{what} {target}: the folder is not writable ({why}): no output can be "
+                "written in it; write elsewhere"
+            ) from None
+        raise PermissionError(
+            f"{what} {target}: cannot create the folder: {folder} is not writable ({why}); "
+            "write elsewhere"
+        ) from None
 
 
 def _remove_empty(folders: Iterable[Path]) -> None:
