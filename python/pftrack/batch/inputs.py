@@ -15,6 +15,7 @@ import json
 import os
 import warnings
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -211,7 +212,7 @@ def _annotations(folder: Path) -> tuple[Path | None, Path | None]:
     )
 
 
-#: How far below a folder of sequences :func:`_deeper` looks for the sequences it passed over
+#: How far below a folder of sequences :func:`_below` looks for the sequences it passed over
 #: (``DIR/a/b/c/SEQ`` for ``DIR``), and how many folders it lists at most: a hint, not a scan.
 DEEPER_LEVELS = 3
 DEEPER_FOLDERS = 256
@@ -237,14 +238,16 @@ def _has_frames(folder: Path) -> bool:
         return False
 
 
-def _deeper(folders: list[Path]) -> list[tuple[Path, list[str]]]:
-    """The folders below `folders` that hold sequences, with those sequences' names.
+def _below(
+    folders: list[Path], names_in: Callable[[list[Path]], tuple[list[str], list[Path]]]
+) -> list[tuple[Path, list[str]]]:
+    """The folders below `folders` (themselves included) that hold what `names_in` names.
 
-    `folders` are the sub-folders a folder of sequences passed over (neither sequences nor
-    images). Looked into breadth first, :data:`DEEPER_LEVELS` levels down at most, each branch
-    stopping at the first folder that holds sequences (videos, or folders with frames:
-    :func:`_has_frames`); symbolic links to folders below `folders` are not followed (a loop),
-    hidden entries are passed over, as a folder of sequences passes them over.
+    Breadth first, :data:`DEEPER_LEVELS` levels down at most and :data:`DEEPER_FOLDERS`
+    folders in all (a hint, not a scan), each branch stopping at the first folder that holds
+    something. ``names_in(entries)`` gets a folder's visible entries (hidden ones and broken
+    links passed over, in listing order) and returns the names it holds and the folders to
+    look into when it holds none. A folder that cannot be listed is passed over.
     """
     found: list[tuple[Path, list[str]]] = []
     queue = deque((f, 1) for f in folders)
@@ -254,30 +257,42 @@ def _deeper(folders: list[Path]) -> list[tuple[Path, list[str]]]:
         listed += 1
         try:
             entries = sorted(folder.iterdir(), key=_listing_key)
+            names, below = names_in(
+                [e for e in entries if not e.name.startswith(".") and not _broken_link(e)]
+            )
         except OSError:
             continue
-        names: list[str] = []
-        below: list[Path] = []
-        for entry in entries:
-            if entry.name.startswith(".") or _broken_link(entry):
-                continue
-            try:
-                if entry.is_file():
-                    video = entry.suffix.lower() in VIDEO_SUFFIXES
-                    if video and not _batch_output(entry):
-                        names.append(entry.name)
-                elif entry.is_dir():
-                    if _has_frames(entry):
-                        names.append(entry.name)
-                    elif not entry.is_symlink():
-                        below.append(entry)
-            except OSError:
-                continue
         if names:
             found.append((folder, names))
         elif level < DEEPER_LEVELS:
             queue.extend((f, level + 1) for f in below)
     return found
+
+
+def _sequences_in(entries: list[Path]) -> tuple[list[str], list[Path]]:
+    """The sequences among a folder's `entries` (videos, folders with frames), and the others.
+
+    The other folders, for :func:`_below` to look into: symbolic links to folders are not
+    followed (a loop).
+    """
+    names: list[str] = []
+    below: list[Path] = []
+    for entry in entries:
+        if entry.is_file():
+            if entry.suffix.lower() in VIDEO_SUFFIXES and not _batch_output(entry):
+                names.append(entry.name)
+        elif entry.is_dir():
+            if _has_frames(entry):
+                names.append(entry.name)
+            elif not entry.is_symlink():
+                below.append(entry)
+    return names, below
+
+
+def _tracks_in(entries: list[Path]) -> tuple[list[str], list[Path]]:
+    """The ``.txt`` files among a folder's `entries`, and its folders (not links to them)."""
+    names = [e.name for e in entries if e.suffix == ".txt" and e.is_file()]
+    return names, [e for e in entries if e.is_dir() and not e.is_symlink()]
 
 
 def _held(deeper: list[tuple[Path, list[str]]]) -> str:
@@ -353,7 +368,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
             elif entry.is_dir():  # a link to one too (train -> /mnt/train); not deeper ones
                 passed.append(entry)
         given = {os.path.realpath(p) for p in paths}  # DIR and DIR/train both given: said of none
-        deeper = [d for d in _deeper(passed) if os.path.realpath(d[0]) not in given]
+        deeper = [d for d in _below(passed, _sequences_in) if os.path.realpath(d[0]) not in given]
         if len(found) == before:  # was: the same words with deeper sequences, not naming them
             where = (
                 f"; deeper, {_held(deeper)}: {_pass(deeper)} instead (a folder is looked into "
@@ -417,27 +432,15 @@ def _txt_below(folder: Path) -> str:
     """``; DIR/data holds 3 (a.txt, b.txt, c.txt): pass it instead`` for tracks files deeper.
 
     A tracker's results often sit a level or two down (TrackEval's
-    ``trackers/NAME/data/SEQ.txt``): was "no .txt file in folder DIR" alone. Breadth first,
-    :data:`DEEPER_LEVELS` levels and :data:`DEEPER_FOLDERS` folders at most, each branch
-    stopping at the first folder that holds ``.txt`` files; hidden entries and symbolic links
-    to folders are passed over. Empty when none is found.
+    ``trackers/NAME/data/SEQ.txt``): was "no .txt file in folder DIR" alone. The folders below
+    `folder` (:func:`_below`) that hold ``.txt`` files; empty when there is none.
     """
-    found: list[tuple[Path, list[str]]] = []
-    queue = deque((f, 1) for f in [folder])
-    listed = 0
-    while queue and listed < DEEPER_FOLDERS:
-        here, level = queue.popleft()
-        listed += 1
-        try:
-            entries = sorted(here.iterdir(), key=_listing_key)
-        except OSError:
-            continue
-        visible = [e for e in entries if not e.name.startswith(".")]
-        names = [e.name for e in visible if e.suffix == ".txt" and e.is_file()]
-        if names and here != folder:
-            found.append((here, names))
-        elif level <= DEEPER_LEVELS:
-            queue.extend((e, level + 1) for e in visible if e.is_dir() and not e.is_symlink())
+    try:
+        subfolders = [e for e in sorted(folder.iterdir(), key=_listing_key) if e.is_dir()]
+    except OSError:
+        return ""
+    found = _below([e for e in subfolders if not e.name.startswith(".") and not e.is_symlink()],
+                   _tracks_in)  # fmt: skip
     if not found:
         return ""
     held = "; ".join(
