@@ -753,26 +753,34 @@ def test_the_command_on_a_full_device_or_a_closed_pipe_prints_no_traceback(
 ) -> None:
     """The process as a shell runs it: ``> /dev/full`` one line and exit status 2, ``| head``
     (a pipe closed before the table) nothing at all, and neither a traceback at exit."""
-    import subprocess
     import sys
 
     src = _tracks(tmp_path / "t.txt")
     argv = [sys.executable, "-m", "pftrack", "eval", "--gt", str(src), "--res", str(src)]
-    with open("/dev/full", "wb") as full:
-        run = subprocess.run(argv, stdout=full, stderr=subprocess.PIPE, text=True, check=False,
-                             timeout=120)  # fmt: skip
-    assert (run.returncode, run.stderr) == (
+    full, closed = _into_full_and_closed(argv)
+    assert (full.returncode, full.stderr) == (
         2,
         "pftrack eval: error: cannot write to standard output (No space left on device)\n",
     )
+    assert (closed.returncode, closed.stderr) == (1, "")
+
+
+def _into_full_and_closed(argv: list[str]) -> tuple[Any, Any]:
+    """The process `argv` run with stdout on ``/dev/full``, then on a pipe closed before it
+    writes (as ``| head`` leaves it): both ``subprocess.run`` results, stderr as text."""
+    import subprocess
+
+    with open("/dev/full", "wb") as full:
+        into_full = subprocess.run(argv, stdout=full, stderr=subprocess.PIPE, text=True,
+                                   check=False, timeout=120)  # fmt: skip
     read, write = os.pipe()
     os.close(read)  # closed before the command writes
     try:
-        run = subprocess.run(argv, stdout=write, stderr=subprocess.PIPE, text=True, check=False,
-                             timeout=120)  # fmt: skip
+        into_closed = subprocess.run(argv, stdout=write, stderr=subprocess.PIPE, text=True,
+                                     check=False, timeout=120)  # fmt: skip
     finally:
         os.close(write)
-    assert (run.returncode, run.stderr) == (1, "")
+    return into_full, into_closed
 
 
 @pytest.mark.parametrize(
@@ -816,25 +824,14 @@ def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
 def test_help_and_version_on_a_full_device_say_so(words: list[str], prog: str) -> None:
     """Was: ``pftrack --help > /dev/full`` printed nothing and exited 0 (argparse ignores a
     failed write); a closed pipe still ends quietly with status 0, as ``| head`` expects."""
-    import subprocess
     import sys
 
-    argv = [sys.executable, "-m", "pftrack", *words]
-    with open("/dev/full", "wb") as full:
-        run = subprocess.run(argv, stdout=full, stderr=subprocess.PIPE, text=True, check=False,
-                             timeout=60)  # fmt: skip
-    assert (run.returncode, run.stderr) == (
+    full, closed = _into_full_and_closed([sys.executable, "-m", "pftrack", *words])
+    assert (full.returncode, full.stderr) == (
         2,
         f"{prog}: error: cannot write to standard output (No space left on device)\n",
     )
-    read, write = os.pipe()
-    os.close(read)
-    try:
-        run = subprocess.run(argv, stdout=write, stderr=subprocess.PIPE, text=True, check=False,
-                             timeout=60)  # fmt: skip
-    finally:
-        os.close(write)
-    assert (run.returncode, run.stderr) == (0, "")
+    assert (closed.returncode, closed.stderr) == (0, "")
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")

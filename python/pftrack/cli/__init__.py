@@ -79,10 +79,7 @@ class Parser(argparse.ArgumentParser):
                 os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
             if isinstance(exc, BrokenPipeError) or stream is sys.stderr:
                 return
-            print(
-                f"{self.prog}: error: cannot write to standard output ({exc.strerror or exc})",
-                file=sys.stderr,
-            )
+            print(f"{self.prog}: error: {_stdout_failed(exc)}", file=sys.stderr)
             sys.exit(2)
 
 
@@ -196,6 +193,11 @@ def _names_on_stdout() -> Iterator[None]:
             stream.reconfigure(errors=errors)  # type: ignore[union-attr]
 
 
+def _stdout_failed(exc: OSError) -> str:
+    """``cannot write to standard output (No space left on device)``: what a failed write says."""
+    return f"cannot write to standard output ({exc.strerror or exc})"
+
+
 class StdoutError(OSError):
     """Standard output refused the command's report: ``cannot write to standard output ...``.
 
@@ -215,7 +217,7 @@ class _NamedStdout:
         self._stream = stream
 
     def _failed(self, exc: OSError) -> StdoutError:
-        error = StdoutError(f"cannot write to standard output ({exc.strerror or exc})")
+        error = StdoutError(_stdout_failed(exc))
         error.errno = exc.errno
         if interrupts_held():  # the report comes after the outputs (recover, smooth, track)
             set_outcome(error, "the outputs were written before it")

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import bgr_array, number, real_array
+from pftrack._check import bgr_array, integer, number, real_array
 
 BinnedImage = _core.BinnedImage
 
@@ -64,11 +64,7 @@ class HsvBinning:
 
     def __post_init__(self) -> None:
         for name in ("n_h", "n_s", "n_v"):
-            v = getattr(self, name)
-            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
-                raise TypeError(f"HsvBinning: {name} is {v!r}, expected an int in [1, 64]")
-            if not 1 <= v <= 64:
-                raise ValueError(f"{name} is {v!r}, expected an int in [1, 64]")
+            integer(getattr(self, name), f"HsvBinning: {name}", 1, 64)
         for name in ("s_min", "v_min"):
             v = number(getattr(self, name), f"HsvBinning: {name}", finite=False)
             if not (0.0 <= v <= 1.0):
