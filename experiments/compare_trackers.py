@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 from experiments._common import data_root, experiment_parser, write_text
 from experiments.public_detections import black_frames
 from pftrack.eval import MotMetrics, evaluate_mot
-from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.mot import as_written, group_by_frame, read_mot
 from pftrack.io.video import read_frames
 
 Boxes: TypeAlias = NDArray[np.float64]  # (K, 5) left, top, w, h, score
@@ -285,8 +285,10 @@ class PftrackStep:
         self._trk.prime(bootstrap_frames(frames, 30, "spread" if own else "first"))
 
     def result(self) -> NDArray[np.float64]:
-        """Every row, after the offline pass (MOTChallenge layout): ``Tracker.finalize()``."""
-        return self._trk.finalize()
+        """Every row after the offline pass (``Tracker.finalize()``), with the values ``pftrack
+        track`` writes (rounded to 2 decimals): ``pftrack eval`` of its file scores the same
+        (was: the unrounded rows, 2 FP apart on PETS09, 83.0 against 82.9 MOTA)."""
+        return as_written(self._trk.finalize())
 
 
 def make_pftrack(seq: Sequence, offline: bool = True) -> Step:

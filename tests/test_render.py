@@ -79,6 +79,20 @@ def test_write_annotated_video_from_rows(tmp_path: Path) -> None:
     assert got[0][26, 22:28].max() < 30
 
 
+def test_a_trail_holds_only_the_foot_points_of_the_last_trail_frames(tmp_path: Path) -> None:
+    # id 3 at frames 1-5 (feet at x 14..22), away, then back at frames 56-60 (feet at x 84):
+    # was a trail line from frame 5's foot, 51 frames old, across x 22..84 on frame 56
+    rows = np.array(
+        [[k, 3, 10 + 2 * (k - 1), 10, 8, 16, 1, -1, -1, -1] for k in range(1, 6)]
+        + [[k, 3, 80, 10, 8, 16, 1, -1, -1, -1] for k in range(56, 61)],
+        float,
+    )
+    frames = [np.zeros((48, 120, 3), np.uint8) for _ in range(60)]
+    _, got = decode(write_annotated_video(tmp_path / "v.mp4", frames, rows, fps=10, trail=40))
+    assert got[4][26, 15:21].max(axis=1).min() > 100  # the trail of frames 1-5 is drawn
+    assert got[55][26, 30:75].max() < 30
+
+
 def test_labels_grow_with_the_frame() -> None:
     """Was: 0.4-scale labels and 1-2 px lines at any size, about 10 px tall at 1920x1080."""
     from pftrack.render import draw_tracks, ink_scale

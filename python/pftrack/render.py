@@ -151,13 +151,18 @@ def write_annotated_video(
         raise ValueError("write_annotated_video: frames is empty; no frame to write")
     by_frame = group_by_frame(rows)
     empty = np.zeros((0, 10))
-    trails: dict[int, deque[tuple[float, float]]] = {}
+    trails: dict[int, deque[tuple[int, tuple[float, float]]]] = {}  # (frame, foot point)
     with VideoWriter(path, fps, preset=preset) as writer:
         for k, frame in enumerate(itertools.chain([first], it), start=1):
             here = by_frame.get(k, empty)
             for r in here:
-                trails.setdefault(int(r[1]), deque(maxlen=max(trail, 1))).append(_foot(r[2:6]))
-            shown = {int(r[1]): trails[int(r[1])] for r in here} if trail > 0 else {}
+                pts = trails.setdefault(int(r[1]), deque(maxlen=max(trail, 1)))
+                pts.append((k, _foot(r[2:6])))
+            # the foot points of frames k - trail + 1 .. k (was: the last `trail` points however
+            # old, a line across the track's absence from a point long gone)
+            shown = {}
+            for tid in {int(r[1]) for r in here} if trail > 0 else ():
+                shown[tid] = [p for f, p in trails[tid] if f > k - trail]
             image = draw_tracks(frame, here, f"frame {k}")
             draw_trails(image, shown)
             writer.write(image)

@@ -453,3 +453,10 @@ def test_every_command_refuses_an_empty_field_by_file_line_and_column(
     # many files: the file fails by name, as any bad file of a batch (the others are done)
     assert main(["batch", "SEQ", "--detections", "auto", "--out", "b", "-q"]) == 1
     assert "det.txt:2: detection file line has an empty column 3 (left)" in capsys.readouterr().err
+
+
+def test_as_written_gives_the_values_read_back_in_the_rows_order(tmp_path: Path) -> None:
+    rows = np.array([[2, 1, 10.123456789012, 5.005, 20.0, 40.0], [1, 2, 3.5, 4.25, 6.0, 8.0]])
+    mot.write_mot(tmp_path / "t.txt", rows)
+    np.testing.assert_array_equal(mot.as_written(rows), mot.read_mot(tmp_path / "t.txt")[::-1])
+    assert mot.as_written(np.zeros((0, 6))).shape == (0, 10)

@@ -308,14 +308,6 @@ def sequence_metrics(
     return {k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in out.items()}
 
 
-def _as_written(rows: F64) -> F64:
-    """`rows` rounded as ``NAME.txt`` stores them: the metrics are ``pftrack eval``'s on it."""
-    from pftrack.io.mot import mot_text
-
-    lines = [line.split(",") for line in mot_text(rows).splitlines()]
-    return np.array(lines, dtype=np.float64).reshape(len(rows), 10)
-
-
 def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     """Track one sequence as ``pftrack track`` would; score it where it has ground truth.
 
@@ -334,7 +326,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         its `error` is set if the ground truth could not be scored (the rows are still there).
     """
     from pftrack.eval.sequences import benchmark_of_path
-    from pftrack.io.mot import read_mot
+    from pftrack.io.mot import as_written, read_mot
     from pftrack.io.video import FrameSource, info_scale
     from pftrack.tracking.run import track_path
 
@@ -373,7 +365,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     )
     rows = run.rows
     # NAME.txt's values, what pftrack render and eval read: only for a video or a score
-    written = _as_written(rows) if options.render is not None or seq.gt is not None else rows
+    written = as_written(rows) if options.render is not None or seq.gt is not None else rows
     files: dict[str, bytes] = {}
     if options.render is not None:
         from pftrack.render import write_annotated_video

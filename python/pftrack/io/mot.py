@@ -457,6 +457,23 @@ def mot_text(rows: NDArray[np.float64] | Iterable[Iterable[float]], *, exact: Ex
     return _lines(a, _exact_mask(exact, len(a), "mot_text"))
 
 
+def as_written(rows: NDArray[np.float64] | Iterable[Iterable[float]]) -> F64:
+    """`rows` (M, 6..10) as (M, 10) float64, with the values :func:`write_mot` writes.
+
+    Computed values rounded to 2 decimals, as :func:`mot_text` rounds them, the rows in their
+    order: what :func:`read_mot` reads back from the file, for scoring rows as ``pftrack
+    eval`` scores the written file.
+
+    Raises
+    ------
+    ValueError
+        What :func:`mot_text` refuses.
+    """
+    a = _checked(rows, "as_written")
+    lines = [line.split(",") for line in _lines(a).splitlines()]
+    return np.array(lines, dtype=np.float64).reshape(len(a), 10)
+
+
 def format_mot_row(row: Iterable[float], *, exact: bool = False) -> str:
     """One MOTChallenge line (10 columns, no newline), as :func:`mot_text` writes it."""
     a = _checked([list(row)], "format_mot_row")
