@@ -497,6 +497,13 @@ def test_boxes_outside_the_frame_are_clipped_once(scene):
         (np.zeros((0, 7)), ValueError, r"got \(0, 7\)"),
         (np.array([[1.0, 2, np.nan, 4]]), ValueError, "NaN or inf"),
         (np.array([["a", "b", "c", "d"]]), TypeError, "numbers"),
+        # rows of different lengths: was NumPy's "setting an array element with a sequence.
+        # The requested array has an inhomogeneous shape ...", which named no argument
+        (
+            [[10.0, 10, 50, 80, 0.9], [10.0, 10, 50]],
+            ValueError,
+            r"^dets must be a rectangular array of numbers, got rows of different lengths$",
+        ),
         # two inverted boxes (one alone is dropped with a warning)
         (
             np.array([[10.0, 10, 5, -4], [20, 20, 15, 8]]),

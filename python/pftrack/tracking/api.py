@@ -35,7 +35,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, flag, integer, number
+from pftrack._check import bgr_frame, flag, integer, number, real_array
 from pftrack._check import seed as check_seed
 from pftrack._typing import (
     F64,
@@ -212,18 +212,16 @@ def check_boxes_xyxy(
     Raises
     ------
     TypeError
-        Not numbers.
+        Not real numbers (text, booleans, complex numbers).
     ValueError
-        Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31 - 1]``,
-        or a layout mistake: inverted boxes in this frame, and, with those of `seen`, at least
-        two and more than half of the boxes with an extent (the message says when the rows
-        look like ``x, y, w, h``). One stray box never trips it, nor do boxes without area,
-        which are no evidence of a layout.
+        Rows of different lengths, wrong shape, NaN or inf, a class id that is not an integer
+        in ``[-2**31, 2**31 - 1]``, or a layout mistake: inverted boxes in this frame, and,
+        with those of `seen`, at least two and more than half of the boxes with an extent (the
+        message says when the rows look like ``x, y, w, h``). One stray box never trips it,
+        nor do boxes without area, which are no evidence of a layout.
     """
-    d = np.asarray(dets)
-    if d.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be an array of numbers, got dtype {d.dtype}")
-    d = d.astype(np.float64)
+    # ragged rows named as such (was NumPy's "inhomogeneous shape", naming no argument)
+    d = real_array(dets, name, booleans=False)
     if d.shape == (0,) or (d.ndim == 2 and d.shape[0] == 0 and d.shape[1] in (4, 5, 6)):
         return CheckedBoxes(np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64),
                             False, 0, 0, 0)  # fmt: skip
