@@ -1023,6 +1023,45 @@ def test_prime_reads_no_more_than_prime_frames(scene):
     assert read == []
 
 
+def _one_buffer(frames, buffer=None):
+    """`frames` read into one reused array, as ``cap.read(buffer)`` loops read them."""
+    buffer = np.empty_like(frames[0]) if buffer is None else buffer
+    for f in frames:
+        np.copyto(buffer, f)
+        yield buffer
+
+
+@pytest.mark.parametrize("memmap", [False, True])
+def test_prime_from_one_reused_buffer_is_the_prime_of_the_frames(scene, memmap, tmp_path):
+    """A trial find: ``prime`` kept the arrays a generator yielded, so a loop reading every
+    frame into one buffer primed the background from its last frame 30 times, not from the
+    median of 30 frames (silently other tracks; with ``max_side`` scaling it was right). A
+    memmap buffer is taken as a new array sharing its memory, not as the same object."""
+    shape = scene.frames[0].shape
+    buffer = np.memmap(tmp_path / "frame", np.uint8, "w+", shape=shape) if memmap else None
+
+    def rows(frames):
+        tracker = pftrack.Tracker()
+        tracker.prime(frames)
+        for f in scene.frames:
+            tracker.update(None, f)
+        return tracker.finalize()
+
+    once = rows(_one_buffer(scene.frames, buffer))
+    np.testing.assert_array_equal(once, rows(list(scene.frames)))
+
+
+def test_multi_object_tracker_prime_from_one_reused_buffer(scene):
+    """As above, for ``MultiObjectTracker.prime``, which took the generator as a list."""
+
+    def boxes(frames):
+        tracker = pftrack.MultiObjectTracker(rng=0)
+        tracker.prime(frames)
+        return [(t.id, *t.box_xywh) for f in scene.frames for t in tracker.update(f)]
+
+    assert boxes(_one_buffer(scene.frames)) == boxes(list(scene.frames))
+
+
 def test_prime_and_update_of_other_sizes_are_refused_by_the_tracker():
     tracker = pftrack.Tracker()
     tracker.prime([np.zeros((100, 100, 3), np.uint8)] * 3)

@@ -787,6 +787,9 @@ class Tracker:
         `frames` is an iterable of (H, W, 3) uint8 BGR frames: a list, a generator, or a
         (K, H, W, 3) array. One frame alone (an array of shape (H, W, 3) or (H, W)) is refused,
         TypeError (iterated, it was taken for rows of a grey frame): ``prime([frame])``.
+        The frames a generator (any iterable but a list, a tuple or an array) yields are
+        copied as they come, so one that refills one buffer with each frame primes as its
+        frames would.
         """
         if isinstance(frames, np.ndarray) and (
             frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
@@ -805,6 +808,7 @@ class Tracker:
         with self._alone("prime"):
             if self.frame_count:
                 raise ValueError("prime() must come before the first update()")
+            held = isinstance(frames, (list, tuple, np.ndarray))  # frames that stay as given
             first = itertools.islice(iterator, self.prime_frames)  # no more: a whole video is big
             picked = []
             shape: tuple[int, ...] | None = None
@@ -817,7 +821,11 @@ class Tracker:
                         f"prime frame {i} is {f.shape[1]}x{f.shape[0]}, frame 0 "
                         f"{shape[1]}x{shape[0]} (the frames of one run are one size)"
                     )
-                picked.append(self.working_frame(f))
+                work = self.working_frame(f)
+                # an iterator may refill one buffer with each frame (``cap.read(buffer)``):
+                # its frames are copied, or the median would be of its last frame alone
+                fresh = held or not np.may_share_memory(work, frame)  # a view of it too
+                picked.append(work if fresh else work.copy())
             if picked:
                 self._tracker.prime(picked)
 
