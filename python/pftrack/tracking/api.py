@@ -403,9 +403,9 @@ class Tracker:
     >>> rows = tracker.finalize()                           # doctest: +SKIP
     """
 
-    #: Calls between the user's code and ``update``: an adapter that calls ``update`` sets 1
-    #: (:class:`~pftrack.integrations.supervision.SupervisionTracker`), so that warnings name
-    #: the user's line, not the adapter's.
+    #: Calls between the user's code and ``update`` or ``finalize``: an adapter that calls
+    #: them sets 1 (:class:`~pftrack.integrations.supervision.SupervisionTracker`), so that
+    #: warnings name the user's line, not the adapter's.
     _caller_depth = 0
 
     #: What messages about the boxes given to :meth:`update` call them; an adapter whose boxes
@@ -1168,6 +1168,6 @@ class Tracker:
                 warnings.warn(
                     f"no track over {n} frame{'s' * (n != 1)}: {self._no_track_cause(n_tracked)}",
                     RuntimeWarning,
-                    stacklevel=2,
+                    stacklevel=2 + self._caller_depth,  # the user's line, through an adapter too
                 )
             return self._restore_rows(rows)
