@@ -1301,6 +1301,9 @@ def test_one_tracker_in_two_threads_at_once_raises_not_crashes(scene):
         ("finalize", ()),
         ("reset", ()),
         ("prime", ([scene.frames[0]],)),
+        # a trial find: read the writer's rows while the other thread appended them (a block
+        # moved, rows of np.empty garbage or 1024 rows missing), as the docs say it raises
+        ("settled_rows", ()),
     ):
         with pytest.raises(RuntimeError, match=rf"^Tracker\.{method}: this Tracker is in use by "):
             getattr(tracker, method)(*args)

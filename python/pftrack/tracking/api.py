@@ -1031,8 +1031,9 @@ class Tracker:
         """
         start = check_seed(start, "Tracker.settled_rows: start")
         self._check_recorded("settled_rows")
-        rows = self._writer.rows.arrays(start)[0]
-        return self._restore_rows(self._stabiliser.restore(rows))
+        with self._alone("settled_rows"):  # not while another thread's update appends rows
+            rows = self._writer.rows.arrays(start)[0]
+            return self._restore_rows(self._stabiliser.restore(rows))
 
     def _check_recorded(self, method: str) -> None:
         if not self.record:
