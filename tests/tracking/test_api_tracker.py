@@ -1069,6 +1069,20 @@ def test_prime_and_update_of_other_sizes_are_refused_by_the_tracker():
         tracker.update(None, np.zeros((36, 48, 3), np.uint8))
 
 
+@pytest.mark.parametrize("size", [(360, 640), (540, 960)])
+def test_prime_and_update_of_other_sizes_are_refused_with_max_side(size):
+    """A trial find: with ``max_side`` the check compared the scaled sizes, so 1280x720 prime
+    frames and 640x360 or 960x540 frames to track (all 640x360 once scaled) were taken: the
+    background of another picture, silently."""
+    tracker = pftrack.Tracker(max_side=640)
+    tracker.prime([np.zeros((720, 1280, 3), np.uint8)] * 3)
+    message = rf"^frame is {size[1]}x{size[0]}, the frames given to prime\(\) 1280x720 \(one "
+    with pytest.raises(ValueError, match=message):
+        tracker.update(None, np.zeros((*size, 3), np.uint8))
+    assert tracker.frame_count == 0
+    tracker.update(None, np.zeros((720, 1280, 3), np.uint8))  # the primed size is taken
+
+
 def test_score_options_must_be_finite_numbers():
     with pytest.raises(ValueError, match="birth_score is nan, expected a finite number"):
         pftrack.Tracker(birth_score=float("nan"))

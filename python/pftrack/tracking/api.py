@@ -418,6 +418,9 @@ class Tracker:
     #: Whether the run keeps its rows for :meth:`finalize` (the constructor's `record`; a class
     #: default for a checkpoint pickled before it was an option).
     record: bool = True
+    #: The shape of the frames given to :meth:`prime` (None: not primed). A class default for
+    #: a checkpoint pickled before it was kept.
+    _primed: tuple[int, ...] | None = None
 
     def __init__(
         self,
@@ -656,6 +659,7 @@ class Tracker:
             # with the run's first frame (None: tracked at the frame's own size)
             self._scale: F64 | None = None
             self._shape: tuple[int, ...] | None = None  # the run's frame shape
+            self._primed = None  # the shape of the frames given to prime()
             self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
             # the frame whose update was cut short after it changed the tracker (0: none)
             self._torn = 0
@@ -828,6 +832,7 @@ class Tracker:
                 picked.append(work if fresh else work.copy())
             if picked:
                 self._tracker.prime(picked)
+                self._primed = shape
 
     def update(self, dets: ArrayLike | None, frame: NDArray[np.uint8]) -> F64:
         """Track one frame.
@@ -893,6 +898,14 @@ class Tracker:
             shape = self._shape  # None until the run's first frame is taken
             first = shape is None
             if shape is None:
+                primed = self._primed
+                # the frames' own sizes: with max_side two sizes may scale to one, which the
+                # tracker inside (it compares the scaled frames) would take
+                if primed is not None and f.shape != primed:
+                    raise ValueError(
+                        f"frame is {f.shape[1]}x{f.shape[0]}, the frames given to prime() "
+                        f"{primed[1]}x{primed[0]} (one size per run)"
+                    )
                 size = working_size(f.shape, self.config.max_side)
                 self._scale = None  # one scale for the whole run's rows
                 if size is not None:
