@@ -157,6 +157,17 @@ def test_the_adapters_warnings_name_the_callers_line(scene):
     assert {w.filename for w in caught} == {__file__}
 
 
+def test_the_adapters_no_track_warning_names_the_callers_line(scene):
+    """A trial find: ``finalize``'s "no track" warning named the adapter's own line
+    (pftrack/integrations/supervision.py), as update's warnings once did."""
+    tracker = SupervisionTracker()
+    detections = sv.Detections(xyxy=np.array([[10.0, 30, 40, 90]]), confidence=np.array([0.1]))
+    tracker.update_with_detections(detections, scene.frames[0])
+    with pytest.warns(RuntimeWarning, match="^no track over 1 frame") as caught:
+        tracker.finalize()
+    assert [w.filename for w in caught] == [__file__]
+
+
 # As tests/tracking/test_api_checkpoint.py's: in a child process, where protocols 0 and 1
 # aborted the interpreter once the background model existed.
 ADAPTER_AT_EVERY_PROTOCOL = """

@@ -497,6 +497,13 @@ def test_boxes_outside_the_frame_are_clipped_once(scene):
         (np.zeros((0, 7)), ValueError, r"got \(0, 7\)"),
         (np.array([[1.0, 2, np.nan, 4]]), ValueError, "NaN or inf"),
         (np.array([["a", "b", "c", "d"]]), TypeError, "numbers"),
+        # rows of different lengths: was NumPy's "setting an array element with a sequence.
+        # The requested array has an inhomogeneous shape ...", which named no argument
+        (
+            [[10.0, 10, 50, 80, 0.9], [10.0, 10, 50]],
+            ValueError,
+            r"^dets must be a rectangular array of numbers, got rows of different lengths$",
+        ),
         # two inverted boxes (one alone is dropped with a warning)
         (
             np.array([[10.0, 10, 5, -4], [20, 20, 15, 8]]),
@@ -1016,11 +1023,64 @@ def test_prime_reads_no_more_than_prime_frames(scene):
     assert read == []
 
 
+def _one_buffer(frames, buffer=None):
+    """`frames` read into one reused array, as ``cap.read(buffer)`` loops read them."""
+    buffer = np.empty_like(frames[0]) if buffer is None else buffer
+    for f in frames:
+        np.copyto(buffer, f)
+        yield buffer
+
+
+@pytest.mark.parametrize("memmap", [False, True])
+def test_prime_from_one_reused_buffer_is_the_prime_of_the_frames(scene, memmap, tmp_path):
+    """A trial find: ``prime`` kept the arrays a generator yielded, so a loop reading every
+    frame into one buffer primed the background from its last frame 30 times, not from the
+    median of 30 frames (silently other tracks; with ``max_side`` scaling it was right). A
+    memmap buffer is taken as a new array sharing its memory, not as the same object."""
+    shape = scene.frames[0].shape
+    buffer = np.memmap(tmp_path / "frame", np.uint8, "w+", shape=shape) if memmap else None
+
+    def rows(frames):
+        tracker = pftrack.Tracker()
+        tracker.prime(frames)
+        for f in scene.frames:
+            tracker.update(None, f)
+        return tracker.finalize()
+
+    once = rows(_one_buffer(scene.frames, buffer))
+    np.testing.assert_array_equal(once, rows(list(scene.frames)))
+
+
+def test_multi_object_tracker_prime_from_one_reused_buffer(scene):
+    """As above, for ``MultiObjectTracker.prime``, which took the generator as a list."""
+
+    def boxes(frames):
+        tracker = pftrack.MultiObjectTracker(rng=0)
+        tracker.prime(frames)
+        return [(t.id, *t.box_xywh) for f in scene.frames for t in tracker.update(f)]
+
+    assert boxes(_one_buffer(scene.frames)) == boxes(list(scene.frames))
+
+
 def test_prime_and_update_of_other_sizes_are_refused_by_the_tracker():
     tracker = pftrack.Tracker()
     tracker.prime([np.zeros((100, 100, 3), np.uint8)] * 3)
     with pytest.raises(ValueError, match=r"frame is 48x36, the frames given to prime\(\) 100x100"):
         tracker.update(None, np.zeros((36, 48, 3), np.uint8))
+
+
+@pytest.mark.parametrize("size", [(360, 640), (540, 960)])
+def test_prime_and_update_of_other_sizes_are_refused_with_max_side(size):
+    """A trial find: with ``max_side`` the check compared the scaled sizes, so 1280x720 prime
+    frames and 640x360 or 960x540 frames to track (all 640x360 once scaled) were taken: the
+    background of another picture, silently."""
+    tracker = pftrack.Tracker(max_side=640)
+    tracker.prime([np.zeros((720, 1280, 3), np.uint8)] * 3)
+    message = rf"^frame is {size[1]}x{size[0]}, the frames given to prime\(\) 1280x720 \(one "
+    with pytest.raises(ValueError, match=message):
+        tracker.update(None, np.zeros((*size, 3), np.uint8))
+    assert tracker.frame_count == 0
+    tracker.update(None, np.zeros((720, 1280, 3), np.uint8))  # the primed size is taken
 
 
 def test_score_options_must_be_finite_numbers():
@@ -1255,6 +1315,9 @@ def test_one_tracker_in_two_threads_at_once_raises_not_crashes(scene):
         ("finalize", ()),
         ("reset", ()),
         ("prime", ([scene.frames[0]],)),
+        # a trial find: read the writer's rows while the other thread appended them (a block
+        # moved, rows of np.empty garbage or 1024 rows missing), as the docs say it raises
+        ("settled_rows", ()),
     ):
         with pytest.raises(RuntimeError, match=rf"^Tracker\.{method}: this Tracker is in use by "):
             getattr(tracker, method)(*args)

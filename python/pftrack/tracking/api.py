@@ -35,7 +35,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, flag, integer, number
+from pftrack._check import bgr_frame, flag, integer, number, real_array
 from pftrack._check import seed as check_seed
 from pftrack._typing import (
     F64,
@@ -212,18 +212,16 @@ def check_boxes_xyxy(
     Raises
     ------
     TypeError
-        Not numbers.
+        Not real numbers (text, booleans, complex numbers).
     ValueError
-        Wrong shape, NaN or inf, a class id that is not an integer in ``[-2**31, 2**31 - 1]``,
-        or a layout mistake: inverted boxes in this frame, and, with those of `seen`, at least
-        two and more than half of the boxes with an extent (the message says when the rows
-        look like ``x, y, w, h``). One stray box never trips it, nor do boxes without area,
-        which are no evidence of a layout.
+        Rows of different lengths, wrong shape, NaN or inf, a class id that is not an integer
+        in ``[-2**31, 2**31 - 1]``, or a layout mistake: inverted boxes in this frame, and,
+        with those of `seen`, at least two and more than half of the boxes with an extent (the
+        message says when the rows look like ``x, y, w, h``). One stray box never trips it,
+        nor do boxes without area, which are no evidence of a layout.
     """
-    d = np.asarray(dets)
-    if d.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be an array of numbers, got dtype {d.dtype}")
-    d = d.astype(np.float64)
+    # ragged rows named as such (was NumPy's "inhomogeneous shape", naming no argument)
+    d = real_array(dets, name, booleans=False)
     if d.shape == (0,) or (d.ndim == 2 and d.shape[0] == 0 and d.shape[1] in (4, 5, 6)):
         return CheckedBoxes(np.zeros((0, 5)), np.zeros(0, np.int64), np.zeros(0, np.int64),
                             False, 0, 0, 0)  # fmt: skip
@@ -405,9 +403,9 @@ class Tracker:
     >>> rows = tracker.finalize()                           # doctest: +SKIP
     """
 
-    #: Calls between the user's code and ``update``: an adapter that calls ``update`` sets 1
-    #: (:class:`~pftrack.integrations.supervision.SupervisionTracker`), so that warnings name
-    #: the user's line, not the adapter's.
+    #: Calls between the user's code and ``update`` or ``finalize``: an adapter that calls
+    #: them sets 1 (:class:`~pftrack.integrations.supervision.SupervisionTracker`), so that
+    #: warnings name the user's line, not the adapter's.
     _caller_depth = 0
 
     #: What messages about the boxes given to :meth:`update` call them; an adapter whose boxes
@@ -420,6 +418,9 @@ class Tracker:
     #: Whether the run keeps its rows for :meth:`finalize` (the constructor's `record`; a class
     #: default for a checkpoint pickled before it was an option).
     record: bool = True
+    #: The shape of the frames given to :meth:`prime` (None: not primed). A class default for
+    #: a checkpoint pickled before it was kept.
+    _primed: tuple[int, ...] | None = None
 
     def __init__(
         self,
@@ -658,6 +659,7 @@ class Tracker:
             # with the run's first frame (None: tracked at the frame's own size)
             self._scale: F64 | None = None
             self._shape: tuple[int, ...] | None = None  # the run's frame shape
+            self._primed = None  # the shape of the frames given to prime()
             self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
             # the frame whose update was cut short after it changed the tracker (0: none)
             self._torn = 0
@@ -789,6 +791,9 @@ class Tracker:
         `frames` is an iterable of (H, W, 3) uint8 BGR frames: a list, a generator, or a
         (K, H, W, 3) array. One frame alone (an array of shape (H, W, 3) or (H, W)) is refused,
         TypeError (iterated, it was taken for rows of a grey frame): ``prime([frame])``.
+        The frames a generator (any iterable but a list, a tuple or an array) yields are
+        copied as they come, so one that refills one buffer with each frame primes as its
+        frames would.
         """
         if isinstance(frames, np.ndarray) and (
             frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
@@ -807,6 +812,7 @@ class Tracker:
         with self._alone("prime"):
             if self.frame_count:
                 raise ValueError("prime() must come before the first update()")
+            held = isinstance(frames, (list, tuple, np.ndarray))  # frames that stay as given
             first = itertools.islice(iterator, self.prime_frames)  # no more: a whole video is big
             picked = []
             shape: tuple[int, ...] | None = None
@@ -819,9 +825,14 @@ class Tracker:
                         f"prime frame {i} is {f.shape[1]}x{f.shape[0]}, frame 0 "
                         f"{shape[1]}x{shape[0]} (the frames of one run are one size)"
                     )
-                picked.append(self.working_frame(f))
+                work = self.working_frame(f)
+                # an iterator may refill one buffer with each frame (``cap.read(buffer)``):
+                # its frames are copied, or the median would be of its last frame alone
+                fresh = held or not np.may_share_memory(work, frame)  # a view of it too
+                picked.append(work if fresh else work.copy())
             if picked:
                 self._tracker.prime(picked)
+                self._primed = shape
 
     def update(self, dets: ArrayLike | None, frame: NDArray[np.uint8]) -> F64:
         """Track one frame.
@@ -887,6 +898,14 @@ class Tracker:
             shape = self._shape  # None until the run's first frame is taken
             first = shape is None
             if shape is None:
+                primed = self._primed
+                # the frames' own sizes: with max_side two sizes may scale to one, which the
+                # tracker inside (it compares the scaled frames) would take
+                if primed is not None and f.shape != primed:
+                    raise ValueError(
+                        f"frame is {f.shape[1]}x{f.shape[0]}, the frames given to prime() "
+                        f"{primed[1]}x{primed[0]} (one size per run)"
+                    )
                 size = working_size(f.shape, self.config.max_side)
                 self._scale = None  # one scale for the whole run's rows
                 if size is not None:
@@ -1025,8 +1044,9 @@ class Tracker:
         """
         start = check_seed(start, "Tracker.settled_rows: start")
         self._check_recorded("settled_rows")
-        rows = self._writer.rows.arrays(start)[0]
-        return self._restore_rows(self._stabiliser.restore(rows))
+        with self._alone("settled_rows"):  # not while another thread's update appends rows
+            rows = self._writer.rows.arrays(start)[0]
+            return self._restore_rows(self._stabiliser.restore(rows))
 
     def _check_recorded(self, method: str) -> None:
         if not self.record:
@@ -1162,6 +1182,6 @@ class Tracker:
                 warnings.warn(
                     f"no track over {n} frame{'s' * (n != 1)}: {self._no_track_cause(n_tracked)}",
                     RuntimeWarning,
-                    stacklevel=2,
+                    stacklevel=2 + self._caller_depth,  # the user's line, through an adapter too
                 )
             return self._restore_rows(rows)

@@ -185,11 +185,16 @@ class MultiObjectTracker:
         """Start the built-in detector's background from the median of `frames`.
 
         Reading ahead (e.g. the first 30 frames) gives the background model a picture of the
-        empty scene before frame 1 is tracked; detectors without ``prime`` ignore it.
+        empty scene before frame 1 is tracked; detectors without ``prime`` ignore it. The
+        arrays of an iterable other than a list, a tuple or an array are copied as they come
+        (a generator may refill one buffer with each frame).
         """
         detector = self._ensure_detector()
         if hasattr(detector, "prime"):
-            frames = list(frames)
+            if isinstance(frames, (list, tuple, np.ndarray)):
+                frames = list(frames)
+            else:  # an iterator may refill one buffer with each frame: its arrays are copied
+                frames = [f.copy() if isinstance(f, np.ndarray) else f for f in frames]
             if frames:
                 self._primed_shape = np.shape(frames[0])
             if self.config.camera_motion != "off" and self.camera.check_frames(frames):
