@@ -17,7 +17,7 @@ from pftrack.recovery import (
 from pftrack.recovery.calibrate import fixed_noise_model
 from pftrack.recovery.demo import demo_report
 from pftrack.recovery.gdt import GdtModel
-from pftrack.recovery.noise import DEFAULT_NOISE, NoiseEstimate
+from pftrack.recovery.noise import DEFAULT_NOISE, MAX_R_RATIO, MIN_R, NoiseEstimate
 from pftrack.recovery.problems import GdtProblem, SegmentModel, gdt_bi_problem, gdt_problem
 from tests.reference import bridge as ref
 
@@ -143,6 +143,26 @@ def test_noise_estimates_recover_simulated_levels(method):
     for ax in range(2):
         assert 0.6 * q < est.q[ax] < 1.6 * q, est
         assert 0.6 * r < est.r[ax] < 1.6 * r, est
+
+
+@pytest.mark.parametrize("q", [(0.0, 0.0), (0.0, 1e5), (1e-300, 2.0)])
+@pytest.mark.parametrize("r", [(MIN_R, MIN_R), (1.0, 0.999 * MAX_R_RATIO), (MIN_R, 1e-3)])
+@pytest.mark.parametrize("method", ["gdt-bi", "gdt-mix"])
+def test_every_noise_estimate_taken_is_solved(q, r, method):
+    """At the bounds NoiseEstimate checks, the C++ core solves: no error of its own.
+
+    Were taken and failed in gdt_recover_batch: ``r`` of 1e-13 px² with ``q = 0`` ("Pi_T +
+    H S H^T is not positive definite"; now refused as below MIN_R) and ``r`` 1e10 apart ("R
+    is not positive definite"; now refused as MAX_R_RATIO apart or more).
+    """
+    noise = NoiseEstimate(q=q, r=r)
+    pairs = [
+        (line(np.arange(1, 3)), line(np.arange(4, 6))),  # the shortest runs, the most fragile
+        (line(np.arange(1, 31)), line(np.arange(45, 80))),
+        (line(np.arange(1, 400)), line(np.arange(430, 800))),
+    ]
+    for path in recover_gaps(pairs, method, noise=noise):
+        assert np.isfinite(path).all()
 
 
 def test_noise_estimate_defaults_without_data():

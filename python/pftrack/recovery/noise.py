@@ -19,7 +19,16 @@ from pftrack._check import number
 from pftrack._typing import F64
 from pftrack.recovery.segments import consecutive_runs
 
-__all__ = ["DEFAULT_NOISE", "NoiseEstimate", "estimate_noise"]
+__all__ = ["DEFAULT_NOISE", "MAX_R_RATIO", "MIN_R", "NoiseEstimate", "estimate_noise"]
+
+
+#: Smallest measurement variance (px²): below it the Kalman covariances of the C++ core lose
+#: positive definiteness to round-off ("Pi_T + H S H^T is not positive definite" from 1e-13
+#: px² with q = 0 on short runs; a user trial). Estimates never go below ``floor_r`` (1e-3).
+MIN_R = 1e-12
+#: The two axes' measurement variances must be less than this many times apart: the core
+#: refuses ``diag(r)`` as singular from there ("R is not positive definite").
+MAX_R_RATIO = 5e9
 
 
 @dataclass(frozen=True)
@@ -28,8 +37,10 @@ class NoiseEstimate:
 
     ``q``: white-noise-acceleration intensity (px²/frame³); ``r``: measurement variance (px²).
     Each is 2 real numbers (a tuple, a list or an array; kept as a tuple of floats): ``q``
-    finite and ``>= 0``, ``r`` finite and ``> 0`` (a zero measurement variance makes the
-    filters' covariances singular).
+    finite and ``>= 0``, ``r`` finite and at least :data:`MIN_R` (a zero or tiny measurement
+    variance makes the filters' covariances singular to round-off), its two values less than
+    :data:`MAX_R_RATIO` times apart (the filters' measurement covariance ``diag(r)`` would be
+    singular to the C++ core's check).
 
     Raises
     ------
@@ -38,14 +49,16 @@ class NoiseEstimate:
         ``NoiseEstimate.q[0] must be a number, got bool True``.
     ValueError
         Not 2 values, or a value out of range:
-        ``NoiseEstimate.r[1] is -1.0, expected a finite number > 0 (px²)``.
+        ``NoiseEstimate.r[1] is -1.0, expected a finite number >= 1e-12 (px²)``,
+        ``NoiseEstimate.r is (1e-05, 100000.0): its values are 1e+10 times apart, expected
+        less than 5e+09``.
     """
 
     q: tuple[float, float]
     r: tuple[float, float]
 
     def __post_init__(self) -> None:
-        for name, lo, unit in (("q", ">= 0", "px²/frame³"), ("r", "> 0", "px²")):
+        for name, lo, unit in (("q", 0.0, "px²/frame³"), ("r", MIN_R, "px²")):
             what = f"NoiseEstimate.{name}"
             raw: object = getattr(self, name)
             if isinstance(raw, (str, bytes)) or not isinstance(raw, (Sequence, np.ndarray)):
@@ -60,10 +73,18 @@ class NoiseEstimate:
                 raise ValueError(f"{what} is {raw!r}: {len(raw)} values, expected 2 (x, y)")
             pair = tuple(number(v, f"{what}[{i}]", finite=False) for i, v in enumerate(raw))
             for i, v in enumerate(pair):
-                if not (np.isfinite(v) and (v >= 0 if name == "q" else v > 0)):
+                if not (np.isfinite(v) and v >= lo):
                     raise ValueError(
-                        f"{what}[{i}] is {v!r}, expected a finite number {lo} ({unit})"
+                        f"{what}[{i}] is {v!r}, expected a finite number >= {lo:g} ({unit})"
                     )
+            # the core's test of a covariance, as it computes it (bridge.hpp,
+            # require_covariance): every pivot above 1e-10 * size * the largest entry, so
+            # the values less than 1 / (2e-10) = MAX_R_RATIO times apart
+            if name == "r" and not min(pair) > 1e-10 * 2.0 * max(pair):
+                raise ValueError(
+                    f"{what} is {pair!r}: its values are {max(pair) / min(pair):.3g} times apart, "
+                    f"expected less than {MAX_R_RATIO:g}"
+                )
             object.__setattr__(self, name, pair)
 
 
