@@ -165,6 +165,24 @@ def test_every_noise_estimate_taken_is_solved(q, r, method):
         assert np.isfinite(path).all()
 
 
+@pytest.mark.parametrize("method", METHODS)
+def test_a_translated_gap_is_recovered_translated(method):
+    """Every method moves with the tracks: at 1e7 px only round-off may differ.
+
+    ``gsi``'s Gaussian process had a zero prior mean (StrongSORT's): it pulled the path toward
+    the image origin by 1.9e-7 of the coordinates, 1.9 px at 1e7 px.
+    """
+    rng = np.random.default_rng(0)
+    fa, fb = np.arange(1.0, 41), np.arange(52.0, 92)
+    a = np.column_stack([fa, 10 + 0.5 * fa + rng.normal(0, 1, 40), 5 + 0.2 * fa])
+    b = np.column_stack([fb, 40 + 0.5 * fb + rng.normal(0, 1, 40), 5 + 0.2 * fb])
+    base = recover_gap(a, b, method=method)
+    tol = 1e-4 if method == "gsi" else 1e-5  # gsi's kernel matrix (jitter 1e-10) amplifies more
+    for shift in (1e7, -1e7):
+        got = recover_gap(a + [0, shift, shift], b + [0, shift, shift], method=method)
+        np.testing.assert_allclose(got - shift, base, rtol=0, atol=tol)
+
+
 def test_noise_estimate_defaults_without_data():
     assert estimate_noise([np.zeros((2, 3))]) == DEFAULT_NOISE
     with pytest.raises(ValueError, match="method"):
