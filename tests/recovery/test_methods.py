@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -181,6 +183,30 @@ def test_a_translated_gap_is_recovered_translated(method):
     for shift in (1e7, -1e7):
         got = recover_gap(a + [0, shift, shift], b + [0, shift, shift], method=method)
         np.testing.assert_allclose(got - shift, base, rtol=0, atol=tol)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        # were: the core's "noise_loglik_grid: q and r must be finite and > 0 (pair 0)" after
+        # a NumPy RuntimeWarning, NumPy's TypeError, a NoiseEstimate error naming its own
+        # field, or an estimate below its floor (floor_r 1e300 gave r = 4.5e6)
+        ({"floor_r": 0.0}, ValueError, "estimate_noise: floor_r is 0.0, expected"),
+        ({"floor_q": -1.0}, ValueError, "estimate_noise: floor_q is -1.0, expected"),
+        ({"floor_q": 0.0}, ValueError, "estimate_noise: floor_q is 0.0, expected"),
+        ({"floor_r": float("nan")}, ValueError, "estimate_noise: floor_r is nan, expected"),
+        ({"floor_r": 1e-15}, ValueError, "estimate_noise: floor_r is 1e-15, expected"),
+        ({"floor_r": 1e300}, ValueError, "estimate_noise: floor_r is 1e+300, expected"),
+        ({"floor_r": "a"}, TypeError, "estimate_noise: floor_r must be a number, got str"),
+        ({"min_points": 2.5}, TypeError, "estimate_noise: min_points must be an integer"),
+    ],
+)
+@pytest.mark.parametrize("method", ["ml", "moments"])
+def test_estimate_noise_names_a_bad_floor(kwargs, error, message, method):
+    rng = np.random.default_rng(0)
+    run = np.column_stack([np.arange(50.0), rng.normal(0, 1, (50, 2)).cumsum(axis=0)])
+    with pytest.raises(error, match="^" + re.escape(message)):
+        estimate_noise([run], method=method, **kwargs)
 
 
 def test_noise_estimate_defaults_without_data():

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import number
+from pftrack._check import MAX_FRAME, integer, number
 from pftrack._typing import F64
 from pftrack.recovery.segments import consecutive_runs
 
@@ -88,6 +88,9 @@ class NoiseEstimate:
             object.__setattr__(self, name, pair)
 
 
+#: Top of the maximum-likelihood grid of ``q`` and ``r`` (the floors must lie below it).
+GRID_TOP = 100.0
+
 #: Used when the segments are too short to estimate anything.
 DEFAULT_NOISE = NoiseEstimate(q=(0.1, 0.1), r=(1.0, 1.0))
 
@@ -129,7 +132,8 @@ def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseE
     for axis in range(2):
         # the runs' values, stacked once for the three levels of the grid
         z = np.ascontiguousarray(np.concatenate([run[:, 1 + axis] for run in segments]))
-        lq_lo, lq_hi, lr_lo, lr_hi = np.log10(floor_q), 2.0, np.log10(floor_r), 2.0
+        top = np.log10(GRID_TOP)
+        lq_lo, lq_hi, lr_lo, lr_hi = np.log10(floor_q), top, np.log10(floor_r), top
         best = (0.0, 0.0)
         for _ in range(3):  # coarse-to-fine grid on log10 q, log10 r
             lq, lr = np.meshgrid(np.linspace(lq_lo, lq_hi, 9), np.linspace(lr_lo, lr_hi, 9))
@@ -171,9 +175,10 @@ def estimate_noise(
         runs, maximised on a coarse-to-fine log grid); ``"moments"``: method of moments on
         second differences (``r = (c0 - 4 c1) / 22``, ``q = 3 (c0 - 6 r) / 2``).
     floor_q, floor_r : float
-        Lower bounds of the estimates.
+        Lower bounds of the estimates: ``0 < floor_q < 100`` (px²/frame³) and
+        ``MIN_R <= floor_r < 100`` (px²; 100 is the top of the likelihood grid).
     min_points : int
-        Shortest run used.
+        Shortest run used (an int >= 1).
     scales : sequence of int
         ``"ml"`` only: the model is fitted to the runs sampled every ``s`` frames for each
         ``s``; per axis, going from fine to coarse, a scale replaces the current estimate when
@@ -191,6 +196,19 @@ def estimate_noise(
     """
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
+    floor_q = number(floor_q, "estimate_noise: floor_q", finite=False)
+    floor_r = number(floor_r, "estimate_noise: floor_r", finite=False)
+    if not 0.0 < floor_q < GRID_TOP:  # NaN fails too
+        raise ValueError(
+            f"estimate_noise: floor_q is {floor_q!r}, expected a number in (0, {GRID_TOP:g}) "
+            "(px²/frame³)"
+        )
+    if not MIN_R <= floor_r < GRID_TOP:
+        raise ValueError(
+            f"estimate_noise: floor_r is {floor_r!r}, expected a number in [{MIN_R:g}, "
+            f"{GRID_TOP:g}) (px²)"
+        )
+    min_points = integer(min_points, "estimate_noise: min_points", 1, MAX_FRAME)
     runs = consecutive_runs(segments, max(min_points, 4))
     if sum(len(r) - 3 for r in runs) < 4:
         return DEFAULT_NOISE
