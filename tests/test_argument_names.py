@@ -201,9 +201,29 @@ def test_resamplers_name_their_rng(
             (1, 1),
             (np.inf, 1),
             ValueError,
-            "NoiseEstimate.r[0] is inf, expected a finite number > 0 (px²)",
+            "NoiseEstimate.r[0] is inf, expected a finite number >= 1e-12 (px²)",
         ),
-        ((1, 1), (1, 0), ValueError, "NoiseEstimate.r[1] is 0.0, expected a finite number > 0"),
+        (
+            (1, 1),
+            (1, 0),
+            ValueError,
+            "NoiseEstimate.r[1] is 0.0, expected a finite number >= 1e-12",
+        ),
+        # were taken, and failed in gdt_recover_batch: "Pi_T + H S H^T is not positive
+        # definite" (tiny r, q = 0) and "R is not positive definite" (r 1e10 times apart)
+        (
+            (0, 0),
+            (1e-20, 1e-20),
+            ValueError,
+            "NoiseEstimate.r[0] is 1e-20, expected a finite number >= 1e-12 (px²)",
+        ),
+        (
+            (1, 1),
+            (1e-5, 1e5),
+            ValueError,
+            "NoiseEstimate.r is (1e-05, 100000.0): its values are 1e+10 times apart, expected "
+            "less than 5e+09",
+        ),
         ((True, 1), (1, 1), TypeError, "NoiseEstimate.q[0] must be a number, got bool True"),
         ((1, 1), (1, "2"), TypeError, "NoiseEstimate.r[1] must be a number, got str '2'"),
         ("ab", (1, 1), TypeError, "NoiseEstimate.q must be 2 numbers (x, y), got str 'ab'"),

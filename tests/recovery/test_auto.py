@@ -817,7 +817,6 @@ def test_fill_does_not_depend_on_how_the_ids_are_numbered() -> None:
 
     assert rep.n_filled_rows > 0
     np.testing.assert_array_equal(canon(out), canon(out2))
-    assert rep.calibration == rep2.calibration
 
 
 def test_a_bucket_never_does_worse_than_linear_on_its_validation_gaps() -> None:
@@ -843,3 +842,31 @@ def test_a_bucket_never_does_worse_than_linear_on_its_validation_gaps() -> None:
                 assert c.method == "linear" and c.replaced[1] > vals["linear"]
                 assert "did worse than linear" in cal.describe()
     assert replaced > 0  # the data exercise the rule
+
+
+@pytest.mark.parametrize("shift", [1000.0, -777.0])
+def test_fill_does_not_depend_on_where_the_tracks_are(shift: float) -> None:
+    """A translated copy of a file is filled alike, up to round-off (a trial: 0.23 px apart).
+
+    Distances between gap ends differ by round-off once translated; the calibration sorted the
+    real gaps by them and kept the nearest of the drawn places, so round-off reordered exact
+    ties (steps of 0.1 px make many) and another set of validation gaps was cut.
+    """
+    rng = np.random.default_rng(2)
+    rows = []
+    for i in range(12):
+        xy = np.array([100.1 + 37.3 * i, 50.7 + 20.9 * i]) + np.cumsum(
+            rng.integers(-15, 16, (120, 2)) / 10, axis=0
+        )
+        keep = rng.random(120) > 0.2
+        keep[[0, -1]] = True
+        track = np.column_stack([np.arange(1.0, 121.0), np.full(120, i + 1.0), xy])
+        rows.append(np.column_stack([track, np.full((120, 2), [40.0, 80.0])])[keep])
+    tracks = np.vstack(rows)
+    moved = tracks.copy()
+    moved[:, 2:4] += shift
+    out, rep = fill_gaps(tracks)
+    out2, rep2 = fill_gaps(moved)
+    assert rep.n_filled_rows > 0
+    np.testing.assert_allclose(out2[:, 2:4] - shift, out[:, 2:4], rtol=0, atol=1e-9)
+    assert rep.describe() == rep2.describe()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -17,7 +19,7 @@ from pftrack.recovery import (
 from pftrack.recovery.calibrate import fixed_noise_model
 from pftrack.recovery.demo import demo_report
 from pftrack.recovery.gdt import GdtModel
-from pftrack.recovery.noise import DEFAULT_NOISE, NoiseEstimate
+from pftrack.recovery.noise import DEFAULT_NOISE, MAX_R_RATIO, MIN_R, NoiseEstimate
 from pftrack.recovery.problems import GdtProblem, SegmentModel, gdt_bi_problem, gdt_problem
 from tests.reference import bridge as ref
 
@@ -143,6 +145,68 @@ def test_noise_estimates_recover_simulated_levels(method):
     for ax in range(2):
         assert 0.6 * q < est.q[ax] < 1.6 * q, est
         assert 0.6 * r < est.r[ax] < 1.6 * r, est
+
+
+@pytest.mark.parametrize("q", [(0.0, 0.0), (0.0, 1e5), (1e-300, 2.0)])
+@pytest.mark.parametrize("r", [(MIN_R, MIN_R), (1.0, 0.999 * MAX_R_RATIO), (MIN_R, 1e-3)])
+@pytest.mark.parametrize("method", ["gdt-bi", "gdt-mix"])
+def test_every_noise_estimate_taken_is_solved(q, r, method):
+    """At the bounds NoiseEstimate checks, the C++ core solves: no error of its own.
+
+    Were taken and failed in gdt_recover_batch: ``r`` of 1e-13 px² with ``q = 0`` ("Pi_T +
+    H S H^T is not positive definite"; now refused as below MIN_R) and ``r`` 1e10 apart ("R
+    is not positive definite"; now refused as MAX_R_RATIO apart or more).
+    """
+    noise = NoiseEstimate(q=q, r=r)
+    pairs = [
+        (line(np.arange(1, 3)), line(np.arange(4, 6))),  # the shortest runs, the most fragile
+        (line(np.arange(1, 31)), line(np.arange(45, 80))),
+        (line(np.arange(1, 400)), line(np.arange(430, 800))),
+    ]
+    for path in recover_gaps(pairs, method, noise=noise):
+        assert np.isfinite(path).all()
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_a_translated_gap_is_recovered_translated(method):
+    """Every method moves with the tracks: at 1e7 px only round-off may differ.
+
+    ``gsi``'s Gaussian process had a zero prior mean (StrongSORT's): it pulled the path toward
+    the image origin by 1.9e-7 of the coordinates, 1.9 px at 1e7 px.
+    """
+    rng = np.random.default_rng(0)
+    fa, fb = np.arange(1.0, 41), np.arange(52.0, 92)
+    a = np.column_stack([fa, 10 + 0.5 * fa + rng.normal(0, 1, 40), 5 + 0.2 * fa])
+    b = np.column_stack([fb, 40 + 0.5 * fb + rng.normal(0, 1, 40), 5 + 0.2 * fb])
+    base = recover_gap(a, b, method=method)
+    tol = 1e-4 if method == "gsi" else 1e-5  # gsi's kernel matrix (jitter 1e-10) amplifies more
+    for shift in (1e7, -1e7):
+        got = recover_gap(a + [0, shift, shift], b + [0, shift, shift], method=method)
+        np.testing.assert_allclose(got - shift, base, rtol=0, atol=tol)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        # were: the core's "noise_loglik_grid: q and r must be finite and > 0 (pair 0)" after
+        # a NumPy RuntimeWarning, NumPy's TypeError, a NoiseEstimate error naming its own
+        # field, or an estimate below its floor (floor_r 1e300 gave r = 4.5e6)
+        ({"floor_r": 0.0}, ValueError, "estimate_noise: floor_r is 0.0, expected"),
+        ({"floor_q": -1.0}, ValueError, "estimate_noise: floor_q is -1.0, expected"),
+        ({"floor_q": 0.0}, ValueError, "estimate_noise: floor_q is 0.0, expected"),
+        ({"floor_r": float("nan")}, ValueError, "estimate_noise: floor_r is nan, expected"),
+        ({"floor_r": 1e-15}, ValueError, "estimate_noise: floor_r is 1e-15, expected"),
+        ({"floor_r": 1e300}, ValueError, "estimate_noise: floor_r is 1e+300, expected"),
+        ({"floor_r": "a"}, TypeError, "estimate_noise: floor_r must be a number, got str"),
+        ({"min_points": 2.5}, TypeError, "estimate_noise: min_points must be an integer"),
+    ],
+)
+@pytest.mark.parametrize("method", ["ml", "moments"])
+def test_estimate_noise_names_a_bad_floor(kwargs, error, message, method):
+    rng = np.random.default_rng(0)
+    run = np.column_stack([np.arange(50.0), rng.normal(0, 1, (50, 2)).cumsum(axis=0)])
+    with pytest.raises(error, match="^" + re.escape(message)):
+        estimate_noise([run], method=method, **kwargs)
 
 
 def test_noise_estimate_defaults_without_data():

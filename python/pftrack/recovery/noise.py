@@ -15,11 +15,20 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import number
+from pftrack._check import MAX_FRAME, integer, number
 from pftrack._typing import F64
 from pftrack.recovery.segments import consecutive_runs
 
-__all__ = ["DEFAULT_NOISE", "NoiseEstimate", "estimate_noise"]
+__all__ = ["DEFAULT_NOISE", "MAX_R_RATIO", "MIN_R", "NoiseEstimate", "estimate_noise"]
+
+
+#: Smallest measurement variance (px²): below it the Kalman covariances of the C++ core lose
+#: positive definiteness to round-off ("Pi_T + H S H^T is not positive definite" from 1e-13
+#: px² with q = 0 on short runs; a user trial). Estimates never go below ``floor_r`` (1e-3).
+MIN_R = 1e-12
+#: The two axes' measurement variances must be less than this many times apart: the core
+#: refuses ``diag(r)`` as singular from there ("R is not positive definite").
+MAX_R_RATIO = 5e9
 
 
 @dataclass(frozen=True)
@@ -28,8 +37,10 @@ class NoiseEstimate:
 
     ``q``: white-noise-acceleration intensity (px²/frame³); ``r``: measurement variance (px²).
     Each is 2 real numbers (a tuple, a list or an array; kept as a tuple of floats): ``q``
-    finite and ``>= 0``, ``r`` finite and ``> 0`` (a zero measurement variance makes the
-    filters' covariances singular).
+    finite and ``>= 0``, ``r`` finite and at least :data:`MIN_R` (a zero or tiny measurement
+    variance makes the filters' covariances singular to round-off), its two values less than
+    :data:`MAX_R_RATIO` times apart (the filters' measurement covariance ``diag(r)`` would be
+    singular to the C++ core's check).
 
     Raises
     ------
@@ -38,14 +49,16 @@ class NoiseEstimate:
         ``NoiseEstimate.q[0] must be a number, got bool True``.
     ValueError
         Not 2 values, or a value out of range:
-        ``NoiseEstimate.r[1] is -1.0, expected a finite number > 0 (px²)``.
+        ``NoiseEstimate.r[1] is -1.0, expected a finite number >= 1e-12 (px²)``,
+        ``NoiseEstimate.r is (1e-05, 100000.0): its values are 1e+10 times apart, expected
+        less than 5e+09``.
     """
 
     q: tuple[float, float]
     r: tuple[float, float]
 
     def __post_init__(self) -> None:
-        for name, lo, unit in (("q", ">= 0", "px²/frame³"), ("r", "> 0", "px²")):
+        for name, lo, unit in (("q", 0.0, "px²/frame³"), ("r", MIN_R, "px²")):
             what = f"NoiseEstimate.{name}"
             raw: object = getattr(self, name)
             if isinstance(raw, (str, bytes)) or not isinstance(raw, (Sequence, np.ndarray)):
@@ -60,12 +73,23 @@ class NoiseEstimate:
                 raise ValueError(f"{what} is {raw!r}: {len(raw)} values, expected 2 (x, y)")
             pair = tuple(number(v, f"{what}[{i}]", finite=False) for i, v in enumerate(raw))
             for i, v in enumerate(pair):
-                if not (np.isfinite(v) and (v >= 0 if name == "q" else v > 0)):
+                if not (np.isfinite(v) and v >= lo):
                     raise ValueError(
-                        f"{what}[{i}] is {v!r}, expected a finite number {lo} ({unit})"
+                        f"{what}[{i}] is {v!r}, expected a finite number >= {lo:g} ({unit})"
                     )
+            # the core's test of a covariance, as it computes it (bridge.hpp,
+            # require_covariance): every pivot above 1e-10 * size * the largest entry, so
+            # the values less than 1 / (2e-10) = MAX_R_RATIO times apart
+            if name == "r" and not min(pair) > 1e-10 * 2.0 * max(pair):
+                raise ValueError(
+                    f"{what} is {pair!r}: its values are {max(pair) / min(pair):.3g} times apart, "
+                    f"expected less than {MAX_R_RATIO:g}"
+                )
             object.__setattr__(self, name, pair)
 
+
+#: Top of the maximum-likelihood grid of ``q`` and ``r`` (the floors must lie below it).
+GRID_TOP = 100.0
 
 #: Used when the segments are too short to estimate anything.
 DEFAULT_NOISE = NoiseEstimate(q=(0.1, 0.1), r=(1.0, 1.0))
@@ -108,7 +132,8 @@ def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseE
     for axis in range(2):
         # the runs' values, stacked once for the three levels of the grid
         z = np.ascontiguousarray(np.concatenate([run[:, 1 + axis] for run in segments]))
-        lq_lo, lq_hi, lr_lo, lr_hi = np.log10(floor_q), 2.0, np.log10(floor_r), 2.0
+        top = np.log10(GRID_TOP)
+        lq_lo, lq_hi, lr_lo, lr_hi = np.log10(floor_q), top, np.log10(floor_r), top
         best = (0.0, 0.0)
         for _ in range(3):  # coarse-to-fine grid on log10 q, log10 r
             lq, lr = np.meshgrid(np.linspace(lq_lo, lq_hi, 9), np.linspace(lr_lo, lr_hi, 9))
@@ -150,9 +175,10 @@ def estimate_noise(
         runs, maximised on a coarse-to-fine log grid); ``"moments"``: method of moments on
         second differences (``r = (c0 - 4 c1) / 22``, ``q = 3 (c0 - 6 r) / 2``).
     floor_q, floor_r : float
-        Lower bounds of the estimates.
+        Lower bounds of the estimates: ``0 < floor_q < 100`` (px²/frame³) and
+        ``MIN_R <= floor_r < 100`` (px²; 100 is the top of the likelihood grid).
     min_points : int
-        Shortest run used.
+        Shortest run used (an int >= 1).
     scales : sequence of int
         ``"ml"`` only: the model is fitted to the runs sampled every ``s`` frames for each
         ``s``; per axis, going from fine to coarse, a scale replaces the current estimate when
@@ -170,6 +196,19 @@ def estimate_noise(
     """
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
+    floor_q = number(floor_q, "estimate_noise: floor_q", finite=False)
+    floor_r = number(floor_r, "estimate_noise: floor_r", finite=False)
+    if not 0.0 < floor_q < GRID_TOP:  # NaN fails too
+        raise ValueError(
+            f"estimate_noise: floor_q is {floor_q!r}, expected a number in (0, {GRID_TOP:g}) "
+            "(px²/frame³)"
+        )
+    if not MIN_R <= floor_r < GRID_TOP:
+        raise ValueError(
+            f"estimate_noise: floor_r is {floor_r!r}, expected a number in [{MIN_R:g}, "
+            f"{GRID_TOP:g}) (px²)"
+        )
+    min_points = integer(min_points, "estimate_noise: min_points", 1, MAX_FRAME)
     runs = consecutive_runs(segments, max(min_points, 4))
     if sum(len(r) - 3 for r in runs) < 4:
         return DEFAULT_NOISE
