@@ -167,6 +167,21 @@ def test_every_noise_estimate_taken_is_solved(q, r, method):
         assert np.isfinite(path).all()
 
 
+@pytest.mark.parametrize("method", ["gdt-bi", "gdt-mix"])
+def test_a_path_that_overflows_is_an_error_not_nan(method):
+    """A finite ``q`` NoiseEstimate takes can overflow over a long gap (``q T^3``): the
+    paths came back NaN without a word (1e300 px²/frame³ over 1000 frames; a user trial)."""
+    noise = NoiseEstimate(q=(1e300, 1e300), r=(1.0, 1.0))
+    pairs = [
+        (line(np.arange(1, 31)), line(np.arange(45, 80))),
+        (line(np.arange(1, 21)), line(np.arange(1021, 1041))),
+    ]
+    with pytest.raises(ValueError, match=r"gap 1 \(1000 missing frames\) overflows"):
+        recover_gaps(pairs, method, noise=noise)
+    short = recover_gaps(pairs[:1], method, noise=NoiseEstimate(q=(1e100, 1e100), r=(1.0, 1.0)))
+    assert np.isfinite(short[0]).all()  # huge, but finite over its gap: no error
+
+
 @pytest.mark.parametrize("method", METHODS)
 def test_a_translated_gap_is_recovered_translated(method):
     """Every method moves with the tracks: at 1e7 px only round-off may differ.

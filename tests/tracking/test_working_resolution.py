@@ -64,6 +64,20 @@ def test_working_frame_is_inter_area(scene):
     assert np.array_equal(tracker.working_frame(doubled(f)), f)
 
 
+@pytest.mark.parametrize(
+    ("frame", "error", "words"),
+    [
+        ([[[0, 0, 0]]], TypeError, "working_frame: frame is list"),
+        (np.zeros((4, 4), np.uint8), ValueError, "working_frame: frame must have shape"),
+        (np.zeros((4, 4, 3)), TypeError, "working_frame: frame dtype is float64"),
+    ],
+)
+def test_working_frame_names_a_bad_frame(frame, error, words):
+    """Was an AttributeError ('list' object has no attribute 'shape') for a list."""
+    with pytest.raises(error, match=words):
+        pftrack.Tracker(max_side=480).working_frame(frame)
+
+
 @pytest.mark.parametrize("given", [True, False], ids=["detections", "builtin"])
 def test_doubled_frames_give_doubled_boxes_byte_for_byte(scene, given):
     dets = truth_dets(scene) if given else [None] * len(scene.frames)

@@ -41,7 +41,7 @@ from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.kalman import cv_transition, wna_Q
 from pftrack.recovery.noise import NoiseEstimate, estimate_noise
-from pftrack.recovery.problems import SegmentModel
+from pftrack.recovery.problems import SegmentModel, check_finite_paths
 from pftrack.recovery.segments import consecutive_runs
 
 __all__ = [
@@ -423,4 +423,7 @@ def recover_mixture_gaps(
         else:
             out.append(_posterior_mean(w, results[at : at + 2]))
             at += 2
+    T = [int(b[0, 0] - a[-1, 0]) for a, b in gaps]
+    q = max(m.q for m in fit.axes)
+    check_finite_paths(out, T, f"the motion model's process noise {q:.3g}")
     return out

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Literal, TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import pftrack._core as _core
 from pftrack._typing import F64
@@ -244,4 +245,21 @@ class SegmentModel:
             self.start_conditioned,
         )
         T = (b[np.cumsum(b_len) - b_len, 0] - a[np.cumsum(a_len) - 1, 0]).astype(np.int64)
-        return split_rows(out, T - 1)
+        paths = split_rows(out, T - 1)
+        check_finite_paths(paths, T, f"process noise up to {np.max(self.Q):.3g}")
+        return paths
+
+
+def check_finite_paths(paths: Sequence[F64], T: ArrayLike, cause: str) -> None:
+    """Raise ValueError naming the first gap whose recovered path is not finite.
+
+    A model's covariances grow with the gap (``q T^3``): noise levels that NoiseEstimate takes
+    (any finite ``q``) can overflow over a long gap, which gave NaN paths without a word.
+    """
+    for k, p in enumerate(paths):
+        if not np.isfinite(p).all():
+            n = int(np.asarray(T)[k]) - 1
+            raise ValueError(
+                f"the goal-directed path of gap {k} ({n} missing frames) overflows: {cause} "
+                "is too large for a gap this long (NoiseEstimate.q)"
+            )

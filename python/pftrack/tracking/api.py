@@ -678,7 +678,17 @@ class Tracker:
 
         OpenCV's ``INTER_AREA`` (the mean of the pixels each output pixel covers), to the size
         :func:`working_size` gives.
+
+        Raises
+        ------
+        TypeError, ValueError
+            Not a (H, W, 3) uint8 array with pixels (:func:`pftrack._check.bgr_frame`'s
+            words; was an AttributeError for a list).
         """
+        f = frame
+        if not (isinstance(f, np.ndarray) and f.dtype == np.uint8 and f.ndim == 3
+                and f.shape[2] == 3 and f.size):  # fmt: skip
+            frame = bgr_frame(frame, "working_frame: frame")  # raises, or packs a view
         size = working_size(frame.shape, self.config.max_side)
         if size is None:
             return frame
