@@ -47,6 +47,7 @@ from experiments._common import (
 )
 from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
+from pftrack.io.mot import as_written
 from pftrack.io.opencv_io import write_image
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene, make_scene
@@ -186,7 +187,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                     bootstrap=args.bootstrap,
                     show_progress=False,
                 )
-                s = evaluate_sequence(gt, run.rows)
+                s = evaluate_sequence(gt, as_written(run.rows))
                 print(
                     f"{name:9s} {variant:7s} {100 * s.mot.mota:6.1f} {100 * s.mot.idf1:6.1f} "
                     f"{100 * s.hota.hota:6.1f} {s.mot.false_positives:5d} {s.mot.misses:5d} "

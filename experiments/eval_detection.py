@@ -32,7 +32,7 @@ from pftrack._typing import F64
 from pftrack.boxes import iou_xywh
 from pftrack.detection import PaperDetector, make_detector
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
-from pftrack.io.mot import group_by_frame
+from pftrack.io.mot import as_written, group_by_frame
 from pftrack.io.video import read_frames, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 
@@ -220,7 +220,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                     bootstrap=args.bootstrap,
                     show_progress=False,
                 )
-                rows = run.rows
+                rows = as_written(run.rows)  # what pftrack track writes
                 m = evaluate_mot(gt, rows)
                 line += f" MOTA={100 * m.mota:.1f} IDF1={100 * m.idf1:.1f}"
                 by_iou, by_area = empty_floor_runs(rows, gt)

@@ -46,7 +46,7 @@ from experiments.public_detections import (
 )
 from pftrack._typing import F64
 from pftrack.eval import SequenceScores, evaluate_sequence
-from pftrack.io.mot import read_mot
+from pftrack.io.mot import as_written, read_mot
 from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 from pftrack.tracking import load_detections, track_frames
@@ -179,7 +179,7 @@ def main(argv: list[str] | None = None) -> int:
                 scores = []
                 for i, seed in enumerate(args.seeds):
                     run = track_frames(frames, detections=dets, config=config, rng=seed)
-                    s = evaluate_sequence(gt, run.rows, scale=scale)
+                    s = evaluate_sequence(gt, as_written(run.rows), scale=scale)
                     scores.append(s)
                     pooled[version][i].append(s)
                 row = _row(f"{name} {version}", scores)

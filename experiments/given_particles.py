@@ -23,7 +23,7 @@ import numpy as np
 
 from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
 from pftrack.eval import evaluate_sequence
-from pftrack.io.mot import read_mot
+from pftrack.io.mot import as_written, read_mot
 from pftrack.io.video import FrameSource
 from pftrack.tracking import TrackerConfig, load_detections, track_frames
 
@@ -37,7 +37,7 @@ def scores(folder: Path, video: str, scale: float, count: int, seed: int) -> tup
         config=config,
         rng=seed,
     )
-    s = evaluate_sequence(read_mot(folder / "gt.txt"), run.rows, scale=scale)
+    s = evaluate_sequence(read_mot(folder / "gt.txt"), as_written(run.rows), scale=scale)
     return 100 * s.mot.mota, 100 * s.mot.idf1, 100 * s.hota.hota
 
 

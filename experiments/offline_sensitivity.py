@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from experiments._common import data_root, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.eval import evaluate_mot
-from pftrack.io.mot import read_mot
+from pftrack.io.mot import as_written, read_mot
 from pftrack.io.video import read_frames
 from pftrack.synthetic import Scene, make_scene
 from pftrack.tracking import (
@@ -74,7 +74,7 @@ def setting_row(
                 show_progress=False,
                 smoother=smoother,
             )
-            m = evaluate_mot(gt, run.rows, scale=scale)
+            m = evaluate_mot(gt, as_written(run.rows), scale=scale)
             scores.append((m.mota, m.idf1))
         a = 100 * np.asarray(scores)
         mota, idf1 = a[:, 0], a[:, 1]
@@ -88,7 +88,7 @@ def setting_row(
             show_progress=False,
             smoother=smoother,
         )
-        m = evaluate_mot(sc.truth, run.rows)
+        m = evaluate_mot(sc.truth, as_written(run.rows))
         syn.append((m.mota, m.idf1))
     b = 100 * np.asarray(syn).reshape(-1, 2)
     cells.append(f"{b[:, 0].mean():.1f} / {b[:, 1].mean():.1f}" if len(b) else "-")

@@ -40,7 +40,7 @@ from experiments._common import data_root, experiment_parser, write_text
 from pftrack.boxes import iou_xywh
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.atomic import atomic_path, atomic_write
-from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.mot import as_written, group_by_frame, read_mot
 from pftrack.io.video import FrameSource
 from pftrack.particle_filter import (
     ColourParticleFilter,
@@ -118,7 +118,7 @@ def run_sampler(
         smoother=None,
         link=None,
     )
-    m = evaluate_mot(gt, run.rows, scale=gt_scale, image_size=image_size)
+    m = evaluate_mot(gt, as_written(run.rows), scale=gt_scale, image_size=image_size)
     n_tracks = len(np.unique(run.rows[:, 1])) if len(run.rows) else 0
     return SamplerResult(sequence, detector, sampler, m, n_tracks, run.fps)
 

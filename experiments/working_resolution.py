@@ -45,7 +45,7 @@ from experiments._common import data_root, experiment_parser, tee_stdout
 from experiments.cost_per_object import make_crowd
 from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
-from pftrack.io.mot import group_by_frame, read_mot
+from pftrack.io.mot import as_written, group_by_frame, read_mot
 from pftrack.io.opencv_io import opencv_name
 from pftrack.io.video import FrameSource
 from pftrack.tracking import TrackerConfig, track_frames
@@ -151,7 +151,7 @@ def main(argv: list[str] | None = None) -> int:
                             rng=seed,
                             show_progress=False,
                         )
-                        s = evaluate_sequence(made.gt, run.rows)
+                        s = evaluate_sequence(made.gt, as_written(run.rows))
                         print(
                             f"{name:8s} {mode:8s} {side or 'full'!s:6s} {seed:4d} "
                             f"{100 * s.mot.mota:6.1f} {100 * s.mot.idf1:6.1f} "
