@@ -791,6 +791,45 @@ def test_no_track_warning_says_min_conf_left_the_built_in_detectors_objects_out(
     ), said
 
 
+def test_no_track_warning_says_min_area_left_the_built_in_detectors_objects_out():
+    """A defect trial: a 6x6 object, under min_area=64 pixels, was said to be scored at most
+    1 with "none reached min_conf 0" (1 >= 0: min_conf left nothing out)."""
+    background = np.random.default_rng(0).integers(60, 120, (120, 160, 3), dtype=np.uint8)
+    frames = [background.copy() for _ in range(6)]
+    for f in frames[3:]:
+        f[40:46, 60:66] = (0, 0, 255)
+    for sampler in ("sis", "rjmcmc"):
+        tracker = pftrack.Tracker(sampler=sampler)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for f in frames:
+                tracker.update(None, f)
+            assert len(tracker.finalize()) == 0
+        said = [str(c.message) for c in caught if "no track" in str(c.message)]
+        assert said == [
+            "no track over 6 frames: the built-in detector found 3 objects over the run: each "
+            "one scoring at least min_conf 0 was under min_area=64 pixels "
+            "(LifecycleConfig.min_area)"
+        ], sampler
+
+
+def test_no_track_warning_of_the_joint_sampler_names_min_conf():
+    """A defect trial: with rjmcmc, detections all below min_conf (logits) were said to be
+    proposed as births the sampler kept none of; it never saw them."""
+    tracker = pftrack.Tracker(sampler="rjmcmc")
+    frame = np.random.default_rng(0).integers(0, 255, (200, 300, 3), dtype=np.uint8)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(3):
+            tracker.update(np.array([[10, 20, 50, 120, -0.5]]), frame)
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert said == [
+        "no track over 3 frames: the highest detection confidence was -0.5 (min_conf 0, "
+        "birth_score 0.9)"
+    ]
+
+
 @pytest.mark.parametrize(
     ("where", "hint"),
     [

@@ -1067,15 +1067,28 @@ class Tracker:
                 f"{started} track{'s' * (started != 1)} started but none reached "
                 f"min_hits={cfg.min_hits} matched frames (shorter tracks are left out)"
             )
-        if not self._given and self._tracker.found_own:
+        found = self._tracker.found_own
+        if not self._given and found:
+            objects = f"{found} object{'s' * (found != 1)}"
+            own = f"the built-in detector found {objects} over the run"
+            if self._tracker.kept_own:  # only the joint sampler leaves kept objects untracked
+                return (
+                    f"the joint sampler (rjmcmc) kept none of the {objects} the built-in "
+                    "detector found (each is proposed as a birth; too few frames, or no colour "
+                    "to weigh them?)"
+                )
+            if self._tracker.best_own_score >= cfg.min_score:  # min_area left them out
+                return (
+                    f"{own}: each one scoring at least min_conf {cfg.min_score:.3g} was under "
+                    f"min_area={cfg.min_area:g} pixels (LifecycleConfig.min_area)"
+                )
             return (
-                f"the built-in detector found {self._tracker.found_own} objects over the run, "
-                f"scored at most {self._tracker.best_own_score:.3g}: none reached min_conf "
-                f"{cfg.min_score:.3g}"
+                f"{own}, scored at most {self._tracker.best_own_score:.3g}: none reached "
+                f"min_conf {cfg.min_score:.3g}"
             )
         if not self._given:
             return "the built-in detector found no object (no detection was given)"
-        if self.config.sampler == "rjmcmc" and np.isfinite(self._max_conf):
+        if self.config.sampler == "rjmcmc" and self._tracker.kept_given:
             return (  # its births take every detection kept (min_conf), confident or not
                 "the joint sampler (rjmcmc) kept no object of the detections given (each is "
                 "proposed as a birth; too few frames, or no colour to weigh them?)"
