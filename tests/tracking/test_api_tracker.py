@@ -1131,6 +1131,24 @@ def test_score_options_must_be_finite_numbers():
         TrackerConfig(lifecycle=_lifecycle(birth_score=np.inf))
 
 
+@pytest.mark.parametrize(
+    ("given", "named"),
+    [
+        ({"max_coast": 1.0}, "max_coast 1"),
+        ({"birth_score": 0.5}, "birth_score 0.5"),
+        ({"birth_quantile": None}, "birth_quantile None"),
+        ({"max_coast": 0.4, "birth_score": 0.2}, "max_coast 0.4, birth_score 0.2"),
+    ],
+)
+def test_joint_sampler_refuses_the_lifecycle_options_it_ignores(given, named):
+    """A defect trial: ``pftrack track`` refuses --max-coast and --birth-score with --sampler
+    rjmcmc (its chain keeps and starts tracks by its own existence probabilities), but
+    Tracker(sampler="rjmcmc", ...) took them and tracked as without them."""
+    with pytest.raises(ValueError, match=rf"^{re.escape(named)}: the joint sampler \(rjmcmc\)"):
+        pftrack.Tracker(sampler="rjmcmc", **given)
+    pftrack.Tracker(sampler="sis", **given)  # used there
+
+
 def test_joint_sampler_counts_the_objects_it_started(scene):
     tracker = pftrack.Tracker(frame_rate=10.0, sampler="rjmcmc")
     for d, f in zip(scene_dets(scene)[:6], scene.frames[:6], strict=True):

@@ -369,8 +369,10 @@ class Tracker:
         (``refine="no"`` would turn refinement on), a `frame_rate`, `max_coast`, `prime`,
         `min_conf` or `birth_score` that is not a number, a `seed` that is not an int.
     ValueError
-        A value out of its range, or ``crossings=True`` with ``smooth=False`` (the repair is
-        part of the smoothing pass).
+        A value out of its range, ``crossings=True`` with ``smooth=False`` (the repair is
+        part of the smoothing pass), or `max_coast`, `birth_score` or `birth_quantile` other
+        than its default with ``sampler="rjmcmc"`` (the joint chain keeps and starts tracks by
+        its own existence probabilities: they would do nothing).
 
     Notes
     -----
@@ -486,6 +488,23 @@ class Tracker:
                 birth_quantile=birth_quantile,
             ),
         )
+        if sampler == "rjmcmc":  # its chain ignores them (the CLI refuses them likewise)
+            unused = [
+                f"{name} {'None' if value is None else format(value, 'g')}"
+                for name, value, default in (
+                    ("max_coast", max_coast, None),
+                    ("birth_score", birth_score, 0.9),
+                    ("birth_quantile", birth_quantile, 0.25),
+                )
+                if value != default
+            ]
+            if unused:
+                one = len(unused) == 1
+                raise ValueError(
+                    f"{', '.join(unused)}: the joint sampler (rjmcmc) keeps and starts tracks by "
+                    f"its own existence probabilities, so {'it does' if one else 'they do'} "
+                    f"nothing: drop {'it' if one else 'them'}, or use sampler 'sis' or 'mh'"
+                )
         link_config = LinkConfig()
         self._setup(
             config,
