@@ -813,6 +813,29 @@ def test_no_track_warning_says_min_area_left_the_built_in_detectors_objects_out(
         ], sampler
 
 
+def test_no_track_warning_of_the_joint_sampler_on_the_built_in_detector():
+    """A defect trial (``pftrack track`` on a 40x1 image folder, --sampler rjmcmc): objects
+    the joint sampler kept none of were said to have "none reached min_conf 0" at score 1.
+    Its chain is stubbed to keep nothing here: a real run needs odd footage."""
+    background = np.random.default_rng(0).integers(60, 120, (120, 160, 3), dtype=np.uint8)
+    frames = [background.copy() for _ in range(6)]
+    for i, f in enumerate(frames[2:]):
+        f[40:80, 60 + 2 * i : 80 + 2 * i] = (0, 0, 255)
+    tracker = pftrack.Tracker(sampler="rjmcmc")
+    tracker.tracker._joint.step = lambda *args: []  # type: ignore[method-assign]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for f in frames:
+            tracker.update(None, f)
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert said == [
+        "no track over 6 frames: the joint sampler (rjmcmc) kept none of the 4 objects the "
+        "built-in detector found (each is proposed as a birth; too few frames, or no colour to "
+        "weigh them?)"
+    ]
+
+
 def test_no_track_warning_of_the_joint_sampler_names_min_conf():
     """A defect trial: with rjmcmc, detections all below min_conf (logits) were said to be
     proposed as births the sampler kept none of; it never saw them."""

@@ -1090,12 +1090,14 @@ class Tracker:
         if not self._given and found:
             objects = f"{found} object{'s' * (found != 1)}"
             own = f"the built-in detector found {objects} over the run"
-            if self._tracker.kept_own:  # only the joint sampler leaves kept objects untracked
+            if self._tracker.kept_own and self.config.sampler == "rjmcmc":
                 return (
                     f"the joint sampler (rjmcmc) kept none of the {objects} the built-in "
                     "detector found (each is proposed as a birth; too few frames, or no colour "
                     "to weigh them?)"
                 )
+            if self._tracker.kept_own:  # kept, and not one with colour to start a track from
+                return f"{own}, none with colour in its box to start a track from"
             if self._tracker.best_own_score >= cfg.min_score:  # min_area left them out
                 return (
                     f"{own}: each one scoring at least min_conf {cfg.min_score:.3g} was under "
