@@ -8,7 +8,7 @@ import pytest
 from pftrack.boxes import iou_xywh
 from pftrack.io.mot import read_mot
 from pftrack.io.video import FrameSource
-from pftrack.synthetic import make_scene
+from pftrack.synthetic import make_busy_scene, make_scene
 
 
 @pytest.fixture(scope="module")
@@ -122,6 +122,15 @@ def test_an_odd_sized_scene_is_written_whole(tmp_path, suffix):
 def test_bad_arguments(kwargs, match):
     with pytest.raises(ValueError, match=match):
         make_scene(**kwargs)
+
+
+@pytest.mark.parametrize("make", [make_scene, lambda **kw: make_busy_scene("present", **kw)])
+@pytest.mark.parametrize(("rng", "error"), [(2.5, TypeError), (True, TypeError), (-1, ValueError)])
+def test_bad_rng_is_named(make, rng, error):
+    """A defect trial: make_scene(rng=2.5) and rng=-1 raised NumPy's messages without the
+    argument's name ("expected non-negative integer"); rng=True was taken as the seed 1."""
+    with pytest.raises(error, match=r"^make_(busy_)?scene: rng must be a numpy\.random\.Generator"):
+        make(n_frames=2, rng=rng)
 
 
 def test_warp_rows_moves_clips_and_drops():

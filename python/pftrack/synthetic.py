@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import generator
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
@@ -345,7 +346,7 @@ def make_scene(
     _check_scene_args("make_scene", n_frames, width, height, noise)
     if not isinstance(n_walkers, (int, np.integer)) or not 1 <= n_walkers <= 40:
         raise ValueError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
-    gen = np.random.default_rng(rng)
+    gen = generator(rng, "make_scene: rng")
     bg = _background(width, height, gen)
     size_scale = height / 360.0
 
@@ -602,7 +603,7 @@ def make_busy_scene(
     if kind not in BUSY_SCENES:
         raise ValueError(f"make_busy_scene: kind is {kind!r}, expected one of {BUSY_SCENES}")
     _check_scene_args("make_busy_scene", n_frames, width, height, noise)
-    gen = np.random.default_rng(rng)
+    gen = generator(rng, "make_busy_scene: rng")
     bg = _background(width, height, gen)
     grey = kind == "overhead"
     if grey:

@@ -791,6 +791,68 @@ def test_no_track_warning_says_min_conf_left_the_built_in_detectors_objects_out(
     ), said
 
 
+def test_no_track_warning_says_min_area_left_the_built_in_detectors_objects_out():
+    """A defect trial: a 6x6 object, under min_area=64 pixels, was said to be scored at most
+    1 with "none reached min_conf 0" (1 >= 0: min_conf left nothing out)."""
+    background = np.random.default_rng(0).integers(60, 120, (120, 160, 3), dtype=np.uint8)
+    frames = [background.copy() for _ in range(6)]
+    for f in frames[3:]:
+        f[40:46, 60:66] = (0, 0, 255)
+    for sampler in ("sis", "rjmcmc"):
+        tracker = pftrack.Tracker(sampler=sampler)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for f in frames:
+                tracker.update(None, f)
+            assert len(tracker.finalize()) == 0
+        said = [str(c.message) for c in caught if "no track" in str(c.message)]
+        assert said == [
+            "no track over 6 frames: the built-in detector found 3 objects over the run: each "
+            "one scoring at least min_conf 0 was under min_area=64 pixels "
+            "(LifecycleConfig.min_area)"
+        ], sampler
+
+
+def test_no_track_warning_of_the_joint_sampler_on_the_built_in_detector():
+    """A defect trial (``pftrack track`` on a 40x1 image folder, --sampler rjmcmc): objects
+    the joint sampler kept none of were said to have "none reached min_conf 0" at score 1.
+    Its chain is stubbed to keep nothing here: a real run needs odd footage."""
+    background = np.random.default_rng(0).integers(60, 120, (120, 160, 3), dtype=np.uint8)
+    frames = [background.copy() for _ in range(6)]
+    for i, f in enumerate(frames[2:]):
+        f[40:80, 60 + 2 * i : 80 + 2 * i] = (0, 0, 255)
+    tracker = pftrack.Tracker(sampler="rjmcmc")
+    tracker.tracker._joint.step = lambda *args: []  # type: ignore[method-assign]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for f in frames:
+            tracker.update(None, f)
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert said == [
+        "no track over 6 frames: the joint sampler (rjmcmc) kept none of the 4 objects the "
+        "built-in detector found (each is proposed as a birth; too few frames, or no colour to "
+        "weigh them?)"
+    ]
+
+
+def test_no_track_warning_of_the_joint_sampler_names_min_conf():
+    """A defect trial: with rjmcmc, detections all below min_conf (logits) were said to be
+    proposed as births the sampler kept none of; it never saw them."""
+    tracker = pftrack.Tracker(sampler="rjmcmc")
+    frame = np.random.default_rng(0).integers(0, 255, (200, 300, 3), dtype=np.uint8)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(3):
+            tracker.update(np.array([[10, 20, 50, 120, -0.5]]), frame)
+        assert len(tracker.finalize()) == 0
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert said == [
+        "no track over 3 frames: the highest detection confidence was -0.5 (min_conf 0, "
+        "birth_score 0.9)"
+    ]
+
+
 @pytest.mark.parametrize(
     ("where", "hint"),
     [
@@ -1090,6 +1152,24 @@ def test_score_options_must_be_finite_numbers():
         pftrack.Tracker(min_conf="0.5")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="birth_score is inf"):
         TrackerConfig(lifecycle=_lifecycle(birth_score=np.inf))
+
+
+@pytest.mark.parametrize(
+    ("given", "named"),
+    [
+        ({"max_coast": 1.0}, "max_coast 1"),
+        ({"birth_score": 0.5}, "birth_score 0.5"),
+        ({"birth_quantile": None}, "birth_quantile None"),
+        ({"max_coast": 0.4, "birth_score": 0.2}, "max_coast 0.4, birth_score 0.2"),
+    ],
+)
+def test_joint_sampler_refuses_the_lifecycle_options_it_ignores(given, named):
+    """A defect trial: ``pftrack track`` refuses --max-coast and --birth-score with --sampler
+    rjmcmc (its chain keeps and starts tracks by its own existence probabilities), but
+    Tracker(sampler="rjmcmc", ...) took them and tracked as without them."""
+    with pytest.raises(ValueError, match=rf"^{re.escape(named)}: the joint sampler \(rjmcmc\)"):
+        pftrack.Tracker(sampler="rjmcmc", **given)
+    pftrack.Tracker(sampler="sis", **given)  # used there
 
 
 def test_joint_sampler_counts_the_objects_it_started(scene):

@@ -237,6 +237,17 @@ def test_negative_seed():
         pftrack.Tracker(seed=-1)
 
 
+@pytest.mark.parametrize(
+    ("rng", "error"), [(2.5, TypeError), ("0", TypeError), (True, TypeError), (-1, ValueError)]
+)
+def test_track_frames_names_its_rng(rng, error):
+    """A defect trial: track_frames(rng=2.5) raised NumPy's "SeedSequence expects int or
+    sequence of ints for entropy not 2.5", rng=-1 named MultiObjectTracker's rng."""
+    frames = make_scene(n_frames=2, width=96, height=64, rng=0).frames
+    with pytest.raises(error, match=r"^track_frames: rng must be a numpy\.random\.Generator"):
+        pftrack.track_frames(frames, rng=rng)
+
+
 @pytest.mark.parametrize("name", ["max_coast", "prime"])
 @pytest.mark.parametrize("value", ["1", [1], True])
 def test_seconds_of_the_wrong_kind(name, value):

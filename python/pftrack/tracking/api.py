@@ -369,8 +369,10 @@ class Tracker:
         (``refine="no"`` would turn refinement on), a `frame_rate`, `max_coast`, `prime`,
         `min_conf` or `birth_score` that is not a number, a `seed` that is not an int.
     ValueError
-        A value out of its range, or ``crossings=True`` with ``smooth=False`` (the repair is
-        part of the smoothing pass).
+        A value out of its range, ``crossings=True`` with ``smooth=False`` (the repair is
+        part of the smoothing pass), or `max_coast`, `birth_score` or `birth_quantile` other
+        than its default with ``sampler="rjmcmc"`` (the joint chain keeps and starts tracks by
+        its own existence probabilities: they would do nothing).
 
     Notes
     -----
@@ -486,6 +488,23 @@ class Tracker:
                 birth_quantile=birth_quantile,
             ),
         )
+        if sampler == "rjmcmc":  # its chain ignores them (the CLI refuses them likewise)
+            unused = [
+                f"{name} {'None' if value is None else format(value, 'g')}"
+                for name, value, default in (
+                    ("max_coast", max_coast, None),
+                    ("birth_score", birth_score, 0.9),
+                    ("birth_quantile", birth_quantile, 0.25),
+                )
+                if value != default
+            ]
+            if unused:
+                one = len(unused) == 1
+                raise ValueError(
+                    f"{', '.join(unused)}: the joint sampler (rjmcmc) keeps and starts tracks by "
+                    f"its own existence probabilities, so {'it does' if one else 'they do'} "
+                    f"nothing: drop {'it' if one else 'them'}, or use sampler 'sis' or 'mh'"
+                )
         link_config = LinkConfig()
         self._setup(
             config,
@@ -1077,15 +1096,30 @@ class Tracker:
                 f"{started} track{'s' * (started != 1)} started but none reached "
                 f"min_hits={cfg.min_hits} matched frames (shorter tracks are left out)"
             )
-        if not self._given and self._tracker.found_own:
+        found = self._tracker.found_own
+        if not self._given and found:
+            objects = f"{found} object{'s' * (found != 1)}"
+            own = f"the built-in detector found {objects} over the run"
+            if self._tracker.kept_own and self.config.sampler == "rjmcmc":
+                return (
+                    f"the joint sampler (rjmcmc) kept none of the {objects} the built-in "
+                    "detector found (each is proposed as a birth; too few frames, or no colour "
+                    "to weigh them?)"
+                )
+            if self._tracker.kept_own:  # kept, and not one with colour to start a track from
+                return f"{own}, none with colour in its box to start a track from"
+            if self._tracker.best_own_score >= cfg.min_score:  # min_area left them out
+                return (
+                    f"{own}: each one scoring at least min_conf {cfg.min_score:.3g} was under "
+                    f"min_area={cfg.min_area:g} pixels (LifecycleConfig.min_area)"
+                )
             return (
-                f"the built-in detector found {self._tracker.found_own} objects over the run, "
-                f"scored at most {self._tracker.best_own_score:.3g}: none reached min_conf "
-                f"{cfg.min_score:.3g}"
+                f"{own}, scored at most {self._tracker.best_own_score:.3g}: none reached "
+                f"min_conf {cfg.min_score:.3g}"
             )
         if not self._given:
             return "the built-in detector found no object (no detection was given)"
-        if self.config.sampler == "rjmcmc" and np.isfinite(self._max_conf):
+        if self.config.sampler == "rjmcmc" and self._tracker.kept_given:
             return (  # its births take every detection kept (min_conf), confident or not
                 "the joint sampler (rjmcmc) kept no object of the detections given (each is "
                 "proposed as a birth; too few frames, or no colour to weigh them?)"

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_FRAME, first_bad_box, flag, number, real_array
+from pftrack._check import MAX_FRAME, first_bad_box, flag, generator, number, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
@@ -191,10 +191,11 @@ def track_frames(
     ------
     TypeError
         `detections` is not a dict (a path, a list), a key is not an int, or a value does not
-        hold real numbers.
+        hold real numbers; `rng` is not a Generator, an int or None (a float, a bool).
     ValueError
-        A key below 1 (frames are 1-based: 0-based keys would put every box one frame late),
-        a value not of shape (k, 5) or (k, 4), NaN, inf, a negative width or height;
+        A negative `rng`. A key below 1 (frames are 1-based: 0-based keys would put every box
+        one frame late), a value not of shape (k, 5) or (k, 4), NaN, inf, a negative width or
+        height;
         `detections` of frames after the video's last, by its frame count (one rule for every
         length; a source of unknown length, count 0, is not checked); `detections` for an image
         folder whose names skip numbers (:attr:`FrameSource.gap`: whether the detections count
@@ -226,10 +227,13 @@ def track_frames(
         _check_numbering(frames)
         # a FrameSource's count only when known: FFmpeg's estimate (Matroska's) may be short
         _check_last_frame(detections, getattr(frames, "counted_frames", len(frames)))
+    # an int seed goes on as it is; anything else through generator(), whose errors name rng
+    # (a float, a string, a bool or a negative int were NumPy's or MultiObjectTracker's)
     seed = (
         rng
-        if rng is None or isinstance(rng, (int, np.integer))
-        else int(np.random.default_rng(rng).integers(2**63))
+        if rng is None
+        or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)
+        else int(generator(rng, "track_frames: rng").integers(2**63))
     )
     tracker = Tracker.from_config(
         config, seed, coasting=coasting, fill=fill, smoother=smoother, link=link,

@@ -128,6 +128,9 @@ class MultiObjectTracker:
     #: Calls between ``update``'s caller and the code whose line a warning names: a wrapper
     #: that calls ``update`` sets one more (:class:`pftrack.Tracker`, each frame, its own).
     caller_depth = 0
+    #: The built-in detector's objects kept (see ``__init__``): a class default for a
+    #: checkpoint pickled before it was kept.
+    kept_own = 0
 
     def __init__(self, config: TrackerConfig | None = None, rng: RngLike = None,
                  detector: Any = None) -> None:  # fmt: skip
@@ -146,9 +149,11 @@ class MultiObjectTracker:
         #: clear of the frame's border), and given ones kept, over the run: why no track, said.
         self.tiny_given = 0
         self.kept_given = 0
-        #: The built-in detector's objects over the run, and the highest score among them: a
-        #: run whose objects ``min_score`` left out says so (not "found no object").
+        #: The built-in detector's objects over the run, those kept (``min_score`` and
+        #: ``min_area``), and the highest score among them: a run whose objects ``min_score``
+        #: or ``min_area`` left out says which (not "found no object").
         self.found_own = 0
+        self.kept_own = 0
         self.best_own_score = -np.inf
         self.frame_index = 0
         self._mask: NDArray[np.uint8] | None = None  # the last frame's, see last_mask
@@ -492,6 +497,7 @@ class MultiObjectTracker:
             self.kept_given += len(index)
         elif len(tiny):  # the built-in detector's boxes, before min_score
             self.found_own += len(tiny)
+            self.kept_own += len(index)
             self.best_own_score = max(self.best_own_score, float(scores_all.max()))
         if given is not None and len(given[1]) and not self._negative_warned:
             low = float(given[1].min())
