@@ -307,7 +307,7 @@ def run(args: argparse.Namespace) -> int:
                 with contextlib.ExitStack() as stack:
                     if streamed:
                         online = stack.enter_context(atomic_write(args.out))  # written through
-                    if live and not streamed:
+                    if live:  # into a pipe too: the run's --render and --plot are kept
                         stack.enter_context(_StopOnCtrlC(source))
                     caught = stack.enter_context(warnings.catch_warnings(record=True))
                     warnings.simplefilter("always")
