@@ -807,6 +807,38 @@ def test_live_run_into_a_named_pipe_streams_its_rows_there(
     assert stat.S_ISFIFO(fifo.stat().st_mode)
 
 
+def test_live_run_into_a_pipe_counts_the_rows_it_wrote_there(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The summary counts the online rows and ids the pipe got.
+
+    Was: those of the finished tracks (linked and smoothed: other ids, filled rows), which
+    are not written into a pipe: "22 tracks, 4471 boxes ... -> /dev/stdout (online rows, as
+    they settled)" where 27 ids and 4405 rows went (PETS09-S2L1 through a named pipe).
+    """
+    import threading
+
+    scene = make_scene(n_frames=40, rng=0)
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 1.0
+    walker = scene.truth[:, 1] == scene.truth[0, 1]
+    det = det[~(walker & (det[:, 0] >= 12) & (det[:, 0] <= 27))]  # lost, found: two ids, linked
+    write_mot(tmp_path / "det.txt", det)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    with serve_stream(scene.frames, pace=0.0) as server:
+        argv = ["-q", "track", server.url, "--out", str(fifo), "--detections",
+                str(tmp_path / "det.txt")]  # fmt: skip
+        assert main(argv) == 0
+    reader.join(30)
+    lines = got[0].splitlines()
+    n_ids = len({line.split(",")[1] for line in lines})
+    assert f", {n_ids} tracks, {len(lines)} boxes in " in capsys.readouterr().out
+
+
 def test_first_ctrl_c_of_a_live_run_into_a_pipe_stops_after_the_frame(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
