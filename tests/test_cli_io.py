@@ -807,6 +807,81 @@ def test_live_run_into_a_named_pipe_streams_its_rows_there(
     assert stat.S_ISFIFO(fifo.stat().st_mode)
 
 
+def test_live_run_into_a_pipe_counts_the_rows_it_wrote_there(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The summary counts the online rows and ids the pipe got.
+
+    Was: those of the finished tracks (linked and smoothed: other ids, filled rows), which
+    are not written into a pipe: "22 tracks, 4471 boxes ... -> /dev/stdout (online rows, as
+    they settled)" where 27 ids and 4405 rows went (PETS09-S2L1 through a named pipe).
+    """
+    import threading
+
+    scene = make_scene(n_frames=40, rng=0)
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 1.0
+    walker = scene.truth[:, 1] == scene.truth[0, 1]
+    det = det[~(walker & (det[:, 0] >= 12) & (det[:, 0] <= 27))]  # lost, found: two ids, linked
+    write_mot(tmp_path / "det.txt", det)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    with serve_stream(scene.frames, pace=0.0) as server:
+        argv = ["-q", "track", server.url, "--out", str(fifo), "--detections",
+                str(tmp_path / "det.txt")]  # fmt: skip
+        assert main(argv) == 0
+    reader.join(30)
+    lines = got[0].splitlines()
+    n_ids = len({line.split(",")[1] for line in lines})
+    assert f", {n_ids} tracks, {len(lines)} boxes in " in capsys.readouterr().out
+
+
+def test_first_ctrl_c_of_a_live_run_into_a_pipe_stops_after_the_frame(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The first Ctrl-C of a live run stops it after the current frame, --out a pipe too.
+
+    Was: into a device or pipe (/dev/stdout) the first Ctrl-C aborted at once (exit 130) and
+    the --render video of the frames so far was thrown away; --help promises a stop after the
+    current frame (exit 0) for every live source, and a second Ctrl-C to abort.
+    """
+    import threading
+
+    import pftrack.tracking
+
+    real = pftrack.tracking.track_frames
+
+    def ctrl_c_at_frame_5(source: Any, *, on_frame: Any, **kwargs: Any) -> Any:
+        def hook(n: int, frame: Any, tracks: Any, rows: Any) -> None:
+            on_frame(n, frame, tracks, rows)
+            if n == 5:
+                signal.raise_signal(signal.SIGINT)  # as a terminal's Ctrl-C
+
+        return real(source, on_frame=hook, **kwargs)
+
+    monkeypatch.setattr("pftrack.tracking.track_frames", ctrl_c_at_frame_5)
+    fifo, video = tmp_path / "fifo", tmp_path / "live.avi"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    with serve_stream(make_scene(n_frames=40, rng=0).frames) as server:
+        argv = ["-q", "track", server.url, "--out", str(fifo), "--render", str(video)]
+        assert main(argv) == 0
+    reader.join(30)
+    captured = capsys.readouterr()
+    assert "stopping after this frame (Ctrl-C again to abort)" in captured.err
+    n_frames = int(captured.out.split(" frames (stopped by Ctrl-C), ")[0])
+    assert 5 <= n_frames < 40  # the frames read ahead of the 5th are tracked too
+    assert f"-> {video}" in captured.out
+    assert cv2.VideoCapture(str(video)).get(cv2.CAP_PROP_FRAME_COUNT) == n_frames
+    assert all(line.count(",") == 9 for line in got[0].splitlines())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo", "live.avi"]
+
+
 def test_render_of_an_odd_sized_source_is_even_and_its_help_says_so(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -273,6 +273,7 @@ def run(args: argparse.Namespace) -> int:
     streamed = live and writes_through(args.out)
     online: IO[str] | None = None  # where the streamed rows go
     n_online = [0]  # rows streamed so far
+    online_ids: set[float] = set()  # their ids
     side: SideFile | None = None
     committed = False  # every staged output renamed into place
     try:
@@ -303,11 +304,12 @@ def run(args: argparse.Namespace) -> int:
                             online.write(format_mot_row(r) + "\n")
                         online.flush()
                         n_online[0] += len(rows)
+                        online_ids.update(r[1] for r in rows)
 
                 with contextlib.ExitStack() as stack:
                     if streamed:
                         online = stack.enter_context(atomic_write(args.out))  # written through
-                    if live and not streamed:
+                    if live:  # into a pipe too: the run's --render and --plot are kept
                         stack.enter_context(_StopOnCtrlC(source))
                     caught = stack.enter_context(warnings.catch_warnings(record=True))
                     warnings.simplefilter("always")
@@ -329,10 +331,13 @@ def run(args: argparse.Namespace) -> int:
                 if not streamed:
                     write_mot(stage(args.out), result.rows)
                 n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
+                n_rows = len(result.rows)
+                if streamed:  # what went there: the finished tracks are not written
+                    n_ids, n_rows = len(online_ids), n_online[0]
                 stopped = " (stopped by Ctrl-C)" if source.stopped else ""
                 how = " (online rows, as they settled)" if streamed else ""
                 said.append(
-                    f"{result.n_frames} frames{stopped}, {n_ids} tracks, {len(result.rows)} "
+                    f"{result.n_frames} frames{stopped}, {n_ids} tracks, {n_rows} "
                     f"boxes in {result.seconds:.2f} s ({result.fps:.0f} frames/s), seed "
                     f"{args.seed} -> {args.out}{how}"
                 )
