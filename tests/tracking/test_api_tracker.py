@@ -199,6 +199,33 @@ def test_classes_never_share_an_identity():
     assert len(one) == 1
 
 
+@pytest.mark.parametrize(("overlap", "cls", "n_ids"), [(0.3, 0, 1), (None, 0, 2), (0.3, 1, 2)])
+def test_a_second_box_on_a_followed_person_starts_no_track(overlap, cls, n_ids):
+    """LifecycleConfig.birth_overlap: from frame 9 a second detection overlaps the confirmed
+    track by IoU 0.43. It starts no track, unless it is of another class or the rule is off."""
+    frame = np.zeros((80, 100, 3), np.uint8)
+    frame[20:60, 30:58] = (40, 60, 220)
+    box, second = [30.0, 20.0, 50.0, 60.0, 0.95, 0.0], [38.0, 20.0, 58.0, 60.0, 0.95, cls]
+    config = TrackerConfig()
+    config = dataclasses.replace(
+        config, lifecycle=dataclasses.replace(config.lifecycle, birth_overlap=overlap)
+    )
+    tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
+    ids = set()
+    for k in range(20):
+        dets = np.array([box, second] if k >= 8 else [box])
+        ids |= {int(r[4]) for r in tracker.update(dets, frame)}
+    assert len(ids) == n_ids
+
+
+def test_birth_overlap_is_checked():
+    for bad in (0.0, 1.5, -0.1):
+        with pytest.raises(ValueError, match="birth_overlap is .*, expected a value in"):
+            pftrack.tracking.LifecycleConfig(birth_overlap=bad)
+    with pytest.raises(TypeError, match="birth_overlap"):
+        pftrack.tracking.LifecycleConfig(birth_overlap="0.3")  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize("cls", [0.7, -0.5, 1e20, 2.0**31 + 1, 2.0**31, -(2.0**31) - 1])
 def test_class_ids_must_be_integers(cls):
     frame = np.zeros((80, 100, 3), np.uint8)

@@ -21,7 +21,7 @@ import itertools
 import math
 import warnings
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import bgr_frame, generator
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
-from pftrack.boxes import _to_cxcywh
+from pftrack.boxes import _iou_matrix, _to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
@@ -608,9 +608,13 @@ class MultiObjectTracker:
         confidences = detections is not None and self._scores_are_confidences
         birth_score = self._birth_threshold(scores) if confidences else -np.inf
         born = cfg if detections is None else self._given_config  # given_particles
+        unmatched = result.unmatched_detections
+        beside = set() if detections is None else self._beside(boxes, labels, unmatched, cfg)
         for di in result.unmatched_detections:
-            if hists[di].sum() <= 0 or scores[di] < birth_score:
-                continue  # no foreground colour to build a reference from, or too unsure
+            if hists[di].sum() <= 0 or scores[di] < birth_score or di in beside:
+                # no foreground colour to build a reference from, too unsure, or a second box
+                # on a person already followed (LifecycleConfig.birth_overlap)
+                continue
             seed = int(self._rng.integers(2**63))
             t = LiveTrack(
                 next(self._ids), boxes[di].copy(), hists[di], born, seed, float(scores[di])
@@ -624,6 +628,25 @@ class MultiObjectTracker:
         early = self.frame_index <= cfg.lifecycle.min_hits
         reports = (t.report(self.frame_index, early, cfg.lifecycle) for t in self.tracks)
         return [r for r in reports if r is not None]
+
+    def _beside(self, boxes: F64, labels: NDArray[np.int64], unmatched: Sequence[int],
+                cfg: TrackerConfig) -> set[int]:  # fmt: skip
+        """Unmatched detections on a confirmed track of their class: they start no track.
+
+        Those that overlap it by an IoU above ``LifecycleConfig.birth_overlap`` (given
+        detections only; the caller skips the built-in detector's).
+        """
+        life = cfg.lifecycle
+        if life.birth_overlap is None or not len(unmatched):
+            return set()
+        confirmed = [t for t in self.tracks if t.hits >= life.min_hits]
+        if not confirmed:
+            return set()
+        rows = np.asarray(unmatched, dtype=np.intp)
+        iou = _iou_matrix(boxes[rows, :4], np.array([t.box for t in confirmed]))
+        same = labels[rows][:, None] == np.array([t.cls for t in confirmed])[None, :]
+        hit = ((iou > life.birth_overlap) & same).any(axis=1)
+        return set(rows[hit].tolist())
 
     def _measure_speeds(
         self, followed: list[tuple[int, int]], boxes: F64, cfg: TrackerConfig
