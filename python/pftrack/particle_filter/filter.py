@@ -673,12 +673,12 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
                 try:
                     st = f.step(image)
                 except ValueError as exc:  # "X.step: what" -> "step_filters: filters[k]: what"
-                    renamed = _public_error(exc, f"{type(f).__name__}.step", "step_filters")
+                    renamed = _public_error(
+                        exc, f"{type(f).__name__}.step", f"step_filters: filters[{k}]"
+                    )
                     if renamed is None:
                         raise
-                    raise ValueError(
-                        str(renamed).replace("step_filters: ", f"step_filters: filters[{k}]: ", 1)
-                    ) from None
+                    raise renamed from None
                 summary[k] = (st.box_cxcywh[0], st.box_cxcywh[1], st.rho, st.rho_max)
     return summary
 

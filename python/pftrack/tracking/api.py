@@ -51,7 +51,7 @@ from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.filter import MAX_PARTICLES
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
-from pftrack.tracking.config import TrackerConfig
+from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.offline import BoxSmoother, CrossingConfig, complete_boxes, drop_nested
 from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
@@ -492,9 +492,9 @@ class Tracker:
             unused = [
                 f"{name} {'None' if value is None else format(value, 'g')}"
                 for name, value, default in (
-                    ("max_coast", max_coast, None),
-                    ("birth_score", birth_score, 0.9),
-                    ("birth_quantile", birth_quantile, 0.25),
+                    ("max_coast", max_coast, None),  # None: the command's frame count
+                    ("birth_score", birth_score, LifecycleConfig.birth_score),
+                    ("birth_quantile", birth_quantile, LifecycleConfig.birth_quantile),
                 )
                 if value != default
             ]
@@ -704,10 +704,9 @@ class Tracker:
             Not a (H, W, 3) uint8 array with pixels (:func:`pftrack._check.bgr_frame`'s
             words; was an AttributeError for a list).
         """
-        f = frame
-        if not (isinstance(f, np.ndarray) and f.dtype == np.uint8 and f.ndim == 3
-                and f.shape[2] == 3 and f.size):  # fmt: skip
-            frame = bgr_frame(frame, "working_frame: frame")  # raises, or packs a view
+        if not (isinstance(frame, np.ndarray) and frame.dtype == np.uint8 and frame.ndim == 3
+                and frame.shape[2] == 3 and frame.size):  # fmt: skip
+            frame = bgr_frame(frame, "working_frame: frame")  # raises
         size = working_size(frame.shape, self.config.max_side)
         if size is None:
             return frame
