@@ -773,6 +773,24 @@ def test_an_aborted_live_run_into_a_pipe_says_its_rows_went_there(
     assert len(got[0].splitlines()) == 6
 
 
+def _track_stream_into_fifo(tmp_path: Path, frames: Any, det: Any) -> tuple[Path, list[str]]:
+    """``pftrack track URL --out FIFO --detections det.txt`` (exit 0): the fifo, its lines."""
+    import threading
+
+    write_mot(tmp_path / "det.txt", det)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    with serve_stream(frames, pace=0.0) as server:
+        argv = ["-q", "track", server.url, "--out", str(fifo), "--detections",
+                str(tmp_path / "det.txt")]  # fmt: skip
+        assert main(argv) == 0
+    reader.join(30)
+    return fifo, got[0].splitlines()
+
+
 def test_live_run_into_a_named_pipe_streams_its_rows_there(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -782,25 +800,12 @@ def test_live_run_into_a_named_pipe_streams_its_rows_there(
     never an end). The finished tracks are not written after the online rows (they would
     repeat every one).
     """
-    import threading
-
     scene = make_scene(n_frames=40, rng=0)
     det = scene.truth.copy()
     det[:, 1], det[:, 6] = -1, 1.0
-    write_mot(tmp_path / "det.txt", det)
-    fifo = tmp_path / "fifo"
-    os.mkfifo(fifo)
-    got: list[str] = []
-    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
-    reader.start()
-    with serve_stream(scene.frames, pace=0.0) as server:
-        argv = ["-q", "track", server.url, "--out", str(fifo), "--detections",
-                str(tmp_path / "det.txt")]  # fmt: skip
-        assert main(argv) == 0
-    reader.join(30)
+    fifo, lines = _track_stream_into_fifo(tmp_path, scene.frames, det)
     out = capsys.readouterr().out
     assert f"-> {fifo} (online rows, as they settled)" in out
-    lines = got[0].splitlines()
     assert len(lines) > 20 and all(line.count(",") == 9 for line in lines)
     keys = [tuple(line.split(",")[:2]) for line in lines]
     assert len(set(keys)) == len(keys)  # each (frame, id) once: no second, finished copy
@@ -816,25 +821,12 @@ def test_live_run_into_a_pipe_counts_the_rows_it_wrote_there(
     are not written into a pipe: "22 tracks, 4471 boxes ... -> /dev/stdout (online rows, as
     they settled)" where 27 ids and 4405 rows went (PETS09-S2L1 through a named pipe).
     """
-    import threading
-
     scene = make_scene(n_frames=40, rng=0)
     det = scene.truth.copy()
     det[:, 1], det[:, 6] = -1, 1.0
     walker = scene.truth[:, 1] == scene.truth[0, 1]
     det = det[~(walker & (det[:, 0] >= 12) & (det[:, 0] <= 27))]  # lost, found: two ids, linked
-    write_mot(tmp_path / "det.txt", det)
-    fifo = tmp_path / "fifo"
-    os.mkfifo(fifo)
-    got: list[str] = []
-    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
-    reader.start()
-    with serve_stream(scene.frames, pace=0.0) as server:
-        argv = ["-q", "track", server.url, "--out", str(fifo), "--detections",
-                str(tmp_path / "det.txt")]  # fmt: skip
-        assert main(argv) == 0
-    reader.join(30)
-    lines = got[0].splitlines()
+    _, lines = _track_stream_into_fifo(tmp_path, scene.frames, det)
     n_ids = len({line.split(",")[1] for line in lines})
     assert f", {n_ids} tracks, {len(lines)} boxes in " in capsys.readouterr().out
 

@@ -785,15 +785,20 @@ def test_no_track_warning_names_min_hits_when_tracks_started():
     ]
 
 
-def test_no_track_warning_of_the_built_in_detector_blames_it():
-    # was "no external detection was given", which the user never meant to give
-    tracker = pftrack.Tracker(seed=0)
+def _no_track_said(tracker, frames, dets=None) -> list[str]:
+    """Track `frames` (each with `dets`, None: the built-in detector) to an empty finalize();
+    the "no track" warnings it gave."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        for _ in range(5):
-            tracker.update(None, np.full((60, 80, 3), 90, np.uint8))
+        for f in frames:
+            tracker.update(dets, f)
         assert len(tracker.finalize()) == 0
-    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    return [str(c.message) for c in caught if "no track" in str(c.message)]
+
+
+def test_no_track_warning_of_the_built_in_detector_blames_it():
+    # was "no external detection was given", which the user never meant to give
+    said = _no_track_said(pftrack.Tracker(seed=0), [np.full((60, 80, 3), 90, np.uint8)] * 5)
     assert said == [
         "no track over 5 frames: the built-in detector found no object (no detection was given)"
     ]
@@ -804,12 +809,7 @@ def test_no_track_warning_says_min_conf_left_the_built_in_detectors_objects_out(
     though it found hundreds and min_conf left every one out."""
     tracker = pftrack.Tracker(seed=0, min_conf=1.5)  # the paper detector's scores reach 1
     tracker.prime(scene.frames)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        for frame in scene.frames:
-            tracker.update(None, frame)
-        assert len(tracker.finalize()) == 0
-    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    said = _no_track_said(tracker, scene.frames)
     assert len(said) == 1
     assert re.fullmatch(
         r"no track over 40 frames: the built-in detector found \d+ objects over the run, "
@@ -826,13 +826,7 @@ def test_no_track_warning_says_min_area_left_the_built_in_detectors_objects_out(
     for f in frames[3:]:
         f[40:46, 60:66] = (0, 0, 255)
     for sampler in ("sis", "rjmcmc"):
-        tracker = pftrack.Tracker(sampler=sampler)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            for f in frames:
-                tracker.update(None, f)
-            assert len(tracker.finalize()) == 0
-        said = [str(c.message) for c in caught if "no track" in str(c.message)]
+        said = _no_track_said(pftrack.Tracker(sampler=sampler), frames)
         assert said == [
             "no track over 6 frames: the built-in detector found 3 objects over the run: each "
             "one scoring at least min_conf 0 was under min_area=64 pixels "
@@ -850,12 +844,7 @@ def test_no_track_warning_of_the_joint_sampler_on_the_built_in_detector():
         f[40:80, 60 + 2 * i : 80 + 2 * i] = (0, 0, 255)
     tracker = pftrack.Tracker(sampler="rjmcmc")
     tracker.tracker._joint.step = lambda *args: []  # type: ignore[method-assign]
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        for f in frames:
-            tracker.update(None, f)
-        assert len(tracker.finalize()) == 0
-    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    said = _no_track_said(tracker, frames)
     assert said == [
         "no track over 6 frames: the joint sampler (rjmcmc) kept none of the 4 objects the "
         "built-in detector found (each is proposed as a birth; too few frames, or no colour to "
@@ -868,12 +857,7 @@ def test_no_track_warning_of_the_joint_sampler_names_min_conf():
     proposed as births the sampler kept none of; it never saw them."""
     tracker = pftrack.Tracker(sampler="rjmcmc")
     frame = np.random.default_rng(0).integers(0, 255, (200, 300, 3), dtype=np.uint8)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        for _ in range(3):
-            tracker.update(np.array([[10, 20, 50, 120, -0.5]]), frame)
-        assert len(tracker.finalize()) == 0
-    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    said = _no_track_said(tracker, [frame] * 3, np.array([[10, 20, 50, 120, -0.5]]))
     assert said == [
         "no track over 3 frames: the highest detection confidence was -0.5 (min_conf 0, "
         "birth_score 0.9)"
