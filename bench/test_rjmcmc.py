@@ -11,11 +11,15 @@ Locally: ``pytest bench/test_rjmcmc.py --benchmark-only``.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pytest
+from numpy.typing import NDArray
 from pytest_benchmark.fixture import BenchmarkFixture
 
 from experiments.rjmcmc_speed import Frames, one_object, pets_sequence, run_filter, run_rjmcmc
+from pftrack import _core
 
 
 @pytest.fixture(scope="module")
@@ -40,3 +44,60 @@ def test_sis_400(benchmark: BenchmarkFixture, seq: Frames) -> None:
 @pytest.mark.benchmark(group="one object, 400 likelihoods a frame")
 def test_mh_200x1(benchmark: BenchmarkFixture, seq: Frames) -> None:
     benchmark(run_filter, *one_object(seq), "mh", 200, 1)
+
+
+# ---- large boxes (1920x1080, 100x250 people): every pixel against the lattice ----------------
+
+
+@pytest.fixture(scope="module")
+def large() -> tuple[_core.BinnedImage, NDArray[np.uint8], NDArray[np.float64]]:
+    """Five 100x250 people on a 1920x1080 noise frame: the bins, the foreground, the boxes."""
+    g = np.random.default_rng(0)
+    frame = g.integers(0, 256, (1080, 1920, 3), dtype=np.uint8)
+    mask = np.zeros((1080, 1920), np.uint8)
+    boxes = []
+    for k in range(5):
+        cx, cy = 200 + 350 * k, 540
+        frame[cy - 125 : cy + 125, cx - 50 : cx + 50] = (40 * k, 200 - 30 * k, 90)
+        mask[cy - 130 : cy + 130, cx - 55 : cx + 55] = 1
+        boxes.append([cx, cy, 100.0, 250.0])
+    return _core.hsv_bins(frame, mask), mask, np.array(boxes)
+
+
+def _rj_frames(large: Any, min_samples: float) -> None:
+    img, mask, boxes = large
+    t = _core.RJMCMCTracker(min_samples=min_samples)
+    for s in range(6):
+        t.step(img, mask, boxes, seed=1, step=s)
+
+
+@pytest.mark.benchmark(group="rjmcmc 1920x1080, 5 people 100x250, 6 frames")
+@pytest.mark.parametrize("min_samples", [0, 2048], ids=["every pixel", "lattice 2048"])
+def test_rjmcmc_large_boxes(benchmark: BenchmarkFixture, large: Any, min_samples: int) -> None:
+    """RJMCMCConfig.min_samples (default 2048) against counting every pixel (0; was the only
+    way until 4 December 2026)."""
+    benchmark.pedantic(_rj_frames, args=(large, float(min_samples)), rounds=3, iterations=1)
+
+
+def _mh_steps(large: Any, min_samples: float) -> None:
+    img, _, boxes = large
+    cx, cy, w, h = boxes[0]
+    ref = np.asarray(_core.box_histograms(img, boxes[:1]))[0] + 1e-3
+    n = 200
+    p = np.tile([cx, cy, 1.0, cx, cy, 1.0], (n, 1))
+    wts = np.full(n, 1.0 / n)
+    m = np.array([[cx, cy, 1.0], [cx, cy, 1.0]])
+    a, b = np.array([2.0, 2.0, 2.0]), np.array([-1.0, -1.0, -1.0])
+    for s in range(5):
+        _core.mh_step(
+            p, wts, m, img, ref, w, h, a, b, np.array([3.0, 3.0, 0.02]), 0.5, 2.0, False, 20.0,
+            "uniform", True, 11, s, n_iter=5, burn_in=2, min_samples=min_samples,
+        )  # fmt: skip
+
+
+@pytest.mark.benchmark(group="mh 1920x1080, one 100x250 person, 200 particles x 6, 5 steps")
+@pytest.mark.parametrize("min_samples", [0, 2048], ids=["every pixel", "lattice 2048"])
+def test_mh_large_boxes(benchmark: BenchmarkFixture, large: Any, min_samples: int) -> None:
+    """mh_step counts a lattice's points in place (4 December 2026: it gathered them into an
+    image of their own for every evaluation first)."""
+    benchmark.pedantic(_mh_steps, args=(large, float(min_samples)), rounds=3, iterations=1)

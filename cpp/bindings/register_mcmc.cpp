@@ -149,7 +149,7 @@ void register_mcmc(py::module_& m) {
                          double s_max, double lam, const std::string& kernel, double interaction,
                          double coverage, double background_penalty, double birth_prior, double survival,
                          double birth_sigma_xy, double birth_sigma_s, double birth_eps,
-                         double birth_gate, double detection) {
+                         double birth_gate, double detection, double min_samples) {
                  RjParams p;
                  p.burn_in = burn_in;
                  p.n_samples = n_samples;
@@ -174,6 +174,7 @@ void register_mcmc(py::module_& m) {
                  p.birth_eps = birth_eps;
                  p.birth_gate = birth_gate;
                  p.detection = detection;
+                 p.min_samples = min_samples;
                  return PyRjTracker{RJMCMCTracker(p), nullptr, nullptr};
              }),
              py::arg("burn_in") = 50, py::arg("n_samples") = 200, py::arg("p_birth") = 0.1,
@@ -186,7 +187,7 @@ void register_mcmc(py::module_& m) {
              py::arg("birth_prior") = 2.0, py::arg("survival") = 0.95,
              py::arg("birth_sigma_xy") = 3.0, py::arg("birth_sigma_s") = 0.05,
              py::arg("birth_eps") = 0.02, py::arg("birth_gate") = 0.1,
-             py::arg("detection") = 20.0)
+             py::arg("detection") = 20.0, py::arg("min_samples") = 0.0)
         .def("__reduce__",
              bind::refuse_pickle("RJMCMCTracker", "its chain has no pickled form (a run "
                                                   "checkpoints with the 'sis' or 'mh' sampler)"))

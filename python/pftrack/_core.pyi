@@ -162,6 +162,7 @@ class RJMCMCTracker:
         birth_eps: float = 0.02,
         birth_gate: float = 0.1,  # no newborn on a candidate overlapping a kept identity this much
         detection: float = 20.0,  # weight of an object's best IoU with a candidate in log π
+        min_samples: float = 0.0,  # large boxes counted on a lattice (lattice_step); 0: every pixel
     ) -> None: ...
     def __reduce__(self) -> NoReturn: ...  # TypeError: the chain cannot be pickled
     # mask (H, W) uint8/bool; candidates (K, 4) cx, cy, w, h; candidate_hists (K, B) or None.

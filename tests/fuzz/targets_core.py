@@ -414,6 +414,7 @@ def _rjmcmc_calls() -> st.SearchStrategy[Any]:
         "burn_in": maybe(ints(0, 5)), "n_samples": maybe(ints(1, 10)),
         "p_birth": maybe(fl(0, 1)), "lam": maybe(fl(0, 50)), "s_min": maybe(fl(0.1, 1)),
         "sigma": maybe(vec3(0, 3)), "kernel": maybe(st.sampled_from(["uniform", "gaussian"])),
+        "min_samples": maybe(fl(-1, 100)),
     })  # fmt: skip
     return st.tuples(frames(), N).flatmap(lambda fk: call(
         _rjmcmc, params, maybe(st.just(_core.hsv_bins(np.ascontiguousarray(fk[0]), None, 4, 4, 4))),

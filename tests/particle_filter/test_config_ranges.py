@@ -63,6 +63,8 @@ RJ_REFUSED = [
     ("s_max", math.inf, ValueError, r"expected a finite value >= s_min \(0.2\)"),
     ("s_max", 0.1, ValueError, r"expected a finite value >= s_min \(0.2\)"),
     ("s_min", 0.0, ValueError, "expected a finite value > 0"),
+    ("min_samples", -1, ValueError, r"expected an integer in \[0, 2147483647\]"),
+    ("min_samples", 2048.0, TypeError, "int"),
 ]
 
 

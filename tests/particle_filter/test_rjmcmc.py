@@ -128,6 +128,35 @@ def test_log_target_matches_numpy_reference(model):
         assert t.log_target(*arrays(config)) == pytest.approx(r.log_target(config), abs=1e-9)
 
 
+def _model_with(**params):
+    """The `model` fixture's frame and reference, with other tracker params."""
+    t = tracker(**params)
+    f0, m0 = scene(0, BLOBS[:1])
+    t.step(_core.hsv_bins(f0, m0), m0, boxes(BLOBS[:1]), seed=7, step=0)
+    f1, m1 = scene(1, BLOBS[:2])
+    img = _core.hsv_bins(f1, m1)
+    t.prepare(img, m1, boxes(BLOBS[:2]))
+    every = {**PARAMS, **params}
+    dets = boxes(BLOBS[:2])
+    return t, ref.RjReference(img.bins, img.n_bins, m1, t.slots(), t.tracks, every, dets)
+
+
+def test_min_samples_counts_each_slot_on_the_lattice_of_its_anchor_box():
+    """min_samples as the SIS filter's: a slot's boxes are counted on the lattice of its
+    anchor box (10x18 candidates, min_samples 20: every 2nd or 3rd pixel, lattice_step), and
+    log pi equals the reference counting those points (was: every pixel, whatever the box's
+    size)."""
+    t, r = _model_with(min_samples=20.0)
+    assert [r.lattice(s) for s in range(2)] == [2, 3]  # the kept slot's prediction is smaller
+    t0, _ = _model_with(min_samples=0.0)
+    moved = 0
+    for config in enumerate_states(r):
+        got = t.log_target(*arrays(config))
+        assert got == pytest.approx(r.log_target(config), abs=1e-9)
+        moved += got != pytest.approx(t0.log_target(*arrays(config)), abs=1e-9)
+    assert moved > 0  # the lattice changed the colour term of some states
+
+
 def test_detailed_balance_on_enumerated_states(model):
     # pi(X) q(X'|X) min(1, r(X->X')) == pi(X') q(X|X') min(1, r(X'->X)) for every pair of the
     # enumerated states, with pi and q from the NumPy reference and r from the C++ core.

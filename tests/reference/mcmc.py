@@ -59,19 +59,22 @@ def iou_cxcywh(a, b):
     return iw * ih / (a[2] * a[3] + b[2] * b[3] - iw * ih)
 
 
-def histogram(bins, n_bins, box):
+def histogram(bins, n_bins, box, step=1):
+    """Normalised histogram and counted pixels of a box; with `step` > 1 of its pixels whose
+    column and row are multiples of `step` only (counted: those points)."""
     x0, x1, y0, y1 = box_pixels(*box, *bins.shape)
+    x0, y0 = -(-x0 // step) * step, -(-y0 // step) * step  # the first multiples of step
     if x0 >= x1 or y0 >= y1:
         return np.zeros(n_bins), 0.0
-    b = bins[y0:y1, x0:x1].ravel()
+    b = bins[y0:y1:step, x0:x1:step].ravel()
     b = b[b >= 0]
     h = np.bincount(b, minlength=n_bins).astype(float)
     total = h.sum()
     return (h / total if total > 0 else h), float(total)
 
 
-def colour_loglik(bins, n_bins, box, ref, lam):
-    h, _ = histogram(bins, n_bins, box)
+def colour_loglik(bins, n_bins, box, ref, lam, step=1):
+    h, _ = histogram(bins, n_bins, box, step)
     rho = np.sum(np.sqrt(h * ref / ref.sum()))
     return -lam * max(0.0, 1.0 - min(rho, 1.0))
 
@@ -193,6 +196,12 @@ class RjReference:
         s = self.slots[slot]
         return (x[0], x[1], x[2] * s["w0"], x[2] * s["h0"])
 
+    def lattice(self, slot):
+        """The step every box of `slot` is counted on this frame: lattice_step of its anchor
+        box (the mean prediction's, a newborn's candidate's) and params' min_samples."""
+        a = self.slots[slot]["anchor"]
+        return kernels.lattice_step(a[2], a[3], self.p.get("min_samples", 0))
+
     def rng_box(self, slot, x):
         return box_pixels(*self.box(slot, x), *self.bins.shape)
 
@@ -231,7 +240,9 @@ class RjReference:
             if not np.isfinite(lp):
                 return -np.inf
             ref = self.slots[slot]["ref"]
-            t += colour_loglik(self.bins, self.n_bins, self.box(slot, x), ref, p["lam"])
+            t += colour_loglik(
+                self.bins, self.n_bins, self.box(slot, x), ref, p["lam"], self.lattice(slot)
+            )
             t += lp + self.log_omega(slot)
             if len(self.dets):  # detection support delta max_k IoU(b, d_k)
                 b = self.box(slot, x)

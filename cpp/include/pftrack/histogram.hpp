@@ -193,24 +193,56 @@ private:
     std::int64_t count(const BinImage& img, const PixelRange& r) {
         img.ensure(r.x0, r.x1, r.y0, r.y1);  // a lazy image bins the range first
         const Index area = (r.x1 - r.x0) * (r.y1 - r.y0);
-        return area < 65536 ? count_copies(img, r, counts16_.data(), stride16_)
-                            : count_copies(img, r, counts_.data(), stride_);
+        return area < 65536 ? count_copies(img, r, 1, counts16_.data(), stride16_)
+                            : count_copies(img, r, 1, counts_.data(), stride_);
     }
 
+public:
+    /// Uniform-kernel coefficient of the lattice points `points` (lattice_points of a clipped
+    /// range: the point (i, j) is the pixel (i step, j step)), read in place: the same counts,
+    /// so the same coefficient, as gathering them first (LatticeImage) and counting that.
+    /// `counted` gets the points counted times step^2.
+    double coefficient_of_lattice(const BinImage& img, const PixelRange& points, Index step,
+                                  const double* sqrt_ref, double& counted) {
+        std::int64_t total = 0;
+        if (!points.empty()) {
+            img.ensure(points.x0 * step, (points.x1 - 1) * step + 1, points.y0 * step,
+                       (points.y1 - 1) * step + 1);
+            const Index area = (points.x1 - points.x0) * (points.y1 - points.y0);
+            total = area < 65536 ? count_copies(img, points, step, counts16_.data(), stride16_)
+                                 : count_copies(img, points, step, counts_.data(), stride_);
+        }
+        counted = static_cast<double>(total * step * step);
+        return coefficient_of_counts(counts(), total, sqrt_ref);
+    }
+
+private:
     /// kCopies interleaved copies of type T (uint16 when no count can reach 65536: half the
-    /// bytes to clear and add up per box), summed into counts_.
+    /// bytes to clear and add up per box), summed into counts_. `step` > 1 counts the lattice
+    /// points `r` (in lattice units) of the image, in place.
     template <class T>
-    std::int64_t count_copies(const BinImage& img, const PixelRange& r, T* base, int stride) {
+    std::int64_t count_copies(const BinImage& img, const PixelRange& r, Index step, T* base,
+                              int stride) {
         std::fill(base, base + kCopies * static_cast<size_t>(stride), T(0));
         T* c[kCopies];
         for (int q = 0; q < kCopies; ++q) c[q] = base + 1 + q * stride;  // +1: bin -1 in slot 0
         const Index w = r.x1 - r.x0;
-        for (Index y = r.y0; y < r.y1; ++y) {
-            const std::int16_t* b = img.row(y) + r.x0;
-            Index x = 0;
-            for (; x + kCopies <= w; x += kCopies)
-                for (int q = 0; q < kCopies; ++q) ++c[q][b[x + q]];
-            for (int q = 0; x < w; ++x, ++q) ++c[q][b[x]];
+        if (step == 1) {
+            for (Index y = r.y0; y < r.y1; ++y) {
+                const std::int16_t* b = img.row(y) + r.x0;
+                Index x = 0;
+                for (; x + kCopies <= w; x += kCopies)
+                    for (int q = 0; q < kCopies; ++q) ++c[q][b[x + q]];
+                for (int q = 0; x < w; ++x, ++q) ++c[q][b[x]];
+            }
+        } else {
+            for (Index y = r.y0; y < r.y1; ++y) {
+                const std::int16_t* b = img.row(y * step) + r.x0 * step;
+                Index x = 0;
+                for (; x + kCopies <= w; x += kCopies)
+                    for (int q = 0; q < kCopies; ++q) ++c[q][b[(x + q) * step]];
+                for (int q = 0; x < w; ++x, ++q) ++c[q][b[x * step]];
+            }
         }
         std::int32_t* out = counts_.data() + 1;
         const int nb = n_bins_;  // a local: stores through `out` (int32) could alias n_bins_

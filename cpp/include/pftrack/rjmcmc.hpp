@@ -73,6 +73,7 @@
 #include <vector>
 
 #include "histogram.hpp"
+#include "integral_histogram.hpp"
 #include "likelihood.hpp"
 #include "propagate.hpp"
 #include "rng.hpp"
@@ -100,6 +101,8 @@ struct RjParams {
     double detection = 20.0;    // delta: log D_i = delta max_k IoU(b_i, d_k) over the candidates
     double birth_gate = 0.1;    // no newborn slot for a candidate with IoU >= this with a kept
                                 // identity's predicted box (> 1: every candidate gets a slot)
+    double min_samples = 0.0;   // large boxes counted on a lattice keeping >= this many points,
+                                // as sis_step counts them (lattice_step); 0: every pixel
 
     void validate(const char* fn) const {
         require(burn_in >= 0, fn, "burn_in", burn_in, ">= 0");
@@ -124,6 +127,8 @@ struct RjParams {
                 fn, "birth_sigma_xy and birth_sigma_s must be > 0");
         require(std::isfinite(birth_eps) && birth_eps > 0.0, fn, "birth_eps", birth_eps, "> 0");
         require(std::isfinite(birth_gate) && birth_gate > 0.0, fn, "birth_gate", birth_gate, "> 0");
+        require(std::isfinite(min_samples) && min_samples >= 0.0, fn, "min_samples", min_samples,
+                ">= 0");
         require(std::isfinite(detection) && detection >= 0.0, fn, "detection", detection, ">= 0");
     }
     double move_total() const { return p_birth + p_death + p_update + p_swap; }
@@ -145,6 +150,7 @@ struct RjIdentity {
     RowMatrixXd mu;            // (N_i, 3) AR2 predictions A x + B x'
     std::vector<Index> runs;   // lengths of the runs of equal consecutive rows of mu (sum N_i)
     double anchor[4] = {0, 0, 0, 0};  // box for the birth weight
+    Index lattice = 1;  // every box of this slot is counted on the lattice of this step
 };
 
 /// One object of a configuration; `unary` caches its single-object log-target term and
@@ -281,8 +287,21 @@ public:
     /// Colour log-likelihood -lambda D^2 of slot at x.
     double log_colour(int slot, const double* x) {
         const RjIdentity& id = ids_[static_cast<size_t>(slot)];
-        scratch_.compute(img_, x[0], x[1], x[2] * id.w0, x[2] * id.h0, prm_.kernel, hist_.data());
-        const double rho = bhattacharyya_coefficient_row(hist_.data(), id.sqrt_ref.data(), img_.n_bins);
+        const double w = x[2] * id.w0, h = x[2] * id.h0;
+        double rho = 0.0, counted = 0.0;
+        if (id.lattice > 1 && prm_.kernel == Kernel::kUniform) {
+            // the slot's lattice, read in place (the points and counts of box_coefficients)
+            const PixelRange points =
+                lattice_points(box_pixels(x[0], x[1], w, h, img_.rows, img_.cols), id.lattice);
+            rho = scratch_.coefficient_of_lattice(img_, points, id.lattice, id.sqrt_ref.data(), counted);
+        } else if (id.lattice > 1) {
+            const Eigen::Matrix<double, 1, 4> box(x[0], x[1], w, h);
+            box_coefficients(img_, box, id.sqrt_ref.data(), prm_.kernel, BoxPath::kDirect, &rho,
+                             &counted, id.lattice, &scratch_);
+        } else {
+            scratch_.compute(img_, x[0], x[1], w, h, prm_.kernel, hist_.data());
+            rho = bhattacharyya_coefficient_row(hist_.data(), id.sqrt_ref.data(), img_.n_bins);
+        }
         const double d = bhattacharyya_distance_from_rho(rho);
         return -prm_.lambda * d * d;
     }
@@ -627,6 +646,8 @@ public:
             id.anchor[1] = mean[1];
             id.anchor[2] = s * t.w0;
             id.anchor[3] = s * t.h0;
+            // one lattice for the frame, from the mean prediction's box (as mh_step)
+            id.lattice = lattice_step(id.anchor[2], id.anchor[3], prm_.min_samples);
             ids.push_back(std::move(id));
         }
         const size_t n_kept = ids.size();
@@ -651,6 +672,7 @@ public:
             id.sqrt_ref = id.ref.array().sqrt().matrix();
             id.log_omega = std::log(prm_.birth_prior);
             for (int d = 0; d < 4; ++d) id.anchor[d] = cands(k, d);
+            id.lattice = lattice_step(id.w0, id.h0, prm_.min_samples);
             ids.push_back(std::move(id));
         }
         std::vector<std::array<double, 4>> dets;

@@ -72,6 +72,11 @@ class RJMCMCConfig:
     detection : float
         ``delta``: each object's target gains ``delta`` times its best IoU with a candidate box
         (the detections support the identities they overlap; 0: off).
+    min_samples : int
+        Boxes of more than 4 `min_samples` pixels are counted on a lattice that keeps at
+        least `min_samples` of their points, as the SIS and MH filters count them
+        (`FilterConfig.min_samples`; each identity's lattice is set once a frame, from its mean
+        prediction's box, or its candidate's for a newborn); 0 counts every pixel.
     min_existence : float
         ``step`` reports identities whose existence probability is at least this.
 
@@ -88,7 +93,8 @@ class RJMCMCConfig:
         ``0 < s_min <= s_max``; `lam`, `interaction`, `coverage`, `background_penalty`,
         `detection` finite and >= 0; `birth_prior`, `birth_sigma_xy`, `birth_sigma_s`,
         `birth_eps`, `birth_gate` finite and > 0; `survival` in (0, 1]; `min_existence` in
-        [0, 1]; `kernel` not "uniform" or "epanechnikov".
+        [0, 1]; `kernel` not "uniform" or "epanechnikov"; `min_samples` (an int: TypeError
+        otherwise) not in [0, 2147483647].
     """
 
     burn_in: int = 50
@@ -114,6 +120,7 @@ class RJMCMCConfig:
     birth_eps: float = 0.02
     birth_gate: float = 0.1
     detection: float = 20.0
+    min_samples: int = 2048
     min_existence: float = 0.5
 
     def __post_init__(self) -> None:
@@ -153,6 +160,7 @@ class RJMCMCConfig:
             )
         for name in ("lam", "interaction", "coverage", "background_penalty", "detection"):
             _at_least(self, name, 0.0)
+        integer(self.min_samples, f"{own}: min_samples", 0, 2**31 - 1)  # 0: every pixel
         for name in ("birth_prior", "birth_sigma_xy", "birth_sigma_s", "birth_eps", "birth_gate"):
             _at_least(self, name, 0.0, strict=True)
         survival = number(self.survival, f"{own}: survival", finite=False)
@@ -191,6 +199,7 @@ class RJMCMCConfig:
                 "birth_eps",
                 "birth_gate",
                 "detection",
+                "min_samples",
             )
         }
         for k in ("a", "b", "sigma"):
