@@ -135,18 +135,39 @@ def test_a_compressed_or_binary_file_is_named_as_such(tmp_path: Path) -> None:
     with zipfile.ZipFile(tmp_path / "t.zip", "w") as z:
         z.writestr("t.txt", text)
     (tmp_path / "nul.txt").write_bytes(text + b"\0\0")
-    (tmp_path / "utf16.txt").write_bytes(text.decode().encode("utf-16"))
+    (tmp_path / "utf32.txt").write_bytes(text.decode().encode("utf-32"))
     for name, message in (
         ("t.txt.gz", "is gzip-compressed, not text; decompress it first"),
         ("t.txt.bz2", "is bzip2-compressed, not text; decompress it first"),
         ("t.txt.xz", "is xz-compressed, not text; decompress it first"),
         ("t.zip", "is zip-compressed, not text; decompress it first"),
         ("nul.txt", "is not a text file (it holds NUL bytes)"),
-        ("utf16.txt", "is not a text file (it holds NUL bytes)"),
+        ("utf32.txt", "is not a text file (it holds NUL bytes)"),
     ):
         with pytest.raises(ValueError) as exc:
             mot.read_mot(tmp_path / name, what="tracks file")
         assert str(exc.value) == f"tracks file {tmp_path / name} {message}"
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
+def test_utf16_text_with_its_bom_is_read(tmp_path: Path, encoding: str) -> None:
+    """Windows PowerShell 5's ``>`` writes a program's output as UTF-16 with a BOM.
+
+    Was refused as "not a text file (it holds NUL bytes)".
+    """
+    text = "1,1,10,10,5,5,0.9,-1,-1,-1\r\n\r\n3 1 14.5 10 5 5\r\n# note\r\n4,1,16,10,5,5,\r\n"
+    bom = {"utf-16": "", "utf-16-le": "\ufeff", "utf-16-be": "\ufeff"}[encoding]
+    (tmp_path / "t.txt").write_bytes((bom + text).encode(encoding))
+    (tmp_path / "u.txt").write_text(text, encoding="utf-8")
+    got = mot.read_mot(tmp_path / "t.txt")
+    assert np.array_equal(got, mot.read_mot(tmp_path / "u.txt"))
+    assert got[:, 0].tolist() == [1, 3, 4] and got[1, 2] == 14.5
+    assert mot.first_row_fields(tmp_path / "t.txt") == 10
+    assert mot.data_line_numbers(tmp_path / "t.txt") == [1, 3, 5]
+    # the fast reader and the line reader alike: a bad line is named by its number
+    (tmp_path / "bad.txt").write_bytes("\ufeff1,1,10,10,5,5\n2,1,x,10,5,5\n".encode("utf-16-le"))
+    with pytest.raises(ValueError, match=r"bad.txt:2: MOT file line has a non-number"):
+        mot.read_mot(tmp_path / "bad.txt")
 
 
 def test_write_refuses_non_finite(tmp_path: Path) -> None:
