@@ -149,6 +149,30 @@ def test_a_compressed_or_binary_file_is_named_as_such(tmp_path: Path) -> None:
         assert str(exc.value) == f"tracks file {tmp_path / name} {message}"
 
 
+def test_a_far_edge_is_named_with_the_sum_that_reaches_it(tmp_path: Path) -> None:
+    """Was ``write_mot: row 0 (frame 8, id 1) has width 40: a box's right or bottom edge is
+    beyond ±1e+09 px`` (``pftrack smooth`` of boxes near the bound): the width alone is fine,
+    left + width is not, and the message gave neither the left nor the edge."""
+    row = [8, 1, 999999961.25, 10, 40, 60]
+    with pytest.raises(ValueError) as exc:
+        mot.write_mot(tmp_path / "t.txt", [row])
+    assert str(exc.value) == (
+        "write_mot: row 0 (frame 8, id 1) has width 40: a box's right or bottom edge is beyond "
+        "±1e+09 px (left + width = 1000000001.25)"
+    )
+    (tmp_path / "b.txt").write_text("1,2,3,-999999990,5,-20\n")  # negative sizes come first
+    with pytest.raises(ValueError, match=r":1: negative box width or height"):
+        mot.read_mot(tmp_path / "b.txt")
+    (tmp_path / "b.txt").write_text("1,2,3,-999999990,5,20\n2,2,3,999999990,5,20\n")
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(tmp_path / "b.txt")
+    assert str(exc.value) == (
+        f"{tmp_path / 'b.txt'}:2: a box's right or bottom edge is beyond ±1e+09 px (top + "
+        "height = 1000000010): '2,2,3,999999990,5,20'"
+    )
+    assert not (tmp_path / "t.txt").exists()
+
+
 @pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
 def test_utf16_text_with_its_bom_is_read(tmp_path: Path, encoding: str) -> None:
     """Windows PowerShell 5's ``>`` writes a program's output as UTF-16 with a BOM.
