@@ -149,6 +149,35 @@ def test_a_compressed_or_binary_file_is_named_as_such(tmp_path: Path) -> None:
         assert str(exc.value) == f"tracks file {tmp_path / name} {message}"
 
 
+def test_a_header_line_gets_a_hint(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A header line (pandas' ``to_csv``, a spreadsheet's export) was refused as any line
+    with a non-number, with no word of what to do; a '#' line is a comment, already read."""
+    from pftrack.cli import main
+
+    header = "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z"
+    body = "1,1,10,20,30,60,1,-1,-1,-1\n3,1,14,20,30,60,1,-1,-1,-1\n"
+    hint = " (a header line? delete it, or start it with # to keep it as a comment)"
+    p = tmp_path / "h.txt"
+    for text, line in ((f"{header}\n{body}", 1), (f"\n{header.replace(',', ' ')}\r\n{body}", 2)):
+        p.write_text(text)
+        with pytest.raises(ValueError) as exc:
+            mot.read_mot(p, what="tracks file")
+        assert str(exc.value).startswith(f"{p}:{line}: tracks file line has a non-number: ")
+        assert str(exc.value).endswith(hint)
+        p.write_text("#" + text.lstrip())
+        assert mot.read_mot(p).shape == (2, 10)  # the way out the hint names
+    # only the file's first row may be a header: a word further down is a bad line, no more
+    p.write_text(f"{body}{header}\n")
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value) == f"{p}:3: MOT file line has a non-number: {header!r}"
+    p.write_text(f"{header}\n{body}")
+    assert main(["recover", str(p), "--out", str(tmp_path / "o.txt")]) == 2
+    err = capsys.readouterr().err
+    assert err.endswith(f"{hint}\n") and err.count("\n") == 1, err
+    assert not (tmp_path / "o.txt").exists()
+
+
 def test_a_far_edge_is_named_with_the_sum_that_reaches_it(tmp_path: Path) -> None:
     """Was ``write_mot: row 0 (frame 8, id 1) has width 40: a box's right or bottom edge is
     beyond ±1e+09 px`` (``pftrack smooth`` of boxes near the bound): the width alone is fine,

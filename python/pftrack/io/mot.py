@@ -157,7 +157,8 @@ def read_mot(
         naming the file and the 1-based line number: fewer than 6 fields, an empty field
         (``1,,7,...``: two commas in a row) in the first 6 columns or before a non-empty one
         (empty fields at the end of a line, ``...,0.9,,,`` or a trailing comma, are absent
-        columns: their defaults), a non-number, a non-finite value in any of the first 10
+        columns: their defaults), a non-number (a first row with a word in it ends with
+        :data:`HEADER_HINT`: a header line?), a non-finite value in any of the first 10
         columns (a NaN score too), a frame that is not an integer in ``1..2**31-1``, a
         negative width or height, or a box value beyond ±1e9 px. A UTF-8 byte-order mark is
         skipped; UTF-16 text with its byte-order mark (what Windows PowerShell's ``>``
@@ -193,6 +194,12 @@ def read_mot(
         values = _parse_line(text, what)
         if isinstance(values, str):
             error = f"{p}:{lineno}: {values}"
+            if (
+                not rows
+                and values.startswith(f"{what} line has a non-number")
+                and _WORD.search(text)
+            ):  # the first row a word: pandas' to_csv, a spreadsheet's export
+                error += HEADER_HINT
             break
         rows.append(values)
         numbers.append(lineno)
@@ -214,6 +221,11 @@ def read_mot(
         )
     return a
 
+
+#: What a refused first row with a word in it (``frame,id,bb_left,...``) is told.
+HEADER_HINT = " (a header line? delete it, or start it with # to keep it as a comment)"
+#: A word: two letters in a row, which no number has (``1e5``, ``inf`` is refused as such).
+_WORD = re.compile(r"[A-Za-z_]{2,}")
 
 #: A number as MOTChallenge files write them: ASCII digits, a point, an exponent (``float()``
 #: alone also takes ``1_0`` for 10 and other scripts' digits, ``１００``: a user trial).
