@@ -38,6 +38,10 @@ __all__ = [
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
 #: wide, and splines and Kalman filters square and multiply them (1e308 overflows).
 MAX_COORD = 1e9
+#: Boxes whose right and bottom edges all stay within this many units are taken for
+#: normalised coordinates (1 is the frame's width and height; a tracker's boxes may reach a
+#: little past it): no file in pixels holds people that fit in 2 x 2 px.
+NORMALISED_REACH = 2.0
 #: The largest frame number anywhere (a 32-bit int: 2.3 years of video at 30 frames/s).
 MAX_FRAME = 2**31 - 1
 #: Largest absolute track id accepted (as frames: ids are cast to 32- or 64-bit integers).

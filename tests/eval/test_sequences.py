@@ -379,6 +379,24 @@ def test_corner_boxes_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert main([*argv, "--no-scale-check"]) == 0  # scored as given, as asked
 
 
+def test_normalised_result_refused() -> None:
+    """A result in normalised coordinates was told "its boxes look 0.000521 times the ground
+    truth's across and 0.000863 times down ...: the result is of a video of another shape
+    ..., rescale one of them per axis": not what is wrong with it."""
+    gt = spread_scene(0)
+    res = perturbed(gt, 1)
+    res[:, [2, 4]] /= 768
+    res[:, [3, 5]] /= 576  # its boxes reach a little past the frame, as the truth's do
+    with pytest.raises(ValueError) as refused:
+        check_scale(gt, res, name="res.txt")
+    assert str(refused.value) == (
+        "res.txt: every box lies within 0.943 x 1.09, the ground truth's within 724 x 609 px: "
+        "normalised coordinates? give pixels (x times the image width, y times its height), "
+        "or --no-scale-check"
+    )
+    check_scale(gt / [1, 1, 768, 576, 768, 576, 1, 1, 1, 1], res)  # both normalised: alike
+
+
 @pytest.mark.dataset
 def test_cli_on_real_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """../shared/data as a MOTChallenge folder (SEQ/gt.txt), PETS results on the video's scale."""

@@ -25,6 +25,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import NORMALISED_REACH
 from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
@@ -275,8 +276,9 @@ def check_scale(
     relative to the ground truth already scaled by `scale`, "look 1.26 times" with
     ``scale=0.5`` where 0.631 was meant).
 
-    Before the factors, a result whose columns 5-6 hold the boxes' right and bottom edges
-    (``x1, y1, x2, y2``) is refused as such (:func:`_check_corners`).
+    Before the factors, a result in normalised coordinates (every box within [0, 1] x [0, 1],
+    the ground truth's in pixels) and one whose columns 5-6 hold the boxes' right and bottom
+    edges (``x1, y1, x2, y2``, :func:`_check_corners`) are refused as such.
 
     Raises
     ------
@@ -307,6 +309,15 @@ def check_scale(
     as_given = _matched_fraction(g, r, scale, sample)
     if as_given >= 0.5:
         return
+    # the rightmost and lowest edges: normalised boxes (was: "a video of another shape")
+    rx, ry, gx, gy = (float(np.max(a[:, c] + a[:, c + 2])) for a in (r, g) for c in (LEFT, TOP))
+    gx, gy = gx * scale, gy * scale
+    if max(rx, ry) <= NORMALISED_REACH < min(gx, gy):
+        raise ValueError(
+            f"{name}: every box lies within {rx:.3g} x {ry:.3g}, the ground truth's within "
+            f"{gx:.0f} x {gy:.0f} px: normalised coordinates? give pixels (x times the image "
+            "width, y times its height), or --no-scale-check"
+        )
     _check_corners(g, r, scale, sample, as_given, name)
     # Box heights give the ratio roughly; positions need it closer (a 5 % error moves a box
     # at x = 600 by 30 px), so try factors around it and keep the best.
