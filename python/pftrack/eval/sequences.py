@@ -276,14 +276,15 @@ def check_scale(
     relative to the ground truth already scaled by `scale`, "look 1.26 times" with
     ``scale=0.5`` where 0.631 was meant).
 
-    Before the factors, a result in normalised coordinates (every box within [0, 1] x [0, 1],
-    the ground truth's in pixels) and one whose columns 5-6 hold the boxes' right and bottom
-    edges (``x1, y1, x2, y2``, :func:`_check_corners`) are refused as such.
+    Before the factors, a result in normalised coordinates (every box within
+    :data:`~pftrack._check.NORMALISED_REACH` units, the ground truth's in pixels) and one
+    whose columns 5-6 hold the boxes' right and bottom edges (``x1, y1, x2, y2``,
+    :func:`_check_corners`) are refused as such.
 
     Raises
     ------
     ValueError
-        On such a mismatch, with the scale that fits, or on corner boxes.
+        On such a mismatch, with the scale that fits; on normalised or corner boxes.
     """
     g = np.asarray(gt, dtype=np.float64)
     r = np.asarray(result, dtype=np.float64)
