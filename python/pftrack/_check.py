@@ -38,6 +38,10 @@ __all__ = [
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
 #: wide, and splines and Kalman filters square and multiply them (1e308 overflows).
 MAX_COORD = 1e9
+#: Boxes whose right and bottom edges all stay within this many units are taken for
+#: normalised coordinates (1 is the frame's width and height; a tracker's boxes may reach a
+#: little past it): no file in pixels holds people that fit in 2 x 2 px.
+NORMALISED_REACH = 2.0
 #: The largest frame number anywhere (a 32-bit int: 2.3 years of video at 30 frames/s).
 MAX_FRAME = 2**31 - 1
 #: Largest absolute track id accepted (as frames: ids are cast to 32- or 64-bit integers).
@@ -185,7 +189,8 @@ def first_bad_box(boxes: ArrayLike, *, edges: bool = True) -> tuple[int, int, st
     -------
     (row, column, problem) or None
         The first bad value's row, its column in `boxes` (0-3, :data:`BOX_VALUES`) and what is
-        wrong: ``"negative box width or height"`` or ``"a box value is beyond ±1e+09 px"``.
+        wrong: ``"negative box width or height"``, ``"a box value is beyond ±1e+09 px"`` or
+        ``"a box's right or bottom edge is beyond ±1e+09 px (left + width = 1000000001)"``.
     """
     b = np.asarray(boxes, dtype=np.float64).reshape(-1, 4)
     negative = b[:, 2:] < 0
@@ -202,11 +207,10 @@ def first_bad_box(boxes: ArrayLike, *, edges: bool = True) -> tuple[int, int, st
         return r, 2 + int(np.argmax(negative[r])), "negative box width or height"
     if far[r].any():
         return r, int(np.argmax(far[r])), f"a box value is beyond ±{MAX_COORD:g} px"
-    return (
-        r,
-        2 + int(np.argmax(edge[r])),
-        f"a box's right or bottom edge is beyond ±{MAX_COORD:g} px",
-    )
+    c = int(np.argmax(edge[r]))  # 0: the right edge, 1: the bottom one
+    # the sum named: the size the caller names may be small, its left or top the far one
+    total = f"{BOX_VALUES[c]} + {BOX_VALUES[2 + c]} = {b[r, c] + b[r, 2 + c]:.12g}"
+    return r, 2 + c, f"a box's right or bottom edge is beyond ±{MAX_COORD:g} px ({total})"
 
 
 def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:

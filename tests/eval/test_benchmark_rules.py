@@ -226,3 +226,36 @@ def test_real_data_gives_no_class_warning(
     res.write_text((data / "tud-campus" / "gt.txt").read_text())
     assert main(["eval", "-q", "--gt", str(data / "tud-campus" / "gt.txt"), "--res", str(res)]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_flags_and_classes_beyond_int64_or_nan_are_read_without_a_cast_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Regression: a ground-truth flag (column 7) of 1e20 in a file, or NaN in an array, and a
+    result class of 1e20, went through ``astype(int64)``: ``pftrack eval: warning: invalid
+    value encountered in cast`` (a RuntimeWarning, an error under ``-W error``), and the
+    result's note named ``class -9223372036854775808``."""
+    gt, res = mot17_case(0)
+    base = evaluate_sequence(gt, res, benchmark="MOT17")
+    for flag in (1e20, np.nan, -1e20):  # not 0 once truncated: scored, as TrackEval scores it
+        g = gt.copy()
+        g[g[:, 6] != 0, 6] = flag
+        s = evaluate_sequence(g, res, benchmark="MOT17")  # pytest turns warnings into errors
+        assert (s.hota.hota, s.mot.mota) == (base.hota.hota, base.mot.mota), flag
+    g = gt.copy()
+    g[g[:, 6] != 0, 6] = 1e20
+    (tmp_path / "gt.txt").write_text("".join(
+        ",".join(f"{v:.17g}" for v in row) + "\n" for row in g
+    ))  # fmt: skip
+    write_rows(tmp_path / "res.txt", res)
+    argv = ["eval", "-q", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt")]
+    assert main([*argv, "--benchmark", "MOT17"]) == 0
+    assert capsys.readouterr().err == ""
+    r = res.copy()
+    r[:3, 7] = 1e20
+    r[3:5, 7] = 3
+    note = result_class_note(r, "MOT17")
+    assert note == (
+        "5 result boxes have classes 1e+20 (3), 3 (2) in column 8: scored as pedestrians; "
+        "TrackEval refuses such a file"
+    )

@@ -135,18 +135,92 @@ def test_a_compressed_or_binary_file_is_named_as_such(tmp_path: Path) -> None:
     with zipfile.ZipFile(tmp_path / "t.zip", "w") as z:
         z.writestr("t.txt", text)
     (tmp_path / "nul.txt").write_bytes(text + b"\0\0")
-    (tmp_path / "utf16.txt").write_bytes(text.decode().encode("utf-16"))
+    (tmp_path / "utf32.txt").write_bytes(text.decode().encode("utf-32"))
     for name, message in (
         ("t.txt.gz", "is gzip-compressed, not text; decompress it first"),
         ("t.txt.bz2", "is bzip2-compressed, not text; decompress it first"),
         ("t.txt.xz", "is xz-compressed, not text; decompress it first"),
         ("t.zip", "is zip-compressed, not text; decompress it first"),
         ("nul.txt", "is not a text file (it holds NUL bytes)"),
-        ("utf16.txt", "is not a text file (it holds NUL bytes)"),
+        ("utf32.txt", "is not a text file (it holds NUL bytes)"),
     ):
         with pytest.raises(ValueError) as exc:
             mot.read_mot(tmp_path / name, what="tracks file")
         assert str(exc.value) == f"tracks file {tmp_path / name} {message}"
+
+
+def test_a_header_line_gets_a_hint(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A header line (pandas' ``to_csv``, a spreadsheet's export) was refused as any line
+    with a non-number, with no word of what to do; a '#' line is a comment, already read."""
+    from pftrack.cli import main
+
+    header = "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z"
+    body = "1,1,10,20,30,60,1,-1,-1,-1\n3,1,14,20,30,60,1,-1,-1,-1\n"
+    hint = " (a header line? delete it, or start it with # to keep it as a comment)"
+    p = tmp_path / "h.txt"
+    for text, line in ((f"{header}\n{body}", 1), (f"\n{header.replace(',', ' ')}\r\n{body}", 2)):
+        p.write_text(text)
+        with pytest.raises(ValueError) as exc:
+            mot.read_mot(p, what="tracks file")
+        assert str(exc.value).startswith(f"{p}:{line}: tracks file line has a non-number: ")
+        assert str(exc.value).endswith(hint)
+        p.write_text("#" + text.lstrip())
+        assert mot.read_mot(p).shape == (2, 10)  # the way out the hint names
+    # only the file's first row may be a header: a word further down is a bad line, no more
+    p.write_text(f"{body}{header}\n")
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value) == f"{p}:3: MOT file line has a non-number: {header!r}"
+    p.write_text(f"{header}\n{body}")
+    assert main(["recover", str(p), "--out", str(tmp_path / "o.txt")]) == 2
+    err = capsys.readouterr().err
+    assert err.endswith(f"{hint}\n") and err.count("\n") == 1, err
+    assert not (tmp_path / "o.txt").exists()
+
+
+def test_a_far_edge_is_named_with_the_sum_that_reaches_it(tmp_path: Path) -> None:
+    """Was ``write_mot: row 0 (frame 8, id 1) has width 40: a box's right or bottom edge is
+    beyond ±1e+09 px`` (``pftrack smooth`` of boxes near the bound): the width alone is fine,
+    left + width is not, and the message gave neither the left nor the edge."""
+    row = [8, 1, 999999961.25, 10, 40, 60]
+    with pytest.raises(ValueError) as exc:
+        mot.write_mot(tmp_path / "t.txt", [row])
+    assert str(exc.value) == (
+        "write_mot: row 0 (frame 8, id 1) has width 40: a box's right or bottom edge is beyond "
+        "±1e+09 px (left + width = 1000000001.25)"
+    )
+    (tmp_path / "b.txt").write_text("1,2,3,-999999990,5,-20\n")  # negative sizes come first
+    with pytest.raises(ValueError, match=r":1: negative box width or height"):
+        mot.read_mot(tmp_path / "b.txt")
+    (tmp_path / "b.txt").write_text("1,2,3,-999999990,5,20\n2,2,3,999999990,5,20\n")
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(tmp_path / "b.txt")
+    assert str(exc.value) == (
+        f"{tmp_path / 'b.txt'}:2: a box's right or bottom edge is beyond ±1e+09 px (top + "
+        "height = 1000000010): '2,2,3,999999990,5,20'"
+    )
+    assert not (tmp_path / "t.txt").exists()
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be"])
+def test_utf16_text_with_its_bom_is_read(tmp_path: Path, encoding: str) -> None:
+    """Windows PowerShell 5's ``>`` writes a program's output as UTF-16 with a BOM.
+
+    Was refused as "not a text file (it holds NUL bytes)".
+    """
+    text = "1,1,10,10,5,5,0.9,-1,-1,-1\r\n\r\n3 1 14.5 10 5 5\r\n# note\r\n4,1,16,10,5,5,\r\n"
+    bom = {"utf-16": "", "utf-16-le": "\ufeff", "utf-16-be": "\ufeff"}[encoding]
+    (tmp_path / "t.txt").write_bytes((bom + text).encode(encoding))
+    (tmp_path / "u.txt").write_text(text, encoding="utf-8")
+    got = mot.read_mot(tmp_path / "t.txt")
+    assert np.array_equal(got, mot.read_mot(tmp_path / "u.txt"))
+    assert got[:, 0].tolist() == [1, 3, 4] and got[1, 2] == 14.5
+    assert mot.first_row_fields(tmp_path / "t.txt") == 10
+    assert mot.data_line_numbers(tmp_path / "t.txt") == [1, 3, 5]
+    # the fast reader and the line reader alike: a bad line is named by its number
+    (tmp_path / "bad.txt").write_bytes("\ufeff1,1,10,10,5,5\n2,1,x,10,5,5\n".encode("utf-16-le"))
+    with pytest.raises(ValueError, match=r"bad.txt:2: MOT file line has a non-number"):
+        mot.read_mot(tmp_path / "bad.txt")
 
 
 def test_write_refuses_non_finite(tmp_path: Path) -> None:

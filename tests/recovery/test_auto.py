@@ -331,6 +331,18 @@ def test_fill_report_records_its_method() -> None:
         auto.describe("linear")
     _, none = fill_gaps(full)  # no hole
     assert none.method == "auto" and none.describe() == "auto: no gap to fill"
+    # holes, all longer than max_gap: was "auto: no gap to fill", of a file with 8 gaps
+    _, long = fill_gaps(cut, max_gap=5)
+    assert (long.n_gaps, long.n_long_holes, long.longest_hole) == (0, 8, 6)
+    assert long.describe() == (
+        "auto: no gap of at most max_gap frames to fill, nothing was chosen (8 holes longer, "
+        "left unfilled; the longest 6 frames)"
+    )
+    _, one = fill_gaps(cut[(cut[:, 1] == cut[0, 1])], max_gap=5)
+    assert one.describe() == (
+        "auto: no gap of at most max_gap frames to fill, nothing was chosen (1 hole longer, "
+        "left unfilled: 6 frames)"
+    )
 
 
 def test_cli_explain_prints_centres_and_sizes(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]

@@ -130,3 +130,38 @@ def test_filled_mask_of_short_rows_marks_none() -> None:
     assert filled_mask(filled).any()
     assert not filled_mask(filled[:, :7]).any()
     np.testing.assert_array_equal(filled_mask(filled[:, :9]), filled_mask(filled))
+
+
+def test_normalised_boxes_are_warned_about(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Boxes within [0, 1] x [0, 1] (a detector's normalised output) went through ``recover`` and
+    ``smooth`` without a word: the 50 px linking gate spans 50 frames' widths (ADL-Rundle-6's
+    ground truth so written: 24 ids joined into 18) and the filled and smoothed boxes were
+    written with 2 decimals (a width of 0.08 +- 0.005: 6 %)."""
+    import warnings
+
+    from pftrack.cli import main
+    from pftrack.recovery.linking import read_tracks
+
+    norm = tmp_path / "norm.txt"
+    rows = [[f, 1, 0.1 + 0.01 * f, 0.2, 0.05, 0.3] for f in (1, 2, 3, 6, 7)]
+    write_mot(norm, [*rows, [1, 2, 0.5, 0.52, 0.5, 0.5]])  # a tracker's box past the edge
+    said = (
+        f"{norm}: every box lies within 1 x 1.02 (its rightmost and lowest edges): normalised "
+        "coordinates? pftrack works in pixels (its linking gate, boxes written with 2 decimals): "
+        "give pixels (x times the image width, y times its height)"
+    )
+    with pytest.warns(UserWarning) as caught:
+        read_tracks(norm)
+    assert [str(w.message) for w in caught] == [said]
+    for command in ("recover", "smooth"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
+            assert main(["-q", command, str(norm), "--out", str(tmp_path / "o.txt")]) == 0
+        assert capsys.readouterr().err == f"pftrack {command}: warning: {said}\n"
+    pixels = tmp_path / "px.txt"  # one box reaching past 2: pixels, nothing said
+    write_mot(pixels, [*rows, [1, 2, 0.5, 0.5, 0.5, 1.6]])
+    read_tracks(pixels)  # warnings are errors here
+    (tmp_path / "empty.txt").write_text("")
+    read_tracks(tmp_path / "empty.txt")

@@ -90,7 +90,9 @@ def add_parser(sub: Any) -> None:
                    "is one)")  # fmt: skip
     p.add_argument(
         "--no-scale-check", action="store_true",
-        help="score even when result boxes look like another pixel scale than the ground truth",
+        help="score even when result boxes look like another pixel scale than the ground "
+        "truth, normalised coordinates, or corners x1, y1, x2, y2 where width and height "
+        "belong",
     )  # fmt: skip
     p.add_argument("--json", default=None, help="also write all metrics to this JSON file")
     p.add_argument("--csv", default=None, help="also write the table's scores to this CSV file")

@@ -247,14 +247,16 @@ def result_class_note(result: ArrayLike, benchmark: str) -> str | None:
     other = (cls == np.round(cls)) & (cls != _PEDESTRIAN) & (cls != -1)
     if not np.any(other):
         return None
-    values, counts = np.unique(cls[other].astype(np.int64), return_counts=True)
+    values, counts = np.unique(cls[other], return_counts=True)  # floats: 1e20 is no int64
     order = np.argsort(-counts, kind="stable")
     values, counts = values[order], counts[order]
     n = int(counts.sum())
     if len(values) == 1:
-        which = f"class {values[0]}"
+        which = f"class {values[0]:.15g}"
     else:
-        which = "classes " + ", ".join(f"{v} ({c})" for v, c in zip(values, counts, strict=True))
+        which = "classes " + ", ".join(
+            f"{v:.15g} ({c})" for v, c in zip(values, counts, strict=True)
+        )
     refused = "; TrackEval refuses such a file" if np.any(values > _PEDESTRIAN) else ""
     boxes = "1 result box has" if n == 1 else f"{n} result boxes have"
     return f"{boxes} {which} in column 8: scored as pedestrians{refused}"
@@ -344,7 +346,10 @@ def prepare_mot(
             rows_m, cols_m = rows_m[hit], cols_m[hit]
             drop = cols_m[np.isin(gt_f[rows_m, _CLASS].astype(np.int64), distractors)]
             res_f = np.delete(res_f, drop, axis=0)
-        keep = gt_f[:, CONF].astype(np.int64) != 0
+        # TrackEval's astype(int) != 0, without the cast: a flag of NaN (an array) or beyond
+        # int64 (1e20) is not 0 and is kept, as there, with no "invalid value encountered in
+        # cast" warning
+        keep = np.trunc(gt_f[:, CONF]) != 0
         if with_classes:
             keep &= gt_f[:, _CLASS].astype(np.int64) == _PEDESTRIAN
         keep_g.append(gt_f[keep])

@@ -25,11 +25,12 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import NORMALISED_REACH
 from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
 from pftrack.eval.rows import _mot_iou, not_parts_message
-from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, WIDTH
+from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, TOP, WIDTH
 
 __all__ = [
     "COMBINED",
@@ -275,10 +276,15 @@ def check_scale(
     relative to the ground truth already scaled by `scale`, "look 1.26 times" with
     ``scale=0.5`` where 0.631 was meant).
 
+    Before the factors, a result in normalised coordinates (every box within
+    :data:`~pftrack._check.NORMALISED_REACH` units, the ground truth's in pixels) and one
+    whose columns 5-6 hold the boxes' right and bottom edges (``x1, y1, x2, y2``,
+    :func:`_check_corners`) are refused as such.
+
     Raises
     ------
     ValueError
-        On such a mismatch, with the scale that fits.
+        On such a mismatch, with the scale that fits; on normalised or corner boxes.
     """
     g = np.asarray(gt, dtype=np.float64)
     r = np.asarray(result, dtype=np.float64)
@@ -304,6 +310,16 @@ def check_scale(
     as_given = _matched_fraction(g, r, scale, sample)
     if as_given >= 0.5:
         return
+    # the rightmost and lowest edges: normalised boxes (was: "a video of another shape")
+    rx, ry, gx, gy = (float(np.max(a[:, c] + a[:, c + 2])) for a in (r, g) for c in (LEFT, TOP))
+    gx, gy = gx * scale, gy * scale
+    if max(rx, ry) <= NORMALISED_REACH < min(gx, gy):
+        raise ValueError(
+            f"{name}: every box lies within {rx:.3g} x {ry:.3g}, the ground truth's within "
+            f"{gx:.0f} x {gy:.0f} px: normalised coordinates? give pixels (x times the image "
+            "width, y times its height), or --no-scale-check"
+        )
+    _check_corners(g, r, scale, sample, as_given, name)
     # Box heights give the ratio roughly; positions need it closer (a 5 % error moves a box
     # at x = 600 by 30 px), so try factors around it and keep the best.
     best, fit = max(
@@ -360,6 +376,38 @@ def check_scale(
             f"{_scaled_by(scale)}, {best:.0%} with it scaled by {fit:g}): pass {option}"
             f"{instead}, the ratio of the image sizes (0.625 for PETS09 ground truth on its "
             "480x360 video), or --no-scale-check"
+        )
+
+
+def _check_corners(
+    g: NDArray[np.float64],
+    r: NDArray[np.float64],
+    scale: float,
+    sample: NDArray[np.int64],
+    as_given: float,
+    name: str,
+) -> None:
+    """Refuse a result whose columns 5-6 hold the boxes' right and bottom edges (x2, y2).
+
+    A detector's ``x1, y1, x2, y2`` written where MOTChallenge holds ``left, top, width,
+    height``: when every row's "width" and "height" reach at least its left and top, and the
+    boxes read as corners more than double the share of ground-truth boxes matched as given
+    (and reach 30 %), as :func:`check_scale` tests a scale (was: scored as given, MOTA -94.5
+    for ADL-Rundle-6's ground truth so written).
+    """
+    corners = r.copy()
+    corners[:, WIDTH] -= r[:, LEFT]
+    corners[:, HEIGHT] -= r[:, TOP]
+    if np.any(corners[:, WIDTH] < 0) or np.any(corners[:, HEIGHT] < 0):
+        return  # a right edge left of its left edge: no corners
+    as_corners = _matched_fraction(g, corners, scale, sample)
+    if as_corners >= 0.3 and as_corners > 2 * as_given:
+        raise ValueError(
+            f"{name}: its columns 5-6 look like the boxes' right and bottom edges (x2, y2), "
+            f"not their width and height ({as_given:.0%} of ground-truth boxes matched"
+            f"{_scaled_by(scale)}, {as_corners:.0%} with width = x2 - x1 and height = y2 - y1): "
+            "write left, top, width, height, as MOTChallenge files hold them (awk -F, -v OFS=, "
+            "'{$5-=$3; $6-=$4} 1' for a comma-separated file), or --no-scale-check"
         )
 
 

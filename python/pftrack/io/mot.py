@@ -41,20 +41,46 @@ _COMPRESSED = (
 )
 
 
+#: Byte-order marks of UTF-16 text, as Windows PowerShell 5's ``>`` and ``Out-File`` write a
+#: program's output: such a file is read in its encoding (was: refused as "not a text file (it
+#: holds NUL bytes)"). UTF-32's marks begin with UTF-16's and two NUL bytes: that is not read.
+_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
+_UTF32_BOMS = (b"\xff\xfe\0\0", b"\0\0\xfe\xff")
+
+
+def _encoding(head: bytes) -> str:
+    """The encoding of a MOT file whose first bytes are `head`: UTF-16 by its BOM, else UTF-8.
+
+    ``utf-8-sig``: a UTF-8 BOM is skipped, never read as part of the first field.
+    """
+    if head[:2] in _UTF16_BOMS and head[:4] not in _UTF32_BOMS:
+        return "utf-16"
+    return "utf-8-sig"
+
+
+def _file_encoding(p: Path) -> str:
+    """:func:`_encoding` of the file `p`."""
+    with p.open("rb") as fh:
+        return _encoding(fh.read(4))
+
+
 def _refuse_binary(p: Path, what: str) -> None:
-    """ValueError when `p` is compressed or not text (its first 8 KiB hold a NUL byte)."""
+    """ValueError when `p` is compressed or not text (its first 8 KiB hold a NUL byte).
+
+    UTF-16 text with its byte-order mark is text (:func:`_encoding`), NUL bytes and all.
+    """
     with p.open("rb") as fh:
         head = fh.read(8192)
     for magic, kind in _COMPRESSED:
         if head.startswith(magic):
             raise ValueError(f"{what} {p} is {kind}-compressed, not text; decompress it first")
-    if b"\0" in head:
+    if b"\0" in head and _encoding(head) != "utf-16":
         raise ValueError(f"{what} {p} is not a text file (it holds NUL bytes)")
 
 
 def _data_lines(path: Path) -> Iterator[tuple[int, str]]:
     """(1-based line number, stripped text) of every line that holds a row."""
-    with path.open("r", encoding="utf-8-sig", errors="replace") as fh:  # -sig: a BOM is no field
+    with path.open("r", encoding=_file_encoding(path), errors="replace") as fh:
         for lineno, line in enumerate(fh, start=1):
             text = line.strip()
             if text and not text.startswith("#"):
@@ -131,11 +157,13 @@ def read_mot(
         naming the file and the 1-based line number: fewer than 6 fields, an empty field
         (``1,,7,...``: two commas in a row) in the first 6 columns or before a non-empty one
         (empty fields at the end of a line, ``...,0.9,,,`` or a trailing comma, are absent
-        columns: their defaults), a non-number, a non-finite value in any of the first 10
+        columns: their defaults), a non-number (a first row with a word in it ends with
+        :data:`HEADER_HINT`: a header line?), a non-finite value in any of the first 10
         columns (a NaN score too), a frame that is not an integer in ``1..2**31-1``, a
         negative width or height, or a box value beyond ±1e9 px. A UTF-8 byte-order mark is
-        skipped. A compressed file (gzip, zip, bzip2, xz, zstd) or one with NUL bytes in its
-        first 8 KiB (not text), naming the file.
+        skipped; UTF-16 text with its byte-order mark (what Windows PowerShell's ``>``
+        writes) is read in its encoding. A compressed file (gzip, zip, bzip2, xz, zstd) or
+        one with NUL bytes in its first 8 KiB (not text), naming the file.
 
     Warns
     -----
@@ -166,6 +194,12 @@ def read_mot(
         values = _parse_line(text, what)
         if isinstance(values, str):
             error = f"{p}:{lineno}: {values}"
+            if (
+                not rows
+                and values.startswith(f"{what} line has a non-number")
+                and _WORD.search(text)
+            ):  # the first row a word: pandas' to_csv, a spreadsheet's export
+                error += HEADER_HINT
             break
         rows.append(values)
         numbers.append(lineno)
@@ -187,6 +221,11 @@ def read_mot(
         )
     return a
 
+
+#: What a refused first row with a word in it (``frame,id,bb_left,...``) is told.
+HEADER_HINT = " (a header line? delete it, or start it with # to keep it as a comment)"
+#: A word: two letters in a row, which no number has (``1e5``, ``inf`` is refused as such).
+_WORD = re.compile(r"[A-Za-z_]{2,}")
 
 #: A number as MOTChallenge files write them: ASCII digits, a point, an exponent (``float()``
 #: alone also takes ``1_0`` for 10 and other scripts' digits, ``１００``: a user trial).
@@ -244,8 +283,9 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
 
     None sends the file to the line-by-line reader, which names the first bad line.
     """
+    encoding = _file_encoding(p)
     try:
-        with p.open("r", encoding="utf-8-sig") as fh:
+        with p.open("r", encoding=encoding) as fh:
             first = ""
             for line in fh:
                 if line.strip():
@@ -254,7 +294,7 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
         if not first:
             return np.zeros((0, 10))
         a = np.loadtxt(
-            p, delimiter="," if "," in first else None, ndmin=2, encoding="utf-8-sig", comments=None
+            p, delimiter="," if "," in first else None, ndmin=2, encoding=encoding, comments=None
         )
     except (ValueError, UnicodeDecodeError):
         return None

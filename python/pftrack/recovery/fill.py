@@ -88,7 +88,8 @@ class FillReport:
 
         With ``"auto"``, the choice for the box centres, then for the box sizes
         (:meth:`~pftrack.recovery.calibrate.Calibration.describe`), or that there was no gap
-        to fill; with a named method, that it filled every gap and nothing was chosen.
+        to fill (and how many holes were longer than ``max_gap``); with a named method, that
+        it filled every gap and nothing was chosen.
 
         Parameters
         ----------
@@ -111,6 +112,16 @@ class FillReport:
             parts += ["box centres (x, y):", self.calibration.describe()]
         if self.size_calibration is not None:
             parts += ["box sizes (w, h):", self.size_calibration.describe()]
+        elif self.method == "auto" and self.n_long_holes:  # was "no gap to fill" of them
+            holes = (
+                f"1 hole longer, left unfilled: {self.longest_hole} frames"
+                if self.n_long_holes == 1
+                else f"{self.n_long_holes} holes longer, left unfilled; the longest "
+                f"{self.longest_hole} frames"
+            )
+            parts.append(
+                f"auto: no gap of at most max_gap frames to fill, nothing was chosen ({holes})"
+            )
         elif self.method == "auto":
             parts.append("auto: no gap to fill")
         else:

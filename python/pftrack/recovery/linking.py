@@ -23,6 +23,7 @@ from pftrack._check import (
     BOX_VALUES,
     MAX_FRAME,
     MAX_ID,
+    NORMALISED_REACH,
     bad_id_message,
     first_bad_box,
     first_bad_id,
@@ -668,7 +669,28 @@ def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
     except ValueError:
         check_unique(rows, data_line_numbers(path), path)
     _warn_padded_flags(rows, path)
+    _warn_normalised(rows, path)
     return rows
+
+
+def _warn_normalised(rows: F64, path: PathLike) -> None:
+    """Warn when every box of a file ends within 2 x 2 units: normalised coordinates.
+
+    pftrack works in pixels: the linking gate (50 px) would span 50 frames' widths, and the
+    filled and smoothed boxes are written with 2 decimals (``pftrack.io.mot``), 6 % of a
+    width of 0.08 (was: silent; the tracker's API warns alike of a detector's normalised boxes).
+    :data:`pftrack._check.NORMALISED_REACH`: boxes may reach a little past the frame.
+    """
+    if not len(rows):
+        return
+    right, bottom = np.max(rows[:, 2] + rows[:, 4]), np.max(rows[:, 3] + rows[:, 5])
+    if max(right, bottom) <= NORMALISED_REACH:
+        warnings.warn(
+            f"{path}: every box lies within {right:.3g} x {bottom:.3g} (its rightmost and lowest "
+            "edges): normalised coordinates? pftrack works in pixels (its linking gate, boxes "
+            "written with 2 decimals): give pixels (x times the image width, y times its height)",
+            stacklevel=3,
+        )
 
 
 def _warn_padded_flags(rows: F64, path: PathLike) -> None:
