@@ -330,3 +330,23 @@ def test_video_writer_names_the_conversion_too(tmp_path, frame):
     with pytest.raises(ValueError, match=r"^frame has shape \(6, 8(, 4)?\), expected") as e:
         writer.write(frame)
     assert str(e.value).endswith(f"? {TO_BGR[id(frame)]} makes it BGR")
+
+
+@pytest.mark.parametrize("external", [False, True])
+def test_track_frames_of_unpacked_views_track_as_their_packed_copies(frames, external):
+    """``track_frames`` of in-memory views (``frame[..., ::-1]``, Fortran order): as packed.
+
+    Was: RuntimeError "DetectAhead: the tracker asked about a frame the detection thread did
+    not detect": the thread detected the view, ``update`` the packed copy it made of it.
+    """
+    views = [np.ascontiguousarray(f[..., ::-1])[..., ::-1] for f in frames]
+    fortran = [np.asfortranarray(f) for f in frames]
+    assert not views[0].flags.c_contiguous and not fortran[0].flags.c_contiguous
+    dets = {k: np.array([[40.0, 40.0, 30.0, 80.0, 0.9]]) for k in range(1, len(frames) + 1)}
+    kwargs = {"detections": dets} if external else {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # short scene: no track may be said
+        base = pftrack.track_frames(frames, show_progress=False, **kwargs).rows
+        for seq in (views, fortran):
+            got = pftrack.track_frames(seq, show_progress=False, **kwargs).rows
+            np.testing.assert_array_equal(got, base)

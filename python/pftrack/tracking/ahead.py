@@ -175,7 +175,9 @@ def _work(frames: Iterable[Any], call: Any,
     it = iter(frames)
     try:
         for item in it:
-            frame = np.asarray(item)  # the very object update() will be given
+            # the very object update() will be given, and uses as it is: packed (update()
+            # copies a view, frame[..., ::-1], which the thread would not have detected)
+            frame = np.ascontiguousarray(item)
             try:
                 # the very object update() hands the detector
                 work = frame if prepare is None else prepare(frame)
