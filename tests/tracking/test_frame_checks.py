@@ -186,6 +186,19 @@ def test_a_pil_image_is_refused_with_the_conversion_to_bgr():
         )
 
 
+@pytest.mark.parametrize("threads", [True, False])
+def test_track_frames_refuses_pil_images_unprimed(frames, threads):
+    """``track_frames`` of PIL images without priming: refused as ``update`` refuses them.
+
+    Was (threads on): the detection thread made arrays of them, and the RGB images were
+    tracked as BGR without a word.
+    """
+    image = pytest.importorskip("PIL.Image")
+    pil = [image.fromarray(np.ascontiguousarray(f[..., ::-1])) for f in frames]
+    with pytest.raises(TypeError, match="a PIL image is RGB"):
+        pftrack.track_frames(pil, prime_frames=0, threads=threads, show_progress=False)
+
+
 def test_unpacked_views_track_as_their_packed_copies(frames):
     rgb = [np.ascontiguousarray(f[..., ::-1]) for f in frames]  # a user's RGB frames
     views = [f[..., ::-1] for f in rgb]  # the usual RGB -> BGR view
