@@ -777,6 +777,10 @@ def _cut_jpeg(path: Path) -> bool:
     return _jpeg_ends(data) is False
 
 
+#: What libjpeg prints on stderr of a file that ends before its end marker (:func:`_cut_jpeg`).
+JPEG_CUT_NOTE = "Premature end of JPEG file"
+
+
 def _jpeg_ends(data: bytes) -> bool | None:
     """Whether the JPEG stream in `data` reaches its end marker; None if it cannot be told.
 
@@ -1057,6 +1061,7 @@ class FrameSource:
         self._depth_from = ""  # the images `bits` was decided from, for the clipping warning
         self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._cut_said = False  # a JPEG without its end marker: said once
+        self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_lost = False  # frames inside the video could not be decoded
         self._cap: Any = None
@@ -1167,7 +1172,8 @@ class FrameSource:
         dark first image (a lens cap, a night start) does not decide it alone. 8-bit and
         full-range 16-bit images are read as OpenCV reads them, the same pixels as ever.
         """
-        first = read_image_depth(path)
+        unsaid: list[str] = []  # the decoders' notes: said when the images are read as frames
+        first = read_image_depth(path, notes=unsaid)
         if first is None:
             raise ValueError(f"cannot read image {path}")
         if first.dtype == np.uint8:  # the pixels read_image gives
@@ -1179,12 +1185,12 @@ class FrameSource:
         for k in sample[1:]:
             if _bit_depth(top) == 16:
                 break
-            other = read_image_depth(images[k])  # unreadable: refused when read, as ever
+            other = read_image_depth(images[k], notes=unsaid)  # unreadable: refused when read
             if other is not None and other.dtype == np.uint16 and int(other.max()) > top:
                 top, brightest = int(other.max()), images[k]
         bits = _bit_depth(top)
         if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
-            again = read_image(path)
+            again = read_image(path, notes=unsaid)
             if again is None:
                 raise ValueError(f"cannot read image {path}")
             return again
@@ -1276,16 +1282,18 @@ class FrameSource:
             note, self._depth_note = self._depth_note, None
             warnings.warn(note, UserWarning, stacklevel=3)
         img: NDArray[Any] | None
+        notes: list[str] = []  # what its decoder prints on stderr (libpng, libjpeg)
         if self.bits is None:
-            img = read_image(path)
+            img = read_image(path, notes=notes)
         else:
-            img = read_image_depth(path)
+            img = read_image_depth(path, notes=notes)
             if img is not None and img.dtype == np.uint16:
                 img = self._to_8_bits(img, path)
             elif img is not None and img.dtype != np.uint8:
-                img = read_image(path)
+                img = read_image(path, notes=notes)
         if img is None:
-            raise ValueError(f"cannot read image {path}")
+            said = f" (its decoder says {'; '.join(dict.fromkeys(notes))!r})" if notes else ""
+            raise ValueError(f"cannot read image {path}{said}")
         if not self._cut_said and path.suffix.lower() in (".jpg", ".jpeg") and _cut_jpeg(path):
             self._cut_said = True
             warnings.warn(
@@ -1293,6 +1301,16 @@ class FrameSource:
                 "decoded as flat grey, and tracked as it is (said once a run)",
                 UserWarning,
                 stacklevel=4,  # the loop over the frames (through two generators)
+            )
+        for note in notes:  # each once a run, naming the image (was: on stderr, no file named)
+            if note in self._decoder_said or (self._cut_said and note == JPEG_CUT_NOTE):
+                continue  # a cut JPEG: said above
+            self._decoder_said.add(note)
+            warnings.warn(
+                f"image {path}: its decoder says {note!r} (the image is read all the same; "
+                "said once a run)",
+                UserWarning,
+                stacklevel=4,
             )
         if img.shape[:2] != self._image_shape:
             h0, w0 = self._image_shape
