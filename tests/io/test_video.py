@@ -1132,6 +1132,39 @@ def test_what_an_image_decoder_prints_is_one_warning_naming_the_image(
     assert capfd.readouterr().err == ""
 
 
+@pytest.mark.parametrize("first", [False, True])
+def test_an_image_that_cannot_be_read_says_why(tmp_path: Path, first: bool) -> None:
+    """A user trial: an empty file (a copy that failed), a folder or a broken link named like
+    an image were each "cannot read image 3.png", which said nothing of why."""
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in (1, 2, 4):
+        cv2.imwrite(str(folder / f"{k}.png"), np.zeros((6, 8, 3), np.uint8))
+    bad = folder / ("0.png" if first else "3.png")  # the first image is read when opened
+
+    def read() -> None:
+        list(FrameSource(folder))
+
+    bad.write_bytes(b"")
+    with pytest.raises(ValueError, match=rf"^cannot read image {bad}: it is empty \(0 bytes\)$"):
+        read()
+    bad.unlink()
+    bad.mkdir()
+    with pytest.raises(ValueError, match=rf"^cannot read image {bad}: it is a folder$"):
+        read()
+    bad.rmdir()
+    bad.symlink_to(tmp_path / "gone.png")
+    with pytest.raises(
+        ValueError, match=rf"^cannot read image {bad}: a symbolic link to {tmp_path / 'gone.png'}, "
+        "which does not exist$"
+    ):  # fmt: skip
+        read()
+    bad.unlink()
+    bad.write_bytes(b"not an image at all")
+    with pytest.raises(ValueError, match=r"\.png: not an image OpenCV can decode \(damaged\?\)$"):
+        read()
+
+
 def test_a_sequence_folder_without_seqinfo_is_a_sequence_as_batch_takes_it(tmp_path: Path) -> None:
     """A user trial: ``SEQ/img1`` + ``SEQ/det/det.txt`` without seqinfo.ini was a sequence to
     ``pftrack batch`` (its det.txt read by ``--detections auto``) but not to ``pftrack track``

@@ -26,6 +26,7 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import errno
 import itertools
 import operator
 import os
@@ -821,6 +822,35 @@ def _jpeg_ends(data: bytes) -> bool | None:
     return False
 
 
+def _unreadable(path: Path, notes: Sequence[str]) -> str:
+    """The error of image `path` of a folder that cannot be read, saying why.
+
+    An empty file (a copy that failed), a folder or a broken link named like an image, a file
+    that cannot be opened, or what its decoder said (`notes`, :func:`read_image`'s); were all
+    ``cannot read image P``.
+    """
+    try:
+        info = path.stat()
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+        if path.is_symlink() and exc.errno == errno.ENOENT:
+            why = f"a symbolic link to {os.readlink(path)}, which does not exist"
+    else:
+        if stat.S_ISDIR(info.st_mode):
+            why = "it is a folder"
+        elif info.st_size == 0:
+            why = "it is empty (0 bytes)"
+        elif notes:
+            why = f"its decoder says {'; '.join(dict.fromkeys(notes))!r}"
+        else:
+            why = "not an image OpenCV can decode (damaged?)"
+            try:
+                path.open("rb").close()
+            except OSError as exc:
+                why = exc.strerror or str(exc)
+    return f"cannot read image {path}: {why}"
+
+
 def image_files(folder: Path) -> list[Path]:
     """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order.
 
@@ -1175,7 +1205,7 @@ class FrameSource:
         unsaid: list[str] = []  # the decoders' notes: said when the images are read as frames
         first = read_image_depth(path, notes=unsaid)
         if first is None:
-            raise ValueError(f"cannot read image {path}")
+            raise ValueError(_unreadable(path, unsaid))
         if first.dtype == np.uint8:  # the pixels read_image gives
             return first
         top = int(first.max()) if first.dtype == np.uint16 else 65535
@@ -1192,7 +1222,7 @@ class FrameSource:
         if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
             again = read_image(path, notes=unsaid)
             if again is None:
-                raise ValueError(f"cannot read image {path}")
+                raise ValueError(_unreadable(path, unsaid))
             return again
         self.bits = bits
         self._depth_from = (
@@ -1292,8 +1322,7 @@ class FrameSource:
             elif img is not None and img.dtype != np.uint8:
                 img = read_image(path, notes=notes)
         if img is None:
-            said = f" (its decoder says {'; '.join(dict.fromkeys(notes))!r})" if notes else ""
-            raise ValueError(f"cannot read image {path}{said}")
+            raise ValueError(_unreadable(path, notes))
         if not self._cut_said and path.suffix.lower() in (".jpg", ".jpeg") and _cut_jpeg(path):
             self._cut_said = True
             warnings.warn(
