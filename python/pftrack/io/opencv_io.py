@@ -6,12 +6,13 @@ Latin-1 ``vid\xfe.mp4`` made on another system: Python keeps such bytes as surro
 ``cv2.imread``, ``cv2.imwrite`` and ``cv2.VideoWriter`` (a segmentation fault, OpenCV 5.0).
 pftrack never hands OpenCV such a name:
 
-- images are read and written through memory (:func:`read_image`, :func:`read_image_depth`:
-  ``numpy.fromfile`` and ``cv2.imdecode``; :func:`write_image`: ``cv2.imencode`` and an
-  atomic write);
-- videos are opened through a symbolic link with an ASCII name in the system's temporary
-  folder (:func:`opencv_name`), removed as soon as OpenCV has opened the file: OpenCV keeps
-  its own handle;
+- images are written through memory (:func:`write_image`: ``cv2.imencode`` and an atomic
+  write);
+- videos are opened, and images read (:func:`read_image`, :func:`read_image_depth`),
+  through a symbolic link with an ASCII name in the system's temporary folder
+  (:func:`opencv_name`), removed as soon as OpenCV has opened or read the file: OpenCV keeps
+  its own handle (images are not read from memory, ``cv2.imdecode``, which refuses a truncated
+  JPEG that ``cv2.imread`` decodes);
 - a stream URL that is not valid UTF-8 is refused (:func:`utf8_name`);
 - text drawn with ``cv2.putText`` (a plot's title: the video's file name) is made printable
   ASCII first (:func:`text_for_opencv`).
@@ -193,10 +194,19 @@ def _decoder_notes(notes: list[str]) -> Iterator[None]:
 
 
 def _decode(path: PathLike, flags: int, notes: list[str] | None) -> Any:
-    """``cv2.imread(path, flags)`` under any name: the array, or None if it cannot be read."""
+    """``cv2.imread(path, flags)`` under any name: the array, or None if it cannot be read.
+
+    A name that is not UTF-8 is read through :func:`opencv_name`'s link, by ``cv2.imread``
+    too: ``cv2.imdecode`` of the file's bytes refuses a truncated JPEG that ``cv2.imread``
+    decodes (the rest grey), and a folder tracked under one name failed under another. From
+    memory only when the temporary folder's name is not UTF-8 either.
+    """
     with contextlib.nullcontext() if notes is None else _decoder_notes(notes):
-        if is_utf8(path):
-            return cv2.imread(utf8_name(path), flags)
+        try:
+            with opencv_name(path) as name:
+                return cv2.imread(name, flags)
+        except ValueError:  # no name OpenCV can take
+            pass
         try:
             data = np.fromfile(os.fspath(path), dtype=np.uint8)
         except (OSError, ValueError):
