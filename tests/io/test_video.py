@@ -1165,6 +1165,27 @@ def test_an_image_that_cannot_be_read_says_why(tmp_path: Path, first: bool) -> N
         read()
 
 
+def test_an_empty_image_folder_beside_a_sequence_video_says_how_to_read_it(
+    tmp_path: Path,
+) -> None:
+    """A user trial: SEQ/video.mp4 beside an empty SEQ/img1 (an extraction that failed) was
+    "no images in folder SEQ/img1", with no word of the video that is read without img1."""
+    seq = tmp_path / "SEQ"
+    (seq / "img1").mkdir(parents=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=10\n")
+    make_scene(n_frames=3, width=64, height=64, rng=0).write_video(seq / "video.mp4")
+    for source in (seq, seq / "img1"):
+        with pytest.raises(ValueError) as e:
+            FrameSource(source)
+        assert str(e.value) == (
+            f"no images (.jpg, .jpeg, .png, .bmp, .tif, .tiff, .webp) in folder {seq / 'img1'}; "
+            f"{seq} holds a video, video.mp4, read as the sequence's frames once the empty "
+            f"image folder is gone (or give {seq / 'video.mp4'})"
+        )
+    (seq / "img1").rmdir()
+    assert len(list(FrameSource(seq))) == 3
+
+
 def test_a_sequence_folder_without_seqinfo_is_a_sequence_as_batch_takes_it(tmp_path: Path) -> None:
     """A user trial: ``SEQ/img1`` + ``SEQ/det/det.txt`` without seqinfo.ini was a sequence to
     ``pftrack batch`` (its det.txt read by ``--detections auto``) but not to ``pftrack track``

@@ -742,11 +742,24 @@ def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
     return path
 
 
-def _no_images(folder: Path) -> str:
-    """The message for a folder source without images; one of videos says how to track them."""
+def _no_images(folder: Path, sequence: SequenceInfo | None = None) -> str:
+    """The message for a folder source without images; one of videos says how to track them.
+
+    An empty image folder of `sequence` beside the one video :func:`sequence_video` would read
+    without it (``SEQ/img1/``, ``SEQ/seqinfo.ini`` and ``SEQ/video.mp4``) says so.
+    """
     videos = video_files(folder)
     if not videos:
-        return f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+        none = f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+        if sequence is None or not (sequence.folder / "seqinfo.ini").is_file():
+            return none
+        beside = video_files(sequence.folder)
+        if len(beside) != 1:
+            return none
+        return (
+            f"{none}; {sequence.folder} holds a video, {beside[0].name}, read as the sequence's "
+            f"frames once the empty image folder is gone (or give {beside[0]})"
+        )
     names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
     if len(videos) == 1:
         return f"folder {folder} holds a video ({names}) and no images: give it ({videos[0]})"
@@ -1171,7 +1184,9 @@ class FrameSource:
         folder = _image_folder(path, self.sequence)
         images = image_files(folder)
         if not images:
-            raise ValueError(_no_images(folder))
+            seq = self.sequence
+            own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
+            raise ValueError(_no_images(folder, seq if own and not any(folder.iterdir()) else None))
         videos = video_files(folder)
         if videos:  # was passed over without a word
             names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
