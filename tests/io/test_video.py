@@ -1186,6 +1186,16 @@ def test_an_empty_image_folder_beside_a_sequence_video_says_how_to_read_it(
     assert len(list(FrameSource(seq))) == 3
 
 
+def test_an_image_folder_that_is_a_file_is_not_said_missing(tmp_path: Path) -> None:
+    # was: "image folder SEQ/img1.zip does not exist", of a file that does
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimDir=img1.zip\n")
+    (seq / "img1.zip").write_bytes(b"PK")
+    with pytest.raises(ValueError, match=r"folder \S+img1.zip is a file and \S+SEQ holds no video"):
+        FrameSource(seq)
+
+
 def test_a_sequence_folder_without_seqinfo_is_a_sequence_as_batch_takes_it(tmp_path: Path) -> None:
     """A user trial: ``SEQ/img1`` + ``SEQ/det/det.txt`` without seqinfo.ini was a sequence to
     ``pftrack batch`` (its det.txt read by ``--detections auto``) but not to ``pftrack track``

@@ -478,6 +478,11 @@ def video_files(folder: Path) -> list[Path]:
     )
 
 
+def _not_there(folder: Path) -> str:
+    """How an image folder that is not there is not: ``does not exist``, ``is a file``."""
+    return "is a file" if folder.exists() else "does not exist"
+
+
 def sequence_video(folder: PathLike) -> Path | None:
     """The video a MOTChallenge sequence folder without its image folder is read from.
 
@@ -516,7 +521,7 @@ def sequence_video(folder: PathLike) -> Path | None:
         else f"no video ({', '.join(VIDEO_SUFFIXES)})"
     )
     raise ValueError(
-        f"{path / 'seqinfo.ini'}: image folder {images} does not exist and {path} holds "
+        f"{path / 'seqinfo.ini'}: image folder {images} {_not_there(images)} and {path} holds "
         f"{found} to read instead"
     )
 
@@ -735,7 +740,7 @@ def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
     if sequence is not None and sequence.folder == path:
         folder = path / sequence.image_dir
         if not folder.is_dir():
-            raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
+            raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} {_not_there(folder)}")
         return folder
     if (path / "img1").is_dir():
         return path / "img1"
