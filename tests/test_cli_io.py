@@ -1042,3 +1042,29 @@ def test_the_command_runs_blas_at_one_thread(
         text=True, timeout=60,
     )  # fmt: skip
     assert proc.returncode == 0 and proc.stdout.strip() == expected, proc.stderr
+
+
+@pytest.mark.parametrize("command", ["track", "render"])
+def test_a_warning_names_a_file_whose_name_is_not_utf8_as_errors_do(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    r"""A warning of the run names a Latin-1 name's byte as ``\xe9``, as the errors and the
+    warnings given before the run do (was: ``\udce9``, Python's surrogate escape printed)."""
+    folder = Path(os.fsdecode(bytes(tmp_path) + b"/lat\xe9n"))
+    folder.mkdir()
+    rng = np.random.default_rng(0)
+    for k in range(1, 6):
+        cv2.imwrite(str(tmp_path / "x.jpg"), rng.integers(0, 255, (40, 60, 3), np.uint8))
+        data = (tmp_path / "x.jpg").read_bytes()
+        (folder / f"{k}.jpg").write_bytes(data[: len(data) // 2] if k == 3 else data)
+    (tmp_path / "t.txt").write_text("1,1,5,5,10,20,1,-1,-1,-1\n")
+    tracks = str(tmp_path / "t.txt")
+    args = (
+        ["track", str(folder), "--out", str(tmp_path / "o.txt")]
+        if command == "track"
+        else ["render", str(folder), tracks, "--out", str(tmp_path / "o.mp4")]
+    )
+    assert main(["-q", *args]) == 0
+    err = capsys.readouterr().err
+    assert "lat\\xe9n/3.jpg has no JPEG end marker" in err, err
+    assert "udce9" not in err

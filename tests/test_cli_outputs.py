@@ -309,13 +309,17 @@ def test_interrupted_track_run_changes_no_output(
         raise KeyboardInterrupt
 
     def interrupt_mid_video(source: Any, *args: Any, **kwargs: Any) -> Any:
-        def frames() -> Any:
-            for k, frame in enumerate(source):
-                if k == 10:
-                    raise KeyboardInterrupt
-                yield frame
+        class Frames(list):  # type: ignore[type-arg]
+            """The video's frames; Ctrl-C at the 11th as they are tracked (a sequence: a
+            generator is refused, its frames being read twice)."""
 
-        return real_track(frames(), *args, **kwargs)
+            def __iter__(self) -> Any:
+                for k in range(len(self)):
+                    if k == 10:
+                        raise KeyboardInterrupt
+                    yield self[k]
+
+        return real_track(Frames(source), *args, **kwargs)
 
     def interrupt_closing(self: Any) -> None:  # the video is encoded, not yet in place
         raise KeyboardInterrupt

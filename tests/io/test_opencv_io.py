@@ -63,6 +63,23 @@ def test_images_are_written_and_read_under_any_name(tmp_path: Path) -> None:
     assert len(os.listdir(tmp_path)) == 2  # no temporary file
 
 
+def test_a_truncated_jpeg_is_read_under_any_name_as_under_a_utf8_one(tmp_path: Path) -> None:
+    """libjpeg decodes a cut file, the rest grey (pftrack warns of it: video.py's _cut_jpeg).
+
+    Was: under a name that is not UTF-8, read from memory (``cv2.imdecode``), it could not be
+    read at all: a folder tracked under one name failed under another.
+    """
+    image = make_scene(n_frames=1, rng=0).frames[0]
+    data = cv2.imencode(".jpg", image)[1].tobytes()
+    good, bad = tmp_path / "a.jpg", _latin1(tmp_path, b"b\xe9.jpg")
+    for path in (good, bad):
+        path.write_bytes(data[: len(data) // 2])
+    before = _pftrack_scratch()
+    want, got = read_image(good, notes=[]), read_image(bad, notes=[])
+    assert want is not None and got is not None and np.array_equal(got, want)
+    assert _pftrack_scratch() == before  # no link left behind
+
+
 def test_a_video_and_an_image_folder_under_any_name_give_the_same_frames(
     tmp_path: Path,
 ) -> None:

@@ -1077,6 +1077,125 @@ def test_a_truncated_jpeg_in_a_folder_is_said_once(tmp_path: Path) -> None:
         assert len(list(FrameSource(folder))) == 4
 
 
+def _png_with_short_iccp(image: np.ndarray) -> bytes:
+    """`image` as a PNG whose ICC profile chunk is too short: libpng warns on every read."""
+    import struct
+    import zlib
+
+    data = cv2.imencode(".png", image)[1].tobytes()
+    body = b"iCCP" + b"x\0\0" + zlib.compress(b"\0" * 8)
+    chunk = struct.pack(">I", len(body) - 4) + body + struct.pack(">I", zlib.crc32(body))
+    return data[:33] + chunk + data[33:]  # after the signature and IHDR
+
+
+def test_what_an_image_decoder_prints_is_one_warning_naming_the_image(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: PNGs with a bad ICC profile printed "libpng warning: iCCP: too short"
+    twice per image (priming, then tracking: 62 lines for 30 images), a JPEG with damaged
+    data "Corrupt JPEG data: 102 extraneous bytes before marker 0xd9" twice, naming no file;
+    libjpeg's "Premature end of JPEG file" came beside pftrack's own warning of a cut file."""
+    folder = tmp_path / "png"
+    folder.mkdir()
+    rng = np.random.default_rng(0)
+    frames = [rng.integers(0, 255, (40, 60, 3), np.uint8) for _ in range(4)]
+    for k, frame in enumerate(frames, start=1):
+        (folder / f"{k}.png").write_bytes(_png_with_short_iccp(frame))
+    source = FrameSource(folder)
+    capfd.readouterr()
+    with pytest.warns(UserWarning) as record:
+        got = list(source) + list(source)  # two passes: said once
+    assert all(np.array_equal(a, b) for a, b in zip(got, frames * 2, strict=True))
+    assert [str(w.message) for w in record] == [
+        f"image {folder / '1.png'}: its decoder says 'libpng warning: iCCP: too short' (the "
+        "image is read all the same; said once a run)"
+    ]
+    assert capfd.readouterr().err == ""
+    jpg = tmp_path / "jpg"
+    jpg.mkdir()
+    y, x = np.mgrid[0:120, 0:160]
+    for k in range(1, 4):
+        image = np.stack([(x + 9 * k) % 256, (2 * y) % 256, (x + y) % 256], -1).astype(np.uint8)
+        cv2.imwrite(str(jpg / f"{k}.jpg"), image)
+    data = bytearray((jpg / "2.jpg").read_bytes())
+    data[len(data) // 2 : len(data) // 2 + 300] = bytes(300)  # damaged, not cut
+    (jpg / "2.jpg").write_bytes(bytes(data))
+    data = (jpg / "3.jpg").read_bytes()
+    (jpg / "3.jpg").write_bytes(data[: len(data) // 2])  # cut
+    capfd.readouterr()
+    with pytest.warns(UserWarning) as record:
+        assert len(list(FrameSource(jpg))) == 3
+    said = [str(w.message) for w in record]
+    assert len(said) == 2, said
+    assert said[0].startswith(f"image {jpg / '2.jpg'}: its decoder says 'Corrupt JPEG data: ")
+    assert said[1].startswith(f"image {jpg / '3.jpg'} has no JPEG end marker")
+    assert capfd.readouterr().err == ""
+
+
+@pytest.mark.parametrize("first", [False, True])
+def test_an_image_that_cannot_be_read_says_why(tmp_path: Path, first: bool) -> None:
+    """A user trial: an empty file (a copy that failed), a folder or a broken link named like
+    an image were each "cannot read image 3.png", which said nothing of why."""
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in (1, 2, 4):
+        cv2.imwrite(str(folder / f"{k}.png"), np.zeros((6, 8, 3), np.uint8))
+    bad = folder / ("0.png" if first else "3.png")  # the first image is read when opened
+
+    def read() -> None:
+        list(FrameSource(folder))
+
+    bad.write_bytes(b"")
+    with pytest.raises(ValueError, match=rf"^cannot read image {bad}: it is empty \(0 bytes\)$"):
+        read()
+    bad.unlink()
+    bad.mkdir()
+    with pytest.raises(ValueError, match=rf"^cannot read image {bad}: it is a folder$"):
+        read()
+    bad.rmdir()
+    bad.symlink_to(tmp_path / "gone.png")
+    with pytest.raises(
+        ValueError, match=rf"^cannot read image {bad}: a symbolic link to {tmp_path / 'gone.png'}, "
+        "which does not exist$"
+    ):  # fmt: skip
+        read()
+    bad.unlink()
+    bad.write_bytes(b"not an image at all")
+    with pytest.raises(ValueError, match=r"\.png: not an image OpenCV can decode \(damaged\?\)$"):
+        read()
+
+
+def test_an_empty_image_folder_beside_a_sequence_video_says_how_to_read_it(
+    tmp_path: Path,
+) -> None:
+    """A user trial: SEQ/video.mp4 beside an empty SEQ/img1 (an extraction that failed) was
+    "no images in folder SEQ/img1", with no word of the video that is read without img1."""
+    seq = tmp_path / "SEQ"
+    (seq / "img1").mkdir(parents=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nframeRate=10\n")
+    make_scene(n_frames=3, width=64, height=64, rng=0).write_video(seq / "video.mp4")
+    for source in (seq, seq / "img1"):
+        with pytest.raises(ValueError) as e:
+            FrameSource(source)
+        assert str(e.value) == (
+            f"no images (.jpg, .jpeg, .png, .bmp, .tif, .tiff, .webp) in folder {seq / 'img1'}; "
+            f"{seq} holds a video, video.mp4, read as the sequence's frames once the empty "
+            f"image folder is gone (or give {seq / 'video.mp4'})"
+        )
+    (seq / "img1").rmdir()
+    assert len(list(FrameSource(seq))) == 3
+
+
+def test_an_image_folder_that_is_a_file_is_not_said_missing(tmp_path: Path) -> None:
+    # was: "image folder SEQ/img1.zip does not exist", of a file that does
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimDir=img1.zip\n")
+    (seq / "img1.zip").write_bytes(b"PK")
+    with pytest.raises(ValueError, match=r"folder \S+img1.zip is a file and \S+SEQ holds no video"):
+        FrameSource(seq)
+
+
 def test_a_sequence_folder_without_seqinfo_is_a_sequence_as_batch_takes_it(tmp_path: Path) -> None:
     """A user trial: ``SEQ/img1`` + ``SEQ/det/det.txt`` without seqinfo.ini was a sequence to
     ``pftrack batch`` (its det.txt read by ``--detections auto``) but not to ``pftrack track``

@@ -86,6 +86,45 @@ def test_avi_is_mjpeg_through_opencv(tmp_path: Path) -> None:
     assert stream.codec == "mjpeg" and len(got) == 4
 
 
+_NARROW_AVI = """
+import sys
+from pathlib import Path
+import numpy as np
+from pftrack.io.video_writer import VideoWriter
+w, h = int(sys.argv[2]), int(sys.argv[3])
+rng = np.random.default_rng(0)
+with VideoWriter(Path(sys.argv[1]), 10) as writer:
+    for _ in range(10):
+        writer.write(rng.integers(0, 255, (h, w, 3), np.uint8))
+print(writer.codec)
+"""
+
+
+@pytest.mark.parametrize(("w", "h"), [(1, 8), (2, 50), (5, 120), (6, 120)])
+def test_a_narrow_avi_is_written(tmp_path: Path, w: int, h: int) -> None:
+    """Frames 1, 2, 5 or 6 pixels wide (2 or 6 once made even) make a playable .avi.
+
+    Was: OpenCV's FFmpeg MJPG writer corrupted the heap on them ("double free or corruption",
+    the process aborted) unless the height was a multiple of 16: ``pftrack track`` of a folder
+    of 1-pixel-wide images with ``--render v.avi`` died with exit status 134. Run in a process
+    of its own: the failure kills it.
+    """
+    import subprocess
+    import sys
+
+    out = tmp_path / "v.avi"
+    env = {**os.environ, "MALLOC_CHECK_": "3"}  # glibc: any heap damage aborts
+    run = subprocess.run(
+        [sys.executable, "-c", _NARROW_AVI, str(out), str(w), str(h)],
+        capture_output=True, text=True, env=env, timeout=120, check=False,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr[-500:]
+    assert run.stdout.strip() == "mjpeg"
+    stream, got = decode(out)
+    assert stream.codec == "mjpeg" and len(got) == 10
+    assert got[0].shape == (h + h % 2, w + w % 2, 3)
+
+
 def test_a_failure_keeps_the_old_file_and_leaves_nothing(tmp_path: Path) -> None:
     target = tmp_path / "v.mp4"
     target.write_bytes(b"old")

@@ -1530,6 +1530,23 @@ def test_track_frames_names_every_bootstrap_it_takes():
             track_frames([], bootstrap="sprad", prime_frames=prime)  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize(
+    ("source", "kind"),
+    [((f for f in ()), "generator"), (iter([]), "list_iterator"), (0, "int"), (None, "NoneType"),
+     (b"frames", "bytes")],
+)  # fmt: skip
+def test_track_frames_names_a_source_it_cannot_read(source, kind):
+    # were Python's "object of type 'generator' has no len()", "'int' object is not
+    # iterable", and for bytes "prime frame is int"
+    from pftrack.tracking import track_frames
+
+    with pytest.raises(TypeError) as e:
+        track_frames(source, show_progress=False)  # type: ignore[arg-type]
+    assert str(e.value).startswith(
+        f"track_frames: source is {kind}, expected a path, a FrameSource or a sequence of frames"
+    )
+
+
 def _blank_messages(record: list[warnings.WarningMessage]) -> list[str]:
     return [str(w.message) for w in record if "is blank" in str(w.message)]
 

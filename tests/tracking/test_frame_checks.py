@@ -186,6 +186,19 @@ def test_a_pil_image_is_refused_with_the_conversion_to_bgr():
         )
 
 
+@pytest.mark.parametrize("threads", [True, False])
+def test_track_frames_refuses_pil_images_unprimed(frames, threads):
+    """``track_frames`` of PIL images without priming: refused as ``update`` refuses them.
+
+    Was (threads on): the detection thread made arrays of them, and the RGB images were
+    tracked as BGR without a word.
+    """
+    image = pytest.importorskip("PIL.Image")
+    pil = [image.fromarray(np.ascontiguousarray(f[..., ::-1])) for f in frames]
+    with pytest.raises(TypeError, match="a PIL image is RGB"):
+        pftrack.track_frames(pil, prime_frames=0, threads=threads, show_progress=False)
+
+
 def test_unpacked_views_track_as_their_packed_copies(frames):
     rgb = [np.ascontiguousarray(f[..., ::-1]) for f in frames]  # a user's RGB frames
     views = [f[..., ::-1] for f in rgb]  # the usual RGB -> BGR view
@@ -330,3 +343,23 @@ def test_video_writer_names_the_conversion_too(tmp_path, frame):
     with pytest.raises(ValueError, match=r"^frame has shape \(6, 8(, 4)?\), expected") as e:
         writer.write(frame)
     assert str(e.value).endswith(f"? {TO_BGR[id(frame)]} makes it BGR")
+
+
+@pytest.mark.parametrize("external", [False, True])
+def test_track_frames_of_unpacked_views_track_as_their_packed_copies(frames, external):
+    """``track_frames`` of in-memory views (``frame[..., ::-1]``, Fortran order): as packed.
+
+    Was: RuntimeError "DetectAhead: the tracker asked about a frame the detection thread did
+    not detect": the thread detected the view, ``update`` the packed copy it made of it.
+    """
+    views = [np.ascontiguousarray(f[..., ::-1])[..., ::-1] for f in frames]
+    fortran = [np.asfortranarray(f) for f in frames]
+    assert not views[0].flags.c_contiguous and not fortran[0].flags.c_contiguous
+    dets = {k: np.array([[40.0, 40.0, 30.0, 80.0, 0.9]]) for k in range(1, len(frames) + 1)}
+    kwargs = {"detections": dets} if external else {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # short scene: no track may be said
+        base = pftrack.track_frames(frames, show_progress=False, **kwargs).rows
+        for seq in (views, fortran):
+            got = pftrack.track_frames(seq, show_progress=False, **kwargs).rows
+            np.testing.assert_array_equal(got, base)

@@ -75,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``pftrack render``; return the exit status."""
     import numpy as np
 
+    from pftrack.cli import _shown  # a name's bytes that are not UTF-8 as \xe9, as errors
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_distinct, check_output, output_format, staged_outputs
@@ -140,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
             "drawn"
         )
     for note in notes:
-        print(f"pftrack render: warning: {note}", file=sys.stderr)
+        print(f"pftrack render: warning: {_shown(note)}", file=sys.stderr)
     shown = rows[rows[:, 0] <= drawn[0]]
     ids = len(np.unique(shown[:, 1])) if len(shown) else 0
     print(

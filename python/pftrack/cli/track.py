@@ -234,6 +234,7 @@ def run(args: argparse.Namespace) -> int:
     """
     import numpy as np
 
+    from pftrack.cli import _shown  # a name's bytes that are not UTF-8 as \xe9, as errors
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts, set_outcome
     from pftrack.io.atomic import (
@@ -327,7 +328,7 @@ def run(args: argparse.Namespace) -> int:
                         on_frame=on_frame,
                     )
                 # clipped boxes, a run without any track: said, not fatal
-                warned.extend(f"pftrack track: warning: {w.message}" for w in caught)
+                warned.extend(f"pftrack track: warning: {_shown(str(w.message))}" for w in caught)
                 if not streamed:
                     write_mot(stage(args.out), result.rows)
                 n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0

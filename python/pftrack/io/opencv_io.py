@@ -6,15 +6,21 @@ Latin-1 ``vid\xfe.mp4`` made on another system: Python keeps such bytes as surro
 ``cv2.imread``, ``cv2.imwrite`` and ``cv2.VideoWriter`` (a segmentation fault, OpenCV 5.0).
 pftrack never hands OpenCV such a name:
 
-- images are read and written through memory (:func:`read_image`, :func:`read_image_depth`:
-  ``numpy.fromfile`` and ``cv2.imdecode``; :func:`write_image`: ``cv2.imencode`` and an
-  atomic write);
-- videos are opened through a symbolic link with an ASCII name in the system's temporary
-  folder (:func:`opencv_name`), removed as soon as OpenCV has opened the file: OpenCV keeps
-  its own handle;
+- images are written through memory (:func:`write_image`: ``cv2.imencode`` and an atomic
+  write);
+- videos are opened, and images read (:func:`read_image`, :func:`read_image_depth`),
+  through a symbolic link with an ASCII name in the system's temporary folder
+  (:func:`opencv_name`), removed as soon as OpenCV has opened or read the file: OpenCV keeps
+  its own handle (images are not read from memory, ``cv2.imdecode``, which refuses a truncated
+  JPEG that ``cv2.imread`` decodes);
 - a stream URL that is not valid UTF-8 is refused (:func:`utf8_name`);
 - text drawn with ``cv2.putText`` (a plot's title: the video's file name) is made printable
   ASCII first (:func:`text_for_opencv`).
+
+What the image libraries under OpenCV print on stderr themselves, naming no file (libpng's
+``libpng warning: iCCP: known incorrect sRGB profile``, libjpeg's ``Corrupt JPEG data: ...``),
+a caller of :func:`read_image` or :func:`read_image_depth` may take as notes instead
+(`notes`), to say it once, naming the image (:class:`pftrack.io.video.FrameSource` does).
 
 A name that is valid UTF-8, which is almost every name, goes to OpenCV as the text its bytes
 spell in UTF-8 (:func:`utf8_name`), which is not always the ``str`` Python made of them: under a
@@ -27,8 +33,10 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import shutil
 import tempfile
+import threading
 import unicodedata
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -137,31 +145,95 @@ def opencv_name(path: PathLike) -> Iterator[str]:
         shutil.rmtree(scratch, ignore_errors=True)
 
 
-def _decode(path: PathLike, flags: int) -> Any:
-    """``cv2.imread(path, flags)`` under any name: the array, or None if it cannot be read."""
-    if is_utf8(path):
-        return cv2.imread(utf8_name(path), flags)
-    try:
-        data = np.fromfile(os.fspath(path), dtype=np.uint8)
-    except (OSError, ValueError):
-        return None
-    return cv2.imdecode(data, flags) if data.size else None
+#: A line the image libraries under OpenCV print on stderr themselves: libpng's warnings and
+#: errors, libjpeg's warnings (the texts of its jerror.h's ``JWRN_*``; its errors OpenCV
+#: handles without a word).
+_DECODER_LINE = re.compile(
+    rb"(libpng (?:warning|error): [^\n]*|Corrupt JPEG data: [^\n]*|Premature end of JPEG file"
+    rb"|Invalid SOS parameters for sequential JPEG|Inconsistent progression sequence [^\n]*"
+    rb"|Unknown Adobe color transform code [^\n]*|Warning: unknown JFIF revision number [^\n]*"
+    rb"|Application transferred too many scanlines)\n?"
+)
+_HELD = threading.Lock()  # one thread at a time holds file descriptor 2
 
 
-def read_image(path: PathLike, flags: int = cv2.IMREAD_COLOR) -> NDArray[np.uint8] | None:
-    """The image at `path` as ``cv2.imread`` reads it (any name); None if it cannot be read."""
-    image = _decode(path, flags)
+@contextlib.contextmanager
+def _decoder_notes(notes: list[str]) -> Iterator[None]:
+    """The image libraries' lines on stderr during the block into `notes`, instead of stderr.
+
+    What is written to file descriptor 2 while the block runs is held; then each line the image
+    libraries printed (:data:`_DECODER_LINE`) goes to `notes`, the rest (another thread's
+    progress bar, a warning) to stderr as it was. Without a file descriptor 2: nothing held.
+    """
+    with _HELD:
+        try:
+            saved = os.dup(2)
+        except OSError:
+            yield
+            return
+        try:
+            with tempfile.TemporaryFile() as held:
+                os.dup2(held.fileno(), 2)
+                try:
+                    yield
+                finally:
+                    os.dup2(saved, 2)
+                held.seek(0)
+                text = held.read()
+        finally:
+            os.close(saved)
+
+    def take(match: re.Match[bytes]) -> bytes:
+        notes.append(match.group(1).decode("utf-8", "replace"))
+        return b""
+
+    rest = _DECODER_LINE.sub(take, text)
+    if rest:
+        with contextlib.suppress(OSError):
+            os.write(2, rest)
+
+
+def _decode(path: PathLike, flags: int, notes: list[str] | None) -> Any:
+    """``cv2.imread(path, flags)`` under any name: the array, or None if it cannot be read.
+
+    A name that is not UTF-8 is read through :func:`opencv_name`'s link, by ``cv2.imread``
+    too: ``cv2.imdecode`` of the file's bytes refuses a truncated JPEG that ``cv2.imread``
+    decodes (the rest grey), and a folder tracked under one name failed under another. From
+    memory only when the temporary folder's name is not UTF-8 either.
+    """
+    with contextlib.nullcontext() if notes is None else _decoder_notes(notes):
+        try:
+            with opencv_name(path) as name:
+                return cv2.imread(name, flags)
+        except ValueError:  # no name OpenCV can take
+            pass
+        try:
+            data = np.fromfile(os.fspath(path), dtype=np.uint8)
+        except (OSError, ValueError):
+            return None
+        return cv2.imdecode(data, flags) if data.size else None
+
+
+def read_image(
+    path: PathLike, flags: int = cv2.IMREAD_COLOR, *, notes: list[str] | None = None
+) -> NDArray[np.uint8] | None:
+    """The image at `path` as ``cv2.imread`` reads it (any name); None if it cannot be read.
+
+    With `notes`, what the image's decoder prints on stderr itself (``libpng warning: iCCP:
+    too short``) is appended to it instead, a line each.
+    """
+    image = _decode(path, flags, notes)
     return None if image is None else np.asarray(image, dtype=np.uint8)
 
 
-def read_image_depth(path: PathLike) -> NDArray[Any] | None:
+def read_image_depth(path: PathLike, *, notes: list[str] | None = None) -> NDArray[Any] | None:
     """The image at `path` in BGR at the depth it is stored in (any name); None if unreadable.
 
     ``cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH``: a 16-bit PNG or TIFF is uint16 (``cv2.imread``'s
     colour read keeps its high byte); an 8-bit image is uint8, the pixels :func:`read_image`
-    gives.
+    gives. `notes` as :func:`read_image`'s.
     """
-    image = _decode(path, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+    image = _decode(path, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH, notes)
     return None if image is None else np.asarray(image)
 
 

@@ -26,6 +26,7 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import errno
 import itertools
 import operator
 import os
@@ -477,6 +478,11 @@ def video_files(folder: Path) -> list[Path]:
     )
 
 
+def _not_there(folder: Path) -> str:
+    """How an image folder that is not there is not: ``does not exist``, ``is a file``."""
+    return "is a file" if folder.exists() else "does not exist"
+
+
 def sequence_video(folder: PathLike) -> Path | None:
     """The video a MOTChallenge sequence folder without its image folder is read from.
 
@@ -515,7 +521,7 @@ def sequence_video(folder: PathLike) -> Path | None:
         else f"no video ({', '.join(VIDEO_SUFFIXES)})"
     )
     raise ValueError(
-        f"{path / 'seqinfo.ini'}: image folder {images} does not exist and {path} holds "
+        f"{path / 'seqinfo.ini'}: image folder {images} {_not_there(images)} and {path} holds "
         f"{found} to read instead"
     )
 
@@ -734,18 +740,31 @@ def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
     if sequence is not None and sequence.folder == path:
         folder = path / sequence.image_dir
         if not folder.is_dir():
-            raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} does not exist")
+            raise ValueError(f"{path / 'seqinfo.ini'}: image folder {folder} {_not_there(folder)}")
         return folder
     if (path / "img1").is_dir():
         return path / "img1"
     return path
 
 
-def _no_images(folder: Path) -> str:
-    """The message for a folder source without images; one of videos says how to track them."""
+def _no_images(folder: Path, sequence: SequenceInfo | None = None) -> str:
+    """The message for a folder source without images; one of videos says how to track them.
+
+    An empty image folder of `sequence` beside the one video :func:`sequence_video` would read
+    without it (``SEQ/img1/``, ``SEQ/seqinfo.ini`` and ``SEQ/video.mp4``) says so.
+    """
     videos = video_files(folder)
     if not videos:
-        return f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+        none = f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+        if sequence is None or not (sequence.folder / "seqinfo.ini").is_file():
+            return none
+        beside = video_files(sequence.folder)
+        if len(beside) != 1:
+            return none
+        return (
+            f"{none}; {sequence.folder} holds a video, {beside[0].name}, read as the sequence's "
+            f"frames once the empty image folder is gone (or give {beside[0]})"
+        )
     names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
     if len(videos) == 1:
         return f"folder {folder} holds a video ({names}) and no images: give it ({videos[0]})"
@@ -775,6 +794,10 @@ def _cut_jpeg(path: Path) -> bool:
     except OSError:
         return False
     return _jpeg_ends(data) is False
+
+
+#: What libjpeg prints on stderr of a file that ends before its end marker (:func:`_cut_jpeg`).
+JPEG_CUT_NOTE = "Premature end of JPEG file"
 
 
 def _jpeg_ends(data: bytes) -> bool | None:
@@ -815,6 +838,35 @@ def _jpeg_ends(data: bytes) -> bool | None:
                     i = j
                     break
     return False
+
+
+def _unreadable(path: Path, notes: Sequence[str]) -> str:
+    """The error of image `path` of a folder that cannot be read, saying why.
+
+    An empty file (a copy that failed), a folder or a broken link named like an image, a file
+    that cannot be opened, or what its decoder said (`notes`, :func:`read_image`'s); were all
+    ``cannot read image P``.
+    """
+    try:
+        info = path.stat()
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+        if path.is_symlink() and exc.errno == errno.ENOENT:
+            why = f"a symbolic link to {os.readlink(path)}, which does not exist"
+    else:
+        if stat.S_ISDIR(info.st_mode):
+            why = "it is a folder"
+        elif info.st_size == 0:
+            why = "it is empty (0 bytes)"
+        elif notes:
+            why = f"its decoder says {'; '.join(dict.fromkeys(notes))!r}"
+        else:
+            why = "not an image OpenCV can decode (damaged?)"
+            try:
+                path.open("rb").close()
+            except OSError as exc:
+                why = exc.strerror or str(exc)
+    return f"cannot read image {path}: {why}"
 
 
 def image_files(folder: Path) -> list[Path]:
@@ -1057,6 +1109,7 @@ class FrameSource:
         self._depth_from = ""  # the images `bits` was decided from, for the clipping warning
         self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._cut_said = False  # a JPEG without its end marker: said once
+        self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_lost = False  # frames inside the video could not be decoded
         self._cap: Any = None
@@ -1136,7 +1189,9 @@ class FrameSource:
         folder = _image_folder(path, self.sequence)
         images = image_files(folder)
         if not images:
-            raise ValueError(_no_images(folder))
+            seq = self.sequence
+            own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
+            raise ValueError(_no_images(folder, seq if own and not any(folder.iterdir()) else None))
         videos = video_files(folder)
         if videos:  # was passed over without a word
             names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
@@ -1167,9 +1222,10 @@ class FrameSource:
         dark first image (a lens cap, a night start) does not decide it alone. 8-bit and
         full-range 16-bit images are read as OpenCV reads them, the same pixels as ever.
         """
-        first = read_image_depth(path)
+        unsaid: list[str] = []  # the decoders' notes: said when the images are read as frames
+        first = read_image_depth(path, notes=unsaid)
         if first is None:
-            raise ValueError(f"cannot read image {path}")
+            raise ValueError(_unreadable(path, unsaid))
         if first.dtype == np.uint8:  # the pixels read_image gives
             return first
         top = int(first.max()) if first.dtype == np.uint16 else 65535
@@ -1179,14 +1235,14 @@ class FrameSource:
         for k in sample[1:]:
             if _bit_depth(top) == 16:
                 break
-            other = read_image_depth(images[k])  # unreadable: refused when read, as ever
+            other = read_image_depth(images[k], notes=unsaid)  # unreadable: refused when read
             if other is not None and other.dtype == np.uint16 and int(other.max()) > top:
                 top, brightest = int(other.max()), images[k]
         bits = _bit_depth(top)
         if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
-            again = read_image(path)
+            again = read_image(path, notes=unsaid)
             if again is None:
-                raise ValueError(f"cannot read image {path}")
+                raise ValueError(_unreadable(path, unsaid))
             return again
         self.bits = bits
         self._depth_from = (
@@ -1276,16 +1332,17 @@ class FrameSource:
             note, self._depth_note = self._depth_note, None
             warnings.warn(note, UserWarning, stacklevel=3)
         img: NDArray[Any] | None
+        notes: list[str] = []  # what its decoder prints on stderr (libpng, libjpeg)
         if self.bits is None:
-            img = read_image(path)
+            img = read_image(path, notes=notes)
         else:
-            img = read_image_depth(path)
+            img = read_image_depth(path, notes=notes)
             if img is not None and img.dtype == np.uint16:
                 img = self._to_8_bits(img, path)
             elif img is not None and img.dtype != np.uint8:
-                img = read_image(path)
+                img = read_image(path, notes=notes)
         if img is None:
-            raise ValueError(f"cannot read image {path}")
+            raise ValueError(_unreadable(path, notes))
         if not self._cut_said and path.suffix.lower() in (".jpg", ".jpeg") and _cut_jpeg(path):
             self._cut_said = True
             warnings.warn(
@@ -1293,6 +1350,16 @@ class FrameSource:
                 "decoded as flat grey, and tracked as it is (said once a run)",
                 UserWarning,
                 stacklevel=4,  # the loop over the frames (through two generators)
+            )
+        for note in notes:  # each once a run, naming the image (was: on stderr, no file named)
+            if note in self._decoder_said or (self._cut_said and note == JPEG_CUT_NOTE):
+                continue  # a cut JPEG: said above
+            self._decoder_said.add(note)
+            warnings.warn(
+                f"image {path}: its decoder says {note!r} (the image is read all the same; "
+                "said once a run)",
+                UserWarning,
+                stacklevel=4,
             )
         if img.shape[:2] != self._image_shape:
             h0, w0 = self._image_shape

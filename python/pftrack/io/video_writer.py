@@ -137,9 +137,14 @@ class VideoWriter:
             self._stream = stream
             return
         candidates = ("MJPG",) if self.path.suffix.lower() == ".avi" else ("avc1", "mp4v")
+        # OpenCV's FFmpeg MJPG writer corrupts the heap on frames 2 or 6 pixels wide (the
+        # process aborts, "double free or corruption", unless the height is a multiple of
+        # 16): OpenCV's own MJPEG writer takes frames narrower than 8, wider ones as ever
         for fourcc in candidates:
+            api = cv2.CAP_OPENCV_MJPEG if fourcc == "MJPG" and w < 8 else cv2.CAP_ANY
             with contextlib.suppress(cv2.error), opencv_name(self._tmp) as name:  # any name
-                writer = cv2.VideoWriter(name, cv2.VideoWriter.fourcc(*fourcc), self.fps, (w, h))
+                code = cv2.VideoWriter.fourcc(*fourcc)
+                writer = cv2.VideoWriter(name, api, code, self.fps, (w, h))
                 if writer.isOpened():
                     self._cv = writer
                     self.codec = {"MJPG": "mjpeg", "avc1": "h264"}.get(fourcc, fourcc)

@@ -175,7 +175,11 @@ def _work(frames: Iterable[Any], call: Any,
     it = iter(frames)
     try:
         for item in it:
-            frame = np.asarray(item)  # the very object update() will be given
+            # the very object update() will be given, and uses as it is: an array packed
+            # (update() copies a view, frame[..., ::-1], which the thread would not have
+            # detected), anything else as it came, for update() to refuse in its words (a PIL
+            # image, RGB, made an array here was tracked as BGR)
+            frame = np.ascontiguousarray(item) if isinstance(item, np.ndarray) else item
             try:
                 # the very object update() hands the detector
                 work = frame if prepare is None else prepare(frame)

@@ -190,6 +190,7 @@ def track_frames(
     Raises
     ------
     TypeError
+        `source` is not a path, a FrameSource or a sequence of frames (an iterator, an int);
         `detections` is not a dict (a path, a list), a key is not an int, or a value does not
         hold real numbers; `rng` is not a Generator, an int or None (a float, a bool).
     ValueError
@@ -223,6 +224,7 @@ def track_frames(
         detections = _check_detections(detections)
     config = config if config is not None else TrackerConfig()
     frames = FrameSource(source) if isinstance(source, (str, os.PathLike)) else source
+    _check_frames(frames)
     if detections:
         _check_numbering(frames)
         # a FrameSource's count only when known: FFmpeg's estimate (Matroska's) may be short
@@ -294,6 +296,32 @@ def track_frames(
                 stacklevel=2,
             )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+
+
+def _check_frames(frames: object) -> None:
+    """Refuse a `source` that is neither a FrameSource nor a sequence of frames, naming it.
+
+    Were Python's words: "object of type 'generator' has no len()", "'int' object is not
+    iterable", and for bytes "prime frame is int".
+    """
+    if isinstance(frames, FrameSource) or (
+        hasattr(frames, "__len__")
+        and hasattr(frames, "__getitem__")
+        and not isinstance(frames, (bytes, bytearray))
+    ):
+        return
+    if isinstance(frames, (int, np.integer)):
+        hint = "; for a camera, FrameSource(index)"
+    elif isinstance(frames, (bytes, bytearray)):
+        hint = "; a path as a str"
+    elif hasattr(frames, "__iter__"):
+        hint = "; list(frames) for an iterator (the frames are read twice: to prime, to track)"
+    else:
+        hint = ""
+    raise TypeError(
+        f"track_frames: source is {type(frames).__name__}, expected a path, a FrameSource or "
+        f"a sequence of frames{hint}"
+    )
 
 
 def _check_numbering(frames: object) -> None:
