@@ -206,6 +206,8 @@ void register_histogram(py::module_& m) {
            const std::string& method) {
             const char* fn = "box_histograms";
             check_boxes(boxes, fn, "boxes");
+            require_size(static_cast<double>(boxes.rows()) * image.n_bins, fn,
+                         "the (K, B) histograms of " + std::to_string(boxes.rows()) + " boxes");
             const Kernel k = parse_kernel(kernel, fn);
             const BoxPath path = parse_method(method, fn);
             py::gil_scoped_release nogil;  // safe: Eigen views and the C++ image only

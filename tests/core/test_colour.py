@@ -74,6 +74,18 @@ def test_hsv_bins_of_a_strided_view(textured_frame):
     np.testing.assert_array_equal(hsv_bins(flipped).bins, ref.hsv_bins(flipped))
 
 
+def test_hsv_bins_of_rows_flipped_or_broadcast(textured_frame):
+    # pixels packed, rows at a negative or zero stride (np.flipud, np.broadcast_to): the core
+    # takes rows at a positive stride only; the wrapper copies (was "frame pixels must be
+    # packed", of pixels that are)
+    upside_down = textured_frame[::-1]
+    np.testing.assert_array_equal(hsv_bins(upside_down).bins, ref.hsv_bins(upside_down))
+    one_row = np.broadcast_to(textured_frame[:1], textured_frame.shape)
+    np.testing.assert_array_equal(hsv_bins(one_row).bins, ref.hsv_bins(one_row))
+    lazy = hsv_bins(upside_down, lazy=True)
+    np.testing.assert_array_equal(lazy.bins, ref.hsv_bins(upside_down))
+
+
 def test_pure_colours_land_in_expected_bins():
     frame = np.array([[[0, 0, 255], [0, 255, 0], [255, 0, 0], [0, 0, 0], [255, 255, 255]]],
                      dtype=np.uint8)  # fmt: skip

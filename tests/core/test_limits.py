@@ -18,8 +18,24 @@ PROBLEM = (I2, I2, I2, I2, np.zeros(2), I2, np.ones(2))
         lambda: _core.counter_uniforms(0, 0, 0, 2**62),
         lambda: _core.gdt_solve(*PROBLEM, 2**30),
         lambda: _core.gdt_sample(*PROBLEM, 100, 2**30, 0),
+        # n (n - 1) / 2 pairwise slopes: 5e9 for 100 000 points (was std::bad_alloc, a
+        # MemoryError, and the same from size_fit of as many samples)
+        lambda: _core.theil_sen(np.arange(100_000.0), np.arange(100_000.0)),
+        lambda: _core.size_fit(np.column_stack([np.arange(100_000.0)] * 3)),
+        # (K, B) histograms: 10 000 boxes of an image of 32 767 bins (was std::bad_alloc)
+        lambda: _core.box_histograms(
+            _core.BinnedImage(np.zeros((2, 2), np.int16), 32767), np.ones((10_000, 4))
+        ),
     ],
-    ids=["counter_normals", "counter_uniforms", "gdt_solve", "gdt_sample"],
+    ids=[
+        "counter_normals",
+        "counter_uniforms",
+        "gdt_solve",
+        "gdt_sample",
+        "theil_sen",
+        "size_fit",
+        "box_histograms",
+    ],
 )
 def test_huge_sizes_are_refused_not_allocated(call) -> None:
     with pytest.raises(ValueError, match="more than the limit"):

@@ -44,6 +44,9 @@ inline double median_of(std::vector<double>& v) {
 /// Theil-Sen line through (x, y): the median of the slopes over every pair with distinct x,
 /// intercept median(y - slope x). Throws std::invalid_argument when no two x differ.
 inline std::pair<double, double> theil_sen(const double* x, const double* y, Index n) {
+    // 0.5 n (n - 1) in double: the count cannot overflow before it is checked
+    require_size(0.5 * static_cast<double>(n) * static_cast<double>(n - 1), "theil_sen",
+                 "the pairwise slopes of " + std::to_string(n) + " points");
     std::vector<double> s;
     s.reserve(static_cast<std::size_t>(n > 1 ? n * (n - 1) / 2 : 0));
     for (Index i = 0; i < n; ++i)

@@ -737,8 +737,8 @@ inline RowMatrixXd gdt_recover_batch(const Eigen::Ref<const RowMatrixXd>& seg_a,
     require(seg_a.cols() == m + 1 && seg_b.cols() == m + 1, fn,
             "segments must have columns (frame, position...)");
     require(a_len.size() == b_len.size(), fn, "len(b_len)", b_len.size(), a_len.size());
-    require(a_len.sum() == seg_a.rows(), fn, "sum(a_len)", a_len.sum(), seg_a.rows());
-    require(b_len.sum() == seg_b.rows(), fn, "sum(b_len)", b_len.sum(), seg_b.rows());
+    require_lengths(a_len, seg_a.rows(), fn, "a_len");
+    require_lengths(b_len, seg_b.rows(), fn, "b_len");
     require(history >= 1, fn, "history", history, ">= 1");
     require_finite(seg_a, fn, "seg_a");
     require_finite(seg_b, fn, "seg_b");

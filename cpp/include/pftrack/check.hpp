@@ -42,6 +42,28 @@ inline void require_size(double count, const char* fn, const std::string& what) 
     fail(fn, s.str());
 }
 
+/// Run lengths of rows stacked into one array of `total` rows: every length >= 0 and their sum
+/// `total`, summed in 64 bits (an int32 sum wraps: lengths {2^31 - 1, 2^31 - 1, 8} passed a check
+/// against 6 rows, then a run read far past the end, or its scratch ended in bad_alloc).
+inline void require_lengths(const Eigen::Ref<const Eigen::VectorXi>& lengths, Eigen::Index total,
+                            const char* fn, const char* what) {
+    long long sum = 0;
+    for (Eigen::Index i = 0; i < lengths.size(); ++i) {
+        if (lengths(i) < 0) {
+            std::ostringstream s;
+            s << what << "[" << i << "] is " << lengths(i) << ", expected >= 0";
+            fail(fn, s.str());
+        }
+        sum += lengths(i);
+    }
+    if (sum != static_cast<long long>(total)) {
+        std::ostringstream s;
+        s << "sum(" << what << ") is " << sum << ", expected " << total
+          << " (the rows they split)";
+        fail(fn, s.str());
+    }
+}
+
 /// Every entry finite; the message gives the first bad position.
 template <class Derived>
 inline void require_finite(const Eigen::DenseBase<Derived>& a, const char* fn, const char* what) {

@@ -323,8 +323,7 @@ inline Eigen::VectorXd state_loglik_batch(const Eigen::Ref<const Eigen::VectorXd
     require(d == 2 || d == 3, fn, "state dimension (cols of F)", d, "2 or 3");
     require(F.rows() == K * d && Q.rows() == K * d && Q.cols() == d, fn,
             "F and Q must be (K * d, d) with K = len(r)");
-    require(lengths.size() == 0 || lengths.minCoeff() >= 0, fn, "lengths must be >= 0");
-    require(lengths.sum() == z.size(), fn, "sum(lengths)", lengths.sum(), z.size());
+    require_lengths(lengths, z.size(), fn, "lengths");
     require_finite(z, fn, "z");
     require_finite(F, fn, "F");
     require_finite(Q, fn, "Q");

@@ -25,7 +25,7 @@ inline Eigen::VectorXd noise_loglik_grid(const Eigen::Ref<const Eigen::VectorXd>
                                          const Eigen::Ref<const Eigen::VectorXd>& r) {
     const char* fn = "noise_loglik_grid";
     require(q.size() == r.size(), fn, "len(r)", r.size(), q.size());
-    require(lengths.sum() == z.size(), fn, "sum(lengths)", lengths.sum(), z.size());
+    require_lengths(lengths, z.size(), fn, "lengths");
     require_finite(z, fn, "z");
     for (Index g = 0; g < q.size(); ++g)
         require(q(g) > 0 && r(g) > 0 && std::isfinite(q(g)) && std::isfinite(r(g)), fn,

@@ -78,7 +78,9 @@ class HsvBinning:
 
 def _frame(frame: ArrayLike, name: str = "frame") -> NDArray[np.uint8]:
     f = bgr_array(frame, name)
-    if f.strides[2] != 1 or f.strides[1] != 3:
+    # the core reads packed pixels in rows at a positive stride (a crop of a larger image is
+    # fine): anything else, a flipped (``frame[::-1]``) or broadcast frame too, is copied once
+    if f.strides[2] != 1 or f.strides[1] != 3 or f.strides[0] <= 0:
         f = np.ascontiguousarray(f)
     return f
 
