@@ -37,6 +37,26 @@ def test_matches_reference(seed: int) -> None:
         np.testing.assert_array_equal(got_bool, want)
 
 
+def test_a_flipped_or_broadcast_mask_is_refined_as_its_copy() -> None:
+    # was: ValueError "refine_boxes: mask must be packed along rows" for mask[::-1] (a
+    # negative row stride) and np.broadcast_to (a zero one), whose pixels are packed
+    rng = np.random.default_rng(3)
+    mask = _scene(rng)
+    boxes = np.column_stack(
+        [rng.uniform(0, 100, 20), rng.uniform(0, 70, 20), rng.uniform(5, 40, (20, 2))]
+    )
+    flipped = mask[::-1]
+    np.testing.assert_array_equal(
+        refine_boxes(boxes, flipped, 0.05, 0.1),
+        refine_boxes_reference(boxes, np.ascontiguousarray(flipped), 0.05, 0.1),
+    )
+    row = np.broadcast_to(mask[40], mask.shape)
+    np.testing.assert_array_equal(
+        refine_boxes(boxes, row, 0.05, 0.1),
+        refine_boxes_reference(boxes, np.ascontiguousarray(row), 0.05, 0.1),
+    )
+
+
 def _shaded(rng: np.random.Generator, rows: int = 90, cols: int = 120) -> np.ndarray:
     """The same with shadow pixels (127): patches of shadow, some of them below an object."""
     mask = _scene(rng, rows, cols)

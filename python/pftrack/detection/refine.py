@@ -73,7 +73,9 @@ def refine_boxes(
     if not np.isfinite(b).all():
         raise ValueError("boxes_xywh contains NaN or inf")
     m = np.asarray(mask)
-    if m.ndim == 2 and m.strides[1] != 1:
+    if m.ndim == 2 and (m.strides[1] != 1 or m.strides[0] <= 0):
+        # the core reads rows of packed pixels at a positive stride: a flipped (mask[::-1]) or
+        # broadcast mask is copied once (was: refused as "must be packed along rows")
         m = np.ascontiguousarray(m)
     fill = None if leg_fill is None else float(leg_fill)
     out: F64 = _core.refine_boxes(b, m, float(fraction), float(min_cover), fill, float(min_height))
