@@ -2255,6 +2255,49 @@ def test_a_path_a_worker_cannot_see_is_said_so(data: Path, client: Any, tmp_path
     assert entry["error"] == f"video source not found: {gone.frames}" and entry["host"] == host
 
 
+def _worker_sees_other_files(grown: int) -> None:
+    """On a worker: its view of every input is `grown` bytes larger than the client's (0: undo)."""
+    from pftrack.batch import engine
+
+    if not hasattr(engine, "_real_fingerprint"):
+        engine._real_fingerprint = engine.fingerprint  # type: ignore[attr-defined]
+    real = engine._real_fingerprint  # type: ignore[attr-defined]
+
+    def other(paths: Any) -> list[dict[str, Any]]:
+        return [{**p, "size": p["size"] + grown} if "size" in p else p for p in real(paths)]
+
+    engine.fingerprint = other if grown else real  # type: ignore[assignment]
+
+
+def test_a_worker_that_reads_other_files_fails_the_task(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    """A user trial: a worker whose copy of the inputs differed (another video, fewer images
+    under the same path) reported the sequence done with its own frames, and its sidecar
+    vouched for the client's file, so a re-run skipped it; a file the worker could not decode
+    said "not a video", of a video the client can read."""
+    assert client.run(_worker_sees_other_files, 100)
+    try:
+        summary = track_many(data, tmp_path / "out", client, options=TrackOptions(config=_config()))
+    finally:
+        client.run(_worker_sees_other_files, 0)
+    host = socket.gethostname()
+    by_name = {e["name"]: e for e in summary.entries}
+    walk = by_name["walk"]
+    assert walk["status"] == "failed" and walk["host"] == host
+    size = (data / "walk.avi").stat().st_size
+    assert walk["error"] == (
+        f"{data / 'walk.avi'}: another file on worker {host} ({size + 100} bytes there, {size} "
+        "here): workers must see the same files at the same paths"
+    )
+    plain = by_name["plain"]
+    assert plain["status"] == "failed" and "another folder on worker" in plain["error"]
+    assert not list((tmp_path / "out").glob("*.txt"))  # no output of what the client has not
+    # the same files: done, and the worker's view is not taken in this process
+    again = track_many(data, tmp_path / "out", client, options=TrackOptions(config=_config()))
+    assert [e["status"] for e in again.entries] == ["done"] * 3
+
+
 def test_a_broken_link_in_a_scanned_folder_fails_alone(
     data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

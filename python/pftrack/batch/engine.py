@@ -1303,6 +1303,9 @@ class Outcome(NamedTuple):
         The task failed on a file it could not find (``FileNotFoundError``): the file's name
         if the error carries one, else ``""``. The client tells a file its worker cannot see
         from one that does not exist (:func:`_failure`).
+    seen : list of dict or None
+        On a Dask worker: the :func:`fingerprint` of the task's inputs as the worker saw them
+        before it ran, which the client compares with its own (:func:`_seen_otherwise`).
     """
 
     result: TaskResult | None
@@ -1310,6 +1313,7 @@ class Outcome(NamedTuple):
     traceback: str | None = None
     host: str | None = None
     missing: str | None = None
+    seen: list[dict[str, Any]] | None = None
 
 
 def _worker_stop() -> Callable[[], None] | None:
@@ -1343,6 +1347,7 @@ def call_task(
     func: Callable[..., TaskResult],
     args: tuple[Any, ...],
     progress: Callable[[int], None] | tuple[str, str] | None = None,
+    reads: Sequence[Path] | None = None,
 ) -> Outcome:
     """Run one task; an exception comes back as data (its line and traceback), not raised.
 
@@ -1359,7 +1364,13 @@ def call_task(
     On a Dask worker the task also stops itself once its future is cancelled (Ctrl-C on the
     client): every 25 frames it looks (:func:`_worker_stop`), and ends with
     :class:`~pftrack.batch.tasks.TaskCancelled`, its worker free for other work.
+
+    With `reads` (the job's inputs, given on Dask), the outcome carries their
+    :func:`fingerprint` as this process sees them, taken before the task reads them, and the
+    host: the client tells a worker that sees other files than its own (:func:`_seen_otherwise`).
     """
+    seen = fingerprint(reads) if reads is not None else None
+    host = _host() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
     with warnings.catch_warnings(record=True) as caught, reporting_frames(report, stop):
@@ -1370,11 +1381,11 @@ def call_task(
             missing = None
             if isinstance(exc, FileNotFoundError):
                 missing = str(exc.filename) if exc.filename else ""
-            return Outcome(None, one_line(exc), traceback.format_exc(), _host(), missing)
+            return Outcome(None, one_line(exc), traceback.format_exc(), _host(), missing, seen)
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
-    return Outcome(result)
+    return Outcome(result, host=host, seen=seen)
 
 
 def _host() -> str:
@@ -1383,6 +1394,41 @@ def _host() -> str:
 
 #: How the client words a file that a worker could not find but the client can.
 UNSEEN = "not found on worker {host} (the client sees it: workers must see the same paths)"
+
+
+def _seen_otherwise(here: list[dict[str, Any]], outcome: Outcome) -> str | None:
+    """Why the worker of `outcome` read other inputs than this process sees (`here`), or None.
+
+    Compared: whether each input exists, a file's size, a folder's number of images and their
+    total size; not the times (a copy made on each machine has its own). Was: a worker whose
+    copy differed (another video, fewer images under the same path) reported the sequence
+    done with its own frames, written as the client's and skipped as complete by a re-run.
+    """
+    if outcome.seen is None or outcome.host is None or len(outcome.seen) != len(here):
+        return None
+    for mine, theirs in zip(here, outcome.seen, strict=True):
+        if mine.get("missing"):
+            continue  # the task fails (or not) on its own, as it would in this process
+        path = mine["path"]
+        if theirs.get("missing"):
+            return f"{path}: {UNSEEN.format(host=outcome.host)}"
+        counted = (theirs.get("files"), theirs.get("size"))
+        if "files" in mine and (mine["files"], mine["size"]) != counted:
+            return (
+                f"{path}: another folder on worker {outcome.host} ({theirs.get('files')} "
+                f"images, {theirs.get('size')} bytes there; {mine['files']} images, "
+                f"{mine['size']} bytes here): {SAME_FILES}"
+            )
+        if "files" not in mine and mine.get("size") != theirs.get("size"):
+            return (
+                f"{path}: another file on worker {outcome.host} ({theirs.get('size')} bytes "
+                f"there, {mine.get('size')} here): {SAME_FILES}"
+            )
+    return None
+
+
+#: How the client ends the error of a task whose worker read other inputs than it sees.
+SAME_FILES = "workers must see the same files at the same paths"
 
 
 def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
@@ -1635,6 +1681,9 @@ def run_jobs(
 
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
+        other = _seen_otherwise(prints[job.name], outcome) if remote else None
+        if other is not None:  # not written: the outputs of files this process does not have
+            outcome = Outcome(None, other, outcome.traceback, outcome.host)
         if outcome.result is not None:
             try:
                 entries[job.name] = _write(
@@ -2056,7 +2105,7 @@ def _run_on_dask(
     for job in sendable:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
         where = (topic, job.name) if frames is not None else None
-        fut = c.submit(call_task, job.func, job.args, where, key=key, pure=False)
+        fut = c.submit(call_task, job.func, job.args, where, job.reads, key=key, pure=False)
         futures[fut.key] = (fut, job)
     watch = _WorkersWatch(c, address, wait)
     noun = "sequence" if kind == "track" else "file"
