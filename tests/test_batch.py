@@ -1051,6 +1051,60 @@ def test_a_port_that_says_nothing_is_no_scheduler(
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize(
+    ("greeting", "said"),
+    [
+        (b"\x01", "began to answer but did not finish Dask's handshake within 1 s (a frozen or "
+         "overloaded scheduler, or no Dask server)"),
+        (b"hello garbage\n", "answered in a protocol that is not Dask's"),
+    ],
+)  # fmt: skip
+def test_a_port_that_answers_half_or_in_another_protocol_is_no_scheduler(
+    greeting: bytes,
+    said: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A user trial: a server that sent one byte and then nothing held the batch for ever
+    (Dask's connect timeout does not cover its handshake), one that greeted in another
+    protocol said "MemoryError: Unable to allocate 6.09 EiB for an array"."""
+    from pftrack.batch import engine
+
+    monkeypatch.setattr(engine, "GREETING_WAIT", 1.0)
+    _tracks_files(tmp_path / "tracks")
+    held: list[socket.socket] = []
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(8)
+
+        def serve() -> None:
+            with contextlib.suppress(OSError):
+                while True:
+                    conn, _ = listener.accept()
+                    held.append(conn)
+                    conn.sendall(greeting)
+
+        threading.Thread(target=serve, daemon=True).start()
+        address = f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+        argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+        status: list[int] = []
+        run = threading.Thread(target=lambda: status.append(main([*argv, "--scheduler", address])))
+        run.daemon = True
+        run.start()
+        run.join(30)
+        for conn in held:
+            conn.close()
+    assert status == [2]
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"pftrack recover: error: cannot connect to the Dask scheduler at {address}: port "
+        f"{address.rpartition(':')[2]} of 127.0.0.1 {said}"
+    ), err
+    assert err.count("\n") == 1
+    assert not (tmp_path / "out").exists()
+
+
 class _Quiet(http.server.SimpleHTTPRequestHandler):
     """``python -m http.server``'s handler, without its log lines on stderr."""
 

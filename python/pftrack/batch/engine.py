@@ -429,7 +429,7 @@ def _refused(address: str) -> str | None:
     while True:
         try:
             with socket.create_connection((host, port), timeout=REFUSED_GRACE) as sock:
-                return _silent(sock, host, port)
+                return _silent(sock, host, port, address)
         except socket.gaierror:
             return f"host {host} not found (its name does not resolve)"
         except ConnectionRefusedError:
@@ -468,29 +468,34 @@ HTTP_ASK_AFTER = 2.0
 HTTP_WAIT = 2.0
 
 
-def _silent(sock: socket.socket, host: str, port: int) -> str | None:
+def _silent(sock: socket.socket, host: str, port: int, address: str) -> str | None:
     """Why the server at the other end of `sock` is no Dask scheduler: it says nothing.
 
     Silent for :data:`HTTP_ASK_AFTER` seconds, the port is asked, on a connection of its own,
     whether it speaks HTTP (:func:`_http_server`): the dashboard's port, or any web server, is
     then named as such at once (was: after Dask's whole connect timeout, 30 s, with a guess).
-    Otherwise the rest of the wait is waited for a greeting.
+    Otherwise the rest of the wait is waited for a greeting, and a greeting must be Dask's
+    whole handshake, within the same wait (:func:`_handshake`).
     """
     wait = _greeting_wait()
     start = time.monotonic()
+
+    def left() -> float:
+        return max(wait - (time.monotonic() - start), 0.001)
+
     sock.settimeout(min(wait, HTTP_ASK_AFTER))
     try:
         try:
             if sock.recv(1):
-                return None
+                return _handshake(address, host, port, left(), wait)
             said = "closed the connection without a word"
         except TimeoutError:
             http = _http_server(host, port, max(min(HTTP_WAIT, wait - HTTP_ASK_AFTER), 0.2))
             if http is not None:
                 return http
-            sock.settimeout(max(wait - (time.monotonic() - start), 0.001))
+            sock.settimeout(left())
             if sock.recv(1):
-                return None
+                return _handshake(address, host, port, left(), wait)
             said = "closed the connection without a word"
     except TimeoutError:
         said = f"said nothing within {wait:g} s"
@@ -499,6 +504,50 @@ def _silent(sock: socket.socket, host: str, port: int) -> str | None:
     return (
         f"port {port} of {host} accepted the connection but {said}, as no Dask scheduler "
         "does (the dashboard's port? a scheduler listens on 8786 unless told otherwise)"
+    )
+
+
+def _handshake(address: str, host: str, port: int, timeout: float, wait: float) -> str | None:
+    """Why the server at `address`, which began to greet, is no Dask server; None if it is one.
+
+    Dask's own connection (``distributed.comm.connect``) within `timeout` seconds, in a thread
+    of its own with its own event loop (the caller may run one): Dask waits for the rest of a
+    greeting without a time limit, so a server that sent a byte and then nothing held
+    ``Client(address)`` for ever, and one that greeted in another protocol failed with
+    "MemoryError: Unable to allocate 6.09 EiB" (user trials). `wait` is the whole wait, as the
+    message states it.
+    """
+    import asyncio
+
+    from distributed.comm.core import connect
+
+    async def greet() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        await comm.close()
+
+    failed: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            asyncio.run(greet())
+        except BaseException as exc:  # noqa: BLE001 - told below, whatever Dask raised
+            failed.append(exc)
+
+    thread = threading.Thread(target=run, name="pftrack-handshake", daemon=True)
+    thread.start()
+    thread.join(timeout + 1.0)
+    if not thread.is_alive() and not failed:
+        return None
+    if thread.is_alive() or isinstance(failed[0], (TimeoutError, asyncio.TimeoutError)):
+        return (
+            f"port {port} of {host} began to answer but did not finish Dask's handshake within "
+            f"{wait:g} s (a frozen or overloaded scheduler, or no Dask server)"
+        )
+    if isinstance(failed[0], OSError):
+        return None  # reset, closed, or the like: Dask's own connection says what it finds
+    return (
+        f"port {port} of {host} answered in a protocol that is not Dask's "
+        f"({type(failed[0]).__name__} on its greeting): no Dask scheduler listens there"
     )
 
 
