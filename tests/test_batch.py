@@ -2137,6 +2137,44 @@ def test_workers_without_pftrack_are_one_line_before_anything(
     assert not out.exists()
 
 
+def _set_version(version: str) -> str:
+    """On a worker: give its pftrack another release number; return the one it had."""
+    import pftrack
+
+    was, pftrack.__version__ = pftrack.__version__, version
+    return was
+
+
+def test_workers_of_another_pftrack_release_are_one_line_before_anything(
+    client: Any, tmp_path: Path
+) -> None:
+    """A user trial: workers with another pftrack release tracked every sequence, written as
+    this release's (the sidecar names the client's release, so a re-run skipped them) and
+    unlike ``pftrack track`` here."""
+    import pftrack
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    address = client.scheduler.address
+    (_, second) = sorted(client.scheduler_info()["workers"])
+    client.run(_set_version, "9.9.9", workers=[second])
+    try:
+        with pytest.raises(ImportError) as caught:
+            smooth_many(tmp_path / "tracks", out, client)
+        assert str(caught.value) == (
+            f"1 of the 2 workers ({second}) at {address} run pftrack 9.9.9, this is pftrack "
+            f"{pftrack.__version__}: install the same pftrack where this process and every "
+            "worker run (a batch's outputs are those of one release)"
+        )
+        assert caught.value.name == "pftrack"
+        assert not out.exists()
+    finally:
+        client.run(_set_version, pftrack.__version__)
+    assert [e["status"] for e in smooth_many(tmp_path / "tracks", out, client).entries] == [
+        "done"
+    ] * 3
+
+
 def test_a_scheduler_without_pftrack_is_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

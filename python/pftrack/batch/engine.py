@@ -707,7 +707,9 @@ def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
     ------
     ImportError
         One line naming the scheduler's address (and the workers that failed), the import
-        error, and what to do (``name`` is ``"pftrack"``).
+        error, and what to do (``name`` is ``"pftrack"``); or the workers that run another
+        pftrack release than this process (their outputs would be another release's, named
+        as this one's in the sidecars).
     """
     if scheduler:
         try:
@@ -729,6 +731,22 @@ def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
         )
         raise ImportError(
             f"{which} at {address} cannot import pftrack ({one_line(first)}): {INSTALL_EVERYWHERE}",
+            name="pftrack",
+        )
+    # another release may track otherwise, and the sidecars name this one's (a user trial)
+    releases = c.run(eval, "__import__('pftrack').__version__", on_error="return")
+    other = {w: v for w, v in releases.items() if v != _version()}
+    if other:
+        shown = ", ".join(sorted({str(v) for v in other.values()}))
+        which = (
+            "the workers"
+            if len(other) == len(releases)
+            else f"{len(other)} of the {len(releases)} workers ({', '.join(sorted(other))})"
+        )
+        raise ImportError(
+            f"{which} at {address} run pftrack {shown}, this is pftrack {_version()}: install "
+            "the same pftrack where this process and every worker run (a batch's outputs are "
+            "those of one release)",
             name="pftrack",
         )
 
