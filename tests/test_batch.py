@@ -2390,6 +2390,32 @@ def test_a_worker_that_reads_other_files_fails_the_task(
     assert [e["status"] for e in again.entries] == ["done"] * 3
 
 
+def test_an_input_changed_while_the_batch_ran_is_not_a_workers_other_file(
+    tmp_path: Path,
+) -> None:
+    """The worker's view is compared with this process's view now, too: an input changed
+    after the batch began (the same file on a local cluster) is no worker seeing other files."""
+    from pftrack.batch.engine import Outcome, _seen_otherwise, fingerprint
+
+    video = tmp_path / "walk.avi"
+    video.write_bytes(b"x" * 10)
+    job = Job("walk", track_sequence_stub, (), (video,))
+    before = fingerprint([video])
+    video.write_bytes(b"x" * 20)  # after the client's fingerprint, before the worker's
+    outcome = Outcome(None, host="node7", seen=fingerprint([video]))
+    assert _seen_otherwise(job, outcome, before) is None
+    other = Outcome(None, host="node7", seen=[{**before[0], "size": 30}])
+    assert _seen_otherwise(job, other, before) == (
+        f"{video}: another file on worker node7 (30 bytes there, 20 here): workers must see "
+        "the same files at the same paths"
+    )
+
+
+def track_sequence_stub() -> TaskResult:
+    """A task function for jobs that never run."""
+    raise AssertionError("not run")
+
+
 def test_a_broken_link_in_a_scanned_folder_fails_alone(
     data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

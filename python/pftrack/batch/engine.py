@@ -1463,33 +1463,44 @@ def _host() -> str:
 UNSEEN = "not found on worker {host} (the client sees it: workers must see the same paths)"
 
 
-def _seen_otherwise(here: list[dict[str, Any]], outcome: Outcome) -> str | None:
-    """Why the worker of `outcome` read other inputs than this process sees (`here`), or None.
+def _seen_otherwise(job: Job, outcome: Outcome, here: list[dict[str, Any]]) -> str | None:
+    """Why the worker of `outcome` read other inputs than this process sees, or None.
 
-    Compared: whether each input exists, a file's size, a folder's number of images and their
-    total size; not the times (a copy made on each machine has its own). Was: a worker whose
-    copy differed (another video, fewer images under the same path) reported the sequence
-    done with its own frames, written as the client's and skipped as complete by a re-run.
+    `here`: the :func:`fingerprint` of ``job.reads`` taken before the tasks ran. Compared:
+    whether each input exists, a file's size, a folder's number of images and their total
+    size; not the times (a copy made on each machine has its own). An input that differs from
+    `here` but not from what this process sees now changed while the batch ran: not the
+    worker's view (its sidecar keeps `here`, so a re-run redoes it). Was: a worker whose copy
+    differed (another video, fewer images under the same path) reported the sequence done with
+    its own frames, written as the client's and skipped as complete by a re-run.
     """
-    if outcome.seen is None or outcome.host is None or len(outcome.seen) != len(here):
+    seen, host = outcome.seen, outcome.host
+    if seen is None or host is None or len(seen) != len(here):
         return None
-    for mine, theirs in zip(here, outcome.seen, strict=True):
+    if _difference(here, seen, host) is None:
+        return None
+    return _difference(fingerprint(job.reads), seen, host)  # changed meanwhile: None
+
+
+def _difference(here: list[dict[str, Any]], seen: list[dict[str, Any]], host: str) -> str | None:
+    """The first input whose fingerprints `here` and `seen` (on worker `host`) differ, said."""
+    for mine, theirs in zip(here, seen, strict=True):
         if mine.get("missing"):
             continue  # the task fails (or not) on its own, as it would in this process
         path = mine["path"]
         if theirs.get("missing"):
-            return f"{path}: {UNSEEN.format(host=outcome.host)}"
+            return f"{path}: {UNSEEN.format(host=host)}"
         counted = (theirs.get("files"), theirs.get("size"))
         if "files" in mine and (mine["files"], mine["size"]) != counted:
             return (
-                f"{path}: another folder on worker {outcome.host} ({theirs.get('files')} "
-                f"images, {theirs.get('size')} bytes there; {mine['files']} images, "
-                f"{mine['size']} bytes here): {SAME_FILES}"
+                f"{path}: another folder on worker {host} ({theirs.get('files')} images, "
+                f"{theirs.get('size')} bytes there; {mine['files']} images, {mine['size']} "
+                f"bytes here): {SAME_FILES}"
             )
         if "files" not in mine and mine.get("size") != theirs.get("size"):
             return (
-                f"{path}: another file on worker {outcome.host} ({theirs.get('size')} bytes "
-                f"there, {mine.get('size')} here): {SAME_FILES}"
+                f"{path}: another file on worker {host} ({theirs.get('size')} bytes there, "
+                f"{mine.get('size')} here): {SAME_FILES}"
             )
     return None
 
@@ -1748,7 +1759,7 @@ def run_jobs(
 
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
-        other = _seen_otherwise(prints[job.name], outcome) if remote else None
+        other = _seen_otherwise(job, outcome, prints[job.name]) if remote else None
         if other is not None:  # not written: the outputs of files this process does not have
             outcome = Outcome(None, other, outcome.traceback, outcome.host)
         if outcome.result is not None:
