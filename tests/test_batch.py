@@ -2092,6 +2092,49 @@ sys.modules["pftrack"] = None
 """
 
 
+@pytest.mark.parametrize(
+    ("key", "variable", "example"),
+    [
+        ("distributed.comm.timeouts.connect", "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT", "30s"),
+        ("distributed.scheduler.no-workers-timeout",
+         "DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT", "60s"),
+    ],
+)  # fmt: skip
+@pytest.mark.parametrize("where", ["local", "scheduler"])
+def test_a_dask_wait_that_is_no_duration_is_one_line(
+    key: str,
+    variable: str,
+    example: str,
+    where: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A user trial: ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=abc`` (a setting the help
+    names) gave Dask's traceback ("KeyError: 'Invalid time unit: abc ...'"), with a local
+    cluster ("Cluster failed to start") or a scheduler; so did the no-workers wait locally."""
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(out)]
+    if where == "scheduler":  # a port that says nothing: the connect timeout is read first
+        listener = socket.socket()
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(4)
+        argv += ["--scheduler", f"tcp://127.0.0.1:{listener.getsockname()[1]}"]
+    try:
+        with dask.config.set({key: "abc"}):
+            assert main(argv) == 2
+    finally:
+        if where == "scheduler":
+            listener.close()
+    assert capsys.readouterr().err == (
+        f"pftrack recover: error: {key} is 'abc' (${variable}), expected a duration such as "
+        f"'{example}'\n"
+    )
+    assert not out.exists()
+
+
 def test_workers_without_pftrack_are_one_line_before_anything(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -315,7 +315,8 @@ def dask_client(
         `client` is not a ``distributed.Client`` (an address goes in `scheduler`).
     ValueError
         A malformed or empty address; `client`, `scheduler` and `n_workers` that contradict
-        each other (more than one given, or ``n_workers`` < 1).
+        each other (more than one given, or ``n_workers`` < 1); Dask's connect timeout or
+        no-workers timeout that is not a duration (:func:`dask_seconds`).
     OSError
         The scheduler cannot be reached within Dask's ``distributed.comm.timeouts.connect``
         (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``), or Dask cannot
@@ -337,6 +338,9 @@ def dask_client(
     address = where_to_run(client, scheduler, n_workers)
     if n_workers is not None and n_workers < 1:
         raise ValueError(f"n_workers is {n_workers}, expected >= 1 for a cluster")
+    # the waits this reads, and a local cluster's scheduler too: checked before any is used
+    dask_seconds("distributed.comm.timeouts.connect", "30s")
+    no_workers_timeout()
     if client is not None:
         check_pftrack(client, _address_of(client))
         _register(client, SingleThreaded(), _address_of(client))
@@ -455,11 +459,8 @@ GREETING_WAIT: float | None = None
 def _greeting_wait() -> float:
     if GREETING_WAIT is not None:
         return GREETING_WAIT
-    import dask
-    from dask.utils import parse_timedelta
-
-    wait = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s")
-    return float(wait) if wait else 30.0
+    wait = dask_seconds("distributed.comm.timeouts.connect", "30s")
+    return wait if wait else 30.0
 
 
 #: Seconds of silence after which :func:`_silent` asks the port whether it speaks HTTP (a
@@ -1909,19 +1910,36 @@ def no_workers_timeout() -> float:
     ValueError
         The setting is not a duration.
     """
+    seconds = dask_seconds("distributed.scheduler.no-workers-timeout", "60s")
+    return NO_WORKERS_WAIT if seconds is None else seconds
+
+
+def dask_seconds(key: str, example: str) -> float | None:
+    """Dask's duration setting `key`, in seconds; None when it is not set.
+
+    Raises
+    ------
+    ValueError
+        The setting is not a finite duration >= 0: one line naming it, its environment
+        variable and an `example` (was: Dask's traceback, "KeyError: 'Invalid time unit: abc
+        ...'", from the connection or from a local cluster's start, for a setting the help
+        names).
+    """
     import dask
     from dask.utils import parse_timedelta
 
-    key = "distributed.scheduler.no-workers-timeout"
     value = dask.config.get(key, None)
     if value is None:
-        return NO_WORKERS_WAIT
+        return None
     try:
         seconds = float(parse_timedelta(value, default="s"))
     except (TypeError, ValueError, KeyError):
         seconds = math.nan
     if not seconds >= 0 or math.isinf(seconds):
-        raise ValueError(f"{key} is {value!r}, expected a duration such as '60s'")
+        variable = "DASK_" + key.upper().replace(".", "__").replace("-", "_")
+        raise ValueError(
+            f"{key} is {value!r} (${variable}), expected a duration such as '{example}'"
+        )
     return seconds
 
 
