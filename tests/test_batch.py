@@ -2135,6 +2135,27 @@ def test_a_dask_wait_that_is_no_duration_is_one_line(
     assert not out.exists()
 
 
+def test_a_local_cluster_that_cannot_start_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: Dask's temporary folder under a file (``DASK_TEMPORARY_DIRECTORY``) gave
+    a 60-line traceback ending in "RuntimeError: Cluster failed to start", exit status 1."""
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    (tmp_path / "file").write_text("")
+    out = tmp_path / "out"
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(out), "--workers", "1"]
+    with dask.config.set({"temporary-directory": str(tmp_path / "file" / "x")}):
+        assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "pftrack recover: error: cannot start a local Dask cluster of 1 worker: [Errno 20] Not "
+        f"a directory: '{tmp_path / 'file' / 'x'}'\n"
+    ), err
+    assert not out.exists()
+
+
 def test_workers_without_pftrack_are_one_line_before_anything(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -326,6 +326,8 @@ def dask_client(
         class UCXConnector", naming neither). An address that is an HTTP server's (the
         dashboard's) or a Dask worker's is said to be one, with the scheduler's address where
         it tells it (:func:`_http_server`, :func:`_dask_server`).
+        A local cluster that cannot start (Dask's temporary folder not writable, say): one
+        line, Dask's cause.
     ImportError
         The scheduler or the workers cannot import pftrack (:func:`check_pftrack`).
     """
@@ -375,19 +377,27 @@ def dask_client(
         # caller's script again
         with _interrupts_held(), _main_left_out():
             stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
-            cluster = stack.enter_context(
-                LocalCluster(
-                    n_workers=n,
-                    threads_per_worker=1,
-                    processes=True,
-                    host="127.0.0.1",
-                    silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks
-                    dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not
-                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # 8787: many batches
+            try:
+                cluster = stack.enter_context(
+                    LocalCluster(
+                        n_workers=n,
+                        threads_per_worker=1,
+                        processes=True,
+                        host="127.0.0.1",
+                        silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks
+                        dashboard_address=None,  # no dashboard; its HTTP routes on a free port,
+                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # not 8787
+                    )
                 )
-            )
-            c = stack.enter_context(Client(cluster))
-            c.register_plugin(SingleThreaded(ignore_interrupt=True))
+                c = stack.enter_context(Client(cluster))
+                c.register_plugin(SingleThreaded(ignore_interrupt=True))
+            except Exception as exc:  # noqa: BLE001 - whatever stopped Dask: one line
+                # was: Dask's traceback, "RuntimeError: Cluster failed to start: ..." (its
+                # temporary folder under a file, say); the cause says what failed
+                cause = exc.__cause__ if isinstance(exc.__cause__, Exception) else exc
+                raise OSError(
+                    f"cannot start a local Dask cluster of {_count(n, 'worker')}: {one_line(cause)}"
+                ) from None
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
