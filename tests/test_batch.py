@@ -2048,6 +2048,23 @@ def test_where_to_run_is_refused_when_contradictory_or_not_a_client(
     assert not (tmp_path / "o").exists()
 
 
+def test_a_closed_client_is_refused_before_anything(data: Path, tmp_path: Path) -> None:
+    """A user trial: a client closed before the call failed deep in Dask with
+    "AttributeError: 'NoneType' object has no attribute 'run_function'"."""
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
+        dashboard_address=None, scheduler_kwargs=NO_DASHBOARD,
+    ) as cluster:  # fmt: skip
+        closed = distributed.Client(cluster)
+        closed.close()
+        with pytest.raises(ValueError, match=(
+            r"^client is not connected \(its status is 'closed'\): pass a connected "
+            r"distributed.Client, or the scheduler's address as scheduler=$"
+        )):  # fmt: skip
+            track_many(data / "plain", tmp_path / "o", closed)
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.fixture
 def no_workers_timeout_1s() -> Iterator[None]:
     """Dask's ``distributed.scheduler.no-workers-timeout``, the batch's wait for a worker: 1 s."""

@@ -984,13 +984,15 @@ def check_scheduler_address(address: object, what: str = "scheduler") -> str:
 
 
 def check_client(client: object) -> None:
-    """Refuse a `client` that is not a ``distributed.Client`` (None passes).
+    """Refuse a `client` that is not a connected ``distributed.Client`` (None passes).
 
     Raises
     ------
     TypeError
         Naming `client`, and how to connect to an address (``scheduler=``): a string address
         failed deep in Dask with "'str' object has no attribute 'register_plugin'".
+    ValueError
+        A client that is not connected (closed, or still connecting).
     """
     if client is None:
         return
@@ -999,6 +1001,12 @@ def check_client(client: object) -> None:
     except ImportError:  # no Dask: whatever it is, it is not a Client
         Client = None  # type: ignore[assignment,misc]  # noqa: N806
     if Client is not None and isinstance(client, Client):
+        status = str(getattr(client, "status", "running"))
+        if status != "running":  # was: "'NoneType' object has no attribute 'run_function'"
+            raise ValueError(
+                f"client is not connected (its status is {status!r}): pass a connected "
+                "distributed.Client, or the scheduler's address as scheduler="
+            )
         return
     hint = (
         f": to connect to a running scheduler by its address, pass scheduler={client!r} "
