@@ -2048,6 +2048,44 @@ def test_where_to_run_is_refused_when_contradictory_or_not_a_client(
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"n_workers": 2.5}, "n_workers must be an integer >= 0 or None, got float 2.5"),
+        ({"n_workers": True}, "n_workers must be an integer >= 0 or None, got bool True"),
+        ({"n_workers": "2"}, "n_workers must be an integer >= 0 or None, got str '2'"),
+        ({"force": "no", "n_workers": 0}, "force must be True or False, got str 'no'"),
+        ({"show_progress": "no", "n_workers": 0},
+         "show_progress must be True, False or None, got str 'no'"),
+        ({"inputs": None, "n_workers": 0},
+         "inputs must be a path or a list of paths, got NoneType None"),
+        ({"inputs": 3, "n_workers": 0},
+         "inputs must be a path or a list of paths, got int 3"),
+        ({"inputs": ["IN", 3], "n_workers": 0},
+         "inputs[1] must be a path (str or os.PathLike), got int 3"),
+        ({"out_dir": None, "n_workers": 0},
+         "out_dir must be a path (str or os.PathLike), got NoneType None"),
+    ],
+)  # fmt: skip
+def test_python_arguments_of_another_type_are_refused_by_name(
+    kwargs: dict[str, Any], message: str, data: Path, tmp_path: Path
+) -> None:
+    """A user trial: ``force="no"`` forced (a truthy string: files no batch wrote replaced),
+    ``n_workers=2.5`` and ``n_workers=True`` ran, and ``inputs=None``, ``n_workers="2"`` or
+    ``out_dir=None`` failed with Python's words ("'NoneType' object is not iterable", "'<' not
+    supported between instances of 'str' and 'int'"), naming no parameter."""
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "walk.txt").write_text("mine\n")  # a file no batch wrote
+    args = {"inputs": [data / "walk.avi"], "out_dir": tmp_path / "o", **kwargs}
+    if isinstance(args["inputs"], list):
+        args["inputs"] = [data / "walk.avi" if p == "IN" else p for p in args["inputs"]]
+    with pytest.raises(TypeError) as caught:
+        track_many(args.pop("inputs"), args.pop("out_dir"), **args)
+    assert str(caught.value) == message
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["walk.txt"]
+    assert (tmp_path / "o" / "walk.txt").read_text() == "mine\n"
+
+
 def test_a_closed_client_is_refused_before_anything(data: Path, tmp_path: Path) -> None:
     """A user trial: a client closed before the call failed deep in Dask with
     "AttributeError: 'NoneType' object has no attribute 'run_function'"."""

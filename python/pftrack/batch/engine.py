@@ -24,6 +24,7 @@ import hashlib
 import json
 import logging
 import math
+import numbers
 import os
 import signal
 import socket
@@ -36,6 +37,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
+from pftrack._check import flag
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
@@ -1749,8 +1751,7 @@ def run_jobs(
         outputs written so far are complete. What the batch left (nothing, or how many tasks'
         outputs) is attached: :func:`interrupted_left`.
     """
-    if n_workers is not None and n_workers < 0:
-        raise ValueError(f"n_workers is {n_workers}, expected >= 0")
+    _check_arguments(out_dir, n_workers, force, show_progress)
     address = where_to_run(client, scheduler, n_workers)  # checked even when nothing is to run
     start = time.perf_counter()
     out = _check_outputs(jobs, out_dir, suffixes, force)
@@ -1858,6 +1859,32 @@ def run_jobs(
         _say_interrupted(exc, out, kind, written if touched else None)
         raise
     return summary
+
+
+def _check_arguments(out_dir: object, n_workers: object, force: object, show: object) -> None:
+    """Refuse arguments of :func:`run_jobs` of another type or range, naming them.
+
+    Was: ``force="no"`` forced (files no batch wrote replaced), ``n_workers=2.5`` or ``True``
+    ran, and ``n_workers="2"`` or ``out_dir=None`` failed in Python's words.
+    """
+    if not isinstance(out_dir, (str, bytes, os.PathLike)):
+        raise TypeError(
+            f"{_OUT_NAMES.get()[0]} must be a path (str or os.PathLike), got "
+            f"{type(out_dir).__name__} {out_dir!r}"
+        )
+    if n_workers is not None:
+        if isinstance(n_workers, bool) or not isinstance(n_workers, numbers.Integral):
+            raise TypeError(
+                "n_workers must be an integer >= 0 or None, got "
+                f"{type(n_workers).__name__} {n_workers!r}"
+            )
+        if n_workers < 0:
+            raise ValueError(f"n_workers is {n_workers}, expected >= 0")
+    flag(force, "force")
+    if show is not None and not isinstance(show, bool):
+        raise TypeError(
+            f"show_progress must be True, False or None, got {type(show).__name__} {show!r}"
+        )
 
 
 @contextlib.contextmanager
