@@ -1105,6 +1105,53 @@ def test_a_port_that_answers_half_or_in_another_protocol_is_no_scheduler(
     assert not (tmp_path / "out").exists()
 
 
+def test_a_dask_server_that_never_answers_the_client_is_named_so(
+    tmp_path: Path, connect_timeout_1s: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A Dask server that completes the handshake and then answers nothing (a frozen
+    scheduler): was "cannot connect to the Dask scheduler at ADDR: TimeoutError"."""
+    import asyncio
+
+    from distributed.comm import listen
+
+    _tracks_files(tmp_path / "tracks")
+    ready = threading.Event()
+    port: list[int] = []
+    stop = threading.Event()
+
+    async def serve() -> None:
+        async def never(comm: Any) -> None:
+            while not stop.is_set():
+                await asyncio.sleep(0.05)
+
+        listener = listen("tcp://127.0.0.1:0", never)
+        await listener.start()
+        port.append(int(listener.contact_address.rpartition(":")[2]))
+        ready.set()
+        while not stop.is_set():
+            await asyncio.sleep(0.05)
+        listener.stop()
+
+    server = threading.Thread(target=asyncio.run, args=(serve(),), daemon=True)
+    server.start()
+    assert ready.wait(10)
+    address = f"tcp://127.0.0.1:{port[0]}"
+    try:
+        argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+        start = time.monotonic()
+        assert main([*argv, "--scheduler", address]) == 2
+        assert time.monotonic() - start < 15
+    finally:
+        stop.set()
+        server.join(5)
+    assert capsys.readouterr().err == (
+        f"pftrack recover: error: cannot connect to the Dask scheduler at {address}: it "
+        "completed Dask's handshake but did not answer the client within 1 s (a frozen or "
+        "overloaded scheduler, or another Dask server)\n"
+    )
+    assert not (tmp_path / "out").exists()
+
+
 class _Quiet(http.server.SimpleHTTPRequestHandler):
     """``python -m http.server``'s handler, without its log lines on stderr."""
 

@@ -674,6 +674,12 @@ def _connect_problem(address: str, exc: Exception) -> str:
             f"and the client's certificate and key: {TLS_SETTINGS}, or distributed.comm.tls "
             "in a Dask configuration file)"
         )
+    if isinstance(exc, TimeoutError) and text == "TimeoutError":  # Dask's own wait_for
+        # a server that greeted (checked before: _refused) and then said nothing more
+        return (
+            f"it completed Dask's handshake but did not answer the client within "
+            f"{_greeting_wait():g} s (a frozen or overloaded scheduler, or another Dask server)"
+        )
     if isinstance(exc, OSError):  # timed out, refused, unknown host, a TLS handshake
         return text
     if protocol == "ucx":
