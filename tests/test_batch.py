@@ -2837,6 +2837,75 @@ def test_a_scheduler_lost_mid_run_fails_the_tasks_left(client: Any, tmp_path: Pa
     }
 
 
+def _started_then_slow(marker: str, seconds: float) -> TaskResult:
+    """A task that says it has started (a file), then takes `seconds`."""
+    Path(marker).write_text("")
+    time.sleep(seconds)
+    return TaskResult(np.zeros((0, 10)), {}, {})
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("always:the scheduler at")
+def test_a_scheduler_frozen_mid_run_fails_the_tasks_left(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, no_workers_timeout_1s: None
+) -> None:
+    """A scheduler frozen mid-run (stopped with SIGSTOP, a machine swapping): the batch
+    waited for it for ever, saying nothing."""
+    from pftrack.batch import engine
+
+    dask = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    if dask is None or not hasattr(signal, "SIGSTOP"):
+        pytest.skip("needs the dask command and SIGSTOP")
+    monkeypatch.setattr(engine, "ANSWER_WAIT", 0.5)
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    http = ["--dashboard-address", "127.0.0.1:0"]
+    with (tmp_path / "logs.txt").open("w") as log:
+        run = functools.partial(subprocess.Popen, stdout=log, stderr=log, env=env, cwd=tmp_path)
+        procs = [run([dask, "scheduler", "--host", "127.0.0.1", "--port",
+                      address.rpartition(":")[2], *http])]  # fmt: skip
+        try:
+            procs.append(run([dask, "worker", address, "--nthreads", "1", *http]))
+            with distributed.Client(address, timeout="30s") as c:
+                c.wait_for_workers(1, timeout=30)
+            marker = tmp_path / "started"
+            jobs = [Job(f"t{k}", _started_then_slow, (str(marker), 3.0), ()) for k in range(2)]
+
+            def freeze() -> None:
+                deadline = time.monotonic() + 30
+                while not marker.exists() and time.monotonic() < deadline:
+                    time.sleep(0.02)
+                procs[0].send_signal(signal.SIGSTOP)
+
+            threading.Thread(target=freeze, daemon=True).start()
+            start = time.monotonic()
+            with warnings.catch_warnings(record=True) as said:
+                warnings.simplefilter("always")
+                summary = run_jobs(
+                    jobs, tmp_path / "out", kind="smooth", settings={}, scheduler=address
+                )
+            assert time.monotonic() - start < 20
+        finally:
+            for p in reversed(procs):
+                p.send_signal(signal.SIGCONT)
+                p.terminate()
+            for p in reversed(procs):
+                try:
+                    p.wait(timeout=15)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
+    assert [e["status"] for e in summary.entries] == ["failed", "failed"]
+    assert {e["error"] for e in summary.entries} == {
+        f"the scheduler at {address} did not answer for 1 s (frozen or overloaded) before this "
+        "file finished (a re-run does the rest)"
+    }
+    assert [str(w.message) for w in said] == [
+        f"the scheduler at {address} has not answered for 0.5 s (frozen or overloaded?); "
+        "waiting up to 1 s for it"
+    ]
+
+
 def test_the_table_leaves_the_problems_to_stderr(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

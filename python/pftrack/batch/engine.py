@@ -1994,7 +1994,7 @@ def dask_seconds(key: str, example: str) -> float | None:
     return seconds
 
 
-def _n_workers(c: Client) -> int:
+def _n_workers(c: Client, timeout: float | None = None) -> int:
     """The scheduler's workers now, as the scheduler counts them (its ``identity``).
 
     Not ``len(c.scheduler_info()["workers"])``: the client refreshes that cache every 2 s
@@ -2004,10 +2004,20 @@ def _n_workers(c: Client) -> int:
     scheduler has lost all its workers" while they ran. The ``n_workers`` key, where the Dask
     has it, counts them all; an older Dask lists them all. With the connection going (an
     OSError), what the client last heard.
+
+    Raises
+    ------
+    TimeoutError
+        The scheduler did not answer within `timeout` seconds (None: no limit).
     """
     rpc = c.scheduler
     try:
-        info = c.sync(rpc.identity) if rpc is not None else c.scheduler_info()
+        if rpc is None:
+            info = c.scheduler_info()
+        else:
+            info = c.sync(rpc.identity, callback_timeout=timeout)
+    except TimeoutError:
+        raise
     except OSError:
         info = c.scheduler_info()
     n = info.get("n_workers")
@@ -2053,21 +2063,49 @@ def _wait_for_workers(c: Client, address: str, wait: float) -> int:
     return n
 
 
+#: Seconds the scheduler has to answer a count of its workers while tasks wait on it. One that
+#: does not (frozen: stopped, swapping, its event loop blocked) is said to be so, and waited for
+#: as long as for a worker (:func:`no_workers_timeout`); was: waited for, silently, for ever.
+ANSWER_WAIT = 5.0
+
+
 class _WorkersWatch:
-    """While tasks wait on a cluster: tells when it has been without workers for too long."""
+    """While tasks wait on a cluster: tells when it has been without workers for too long.
+
+    Or when its scheduler has not answered for that long (:data:`ANSWER_WAIT`): ``frozen``.
+    """
 
     def __init__(self, c: Client, address: str, wait: float) -> None:
         self.c, self.address, self.wait = c, address, wait
         self.since: float | None = None  # when the workers were last seen gone
+        self.silent: float | None = None  # when the scheduler was first asked in vain
+        self.frozen = False
         self._checked = -math.inf
 
     def given_up(self) -> bool:
-        """True once the cluster has had no worker for `wait` seconds (warns when they go)."""
+        """True once the cluster has had no worker for `wait` seconds (warns when they go).
+
+        True too once the scheduler has not answered for `wait` seconds (warns once it has
+        not answered for :data:`ANSWER_WAIT`).
+        """
         now = time.monotonic()
         if now - self._checked < WORKERS_POLL:
             return False
         self._checked = now
-        if _n_workers(self.c):
+        try:
+            n = _n_workers(self.c, ANSWER_WAIT)
+        except TimeoutError:
+            if self.silent is None:
+                self.silent = now
+                warnings.warn(
+                    f"the scheduler at {self.address} has not answered for {ANSWER_WAIT:g} s "
+                    f"(frozen or overloaded?); waiting up to {self.wait:g} s for it",
+                    stacklevel=2,
+                )
+            self.frozen = time.monotonic() - self.silent >= self.wait
+            return self.frozen
+        self.silent = None
+        if n:
             self.since = None
             return False
         if self.since is None:
@@ -2081,6 +2119,11 @@ class _WorkersWatch:
 
     def error(self, noun: str) -> str:
         """The error of a task left waiting when :meth:`given_up`."""
+        if self.frozen:
+            return (
+                f"the scheduler at {self.address} did not answer for {self.wait:g} s (frozen "
+                f"or overloaded) before this {noun} finished (a re-run does the rest)"
+            )
         return (
             f"no worker on the scheduler at {self.address} for {self.wait:g} s: its workers "
             f"were lost before this {noun} ran or finished (start some: dask worker "
