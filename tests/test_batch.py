@@ -1657,6 +1657,47 @@ def test_a_script_without_a_main_guard_runs_once(data: Path, tmp_path: Path) -> 
     ]  # fmt: skip
 
 
+_CRASHING_SCRIPT = """
+import os, sys
+with open(sys.argv[2], "a") as log:  # one line each time this top level runs
+    log.write(f"{os.getpid()}\\n")
+import numpy as np
+from pftrack.batch import Job, TaskResult, run_jobs
+def crash_once(k, marker):
+    if k == 0 and not os.path.exists(marker):
+        open(marker, "w").close()
+        os._exit(3)  # the worker dies: its nanny starts another
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+jobs = [Job(f"j{k}", crash_once, (k, sys.argv[3]), ()) for k in range(3)]
+summary = run_jobs(jobs, sys.argv[1], kind="smooth", settings={}, n_workers=1)
+print(*[e["status"] for e in summary.entries])
+"""
+
+
+@pytest.mark.slow
+def test_a_script_without_a_main_guard_survives_a_worker_restart(tmp_path: Path) -> None:
+    """A worker of the local cluster that dies (a crash, the kernel's OOM killer) is started
+    again by its nanny, which imported the unguarded script, ran its batch inside the new
+    worker and never had it join: the tasks left failed after the 60 s wait, with "start
+    some: dask worker ..." for a cluster the batch had started itself."""
+    script, log = tmp_path / "crash_script.py", tmp_path / "ran.txt"
+    script.write_text(_CRASHING_SCRIPT)
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(sys.path),
+        "DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT": "10s",
+    }
+    start = time.monotonic()
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path / "out"), str(log), str(tmp_path / "m")],
+        env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["done", "done", "done"], out.stdout
+    assert len(log.read_text().split()) == 1
+    assert time.monotonic() - start < 60
+
+
 def test_help_imports_no_dask() -> None:
     code = (
         "import sys\nfrom pftrack.cli import main\n"

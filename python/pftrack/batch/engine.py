@@ -376,8 +376,10 @@ def dask_client(
     stack = contextlib.ExitStack()
     try:
         # the cluster starts whole; its workers deaf to Ctrl-C, SIGTERM, and not running the
-        # caller's script again
-        with _interrupts_held(), _main_left_out():
+        # caller's script again: nor those its nannies start again later, for one that died
+        # (the script is left out until the cluster is closed)
+        with _interrupts_held():
+            stack.enter_context(_main_left_out())
             stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
             try:
                 cluster = stack.enter_context(
@@ -819,7 +821,10 @@ def _main_left_out() -> Iterator[None]:
     workers only imported what its top level imports (a deep-learning framework, say) for
     nothing: pftrack's tasks are functions of pftrack. Meanwhile the main module looks to
     ``multiprocessing`` as ``python -c`` does (no ``__spec__``, no ``__file__``); both are
-    put back at the end.
+    put back at the end. :func:`dask_client` holds it while its local cluster runs, not only
+    while it starts: a nanny starts its worker again when it dies (a crash, the kernel's OOM
+    killer), and that one ran the script too (a user trial: it never joined, and the tasks
+    left failed after the 60 s wait for a worker).
     """
     import sys
 
