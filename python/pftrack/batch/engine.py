@@ -2304,20 +2304,27 @@ def _run_on_dask(
         futures[fut.key] = (fut, job)
     watch = _WorkersWatch(c, address, wait)
     noun = "sequence" if kind == "track" else "file"
-    done = _completed(as_completed([f for f, _ in futures.values()]), watch.given_up)
+    tracked = as_completed([f for f, _ in futures.values()])
+    done = _completed(tracked, watch.given_up)
     try:
         for fut in progress(done, **bar) if frames is None else done:
+            status = fut.status
+            if status not in ("finished", "error", "cancelled"):
+                # finished, then its result lost with its worker before it was taken: Dask
+                # computes it again ("lost", "pending"); was: left out, "cancelled", not written
+                tracked.add(fut)
+                continue
             _, job = futures.pop(fut.key)
             if frames is not None:
                 frames.finish(job.name)
-            if fut.status == "finished":
+            if status == "finished":
                 record(job, fut.result())
-            elif fut.status == "error":  # the worker died (KilledWorker) or the like
+            elif status == "error":  # the worker died (KilledWorker) or the like
                 exc = fut.exception()
                 # the scheduler's own no-workers-timeout: said as this process's watch says it
                 lost = type(exc).__name__ == "NoWorkerError"
                 record(job, Outcome(None, watch.error(noun) if lost else one_line(exc)))
-            elif fut.status == "cancelled" and _connection_lost(c, fut):  # Dask cancels them all
+            elif status == "cancelled" and _connection_lost(c, fut):  # Dask cancels them all
                 record(job, Outcome(None, _scheduler_lost(address, noun)))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
         if futures:  # given up: no worker for too long
