@@ -1051,6 +1051,107 @@ def test_a_port_that_says_nothing_is_no_scheduler(
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize(
+    ("greeting", "said"),
+    [
+        (b"\x01", "began to answer but did not finish Dask's handshake within 1 s (a frozen or "
+         "overloaded scheduler, or no Dask server)"),
+        (b"hello garbage\n", "answered in a protocol that is not Dask's"),
+    ],
+)  # fmt: skip
+def test_a_port_that_answers_half_or_in_another_protocol_is_no_scheduler(
+    greeting: bytes,
+    said: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A user trial: a server that sent one byte and then nothing held the batch for ever
+    (Dask's connect timeout does not cover its handshake), one that greeted in another
+    protocol said "MemoryError: Unable to allocate 6.09 EiB for an array"."""
+    from pftrack.batch import engine
+
+    monkeypatch.setattr(engine, "GREETING_WAIT", 1.0)
+    _tracks_files(tmp_path / "tracks")
+    held: list[socket.socket] = []
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(8)
+
+        def serve() -> None:
+            with contextlib.suppress(OSError):
+                while True:
+                    conn, _ = listener.accept()
+                    held.append(conn)
+                    conn.sendall(greeting)
+
+        threading.Thread(target=serve, daemon=True).start()
+        address = f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+        argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+        status: list[int] = []
+        run = threading.Thread(target=lambda: status.append(main([*argv, "--scheduler", address])))
+        run.daemon = True
+        run.start()
+        run.join(30)
+        for conn in held:
+            conn.close()
+    assert status == [2]
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"pftrack recover: error: cannot connect to the Dask scheduler at {address}: port "
+        f"{address.rpartition(':')[2]} of 127.0.0.1 {said}"
+    ), err
+    assert err.count("\n") == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_dask_server_that_never_answers_the_client_is_named_so(
+    tmp_path: Path, connect_timeout_1s: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A Dask server that completes the handshake and then answers nothing (a frozen
+    scheduler): was "cannot connect to the Dask scheduler at ADDR: TimeoutError"."""
+    import asyncio
+
+    from distributed.comm import listen
+
+    _tracks_files(tmp_path / "tracks")
+    ready = threading.Event()
+    port: list[int] = []
+    stop = threading.Event()
+
+    async def serve() -> None:
+        async def never(comm: Any) -> None:
+            while not stop.is_set():
+                await asyncio.sleep(0.05)
+
+        listener = listen("tcp://127.0.0.1:0", never)
+        await listener.start()
+        port.append(int(listener.contact_address.rpartition(":")[2]))
+        ready.set()
+        while not stop.is_set():
+            await asyncio.sleep(0.05)
+        listener.stop()
+
+    server = threading.Thread(target=asyncio.run, args=(serve(),), daemon=True)
+    server.start()
+    assert ready.wait(10)
+    address = f"tcp://127.0.0.1:{port[0]}"
+    try:
+        argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out")]
+        start = time.monotonic()
+        assert main([*argv, "--scheduler", address]) == 2
+        assert time.monotonic() - start < 15
+    finally:
+        stop.set()
+        server.join(5)
+    assert capsys.readouterr().err == (
+        f"pftrack recover: error: cannot connect to the Dask scheduler at {address}: it "
+        "completed Dask's handshake but did not answer the client within 1 s (a frozen or "
+        "overloaded scheduler, or another Dask server)\n"
+    )
+    assert not (tmp_path / "out").exists()
+
+
 class _Quiet(http.server.SimpleHTTPRequestHandler):
     """``python -m http.server``'s handler, without its log lines on stderr."""
 
@@ -1556,6 +1657,47 @@ def test_a_script_without_a_main_guard_runs_once(data: Path, tmp_path: Path) -> 
     ]  # fmt: skip
 
 
+_CRASHING_SCRIPT = """
+import os, sys
+with open(sys.argv[2], "a") as log:  # one line each time this top level runs
+    log.write(f"{os.getpid()}\\n")
+import numpy as np
+from pftrack.batch import Job, TaskResult, run_jobs
+def crash_once(k, marker):
+    if k == 0 and not os.path.exists(marker):
+        open(marker, "w").close()
+        os._exit(3)  # the worker dies: its nanny starts another
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+jobs = [Job(f"j{k}", crash_once, (k, sys.argv[3]), ()) for k in range(3)]
+summary = run_jobs(jobs, sys.argv[1], kind="smooth", settings={}, n_workers=1)
+print(*[e["status"] for e in summary.entries])
+"""
+
+
+@pytest.mark.slow
+def test_a_script_without_a_main_guard_survives_a_worker_restart(tmp_path: Path) -> None:
+    """A worker of the local cluster that dies (a crash, the kernel's OOM killer) is started
+    again by its nanny, which imported the unguarded script, ran its batch inside the new
+    worker and never had it join: the tasks left failed after the 60 s wait, with "start
+    some: dask worker ..." for a cluster the batch had started itself."""
+    script, log = tmp_path / "crash_script.py", tmp_path / "ran.txt"
+    script.write_text(_CRASHING_SCRIPT)
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(sys.path),
+        "DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT": "10s",
+    }
+    start = time.monotonic()
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path / "out"), str(log), str(tmp_path / "m")],
+        env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["done", "done", "done"], out.stdout
+    assert len(log.read_text().split()) == 1
+    assert time.monotonic() - start < 60
+
+
 def test_help_imports_no_dask() -> None:
     code = (
         "import sys\nfrom pftrack.cli import main\n"
@@ -1994,6 +2136,61 @@ def test_where_to_run_is_refused_when_contradictory_or_not_a_client(
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"n_workers": 2.5}, "n_workers must be an integer >= 0 or None, got float 2.5"),
+        ({"n_workers": True}, "n_workers must be an integer >= 0 or None, got bool True"),
+        ({"n_workers": "2"}, "n_workers must be an integer >= 0 or None, got str '2'"),
+        ({"force": "no", "n_workers": 0}, "force must be True or False, got str 'no'"),
+        ({"show_progress": "no", "n_workers": 0},
+         "show_progress must be True, False or None, got str 'no'"),
+        ({"inputs": None, "n_workers": 0},
+         "inputs must be a path or a list of paths, got NoneType None"),
+        ({"inputs": 3, "n_workers": 0},
+         "inputs must be a path or a list of paths, got int 3"),
+        ({"inputs": ["IN", 3], "n_workers": 0},
+         "inputs[1] must be a path (str or os.PathLike), got int 3"),
+        ({"out_dir": None, "n_workers": 0},
+         "out_dir must be a path (str or os.PathLike), got NoneType None"),
+    ],
+)  # fmt: skip
+def test_python_arguments_of_another_type_are_refused_by_name(
+    kwargs: dict[str, Any], message: str, data: Path, tmp_path: Path
+) -> None:
+    """A user trial: ``force="no"`` forced (a truthy string: files no batch wrote replaced),
+    ``n_workers=2.5`` and ``n_workers=True`` ran, and ``inputs=None``, ``n_workers="2"`` or
+    ``out_dir=None`` failed with Python's words ("'NoneType' object is not iterable", "'<' not
+    supported between instances of 'str' and 'int'"), naming no parameter."""
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "walk.txt").write_text("mine\n")  # a file no batch wrote
+    args = {"inputs": [data / "walk.avi"], "out_dir": tmp_path / "o", **kwargs}
+    if isinstance(args["inputs"], list):
+        args["inputs"] = [data / "walk.avi" if p == "IN" else p for p in args["inputs"]]
+    with pytest.raises(TypeError) as caught:
+        track_many(args.pop("inputs"), args.pop("out_dir"), **args)
+    assert str(caught.value) == message
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["walk.txt"]
+    assert (tmp_path / "o" / "walk.txt").read_text() == "mine\n"
+
+
+def test_a_closed_client_is_refused_before_anything(data: Path, tmp_path: Path) -> None:
+    """A user trial: a client closed before the call failed deep in Dask with
+    "AttributeError: 'NoneType' object has no attribute 'run_function'"."""
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
+        dashboard_address=None, scheduler_kwargs=NO_DASHBOARD,
+    ) as cluster:  # fmt: skip
+        closed = distributed.Client(cluster)
+        closed.close()
+        with pytest.raises(ValueError, match=(
+            r"^client is not connected \(its status is 'closed'\): pass a connected "
+            r"distributed.Client, or the scheduler's address as scheduler=$"
+        )):  # fmt: skip
+            track_many(data / "plain", tmp_path / "o", closed)
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.fixture
 def no_workers_timeout_1s() -> Iterator[None]:
     """Dask's ``distributed.scheduler.no-workers-timeout``, the batch's wait for a worker: 1 s."""
@@ -2036,6 +2233,70 @@ for name in [n for n in sys.modules if n == "pftrack" or n.startswith("pftrack."
     sys.modules[name] = None
 sys.modules["pftrack"] = None
 """
+
+
+@pytest.mark.parametrize(
+    ("key", "variable", "example"),
+    [
+        ("distributed.comm.timeouts.connect", "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT", "30s"),
+        ("distributed.scheduler.no-workers-timeout",
+         "DASK_DISTRIBUTED__SCHEDULER__NO_WORKERS_TIMEOUT", "60s"),
+    ],
+)  # fmt: skip
+@pytest.mark.parametrize("where", ["local", "scheduler"])
+def test_a_dask_wait_that_is_no_duration_is_one_line(
+    key: str,
+    variable: str,
+    example: str,
+    where: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A user trial: ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT=abc`` (a setting the help
+    names) gave Dask's traceback ("KeyError: 'Invalid time unit: abc ...'"), with a local
+    cluster ("Cluster failed to start") or a scheduler; so did the no-workers wait locally."""
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(out)]
+    if where == "scheduler":  # a port that says nothing: the connect timeout is read first
+        listener = socket.socket()
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(4)
+        argv += ["--scheduler", f"tcp://127.0.0.1:{listener.getsockname()[1]}"]
+    try:
+        with dask.config.set({key: "abc"}):
+            assert main(argv) == 2
+    finally:
+        if where == "scheduler":
+            listener.close()
+    assert capsys.readouterr().err == (
+        f"pftrack recover: error: {key} is 'abc' (${variable}), expected a duration such as "
+        f"'{example}'\n"
+    )
+    assert not out.exists()
+
+
+def test_a_local_cluster_that_cannot_start_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: Dask's temporary folder under a file (``DASK_TEMPORARY_DIRECTORY``) gave
+    a 60-line traceback ending in "RuntimeError: Cluster failed to start", exit status 1."""
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    (tmp_path / "file").write_text("")
+    out = tmp_path / "out"
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(out), "--workers", "1"]
+    with dask.config.set({"temporary-directory": str(tmp_path / "file" / "x")}):
+        assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "pftrack recover: error: cannot start a local Dask cluster of 1 worker: [Errno 20] Not "
+        f"a directory: '{tmp_path / 'file' / 'x'}'\n"
+    ), err
+    assert not out.exists()
 
 
 def test_workers_without_pftrack_are_one_line_before_anything(
@@ -2081,6 +2342,44 @@ def test_workers_without_pftrack_are_one_line_before_anything(
             f"the scheduler at {late.scheduler_address} has no workers"
         ]
     assert not out.exists()
+
+
+def _set_version(version: str) -> str:
+    """On a worker: give its pftrack another release number; return the one it had."""
+    import pftrack
+
+    was, pftrack.__version__ = pftrack.__version__, version
+    return was
+
+
+def test_workers_of_another_pftrack_release_are_one_line_before_anything(
+    client: Any, tmp_path: Path
+) -> None:
+    """A user trial: workers with another pftrack release tracked every sequence, written as
+    this release's (the sidecar names the client's release, so a re-run skipped them) and
+    unlike ``pftrack track`` here."""
+    import pftrack
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    address = client.scheduler.address
+    (_, second) = sorted(client.scheduler_info()["workers"])
+    client.run(_set_version, "9.9.9", workers=[second])
+    try:
+        with pytest.raises(ImportError) as caught:
+            smooth_many(tmp_path / "tracks", out, client)
+        assert str(caught.value) == (
+            f"1 of the 2 workers ({second}) at {address} run pftrack 9.9.9, this is pftrack "
+            f"{pftrack.__version__}: install the same pftrack where this process and every "
+            "worker run (a batch's outputs are those of one release)"
+        )
+        assert caught.value.name == "pftrack"
+        assert not out.exists()
+    finally:
+        client.run(_set_version, pftrack.__version__)
+    assert [e["status"] for e in smooth_many(tmp_path / "tracks", out, client).entries] == [
+        "done"
+    ] * 3
 
 
 def test_a_scheduler_without_pftrack_is_one_line(
@@ -2253,6 +2552,75 @@ def test_a_path_a_worker_cannot_see_is_said_so(data: Path, client: Any, tmp_path
     job = Job("gone", _track_unseen, (gone, TrackOptions(config=_config())), gone.files)
     (entry,) = run_jobs([job], tmp_path / "o2", kind="track", settings={}, client=client).entries
     assert entry["error"] == f"video source not found: {gone.frames}" and entry["host"] == host
+
+
+def _worker_sees_other_files(grown: int) -> None:
+    """On a worker: its view of every input is `grown` bytes larger than the client's (0: undo)."""
+    from pftrack.batch import engine
+
+    if not hasattr(engine, "_real_fingerprint"):
+        engine._real_fingerprint = engine.fingerprint  # type: ignore[attr-defined]
+    real = engine._real_fingerprint  # type: ignore[attr-defined]
+
+    def other(paths: Any) -> list[dict[str, Any]]:
+        return [{**p, "size": p["size"] + grown} if "size" in p else p for p in real(paths)]
+
+    engine.fingerprint = other if grown else real  # type: ignore[assignment]
+
+
+def test_a_worker_that_reads_other_files_fails_the_task(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    """A user trial: a worker whose copy of the inputs differed (another video, fewer images
+    under the same path) reported the sequence done with its own frames, and its sidecar
+    vouched for the client's file, so a re-run skipped it; a file the worker could not decode
+    said "not a video", of a video the client can read."""
+    assert client.run(_worker_sees_other_files, 100)
+    try:
+        summary = track_many(data, tmp_path / "out", client, options=TrackOptions(config=_config()))
+    finally:
+        client.run(_worker_sees_other_files, 0)
+    host = socket.gethostname()
+    by_name = {e["name"]: e for e in summary.entries}
+    walk = by_name["walk"]
+    assert walk["status"] == "failed" and walk["host"] == host
+    size = (data / "walk.avi").stat().st_size
+    assert walk["error"] == (
+        f"{data / 'walk.avi'}: another file on worker {host} ({size + 100} bytes there, {size} "
+        "here): workers must see the same files at the same paths"
+    )
+    plain = by_name["plain"]
+    assert plain["status"] == "failed" and "another folder on worker" in plain["error"]
+    assert not list((tmp_path / "out").glob("*.txt"))  # no output of what the client has not
+    # the same files: done, and the worker's view is not taken in this process
+    again = track_many(data, tmp_path / "out", client, options=TrackOptions(config=_config()))
+    assert [e["status"] for e in again.entries] == ["done"] * 3
+
+
+def test_an_input_changed_while_the_batch_ran_is_not_a_workers_other_file(
+    tmp_path: Path,
+) -> None:
+    """The worker's view is compared with this process's view now, too: an input changed
+    after the batch began (the same file on a local cluster) is no worker seeing other files."""
+    from pftrack.batch.engine import Outcome, _seen_otherwise, fingerprint
+
+    video = tmp_path / "walk.avi"
+    video.write_bytes(b"x" * 10)
+    job = Job("walk", track_sequence_stub, (), (video,))
+    before = fingerprint([video])
+    video.write_bytes(b"x" * 20)  # after the client's fingerprint, before the worker's
+    outcome = Outcome(None, host="node7", seen=fingerprint([video]))
+    assert _seen_otherwise(job, outcome, before) is None
+    other = Outcome(None, host="node7", seen=[{**before[0], "size": 30}])
+    assert _seen_otherwise(job, other, before) == (
+        f"{video}: another file on worker node7 (30 bytes there, 20 here): workers must see "
+        "the same files at the same paths"
+    )
+
+
+def track_sequence_stub() -> TaskResult:
+    """A task function for jobs that never run."""
+    raise AssertionError("not run")
 
 
 def test_a_broken_link_in_a_scanned_folder_fails_alone(
@@ -2508,6 +2876,102 @@ def test_a_scheduler_lost_mid_run_fails_the_tasks_left(client: Any, tmp_path: Pa
         f"the connection to the scheduler at {address} was lost before this file finished (the "
         "scheduler stopped, or the network failed; a re-run does the rest)"
     }
+
+
+def _started_then_slow(marker: str, seconds: float) -> TaskResult:
+    """A task that says it has started (a file), then takes `seconds`."""
+    Path(marker).write_text("")
+    time.sleep(seconds)
+    return TaskResult(np.zeros((0, 10)), {}, {})
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("always:the scheduler at")
+def test_a_scheduler_frozen_mid_run_fails_the_tasks_left(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, no_workers_timeout_1s: None
+) -> None:
+    """A scheduler frozen mid-run (stopped with SIGSTOP, a machine swapping): the batch
+    waited for it for ever, saying nothing."""
+    from pftrack.batch import engine
+
+    dask = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    if dask is None or not hasattr(signal, "SIGSTOP"):
+        pytest.skip("needs the dask command and SIGSTOP")
+    monkeypatch.setattr(engine, "ANSWER_WAIT", 0.5)
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    http = ["--dashboard-address", "127.0.0.1:0"]
+    with (tmp_path / "logs.txt").open("w") as log:
+        run = functools.partial(subprocess.Popen, stdout=log, stderr=log, env=env, cwd=tmp_path)
+        procs = [run([dask, "scheduler", "--host", "127.0.0.1", "--port",
+                      address.rpartition(":")[2], *http])]  # fmt: skip
+        try:
+            procs.append(run([dask, "worker", address, "--nthreads", "1", *http]))
+            with distributed.Client(address, timeout="30s") as c:
+                c.wait_for_workers(1, timeout=30)
+            marker = tmp_path / "started"
+            jobs = [Job(f"t{k}", _started_then_slow, (str(marker), 3.0), ()) for k in range(2)]
+
+            def freeze() -> None:
+                deadline = time.monotonic() + 30
+                while not marker.exists() and time.monotonic() < deadline:
+                    time.sleep(0.02)
+                procs[0].send_signal(signal.SIGSTOP)
+
+            threading.Thread(target=freeze, daemon=True).start()
+            start = time.monotonic()
+            with warnings.catch_warnings(record=True) as said:
+                warnings.simplefilter("always")
+                summary = run_jobs(
+                    jobs, tmp_path / "out", kind="smooth", settings={}, scheduler=address
+                )
+            assert time.monotonic() - start < 20
+        finally:
+            for p in reversed(procs):
+                p.send_signal(signal.SIGCONT)
+                p.terminate()
+            for p in reversed(procs):
+                try:
+                    p.wait(timeout=15)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
+    assert [e["status"] for e in summary.entries] == ["failed", "failed"]
+    assert {e["error"] for e in summary.entries} == {
+        f"the scheduler at {address} did not answer for 1 s (frozen or overloaded) before this "
+        "file finished (a re-run does the rest)"
+    }
+    assert [str(w.message) for w in said] == [
+        f"the scheduler at {address} has not answered for 0.5 s (frozen or overloaded?); "
+        "waiting up to 1 s for it"
+    ]
+
+
+def test_a_result_lost_with_its_worker_is_waited_for_not_dropped(
+    client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A task finished, then its worker died before the client took its result (a crash, the
+    OOM killer): Dask computes it again, and its future is "lost", then "pending", where the
+    client looked. Was: the task left out, "cancelled" in the summary, its outputs never
+    written, and no failure counted (exit status 0 if the others were done); 2 runs in 6 of
+    a batch whose first task killed its worker. Here its status reads "lost" once, where the
+    batch looks."""
+    seen: set[str] = set()
+    real = distributed.Future.status
+
+    def status(self: Any) -> str:
+        looker = sys._getframe(1).f_code.co_name
+        if looker == "_run_on_dask" and "-slow1-" in self.key and self.key not in seen:
+            seen.add(self.key)
+            return "lost"
+        return str(real.fget(self))
+
+    monkeypatch.setattr(distributed.Future, "status", property(status))
+    jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(2)]
+    summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={}, client=client)
+    assert seen
+    assert [e["status"] for e in summary.entries] == ["done", "done"]
+    assert sorted(p.name for p in (tmp_path / "out").glob("*.txt")) == ["slow0.txt", "slow1.txt"]
 
 
 def test_the_table_leaves_the_problems_to_stderr(

@@ -24,6 +24,7 @@ import hashlib
 import json
 import logging
 import math
+import numbers
 import os
 import signal
 import socket
@@ -36,6 +37,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
+from pftrack._check import flag
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
@@ -315,7 +317,8 @@ def dask_client(
         `client` is not a ``distributed.Client`` (an address goes in `scheduler`).
     ValueError
         A malformed or empty address; `client`, `scheduler` and `n_workers` that contradict
-        each other (more than one given, or ``n_workers`` < 1).
+        each other (more than one given, or ``n_workers`` < 1); Dask's connect timeout or
+        no-workers timeout that is not a duration (:func:`dask_seconds`).
     OSError
         The scheduler cannot be reached within Dask's ``distributed.comm.timeouts.connect``
         (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``), or Dask cannot
@@ -325,6 +328,8 @@ def dask_client(
         class UCXConnector", naming neither). An address that is an HTTP server's (the
         dashboard's) or a Dask worker's is said to be one, with the scheduler's address where
         it tells it (:func:`_http_server`, :func:`_dask_server`).
+        A local cluster that cannot start (Dask's temporary folder not writable, say): one
+        line, Dask's cause.
     ImportError
         The scheduler or the workers cannot import pftrack (:func:`check_pftrack`).
     """
@@ -337,6 +342,9 @@ def dask_client(
     address = where_to_run(client, scheduler, n_workers)
     if n_workers is not None and n_workers < 1:
         raise ValueError(f"n_workers is {n_workers}, expected >= 1 for a cluster")
+    # the waits this reads, and a local cluster's scheduler too: checked before any is used
+    dask_seconds("distributed.comm.timeouts.connect", "30s")
+    no_workers_timeout()
     if client is not None:
         check_pftrack(client, _address_of(client))
         _register(client, SingleThreaded(), _address_of(client))
@@ -368,22 +376,32 @@ def dask_client(
     stack = contextlib.ExitStack()
     try:
         # the cluster starts whole; its workers deaf to Ctrl-C, SIGTERM, and not running the
-        # caller's script again
-        with _interrupts_held(), _main_left_out():
+        # caller's script again: nor those its nannies start again later, for one that died
+        # (the script is left out until the cluster is closed)
+        with _interrupts_held():
+            stack.enter_context(_main_left_out())
             stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
-            cluster = stack.enter_context(
-                LocalCluster(
-                    n_workers=n,
-                    threads_per_worker=1,
-                    processes=True,
-                    host="127.0.0.1",
-                    silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks
-                    dashboard_address=None,  # no dashboard; its HTTP routes on a free port, not
-                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # 8787: many batches
+            try:
+                cluster = stack.enter_context(
+                    LocalCluster(
+                        n_workers=n,
+                        threads_per_worker=1,
+                        processes=True,
+                        host="127.0.0.1",
+                        silence_logs=logging.ERROR,  # not the workers' warnings on cancelled tasks
+                        dashboard_address=None,  # no dashboard; its HTTP routes on a free port,
+                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # not 8787
+                    )
                 )
-            )
-            c = stack.enter_context(Client(cluster))
-            c.register_plugin(SingleThreaded(ignore_interrupt=True))
+                c = stack.enter_context(Client(cluster))
+                c.register_plugin(SingleThreaded(ignore_interrupt=True))
+            except Exception as exc:  # noqa: BLE001 - whatever stopped Dask: one line
+                # was: Dask's traceback, "RuntimeError: Cluster failed to start: ..." (its
+                # temporary folder under a file, say); the cause says what failed
+                cause = exc.__cause__ if isinstance(exc.__cause__, Exception) else exc
+                raise OSError(
+                    f"cannot start a local Dask cluster of {_count(n, 'worker')}: {one_line(cause)}"
+                ) from None
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
         yield c
@@ -429,7 +447,7 @@ def _refused(address: str) -> str | None:
     while True:
         try:
             with socket.create_connection((host, port), timeout=REFUSED_GRACE) as sock:
-                return _silent(sock, host, port)
+                return _silent(sock, host, port, address)
         except socket.gaierror:
             return f"host {host} not found (its name does not resolve)"
         except ConnectionRefusedError:
@@ -455,11 +473,8 @@ GREETING_WAIT: float | None = None
 def _greeting_wait() -> float:
     if GREETING_WAIT is not None:
         return GREETING_WAIT
-    import dask
-    from dask.utils import parse_timedelta
-
-    wait = parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), default="s")
-    return float(wait) if wait else 30.0
+    wait = dask_seconds("distributed.comm.timeouts.connect", "30s")
+    return wait if wait else 30.0
 
 
 #: Seconds of silence after which :func:`_silent` asks the port whether it speaks HTTP (a
@@ -468,29 +483,34 @@ HTTP_ASK_AFTER = 2.0
 HTTP_WAIT = 2.0
 
 
-def _silent(sock: socket.socket, host: str, port: int) -> str | None:
+def _silent(sock: socket.socket, host: str, port: int, address: str) -> str | None:
     """Why the server at the other end of `sock` is no Dask scheduler: it says nothing.
 
     Silent for :data:`HTTP_ASK_AFTER` seconds, the port is asked, on a connection of its own,
     whether it speaks HTTP (:func:`_http_server`): the dashboard's port, or any web server, is
     then named as such at once (was: after Dask's whole connect timeout, 30 s, with a guess).
-    Otherwise the rest of the wait is waited for a greeting.
+    Otherwise the rest of the wait is waited for a greeting, and a greeting must be Dask's
+    whole handshake, within the same wait (:func:`_handshake`).
     """
     wait = _greeting_wait()
     start = time.monotonic()
+
+    def left() -> float:
+        return max(wait - (time.monotonic() - start), 0.001)
+
     sock.settimeout(min(wait, HTTP_ASK_AFTER))
     try:
         try:
             if sock.recv(1):
-                return None
+                return _handshake(address, host, port, left(), wait)
             said = "closed the connection without a word"
         except TimeoutError:
             http = _http_server(host, port, max(min(HTTP_WAIT, wait - HTTP_ASK_AFTER), 0.2))
             if http is not None:
                 return http
-            sock.settimeout(max(wait - (time.monotonic() - start), 0.001))
+            sock.settimeout(left())
             if sock.recv(1):
-                return None
+                return _handshake(address, host, port, left(), wait)
             said = "closed the connection without a word"
     except TimeoutError:
         said = f"said nothing within {wait:g} s"
@@ -499,6 +519,50 @@ def _silent(sock: socket.socket, host: str, port: int) -> str | None:
     return (
         f"port {port} of {host} accepted the connection but {said}, as no Dask scheduler "
         "does (the dashboard's port? a scheduler listens on 8786 unless told otherwise)"
+    )
+
+
+def _handshake(address: str, host: str, port: int, timeout: float, wait: float) -> str | None:
+    """Why the server at `address`, which began to greet, is no Dask server; None if it is one.
+
+    Dask's own connection (``distributed.comm.connect``) within `timeout` seconds, in a thread
+    of its own with its own event loop (the caller may run one): Dask waits for the rest of a
+    greeting without a time limit, so a server that sent a byte and then nothing held
+    ``Client(address)`` for ever, and one that greeted in another protocol failed with
+    "MemoryError: Unable to allocate 6.09 EiB" (user trials). `wait` is the whole wait, as the
+    message states it.
+    """
+    import asyncio
+
+    from distributed.comm.core import connect
+
+    async def greet() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        await comm.close()
+
+    failed: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            asyncio.run(greet())
+        except BaseException as exc:  # noqa: BLE001 - told below, whatever Dask raised
+            failed.append(exc)
+
+    thread = threading.Thread(target=run, name="pftrack-handshake", daemon=True)
+    thread.start()
+    thread.join(timeout + 1.0)
+    if not thread.is_alive() and not failed:
+        return None
+    if thread.is_alive() or isinstance(failed[0], (TimeoutError, asyncio.TimeoutError)):
+        return (
+            f"port {port} of {host} began to answer but did not finish Dask's handshake within "
+            f"{wait:g} s (a frozen or overloaded scheduler, or no Dask server)"
+        )
+    if isinstance(failed[0], OSError):
+        return None  # reset, closed, or the like: Dask's own connection says what it finds
+    return (
+        f"port {port} of {host} answered in a protocol that is not Dask's "
+        f"({type(failed[0]).__name__} on its greeting): no Dask scheduler listens there"
     )
 
 
@@ -612,6 +676,12 @@ def _connect_problem(address: str, exc: Exception) -> str:
             f"and the client's certificate and key: {TLS_SETTINGS}, or distributed.comm.tls "
             "in a Dask configuration file)"
         )
+    if isinstance(exc, TimeoutError) and text == "TimeoutError":  # Dask's own wait_for
+        # a server that greeted (checked before: _refused) and then said nothing more
+        return (
+            f"it completed Dask's handshake but did not answer the client within "
+            f"{_greeting_wait():g} s (a frozen or overloaded scheduler, or another Dask server)"
+        )
     if isinstance(exc, OSError):  # timed out, refused, unknown host, a TLS handshake
         return text
     if protocol == "ucx":
@@ -658,7 +728,9 @@ def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
     ------
     ImportError
         One line naming the scheduler's address (and the workers that failed), the import
-        error, and what to do (``name`` is ``"pftrack"``).
+        error, and what to do (``name`` is ``"pftrack"``); or the workers that run another
+        pftrack release than this process (their outputs would be another release's, named
+        as this one's in the sidecars).
     """
     if scheduler:
         try:
@@ -680,6 +752,22 @@ def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
         )
         raise ImportError(
             f"{which} at {address} cannot import pftrack ({one_line(first)}): {INSTALL_EVERYWHERE}",
+            name="pftrack",
+        )
+    # another release may track otherwise, and the sidecars name this one's (a user trial)
+    releases = c.run(eval, "__import__('pftrack').__version__", on_error="return")
+    other = {w: v for w, v in releases.items() if v != _version()}
+    if other:
+        shown = ", ".join(sorted({str(v) for v in other.values()}))
+        which = (
+            "the workers"
+            if len(other) == len(releases)
+            else f"{len(other)} of the {len(releases)} workers ({', '.join(sorted(other))})"
+        )
+        raise ImportError(
+            f"{which} at {address} run pftrack {shown}, this is pftrack {_version()}: install "
+            "the same pftrack where this process and every worker run (a batch's outputs are "
+            "those of one release)",
             name="pftrack",
         )
 
@@ -733,7 +821,10 @@ def _main_left_out() -> Iterator[None]:
     workers only imported what its top level imports (a deep-learning framework, say) for
     nothing: pftrack's tasks are functions of pftrack. Meanwhile the main module looks to
     ``multiprocessing`` as ``python -c`` does (no ``__spec__``, no ``__file__``); both are
-    put back at the end.
+    put back at the end. :func:`dask_client` holds it while its local cluster runs, not only
+    while it starts: a nanny starts its worker again when it dies (a crash, the kernel's OOM
+    killer), and that one ran the script too (a user trial: it never joined, and the tasks
+    left failed after the 60 s wait for a worker).
     """
     import sys
 
@@ -906,13 +997,15 @@ def check_scheduler_address(address: object, what: str = "scheduler") -> str:
 
 
 def check_client(client: object) -> None:
-    """Refuse a `client` that is not a ``distributed.Client`` (None passes).
+    """Refuse a `client` that is not a connected ``distributed.Client`` (None passes).
 
     Raises
     ------
     TypeError
         Naming `client`, and how to connect to an address (``scheduler=``): a string address
         failed deep in Dask with "'str' object has no attribute 'register_plugin'".
+    ValueError
+        A client that is not connected (closed, or still connecting).
     """
     if client is None:
         return
@@ -921,6 +1014,12 @@ def check_client(client: object) -> None:
     except ImportError:  # no Dask: whatever it is, it is not a Client
         Client = None  # type: ignore[assignment,misc]  # noqa: N806
     if Client is not None and isinstance(client, Client):
+        status = str(getattr(client, "status", "running"))
+        if status != "running":  # was: "'NoneType' object has no attribute 'run_function'"
+            raise ValueError(
+                f"client is not connected (its status is {status!r}): pass a connected "
+                "distributed.Client, or the scheduler's address as scheduler="
+            )
         return
     hint = (
         f": to connect to a running scheduler by its address, pass scheduler={client!r} "
@@ -1303,6 +1402,9 @@ class Outcome(NamedTuple):
         The task failed on a file it could not find (``FileNotFoundError``): the file's name
         if the error carries one, else ``""``. The client tells a file its worker cannot see
         from one that does not exist (:func:`_failure`).
+    seen : list of dict or None
+        On a Dask worker: the :func:`fingerprint` of the task's inputs as the worker saw them
+        before it ran, which the client compares with its own (:func:`_seen_otherwise`).
     """
 
     result: TaskResult | None
@@ -1310,6 +1412,7 @@ class Outcome(NamedTuple):
     traceback: str | None = None
     host: str | None = None
     missing: str | None = None
+    seen: list[dict[str, Any]] | None = None
 
 
 def _worker_stop() -> Callable[[], None] | None:
@@ -1343,6 +1446,7 @@ def call_task(
     func: Callable[..., TaskResult],
     args: tuple[Any, ...],
     progress: Callable[[int], None] | tuple[str, str] | None = None,
+    reads: Sequence[Path] | None = None,
 ) -> Outcome:
     """Run one task; an exception comes back as data (its line and traceback), not raised.
 
@@ -1359,7 +1463,13 @@ def call_task(
     On a Dask worker the task also stops itself once its future is cancelled (Ctrl-C on the
     client): every 25 frames it looks (:func:`_worker_stop`), and ends with
     :class:`~pftrack.batch.tasks.TaskCancelled`, its worker free for other work.
+
+    With `reads` (the job's inputs, given on Dask), the outcome carries their
+    :func:`fingerprint` as this process sees them, taken before the task reads them, and the
+    host: the client tells a worker that sees other files than its own (:func:`_seen_otherwise`).
     """
+    seen = fingerprint(reads) if reads is not None else None
+    host = _host() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
     with warnings.catch_warnings(record=True) as caught, reporting_frames(report, stop):
@@ -1370,11 +1480,11 @@ def call_task(
             missing = None
             if isinstance(exc, FileNotFoundError):
                 missing = str(exc.filename) if exc.filename else ""
-            return Outcome(None, one_line(exc), traceback.format_exc(), _host(), missing)
+            return Outcome(None, one_line(exc), traceback.format_exc(), _host(), missing, seen)
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
-    return Outcome(result)
+    return Outcome(result, host=host, seen=seen)
 
 
 def _host() -> str:
@@ -1383,6 +1493,52 @@ def _host() -> str:
 
 #: How the client words a file that a worker could not find but the client can.
 UNSEEN = "not found on worker {host} (the client sees it: workers must see the same paths)"
+
+
+def _seen_otherwise(job: Job, outcome: Outcome, here: list[dict[str, Any]]) -> str | None:
+    """Why the worker of `outcome` read other inputs than this process sees, or None.
+
+    `here`: the :func:`fingerprint` of ``job.reads`` taken before the tasks ran. Compared:
+    whether each input exists, a file's size, a folder's number of images and their total
+    size; not the times (a copy made on each machine has its own). An input that differs from
+    `here` but not from what this process sees now changed while the batch ran: not the
+    worker's view (its sidecar keeps `here`, so a re-run redoes it). Was: a worker whose copy
+    differed (another video, fewer images under the same path) reported the sequence done with
+    its own frames, written as the client's and skipped as complete by a re-run.
+    """
+    seen, host = outcome.seen, outcome.host
+    if seen is None or host is None or len(seen) != len(here):
+        return None
+    if _difference(here, seen, host) is None:
+        return None
+    return _difference(fingerprint(job.reads), seen, host)  # changed meanwhile: None
+
+
+def _difference(here: list[dict[str, Any]], seen: list[dict[str, Any]], host: str) -> str | None:
+    """The first input whose fingerprints `here` and `seen` (on worker `host`) differ, said."""
+    for mine, theirs in zip(here, seen, strict=True):
+        if mine.get("missing"):
+            continue  # the task fails (or not) on its own, as it would in this process
+        path = mine["path"]
+        if theirs.get("missing"):
+            return f"{path}: {UNSEEN.format(host=host)}"
+        counted = (theirs.get("files"), theirs.get("size"))
+        if "files" in mine and (mine["files"], mine["size"]) != counted:
+            return (
+                f"{path}: another folder on worker {host} ({theirs.get('files')} images, "
+                f"{theirs.get('size')} bytes there; {mine['files']} images, {mine['size']} "
+                f"bytes here): {SAME_FILES}"
+            )
+        if "files" not in mine and mine.get("size") != theirs.get("size"):
+            return (
+                f"{path}: another file on worker {host} ({theirs.get('size')} bytes there, "
+                f"{mine.get('size')} here): {SAME_FILES}"
+            )
+    return None
+
+
+#: How the client ends the error of a task whose worker read other inputs than it sees.
+SAME_FILES = "workers must see the same files at the same paths"
 
 
 def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
@@ -1606,8 +1762,7 @@ def run_jobs(
         outputs written so far are complete. What the batch left (nothing, or how many tasks'
         outputs) is attached: :func:`interrupted_left`.
     """
-    if n_workers is not None and n_workers < 0:
-        raise ValueError(f"n_workers is {n_workers}, expected >= 0")
+    _check_arguments(out_dir, n_workers, force, show_progress)
     address = where_to_run(client, scheduler, n_workers)  # checked even when nothing is to run
     start = time.perf_counter()
     out = _check_outputs(jobs, out_dir, suffixes, force)
@@ -1635,6 +1790,9 @@ def run_jobs(
 
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
+        other = _seen_otherwise(job, outcome, prints[job.name]) if remote else None
+        if other is not None:  # not written: the outputs of files this process does not have
+            outcome = Outcome(None, other, outcome.traceback, outcome.host)
         if outcome.result is not None:
             try:
                 entries[job.name] = _write(
@@ -1714,6 +1872,32 @@ def run_jobs(
     return summary
 
 
+def _check_arguments(out_dir: object, n_workers: object, force: object, show: object) -> None:
+    """Refuse arguments of :func:`run_jobs` of another type or range, naming them.
+
+    Was: ``force="no"`` forced (files no batch wrote replaced), ``n_workers=2.5`` or ``True``
+    ran, and ``n_workers="2"`` or ``out_dir=None`` failed in Python's words.
+    """
+    if not isinstance(out_dir, (str, bytes, os.PathLike)):
+        raise TypeError(
+            f"{_OUT_NAMES.get()[0]} must be a path (str or os.PathLike), got "
+            f"{type(out_dir).__name__} {out_dir!r}"
+        )
+    if n_workers is not None:
+        if isinstance(n_workers, bool) or not isinstance(n_workers, numbers.Integral):
+            raise TypeError(
+                "n_workers must be an integer >= 0 or None, got "
+                f"{type(n_workers).__name__} {n_workers!r}"
+            )
+        if n_workers < 0:
+            raise ValueError(f"n_workers is {n_workers}, expected >= 0")
+    flag(force, "force")
+    if show is not None and not isinstance(show, bool):
+        raise TypeError(
+            f"show_progress must be True, False or None, got {type(show).__name__} {show!r}"
+        )
+
+
 @contextlib.contextmanager
 def _no_bars() -> Iterator[None]:
     """Meanwhile, no new progress bar (a task run in this process: the batch's bar is drawn).
@@ -1782,23 +1966,40 @@ def no_workers_timeout() -> float:
     ValueError
         The setting is not a duration.
     """
+    seconds = dask_seconds("distributed.scheduler.no-workers-timeout", "60s")
+    return NO_WORKERS_WAIT if seconds is None else seconds
+
+
+def dask_seconds(key: str, example: str) -> float | None:
+    """Dask's duration setting `key`, in seconds; None when it is not set.
+
+    Raises
+    ------
+    ValueError
+        The setting is not a finite duration >= 0: one line naming it, its environment
+        variable and an `example` (was: Dask's traceback, "KeyError: 'Invalid time unit: abc
+        ...'", from the connection or from a local cluster's start, for a setting the help
+        names).
+    """
     import dask
     from dask.utils import parse_timedelta
 
-    key = "distributed.scheduler.no-workers-timeout"
     value = dask.config.get(key, None)
     if value is None:
-        return NO_WORKERS_WAIT
+        return None
     try:
         seconds = float(parse_timedelta(value, default="s"))
     except (TypeError, ValueError, KeyError):
         seconds = math.nan
     if not seconds >= 0 or math.isinf(seconds):
-        raise ValueError(f"{key} is {value!r}, expected a duration such as '60s'")
+        variable = "DASK_" + key.upper().replace(".", "__").replace("-", "_")
+        raise ValueError(
+            f"{key} is {value!r} (${variable}), expected a duration such as '{example}'"
+        )
     return seconds
 
 
-def _n_workers(c: Client) -> int:
+def _n_workers(c: Client, timeout: float | None = None) -> int:
     """The scheduler's workers now, as the scheduler counts them (its ``identity``).
 
     Not ``len(c.scheduler_info()["workers"])``: the client refreshes that cache every 2 s
@@ -1808,10 +2009,20 @@ def _n_workers(c: Client) -> int:
     scheduler has lost all its workers" while they ran. The ``n_workers`` key, where the Dask
     has it, counts them all; an older Dask lists them all. With the connection going (an
     OSError), what the client last heard.
+
+    Raises
+    ------
+    TimeoutError
+        The scheduler did not answer within `timeout` seconds (None: no limit).
     """
     rpc = c.scheduler
     try:
-        info = c.sync(rpc.identity) if rpc is not None else c.scheduler_info()
+        if rpc is None:
+            info = c.scheduler_info()
+        else:
+            info = c.sync(rpc.identity, callback_timeout=timeout)
+    except TimeoutError:
+        raise
     except OSError:
         info = c.scheduler_info()
     n = info.get("n_workers")
@@ -1857,21 +2068,49 @@ def _wait_for_workers(c: Client, address: str, wait: float) -> int:
     return n
 
 
+#: Seconds the scheduler has to answer a count of its workers while tasks wait on it. One that
+#: does not (frozen: stopped, swapping, its event loop blocked) is said to be so, and waited for
+#: as long as for a worker (:func:`no_workers_timeout`); was: waited for, silently, for ever.
+ANSWER_WAIT = 5.0
+
+
 class _WorkersWatch:
-    """While tasks wait on a cluster: tells when it has been without workers for too long."""
+    """While tasks wait on a cluster: tells when it has been without workers for too long.
+
+    Or when its scheduler has not answered for that long (:data:`ANSWER_WAIT`): ``frozen``.
+    """
 
     def __init__(self, c: Client, address: str, wait: float) -> None:
         self.c, self.address, self.wait = c, address, wait
         self.since: float | None = None  # when the workers were last seen gone
+        self.silent: float | None = None  # when the scheduler was first asked in vain
+        self.frozen = False
         self._checked = -math.inf
 
     def given_up(self) -> bool:
-        """True once the cluster has had no worker for `wait` seconds (warns when they go)."""
+        """True once the cluster has had no worker for `wait` seconds (warns when they go).
+
+        True too once the scheduler has not answered for `wait` seconds (warns once it has
+        not answered for :data:`ANSWER_WAIT`).
+        """
         now = time.monotonic()
         if now - self._checked < WORKERS_POLL:
             return False
         self._checked = now
-        if _n_workers(self.c):
+        try:
+            n = _n_workers(self.c, ANSWER_WAIT)
+        except TimeoutError:
+            if self.silent is None:
+                self.silent = now
+                warnings.warn(
+                    f"the scheduler at {self.address} has not answered for {ANSWER_WAIT:g} s "
+                    f"(frozen or overloaded?); waiting up to {self.wait:g} s for it",
+                    stacklevel=2,
+                )
+            self.frozen = time.monotonic() - self.silent >= self.wait
+            return self.frozen
+        self.silent = None
+        if n:
             self.since = None
             return False
         if self.since is None:
@@ -1885,6 +2124,11 @@ class _WorkersWatch:
 
     def error(self, noun: str) -> str:
         """The error of a task left waiting when :meth:`given_up`."""
+        if self.frozen:
+            return (
+                f"the scheduler at {self.address} did not answer for {self.wait:g} s (frozen "
+                f"or overloaded) before this {noun} finished (a re-run does the rest)"
+            )
         return (
             f"no worker on the scheduler at {self.address} for {self.wait:g} s: its workers "
             f"were lost before this {noun} ran or finished (start some: dask worker "
@@ -2056,24 +2300,31 @@ def _run_on_dask(
     for job in sendable:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
         where = (topic, job.name) if frames is not None else None
-        fut = c.submit(call_task, job.func, job.args, where, key=key, pure=False)
+        fut = c.submit(call_task, job.func, job.args, where, job.reads, key=key, pure=False)
         futures[fut.key] = (fut, job)
     watch = _WorkersWatch(c, address, wait)
     noun = "sequence" if kind == "track" else "file"
-    done = _completed(as_completed([f for f, _ in futures.values()]), watch.given_up)
+    tracked = as_completed([f for f, _ in futures.values()])
+    done = _completed(tracked, watch.given_up)
     try:
         for fut in progress(done, **bar) if frames is None else done:
+            status = fut.status
+            if status not in ("finished", "error", "cancelled"):
+                # finished, then its result lost with its worker before it was taken: Dask
+                # computes it again ("lost", "pending"); was: left out, "cancelled", not written
+                tracked.add(fut)
+                continue
             _, job = futures.pop(fut.key)
             if frames is not None:
                 frames.finish(job.name)
-            if fut.status == "finished":
+            if status == "finished":
                 record(job, fut.result())
-            elif fut.status == "error":  # the worker died (KilledWorker) or the like
+            elif status == "error":  # the worker died (KilledWorker) or the like
                 exc = fut.exception()
                 # the scheduler's own no-workers-timeout: said as this process's watch says it
                 lost = type(exc).__name__ == "NoWorkerError"
                 record(job, Outcome(None, watch.error(noun) if lost else one_line(exc)))
-            elif fut.status == "cancelled" and _connection_lost(c, fut):  # Dask cancels them all
+            elif status == "cancelled" and _connection_lost(c, fut):  # Dask cancels them all
                 record(job, Outcome(None, _scheduler_lost(address, noun)))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
         if futures:  # given up: no worker for too long

@@ -79,15 +79,43 @@ class SequenceInput:
 
 
 def _absolute(inputs: Inputs) -> list[Path]:
-    """The inputs as absolute paths: workers may run in another folder than this process."""
-    paths = [inputs] if isinstance(inputs, (str, os.PathLike)) else list(inputs)
-    if not paths:
+    """The inputs as absolute paths: workers may run in another folder than this process.
+
+    Raises
+    ------
+    TypeError
+        `inputs` is neither a path nor an iterable of paths, or one of them is no path
+        (was: Python's words, "'NoneType' object is not iterable", naming no parameter).
+    ValueError
+        No input, an empty path or ``-``.
+    """
+    if isinstance(inputs, bytes):
+        inputs = os.fsdecode(inputs)
+    if isinstance(inputs, (str, os.PathLike)):
+        paths: list[object] = [inputs]
+    else:
+        try:  # a list, a tuple, or any iterable of paths (Path.glob's)
+            paths = list(inputs)
+        except TypeError:
+            raise TypeError(
+                f"inputs must be a path or a list of paths, got {type(inputs).__name__} {inputs!r}"
+            ) from None
+    given: list[str | os.PathLike[str]] = []
+    for i, p in enumerate(paths):
+        if isinstance(p, bytes):
+            p = os.fsdecode(p)
+        if not isinstance(p, (str, os.PathLike)):
+            raise TypeError(
+                f"inputs[{i}] must be a path (str or os.PathLike), got {type(p).__name__} {p!r}"
+            )
+        given.append(p)
+    if not given:
         raise ValueError("no input given")
-    for p in paths:  # was: "input not found: /cwd/-"
+    for p in given:  # was: "input not found: /cwd/-"
         refuse_dash(p, "input", name="file or folder")
         if os.fspath(p) == "":  # was: the current folder, tracked as an image folder
             raise ValueError("an input is an empty path; give a file or folder")
-    return [Path(os.path.abspath(p)) for p in paths]
+    return [Path(os.path.abspath(p)) for p in given]
 
 
 def _first_file(folder: Path, *candidates: str) -> Path | None:
