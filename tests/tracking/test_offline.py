@@ -208,6 +208,22 @@ def test_smooth_tracks_on_any_trackers_output():
         smooth_tracks(rows, smoother="x")  # type: ignore[arg-type]
 
 
+def test_a_hole_left_unfilled_is_no_bridge_for_the_smoother():
+    """An id a tracker gives a second person after a hole longer than the filling's gap
+    (here 41 frames, max_gap 30): each person stands still, so each side smooths to its own
+    box (was: the smoother joined the sides through the hole, up to BoxSmoother.max_hole = 300
+    frames, and bent both people's boxes towards each other by up to 10 px)."""
+    frames = np.r_[np.arange(1, 21), np.arange(62, 82)]
+    boxes = np.where(frames[:, None] < 21, [100.0, 50.0, 20.0, 50.0], [300.0, 80.0, 20.0, 50.0])
+    rows = np.column_stack([frames, np.full(40, 4.0), boxes, np.ones(40), -np.ones((40, 3))])
+    for link in ("auto", None):
+        out = smooth_tracks(rows, link=link, max_gap=30)
+        assert out[:, 0].tolist() == frames.tolist()  # the hole is left as it is
+        np.testing.assert_allclose(out[:, 2:6], boxes, atol=1e-6)
+    joined = smooth_tracks(rows, link=None, max_gap=50)  # filled: one track, smoothed as one
+    assert len(joined) == 81
+
+
 def test_cli_smooth_links_fills_and_refuses_its_input(tmp_path, capsys):
     from pftrack.cli import main
     from pftrack.io.mot import read_mot, write_mot

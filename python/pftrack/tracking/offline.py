@@ -15,7 +15,7 @@ the smoothed boxes match the annotation far more often than the detections thems
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -512,6 +512,8 @@ def smooth_tracks(
         With a smoother: fill the holes of at most this many frames inside each id's track,
         as `link` does (an int in ``1..MAX_GAP_LIMIT``; ``pftrack smooth --no-link`` passes
         it without `link`). None (default): ``link.max_gap``, and no filling without `link`.
+        A hole longer than the filling's gap is not bridged by the smoother either: the
+        track is smoothed in pieces split there (``BoxSmoother.max_hole`` at most that gap).
 
     Returns
     -------
@@ -593,6 +595,11 @@ def smooth_tracks(
     new = np.zeros(len(a), dtype=bool)
     if smoother is not None and fill_gap is not None:
         a, obs, z, new = _add_hole_rows(a, obs, z, fill_gap, fill_method, seed)
+    if smoother is not None and fill_gap is not None:
+        # a hole left unfilled is no bridge for the smoother either: its two sides are
+        # smoothed apart (was: joined through holes of up to max_hole = 300 frames, so an id a
+        # tracker gave a second, still person 41 frames later bent both people's boxes by 10 px)
+        smoother = replace(smoother, max_hole=min(smoother.max_hole, fill_gap))
     if smoother is not None:
         starts = np.flatnonzero(np.r_[True, a[1:, 1] != a[:-1, 1], True])
         spans = list(zip(starts[:-1], starts[1:], strict=True))
