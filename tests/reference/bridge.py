@@ -156,3 +156,39 @@ def loglik_grid(runs, axis, q, r):
             p01 = (1.0 - k0) * a01
             p11 = a11 - k1 * a01
     return ll
+
+
+def two_sided_posterior(za, zb, T, A, Q, H, R, prior_a, prior_b):
+    """E[x_t | every point] of the whole window: segment A (consecutive frames), the gap of
+    T - 1 frames, segment B (consecutive frames), with a Gaussian factor on each far end.
+
+    Written from the model, not from the goal-directed algebra: one linear-Gaussian chain
+    ``x_k = A x_{k-1} + w_k`` over every frame from A's first point to B's last, measurements
+    ``z = H x + v`` on the observed frames, ``N(x_first; *prior_a)`` on A's first state and
+    ``N(x_last; *prior_b)`` on B's last; the joint density's precision matrix is assembled
+    factor by factor and solved densely. Returns the means, ``(len(za) + T - 1 + len(zb), n)``.
+    """
+    n = A.shape[0]
+    N = len(za) + T - 1 + len(zb)
+    Lam = np.zeros((n * N, n * N))
+    eta = np.zeros(n * N)
+
+    def blk(i):
+        return slice(i * n, (i + 1) * n)
+
+    Qi, Ri = np.linalg.inv(Q), np.linalg.inv(R)
+    for k in range(1, N):
+        Lam[blk(k), blk(k)] += Qi
+        Lam[blk(k - 1), blk(k - 1)] += A.T @ Qi @ A
+        Lam[blk(k), blk(k - 1)] -= Qi @ A
+        Lam[blk(k - 1), blk(k)] -= A.T @ Qi
+    observed = [(k, z) for k, z in enumerate(za)]
+    observed += [(len(za) + T - 1 + k, z) for k, z in enumerate(zb)]
+    for k, z in observed:
+        Lam[blk(k), blk(k)] += H.T @ Ri @ H
+        eta[blk(k)] += H.T @ Ri @ z
+    for k, (m, P) in ((0, prior_a), (N - 1, prior_b)):
+        Pi = np.linalg.inv(P)
+        Lam[blk(k), blk(k)] += Pi
+        eta[blk(k)] += Pi @ m
+    return np.linalg.solve(Lam, eta).reshape(N, n)

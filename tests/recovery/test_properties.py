@@ -1,0 +1,109 @@
+"""Mathematical properties of the recovery methods, against references derived from the model.
+
+``gdt-bi`` is checked against the posterior mean of the whole linear-Gaussian chain over both
+segments and the gap (``tests/reference/bridge.py: two_sided_posterior``, assembled factor by
+factor from the model and solved densely, with no goal-directed algebra and no Kalman filter),
+and every method against the symmetries its equations have.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pftrack.kalman import cv_transition_xy, wna_Q_xy
+from pftrack.recovery import METHODS, recover_gap, recover_gaps
+from pftrack.recovery.noise import NoiseEstimate
+from tests.reference import bridge as ref
+
+_H = np.hstack([np.eye(2), np.zeros((2, 2))])
+_J = np.diag([1.0, 1.0, -1.0, -1.0])  # time reversal: the velocity changes sign
+#: A Kalman filter's start in pftrack.recovery.problems: the first point (variance r), the
+#: first difference as velocity (variance 100); the first point is then also measured.
+_P_VELOCITY = 100.0
+
+
+def _far_end_prior(z: np.ndarray, r: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The prior a filter from ``z[0]`` towards ``z[-1]`` puts on ``z[0]``'s state."""
+    return np.r_[z[0], z[1] - z[0]], np.diag([r[0], r[1], _P_VELOCITY, _P_VELOCITY])
+
+
+def _pair(seed: int, T: int, na: int, nb: int, start: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
+    """Two runs of consecutive frames around a gap of `T` frames (T - 1 missing), curved + noise."""
+    rng = np.random.default_rng(seed)
+    fa = np.arange(start, start + na)
+    fb = np.arange(fa[-1] + T, fa[-1] + T + nb)
+    f = np.r_[fa, fb]
+    xy = np.column_stack([3 + 1.3 * f + 0.02 * f**2, 50 - 0.6 * f - 0.01 * f**2])
+    xy += rng.normal(0.0, 0.7, xy.shape)
+    return np.column_stack([fa, xy[:na]]), np.column_stack([fb, xy[na:]])
+
+
+@pytest.mark.parametrize(("T", "na", "nb"), [(12, 9, 7), (2, 9, 7), (2, 2, 2), (30, 2, 15)])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_gdt_bi_is_the_posterior_mean_of_both_segments(T, na, nb, seed):
+    """The forward filter over A, the backward filter over B as the goal and the goal-directed
+    path are together the exact smoother of the whole window (the white-noise-acceleration
+    model is its own time reversal), a gap of one missing frame (T = 2) included."""
+    a, b = _pair(seed, T, na, nb)
+    noise = NoiseEstimate(q=(0.05, 0.3), r=(0.5, 0.8))
+    got = recover_gap(a, b, method="gdt-bi", noise=noise)
+    m_b, P_b = _far_end_prior(b[::-1, 1:3], noise.r)  # B's filter runs backwards from its end
+    means = ref.two_sided_posterior(
+        a[:, 1:3],
+        b[:, 1:3],
+        T,
+        cv_transition_xy(1.0),
+        wna_Q_xy(noise.q),
+        _H,
+        np.diag(noise.r),
+        _far_end_prior(a[:, 1:3], noise.r),
+        (_J @ m_b, P_b),
+    )
+    assert got.shape == (T - 1, 2)
+    np.testing.assert_allclose(got, means[na : na + T - 1, :2], rtol=0, atol=1e-9)
+
+
+#: Methods whose equations are symmetric in time: the gap recovered on the time-reversed
+#: track is the same path. (Not ``gdt``, the paper's one-sided filter; not ``rts``, whose
+#: prior sits on the window's first point; not ``gdt-fixed``, see the test below.)
+_TIME_SYMMETRIC = ("gdt-bi", "linear", "cubic", "bspline", "gsi")
+
+
+@pytest.mark.parametrize("method", _TIME_SYMMETRIC)
+@pytest.mark.parametrize("seed", [0, 1])
+def test_time_symmetric_methods_recover_a_reversed_gap_reversed(method, seed):
+    a, b = _pair(seed, T=15, na=35, nb=40)
+    forward = recover_gap(a, b, method=method)
+    # frame f -> 1000 - f: B comes first, A second, each with its rows in increasing frames
+    ra, rb = (np.column_stack([1000.0 - s[::-1, 0], s[::-1, 1:]]) for s in (b, a))
+    backward = recover_gap(ra, rb, method=method)[::-1]
+    tol = 1e-4 if method == "gsi" else 1e-9  # gsi's RBF kernel matrix is ill-conditioned
+    np.testing.assert_allclose(backward, forward, rtol=0, atol=tol)
+
+
+@pytest.mark.parametrize("method", [m for m in METHODS if m != "auto"])
+def test_swapping_x_and_y_swaps_the_path(method):
+    """Every method treats the two axes alike: no axis is special in any of the models."""
+    a, b = _pair(3, T=15, na=35, nb=40)
+    got = recover_gap(a, b, method=method)
+    swapped = recover_gap(a[:, [0, 2, 1]], b[:, [0, 2, 1]], method=method)
+    np.testing.assert_allclose(swapped[:, ::-1], got, rtol=0, atol=1e-9)
+
+
+def test_auto_swaps_with_the_axes_too():
+    a, b = _pair(3, T=15, na=35, nb=40)
+    pairs = [(a, b), _pair(4, T=9, na=30, nb=30, start=200.0)]
+    got = recover_gaps(pairs, "auto")
+    swapped = recover_gaps([(p[:, [0, 2, 1]], q[:, [0, 2, 1]]) for p, q in pairs], "auto")
+    for g, s in zip(got, swapped, strict=True):
+        np.testing.assert_allclose(s[:, ::-1], g, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("method", ["gdt", "gdt-bi", "gdt-fixed", "rts", "linear", "cubic"])
+def test_mirroring_an_axis_mirrors_the_path(method):
+    a, b = _pair(5, T=15, na=35, nb=40)
+    got = recover_gap(a, b, method=method)
+    flip = np.array([1.0, -1.0, 1.0])
+    mirrored = recover_gap(a * flip, b * flip, method=method)
+    np.testing.assert_allclose(mirrored * [-1.0, 1.0], got, rtol=0, atol=1e-9)
