@@ -13,6 +13,7 @@ import pytest
 
 from pftrack.kalman import cv_transition_xy, wna_Q_xy
 from pftrack.recovery import METHODS, recover_gap, recover_gaps
+from pftrack.recovery.baselines import rts, rts_batch
 from pftrack.recovery.noise import NoiseEstimate
 from tests.reference import bridge as ref
 
@@ -107,3 +108,39 @@ def test_mirroring_an_axis_mirrors_the_path(method):
     flip = np.array([1.0, -1.0, 1.0])
     mirrored = recover_gap(a * flip, b * flip, method=method)
     np.testing.assert_allclose(mirrored * [-1.0, 1.0], got, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("history", "na", "nb", "holes"),
+    [(30, 20, 25, False), (30, 50, 45, True), (5, 12, 12, True), (30, 1, 1, False)],
+)
+def test_rts_is_the_posterior_mean_of_its_window(history, na, nb, holes):
+    """``rts`` (and its batch) is the exact smoother of `history` points a side and the gap:
+    prior ``N([z_0, 0], diag(r, 100))`` on the window's first state, which is then also
+    measured, holes inside the segments included."""
+    rng = np.random.default_rng(na + nb)
+    fa = np.arange(10.0, 10 + na)
+    fb = np.arange(fa[-1] + 9, fa[-1] + 9 + nb)
+    if holes:
+        fa, fb = np.delete(fa, [3, 4, 7]), np.delete(fb, [2, 5])
+    a, b = (
+        np.column_stack([f, 2 * f + rng.normal(0, 1, len(f)), -f + rng.normal(0, 1, len(f))])
+        for f in (fa, fb)
+    )
+    q, r = 0.1, 1.0  # the baseline's fixed levels
+    window = np.vstack([a[-history:], b[:history]])
+    f0 = window[0, 0]
+    means = ref.chain_posterior(
+        int(window[-1, 0] - f0 + 1),
+        [(int(row[0] - f0), row[1:3]) for row in window],
+        cv_transition_xy(1.0),
+        wna_Q_xy((q, q)),
+        _H,
+        np.diag([r, r]),
+        [(0, np.r_[window[0, 1:3], 0.0, 0.0], np.diag([r, r, 100.0, 100.0]))],
+    )
+    gap = np.arange(a[-1, 0] + 1, b[0, 0]).astype(np.int64)
+    expected = means[(gap - f0).astype(int), :2]
+    np.testing.assert_allclose(rts(a, b, gap, history=history), expected, rtol=0, atol=1e-9)
+    batch = rts_batch([(a, b)], history=history)[0]
+    np.testing.assert_allclose(batch, expected, rtol=0, atol=1e-9)

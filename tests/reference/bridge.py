@@ -165,11 +165,23 @@ def two_sided_posterior(za, zb, T, A, Q, H, R, prior_a, prior_b):
     Written from the model, not from the goal-directed algebra: one linear-Gaussian chain
     ``x_k = A x_{k-1} + w_k`` over every frame from A's first point to B's last, measurements
     ``z = H x + v`` on the observed frames, ``N(x_first; *prior_a)`` on A's first state and
-    ``N(x_last; *prior_b)`` on B's last; the joint density's precision matrix is assembled
-    factor by factor and solved densely. Returns the means, ``(len(za) + T - 1 + len(zb), n)``.
+    ``N(x_last; *prior_b)`` on B's last (:func:`chain_posterior`). Returns the means,
+    ``(len(za) + T - 1 + len(zb), n)``.
+    """
+    N = len(za) + T - 1 + len(zb)
+    observed = [(k, z) for k, z in enumerate(za)]
+    observed += [(len(za) + T - 1 + k, z) for k, z in enumerate(zb)]
+    return chain_posterior(N, observed, A, Q, H, R, [(0, *prior_a), (N - 1, *prior_b)])
+
+
+def chain_posterior(N, observed, A, Q, H, R, priors):
+    """Posterior means ``(N, n)`` of the chain ``x_k = A x_{k-1} + N(0, Q)``, k = 1..N-1.
+
+    `observed` holds ``(k, z)``: ``z = H x_k + N(0, R)``; `priors` holds ``(k, m, P)``: a
+    factor ``N(x_k; m, P)``. The joint density's precision matrix is assembled factor by
+    factor and solved densely (no filter, no recursion).
     """
     n = A.shape[0]
-    N = len(za) + T - 1 + len(zb)
     Lam = np.zeros((n * N, n * N))
     eta = np.zeros(n * N)
 
@@ -182,12 +194,10 @@ def two_sided_posterior(za, zb, T, A, Q, H, R, prior_a, prior_b):
         Lam[blk(k - 1), blk(k - 1)] += A.T @ Qi @ A
         Lam[blk(k), blk(k - 1)] -= Qi @ A
         Lam[blk(k - 1), blk(k)] -= A.T @ Qi
-    observed = [(k, z) for k, z in enumerate(za)]
-    observed += [(len(za) + T - 1 + k, z) for k, z in enumerate(zb)]
     for k, z in observed:
         Lam[blk(k), blk(k)] += H.T @ Ri @ H
         eta[blk(k)] += H.T @ Ri @ z
-    for k, (m, P) in ((0, prior_a), (N - 1, prior_b)):
+    for k, m, P in priors:
         Pi = np.linalg.inv(P)
         Lam[blk(k), blk(k)] += Pi
         eta[blk(k)] += Pi @ m
