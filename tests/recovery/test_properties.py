@@ -13,9 +13,10 @@ import pytest
 
 from pftrack.kalman import cv_transition_xy, wna_Q_xy
 from pftrack.recovery import METHODS, recover_gap, recover_gaps
-from pftrack.recovery.baselines import rts, rts_batch
+from pftrack.recovery.baselines import bspline, rts, rts_batch
 from pftrack.recovery.noise import NoiseEstimate
 from tests.reference import bridge as ref
+from tests.reference import splines
 
 _H = np.hstack([np.eye(2), np.zeros((2, 2))])
 _J = np.diag([1.0, 1.0, -1.0, -1.0])  # time reversal: the velocity changes sign
@@ -144,3 +145,38 @@ def test_rts_is_the_posterior_mean_of_its_window(history, na, nb, holes):
     np.testing.assert_allclose(rts(a, b, gap, history=history), expected, rtol=0, atol=1e-9)
     batch = rts_batch([(a, b)], history=history)[0]
     np.testing.assert_allclose(batch, expected, rtol=0, atol=1e-9)
+
+
+def _curve(na: int, nb: int, T: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    fa = np.arange(0.0, na)
+    fb = np.arange(na - 1 + T, na - 1 + T + nb)
+    f = np.r_[fa, fb]
+    xy = np.column_stack([3 * f + 5 * np.sin(f / 4), -f + 0.05 * f**2])
+    xy += rng.normal(0, 1, xy.shape)
+    frames = np.arange(fa[-1] + 1, fb[0]).astype(np.int64)
+    return np.column_stack([fa, xy[:na]]), np.column_stack([fb, xy[na:]]), frames
+
+
+@pytest.mark.parametrize(("na", "nb", "T"), [(20, 20, 10), (12, 12, 5), (30, 9, 17), (5, 4, 3)])
+def test_bspline_is_the_documented_weighted_least_squares_fit(na, nb, T):
+    """Against a Cox-de Boor basis and the weighted normal equations (no SciPy): the residual
+    of a point `d` frames from the gap is multiplied by ``1 / (1 + d / 5)`` (SciPy's ``w``),
+    so its square weighs ``1 / (1 + d / 5)²``."""
+    a, b, frames = _curve(na, nb, T, seed=na + T)
+    np.testing.assert_allclose(
+        bspline(a, b, frames), splines.weighted_bspline(a, b, frames), rtol=0, atol=1e-9
+    )
+
+
+@pytest.mark.parametrize("method", ["cubic", "bspline"])
+def test_splines_recover_a_cubic_track_exactly(method):
+    """A cubic polynomial lies in both spline spaces: the interpolating not-a-knot spline and
+    the least-squares fit both reproduce it, whatever the weights and knots."""
+    fa, fb = np.arange(0.0, 20), np.arange(31.0, 50)
+    f = np.r_[fa, fb]
+    xy = np.column_stack([2 + 0.5 * f - 0.03 * f**2 + 1e-3 * f**3, 7 - 0.2 * f + 2e-4 * f**3])
+    a, b = np.column_stack([fa, xy[:20]]), np.column_stack([fb, xy[20:]])
+    g = np.arange(20.0, 31)
+    truth = np.column_stack([2 + 0.5 * g - 0.03 * g**2 + 1e-3 * g**3, 7 - 0.2 * g + 2e-4 * g**3])
+    np.testing.assert_allclose(recover_gap(a, b, method=method), truth, rtol=0, atol=1e-9)

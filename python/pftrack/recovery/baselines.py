@@ -101,7 +101,9 @@ def bspline(
     """Weighted least-squares cubic B-spline over `window` points on each side.
 
     Interior knots every `spacing` frames inside each observed window; points near the gap
-    weigh more (Sun et al. 2005, the paper's first baseline). Falls back to :func:`cubic`
+    weigh more: the residual of a point ``d`` frames from the gap is multiplied by
+    ``1 / (1 + d / 5)`` (SciPy's ``w``), so its square weighs ``1 / (1 + d / 5)²`` (Sun et al.
+    2005, the paper's first baseline). Falls back to :func:`cubic`
     with fewer than 8 points or a singular fit (an error or a non-finite result).
     """
     from scipy.interpolate import make_lsq_spline
