@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from pftrack.kalman import cv_transition_xy, wna_Q_xy
-from pftrack.recovery import METHODS, recover_gap, recover_gaps
+from pftrack.recovery import METHODS, goal_directed_path, recover_gap, recover_gaps
 from pftrack.recovery.baselines import bspline, rts, rts_batch
 from pftrack.recovery.noise import NoiseEstimate
+from tests.recovery.test_bridge import problem
 from tests.reference import bridge as ref
 from tests.reference import splines
 
@@ -180,3 +181,26 @@ def test_splines_recover_a_cubic_track_exactly(method):
     g = np.arange(20.0, 31)
     truth = np.column_stack([2 + 0.5 * g - 0.03 * g**2 + 1e-3 * g**3, 7 - 0.2 * g + 2e-4 * g**3])
     np.testing.assert_allclose(recover_gap(a, b, method=method), truth, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("T", [1, 4, 9])
+@pytest.mark.parametrize("start_conditioned", [False, True])
+@pytest.mark.parametrize("form", ["general", "invertible", "pseudo_inverse"])
+def test_state_covariances_propagate_the_linear_drift(T, start_conditioned, form):
+    """The drift is linear, ``u_t = K_t (y_T - H Phi(T, t-1) x_{t-1})``, so the state's
+    covariance obeys ``C_t = (A_t - K_t H Phi(T, t-1)) C_{t-1} (...)^T + eps_t`` from
+    ``C_0 = cov(x_0 | y_T)``, or ``Pi_0`` when the path starts at ``m0`` (not covered by the
+    joint conditional, which holds for a conditioned start only)."""
+    rng = np.random.default_rng(T)
+    p = problem(rng, n=4, m=4, T=T, varying=True)
+    got = goal_directed_path(**p, form=form, start_conditioned=start_conditioned)
+    A, Q, H = list(p["A"]), list(p["Q"]), p["H_T"]
+    C = got.x0_cov if start_conditioned else p["Pi_0"]
+    expected = [C]
+    for t in range(1, T + 1):
+        M = p["Pi_T"] + H @ ref.S_sum(A, Q, T, t) @ H.T
+        K = Q[t - 1] @ ref.phi(A, T, t).T @ H.T @ np.linalg.inv(M)
+        F = A[t - 1] - K @ H @ ref.phi(A, T, t - 1)
+        C = F @ C @ F.T + (Q[t - 1] - K @ H @ ref.phi(A, T, t) @ Q[t - 1])
+        expected.append(C)
+    np.testing.assert_allclose(got.cov, np.array(expected), rtol=1e-9, atol=1e-12)
