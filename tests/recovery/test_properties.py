@@ -28,7 +28,8 @@ _P_VELOCITY = 100.0
 
 def _far_end_prior(z: np.ndarray, r: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
     """The prior a filter from ``z[0]`` towards ``z[-1]`` puts on ``z[0]``'s state."""
-    return np.r_[z[0], z[1] - z[0]], np.diag([r[0], r[1], _P_VELOCITY, _P_VELOCITY])
+    velocity = z[1] - z[0] if len(z) > 1 else np.zeros(2)  # one point: velocity 0
+    return np.r_[z[0], velocity], np.diag([r[0], r[1], _P_VELOCITY, _P_VELOCITY])
 
 
 def _pair(seed: int, T: int, na: int, nb: int, start: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
@@ -42,7 +43,9 @@ def _pair(seed: int, T: int, na: int, nb: int, start: float = 5.0) -> tuple[np.n
     return np.column_stack([fa, xy[:na]]), np.column_stack([fb, xy[na:]])
 
 
-@pytest.mark.parametrize(("T", "na", "nb"), [(12, 9, 7), (2, 9, 7), (2, 2, 2), (30, 2, 15)])
+@pytest.mark.parametrize(
+    ("T", "na", "nb"), [(12, 9, 7), (2, 9, 7), (2, 2, 2), (30, 2, 15), (6, 1, 1), (9, 6, 1)]
+)
 @pytest.mark.parametrize("seed", [0, 1])
 def test_gdt_bi_is_the_posterior_mean_of_both_segments(T, na, nb, seed):
     """The forward filter over A, the backward filter over B as the goal and the goal-directed
