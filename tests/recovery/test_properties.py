@@ -14,6 +14,7 @@ import pytest
 from pftrack.kalman import cv_transition_xy, wna_Q_xy
 from pftrack.recovery import METHODS, goal_directed_path, recover_gap, recover_gaps
 from pftrack.recovery.baselines import bspline, rts, rts_batch
+from pftrack.recovery.gdt import GdtModel
 from pftrack.recovery.noise import NoiseEstimate
 from tests.recovery.test_bridge import problem
 from tests.reference import bridge as ref
@@ -207,3 +208,37 @@ def test_state_covariances_propagate_the_linear_drift(T, start_conditioned, form
         C = F @ C @ F.T + (Q[t - 1] - K @ H @ ref.phi(A, T, t) @ Q[t - 1])
         expected.append(C)
     np.testing.assert_allclose(got.cov, np.array(expected), rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_gdt_fixed_is_the_posterior_of_a_chain_reversed_inside_b(seed):
+    """``gdt-fixed``'s backward filter runs the paper's ``A``, ``Q`` on B's points in reverse
+    order: in forward time, B's steps have the noise ``A J Q J A^T``, which for the paper's
+    diagonal ``Q`` is not ``Q`` (the white-noise-acceleration ``Q`` of ``gdt-bi`` is its own
+    reversal). So ``gdt-fixed`` is the exact posterior of that chain, not of the paper's
+    model over the whole window, and not symmetric in time (docs/recovery.md, methods)."""
+    T, na, nb = 12, 9, 7
+    a, b = _pair(seed, T, na, nb)
+    paper = GdtModel()
+    A, Q, r = paper.A, paper.Q, paper.r
+    m_b, P_b = _far_end_prior(b[::-1, 1:3], r)
+    N = na + T - 1 + nb
+    into_b = na + T - 1  # the step to B's first frame is the gap's last: Q
+    chain = np.array([Q if k < into_b else A @ _J @ Q @ _J @ A.T for k in range(N - 1)])
+    posterior = {
+        name: ref.two_sided_posterior(
+            a[:, 1:3],
+            b[:, 1:3],
+            T,
+            A,
+            q,
+            _H,
+            paper.R,
+            _far_end_prior(a[:, 1:3], r),
+            (_J @ m_b, P_b),
+        )[na : na + T - 1, :2]
+        for name, q in (("reversed inside B", chain), ("paper's model", Q))
+    }
+    got = recover_gap(a, b, method="gdt-fixed")
+    np.testing.assert_allclose(got, posterior["reversed inside B"], rtol=0, atol=1e-8)
+    assert np.abs(got - posterior["paper's model"]).max() > 0.02  # 0.04-0.32 px here

@@ -177,8 +177,9 @@ def two_sided_posterior(za, zb, T, A, Q, H, R, prior_a, prior_b):
 def chain_posterior(N, observed, A, Q, H, R, priors):
     """Posterior means ``(N, n)`` of the chain ``x_k = A x_{k-1} + N(0, Q)``, k = 1..N-1.
 
-    `observed` holds ``(k, z)``: ``z = H x_k + N(0, R)``; `priors` holds ``(k, m, P)``: a
-    factor ``N(x_k; m, P)``. The joint density's precision matrix is assembled factor by
+    `Q` is one matrix or ``N - 1`` of them (``Q[k-1]`` for the step to ``x_k``). `observed`
+    holds ``(k, z)``: ``z = H x_k + N(0, R)``; `priors` holds ``(k, m, P)``: a factor
+    ``N(x_k; m, P)``. The joint density's precision matrix is assembled factor by
     factor and solved densely (no filter, no recursion).
     """
     n = A.shape[0]
@@ -188,8 +189,10 @@ def chain_posterior(N, observed, A, Q, H, R, priors):
     def blk(i):
         return slice(i * n, (i + 1) * n)
 
-    Qi, Ri = np.linalg.inv(Q), np.linalg.inv(R)
+    Qs = _stack(Q, N - 1)
+    Ri = np.linalg.inv(R)
     for k in range(1, N):
+        Qi = np.linalg.inv(Qs[k - 1])
         Lam[blk(k), blk(k)] += Qi
         Lam[blk(k - 1), blk(k - 1)] += A.T @ Qi @ A
         Lam[blk(k), blk(k - 1)] -= Qi @ A
