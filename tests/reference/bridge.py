@@ -156,3 +156,52 @@ def loglik_grid(runs, axis, q, r):
             p01 = (1.0 - k0) * a01
             p11 = a11 - k1 * a01
     return ll
+
+
+def two_sided_posterior(za, zb, T, A, Q, H, R, prior_a, prior_b):
+    """E[x_t | every point] of the whole window: segment A (consecutive frames), the gap of
+    T - 1 frames, segment B (consecutive frames), with a Gaussian factor on each far end.
+
+    Written from the model, not from the goal-directed algebra: one linear-Gaussian chain
+    ``x_k = A x_{k-1} + w_k`` over every frame from A's first point to B's last, measurements
+    ``z = H x + v`` on the observed frames, ``N(x_first; *prior_a)`` on A's first state and
+    ``N(x_last; *prior_b)`` on B's last (:func:`chain_posterior`). Returns the means,
+    ``(len(za) + T - 1 + len(zb), n)``.
+    """
+    N = len(za) + T - 1 + len(zb)
+    observed = [(k, z) for k, z in enumerate(za)]
+    observed += [(len(za) + T - 1 + k, z) for k, z in enumerate(zb)]
+    return chain_posterior(N, observed, A, Q, H, R, [(0, *prior_a), (N - 1, *prior_b)])
+
+
+def chain_posterior(N, observed, A, Q, H, R, priors):
+    """Posterior means ``(N, n)`` of the chain ``x_k = A x_{k-1} + N(0, Q)``, k = 1..N-1.
+
+    `Q` is one matrix or ``N - 1`` of them (``Q[k-1]`` for the step to ``x_k``). `observed`
+    holds ``(k, z)``: ``z = H x_k + N(0, R)``; `priors` holds ``(k, m, P)``: a factor
+    ``N(x_k; m, P)``. The joint density's precision matrix is assembled factor by
+    factor and solved densely (no filter, no recursion).
+    """
+    n = A.shape[0]
+    Lam = np.zeros((n * N, n * N))
+    eta = np.zeros(n * N)
+
+    def blk(i):
+        return slice(i * n, (i + 1) * n)
+
+    Qs = _stack(Q, N - 1)
+    Ri = np.linalg.inv(R)
+    for k in range(1, N):
+        Qi = np.linalg.inv(Qs[k - 1])
+        Lam[blk(k), blk(k)] += Qi
+        Lam[blk(k - 1), blk(k - 1)] += A.T @ Qi @ A
+        Lam[blk(k), blk(k - 1)] -= Qi @ A
+        Lam[blk(k - 1), blk(k)] -= A.T @ Qi
+    for k, z in observed:
+        Lam[blk(k), blk(k)] += H.T @ Ri @ H
+        eta[blk(k)] += H.T @ Ri @ z
+    for k, m, P in priors:
+        Pi = np.linalg.inv(P)
+        Lam[blk(k), blk(k)] += Pi
+        eta[blk(k)] += Pi @ m
+    return np.linalg.solve(Lam, eta).reshape(N, n)

@@ -101,7 +101,9 @@ def bspline(
     """Weighted least-squares cubic B-spline over `window` points on each side.
 
     Interior knots every `spacing` frames inside each observed window; points near the gap
-    weigh more (Sun et al. 2005, the paper's first baseline). Falls back to :func:`cubic`
+    weigh more: the residual of a point ``d`` frames from the gap is multiplied by
+    ``1 / (1 + d / 5)`` (SciPy's ``w``), so its square weighs ``1 / (1 + d / 5)²`` (Sun et al.
+    2005, the paper's first baseline). Falls back to :func:`cubic`
     with fewer than 8 points or a singular fit (an error or a non-finite result).
     """
     from scipy.interpolate import make_lsq_spline
@@ -142,7 +144,9 @@ def gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) ->
     ``clip(tau log(tau^3 / n), 1/tau, tau^2)`` for a track of ``n`` points) over the whole
     track; here over the points within 3 length scales of the gap, and for a gap of more than
     :data:`GSI_BLOCK` frames block by block, each block over the points within 3 length
-    scales of it (the same numbers up to the points' weight beyond them: tested). The
+    scales of it (the same numbers up to the points' weight beyond them: tested; StrongSORT's
+    regression over the whole track differs by up to 0.05-0.15 px on tracks of 200-600
+    points; doubling its 1e-10 jitter moves the path by 0.02-0.05 px). The
     coordinates are taken from the middle of the gap's two ends: the process has a zero prior
     mean (StrongSORT's), which pulled the path toward the image origin by about 2e-7 of the
     coordinates (1.9 px at 1e7 px; a user trial), so the path did not move with the track.
