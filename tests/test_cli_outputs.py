@@ -260,6 +260,28 @@ def test_interrupted_demo_removes_the_folder_it_made(
     assert list((tmp_path / "old").iterdir()) == []  # there before: kept
 
 
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+def test_demo_interrupted_after_writing_says_its_outputs_were_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Was: Ctrl-C during the recovery demo, after the four files were in place, said "no
+    output was changed"."""
+    import pftrack.demo as demo
+
+    def interrupt(*args: Any, **kwargs: Any) -> Any:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(demo, "demo_report", interrupt)
+    out_dir = tmp_path / "d"
+    assert main(["demo", "--out-dir", str(out_dir), "--frames", "5"]) == 130
+    assert capsys.readouterr().err == (
+        f"pftrack demo: interrupted; the outputs were written before it: {out_dir}/tracks.txt, "
+        "truth.txt, annotated.mp4, trajectories.png\n"
+    )
+    names = ["annotated.mp4", "tracks.txt", "trajectories.png", "truth.txt"]
+    assert sorted(p.name for p in out_dir.iterdir()) == names
+
+
 def test_recover_in_place_needs_the_flag(
     inputs: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
