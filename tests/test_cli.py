@@ -262,6 +262,24 @@ def test_experiment_gaps_one_sequence_writes_json(
     assert sum(sweep["median"]["best_at"].values()) == 2
 
 
+def test_experiment_gaps_writes_the_figure_of_a_mask_that_cuts_no_gap(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: --figure asked for, exit 0, no figure written and nothing said of it."""
+    import cv2
+
+    gt, fig = _walkers(tmp_path / "gt.txt"), tmp_path / "f.png"
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--mask",
+            "0,0,2,2", "--methods", "linear", "--repeat", "1", "--figure", str(fig)]  # fmt: skip
+    assert main(argv) == 0
+    said = capsys.readouterr().out
+    assert "0 gaps" in said and "no gap under this mask" in said
+    assert said.endswith(f"figure: {fig}\n")
+    image = cv2.imread(str(fig))
+    assert image is not None and image.shape[0] == 360
+    assert image.max() > 0  # the ground truth's paths, grey
+
+
 @pytest.mark.parametrize("size", [["768x576"], ["768", "576"], ["768X576"]])
 def test_experiment_gaps_takes_the_image_size_as_eval_does_or_as_wxh(
     tmp_path: Path, size: list[str]

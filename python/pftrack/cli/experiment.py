@@ -332,6 +332,11 @@ def run_gaps(args: argparse.Namespace) -> int:
     }
     if not run.gaps:
         said.append("no gap under this mask")
+        if args.figure:  # the ground truth and the mask: where it missed (was: not written)
+            _write_figure(args.figure, E.draw_figure(
+                trajs, run.gaps, run.paths, mask, (int(width), int(height)), []
+            ))  # fmt: skip
+            said.append(f"figure: {args.figure}")
         if args.json:
             _write_json(args.json, doc)
             said.append(f"json: {args.json}")
