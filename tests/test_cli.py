@@ -280,6 +280,27 @@ def test_experiment_gaps_writes_the_figure_of_a_mask_that_cuts_no_gap(
     assert image.max() > 0  # the ground truth's paths, grey
 
 
+@pytest.mark.parametrize(
+    ("size", "box", "mask", "width"),
+    [("1x100000", "0,{k2},1,2", "0,40,1,20", 1 + 4 + 360),  # was: cv2.error, a traceback
+     ("100000x1", "{k2},0,2,1", "40,0,20,1", 4 * 360 + 4 + 360)],  # was: out of memory
+    ids=["tall", "wide"],
+)  # fmt: skip
+def test_experiment_gaps_figure_of_a_thin_image_is_drawn_in_bounds(
+    tmp_path: Path, size: str, box: str, mask: str, width: int
+) -> None:
+    """The scene panel was ``360 W / H`` px wide: 0 px (cv2.error) or 36 million px (13 GB)."""
+    import cv2
+
+    gt, fig = tmp_path / "gt.txt", tmp_path / "f.png"
+    gt.write_text("".join(f"{k + 1},1,{box.format(k2=2 * k)},1,-1,-1,-1\n" for k in range(60)))
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--image-size", size, "--mask", mask,
+            "--methods", "linear", "--repeat", "1", "--figure", str(fig)]  # fmt: skip
+    assert main(argv) == 0
+    image = cv2.imread(str(fig))
+    assert image is not None and image.shape == (360, width, 3)
+
+
 @pytest.mark.parametrize("size", [["768x576"], ["768", "576"], ["768X576"]])
 def test_experiment_gaps_takes_the_image_size_as_eval_does_or_as_wxh(
     tmp_path: Path, size: list[str]
