@@ -301,6 +301,25 @@ def test_experiment_gaps_figure_of_a_thin_image_is_drawn_in_bounds(
     assert image is not None and image.shape == (360, width, 3)
 
 
+@pytest.mark.parametrize(
+    ("options", "said"),
+    [(["--image-size", "80x60"], "--size 100: no 100 px mask fits in the 80x60 image; give a "
+      "smaller --size, or --mask"),
+     (["--image-size", "768x576", "--gaps", "1000"], "no mask position meets the selection "
+      "(1000 gaps); relax it (--min-gaps, --trajectories, --gaps, --size), or pass --mask")],
+    ids=["mask larger than the image", "selection"],
+)  # fmt: skip
+def test_experiment_gaps_says_why_no_mask_position_is_kept(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], options: list[str], said: str
+) -> None:
+    """Was: "no mask position meets the selection; pass --mask" for a --size larger than the
+    image too, where no position exists, whatever the selection."""
+    gt = _walkers(tmp_path / "gt.txt")
+    argv = ["experiment", "gaps", "--gt", str(gt), *options, "--methods", "linear"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"pftrack experiment gaps: error: {said}\n"
+
+
 @pytest.mark.parametrize("size", [["768x576"], ["768", "576"], ["768X576"]])
 def test_experiment_gaps_takes_the_image_size_as_eval_does_or_as_wxh(
     tmp_path: Path, size: list[str]

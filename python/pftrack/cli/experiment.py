@@ -303,8 +303,16 @@ def run_gaps(args: argparse.Namespace) -> int:
             )
     elif len(sweep):
         mask = sweep.representative()
+    elif args.size > width or args.size > height:  # was: "no mask position meets the selection"
+        raise ValueError(
+            f"--size {args.size:g}: no {args.size:g} px mask fits in the {width:g}x{height:g} "
+            "image; give a smaller --size, or --mask"
+        )
     else:
-        raise ValueError("no mask position meets the selection; pass --mask")
+        raise ValueError(
+            f"no mask position meets the selection ({sweep.selection}); relax it (--min-gaps, "
+            "--trajectories, --gaps, --size), or pass --mask"
+        )
     run = E.run_mask(trajs, mask, methods, args.repeat)
     said += [
         "",
