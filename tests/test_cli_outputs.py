@@ -472,6 +472,26 @@ def test_two_outputs_on_one_file_are_refused_before_any_work(
     assert _snapshot(tmp_path) == before
 
 
+def test_experiment_json_and_figure_on_one_file_are_refused_before_any_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Was: exit 0, the figure written through the link into the JSON file, then the JSON over
+    it (or, with both on /dev/stdout, a PNG and the JSON in one stream)."""
+    monkeypatch.chdir(tmp_path)
+    gt = _walkers(tmp_path / "A")
+    (tmp_path / "r.json").write_text("an earlier result\n")
+    (tmp_path / "alias.png").symlink_to("r.json")
+    before = _snapshot(tmp_path)
+    argv = ["experiment", "gaps", "--gt", str(gt), "--methods", "linear", "--repeat", "1",
+            "--max-positions", "1", "--json", "r.json", "--figure", "alias.png"]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "pftrack experiment gaps: error: --json r.json and --figure alias.png are the same "
+        "file; give each output its own\n"
+    )
+    assert _snapshot(tmp_path) == before
+
+
 def test_check_distinct_names_both_outputs(tmp_path: Path) -> None:
     from pftrack.io.atomic import check_distinct
 

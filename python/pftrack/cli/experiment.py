@@ -251,7 +251,7 @@ def _check_distinct_gt(paths: list[str]) -> None:
 
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
-    from pftrack.io.atomic import check_output
+    from pftrack.io.atomic import check_distinct, check_output
 
     multi = _check_mode(args)  # before any other check: the options a mode does not use
     _check_distinct_gt(args.gt)
@@ -264,6 +264,8 @@ def run_gaps(args: argparse.Namespace) -> int:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.figure is not None:
         check_output(args.figure, what="--figure", suffixes=FIGURE_SUFFIXES, inputs=inputs)
+    # was: --json /dev/stdout --figure /dev/stdout wrote a PNG and the JSON into one stream
+    check_distinct({"--json": args.json, "--figure": args.figure})
     if multi:
         return _run_sequences(args)
     import numpy as np
