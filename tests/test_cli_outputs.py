@@ -492,6 +492,21 @@ def test_experiment_json_and_figure_on_one_file_are_refused_before_any_work(
     assert _snapshot(tmp_path) == before
 
 
+def test_experiment_figure_is_kept_when_its_json_cannot_be_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: exit 2 for --json /dev/full, the user's --figure replaced by the failed run's."""
+    gt = _walkers(tmp_path / "A")
+    (tmp_path / "f.png").write_bytes(b"an earlier figure\n")
+    before = _snapshot(tmp_path)
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--methods", "linear", "--repeat", "1",
+            "--max-positions", "1", "--json", "/dev/full",
+            "--figure", str(tmp_path / "f.png")]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err.startswith("pftrack experiment gaps: error: No space left")
+    assert _snapshot(tmp_path) == before
+
+
 def test_check_distinct_names_both_outputs(tmp_path: Path) -> None:
     from pftrack.io.atomic import check_distinct
 
