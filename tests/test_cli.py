@@ -262,6 +262,64 @@ def test_experiment_gaps_one_sequence_writes_json(
     assert sum(sweep["median"]["best_at"].values()) == 2
 
 
+def test_experiment_gaps_writes_the_figure_of_a_mask_that_cuts_no_gap(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: --figure asked for, exit 0, no figure written and nothing said of it."""
+    import cv2
+
+    gt, fig = _walkers(tmp_path / "gt.txt"), tmp_path / "f.png"
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--image-size", "768x576", "--mask",
+            "0,0,2,2", "--methods", "linear", "--repeat", "1", "--figure", str(fig)]  # fmt: skip
+    assert main(argv) == 0
+    said = capsys.readouterr().out
+    assert "0 gaps" in said and "no gap under this mask" in said
+    assert said.endswith(f"figure: {fig}\n")
+    image = cv2.imread(str(fig))
+    assert image is not None and image.shape[0] == 360
+    assert image.max() > 0  # the ground truth's paths, grey
+
+
+@pytest.mark.parametrize(
+    ("size", "box", "mask", "width"),
+    [("1x100000", "0,{k2},1,2", "0,40,1,20", 1 + 4 + 360),  # was: cv2.error, a traceback
+     ("100000x1", "{k2},0,2,1", "40,0,20,1", 4 * 360 + 4 + 360)],  # was: out of memory
+    ids=["tall", "wide"],
+)  # fmt: skip
+def test_experiment_gaps_figure_of_a_thin_image_is_drawn_in_bounds(
+    tmp_path: Path, size: str, box: str, mask: str, width: int
+) -> None:
+    """The scene panel was ``360 W / H`` px wide: 0 px (cv2.error) or 36 million px (13 GB)."""
+    import cv2
+
+    gt, fig = tmp_path / "gt.txt", tmp_path / "f.png"
+    gt.write_text("".join(f"{k + 1},1,{box.format(k2=2 * k)},1,-1,-1,-1\n" for k in range(60)))
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--image-size", size, "--mask", mask,
+            "--methods", "linear", "--repeat", "1", "--figure", str(fig)]  # fmt: skip
+    assert main(argv) == 0
+    image = cv2.imread(str(fig))
+    assert image is not None and image.shape == (360, width, 3)
+
+
+@pytest.mark.parametrize(
+    ("options", "said"),
+    [(["--image-size", "80x60"], "--size 100: no 100 px mask fits in the 80x60 image; give a "
+      "smaller --size, or --mask"),
+     (["--image-size", "768x576", "--gaps", "1000"], "no mask position meets the selection "
+      "(1000 gaps); relax it (--min-gaps, --trajectories, --gaps, --size), or pass --mask")],
+    ids=["mask larger than the image", "selection"],
+)  # fmt: skip
+def test_experiment_gaps_says_why_no_mask_position_is_kept(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], options: list[str], said: str
+) -> None:
+    """Was: "no mask position meets the selection; pass --mask" for a --size larger than the
+    image too, where no position exists, whatever the selection."""
+    gt = _walkers(tmp_path / "gt.txt")
+    argv = ["experiment", "gaps", "--gt", str(gt), *options, "--methods", "linear"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"pftrack experiment gaps: error: {said}\n"
+
+
 @pytest.mark.parametrize("size", [["768x576"], ["768", "576"], ["768X576"]])
 def test_experiment_gaps_takes_the_image_size_as_eval_does_or_as_wxh(
     tmp_path: Path, size: list[str]

@@ -260,6 +260,28 @@ def test_interrupted_demo_removes_the_folder_it_made(
     assert list((tmp_path / "old").iterdir()) == []  # there before: kept
 
 
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+def test_demo_interrupted_after_writing_says_its_outputs_were_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Was: Ctrl-C during the recovery demo, after the four files were in place, said "no
+    output was changed"."""
+    import pftrack.demo as demo
+
+    def interrupt(*args: Any, **kwargs: Any) -> Any:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(demo, "demo_report", interrupt)
+    out_dir = tmp_path / "d"
+    assert main(["demo", "--out-dir", str(out_dir), "--frames", "5"]) == 130
+    assert capsys.readouterr().err == (
+        f"pftrack demo: interrupted; the outputs were written before it: {out_dir}/tracks.txt, "
+        "truth.txt, annotated.mp4, trajectories.png\n"
+    )
+    names = ["annotated.mp4", "tracks.txt", "trajectories.png", "truth.txt"]
+    assert sorted(p.name for p in out_dir.iterdir()) == names
+
+
 def test_recover_in_place_needs_the_flag(
     inputs: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -447,6 +469,41 @@ def test_two_outputs_on_one_file_are_refused_before_any_work(
         f"pftrack track: error: {first} {name} and {second} {Path(other)} are the same file; "
         "give each output its own\n"
     )
+    assert _snapshot(tmp_path) == before
+
+
+def test_experiment_json_and_figure_on_one_file_are_refused_before_any_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Was: exit 0, the figure written through the link into the JSON file, then the JSON over
+    it (or, with both on /dev/stdout, a PNG and the JSON in one stream)."""
+    monkeypatch.chdir(tmp_path)
+    gt = _walkers(tmp_path / "A")
+    (tmp_path / "r.json").write_text("an earlier result\n")
+    (tmp_path / "alias.png").symlink_to("r.json")
+    before = _snapshot(tmp_path)
+    argv = ["experiment", "gaps", "--gt", str(gt), "--methods", "linear", "--repeat", "1",
+            "--max-positions", "1", "--json", "r.json", "--figure", "alias.png"]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "pftrack experiment gaps: error: --json r.json and --figure alias.png are the same "
+        "file; give each output its own\n"
+    )
+    assert _snapshot(tmp_path) == before
+
+
+def test_experiment_figure_is_kept_when_its_json_cannot_be_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: exit 2 for --json /dev/full, the user's --figure replaced by the failed run's."""
+    gt = _walkers(tmp_path / "A")
+    (tmp_path / "f.png").write_bytes(b"an earlier figure\n")
+    before = _snapshot(tmp_path)
+    argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--methods", "linear", "--repeat", "1",
+            "--max-positions", "1", "--json", "/dev/full",
+            "--figure", str(tmp_path / "f.png")]  # fmt: skip
+    assert main(argv) == 2
+    assert capsys.readouterr().err.startswith("pftrack experiment gaps: error: No space left")
     assert _snapshot(tmp_path) == before
 
 

@@ -251,7 +251,7 @@ def _check_distinct_gt(paths: list[str]) -> None:
 
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
-    from pftrack.io.atomic import check_output
+    from pftrack.io.atomic import check_distinct, check_output
 
     multi = _check_mode(args)  # before any other check: the options a mode does not use
     _check_distinct_gt(args.gt)
@@ -264,6 +264,8 @@ def run_gaps(args: argparse.Namespace) -> int:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.figure is not None:
         check_output(args.figure, what="--figure", suffixes=FIGURE_SUFFIXES, inputs=inputs)
+    # was: --json /dev/stdout --figure /dev/stdout wrote a PNG and the JSON into one stream
+    check_distinct({"--json": args.json, "--figure": args.figure})
     if multi:
         return _run_sequences(args)
     import numpy as np
@@ -303,8 +305,16 @@ def run_gaps(args: argparse.Namespace) -> int:
             )
     elif len(sweep):
         mask = sweep.representative()
+    elif args.size > width or args.size > height:  # was: "no mask position meets the selection"
+        raise ValueError(
+            f"--size {args.size:g}: no {args.size:g} px mask fits in the {width:g}x{height:g} "
+            "image; give a smaller --size, or --mask"
+        )
     else:
-        raise ValueError("no mask position meets the selection; pass --mask")
+        raise ValueError(
+            f"no mask position meets the selection ({sweep.selection}); relax it (--min-gaps, "
+            "--trajectories, --gaps, --size), or pass --mask"
+        )
     run = E.run_mask(trajs, mask, methods, args.repeat)
     said += [
         "",
@@ -332,11 +342,10 @@ def run_gaps(args: argparse.Namespace) -> int:
     }
     if not run.gaps:
         said.append("no gap under this mask")
-        if args.json:
-            _write_json(args.json, doc)
-            said.append(f"json: {args.json}")
-        print("\n".join(said), file=report_stream(args.json))
-        return 0
+        figure = None
+        if args.figure:  # the ground truth and the mask: where it missed (was: not written)
+            figure = E.draw_figure(trajs, run.gaps, run.paths, mask, (int(width), int(height)), [])
+        return _finish(args, said, doc, figure)
     said.append(E.format_table(run.scores))
     if run.noise is not None:
         said.append(
@@ -369,16 +378,39 @@ def run_gaps(args: argparse.Namespace) -> int:
             "scores": {m: asdict(v) for m, v in median.median.items()},
             "best_at": median.wins,
         }
+    figure = None
     if args.figure:
-        _write_figure(args.figure, E.draw_figure(
+        figure = E.draw_figure(
             trajs, run.gaps, run.paths, mask, (int(width), int(height)),
             [m for m in ("gdt", "gdt-mix", "bspline") if m in methods],
-        ))  # fmt: skip
-        said.append(f"figure: {args.figure}")
-    if args.json:
-        _write_json(args.json, doc)
-        said.append(f"json: {args.json}")
-    # after the files: a closed stdout cannot lose them; not into a file written to stdout
+        )  # fmt: skip
+    return _finish(args, said, doc, figure)
+
+
+def _finish(args: argparse.Namespace, said: list[str], doc: dict[str, Any], figure: Any) -> int:
+    """Write the one-sequence sweep's --figure and --json, then print what it has to say.
+
+    The two files are replaced together at the end, or neither (was: the figure replaced, then
+    exit 2 for a JSON that could not be written). The report comes after them: a closed stdout
+    cannot lose them; and never into a file written to stdout.
+    """
+    import json
+
+    import cv2
+
+    from pftrack.io.atomic import output_format, staged_outputs
+    from pftrack.io.opencv_io import write_image
+
+    with staged_outputs() as stage:
+        if args.figure:
+            ext = output_format(args.figure, FIGURE_SUFFIXES)  # a device (/dev/stdout): .png
+            params = [cv2.IMWRITE_PNG_COMPRESSION, 9]
+            write_image(stage(args.figure, ext), figure, params, ext=ext)
+        if args.json:
+            with open(stage(args.json), "w", encoding="utf-8") as f:
+                json.dump(doc, f, indent=1)
+    said += [f"{what}: {path}" for what, path in (("figure", args.figure), ("json", args.json))
+             if path]  # fmt: skip
     print("\n".join(said), file=report_stream(args.json, args.figure))
     return 0
 
@@ -410,16 +442,6 @@ def _write_json(path: str, doc: dict[str, Any]) -> None:
 
     with atomic_write(path) as f:
         json.dump(doc, f, indent=1)
-
-
-def _write_figure(path: str, image: Any) -> None:
-    import cv2
-
-    from pftrack.io.atomic import output_format
-    from pftrack.io.opencv_io import write_image
-
-    ext = output_format(path, FIGURE_SUFFIXES)  # a device (/dev/stdout): .png
-    write_image(path, image, [cv2.IMWRITE_PNG_COMPRESSION, 9], ext=ext)
 
 
 def _run_sequences(args: argparse.Namespace) -> int:

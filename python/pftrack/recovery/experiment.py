@@ -358,6 +358,10 @@ def _draw_panel(
 _COLOURS = [(60, 60, 255), (0, 220, 0), (255, 160, 0), (255, 0, 255), (0, 255, 255)]
 
 
+#: Widest scene panel of :func:`draw_figure`, in heights (a 4:1 image fills it).
+FIGURE_ASPECT = 4.0
+
+
 def draw_figure(
     trajs: dict[int, F64],
     gaps: Sequence[Gap],
@@ -369,18 +373,22 @@ def draw_figure(
 ) -> NDArray[np.uint8]:
     """Draw ground truth against recovered paths with OpenCV.
 
-    Left: the whole scene; right: the mask region enlarged. Grey: ground-truth trajectories;
-    white dots: the lost (ground-truth) points; coloured: recovered paths; yellow: the mask.
+    Left: the whole scene (`height` px high, at most :data:`FIGURE_ASPECT` times as wide);
+    right: the mask region enlarged. Grey: ground-truth trajectories; white dots: the lost
+    (ground-truth) points; coloured: recovered paths; yellow: the mask.
     """
     import cv2
 
     from pftrack.io.opencv_io import text_for_opencv
 
     w, h = size
-    s_full = height / float(h)
+    # at most FIGURE_ASPECT heights wide, at least 1 px: an image of 100000x1 px asked for a
+    # panel 36 million px wide (out of memory), one of 1x100000 px for one 0 px wide (cv2.error)
+    s_full = min(height / float(h), FIGURE_ASPECT * height / float(w))
     left = _draw_panel(
-        trajs, gaps, paths, mask, methods, (0.0, 0.0), s_full, (int(round(w * s_full)), height)
-    )
+        trajs, gaps, paths, mask, methods, (0.0, 0.0), s_full,
+        (max(1, int(round(w * s_full))), height),
+    )  # fmt: skip
     mx, my, mw, mh = mask
     pad = 0.15 * max(mw, mh)
     side = max(mw, mh) + 2 * pad
