@@ -1540,3 +1540,37 @@ def test_an_empty_argument_is_refused_by_name(
     assert main(argv) == 2
     assert capsys.readouterr().err == f"pftrack {argv[0]}: error: {named} is empty; give a value\n"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_opencv_error_is_one_line_and_exit_2(monkeypatch, capsys, tmp_path):
+    """OpenCV refusing an input pftrack did not check first (a path the trials found: a
+    figure of a 1 x 100000 image) is one line, exit 2; another exception stays a traceback."""
+    import cv2
+
+    from pftrack.cli import evaluate
+
+    def refused(args: argparse.Namespace) -> int:
+        cv2.resize(np.zeros((0, 0), np.uint8), (4, 4))
+        return 0
+
+    monkeypatch.setattr(evaluate, "run", refused)
+    gt = tmp_path / "gt.txt"
+    gt.write_text("1,1,10,10,5,5,1,1,1\n")
+    assert main(["eval", "--gt", str(gt), "--res", str(gt)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pftrack eval: error: OpenCV(") and err.count("\n") == 1
+
+    def bug(args: argparse.Namespace) -> int:
+        raise KeyError("a defect")
+
+    monkeypatch.setattr(evaluate, "run", bug)
+    with pytest.raises(KeyError):
+        main(["eval", "--gt", str(gt), "--res", str(gt)])
+
+
+def test_experiment_repeat_is_bounded(capsys):
+    # was: --repeat 100000000 (a typo) ran without a word until killed (a user trial)
+    with pytest.raises(SystemExit) as info:
+        main(["experiment", "gaps", "--gt", "gt.txt", "--repeat", "100000000"])
+    assert info.value.code == 2
+    assert "--repeat: expected an integer in [1, 1000], got 100000000" in capsys.readouterr().err

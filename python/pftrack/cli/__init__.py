@@ -319,6 +319,16 @@ def _empty_argument(command: argparse.ArgumentParser, args: argparse.Namespace) 
     return None
 
 
+def _opencv_error(exc: BaseException) -> bool:
+    """Whether `exc` is OpenCV's ``cv2.error`` (told without importing cv2: ``--help`` does not).
+
+    OpenCV raises it on input it cannot handle (an image or a size its functions refuse); a
+    path pftrack does not check first then ends in one line, exit 2, not a traceback.
+    """
+    kind = type(exc)
+    return kind.__name__ == "error" and kind.__module__.split(".")[0] == "cv2"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pftrack`` script; returns the exit status."""
     parser = build_parser()
@@ -356,6 +366,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         left = outcome(exc)
         said = f"; {_shown(left)}" if left else ""
         print(f"{prog}: error: out of memory{said}", file=sys.stderr)
+        return 2
+    except Exception as exc:
+        if not _opencv_error(exc):
+            raise  # a defect of pftrack's: its traceback is what a report needs
+        left = outcome(exc)
+        said = f"; {_shown(left)}" if left else ""
+        print(f"{prog}: error: {_one_line(exc)}{said}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:  # outputs are atomic: nothing half-written is left behind
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"

@@ -14,6 +14,7 @@ from pftrack.cli._options import (
     WidthHeight,
     add_command,
     bounded_float,
+    bounded_int,
     non_negative_int,
     positive_int,
     report_stream,
@@ -24,6 +25,10 @@ MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this ar
 #: ``--figure``'s formats; the first is a device's (``--figure /dev/stdout``).
 FIGURE_SUFFIXES = (".png", ".jpg")
 #: Options of the one-sequence sweep (one --gt, no --auto-masks): refused in the other mode.
+#: Most timing runs ``--repeat`` takes: each run recovers every gap again, and a typo of
+#: 100000000 ran without a word until killed (a user trial).
+MAX_REPEAT = 1000
+
 SINGLE_ONLY = ("mask", "size", "grid", "trajectories", "gaps", "min_gaps", "repeat",
                "max_positions", "figure")  # fmt: skip
 #: Options of the multi-sequence protocol (several --gt, or --auto-masks): refused with one.
@@ -100,9 +105,9 @@ def add_parser(sub: Any) -> None:
         f"many gaps (default: {DEFAULTS['min_gaps']})",
     )  # fmt: skip
     g.add_argument("--methods", default=",".join(METHODS), help="comma-separated methods")
-    g.add_argument("--repeat", type=positive_int, default=None, metavar="N",
-                   help="one sequence: timing, best of this many runs (default: "
-                   f"{DEFAULTS['repeat']})")  # fmt: skip
+    g.add_argument("--repeat", type=bounded_int(1, MAX_REPEAT), default=None, metavar="N",
+                   help=f"one sequence: timing, best of this many runs, 1 to {MAX_REPEAT} "
+                   f"(default: {DEFAULTS['repeat']})")  # fmt: skip
     g.add_argument(
         "--max-positions", type=non_negative_int, default=None, metavar="N",
         help="one sequence: evaluate at most this many sweep positions, evenly spread "
