@@ -66,8 +66,10 @@ def _report(scene: Scene, run: TrackingRun, *, seed: int, n_frames: int, particl
     # (was: the unrounded rows', seed 2 MOTA 16.1 against the file's 15.7)
     size = (scene.width, scene.height)
     metrics = evaluate_mot(scene.truth, as_written(run.rows), image_size=size)
-    print(f"pftrack demo: synthetic scene, {n_frames} frames {scene.width}x{scene.height}, "
-          f"{len(np.unique(scene.truth[:, 1]))} walkers, seed {seed}")  # fmt: skip
+    walkers = len(np.unique(scene.truth[:, 1]))
+    print(f"pftrack demo: synthetic scene, {n_frames} frame{'' if n_frames == 1 else 's'} "
+          f"{scene.width}x{scene.height}, {walkers} walker{'' if walkers == 1 else 's'}, "
+          f"seed {seed}")  # fmt: skip
     print(f"tracked at {run.fps:.0f} frames/s (detection + {particles} particles per object)")
     print(format_metrics({"pftrack": metrics}))
     print()

@@ -15,6 +15,7 @@ from pftrack.cli._options import (
     add_command,
     bounded_float,
     bounded_int,
+    counted,
     non_negative_int,
     positive_int,
     report_stream,
@@ -296,7 +297,8 @@ def run_gaps(args: argparse.Namespace) -> int:
         trajs, args.size, width, height, args.grid, args.trajectories, args.gaps, args.min_gaps
     )
     said = [  # printed once the figure is written: a closed stdout cannot lose it
-        f"{args.gt}: {len(trajs)} trajectories, {args.point} point, {width:.0f}x{height:.0f}",
+        f"{args.gt}: {len(trajs)} {'trajectory' if len(trajs) == 1 else 'trajectories'}, "
+        f"{args.point} point, {width:.0f}x{height:.0f}",
         f"sweep: {args.size:g}x{args.size:g} masks on a {args.grid:g} px grid, "
         f"{len(sweep)} positions kept ({sweep.selection})",
     ]
@@ -324,7 +326,8 @@ def run_gaps(args: argparse.Namespace) -> int:
     said += [
         "",
         f"representative mask x,y,w,h = {','.join(f'{v:g}' for v in mask)}: "
-        f"{run.n_traj} trajectories, {len(run.gaps)} gaps, "
+        f"{run.n_traj} {'trajectory' if run.n_traj == 1 else 'trajectories'}, "
+        f"{counted(len(run.gaps), 'gap')}, "
         f"{sum(len(g.truth) for g in run.gaps)} lost points",
     ]
     doc: dict[str, Any] = {

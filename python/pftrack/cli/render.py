@@ -145,7 +145,8 @@ def run(args: argparse.Namespace) -> int:
     shown = rows[rows[:, 0] <= drawn[0]]
     ids = len(np.unique(shown[:, 1])) if len(shown) else 0
     print(
-        f"{drawn[0]} frames, {ids} tracks, {len(shown)} boxes drawn, {source.fps:g} fps "
+        f"{drawn[0]} frame{'' if drawn[0] == 1 else 's'}, {ids} track{'' if ids == 1 else 's'}, "
+        f"{len(shown)} box{'' if len(shown) == 1 else 'es'} drawn, {source.fps:g} fps "
         f"({source.fps_origin if source.fps_origin != 'given' else '--fps'}) -> {args.out}"
         + (f"; trajectory plot -> {args.plot}" if args.plot else ""),
         file=out,

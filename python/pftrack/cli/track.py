@@ -16,6 +16,7 @@ from pftrack.cli._options import (
     add_command,
     add_tracker_options,
     bounded_float,
+    counted,
     det_scale,
     report_stream,
     tracker_config,
@@ -338,8 +339,9 @@ def run(args: argparse.Namespace) -> int:
                 stopped = " (stopped by Ctrl-C)" if source.stopped else ""
                 how = " (online rows, as they settled)" if streamed else ""
                 said.append(
-                    f"{result.n_frames} frames{stopped}, {n_ids} tracks, {n_rows} "
-                    f"boxes in {result.seconds:.2f} s ({result.fps:.0f} frames/s), seed "
+                    f"{counted(result.n_frames, 'frame')}{stopped}, {counted(n_ids, 'track')}, "
+                    f"{n_rows} {'box' if n_rows == 1 else 'boxes'} in {result.seconds:.2f} s "
+                    f"({result.fps:.0f} frames/s), seed "
                     f"{args.seed} -> {args.out}{how}"
                 )
                 if renderer is not None:
