@@ -702,6 +702,32 @@ def test_sigterm_is_handled_as_ctrl_c(tmp_path: Path) -> None:
     assert _snapshot(out) == before
 
 
+def test_a_second_sigterm_does_not_break_into_the_cleanup() -> None:
+    """``timeout`` sends two SIGTERMs (one to the process, one to its group). The second was
+    raised again wherever the first one's cleanup stood, and could skip the wait for a live
+    source's reader thread: ``pftrack track PIPE`` under ``timeout`` then ended with SIGABRT
+    ("FATAL: exception not rethrown") or SIGSEGV instead of 143, about 1 run in 2. Now the
+    first raises, later ones are ignored until the command ends."""
+    import signal
+
+    from pftrack.cli._signals import Terminated, sigterm_raises
+
+    before = signal.getsignal(signal.SIGTERM)
+    cleaned = False
+    with pytest.raises(Terminated), sigterm_raises():
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(1000):  # Python runs the handler between bytecodes
+                pass
+        finally:
+            os.kill(os.getpid(), signal.SIGTERM)  # the second, during the cleanup
+            for _ in range(1000):
+                pass
+            cleaned = True
+    assert cleaned
+    assert signal.getsignal(signal.SIGTERM) == before  # restored when the command ends
+
+
 def test_sigterm_ends_a_batch_with_its_own_status(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

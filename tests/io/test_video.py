@@ -1216,3 +1216,57 @@ def test_a_sequence_folder_without_seqinfo_is_a_sequence_as_batch_takes_it(tmp_p
         cv2.imwrite(str(plain / f"{k}.png"), np.zeros((4, 4, 3), np.uint8))
     source = FrameSource(plain)
     assert source.sequence is None and len(source) == 3
+
+
+_CLOSE_WHILE_READING = """
+import os, sys, threading, time
+from pftrack.io.video import FrameSource
+from pftrack.synthetic import make_scene
+
+folder = sys.argv[1]
+data = open(make_scene(n_frames=40, width=160, height=120, rng=0).write_video(
+    os.path.join(folder, "scene.avi")), "rb").read()
+fifo = os.path.join(folder, "cam.avi")
+os.mkfifo(fifo)
+go_on = threading.Event()
+
+def feed():
+    with open(fifo, "wb") as fh:
+        fh.write(data[: len(data) // 3])
+        fh.flush()
+        go_on.wait(30)  # the reader now waits in read() for the rest
+        try:
+            fh.write(data[len(data) // 3 :])
+        except BrokenPipeError:
+            pass
+
+threading.Thread(target=feed, daemon=True).start()
+src = FrameSource(fifo)
+frames = []
+reader = threading.Thread(target=lambda: frames.extend(src), daemon=True)
+reader.start()
+seen, deadline = -1, time.monotonic() + 30
+while (seen != len(frames) or not frames) and time.monotonic() < deadline:
+    seen = len(frames)  # until the reader waits in read() for the held-back bytes
+    time.sleep(0.3)
+src.close()  # from another thread, as pftrack track's cleanup after a second Ctrl-C
+go_on.set()  # the reader's read() returns: on a released capture, a segmentation fault
+reader.join(30)
+print(src.live, reader.is_alive(), 0 < len(frames) < 40)
+"""
+
+
+def test_closing_a_live_source_while_a_thread_reads_it_is_no_crash(tmp_path: Path) -> None:
+    """Was: a segmentation fault. ``pftrack track`` reads a live source on a thread; a second
+    Ctrl-C (or ``timeout``'s two SIGTERMs) interrupted the wait for that thread, and the
+    command's cleanup released the capture while the thread was inside its ``read()``.
+    ``close()`` during a read now leaves the release to the reader, after its ``read()``."""
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    run = subprocess.run([sys.executable, "-c", _CLOSE_WHILE_READING, str(tmp_path)],
+                         capture_output=True, text=True, env=env, check=False,
+                         timeout=120)  # fmt: skip
+    assert run.returncode == 0, (run.returncode, run.stderr[-2000:])
+    assert run.stdout.split() == ["True", "False", "True"]

@@ -75,6 +75,12 @@ def line_end() -> str:
 
 
 def _raise_terminated(signum: int, frame: Any) -> None:
+    # once: the command is unwinding (its writers removing their temporary files, its reader
+    # threads stopping), and a second SIGTERM raised in that cleanup left a reader thread
+    # inside a C++ read as the process exited, which aborted or crashed it ("FATAL: exception
+    # not rethrown", a segmentation fault). ``timeout`` sends two: one to the process, one to
+    # its process group. sigterm_raises restores the handler when the command ends.
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise Terminated
 
 

@@ -105,6 +105,10 @@ class _StopOnCtrlC:
 
     def _handler(self, signum: int, frame: Any) -> None:
         if self.source.stopped:
+            # the abort, once: a third Ctrl-C raised in its cleanup could skip the wait for the
+            # source's reader threads, and the process aborted at exit with a thread inside a
+            # C++ read ("FATAL: exception not rethrown"); __exit__ restores the handler
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
             raise KeyboardInterrupt
         self.source.stop()
         from pftrack.cli._signals import line_end

@@ -32,6 +32,7 @@ import operator
 import os
 import re
 import stat
+import threading
 import warnings
 from collections.abc import Collection, Generator, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -998,6 +999,11 @@ def is_live_source(source: PathLike | int) -> bool:
 #: Largest side of a frame that `FrameSource(scale=...)` may make (OpenCV's image limit).
 MAX_SCALED_SIDE = 32767
 
+#: Guards a live source's capture between a reader inside its ``read()`` and ``close()``
+#: from another thread; held only for that bookkeeping, never during a read (one for every
+#: source: a FrameSource stays picklable).
+_LIVE_CAPTURE = threading.Lock()
+
 
 class FrameSource:
     """Iterate over BGR uint8 frames of a video, image folder, sequence, camera or stream.
@@ -1113,6 +1119,7 @@ class FrameSource:
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_lost = False  # frames inside the video could not be decoded
         self._cap: Any = None
+        self._reading = False  # a thread is inside the live capture's read()
         self._replay: list[NDArray[np.uint8]] = []
         self._read_past_replay = False
         self.stopped = False
@@ -1570,8 +1577,22 @@ class FrameSource:
         if self._read_past_replay:
             raise ValueError(f"live source {self.name} was read already; open it again")
         yield from list(self._replay)
-        while self._cap is not None:
-            ok, frame = self._cap.read()
+        while True:
+            with _LIVE_CAPTURE:
+                cap = self._cap
+                if cap is None:
+                    break
+                self._reading = True
+            try:
+                ok, frame = cap.read()
+            finally:
+                with _LIVE_CAPTURE:
+                    self._reading = False
+                    closed = self._cap is None
+                if closed:  # close() came during the read: released here, not under it
+                    cap.release()
+            if closed:
+                break
             if not ok:
                 self.close()
                 break
@@ -1584,10 +1605,16 @@ class FrameSource:
             yield frame
 
     def close(self) -> None:
-        """Release a live source's capture (files and folders hold nothing open)."""
-        if self._cap is not None:
-            self._cap.release()
-            self._cap = None
+        """Release a live source's capture (files and folders hold nothing open).
+
+        From another thread while one reads the source, the reader releases it when its
+        ``read()`` returns, and stops (was: released under the read, a segmentation fault).
+        """
+        with _LIVE_CAPTURE:
+            cap, self._cap = self._cap, None
+            reading = self._reading
+        if cap is not None and not reading:
+            cap.release()
 
     def __enter__(self) -> FrameSource:
         return self
