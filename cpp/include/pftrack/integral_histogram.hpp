@@ -464,6 +464,30 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
         });
 }
 
+/// Coefficient rho of one box (cx, cy, w, h) against `sqrt_ref`, as the MCMC samplers evaluate
+/// a state; `counted` gets its counted weight. With `step` > 1 on the lattice of that step, the
+/// points and coefficient box_coefficients gives the box (the uniform kernel's points read in
+/// place, not gathered first); step 1: every pixel, the normalised histogram into `hist`
+/// (img.n_bins values) and its Bhattacharyya coefficient.
+inline double state_coefficient(const BinImage& img, double cx, double cy, double w, double h,
+                                const double* sqrt_ref, Kernel kernel, Index step,
+                                HistogramScratch& scratch, std::vector<double>& hist,
+                                double& counted) {
+    double rho = 0.0;
+    if (step > 1 && kernel == Kernel::kUniform) {
+        const PixelRange points = lattice_points(box_pixels(cx, cy, w, h, img.rows, img.cols), step);
+        rho = scratch.coefficient_of_lattice(img, points, step, sqrt_ref, counted);
+    } else if (step > 1) {
+        const Eigen::Matrix<double, 1, 4> box(cx, cy, w, h);
+        box_coefficients(img, box, sqrt_ref, kernel, BoxPath::kDirect, &rho, &counted, step,
+                         &scratch);
+    } else {
+        counted = scratch.compute(img, cx, cy, w, h, kernel, hist.data());
+        rho = bhattacharyya_coefficient_row(hist.data(), sqrt_ref, img.n_bins);
+    }
+    return rho;
+}
+
 /// Histograms (K, n_bins) of K boxes, as box_histograms(img, boxes, kernel), with the uniform
 /// kernel's counts from for_each_box_count (the same values: c_k / total, or a zero row).
 template <class Derived>

@@ -93,22 +93,10 @@ inline MhEval mh_evaluate(HistogramScratch& scratch, std::vector<double>& hist, 
                           const double* sqref, const double* x, const SisParams& p,
                           Index lattice) {
     MhEval e;
-    if (lattice > 1 && p.kernel == Kernel::kUniform) {
-        // as sis_step counts a box on a lattice of step `lattice` (box_coefficients: the same
-        // points, the same coefficient of their counts, counted = points x step^2), read in
-        // place rather than gathered first
-        const PixelRange points = lattice_points(
-            box_pixels(x[0], x[1], x[2] * p.w0, x[2] * p.h0, img.rows, img.cols), lattice);
-        e.rho = scratch.coefficient_of_lattice(img, points, lattice, sqref, e.counted);
-    } else if (lattice > 1) {
-        const Eigen::Matrix<double, 1, 4> box(x[0], x[1], x[2] * p.w0, x[2] * p.h0);
-        box_coefficients(img, box, sqref, p.kernel, BoxPath::kDirect, &e.rho, &e.counted, lattice,
-                         &scratch);
-    } else {  // every pixel
-        e.counted = scratch.compute(img, x[0], x[1], x[2] * p.w0, x[2] * p.h0, p.kernel,
-                                    hist.data());
-        e.rho = bhattacharyya_coefficient_row(hist.data(), sqref, img.n_bins);
-    }
+    // as sis_step counts the box: on its lattice when `lattice` > 1 (the same points, the same
+    // coefficient of their counts, counted = points x step^2), else every pixel
+    e.rho = state_coefficient(img, x[0], x[1], x[2] * p.w0, x[2] * p.h0, sqref, p.kernel, lattice,
+                              scratch, hist, e.counted);
     const double d = bhattacharyya_distance_from_rho(e.rho);
     e.loglik = -p.lambda * d * d;
     return e;

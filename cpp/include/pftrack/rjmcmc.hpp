@@ -287,21 +287,10 @@ public:
     /// Colour log-likelihood -lambda D^2 of slot at x.
     double log_colour(int slot, const double* x) {
         const RjIdentity& id = ids_[static_cast<size_t>(slot)];
-        const double w = x[2] * id.w0, h = x[2] * id.h0;
-        double rho = 0.0, counted = 0.0;
-        if (id.lattice > 1 && prm_.kernel == Kernel::kUniform) {
-            // the slot's lattice, read in place (the points and counts of box_coefficients)
-            const PixelRange points =
-                lattice_points(box_pixels(x[0], x[1], w, h, img_.rows, img_.cols), id.lattice);
-            rho = scratch_.coefficient_of_lattice(img_, points, id.lattice, id.sqrt_ref.data(), counted);
-        } else if (id.lattice > 1) {
-            const Eigen::Matrix<double, 1, 4> box(x[0], x[1], w, h);
-            box_coefficients(img_, box, id.sqrt_ref.data(), prm_.kernel, BoxPath::kDirect, &rho,
-                             &counted, id.lattice, &scratch_);
-        } else {
-            scratch_.compute(img_, x[0], x[1], w, h, prm_.kernel, hist_.data());
-            rho = bhattacharyya_coefficient_row(hist_.data(), id.sqrt_ref.data(), img_.n_bins);
-        }
+        double counted = 0.0;  // the slot's lattice (min_samples), or every pixel
+        const double rho = state_coefficient(img_, x[0], x[1], x[2] * id.w0, x[2] * id.h0,
+                                             id.sqrt_ref.data(), prm_.kernel, id.lattice, scratch_,
+                                             hist_, counted);
         const double d = bhattacharyya_distance_from_rho(rho);
         return -prm_.lambda * d * d;
     }
