@@ -595,7 +595,6 @@ def smooth_tracks(
     new = np.zeros(len(a), dtype=bool)
     if smoother is not None and fill_gap is not None:
         a, obs, z, new = _add_hole_rows(a, obs, z, fill_gap, fill_method, seed)
-    if smoother is not None and fill_gap is not None:
         # a hole left unfilled is no bridge for the smoother either: its two sides are
         # smoothed apart (was: joined through holes of up to max_hole = 300 frames, so an id a
         # tracker gave a second, still person 41 frames later bent both people's boxes by 10 px)
