@@ -1767,14 +1767,19 @@ def test_scheduler_and_worker_started_as_processes(data: Path, tmp_path: Path) -
             summary = json.loads((out / "summary.json").read_text())
             assert summary["scheduler"] == address and summary["workers"] == 1
         finally:
-            for p in reversed(procs):
-                p.terminate()
-            for p in reversed(procs):
-                try:
-                    p.wait(timeout=15)
-                except subprocess.TimeoutExpired:
-                    p.kill()
-                    p.wait()
+            _stop_processes(procs)
+
+
+def _stop_processes(procs: list[subprocess.Popen[Any]]) -> None:
+    """Terminate `procs` (the workers before their scheduler) and wait; kill after 15 s."""
+    for p in reversed(procs):
+        p.terminate()
+    for p in reversed(procs):
+        try:
+            p.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
 
 
 def test_render_writes_a_video_per_sequence_and_counts_for_resume(
@@ -2927,15 +2932,9 @@ def test_a_scheduler_frozen_mid_run_fails_the_tasks_left(
                 )
             assert time.monotonic() - start < 20
         finally:
-            for p in reversed(procs):
-                p.send_signal(signal.SIGCONT)
-                p.terminate()
-            for p in reversed(procs):
-                try:
-                    p.wait(timeout=15)
-                except subprocess.TimeoutExpired:
-                    p.kill()
-                    p.wait()
+            for p in procs:
+                p.send_signal(signal.SIGCONT)  # a stopped scheduler cannot take SIGTERM
+            _stop_processes(procs)
     assert [e["status"] for e in summary.entries] == ["failed", "failed"]
     assert {e["error"] for e in summary.entries} == {
         f"the scheduler at {address} did not answer for 1 s (frozen or overloaded) before this "
