@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 
+from pftrack._text import counted
 from pftrack.eval import evaluate_mot, format_metrics
 from pftrack.io.atomic import check_output, check_output_folder, made_folder, staged_outputs
 from pftrack.io.mot import as_written, write_mot
@@ -67,9 +68,8 @@ def _report(scene: Scene, run: TrackingRun, *, seed: int, n_frames: int, particl
     size = (scene.width, scene.height)
     metrics = evaluate_mot(scene.truth, as_written(run.rows), image_size=size)
     walkers = len(np.unique(scene.truth[:, 1]))
-    print(f"pftrack demo: synthetic scene, {n_frames} frame{'' if n_frames == 1 else 's'} "
-          f"{scene.width}x{scene.height}, {walkers} walker{'' if walkers == 1 else 's'}, "
-          f"seed {seed}")  # fmt: skip
+    print(f"pftrack demo: synthetic scene, {counted(n_frames, 'frame')} "
+          f"{scene.width}x{scene.height}, {counted(walkers, 'walker')}, seed {seed}")  # fmt: skip
     print(f"tracked at {run.fps:.0f} frames/s (detection + {particles} particles per object)")
     print(format_metrics({"pftrack": metrics}))
     print()

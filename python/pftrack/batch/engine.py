@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._check import flag
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
+from pftrack._text import counted
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
 from pftrack.io.mot import write_mot
@@ -192,13 +193,13 @@ class BatchSummary:
         counts = ", ".join(
             f"{n} {s}" for s in _STATUSES if (n := sum(e["status"] == s for e in self.entries))
         )
-        where = _count(self.workers, "worker") if self.workers else "in this process"
+        where = counted(self.workers, "worker") if self.workers else "in this process"
         if not self.workers and all(e["status"] == "skipped" for e in self.entries):
             where = "nothing to run"  # no cluster is started or asked for skipped inputs
         if self.scheduler:
             where += f" at {self.scheduler}"
         noun = "sequence" if self.kind == "track" else "file"
-        text.append(f"{_count(len(self.entries), noun)}: {counts}; {self.seconds:.1f} s, {where}")
+        text.append(f"{counted(len(self.entries), noun)}: {counts}; {self.seconds:.1f} s, {where}")
         for e in self.entries:
             if e.get("note"):
                 text.append(f"{e['name']}: {e['note']}")
@@ -219,10 +220,6 @@ class BatchSummary:
 
 
 _STATUSES = ("done", "skipped", "failed", "cancelled")
-
-
-def _count(n: int, noun: str) -> str:
-    return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
 def _pct(v: float) -> str:
@@ -399,8 +396,9 @@ def dask_client(
                 # was: Dask's traceback, "RuntimeError: Cluster failed to start: ..." (its
                 # temporary folder under a file, say); the cause says what failed
                 cause = exc.__cause__ if isinstance(exc.__cause__, Exception) else exc
+                workers = counted(n, "worker")
                 raise OSError(
-                    f"cannot start a local Dask cluster of {_count(n, 'worker')}: {one_line(cause)}"
+                    f"cannot start a local Dask cluster of {workers}: {one_line(cause)}"
                 ) from None
         # a Ctrl-C (or SIGTERM) held while the cluster started is raised on leaving
         # _interrupts_held: the stack then closes the client and the whole cluster
@@ -1933,7 +1931,7 @@ def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int 
         )
     else:
         text = (
-            f"the outputs of the {_count(written, noun)} finished are written and complete; "
+            f"the outputs of the {counted(written, noun)} finished are written and complete; "
             f"{out / SUMMARY_NAME} lists the rest as cancelled (re-run to finish them)"
         )
     exc.pftrack_batch_left = text  # type: ignore[attr-defined]

@@ -7,6 +7,8 @@ import math
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
+from pftrack._text import counted as counted  # the commands' counts, re-exported
+
 if TYPE_CHECKING:
     from pftrack.tracking import TrackerConfig
 
@@ -118,11 +120,6 @@ def add_command(sub: Any, name: str, **kwargs: Any) -> argparse.ArgumentParser:
         help="no progress bars (as pftrack --quiet)",
     )  # fmt: skip
     return parser
-
-
-def counted(n: int, noun: str) -> str:
-    """``n noun`` with the noun's plural ``s`` unless `n` is 1 (``1 row``, ``2 rows``)."""
-    return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
 def int_at_least(lo: int) -> Any:

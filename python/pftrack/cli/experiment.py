@@ -297,7 +297,7 @@ def run_gaps(args: argparse.Namespace) -> int:
         trajs, args.size, width, height, args.grid, args.trajectories, args.gaps, args.min_gaps
     )
     said = [  # printed once the figure is written: a closed stdout cannot lose it
-        f"{args.gt}: {len(trajs)} {'trajectory' if len(trajs) == 1 else 'trajectories'}, "
+        f"{args.gt}: {counted(len(trajs), 'trajectory', 'trajectories')}, "
         f"{args.point} point, {width:.0f}x{height:.0f}",
         f"sweep: {args.size:g}x{args.size:g} masks on a {args.grid:g} px grid, "
         f"{len(sweep)} positions kept ({sweep.selection})",
@@ -326,7 +326,7 @@ def run_gaps(args: argparse.Namespace) -> int:
     said += [
         "",
         f"representative mask x,y,w,h = {','.join(f'{v:g}' for v in mask)}: "
-        f"{run.n_traj} {'trajectory' if run.n_traj == 1 else 'trajectories'}, "
+        f"{counted(run.n_traj, 'trajectory', 'trajectories')}, "
         f"{counted(len(run.gaps), 'gap')}, "
         f"{sum(len(g.truth) for g in run.gaps)} lost points",
     ]

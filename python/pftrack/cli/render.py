@@ -18,6 +18,7 @@ from pftrack.cli._options import (
     add_command,
     bounded_float,
     check_input_file,
+    counted,
     report_stream,
 )
 from pftrack.cli.track import PLOT_SUFFIXES
@@ -111,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     drawn = [0]
     kept: list[Any] = []  # the first frame, the plot's background (the video read once)
 
-    def counted() -> Any:
+    def read_counting() -> Any:
         for frame in source:
             if not kept:
                 kept.append(frame.copy())
@@ -124,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
         warnings.simplefilter("always")
         with staged_outputs() as stage:  # both outputs replaced at the end, or neither
             video = stage(args.out, output_format(args.out, VIDEO_SUFFIXES))
-            write_annotated_video(video, _progress(counted(), n_frames), rows, source.fps,
+            write_annotated_video(video, _progress(read_counting(), n_frames), rows, source.fps,
                                   trail=args.trail)  # fmt: skip
             if args.plot:
                 plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))
@@ -145,8 +146,8 @@ def run(args: argparse.Namespace) -> int:
     shown = rows[rows[:, 0] <= drawn[0]]
     ids = len(np.unique(shown[:, 1])) if len(shown) else 0
     print(
-        f"{drawn[0]} frame{'' if drawn[0] == 1 else 's'}, {ids} track{'' if ids == 1 else 's'}, "
-        f"{len(shown)} box{'' if len(shown) == 1 else 'es'} drawn, {source.fps:g} fps "
+        f"{counted(drawn[0], 'frame')}, {counted(ids, 'track')}, "
+        f"{counted(len(shown), 'box', 'boxes')} drawn, {source.fps:g} fps "
         f"({source.fps_origin if source.fps_origin != 'given' else '--fps'}) -> {args.out}"
         + (f"; trajectory plot -> {args.plot}" if args.plot else ""),
         file=out,

@@ -344,7 +344,7 @@ def run(args: argparse.Namespace) -> int:
                 how = " (online rows, as they settled)" if streamed else ""
                 said.append(
                     f"{counted(result.n_frames, 'frame')}{stopped}, {counted(n_ids, 'track')}, "
-                    f"{n_rows} {'box' if n_rows == 1 else 'boxes'} in {result.seconds:.2f} s "
+                    f"{counted(n_rows, 'box', 'boxes')} in {result.seconds:.2f} s "
                     f"({result.fps:.0f} frames/s), seed "
                     f"{args.seed} -> {args.out}{how}"
                 )

@@ -1,0 +1,13 @@
+"""Small text helpers of the messages and reports (no NumPy: ``pftrack --help`` imports this)."""
+
+from __future__ import annotations
+
+__all__ = ["counted"]
+
+
+def counted(n: int, noun: str, plural: str | None = None) -> str:
+    """``n noun``, in the plural unless `n` is 1: ``1 row``, ``2 rows``.
+
+    `plural` for a noun whose plural is not ``noun + "s"`` (``counted(2, "box", "boxes")``).
+    """
+    return f"{n} {noun if n == 1 else plural or noun + 's'}"
