@@ -155,6 +155,22 @@ _DECODER_LINE = re.compile(
     rb"|Application transferred too many scanlines)\n?"
 )
 _HELD = threading.Lock()  # one thread at a time holds file descriptor 2
+_HOLDERS: dict[int, Any] = {}  # process id -> the temporary file stderr is held in
+
+
+def _holder() -> Any:
+    """The temporary file of this process for what stderr gets during a decode, emptied.
+
+    One per process, made once (was: a new temporary file for every image read, a frame's
+    worth of system calls); a forked child makes its own, not writing into its parent's.
+    """
+    held = _HOLDERS.get(os.getpid())
+    if held is None:
+        _HOLDERS.clear()  # a parent's, inherited over fork
+        held = _HOLDERS[os.getpid()] = tempfile.TemporaryFile()
+    held.seek(0)
+    held.truncate()
+    return held
 
 
 @contextlib.contextmanager
@@ -172,14 +188,14 @@ def _decoder_notes(notes: list[str]) -> Iterator[None]:
             yield
             return
         try:
-            with tempfile.TemporaryFile() as held:
-                os.dup2(held.fileno(), 2)
-                try:
-                    yield
-                finally:
-                    os.dup2(saved, 2)
-                held.seek(0)
-                text = held.read()
+            held = _holder()
+            os.dup2(held.fileno(), 2)
+            try:
+                yield
+            finally:
+                os.dup2(saved, 2)
+            held.seek(0)
+            text = held.read()
         finally:
             os.close(saved)
 
