@@ -25,11 +25,10 @@ from pftrack.recovery.names import METHODS
 MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this are refused
 #: ``--figure``'s formats; the first is a device's (``--figure /dev/stdout``).
 FIGURE_SUFFIXES = (".png", ".jpg")
-#: Options of the one-sequence sweep (one --gt, no --auto-masks): refused in the other mode.
 #: Most timing runs ``--repeat`` takes: each run recovers every gap again, and a typo of
 #: 100000000 ran without a word until killed (a user trial).
 MAX_REPEAT = 1000
-
+#: Options of the one-sequence sweep (one --gt, no --auto-masks): refused in the other mode.
 SINGLE_ONLY = ("mask", "size", "grid", "trajectories", "gaps", "min_gaps", "repeat",
                "max_positions", "figure")  # fmt: skip
 #: Options of the multi-sequence protocol (several --gt, or --auto-masks): refused with one.
