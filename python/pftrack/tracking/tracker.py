@@ -610,7 +610,7 @@ class MultiObjectTracker:
         born = cfg if detections is None else self._given_config  # given_particles
         unmatched = result.unmatched_detections
         beside = set() if detections is None else self._beside(boxes, labels, unmatched, cfg)
-        for di in result.unmatched_detections:
+        for di in unmatched:
             if hists[di].sum() <= 0 or scores[di] < birth_score or di in beside:
                 # no foreground colour to build a reference from, too unsure, or a second box
                 # on a person already followed (LifecycleConfig.birth_overlap)
