@@ -17,11 +17,11 @@ using bind::make_model;
 
 namespace {
 
-/// A list item that sis_step_batch updates in place: float64, C-contiguous, writeable, `cols`
-/// columns (a (rows,) vector when cols == 0).
+/// A list item that `fn` (sis_step_batch, reseed_batch) updates in place: float64,
+/// C-contiguous, writeable, `cols` columns (a (rows,) vector when cols == 0).
 py::array_t<double> batch_item(const py::handle& h, const char* what, py::ssize_t k,
-                               py::ssize_t rows, py::ssize_t cols) {
-    const char* fn = "sis_step_batch";
+                               py::ssize_t rows, py::ssize_t cols,
+                               const char* fn = "sis_step_batch") {
     // every message (the item's name, the dtype's) built only on failure: this runs for each
     // object on every frame
     const auto name = [&] { return std::string(what) + "[" + std::to_string(k) + "]"; };
@@ -226,4 +226,76 @@ void register_filter(py::module_& m) {
         "particles (N_k, 6), weights (N_k,), means (2, 3) updated in place, K refs; w0, h0, seeds, "
         "steps (K,). Returns (K, 11): mean (3), map (3), map_index, ess, rho_max, rho_mean, "
         "fg_mean; each row equal to sis_step's for the same object.");
+
+    m.def(
+        "reseed_batch",
+        [](const py::list& particles, const py::list& weights, const py::list& means,
+           Eigen::Ref<const RowMatrixXd> boxes, Eigen::Ref<const RowMatrixXd> velocities,
+           Eigen::Ref<const Eigen::VectorXd> w0, Eigen::Ref<const Eigen::VectorXd> h0,
+           Eigen::Ref<const RowMatrixXd> noise, double pos_sd, double s_sd, double s_min,
+           double s_max) {
+            const char* fn = "reseed_batch";
+            const auto k = static_cast<py::ssize_t>(particles.size());
+            require(static_cast<py::ssize_t>(weights.size()) == k &&
+                        static_cast<py::ssize_t>(means.size()) == k && boxes.rows() == k &&
+                        velocities.rows() == k && w0.size() == k && h0.size() == k,
+                    fn, "particles, weights, means, boxes, velocities, w0 and h0 must all have "
+                        "one entry per object");
+            require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (cx, cy, w, h)");
+            require(velocities.cols() == 2, fn, "velocities cols", velocities.cols(),
+                    "2 (vx, vy)");
+            require(noise.cols() == kStateDim, fn, "noise cols", noise.cols(), 3);
+            require_finite(boxes, fn, "boxes");
+            require_finite(velocities, fn, "velocities");
+            require_finite(noise, fn, "noise");
+            require((boxes.col(2).array() > 0.0).all() && (boxes.col(3).array() > 0.0).all(),
+                    fn, "boxes must have w, h > 0");
+            require(w0.allFinite() && h0.allFinite() && (w0.array() > 0.0).all() &&
+                        (h0.array() > 0.0).all(),
+                    fn, "w0 and h0 must be finite and > 0");
+            require(std::isfinite(pos_sd) && pos_sd >= 0.0 && std::isfinite(s_sd) && s_sd >= 0.0,
+                    fn, "pos_sd and s_sd must be finite and >= 0");
+            require(std::isfinite(s_min) && std::isfinite(s_max) && s_min > 0.0 && s_min <= s_max,
+                    fn, "scale bounds must satisfy 0 < s_min <= s_max");
+            // every array checked with the GIL held, before any object is re-seeded
+            std::vector<py::array_t<double>> keep;
+            keep.reserve(static_cast<size_t>(3 * k));
+            Index rows = 0;
+            for (py::ssize_t i = 0; i < k; ++i) {
+                auto p = batch_item(particles[i], "particles", i, -1, kParticleCols, fn);
+                const py::ssize_t n = p.shape(0);
+                require(n > 0, fn, "particles rows", n, ">= 1");
+                rows += n;
+                keep.push_back(p);
+                keep.push_back(batch_item(weights[i], "weights", i, n, 0, fn));
+                keep.push_back(batch_item(means[i], "means", i, 2, kStateDim, fn));
+            }
+            require(noise.rows() == rows, fn, "noise rows", noise.rows(),
+                    "the particles' rows of all objects together");
+            using MatMap = Eigen::Map<RowMatrixXd>;
+            using VecMap = Eigen::Map<Eigen::VectorXd>;
+            {
+                py::gil_scoped_release nogil;  // safe: raw buffers kept alive by `keep`
+                Index at = 0;
+                for (py::ssize_t i = 0; i < k; ++i) {
+                    auto& pa = keep[static_cast<size_t>(3 * i)];
+                    auto& wa = keep[static_cast<size_t>(3 * i + 1)];
+                    auto& ma = keep[static_cast<size_t>(3 * i + 2)];
+                    const Index n = pa.shape(0);
+                    reseed_particles(MatMap(pa.mutable_data(), n, kParticleCols),
+                                     VecMap(wa.mutable_data(), n),
+                                     MatMap(ma.mutable_data(), 2, kStateDim),
+                                     boxes.row(i).transpose(), velocities.row(i).transpose(),
+                                     w0(i), h0(i), noise.middleRows(at, n), pos_sd, s_sd, s_min,
+                                     s_max);
+                    at += n;
+                }
+            }
+        },
+        py::arg("particles"), py::arg("weights"), py::arg("means"), py::arg("boxes"),
+        py::arg("velocities"), py::arg("w0"), py::arg("h0"), py::arg("noise"),
+        py::arg("pos_sd"), py::arg("s_sd"), py::arg("s_min"), py::arg("s_max"),
+        "Re-seed K particle sets around their boxes in place: lists of K particles (N_k, 6), "
+        "weights (N_k,), means (2, 3); boxes (K, 4) cx, cy, w, h; velocities (K, 2); w0, h0 "
+        "(K,); noise (sum N_k, 3) N(0, 1), object after object.");
 }

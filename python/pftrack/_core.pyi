@@ -367,6 +367,23 @@ def sis_step_batch(
     steps: list[int],
     min_samples: float = 0.0,
 ) -> _F64: ...
+
+# lists of K particles (N_k, 6), weights (N_k,), means (2, 3) re-seeded in place around boxes
+# (K, 4) cx, cy, w, h with velocities (K, 2); noise (sum N_k, 3), object after object
+def reseed_batch(
+    particles: list[_F64],
+    weights: list[_F64],
+    means: list[_F64],
+    boxes: ArrayLike,
+    velocities: ArrayLike,
+    w0: ArrayLike,
+    h0: ArrayLike,
+    noise: ArrayLike,
+    pos_sd: float,
+    s_sd: float,
+    s_min: float,
+    s_max: float,
+) -> None: ...
 def mh_step(
     particles: _F64,
     weights: _F64,

@@ -145,6 +145,31 @@ def _sis_batch() -> st.SearchStrategy[Any]:
     )
 
 
+def _reseed_batch() -> st.SearchStrategy[Any]:
+    def kw(ns: list[int]) -> dict[str, st.SearchStrategy[Any]]:
+        k = len(ns)
+        per = [_object_kwargs(n) for n in ns]
+        return {
+            **{
+                key: maybe(st.tuples(*[p[key] for p in per]).map(list))
+                for key in ("particles", "weights", "means")
+            },
+            "boxes": maybe(floats_array((k, 4), 0.5, 20)),
+            "velocities": maybe(floats_array((k, 2), -3, 3)),
+            "w0": maybe(floats_array((k,), 0.5, 20)),
+            "h0": maybe(floats_array((k,), 0.5, 20)),
+            "noise": maybe(floats_array((sum(ns), 3), -3, 3)),
+            "pos_sd": maybe(fl(0, 5)),
+            "s_sd": maybe(fl(0, 1)),
+            "s_min": maybe(fl(0.1, 1)),
+            "s_max": maybe(fl(1, 5)),
+        }
+
+    return st.lists(st.integers(0, 6), max_size=3).flatmap(
+        lambda ns: call(_core.reseed_batch, **kw(ns))
+    )
+
+
 def _assignment() -> st.SearchStrategy[Any]:
     return st.tuples(N, N).flatmap(
         lambda rc: call(_core.linear_sum_assignment, maybe(floats_array(rc, -10, 10)))
@@ -516,6 +541,7 @@ TARGETS: list[Target] = [
     Target("sis_step", _sis()),
     Target("mh_step", _mh()),
     Target("sis_step_batch", _sis_batch()),
+    Target("reseed_batch", _reseed_batch()),
     Target("linear_sum_assignment", _assignment()),
     Target("sparse_assignment", _sparse_assignment()),
     Target(

@@ -142,6 +142,22 @@ def propagate(particles, noise, a, b, sigma, s_min, s_max, use_means=False, m1=N
     return p
 
 
+def reseed(box, velocity, w0, h0, noise, pos_sd, s_sd, s_min, s_max):
+    """Particles (N, 6), weights (N,) and means (2, 3) re-seeded around `box` (cx, cy, w, h)."""
+    cx, cy, w, h = box
+    vx, vy = velocity
+    s0 = np.clip(np.sqrt((w / w0) * (h / h0)), s_min, s_max)
+    p = np.empty((len(noise), 6))
+    p[:, 0] = cx + pos_sd * noise[:, 0]
+    p[:, 1] = cy + pos_sd * noise[:, 1]
+    p[:, 2] = np.clip(s0 + s_sd * noise[:, 2], s_min, s_max)
+    p[:, 3] = p[:, 0] - vx
+    p[:, 4] = p[:, 1] - vy
+    p[:, 5] = p[:, 2]
+    means = np.array([[cx, cy, s0], [cx - vx, cy - vy, s0]])
+    return p, np.full(len(noise), 1.0 / len(noise)), means
+
+
 def sis_step(
     particles,
     weights,

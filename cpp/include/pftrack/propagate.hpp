@@ -70,6 +70,36 @@ inline void propagate_ar2(Eigen::Ref<RowMatrixXd> particles,
         ar2_step(particles.row(i).data(), noise.row(i).data(), m, m1.data(), m2.data());
 }
 
+/// Re-seeds one particle set around a box (ColourParticleFilter.reinitialise), in place.
+/// `box` is (cx, cy, w, h), its scale s0 = sqrt((w / w0) (h / h0)) clamped to [s_min, s_max];
+/// particle i, with the standard-normal draws noise.row(i), becomes
+///   (cx + pos_sd w_i0, cy + pos_sd w_i1, s) with s = s0 + s_sd w_i2 clamped to [s_min, s_max],
+///   and one velocity (vx, vy) back the previous state (cx_i - vx, cy_i - vy, s);
+/// weights 1/N, means (cx, cy, s0) and (cx - vx, cy - vy, s0). The floats of the NumPy reseed
+/// (tests/reference/kernels.py: reseed): each clamp is max, then min, as NumPy's.
+/// Unchecked: the caller (reseed_batch's binding) checks shapes and values.
+inline void reseed_particles(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
+                             Eigen::Ref<RowMatrixXd> means, const Eigen::Vector4d& box,
+                             const Eigen::Vector2d& velocity, double w0, double h0,
+                             const Eigen::Ref<const RowMatrixXd>& noise, double pos_sd,
+                             double s_sd, double s_min, double s_max) {
+    const double s0 = std::min(std::max(std::sqrt((box(2) / w0) * (box(3) / h0)), s_min), s_max);
+    const Index n = particles.rows();
+    for (Index i = 0; i < n; ++i) {
+        double* row = particles.row(i).data();
+        const double* w = noise.row(i).data();
+        row[0] = box(0) + pos_sd * w[0];
+        row[1] = box(1) + pos_sd * w[1];
+        row[2] = std::min(std::max(s0 + s_sd * w[2], s_min), s_max);
+        row[3] = row[0] - velocity(0);
+        row[4] = row[1] - velocity(1);
+        row[5] = row[2];
+    }
+    weights.setConstant(1.0 / static_cast<double>(n));
+    means.row(0) << box(0), box(1), s0;
+    means.row(1) << box(0) - velocity(0), box(1) - velocity(1), s0;
+}
+
 struct Estimate {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();  // weighted mean state
     Eigen::Vector3d map = Eigen::Vector3d::Zero();   // state of the maximum-weight particle (eq. 2)

@@ -768,16 +768,18 @@ def reinitialise_filters(
             f"boxes_cxcywh {b.shape} and velocities {v.shape} for {k} filters, expected "
             f"({k}, 4) and ({k}, 2)"
         )
-    bad_v = ~(np.abs(v) < MAX_COORD).all(axis=1)
-    if bad_v.any():
+    # each test first over all values at once (NaN fails it): the per-row search that names
+    # the bad one runs only when there is one (the tracker calls this every frame)
+    if not np.abs(v).max() < MAX_COORD:
+        bad_v = ~(np.abs(v) < MAX_COORD).all(axis=1)
         _velocity(v[int(np.flatnonzero(bad_v)[0])])  # raises, naming the velocity
     cfg = filters[0].config
     one_config = all(f.config is cfg or f.config == cfg for f in filters)
     if not one_config:
         for f in filters:  # every filter's own bound, before any is re-seeded
             _spread(spread, f.config.model)
-    bad = ~((np.abs(b) < MAX_COORD).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0))
-    if bad.any():
+    if not (np.abs(b).max() < MAX_COORD and b[:, 2:].min() > 0):
+        bad = ~((np.abs(b) < MAX_COORD).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0))
         _box(b[int(np.flatnonzero(bad)[0])])  # raises, naming the box
     held = list({id(f): f for f in filters}.values())  # a filter given twice: one lock
     _take(held, "reinitialise_filters")
@@ -794,30 +796,20 @@ def reinitialise_filters(
 def _reseed_batch(
     filters: Sequence[ColourParticleFilter], cfg: FilterConfig, b: F64, v: F64, spread: float
 ) -> None:
-    """:func:`reinitialise_filters` of checked arguments, one configuration, the locks held."""
-    k = len(filters)
+    """:func:`reinitialise_filters` of checked arguments, one configuration, the locks held.
+
+    Each filter draws its noise from its own generator, in order, as :meth:`_reseed`; one core
+    call (``reseed_batch``) then writes the particles, weights and means of all of them, the
+    same floats as :meth:`_reseed`'s NumPy (was NumPy over (K, N, 6) arrays: about 60 calls on
+    small arrays a frame).
+    """
     m = cfg.model
     n = cfg.n_particles
-    w0 = np.array([f.w0 for f in filters])
-    h0 = np.array([f.h0 for f in filters])
-    s = np.minimum(np.maximum(np.sqrt((b[:, 2] / w0) * (b[:, 3] / h0)), m.s_min), m.s_max)
-    noise = np.empty((k, n, 3))
+    noise = np.empty((len(filters) * n, 3))
     for i, f in enumerate(filters):  # each filter's own draws, as reinitialise takes them
-        f._rng.standard_normal(out=noise[i])
-    p = np.empty((k, n, 6))
-    p[:, :, 0] = b[:, 0:1] + spread * m.sigma_xy * noise[:, :, 0]
-    p[:, :, 1] = b[:, 1:2] + spread * m.sigma_xy * noise[:, :, 1]
-    p[:, :, 2] = np.minimum(
-        np.maximum(s[:, None] + spread * m.sigma_s * noise[:, :, 2], m.s_min), m.s_max
-    )
-    p[:, :, 3] = p[:, :, 0] - v[:, 0:1]
-    p[:, :, 4] = p[:, :, 1] - v[:, 1:2]
-    p[:, :, 5] = p[:, :, 2]
-    means = np.empty((k, 2, 3))
-    means[:, 0, :2] = b[:, :2]
-    means[:, 1, :2] = b[:, :2] - v
-    means[:, :, 2] = s[:, None]
-    for i, f in enumerate(filters):
-        f.particles[...] = p[i]
-        f.weights.fill(1.0 / n)
-        f.means[...] = means[i]
+        f._rng.standard_normal(out=noise[i * n : (i + 1) * n])
+    _core.reseed_batch(
+        [f.particles for f in filters], [f.weights for f in filters], [f.means for f in filters],
+        b, v, np.array([f.w0 for f in filters]), np.array([f.h0 for f in filters]), noise,
+        spread * m.sigma_xy, spread * m.sigma_s, m.s_min, m.s_max,
+    )  # fmt: skip

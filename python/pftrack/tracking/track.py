@@ -395,13 +395,18 @@ def reseed_tracks(
     if rate <= 0:
         return
     has = hists.sum(axis=1) > 0
-    idx = has.nonzero()[0]
-    if not len(idx):
-        return
-    blend = (1 - rate) * np.array([filters[i].reference for i in idx]) + rate * hists[idx]
-    if not (np.isfinite(blend).all() and (blend >= 0).all()):
+    if has.all():  # the usual case: every detection has colour
+        idx: list[int] = list(range(len(filters)))
+        blend = (1 - rate) * np.array([f.reference for f in filters]) + rate * hists
+    else:
+        idx = has.nonzero()[0].tolist()
+        if not idx:
+            return
+        blend = (1 - rate) * np.array([filters[i].reference for i in idx]) + rate * hists[idx]
+    # finite and >= 0 everywhere: the least value >= 0 (NaN fails) and the largest below inf
+    if not (blend.min() >= 0 and blend.max() < np.inf):
         raise ValueError("reference histogram must be finite, >= 0 and not all zero")
     # each row over its own sum (the same floats as row / row.sum(), row by row)
     blend /= blend.sum(axis=1, keepdims=True)
-    for i, row in zip(idx.tolist(), blend, strict=True):
+    for i, row in zip(idx, blend, strict=True):
         filters[i].reference = row
