@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import overload
+from typing import cast, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
 from pftrack.boxes import _to_cxcywh
-from pftrack.kalman import _cv_predict, _cv_update, _cv_update_where  # unchecked: per frame
+from pftrack.kalman import Cov
 from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
 from pftrack.particle_filter.filter import reinitialise_filters, step_filters_summary
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
@@ -272,26 +272,15 @@ class LiveTrack:
         )
 
 
-def _motion_state(tracks: Sequence[LiveTrack]) -> tuple[F64, F64, tuple[F64, F64, F64]]:
-    """The centre filters' state as arrays over the tracks.
-
-    p (K, 2), v (K, 2), and the covariance's p00, p01, p11 as (K, 1) columns: what
-    :func:`pftrack.kalman.cv_predict` and :func:`~pftrack.kalman.cv_update` take.
-    """
-    p = np.array([t.motion.p for t in tracks])
-    v = np.array([t.motion.v for t in tracks])
-    cov = np.array([t.motion.cov for t in tracks])  # (K, 3): p00, p01, p11
-    return p, v, (cov[:, 0:1], cov[:, 1:2], cov[:, 2:3])
-
-
 def predict_tracks(
     tracks: Sequence[LiveTrack], binned: BinnedImage, colour_noise: float, accel_gain: float = 1.0
 ) -> None:
     """:meth:`LiveTrack.predict` for every track at once.
 
     One C++ call steps all the particle filters (:func:`~pftrack.particle_filter.filter.
-    step_filters`), and the centre filters' predict and update run as arrays over the tracks:
-    the same numbers as calling ``t.predict(binned, colour_noise)`` for each track in turn.
+    step_filters`); the centre filters' predict and update then run on plain floats, track by
+    track: the same numbers as calling ``t.predict(binned, colour_noise)`` for each track in
+    turn.
 
     Parameters
     ----------
@@ -306,34 +295,67 @@ def predict_tracks(
     """
     if not tracks:
         return
-    summary = step_filters_summary([t.filter for t in tracks], binned)
-    size = np.array([t.size for t in tracks])  # (K, 2)
-    h = size[:, 1:2]
-    p, v, cov = _motion_state(tracks)
-    accel = np.array([t.motion.accel for t in tracks])[:, None]
-    if accel_gain != 1.0:
-        accel = accel * accel_gain
-    z = summary[:, 0:2]
-    mean, c = _cv_predict((p, v), cov, (accel * h) ** 2)
-    # a flat likelihood is no measurement: those tracks keep the prediction
-    evidence = colour_evidence(summary[:, 2:3], summary[:, 3:4])
-    mean, c = _cv_update_where(mean, c, z, (colour_noise * h) ** 2, evidence)
-    p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
-    boxes = np.concatenate([p - size / 2, size], axis=1)
-    covs = np.concatenate(c, axis=1).tolist()
-    for k, (t, rho) in enumerate(zip(tracks, summary[:, 2].tolist(), strict=True)):
+    summary = step_filters_summary([t.filter for t in tracks], binned).tolist()
+    # Floats, not arrays over the tracks: with a few to tens of tracks, the 30-odd NumPy calls
+    # on (K, 1) and (K, 2) arrays cost more than the loop (issue 17).
+    for t, (zx, zy, rho, rho_max) in zip(tracks, summary, strict=True):
+        m = t.motion
+        w, h = t.size.tolist()
+        (px, py), (vx, vy) = m.p.tolist(), m.v.tolist()
+        a = m.accel * accel_gain if accel_gain != 1.0 else m.accel
+        q = a * h
+        q = q * q  # (accel h)²
+        px, py, p00, p01, p11 = _cv_predict_floats(px, py, vx, vy, _floats(m.cov), q)
+        # a flat likelihood is no measurement: the prediction stands
+        if colour_evidence(rho, rho_max):
+            r = colour_noise * h
+            px, py, vx, vy, p00, p01, p11 = _cv_update_floats(
+                px, py, vx, vy, p00, p01, p11, zx, zy, r * r
+            )
+        m.p, m.v, m.cov = np.array((px, py)), np.array((vx, vy)), (p00, p01, p11)
         t.measured = None
         t.rho = rho
-        m = t.motion
-        m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
-        t.box = boxes[k]
+        t.box = np.array((px - w / 2, py - h / 2, w, h))
         t.age += 1
+
+
+def _floats(cov: Cov) -> tuple[float, float, float]:
+    """A centre filter's covariance, whose entries are floats (the tracker sets them so)."""
+    return cast(tuple[float, float, float], cov)
+
+
+def _cv_predict_floats(
+    px: float, py: float, vx: float, vy: float, cov: tuple[float, float, float], q: float
+) -> tuple[float, float, float, float, float]:
+    """:func:`pftrack.kalman.cv_predict` of one frame (dt = 1) of a centre's two axes, floats.
+
+    The same floats as ``_cv_predict``'s NumPy (its products by ``dt = 1.0`` are exact):
+    returns the new position and covariance ``p00, p01, p11`` (the velocity stays).
+    """
+    p00, p01, p11 = cov
+    return px + vx, py + vy, p00 + 2.0 * p01 + p11 + q / 3.0, p01 + p11 + q / 2, p11 + q
+
+
+def _cv_update_floats(px: float, py: float, vx: float, vy: float, p00: float, p01: float,
+                      p11: float, zx: float, zy: float, r2: float
+                      ) -> tuple[float, float, float, float, float, float, float]:  # fmt: skip
+    """:func:`pftrack.kalman.cv_update` of a centre's two axes with the measured ``(zx, zy)``.
+
+    The same floats as ``_cv_update``'s NumPy; returns position, velocity and covariance.
+    """
+    s = p00 + r2
+    k0, k1 = p00 / s, p01 / s
+    ex, ey = zx - px, zy - py
+    return (
+        px + k0 * ex, py + k0 * ey, vx + k1 * ex, vy + k1 * ey,
+        (1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01,
+    )  # fmt: skip
 
 
 def follow_tracks_motion(
     tracks: Sequence[LiveTrack], boxes_xywh: F64, config: TrackerConfig, smooth: bool
 ) -> None:
-    """:meth:`LiveTrack.follow_motion` for many tracks, as arrays over them (the same numbers).
+    """:meth:`LiveTrack.follow_motion` for many tracks (the same numbers), on plain floats.
 
     Parameters
     ----------
@@ -349,21 +371,20 @@ def follow_tracks_motion(
     if not tracks:
         return
     b = np.asarray(boxes_xywh, dtype=np.float64).reshape(-1, 4)
-    size = np.array([t.size for t in tracks])  # (K, 2)
-    p, v, cov = _motion_state(tracks)
-    centre = b[:, :2] + b[:, 2:] / 2
-    sigma = config.motion.detection_noise * size[:, 1:2]
-    mean, c = _cv_update((p, v), cov, centre, sigma**2)
-    p, v = np.asarray(mean[0], np.float64), np.asarray(mean[1], np.float64)
-    size = 0.7 * size + 0.3 * b[:, 2:]
-    boxes = np.concatenate([p - size / 2, size], axis=1) if smooth else b.copy()
-    covs = np.concatenate(c, axis=1).tolist()
-    for k, t in enumerate(tracks):
-        t.measured = b[k].copy()
+    noise = config.motion.detection_noise
+    for t, (bx, by, bw, bh), row in zip(tracks, b.tolist(), b, strict=True):
         m = t.motion
-        m.p, m.v, m.cov = p[k], v[k], tuple(covs[k])
-        t.size = size[k]
-        t.box = boxes[k]
+        w, h = t.size.tolist()
+        (px, py), (vx, vy) = m.p.tolist(), m.v.tolist()
+        sigma = noise * h
+        px, py, vx, vy, p00, p01, p11 = _cv_update_floats(
+            px, py, vx, vy, *_floats(m.cov), bx + bw / 2, by + bh / 2, sigma * sigma
+        )
+        m.p, m.v, m.cov = np.array((px, py)), np.array((vx, vy)), (p00, p01, p11)
+        w, h = 0.7 * w + 0.3 * bw, 0.7 * h + 0.3 * bh
+        t.measured = row.copy()
+        t.size = np.array((w, h))
+        t.box = np.array((px - w / 2, py - h / 2, w, h)) if smooth else row.copy()
 
 
 def reseed_tracks(
