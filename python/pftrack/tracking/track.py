@@ -297,43 +297,37 @@ def predict_tracks(
         return
     summary = step_filters_summary([t.filter for t in tracks], binned).tolist()
     # Floats, not arrays over the tracks: with a few to tens of tracks, the 30-odd NumPy calls
-    # on (K, 1) and (K, 2) arrays cost more than the loop (issue 17).
+    # on (K, 1) and (K, 2) arrays cost more than the loop (issue 17). The new positions,
+    # velocities and boxes go into one array, whose rows the tracks take.
+    rows = []
     for t, (zx, zy, rho, rho_max) in zip(tracks, summary, strict=True):
         m = t.motion
         w, h = t.size.tolist()
         (px, py), (vx, vy) = m.p.tolist(), m.v.tolist()
-        a = m.accel * accel_gain if accel_gain != 1.0 else m.accel
-        q = a * h
+        p00, p01, p11 = _floats(m.cov)
+        q = (m.accel * accel_gain if accel_gain != 1.0 else m.accel) * h
         q = q * q  # (accel h)²
-        px, py, p00, p01, p11 = _cv_predict_floats(px, py, vx, vy, _floats(m.cov), q)
-        # a flat likelihood is no measurement: the prediction stands
-        if colour_evidence(rho, rho_max):
+        # cv_predict over one frame (dt = 1: its products by dt are exact)
+        px, py = px + vx, py + vy
+        p00, p01, p11 = p00 + 2.0 * p01 + p11 + q / 3.0, p01 + p11 + q / 2, p11 + q
+        if rho_max - rho > FLAT_RHO:  # colour_evidence: a flat likelihood is no measurement
             r = colour_noise * h
             px, py, vx, vy, p00, p01, p11 = _cv_update_floats(
                 px, py, vx, vy, p00, p01, p11, zx, zy, r * r
             )
-        m.p, m.v, m.cov = np.array((px, py)), np.array((vx, vy)), (p00, p01, p11)
+        m.cov = (p00, p01, p11)
         t.measured = None
         t.rho = rho
-        t.box = np.array((px - w / 2, py - h / 2, w, h))
         t.age += 1
+        rows.append((px, py, vx, vy, px - w / 2, py - h / 2, w, h))
+    out = np.array(rows)
+    for t, p, v, box in zip(tracks, out[:, 0:2], out[:, 2:4], out[:, 4:8], strict=True):
+        t.motion.p, t.motion.v, t.box = p, v, box
 
 
 def _floats(cov: Cov) -> tuple[float, float, float]:
     """A centre filter's covariance, whose entries are floats (the tracker sets them so)."""
     return cast(tuple[float, float, float], cov)
-
-
-def _cv_predict_floats(
-    px: float, py: float, vx: float, vy: float, cov: tuple[float, float, float], q: float
-) -> tuple[float, float, float, float, float]:
-    """:func:`pftrack.kalman.cv_predict` of one frame (dt = 1) of a centre's two axes, floats.
-
-    The same floats as ``_cv_predict``'s NumPy (its products by ``dt = 1.0`` are exact):
-    returns the new position and covariance ``p00, p01, p11`` (the velocity stays).
-    """
-    p00, p01, p11 = cov
-    return px + vx, py + vy, p00 + 2.0 * p01 + p11 + q / 3.0, p01 + p11 + q / 2, p11 + q
 
 
 def _cv_update_floats(px: float, py: float, vx: float, vy: float, p00: float, p01: float,
@@ -372,7 +366,8 @@ def follow_tracks_motion(
         return
     b = np.asarray(boxes_xywh, dtype=np.float64).reshape(-1, 4)
     noise = config.motion.detection_noise
-    for t, (bx, by, bw, bh), row in zip(tracks, b.tolist(), b, strict=True):
+    rows = []  # one array of the new positions, velocities, sizes and boxes (predict_tracks)
+    for t, (bx, by, bw, bh) in zip(tracks, b.tolist(), strict=True):
         m = t.motion
         w, h = t.size.tolist()
         (px, py), (vx, vy) = m.p.tolist(), m.v.tolist()
@@ -380,11 +375,19 @@ def follow_tracks_motion(
         px, py, vx, vy, p00, p01, p11 = _cv_update_floats(
             px, py, vx, vy, *_floats(m.cov), bx + bw / 2, by + bh / 2, sigma * sigma
         )
-        m.p, m.v, m.cov = np.array((px, py)), np.array((vx, vy)), (p00, p01, p11)
+        m.cov = (p00, p01, p11)
         w, h = 0.7 * w + 0.3 * bw, 0.7 * h + 0.3 * bh
-        t.measured = row.copy()
-        t.size = np.array((w, h))
-        t.box = np.array((px - w / 2, py - h / 2, w, h)) if smooth else row.copy()
+        box = (px - w / 2, py - h / 2, w, h) if smooth else (bx, by, bw, bh)
+        rows.append((px, py, vx, vy, w, h, *box, bx, by, bw, bh))
+    out = np.array(rows)
+    for t, row in zip(tracks, out, strict=True):
+        t.motion.p, t.motion.v, t.size, t.box, t.measured = (
+            row[0:2],
+            row[2:4],
+            row[4:6],
+            row[6:10],
+            row[10:14],
+        )
 
 
 def reseed_tracks(
