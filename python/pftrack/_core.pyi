@@ -249,6 +249,18 @@ def bhattacharyya_distance(hists: _F64, ref: _F64) -> _F64: ...
 def bhattacharyya_weights(hists: _F64, ref: _F64, lam: float = 20.0) -> _F64: ...
 
 # --- assignment: cost (R, C) float64, +inf forbids a pair -> (rows, cols) int32 ----------
+# gated pairing cost (T, D) of track boxes (T, 4) and detection boxes (D, 4), xywh
+def association_cost(
+    track_boxes: ArrayLike,
+    heights: ArrayLike,
+    coasted: ArrayLike,
+    rho: ArrayLike,
+    boxes: ArrayLike,
+    match_distance: float,
+    colour_weight: float,
+    match_iou: float,
+    forbidden: float,
+) -> _F64: ...
 def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascending
 def sparse_assignment(
     r: ArrayLike, c: ArrayLike, cost: ArrayLike, n_ends: int, n_starts: int, unjoined: float

@@ -170,6 +170,23 @@ def _reseed_batch() -> st.SearchStrategy[Any]:
     )
 
 
+def _association_cost() -> st.SearchStrategy[Any]:
+    return st.tuples(N, N).flatmap(
+        lambda td: call(
+            _core.association_cost,
+            maybe(floats_array((td[0], 4), 0, 50)),
+            maybe(floats_array((td[0],), 1, 50)),
+            maybe(floats_array((td[0],), 0, 20)),
+            maybe(floats_array(td, 0, 1)),
+            maybe(floats_array((td[1], 4), 0, 50)),
+            maybe(fl(0.1, 3)),
+            maybe(fl(0, 2)),
+            maybe(fl(0, 1)),
+            maybe(fl(0, 1e6)),
+        )
+    )
+
+
 def _assignment() -> st.SearchStrategy[Any]:
     return st.tuples(N, N).flatmap(
         lambda rc: call(_core.linear_sum_assignment, maybe(floats_array(rc, -10, 10)))
@@ -543,6 +560,7 @@ TARGETS: list[Target] = [
     Target("sis_step_batch", _sis_batch()),
     Target("reseed_batch", _reseed_batch()),
     Target("linear_sum_assignment", _assignment()),
+    Target("association_cost", _association_cost()),
     Target("sparse_assignment", _sparse_assignment()),
     Target(
         "refine_boxes",

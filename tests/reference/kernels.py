@@ -158,6 +158,28 @@ def reseed(box, velocity, w0, h0, noise, pos_sd, s_sd, s_min, s_max):
     return p, np.full(len(noise), 1.0 / len(noise)), means
 
 
+def association_cost(
+    track_boxes, heights, coasted, rho, boxes, match_distance, colour_weight, match_iou, forbidden
+):
+    """The gated pairing cost of tracks and detections, as pftrack's associate computed it."""
+    a, b = track_boxes[:, None, :], boxes[None, :, :]
+    ax1, ay1 = a[..., 0] + a[..., 2], a[..., 1] + a[..., 3]
+    bx1, by1 = b[..., 0] + b[..., 2], b[..., 1] + b[..., 3]
+    iw = np.maximum(np.minimum(ax1, bx1) - np.maximum(a[..., 0], b[..., 0]), 0.0)
+    ih = np.maximum(np.minimum(ay1, by1) - np.maximum(a[..., 1], b[..., 1]), 0.0)
+    inter = iw * ih
+    union = a[..., 2] * a[..., 3] + b[..., 2] * b[..., 3] - inter
+    iou = np.divide(inter, union, out=np.zeros(inter.shape), where=union > 0)
+    tc = track_boxes[:, :2] + track_boxes[:, 2:] / 2
+    dc = boxes[:, :2] + boxes[:, 2:] / 2
+    dx, dy = tc[:, 0:1] - dc[:, 0], tc[:, 1:2] - dc[:, 1]
+    dist = np.sqrt(dx * dx + dy * dy)
+    radius = match_distance * heights * (1.0 + 0.25 * np.minimum(coasted, 8))
+    cost = (1.0 - iou) + colour_weight * (1.0 - rho) + np.minimum(dist / radius[:, None], 2.0)
+    gate = (iou >= match_iou) | (dist <= radius[:, None])
+    return np.where(gate, cost, forbidden)
+
+
 def sis_step(
     particles,
     weights,

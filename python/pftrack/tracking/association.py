@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack import _core
 from pftrack._typing import F64
 from pftrack.assignment import linear_sum_assignment
-from pftrack.boxes import _iou_matrix
 from pftrack.tracking.config import AssociationConfig
 
 __all__ = ["Association", "associate", "covers_another"]
@@ -73,21 +73,15 @@ def associate(
     nt, nd = len(track_boxes), len(boxes)
     if nt == 0 or nd == 0:
         return Association([], list(range(nt)), list(range(nd)))
-    iou = _iou_matrix(track_boxes, boxes)
-    tc = track_boxes[:, :2] + track_boxes[:, 2:] / 2
-    dc = boxes[:, :2] + boxes[:, 2:] / 2
-    dx, dy = tc[:, 0:1] - dc[:, 0], tc[:, 1:2] - dc[:, 1]
-    dist = np.sqrt(dx * dx + dy * dy)  # np.linalg.norm over (dx, dy), the same floats
-    radius = config.match_distance * heights * (1.0 + 0.25 * np.minimum(coasted, 8))
-    # Bhattacharyya coefficients of every (track reference, detection) pair in one product
+    # Bhattacharyya coefficients of every (track reference, detection) pair in one product;
+    # the rest of the cost and the gate in one core pass over the pairs (the module's rules)
     rho = np.sqrt(references) @ np.sqrt(hists).T
-    cost = (
-        (1.0 - iou) + config.colour_weight * (1.0 - rho) + np.minimum(dist / radius[:, None], 2.0)
-    )
-    gate = (iou >= config.match_iou) | (dist <= radius[:, None])
+    cost = _core.association_cost(
+        track_boxes, heights, coasted, rho, boxes, config.match_distance,
+        config.colour_weight, config.match_iou, FORBIDDEN,
+    )  # fmt: skip
     if allowed is not None:
-        gate &= allowed
-    cost = np.where(gate, cost, FORBIDDEN)
+        cost = np.where(allowed, cost, FORBIDDEN)
     if np.isfinite(config.unmatched_cost):
         # leaving a track or a detection unmatched costs `unmatched_cost` each, so a pair is
         # only made when it is cheaper than leaving both alone (not just because it is gated)
