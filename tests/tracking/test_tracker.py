@@ -322,6 +322,8 @@ def test_association_leaves_pairs_unmade_when_cheaper(tau, expected):
         config.association,
     )
     assert sorted(result.matches) == expected
+    left = [] if expected == [(0, 1), (1, 0)] else [1]  # track 1 and detection 1 wait
+    assert result.unmatched_tracks == left and result.unmatched_detections == left
 
 
 def test_unmatched_cost_must_be_positive():

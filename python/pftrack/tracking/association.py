@@ -10,6 +10,7 @@ costs ``unmatched_cost`` each, so a gated pair is only made when it is cheaper t
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,7 +18,6 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack._typing import F64
-from pftrack.assignment import linear_sum_assignment
 from pftrack.tracking.config import AssociationConfig
 
 __all__ = ["Association", "associate", "covers_another"]
@@ -82,7 +82,7 @@ def associate(
     )  # fmt: skip
     if allowed is not None:
         cost = np.where(allowed, cost, FORBIDDEN)
-    if np.isfinite(config.unmatched_cost):
+    if math.isfinite(config.unmatched_cost):
         # leaving a track or a detection unmatched costs `unmatched_cost` each, so a pair is
         # only made when it is cheaper than leaving both alone (not just because it is gated)
         tau = config.unmatched_cost
@@ -92,21 +92,26 @@ def associate(
         padded[k[:nt], nd + k[:nt]] = tau  # the diagonal of padded[:nt, nd:]
         padded[nt + k[:nd], k[:nd]] = tau  # the diagonal of padded[nt:, :nd]
         padded[nt:, nd:] = 0.0
-        rows, cols = linear_sum_assignment(padded)
-        keep = (rows < nt) & (cols < nd)
-        rows, cols = rows[keep], cols[keep]
+        cost_in = padded
     else:
-        rows, cols = linear_sum_assignment(cost)
-    ok = cost[rows, cols] < FORBIDDEN
-    rows, cols = rows[ok], cols[ok]
-    free_t = np.ones(nt, bool)
-    free_t[rows] = False
-    free_d = np.ones(nd, bool)
-    free_d[cols] = False
+        cost_in = np.ascontiguousarray(cost)
+    # pftrack.assignment.linear_sum_assignment without its checks of the argument (a finite
+    # float64 matrix made here); the pairs as lists from here on: a few tens of them, cheaper
+    # than NumPy's calls on tiny arrays
+    rows, cols = _core.linear_sum_assignment(cost_in)
+    # pairs of a track and a detection that the gate allows (a pair with a padding row or
+    # column leaves its track or detection unmatched)
+    matches = [
+        (r, c)
+        for r, c in zip(rows.tolist(), cols.tolist(), strict=True)
+        if r < nt and c < nd and cost[r, c] < FORBIDDEN
+    ]
+    taken_t = {r for r, _ in matches}
+    taken_d = {c for _, c in matches}
     return Association(
-        list(zip(rows.tolist(), cols.tolist(), strict=True)),
-        free_t.nonzero()[0].tolist(),
-        free_d.nonzero()[0].tolist(),
+        matches,
+        [i for i in range(nt) if i not in taken_t],
+        [j for j in range(nd) if j not in taken_d],
     )
 
 
