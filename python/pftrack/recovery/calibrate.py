@@ -443,38 +443,62 @@ def _artificial_gaps(
     used: set[tuple[int, int, int]] = set()
     places: dict[int, tuple[NDArray[np.int64], NDArray[np.int64], int]] = {}
     order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
-    for attempt in range(4 * n):
-        if len(out) >= n or not len(order):
-            break
-        t = targets[int(order[attempt % len(order)])]
-        L, dist = int(t[0]), float(t[1])
-        n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
-        ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
-        ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
-        span = L + ctx_a + ctx_b  # the places depend on it only: computed once per span
-        if span not in places:
-            slots_of = np.maximum(sizes - span + 1, 0)
-            cum_of = np.cumsum(slots_of)
-            places[span] = (slots_of, cum_of, int(cum_of[-1]) if len(cum_of) else 0)
-        slots, cum, total = places[span]
-        if total == 0:
+    attempt, limit = 0, 4 * n if len(order) else 0
+    while attempt < limit and len(out) < n:
+        # The next attempts are drawn, then their places matched in a few array operations:
+        # as many as gaps are still wanted, so the draws are those of one attempt at a time
+        # (an attempt gives one gap at most: none is drawn past the last one needed).
+        drawn: list[tuple[int, float, int, int, int, int, NDArray[np.int64]]] = []
+        for a in range(attempt, min(limit, attempt + n - len(out))):
+            t = targets[int(order[a % len(order)])]
+            L, dist = int(t[0]), float(t[1])
+            n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
+            ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
+            ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
+            span = L + ctx_a + ctx_b  # the places depend on it only: computed once per span
+            if span not in places:
+                slots_of = np.maximum(sizes - span + 1, 0)
+                cum_of = np.cumsum(slots_of)
+                places[span] = (slots_of, cum_of, int(cum_of[-1]) if len(cum_of) else 0)
+            if places[span][2] == 0:
+                continue
+            ks = rng.integers(places[span][2], size=MATCH_DRAWS)
+            drawn.append((L, dist, n_a, n_b, ctx_a, span, ks))
+        attempt = min(limit, attempt + n - len(out))
+        if not drawn:
             continue
-        ks = rng.integers(total, size=MATCH_DRAWS)
-        idx = np.searchsorted(cum, ks, side="right")
-        starts = ctx_a + ks - (cum[idx] - slots[idx])
-        j = 0
-        if dist >= 0:
-            at = offset[idx] + starts
-            d = np.round(np.hypot(*(xy[at + L] - xy[at - 1]).T), SPAN_DECIMALS)
-            j = int(np.argmin(np.abs(np.log1p(d) - np.log1p(dist))))
-        i, st = int(idx[j]), int(starts[j])
-        if (i, st, L) in used:
-            continue
-        used.add((i, st, L))
-        r = runs[i]
-        lo = 0 if n_a < 0 else max(0, st - n_a)
-        hi = len(r) if n_b < 0 else st + L + n_b
-        out.append((r[lo:st], r[st + L : hi], r[st : st + L], i))
+        k = len(drawn)
+        idx = np.zeros((k, MATCH_DRAWS), dtype=np.int64)
+        starts = np.zeros((k, MATCH_DRAWS), dtype=np.int64)
+        spans = np.array([e[5] for e in drawn])
+        for span in set(spans.tolist()):  # each row as its own attempt computed it
+            rows = np.flatnonzero(spans == span)
+            slots, cum, _ = places[span]
+            ks = np.stack([drawn[r][6] for r in rows])
+            got = np.searchsorted(cum, ks, side="right")
+            idx[rows] = got
+            ctx = np.array([drawn[r][4] for r in rows])[:, None]
+            starts[rows] = ctx + ks - (cum[got] - slots[got])
+        # the draw whose end-point distance is nearest the target's (the first when no target)
+        near = np.zeros(k, dtype=np.int64)
+        aim = np.flatnonzero(np.array([e[1] for e in drawn]) >= 0)
+        if len(aim):
+            L_of = np.array([drawn[r][0] for r in aim])[:, None]
+            at = offset[idx[aim]] + starts[aim]
+            gap = xy[at + L_of] - xy[at - 1]  # (rows, MATCH_DRAWS, 2)
+            d = np.round(np.hypot(gap[..., 0], gap[..., 1]), SPAN_DECIMALS)
+            log_dist = np.log1p(np.array([drawn[r][1] for r in aim]))[:, None]
+            near[aim] = np.argmin(np.abs(np.log1p(d) - log_dist), axis=1)
+        for row, (L, _, n_a, n_b, _, _, _) in enumerate(drawn):
+            j = int(near[row])
+            i, st = int(idx[row, j]), int(starts[row, j])
+            if (i, st, L) in used:
+                continue
+            used.add((i, st, L))
+            r = runs[i]
+            lo = 0 if n_a < 0 else max(0, st - n_a)
+            hi = len(r) if n_b < 0 else st + L + n_b
+            out.append((r[lo:st], r[st + L : hi], r[st : st + L], i))
     return out
 
 
