@@ -882,3 +882,43 @@ def test_fill_does_not_depend_on_where_the_tracks_are(shift: float) -> None:
     assert rep.n_filled_rows > 0
     np.testing.assert_allclose(out2[:, 2:4] - shift, out[:, 2:4], rtol=0, atol=1e-9)
     assert rep.describe() == rep2.describe()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_artificial_gaps_are_one_attempt_at_a_time(seed):
+    """The places of several attempts are matched in a few array operations: the same gaps
+    as one attempt at a time (tests/reference/calibrate.py), and the same draws (the
+    generator's state after the call), with or without distances and contexts, places
+    drawn twice (few runs, many gaps wanted) and lengths no run has room for."""
+    from pftrack.recovery.calibrate import _artificial_gaps
+    from tests.reference.calibrate import artificial_gaps
+
+    rng = np.random.default_rng(seed)
+    runs = []
+    for _ in range(int(rng.integers(1, 12))):
+        k = int(rng.integers(1, 70))
+        frames = np.arange(k, dtype=float) + float(rng.integers(1, 500))
+        xy = np.cumsum(rng.normal(0, 2, (k, 2)), axis=0)
+        runs.append(np.column_stack([frames, xy]))
+    cut = 0
+    for kind in ("plain", "distance", "context"):
+        targets = []
+        for _ in range(int(rng.integers(1, 6))):
+            L, dist = int(rng.integers(1, 60)), float(rng.exponential(8))
+            if kind == "plain":
+                targets.append((L, -1.0))
+            elif kind == "distance":
+                targets.append((L, dist))
+            else:
+                targets.append((L, dist, int(rng.integers(-1, 30)), int(rng.integers(-1, 30))))
+        n = int(rng.integers(1, 150))
+        got_rng, want_rng = np.random.default_rng([seed, 1]), np.random.default_rng([seed, 1])
+        got = _artificial_gaps(runs, targets, n, got_rng)
+        want = artificial_gaps(runs, targets, n, want_rng)
+        assert len(got) == len(want)
+        cut += len(got)
+        for g, w in zip(got, want, strict=True):
+            assert g[3] == w[3]  # the run cut from, then its segments and truth
+            assert all(np.array_equal(a, b) for a, b in zip(g[:3], w[:3], strict=True))
+        assert got_rng.integers(1 << 62) == want_rng.integers(1 << 62)
+    assert cut > 0

@@ -197,6 +197,31 @@ def test_gap_mixture_many_is_gap_mixture_per_job(threads: int) -> None:
     assert _core.gap_mixture_many([], *models, threads) == []
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_gap_mixture_many_shared_shapes_are_gap_mixture_per_job(threads: int) -> None:
+    """Jobs of one shape (the calibration's validation gaps of a bucket) share their
+    covariances in the batch: still every job's own bits. 40 jobs of each model on one window
+    shape (more than one piece of shared jobs), others with holes at other places or other
+    hypotheses among them, which must not share with them."""
+    rng = np.random.default_rng(5)
+    _, models = _mixture_jobs(rng, 0)
+    n, fa, fb = 50, 29, 40
+    t1, t2 = stand_hypotheses(fb - fa, grid=8)
+    jobs = []
+    for j in range(100):
+        z = _window(rng, n, fa, fb, holes=0)
+        kind = j % 5
+        if kind == 3:  # a hole in segment A: another shape
+            z[3 + j % 7] = np.nan
+        hyp = (t1[:1], t2[:1]) if kind == 4 else (t1, t2)  # walking only: other hypotheses
+        jobs.append((z, fa, fb, j % 2, *hyp))
+    got = _core.gap_mixture_many(jobs, *models, threads)
+    F, Q, r, p0, v2 = models
+    for (z, fa_, fb_, k, h1, h2), (paths, ll) in zip(jobs, got, strict=True):
+        want_p, want_ll = _core.gap_mixture(z, fa_, fb_, F[k], Q[k], r[k], p0[k], h1, h2, v2[k])
+        assert np.array_equal(paths, want_p) and np.array_equal(ll, want_ll)
+
+
 @pytest.mark.parametrize(
     "change, error, match",
     [

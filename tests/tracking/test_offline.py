@@ -373,6 +373,30 @@ def test_complete_boxes_matches_the_row_by_row_reference(seed, n, share, anchor,
     np.testing.assert_array_equal(got[:, [0, 1, 3, 6, 7, 8, 9]], rows[:, [0, 1, 3, 6, 7, 8, 9]])
 
 
+@pytest.mark.parametrize("block", [1, 5, 64])
+def test_frame_pairs_in_blocks_give_the_same_rows(monkeypatch, block):
+    """drop_nested and complete_boxes pair the rows of each frame in blocks of about
+    PAIR_BLOCK pairs (bounded memory): any block size gives the same rows, the references'
+    rows, over 60 frames of a few boxes each given in no order."""
+    from pftrack.tracking import offline
+
+    rng = np.random.default_rng(block)
+    n = 300
+    rows = np.zeros((n, 10))
+    rows[:, 0] = np.sort(rng.integers(1, 60, n))[rng.permutation(n)]  # frames in any order
+    rows[:, 1] = np.arange(n)
+    rows[:, 2:4] = rng.uniform(0, 120, (n, 2))
+    rows[:, 4:6] = rng.uniform(2, 60, (n, 2))
+    lines = np.array([[0.4, 10.0], [0.3, 5.0]])
+    whole = drop_nested(rows, 0.7, 1.5), complete_boxes(rows, lines, 0.9)
+    monkeypatch.setattr(offline, "PAIR_BLOCK", block)
+    np.testing.assert_array_equal(drop_nested(rows, 0.7, 1.5), whole[0])
+    np.testing.assert_array_equal(complete_boxes(rows, lines, 0.9), whole[1])
+    np.testing.assert_array_equal(whole[0], _nested_reference(rows, 0.7, 1.5))
+    np.testing.assert_allclose(whole[1], _complete_reference(rows, lines, 0.9, "side", 1.6))
+    assert len(whole[0]) < n and np.any(whole[1][:, 2] != rows[:, 2])  # both had work to do
+
+
 def test_complete_boxes_grows_a_partly_hidden_person_towards_the_hidden_side():
     # h = 0.5 * foot: a head at row y has h_e = y (foot 2y); w = 0.4 h at the foot row
     lines = np.array([[0.5, 0.0], [0.2, 0.0]])

@@ -11,8 +11,9 @@
 //
 // For every hypothesis one Kalman filter and Rauch-Tung-Striebel smoother run over the window
 // (the filter over the part before the gap, and the smoother gains where hypotheses agree, are
-// shared); the result is the smoothed positions inside the gap and the log-likelihood of the
-// window's observations, so that the caller can weight the hypotheses by their evidence. For a
+// shared; gap_mixture_many also shares the covariances of windows of one shape); the result is
+// the smoothed positions inside the gap and the log-likelihood of the window's observations, so
+// that the caller can weight the hypotheses by their evidence. For a
 // linear-Gaussian model the smoothed mean inside the gap is the goal-directed path conditioned
 // on the filtered states at both ends.
 #pragma once
@@ -58,16 +59,27 @@ Eigen::Matrix<double, D, D> psd_pinv(const Eigen::Matrix<double, D, D>& P) {
     return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
 }
 
+/// `gap_mixture` of G windows that share everything but their observed values: the same
+/// length, the same unobserved indices (NaN), fa, fb, model and hypotheses. The covariances,
+/// gains and innovation variances depend on those only, so they are computed once for the G
+/// windows and only the means and log-likelihoods per window (the calibration's validation
+/// gaps of a bucket have the real gap's length and context: 227 of the 300 of PETS09-S2L1's
+/// offline pass fall in 6 shapes of 32-42 windows). Every window's result is the same, bit for
+/// bit, as a call with it alone: the same expressions on the same operands, in the same order.
+/// zs[g] is window g (the mask is read from zs[0]); outs[g] receives its result.
 template <int D>
-GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index fa, Index fb,
-                             const Eigen::Ref<const RowMatrixXd>& F_in,
-                             const Eigen::Ref<const RowMatrixXd>& Q_in, double r,
-                             const Eigen::Ref<const Eigen::VectorXd>& p0,
-                             const Eigen::Ref<const Eigen::VectorXi>& t1s,
-                             const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2) {
+void gap_mixture_shared(const std::vector<const Eigen::VectorXd*>& zs, Index fa, Index fb,
+                        const Eigen::Ref<const RowMatrixXd>& F_in,
+                        const Eigen::Ref<const RowMatrixXd>& Q_in, double r,
+                        const Eigen::Ref<const Eigen::VectorXd>& p0,
+                        const Eigen::Ref<const Eigen::VectorXi>& t1s,
+                        const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2,
+                        const std::vector<GapMixtureResult*>& outs) {
     using Mat = Eigen::Matrix<double, D, D>;
     using Vec = Eigen::Matrix<double, D, 1>;
-    const Index n = z.size(), T = fb - fa, H = t1s.size();
+    const std::size_t G = zs.size();
+    const Eigen::VectorXd& mask = *zs[0];  // which values are observed: every window's
+    const Index n = mask.size(), T = fb - fa, H = t1s.size();
     const Mat F = F_in, Q = Q_in;
     Mat stand = Mat::Zero();
     stand(0, 0) = 1.0;
@@ -76,120 +88,162 @@ GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index f
     Mat q_restart = q_stand;
     q_restart(1, 1) = v2;
 
-    // Filter over the window up to the end of segment A: the same for every hypothesis.
-    Vec m = Vec::Zero();
-    m(0) = z(0);
-    Mat P = p0.asDiagonal();
-    double ll_prefix = 0.0;
+    // One observation: the covariance update (shared) and, for every window g, its mean's
+    // (the innovation v counted in the log-likelihood after the first D observations).
     int seen = 0;
-    auto update = [&](Vec& mm, Mat& PP, double zt, double& ll) {
+    auto update = [&](Mat& PP, Index t, Vec* mm, std::size_t mstride, double* ll,
+                      std::size_t lstride) {
         const double s = PP(0, 0) + r;
-        const double v = zt - mm(0);
-        if (seen >= D) ll -= 0.5 * (std::log(kTwoPi * s) + v * v / s);
+        const bool counted = seen >= D;
+        const double log_s = counted ? std::log(kTwoPi * s) : 0.0;
         ++seen;
         const Vec k = PP.col(0) / s;
-        mm += k * v;
+        for (std::size_t g = 0; g < G; ++g) {
+            Vec& m = mm[g * mstride];
+            const double v = (*zs[g])(t) - m(0);
+            if (counted) ll[g * lstride] -= 0.5 * (log_s + v * v / s);
+            m += k * v;
+        }
         PP -= k * PP.row(0);
         PP = 0.5 * (PP + PP.transpose()).eval();
     };
+
+    // Filter over the window up to the end of segment A: the same for every hypothesis.
+    std::vector<Vec> m(G, Vec::Zero());
+    for (std::size_t g = 0; g < G; ++g) m[g](0) = (*zs[g])(0);
+    Mat P = p0.asDiagonal();
+    std::vector<double> ll_prefix(G, 0.0);
     for (Index t = 0; t <= fa; ++t) {
         if (t > 0) {
-            m = F * m;
+            for (std::size_t g = 0; g < G; ++g) m[g] = F * m[g];
             P = F * P * F.transpose() + Q;
         }
-        if (std::isfinite(z(t))) update(m, P, z(t), ll_prefix);
+        if (std::isfinite(mask(t))) update(P, t, m.data(), 1, ll_prefix.data(), 1);
     }
     const int seen_prefix = seen;
 
-    GapMixtureResult out{RowMatrixXd(H, T - 1), Eigen::VectorXd(H)};
+    for (std::size_t g = 0; g < G; ++g) *outs[g] = {RowMatrixXd(H, T - 1), Eigen::VectorXd(H)};
     const Index len = n - fa;  // window steps from the end of A on
+    const auto L = static_cast<std::size_t>(len);
     // The walking filter over the rest of the window, kept: a stand hypothesis (t1, t2) is the
     // same filter up to gap step t1, so it starts from there instead of from the end of A.
-    std::vector<Vec> walk_m(len), walk_mp(len);
-    std::vector<Mat> walk_P(len), walk_Pp(len);
-    std::vector<double> walk_ll(len);
-    std::vector<int> walk_seen(len);
-    walk_m[0] = walk_mp[0] = m;
+    // Per window g: entries g * L + j.
+    std::vector<Vec> walk_m(G * L), walk_mp(G * L);
+    std::vector<double> walk_ll(G * L);
+    std::vector<Mat> walk_P(L), walk_Pp(L);
+    std::vector<int> walk_seen(L);
+    for (std::size_t g = 0; g < G; ++g) {
+        walk_m[g * L] = walk_mp[g * L] = m[g];
+        walk_ll[g * L] = ll_prefix[g];
+    }
     walk_P[0] = walk_Pp[0] = P;
-    walk_ll[0] = ll_prefix;
     walk_seen[0] = seen_prefix;
     for (Index j = 1; j < len; ++j) {
-        Vec mj = F * walk_m[j - 1];
-        Mat Pj = F * walk_P[j - 1] * F.transpose() + Q;
-        walk_mp[j] = mj;
-        walk_Pp[j] = Pj;
-        double ll = walk_ll[j - 1];
-        seen = walk_seen[j - 1];
-        if (std::isfinite(z(fa + j))) update(mj, Pj, z(fa + j), ll);
-        walk_m[j] = mj;
-        walk_P[j] = Pj;
-        walk_ll[j] = ll;
-        walk_seen[j] = seen;
+        const auto u = static_cast<std::size_t>(j);
+        for (std::size_t g = 0; g < G; ++g) {
+            walk_m[g * L + u] = F * walk_m[g * L + u - 1];
+            walk_mp[g * L + u] = walk_m[g * L + u];
+            walk_ll[g * L + u] = walk_ll[g * L + u - 1];
+        }
+        Mat Pj = F * walk_P[u - 1] * F.transpose() + Q;
+        walk_Pp[u] = Pj;
+        seen = walk_seen[u - 1];
+        if (std::isfinite(mask(fa + j)))
+            update(Pj, fa + j, walk_m.data() + u, L, walk_ll.data() + u, L);
+        walk_P[u] = Pj;
+        walk_seen[u] = seen;
     }
 
-    std::vector<Vec> mp(len), ms(len);
-    std::vector<Mat> Pp(len), Ps(len);
-    std::vector<const Mat*> Fs(len, &F);
+    std::vector<Vec> mp(G * L), ms(G * L), mh(G);
+    std::vector<double> ll(G);
+    std::vector<Mat> Pp(L), Ps(L);
+    std::vector<const Mat*> Fs(L, &F);
     // Smoother gains C_j = Ps[j] F_{j+1}' pinv(Pp[j+1]) depend on covariances only, which do not
     // depend on the observed values. Before gap step t1 every hypothesis has the walking filter's
     // (walk_gain, computed once); while standing (t1 <= j < t2) they depend on (t1, j) only
     // (stand_gain, kept for the last t1 seen: hypotheses come grouped by t1). The same
     // expression on the same operands: the same bits as computing them per hypothesis.
-    std::vector<Mat> walk_gain(len), stand_gain(len);
-    std::vector<char> have_walk(len, 0);
-    std::vector<int> stand_t1(len, -2);
+    std::vector<Mat> walk_gain(L), stand_gain(L);
+    std::vector<char> have_walk(L, 0);
+    std::vector<int> stand_t1(L, -2);
     for (Index h = 0; h < H; ++h) {
         const int t1 = t1s(h), t2 = t2s(h);
         const Index first = t1 < 0 ? len : t1 + 1;  // first step that differs from walking
+        const auto f1 = static_cast<std::size_t>(first - 1);
         // Before `first` the walking filter's arrays are read directly (walk_*); only the
         // last walking step, where the hypothesis branches off, is copied.
-        ms[first - 1] = walk_m[first - 1];
-        Ps[first - 1] = walk_P[first - 1];
-        Vec mh = ms[first - 1];
-        Mat Ph = Ps[first - 1];
-        double ll = walk_ll[first - 1];
-        seen = walk_seen[first - 1];
+        for (std::size_t g = 0; g < G; ++g) {
+            ms[g * L + f1] = walk_m[g * L + f1];
+            mh[g] = ms[g * L + f1];
+            ll[g] = walk_ll[g * L + f1];
+        }
+        Ps[f1] = walk_P[f1];
+        Mat Ph = Ps[f1];
+        seen = walk_seen[f1];
         for (Index j = first; j < len; ++j) {  // window index fa + j, gap step j
+            const auto u = static_cast<std::size_t>(j);
             const Mat* Fj = &F;
             const Mat* Qj = &Q;
             if (j <= t2 + 1) {
                 Fj = &stand;
                 Qj = j == t2 + 1 ? &q_restart : &q_stand;
             }
-            Fs[j] = Fj;
-            mh = (*Fj) * mh;
+            Fs[u] = Fj;
+            for (std::size_t g = 0; g < G; ++g) {
+                mh[g] = (*Fj) * mh[g];
+                mp[g * L + u] = mh[g];
+            }
             Ph = (*Fj) * Ph * Fj->transpose() + *Qj;
-            mp[j] = mh;
-            Pp[j] = Ph;
-            if (std::isfinite(z(fa + j))) update(mh, Ph, z(fa + j), ll);
-            ms[j] = mh;
-            Ps[j] = Ph;
+            Pp[u] = Ph;
+            if (std::isfinite(mask(fa + j))) update(Ph, fa + j, mh.data(), 1, ll.data(), 1);
+            for (std::size_t g = 0; g < G; ++g) ms[g * L + u] = mh[g];
+            Ps[u] = Ph;
         }
         for (Index j = len - 2; j >= 1; --j) {
             const auto u = static_cast<std::size_t>(j);
             if (j + 1 < first) {  // walking up to here: Ps[j], Pp[j + 1], Fs[j + 1] are walk's
                 if (!have_walk[u]) {
-                    const Mat C = walk_P[j] * F.transpose() * psd_pinv<D>(walk_Pp[j + 1]);
+                    const Mat C = walk_P[u] * F.transpose() * psd_pinv<D>(walk_Pp[u + 1]);
                     walk_gain[u] = C;
                     have_walk[u] = 1;
                 }
-                ms[j] = walk_m[j];
-                ms[j] += walk_gain[u] * (ms[j + 1] - walk_mp[j + 1]);
+                for (std::size_t g = 0; g < G; ++g) {
+                    Vec& x = ms[g * L + u];
+                    x = walk_m[g * L + u];
+                    x += walk_gain[u] * (ms[g * L + u + 1] - walk_mp[g * L + u + 1]);
+                }
             } else if (j < t2) {  // standing from t1 + 1 to j + 1 <= t2: depends on (t1, j)
                 if (stand_t1[u] != t1) {
-                    const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
+                    const Mat C = Ps[u] * Fs[u + 1]->transpose() * psd_pinv<D>(Pp[u + 1]);
                     stand_gain[u] = C;
                     stand_t1[u] = t1;
                 }
-                ms[j] += stand_gain[u] * (ms[j + 1] - mp[j + 1]);
+                for (std::size_t g = 0; g < G; ++g)
+                    ms[g * L + u] += stand_gain[u] * (ms[g * L + u + 1] - mp[g * L + u + 1]);
             } else {
-                const Mat C = Ps[j] * Fs[j + 1]->transpose() * psd_pinv<D>(Pp[j + 1]);
-                ms[j] += C * (ms[j + 1] - mp[j + 1]);
+                const Mat C = Ps[u] * Fs[u + 1]->transpose() * psd_pinv<D>(Pp[u + 1]);
+                for (std::size_t g = 0; g < G; ++g)
+                    ms[g * L + u] += C * (ms[g * L + u + 1] - mp[g * L + u + 1]);
             }
         }
-        for (Index j = 1; j < T; ++j) out.paths(h, j - 1) = ms[j](0);
-        out.loglik(h) = ll;
+        for (std::size_t g = 0; g < G; ++g) {
+            for (Index j = 1; j < T; ++j)
+                outs[g]->paths(h, j - 1) = ms[g * L + static_cast<std::size_t>(j)](0);
+            outs[g]->loglik(h) = ll[g];
+        }
     }
+}
+
+template <int D>
+GapMixtureResult gap_mixture(const Eigen::Ref<const Eigen::VectorXd>& z, Index fa, Index fb,
+                             const Eigen::Ref<const RowMatrixXd>& F_in,
+                             const Eigen::Ref<const RowMatrixXd>& Q_in, double r,
+                             const Eigen::Ref<const Eigen::VectorXd>& p0,
+                             const Eigen::Ref<const Eigen::VectorXi>& t1s,
+                             const Eigen::Ref<const Eigen::VectorXi>& t2s, double v2) {
+    const Eigen::VectorXd window = z;
+    GapMixtureResult out;
+    gap_mixture_shared<D>({&window}, fa, fb, F_in, Q_in, r, p0, t1s, t2s, v2, {&out});
     return out;
 }
 
@@ -291,17 +345,51 @@ inline std::vector<GapMixtureResult> gap_mixture_many(const std::vector<GapMixtu
         check_gap_mixture(g.z, g.fa, g.fb, models.F[k], models.Q[k], models.r[k], models.p0[k],
                           g.t1s, g.t2s, models.v2[k], what.c_str());
     }
+    // Jobs of one shape (window length, unobserved indices, fa, fb, model, hypotheses) share
+    // their covariances (detail::gap_mixture_shared), in pieces of at most `most` jobs so that
+    // the threads still get several pieces each; the results are the same whatever the pieces.
+    const std::size_t most =
+        std::max<std::size_t>(16, jobs.size() / (4 * static_cast<std::size_t>(threads)) + 1);
+    std::vector<std::string> keys(jobs.size());
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+        const GapMixtureJob& g = jobs[j];
+        const Index head[5] = {g.model, g.fa, g.fb, g.z.size(), g.t1s.size()};
+        std::string& key = keys[j];
+        key.append(reinterpret_cast<const char*>(head), sizeof(head));
+        key.append(reinterpret_cast<const char*>(g.t1s.data()),
+                   static_cast<std::size_t>(g.t1s.size()) * sizeof(int));
+        key.append(reinterpret_cast<const char*>(g.t2s.data()),
+                   static_cast<std::size_t>(g.t2s.size()) * sizeof(int));
+        for (Index t = 0; t < g.z.size(); ++t) key.push_back(std::isfinite(g.z(t)) ? '1' : '0');
+    }
+    std::vector<std::size_t> order(jobs.size());
+    for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+    std::vector<std::vector<std::size_t>> pieces;
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        if (i == 0 || keys[order[i]] != keys[order[i - 1]] || pieces.back().size() == most)
+            pieces.emplace_back();
+        pieces.back().push_back(order[i]);
+    }
     std::vector<GapMixtureResult> out(jobs.size());
-    parallel_for(static_cast<Index>(jobs.size()), threads, [&](Index j) {
-        const GapMixtureJob& g = jobs[static_cast<std::size_t>(j)];
+    parallel_for(static_cast<Index>(pieces.size()), threads, [&](Index p) {
+        const std::vector<std::size_t>& piece = pieces[static_cast<std::size_t>(p)];
+        std::vector<const Eigen::VectorXd*> zs;
+        std::vector<GapMixtureResult*> outs;
+        for (const std::size_t j : piece) {
+            zs.push_back(&jobs[j].z);
+            outs.push_back(&out[j]);
+        }
+        const GapMixtureJob& g = jobs[piece[0]];
         const auto k = static_cast<std::size_t>(g.model);
         const RowMatrixXd& F = models.F[k];
-        out[static_cast<std::size_t>(j)] =
-            F.rows() == 2
-                ? detail::gap_mixture<2>(g.z, g.fa, g.fb, F, models.Q[k], models.r[k],
-                                         models.p0[k], g.t1s, g.t2s, models.v2[k])
-                : detail::gap_mixture<3>(g.z, g.fa, g.fb, F, models.Q[k], models.r[k],
-                                         models.p0[k], g.t1s, g.t2s, models.v2[k]);
+        if (F.rows() == 2)
+            detail::gap_mixture_shared<2>(zs, g.fa, g.fb, F, models.Q[k], models.r[k],
+                                          models.p0[k], g.t1s, g.t2s, models.v2[k], outs);
+        else
+            detail::gap_mixture_shared<3>(zs, g.fa, g.fb, F, models.Q[k], models.r[k],
+                                          models.p0[k], g.t1s, g.t2s, models.v2[k], outs);
     });
     return out;
 }

@@ -443,38 +443,62 @@ def _artificial_gaps(
     used: set[tuple[int, int, int]] = set()
     places: dict[int, tuple[NDArray[np.int64], NDArray[np.int64], int]] = {}
     order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
-    for attempt in range(4 * n):
-        if len(out) >= n or not len(order):
-            break
-        t = targets[int(order[attempt % len(order)])]
-        L, dist = int(t[0]), float(t[1])
-        n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
-        ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
-        ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
-        span = L + ctx_a + ctx_b  # the places depend on it only: computed once per span
-        if span not in places:
-            slots_of = np.maximum(sizes - span + 1, 0)
-            cum_of = np.cumsum(slots_of)
-            places[span] = (slots_of, cum_of, int(cum_of[-1]) if len(cum_of) else 0)
-        slots, cum, total = places[span]
-        if total == 0:
+    attempt, limit = 0, 4 * n if len(order) else 0
+    while attempt < limit and len(out) < n:
+        # The next attempts are drawn, then their places matched in a few array operations:
+        # as many as gaps are still wanted, so the draws are those of one attempt at a time
+        # (an attempt gives one gap at most: none is drawn past the last one needed).
+        drawn: list[tuple[int, float, int, int, int, int, NDArray[np.int64]]] = []
+        for a in range(attempt, min(limit, attempt + n - len(out))):
+            t = targets[int(order[a % len(order)])]
+            L, dist = int(t[0]), float(t[1])
+            n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
+            ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
+            ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
+            span = L + ctx_a + ctx_b  # the places depend on it only: computed once per span
+            if span not in places:
+                slots_of = np.maximum(sizes - span + 1, 0)
+                cum_of = np.cumsum(slots_of)
+                places[span] = (slots_of, cum_of, int(cum_of[-1]) if len(cum_of) else 0)
+            if places[span][2] == 0:
+                continue
+            ks = rng.integers(places[span][2], size=MATCH_DRAWS)
+            drawn.append((L, dist, n_a, n_b, ctx_a, span, ks))
+        attempt = min(limit, attempt + n - len(out))
+        if not drawn:
             continue
-        ks = rng.integers(total, size=MATCH_DRAWS)
-        idx = np.searchsorted(cum, ks, side="right")
-        starts = ctx_a + ks - (cum[idx] - slots[idx])
-        j = 0
-        if dist >= 0:
-            at = offset[idx] + starts
-            d = np.round(np.hypot(*(xy[at + L] - xy[at - 1]).T), SPAN_DECIMALS)
-            j = int(np.argmin(np.abs(np.log1p(d) - np.log1p(dist))))
-        i, st = int(idx[j]), int(starts[j])
-        if (i, st, L) in used:
-            continue
-        used.add((i, st, L))
-        r = runs[i]
-        lo = 0 if n_a < 0 else max(0, st - n_a)
-        hi = len(r) if n_b < 0 else st + L + n_b
-        out.append((r[lo:st], r[st + L : hi], r[st : st + L], i))
+        k = len(drawn)
+        idx = np.zeros((k, MATCH_DRAWS), dtype=np.int64)
+        starts = np.zeros((k, MATCH_DRAWS), dtype=np.int64)
+        spans = np.array([e[5] for e in drawn])
+        for span in set(spans.tolist()):  # each row as its own attempt computed it
+            rows = np.flatnonzero(spans == span)
+            slots, cum, _ = places[span]
+            ks = np.stack([drawn[r][6] for r in rows])
+            got = np.searchsorted(cum, ks, side="right")
+            idx[rows] = got
+            ctx = np.array([drawn[r][4] for r in rows])[:, None]
+            starts[rows] = ctx + ks - (cum[got] - slots[got])
+        # the draw whose end-point distance is nearest the target's (the first when no target)
+        near = np.zeros(k, dtype=np.int64)
+        aim = np.flatnonzero(np.array([e[1] for e in drawn]) >= 0)
+        if len(aim):
+            L_of = np.array([drawn[r][0] for r in aim])[:, None]
+            at = offset[idx[aim]] + starts[aim]
+            gap = xy[at + L_of] - xy[at - 1]  # (rows, MATCH_DRAWS, 2)
+            d = np.round(np.hypot(gap[..., 0], gap[..., 1]), SPAN_DECIMALS)
+            log_dist = np.log1p(np.array([drawn[r][1] for r in aim]))[:, None]
+            near[aim] = np.argmin(np.abs(np.log1p(d) - log_dist), axis=1)
+        for row, (L, _, n_a, n_b, _, _, _) in enumerate(drawn):
+            j = int(near[row])
+            i, st = int(idx[row, j]), int(starts[row, j])
+            if (i, st, L) in used:
+                continue
+            used.add((i, st, L))
+            r = runs[i]
+            lo = 0 if n_a < 0 else max(0, st - n_a)
+            hi = len(r) if n_b < 0 else st + L + n_b
+            out.append((r[lo:st], r[st + L : hi], r[st : st + L], i))
     return out
 
 
@@ -576,7 +600,12 @@ def calibrate(
         t.sort()
     if not by_bucket:
         return Calibration(())
-    runs = distinct_runs(observed, strict="calibrate")
+    # recover_auto's runs are distinct_runs' already (they would come back the same)
+    runs = (
+        observed
+        if isinstance(observed, _DistinctRuns)
+        else distinct_runs(observed, strict="calibrate")
+    )
     whole = _fit_sample([r for r in runs if len(r) >= 4], seed)
     if noise is None and ("gdt-bi" in names or "gdt-mix" in names):
         noise = estimate_noise(whole) if whole else None
@@ -594,25 +623,36 @@ def calibrate(
     n_cut: dict[int, int] = {}
     flat = _flat(runs)
     hood = Neighbourhood(runs) if any(m.endswith(NB_SUFFIX) for m in scored) else None
-    for b in progress(sorted(by_bucket), desc="auto: calibrating", unit="bucket"):
+    cuts: dict[int, list[tuple[F64, F64, F64, int]]] = {}
+    for b in sorted(by_bucket):
         rng = np.random.default_rng([seed, b])
         cut = _artificial_gaps(runs, targets[b], quota[b], rng, flat)
         n_cut[b] = len(cut)
-        if len(cut) < MIN_VALIDATION_GAPS:
-            continue
-        pairs = [(a, c) for a, c, _, _ in cut]
+        if len(cut) >= MIN_VALIDATION_GAPS:
+            cuts[b] = cut
+    # Every candidate recovers the validation gaps of every bucket in one call (one C++ call,
+    # threads over all of them): each gap is recovered on its own, so its path is the one a
+    # call per bucket gave (was: a call per bucket and method, 4 buckets on PETS09-S2L1).
+    pairs = [(a, c) for cut in cuts.values() for a, c, _, _ in cut]
+    cut_from = [i for cut in cuts.values() for _, _, _, i in cut]
+    every: dict[str, list[F64]] = {}
+    for m in progress(scored if pairs else [], desc="auto: calibrating", unit="method"):
+        # a "-nb" method corrects its base's paths, scored before it
+        base = every.get(m.removesuffix(NB_SUFFIX)) if m.endswith(NB_SUFFIX) else None
+        every[m] = recover_with(
+            m, pairs, noise or _NO_NOISE, motion or _NO_MOTION, hood, cut_from, base
+        )
+    at = 0
+    for b, cut in cuts.items():
         truth = [t for _, _, t, _ in cut]
-        cut_from = [i for _, _, _, i in cut]
         errors[b] = {}
         found[b] = {}
         truths[b] = truth
-        for m in scored:  # a "-nb" method corrects its base's paths, scored before it
-            base = found[b].get(m.removesuffix(NB_SUFFIX)) if m.endswith(NB_SUFFIX) else None
-            paths = recover_with(
-                m, pairs, noise or _NO_NOISE, motion or _NO_MOTION, hood, cut_from, base
-            )
+        for m in scored:
+            paths = every[m][at : at + len(cut)]
             errors[b][m] = _gap_errors(paths, truth)
             found[b][m] = paths
+        at += len(cut)
     weights = {b: len(by_bucket[b]) for b in errors}
     blends = _Blends(found, truths)
     stacked = {b: np.stack([errors[b][m] for m in scored]) for b in errors}
@@ -743,19 +783,25 @@ def _choose(
     if idx is not None:
         stacked = {b: v[:, idx[b]] for b, v in stacked.items()}
     errors = {b: dict(zip(names, v, strict=True)) for b, v in stacked.items()}
-    pooled = _pooled_choice(errors, weights, names)
+    # every row's mean as row.mean() gives it (one pairwise sum per row of a C-contiguous
+    # copy: `stacked` is not, after the resample), once for the pooled choice and the tests
+    row_means = {
+        b: dict(zip(names, np.ascontiguousarray(v).mean(axis=1).tolist(), strict=True))
+        for b, v in stacked.items()
+    }
+    pooled = _pooled_choice(errors, weights, names, row_means)
     out: dict[int, tuple[tuple[str, float], ...]] = {}
     for b, e in errors.items():
         means = dict(zip(names, stacked[b].mean(axis=1).tolist(), strict=True))
         method = pooled
         best = min(names, key=lambda m: means[m])
-        if best != pooled and _better(e[best], e[pooled]):
+        if best != pooled and _better(e[best], e[pooled], row_means[b][pooled]):
             method = best
         out[b] = ((method, 1.0),)
         if combine and len(names) > 1:
             other = min((m for m in names if m != method), key=lambda m: means[m])
             w, err = blends.fit(b, method, other, None if idx is None else idx[b])
-            if 0.0 < w and _better(err, e[method]):
+            if 0.0 < w and _better(err, e[method], row_means[b][method]):
                 out[b] = ((method, 1.0 - w), (other, w))
     return pooled, out
 
@@ -802,21 +848,30 @@ def _gap_errors(paths: Sequence[F64], truth: Sequence[F64]) -> F64:
     return out
 
 
-def _better(cand: F64, ref: F64) -> bool:
-    """`cand` beats `ref` on the same validation gaps: a paired test and the margin."""
+def _better(cand: F64, ref: F64, ref_mean: float | None = None) -> bool:
+    """`cand` beats `ref` on the same validation gaps: a paired test and the margin.
+
+    `ref_mean`: ``float(ref.mean())`` when the caller has it.
+    """
     d = cand - ref
     se = float(np.std(d, ddof=1)) / np.sqrt(len(d)) if len(d) > 1 else np.inf
     mean = float(d.mean())
-    return mean < -PAIRED_Z * se and mean < -max(LINEAR_MARGIN * float(ref.mean()), TIE)
+    if ref_mean is None:
+        ref_mean = float(ref.mean())
+    return mean < -PAIRED_Z * se and mean < -max(LINEAR_MARGIN * ref_mean, TIE)
 
 
 def _pooled_choice(
-    errors: dict[int, dict[str, F64]], weights: dict[int, int], names: Sequence[str]
+    errors: dict[int, dict[str, F64]],
+    weights: dict[int, int],
+    names: Sequence[str],
+    means: dict[int, dict[str, float]],
 ) -> str:
     """The file's method: validation MMAE of every bucket weighted by its real gaps.
 
     ``"linear"`` unless the best beats it by :data:`LINEAR_MARGIN` and :data:`PAIRED_Z`
-    standard errors of the weighted paired difference.
+    standard errors of the weighted paired difference. `means` holds
+    ``float(errors[b][m].mean())`` of every bucket and method (each computed once).
     """
     if not errors:
         return "linear"
@@ -824,7 +879,7 @@ def _pooled_choice(
     w = {b: weights[b] / total for b in errors}
 
     def score(m: str) -> float:
-        return sum(w[b] * float(errors[b][m].mean()) for b in errors)
+        return sum(w[b] * means[b][m] for b in errors)
 
     best = min(names, key=score)
     if best == "linear":
@@ -839,6 +894,14 @@ def _pooled_choice(
     if diff < -PAIRED_Z * np.sqrt(var) and diff < -max(LINEAR_MARGIN * score("linear"), TIE):
         return best
     return "linear"
+
+
+class _DistinctRuns(list[F64]):
+    """Runs :func:`~pftrack.recovery.segments.distinct_runs` gave, as :func:`recover_auto` has them.
+
+    :func:`calibrate` takes them as they are: they would come back the same (splitting them
+    again cost 3 ms a call on a file of 500 tracks).
+    """
 
 
 # Placeholders that are never used (the methods needing them are skipped without them).
@@ -1055,7 +1118,7 @@ def recover_auto(
     if observed is None:
         observed = [s for pair in checked for s in pair]
     lengths = [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
-    all_runs = distinct_runs(observed, strict="recover_auto")
+    all_runs = _DistinctRuns(distinct_runs(observed, strict="recover_auto"))
     runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:
         needs = "gdt-bi" in candidates or "gdt-mix" in candidates

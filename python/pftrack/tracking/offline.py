@@ -15,6 +15,7 @@ the smoothed boxes match the annotation far more often than the detections thems
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Literal
 
@@ -25,7 +26,7 @@ from pftrack import _check
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
-from pftrack.boxes import _intersection_matrix, _iou_rows, _to_cxcywh, _to_xywh
+from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
 from pftrack.recovery.fill import DEFAULT_MAX_GAP, MAX_GAP_LIMIT, fill_rows
@@ -658,14 +659,14 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
         raise ValueError(f"drop_nested: area_ratio is {area_ratio}, expected a finite value >= 1")
     a: F64 = check_rows(rows, "drop_nested")
     drop = np.zeros(len(a), dtype=bool)
-    for idx in _frame_groups(a[:, 0]):
-        if len(idx) < 2:
-            continue
-        box = a[idx, 2:6]
-        overlap = _intersection_matrix(box, box)  # [i, j]: area of box i inside box j
-        area = box[:, 2] * box[:, 3]
-        covered = (overlap > inside * area[:, None]) & (area[None, :] > area_ratio * area[:, None])
-        drop[idx] = covered.any(axis=1)
+    box = a[:, 2:6]
+    area = box[:, 2] * box[:, 3]
+    # every pair of rows of one frame at once (was a loop over the frames, 16 ms of PETS09's
+    # 4500 rows): the same operations on each pair
+    for i, j in _frame_pairs(a[:, 0]):
+        overlap = _intersection(box[i], box[j])  # area of box i inside box j
+        covered = (overlap > inside * area[i]) & (area[j] > area_ratio * area[i])
+        drop[i[covered]] = True
     return a[~drop]
 
 
@@ -746,32 +747,58 @@ def complete_boxes(
     new_w = np.where(widen, w_exp, w)
     shift = 0.5 * (w - new_w)  # centred
     if anchor == "side" and widen.any():
-        for idx in _frame_groups(a[:, 0]):
-            if len(idx) < 2 or not widen[idx].any():
-                continue
-            x0, y0, x1, y1 = x[idx], y[idx], x[idx] + w[idx], y[idx] + h[idx]
-            rows_meet = (y0[:, None] < y1[None, :]) & (y0[None, :] < y1[:, None])
-            np.fill_diagonal(rows_meet, False)
-            # [i, j]: box i's left (right) edge lies inside box j's columns
-            left_in = (x0[None, :] < x0[:, None]) & (x0[:, None] < x1[None, :]) & rows_meet
-            right_in = (x0[None, :] < x1[:, None]) & (x1[:, None] < x1[None, :]) & rows_meet
-            hid_l, hid_r = left_in.any(axis=1), right_in.any(axis=1)
-            grow_left = hid_l & ~hid_r  # keep the right edge
-            grow_right = hid_r & ~hid_l  # keep the left edge
-            s = shift[idx]
-            s[grow_left] = (w[idx] - new_w[idx])[grow_left]
-            s[grow_right] = 0.0
-            shift[idx] = s
+        # each widened box against every other box of its frame, all pairs at once
+        x1, y1 = x + w, y + h
+        hid_l = np.zeros(len(a), dtype=bool)
+        hid_r = np.zeros(len(a), dtype=bool)
+        for i, j in _frame_pairs(a[:, 0], widen):
+            rows_meet = (y[i] < y1[j]) & (y[j] < y1[i]) & (i != j)
+            # box i's left (right) edge lies inside box j's columns
+            hid_l[i[(x[j] < x[i]) & (x[i] < x1[j]) & rows_meet]] = True
+            hid_r[i[(x[j] < x1[i]) & (x1[i] < x1[j]) & rows_meet]] = True
+        grow_left = widen & hid_l & ~hid_r  # keep the right edge
+        grow_right = widen & hid_r & ~hid_l  # keep the left edge
+        shift[grow_left] = (w - new_w)[grow_left]
+        shift[grow_right] = 0.0
     a[:, 2] = np.where(widen, x + shift, x)
     a[:, 4] = new_w
     a[:, 5] = new_h
     return a
 
 
-def _frame_groups(frames: F64) -> list[NDArray[np.intp]]:
-    """Row indices of each frame, frames ascending, rows in their order within a frame."""
+#: Pairs of rows :func:`_frame_pairs` gives at a time, at most (unless one frame has more):
+#: bounded memory whatever the number of boxes a frame holds.
+PAIR_BLOCK = 1 << 20
+
+
+def _frame_pairs(
+    frames: F64, rows: NDArray[np.bool_] | None = None
+) -> Iterator[tuple[NDArray[np.intp], NDArray[np.intp]]]:
+    """Row indices ``(i, j)`` of every pair of rows of one frame, ``i == j`` too, in blocks.
+
+    With `rows`, only the pairs whose ``i`` is one of `rows` (a mask). Blocks of whole frames,
+    of about :data:`PAIR_BLOCK` pairs.
+    """
     order = np.argsort(frames, kind="stable")
-    return np.split(order, np.flatnonzero(np.diff(frames[order])) + 1)
+    f = frames[order]
+    starts = np.flatnonzero(np.r_[True, f[1:] != f[:-1]]) if len(f) else np.zeros(0, np.intp)
+    sizes = np.diff(np.r_[starts, len(f)])
+    first = np.repeat(starts, sizes)  # per position of `order`: its frame's first position
+    size = np.repeat(sizes, sizes)
+    keep = np.ones(len(f), dtype=bool) if rows is None else rows[order]
+    kept = np.add.reduceat(keep.astype(np.intp), starts) if len(starts) else sizes
+    ends = np.cumsum(sizes * kept)  # pairs up to the end of each frame
+    lo = 0  # frames lo .. hi - 1 of `starts` in this block
+    while lo < len(starts):
+        done = ends[lo - 1] if lo else 0
+        hi = max(lo + 1, int(np.searchsorted(ends, done + PAIR_BLOCK, side="right")))
+        stop = starts[hi] if hi < len(starts) else len(f)
+        p = np.flatnonzero(keep[starts[lo] : stop]) + starts[lo]  # the positions paired
+        n = size[p]
+        at = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)  # 0 .. n - 1 per row
+        if len(p):
+            yield order[np.repeat(p, n)], order[np.repeat(first[p], n) + at]
+        lo = hi
 
 
 def split_refound(
