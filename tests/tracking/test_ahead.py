@@ -173,3 +173,51 @@ def test_without_threads_the_rows_are_the_same(scene):
     on = track_frames(scene.frames, detections=dets, config=config, rng=0)
     off = track_frames(scene.frames, detections=dets, config=config, rng=0, threads=False)
     np.testing.assert_array_equal(on.rows, off.rows)
+
+
+@pytest.mark.parametrize("read_depth", [None, 2])
+def test_the_cameras_grey_is_made_ahead(scene, monkeypatch, read_depth):
+    # each frame's grey for the camera-motion check is made on a thread (with read_depth the
+    # reading one, which also prepares the frames) and handed over: update() makes none
+    from pftrack.tracking import camera
+
+    made, prepared, detected = [], [], []
+    grey = camera._Measure.grey
+
+    def recorded(self, frame):
+        made.append(threading.get_ident())
+        return grey(self, frame)
+
+    def prepare(frame):
+        prepared.append(threading.get_ident())
+        return frame
+
+    frames = move_camera(scene).frames[:12]
+    config = replace(TrackerConfig(), camera_motion="on")
+    alone = MultiObjectTracker(config, rng=0)
+    expected = [(alone.update(f, None), alone.camera_step)[1] for f in frames]
+    monkeypatch.setattr(camera._Measure, "grey", recorded)
+    mot = MultiObjectTracker(config, rng=0)
+    real = mot.detector
+    detect = real.detect
+
+    def detect_recorded(frame):
+        detected.append(threading.get_ident())
+        return detect(frame)
+
+    monkeypatch.setattr(real, "detect", detect_recorded)
+    steps = []
+    with DetectAhead(mot, frames, external=False, prepare=prepare, read_depth=read_depth) as ahead:
+        for frame in ahead:
+            mot.update(frame, None)
+            steps.append(mot.camera_step)
+    main = threading.get_ident()
+    assert len(made) == len(frames) and main not in made
+    assert set(made) == set(prepared) and len(set(made)) == 1
+    # the reading thread is not the detector's
+    assert (set(made) == set(detected)) == (read_depth is None)
+    assert any(s.apply is not None for s in expected)
+    for got, want in zip(steps, expected, strict=True):
+        assert got.moving == want.moving and got.magnitude == want.magnitude
+        np.testing.assert_array_equal(got.apply, want.apply)
+    assert no_reader_thread()

@@ -213,6 +213,27 @@ def test_on_and_off_modes(texture: np.ndarray) -> None:
     assert s_on.apply is not None  # applied every frame, even a tiny estimate
 
 
+def test_a_grey_handed_over_is_used_for_its_frame_only(texture: np.ndarray) -> None:
+    shifted = warp_frame(texture, similarity(1.0, 0.0, 6.0, 0.0))
+    own, handed = CameraMotion("on"), CameraMotion("on")
+    own.update(texture)
+    handed.update(texture)
+    # the grey of another frame, handed over with this one, is what update measures
+    handed.hand_over(texture, handed.grey(shifted))
+    step = handed.update(texture)
+    assert step.affine is not None and step.magnitude > 5.0
+    assert own.update(shifted).affine == pytest.approx(step.affine)
+    # handed over with another array (a copy of the frame): measured as without it
+    handed.hand_over(texture.copy(), handed.grey(texture))
+    np.testing.assert_array_equal(handed.update(shifted).affine, own.update(shifted).affine)
+    # for the next update only: a later update of that array measures it anew
+    handed.hand_over(texture, handed.grey(shifted))
+    np.testing.assert_array_equal(handed.update(shifted).affine, own.update(shifted).affine)
+    step = handed.update(texture)
+    np.testing.assert_array_equal(step.affine, own.update(texture).affine)
+    assert step.magnitude > 5.0
+
+
 def test_bad_input_names_the_problem(texture: np.ndarray) -> None:
     with pytest.raises(ValueError, match="camera_motion"):
         CameraMotion("sometimes")

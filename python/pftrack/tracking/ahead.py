@@ -12,6 +12,13 @@ stand-in hands the tracker, for the very frame object it was given, what the thr
 with the real detector, or raises the error the detector raised on that frame, at the place in
 ``update`` where the detector would have raised it. The tracker's output is therefore the same,
 byte for byte, as with the detector called in ``update``.
+
+Each frame's grey, which the tracker's camera-motion check measures
+(:meth:`~pftrack.tracking.camera.CameraMotion.grey`, a pure function of the frame), is made
+ahead too and handed to the camera with the frame. With ``read_depth`` the frames are read on a
+thread of their own, which also prepares them and makes their grey: on two cores the reading
+thread has time to spare, the detector's thread (the larger frames) or the tracker's (the
+smaller) has not.
 """
 
 from __future__ import annotations
@@ -25,12 +32,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack.io.prefetch import prefetch
+from pftrack.tracking.camera import CameraMotion
 from pftrack.tracking.tracker import MultiObjectTracker
 
 __all__ = ["DetectAhead"]
 
-# (the frame as read, the frame the detector saw, its result, its error)
-_Work = tuple[NDArray[np.uint8], NDArray[np.uint8], Any, BaseException | None]
+# (the frame as read, the frame the detector sees, the camera's grey of it or None, the error
+# of making them)
+_Prepared = tuple[Any, Any, Any, BaseException | None]
+# (the frame as read, the frame the detector saw, its result, its error, the camera's grey)
+_Work = tuple[NDArray[np.uint8], NDArray[np.uint8], Any, BaseException | None, Any]
 _Frame = NDArray[np.uint8]
 
 
@@ -93,14 +104,19 @@ class DetectAhead:
         How many frames may wait detected.
     prepare : callable, optional
         Turns each frame into the one the tracker's detector sees (the working resolution,
-        :meth:`pftrack.Tracker.working_frame`), on the thread; default: the frame itself.
+        :meth:`pftrack.Tracker.working_frame`), on a thread (the reading thread with
+        `read_depth`); default: the frame itself.
     hand_over : callable, optional
         Called as ``hand_over(frame, prepared)`` just before `frame` is yielded, so that the
         caller's ``update`` uses the very prepared array (:meth:`pftrack.Tracker.hand_over`).
+    read_depth : int, optional
+        Read `frames` on a thread of their own (a :func:`~pftrack.io.prefetch.prefetch` this
+        deep), which also prepares each frame and makes the camera's grey of it; default: all
+        on the detector's thread.
 
     Examples
     --------
-    >>> with DetectAhead(mot, prefetch(source), external=False) as frames:  # doctest: +SKIP
+    >>> with DetectAhead(mot, source, external=False, read_depth=4) as frames:  # doctest: +SKIP
     ...     for frame in frames:
     ...         mot.update(frame, None)
     """
@@ -108,8 +124,10 @@ class DetectAhead:
     def __init__(self, tracker: MultiObjectTracker, frames: Iterable[NDArray[np.uint8]],
                  *, external: bool, depth: int = 2,
                  prepare: Callable[[_Frame], _Frame] | None = None,
-                 hand_over: Callable[[_Frame, _Frame], None] | None = None) -> None:  # fmt: skip
+                 hand_over: Callable[[_Frame, _Frame], None] | None = None,
+                 read_depth: int | None = None) -> None:  # fmt: skip
         self._tracker = tracker
+        self._read_depth = read_depth
         self._frames = frames
         self._external = external
         self._depth = depth
@@ -135,9 +153,14 @@ class DetectAhead:
             call = _mask_and_bins(detector)
         self._detector = detector
         self._stand_in = _StandIn(self._external, shadows)
-        self._stream = prefetch(_work(self._frames, call, self._prepare), depth=self._depth)
+        camera = self._tracker.camera
+        grey = None if camera.mode == "off" else camera.grey
+        prepared = _prepared(self._frames, self._prepare, grey)
+        if self._read_depth is not None:
+            prepared = prefetch(prepared, depth=self._read_depth)
+        self._stream = prefetch(_work(prepared, call), depth=self._depth)
         self._tracker.detector = self._stand_in
-        return self._hand_over(self._stream, self._stand_in, self._hand)
+        return self._hand_over(self._stream, self._stand_in, self._hand, camera)
 
     def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
                  trace: TracebackType | None) -> None:  # fmt: skip
@@ -148,11 +171,14 @@ class DetectAhead:
 
     @staticmethod
     def _hand_over(stream: Iterator[_Work], stand_in: _StandIn,
-                   hand: Callable[[_Frame, _Frame], None] | None) -> Iterator[_Frame]:  # fmt: skip
+                   hand: Callable[[_Frame, _Frame], None] | None,
+                   camera: CameraMotion) -> Iterator[_Frame]:  # fmt: skip
         for work in stream:
             stand_in.expect(work)
             if hand is not None:
                 hand(work[0], work[1])
+            if work[4] is not None:
+                camera.hand_over(work[1], work[4])
             yield work[0]
 
 
@@ -166,11 +192,12 @@ def _mask_and_bins(detector: Any) -> Any:
     return call
 
 
-def _work(frames: Iterable[Any], call: Any,
-          prepare: Callable[[_Frame], _Frame] | None) -> Iterator[_Work]:  # fmt: skip
-    """Each frame, prepared, with the detector's result, or with its error (then no more).
+def _prepared(frames: Iterable[Any], prepare: Callable[[_Frame], _Frame] | None,
+              grey: Callable[[_Frame], Any] | None) -> Iterator[_Prepared]:  # fmt: skip
+    """Each frame, prepared, with its `grey`, or with the error of preparing it (then no more).
 
-    `frames`' iterator is closed when this ends, however it ends (a reader thread stops).
+    The grey is None without `grey`, or when it refuses the frame (``update`` then refuses it
+    in its own words). `frames`' iterator is closed when this ends, however it ends.
     """
     it = iter(frames)
     try:
@@ -183,11 +210,39 @@ def _work(frames: Iterable[Any], call: Any,
             try:
                 # the very object update() hands the detector
                 work = frame if prepare is None else prepare(frame)
-                result = call(work)
             except Exception as error:  # raised by the stand-in in update(), where it belongs
                 yield frame, frame, None, error
                 return
-            yield frame, work, result, None
+            measured = None
+            if grey is not None:
+                try:
+                    measured = grey(work)
+                except Exception:  # not a frame update() takes: it refuses it itself
+                    measured = None
+            yield frame, work, measured, None
+    finally:
+        close = getattr(it, "close", None)
+        if close is not None:
+            close()
+
+
+def _work(prepared: Iterable[_Prepared], call: Any) -> Iterator[_Work]:
+    """Each prepared frame with the detector's result, or with its error (then no more).
+
+    `prepared`'s iterator is closed when this ends, however it ends (a reader thread stops).
+    """
+    it = iter(prepared)
+    try:
+        for frame, work, measured, error in it:
+            if error is None:
+                try:
+                    result = call(work)
+                except Exception as raised:  # raised by the stand-in in update(), as above
+                    error = raised
+            if error is not None:
+                yield frame, frame, None, error, None
+                return
+            yield frame, work, result, None, measured
     finally:
         close = getattr(it, "close", None)
         if close is not None:

@@ -264,6 +264,23 @@ class CameraMotion:
         self._since_moving = self.config.settle_frames if self.mode == "auto" else 0
         self._corners: NDArray[np.float32] | None = None  # followed while still ("auto")
         self._corner_age = 0
+        # the next frame and its grey(), made elsewhere (hand_over)
+        self._handed: tuple[NDArray[np.uint8], tuple[float, NDArray[np.uint8]]] | None = None
+
+    def grey(self, frame: NDArray[np.uint8]) -> tuple[float, NDArray[np.uint8]]:
+        """What :meth:`update` measures `frame` on: the scale factor and the scaled grey frame.
+
+        A pure function of `frame` (and the config), safe on any thread.
+        """
+        return self._measure.grey(frame)
+
+    def hand_over(self, frame: NDArray[np.uint8], grey: tuple[float, NDArray[np.uint8]]) -> None:
+        """Give the next :meth:`update` of `frame` its :meth:`grey`, made elsewhere.
+
+        :class:`~pftrack.tracking.ahead.DetectAhead` makes it on its thread; ``update`` takes
+        it for that very array only (another frame is measured as without it).
+        """
+        self._handed = (frame, grey)
 
     def update(self, frame: NDArray[np.uint8], exclude_xywh: ArrayLike = ()) -> CameraStep:
         """Measure the motion from the previous frame to `frame` and decide.
@@ -275,10 +292,14 @@ class CameraMotion:
         exclude_xywh : (K, 4) array_like
             Boxes of the objects being tracked or detected (corners inside are not used).
         """
+        handed, self._handed = self._handed, None
         if self.mode == "off":
             return CameraStep(None, 0.0, False, None, True)
         cfg = self.config
-        factor, grey = self._measure.grey(frame)
+        if handed is not None and handed[0] is frame:
+            factor, grey = handed[1]
+        else:
+            factor, grey = self._measure.grey(frame)
         prev, self._prev = self._prev, grey
         affine = None
         magnitude = 0.0

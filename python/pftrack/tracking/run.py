@@ -209,8 +209,9 @@ def track_frames(
 
     Notes
     -----
-    Three threads share the work: one decodes (:func:`~pftrack.io.prefetch.prefetch`), one runs
-    the detector on the frames in order ahead of the tracker
+    Three threads share the work: one decodes (:func:`~pftrack.io.prefetch.prefetch`; it also
+    scales each frame to the working resolution and makes the grey the camera-motion check
+    measures), one runs the detector on the frames in order ahead of the tracker
     (:class:`~pftrack.tracking.ahead.DetectAhead`: the built-in detector, or the foreground that
     refines external detections), and this one tracks. The rows are those of the loop that calls
     the detector inside ``update``, byte for byte, and a detector error is raised from
@@ -261,10 +262,11 @@ def track_frames(
     elif ahead:
         stream = DetectAhead(
             tracker.tracker,
-            prefetch(frames),
+            frames,
             external=detections is not None,
             prepare=tracker.working_frame,
             hand_over=tracker.hand_over,
+            read_depth=4,  # as prefetch's: the reading thread prepares the frames too
         )
     else:
         stream = closing(prefetch(frames))
