@@ -68,6 +68,26 @@ def test_global_gain_equals_reference(step: int) -> None:
     assert m.global_gain(np.zeros((8, 8, 3), np.uint8)) == 1.0  # no pixel qualifies
 
 
+def test_frame_gain_of_uint8_frames_is_numpys_reduction_bit_for_bit() -> None:
+    """The sums of uint8 channels are added as slices (exact integers): the same floats."""
+    from pftrack.detection.light import _pixel_sums
+
+    rng = np.random.default_rng(7)
+    for shape in ((37, 53, 3), (360, 480, 3)):
+        a = rng.integers(0, 256, shape, dtype=np.uint8)
+        a[:3] = 255  # the largest sums
+        b = np.clip(a * rng.uniform(0.5, 1.5) + rng.normal(0, 9, shape), 0, 255).astype(np.uint8)
+        for step in (1, 4, 7):
+            want = a[::step, ::step].astype(np.float64).sum(axis=2)
+            got = _pixel_sums(a[::step, ::step])
+            assert got.dtype == np.float64 and np.array_equal(got, want)
+            si, sr = (x[::step, ::step].astype(np.float64).sum(axis=2) for x in (b, a))
+            keep = (sr >= 30.0) & (sr > 0)
+            assert frame_gain(b, a, step) == float(np.median(si[keep] / sr[keep]))
+    bg = rng.uniform(0, 255, (20, 30, 3)).astype(np.float32)  # a background: NumPy's own sums
+    np.testing.assert_array_equal(_pixel_sums(bg), bg.astype(np.float64).sum(axis=2))
+
+
 def test_scale_equals_reference_and_clips() -> None:
     rng = np.random.default_rng(1)
     bg = rng.uniform(0, 255, (20, 30, 3)).astype(np.float32)

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -198,10 +199,26 @@ def frame_gain(
     float
     """
     step = sample_step(frame.shape) if step is None else step
-    sr = reference[::step, ::step].astype(np.float64).sum(axis=2)
-    si = frame[::step, ::step].astype(np.float64).sum(axis=2)
+    sr = _pixel_sums(reference[::step, ::step])
+    si = _pixel_sums(frame[::step, ::step])
     keep = (sr >= min_sum) & (sr > 0)
     return float(np.median(si[keep] / sr[keep])) if keep.any() else 1.0
+
+
+def _pixel_sums(image: NDArray[Any]) -> NDArray[np.float64]:
+    """``image.astype(np.float64).sum(axis=2)``: B + G + R of each pixel of an (H, W, 3) array.
+
+    uint8 channels add up to integers below 2**53, exact in any order: three slices added are
+    the same sums at a fifteenth of the time of NumPy's reduction over an axis of 3 (0.02
+    against 0.35 ms a 480x360 frame at step 4; :func:`level_frames` measures 29 of them).
+    """
+    if image.dtype != np.uint8:  # float sums depend on their order: NumPy's own
+        total: NDArray[np.float64] = image.astype(np.float64).sum(axis=2)
+        return total
+    sums = image[..., 0].astype(np.float64)
+    sums += image[..., 1]
+    sums += image[..., 2]
+    return sums
 
 
 def level_frames(frames: list[NDArray[np.uint8]], band: float) -> list[NDArray[np.uint8]]:
