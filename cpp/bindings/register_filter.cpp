@@ -199,6 +199,7 @@ void register_filter(py::module_& m) {
             RowMatrixXd out(k, 11);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers kept alive by `keep`
+                SisWorkspace ws(img.n_bins);  // one for all objects: no allocations per object
                 for (py::ssize_t i = 0; i < k; ++i) {
                     auto& pa = keep[static_cast<size_t>(4 * i)];
                     auto& wa = keep[static_cast<size_t>(4 * i + 1)];
@@ -209,7 +210,7 @@ void register_filter(py::module_& m) {
                     const SisResult r = sis_step_checked(
                         p, w, mm, img, sqrefs[static_cast<size_t>(i)],
                         prms[static_cast<size_t>(i)], seeds[static_cast<size_t>(i)],
-                        steps[static_cast<size_t>(i)]);
+                        steps[static_cast<size_t>(i)], &ws);
                     out.row(i) << r.estimate.mean.transpose(), r.estimate.map.transpose(),
                         static_cast<double>(r.estimate.map_index), r.ess, r.rho_max, r.rho_mean,
                         r.fg_mean;

@@ -76,6 +76,38 @@ def test_batch_equals_per_object_sis_step_bit_for_bit(textured_frame, rng, kerne
         np.testing.assert_array_equal(row, [*want, r["fg_mean"]])
 
 
+@pytest.mark.parametrize("min_samples", [0.0, 20.0])
+def test_batch_scratch_reused_across_objects_of_any_size(textured_frame, rng, min_samples):
+    """One batch reuses its count scratch (integral tables, per-box counts) from object to
+    object: large boxes, then small, then large again, one far outside the image, each on the
+    lattice or not, give what one sis_step per object gives, bit for bit."""
+    image = hsv_bins(textured_frame)
+    model = Ar2Model(sigma_xy=2.0, sigma_s=0.03)
+    sizes = [(40.0, 60.0), (4.0, 6.0), (50.0, 70.0), (10.0, 12.0), (30.0, 30.0)]
+    objs = _objects(rng, image, len(sizes))
+    for o, (w0, h0) in zip(objs, sizes, strict=True):
+        o["w0"], o["h0"] = w0, h0
+    objs[3]["p"][:, [0, 3]] -= 500.0  # every box outside the image: rho 0
+    objs[3]["m"][:, 0] -= 500.0
+    single = copy.deepcopy(objs)
+    args = (model.a, model.b, model.sigma, model.s_min, model.s_max, False, 20.0, "uniform", True)
+    out = _core.sis_step_batch(
+        [o["p"] for o in objs], [o["w"] for o in objs], [o["m"] for o in objs], image,
+        [o["ref"] for o in objs], np.array([o["w0"] for o in objs]),
+        np.array([o["h0"] for o in objs]), *args, [o["seed"] for o in objs],
+        [o["step"] for o in objs], min_samples,
+    )  # fmt: skip
+    assert out[3, 8] == 0.0  # rho_max of the object outside the image
+    assert np.all(out[[0, 2, 4], 8] > 0.0)
+    for o, s, row in zip(objs, single, out, strict=True):
+        r = _core.sis_step(s["p"], s["w"], s["m"], image, s["ref"], s["w0"], s["h0"], *args,
+                           s["seed"], s["step"], min_samples)  # fmt: skip
+        np.testing.assert_array_equal(o["p"], s["p"])
+        np.testing.assert_array_equal(o["w"], s["w"])
+        want = [*r["mean"], *r["map"], r["map_index"], r["ess"], r["rho_max"], r["rho_mean"]]
+        np.testing.assert_array_equal(row, [*want, r["fg_mean"]])
+
+
 def test_batch_matches_numpy_composition(textured_frame, rng):
     image = hsv_bins(textured_frame)
     model = Ar2Model(sigma_xy=2.0, sigma_s=0.03)

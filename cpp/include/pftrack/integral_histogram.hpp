@@ -42,6 +42,11 @@ public:
         : n_bins_(n_bins), local_of_(static_cast<size_t>(n_bins) + 1),
           seen_(static_cast<size_t>(n_bins) + 1) {}
 
+    int n_bins() const { return n_bins_; }
+    /// The bins (>= 0) present in the prepared region, in increasing order; n_present() of them.
+    const std::int16_t* present() const { return bin_of_local_.data() + first_bin_; }
+    int n_present() const { return n_local_ - first_bin_; }
+
     /// Numbers the bins present in `region` (background, bin -1, included when present).
     /// Returns the table's entries per pixel: a multiple of kLanes. A lazy image bins the
     /// region here, for build() too (which reads the prepared region only).
@@ -60,6 +65,7 @@ public:
             if (seen[b]) bin_of_local_.push_back(b);
         }
         n_local_ = static_cast<int>(bin_of_local_.size());
+        first_bin_ = n_local_ > 0 && bin_of_local_[0] == -1 ? 1 : 0;
         stride_ = (n_local_ + kLanes - 1) / kLanes * kLanes;
         return stride_;
     }
@@ -196,6 +202,7 @@ private:
 
     int n_bins_;
     int n_local_ = 0;
+    int first_bin_ = 0;  // 1 when background (-1) is present: bin_of_local_[0]
     int stride_ = 0;
     Index row_len_ = 0;
     PixelRange region_{0, 0, 0, 0};
@@ -231,13 +238,16 @@ struct BoxCostModel {
 /// clipped union grows by at most twice the box's area (two particles of one object offset by
 /// half a box still join; two objects a box apart do not). Each group is then counted directly or
 /// from an integral histogram of its union, whichever the cost model finds cheaper.
-/// Calls `from_counts(i, c, total)` with box i's counts c[0 .. n_bins) (c[-1]: background) and
-/// counted pixels for boxes counted from a table, and `direct(i, r)` with the clipped pixel
-/// range of every other box (empty ones included). Scratch is local to the call.
+/// Calls `from_counts(i, c, total, present, n)` with box i's counts c[0 .. n_bins) (c[-1]:
+/// background; 0 but for the n bins `present`, in increasing order) and counted pixels for boxes
+/// counted from a table, and `direct(i, r)` with the clipped pixel
+/// range of every other box (empty ones included). Scratch is local to the call, but for the
+/// table: `shared_table`, the caller's to reuse (for img.n_bins bins), else a local one.
 /// for_each_box_count of boxes given as clipped pixel ranges of `img` (as box_pixels gives).
 template <class FromCounts, class Direct>
 inline void for_each_range_count(const BinImage& img, const std::vector<PixelRange>& ranges,
-                                 BoxPath path, FromCounts&& from_counts, Direct&& direct) {
+                                 BoxPath path, FromCounts&& from_counts, Direct&& direct,
+                                 IntegralHistogram* shared_table = nullptr) {
     const Index n = static_cast<Index>(ranges.size());
     if (path == BoxPath::kDirect) {
         for (Index i = 0; i < n; ++i) direct(i, ranges[static_cast<size_t>(i)]);
@@ -310,7 +320,11 @@ inline void for_each_range_count(const BinImage& img, const std::vector<PixelRan
     }
 
     const BoxCostModel cost;
-    IntegralHistogram table(img.n_bins);
+    // a table kept by the caller keeps its memory: a new one per object and frame allocated,
+    // and zeroed, up to megabytes before build() wrote over them
+    std::optional<IntegralHistogram> own_table;
+    if (shared_table == nullptr || shared_table->n_bins() != img.n_bins) own_table.emplace(img.n_bins);
+    IntegralHistogram& table = own_table ? *own_table : *shared_table;
     std::vector<std::int32_t> counts(static_cast<size_t>(img.n_bins) + 1);
     std::int32_t* c = counts.data() + 1;  // c[-1]: background
     for (size_t g = 0; g < groups.size(); ++g) {
@@ -336,7 +350,8 @@ inline void for_each_range_count(const BinImage& img, const std::vector<PixelRan
         for (const Index* m = m0; m != m1; ++m) {
             const PixelRange& r = ranges[static_cast<size_t>(*m)];
             table.box_counts(r, c);
-            from_counts(*m, static_cast<const std::int32_t*>(c), pixel_count(r) - c[-1]);
+            from_counts(*m, static_cast<const std::int32_t*>(c), pixel_count(r) - c[-1],
+                        table.present(), table.n_present());
         }
     }
 }
@@ -345,13 +360,14 @@ inline void for_each_range_count(const BinImage& img, const std::vector<PixelRan
 /// clipped pixel ranges.
 template <class Derived, class FromCounts, class Direct>
 inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
-                               BoxPath path, FromCounts&& from_counts, Direct&& direct) {
+                               BoxPath path, FromCounts&& from_counts, Direct&& direct,
+                               IntegralHistogram* shared_table = nullptr) {
     std::vector<PixelRange> ranges(static_cast<size_t>(boxes.rows()));
     for (Index i = 0; i < boxes.rows(); ++i)
         ranges[static_cast<size_t>(i)] =
             box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols);
     for_each_range_count(img, ranges, path, std::forward<FromCounts>(from_counts),
-                         std::forward<Direct>(direct));
+                         std::forward<Direct>(direct), shared_table);
 }
 
 /// The points of the lattice of step `step` (the pixels whose column and row are multiples of
@@ -412,11 +428,13 @@ private:
 /// `sqrt_ref`. Uniform kernel: for_each_box_count (bit-identical to counting each box);
 /// Epanechnikov: each box directly. With `step` > 1 only the points of the lattice of that step
 /// are counted (LatticeImage; `counted` is then the points counted times step^2).
-/// `shared`: scratch space of the caller's to reuse (for img.n_bins bins), else a local one.
+/// `shared`: scratch space of the caller's to reuse (for img.n_bins bins), else a local one;
+/// `shared_table` likewise for the integral histograms (for_each_range_count).
 template <class Derived>
 inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
                              const double* sqrt_ref, Kernel kernel, BoxPath path, double* rho,
-                             double* counted, Index step = 1, HistogramScratch* shared = nullptr) {
+                             double* counted, Index step = 1, HistogramScratch* shared = nullptr,
+                             IntegralHistogram* shared_table = nullptr) {
     std::optional<HistogramScratch> own;
     if (shared == nullptr) own.emplace(img.n_bins);
     HistogramScratch& scratch = shared != nullptr ? *shared : *own;
@@ -437,14 +455,16 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
         }
         for_each_range_count(
             points, ranges, path,
-            [&](Index i, const std::int32_t* c, std::int64_t total) {
+            [&](Index i, const std::int32_t* c, std::int64_t total, const std::int16_t* present,
+                int n) {
                 counted[i] = static_cast<double>(total) * area;
-                rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref);
+                rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present, n);
             },
             [&](Index i, const PixelRange& r) {
                 rho[i] = scratch.coefficient_of_range(points, r, sqrt_ref, counted[i]);
                 counted[i] *= area;
-            });
+            },
+            shared_table);
         return;
     }
     if (kernel != Kernel::kUniform) {
@@ -455,13 +475,15 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
     }
     for_each_box_count(
         img, boxes, path,
-        [&](Index i, const std::int32_t* c, std::int64_t total) {
+        [&](Index i, const std::int32_t* c, std::int64_t total, const std::int16_t* present,
+            int n) {
             counted[i] = static_cast<double>(total);
-            rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref);
+            rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present, n);
         },
         [&](Index i, const PixelRange& r) {
             rho[i] = scratch.coefficient_of_range(img, r, sqrt_ref, counted[i]);
-        });
+        },
+        shared_table);
 }
 
 /// Coefficient rho of one box (cx, cy, w, h) against `sqrt_ref`, as the MCMC samplers evaluate
@@ -499,7 +521,7 @@ inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<D
     const int nb = img.n_bins;
     for_each_box_count(
         img, boxes, path,
-        [&](Index i, const std::int32_t* c, std::int64_t total) {
+        [&](Index i, const std::int32_t* c, std::int64_t total, const std::int16_t*, int) {
             double* row = out.row(i).data();
             if (total == 0) {
                 std::fill(row, row + nb, 0.0);

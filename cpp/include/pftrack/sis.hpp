@@ -84,12 +84,22 @@ inline Eigen::VectorXd sis_checked(const Eigen::Ref<const RowMatrixXd>& particle
     return sqrt_reference(ref, img.n_bins, fn);
 }
 
-/// sis_step of values `sis_checked` accepted (`sqref`: what it returned).
+/// Scratch space of the box counts that successive steps on images of `n_bins` bins reuse
+/// (sis_step_batch: one for all objects of the frame).
+struct SisWorkspace {
+    explicit SisWorkspace(int n_bins) : scratch(n_bins), table(n_bins) {}
+    HistogramScratch scratch;
+    IntegralHistogram table;
+};
+
+/// sis_step of values `sis_checked` accepted (`sqref`: what it returned). `ws`: scratch space
+/// of the caller's for img.n_bins bins, else a local one.
 inline SisResult sis_step_checked(Eigen::Ref<RowMatrixXd> particles,
                                   Eigen::Ref<Eigen::VectorXd> weights,
                                   Eigen::Ref<RowMatrixXd> means, const BinImage& img,
                                   const Eigen::VectorXd& sqref, const SisParams& prm,
-                                  std::uint64_t seed, std::uint64_t step) {
+                                  std::uint64_t seed, std::uint64_t step,
+                                  SisWorkspace* ws = nullptr) {
     const char* fn = "sis_step";
     const Index n = particles.rows();
     const CounterRng rng(seed, step);
@@ -119,8 +129,10 @@ inline SisResult sis_step_checked(Eigen::Ref<RowMatrixXd> particles,
     //    previous mean state): the cost per particle stays near min_samples points.
     const Index lattice = lattice_step(m1(2) * prm.w0, m1(2) * prm.h0, prm.min_samples);
     Eigen::VectorXd rho(n), counted(n), logw(n);
+    const bool shared = ws != nullptr && ws->table.n_bins() == img.n_bins;
     box_coefficients(img, boxes, sqref.data(), prm.kernel, BoxPath::kAuto, rho.data(),
-                     counted.data(), lattice);
+                     counted.data(), lattice, shared ? &ws->scratch : nullptr,
+                     shared ? &ws->table : nullptr);
     for (Index i = 0; i < n; ++i) {
         const double d = bhattacharyya_distance_from_rho(rho(i));
         logw(i) = std::log(weights(i)) - prm.lambda * d * d;
