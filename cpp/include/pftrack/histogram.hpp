@@ -76,6 +76,16 @@ inline bool box_is_sane(double cx, double cy, double w, double h) {
            w >= 0.0 && h >= 0.0 && std::abs(cx) < 1e9 && std::abs(cy) < 1e9 && w < 1e9 && h < 1e9;
 }
 
+/// The partial sum (0-3) to which HistogramScratch::coefficient_of_counts adds bin k's term:
+/// k mod 4, but 0 for the bins after the last whole group of 4 (the loop's tail).
+inline int partial_sum_of(int k, int n_bins) { return k < (n_bins & ~3) ? (k & 3) : 0; }
+
+/// Bins split by partial_sum_of: bins[q][0 .. n[q]) go to partial sum q, in increasing order.
+struct BinLanes {
+    const std::int16_t* bins[4];
+    int n[4];
+};
+
 /// Scratch space for one histogram. Slot 0 collects background (bin -1) so the inner loop never
 /// branches; kCopies interleaved copies break the store-to-load dependency of runs of equal bins.
 class HistogramScratch {
@@ -173,23 +183,34 @@ public:
         return ((r0 + r1) + (r2 + r3)) / norm;
     }
 
-    /// coefficient_of_counts of counts that are 0 outside the bins `present` (n of them, in
-    /// increasing order): the same sums, bit for bit, over those bins only. Each term goes to
-    /// the partial sum the full loop adds it to, in the same order; the terms skipped are
-    /// 0 * sqrt_ref[k] = +0, and adding +0 leaves a partial sum (>= +0) unchanged.
+    /// coefficient_of_counts of counts that are 0 outside the bins `present` (split by
+    /// partial_sum_of): the same sums, bit for bit, over those bins only. Each term goes to the
+    /// partial sum the full loop adds it to, in the same order; the terms skipped are
+    /// 0 * sqrt_ref[k] = +0, and adding +0 leaves a partial sum (>= +0) unchanged. The four
+    /// sums advance together, in registers.
     double coefficient_of_counts(const std::int32_t* c, std::int64_t total, const double* sqrt_ref,
-                                 const std::int16_t* present, int n) {
+                                 const BinLanes& present) {
         if (total == 0) return 0.0;
         if (total >= kSqrtTableMax) return coefficient_of_counts(c, total, sqrt_ref);
         const double norm = std::sqrt(static_cast<double>(total));
         const double* tab = sqrt_table(static_cast<size_t>(total));
-        const int tail = n_bins_ & ~3;  // bins from here on go to r0 (the full loop's tail)
-        double r[4] = {0.0, 0.0, 0.0, 0.0};
-        for (int j = 0; j < n; ++j) {
-            const int k = present[j];
-            r[k < tail ? (k & 3) : 0] += tab[c[k]] * sqrt_ref[k];
+        const auto term = [&](int k) { return tab[c[k]] * sqrt_ref[k]; };
+        const std::int16_t *b0 = present.bins[0], *b1 = present.bins[1], *b2 = present.bins[2],
+                           *b3 = present.bins[3];
+        const int n0 = present.n[0], n1 = present.n[1], n2 = present.n[2], n3 = present.n[3];
+        const int m = std::min(std::min(n0, n1), std::min(n2, n3));
+        double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+        for (int j = 0; j < m; ++j) {
+            r0 += term(b0[j]);
+            r1 += term(b1[j]);
+            r2 += term(b2[j]);
+            r3 += term(b3[j]);
         }
-        return ((r[0] + r[1]) + (r[2] + r[3])) / norm;
+        for (int j = m; j < n0; ++j) r0 += term(b0[j]);
+        for (int j = m; j < n1; ++j) r1 += term(b1[j]);
+        for (int j = m; j < n2; ++j) r2 += term(b2[j]);
+        for (int j = m; j < n3; ++j) r3 += term(b3[j]);
+        return ((r0 + r1) + (r2 + r3)) / norm;
     }
 
 private:

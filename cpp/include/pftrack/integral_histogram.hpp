@@ -43,9 +43,15 @@ public:
           seen_(static_cast<size_t>(n_bins) + 1) {}
 
     int n_bins() const { return n_bins_; }
-    /// The bins (>= 0) present in the prepared region, in increasing order; n_present() of them.
-    const std::int16_t* present() const { return bin_of_local_.data() + first_bin_; }
-    int n_present() const { return n_local_ - first_bin_; }
+    /// The bins (>= 0) present in the prepared region, split by partial_sum_of.
+    BinLanes present() const {
+        BinLanes l;
+        for (int q = 0; q < 4; ++q) {
+            l.bins[q] = lanes_.data() + lane_start_[q];
+            l.n[q] = lane_start_[q + 1] - lane_start_[q];
+        }
+        return l;
+    }
 
     /// Numbers the bins present in `region` (background, bin -1, included when present).
     /// Returns the table's entries per pixel: a multiple of kLanes. A lazy image bins the
@@ -65,7 +71,14 @@ public:
             if (seen[b]) bin_of_local_.push_back(b);
         }
         n_local_ = static_cast<int>(bin_of_local_.size());
-        first_bin_ = n_local_ > 0 && bin_of_local_[0] == -1 ? 1 : 0;
+        lanes_.resize(bin_of_local_.size());  // present(): bins >= 0 by partial sum, in order
+        int at = 0;
+        for (int q = 0; q < 4; ++q) {
+            lane_start_[q] = at;
+            for (const std::int16_t b : bin_of_local_)
+                if (b >= 0 && partial_sum_of(b, n_bins_) == q) lanes_[static_cast<size_t>(at++)] = b;
+        }
+        lane_start_[4] = at;
         stride_ = (n_local_ + kLanes - 1) / kLanes * kLanes;
         return stride_;
     }
@@ -202,13 +215,14 @@ private:
 
     int n_bins_;
     int n_local_ = 0;
-    int first_bin_ = 0;  // 1 when background (-1) is present: bin_of_local_[0]
+    int lane_start_[5] = {0, 0, 0, 0, 0};  // lanes_[lane_start_[q] ..): partial sum q's bins
     int stride_ = 0;
     Index row_len_ = 0;
     PixelRange region_{0, 0, 0, 0};
     std::vector<std::int16_t> local_of_;     // bin + 1 -> compact index (for bins present)
     std::vector<std::uint8_t> seen_;         // bin + 1 -> present in the region
     std::vector<std::int16_t> bin_of_local_;  // compact index -> bin (-1: background)
+    std::vector<std::int16_t> lanes_;        // the bins >= 0 present, by partial sum (present())
     std::vector<std::uint16_t> table_;       // (h + 1) x (w + 1) x stride_
     std::vector<std::uint16_t> local_;       // one box's (or one row's running) compact counts
 };
@@ -238,8 +252,8 @@ struct BoxCostModel {
 /// clipped union grows by at most twice the box's area (two particles of one object offset by
 /// half a box still join; two objects a box apart do not). Each group is then counted directly or
 /// from an integral histogram of its union, whichever the cost model finds cheaper.
-/// Calls `from_counts(i, c, total, present, n)` with box i's counts c[0 .. n_bins) (c[-1]:
-/// background; 0 but for the n bins `present`, in increasing order) and counted pixels for boxes
+/// Calls `from_counts(i, c, total, present)` with box i's counts c[0 .. n_bins) (c[-1]:
+/// background; 0 but for the bins `present`, BinLanes) and counted pixels for boxes
 /// counted from a table, and `direct(i, r)` with the clipped pixel
 /// range of every other box (empty ones included). Scratch is local to the call, but for the
 /// table: `shared_table`, the caller's to reuse (for img.n_bins bins), else a local one.
@@ -327,6 +341,7 @@ inline void for_each_range_count(const BinImage& img, const std::vector<PixelRan
     IntegralHistogram& table = own_table ? *own_table : *shared_table;
     std::vector<std::int32_t> counts(static_cast<size_t>(img.n_bins) + 1);
     std::int32_t* c = counts.data() + 1;  // c[-1]: background
+    BinLanes present{};
     for (size_t g = 0; g < groups.size(); ++g) {
         const Group& grp = groups[g];
         const Index* m0 = members.data() + start[g];
@@ -346,12 +361,13 @@ inline void for_each_range_count(const BinImage& img, const std::vector<PixelRan
             continue;
         }
         table.build(img);
+        present = table.present();
         std::fill(counts.begin(), counts.end(), 0);  // bins absent from the region stay 0
         for (const Index* m = m0; m != m1; ++m) {
             const PixelRange& r = ranges[static_cast<size_t>(*m)];
             table.box_counts(r, c);
             from_counts(*m, static_cast<const std::int32_t*>(c), pixel_count(r) - c[-1],
-                        table.present(), table.n_present());
+                        present);
         }
     }
 }
@@ -455,10 +471,9 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
         }
         for_each_range_count(
             points, ranges, path,
-            [&](Index i, const std::int32_t* c, std::int64_t total, const std::int16_t* present,
-                int n) {
+            [&](Index i, const std::int32_t* c, std::int64_t total, const BinLanes& present) {
                 counted[i] = static_cast<double>(total) * area;
-                rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present, n);
+                rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present);
             },
             [&](Index i, const PixelRange& r) {
                 rho[i] = scratch.coefficient_of_range(points, r, sqrt_ref, counted[i]);
@@ -475,10 +490,9 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
     }
     for_each_box_count(
         img, boxes, path,
-        [&](Index i, const std::int32_t* c, std::int64_t total, const std::int16_t* present,
-            int n) {
+        [&](Index i, const std::int32_t* c, std::int64_t total, const BinLanes& present) {
             counted[i] = static_cast<double>(total);
-            rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present, n);
+            rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present);
         },
         [&](Index i, const PixelRange& r) {
             rho[i] = scratch.coefficient_of_range(img, r, sqrt_ref, counted[i]);
@@ -521,7 +535,7 @@ inline RowMatrixXd box_histograms(const BinImage& img, const Eigen::MatrixBase<D
     const int nb = img.n_bins;
     for_each_box_count(
         img, boxes, path,
-        [&](Index i, const std::int32_t* c, std::int64_t total, const std::int16_t*, int) {
+        [&](Index i, const std::int32_t* c, std::int64_t total, const BinLanes&) {
             double* row = out.row(i).data();
             if (total == 0) {
                 std::fill(row, row + nb, 0.0);
