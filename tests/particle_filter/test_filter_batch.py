@@ -413,3 +413,34 @@ def test_follow_tracks_motion_equals_follow_motion_each(smooth: bool):
         np.testing.assert_array_equal(b.motion.v, s.motion.v)
         assert b.motion.cov == s.motion.cov
     assert not np.array_equal(batched[0].box, make()[0].box)
+
+
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        ({(1, 0): 2e9}, r"particles has a value 2e\+09 at \[1, 0\] beyond \+-1e\+09 px"),
+        ({(2, 4): -1e9}, r"particles has a value -1e\+09 at \[2, 4\] beyond \+-1e\+09 px"),
+        # every value checked finite before any is checked within the bound
+        ({(1, 0): 2e9, (4, 2): np.inf}, r"particles has a non-finite value inf at \[4, 2\]"),
+        ({(3, 5): np.nan}, r"particles has a non-finite value nan at \[3, 5\]"),
+    ],
+)
+def test_particles_beyond_the_bound_are_named(textured_frame, rng, bad, message):
+    """sis_step and sis_step_batch name the first bad particle value, and change nothing."""
+    image = hsv_bins(textured_frame)
+    model = Ar2Model()
+    (o,) = _objects(rng, image, 1)
+    for (i, j), v in bad.items():
+        o["p"][i, j] = v
+    before = copy.deepcopy(o)
+    args = (model.a, model.b, model.sigma, model.s_min, model.s_max, False, 20.0, "uniform", True)
+    with pytest.raises(ValueError, match="sis_step: " + message):
+        _core.sis_step(o["p"], o["w"], o["m"], image, o["ref"], o["w0"], o["h0"], *args,
+                       o["seed"], o["step"])  # fmt: skip
+    with pytest.raises(ValueError, match="sis_step_batch: entry 0: " + message):
+        _core.sis_step_batch(
+            [o["p"]], [o["w"]], [o["m"]], image, [o["ref"]], np.array([o["w0"]]),
+            np.array([o["h0"]]), *args, [o["seed"]], [o["step"]],
+        )  # fmt: skip
+    for key in ("p", "w", "m"):
+        np.testing.assert_array_equal(o[key], before[key])

@@ -29,8 +29,19 @@ struct SisResult {
 inline void check_particle_set(const Eigen::Ref<const RowMatrixXd>& particles,
                                const Eigen::Ref<const Eigen::VectorXd>& weights,
                                const Eigen::Ref<const RowMatrixXd>& means, const char* fn) {
-    check_particles(particles, fn);
-    require_bounded(particles, 1e9, fn, "particles");
+    // one pass without early exit when all is well (|x| < 1e9 is false for NaN and inf); the
+    // checks that name the first bad value (three passes) only when it is not
+    bool within = particles.rows() > 0 && particles.cols() == kParticleCols;
+    for (Index i = 0; within && i < particles.rows(); ++i) {
+        const double* row = particles.row(i).data();
+        bool ok = true;
+        for (int d = 0; d < kParticleCols; ++d) ok &= std::abs(row[d]) < 1e9;
+        within = ok;
+    }
+    if (!within) {
+        check_particles(particles, fn);
+        require_bounded(particles, 1e9, fn, "particles");
+    }
     require(weights.size() == particles.rows(), fn, "weights size", weights.size(),
             particles.rows());
     require_weights(weights, fn, "weights", kParticleWeightsZero);
