@@ -80,6 +80,31 @@ def test_close_mask_any_element_of_runs(seed: int, rows: int, cols: int, kh: int
     np.testing.assert_array_equal(got, _opencv(mask, el))
 
 
+@pytest.mark.parametrize(
+    "element",
+    [
+        np.asarray(cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (11, 11)), np.uint8),
+        np.asarray(cv2.getStructuringElement(cv2.MORPH_RECT, (3, 6)), np.uint8),
+        np.array([[0, 0, 1, 1], [1, 1, 1, 0], [0, 0, 0, 1]], np.uint8),  # runs off the anchor
+    ],
+)
+def test_close_mask_with_empty_rows(element: np.ndarray) -> None:
+    """A foreground mask's all-0 rows, which the closing does not reduce: the full values."""
+    rng = np.random.default_rng(int(element.sum()))
+    for rows, cols in [(3, 9), (60, 80), (200, 333)]:
+        for _ in range(4):
+            mask = np.zeros((rows, cols), np.uint8)
+            for _ in range(int(rng.integers(1, 5))):  # a few blobs, empty rows between them
+                y, x = int(rng.integers(0, rows)), int(rng.integers(0, cols))
+                h, w = int(rng.integers(1, 12)), int(rng.integers(1, 40))
+                mask[y : y + h, x : x + w] = rng.choice([127, 255])
+            mask[rng.integers(0, rows), rng.integers(0, cols)] = 255  # a lone pixel
+            assert (mask.max(axis=1) == 0).any() or rows < 10
+            got = _core.close_mask(mask, element)
+            np.testing.assert_array_equal(got, close_mask_reference(mask, element))
+            np.testing.assert_array_equal(got, _opencv(mask, element))
+
+
 def test_clean_is_opening_then_this_closing_on_a_strided_view() -> None:
     rng = np.random.default_rng(3)
     view = _mask(rng, 80, 120)[:, 10:100]  # rows strided
