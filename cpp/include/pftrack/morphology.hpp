@@ -200,4 +200,13 @@ inline void close_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* 
     morphology(tmp, cols, dst, rows, cols, el, MorphOp::erode, s);
 }
 
+/// The opening (an erosion, then a dilation) of `src` by `el` into `dst`, as
+/// cv2.morphologyEx(MORPH_OPEN); the arguments as `close_mask`'s.
+inline void open_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
+                      std::uint8_t* tmp, Index rows, Index cols,
+                      const std::vector<ElementRow>& el, MorphScratch& s) {
+    morphology(src, src_stride, tmp, rows, cols, el, MorphOp::erode, s);
+    morphology(tmp, cols, dst, rows, cols, el, MorphOp::dilate, s);
+}
+
 }  // namespace pftrack
