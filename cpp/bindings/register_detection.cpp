@@ -430,4 +430,31 @@ void register_detection(py::module_& m) {
         py::arg("mask"), py::arg("element"),
         "Closing (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
         "single runs: cv2.morphologyEx(mask, MORPH_CLOSE, element)'s values.");
+
+    m.def(
+        "open_mask",
+        [](const py::array& mask, const py::array& element) {
+            const char* fn = "open_mask";
+            if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
+                fail(fn, "mask must be a non-empty (H, W) array");
+            bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
+            const std::vector<ElementRow> el = to_element(element, fn);
+            const Index rows = mask.shape(0), cols = mask.shape(1);
+            auto out = new_mask(rows, cols);
+            std::uint8_t* optr = out.mutable_data();
+            const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
+            const Index mstride = mask.strides(0);
+            {
+                py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
+                // scratch kept per thread from frame to frame (each detector runs on one thread)
+                thread_local std::vector<std::uint8_t> tmp;
+                thread_local MorphScratch scratch;
+                tmp.resize(static_cast<size_t>(rows * cols));
+                open_mask(mptr, mstride, optr, tmp.data(), rows, cols, el, scratch);
+            }
+            return out;
+        },
+        py::arg("mask"), py::arg("element"),
+        "Opening (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
+        "single runs: cv2.morphologyEx(mask, MORPH_OPEN, element)'s values.");
 }

@@ -223,6 +223,9 @@ def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # ma
 # as cv2.morphologyEx(MORPH_CLOSE) -> new (H, W) uint8
 def close_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: ...
 
+# opening (an erosion, then a dilation), likewise, as cv2.morphologyEx(MORPH_OPEN)
+def open_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: ...
+
 # boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)
 # method "auto" | "direct" | "integral", as box_weights (the same histograms on every path)
 def box_histograms(

@@ -83,6 +83,23 @@ def test_background_model_matches_reference(seed, kw):
     assert model.frame_count == 6
 
 
+@pytest.mark.parametrize("bins", [True, False])
+def test_background_model_matches_reference_at_odd_widths(bins):
+    # the vectorised row loops (mask and shadow test included) and their scalar remainders
+    for cols in (7, 61, 133):
+        rng = np.random.default_rng(cols)
+        model, ref = _core.BackgroundModel(n_learn=2), BackgroundReference(n_learn=2)
+        n_shadow = 0
+        for frame in random_scene(rng, shape=(40, cols)):
+            _, mask = model.apply(frame, bins=bins)
+            _, rmask = ref.apply(frame)
+            np.testing.assert_array_equal(mask, rmask)
+            np.testing.assert_array_equal(model.background, ref.background)
+            assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
+            n_shadow += int((mask == 127).sum())
+        assert n_shadow > 0 or cols < 30  # the shadowed patch was marked, where it fits
+
+
 def test_apply_without_bins_is_the_same_pass():
     # bins=False (the built-in detector: it bins only its foreground) changes nothing else
     frames = random_scene(np.random.default_rng(3), shape=(37, 61), steps=5)

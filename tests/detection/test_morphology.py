@@ -11,11 +11,11 @@ from hypothesis import strategies as st
 
 from pftrack import _core
 from pftrack.detection.base import BlobConfig, BlobExtractor
-from tests.reference.detection import close_mask_reference
+from tests.reference.detection import close_mask_reference, open_mask_reference
 
 
-def _opencv(mask: np.ndarray, element: np.ndarray) -> np.ndarray:
-    return np.asarray(cv2.morphologyEx(mask, cv2.MORPH_CLOSE, element), np.uint8)
+def _opencv(mask: np.ndarray, element: np.ndarray, op: int = cv2.MORPH_CLOSE) -> np.ndarray:
+    return np.asarray(cv2.morphologyEx(mask, op, element), np.uint8)
 
 
 def _mask(rng: np.random.Generator, rows: int, cols: int) -> np.ndarray:
@@ -54,6 +54,9 @@ def test_close_mask_equals_reference_and_opencv(shape: int, size: tuple[int, int
         got = _core.close_mask(mask, el)
         np.testing.assert_array_equal(got, close_mask_reference(mask, el))
         np.testing.assert_array_equal(got, _opencv(mask, el))
+        opened = _core.open_mask(mask, el)
+        np.testing.assert_array_equal(opened, open_mask_reference(mask, el))
+        np.testing.assert_array_equal(opened, _opencv(mask, el, cv2.MORPH_OPEN))
 
 
 @settings(max_examples=80, deadline=None)
@@ -78,6 +81,38 @@ def test_close_mask_any_element_of_runs(seed: int, rows: int, cols: int, kh: int
     got = _core.close_mask(mask, el)
     np.testing.assert_array_equal(got, close_mask_reference(mask, el))
     np.testing.assert_array_equal(got, _opencv(mask, el))
+    opened = _core.open_mask(mask, el)
+    np.testing.assert_array_equal(opened, open_mask_reference(mask, el))
+    np.testing.assert_array_equal(opened, _opencv(mask, el, cv2.MORPH_OPEN))
+
+
+@pytest.mark.parametrize(
+    "element",
+    [
+        np.asarray(cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (11, 11)), np.uint8),
+        np.asarray(cv2.getStructuringElement(cv2.MORPH_RECT, (3, 6)), np.uint8),
+        np.array([[0, 0, 1, 1], [1, 1, 1, 0], [0, 0, 0, 1]], np.uint8),  # runs off the anchor
+    ],
+)
+def test_close_mask_with_empty_rows(element: np.ndarray) -> None:
+    """A foreground mask's all-0 rows, which neither the closing nor the opening reduces: the
+    full values."""
+    rng = np.random.default_rng(int(element.sum()))
+    for rows, cols in [(3, 9), (60, 80), (200, 333)]:
+        for _ in range(4):
+            mask = np.zeros((rows, cols), np.uint8)
+            for _ in range(int(rng.integers(1, 5))):  # a few blobs, empty rows between them
+                y, x = int(rng.integers(0, rows)), int(rng.integers(0, cols))
+                h, w = int(rng.integers(1, 12)), int(rng.integers(1, 40))
+                mask[y : y + h, x : x + w] = rng.choice([127, 255])
+            mask[rng.integers(0, rows), rng.integers(0, cols)] = 255  # a lone pixel
+            assert (mask.max(axis=1) == 0).any() or rows < 10
+            got = _core.close_mask(mask, element)
+            np.testing.assert_array_equal(got, close_mask_reference(mask, element))
+            np.testing.assert_array_equal(got, _opencv(mask, element))
+            opened = _core.open_mask(mask, element)
+            np.testing.assert_array_equal(opened, open_mask_reference(mask, element))
+            np.testing.assert_array_equal(opened, _opencv(mask, element, cv2.MORPH_OPEN))
 
 
 def test_clean_is_opening_then_this_closing_on_a_strided_view() -> None:
@@ -88,18 +123,20 @@ def test_clean_is_opening_then_this_closing_on_a_strided_view() -> None:
     opened = cv2.morphologyEx(np.ascontiguousarray(view), cv2.MORPH_OPEN, k_open)
     want = close_mask_reference(opened, k_close)
     np.testing.assert_array_equal(_core.close_mask(view, k_close), _opencv(view, k_close))
+    np.testing.assert_array_equal(_core.open_mask(view, k_open), opened)
     np.testing.assert_array_equal(ex.clean(view), want)
 
 
-def test_close_mask_refuses_bad_input() -> None:
+@pytest.mark.parametrize("fn", [_core.close_mask, _core.open_mask])
+def test_close_and_open_mask_refuse_bad_input(fn) -> None:
     mask = np.zeros((5, 5), np.uint8)
     with pytest.raises(ValueError, match="not one run"):
-        _core.close_mask(mask, np.array([[1, 0, 1]], np.uint8))
+        fn(mask, np.array([[1, 0, 1]], np.uint8))
     with pytest.raises(ValueError, match="no set pixel"):
-        _core.close_mask(mask, np.zeros((3, 3), np.uint8))
+        fn(mask, np.zeros((3, 3), np.uint8))
     with pytest.raises(ValueError, match="shape"):
-        _core.close_mask(mask, np.ones(3, np.uint8))
+        fn(mask, np.ones(3, np.uint8))
     with pytest.raises(ValueError, match="dtype"):
-        _core.close_mask(mask.astype(np.float32), np.ones((3, 3), np.uint8))
+        fn(mask.astype(np.float32), np.ones((3, 3), np.uint8))
     with pytest.raises(ValueError, match="non-empty"):
-        _core.close_mask(np.zeros((0, 5), np.uint8), np.ones((3, 3), np.uint8))
+        fn(np.zeros((0, 5), np.uint8), np.ones((3, 3), np.uint8))

@@ -498,6 +498,16 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target(
+        "open_mask",
+        call(
+            _core.open_mask,
+            maybe(masks().flatmap(layout)),
+            maybe(
+                hnp.arrays(st.sampled_from([np.uint8, np.bool_]), st.tuples(ints(1, 7), ints(1, 7)))
+            ),
+        ),
+    ),  # fmt: skip
+    Target(
         "median_frames",
         call(
             _core.median_frames,

@@ -202,6 +202,11 @@ def close_mask_reference(mask: np.ndarray, element: np.ndarray) -> np.ndarray:
     return morphology_reference(morphology_reference(mask, element, "dilate"), element, "erode")
 
 
+def open_mask_reference(mask: np.ndarray, element: np.ndarray) -> np.ndarray:
+    """The opening of `mask` by `element` (an erosion, then a dilation), in NumPy."""
+    return morphology_reference(morphology_reference(mask, element, "erode"), element, "dilate")
+
+
 def scale_reference(background: np.ndarray, gain: float) -> np.ndarray:
     """BackgroundModel.scale: background * float32(gain), clipped to 255, in float32."""
     return np.minimum(background.astype(np.float32) * np.float32(gain), np.float32(255))

@@ -145,27 +145,49 @@ PFTRACK_VECTOR_CLONES static void hsv_row_indices(Index n, const std::uint8_t* _
                     static_cast<float>(px[3 * x + 2]), si[x], hi[x]);
 }
 
+/// The shadow bounds of `candidate`'s test (BackgroundConfig's shadow_lo, shadow_chroma).
+struct ShadowBounds {
+    float lo;
+    float chroma;
+};
+
 /// d_bg = max_c |frame_c - background_c| of one pixel, floor(d_bg) clamped to 255 into `di`,
-/// and the candidate flag (1 or 0) into `cand`.
+/// the candidate flag (1 or 0) into `cand`, and the mask byte into `m`: 0 for no candidate, 127
+/// for a candidate that is a shadow (darker by a bounded ratio, same chromaticity:
+/// |I_c sB - B_c sI| <= k sI sB for every c), 255 for foreground. Every test is computed for
+/// every pixel (float32, in the order of the scalar test it replaced), so that the loops
+/// calling it vectorise.
 inline __attribute__((always_inline)) void candidate(float b, float g, float r, float qb, float qg,
                                                      float qr, float dprev, float t, float t_low,
-                                                     std::int32_t& di, float& cand) {
+                                                     ShadowBounds sh, std::int32_t& di,
+                                                     float& cand, std::uint8_t& m) {
     const float d_bg = std::max(std::abs(b - qb), std::max(std::abs(g - qg), std::abs(r - qr)));
     di = static_cast<std::int32_t>(std::min(d_bg, 255.0f));
-    cand = ((d_bg > t) | ((dprev > t) & (d_bg > t_low))) ? 1.0f : 0.0f;
+    const bool is_cand = (d_bg > t) | ((dprev > t) & (d_bg > t_low));
+    cand = is_cand ? 1.0f : 0.0f;
+    const float s_i = b + g + r, s_b = qb + qg + qr;
+    const float tol = sh.chroma * s_i * s_b;
+    const bool shadow = (s_i < s_b) & (s_i >= sh.lo * s_b) & (s_i > 0.0f) &
+                        (std::abs(b * s_b - qb * s_i) <= tol) &
+                        (std::abs(g * s_b - qg * s_i) <= tol) &
+                        (std::abs(r * s_b - qr * s_i) <= tol);
+    // 255 - 128 = 127 for a shadow; times 0 or 1 (arithmetic: a select does not vectorise)
+    m = static_cast<std::uint8_t>(static_cast<std::int32_t>(is_cand) *
+                                  (255 - 128 * static_cast<std::int32_t>(shadow)));
 }
 
 /// Per pixel of one row, in float (exact on these small integers), branch-free: HsvLut indices
-/// (sat, hue), floor(d_bg) clamped to 255, and the candidate flag (1 or 0).
+/// (sat, hue), floor(d_bg) clamped to 255, the candidate flag (1 or 0) and the mask byte.
 PFTRACK_VECTOR_CLONES static void background_row_scan(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
     const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
-    const float* __restrict dprev, float t, float t_low, std::int32_t* __restrict si,
-    std::int32_t* __restrict hi, std::int32_t* __restrict di,
-    float* __restrict cand) {
+    const float* __restrict dprev, float t, float t_low, ShadowBounds sh,
+    std::int32_t* __restrict si, std::int32_t* __restrict hi, std::int32_t* __restrict di,
+    float* __restrict cand, std::uint8_t* __restrict m) {
     for (Index x = 0; x < n; ++x) {
         hsv_indices(fb[x], fg[x], fr[x], si[x], hi[x]);
-        candidate(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, di[x], cand[x]);
+        candidate(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, sh, di[x],
+                  cand[x], m[x]);
     }
 }
 
@@ -173,10 +195,11 @@ PFTRACK_VECTOR_CLONES static void background_row_scan(
 PFTRACK_VECTOR_CLONES static void background_row_candidates(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
     const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
-    const float* __restrict dprev, float t, float t_low, std::int32_t* __restrict di,
-    float* __restrict cand) {
+    const float* __restrict dprev, float t, float t_low, ShadowBounds sh,
+    std::int32_t* __restrict di, float* __restrict cand, std::uint8_t* __restrict m) {
     for (Index x = 0; x < n; ++x)
-        candidate(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, di[x], cand[x]);
+        candidate(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, sh, di[x],
+                  cand[x], m[x]);
 }
 
 /// One row of BGR bytes (and of the previous frame) -> float planes b, g, r and
@@ -387,9 +410,9 @@ public:
         const float a_fg = static_cast<float>(learning ? a_learn : config_.alpha_fg);
         const float s_lo = static_cast<float>(config_.shadow_lo);
         const float s_chroma = static_cast<float>(config_.shadow_chroma);
-        // Four interleaved histograms: consecutive pixels mostly fall in the same bin, and
+        // Eight interleaved histograms: consecutive pixels mostly fall in the same bin, and
         // incrementing one counter back to back would serialise on store-to-load forwarding.
-        std::array<std::array<std::int32_t, 256>, 4> h4{};
+        std::array<std::array<std::int32_t, 256>, 8> h8{};
         const Index n3 = cols * 3;
         const auto ns = static_cast<size_t>(cols);
         scratch_f_.resize(5 * ns);
@@ -402,9 +425,11 @@ public:
         std::int32_t* __restrict si = scratch_i_.data();
         std::int32_t* __restrict hi = si + ns;
         std::int32_t* __restrict di = hi + ns;
+        const detail::ShadowBounds sh{s_lo, s_chroma};
         // Each row in four loops over L1-resident row buffers: (1), (3), (5) are vectorised by
-        // the compiler; (4) does the table look-ups, the histogram and the shadow test of the
-        // few candidates, which cannot be vectorised.
+        // the compiler (the shadow test of (3) too, for every pixel: cheaper vectorised than
+        // branching to it for the few candidates); (4) does the table look-ups and the
+        // histogram, which cannot be vectorised.
         for (Index y = 0; y < rows; ++y) {
             const std::uint8_t* __restrict px = bgr + y * row_stride;
             float* __restrict qb = background_.data() + y * n3;
@@ -415,41 +440,27 @@ public:
             std::uint8_t* __restrict m = mask + y * cols;
             // (1) deinterleave into float planes, d_prev; I' <- I
             detail::background_row_split(cols, px, prev, fb, fg, fr, dprev);
-            // (3) per pixel, vectorised: table indices (with bins), d_bg, candidates
+            // (3) per pixel, vectorised: table indices (with bins), d_bg, candidates, mask
             if (o != nullptr)
-                detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, si, hi,
-                                            di, cand);
+                detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, sh, si,
+                                            hi, di, cand, m);
             else
                 detail::background_row_candidates(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low,
-                                                  di, cand);
-            // (4) bins by table look-up, histogram of floor(d_bg), shadow test on candidates
+                                                  sh, di, cand, m);
+            // (4) bins by table look-up, histogram of floor(d_bg)
             if (o != nullptr)
                 for (Index x = 0; x < cols; ++x)
                     o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
-            for (Index x = 0; x < cols; ++x) {
-                ++h4[static_cast<size_t>(x & 3)][static_cast<size_t>(di[x])];
-                std::uint8_t out = 0;
-                if (cand[x] != 0.0f) {
-                    // shadow: darker by a bounded ratio, same chromaticity:
-                    // |I_c sB - B_c sI| <= k sI sB for every c
-                    const float b = fb[x], g = fg[x], r = fr[x];
-                    const float s_i = b + g + r, s_b = qb[x] + qg[x] + qr[x];
-                    bool shadow = false;
-                    if (s_i < s_b && s_i >= s_lo * s_b && s_i > 0.0f) {
-                        const float tol = s_chroma * s_i * s_b;
-                        shadow = std::abs(b * s_b - qb[x] * s_i) <= tol &&
-                                 std::abs(g * s_b - qg[x] * s_i) <= tol &&
-                                 std::abs(r * s_b - qr[x] * s_i) <= tol;
-                    }
-                    out = shadow ? 127 : 255;
-                }
-                m[x] = out;
-            }
+            for (Index x = 0; x < cols; ++x)
+                ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
             // (5) background_c += a (frame_c - background_c), vectorised (selective update)
             detail::background_row_update(cols, fb, fg, fr, qb, qg, qr, cand, a_bg, a_fg);
         }
-        for (size_t i = 0; i < 256; ++i)
-            hist_[i] = std::int64_t(h4[0][i]) + h4[1][i] + h4[2][i] + h4[3][i];
+        for (size_t i = 0; i < 256; ++i) {
+            std::int64_t c = 0;
+            for (const auto& h : h8) c += h[i];
+            hist_[i] = c;
+        }
         threshold_ = next_threshold();
         ++frame_count_;
     }

@@ -79,16 +79,30 @@ PFTRACK_VECTOR_CLONES static void extremum_into(bool dilate, const std::uint8_t*
         for (Index i = 0; i < n; ++i) o[i] = std::min(o[i], a[i]);
 }
 
+/// Whether the n bytes at p are all 0 (an OR reduction, vectorised).
+PFTRACK_VECTOR_CLONES static bool all_zero(const std::uint8_t* __restrict p, Index n) {
+    std::uint8_t any = 0;
+    for (Index i = 0; i < n; ++i) any = static_cast<std::uint8_t>(any | p[i]);
+    return any == 0;
+}
+
 }  // namespace detail
 
 /// Scratch of `morphology`, reused from call to call.
 struct MorphScratch {
     std::vector<std::uint8_t> pow2, ring;
+    std::vector<std::uint8_t> zero;  // per ring slot: its source row was all 0 (not reduced)
 };
 
 /// dst (rows x cols, packed) = erosion (min) or dilation (max) of src (rows x cols,
 /// `src_stride` bytes a row) by the element `el`: dst(y, x) = extremum over (dy, dx) in the
 /// element of src(y + dy, x + dx), pixels outside the image left out. `dst` must not alias `src`.
+///
+/// A foreground mask is mostly empty rows, which are not reduced: an all-0 source row gives 0
+/// for every run that holds the anchor column (dx = 0: the pixel itself is 0), so a dilation
+/// leaves it out of its maxima and an erosion's output row is 0 wherever it contributes (when
+/// every run holds the anchor, as the rectangles, ellipses and crosses of OpenCV do; else every
+/// row is reduced). Min and max being exact, the values are those of the full pass.
 inline void morphology(const std::uint8_t* src, Index src_stride, std::uint8_t* dst, Index rows,
                        Index cols, const std::vector<ElementRow>& el, MorphOp op,
                        MorphScratch& s) {
@@ -115,8 +129,14 @@ inline void morphology(const std::uint8_t* src, Index src_stride, std::uint8_t* 
     const auto nr = static_cast<Index>(runs.size());
     s.pow2.assign(static_cast<size_t>(levels * pw), identity);
     s.ring.resize(static_cast<size_t>(span * nr * cols));
+    s.zero.assign(static_cast<size_t>(span), 0);
+    bool skip_zero = true;  // every run holds the anchor column: all-0 rows need no reduction
+    for (const auto& [lo, hi] : runs) skip_zero = skip_zero && lo <= 0 && hi >= 0;
     // the runs of source row sy into ring slot sy mod span
     auto reduce_row = [&](Index sy) {
+        const bool zero = skip_zero && detail::all_zero(src + sy * src_stride, cols);
+        s.zero[static_cast<size_t>(sy % span)] = zero ? 1 : 0;
+        if (zero) return;  // every run of it is 0 (see above): the slot is never read
         std::uint8_t* p0 = s.pow2.data();
         std::memcpy(p0 + ext, src + sy * src_stride, static_cast<size_t>(cols));
         for (Index j = 1; j < levels; ++j) {  // level j: extremum of pixels [i, i + 2^j)
@@ -143,10 +163,22 @@ inline void morphology(const std::uint8_t* src, Index src_stride, std::uint8_t* 
         for (const Index need = std::min(y + dy_max + 1, rows); reduced < need; ++reduced)
             reduce_row(reduced);
         std::uint8_t* out = dst + y * cols;
+        if (!dil) {  // an erosion's row is 0 where an all-0 row contributes
+            bool zero = false;
+            for (size_t r = 0; r < el.size() && !zero; ++r) {
+                const Index sy = y + el[r].dy;
+                zero = sy >= 0 && sy < rows && s.zero[static_cast<size_t>(sy % span)] != 0;
+            }
+            if (zero) {
+                std::memset(out, 0, static_cast<size_t>(cols));
+                continue;
+            }
+        }
         bool first = true;
         for (size_t r = 0; r < el.size(); ++r) {
             const Index sy = y + el[r].dy;
             if (sy < 0 || sy >= rows) continue;
+            if (s.zero[static_cast<size_t>(sy % span)] != 0) continue;  // dilation: max with 0
             const std::uint8_t* in = s.ring.data() + ((sy % span) * nr + run_of[r]) * cols;
             if (first)
                 std::memcpy(out, in, static_cast<size_t>(cols));
@@ -166,6 +198,15 @@ inline void close_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* 
                        const std::vector<ElementRow>& el, MorphScratch& s) {
     morphology(src, src_stride, tmp, rows, cols, el, MorphOp::dilate, s);
     morphology(tmp, cols, dst, rows, cols, el, MorphOp::erode, s);
+}
+
+/// The opening (an erosion, then a dilation) of `src` by `el` into `dst`, as
+/// cv2.morphologyEx(MORPH_OPEN); the arguments as `close_mask`'s.
+inline void open_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
+                      std::uint8_t* tmp, Index rows, Index cols,
+                      const std::vector<ElementRow>& el, MorphScratch& s) {
+    morphology(src, src_stride, tmp, rows, cols, el, MorphOp::erode, s);
+    morphology(tmp, cols, dst, rows, cols, el, MorphOp::dilate, s);
 }
 
 }  // namespace pftrack
