@@ -50,6 +50,33 @@ std::vector<ElementRow> to_element(const py::array& k, const char* fn) {
     return element_rows(static_cast<const std::uint8_t*>(k.data()), k.shape(0), k.shape(1), fn);
 }
 
+/// The signature of close_mask and open_mask (morphology.hpp): two passes through `tmp`.
+using MaskPass = void (*)(const std::uint8_t*, Index, std::uint8_t*, std::uint8_t*, Index, Index,
+                          const std::vector<ElementRow>&, MorphScratch&);
+
+/// `pass` of a (H, W) uint8/bool mask by a structuring element, checked, into a new mask.
+py::array_t<std::uint8_t> mask_pass(const py::array& mask, const py::array& element,
+                                    const char* fn, MaskPass pass) {
+    if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
+        fail(fn, "mask must be a non-empty (H, W) array");
+    bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
+    const std::vector<ElementRow> el = to_element(element, fn);
+    const Index rows = mask.shape(0), cols = mask.shape(1);
+    auto out = new_mask(rows, cols);
+    std::uint8_t* optr = out.mutable_data();
+    const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
+    const Index mstride = mask.strides(0);
+    {
+        py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
+        // scratch kept per thread from frame to frame (each detector runs on one thread)
+        thread_local std::vector<std::uint8_t> tmp;
+        thread_local MorphScratch scratch;
+        tmp.resize(static_cast<size_t>(rows * cols));
+        pass(mptr, mstride, optr, tmp.data(), rows, cols, el, scratch);
+    }
+    return out;
+}
+
 }  // namespace
 
 void register_detection(py::module_& m) {
@@ -407,25 +434,7 @@ void register_detection(py::module_& m) {
     m.def(
         "close_mask",
         [](const py::array& mask, const py::array& element) {
-            const char* fn = "close_mask";
-            if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
-                fail(fn, "mask must be a non-empty (H, W) array");
-            bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
-            const std::vector<ElementRow> el = to_element(element, fn);
-            const Index rows = mask.shape(0), cols = mask.shape(1);
-            auto out = new_mask(rows, cols);
-            std::uint8_t* optr = out.mutable_data();
-            const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
-            const Index mstride = mask.strides(0);
-            {
-                py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
-                // scratch kept per thread from frame to frame (each detector runs on one thread)
-                thread_local std::vector<std::uint8_t> tmp;
-                thread_local MorphScratch scratch;
-                tmp.resize(static_cast<size_t>(rows * cols));
-                close_mask(mptr, mstride, optr, tmp.data(), rows, cols, el, scratch);
-            }
-            return out;
+            return mask_pass(mask, element, "close_mask", close_mask);
         },
         py::arg("mask"), py::arg("element"),
         "Closing (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
@@ -434,25 +443,7 @@ void register_detection(py::module_& m) {
     m.def(
         "open_mask",
         [](const py::array& mask, const py::array& element) {
-            const char* fn = "open_mask";
-            if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
-                fail(fn, "mask must be a non-empty (H, W) array");
-            bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
-            const std::vector<ElementRow> el = to_element(element, fn);
-            const Index rows = mask.shape(0), cols = mask.shape(1);
-            auto out = new_mask(rows, cols);
-            std::uint8_t* optr = out.mutable_data();
-            const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
-            const Index mstride = mask.strides(0);
-            {
-                py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
-                // scratch kept per thread from frame to frame (each detector runs on one thread)
-                thread_local std::vector<std::uint8_t> tmp;
-                thread_local MorphScratch scratch;
-                tmp.resize(static_cast<size_t>(rows * cols));
-                open_mask(mptr, mstride, optr, tmp.data(), rows, cols, el, scratch);
-            }
-            return out;
+            return mask_pass(mask, element, "open_mask", open_mask);
         },
         py::arg("mask"), py::arg("element"),
         "Opening (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
