@@ -420,6 +420,12 @@ def _kalman() -> st.SearchStrategy[Any]:
     ))  # fmt: skip
 
 
+def _mask_pass(fn: Any) -> st.SearchStrategy[Any]:
+    """Calls of a morphology pass (close_mask, open_mask): a mask and a small element."""
+    element = hnp.arrays(st.sampled_from([np.uint8, np.bool_]), st.tuples(ints(1, 7), ints(1, 7)))
+    return call(fn, maybe(masks().flatmap(layout)), maybe(element))
+
+
 def _background(
     params: dict[str, Any], frames_: list[Any], mask: Any, rate: Any, boxes: Any
 ) -> Any:
@@ -487,26 +493,8 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target("mask_bins", call(_core.mask_bins, maybe(binned()), maybe(masks()))),
-    Target(
-        "close_mask",
-        call(
-            _core.close_mask,
-            maybe(masks().flatmap(layout)),
-            maybe(
-                hnp.arrays(st.sampled_from([np.uint8, np.bool_]), st.tuples(ints(1, 7), ints(1, 7)))
-            ),
-        ),
-    ),  # fmt: skip
-    Target(
-        "open_mask",
-        call(
-            _core.open_mask,
-            maybe(masks().flatmap(layout)),
-            maybe(
-                hnp.arrays(st.sampled_from([np.uint8, np.bool_]), st.tuples(ints(1, 7), ints(1, 7)))
-            ),
-        ),
-    ),  # fmt: skip
+    Target("close_mask", _mask_pass(_core.close_mask)),
+    Target("open_mask", _mask_pass(_core.open_mask)),
     Target(
         "median_frames",
         call(
