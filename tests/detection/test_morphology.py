@@ -32,6 +32,16 @@ def _mask(rng: np.random.Generator, rows: int, cols: int) -> np.ndarray:
     return m
 
 
+def _assert_close_and_open(mask: np.ndarray, el: np.ndarray) -> None:
+    """The core's closing and opening of `mask` by `el` equal the NumPy reference's and OpenCV's."""
+    got = _core.close_mask(mask, el)
+    np.testing.assert_array_equal(got, close_mask_reference(mask, el))
+    np.testing.assert_array_equal(got, _opencv(mask, el))
+    opened = _core.open_mask(mask, el)
+    np.testing.assert_array_equal(opened, open_mask_reference(mask, el))
+    np.testing.assert_array_equal(opened, _opencv(mask, el, cv2.MORPH_OPEN))
+
+
 @pytest.mark.parametrize(
     "shape, size",
     [
@@ -51,12 +61,7 @@ def test_close_mask_equals_reference_and_opencv(shape: int, size: tuple[int, int
     el = np.asarray(cv2.getStructuringElement(shape, size), np.uint8)
     for rows, cols in [(1, 1), (2, 7), (13, 1), (40, 57), (64, 96), (360, 480)]:
         mask = _mask(rng, rows, cols)
-        got = _core.close_mask(mask, el)
-        np.testing.assert_array_equal(got, close_mask_reference(mask, el))
-        np.testing.assert_array_equal(got, _opencv(mask, el))
-        opened = _core.open_mask(mask, el)
-        np.testing.assert_array_equal(opened, open_mask_reference(mask, el))
-        np.testing.assert_array_equal(opened, _opencv(mask, el, cv2.MORPH_OPEN))
+        _assert_close_and_open(mask, el)
 
 
 @settings(max_examples=80, deadline=None)
@@ -78,12 +83,7 @@ def test_close_mask_any_element_of_runs(seed: int, rows: int, cols: int, kh: int
     if not el.any():
         el[int(rng.integers(0, kh)), int(rng.integers(0, kw))] = 1
     mask = _mask(rng, rows, cols)
-    got = _core.close_mask(mask, el)
-    np.testing.assert_array_equal(got, close_mask_reference(mask, el))
-    np.testing.assert_array_equal(got, _opencv(mask, el))
-    opened = _core.open_mask(mask, el)
-    np.testing.assert_array_equal(opened, open_mask_reference(mask, el))
-    np.testing.assert_array_equal(opened, _opencv(mask, el, cv2.MORPH_OPEN))
+    _assert_close_and_open(mask, el)
 
 
 @pytest.mark.parametrize(
@@ -107,12 +107,7 @@ def test_close_mask_with_empty_rows(element: np.ndarray) -> None:
                 mask[y : y + h, x : x + w] = rng.choice([127, 255])
             mask[rng.integers(0, rows), rng.integers(0, cols)] = 255  # a lone pixel
             assert (mask.max(axis=1) == 0).any() or rows < 10
-            got = _core.close_mask(mask, element)
-            np.testing.assert_array_equal(got, close_mask_reference(mask, element))
-            np.testing.assert_array_equal(got, _opencv(mask, element))
-            opened = _core.open_mask(mask, element)
-            np.testing.assert_array_equal(opened, open_mask_reference(mask, element))
-            np.testing.assert_array_equal(opened, _opencv(mask, element, cv2.MORPH_OPEN))
+            _assert_close_and_open(mask, element)
 
 
 def test_clean_is_opening_then_this_closing_on_a_strided_view() -> None:
