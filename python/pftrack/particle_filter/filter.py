@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import re
 import threading
 from collections.abc import Sequence
@@ -496,21 +495,7 @@ class ColourParticleFilter:
 
     def _reseed(self, b: F64, v: F64, spread: float) -> None:
         """:meth:`reinitialise` of checked arguments, the filter's lock held."""
-        m = self.config.model
-        s = math.sqrt(float((b[2] / self.w0) * (b[3] / self.h0)))
-        s = min(max(s, m.s_min), m.s_max)  # np.clip's value, without its call overhead
-        n = self.config.n_particles
-        noise = self._rng.standard_normal((n, 3))
-        p = self.particles
-        p[:, 0] = b[0] + spread * m.sigma_xy * noise[:, 0]
-        p[:, 1] = b[1] + spread * m.sigma_xy * noise[:, 1]
-        p[:, 2] = np.minimum(np.maximum(s + spread * m.sigma_s * noise[:, 2], m.s_min), m.s_max)
-        p[:, 3] = p[:, 0] - v[0]
-        p[:, 4] = p[:, 1] - v[1]
-        p[:, 5] = p[:, 2]
-        self.weights.fill(1.0 / n)
-        self.means[0] = (b[0], b[1], s)
-        self.means[1] = (b[0] - v[0], b[1] - v[1], s)
+        _reseed_batch([self], self.config, np.reshape(b, (1, 4)), np.reshape(v, (1, 2)), spread)
 
     @property
     def velocity(self) -> NDArray[np.float64]:
@@ -798,10 +783,11 @@ def _reseed_batch(
 ) -> None:
     """:func:`reinitialise_filters` of checked arguments, one configuration, the locks held.
 
-    Each filter draws its noise from its own generator, in order, as :meth:`_reseed`; one core
-    call (``reseed_batch``) then writes the particles, weights and means of all of them, the
-    same floats as :meth:`_reseed`'s NumPy (was NumPy over (K, N, 6) arrays: about 60 calls on
-    small arrays a frame).
+    Each filter draws its noise from its own generator, in order; one core call
+    (``reseed_batch``) then writes the particles, weights and means of all of them, the floats
+    of the NumPy reference (tests/core/test_reseed.py; was NumPy over (K, N, 6) arrays: about
+    60 calls on small arrays a frame). :meth:`ColourParticleFilter.reinitialise` is this for one
+    filter.
     """
     m = cfg.model
     n = cfg.n_particles
