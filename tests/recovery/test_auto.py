@@ -230,11 +230,11 @@ def test_paired_test_keeps_the_reference_within_noise() -> None:
 
     rng = np.random.default_rng(7)
     ref = rng.uniform(1.0, 2.0, 40)
-    assert not _better(ref - 0.001, ref)  # below the 1 % margin
+    assert not _better(ref - 0.001, ref, float(ref.mean()))  # below the 1 % margin
     noisy = ref + rng.normal(0, 0.5, 40)
     noisy -= noisy.mean() - ref.mean() + 0.02  # 1.3 % better on average, but within noise
-    assert not _better(noisy, ref)
-    assert _better(0.8 * ref, ref)  # clearly better on every gap
+    assert not _better(noisy, ref, float(ref.mean()))
+    assert _better(0.8 * ref, ref, float(ref.mean()))  # clearly better on every gap
 
 
 def test_small_buckets_take_the_files_choice() -> None:

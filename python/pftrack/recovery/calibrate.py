@@ -792,7 +792,7 @@ def _choose(
     pooled = _pooled_choice(errors, weights, names, row_means)
     out: dict[int, tuple[tuple[str, float], ...]] = {}
     for b, e in errors.items():
-        means = dict(zip(names, stacked[b].mean(axis=1).tolist(), strict=True))
+        means = row_means[b]
         method = pooled
         best = min(names, key=lambda m: means[m])
         if best != pooled and _better(e[best], e[pooled], row_means[b][pooled]):
@@ -848,16 +848,14 @@ def _gap_errors(paths: Sequence[F64], truth: Sequence[F64]) -> F64:
     return out
 
 
-def _better(cand: F64, ref: F64, ref_mean: float | None = None) -> bool:
+def _better(cand: F64, ref: F64, ref_mean: float) -> bool:
     """`cand` beats `ref` on the same validation gaps: a paired test and the margin.
 
-    `ref_mean`: ``float(ref.mean())`` when the caller has it.
+    `ref_mean` is ``float(ref.mean())``, which the caller has already.
     """
     d = cand - ref
     se = float(np.std(d, ddof=1)) / np.sqrt(len(d)) if len(d) > 1 else np.inf
     mean = float(d.mean())
-    if ref_mean is None:
-        ref_mean = float(ref.mean())
     return mean < -PAIRED_Z * se and mean < -max(LINEAR_MARGIN * ref_mean, TIE)
 
 
