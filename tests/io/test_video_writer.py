@@ -176,3 +176,27 @@ def test_the_preset_trades_encoding_time_for_size(tmp_path: Path) -> None:
         assert len(got) == 40 and np.abs(got[-1].astype(int) - frames[-1]).mean() < 6
     assert sizes["ultrafast"] > sizes["medium"]  # the same quality target, a larger file
     assert inspect.signature(VideoWriter).parameters["preset"].default == "ultrafast"
+
+
+@pytest.mark.parametrize(("h", "w"), [(20, 32), (22, 34), (21, 33), (6, 10), (2, 2)])
+def test_wrapped_planes_encode_the_bytes_of_copied_ones(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, h: int, w: int
+) -> None:
+    """``from_numpy_buffer`` (heights that are multiples of 4) writes ``from_ndarray``'s file."""
+    import av
+
+    def write(name: str) -> bytes:
+        with VideoWriter(tmp_path / name, 7) as writer:
+            for f in _frames(6, h, w):
+                writer.write(f)
+        return (tmp_path / name).read_bytes()
+
+    wrapped = write("wrapped.mp4")
+    monkeypatch.setattr(
+        av.VideoFrame,
+        "from_numpy_buffer",
+        lambda array, format: av.VideoFrame.from_ndarray(array, format=format),
+    )
+    assert write("copied.mp4") == wrapped
+    _, got = decode(tmp_path / "wrapped.mp4")
+    assert len(got) == 6 and got[0].shape[:2] == (h + h % 2, w + w % 2)
