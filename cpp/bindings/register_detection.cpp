@@ -387,7 +387,7 @@ void register_detection(py::module_& m) {
                 // safe: the frames are held in `keep`, the output is owned here
                 py::gil_scoped_release nogil;
                 // chunks of a row small enough that the m frames' pieces stay in L1 over the
-                // 8 (or 16) passes of the selection
+                // 8 passes of the selection (9 for an even m)
                 const Index chunk = std::max(Index(64), Index(16384) / m);
                 // bands of rows on up to `threads` threads, each with its own scratch: every
                 // pixel's median is its own, so the values do not depend on the split

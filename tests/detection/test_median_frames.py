@@ -56,3 +56,15 @@ def test_median_frames_checks_its_arguments() -> None:
         _core.median_frames([f.astype(np.float64)])
     with pytest.raises(ValueError, match=r"frames\[0\] is list"):
         _core.median_frames([[1, 2, 3]])
+
+
+@pytest.mark.parametrize("m", [2, 4, 6, 30, 64])
+def test_median_frames_of_an_even_count_with_many_ties(m: int) -> None:
+    """The upper middle value (found from the lower one in one pass): the lower one again
+    when it repeats past the middle, else the least value above it."""
+    rng = np.random.default_rng(m)
+    frames = [(rng.integers(0, 4, (11, 17, 3)) * 85).astype(np.uint8) for _ in range(m)]
+    frames[0][0, :2] = [[255, 255, 255], [0, 0, 0]]
+    got = _core.median_frames(frames)
+    np.testing.assert_array_equal(got, np.median(np.stack(frames), axis=0).astype(np.float32))
+    assert 0 < np.mean(got % 85 == 0) < 1  # both: middle values equal, and apart

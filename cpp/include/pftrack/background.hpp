@@ -599,6 +599,39 @@ PFTRACK_VECTOR_CLONES static void kth_smallest_u8(const std::uint8_t* const* fra
     }
 }
 
+/// count[e] += v[e] <= lo[e] (its own function for `__restrict`, as `count_less`).
+inline void count_at_most(const std::uint8_t* __restrict v, const std::uint8_t* __restrict lo,
+                          std::uint16_t* __restrict count, Index n) {
+    for (Index e = 0; e < n; ++e)
+        count[e] = static_cast<std::uint16_t>(count[e] + (v[e] <= lo[e] ? 1 : 0));
+}
+
+/// above[e] = min(above[e], v[e] > lo[e] ? v[e] : 255), likewise.
+inline void least_above(const std::uint8_t* __restrict v, const std::uint8_t* __restrict lo,
+                        std::uint8_t* __restrict above, Index n) {
+    for (Index e = 0; e < n; ++e)
+        above[e] = std::min(above[e], static_cast<std::uint8_t>(v[e] > lo[e] ? v[e] : 255));
+}
+
+/// For each of the n elements, the k-th smallest (0-based) of the m values, given `lo`, the
+/// (k - 1)-th: lo itself when more than k values are at most lo, else the least value above
+/// it. One pass over the m values.
+PFTRACK_VECTOR_CLONES static void next_up_u8(const std::uint8_t* const* frames, Index m, Index n,
+                                              Index k, const std::uint8_t* __restrict lo,
+                                              std::uint8_t* __restrict out,
+                                              std::uint16_t* __restrict count) {
+    for (Index e = 0; e < n; ++e) {
+        count[e] = 0;
+        out[e] = 255;
+    }
+    for (Index f = 0; f < m; ++f) {
+        count_at_most(frames[f], lo, count, n);
+        least_above(frames[f], lo, out, n);
+    }
+    const auto kk = static_cast<std::uint16_t>(k);
+    for (Index e = 0; e < n; ++e) out[e] = count[e] > kk ? lo[e] : out[e];
+}
+
 }  // namespace detail
 
 /// Per-element median of m >= 1 images of n bytes each (`frames[f]` points at image f's row
@@ -614,7 +647,9 @@ inline void median_u8(const std::uint8_t* const* frames, Index m, Index n, float
         for (Index e = 0; e < n; ++e) out[e] = static_cast<float>(lo[e]);
         return;
     }
-    detail::kth_smallest_u8(frames, m, n, m / 2, hi, cand, count);
+    // the next one up, in one pass instead of a second selection: lo again when more than
+    // m / 2 values are at most lo, else the least value above lo
+    detail::next_up_u8(frames, m, n, m / 2, lo, hi, count);
     for (Index e = 0; e < n; ++e)
         out[e] = 0.5f * (static_cast<float>(lo[e]) + static_cast<float>(hi[e]));
 }
