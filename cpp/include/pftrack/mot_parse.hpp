@@ -85,11 +85,12 @@ inline bool parse_number(const char* p, const char* end, double& out) {
 
 /// The rows of MOTChallenge text `text` (a file's bytes) as an (M, K) array, K = 6..10 the
 /// columns of every row, or std::nullopt for a text not of the common layout. That layout: an
-/// optional UTF-8 byte-order mark, then lines ending in "\n" or "\r\n" (a lone '\r', a line
-/// end to Python, is refused: it lies in a field); comma-separated when the first non-empty line
-/// has a comma (spaces and tabs around a field allowed), else separated by runs of spaces and
-/// tabs; every field a number (detail::parse_number: so no letter, '#', control or non-ASCII
-/// byte anywhere), none empty (two commas in a row, a trailing comma), no line of only blanks,
+/// optional UTF-8 byte-order mark, then lines ending in "\n" or "\r\n" (or a '\r' ending the
+/// text; another lone '\r', a line end to Python, is refused: it lies in a field);
+/// comma-separated when the first non-empty line has a comma (spaces and tabs around a field
+/// allowed), else separated by runs of spaces and tabs; every field a number
+/// (detail::parse_number: so no letter but an exponent's e, no '#', control or non-ASCII byte
+/// anywhere), none empty (two commas in a row, a trailing comma), no line of only blanks,
 /// the same K on every line. Empty lines are skipped; no row at all gives (0, 10), as mot.py's
 /// empty file. For such a text the array is bit for bit np.loadtxt's (that delimiter, ndmin=2,
 /// comments=None); the caller checks frames, finiteness and boxes as it checks loadtxt's.
@@ -103,7 +104,8 @@ inline std::optional<RowMatrixXd> parse_mot_text(std::string_view text) {
     Eigen::Index rows = 0;
     double row[10];
     while (p < end) {
-        const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
+        const auto* eol = static_cast<const char*>(
+            std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
         const char* next = eol ? eol + 1 : end;
         const char* line_end = eol ? eol : end;
         if (line_end > p && line_end[-1] == '\r') --line_end;  // "\r\n"
