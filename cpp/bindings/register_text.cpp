@@ -1,9 +1,14 @@
+#include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 
+#include "pftrack/mot_parse.hpp"
 #include "pftrack/mot_text.hpp"
 #include "arrays.hpp"
 
@@ -34,6 +39,16 @@ py::array_t<T, py::array::c_style> table(const py::array& a, const char* fn, con
 }  // namespace
 
 void register_text(py::module_& m) {
+    m.def(
+        "parse_mot_text",
+        [](const py::bytes& text) {
+            const std::string_view view = text;  // the bytes object's own buffer, no copy
+            py::gil_scoped_release nogil;  // safe: bytes are immutable, kept alive by `text`
+            return parse_mot_text(view);
+        },
+        py::arg("text"),
+        "The rows (M, 6..10) float64 of a MOTChallenge file's bytes of the common layout (as "
+        "np.loadtxt reads them), or None for any other text.");
     m.def(
         "mot_lines",
         [](const py::array& ids, const py::array& values, const py::array& decimals) {

@@ -199,9 +199,10 @@ def first_bad_box(boxes: ArrayLike, *, edges: bool = True) -> tuple[int, int, st
     # a kernel's message naming no file or line; a user trial)
     with np.errstate(over="ignore"):  # 1e308 + 1e308: far already, named as such
         edge = np.abs(b[:, :2] + b[:, 2:]) > MAX_COORD if edges else np.zeros((len(b), 2), bool)
-    bad = negative.any(axis=1) | far.any(axis=1) | edge.any(axis=1)
-    if not bad.any():
+    # whole-array tests first: the rows' any(axis=1) took 2.4 of the 4 ms for 62 000 good boxes
+    if not (negative.any() or far.any() or edge.any()):
         return None
+    bad = negative.any(axis=1) | far.any(axis=1) | edge.any(axis=1)
     r = int(np.argmax(bad))
     if negative[r].any():
         return r, 2 + int(np.argmax(negative[r])), "negative box width or height"

@@ -557,3 +557,8 @@ def mot_lines(
 # values (n,) float64 -> (n,) int64: the fewest decimals d <= most (0..22) with
 # rint(v 10^d) / 10^d == v and |rint(v 10^d)| < limit (<= 2**53), else -1
 def fewest_decimals(values: NDArray[np.float64], limit: float, most: int) -> NDArray[np.int64]: ...
+
+# a MOT file's bytes -> its rows (M, 6..10) float64, bit for bit as np.loadtxt reads them, when
+# they are of the common layout (numbers only, one separator, the same columns on every line;
+# no row: (0, 10)), else None (mot.py's _read_fast then calls np.loadtxt)
+def parse_mot_text(text: bytes) -> NDArray[np.float64] | None: ...

@@ -411,6 +411,17 @@ def _mot_lines(draw: st.DrawFn) -> Any:
     ))  # fmt: skip
 
 
+def _mot_bytes() -> st.SearchStrategy[bytes]:
+    """Bytes that are mostly MOT text: numbers, separators and line ends, sometimes anything."""
+    line = st.lists(st.sampled_from(["1", "-2.5", "+.5", "3e2", "1e400", "nan", ""]), max_size=11)
+    sep = st.sampled_from([",", " ", ", ", "\t"])
+    end = st.sampled_from(["\n", "\r\n", "\r", ""])
+    text = st.lists(st.tuples(line, sep, end), max_size=5).map(
+        lambda ls: "".join(s.join(f) + e for f, s, e in ls).encode()
+    )
+    return st.one_of(text, st.binary(max_size=40))
+
+
 def _kalman() -> st.SearchStrategy[Any]:
     F = np.array([[1.0, 1.0], [0.0, 1.0]])
     return N.flatmap(lambda k: call(
@@ -673,6 +684,7 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target("mot_lines", _mot_lines()),
+    Target("parse_mot_text", call(_core.parse_mot_text, maybe(_mot_bytes()))),
     Target("rts_gaps_batch", _rts_gaps()),
     Target("rts_smooth", _rts_smooth()),
     Target("BackgroundModel", _background_calls()),

@@ -281,9 +281,41 @@ def _parse_line(text: str, what: str) -> list[float] | str:
 def _read_fast(p: Path) -> NDArray[np.float64] | None:
     """The rows of a well-formed file in one vectorised parse, or None.
 
-    None sends the file to the line-by-line reader, which names the first bad line.
+    None sends the file to the line-by-line reader, which names the first bad line. A UTF-8
+    file of the common layout (numbers only, one separator, the same columns on every line) is
+    parsed by ``_core.parse_mot_text`` in one C++ pass, to the same doubles as
+    :func:`_loadtxt` (``tests/io/test_mot_parse.py``): 8 ms against 95 ms for the 61 981 rows
+    of a 500-track file (``bench/test_io.py``); any other goes to :func:`_loadtxt`. The checks
+    after the parse are the same for both.
     """
-    encoding = _file_encoding(p)
+    data = p.read_bytes()
+    encoding = _encoding(data[:4])
+    a = _core.parse_mot_text(data) if encoding == "utf-8-sig" else None
+    if a is None:
+        a = _loadtxt(p, encoding)
+        if a is None:
+            return None
+    n = a.shape[1]
+    if not 6 <= n <= 10:
+        return None
+    fr = a[:, FRAME]
+    finite = bool(np.all(np.isfinite(a)))  # every column: a NaN score too
+    if not (finite and np.all(fr >= 1) and np.all(fr == np.floor(fr))) or np.any(fr > MAX_FRAME):
+        return None
+    if first_bad_box(a[:, LEFT : HEIGHT + 1]) is not None:
+        return None  # the line reader names the line
+    if n < 10:
+        a = np.hstack([a, np.tile(np.asarray(_DEFAULTS[n:]), (len(a), 1))])
+    return a
+
+
+def _loadtxt(p: Path, encoding: str) -> NDArray[np.float64] | None:
+    """The rows of `p` as ``np.loadtxt`` reads them (M, K), (0, 10) without a row, or None.
+
+    The delimiter is a comma when the first line holding a field has one, else blanks; None for
+    what loadtxt refuses (a comment, an empty field, a ragged line, a word, bytes not of
+    `encoding`).
+    """
     try:
         with p.open("r", encoding=encoding) as fh:
             first = ""
@@ -298,17 +330,6 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
         )
     except (ValueError, UnicodeDecodeError):
         return None
-    n = a.shape[1]
-    if not 6 <= n <= 10:
-        return None
-    fr = a[:, FRAME]
-    finite = bool(np.all(np.isfinite(a)))  # every column: a NaN score too
-    if not (finite and np.all(fr >= 1) and np.all(fr == np.floor(fr))) or np.any(fr > MAX_FRAME):
-        return None
-    if first_bad_box(a[:, LEFT : HEIGHT + 1]) is not None:
-        return None  # the line reader names the line
-    if n < 10:
-        a = np.hstack([a, np.tile(np.asarray(_DEFAULTS[n:]), (len(a), 1))])
     return a
 
 
