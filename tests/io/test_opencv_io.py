@@ -218,3 +218,20 @@ def test_track_under_the_c_locale_reads_a_utf8_name(tmp_path: Path) -> None:
                          check=False)  # fmt: skip
     assert run.returncode == 0, (run.returncode, run.stderr)
     assert (tmp_path / "t.txt").stat().st_size > 0
+
+
+def test_reading_an_image_leaves_no_unclosed_file_at_exit(tmp_path: Path) -> None:
+    # the file stderr is held in during a decode is closed at exit, not left to the garbage
+    # collector (a ResourceWarning under `python -X dev`, pytest and every warnings filter)
+    image = tmp_path / "a.png"
+    write_image(image, np.zeros((4, 4, 3), np.uint8))
+    script = (
+        "import sys; from pftrack.io.opencv_io import read_image; read_image(sys.argv[1], notes=[])"
+    )
+    run = subprocess.run(
+        [sys.executable, "-X", "dev", "-c", script, str(image)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert "ResourceWarning" not in run.stderr, run.stderr

@@ -31,6 +31,7 @@ OpenCV too.
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import os
 import re
@@ -162,12 +163,16 @@ def _holder() -> Any:
     """The temporary file of this process for what stderr gets during a decode, emptied.
 
     One per process, made once (was: a new temporary file for every image read, a frame's
-    worth of system calls); a forked child makes its own, not writing into its parent's.
+    worth of system calls); a forked child makes its own, not writing into its parent's. It is
+    closed at exit (was: left to the garbage collector, a ResourceWarning under ``-X dev``).
     """
     held = _HOLDERS.get(os.getpid())
     if held is None:
-        _HOLDERS.clear()  # a parent's, inherited over fork
+        for inherited in _HOLDERS.values():  # a parent's, over fork: the child's copy closed
+            inherited.close()
+        _HOLDERS.clear()
         held = _HOLDERS[os.getpid()] = tempfile.TemporaryFile()
+        atexit.register(held.close)
     held.seek(0)
     held.truncate()
     return held
