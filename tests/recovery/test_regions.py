@@ -116,7 +116,11 @@ def test_calibration_says_the_regions_it_cut_by() -> None:
     assert cal.region == round(max(spans), SPAN_DECIMALS)
     n_reg = sum(c.n_region for c in cal.buckets)
     assert 0 < n_reg <= sum(c.n_validation for c in cal.buckets)
-    assert f"where a square of side {cal.region:.3g} px crosses them" in cal.describe()
+    said = cal.describe().splitlines()[0]
+    assert f"where a square of side {cal.region:.3g} px crosses them" in said
+    n_val = sum(c.n_validation for c in cal.buckets)
+    assert f"({n_reg} of {n_val} where" in said
+    assert ("the others at random places" in said) == (n_reg < n_val)
     _, off = recover_auto(pairs, tracks, regions=False)
     assert off.region is None and all(c.n_region == 0 for c in off.buckets)
     assert "square" not in off.describe()

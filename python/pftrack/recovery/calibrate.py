@@ -251,9 +251,10 @@ class Calibration:
         if self.region is not None:
             n_reg = sum(c.n_region for c in self.buckets)
             n_val = sum(c.n_validation for c in self.buckets)
+            rest = ", the others at random places" if n_reg < n_val else ""
             where = (
                 f" ({n_reg} of {n_val} where a square of side {self.region:.3g} px crosses "
-                "them, the others at random places)"
+                f"them{rest})"
             )
         lines = [
             f"auto: validation MMAE (px) on artificial gaps cut into observed runs{where}; "
