@@ -58,6 +58,7 @@ __all__ = [
     "LINEAR_MARGIN",
     "MAX_CALIBRATION_GAPS",
     "BAGS",
+    "REGION_SQUARES",
     "WINDOW_POINTS",
     "BucketChoice",
     "Calibration",
@@ -96,6 +97,15 @@ CONTEXT = 3
 MAX_CONTEXT = 10
 #: Random places drawn per artificial gap; the one nearest the real gap's speed is kept.
 MATCH_DRAWS = 16
+#: Square regions placed over the observed runs to cut artificial gaps the way the real ones
+#: were made (:func:`_region_blocks`): a track is lost while it is inside a region, so its
+#: lost points are those that moved in and its end points those that stayed out.
+REGION_SQUARES = 2000
+#: At most this many point tests for the squares (each tests the points of its band of x): on
+#: big files or big squares fewer squares are laid, so the cost stays bounded (about 0.1 s).
+#: The eight test scenes need 0.1-2.3 million, the 500-track file of ``bench.recovery_file``
+#: about 4.7 million (1700 squares of 2000 are laid there).
+REGION_WORK = 4_000_000
 #: Decimals (px) the distances between gap ends are compared at: a translated copy of a file
 #: has the same differences only up to round-off, which reordered exact ties (the real gaps
 #: sorted by distance, the nearest of the drawn places) and changed the choice (up to 0.23 px
@@ -154,6 +164,9 @@ class BucketChoice:
         The choice the rule made (a method or ``"a+b"``) and its validation MMAE, when it did
         worse than ``linear`` on the bucket's validation gaps and ``linear`` was used instead;
         None otherwise.
+    n_region : int
+        Of the `n_validation` artificial gaps, those cut where a square region crosses a run
+        (:attr:`Calibration.region`); the others were cut at random places.
     """
 
     lengths: tuple[int, int]
@@ -164,6 +177,7 @@ class BucketChoice:
     weights: tuple[tuple[str, float], ...] = ()
     combined_mmae: float | None = None
     replaced: tuple[str, float] | None = None
+    n_region: int = 0
 
     @property
     def span(self) -> str:
@@ -190,12 +204,17 @@ class Calibration:
         every resample chose :attr:`pooled` or without bagging.
     bags : int
         Bootstrap resamples the weights were averaged over (0: one choice, no bagging).
+    region : float or None
+        Side (px) of the square regions the artificial gaps were cut by where they could be
+        (:func:`_region_blocks`; the others at random places of the runs), or None when every
+        artificial gap was cut at a random place.
     """
 
     buckets: tuple[BucketChoice, ...]
     pooled: str = "linear"
     pooled_weights: tuple[tuple[str, float], ...] = ()
     bags: int = 0
+    region: float | None = None
 
     def method_for(self, length: int) -> str:
         """The method chosen for a gap of `length` missing frames (:attr:`pooled` if unseen).
@@ -228,9 +247,18 @@ class Calibration:
         if self.pooled_weights:  # the weights a bucket without validation gaps takes
             mix = " + ".join(f"{_weight(w)} {m}" for m, w in self.pooled_weights)
             over = f" ({mix} over {self.bags} bootstrap resamples)"
+        where = ""
+        if self.region is not None:
+            n_reg = sum(c.n_region for c in self.buckets)
+            n_val = sum(c.n_validation for c in self.buckets)
+            rest = ", the others at random places" if n_reg < n_val else ""
+            where = (
+                f" ({n_reg} of {n_val} where a square of side {self.region:.3g} px crosses "
+                f"them{rest})"
+            )
         lines = [
-            "auto: validation MMAE (px) on artificial gaps cut into observed runs; file's "
-            f"choice {self.pooled}{over}",
+            f"auto: validation MMAE (px) on artificial gaps cut into observed runs{where}; "
+            f"file's choice {self.pooled}{over}",
             head,
         ]
         for c in self.buckets:
@@ -418,12 +446,85 @@ def bucket_quotas(real_gaps: dict[int, int], max_gaps: int) -> dict[int, int]:
     return {b: max(MIN_VALIDATION_GAPS, round(max_gaps * n / total)) for b, n in real_gaps.items()}
 
 
+class RegionBlocks(NamedTuple):
+    """Stretches of observed runs inside a square region, with observed points on both sides.
+
+    One entry per (square, stretch): the run (an index into the runs), the stretch's first
+    point in the run and its number of points. A stretch cut by several squares appears once
+    per square, so drawing entries uniformly draws stretches as random squares cut them.
+    """
+
+    run: NDArray[np.int64]
+    start: NDArray[np.int64]
+    length: NDArray[np.int64]
+
+
+def _region_blocks(
+    flat: tuple[NDArray[np.int64], NDArray[np.int64], F64],
+    side: float,
+    rng: np.random.Generator,
+    squares: int = REGION_SQUARES,
+) -> RegionBlocks:
+    """The stretches of the runs that `squares` random squares of `side` px leave unobserved.
+
+    Each square is centred on a random observed point, so the squares fall where the tracks
+    are, and the other tracks pass through them at every offset, grazing their edges too (a
+    centre moved at random along each axis would tie the draws to the axes: swapping x and y
+    would cut other gaps). Inside a square every point is lost, as a mask or an occluder
+    loses them: a stretch of consecutive points inside, with a point outside it before and
+    after in its run, is a gap such a region makes.
+    """
+    sizes, offset, xy = flat
+    n = len(xy)
+    none = np.zeros(0, dtype=np.int64)
+    if n == 0 or not side > 0:
+        return RegionBlocks(none, none, none)
+    run_of = np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
+    pos = np.arange(n, dtype=np.int64) - np.repeat(offset, sizes)
+    first = pos == 0
+    last = pos == np.repeat(sizes, sizes) - 1
+    by_x = np.argsort(xy[:, 0], kind="stable")
+    xs = xy[by_x, 0]
+    half = 0.5 * side
+    centres = xy[rng.integers(n, size=squares)]
+    # distances compared rounded to SPAN_DECIMALS, as the spans are: a translated copy of the
+    # file (the same differences up to round-off) is cut by the same squares
+    reach = half + 10.0**-SPAN_DECIMALS
+    lo = np.searchsorted(xs, centres[:, 0] - reach, side="left")
+    hi = np.searchsorted(xs, centres[:, 0] + reach, side="right")
+    # the work is the points in each square's band of x: squares in turn up to a budget
+    within = np.cumsum(hi - lo) <= REGION_WORK
+    kept = max(1, int(np.argmin(within)) if not within.all() else squares)
+    starts: list[NDArray[np.int64]] = []
+    ends: list[NDArray[np.int64]] = []
+    for k in range(kept):
+        inside = by_x[lo[k] : hi[k]]
+        inside = inside[np.abs(xy[inside, 1] - centres[k, 1]) <= reach]  # the band of y too
+        near = np.round(np.abs(xy[inside] - centres[k]), SPAN_DECIMALS)
+        inside = np.sort(inside[(near <= half).all(axis=1)])
+        if len(inside) == 0:
+            continue
+        # a stretch breaks where the next point inside is not the next point of the same run
+        cut = np.flatnonzero((np.diff(inside) != 1) | first[inside[1:]])
+        s = inside[np.r_[0, cut + 1]]
+        e = inside[np.r_[cut, len(inside) - 1]]
+        ok = ~first[s] & ~last[e]  # observed on both sides (a point before, a point after)
+        starts.append(s[ok])
+        ends.append(e[ok])
+    if not starts:
+        return RegionBlocks(none, none, none)
+    s_all, e_all = np.concatenate(starts), np.concatenate(ends)
+    return RegionBlocks(run_of[s_all], pos[s_all], e_all - s_all + 1)
+
+
 def _artificial_gaps(
     runs: Sequence[F64],
     targets: Sequence[tuple[int, float] | tuple[int, float, int, int]],
     n: int,
     rng: np.random.Generator,
     flat: tuple[NDArray[np.int64], NDArray[np.int64], F64] | None = None,
+    regions: RegionBlocks | None = None,
+    marks: list[bool] | None = None,
 ) -> list[tuple[F64, F64, F64, int]]:
     """Up to `n` artificial gaps ``(segment_a, segment_b, truth, run)`` matched to `targets`.
 
@@ -437,11 +538,20 @@ def _artificial_gaps(
     lengths and speeds. With ``n_a, n_b``, a place needs ``clip(n, CONTEXT, MAX_CONTEXT)``
     observed points on each side and the artificial segments are cut to ``n_a`` and ``n_b``
     points: the candidates see as much of the track as on the real gap.
+
+    With `regions` (:func:`_region_blocks`), an attempt draws its places among the stretches
+    square regions cut that have the target's length and room for its context, when there
+    are any, and at random places of the runs otherwise; when the stretches run out (each is
+    used once) before `n` gaps are cut, the rest are cut at random places. `marks` (if given)
+    gets one flag per gap returned, True for a region's.
     """
     sizes, offset, xy = _flat(runs) if flat is None else flat
     out: list[tuple[F64, F64, F64, int]] = []
     used: set[tuple[int, int, int]] = set()
     places: dict[int, tuple[NDArray[np.int64], NDArray[np.int64], int]] = {}
+    # per (length, context before, context after): the regions' stretches that fit
+    fits: dict[tuple[int, int, int], int] = {}  # the index in `fitting` of each key's
+    fitting: list[tuple[NDArray[np.int64], NDArray[np.int64]]] = []
     order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
     attempt, limit = 0, 4 * n if len(order) else 0
     while attempt < limit and len(out) < n:
@@ -455,6 +565,20 @@ def _artificial_gaps(
             n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
             ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
             ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
+            if regions is not None:
+                key = (L, ctx_a, ctx_b)
+                if key not in fits:
+                    ok = (
+                        (regions.length == L)
+                        & (regions.start >= ctx_a)
+                        & (regions.start + L + ctx_b <= sizes[regions.run])
+                    )
+                    fits[key] = len(fitting)
+                    fitting.append((regions.run[ok], regions.start[ok]))
+                if len(fitting[fits[key]][0]):  # span -1 - k: the stretches of fitting[k]
+                    ks = rng.integers(len(fitting[fits[key]][0]), size=MATCH_DRAWS)
+                    drawn.append((L, dist, n_a, n_b, ctx_a, -1 - fits[key], ks))
+                    continue
             span = L + ctx_a + ctx_b  # the places depend on it only: computed once per span
             if span not in places:
                 slots_of = np.maximum(sizes - span + 1, 0)
@@ -473,6 +597,11 @@ def _artificial_gaps(
         spans = np.array([e[5] for e in drawn])
         for span in set(spans.tolist()):  # each row as its own attempt computed it
             rows = np.flatnonzero(spans == span)
+            if span < 0:  # a region's stretches: the run and start of each drawn entry
+                run_r, start_r = fitting[-1 - span]
+                ks = np.stack([drawn[r][6] for r in rows])
+                idx[rows], starts[rows] = run_r[ks], start_r[ks]
+                continue
             slots, cum, _ = places[span]
             ks = np.stack([drawn[r][6] for r in rows])
             got = np.searchsorted(cum, ks, side="right")
@@ -499,6 +628,18 @@ def _artificial_gaps(
             lo = 0 if n_a < 0 else max(0, st - n_a)
             hi = len(r) if n_b < 0 else st + L + n_b
             out.append((r[lo:st], r[st + L : hi], r[st : st + L], i))
+            if marks is not None:
+                marks.append(int(spans[row]) < 0)
+    if regions is not None and len(out) < n:
+        # the regions' stretches ran out (each is used once): the rest at random places
+        for seg_a, seg_b, lost, k in _artificial_gaps(runs, targets, 4 * (n - len(out)), rng, flat):
+            st = int(np.searchsorted(runs[k][:, 0], lost[0, 0]))
+            if len(out) >= n or (k, st, len(lost)) in used:
+                continue
+            used.add((k, st, len(lost)))
+            out.append((seg_a, seg_b, lost, k))
+            if marks is not None:
+                marks.append(False)
     return out
 
 
@@ -515,6 +656,7 @@ def calibrate(
     contexts: Sequence[tuple[int, int]] | None = None,
     combine: bool = True,
     bags: int | None = None,
+    regions: bool = True,
 ) -> Calibration:
     """Choose a method per gap-length bucket by recovering artificial gaps of observed runs.
 
@@ -550,6 +692,16 @@ def calibrate(
         averaged, which blends the methods different resamples chose. 0: one choice on the
         validation gaps as drawn. None (default): :data:`BAGS` with `combine`, 0 without
         (:func:`bags_for`; more than 0 with ``combine=False`` is refused).
+    regions : bool
+        With `spans`, cut the artificial gaps where possible as the real gaps of a masked or
+        occluded region are made: :data:`REGION_SQUARES` random squares whose side is the
+        longest of `spans` (a region that holds every real gap's end points) are laid over
+        the runs, and a validation gap of a given length is a stretch of that many points
+        inside a square (:func:`_region_blocks`). So its lost points are those that moved
+        into the region and its end points those that stayed out, which a random place does
+        not reproduce. Lengths no square cuts are cut at random places. Default True; False
+        (or no `spans`): random places only (for signals that are not image positions, such
+        as box sizes).
 
     Returns
     -------
@@ -568,6 +720,7 @@ def calibrate(
     """
     lengths = [_check.integer(v, "calibrate: a gap length", 1, MAX_FRAME) for v in gap_lengths]
     combine = _check.flag(combine, "calibrate: combine")
+    regions = _check.flag(regions, "calibrate: regions")
     max_gaps, bags, seed = _settings("calibrate", max_gaps, bags, seed, combine)
     for m in candidates:
         if m not in CANDIDATES:
@@ -624,10 +777,20 @@ def calibrate(
     flat = _flat(runs)
     hood = Neighbourhood(runs) if any(m.endswith(NB_SUFFIX) for m in scored) else None
     cuts: dict[int, list[tuple[F64, F64, F64, int]]] = {}
+    # the square regions' side: the longest distance between a real gap's two end points
+    side = round(max(dists), SPAN_DECIMALS) if regions and spans is not None and dists else None
+    blocks = (
+        _region_blocks(flat, side, np.random.default_rng([seed, 0x5E6]))
+        if side is not None and side > 0
+        else None
+    )
+    n_region: dict[int, int] = {}
     for b in sorted(by_bucket):
         rng = np.random.default_rng([seed, b])
-        cut = _artificial_gaps(runs, targets[b], quota[b], rng, flat)
+        marks: list[bool] = []
+        cut = _artificial_gaps(runs, targets[b], quota[b], rng, flat, blocks, marks)
         n_cut[b] = len(cut)
+        n_region[b] = sum(marks)
         if len(cut) >= MIN_VALIDATION_GAPS:
             cuts[b] = cut
     # Every candidate recovers the validation gaps of every bucket in one call (one C++ call,
@@ -686,12 +849,30 @@ def calibrate(
         span = _bucket_range(b)
         if len(mix) == 1:
             choices.append(
-                BucketChoice(span, mix[0][0], len(by_bucket[b]), n_cut[b], mmae, replaced=replaced)
+                BucketChoice(
+                    span,
+                    mix[0][0],
+                    len(by_bucket[b]),
+                    n_cut[b],
+                    mmae,
+                    replaced=replaced,
+                    n_region=n_region[b],
+                )
             )
             continue
         name = "+".join(m for m, _ in mix)
-        choices.append(BucketChoice(span, name, len(by_bucket[b]), n_cut[b], mmae, mix, mixed))
-    return Calibration(tuple(choices), pooled, pooled_mix if len(pooled_mix) > 1 else (), bags)
+        choices.append(
+            BucketChoice(
+                span, name, len(by_bucket[b]), n_cut[b], mmae, mix, mixed, n_region=n_region[b]
+            )
+        )
+    return Calibration(
+        tuple(choices),
+        pooled,
+        pooled_mix if len(pooled_mix) > 1 else (),
+        bags,
+        None if blocks is None or side is None else side,
+    )
 
 
 class _Blends:
@@ -1047,6 +1228,7 @@ def recover_auto(
     combine: bool = True,
     bags: int | None = None,
     contexts: Sequence[tuple[int, int]] | None = None,
+    regions: bool = True,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -1077,6 +1259,10 @@ def recover_auto(
         points next to the gaps that the candidates read (:func:`gap_windows`; the artificial
         gaps keep as many, :func:`calibrate`); default: the segments' lengths. With it, pass
         `observed`: the calibration runs on the whole tracks, not on the windows.
+    regions : bool
+        Cut the artificial gaps by square regions where possible (:func:`calibrate`;
+        default). False for signals that are not image positions (``fill_gaps`` passes it for
+        box sizes).
 
     Returns
     -------
@@ -1140,6 +1326,7 @@ def recover_auto(
         max_gaps=max_gaps,
         combine=combine,
         bags=bags,
+        regions=regions,
     )
     mixes = [cal.weights_for(L) if L > 0 else (("linear", 1.0),) for L in lengths]
     groups: dict[str, list[int]] = {}  # each method once, over every gap that uses it

@@ -348,6 +348,7 @@ def fill_rows(
                 combine=combine,
                 bags=bags,
                 contexts=contexts,
+                regions=False,  # sizes are not image positions: no region cuts them
             )
         else:
             observed = whole if method in NEIGHBOUR_METHODS else None
