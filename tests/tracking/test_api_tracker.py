@@ -1547,6 +1547,21 @@ def test_track_frames_names_a_source_it_cannot_read(source, kind):
     )
 
 
+@pytest.mark.parametrize("shape", [(60, 80, 3), (60, 80)])
+@pytest.mark.parametrize("dets", [None, {1: np.array([[10.0, 10.0, 20.0, 40.0, 0.9]])}])
+def test_track_frames_of_one_frame_says_to_put_it_in_a_list(shape, dets):
+    # was: its rows taken for frames, "prime frame must have shape (H, W, 3) (BGR), got
+    # (80, 3): a grey frame? cv2.cvtColor(...)", which names neither the frame nor the cure
+    from pftrack.tracking import track_frames
+
+    with pytest.raises(TypeError) as e:
+        track_frames(np.zeros(shape, np.uint8), detections=dets, show_progress=False)
+    assert str(e.value).startswith(
+        f"track_frames: source is one {shape} frame, expected a sequence of frames: "
+        "track_frames([frame])"
+    )
+
+
 def _blank_messages(record: list[warnings.WarningMessage]) -> list[str]:
     return [str(w.message) for w in record if "is blank" in str(w.message)]
 
