@@ -583,6 +583,24 @@ def test_options_and_frames():
     assert pftrack.Tracker(frame_rate=50.0, max_coast=0.4).config.lifecycle.max_coast == 20
 
 
+def test_a_frame_rate_as_a_fraction_is_a_number():
+    # PyAV gives a stream's rate as a Fraction (stream.average_rate): it was refused, "frame_rate
+    # must be a number, got Fraction Fraction(30000, 1001)"
+    from fractions import Fraction
+
+    ntsc = Fraction(30000, 1001)
+    tracker = pftrack.Tracker(frame_rate=ntsc, max_coast=Fraction(1, 2), prime=1.0)
+    assert tracker.frame_rate == float(ntsc)
+    assert tracker.config.lifecycle.max_coast == 15 and tracker.prime_frames == 30
+    with pytest.raises(ValueError, match=r"^frame_rate is 2000, expected a number in \(0, 1000"):
+        pftrack.Tracker(frame_rate=Fraction(2000))
+    with pytest.raises(ValueError, match=r"^max_coast 0.5: the joint sampler"):
+        pftrack.Tracker(frame_rate=ntsc, sampler="rjmcmc", max_coast=Fraction(1, 2))
+    for wrong in ("25", True, None, 25j):  # still not numbers
+        with pytest.raises(TypeError, match="^frame_rate must be a number"):
+            pftrack.Tracker(frame_rate=wrong)  # type: ignore[arg-type]
+
+
 def test_no_refine_takes_the_boxes_as_given(scene, tmp_path):
     from pftrack.cli import build_parser
     from pftrack.cli._options import tracker_config
