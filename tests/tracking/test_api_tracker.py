@@ -545,6 +545,25 @@ def test_bad_detections_are_one_line_errors(dets, error, match):
         pftrack.Tracker().update(dets, np.zeros((30, 40, 3), np.uint8))
 
 
+@pytest.mark.parametrize(
+    "dets",
+    [np.array([[10.0, 10, 50, 80, 0.9, 0]]), np.zeros((0, 6), np.float32), [], None],
+)
+def test_an_image_given_as_dets_says_the_arguments_are_swapped(dets):
+    # update(frame, dets), MultiObjectTracker.update's order: was "frame dtype is float64,
+    # expected uint8" about the user's uint8 frame (or "frame is list", "frame is NoneType")
+    frame = np.zeros((30, 40, 3), np.uint8)
+    tracker = pftrack.Tracker()
+    with pytest.raises(TypeError) as e:
+        tracker.update(frame, dets)
+    assert str(e.value) == (
+        "Tracker.update(dets, frame): dets is a (30, 40, 3) uint8 array, an image; were the "
+        "arguments swapped? (MultiObjectTracker.update takes (frame, detections))"
+    )
+    assert tracker.frame_count == 0
+    tracker.update([], frame)  # the run goes on
+
+
 def test_options_and_frames():
     with pytest.raises(ValueError, match="frame_rate"):
         pftrack.Tracker(frame_rate=0)

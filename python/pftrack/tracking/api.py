@@ -927,6 +927,9 @@ class Tracker:
 
         Raises
         ------
+        TypeError
+            `dets` is a uint8 image (``update(frame, dets)``: the message says the arguments
+            look swapped); see `frame` and `dets` for the others.
         RuntimeError
             An earlier ``update`` of the run was cut short (KeyboardInterrupt, or an error
             inside the tracker) after it had changed the tracker: the run cannot go on, but
@@ -939,6 +942,14 @@ class Tracker:
                     "(KeyboardInterrupt, or an error inside the tracker) after it had changed "
                     "the tracker, which no longer holds a whole frame; finalize() still returns "
                     f"the rows of frames 1-{self._torn - 1}, reset() starts a new run"
+                )
+            if isinstance(dets, np.ndarray) and dets.ndim == 3 and dets.dtype == np.uint8:
+                # update(frame, dets), the lower-level API's order: the frame's check would
+                # say the user's uint8 frame was float64 (the detections' dtype)
+                raise TypeError(
+                    f"Tracker.update(dets, frame): dets is a {dets.shape} uint8 array, an image; "
+                    "were the arguments swapped? (MultiObjectTracker.update takes (frame, "
+                    "detections))"
                 )
             f = bgr_frame(frame)
             shape = self._shape  # None until the run's first frame is taken
