@@ -929,7 +929,9 @@ class Tracker:
         ------
         TypeError
             `dets` is a uint8 image (``update(frame, dets)``: the message says the arguments
-            look swapped); see `frame` and `dets` for the others.
+            look swapped), or supervision's ``Detections`` (the message names
+            :class:`~pftrack.integrations.supervision.SupervisionTracker`); see `frame` and
+            `dets` for the others.
         RuntimeError
             An earlier ``update`` of the run was cut short (KeyboardInterrupt, or an error
             inside the tracker) after it had changed the tracker: the run cannot go on, but
@@ -950,6 +952,14 @@ class Tracker:
                     f"Tracker.update(dets, frame): dets is a {dets.shape} uint8 array, an image; "
                     "were the arguments swapped? (MultiObjectTracker.update takes (frame, "
                     "detections))"
+                )
+            kind = type(dets)
+            if kind.__name__ == "Detections" and kind.__module__.startswith("supervision"):
+                # its fields iterated as rows (or, empty, taken for no detection)
+                raise TypeError(
+                    f"{self._box_source} is a supervision Detections: use pftrack.integrations."
+                    "supervision.SupervisionTracker's update_with_detections(detections, frame), "
+                    "or give np.column_stack([d.xyxy, d.confidence, d.class_id])"
                 )
             f = bgr_frame(frame)
             shape = self._shape  # None until the run's first frame is taken
