@@ -153,6 +153,23 @@ CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
         r"RJMCMCFilter: rng must be a numpy.random.Generator \(or RandomState\), an int >= 0 or "
         "None, got int -1",
     ),
+    # an int beyond a float's range: was NumPy's "ufunc 'isfinite' not supported for the input
+    # types" (or "int too large to convert to float"), naming nothing
+    "Tracker(frame_rate=10**400)": (
+        lambda: pftrack.Tracker(frame_rate=10**400),
+        ValueError,
+        r"^frame_rate is an int beyond a float's range \(±1.8e\+308\)$",
+    ),
+    "Tracker(max_coast=-10**400)": (
+        lambda: pftrack.Tracker(max_coast=-(10**400)),
+        ValueError,
+        r"^max_coast is an int beyond a float's range",
+    ),
+    "FilterConfig(lam=10**400)": (
+        lambda: FilterConfig(lam=10**400),
+        ValueError,
+        r"^FilterConfig: lam is an int beyond a float's range",
+    ),
 }
 
 

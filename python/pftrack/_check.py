@@ -339,15 +339,20 @@ def number(value: object, what: str, *, finite: bool = True) -> float:
     TypeError
         Not an int or float (NumPy's too).
     ValueError
-        NaN or infinite (with `finite`).
+        NaN or infinite (with `finite`); an int beyond a float's range (``10**400``: was
+        NumPy's "ufunc 'isfinite' not supported", naming nothing).
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(
         value, (int, float, np.integer, np.floating)
     ):
         raise TypeError(f"{what} must be a number, got {type(value).__name__} {value!r}")
-    if finite and not np.isfinite(value):
+    try:
+        v = float(value)
+    except OverflowError:
+        raise ValueError(f"{what} is an int beyond a float's range (±1.8e+308)") from None
+    if finite and not np.isfinite(v):
         raise ValueError(f"{what} is {value}, expected a finite number")
-    return float(value)
+    return v
 
 
 def integer(value: object, what: str, lo: int, hi: int) -> int:

@@ -97,6 +97,23 @@ def test_empty_and_bad_input(scene):
         SupervisionTracker(bogus=1)  # type: ignore[call-arg]
 
 
+@pytest.mark.parametrize("empty", [False, True])
+def test_detections_given_to_the_plain_tracker_name_the_adapter(scene, empty):
+    # a user trial: Tracker.update(sv.Detections, frame) said "dets must be a rectangular array
+    # of numbers, got rows of different lengths", and empty Detections were taken silently as
+    # a frame without detections
+    dets = frame_detections(scene, 1)
+    tracker = pftrack.Tracker()
+    with pytest.raises(TypeError) as e:
+        tracker.update(sv.Detections.empty() if empty else dets, scene.frames[0])
+    assert str(e.value) == (
+        "dets is a supervision Detections: use pftrack.integrations.supervision."
+        "SupervisionTracker's update_with_detections(detections, frame), or give "
+        "np.column_stack([d.xyxy, d.confidence, d.class_id])"
+    )
+    assert tracker.frame_count == 0
+
+
 def test_boxes_without_area_and_inverted_boxes(scene):
     # a frame whose only box had no area raised "the boxes look like x, y, w, h": supervision's
     # boxes are always x1, y1, x2, y2, and a box without area is dropped (one warning)

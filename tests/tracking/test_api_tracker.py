@@ -545,6 +545,25 @@ def test_bad_detections_are_one_line_errors(dets, error, match):
         pftrack.Tracker().update(dets, np.zeros((30, 40, 3), np.uint8))
 
 
+@pytest.mark.parametrize(
+    "dets",
+    [np.array([[10.0, 10, 50, 80, 0.9, 0]]), np.zeros((0, 6), np.float32), [], None],
+)
+def test_an_image_given_as_dets_says_the_arguments_are_swapped(dets):
+    # update(frame, dets), MultiObjectTracker.update's order: was "frame dtype is float64,
+    # expected uint8" about the user's uint8 frame (or "frame is list", "frame is NoneType")
+    frame = np.zeros((30, 40, 3), np.uint8)
+    tracker = pftrack.Tracker()
+    with pytest.raises(TypeError) as e:
+        tracker.update(frame, dets)
+    assert str(e.value) == (
+        "Tracker.update(dets, frame): dets is a (30, 40, 3) uint8 array, an image; were the "
+        "arguments swapped? (MultiObjectTracker.update takes (frame, detections))"
+    )
+    assert tracker.frame_count == 0
+    tracker.update([], frame)  # the run goes on
+
+
 def test_options_and_frames():
     with pytest.raises(ValueError, match="frame_rate"):
         pftrack.Tracker(frame_rate=0)
@@ -581,6 +600,24 @@ def test_options_and_frames():
     slow = pftrack.Tracker(frame_rate=7.0, max_coast=0.4, prime=1.2)
     assert slow.config.lifecycle.max_coast == 3 and slow.prime_frames == 8
     assert pftrack.Tracker(frame_rate=50.0, max_coast=0.4).config.lifecycle.max_coast == 20
+
+
+def test_a_frame_rate_as_a_fraction_is_a_number():
+    # PyAV gives a stream's rate as a Fraction (stream.average_rate): it was refused, "frame_rate
+    # must be a number, got Fraction Fraction(30000, 1001)"
+    from fractions import Fraction
+
+    ntsc = Fraction(30000, 1001)
+    tracker = pftrack.Tracker(frame_rate=ntsc, max_coast=Fraction(1, 2), prime=1.0)
+    assert tracker.frame_rate == float(ntsc)
+    assert tracker.config.lifecycle.max_coast == 15 and tracker.prime_frames == 30
+    with pytest.raises(ValueError, match=r"^frame_rate is 2000, expected a number in \(0, 1000"):
+        pftrack.Tracker(frame_rate=Fraction(2000))
+    with pytest.raises(ValueError, match=r"^max_coast 0.5: the joint sampler"):
+        pftrack.Tracker(frame_rate=ntsc, sampler="rjmcmc", max_coast=Fraction(1, 2))
+    for wrong in ("25", True, None, 25j):  # still not numbers
+        with pytest.raises(TypeError, match="^frame_rate must be a number"):
+            pftrack.Tracker(frame_rate=wrong)  # type: ignore[arg-type]
 
 
 def test_no_refine_takes_the_boxes_as_given(scene, tmp_path):
@@ -1544,6 +1581,21 @@ def test_track_frames_names_a_source_it_cannot_read(source, kind):
         track_frames(source, show_progress=False)  # type: ignore[arg-type]
     assert str(e.value).startswith(
         f"track_frames: source is {kind}, expected a path, a FrameSource or a sequence of frames"
+    )
+
+
+@pytest.mark.parametrize("shape", [(60, 80, 3), (60, 80)])
+@pytest.mark.parametrize("dets", [None, {1: np.array([[10.0, 10.0, 20.0, 40.0, 0.9]])}])
+def test_track_frames_of_one_frame_says_to_put_it_in_a_list(shape, dets):
+    # was: its rows taken for frames, "prime frame must have shape (H, W, 3) (BGR), got
+    # (80, 3): a grey frame? cv2.cvtColor(...)", which names neither the frame nor the cure
+    from pftrack.tracking import track_frames
+
+    with pytest.raises(TypeError) as e:
+        track_frames(np.zeros(shape, np.uint8), detections=dets, show_progress=False)
+    assert str(e.value).startswith(
+        f"track_frames: source is one {shape} frame, expected a sequence of frames: "
+        "track_frames([frame])"
     )
 
 

@@ -224,6 +224,21 @@ def test_a_packed_frame_is_not_copied(frames):
     assert bgr_frame(frames[0]) is frames[0]
 
 
+def test_multi_object_tracker_says_when_the_arguments_look_swapped(frames):
+    # update(dets, frame), BoxMOT's and Tracker.update's order: was "frame dtype is float64,
+    # expected uint8" about the user's uint8 frame
+    tracker = MultiObjectTracker(rng=0)
+    with pytest.raises(TypeError) as e:
+        tracker.update(np.array([[10.0, 10, 20, 40, 0.9]]), frames[0])  # type: ignore[arg-type]
+    assert str(e.value) == (
+        "MultiObjectTracker.update(frame, detections): detections is a (360, 480, 3) uint8 "
+        "array, an image; were the arguments swapped? (Tracker.update takes (dets, frame), "
+        "BoxMOT's order)"
+    )
+    assert tracker.frame_index == 0
+    tracker.update(frames[0], np.array([[10.0, 10, 20, 40, 0.9]]))  # the run goes on
+
+
 def test_a_new_size_mid_run_names_the_sizes(frames):
     tracker = MultiObjectTracker(rng=0)
     tracker.update(frames[0])

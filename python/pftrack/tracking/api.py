@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import numbers
 import operator
 import pickle
 import threading
@@ -89,6 +90,19 @@ def _unpickle_tracker(cls: type[Tracker], data: bytes) -> Tracker:
     return tracker
 
 
+def _real(value: Any) -> Any:
+    """`value` as a float if it is a real number of another type, else as given.
+
+    A :class:`fractions.Fraction` (PyAV's ``stream.average_rate``, ``Fraction(30000, 1001)``)
+    was refused as not a number (:func:`pftrack._check.number` takes ints and floats).
+    """
+    if isinstance(value, numbers.Real) and not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
+        return float(value)
+    return value
+
+
 def _frames(seconds: float, frame_rate: float, name: str) -> int:
     """`seconds` as a whole number of frames at `frame_rate` (TypeError: not a number)."""
     if not (np.isfinite(number(seconds, name, finite=False)) and seconds >= 0):
@@ -102,12 +116,14 @@ def _frames(seconds: float, frame_rate: float, name: str) -> int:
     return int(round(n))
 
 
-def _check_rate(frame_rate: object) -> None:
-    """TypeError or ValueError unless `frame_rate` is a number in ``(0, MAX_FRAME_RATE]``."""
-    if not 0 < number(frame_rate, "frame_rate") <= MAX_FRAME_RATE:
+def _check_rate(frame_rate: object) -> float:
+    """`frame_rate` as a float: TypeError or ValueError unless in ``(0, MAX_FRAME_RATE]``."""
+    rate = number(_real(frame_rate), "frame_rate")
+    if not 0 < rate <= MAX_FRAME_RATE:
         raise ValueError(
             f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
         )
+    return rate
 
 
 def xywh_to_xyxy_dets(dets: ArrayLike) -> F64:
@@ -305,7 +321,8 @@ class Tracker:
     ----------
     frame_rate : float
         Frames per second of the input: turns the time constants given below (`max_coast`,
-        `prime`) into frames. The defaults are the command's frame counts at any rate.
+        `prime`) into frames. The defaults are the command's frame counts at any rate. Any
+        real number: a :class:`~fractions.Fraction` too (PyAV's ``stream.average_rate``).
     seed : int or None
         Seed: the same seed, frames and detections give the same tracks (None: fresh entropy).
     detector : {"paper", "mog2", "knn"}
@@ -449,7 +466,8 @@ class Tracker:
     ) -> None:
         if seed is not None:
             seed = check_seed(seed, "seed")
-        _check_rate(frame_rate)
+        frame_rate = _check_rate(frame_rate)
+        max_coast, prime = _real(max_coast), _real(prime)  # a Fraction too, as frame_rate
         refine, smooth, link, crossings, record = (
             flag(refine, "refine"), flag(smooth, "smooth"), flag(link, "link"),
             flag(crossings, "crossings"), flag(record, "record"),
@@ -574,9 +592,9 @@ class Tracker:
             or prime_frames < 0
         ):
             raise ValueError(f"prime_frames is {prime_frames!r}, expected an integer >= 0")
-        _check_rate(frame_rate)
+        rate = _check_rate(frame_rate)
         self.config = config
-        self.frame_rate = float(frame_rate)
+        self.frame_rate = rate
         self.seed = seed
         self.prime_frames = int(prime_frames)
         self.record = record
@@ -909,6 +927,11 @@ class Tracker:
 
         Raises
         ------
+        TypeError
+            `dets` is a uint8 image (``update(frame, dets)``: the message says the arguments
+            look swapped), or supervision's ``Detections`` (the message names
+            :class:`~pftrack.integrations.supervision.SupervisionTracker`); see `frame` and
+            `dets` for the others.
         RuntimeError
             An earlier ``update`` of the run was cut short (KeyboardInterrupt, or an error
             inside the tracker) after it had changed the tracker: the run cannot go on, but
@@ -921,6 +944,22 @@ class Tracker:
                     "(KeyboardInterrupt, or an error inside the tracker) after it had changed "
                     "the tracker, which no longer holds a whole frame; finalize() still returns "
                     f"the rows of frames 1-{self._torn - 1}, reset() starts a new run"
+                )
+            if isinstance(dets, np.ndarray) and dets.ndim == 3 and dets.dtype == np.uint8:
+                # update(frame, dets), the lower-level API's order: the frame's check would
+                # say the user's uint8 frame was float64 (the detections' dtype)
+                raise TypeError(
+                    f"Tracker.update(dets, frame): dets is a {dets.shape} uint8 array, an image; "
+                    "were the arguments swapped? (MultiObjectTracker.update takes (frame, "
+                    "detections))"
+                )
+            kind = type(dets)
+            if kind.__name__ == "Detections" and kind.__module__.startswith("supervision"):
+                # its fields iterated as rows (or, empty, taken for no detection)
+                raise TypeError(
+                    f"{self._box_source} is a supervision Detections: use pftrack.integrations."
+                    "supervision.SupervisionTracker's update_with_detections(detections, frame), "
+                    "or give np.column_stack([d.xyxy, d.confidence, d.class_id])"
                 )
             f = bgr_frame(frame)
             shape = self._shape  # None until the run's first frame is taken

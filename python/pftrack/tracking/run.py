@@ -190,9 +190,10 @@ def track_frames(
     Raises
     ------
     TypeError
-        `source` is not a path, a FrameSource or a sequence of frames (an iterator, an int);
-        `detections` is not a dict (a path, a list), a key is not an int, or a value does not
-        hold real numbers; `rng` is not a Generator, an int or None (a float, a bool).
+        `source` is not a path, a FrameSource or a sequence of frames (an iterator, an int,
+        one frame alone: ``track_frames([frame])``); `detections` is not a dict (a path, a
+        list), a key is not an int, or a value does not hold real numbers; `rng` is not a
+        Generator, an int or None (a float, a bool).
     ValueError
         A negative `rng`. A key below 1 (frames are 1-based: 0-based keys would put every box
         one frame late), a value not of shape (k, 5) or (k, 4), NaN, inf, a negative width or
@@ -304,8 +305,17 @@ def _check_frames(frames: object) -> None:
     """Refuse a `source` that is neither a FrameSource nor a sequence of frames, naming it.
 
     Were Python's words: "object of type 'generator' has no len()", "'int' object is not
-    iterable", and for bytes "prime frame is int".
+    iterable", and for bytes "prime frame is int". One frame alone (an (H, W, 3) or (H, W)
+    array) is refused as :meth:`Tracker.prime` refuses it (its rows were taken for frames,
+    and the message said they looked like grey frames).
     """
+    if isinstance(frames, np.ndarray) and (
+        frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
+    ):
+        raise TypeError(
+            f"track_frames: source is one {frames.shape} frame, expected a sequence of frames: "
+            "track_frames([frame])"
+        )
     if isinstance(frames, FrameSource) or (
         hasattr(frames, "__len__")
         and hasattr(frames, "__getitem__")

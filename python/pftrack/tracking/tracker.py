@@ -442,7 +442,23 @@ class MultiObjectTracker:
         list of Track
             The tracks reported for this frame (confirmed, and coasting ones the colour filter
             still holds), with the index of the detection each was matched to.
+
+        Raises
+        ------
+        TypeError
+            `detections` is a uint8 image (``update(dets, frame)``, :class:`Tracker`'s order:
+            the message says the arguments look swapped), or `frame` is not a uint8 array.
         """
+        if (
+            isinstance(detections, np.ndarray)
+            and detections.ndim == 3
+            and detections.dtype == np.uint8
+        ):  # the frame's check would say the user's uint8 frame was float64
+            raise TypeError(
+                f"MultiObjectTracker.update(frame, detections): detections is a "
+                f"{detections.shape} uint8 array, an image; were the arguments swapped? "
+                "(Tracker.update takes (dets, frame), BoxMOT's order)"
+            )
         f = bgr_frame(frame)
         cfg = self._effective
         if cfg is not None and f.shape != self._frame_shape:
