@@ -102,7 +102,9 @@ MATCH_DRAWS = 16
 #: lost points are those that moved in and its end points those that stayed out.
 REGION_SQUARES = 2000
 #: At most this many point tests for the squares (each tests the points of its band of x): on
-#: big files or big squares fewer squares are laid, so the cost stays bounded (about 0.1 s).
+#: big files or big squares fewer squares are laid, so the cost stays bounded (about 0.1 s in
+#: the NumPy loop it was set for; the C++ kernel, which finds the points of a band in a grid,
+#: takes about 10 ms there).
 #: The eight test scenes need 0.1-2.3 million, the 500-track file of ``bench.recovery_file``
 #: about 4.7 million (1700 squares of 2000 are laid there).
 REGION_WORK = 4_000_000
