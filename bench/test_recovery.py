@@ -26,6 +26,11 @@
   per track, what the offline pass and ``pftrack smooth`` run for every track's box) against
   the NumPy loop it replaced (``rts_smooth_numpy``), over the 500 tracks of
   :mod:`bench.recovery_file` (four axes: centre and size).
+* ``region blocks, 500 tracks``: the square regions ``auto`` cuts its validation gaps with
+  (:func:`~pftrack.recovery.calibrate._region_blocks`, one C++ call ``_core.region_blocks``)
+  against the NumPy loop over the squares it replaced (``tests/reference/regions.py``), on the
+  box centres' runs of the 500-track file, squares of 57 px as ``recover`` lays there (1700 of
+  2000 within ``REGION_WORK``) and of 5 px; the same stretches.
 
 Locally: ``pytest bench/test_recovery.py --benchmark-only``; CI: ``--benchmark-disable``.
 """
@@ -43,7 +48,7 @@ from pftrack._typing import F64
 from pftrack.kalman import cv_transition, rts_smooth, wna_Q
 from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
 from pftrack.recovery.baselines import rts_batch
-from pftrack.recovery.calibrate import _fit_sample
+from pftrack.recovery.calibrate import _fit_sample, _flat, _region_blocks
 from pftrack.recovery.mixture import (
     DIFFUSE,
     fit_motion,
@@ -55,6 +60,7 @@ from pftrack.recovery.segments import distinct_runs
 from tests.reference import bridge as ref_bridge
 from tests.reference import mixture as ref_mix
 from tests.reference.linking import dense_link_tracklets
+from tests.reference.regions import region_blocks as region_blocks_numpy
 from tests.reference.smoothing import dense_kalman_rts, rts_batch_numpy, rts_smooth_numpy
 
 
@@ -160,6 +166,32 @@ def fit_runs(tracks_500: F64) -> list[F64]:
     ids = tracks_500[:, 1]
     runs = distinct_runs([centres[ids == i] for i in np.unique(ids)])
     return _fit_sample([r for r in runs if len(r) >= 4], 0)
+
+
+@pytest.fixture(scope="module")
+def centre_runs(tracks_500: F64) -> list[F64]:
+    """The box centres' runs of the 500-track file, every one (what ``auto`` lays squares on)."""
+    centres = tracks_500[:, [0, 2, 3]].copy()
+    centres[:, 1:] += 0.5 * tracks_500[:, 4:6]
+    ids = tracks_500[:, 1]
+    return distinct_runs([centres[ids == i] for i in np.unique(ids)])
+
+
+@pytest.mark.parametrize("impl", ["core", "numpy"])
+@pytest.mark.parametrize("side", [57.0, 5.0])
+def test_region_blocks(
+    benchmark: BenchmarkFixture, centre_runs: list[F64], side: float, impl: str
+) -> None:
+    benchmark.group = f"region blocks, 500 tracks, side {side:g} px"
+    flat = _flat(centre_runs)
+    fn = _region_blocks if impl == "core" else region_blocks_numpy
+    got = benchmark(lambda: fn(flat, side, np.random.default_rng(0)))
+    want = (region_blocks_numpy if impl == "core" else _region_blocks)(
+        flat, side, np.random.default_rng(0)
+    )
+    assert len(want.run) > 0
+    for g, w in zip(got, want, strict=True):
+        np.testing.assert_array_equal(g, w)
 
 
 _GRID_Q, _GRID_R = (

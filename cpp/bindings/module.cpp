@@ -16,6 +16,7 @@ void register_smoothing(py::module_& m);
 void register_refine(py::module_& m);
 void register_blobs(py::module_& m);
 void register_text(py::module_& m);
+void register_regions(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -31,4 +32,5 @@ PYBIND11_MODULE(_core, m) {
     register_refine(m);
     register_blobs(m);
     register_text(m);
+    register_regions(m);
 }

@@ -562,3 +562,18 @@ def fewest_decimals(values: NDArray[np.float64], limit: float, most: int) -> NDA
 # they are of the common layout (numbers only, one separator, the same columns on every line;
 # no row: (0, 10)), else None (mot.py's _read_fast then calls np.loadtxt)
 def parse_mot_text(text: bytes) -> NDArray[np.float64] | None: ...
+
+# --- square regions (recovery.calibrate._region_blocks) -------------------------------------
+# xy (n, 2) float64 finite, points of runs of sizes (runs,) int64 (sum n); centres (squares, 2)
+# float64 finite; side finite > 0; work >= 0; decimals 0..22 -> (run, start, length) int64 of
+# the stretches inside each square (distances rounded to decimals as np.round rounds them) with
+# a point of the run before and after, square by square while the points in their bands of x
+# stay within work (the first square always)
+def region_blocks(
+    xy: NDArray[np.float64],
+    sizes: NDArray[np.int64],
+    centres: NDArray[np.float64],
+    side: float,
+    work: int,
+    decimals: int,
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]: ...

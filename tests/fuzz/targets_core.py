@@ -411,6 +411,18 @@ def _mot_lines(draw: st.DrawFn) -> Any:
     ))  # fmt: skip
 
 
+@st.composite
+def _region_blocks(draw: st.DrawFn) -> Any:
+    sizes = draw(st.lists(st.integers(0, 6), max_size=6))
+    n = sum(sizes)
+    return draw(call(
+        _core.region_blocks, maybe(floats_array((n, 2), -20, 20)),
+        maybe(st.just(np.array(sizes, dtype=np.int64))),
+        maybe(N.flatmap(lambda k: floats_array((k, 2), -20, 20))), maybe(fl(0, 50)),
+        maybe(ints(0, 100)), maybe(st.integers(0, 22)),
+    ))  # fmt: skip
+
+
 def _mot_bytes() -> st.SearchStrategy[bytes]:
     """Bytes that are mostly MOT text: numbers, separators and line ends, sometimes anything."""
     line = st.lists(st.sampled_from(["1", "-2.5", "+.5", "3e2", "1e400", "nan", ""]), max_size=11)
@@ -685,6 +697,7 @@ TARGETS: list[Target] = [
     ),  # fmt: skip
     Target("mot_lines", _mot_lines()),
     Target("parse_mot_text", call(_core.parse_mot_text, maybe(_mot_bytes()))),
+    Target("region_blocks", _region_blocks()),
     Target("rts_gaps_batch", _rts_gaps()),
     Target("rts_smooth", _rts_smooth()),
     Target("BackgroundModel", _background_calls()),

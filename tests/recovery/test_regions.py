@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from unittest import mock
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+import pftrack.recovery.calibrate as cal
 from pftrack.recovery import fill_gaps
 from pftrack.recovery.calibrate import (
     SPAN_DECIMALS,
@@ -15,6 +20,7 @@ from pftrack.recovery.calibrate import (
     calibrate,
     recover_auto,
 )
+from tests.reference.regions import region_blocks as reference_blocks
 
 from .test_auto import _cut, _manoeuvring_tracks, _mot_rows
 
@@ -150,3 +156,71 @@ def test_a_translated_file_is_cut_by_the_same_squares() -> None:
     assert len(a.run) > 0
     for x, y in zip(a, b, strict=True):
         np.testing.assert_array_equal(x, y)
+
+
+@st.composite
+def _region_inputs(draw: st.DrawFn) -> tuple[list[np.ndarray], float, int, int, int]:
+    """Runs (one-point runs and no run included), a side, squares, a work budget and a seed.
+
+    Points on a grid of half the side (on the squares' edges), sometimes translated (distances
+    equal to half a side up to round-off), or anywhere (up to 1.7e308: differences overflow);
+    sides from subnormal to 1e12 px; budgets that cut the squares short (0: the first square
+    alone) or not."""
+    sizes = draw(st.lists(st.integers(1, 30), min_size=0, max_size=12))
+    side = draw(st.sampled_from([5e-324, 1e-9, 1e-6, 0.5, 2.0, 3.0, 4.0, 7.25, 40.0, 1e12]))
+    grid = draw(st.sampled_from(["grid", "translated", "uniform", "huge", "vast"]))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    total = sum(sizes)
+    if grid == "uniform":
+        xy = rng.uniform(-50.0, 50.0, (total, 2))
+    elif grid == "huge":
+        xy = rng.uniform(-1e9, 1e9, (total, 2))
+    elif grid == "vast":  # differences that overflow to inf
+        xy = rng.uniform(-1.0, 1.0, (total, 2)) * 1.7e308
+    else:
+        step = 0.5 * side if side >= 1e-6 else 1.0
+        xy = rng.integers(-8, 9, (total, 2)) * step
+        if grid == "translated":
+            xy = xy + [0.1, 0.2]
+    runs = []
+    for k, n in enumerate(sizes):
+        at = sum(sizes[:k])
+        runs.append(np.column_stack([np.arange(n, dtype=np.float64), xy[at : at + n]]))
+    squares = draw(st.integers(1, 60))
+    work = draw(st.sampled_from([0, 1, 10, 100, 10**9]))
+    return runs, side, squares, work, draw(st.integers(0, 2**32 - 1))
+
+
+@settings(max_examples=400, deadline=None)
+@given(_region_inputs())
+def test_region_blocks_equal_the_numpy_loop_bit_for_bit(
+    args: tuple[list[np.ndarray], float, int, int, int],
+) -> None:
+    """The C++ squares (``_core.region_blocks``) give the stretches of the NumPy loop they
+    replaced (tests/reference/regions.py) in the same order, from the same draws."""
+    runs, side, squares, work, seed = args
+    flat = _flat(runs)
+    g_rng, w_rng = np.random.default_rng(seed), np.random.default_rng(seed)
+    want = reference_blocks(flat, side, w_rng, squares, work)
+    with mock.patch.object(cal, "REGION_WORK", work):
+        got = _region_blocks(flat, side, g_rng, squares)
+    for g, w in zip(got, want, strict=True):
+        assert g.dtype == w.dtype == np.int64
+        np.testing.assert_array_equal(g, w)
+    assert g_rng.integers(2**62) == w_rng.integers(2**62)  # the same draws taken
+
+
+def test_region_blocks_on_the_500_track_file_equal_the_numpy_loop() -> None:
+    """The squares of the 500-track benchmark file (its budget cuts them at about 1700) and of
+    a side of 5 px and 300 px: the same stretches as the NumPy loop."""
+    from bench.recovery_file import synthetic_tracks
+
+    rows = synthetic_tracks(500, seed=0)
+    runs = [rows[rows[:, 1] == i][:, [0, 2, 3]] for i in np.unique(rows[:, 1])]
+    flat = _flat(runs)
+    for side in (5.0, 57.25, 300.0):
+        got = _region_blocks(flat, side, np.random.default_rng(1))
+        want = reference_blocks(flat, side, np.random.default_rng(1))
+        assert len(want.run) > 0
+        for g, w in zip(got, want, strict=True):
+            np.testing.assert_array_equal(g, w)
