@@ -8,12 +8,14 @@ this frame by pyramidal Lucas-Kanade optical flow (``cv2.calcOpticalFlowPyrLK``)
 transform fitted to them by RANSAC (``cv2.estimateAffinePartial2D``), which leaves out the
 points on anything that moves by itself. It then decides, with hysteresis, whether the camera
 moves: a frame moves when a corner of the image moves by more than a share of the image
-diagonal; the camera starts moving after a few such frames in a row and stops after more still
-ones. While it does not move the transform it hands back is None and nothing is changed, so a
-still camera tracks exactly as without compensation. While it is still, the measurement is
-cheap: the last corners found are followed from frame to frame (at most
-``CameraConfig.still_features``, no new corner search), and a frame is measured in full only
-when that finds motion near the threshold or too few inliers, or the corners are
+diagonal; the camera starts moving after a few such frames in a row (the transform then applied
+covers them and the frames just before them that moved by more than a lower share), and stops
+after more frames in a row under the lower share (a Schmitt trigger: where a moving camera
+slows down, its small motion is still applied). While it does not move the transform it hands
+back is None and nothing is changed, so a still camera tracks exactly as without compensation.
+While it is still, the measurement is cheap: the last corners found are followed from frame to
+frame (at most ``CameraConfig.still_features``, no new corner search), and a frame is measured
+in full only when that finds motion near the threshold or too few inliers, or the corners are
 ``refresh_frames`` old.
 
 :func:`warp_tracks` applies a transform to the tracker's state: every particle (its current and
@@ -320,18 +322,19 @@ class CameraMotion:
             return CameraStep(affine, magnitude, True, affine, False)
 
         moves = affine is not None and magnitude > cfg.threshold * diagonal
+        stirs = affine is not None and magnitude > cfg.still_threshold * diagonal
         apply = None
         if not self.moving:
-            if moves and affine is not None:
+            if stirs and affine is not None:  # pending: the frames over the lower threshold
                 self._pending = affine if self._pending is None else compose(affine, self._pending)
-                self._run += 1
+                self._run = self._run + 1 if moves else 0
                 if self._run >= cfg.on_frames:
                     self.moving, apply, self._pending, self._run = True, self._pending, None, 0
             else:
                 self._pending, self._run = None, 0
         else:
             apply = affine
-            self._run = 0 if moves else self._run + 1
+            self._run = 0 if stirs else self._run + 1
             if self._run >= cfg.off_frames:
                 self.moving, self._run, self._since_moving = False, 0, 0
         if self.moving:
