@@ -489,6 +489,13 @@ class CameraConfig:
         full. 0: every frame in full.
     refresh_frames : int
         The corners followed while still are found anew after this many frames.
+    key_frames : int
+        While the camera moves, corners found on a key frame are followed into each later
+        frame directly and the transform from the previous frame is the difference of two
+        key-to-frame fits: the estimate's errors no longer add up frame after frame along the
+        camera's path. The previous frame becomes the key frame after this many frames (or
+        when fewer than half the key frame's corners stay inliers). 1: every moving frame is
+        measured against the previous one with new corners (as before 5 December).
     """
 
     max_side: int = 240
@@ -502,10 +509,11 @@ class CameraConfig:
     settle_frames: int = 25
     still_features: int = 40
     refresh_frames: int = 25
+    key_frames: int = 10
 
     def __post_init__(self) -> None:
         names = ("max_side", "max_features", "min_inliers", "on_frames", "off_frames")
-        _integers_at_least("CameraConfig", 1, self, *names, "refresh_frames")
+        _integers_at_least("CameraConfig", 1, self, *names, "refresh_frames", "key_frames")
         _integers_at_least("CameraConfig", 0, self, "settle_frames", "still_features")
         for name in ("ransac_threshold", "threshold", "still_threshold"):
             v = number(getattr(self, name), f"CameraConfig: {name}", finite=False)
