@@ -8,12 +8,14 @@ this frame by pyramidal Lucas-Kanade optical flow (``cv2.calcOpticalFlowPyrLK``)
 transform fitted to them by RANSAC (``cv2.estimateAffinePartial2D``), which leaves out the
 points on anything that moves by itself. It then decides, with hysteresis, whether the camera
 moves: a frame moves when a corner of the image moves by more than a share of the image
-diagonal; the camera starts moving after a few such frames in a row and stops after more still
-ones. While it does not move the transform it hands back is None and nothing is changed, so a
-still camera tracks exactly as without compensation. While it is still, the measurement is
-cheap: the last corners found are followed from frame to frame (at most
-``CameraConfig.still_features``, no new corner search), and a frame is measured in full only
-when that finds motion near the threshold or too few inliers, or the corners are
+diagonal; the camera starts moving after a few such frames in a row (the transform then applied
+covers them and the frames just before them that moved by more than a lower share), and stops
+after more frames in a row under the lower share (a Schmitt trigger: where a moving camera
+slows down, its small motion is still applied). While it does not move the transform it hands
+back is None and nothing is changed, so a still camera tracks exactly as without compensation.
+While it is still, the measurement is cheap: the last corners found are followed from frame to
+frame (at most ``CameraConfig.still_features``, no new corner search), and a frame is measured
+in full only when that finds motion near the threshold or too few inliers, or the corners are
 ``refresh_frames`` old.
 
 :func:`warp_tracks` applies a transform to the tracker's state: every particle (its current and
@@ -192,13 +194,21 @@ class _Measure:
     def fit_corners(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], factor: float,
                     exclude: F64) -> tuple[F64 | None, NDArray[np.float32] | None]:  # fmt: skip
         """The transform from new corners of `prev`, and its inlier corners moved into `cur`."""
-        cfg = self.config
-        mask = _exclusion_mask(prev.shape, exclude.reshape(-1, 4), factor)
-        spacing = max(4.0, min(prev.shape) / 40)
-        pts = cv2.goodFeaturesToTrack(prev, cfg.max_features, 0.01, spacing, mask=mask)
-        if pts is None or len(pts) < cfg.min_inliers:
+        pts = self.corners(prev, factor, exclude)
+        if pts is None:
             return None, None
-        return self.follow(prev, cur, np.asarray(pts, np.float32), factor)
+        return self.follow(prev, cur, pts, factor)
+
+    def corners(self, grey: NDArray[np.uint8], factor: float,
+                exclude: F64) -> NDArray[np.float32] | None:  # fmt: skip
+        """Corners (N, 1, 2) of `grey` outside the boxes, strongest first (None: too few)."""
+        cfg = self.config
+        mask = _exclusion_mask(grey.shape, exclude.reshape(-1, 4), factor)
+        spacing = max(4.0, min(grey.shape) / 40)
+        pts = cv2.goodFeaturesToTrack(grey, cfg.max_features, 0.01, spacing, mask=mask)
+        if pts is None or len(pts) < cfg.min_inliers:
+            return None
+        return np.asarray(pts, np.float32)
 
     def follow(self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32],
                factor: float) -> tuple[F64 | None, NDArray[np.float32] | None]:  # fmt: skip
@@ -226,6 +236,62 @@ class _Measure:
         a[:, 2] /= factor  # scaled pixels -> frame pixels (the linear part is the same)
         kept = np.ascontiguousarray(dst[inliers.reshape(-1) == 1].reshape(-1, 1, 2))
         return a, kept
+
+    def follow_key(
+        self, key: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32], guess: F64
+    ) -> tuple[F64, NDArray[np.float32], NDArray[np.bool_]] | None:
+        """Corners `pts` (N, 1, 2) of key frame `key` followed into `cur`, scaled pixels.
+
+        The flow starts where `guess` (a transform) puts each corner. Returns the transform
+        from `key` fitted to them (RANSAC), every corner's place in `cur` (N, 2) and which are
+        its inliers, or None (too few corners followed or inliers).
+        """
+        start = _map_points(pts.reshape(-1, 2).astype(np.float64), guess)
+        nxt, status, _ = cv2.calcOpticalFlowPyrLK(
+            key, cur, pts, np.ascontiguousarray(start.reshape(-1, 1, 2), dtype=np.float32),
+            winSize=(11, 11), maxLevel=2,
+            criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
+            flags=cv2.OPTFLOW_USE_INITIAL_FLOW,
+        )  # fmt: skip
+        ok = status.reshape(-1) == 1
+        places: NDArray[np.float32] = np.asarray(nxt, np.float32).reshape(-1, 2)
+        m, inliers = self.fit(pts.reshape(-1, 2)[ok], places[ok])
+        if m is None:
+            return None
+        ok[ok] = inliers
+        return m, places, ok
+
+    def fit(self, src: NDArray[np.float32], dst: NDArray[np.float32]
+             ) -> tuple[F64 | None, NDArray[np.bool_]]:  # fmt: skip
+        """The similarity from `src` to `dst` (N, 2) by RANSAC, and its inliers (None: too few)."""
+        cfg = self.config
+        none = np.zeros(len(src), bool)
+        if len(src) < cfg.min_inliers:
+            return None, none
+        m, inliers = cv2.estimateAffinePartial2D(
+            src, dst, method=cv2.RANSAC, ransacReprojThreshold=cfg.ransac_threshold,
+            maxIters=2000, confidence=0.995, refineIters=10,
+        )  # fmt: skip
+        if m is None or inliers is None or int(inliers.sum()) < cfg.min_inliers:
+            return None, none
+        return np.asarray(m, dtype=np.float64), inliers.reshape(-1) == 1
+
+
+#: A key frame is replaced when fewer than this share of its corners stay inliers.
+KEY_INLIERS = 0.75
+
+
+@dataclass
+class _KeyFrame:
+    """The key frame a moving camera is measured against (scaled pixels)."""
+
+    grey: NDArray[np.uint8]
+    points: NDArray[np.float32]  # its corners, (N, 1, 2)
+    to_prev: F64  # key frame -> previous frame (fitted)
+    places: NDArray[np.float32]  # the corners in the previous frame, (N, 2)
+    inliers: NDArray[np.bool_]  # which of them were inliers there
+    step: F64  # previous frame's own transform (repeated: the guess for this one)
+    age: int = 0  # frames measured against it
 
 
 class CameraMotion:
@@ -264,6 +330,7 @@ class CameraMotion:
         self._since_moving = self.config.settle_frames if self.mode == "auto" else 0
         self._corners: NDArray[np.float32] | None = None  # followed while still ("auto")
         self._corner_age = 0
+        self._key: _KeyFrame | None = None  # measured against while moving
         # the next frame and its grey(), made elsewhere (hand_over)
         self._handed: tuple[NDArray[np.uint8], tuple[float, NDArray[np.uint8]]] | None = None
 
@@ -309,9 +376,15 @@ class CameraMotion:
             still = self._still(prev, grey, factor, size, diagonal)
             if still is not None:
                 affine, magnitude = still
-            else:  # in full: new corners
+            else:  # in full: against the key frame while moving, else new corners
                 exclude = np.asarray(exclude_xywh, dtype=np.float64).reshape(-1, 4)
-                affine, corners = self._measure.fit_corners(prev, grey, factor, exclude)
+                keyed = self._keyed(prev, grey, factor, exclude) if self.moving else None
+                found: tuple[F64 | None, NDArray[np.float32] | None] = (
+                    keyed
+                    if keyed is not None
+                    else self._measure.fit_corners(prev, grey, factor, exclude)
+                )
+                affine, corners = found
                 self._corners = None if corners is None else corners[: cfg.still_features]
                 self._corner_age = 0
                 if affine is not None:
@@ -320,26 +393,78 @@ class CameraMotion:
             return CameraStep(affine, magnitude, True, affine, False)
 
         moves = affine is not None and magnitude > cfg.threshold * diagonal
+        stirs = affine is not None and magnitude > cfg.still_threshold * diagonal
         apply = None
         if not self.moving:
-            if moves and affine is not None:
+            if stirs and affine is not None:  # pending: the frames over the lower threshold
                 self._pending = affine if self._pending is None else compose(affine, self._pending)
-                self._run += 1
+                self._run = self._run + 1 if moves else 0
                 if self._run >= cfg.on_frames:
                     self.moving, apply, self._pending, self._run = True, self._pending, None, 0
             else:
                 self._pending, self._run = None, 0
         else:
             apply = affine
-            self._run = 0 if moves else self._run + 1
+            self._run = 0 if stirs else self._run + 1
             if self._run >= cfg.off_frames:
                 self.moving, self._run, self._since_moving = False, 0, 0
         if self.moving:
             self._since_moving = 0
-        elif self._since_moving < cfg.settle_frames:
-            self._since_moving += 1
+        else:
+            self._key = None  # a new key frame when it moves again
+            if self._since_moving < cfg.settle_frames:
+                self._since_moving += 1
         background_ok = not self.moving and self._since_moving >= cfg.settle_frames
         return CameraStep(affine, magnitude, self.moving, apply, background_ok)
+
+    def _keyed(self, prev: NDArray[np.uint8], grey: NDArray[np.uint8], factor: float,
+               exclude: F64) -> tuple[F64, NDArray[np.float32]] | None:  # fmt: skip
+        """The moving camera's transform from the previous frame, measured against a key frame.
+
+        The key frame's corners are followed into this frame directly (the flow starting where
+        the last frame's transform, repeated, puts them), not from the previous frame: each
+        corner's place carries the error of one flow, not of every frame since it was found,
+        so the errors do not add up along the camera's path. The transform is fitted (RANSAC)
+        to the corners that were inliers of the key-to-frame fit in both frames. The previous
+        frame becomes the key frame after ``key_frames`` frames, when fewer than
+        :data:`KEY_INLIERS` of its corners stay inliers, or when a fit fails. Returns the
+        transform (frame pixels) and its inlier corners in this frame, or None (measure in full).
+        """
+        cfg = self.config
+        key = self._key
+        if (
+            key is None
+            or key.age >= cfg.key_frames
+            or key.inliers.sum() < KEY_INLIERS * len(key.points)
+        ):
+            if cfg.key_frames <= 1:
+                return None
+            pts = self._measure.corners(prev, factor, exclude)
+            if pts is None:
+                self._key = None
+                return None
+            step = IDENTITY if key is None else key.step
+            every = np.ones(len(pts), bool)
+            key = self._key = _KeyFrame(prev, pts, IDENTITY, pts.reshape(-1, 2), every, step)
+        followed = self._measure.follow_key(
+            key.grey, grey, key.points, compose(key.step, key.to_prev)
+        )
+        if followed is None:
+            self._key = None
+            return None
+        to_cur, places, inliers = followed
+        both = key.inliers & inliers
+        fitted, kept = self._measure.fit(key.places[both], places[both])
+        if fitted is None:
+            self._key = None
+            return None
+        step = fitted
+        key.to_prev, key.places, key.inliers, key.step = to_cur, places, inliers, step
+        key.age += 1
+        affine = step.copy()
+        affine[:, 2] /= factor  # scaled pixels -> frame pixels (the linear part is the same)
+        corners = np.ascontiguousarray(places[both][kept].reshape(-1, 1, 2))
+        return affine, corners
 
     def _still(self, prev: NDArray[np.uint8], grey: NDArray[np.uint8], factor: float,
                size: tuple[int, int], diagonal: float) -> tuple[F64, float] | None:  # fmt: skip

@@ -466,10 +466,19 @@ class CameraConfig:
         A frame moves when a corner of the image moves by more than this share of the image
         diagonal (0.002: 1.2 px on 480x360; the still PETS09 and TUD-Campus videos measure at
         most 0.4 and 0.6 px).
+    still_threshold : float
+        The lower threshold of the hysteresis (a share of the image diagonal, at most
+        `threshold`): once the camera moves, a frame counts as still only when no corner of
+        the image moves by more than this, and the transform applied when the camera starts to
+        move covers every frame over it just before (0.001: 0.6 px on 480x360, above the still
+        PETS09's 0.4 px and TUD-Campus's 0.6 px of 800; the slowest frame of the moving
+        versions of experiments/moving_camera.py moves 0.00083). Was `threshold` itself: the
+        moving versions counted as still where their sinusoids turn, and frames of up to
+        1.4 px went uncompensated.
     on_frames : int
         Consecutive moving frames before the camera counts as moving (``"auto"``).
     off_frames : int
-        Consecutive still frames before it counts as still again.
+        Consecutive still frames (under `still_threshold`) before it counts as still again.
     settle_frames : int
         Frames after the camera stops during which the background model is still not trusted
         (it learns the new view).
@@ -480,6 +489,13 @@ class CameraConfig:
         full. 0: every frame in full.
     refresh_frames : int
         The corners followed while still are found anew after this many frames.
+    key_frames : int
+        While the camera moves, corners found on a key frame are followed into each later
+        frame directly and the transform from the previous frame is the difference of two
+        key-to-frame fits: the estimate's errors no longer add up frame after frame along the
+        camera's path. The previous frame becomes the key frame after this many frames (or
+        when fewer than half the key frame's corners stay inliers). 1: every moving frame is
+        measured against the previous one with new corners (as before 5 December).
     """
 
     max_side: int = 240
@@ -487,20 +503,27 @@ class CameraConfig:
     ransac_threshold: float = 1.0
     min_inliers: int = 20
     threshold: float = 0.002
+    still_threshold: float = 0.001
     on_frames: int = 3
     off_frames: int = 10
     settle_frames: int = 25
     still_features: int = 40
     refresh_frames: int = 25
+    key_frames: int = 10
 
     def __post_init__(self) -> None:
         names = ("max_side", "max_features", "min_inliers", "on_frames", "off_frames")
-        _integers_at_least("CameraConfig", 1, self, *names, "refresh_frames")
+        _integers_at_least("CameraConfig", 1, self, *names, "refresh_frames", "key_frames")
         _integers_at_least("CameraConfig", 0, self, "settle_frames", "still_features")
-        for name in ("ransac_threshold", "threshold"):
+        for name in ("ransac_threshold", "threshold", "still_threshold"):
             v = number(getattr(self, name), f"CameraConfig: {name}", finite=False)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"CameraConfig: {name} is {v}, expected a finite value > 0")
+        if self.still_threshold > self.threshold:
+            raise ValueError(
+                f"CameraConfig: still_threshold is {self.still_threshold}, expected at most "
+                f"threshold ({self.threshold})"
+            )
 
 
 @dataclass(frozen=True)
