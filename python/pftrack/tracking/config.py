@@ -491,11 +491,13 @@ class CameraConfig:
         The corners followed while still are found anew after this many frames.
     key_frames : int
         While the camera moves, corners found on a key frame are followed into each later
-        frame directly and the transform from the previous frame is the difference of two
-        key-to-frame fits: the estimate's errors no longer add up frame after frame along the
-        camera's path. The previous frame becomes the key frame after this many frames (or
-        when fewer than half the key frame's corners stay inliers). 1: every moving frame is
-        measured against the previous one with new corners (as before 5 December).
+        frame directly, and the transform from the previous frame is fitted to the corners
+        that were inliers in both frames: each corner's place carries the error of one flow,
+        so the estimate's errors no longer add up frame after frame along the camera's path.
+        The previous frame becomes the key frame after this many frames, when fewer than 3/4
+        of the key frame's corners stay inliers (``camera.KEY_INLIERS``), or when a fit fails.
+        1: every moving frame is measured against the previous one with new corners (as
+        before 5 December).
     """
 
     max_side: int = 240
