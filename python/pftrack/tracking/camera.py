@@ -180,6 +180,24 @@ def estimate_motion(
     return measure.fit_corners(prev, cur, factor, np.asarray(exclude_xywh, np.float64))[0]
 
 
+def _flow(prev: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32],
+          start: F64 | None = None) -> tuple[NDArray[np.float32], NDArray[np.bool_]]:  # fmt: skip
+    """Corners `pts` (N, 1, 2) of `prev` followed into `cur` by pyramidal Lucas-Kanade flow.
+
+    The flow starts at `start` (N, 2) when given, else at the corners themselves. Returns every
+    corner's place in `cur` (N, 2) and which were followed.
+    """
+    nxt, status, _ = cv2.calcOpticalFlowPyrLK(
+        prev, cur, pts,
+        np.empty_like(pts) if start is None
+        else np.ascontiguousarray(start.reshape(-1, 1, 2), dtype=np.float32),
+        winSize=(11, 11), maxLevel=2,
+        criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
+        flags=0 if start is None else cv2.OPTFLOW_USE_INITIAL_FLOW,
+    )  # fmt: skip
+    return np.asarray(nxt, np.float32).reshape(-1, 2), status.reshape(-1) == 1
+
+
 class _Measure:
     """The estimation steps, shared by :func:`estimate_motion` and :class:`CameraMotion`."""
 
@@ -217,25 +235,13 @@ class _Measure:
         Returns it (None: too few corners followed or inliers) and the inlier corners' places
         in `cur` (in the order of `pts`: strongest first, as ``goodFeaturesToTrack`` gives them).
         """
-        cfg = self.config
-        nxt, status, _ = cv2.calcOpticalFlowPyrLK(
-            prev, cur, pts, np.empty_like(pts), winSize=(11, 11), maxLevel=2,
-            criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
-        )  # fmt: skip
-        ok = status.reshape(-1) == 1
-        if ok.sum() < cfg.min_inliers:
+        nxt, ok = _flow(prev, cur, pts)
+        dst = nxt[ok]
+        a, inliers = self.fit(pts.reshape(-1, 2)[ok], dst)
+        if a is None:
             return None, None
-        src, dst = pts.reshape(-1, 2)[ok], nxt.reshape(-1, 2)[ok]
-        m, inliers = cv2.estimateAffinePartial2D(
-            src, dst, method=cv2.RANSAC, ransacReprojThreshold=cfg.ransac_threshold,
-            maxIters=2000, confidence=0.995, refineIters=10,
-        )  # fmt: skip
-        if m is None or inliers is None or int(inliers.sum()) < cfg.min_inliers:
-            return None, None
-        a = np.asarray(m, dtype=np.float64)
         a[:, 2] /= factor  # scaled pixels -> frame pixels (the linear part is the same)
-        kept = np.ascontiguousarray(dst[inliers.reshape(-1) == 1].reshape(-1, 1, 2))
-        return a, kept
+        return a, np.ascontiguousarray(dst[inliers].reshape(-1, 1, 2))
 
     def follow_key(
         self, key: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32], guess: F64
@@ -247,14 +253,7 @@ class _Measure:
         its inliers, or None (too few corners followed or inliers).
         """
         start = _map_points(pts.reshape(-1, 2).astype(np.float64), guess)
-        nxt, status, _ = cv2.calcOpticalFlowPyrLK(
-            key, cur, pts, np.ascontiguousarray(start.reshape(-1, 1, 2), dtype=np.float32),
-            winSize=(11, 11), maxLevel=2,
-            criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 30, 0.01),
-            flags=cv2.OPTFLOW_USE_INITIAL_FLOW,
-        )  # fmt: skip
-        ok = status.reshape(-1) == 1
-        places: NDArray[np.float32] = np.asarray(nxt, np.float32).reshape(-1, 2)
+        places, ok = _flow(key, cur, pts, start)
         m, inliers = self.fit(pts.reshape(-1, 2)[ok], places[ok])
         if m is None:
             return None
