@@ -259,6 +259,20 @@ def colour_hint(shape: tuple[int, ...]) -> str:
     return ""
 
 
+def not_an_image(boxes: object, call: str, what: str, other: str) -> None:
+    """TypeError when `boxes` is a uint8 (H, W, 3) array, a frame given for the boxes.
+
+    `call` is the called signature, `what` the name of its boxes argument and `other` the call
+    whose order the caller followed (``update(frame, dets)`` for ``update(dets, frame)``): the
+    frame's own check would say the user's uint8 frame was the boxes' dtype.
+    """
+    if isinstance(boxes, np.ndarray) and boxes.ndim == 3 and boxes.dtype == np.uint8:
+        raise TypeError(
+            f"{call}: {what} is a {boxes.shape} uint8 array, an image; were the arguments "
+            f"swapped? ({other})"
+        )
+
+
 def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     """`frame` as a C-contiguous (H, W, 3) uint8 array with at least one pixel.
 

@@ -36,7 +36,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, flag, integer, number, real_array
+from pftrack._check import bgr_frame, flag, integer, not_an_image, number, real_array
 from pftrack._check import seed as check_seed
 from pftrack._typing import (
     F64,
@@ -945,14 +945,10 @@ class Tracker:
                     "the tracker, which no longer holds a whole frame; finalize() still returns "
                     f"the rows of frames 1-{self._torn - 1}, reset() starts a new run"
                 )
-            if isinstance(dets, np.ndarray) and dets.ndim == 3 and dets.dtype == np.uint8:
-                # update(frame, dets), the lower-level API's order: the frame's check would
-                # say the user's uint8 frame was float64 (the detections' dtype)
-                raise TypeError(
-                    f"Tracker.update(dets, frame): dets is a {dets.shape} uint8 array, an image; "
-                    "were the arguments swapped? (MultiObjectTracker.update takes (frame, "
-                    "detections))"
-                )
+            not_an_image(  # update(frame, dets), the lower-level API's order
+                dets, "Tracker.update(dets, frame)", "dets",
+                "MultiObjectTracker.update takes (frame, detections)",
+            )  # fmt: skip
             kind = type(dets)
             if kind.__name__ == "Detections" and kind.__module__.startswith("supervision"):
                 # its fields iterated as rows (or, empty, taken for no detection)

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, generator
+from pftrack._check import bgr_frame, generator, not_an_image
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack.boxes import _iou_matrix, _to_cxcywh
@@ -449,16 +449,10 @@ class MultiObjectTracker:
             `detections` is a uint8 image (``update(dets, frame)``, :class:`Tracker`'s order:
             the message says the arguments look swapped), or `frame` is not a uint8 array.
         """
-        if (
-            isinstance(detections, np.ndarray)
-            and detections.ndim == 3
-            and detections.dtype == np.uint8
-        ):  # the frame's check would say the user's uint8 frame was float64
-            raise TypeError(
-                f"MultiObjectTracker.update(frame, detections): detections is a "
-                f"{detections.shape} uint8 array, an image; were the arguments swapped? "
-                "(Tracker.update takes (dets, frame), BoxMOT's order)"
-            )
+        not_an_image(  # update(dets, frame), Tracker's and BoxMOT's order
+            detections, "MultiObjectTracker.update(frame, detections)", "detections",
+            "Tracker.update takes (dets, frame), BoxMOT's order",
+        )  # fmt: skip
         f = bgr_frame(frame)
         cfg = self._effective
         if cfg is not None and f.shape != self._frame_shape:
