@@ -1633,3 +1633,86 @@ def test_a_picture_or_a_later_blank_frame_does_not_warn(scene) -> None:
             for frame in frames:  # the scene's second frame is black: only frame 1 is looked at
                 tracker.update(dets, frame)
         assert _blank_messages(record) == []
+
+
+def _loop_under(action, make, frames, dets):
+    """Every ``update``'s output (None where a warning made an error raised) and the rows.
+
+    `action` is the warnings filter ("error" or "ignore"); `make` makes the tracker.
+    """
+    tracker = make()
+    outs, raised = [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter(action)
+        for d, f in zip(dets, frames, strict=True):
+            try:
+                outs.append(tracker.update(d, f))
+            except Warning as w:  # the frame is taken whole before a warning is given
+                outs.append(None)
+                raised.append(str(w))
+        rows = tracker.finalize()
+    return outs, rows, raised, tracker
+
+
+def test_a_warning_made_an_error_leaves_the_tracker_usable(scene):
+    """A user trial: under ``python -W error`` the low-confidence warnings, the moving-camera
+    warning and the grey-video warning were raised after the tracker had changed, so every
+    later ``update`` was refused as interrupted ("the update of frame 1 was interrupted")."""
+    from tests.tracking.test_camera import _panned
+
+    dets = scene_dets(scene)
+    grey = [np.repeat(f.mean(axis=2, keepdims=True).astype(np.uint8), 3, axis=2)
+            for f in scene.frames]  # fmt: skip
+    cases = {
+        "a detection confidence is -0.5": (scene.frames, [np.column_stack(
+            [d[:, :4], np.where(np.arange(len(d)) == 0, -0.5, d[:, 4])]) for d in dets]),
+        "a detection score is 3": (scene.frames, [np.column_stack(
+            [d[:, :4], d[:, 4] * 3]) for d in dets]),
+        "the camera moves": (_panned(), [None] * 30),
+        "the video is grey": (grey, dets),
+    }  # fmt: skip
+    for said, (frames, given) in cases.items():
+
+        def make():
+            return pftrack.Tracker(frame_rate=10.0)
+
+        outs, rows, raised, tracker = _loop_under("error", make, frames, given)
+        plain, plain_rows, _, _ = _loop_under("ignore", make, frames, given)
+        assert len(raised) == 1 and raised[0].startswith(said), (said, raised)
+        assert tracker.frame_count == len(frames)  # every frame taken, the run whole
+        assert len(plain_rows) > 0
+        np.testing.assert_array_equal(rows, plain_rows)
+        for out, ref in zip(outs, plain, strict=True):
+            if out is not None:
+                np.testing.assert_array_equal(out, ref)
+
+
+def test_a_warning_made_an_error_leaves_the_multi_object_tracker_whole(scene):
+    """As for Tracker: MultiObjectTracker warned of a score above 1 after it had counted the
+    frame and before it had tracked it, so the frame's detections started no track; and its
+    warnings named the line above the caller's (``stacklevel`` one too many)."""
+    dets = [np.column_stack([d[:, :2], d[:, 2:4] - d[:, :2], d[:, 4] * 3])
+            for d in scene_dets(scene)]  # fmt: skip
+
+    def run(action):
+        tracker = pftrack.MultiObjectTracker(rng=0)
+        said, ids = [], []
+        with warnings.catch_warnings():
+            warnings.simplefilter(action)
+            for d, f in zip(dets, scene.frames, strict=True):
+                try:
+                    tracker.update(f, d)
+                except UserWarning as w:
+                    said.append(str(w))
+                ids.append(sorted(t.id for t in tracker.tracks))
+        return tracker, said, ids
+
+    tracker, said, ids = run("error")
+    plain, _, plain_ids = run("ignore")
+    assert len(said) == 1 and said[0].startswith("a detection score is 3")
+    assert tracker.frame_index == plain.frame_index == len(scene.frames)
+    assert ids == plain_ids and len(ids[0]) > 0  # frame 1's detections started its tracks
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        pftrack.MultiObjectTracker(rng=0).update(scene.frames[0], dets[0])
+    assert [Path(w.filename).name for w in caught] == [Path(__file__).name]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 
@@ -11,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
+from pftrack._warn import warn
 from pftrack.detection.base import (
     BlobConfig,
     BlobExtractor,
@@ -251,7 +251,7 @@ class PaperDetector:
                 f"the video is grey (its colour channels are equal): box refinement's shadow "
                 f"test is {test}, and the trackers tell people apart by brightness alone"
             )
-        warnings.warn(text, UserWarning, stacklevel=stacklevel + 1)
+        warn(text, UserWarning, stacklevel=stacklevel + 1)  # held inside a tracker's update
 
     def _apply(
         self, frame: NDArray[np.uint8], bins: bool

@@ -47,6 +47,7 @@ from pftrack._typing import (
     RngLike,
     SamplerName,
 )
+from pftrack._warn import Held, warn
 from pftrack.detection.light import BLANK_LEVELS, is_blank
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.filter import MAX_PARTICLES
@@ -739,19 +740,16 @@ class Tracker:
         """
         self._prepared = (frame, working)
 
-    def _warn_once(self, key: str, message: str | Callable[[], str], stacklevel: int = 3) -> None:
+    def _warn_once(self, key: str, message: str | Callable[[], str]) -> None:
         """Warn `message` from ``update``'s caller, the first time `key` comes up in a run.
 
         `message` may be a function that makes it, called only then (a per-frame caller builds
-        no text). `stacklevel` as ``warnings.warn``'s, counted from here: 1 here, 2
-        ``update``, 3 its caller (one more from a helper of ``update``).
+        no text). Held until ``update`` has taken the frame whole (:class:`pftrack._warn.Held`):
+        under ``python -W error`` the error leaves the tracker usable.
         """
         if key not in self._warned:
             self._warned.add(key)
-            warnings.warn(
-                message if isinstance(message, str) else message(),
-                stacklevel=stacklevel + self._caller_depth,
-            )
+            warn(message if isinstance(message, str) else message())
 
     def _warn_moving_camera(self) -> None:
         """Say once a run that the built-in detector runs on a moving camera.
@@ -775,7 +773,7 @@ class Tracker:
                 "Tracker.update(dets, frame))"
             )
 
-        self._warn_once("moving camera", message, stacklevel=4)
+        self._warn_once("moving camera", message)
 
     def _working(self, frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
         prepared, self._prepared = self._prepared, None
@@ -938,145 +936,156 @@ class Tracker:
             :meth:`finalize` returns the frames before it and :meth:`reset` starts a new run.
         """
         with self._alone("update"):
-            if self._torn:
-                raise RuntimeError(
-                    f"Tracker.update: the update of frame {self._torn} was interrupted "
-                    "(KeyboardInterrupt, or an error inside the tracker) after it had changed "
-                    "the tracker, which no longer holds a whole frame; finalize() still returns "
-                    f"the rows of frames 1-{self._torn - 1}, reset() starts a new run"
-                )
-            not_an_image(  # update(frame, dets), the lower-level API's order
-                dets, "Tracker.update(dets, frame)", "dets",
-                "MultiObjectTracker.update takes (frame, detections)",
-            )  # fmt: skip
-            kind = type(dets)
-            if kind.__name__ == "Detections" and kind.__module__.startswith("supervision"):
-                # its fields iterated as rows (or, empty, taken for no detection)
-                raise TypeError(
-                    f"{self._box_source} is a supervision Detections: use pftrack.integrations."
-                    "supervision.SupervisionTracker's update_with_detections(detections, frame), "
-                    "or give np.column_stack([d.xyxy, d.confidence, d.class_id])"
-                )
-            f = bgr_frame(frame)
-            shape = self._shape  # None until the run's first frame is taken
-            first = shape is None
-            if shape is None:
-                primed = self._primed
-                # the frames' own sizes: with max_side two sizes may scale to one, which the
-                # tracker inside (it compares the scaled frames) would take
-                if primed is not None and f.shape != primed:
-                    raise ValueError(
-                        f"frame is {f.shape[1]}x{f.shape[0]}, the frames given to prime() "
-                        f"{primed[1]}x{primed[0]} (one size per run)"
-                    )
-                size = working_size(f.shape, self.config.max_side)
-                self._scale = None  # one scale for the whole run's rows
-                if size is not None:
-                    sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
-                    self._scale = np.array([sx, sy, sx, sy])
-            elif f.shape != shape:
-                scales = self.config.max_side is not None
-                why = "max_side scales one size per run" if scales else "one size per run"
-                raise ValueError(
-                    f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
-                    f"{shape[1]}x{shape[0]} ({why}; call reset() or use a new "
-                    "Tracker before a new video)"
-                )
-            work = self._working(f)
-            if first and is_blank(f):
-                self._warn_once(
-                    "blank",
-                    f"frame 1 is blank (every pixel within {BLANK_LEVELS} levels of the others): "
-                    "on blank frames the colour filters and box refinement have nothing to see, "
-                    "and tracks follow their detections and motion alone (placeholder frames? "
-                    "give the real ones)",
-                )
-            if dets is None:
-                if self._given:  # was silent: a loop's "no detections" for this frame?
-                    self._warn_once(
-                        "none after dets",
-                        f"frame {self.frame_count + 1}: dets=None runs the built-in "
-                        "background-subtraction detector for this frame, after frames with "
-                        "detections; for a frame without detections give [] or "
-                        "np.zeros((0, 6))",
-                    )
-                kept = None
-                reports = self._step(work, None, None)
-                if self._tracker.camera_step.moving:
-                    self._warn_moving_camera()
-            else:
-                xywh, cls, kept, clipped, flat, inverted, extent = check_boxes_xyxy(
-                    dets, (f.shape[0], f.shape[1]), name=self._box_source,
-                    xywh_hint=self._box_source == "dets", seen=self._layout,
-                )  # fmt: skip
-                if flat:
-                    self._warn_once(
-                        "empty",
-                        f"{flat} detection box{'es' if flat > 1 else ''} without area "
-                        "(x2 == x1 or y2 == y1) ignored; later ones are ignored silently",
-                    )
-                if inverted:
-                    self._warn_once(
-                        "inverted",
-                        f"{inverted} detection box{'es' if inverted > 1 else ''} with x2 < x1 "
-                        "or y2 < y1 ignored (x1, y1, x2, y2 expected); later ones are ignored "
-                        "silently",
-                    )
-                if clipped:
-                    self._warn_once(
-                        "clipped",
-                        f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
-                        "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
-                    )
-                confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
-                if (
-                    self._max_conf == -np.inf and len(xywh) and min(f.shape[:2]) > 2
-                    and (xywh[:, 0] + xywh[:, 2]).max() <= 1
-                    and (xywh[:, 1] + xywh[:, 3]).max() <= 1
-                ):  # fmt: skip
-                    # the run's first boxes, all inside one pixel: a detector's xyxyn output
-                    self._warn_once(
-                        "normalised",
-                        f"frame {self.frame_count + 1}: every detection box lies within "
-                        "[0, 1] x [0, 1] of a "
-                        f"{f.shape[1]}x{f.shape[0]} frame: normalised coordinates? give "
-                        "pixels (x times the width, y times the height)",
-                    )
-                if self._scale is not None:
-                    xywh[:, :4] *= self._scale
-                    xywh, cls, kept = _inside_working(xywh, cls, kept, work.shape)
-                reports = self._step(work, xywh, cls)
-                self._given = (
-                    True  # once the frame is taken (an update that raises changes nothing)
-                )
-                self._layout = (self._layout[0] + inverted, self._layout[1] + extent)
-                self._max_conf = max(self._max_conf, confidence)
-            self.frame_count += 1
-            if first:  # the run's size, once its first frame is taken
-                self._shape = f.shape
-            if self.record:
-                # the offline pass sees a still camera: boxes in the first frame's coordinates
-                self._stabiliser.add(self._tracker.camera_step.apply)
-                self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
-            self._reports = reports
-            self._torn = 0
-            # coasting tracks (carried by the particle filter alone) are held back
-            live = [t for t in reports if t.time_since_update == 0]
-            out = np.zeros((len(live), 8))
-            if live:
-                b = np.array([t.box_xywh for t in live])
-                if self._scale is not None:
-                    b = b / self._scale
-                out[:, 0:2] = b[:, 0:2]
-                out[:, 2:4] = b[:, 0:2] + b[:, 2:4]
-                out[:, 4:7] = [(t.id, t.score, t.cls) for t in live]
-                if kept is not None:
-                    out[:, 7] = [
-                        -1 if t.detection_index is None else kept[t.detection_index] for t in live
-                    ]
-                else:
-                    out[:, 7] = -1
+            warned = set(self._warned)
+            with Held() as held:  # given once the frame is taken whole (python -W error)
+                try:
+                    out = self._update(dets, frame)
+                except BaseException:
+                    self._warned = warned  # the warnings held were not given
+                    raise
+            held.release(2 + self._caller_depth)  # the user's line, through an adapter too
             return out
+
+    def _update(self, dets: ArrayLike | None, frame: NDArray[np.uint8]) -> F64:
+        """:meth:`update`, holding the tracker and its warnings (:class:`pftrack._warn.Held`)."""
+        if self._torn:
+            raise RuntimeError(
+                f"Tracker.update: the update of frame {self._torn} was interrupted "
+                "(KeyboardInterrupt, or an error inside the tracker) after it had changed "
+                "the tracker, which no longer holds a whole frame; finalize() still returns "
+                f"the rows of frames 1-{self._torn - 1}, reset() starts a new run"
+            )
+        not_an_image(  # update(frame, dets), the lower-level API's order
+            dets, "Tracker.update(dets, frame)", "dets",
+            "MultiObjectTracker.update takes (frame, detections)",
+        )  # fmt: skip
+        kind = type(dets)
+        if kind.__name__ == "Detections" and kind.__module__.startswith("supervision"):
+            # its fields iterated as rows (or, empty, taken for no detection)
+            raise TypeError(
+                f"{self._box_source} is a supervision Detections: use pftrack.integrations."
+                "supervision.SupervisionTracker's update_with_detections(detections, frame), "
+                "or give np.column_stack([d.xyxy, d.confidence, d.class_id])"
+            )
+        f = bgr_frame(frame)
+        shape = self._shape  # None until the run's first frame is taken
+        first = shape is None
+        if shape is None:
+            primed = self._primed
+            # the frames' own sizes: with max_side two sizes may scale to one, which the
+            # tracker inside (it compares the scaled frames) would take
+            if primed is not None and f.shape != primed:
+                raise ValueError(
+                    f"frame is {f.shape[1]}x{f.shape[0]}, the frames given to prime() "
+                    f"{primed[1]}x{primed[0]} (one size per run)"
+                )
+            size = working_size(f.shape, self.config.max_side)
+            self._scale = None  # one scale for the whole run's rows
+            if size is not None:
+                sx, sy = size[0] / f.shape[1], size[1] / f.shape[0]
+                self._scale = np.array([sx, sy, sx, sy])
+        elif f.shape != shape:
+            scales = self.config.max_side is not None
+            why = "max_side scales one size per run" if scales else "one size per run"
+            raise ValueError(
+                f"frame is {f.shape[1]}x{f.shape[0]}, the run's earlier frames "
+                f"{shape[1]}x{shape[0]} ({why}; call reset() or use a new "
+                "Tracker before a new video)"
+            )
+        work = self._working(f)
+        if first and is_blank(f):
+            self._warn_once(
+                "blank",
+                f"frame 1 is blank (every pixel within {BLANK_LEVELS} levels of the others): "
+                "on blank frames the colour filters and box refinement have nothing to see, "
+                "and tracks follow their detections and motion alone (placeholder frames? "
+                "give the real ones)",
+            )
+        if dets is None:
+            if self._given:  # was silent: a loop's "no detections" for this frame?
+                self._warn_once(
+                    "none after dets",
+                    f"frame {self.frame_count + 1}: dets=None runs the built-in "
+                    "background-subtraction detector for this frame, after frames with "
+                    "detections; for a frame without detections give [] or "
+                    "np.zeros((0, 6))",
+                )
+            kept = None
+            reports = self._step(work, None, None)
+            if self._tracker.camera_step.moving:
+                self._warn_moving_camera()
+        else:
+            xywh, cls, kept, clipped, flat, inverted, extent = check_boxes_xyxy(
+                dets, (f.shape[0], f.shape[1]), name=self._box_source,
+                xywh_hint=self._box_source == "dets", seen=self._layout,
+            )  # fmt: skip
+            if flat:
+                self._warn_once(
+                    "empty",
+                    f"{flat} detection box{'es' if flat > 1 else ''} without area "
+                    "(x2 == x1 or y2 == y1) ignored; later ones are ignored silently",
+                )
+            if inverted:
+                self._warn_once(
+                    "inverted",
+                    f"{inverted} detection box{'es' if inverted > 1 else ''} with x2 < x1 "
+                    "or y2 < y1 ignored (x1, y1, x2, y2 expected); later ones are ignored "
+                    "silently",
+                )
+            if clipped:
+                self._warn_once(
+                    "clipped",
+                    f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
+                    "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
+                )
+            confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
+            if (
+                self._max_conf == -np.inf and len(xywh) and min(f.shape[:2]) > 2
+                and (xywh[:, 0] + xywh[:, 2]).max() <= 1
+                and (xywh[:, 1] + xywh[:, 3]).max() <= 1
+            ):  # fmt: skip
+                # the run's first boxes, all inside one pixel: a detector's xyxyn output
+                self._warn_once(
+                    "normalised",
+                    f"frame {self.frame_count + 1}: every detection box lies within "
+                    "[0, 1] x [0, 1] of a "
+                    f"{f.shape[1]}x{f.shape[0]} frame: normalised coordinates? give "
+                    "pixels (x times the width, y times the height)",
+                )
+            if self._scale is not None:
+                xywh[:, :4] *= self._scale
+                xywh, cls, kept = _inside_working(xywh, cls, kept, work.shape)
+            reports = self._step(work, xywh, cls)
+            # once the frame is taken (an update that raises changes nothing)
+            self._given = True
+            self._layout = (self._layout[0] + inverted, self._layout[1] + extent)
+            self._max_conf = max(self._max_conf, confidence)
+        self.frame_count += 1
+        if first:  # the run's size, once its first frame is taken
+            self._shape = f.shape
+        if self.record:
+            # the offline pass sees a still camera: boxes in the first frame's coordinates
+            self._stabiliser.add(self._tracker.camera_step.apply)
+            self._writer.add(self.frame_count, self._stabiliser.stabilise(reports))
+        self._reports = reports
+        self._torn = 0
+        # coasting tracks (carried by the particle filter alone) are held back
+        live = [t for t in reports if t.time_since_update == 0]
+        out = np.zeros((len(live), 8))
+        if live:
+            b = np.array([t.box_xywh for t in live])
+            if self._scale is not None:
+                b = b / self._scale
+            out[:, 0:2] = b[:, 0:2]
+            out[:, 2:4] = b[:, 0:2] + b[:, 2:4]
+            out[:, 4:7] = [(t.id, t.score, t.cls) for t in live]
+            if kept is not None:
+                out[:, 7] = [
+                    -1 if t.detection_index is None else kept[t.detection_index] for t in live
+                ]
+            else:
+                out[:, 7] = -1
+        return out
 
     @property
     def last_reports(self) -> list[Track]:

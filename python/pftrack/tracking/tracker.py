@@ -19,7 +19,6 @@ import dataclasses
 import inspect
 import itertools
 import math
-import warnings
 from collections import deque
 from collections.abc import Iterable, Sequence
 from typing import Any
@@ -30,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import bgr_frame, generator, not_an_image
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
+from pftrack._warn import Held, warn
 from pftrack.boxes import _iou_matrix, _to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
@@ -448,7 +448,22 @@ class MultiObjectTracker:
         TypeError
             `detections` is a uint8 image (``update(dets, frame)``, :class:`Tracker`'s order:
             the message says the arguments look swapped), or `frame` is not a uint8 array.
+
+        Warns
+        -----
+        UserWarning
+            Once a run each: a confidence below 0 and `min_score`, a score above 1. Given once
+            the frame is taken whole: a warning made an error (``python -W error``) leaves the
+            tracker at the end of this frame, ready for the next one.
         """
+        with Held() as held:
+            reports = self._update(frame, detections, classes, checked)
+        held.release(2 + self.caller_depth)  # update's caller, or the wrapper's
+        return reports
+
+    def _update(self, frame: ArrayLike, detections: ArrayLike | None, classes: ArrayLike | None,
+                checked: bool) -> list[Track]:  # fmt: skip
+        """:meth:`update`'s step; its warnings are held (:class:`pftrack._warn.Held`)."""
         not_an_image(  # update(dets, frame), Tracker's and BoxMOT's order
             detections, "MultiObjectTracker.update(frame, detections)", "detections",
             "Tracker.update takes (dets, frame), BoxMOT's order",
@@ -513,11 +528,10 @@ class MultiObjectTracker:
             low = float(given[1].min())
             if low < 0.0 and low < cfg.lifecycle.min_score:  # said once a run
                 self._negative_warned = True
-                warnings.warn(
+                warn(
                     f"a detection confidence is {low:.3g}: confidences below min_conf "
                     f"{cfg.lifecycle.min_score:.3g} are ignored (logits? give probabilities in "
-                    "[0, 1], or set min_conf)",
-                    stacklevel=3 + self.caller_depth,
+                    "[0, 1], or set min_conf)"
                 )
         if given is not None and len(scores) and self._scores_are_confidences:
             # kept scores outside [0, 1] are a detector's own scale, not confidences: below 0
@@ -526,11 +540,10 @@ class MultiObjectTracker:
             if scores.min() < 0.0 or high > 1.0 + CONFIDENCE_SLACK:
                 self._scores_are_confidences = False
             if high > 1.0 + CONFIDENCE_SLACK:
-                warnings.warn(
+                warn(
                     f"a detection score is {high:.3g} (frame {self.frame_index}): scores above "
                     "1 are taken as a detector's own scale, not confidences, so birth_score no "
-                    "longer applies (min_conf still does)",
-                    stacklevel=3 + self.caller_depth,
+                    "longer applies (min_conf still does)"
                 )
         if cfg.sampler == "rjmcmc":
             mask = self.last_mask

@@ -1,0 +1,70 @@
+"""Warnings held until a frame's state is whole, so that a warning made an error tears nothing.
+
+Under ``python -W error`` (or ``warnings.simplefilter("error")``) a warning raises where it
+is given. A tracker that warns half-way through a frame (a negative confidence, a moving
+camera, a grey video) would then stop with its state half-changed, and every later ``update``
+was refused as interrupted. The per-frame methods hold their warnings instead (:class:`Held`)
+and give them once the frame is taken whole: an error then leaves a usable tracker.
+
+The holding is per thread, and nested holds give their warnings to the outermost one (the
+:class:`~pftrack.Tracker` around its :class:`~pftrack.MultiObjectTracker`), which gives them
+from its caller's line.
+"""
+
+from __future__ import annotations
+
+import threading
+import warnings
+
+__all__ = ["Held", "warn"]
+
+_local = threading.local()
+
+
+def warn(message: str, category: type[Warning] = UserWarning, stacklevel: int = 1) -> None:
+    """``warnings.warn(message, category, stacklevel)``, or held inside this thread's :class:`Held`.
+
+    `stacklevel` counts from the caller of this function, as ``warnings.warn``'s; a held
+    warning is given from the line :meth:`Held.release` names.
+    """
+    pending: list[tuple[str, type[Warning]]] | None = getattr(_local, "pending", None)
+    if pending is None:
+        warnings.warn(message, category, stacklevel=stacklevel + 1)
+    else:
+        pending.append((message, category))
+
+
+class Held:
+    """``with Held() as held: ...`` holds this thread's :func:`warn` calls; then ``release``.
+
+    The outermost hold of a thread collects every warning given inside it (inner holds'
+    too); leaving the block by an exception drops them (the call did not complete, and
+    its own error says what went wrong). :meth:`release` gives them, once the caller's state
+    is whole; an inner hold's ``release`` gives nothing (its outer hold will).
+    """
+
+    __slots__ = ("outermost", "pending")
+
+    def __enter__(self) -> Held:
+        outer: list[tuple[str, type[Warning]]] | None = getattr(_local, "pending", None)
+        self.outermost = outer is None
+        self.pending: list[tuple[str, type[Warning]]] = [] if outer is None else outer
+        if outer is None:
+            _local.pending = self.pending
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.outermost:
+            _local.pending = None
+
+    def release(self, stacklevel: int) -> None:
+        """Give the held warnings, from the line `stacklevel` names (as ``warnings.warn``'s).
+
+        Call it after the block, once the state is whole. Under ``-W error`` the first one
+        raises (the rest of that call are not given).
+        """
+        if not self.outermost:
+            return
+        pending, self.pending = self.pending, []
+        for message, category in pending:
+            warnings.warn(message, category, stacklevel=stacklevel + 1)
