@@ -57,7 +57,7 @@ CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
     "Tracker(birth_quantile='0.2')": (
         lambda: pftrack.Tracker(birth_quantile="0.2"),
         TypeError,
-        "LifecycleConfig: birth_quantile must be a number, got str '0.2'",
+        "^birth_quantile must be a number, got str '0.2'",  # Tracker's own option, named
     ),
     "AssociationConfig(unmatched_cost='1')": (
         lambda: AssociationConfig(unmatched_cost="1"),

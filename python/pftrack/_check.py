@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 import os
 from collections.abc import Iterator
 
@@ -367,6 +368,29 @@ def number(value: object, what: str, *, finite: bool = True) -> float:
     if finite and not np.isfinite(v):
         raise ValueError(f"{what} is {value}, expected a finite number")
     return v
+
+
+def real(value: object, what: str, *, finite: bool = True) -> float:
+    """:func:`number`, also taking any other real number, as a float (a frame rate, seconds).
+
+    A :class:`fractions.Fraction` is how PyAV gives a stream's rate (``average_rate``,
+    ``Fraction(30000, 1001)``): where a frame rate or a time in seconds is taken it works as
+    its float does (:func:`number` alone refuses it; a :class:`decimal.Decimal` is not a
+    ``numbers.Real`` and stays refused, TypeError).
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`number`; ValueError for a real number beyond a float's range.
+    """
+    if isinstance(value, numbers.Real) and not isinstance(
+        value, (bool, np.bool_, int, float, np.integer, np.floating)
+    ):
+        try:
+            value = float(value)
+        except OverflowError:
+            raise ValueError(f"{what} is {value}, beyond a float's range (±1.8e+308)") from None
+    return number(value, what, finite=finite)
 
 
 def integer(value: object, what: str, lo: int, hi: int) -> int:

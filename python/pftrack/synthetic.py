@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import generator
+from pftrack._check import generator, real
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
@@ -298,13 +298,23 @@ def _paste(
     return xa, ya, xb - xa, yb - ya
 
 
-def _check_scene_args(fn: str, n_frames: int, width: int, height: int, noise: float) -> None:
-    """The frame count, size and noise level that `make_scene` and `make_busy_scene` share."""
+def _check_scene_args(
+    fn: str, n_frames: int, width: int, height: int, noise: float, fps: float
+) -> float:
+    """The frame count, size, noise level and rate `make_scene` and `make_busy_scene` share.
+
+    Returns `fps` as a float (a Fraction too, as PyAV gives rates; was stored as given, and a
+    scene with a Fraction, text or 0 failed only when saved).
+    """
     for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
         if not isinstance(v, (int, np.integer)) or v < lo:
             raise ValueError(f"{fn}: {name} is {v!r}, expected an integer >= {lo}")
     if not (np.isfinite(noise) and noise >= 0):
         raise ValueError(f"{fn}: noise is {noise}, expected a finite value >= 0")
+    rate = real(fps, f"{fn}: fps", finite=False)
+    if not (np.isfinite(rate) and rate > 0):
+        raise ValueError(f"{fn}: fps is {fps}, expected a finite value > 0")
+    return rate
 
 
 def make_scene(
@@ -343,7 +353,7 @@ def make_scene(
     -------
     Scene
     """
-    _check_scene_args("make_scene", n_frames, width, height, noise)
+    fps = _check_scene_args("make_scene", n_frames, width, height, noise, fps)
     if not isinstance(n_walkers, (int, np.integer)) or not 1 <= n_walkers <= 40:
         raise ValueError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
     gen = generator(rng, "make_scene: rng")
@@ -602,7 +612,7 @@ def make_busy_scene(
     """
     if kind not in BUSY_SCENES:
         raise ValueError(f"make_busy_scene: kind is {kind!r}, expected one of {BUSY_SCENES}")
-    _check_scene_args("make_busy_scene", n_frames, width, height, noise)
+    fps = _check_scene_args("make_busy_scene", n_frames, width, height, noise, fps)
     gen = generator(rng, "make_busy_scene: rng")
     bg = _background(width, height, gen)
     grey = kind == "overhead"

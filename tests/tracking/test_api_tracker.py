@@ -620,6 +620,54 @@ def test_a_frame_rate_as_a_fraction_is_a_number():
             pftrack.Tracker(frame_rate=wrong)  # type: ignore[arg-type]
 
 
+def test_every_frame_rate_and_time_takes_a_fraction_as_its_float(scene, tmp_path):
+    """A user trial: the Fraction of the test above worked for Tracker's time constants only.
+    ``birth_score=Fraction(1, 2)`` and ``FrameSource(path, fps=Fraction(...))`` were refused
+    as not numbers, ``VideoWriter`` / ``TrackRenderer`` / ``write_annotated_video`` failed
+    with NumPy's "ufunc 'isfinite' not supported", ``make_scene`` stored it as given, and a
+    NumPy ``float16`` of seconds overflowed ("RuntimeWarning: overflow encountered in cast")."""
+    from fractions import Fraction
+
+    from pftrack.integrations.supervision import SupervisionTracker
+    from pftrack.synthetic import make_busy_scene
+
+    ntsc = Fraction(30000, 1001)
+    as_float = pftrack.Tracker(frame_rate=float(ntsc), max_coast=0.5, prime=1.0,
+                               min_conf=0.25, birth_score=0.5, birth_quantile=0.5)  # fmt: skip
+    for kind in (Fraction, np.float64, np.float32, np.float16):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no overflow in a float16's cast
+            t = pftrack.Tracker(
+                frame_rate=ntsc if kind is Fraction else kind(float(ntsc)),
+                max_coast=kind(1) / 2, prime=kind(1), min_conf=kind(1) / 4,
+                birth_score=kind(1) / 2, birth_quantile=kind(1) / 2,
+            )  # fmt: skip
+        assert t.config == as_float.config and t.prime_frames == as_float.prime_frames
+        assert type(t.config.lifecycle.birth_quantile) is float
+    assert SupervisionTracker(frame_rate=ntsc).tracker.frame_rate == float(ntsc)
+    assert pftrack.Tracker.from_config(frame_rate=ntsc).frame_rate == float(ntsc)
+    video = tmp_path / "scene.avi"
+    with pftrack.VideoWriter(video, ntsc) as writer:
+        for f in scene.frames[:3]:
+            writer.write(f)
+    assert writer.fps == float(ntsc)
+    assert pftrack.FrameSource(video, fps=ntsc).fps == float(ntsc)
+    pftrack.write_annotated_video(tmp_path / "a.avi", scene.frames[:3], scene.truth, ntsc)
+    renderer = pftrack.TrackRenderer(tmp_path / "r.avi", ntsc)
+    renderer.add(scene.frames[0], [])
+    renderer.close()
+    assert make_scene(n_frames=2, fps=ntsc).fps == float(ntsc)
+    assert make_busy_scene("groups", n_frames=2, fps=ntsc).fps == float(ntsc)
+    # what is not a real number is refused, naming the argument
+    for call, name in ((lambda v: pftrack.VideoWriter(tmp_path / "b.avi", v), "video frame rate"),
+                       (lambda v: pftrack.FrameSource(video, fps=v), "fps"),
+                       (lambda v: make_scene(n_frames=2, fps=v), "make_scene: fps"),
+                       (lambda v: pftrack.Tracker(max_coast=v), "max_coast")):  # fmt: skip
+        for wrong in ("25", 2j):
+            with pytest.raises(TypeError, match=f"^{name} must be a number"):
+                call(wrong)
+
+
 def test_no_refine_takes_the_boxes_as_given(scene, tmp_path):
     from pftrack.cli import build_parser
     from pftrack.cli._options import tracker_config

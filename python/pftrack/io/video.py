@@ -45,7 +45,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import number
+from pftrack._check import number, real
 from pftrack._typing import PathLike
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
 
@@ -1099,7 +1099,7 @@ class FrameSource:
         if not (np.isfinite(scale) and scale > 0):
             raise ValueError(f"scale is {scale}, expected a finite value > 0")
         if fps is not None:
-            fps = number(fps, "fps", finite=False)
+            fps = real(fps, "fps", finite=False)  # a Fraction too (PyAV's stream rates)
             if not (np.isfinite(fps) and fps > 0):
                 raise ValueError(f"fps is {fps}, expected a finite value > 0")
         self.scale = scale

@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import colour_hint
+from pftrack._check import colour_hint, real
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
@@ -94,6 +94,9 @@ class VideoWriter:
                 f"video {self.path}: unsupported extension {suffix or '(none)'!r}, expected one "
                 f"of {', '.join(VIDEO_SUFFIXES)}"
             )
+        # any real number (a Fraction: PyAV's rates); text or None a TypeError naming it (was
+        # NumPy's "ufunc 'isfinite' not supported", for a Fraction too)
+        fps = real(fps, "video frame rate", finite=False)
         if not (np.isfinite(fps) and fps > 0):
             raise ValueError(f"video frame rate is {fps}, expected a finite value > 0")
         if preset not in X264_PRESETS:

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import copy
 import itertools
-import numbers
 import operator
 import pickle
 import threading
@@ -36,7 +35,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, flag, integer, not_an_image, number, real_array
+from pftrack._check import bgr_frame, flag, integer, not_an_image, real, real_array
 from pftrack._check import seed as check_seed
 from pftrack._typing import (
     F64,
@@ -91,23 +90,15 @@ def _unpickle_tracker(cls: type[Tracker], data: bytes) -> Tracker:
     return tracker
 
 
-def _real(value: Any) -> Any:
-    """`value` as a float if it is a real number of another type, else as given.
+def _frames(value: object, frame_rate: float, name: str) -> int:
+    """`value` seconds as a whole number of frames at `frame_rate` (TypeError: not a number).
 
-    A :class:`fractions.Fraction` (PyAV's ``stream.average_rate``, ``Fraction(30000, 1001)``)
-    was refused as not a number (:func:`pftrack._check.number` takes ints and floats).
+    Any real number (:func:`pftrack._check.real`: a Fraction, a NumPy scalar), taken as a
+    float (was: a NumPy ``float16`` multiplied in ``float16``, which overflowed comparing).
     """
-    if isinstance(value, numbers.Real) and not isinstance(
-        value, (int, float, np.integer, np.floating)
-    ):
-        return float(value)
-    return value
-
-
-def _frames(seconds: float, frame_rate: float, name: str) -> int:
-    """`seconds` as a whole number of frames at `frame_rate` (TypeError: not a number)."""
-    if not (np.isfinite(number(seconds, name, finite=False)) and seconds >= 0):
-        raise ValueError(f"{name} is {seconds} s, expected a finite number of seconds >= 0")
+    seconds = real(value, name, finite=False)
+    if not (np.isfinite(seconds) and seconds >= 0):
+        raise ValueError(f"{name} is {value} s, expected a finite number of seconds >= 0")
     n = seconds * frame_rate
     if n > MAX_SPAN_FRAMES:
         raise ValueError(
@@ -119,7 +110,7 @@ def _frames(seconds: float, frame_rate: float, name: str) -> int:
 
 def _check_rate(frame_rate: object) -> float:
     """`frame_rate` as a float: TypeError or ValueError unless in ``(0, MAX_FRAME_RATE]``."""
-    rate = number(_real(frame_rate), "frame_rate")
+    rate = real(frame_rate, "frame_rate")  # a Fraction too: PyAV's stream.average_rate
     if not 0 < rate <= MAX_FRAME_RATE:
         raise ValueError(
             f"frame_rate is {frame_rate}, expected a number in (0, {MAX_FRAME_RATE:g}]"
@@ -468,7 +459,14 @@ class Tracker:
         if seed is not None:
             seed = check_seed(seed, "seed")
         frame_rate = _check_rate(frame_rate)
-        max_coast, prime = _real(max_coast), _real(prime)  # a Fraction too, as frame_rate
+        # any real number as its float (a Fraction: PyAV's rates; the messages format floats)
+        min_conf, birth_score = real(min_conf, "min_conf"), real(birth_score, "birth_score")
+        if birth_quantile is not None:
+            birth_quantile = real(birth_quantile, "birth_quantile")
+        if max_coast is not None:
+            max_coast = real(max_coast, "max_coast", finite=False)  # _frames says which
+        if prime is not None:
+            prime = real(prime, "prime", finite=False)
         refine, smooth, link, crossings, record = (
             flag(refine, "refine"), flag(smooth, "smooth"), flag(link, "link"),
             flag(crossings, "crossings"), flag(record, "record"),
@@ -502,8 +500,8 @@ class Tracker:
                     if max_coast is None
                     else _frames(max_coast, frame_rate, "max_coast")
                 ),
-                min_score=number(min_conf, "min_conf"),
-                birth_score=number(birth_score, "birth_score"),
+                min_score=min_conf,
+                birth_score=birth_score,
                 birth_quantile=birth_quantile,
             ),
         )
