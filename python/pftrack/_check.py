@@ -49,6 +49,18 @@ MAX_FRAME = 2**31 - 1
 MAX_ID = MAX_FRAME
 
 
+def frames_from_1(frame: float, mend: str = "rows[:, 0] += 1") -> str:
+    """What a refusal of `frame` as a frame number adds: frames count from 1.
+
+    MOTChallenge frames (and TrackEval's, and pftrack's) are 1-based; a frame 0 is most
+    often a file or array numbered from 0 (Python's ``enumerate``, a video decoder's index),
+    which the words say how to mend: add 1 to every frame (`mend`, how).
+    """
+    if frame == 0:
+        return f"(MOTChallenge frames count from 1: numbered from 0? add 1 to every frame, {mend})"
+    return "(frames count from 1)"
+
+
 def first_bad_id(ids: ArrayLike) -> int | None:
     """Index of the first id that is not an integer with ``|id| <= MAX_ID``, or None.
 

@@ -165,3 +165,51 @@ def test_normalised_boxes_are_warned_about(
     read_tracks(pixels)  # warnings are errors here
     (tmp_path / "empty.txt").write_text("")
     read_tracks(tmp_path / "empty.txt")
+
+
+#: The words a frame 0 gets, wherever rows or a file are refused for it.
+ZERO_BASED = "MOTChallenge frames count from 1: numbered from 0? add 1 to every frame"
+
+
+@pytest.mark.parametrize(
+    "name", ["fill_gaps", "smooth_tracks", "link_tracklets", "repair_crossings", "mot_text"]
+)
+def test_rows_numbered_from_0_are_refused_with_the_mend(name: str) -> None:
+    """A user trial: another tracker's rows numbered from 0 (``enumerate`` over frames) were
+    refused as "frame 0 is not an integer in 1..2147483647 (refused)", no word of why or
+    what to do. MOTChallenge frames count from 1 (``read_mot``, ``eval`` and TrackEval refuse
+    frame 0 too), so the rows stay refused, with the mend; a frame -1 gets no such hint."""
+    call, _ = ENTRY_POINTS[name]
+    rows = ROWS.copy()
+    rows[:, 0] -= 1
+    mend = re.escape(f"({ZERO_BASED}, rows[:, 0] += 1)")
+    with pytest.raises(ValueError, match="frame 0, .*" + mend):
+        call(rows)
+    rows[0, 0] = -1
+    with pytest.raises(ValueError, match=r"frame -1, .* \(frames count from 1\)$"):
+        call(rows)
+    rows[:, 0] += 2  # what the words say: the rows of the same tracks from frame 1
+    call(rows)
+
+
+def test_a_file_numbered_from_0_is_refused_with_the_mend(tmp_path: Path, capsys: Any) -> None:
+    """The same for a file: ``pftrack recover`` / ``smooth`` / ``eval`` and ``read_mot``."""
+    from pftrack.cli import main
+    from pftrack.eval import evaluate_mot
+
+    rows = ROWS.copy()
+    rows[:, 0] -= 1
+    path = tmp_path / "zero.txt"
+    path.write_text("".join(",".join(f"{v:g}" for v in r) + "\n" for r in rows))
+    said = f"zero.txt:1: frame is 0, expected an integer in 1..2147483647 ({ZERO_BASED}, the "
+    with pytest.raises(ValueError, match=re.escape(said)):
+        read_mot(path)
+    for argv in (["recover", str(path), "--out", str(tmp_path / "r.txt")],
+                 ["smooth", str(path), "--out", str(tmp_path / "s.txt")],
+                 ["eval", "--gt", str(path), "--res", str(path)]):  # fmt: skip
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert said in err and err.count("\n") == 1, err
+    gt = re.escape(f"gt row 0 has frame 0, expected >= 1 ({ZERO_BASED}")
+    with pytest.raises(ValueError, match=gt):
+        evaluate_mot(rows, ROWS)

@@ -18,6 +18,7 @@ from pftrack._check import (
     MOT_DEFAULTS,
     bad_id_message,
     first_bad_id,
+    frames_from_1,
     integer,
     number,
     path_refused,
@@ -81,7 +82,7 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     if early.any():  # as read_mot refuses it: MOTChallenge frames count from 1
         k = int(np.flatnonzero(early)[0])
         raise ValueError(
-            f"{what} row {k} has frame {a[k, 0]:g}, expected >= 1 (frames count from 1)"
+            f"{what} row {k} has frame {a[k, 0]:g}, expected >= 1 {frames_from_1(a[k, 0])}"
         )
     negative = (a[:, 4] < 0) | (a[:, 5] < 0)
     if negative.any():  # as read_mot refuses it: such a box overlaps nothing, silently

@@ -21,7 +21,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import BOX_VALUES, MAX_FRAME, MOT_DEFAULTS, first_bad_box, mot_rows
+from pftrack._check import (
+    BOX_VALUES,
+    MAX_FRAME,
+    MOT_DEFAULTS,
+    first_bad_box,
+    frames_from_1,
+    mot_rows,
+)
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write, refuse_dash, refuse_loop
 
@@ -273,7 +280,8 @@ def _parse_line(text: str, what: str) -> list[float] | str:
         )
     frame = values[FRAME]
     if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
-        return f"frame is {fields[0]}, expected an integer in 1..{MAX_FRAME} (frames count from 1)"
+        hint = frames_from_1(frame, "the first value of each line")
+        return f"frame is {fields[0]}, expected an integer in 1..{MAX_FRAME} {hint}"
     values.extend(_DEFAULTS[len(values) :])
     return values
 
@@ -431,7 +439,7 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
         k = int(np.flatnonzero((fr < 1) | (fr > MAX_FRAME))[0])
         raise ValueError(
             f"{who}: row {k} has frame {fr[k]:g}, expected an integer in 1..{MAX_FRAME} "
-            "(frames count from 1)"
+            f"{frames_from_1(fr[k])}"
         )
     bad = first_bad_box(a[:, LEFT : HEIGHT + 1])  # what read_mot refuses is never written
     if bad is not None:

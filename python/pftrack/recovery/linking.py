@@ -27,6 +27,7 @@ from pftrack._check import (
     bad_id_message,
     first_bad_box,
     first_bad_id,
+    frames_from_1,
     mot_rows,
 )
 from pftrack._typing import F64, PathLike
@@ -560,8 +561,10 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
         raise ValueError(f"{what}: row {r} has a non-finite {names[c]} ({a[r, c]}): NaN or inf")
     bad = (f < 1) | (f > MAX_FRAME) | (f != np.floor(f))
     if bad.any():
+        r = int(np.flatnonzero(bad)[0])
         raise ValueError(
-            f"{what}: frame {f[bad][0]:g} is not an integer in 1..{MAX_FRAME} (refused)"
+            f"{what}: row {r} has frame {f[r]:g}, not an integer in 1..{MAX_FRAME} "
+            f"{frames_from_1(f[r])}"
         )
     k = first_bad_id(i)
     if k is not None:
