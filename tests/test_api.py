@@ -382,3 +382,38 @@ def test_readme_recovery_and_kernels_block_runs_as_written() -> None:
     assert namespace["path"].shape == (4, 2)
     assert namespace["filled"].shape[1] == 10 and namespace["report"].n_filled_rows > 0
     assert namespace["hists"].shape[0] == 2 and np.isclose(namespace["w"].sum(), 1.0)
+
+
+def test_printing_a_report_shows_its_readable_form(tmp_path: Path) -> None:
+    """A user trial: ``print(report)`` of what fill_gaps, track_frames, evaluate_* and
+    track_many return printed the whole dataclass on one line (a FillReport its nested
+    calibrations, a HotaMetrics seven (19,) arrays); ``describe()`` / ``table()`` were the
+    readable forms. ``str`` is now that form; ``repr`` still names every field."""
+    from pftrack.batch.engine import BatchSummary
+    from pftrack.eval import format_metrics, format_scores
+
+    scene = pftrack.make_scene(n_frames=30, rng=1)
+    rows = scene.truth[scene.truth[:, 0] % 7 != 3]  # a hole in every track
+    _, report = pftrack.fill_gaps(rows, max_gap=3)
+    assert str(report).splitlines()[0] == (
+        f"fill_gaps (auto): {report.n_gaps} gaps filled, {report.n_filled_rows} rows added"
+    )
+    assert str(report).endswith(report.describe()) and report.n_gaps > 1
+    assert repr(report).startswith("FillReport(n_gaps=")
+    assert report.calibration is not None
+    assert str(report.calibration) == report.calibration.describe()
+    _, long = pftrack.fill_gaps(rows[rows[:, 0] % 7 != 4], "linear", max_gap=1)
+    unfilled = f"{long.n_long_holes} holes longer than max_gap left unfilled (the longest 2 frames)"
+    assert str(long).splitlines()[0].endswith(f"; {unfilled}")
+    mot = pftrack.evaluate_mot(scene.truth, rows)
+    assert str(mot) == format_metrics(mot) and repr(mot).startswith("MotMetrics(mota=")
+    scores = pftrack.evaluate_sequence(scene.truth, rows)
+    assert str(scores) == format_scores({"result": scores})
+    hota = scores.hota
+    head, values, note = str(hota).splitlines()
+    assert head.split() == ["HOTA", "DetA", "AssA", "DetRe", "DetPr", "AssRe", "AssPr", "LocA"]
+    assert values.split()[0] == f"{100 * hota.hota:.1f}" and "array(" not in str(hota)
+    run = pftrack.track_frames(scene.frames[:12], show_progress=False)
+    assert str(run).startswith(f"TrackingRun: 12 frames, {len(np.unique(run.rows[:, 1]))} track")
+    summary = BatchSummary("track", tmp_path, [{"name": "a", "status": "done"}])
+    assert str(summary) == summary.table()

@@ -164,6 +164,10 @@ class BatchSummary:
         """JSON text of :meth:`as_dict`."""
         return json.dumps(self.as_dict(), indent=2)
 
+    def __str__(self) -> str:
+        """:meth:`table`, what ``print(summary)`` shows (``repr``: every field)."""
+        return self.table()
+
     def table(self, problems: bool = True) -> str:
         """A text table: one line per task, then the totals, the notes and the problems.
 

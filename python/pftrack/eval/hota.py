@@ -153,6 +153,22 @@ class HotaMetrics:
         """HOTA at the lowest threshold (0.05), TrackEval's ``HOTA(0)``."""
         return float(self.hota_alpha[0])
 
+    def __str__(self) -> str:
+        """What ``print(metrics)`` shows: :meth:`summary` as percentages (``repr``: arrays).
+
+        Was the dataclass's every field, seven (19,) arrays of them.
+        """
+        names = ("HOTA", "DetA", "AssA", "DetRe", "DetPr", "AssRe", "AssPr", "LocA")
+        values = [f"{100.0 * v:.1f}" for v in self.summary().values()]
+        widths = [max(len(n), len(v)) for n, v in zip(names, values, strict=True)]
+        return (
+            "\n".join(
+                "  ".join(c.rjust(w) for c, w in zip(row, widths, strict=True))
+                for row in (names, values)
+            )
+            + "\n(TrackEval's HOTA and its parts, means over the 19 localisation thresholds)"
+        )
+
     def summary(self) -> dict[str, float]:
         """The scalar scores (means over thresholds), keyed by metric name."""
         return {

@@ -158,6 +158,10 @@ class MotMetrics:
         """Human-readable text table (see :func:`format_metrics`)."""
         return format_metrics(self)
 
+    def __str__(self) -> str:
+        """:meth:`table`, what ``print(metrics)`` shows (``repr``: every field)."""
+        return format_metrics(self)
+
 
 def _pct(x: float) -> str:
     return "-" if not math.isfinite(x) else f"{100.0 * x:.1f}"  # "-": no value (JSON: null)

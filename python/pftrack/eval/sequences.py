@@ -434,6 +434,10 @@ class SequenceScores:
     hota: HotaMetrics
     benchmark: str
 
+    def __str__(self) -> str:
+        """:func:`format_scores` of this row, what ``print(scores)`` shows (``repr``: fields)."""
+        return format_scores({"result": self})
+
     def as_dict(self) -> dict[str, object]:
         """Flat JSON-ready dict: HOTA's scores, then CLEAR-MOT's, per-alpha arrays nested."""
         h = self.hota.as_dict()

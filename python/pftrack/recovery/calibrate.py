@@ -237,6 +237,10 @@ class Calibration:
                 return c.weights or ((c.method, 1.0),)
         return self.pooled_weights or ((self.pooled, 1.0),)
 
+    def __str__(self) -> str:
+        """:meth:`describe`, what ``print(calibration)`` shows (``repr``: every field)."""
+        return self.describe()
+
     def describe(self) -> str:
         """A table: per bucket, the chosen method, each candidate's validation MMAE, counts."""
         if not self.buckets:

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
 from pftrack._check import MAX_COORD
+from pftrack._text import counted
 from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.calibrate import Calibration, bags_for, gap_windows, recover_auto
 from pftrack.recovery.linking import (
@@ -82,6 +83,19 @@ class FillReport:
     n_long_holes: int = 0
     longest_hole: int = 0
     method: RecoveryMethod = DEFAULT_METHOD
+
+    def __str__(self) -> str:
+        """What ``print(report)`` shows: the counts, then :meth:`describe` (``repr``: fields).
+
+        Was the dataclass's every field, nested calibrations and all, on one line.
+        """
+        filled = f"{counted(self.n_gaps, 'gap')} filled, {counted(self.n_filled_rows, 'row')} added"
+        if self.n_long_holes:
+            filled += (
+                f"; {counted(self.n_long_holes, 'hole')} longer than max_gap left unfilled "
+                f"(the longest {counted(self.longest_hole, 'frame')})"
+            )
+        return f"fill_gaps ({self.method}): {filled}\n{self.describe()}"
 
     def describe(self, method: str | None = None) -> str:
         """What was chosen: what ``pftrack recover --explain`` prints.

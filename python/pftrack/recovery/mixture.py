@@ -155,6 +155,10 @@ class MotionFit:
     v2: tuple[float, float]
     noise: NoiseEstimate
 
+    def __str__(self) -> str:
+        """:meth:`describe`, what ``print(fit)`` shows (``repr``: every field)."""
+        return self.describe()
+
     def describe(self) -> str:
         """One line: the model of each axis, the stand rate and the restart velocity."""
         parts = []

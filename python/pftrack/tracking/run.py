@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import MAX_FRAME, first_bad_box, flag, generator, number, real_array
 from pftrack._progress import progress
+from pftrack._text import counted
 from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
@@ -52,6 +53,14 @@ class TrackingRun:
     def fps(self) -> float:
         """Frames per second over the whole run."""
         return self.n_frames / self.seconds if self.seconds > 0 else float("inf")
+
+    def __str__(self) -> str:
+        """What ``print(run)`` shows: frames, tracks, rows and speed (``repr``: the rows)."""
+        n_ids = len(np.unique(self.rows[:, 1])) if len(self.rows) else 0
+        return (
+            f"TrackingRun: {counted(self.n_frames, 'frame')}, {counted(n_ids, 'track')}, "
+            f"{counted(len(self.rows), 'row')} in {self.seconds:.2f} s ({self.fps:.1f} frames/s)"
+        )
 
 
 #: The detection scales :func:`load_detections` accepts (``--det-scale``, ``TrackOptions``).
