@@ -60,11 +60,22 @@ class Held:
     def release(self, stacklevel: int) -> None:
         """Give the held warnings, from the line `stacklevel` names (as ``warnings.warn``'s).
 
-        Call it after the block, once the state is whole. Under ``-W error`` the first one
-        raises (the rest of that call are not given).
+        Call it after the block, once the state is whole. Every one is given: under ``-W
+        error`` the first one made an error is raised once all are given, the others made
+        errors added to it as notes (``add_note``, Python 3.11 on), so that none is lost (a
+        once-a-run warning is not given again).
         """
         if not self.outermost:
             return
         pending, self.pending = self.pending, []
+        first: Warning | None = None
         for message, category in pending:
-            warnings.warn(message, category, stacklevel=stacklevel + 1)
+            try:
+                warnings.warn(message, category, stacklevel=stacklevel + 1)
+            except Warning as raised:  # made an error by the filters: the rest still given
+                if first is None:
+                    first = raised
+                elif hasattr(first, "add_note"):  # Python 3.11 on
+                    first.add_note(f"{category.__name__}: {message}")
+        if first is not None:
+            raise first

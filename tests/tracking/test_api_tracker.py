@@ -6,6 +6,7 @@ import copy
 import dataclasses
 import itertools
 import re
+import sys
 import warnings
 from pathlib import Path
 
@@ -1764,3 +1765,21 @@ def test_a_warning_made_an_error_leaves_the_multi_object_tracker_whole(scene):
         warnings.simplefilter("always")
         pftrack.MultiObjectTracker(rng=0).update(scene.frames[0], dets[0])
     assert [Path(w.filename).name for w in caught] == [Path(__file__).name]
+
+
+def test_a_frames_warnings_made_errors_are_all_given(scene):
+    """A user trial: under ``-W error`` a frame with a box without area and a negative
+    confidence raised the first warning only; the second, said once a run, was never given."""
+    tracker = pftrack.Tracker(frame_rate=10.0)
+    dets = np.array([[50.0, 50, 50, 80, 0.9], [100, 100, 130, 180, -0.4]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match="^1 detection box without area") as raised:
+            tracker.update(dets, scene.frames[0])
+        if sys.version_info >= (3, 11):  # add_note
+            assert raised.value.__notes__ == [
+                "UserWarning: a detection confidence is -0.4: confidences below min_conf 0 are "
+                "ignored (logits? give probabilities in [0, 1], or set min_conf)"
+            ]
+        tracker.update(dets, scene.frames[1])  # each said once a run: the run goes on
+    assert tracker.frame_count == 2
