@@ -401,7 +401,9 @@ def real(value: object, what: str, *, finite: bool = True) -> float:
         try:
             value = float(value)
         except OverflowError:
-            raise ValueError(f"{what} is {value}, beyond a float's range (±1.8e+308)") from None
+            raise ValueError(  # its digits unprinted, as number()'s int beyond the range
+                f"{what} is a {type(value).__name__} beyond a float's range (±1.8e+308)"
+            ) from None
     return number(value, what, finite=finite)
 
 

@@ -667,6 +667,8 @@ def test_every_frame_rate_and_time_takes_a_fraction_as_its_float(scene, tmp_path
         for wrong in ("25", 2j):
             with pytest.raises(TypeError, match=f"^{name} must be a number"):
                 call(wrong)
+        with pytest.raises(ValueError, match=f"^{name} is a Fraction beyond a float's range"):
+            call(Fraction(10**400))  # named, not printed: 401 digits
 
 
 def test_no_refine_takes_the_boxes_as_given(scene, tmp_path):
