@@ -78,9 +78,9 @@ def test_default_max_gap_everywhere() -> None:
 @pytest.mark.parametrize(
     ("bad", "match"),
     [
-        (1e12, "frame 1e\\+12 is not an integer"),
-        (2.5, "frame 2.5 is not an integer"),
-        (0, "frame 0 is not an integer"),
+        (1e12, "row 0 has frame 1e\\+12, not an integer"),
+        (2.5, "row 0 has frame 2.5, not an integer"),
+        (0, "row 0 has frame 0, not an integer .*add 1 to every frame"),
         (np.nan, "non-finite"),
     ],
 )
