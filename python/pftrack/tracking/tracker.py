@@ -34,7 +34,7 @@ from pftrack.boxes import _iou_matrix, _to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
-from pftrack.tracking.association import associate, covers_another
+from pftrack.tracking.association import _covers, associate
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
@@ -594,8 +594,8 @@ class MultiObjectTracker:
         for (ti, di), big in zip(result.matches, large.tolist(), strict=True):
             if big:
                 follow_pending()
-                others = np.array([o.box for k, o in enumerate(tracks) if k != ti])
-                if covers_another(boxes[di], others):
+                others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti)
+                if _covers(boxes[di].tolist(), others):
                     continue  # a merged blob: the track keeps its own prediction
             followed.append((ti, di))
         follow_pending()
