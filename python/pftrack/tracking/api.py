@@ -1074,21 +1074,21 @@ class Tracker:
             self._torn = 0
             # coasting tracks (carried by the particle filter alone) are held back
             live = [t for t in reports if t.time_since_update == 0]
-            out = np.zeros((len(live), 8))
-            if live:
-                b = np.array([t.box_xywh for t in live])
-                if self._scale is not None:
-                    b = b / self._scale
-                out[:, 0:2] = b[:, 0:2]
-                out[:, 2:4] = b[:, 0:2] + b[:, 2:4]
-                out[:, 4:7] = [(t.id, t.score, t.cls) for t in live]
-                if kept is not None:
-                    out[:, 7] = [
-                        -1 if t.detection_index is None else kept[t.detection_index] for t in live
-                    ]
-                else:
-                    out[:, 7] = -1
-            return out
+            if not live:
+                return np.zeros((0, 8))
+            # the rows on plain floats, one array made of them (the same float64 operations as
+            # over arrays: a box divided by the scale, x2 = x1 + w; ids and rows as floats)
+            scale = None if self._scale is None else self._scale.tolist()
+            rows = kept.tolist() if kept is not None else None
+            out = []
+            for t in live:
+                x, y, w, h = t.box_xywh.tolist()
+                if scale is not None:
+                    x, y, w, h = x / scale[0], y / scale[1], w / scale[2], h / scale[3]
+                i = t.detection_index
+                row = -1 if rows is None or i is None else rows[i]
+                out.append((x, y, x + w, y + h, t.id, t.score, t.cls, row))
+            return np.array(out, dtype=np.float64)
 
     @property
     def last_reports(self) -> list[Track]:
