@@ -570,10 +570,14 @@ class MultiObjectTracker:
         #    (the particles and references of all of them re-seeded at once, at the end)
         smooth = cfg.motion.smooth_external and detections is not None
         followed: list[tuple[int, int]] = []
-        pairs = np.array(result.matches, np.int64).reshape(-1, 2)
-        size = np.array([tracks[ti].size for ti in pairs[:, 0]]).reshape(-1, 2)
-        b = boxes[pairs[:, 1]]
-        large = b[:, 2] * b[:, 3] > cfg.association.merge_ratio * size[:, 0] * size[:, 1]
+        # a detection larger than merge_ratio times its track's size may be a merged blob (on
+        # plain floats, the same products as over arrays; sizes from before the tracks follow)
+        box_list = boxes.tolist()
+        ratio = cfg.association.merge_ratio
+        large = []
+        for ti, di in result.matches:
+            w, h = tracks[ti].size.tolist()
+            large.append(box_list[di][2] * box_list[di][3] > ratio * w * h)
         score_list, index_list = scores.tolist(), index.tolist()
         for ti, di in result.matches:
             tracks[ti].matched(score_list[di], index_list[di])
@@ -591,11 +595,11 @@ class MultiObjectTracker:
                 )
                 moved = len(followed)
 
-        for (ti, di), big in zip(result.matches, large.tolist(), strict=True):
+        for (ti, di), big in zip(result.matches, large, strict=True):
             if big:
                 follow_pending()
                 others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti)
-                if _covers(boxes[di].tolist(), others):
+                if _covers(box_list[di], others):
                     continue  # a merged blob: the track keeps its own prediction
             followed.append((ti, di))
         follow_pending()
