@@ -516,6 +516,24 @@ def test_boxes_outside_the_frame_are_clipped_once(scene):
     )
 
 
+@pytest.mark.parametrize("cols", [4, 5, 6])
+def test_boxes_all_inside_the_frame_are_checked_as_any_others(cols):
+    # the usual frame (every box with an extent, inside the frame) takes a shorter path: the
+    # same arrays as the general one, which one box reaching outside the frame takes
+    h, w = 120, 160
+    rows = [[-0.0, 0.0, 30, 40, 0.9, 2], [10, 5, 160, 120, 0.4, 0], [3.5, 7.25, 9, 8, 1, 1]]
+    dets = np.array(rows)[:, :cols]
+    fast = check_boxes_xyxy(dets, (h, w))
+    outside = np.vstack([dets, [[-50, 10, -10, 30, 0.5, 1][:cols]]])
+    general = check_boxes_xyxy(outside, (h, w))
+    assert general.clipped and list(general.kept) == [0, 1, 2]  # the box outside dropped
+    assert (fast.clipped, fast.flat, fast.inverted, fast.extent) == (False, 0, 0, 3)
+    assert general.extent == 4
+    for a, b in zip(fast[:3], general[:3], strict=True):
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes()  # -0.0 made +0.0 by both
+    assert not np.signbit(fast.xywh_score[0, 0])
+
+
 @pytest.mark.parametrize(
     ("dets", "error", "match"),
     [

@@ -520,6 +520,31 @@ def test_writer_rows_in_blocks_read_back_from_any_row() -> None:
     assert len(store) == 11
 
 
+@pytest.mark.parametrize("sizes", [[4, 0, 2, 5], [1, 1, 1, 1, 1, 1, 1], [11]])
+def test_writer_rows_extended_in_runs_equal_rows_appended_one_by_one(sizes) -> None:
+    """A frame's rows written at once (TrackWriter.add) across block boundaries (blocks of 3)
+    are the rows and detection boxes appended one by one."""
+    from pftrack.tracking.writer import _Rows
+
+    class Small(_Rows):
+        BLOCK = 3
+
+    one, runs = Small(), Small()
+    i = 0
+    for n in sizes:
+        rows, boxes = [], []
+        for _ in range(n):
+            rows.append([float(i), 1.0, i + 0.25, 2.0, 3.0, 4.0, 0.5, -1.0, -1.0, -1.0])
+            boxes.append(None if i % 4 == 1 else np.array([i + 0.5, 1.0, 2.0, 3.0]))
+            one.append(rows[-1], boxes[-1])
+            i += 1
+        runs.extend(rows, boxes)
+        assert len(runs) == len(one) == i
+        for a, b in zip(runs.arrays(), one.arrays(), strict=True):
+            np.testing.assert_array_equal(a, b)
+    assert runs.arrays()[2].sum() == sum(k % 4 != 1 for k in range(i))
+
+
 def test_a_writer_checkpointed_with_list_rows_loads() -> None:
     """A pickle of a writer made before its rows went into blocks (lists of floats and a
     list of detection boxes) loads and gives the same result as the writer it was."""

@@ -462,3 +462,24 @@ def test_a_speckle_of_tiny_boxes_changes_nothing():
         return np.array(rows)
 
     np.testing.assert_array_equal(run(True), run(False))
+
+
+@pytest.mark.parametrize("measured", [True, False])
+def test_reported_tracks_are_tracks_made_by_their_dataclass(measured):
+    # LiveTrack.report makes its Track without the frozen dataclass's __init__ (speed): the
+    # object must be the one Track(...) makes, every field set, pickled to the same bytes
+    import dataclasses
+    import pickle
+
+    from pftrack.tracking.track import Track, _new_track
+
+    box, det = np.array([1.0, 2.0, 3.0, 4.0]), np.array([1.5, 2.5, 3.0, 4.0])
+    history = ((3, np.array([0.0, 1.0, 2.0, 3.0]), 0.7),)
+    values = (7, box, 0.9, 2 if measured else None, 5, 0, history, det if measured else None, 1)
+    fast, made = _new_track(*values), Track(*values)
+    assert type(fast) is Track
+    assert list(vars(fast)) == [f.name for f in dataclasses.fields(Track)] == list(vars(made))
+    assert repr(fast) == repr(made)
+    assert pickle.dumps(fast) == pickle.dumps(made)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.score = 0.0  # type: ignore[misc]

@@ -11,10 +11,11 @@ costs ``unmatched_cost`` each, so a gated pair is only made when it is cheaper t
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
 from pftrack._typing import F64
@@ -85,13 +86,8 @@ def associate(
     if math.isfinite(config.unmatched_cost):
         # leaving a track or a detection unmatched costs `unmatched_cost` each, so a pair is
         # only made when it is cheaper than leaving both alone (not just because it is gated)
-        tau = config.unmatched_cost
-        padded = np.full((nt + nd, nd + nt), FORBIDDEN)
+        padded = _padding(nt, nd, config.unmatched_cost).copy()
         padded[:nt, :nd] = cost
-        k = np.arange(max(nt, nd))
-        padded[k[:nt], nd + k[:nt]] = tau  # the diagonal of padded[:nt, nd:]
-        padded[nt + k[:nd], k[:nd]] = tau  # the diagonal of padded[nt:, :nd]
-        padded[nt:, nd:] = 0.0
         cost_in = padded
     else:
         cost_in = np.ascontiguousarray(cost)
@@ -115,11 +111,50 @@ def associate(
     )
 
 
-def covers_another(box_xywh: F64, others_xywh: F64) -> bool:
+#: Padded cost matrices made so far, by (tracks, detections, unmatched cost): a frame's
+#: matrix is a copy of its template with the pairs' costs written in (one NumPy call instead
+#: of seven; a run sees a few shapes, the number of objects in view).
+_PADDING: dict[tuple[int, int, float], F64] = {}
+_PADDING_KEPT = 256
+
+
+def _padding(nt: int, nd: int, tau: float) -> F64:
+    """The padded matrix of :func:`associate` with every pair forbidden (read-only, shared).
+
+    ``[[pairs, tau on the diagonal], [tau on the diagonal, 0]]``: leaving a track or a
+    detection unmatched costs `tau`, two padding entries nothing.
+    """
+    key = (nt, nd, tau)
+    padded = _PADDING.get(key)
+    if padded is None:
+        padded = np.full((nt + nd, nd + nt), FORBIDDEN)
+        k = np.arange(max(nt, nd))
+        padded[k[:nt], nd + k[:nt]] = tau  # the diagonal of padded[:nt, nd:]
+        padded[nt + k[:nd], k[:nd]] = tau  # the diagonal of padded[nt:, :nd]
+        padded[nt:, nd:] = 0.0
+        padded.flags.writeable = False
+        if len(_PADDING) >= _PADDING_KEPT:  # a long run of varied crowds: start afresh
+            _PADDING.clear()
+        _PADDING[key] = padded
+    return padded
+
+
+def covers_another(box_xywh: ArrayLike, others_xywh: ArrayLike) -> bool:
     """Tell whether `box_xywh` contains the centre of any of `others_xywh` (a merged blob)."""
-    if len(others_xywh) == 0:
-        return False
-    b, o = box_xywh, others_xywh
-    inside_x = (o[:, 0] + o[:, 2] / 2 > b[0]) & (o[:, 0] + o[:, 2] / 2 < b[0] + b[2])
-    inside_y = (o[:, 1] + o[:, 3] / 2 > b[1]) & (o[:, 1] + o[:, 3] / 2 < b[1] + b[3])
-    return bool(np.any(inside_x & inside_y))
+    others = np.asarray(others_xywh, dtype=np.float64).reshape(-1, 4).tolist()
+    return _covers(np.asarray(box_xywh, dtype=np.float64).tolist(), others)
+
+
+def _covers(box_xywh: Sequence[float], others_xywh: Iterable[Sequence[float]]) -> bool:
+    """:func:`covers_another` of plain floats (the same comparisons of the same floats).
+
+    The tracker asks once per large detection, against a few to tens of tracks: NumPy's calls
+    on such tiny arrays cost more than the loop.
+    """
+    x, y, w, h = box_xywh
+    right, bottom = x + w, y + h
+    for ox, oy, ow, oh in others_xywh:
+        cx, cy = ox + ow / 2, oy + oh / 2
+        if x < cx < right and y < cy < bottom:
+            return True
+    return False

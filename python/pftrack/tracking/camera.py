@@ -35,6 +35,7 @@ References
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
@@ -112,10 +113,17 @@ def _affine(affine: ArrayLike) -> F64:
 def motion_magnitude(affine: ArrayLike, size: tuple[int, int]) -> float:
     """Largest displacement (pixels) of the corners of a `size` = (height, width) image."""
     a = np.asarray(affine, dtype=np.float64)
-    h, w = size
-    corners = np.array([[0.0, 0.0], [w, 0.0], [0.0, h], [w, h]])
+    corners = _image_corners(size[0], size[1])
     moved = corners @ a[:, :2].T + a[:, 2]
     return float(np.max(np.hypot(*(moved - corners).T)))
+
+
+@functools.lru_cache(maxsize=16)
+def _image_corners(h: int, w: int) -> F64:
+    """The corners (4, 2) of an `h` x `w` image (read-only: one array for every frame)."""
+    corners = np.array([[0.0, 0.0], [w, 0.0], [0.0, h], [w, h]])
+    corners.flags.writeable = False
+    return corners
 
 
 def _grey(frame: NDArray[np.uint8], factor: float) -> NDArray[np.uint8]:
@@ -264,15 +272,14 @@ class _Measure:
              ) -> tuple[F64 | None, NDArray[np.bool_]]:  # fmt: skip
         """The similarity from `src` to `dst` (N, 2) by RANSAC, and its inliers (None: too few)."""
         cfg = self.config
-        none = np.zeros(len(src), bool)
         if len(src) < cfg.min_inliers:
-            return None, none
+            return None, np.zeros(len(src), bool)
         m, inliers = cv2.estimateAffinePartial2D(
             src, dst, method=cv2.RANSAC, ransacReprojThreshold=cfg.ransac_threshold,
             maxIters=2000, confidence=0.995, refineIters=10,
         )  # fmt: skip
-        if m is None or inliers is None or int(inliers.sum()) < cfg.min_inliers:
-            return None, none
+        if m is None or inliers is None or np.count_nonzero(inliers) < cfg.min_inliers:
+            return None, np.zeros(len(src), bool)
         return np.asarray(m, dtype=np.float64), inliers.reshape(-1) == 1
 
 

@@ -34,7 +34,7 @@ from pftrack.boxes import _iou_matrix, _to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
-from pftrack.tracking.association import associate, covers_another
+from pftrack.tracking.association import _covers, associate
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
@@ -583,10 +583,14 @@ class MultiObjectTracker:
         #    (the particles and references of all of them re-seeded at once, at the end)
         smooth = cfg.motion.smooth_external and detections is not None
         followed: list[tuple[int, int]] = []
-        pairs = np.array(result.matches, np.int64).reshape(-1, 2)
-        size = np.array([tracks[ti].size for ti in pairs[:, 0]]).reshape(-1, 2)
-        b = boxes[pairs[:, 1]]
-        large = b[:, 2] * b[:, 3] > cfg.association.merge_ratio * size[:, 0] * size[:, 1]
+        # a detection larger than merge_ratio times its track's size may be a merged blob (on
+        # plain floats, the same products as over arrays; sizes from before the tracks follow)
+        box_list = boxes.tolist()
+        ratio = cfg.association.merge_ratio
+        large = []
+        for ti, di in result.matches:
+            w, h = tracks[ti].size.tolist()
+            large.append(box_list[di][2] * box_list[di][3] > ratio * w * h)
         score_list, index_list = scores.tolist(), index.tolist()
         for ti, di in result.matches:
             tracks[ti].matched(score_list[di], index_list[di])
@@ -604,11 +608,11 @@ class MultiObjectTracker:
                 )
                 moved = len(followed)
 
-        for (ti, di), big in zip(result.matches, large.tolist(), strict=True):
+        for (ti, di), big in zip(result.matches, large, strict=True):
             if big:
                 follow_pending()
-                others = np.array([o.box for k, o in enumerate(tracks) if k != ti])
-                if covers_another(boxes[di], others):
+                others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti)
+                if _covers(box_list[di], others):
                     continue  # a merged blob: the track keeps its own prediction
             followed.append((ti, di))
         follow_pending()
@@ -711,6 +715,8 @@ def tiny_inside(boxes: F64, shape: tuple[int, ...], min_area: float) -> NDArray[
     """
     rows, cols = shape[0], shape[1]
     small = boxes[:, 2] * boxes[:, 3] < min_area
+    if not small.any():  # the usual frame: no small box, none to test against the border
+        return small
     clear = (
         (boxes[:, 0] > 0.5)
         & (boxes[:, 1] > 0.5)

@@ -45,6 +45,25 @@ class _Rows:
             self._has[self._n] = True
         self._n += 1
 
+    def extend(self, rows: list[list[float]], boxes: list[F64 | None]) -> None:
+        """:meth:`append` of each row and its box in turn, the rows of a block in one copy.
+
+        A frame's rows (one per track reported) were one NumPy assignment each.
+        """
+        at = 0
+        while at < len(rows):
+            if self._n == self.BLOCK:
+                self._done.append((self._rows, self._boxes, self._has))
+                self._new()
+            k = min(len(rows) - at, self.BLOCK - self._n)
+            self._rows[self._n : self._n + k] = rows[at : at + k]
+            for j, box in enumerate(boxes[at : at + k], start=self._n):
+                if box is not None:
+                    self._boxes[j] = box
+                    self._has[j] = True
+            self._n += k
+            at += k
+
     def __len__(self) -> int:
         return self.BLOCK * len(self._done) + self._n
 
@@ -127,11 +146,14 @@ class TrackWriter:
 
     def add(self, frame: int, tracks: list[Track]) -> None:
         """Record the tracks reported for `frame` (1-based)."""
+        rows: list[list[float]] = []  # the frame's rows in order, written at once at the end
+        boxes: list[F64 | None] = []
         for t in tracks:
             self._cls[t.id] = t.cls
             for f, box, score in t.history:  # a new track's detections from before confirmation
                 row = [float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0]
-                self._append(row, np.asarray(box))
+                rows.append(row)
+                boxes.append(np.asarray(box))
             row = [float(frame), float(t.id), *t.box_xywh.tolist(), float(t.score)]
             row += [-1.0, -1.0, -1.0]
             if t.time_since_update == 0:
@@ -141,14 +163,18 @@ class TrackWriter:
                     for p in pending:
                         u = (p[0] - a[0]) / (b[0] - a[0])
                         p[2:6] = list((1 - u) * a[2:6] + u * b[2:6])
-                for p in pending:
-                    self._append(p, None)
-                self._append(row, t.detection_box)
+                rows += pending
+                boxes += [None] * len(pending)
+                rows.append(row)
+                boxes.append(t.detection_box)
                 self._last[t.id] = row
             elif self.coasting == "all":
-                self._append(row, None)
+                rows.append(row)
+                boxes.append(None)
             elif self.coasting == "confirmed":
                 self._pending.setdefault(t.id, []).append(row)
+        if rows:
+            self.rows.extend(rows, boxes)
 
     def result(self, drop: Collection[int] = (), crossings: CrossingConfig | None = None,
                relink_coast: int | None = None) -> F64:  # fmt: skip
