@@ -625,6 +625,32 @@ def _artificial_gaps(
     return out
 
 
+def _rank_z(x: F64, y: F64) -> float:
+    """One-sided Mann-Whitney statistic that `x` tends to be larger than `y`, in standard errors.
+
+    ``(U - n_x n_y / 2) / sd(U)`` with ``U`` from mid-ranks (tied values share their ranks) and
+    the normal approximation's tie-corrected variance
+    ``n_x n_y / 12 * (n + 1 - sum(t^3 - t) / (n (n - 1)))``, ``t`` the sizes of the groups of
+    equal values (the ``z`` of ``scipy.stats.mannwhitneyu(x, y, alternative="greater",
+    method="asymptotic", use_continuity=False)``). Without the correction the variance is too
+    large where end-point distances repeat, and the test too timid.
+    0 when there is nothing to rank: an empty sample, or every value equal.
+    """
+    n1, n2 = len(x), len(y)
+    n = n1 + n2
+    if n1 == 0 or n2 == 0:
+        return 0.0
+    _, inv, counts = np.unique(np.concatenate([x, y]), return_inverse=True, return_counts=True)
+    first = np.r_[0, np.cumsum(counts)[:-1]]
+    ranks = (first + (counts + 1) / 2.0)[inv]  # mid-ranks, ties shared
+    u = float(ranks[:n1].sum()) - n1 * (n1 + 1) / 2.0
+    ties = float((counts.astype(np.float64) ** 3 - counts).sum())
+    var = n1 * n2 / 12.0 * ((n + 1) - ties / (n * (n - 1)))
+    if not var > 0:
+        return 0.0
+    return (u - n1 * n2 / 2.0) / math.sqrt(var)
+
+
 def _matched_weights(
     cut: Sequence[tuple[F64, F64, F64, int]],
     targets: Sequence[tuple[int, float, int, int]],
@@ -637,26 +663,20 @@ def _matched_weights(
     those are used up and the bucket fills with slower places, which rate the methods for
     slower motion. When a one-sided rank test (Mann-Whitney, normal approximation) says the
     real gaps' distances are larger than the validation gaps' by more than :data:`PAIRED_Z`
-    standard errors, each real gap takes the ``ceil(n / n_real)`` validation gaps nearest to
-    it (``|log(1 + d) - log(1 + d_real)| + |log(L + 1) - log(L_real + 1)|``) and a validation
-    gap's weight is the number of real gaps that took it. None otherwise (every gap alike).
+    standard errors (:func:`_rank_z`), each real gap takes the ``ceil(n / n_real)`` validation
+    gaps nearest to it (``|log(1 + d) - log(1 + d_real)| + |log(L + 1) - log(L_real + 1)|``)
+    and a validation gap's weight is the number of real gaps that took it. None otherwise
+    (every gap alike).
     """
-    if not cut or any(t[1] < 0 for t in targets):
+    if not cut or not targets or any(t[1] < 0 for t in targets):
         return None
     dv = np.array(
         [np.round(np.hypot(*(b[0, 1:3] - a[-1, 1:3])), SPAN_DECIMALS) for a, b, _, _ in cut]
     )
     lv = np.array([len(t) for _, _, t, _ in cut], dtype=np.float64)
-    real = np.log1p(np.array([t[1] for t in targets]))
     val = np.log1p(dv)
-    n1, n2 = len(real), len(val)
-    both = np.concatenate([real, val])
-    _, inv, counts = np.unique(both, return_inverse=True, return_counts=True)
-    first = np.r_[0, np.cumsum(counts)[:-1]]
-    ranks = (first + (counts + 1) / 2.0)[inv]  # mid-ranks, ties shared
-    u = float(ranks[:n1].sum()) - n1 * (n1 + 1) / 2.0
-    z = (u - n1 * n2 / 2.0) / math.sqrt(n1 * n2 * (n1 + n2 + 1) / 12.0)
-    if z <= PAIRED_Z:
+    n1, n2 = len(targets), len(val)
+    if _rank_z(np.log1p(np.array([t[1] for t in targets])), val) <= PAIRED_Z:
         return None
     k = math.ceil(n2 / n1)
     count = np.zeros(n2)
