@@ -733,9 +733,12 @@ def calibrate(
     bags : int or None
         Bootstrap resamples of each bucket's validation gaps (>= 0, seeded by `seed`): the
         choice (file, bucket, combination) is made on each and the methods' weights are
-        averaged, which blends the methods different resamples chose. 0: one choice on the
-        validation gaps as drawn. None (default): :data:`BAGS` with `combine`, 0 without
-        (:func:`bags_for`; more than 0 with ``combine=False`` is refused).
+        averaged, which blends the methods different resamples chose. A bucket whose real
+        gaps a rank test finds faster than its validation gaps draws them by nearness to the
+        real gaps (:func:`_matched_weights`), and its floor at ``linear`` is weighted alike.
+        0: one choice on the validation gaps as drawn. None (default): :data:`BAGS` with
+        `combine`, 0 without (:func:`bags_for`; more than 0 with ``combine=False`` is
+        refused).
     regions : bool
         With `spans`, cut the artificial gaps where possible as the real gaps of a masked or
         occluded region are made: :data:`REGION_SQUARES` random squares whose side is the
