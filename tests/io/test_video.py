@@ -547,6 +547,26 @@ def test_a_negative_camera_index_is_refused_not_a_crash() -> None:
 
 
 @pytest.mark.parametrize(
+    ("source", "message"),
+    [
+        (2**31, "camera index is 2147483648, expected an int from 0 to 2147483647"),
+        ("99999999999999999999", "camera index is 99999999999999999999, expected an int from "),
+        ("\u00b2", "video source not found: \u00b2"),  # '²'.isdigit(), but no number
+        ("\u0663", "video source not found: \u0663"),  # an Arabic-Indic 3: not camera 3
+    ],
+)
+def test_a_camera_index_is_ascii_digits_of_an_int(source: object, message: str) -> None:
+    """Was: OpenCV's multi-line overload error (a C int is too small), ``'\u00b2'``: "invalid
+    literal for int() with base 10", and ``'\u0663'`` opened camera 3 (``str.isdigit`` takes any
+    Unicode digit)."""
+    with pytest.raises((ValueError, FileNotFoundError), match=re.escape(message)) as info:
+        FrameSource(source)  # type: ignore[arg-type]
+    assert "\n" not in str(info.value)
+    if isinstance(source, str):
+        assert is_live_source(source) == source.isascii()
+
+
+@pytest.mark.parametrize(
     ("source", "error", "message"),
     [
         (True, TypeError, "video source is True, a bool; expected a video file, "),

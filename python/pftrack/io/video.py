@@ -85,6 +85,8 @@ MAX_IMAGE_SIDE = 100_000
 #: The codec FFmpeg's ``tty`` demuxer reports: it opens text files (``.txt``, ``.nfo``, ``.asc``,
 #: ...) as ANSI art, 640x400 frames of rendered characters. A text file is not a video.
 TEXT_FOURCC = "ansi"
+#: Largest camera index (OpenCV's ``VideoCapture(index)`` takes a C int).
+MAX_CAMERA_INDEX = 2**31 - 1
 REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
 
@@ -957,14 +959,24 @@ def check_source(source: object) -> None:
         camera 1).
     ValueError
         A negative camera index (OpenCV's ``VideoCapture(-1)`` crashes the process when there is
-        no camera), or an empty string (it would read the current folder).
+        no camera), one beyond a C int (``"99999999999999999999"``), or an empty string (it
+        would read the current folder).
     """
     what = "expected a video file, an image or sequence folder, a stream URL or a camera index"
     if isinstance(source, (bool, np.bool_)):
         raise TypeError(f"video source is {source}, a bool; {what} (an int >= 0)")
+    if isinstance(source, (int, np.integer)) and source < 0:
+        raise ValueError(f"camera index is {source}, expected an int >= 0")
     if isinstance(source, (int, np.integer)):
-        if source < 0:
-            raise ValueError(f"camera index is {source}, expected an int >= 0")
+        camera: int | None = int(source)
+    else:  # a name: "0", or Path("0"), when no file has it
+        camera = _camera_index(str(source)) if isinstance(source, (str, os.PathLike)) else None
+    if camera is not None and camera > MAX_CAMERA_INDEX:  # was OpenCV's overload error
+        raise ValueError(
+            f"camera index is {camera}, expected an int from 0 to {MAX_CAMERA_INDEX} (OpenCV's "
+            "VideoCapture takes a C int)"
+        )
+    if isinstance(source, (int, np.integer)):
         return
     if not isinstance(source, (str, os.PathLike)):
         kind = type(source).__name__
@@ -978,7 +990,9 @@ def _camera_index(source: PathLike | int) -> int | None:
     if isinstance(source, (int, np.integer)) and not isinstance(source, (bool, np.bool_)):
         return int(source)
     text = str(source)
-    return int(text) if text.isdigit() and not Path(text).exists() else None
+    # ASCII digits only: str.isdigit() takes any Unicode digit ('\u00b2', which int() refuses)
+    digits = text.isascii() and text.isdigit()
+    return int(text) if digits and not Path(text).exists() else None
 
 
 def is_live_source(source: PathLike | int) -> bool:
