@@ -495,6 +495,24 @@ def test_8_bit_and_full_range_16_bit_images_are_read_as_opencv_reads_them(
         assert all(np.array_equal(f, e) for f, e in zip(src, expected, strict=True))
 
 
+@pytest.mark.parametrize("first", ["float", "8-bit"])
+def test_a_float_tiff_is_refused_by_its_depth_not_as_damaged(tmp_path: Path, first: str) -> None:
+    """A 32-bit float TIFF (a processing pipeline's output) decodes only at its own depth, which
+    OpenCV's colour read cannot give. Was: ``cannot read image .../1.tif: not an image OpenCV can
+    decode (damaged?)``, of an intact file; now its depth and the mend are named."""
+    image = np.linspace(0, 1, 48 * 64 * 3, dtype=np.float32).reshape(48, 64, 3)
+    for k in (1, 2):
+        eight = first == "8-bit" and k == 1
+        cv2.imwrite(str(tmp_path / f"{k}.tif"), (image * 255).astype(np.uint8) if eight else image)
+    bad = tmp_path / ("2.tif" if first == "8-bit" else "1.tif")
+    with pytest.raises(ValueError) as info:
+        list(FrameSource(tmp_path))
+    assert str(info.value) == (
+        f"cannot read image {bad}: its pixels are 32-bit floats (float32), not 8- or 16-bit "
+        "integers (whose range is known); convert the images to 8 or 16 bits (PNG or TIFF)"
+    )
+
+
 def test_seqinfo_of_pets_gives_its_true_frame_rate() -> None:
     folder = dataset("pets09-s2l1")
     src = FrameSource(folder / "video.avi")

@@ -843,12 +843,25 @@ def _jpeg_ends(data: bytes) -> bool | None:
     return False
 
 
+def _odd_depth(path: Path) -> str | None:
+    """The depth of image `path` if it decodes only at a depth other than 8 or 16 bits.
+
+    A 32-bit float TIFF (a processing pipeline's output) decodes at its own depth but not in
+    OpenCV's 8-bit colour read; its values have no set range (0..1, 0..255, radiance).
+    """
+    image = read_image_depth(path, notes=[])  # the decoder's lines: said by the caller's read
+    if image is None or image.dtype in (np.uint8, np.uint16):
+        return None
+    kind = {"f": "floats", "i": "signed integers", "u": "unsigned integers"}
+    return f"{image.dtype.itemsize * 8}-bit {kind.get(image.dtype.kind, 'values')} ({image.dtype})"
+
+
 def _unreadable(path: Path, notes: Sequence[str]) -> str:
     """The error of image `path` of a folder that cannot be read, saying why.
 
     An empty file (a copy that failed), a folder or a broken link named like an image, a file
-    that cannot be opened, or what its decoder said (`notes`, :func:`read_image`'s); were all
-    ``cannot read image P``.
+    that cannot be opened, an image of another depth than 8 or 16 bits (:func:`_odd_depth`), or
+    what its decoder said (`notes`, :func:`read_image`'s); were all ``cannot read image P``.
     """
     try:
         info = path.stat()
@@ -861,6 +874,11 @@ def _unreadable(path: Path, notes: Sequence[str]) -> str:
             why = "it is a folder"
         elif info.st_size == 0:
             why = "it is empty (0 bytes)"
+        elif (depth := _odd_depth(path)) is not None:  # was "damaged?", of an intact file
+            why = (
+                f"its pixels are {depth}, not 8- or 16-bit integers (whose range is known); "
+                "convert the images to 8 or 16 bits (PNG or TIFF)"
+            )
         elif notes:
             why = f"its decoder says {'; '.join(dict.fromkeys(notes))!r}"
         else:
@@ -1260,7 +1278,7 @@ class FrameSource:
             if other is not None and other.dtype == np.uint16 and int(other.max()) > top:
                 top, brightest = int(other.max()), images[k]
         bits = _bit_depth(top)
-        if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
+        if bits == 16:  # full range, or another depth: as OpenCV reads it (a float TIFF: refused)
             again = read_image(path, notes=unsaid)
             if again is None:
                 raise ValueError(_unreadable(path, unsaid))
