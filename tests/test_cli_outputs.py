@@ -637,6 +637,46 @@ INPUT_FOLDER_CASES = {
 }  # fmt: skip
 
 
+# a run whose image output would be new in the folder its frames are read from
+FRAME_FOLDER_CASES = {
+    "track --plot": ("track IN/imgs --out o.txt --plot IN/imgs/paths.png", "--plot", "imgs"),
+    "track --plot through ..":
+        ("track IN/imgs --out o.txt --plot IN/seq/../imgs/p.JPG", "--plot", "imgs"),
+    "track --out": ("track IN/imgs --out IN/imgs/tracks.png", "--out", "imgs"),
+    "track seq --plot": ("track IN/seq --out o.txt --plot IN/seq/img1/p.png", "--plot", "seq/img1"),
+    "render --plot":
+        ("render IN/imgs IN/tracks.txt --out o.mp4 --plot IN/imgs/p.png", "--plot", "imgs"),
+    "recover --video": ("recover IN/tracks.txt --link --video IN/imgs --out IN/imgs/f.png",
+                        "--out", "imgs"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(FRAME_FOLDER_CASES))
+def test_a_new_image_in_the_folder_of_the_frames_is_refused(
+    case: str,
+    folders: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    no_work: None,
+) -> None:
+    """Was: exit 0, and the next run on the folder read the plot as its last frame (a
+    ``--plot imgs/paths.png`` beside ``0001.jpg .. 0020.jpg`` made 21 frames, silently)."""
+    monkeypatch.chdir(tmp_path)
+    line, what, folder = FRAME_FOLDER_CASES[case]
+    argv = [word.replace("IN/", f"{folders}/") for word in line.split()]
+    out = argv[argv.index(what) + 1]
+    before = {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()}
+    assert main(["-q", *argv]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {argv[0]}: error: {what} {out} is in {folders / folder}, whose images are "
+        "this run's frames: a later run on it would read it as one more frame; write "
+        "elsewhere\n"
+    )
+    assert {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()} == before
+    assert not [p for p in tmp_path.rglob("*") if p.is_file()]
+
+
 @pytest.mark.parametrize("case", list(INPUT_FOLDER_CASES))
 def test_a_file_of_an_input_folder_is_not_an_output(
     case: str,

@@ -80,7 +80,13 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_distinct, check_output, output_format, staged_outputs
-    from pftrack.io.video import FrameSource, check_source, is_live_source, source_files
+    from pftrack.io.video import (
+        FrameSource,
+        check_outside_frames,
+        check_source,
+        is_live_source,
+        source_files,
+    )
     from pftrack.io.video_writer import VIDEO_SUFFIXES
     from pftrack.recovery.linking import read_tracks
     from pftrack.render import plot_trajectories, write_annotated_video
@@ -97,6 +103,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:  # "" too: refused as empty (was: no plot, without a word)
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--plot": args.plot})
+    check_outside_frames({"--out": args.out, "--plot": args.plot}, args.source)
     rows = read_tracks(args.tracks)
     rows[:, 2:6] *= args.scale
     source = FrameSource(args.source, fps=args.fps)

@@ -210,7 +210,7 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output
-    from pftrack.io.video import find_sequence, source_files
+    from pftrack.io.video import check_outside_frames, find_sequence, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES
 
     given = [d for d in (args.detections,) if d and d != "auto"]
@@ -228,7 +228,10 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
         check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
     if args.plot is not None:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
-    check_distinct({"--out": args.out, "--render": args.render, "--plot": args.plot})
+    outputs = {"--out": args.out, "--render": args.render, "--plot": args.plot}
+    check_distinct(outputs)
+    if not live:
+        check_outside_frames(outputs, args.source)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -34,7 +34,7 @@ import re
 import stat
 import threading
 import warnings
-from collections.abc import Collection, Generator, Iterable, Iterator, Sequence
+from collections.abc import Collection, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from decimal import Decimal
@@ -965,6 +965,44 @@ def source_files(source: PathLike | int) -> list[Path]:
         except ValueError:  # its image folder is missing: refused when read
             folders = []
     return files + [p for f in folders if f.is_dir() for p in image_files(f)]
+
+
+def check_outside_frames(outputs: Mapping[str, PathLike | None], source: PathLike | int) -> None:
+    """Refuse an image output in the folder whose images are `source`'s frames.
+
+    The run itself reads its frames before writing it, but the next run on that folder would
+    read it as one more frame (was: a ``--plot imgs/paths.png`` beside ``0001.jpg`` ..
+    ``0020.jpg`` was frame 21 of every later run, silently; a user trial). An output that is
+    already one of the images is an input of the run, refused by
+    :func:`~pftrack.io.atomic.check_output`.
+
+    Parameters
+    ----------
+    outputs : mapping of str to path or None
+        Each output by the name error messages give it (e.g. ``"--plot"``); None: not written.
+    source : str, int or os.PathLike
+        As :class:`FrameSource` takes it: only an image or sequence folder has such a folder.
+
+    Raises
+    ------
+    ValueError
+        An output with an image's extension (:data:`IMAGE_SUFFIXES`) lies in that folder.
+    """
+    if not Path(str(source)).is_dir():
+        return
+    frames = [p for p in source_files(source) if p.suffix.lower() in IMAGE_SUFFIXES]
+    if not frames:
+        return
+    folder = frames[0].parent
+    for what, path in outputs.items():
+        target = Path(path) if path is not None else None
+        if target is None or target.suffix.lower() not in IMAGE_SUFFIXES:
+            continue
+        if _same_folder(target.parent, folder):
+            raise ValueError(
+                f"{what} {target} is in {folder}, whose images are this run's frames: a later "
+                "run on it would read it as one more frame; write elsewhere"
+            )
 
 
 def check_source(source: object) -> None:
