@@ -214,6 +214,42 @@ def test_demo_refuses_a_file_as_its_folder_and_a_folder_as_an_output(
     assert sorted(p.name for p in (tmp_path / "d").iterdir()) == ["annotated.mp4"]
 
 
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+@pytest.mark.parametrize("mine", [["tracks.txt"], ["truth.txt", "trajectories.png"]])
+def test_demo_does_not_replace_a_users_file_of_one_of_its_names(
+    mine: list[str],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``pftrack demo --out-dir .`` where ``pftrack track ... --out tracks.txt`` had written:
+    was exit 0, the user's tracks replaced by the demo's. A folder holding all four files (an
+    earlier demo's) is still written over; one holding some of them is refused before work."""
+    import pftrack.demo
+
+    for name in mine:
+        (tmp_path / name).write_text("the user's own\n")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("work started before the outputs were checked")
+
+    with monkeypatch.context() as m:
+        m.setattr(pftrack.demo, "track_frames", refuse)
+        assert main(["demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 2
+    listed = ", ".join(mine)
+    assert capsys.readouterr().err == (
+        f"pftrack demo: error: --out-dir {tmp_path} holds {listed}, but not all four files of "
+        "an earlier pftrack demo (tracks.txt, truth.txt, annotated.mp4, trajectories.png): "
+        "not the demo's to replace; move them, or give another --out-dir\n"
+    )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    out = tmp_path / "d"  # an earlier demo's folder is written again
+    for _ in range(2):
+        assert main(["-q", "demo", "--out-dir", str(out), "--frames", "5"]) == 0
+    assert len(list(out.iterdir())) == 4
+
+
 def test_demo_help_says_its_folder_is_created_with_its_parents_unlike_a_files_folder(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
