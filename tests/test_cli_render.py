@@ -130,3 +130,17 @@ def test_help_states_the_limits_it_enforces(
     except SystemExit as exc:
         status = exc.code  # type: ignore[assignment]
     assert status == 2
+
+
+@pytest.mark.parametrize("command", ["track", "render"])
+def test_fps_help_names_every_place_the_rate_comes_from(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """FrameSource takes a rate from the frames' time stamps when the header has none, or a
+    time base (Matroska's 1000 "fps"): ``--fps``'s default said only "seqinfo.ini's
+    frameRate, else the container's header, else 25"."""
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    help_of_fps = text.split("--fps FPS ")[-1].split("else 25)")[0]  # its help, not the usage
+    assert "else the container's header, else the frames' time stamps" in help_of_fps

@@ -57,7 +57,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
         help=f"frame rate of the video written, {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} (default: "
-        "seqinfo.ini's frameRate, else the container's header, else 25)",
+        "seqinfo.ini's frameRate, else the container's header, else the frames' time stamps "
+        "(a header rate of 1000 or more is a time base), else 25)",
     )  # fmt: skip
     p.add_argument(
         "--trail",

@@ -79,7 +79,7 @@ def add_parser(sub: Any) -> None:
         "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
         help=f"frame rate of SOURCE, for --render, {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} "
         "(default: seqinfo.ini's frameRate, in the same range, else the container's header, "
-        "else 25)",
+        "else the frames' time stamps (a header rate of 1000 or more is a time base), else 25)",
     )  # fmt: skip
     p.add_argument(
         "--render", metavar="VIDEO",
