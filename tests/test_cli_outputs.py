@@ -713,6 +713,16 @@ def test_a_new_image_in_the_folder_of_the_frames_is_refused(
     assert not [p for p in tmp_path.rglob("*") if p.is_file()]
 
 
+def test_outputs_that_no_run_reads_as_a_frame_are_taken(folders: Path) -> None:
+    """Beside the frames: a hidden image (image folders leave it out), text, a video."""
+    from pftrack.io.video import check_outside_frames
+
+    imgs = folders / "imgs"
+    outputs = {"--plot": imgs / ".p.png", "--out": imgs / "t.txt", "--render": imgs / "v.mp4"}
+    check_outside_frames(outputs, imgs)
+    check_outside_frames({"--plot": imgs / "p.png"}, folders / "vseq")  # frames of a video
+
+
 @pytest.mark.parametrize("case", list(INPUT_FOLDER_CASES))
 def test_a_file_of_an_input_folder_is_not_an_output(
     case: str,

@@ -998,6 +998,8 @@ def check_outside_frames(outputs: Mapping[str, PathLike | None], source: PathLik
         target = Path(path) if path is not None else None
         if target is None or target.suffix.lower() not in IMAGE_SUFFIXES:
             continue
+        if target.name.startswith("."):  # hidden: no frame (image_files)
+            continue
         if _same_folder(target.parent, folder):
             raise ValueError(
                 f"{what} {target} is in {folder}, whose images are this run's frames: a later "
