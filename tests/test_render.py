@@ -214,3 +214,31 @@ def test_every_text_the_package_draws_goes_through_text_for_opencv() -> None:
                 ):
                     raw.append(f"{path.relative_to(package)}:{node.lineno}")
     assert calls >= 4 and raw == []
+
+
+@pytest.mark.parametrize(
+    ("trail", "error", "message"),
+    [
+        (-1, ValueError, "trail is -1, expected an integer in [0, 100000]"),
+        (10**30, ValueError, "trail is 1000000000000000000000000000000, expected an integer in"),
+        (2.5, TypeError, "trail must be an integer in [0, 100000], got float 2.5"),
+        ("40", TypeError, "trail must be an integer in [0, 100000], got str '40'"),
+        (None, TypeError, "trail must be an integer in [0, 100000], got NoneType None"),
+        (True, TypeError, "trail must be an integer in [0, 100000], got bool True"),
+    ],
+)
+def test_a_bad_trail_is_refused_alike_by_both_writers(
+    trail: object, error: type[Exception], message: str, tmp_path: Path
+) -> None:
+    """Was: write_annotated_video drew no trail for -1 (TrackRenderer refused it), and both
+    said "'>' not supported between instances of 'int' and 'str'", "an integer is required" or
+    an OverflowError, or took 2.5 and True as 2 and 1."""
+    rows = np.array([[1, 1, 10, 10, 20, 40], [2, 1, 12, 10, 20, 40]], float)
+    frames = [np.zeros((48, 64, 3), np.uint8)] * 2
+    with pytest.raises(error) as info:
+        write_annotated_video(tmp_path / "v.mp4", frames, rows, trail=trail)  # type: ignore[arg-type]
+    assert str(info.value).startswith(message)
+    with pytest.raises(error) as info:
+        TrackRenderer(tmp_path / "w.mp4", 10, trail=trail)  # type: ignore[arg-type]
+    assert str(info.value).startswith(message)
+    assert sorted(os.listdir(tmp_path)) == []  # no file, no temporary file

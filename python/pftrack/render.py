@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, real_array
+from pftrack._check import bgr_frame, integer, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
@@ -96,6 +96,8 @@ def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
     return float(box[0] + box[2] / 2), float(box[1] + box[3])
 
 
+#: Longest trail, in frames (``pftrack render --trail``'s limit).
+MAX_TRAIL = 100_000
 #: The columns of a MOT row that the pictures read.
 ROW_COLUMNS = "frame, id, left, top, width, height"
 #: Largest side of a plot's canvas in pixels (OpenCV's image limit).
@@ -140,10 +142,12 @@ def write_annotated_video(
     ------
     ValueError
         `frames` is empty (nothing is written); `rows` are not (M, 6+) MOT rows (frame, id,
-        left, top, width, height, ...) with those six values finite.
+        left, top, width, height, ...) with those six values finite; `trail` is not in
+        [0, :data:`MAX_TRAIL`].
     TypeError
-        `rows` are not real numbers.
+        `rows` are not real numbers; `trail` is not an integer.
     """
+    trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
     rows = _track_rows(rows, "write_annotated_video")
     it = iter(frames)
     first = next(it, None)
@@ -200,7 +204,8 @@ class TrackRenderer:
     fps : float
         Frame rate of the video.
     trail : int
-        Foot points of the last `trail` frames drawn behind each track (0: none).
+        Foot points of the last `trail` frames drawn behind each track (0: none), up to
+        :data:`MAX_TRAIL`.
     threaded : bool
         Draw and encode on a worker thread (False: in :meth:`add`).
     backend : {"pyav", "opencv"}, optional
@@ -222,10 +227,8 @@ class TrackRenderer:
         queue_size: int = 8,
         preset: str = "ultrafast",
     ) -> None:
-        if trail < 0:
-            raise ValueError(f"trail is {trail}, expected >= 0")
+        self.trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: 2.5 and True taken as 2, 1
         self.writer = VideoWriter(path, fps, backend=backend, preset=preset)
-        self.trail = int(trail)
         self._trails: dict[int, deque[tuple[float, float]]] = {}
         self._error: BaseException | None = None
         self._n = 0
