@@ -60,7 +60,16 @@ def draw_tracks(
     """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids (dashed if filled).
 
     Lines and labels grow with the frame (:func:`ink_scale`).
+
+    Raises
+    ------
+    ValueError
+        `rows` are not (k, 6+) MOT rows with finite frame, id and box.
+    TypeError
+        `rows` are not real numbers; `label` is not a str.
     """
+    rows = _track_rows(rows, "draw_tracks")  # was "not enough values to unpack" of (k, 5)
+    _text(label, "draw_tracks", "label")
     out: NDArray[np.uint8] = frame.copy()
     k = ink_scale(out.shape)
     for r in rows:
@@ -102,6 +111,12 @@ MAX_TRAIL = 100_000
 ROW_COLUMNS = "frame, id, left, top, width, height"
 #: Largest side of a plot's canvas in pixels (OpenCV's image limit).
 MAX_CANVAS = 32767
+
+
+def _text(value: object, who: str, what: str) -> None:
+    """Refuse a caption that is not a str (None: none); was an AttributeError ('encode')."""
+    if value is not None and not isinstance(value, str):
+        raise TypeError(f"{who}: {what} must be a str, got {type(value).__name__} {value!r}")
 
 
 def _track_rows(rows: ArrayLike, who: str, what: str = "rows") -> F64:
@@ -228,6 +243,7 @@ class TrackRenderer:
         preset: str = "ultrafast",
     ) -> None:
         self.trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: 2.5 and True taken as 2, 1
+        queue_size = integer(queue_size, "queue_size", 0, 2**31 - 1)  # 0: as 1
         self.writer = VideoWriter(path, fps, backend=backend, preset=preset)
         self._trails: dict[int, deque[tuple[float, float]]] = {}
         self._error: BaseException | None = None
@@ -388,7 +404,8 @@ def plot_trajectories(
         `rows` or `truth` are not (M, 6+) MOT rows with finite frame, id and box; `size`
         is not two whole numbers from 1 to 32767, or the boxes reach beyond 32767 px.
     TypeError
-        `rows` or `truth` are not real numbers; `background` is not a (H, W, 3) uint8 image.
+        `rows` or `truth` are not real numbers; `background` is not a (H, W, 3) uint8 image;
+        `title` is not a str.
 
     Notes
     -----
@@ -398,6 +415,7 @@ def plot_trajectories(
     """
     who = "plot_trajectories"
     rows = _track_rows(rows, who)
+    _text(title, who, "title")
     truth = None if truth is None else _track_rows(truth, who, "truth")
     if background is not None:
         background = bgr_frame(background, f"{who}: background")
