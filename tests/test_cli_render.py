@@ -144,3 +144,27 @@ def test_fps_help_names_every_place_the_rate_comes_from(
     text = " ".join(capsys.readouterr().out.split())
     help_of_fps = text.split("--fps FPS ")[-1].split("else 25)")[0]  # its help, not the usage
     assert "else the container's header, else the frames' time stamps" in help_of_fps
+
+
+def test_rows_past_a_folder_whose_names_skip_numbers_say_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Images 1, 6, 11, 16 and another tool's rows numbered by the names: frame k is drawn on
+    the k-th image. Was said only as "rows of frames 6-16 are past the video's last frame 4",
+    the words of another video's tracks; the names that skip numbers are now named."""
+    scene = make_scene(n_frames=4, width=64, height=64, n_walkers=1, rng=0)
+    folder = tmp_path / "imgs"
+    scene.write_images(folder)
+    for k, path in enumerate(sorted(folder.iterdir()), start=0):
+        path.rename(folder / f"{1 + 5 * k}.png")
+    rows = scene.truth[:4].copy()
+    rows[:, 0] = [1, 6, 11, 16]
+    write_mot(tmp_path / "t.txt", rows)
+    assert main(["-q", "render", str(folder), str(tmp_path / "t.txt"), "--out",
+                 str(tmp_path / "v.mp4")]) == 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert err == (
+        "pftrack render: warning: 3 rows of frames 6-16 are past the video's last frame 4: not "
+        f"drawn ({folder}: image 2 is missing (names 1..16 skip numbers): row frame k is drawn "
+        "on the k-th image)\n"
+    )

@@ -144,10 +144,12 @@ def run(args: argparse.Namespace) -> int:
     if len(late):
         first, last = int(late[:, 0].min()), int(late[:, 0].max())
         frames = f"frame {first}" if first == last else f"frames {first}-{last}"
+        # names that skip numbers: another tool may have numbered the rows by them
+        gap = f" ({source.gap}: row frame k is drawn on the k-th image)" if source.gap else ""
         notes.append(
             f"{len(late)} row{'s' * (len(late) != 1)} of {frames} "
             f"{'are' if len(late) != 1 else 'is'} past the video's last frame {drawn[0]}: not "
-            "drawn"
+            f"drawn{gap}"
         )
     for note in notes:
         print(f"pftrack render: warning: {_shown(note)}", file=sys.stderr)
