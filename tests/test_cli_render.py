@@ -168,3 +168,41 @@ def test_rows_past_a_folder_whose_names_skip_numbers_say_so(
         f"drawn ({folder}: image 2 is missing (names 1..16 skip numbers): row frame k is drawn "
         "on the k-th image)\n"
     )
+
+
+@pytest.mark.parametrize("command", ["track", "render"])
+def test_frames_too_wide_for_h264_are_refused_before_any_work(
+    command: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A 20000x64 panorama into an .mp4: was a traceback (PyAV's "Generic error in an external
+    library: avcodec_open2") and exit status 1 after the first frame; now one line naming the
+    option, before any work, and nothing written."""
+    import cv2
+
+    import pftrack.tracking as tracking
+
+    folder = tmp_path / "pano"
+    folder.mkdir()
+    for k in (1, 2):
+        cv2.imwrite(str(folder / f"{k}.png"), np.full((64, 20001, 3), 90 * k, np.uint8))
+    write_mot(tmp_path / "t.txt", np.array([[1, 1, 10, 10, 20, 40, 1, -1, -1, -1]], float))
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("work started before the size was checked")
+
+    monkeypatch.setattr(tracking, "track_frames", refuse)
+    monkeypatch.chdir(tmp_path)
+    if command == "track":
+        argv, what = ["track", "pano", "--out", "o.txt", "--render", "v.mp4"], "--render"
+    else:
+        argv, what = ["render", "pano", "t.txt", "--out", "v.mp4"], "--out"
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert main(["-q", *argv]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {command}: error: {what} v.mp4: H.264 takes frames up to 16384 pixels a side "
+        "(x264), not 20002x64; write an .avi (Motion-JPEG) instead\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == before

@@ -88,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
         is_live_source,
         source_files,
     )
-    from pftrack.io.video_writer import VIDEO_SUFFIXES
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery.linking import read_tracks
     from pftrack.render import plot_trajectories, write_annotated_video
 
@@ -108,6 +108,8 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(args.tracks)
     rows[:, 2:6] *= args.scale
     source = FrameSource(args.source, fps=args.fps)
+    fmt = output_format(args.out, VIDEO_SUFFIXES)  # a size its encoder cannot take: said now
+    check_frame_size(f"--out {args.out}", fmt, source.width, source.height)
     n_frames = len(source)
     known = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
     if known and len(rows) and rows[:, 0].min() > known:  # was: an empty video, exit 0

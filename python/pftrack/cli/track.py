@@ -255,7 +255,7 @@ def run(args: argparse.Namespace) -> int:
     )
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, check_source, is_live_source
-    from pftrack.io.video_writer import VIDEO_SUFFIXES
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections
@@ -286,6 +286,9 @@ def run(args: argparse.Namespace) -> int:
     side: SideFile | None = None
     committed = False  # every staged output renamed into place
     try:
+        if args.render:  # a size its encoder cannot take: said before any work
+            fmt = output_format(args.render, VIDEO_SUFFIXES)
+            check_frame_size(f"--render {args.render}", fmt, source.width, source.height)
         with contextlib.ExitStack() as keep:
             if live and not streamed:
                 side = keep.enter_context(side_file(args.out))
