@@ -1308,3 +1308,19 @@ def test_closing_a_live_source_while_a_thread_reads_it_is_no_crash(tmp_path: Pat
                          timeout=120)  # fmt: skip
     assert run.returncode == 0, (run.returncode, run.stderr[-2000:])
     assert run.stdout.split() == ["True", "False", "True"]
+
+
+def test_frames_beyond_the_largest_side_are_refused_without_a_scale_given(
+    tmp_path: Path,
+) -> None:
+    """A 40000x8 image folder read as it is: was "scale 1 makes the 40000x8 frames of imgs
+    40000x8 pixels", of a scale nobody gave; the frames' own size is now named alone."""
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in (1, 2):
+        cv2.imwrite(str(folder / f"{k}.png"), np.zeros((8, 40000, 3), np.uint8))
+    with pytest.raises(ValueError) as info:
+        FrameSource(folder)
+    assert str(info.value) == (
+        f"the frames of {folder} are 40000x8 pixels; expected 1 to 32767 pixels a side"
+    )

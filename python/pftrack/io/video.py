@@ -1255,10 +1255,13 @@ class FrameSource:
         if min(size) < 1 or max(size) > MAX_SCALED_SIDE:
             if self._cap is not None:
                 self._cap.release()
-            raise ValueError(
-                f"scale {self.scale:g} makes the {w}x{h} frames of {self.name} {size[0]}x"
-                f"{size[1]} pixels; expected 1 to {MAX_SCALED_SIDE} pixels a side"
+            made = (  # a scale nobody gave is not named (was "scale 1 makes the ...")
+                f"the frames of {self.name} are {w}x{h} pixels"
+                if self.scale == 1.0
+                else f"scale {self.scale:g} makes the {w}x{h} frames of {self.name} "
+                f"{size[0]}x{size[1]} pixels"
             )
+            raise ValueError(f"{made}; expected 1 to {MAX_SCALED_SIDE} pixels a side")
         first = self._resize(first)
         self.height, self.width = int(first.shape[0]), int(first.shape[1])
         if self.live:
