@@ -214,6 +214,42 @@ def test_demo_refuses_a_file_as_its_folder_and_a_folder_as_an_output(
     assert sorted(p.name for p in (tmp_path / "d").iterdir()) == ["annotated.mp4"]
 
 
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+@pytest.mark.parametrize("mine", [["tracks.txt"], ["truth.txt", "trajectories.png"]])
+def test_demo_does_not_replace_a_users_file_of_one_of_its_names(
+    mine: list[str],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``pftrack demo --out-dir .`` where ``pftrack track ... --out tracks.txt`` had written:
+    was exit 0, the user's tracks replaced by the demo's. A folder holding all four files (an
+    earlier demo's) is still written over; one holding some of them is refused before work."""
+    import pftrack.demo
+
+    for name in mine:
+        (tmp_path / name).write_text("the user's own\n")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("work started before the outputs were checked")
+
+    with monkeypatch.context() as m:
+        m.setattr(pftrack.demo, "track_frames", refuse)
+        assert main(["demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 2
+    listed = ", ".join(mine)
+    assert capsys.readouterr().err == (
+        f"pftrack demo: error: --out-dir {tmp_path} holds {listed}, but not all four files of "
+        "an earlier pftrack demo (tracks.txt, truth.txt, annotated.mp4, trajectories.png): "
+        "not the demo's to replace; move them, or give another --out-dir\n"
+    )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    out = tmp_path / "d"  # an earlier demo's folder is written again
+    for _ in range(2):
+        assert main(["-q", "demo", "--out-dir", str(out), "--frames", "5"]) == 0
+    assert len(list(out.iterdir())) == 4
+
+
 def test_demo_help_says_its_folder_is_created_with_its_parents_unlike_a_files_folder(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -635,6 +671,56 @@ INPUT_FOLDER_CASES = {
     "eval --json": "eval --gt IN/seq --res IN/res --json link.json>seq/gt/gt.txt",
     "eval --csv": "eval --gt IN/seq --res IN/res --csv link.csv>res/seq.txt",
 }  # fmt: skip
+
+
+# a run whose image output would be new in the folder its frames are read from
+FRAME_FOLDER_CASES = {
+    "track --plot": ("track IN/imgs --out o.txt --plot IN/imgs/paths.png", "--plot", "imgs"),
+    "track --plot through ..":
+        ("track IN/imgs --out o.txt --plot IN/seq/../imgs/p.JPG", "--plot", "imgs"),
+    "track --out": ("track IN/imgs --out IN/imgs/tracks.png", "--out", "imgs"),
+    "track seq --plot": ("track IN/seq --out o.txt --plot IN/seq/img1/p.png", "--plot", "seq/img1"),
+    "render --plot":
+        ("render IN/imgs IN/tracks.txt --out o.mp4 --plot IN/imgs/p.png", "--plot", "imgs"),
+    "recover --video": ("recover IN/tracks.txt --link --video IN/imgs --out IN/imgs/f.png",
+                        "--out", "imgs"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(FRAME_FOLDER_CASES))
+def test_a_new_image_in_the_folder_of_the_frames_is_refused(
+    case: str,
+    folders: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    no_work: None,
+) -> None:
+    """Was: exit 0, and the next run on the folder read the plot as its last frame (a
+    ``--plot imgs/paths.png`` beside ``0001.jpg .. 0020.jpg`` made 21 frames, silently)."""
+    monkeypatch.chdir(tmp_path)
+    line, what, folder = FRAME_FOLDER_CASES[case]
+    argv = [word.replace("IN/", f"{folders}/") for word in line.split()]
+    out = argv[argv.index(what) + 1]
+    before = {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()}
+    assert main(["-q", *argv]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {argv[0]}: error: {what} {out} is in {folders / folder}, whose images are "
+        "this run's frames: a later run on it would read it as one more frame; write "
+        "elsewhere\n"
+    )
+    assert {p: p.read_bytes() for p in folders.rglob("*") if p.is_file()} == before
+    assert not [p for p in tmp_path.rglob("*") if p.is_file()]
+
+
+def test_outputs_that_no_run_reads_as_a_frame_are_taken(folders: Path) -> None:
+    """Beside the frames: a hidden image (image folders leave it out), text, a video."""
+    from pftrack.io.video import check_outside_frames
+
+    imgs = folders / "imgs"
+    outputs = {"--plot": imgs / ".p.png", "--out": imgs / "t.txt", "--render": imgs / "v.mp4"}
+    check_outside_frames(outputs, imgs)
+    check_outside_frames({"--plot": imgs / "p.png"}, folders / "vseq")  # frames of a video
 
 
 @pytest.mark.parametrize("case", list(INPUT_FOLDER_CASES))

@@ -130,3 +130,79 @@ def test_help_states_the_limits_it_enforces(
     except SystemExit as exc:
         status = exc.code  # type: ignore[assignment]
     assert status == 2
+
+
+@pytest.mark.parametrize("command", ["track", "render"])
+def test_fps_help_names_every_place_the_rate_comes_from(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """FrameSource takes a rate from the frames' time stamps when the header has none, or a
+    time base (Matroska's 1000 "fps"): ``--fps``'s default said only "seqinfo.ini's
+    frameRate, else the container's header, else 25"."""
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    help_of_fps = text.split("--fps FPS ")[-1].split("else 25)")[0]  # its help, not the usage
+    assert "else the container's header, else the frames' time stamps" in help_of_fps
+
+
+def test_rows_past_a_folder_whose_names_skip_numbers_say_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Images 1, 6, 11, 16 and another tool's rows numbered by the names: frame k is drawn on
+    the k-th image. Was said only as "rows of frames 6-16 are past the video's last frame 4",
+    the words of another video's tracks; the names that skip numbers are now named."""
+    scene = make_scene(n_frames=4, width=64, height=64, n_walkers=1, rng=0)
+    folder = tmp_path / "imgs"
+    scene.write_images(folder)
+    for k, path in enumerate(sorted(folder.iterdir()), start=0):
+        path.rename(folder / f"{1 + 5 * k}.png")
+    rows = scene.truth[:4].copy()
+    rows[:, 0] = [1, 6, 11, 16]
+    write_mot(tmp_path / "t.txt", rows)
+    assert main(["-q", "render", str(folder), str(tmp_path / "t.txt"), "--out",
+                 str(tmp_path / "v.mp4")]) == 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert err == (
+        "pftrack render: warning: 3 rows of frames 6-16 are past the video's last frame 4: not "
+        f"drawn ({folder}: image 2 is missing (names 1..16 skip numbers): row frame k is drawn "
+        "on the k-th image)\n"
+    )
+
+
+@pytest.mark.parametrize("command", ["track", "render"])
+def test_frames_too_wide_for_h264_are_refused_before_any_work(
+    command: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A 20000x64 panorama into an .mp4: was a traceback (PyAV's "Generic error in an external
+    library: avcodec_open2") and exit status 1 after the first frame; now one line naming the
+    option, before any work, and nothing written."""
+    import cv2
+
+    import pftrack.tracking as tracking
+
+    folder = tmp_path / "pano"
+    folder.mkdir()
+    for k in (1, 2):
+        cv2.imwrite(str(folder / f"{k}.png"), np.full((64, 20001, 3), 90 * k, np.uint8))
+    write_mot(tmp_path / "t.txt", np.array([[1, 1, 10, 10, 20, 40, 1, -1, -1, -1]], float))
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("work started before the size was checked")
+
+    monkeypatch.setattr(tracking, "track_frames", refuse)
+    monkeypatch.chdir(tmp_path)
+    if command == "track":
+        argv, what = ["track", "pano", "--out", "o.txt", "--render", "v.mp4"], "--render"
+    else:
+        argv, what = ["render", "pano", "t.txt", "--out", "v.mp4"], "--out"
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert main(["-q", *argv]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {command}: error: {what} v.mp4: H.264 takes frames up to 16384 pixels a side "
+        "(x264), not 20002x64; write an .avi (Motion-JPEG) instead\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == before

@@ -214,3 +214,52 @@ def test_every_text_the_package_draws_goes_through_text_for_opencv() -> None:
                 ):
                     raw.append(f"{path.relative_to(package)}:{node.lineno}")
     assert calls >= 4 and raw == []
+
+
+@pytest.mark.parametrize(
+    ("trail", "error", "message"),
+    [
+        (-1, ValueError, "trail is -1, expected an integer in [0, 100000]"),
+        (10**30, ValueError, "trail is 1000000000000000000000000000000, expected an integer in"),
+        (2.5, TypeError, "trail must be an integer in [0, 100000], got float 2.5"),
+        ("40", TypeError, "trail must be an integer in [0, 100000], got str '40'"),
+        (None, TypeError, "trail must be an integer in [0, 100000], got NoneType None"),
+        (True, TypeError, "trail must be an integer in [0, 100000], got bool True"),
+    ],
+)
+def test_a_bad_trail_is_refused_alike_by_both_writers(
+    trail: object, error: type[Exception], message: str, tmp_path: Path
+) -> None:
+    """Was: write_annotated_video drew no trail for -1 (TrackRenderer refused it), and both
+    said "'>' not supported between instances of 'int' and 'str'", "an integer is required" or
+    an OverflowError, or took 2.5 and True as 2 and 1."""
+    rows = np.array([[1, 1, 10, 10, 20, 40], [2, 1, 12, 10, 20, 40]], float)
+    frames = [np.zeros((48, 64, 3), np.uint8)] * 2
+    with pytest.raises(error) as info:
+        write_annotated_video(tmp_path / "v.mp4", frames, rows, trail=trail)  # type: ignore[arg-type]
+    assert str(info.value).startswith(message)
+    with pytest.raises(error) as info:
+        TrackRenderer(tmp_path / "w.mp4", 10, trail=trail)  # type: ignore[arg-type]
+    assert str(info.value).startswith(message)
+    assert sorted(os.listdir(tmp_path)) == []  # no file, no temporary file
+
+
+def test_the_pictures_refuse_what_they_cannot_draw_in_one_line(tmp_path: Path) -> None:
+    """Was: ``plot_trajectories(title=123)`` an AttributeError ('int' object has no attribute
+    'encode'), ``draw_tracks`` of (k, 5) rows "not enough values to unpack (expected 4, got
+    3)", ``TrackRenderer(queue_size='8')`` "'>' not supported between 'int' and 'str'"."""
+    from pftrack.render import draw_tracks
+
+    rows = np.array([[1, 1, 10, 10, 20, 40], [2, 1, 12, 10, 20, 40]], float)
+    frame = np.zeros((48, 64, 3), np.uint8)
+    with pytest.raises(TypeError, match=r"^plot_trajectories: title must be a str, got int 123$"):
+        plot_trajectories(tmp_path / "p.png", rows, title=123)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"^draw_tracks: label must be a str, got int 7$"):
+        draw_tracks(frame, rows[:1], label=7)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^draw_tracks: rows has shape \(1, 5\), expected \(M"):
+        draw_tracks(frame, np.ones((1, 5)))
+    with pytest.raises(TypeError, match=r"^queue_size must be an integer in \[0, "):
+        TrackRenderer(tmp_path / "v.mp4", 10, queue_size="8")  # type: ignore[arg-type]
+    assert sorted(os.listdir(tmp_path)) == []
+    assert draw_tracks(frame, rows[:1], label="frame 1").shape == frame.shape  # still drawn
+    assert draw_tracks(frame, np.zeros((0, 8))).shape == frame.shape

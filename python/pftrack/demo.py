@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 
@@ -25,8 +26,9 @@ def run_demo(
 
     Writes ``tracks.txt``, ``truth.txt``, ``annotated.mp4`` and ``trajectories.png`` into
     `out_dir` (created if missing; removed again, when it was created and is still empty, if
-    the run stops before writing them) and prints MOTA, IDF1 and the rest against the scene's
-    known truth. An interrupt or error after the files are written says they were (the
+    the run stops before writing them; refused, before any work, if it holds some of these
+    files but not all four, an earlier demo's) and prints MOTA, IDF1 and the rest against the
+    scene's known truth. An interrupt or error after the files are written says they were (the
     command's "interrupted; ..." line).
     """
     from dataclasses import replace
@@ -36,6 +38,7 @@ def run_demo(
     with made_folder(out_dir, "--out-dir"):
         for name in names:  # before any work: every output can be written
             check_output(out_dir / name, what="--out-dir", within=out_dir)
+        _check_own(out_dir, names)
         scene = make_scene(n_frames=n_frames, rng=seed)
         base = TrackerConfig()
         config = replace(base, filter=replace(base.filter, n_particles=particles))
@@ -59,6 +62,23 @@ def run_demo(
         raise
     print(f"\nwrote {wrote}")
     return 0
+
+
+def _check_own(out_dir: Path, names: tuple[str, ...]) -> None:
+    """Refuse to replace files of the demo's names in `out_dir` that no earlier demo wrote.
+
+    An earlier demo leaves all four (they are renamed into place together); some of them alone
+    are the user's: ``pftrack demo --out-dir .`` replaced the ``tracks.txt`` that ``pftrack
+    track ... --out tracks.txt`` had written there (a user trial; ``pftrack batch`` likewise
+    replaces only its own files).
+    """
+    there = [name for name in names if os.path.lexists(out_dir / name)]
+    if there and len(there) < len(names):
+        raise ValueError(
+            f"--out-dir {out_dir} holds {', '.join(there)}, but not all four files of an "
+            f"earlier pftrack demo ({', '.join(names)}): not the demo's to replace; move them, "
+            "or give another --out-dir"
+        )
 
 
 def _report(scene: Scene, run: TrackingRun, *, seed: int, n_frames: int, particles: int) -> None:

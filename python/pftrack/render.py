@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, real_array
+from pftrack._check import bgr_frame, integer, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
@@ -60,7 +60,16 @@ def draw_tracks(
     """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids (dashed if filled).
 
     Lines and labels grow with the frame (:func:`ink_scale`).
+
+    Raises
+    ------
+    ValueError
+        `rows` are not (k, 6+) MOT rows with finite frame, id and box.
+    TypeError
+        `rows` are not real numbers; `label` is not a str.
     """
+    rows = _track_rows(rows, "draw_tracks")  # was "not enough values to unpack" of (k, 5)
+    _text(label, "draw_tracks", "label")
     out: NDArray[np.uint8] = frame.copy()
     k = ink_scale(out.shape)
     for r in rows:
@@ -96,10 +105,18 @@ def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
     return float(box[0] + box[2] / 2), float(box[1] + box[3])
 
 
+#: Longest trail, in frames (``pftrack render --trail``'s limit).
+MAX_TRAIL = 100_000
 #: The columns of a MOT row that the pictures read.
 ROW_COLUMNS = "frame, id, left, top, width, height"
 #: Largest side of a plot's canvas in pixels (OpenCV's image limit).
 MAX_CANVAS = 32767
+
+
+def _text(value: object, who: str, what: str) -> None:
+    """Refuse a caption that is not a str (None: none); was an AttributeError ('encode')."""
+    if value is not None and not isinstance(value, str):
+        raise TypeError(f"{who}: {what} must be a str, got {type(value).__name__} {value!r}")
 
 
 def _track_rows(rows: ArrayLike, who: str, what: str = "rows") -> F64:
@@ -140,10 +157,12 @@ def write_annotated_video(
     ------
     ValueError
         `frames` is empty (nothing is written); `rows` are not (M, 6+) MOT rows (frame, id,
-        left, top, width, height, ...) with those six values finite.
+        left, top, width, height, ...) with those six values finite; `trail` is not in
+        [0, :data:`MAX_TRAIL`].
     TypeError
-        `rows` are not real numbers.
+        `rows` are not real numbers; `trail` is not an integer.
     """
+    trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
     rows = _track_rows(rows, "write_annotated_video")
     it = iter(frames)
     first = next(it, None)
@@ -200,7 +219,8 @@ class TrackRenderer:
     fps : float
         Frame rate of the video.
     trail : int
-        Foot points of the last `trail` frames drawn behind each track (0: none).
+        Foot points of the last `trail` frames drawn behind each track (0: none), up to
+        :data:`MAX_TRAIL`.
     threaded : bool
         Draw and encode on a worker thread (False: in :meth:`add`).
     backend : {"pyav", "opencv"}, optional
@@ -222,10 +242,9 @@ class TrackRenderer:
         queue_size: int = 8,
         preset: str = "ultrafast",
     ) -> None:
-        if trail < 0:
-            raise ValueError(f"trail is {trail}, expected >= 0")
+        self.trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: 2.5 and True taken as 2, 1
+        queue_size = integer(queue_size, "queue_size", 0, 2**31 - 1)  # 0: as 1
         self.writer = VideoWriter(path, fps, backend=backend, preset=preset)
-        self.trail = int(trail)
         self._trails: dict[int, deque[tuple[float, float]]] = {}
         self._error: BaseException | None = None
         self._n = 0
@@ -385,7 +404,8 @@ def plot_trajectories(
         `rows` or `truth` are not (M, 6+) MOT rows with finite frame, id and box; `size`
         is not two whole numbers from 1 to 32767, or the boxes reach beyond 32767 px.
     TypeError
-        `rows` or `truth` are not real numbers; `background` is not a (H, W, 3) uint8 image.
+        `rows` or `truth` are not real numbers; `background` is not a (H, W, 3) uint8 image;
+        `title` is not a str.
 
     Notes
     -----
@@ -395,6 +415,7 @@ def plot_trajectories(
     """
     who = "plot_trajectories"
     rows = _track_rows(rows, who)
+    _text(title, who, "title")
     truth = None if truth is None else _track_rows(truth, who, "truth")
     if background is not None:
         background = bgr_frame(background, f"{who}: background")

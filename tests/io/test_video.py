@@ -495,6 +495,24 @@ def test_8_bit_and_full_range_16_bit_images_are_read_as_opencv_reads_them(
         assert all(np.array_equal(f, e) for f, e in zip(src, expected, strict=True))
 
 
+@pytest.mark.parametrize("first", ["float", "8-bit"])
+def test_a_float_tiff_is_refused_by_its_depth_not_as_damaged(tmp_path: Path, first: str) -> None:
+    """A 32-bit float TIFF (a processing pipeline's output) decodes only at its own depth, which
+    OpenCV's colour read cannot give. Was: ``cannot read image .../1.tif: not an image OpenCV can
+    decode (damaged?)``, of an intact file; now its depth and the mend are named."""
+    image = np.linspace(0, 1, 48 * 64 * 3, dtype=np.float32).reshape(48, 64, 3)
+    for k in (1, 2):
+        eight = first == "8-bit" and k == 1
+        cv2.imwrite(str(tmp_path / f"{k}.tif"), (image * 255).astype(np.uint8) if eight else image)
+    bad = tmp_path / ("2.tif" if first == "8-bit" else "1.tif")
+    with pytest.raises(ValueError) as info:
+        list(FrameSource(tmp_path))
+    assert str(info.value) == (
+        f"cannot read image {bad}: its pixels are 32-bit floats (float32), not 8- or 16-bit "
+        "integers (whose range is known); convert the images to 8 or 16 bits (PNG or TIFF)"
+    )
+
+
 def test_seqinfo_of_pets_gives_its_true_frame_rate() -> None:
     folder = dataset("pets09-s2l1")
     src = FrameSource(folder / "video.avi")
@@ -544,6 +562,26 @@ def test_a_negative_camera_index_is_refused_not_a_crash() -> None:
     assert run.stdout == (
         "camera index is -1, expected an int >= 0\ncamera index is -2, expected an int >= 0\n"
     )
+
+
+@pytest.mark.parametrize(
+    ("source", "message"),
+    [
+        (2**31, "camera index is 2147483648, expected an int from 0 to 2147483647"),
+        ("99999999999999999999", "camera index is 99999999999999999999, expected an int from "),
+        ("\u00b2", "video source not found: \u00b2"),  # '²'.isdigit(), but no number
+        ("\u0663", "video source not found: \u0663"),  # an Arabic-Indic 3: not camera 3
+    ],
+)
+def test_a_camera_index_is_ascii_digits_of_an_int(source: object, message: str) -> None:
+    """Was: OpenCV's multi-line overload error (a C int is too small), ``'\u00b2'``: "invalid
+    literal for int() with base 10", and ``'\u0663'`` opened camera 3 (``str.isdigit`` takes any
+    Unicode digit)."""
+    with pytest.raises((ValueError, FileNotFoundError), match=re.escape(message)) as info:
+        FrameSource(source)  # type: ignore[arg-type]
+    assert "\n" not in str(info.value)
+    if isinstance(source, str):
+        assert is_live_source(source) == source.isascii()
 
 
 @pytest.mark.parametrize(
@@ -1270,3 +1308,19 @@ def test_closing_a_live_source_while_a_thread_reads_it_is_no_crash(tmp_path: Pat
                          timeout=120)  # fmt: skip
     assert run.returncode == 0, (run.returncode, run.stderr[-2000:])
     assert run.stdout.split() == ["True", "False", "True"]
+
+
+def test_frames_beyond_the_largest_side_are_refused_without_a_scale_given(
+    tmp_path: Path,
+) -> None:
+    """A 40000x8 image folder read as it is: was "scale 1 makes the 40000x8 frames of imgs
+    40000x8 pixels", of a scale nobody gave; the frames' own size is now named alone."""
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in (1, 2):
+        cv2.imwrite(str(folder / f"{k}.png"), np.zeros((8, 40000, 3), np.uint8))
+    with pytest.raises(ValueError) as info:
+        FrameSource(folder)
+    assert str(info.value) == (
+        f"the frames of {folder} are 40000x8 pixels; expected 1 to 32767 pixels a side"
+    )

@@ -200,3 +200,24 @@ def test_wrapped_planes_encode_the_bytes_of_copied_ones(
     assert write("copied.mp4") == wrapped
     _, got = decode(tmp_path / "wrapped.mp4")
     assert len(got) == 6 and got[0].shape[:2] == (h + h % 2, w + w % 2)
+
+
+@pytest.mark.parametrize(("w", "h"), [(16385, 8), (8, 16386), (20000, 64)])
+def test_an_mp4_beyond_h264s_side_is_refused_in_one_line(tmp_path: Path, w: int, h: int) -> None:
+    """x264 takes frames up to 16384 pixels a side. Was: PyAV's ExternalError ("Generic error in
+    an external library: avcodec_open2(...)"), a traceback and exit status 1 for ``pftrack
+    track panorama/ --render v.mp4`` of 20000x64 frames; the .avi (MJPG) takes them."""
+    frame = np.zeros((h, w, 3), np.uint8)
+    writer = VideoWriter(tmp_path / "v.mp4", 10)
+    with pytest.raises(ValueError) as info:
+        writer.write(frame)
+    writer.abort()
+    assert str(info.value) == (
+        f"video {tmp_path / 'v.mp4'}: H.264 takes frames up to 16384 pixels a side (x264), not "
+        f"{w + w % 2}x{h + h % 2}; write an .avi (Motion-JPEG) instead"
+    )
+    assert os.listdir(tmp_path) == []
+    with VideoWriter(tmp_path / "v.avi", 10) as avi:  # the way out works
+        avi.write(frame)
+    frames = decode(tmp_path / "v.avi")[1]
+    assert len(frames) == 1 and frames[0].shape == (h + h % 2, w + w % 2, 3)

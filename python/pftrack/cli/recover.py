@@ -101,6 +101,10 @@ def run(args: argparse.Namespace) -> int:
 
         inputs = tuple(source_files(args.video))
     check_output(args.out, what="--out", inputs=inputs)
+    if args.video:  # an image --out beside its frames: one more frame of the next run
+        from pftrack.io.video import check_outside_frames
+
+        check_outside_frames({"--out": args.out}, args.video)
     rows = read_tracks(src)
     n_links = 0
     if args.link:

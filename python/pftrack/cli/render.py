@@ -57,7 +57,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
         help=f"frame rate of the video written, {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} (default: "
-        "seqinfo.ini's frameRate, else the container's header, else 25)",
+        "seqinfo.ini's frameRate, else the container's header, else the frames' time stamps "
+        "(a header rate of 1000 or more is a time base), else 25)",
     )  # fmt: skip
     p.add_argument(
         "--trail",
@@ -80,8 +81,14 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_distinct, check_output, output_format, staged_outputs
-    from pftrack.io.video import FrameSource, check_source, is_live_source, source_files
-    from pftrack.io.video_writer import VIDEO_SUFFIXES
+    from pftrack.io.video import (
+        FrameSource,
+        check_outside_frames,
+        check_source,
+        is_live_source,
+        source_files,
+    )
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery.linking import read_tracks
     from pftrack.render import plot_trajectories, write_annotated_video
 
@@ -97,9 +104,12 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:  # "" too: refused as empty (was: no plot, without a word)
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--plot": args.plot})
+    check_outside_frames({"--out": args.out, "--plot": args.plot}, args.source)
     rows = read_tracks(args.tracks)
     rows[:, 2:6] *= args.scale
     source = FrameSource(args.source, fps=args.fps)
+    fmt = output_format(args.out, VIDEO_SUFFIXES)  # a size its encoder cannot take: said now
+    check_frame_size(f"--out {args.out}", fmt, source.width, source.height)
     n_frames = len(source)
     known = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
     if known and len(rows) and rows[:, 0].min() > known:  # was: an empty video, exit 0
@@ -136,10 +146,12 @@ def run(args: argparse.Namespace) -> int:
     if len(late):
         first, last = int(late[:, 0].min()), int(late[:, 0].max())
         frames = f"frame {first}" if first == last else f"frames {first}-{last}"
+        # names that skip numbers: another tool may have numbered the rows by them
+        gap = f" ({source.gap}: row frame k is drawn on the k-th image)" if source.gap else ""
         notes.append(
             f"{len(late)} row{'s' * (len(late) != 1)} of {frames} "
             f"{'are' if len(late) != 1 else 'is'} past the video's last frame {drawn[0]}: not "
-            "drawn"
+            f"drawn{gap}"
         )
     for note in notes:
         print(f"pftrack render: warning: {_shown(note)}", file=sys.stderr)

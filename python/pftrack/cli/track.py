@@ -79,7 +79,7 @@ def add_parser(sub: Any) -> None:
         "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
         help=f"frame rate of SOURCE, for --render, {FPS_RANGE[0]:g} to {FPS_RANGE[1]:g} "
         "(default: seqinfo.ini's frameRate, in the same range, else the container's header, "
-        "else 25)",
+        "else the frames' time stamps (a header rate of 1000 or more is a time base), else 25)",
     )  # fmt: skip
     p.add_argument(
         "--render", metavar="VIDEO",
@@ -210,7 +210,7 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output
-    from pftrack.io.video import find_sequence, source_files
+    from pftrack.io.video import check_outside_frames, find_sequence, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES
 
     given = [d for d in (args.detections,) if d and d != "auto"]
@@ -228,7 +228,10 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
         check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
     if args.plot is not None:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
-    check_distinct({"--out": args.out, "--render": args.render, "--plot": args.plot})
+    outputs = {"--out": args.out, "--render": args.render, "--plot": args.plot}
+    check_distinct(outputs)
+    if not live:
+        check_outside_frames(outputs, args.source)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -252,7 +255,7 @@ def run(args: argparse.Namespace) -> int:
     )
     from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, check_source, is_live_source
-    from pftrack.io.video_writer import VIDEO_SUFFIXES
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections
@@ -283,6 +286,9 @@ def run(args: argparse.Namespace) -> int:
     side: SideFile | None = None
     committed = False  # every staged output renamed into place
     try:
+        if args.render:  # a size its encoder cannot take: said before any work
+            fmt = output_format(args.render, VIDEO_SUFFIXES)
+            check_frame_size(f"--render {args.render}", fmt, source.width, source.height)
         with contextlib.ExitStack() as keep:
             if live and not streamed:
                 side = keep.enter_context(side_file(args.out))

@@ -34,7 +34,7 @@ import re
 import stat
 import threading
 import warnings
-from collections.abc import Collection, Generator, Iterable, Iterator, Sequence
+from collections.abc import Collection, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from decimal import Decimal
@@ -85,6 +85,8 @@ MAX_IMAGE_SIDE = 100_000
 #: The codec FFmpeg's ``tty`` demuxer reports: it opens text files (``.txt``, ``.nfo``, ``.asc``,
 #: ...) as ANSI art, 640x400 frames of rendered characters. A text file is not a video.
 TEXT_FOURCC = "ansi"
+#: Largest camera index (OpenCV's ``VideoCapture(index)`` takes a C int).
+MAX_CAMERA_INDEX = 2**31 - 1
 REPLAY_FRAMES = 64
 """Frames of a live source kept for a second pass (the tracker reads ahead to prime)."""
 
@@ -841,12 +843,25 @@ def _jpeg_ends(data: bytes) -> bool | None:
     return False
 
 
+def _odd_depth(path: Path) -> str | None:
+    """The depth of image `path` if it decodes only at a depth other than 8 or 16 bits.
+
+    A 32-bit float TIFF (a processing pipeline's output) decodes at its own depth but not in
+    OpenCV's 8-bit colour read; its values have no set range (0..1, 0..255, radiance).
+    """
+    image = read_image_depth(path, notes=[])  # the decoder's lines: said by the caller's read
+    if image is None or image.dtype in (np.uint8, np.uint16):
+        return None
+    kind = {"f": "floats", "i": "signed integers", "u": "unsigned integers"}
+    return f"{image.dtype.itemsize * 8}-bit {kind.get(image.dtype.kind, 'values')} ({image.dtype})"
+
+
 def _unreadable(path: Path, notes: Sequence[str]) -> str:
     """The error of image `path` of a folder that cannot be read, saying why.
 
     An empty file (a copy that failed), a folder or a broken link named like an image, a file
-    that cannot be opened, or what its decoder said (`notes`, :func:`read_image`'s); were all
-    ``cannot read image P``.
+    that cannot be opened, an image of another depth than 8 or 16 bits (:func:`_odd_depth`), or
+    what its decoder said (`notes`, :func:`read_image`'s); were all ``cannot read image P``.
     """
     try:
         info = path.stat()
@@ -859,6 +874,11 @@ def _unreadable(path: Path, notes: Sequence[str]) -> str:
             why = "it is a folder"
         elif info.st_size == 0:
             why = "it is empty (0 bytes)"
+        elif (depth := _odd_depth(path)) is not None:  # was "damaged?", of an intact file
+            why = (
+                f"its pixels are {depth}, not 8- or 16-bit integers (whose range is known); "
+                "convert the images to 8 or 16 bits (PNG or TIFF)"
+            )
         elif notes:
             why = f"its decoder says {'; '.join(dict.fromkeys(notes))!r}"
         else:
@@ -947,6 +967,46 @@ def source_files(source: PathLike | int) -> list[Path]:
     return files + [p for f in folders if f.is_dir() for p in image_files(f)]
 
 
+def check_outside_frames(outputs: Mapping[str, PathLike | None], source: PathLike | int) -> None:
+    """Refuse an image output in the folder whose images are `source`'s frames.
+
+    The run itself reads its frames before writing it, but the next run on that folder would
+    read it as one more frame (was: a ``--plot imgs/paths.png`` beside ``0001.jpg`` ..
+    ``0020.jpg`` was frame 21 of every later run, silently; a user trial). An output that is
+    already one of the images is an input of the run, refused by
+    :func:`~pftrack.io.atomic.check_output`.
+
+    Parameters
+    ----------
+    outputs : mapping of str to path or None
+        Each output by the name error messages give it (e.g. ``"--plot"``); None: not written.
+    source : str, int or os.PathLike
+        As :class:`FrameSource` takes it: only an image or sequence folder has such a folder.
+
+    Raises
+    ------
+    ValueError
+        An output with an image's extension (:data:`IMAGE_SUFFIXES`) lies in that folder.
+    """
+    if not Path(str(source)).is_dir():
+        return
+    frames = [p for p in source_files(source) if p.suffix.lower() in IMAGE_SUFFIXES]
+    if not frames:
+        return
+    folder = frames[0].parent
+    for what, path in outputs.items():
+        target = Path(path) if path is not None else None
+        if target is None or target.suffix.lower() not in IMAGE_SUFFIXES:
+            continue
+        if target.name.startswith("."):  # hidden: no frame (image_files)
+            continue
+        if _same_folder(target.parent, folder):
+            raise ValueError(
+                f"{what} {target} is in {folder}, whose images are this run's frames: a later "
+                "run on it would read it as one more frame; write elsewhere"
+            )
+
+
 def check_source(source: object) -> None:
     """Refuse what cannot name a frame source, before anything is opened.
 
@@ -957,14 +1017,24 @@ def check_source(source: object) -> None:
         camera 1).
     ValueError
         A negative camera index (OpenCV's ``VideoCapture(-1)`` crashes the process when there is
-        no camera), or an empty string (it would read the current folder).
+        no camera), one beyond a C int (``"99999999999999999999"``), or an empty string (it
+        would read the current folder).
     """
     what = "expected a video file, an image or sequence folder, a stream URL or a camera index"
     if isinstance(source, (bool, np.bool_)):
         raise TypeError(f"video source is {source}, a bool; {what} (an int >= 0)")
+    if isinstance(source, (int, np.integer)) and source < 0:
+        raise ValueError(f"camera index is {source}, expected an int >= 0")
     if isinstance(source, (int, np.integer)):
-        if source < 0:
-            raise ValueError(f"camera index is {source}, expected an int >= 0")
+        camera: int | None = int(source)
+    else:  # a name: "0", or Path("0"), when no file has it
+        camera = _camera_index(str(source)) if isinstance(source, (str, os.PathLike)) else None
+    if camera is not None and camera > MAX_CAMERA_INDEX:  # was OpenCV's overload error
+        raise ValueError(
+            f"camera index is {camera}, expected an int from 0 to {MAX_CAMERA_INDEX} (OpenCV's "
+            "VideoCapture takes a C int)"
+        )
+    if isinstance(source, (int, np.integer)):
         return
     if not isinstance(source, (str, os.PathLike)):
         kind = type(source).__name__
@@ -978,7 +1048,9 @@ def _camera_index(source: PathLike | int) -> int | None:
     if isinstance(source, (int, np.integer)) and not isinstance(source, (bool, np.bool_)):
         return int(source)
     text = str(source)
-    return int(text) if text.isdigit() and not Path(text).exists() else None
+    # ASCII digits only: str.isdigit() takes any Unicode digit ('\u00b2', which int() refuses)
+    digits = text.isascii() and text.isdigit()
+    return int(text) if digits and not Path(text).exists() else None
 
 
 def is_live_source(source: PathLike | int) -> bool:
@@ -1183,10 +1255,13 @@ class FrameSource:
         if min(size) < 1 or max(size) > MAX_SCALED_SIDE:
             if self._cap is not None:
                 self._cap.release()
-            raise ValueError(
-                f"scale {self.scale:g} makes the {w}x{h} frames of {self.name} {size[0]}x"
-                f"{size[1]} pixels; expected 1 to {MAX_SCALED_SIDE} pixels a side"
+            made = (  # a scale nobody gave is not named (was "scale 1 makes the ...")
+                f"the frames of {self.name} are {w}x{h} pixels"
+                if self.scale == 1.0
+                else f"scale {self.scale:g} makes the {w}x{h} frames of {self.name} "
+                f"{size[0]}x{size[1]} pixels"
             )
+            raise ValueError(f"{made}; expected 1 to {MAX_SCALED_SIDE} pixels a side")
         first = self._resize(first)
         self.height, self.width = int(first.shape[0]), int(first.shape[1])
         if self.live:
@@ -1246,7 +1321,7 @@ class FrameSource:
             if other is not None and other.dtype == np.uint16 and int(other.max()) > top:
                 top, brightest = int(other.max()), images[k]
         bits = _bit_depth(top)
-        if bits == 16:  # full range, or another depth (float TIFF): as OpenCV reads it
+        if bits == 16:  # full range, or another depth: as OpenCV reads it (a float TIFF: refused)
             again = read_image(path, notes=unsaid)
             if again is None:
                 raise ValueError(_unreadable(path, unsaid))

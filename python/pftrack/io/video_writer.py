@@ -25,9 +25,18 @@ from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
 
-__all__ = ["VIDEO_SUFFIXES", "X264_PRESETS", "VideoWriter", "pyav_available"]
+__all__ = [
+    "MAX_H264_SIDE",
+    "VIDEO_SUFFIXES",
+    "X264_PRESETS",
+    "VideoWriter",
+    "check_frame_size",
+    "pyav_available",
+]
 
 VIDEO_SUFFIXES = (".mp4", ".avi")
+#: Largest side of an H.264 frame that x264 encodes (pixels).
+MAX_H264_SIDE = 16384
 #: x264's presets, fastest first (:class:`VideoWriter`'s `preset`).
 X264_PRESETS = (
     "ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
@@ -38,6 +47,27 @@ X264_PRESETS = (
 def pyav_available() -> bool:
     """Whether PyAV (``import av``) can be used for H.264 output."""
     return importlib.util.find_spec("av") is not None
+
+
+def check_frame_size(what: str, suffix: str, width: int, height: int) -> None:
+    """Refuse frames of `width` x `height` that the encoder of a `suffix` video cannot take.
+
+    An ``.mp4`` is H.264 (x264 through PyAV): up to :data:`MAX_H264_SIDE` pixels a side, the
+    odd sides made even first. For a command to call before any work, naming the output as
+    `what` (``"--render v.mp4"``); :class:`VideoWriter` calls it at its first frame.
+
+    Raises
+    ------
+    ValueError
+        Such a size (was PyAV's "Generic error in an external library: avcodec_open2", a
+        traceback of ``pftrack track`` with exit status 1, for 20000x64 frames).
+    """
+    w, h = width + width % 2, height + height % 2
+    if suffix == ".mp4" and max(w, h) > MAX_H264_SIDE:
+        raise ValueError(
+            f"{what}: H.264 takes frames up to {MAX_H264_SIDE} pixels a side (x264), not "
+            f"{w}x{h}; write an .avi (Motion-JPEG) instead"
+        )
 
 
 class VideoWriter:
@@ -75,7 +105,8 @@ class VideoWriter:
     Notes
     -----
     H.264 with 4:2:0 chroma needs even width and height: odd frames get one replicated row or
-    column at the bottom or right. All frames must have the size of the first.
+    column at the bottom or right. All frames must have the size of the first. x264 takes up
+    to :data:`MAX_H264_SIDE` pixels a side: a larger first frame is a ValueError.
     """
 
     def __init__(
@@ -124,6 +155,7 @@ class VideoWriter:
         self._size = (height, width)
         h, w = height + height % 2, width + width % 2
         if self.backend == "pyav":
+            check_frame_size(f"video {self.path}", ".mp4", width, height)
             import av
 
             rate = Fraction(self.fps).limit_denominator(1001)
