@@ -621,6 +621,76 @@ def test_files_no_batch_wrote_are_not_replaced_without_force(
         track_many([vids], vids, n_workers=0)
 
 
+@contextlib.contextmanager
+def _unreadable(folder: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """`folder` made mode 000: it can be seen, not looked into (as a user; root is let in
+    anywhere, so the listing and every look inside it raise here as they would for a user)."""
+    real = os.stat, os.listdir, os.scandir
+    top = os.path.abspath(folder)
+
+    def inside(path: Any, itself: bool) -> bool:
+        if isinstance(path, int):
+            return False
+        name = os.path.abspath(os.fsdecode(os.fspath(path)))
+        return (itself and name == top) or name.startswith(top + os.sep)
+
+    def refuse(path: Any) -> None:
+        raise PermissionError(13, "Permission denied", os.fspath(path))
+
+    def stat(path: Any, *args: Any, **kwargs: Any) -> Any:
+        if inside(path, itself=False):
+            refuse(path)
+        return real[0](path, *args, **kwargs)
+
+    def listdir(path: Any = ".") -> Any:
+        if inside(path, itself=True):
+            refuse(path)
+        return real[1](path)
+
+    def scandir(path: Any = ".") -> Any:
+        if inside(path, itself=True):
+            refuse(path)
+        return real[2](path)
+
+    folder.chmod(0)
+    try:
+        with monkeypatch.context() as m:
+            m.setattr(os, "stat", stat)
+            m.setattr(os, "listdir", listdir)
+            m.setattr(os, "scandir", scandir)
+            yield
+    finally:
+        folder.chmod(0o755)
+
+
+@pytest.mark.parametrize("locked", ["s", "s/img1"])
+def test_a_sequence_folder_that_cannot_be_read_fails_alone(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, locked: str,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    """A user trial: a folder of sequences with one that cannot be read (mode 700 of another
+    user, ``lost+found``) stopped the whole batch, exit 2, with ``Permission denied:
+    .../s/seqinfo.ini`` (a file that need not exist), and with its ``img1/`` unreadable
+    ``Permission denied: .../s/img1/seqinfo.ini``; given alone, said so too."""
+    root = tmp_path / "in"
+    shutil.copytree(data / "MOT-01", root / "good")
+    shutil.copytree(data / "MOT-01", root / "s")
+    out = tmp_path / "out"
+    with _unreadable(root / locked, monkeypatch):
+        summary = track_many(root, out, n_workers=0, options=TrackOptions(_config()))
+        status = {e["name"]: (e["status"], e.get("error")) for e in summary.entries}
+        assert status["good"] == ("done", None)
+        assert status["s"] == (
+            "failed", f"cannot read the folder {root / locked} (Permission denied)"
+        ), status  # fmt: skip
+        assert sorted(p.name for p in out.iterdir()) == ["good.json", "good.txt", "summary.json"]
+        assert main(["batch", str(root / "s"), "--out", str(tmp_path / "o2"), "--workers", "0",
+                     *FAST]) == 1  # fmt: skip
+        assert capsys.readouterr().err == (
+            f"s: error: cannot read the folder {root / locked} (Permission denied)\n"
+        )
+
+
 def test_an_unwritable_out_is_refused_before_the_cluster_starts(
     data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 from pftrack._check import flag
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack._text import counted
+from pftrack.batch.inputs import cannot_read
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
 from pftrack.io.mot import write_mot
@@ -1547,7 +1548,8 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     """The error of a failed task as the client can tell it.
 
     A read path that is a broken symbolic link here is named as one (was: "No such file or
-    directory", or "video source not found"). A file the task could not find on a worker
+    directory", or "video source not found"), and so is a folder that cannot be looked into
+    (was: "Permission denied: DIR/seqinfo.ini"). A file the task could not find on a worker
     (`remote`) while this process sees it is the worker's view that differs: said so, with
     the worker's host (was: "video source not found: PATH", as if it did not exist).
     """
@@ -1557,6 +1559,13 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
         return f"symbolic link loop: {loop}"
     if broken:
         return f"broken symbolic link: {broken[0]} -> {os.readlink(broken[0])}"
+    unreadable = [
+        text
+        for p in job.reads
+        if str(p) in (outcome.error or "") and (text := cannot_read(p)) is not None
+    ]
+    if unreadable:  # was: "Permission denied: DIR/seqinfo.ini", a file that need not exist
+        return unreadable[0]
     if not remote or outcome.missing is None or outcome.host is None or outcome.error is None:
         return outcome.error
     if outcome.missing:

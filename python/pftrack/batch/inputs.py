@@ -232,6 +232,18 @@ def _as_sequence(path: Path) -> SequenceInput | None:
     )
 
 
+def _readable_as_sequence(path: Path) -> SequenceInput | None:
+    """:func:`_as_sequence`, or a sequence whose task fails for a folder it cannot look into.
+
+    As an unreadable video is (the others run; :func:`cannot_read` names it in the failed
+    entry). Was: the whole batch stopped, exit 2, with ``Permission denied: DIR/seqinfo.ini``.
+    """
+    try:
+        return _as_sequence(path)
+    except PermissionError:
+        return SequenceInput(path.name, path)
+
+
 def _annotations(folder: Path) -> tuple[Path | None, Path | None]:
     """A sequence folder's detection and ground-truth files, if any."""
     return (
@@ -371,7 +383,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     found: list[SequenceInput] = []
     for path in paths:
         _check_exists(path)
-        seq = _as_sequence(path)
+        seq = _readable_as_sequence(path)
         if seq is not None:
             found.append(seq)
             continue
@@ -390,7 +402,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
                 entry.suffix.lower() not in VIDEO_SUFFIXES or _batch_output(entry)
             ):
                 continue
-            child = _as_sequence(entry)
+            child = _readable_as_sequence(entry)
             if child is not None:
                 found.append(child)
             elif entry.is_dir():  # a link to one too (train -> /mnt/train); not deeper ones
@@ -477,6 +489,21 @@ def _txt_below(folder: Path) -> str:
     )
     more = f" and {len(found) - 3} more folders" if len(found) > 3 else ""
     return f"; {held}{more}: pass {'it' if len(found) == 1 else 'them'} instead"
+
+
+def cannot_read(path: Path) -> str | None:
+    """Why `path` cannot be looked into, if it is a folder that cannot be, else None.
+
+    ``cannot read the folder PATH (Permission denied)``: such a folder (mode 700 of another
+    user, ``lost+found``) can be seen but not listed, and what was looked for in it
+    (``seqinfo.ini``, ``img1/``) raised ``PermissionError``, naming a file that need not exist.
+    """
+    try:
+        if path.is_dir():
+            os.scandir(path).close()
+    except OSError as exc:
+        return f"cannot read the folder {path} ({exc.strerror})"
+    return None
 
 
 def _broken_link(path: Path) -> bool:
