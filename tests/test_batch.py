@@ -105,6 +105,30 @@ def test_find_sequences_names_and_files(data: Path) -> None:
     assert direct == mot
 
 
+def test_seq_img1_without_seqinfo_is_the_sequence_seq(data: Path, tmp_path: Path) -> None:
+    """``SEQ/img1`` given directly, ``SEQ`` without ``seqinfo.ini``: was the sequence ``img1``
+    without detections or ground truth (``--detections auto`` failed, "sequence img1 has no
+    det/det.txt") while ``pftrack track SEQ/img1`` reads ``SEQ/det/det.txt``."""
+    seq = tmp_path / "SEQ"
+    shutil.copytree(data / "MOT-01", seq)
+    (seq / "seqinfo.ini").unlink()
+    (direct,) = find_sequences(seq / "img1")
+    assert (
+        direct
+        == find_sequences(seq)[0]
+        == SequenceInput("SEQ", seq / "img1", seq / "det" / "det.txt", seq / "gt" / "gt.txt")
+    )
+    out = tmp_path / "out"
+    argv = ["batch", str(seq / "img1"), "--detections", "auto", "--out", str(out), *FAST]
+    assert main([*argv, "--workers", "0"]) == 0
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["status"] == "done" and entry["metrics"]["mota"] > 0.5, entry
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq / "img1"), "--detections", "auto", "--out", str(single),
+                 *FAST]) == 0  # fmt: skip
+    assert single.read_bytes() == (out / "SEQ.txt").read_bytes()
+
+
 def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
     # ../shared/data's layout: SEQ/video.avi + seqinfo.ini + det.txt + gt.txt
     seq = tmp_path / "pets"

@@ -210,8 +210,8 @@ def _as_sequence(path: Path) -> SequenceInput | None:
     """`path` as one sequence, or None when it is a folder of sequences."""
     if path.is_file():
         return SequenceInput(path.stem, path)
-    if path.name == "img1" and (path.parent / "seqinfo.ini").is_file():
-        path = path.parent  # SEQ/img1 given: the sequence is SEQ
+    if path.name == "img1":  # SEQ/img1 given: the sequence is SEQ, seqinfo.ini or not,
+        path = path.parent  # as pftrack track takes it (was: 'img1', no det.txt, without one)
     ini = path / "seqinfo.ini"
     if not ini.is_file():
         if (path / "img1").is_dir():
