@@ -579,6 +579,32 @@ def test_a_truth_that_cannot_be_scored_keeps_the_tracks(
     assert json.loads((out / "summary.json").read_text())["counts"]["skipped"] == 1
 
 
+def test_a_truth_beyond_seqlength_is_refused_as_pftrack_eval_refuses_it(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A ``gt.txt`` with a frame past ``seqLength`` (another sequence's, a wrong file): was
+    scored by the batch, its rows misses, while ``pftrack eval`` on the same files refuses it;
+    the batch's figures are said to be ``pftrack eval``'s."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=192\nimHeight=144\nseqLength=30\n")
+    with (seq / "gt" / "gt.txt").open("a") as fh:
+        fh.write("31,1,10,10,20,40,1,1,1\n")
+    out = tmp_path / "out"
+    assert main(["batch", str(seq), "--out", str(out), "--workers", "0", *FAST]) == 1
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    said = "ground truth has frame 31, beyond the sequence's 30 frames (seqLength)"
+    assert entry["status"] == "failed" and entry["metrics"] is None, entry
+    assert (
+        entry["error"]
+        == f"scoring against {seq / 'gt' / 'gt.txt'} (the tracks are written): {said}"
+    )
+    capsys.readouterr()
+    gt = str(seq / "gt" / "gt.txt")
+    assert main(["eval", "--gt", gt, "--res", str(out / "MOT-01.txt")]) == 2
+    assert said in capsys.readouterr().err
+
+
 def test_resume_skips_complete_outputs_and_force_redoes(
     data: Path, client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -281,16 +281,21 @@ def sequence_metrics(
     scale: float = 1.0,
     iou: float = 0.5,
     benchmark: BenchmarkName = "auto",
+    num_frames: int | None = None,
 ) -> dict[str, float | int | str | None]:
     """The figures of one sequence's tracks against its ground truth, for the summary.
 
     HOTA, DetA, AssA and LocA (TrackEval's, under `benchmark`'s ground-truth rules; ``"auto"``
     guesses them from `gt`'s columns), then MOTA, IDF1 and their counts:
     :func:`pftrack.eval.evaluate_sequence`, what ``pftrack eval`` prints for the same files.
+    `num_frames`: the sequence's ``seqLength``, where ``seqinfo.ini`` gives one (a row in a
+    later frame is an error, as in ``pftrack eval``).
     """
     from pftrack.eval import evaluate_sequence
 
-    s = evaluate_sequence(gt, rows, iou_threshold=iou, scale=scale, benchmark=benchmark)
+    s = evaluate_sequence(
+        gt, rows, iou_threshold=iou, scale=scale, benchmark=benchmark, num_frames=num_frames
+    )
     m, h = s.mot, s.hota
     out: dict[str, float | int | str | None] = {
         "hota": h.hota,
@@ -327,7 +332,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     """
     from pftrack.eval.sequences import benchmark_of_path
     from pftrack.io.mot import as_written, read_mot
-    from pftrack.io.video import FrameSource, info_scale
+    from pftrack.io.video import FrameSource, info_scale, read_seqinfo
     from pftrack.tracking.run import track_path
 
     cpu = time.process_time()
@@ -394,6 +399,8 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                 scale=gt_scale,
                 iou=options.iou,
                 benchmark="auto" if named is None else named[0],
+                # a frame past seqLength is refused, as pftrack eval refuses it (was: scored)
+                num_frames=None if seq.seqinfo is None else read_seqinfo(seq.seqinfo).length,
             )
         except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed
             error = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"
