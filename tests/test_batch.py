@@ -605,6 +605,22 @@ def test_a_truth_beyond_seqlength_is_refused_as_pftrack_eval_refuses_it(
     assert said in capsys.readouterr().err
 
 
+def test_a_truth_with_a_fractional_id_is_named_by_its_line(data: Path, tmp_path: Path) -> None:
+    """Was ``ground truth row 30: track id 1.5 ...``, the 0-based index of an array the user
+    never saw (line 31 of the file), where ``pftrack eval`` says ``gt.txt:31: track id 1.5``."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    gt = seq / "gt" / "gt.txt"
+    lines = gt.read_text().splitlines(keepends=True)
+    gt.write_text("".join(lines[:30]) + "1,1.5,10,10,20,40,1,1,1\n" + "".join(lines[30:]))
+    summary = track_many(seq, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    (entry,) = summary.entries
+    assert entry["error"] == (
+        f"scoring against {gt} (the tracks are written): {gt}:31: track id 1.5 is not an "
+        "integer with |id| <= 2147483647"
+    )
+
+
 def test_resume_skips_complete_outputs_and_force_redoes(
     data: Path, client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
