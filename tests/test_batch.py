@@ -729,6 +729,38 @@ def _unreadable(folder: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]
         folder.chmod(0o755)
 
 
+def test_a_pipe_or_device_input_is_named_as_one(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was ``pftrack batch: error: Not a directory: vids/pipe.mp4`` (and for ``/dev/null``),
+    the whole batch stopped, a pipe met in a folder of videos too; ``recover`` and ``smooth``
+    given one among their files likewise."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy(data / "walk.avi", vids / "walk.avi")
+    os.mkfifo(vids / "pipe.mp4")
+    out = tmp_path / "out"
+    with pytest.warns(UserWarning, match=f"{vids / 'pipe.mp4'} is a named pipe, not a video "):
+        summary = track_many(vids, out, n_workers=0, options=TrackOptions(_config()))
+    assert [(e["name"], e["status"]) for e in summary.entries] == [("walk", "done")]
+    assert main(["batch", str(vids / "pipe.mp4"), "--out", str(out), *FAST]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack batch: error: input {vids / 'pipe.mp4'} is a named pipe, not a file or a "
+        "folder: a batch reads files (pftrack track reads a pipe live, alone)\n"
+    )
+    assert main(["batch", os.devnull, "--out", str(out)]) == 2
+    assert "input /dev/null is a character device, not a file or a " in capsys.readouterr().err
+    tracks = tmp_path / "a.txt"
+    shutil.copy(out / "walk.txt", tracks)
+    for command in ("recover", "smooth"):
+        argv = [command, str(tracks), os.devnull, "--out", str(tmp_path / command)]
+        assert main(argv) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack {command}: error: input /dev/null is a character device, not a file or a "
+            "folder: a batch reads files\n"
+        )
+
+
 @pytest.mark.parametrize("locked", ["s", "s/img1"])
 def test_a_sequence_folder_that_cannot_be_read_fails_alone(
     data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, locked: str,

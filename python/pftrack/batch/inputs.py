@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 import warnings
 from collections import deque
 from collections.abc import Callable
@@ -383,6 +384,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     found: list[SequenceInput] = []
     for path in paths:
         _check_exists(path)
+        _refuse_special(path, " (pftrack track reads a pipe live, alone)")
         seq = _readable_as_sequence(path)
         if seq is not None:
             found.append(seq)
@@ -401,6 +403,16 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
             if entry.is_file() and (
                 entry.suffix.lower() not in VIDEO_SUFFIXES or _batch_output(entry)
             ):
+                continue
+            kind = _special(entry)
+            if kind is not None:  # was: "Not a directory: PATH", the whole batch stopped
+                if entry.suffix.lower() in VIDEO_SUFFIXES:
+                    warnings.warn(
+                        f"{entry} is {kind}, not a video file: passed over (pftrack track "
+                        "reads a pipe live, alone)",
+                        UserWarning,
+                        stacklevel=2,
+                    )
                 continue
             child = _readable_as_sequence(entry)
             if child is not None:
@@ -449,6 +461,7 @@ def find_track_files(inputs: Inputs) -> list[Path]:
     found: list[Path] = []
     for path in paths:
         _check_exists(path)
+        _refuse_special(path)
         if path.is_file():
             found.append(path)
             continue
@@ -504,6 +517,34 @@ def cannot_read(path: Path) -> str | None:
     except OSError as exc:
         return f"cannot read the folder {path} ({exc.strerror})"
     return None
+
+
+def _special(path: Path) -> str | None:
+    """``a named pipe``, ``a character device``, ... if `path` is neither a file nor a folder."""
+    try:
+        mode = path.stat().st_mode
+    except OSError:  # missing or unreadable: said elsewhere
+        return None
+    kinds = (
+        (stat.S_ISFIFO, "a named pipe"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    )
+    return next((kind for test, kind in kinds if test(mode)), None)
+
+
+def _refuse_special(path: Path, hint: str = "") -> None:
+    """Refuse an input that is a pipe, a device or a socket, naming it as one.
+
+    A batch reads each input from a file or folder, as many times as it takes (the client's
+    fingerprint and frame count, then the task). Was: ``Not a directory: PATH``.
+    """
+    kind = _special(path)
+    if kind is not None:
+        raise ValueError(
+            f"input {path} is {kind}, not a file or a folder: a batch reads files{hint}"
+        )
 
 
 def _broken_link(path: Path) -> bool:
