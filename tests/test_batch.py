@@ -949,6 +949,39 @@ def test_an_output_that_cannot_be_written_fails_its_task_not_the_batch(
     assert "run1" in capsys.readouterr().out  # the table
 
 
+def test_a_summary_that_cannot_be_written_keeps_the_table(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: the disk full (or --out made read-only) by the end, summary.json could
+    not be written: exit status 2 ("bad usage, nothing ran") with ``Permission denied:
+    out/summary.json`` alone, no table, though the tasks' outputs were written."""
+    import errno
+
+    from pftrack.batch import engine
+
+    _tracks_files(tmp_path / "tracks")
+    real = engine.atomic_write
+
+    def full(path: Any, *args: Any, **kwargs: Any) -> Any:
+        if Path(path).name == "summary.json":
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(engine, "atomic_write", full)
+    out = tmp_path / "out"
+    assert main(["recover", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]) == 1
+    text, err = capsys.readouterr()
+    assert re.search(r"^run1 +done ", text, re.M) and "summary ->" not in text
+    said = f"{out / 'summary.json'} not written (No space left on device)"
+    assert err == f"error: {said}; the outputs written before it are complete\n"
+    assert sorted(p.name for p in out.iterdir()) == [
+        f"run{k}.{ext}" for k in range(3) for ext in ("json", "txt")
+    ]
+    summary = recover_many(tmp_path / "tracks", out, n_workers=0, force=True)
+    assert summary.unwritten == f"{said}; the outputs written before it are complete"
+    assert summary.table().endswith(f"\nerror: {summary.unwritten}")
+
+
 def test_resume_redoes_an_output_truncated_emptied_or_replaced(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -129,6 +129,10 @@ class BatchSummary:
         else as Dask reports it (None: in this process).
     settings : dict
         The settings every task ran with.
+    unwritten : str or None
+        Why ``out_dir/summary.json`` could not be written at the end (a full disk, a folder
+        made read-only meanwhile), else None: the tasks' outputs written stay, and this is the
+        run's only record (``pftrack`` prints its table and exits with status 1).
     """
 
     kind: str
@@ -138,6 +142,7 @@ class BatchSummary:
     workers: int = 0
     scheduler: str | None = None
     settings: dict[str, Any] = field(default_factory=dict)
+    unwritten: str | None = None
 
     @property
     def failed(self) -> list[dict[str, Any]]:
@@ -218,9 +223,14 @@ class BatchSummary:
         return "\n".join(text)
 
     def problems(self) -> list[str]:
-        """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``)."""
+        """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``).
+
+        Last, ``error: DIR/summary.json not written (...)`` if it could not be.
+        """
         text = [f"{e['name']}: warning: {w}" for e in self.entries for w in e.get("warnings", ())]
         text.extend(f"{e['name']}: error: {e['error']}" for e in self.failed)
+        if self.unwritten:
+            text.append(f"error: {self.unwritten}")
         return text
 
 
@@ -1875,8 +1885,14 @@ def run_jobs(
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
                 summary.entries = [entries[job.name] for job in jobs]
                 summary.seconds = time.perf_counter() - start
-                with atomic_write(out / SUMMARY_NAME) as fh:
-                    fh.write(summary.to_json() + "\n")
+                try:
+                    with atomic_write(out / SUMMARY_NAME) as fh:
+                        fh.write(summary.to_json() + "\n")
+                except OSError as exc:  # was: exit status 2 with this error alone, no table
+                    summary.unwritten = (
+                        f"{out / SUMMARY_NAME} not written ({exc.strerror or one_line(exc)}); "
+                        "the outputs written before it are complete"
+                    )
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM: say what it left, truthfully
         _say_interrupted(exc, out, kind, written if touched else None)
         raise
