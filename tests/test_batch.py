@@ -1480,6 +1480,51 @@ def test_tasks_on_workers_report_their_frames(client: Any, data: Path) -> None:
     assert all(0 < n <= 30 for _, n in got)
 
 
+def _warning_task(word: str, both: threading.Barrier, seen: dict[str, Any]) -> TaskResult:
+    from pftrack.batch import tasks
+
+    both.wait()  # the two tasks inside call_task at once
+    warnings.warn(f"{word} before", UserWarning, stacklevel=1)
+    seen[word] = tasks.running_task()
+    both.wait()
+    warnings.warn(f"{word} after", UserWarning, stacklevel=1)
+    both.wait()
+    return TaskResult(np.zeros((0, 10)))
+
+
+def test_tasks_on_threads_of_one_worker_keep_their_own_warnings_and_reports() -> None:
+    """A worker with two threads (``Client()`` in a notebook, ``dask worker --nthreads 2``)
+    runs two tasks in one process: one task's warnings were given to the other (a truncated
+    video's "ended after 4 frames" under another sequence's name, none under its own), and the
+    frame report and stop check of the task that started last served both."""
+    from pftrack.batch.engine import call_task
+
+    both = threading.Barrier(2, timeout=20)
+    outcomes: dict[str, Any] = {}
+    seen: dict[str, Any] = {}
+
+    def report_a(n: int) -> None:
+        pass
+
+    def report_b(n: int) -> None:
+        pass
+
+    reports = {"a": report_a, "b": report_b}
+
+    def run(word: str) -> None:
+        outcomes[word] = call_task(_warning_task, (word, both, seen), reports[word])
+
+    threads = [threading.Thread(target=run, args=(word,)) for word in "ab"]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    for word in "ab":
+        assert outcomes[word].error is None, outcomes[word].traceback
+        assert outcomes[word].result.info["warnings"] == [f"{word} before", f"{word} after"]
+        assert seen[word][0] is reports[word]
+
+
 @pytest.fixture
 def ctrl_c_raises() -> Iterator[None]:
     """Python's own Ctrl-C handler while the test runs, whatever the test run inherited.

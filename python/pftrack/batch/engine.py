@@ -1455,6 +1455,68 @@ def _worker_stop() -> Callable[[], None] | None:
     return stop
 
 
+class _TaskWarnings:
+    """The warnings of the tasks running in this process, each task's to its own list.
+
+    ``warnings.catch_warnings`` is one state for the whole process: a Dask worker with several
+    threads runs several tasks at once, and each task's ``catch_warnings(record=True)`` took
+    the others' warnings, or restored the module in the wrong order. One recording serves them
+    all (entered by the first task, left by the last), and each warning goes to the task of
+    the thread that raised it; one from another thread (a read-ahead thread of ``pftrack batch
+    --workers 0``) to the task running, when only one runs.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._logs: dict[int, list[warnings.WarningMessage]] = {}
+        self._saved: warnings.catch_warnings[None] | None = None
+        self._shown: Callable[..., None] = warnings.showwarning
+
+    @contextlib.contextmanager
+    def recording(self) -> Iterator[list[warnings.WarningMessage]]:
+        """Meanwhile, the warnings this thread raises (every one: filter ``always``)."""
+        log: list[warnings.WarningMessage] = []
+        thread = threading.get_ident()
+        with self._lock:
+            if not self._logs:
+                self._saved = warnings.catch_warnings()
+                self._saved.__enter__()
+                warnings.simplefilter("always")
+                self._shown = warnings.showwarning
+                warnings.showwarning = self._show
+            self._logs[thread] = log
+        try:
+            yield log
+        finally:
+            with self._lock:
+                del self._logs[thread]
+                if not self._logs and self._saved is not None:
+                    self._saved.__exit__(None, None, None)
+                    self._saved = None
+
+    def _show(
+        self,
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: Any = None,
+        line: str | None = None,
+    ) -> None:
+        with self._lock:
+            log = self._logs.get(threading.get_ident())
+            if log is None and len(self._logs) == 1:
+                (log,) = self._logs.values()
+            if log is not None:
+                log.append(warnings.WarningMessage(message, category, filename, lineno, file, line))
+                return
+        self._shown(message, category, filename, lineno, file, line)
+
+
+#: The recording of :func:`call_task`'s warnings in this process.
+_TASK_WARNINGS = _TaskWarnings()
+
+
 def call_task(
     func: Callable[..., TaskResult],
     args: tuple[Any, ...],
@@ -1485,8 +1547,7 @@ def call_task(
     host = _host() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
-    with warnings.catch_warnings(record=True) as caught, reporting_frames(report, stop):
-        warnings.simplefilter("always")
+    with _TASK_WARNINGS.recording() as caught, reporting_frames(report, stop):
         try:
             result = func(*args)
         except Exception as exc:  # noqa: BLE001 - reported per task

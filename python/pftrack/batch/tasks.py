@@ -14,6 +14,7 @@ import dataclasses
 import math
 import socket
 import tempfile
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
@@ -48,12 +49,12 @@ __all__ = [
 ]
 
 
-#: Where the running task reports the frames it has tracked (``report(n)``): set by the
-#: batch engine around a task (:func:`reporting_frames`), None otherwise.
-_report_frames: Callable[[int], None] | None = None
-#: What the running task calls every :data:`STOP_CHECK_EVERY` frames, which raises
-#: :class:`TaskCancelled` to stop it: set by the batch engine around a task on a Dask worker.
-_stop_check: Callable[[], None] | None = None
+#: Per thread, where the task running on it reports the frames it has tracked (``report``:
+#: ``report(n)``) and what it calls every :data:`STOP_CHECK_EVERY` frames, which raises
+#: :class:`TaskCancelled` to stop it (``stop``): set by the batch engine around a task
+#: (:func:`reporting_frames`). Per thread: a Dask worker with several threads runs several
+#: tasks at once (was: one global pair, the last task's, served them all).
+_running = threading.local()
 #: Frames between two calls of the stop check (tracking, then rendering).
 STOP_CHECK_EVERY = 25
 
@@ -77,13 +78,20 @@ def reporting_frames(
     called every :data:`STOP_CHECK_EVERY` frames tracked or rendered, and raises
     (:class:`TaskCancelled`) to end the task.
     """
-    global _report_frames, _stop_check
-    before = _report_frames, _stop_check
-    _report_frames, _stop_check = report, stop
+    before = running_task()
+    _running.report, _running.stop = report, stop
     try:
         yield
     finally:
-        _report_frames, _stop_check = before
+        _running.report, _running.stop = before
+
+
+def running_task() -> tuple[Callable[[int], None] | None, Callable[[], None] | None]:
+    """The frame report and the stop check of the task running on this thread, if any.
+
+    What :func:`reporting_frames` set for this thread; ``(None, None)`` outside a task.
+    """
+    return getattr(_running, "report", None), getattr(_running, "stop", None)
 
 
 def _checked(frames: Iterable[Any], stop: Callable[[], None] | None) -> Iterator[Any]:
@@ -337,7 +345,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     from pftrack.tracking.run import track_path
 
     cpu = time.process_time()
-    report, stop = _report_frames, _stop_check
+    report, stop = running_task()
     frames = FrameSource(seq.frames)
     # the boxes of det.txt and gt.txt are in seqinfo.ini's pixels
     auto_scale = info_scale(
