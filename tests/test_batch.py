@@ -729,6 +729,21 @@ def _unreadable(folder: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]
         folder.chmod(0o755)
 
 
+def test_a_name_too_long_for_its_outputs_fails_alone(data: Path, tmp_path: Path) -> None:
+    """A video named with 251 bytes before ``.avi`` (255 in all, the file system's most): its
+    ``NAME.json`` cannot exist. Was: the whole batch stopped, exit 2, ``File name too long:
+    vids/NAME.json``, a file the user never had (the look for a batch's sidecar beside it)."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    long = "v" * 251
+    shutil.copy(data / "walk.avi", vids / f"{long}.avi")
+    shutil.copy(data / "walk.avi", vids / "walk.avi")
+    summary = track_many(vids, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    status = {e["name"]: (e["status"], e.get("error")) for e in summary.entries}
+    assert status["walk"] == ("done", None)
+    assert status[long][0] == "failed" and "File name too long" in status[long][1], status
+
+
 def test_a_pipe_or_device_input_is_named_as_one(
     data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -135,9 +135,9 @@ def _batch_output(path: Path) -> bool:
     when its folder is looked into: a batch whose ``--out`` is its input folder can be re-run.
     """
     sidecar = path.with_name(f"{path.stem}.json")
-    if not sidecar.is_file():
-        return False
     try:
+        if not sidecar.is_file():  # ENAMETOOLONG for a 251-byte stem: no sidecar either
+            return False
         entry = json.loads(sidecar.read_text(encoding="utf-8"))
     except (OSError, ValueError):  # not a sidecar of ours: the video is an input
         return False
