@@ -729,6 +729,26 @@ def _unreadable(folder: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]
         folder.chmod(0o755)
 
 
+def test_a_stream_url_input_is_named_as_one(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was ``input not found: /cwd/rtsp:/cam/stream``, a path the user never gave."""
+    out = str(tmp_path / "out")
+    assert main(["batch", "rtsp://cam/stream", str(data / "walk.avi"), "--out", out]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack batch: error: input rtsp://cam/stream is a URL, not a file or a folder: a "
+        "batch reads files (pftrack track reads a stream live, alone)\n"
+    )
+    tracks = tmp_path / "a.txt"
+    tracks.write_text("1,1,10,10,20,40,1,-1,-1,-1\n")
+    assert main(["recover", str(tracks), "http://host/b.txt", "--out", out]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack recover: error: input http://host/b.txt is a URL, not a file or a folder: a "
+        "batch reads files\n"
+    )
+    assert not Path(out).exists()
+
+
 def test_a_name_too_long_for_its_outputs_fails_alone(data: Path, tmp_path: Path) -> None:
     """A video named with 251 bytes before ``.avi`` (255 in all, the file system's most): its
     ``NAME.json`` cannot exist. Was: the whole batch stopped, exit 2, ``File name too long:

@@ -37,6 +37,9 @@ __all__ = ["VIDEO_SUFFIXES", "SequenceInput", "find_sequences", "find_track_file
 #: What a batch is given: one path or several.
 Inputs = PathLike | list[PathLike] | tuple[PathLike, ...]
 
+#: How the refusal of a stream URL among a batch's sequences ends.
+_LIVE = " (pftrack track reads a stream live, alone)"
+
 #: Names a sequence may not have: its outputs would overwrite the batch's own files.
 RESERVED_NAMES = ("summary",)
 
@@ -79,7 +82,7 @@ class SequenceInput:
         return tuple(p for p in paths if p is not None)
 
 
-def _absolute(inputs: Inputs) -> list[Path]:
+def _absolute(inputs: Inputs, hint: str = "") -> list[Path]:
     """The inputs as absolute paths: workers may run in another folder than this process.
 
     Raises
@@ -88,7 +91,8 @@ def _absolute(inputs: Inputs) -> list[Path]:
         `inputs` is neither a path nor an iterable of paths, or one of them is no path
         (was: Python's words, "'NoneType' object is not iterable", naming no parameter).
     ValueError
-        No input, an empty path or ``-``.
+        No input, an empty path or ``-``, or a URL (``rtsp://cam/stream``; `hint` ends that
+        message; was: "input not found: /cwd/rtsp:/cam/stream").
     """
     if isinstance(inputs, bytes):
         inputs = os.fsdecode(inputs)
@@ -116,6 +120,10 @@ def _absolute(inputs: Inputs) -> list[Path]:
         refuse_dash(p, "input", name="file or folder")
         if os.fspath(p) == "":  # was: the current folder, tracked as an image folder
             raise ValueError("an input is an empty path; give a file or folder")
+        if "://" in os.fspath(p) and not os.path.lexists(p):
+            raise ValueError(
+                f"input {os.fspath(p)} is a URL, not a file or a folder: a batch reads files{hint}"
+            )
     return [Path(os.path.abspath(p)) for p in given]
 
 
@@ -380,7 +388,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
         A folder of sequences has sequences deeper than one level (``DIR/train/SEQ`` for
         ``DIR``): they are not tracked; the warning names the folders that hold them.
     """
-    paths = _absolute(inputs)
+    paths = _absolute(inputs, _LIVE)
     found: list[SequenceInput] = []
     for path in paths:
         _check_exists(path)
