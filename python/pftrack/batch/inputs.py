@@ -250,6 +250,8 @@ def _readable_as_sequence(path: Path) -> SequenceInput | None:
     try:
         return _as_sequence(path)
     except PermissionError:
+        if cannot_read(path) is None:  # deeper (its det/ unreadable): said as it is
+            raise
         return SequenceInput(path.name, path)
 
 
