@@ -129,6 +129,33 @@ def test_seq_img1_without_seqinfo_is_the_sequence_seq(data: Path, tmp_path: Path
     assert single.read_bytes() == (out / "SEQ.txt").read_bytes()
 
 
+@pytest.mark.parametrize("given", ["img1", "images"])
+def test_an_image_folder_of_a_sequence_given_itself_is_read_as_pftrack_track_reads_it(
+    data: Path, tmp_path: Path, given: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``SEQ/img1`` given where ``seqinfo.ini`` says ``imDir=images``: the batch tracked
+    ``SEQ/images``, ``pftrack track SEQ/img1`` tracks ``SEQ/img1``; ``SEQ/images`` given (its
+    ``imDir``, not named img1) was the sequence ``images`` without detections or ground truth
+    (``--detections auto`` failed) while ``pftrack track`` reads ``SEQ/det/det.txt``."""
+    seq = tmp_path / "SEQ"
+    shutil.copytree(data / "MOT-01", seq)
+    shutil.copytree(data / "plain", seq / "images")  # other frames than img1's
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimDir=images\nimWidth=192\nimHeight=144\n")
+    (found,) = find_sequences(seq / given)
+    assert found == SequenceInput(
+        "SEQ", seq / given, seq / "det" / "det.txt", seq / "gt" / "gt.txt", 192, 144,
+        seqinfo=seq / "seqinfo.ini",
+    )  # fmt: skip
+    out = tmp_path / "out"
+    argv = ["batch", str(seq / given), "--detections", "auto", "--out", str(out), *FAST]
+    assert main([*argv, "--workers", "0"]) == 0
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq / given), "--detections", "auto", "--out", str(single),
+                 *FAST]) == 0  # fmt: skip
+    assert single.read_bytes() == (out / "SEQ.txt").read_bytes()
+    capsys.readouterr()
+
+
 def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
     # ../shared/data's layout: SEQ/video.avi + seqinfo.ini + det.txt + gt.txt
     seq = tmp_path / "pets"

@@ -219,8 +219,23 @@ def _as_sequence(path: Path) -> SequenceInput | None:
     """`path` as one sequence, or None when it is a folder of sequences."""
     if path.is_file():
         return SequenceInput(path.stem, path)
-    if path.name == "img1":  # SEQ/img1 given: the sequence is SEQ, seqinfo.ini or not,
-        path = path.parent  # as pftrack track takes it (was: 'img1', no det.txt, without one)
+    beside = path.parent / "seqinfo.ini"
+    if (
+        beside.is_file()
+        and not (path / "seqinfo.ini").is_file()
+        and (path.name == "img1" or image_files(path))
+    ):  # SEQ/img1 or SEQ/IMDIR given: the sequence SEQ, these frames, as pftrack track reads
+        # them (was: SEQ's imDir read instead of img1; IMDIR a sequence without det.txt)
+        try:
+            info = read_seqinfo(beside)
+        except ValueError:  # its task reads it again and fails, naming the fault
+            return SequenceInput(path.parent.name, path, seqinfo=beside)
+        seq = path.parent
+        return SequenceInput(
+            seq.name, path, *_annotations(seq), info.width, info.height, seqinfo=beside
+        )
+    if path.name == "img1":  # SEQ/img1 given, no seqinfo.ini: the sequence is SEQ, as
+        path = path.parent  # pftrack track takes it (was: 'img1', no det.txt)
     ini = path / "seqinfo.ini"
     if not ini.is_file():
         if (path / "img1").is_dir():
