@@ -156,6 +156,36 @@ def test_an_image_folder_of_a_sequence_given_itself_is_read_as_pftrack_track_rea
     capsys.readouterr()
 
 
+def test_the_video_of_a_sequence_folder_given_itself_has_its_detections(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``pftrack batch pets09-s2l1/video.avi --detections auto`` (../shared/data's layout)
+    failed, "sequence video has no det/det.txt (nor det.txt)", and was not scored, while
+    ``pftrack track pets09-s2l1/video.avi --detections auto`` reads its det.txt and scales its
+    boxes by seqinfo.ini's imWidth."""
+    seq = tmp_path / "pets"
+    seq.mkdir()
+    shutil.copy(data / "walk.avi", seq / "video.avi")
+    for name in ("det", "gt"):
+        shutil.copy(data / "MOT-01" / name / f"{name}.txt", seq / f"{name}.txt")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=384\nimHeight=288\n")
+    (found,) = find_sequences(seq / "video.avi")
+    assert found == SequenceInput(
+        "video", seq / "video.avi", seq / "det.txt", seq / "gt.txt", 384, 288,
+        seqinfo=seq / "seqinfo.ini",
+    )  # fmt: skip
+    out = tmp_path / "out"
+    argv = ["batch", str(seq / "video.avi"), "--detections", "auto", "--out", str(out), *FAST]
+    assert main([*argv, "--workers", "0"]) == 0
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["det_scale"] == 0.5 and entry["metrics"] is not None, entry
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq / "video.avi"), "--detections", "auto", "--out", str(single),
+                 *FAST]) == 0  # fmt: skip
+    assert single.read_bytes() == (out / "video.txt").read_bytes()
+    capsys.readouterr()
+
+
 def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
     # ../shared/data's layout: SEQ/video.avi + seqinfo.ini + det.txt + gt.txt
     seq = tmp_path / "pets"

@@ -217,23 +217,20 @@ def _image_folder(path: Path) -> SequenceInput | None:
 
 def _as_sequence(path: Path) -> SequenceInput | None:
     """`path` as one sequence, or None when it is a folder of sequences."""
-    if path.is_file():
-        return SequenceInput(path.stem, path)
     beside = path.parent / "seqinfo.ini"
+    if path.is_file():
+        # SEQ/video.avi (../shared/data's layout): SEQ's detections, truth and sizes, as
+        # pftrack track reads it (was: none, --detections auto failed, no metrics)
+        return (
+            _within(path.stem, path, beside) if beside.is_file() else SequenceInput(path.stem, path)
+        )
     if (
         beside.is_file()
         and not (path / "seqinfo.ini").is_file()
         and (path.name == "img1" or image_files(path))
     ):  # SEQ/img1 or SEQ/IMDIR given: the sequence SEQ, these frames, as pftrack track reads
         # them (was: SEQ's imDir read instead of img1; IMDIR a sequence without det.txt)
-        try:
-            info = read_seqinfo(beside)
-        except ValueError:  # its task reads it again and fails, naming the fault
-            return SequenceInput(path.parent.name, path, seqinfo=beside)
-        seq = path.parent
-        return SequenceInput(
-            seq.name, path, *_annotations(seq), info.width, info.height, seqinfo=beside
-        )
+        return _within(path.parent.name, path, beside)
     if path.name == "img1":  # SEQ/img1 given, no seqinfo.ini: the sequence is SEQ, as
         path = path.parent  # pftrack track takes it (was: 'img1', no det.txt)
     ini = path / "seqinfo.ini"
@@ -254,6 +251,20 @@ def _as_sequence(path: Path) -> SequenceInput | None:
     return SequenceInput(
         path.name, frames, *_annotations(path), info.width, info.height, seqinfo=ini
     )
+
+
+def _within(name: str, frames: Path, ini: Path) -> SequenceInput:
+    """`frames` (a video or an image folder) of the sequence folder of `ini`, given itself.
+
+    With that folder's detections, ground truth and ``seqinfo.ini`` sizes, as
+    ``pftrack track FRAMES`` reads them.
+    """
+    try:
+        info = read_seqinfo(ini)
+    except ValueError:  # its task reads it again and fails, naming the fault; the others run
+        return SequenceInput(name, frames, seqinfo=ini)
+    annotations = _annotations(ini.parent)
+    return SequenceInput(name, frames, *annotations, info.width, info.height, seqinfo=ini)
 
 
 def _readable_as_sequence(path: Path) -> SequenceInput | None:
