@@ -42,6 +42,7 @@ __all__ = [
     "read_tracks",
     "recover_file",
     "reporting_frames",
+    "running_task",
     "sequence_length",
     "sequence_metrics",
     "smooth_file",
