@@ -1484,12 +1484,16 @@ class _TaskWarnings:
                 warnings.simplefilter("always")
                 self._shown = warnings.showwarning
                 warnings.showwarning = self._show
+            before = self._logs.get(thread)  # a task within a task: its own, then the outer's
             self._logs[thread] = log
         try:
             yield log
         finally:
             with self._lock:
-                del self._logs[thread]
+                if before is None:
+                    del self._logs[thread]
+                else:
+                    self._logs[thread] = before
                 if not self._logs and self._saved is not None:
                     self._saved.__exit__(None, None, None)
                     self._saved = None
