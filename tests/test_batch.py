@@ -105,6 +105,87 @@ def test_find_sequences_names_and_files(data: Path) -> None:
     assert direct == mot
 
 
+def test_seq_img1_without_seqinfo_is_the_sequence_seq(data: Path, tmp_path: Path) -> None:
+    """``SEQ/img1`` given directly, ``SEQ`` without ``seqinfo.ini``: was the sequence ``img1``
+    without detections or ground truth (``--detections auto`` failed, "sequence img1 has no
+    det/det.txt") while ``pftrack track SEQ/img1`` reads ``SEQ/det/det.txt``."""
+    seq = tmp_path / "SEQ"
+    shutil.copytree(data / "MOT-01", seq)
+    (seq / "seqinfo.ini").unlink()
+    (direct,) = find_sequences(seq / "img1")
+    assert (
+        direct
+        == find_sequences(seq)[0]
+        == SequenceInput("SEQ", seq / "img1", seq / "det" / "det.txt", seq / "gt" / "gt.txt")
+    )
+    out = tmp_path / "out"
+    argv = ["batch", str(seq / "img1"), "--detections", "auto", "--out", str(out), *FAST]
+    assert main([*argv, "--workers", "0"]) == 0
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["status"] == "done" and entry["metrics"]["mota"] > 0.5, entry
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq / "img1"), "--detections", "auto", "--out", str(single),
+                 *FAST]) == 0  # fmt: skip
+    assert single.read_bytes() == (out / "SEQ.txt").read_bytes()
+
+
+@pytest.mark.parametrize("given", ["img1", "images"])
+def test_an_image_folder_of_a_sequence_given_itself_is_read_as_pftrack_track_reads_it(
+    data: Path, tmp_path: Path, given: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``SEQ/img1`` given where ``seqinfo.ini`` says ``imDir=images``: the batch tracked
+    ``SEQ/images``, ``pftrack track SEQ/img1`` tracks ``SEQ/img1``; ``SEQ/images`` given (its
+    ``imDir``, not named img1) was the sequence ``images`` without detections or ground truth
+    (``--detections auto`` failed) while ``pftrack track`` reads ``SEQ/det/det.txt``."""
+    seq = tmp_path / "SEQ"
+    shutil.copytree(data / "MOT-01", seq)
+    shutil.copytree(data / "plain", seq / "images")  # other frames than img1's
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimDir=images\nimWidth=192\nimHeight=144\n")
+    (found,) = find_sequences(seq / given)
+    assert found == SequenceInput(
+        "SEQ", seq / given, seq / "det" / "det.txt", seq / "gt" / "gt.txt", 192, 144,
+        seqinfo=seq / "seqinfo.ini",
+    )  # fmt: skip
+    out = tmp_path / "out"
+    argv = ["batch", str(seq / given), "--detections", "auto", "--out", str(out), *FAST]
+    assert main([*argv, "--workers", "0"]) == 0
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq / given), "--detections", "auto", "--out", str(single),
+                 *FAST]) == 0  # fmt: skip
+    assert single.read_bytes() == (out / "SEQ.txt").read_bytes()
+    capsys.readouterr()
+
+
+def test_the_video_of_a_sequence_folder_given_itself_has_its_detections(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``pftrack batch pets09-s2l1/video.avi --detections auto`` (../shared/data's layout)
+    failed, "sequence video has no det/det.txt (nor det.txt)", and was not scored, while
+    ``pftrack track pets09-s2l1/video.avi --detections auto`` reads its det.txt and scales its
+    boxes by seqinfo.ini's imWidth."""
+    seq = tmp_path / "pets"
+    seq.mkdir()
+    shutil.copy(data / "walk.avi", seq / "video.avi")
+    for name in ("det", "gt"):
+        shutil.copy(data / "MOT-01" / name / f"{name}.txt", seq / f"{name}.txt")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=384\nimHeight=288\n")
+    (found,) = find_sequences(seq / "video.avi")
+    assert found == SequenceInput(
+        "video", seq / "video.avi", seq / "det.txt", seq / "gt.txt", 384, 288,
+        seqinfo=seq / "seqinfo.ini",
+    )  # fmt: skip
+    out = tmp_path / "out"
+    argv = ["batch", str(seq / "video.avi"), "--detections", "auto", "--out", str(out), *FAST]
+    assert main([*argv, "--workers", "0"]) == 0
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["det_scale"] == 0.5 and entry["metrics"] is not None, entry
+    single = tmp_path / "single.txt"
+    assert main(["track", str(seq / "video.avi"), "--detections", "auto", "--out", str(single),
+                 *FAST]) == 0  # fmt: skip
+    assert single.read_bytes() == (out / "video.txt").read_bytes()
+    capsys.readouterr()
+
+
 def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:
     # ../shared/data's layout: SEQ/video.avi + seqinfo.ini + det.txt + gt.txt
     seq = tmp_path / "pets"
@@ -555,6 +636,48 @@ def test_a_truth_that_cannot_be_scored_keeps_the_tracks(
     assert json.loads((out / "summary.json").read_text())["counts"]["skipped"] == 1
 
 
+def test_a_truth_beyond_seqlength_is_refused_as_pftrack_eval_refuses_it(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A ``gt.txt`` with a frame past ``seqLength`` (another sequence's, a wrong file): was
+    scored by the batch, its rows misses, while ``pftrack eval`` on the same files refuses it;
+    the batch's figures are said to be ``pftrack eval``'s."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=192\nimHeight=144\nseqLength=30\n")
+    with (seq / "gt" / "gt.txt").open("a") as fh:
+        fh.write("31,1,10,10,20,40,1,1,1\n")
+    out = tmp_path / "out"
+    assert main(["batch", str(seq), "--out", str(out), "--workers", "0", *FAST]) == 1
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    said = "ground truth has frame 31, beyond the sequence's 30 frames (seqLength)"
+    assert entry["status"] == "failed" and entry["metrics"] is None, entry
+    assert (
+        entry["error"]
+        == f"scoring against {seq / 'gt' / 'gt.txt'} (the tracks are written): {said}"
+    )
+    capsys.readouterr()
+    gt = str(seq / "gt" / "gt.txt")
+    assert main(["eval", "--gt", gt, "--res", str(out / "MOT-01.txt")]) == 2
+    assert said in capsys.readouterr().err
+
+
+def test_a_truth_with_a_fractional_id_is_named_by_its_line(data: Path, tmp_path: Path) -> None:
+    """Was ``ground truth row 30: track id 1.5 ...``, the 0-based index of an array the user
+    never saw (line 31 of the file), where ``pftrack eval`` says ``gt.txt:31: track id 1.5``."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    gt = seq / "gt" / "gt.txt"
+    lines = gt.read_text().splitlines(keepends=True)
+    gt.write_text("".join(lines[:30]) + "1,1.5,10,10,20,40,1,1,1\n" + "".join(lines[30:]))
+    summary = track_many(seq, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    (entry,) = summary.entries
+    assert entry["error"] == (
+        f"scoring against {gt} (the tracks are written): {gt}:31: track id 1.5 is not an "
+        "integer with |id| <= 2147483647"
+    )
+
+
 def test_resume_skips_complete_outputs_and_force_redoes(
     data: Path, client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -619,6 +742,143 @@ def test_files_no_batch_wrote_are_not_replaced_without_force(
     with pytest.raises(ValueError, match=r"exists and no earlier batch .* give force=True"):
         (vids / "walk.json").unlink()
         track_many([vids], vids, n_workers=0)
+
+
+@contextlib.contextmanager
+def _unreadable(folder: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """`folder` made mode 000: it can be seen, not looked into (as a user; root is let in
+    anywhere, so the listing and every look inside it raise here as they would for a user)."""
+    real = os.stat, os.listdir, os.scandir
+    top = os.path.abspath(folder)
+
+    def inside(path: Any, itself: bool) -> bool:
+        if isinstance(path, int):
+            return False
+        name = os.path.abspath(os.fsdecode(os.fspath(path)))
+        return (itself and name == top) or name.startswith(top + os.sep)
+
+    def refuse(path: Any) -> None:
+        raise PermissionError(13, "Permission denied", os.fspath(path))
+
+    def stat(path: Any, *args: Any, **kwargs: Any) -> Any:
+        if inside(path, itself=False):
+            refuse(path)
+        return real[0](path, *args, **kwargs)
+
+    def listdir(path: Any = ".") -> Any:
+        if inside(path, itself=True):
+            refuse(path)
+        return real[1](path)
+
+    def scandir(path: Any = ".") -> Any:
+        if inside(path, itself=True):
+            refuse(path)
+        return real[2](path)
+
+    folder.chmod(0)
+    try:
+        with monkeypatch.context() as m:
+            m.setattr(os, "stat", stat)
+            m.setattr(os, "listdir", listdir)
+            m.setattr(os, "scandir", scandir)
+            yield
+    finally:
+        folder.chmod(0o755)
+
+
+def test_a_stream_url_input_is_named_as_one(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was ``input not found: /cwd/rtsp:/cam/stream``, a path the user never gave."""
+    out = str(tmp_path / "out")
+    assert main(["batch", "rtsp://cam/stream", str(data / "walk.avi"), "--out", out]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack batch: error: input rtsp://cam/stream is a URL, not a file or a folder: a "
+        "batch reads files (pftrack track reads a stream live, alone)\n"
+    )
+    tracks = tmp_path / "a.txt"
+    tracks.write_text("1,1,10,10,20,40,1,-1,-1,-1\n")
+    assert main(["recover", str(tracks), "http://host/b.txt", "--out", out]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack recover: error: input http://host/b.txt is a URL, not a file or a folder: a "
+        "batch reads files\n"
+    )
+    assert not Path(out).exists()
+
+
+def test_a_name_too_long_for_its_outputs_fails_alone(data: Path, tmp_path: Path) -> None:
+    """A video named with 251 bytes before ``.avi`` (255 in all, the file system's most): its
+    ``NAME.json`` cannot exist. Was: the whole batch stopped, exit 2, ``File name too long:
+    vids/NAME.json``, a file the user never had (the look for a batch's sidecar beside it)."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    long = "v" * 251
+    shutil.copy(data / "walk.avi", vids / f"{long}.avi")
+    shutil.copy(data / "walk.avi", vids / "walk.avi")
+    summary = track_many(vids, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    status = {e["name"]: (e["status"], e.get("error")) for e in summary.entries}
+    assert status["walk"] == ("done", None)
+    assert status[long][0] == "failed" and "File name too long" in status[long][1], status
+
+
+def test_a_pipe_or_device_input_is_named_as_one(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was ``pftrack batch: error: Not a directory: vids/pipe.mp4`` (and for ``/dev/null``),
+    the whole batch stopped, a pipe met in a folder of videos too; ``recover`` and ``smooth``
+    given one among their files likewise."""
+    vids = tmp_path / "vids"
+    vids.mkdir()
+    shutil.copy(data / "walk.avi", vids / "walk.avi")
+    os.mkfifo(vids / "pipe.mp4")
+    out = tmp_path / "out"
+    with pytest.warns(UserWarning, match=f"{vids / 'pipe.mp4'} is a named pipe, not a video "):
+        summary = track_many(vids, out, n_workers=0, options=TrackOptions(_config()))
+    assert [(e["name"], e["status"]) for e in summary.entries] == [("walk", "done")]
+    assert main(["batch", str(vids / "pipe.mp4"), "--out", str(out), *FAST]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack batch: error: input {vids / 'pipe.mp4'} is a named pipe, not a file or a "
+        "folder: a batch reads files (pftrack track reads a pipe live, alone)\n"
+    )
+    assert main(["batch", os.devnull, "--out", str(out)]) == 2
+    assert "input /dev/null is a character device, not a file or a " in capsys.readouterr().err
+    tracks = tmp_path / "a.txt"
+    shutil.copy(out / "walk.txt", tracks)
+    for command in ("recover", "smooth"):
+        argv = [command, str(tracks), os.devnull, "--out", str(tmp_path / command)]
+        assert main(argv) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack {command}: error: input /dev/null is a character device, not a file or a "
+            "folder: a batch reads files\n"
+        )
+
+
+@pytest.mark.parametrize("locked", ["s", "s/img1"])
+def test_a_sequence_folder_that_cannot_be_read_fails_alone(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, locked: str,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    """A user trial: a folder of sequences with one that cannot be read (mode 700 of another
+    user, ``lost+found``) stopped the whole batch, exit 2, with ``Permission denied:
+    .../s/seqinfo.ini`` (a file that need not exist), and with its ``img1/`` unreadable
+    ``Permission denied: .../s/img1/seqinfo.ini``; given alone, said so too."""
+    root = tmp_path / "in"
+    shutil.copytree(data / "MOT-01", root / "good")
+    shutil.copytree(data / "MOT-01", root / "s")
+    out = tmp_path / "out"
+    with _unreadable(root / locked, monkeypatch):
+        summary = track_many(root, out, n_workers=0, options=TrackOptions(_config()))
+        status = {e["name"]: (e["status"], e.get("error")) for e in summary.entries}
+        assert status["good"] == ("done", None)
+        assert status["s"] == (
+            "failed", f"cannot read the folder {root / locked} (Permission denied)"
+        ), status  # fmt: skip
+        assert sorted(p.name for p in out.iterdir()) == ["good.json", "good.txt", "summary.json"]
+        assert main(["batch", str(root / "s"), "--out", str(tmp_path / "o2"), "--workers", "0",
+                     *FAST]) == 1  # fmt: skip
+        assert capsys.readouterr().err == (
+            f"s: error: cannot read the folder {root / locked} (Permission denied)\n"
+        )
 
 
 def test_an_unwritable_out_is_refused_before_the_cluster_starts(
@@ -779,6 +1039,39 @@ def test_an_output_that_cannot_be_written_fails_its_task_not_the_batch(
     assert error.startswith("writing its outputs: ") and "No space left on device" in error
     assert str(out / "run1.txt") in error
     assert "run1" in capsys.readouterr().out  # the table
+
+
+def test_a_summary_that_cannot_be_written_keeps_the_table(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: the disk full (or --out made read-only) by the end, summary.json could
+    not be written: exit status 2 ("bad usage, nothing ran") with ``Permission denied:
+    out/summary.json`` alone, no table, though the tasks' outputs were written."""
+    import errno
+
+    from pftrack.batch import engine
+
+    _tracks_files(tmp_path / "tracks")
+    real = engine.atomic_write
+
+    def full(path: Any, *args: Any, **kwargs: Any) -> Any:
+        if Path(path).name == "summary.json":
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(engine, "atomic_write", full)
+    out = tmp_path / "out"
+    assert main(["recover", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]) == 1
+    text, err = capsys.readouterr()
+    assert re.search(r"^run1 +done ", text, re.M) and "summary ->" not in text
+    said = f"{out / 'summary.json'} not written (No space left on device)"
+    assert err == f"error: {said}; the outputs written before it are complete\n"
+    assert sorted(p.name for p in out.iterdir()) == [
+        f"run{k}.{ext}" for k in range(3) for ext in ("json", "txt")
+    ]
+    summary = recover_many(tmp_path / "tracks", out, n_workers=0, force=True)
+    assert summary.unwritten == f"{said}; the outputs written before it are complete"
+    assert summary.table().endswith(f"\nerror: {summary.unwritten}")
 
 
 def test_resume_redoes_an_output_truncated_emptied_or_replaced(
@@ -1277,6 +1570,51 @@ def test_tasks_on_workers_report_their_frames(client: Any, data: Path) -> None:
         client.unsubscribe_topic(topic)
     assert got and list(got[0]) == ["walk", 1]  # the first frame at once, then twice a second
     assert all(0 < n <= 30 for _, n in got)
+
+
+def _warning_task(word: str, both: threading.Barrier, seen: dict[str, Any]) -> TaskResult:
+    from pftrack.batch import tasks
+
+    both.wait()  # the two tasks inside call_task at once
+    warnings.warn(f"{word} before", UserWarning, stacklevel=1)
+    seen[word] = tasks.running_task()
+    both.wait()
+    warnings.warn(f"{word} after", UserWarning, stacklevel=1)
+    both.wait()
+    return TaskResult(np.zeros((0, 10)))
+
+
+def test_tasks_on_threads_of_one_worker_keep_their_own_warnings_and_reports() -> None:
+    """A worker with two threads (``Client()`` in a notebook, ``dask worker --nthreads 2``)
+    runs two tasks in one process: one task's warnings were given to the other (a truncated
+    video's "ended after 4 frames" under another sequence's name, none under its own), and the
+    frame report and stop check of the task that started last served both."""
+    from pftrack.batch.engine import call_task
+
+    both = threading.Barrier(2, timeout=20)
+    outcomes: dict[str, Any] = {}
+    seen: dict[str, Any] = {}
+
+    def report_a(n: int) -> None:
+        pass
+
+    def report_b(n: int) -> None:
+        pass
+
+    reports = {"a": report_a, "b": report_b}
+
+    def run(word: str) -> None:
+        outcomes[word] = call_task(_warning_task, (word, both, seen), reports[word])
+
+    threads = [threading.Thread(target=run, args=(word,)) for word in "ab"]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    for word in "ab":
+        assert outcomes[word].error is None, outcomes[word].traceback
+        assert outcomes[word].result.info["warnings"] == [f"{word} before", f"{word} after"]
+        assert seen[word][0] is reports[word]
 
 
 @pytest.fixture

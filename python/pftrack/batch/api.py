@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 from pftrack._typing import PathLike
 from pftrack.batch.engine import BatchSummary, Job, run_jobs
-from pftrack.batch.inputs import Inputs, find_sequences, find_track_files
+from pftrack.batch.inputs import Inputs, SequenceInput, find_sequences, find_track_files
 from pftrack.batch.tasks import (
     RecoverOptions,
     SmoothOptions,
@@ -20,6 +20,8 @@ from pftrack.batch.tasks import (
 from pftrack.io.video import source_files
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from distributed import Client
 
 __all__ = ["recover_many", "smooth_many", "track_many"]
@@ -129,7 +131,7 @@ def track_many(
             (s, opts),
             s.files,
             functools.partial(sequence_length, s),
-            guards=tuple(source_files(s.frames)),  # every image read, seqinfo.ini
+            guards=_guards(s),
         )
         for s in seqs
     ]
@@ -145,6 +147,18 @@ def track_many(
         force=force,
         show_progress=show_progress,
     )
+
+
+def _guards(seq: SequenceInput) -> tuple[Path, ...]:
+    """What no output may replace: every image `seq` reads, its ``seqinfo.ini``.
+
+    Only the frames' path for a folder that cannot be looked into (its task fails, named so;
+    was: the whole batch stopped, ``Permission denied: .../img1/seqinfo.ini``).
+    """
+    try:
+        return tuple(source_files(seq.frames))
+    except PermissionError:
+        return (seq.frames,)
 
 
 def recover_many(

@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 from pftrack._check import flag
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack._text import counted
+from pftrack.batch.inputs import cannot_read
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
 from pftrack.io.mot import write_mot
@@ -128,6 +129,10 @@ class BatchSummary:
         else as Dask reports it (None: in this process).
     settings : dict
         The settings every task ran with.
+    unwritten : str or None
+        Why ``out_dir/summary.json`` could not be written at the end (a full disk, a folder
+        made read-only meanwhile), else None: the tasks' outputs written stay, and this is the
+        run's only record (``pftrack`` prints its table and exits with status 1).
     """
 
     kind: str
@@ -137,6 +142,7 @@ class BatchSummary:
     workers: int = 0
     scheduler: str | None = None
     settings: dict[str, Any] = field(default_factory=dict)
+    unwritten: str | None = None
 
     @property
     def failed(self) -> list[dict[str, Any]]:
@@ -217,9 +223,14 @@ class BatchSummary:
         return "\n".join(text)
 
     def problems(self) -> list[str]:
-        """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``)."""
+        """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``).
+
+        Last, ``error: DIR/summary.json not written (...)`` if it could not be.
+        """
         text = [f"{e['name']}: warning: {w}" for e in self.entries for w in e.get("warnings", ())]
         text.extend(f"{e['name']}: error: {e['error']}" for e in self.failed)
+        if self.unwritten:
+            text.append(f"error: {self.unwritten}")
         return text
 
 
@@ -1444,6 +1455,72 @@ def _worker_stop() -> Callable[[], None] | None:
     return stop
 
 
+class _TaskWarnings:
+    """The warnings of the tasks running in this process, each task's to its own list.
+
+    ``warnings.catch_warnings`` is one state for the whole process: a Dask worker with several
+    threads runs several tasks at once, and each task's ``catch_warnings(record=True)`` took
+    the others' warnings, or restored the module in the wrong order. One recording serves them
+    all (entered by the first task, left by the last), and each warning goes to the task of
+    the thread that raised it; one from another thread (a read-ahead thread of ``pftrack batch
+    --workers 0``) to the task running, when only one runs.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._logs: dict[int, list[warnings.WarningMessage]] = {}
+        self._saved: warnings.catch_warnings[None] | None = None
+        self._shown: Callable[..., None] = warnings.showwarning
+
+    @contextlib.contextmanager
+    def recording(self) -> Iterator[list[warnings.WarningMessage]]:
+        """Meanwhile, the warnings this thread raises (every one: filter ``always``)."""
+        log: list[warnings.WarningMessage] = []
+        thread = threading.get_ident()
+        with self._lock:
+            if not self._logs:
+                self._saved = warnings.catch_warnings()
+                self._saved.__enter__()
+                warnings.simplefilter("always")
+                self._shown = warnings.showwarning
+                warnings.showwarning = self._show
+            before = self._logs.get(thread)  # a task within a task: its own, then the outer's
+            self._logs[thread] = log
+        try:
+            yield log
+        finally:
+            with self._lock:
+                if before is None:
+                    del self._logs[thread]
+                else:
+                    self._logs[thread] = before
+                if not self._logs and self._saved is not None:
+                    self._saved.__exit__(None, None, None)
+                    self._saved = None
+
+    def _show(
+        self,
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: Any = None,
+        line: str | None = None,
+    ) -> None:
+        with self._lock:
+            log = self._logs.get(threading.get_ident())
+            if log is None and len(self._logs) == 1:
+                (log,) = self._logs.values()
+            if log is not None:
+                log.append(warnings.WarningMessage(message, category, filename, lineno, file, line))
+                return
+        self._shown(message, category, filename, lineno, file, line)
+
+
+#: The recording of :func:`call_task`'s warnings in this process.
+_TASK_WARNINGS = _TaskWarnings()
+
+
 def call_task(
     func: Callable[..., TaskResult],
     args: tuple[Any, ...],
@@ -1474,8 +1551,7 @@ def call_task(
     host = _host() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
-    with warnings.catch_warnings(record=True) as caught, reporting_frames(report, stop):
-        warnings.simplefilter("always")
+    with _TASK_WARNINGS.recording() as caught, reporting_frames(report, stop):
         try:
             result = func(*args)
         except Exception as exc:  # noqa: BLE001 - reported per task
@@ -1547,7 +1623,8 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     """The error of a failed task as the client can tell it.
 
     A read path that is a broken symbolic link here is named as one (was: "No such file or
-    directory", or "video source not found"). A file the task could not find on a worker
+    directory", or "video source not found"), and so is a folder that cannot be looked into
+    (was: "Permission denied: DIR/seqinfo.ini"). A file the task could not find on a worker
     (`remote`) while this process sees it is the worker's view that differs: said so, with
     the worker's host (was: "video source not found: PATH", as if it did not exist).
     """
@@ -1557,6 +1634,13 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
         return f"symbolic link loop: {loop}"
     if broken:
         return f"broken symbolic link: {broken[0]} -> {os.readlink(broken[0])}"
+    unreadable = [
+        text
+        for p in job.reads
+        if str(p) in (outcome.error or "") and (text := cannot_read(p)) is not None
+    ]
+    if unreadable:  # was: "Permission denied: DIR/seqinfo.ini", a file that need not exist
+        return unreadable[0]
     if not remote or outcome.missing is None or outcome.host is None or outcome.error is None:
         return outcome.error
     if outcome.missing:
@@ -1866,8 +1950,14 @@ def run_jobs(
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
                 summary.entries = [entries[job.name] for job in jobs]
                 summary.seconds = time.perf_counter() - start
-                with atomic_write(out / SUMMARY_NAME) as fh:
-                    fh.write(summary.to_json() + "\n")
+                try:
+                    with atomic_write(out / SUMMARY_NAME) as fh:
+                        fh.write(summary.to_json() + "\n")
+                except OSError as exc:  # was: exit status 2 with this error alone, no table
+                    summary.unwritten = (
+                        f"{out / SUMMARY_NAME} not written ({exc.strerror or one_line(exc)}); "
+                        "the outputs written before it are complete"
+                    )
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM: say what it left, truthfully
         _say_interrupted(exc, out, kind, written if touched else None)
         raise

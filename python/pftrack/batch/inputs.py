@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 import warnings
 from collections import deque
 from collections.abc import Callable
@@ -35,6 +36,9 @@ __all__ = ["VIDEO_SUFFIXES", "SequenceInput", "find_sequences", "find_track_file
 
 #: What a batch is given: one path or several.
 Inputs = PathLike | list[PathLike] | tuple[PathLike, ...]
+
+#: How the refusal of a stream URL among a batch's sequences ends.
+_LIVE = " (pftrack track reads a stream live, alone)"
 
 #: Names a sequence may not have: its outputs would overwrite the batch's own files.
 RESERVED_NAMES = ("summary",)
@@ -78,7 +82,7 @@ class SequenceInput:
         return tuple(p for p in paths if p is not None)
 
 
-def _absolute(inputs: Inputs) -> list[Path]:
+def _absolute(inputs: Inputs, hint: str = "") -> list[Path]:
     """The inputs as absolute paths: workers may run in another folder than this process.
 
     Raises
@@ -87,7 +91,8 @@ def _absolute(inputs: Inputs) -> list[Path]:
         `inputs` is neither a path nor an iterable of paths, or one of them is no path
         (was: Python's words, "'NoneType' object is not iterable", naming no parameter).
     ValueError
-        No input, an empty path or ``-``.
+        No input, an empty path or ``-``, or a URL (``rtsp://cam/stream``; `hint` ends that
+        message; was: "input not found: /cwd/rtsp:/cam/stream").
     """
     if isinstance(inputs, bytes):
         inputs = os.fsdecode(inputs)
@@ -115,6 +120,10 @@ def _absolute(inputs: Inputs) -> list[Path]:
         refuse_dash(p, "input", name="file or folder")
         if os.fspath(p) == "":  # was: the current folder, tracked as an image folder
             raise ValueError("an input is an empty path; give a file or folder")
+        if "://" in os.fspath(p) and not os.path.lexists(p):
+            raise ValueError(
+                f"input {os.fspath(p)} is a URL, not a file or a folder: a batch reads files{hint}"
+            )
     return [Path(os.path.abspath(p)) for p in given]
 
 
@@ -134,9 +143,9 @@ def _batch_output(path: Path) -> bool:
     when its folder is looked into: a batch whose ``--out`` is its input folder can be re-run.
     """
     sidecar = path.with_name(f"{path.stem}.json")
-    if not sidecar.is_file():
-        return False
     try:
+        if not sidecar.is_file():  # ENAMETOOLONG for a 251-byte stem: no sidecar either
+            return False
         entry = json.loads(sidecar.read_text(encoding="utf-8"))
     except (OSError, ValueError):  # not a sidecar of ours: the video is an input
         return False
@@ -208,10 +217,22 @@ def _image_folder(path: Path) -> SequenceInput | None:
 
 def _as_sequence(path: Path) -> SequenceInput | None:
     """`path` as one sequence, or None when it is a folder of sequences."""
+    beside = path.parent / "seqinfo.ini"
     if path.is_file():
-        return SequenceInput(path.stem, path)
-    if path.name == "img1" and (path.parent / "seqinfo.ini").is_file():
-        path = path.parent  # SEQ/img1 given: the sequence is SEQ
+        # SEQ/video.avi (../shared/data's layout): SEQ's detections, truth and sizes, as
+        # pftrack track reads it (was: none, --detections auto failed, no metrics)
+        return (
+            _within(path.stem, path, beside) if beside.is_file() else SequenceInput(path.stem, path)
+        )
+    if (
+        beside.is_file()
+        and not (path / "seqinfo.ini").is_file()
+        and (path.name == "img1" or image_files(path))
+    ):  # SEQ/img1 or SEQ/IMDIR given: the sequence SEQ, these frames, as pftrack track reads
+        # them (was: SEQ's imDir read instead of img1; IMDIR a sequence without det.txt)
+        return _within(path.parent.name, path, beside)
+    if path.name == "img1":  # SEQ/img1 given, no seqinfo.ini: the sequence is SEQ, as
+        path = path.parent  # pftrack track takes it (was: 'img1', no det.txt)
     ini = path / "seqinfo.ini"
     if not ini.is_file():
         if (path / "img1").is_dir():
@@ -230,6 +251,34 @@ def _as_sequence(path: Path) -> SequenceInput | None:
     return SequenceInput(
         path.name, frames, *_annotations(path), info.width, info.height, seqinfo=ini
     )
+
+
+def _within(name: str, frames: Path, ini: Path) -> SequenceInput:
+    """`frames` (a video or an image folder) of the sequence folder of `ini`, given itself.
+
+    With that folder's detections, ground truth and ``seqinfo.ini`` sizes, as
+    ``pftrack track FRAMES`` reads them.
+    """
+    try:
+        info = read_seqinfo(ini)
+    except ValueError:  # its task reads it again and fails, naming the fault; the others run
+        return SequenceInput(name, frames, seqinfo=ini)
+    annotations = _annotations(ini.parent)
+    return SequenceInput(name, frames, *annotations, info.width, info.height, seqinfo=ini)
+
+
+def _readable_as_sequence(path: Path) -> SequenceInput | None:
+    """:func:`_as_sequence`, or a sequence whose task fails for a folder it cannot look into.
+
+    As an unreadable video is (the others run; :func:`cannot_read` names it in the failed
+    entry). Was: the whole batch stopped, exit 2, with ``Permission denied: DIR/seqinfo.ini``.
+    """
+    try:
+        return _as_sequence(path)
+    except PermissionError:
+        if cannot_read(path) is None:  # deeper (its det/ unreadable): said as it is
+            raise
+        return SequenceInput(path.name, path)
 
 
 def _annotations(folder: Path) -> tuple[Path | None, Path | None]:
@@ -367,11 +416,12 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
         A folder of sequences has sequences deeper than one level (``DIR/train/SEQ`` for
         ``DIR``): they are not tracked; the warning names the folders that hold them.
     """
-    paths = _absolute(inputs)
+    paths = _absolute(inputs, _LIVE)
     found: list[SequenceInput] = []
     for path in paths:
         _check_exists(path)
-        seq = _as_sequence(path)
+        _refuse_special(path, " (pftrack track reads a pipe live, alone)")
+        seq = _readable_as_sequence(path)
         if seq is not None:
             found.append(seq)
             continue
@@ -390,7 +440,17 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
                 entry.suffix.lower() not in VIDEO_SUFFIXES or _batch_output(entry)
             ):
                 continue
-            child = _as_sequence(entry)
+            kind = _special(entry)
+            if kind is not None:  # was: "Not a directory: PATH", the whole batch stopped
+                if entry.suffix.lower() in VIDEO_SUFFIXES:
+                    warnings.warn(
+                        f"{entry} is {kind}, not a video file: passed over (pftrack track "
+                        "reads a pipe live, alone)",
+                        UserWarning,
+                        stacklevel=2,
+                    )
+                continue
+            child = _readable_as_sequence(entry)
             if child is not None:
                 found.append(child)
             elif entry.is_dir():  # a link to one too (train -> /mnt/train); not deeper ones
@@ -437,6 +497,7 @@ def find_track_files(inputs: Inputs) -> list[Path]:
     found: list[Path] = []
     for path in paths:
         _check_exists(path)
+        _refuse_special(path)
         if path.is_file():
             found.append(path)
             continue
@@ -477,6 +538,49 @@ def _txt_below(folder: Path) -> str:
     )
     more = f" and {len(found) - 3} more folders" if len(found) > 3 else ""
     return f"; {held}{more}: pass {'it' if len(found) == 1 else 'them'} instead"
+
+
+def cannot_read(path: Path) -> str | None:
+    """Why `path` cannot be looked into, if it is a folder that cannot be, else None.
+
+    ``cannot read the folder PATH (Permission denied)``: such a folder (mode 700 of another
+    user, ``lost+found``) can be seen but not listed, and what was looked for in it
+    (``seqinfo.ini``, ``img1/``) raised ``PermissionError``, naming a file that need not exist.
+    """
+    try:
+        if path.is_dir():
+            os.scandir(path).close()
+    except OSError as exc:
+        return f"cannot read the folder {path} ({exc.strerror})"
+    return None
+
+
+def _special(path: Path) -> str | None:
+    """``a named pipe``, ``a character device``, ... if `path` is neither a file nor a folder."""
+    try:
+        mode = path.stat().st_mode
+    except OSError:  # missing or unreadable: said elsewhere
+        return None
+    kinds = (
+        (stat.S_ISFIFO, "a named pipe"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    )
+    return next((kind for test, kind in kinds if test(mode)), None)
+
+
+def _refuse_special(path: Path, hint: str = "") -> None:
+    """Refuse an input that is a pipe, a device or a socket, naming it as one.
+
+    A batch reads each input from a file or folder, as many times as it takes (the client's
+    fingerprint and frame count, then the task). Was: ``Not a directory: PATH``.
+    """
+    kind = _special(path)
+    if kind is not None:
+        raise ValueError(
+            f"input {path} is {kind}, not a file or a folder: a batch reads files{hint}"
+        )
 
 
 def _broken_link(path: Path) -> bool:

@@ -14,6 +14,7 @@ import dataclasses
 import math
 import socket
 import tempfile
+import threading
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
@@ -41,6 +42,7 @@ __all__ = [
     "read_tracks",
     "recover_file",
     "reporting_frames",
+    "running_task",
     "sequence_length",
     "sequence_metrics",
     "smooth_file",
@@ -48,12 +50,12 @@ __all__ = [
 ]
 
 
-#: Where the running task reports the frames it has tracked (``report(n)``): set by the
-#: batch engine around a task (:func:`reporting_frames`), None otherwise.
-_report_frames: Callable[[int], None] | None = None
-#: What the running task calls every :data:`STOP_CHECK_EVERY` frames, which raises
-#: :class:`TaskCancelled` to stop it: set by the batch engine around a task on a Dask worker.
-_stop_check: Callable[[], None] | None = None
+#: Per thread, where the task running on it reports the frames it has tracked (``report``:
+#: ``report(n)``) and what it calls every :data:`STOP_CHECK_EVERY` frames, which raises
+#: :class:`TaskCancelled` to stop it (``stop``): set by the batch engine around a task
+#: (:func:`reporting_frames`). Per thread: a Dask worker with several threads runs several
+#: tasks at once (was: one global pair, the last task's, served them all).
+_running = threading.local()
 #: Frames between two calls of the stop check (tracking, then rendering).
 STOP_CHECK_EVERY = 25
 
@@ -77,13 +79,20 @@ def reporting_frames(
     called every :data:`STOP_CHECK_EVERY` frames tracked or rendered, and raises
     (:class:`TaskCancelled`) to end the task.
     """
-    global _report_frames, _stop_check
-    before = _report_frames, _stop_check
-    _report_frames, _stop_check = report, stop
+    before = running_task()
+    _running.report, _running.stop = report, stop
     try:
         yield
     finally:
-        _report_frames, _stop_check = before
+        _running.report, _running.stop = before
+
+
+def running_task() -> tuple[Callable[[int], None] | None, Callable[[], None] | None]:
+    """The frame report and the stop check of the task running on this thread, if any.
+
+    What :func:`reporting_frames` set for this thread; ``(None, None)`` outside a task.
+    """
+    return getattr(_running, "report", None), getattr(_running, "stop", None)
 
 
 def _checked(frames: Iterable[Any], stop: Callable[[], None] | None) -> Iterator[Any]:
@@ -281,16 +290,21 @@ def sequence_metrics(
     scale: float = 1.0,
     iou: float = 0.5,
     benchmark: BenchmarkName = "auto",
+    num_frames: int | None = None,
 ) -> dict[str, float | int | str | None]:
     """The figures of one sequence's tracks against its ground truth, for the summary.
 
     HOTA, DetA, AssA and LocA (TrackEval's, under `benchmark`'s ground-truth rules; ``"auto"``
     guesses them from `gt`'s columns), then MOTA, IDF1 and their counts:
     :func:`pftrack.eval.evaluate_sequence`, what ``pftrack eval`` prints for the same files.
+    `num_frames`: the sequence's ``seqLength``, where ``seqinfo.ini`` gives one (a row in a
+    later frame is an error, as in ``pftrack eval``).
     """
     from pftrack.eval import evaluate_sequence
 
-    s = evaluate_sequence(gt, rows, iou_threshold=iou, scale=scale, benchmark=benchmark)
+    s = evaluate_sequence(
+        gt, rows, iou_threshold=iou, scale=scale, benchmark=benchmark, num_frames=num_frames
+    )
     m, h = s.mot, s.hota
     out: dict[str, float | int | str | None] = {
         "hota": h.hota,
@@ -327,11 +341,12 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     """
     from pftrack.eval.sequences import benchmark_of_path
     from pftrack.io.mot import as_written, read_mot
-    from pftrack.io.video import FrameSource, info_scale
+    from pftrack.io.video import FrameSource, info_scale, read_seqinfo
+    from pftrack.recovery.linking import check_file_ids
     from pftrack.tracking.run import track_path
 
     cpu = time.process_time()
-    report, stop = _report_frames, _stop_check
+    report, stop = running_task()
     frames = FrameSource(seq.frames)
     # the boxes of det.txt and gt.txt are in seqinfo.ini's pixels
     auto_scale = info_scale(
@@ -386,6 +401,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                     "ground truth's frames alike"
                 )
             gt = read_mot(seq.gt, what="ground truth")
+            check_file_ids(gt, seq.gt)  # FILE:LINE, as pftrack eval (was: 'row K', 0-based)
             # the benchmark a TrackEval tree's BENCH-SPLIT folder names, as pftrack eval takes it
             named = benchmark_of_path(seq.gt)
             metrics = sequence_metrics(
@@ -394,6 +410,8 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                 scale=gt_scale,
                 iou=options.iou,
                 benchmark="auto" if named is None else named[0],
+                # a frame past seqLength is refused, as pftrack eval refuses it (was: scored)
+                num_frames=None if seq.seqinfo is None else read_seqinfo(seq.seqinfo).length,
             )
         except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed
             error = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"

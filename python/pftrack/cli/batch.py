@@ -217,8 +217,9 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
     if problems:  # on stderr: stdout's table stays parseable
         sys.stdout.flush()
         print("\n".join(problems), file=sys.stderr)
-    print(f"summary -> {summary.out_dir / 'summary.json'}")
-    return EXIT_SOME_FAILED if summary.failed else 0
+    if summary.unwritten is None:  # else said with the problems
+        print(f"summary -> {summary.out_dir / 'summary.json'}")
+    return EXIT_SOME_FAILED if summary.failed or summary.unwritten else 0
 
 
 def _where(args: argparse.Namespace) -> dict[str, Any]:
