@@ -1,4 +1,4 @@
-"""``recover`` and ``smooth`` given a folder or several files: why they run as a batch, first."""
+"""``recover``, ``smooth`` and ``batch`` given a folder or several files: --out is a folder."""
 
 from __future__ import annotations
 
@@ -50,3 +50,17 @@ def test_without_dask_the_message_names_the_folder(folder, tmp_path, capsys, mon
     # --workers 0 needs no Dask: the batch runs in this process
     assert main([command, str(folder), "--out", str(tmp_path / "out"), "--workers", "0"]) == 0
     assert sorted(p.name for p in (tmp_path / "out").glob("*.txt")) == ["a.txt", "b.txt"]
+
+
+def test_batch_with_a_file_out_is_refused(tmp_path, capsys):
+    """Was: pftrack batch --out out.txt made a folder named out.txt, as recover's did."""
+    from pftrack.synthetic import make_scene
+
+    video = tmp_path / "walk.avi"
+    make_scene(n_frames=5, width=64, height=64, n_walkers=1, rng=0).write_video(video)
+    out = tmp_path / "out.TXT"
+    assert main(["batch", str(video), "--out", str(out), "--workers", "0"]) == 2
+    err = capsys.readouterr().err
+    assert f"--out is a folder for one output per sequence, not {out}" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not out.exists()

@@ -113,6 +113,11 @@ def is_batch(paths: list[str]) -> bool:
     return len(paths) > 1 or any(Path(p).is_dir() for p in paths)
 
 
+def _names_a_file(out: str) -> bool:
+    """Whether a batch's `out` is named like a tracks file (``f.txt``) and is no folder."""
+    return Path(out).suffix.lower() == ".txt" and not Path(out).is_dir()
+
+
 def _as_batch(command: str, paths: list[str], out: str, where: dict[str, Any]) -> None:
     """Say why `command` runs as a batch before its batch-only errors (folder out, Dask).
 
@@ -124,7 +129,7 @@ def _as_batch(command: str, paths: list[str], out: str, where: dict[str, Any]) -
         why = f"{paths[0]} is a folder: pftrack {command} runs the tracks files in it"
     else:
         why = f"{len(paths)} inputs: pftrack {command} runs them"
-    if Path(out).suffix.lower() == ".txt" and not Path(out).is_dir():
+    if _names_a_file(out):
         raise ValueError(
             f"{why} as a batch, whose --out is a folder for one output per file, not {out}; "
             f"give one tracks file for --out {out}"
@@ -251,6 +256,11 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.batch import TrackOptions, track_many
     from pftrack.cli._options import opencv_single_threaded, tracker_config
 
+    if _names_a_file(args.out):  # was: made a folder named like a file (as recover's did)
+        raise ValueError(
+            f"--out is a folder for one output per sequence, not {args.out}; "
+            f"give a folder, such as {Path(args.out).with_suffix('')}"
+        )
     opencv_single_threaded()
 
     options = TrackOptions(
