@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import pftrack.batch.engine
+from pftrack._threads import usable_cpus
+from pftrack.batch import recover_many
 from pftrack.cli import main
 from pftrack.io.mot import write_mot
 
@@ -64,3 +67,26 @@ def test_batch_with_a_file_out_is_refused(tmp_path, capsys):
     assert f"--out is a folder for one output per sequence, not {out}" in err
     assert len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_the_default_workers_are_the_cores_this_process_may_use(folder, tmp_path, capsys,
+                                                                monkeypatch):  # fmt: skip
+    """Was: os.cpu_count(), 8 on a machine where taskset or a cpuset gave the process 1."""
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0}, raising=False)
+    monkeypatch.setattr(os, "cpu_count", lambda: 8)
+    assert usable_cpus() == 1
+    with pytest.raises(SystemExit):
+        main(["batch", "--help"])
+    assert "one per core this process may use, 1 here)" in " ".join(capsys.readouterr().out.split())
+    sizes: list[int | None] = []
+
+    def no_cluster(client=None, scheduler=None, n_workers=None):
+        sizes.append(n_workers)
+        raise ValueError("no cluster in this test")
+
+    monkeypatch.setattr(pftrack.batch.engine, "dask_client", no_cluster)
+    with pytest.raises(ValueError, match="no cluster in this test"):
+        recover_many([folder], tmp_path / "o")  # two files: was a cluster of two workers
+    assert sizes == [1]
+    monkeypatch.delattr(os, "sched_getaffinity", raising=False)  # not on Linux
+    assert usable_cpus() == 8

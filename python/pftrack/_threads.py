@@ -15,6 +15,7 @@ __all__ = [
     "kernel_threads",
     "one_blas_thread",
     "tracking_threads",
+    "usable_cpus",
 ]
 
 #: Set to "0" by the worker plugin (:mod:`pftrack.batch._plugin`) in every Dask worker.
@@ -38,6 +39,18 @@ def tracking_threads() -> bool:
     return os.environ.get(WORKER_THREADS_VARIABLE, "1") != "0"
 
 
+def usable_cpus() -> int:
+    """The CPUs this process may run on: its affinity (``taskset``, a container's cpuset).
+
+    ``os.cpu_count()`` where the affinity cannot be read (not on Linux): it counts the
+    machine's CPUs, more than a process limited to some of them may use.
+    """
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
 def kernel_threads() -> int:
     """Threads for a C++ kernel of independent pieces (the results do not depend on it).
 
@@ -46,11 +59,7 @@ def kernel_threads() -> int:
     """
     if not tracking_threads():
         return 1
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        cpus = os.cpu_count() or 1
-    return max(1, min(cpus, MAX_KERNEL_THREADS))
+    return min(usable_cpus(), MAX_KERNEL_THREADS)
 
 
 def one_blas_thread() -> None:

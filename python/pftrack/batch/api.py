@@ -87,8 +87,8 @@ def track_many(
     scheduler : str, optional
         Address of a running Dask scheduler (also read from ``DASK_SCHEDULER_ADDRESS``).
     n_workers : int, optional
-        Workers of the local cluster (default: one per core); 0 runs in this process, one
-        sequence after the other, without Dask.
+        Workers of the local cluster (default: one per core this process may use); 0 runs in
+        this process, one sequence after the other, without Dask.
     force : bool
         Redo sequences whose outputs are already complete.
     show_progress : bool, optional
@@ -193,8 +193,8 @@ def recover_many(
     scheduler : str, optional
         Address of a running Dask scheduler (also read from ``DASK_SCHEDULER_ADDRESS``).
     n_workers : int, optional
-        Workers of the local cluster (default: one per core); 0 runs in this process, one
-        file after the other, without Dask.
+        Workers of the local cluster (default: one per core this process may use); 0 runs in
+        this process, one file after the other, without Dask.
     force : bool
         Redo files whose outputs are already complete.
     show_progress : bool, optional
@@ -258,8 +258,8 @@ def smooth_many(
     scheduler : str, optional
         Address of a running Dask scheduler (also read from ``DASK_SCHEDULER_ADDRESS``).
     n_workers : int, optional
-        Workers of the local cluster (default: one per core); 0 runs in this process, one
-        file after the other, without Dask.
+        Workers of the local cluster (default: one per core this process may use); 0 runs in
+        this process, one file after the other, without Dask.
     force : bool
         Redo files whose outputs are already complete.
     show_progress : bool, optional

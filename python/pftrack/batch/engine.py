@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 from pftrack._check import flag
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack._text import counted
+from pftrack._threads import usable_cpus
 from pftrack.batch.inputs import cannot_read
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
@@ -321,7 +322,7 @@ def dask_client(
         Workers of a new ``LocalCluster``, each a process with one thread. Given, a local
         cluster is started even where Dask's ``scheduler-address`` setting
         (``DASK_SCHEDULER_ADDRESS``) names a scheduler. Default: that setting's scheduler,
-        else a local cluster of one worker per core.
+        else a local cluster of one worker per core this process may use.
 
     Raises
     ------
@@ -384,7 +385,7 @@ def dask_client(
                 if c.status != "running":  # the scheduler went away: its end said by the batch
                     quiet.enter_context(_silenced(*_CLIENT_LOGGERS))
         return
-    n = n_workers if n_workers is not None else (os.cpu_count() or 1)
+    n = n_workers if n_workers is not None else usable_cpus()
     stack = contextlib.ExitStack()
     try:
         # the cluster starts whole; its workers deaf to Ctrl-C, SIGTERM, and not running the
@@ -1915,7 +1916,7 @@ def run_jobs(
                 if client is not None or address:
                     c = stack.enter_context(dask_client(client, address))
                 else:  # a local cluster: no idle worker to start
-                    n = n_workers if n_workers is not None else (os.cpu_count() or 1)
+                    n = n_workers if n_workers is not None else usable_cpus()
                     c = stack.enter_context(dask_client(n_workers=min(n, len(pending))))
                 remote = True
                 info = c.scheduler_info()

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from pftrack._threads import usable_cpus
 from pftrack.cli._options import (
     DET_SCALE_RANGE,
     IOU_HELP,
@@ -68,18 +69,15 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     g.add_argument(
         "--workers", type=non_negative_int, default=None, metavar="N",
-        help="worker processes of the local cluster, one thread each (default: one per core, "
-        f"{_cores()} here); 0 runs in this process without Dask; not with --scheduler (and "
-        "given, a local run even where $DASK_SCHEDULER_ADDRESS is set)",
+        help="worker processes of the local cluster, one thread each (default: one per core "
+        f"this process may use, {usable_cpus()} here); 0 runs in this process without Dask; "
+        "not with --scheduler (and given, a local run even where $DASK_SCHEDULER_ADDRESS is "
+        "set)",
     )  # fmt: skip
     g.add_argument("--force", action="store_true",
                    help="redo inputs whose outputs are complete, instead of skipping "
                    "them, and replace files of the outputs' names in DIR that no earlier "
                    "batch wrote (refused without it)")  # fmt: skip
-
-
-def _cores() -> int:
-    return os.cpu_count() or 1
 
 
 #: The options of :func:`add_batch_options`, which a command given one file does not use.
