@@ -15,7 +15,13 @@ import numpy as np
 import pytest
 
 from pftrack.io import video
-from pftrack.io.video import FrameSource, is_live_source, natural_key, read_seqinfo
+from pftrack.io.video import (
+    FrameSequence,
+    FrameSource,
+    is_live_source,
+    natural_key,
+    read_seqinfo,
+)
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
 from tests.io.streaming import serve_stream
@@ -1324,3 +1330,17 @@ def test_frames_beyond_the_largest_side_are_refused_without_a_scale_given(
     assert str(info.value) == (
         f"the frames of {folder} are 40000x8 pixels; expected 1 to 32767 pixels a side"
     )
+
+
+def test_a_one_frame_video_is_counted_in_the_singular(tmp_path: Path) -> None:
+    """Was: "video.avi ended after 1 frames", "out of range for 1 frames"."""
+    seq = _video_sequence(tmp_path / "SEQ", 1)
+    ini = seq / "seqinfo.ini"
+    ini.write_text(ini.read_text().replace("seqLength=1", "seqLength=2"))
+    message = rf"^{re.escape(str(seq))}/video.avi ended after 1 frame but "
+    with pytest.warns(UserWarning, match=message):
+        assert sum(1 for _ in FrameSource(seq)) == 1
+    frames = FrameSequence(seq / "video.avi")
+    with pytest.raises(IndexError, match=r"^frame index 1 is out of range for 1 frame$"):
+        frames[1]
+    frames.close()

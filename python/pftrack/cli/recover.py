@@ -159,11 +159,11 @@ def check_video(video: str, frames: Any, rows: Any, src: Path) -> None:
         return
     source = frames.source
     last = int(rows[:, 0].max())
-    counted = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
-    if 0 < counted < last:
+    header = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
+    if 0 < header < last:
         raise ValueError(
-            f"--video {video} has {counted} frames but {src} has rows up to frame {last}: "
-            "not the video of these tracks"
+            f"--video {video} has {counted(header, 'frame')} but {src} has rows up to frame "
+            f"{last}: not the video of these tracks"
         )
     for axis, size, edge in ((2, source.width, "right"), (3, source.height, "bottom")):
         k = int(rows[:, axis].argmax())

@@ -46,6 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import number, real
+from pftrack._text import counted
 from pftrack._typing import PathLike
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
 
@@ -1632,18 +1633,19 @@ class FrameSource:
         a second decoding pass to count its frames would cost as much as the run.
         """
         said = []
-        counted = self.counted_frames  # not FFmpeg's estimate (Matroska)
-        if decoded < counted:
-            said.append(f"its header says {counted}")
+        header = self.counted_frames  # not FFmpeg's estimate (Matroska)
+        if decoded < header:
+            said.append(f"its header says {header}")
         seq = self.sequence
         if seq is not None and seq.length is not None and decoded != seq.length:
             said.append(f"{seq.folder / 'seqinfo.ini'} says seqLength={seq.length}")
         if not said:
             return
         self._warned_short = True  # once, not on every pass
-        damaged = ": a truncated or damaged file?" if decoded < counted else ""
+        damaged = ": a truncated or damaged file?" if decoded < header else ""
         warnings.warn(
-            f"{self.path} ended after {decoded} frames but {' and '.join(said)}{damaged}",
+            f"{self.path} ended after {counted(decoded, 'frame')} but "
+            f"{' and '.join(said)}{damaged}",
             UserWarning,
             stacklevel=3,
         )
@@ -1744,7 +1746,7 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
         if i < 0:
             i += n
         if not 0 <= i < n:
-            raise IndexError(f"frame index {index} is out of range for {n} frames")
+            raise IndexError(f"frame index {index} is out of range for {counted(n, 'frame')}")
         if self._last is not None and self._last[0] == i:
             return self._last[1]
         if self.source._images is not None:
@@ -1760,7 +1762,7 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
                 self.close()
                 raise ValueError(
                     f"{self.source.name}: frame {i + 1} cannot be decoded: the video ended after "
-                    f"{ended} frames but its header says {n}"
+                    f"{counted(ended, 'frame')} but its header says {n}"
                 )
             frame = picked[0]
         self._last = (i, frame)
