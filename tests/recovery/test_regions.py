@@ -224,3 +224,18 @@ def test_region_blocks_on_the_500_track_file_equal_the_numpy_loop() -> None:
         assert len(want.run) > 0
         for g, w in zip(got, want, strict=True):
             np.testing.assert_array_equal(g, w)
+
+
+def test_calibration_without_validation_gaps_says_none_could_be_cut() -> None:
+    """Was: "(0 of 0 where a square of side 9.49 px crosses them)": runs of 2 frames only."""
+    rows = np.array(
+        [[f, i, 10.0 + 3 * f + 50 * i, 20.0 + f, 30.0, 60.0, 1, -1, -1, -1] for i in (1, 2, 3)
+         for f in (1, 2, 5, 6, 9, 10)]
+    )  # fmt: skip
+    _, rep = fill_gaps(rows, "auto", 10)
+    said = [line for line in rep.describe().splitlines() if line.startswith("auto:")]
+    assert len(said) == 2  # box centres (cut by squares), box sizes (at random places)
+    for line in said:
+        assert "0 of 0" not in line and "square" not in line and "MMAE" not in line
+        assert line.startswith("auto: no validation gap could be cut: no observed run holds ")
+        assert line.endswith("; file's choice linear")

@@ -253,20 +253,21 @@ class Calibration:
         if self.pooled_weights:  # the weights a bucket without validation gaps takes
             mix = " + ".join(f"{_weight(w)} {m}" for m, w in self.pooled_weights)
             over = f" ({mix} over {self.bags} bootstrap resamples)"
-        where = ""
-        if self.region is not None:
+        n_val = sum(c.n_validation for c in self.buckets)
+        scored = "validation MMAE (px) on artificial gaps cut into observed runs"
+        if n_val == 0:  # was "(0 of 0 where a square of side ... px crosses them)"
+            scored = (
+                f"no validation gap could be cut: no observed run holds a gap of these lengths "
+                f"with at least {CONTEXT} observed frames on each side"
+            )
+        elif self.region is not None:
             n_reg = sum(c.n_region for c in self.buckets)
-            n_val = sum(c.n_validation for c in self.buckets)
             rest = ", the others at random places" if n_reg < n_val else ""
-            where = (
+            scored += (
                 f" ({n_reg} of {n_val} where a square of side {self.region:.3g} px crosses "
                 f"them{rest})"
             )
-        lines = [
-            f"auto: validation MMAE (px) on artificial gaps cut into observed runs{where}; "
-            f"file's choice {self.pooled}{over}",
-            head,
-        ]
+        lines = [f"auto: {scored}; file's choice {self.pooled}{over}", head]
         for c in self.buckets:
             span = c.span
             vals = dict(c.mmae)
