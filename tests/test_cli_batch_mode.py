@@ -90,3 +90,13 @@ def test_the_default_workers_are_the_cores_this_process_may_use(folder, tmp_path
     assert sizes == [1]
     monkeypatch.delattr(os, "sched_getaffinity", raising=False)  # not on Linux
     assert usable_cpus() == 8
+
+
+def test_a_complete_batch_needs_no_scheduler(folder, tmp_path, capsys):
+    """Nothing to run: no scheduler is asked, as no local cluster is started (a choice)."""
+    argv = ["recover", str(folder), "--out", str(tmp_path / "out")]
+    assert main([*argv, "--workers", "0"]) == 0
+    capsys.readouterr()
+    assert main([*argv, "--scheduler", "tcp://127.0.0.1:1"]) == 0  # nothing listens there
+    assert "nothing to run" in capsys.readouterr().out
+    assert main([*argv, "--scheduler", "tcp://127.0.0.1:0"]) == 2  # its form is still checked

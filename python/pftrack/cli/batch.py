@@ -54,7 +54,8 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--scheduler", metavar="ADDRESS", default=None,
         help="a running Dask scheduler, tcp://HOST:PORT, checked first (protocol, host, port "
-        "1-65535; not with --workers), connected to before --out is written; waits up to "
+        "1-65535; not with --workers), connected to before --out is written (not at all when "
+        "every output is complete: nothing runs, as no local cluster starts); waits up to "
         "Dask's connect timeout to reach it (30 s; $DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT), "
         "as long for a tcp:// port that says nothing or does not finish Dask's handshake "
         "(no Dask scheduler, or a frozen one; a web server, such "
