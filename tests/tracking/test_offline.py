@@ -554,8 +554,8 @@ def test_a_writer_checkpointed_with_list_rows_loads() -> None:
 
     writer = TrackWriter(smoother=None, link=None)
     for i in range(5):
-        writer._append([float(i + 1), 1.0, 10.0 + i, 20.0, 5.0, 10.0, 0.9, -1, -1, -1],
-                       None if i == 2 else np.array([10.0 + i, 20.0, 5.0, 10.0]))  # fmt: skip
+        writer.rows.append([float(i + 1), 1.0, 10.0 + i, 20.0, 5.0, 10.0, 0.9, -1, -1, -1],
+                           None if i == 2 else np.array([10.0 + i, 20.0, 5.0, 10.0]))  # fmt: skip
     rows, boxes, has = writer.rows.arrays()
     state = copy.copy(writer.__dict__)
     state["rows"] = rows.tolist()  # the old layout

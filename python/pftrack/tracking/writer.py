@@ -36,17 +36,11 @@ class _Rows:
         self._n = 0
 
     def append(self, row: list[float], box: F64 | None) -> None:
-        if self._n == self.BLOCK:
-            self._done.append((self._rows, self._boxes, self._has))
-            self._new()
-        self._rows[self._n] = row
-        if box is not None:
-            self._boxes[self._n] = box
-            self._has[self._n] = True
-        self._n += 1
+        """Keep one row and its detection box (None: the row has none)."""
+        self.extend([row], [box])
 
     def extend(self, rows: list[list[float]], boxes: list[F64 | None]) -> None:
-        """:meth:`append` of each row and its box in turn, the rows of a block in one copy.
+        """Keep each row and its box in turn, the rows of a block in one copy.
 
         A frame's rows (one per track reported) were one NumPy assignment each.
         """
@@ -140,9 +134,6 @@ class TrackWriter:
                 store.append(row, None if box is None else np.asarray(box, np.float64))
             state["rows"] = store
         self.__dict__.update(state)
-
-    def _append(self, row: list[float], measured: F64 | None) -> None:
-        self.rows.append(row, measured)
 
     def add(self, frame: int, tracks: list[Track]) -> None:
         """Record the tracks reported for `frame` (1-based)."""
