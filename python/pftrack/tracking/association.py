@@ -15,7 +15,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack._typing import F64
@@ -139,17 +139,14 @@ def _padding(nt: int, nd: int, tau: float) -> F64:
     return padded
 
 
-def covers_another(box_xywh: ArrayLike, others_xywh: ArrayLike) -> bool:
-    """Tell whether `box_xywh` contains the centre of any of `others_xywh` (a merged blob)."""
-    others = np.asarray(others_xywh, dtype=np.float64).reshape(-1, 4).tolist()
-    return _covers(np.asarray(box_xywh, dtype=np.float64).tolist(), others)
+def covers_another(
+    box_xywh: Sequence[float] | F64, others_xywh: Iterable[Sequence[float]] | F64
+) -> bool:
+    """Tell whether `box_xywh` contains the centre of any of `others_xywh` (a merged blob).
 
-
-def _covers(box_xywh: Sequence[float], others_xywh: Iterable[Sequence[float]]) -> bool:
-    """:func:`covers_another` of plain floats (the same comparisons of the same floats).
-
-    The tracker asks once per large detection, against a few to tens of tracks: NumPy's calls
-    on such tiny arrays cost more than the loop.
+    Plain floats or float64 arrays alike (the same comparisons of the same floats): the
+    tracker asks once per large detection, against a few to tens of tracks, with lists, as
+    NumPy's calls on such tiny arrays cost more than the loop.
     """
     x, y, w, h = box_xywh
     right, bottom = x + w, y + h

@@ -34,7 +34,7 @@ from pftrack.boxes import _iou_matrix, _to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
-from pftrack.tracking.association import _covers, associate
+from pftrack.tracking.association import associate, covers_another
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
@@ -612,7 +612,7 @@ class MultiObjectTracker:
             if big:
                 follow_pending()
                 others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti)
-                if _covers(box_list[di], others):
+                if covers_another(box_list[di], others):
                     continue  # a merged blob: the track keeps its own prediction
             followed.append((ti, di))
         follow_pending()
