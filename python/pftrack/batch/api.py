@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING, TypeVar
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from pftrack._typing import PathLike
 from pftrack.batch.engine import BatchSummary, Job, run_jobs
@@ -11,6 +12,7 @@ from pftrack.batch.inputs import Inputs, SequenceInput, find_sequences, find_tra
 from pftrack.batch.tasks import (
     RecoverOptions,
     SmoothOptions,
+    TaskResult,
     TrackOptions,
     recover_file,
     sequence_length,
@@ -212,18 +214,10 @@ def recover_many(
         `options` is not a :class:`RecoverOptions` (nor None), before anything else.
     """
     opts = _options(options, RecoverOptions, "recover_many")
-    jobs = [Job(p.stem, recover_file, (p, opts), (p,)) for p in find_track_files(inputs)]
-    return run_jobs(
-        jobs,
-        out_dir,  # as given: run_jobs refuses an empty one (Path("") is ".")
-        kind="recover",
-        settings=opts.settings(),
-        client=client,
-        scheduler=scheduler,
-        n_workers=n_workers,
-        force=force,
-        show_progress=show_progress,
-    )
+    return _each_file(
+        "recover", recover_file, opts, inputs, out_dir,
+        client, scheduler, n_workers, force, show_progress,
+    )  # fmt: skip
 
 
 def smooth_many(
@@ -277,11 +271,34 @@ def smooth_many(
         `options` is not a :class:`SmoothOptions` (nor None), before anything else.
     """
     opts = _options(options, SmoothOptions, "smooth_many")
-    jobs = [Job(p.stem, smooth_file, (p, opts), (p,)) for p in find_track_files(inputs)]
+    return _each_file(
+        "smooth", smooth_file, opts, inputs, out_dir,
+        client, scheduler, n_workers, force, show_progress,
+    )  # fmt: skip
+
+
+def _each_file(
+    kind: str,
+    task: Callable[[Path, Any], TaskResult],
+    opts: RecoverOptions | SmoothOptions,
+    inputs: Inputs,
+    out_dir: PathLike,
+    client: Client | None,
+    scheduler: str | None,
+    n_workers: int | None,
+    force: bool,
+    show_progress: bool | None,
+) -> BatchSummary:
+    """Run `task` with `opts` on every tracks file of `inputs`, one job each.
+
+    The body of :func:`recover_many` (`kind` ``"recover"``) and :func:`smooth_many`
+    (``"smooth"``), once their options are checked.
+    """
+    jobs = [Job(p.stem, task, (p, opts), (p,)) for p in find_track_files(inputs)]
     return run_jobs(
         jobs,
         out_dir,  # as given: run_jobs refuses an empty one (Path("") is ".")
-        kind="smooth",
+        kind=kind,
         settings=opts.settings(),
         client=client,
         scheduler=scheduler,

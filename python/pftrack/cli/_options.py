@@ -196,6 +196,14 @@ def bounded_float(lo: float, hi: float) -> Any:
     return parse
 
 
+def add_max_distance(p: argparse.ArgumentParser) -> None:
+    """``--max-distance``, the linking gate of ``recover --link`` and ``smooth``."""
+    p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=None, metavar="PX",
+                   help="linking gate on the motion-prediction distance (pixels, 0.001 to 1e6; "
+                   "default: 50 px, times the diagonal of the boxes' extent over 800 when it is "
+                   "larger than 640x480)")  # fmt: skip
+
+
 def max_side(text: str) -> int:
     """Argument type of ``--max-side``: 0 (the frame's own size) or pixels in [64, 100000]."""
     from pftrack.tracking.config import MAX_SIDE, MIN_SIDE

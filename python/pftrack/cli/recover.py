@@ -11,7 +11,7 @@ from typing import Any
 from pftrack.cli import batch
 from pftrack.cli._options import (
     add_command,
-    bounded_float,
+    add_max_distance,
     counted,
     non_negative_int,
     report_stream,
@@ -49,10 +49,7 @@ def add_parser(sub: Any) -> None:
                    help="auto: seed of the artificial calibration gaps, an integer >= 0 "
                    "(default: 0; refused with another --method)")  # fmt: skip
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
-    p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=None, metavar="PX",
-                   help="linking gate on the motion-prediction distance (pixels, 0.001 to 1e6; "
-                   "default: 50 px, times the diagonal of the boxes' extent over 800 when it is "
-                   "larger than 640x480)")  # fmt: skip
+    add_max_distance(p)
     p.add_argument("--video", help="video or image folder for the colour term of --link: "
                    "only the frames of fragment ends are read, in one pass; refused when it "
                    "has fewer frames than the tracks, or boxes start more than a tenth of "

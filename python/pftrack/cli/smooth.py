@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, bounded_float, counted, report_stream
+from pftrack.cli._options import add_command, add_max_distance, counted, report_stream
 
 
 def add_parser(sub: Any) -> None:
@@ -37,10 +37,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--no-link", action="store_true",
                    help="join no fragments: fill the holes inside each id and smooth each id "
                    "as it is")  # fmt: skip
-    p.add_argument("--max-distance", type=bounded_float(1e-3, 1e6), default=None, metavar="PX",
-                   help="linking gate on the motion-prediction distance (pixels, 0.001 to 1e6; "
-                   "default: 50 px, times the diagonal of the boxes' extent over 800 when it is "
-                   "larger than 640x480)")  # fmt: skip
+    add_max_distance(p)
     batch.add_batch_options(p)
     p.set_defaults(func=run)
 

@@ -243,6 +243,31 @@ def _keep_mode(tmp: str | int, target: Path) -> None:
         os.chmod(tmp, mode)
 
 
+def _folder_of(target: Path, path: PathLike) -> Path:
+    """The folder output `path` (resolved to the file `target`) is written in, which must exist.
+
+    Raises
+    ------
+    OSError
+        No such folder, or a file on the way (:func:`_missing_folder`).
+    """
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise _missing_folder(folder, path)
+    return folder
+
+
+def _put_in_place(tmp: str, target: Path, path: PathLike) -> None:
+    """Rename the finished temporary file `tmp` over `target`, with `target`'s permission bits.
+
+    The bits are given again here, as a writer may have made `tmp` anew; an OSError names
+    output `path`, not `tmp` (:func:`_named`).
+    """
+    with _named(path, hidden=True):
+        _keep_mode(tmp, target)
+        os.replace(tmp, target)
+
+
 @contextlib.contextmanager
 def _named(path: PathLike, *, hidden: bool = False) -> Iterator[None]:
     """Name output `path` in an OSError that names no file (a full disk: ``[Errno 28] ...``).
@@ -302,9 +327,7 @@ def atomic_write(
             yield fh
         return
     target = resolved.path
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise _missing_folder(folder, path)
+    folder = _folder_of(target, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
         with _named(path, hidden=True):  # a read-only file system, a folder not writable
@@ -314,9 +337,7 @@ def atomic_write(
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
-        with _named(path, hidden=True):
-            _keep_mode(tmp, target)
-            os.replace(tmp, target)
+        _put_in_place(tmp, target, path)
     except BaseException:
         _remove(made)
         raise
@@ -341,9 +362,7 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
                 _copy_through(tmp_path, resolved)
         return
     target = resolved.path
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise _missing_folder(folder, path)
+    folder = _folder_of(target, path)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
         with _named(path, hidden=True):  # a read-only file system, a folder not writable
@@ -355,9 +374,7 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         yield Path(tmp)
         if not Path(tmp).exists() or Path(tmp).stat().st_size == 0:
             raise OSError(f"nothing was written for {target}")
-        with _named(path, hidden=True):
-            _keep_mode(tmp, target)  # again: a writer may have made the file anew
-            os.replace(tmp, target)
+        _put_in_place(tmp, target, path)
     except BaseException:
         _remove(made)
         raise
@@ -464,9 +481,7 @@ def side_file(path: PathLike, suffix: str = ".part") -> Iterator[SideFile]:
     if resolved.through:
         raise ValueError(f"{os.fsdecode(os.fspath(path))} is written through; no side file")
     target = resolved.path
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise _missing_folder(folder, path)
+    folder = _folder_of(target, path)
     made: list[str] = []
     side: SideFile | None = None
     try:  # the file is made inside: removed whenever the block is left without lines
@@ -957,9 +972,7 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
             through.append((tmp_path, resolved))
             return tmp_path
         target = resolved.path
-        folder = target.parent if str(target.parent) else Path(".")
-        if not folder.is_dir():
-            raise _missing_folder(folder, path)
+        folder = _folder_of(target, path)
         with _named(path, hidden=True):  # a read-only file system, a folder not writable
             fd, tmp = _create_beside(folder, f".{target.stem}.", suffix or ".tmp", made)
         staged.append((tmp, target))

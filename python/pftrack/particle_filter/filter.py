@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -525,23 +525,39 @@ class ColourParticleFilter:
             in one thread at a time: the step updates the arrays in place without the GIL).
         """
         m = self.config.model
+
+        def sis_step() -> dict[str, Any]:
+            return _core.sis_step(
+                self.particles, self.weights, self.means, image, self.reference,
+                self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+                self.config.lam, self.config.kernel, True, self._seed, self._step,
+                float(self.config.min_samples),
+            )  # fmt: skip
+
+        return self._advance(image, "sis_step", sis_step)
+
+    def _advance(
+        self, image: _core.BinnedImage, core: str, kernel: Callable[[], dict[str, Any]]
+    ) -> FilterState:
+        """One :meth:`step`: `kernel` (a call of the core's step `core` on `image`), then its state.
+
+        Under the filter's lock (RuntimeError when another thread holds it); the core's
+        refusals are said in the public API's words (a TypeError naming the argument it could
+        not take, a ValueError naming ``Class.step`` instead of `core`). On success the step
+        counter moves on and the state is :attr:`last`.
+        """
         if not self._busy.acquire(blocking=False):
             raise _in_use(self, f"{type(self).__name__}.step")
         try:
             try:
-                r = _core.sis_step(
-                    self.particles, self.weights, self.means, image, self.reference,
-                    self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-                    self.config.lam, self.config.kernel, True, self._seed, self._step,
-                    float(self.config.min_samples),
-                )  # fmt: skip
+                r = kernel()
             except TypeError:
                 error = _step_argument_error(image, self)
                 if error is None:
                     raise
                 raise error from None
             except ValueError as exc:  # "sis_step: what" -> "ColourParticleFilter.step: what"
-                renamed = _public_error(exc, "sis_step", f"{type(self).__name__}.step")
+                renamed = _public_error(exc, core, f"{type(self).__name__}.step")
                 if renamed is None:
                     raise
                 raise renamed from None

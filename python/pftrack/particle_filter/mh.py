@@ -13,6 +13,8 @@ otherwise the chain keeps ``x``. The kernel is ``pftrack._core.mh_step``
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -20,14 +22,7 @@ from pftrack import _core
 from pftrack._check import integer
 from pftrack._typing import RngLike
 from pftrack.particle_filter.colour import HsvBinning
-from pftrack.particle_filter.filter import (
-    ColourParticleFilter,
-    FilterConfig,
-    FilterState,
-    _in_use,
-    _public_error,
-    _step_argument_error,
-)
+from pftrack.particle_filter.filter import ColourParticleFilter, FilterConfig, FilterState
 
 __all__ = ["MHColourParticleFilter"]
 
@@ -91,39 +86,17 @@ class MHColourParticleFilter(ColourParticleFilter):
         inside this filter).
         """
         m = self.config.model
-        if not self._busy.acquire(blocking=False):
-            raise _in_use(self, f"{type(self).__name__}.step")
-        try:
-            try:
-                r = _core.mh_step(
-                    self.particles, self.weights, self.means, image, self.reference,
-                    self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-                    self.config.lam, self.config.kernel, True, self._seed, self._step,
-                    n_iter=self.n_iter, burn_in=0, proposal="dynamics",
-                    rw_sigma=np.array([2.0, 2.0, 0.01]),
-                    min_samples=float(self.config.min_samples),
-                )  # fmt: skip
-            except TypeError:  # as ColourParticleFilter.step: say which argument
-                error = _step_argument_error(image, self)
-                if error is None:
-                    raise
-                raise error from None
-            except ValueError as exc:  # "mh_step: what" -> "MHColourParticleFilter.step: what"
-                renamed = _public_error(exc, "mh_step", f"{type(self).__name__}.step")
-                if renamed is None:
-                    raise
-                raise renamed from None
-            self._step += 1
+
+        def mh_step() -> dict[str, Any]:
+            r: dict[str, Any] = _core.mh_step(
+                self.particles, self.weights, self.means, image, self.reference,
+                self.w0, self.h0, m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+                self.config.lam, self.config.kernel, True, self._seed, self._step,
+                n_iter=self.n_iter, burn_in=0, proposal="dynamics",
+                rw_sigma=np.array([2.0, 2.0, 0.01]),
+                min_samples=float(self.config.min_samples),
+            )  # fmt: skip
             self.acceptance = float(r["acceptance"])
-            cx, cy, s = r["map"] if self.config.estimate == "map" else r["mean"]
-            state = FilterState(
-                np.array([cx, cy, s * self.w0, s * self.h0]),
-                float(r["rho_mean"]),
-                float(r["rho_max"]),
-                float(r["ess"]),
-                float(r["fg_mean"]),
-            )
-            self.last = state
-        finally:
-            self._busy.release()
-        return state
+            return r
+
+        return self._advance(image, "mh_step", mh_step)

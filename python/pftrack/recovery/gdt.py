@@ -94,13 +94,16 @@ class GdtSolution:
     x0_cov: F64
 
 
-def _check_T(T: object, fn: str) -> int:
-    """`T` as an int in ``[1, MAX_FRAME]`` (the core takes a 32-bit int)."""
-    if isinstance(T, (bool, np.bool_)) or not isinstance(T, (int, np.integer)):
-        raise TypeError(f"{fn}: T must be an int, got {type(T).__name__}")
-    if not 0 < T <= MAX_FRAME:
-        raise ValueError(f"{fn}: T is {T}, expected an int in [1, {MAX_FRAME}]")
-    return int(T)
+def _count(value: object, name: str, fn: str) -> int:
+    """`value`, argument `name` of `fn` (``T``, ``n_samples``), as an int in ``[1, MAX_FRAME]``.
+
+    ``MAX_FRAME`` is ``2**31 - 1``: the core takes a 32-bit int.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{fn}: {name} must be an int, got {type(value).__name__}")
+    if not 0 < value <= MAX_FRAME:
+        raise ValueError(f"{fn}: {name} is {value}, expected an int in [1, {MAX_FRAME}]")
+    return int(value)
 
 
 def _check_form(form: str, fn: str) -> None:
@@ -260,7 +263,7 @@ def goal_directed_path(
        goal-directed movements using neural signals. Neural Computation 18(10).
     """
     fn = "goal_directed_path"
-    T = _check_T(T, fn)
+    T = _count(T, "T", fn)
     _check_form(form, fn)
     conditioned = flag(start_conditioned, f"{fn}: start_conditioned")
     arrays = _model_arrays(fn, A, Q, H_T, Pi_T, m0, Pi_0, y_T, T)
@@ -298,17 +301,14 @@ def sample_goal_directed_paths(
     ``x_t = A_t x_{t-1} + u_t + eps_t``.
     """
     fn = "sample_goal_directed_paths"
-    T = _check_T(T, fn)
+    T = _count(T, "T", fn)
     _check_form(form, fn)
-    if isinstance(n_samples, (bool, np.bool_)) or not isinstance(n_samples, (int, np.integer)):
-        raise TypeError(f"{fn}: n_samples must be an int, got {type(n_samples).__name__}")
-    if not 0 < n_samples <= 2**31 - 1:
-        raise ValueError(f"{fn}: n_samples is {n_samples}, expected an int in [1, {2**31 - 1}]")
+    n_samples = _count(n_samples, "n_samples", fn)
     conditioned = flag(start_conditioned, f"{fn}: start_conditioned")
     seed = int(generator(rng, f"{fn}: rng").integers(2**63))
     arrays = _model_arrays(fn, A, Q, H_T, Pi_T, m0, Pi_0, y_T, T)
     try:
-        out: F64 = _core.gdt_sample(*arrays, T, int(n_samples), seed, form, conditioned)
+        out: F64 = _core.gdt_sample(*arrays, T, n_samples, seed, form, conditioned)
     except ValueError as e:
         raise _core_error(e, "gdt_sample", fn) from None
     return out
