@@ -348,7 +348,7 @@ def dask_client(
     """
     _require_dask()
     import dask
-    from distributed import Client, LocalCluster
+    from distributed import LocalCluster
 
     from pftrack.batch._plugin import SingleThreaded
 
@@ -367,15 +367,15 @@ def dask_client(
         refused = _refused(address)  # known at once: Dask would retry for its whole timeout
         if refused is not None:
             raise OSError(f"cannot connect to the Dask scheduler at {address}: {refused}")
+        quiet = contextlib.ExitStack()
         try:
-            connected = Client(address)  # timeout: distributed.comm.timeouts.connect
+            connected = _new_client(address)  # timeout: distributed.comm.timeouts.connect
         except Exception as exc:  # noqa: BLE001 - whatever Dask raised: one line, the address
             # a Dask server that is no scheduler answers, then refuses the client's request (a
             # worker: a TypeError); one not reached at all (an OSError) is not asked again
             other = None if isinstance(exc, OSError) else _dask_server(address)
             problem = other or _connect_problem(address, exc)
             raise OSError(f"cannot connect to the Dask scheduler at {address}: {problem}") from None
-        quiet = contextlib.ExitStack()
         with quiet, connected as c:  # `quiet` ends after the client is closed
             check_pftrack(c, address)
             _register(c, SingleThreaded(), address)
@@ -406,7 +406,7 @@ def dask_client(
                         scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # not 8787
                     )
                 )
-                c = stack.enter_context(Client(cluster))
+                c = stack.enter_context(_new_client(cluster))
                 c.register_plugin(SingleThreaded(ignore_interrupt=True))
             except Exception as exc:  # noqa: BLE001 - whatever stopped Dask: one line
                 # was: Dask's traceback, "RuntimeError: Cluster failed to start: ..." (its
@@ -426,6 +426,48 @@ def dask_client(
         # once the cluster is closed
         with _interrupts_held():
             stack.close()
+
+
+def _new_client(target: Any) -> Client:
+    """``distributed.Client(target)``: one whose start fails is closed here, not left to the GC.
+
+    Dask's constructor leaves the client it made behind when the connection fails with
+    anything but an ``OSError`` or ``ImportError`` (a worker's port: a ``TypeError``; a
+    protocol it cannot speak; Ctrl-C while it connects): connecting, the process's default
+    client, its event loop's thread running; and with an ``OSError`` closed, but that thread
+    running still. The garbage collector closed it later, wherever it ran: inside the start of
+    a later local cluster in the same thread (Dask's ``LoopRunner`` lock held), its close then
+    waited on that lock for ever (a hang of the tests; py-spy: ``LoopRunner.start`` ... ``gc``
+    ... ``Client.__del__``, ``Client.close``, ``LoopRunner.stop``). So the client is made in two
+    steps, to hold it when its ``__init__`` raises.
+
+    `target`: a scheduler's address, or a cluster.
+    """
+    from distributed import Client
+
+    c = Client.__new__(Client)
+    try:
+        Client.__init__(c, target)
+    except BaseException:
+        with _interrupts_held(spawns=False):  # a Ctrl-C meanwhile: raised once closed
+            _close_failed(c)
+        raise
+    return c
+
+
+def _close_failed(c: Client) -> None:
+    """Close a Dask client whose start failed, and stop its event loop's thread.
+
+    Dask internals: ``close`` may refuse (nothing started, or closed already: it then leaves
+    the thread running), and the ``LoopRunner`` that runs the thread (``_loop_runner``) is
+    stopped whatever it did; its ``stop`` does nothing when it is stopped already.
+    """
+    with contextlib.suppress(Exception):  # half made: what it lacks, Dask may trip on
+        c.close()
+    runner = getattr(c, "_loop_runner", None)
+    if runner is not None:
+        with contextlib.suppress(Exception):
+            runner.stop()
 
 
 #: Dask's settings of a TLS client (``tls://``, ``wss://``), as environment variables.
@@ -868,7 +910,7 @@ _HELD_SIGNALS = frozenset(
 
 
 @contextlib.contextmanager
-def _interrupts_held() -> Iterator[None]:
+def _interrupts_held(spawns: bool = True) -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) and SIGTERM in this thread meanwhile; one held is raised at the end.
 
     While a local cluster starts: a ``KeyboardInterrupt`` in the middle (Ctrl-C, or SIGTERM
@@ -889,16 +931,21 @@ def _interrupts_held() -> Iterator[None]:
     for the cluster wakes, in ``SpecCluster.__init__``). In the main thread the handlers are
     therefore replaced too, by one that notes the signal; each one noted is sent again, to the
     handler it was meant for, at the end.
+
+    `spawns`: processes may be started meanwhile (a local cluster's workers). False when none
+    is (a failed client closed: :func:`_new_client`), so as not to start multiprocessing's
+    resource tracker, a process, for nothing.
     """
     if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
         yield
         return
-    # multiprocessing's resource tracker, started with the first worker process, unblocks
-    # SIGINT and SIGTERM in the thread that starts it (resource_tracker.ensure_running): now,
-    # before the hold, it is not started again in the thread that spawns the workers
-    from multiprocessing import resource_tracker
+    if spawns:
+        # multiprocessing's resource tracker, started with the first worker process, unblocks
+        # SIGINT and SIGTERM in the thread that starts it (resource_tracker.ensure_running):
+        # now, before the hold, it is not started again in the thread that spawns the workers
+        from multiprocessing import resource_tracker
 
-    resource_tracker.ensure_running()
+        resource_tracker.ensure_running()
     noted: list[int] = []
     handlers: dict[int, Any] = {}
     if threading.current_thread() is threading.main_thread():
@@ -1909,15 +1956,18 @@ def run_jobs(
     desc = "sequences" if kind == "track" else "files"
     bar = {"total": len(pending), "desc": desc, "enable": show_progress}
     frames: _Frames | None = None
+    # connected (or the local cluster started) before --out is touched; in a with statement of
+    # its own: ExitStack.enter_context, interrupted (Ctrl-C) between entering the client and
+    # noting its exit, left them open for the garbage collector to close (see _new_client)
+    on: contextlib.AbstractContextManager[Client | None] = contextlib.nullcontext()
+    if on_dask and (client is not None or address):
+        on = dask_client(client, address)
+    elif on_dask:  # a local cluster: no idle worker to start
+        n = n_workers if n_workers is not None else usable_cpus()
+        on = dask_client(n_workers=min(n, len(pending)))
     try:
-        with contextlib.ExitStack() as stack:
-            c = None
-            if on_dask:  # connected (or the local cluster started) before --out is touched
-                if client is not None or address:
-                    c = stack.enter_context(dask_client(client, address))
-                else:  # a local cluster: no idle worker to start
-                    n = n_workers if n_workers is not None else usable_cpus()
-                    c = stack.enter_context(dask_client(n_workers=min(n, len(pending))))
+        with on as c, contextlib.ExitStack() as stack:
+            if c is not None:
                 remote = True
                 info = c.scheduler_info()
                 reported = str(info.get("address")) if info.get("address") else None
