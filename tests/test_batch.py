@@ -2660,8 +2660,9 @@ def test_a_scheduler_without_workers_is_said_at_once_then_an_error(
     _tracks_files(tmp_path / "tracks")
     out = tmp_path / "out"
     with distributed.LocalCluster(
-        n_workers=0, host="127.0.0.1", dashboard_address=None, processes=True
-    ) as bare:
+        n_workers=0, host="127.0.0.1", dashboard_address=None, processes=True,
+        scheduler_kwargs=NO_DASHBOARD,
+    ) as bare:  # fmt: skip
         address = bare.scheduler_address
         start = time.monotonic()
         assert main(["smooth", str(tmp_path / "tracks"), "--out", str(out),
@@ -2942,7 +2943,8 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
         if setting_on_the_scheduler:
             stack.enter_context(dask.config.set(setting))
         cluster = stack.enter_context(distributed.LocalCluster(
-            n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+            n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+            scheduler_kwargs=NO_DASHBOARD,
         ))  # fmt: skip
         stack.enter_context(dask.config.set(setting))
         address = cluster.scheduler_address
