@@ -3389,10 +3389,11 @@ def test_a_scheduler_frozen_mid_run_fails_the_tasks_left(
         f"the scheduler at {address} did not answer for 1 s (frozen or overloaded) before this "
         "file finished (a re-run does the rest)"
     }
-    assert [str(w.message) for w in said] == [
+    # a loaded machine's scheduler may also be slow once before the freeze: said again then
+    assert {str(w.message) for w in said} == {
         f"the scheduler at {address} has not answered for 0.5 s (frozen or overloaded?); "
         "waiting up to 1 s for it"
-    ]
+    }
 
 
 def test_a_result_lost_with_its_worker_is_waited_for_not_dropped(
