@@ -27,6 +27,7 @@ from pftrack.recovery.linking import (
     FLAG_COLUMN,
     box_centres,
     check_rows,
+    check_tracked,
     check_unique,
     split_tracks,
 )
@@ -303,6 +304,7 @@ def fill_rows(
     max_gap = _check.integer(max_gap, "fill_gaps: max_gap", 1, MAX_GAP_LIMIT)
     rows = check_rows(rows, "fill_gaps")
     check_unique(rows, who="fill_gaps")
+    check_tracked(rows, who="fill_gaps")
     per_id = split_tracks(rows)
     # every track's rows one after the other (by id, then frame), its centres and segment rows
     r = np.concatenate(list(per_id.values())) if per_id else np.zeros((0, 10))
