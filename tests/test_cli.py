@@ -1447,6 +1447,27 @@ def test_a_one_frame_video_with_detections_blames_min_hits(
     )
 
 
+def test_a_tracks_file_given_as_detections_is_said(
+    video: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--detections`` of another tracker's output (ids, not -1) was read with its ids
+    ignored without a word."""
+    import warnings
+
+    write_mot(tmp_path / "tracks.txt", scene.truth)
+    argv = ["-q", "track", str(video), "--detections", str(tmp_path / "tracks.txt")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as outside the test suite (which makes them errors)
+        assert main([*argv, "--out", str(tmp_path / "t.txt")]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"pftrack track: warning: {tmp_path / 'tracks.txt'}: {len(scene.truth)} of "
+        f"{len(scene.truth)} rows have a track id, not -1 (the first: id "
+    )
+    assert "the ids are ignored, the tracker makes its own\n" in err
+    assert (tmp_path / "t.txt").exists()
+
+
 def test_an_empty_detection_file_is_said_to_be_empty(
     video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

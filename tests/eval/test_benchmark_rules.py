@@ -215,6 +215,33 @@ def test_result_classes_other_than_pedestrian_are_warned_about(
     assert result_class_note(np.c_[res[:, :7], np.full(len(res), 12.5)], "MOT17") is None
 
 
+def test_ground_truth_with_scores_in_its_flag_column_is_warned_about(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Regression: another tracker's output given as the ground truth (scores in (0, 1) in
+    column 7, which TrackEval truncates to the "consider" flag 0) scored nothing (GT 0, every
+    result box a false positive) without a word."""
+    gt, res = mot17_case(0)
+    g = gt[gt[:, 6] == 1].copy()
+    g[:, 6] = np.linspace(0.2, 0.99, len(g))
+    g[-3:, 6] = 1.0
+    write_rows(tmp_path / "gt.txt", g)
+    write_rows(tmp_path / "res.txt", res)
+    argv = ["eval", "-q", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt")]
+    assert main([*argv, "--benchmark", "MOT15"]) == 0
+    n = len(g) - 3
+    assert capsys.readouterr().err == (
+        f"pftrack eval: warning: {tmp_path / 'gt.txt'}: {n} of {len(g)} ground-truth rows have "
+        "a conf (column 7, the consider flag: 0 or 1) that is not an integer (the first 0.2, in "
+        f"frame {int(g[0, 0])}): TrackEval truncates it, so {n} of the rows are 0 and not "
+        "scored; a tracker's scores? set column 7 to 1 to score every row\n"
+    )
+    g[:, 6] = 1.0  # flags: nothing to say
+    write_rows(tmp_path / "gt.txt", g)
+    assert main([*argv, "--benchmark", "MOT15"]) == 0
+    assert capsys.readouterr().err == ""
+
+
 def test_real_data_gives_no_class_warning(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -321,6 +321,53 @@ def test_recover_of_a_detection_file_says_it_needs_tracks(
     )
 
 
+def test_rows_of_id_minus_1_among_tracks_are_refused() -> None:
+    """Rows of id -1 (MOTChallenge's unassociated boxes) among tracks were joined into one
+    track: holes between unrelated detections were filled, smoothed and linked."""
+    from pftrack.recovery import fill_gaps, link_tracklets
+    from pftrack.recovery.linking import LinkConfig
+    from pftrack.tracking import smooth_tracks
+    from pftrack.tracking.offline import repair_crossings
+
+    rows = _walkers(n_ids=2, n_frames=10)
+    loose = np.array([[5, -1, 300, 200, 20, 40, 0.5, -1, -1, -1],
+                      [1, -1, 100, 100, 20, 40, 0.5, -1, -1, -1]])  # fmt: skip
+    mixed = np.vstack([rows, loose])
+    for who, call in (
+        ("fill_gaps", lambda: fill_gaps(mixed)),
+        ("smooth_tracks", lambda: smooth_tracks(mixed)),
+        ("link_tracklets", lambda: link_tracklets(mixed, LinkConfig())),
+        ("repair_crossings", lambda: repair_crossings(mixed)),
+    ):
+        with pytest.raises(ValueError) as exc:
+            call()
+        assert str(exc.value) == (
+            f"{who}: row 20 has id -1 (frame 5; 2 rows have it): -1 is MOTChallenge's id of a "
+            "box no track holds (an unassociated detection), not a track; drop those rows, or "
+            "make tracks of them (pftrack track SOURCE --detections FILE)"
+        )
+    fill_gaps(np.vstack([rows, loose * [1, -5, 1, 1, 1, 1, 1, 1, 1, 1]]))  # id 5: a track
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_recover_of_tracks_with_id_minus_1_rows_refuses_them(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: exit 0, the two id -1 rows (frames 1 and 5) joined by 3 filled rows."""
+    src, out = tmp_path / "t.txt", tmp_path / "o.txt"
+    src.write_text(
+        "1,1,10,10,20,40,1\n2,1,12,10,20,40,1\n3,1,14,10,20,40,1\n1,-1,300,200,20,40,0.5\n"
+        "5,-1,100,100,20,40,0.5\n6,1,20,10,20,40,1\n"
+    )
+    assert main([command, str(src), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {command}: error: {src}:4: id -1 in frame 1 (2 rows have it): -1 is "
+        "MOTChallenge's id of a box no track holds (an unassociated detection), not a track; "
+        "drop those rows, or make tracks of them (pftrack track SOURCE --detections FILE)\n"
+    )
+    assert not out.exists()
+
+
 def test_paired_excess_is_the_mean_difference_to_the_best_other_method_and_its_error() -> None:
     """Worked numbers: per sequence and pooled, against the other method of lowest MMAE."""
     a = E.SequenceResult("a", (768.0, 576.0), (), 3, {

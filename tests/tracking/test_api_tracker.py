@@ -1317,6 +1317,26 @@ def test_a_detection_file_without_scores_is_said(tmp_path):
     assert float(load_detections(tmp_path / "seven.txt")[1][0, 4]) == 0.8  # no warning
 
 
+def test_a_detection_file_with_ids_is_said(tmp_path):
+    """A file whose id column holds ids (another tracker's output, a ground truth) given as
+    detections was read with its ids ignored without a word."""
+    rows = "1,7,10,10,20,40,1\n1,-1,50,10,20,40,1\n2,7,11,10,20,40,1\n"
+    (tmp_path / "tracks.txt").write_text(rows)
+    with pytest.warns(UserWarning) as caught:
+        got = load_detections(tmp_path / "tracks.txt")
+    said = [str(w.message) for w in caught]
+    assert said == [
+        f"{tmp_path / 'tracks.txt'}: 2 of 3 rows have a track id, not -1 (the first: id 7 in "
+        "frame 1): a tracks file? Read as detections: the ids are ignored, the tracker makes "
+        "its own"
+    ]
+    assert [len(r) for r in got.values()] == [2, 1]  # every box still read
+    (tmp_path / "det.txt").write_text("1,-1,10,10,20,40,0.8\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load_detections(tmp_path / "det.txt")  # id -1: no warning
+
+
 def test_detections_after_a_video_that_ended_early_are_said(tmp_path):
     """A truncated video (its header promised more frames) ended the run with its detections of
     the frames never decoded dropped without a word.
@@ -1424,7 +1444,8 @@ def test_track_frames_takes_detections_as_load_detections_gives_them(tmp_path):
     """NumPy int keys, lists, (k, 4) rows without score, empty values: the rows of the file."""
     scene = make_scene(n_frames=12, rng=0)
     det = tmp_path / "det.txt"
-    write_mot(det, scene.truth)
+    write_mot(det, np.column_stack([scene.truth[:, 0], -np.ones(len(scene.truth)),
+                                    scene.truth[:, 2:]]))  # fmt: skip
     loaded = load_detections(det)
     expected = track_frames(scene.frames, detections=loaded, rng=0).rows
     as_lists = {np.int64(f): v.tolist() for f, v in loaded.items()}

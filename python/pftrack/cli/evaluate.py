@@ -241,7 +241,7 @@ def run(args: argparse.Namespace) -> int:
     import json
 
     from pftrack._progress import progress
-    from pftrack.eval.rows import result_class_note
+    from pftrack.eval.rows import gt_conf_note, result_class_note
     from pftrack.eval.sequences import (
         SequenceScores,
         benchmark_of_path,
@@ -306,6 +306,9 @@ def run(args: argparse.Namespace) -> int:
         note = result_class_note(res, scores[name].benchmark)
         if note:
             notes.append(f"{path}: {note}")
+        note = gt_conf_note(gt)
+        if note:
+            notes.append(f"{seq.gt_path}: {note}")
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
     if args.json:
         if Path(args.gt).is_file():  # one file: its metrics at the top level, as before

@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--plot": args.plot})
     check_outside_frames({"--out": args.out, "--plot": args.plot}, args.source)
-    rows = read_tracks(args.tracks)
+    rows = read_tracks(args.tracks, tracks_only=False)  # id -1 rows drawn, as any other
     rows[:, 2:6] *= args.scale
     source = FrameSource(args.source, fps=args.fps)
     fmt = output_format(args.out, VIDEO_SUFFIXES)  # a size its encoder cannot take: said now

@@ -263,6 +263,30 @@ def result_class_note(result: ArrayLike, benchmark: str) -> str | None:
     return f"{boxes} {which} in column 8: scored as pedestrians{refused}"
 
 
+def gt_conf_note(gt: ArrayLike) -> str | None:
+    """What is odd in the "consider" flag (column 7) of ground truth `gt`, or None.
+
+    MOTChallenge's ground truth holds 0 (not scored) or 1 there; TrackEval truncates the value
+    to an integer, so a score in (0, 1), what a tracker's output holds (another tracker's
+    tracks given as the ground truth), drops its row, and a file of them scores nothing (was:
+    silently, every result box a false positive). The note names how many rows hold a value
+    that is not an integer, the first, and how many of the rows are not scored.
+    """
+    g = check_eval_rows(gt, "ground truth")
+    conf = g[:, CONF]
+    odd = np.isfinite(conf) & (conf != np.trunc(conf))
+    if not np.any(odd):
+        return None
+    k = int(np.argmax(odd))
+    dropped = int(np.sum(np.trunc(conf) == 0))
+    return (
+        f"{int(odd.sum())} of {len(g)} ground-truth rows have a conf (column 7, the consider "
+        f"flag: 0 or 1) that is not an integer (the first {conf[k]:.15g}, in frame "
+        f"{int(g[k, FRAME])}): TrackEval truncates it, so {dropped} of the rows are 0 and not "
+        "scored; a tracker's scores? set column 7 to 1 to score every row"
+    )
+
+
 def prepare_mot(
     gt: ArrayLike,
     result: ArrayLike,

@@ -27,6 +27,7 @@ from pftrack.recovery.linking import (
     FLAG_COLUMN,
     box_centres,
     check_rows,
+    check_tracked,
     check_unique,
     split_tracks,
 )
@@ -259,7 +260,8 @@ def fill_gaps(
         more than 0 with ``combine=False``), `max_gap` outside ``1..MAX_GAP_LIMIT``,
         rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
-        or height, a value beyond ±1e9 px) or a duplicate (frame, id).
+        or height, a value beyond ±1e9 px), a duplicate (frame, id) or a row of id -1 (an
+        unassociated box, not a track: :func:`pftrack.recovery.linking.check_tracked`).
     """
     rows = _check.mot_rows(tracks, "fill_gaps")  # (M, 6..10), [] too, as smooth_tracks
     # what the method does not use is refused, as the command refuses --seed (was ignored
@@ -303,6 +305,7 @@ def fill_rows(
     max_gap = _check.integer(max_gap, "fill_gaps: max_gap", 1, MAX_GAP_LIMIT)
     rows = check_rows(rows, "fill_gaps")
     check_unique(rows, who="fill_gaps")
+    check_tracked(rows, who="fill_gaps")
     per_id = split_tracks(rows)
     # every track's rows one after the other (by id, then frame), its centres and segment rows
     r = np.concatenate(list(per_id.values())) if per_id else np.zeros((0, 10))

@@ -30,6 +30,7 @@ from pftrack._check import (
     frames_from_1,
     mot_rows,
 )
+from pftrack._text import counted
 from pftrack._typing import F64, PathLike
 from pftrack.boxes import _to_cxcywh
 from pftrack.particle_filter.colour import (
@@ -510,6 +511,7 @@ def link_tracklets(
         )
     rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
     check_unique(rows, who="link_tracklets")  # a track seen twice has no velocity to link
+    check_tracked(rows, who="link_tracklets")
     if len(rows) == 0:
         return rows, {}
     if frames is not None and len(frames) < rows[:, 0].max():
@@ -653,12 +655,46 @@ def check_unique(
         )
 
 
-def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
+def check_tracked(
+    rows: F64,
+    line_numbers: Iterable[int] | None = None,
+    path: PathLike | None = None,
+    *,
+    who: str | None = None,
+) -> None:
+    """Refuse rows of id -1 (ValueError naming the first, its frame and how many there are).
+
+    Id -1 is MOTChallenge's id of a box no track holds (a detection file's every row, the
+    unassociated boxes some trackers write beside their tracks): taken as one track, its rows
+    had their holes filled, their boxes smoothed and linked to other tracks, each across
+    unrelated objects. As ``pftrack eval`` refuses them (TrackEval cannot score them). Other
+    negative ids are tracks. With `line_numbers` and `path` the message starts with
+    ``FILE:LINE:``; else with ``WHO:``. `rows` are checked (M, 10) rows.
+    """
+    loose = rows[:, 1] == -1
+    if not loose.any():
+        return
+    k, n = int(np.argmax(loose)), int(loose.sum())
+    frame, many = int(rows[k, 0]), f"{counted(n, 'row')} {'has' if n == 1 else 'have'} it"
+    if line_numbers is not None and path is not None:
+        head = f"{path}:{list(line_numbers)[k]}: id -1 in frame {frame} ({many})"
+    else:
+        head = f"{who or 'check_tracked'}: row {k} has id -1 (frame {frame}; {many})"
+    raise ValueError(
+        f"{head}: -1 is MOTChallenge's id of a box no track holds (an unassociated detection), "
+        "not a track; drop those rows, or make tracks of them (pftrack track SOURCE "
+        "--detections FILE)"
+    )
+
+
+def read_tracks(path: PathLike, what: str = "tracks file", *, tracks_only: bool = True) -> F64:
     """Read a tracks file whose ids are integers and (frame, id) pairs unique (errors name lines).
 
     :func:`pftrack.io.mot.read_mot` (`what` names the file in its errors), the ids' check
     (``FILE:LINE``), then :func:`check_unique` (``FILE:LINE: duplicate rows ...``); the file
-    is read a second time, for its line numbers, only when a pair repeats. What ``pftrack
+    is read a second time, for its line numbers, only when a pair repeats. Rows of id -1
+    (unassociated boxes) are refused by :func:`check_tracked` unless `tracks_only` is False
+    (``pftrack render`` draws them). What ``pftrack
     recover`` and ``pftrack smooth`` read, one file or many, and ``pftrack experiment gaps``
     its ground truth (``what="ground truth"``). Lines of more than 10 columns give one
     UserWarning naming the file: columns past 10 are not kept.
@@ -671,6 +707,8 @@ def read_tracks(path: PathLike, what: str = "tracks file") -> F64:
         check_unique(rows)
     except ValueError:
         check_unique(rows, data_line_numbers(path), path)
+    if tracks_only and np.any(rows[:, 1] == -1):
+        check_tracked(rows, data_line_numbers(path), path)
     _warn_padded_flags(rows, path)
     _warn_normalised(rows, path)
     return rows

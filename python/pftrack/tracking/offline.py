@@ -35,6 +35,7 @@ from pftrack.recovery.linking import (
     LinkConfig,
     check_boxes,
     check_rows,
+    check_tracked,
     check_unique,
     link_config_for,
     link_tracklets,
@@ -308,6 +309,7 @@ def repair_crossings(
             f"repair_crossings: measurements has shape {z.shape}, expected finite ({n}, 4)"
         )
     check_unique(a, who="repair_crossings")
+    check_tracked(a, who="repair_crossings")
     if n < 2:
         return a
     perm = np.argsort(a[:, 0], kind="stable")  # rows by frame: every selection in time order
@@ -559,6 +561,7 @@ def smooth_tracks(
         )
     a: F64 = check_rows(rows, "smooth_tracks")
     check_unique(a, who="smooth_tracks")  # was: BoxSmoother.smooth's "frames must be ..."
+    check_tracked(a, who="smooth_tracks")
     a = a.copy()
     obs = np.ones(len(a), dtype=bool) if observed is None else np.asarray(observed)
     if obs.dtype != np.bool_:  # 0.5 or NaN would read as True

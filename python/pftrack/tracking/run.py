@@ -89,7 +89,8 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     -----
     UserWarning
         Boxes of zero width or height are left out (a box with no area cannot be tracked); a
-        file without a score column (6 fields a row) gives every box the score 1.
+        file without a score column (6 fields a row) gives every box the score 1; rows whose
+        id is not -1 (another tracker's output) are read as detections, their ids ignored.
     """
     lo, hi = DET_SCALE_RANGE
     if not (lo <= number(scale, "detection scale", finite=False) <= hi):
@@ -99,6 +100,15 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
         warnings.warn(
             f"{path}: no score column (6 fields a row): every detection scores 1, so "
             "birth_score and min_conf gate none of them",
+            stacklevel=2,
+        )
+    tracked = rows[:, 1] != -1  # detection files hold id -1 (MOTChallenge's "no id")
+    if tracked.any():
+        k = int(np.argmax(tracked))
+        warnings.warn(
+            f"{path}: {int(tracked.sum())} of {len(rows)} rows have a track id, not -1 (the "
+            f"first: id {rows[k, 1]:g} in frame {int(rows[k, 0])}): a tracks file? Read as "
+            "detections: the ids are ignored, the tracker makes its own",
             stacklevel=2,
         )
     flat = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
