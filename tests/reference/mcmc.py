@@ -114,7 +114,10 @@ def mh_step(
     def log_dyn(x, mu):
         if not s_min <= x[2] <= s_max:
             return -np.inf
-        return -0.5 * np.sum(((x - mu) / sigma) ** 2)
+        fixed = sigma == 0  # a deterministic component: no mass off its prediction
+        if np.any((x != mu) & fixed):
+            return -np.inf
+        return -0.5 * np.sum(((x - mu)[~fixed] / sigma[~fixed]) ** 2)
 
     def box_of(x):
         return (x[0], x[1], x[2] * w0, x[2] * h0)
@@ -159,9 +162,10 @@ def mh_step(
             ok = False
             if np.isfinite(ld):
                 new = loglik(xs) + ld
-                # eq. 5 with q = dynamics mixture (q ratio = prior ratio) or a symmetric walk
-                log_a = new - cur
-                if proposal == "dynamics":
+                # eq. 5 with q = dynamics mixture (q ratio = prior ratio) or a symmetric walk;
+                # a current state of target 0 is left by any proposal of positive target
+                log_a = new - cur if np.isfinite(cur) else np.inf
+                if proposal == "dynamics" and np.isfinite(cur):
                     log_a += log_dyn(x, mus[par]) - ld
                 ok = log_a >= 0 or rng.uniform(2 * (k + 3)) < math.exp(log_a)
             if ok:
