@@ -275,6 +275,11 @@ def test_errors():
     img = _core.hsv_bins(frame, mask)
     with pytest.raises(ValueError, match="burn_in"):
         tracker(burn_in=-1)
+    # was accepted: the chain's int count B + N overflowed (undefined behaviour) at the first step
+    with pytest.raises(
+        ValueError, match=r"burn_in \+ n_samples is 2147483652, expected <= 2147483647"
+    ):
+        tracker(burn_in=5, n_samples=2**31 - 1)
     with pytest.raises(ValueError, match="p_birth and p_death"):
         tracker(p_birth=0.0)
     with pytest.raises(ValueError, match="sigma"):
