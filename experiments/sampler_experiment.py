@@ -38,6 +38,12 @@ from numpy.typing import NDArray
 
 from experiments._common import data_root, experiment_parser, write_text
 from pftrack.boxes import iou_xywh
+from pftrack.cli._options import (
+    RJMCMC_MAX_SAMPLES,
+    bounded_int,
+    non_negative_int,
+    positive_int,
+)
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.atomic import atomic_path, atomic_write
 from pftrack.io.mot import as_written, group_by_frame, read_mot
@@ -423,12 +429,22 @@ def occlusion_figure(
 
 def main(argv: Sequence[str] | None = None) -> int:
     p = experiment_parser("sampler_experiment", __doc__)
-    p.add_argument("--particles", type=int, default=100)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--max-walkers", type=int, default=8)
+    # every value checked here, before any work (was: --particles 0 a traceback, --max-walkers
+    # 41 one after the whole table had run)
     p.add_argument(
-        "--max-frames", type=int, default=None, help="only the first frames of each real sequence"
-    )
+        "--particles", type=bounded_int(1, RJMCMC_MAX_SAMPLES), default=100,
+        help=f"particles per object (SIS, MH) and kept samples of the joint chain, 1 to "
+        f"{RJMCMC_MAX_SAMPLES} (pftrack track's limit for the chain)",
+    )  # fmt: skip
+    p.add_argument("--seed", type=non_negative_int, default=0, help="random seed, >= 0")
+    p.add_argument(
+        "--max-walkers", type=bounded_int(1, 40), default=8,
+        help="timing: synthetic scenes of 1 to this many walkers, 1 to 40",
+    )  # fmt: skip
+    p.add_argument(
+        "--max-frames", type=positive_int, default=None,
+        help="only the first frames of each real sequence, >= 1 (default: all)",
+    )  # fmt: skip
     p.add_argument("--skip-timing", action="store_true")
     p.add_argument("--skip-figure", action="store_true")
     args = p.parse_args(argv)

@@ -113,3 +113,27 @@ def test_the_figures_need_matplotlib_and_say_so_before_any_work(
 
 def _no_work(*args: object) -> list[object]:
     raise AssertionError("work started")
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (["--particles", "0"], "argument --particles: expected an integer in [1, 10000], got 0"),
+        (["--particles", "10001"], "expected an integer in [1, 10000], got 10001"),
+        (["--seed", "-1"], "argument --seed: expected an integer >= 0, got -1"),
+        (["--max-walkers", "0"], "argument --max-walkers: expected an integer in [1, 40], got 0"),
+        (["--max-walkers", "41"], "expected an integer in [1, 40], got 41"),
+        (["--max-frames", "0"], "argument --max-frames: expected an integer >= 1, got 0"),
+    ],
+)
+def test_bad_values_are_refused_before_any_work(
+    args: list[str], said: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: --particles 0 and --seed -1 a traceback (exit 1) after the sequences were read,
+    --max-walkers 41 one after the whole table had run (make_scene takes 1..40), --max-walkers
+    0 and --max-frames 0 taken (no timing rows; every frame)."""
+    with pytest.raises(SystemExit) as e:
+        se.main([*args, "--skip-timing", "--skip-figure", "--out", str(tmp_path / "out")])
+    assert e.value.code == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

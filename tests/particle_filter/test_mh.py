@@ -147,6 +147,30 @@ def test_dynamics_proposal_with_flat_likelihood_accepts_everything(rng):
     assert out["acceptance"] == 1.0
 
 
+@pytest.mark.parametrize("lam", [0.0, 20.0])
+def test_a_chain_started_outside_the_support_leaves_it(rng, lam):
+    """sigma_s = 0 and parents whose prediction of the scale lies beyond s_max: a chain started
+    there is clamped onto the bound, where the deterministic scale puts no mass (target 0), so
+    the first proposal of positive target must be accepted (a = +inf). Was: log a = +inf - inf
+    = NaN, never accepted, and such chains stayed on the clamped box for all n_iter iterations
+    (the NumPy reference did the same)."""
+    frame, mask = scene(rng)
+    img = _core.hsv_bins(frame, mask)
+    r = _core.box_histograms(img, np.array([[40.0, 30, 12, 20]]))[0]
+    n = 20
+    p = particles_at(n, 40.0, 30.0)
+    p[: n // 2, 2], p[: n // 2, 5] = 3.0, 0.5  # predicted scale 2 * 3 - 0.5 = 5.5 > s_max 5
+    before = p.copy()
+    out = call(p, np.full(n, 1 / n), np.zeros((2, 3)), img, r, lam=lam, n_iter=20, burn_in=0,
+               sigma=[4.0, 4.0, 0.0])  # fmt: skip
+    np.testing.assert_array_equal(p[:, 2], 1.0)  # every chain on a parent of scale 1
+    expect, _, acc = ref.mh_step(before, img.bins, img.n_bins, r, 12.0, 20.0, A, B,
+                                 [4.0, 4.0, 0.0], 0.2, 5.0, lam, 3, 0, 20, 0, "dynamics",
+                                 (2.0, 2.0, 0.01))  # fmt: skip
+    np.testing.assert_allclose(p, expect, rtol=0, atol=1e-9)
+    assert out["acceptance"] == pytest.approx(acc)
+
+
 def test_fixed_seed_fixed_result(rng):
     frame, mask = scene(rng)
     img = _core.hsv_bins(frame, mask)

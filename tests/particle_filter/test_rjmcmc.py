@@ -275,6 +275,11 @@ def test_errors():
     img = _core.hsv_bins(frame, mask)
     with pytest.raises(ValueError, match="burn_in"):
         tracker(burn_in=-1)
+    # was accepted: the chain's int count B + N overflowed (undefined behaviour) at the first step
+    with pytest.raises(
+        ValueError, match=r"burn_in \+ n_samples is 2147483652, expected <= 2147483647"
+    ):
+        tracker(burn_in=5, n_samples=2**31 - 1)
     with pytest.raises(ValueError, match="p_birth and p_death"):
         tracker(p_birth=0.0)
     with pytest.raises(ValueError, match="sigma"):
@@ -365,3 +370,48 @@ def test_step_takes_no_candidate_and_one_candidate():
     ta, tb = a.step(img, mask, one), b.step(img, mask, one[None, :])  # (4,) is one box
     assert a.n_steps == b.n_steps == 2 and len(ta) == len(tb) == 1
     np.testing.assert_array_equal(ta[0].box_cxcywh, tb[0].box_cxcywh)
+
+
+#: A flatter target than PARAMS' (weak colour, coverage, detection and interaction terms), so
+#: that births, deaths and swaps are accepted too, not only updates (broad priors: a swap moves
+#: an object by about 30 px)
+FLAT = dict(lam=1.0, coverage=1.0, detection=1.0, interaction=1.0, birth_prior=1.0,
+            sigma=(30.0, 30.0, 0.05), birth_sigma_xy=30.0)  # fmt: skip
+
+
+@pytest.mark.parametrize(("seed", "flat"), [(0, True), (1, True), (3, True), (2, False)])
+def test_chain_matches_numpy_reference(seed, flat):
+    """A whole frame of the chain (move choice, proposals, acceptance, kept samples, estimates,
+    MAP, acceptance counts) equals the NumPy reference's, which accepts with the general
+    ratio pi(X') q(X|X') / [pi(X) q(X'|X)] of its own pi and q: on random scenes with kept
+    identities and newborn slots; on the flatter target every move is accepted."""
+    g = np.random.default_rng(seed)
+    params = {**PARAMS, "p_swap": 0.3, "p_update": 0.35, "burn_in": 10, "n_samples": 120}
+    params.update(FLAT if flat else {})
+    blobs = [((cx + int(g.integers(-3, 4)), cy), col) for (cx, cy), col in BLOBS]
+    t = tracker(**params)
+    f0, m0 = scene(10 + seed, blobs[:2])
+    t.step(_core.hsv_bins(f0, m0), m0, boxes(blobs[:2]), seed=seed, step=0)
+    moved = [((cx + 1, cy), col) for (cx, cy), col in blobs]
+    f1, m1 = scene(20 + seed, moved)
+    img = _core.hsv_bins(f1, m1)
+    cands = boxes(moved) + g.normal(0, 1, (3, 4)) * [1, 1, 0, 0]
+    t.prepare(img, m1, cands)
+    tracks = t.tracks
+    r = ref.RjReference(img.bins, img.n_bins, m1, t.slots(), tracks, params, cands)
+    assert len(r.slots) >= 3  # kept identities and at least one newborn slot
+    samples, targets, accepted, proposed = ref.rj_chain(r, tracks, seed, 1)
+    want, want_map = ref.rj_summary(r, samples, targets)
+    got = t.step(img, m1, cands, seed=seed, step=1)
+    assert {m: got["acceptance"][m] for m in ref.MOVES} == {
+        m: (accepted[m], proposed[m]) for m in ref.MOVES
+    }
+    assert min(accepted.values()) > 0 or not flat  # every move was taken at least once
+    np.testing.assert_allclose(got["estimates"][:, 1:], want[:, 1:], rtol=0, atol=1e-9)
+    kept_ids = [s["id"] for s in r.slots]
+    for row, slot in zip(got["estimates"], want[:, 0].astype(int), strict=True):
+        if r.slots[slot]["candidate"] < 0:
+            assert row[0] == kept_ids[slot]
+    np.testing.assert_allclose(got["map"][:, 1:], want_map[:, 1:], rtol=0, atol=1e-9)
+    assert got["map_log_target"] == pytest.approx(max(targets), abs=1e-8)
+    assert got["mean_objects"] == pytest.approx(np.mean([len(c) for c in samples]))

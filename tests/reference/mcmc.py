@@ -114,7 +114,10 @@ def mh_step(
     def log_dyn(x, mu):
         if not s_min <= x[2] <= s_max:
             return -np.inf
-        return -0.5 * np.sum(((x - mu) / sigma) ** 2)
+        fixed = sigma == 0  # a deterministic component: no mass off its prediction
+        if np.any((x != mu) & fixed):
+            return -np.inf
+        return -0.5 * np.sum(((x - mu)[~fixed] / sigma[~fixed]) ** 2)
 
     def box_of(x):
         return (x[0], x[1], x[2] * w0, x[2] * h0)
@@ -159,9 +162,10 @@ def mh_step(
             ok = False
             if np.isfinite(ld):
                 new = loglik(xs) + ld
-                # eq. 5 with q = dynamics mixture (q ratio = prior ratio) or a symmetric walk
-                log_a = new - cur
-                if proposal == "dynamics":
+                # eq. 5 with q = dynamics mixture (q ratio = prior ratio) or a symmetric walk;
+                # a current state of target 0 is left by any proposal of positive target
+                log_a = new - cur if np.isfinite(cur) else np.inf
+                if proposal == "dynamics" and np.isfinite(cur):
                     log_a += log_dyn(x, mus[par]) - ld
                 ok = log_a >= 0 or rng.uniform(2 * (k + 3)) < math.exp(log_a)
             if ok:
@@ -298,3 +302,114 @@ class RjReference:
         if move == "update":
             return math.log(self.move_prob("update") / n) + self.log_prior_pos(slot, dict(to)[slot])
         return math.log(self.move_prob("swap") / (n * (n - 1) / 2))
+
+
+# ---- RJ-MCMC chain of one frame (rjmcmc.hpp: draw layout, Metropolis-Hastings-Green) ----
+MOVES = ("birth", "death", "update", "swap")
+
+
+def rj_chain(r, tracks, seed, step):
+    """One frame of the joint chain on the model `r` (an RjReference whose slots are the
+    prepared frame's), from the documented start (every identity of `tracks` with existence
+    >= 1/2 at its mean prediction) and draws (iteration k: uniforms 8k move, 8k+1 and 8k+2 the
+    proposal's, 8k+3 acceptance of CounterRng(seed, step); normals 4k .. 4k+2 of
+    CounterRng(mix64(seed ^ 0xD1B54A32D192ED03), step)). Each move is accepted when
+    u < pi(X') q(X|X') / [pi(X) q(X'|X)] with pi and q of the reference: the general ratio of
+    Green (1995), not the closed forms of the core.
+
+    Returns (samples, log_targets, accepted, proposed): the kept configurations, each a list
+    of (slot, x, prev) sorted by slot, their log pi, and per move the counts over kept
+    iterations."""
+    p = r.p
+    ur = CounterRng(seed, step)
+    nr = CounterRng(mix64(seed ^ 0xD1B54A32D192ED03), step)
+    cur = []
+    for s, t in enumerate(tracks):
+        if t["existence"] < 0.5:
+            continue
+        an = r.slots[s]["anchor"]
+        x = np.array([an[0], an[1], min(max(an[2] / t["w0"], p["s_min"]), p["s_max"])])
+        cur.append((s, x, t["parents"][:, :3].mean(axis=0)))
+
+    def plain(c):
+        return [(s, x) for s, x, _ in c]
+
+    def draw(slot, u, w):
+        sl = r.slots[slot]
+        if sl["candidate"] >= 0:
+            sd = np.array([p["birth_sigma_xy"], p["birth_sigma_xy"], p["birth_sigma_s"]])
+            x = np.array([sl["anchor"][0], sl["anchor"][1], 1.0]) + sd * w
+            return x, x.copy()  # zero velocity at birth
+        mu = r.mu(slot)
+        n = min(len(mu) - 1, int(u * len(mu)))
+        return mu[n] + r.sigma * w, r.tracks[sl["id"]]["parents"][n, :3].copy()
+
+    probs = np.array([r.move_prob(m) for m in MOVES])
+    samples, targets = [], []
+    accepted, proposed = dict.fromkeys(MOVES, 0), dict.fromkeys(MOVES, 0)
+    for k in range(p["burn_in"] + p["n_samples"]):
+        u = ur.uniform(8 * k)
+        move = next(
+            (m for m, c in zip(MOVES[:3], np.cumsum(probs[:3]), strict=True) if u < c), "swap"
+        )
+        u1, u2 = ur.uniform(8 * k + 1), ur.uniform(8 * k + 2)
+        w = np.array([nr.normal(4 * k + d) for d in range(3)])
+        n, new, slot = len(cur), None, -1
+        if move == "birth":
+            present = {s for s, _, _ in cur}
+            absent = [s for s in range(len(r.slots)) if s not in present]
+            if absent:
+                cum = np.cumsum([r.birth_weight(s, plain(cur)) for s in absent])
+                slot = absent[next((j for j in range(len(absent) - 1) if u1 * cum[-1] < cum[j]),
+                                   len(absent) - 1)]  # fmt: skip
+                new = sorted([*cur, (slot, *draw(slot, u2, w))], key=lambda o: o[0])
+        elif move in ("death", "update") and n > 0:
+            j = min(n - 1, int(u1 * n))
+            slot = cur[j][0]
+            new = list(cur)
+            if move == "death":
+                del new[j]
+            else:
+                new[j] = (slot, *draw(slot, u2, w))
+        elif move == "swap" and n > 1:
+            pairs = n * (n - 1) // 2
+            q = min(pairs - 1, int(u1 * pairs))
+            a = 0
+            while q >= n - 1 - a:
+                q -= n - 1 - a
+                a += 1
+            b = a + 1 + q
+            new = list(cur)
+            new[a] = (cur[a][0], cur[b][1], cur[b][2])
+            new[b] = (cur[b][0], cur[a][1], cur[a][2])
+        kept = k >= p["burn_in"]
+        if new is not None:
+            proposed[move] += kept
+            reverse = {"birth": "death", "death": "birth"}.get(move, move)
+            x, y = plain(cur), plain(new)
+            ty = r.log_target(y)
+            lr = -np.inf
+            if np.isfinite(ty):
+                lr = ty + r.log_q(reverse, y, x, slot) - r.log_target(x) - r.log_q(move, x, y, slot)
+            if lr >= 0 or ur.uniform(8 * k + 3) < math.exp(lr):
+                cur = new
+                accepted[move] += kept
+        if kept:
+            samples.append(cur)
+            targets.append(r.log_target(plain(cur)))
+    return samples, targets, accepted, proposed
+
+
+def rj_summary(r, samples, targets):
+    """Per slot present in a kept sample: (slot, cx, cy, w, h, existence), the mean state over
+    the samples containing it; and the MAP sample's (slot, cx, cy, w, h) rows."""
+    rows = []
+    for s in range(len(r.slots)):
+        xs = [x for c in samples for slot, x, _ in c if slot == s]
+        if xs:
+            m = np.mean(xs, axis=0)
+            w0, h0 = r.slots[s]["w0"], r.slots[s]["h0"]
+            rows.append([s, m[0], m[1], m[2] * w0, m[2] * h0, len(xs) / len(samples)])
+    best = samples[int(np.argmax(targets))]
+    mp = [[s, *r.box(s, x)] for s, x, _ in best]
+    return np.array(rows).reshape(-1, 6), np.array(mp).reshape(-1, 5)

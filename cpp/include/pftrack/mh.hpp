@@ -178,7 +178,13 @@ inline MhResult mh_step(Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::Vec
                     prm.proposal == MhProposal::kDynamics ? cur_lp - prop_lp : 0.0;
                 // log a = log p(z|x*) + log p(x*|x_{t-1}) + log q(x|x*)
                 //       - log p(z|x)  - log p(x|x_{t-1})  - log q(x*|x)        (eq. 5)
-                const double log_a = (prop.loglik + prop_lp) - (cur.loglik + cur_lp) + log_q_ratio;
+                // A current state of target 0 (a start clamped onto a scale bound where a
+                // deterministic component puts no mass) is left by any proposal of positive
+                // target: a = +inf, where the terms above would give inf - inf = NaN.
+                const double log_a =
+                    std::isfinite(cur_lp)
+                        ? (prop.loglik + prop_lp) - (cur.loglik + cur_lp) + log_q_ratio
+                        : std::numeric_limits<double>::infinity();
                 const double u = rng.uniform(2 * (k + 3));
                 accept = log_a >= 0.0 || u < std::exp(log_a);
             }

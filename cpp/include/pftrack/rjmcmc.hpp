@@ -107,6 +107,10 @@ struct RjParams {
     void validate(const char* fn) const {
         require(burn_in >= 0, fn, "burn_in", burn_in, ">= 0");
         require(n_samples >= 1, fn, "n_samples", n_samples, ">= 1");
+        // the chain counts its B + N iterations in an int: the sum must not overflow
+        require(n_samples <= std::numeric_limits<int>::max() - burn_in, fn,
+                "burn_in + n_samples", static_cast<std::int64_t>(burn_in) + n_samples,
+                "<= 2147483647");
         const double p[4] = {p_birth, p_death, p_update, p_swap};
         for (double v : p) require(std::isfinite(v) && v >= 0.0, fn, "move probabilities must be >= 0");
         require(p_birth + p_death + p_update + p_swap > 0.0, fn, "move probabilities sum to 0");
