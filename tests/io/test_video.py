@@ -1344,3 +1344,28 @@ def test_a_one_frame_video_is_counted_in_the_singular(tmp_path: Path) -> None:
     with pytest.raises(IndexError, match=r"^frame index 1 is out of range for 1 frame$"):
         frames[1]
     frames.close()
+
+
+@pytest.mark.parametrize("suffix", [".png", ".tif"])
+def test_a_16_bit_image_after_an_8_bit_first_is_refused_naming_it(
+    tmp_path: Path, suffix: str
+) -> None:
+    """A user trial: 1.png 8-bit, 2.png and 3.png 16-bit of 12-bit data (up to 3200) were read
+    as OpenCV reads them, value / 256: levels 200, then 12, 12 (almost black), silently."""
+    cv2.imwrite(str(tmp_path / f"1{suffix}"), np.full((16, 24, 3), 200, np.uint8))
+    for k in (2, 3):
+        cv2.imwrite(str(tmp_path / f"{k}{suffix}"), np.full((16, 24, 3), 3200, np.uint16))
+    src = FrameSource(tmp_path)
+    with pytest.raises(ValueError) as info:
+        list(src)
+    assert str(info.value) == (
+        f"image {tmp_path / f'2{suffix}'} is 16-bit but 1{suffix}, the folder's first, is 8-bit: "
+        "a folder's images must have one depth (its 16-bit images are read at the depth their "
+        "values show only when the first is 16-bit); convert them to one"
+    )
+    with pytest.raises(ValueError, match=rf"image .*3\{suffix} is 16-bit but 1\{suffix}"):
+        src.frames_at([2])
+    # 8-bit images after an 8-bit first: the pixels OpenCV's colour read gives, as before
+    cv2.imwrite(str(tmp_path / f"2{suffix}"), np.full((16, 24, 3), 90, np.uint8))
+    (tmp_path / f"3{suffix}").unlink()
+    assert [int(f.max()) for f in FrameSource(tmp_path)] == [200, 90]

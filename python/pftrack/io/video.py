@@ -69,6 +69,8 @@ __all__ = [
 ]
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
+#: The image formats of :data:`IMAGE_SUFFIXES` that may hold 16-bit pixels (PNG, TIFF).
+DEEP_SUFFIXES = (".png", ".tif", ".tiff")
 #: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 #: Containers whose header holds the number of frames (AVI's frame total, MP4's sample table):
@@ -1143,7 +1145,8 @@ class FrameSource:
         If `source` is not a path, a string or an int (a bool is refused).
     ValueError
         If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
-        no frame; if two images of a folder have one number; or if a MOTChallenge sequence's
+        no frame; if two images of a folder have one number, or another size than the first,
+        or are 16-bit where the first is 8-bit (when read); or if a MOTChallenge sequence's
         image folder is named by number and one is missing (a hole in the numbering, numbers
         that do not start at 1 or a count other than ``seqLength``).
 
@@ -1185,6 +1188,7 @@ class FrameSource:
         self.bits: int | None = None
         self.gap: str | None = None  # an image folder's names skip a number
         self._depth_note: str | None = None  # the warning saying so, given at the first read
+        self._eight_bit = False  # the folder's first image is 8-bit: a 16-bit one is refused
         self._depth_from = ""  # the images `bits` was decided from, for the clipping warning
         self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._cut_said = False  # a JPEG without its end marker: said once
@@ -1310,6 +1314,7 @@ class FrameSource:
         if first is None:
             raise ValueError(_unreadable(path, unsaid))
         if first.dtype == np.uint8:  # the pixels read_image gives
+            self._eight_bit = True
             return first
         top = int(first.max()) if first.dtype == np.uint16 else 65535
         brightest = path
@@ -1409,14 +1414,27 @@ class FrameSource:
     def _read_image(self, path: Path) -> NDArray[np.uint8]:
         """One image of a folder, resized; ValueError if unreadable or not the first's size.
 
-        At :attr:`bits` when the folder's images set it (the first read says so, once).
+        At :attr:`bits` when the folder's images set it (the first read says so, once). A 16-bit
+        PNG or TIFF in a folder whose first image is 8-bit is refused, naming it (was: read as
+        OpenCV reads it, value / 256: 10- or 12-bit data almost black, without a word).
         """
         if self._depth_note is not None:
             note, self._depth_note = self._depth_note, None
             warnings.warn(note, UserWarning, stacklevel=3)
         img: NDArray[Any] | None
         notes: list[str] = []  # what its decoder prints on stderr (libpng, libjpeg)
-        if self.bits is None:
+        if self._eight_bit and path.suffix.lower() in DEEP_SUFFIXES:
+            img = read_image_depth(path, notes=notes)  # an 8-bit image: read_image's pixels
+            if img is not None and img.dtype == np.uint16:
+                first = self._images[0].name if self._images else "the first image"
+                raise ValueError(
+                    f"image {path} is 16-bit but {first}, the folder's first, is 8-bit: a "
+                    "folder's images must have one depth (its 16-bit images are read at the "
+                    "depth their values show only when the first is 16-bit); convert them to one"
+                )
+            if img is not None and img.dtype != np.uint8:  # a float TIFF: refused below
+                img = read_image(path, notes=notes)
+        elif self.bits is None:
             img = read_image(path, notes=notes)
         else:
             img = read_image_depth(path, notes=notes)
