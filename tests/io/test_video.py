@@ -6,8 +6,10 @@ import itertools
 import os
 import re
 import threading
+import time
 from fractions import Fraction
 from pathlib import Path
+from typing import Any
 
 import av
 import cv2
@@ -874,9 +876,11 @@ def test_a_split_pass_whose_seek_goes_wrong_reads_on_from_the_first_half(
     plain = src.frames_at(spread)
     seek = FrameSource._read_from_seek
 
-    def wrong(self: FrameSource, middle: int, wanted: list[int]) -> object:
+    def wrong(
+        self: FrameSource, middle: int, wanted: list[int], halt: threading.Event | None = None
+    ) -> object:
         # a container whose seek lands one frame late, or that cannot seek at all
-        return seek(self, middle + 1, wanted) if fault == "late" else None
+        return seek(self, middle + 1, wanted, halt) if fault == "late" else None
 
     monkeypatch.setattr(FrameSource, "_read_from_seek", wrong)
     got = src.frames_at(spread, split=True)
@@ -1369,3 +1373,49 @@ def test_a_16_bit_image_after_an_8_bit_first_is_refused_naming_it(
     cv2.imwrite(str(tmp_path / f"2{suffix}"), np.full((16, 24, 3), 90, np.uint8))
     (tmp_path / f"3{suffix}").unlink()
     assert [int(f.max()) for f in FrameSource(tmp_path)] == [200, 90]
+
+
+def test_an_interrupted_split_read_stops_its_second_half(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``frames_at(split=True)`` (the spread bootstrap's pass) interrupted in its first half, by
+    Ctrl-C or SIGTERM (raised there as a KeyboardInterrupt, ``pftrack.cli._signals``): its
+    pool's join waited for the thread of the second half to read that whole half (1.2 s after
+    a SIGTERM at 0.5 s on a 2400-frame 960x720 video; minutes on a long one), SIGTERM ignored
+    meanwhile. Now the second half stops at its next frame."""
+    path = make_scene(n_frames=80, rng=0).write_video(tmp_path / "walk.avi")
+    src = FrameSource(path)
+    real = video._file_capture
+    interrupted = threading.Event()
+    after = []  # frames the second half read after the interrupt
+
+    class Capture:
+        def __init__(self, cap: cv2.VideoCapture) -> None:
+            self.cap, self.frames = cap, 0
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self.cap, name)
+
+        def _step(self) -> None:
+            if threading.current_thread() is threading.main_thread():
+                self.frames += 1
+                if self.frames == 5:
+                    interrupted.set()
+                    raise KeyboardInterrupt
+            else:
+                time.sleep(0.02)  # the second half: slower than the first
+                if interrupted.is_set():
+                    after.append(1)
+
+        def grab(self) -> bool:
+            self._step()
+            return bool(self.cap.grab())
+
+        def read(self) -> Any:
+            self._step()
+            return self.cap.read()
+
+    monkeypatch.setattr(video, "_file_capture", lambda name: Capture(real(name)))
+    with pytest.raises(KeyboardInterrupt):
+        src.frames_at(range(0, 80, 3), split=True)
+    assert interrupted.is_set() and len(after) <= 1  # was: the rest of its 40 frames

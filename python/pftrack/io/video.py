@@ -1531,10 +1531,18 @@ class FrameSource:
             if not split or len(wanted) < 4 or middle < 2:
                 return self._read_at(cap, 0, wanted)[0]
             first = [i for i in wanted if i <= middle + 1]
+            # an interrupt (Ctrl-C; SIGTERM, raised here by pftrack.cli._signals) stops the
+            # second half at its next frame: the pool's join waited for it to read its whole
+            # half (minutes of a long video), SIGTERM ignored meanwhile
+            halt = threading.Event()
             with ThreadPoolExecutor(1, thread_name_prefix="pftrack-bootstrap") as pool:
-                tail = pool.submit(self._read_from_seek, middle, wanted)
-                head, check, at = self._read_at(cap, 0, first, middle)
-                second = tail.result()
+                tail = pool.submit(self._read_from_seek, middle, wanted, halt)
+                try:
+                    head, check, at = self._read_at(cap, 0, first, middle)
+                    second = tail.result()
+                except BaseException:
+                    halt.set()
+                    raise
             if second is not None and len(check) == 2 and _same_frames(check, second[1]):
                 return head[: sum(i < middle for i in first)] + second[0]
             rest, _, _ = self._read_at(cap, at, [i for i in wanted if i > middle + 1])
@@ -1543,20 +1551,26 @@ class FrameSource:
             cap.release()
 
     def _read_at(
-        self, cap: cv2.VideoCapture, start: int, keep: list[int], check: int | None = None
+        self,
+        cap: cv2.VideoCapture,
+        start: int,
+        keep: list[int],
+        check: int | None = None,
+        halt: threading.Event | None = None,
     ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]], int]:
         """Read on from frame `start` (where `cap` stands) through the last of `keep`.
 
         Returns the frames at `keep`, resized; with `check`, the raw frames `check` and
         `check + 1` with their time stamps (the pass then goes on to them); and the index of
-        the frame `cap` stands at afterwards.
+        the frame `cap` stands at afterwards. Stops early, before its next frame, once
+        :meth:`stop` is called or `halt` is set.
         """
         picked: list[NDArray[np.uint8]] = []
         seen: list[tuple[NDArray[Any], float]] = []
         stop = max(keep[-1] if keep else -1, -1 if check is None else check + 1) + 1
         wanted = set(keep)
         i = start
-        while i < stop and not self.stopped:
+        while i < stop and not self.stopped and not (halt is not None and halt.is_set()):
             compare = check is not None and check <= i <= check + 1
             if i in wanted or compare:
                 ok, frame = cap.read()
@@ -1572,17 +1586,19 @@ class FrameSource:
         return picked, seen, i
 
     def _read_from_seek(
-        self, middle: int, wanted: list[int]
+        self, middle: int, wanted: list[int], halt: threading.Event | None = None
     ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]]] | None:
         """The second half of a split pass: frames from `middle` on, after a seek to it.
 
-        None when the file cannot seek (or OpenCV fails on it): the first half reads on.
+        None when the file cannot seek (or OpenCV fails on it): the first half reads on. Ends
+        at its next frame once `halt` is set (the first half was interrupted).
         """
         cap = _file_capture(str(self.path))
         try:
             if not cap.set(cv2.CAP_PROP_POS_FRAMES, middle):
                 return None
-            picked, seen, _ = self._read_at(cap, middle, [i for i in wanted if i >= middle], middle)
+            keep = [i for i in wanted if i >= middle]
+            picked, seen, _ = self._read_at(cap, middle, keep, middle, halt)
             return picked, seen
         except cv2.error:
             return None
