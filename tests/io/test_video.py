@@ -1419,3 +1419,42 @@ def test_an_interrupted_split_read_stops_its_second_half(
     with pytest.raises(KeyboardInterrupt):
         src.frames_at(range(0, 80, 3), split=True)
     assert interrupted.is_set() and len(after) <= 1  # was: the rest of its 40 frames
+
+
+def test_an_avi_whose_chunks_break_off_inside_is_named_before_the_frames_shift(
+    tmp_path: Path,
+) -> None:
+    """A user trial: bytes cut out of the middle of an .avi (or overwritten across a chunk's
+    header): FFmpeg's AVI demuxer reads on from the next chunk it finds and numbers the frames
+    by counting them, so every later frame took an earlier frame's number, silently (a warning
+    at the end said only that the video had fewer frames than its header). The chunks are
+    walked when the file is opened, and where they break off is said before any frame is read."""
+    path = make_scene(n_frames=30, rng=0).write_video(tmp_path / "walk.avi")
+    good = list(FrameSource(path))
+    data = path.read_bytes()
+    at = len(data) // 2
+    damaged = tmp_path / "damaged.avi"
+    damaged.write_bytes(data[:at] + data[at + 2000 :])
+    with pytest.warns(UserWarning) as said:
+        src = FrameSource(damaged)
+    message = str(said[0].message)
+    match = re.fullmatch(
+        r".*damaged\.avi: damaged inside: its AVI chunks break off after frame (\d+) \(byte "
+        r"\d+\), and FFmpeg reads on from the next chunk it finds, numbering the frames it reads "
+        r"by counting them: the frames after frame \1 may carry the numbers of earlier ones "
+        r"\(tracks, detections and ground truth apart there\)",
+        message,
+    )
+    assert match is not None, message
+    before = int(match.group(1))
+    assert 0 < before < 30
+    with pytest.warns(UserWarning, match="ended after"):
+        frames = list(src)
+    assert len(frames) < 30  # what the warning is about: later frames are off by what is lost
+    assert not np.array_equal(frames[-1], good[len(frames) - 1])
+    # an intact file, a file that ends early (cut at its end): nothing said, numbers kept
+    assert video._avi_break(path) is None
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: int(len(data) * 0.6)])
+    assert video._avi_break(cut) is None
+    assert video._avi_break(dataset("pets09-s2l1") / "video.avi") is None

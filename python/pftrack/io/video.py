@@ -437,6 +437,67 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     return None
 
 
+#: The RIFF forms and lists whose chunks :func:`_avi_break` walks into: the file's RIFF lists
+#: (``AVIX``: an OpenDML file's later ones), the frames' ``movi`` and their ``rec`` groups.
+AVI_LISTS = (b"AVI ", b"AVIX", b"movi", b"rec ")
+
+
+def _printable_id(chunk_id: bytes) -> bool:
+    """Whether `chunk_id` can be a RIFF chunk's id: four printable ASCII characters."""
+    return len(chunk_id) == 4 and all(0x20 <= c <= 0x7E for c in chunk_id)
+
+
+def _avi_break(path: Path) -> tuple[int, int] | None:
+    """Where the chunks of AVI file `path` break off inside it: (frames before it, its byte).
+
+    FFmpeg's AVI demuxer reads on past damage in the middle of a file (bytes overwritten or
+    cut out) from the next chunk it finds, and numbers the frames it reads by counting them:
+    every frame after the damage takes the number of an earlier one, silently (a user trial:
+    frames 35.. read as 32.., tracks and ground truth three frames apart). The chunks are
+    walked from the start, 8 bytes read for each (no decoding: a bounded cost), counting the
+    frames (``##dc``, ``##db`` of the first stream that has them) before a chunk that is not
+    one (an id that is not four printable characters, or a size past the list holding it).
+
+    Returns
+    -------
+    tuple of (int, int) or None
+        The frames before the break and its offset in the file; None when the chunks do not
+        break (a file that ends early, its last chunk cut, keeps its frames' numbers) or
+        `path` is not a RIFF file.
+    """
+    try:
+        with path.open("rb") as fh:
+            size = os.fstat(fh.fileno()).st_size
+            stream: bytes | None = None
+            frames = 0
+            if fh.read(4) != b"RIFF":
+                return None
+            # (start, declared end) of the lists still to walk: the file (whose chunks are
+            # RIFF lists, ending where the file ends), then RIFF, movi and rec lists; a list
+            # declared past the file's end is of a file that ends early, not broken
+            todo = [(0, 1 << 63)]
+            while todo:
+                pos, end = todo.pop()
+                while pos + 8 <= min(end, size):
+                    fh.seek(pos)
+                    head = fh.read(12)
+                    chunk_id, length = head[:4], int.from_bytes(head[4:8], "little")
+                    stop = pos + 8 + length + (length & 1)
+                    if not _printable_id(chunk_id) or (stop > end and end <= size):
+                        return frames, pos
+                    if chunk_id in (b"RIFF", b"LIST") and head[8:12] in AVI_LISTS:
+                        todo.append((stop, end))  # the rest of this list, after the inner one
+                        pos, end = pos + 12, stop
+                        continue
+                    if chunk_id[2:] in (b"dc", b"db") and stream in (None, chunk_id[:2]):
+                        stream = chunk_id[:2]
+                        frames += 1
+                    pos = stop
+    except OSError:
+        return None
+    return None
+
+
 #: Reads tried after a frame inside a video fails to decode, before the video counts as ended.
 RESUME_TRIES = 16
 
@@ -1157,7 +1218,8 @@ class FrameSource:
         other than its sequence's ``seqLength`` (counted as read: no pass of its own). At the
         first image read, when a folder's 16-bit images are read at :attr:`bits`; once, when
         an image it was not decided from is brighter than that depth holds (its brighter
-        pixels clipped to white).
+        pixels clipped to white). When an ``.avi`` is opened whose chunks break off inside it
+        (:func:`_avi_break`): the frames after the break may carry earlier frames' numbers.
 
     Notes
     -----
@@ -1195,6 +1257,7 @@ class FrameSource:
         self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_lost = False  # frames inside the video could not be decoded
+        self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
         self._reading = False  # a thread is inside the live capture's read()
         self._replay: list[NDArray[np.uint8]] = []
@@ -1225,6 +1288,18 @@ class FrameSource:
                 first, header_fps, count = self._open_live()
             else:
                 first, header_fps, count = self._probe_file(self.path)
+                self._broken = _avi_break(self.path)
+        if self._broken is not None:  # before any work: said once for each source opened
+            frames, offset = self._broken
+            warnings.warn(
+                f"{self.name}: damaged inside: its AVI chunks break off after frame {frames} "
+                f"(byte {offset}), and FFmpeg reads on from the next chunk it finds, numbering "
+                f"the frames it reads by counting them: the frames after frame {frames} may "
+                "carry the numbers of earlier ones (tracks, detections and ground truth apart "
+                "there)",
+                UserWarning,
+                stacklevel=2,
+            )
         self.n_frames = max(count, 0)
         self.count_known = self.n_frames > 0 and (
             self.path is not None
@@ -1650,9 +1725,12 @@ class FrameSource:
             cap.release()
         if lost and not self._warned_lost:
             self._warned_lost = True
+            kept = (  # not where FFmpeg numbers the frames after the break by counting them
+                ", so the later frames keep their numbers" if self._broken is None else ""
+            )
             warnings.warn(
                 f"{self.path}: {_frame_list(lost)} could not be decoded (a damaged file?): the "
-                "frame before stands in for each, so the later frames keep their numbers",
+                f"frame before stands in for each{kept}",
                 UserWarning,
                 stacklevel=2,
             )
