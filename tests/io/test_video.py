@@ -1458,3 +1458,32 @@ def test_an_avi_whose_chunks_break_off_inside_is_named_before_the_frames_shift(
     cut.write_bytes(data[: int(len(data) * 0.6)])
     assert video._avi_break(cut) is None
     assert video._avi_break(dataset("pets09-s2l1") / "video.avi") is None
+
+
+def test_frames_read_at_chosen_indices_of_a_damaged_video_are_the_iterated_ones(
+    tmp_path: Path,
+) -> None:
+    """A frame that fails inside a video ended a pass of grabs: ``FrameSequence`` (``pftrack
+    recover --video``'s colour term) raised "frame 12 cannot be decoded: the video ended after
+    9 frames but its header says 30" of a video ``pftrack track`` reads to its end, and
+    ``frames_at`` (the spread bootstrap) gave only the frames before the damage. Now both give
+    the frames iterating gives: the frame before stands in, the later frames keep their
+    numbers."""
+    path = make_scene(n_frames=30, rng=0).write_video(tmp_path / "walk.avi")
+    data = bytearray(path.read_bytes())
+    at = int(len(data) * 0.3)
+    data[at : at + 20000] = np.random.default_rng(1).bytes(20000)  # inside frame 10
+    damaged = tmp_path / "damaged.avi"
+    damaged.write_bytes(bytes(data))
+    with pytest.warns(UserWarning, match="frame 10 could not be decoded"):
+        frames = list(FrameSource(damaged))
+    assert len(frames) == 30
+    wanted = [0, 5, 9, 12, 20, 29]
+    for split in (False, True):
+        got = FrameSource(damaged).frames_at(wanted, split=split)
+        assert len(got) == len(wanted)
+        for k, frame in zip(wanted, got, strict=True):
+            np.testing.assert_array_equal(frame, frames[k])
+    with FrameSequence(damaged) as seq:
+        for k in (3, 9, 12, 29, 5, 20):  # in order, and back again
+            np.testing.assert_array_equal(seq[k], frames[k])

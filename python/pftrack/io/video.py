@@ -525,6 +525,14 @@ def _resume(
     return None
 
 
+class _DamagedInside(Exception):  # a signal between readers, never raised out of them
+    """A pass of grabs stopped at a frame that fails to decode, with frames after it that do.
+
+    :meth:`FrameSource._read_at` raises it; its callers read such a file as iterating reads
+    it instead (:meth:`FrameSource._iter_stored`: the frame before stands in).
+    """
+
+
 def _frame_list(indexes: list[int]) -> str:
     """``frame 18`` or ``frames 18-20, 31`` (1-based) for 0-based `indexes`, in order."""
     runs: list[list[int]] = []
@@ -1600,6 +1608,30 @@ class FrameSource:
             for i in (i for i in wanted if i < len(self._images)):
                 out.append(self._read_image(self._images[i]))
             return out
+        try:
+            return self._file_frames_at(wanted, split)
+        except _DamagedInside:
+            # a frame inside the video failed to decode, which ends a pass of grabs: read as
+            # iterating reads (the frame before stands in, the later frames keep their
+            # numbers), not fewer frames (was: the spread bootstrap's frames all before it)
+            return self._iterated_at(wanted)
+
+    def _iterated_at(self, wanted: list[int]) -> list[NDArray[np.uint8]]:
+        """The frames at `wanted` (increasing) as iterating the file gives them, stand-ins too."""
+        keep, out = set(wanted), []
+        frames = self._iter_stored()
+        try:
+            for i, frame in enumerate(frames):
+                if i in keep:
+                    out.append(frame)
+                if i >= wanted[-1]:
+                    break
+        finally:
+            frames.close()
+        return out
+
+    def _file_frames_at(self, wanted: list[int], split: bool) -> list[NDArray[np.uint8]]:
+        """:meth:`frames_at` of a video file, in one pass of grabs (two with `split`)."""
         cap = _file_capture(str(self.path))
         try:
             middle = wanted[len(wanted) // 2]
@@ -1658,6 +1690,10 @@ class FrameSource:
             elif not cap.grab():
                 break
             i += 1
+        else:
+            return picked, seen, i
+        if i < self.counted_frames and any(cap.grab() for _ in range(RESUME_TRIES)):
+            raise _DamagedInside(i)  # frames decode after it: not the video's end
         return picked, seen, i
 
     def _read_from_seek(
@@ -1845,6 +1881,10 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
         self._cap: Any = None
         self._at = 0  # the index of the frame self._cap reads next
         self._last: tuple[int, NDArray[np.uint8]] | None = None
+        # after a frame inside the video failed to decode (a pass of grabs ends there): its
+        # frames as iterating reads them, stand-ins too, and the index of the next one
+        self._stored: Generator[NDArray[np.uint8], None, None] | None = None
+        self._stored_at = 0
 
     def __len__(self) -> int:
         return self.source.n_frames
@@ -1863,12 +1903,19 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
             return self._last[1]
         if self.source._images is not None:
             frame = self.source._read_image(self.source._images[i])
-        else:
+        elif self._stored is None:
             if self._cap is None or i < self._at:  # a new pass from the start
                 self.close()
                 self._cap = _file_capture(str(self.source.path))
                 self._at = 0
-            picked, _, self._at = self.source._read_at(self._cap, self._at, [i])
+            try:
+                picked, _, self._at = self.source._read_at(self._cap, self._at, [i])
+            except _DamagedInside:
+                # a frame inside the video failed to decode: read on as iterating reads (the
+                # frame before stands in), from here on (was: "the video ended", an error)
+                self.close()
+                self._stored = self.source._iter_stored()
+                return self[i]
             if not picked:
                 ended = self._at  # before close() starts the count over
                 self.close()
@@ -1877,6 +1924,20 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
                     f"{counted(ended, 'frame')} but its header says {n}"
                 )
             frame = picked[0]
+        else:
+            if i < self._stored_at:  # a new pass from the start
+                self._stored.close()
+                self._stored, self._stored_at = self.source._iter_stored(), 0
+            while self._stored_at <= i:
+                got = next(self._stored, None)
+                if got is None:
+                    ended = self._stored_at
+                    self.close()
+                    raise ValueError(
+                        f"{self.source.name}: frame {i + 1} cannot be decoded: the video ended "
+                        f"after {counted(ended, 'frame')} but its header says {n}"
+                    )
+                frame, self._stored_at = got, self._stored_at + 1
         self._last = (i, frame)
         return frame
 
@@ -1886,6 +1947,9 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
             self._cap.release()
             self._cap = None
         self._at = 0
+        if self._stored is not None:
+            self._stored.close()
+            self._stored, self._stored_at = None, 0
 
     def __enter__(self) -> FrameSequence:
         return self
