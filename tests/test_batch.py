@@ -27,6 +27,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import pytest
 
@@ -2108,6 +2109,7 @@ _CRASHING_SCRIPT = """
 import os, sys
 with open(sys.argv[2], "a") as log:  # one line each time this top level runs
     log.write(f"{os.getpid()}\\n")
+import cv2
 import numpy as np
 from pftrack.batch import Job, TaskResult, run_jobs
 def crash_once(k, marker):
@@ -3494,3 +3496,26 @@ def test_tracks_files_deeper_than_the_folder_are_named(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"^no \.txt file in folder .*empty$"):
         find_track_files([tmp_path / "empty"])
     assert [p.stem for p in find_track_files([data])] == ["a", "b", "c", "d"]
+
+
+def test_render_of_frames_too_wide_for_h264_keeps_the_tracks(tmp_path: Path) -> None:
+    """A user trial: ``batch --render`` of 16400-pixel-wide frames tracked the sequence, then
+    failed on the .mp4 writer (naming a temporary file): the tracks were lost. ``track
+    --render`` refuses such a size before work; here the tracks are written, the video not,
+    and the sequence fails saying why."""
+    folder = tmp_path / "wide" / "img1"
+    folder.mkdir(parents=True)
+    for k in range(1, 4):
+        frame = np.full((32, 16400, 3), 100, np.uint8)
+        frame[8:24, 100 * k : 100 * k + 8] = 250
+        cv2.imwrite(str(folder / f"{k:06d}.png"), frame)
+    out = tmp_path / "out"
+    options = TrackOptions(config=_config(), render=".mp4")
+    entry = track_many(tmp_path / "wide", out, options=options, n_workers=0).entries[0]
+    assert entry["status"] == "failed"
+    assert entry["error"] == (
+        "--render wide.mp4: H.264 takes frames up to 16384 pixels a side (x264), not 16400x32; "
+        "write an .avi (Motion-JPEG) instead (pftrack render can draw wide.txt, which is "
+        "written, into one)"
+    )
+    assert (out / "wide.txt").is_file() and not (out / "wide.mp4").exists()

@@ -223,8 +223,8 @@ def test_demo_does_not_replace_a_users_file_of_one_of_its_names(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """``pftrack demo --out-dir .`` where ``pftrack track ... --out tracks.txt`` had written:
-    was exit 0, the user's tracks replaced by the demo's. A folder holding all four files (an
-    earlier demo's) is still written over; one holding some of them is refused before work."""
+    was exit 0, the user's tracks replaced by the demo's. An earlier demo's folder is still
+    written over (its record gives each file's SHA-256); other files are refused before work."""
     import pftrack.demo
 
     for name in mine:
@@ -237,17 +237,49 @@ def test_demo_does_not_replace_a_users_file_of_one_of_its_names(
     with monkeypatch.context() as m:
         m.setattr(pftrack.demo, "track_frames", refuse)
         assert main(["demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 2
-    listed = ", ".join(mine)
+    listed, it = ", ".join(mine), "it" if len(mine) == 1 else "them"
     assert capsys.readouterr().err == (
-        f"pftrack demo: error: --out-dir {tmp_path} holds {listed}, but not all four files of "
-        "an earlier pftrack demo (tracks.txt, truth.txt, annotated.mp4, trajectories.png): "
-        "not the demo's to replace; move them, or give another --out-dir\n"
+        f"pftrack demo: error: --out-dir {tmp_path} holds {listed}, but no record that pftrack "
+        f"demo wrote {it} (.pftrack-demo.json): not the demo's to replace; move {it}, or give "
+        "another --out-dir\n"
     )
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     out = tmp_path / "d"  # an earlier demo's folder is written again
     for _ in range(2):
         assert main(["-q", "demo", "--out-dir", str(out), "--frames", "5"]) == 0
-    assert len(list(out.iterdir())) == 4
+    names = ["annotated.mp4", "tracks.txt", "trajectories.png", "truth.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [".pftrack-demo.json", *names]
+
+
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+def test_demo_does_not_replace_a_users_file_put_in_place_of_an_earlier_demos(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A user trial: an earlier demo's folder whose tracks.txt the user had replaced by their
+    own was written over (exit 0), as its four names were all there. Now a file of the demo's
+    names is its own only if the demo's record gives its SHA-256."""
+    import pftrack.demo
+
+    assert main(["-q", "demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 0
+    (tmp_path / "tracks.txt").write_text("1,1,10,10,20,40,1,-1,-1,-1\n")  # the user's own
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise AssertionError("work started before the outputs were checked")
+
+    with monkeypatch.context() as m:
+        m.setattr(pftrack.demo, "track_frames", refuse)
+        assert main(["demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack demo: error: --out-dir {tmp_path}: tracks.txt is not the file an earlier "
+            "pftrack demo wrote there (.pftrack-demo.json records another): not the demo's to "
+            "replace; move it, or give another --out-dir\n"
+        )
+        (tmp_path / ".pftrack-demo.json").unlink()  # four files, no record: not known as its
+        assert main(["demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 2
+        assert "but no record that pftrack demo wrote them" in capsys.readouterr().err
+    del before[".pftrack-demo.json"]
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
 def test_demo_help_says_its_folder_is_created_with_its_parents_unlike_a_files_folder(
@@ -314,7 +346,7 @@ def test_demo_interrupted_after_writing_says_its_outputs_were_written(
         f"pftrack demo: interrupted; the outputs were written before it: {out_dir}/tracks.txt, "
         "truth.txt, annotated.mp4, trajectories.png\n"
     )
-    names = ["annotated.mp4", "tracks.txt", "trajectories.png", "truth.txt"]
+    names = [".pftrack-demo.json", "annotated.mp4", "tracks.txt", "trajectories.png", "truth.txt"]
     assert sorted(p.name for p in out_dir.iterdir()) == names
 
 

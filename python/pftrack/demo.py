@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 from pathlib import Path
 
@@ -18,6 +20,11 @@ from pftrack.tracking import TrackerConfig, TrackingRun, track_frames
 
 __all__ = ["run_demo"]
 
+#: The demo's outputs, in the order it names them.
+OUTPUTS = ("tracks.txt", "truth.txt", "annotated.mp4", "trajectories.png")
+#: The hidden file beside them that records what the demo wrote: the SHA-256 of each.
+RECORD = ".pftrack-demo.json"
+
 
 def run_demo(
     out_dir: str | os.PathLike[str], *, seed: int = 0, n_frames: int = 150, particles: int = 100
@@ -25,33 +32,35 @@ def run_demo(
     """Track a synthetic scene, score it, render it, and show trajectory recovery.
 
     Writes ``tracks.txt``, ``truth.txt``, ``annotated.mp4`` and ``trajectories.png`` into
-    `out_dir` (created if missing; removed again, when it was created and is still empty, if
-    the run stops before writing them; refused, before any work, if it holds some of these
-    files but not all four, an earlier demo's) and prints MOTA, IDF1 and the rest against the
+    `out_dir`, with the hidden :data:`RECORD` of their SHA-256 (`out_dir` created if missing;
+    removed again, when it was created and is still empty, if the run stops before writing
+    them; refused, before any work, if it holds a file of these names that is not the one an
+    earlier demo wrote, as its record says) and prints MOTA, IDF1 and the rest against the
     scene's known truth. An interrupt or error after the files are written says they were (the
     command's "interrupted; ..." line).
     """
     from dataclasses import replace
 
     out_dir = check_output_folder(out_dir, "--out-dir")
-    names = ("tracks.txt", "truth.txt", "annotated.mp4", "trajectories.png")
     with made_folder(out_dir, "--out-dir"):
-        for name in names:  # before any work: every output can be written
+        for name in (*OUTPUTS, RECORD):  # before any work: every output can be written
             check_output(out_dir / name, what="--out-dir", within=out_dir)
-        _check_own(out_dir, names)
+        _check_own(out_dir)
         scene = make_scene(n_frames=n_frames, rng=seed)
         base = TrackerConfig()
         config = replace(base, filter=replace(base.filter, n_particles=particles))
         run = track_frames(scene.frames, config=config, rng=seed)
         with staged_outputs() as stage:  # the four files are replaced together, or not at all
-            write_mot(stage(out_dir / "tracks.txt"), run.rows)
-            scene.write_truth(stage(out_dir / "truth.txt"))
-            write_annotated_video(
-                stage(out_dir / "annotated.mp4"), scene.frames, run.rows, scene.fps
-            )
-            plot_trajectories(stage(out_dir / "trajectories.png"), run.rows,
+            staged = {name: stage(out_dir / name) for name in OUTPUTS}
+            write_mot(staged["tracks.txt"], run.rows)
+            scene.write_truth(staged["truth.txt"])
+            write_annotated_video(staged["annotated.mp4"], scene.frames, run.rows, scene.fps)
+            plot_trajectories(staged["trajectories.png"], run.rows,
                               background=scene.background, truth=scene.truth,
                               title="tracks (colour) over truth (grey)")  # fmt: skip
+            record = {name: _sha256(path) for name, path in staged.items()}
+            with stage(out_dir / RECORD).open("w", encoding="utf-8") as fh:  # theirs, a re-run
+                json.dump(record, fh, indent=1)  # may replace them (_check_own)
     wrote = f"{out_dir}/tracks.txt, truth.txt, annotated.mp4, trajectories.png"
     try:  # the scores and the recovery demo take seconds more: a Ctrl-C there keeps the files
         _report(scene, run, seed=seed, n_frames=n_frames, particles=particles)
@@ -64,21 +73,49 @@ def run_demo(
     return 0
 
 
-def _check_own(out_dir: Path, names: tuple[str, ...]) -> None:
+def _sha256(path: Path) -> str:
+    """The SHA-256 of file `path`, in hex."""
+    digest = hashlib.sha256()
+    with path.open("rb") as fh:
+        while chunk := fh.read(1 << 20):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def _check_own(out_dir: Path) -> None:
     """Refuse to replace files of the demo's names in `out_dir` that no earlier demo wrote.
 
-    An earlier demo leaves all four (they are renamed into place together); some of them alone
-    are the user's: ``pftrack demo --out-dir .`` replaced the ``tracks.txt`` that ``pftrack
-    track ... --out tracks.txt`` had written there (a user trial; ``pftrack batch`` likewise
-    replaces only its own files).
+    A file of one of :data:`OUTPUTS`' names is the demo's only when the :data:`RECORD` an
+    earlier demo wrote beside it gives its SHA-256. Was: by names alone, some of them were the
+    user's (``pftrack demo --out-dir .`` replaced the ``tracks.txt`` of ``pftrack track ...
+    --out tracks.txt``, a user trial), all four an earlier demo's, so an earlier demo's file
+    the user had replaced by one of their own (their ``tracks.txt``) was written over.
     """
-    there = [name for name in names if os.path.lexists(out_dir / name)]
-    if there and len(there) < len(names):
+    there = [name for name in OUTPUTS if os.path.lexists(out_dir / name)]
+    if not there:
+        return
+    try:
+        record = json.loads((out_dir / RECORD).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        record = None
+    if not isinstance(record, dict):
+        it = "it" if len(there) == 1 else "them"
         raise ValueError(
-            f"--out-dir {out_dir} holds {', '.join(there)}, but not all four files of an "
-            f"earlier pftrack demo ({', '.join(names)}): not the demo's to replace; move them, "
-            "or give another --out-dir"
+            f"--out-dir {out_dir} holds {', '.join(there)}, but no record that pftrack demo "
+            f"wrote {it} ({RECORD}): not the demo's to replace; move {it}, or give another "
+            "--out-dir"
         )
+    for name in there:
+        try:
+            same = (out_dir / name).is_file() and _sha256(out_dir / name) == record.get(name)
+        except OSError:
+            same = False
+        if not same:
+            raise ValueError(
+                f"--out-dir {out_dir}: {name} is not the file an earlier pftrack demo wrote "
+                f"there ({RECORD} records another): not the demo's to replace; move it, or "
+                "give another --out-dir"
+            )
 
 
 def _report(scene: Scene, run: TrackingRun, *, seed: int, n_frames: int, particles: int) -> None:

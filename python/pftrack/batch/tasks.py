@@ -136,8 +136,10 @@ class TaskResult:
         ``smooth`` copy, :func:`~pftrack.io.mot.write_mot`'s `exact`); None: 2 decimals.
     error, traceback : str or None
         Set when a step after the work failed (scoring the tracks against a ``gt.txt`` that
-        cannot be read): the outputs are still written, and the task counts as failed with
-        this one-line error and traceback (its sidecar too, so a re-run does it again).
+        cannot be read), or the video of ``--render`` cannot be written (frames wider or
+        higher than its encoder takes, known before the work: no video, and no traceback):
+        the other outputs are still written, and the task counts as failed with this one-line
+        error and traceback (its sidecar too, so a re-run does it again).
 
     Raises
     ------
@@ -365,6 +367,15 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     # for ground truth of twice the frames' size, a user trial)
     unsized = seq.image_width is None and seq.image_height is None
     gt_scale = det_scale if unsized and det is not None else auto_scale
+    render, error = options.render, None
+    if render is not None:  # before the work, as track --render: frames its encoder refuses
+        from pftrack.io.video_writer import check_frame_size
+
+        try:  # are no reason to lose the tracks (was: refused after tracking, the tracks lost)
+            check_frame_size(f"--render {seq.name}{render}", render, frames.width, frames.height)
+        except ValueError as exc:
+            render = None
+            error = f"{exc} (pftrack render can draw {seq.name}.txt, which is written, into one)"
     run = track_path(
         frames,
         detections=det,
@@ -382,16 +393,16 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     # NAME.txt's values, what pftrack render and eval read: only for a video or a score
     written = as_written(rows) if options.render is not None or seq.gt is not None else rows
     files: dict[str, bytes] = {}
-    if options.render is not None:
+    if render is not None:
         from pftrack.render import write_annotated_video
 
         with tempfile.TemporaryDirectory(prefix="pftrack-render-") as tmp:
-            target = Path(tmp) / f"{seq.name}{options.render}"
+            target = Path(tmp) / f"{seq.name}{render}"
             write_annotated_video(
                 target, _checked(FrameSource(seq.frames), stop), written, frames.fps
             )
-            files[options.render] = target.read_bytes()
-    metrics = error = trace = None
+            files[render] = target.read_bytes()
+    metrics = trace = None
     if seq.gt is not None:  # last: a ground truth that cannot be scored loses no tracks
         try:
             if frames.gap is not None:  # frame k is the k-th image: the names may be gt's
@@ -414,7 +425,8 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                 num_frames=None if seq.seqinfo is None else read_seqinfo(seq.seqinfo).length,
             )
         except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed
-            error = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"
+            scoring = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"
+            error = scoring if error is None else f"{error}; {scoring}"
             trace = traceback.format_exc()
     info: dict[str, Any] = {
         "source": str(seq.frames),

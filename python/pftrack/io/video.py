@@ -69,6 +69,8 @@ __all__ = [
 ]
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
+#: The image formats of :data:`IMAGE_SUFFIXES` that may hold 16-bit pixels (PNG, TIFF).
+DEEP_SUFFIXES = (".png", ".tif", ".tiff")
 #: Extensions taken as video files when a folder is looked into (those of ``pftrack batch``).
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".webm", ".wmv")
 #: Containers whose header holds the number of frames (AVI's frame total, MP4's sample table):
@@ -435,6 +437,67 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     return None
 
 
+#: The RIFF forms and lists whose chunks :func:`_avi_break` walks into: the file's RIFF lists
+#: (``AVIX``: an OpenDML file's later ones), the frames' ``movi`` and their ``rec`` groups.
+AVI_LISTS = (b"AVI ", b"AVIX", b"movi", b"rec ")
+
+
+def _printable_id(chunk_id: bytes) -> bool:
+    """Whether `chunk_id` can be a RIFF chunk's id: four printable ASCII characters."""
+    return len(chunk_id) == 4 and all(0x20 <= c <= 0x7E for c in chunk_id)
+
+
+def _avi_break(path: Path) -> tuple[int, int] | None:
+    """Where the chunks of AVI file `path` break off inside it: (frames before it, its byte).
+
+    FFmpeg's AVI demuxer reads on past damage in the middle of a file (bytes overwritten or
+    cut out) from the next chunk it finds, and numbers the frames it reads by counting them:
+    every frame after the damage takes the number of an earlier one, silently (a user trial:
+    frames 35.. read as 32.., tracks and ground truth three frames apart). The chunks are
+    walked from the start, 8 bytes read for each (no decoding: a bounded cost), counting the
+    frames (``##dc``, ``##db`` of the first stream that has them) before a chunk that is not
+    one (an id that is not four printable characters, or a size past the list holding it).
+
+    Returns
+    -------
+    tuple of (int, int) or None
+        The frames before the break and its offset in the file; None when the chunks do not
+        break (a file that ends early, its last chunk cut, keeps its frames' numbers) or
+        `path` is not a RIFF file.
+    """
+    try:
+        with path.open("rb") as fh:
+            size = os.fstat(fh.fileno()).st_size
+            stream: bytes | None = None
+            frames = 0
+            if fh.read(4) != b"RIFF":
+                return None
+            # (start, declared end) of the lists still to walk: the file (whose chunks are
+            # RIFF lists, ending where the file ends), then RIFF, movi and rec lists; a list
+            # declared past the file's end is of a file that ends early, not broken
+            todo = [(0, 1 << 63)]
+            while todo:
+                pos, end = todo.pop()
+                while pos + 8 <= min(end, size):
+                    fh.seek(pos)
+                    head = fh.read(12)
+                    chunk_id, length = head[:4], int.from_bytes(head[4:8], "little")
+                    stop = pos + 8 + length + (length & 1)
+                    if not _printable_id(chunk_id) or (stop > end and end <= size):
+                        return frames, pos
+                    if chunk_id in (b"RIFF", b"LIST") and head[8:12] in AVI_LISTS:
+                        todo.append((stop, end))  # the rest of this list, after the inner one
+                        pos, end = pos + 12, stop
+                        continue
+                    if chunk_id[2:] in (b"dc", b"db") and stream in (None, chunk_id[:2]):
+                        stream = chunk_id[:2]
+                        frames += 1
+                    pos = stop
+    except OSError:
+        return None
+    return None
+
+
 #: Reads tried after a frame inside a video fails to decode, before the video counts as ended.
 RESUME_TRIES = 16
 
@@ -460,6 +523,14 @@ def _resume(
             index = _stamp_index(cap, rate) - start
             return (index, frame) if at <= index < max(n_frames, at + 1) else None
     return None
+
+
+class _DamagedInside(Exception):  # a signal between readers, never raised out of them
+    """A pass of grabs stopped at a frame that fails to decode, with frames after it that do.
+
+    :meth:`FrameSource._read_at` raises it; its callers read such a file as iterating reads
+    it instead (:meth:`FrameSource._iter_stored`: the frame before stands in).
+    """
 
 
 def _frame_list(indexes: list[int]) -> str:
@@ -1143,7 +1214,8 @@ class FrameSource:
         If `source` is not a path, a string or an int (a bool is refused).
     ValueError
         If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
-        no frame; if two images of a folder have one number; or if a MOTChallenge sequence's
+        no frame; if two images of a folder have one number, or another size than the first,
+        or are 16-bit where the first is 8-bit (when read); or if a MOTChallenge sequence's
         image folder is named by number and one is missing (a hole in the numbering, numbers
         that do not start at 1 or a count other than ``seqLength``).
 
@@ -1154,7 +1226,8 @@ class FrameSource:
         other than its sequence's ``seqLength`` (counted as read: no pass of its own). At the
         first image read, when a folder's 16-bit images are read at :attr:`bits`; once, when
         an image it was not decided from is brighter than that depth holds (its brighter
-        pixels clipped to white).
+        pixels clipped to white). When an ``.avi`` is opened whose chunks break off inside it
+        (:func:`_avi_break`): the frames after the break may carry earlier frames' numbers.
 
     Notes
     -----
@@ -1185,12 +1258,14 @@ class FrameSource:
         self.bits: int | None = None
         self.gap: str | None = None  # an image folder's names skip a number
         self._depth_note: str | None = None  # the warning saying so, given at the first read
+        self._eight_bit = False  # the folder's first image is 8-bit: a 16-bit one is refused
         self._depth_from = ""  # the images `bits` was decided from, for the clipping warning
         self._clipped = False  # a later 16-bit image went past `bits`: said once
         self._cut_said = False  # a JPEG without its end marker: said once
         self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_lost = False  # frames inside the video could not be decoded
+        self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
         self._reading = False  # a thread is inside the live capture's read()
         self._replay: list[NDArray[np.uint8]] = []
@@ -1221,6 +1296,18 @@ class FrameSource:
                 first, header_fps, count = self._open_live()
             else:
                 first, header_fps, count = self._probe_file(self.path)
+                self._broken = _avi_break(self.path)
+        if self._broken is not None:  # before any work: said once for each source opened
+            frames, offset = self._broken
+            warnings.warn(
+                f"{self.name}: damaged inside: its AVI chunks break off after frame {frames} "
+                f"(byte {offset}), and FFmpeg reads on from the next chunk it finds, numbering "
+                f"the frames it reads by counting them: the frames after frame {frames} may "
+                "carry the numbers of earlier ones (tracks, detections and ground truth apart "
+                "there)",
+                UserWarning,
+                stacklevel=2,
+            )
         self.n_frames = max(count, 0)
         self.count_known = self.n_frames > 0 and (
             self.path is not None
@@ -1310,6 +1397,7 @@ class FrameSource:
         if first is None:
             raise ValueError(_unreadable(path, unsaid))
         if first.dtype == np.uint8:  # the pixels read_image gives
+            self._eight_bit = True
             return first
         top = int(first.max()) if first.dtype == np.uint16 else 65535
         brightest = path
@@ -1409,14 +1497,27 @@ class FrameSource:
     def _read_image(self, path: Path) -> NDArray[np.uint8]:
         """One image of a folder, resized; ValueError if unreadable or not the first's size.
 
-        At :attr:`bits` when the folder's images set it (the first read says so, once).
+        At :attr:`bits` when the folder's images set it (the first read says so, once). A 16-bit
+        PNG or TIFF in a folder whose first image is 8-bit is refused, naming it (was: read as
+        OpenCV reads it, value / 256: 10- or 12-bit data almost black, without a word).
         """
         if self._depth_note is not None:
             note, self._depth_note = self._depth_note, None
             warnings.warn(note, UserWarning, stacklevel=3)
         img: NDArray[Any] | None
         notes: list[str] = []  # what its decoder prints on stderr (libpng, libjpeg)
-        if self.bits is None:
+        if self._eight_bit and path.suffix.lower() in DEEP_SUFFIXES:
+            img = read_image_depth(path, notes=notes)  # an 8-bit image: read_image's pixels
+            if img is not None and img.dtype == np.uint16:
+                first = self._images[0].name if self._images else "the first image"
+                raise ValueError(
+                    f"image {path} is 16-bit but {first}, the folder's first, is 8-bit: a "
+                    "folder's images must have one depth (its 16-bit images are read at the "
+                    "depth their values show only when the first is 16-bit); convert them to one"
+                )
+            if img is not None and img.dtype != np.uint8:  # a float TIFF: refused below
+                img = read_image(path, notes=notes)
+        elif self.bits is None:
             img = read_image(path, notes=notes)
         else:
             img = read_image_depth(path, notes=notes)
@@ -1507,16 +1608,48 @@ class FrameSource:
             for i in (i for i in wanted if i < len(self._images)):
                 out.append(self._read_image(self._images[i]))
             return out
+        try:
+            return self._file_frames_at(wanted, split)
+        except _DamagedInside:
+            # a frame inside the video failed to decode, which ends a pass of grabs: read as
+            # iterating reads (the frame before stands in, the later frames keep their
+            # numbers), not fewer frames (was: the spread bootstrap's frames all before it)
+            return self._iterated_at(wanted)
+
+    def _iterated_at(self, wanted: list[int]) -> list[NDArray[np.uint8]]:
+        """The frames at `wanted` (increasing) as iterating the file gives them, stand-ins too."""
+        keep, out = set(wanted), []
+        frames = self._iter_stored()
+        try:
+            for i, frame in enumerate(frames):
+                if i in keep:
+                    out.append(frame)
+                if i >= wanted[-1]:
+                    break
+        finally:
+            frames.close()
+        return out
+
+    def _file_frames_at(self, wanted: list[int], split: bool) -> list[NDArray[np.uint8]]:
+        """:meth:`frames_at` of a video file, in one pass of grabs (two with `split`)."""
         cap = _file_capture(str(self.path))
         try:
             middle = wanted[len(wanted) // 2]
             if not split or len(wanted) < 4 or middle < 2:
                 return self._read_at(cap, 0, wanted)[0]
             first = [i for i in wanted if i <= middle + 1]
+            # an interrupt (Ctrl-C; SIGTERM, raised here by pftrack.cli._signals) stops the
+            # second half at its next frame: the pool's join waited for it to read its whole
+            # half (minutes of a long video), SIGTERM ignored meanwhile
+            halt = threading.Event()
             with ThreadPoolExecutor(1, thread_name_prefix="pftrack-bootstrap") as pool:
-                tail = pool.submit(self._read_from_seek, middle, wanted)
-                head, check, at = self._read_at(cap, 0, first, middle)
-                second = tail.result()
+                tail = pool.submit(self._read_from_seek, middle, wanted, halt)
+                try:
+                    head, check, at = self._read_at(cap, 0, first, middle)
+                    second = tail.result()
+                except BaseException:
+                    halt.set()
+                    raise
             if second is not None and len(check) == 2 and _same_frames(check, second[1]):
                 return head[: sum(i < middle for i in first)] + second[0]
             rest, _, _ = self._read_at(cap, at, [i for i in wanted if i > middle + 1])
@@ -1525,20 +1658,26 @@ class FrameSource:
             cap.release()
 
     def _read_at(
-        self, cap: cv2.VideoCapture, start: int, keep: list[int], check: int | None = None
+        self,
+        cap: cv2.VideoCapture,
+        start: int,
+        keep: list[int],
+        check: int | None = None,
+        halt: threading.Event | None = None,
     ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]], int]:
         """Read on from frame `start` (where `cap` stands) through the last of `keep`.
 
         Returns the frames at `keep`, resized; with `check`, the raw frames `check` and
         `check + 1` with their time stamps (the pass then goes on to them); and the index of
-        the frame `cap` stands at afterwards.
+        the frame `cap` stands at afterwards. Stops early, before its next frame, once
+        :meth:`stop` is called or `halt` is set.
         """
         picked: list[NDArray[np.uint8]] = []
         seen: list[tuple[NDArray[Any], float]] = []
         stop = max(keep[-1] if keep else -1, -1 if check is None else check + 1) + 1
         wanted = set(keep)
         i = start
-        while i < stop and not self.stopped:
+        while i < stop and not self.stopped and not (halt is not None and halt.is_set()):
             compare = check is not None and check <= i <= check + 1
             if i in wanted or compare:
                 ok, frame = cap.read()
@@ -1551,20 +1690,26 @@ class FrameSource:
             elif not cap.grab():
                 break
             i += 1
+        else:
+            return picked, seen, i
+        if i < self.counted_frames and any(cap.grab() for _ in range(RESUME_TRIES)):
+            raise _DamagedInside(i)  # frames decode after it: not the video's end
         return picked, seen, i
 
     def _read_from_seek(
-        self, middle: int, wanted: list[int]
+        self, middle: int, wanted: list[int], halt: threading.Event | None = None
     ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]]] | None:
         """The second half of a split pass: frames from `middle` on, after a seek to it.
 
-        None when the file cannot seek (or OpenCV fails on it): the first half reads on.
+        None when the file cannot seek (or OpenCV fails on it): the first half reads on. Ends
+        at its next frame once `halt` is set (the first half was interrupted).
         """
         cap = _file_capture(str(self.path))
         try:
             if not cap.set(cv2.CAP_PROP_POS_FRAMES, middle):
                 return None
-            picked, seen, _ = self._read_at(cap, middle, [i for i in wanted if i >= middle], middle)
+            keep = [i for i in wanted if i >= middle]
+            picked, seen, _ = self._read_at(cap, middle, keep, middle, halt)
             return picked, seen
         except cv2.error:
             return None
@@ -1616,9 +1761,12 @@ class FrameSource:
             cap.release()
         if lost and not self._warned_lost:
             self._warned_lost = True
+            kept = (  # not where FFmpeg numbers the frames after the break by counting them
+                ", so the later frames keep their numbers" if self._broken is None else ""
+            )
             warnings.warn(
                 f"{self.path}: {_frame_list(lost)} could not be decoded (a damaged file?): the "
-                "frame before stands in for each, so the later frames keep their numbers",
+                f"frame before stands in for each{kept}",
                 UserWarning,
                 stacklevel=2,
             )
@@ -1733,6 +1881,10 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
         self._cap: Any = None
         self._at = 0  # the index of the frame self._cap reads next
         self._last: tuple[int, NDArray[np.uint8]] | None = None
+        # after a frame inside the video failed to decode (a pass of grabs ends there): its
+        # frames as iterating reads them, stand-ins too, and the index of the next one
+        self._stored: Generator[NDArray[np.uint8], None, None] | None = None
+        self._stored_at = 0
 
     def __len__(self) -> int:
         return self.source.n_frames
@@ -1751,12 +1903,19 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
             return self._last[1]
         if self.source._images is not None:
             frame = self.source._read_image(self.source._images[i])
-        else:
+        elif self._stored is None:
             if self._cap is None or i < self._at:  # a new pass from the start
                 self.close()
                 self._cap = _file_capture(str(self.source.path))
                 self._at = 0
-            picked, _, self._at = self.source._read_at(self._cap, self._at, [i])
+            try:
+                picked, _, self._at = self.source._read_at(self._cap, self._at, [i])
+            except _DamagedInside:
+                # a frame inside the video failed to decode: read on as iterating reads (the
+                # frame before stands in), from here on (was: "the video ended", an error)
+                self.close()
+                self._stored = self.source._iter_stored()
+                return self[i]
             if not picked:
                 ended = self._at  # before close() starts the count over
                 self.close()
@@ -1765,6 +1924,20 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
                     f"{counted(ended, 'frame')} but its header says {n}"
                 )
             frame = picked[0]
+        else:
+            if i < self._stored_at:  # a new pass from the start
+                self._stored.close()
+                self._stored, self._stored_at = self.source._iter_stored(), 0
+            while self._stored_at <= i:
+                got = next(self._stored, None)
+                if got is None:
+                    ended = self._stored_at
+                    self.close()
+                    raise ValueError(
+                        f"{self.source.name}: frame {i + 1} cannot be decoded: the video ended "
+                        f"after {counted(ended, 'frame')} but its header says {n}"
+                    )
+                frame, self._stored_at = got, self._stored_at + 1
         self._last = (i, frame)
         return frame
 
@@ -1774,6 +1947,9 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
             self._cap.release()
             self._cap = None
         self._at = 0
+        if self._stored is not None:
+            self._stored.close()
+            self._stored, self._stored_at = None, 0
 
     def __enter__(self) -> FrameSequence:
         return self
