@@ -156,15 +156,17 @@ def _snapshot(folder: Path) -> dict[str, bytes | None]:
     return {p.name: (p.read_bytes() if p.is_file() else None) for p in folder.iterdir()}
 
 
+def _no_work(*args: object, **kwargs: object) -> None:
+    """Stands in for the work of a command whose outputs must be refused before it starts."""
+    raise AssertionError("work started before the outputs were checked")
+
+
 @pytest.fixture
 def no_work(monkeypatch: pytest.MonkeyPatch) -> None:
     """Tracking fails the test: the command must refuse before any work."""
     import pftrack.tracking as tracking
 
-    def refuse(*args: Any, **kwargs: Any) -> Any:
-        raise AssertionError("work started before the outputs were checked")
-
-    monkeypatch.setattr(tracking, "track_frames", refuse)
+    monkeypatch.setattr(tracking, "track_frames", _no_work)
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -231,11 +233,8 @@ def test_demo_does_not_replace_a_users_file_of_one_of_its_names(
         (tmp_path / name).write_text("the user's own\n")
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
 
-    def refuse(*args: Any, **kwargs: Any) -> Any:
-        raise AssertionError("work started before the outputs were checked")
-
     with monkeypatch.context() as m:
-        m.setattr(pftrack.demo, "track_frames", refuse)
+        m.setattr(pftrack.demo, "track_frames", _no_work)
         assert main(["demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 2
     listed, it = ", ".join(mine), "it" if len(mine) == 1 else "them"
     assert capsys.readouterr().err == (
@@ -264,11 +263,8 @@ def test_demo_does_not_replace_a_users_file_put_in_place_of_an_earlier_demos(
     (tmp_path / "tracks.txt").write_text("1,1,10,10,20,40,1,-1,-1,-1\n")  # the user's own
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
 
-    def refuse(*args: Any, **kwargs: Any) -> Any:
-        raise AssertionError("work started before the outputs were checked")
-
     with monkeypatch.context() as m:
-        m.setattr(pftrack.demo, "track_frames", refuse)
+        m.setattr(pftrack.demo, "track_frames", _no_work)
         assert main(["demo", "--out-dir", str(tmp_path), "--frames", "5"]) == 2
         assert capsys.readouterr().err == (
             f"pftrack demo: error: --out-dir {tmp_path}: tracks.txt is not the file an earlier "
