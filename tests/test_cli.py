@@ -836,6 +836,23 @@ def test_the_command_on_a_full_device_or_a_closed_pipe_prints_no_traceback(
     assert (closed.returncode, closed.stderr) == (1, "")
 
 
+def test_track_with_stderr_closed_writes_its_tracks(video: Path, tmp_path: Path) -> None:
+    """``pftrack track ... 2>&-`` (a daemon's or cron's closed stderr): the tracks as with one.
+
+    Was: exit status 1 and no file (the progress bar asked the missing stderr whether it is a
+    terminal; the error went to the closed stderr too)."""
+    import subprocess
+    import sys
+
+    closed, open_ = tmp_path / "closed.txt", tmp_path / "open.txt"
+    argv = [sys.executable, "-m", "pftrack", "track", str(video), "--particles", "30"]
+    run = subprocess.run(["sh", "-c", 'exec "$@" 2>&-', "sh", *argv, "--out", str(closed)],
+                         stdout=subprocess.DEVNULL, check=False, timeout=300)  # fmt: skip
+    assert run.returncode == 0
+    assert main(["-q", "track", str(video), "--particles", "30", "--out", str(open_)]) == 0
+    assert closed.read_bytes() == open_.read_bytes() != b""
+
+
 def _into_full_and_closed(argv: list[str]) -> tuple[Any, Any]:
     """The process `argv` run with stdout on ``/dev/full``, then on a pipe closed before it
     writes (as ``| head`` leaves it): both ``subprocess.run`` results, stderr as text."""

@@ -34,6 +34,18 @@ def test_pyproject_names_the_license_file() -> None:
     assert text.startswith("MIT License") and "the pftrack developers" in text
 
 
+def test_pyproject_classifies_the_package() -> None:
+    # was: no classifiers (pip show and an index showed nothing of its language or types)
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+    project = tomllib.loads((REPO / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    classifiers = project["classifiers"]
+    assert "Programming Language :: Python :: 3" in classifiers
+    assert "Programming Language :: C++" in classifiers
+    # the wheel ships py.typed and _core.pyi
+    assert (REPO / "python" / "pftrack" / "py.typed").exists() == ("Typing :: Typed" in classifiers)
+    assert not [c for c in classifiers if c.startswith("License ::")]  # PEP 639: the expression
+
+
 def test_the_sdist_holds_the_allowed_files_only(tmp_path: Path) -> None:
     pytest.importorskip("scikit_build_core")
     tree = tmp_path / "tree"

@@ -59,6 +59,14 @@ def test_total_defaults_to_the_length(monkeypatch: pytest.MonkeyPatch) -> None:
     assert "3it" in err.getvalue()  # unknown total: the count alone
 
 
+def test_no_stderr_draws_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    # a process started with stderr closed (2>&-) has sys.stderr None: was AttributeError on
+    # its isatty, so `pftrack track ... 2>&-` exited 1 without writing its tracks
+    monkeypatch.setattr(sys, "stderr", None)
+    assert not _progress.enabled()
+    assert list(progress(range(5), desc="work")) == list(range(5))
+
+
 def test_bar_moved_by_hand(monkeypatch: pytest.MonkeyPatch) -> None:
     err = io.StringIO()
     monkeypatch.setattr(sys, "stderr", err)

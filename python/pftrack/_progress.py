@@ -34,7 +34,10 @@ def enabled(enable: bool | None = None) -> bool:
     if _quiet:
         return False
     if enable is None:
-        return sys.stderr.isatty()
+        try:  # no stderr (started with it closed, 2>&-): no bar, no crash
+            return sys.stderr.isatty()
+        except (AttributeError, OSError, ValueError):
+            return False
     return enable
 
 
