@@ -14,6 +14,7 @@ import pytest
         ("soak", "(default: 10000)"),
         ("given_particles", "(default: 25)"),
         ("python_share", "--rounds ROUNDS rounds per case (default 7)"),
+        ("peer_gap_filling", "--max-gap MAX_GAP most missing frames filled"),
     ],
 )
 def test_help_names_the_module_and_shows_defaults(
