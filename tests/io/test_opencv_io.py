@@ -235,3 +235,50 @@ def test_reading_an_image_leaves_no_unclosed_file_at_exit(tmp_path: Path) -> Non
         check=True,
     )
     assert "ResourceWarning" not in run.stderr, run.stderr
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
+def test_a_fork_while_another_thread_reads_an_image_leaves_the_child_free(tmp_path: Path) -> None:
+    # was: a fork (multiprocessing's default on Linux before Python 3.14) while a reading thread
+    # held file descriptor 2 gave the child the lock taken for good, its first image read with
+    # notes (FrameSource of an image folder) hung, and its stderr went to the parent's file
+    import threading
+    import time
+
+    from pftrack.io import opencv_io
+
+    image = write_image(tmp_path / "1.png", np.full((8, 8, 3), 90, np.uint8))
+    stderr_before = os.fstat(2)
+    inside, leave = threading.Event(), threading.Event()
+
+    def reader() -> None:  # a thread of the parent, caught half-way through a read
+        with opencv_io._decoder_notes([]):
+            inside.set()
+            leave.wait(10)
+
+    thread = threading.Thread(target=reader)
+    thread.start()
+    assert inside.wait(10)
+    threading.Timer(0.3, leave.set).start()  # a read ends soon: the fork may wait for it
+    pid = os.fork()
+    if pid == 0:  # the child: read an image, stderr the parent's own
+        code = 1
+        try:
+            got = read_image(image, notes=[])
+            same = os.fstat(2)
+            code = 0 if got is not None and same.st_ino == stderr_before.st_ino else 3
+        finally:
+            os._exit(code)
+    leave.set()
+    thread.join(10)
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            break
+        time.sleep(0.05)
+    else:
+        os.kill(pid, 9)
+        os.waitpid(pid, 0)
+        pytest.fail("the forked child hung reading an image")
+    assert os.waitstatus_to_exitcode(status) == 0

@@ -157,6 +157,14 @@ _DECODER_LINE = re.compile(
 )
 _HELD = threading.Lock()  # one thread at a time holds file descriptor 2
 _HOLDERS: dict[int, Any] = {}  # process id -> the temporary file stderr is held in
+# A fork waits for a read holding file descriptor 2 to end (one image: milliseconds), so that
+# the child starts with its stderr the parent's own and the lock free. Was: a fork while a
+# thread read an image folder gave the child the lock taken for good (its first image read
+# hung) and its stderr the parent's temporary file.
+if hasattr(os, "register_at_fork"):  # not on Windows
+    os.register_at_fork(
+        before=_HELD.acquire, after_in_parent=_HELD.release, after_in_child=_HELD.release
+    )
 
 
 def _holder() -> Any:

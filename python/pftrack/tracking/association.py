@@ -113,13 +113,20 @@ def associate(
 
 #: Padded cost matrices made so far, by (tracks, detections, unmatched cost): a frame's
 #: matrix is a copy of its template with the pairs' costs written in (one NumPy call instead
-#: of seven; a run sees a few shapes, the number of objects in view).
+#: of seven; a run sees a few shapes, the number of objects in view). Shared by every tracker
+#: of the process, at most :data:`_PADDING_KEPT` of at most :data:`_PADDING_LARGEST` bytes each
+#: (16 MB in all).
 _PADDING: dict[tuple[int, int, float], F64] = {}
 _PADDING_KEPT = 256
+#: The largest matrix kept (64 KiB: tracks + detections up to 90). A larger one is made anew
+#: each frame, at little cost beside its assignment (a 400 x 400 matrix: 117 us made, 29 us
+#: copied, against milliseconds for the assignment); was: every shape kept, and a service
+#: tracking crowds of 150-180 people held 213 MB of them (32 MB for each 1000 + 1000 shape).
+_PADDING_LARGEST = 2**16
 
 
 def _padding(nt: int, nd: int, tau: float) -> F64:
-    """The padded matrix of :func:`associate` with every pair forbidden (read-only, shared).
+    """The padded matrix of :func:`associate` with every pair forbidden (read-only, kept if small).
 
     ``[[pairs, tau on the diagonal], [tau on the diagonal, 0]]``: leaving a track or a
     detection unmatched costs `tau`, two padding entries nothing.
@@ -133,9 +140,10 @@ def _padding(nt: int, nd: int, tau: float) -> F64:
         padded[nt + k[:nd], k[:nd]] = tau  # the diagonal of padded[nt:, :nd]
         padded[nt:, nd:] = 0.0
         padded.flags.writeable = False
-        if len(_PADDING) >= _PADDING_KEPT:  # a long run of varied crowds: start afresh
-            _PADDING.clear()
-        _PADDING[key] = padded
+        if padded.nbytes <= _PADDING_LARGEST:
+            if len(_PADDING) >= _PADDING_KEPT:  # a long run of varied crowds: start afresh
+                _PADDING.clear()
+            _PADDING[key] = padded
     return padded
 
 

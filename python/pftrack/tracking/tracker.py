@@ -19,6 +19,7 @@ import dataclasses
 import inspect
 import itertools
 import math
+import threading
 from collections import deque
 from collections.abc import Iterable, Sequence
 from typing import Any
@@ -34,6 +35,7 @@ from pftrack.boxes import _iou_matrix, _to_cxcywh
 from pftrack.detection import check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
+from pftrack.particle_filter.filter import _in_use
 from pftrack.tracking.association import associate, covers_another
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
@@ -108,6 +110,13 @@ class MultiObjectTracker:
         Any object with ``detect(frame) -> Detections`` (see :mod:`pftrack.detection`); by
         default the one named by ``config.detector``, created on first use.
 
+    Notes
+    -----
+    One tracker is one run, stepped by one thread at a time: while a thread is inside
+    :meth:`update` or :meth:`prime`, another thread's ``update``, ``prime``, ``copy.deepcopy``
+    or pickle of the same tracker raises RuntimeError (``MultiObjectTracker.update: this
+    MultiObjectTracker is in use by another thread ...``). Different trackers run in parallel.
+
     Attributes
     ----------
     pixel_scale : float
@@ -139,6 +148,7 @@ class MultiObjectTracker:
                 f"MultiObjectTracker: config must be a TrackerConfig, got {type(config).__name__}"
             )
         self.config = config if config is not None else TrackerConfig()
+        self._busy = threading.Lock()  # held by update and prime (see _take)
         self._rng = generator(rng, "MultiObjectTracker: rng")
         self._ids = itertools.count(1)
         self._detector = detector
@@ -180,6 +190,30 @@ class MultiObjectTracker:
         self._speeds = RollingMedian(MAX_SPEED_SAMPLES)
         self._gain = 1.0
 
+    def _take(self, method: str) -> None:
+        """Hold the tracker for one call, without waiting (RuntimeError naming `method`).
+
+        Two threads' frames would otherwise go in one after the other's, until an object
+        inside (a colour filter, the background model) refused the second thread halfway
+        through a frame, the run torn.
+        """
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, f"MultiObjectTracker.{method}")
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The run's state for pickle and ``copy`` (not while another thread is inside)."""
+        self._take("__getstate__")
+        try:
+            state = self.__dict__.copy()
+        finally:
+            self._busy.release()
+        del state["_busy"]  # a lock is not copied or pickled: a copy is free
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._busy = threading.Lock()  # a checkpoint pickled before the lock had none
+
     @property
     def frame_shape(self) -> tuple[int, ...]:
         """The run's frame shape ``(H, W, 3)`` (of its first frame; empty before it)."""
@@ -194,6 +228,14 @@ class MultiObjectTracker:
         arrays of an iterable other than a list, a tuple or an array are copied as they come
         (a generator may refill one buffer with each frame).
         """
+        self._take("prime")
+        try:
+            self._prime(frames)
+        finally:
+            self._busy.release()
+
+    def _prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
+        """:meth:`prime`, holding the tracker."""
         detector = self._ensure_detector()
         if hasattr(detector, "prime"):
             if isinstance(frames, (list, tuple, np.ndarray)):
@@ -448,6 +490,9 @@ class MultiObjectTracker:
         TypeError
             `detections` is a uint8 image (``update(dets, frame)``, :class:`Tracker`'s order:
             the message says the arguments look swapped), or `frame` is not a uint8 array.
+        RuntimeError
+            Another thread is inside this tracker's ``update`` or ``prime`` (one thread at a
+            time; nothing of this call went in).
 
         Warns
         -----
@@ -456,9 +501,13 @@ class MultiObjectTracker:
             the frame is taken whole: a warning made an error (``python -W error``) leaves the
             tracker at the end of this frame, ready for the next one.
         """
-        with Held() as held:
-            reports = self._update(frame, detections, classes, checked)
-        held.release(2 + self.caller_depth)  # update's caller, or the wrapper's
+        self._take("update")
+        try:
+            with Held() as held:
+                reports = self._update(frame, detections, classes, checked)
+            held.release(2 + self.caller_depth)  # update's caller, or the wrapper's
+        finally:
+            self._busy.release()
         return reports
 
     def _update(self, frame: ArrayLike, detections: ArrayLike | None, classes: ArrayLike | None,
