@@ -66,8 +66,10 @@ class MotMetrics:
         Identity switches: a ground-truth object matched to a different result id than at its
         last match.
     num_fragmentations : int
-        Times a ground-truth trajectory goes from tracked to untracked, counted between its first
-        and last tracked frame.
+        Tracked runs of an object after its first (TrackEval's Frag), a run being its matches
+        in consecutive scored frames (frames holding both ground truth and results): a scored
+        frame without the object ends one, as a miss does (py-motmetrics counts only the misses
+        between its first and last match).
     mostly_tracked, partially_tracked, mostly_lost : int
         Objects tracked in more than 80 %, in [20 %, 80 %], and in under 20 % of their frames
         (TrackEval's rule; py-motmetrics counts exactly 80 % as mostly tracked).
