@@ -439,6 +439,20 @@ def test_a_frame_without_the_object_ends_its_run_as_in_trackeval(tmp_path):
     assert evaluate_mot(gt, res).num_fragmentations == ref["s"]["Frag"] == 0
 
 
+def test_below_iou_half_clear_takes_the_largest_iou_sum_as_trackeval(tmp_path):
+    """At IoU 0.3 one match at IoU 1 beats two at 1/3 in TrackEval's CLEAR (and pftrack's);
+    py-motmetrics takes the two (docs/eval.md, its fifth difference)."""
+    from tests.eval.test_hota import assert_same_clear, trackeval_hota  # skips without it
+
+    gt = rows((1, 1, 0, 0, 10, 10), (1, 2, 5, 0, 10, 10))  # A, B
+    res = rows((1, 7, 0, 0, 10, 10), (1, 8, -5, 0, 10, 10))  # X on A, Y at 1/3 with A only
+    ref = trackeval_hota(tmp_path, {"s": (gt, res)}, "MOT15", ("CLEAR", "Identity"), 0.3)
+    m = evaluate_mot(gt, res, iou_threshold=0.3)
+    assert (m.num_matches, m.mota, m.idf1) == (1, 0.0, 1.0)
+    assert_same_clear(m, ref["s"])
+    assert motmetrics_summary(gt, res, thr=0.3)["mota"] == 1.0
+
+
 def test_metrics_type():
     assert isinstance(evaluate_mot(HAND_GT, HAND_GT), MotMetrics)
     assert evaluate_mot(HAND_GT, HAND_GT).mota == 1.0
