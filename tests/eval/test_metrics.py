@@ -405,7 +405,8 @@ def test_identity_agrees_with_motmetrics(seed):
     """IDF1, IDP and IDR, which py-motmetrics defines as TrackEval does, equal its figures.
 
     (Its CLEAR-MOT differs from TrackEval's, which pftrack follows: it keeps a match after any
-    gap, counts an object mostly tracked from 80 % and a fragmentation per gap of the object.)
+    gap, counts an object mostly tracked from 80 %, and counts fragmentations otherwise: the
+    next test.)
     """
     gt, res = random_case(seed)
     ref = motmetrics_summary(gt, res)
@@ -416,6 +417,40 @@ def test_identity_agrees_with_motmetrics(seed):
     assert m.false_positives + m.misses == pytest.approx(
         ref["num_false_positives"] + ref["num_misses"], abs=2 * m.num_switches
     )
+
+
+def test_a_frame_without_the_object_ends_its_run_as_in_trackeval(tmp_path):
+    """Frag: TrackEval ends an object's tracked run at a scored frame without it, py-motmetrics
+    does not (docs/eval.md names the four ways its CLEAR-MOT differs; three were named)."""
+    from tests.eval.test_hota import assert_same_clear, trackeval_hota  # skips without it
+
+    one, two = [10, 10, 20, 40, 1, -1, -1, -1], [100, 10, 20, 40, 1, -1, -1, -1]
+    # object 1 in frames 1-2 and 4-5, matched by result 7 throughout; object 2 (result 8) in 3
+    gt = rows(*[(f, 1, *one) for f in (1, 2)], (3, 2, *two), *[(f, 1, *one) for f in (4, 5)])
+    res = gt.copy()
+    res[:, 1] += 6
+    ref = trackeval_hota(tmp_path, {"s": (gt, res)}, "MOT15", ("CLEAR", "Identity"))
+    m = evaluate_mot(gt, res)
+    assert (m.num_fragmentations, m.num_switches, m.mota) == (1, 0, 1.0)
+    assert_same_clear(m, ref["s"])
+    assert motmetrics_summary(gt, res)["num_fragmentations"] == 0
+    res = np.delete(res, 2, axis=0)  # frame 3 without results: no scored frame, no new run
+    ref = trackeval_hota(tmp_path / "b", {"s": (gt, res)}, "MOT15", ("CLEAR", "Identity"))
+    assert evaluate_mot(gt, res).num_fragmentations == ref["s"]["Frag"] == 0
+
+
+def test_below_iou_half_clear_takes_the_largest_iou_sum_as_trackeval(tmp_path):
+    """At IoU 0.3 one match at IoU 1 beats two at 1/3 in TrackEval's CLEAR (and pftrack's);
+    py-motmetrics takes the two (docs/eval.md, its fifth difference)."""
+    from tests.eval.test_hota import assert_same_clear, trackeval_hota  # skips without it
+
+    gt = rows((1, 1, 0, 0, 10, 10), (1, 2, 5, 0, 10, 10))  # A, B
+    res = rows((1, 7, 0, 0, 10, 10), (1, 8, -5, 0, 10, 10))  # X on A, Y at 1/3 with A only
+    ref = trackeval_hota(tmp_path, {"s": (gt, res)}, "MOT15", ("CLEAR", "Identity"), 0.3)
+    m = evaluate_mot(gt, res, iou_threshold=0.3)
+    assert (m.num_matches, m.mota, m.idf1) == (1, 0.0, 1.0)
+    assert_same_clear(m, ref["s"])
+    assert motmetrics_summary(gt, res, thr=0.3)["mota"] == 1.0
 
 
 def test_metrics_type():

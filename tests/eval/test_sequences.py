@@ -432,6 +432,78 @@ def test_cli_on_real_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     assert 0.3 < doc["combined"]["hota"] < 0.9
 
 
+def test_trackevals_seqmap_chooses_the_sequences_as_in_trackeval(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """TrackEval scores ``MOT15-train`` on the sequences ``seqmaps/MOT15-train.txt`` lists.
+
+    pftrack scored every folder: with A, B, C there and A, B listed, its COMBINED row was of
+    all three (HOTA 31.2, MOTA 8.2 on these cases) where TrackEval's is of A and B (24.8,
+    -11.7).
+    """
+    import contextlib
+    import io
+
+    trackeval = pytest.importorskip("trackeval")
+    cases = {name: random_case(k + 1) for k, name in enumerate("ABC")}
+    gt_split, res_flat = make_layout(tmp_path / "flat", cases)
+    gt_root = tmp_path / "data" / "gt" / "mot_challenge"
+    shutil.copytree(gt_split, gt_root / "MOT15-train")
+    (gt_root / "seqmaps").mkdir()
+    (gt_root / "seqmaps" / "MOT15-train.txt").write_text("name\nA\nB\n")
+    trackers = tmp_path / "data" / "trackers" / "mot_challenge"
+    shutil.copytree(res_flat, trackers / "MOT15-train" / "mine" / "data")
+    config = trackeval.Evaluator.get_default_eval_config()
+    config.update({"PRINT_RESULTS": False, "PRINT_CONFIG": False, "TIME_PROGRESS": False,
+                   "OUTPUT_SUMMARY": False, "OUTPUT_DETAILED": False, "PLOT_CURVES": False,
+                   "USE_PARALLEL": False})  # fmt: skip
+    dataset_config = {
+        "GT_FOLDER": str(gt_root),
+        "TRACKERS_FOLDER": str(trackers),
+        "BENCHMARK": "MOT15",
+        "SPLIT_TO_EVAL": "train",
+        "PRINT_CONFIG": False,
+    }
+    with contextlib.redirect_stdout(io.StringIO()):
+        res, _ = trackeval.Evaluator(config).evaluate(
+            [trackeval.datasets.MotChallenge2DBox(dataset_config)],
+            [trackeval.metrics.HOTA(), trackeval.metrics.CLEAR(), trackeval.metrics.Identity()],
+        )
+    ref = res["MotChallenge2DBox"]["mine"]
+    assert sorted(ref) == ["A", "B", "COMBINED_SEQ"]  # TrackEval's own choice
+    combined = ref["COMBINED_SEQ"]["pedestrian"]
+    out = tmp_path / "s.json"
+    for gt in (gt_root / "MOT15-train", gt_root):
+        argv = ["eval", "--gt", str(gt), "--res", str(trackers / "MOT15-train" / "mine")]
+        assert main([*argv, "--json", str(out)]) == 0
+        capsys.readouterr()
+        doc = json.loads(out.read_text())
+        assert sorted(doc["sequences"]) == ["A", "B"]
+        got = doc["combined"]
+        assert got["hota"] == pytest.approx(float(np.mean(combined["HOTA"]["HOTA"])), abs=1e-12)
+        assert got["mota"] == combined["CLEAR"]["MOTA"]
+        assert got["idf1"] == combined["Identity"]["IDF1"]
+        assert got["num_switches"] == combined["CLEAR"]["IDSW"]
+    assert [s.name for s in find_sequences(gt_root / "MOT15-train")] == ["A", "B"]
+    # --seqs picks any folder; a listed sequence without its folder, or none listed: refused
+    assert [s.name for s in find_sequences(gt_root / "MOT15-train", ["C"])] == ["A", "B", "C"]
+    argv = ["eval", "--gt", str(gt_root / "MOT15-train"), "--res", str(res_flat)]
+    assert main([*argv, "--seqs", "C"]) == 0
+    assert " C " in capsys.readouterr().out
+    for listed, message in (("name\nA\nD\n", "lists sequence D, which has no folder"),
+                            ("name\n", "lists no sequence")):  # fmt: skip
+        (gt_root / "seqmaps" / "MOT15-train.txt").write_text(listed)
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("pftrack eval: error: ") and message in err
+        assert err.count("\n") == 1
+    # the seqinfo.ini of a sequence the seqmap leaves out is not read
+    (gt_root / "seqmaps" / "MOT15-train.txt").write_text("name\nA\nB\n")
+    (gt_root / "MOT15-train" / "C" / "seqinfo.ini").write_text("[Sequence]\nseqLength=x\n")
+    assert main(argv) == 0
+    capsys.readouterr()
+
+
 def test_cli_reads_trackevals_tree(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Regression: ``--res trackers/mot_challenge/MOT15-train/NAME`` (results in ``data/``) said
     "no result for sequence ... (choose sequences with --seqs)", and ``--gt gt/mot_challenge``

@@ -66,8 +66,10 @@ class MotMetrics:
         Identity switches: a ground-truth object matched to a different result id than at its
         last match.
     num_fragmentations : int
-        Times a ground-truth trajectory goes from tracked to untracked, counted between its first
-        and last tracked frame.
+        Tracked runs of an object after its first (TrackEval's Frag), a run being its matches
+        in consecutive scored frames (frames holding both ground truth and results): a scored
+        frame without the object ends one, as a miss does (py-motmetrics counts only the misses
+        between its first and last match).
     mostly_tracked, partially_tracked, mostly_lost : int
         Objects tracked in more than 80 %, in [20 %, 80 %], and in under 20 % of their frames
         (TrackEval's rule; py-motmetrics counts exactly 80 % as mostly tracked).
@@ -331,7 +333,8 @@ def evaluate_mot(
     plus the pair's IoU: a track goes on where it can, and IoU decides the rest. Exact ties go
     by the order of the rows in the frame, as TrackEval reads them from the file. A match to a
     different id than the object's last match, however long ago, is an identity switch.
-    (py-motmetrics differs: it keeps a match after any gap and pairs the rest separately.)
+    (py-motmetrics differs: it keeps a match after any gap and pairs the rest separately, for
+    the most matches: below an `iou_threshold` of 0.5 the largest IoU sum can be fewer.)
     Identity (IDF1) counts the frames where a pair's IoU is >= `iou_threshold`, as TrackEval's
     ``Identity``.
 
@@ -341,7 +344,8 @@ def evaluate_mot(
     boxes matched to a distractor (a static person, a reflection, ...). Under MOT15 rules a
     result box on a left-out ground-truth box stays, as a false positive. The figures are
     TrackEval's ``CLEAR`` and ``Identity`` on the same files
-    (``tests/eval/test_hota.py``), and py-motmetrics' on the rows scored.
+    (``tests/eval/test_hota.py``); IDF1, IDP and IDR are py-motmetrics' too on the rows scored
+    (its CLEAR-MOT differs in five details: ``docs/eval.md``).
 
     References
     ----------

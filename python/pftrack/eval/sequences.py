@@ -45,6 +45,7 @@ __all__ = [
     "result_file",
     "scores_csv",
     "scores_json",
+    "seqmap_of",
 ]
 
 #: Name of the combined row in tables, JSON and CSV.
@@ -128,17 +129,21 @@ def find_sequences(root: PathLike, only: Collection[str] | None = None) -> list[
 
     `root` is one sequence folder (it has ``gt/gt.txt`` or ``gt.txt``), a folder of them, or
     a folder of such folders (TrackEval's ``gt/mot_challenge/`` with ``MOT17-train/``, ...:
-    the sequences of all of them); folders without a ground-truth file are skipped. With
-    `only` (``pftrack eval --seqs``), the ``seqinfo.ini`` of the sequences it does not name is
-    not read: a malformed one of a sequence not scored stopped the run.
+    the sequences of all of them); folders without a ground-truth file are skipped. A
+    benchmark-split folder with TrackEval's list of its sequences beside it
+    (``seqmaps/MOT17-train.txt``, :func:`seqmap_of`) gives the sequences listed, as TrackEval
+    evaluates them (was: every folder, so the combined row held sequences TrackEval leaves
+    out). With `only` (``pftrack eval --seqs``), the sequences are the folders (whatever the
+    list), and the ``seqinfo.ini`` of those it does not name is not read: a malformed one of
+    a sequence not scored stopped the run.
 
     Raises
     ------
     FileNotFoundError
         `root` is not a folder.
     ValueError
-        No sequence was found, two folders of `root` hold a sequence of the same name, or a
-        ``seqinfo.ini`` is malformed.
+        No sequence was found, two folders of `root` hold a sequence of the same name, a
+        ``seqinfo.ini`` is malformed, or a seqmap lists no sequence or one without a folder.
     """
     base = Path(root)
     if not base.is_dir():
@@ -170,7 +175,38 @@ def _folders(base: Path) -> list[Path]:
 
 
 def _sequences_in(base: Path, only: Collection[str] | None = None) -> list[SequenceInfo]:
-    return [s for d in _folders(base) if (s := _sequence(d, only)) is not None]
+    listed = seqmap_of(base) if only is None else None  # --seqs picks any folder
+    if listed is None:
+        return [s for d in _folders(base) if (s := _sequence(d, only)) is not None]
+    seqmap, names = listed
+    if not names:
+        raise ValueError(f"{seqmap} lists no sequence: TrackEval evaluates none of {base}")
+    # the seqinfo.ini of a folder not listed is not read, as with --seqs
+    found = [s for d in _folders(base) if (s := _sequence(d, names)) is not None]
+    have = {s.name for s in found}
+    absent = [n for n in names if n not in have]
+    if absent:  # TrackEval stops too ("ini file does not exist")
+        raise ValueError(
+            f"{seqmap} lists sequence {absent[0]}, which has no folder with gt/gt.txt in {base}"
+        )
+    return [s for s in found if s.name in names]
+
+
+def seqmap_of(split: PathLike) -> tuple[Path, list[str]] | None:
+    """TrackEval's list of the sequences of benchmark-split folder `split`, or None.
+
+    TrackEval evaluates ``gt/mot_challenge/BENCH-SPLIT`` on the sequences that
+    ``gt/mot_challenge/seqmaps/BENCH-SPLIT.txt`` lists (a header line, then one name a line),
+    not on every folder: `split` named ``BENCH-SPLIT`` (``MOT17-train``) with that file beside
+    it gives ``(seqmap path, names)``; any other folder None.
+    """
+    folder = Path(split).absolute()
+    seqmap = folder.parent / "seqmaps" / f"{folder.name}.txt"
+    if not _BENCH_SPLIT.fullmatch(folder.name) or not seqmap.is_file():
+        return None
+    text = seqmap.read_text(encoding="utf-8-sig", errors="replace")
+    rows = list(csv.reader(io.StringIO(text)))[1:]  # TrackEval's reader: row 0 is "name"
+    return seqmap, [r[0].strip() for r in rows if r and r[0].strip()]
 
 
 #: TrackEval's benchmark-split folder: BENCHMARK + "-" + SPLIT_TO_EVAL (``MOT17-train``,
