@@ -5,7 +5,9 @@ from __future__ import annotations
 import tracemalloc
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
+from pftrack.eval import evaluate_mot
 from pftrack.eval.hota import ALPHAS, evaluate_hota
 
 
@@ -43,3 +45,34 @@ def test_hota_of_many_ids_holds_no_ids_by_ids_matrix():
     matched = ALPHAS < 0.81  # IoU 27/33 = 0.82: matched up to alpha 0.8
     assert np.all(h.ass_a[matched] == 1.0)  # each object its own result id
     assert np.all(h.tp[matched] == 2000) and np.all(h.tp[~matched] == 0)
+
+
+def test_identity_of_many_ids_holds_no_ids_by_ids_matrix():
+    gt, res = many_ids(2000, 100)
+    peak, m = peak_mib(evaluate_mot, gt, res)  # one (ids, ids) matrix for IDF1: peak 62 MiB
+    assert peak < 15, f"{peak:.0f} MiB"
+    assert m.idtp == 2000 and m.idf1 == 1.0
+
+
+def test_identity_by_groups_equals_one_assignment_over_all_ids():
+    # id switches link ids into groups; the best pairing summed over groups is the best of all
+    rng = np.random.default_rng(5)
+    gt, res = many_ids(600, 20)
+    k = np.arange(len(res))  # a switch to one of 40 ids, unique within a frame
+    other = 200_000 + k % 20 + 20 * rng.integers(0, 2, len(res))
+    res[:, 1] = np.where(rng.random(len(res)) < 0.3, other, res[:, 1])
+    gt = np.vstack([gt, gt + [[30, 0] + [0] * 8]])  # each object again 30 frames later
+    res = np.vstack([res, res + [[30, 0] + [0] * 8]])
+    m = evaluate_mot(gt, res)
+    g_ids = np.unique(gt[:, 1])
+    r_ids = np.unique(res[:, 1])
+    w = np.zeros((len(g_ids), len(r_ids)))
+    for f in np.unique(gt[:, 0]):
+        g, r = gt[gt[:, 0] == f], res[res[:, 0] == f]
+        for gi in g:
+            for ri in r:
+                if ri[2] < gi[2] + gi[4] and gi[2] < ri[2] + ri[4]:  # same row: IoU 27/33
+                    w[np.searchsorted(g_ids, gi[1]), np.searchsorted(r_ids, ri[1])] += 1
+    a, b = linear_sum_assignment(-w)
+    assert m.idtp == int(w[a, b].sum())
+    assert 0 < m.idtp < len(gt)
