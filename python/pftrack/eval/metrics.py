@@ -14,6 +14,8 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from pftrack._check import number
 from pftrack._typing import BenchmarkName
@@ -289,6 +291,42 @@ def _concat(parts: list[NDArray[np.int64]]) -> NDArray[np.int64]:
     return out
 
 
+def _identity_tp(
+    obj: NDArray[np.int64],
+    res: NDArray[np.int64],
+    frames: NDArray[np.int64],
+    n_o: int,
+    n_h: int,
+) -> int:
+    """IDTP: the most frames a one-to-one pairing of objects and result ids matches.
+
+    `obj`, `res`, `frames`: each pair that matches somewhere, and in how many frames. The
+    pairing is the Hungarian assignment of IDF1 (Ristani et al.), made in each group of ids
+    that pairs link (connected components): ids of different groups never share a frame's
+    match, so the groups' best totals add up to the whole best total, the same integer. One
+    (objects, result ids) matrix over every id would grow as their product (5000 a side: 200
+    MB and seconds of assignment; 20 000: 3.2 GB).
+    """
+    if len(obj) == 0:
+        return 0
+    graph = coo_matrix((np.ones(len(obj)), (obj, n_o + res)), shape=(n_o + n_h, n_o + n_h))
+    _, label = connected_components(graph, directed=False)
+    group = label[obj]
+    order = np.argsort(group, kind="stable")
+    total = 0
+    for part in np.split(order, np.flatnonzero(np.diff(group[order])) + 1):
+        if len(part) == 1:  # one pair alone: its frames
+            total += int(frames[part[0]])
+            continue
+        o_ids, o_at = np.unique(obj[part], return_inverse=True)
+        r_ids, r_at = np.unique(res[part], return_inverse=True)
+        w = np.zeros((len(o_ids), len(r_ids)))
+        w[o_at, r_at] = frames[part]
+        a, b = linear_sum_assignment(-w)
+        total += int(w[a, b].sum())
+    return total
+
+
 def evaluate_mot(
     gt: ArrayLike,
     result: ArrayLike,
@@ -453,12 +491,7 @@ def evaluate_mot(
     hit_k, hit_n = np.unique(_concat(hit_keys), return_counts=True)
 
     # Identity: global assignment maximising the frames where a pair overlaps >= threshold.
-    idtp = 0
-    if n_o and n_h:
-        w = np.zeros((n_o, n_h))
-        w[hit_k // n_h, hit_k % n_h] = hit_n
-        a, b = linear_sum_assignment(-w)
-        idtp = int(w[a, b].sum())
+    idtp = _identity_tp(hit_k // n_h, hit_k % n_h, hit_n, n_o, n_h) if n_h else 0
     idfn = n_gt - idtp
     idfp = n_res - idtp
     # TrackEval's max(1, denominator): 0, not NaN, without ground truth or results

@@ -151,6 +151,16 @@ def check_unique_ids(frames: dict[int, NDArray[np.float64]], name: str) -> None:
     `frames`: rows grouped by frame. Shared by :func:`evaluate_mot` and
     :func:`~pftrack.eval.hota.evaluate_hota`, so both refuse what ``pftrack eval`` refuses.
     """
+    # all frames at once (one np.unique per frame took 6 s over 100 000 frames); the frames
+    # one by one only to name the first that repeats an id
+    sizes = np.fromiter((len(r) for r in frames.values()), np.int64, len(frames))
+    if not sizes.sum():
+        return
+    ids = np.concatenate([r[:, ID] for r in frames.values()]).astype(np.int64)
+    slot = np.repeat(np.arange(len(sizes)), sizes)
+    order = np.lexsort((ids, slot))
+    if not np.any((np.diff(ids[order]) == 0) & (np.diff(slot[order]) == 0)):
+        return
     for f, r in frames.items():
         ids, counts = np.unique(r[:, ID].astype(np.int64), return_counts=True)
         if np.any(counts > 1):
