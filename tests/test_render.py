@@ -263,3 +263,21 @@ def test_the_pictures_refuse_what_they_cannot_draw_in_one_line(tmp_path: Path) -
     assert sorted(os.listdir(tmp_path)) == []
     assert draw_tracks(frame, rows[:1], label="frame 1").shape == frame.shape  # still drawn
     assert draw_tracks(frame, np.zeros((0, 8))).shape == frame.shape
+
+
+def test_a_filled_box_is_dashed_and_a_ground_truth_class_is_not_a_fill() -> None:
+    """Was: any row whose column 8 is 1 drawn thin (said: dashed), MOT16+ truth's class 1 too."""
+    from pftrack.render import draw_tracks
+
+    frame = np.zeros((80, 100, 3), np.uint8)
+
+    def top_edge(extra: list[float]) -> np.ndarray:
+        row = np.array([[1, 4, 20, 30, 60, 40, *extra]], float)
+        return draw_tracks(frame, row)[30, 22:78].max(axis=1)  # the box's top edge, corners out
+
+    observed = top_edge([])  # a 6-column row: observed
+    assert observed.min() > 100  # solid
+    filled = top_edge([1, 1, -1, -1])  # pftrack's interpolated flag (filled_mask)
+    assert filled.max() > 100 and (filled < 30).sum() >= 10  # dashes and gaps
+    for truth in ([1, 1, 0.5, -1], [1, 1, -1, 0.8], [1, 1]):  # MOT16+ truth: class 1, visibility
+        np.testing.assert_array_equal(top_edge(truth), observed)

@@ -20,6 +20,7 @@ from pftrack._typing import F64, PathLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
 from pftrack.io.video_writer import VideoWriter
+from pftrack.recovery.linking import FILLED_MARK, FLAG_COLUMN
 
 __all__ = [
     "TrackRenderer",
@@ -57,9 +58,12 @@ def ink_scale(shape: tuple[int, ...]) -> int:
 def draw_tracks(
     frame: NDArray[np.uint8], rows: NDArray[np.float64], label: str = ""
 ) -> NDArray[np.uint8]:
-    """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids (dashed if filled).
+    """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids.
 
-    Lines and labels grow with the frame (:func:`ink_scale`).
+    A box is dashed where it was not observed: a row that ``pftrack recover`` or ``smooth``
+    filled (columns 8-10 ``1, -1, -1``, :func:`pftrack.recovery.filled_mask`), or a track
+    coasting in :class:`TrackRenderer`; other rows are solid (MOT16+ ground truth's class 1
+    in column 8 too). Lines and labels grow with the frame (:func:`ink_scale`).
 
     Raises
     ------
@@ -72,11 +76,17 @@ def draw_tracks(
     _text(label, "draw_tracks", "label")
     out: NDArray[np.uint8] = frame.copy()
     k = ink_scale(out.shape)
-    for r in rows:
+    # was: column 8 == 1 alone, drawn thin: every box of MOT16+ truth (class 1, pedestrian)
+    marks = rows[:, FLAG_COLUMN : FLAG_COLUMN + 3]
+    filled = np.all(marks == FILLED_MARK, axis=1) if marks.shape[1] == 3 else np.zeros(len(rows))
+    for i, r in enumerate(rows):
         tid = int(r[1])
         x, y, w, h = (int(round(v)) for v in r[2:6])
         c = colour_of(tid)
-        cv2.rectangle(out, (x, y), (x + w, y + h), c, k * (1 if len(r) > 7 and r[7] == 1 else 2))
+        if filled[i]:
+            _dashed_rectangle(out, (x, y), (x + w, y + h), c, 2 * k, 6 * k)
+        else:
+            cv2.rectangle(out, (x, y), (x + w, y + h), c, 2 * k)
         cv2.putText(
             out, text_for_opencv(str(tid)), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX,
             0.4 * k, c, k, cv2.LINE_AA,
@@ -87,6 +97,27 @@ def draw_tracks(
             (255, 255, 255), k, cv2.LINE_AA,
         )  # fmt: skip
     return out
+
+
+def _dashed_rectangle(
+    image: NDArray[np.uint8],
+    p0: tuple[int, int],
+    p1: tuple[int, int],
+    colour: tuple[int, int, int],
+    thickness: int,
+    dash: int,
+) -> None:
+    """A rectangle from corner `p0` to `p1` of dashes `dash` px long and gaps as long."""
+    (x0, y0), (x1, y1) = p0, p1
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
+    for a, b in itertools.pairwise(corners):
+        length = max(abs(b[0] - a[0]), abs(b[1] - a[1]))
+        for s in range(0, length + 1, 2 * dash):
+            e = min(s + dash, length)
+            t0, t1 = s / max(length, 1), e / max(length, 1)
+            q0 = (round(a[0] + (b[0] - a[0]) * t0), round(a[1] + (b[1] - a[1]) * t0))
+            q1 = (round(a[0] + (b[0] - a[0]) * t1), round(a[1] + (b[1] - a[1]) * t1))
+            cv2.line(image, q0, q1, colour, thickness)
 
 
 def draw_trails(
@@ -262,8 +293,9 @@ class TrackRenderer:
         rows, seen = [], set()
         for t in tracks:
             box = np.asarray(t.box_xywh, dtype=np.float64)
-            # MOT row; column 8: 1 = coasting, drawn thin
-            rows.append([self._n, t.id, *box[:4], 0.0, 1.0 if t.time_since_update else 0.0])
+            # MOT row; columns 8-10 a filled row's mark when coasting: drawn dashed
+            unseen = FILLED_MARK if t.time_since_update else (-1.0, -1.0, -1.0)
+            rows.append([self._n, t.id, *box[:4], 0.0, *unseen])
             seen.add(t.id)
             if self.trail:
                 trail = self._trails.setdefault(t.id, deque(maxlen=self.trail))
@@ -271,7 +303,7 @@ class TrackRenderer:
         for tid in set(self._trails) - seen:
             del self._trails[tid]
         trails = {tid: list(pts) for tid, pts in self._trails.items()}
-        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 8), trails)
+        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 10), trails)
         if self._queue is None:
             self._draw(job)
         else:

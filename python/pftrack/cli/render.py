@@ -39,7 +39,7 @@ def add_parser(sub: Any) -> None:
         "with --plot, a trajectory plot on the first frame. Row frame k is drawn on the "
         "video's k-th frame. pftrack track --render shows the boxes as tracked online; this "
         "shows a file as it is: pftrack track's final tracks, the output of pftrack smooth "
-        "or recover (filled rows too), another tracker's, or the ground truth.",
+        "or recover (filled rows dashed), another tracker's, or the ground truth.",
     )
     p.add_argument("source", help="video file, image folder, or MOTChallenge sequence folder")
     p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,...)")
