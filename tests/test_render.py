@@ -281,3 +281,15 @@ def test_a_filled_box_is_dashed_and_a_ground_truth_class_is_not_a_fill() -> None
     assert filled.max() > 100 and (filled < 30).sum() >= 10  # dashes and gaps
     for truth in ([1, 1, 0.5, -1], [1, 1, -1, 0.8], [1, 1]):  # MOT16+ truth: class 1, visibility
         np.testing.assert_array_equal(top_edge(truth), observed)
+
+
+@pytest.mark.parametrize("left", [-30.0, 90.0, 40.0])
+def test_an_id_is_drawn_whole_inside_the_frame_when_its_box_is_not(left: float) -> None:
+    """Was: the label at the box's left edge, off the frame for a box entering from the left."""
+    from pftrack.render import draw_tracks
+
+    frame = np.zeros((80, 120, 3), np.uint8)
+    row = np.array([[1, 123456, left, 40, 50, 30]], float)
+    label = draw_tracks(frame, row)[:36].any(axis=2)  # above the box: the label alone
+    centred = draw_tracks(frame, row * [1, 1, 0, 1, 1, 1] + [0, 0, 30, 0, 0, 0])[:36].any(axis=2)
+    assert label.sum() == centred.sum() > 50  # all of it, as of a box in the middle

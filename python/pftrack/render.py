@@ -87,9 +87,13 @@ def draw_tracks(
             _dashed_rectangle(out, (x, y), (x + w, y + h), c, 2 * k, 6 * k)
         else:
             cv2.rectangle(out, (x, y), (x + w, y + h), c, 2 * k)
+        (tw, _), _ = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, k)
+        # the whole label inside the frame, over the part of the box that is (was: at the box's
+        # left edge, off the frame for a box entering from the left, cut for one leaving right)
+        org = (max(0, min(x, out.shape[1] - tw)), min(max(10 * k, y - 3 * k), out.shape[0] - 2 * k))
         cv2.putText(
-            out, text_for_opencv(str(tid)), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX,
-            0.4 * k, c, k, cv2.LINE_AA,
+            out, text_for_opencv(str(tid)), org, cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, c, k,
+            cv2.LINE_AA,
         )  # fmt: skip
     if label:
         cv2.putText(
