@@ -293,3 +293,18 @@ def test_an_id_is_drawn_whole_inside_the_frame_when_its_box_is_not(left: float) 
     label = draw_tracks(frame, row)[:36].any(axis=2)  # above the box: the label alone
     centred = draw_tracks(frame, row * [1, 1, 0, 1, 1, 1] + [0, 0, 30, 0, 0, 0])[:36].any(axis=2)
     assert label.sum() == centred.sum() > 50  # all of it, as of a box in the middle
+
+
+@pytest.mark.parametrize("tid", [7, 8, 123456])
+def test_ids_and_the_frame_number_are_legible_on_any_frame(tid: int) -> None:
+    """Was: white frame numbers on a white frame, an id in its colour on that colour, unseen."""
+    from pftrack.render import draw_tracks
+
+    row = np.array([[1, tid, 40, 40, 50, 30]], float)
+    for fill in [(255, 255, 255), colour_of(tid), (0, 0, 0)]:
+        frame = np.full((80, 120, 3), fill, np.uint8)
+        out = draw_tracks(frame, row, "frame 1").astype(int)
+        for where in (out[:20, :60], out[22:38, 30:110]):  # the frame number; the id over its box
+            # the text stands out of what is drawn around it: a dark and a light shade both
+            luma = where @ [0.114, 0.587, 0.299]
+            assert luma.max() - luma.min() > 100, (fill, where.shape)

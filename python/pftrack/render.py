@@ -87,20 +87,37 @@ def draw_tracks(
             _dashed_rectangle(out, (x, y), (x + w, y + h), c, 2 * k, 6 * k)
         else:
             cv2.rectangle(out, (x, y), (x + w, y + h), c, 2 * k)
-        (tw, _), _ = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, k)
+        (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, k)
         # the whole label inside the frame, over the part of the box that is (was: at the box's
         # left edge, off the frame for a box entering from the left, cut for one leaving right)
-        org = (max(0, min(x, out.shape[1] - tw)), min(max(10 * k, y - 3 * k), out.shape[0] - 2 * k))
-        cv2.putText(
-            out, text_for_opencv(str(tid)), org, cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, c, k,
-            cv2.LINE_AA,
-        )  # fmt: skip
+        x = max(k, min(x, out.shape[1] - tw - k))
+        _tag(out, str(tid), (x, min(max(th + k, y - 3 * k), out.shape[0] - base - k)), 0.4 * k, c)
     if label:
-        cv2.putText(
-            out, text_for_opencv(label), (5 * k, 15 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k,
-            (255, 255, 255), k, cv2.LINE_AA,
-        )  # fmt: skip
+        _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0))
     return out
+
+
+def _tag(
+    image: NDArray[np.uint8],
+    text: str,
+    org: tuple[int, int],
+    scale: float,
+    colour: tuple[int, int, int],
+) -> None:
+    """`text` from `org` (its baseline's left end) on a box of `colour`, in black or white.
+
+    Legible on any frame (was: a white frame number on a white frame, a coloured id on that
+    colour): the ink is whichever of black and white stands out of `colour` more.
+    """
+    k = ink_scale(image.shape)
+    (tw, th), base = cv2.getTextSize(text_for_opencv(text), cv2.FONT_HERSHEY_SIMPLEX, scale, k)
+    x, y = org
+    cv2.rectangle(image, (x - k, y - th - k), (x + tw + k - 1, y + base), colour, -1)
+    luma = 0.114 * colour[0] + 0.587 * colour[1] + 0.299 * colour[2]  # BT.601, BGR
+    ink = (0, 0, 0) if luma > 127 else (255, 255, 255)
+    cv2.putText(
+        image, text_for_opencv(text), org, cv2.FONT_HERSHEY_SIMPLEX, scale, ink, k, cv2.LINE_AA
+    )
 
 
 def _dashed_rectangle(
