@@ -206,3 +206,23 @@ def test_frames_too_wide_for_h264_are_refused_before_any_work(
         "(x264), not 20002x64; write an .avi (Motion-JPEG) instead\n"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_the_plot_title_says_what_it_shows(
+    scene_files: tuple[Scene, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Was the sequence's name alone: not what the lines are, nor of how many tracks."""
+    import pftrack.render
+
+    _, video, truth = scene_files
+    titles = []
+    real = pftrack.render.plot_trajectories
+
+    def spy(*args: object, title: str = "", **kwargs: object) -> Path:
+        titles.append(title)
+        return real(*args, title=title, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(pftrack.render, "plot_trajectories", spy)
+    argv = ["-q", "render", str(video), str(truth), "--out", str(tmp_path / "v.mp4")]
+    assert main([*argv, "--plot", str(tmp_path / "p.png")]) == 0
+    assert titles == ["scene.avi: foot-point paths of 3 tracks, frames 1-30"]

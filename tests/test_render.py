@@ -308,3 +308,11 @@ def test_ids_and_the_frame_number_are_legible_on_any_frame(tid: int) -> None:
             # the text stands out of what is drawn around it: a dark and a light shade both
             luma = where @ [0.114, 0.587, 0.299]
             assert luma.max() - luma.min() > 100, (fill, where.shape)
+
+
+def test_paths_title_counts_the_tracks_and_frames() -> None:
+    from pftrack.render import paths_title
+
+    assert paths_title("s", _ROWS) == "s: foot-point paths of 2 tracks, frames 1-5"
+    assert paths_title("s", _ROWS[:1]) == "s: foot-point paths of 1 track, frame 1"
+    assert paths_title("s", []) == "s: foot-point paths of 0 tracks"

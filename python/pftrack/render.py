@@ -28,6 +28,7 @@ __all__ = [
     "draw_tracks",
     "draw_trails",
     "ink_scale",
+    "paths_title",
     "plot_trajectories",
     "write_annotated_video",
 ]
@@ -419,6 +420,20 @@ def _with_axes(canvas: NDArray[np.uint8], title: str) -> NDArray[np.uint8]:
             out, text_for_opencv(title), (left, 16), font, 0.45, (255, 255, 255), 1, cv2.LINE_AA
         )
     return out
+
+
+def paths_title(name: str, rows: ArrayLike) -> str:
+    """A title saying what :func:`plot_trajectories` of `rows` shows, for a source `name`.
+
+    ``"PETS09-S2L1: foot-point paths of 23 tracks, frames 1-795"`` (no rows: ``0 tracks``).
+    """
+    a = _track_rows(rows, "paths_title")
+    n = len(np.unique(a[:, 1]))
+    what = f"{name}: foot-point paths of {n} track{'s' * (n != 1)}"
+    if not len(a):
+        return what
+    first, last = int(a[:, 0].min()), int(a[:, 0].max())
+    return f"{what}, frame {first}" if first == last else f"{what}, frames {first}-{last}"
 
 
 def plot_trajectories(
