@@ -316,3 +316,19 @@ def test_paths_title_counts_the_tracks_and_frames() -> None:
     assert paths_title("s", _ROWS) == "s: foot-point paths of 2 tracks, frames 1-5"
     assert paths_title("s", _ROWS[:1]) == "s: foot-point paths of 1 track, frame 1"
     assert paths_title("s", []) == "s: foot-point paths of 0 tracks"
+
+
+@pytest.mark.parametrize("start", [-40.0, 15.0, 190.0])
+def test_a_plot_labels_each_path_legibly_inside_the_canvas(tmp_path: Path, start: float) -> None:
+    """Was: the id in its colour at the path's first point: off the canvas for a track that
+    came in from outside, dim for a blue one on a dark frame."""
+    import cv2
+
+    tid = min(range(1, 50), key=lambda i: sum(np.array(colour_of(i)) * [0.114, 0.587, 0.299]))
+    rows = np.array([[k, tid, start + 10 * k, 10, 10, 30, 1, -1, -1, -1] for k in range(8)], float)
+    dark = np.zeros((80, 200, 3), np.uint8)
+    image = cv2.imread(str(plot_trajectories(tmp_path / "p.png", rows[::-1], background=dark)))
+    luma = image.astype(int) @ [0.114, 0.587, 0.299]
+    near = luma[20:45, max(0, int(start) - 5) : int(start) + 45]  # about where the path starts
+    assert near.max() > 200  # white ink on the id's tag
+    assert (luma > 200).sum() > 10

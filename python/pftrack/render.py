@@ -92,9 +92,10 @@ def draw_tracks(
         # the whole label inside the frame, over the part of the box that is (was: at the box's
         # left edge, off the frame for a box entering from the left, cut for one leaving right)
         x = max(k, min(x, out.shape[1] - tw - k))
-        _tag(out, str(tid), (x, min(max(th + k, y - 3 * k), out.shape[0] - base - k)), 0.4 * k, c)
+        y = min(max(th + k, y - 3 * k), out.shape[0] - base - k)
+        _tag(out, str(tid), (x, y), 0.4 * k, c, k)
     if label:
-        _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0))
+        _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k)
     return out
 
 
@@ -104,13 +105,14 @@ def _tag(
     org: tuple[int, int],
     scale: float,
     colour: tuple[int, int, int],
+    k: int,
 ) -> None:
     """`text` from `org` (its baseline's left end) on a box of `colour`, in black or white.
 
     Legible on any frame (was: a white frame number on a white frame, a coloured id on that
-    colour): the ink is whichever of black and white stands out of `colour` more.
+    colour): the ink is whichever of black and white stands out of `colour` more; `k` is the
+    ink's thickness and the box's margin.
     """
-    k = ink_scale(image.shape)
     (tw, th), base = cv2.getTextSize(text_for_opencv(text), cv2.FONT_HERSHEY_SIMPLEX, scale, k)
     x, y = org
     cv2.rectangle(image, (x - k, y - th - k), (x + tw + k - 1, y + base), colour, -1)
@@ -523,20 +525,18 @@ def plot_trajectories(
     if truth is not None and len(truth):
         for pts in paths(truth).values():
             cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, (170, 170, 170), 1, cv2.LINE_AA)
-    for tid, pts in paths(rows).items() if len(rows) else []:
+    drawn = paths(rows) if len(rows) else {}
+    for tid, pts in drawn.items():
         c = colour_of(tid)
         cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, c, 2, cv2.LINE_AA)
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
-        cv2.putText(
-            canvas,
-            text_for_opencv(str(tid)),
-            tuple(int(v) for v in pts[0]),
-            cv2.FONT_HERSHEY_SIMPLEX,
-            0.4,
-            c,
-            1,
-            cv2.LINE_AA,
-        )
+    # each id at its path's first point, on a tag of its colour, over every path, whole inside
+    # the canvas (was: the id's colour on the dimmed frame, off it for a track from outside)
+    for tid, pts in drawn.items():
+        (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)
+        x = max(1, min(int(pts[0][0]), canvas.shape[1] - tw - 1))
+        y = min(max(th + 1, int(pts[0][1])), canvas.shape[0] - base - 1)
+        _tag(canvas, str(tid), (x, y), 0.4, colour_of(tid), 1)
     if background is None:
         canvas = _with_axes(canvas, title)
     elif title:
