@@ -332,3 +332,33 @@ def test_a_plot_labels_each_path_legibly_inside_the_canvas(tmp_path: Path, start
     near = luma[20:45, max(0, int(start) - 5) : int(start) + 45]  # about where the path starts
     assert near.max() > 200  # white ink on the id's tag
     assert (luma > 200).sum() > 10
+
+
+def test_a_trail_is_not_drawn_across_frames_its_track_is_absent(tmp_path: Path) -> None:
+    """Was: a straight line from where a track was last seen to where it came back, as if walked
+    (a track that left the frame and re-entered within `trail` frames, or a hole in a file)."""
+    rows = np.array(
+        [[k, 3, 10 + 2 * (k - 1), 10, 8, 16, 1, -1, -1, -1] for k in range(1, 6)]
+        + [[k, 3, 80 + 2 * (k - 10), 10, 8, 16, 1, -1, -1, -1] for k in range(10, 15)],
+        float,
+    )
+    frames = [np.zeros((48, 120, 3), np.uint8) for _ in range(14)]
+    _, got = decode(write_annotated_video(tmp_path / "v.mp4", frames, rows, fps=10, trail=40))
+    assert got[4][26, 15:21].max(axis=1).min() > 100  # frames 1-5: their trail
+    assert got[13][26, 85:92].max(axis=1).min() > 100  # frames 10-14: theirs
+    assert got[13][26, 30:75].max() < 30  # nothing between them
+
+
+def test_a_plot_draws_a_hole_in_a_track_thin(tmp_path: Path) -> None:
+    """Was: a hole (frames 6-9 missing) drawn as the observed path is, 2 px wide."""
+    import cv2
+
+    rows = np.array(
+        [[k, 3, 10 + 2 * (k - 1), 10, 8, 16] for k in range(1, 6)]
+        + [[k, 3, 80 + 2 * (k - 10), 10, 8, 16] for k in range(10, 15)],
+        float,
+    )
+    dark = np.zeros((48, 120, 3), np.uint8)
+    image = cv2.imread(str(plot_trajectories(tmp_path / "p.png", rows, background=dark)))
+    lit = image.max(axis=2) > 60
+    assert lit[:, 45].sum() == 1 and lit[:, 90].sum() >= 2  # the hole 1 px, the path 2 or more

@@ -206,7 +206,8 @@ def write_annotated_video(
     """Write `frames` with the tracks of `rows` (MOT, 1-based frames) drawn on, atomically.
 
     ``.mp4`` is H.264 (see :class:`~pftrack.io.video_writer.VideoWriter`, whose x264 `preset`
-    this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames.
+    this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames,
+    one line for each run of frames it was seen on (none across a frame it is absent from).
 
     Raises
     ------
@@ -234,13 +235,21 @@ def write_annotated_video(
                 pts.append((k, _foot(r[2:6])))
             # the foot points of frames k - trail + 1 .. k (was: the last `trail` points however
             # old, a line across the track's absence from a point long gone)
-            shown = {}
-            for tid in {int(r[1]) for r in here} if trail > 0 else ():
-                shown[tid] = [p for f, p in trails[tid] if f > k - trail]
             image = draw_tracks(frame, here, f"frame {k}")
-            draw_trails(image, shown)
+            for tid in {int(r[1]) for r in here} if trail > 0 else ():
+                recent = [(f, p) for f, p in trails[tid] if f > k - trail]
+                # one line for each run of frames it was seen on (was: a straight line across
+                # its absence, from where it left to where it came back, as if walked)
+                for run in _runs([f for f, _ in recent]):
+                    draw_trails(image, {tid: [recent[i][1] for i in run]})
             writer.write(image)
     return Path(path)
+
+
+def _runs(frames: Sequence[float]) -> list[range]:
+    """Index ranges of `frames` (ascending) that run without a missing frame between them."""
+    cuts = [0, *(i for i in range(1, len(frames)) if frames[i] - frames[i - 1] > 1), len(frames)]
+    return [range(a, b) for a, b in itertools.pairwise(cuts) if b > a]
 
 
 class TrackLike(Protocol):
@@ -448,6 +457,9 @@ def plot_trajectories(
 ) -> Path:
     """Draw each track's foot-point path (bottom centre of its box) as a PNG, atomically.
 
+    Each path is 2 px wide over the frames its track was seen on and 1 px across a hole (frames
+    it has no row on), with its id at its first point and a dot at its last.
+
     Parameters
     ----------
     path : str or os.PathLike
@@ -513,26 +525,29 @@ def plot_trajectories(
                 )
         canvas = np.full((h, w, 3), 30, np.uint8)
 
-    def paths(r: NDArray[np.float64]) -> dict[int, NDArray[np.int32]]:
+    def paths(r: NDArray[np.float64]) -> dict[int, tuple[F64, NDArray[np.int32]]]:
         out = {}
         for tid in np.unique(r[:, 1]).astype(int):
             t = r[r[:, 1] == tid]
-            t = t[np.argsort(t[:, 0])]
+            t = t[np.argsort(t[:, 0], kind="stable")]
             pts = np.column_stack([t[:, 2] + t[:, 4] / 2, t[:, 3] + t[:, 5]])
-            out[tid] = np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
+            out[tid] = t[:, 0], np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
         return out
 
     if truth is not None and len(truth):
-        for pts in paths(truth).values():
+        for _, pts in paths(truth).values():
             cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, (170, 170, 170), 1, cv2.LINE_AA)
     drawn = paths(rows) if len(rows) else {}
-    for tid, pts in drawn.items():
+    for tid, (frames, pts) in drawn.items():
         c = colour_of(tid)
-        cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, c, 2, cv2.LINE_AA)
+        # the frames it was seen on 2 px wide, a hole in the track 1 px (was: 2 px, as if seen)
+        cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, c, 1, cv2.LINE_AA)
+        runs = [pts[run.start : run.stop].reshape(-1, 1, 2) for run in _runs(list(frames))]
+        cv2.polylines(canvas, runs, False, c, 2, cv2.LINE_AA)
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
     # each id at its path's first point, on a tag of its colour, over every path, whole inside
     # the canvas (was: the id's colour on the dimmed frame, off it for a track from outside)
-    for tid, pts in drawn.items():
+    for tid, (_, pts) in drawn.items():
         (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)
         x = max(1, min(int(pts[0][0]), canvas.shape[1] - tw - 1))
         y = min(max(th + 1, int(pts[0][1])), canvas.shape[0] - base - 1)
