@@ -362,3 +362,15 @@ def test_a_plot_draws_a_hole_in_a_track_thin(tmp_path: Path) -> None:
     image = cv2.imread(str(plot_trajectories(tmp_path / "p.png", rows, background=dark)))
     lit = image.max(axis=2) > 60
     assert lit[:, 45].sum() == 1 and lit[:, 90].sum() >= 2  # the hole 1 px, the path 2 or more
+
+
+def test_a_frame_too_small_for_its_number_is_not_covered_by_it() -> None:
+    """Was: on a 32x24 frame the frame number's tag hid two thirds of the picture."""
+    from pftrack.render import draw_tracks
+
+    for size in [(24, 32), (60, 100)]:
+        frame = np.full((*size, 3), 90, np.uint8)
+        changed = (draw_tracks(frame, np.zeros((0, 6)), "frame 123") != 90).any(axis=2)
+        assert changed.mean() < 0.25, size
+    shown = draw_tracks(np.full((120, 160, 3), 90, np.uint8), np.zeros((0, 6)), "frame 123")
+    assert (shown != 90).any(axis=2).mean() > 0.02  # drawn where it fits

@@ -64,7 +64,9 @@ def draw_tracks(
     A box is dashed where it was not observed: a row that ``pftrack recover`` or ``smooth``
     filled (columns 8-10 ``1, -1, -1``, :func:`pftrack.recovery.filled_mask`), or a track
     coasting in :class:`TrackRenderer`; other rows are solid (MOT16+ ground truth's class 1
-    in column 8 too). Lines and labels grow with the frame (:func:`ink_scale`).
+    in column 8 too). Lines and labels grow with the frame (:func:`ink_scale`). `label` goes in
+    the top-left corner of a frame with room for it there (at most half its width and a third
+    of its height: ``"frame 123"`` from 138x48 pixels).
 
     Raises
     ------
@@ -94,7 +96,9 @@ def draw_tracks(
         x = max(k, min(x, out.shape[1] - tw - k))
         y = min(max(th + k, y - 3 * k), out.shape[0] - base - k)
         _tag(out, str(tid), (x, y), 0.4 * k, c, k)
-    if label:
+    (tw, _), base = cv2.getTextSize(text_for_opencv(label), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k, k)
+    # only where it fits in a corner (was: on a 32x24 frame, a tag over two thirds of it)
+    if label and 2 * (6 * k + tw) <= out.shape[1] and 3 * (15 * k + base) <= out.shape[0]:
         _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k)
     return out
 
