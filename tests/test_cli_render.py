@@ -208,21 +208,26 @@ def test_frames_too_wide_for_h264_are_refused_before_any_work(
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
-def test_the_plot_title_says_what_it_shows(
+def test_the_plot_title_says_what_it_shows_and_the_plot_what_the_video_does(
     scene_files: tuple[Scene, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Was the sequence's name alone: not what the lines are, nor of how many tracks."""
+    """Was the sequence's name alone: not what the lines are, nor of how many tracks; and the
+    plot drew the rows past the video's end that the warning says are not drawn."""
     import pftrack.render
 
-    _, video, truth = scene_files
-    titles = []
+    scene, video, _ = scene_files
+    tracks = tmp_path / "late.txt"
+    write_mot(tracks, np.vstack([scene.truth, [35, 99, 10, 10, 5, 9, 1, -1, -1, -1]]))
+    calls = []
     real = pftrack.render.plot_trajectories
 
-    def spy(*args: object, title: str = "", **kwargs: object) -> Path:
-        titles.append(title)
-        return real(*args, title=title, **kwargs)  # type: ignore[arg-type]
+    def spy(path: Path, rows: np.ndarray, *args: object, title: str = "", **kw: object) -> Path:
+        calls.append((rows, title))
+        return real(path, rows, *args, title=title, **kw)  # type: ignore[arg-type]
 
     monkeypatch.setattr(pftrack.render, "plot_trajectories", spy)
-    argv = ["-q", "render", str(video), str(truth), "--out", str(tmp_path / "v.mp4")]
+    argv = ["-q", "render", str(video), str(tracks), "--out", str(tmp_path / "v.mp4")]
     assert main([*argv, "--plot", str(tmp_path / "p.png")]) == 0
-    assert titles == ["scene.avi: foot-point paths of 3 tracks, frames 1-30"]
+    [(rows, title)] = calls
+    assert title == "scene.avi: foot-point paths of 3 tracks, frames 1-30"
+    assert len(rows) == len(scene.truth) and rows[:, 0].max() == 30

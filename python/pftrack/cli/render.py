@@ -142,8 +142,9 @@ def run(args: argparse.Namespace) -> int:
                 plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))
                 # the sequence's or the file's name, as pftrack track's plot (was the whole path)
                 name = source.sequence.name if source.sequence else Path(args.source).name
-                title = paths_title(name, rows[rows[:, 0] <= drawn[0]])  # those drawn
-                plot_trajectories(plot, rows, background=kept[0], title=title)
+                # the rows the video shows (was: those past its end too, said not drawn)
+                seen = rows[rows[:, 0] <= drawn[0]]
+                plot_trajectories(plot, seen, background=kept[0], title=paths_title(name, seen))
             hold_interrupts()  # the work is done: the outputs are put in place whatever comes
     late = rows[rows[:, 0] > drawn[0]]
     notes = [str(w.message) for w in caught] + _outside(rows, source.width, source.height)
