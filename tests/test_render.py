@@ -374,3 +374,13 @@ def test_a_frame_too_small_for_its_number_is_not_covered_by_it() -> None:
         assert changed.mean() < 0.25, size
     shown = draw_tracks(np.full((120, 160, 3), 90, np.uint8), np.zeros((0, 6)), "frame 123")
     assert (shown != 90).any(axis=2).mean() > 0.02  # drawn where it fits
+
+
+def test_a_coasting_track_is_dashed_while_tracking(tmp_path: Path) -> None:
+    renderer = TrackRenderer(tmp_path / "a.mp4", 7, threaded=False)
+    seen = FakeTrack(1, np.array([10.0, 20.0, 60.0, 30.0]))
+    coasting = FakeTrack(2, np.array([10.0, 60.0, 60.0, 30.0]), time_since_update=3)
+    renderer.add(np.zeros((100, 120, 3), np.uint8), [seen, coasting])
+    _, [frame] = decode(renderer.close())
+    solid, dashed = frame[20, 14:66].max(axis=1), frame[60, 14:66].max(axis=1)
+    assert solid.min() > 100 and dashed.max() > 100 and (dashed < 40).sum() >= 10
