@@ -9,7 +9,7 @@ import threading
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Protocol
+from typing import Protocol, TypeVar
 
 import cv2
 import numpy as np
@@ -152,11 +152,8 @@ def draw_trails(
     frame: NDArray[np.uint8], trails: Mapping[int, Sequence[tuple[float, float]]]
 ) -> None:
     """Draw each id's recent foot points on `frame` in place, as a line in the id's colour."""
-    k = ink_scale(frame.shape)
     for tid, pts in trails.items():
-        if len(pts) > 1:
-            line = np.round(np.asarray(pts, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
-            cv2.polylines(frame, [line], False, colour_of(tid), k, cv2.LINE_AA)
+        _trail_line(frame, pts, colour_of(tid))
 
 
 def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
@@ -230,30 +227,46 @@ def write_annotated_video(
         raise ValueError("write_annotated_video: frames is empty; no frame to write")
     by_frame = group_by_frame(rows)
     empty = np.zeros((0, 10))
-    trails: dict[int, deque[tuple[int, tuple[float, float]]]] = {}  # (frame, foot point)
+    paths = _foot_paths(rows) if trail > 0 else {}
     with VideoWriter(path, fps, preset=preset) as writer:
         for k, frame in enumerate(itertools.chain([first], it), start=1):
             here = by_frame.get(k, empty)
-            for r in here:
-                pts = trails.setdefault(int(r[1]), deque(maxlen=max(trail, 1)))
-                pts.append((k, _foot(r[2:6])))
-            # the foot points of frames k - trail + 1 .. k (was: the last `trail` points however
-            # old, a line across the track's absence from a point long gone)
             image = draw_tracks(frame, here, f"frame {k}")
             for tid in {int(r[1]) for r in here} if trail > 0 else ():
-                recent = [(f, p) for f, p in trails[tid] if f > k - trail]
-                # one line for each run of frames it was seen on (was: a straight line across
-                # its absence, from where it left to where it came back, as if walked)
-                for run in _runs([f for f, _ in recent]):
-                    draw_trails(image, {tid: [recent[i][1] for i in run]})
+                # the foot points of frames k - trail + 1 .. k (was: the last `trail` points
+                # however old, a line across the track's absence from a point long gone), one
+                # line for each run of frames it was seen on (was: a straight line across its
+                # absence, from where it left to where it came back, as if walked)
+                frames, feet = paths[tid]
+                a, b = np.searchsorted(frames, [k - trail, k], side="right")
+                for run in _runs(frames[a:b], feet[a:b]):
+                    _trail_line(image, run, colour_of(tid))
             writer.write(image)
     return Path(path)
 
 
-def _runs(frames: Sequence[float]) -> list[range]:
-    """Index ranges of `frames` (ascending) that run without a missing frame between them."""
-    cuts = [0, *(i for i in range(1, len(frames)) if frames[i] - frames[i - 1] > 1), len(frames)]
-    return [range(a, b) for a, b in itertools.pairwise(cuts) if b > a]
+def _foot_paths(rows: F64) -> dict[int, tuple[F64, F64]]:
+    """Each id's frames, ascending (n,), and the foot points of its boxes on them (n, 2)."""
+    ids = np.trunc(rows[:, 1])  # as int() takes an id
+    r = rows[np.lexsort((rows[:, 0], ids))]
+    cuts = [0, *(np.flatnonzero(np.diff(np.trunc(r[:, 1]))) + 1), len(r)]
+    feet = np.column_stack([r[:, 2] + r[:, 4] / 2, r[:, 3] + r[:, 5]])
+    return {int(r[a, 1]): (r[a:b, 0], feet[a:b]) for a, b in itertools.pairwise(cuts) if b > a}
+
+
+_S = TypeVar("_S", bound=np.generic)
+
+
+def _runs(frames: F64, points: NDArray[_S]) -> list[NDArray[_S]]:
+    """`points` split where `frames` (ascending) skip a frame: one part for each run."""
+    return np.split(points, np.flatnonzero(np.diff(frames) > 1) + 1)
+
+
+def _trail_line(image: NDArray[np.uint8], pts: ArrayLike, colour: tuple[int, int, int]) -> None:
+    """Foot points `pts` (n, 2) as a line on `image`, in place; nothing for fewer than 2."""
+    line = np.round(np.asarray(pts, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
+    if len(line) > 1:
+        cv2.polylines(image, [line], False, colour, ink_scale(image.shape), cv2.LINE_AA)
 
 
 class TrackLike(Protocol):
@@ -546,7 +559,7 @@ def plot_trajectories(
         c = colour_of(tid)
         # the frames it was seen on 2 px wide, a hole in the track 1 px (was: 2 px, as if seen)
         cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, c, 1, cv2.LINE_AA)
-        runs = [pts[run.start : run.stop].reshape(-1, 1, 2) for run in _runs(list(frames))]
+        runs = [run.reshape(-1, 1, 2) for run in _runs(frames, pts)]
         cv2.polylines(canvas, runs, False, c, 2, cv2.LINE_AA)
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
     # each id at its path's first point, on a tag of its colour, over every path, whole inside
