@@ -349,13 +349,15 @@ def test_a_trail_is_not_drawn_across_frames_its_track_is_absent(tmp_path: Path) 
     assert got[13][26, 30:75].max() < 30  # nothing between them
 
 
-def test_a_plot_draws_a_hole_in_a_track_thin(tmp_path: Path) -> None:
-    """Was: a hole (frames 6-9 missing) drawn as the observed path is, 2 px wide."""
+@pytest.mark.parametrize("filled", [False, True])
+def test_a_plot_draws_a_hole_in_a_track_thin(tmp_path: Path, filled: bool) -> None:
+    """Was: a hole (frames 6-9 missing, or filled) drawn as the observed path is, 2 px wide."""
     import cv2
 
     rows = np.array(
-        [[k, 3, 10 + 2 * (k - 1), 10, 8, 16] for k in range(1, 6)]
-        + [[k, 3, 80 + 2 * (k - 10), 10, 8, 16] for k in range(10, 15)],
+        [[k, 3, 10 + 2 * (k - 1), 10, 8, 16, 1, -1, -1, -1] for k in range(1, 6)]
+        + [[k, 3, 80 + 2 * (k - 10), 10, 8, 16, 1, -1, -1, -1] for k in range(10, 15)]
+        + [[k, 3, 18 + 16 * (k - 5), 10, 8, 16, 1, 1, -1, -1] for k in range(6, 10) if filled],
         float,
     )
     dark = np.zeros((48, 120, 3), np.uint8)

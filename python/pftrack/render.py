@@ -80,8 +80,7 @@ def draw_tracks(
     out: NDArray[np.uint8] = frame.copy()
     k = ink_scale(out.shape)
     # was: column 8 == 1 alone, drawn thin: every box of MOT16+ truth (class 1, pedestrian)
-    marks = rows[:, FLAG_COLUMN : FLAG_COLUMN + 3]
-    filled = np.all(marks == FILLED_MARK, axis=1) if marks.shape[1] == 3 else np.zeros(len(rows))
+    filled = _filled(rows)
     for i, r in enumerate(rows):
         tid = int(r[1])
         x, y, w, h = (int(round(v)) for v in r[2:6])
@@ -100,6 +99,15 @@ def draw_tracks(
     # only where it fits in a corner (was: on a 32x24 frame, a tag over two thirds of it)
     if label and 2 * (6 * k + tw) <= out.shape[1] and 3 * (15 * k + base) <= out.shape[0]:
         _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k)
+    return out
+
+
+def _filled(rows: F64) -> NDArray[np.bool_]:
+    """Which MOT rows (M, 6+) carry a filled row's mark, columns 8-10 ``1, -1, -1``."""
+    marks = rows[:, FLAG_COLUMN : FLAG_COLUMN + 3]
+    if marks.shape[1] < 3:
+        return np.zeros(len(rows), bool)
+    out: NDArray[np.bool_] = np.all(marks == FILLED_MARK, axis=1)
     return out
 
 
@@ -475,7 +483,8 @@ def plot_trajectories(
     """Draw each track's foot-point path (bottom centre of its box) as a PNG, atomically.
 
     Each path is 2 px wide over the frames its track was seen on and 1 px across a hole (frames
-    it has no row on), with its id at its first point and a dot at its last.
+    it has no row on, or filled rows: columns 8-10 ``1, -1, -1``, as ``pftrack recover`` marks
+    them), with its id at its first point and a dot at its last.
 
     Parameters
     ----------
@@ -542,29 +551,32 @@ def plot_trajectories(
                 )
         canvas = np.full((h, w, 3), 30, np.uint8)
 
-    def paths(r: NDArray[np.float64]) -> dict[int, tuple[F64, NDArray[np.int32]]]:
+    def paths(r: F64) -> dict[int, tuple[F64, NDArray[np.int32], NDArray[np.bool_]]]:
+        """Each id's frames, foot points and whether each was seen (not filled), by frame."""
         out = {}
         for tid in np.unique(r[:, 1]).astype(int):
             t = r[r[:, 1] == tid]
             t = t[np.argsort(t[:, 0], kind="stable")]
             pts = np.column_stack([t[:, 2] + t[:, 4] / 2, t[:, 3] + t[:, 5]])
-            out[tid] = t[:, 0], np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
+            pts = np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
+            out[tid] = t[:, 0], pts, ~_filled(t)
         return out
 
     if truth is not None and len(truth):
-        for _, pts in paths(truth).values():
+        for _, pts, _ in paths(truth).values():
             cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, (170, 170, 170), 1, cv2.LINE_AA)
     drawn = paths(rows) if len(rows) else {}
-    for tid, (frames, pts) in drawn.items():
+    for tid, (frames, pts, seen) in drawn.items():
         c = colour_of(tid)
-        # the frames it was seen on 2 px wide, a hole in the track 1 px (was: 2 px, as if seen)
+        # the frames it was seen on 2 px wide, a hole in the track, or the rows filled there,
+        # 1 px (was: 2 px, as if seen)
         cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, c, 1, cv2.LINE_AA)
-        runs = [run.reshape(-1, 1, 2) for run in _runs(frames, pts)]
+        runs = [run.reshape(-1, 1, 2) for run in _runs(frames[seen], pts[seen])]
         cv2.polylines(canvas, runs, False, c, 2, cv2.LINE_AA)
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
     # each id at its path's first point, on a tag of its colour, over every path, whole inside
     # the canvas (was: the id's colour on the dimmed frame, off it for a track from outside)
-    for tid, (_, pts) in drawn.items():
+    for tid, (_, pts, _) in drawn.items():
         (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)
         x = max(1, min(int(pts[0][0]), canvas.shape[1] - tw - 1))
         y = min(max(th + 1, int(pts[0][1])), canvas.shape[0] - base - 1)
