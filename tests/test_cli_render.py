@@ -206,3 +206,28 @@ def test_frames_too_wide_for_h264_are_refused_before_any_work(
         "(x264), not 20002x64; write an .avi (Motion-JPEG) instead\n"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_the_plot_title_says_what_it_shows_and_the_plot_what_the_video_does(
+    scene_files: tuple[Scene, Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Was the sequence's name alone: not what the lines are, nor of how many tracks; and the
+    plot drew the rows past the video's end that the warning says are not drawn."""
+    import pftrack.render
+
+    scene, video, _ = scene_files
+    tracks = tmp_path / "late.txt"
+    write_mot(tracks, np.vstack([scene.truth, [35, 99, 10, 10, 5, 9, 1, -1, -1, -1]]))
+    calls = []
+    real = pftrack.render.plot_trajectories
+
+    def spy(path: Path, rows: np.ndarray, *args: object, title: str = "", **kw: object) -> Path:
+        calls.append((rows, title))
+        return real(path, rows, *args, title=title, **kw)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(pftrack.render, "plot_trajectories", spy)
+    argv = ["-q", "render", str(video), str(tracks), "--out", str(tmp_path / "v.mp4")]
+    assert main([*argv, "--plot", str(tmp_path / "p.png")]) == 0
+    [(rows, title)] = calls
+    assert title == "scene.avi: foot-point paths of 3 tracks, frames 1-30"
+    assert len(rows) == len(scene.truth) and rows[:, 0].max() == 30

@@ -263,3 +263,126 @@ def test_the_pictures_refuse_what_they_cannot_draw_in_one_line(tmp_path: Path) -
     assert sorted(os.listdir(tmp_path)) == []
     assert draw_tracks(frame, rows[:1], label="frame 1").shape == frame.shape  # still drawn
     assert draw_tracks(frame, np.zeros((0, 8))).shape == frame.shape
+
+
+def test_a_filled_box_is_dashed_and_a_ground_truth_class_is_not_a_fill() -> None:
+    """Was: any row whose column 8 is 1 drawn thin (said: dashed), MOT16+ truth's class 1 too."""
+    from pftrack.render import draw_tracks
+
+    frame = np.zeros((80, 100, 3), np.uint8)
+
+    def top_edge(extra: list[float]) -> np.ndarray:
+        row = np.array([[1, 4, 20, 30, 60, 40, *extra]], float)
+        return draw_tracks(frame, row)[30, 22:78].max(axis=1)  # the box's top edge, corners out
+
+    observed = top_edge([])  # a 6-column row: observed
+    assert observed.min() > 100  # solid
+    filled = top_edge([1, 1, -1, -1])  # pftrack's interpolated flag (filled_mask)
+    assert filled.max() > 100 and (filled < 30).sum() >= 10  # dashes and gaps
+    for truth in ([1, 1, 0.5, -1], [1, 1, -1, 0.8], [1, 1]):  # MOT16+ truth: class 1, visibility
+        np.testing.assert_array_equal(top_edge(truth), observed)
+
+
+@pytest.mark.parametrize("left", [-30.0, 90.0, 40.0])
+def test_an_id_is_drawn_whole_inside_the_frame_when_its_box_is_not(left: float) -> None:
+    """Was: the label at the box's left edge, off the frame for a box entering from the left."""
+    from pftrack.render import draw_tracks
+
+    frame = np.zeros((80, 120, 3), np.uint8)
+    row = np.array([[1, 123456, left, 40, 50, 30]], float)
+    label = draw_tracks(frame, row)[:36].any(axis=2)  # above the box: the label alone
+    centred = draw_tracks(frame, row * [1, 1, 0, 1, 1, 1] + [0, 0, 30, 0, 0, 0])[:36].any(axis=2)
+    assert label.sum() == centred.sum() > 50  # all of it, as of a box in the middle
+
+
+@pytest.mark.parametrize("tid", [7, 8, 123456])
+def test_ids_and_the_frame_number_are_legible_on_any_frame(tid: int) -> None:
+    """Was: white frame numbers on a white frame, an id in its colour on that colour, unseen."""
+    from pftrack.render import draw_tracks
+
+    row = np.array([[1, tid, 40, 40, 50, 30]], float)
+    for fill in [(255, 255, 255), colour_of(tid), (0, 0, 0)]:
+        frame = np.full((80, 120, 3), fill, np.uint8)
+        out = draw_tracks(frame, row, "frame 1").astype(int)
+        for where in (out[:20, :60], out[22:38, 30:110]):  # the frame number; the id over its box
+            # the text stands out of what is drawn around it: a dark and a light shade both
+            luma = where @ [0.114, 0.587, 0.299]
+            assert luma.max() - luma.min() > 100, (fill, where.shape)
+
+
+def test_paths_title_counts_the_tracks_and_frames() -> None:
+    from pftrack.render import paths_title
+
+    assert paths_title("s", _ROWS) == "s: foot-point paths of 2 tracks, frames 1-5"
+    assert paths_title("s", _ROWS[:1]) == "s: foot-point paths of 1 track, frame 1"
+    assert paths_title("s", []) == "s: foot-point paths of 0 tracks"
+
+
+@pytest.mark.parametrize("start", [-40.0, 15.0, 190.0])
+def test_a_plot_labels_each_path_legibly_inside_the_canvas(tmp_path: Path, start: float) -> None:
+    """Was: the id in its colour at the path's first point: off the canvas for a track that
+    came in from outside, dim for a blue one on a dark frame."""
+    import cv2
+
+    tid = min(range(1, 50), key=lambda i: sum(np.array(colour_of(i)) * [0.114, 0.587, 0.299]))
+    rows = np.array([[k, tid, start + 10 * k, 10, 10, 30, 1, -1, -1, -1] for k in range(8)], float)
+    dark = np.zeros((80, 200, 3), np.uint8)
+    image = cv2.imread(str(plot_trajectories(tmp_path / "p.png", rows[::-1], background=dark)))
+    luma = image.astype(int) @ [0.114, 0.587, 0.299]
+    near = luma[20:45, max(0, int(start) - 5) : int(start) + 45]  # about where the path starts
+    assert near.max() > 200  # white ink on the id's tag
+    assert (luma > 200).sum() > 10
+
+
+def test_a_trail_is_not_drawn_across_frames_its_track_is_absent(tmp_path: Path) -> None:
+    """Was: a straight line from where a track was last seen to where it came back, as if walked
+    (a track that left the frame and re-entered within `trail` frames, or a hole in a file)."""
+    rows = np.array(
+        [[k, 3, 10 + 2 * (k - 1), 10, 8, 16, 1, -1, -1, -1] for k in range(1, 6)]
+        + [[k, 3, 80 + 2 * (k - 10), 10, 8, 16, 1, -1, -1, -1] for k in range(10, 15)],
+        float,
+    )
+    frames = [np.zeros((48, 120, 3), np.uint8) for _ in range(14)]
+    _, got = decode(write_annotated_video(tmp_path / "v.mp4", frames, rows, fps=10, trail=40))
+    assert got[4][26, 15:21].max(axis=1).min() > 100  # frames 1-5: their trail
+    assert got[13][26, 85:92].max(axis=1).min() > 100  # frames 10-14: theirs
+    assert got[13][26, 30:75].max() < 30  # nothing between them
+
+
+@pytest.mark.parametrize("filled", [False, True])
+def test_a_plot_draws_a_hole_in_a_track_thin(tmp_path: Path, filled: bool) -> None:
+    """Was: a hole (frames 6-9 missing, or filled) drawn as the observed path is, 2 px wide."""
+    import cv2
+
+    rows = np.array(
+        [[k, 3, 10 + 2 * (k - 1), 10, 8, 16, 1, -1, -1, -1] for k in range(1, 6)]
+        + [[k, 3, 80 + 2 * (k - 10), 10, 8, 16, 1, -1, -1, -1] for k in range(10, 15)]
+        + [[k, 3, 18 + 16 * (k - 5), 10, 8, 16, 1, 1, -1, -1] for k in range(6, 10) if filled],
+        float,
+    )
+    dark = np.zeros((48, 120, 3), np.uint8)
+    image = cv2.imread(str(plot_trajectories(tmp_path / "p.png", rows, background=dark)))
+    lit = image.max(axis=2) > 60
+    assert lit[:, 45].sum() == 1 and lit[:, 90].sum() >= 2  # the hole 1 px, the path 2 or more
+
+
+def test_a_frame_too_small_for_its_number_is_not_covered_by_it() -> None:
+    """Was: on a 32x24 frame the frame number's tag hid two thirds of the picture."""
+    from pftrack.render import draw_tracks
+
+    for size in [(24, 32), (60, 100)]:
+        frame = np.full((*size, 3), 90, np.uint8)
+        changed = (draw_tracks(frame, np.zeros((0, 6)), "frame 123") != 90).any(axis=2)
+        assert changed.mean() < 0.25, size
+    shown = draw_tracks(np.full((120, 160, 3), 90, np.uint8), np.zeros((0, 6)), "frame 123")
+    assert (shown != 90).any(axis=2).mean() > 0.02  # drawn where it fits
+
+
+def test_a_coasting_track_is_dashed_while_tracking(tmp_path: Path) -> None:
+    renderer = TrackRenderer(tmp_path / "a.mp4", 7, threaded=False)
+    seen = FakeTrack(1, np.array([10.0, 20.0, 60.0, 30.0]))
+    coasting = FakeTrack(2, np.array([10.0, 60.0, 60.0, 30.0]), time_since_update=3)
+    renderer.add(np.zeros((100, 120, 3), np.uint8), [seen, coasting])
+    _, [frame] = decode(renderer.close())
+    solid, dashed = frame[20, 14:66].max(axis=1), frame[60, 14:66].max(axis=1)
+    assert solid.min() > 100 and dashed.max() > 100 and (dashed < 40).sum() >= 10

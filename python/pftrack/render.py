@@ -9,7 +9,7 @@ import threading
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Protocol
+from typing import Protocol, TypeVar
 
 import cv2
 import numpy as np
@@ -20,6 +20,7 @@ from pftrack._typing import F64, PathLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
 from pftrack.io.video_writer import VideoWriter
+from pftrack.recovery.linking import FILLED_MARK, FLAG_COLUMN
 
 __all__ = [
     "TrackRenderer",
@@ -27,6 +28,7 @@ __all__ = [
     "draw_tracks",
     "draw_trails",
     "ink_scale",
+    "paths_title",
     "plot_trajectories",
     "write_annotated_video",
 ]
@@ -57,9 +59,14 @@ def ink_scale(shape: tuple[int, ...]) -> int:
 def draw_tracks(
     frame: NDArray[np.uint8], rows: NDArray[np.float64], label: str = ""
 ) -> NDArray[np.uint8]:
-    """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids (dashed if filled).
+    """Draw MOT rows (k, 6+) of one frame on a copy of `frame`: boxes and ids.
 
-    Lines and labels grow with the frame (:func:`ink_scale`).
+    A box is dashed where it was not observed: a row that ``pftrack recover`` or ``smooth``
+    filled (columns 8-10 ``1, -1, -1``, :func:`pftrack.recovery.filled_mask`), or a track
+    coasting in :class:`TrackRenderer`; other rows are solid (MOT16+ ground truth's class 1
+    in column 8 too). Lines and labels grow with the frame (:func:`ink_scale`). `label` goes in
+    the top-left corner of a frame with room for it there (at most half its width and a third
+    of its height: ``"frame 123"`` from 138x48 pixels).
 
     Raises
     ------
@@ -72,32 +79,89 @@ def draw_tracks(
     _text(label, "draw_tracks", "label")
     out: NDArray[np.uint8] = frame.copy()
     k = ink_scale(out.shape)
-    for r in rows:
+    # was: column 8 == 1 alone, drawn thin: every box of MOT16+ truth (class 1, pedestrian)
+    filled = _filled(rows)
+    for i, r in enumerate(rows):
         tid = int(r[1])
         x, y, w, h = (int(round(v)) for v in r[2:6])
         c = colour_of(tid)
-        cv2.rectangle(out, (x, y), (x + w, y + h), c, k * (1 if len(r) > 7 and r[7] == 1 else 2))
-        cv2.putText(
-            out, text_for_opencv(str(tid)), (x, max(10 * k, y - 3 * k)), cv2.FONT_HERSHEY_SIMPLEX,
-            0.4 * k, c, k, cv2.LINE_AA,
-        )  # fmt: skip
-    if label:
-        cv2.putText(
-            out, text_for_opencv(label), (5 * k, 15 * k), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k,
-            (255, 255, 255), k, cv2.LINE_AA,
-        )  # fmt: skip
+        if filled[i]:
+            _dashed_rectangle(out, (x, y), (x + w, y + h), c, 2 * k, 6 * k)
+        else:
+            cv2.rectangle(out, (x, y), (x + w, y + h), c, 2 * k)
+        (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, k)
+        # the whole label inside the frame, over the part of the box that is (was: at the box's
+        # left edge, off the frame for a box entering from the left, cut for one leaving right)
+        x = max(k, min(x, out.shape[1] - tw - k))
+        y = min(max(th + k, y - 3 * k), out.shape[0] - base - k)
+        _tag(out, str(tid), (x, y), 0.4 * k, c, k)
+    (tw, _), base = cv2.getTextSize(text_for_opencv(label), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k, k)
+    # only where it fits in a corner (was: on a 32x24 frame, a tag over two thirds of it)
+    if label and 2 * (6 * k + tw) <= out.shape[1] and 3 * (15 * k + base) <= out.shape[0]:
+        _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k)
     return out
+
+
+def _filled(rows: F64) -> NDArray[np.bool_]:
+    """Which MOT rows (M, 6+) carry a filled row's mark, columns 8-10 ``1, -1, -1``."""
+    marks = rows[:, FLAG_COLUMN : FLAG_COLUMN + 3]
+    if marks.shape[1] < 3:
+        return np.zeros(len(rows), bool)
+    out: NDArray[np.bool_] = np.all(marks == FILLED_MARK, axis=1)
+    return out
+
+
+def _tag(
+    image: NDArray[np.uint8],
+    text: str,
+    org: tuple[int, int],
+    scale: float,
+    colour: tuple[int, int, int],
+    k: int,
+) -> None:
+    """`text` from `org` (its baseline's left end) on a box of `colour`, in black or white.
+
+    Legible on any frame (was: a white frame number on a white frame, a coloured id on that
+    colour): the ink is whichever of black and white stands out of `colour` more; `k` is the
+    ink's thickness and the box's margin.
+    """
+    (tw, th), base = cv2.getTextSize(text_for_opencv(text), cv2.FONT_HERSHEY_SIMPLEX, scale, k)
+    x, y = org
+    cv2.rectangle(image, (x - k, y - th - k), (x + tw + k - 1, y + base), colour, -1)
+    luma = 0.114 * colour[0] + 0.587 * colour[1] + 0.299 * colour[2]  # BT.601, BGR
+    ink = (0, 0, 0) if luma > 127 else (255, 255, 255)
+    cv2.putText(
+        image, text_for_opencv(text), org, cv2.FONT_HERSHEY_SIMPLEX, scale, ink, k, cv2.LINE_AA
+    )
+
+
+def _dashed_rectangle(
+    image: NDArray[np.uint8],
+    p0: tuple[int, int],
+    p1: tuple[int, int],
+    colour: tuple[int, int, int],
+    thickness: int,
+    dash: int,
+) -> None:
+    """A rectangle from corner `p0` to `p1` of dashes `dash` px long and gaps as long."""
+    (x0, y0), (x1, y1) = p0, p1
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
+    for a, b in itertools.pairwise(corners):
+        length = max(abs(b[0] - a[0]), abs(b[1] - a[1]))
+        for s in range(0, length + 1, 2 * dash):
+            e = min(s + dash, length)
+            t0, t1 = s / max(length, 1), e / max(length, 1)
+            q0 = (round(a[0] + (b[0] - a[0]) * t0), round(a[1] + (b[1] - a[1]) * t0))
+            q1 = (round(a[0] + (b[0] - a[0]) * t1), round(a[1] + (b[1] - a[1]) * t1))
+            cv2.line(image, q0, q1, colour, thickness)
 
 
 def draw_trails(
     frame: NDArray[np.uint8], trails: Mapping[int, Sequence[tuple[float, float]]]
 ) -> None:
     """Draw each id's recent foot points on `frame` in place, as a line in the id's colour."""
-    k = ink_scale(frame.shape)
     for tid, pts in trails.items():
-        if len(pts) > 1:
-            line = np.round(np.asarray(pts, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
-            cv2.polylines(frame, [line], False, colour_of(tid), k, cv2.LINE_AA)
+        _trail_line(frame, pts, colour_of(tid))
 
 
 def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
@@ -151,7 +215,8 @@ def write_annotated_video(
     """Write `frames` with the tracks of `rows` (MOT, 1-based frames) drawn on, atomically.
 
     ``.mp4`` is H.264 (see :class:`~pftrack.io.video_writer.VideoWriter`, whose x264 `preset`
-    this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames.
+    this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames,
+    one line for each run of frames it was seen on (none across a frame it is absent from).
 
     Raises
     ------
@@ -170,22 +235,46 @@ def write_annotated_video(
         raise ValueError("write_annotated_video: frames is empty; no frame to write")
     by_frame = group_by_frame(rows)
     empty = np.zeros((0, 10))
-    trails: dict[int, deque[tuple[int, tuple[float, float]]]] = {}  # (frame, foot point)
+    paths = _foot_paths(rows) if trail > 0 else {}
     with VideoWriter(path, fps, preset=preset) as writer:
         for k, frame in enumerate(itertools.chain([first], it), start=1):
             here = by_frame.get(k, empty)
-            for r in here:
-                pts = trails.setdefault(int(r[1]), deque(maxlen=max(trail, 1)))
-                pts.append((k, _foot(r[2:6])))
-            # the foot points of frames k - trail + 1 .. k (was: the last `trail` points however
-            # old, a line across the track's absence from a point long gone)
-            shown = {}
-            for tid in {int(r[1]) for r in here} if trail > 0 else ():
-                shown[tid] = [p for f, p in trails[tid] if f > k - trail]
             image = draw_tracks(frame, here, f"frame {k}")
-            draw_trails(image, shown)
+            for tid in {int(r[1]) for r in here} if trail > 0 else ():
+                # the foot points of frames k - trail + 1 .. k (was: the last `trail` points
+                # however old, a line across the track's absence from a point long gone), one
+                # line for each run of frames it was seen on (was: a straight line across its
+                # absence, from where it left to where it came back, as if walked)
+                frames, feet = paths[tid]
+                a, b = np.searchsorted(frames, [k - trail, k], side="right")
+                for run in _runs(frames[a:b], feet[a:b]):
+                    _trail_line(image, run, colour_of(tid))
             writer.write(image)
     return Path(path)
+
+
+def _foot_paths(rows: F64) -> dict[int, tuple[F64, F64]]:
+    """Each id's frames, ascending (n,), and the foot points of its boxes on them (n, 2)."""
+    ids = np.trunc(rows[:, 1])  # as int() takes an id
+    r = rows[np.lexsort((rows[:, 0], ids))]
+    cuts = [0, *(np.flatnonzero(np.diff(np.trunc(r[:, 1]))) + 1), len(r)]
+    feet = np.column_stack([r[:, 2] + r[:, 4] / 2, r[:, 3] + r[:, 5]])
+    return {int(r[a, 1]): (r[a:b, 0], feet[a:b]) for a, b in itertools.pairwise(cuts) if b > a}
+
+
+_S = TypeVar("_S", bound=np.generic)
+
+
+def _runs(frames: F64, points: NDArray[_S]) -> list[NDArray[_S]]:
+    """`points` split where `frames` (ascending) skip a frame: one part for each run."""
+    return np.split(points, np.flatnonzero(np.diff(frames) > 1) + 1)
+
+
+def _trail_line(image: NDArray[np.uint8], pts: ArrayLike, colour: tuple[int, int, int]) -> None:
+    """Foot points `pts` (n, 2) as a line on `image`, in place; nothing for fewer than 2."""
+    line = np.round(np.asarray(pts, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
+    if len(line) > 1:
+        cv2.polylines(image, [line], False, colour, ink_scale(image.shape), cv2.LINE_AA)
 
 
 class TrackLike(Protocol):
@@ -262,8 +351,9 @@ class TrackRenderer:
         rows, seen = [], set()
         for t in tracks:
             box = np.asarray(t.box_xywh, dtype=np.float64)
-            # MOT row; column 8: 1 = coasting, drawn thin
-            rows.append([self._n, t.id, *box[:4], 0.0, 1.0 if t.time_since_update else 0.0])
+            # MOT row; columns 8-10 a filled row's mark when coasting: drawn dashed
+            unseen = FILLED_MARK if t.time_since_update else (-1.0, -1.0, -1.0)
+            rows.append([self._n, t.id, *box[:4], 0.0, *unseen])
             seen.add(t.id)
             if self.trail:
                 trail = self._trails.setdefault(t.id, deque(maxlen=self.trail))
@@ -271,7 +361,7 @@ class TrackRenderer:
         for tid in set(self._trails) - seen:
             del self._trails[tid]
         trails = {tid: list(pts) for tid, pts in self._trails.items()}
-        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 8), trails)
+        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 10), trails)
         if self._queue is None:
             self._draw(job)
         else:
@@ -368,6 +458,20 @@ def _with_axes(canvas: NDArray[np.uint8], title: str) -> NDArray[np.uint8]:
     return out
 
 
+def paths_title(name: str, rows: ArrayLike) -> str:
+    """A title saying what :func:`plot_trajectories` of `rows` shows, for a source `name`.
+
+    ``"PETS09-S2L1: foot-point paths of 23 tracks, frames 1-795"`` (no rows: ``0 tracks``).
+    """
+    a = _track_rows(rows, "paths_title")
+    n = len(np.unique(a[:, 1]))
+    what = f"{name}: foot-point paths of {n} track{'s' * (n != 1)}"
+    if not len(a):
+        return what
+    first, last = int(a[:, 0].min()), int(a[:, 0].max())
+    return f"{what}, frame {first}" if first == last else f"{what}, frames {first}-{last}"
+
+
 def plot_trajectories(
     path: PathLike,
     rows: NDArray[np.float64],
@@ -377,6 +481,10 @@ def plot_trajectories(
     title: str = "",
 ) -> Path:
     """Draw each track's foot-point path (bottom centre of its box) as a PNG, atomically.
+
+    Each path is 2 px wide over the frames its track was seen on and 1 px across a hole (frames
+    it has no row on, or filled rows: columns 8-10 ``1, -1, -1``, as ``pftrack recover`` marks
+    them), with its id at its first point and a dot at its last.
 
     Parameters
     ----------
@@ -443,32 +551,36 @@ def plot_trajectories(
                 )
         canvas = np.full((h, w, 3), 30, np.uint8)
 
-    def paths(r: NDArray[np.float64]) -> dict[int, NDArray[np.int32]]:
+    def paths(r: F64) -> dict[int, tuple[F64, NDArray[np.int32], NDArray[np.bool_]]]:
+        """Each id's frames, foot points and whether each was seen (not filled), by frame."""
         out = {}
         for tid in np.unique(r[:, 1]).astype(int):
             t = r[r[:, 1] == tid]
-            t = t[np.argsort(t[:, 0])]
+            t = t[np.argsort(t[:, 0], kind="stable")]
             pts = np.column_stack([t[:, 2] + t[:, 4] / 2, t[:, 3] + t[:, 5]])
-            out[tid] = np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
+            pts = np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
+            out[tid] = t[:, 0], pts, ~_filled(t)
         return out
 
     if truth is not None and len(truth):
-        for pts in paths(truth).values():
+        for _, pts, _ in paths(truth).values():
             cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, (170, 170, 170), 1, cv2.LINE_AA)
-    for tid, pts in paths(rows).items() if len(rows) else []:
+    drawn = paths(rows) if len(rows) else {}
+    for tid, (frames, pts, seen) in drawn.items():
         c = colour_of(tid)
-        cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, c, 2, cv2.LINE_AA)
+        # the frames it was seen on 2 px wide, a hole in the track, or the rows filled there,
+        # 1 px (was: 2 px, as if seen)
+        cv2.polylines(canvas, [pts.reshape(-1, 1, 2)], False, c, 1, cv2.LINE_AA)
+        runs = [run.reshape(-1, 1, 2) for run in _runs(frames[seen], pts[seen])]
+        cv2.polylines(canvas, runs, False, c, 2, cv2.LINE_AA)
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
-        cv2.putText(
-            canvas,
-            text_for_opencv(str(tid)),
-            tuple(int(v) for v in pts[0]),
-            cv2.FONT_HERSHEY_SIMPLEX,
-            0.4,
-            c,
-            1,
-            cv2.LINE_AA,
-        )
+    # each id at its path's first point, on a tag of its colour, over every path, whole inside
+    # the canvas (was: the id's colour on the dimmed frame, off it for a track from outside)
+    for tid, (_, pts, _) in drawn.items():
+        (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)
+        x = max(1, min(int(pts[0][0]), canvas.shape[1] - tw - 1))
+        y = min(max(th + 1, int(pts[0][1])), canvas.shape[0] - base - 1)
+        _tag(canvas, str(tid), (x, y), 0.4, colour_of(tid), 1)
     if background is None:
         canvas = _with_axes(canvas, title)
     elif title:

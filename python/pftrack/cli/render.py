@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
+from pathlib import Path
 from typing import Any
 
 from pftrack.cli._options import (
@@ -39,7 +40,7 @@ def add_parser(sub: Any) -> None:
         "with --plot, a trajectory plot on the first frame. Row frame k is drawn on the "
         "video's k-th frame. pftrack track --render shows the boxes as tracked online; this "
         "shows a file as it is: pftrack track's final tracks, the output of pftrack smooth "
-        "or recover (filled rows too), another tracker's, or the ground truth.",
+        "or recover (filled rows dashed), another tracker's, or the ground truth.",
     )
     p.add_argument("source", help="video file, image folder, or MOTChallenge sequence folder")
     p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,...)")
@@ -90,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     )
     from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery.linking import read_tracks
-    from pftrack.render import plot_trajectories, write_annotated_video
+    from pftrack.render import paths_title, plot_trajectories, write_annotated_video
 
     if not 0 <= args.trail <= 100_000:
         raise ValueError(f"--trail is {args.trail}, expected 0 to 100000 frames")
@@ -139,7 +140,11 @@ def run(args: argparse.Namespace) -> int:
                                   trail=args.trail)  # fmt: skip
             if args.plot:
                 plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))
-                plot_trajectories(plot, rows, background=kept[0], title=source.name)
+                # the sequence's or the file's name, as pftrack track's plot (was the whole path)
+                name = source.sequence.name if source.sequence else Path(args.source).name
+                # the rows the video shows (was: those past its end too, said not drawn)
+                seen = rows[rows[:, 0] <= drawn[0]]
+                plot_trajectories(plot, seen, background=kept[0], title=paths_title(name, seen))
             hold_interrupts()  # the work is done: the outputs are put in place whatever comes
     late = rows[rows[:, 0] > drawn[0]]
     notes = [str(w.message) for w in caught] + _outside(rows, source.width, source.height)

@@ -257,7 +257,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.video import FrameSource, check_source, is_live_source
     from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery import LinkConfig
-    from pftrack.render import TrackRenderer, plot_trajectories
+    from pftrack.render import TrackRenderer, paths_title, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections
 
     opencv_single_threaded()
@@ -368,7 +368,8 @@ def run(args: argparse.Namespace) -> int:
                         else Path(args.source).name
                     )
                     plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))  # device: png
-                    plot_trajectories(plot, result.rows, background=first[0], title=name)
+                    title = paths_title(name, result.rows)
+                    plot_trajectories(plot, result.rows, background=first[0], title=title)
                     said.append(f"trajectory plot -> {args.plot}")
                 hold_interrupts()  # the work is done: the outputs are put in place whatever comes
             committed = True
