@@ -77,6 +77,11 @@ def draw_tracks(
     """
     rows = _track_rows(rows, "draw_tracks")  # was "not enough values to unpack" of (k, 5)
     _text(label, "draw_tracks", "label")
+    return _draw_boxes(frame, rows, label)
+
+
+def _draw_boxes(frame: NDArray[np.uint8], rows: F64, label: str) -> NDArray[np.uint8]:
+    """:func:`draw_tracks` of rows checked already (each frame of a video whose rows were)."""
     out: NDArray[np.uint8] = frame.copy()
     k = ink_scale(out.shape)
     # was: column 8 == 1 alone, drawn thin: every box of MOT16+ truth (class 1, pedestrian)
@@ -89,16 +94,15 @@ def draw_tracks(
             _dashed_rectangle(out, (x, y), (x + w, y + h), c, 2 * k, 6 * k)
         else:
             cv2.rectangle(out, (x, y), (x + w, y + h), c, 2 * k)
-        (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4 * k, k)
         # the whole label inside the frame, over the part of the box that is (was: at the box's
         # left edge, off the frame for a box entering from the left, cut for one leaving right)
-        x = max(k, min(x, out.shape[1] - tw - k))
-        y = min(max(th + k, y - 3 * k), out.shape[0] - base - k)
-        _tag(out, str(tid), (x, y), 0.4 * k, c, k)
-    (tw, _), base = cv2.getTextSize(text_for_opencv(label), cv2.FONT_HERSHEY_SIMPLEX, 0.45 * k, k)
-    # only where it fits in a corner (was: on a 32x24 frame, a tag over two thirds of it)
-    if label and 2 * (6 * k + tw) <= out.shape[1] and 3 * (15 * k + base) <= out.shape[0]:
-        _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k)
+        _tag(out, str(tid), (x, y - 3 * k), 0.4 * k, c, k)
+    if label:
+        size = _text_size(label, 0.45 * k, k)
+        (tw, _), base = size
+        # only where it fits in a corner (was: on a 32x24 frame, a tag over two thirds of it)
+        if 2 * (6 * k + tw) <= out.shape[1] and 3 * (15 * k + base) <= out.shape[0]:
+            _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k, size)
     return out
 
 
@@ -111,6 +115,12 @@ def _filled(rows: F64) -> NDArray[np.bool_]:
     return out
 
 
+def _text_size(text: str, scale: float, k: int) -> tuple[tuple[int, int], int]:
+    """``cv2.getTextSize`` of `text` as :func:`_tag` draws it: ((width, height), baseline)."""
+    (tw, th), base = cv2.getTextSize(text_for_opencv(text), cv2.FONT_HERSHEY_SIMPLEX, scale, k)
+    return (tw, th), base
+
+
 def _tag(
     image: NDArray[np.uint8],
     text: str,
@@ -118,20 +128,24 @@ def _tag(
     scale: float,
     colour: tuple[int, int, int],
     k: int,
+    size: tuple[tuple[int, int], int] | None = None,
 ) -> None:
-    """`text` from `org` (its baseline's left end) on a box of `colour`, in black or white.
+    """`text` near `org` (its baseline's left end) on a box of `colour`, in black or white.
 
     Legible on any frame (was: a white frame number on a white frame, a coloured id on that
     colour): the ink is whichever of black and white stands out of `colour` more; `k` is the
-    ink's thickness and the box's margin.
+    ink's thickness and the box's margin. The tag is moved the least that puts it whole inside
+    `image` (a box's id on a box partly outside the frame, a path's id at a point outside the
+    plot). `size`: :func:`_text_size` of `text`, when the caller has it.
     """
-    (tw, th), base = cv2.getTextSize(text_for_opencv(text), cv2.FONT_HERSHEY_SIMPLEX, scale, k)
-    x, y = org
+    (tw, th), base = _text_size(text, scale, k) if size is None else size
+    x = max(k, min(org[0], image.shape[1] - tw - k))
+    y = min(max(th + k, org[1]), image.shape[0] - base - k)
     cv2.rectangle(image, (x - k, y - th - k), (x + tw + k - 1, y + base), colour, -1)
     luma = 0.114 * colour[0] + 0.587 * colour[1] + 0.299 * colour[2]  # BT.601, BGR
     ink = (0, 0, 0) if luma > 127 else (255, 255, 255)
     cv2.putText(
-        image, text_for_opencv(text), org, cv2.FONT_HERSHEY_SIMPLEX, scale, ink, k, cv2.LINE_AA
+        image, text_for_opencv(text), (x, y), cv2.FONT_HERSHEY_SIMPLEX, scale, ink, k, cv2.LINE_AA
     )
 
 
@@ -239,7 +253,7 @@ def write_annotated_video(
     with VideoWriter(path, fps, preset=preset) as writer:
         for k, frame in enumerate(itertools.chain([first], it), start=1):
             here = by_frame.get(k, empty)
-            image = draw_tracks(frame, here, f"frame {k}")
+            image = _draw_boxes(frame, here, f"frame {k}")
             for tid in {int(r[1]) for r in here} if trail > 0 else ():
                 # the foot points of frames k - trail + 1 .. k (was: the last `trail` points
                 # however old, a line across the track's absence from a point long gone), one
@@ -577,10 +591,7 @@ def plot_trajectories(
     # each id at its path's first point, on a tag of its colour, over every path, whole inside
     # the canvas (was: the id's colour on the dimmed frame, off it for a track from outside)
     for tid, (_, pts, _) in drawn.items():
-        (tw, th), base = cv2.getTextSize(str(tid), cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)
-        x = max(1, min(int(pts[0][0]), canvas.shape[1] - tw - 1))
-        y = min(max(th + 1, int(pts[0][1])), canvas.shape[0] - base - 1)
-        _tag(canvas, str(tid), (x, y), 0.4, colour_of(tid), 1)
+        _tag(canvas, str(tid), (int(pts[0][0]), int(pts[0][1])), 0.4, colour_of(tid), 1)
     if background is None:
         canvas = _with_axes(canvas, title)
     elif title:
