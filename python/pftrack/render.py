@@ -259,7 +259,7 @@ def write_annotated_video(
                 # however old, a line across the track's absence from a point long gone), one
                 # line for each run of frames it was seen on (was: a straight line across its
                 # absence, from where it left to where it came back, as if walked)
-                frames, feet = paths[tid]
+                frames, feet, _ = paths[tid]
                 a, b = np.searchsorted(frames, [k - trail, k], side="right")
                 for run in _runs(frames[a:b], feet[a:b]):
                     _trail_line(image, run, colour_of(tid))
@@ -267,13 +267,21 @@ def write_annotated_video(
     return Path(path)
 
 
-def _foot_paths(rows: F64) -> dict[int, tuple[F64, F64]]:
-    """Each id's frames, ascending (n,), and the foot points of its boxes on them (n, 2)."""
+def _foot_paths(rows: F64) -> dict[int, tuple[F64, F64, NDArray[np.bool_]]]:
+    """Each id's frames (n,), foot points (n, 2) and rows seen, not filled (n,), by frame.
+
+    :func:`write_annotated_video`'s trails and :func:`plot_trajectories`' paths.
+    """
     ids = np.trunc(rows[:, 1])  # as int() takes an id
     r = rows[np.lexsort((rows[:, 0], ids))]
     cuts = [0, *(np.flatnonzero(np.diff(np.trunc(r[:, 1]))) + 1), len(r)]
     feet = np.column_stack([r[:, 2] + r[:, 4] / 2, r[:, 3] + r[:, 5]])
-    return {int(r[a, 1]): (r[a:b, 0], feet[a:b]) for a, b in itertools.pairwise(cuts) if b > a}
+    seen = ~_filled(r)
+    return {
+        int(r[a, 1]): (r[a:b, 0], feet[a:b], seen[a:b])
+        for a, b in itertools.pairwise(cuts)
+        if b > a
+    }
 
 
 _S = TypeVar("_S", bound=np.generic)
@@ -566,15 +574,11 @@ def plot_trajectories(
         canvas = np.full((h, w, 3), 30, np.uint8)
 
     def paths(r: F64) -> dict[int, tuple[F64, NDArray[np.int32], NDArray[np.bool_]]]:
-        """Each id's frames, foot points and whether each was seen (not filled), by frame."""
-        out = {}
-        for tid in np.unique(r[:, 1]).astype(int):
-            t = r[r[:, 1] == tid]
-            t = t[np.argsort(t[:, 0], kind="stable")]
-            pts = np.column_stack([t[:, 2] + t[:, 4] / 2, t[:, 3] + t[:, 5]])
-            pts = np.round(np.clip(pts, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32)
-            out[tid] = t[:, 0], pts, ~_filled(t)
-        return out
+        """:func:`_foot_paths` of `r`, the points as the canvas's pixels."""
+        return {
+            tid: (frames, np.round(np.clip(feet, -MAX_CANVAS, MAX_CANVAS)).astype(np.int32), seen)
+            for tid, (frames, feet, seen) in _foot_paths(r).items()
+        }
 
     if truth is not None and len(truth):
         for _, pts, _ in paths(truth).values():
