@@ -520,6 +520,22 @@ def test_writer_rows_in_blocks_read_back_from_any_row() -> None:
     assert len(store) == 11
 
 
+def test_writer_rows_from_a_start_copy_those_rows_only() -> None:
+    """``arrays(start)`` copies the rows from `start` on, not the whole block holding them:
+    ``pftrack track`` asks for each frame's newly settled rows (``Tracker.settled_rows``), and
+    every frame copied up to 1024 rows to return a few (views into that copy)."""
+    from pftrack.tracking.writer import _Rows
+
+    store = _Rows()
+    for i in range(700):
+        store.append([float(i)] * 10, None if i % 2 else np.array([i, 1.0, 2.0, 3.0]))
+    for start in (0, 1, 695, 700, 2000):
+        for got in store.arrays(start):
+            assert len(got) == max(700 - start, 0)
+            assert got.flags.owndata  # its own rows: no larger copy behind a view
+        np.testing.assert_array_equal(store.arrays(start)[0][:, 0], np.arange(start, 700))
+
+
 @pytest.mark.parametrize("sizes", [[4, 0, 2, 5], [1, 1, 1, 1, 1, 1, 1], [11]])
 def test_writer_rows_extended_in_runs_equal_rows_appended_one_by_one(sizes) -> None:
     """A frame's rows written at once (TrackWriter.add) across block boundaries (blocks of 3)
