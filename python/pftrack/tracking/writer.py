@@ -64,8 +64,8 @@ class _Rows:
     def arrays(self, start: int = 0) -> tuple[F64, F64, np.ndarray]:
         """Rows ``(M, 10)``, boxes ``(M, 4)`` and whether each has one, from row `start` on.
 
-        Only those rows are copied (a live run asks for its newest rows every frame: was the
-        whole block holding them, up to 1024 rows, each frame); the arrays returned are copies.
+        Only those rows are copied (a live run asks for its newest rows every frame); the arrays
+        returned are copies.
         """
         first = min(max(start, 0) // self.BLOCK, len(self._done))  # blocks before it: skipped
         cut = max(start, 0) - first * self.BLOCK  # rows of the first block read: from `cut` on
