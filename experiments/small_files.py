@@ -26,6 +26,9 @@ between them and at both ends):
   video), all ids (masks); ``dup60-ids3``: 3 random ids;
 - ``x0.1``, ``x10``: boxes and image scaled by 0.1 and by 10, all ids (masks); ``x0.1-ids3``,
   ``x10-ids3``: 3 random ids;
+- ``holes5``: 5 random ids with at least 20 rows (holes); ``holes5-x0.001``: the same ids and
+  holes with boxes and image scaled by 0.001 (coordinates normalised to the image, as some
+  detectors write them; masks of whole pixels cannot be laid there);
 - ``standing``: only the tracks whose centre stays within 0.5 median box heights of its
   median over the track (people standing; the sequences that have two or more), holes;
 - ``fast``: the 3 ids with the highest median speed per frame (holes);
@@ -72,7 +75,8 @@ from pftrack.recovery.registry import recover_gaps
 OTHERS = ("linear", "rts", "gdt-bi", "gdt-mix", "gdt-fixed")
 CASES = (
     "all", "ids1", "ids2", "ids3", "ids5", "short", "long", "third", "third-ids3", "dup60",
-    "dup60-ids3", "x0.1", "x0.1-ids3", "x10", "x10-ids3", "standing", "fast", "car",
+    "dup60-ids3", "x0.1", "x0.1-ids3", "x10", "x10-ids3", "holes5", "holes5-x0.001", "standing",
+    "fast", "car",
 )  # fmt: skip
 #: Cases that draw nothing (the same files with every seed): run once.
 FIXED_CASES = ("all", "third", "dup60", "x0.1", "x10")
@@ -303,6 +307,13 @@ def files(case: str, root: Path, seed: int) -> Iterator[File]:
         rng = np.random.default_rng([seed, zlib.crc32(f"{name}/{case}".encode())])
         trajs = trajectories(rows)
         base, _, sub = case.partition("-")
+        if base == "holes5":  # the same ids and holes with and without "-x0.001"
+            rng = np.random.default_rng([seed, zlib.crc32(f"{name}/holes5".encode())])
+            picked = _subset(trajs, 5, rng, min_rows=20)
+            lost = _holes(picked, rng)
+            s = 1e-3 if sub else 1.0
+            yield File(name, _scaled(picked, s), s * w, s * h, "holes", lost)
+            continue
         if sub:  # "-ids3": three random ids first
             trajs = _subset(trajs, 3, rng)
         if base == "all":
@@ -357,7 +368,7 @@ def _diff(a: np.ndarray, b: np.ndarray) -> str:
     d = a - b
     se = d.std(ddof=1) / np.sqrt(len(d)) if len(d) > 1 else float("nan")
     mark = "!" if len(d) > 1 and d.mean() > 2 * se else " "
-    return f"{d.mean():+8.3f} ± {se:6.3f}{mark}"
+    return f"{d.mean():+8.3g} ± {se:6.3g}{mark}"
 
 
 def format_case(case: str, r: CaseResult) -> str:
@@ -379,11 +390,11 @@ def format_case(case: str, r: CaseResult) -> str:
         bm = min(others, key=lambda m: others[m])
         lines.append(
             f"{(case + label):<14}{len(r.files) if not label else '':>5}{sel.sum():>6}"
-            f"{a.mean():>9.3f}{lin.mean():>9.3f}{a.mean() / lin.mean():>7.3f} {_diff(a, lin)}"
-            f"  {bm:<9}{others[bm]:>8.3f}"
+            f"{a.mean():>9.4g}{lin.mean():>9.4g}{a.mean() / lin.mean():>7.3f} {_diff(a, lin)}"
+            f"  {bm:<9}{others[bm]:>8.4g}"
         )
     worse = [
-        f"{n} {au:.2f}/{li:.2f} ({k}){'!' if au - li > 2 * se else ''}"
+        f"{n} {au:.3g}/{li:.3g} ({k}){'!' if au - li > 2 * se else ''}"
         for n, au, li, k, se in r.files
         if au > li * 1.001
     ]

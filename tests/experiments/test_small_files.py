@@ -65,10 +65,10 @@ def test_car_case_runs_without_data_and_the_table_marks_losses(tmp_path: Path) -
     auto, lin = np.mean(res.errors["auto"]), np.mean(res.errors["linear"])
     first = text.splitlines()[0].split()
     assert first[:3] == ["car", "2", str(n)]
-    assert first[3:5] == [f"{auto:.3f}", f"{lin:.3f}"]
+    assert first[3:5] == [f"{auto:.4g}", f"{lin:.4g}"]
     # a file worse than linear is listed, with "!" when beyond 2 standard errors
     res.files.append(("fake/9", 2.0, 1.0, 10, 0.1))
-    assert "fake/9 2.00/1.00 (10)!" in ex.format_case("car", res)
+    assert "fake/9 2/1 (10)!" in ex.format_case("car", res)
 
 
 def test_cases_that_draw_nothing_run_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
