@@ -770,6 +770,27 @@ def test_a_video_that_ends_before_its_header_says_warns_once(tmp_path: Path) -> 
     assert sum(1 for _ in FrameSource(full)) == 20  # whole: no warning (warnings are errors)
 
 
+def _header_count(path: Path, count: int) -> Path:
+    """`path`, an AVI, with its header's frame count (``avih`` and ``strh``) set to `count`."""
+    data = bytearray(path.read_bytes())
+    for chunk, at in ((b"avih", 16), (b"strh", 32)):
+        i = data.index(chunk) + 8 + at
+        data[i : i + 4] = count.to_bytes(4, "little")
+    path.write_bytes(bytes(data))
+    return path
+
+
+def test_a_header_count_short_of_the_frames_is_counted_when_it_matters(tmp_path: Path) -> None:
+    """An AVI whose header says 5 of its 20 frames: was taken at its word by the checks."""
+    short = _header_count(_mjpg(tmp_path / "short.avi", 20, np.random.default_rng(0)), 5)
+    src = FrameSource(short)
+    assert (len(src), src.counted_frames, src.frames_to(5)) == (5, 5, 5)  # enough: no count
+    with pytest.warns(UserWarning, match=r"short.avi: its header says 5 frames but it holds 20 "):
+        assert src.frames_to(12) == 20
+    assert (len(src), src.counted_frames, src.frames_to(20)) == (20, 20, 20)  # counted once
+    assert sum(1 for _ in src) == 20
+
+
 @pytest.mark.parametrize("length", [4, 9])
 def test_a_sequence_video_of_another_length_than_seqlength_warns_once(
     tmp_path: Path, length: int

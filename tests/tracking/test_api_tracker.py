@@ -1476,6 +1476,24 @@ def test_cli_refuses_detections_of_a_longer_video_for_a_1_frame_video(tmp_path, 
     assert len(err.splitlines()) == 1 and not out.exists()
 
 
+def test_cli_counts_the_frames_of_a_video_whose_header_says_too_few(tmp_path, capsys):
+    """An AVI whose header says 5 of its 20 frames: its detections of frames 6-20 were refused
+    ("detections go up to frame 20 but the video has 5 frames"), the run not made."""
+    from tests.io.test_video import _header_count
+
+    video = _header_count(make_scene(n_frames=20, rng=0).write_video(tmp_path / "v.avi"), 5)
+    det = tmp_path / "det.txt"
+    det.write_text("".join(f"{f},-1,40,30,20,40,0.9\n" for f in range(1, 21)))
+    out = tmp_path / "t.txt"
+    assert main(["-q", "track", str(video), "--detections", str(det), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "its header says 5 frames but it holds 20 (counted)" in err, err
+    assert read_mot(out)[:, 0].max() == 20
+    det.write_text("".join(f"{f},-1,40,30,20,40,0.9\n" for f in range(1, 31)))
+    assert main(["-q", "track", str(video), "--detections", str(det), "--out", str(out)]) == 2
+    assert "detections go up to frame 30 but the video has 20 frames" in capsys.readouterr().err
+
+
 @pytest.mark.filterwarnings("ignore::UserWarning")
 def test_output_boxes_may_reach_past_the_frame_as_documented():
     """A user trial found boxes out of the frame (x2 = 482.7 on a 480-wide video) while the

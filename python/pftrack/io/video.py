@@ -1563,6 +1563,36 @@ class FrameSource:
         """
         return self.n_frames if self.count_known else 0
 
+    def frames_to(self, needed: int) -> int:
+        """`counted_frames`, or the frames counted when a header says fewer than `needed`.
+
+        A video's header count may be short of its frames (an AVI whose recorder stopped
+        before its last header update, or whose header another tool wrote): a check that
+        would refuse frame `needed` past the header's last frame, as not the video's, first
+        counts the file's frames (grabbed: decoded, not converted), once. A count other than
+        the header's becomes `n_frames`, with a warning naming both. An image folder's count,
+        0 (not known) and a header count of `needed` or more are returned as they are.
+        """
+        header = self.counted_frames
+        if not 0 < header < needed or self._images is not None or self.path is None:
+            return header
+        cap = _file_capture(str(self.path))
+        found = 0
+        try:
+            while cap.grab():
+                found += 1
+        finally:
+            cap.release()
+        if found != header:
+            self.n_frames = found
+            warnings.warn(
+                f"{self.path}: its header says {counted(header, 'frame')} but it holds {found} "
+                "(counted): the header is wrong, the count is taken",
+                UserWarning,
+                stacklevel=2,
+            )
+        return self.n_frames
+
     def __len__(self) -> int:
         return self.n_frames
 

@@ -249,7 +249,14 @@ def track_frames(
     if detections:
         _check_numbering(frames)
         # a FrameSource's count only when known: FFmpeg's estimate (Matroska's) may be short
-        _check_last_frame(detections, getattr(frames, "counted_frames", len(frames)))
+        last = max((f for f, d in detections.items() if len(d)), default=0)
+        # a header count below the detections' last frame is checked by counting the frames
+        held = (
+            frames.frames_to(last)
+            if isinstance(frames, FrameSource)
+            else getattr(frames, "counted_frames", len(frames))
+        )
+        _check_last_frame(detections, held)
     # an int seed goes on as it is; anything else through generator(), whose errors name rng
     # (a float, a string, a bool or a negative int were NumPy's or MultiObjectTracker's)
     seed = (
