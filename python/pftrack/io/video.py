@@ -1569,13 +1569,24 @@ class FrameSource:
         A video's header count may be short of its frames (an AVI whose recorder stopped
         before its last header update, or whose header another tool wrote): a check that
         would refuse frame `needed` past the header's last frame, as not the video's, first
-        counts the file's frames (grabbed: decoded, not converted), once. A count other than
-        the header's becomes `n_frames`, with a warning naming both. An image folder's count,
-        0 (not known) and a header count of `needed` or more are returned as they are.
+        counts the file's frames (:meth:`recount`). An image folder's count, 0 (not known) and
+        a header count of `needed` or more are returned as they are.
         """
         header = self.counted_frames
         if not 0 < header < needed or self._images is not None or self.path is None:
             return header
+        return self.recount()
+
+    def recount(self) -> int:
+        """The frames of a video file, counted (grabbed: decoded, not converted); `n_frames`.
+
+        For a header count found wrong: too few (:meth:`frames_to`), or too many (frames
+        asked for past the video's end, :func:`pftrack.detection.bootstrap.bootstrap_frames`).
+        A count other than the header's becomes `n_frames`, with a warning naming both. An
+        image folder's count, and a live source's 0, are returned as they are.
+        """
+        if self._images is not None or self.path is None or self.live:
+            return self.n_frames
         cap = _file_capture(str(self.path))
         found = 0
         try:
@@ -1583,14 +1594,17 @@ class FrameSource:
                 found += 1
         finally:
             cap.release()
-        if found != header:
-            self.n_frames = found
-            warnings.warn(
-                f"{self.path}: its header says {counted(header, 'frame')} but it holds {found} "
-                "(counted): the header is wrong, the count is taken",
-                UserWarning,
-                stacklevel=2,
-            )
+        header = self.counted_frames
+        if found != self.n_frames:
+            self.n_frames, self.count_known = found, True
+            if header:  # an estimate (Matroska's) is no header count to correct
+                why = "the header is wrong" if found > header else "a truncated or damaged file"
+                warnings.warn(
+                    f"{self.path}: its header says {counted(header, 'frame')} but it holds "
+                    f"{found} (counted): {why}, the count is taken",
+                    UserWarning,
+                    stacklevel=3,
+                )
         return self.n_frames
 
     def __len__(self) -> int:
