@@ -770,6 +770,36 @@ def test_a_video_that_ends_before_its_header_says_warns_once(tmp_path: Path) -> 
     assert sum(1 for _ in FrameSource(full)) == 20  # whole: no warning (warnings are errors)
 
 
+def turned_mp4(path: Path, frames: list[np.ndarray], degrees: int) -> Path:
+    """An H.264 MP4 of `frames` whose display matrix turns them `degrees` counter-clockwise
+    (FFmpeg's sense; a phone's portrait video), written with PyAV."""
+    with av.open(str(path), "w") as out:
+        stream = out.add_stream("libx264", rate=10)
+        stream.height, stream.width = frames[0].shape[:2]
+        stream.pix_fmt = "yuv420p"
+        stream.set_display_rotation(degrees)
+        for frame in frames:
+            out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
+        out.mux(stream.encode())
+    return path
+
+
+@pytest.mark.parametrize(("degrees", "clockwise"), [(90, 270), (180, 180), (270, 90), (0, 0)])
+def test_a_turned_video_is_read_as_shown_and_says_its_rotation(
+    tmp_path: Path, degrees: int, clockwise: int
+) -> None:
+    """A phone's portrait video (stored 96x64, shown 64x96): frames as players show them."""
+    frames = make_scene(n_frames=3, width=96, height=64, rng=0).frames
+    src = FrameSource(turned_mp4(tmp_path / "v.mp4", frames, degrees))
+    size = (64, 96) if degrees % 180 else (96, 64)
+    assert (src.rotation, (src.width, src.height)) == (clockwise, size)
+    turn = {0: None, 90: cv2.ROTATE_90_CLOCKWISE, 180: cv2.ROTATE_180}
+    turn[270] = cv2.ROTATE_90_COUNTERCLOCKWISE
+    for got, frame in zip(src, frames, strict=True):  # lossy H.264: near, not equal
+        shown = frame if turn[clockwise] is None else cv2.rotate(frame, turn[clockwise])
+        assert np.abs(got.astype(int) - shown).mean() < 8
+
+
 def _header_count(path: Path, count: int) -> Path:
     """`path`, an AVI, with its header's frame count (``avih`` and ``strh``) set to `count`."""
     data = bytearray(path.read_bytes())
