@@ -1612,3 +1612,30 @@ def test_experiment_repeat_is_bounded(capsys):
         main(["experiment", "gaps", "--gt", "gt.txt", "--repeat", "100000000"])
     assert info.value.code == 2
     assert "--repeat: expected an integer in [1, 1000], got 100000000" in capsys.readouterr().err
+
+
+def test_a_file_named_with_a_leading_dash_is_named_with_the_way_to_give_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``pftrack track -clip.mp4 --out t.txt``: was ``the following arguments are required:
+    source``, of a source given (argparse takes ``-clip.mp4`` for an option)."""
+    monkeypatch.chdir(tmp_path)
+    video = make_scene(n_frames=8, width=96, height=64, rng=0).write_video(tmp_path / "v.avi")
+    Path("-clip.mp4").write_bytes(video.read_bytes())
+    hint = (
+        "(-clip.mp4 is a file, read as an option: give it as ./-clip.mp4, or after -- at the end)"
+    )
+    for argv, what in (
+        (["track", "-clip.mp4", "--out", "t.txt"], "the following arguments are required: source"),
+        (["track", str(video), "--out", "t.txt", "-clip.mp4"], "unrecognized arguments: -clip.mp4"),
+    ):
+        with pytest.raises(SystemExit) as exit_:
+            main(["-q", *argv])
+        assert exit_.value.code == 2
+        assert capsys.readouterr().err == f"pftrack track: error: {what} {hint}\n"
+    assert main(["-q", "track", "--out", "t.txt", "--", "-clip.mp4"]) == 0
+    assert main(["-q", "track", "./-clip.mp4", "--out", "t2.txt"]) == 0
+    assert Path("t.txt").read_text() == Path("t2.txt").read_text()
+    with pytest.raises(SystemExit):  # no such file: argparse's words alone
+        main(["-q", "track", "-other.mp4", "--out", "t.txt"])
+    assert capsys.readouterr().err.endswith("are required: source\n")
