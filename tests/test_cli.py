@@ -904,6 +904,37 @@ def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
     assert not (tmp_path / "o.txt").exists() and not (tmp_path / "o.mp4").exists()
 
 
+@pytest.mark.parametrize(
+    ("argv", "what"),
+    [
+        (["track", "L", "--out", "O"], "video source"),
+        (["render", "L", "T", "--out", "O.mp4"], "video source"),
+        (["track", "V", "--detections", "L", "--out", "O"], "--detections"),
+        (["recover", "L", "--out", "O"], "tracks file"),
+        (["smooth", "L", "--out", "O"], "tracks file"),
+        (["eval", "--gt", "T", "--res", "L"], "--res"),
+        (["experiment", "gaps", "--gt", "L", "--image-size", "768x576"], "ground truth"),
+    ],
+    ids=["track", "render", "detections", "recover", "smooth", "eval", "experiment"],
+)
+def test_an_input_that_is_a_broken_symbolic_link_is_named_as_one(
+    argv: list[str], what: str, tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A link whose video was moved: was ``video source not found: clip.mp4``, though ``ls``
+    lists it (``pftrack batch`` named it already)."""
+    link = tmp_path / "clip.mp4"
+    link.symlink_to(tmp_path / "moved" / "clip.mp4")
+    tracks = _tracks(tmp_path / "t.txt")
+    names = {"L": str(link), "T": str(tracks), "V": str(video), "O": str(tmp_path / "o.txt")}
+    names["O.mp4"] = str(tmp_path / "o.mp4")
+    assert main([names.get(x, x) for x in argv]) == 2
+    assert capsys.readouterr().err.endswith(
+        f"error: {what} not found: {link} is a broken symbolic link (to "
+        f"{tmp_path / 'moved' / 'clip.mp4'})\n"
+    )
+    assert not (tmp_path / "o.txt").exists() and not (tmp_path / "o.mp4").exists()
+
+
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
 @pytest.mark.parametrize(
     ("words", "prog"),
