@@ -904,6 +904,37 @@ def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
     assert not (tmp_path / "o.txt").exists() and not (tmp_path / "o.mp4").exists()
 
 
+@pytest.mark.parametrize(
+    ("argv", "what"),
+    [
+        (["track", "L", "--out", "O"], "video source"),
+        (["render", "L", "T", "--out", "O.mp4"], "video source"),
+        (["track", "V", "--detections", "L", "--out", "O"], "--detections"),
+        (["recover", "L", "--out", "O"], "tracks file"),
+        (["smooth", "L", "--out", "O"], "tracks file"),
+        (["eval", "--gt", "T", "--res", "L"], "--res"),
+        (["experiment", "gaps", "--gt", "L", "--image-size", "768x576"], "ground truth"),
+    ],
+    ids=["track", "render", "detections", "recover", "smooth", "eval", "experiment"],
+)
+def test_an_input_that_is_a_broken_symbolic_link_is_named_as_one(
+    argv: list[str], what: str, tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A link whose video was moved: was ``video source not found: clip.mp4``, though ``ls``
+    lists it (``pftrack batch`` named it already)."""
+    link = tmp_path / "clip.mp4"
+    link.symlink_to(tmp_path / "moved" / "clip.mp4")
+    tracks = _tracks(tmp_path / "t.txt")
+    names = {"L": str(link), "T": str(tracks), "V": str(video), "O": str(tmp_path / "o.txt")}
+    names["O.mp4"] = str(tmp_path / "o.mp4")
+    assert main([names.get(x, x) for x in argv]) == 2
+    assert capsys.readouterr().err.endswith(
+        f"error: {what} not found: {link} is a broken symbolic link (to "
+        f"{tmp_path / 'moved' / 'clip.mp4'})\n"
+    )
+    assert not (tmp_path / "o.txt").exists() and not (tmp_path / "o.mp4").exists()
+
+
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (Linux)")
 @pytest.mark.parametrize(
     ("words", "prog"),
@@ -1612,3 +1643,30 @@ def test_experiment_repeat_is_bounded(capsys):
         main(["experiment", "gaps", "--gt", "gt.txt", "--repeat", "100000000"])
     assert info.value.code == 2
     assert "--repeat: expected an integer in [1, 1000], got 100000000" in capsys.readouterr().err
+
+
+def test_a_file_named_with_a_leading_dash_is_named_with_the_way_to_give_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``pftrack track -clip.mp4 --out t.txt``: was ``the following arguments are required:
+    source``, of a source given (argparse takes ``-clip.mp4`` for an option)."""
+    monkeypatch.chdir(tmp_path)
+    video = make_scene(n_frames=8, width=96, height=64, rng=0).write_video(tmp_path / "v.avi")
+    Path("-clip.mp4").write_bytes(video.read_bytes())
+    hint = (
+        "(-clip.mp4 is a file, read as an option: give it as ./-clip.mp4, or after -- at the end)"
+    )
+    for argv, what in (
+        (["track", "-clip.mp4", "--out", "t.txt"], "the following arguments are required: source"),
+        (["track", str(video), "--out", "t.txt", "-clip.mp4"], "unrecognized arguments: -clip.mp4"),
+    ):
+        with pytest.raises(SystemExit) as exit_:
+            main(["-q", *argv])
+        assert exit_.value.code == 2
+        assert capsys.readouterr().err == f"pftrack track: error: {what} {hint}\n"
+    assert main(["-q", "track", "--out", "t.txt", "--", "-clip.mp4"]) == 0
+    assert main(["-q", "track", "./-clip.mp4", "--out", "t2.txt"]) == 0
+    assert Path("t.txt").read_text() == Path("t2.txt").read_text()
+    with pytest.raises(SystemExit):  # no such file: argparse's words alone
+        main(["-q", "track", "-other.mp4", "--out", "t.txt"])
+    assert capsys.readouterr().err.endswith("are required: source\n")

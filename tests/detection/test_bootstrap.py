@@ -219,3 +219,24 @@ def test_spread_from_a_frame_source_equals_iterating_it(tmp_path) -> None:
         assert len(src.frames_at([0, 22, 40])) == 2  # past the end: left out
         with pytest.raises(ValueError, match="frame index is -1"):
             src.frames_at([-1, 3])
+
+
+def test_spread_over_a_video_whose_header_says_too_many_frames(tmp_path) -> None:
+    """A truncated AVI whose header says 999 of its 40 frames: the spread bootstrap took the
+    frames at 0, 34, 69, ... of 999, the first alone there (the median of one frame, every
+    person in it a ghost); it now spreads over the 40 frames it holds, as over the whole file."""
+    from pftrack.io.video import FrameSource
+    from tests.io.test_video import _header_count, _mjpg
+
+    whole = _mjpg(tmp_path / "whole.avi", 40, np.random.default_rng(5))
+    (tmp_path / "cut.avi").write_bytes(whole.read_bytes())
+    cut = _header_count(tmp_path / "cut.avi", 999)
+    src = FrameSource(cut)
+    assert len(src) == 999
+    with pytest.warns(UserWarning, match=r"cut.avi: its header says 999 frames but it holds 40 "):
+        got = bootstrap_frames(src, 6, "spread")
+    want = bootstrap_frames(FrameSource(whole), 6, "spread")
+    assert len(src) == 40 and len(got) == len(want) == 6
+    for g, w in zip(got, want, strict=True):
+        np.testing.assert_array_equal(g, w)
+    assert sum(1 for _ in src) == 40  # said once: no "ended after 40 frames" warning (an error)

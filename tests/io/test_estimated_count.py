@@ -91,9 +91,9 @@ def test_a_rate_the_header_lacks_comes_from_the_time_stamps(
     video = write_vfr(tmp_path / "ten.mkv", scene, [100] * 60)
     probe = FrameSource._probe_file
 
-    def time_base_as_rate(path: Path) -> tuple[np.ndarray, float, int]:
-        first, _, count = probe(path)
-        return first, 1000.0, count
+    def time_base_as_rate(path: Path) -> tuple[np.ndarray, float, int, int]:
+        first, _, count, rotation = probe(path)
+        return first, 1000.0, count, rotation
 
     monkeypatch.setattr(FrameSource, "_probe_file", staticmethod(time_base_as_rate))
     source = FrameSource(video)

@@ -770,6 +770,57 @@ def test_a_video_that_ends_before_its_header_says_warns_once(tmp_path: Path) -> 
     assert sum(1 for _ in FrameSource(full)) == 20  # whole: no warning (warnings are errors)
 
 
+def turned_mp4(path: Path, frames: list[np.ndarray], degrees: int) -> Path:
+    """An H.264 MP4 of `frames` whose display matrix turns them `degrees` counter-clockwise
+    (FFmpeg's sense; a phone's portrait video), written with PyAV."""
+    with av.open(str(path), "w") as out:
+        stream = out.add_stream("libx264", rate=10)
+        stream.height, stream.width = frames[0].shape[:2]
+        stream.pix_fmt = "yuv420p"
+        stream.set_display_rotation(degrees)
+        for frame in frames:
+            out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
+        out.mux(stream.encode())
+    return path
+
+
+@pytest.mark.parametrize(("degrees", "clockwise"), [(90, 270), (180, 180), (270, 90), (0, 0)])
+def test_a_turned_video_is_read_as_shown_and_says_its_rotation(
+    tmp_path: Path, degrees: int, clockwise: int
+) -> None:
+    """A phone's portrait video (stored 96x64, shown 64x96): frames as players show them."""
+    frames = make_scene(n_frames=3, width=96, height=64, rng=0).frames
+    src = FrameSource(turned_mp4(tmp_path / "v.mp4", frames, degrees))
+    size = (64, 96) if degrees % 180 else (96, 64)
+    assert (src.rotation, (src.width, src.height)) == (clockwise, size)
+    turn = {0: None, 90: cv2.ROTATE_90_CLOCKWISE, 180: cv2.ROTATE_180}
+    turn[270] = cv2.ROTATE_90_COUNTERCLOCKWISE
+    for got, frame in zip(src, frames, strict=True):  # lossy H.264: near, not equal
+        shown = frame if turn[clockwise] is None else cv2.rotate(frame, turn[clockwise])
+        assert np.abs(got.astype(int) - shown).mean() < 8
+
+
+def _header_count(path: Path, count: int) -> Path:
+    """`path`, an AVI, with its header's frame count (``avih`` and ``strh``) set to `count`."""
+    data = bytearray(path.read_bytes())
+    for chunk, at in ((b"avih", 16), (b"strh", 32)):
+        i = data.index(chunk) + 8 + at
+        data[i : i + 4] = count.to_bytes(4, "little")
+    path.write_bytes(bytes(data))
+    return path
+
+
+def test_a_header_count_short_of_the_frames_is_counted_when_it_matters(tmp_path: Path) -> None:
+    """An AVI whose header says 5 of its 20 frames: was taken at its word by the checks."""
+    short = _header_count(_mjpg(tmp_path / "short.avi", 20, np.random.default_rng(0)), 5)
+    src = FrameSource(short)
+    assert (len(src), src.counted_frames, src.frames_to(5)) == (5, 5, 5)  # enough: no count
+    with pytest.warns(UserWarning, match=r"short.avi: its header says 5 frames but it holds 20 "):
+        assert src.frames_to(12) == 20
+    assert (len(src), src.counted_frames, src.frames_to(20)) == (20, 20, 20)  # counted once
+    assert sum(1 for _ in src) == 20
+
+
 @pytest.mark.parametrize("length", [4, 9])
 def test_a_sequence_video_of_another_length_than_seqlength_warns_once(
     tmp_path: Path, length: int

@@ -476,6 +476,23 @@ def test_cli_recover_refuses_a_video_that_is_not_the_tracks_own(
     assert not out.exists()
 
 
+def test_cli_recover_counts_a_video_whose_header_says_too_few_frames(tmp_path, capsys):
+    """An AVI whose header says 50 of its 100 frames: was refused as not the tracks' video."""
+    import warnings
+
+    from tests.io.test_video import _header_count
+
+    tracks = tmp_path / "t.txt"
+    write_mot(tracks, scene())
+    v = _header_count(_scene_video(tmp_path / "v.avi", 100, (600, 700)), 50)
+    out = tmp_path / "o.txt"
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")  # as outside the test suite (which makes them errors)
+        assert main(["recover", str(tracks), "--link", "--video", str(v), "--out", str(out)]) == 0
+    assert "its header says 50 frames but it holds 100 (counted)" in capsys.readouterr().err
+    assert out.exists()
+
+
 @pytest.mark.parametrize("tail", [",0.9,1", ",0.9,1,-1"])
 def test_padded_columns_that_look_filled_are_said(tail, tmp_path, capsys):
     # was: an 8- or 9-column file with a class 1 in column 8 read as rows pftrack filled, and

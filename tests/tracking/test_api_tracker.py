@@ -1476,6 +1476,46 @@ def test_cli_refuses_detections_of_a_longer_video_for_a_1_frame_video(tmp_path, 
     assert len(err.splitlines()) == 1 and not out.exists()
 
 
+def test_cli_counts_the_frames_of_a_video_whose_header_says_too_few(tmp_path, capsys):
+    """An AVI whose header says 5 of its 20 frames: its detections of frames 6-20 were refused
+    ("detections go up to frame 20 but the video has 5 frames"), the run not made."""
+    from tests.io.test_video import _header_count
+
+    video = _header_count(make_scene(n_frames=20, rng=0).write_video(tmp_path / "v.avi"), 5)
+    det = tmp_path / "det.txt"
+    det.write_text("".join(f"{f},-1,40,30,20,40,0.9\n" for f in range(1, 21)))
+    out = tmp_path / "t.txt"
+    assert main(["-q", "track", str(video), "--detections", str(det), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "its header says 5 frames but it holds 20 (counted)" in err, err
+    assert read_mot(out)[:, 0].max() == 20
+    det.write_text("".join(f"{f},-1,40,30,20,40,0.9\n" for f in range(1, 31)))
+    assert main(["-q", "track", str(video), "--detections", str(det), "--out", str(out)]) == 2
+    assert "detections go up to frame 30 but the video has 20 frames" in capsys.readouterr().err
+
+
+def test_cli_says_detections_of_a_turned_videos_stored_frames_are_so(tmp_path, capsys):
+    """A phone's portrait video (stored 96x64, shown 64x96) and boxes a detector found on its
+    stored frames: was refused as "in a larger frame's pixels? Scale them with --det-scale"."""
+    from tests.io.test_video import turned_mp4
+
+    frames = make_scene(n_frames=25, width=96, height=64, rng=0).frames
+    video = turned_mp4(tmp_path / "v.mp4", frames, 90)
+    det = tmp_path / "det.txt"
+    det.write_text("".join(f"{f},-1,70,20,12,30,0.9\n" for f in range(1, 26)))
+    out = tmp_path / "t.txt"
+    assert main(["-q", "track", str(video), "--detections", str(det), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "pftrack track: error: 25 of 25 detection boxes lie wholly outside the 64x96 frames "
+        "(they reach 82x50), and all fit 96x64: the video is stored 96x64 and turned 270 "
+        "degrees clockwise by its rotation metadata, as players, FFmpeg and OpenCV show it "
+        "and pftrack reads it; run the detector on the frames as shown (OpenCV's VideoCapture "
+        "turns them), not on the stored ones\n"
+    ), err
+    assert not out.exists()
+
+
 @pytest.mark.filterwarnings("ignore::UserWarning")
 def test_output_boxes_may_reach_past_the_frame_as_documented():
     """A user trial found boxes out of the frame (x2 = 482.7 on a 480-wide video) while the

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import codecs
 import contextlib
+import contextvars
 import os
 import sys
 import warnings
@@ -50,6 +51,10 @@ examples:
 """
 
 
+#: The arguments :func:`main` parses, up to a ``--`` (after it nothing is taken for an option).
+_ARGV: contextvars.ContextVar[Sequence[str]] = contextvars.ContextVar("_ARGV", default=())
+
+
 class Parser(argparse.ArgumentParser):
     """argparse's parser, refusing bad usage in one line (``pftrack track: error: ...``).
 
@@ -59,7 +64,18 @@ class Parser(argparse.ArgumentParser):
     """
 
     def error(self, message: str) -> NoReturn:
-        """Print ``PROG: error: MESSAGE`` and exit with status 2."""
+        """Print ``PROG: error: MESSAGE`` and exit with status 2.
+
+        A file named with a leading ``-`` (``-clip.mp4``), which argparse takes for an option,
+        is named with the way to give it (was: ``the following arguments are required:
+        source``, of a source given).
+        """
+        dashed = [a for a in _ARGV.get() if a.startswith("-") and a != "-" and os.path.lexists(a)]
+        if dashed:
+            message += (
+                f" ({dashed[0]} is a file, read as an option: give it as ./{dashed[0]}, or "
+                "after -- at the end)"
+            )
         self.exit(2, f"{self.prog}: error: {message}\n")
 
     def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
@@ -332,10 +348,15 @@ def _opencv_error(exc: BaseException) -> bool:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``pftrack`` script; returns the exit status."""
     parser = build_parser()
-    args, extra = parser.parse_known_args(argv)
-    command = _command_parser(parser, args)
-    if extra:  # named by the command's own parser: its usage, "pftrack smooth: error: ..."
-        command.error(f"unrecognized arguments: {' '.join(extra)}")
+    given = sys.argv[1:] if argv is None else list(argv)
+    token = _ARGV.set(given[: given.index("--")] if "--" in given else given)
+    try:
+        args, extra = parser.parse_known_args(given)
+        command = _command_parser(parser, args)
+        if extra:  # named by the command's own parser: its usage, "pftrack smooth: error: ..."
+            command.error(f"unrecognized arguments: {' '.join(extra)}")
+    finally:
+        _ARGV.reset(token)
     empty = _empty_argument(command, args)
     if empty is not None:  # was: --detections '' ignored, '' as a folder the current one
         print(f"{command.prog}: error: {empty} is empty; give a value", file=sys.stderr)

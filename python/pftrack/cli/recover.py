@@ -156,7 +156,7 @@ def check_video(video: str, frames: Any, rows: Any, src: Path) -> None:
         return
     source = frames.source
     last = int(rows[:, 0].max())
-    header = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
+    header = source.frames_to(last)  # 0: not known (Matroska's count is FFmpeg's estimate)
     if 0 < header < last:
         raise ValueError(
             f"--video {video} has {counted(header, 'frame')} but {src} has rows up to frame "

@@ -111,14 +111,15 @@ def run(args: argparse.Namespace) -> int:
     source = FrameSource(args.source, fps=args.fps)
     fmt = output_format(args.out, VIDEO_SUFFIXES)  # a size its encoder cannot take: said now
     check_frame_size(f"--out {args.out}", fmt, source.width, source.height)
-    n_frames = len(source)
-    known = source.counted_frames  # 0: not known (Matroska's count is FFmpeg's estimate)
+    # 0: not known (Matroska's count is FFmpeg's estimate); a header short of the rows: counted
+    known = source.frames_to(int(rows[:, 0].min())) if len(rows) else source.counted_frames
     if known and len(rows) and rows[:, 0].min() > known:  # was: an empty video, exit 0
         raise ValueError(
             f"every row of {args.tracks} lies past the last frame of {source.name}, which has "
             f"{known} (the rows' frames are {int(rows[:, 0].min())}-"
             f"{int(rows[:, 0].max())}): the tracks of another video?"
         )
+    n_frames = len(source)
     out = report_stream(args.out, args.plot)
     drawn = [0]
     kept: list[Any] = []  # the first frame, the plot's background (the video read once)

@@ -60,7 +60,13 @@ def bootstrap_frames(
     wanted = set(np.linspace(0, total - 1, n).round().astype(int).tolist())
     pick = getattr(frames, "frames_at", None)
     if callable(pick):  # a FrameSource: only the wanted images of a folder, no BGR in between
-        return list(pick(sorted(wanted), split=True) if split else pick(sorted(wanted)))
+        got = list(pick(sorted(wanted), split=True) if split else pick(sorted(wanted)))
+        recount = getattr(frames, "recount", None)
+        if len(got) < len(wanted) and callable(recount) and recount() < total:
+            # a header that says more frames than the video holds (a truncated file): spread
+            # over the frames there are (was: the few before the end, one frame of 30)
+            return bootstrap_frames(frames, n, mode, split=split)
+        return got
     if isinstance(frames, Sequence):
         return [frames[i] for i in sorted(wanted)]
     picked: list[NDArray[np.uint8]] = []

@@ -541,22 +541,31 @@ def link_loop(path: PathLike) -> str | None:
 
 
 def refuse_loop(path: PathLike, what: str) -> None:
-    """Refuse an input `path` whose symbolic links lead to each other: it names nothing.
+    """Refuse an input `path` whose symbolic links lead to each other, or to nothing.
 
-    Was: ``video source not found: a`` for ``a -> b -> a`` (with ``b`` there, a link). Paths
-    that may be such loops are compared with ``os.path.realpath``, which stops at a loop, not
-    ``Path.resolve``, which raised a RuntimeError there (a traceback) before Python 3.13.
+    Was: ``video source not found: a`` for ``a -> b -> a`` (with ``b`` there, a link), and for
+    a link whose target was moved or deleted (``ls`` lists ``a``), as ``pftrack batch`` names
+    it. Paths that may be such loops are compared with ``os.path.realpath``, which stops at a
+    loop, not ``Path.resolve``, which raised a RuntimeError there (a traceback) before Python
+    3.13.
 
     Raises
     ------
     ValueError
         ``WHAT PATH: symbolic link loop (a -> b -> a), ...``.
+    FileNotFoundError
+        ``WHAT not found: PATH is a broken symbolic link (to TARGET)``.
     """
     loop = link_loop(path)
     if loop is not None:
         raise ValueError(
             f"{what} {os.fspath(path)}: symbolic link loop ({loop}), which leads to no file or "
             "folder; point the link at one"
+        )
+    if os.path.islink(path) and not os.path.exists(path):
+        raise FileNotFoundError(
+            f"{what} not found: {os.fspath(path)} is a broken symbolic link (to "
+            f"{os.readlink(path)})"
         )
 
 

@@ -1197,6 +1197,13 @@ class FrameSource:
         numbered 1..N in the names' order; detections, whose frame numbers could count the
         images by name or by position, are refused with it (:func:`pftrack.track_frames`).
         None otherwise.
+    rotation : int
+        For a video file with rotation metadata (a phone's portrait video: a display matrix
+        of 90, 180 or 270 degrees), the degrees its stored frames are turned by, clockwise, to
+        be shown.
+        OpenCV turns them as it reads them, as players and FFmpeg do: the frames, the tracks'
+        boxes, ``--render``'s video and plot, and the detections a source takes are all in
+        the frames as shown (360x480 for a 480x360 video turned 90 degrees). 0 otherwise.
     bits : int or None
         For an image folder whose first image is 16-bit with values of fewer bits (10- or
         12-bit camera data: :func:`_bit_depth` of the largest value of its first image, its
@@ -1253,6 +1260,7 @@ class FrameSource:
         self.live = is_live_source(source)
         self.sequence: SequenceInfo | None = None
         self._images: list[Path] | None = None
+        self.rotation = 0  # a video file's display rotation, applied as OpenCV reads it
         self._image_shape = (0, 0)  # (height, width) of a folder's first image
         # a folder's 16-bit images of fewer bits (from a few of its images): read at that depth
         self.bits: int | None = None
@@ -1295,7 +1303,7 @@ class FrameSource:
             elif self.live:
                 first, header_fps, count = self._open_live()
             else:
-                first, header_fps, count = self._probe_file(self.path)
+                first, header_fps, count, self.rotation = self._probe_file(self.path)
                 self._broken = _avi_break(self.path)
         if self._broken is not None:  # before any work: said once for each source opened
             frames, offset = self._broken
@@ -1447,7 +1455,8 @@ class FrameSource:
         return np.asarray(np.right_shift(image, bits - 8), dtype=np.uint8)
 
     @staticmethod
-    def _probe_file(path: Path) -> tuple[NDArray[Any], float, int]:
+    def _probe_file(path: Path) -> tuple[NDArray[Any], float, int, int]:
+        """The first frame, the header's rate and count, and the rotation OpenCV applies."""
         cap = _file_capture(str(path))
         try:
             if cap.isOpened() and _fourcc(cap) == TEXT_FOURCC:
@@ -1457,6 +1466,8 @@ class FrameSource:
             ok, first = cap.read() if cap.isOpened() else (False, None)
             fps = float(cap.get(cv2.CAP_PROP_FPS)) if cap.isOpened() else 0.0
             count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
+            # the display matrix OpenCV applies (CAP_PROP_ORIENTATION_AUTO is on by default)
+            turn = int(cap.get(cv2.CAP_PROP_ORIENTATION_META)) if cap.isOpened() else 0
         finally:
             cap.release()
         if not ok or first is None:
@@ -1467,7 +1478,7 @@ class FrameSource:
             raise ValueError(
                 f"cannot decode a frame from {path}: not a video OpenCV can read, or empty"
             )
-        return first, fps, count
+        return first, fps, count, turn % 360 if turn % 90 == 0 else 0
 
     def _open_live(self) -> tuple[NDArray[Any], float, int]:
         what = "camera" if isinstance(self._target, int) else "stream"
@@ -1562,6 +1573,50 @@ class FrameSource:
         holds to.
         """
         return self.n_frames if self.count_known else 0
+
+    def frames_to(self, needed: int) -> int:
+        """`counted_frames`, or the frames counted when a header says fewer than `needed`.
+
+        A video's header count may be short of its frames (an AVI whose recorder stopped
+        before its last header update, or whose header another tool wrote): a check that
+        would refuse frame `needed` past the header's last frame, as not the video's, first
+        counts the file's frames (:meth:`recount`). An image folder's count, 0 (not known) and
+        a header count of `needed` or more are returned as they are.
+        """
+        header = self.counted_frames
+        if not 0 < header < needed or self._images is not None or self.path is None:
+            return header
+        return self.recount()
+
+    def recount(self) -> int:
+        """The frames of a video file, counted (grabbed: decoded, not converted); `n_frames`.
+
+        For a header count found wrong: too few (:meth:`frames_to`), or too many (frames
+        asked for past the video's end, :func:`pftrack.detection.bootstrap.bootstrap_frames`).
+        A count other than the header's becomes `n_frames`, with a warning naming both. An
+        image folder's count, and a live source's 0, are returned as they are.
+        """
+        if self._images is not None or self.path is None or self.live:
+            return self.n_frames
+        cap = _file_capture(str(self.path))
+        found = 0
+        try:
+            while cap.grab():
+                found += 1
+        finally:
+            cap.release()
+        header = self.counted_frames
+        if found != self.n_frames:
+            self.n_frames, self.count_known = found, True
+            if header:  # an estimate (Matroska's) is no header count to correct
+                why = "the header is wrong" if found > header else "a truncated or damaged file"
+                warnings.warn(
+                    f"{self.path}: its header says {counted(header, 'frame')} but it holds "
+                    f"{found} (counted): {why}, the count is taken",
+                    UserWarning,
+                    stacklevel=3,
+                )
+        return self.n_frames
 
     def __len__(self) -> int:
         return self.n_frames

@@ -249,7 +249,14 @@ def track_frames(
     if detections:
         _check_numbering(frames)
         # a FrameSource's count only when known: FFmpeg's estimate (Matroska's) may be short
-        _check_last_frame(detections, getattr(frames, "counted_frames", len(frames)))
+        last = max((f for f, d in detections.items() if len(d)), default=0)
+        # a header count below the detections' last frame is checked by counting the frames
+        held = (
+            frames.frames_to(last)
+            if isinstance(frames, FrameSource)
+            else getattr(frames, "counted_frames", len(frames))
+        )
+        _check_last_frame(detections, held)
     # an int seed goes on as it is; anything else through generator(), whose errors name rng
     # (a float, a string, a bool or a negative int were NumPy's or MultiObjectTracker's)
     seed = (
@@ -301,7 +308,12 @@ def track_frames(
             else:
                 dets = detections.get(n, empty)
                 if n == 1:
-                    _check_layout(detections, frame.shape[:2], getattr(frames, "sequence", None))
+                    _check_layout(
+                        detections,
+                        frame.shape[:2],
+                        getattr(frames, "sequence", None),
+                        getattr(frames, "rotation", 0),
+                    )
                 tracker.update(xywh_to_xyxy_dets(dets), frame)
             if on_frame is not None:
                 on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
@@ -505,7 +517,10 @@ def _scale_hint(
 
 
 def _check_layout(
-    detections: Mapping[int, F64], shape: tuple[int, ...], sequence: SequenceInfo | None = None
+    detections: Mapping[int, F64],
+    shape: tuple[int, ...],
+    sequence: SequenceInfo | None = None,
+    rotation: int = 0,
 ) -> None:
     """Refuse x1, y1, x2, y2 boxes as left, top, w, h and a larger frame's; warn of a smaller's.
 
@@ -517,7 +532,9 @@ def _check_layout(
     The warning: at least :data:`SMALL_LAYOUT_BOXES` boxes, and none reaches past half the
     frame's width or height (boxes too large for the frame are clipped, with a warning, by
     the tracker). The scale the refusal suggests is :func:`_scale_hint`'s (`sequence`: the
-    source's ``seqinfo.ini``, if any).
+    source's ``seqinfo.ini``, if any); when the video is turned 90 or 270 degrees as it is
+    read (`rotation`: :attr:`FrameSource.rotation`) and the boxes fit its frames unturned, the
+    refusal says that instead: detections made on the stored frames.
     """
     d = np.concatenate([v[:, :4] for v in detections.values() if len(v)] or [np.zeros((0, 4))])
     if len(d) == 0:
@@ -535,6 +552,16 @@ def _check_layout(
         )
     outside = (d[:, 0] >= cols) | (d[:, 1] >= rows)
     if len(d) >= SMALL_LAYOUT_BOXES and outside.mean() > OUTSIDE_SHARE and not as_xyxy.all():
+        slack = 1 + SEQINFO_SLACK  # detectors' boxes overhang the edge a little
+        if rotation in (90, 270) and right <= rows * slack and bottom <= cols * slack:
+            raise ValueError(  # they fit the frames unturned: made on the stored frames
+                f"{outside.sum()} of {len(d)} detection boxes lie wholly outside the "
+                f"{cols}x{rows} frames (they reach {right:.0f}x{bottom:.0f}), and all fit "
+                f"{rows}x{cols}: the video is stored {rows}x{cols} and turned {rotation} "
+                "degrees clockwise by its rotation metadata, as players, FFmpeg and OpenCV "
+                "show it and pftrack reads it; run the detector on the frames as shown "
+                "(OpenCV's VideoCapture turns them), not on the stored ones"
+            )
         raise ValueError(
             f"{outside.sum()} of {len(d)} detection boxes lie wholly outside the {cols}x{rows} "
             f"frames (they reach {right:.0f}x{bottom:.0f}): are they in a larger frame's "
