@@ -232,6 +232,26 @@ def write_annotated_video(
     this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames,
     one line for each run of frames it was seen on (none across a frame it is absent from).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output video: ``.mp4`` or ``.avi``, written atomically.
+    frames : iterable of (H, W, 3) ndarray of uint8
+        The BGR frames, frame 1 first (a generator is read once).
+    rows : (M, 6+) ndarray
+        MOT rows of the tracks: frame, id, left, top, width, height, ...
+    fps : float
+        Frame rate of the video (default 10).
+    trail : int
+        Foot points of the last `trail` frames drawn behind each track (0: none).
+    preset : str
+        x264 preset of an ``.mp4`` (default ``"ultrafast"``).
+
+    Returns
+    -------
+    Path
+        `path`.
+
     Raises
     ------
     ValueError
