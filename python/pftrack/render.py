@@ -71,13 +71,14 @@ def draw_tracks(
     Raises
     ------
     ValueError
-        `rows` are not (k, 6+) MOT rows with finite frame, id and box.
+        `rows` are not (k, 6+) MOT rows with finite frame, id and box; `frame` is not
+        (H, W, 3) with pixels.
     TypeError
-        `rows` are not real numbers; `label` is not a str.
+        `rows` are not real numbers; `label` is not a str; `frame` is not a uint8 array.
     """
     rows = _track_rows(rows, "draw_tracks")  # was "not enough values to unpack" of (k, 5)
     _text(label, "draw_tracks", "label")
-    return _draw_boxes(frame, rows, label)
+    return _draw_boxes(bgr_frame(frame, "draw_tracks: frame"), rows, label)
 
 
 def _draw_boxes(frame: NDArray[np.uint8], rows: F64, label: str) -> NDArray[np.uint8]:
@@ -257,22 +258,26 @@ def write_annotated_video(
     ValueError
         `frames` is empty (nothing is written); `rows` are not (M, 6+) MOT rows (frame, id,
         left, top, width, height, ...) with those six values finite; `trail` is not in
-        [0, :data:`MAX_TRAIL`].
+        [0, :data:`MAX_TRAIL`]; a frame is not (H, W, 3) with pixels, or not of the first
+        frame's size.
     TypeError
-        `rows` are not real numbers; `trail` is not an integer.
+        `rows` are not real numbers; `trail` is not an integer; a frame is not a uint8 array.
     """
     trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
     rows = _track_rows(rows, "write_annotated_video")
     it = iter(frames)
-    first = next(it, None)
-    if first is None:
-        raise ValueError("write_annotated_video: frames is empty; no frame to write")
+    try:  # not next(it, None): [None] is a bad frame, not no frame
+        first = next(it)
+    except StopIteration:
+        raise ValueError("write_annotated_video: frames is empty; no frame to write") from None
     by_frame = group_by_frame(rows)
     empty = np.zeros((0, 10))
     paths = _foot_paths(rows) if trail > 0 else {}
     with VideoWriter(path, fps, preset=preset) as writer:
         for k, frame in enumerate(itertools.chain([first], it), start=1):
             here = by_frame.get(k, empty)
+            # was: a float frame OpenCV's assertion in putText
+            frame = bgr_frame(frame, "write_annotated_video: frame")
             image = _draw_boxes(frame, here, f"frame {k}")
             for tid in {int(r[1]) for r in here} if trail > 0 else ():
                 # the foot points of frames k - trail + 1 .. k (was: the last `trail` points
@@ -388,6 +393,8 @@ class TrackRenderer:
 
     def add(self, frame: NDArray[np.uint8], tracks: Iterable[TrackLike]) -> None:
         """Queue `frame` (BGR, not modified) with the tracks reported on it."""
+        # checked here, in the caller's thread (was: a float frame drawn black without a word)
+        frame = bgr_frame(frame, "TrackRenderer.add: frame")
         self._raise_worker_error()
         self._n += 1
         rows, seen = [], set()

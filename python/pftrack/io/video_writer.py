@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import colour_hint, real
+from pftrack._check import bgr_frame, real
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
@@ -188,11 +188,17 @@ class VideoWriter:
         raise ValueError(f"OpenCV cannot write video {self.path} (no encoder for {candidates})")
 
     def write(self, frame: NDArray[np.uint8]) -> None:
-        """Append one BGR uint8 frame (H, W, 3)."""
-        if frame.ndim != 3 or frame.shape[2] != 3:
-            raise ValueError(
-                f"frame has shape {frame.shape}, expected (H, W, 3) BGR{colour_hint(frame.shape)}"
-            )
+        """Append one BGR uint8 frame (H, W, 3).
+
+        Raises
+        ------
+        TypeError
+            `frame` is not a NumPy uint8 array (a float or 16-bit frame is not cast: it would
+            come out black or wrapped modulo 256).
+        ValueError
+            `frame` is not (H, W, 3) with pixels, or not of the first frame's size.
+        """
+        frame = bgr_frame(frame)
         if self._size is None:
             self._open(int(frame.shape[0]), int(frame.shape[1]))
         h, w = self._size if self._size is not None else (0, 0)
