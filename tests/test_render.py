@@ -415,3 +415,21 @@ def test_the_video_pictures_refuse_a_frame_that_is_not_bgr_uint8(
     with pytest.raises(error, match=r"^draw_tracks: " + message):
         draw_tracks(frame, rows, "frame 1")  # type: ignore[arg-type]
     assert sorted(os.listdir(tmp_path)) == []
+
+
+def test_track_renderer_refuses_what_is_not_a_track_in_one_line(tmp_path: Path) -> None:
+    """``renderer.add(frame, tracker.update(dets, frame))`` with the drop-in Tracker's (M, 8)
+    rows instead of MultiObjectTracker's Track objects. Was: AttributeError 'numpy.ndarray'
+    object has no attribute 'box_xywh'."""
+    frame = np.zeros((48, 64, 3), np.uint8)
+    renderer = TrackRenderer(tmp_path / "v.mp4", 10)
+    rows = np.array([[10.0, 10.0, 30.0, 50.0, 1, 0.9, 0, 0]])  # Tracker.update's x1..y2, id, ...
+    for tracks in (rows, [None], "abc"):
+        with pytest.raises(
+            TypeError,
+            match=r"^TrackRenderer.add: tracks\[0\] is (ndarray|NoneT"
+            r"ype|str), expected a track with id, box_xywh and time_since_update",
+        ):
+            renderer.add(frame, tracks)  # type: ignore[arg-type]
+    renderer.add(frame, _walk(1)[0])  # the renderer goes on
+    assert renderer.close() == tmp_path / "v.mp4"

@@ -340,6 +340,23 @@ class TrackLike(Protocol):
 _Job = tuple[int, NDArray[np.uint8], NDArray[np.float64], dict[int, list[tuple[float, float]]]]
 
 
+def _track_fields(track: TrackLike, i: int) -> tuple[int, F64, bool]:
+    """`track`'s id, box (x, y, w, h) and whether it is coasting, or a TypeError naming it.
+
+    Was: an AttributeError ('numpy.ndarray' object has no attribute 'box_xywh') for the drop-in
+    :class:`~pftrack.Tracker`'s (M, 8) rows given instead of Track objects.
+    """
+    try:
+        tid, box, since = track.id, track.box_xywh, track.time_since_update
+    except AttributeError:
+        raise TypeError(
+            f"TrackRenderer.add: tracks[{i}] is {type(track).__name__}, expected a track with "
+            "id, box_xywh and time_since_update (pftrack.tracking.Track, as "
+            "MultiObjectTracker.update returns them; not Tracker.update's (M, 8) rows)"
+        ) from None
+    return tid, np.asarray(box, dtype=np.float64), bool(since)
+
+
 class TrackRenderer:
     """Draw tracks with trails on frames as they are tracked, and encode them, on a thread.
 
@@ -396,16 +413,16 @@ class TrackRenderer:
         # checked here, in the caller's thread (was: a float frame drawn black without a word)
         frame = bgr_frame(frame, "TrackRenderer.add: frame")
         self._raise_worker_error()
+        read = [_track_fields(t, i) for i, t in enumerate(tracks)]  # before anything changes
         self._n += 1
         rows, seen = [], set()
-        for t in tracks:
-            box = np.asarray(t.box_xywh, dtype=np.float64)
+        for tid, box, coasting in read:
             # MOT row; columns 8-10 a filled row's mark when coasting: drawn dashed
-            unseen = FILLED_MARK if t.time_since_update else (-1.0, -1.0, -1.0)
-            rows.append([self._n, t.id, *box[:4], 0.0, *unseen])
-            seen.add(t.id)
+            unseen = FILLED_MARK if coasting else (-1.0, -1.0, -1.0)
+            rows.append([self._n, tid, *box[:4], 0.0, *unseen])
+            seen.add(tid)
             if self.trail:
-                trail = self._trails.setdefault(t.id, deque(maxlen=self.trail))
+                trail = self._trails.setdefault(tid, deque(maxlen=self.trail))
                 trail.append(_foot(box))
         for tid in set(self._trails) - seen:
             del self._trails[tid]
