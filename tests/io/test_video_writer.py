@@ -244,3 +244,27 @@ def test_a_frame_that_is_not_bgr_uint8_is_refused_not_cast(
     with pytest.raises(error, match=message), VideoWriter(tmp_path / name, 7) as writer:
         writer.write(frame)  # type: ignore[arg-type]
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("crf", "error", "message"),
+    [
+        (-1, ValueError, r"^crf is -1, expected an integer in \[0, 51\]$"),
+        (100, ValueError, r"^crf is 100, expected an integer in \[0, 51\]$"),
+        (2.5, TypeError, r"^crf must be an integer in \[0, 51\], got float 2.5$"),
+        ("x", TypeError, r"^crf must be an integer in \[0, 51\], got str 'x'$"),
+        (True, TypeError, r"^crf must be an integer in \[0, 51\], got bool True$"),
+        (float("inf"), TypeError, r"^crf must be an integer in \[0, 51\], got float inf$"),
+    ],
+)
+def test_a_crf_outside_x264s_range_is_one_clear_error(
+    tmp_path: Path, crf: object, error: type[Exception], message: str
+) -> None:
+    """Was: -1 and 100 written as given, 2.5 and True taken as 2 and 1, 'x' "invalid literal
+    for int()", inf an OverflowError."""
+    with pytest.raises(error, match=message):
+        VideoWriter(tmp_path / "v.mp4", 7, crf=crf)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []
+    with VideoWriter(tmp_path / "v.mp4", 7, crf=np.int64(51)) as writer:  # NumPy's ints too
+        writer.write(_frames(1)[0])
+    assert writer.crf == 51
