@@ -386,3 +386,50 @@ def test_a_coasting_track_is_dashed_while_tracking(tmp_path: Path) -> None:
     _, [frame] = decode(renderer.close())
     solid, dashed = frame[20, 14:66].max(axis=1), frame[60, 14:66].max(axis=1)
     assert solid.min() > 100 and dashed.max() > 100 and (dashed < 40).sum() >= 10
+
+
+@pytest.mark.parametrize(
+    ("frame", "error", "message"),
+    [
+        (None, TypeError, r"frame is NoneType, expected a \(H, W, 3\) uint8 BGR array$"),
+        (np.full((48, 64, 3), 0.8), TypeError, r"frame dtype is float64, expected uint8"),
+        (np.zeros((48, 64), np.uint8), ValueError, r"frame must have shape \(H, W, 3\)"),
+    ],
+    ids=["none", "float", "grey"],
+)
+def test_the_video_pictures_refuse_a_frame_that_is_not_bgr_uint8(
+    tmp_path: Path, frame: object, error: type[Exception], message: str
+) -> None:
+    """In the caller's thread, naming the call. Was: a float frame drawn black without a word
+    (TrackRenderer) or OpenCV's assertion in putText (write_annotated_video, draw_tracks),
+    None an AttributeError ('NoneType' object has no attribute 'copy')."""
+    from pftrack.render import draw_tracks
+
+    rows = np.array([[1, 1, 10, 10, 20, 40]], float)
+    with pytest.raises(error, match=r"^write_annotated_video: " + message):
+        write_annotated_video(tmp_path / "v.mp4", [frame], rows)  # type: ignore[list-item]
+    renderer = TrackRenderer(tmp_path / "w.mp4", 10)
+    with pytest.raises(error, match=r"^TrackRenderer.add: " + message):
+        renderer.add(frame, _walk(1)[0])  # type: ignore[arg-type]
+    renderer.abort()
+    with pytest.raises(error, match=r"^draw_tracks: " + message):
+        draw_tracks(frame, rows, "frame 1")  # type: ignore[arg-type]
+    assert sorted(os.listdir(tmp_path)) == []
+
+
+def test_track_renderer_refuses_what_is_not_a_track_in_one_line(tmp_path: Path) -> None:
+    """``renderer.add(frame, tracker.update(dets, frame))`` with the drop-in Tracker's (M, 8)
+    rows instead of MultiObjectTracker's Track objects. Was: AttributeError 'numpy.ndarray'
+    object has no attribute 'box_xywh'."""
+    frame = np.zeros((48, 64, 3), np.uint8)
+    renderer = TrackRenderer(tmp_path / "v.mp4", 10)
+    rows = np.array([[10.0, 10.0, 30.0, 50.0, 1, 0.9, 0, 0]])  # Tracker.update's x1..y2, id, ...
+    for tracks in (rows, [None], "abc"):
+        with pytest.raises(
+            TypeError,
+            match=r"^TrackRenderer.add: tracks\[0\] is (ndarray|NoneT"
+            r"ype|str), expected a track with id, box_xywh and time_since_update",
+        ):
+            renderer.add(frame, tracks)  # type: ignore[arg-type]
+    renderer.add(frame, _walk(1)[0])  # the renderer goes on
+    assert renderer.close() == tmp_path / "v.mp4"

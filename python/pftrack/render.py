@@ -71,13 +71,14 @@ def draw_tracks(
     Raises
     ------
     ValueError
-        `rows` are not (k, 6+) MOT rows with finite frame, id and box.
+        `rows` are not (k, 6+) MOT rows with finite frame, id and box; `frame` is not
+        (H, W, 3) with pixels.
     TypeError
-        `rows` are not real numbers; `label` is not a str.
+        `rows` are not real numbers; `label` is not a str; `frame` is not a uint8 array.
     """
     rows = _track_rows(rows, "draw_tracks")  # was "not enough values to unpack" of (k, 5)
     _text(label, "draw_tracks", "label")
-    return _draw_boxes(frame, rows, label)
+    return _draw_boxes(bgr_frame(frame, "draw_tracks: frame"), rows, label)
 
 
 def _draw_boxes(frame: NDArray[np.uint8], rows: F64, label: str) -> NDArray[np.uint8]:
@@ -232,27 +233,51 @@ def write_annotated_video(
     this is), ``.avi`` MJPG. Each track trails its foot points of the last `trail` frames,
     one line for each run of frames it was seen on (none across a frame it is absent from).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Output video: ``.mp4`` or ``.avi``, written atomically.
+    frames : iterable of (H, W, 3) ndarray of uint8
+        The BGR frames, frame 1 first (a generator is read once).
+    rows : (M, 6+) ndarray
+        MOT rows of the tracks: frame, id, left, top, width, height, ...
+    fps : float
+        Frame rate of the video (default 10).
+    trail : int
+        Foot points of the last `trail` frames drawn behind each track (0: none).
+    preset : str
+        x264 preset of an ``.mp4`` (default ``"ultrafast"``).
+
+    Returns
+    -------
+    Path
+        `path`.
+
     Raises
     ------
     ValueError
         `frames` is empty (nothing is written); `rows` are not (M, 6+) MOT rows (frame, id,
         left, top, width, height, ...) with those six values finite; `trail` is not in
-        [0, :data:`MAX_TRAIL`].
+        [0, :data:`MAX_TRAIL`]; a frame is not (H, W, 3) with pixels, or not of the first
+        frame's size.
     TypeError
-        `rows` are not real numbers; `trail` is not an integer.
+        `rows` are not real numbers; `trail` is not an integer; a frame is not a uint8 array.
     """
     trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
     rows = _track_rows(rows, "write_annotated_video")
     it = iter(frames)
-    first = next(it, None)
-    if first is None:
-        raise ValueError("write_annotated_video: frames is empty; no frame to write")
+    try:  # not next(it, None): [None] is a bad frame, not no frame
+        first = next(it)
+    except StopIteration:
+        raise ValueError("write_annotated_video: frames is empty; no frame to write") from None
     by_frame = group_by_frame(rows)
     empty = np.zeros((0, 10))
     paths = _foot_paths(rows) if trail > 0 else {}
     with VideoWriter(path, fps, preset=preset) as writer:
         for k, frame in enumerate(itertools.chain([first], it), start=1):
             here = by_frame.get(k, empty)
+            # was: a float frame OpenCV's assertion in putText
+            frame = bgr_frame(frame, "write_annotated_video: frame")
             image = _draw_boxes(frame, here, f"frame {k}")
             for tid in {int(r[1]) for r in here} if trail > 0 else ():
                 # the foot points of frames k - trail + 1 .. k (was: the last `trail` points
@@ -315,6 +340,23 @@ class TrackLike(Protocol):
 _Job = tuple[int, NDArray[np.uint8], NDArray[np.float64], dict[int, list[tuple[float, float]]]]
 
 
+def _track_fields(track: TrackLike, i: int) -> tuple[int, F64, bool]:
+    """`track`'s id, box (x, y, w, h) and whether it is coasting, or a TypeError naming it.
+
+    Was: an AttributeError ('numpy.ndarray' object has no attribute 'box_xywh') for the drop-in
+    :class:`~pftrack.Tracker`'s (M, 8) rows given instead of Track objects.
+    """
+    try:
+        tid, box, since = track.id, track.box_xywh, track.time_since_update
+    except AttributeError:
+        raise TypeError(
+            f"TrackRenderer.add: tracks[{i}] is {type(track).__name__}, expected a track with "
+            "id, box_xywh and time_since_update (pftrack.tracking.Track, as "
+            "MultiObjectTracker.update returns them; not Tracker.update's (M, 8) rows)"
+        ) from None
+    return tid, np.asarray(box, dtype=np.float64), bool(since)
+
+
 class TrackRenderer:
     """Draw tracks with trails on frames as they are tracked, and encode them, on a thread.
 
@@ -368,17 +410,19 @@ class TrackRenderer:
 
     def add(self, frame: NDArray[np.uint8], tracks: Iterable[TrackLike]) -> None:
         """Queue `frame` (BGR, not modified) with the tracks reported on it."""
+        # checked here, in the caller's thread (was: a float frame drawn black without a word)
+        frame = bgr_frame(frame, "TrackRenderer.add: frame")
         self._raise_worker_error()
+        read = [_track_fields(t, i) for i, t in enumerate(tracks)]  # before anything changes
         self._n += 1
         rows, seen = [], set()
-        for t in tracks:
-            box = np.asarray(t.box_xywh, dtype=np.float64)
+        for tid, box, coasting in read:
             # MOT row; columns 8-10 a filled row's mark when coasting: drawn dashed
-            unseen = FILLED_MARK if t.time_since_update else (-1.0, -1.0, -1.0)
-            rows.append([self._n, t.id, *box[:4], 0.0, *unseen])
-            seen.add(t.id)
+            unseen = FILLED_MARK if coasting else (-1.0, -1.0, -1.0)
+            rows.append([self._n, tid, *box[:4], 0.0, *unseen])
+            seen.add(tid)
             if self.trail:
-                trail = self._trails.setdefault(t.id, deque(maxlen=self.trail))
+                trail = self._trails.setdefault(tid, deque(maxlen=self.trail))
                 trail.append(_foot(box))
         for tid in set(self._trails) - seen:
             del self._trails[tid]

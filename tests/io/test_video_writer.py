@@ -221,3 +221,50 @@ def test_an_mp4_beyond_h264s_side_is_refused_in_one_line(tmp_path: Path, w: int,
         avi.write(frame)
     frames = decode(tmp_path / "v.avi")[1]
     assert len(frames) == 1 and frames[0].shape == (h + h % 2, w + w % 2, 3)
+
+
+@pytest.mark.parametrize(
+    ("frame", "error", "message"),
+    [
+        (None, TypeError, r"^frame is NoneType, expected a \(H, W, 3\) uint8 BGR array$"),
+        ([[[0, 0, 0]]], TypeError, r"^frame is list, expected a NumPy uint8 array"),
+        (np.full((21, 33, 3), 0.8), TypeError, r"^frame dtype is float64, expected uint8"),
+        (np.full((21, 33, 3), 4000, np.uint16), TypeError, r"^frame dtype is uint16, expected"),
+        (np.zeros((0, 0, 3), np.uint8), ValueError, r"^frame is 0x0 pixels, expected at least"),
+    ],
+    ids=["none", "list", "float", "uint16", "empty"],
+)
+@pytest.mark.parametrize("name", ["v.mp4", "v.avi"])
+def test_a_frame_that_is_not_bgr_uint8_is_refused_not_cast(
+    tmp_path: Path, name: str, frame: object, error: type[Exception], message: str
+) -> None:
+    """Was: a float frame of 0..1 written black and a 16-bit one wrapped modulo 256, without a
+    word; None or a list an AttributeError ('list' object has no attribute 'ndim'); an empty
+    frame OpenCV's assertion."""
+    with pytest.raises(error, match=message), VideoWriter(tmp_path / name, 7) as writer:
+        writer.write(frame)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("crf", "error", "message"),
+    [
+        (-1, ValueError, r"^crf is -1, expected an integer in \[0, 51\]$"),
+        (100, ValueError, r"^crf is 100, expected an integer in \[0, 51\]$"),
+        (2.5, TypeError, r"^crf must be an integer in \[0, 51\], got float 2.5$"),
+        ("x", TypeError, r"^crf must be an integer in \[0, 51\], got str 'x'$"),
+        (True, TypeError, r"^crf must be an integer in \[0, 51\], got bool True$"),
+        (float("inf"), TypeError, r"^crf must be an integer in \[0, 51\], got float inf$"),
+    ],
+)
+def test_a_crf_outside_x264s_range_is_one_clear_error(
+    tmp_path: Path, crf: object, error: type[Exception], message: str
+) -> None:
+    """Was: -1 and 100 written as given, 2.5 and True taken as 2 and 1, 'x' "invalid literal
+    for int()", inf an OverflowError."""
+    with pytest.raises(error, match=message):
+        VideoWriter(tmp_path / "v.mp4", 7, crf=crf)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []
+    with VideoWriter(tmp_path / "v.mp4", 7, crf=np.int64(51)) as writer:  # NumPy's ints too
+        writer.write(_frames(1)[0])
+    assert writer.crf == 51

@@ -569,6 +569,29 @@ def write_mot(
     bytes. Longer values are rounded to 2 decimals (pftrack's computed boxes) unless marked
     by `exact` (as in :func:`mot_text`): ``write_mot(out, read_mot(f), exact=True)`` writes
     every value of any file unchanged.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, in an existing folder (:func:`~pftrack.io.atomic.atomic_write`: a new
+        file follows the umask, an existing one keeps its permissions, a symbolic link's
+        target is replaced, a device or FIFO such as ``/dev/null`` is written through; a
+        folder is refused).
+    rows : (M, 6..10) array_like
+        The rows, or an iterable of rows (a generator is read once).
+    exact : bool or (M,) or (M, 6..10) array_like of bool
+        Values written exactly, never rounded (default: none), as in :func:`mot_text`.
+
+    Raises
+    ------
+    ValueError
+        What :func:`mot_text` refuses, or `path` is a folder.
+    TypeError
+        `exact` is not of bool.
+    OSError
+        The folder does not exist (FileNotFoundError naming it), or the hidden temporary file
+        cannot be made, written or renamed (a read-only file system: the error names `path`,
+        left as it was).
     """
     a = _checked(rows, "write_mot")
     mask = _exact_mask(exact, len(a), "write_mot")

@@ -20,12 +20,13 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import colour_hint, real
+from pftrack._check import bgr_frame, integer, real
 from pftrack._typing import PathLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
 
 __all__ = [
+    "MAX_CRF",
     "MAX_H264_SIDE",
     "VIDEO_SUFFIXES",
     "X264_PRESETS",
@@ -37,6 +38,8 @@ __all__ = [
 VIDEO_SUFFIXES = (".mp4", ".avi")
 #: Largest side of an H.264 frame that x264 encodes (pixels).
 MAX_H264_SIDE = 16384
+#: Largest x264 constant rate factor of 8-bit video (:class:`VideoWriter`'s `crf`, from 0).
+MAX_CRF = 51
 #: x264's presets, fastest first (:class:`VideoWriter`'s `preset`).
 X264_PRESETS = (
     "ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
@@ -85,7 +88,8 @@ class VideoWriter:
     backend : {"pyav", "opencv"}, optional
         Default: PyAV for ``.mp4`` when installed, else OpenCV.
     crf : int
-        x264 constant rate factor (lower: better and larger; 23 is x264's default).
+        x264 constant rate factor, 0 to :data:`MAX_CRF` (lower: better and larger; 23 is
+        x264's default).
     preset : str
         x264 preset (:data:`X264_PRESETS`): how much encoding time buys a smaller file at the
         same quality. The default ``"ultrafast"`` keeps an annotated run fast: 795 PETS09-S2L1
@@ -140,7 +144,7 @@ class VideoWriter:
             raise ValueError(f"backend 'pyav' writes .mp4, not {suffix}")
         self.backend = backend
         self.fps = float(fps)
-        self.crf = int(crf)
+        self.crf = integer(crf, "crf", 0, MAX_CRF)  # was int(crf): 2.5 as 2, -1 and 100 kept
         self.preset = preset
         self.codec = "h264" if backend == "pyav" else ("mjpeg" if suffix == ".avi" else "")
         self.n_frames = 0
@@ -188,11 +192,17 @@ class VideoWriter:
         raise ValueError(f"OpenCV cannot write video {self.path} (no encoder for {candidates})")
 
     def write(self, frame: NDArray[np.uint8]) -> None:
-        """Append one BGR uint8 frame (H, W, 3)."""
-        if frame.ndim != 3 or frame.shape[2] != 3:
-            raise ValueError(
-                f"frame has shape {frame.shape}, expected (H, W, 3) BGR{colour_hint(frame.shape)}"
-            )
+        """Append one BGR uint8 frame (H, W, 3).
+
+        Raises
+        ------
+        TypeError
+            `frame` is not a NumPy uint8 array (a float or 16-bit frame is not cast: it would
+            come out black or wrapped modulo 256).
+        ValueError
+            `frame` is not (H, W, 3) with pixels, or not of the first frame's size.
+        """
+        frame = bgr_frame(frame)
         if self._size is None:
             self._open(int(frame.shape[0]), int(frame.shape[1]))
         h, w = self._size if self._size is not None else (0, 0)

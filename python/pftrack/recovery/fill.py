@@ -66,7 +66,9 @@ WHOLE_SEGMENT_METHODS = ("gsi",)
 class FillReport:
     """What :func:`fill_gaps` did.
 
-    ``n_gaps``, ``n_filled_rows``: the holes filled and the rows added;
+    ``n_gaps``, ``n_filled_rows``: the holes filled and the rows added; ``noise``: the noise
+    levels of ``"gdt-bi"`` and ``"gdt-mix"`` (the `noise` given to :func:`fill_gaps`, or
+    estimated from every track when none was), else the `noise` given (None by default);
     ``calibration``: with ``"auto"``, the method chosen per gap-length bucket and the
     validation MMAE of every candidate (:class:`~pftrack.recovery.calibrate.Calibration`);
     ``size_calibration``: the same for the box sizes ``(w, h)`` (candidates
