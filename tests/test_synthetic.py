@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import time
+from functools import partial
 
 import numpy as np
 import pytest
@@ -8,7 +9,7 @@ import pytest
 from pftrack.boxes import iou_xywh
 from pftrack.io.mot import read_mot
 from pftrack.io.video import FrameSource
-from pftrack.synthetic import make_busy_scene, make_scene
+from pftrack.synthetic import BUSY_SCENES, make_busy_scene, make_scene
 
 
 @pytest.fixture(scope="module")
@@ -121,6 +122,23 @@ def test_an_odd_sized_scene_is_written_whole(tmp_path, suffix):
 )
 def test_bad_arguments(kwargs, match):
     with pytest.raises(ValueError, match=match):
+        make_scene(**kwargs)
+
+
+@pytest.mark.parametrize("make", [make_scene, partial(make_busy_scene, BUSY_SCENES[0])])
+def test_a_scene_too_large_to_hold_is_refused_before_any_frame(make):
+    """A defect trial: make_scene(n_frames=10**12) ran until killed (every frame is held)."""
+    with pytest.raises(
+        ValueError, match=r"^make_(busy_)?scene: 1000000000000 frames of 480x360 .* GiB"
+    ):
+        make(n_frames=10**12)
+
+
+@pytest.mark.parametrize("kwargs", [{"n_frames": 2.5}, {"width": 480.0}, {"height": True}])
+def test_a_size_that_is_not_an_integer_is_a_type_error(kwargs):
+    with pytest.raises(
+        TypeError, match=f"^make_scene: {next(iter(kwargs))} is .*expected an integer"
+    ):
         make_scene(**kwargs)
 
 

@@ -298,6 +298,10 @@ def _paste(
     return xa, ya, xb - xa, yb - ya
 
 
+MAX_SCENE_BYTES = 2**33
+"""Largest scene :func:`make_scene` and :func:`make_busy_scene` make: 8 GiB of frames."""
+
+
 def _check_scene_args(
     fn: str, n_frames: int, width: int, height: int, noise: float, fps: float
 ) -> float:
@@ -307,8 +311,17 @@ def _check_scene_args(
     scene with a Fraction, text or 0 failed only when saved).
     """
     for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
-        if not isinstance(v, (int, np.integer)) or v < lo:
+        if not isinstance(v, (int, np.integer)) or isinstance(v, bool):
+            raise TypeError(f"{fn}: {name} is {v!r}, expected an integer >= {lo}")
+        if v < lo:
             raise ValueError(f"{fn}: {name} is {v!r}, expected an integer >= {lo}")
+    size = int(n_frames) * int(width) * int(height) * 3  # the frames are held in memory
+    if size > MAX_SCENE_BYTES:
+        raise ValueError(
+            f"{fn}: {n_frames} frames of {width}x{height} are {size / 2**30:.3g} GiB of BGR "
+            f"pixels, held in memory; at most {MAX_SCENE_BYTES // 2**30} GiB (fewer or smaller "
+            "frames)"
+        )
     if not (np.isfinite(noise) and noise >= 0):
         raise ValueError(f"{fn}: noise is {noise}, expected a finite value >= 0")
     rate = real(fps, f"{fn}: fps", finite=False)
@@ -333,7 +346,7 @@ def make_scene(
     Parameters
     ----------
     n_frames : int
-        Number of frames (>= 1).
+        Number of frames (>= 1; all of them, 8 GiB at most, are held in memory).
     width, height : int
         Frame size (>= 64 x 64).
     n_walkers : int
@@ -594,7 +607,7 @@ def make_busy_scene(
         14 people as ellipses of one size whatever the row (no tall person shape); half
         stand for 20 to 60 frames first; all walk in straight lines in random directions.
     n_frames : int
-        Number of frames (>= 1).
+        Number of frames (>= 1; all of them, 8 GiB at most, are held in memory).
     width, height : int
         Frame size (>= 64 x 64).
     rng : numpy.random.Generator, int or None
