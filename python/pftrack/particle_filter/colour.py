@@ -68,7 +68,7 @@ class HsvBinning:
         for name in ("s_min", "v_min"):
             v = number(getattr(self, name), f"HsvBinning: {name}", finite=False)
             if not (0.0 <= v <= 1.0):
-                raise ValueError(f"{name} is {v!r}, expected a value in [0, 1]")
+                raise ValueError(f"HsvBinning: {name} is {v!r}, expected a value in [0, 1]")
 
     @property
     def n_bins(self) -> int:
