@@ -520,5 +520,12 @@ def rts_smooth(
     zz, hh = real_array(z, f"{fn}: z"), bool_array(has, f"{fn}: has")
     q2, rr = real_array(q, f"{fn}: q"), real_array(r2, f"{fn}: r2")
     sd = number(velocity_sd, f"{fn}: velocity_sd", finite=False)  # the core names NaN, < 0
-    out: F64 = _core.rts_smooth(zz, hh, q2, rr, sd, flag(update_first, f"{fn}: update_first"))
+    try:
+        out: F64 = _core.rts_smooth(zz, hh, q2, rr, sd, flag(update_first, f"{fn}: update_first"))
+    except ValueError:
+        # the core's refusal of q or r2 names neither the entry nor its value: name them, as
+        # cv_update does (checked here only on the way out, at no cost to the smoother's calls)
+        _require(fn, "q", q2, ">= 0")
+        _require(fn, "r2", rr, "> 0")
+        raise
     return out
