@@ -5,7 +5,10 @@ the same names, plus an explicit `rng`. Unlike filterpy, weights need not sum to
 can never produce an index >= N (the CDF's last value is set to 1 and indices are clamped).
 
 Given the same uniform draws, :func:`systematic_resample`, :func:`stratified_resample` and
-:func:`multinomial_resample` return filterpy's indices. :func:`residual_resample` differs on
+:func:`multinomial_resample` return filterpy's indices, but for a multinomial draw of exactly
+0.0 (``Generator.random()`` gives one in 2**53): filterpy's ``searchsorted`` then picks
+particle 0 even when its weight is 0, these the first particle of weight > 0 (as they do the
+residual draws of :func:`residual_resample`). :func:`residual_resample` differs on
 purpose: filterpy 2.0.0 draws the remainder from ``weights - floor(N*weights)`` where Liu &
 Chen's residuals are ``N*weights - floor(N*weights)`` (see its Notes), so only the
 ``floor(N*w_i)`` deterministic copies agree.
