@@ -328,6 +328,12 @@ def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, C
         not finite, `cov` not positive semi-definite (``p01² > p00 p11`` beyond a relative
         round-off of 1e-9), arrays whose shapes do not broadcast together, or a predicted
         state that is not finite (values too extreme: a position of 1e308 moving at 1e308).
+
+    Examples
+    --------
+    >>> from pftrack.kalman import cv_predict
+    >>> cv_predict((10.0, 2.0), (1.0, 0.0, 0.5), q=0.1)  # at 10 px, moving 2 px a frame
+    ((12.0, 2.0), (1.5333333333333334, 0.55, 0.6))
     """
     fn = "cv_predict"
     _require_state(fn, mean, cov, q=q, dt=dt)
@@ -374,6 +380,14 @@ def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
         `cov` not positive semi-definite (as :func:`cv_predict`'s), `r2` not finite and ``> 0``
         (as :func:`rts_smooth`'s), arrays whose shapes do not broadcast together, ``p00 + r2``
         overflowing (the measurement would be ignored) or a filtered state that is not finite.
+
+    Examples
+    --------
+    >>> from pftrack.kalman import cv_predict, cv_update
+    >>> mean, cov = cv_predict((10.0, 2.0), (1.0, 0.0, 0.5), q=0.1)
+    >>> mean, cov = cv_update(mean, cov, z=12.5, r2=1.0)  # measured at 12.5 px
+    >>> round(mean[0], 4), round(mean[1], 4), round(cov[0], 4)
+    (12.3026, 2.1086, 0.6053)
     """
     fn = "cv_update"
     _require_state(fn, mean, cov, z=z, r2=r2)
@@ -485,6 +499,19 @@ def rts_smooth(
         or ``2`` would count as observed), a first frame without a measurement, a measured
         `z` not finite, `q` or `velocity_sd` not finite and ``>= 0``, `r2` not finite and
         ``> 0``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pftrack.kalman import rts_smooth
+    >>> z = np.array([[0.0], [1.2], [np.nan], [2.9], [4.1]])  # one axis, frame 2 missed
+    >>> has = ~np.isnan(z[:, 0])
+    >>> rts_smooth(z, has, [0.1], [0.25], velocity_sd=5.0, update_first=True).round(3)
+    array([[0.041],
+           [1.051],
+           [2.042],
+           [3.031],
+           [4.037]])
     """
     # one C++ loop over frames per axis (tests/reference/smoothing.py holds the NumPy loop it
     # equals), which checks the shapes, the first frame and every value it reads; rows without
@@ -493,5 +520,12 @@ def rts_smooth(
     zz, hh = real_array(z, f"{fn}: z"), bool_array(has, f"{fn}: has")
     q2, rr = real_array(q, f"{fn}: q"), real_array(r2, f"{fn}: r2")
     sd = number(velocity_sd, f"{fn}: velocity_sd", finite=False)  # the core names NaN, < 0
-    out: F64 = _core.rts_smooth(zz, hh, q2, rr, sd, flag(update_first, f"{fn}: update_first"))
+    try:
+        out: F64 = _core.rts_smooth(zz, hh, q2, rr, sd, flag(update_first, f"{fn}: update_first"))
+    except ValueError:
+        # the core's refusal of q or r2 names neither the entry nor its value: name them, as
+        # cv_update does (checked here only on the way out, at no cost to the smoother's calls)
+        _require(fn, "q", q2, ">= 0")
+        _require(fn, "r2", rr, "> 0")
+        raise
     return out

@@ -106,8 +106,14 @@ def test_hsv_bins_bad_frames():
             TypeError, match=rf"HsvBinning: n_s must be an integer in \[1, 64\], got \w+ {bad!r}"
         ):
             HsvBinning(n_s=bad)  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match="s_min is 2"):
+    # named with the class: Ar2Model has an s_min too (a scale), so "s_min is 2" alone was
+    # ambiguous inside a TrackerConfig
+    with pytest.raises(
+        ValueError, match=r"^HsvBinning: s_min is 2\.0, expected a value in \[0, 1\]"
+    ):
         hsv_bins(np.zeros((4, 4, 3), np.uint8), binning=HsvBinning(s_min=2.0))
+    with pytest.raises(ValueError, match=r"^HsvBinning: v_min is nan"):
+        HsvBinning(v_min=float("nan"))
 
 
 def test_box_histograms_bad_boxes():

@@ -58,6 +58,29 @@ def test_invariants(name):
     np.testing.assert_array_equal(fn(w, rng=2), np.full(n, 17))  # all weight on k -> all k
 
 
+@pytest.mark.parametrize(
+    ("name", "w", "u"),
+    [
+        ("multinomial", [0.0, 0.0, 1.0, 3.0], [0.0, 0.1, 0.5, 0.9]),
+        # N w = 0, 1, 1.5, 1.5: three copies, then one draw from the residuals 0, 0, .5, .5
+        ("residual", [0.0, 1.0, 1.5, 1.5], [0.0, 0.0, 0.0, 0.0]),
+    ],
+)
+def test_a_draw_of_zero_never_picks_a_particle_of_weight_zero(name, w, u):
+    """Regression: a uniform draw of exactly 0.0 (``Generator.random()`` returns it once in
+    2**53 draws) picked particle 0 whatever its weight: ``searchsorted(cdf, 0)``, filterpy's
+    search, is the first cdf value >= 0, cdf[0] even when it is 0. It now takes the first
+    particle of weight > 0 (residual: of residual > 0); every other draw is filterpy's."""
+    w, u = np.array(w), np.array(u)
+    idx = getattr(_core, f"{name}_resample")(w, u)
+    assert (w[idx] > 0).all(), idx
+    if name == "residual":
+        np.testing.assert_array_equal(idx, [1, 2, 3, 2])
+    else:
+        np.testing.assert_array_equal(idx, [2, 2, 3, 3])
+    np.testing.assert_array_equal(idx, getattr(ref, f"{name}_resample")(w, u))
+
+
 @pytest.mark.parametrize("name", RESAMPLERS)
 def test_round_off_never_indexes_past_the_end(name):
     n = 1000

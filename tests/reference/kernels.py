@@ -112,9 +112,16 @@ def stratified_resample(weights, u):
     return np.minimum(np.searchsorted(_cdf(weights), positions, side="right"), n - 1)
 
 
+def _search(cdf, u):
+    """np.searchsorted(cdf, u) (filterpy's search), but a draw of exactly 0 takes the first cdf
+    value > 0: never a leading particle of weight 0."""
+    u = np.asarray(u)
+    return np.where(u > 0, np.searchsorted(cdf, u), np.searchsorted(cdf, 0.0, side="right"))
+
+
 def multinomial_resample(weights, u):
     n = len(weights)
-    return np.minimum(np.searchsorted(_cdf(weights), np.asarray(u)[:n]), n - 1)
+    return np.minimum(_search(_cdf(weights), np.asarray(u)[:n]), n - 1)
 
 
 def residual_resample(weights, u):
@@ -127,7 +134,7 @@ def residual_resample(weights, u):
     rest = n - len(idx)
     if rest > 0:
         residual = nw - copies
-        idx = np.concatenate([idx, np.minimum(np.searchsorted(_cdf(residual), u[:rest]), n - 1)])
+        idx = np.concatenate([idx, np.minimum(_search(_cdf(residual), u[:rest]), n - 1)])
     return idx
 
 

@@ -248,6 +248,16 @@ def test_rts_bad_input():
         rts_smooth(
             np.zeros((0, 2)), np.zeros(0, bool), [1, 1], [1, 1], velocity_sd=1.0, update_first=True
         )
+    # the entry and its value are named, as cv_update names them (was: "q must be finite and
+    # >= 0, r2 finite and > 0", whichever of the two, on whichever axis)
+    for q, r2, match in (
+        ([1, -1], [1, 1], r"^rts_smooth: q\[1\] is -1, expected finite and >= 0$"),
+        ([1, np.nan], [1, 1], r"^rts_smooth: q\[1\] is nan, expected finite and >= 0$"),
+        ([1, 1], [0, 1], r"^rts_smooth: r2\[0\] is 0, expected finite and > 0$"),
+        ([1, 1], [1, np.inf], r"^rts_smooth: r2\[1\] is inf, expected finite and > 0$"),
+    ):
+        with pytest.raises(ValueError, match=match):
+            rts_smooth(z, [True] * 4, q, r2, velocity_sd=1.0, update_first=True)
 
 
 MEAN = (np.array([1.0, 2.0]), np.array([0.5, -0.5]))

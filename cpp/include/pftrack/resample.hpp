@@ -360,9 +360,13 @@ inline IndexVector stratified_resample(const Eigen::Ref<const Eigen::VectorXd>& 
     return idx;
 }
 
-/// Index of the first cdf value >= p (binary search), clamped to N-1.
+/// Index of the first cdf value >= p (binary search; numpy.searchsorted(cdf, p), filterpy's
+/// search), clamped to N-1; for p = 0 the first cdf value > 0, so that a draw of exactly 0
+/// (Generator.random() can return it) never picks a leading particle of weight 0 (the first
+/// value >= 0 is cdf[0], whatever its weight). For p > 0 the first value >= p has weight > 0.
 inline int search_cdf(const std::vector<double>& cdf, double p) {
-    const auto it = std::lower_bound(cdf.begin(), cdf.end(), p);
+    const auto it = p > 0.0 ? std::lower_bound(cdf.begin(), cdf.end(), p)
+                            : std::upper_bound(cdf.begin(), cdf.end(), 0.0);
     return static_cast<int>(std::min<std::ptrdiff_t>(it - cdf.begin(),
                                                      static_cast<std::ptrdiff_t>(cdf.size()) - 1));
 }

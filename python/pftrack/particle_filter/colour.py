@@ -68,7 +68,7 @@ class HsvBinning:
         for name in ("s_min", "v_min"):
             v = number(getattr(self, name), f"HsvBinning: {name}", finite=False)
             if not (0.0 <= v <= 1.0):
-                raise ValueError(f"{name} is {v!r}, expected a value in [0, 1]")
+                raise ValueError(f"HsvBinning: {name} is {v!r}, expected a value in [0, 1]")
 
     @property
     def n_bins(self) -> int:
@@ -119,7 +119,19 @@ def hsv_bins(
         an :class:`HsvBinning`.
     ValueError
         A frame not of shape (H, W, 3) (a grey or BGRA frame's message names the
-        ``cv2.cvtColor`` conversion), or a mask of another size.
+        ``cv2.cvtColor`` conversion), an empty frame, or a mask of another size.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pftrack import hsv_bins
+    >>> frame = np.zeros((4, 6, 3), np.uint8)  # black: value 0, grey bin 100 (bins 100-109)
+    >>> frame[:, 3:] = (0, 0, 255)  # BGR red: hue 0, saturation 1, colour bin 9
+    >>> image = hsv_bins(frame)
+    >>> image.n_bins, image.shape, image.bins.dtype
+    (110, (4, 6), dtype('int16'))
+    >>> image.bins[0]
+    array([100, 100, 100,   9,   9,   9], dtype=int16)
     """
     if not isinstance(binning, HsvBinning):
         raise TypeError(
@@ -182,6 +194,21 @@ def box_histograms(
     ----------
     .. [1] Porikli, F. (2005). Integral histogram: a fast way to extract histograms in
        Cartesian spaces. CVPR 2005, 829-836.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pftrack import box_histograms, hsv_bins
+    >>> frame = np.zeros((4, 6, 3), np.uint8)
+    >>> frame[:, 3:] = (0, 0, 255)  # left half black (bin 100), right half red (bin 9)
+    >>> boxes = [[3, 2, 6, 4], [4.5, 2, 3, 4], [100, 100, 4, 4]]  # whole, red half, outside
+    >>> h = box_histograms(hsv_bins(frame), boxes)
+    >>> h.shape, h.dtype
+    ((3, 110), dtype('float64'))
+    >>> h[:, [9, 100]]
+    array([[0.5, 0.5],
+           [1. , 0. ],
+           [0. , 0. ]])
     """
     fn = "box_histograms"
     error = not_binned(image, f"{fn}: image")
@@ -249,6 +276,34 @@ def bhattacharyya_coefficient(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.fl
 
     `ref` and each row of `hists` are normalised to sum 1 first (a row of zeros has rho 0), so
     pixel counts serve as well as histograms: rho is in [0, 1], 1 for the same distribution.
+
+    Parameters
+    ----------
+    hists : (K, B) array_like of float
+        Histograms, one per row (a 1-D array is one row; K may be 0): bin counts or
+        frequencies, finite and >= 0.
+    ref : (B,) array_like of float
+        Reference histogram (counts or frequencies), finite, >= 0, not all 0.
+
+    Returns
+    -------
+    (K,) ndarray of float64
+        The Bhattacharyya coefficient of each row.
+
+    Raises
+    ------
+    TypeError
+        `hists` or `ref` not real numbers (text, objects, complex numbers).
+    ValueError
+        `hists` of more than 2 dimensions, `ref` not 1-D or not of the rows' length B, `ref`
+        empty; an entry negative or not finite; `ref` all 0; a row or `ref` whose sum
+        overflows.
+
+    Examples
+    --------
+    >>> from pftrack import bhattacharyya_coefficient
+    >>> bhattacharyya_coefficient([[1, 1, 0], [2, 0, 0], [0, 0, 0]], [1, 0, 0])
+    array([0.70710678, 1.        , 0.        ])
     """
     fn = "bhattacharyya_coefficient"
     return _core.bhattacharyya_coefficient(_histograms(hists, fn), _reference(ref, fn))
@@ -258,6 +313,35 @@ def bhattacharyya_distance(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float
     """Bhattacharyya distance ``D = sqrt(1 - rho)`` of each row of `hists` to `ref`.
 
     Rows and `ref` normalised as by :func:`bhattacharyya_coefficient`.
+
+    Parameters
+    ----------
+    hists : (K, B) array_like of float
+        Histograms, one per row (a 1-D array is one row; K may be 0): bin counts or
+        frequencies, finite and >= 0.
+    ref : (B,) array_like of float
+        Reference histogram (counts or frequencies), finite, >= 0, not all 0.
+
+    Returns
+    -------
+    (K,) ndarray of float64
+        The distance of each row, in [0, 1] (0: the same distribution; 1: no common bin, or a
+        row of zeros).
+
+    Raises
+    ------
+    TypeError
+        `hists` or `ref` not real numbers (text, objects, complex numbers).
+    ValueError
+        `hists` of more than 2 dimensions, `ref` not 1-D or not of the rows' length B, `ref`
+        empty; an entry negative or not finite; `ref` all 0; a row or `ref` whose sum
+        overflows.
+
+    Examples
+    --------
+    >>> from pftrack import bhattacharyya_distance
+    >>> bhattacharyya_distance([[1, 1, 0], [2, 0, 0], [0, 0, 1]], [1, 0, 0])
+    array([0.5411961, 0.       , 1.       ])
     """
     fn = "bhattacharyya_distance"
     return _core.bhattacharyya_distance(_histograms(hists, fn), _reference(ref, fn))
@@ -291,6 +375,13 @@ def bhattacharyya_weights(
     ValueError
         `lam` is not finite and > 0; no rows in `hists`; shapes that do not match (`ref` not
         1-D); a negative or non-finite entry; `ref` all zeros.
+
+    Examples
+    --------
+    >>> from pftrack import bhattacharyya_weights
+    >>> w = bhattacharyya_weights([[1, 1, 0], [2, 0, 0], [0, 0, 1]], [1, 0, 0], lam=20.0)
+    >>> w.round(6), round(float(w.sum()), 12)
+    (array([0.002849, 0.997151, 0.      ]), 1.0)
     """
     fn = "bhattacharyya_weights"
     if isinstance(lam, bool) or not isinstance(lam, numbers.Real):

@@ -154,6 +154,20 @@ def propagate(
         not (N, 3) or `means` not (2, 3); a value that is not finite; ``model.use_means``
         without `means`; a new state that is not finite (the step overflowed: states or
         noise near 1e308). `particles` is left as it was whenever an error is raised.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pftrack.particle_filter import Ar2Model, propagate
+    >>> particles = np.array([[12.0, 20.0, 1.0, 10.0, 20.0, 1.0]])  # moving 2 px a frame in x
+    >>> propagate(particles, np.zeros((1, 3)))  # no noise: constant velocity
+    >>> particles
+    array([[14., 20.,  1., 12., 20.,  1.]])
+    >>> propagate(particles, np.zeros((1, 3)), Ar2Model(velocity_gain=0.5))  # damped
+    >>> particles
+    array([[15., 20.,  1., 14., 20.,  1.]])
+    >>> rng = np.random.default_rng(0)  # a filter's step: noise drawn in Python
+    >>> propagate(particles, rng.standard_normal((len(particles), 3)))
     """
     fn = "propagate"
     error = _particles_error(particles, fn)
@@ -237,6 +251,14 @@ def estimate(
     ValueError
         `particles` not of shape (N, 6) with N >= 1, `weights` not (N,); a weight negative or
         not finite, or all 0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pftrack.particle_filter import estimate
+    >>> particles = np.array([[10, 20, 1.0, 9, 20, 1.0], [14, 22, 1.2, 13, 22, 1.2]])
+    >>> estimate(particles, [1, 3])  # weights need not sum to 1
+    (array([13.  , 21.5 ,  1.15]), array([14. , 22. ,  1.2]))
     """
     fn = "estimate"
     p = np.ascontiguousarray(real_array(particles, f"{fn}: particles", booleans=False))

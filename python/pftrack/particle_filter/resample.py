@@ -5,7 +5,10 @@ the same names, plus an explicit `rng`. Unlike filterpy, weights need not sum to
 can never produce an index >= N (the CDF's last value is set to 1 and indices are clamped).
 
 Given the same uniform draws, :func:`systematic_resample`, :func:`stratified_resample` and
-:func:`multinomial_resample` return filterpy's indices. :func:`residual_resample` differs on
+:func:`multinomial_resample` return filterpy's indices, but for a multinomial draw of exactly
+0.0 (``Generator.random()`` gives one in 2**53): filterpy's ``searchsorted`` then picks
+particle 0 even when its weight is 0, these the first particle of weight > 0 (as they do the
+residual draws of :func:`residual_resample`). :func:`residual_resample` differs on
 purpose: filterpy 2.0.0 draws the remainder from ``weights - floor(N*weights)`` where Liu &
 Chen's residuals are ``N*weights - floor(N*weights)`` (see its Notes), so only the
 ``floor(N*w_i)`` deterministic copies agree.
@@ -76,6 +79,15 @@ def systematic_resample(
     (N,) ndarray of int32
         Sorted indices into the particle array.
 
+    Raises
+    ------
+    TypeError
+        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        not a Generator, a RandomState, a seed or None (a bool, a float, a string).
+    ValueError
+        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
+        or a sum that overflows; a negative seed.
+
     Notes
     -----
     A seed or a Generator gives exactly ``default_rng(rng).random()`` as the offset, so results
@@ -89,6 +101,16 @@ def systematic_resample(
     ----------
     .. [1] Kitagawa, G. (1996). Monte Carlo filter and smoother for non-Gaussian nonlinear
        state space models. Journal of Computational and Graphical Statistics 5(1), 1-25.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pftrack import systematic_resample
+    >>> systematic_resample([0.1, 0.2, 0.3, 0.4], rng=0)
+    array([1, 2, 3, 3], dtype=int32)
+    >>> particles = np.array([10.0, 20.0, 30.0, 40.0])
+    >>> particles[systematic_resample([1, 2, 3, 4], rng=0)]  # weights need not sum to 1
+    array([20., 30., 40., 40.])
     """
     w = _weights(weights, "systematic_resample")
     return _core.systematic_resample(w, generator(rng, "systematic_resample: rng").random())
@@ -109,11 +131,27 @@ def stratified_resample(
     Returns
     -------
     (N,) ndarray of int32
+        Sorted indices into the particle array.
+
+    Raises
+    ------
+    TypeError
+        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        not a Generator, a RandomState, a seed or None (a bool, a float, a string).
+    ValueError
+        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
+        or a sum that overflows; a negative seed.
 
     References
     ----------
     .. [1] Douc, R., Cappé, O. & Moulines, E. (2005). Comparison of resampling schemes for
        particle filtering. ISPA 2005, 64-69.
+
+    Examples
+    --------
+    >>> from pftrack import stratified_resample
+    >>> stratified_resample([0.1, 0.2, 0.3, 0.4], rng=0)
+    array([1, 2, 2, 3], dtype=int32)
     """
     w = _weights(weights, "stratified_resample")
     return _core.stratified_resample(w, generator(rng, "stratified_resample: rng").random(len(w)))
@@ -138,10 +176,26 @@ def multinomial_resample(
     (N,) ndarray of int64
         As filterpy's (``np.searchsorted``); the other three schemes give int32, as theirs do.
 
+    Raises
+    ------
+    TypeError
+        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        not a Generator, a RandomState, a seed or None (a bool, a float, a string).
+    ValueError
+        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
+        or a sum that overflows; a negative seed.
+
     References
     ----------
     .. [1] Gordon, N., Salmond, D. & Smith, A. (1993). Novel approach to nonlinear/non-Gaussian
        Bayesian state estimation. IEE Proceedings F 140(2), 107-113.
+
+    Examples
+    --------
+    >>> from pftrack import multinomial_resample
+    >>> idx = multinomial_resample([0.1, 0.2, 0.3, 0.4], rng=0)
+    >>> idx, idx.dtype
+    (array([3, 1, 0, 0]), dtype('int64'))
     """
     w = _weights(weights, "multinomial_resample")
     u = generator(rng, "multinomial_resample: rng").random(len(w))
@@ -168,6 +222,17 @@ def residual_resample(
     Returns
     -------
     (N,) ndarray of int32
+        Indices into the particle array: the deterministic copies in particle order, then the
+        remainder in the order of the draws.
+
+    Raises
+    ------
+    TypeError
+        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        not a Generator, a RandomState, a seed or None (a bool, a float, a string).
+    ValueError
+        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
+        or a sum that overflows; a negative seed.
 
     Notes
     -----
@@ -184,6 +249,12 @@ def residual_resample(
     ----------
     .. [1] Liu, J. S. & Chen, R. (1998). Sequential Monte Carlo methods for dynamic systems.
        JASA 93(443), 1032-1044.
+
+    Examples
+    --------
+    >>> from pftrack import residual_resample
+    >>> residual_resample([0.1, 0.2, 0.3, 0.4], rng=0)  # N w = 0.4, 0.8, 1.2, 1.6
+    array([2, 3, 2, 1], dtype=int32)
     """
     w = _weights(weights, "residual_resample")
     return _core.residual_resample(w, generator(rng, "residual_resample: rng").random(len(w)))

@@ -261,6 +261,21 @@ def goal_directed_path(
        Journal of Korea Multimedia Society 18(5).
     .. [2] Srinivasan, L. et al. (2006). A state-space analysis for reconstruction of
        goal-directed movements using neural signals. Neural Computation 18(10).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pftrack import goal_directed_path
+    >>> eye = np.eye(2)  # a random walk in (x, y) from near (0, 0) to the goal (4, 2)
+    >>> s = goal_directed_path(eye, 0.1 * eye, eye, 0.01 * eye, [0, 0], 0.01 * eye, [4, 2], 4)
+    >>> s.path.round(3)
+    array([[0.095, 0.048],
+           [1.048, 0.524],
+           [2.   , 1.   ],
+           [2.952, 1.476],
+           [3.905, 1.952]])
+    >>> s.eps.shape, s.cov.shape
+    ((4, 2, 2), (5, 2, 2))
     """
     fn = "goal_directed_path"
     T = _count(T, "T", fn)

@@ -116,6 +116,18 @@ def recover_gap(
         Empty or malformed segments (:func:`~pftrack.recovery.segments.as_segment`: NaN, a
         frame that is not an integer, a negative width or height, a value beyond ±1e9 px),
         overlapping segments, frames outside the gap or an unknown method.
+
+    Examples
+    --------
+    >>> from pftrack import recover_gap
+    >>> a = [[1, 10, 50], [2, 12, 50], [3, 14, 50]]  # frames 1-3, moving 2 px a frame in x
+    >>> b = [[7, 22, 50], [8, 24, 50]]
+    >>> recover_gap(a, b, method="linear")  # frames 4, 5, 6
+    array([[16., 50.],
+           [18., 50.],
+           [20., 50.]])
+    >>> recover_gap(a, b, frames=[5], method="gdt-bi").round(2)
+    array([[18., 50.]])
     """
     if isinstance(frames, str):  # recover_gap(a, b, "linear"): frames come third here
         hint = f"; the method goes by keyword: method={frames!r}" if frames in METHODS else ""
