@@ -660,7 +660,10 @@ class MultiObjectTracker:
         for (ti, di), big in zip(result.matches, large, strict=True):
             if big:
                 follow_pending()
-                others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti)
+                # a blob of the detection's class: a car's box holding a person is no blob
+                # (was: any track's centre held it, whatever its class)
+                cls = tracks[ti].cls
+                others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti and o.cls == cls)
                 if covers_another(box_list[di], others):
                     continue  # a merged blob: the track keeps its own prediction
             followed.append((ti, di))
