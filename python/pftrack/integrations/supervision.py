@@ -18,9 +18,9 @@ from typing import TYPE_CHECKING, Any, TypedDict
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import real_array
+from pftrack._check import MAX_CLASS, first_bad_class, real_array
 from pftrack._typing import F64, CameraMotion, DetectorName, DynamicsName, FillMode, SamplerName
-from pftrack.tracking.api import MAX_CLASS, Tracker
+from pftrack.tracking.api import Tracker
 
 if sys.version_info >= (3, 11):  # at run time too: typing.get_type_hints resolves it
     from typing import Unpack
@@ -74,11 +74,10 @@ def _field(values: ArrayLike, name: str, shape: tuple[int, int]) -> F64:
         raise ValueError(f"detections.{name}[{k}] is {a[k].tolist()}, expected finite numbers")
     if name == "class_id":
         c = a[:, 0]
-        odd = (c != np.round(c)) | (c < -MAX_CLASS - 1) | (c > MAX_CLASS)
-        if odd.any():
-            k = int(np.flatnonzero(odd)[0])
+        j = first_bad_class(c)
+        if j is not None:
             raise ValueError(
-                f"detections.class_id[{k}] is {c[k]:.17g}, expected an integer in "
+                f"detections.class_id[{j}] is {c[j]:.17g}, expected an integer in "
                 f"[{-MAX_CLASS - 1}, {MAX_CLASS}]"
             )
     return a
