@@ -13,6 +13,7 @@ from pftrack._typing import F64, RngLike
 
 __all__ = [
     "BOX_VALUES",
+    "MAX_CLASS",
     "MAX_COORD",
     "MAX_FRAME",
     "MAX_ID",
@@ -24,6 +25,7 @@ __all__ = [
     "colour_hint",
     "first_bad_box",
     "first_at",
+    "first_bad_class",
     "first_bad_id",
     "flag",
     "generator",
@@ -47,6 +49,8 @@ NORMALISED_REACH = 2.0
 MAX_FRAME = 2**31 - 1
 #: Largest absolute track id accepted (as frames: ids are cast to 32- or 64-bit integers).
 MAX_ID = MAX_FRAME
+#: Largest class id a tracker takes (a 32-bit signed integer: -2**31 to 2**31 - 1).
+MAX_CLASS = 2**31 - 1
 
 
 def frames_from_1(frame: float, mend: str = "rows[:, 0] += 1") -> str:
@@ -71,6 +75,16 @@ def first_bad_id(ids: ArrayLike) -> int | None:
     with np.errstate(invalid="ignore"):
         bad = ~(np.abs(a) <= MAX_ID) | (a != np.floor(a))
     return int(np.flatnonzero(bad)[0]) if bad.any() else None
+
+
+def first_bad_class(classes: F64) -> int | None:
+    """Index of the first of `classes` that is not an integer in ``[-2**31, MAX_CLASS]``, or None.
+
+    One test for every tracker's class ids (``Tracker.update``'s column, ``MultiObjectTracker``'s
+    `classes`, supervision's ``class_id``): 1.5 is refused, never truncated to 1; NaN too.
+    """
+    ok = (classes == np.round(classes)) & (classes >= -MAX_CLASS - 1) & (classes <= MAX_CLASS)
+    return int(np.flatnonzero(~ok)[0]) if not ok.all() else None
 
 
 def bad_id_message(value: float) -> str:

@@ -130,6 +130,35 @@ def test_boxes_without_area_and_inverted_boxes(scene):
         adapter.update_with_detections(inverted, scene.frames[1])
 
 
+@pytest.mark.parametrize(
+    ("field", "value", "error", "message"),
+    [
+        ("confidence", np.array([0.9, np.nan]), ValueError,
+         r"^detections.confidence\[1\] is nan, expected a finite number$"),
+        ("xyxy", np.array([[10.0, 10, 40, 90], [50, np.inf, 80, 90]]), ValueError,
+         r"^detections.xyxy\[1\] is \[50.0, inf, 80.0, 90.0\], expected finite numbers$"),
+        ("class_id", np.array([0, 1.5]), ValueError,
+         r"^detections.class_id\[1\] is 1.5, expected an integer in \[-2147483648, 2147483647\]$"),
+        ("class_id", np.array(["person", "car"]), TypeError,
+         r"^detections.class_id must hold real numbers, got dtype <U6$"),
+    ],
+)  # fmt: skip
+def test_bad_fields_are_named_as_supervisions(scene, field, value, error, message):
+    """A bad value is named by its Detections field (was: "detections row 1 contains NaN or
+    inf: [..., nan, 0.0]", six columns with a class the user never gave, or "(column 6: x1,
+    y1, x2, y2, conf, cls)", or "detections must hold real numbers" for class names)."""
+    fields = {
+        "xyxy": np.array([[10.0, 10, 40, 90], [50, 10, 80, 90]]),
+        "confidence": np.array([0.9, 0.8]),
+        "class_id": np.array([0, 1]),
+    }
+    fields[field] = value
+    adapter = SupervisionTracker()
+    with pytest.raises(error, match=message):
+        adapter.update_with_detections(sv.Detections(**fields), scene.frames[0])
+    assert adapter.tracker.frame_count == 0
+
+
 def test_supervision_is_imported_lazily():
     code = (
         "import sys, pftrack.integrations.supervision as m, pftrack; pftrack.Tracker; "

@@ -317,6 +317,31 @@ def test_merged_blob_rows_name_the_blob():
     assert matched[0].detection_box is None  # a blob does not re-seed the track
 
 
+@pytest.mark.parametrize("person_class", [0, 2])
+def test_a_blob_is_made_of_tracks_of_its_class(person_class):
+    """A car (class 2) whose box grows 3x in one frame, now holding a person's centre.
+
+    A detector's box of one class is no blob of another class's objects: the car's track
+    follows its new box when the person is of another class (was: it kept its old box, as
+    it does when the person is of the car's class, a merged blob).
+    """
+    frame = np.random.default_rng(0).integers(0, 255, (240, 320, 3), dtype=np.uint8)
+    frame[100:180, 100:130] = (0, 0, 200)
+    frame[120:170, 140:200] = (200, 0, 0)
+    person = [100.0, 100.0, 130.0, 180.0, 0.95, person_class]
+    tracker = pftrack.Tracker(refine=False)
+    for k in range(20):
+        car = (
+            [140.0, 120.0, 200.0, 170.0, 0.95, 2]
+            if k < 10
+            else [90.0, 110.0, 230.0, 180.0, 0.95, 2]
+        )
+        out = tracker.update(np.array([person, car]), frame)
+    (row,) = out[out[:, 7] == 1]
+    followed = np.abs(row[:4] - car[:4]).max() < 5  # the car's new box, 90, 110, 230, 180
+    assert followed == (person_class != 2)
+
+
 # -- birth gates -----------------------------------------------------------------------------
 def test_low_score_detector_still_gives_tracks(scene):
     dets = scene_dets(scene, scores=(0.2, 0.5))

@@ -483,3 +483,25 @@ def test_reported_tracks_are_tracks_made_by_their_dataclass(measured):
     assert pickle.dumps(fast) == pickle.dumps(made)
     with pytest.raises(dataclasses.FrozenInstanceError):
         fast.score = 0.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize(
+    ("classes", "error", "message"),
+    [
+        ([0, 1.5], ValueError, r"^classes\[1\] is 1.5, expected an integer in \[-2147483648, "),
+        ([np.nan, 0], ValueError, r"^classes\[0\] is nan, expected an integer in "),
+        ([0, 2.0**40], ValueError, r"^classes\[1\] is 1099511627776, expected an integer in "),
+        (["person", "car"], TypeError, r"^classes must hold real numbers, got dtype <U6$"),
+    ],
+)
+def test_class_ids_given_to_update_are_checked(classes, error, message):
+    """MultiObjectTracker.update's `classes` as Tracker.update's class column (was: 1.5 taken
+    as class 1, NaN as -9223372036854775808, names NumPy's "invalid literal for int()")."""
+    frame = np.random.default_rng(0).integers(0, 255, (80, 120, 3), dtype=np.uint8)
+    boxes = np.array([[10.0, 10, 20, 40, 0.9], [60, 10, 20, 40, 0.9]])
+    tracker = MultiObjectTracker(rng=0)
+    with pytest.raises(error, match=message):
+        tracker.update(frame, boxes, classes)
+    assert tracker.frame_index == 0
+    tracks = tracker.update(frame, boxes, np.array([0.0, 3.0]))  # integers held as floats
+    assert sorted(t.cls for t in tracks) == [0, 3]

@@ -16,8 +16,9 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
+from pftrack._check import MAX_CLASS, first_bad_class, real_array
 from pftrack._typing import F64, CameraMotion, DetectorName, DynamicsName, FillMode, SamplerName
 from pftrack.tracking.api import Tracker
 
@@ -55,6 +56,31 @@ class TrackerOptions(TypedDict, total=False):
     prime: float | None
     max_side: int | None
     record: bool
+
+
+def _field(values: ArrayLike, name: str, shape: tuple[int, int]) -> F64:
+    """The Detections field `name` as a float64 array of `shape`, its errors naming the field.
+
+    The tracker's own checks name the columns it stacks (``detections row 1 contains NaN or
+    inf`` with a class the detections may not have, ``column 6: ... cls``): a supervision user
+    gave fields, not columns.
+    """
+    a: F64 = real_array(values, f"detections.{name}", booleans=False).reshape(shape)
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        if shape[1] == 1:
+            raise ValueError(f"detections.{name}[{k}] is {a[k, 0]}, expected a finite number")
+        raise ValueError(f"detections.{name}[{k}] is {a[k].tolist()}, expected finite numbers")
+    if name == "class_id":
+        c = a[:, 0]
+        j = first_bad_class(c)
+        if j is not None:
+            raise ValueError(
+                f"detections.class_id[{j}] is {c[j]:.17g}, expected an integer in "
+                f"[{-MAX_CLASS - 1}, {MAX_CLASS}]"
+            )
+    return a
 
 
 def _detections_class() -> Any:
@@ -124,6 +150,15 @@ class SupervisionTracker:
             filter's estimate, not clipped to the frame, which may reach past its edge by a
             few pixels, as ground-truth boxes do (clip ``xyxy`` before cropping, e.g. x1, x2
             with ``np.clip(..., 0, W)`` and y1, y2 with ``np.clip(..., 0, H)``).
+
+        Raises
+        ------
+        TypeError
+            Not a ``supervision.Detections``, a field that does not hold real numbers (class
+            names in ``class_id``), or a bad frame (:meth:`pftrack.Tracker.update`).
+        ValueError
+            NaN or inf in ``xyxy`` or ``confidence``, a ``class_id`` that is not an integer
+            (each named by its field and row), or what :meth:`pftrack.Tracker.update` refuses.
         """
         detections_cls = _detections_class()
         if not isinstance(detections, detections_cls):
@@ -131,9 +166,12 @@ class SupervisionTracker:
                 f"detections must be a supervision.Detections, got {type(detections).__name__}"
             )
         n = len(detections)
-        conf = np.ones(n) if detections.confidence is None else detections.confidence
-        cls = np.zeros(n) if detections.class_id is None else detections.class_id
-        dets = np.column_stack([np.asarray(detections.xyxy, np.float64).reshape(n, 4), conf, cls])
+        conf, cls = detections.confidence, detections.class_id
+        dets = np.column_stack([
+            _field(detections.xyxy, "xyxy", (n, 4)),
+            np.ones(n) if conf is None else _field(conf, "confidence", (n, 1)),
+            np.zeros(n) if cls is None else _field(cls, "class_id", (n, 1)),
+        ])  # fmt: skip
         tracks = self.tracker.update(dets, frame)
         # the input's order, as ByteTrack keeps it (a blob's tracks in track order)
         tracks = tracks[np.argsort(tracks[:, 7], kind="stable")]

@@ -35,7 +35,16 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, flag, integer, not_an_image, real, real_array
+from pftrack._check import (
+    MAX_CLASS,
+    bgr_frame,
+    first_bad_class,
+    flag,
+    integer,
+    not_an_image,
+    real,
+    real_array,
+)
 from pftrack._check import seed as check_seed
 from pftrack._typing import (
     F64,
@@ -77,8 +86,6 @@ MAX_SPAN_FRAMES = 100_000
 #: The highest frame rate :class:`Tracker` accepts (as ``pftrack track --fps``).
 MAX_FRAME_RATE = 1000.0
 
-#: Largest class id :meth:`Tracker.update` takes (a 32-bit signed integer: -2**31 to 2**31 - 1).
-MAX_CLASS = 2**31 - 1
 #: Columns of :meth:`Tracker.update`'s output.
 TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
 
@@ -243,11 +250,10 @@ def check_boxes_xyxy(
         raise ValueError(f"{name} row {k} contains NaN or inf: {d[k].tolist()}")
     if d.shape[1] == 6:
         c = d[:, 5]
-        odd = (c != np.round(c)) | (c < -MAX_CLASS - 1) | (c > MAX_CLASS)
-        if odd.any():
-            k = int(np.flatnonzero(odd)[0])
+        j = first_bad_class(c)
+        if j is not None:
             raise ValueError(
-                f"{name} row {k} has class id {c[k]:.17g}, expected an integer in "
+                f"{name} row {j} has class id {c[j]:.17g}, expected an integer in "
                 f"[{-MAX_CLASS - 1}, {MAX_CLASS}] (column 6: x1, y1, x2, y2, conf, cls)"
             )
     rows, cols = shape

@@ -126,9 +126,9 @@ class AssociationConfig:
         terms alone reach 3); ``inf`` assigns every gated pair it can.
     merge_ratio : float
         A matched detection this many times larger than its track, that also covers another
-        track, is a merged blob: it does not re-seed the track's particles (the colour filter
-        carries the track through the merge). At least 1 (a smaller detection is no merge);
-        ``inf``: off.
+        track of its class (the centre of its box), is a merged blob: it does not re-seed the
+        track's particles (the colour filter carries the track through the merge). At least 1
+        (a smaller detection is no merge); ``inf``: off.
 
     Raises
     ------

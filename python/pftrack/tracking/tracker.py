@@ -27,7 +27,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, generator, not_an_image
+from pftrack._check import (
+    MAX_CLASS,
+    bgr_frame,
+    first_bad_class,
+    generator,
+    not_an_image,
+    real_array,
+)
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack._warn import Held, warn
@@ -294,7 +301,17 @@ class MultiObjectTracker:
             boxes, scores = check_detections(detections, (frame.shape[0], frame.shape[1]))
         labels = np.zeros(len(boxes), np.int64)
         if classes is not None:
-            labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
+            if checked:  # integers in range (check_boxes_xyxy's)
+                labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
+            else:  # refused, never truncated (was: 1.5 taken as class 1, NaN as -2**63)
+                c = real_array(classes, "classes").reshape(-1)
+                k = first_bad_class(c)
+                if k is not None:
+                    raise ValueError(
+                        f"classes[{k}] is {c[k]:.17g}, expected an integer in "
+                        f"[{-MAX_CLASS - 1}, {MAX_CLASS}]"
+                    )
+                labels = c.astype(np.int64)
             if len(labels) != len(boxes):
                 raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
         if self.config.sampler == "rjmcmc" and len(labels):
@@ -489,7 +506,11 @@ class MultiObjectTracker:
         ------
         TypeError
             `detections` is a uint8 image (``update(dets, frame)``, :class:`Tracker`'s order:
-            the message says the arguments look swapped), or `frame` is not a uint8 array.
+            the message says the arguments look swapped), or `frame` is not a uint8 array,
+            or `classes` are not numbers.
+        ValueError
+            A class id that is not an integer in ``[-2**31, 2**31 - 1]`` (NaN too), or not as
+            many class ids as detections.
         RuntimeError
             Another thread is inside this tracker's ``update`` or ``prime`` (one thread at a
             time; nothing of this call went in).
@@ -660,7 +681,10 @@ class MultiObjectTracker:
         for (ti, di), big in zip(result.matches, large, strict=True):
             if big:
                 follow_pending()
-                others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti)
+                # a blob of the detection's class: a car's box holding a person is no blob
+                # (was: any track's centre held it, whatever its class)
+                cls = tracks[ti].cls
+                others = (o.box.tolist() for k, o in enumerate(tracks) if k != ti and o.cls == cls)
                 if covers_another(box_list[di], others):
                     continue  # a merged blob: the track keeps its own prediction
             followed.append((ti, di))
