@@ -86,6 +86,9 @@ MAX_SPAN_FRAMES = 100_000
 #: The highest frame rate :class:`Tracker` accepts (as ``pftrack track --fps``).
 MAX_FRAME_RATE = 1000.0
 
+#: Boxes in one frame above which :meth:`Tracker.update` warns (the association is dense).
+MANY_DETECTIONS = 1000
+
 #: Columns of :meth:`Tracker.update`'s output.
 TRACK_COLUMNS = ("x1", "y1", "x2", "y2", "id", "conf", "cls", "det_ind")
 
@@ -1053,6 +1056,15 @@ class Tracker:
                     "clipped",
                     f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
                     "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
+                )
+            if len(xywh) > MANY_DETECTIONS:
+                self._warn_once(
+                    "many",
+                    f"frame {self.frame_count + 1}: {len(xywh)} detections in one frame; each "
+                    "frame's association is a dense (tracks + detections)^2 assignment, seconds "
+                    f"to minutes a frame above {MANY_DETECTIONS} boxes (a detector's raw "
+                    "candidates? give its boxes after a confidence threshold and non-maximum "
+                    "suppression)",
                 )
             confidence = float(xywh[:, 4].max()) if len(xywh) else -np.inf
             if (
