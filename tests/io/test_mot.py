@@ -204,6 +204,27 @@ def test_kitti_tracking_rows_are_named_as_such(tmp_path: Path) -> None:
         mot.read_mot(p)
 
 
+def test_semicolon_separated_rows_are_named_as_such(tmp_path: Path) -> None:
+    """A spreadsheet's CSV export where the decimal mark is a comma separates fields by ';'
+    (``1;1;399,5;182;...``): was "line has 1 fields, expected at least 6", or a non-number,
+    with no word of the separator."""
+    p = tmp_path / "s.txt"
+    for text in ("1;1;399;182;121;229\n", "1;1;399,5;182,25;121;229;1\n", "1; 1; 3; 4; 5; 6\n",
+                 "2,2,3,4,5,6\n1;1;399;182;121;229;0,9\n"):  # fmt: skip
+        p.write_text(text)
+        with pytest.raises(ValueError) as exc:
+            mot.read_mot(p)
+        assert str(exc.value).endswith(mot.SEMICOLON_HINT), str(exc.value)
+    p.write_text("frame; id; left; top; width; height\n1; 1; 3; 4; 5; 6\n")  # one hint
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value).endswith(mot.SEMICOLON_HINT) and "header" not in str(exc.value)
+    p.write_text("1,1,3,4,5,6\n1,1;2,3,4,5,6\n")  # one stray ';': a bad line, no more
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value) == f"{p}:2: MOT file line has a non-number: '1,1;2,3,4,5,6'"
+
+
 def test_a_far_edge_is_named_with_the_sum_that_reaches_it(tmp_path: Path) -> None:
     """Was ``write_mot: row 0 (frame 8, id 1) has width 40: a box's right or bottom edge is
     beyond ±1e+09 px`` (``pftrack smooth`` of boxes near the bound): the width alone is fine,

@@ -166,9 +166,10 @@ def read_mot(
         (empty fields at the end of a line, ``...,0.9,,,`` or a trailing comma, are absent
         columns: their defaults), a non-number (a first row with a word in it ends with
         :data:`HEADER_HINT`: a header line?, or :data:`KITTI_HINT` for KITTI's tracking
-        labels), a non-finite value in any of the first 10 columns (a NaN score too), a frame
-        that is not an integer in ``1..2**31-1``, a negative width or height, or a box value
-        beyond ±1e9 px. A UTF-8 byte-order mark is skipped; UTF-16 text with its byte-order mark
+        labels; fields separated by semicolons end with :data:`SEMICOLON_HINT`), a
+        non-finite value in any of the first 10 columns (a NaN score too), a frame that is
+        not an integer in ``1..2**31-1``, a negative width or height, or a box value beyond
+        ±1e9 px. A UTF-8 byte-order mark is skipped; UTF-16 text with its byte-order mark
         (what Windows PowerShell's ``>`` writes) is read in its encoding. A compressed file
         (gzip, zip, bzip2, xz, zstd) or one with NUL bytes in its first 8 KiB (not text),
         naming the file.
@@ -206,6 +207,7 @@ def read_mot(
                 not rows
                 and values.startswith(f"{what} line has a non-number")
                 and _WORD.search(text)
+                and not values.endswith(SEMICOLON_HINT)  # one hint: ';' said already
             ):  # the first row a word: pandas' to_csv, a spreadsheet's export; or KITTI's
                 error += KITTI_HINT if _kitti(text) else HEADER_HINT
             break
@@ -241,6 +243,12 @@ KITTI_HINT = (
     "with frames from 1: convert them, width = right - left, height = bottom - top)"
 )
 
+#: What a row whose fields are separated by semicolons is told.
+SEMICOLON_HINT = (
+    " (fields separated by ';', as a spreadsheet's CSV export with decimal commas writes them? "
+    "pftrack reads fields separated by commas, spaces or tabs, and decimal points)"
+)
+
 
 def _kitti(text: str) -> bool:
     """Whether `text` is laid out as a KITTI tracking label: ``frame id type`` and 14 numbers.
@@ -254,6 +262,11 @@ def _kitti(text: str) -> bool:
         and not _NUMBER.fullmatch(f[2])
         and all(_NUMBER.fullmatch(v) for v in f[:2] + f[3:])
     )
+
+
+def _semicolons(text: str) -> str:
+    """:data:`SEMICOLON_HINT` when `text` splits into 6 fields or more at semicolons, else ""."""
+    return SEMICOLON_HINT if len(text.split(";")) >= 6 else ""
 
 
 #: A number as MOTChallenge files write them: ASCII digits, a point, an exponent (``float()``
@@ -286,10 +299,10 @@ def _parse_line(text: str, what: str) -> list[float] | str:
     if len(fields) < 6:
         return (
             f"{what} line has {len(fields)} fields, expected at least 6 "
-            f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
+            f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}{_semicolons(text)}"
         )
     if not all(_NUMBER.fullmatch(f.strip()) for f in fields[:10]):  # any space, as loadtxt
-        return f"{what} line has a non-number: {text[:80]!r}"
+        return f"{what} line has a non-number: {text[:80]!r}{_semicolons(text)}"
     values = [float(f) for f in fields[:10]]
     bad = [c for c, v in enumerate(values) if not np.isfinite(v)]
     if bad:  # every column is used: conf as a score, columns 8-10 written back
