@@ -675,7 +675,7 @@ def test_a_truth_with_a_fractional_id_is_named_by_its_line(data: Path, tmp_path:
     (entry,) = summary.entries
     assert entry["error"] == (
         f"scoring against {gt} (the tracks are written): {gt}:31: track id 1.5 is not an "
-        "integer with |id| <= 2147483647"
+        "integer with |id| <= 2147483647: '1,1.5,10,10,20,40,1,1,1'"
     )
 
 

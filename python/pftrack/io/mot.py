@@ -11,6 +11,7 @@ file such as ``np.savetxt``'s, written in their shortest round-trip form; :func:
 
 from __future__ import annotations
 
+import itertools
 import re
 import warnings
 from collections.abc import Iterable, Iterator
@@ -133,6 +134,15 @@ def first_row_fields(path: PathLike) -> int:
 def data_line_numbers(path: PathLike) -> list[int]:
     """The file's line number of each row :func:`read_mot` returns, for error messages."""
     return [n for n, _ in _data_lines(Path(path))]
+
+
+def data_line(path: PathLike, k: int) -> tuple[int, str]:
+    """The file's line number and text of row `k` (0-based) :func:`read_mot` returns.
+
+    For an error message that quotes the line as the file writes it: a value read as a double
+    may not be (an id past 2**53).
+    """
+    return next(itertools.islice(_data_lines(Path(path)), k, None))
 
 
 def read_mot(
