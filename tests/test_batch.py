@@ -675,7 +675,7 @@ def test_a_truth_with_a_fractional_id_is_named_by_its_line(data: Path, tmp_path:
     (entry,) = summary.entries
     assert entry["error"] == (
         f"scoring against {gt} (the tracks are written): {gt}:31: track id 1.5 is not an "
-        "integer with |id| <= 2147483647"
+        "integer with |id| <= 2147483647: '1,1.5,10,10,20,40,1,1,1'"
     )
 
 
@@ -3496,6 +3496,42 @@ def test_tracks_files_deeper_than_the_folder_are_named(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"^no \.txt file in folder .*empty$"):
         find_track_files([tmp_path / "empty"])
     assert [p.stem for p in find_track_files([data])] == ["a", "b", "c", "d"]
+
+
+def test_trackeval_summaries_beside_the_data_are_not_tracks(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial: ``pftrack recover trackers/mine`` after TrackEval had scored it (which writes
+    ``pedestrian_summary.txt`` beside ``data/``) read the summary as tracks and failed its
+    task with "a header line? delete it", the tracks in ``data/`` not said. The summary is
+    passed over with a warning, and the refusal names ``data/``; any other .txt is read."""
+    tracker = tmp_path / "trackers" / "mine"
+    data = tracker / "data"
+    data.mkdir(parents=True)
+    (data / "SEQ.txt").write_text("1,1,10,10,20,40,1,-1,-1,-1\n")
+    summary = tracker / "pedestrian_summary.txt"  # as TrackEval 1.3.0 writes it, shortened
+    summary.write_text("HOTA DetA AssA MOTA MOTP IDF1\n96.744 96.69 96.798 99.164 98.3 99.58\n")
+    with pytest.warns(UserWarning, match="pedestrian_summary.txt is TrackEval's summary"):
+        with pytest.raises(
+            ValueError,
+            match=rf"^no tracks file in folder {re.escape(str(tracker))} \(only TrackEval's "
+            rf"summaries of scores\); {re.escape(str(data))} holds 1 \(SEQ\.txt\): pass it "
+            "instead$",
+        ):
+            find_track_files([tracker])
+    out = tmp_path / "out"
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as a user's shell: the command prints it
+        assert main(["recover", str(tracker), "--out", str(out), "--workers", "0"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and err[0].endswith("summary of scores, not tracks: passed over")
+    assert err[1].startswith("pftrack recover: error: no tracks file in folder ")
+    assert not out.exists()
+    (tracker / "SEQ2.txt").write_text("1,1,10,10,20,40,1,-1,-1,-1\n")
+    with pytest.warns(UserWarning, match="passed over"):
+        assert [p.name for p in find_track_files([tracker])] == ["SEQ2.txt"]
+    summary.write_text("1,1,10,10,20,40\n")  # tracks named so are tracks
+    assert [p.name for p in find_track_files([tracker])] == [summary.name, "SEQ2.txt"]
 
 
 def test_render_of_frames_too_wide_for_h264_keeps_the_tracks(tmp_path: Path) -> None:

@@ -254,7 +254,7 @@ def test_fractional_ids_and_frames_are_refused_not_truncated(tmp_path, capsys):
         assert main([*argv, "--no-scale-check"]) == 2
         assert capsys.readouterr().err == (  # as pftrack recover says it
             f"pftrack eval: error: {tmp_path / 'frac.txt'}:1: track id 1.5 is not an integer "
-            "with |id| <= 2147483647\n"
+            "with |id| <= 2147483647: '1,1.5,10,10,5,5,1,-1,-1,-1'\n"
         )
 
 

@@ -178,6 +178,53 @@ def test_a_header_line_gets_a_hint(tmp_path: Path, capsys: pytest.CaptureFixture
     assert not (tmp_path / "o.txt").exists()
 
 
+def test_kitti_tracking_rows_are_named_as_such(tmp_path: Path) -> None:
+    """KITTI's tracking labels (``frame id type truncated occluded alpha x1 y1 x2 y2 ...``, 17
+    fields, 18 with a score) were refused with the header hint ("a header line? delete it"):
+    deleting the line only moved the refusal to the next one. The message names the layout."""
+    kitti = (
+        "0 1 Pedestrian 0 0 -10 100.0 120.0 150.0 300.0 1.7 0.6 0.8 1.0 1.6 10.0 0.0\n"
+        "1 1 Pedestrian 0 0 -10 102.0 120.0 152.0 300.0 1.7 0.6 0.8 1.0 1.6 10.0 0.0 0.93\n"
+    )
+    p = tmp_path / "0001.txt"
+    for text, line in (
+        (kitti, 1),
+        ("1 -1 DontCare -1 -1 -10 5 5 20 20 -1 -1 -1 -1000 -1000 -1000 -10\n" + kitti, 1),
+        (kitti.split("\n", 1)[1], 1),
+    ):
+        p.write_text(text)
+        with pytest.raises(ValueError) as exc:
+            mot.read_mot(p, what="tracks file")
+        msg = str(exc.value)
+        assert msg.startswith(f"{p}:{line}: tracks file line has a non-number: "), msg
+        assert msg.endswith(mot.KITTI_HINT) and "header" not in msg, msg
+    # a header line is still told it may be one
+    p.write_text("frame id type a b c d e f g h i j k l m n\n" + kitti)
+    with pytest.raises(ValueError, match="a header line"):
+        mot.read_mot(p)
+
+
+def test_semicolon_separated_rows_are_named_as_such(tmp_path: Path) -> None:
+    """A spreadsheet's CSV export where the decimal mark is a comma separates fields by ';'
+    (``1;1;399,5;182;...``): was "line has 1 fields, expected at least 6", or a non-number,
+    with no word of the separator."""
+    p = tmp_path / "s.txt"
+    for text in ("1;1;399;182;121;229\n", "1;1;399,5;182,25;121;229;1\n", "1; 1; 3; 4; 5; 6\n",
+                 "2,2,3,4,5,6\n1;1;399;182;121;229;0,9\n"):  # fmt: skip
+        p.write_text(text)
+        with pytest.raises(ValueError) as exc:
+            mot.read_mot(p)
+        assert str(exc.value).endswith(mot.SEMICOLON_HINT), str(exc.value)
+    p.write_text("frame; id; left; top; width; height\n1; 1; 3; 4; 5; 6\n")  # one hint
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value).endswith(mot.SEMICOLON_HINT) and "header" not in str(exc.value)
+    p.write_text("1,1,3,4,5,6\n1,1;2,3,4,5,6\n")  # one stray ';': a bad line, no more
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value) == f"{p}:2: MOT file line has a non-number: '1,1;2,3,4,5,6'"
+
+
 def test_a_far_edge_is_named_with_the_sum_that_reaches_it(tmp_path: Path) -> None:
     """Was ``write_mot: row 0 (frame 8, id 1) has width 40: a box's right or bottom edge is
     beyond ±1e+09 px`` (``pftrack smooth`` of boxes near the bound): the width alone is fine,

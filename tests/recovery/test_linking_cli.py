@@ -194,6 +194,22 @@ def test_cli_recover_reports_bad_rows_with_line_number(tmp_path, capsys):
     assert not (tmp_path / "o.txt").exists()
 
 
+def test_cli_a_huge_id_is_quoted_as_the_file_writes_it(tmp_path, capsys):
+    """An id past 2**53 (a 64-bit id, as NVIDIA DeepStream's) is read as the nearest double:
+    the refusal named 9007199254740992 for a file holding 9007199254740993, a number the user
+    could not find in it. The line is quoted, as every other refused line is."""
+    src = tmp_path / "big.txt"
+    for big in ("9007199254740993", "18446744069414584321"):
+        line = f"1,{big},10,10,5,5,1,-1,-1,-1"
+        src.write_text(f"1,1,10,10,5,5,1,-1,-1,-1\n{line}\n")
+        for command in ("recover", "smooth"):
+            assert main([command, str(src), "--out", str(tmp_path / "o.txt")]) == 2
+            err = capsys.readouterr().err
+            assert err.count("\n") == 1 and "big.txt:2: track id " in err, err
+            assert err.endswith(f"{line!r}\n"), err
+    assert not (tmp_path / "o.txt").exists()
+
+
 def synthetic_gt():
     rows = []
     rng = np.random.default_rng(0)

@@ -510,11 +510,42 @@ def find_track_files(inputs: Inputs) -> list[Path]:
             key=_listing_key,
         )
         files = [p for p in files if not p.name.startswith(".")]
+        scores = [p for p in files if _trackeval_summary(p)]
+        for p in scores:  # beside the tracker's data/: was read as tracks, its task failed
+            warnings.warn(
+                f"{p} is TrackEval's summary of scores, not tracks: passed over", stacklevel=2
+            )
+        files = [p for p in files if p not in scores]
         if not files:
-            raise ValueError(f"no .txt file in folder {path}{_txt_below(path)}")
+            what = f"no .txt file in folder {path}" if not scores else (
+                f"no tracks file in folder {path} (only TrackEval's summaries of scores)"
+            )  # fmt: skip
+            raise ValueError(f"{what}{_txt_below(path)}")
         found.extend(files)
     _check_names([p.stem for p in found], found)
     return found
+
+
+#: The first field of the header line of a summary TrackEval writes, ``CLS_summary.txt``: its
+#: fields come in a set order, HOTA's, CLEAR's, Identity's and Count's first (its
+#: ``write_summary_results``), so the first is one of these when any of them was evaluated.
+_TRACKEVAL_FIELDS = ("HOTA", "MOTA", "IDF1", "Dets")
+
+
+def _trackeval_summary(path: Path) -> bool:
+    """Whether `path` is a summary of scores that TrackEval wrote, not tracks.
+
+    ``CLS_summary.txt`` (``pedestrian_summary.txt``, beside ``data/`` in ``trackers/NAME/``)
+    whose first line is TrackEval's header of metric names, ``HOTA DetA AssA ...``.
+    """
+    if not path.name.endswith("_summary.txt"):
+        return False
+    try:
+        with path.open(encoding="utf-8", errors="replace") as fh:
+            first = fh.readline(4096).split()
+    except OSError:  # its task names it
+        return False
+    return bool(first) and first[0] in _TRACKEVAL_FIELDS
 
 
 def _txt_below(folder: Path) -> str:

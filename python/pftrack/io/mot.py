@@ -11,6 +11,7 @@ file such as ``np.savetxt``'s, written in their shortest round-trip form; :func:
 
 from __future__ import annotations
 
+import itertools
 import re
 import warnings
 from collections.abc import Iterable, Iterator
@@ -135,6 +136,15 @@ def data_line_numbers(path: PathLike) -> list[int]:
     return [n for n, _ in _data_lines(Path(path))]
 
 
+def data_line(path: PathLike, k: int) -> tuple[int, str]:
+    """The file's line number and text of row `k` (0-based) :func:`read_mot` returns.
+
+    For an error message that quotes the line as the file writes it: a value read as a double
+    may not be (an id past 2**53).
+    """
+    return next(itertools.islice(_data_lines(Path(path)), k, None))
+
+
 def read_mot(
     path: PathLike, *, what: str = "MOT file", warn_extra: bool = False
 ) -> NDArray[np.float64]:
@@ -165,12 +175,14 @@ def read_mot(
         (``1,,7,...``: two commas in a row) in the first 6 columns or before a non-empty one
         (empty fields at the end of a line, ``...,0.9,,,`` or a trailing comma, are absent
         columns: their defaults), a non-number (a first row with a word in it ends with
-        :data:`HEADER_HINT`: a header line?), a non-finite value in any of the first 10
-        columns (a NaN score too), a frame that is not an integer in ``1..2**31-1``, a
-        negative width or height, or a box value beyond ±1e9 px. A UTF-8 byte-order mark is
-        skipped; UTF-16 text with its byte-order mark (what Windows PowerShell's ``>``
-        writes) is read in its encoding. A compressed file (gzip, zip, bzip2, xz, zstd) or
-        one with NUL bytes in its first 8 KiB (not text), naming the file.
+        :data:`HEADER_HINT`: a header line?, or :data:`KITTI_HINT` for KITTI's tracking
+        labels; fields separated by semicolons end with :data:`SEMICOLON_HINT`), a
+        non-finite value in any of the first 10 columns (a NaN score too), a frame that is
+        not an integer in ``1..2**31-1``, a negative width or height, or a box value beyond
+        ±1e9 px. A UTF-8 byte-order mark is skipped; UTF-16 text with its byte-order mark
+        (what Windows PowerShell's ``>`` writes) is read in its encoding. A compressed file
+        (gzip, zip, bzip2, xz, zstd) or one with NUL bytes in its first 8 KiB (not text),
+        naming the file.
 
     Warns
     -----
@@ -205,8 +217,9 @@ def read_mot(
                 not rows
                 and values.startswith(f"{what} line has a non-number")
                 and _WORD.search(text)
-            ):  # the first row a word: pandas' to_csv, a spreadsheet's export
-                error += HEADER_HINT
+                and not values.endswith(SEMICOLON_HINT)  # one hint: ';' said already
+            ):  # the first row a word: pandas' to_csv, a spreadsheet's export; or KITTI's
+                error += KITTI_HINT if _kitti(text) else HEADER_HINT
             break
         rows.append(values)
         numbers.append(lineno)
@@ -233,6 +246,38 @@ def read_mot(
 HEADER_HINT = " (a header line? delete it, or start it with # to keep it as a comment)"
 #: A word: two letters in a row, which no number has (``1e5``, ``inf`` is refused as such).
 _WORD = re.compile(r"[A-Za-z_]{2,}")
+
+#: What a refused first row laid out as KITTI's tracking labels is told (not HEADER_HINT).
+KITTI_HINT = (
+    " (KITTI tracking labels? pftrack reads MOTChallenge rows frame,id,left,top,width,height "
+    "with frames from 1: convert them, width = right - left, height = bottom - top)"
+)
+
+#: What a row whose fields are separated by semicolons is told.
+SEMICOLON_HINT = (
+    " (fields separated by ';', as a spreadsheet's CSV export with decimal commas writes them? "
+    "pftrack reads fields separated by commas, spaces or tabs, and decimal points)"
+)
+
+
+def _kitti(text: str) -> bool:
+    """Whether `text` is laid out as a KITTI tracking label: ``frame id type`` and 14 numbers.
+
+    ``frame id type truncated occluded alpha left top right bottom h w l x y z rotation_y``
+    and, in a tracker's results, a score: a word third among 17 or 18 fields.
+    """
+    f = text.split()
+    return (
+        len(f) in (17, 18)
+        and not _NUMBER.fullmatch(f[2])
+        and all(_NUMBER.fullmatch(v) for v in f[:2] + f[3:])
+    )
+
+
+def _semicolons(text: str) -> str:
+    """:data:`SEMICOLON_HINT` when `text` splits into 6 fields or more at semicolons, else ""."""
+    return SEMICOLON_HINT if len(text.split(";")) >= 6 else ""
+
 
 #: A number as MOTChallenge files write them: ASCII digits, a point, an exponent (``float()``
 #: alone also takes ``1_0`` for 10 and other scripts' digits, ``１００``: a user trial).
@@ -264,10 +309,10 @@ def _parse_line(text: str, what: str) -> list[float] | str:
     if len(fields) < 6:
         return (
             f"{what} line has {len(fields)} fields, expected at least 6 "
-            f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}"
+            f"(frame,id,left,top,width,height[,conf,x,y,z]): {text[:80]!r}{_semicolons(text)}"
         )
     if not all(_NUMBER.fullmatch(f.strip()) for f in fields[:10]):  # any space, as loadtxt
-        return f"{what} line has a non-number: {text[:80]!r}"
+        return f"{what} line has a non-number: {text[:80]!r}{_semicolons(text)}"
     values = [float(f) for f in fields[:10]]
     bad = [c for c, v in enumerate(values) if not np.isfinite(v)]
     if bad:  # every column is used: conf as a score, columns 8-10 written back

@@ -606,13 +606,15 @@ def check_file_ids(rows: F64, path: PathLike) -> None:
     """Refuse rows read from file `path` whose ids are not integers: ``FILE:LINE: track id ...``.
 
     :func:`check_rows`' test of the ids (:func:`pftrack._check.first_bad_id`), named by the
-    file's line: what ``pftrack recover``, ``smooth``, ``experiment gaps`` and ``eval`` read.
+    file's line, which is quoted (an id past 2**53 is read as another number): what ``pftrack
+    recover``, ``smooth``, ``experiment gaps`` and ``eval`` read.
     """
-    from pftrack.io.mot import data_line_numbers
+    from pftrack.io.mot import data_line
 
     k = first_bad_id(rows[:, 1])
     if k is not None:
-        raise ValueError(f"{path}:{data_line_numbers(path)[k]}: {bad_id_message(rows[k, 1])}")
+        lineno, text = data_line(path, k)
+        raise ValueError(f"{path}:{lineno}: {bad_id_message(rows[k, 1])}: {text[:80]!r}")
 
 
 def check_unique(
