@@ -1189,6 +1189,22 @@ def test_normalised_boxes_are_said_once(scene):
         run_loop(pftrack.Tracker(frame_rate=10.0), scene.frames[:5], dets[:5])
 
 
+def test_integer_detections_with_truncated_confidences_are_said_once(scene):
+    """A user trial: ``dets.astype(int)`` turned every confidence into 0, without a word."""
+    dets = scene_dets(scene, scores=(0.5, 0.95))
+    tracker = pftrack.Tracker(frame_rate=10.0)
+    with pytest.warns(
+        UserWarning, match=r"^frame 1: detections given as integers \(int64\)"
+    ) as rec:
+        for d, f in zip(dets[:3], scene.frames[:3], strict=True):
+            tracker.update(d.astype(np.int64), f)
+    assert sum("as integers" in str(r.message) for r in rec) == 1
+    with warnings.catch_warnings():  # integers with their scores kept (0 or 1): no word
+        warnings.filterwarnings("error", message=".*as integers")
+        ones = [np.c_[d[:, :4].astype(np.int64), np.ones((len(d), 1), np.int64)] for d in dets[:10]]
+        run_loop(pftrack.Tracker(frame_rate=10.0), scene.frames[:10], ones)
+
+
 def test_a_detectors_raw_candidates_are_said_once():
     """A user trial: a detector's raw output before NMS (YOLO gives about 8400 boxes a frame)
     took minutes a frame in the dense association, without a word."""

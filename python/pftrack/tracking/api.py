@@ -1057,6 +1057,16 @@ class Tracker:
                     f"detections reaching outside the {f.shape[1]}x{f.shape[0]} frame were "
                     "clipped to it, those wholly outside ignored (wrong coordinate scale?)",
                 )
+            if (
+                isinstance(dets, np.ndarray) and dets.dtype.kind in "iu" and dets.ndim == 2
+                and dets.shape[1] >= 5 and len(xywh) and not xywh[:, 4].any()
+            ):  # fmt: skip
+                self._warn_once(
+                    "integer",
+                    f"frame {self.frame_count + 1}: detections given as integers ({dets.dtype}) "
+                    "with every confidence 0 (truncated by astype(int)? give floats: the "
+                    "confidences gate births)",
+                )
             if len(xywh) > MANY_DETECTIONS:
                 self._warn_once(
                     "many",
