@@ -2754,6 +2754,40 @@ def test_a_local_cluster_that_cannot_start_is_one_line(
     assert not out.exists()
 
 
+def _sockets() -> set[str]:
+    """The sockets this process holds open (``/proc/self/fd``), by inode."""
+    fds = Path("/proc/self/fd")
+    held = set()
+    for fd in fds.iterdir():
+        with contextlib.suppress(OSError):  # the listing's own descriptor, closed meanwhile
+            if (link := os.readlink(fd)).startswith("socket:"):
+                held.add(link)
+    return held
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="needs /proc/self/fd")
+def test_a_local_cluster_that_cannot_start_leaves_no_thread_nor_socket(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: the one-line error, but the cluster's event-loop thread ("IO loop") left running
+    for the rest of the process, with its sockets, and the half-made scheduler's HTTP server
+    still listening (Dask closes neither when its scheduler fails to start; the socket, closed
+    by the garbage collector, said "unclosed socket", an error under pytest)."""
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    (tmp_path / "file").write_text("")
+    argv = ["recover", str(tmp_path / "tracks"), "--out", str(tmp_path / "out"), "--workers", "1"]
+    held = _sockets()
+    with _nothing_left_to_the_gc():  # no client, no loop thread; then what the GC finds
+        with dask.config.set({"temporary-directory": str(tmp_path / "file" / "x")}):
+            assert main(argv) == 2
+        assert _sockets() - held == set()
+    err = capsys.readouterr().err
+    assert err.startswith("pftrack recover: error: cannot start a local Dask cluster of 1 ")
+    assert err.count("\n") == 1, err
+
+
 def test_workers_without_pftrack_are_one_line_before_anything(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -48,7 +48,7 @@ from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
 
 if TYPE_CHECKING:
-    from distributed import Client
+    from distributed import Client, LocalCluster
 
 __all__ = [
     "BatchSummary",
@@ -348,7 +348,6 @@ def dask_client(
     """
     _require_dask()
     import dask
-    from distributed import LocalCluster
 
     from pftrack.batch._plugin import SingleThreaded
 
@@ -396,7 +395,7 @@ def dask_client(
             stack.enter_context(dask.config.set({NO_MALLOC_TRIM: None, NO_PROFILER: False}))
             try:
                 cluster = stack.enter_context(
-                    LocalCluster(
+                    _new_cluster(
                         n_workers=n,
                         threads_per_worker=1,
                         processes=True,
@@ -455,8 +454,56 @@ def _new_client(target: Any) -> Client:
     return c
 
 
-def _close_failed(c: Client) -> None:
-    """Close a Dask client whose start failed, and stop its event loop's thread.
+def _new_cluster(**kwargs: Any) -> LocalCluster:
+    """``distributed.LocalCluster(**kwargs)``: one whose start fails leaves nothing running.
+
+    Dask's constructor, when the scheduler fails to start (Dask's temporary folder under a
+    file, say), closes the cluster but leaves its event loop's thread running, with the loop's
+    sockets, and the half-made scheduler's HTTP server listening (its port open until the
+    garbage collector closes it, with a ``ResourceWarning``, "unclosed socket"). So the cluster
+    is made in two steps, as :func:`_new_client` makes a client, to close what it started when
+    its ``__init__`` raises; the half-made servers are those of the frames the exception went
+    through (Dask keeps no other reference to them).
+    """
+    from distributed import LocalCluster
+
+    cluster = LocalCluster.__new__(LocalCluster)
+    try:
+        LocalCluster.__init__(cluster, **kwargs)
+    except BaseException as exc:
+        with _interrupts_held(spawns=False):  # a Ctrl-C meanwhile: raised once closed
+            _close_failed(cluster)
+            _stop_half_made(exc)
+        raise
+    return cluster
+
+
+def _stop_half_made(exc: BaseException) -> None:
+    """Stop the HTTP servers of the Dask servers whose ``__init__`` `exc` (or its causes) left.
+
+    Dask internals: a ``Scheduler`` (a ``Worker``, a ``Nanny``) starts its HTTP server
+    (``http_server``, Tornado's) early in its ``__init__``; one that raises after it is found
+    as ``self`` in a frame of the traceback. ``stop`` does nothing to a server stopped already.
+    """
+    from distributed.core import Server
+
+    seen: set[int] = set()
+    chained: BaseException | None = exc
+    while chained is not None and id(chained) not in seen:
+        seen.add(id(chained))
+        tb = chained.__traceback__
+        while tb is not None:
+            server = tb.tb_frame.f_locals.get("self")
+            http = getattr(server, "http_server", None) if isinstance(server, Server) else None
+            if http is not None:
+                with contextlib.suppress(Exception):
+                    http.stop()
+            tb = tb.tb_next
+        chained = chained.__cause__ or chained.__context__
+
+
+def _close_failed(c: Client | LocalCluster) -> None:
+    """Close a Dask client or cluster whose start failed, and stop its event loop's thread.
 
     Dask internals: ``close`` may refuse (nothing started, or closed already: it then leaves
     the thread running), and the ``LoopRunner`` that runs the thread (``_loop_runner``) is

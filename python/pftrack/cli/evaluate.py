@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pftrack.cli._options import (
     IOU_HELP,
@@ -16,6 +16,9 @@ from pftrack.cli._options import (
     iou_threshold,
     report_stream,
 )
+
+if TYPE_CHECKING:
+    from pftrack._progress import Bar
 
 #: ``--image-size``'s largest side (px), as ``experiment gaps``' MAX_SIDE.
 MAX_IMAGE_SIDE = 100_000
@@ -236,11 +239,28 @@ def _in_file(message: str, gt: Path, res: Path) -> str:
     return f"{gt} against {res}: {message}"
 
 
+def _bar_label(done: int, n: int) -> str:
+    """The label of ``eval``'s bar: ``eval`` for one sequence, ``eval 1/3 sequences`` else."""
+    return "eval" if n == 1 else f"eval {done}/{n} sequences"
+
+
+def _mover(bar: Bar, before: int, frames: int) -> Callable[[float], None] | None:
+    """`bar`'s ``on_progress`` for a sequence of `frames` frames after `before` frames scored.
+
+    None when the bar is not drawn: the scorers then report nothing.
+    """
+    if not bar.enabled:
+        return None
+    return lambda f: bar.set(before + round(f * frames))
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack eval``: optionally write JSON/CSV, then print the table; return the status."""
     import json
 
-    from pftrack._progress import progress
+    import numpy as np
+
+    from pftrack._progress import Bar, enabled
     from pftrack.eval.rows import gt_conf_note, result_class_note
     from pftrack.eval.sequences import (
         SequenceScores,
@@ -280,35 +300,42 @@ def run(args: argparse.Namespace) -> int:
 
     scores: dict[str, SequenceScores] = {}
     notes: list[str] = []
-    for name, seq, gt, res, path in progress(loaded, total=len(loaded), desc="eval"):
-        s = scales[name]
-        size = tuple(args.image_size) if args.image_size else None
-        if size is None and seq.width and seq.height:
-            size = (round(seq.width * s), round(seq.height * s))
-        # auto: the benchmark of TrackEval's folder (MOT20-train/SEQ), as TrackEval scores it;
-        # else guessed from the columns (was: always guessed, MOT20-train scored as MOT17)
-        folder = benchmark_of_path(seq.gt_path) if args.benchmark == "auto" else None
-        try:
-            scores[name] = evaluate_sequence(
-                gt,
-                res,
-                iou_threshold=args.iou,
-                scale=s,
-                image_size=size,
-                benchmark=folder[0] if folder else args.benchmark,
-                num_frames=seq.length,
-            )
-        except ValueError as exc:
-            message = _in_file(str(exc), seq.gt_path, path)
-            if folder and "MOT15-style" in message:  # say where MOT17 rules came from
-                message += f" (--benchmark auto took {folder[0]} from its folder {folder[1]})"
-            raise ValueError(message) from None
-        note = result_class_note(res, scores[name].benchmark)
-        if note:
-            notes.append(f"{path}: {note}")
-        note = gt_conf_note(gt)
-        if note:
-            notes.append(f"{seq.gt_path}: {note}")
+    # the bar counts the frames scored (those of the ground truth or the result), moved as
+    # each sequence is scored: it counted sequences, and one long sequence sat at 0/1
+    shown = enabled()
+    frames = [len(np.union1d(g[:, 0], r[:, 0])) if shown else 0 for _, _, g, r, _ in loaded]
+    with Bar(sum(frames), desc=_bar_label(0, len(loaded)), enable=shown, unit="frame") as bar:
+        for k, (name, seq, gt, res, path) in enumerate(loaded):
+            s = scales[name]
+            size = tuple(args.image_size) if args.image_size else None
+            if size is None and seq.width and seq.height:
+                size = (round(seq.width * s), round(seq.height * s))
+            # auto: the benchmark of TrackEval's folder (MOT20-train/SEQ), as TrackEval scores
+            # it; else guessed from the columns (was: always guessed, MOT20-train as MOT17)
+            folder = benchmark_of_path(seq.gt_path) if args.benchmark == "auto" else None
+            try:
+                scores[name] = evaluate_sequence(
+                    gt,
+                    res,
+                    iou_threshold=args.iou,
+                    scale=s,
+                    image_size=size,
+                    benchmark=folder[0] if folder else args.benchmark,
+                    num_frames=seq.length,
+                    on_progress=_mover(bar, sum(frames[:k]), frames[k]),
+                )
+            except ValueError as exc:
+                message = _in_file(str(exc), seq.gt_path, path)
+                if folder and "MOT15-style" in message:  # say where MOT17 rules came from
+                    message += f" (--benchmark auto took {folder[0]} from its folder {folder[1]})"
+                raise ValueError(message) from None
+            bar.describe(_bar_label(k + 1, len(loaded)))
+            note = result_class_note(res, scores[name].benchmark)
+            if note:
+                notes.append(f"{path}: {note}")
+            note = gt_conf_note(gt)
+            if note:
+                notes.append(f"{seq.gt_path}: {note}")
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
     if args.json:
         if Path(args.gt).is_file():  # one file: its metrics at the top level, as before

@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
+from pftrack._progress import Report, check_report, reporting
 from pftrack._typing import BenchmarkName
 from pftrack.eval.rows import (  # the scored rows; here too, as before
     BENCHMARKS,
@@ -40,6 +41,12 @@ __all__ = [
 ALPHAS: NDArray[np.float64] = np.arange(0.05, 0.99, 0.05)
 
 _EPS = float(np.finfo(float).eps)
+
+#: Where :func:`evaluate_hota`'s three passes over the frames (IoU; soft match counts;
+#: assignment) begin and end, as fractions of its time, for its `on_progress` (before them:
+#: the rows chosen and grouped; after: the thresholds). Measured on a file of 100 000 frames
+#: and 5000 ids (5 December).
+_PASSES = ((0.22, 0.63), (0.63, 0.77), (0.77, 0.91))
 
 
 @dataclasses.dataclass(frozen=True, eq=False)  # arrays: no element-wise ==
@@ -215,6 +222,7 @@ def evaluate_hota(
     benchmark: BenchmarkName = "auto",
     scale: float = 1.0,
     num_frames: int | None = None,
+    on_progress: Report | None = None,
 ) -> HotaMetrics:
     """HOTA, DetA, AssA, LocA and their recall/precision parts of one sequence.
 
@@ -228,6 +236,9 @@ def evaluate_hota(
         first takes the benchmark a TrackEval folder names, ``MOT20-train``).
     scale, num_frames
         Passed to :func:`prepare_mot`, which chooses the rows that are scored.
+    on_progress : callable, optional
+        Called now and then as ``on_progress(f)``, `f` the fraction of the work done (from 0
+        to 1, ending with 1), as the frames are scored: ``pftrack eval``'s bar.
 
     Returns
     -------
@@ -250,10 +261,13 @@ def evaluate_hota(
        tracking. International Journal of Computer Vision 129, 548-578.
     .. [2] Luiten, J. & Hoffhues, A. (2020). TrackEval. (``trackeval.metrics.HOTA``)
     """
+    check_report(on_progress, "evaluate_hota")
     if benchmark == "auto":
         benchmark = guess_benchmark(gt)
     g, r = prepare_mot(gt, result, benchmark=benchmark, scale=scale, num_frames=num_frames)
     if len(r) == 0 or len(g) == 0:
+        if on_progress is not None:
+            on_progress(1.0)
         return _empty(len(g), len(r))
     gf, rf = group_by_frame(g), group_by_frame(r)
     g_ids, g_idx = np.unique(g[:, ID].astype(np.int64), return_inverse=True)
@@ -263,7 +277,7 @@ def evaluate_hota(
 
     # Frames with both gt and result boxes: (gt index, result index, IoU) of each.
     both: list[tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64]]] = []
-    for f in sorted(set(gf) & set(rf)):
+    for f in reporting(sorted(set(gf) & set(rf)), on_progress, *_PASSES[0]):
         gi = np.searchsorted(g_ids, gf[f][:, ID].astype(np.int64))
         ri = np.searchsorted(r_ids, rf[f][:, ID].astype(np.int64))
         both.append((gi, ri, _mot_iou(gf[f][:, LEFT : LEFT + 4], rf[f][:, LEFT : LEFT + 4])))
@@ -275,7 +289,7 @@ def evaluate_hota(
     n_res_ids = len(r_ids)
     keys_f: list[NDArray[np.int64]] = []
     soft_f: list[NDArray[np.float64]] = []
-    for gi, ri, sim in both:
+    for gi, ri, sim in reporting(both, on_progress, *_PASSES[1]):
         denom = sim.sum(0)[None, :] + sim.sum(1)[:, None] - sim
         on = sim > 0  # elsewhere the soft count is 0: it adds nothing
         keys_f.append((gi[:, None] * n_res_ids + ri[None, :])[on].astype(np.int64))
@@ -293,7 +307,7 @@ def evaluate_hota(
     pair_g: list[NDArray[np.intp]] = []
     pair_r: list[NDArray[np.intp]] = []
     pair_s: list[NDArray[np.float64]] = []
-    for gi, ri, sim in both:
+    for gi, ri, sim in reporting(both, on_progress, *_PASSES[2]):
         score = np.zeros_like(sim)
         on = sim > 0
         at = np.searchsorted(pair_keys, (gi[:, None] * n_res_ids + ri[None, :])[on])
@@ -320,6 +334,8 @@ def evaluate_hota(
         ass_a[a] = np.sum(c * (c / np.maximum(1, gc + rc - c))) / w
         ass_re[a] = np.sum(c * (c / np.maximum(1, gc))) / w
         ass_pr[a] = np.sum(c * (c / np.maximum(1, rc))) / w
+    if on_progress is not None:
+        on_progress(1.0)
     return HotaMetrics(
         tp=tp,
         fn=len(g) - tp,

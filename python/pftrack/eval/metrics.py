@@ -18,6 +18,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from pftrack._check import number
+from pftrack._progress import Report, check_report, reporting
 from pftrack._typing import BenchmarkName
 from pftrack.boxes import iou_xywh
 from pftrack.eval.rows import (
@@ -35,6 +36,12 @@ __all__ = ["MotMetrics", "combine_mot", "evaluate_mot", "format_metrics", "iou_x
 # TrackEval's np.finfo(float).eps: how far below the threshold CLEAR still takes a pair, and
 # the score a pair of the assignment must exceed to be a match.
 _EPS = float(np.finfo(np.float64).eps)
+
+#: Where :func:`evaluate_mot`'s passes (over the frames: CLEAR-MOT and the pairs that overlap;
+#: over the objects: Smith et al.'s measures) begin and end, as fractions of its time, for its
+#: `on_progress` (before them: the rows chosen and sorted; between: IDF1's assignment).
+#: Measured on a file of 100 000 frames and 5000 ids (5 December).
+_PASSES = ((0.22, 0.97), (0.975, 0.995))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -336,6 +343,7 @@ def evaluate_mot(
     image_size: tuple[int, int] | None = None,
     benchmark: BenchmarkName = "auto",
     num_frames: int | None = None,
+    on_progress: Report | None = None,
 ) -> MotMetrics:
     """Score a tracking result against ground truth.
 
@@ -357,6 +365,9 @@ def evaluate_mot(
         ``"auto"`` guesses MOT15 or MOT17 from the columns (:func:`pftrack.eval.guess_benchmark`).
     num_frames : int, optional
         The sequence length (``seqLength``); a row in a later frame is an error.
+    on_progress : callable, optional
+        Called now and then as ``on_progress(f)``, `f` the fraction of the work done (from 0
+        to 1, ending with 1), as the frames are scored: ``pftrack eval``'s bar.
 
     Returns
     -------
@@ -405,6 +416,7 @@ def evaluate_mot(
     # (Identical boxes have IoU exactly 1 in mot_iou's arithmetic: a threshold of 1 matches them.)
     clear_reach = iou_threshold - _EPS
     size = check_image_size(image_size, "evaluate_mot")
+    check_report(on_progress, "evaluate_mot")
     if benchmark != "auto" and benchmark not in BENCHMARKS:
         raise ValueError(
             f"evaluate_mot: benchmark is {benchmark!r}, expected 'auto' or one of "
@@ -442,7 +454,7 @@ def evaluate_mot(
     n_fp = n_fn = n_sw = n_match = 0
     iou_sum = 0.0
 
-    for k in range(len(frames)):
+    for k in reporting(range(len(frames)), on_progress, *_PASSES[0]):
         gs, rs = slice(g_lo[k], g_hi[k]), slice(r_lo[k], r_hi[k])
         gi, ri = g_idx[gs], r_idx[rs]
         if len(gi) == 0 or len(ri) == 0:
@@ -523,7 +535,7 @@ def evaluate_mot(
     hit_of = dict(zip(hit_k.tolist(), hit_n.tolist(), strict=True))
     per_object: list[tuple[int, float, float]] = []
     dists: list[float] = []
-    for o in range(n_o):
+    for o in reporting(range(n_o), on_progress, *_PASSES[1]):
         keys = touch_k[t_lo[o] : t_lo[o + 1]].tolist()
         touch = {
             key % n_h: int(c) for key, c in zip(keys, touch_n[t_lo[o] : t_lo[o + 1]], strict=True)
@@ -545,6 +557,8 @@ def evaluate_mot(
     ratio = cd / (size[0] * size[1]) if size is not None else float("nan")
 
     nan = float("nan")
+    if on_progress is not None:
+        on_progress(1.0)
     return MotMetrics(
         # TrackEval's CLEAR scores a sequence without ground truth (or results) as all 0
         # TrackEval's (TP - FP - IDSW) / GT, not 1 - (FN + FP + IDSW) / GT: the last bit differs

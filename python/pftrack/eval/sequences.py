@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import NORMALISED_REACH
+from pftrack._progress import Report, check_report, part
 from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
@@ -50,6 +51,10 @@ __all__ = [
 
 #: Name of the combined row in tables, JSON and CSV.
 COMBINED = "COMBINED"
+
+#: The share of :func:`evaluate_sequence`'s time HOTA takes (CLEAR-MOT and IDF1 the rest), for
+#: its `on_progress` (measured on a file of 100 000 frames and 5000 ids, 5 December).
+HOTA_SHARE = 0.55
 
 
 @dataclasses.dataclass(frozen=True)
@@ -520,6 +525,7 @@ def evaluate_sequence(
     image_size: tuple[int, int] | None = None,
     benchmark: BenchmarkName = "auto",
     num_frames: int | None = None,
+    on_progress: Report | None = None,
 ) -> SequenceScores:
     """Score one result against its ground truth: HOTA family and CLEAR-MOT/IDF1.
 
@@ -536,13 +542,20 @@ def evaluate_sequence(
         guesses MOT15 or MOT17 from the columns (:func:`~pftrack.eval.guess_benchmark`).
     num_frames : int, optional
         The sequence length; later frames are an error.
+    on_progress : callable, optional
+        Called now and then as ``on_progress(f)``, `f` the fraction of the work done (from 0
+        to 1, ending with 1): HOTA's frames, then CLEAR-MOT's (``pftrack eval``'s bar).
     """
     check_image_size(image_size, "evaluate_sequence")  # before HOTA's work
+    check_report(on_progress, "evaluate_sequence")
     mark = guess_benchmark(gt) if benchmark == "auto" else benchmark
-    h = evaluate_hota(gt, result, benchmark=mark, scale=scale, num_frames=num_frames)
+    h = evaluate_hota(
+        gt, result, benchmark=mark, scale=scale, num_frames=num_frames,
+        on_progress=part(on_progress, 0.0, HOTA_SHARE),
+    )  # fmt: skip
     m = evaluate_mot(
         gt, result, iou_threshold=iou_threshold, scale=scale, image_size=image_size,
-        benchmark=mark, num_frames=num_frames,
+        benchmark=mark, num_frames=num_frames, on_progress=part(on_progress, HOTA_SHARE, 1.0),
     )  # fmt: skip
     return SequenceScores(mot=m, hota=h, benchmark=mark)
 
