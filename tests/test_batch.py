@@ -2733,6 +2733,26 @@ def test_a_dask_wait_that_is_no_duration_is_one_line(
     assert not out.exists()
 
 
+@pytest.mark.parametrize("value", ["abc", 1.5, True])
+def test_a_worker_memory_threshold_that_is_no_fraction_is_one_line(
+    value: object, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``DASK_DISTRIBUTED__WORKER__MEMORY__TARGET=abc`` gave each local worker's
+    traceback (about 30 lines) and a bare ``MemoryError``."""
+    import dask
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    key = "distributed.worker.memory.target"
+    with dask.config.set({key: value}):
+        assert main(["recover", str(tmp_path / "tracks"), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack recover: error: {key} is {value!r} ($DASK_DISTRIBUTED__WORKER__MEMORY__TARGET), "
+        "expected a fraction from 0 to 1 or False\n"
+    )
+    assert not out.exists()
+
+
 def test_a_local_cluster_that_cannot_start_is_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -331,7 +331,8 @@ def dask_client(
     ValueError
         A malformed or empty address; `client`, `scheduler` and `n_workers` that contradict
         each other (more than one given, or ``n_workers`` < 1); Dask's connect timeout or
-        no-workers timeout that is not a duration (:func:`dask_seconds`).
+        no-workers timeout that is not a duration (:func:`dask_seconds`); for a local
+        cluster, a worker memory threshold that is no fraction (:func:`dask_fraction`).
     OSError
         The scheduler cannot be reached within Dask's ``distributed.comm.timeouts.connect``
         (30 s by default; ``DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT``), or Dask cannot
@@ -384,6 +385,8 @@ def dask_client(
                 if c.status != "running":  # the scheduler went away: its end said by the batch
                     quiet.enter_context(_silenced(*_CLIENT_LOGGERS))
         return
+    for key in MEMORY_FRACTIONS:  # read by the local workers as they start
+        dask_fraction(key)
     n = n_workers if n_workers is not None else usable_cpus()
     stack = contextlib.ExitStack()
     try:
@@ -2187,6 +2190,33 @@ def dask_seconds(key: str, example: str) -> float | None:
             f"{key} is {value!r} (${variable}), expected a duration such as '{example}'"
         )
     return seconds
+
+
+#: Dask's worker memory thresholds, fractions of a worker's memory limit (or False: none).
+MEMORY_FRACTIONS = tuple(
+    f"distributed.worker.memory.{k}" for k in ("target", "spill", "pause", "terminate")
+)
+
+
+def dask_fraction(key: str) -> float | None:
+    """Dask's memory threshold `key`, a fraction from 0 to 1; None when off (False) or not set.
+
+    Raises
+    ------
+    ValueError
+        The setting is neither False nor a number from 0 to 1: one line naming it and its
+        environment variable (was: each local worker's traceback, about 30 lines, and a bare
+        ``MemoryError`` at the end).
+    """
+    import dask
+
+    value = dask.config.get(key, None)
+    if value is None or value is False:
+        return None
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and 0 <= value <= 1:
+        return float(value)
+    variable = "DASK_" + key.upper().replace(".", "__").replace("-", "_")
+    raise ValueError(f"{key} is {value!r} (${variable}), expected a fraction from 0 to 1 or False")
 
 
 def _n_workers(c: Client, timeout: float | None = None) -> int:
