@@ -871,7 +871,8 @@ def _into_full_and_closed(argv: list[str]) -> tuple[Any, Any]:
     return into_full, into_closed
 
 
-@pytest.mark.parametrize(
+#: Each command reading an input file L, with how its error names that input.
+INPUT_COMMANDS = pytest.mark.parametrize(
     ("argv", "what"),
     [
         (["track", "L", "--out", "O"], "video source"),
@@ -884,6 +885,9 @@ def _into_full_and_closed(argv: list[str]) -> tuple[Any, Any]:
     ],
     ids=["track", "render", "detections", "recover", "smooth", "eval", "experiment"],
 )
+
+
+@INPUT_COMMANDS
 def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
     argv: list[str], what: str, tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -904,19 +908,7 @@ def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
     assert not (tmp_path / "o.txt").exists() and not (tmp_path / "o.mp4").exists()
 
 
-@pytest.mark.parametrize(
-    ("argv", "what"),
-    [
-        (["track", "L", "--out", "O"], "video source"),
-        (["render", "L", "T", "--out", "O.mp4"], "video source"),
-        (["track", "V", "--detections", "L", "--out", "O"], "--detections"),
-        (["recover", "L", "--out", "O"], "tracks file"),
-        (["smooth", "L", "--out", "O"], "tracks file"),
-        (["eval", "--gt", "T", "--res", "L"], "--res"),
-        (["experiment", "gaps", "--gt", "L", "--image-size", "768x576"], "ground truth"),
-    ],
-    ids=["track", "render", "detections", "recover", "smooth", "eval", "experiment"],
-)
+@INPUT_COMMANDS
 def test_an_input_that_is_a_broken_symbolic_link_is_named_as_one(
     argv: list[str], what: str, tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
