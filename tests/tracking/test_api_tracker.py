@@ -1227,6 +1227,20 @@ def test_a_detectors_raw_candidates_are_said_once():
 
 
 @pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"birth_score": 2}, r"^birth_score is 2.0, expected a value in \[0, 1\]$"),
+        ({"birth_quantile": -0.5}, r"^birth_quantile is -0.5, expected a value in \[0, 1\]$"),
+    ],
+)
+def test_birth_gates_out_of_range_are_named_as_the_arguments(kwargs, match):
+    """A user trial: ``Tracker(birth_score=2)`` said "LifecycleConfig: birth_score is 2.0",
+    naming a class the caller never touched."""
+    with pytest.raises(ValueError, match=match):
+        pftrack.Tracker(**kwargs)
+
+
+@pytest.mark.parametrize(
     ("kwargs", "error", "match"),
     [
         ({"link": "x"}, TypeError, "link must be a LinkConfig or None, got str"),

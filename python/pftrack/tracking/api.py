@@ -484,6 +484,10 @@ class Tracker:
         min_conf, birth_score = real(min_conf, "min_conf"), real(birth_score, "birth_score")
         if birth_quantile is not None:
             birth_quantile = real(birth_quantile, "birth_quantile")
+        for name, value in (("birth_score", birth_score), ("birth_quantile", birth_quantile)):
+            if value is not None and not 0 <= value <= 1:  # named as the argument (was:
+                # "LifecycleConfig: birth_score is 2.0", a class the caller never touched)
+                raise ValueError(f"{name} is {value}, expected a value in [0, 1]")
         if max_coast is not None:
             max_coast = real(max_coast, "max_coast", finite=False)  # _frames says which
         if prime is not None:
