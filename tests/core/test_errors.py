@@ -64,6 +64,8 @@ def test_resample_messages_name_the_function_and_no_particle_filter(fn):
         fn(["a", "b"], rng=0)
     with pytest.raises(TypeError, match=rf"^{name}: weights must be real, got dtype complex128$"):
         fn([1j, 1], rng=0)
+    with pytest.raises(TypeError, match=rf"^{name}: weights must be numeric, got dtype timedelta"):
+        fn(np.array([1, 2], dtype="m8[s]"), rng=0)  # NumPy's integer kind; was resampled
     with pytest.raises(
         TypeError, match=rf"^{name}: weights must be an array or a sequence, got generator"
     ):

@@ -48,10 +48,10 @@ def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
             "(an iterator: make it a list or an array first)"
         )
     w = np.asarray(weights)
-    if w.dtype == object or not (np.issubdtype(w.dtype, np.number) or w.dtype == bool):
-        raise TypeError(f"{fn}: weights must be numeric, got dtype {w.dtype}")
     if np.iscomplexobj(w):
         raise TypeError(f"{fn}: weights must be real, got dtype {w.dtype}")
+    if w.dtype.kind not in "biuf":  # timedelta64 is a NumPy integer, not a number of ours
+        raise TypeError(f"{fn}: weights must be numeric, got dtype {w.dtype}")
     if w.ndim != 1:
         raise ValueError(f"{fn}: weights must be 1-D (N,), got shape {w.shape}")
     return np.ascontiguousarray(w, dtype=np.float64)
