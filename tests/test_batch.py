@@ -2871,6 +2871,34 @@ def test_workers_of_another_pftrack_release_are_one_line_before_anything(
     ] * 3
 
 
+def test_a_worker_of_another_release_that_joins_later_fails_its_tasks(
+    client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A trial: a worker of pftrack 0.2.0 that joined while a 0.1.0 batch ran (after the
+    workers were checked) tracked sequences, written as 0.1.0's, which a re-run skipped."""
+    import pftrack
+    from pftrack.batch import engine
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    # both workers joined after the check: as if check_pftrack had not seen them
+    monkeypatch.setattr(engine, "check_pftrack", lambda *args, **kwargs: None)
+    client.run(_set_version, "9.9.9")
+    try:
+        summary = smooth_many(tmp_path / "tracks", out, client)
+    finally:
+        client.run(_set_version, pftrack.__version__)
+    assert [e["status"] for e in summary.entries] == ["failed"] * 3
+    for e in summary.entries:
+        assert e["error"] == (
+            f"made on worker {e['host']} by pftrack 9.9.9, this is pftrack "
+            f"{pftrack.__version__} (a worker that joined after the batch checked them): not "
+            "written; install the same pftrack where this process and every worker run (a "
+            "batch's outputs are those of one release)"
+        )
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json"]  # nothing tracked
+
+
 def test_a_scheduler_without_pftrack_is_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

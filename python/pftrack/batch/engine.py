@@ -868,11 +868,17 @@ def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
             else f"{len(other)} of the {len(releases)} workers ({', '.join(sorted(other))})"
         )
         raise ImportError(
-            f"{which} at {address} run pftrack {shown}, this is pftrack {_version()}: install "
-            "the same pftrack where this process and every worker run (a batch's outputs are "
-            "those of one release)",
+            f"{which} at {address} run pftrack {shown}, this is pftrack {_version()}: "
+            f"{SAME_RELEASE}",
             name="pftrack",
         )
+
+
+#: What to do about workers of another pftrack release than this process's.
+SAME_RELEASE = (
+    "install the same pftrack where this process and every worker run (a batch's outputs are "
+    "those of one release)"
+)
 
 
 def _register(c: Client, plugin: Any, address: str) -> None:
@@ -1513,6 +1519,9 @@ class Outcome(NamedTuple):
     seen : list of dict or None
         On a Dask worker: the :func:`fingerprint` of the task's inputs as the worker saw them
         before it ran, which the client compares with its own (:func:`_seen_otherwise`).
+    release : str or None
+        On a Dask worker: its pftrack release, which the client compares with its own (a
+        worker that joined after :func:`check_pftrack` ran may run another).
     """
 
     result: TaskResult | None
@@ -1521,6 +1530,7 @@ class Outcome(NamedTuple):
     host: str | None = None
     missing: str | None = None
     seen: list[dict[str, Any]] | None = None
+    release: str | None = None
 
 
 def _worker_stop() -> Callable[[], None] | None:
@@ -1640,10 +1650,13 @@ def call_task(
 
     With `reads` (the job's inputs, given on Dask), the outcome carries their
     :func:`fingerprint` as this process sees them, taken before the task reads them, and the
-    host: the client tells a worker that sees other files than its own (:func:`_seen_otherwise`).
+    host: the client tells a worker that sees other files than its own (:func:`_seen_otherwise`),
+    and the worker's pftrack release: one that joined after :func:`check_pftrack` ran may run
+    another, whose outputs the client does not write (:func:`_other_release`).
     """
     seen = fingerprint(reads) if reads is not None else None
     host = _host() if reads is not None else None
+    release = _version() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
     with _TASK_WARNINGS.recording() as caught, reporting_frames(report, stop):
@@ -1653,15 +1666,34 @@ def call_task(
             missing = None
             if isinstance(exc, FileNotFoundError):
                 missing = str(exc.filename) if exc.filename else ""
-            return Outcome(None, one_line(exc), traceback.format_exc(), _host(), missing, seen)
+            return Outcome(
+                None, one_line(exc), traceback.format_exc(), _host(), missing, seen, release
+            )
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
-    return Outcome(result, host=host, seen=seen)
+    return Outcome(result, host=host, seen=seen, release=release)
 
 
 def _host() -> str:
     return socket.gethostname()
+
+
+def _other_release(outcome: Outcome) -> str | None:
+    """Why the outcome of a worker of another pftrack release is not written, or None.
+
+    :func:`check_pftrack` sees the workers there when the batch starts; one that joins later
+    (while the others are busy) was given tasks unchecked, and its outputs were written as this
+    release's, which a re-run then skipped. A worker of a release that does not say its own
+    (``release`` None) is not told apart.
+    """
+    if outcome.release is None or outcome.release == _version():
+        return None
+    return (
+        f"made on worker {outcome.host} by pftrack {outcome.release}, this is pftrack "
+        f"{_version()} (a worker that joined after the batch checked them): not written; "
+        f"{SAME_RELEASE}"
+    )
 
 
 #: How the client words a file that a worker could not find but the client can.
@@ -1971,7 +2003,9 @@ def run_jobs(
 
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
-        other = _seen_otherwise(job, outcome, prints[job.name]) if remote else None
+        other = _other_release(outcome) if remote else None
+        if other is None and remote:
+            other = _seen_otherwise(job, outcome, prints[job.name])
         if other is not None:  # not written: the outputs of files this process does not have
             outcome = Outcome(None, other, outcome.traceback, outcome.host)
         if outcome.result is not None:
