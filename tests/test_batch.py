@@ -2899,6 +2899,35 @@ def test_a_worker_of_another_release_that_joins_later_fails_its_tasks(
     assert sorted(p.name for p in out.iterdir()) == ["summary.json"]  # nothing tracked
 
 
+def test_a_batch_into_a_folder_another_batch_is_writing_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial: two ``pftrack batch`` runs into the same --out at once both tracked every
+    sequence, each writing over the other's outputs and sidecars (one run's sidecar could vouch
+    for the other's tracks), and the summary was the last one's. The folder is held while a
+    batch writes into it (``flock`` on the folder itself): the second is refused, exit 2."""
+    import fcntl
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]
+    out.mkdir()
+    other = os.open(out, os.O_RDONLY)  # as the other batch holds it
+    try:
+        fcntl.flock(other, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert main(argv) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack smooth: error: --out {out}: another pftrack batch is writing into this "
+            "folder: wait until it ends, or write elsewhere\n"
+        )
+        assert list(out.iterdir()) == []
+    finally:
+        os.close(other)
+    for _ in range(2):  # held only while a batch runs
+        assert main(argv) == 0
+    assert sorted(p.name for p in out.iterdir())[-1] == "summary.json"
+
+
 def test_a_scheduler_without_pftrack_is_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -1908,6 +1908,42 @@ def _make_out_dir(out_dir: Path) -> None:
     check_output(out_dir / SUMMARY_NAME, what=out_name)  # the folder is writable
 
 
+@contextlib.contextmanager
+def _held(out_dir: Path) -> Iterator[None]:
+    """Hold `out_dir` while this batch writes into it: another batch there is refused.
+
+    Two batches into one folder at once both ran every task and wrote over each other's
+    outputs and sidecars (one's sidecar could vouch for the other's ``NAME.txt``). The hold is
+    ``flock`` on the folder itself (no lock file left in it), released when the process ends,
+    however it ends. A file system that takes no such lock (NFS's emulation refuses a folder
+    opened to read) is not held.
+
+    Raises
+    ------
+    ValueError
+        Another batch holds the folder.
+    """
+    try:
+        import fcntl
+    except ImportError:  # not on a POSIX system: no hold
+        yield
+        return
+    fd = os.open(out_dir, os.O_RDONLY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ValueError(
+                f"{_OUT_NAMES.get()[0]} {out_dir}: another pftrack batch is writing into this "
+                "folder: wait until it ends, or write elsewhere"
+            ) from None
+        except OSError:  # no locks on this file system
+            pass
+        yield
+    finally:
+        os.close(fd)
+
+
 def run_jobs(
     jobs: Sequence[Job],
     out_dir: str | os.PathLike[str],
@@ -1966,6 +2002,9 @@ def run_jobs(
     PermissionError
         `out_dir` cannot take new files, or cannot be made (``check_output_folder``); checked
         before the cluster starts or the scheduler is connected to.
+    ValueError
+        Another batch is writing into `out_dir` (:func:`_held`); raised before any file is
+        written.
     OSError
         The scheduler cannot be reached (see :func:`dask_client`), or it has no worker and none
         comes within :func:`no_workers_timeout` (a ``TimeoutError``); raised before `out_dir`
@@ -2060,6 +2099,7 @@ def run_jobs(
                 # frames over all sequences; the clock starts once the cluster runs
                 frames = stack.enter_context(_Frames(pending, desc, show_progress))
             _make_out_dir(out)
+            stack.enter_context(_held(out))  # until summary.json is written
             touched = True
             try:
                 if c is not None:
