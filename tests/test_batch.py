@@ -3061,6 +3061,62 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] >= 2
 
 
+def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) -> None:
+    """A trial: the workers lost mid-run, the operator started one from an environment without
+    pftrack. It joined, was given a task it could not unpickle and died at once, too soon for
+    the count of the workers to see it; the tasks left failed after the wait saying "start
+    some", and the worker started was never named."""
+    import dask
+
+    dask_cmd = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    if dask_cmd is None:
+        pytest.skip("the dask command is not installed")
+    (tmp_path / "hide_pftrack.py").write_text(HIDE_PFTRACK)
+    jobs = [Job("first", _close_my_worker, (0,), ()), *(Job(f"slow{k}", _slow, (k,), ())
+                                                        for k in range(2))]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    with contextlib.ExitStack() as stack:
+        cluster = stack.enter_context(distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+            scheduler_kwargs=NO_DASHBOARD,
+        ))  # fmt: skip
+        stack.enter_context(dask.config.set({"distributed.scheduler.no-workers-timeout": "15s"}))
+        address = cluster.scheduler_address
+        cmd = [dask_cmd, "worker", address, "--nthreads", "1", "--no-nanny", "--no-dashboard",
+               "--preload", str(tmp_path / "hide_pftrack.py")]  # fmt: skip
+        log = stack.enter_context((tmp_path / "log.txt").open("w"))
+        procs: list[subprocess.Popen[bytes]] = []
+
+        def start() -> None:  # once the batch runs, as an operator would, its workers lost
+            procs.append(subprocess.Popen(cmd, stdout=log, stderr=log, env=env, cwd=tmp_path))
+
+        timer = threading.Timer(2.0, start)
+        timer.start()
+        stack.callback(lambda: [p.wait(15) for p in procs])
+        stack.callback(lambda: [p.kill() for p in procs])
+        stack.callback(timer.join)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={},
+                               scheduler=address)  # fmt: skip
+    named = (
+        r"a worker that joined \(tcp://127\.0\.0\.1:\d+\) cannot import pftrack "
+        r"\(ModuleNotFoundError: .*pftrack.*\) and dies on the first task given: install "
+        r"pftrack where the scheduler and every worker run"
+    )
+    said = [str(w.message) for w in caught]
+    warned = rf"the scheduler at {re.escape(address)}: {named}"
+    assert any(re.fullmatch(warned, m) for m in said), said
+    failed = [e for e in summary.entries if e["name"] != "first"]
+    assert [e["status"] for e in failed] == ["failed", "failed"]
+    for e in failed:
+        assert re.fullmatch(
+            rf"no worker on the scheduler at {re.escape(address)} for 15 s: its workers were "
+            rf"lost before this file ran or finished; {named} \(a re-run does the rest\)",
+            e["error"],
+        ), e["error"]
+
+
 # --- inputs a worker cannot see, broken links, the same input twice, listing order ----------
 
 

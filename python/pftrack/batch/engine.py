@@ -2087,8 +2087,10 @@ def run_jobs(
         on = dask_client(n_workers=min(n, len(pending)))
     try:
         with on as c, contextlib.ExitStack() as stack:
+            unusable: dict[str, str] | None = None
             if c is not None:
                 remote = True
+                unusable = stack.enter_context(_setup_failures(c))  # as soon as connected
                 info = c.scheduler_info()
                 reported = str(info.get("address")) if info.get("address") else None
                 summary.scheduler = address or reported  # the user's spelling of the address
@@ -2105,7 +2107,9 @@ def run_jobs(
                 if c is not None:
                     wait = no_workers_timeout()
                     where = summary.scheduler or "?"
-                    _run_on_dask(c, pending, record, summary.kind, bar, frames, where, wait)
+                    _run_on_dask(
+                        c, pending, record, summary.kind, bar, frames, where, wait, unusable
+                    )
                 elif frames is not None:
                     for job in pending:
                         with _no_bars():
@@ -2338,18 +2342,62 @@ def _wait_for_workers(c: Client, address: str, wait: float) -> int:
 ANSWER_WAIT = 5.0
 
 
+@contextlib.contextmanager
+def _setup_failures(c: Client) -> Iterator[dict[str, str]]:
+    """The workers whose pftrack plugin fails to set up from now on: address -> error.
+
+    Such a worker (one that cannot import pftrack, joining after :func:`check_pftrack` ran)
+    dies on the first task it is given, Dask unable to unpickle it, too soon for the count of
+    the workers to see it. Its plugin's setup says so on
+    :data:`~pftrack.batch._plugin.SETUP_FAILED_TOPIC`, to which this subscribes.
+    """
+    from pftrack.batch._plugin import SETUP_FAILED_TOPIC
+
+    failed: dict[str, str] = {}
+
+    def on_event(event: Any) -> None:  # on the client's event loop
+        with contextlib.suppress(TypeError, ValueError):
+            worker, error = event[1]
+            failed.setdefault(str(worker), str(error))
+
+    c.subscribe_topic(SETUP_FAILED_TOPIC, on_event)
+    try:
+        yield failed
+    finally:
+        with contextlib.suppress(Exception):  # the cluster may be going away (Ctrl-C)
+            c.unsubscribe_topic(SETUP_FAILED_TOPIC)
+
+
 class _WorkersWatch:
     """While tasks wait on a cluster: tells when it has been without workers for too long.
 
     Or when its scheduler has not answered for that long (:data:`ANSWER_WAIT`): ``frozen``.
     """
 
-    def __init__(self, c: Client, address: str, wait: float) -> None:
+    def __init__(
+        self, c: Client, address: str, wait: float, unusable: dict[str, str] | None = None
+    ) -> None:
         self.c, self.address, self.wait = c, address, wait
         self.since: float | None = None  # when the workers were last seen gone
         self.silent: float | None = None  # when the scheduler was first asked in vain
         self.frozen = False
         self._checked = -math.inf
+        #: workers that joined but cannot import pftrack: address -> error, as they said it
+        self.unusable = unusable if unusable is not None else {}
+        self._said: set[str] = set()
+
+    def _unusable(self) -> str:
+        """The workers that joined but cannot import pftrack, said; or ``""``."""
+        if not self.unusable:
+            return ""
+        workers = ", ".join(self.unusable)
+        first = next(iter(self.unusable.values()))
+        which = "a worker" if len(self.unusable) == 1 else f"{len(self.unusable)} workers"
+        dies = "dies" if len(self.unusable) == 1 else "die"
+        return (
+            f"{which} that joined ({workers}) cannot import pftrack ({first}) and {dies} on the "
+            f"first task given: {INSTALL_EVERYWHERE}"
+        )
 
     def given_up(self) -> bool:
         """True once the cluster has had no worker for `wait` seconds (warns when they go).
@@ -2361,6 +2409,10 @@ class _WorkersWatch:
         if now - self._checked < WORKERS_POLL:
             return False
         self._checked = now
+        new = [w for w in self.unusable if w not in self._said]
+        if new:  # said once each, here (the main thread), not on Dask's
+            self._said.update(new)
+            warnings.warn(f"the scheduler at {self.address}: {self._unusable()}", stacklevel=2)
         try:
             n = _n_workers(self.c, ANSWER_WAIT)
         except TimeoutError:
@@ -2392,6 +2444,13 @@ class _WorkersWatch:
             return (
                 f"the scheduler at {self.address} did not answer for {self.wait:g} s (frozen "
                 f"or overloaded) before this {noun} finished (a re-run does the rest)"
+            )
+        unusable = self._unusable()
+        if unusable:  # was: "start some", of a worker started and lost without a word
+            return (
+                f"no worker on the scheduler at {self.address} for {self.wait:g} s: its "
+                f"workers were lost before this {noun} ran or finished; {unusable} (a re-run "
+                "does the rest)"
             )
         return (
             f"no worker on the scheduler at {self.address} for {self.wait:g} s: its workers "
@@ -2539,11 +2598,14 @@ def _run_on_dask(
     frames: _Frames | None = None,
     address: str = "?",
     wait: float = NO_WORKERS_WAIT,
+    unusable: dict[str, str] | None = None,
 ) -> None:
     """Submit `pending` to Dask and record each result as it completes.
 
     With `frames`, the tasks' frame counts come as Dask events on a topic of this run. A
-    cluster without workers for `wait` seconds (at `address`) fails the tasks left.
+    cluster without workers for `wait` seconds (at `address`) fails the tasks left; the
+    workers that joined but cannot import pftrack (`unusable`, from :func:`_setup_failures`)
+    are named then, and as they come.
     """
     from distributed import as_completed
 
@@ -2560,13 +2622,13 @@ def _run_on_dask(
                 frames.finish(job.name)
             record(job, Outcome(None, unsent))
     bar = {**bar, "total": len(sendable)}
+    watch = _WorkersWatch(c, address, wait, unusable)
     futures = {}
     for job in sendable:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
         where = (topic, job.name) if frames is not None else None
         fut = c.submit(call_task, job.func, job.args, where, job.reads, key=key, pure=False)
         futures[fut.key] = (fut, job)
-    watch = _WorkersWatch(c, address, wait)
     noun = "sequence" if kind == "track" else "file"
     tracked = as_completed([f for f, _ in futures.values()])
     done = _completed(tracked, watch.given_up)
