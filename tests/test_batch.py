@@ -2891,6 +2891,63 @@ def test_workers_of_another_pftrack_release_are_one_line_before_anything(
     ] * 3
 
 
+def test_a_worker_of_another_release_that_joins_later_fails_its_tasks(
+    client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A trial: a worker of pftrack 0.2.0 that joined while a 0.1.0 batch ran (after the
+    workers were checked) tracked sequences, written as 0.1.0's, which a re-run skipped."""
+    import pftrack
+    from pftrack.batch import engine
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    # both workers joined after the check: as if check_pftrack had not seen them
+    monkeypatch.setattr(engine, "check_pftrack", lambda *args, **kwargs: None)
+    client.run(_set_version, "9.9.9")
+    try:
+        summary = smooth_many(tmp_path / "tracks", out, client)
+    finally:
+        client.run(_set_version, pftrack.__version__)
+    assert [e["status"] for e in summary.entries] == ["failed"] * 3
+    for e in summary.entries:
+        assert e["error"] == (
+            f"made on worker {e['host']} by pftrack 9.9.9, this is pftrack "
+            f"{pftrack.__version__} (a worker that joined after the batch checked them): not "
+            "written; install the same pftrack where this process and every worker run (a "
+            "batch's outputs are those of one release)"
+        )
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json"]  # nothing tracked
+
+
+def test_a_batch_into_a_folder_another_batch_is_writing_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial: two ``pftrack batch`` runs into the same --out at once both tracked every
+    sequence, each writing over the other's outputs and sidecars (one run's sidecar could vouch
+    for the other's tracks), and the summary was the last one's. The folder is held while a
+    batch writes into it (``flock`` on the folder itself): the second is refused, exit 2."""
+    import fcntl
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]
+    out.mkdir()
+    other = os.open(out, os.O_RDONLY)  # as the other batch holds it
+    try:
+        fcntl.flock(other, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert main(argv) == 2
+        assert capsys.readouterr().err == (
+            f"pftrack smooth: error: --out {out}: another pftrack batch is writing into this "
+            "folder: wait until it ends, or write elsewhere\n"
+        )
+        assert list(out.iterdir()) == []
+    finally:
+        os.close(other)
+    for _ in range(2):  # held only while a batch runs
+        assert main(argv) == 0
+    assert sorted(p.name for p in out.iterdir())[-1] == "summary.json"
+
+
 def test_a_scheduler_without_pftrack_is_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -3022,6 +3079,62 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
             "rest)"
         )
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] >= 2
+
+
+def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) -> None:
+    """A trial: the workers lost mid-run, the operator started one from an environment without
+    pftrack. It joined, was given a task it could not unpickle and died at once, too soon for
+    the count of the workers to see it; the tasks left failed after the wait saying "start
+    some", and the worker started was never named."""
+    import dask
+
+    dask_cmd = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    if dask_cmd is None:
+        pytest.skip("the dask command is not installed")
+    (tmp_path / "hide_pftrack.py").write_text(HIDE_PFTRACK)
+    jobs = [Job("first", _close_my_worker, (0,), ()), *(Job(f"slow{k}", _slow, (k,), ())
+                                                        for k in range(2))]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    with contextlib.ExitStack() as stack:
+        cluster = stack.enter_context(distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+            scheduler_kwargs=NO_DASHBOARD,
+        ))  # fmt: skip
+        stack.enter_context(dask.config.set({"distributed.scheduler.no-workers-timeout": "15s"}))
+        address = cluster.scheduler_address
+        cmd = [dask_cmd, "worker", address, "--nthreads", "1", "--no-nanny", "--no-dashboard",
+               "--preload", str(tmp_path / "hide_pftrack.py")]  # fmt: skip
+        log = stack.enter_context((tmp_path / "log.txt").open("w"))
+        procs: list[subprocess.Popen[bytes]] = []
+
+        def start() -> None:  # once the batch runs, as an operator would, its workers lost
+            procs.append(subprocess.Popen(cmd, stdout=log, stderr=log, env=env, cwd=tmp_path))
+
+        timer = threading.Timer(2.0, start)
+        timer.start()
+        stack.callback(lambda: [p.wait(15) for p in procs])
+        stack.callback(lambda: [p.kill() for p in procs])
+        stack.callback(timer.join)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={},
+                               scheduler=address)  # fmt: skip
+    named = (
+        r"a worker that joined \(tcp://127\.0\.0\.1:\d+\) cannot import pftrack "
+        r"\(ModuleNotFoundError: .*pftrack.*\) and dies on the first task given: install "
+        r"pftrack where the scheduler and every worker run"
+    )
+    said = [str(w.message) for w in caught]
+    warned = rf"the scheduler at {re.escape(address)}: {named}"
+    assert any(re.fullmatch(warned, m) for m in said), said
+    failed = [e for e in summary.entries if e["name"] != "first"]
+    assert [e["status"] for e in failed] == ["failed", "failed"]
+    for e in failed:
+        assert re.fullmatch(
+            rf"no worker on the scheduler at {re.escape(address)} for 15 s: its workers were "
+            rf"lost before this file ran or finished; {named} \(a re-run does the rest\)",
+            e["error"],
+        ), e["error"]
 
 
 # --- inputs a worker cannot see, broken links, the same input twice, listing order ----------

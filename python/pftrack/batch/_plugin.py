@@ -7,12 +7,19 @@ import os
 import signal
 import sys
 import threading
+from collections.abc import Coroutine
 from typing import Any
 
 import cloudpickle  # type: ignore[import-untyped]  # distributed's; no type information
 from distributed.diagnostics.plugin import WorkerPlugin
 
-__all__ = ["SingleThreaded"]
+__all__ = ["SETUP_FAILED_TOPIC", "SingleThreaded"]
+
+#: The Dask event topic on which a worker whose plugin setup fails (no pftrack to import) says
+#: so, ``[worker address, "ModuleNotFoundError: ..."]``: a batch running listens to it. Such a
+#: worker that joins mid-run dies on the first task it is given (Dask cannot unpickle it), too
+#: soon for the batch's count of the workers to see it.
+SETUP_FAILED_TOPIC = "pftrack-worker-setup-failed"
 
 # The plugin goes to the workers by value, not by name: a worker that cannot import pftrack
 # then fails in `setup` (logged, the worker runs on, and the batch names the problem:
@@ -55,12 +62,22 @@ class SingleThreaded(WorkerPlugin):
     def __init__(self, ignore_interrupt: bool = False) -> None:
         self.ignore_interrupt = ignore_interrupt
 
-    def setup(self, worker: Any) -> None:
+    def setup(self, worker: Any) -> Coroutine[Any, Any, None] | None:
         """Limit OpenCV to one thread in this worker process, and load the tasks' modules.
 
         Importing the tracker, the video reader, recovery and evaluation costs about half a
         second of CPU: done here, while the cluster starts, rather than in the first task.
+        A failure is also sent to the scheduler as an event on :data:`SETUP_FAILED_TOPIC`
+        (awaited: the worker's batched stream would send it too late), then raised (Dask logs
+        it on the worker).
         """
+        try:
+            self._setup()
+        except Exception as exc:  # noqa: BLE001 - raised again, once said
+            return _said(worker, exc)
+        return None
+
+    def _setup(self) -> None:
         import cv2
 
         from pftrack._progress import set_quiet
@@ -84,3 +101,13 @@ class SingleThreaded(WorkerPlugin):
         """The worker closes: from now on, its Dask logs are silent (local cluster only)."""
         if self.ignore_interrupt:
             logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)
+
+
+async def _said(worker: Any, exc: Exception) -> None:
+    """Send `exc` (one line) on :data:`SETUP_FAILED_TOPIC` with `worker`'s address; raise it."""
+    said = " ".join(f"{type(exc).__name__}: {exc}".split())
+    try:
+        await worker.scheduler.log_event(topic=SETUP_FAILED_TOPIC, msg=[str(worker.address), said])
+    except Exception:  # noqa: BLE001, S110 - the setup's own error is the one raised
+        pass
+    raise exc

@@ -114,7 +114,8 @@ def track_many(
         is not a ``distributed.Client``.
     ValueError
         Bad inputs, or an `out_dir` that is a file or would overwrite an input (named
-        ``out_dir``), before any task runs; see :func:`~pftrack.batch.run_jobs` for the rest.
+        ``out_dir``), before any task runs; an `out_dir` that another batch is writing into;
+        see :func:`~pftrack.batch.run_jobs` for the rest.
     PermissionError
         An `out_dir` that cannot be written (or made), before the cluster starts.
 

@@ -871,11 +871,17 @@ def check_pftrack(c: Client, address: str, scheduler: bool = True) -> None:
             else f"{len(other)} of the {len(releases)} workers ({', '.join(sorted(other))})"
         )
         raise ImportError(
-            f"{which} at {address} run pftrack {shown}, this is pftrack {_version()}: install "
-            "the same pftrack where this process and every worker run (a batch's outputs are "
-            "those of one release)",
+            f"{which} at {address} run pftrack {shown}, this is pftrack {_version()}: "
+            f"{SAME_RELEASE}",
             name="pftrack",
         )
+
+
+#: What to do about workers of another pftrack release than this process's.
+SAME_RELEASE = (
+    "install the same pftrack where this process and every worker run (a batch's outputs are "
+    "those of one release)"
+)
 
 
 def _register(c: Client, plugin: Any, address: str) -> None:
@@ -1516,6 +1522,9 @@ class Outcome(NamedTuple):
     seen : list of dict or None
         On a Dask worker: the :func:`fingerprint` of the task's inputs as the worker saw them
         before it ran, which the client compares with its own (:func:`_seen_otherwise`).
+    release : str or None
+        On a Dask worker: its pftrack release, which the client compares with its own (a
+        worker that joined after :func:`check_pftrack` ran may run another).
     """
 
     result: TaskResult | None
@@ -1524,6 +1533,7 @@ class Outcome(NamedTuple):
     host: str | None = None
     missing: str | None = None
     seen: list[dict[str, Any]] | None = None
+    release: str | None = None
 
 
 def _worker_stop() -> Callable[[], None] | None:
@@ -1643,10 +1653,13 @@ def call_task(
 
     With `reads` (the job's inputs, given on Dask), the outcome carries their
     :func:`fingerprint` as this process sees them, taken before the task reads them, and the
-    host: the client tells a worker that sees other files than its own (:func:`_seen_otherwise`).
+    host: the client tells a worker that sees other files than its own (:func:`_seen_otherwise`),
+    and the worker's pftrack release: one that joined after :func:`check_pftrack` ran may run
+    another, whose outputs the client does not write (:func:`_other_release`).
     """
     seen = fingerprint(reads) if reads is not None else None
     host = _host() if reads is not None else None
+    release = _version() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
     with _TASK_WARNINGS.recording() as caught, reporting_frames(report, stop):
@@ -1656,15 +1669,34 @@ def call_task(
             missing = None
             if isinstance(exc, FileNotFoundError):
                 missing = str(exc.filename) if exc.filename else ""
-            return Outcome(None, one_line(exc), traceback.format_exc(), _host(), missing, seen)
+            return Outcome(
+                None, one_line(exc), traceback.format_exc(), _host(), missing, seen, release
+            )
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
-    return Outcome(result, host=host, seen=seen)
+    return Outcome(result, host=host, seen=seen, release=release)
 
 
 def _host() -> str:
     return socket.gethostname()
+
+
+def _other_release(outcome: Outcome) -> str | None:
+    """Why the outcome of a worker of another pftrack release is not written, or None.
+
+    :func:`check_pftrack` sees the workers there when the batch starts; one that joins later
+    (while the others are busy) was given tasks unchecked, and its outputs were written as this
+    release's, which a re-run then skipped. A worker of a release that does not say its own
+    (``release`` None) is not told apart.
+    """
+    if outcome.release is None or outcome.release == _version():
+        return None
+    return (
+        f"made on worker {outcome.host} by pftrack {outcome.release}, this is pftrack "
+        f"{_version()} (a worker that joined after the batch checked them): not written; "
+        f"{SAME_RELEASE}"
+    )
 
 
 #: How the client words a file that a worker could not find but the client can.
@@ -1879,6 +1911,42 @@ def _make_out_dir(out_dir: Path) -> None:
     check_output(out_dir / SUMMARY_NAME, what=out_name)  # the folder is writable
 
 
+@contextlib.contextmanager
+def _held(out_dir: Path) -> Iterator[None]:
+    """Hold `out_dir` while this batch writes into it: another batch there is refused.
+
+    Two batches into one folder at once both ran every task and wrote over each other's
+    outputs and sidecars (one's sidecar could vouch for the other's ``NAME.txt``). The hold is
+    ``flock`` on the folder itself (no lock file left in it), released when the process ends,
+    however it ends. A file system that takes no such lock (NFS's emulation refuses a folder
+    opened to read) is not held.
+
+    Raises
+    ------
+    ValueError
+        Another batch holds the folder.
+    """
+    try:
+        import fcntl
+    except ImportError:  # not on a POSIX system: no hold
+        yield
+        return
+    fd = os.open(out_dir, os.O_RDONLY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ValueError(
+                f"{_OUT_NAMES.get()[0]} {out_dir}: another pftrack batch is writing into this "
+                "folder: wait until it ends, or write elsewhere"
+            ) from None
+        except OSError:  # no locks on this file system
+            pass
+        yield
+    finally:
+        os.close(fd)
+
+
 def run_jobs(
     jobs: Sequence[Job],
     out_dir: str | os.PathLike[str],
@@ -1937,6 +2005,9 @@ def run_jobs(
     PermissionError
         `out_dir` cannot take new files, or cannot be made (``check_output_folder``); checked
         before the cluster starts or the scheduler is connected to.
+    ValueError
+        Another batch is writing into `out_dir` (:func:`_held`); raised before any file is
+        written.
     OSError
         The scheduler cannot be reached (see :func:`dask_client`), or it has no worker and none
         comes within :func:`no_workers_timeout` (a ``TimeoutError``); raised before `out_dir`
@@ -1974,7 +2045,9 @@ def run_jobs(
 
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
-        other = _seen_otherwise(job, outcome, prints[job.name]) if remote else None
+        other = _other_release(outcome) if remote else None
+        if other is None and remote:
+            other = _seen_otherwise(job, outcome, prints[job.name])
         if other is not None:  # not written: the outputs of files this process does not have
             outcome = Outcome(None, other, outcome.traceback, outcome.host)
         if outcome.result is not None:
@@ -2017,8 +2090,10 @@ def run_jobs(
         on = dask_client(n_workers=min(n, len(pending)))
     try:
         with on as c, contextlib.ExitStack() as stack:
+            unusable: dict[str, str] | None = None
             if c is not None:
                 remote = True
+                unusable = stack.enter_context(_setup_failures(c))  # as soon as connected
                 info = c.scheduler_info()
                 reported = str(info.get("address")) if info.get("address") else None
                 summary.scheduler = address or reported  # the user's spelling of the address
@@ -2029,12 +2104,15 @@ def run_jobs(
                 # frames over all sequences; the clock starts once the cluster runs
                 frames = stack.enter_context(_Frames(pending, desc, show_progress))
             _make_out_dir(out)
+            stack.enter_context(_held(out))  # until summary.json is written
             touched = True
             try:
                 if c is not None:
                     wait = no_workers_timeout()
                     where = summary.scheduler or "?"
-                    _run_on_dask(c, pending, record, summary.kind, bar, frames, where, wait)
+                    _run_on_dask(
+                        c, pending, record, summary.kind, bar, frames, where, wait, unusable
+                    )
                 elif frames is not None:
                     for job in pending:
                         with _no_bars():
@@ -2294,18 +2372,62 @@ def _wait_for_workers(c: Client, address: str, wait: float) -> int:
 ANSWER_WAIT = 5.0
 
 
+@contextlib.contextmanager
+def _setup_failures(c: Client) -> Iterator[dict[str, str]]:
+    """The workers whose pftrack plugin fails to set up from now on: address -> error.
+
+    Such a worker (one that cannot import pftrack, joining after :func:`check_pftrack` ran)
+    dies on the first task it is given, Dask unable to unpickle it, too soon for the count of
+    the workers to see it. Its plugin's setup says so on
+    :data:`~pftrack.batch._plugin.SETUP_FAILED_TOPIC`, to which this subscribes.
+    """
+    from pftrack.batch._plugin import SETUP_FAILED_TOPIC
+
+    failed: dict[str, str] = {}
+
+    def on_event(event: Any) -> None:  # on the client's event loop
+        with contextlib.suppress(TypeError, ValueError):
+            worker, error = event[1]
+            failed.setdefault(str(worker), str(error))
+
+    c.subscribe_topic(SETUP_FAILED_TOPIC, on_event)
+    try:
+        yield failed
+    finally:
+        with contextlib.suppress(Exception):  # the cluster may be going away (Ctrl-C)
+            c.unsubscribe_topic(SETUP_FAILED_TOPIC)
+
+
 class _WorkersWatch:
     """While tasks wait on a cluster: tells when it has been without workers for too long.
 
     Or when its scheduler has not answered for that long (:data:`ANSWER_WAIT`): ``frozen``.
     """
 
-    def __init__(self, c: Client, address: str, wait: float) -> None:
+    def __init__(
+        self, c: Client, address: str, wait: float, unusable: dict[str, str] | None = None
+    ) -> None:
         self.c, self.address, self.wait = c, address, wait
         self.since: float | None = None  # when the workers were last seen gone
         self.silent: float | None = None  # when the scheduler was first asked in vain
         self.frozen = False
         self._checked = -math.inf
+        #: workers that joined but cannot import pftrack: address -> error, as they said it
+        self.unusable = unusable if unusable is not None else {}
+        self._said: set[str] = set()
+
+    def _unusable(self) -> str:
+        """The workers that joined but cannot import pftrack, said; or ``""``."""
+        if not self.unusable:
+            return ""
+        workers = ", ".join(self.unusable)
+        first = next(iter(self.unusable.values()))
+        which = "a worker" if len(self.unusable) == 1 else f"{len(self.unusable)} workers"
+        dies = "dies" if len(self.unusable) == 1 else "die"
+        return (
+            f"{which} that joined ({workers}) cannot import pftrack ({first}) and {dies} on the "
+            f"first task given: {INSTALL_EVERYWHERE}"
+        )
 
     def given_up(self) -> bool:
         """True once the cluster has had no worker for `wait` seconds (warns when they go).
@@ -2317,6 +2439,10 @@ class _WorkersWatch:
         if now - self._checked < WORKERS_POLL:
             return False
         self._checked = now
+        new = [w for w in self.unusable if w not in self._said]
+        if new:  # said once each, here (the main thread), not on Dask's
+            self._said.update(new)
+            warnings.warn(f"the scheduler at {self.address}: {self._unusable()}", stacklevel=2)
         try:
             n = _n_workers(self.c, ANSWER_WAIT)
         except TimeoutError:
@@ -2348,6 +2474,13 @@ class _WorkersWatch:
             return (
                 f"the scheduler at {self.address} did not answer for {self.wait:g} s (frozen "
                 f"or overloaded) before this {noun} finished (a re-run does the rest)"
+            )
+        unusable = self._unusable()
+        if unusable:  # was: "start some", of a worker started and lost without a word
+            return (
+                f"no worker on the scheduler at {self.address} for {self.wait:g} s: its "
+                f"workers were lost before this {noun} ran or finished; {unusable} (a re-run "
+                "does the rest)"
             )
         return (
             f"no worker on the scheduler at {self.address} for {self.wait:g} s: its workers "
@@ -2495,11 +2628,14 @@ def _run_on_dask(
     frames: _Frames | None = None,
     address: str = "?",
     wait: float = NO_WORKERS_WAIT,
+    unusable: dict[str, str] | None = None,
 ) -> None:
     """Submit `pending` to Dask and record each result as it completes.
 
     With `frames`, the tasks' frame counts come as Dask events on a topic of this run. A
-    cluster without workers for `wait` seconds (at `address`) fails the tasks left.
+    cluster without workers for `wait` seconds (at `address`) fails the tasks left; the
+    workers that joined but cannot import pftrack (`unusable`, from :func:`_setup_failures`)
+    are named then, and as they come.
     """
     from distributed import as_completed
 
@@ -2516,13 +2652,13 @@ def _run_on_dask(
                 frames.finish(job.name)
             record(job, Outcome(None, unsent))
     bar = {**bar, "total": len(sendable)}
+    watch = _WorkersWatch(c, address, wait, unusable)
     futures = {}
     for job in sendable:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
         where = (topic, job.name) if frames is not None else None
         fut = c.submit(call_task, job.func, job.args, where, job.reads, key=key, pure=False)
         futures[fut.key] = (fut, job)
-    watch = _WorkersWatch(c, address, wait)
     noun = "sequence" if kind == "track" else "file"
     tracked = as_completed([f for f, _ in futures.values()])
     done = _completed(tracked, watch.given_up)
