@@ -887,6 +887,15 @@ INPUT_COMMANDS = pytest.mark.parametrize(
 )
 
 
+def _run_on_input(argv: list[str], given: Path, tmp_path: Path, video: Path) -> int:
+    """`main` of one of :data:`INPUT_COMMANDS`'s `argv`, `given` as its input L (T: a tracks
+    file, V: a video, O / O.mp4: outputs in `tmp_path`)."""
+    tracks = _tracks(tmp_path / "t.txt")
+    names = {"L": str(given), "T": str(tracks), "V": str(video), "O": str(tmp_path / "o.txt")}
+    names["O.mp4"] = str(tmp_path / "o.mp4")
+    return main([names.get(x, x) for x in argv])
+
+
 @INPUT_COMMANDS
 def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
     argv: list[str], what: str, tmp_path: Path, video: Path, capsys: pytest.CaptureFixture[str]
@@ -897,10 +906,7 @@ def test_an_input_that_is_a_symbolic_link_loop_is_named_as_one(
     loop = tmp_path / "a"
     loop.symlink_to("b")
     (tmp_path / "b").symlink_to("a")
-    tracks = _tracks(tmp_path / "t.txt")
-    names = {"L": str(loop), "T": str(tracks), "V": str(video), "O": str(tmp_path / "o.txt")}
-    names["O.mp4"] = str(tmp_path / "o.mp4")
-    assert main([names.get(x, x) for x in argv]) == 2
+    assert _run_on_input(argv, loop, tmp_path, video) == 2
     assert capsys.readouterr().err.endswith(
         f"error: {what} {loop}: symbolic link loop ({loop} -> b -> a), which leads to no file "
         "or folder; point the link at one\n"
@@ -916,10 +922,7 @@ def test_an_input_that_is_a_broken_symbolic_link_is_named_as_one(
     lists it (``pftrack batch`` named it already)."""
     link = tmp_path / "clip.mp4"
     link.symlink_to(tmp_path / "moved" / "clip.mp4")
-    tracks = _tracks(tmp_path / "t.txt")
-    names = {"L": str(link), "T": str(tracks), "V": str(video), "O": str(tmp_path / "o.txt")}
-    names["O.mp4"] = str(tmp_path / "o.mp4")
-    assert main([names.get(x, x) for x in argv]) == 2
+    assert _run_on_input(argv, link, tmp_path, video) == 2
     assert capsys.readouterr().err.endswith(
         f"error: {what} not found: {link} is a broken symbolic link (to "
         f"{tmp_path / 'moved' / 'clip.mp4'})\n"
