@@ -25,6 +25,7 @@ __all__ = [
     "colour_hint",
     "first_bad_box",
     "first_at",
+    "check_classes",
     "first_bad_class",
     "first_bad_id",
     "flag",
@@ -85,6 +86,22 @@ def first_bad_class(classes: F64) -> int | None:
     """
     ok = (classes == np.round(classes)) & (classes >= -MAX_CLASS - 1) & (classes <= MAX_CLASS)
     return int(np.flatnonzero(~ok)[0]) if not ok.all() else None
+
+
+def check_classes(classes: F64, what: str) -> None:
+    """Refuse `classes` (1-D) holding a value :func:`first_bad_class` finds, as ``what[k]``.
+
+    Raises
+    ------
+    ValueError
+        ``f"{what}[k] is 1.5, expected an integer in [-2147483648, 2147483647]"``.
+    """
+    k = first_bad_class(classes)
+    if k is not None:
+        raise ValueError(
+            f"{what}[{k}] is {classes[k]:.17g}, expected an integer in "
+            f"[{-MAX_CLASS - 1}, {MAX_CLASS}]"
+        )
 
 
 def bad_id_message(value: float) -> str:

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, TypedDict
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_CLASS, first_bad_class, real_array
+from pftrack._check import check_classes, real_array
 from pftrack._typing import F64, CameraMotion, DetectorName, DynamicsName, FillMode, SamplerName
 from pftrack.tracking.api import Tracker
 
@@ -73,13 +73,7 @@ def _field(values: ArrayLike, name: str, shape: tuple[int, int]) -> F64:
             raise ValueError(f"detections.{name}[{k}] is {a[k, 0]}, expected a finite number")
         raise ValueError(f"detections.{name}[{k}] is {a[k].tolist()}, expected finite numbers")
     if name == "class_id":
-        c = a[:, 0]
-        j = first_bad_class(c)
-        if j is not None:
-            raise ValueError(
-                f"detections.class_id[{j}] is {c[j]:.17g}, expected an integer in "
-                f"[{-MAX_CLASS - 1}, {MAX_CLASS}]"
-            )
+        check_classes(a[:, 0], "detections.class_id")
     return a
 
 

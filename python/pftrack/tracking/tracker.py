@@ -27,14 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import (
-    MAX_CLASS,
-    bgr_frame,
-    first_bad_class,
-    generator,
-    not_an_image,
-    real_array,
-)
+from pftrack._check import bgr_frame, check_classes, generator, not_an_image, real_array
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack._warn import Held, warn
@@ -305,12 +298,7 @@ class MultiObjectTracker:
                 labels = np.asarray(classes).astype(np.int64, casting="unsafe").reshape(-1)
             else:  # refused, never truncated (was: 1.5 taken as class 1, NaN as -2**63)
                 c = real_array(classes, "classes").reshape(-1)
-                k = first_bad_class(c)
-                if k is not None:
-                    raise ValueError(
-                        f"classes[{k}] is {c[k]:.17g}, expected an integer in "
-                        f"[{-MAX_CLASS - 1}, {MAX_CLASS}]"
-                    )
+                check_classes(c, "classes")
                 labels = c.astype(np.int64)
             if len(labels) != len(boxes):
                 raise ValueError(f"classes has {len(labels)} entries, expected {len(boxes)}")
