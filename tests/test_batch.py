@@ -1075,6 +1075,51 @@ def test_a_summary_that_cannot_be_written_keeps_the_table(
     assert summary.table().endswith(f"\nerror: {summary.unwritten}")
 
 
+def _remove_folder(out: str, again: bool) -> TaskResult:
+    """A task that removes the batch's output folder (`again`: and makes an empty one there)."""
+    shutil.rmtree(out)
+    if again:
+        os.mkdir(out)
+    return TaskResult(np.zeros((0, 10)), {}, {})
+
+
+def _empty(k: int) -> TaskResult:
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+
+
+@pytest.mark.parametrize("again", [False, True])
+def test_an_out_folder_removed_while_the_batch_runs_is_said_with_what_was_lost(
+    tmp_path: Path, again: bool
+) -> None:
+    """A trial: ``--out`` deleted while the batch ran, the last line still said "the outputs
+    written before it are complete", of outputs gone with the folder; made again meanwhile
+    (``rm -r out; mkdir out``), summary.json went into the new folder, its entries ``done``."""
+    out = tmp_path / "out"
+    first = run_jobs([Job("a", _empty, (0,), ())], out, kind="smooth", settings={}, n_workers=0)
+    assert [e["status"] for e in first.entries] == ["done"] and first.unwritten is None
+    jobs = [
+        Job("a", _empty, (0,), ()),  # skipped: its outputs, complete, were in the folder
+        Job("b", _empty, (1,), ()),
+        Job("gone", _remove_folder, (str(out), again), ()),
+        Job("c", _empty, (2,), ()),
+    ]
+    summary = run_jobs(jobs, out, kind="smooth", settings={}, n_workers=0)
+    status = {e["name"]: e["status"] for e in summary.entries}
+    after = "done" if again else "failed"  # written into the folder made again, or not
+    assert status == {"a": "skipped", "b": "done", "gone": after, "c": after}
+    another = " (the folder there now is another one)" if again else ""
+    assert summary.unwritten == (
+        f"out_dir {out} was removed while the batch ran{another}: the outputs of 2 files "
+        "(a, b) went with it, and summary.json is not written; re-run the batch to make them "
+        "again"
+    )
+    assert summary.table().endswith(f"\nerror: {summary.unwritten}")
+    if again:  # the outputs written into it are there, no summary.json
+        assert sorted(os.listdir(out)) == ["c.json", "c.txt", "gone.json", "gone.txt"]
+    else:
+        assert not out.exists()
+
+
 def test_resume_redoes_an_output_truncated_emptied_or_replaced(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

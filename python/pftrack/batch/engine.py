@@ -132,8 +132,9 @@ class BatchSummary:
         The settings every task ran with.
     unwritten : str or None
         Why ``out_dir/summary.json`` could not be written at the end (a full disk, a folder
-        made read-only meanwhile), else None: the tasks' outputs written stay, and this is the
-        run's only record (``pftrack`` prints its table and exits with status 1).
+        made read-only meanwhile, the folder removed: then the outputs lost with it are named),
+        else None: the tasks' outputs written stay, and this is the run's only record
+        (``pftrack`` prints its table and exits with status 1).
     """
 
     kind: str
@@ -2105,6 +2106,7 @@ def run_jobs(
                 frames = stack.enter_context(_Frames(pending, desc, show_progress))
             _make_out_dir(out)
             stack.enter_context(_held(out))  # until summary.json is written
+            made = _file_id(out)  # the folder written into: removed meanwhile, said at the end
             touched = True
             try:
                 if c is not None:
@@ -2130,8 +2132,10 @@ def run_jobs(
                 summary.entries = [entries[job.name] for job in jobs]
                 summary.seconds = time.perf_counter() - start
                 try:
-                    with atomic_write(out / SUMMARY_NAME) as fh:
-                        fh.write(summary.to_json() + "\n")
+                    summary.unwritten = _out_removed(out, made, summary)
+                    if summary.unwritten is None:
+                        with atomic_write(out / SUMMARY_NAME) as fh:
+                            fh.write(summary.to_json() + "\n")
                 except OSError as exc:  # was: exit status 2 with this error alone, no table
                     summary.unwritten = (
                         f"{out / SUMMARY_NAME} not written ({exc.strerror or one_line(exc)}); "
@@ -2141,6 +2145,36 @@ def run_jobs(
         _say_interrupted(exc, out, kind, written if touched else None)
         raise
     return summary
+
+
+def _out_removed(out: Path, made: tuple[int, int] | None, summary: BatchSummary) -> str | None:
+    """Why `summary` is not written: `out` (`made` its file id) was removed meanwhile; or None.
+
+    The outputs of the entries done or skipped that are not there now are named, lost. Was: the
+    last line said "the outputs written before it are complete", of files gone with the folder;
+    and a folder made again meanwhile (``rm -r out; mkdir out``) got a ``summary.json`` whose
+    entries said ``done`` of outputs not there.
+    """
+    now = _file_id(out)
+    if made is None or now == made:
+        return None
+    another = " (the folder there now is another one)" if now is not None else ""
+    lost = [
+        e["name"]
+        for e in summary.entries
+        if e["status"] in ("done", "skipped") and not _sidecar(out, e["name"]).exists()
+    ]  # those written into a folder made again meanwhile are there
+    noun = "sequence" if summary.kind == "track" else "file"
+    if lost:
+        shown = ", ".join(lost[:3]) + (", ..." if len(lost) > 3 else "")
+        what = f"the outputs of {counted(len(lost), noun)} ({shown}) went with it, and "
+    else:
+        what = "no output had been written in it; "
+    again = " to make them again" if lost else ""
+    return (
+        f"{_OUT_NAMES.get()[0]} {out} was removed while the batch ran{another}: {what}"
+        f"{SUMMARY_NAME} is not written; re-run the batch{again}"
+    )
 
 
 def _check_arguments(out_dir: object, n_workers: object, force: object, show: object) -> None:
