@@ -2343,7 +2343,8 @@ def test_scheduler_address_from_the_environment(
     monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", client.scheduler.address)
     assert main(["batch", str(data / "plain"), "--out", str(tmp_path), *FAST]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["scheduler"] == client.scheduler.address and summary["workers"] == 2
+    # one sequence: one of the two workers ran it (the workers that ran tasks are counted)
+    assert summary["scheduler"] == client.scheduler.address and summary["workers"] == 1
     # the address as the user gave it, not as Dask reports it (tcp://127.0.0.1:PORT)
     given = client.scheduler.address.replace("127.0.0.1", "localhost")
     monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", given)
@@ -3124,6 +3125,40 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
             "rest)"
         )
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] >= 2
+
+
+def _where_i_ran(k: int) -> TaskResult:
+    time.sleep(0.8)
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k, "worker": distributed.get_worker().address})
+
+
+def test_the_summary_counts_the_workers_that_ran_its_tasks(tmp_path: Path) -> None:
+    """A trial: the summary's worker count was the count at the start; a worker that joined
+    mid-run and ran tasks was not in it (nor, on a larger cluster, were the idle ones out)."""
+    jobs = [Job(f"t{k}", _where_i_ran, (k,), ()) for k in range(8)]
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+        scheduler_kwargs=NO_DASHBOARD,
+    ) as cluster:  # fmt: skip
+
+        def join() -> None:  # a second worker, once the batch runs on the first
+            deadline = time.monotonic() + 30
+            while not cluster.scheduler.tasks and time.monotonic() < deadline:
+                time.sleep(0.05)
+            cluster.scale(2)
+
+        joins = threading.Thread(target=join)
+        joins.start()
+        try:
+            summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={},
+                               scheduler=cluster.scheduler_address)  # fmt: skip
+        finally:
+            joins.join()
+    ran = {e["worker"] for e in summary.entries}
+    assert len(ran) == 2, "the second worker ran none: no test"
+    assert summary.workers == 2
+    assert f"8 files: 8 done; {summary.seconds:.1f} s, 2 workers at " in summary.table()
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["workers"] == 2
 
 
 def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) -> None:

@@ -124,7 +124,8 @@ class BatchSummary:
     seconds : float
         Wall time of the batch (cluster start included).
     workers : int
-        Workers that ran it (0: in this process).
+        Workers that ran its tasks, those that joined mid-run included (0: in this process);
+        where no task came back from any, the workers the cluster had at the start.
     scheduler : str or None
         Address of the Dask scheduler, as given (``--scheduler``, ``DASK_SCHEDULER_ADDRESS``),
         else as Dask reports it (None: in this process).
@@ -1526,6 +1527,8 @@ class Outcome(NamedTuple):
     release : str or None
         On a Dask worker: its pftrack release, which the client compares with its own (a
         worker that joined after :func:`check_pftrack` ran may run another).
+    worker : str or None
+        On a Dask worker: its address (the summary counts the workers that ran tasks).
     """
 
     result: TaskResult | None
@@ -1535,6 +1538,17 @@ class Outcome(NamedTuple):
     missing: str | None = None
     seen: list[dict[str, Any]] | None = None
     release: str | None = None
+    worker: str | None = None
+
+
+def _worker_address() -> str | None:
+    """The address of the Dask worker running this task, or None (not on a worker)."""
+    try:
+        from distributed import get_worker
+
+        return str(get_worker().address)
+    except (ImportError, ValueError, AttributeError):
+        return None
 
 
 def _worker_stop() -> Callable[[], None] | None:
@@ -1661,6 +1675,7 @@ def call_task(
     seen = fingerprint(reads) if reads is not None else None
     host = _host() if reads is not None else None
     release = _version() if reads is not None else None
+    worker = _worker_address() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
     with _TASK_WARNINGS.recording() as caught, reporting_frames(report, stop):
@@ -1671,12 +1686,12 @@ def call_task(
             if isinstance(exc, FileNotFoundError):
                 missing = str(exc.filename) if exc.filename else ""
             return Outcome(
-                None, one_line(exc), traceback.format_exc(), _host(), missing, seen, release
+                None, one_line(exc), traceback.format_exc(), _host(), missing, seen, release, worker
             )
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
-    return Outcome(result, host=host, seen=seen, release=release)
+    return Outcome(result, host=host, seen=seen, release=release, worker=worker)
 
 
 def _host() -> str:
@@ -2043,9 +2058,12 @@ def run_jobs(
     remote = False  # the tasks run on Dask workers: set once connected
     touched = False  # --out created (summary.json is written on the way out, whatever happens)
     written = 0  # tasks whose outputs this run wrote
+    ran: set[str] = set()  # the workers that ran tasks (was: the count at the start alone)
 
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
+        if outcome.worker is not None:
+            ran.add(outcome.worker)
         other = _other_release(outcome) if remote else None
         if other is None and remote:
             other = _seen_otherwise(job, outcome, prints[job.name])
@@ -2131,6 +2149,7 @@ def run_jobs(
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
                 summary.entries = [entries[job.name] for job in jobs]
                 summary.seconds = time.perf_counter() - start
+                summary.workers = len(ran) or summary.workers
                 try:
                     summary.unwritten = _out_removed(out, made, summary)
                     if summary.unwritten is None:
