@@ -3240,7 +3240,14 @@ def test_a_path_a_worker_cannot_see_is_said_so(data: Path, client: Any, tmp_path
     """Was: "video source not found: PATH", as if it did not exist, and no host named."""
     (seq,) = [s for s in find_sequences(data) if s.name == "walk"]
     job = Job(seq.name, _track_unseen, (seq, TrackOptions(config=_config())), seq.files)
-    summary = run_jobs([job], tmp_path / "out", kind="track", settings={}, client=client)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        summary = run_jobs([job], tmp_path / "out", kind="track", settings={}, client=client)
+    # tried on each worker (none sees it), each named once
+    workers = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    assert sorted(re.findall(r"the worker (\S+) cannot see", str([w.message for w in caught]))) == (
+        workers
+    )
     (entry,) = summary.entries
     host = socket.gethostname()
     assert entry["status"] == "failed" and entry["host"] == host
@@ -3255,6 +3262,79 @@ def test_a_path_a_worker_cannot_see_is_said_so(data: Path, client: Any, tmp_path
     job = Job("gone", _track_unseen, (gone, TrackOptions(config=_config())), gone.files)
     (entry,) = run_jobs([job], tmp_path / "o2", kind="track", settings={}, client=client).entries
     assert entry["error"] == f"video source not found: {gone.frames}" and entry["host"] == host
+
+
+def _blind_to(prefix: str | None) -> None:
+    """On a worker: every path under `prefix` is not found (a share not mounted there; None:
+    undo)."""
+    if not hasattr(os, "_real_stat"):
+        os._real_stat = os.stat  # type: ignore[attr-defined]
+    real = os._real_stat  # type: ignore[attr-defined]
+
+    def stat(path: Any, *args: Any, **kwargs: Any) -> Any:
+        if prefix is not None and os.fsdecode(path).startswith(prefix):
+            raise FileNotFoundError(2, "No such file or directory", os.fsdecode(path))
+        return real(path, *args, **kwargs)
+
+    os.stat = stat if prefix is not None else real
+
+
+def test_a_worker_that_cannot_see_the_inputs_hands_its_tasks_to_the_others(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    """A trial: a worker that could not see the inputs (started in another mount namespace)
+    failed every task it was given, fast, and so took most of the queue while the good ones
+    idled. Its tasks now go to the other workers, and it is named once; a sequence that no
+    worker can see still fails, as before."""
+    blind, good = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    options = TrackOptions(config=_config())
+    assert client.run(_blind_to, str(data), workers=[blind])
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            summary = track_many(data, tmp_path / "out", client, options=options)
+        assert [e["status"] for e in summary.entries] == ["done"] * 3, summary.table()
+        address = client.scheduler.address
+        said = [str(w.message) for w in caught]
+        (one,) = said  # named once, however many of its tasks it was given
+        assert re.fullmatch(
+            rf"the scheduler at {re.escape(address)}: the worker {re.escape(blind)} cannot see "
+            rf"the inputs this process sees \({re.escape(str(data))}/\S+ not found on "
+            rf"{re.escape(socket.gethostname())}\): its tasks go to the other workers \(workers "
+            r"must see the same paths\)",
+            one,
+        ), one
+        assert len(_files(tmp_path / "out")) == 3
+        # no worker sees them: each sequence fails as before, its worker named
+        assert client.run(_blind_to, str(data), workers=[good])
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            failed = track_many(data, tmp_path / "o2", client, options=options)
+    finally:
+        client.run(_blind_to, None)
+    host = socket.gethostname()
+    assert [e["status"] for e in failed.entries] == ["failed"] * 3
+    for e in failed.entries:
+        assert e["error"] == (
+            f"{e['source']}: not found on worker {host} (the client sees it: workers must see "
+            "the same paths)"
+        )
+
+
+def test_a_task_sent_to_workers_all_gone_since_is_sent_again(client: Any) -> None:
+    """A task sent away from a blind worker goes to the others only (Dask's ``workers=``): were
+    they all to go, Dask would keep it for them for ever while the watch counts the others."""
+    from pftrack.batch import engine
+
+    (worker, *_) = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    blind = engine._Blind(client, client.scheduler.address, lambda job, outcome: None)
+    sent = {"gone": {"tcp://127.0.0.1:1"}, "there": {worker, "tcp://127.0.0.1:1"}}
+    assert blind.stranded(sent) == {"gone"}
+    assert blind.stranded(sent) is None  # once a second at most
+    job = Job("j", track_sequence_stub, (), ())
+    assert blind.others(job) == set(client.scheduler_info(n_workers=-1)["workers"])
+    blind.tried["j"] = blind.others(job) or set()
+    assert blind.others(job) is None  # every worker tried: the task fails
 
 
 def _worker_sees_other_files(grown: int) -> None:

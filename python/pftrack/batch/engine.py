@@ -1787,16 +1787,38 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     ]
     if unreadable:  # was: "Permission denied: DIR/seqinfo.ini", a file that need not exist
         return unreadable[0]
-    if not remote or outcome.missing is None or outcome.host is None or outcome.error is None:
-        return outcome.error
+    unseen = _not_found_there(job, outcome) if remote else None
+    if unseen is None:
+        return outcome.error  # missing here too: the error as the task said it
+    return f"{unseen}: {UNSEEN.format(host=outcome.host)}"
+
+
+def _not_found_there(job: Job, outcome: Outcome) -> Path | None:
+    """The file that the failed task of `outcome` could not find but this process sees, or None."""
+    if outcome.missing is None or outcome.host is None or outcome.error is None:
+        return None
     if outcome.missing:
         named = [Path(outcome.missing)]
     else:  # the path in the message (FrameSource's "video source not found: PATH")
         named = [p for p in (*job.reads, *job.guards) if str(p) in outcome.error]
-    seen = [p for p in named if p.exists()]
-    if not seen:
-        return outcome.error  # missing here too: the error as the task said it
-    return f"{seen[0]}: {UNSEEN.format(host=outcome.host)}"
+    return next((p for p in named if p.exists()), None)
+
+
+def _unseen_input(job: Job, outcome: Outcome, here: list[dict[str, Any]]) -> Path | None:
+    """An input of `job` that the worker of `outcome` could not see but this process sees.
+
+    `here`: the :func:`fingerprint` of ``job.reads`` taken before the tasks ran; the worker's
+    own (``outcome.seen``) says which it could not read, and a failed task which file it could
+    not find. None: the worker saw them all (or the task is not a Dask worker's).
+    """
+    if outcome.worker is None or outcome.host is None:
+        return None
+    seen = outcome.seen or []
+    if len(seen) == len(here):
+        for mine, theirs in zip(here, seen, strict=True):
+            if theirs.get("missing") and not mine.get("missing") and Path(mine["path"]).exists():
+                return Path(mine["path"])
+    return _not_found_there(job, outcome) if outcome.result is None else None
 
 
 #: How the messages name the output folder and a rendered video: the Python parameters
@@ -2131,8 +2153,9 @@ def run_jobs(
                     wait = no_workers_timeout()
                     where = summary.scheduler or "?"
                     _run_on_dask(
-                        c, pending, record, summary.kind, bar, frames, where, wait, unusable
-                    )
+                        c, pending, record, summary.kind, bar, frames, where, wait, unusable,
+                        lambda job, outcome: _unseen_input(job, outcome, prints[job.name]),
+                    )  # fmt: skip
                 elif frames is not None:
                     for job in pending:
                         with _no_bars():
@@ -2672,6 +2695,74 @@ def _not_utf8(job: Job) -> str | None:
     return None
 
 
+def _worker_addresses(c: Client) -> set[str] | None:
+    """The addresses of the scheduler's workers now (None: it did not answer in time)."""
+    rpc = c.scheduler
+    if rpc is None:
+        return None
+    try:
+        info = c.sync(rpc.identity, n_workers=-1, callback_timeout=ANSWER_WAIT)
+    except Exception:  # noqa: BLE001 - frozen, gone, or an older Dask: the task fails as it did
+        return None
+    return set(info.get("workers") or {})
+
+
+class _Blind:
+    """Where to send again the tasks of workers that could not see their inputs.
+
+    A worker that cannot see the inputs (another mount namespace, a share not mounted there)
+    fails every task it is given, fast, so it took most of the queue while the good workers
+    idled, and each of those sequences failed. Such a task goes again to the workers that have
+    not failed to see its inputs (Dask's ``workers=`` restriction), and the worker is named
+    once (a warning). The task fails, as before, once no worker is left to try.
+    """
+
+    def __init__(self, c: Client, address: str, unseen: Callable[[Job, Outcome], Path | None]):
+        self.c, self.address, self.unseen = c, address, unseen
+        self.tried: dict[str, set[str]] = {}  # job name -> the workers that could not see it
+        self.last: dict[str, Outcome] = {}  # job name -> the latest such outcome
+        self.named: set[str] = set()
+        self._checked = -math.inf
+
+    def elsewhere(self, job: Job, outcome: Outcome) -> set[str] | None:
+        """The workers to send `job` to, its `outcome` from a worker blind to it; or None."""
+        path = self.unseen(job, outcome)
+        if path is None or outcome.worker is None:
+            return None
+        if outcome.worker not in self.named:
+            self.named.add(outcome.worker)
+            warnings.warn(
+                f"the scheduler at {self.address}: the worker {outcome.worker} cannot see the "
+                f"inputs this process sees ({path} not found on {outcome.host}): its tasks go "
+                "to the other workers (workers must see the same paths)",
+                stacklevel=3,
+            )
+        self.tried.setdefault(job.name, set()).add(outcome.worker)
+        self.last[job.name] = outcome
+        return self.others(job)
+
+    def others(self, job: Job) -> set[str] | None:
+        """The workers there now that have not failed to see `job`'s inputs; None: none."""
+        now = _worker_addresses(self.c)
+        left = None if now is None else now - self.tried.get(job.name, set())
+        return left or None
+
+    def stranded(self, sent: dict[Any, set[str]]) -> set[Any] | None:
+        """The keys of `sent` (key -> the workers it may run on) whose workers are all gone.
+
+        Checked once a second at most; None meanwhile. Such a task would wait for ever (Dask
+        keeps it for those workers), as the watch of the workers counts the others.
+        """
+        now = time.monotonic()
+        if not sent or now - self._checked < WORKERS_POLL:
+            return None
+        self._checked = now
+        there = _worker_addresses(self.c)
+        if there is None:
+            return None
+        return {key for key, allowed in sent.items() if not allowed & there}
+
+
 def _run_on_dask(
     c: Client,
     pending: Sequence[Job],
@@ -2682,13 +2773,15 @@ def _run_on_dask(
     address: str = "?",
     wait: float = NO_WORKERS_WAIT,
     unusable: dict[str, str] | None = None,
+    unseen: Callable[[Job, Outcome], Path | None] | None = None,
 ) -> None:
     """Submit `pending` to Dask and record each result as it completes.
 
     With `frames`, the tasks' frame counts come as Dask events on a topic of this run. A
     cluster without workers for `wait` seconds (at `address`) fails the tasks left; the
     workers that joined but cannot import pftrack (`unusable`, from :func:`_setup_failures`)
-    are named then, and as they come.
+    are named then, and as they come. With `unseen` (the input a task's worker could not see,
+    :func:`_unseen_input`), such a task goes to the other workers (:class:`_Blind`).
     """
     from distributed import as_completed
 
@@ -2706,17 +2799,46 @@ def _run_on_dask(
             record(job, Outcome(None, unsent))
     bar = {**bar, "total": len(sendable)}
     watch = _WorkersWatch(c, address, wait, unusable)
+    blind = _Blind(c, address, unseen) if unseen is not None else None
     futures = {}
-    for job in sendable:
+    sent: dict[Any, set[str]] = {}  # the keys sent to some workers only: key -> those workers
+
+    def submit(job: Job, workers: set[str] | None = None) -> Any:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
         where = (topic, job.name) if frames is not None else None
-        fut = c.submit(call_task, job.func, job.args, where, job.reads, key=key, pure=False)
+        fut = c.submit(
+            call_task, job.func, job.args, where, job.reads, key=key, pure=False,
+            workers=sorted(workers) if workers else None,
+        )  # fmt: skip
         futures[fut.key] = (fut, job)
+        if workers:
+            sent[fut.key] = workers
+        return fut
+
+    for job in sendable:
+        submit(job)
     noun = "sequence" if kind == "track" else "file"
     tracked = as_completed([f for f, _ in futures.values()])
-    done = _completed(tracked, watch.given_up)
+
+    def given_up() -> bool:  # and the tasks sent to workers all gone since: to the others
+        for key in (blind.stranded(sent) if blind is not None else None) or ():
+            fut, job = futures.pop(key)
+            del sent[key]
+            fut.cancel()
+            workers = blind.others(job) if blind is not None else None
+            if workers:
+                tracked.add(submit(job, workers))
+            else:
+                if frames is not None:
+                    frames.finish(job.name)
+                record(job, blind.last[job.name] if blind is not None else Outcome(None))
+        return watch.given_up()
+
+    done = _completed(tracked, given_up)
     try:
         for fut in progress(done, **bar) if frames is None else done:
+            if fut.key not in futures:  # cancelled and sent again (its workers gone)
+                continue
             status = fut.status
             if status not in ("finished", "error", "cancelled"):
                 # finished, then its result lost with its worker before it was taken: Dask
@@ -2724,10 +2846,19 @@ def _run_on_dask(
                 tracked.add(fut)
                 continue
             _, job = futures.pop(fut.key)
+            sent.pop(fut.key, None)
+            outcome = fut.result() if status == "finished" else None
+            workers = (
+                blind.elsewhere(job, outcome) if blind is not None and outcome is not None else None
+            )
+            if workers:  # its worker could not see its inputs: to the others
+                tracked.add(submit(job, workers))
+                fut.release()
+                continue
             if frames is not None:
                 frames.finish(job.name)
-            if status == "finished":
-                record(job, fut.result())
+            if outcome is not None:
+                record(job, outcome)
             elif status == "error":  # the worker died (KilledWorker) or the like
                 exc = fut.exception()
                 # the scheduler's own no-workers-timeout: said as this process's watch says it
