@@ -3127,7 +3127,11 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] >= 2
 
 
-def _where_i_ran(k: int) -> TaskResult:
+def _where_i_ran(k: int, joined: str) -> TaskResult:
+    """A task of 0.8 s, once the second worker has joined (`joined` exists): 30 s at most."""
+    deadline = time.monotonic() + 30
+    while not os.path.exists(joined) and time.monotonic() < deadline:
+        time.sleep(0.05)
     time.sleep(0.8)
     return TaskResult(np.zeros((0, 10)), {}, {"k": k, "worker": distributed.get_worker().address})
 
@@ -3135,7 +3139,8 @@ def _where_i_ran(k: int) -> TaskResult:
 def test_the_summary_counts_the_workers_that_ran_its_tasks(tmp_path: Path) -> None:
     """A trial: the summary's worker count was the count at the start; a worker that joined
     mid-run and ran tasks was not in it (nor, on a larger cluster, were the idle ones out)."""
-    jobs = [Job(f"t{k}", _where_i_ran, (k,), ()) for k in range(8)]
+    joined = tmp_path / "joined"
+    jobs = [Job(f"t{k}", _where_i_ran, (k, str(joined)), ()) for k in range(8)]
     with distributed.LocalCluster(
         n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
         scheduler_kwargs=NO_DASHBOARD,
@@ -3146,6 +3151,9 @@ def test_the_summary_counts_the_workers_that_ran_its_tasks(tmp_path: Path) -> No
             while not cluster.scheduler.tasks and time.monotonic() < deadline:
                 time.sleep(0.05)
             cluster.scale(2)
+            while len(cluster.scheduler.workers) < 2 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            joined.touch()
 
         joins = threading.Thread(target=join)
         joins.start()
