@@ -3225,6 +3225,49 @@ def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) ->
         ), e["error"]
 
 
+HIDE_PFTRACK_ONCE = """import os, sys
+if os.path.exists({marker!r}):  # pftrack uninstalled: the workers started from now on lack it
+""" + "".join(f"    {line}\n" for line in HIDE_PFTRACK.splitlines())
+
+
+def _uninstall_and_die(marker: str) -> TaskResult:
+    """A task that "uninstalls" pftrack for the workers started from now on, and kills its own."""
+    Path(marker).touch()
+    os.kill(os.getpid(), signal.SIGKILL)
+    raise AssertionError("not reached")
+
+
+def test_a_worker_restarted_without_pftrack_is_named_not_killedworker(tmp_path: Path) -> None:
+    """A trial: a worker's nanny restarted it (the process killed) after pftrack was removed
+    from its environment; given the task again, each such worker died on it, and the sequence
+    failed with Dask's generic ``KilledWorker: Attempted to run task ... on 4 different
+    workers ...``, pftrack never named."""
+    import dask
+
+    marker = tmp_path / "uninstalled"
+    (tmp_path / "hide_once.py").write_text(HIDE_PFTRACK_ONCE.format(marker=str(marker)))
+    jobs = [Job("walk", _uninstall_and_die, (str(marker),), ())]
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(dask.config.set({"distributed.scheduler.no-workers-timeout": "15s"}))
+        cluster = stack.enter_context(distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+            scheduler_kwargs=NO_DASHBOARD, preload=[str(tmp_path / "hide_once.py")],
+        ))  # fmt: skip
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={},
+                               scheduler=cluster.scheduler_address)  # fmt: skip
+    (entry,) = summary.entries
+    assert entry["status"] == "failed"
+    assert re.fullmatch(
+        r"pftrack missing on worker tcp://127\.0\.0\.1:\d+ \(ModuleNotFoundError: .*pftrack.*\): "
+        r"it joined without pftrack \(restarted by its nanny after pftrack was removed\?\) and "
+        r"died on this file, the last of 4 workers that did \(Dask's KilledWorker\); install "
+        r"pftrack where the scheduler and every worker run",
+        entry["error"],
+    ), entry["error"]
+
+
 # --- inputs a worker cannot see, broken links, the same input twice, listing order ----------
 
 

@@ -2544,6 +2544,27 @@ class _WorkersWatch:
             )
         return now - self.since >= self.wait
 
+    def killed(self, exc: BaseException, noun: str) -> str | None:
+        """The error of a task that Dask's ``KilledWorker`` failed on a worker without pftrack.
+
+        Such a worker (restarted by its nanny after pftrack was removed from its environment,
+        or started without it) dies on every task it is given, and the task failed with Dask's
+        generic "Attempted to run task ... on 4 different workers"; None: `exc` is no
+        ``KilledWorker``, or its last worker is not one that said it cannot import pftrack.
+        """
+        if type(exc).__name__ != "KilledWorker":
+            return None
+        worker = getattr(getattr(exc, "last_worker", None), "address", None)
+        if worker is None or str(worker) not in self.unusable:
+            return None
+        failures = getattr(exc, "allowed_failures", None)
+        last = f", the last of {failures + 1} workers that did" if isinstance(failures, int) else ""
+        return (
+            f"pftrack missing on worker {worker} ({self.unusable[str(worker)]}): it joined "
+            f"without pftrack (restarted by its nanny after pftrack was removed?) and died on "
+            f"this {noun}{last} (Dask's KilledWorker); {INSTALL_EVERYWHERE}"
+        )
+
     def error(self, noun: str) -> str:
         """The error of a task left waiting when :meth:`given_up`."""
         if self.frozen:
@@ -2863,7 +2884,8 @@ def _run_on_dask(
                 exc = fut.exception()
                 # the scheduler's own no-workers-timeout: said as this process's watch says it
                 lost = type(exc).__name__ == "NoWorkerError"
-                record(job, Outcome(None, watch.error(noun) if lost else one_line(exc)))
+                error = watch.error(noun) if lost else watch.killed(exc, noun) or one_line(exc)
+                record(job, Outcome(None, error))
             elif status == "cancelled" and _connection_lost(c, fut):  # Dask cancels them all
                 record(job, Outcome(None, _scheduler_lost(address, noun)))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
