@@ -1075,6 +1075,51 @@ def test_a_summary_that_cannot_be_written_keeps_the_table(
     assert summary.table().endswith(f"\nerror: {summary.unwritten}")
 
 
+def _remove_folder(out: str, again: bool) -> TaskResult:
+    """A task that removes the batch's output folder (`again`: and makes an empty one there)."""
+    shutil.rmtree(out)
+    if again:
+        os.mkdir(out)
+    return TaskResult(np.zeros((0, 10)), {}, {})
+
+
+def _empty(k: int) -> TaskResult:
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+
+
+@pytest.mark.parametrize("again", [False, True])
+def test_an_out_folder_removed_while_the_batch_runs_is_said_with_what_was_lost(
+    tmp_path: Path, again: bool
+) -> None:
+    """A trial: ``--out`` deleted while the batch ran, the last line still said "the outputs
+    written before it are complete", of outputs gone with the folder; made again meanwhile
+    (``rm -r out; mkdir out``), summary.json went into the new folder, its entries ``done``."""
+    out = tmp_path / "out"
+    first = run_jobs([Job("a", _empty, (0,), ())], out, kind="smooth", settings={}, n_workers=0)
+    assert [e["status"] for e in first.entries] == ["done"] and first.unwritten is None
+    jobs = [
+        Job("a", _empty, (0,), ()),  # skipped: its outputs, complete, were in the folder
+        Job("b", _empty, (1,), ()),
+        Job("gone", _remove_folder, (str(out), again), ()),
+        Job("c", _empty, (2,), ()),
+    ]
+    summary = run_jobs(jobs, out, kind="smooth", settings={}, n_workers=0)
+    status = {e["name"]: e["status"] for e in summary.entries}
+    after = "done" if again else "failed"  # written into the folder made again, or not
+    assert status == {"a": "skipped", "b": "done", "gone": after, "c": after}
+    another = " (the folder there now is another one)" if again else ""
+    assert summary.unwritten == (
+        f"out_dir {out} was removed while the batch ran{another}: the outputs of 2 files "
+        "(a, b) went with it, and summary.json is not written; re-run the batch to make them "
+        "again"
+    )
+    assert summary.table().endswith(f"\nerror: {summary.unwritten}")
+    if again:  # the outputs written into it are there, no summary.json
+        assert sorted(os.listdir(out)) == ["c.json", "c.txt", "gone.json", "gone.txt"]
+    else:
+        assert not out.exists()
+
+
 def test_resume_redoes_an_output_truncated_emptied_or_replaced(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -2298,7 +2343,8 @@ def test_scheduler_address_from_the_environment(
     monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", client.scheduler.address)
     assert main(["batch", str(data / "plain"), "--out", str(tmp_path), *FAST]) == 0
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["scheduler"] == client.scheduler.address and summary["workers"] == 2
+    # one sequence: one of the two workers ran it (the workers that ran tasks are counted)
+    assert summary["scheduler"] == client.scheduler.address and summary["workers"] == 1
     # the address as the user gave it, not as Dask reports it (tcp://127.0.0.1:PORT)
     given = client.scheduler.address.replace("127.0.0.1", "localhost")
     monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", given)
@@ -3081,6 +3127,48 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] >= 2
 
 
+def _where_i_ran(k: int, joined: str) -> TaskResult:
+    """A task of 0.8 s, once the second worker has joined (`joined` exists): 30 s at most."""
+    deadline = time.monotonic() + 30
+    while not os.path.exists(joined) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.8)
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k, "worker": distributed.get_worker().address})
+
+
+def test_the_summary_counts_the_workers_that_ran_its_tasks(tmp_path: Path) -> None:
+    """A trial: the summary's worker count was the count at the start; a worker that joined
+    mid-run and ran tasks was not in it (nor, on a larger cluster, were the idle ones out)."""
+    joined = tmp_path / "joined"
+    jobs = [Job(f"t{k}", _where_i_ran, (k, str(joined)), ()) for k in range(8)]
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+        scheduler_kwargs=NO_DASHBOARD,
+    ) as cluster:  # fmt: skip
+
+        def join() -> None:  # a second worker, once the batch runs on the first
+            deadline = time.monotonic() + 30
+            while not cluster.scheduler.tasks and time.monotonic() < deadline:
+                time.sleep(0.05)
+            cluster.scale(2)
+            while len(cluster.scheduler.workers) < 2 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            joined.touch()
+
+        joins = threading.Thread(target=join)
+        joins.start()
+        try:
+            summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={},
+                               scheduler=cluster.scheduler_address)  # fmt: skip
+        finally:
+            joins.join()
+    ran = {e["worker"] for e in summary.entries}
+    assert len(ran) == 2, "the second worker ran none: no test"
+    assert summary.workers == 2
+    assert f"8 files: 8 done; {summary.seconds:.1f} s, 2 workers at " in summary.table()
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["workers"] == 2
+
+
 def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) -> None:
     """A trial: the workers lost mid-run, the operator started one from an environment without
     pftrack. It joined, was given a task it could not unpickle and died at once, too soon for
@@ -3137,6 +3225,49 @@ def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) ->
         ), e["error"]
 
 
+HIDE_PFTRACK_ONCE = """import os, sys
+if os.path.exists({marker!r}):  # pftrack uninstalled: the workers started from now on lack it
+""" + "".join(f"    {line}\n" for line in HIDE_PFTRACK.splitlines())
+
+
+def _uninstall_and_die(marker: str) -> TaskResult:
+    """A task that "uninstalls" pftrack for the workers started from now on, and kills its own."""
+    Path(marker).touch()
+    os.kill(os.getpid(), signal.SIGKILL)
+    raise AssertionError("not reached")
+
+
+def test_a_worker_restarted_without_pftrack_is_named_not_killedworker(tmp_path: Path) -> None:
+    """A trial: a worker's nanny restarted it (the process killed) after pftrack was removed
+    from its environment; given the task again, each such worker died on it, and the sequence
+    failed with Dask's generic ``KilledWorker: Attempted to run task ... on 4 different
+    workers ...``, pftrack never named."""
+    import dask
+
+    marker = tmp_path / "uninstalled"
+    (tmp_path / "hide_once.py").write_text(HIDE_PFTRACK_ONCE.format(marker=str(marker)))
+    jobs = [Job("walk", _uninstall_and_die, (str(marker),), ())]
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(dask.config.set({"distributed.scheduler.no-workers-timeout": "15s"}))
+        cluster = stack.enter_context(distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+            scheduler_kwargs=NO_DASHBOARD, preload=[str(tmp_path / "hide_once.py")],
+        ))  # fmt: skip
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={},
+                               scheduler=cluster.scheduler_address)  # fmt: skip
+    (entry,) = summary.entries
+    assert entry["status"] == "failed"
+    assert re.fullmatch(
+        r"pftrack missing on worker tcp://127\.0\.0\.1:\d+ \(ModuleNotFoundError: .*pftrack.*\): "
+        r"it joined without pftrack \(restarted by its nanny after pftrack was removed\?\) and "
+        r"died on this file, the last of 4 workers that did \(Dask's KilledWorker\); install "
+        r"pftrack where the scheduler and every worker run",
+        entry["error"],
+    ), entry["error"]
+
+
 # --- inputs a worker cannot see, broken links, the same input twice, listing order ----------
 
 
@@ -3160,7 +3291,14 @@ def test_a_path_a_worker_cannot_see_is_said_so(data: Path, client: Any, tmp_path
     """Was: "video source not found: PATH", as if it did not exist, and no host named."""
     (seq,) = [s for s in find_sequences(data) if s.name == "walk"]
     job = Job(seq.name, _track_unseen, (seq, TrackOptions(config=_config())), seq.files)
-    summary = run_jobs([job], tmp_path / "out", kind="track", settings={}, client=client)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        summary = run_jobs([job], tmp_path / "out", kind="track", settings={}, client=client)
+    # tried on each worker (none sees it), each named once
+    workers = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    assert sorted(re.findall(r"the worker (\S+) cannot see", str([w.message for w in caught]))) == (
+        workers
+    )
     (entry,) = summary.entries
     host = socket.gethostname()
     assert entry["status"] == "failed" and entry["host"] == host
@@ -3175,6 +3313,79 @@ def test_a_path_a_worker_cannot_see_is_said_so(data: Path, client: Any, tmp_path
     job = Job("gone", _track_unseen, (gone, TrackOptions(config=_config())), gone.files)
     (entry,) = run_jobs([job], tmp_path / "o2", kind="track", settings={}, client=client).entries
     assert entry["error"] == f"video source not found: {gone.frames}" and entry["host"] == host
+
+
+def _blind_to(prefix: str | None) -> None:
+    """On a worker: every path under `prefix` is not found (a share not mounted there; None:
+    undo)."""
+    if not hasattr(os, "_real_stat"):
+        os._real_stat = os.stat  # type: ignore[attr-defined]
+    real = os._real_stat  # type: ignore[attr-defined]
+
+    def stat(path: Any, *args: Any, **kwargs: Any) -> Any:
+        if prefix is not None and os.fsdecode(path).startswith(prefix):
+            raise FileNotFoundError(2, "No such file or directory", os.fsdecode(path))
+        return real(path, *args, **kwargs)
+
+    os.stat = stat if prefix is not None else real
+
+
+def test_a_worker_that_cannot_see_the_inputs_hands_its_tasks_to_the_others(
+    data: Path, client: Any, tmp_path: Path
+) -> None:
+    """A trial: a worker that could not see the inputs (started in another mount namespace)
+    failed every task it was given, fast, and so took most of the queue while the good ones
+    idled. Its tasks now go to the other workers, and it is named once; a sequence that no
+    worker can see still fails, as before."""
+    blind, good = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    options = TrackOptions(config=_config())
+    assert client.run(_blind_to, str(data), workers=[blind])
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            summary = track_many(data, tmp_path / "out", client, options=options)
+        assert [e["status"] for e in summary.entries] == ["done"] * 3, summary.table()
+        address = client.scheduler.address
+        said = [str(w.message) for w in caught]
+        (one,) = said  # named once, however many of its tasks it was given
+        assert re.fullmatch(
+            rf"the scheduler at {re.escape(address)}: the worker {re.escape(blind)} cannot see "
+            rf"the inputs this process sees \({re.escape(str(data))}/\S+ not found on "
+            rf"{re.escape(socket.gethostname())}\): its tasks go to the other workers \(workers "
+            r"must see the same paths\)",
+            one,
+        ), one
+        assert len(_files(tmp_path / "out")) == 3
+        # no worker sees them: each sequence fails as before, its worker named
+        assert client.run(_blind_to, str(data), workers=[good])
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            failed = track_many(data, tmp_path / "o2", client, options=options)
+    finally:
+        client.run(_blind_to, None)
+    host = socket.gethostname()
+    assert [e["status"] for e in failed.entries] == ["failed"] * 3
+    for e in failed.entries:
+        assert e["error"] == (
+            f"{e['source']}: not found on worker {host} (the client sees it: workers must see "
+            "the same paths)"
+        )
+
+
+def test_a_task_sent_to_workers_all_gone_since_is_sent_again(client: Any) -> None:
+    """A task sent away from a blind worker goes to the others only (Dask's ``workers=``): were
+    they all to go, Dask would keep it for them for ever while the watch counts the others."""
+    from pftrack.batch import engine
+
+    (worker, *_) = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    blind = engine._Blind(client, client.scheduler.address, lambda job, outcome: None)
+    sent = {"gone": {"tcp://127.0.0.1:1"}, "there": {worker, "tcp://127.0.0.1:1"}}
+    assert blind.stranded(sent) == {"gone"}
+    assert blind.stranded(sent) is None  # once a second at most
+    job = Job("j", track_sequence_stub, (), ())
+    assert blind.others(job) == set(client.scheduler_info(n_workers=-1)["workers"])
+    blind.tried["j"] = blind.others(job) or set()
+    assert blind.others(job) is None  # every worker tried: the task fails
 
 
 def _worker_sees_other_files(grown: int) -> None:

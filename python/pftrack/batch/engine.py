@@ -124,7 +124,8 @@ class BatchSummary:
     seconds : float
         Wall time of the batch (cluster start included).
     workers : int
-        Workers that ran it (0: in this process).
+        Workers that ran its tasks, those that joined mid-run included (0: in this process);
+        where no task came back from any, the workers the cluster had at the start.
     scheduler : str or None
         Address of the Dask scheduler, as given (``--scheduler``, ``DASK_SCHEDULER_ADDRESS``),
         else as Dask reports it (None: in this process).
@@ -132,8 +133,9 @@ class BatchSummary:
         The settings every task ran with.
     unwritten : str or None
         Why ``out_dir/summary.json`` could not be written at the end (a full disk, a folder
-        made read-only meanwhile), else None: the tasks' outputs written stay, and this is the
-        run's only record (``pftrack`` prints its table and exits with status 1).
+        made read-only meanwhile, the folder removed: then the outputs lost with it are named),
+        else None: the tasks' outputs written stay, and this is the run's only record
+        (``pftrack`` prints its table and exits with status 1).
     """
 
     kind: str
@@ -1525,6 +1527,8 @@ class Outcome(NamedTuple):
     release : str or None
         On a Dask worker: its pftrack release, which the client compares with its own (a
         worker that joined after :func:`check_pftrack` ran may run another).
+    worker : str or None
+        On a Dask worker: its address (the summary counts the workers that ran tasks).
     """
 
     result: TaskResult | None
@@ -1534,6 +1538,17 @@ class Outcome(NamedTuple):
     missing: str | None = None
     seen: list[dict[str, Any]] | None = None
     release: str | None = None
+    worker: str | None = None
+
+
+def _worker_address() -> str | None:
+    """The address of the Dask worker running this task, or None (not on a worker)."""
+    try:
+        from distributed import get_worker
+
+        return str(get_worker().address)
+    except (ImportError, ValueError, AttributeError):
+        return None
 
 
 def _worker_stop() -> Callable[[], None] | None:
@@ -1660,6 +1675,7 @@ def call_task(
     seen = fingerprint(reads) if reads is not None else None
     host = _host() if reads is not None else None
     release = _version() if reads is not None else None
+    worker = _worker_address() if reads is not None else None
     report = _worker_reporter(*progress) if isinstance(progress, tuple) else progress
     stop = _worker_stop()
     with _TASK_WARNINGS.recording() as caught, reporting_frames(report, stop):
@@ -1670,12 +1686,12 @@ def call_task(
             if isinstance(exc, FileNotFoundError):
                 missing = str(exc.filename) if exc.filename else ""
             return Outcome(
-                None, one_line(exc), traceback.format_exc(), _host(), missing, seen, release
+                None, one_line(exc), traceback.format_exc(), _host(), missing, seen, release, worker
             )
     said = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     if said:
         result = dataclasses.replace(result, info={**result.info, "warnings": said})
-    return Outcome(result, host=host, seen=seen, release=release)
+    return Outcome(result, host=host, seen=seen, release=release, worker=worker)
 
 
 def _host() -> str:
@@ -1771,16 +1787,38 @@ def _failure(job: Job, outcome: Outcome, remote: bool) -> str | None:
     ]
     if unreadable:  # was: "Permission denied: DIR/seqinfo.ini", a file that need not exist
         return unreadable[0]
-    if not remote or outcome.missing is None or outcome.host is None or outcome.error is None:
-        return outcome.error
+    unseen = _not_found_there(job, outcome) if remote else None
+    if unseen is None:
+        return outcome.error  # missing here too: the error as the task said it
+    return f"{unseen}: {UNSEEN.format(host=outcome.host)}"
+
+
+def _not_found_there(job: Job, outcome: Outcome) -> Path | None:
+    """The file that the failed task of `outcome` could not find but this process sees, or None."""
+    if outcome.missing is None or outcome.host is None or outcome.error is None:
+        return None
     if outcome.missing:
         named = [Path(outcome.missing)]
     else:  # the path in the message (FrameSource's "video source not found: PATH")
         named = [p for p in (*job.reads, *job.guards) if str(p) in outcome.error]
-    seen = [p for p in named if p.exists()]
-    if not seen:
-        return outcome.error  # missing here too: the error as the task said it
-    return f"{seen[0]}: {UNSEEN.format(host=outcome.host)}"
+    return next((p for p in named if p.exists()), None)
+
+
+def _unseen_input(job: Job, outcome: Outcome, here: list[dict[str, Any]]) -> Path | None:
+    """An input of `job` that the worker of `outcome` could not see but this process sees.
+
+    `here`: the :func:`fingerprint` of ``job.reads`` taken before the tasks ran; the worker's
+    own (``outcome.seen``) says which it could not read, and a failed task which file it could
+    not find. None: the worker saw them all (or the task is not a Dask worker's).
+    """
+    if outcome.worker is None or outcome.host is None:
+        return None
+    seen = outcome.seen or []
+    if len(seen) == len(here):
+        for mine, theirs in zip(here, seen, strict=True):
+            if theirs.get("missing") and not mine.get("missing") and Path(mine["path"]).exists():
+                return Path(mine["path"])
+    return _not_found_there(job, outcome) if outcome.result is None else None
 
 
 #: How the messages name the output folder and a rendered video: the Python parameters
@@ -2042,9 +2080,12 @@ def run_jobs(
     remote = False  # the tasks run on Dask workers: set once connected
     touched = False  # --out created (summary.json is written on the way out, whatever happens)
     written = 0  # tasks whose outputs this run wrote
+    ran: set[str] = set()  # the workers that ran tasks (was: the count at the start alone)
 
     def record(job: Job, outcome: Outcome) -> None:
         nonlocal written
+        if outcome.worker is not None:
+            ran.add(outcome.worker)
         other = _other_release(outcome) if remote else None
         if other is None and remote:
             other = _seen_otherwise(job, outcome, prints[job.name])
@@ -2105,14 +2146,16 @@ def run_jobs(
                 frames = stack.enter_context(_Frames(pending, desc, show_progress))
             _make_out_dir(out)
             stack.enter_context(_held(out))  # until summary.json is written
+            made = _file_id(out)  # the folder written into: removed meanwhile, said at the end
             touched = True
             try:
                 if c is not None:
                     wait = no_workers_timeout()
                     where = summary.scheduler or "?"
                     _run_on_dask(
-                        c, pending, record, summary.kind, bar, frames, where, wait, unusable
-                    )
+                        c, pending, record, summary.kind, bar, frames, where, wait, unusable,
+                        lambda job, outcome: _unseen_input(job, outcome, prints[job.name]),
+                    )  # fmt: skip
                 elif frames is not None:
                     for job in pending:
                         with _no_bars():
@@ -2129,9 +2172,12 @@ def run_jobs(
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
                 summary.entries = [entries[job.name] for job in jobs]
                 summary.seconds = time.perf_counter() - start
+                summary.workers = len(ran) or summary.workers
                 try:
-                    with atomic_write(out / SUMMARY_NAME) as fh:
-                        fh.write(summary.to_json() + "\n")
+                    summary.unwritten = _out_removed(out, made, summary)
+                    if summary.unwritten is None:
+                        with atomic_write(out / SUMMARY_NAME) as fh:
+                            fh.write(summary.to_json() + "\n")
                 except OSError as exc:  # was: exit status 2 with this error alone, no table
                     summary.unwritten = (
                         f"{out / SUMMARY_NAME} not written ({exc.strerror or one_line(exc)}); "
@@ -2141,6 +2187,36 @@ def run_jobs(
         _say_interrupted(exc, out, kind, written if touched else None)
         raise
     return summary
+
+
+def _out_removed(out: Path, made: tuple[int, int] | None, summary: BatchSummary) -> str | None:
+    """Why `summary` is not written: `out` (`made` its file id) was removed meanwhile; or None.
+
+    The outputs of the entries done or skipped that are not there now are named, lost. Was: the
+    last line said "the outputs written before it are complete", of files gone with the folder;
+    and a folder made again meanwhile (``rm -r out; mkdir out``) got a ``summary.json`` whose
+    entries said ``done`` of outputs not there.
+    """
+    now = _file_id(out)
+    if made is None or now == made:
+        return None
+    another = " (the folder there now is another one)" if now is not None else ""
+    lost = [
+        e["name"]
+        for e in summary.entries
+        if e["status"] in ("done", "skipped") and not _sidecar(out, e["name"]).exists()
+    ]  # those written into a folder made again meanwhile are there
+    noun = "sequence" if summary.kind == "track" else "file"
+    if lost:
+        shown = ", ".join(lost[:3]) + (", ..." if len(lost) > 3 else "")
+        what = f"the outputs of {counted(len(lost), noun)} ({shown}) went with it, and "
+    else:
+        what = "no output had been written in it; "
+    again = " to make them again" if lost else ""
+    return (
+        f"{_OUT_NAMES.get()[0]} {out} was removed while the batch ran{another}: {what}"
+        f"{SUMMARY_NAME} is not written; re-run the batch{again}"
+    )
 
 
 def _check_arguments(out_dir: object, n_workers: object, force: object, show: object) -> None:
@@ -2468,6 +2544,27 @@ class _WorkersWatch:
             )
         return now - self.since >= self.wait
 
+    def killed(self, exc: BaseException, noun: str) -> str | None:
+        """The error of a task that Dask's ``KilledWorker`` failed on a worker without pftrack.
+
+        Such a worker (restarted by its nanny after pftrack was removed from its environment,
+        or started without it) dies on every task it is given, and the task failed with Dask's
+        generic "Attempted to run task ... on 4 different workers"; None: `exc` is no
+        ``KilledWorker``, or its last worker is not one that said it cannot import pftrack.
+        """
+        if type(exc).__name__ != "KilledWorker":
+            return None
+        worker = getattr(getattr(exc, "last_worker", None), "address", None)
+        if worker is None or str(worker) not in self.unusable:
+            return None
+        failures = getattr(exc, "allowed_failures", None)
+        last = f", the last of {failures + 1} workers that did" if isinstance(failures, int) else ""
+        return (
+            f"pftrack missing on worker {worker} ({self.unusable[str(worker)]}): it joined "
+            f"without pftrack (restarted by its nanny after pftrack was removed?) and died on "
+            f"this {noun}{last} (Dask's KilledWorker); {INSTALL_EVERYWHERE}"
+        )
+
     def error(self, noun: str) -> str:
         """The error of a task left waiting when :meth:`given_up`."""
         if self.frozen:
@@ -2619,6 +2716,74 @@ def _not_utf8(job: Job) -> str | None:
     return None
 
 
+def _worker_addresses(c: Client) -> set[str] | None:
+    """The addresses of the scheduler's workers now (None: it did not answer in time)."""
+    rpc = c.scheduler
+    if rpc is None:
+        return None
+    try:
+        info = c.sync(rpc.identity, n_workers=-1, callback_timeout=ANSWER_WAIT)
+    except Exception:  # noqa: BLE001 - frozen, gone, or an older Dask: the task fails as it did
+        return None
+    return set(info.get("workers") or {})
+
+
+class _Blind:
+    """Where to send again the tasks of workers that could not see their inputs.
+
+    A worker that cannot see the inputs (another mount namespace, a share not mounted there)
+    fails every task it is given, fast, so it took most of the queue while the good workers
+    idled, and each of those sequences failed. Such a task goes again to the workers that have
+    not failed to see its inputs (Dask's ``workers=`` restriction), and the worker is named
+    once (a warning). The task fails, as before, once no worker is left to try.
+    """
+
+    def __init__(self, c: Client, address: str, unseen: Callable[[Job, Outcome], Path | None]):
+        self.c, self.address, self.unseen = c, address, unseen
+        self.tried: dict[str, set[str]] = {}  # job name -> the workers that could not see it
+        self.last: dict[str, Outcome] = {}  # job name -> the latest such outcome
+        self.named: set[str] = set()
+        self._checked = -math.inf
+
+    def elsewhere(self, job: Job, outcome: Outcome) -> set[str] | None:
+        """The workers to send `job` to, its `outcome` from a worker blind to it; or None."""
+        path = self.unseen(job, outcome)
+        if path is None or outcome.worker is None:
+            return None
+        if outcome.worker not in self.named:
+            self.named.add(outcome.worker)
+            warnings.warn(
+                f"the scheduler at {self.address}: the worker {outcome.worker} cannot see the "
+                f"inputs this process sees ({path} not found on {outcome.host}): its tasks go "
+                "to the other workers (workers must see the same paths)",
+                stacklevel=3,
+            )
+        self.tried.setdefault(job.name, set()).add(outcome.worker)
+        self.last[job.name] = outcome
+        return self.others(job)
+
+    def others(self, job: Job) -> set[str] | None:
+        """The workers there now that have not failed to see `job`'s inputs; None: none."""
+        now = _worker_addresses(self.c)
+        left = None if now is None else now - self.tried.get(job.name, set())
+        return left or None
+
+    def stranded(self, sent: dict[Any, set[str]]) -> set[Any] | None:
+        """The keys of `sent` (key -> the workers it may run on) whose workers are all gone.
+
+        Checked once a second at most; None meanwhile. Such a task would wait for ever (Dask
+        keeps it for those workers), as the watch of the workers counts the others.
+        """
+        now = time.monotonic()
+        if not sent or now - self._checked < WORKERS_POLL:
+            return None
+        self._checked = now
+        there = _worker_addresses(self.c)
+        if there is None:
+            return None
+        return {key for key, allowed in sent.items() if not allowed & there}
+
+
 def _run_on_dask(
     c: Client,
     pending: Sequence[Job],
@@ -2629,13 +2794,15 @@ def _run_on_dask(
     address: str = "?",
     wait: float = NO_WORKERS_WAIT,
     unusable: dict[str, str] | None = None,
+    unseen: Callable[[Job, Outcome], Path | None] | None = None,
 ) -> None:
     """Submit `pending` to Dask and record each result as it completes.
 
     With `frames`, the tasks' frame counts come as Dask events on a topic of this run. A
     cluster without workers for `wait` seconds (at `address`) fails the tasks left; the
     workers that joined but cannot import pftrack (`unusable`, from :func:`_setup_failures`)
-    are named then, and as they come.
+    are named then, and as they come. With `unseen` (the input a task's worker could not see,
+    :func:`_unseen_input`), such a task goes to the other workers (:class:`_Blind`).
     """
     from distributed import as_completed
 
@@ -2653,17 +2820,46 @@ def _run_on_dask(
             record(job, Outcome(None, unsent))
     bar = {**bar, "total": len(sendable)}
     watch = _WorkersWatch(c, address, wait, unusable)
+    blind = _Blind(c, address, unseen) if unseen is not None else None
     futures = {}
-    for job in sendable:
+    sent: dict[Any, set[str]] = {}  # the keys sent to some workers only: key -> those workers
+
+    def submit(job: Job, workers: set[str] | None = None) -> Any:
         key = f"pftrack-{kind}-{job.name}-{os.urandom(4).hex()}"
         where = (topic, job.name) if frames is not None else None
-        fut = c.submit(call_task, job.func, job.args, where, job.reads, key=key, pure=False)
+        fut = c.submit(
+            call_task, job.func, job.args, where, job.reads, key=key, pure=False,
+            workers=sorted(workers) if workers else None,
+        )  # fmt: skip
         futures[fut.key] = (fut, job)
+        if workers:
+            sent[fut.key] = workers
+        return fut
+
+    for job in sendable:
+        submit(job)
     noun = "sequence" if kind == "track" else "file"
     tracked = as_completed([f for f, _ in futures.values()])
-    done = _completed(tracked, watch.given_up)
+
+    def given_up() -> bool:  # and the tasks sent to workers all gone since: to the others
+        for key in (blind.stranded(sent) if blind is not None else None) or ():
+            fut, job = futures.pop(key)
+            del sent[key]
+            fut.cancel()
+            workers = blind.others(job) if blind is not None else None
+            if workers:
+                tracked.add(submit(job, workers))
+            else:
+                if frames is not None:
+                    frames.finish(job.name)
+                record(job, blind.last[job.name] if blind is not None else Outcome(None))
+        return watch.given_up()
+
+    done = _completed(tracked, given_up)
     try:
         for fut in progress(done, **bar) if frames is None else done:
+            if fut.key not in futures:  # cancelled and sent again (its workers gone)
+                continue
             status = fut.status
             if status not in ("finished", "error", "cancelled"):
                 # finished, then its result lost with its worker before it was taken: Dask
@@ -2671,15 +2867,25 @@ def _run_on_dask(
                 tracked.add(fut)
                 continue
             _, job = futures.pop(fut.key)
+            sent.pop(fut.key, None)
+            outcome = fut.result() if status == "finished" else None
+            workers = (
+                blind.elsewhere(job, outcome) if blind is not None and outcome is not None else None
+            )
+            if workers:  # its worker could not see its inputs: to the others
+                tracked.add(submit(job, workers))
+                fut.release()
+                continue
             if frames is not None:
                 frames.finish(job.name)
-            if status == "finished":
-                record(job, fut.result())
+            if outcome is not None:
+                record(job, outcome)
             elif status == "error":  # the worker died (KilledWorker) or the like
                 exc = fut.exception()
                 # the scheduler's own no-workers-timeout: said as this process's watch says it
                 lost = type(exc).__name__ == "NoWorkerError"
-                record(job, Outcome(None, watch.error(noun) if lost else one_line(exc)))
+                error = watch.error(noun) if lost else watch.killed(exc, noun) or one_line(exc)
+                record(job, Outcome(None, error))
             elif status == "cancelled" and _connection_lost(c, fut):  # Dask cancels them all
                 record(job, Outcome(None, _scheduler_lost(address, noun)))
             fut.release()  # cancelled (by another client): left "cancelled" in the summary
