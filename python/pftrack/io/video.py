@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import configparser
 import errno
+import hashlib
 import itertools
 import operator
 import os
@@ -34,7 +35,7 @@ import re
 import stat
 import threading
 import warnings
-from collections.abc import Collection, Generator, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from decimal import Decimal
@@ -177,10 +178,32 @@ def _fourcc(cap: cv2.VideoCapture) -> str:
     return code.to_bytes(4, "little").decode("latin-1")
 
 
-def _same_frames(a: list[tuple[NDArray[Any], float]], b: list[tuple[NDArray[Any], float]]) -> bool:
-    """Whether two reads gave the same frames: the same pixels and the same time stamps."""
+#: What :meth:`FrameSource.frames_at` makes of each frame it keeps (``prepare``).
+_Prepare = Callable[[NDArray[np.uint8]], NDArray[np.uint8]]
+
+
+def _as_read(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """`frame` itself: :meth:`FrameSource.frames_at` without a ``prepare``."""
+    return frame
+
+
+def _frame_digest(frame: NDArray[Any]) -> bytes:
+    """A digest of `frame`'s shape, type and pixels: what :func:`_same_frames` compares.
+
+    Kept instead of the frame itself, which at 4K is 25 MB (a split pass held four).
+    """
+    digest = hashlib.blake2b(repr((frame.shape, frame.dtype.str)).encode())
+    digest.update(np.ascontiguousarray(frame).data)
+    return digest.digest()
+
+
+def _same_frames(a: list[tuple[bytes, float]], b: list[tuple[bytes, float]]) -> bool:
+    """Whether two reads gave the same frames: the same pixels and the same time stamps.
+
+    The frames by their :func:`_frame_digest`.
+    """
     return len(a) == len(b) and all(
-        ta == tb and np.array_equal(fa, fb) for (fa, ta), (fb, tb) in zip(a, b, strict=True)
+        ta == tb and fa == fb for (fa, ta), (fb, tb) in zip(a, b, strict=True)
     )
 
 
@@ -1631,7 +1654,13 @@ class FrameSource:
         finally:
             frames.close()  # a video file's capture is released now, not when collected
 
-    def frames_at(self, indices: Iterable[int], *, split: bool = False) -> list[NDArray[np.uint8]]:
+    def frames_at(
+        self,
+        indices: Iterable[int],
+        *,
+        split: bool = False,
+        prepare: Callable[[NDArray[np.uint8]], NDArray[np.uint8]] | None = None,
+    ) -> list[NDArray[np.uint8]]:
         """The frames at 0-based `indices` (in increasing order, each once), read in one pass.
 
         The same pixels as iterating and keeping those frames: a folder reads only those
@@ -1646,6 +1675,9 @@ class FrameSource:
         first two frames are the first half's, pixel for pixel and time stamp for time stamp;
         otherwise the first half reads on, so the frames are those of the plain pass either way.
 
+        With `prepare`, each frame is passed to it as it is read and its result kept instead
+        (``Tracker.working_frame``: the frames are held at the working size, not their own).
+
         Raises
         ------
         ValueError
@@ -1658,56 +1690,59 @@ class FrameSource:
             raise ValueError(f"live source {self.name} cannot be read at chosen frames")
         if not wanted:
             return []
+        keep = prepare if prepare is not None else _as_read
         if self._images is not None:
             out = []
             for i in (i for i in wanted if i < len(self._images)):
-                out.append(self._read_image(self._images[i]))
+                out.append(keep(self._read_image(self._images[i])))
             return out
         try:
-            return self._file_frames_at(wanted, split)
+            return self._file_frames_at(wanted, split, keep)
         except _DamagedInside:
             # a frame inside the video failed to decode, which ends a pass of grabs: read as
             # iterating reads (the frame before stands in, the later frames keep their
             # numbers), not fewer frames (was: the spread bootstrap's frames all before it)
-            return self._iterated_at(wanted)
+            return self._iterated_at(wanted, keep)
 
-    def _iterated_at(self, wanted: list[int]) -> list[NDArray[np.uint8]]:
+    def _iterated_at(self, wanted: list[int], keep: _Prepare) -> list[NDArray[np.uint8]]:
         """The frames at `wanted` (increasing) as iterating the file gives them, stand-ins too."""
-        keep, out = set(wanted), []
+        kept, out = set(wanted), []
         frames = self._iter_stored()
         try:
             for i, frame in enumerate(frames):
-                if i in keep:
-                    out.append(frame)
+                if i in kept:
+                    out.append(keep(frame))
                 if i >= wanted[-1]:
                     break
         finally:
             frames.close()
         return out
 
-    def _file_frames_at(self, wanted: list[int], split: bool) -> list[NDArray[np.uint8]]:
+    def _file_frames_at(
+        self, wanted: list[int], split: bool, keep: _Prepare
+    ) -> list[NDArray[np.uint8]]:
         """:meth:`frames_at` of a video file, in one pass of grabs (two with `split`)."""
         cap = _file_capture(str(self.path))
         try:
             middle = wanted[len(wanted) // 2]
             if not split or len(wanted) < 4 or middle < 2:
-                return self._read_at(cap, 0, wanted)[0]
+                return self._read_at(cap, 0, wanted, prepare=keep)[0]
             first = [i for i in wanted if i <= middle + 1]
             # an interrupt (Ctrl-C; SIGTERM, raised here by pftrack.cli._signals) stops the
             # second half at its next frame: the pool's join waited for it to read its whole
             # half (minutes of a long video), SIGTERM ignored meanwhile
             halt = threading.Event()
             with ThreadPoolExecutor(1, thread_name_prefix="pftrack-bootstrap") as pool:
-                tail = pool.submit(self._read_from_seek, middle, wanted, halt)
+                tail = pool.submit(self._read_from_seek, middle, wanted, halt, prepare=keep)
                 try:
-                    head, check, at = self._read_at(cap, 0, first, middle)
+                    head, check, at = self._read_at(cap, 0, first, middle, prepare=keep)
                     second = tail.result()
                 except BaseException:
                     halt.set()
                     raise
             if second is not None and len(check) == 2 and _same_frames(check, second[1]):
                 return head[: sum(i < middle for i in first)] + second[0]
-            rest, _, _ = self._read_at(cap, at, [i for i in wanted if i > middle + 1])
+            rest, _, _ = self._read_at(cap, at, [i for i in wanted if i > middle + 1], prepare=keep)
             return head + rest
         finally:
             cap.release()
@@ -1719,16 +1754,19 @@ class FrameSource:
         keep: list[int],
         check: int | None = None,
         halt: threading.Event | None = None,
-    ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]], int]:
+        *,
+        prepare: _Prepare | None = None,
+    ) -> tuple[list[NDArray[np.uint8]], list[tuple[bytes, float]], int]:
         """Read on from frame `start` (where `cap` stands) through the last of `keep`.
 
-        Returns the frames at `keep`, resized; with `check`, the raw frames `check` and
-        `check + 1` with their time stamps (the pass then goes on to them); and the index of
-        the frame `cap` stands at afterwards. Stops early, before its next frame, once
+        Returns the frames at `keep`, resized (and passed through `prepare`); with `check`,
+        the digests (:func:`_frame_digest`) of the raw frames `check` and `check + 1` with
+        their time stamps (the pass then goes on to them); and the index of the frame `cap`
+        stands at afterwards. Stops early, before its next frame, once
         :meth:`stop` is called or `halt` is set.
         """
         picked: list[NDArray[np.uint8]] = []
-        seen: list[tuple[NDArray[Any], float]] = []
+        seen: list[tuple[bytes, float]] = []
         stop = max(keep[-1] if keep else -1, -1 if check is None else check + 1) + 1
         wanted = set(keep)
         i = start
@@ -1739,9 +1777,10 @@ class FrameSource:
                 if not ok:
                     break
                 if i in wanted:
-                    picked.append(self._resize(frame))
+                    resized = self._resize(frame)
+                    picked.append(resized if prepare is None else prepare(resized))
                 if compare:
-                    seen.append((frame, float(cap.get(cv2.CAP_PROP_POS_MSEC))))
+                    seen.append((_frame_digest(frame), float(cap.get(cv2.CAP_PROP_POS_MSEC))))
             elif not cap.grab():
                 break
             i += 1
@@ -1752,8 +1791,13 @@ class FrameSource:
         return picked, seen, i
 
     def _read_from_seek(
-        self, middle: int, wanted: list[int], halt: threading.Event | None = None
-    ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]]] | None:
+        self,
+        middle: int,
+        wanted: list[int],
+        halt: threading.Event | None = None,
+        *,
+        prepare: _Prepare | None = None,
+    ) -> tuple[list[NDArray[np.uint8]], list[tuple[bytes, float]]] | None:
         """The second half of a split pass: frames from `middle` on, after a seek to it.
 
         None when the file cannot seek (or OpenCV fails on it): the first half reads on. Ends
@@ -1764,7 +1808,7 @@ class FrameSource:
             if not cap.set(cv2.CAP_PROP_POS_FRAMES, middle):
                 return None
             keep = [i for i in wanted if i >= middle]
-            picked, seen, _ = self._read_at(cap, middle, keep, middle, halt)
+            picked, seen, _ = self._read_at(cap, middle, keep, middle, halt, prepare=prepare)
             return picked, seen
         except cv2.error:
             return None
