@@ -152,6 +152,37 @@ def _stamped_rate(path: Path) -> float | None:
     return rate if 0 < rate < 1000 else None
 
 
+#: A step between two frames' time stamps more than this share off the median step (and more
+#: than :data:`UNEVEN_MS`) is uneven; :func:`_uneven_steps`.
+UNEVEN_STEP = 0.25
+#: Milliseconds a step may be off the median in any case (stamps in whole milliseconds: a
+#: 29.97 fps video's steps are 33 and 34 ms).
+UNEVEN_MS = 1.5
+#: The share of uneven steps that makes a variable frame rate (one dropped frame in 40 does not).
+UNEVEN_SHARE = 0.05
+
+
+def _uneven_steps(stamps: Sequence[float]) -> tuple[float, float, float] | None:
+    """The smallest, median and largest steps (ms) between `stamps` if they are clearly uneven.
+
+    The steps between consecutive increasing stamps (a decoder's last frames, flushed, may say
+    0: PETS09's) are uneven when more than :data:`UNEVEN_SHARE` of them are more than
+    :data:`UNEVEN_STEP` of the median step off it (and more than :data:`UNEVEN_MS`): a
+    variable-frame-rate video's (a phone's: 100 and 200 ms), not a constant rate in whole
+    milliseconds nor one frame dropped now and then. None otherwise, and with fewer than 10
+    steps.
+    """
+    steps = np.diff(np.asarray(stamps, dtype=np.float64))
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    if len(steps) < 10:
+        return None
+    median = float(np.median(steps))
+    off = np.abs(steps - median) > max(UNEVEN_STEP * median, UNEVEN_MS)
+    if np.count_nonzero(off) <= UNEVEN_SHARE * len(steps):
+        return None
+    return float(steps.min()), median, float(steps.max())
+
+
 def _file_capture(path: str) -> cv2.VideoCapture:
     """A ``cv2.VideoCapture`` of a stored video file whose decoder runs on the calling thread.
 
@@ -1295,6 +1326,7 @@ class FrameSource:
         self._cut_said = False  # a JPEG without its end marker: said once
         self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
+        self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
         self._warned_lost = False  # frames inside the video could not be decoded
         self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
@@ -1830,10 +1862,13 @@ class FrameSource:
         timed = rate > 0  # the frames' time stamps give their indexes, so far
         start = 0  # the first frame's stamp, in frames (PETS09's is 2)
         lost: list[int] = []
+        stamps: list[float] = []  # of the frames decoded, in ms (_uneven_steps)
         last: NDArray[np.uint8] | None = None
         try:
             while True:
                 ok, frame = cap.read()
+                if ok:
+                    stamps.append(float(cap.get(cv2.CAP_PROP_POS_MSEC)))
                 # a frame's number is its place in the decoded order, as a detector's loop
                 # counts it; the stamps only say, after a frame that fails, where to go on
                 if ok and timed:
@@ -1871,6 +1906,30 @@ class FrameSource:
             )
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded)
+        if not self._warned_uneven:
+            self._warn_uneven(stamps)
+
+    def _warn_uneven(self, stamps: list[float]) -> None:
+        """Warn, once, if a video read to its end has a variable frame rate (:func:`_uneven_steps`).
+
+        Only when its rate came from the file (or the default): a rate given or a sequence's is
+        the one its frames are meant to have.
+        """
+        self._warned_uneven = True  # the stamps of one whole read decide, once
+        uneven = _uneven_steps(stamps)
+        if uneven is None or self.fps_origin in ("given", "seqinfo.ini"):
+            return
+        lo, median, hi = uneven
+        origin = {"container": "the header's", "time stamps": "from its first frames' stamps"}
+        warnings.warn(
+            f"{self.path}: variable frame rate: its frames are {lo:.3g} to {hi:.3g} ms apart "
+            f"(median {median:.3g} ms), but it is read at one rate, {self.fps:g} fps "
+            f"({origin.get(self.fps_origin, self.fps_origin)}): a video rendered from it plays "
+            "its frames evenly spaced at that rate, and the tracker takes each step between "
+            "frames as one frame's (give the rate to render at with --fps)",
+            UserWarning,
+            stacklevel=3,
+        )
 
     def _warn_frame_count(self, decoded: int) -> None:
         """Warn, once, if a video read to its end had other than its header's or seqLength's frames.
