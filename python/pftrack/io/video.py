@@ -183,6 +183,38 @@ def _uneven_steps(stamps: Sequence[float]) -> tuple[float, float, float] | None:
     return float(steps.min()), median, float(steps.max())
 
 
+def _import_av() -> Any:
+    """PyAV (``import av``), or None where it cannot be imported."""
+    try:
+        import av
+    except ImportError:
+        return None
+    return av
+
+
+def _video_streams(path: Path) -> list[str]:
+    """The video streams of file `path` as ``#1 (h264 1920x1080)``, in the file's order.
+
+    From its container's header, through PyAV (a pftrack dependency, with FFmpeg as OpenCV's;
+    OpenCV itself says neither how many there are nor which it reads: it opens no file with
+    ``CAP_PROP_VIDEO_STREAM`` set, and reads the first video stream). Cover art (an attached
+    picture) is no stream of frames. Empty where PyAV is missing or cannot open the file.
+    """
+    av = _import_av()
+    if av is None:
+        return []
+    try:
+        with av.open(str(path)) as container:
+            return [
+                f"#{s.index} ({s.codec_context.name} {s.codec_context.width}x"
+                f"{s.codec_context.height})"
+                for s in container.streams.video
+                if not s.disposition & av.stream.Disposition.attached_pic
+            ]
+    except (av.FFmpegError, OSError, ValueError):
+        return []
+
+
 def _file_capture(path: str) -> cv2.VideoCapture:
     """A ``cv2.VideoCapture`` of a stored video file whose decoder runs on the calling thread.
 
@@ -1289,6 +1321,9 @@ class FrameSource:
         an image it was not decided from is brighter than that depth holds (its brighter
         pixels clipped to white). When an ``.avi`` is opened whose chunks break off inside it
         (:func:`_avi_break`): the frames after the break may carry earlier frames' numbers.
+        When a video file of several video streams is opened (:func:`_video_streams`): the
+        first is read. Once, when a video read to its end has clearly uneven time stamps and
+        a rate from the file (:func:`_uneven_steps`): a variable frame rate read as one.
 
     Notes
     -----
@@ -1360,6 +1395,17 @@ class FrameSource:
             else:
                 first, header_fps, count, self.rotation = self._probe_file(self.path)
                 self._broken = _avi_break(self.path)
+                streams = _video_streams(self.path)
+                if len(streams) > 1:  # OpenCV reads the first, without a word
+                    warnings.warn(
+                        f"{self.name}: holds {len(streams)} video streams; the first, "
+                        f"{streams[0]}, is read (OpenCV reads no other), not "
+                        f"{', '.join(streams[1:])}: to track another, copy it to a file of "
+                        "its own first (ffmpeg -i FILE -map 0:v:1 -c copy OUT.mkv: the "
+                        "second)",
+                        UserWarning,
+                        stacklevel=2,
+                    )
         if self._broken is not None:  # before any work: said once for each source opened
             frames, offset = self._broken
             warnings.warn(
