@@ -928,16 +928,43 @@ def test_a_split_pass_whose_seek_goes_wrong_reads_on_from_the_first_half(
     seek = FrameSource._read_from_seek
 
     def wrong(
-        self: FrameSource, middle: int, wanted: list[int], halt: threading.Event | None = None
+        self: FrameSource,
+        middle: int,
+        wanted: list[int],
+        halt: threading.Event | None = None,
+        **options: Any,
     ) -> object:
         # a container whose seek lands one frame late, or that cannot seek at all
-        return seek(self, middle + 1, wanted, halt) if fault == "late" else None
+        return seek(self, middle + 1, wanted, halt, **options) if fault == "late" else None
 
     monkeypatch.setattr(FrameSource, "_read_from_seek", wrong)
     got = src.frames_at(spread, split=True)
     assert len(got) == len(plain) == len(spread)
     for a, b in zip(got, plain, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("split", [False, True])
+def test_frames_at_keeps_what_prepare_makes_of_each_frame(tmp_path: Path, split: bool) -> None:
+    """The spread bootstrap of a 4K video held its 30 frames at their own size (750 MB) until
+    the tracker scaled them: ``frames_at(prepare=...)`` keeps each frame's scaled copy alone,
+    made as it is read (the pass's own check of its two halves keeps digests, not frames)."""
+    path = _mjpg(tmp_path / "v.avi", 30, np.random.default_rng(6))
+    src = FrameSource(path)
+    spread = [0, 4, 9, 14, 15, 16, 22, 29]
+    plain = src.frames_at(spread)
+    made: list[tuple[int, ...]] = []
+
+    def prepare(frame: np.ndarray) -> np.ndarray:
+        made.append(frame.shape)
+        return cv2.resize(frame, (16, 12), interpolation=cv2.INTER_AREA)
+
+    got = src.frames_at(spread, split=split, prepare=prepare)
+    # the frames at the split both halves read are made twice
+    assert set(made) == {(48, 64, 3)} and len(spread) <= len(made) <= len(spread) + 2
+    assert len(got) == len(plain)
+    for a, b in zip(got, plain, strict=True):
+        np.testing.assert_array_equal(a, cv2.resize(b, (16, 12), interpolation=cv2.INTER_AREA))
 
 
 def test_a_split_pass_whose_seek_raises_reads_on_from_the_first_half(

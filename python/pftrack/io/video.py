@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import configparser
 import errno
+import hashlib
 import itertools
 import operator
 import os
@@ -34,7 +35,7 @@ import re
 import stat
 import threading
 import warnings
-from collections.abc import Collection, Generator, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from decimal import Decimal
@@ -151,6 +152,69 @@ def _stamped_rate(path: Path) -> float | None:
     return rate if 0 < rate < 1000 else None
 
 
+#: A step between two frames' time stamps more than this share off the median step (and more
+#: than :data:`UNEVEN_MS`) is uneven; :func:`_uneven_steps`.
+UNEVEN_STEP = 0.25
+#: Milliseconds a step may be off the median in any case (stamps in whole milliseconds: a
+#: 29.97 fps video's steps are 33 and 34 ms).
+UNEVEN_MS = 1.5
+#: The share of uneven steps that makes a variable frame rate (one dropped frame in 40 does not).
+UNEVEN_SHARE = 0.05
+
+
+def _uneven_steps(stamps: Sequence[float]) -> tuple[float, float, float] | None:
+    """The smallest, median and largest steps (ms) between `stamps` if they are clearly uneven.
+
+    The steps between consecutive increasing stamps (a decoder's last frames, flushed, may say
+    0: PETS09's) are uneven when more than :data:`UNEVEN_SHARE` of them are more than
+    :data:`UNEVEN_STEP` of the median step off it (and more than :data:`UNEVEN_MS`): a
+    variable-frame-rate video's (a phone's: 100 and 200 ms), not a constant rate in whole
+    milliseconds nor one frame dropped now and then. None otherwise, and with fewer than 10
+    steps.
+    """
+    steps = np.diff(np.asarray(stamps, dtype=np.float64))
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    if len(steps) < 10:
+        return None
+    median = float(np.median(steps))
+    off = np.abs(steps - median) > max(UNEVEN_STEP * median, UNEVEN_MS)
+    if np.count_nonzero(off) <= UNEVEN_SHARE * len(steps):
+        return None
+    return float(steps.min()), median, float(steps.max())
+
+
+def _import_av() -> Any:
+    """PyAV (``import av``), or None where it cannot be imported."""
+    try:
+        import av
+    except ImportError:
+        return None
+    return av
+
+
+def _video_streams(path: Path) -> list[str]:
+    """The video streams of file `path` as ``#1 (h264 1920x1080)``, in the file's order.
+
+    From its container's header, through PyAV (a pftrack dependency, with FFmpeg as OpenCV's;
+    OpenCV itself says neither how many there are nor which it reads: it opens no file with
+    ``CAP_PROP_VIDEO_STREAM`` set, and reads the first video stream). Cover art (an attached
+    picture) is no stream of frames. Empty where PyAV is missing or cannot open the file.
+    """
+    av = _import_av()
+    if av is None:
+        return []
+    try:
+        with av.open(str(path)) as container:
+            return [
+                f"#{s.index} ({s.codec_context.name} {s.codec_context.width}x"
+                f"{s.codec_context.height})"
+                for s in container.streams.video
+                if not s.disposition & av.stream.Disposition.attached_pic
+            ]
+    except (av.FFmpegError, OSError, ValueError):
+        return []
+
+
 def _file_capture(path: str) -> cv2.VideoCapture:
     """A ``cv2.VideoCapture`` of a stored video file whose decoder runs on the calling thread.
 
@@ -177,10 +241,32 @@ def _fourcc(cap: cv2.VideoCapture) -> str:
     return code.to_bytes(4, "little").decode("latin-1")
 
 
-def _same_frames(a: list[tuple[NDArray[Any], float]], b: list[tuple[NDArray[Any], float]]) -> bool:
-    """Whether two reads gave the same frames: the same pixels and the same time stamps."""
+#: What :meth:`FrameSource.frames_at` makes of each frame it keeps (``prepare``).
+_Prepare = Callable[[NDArray[np.uint8]], NDArray[np.uint8]]
+
+
+def _as_read(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """`frame` itself: :meth:`FrameSource.frames_at` without a ``prepare``."""
+    return frame
+
+
+def _frame_digest(frame: NDArray[Any]) -> bytes:
+    """A digest of `frame`'s shape, type and pixels: what :func:`_same_frames` compares.
+
+    Kept instead of the frame itself, which at 4K is 25 MB (a split pass held four).
+    """
+    digest = hashlib.blake2b(repr((frame.shape, frame.dtype.str)).encode())
+    digest.update(np.ascontiguousarray(frame).data)
+    return digest.digest()
+
+
+def _same_frames(a: list[tuple[bytes, float]], b: list[tuple[bytes, float]]) -> bool:
+    """Whether two reads gave the same frames: the same pixels and the same time stamps.
+
+    The frames by their :func:`_frame_digest`.
+    """
     return len(a) == len(b) and all(
-        ta == tb and np.array_equal(fa, fb) for (fa, ta), (fb, tb) in zip(a, b, strict=True)
+        ta == tb and fa == fb for (fa, ta), (fb, tb) in zip(a, b, strict=True)
     )
 
 
@@ -1235,6 +1321,9 @@ class FrameSource:
         an image it was not decided from is brighter than that depth holds (its brighter
         pixels clipped to white). When an ``.avi`` is opened whose chunks break off inside it
         (:func:`_avi_break`): the frames after the break may carry earlier frames' numbers.
+        When a video file of several video streams is opened (:func:`_video_streams`): the
+        first is read. Once, when a video read to its end has clearly uneven time stamps and
+        a rate from the file (:func:`_uneven_steps`): a variable frame rate read as one.
 
     Notes
     -----
@@ -1272,6 +1361,7 @@ class FrameSource:
         self._cut_said = False  # a JPEG without its end marker: said once
         self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
+        self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
         self._warned_lost = False  # frames inside the video could not be decoded
         self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
@@ -1305,6 +1395,17 @@ class FrameSource:
             else:
                 first, header_fps, count, self.rotation = self._probe_file(self.path)
                 self._broken = _avi_break(self.path)
+                streams = _video_streams(self.path)
+                if len(streams) > 1:  # OpenCV reads the first, without a word
+                    warnings.warn(
+                        f"{self.name}: holds {len(streams)} video streams; the first, "
+                        f"{streams[0]}, is read (OpenCV reads no other), not "
+                        f"{', '.join(streams[1:])}: to track another, copy it to a file of "
+                        "its own first (ffmpeg -i FILE -map 0:v:1 -c copy OUT.mkv: the "
+                        "second)",
+                        UserWarning,
+                        stacklevel=2,
+                    )
         if self._broken is not None:  # before any work: said once for each source opened
             frames, offset = self._broken
             warnings.warn(
@@ -1631,7 +1732,13 @@ class FrameSource:
         finally:
             frames.close()  # a video file's capture is released now, not when collected
 
-    def frames_at(self, indices: Iterable[int], *, split: bool = False) -> list[NDArray[np.uint8]]:
+    def frames_at(
+        self,
+        indices: Iterable[int],
+        *,
+        split: bool = False,
+        prepare: Callable[[NDArray[np.uint8]], NDArray[np.uint8]] | None = None,
+    ) -> list[NDArray[np.uint8]]:
         """The frames at 0-based `indices` (in increasing order, each once), read in one pass.
 
         The same pixels as iterating and keeping those frames: a folder reads only those
@@ -1646,6 +1753,9 @@ class FrameSource:
         first two frames are the first half's, pixel for pixel and time stamp for time stamp;
         otherwise the first half reads on, so the frames are those of the plain pass either way.
 
+        With `prepare`, each frame is passed to it as it is read and its result kept instead
+        (``Tracker.working_frame``: the frames are held at the working size, not their own).
+
         Raises
         ------
         ValueError
@@ -1658,56 +1768,59 @@ class FrameSource:
             raise ValueError(f"live source {self.name} cannot be read at chosen frames")
         if not wanted:
             return []
+        keep = prepare if prepare is not None else _as_read
         if self._images is not None:
             out = []
             for i in (i for i in wanted if i < len(self._images)):
-                out.append(self._read_image(self._images[i]))
+                out.append(keep(self._read_image(self._images[i])))
             return out
         try:
-            return self._file_frames_at(wanted, split)
+            return self._file_frames_at(wanted, split, keep)
         except _DamagedInside:
             # a frame inside the video failed to decode, which ends a pass of grabs: read as
             # iterating reads (the frame before stands in, the later frames keep their
             # numbers), not fewer frames (was: the spread bootstrap's frames all before it)
-            return self._iterated_at(wanted)
+            return self._iterated_at(wanted, keep)
 
-    def _iterated_at(self, wanted: list[int]) -> list[NDArray[np.uint8]]:
+    def _iterated_at(self, wanted: list[int], keep: _Prepare) -> list[NDArray[np.uint8]]:
         """The frames at `wanted` (increasing) as iterating the file gives them, stand-ins too."""
-        keep, out = set(wanted), []
+        kept, out = set(wanted), []
         frames = self._iter_stored()
         try:
             for i, frame in enumerate(frames):
-                if i in keep:
-                    out.append(frame)
+                if i in kept:
+                    out.append(keep(frame))
                 if i >= wanted[-1]:
                     break
         finally:
             frames.close()
         return out
 
-    def _file_frames_at(self, wanted: list[int], split: bool) -> list[NDArray[np.uint8]]:
+    def _file_frames_at(
+        self, wanted: list[int], split: bool, keep: _Prepare
+    ) -> list[NDArray[np.uint8]]:
         """:meth:`frames_at` of a video file, in one pass of grabs (two with `split`)."""
         cap = _file_capture(str(self.path))
         try:
             middle = wanted[len(wanted) // 2]
             if not split or len(wanted) < 4 or middle < 2:
-                return self._read_at(cap, 0, wanted)[0]
+                return self._read_at(cap, 0, wanted, prepare=keep)[0]
             first = [i for i in wanted if i <= middle + 1]
             # an interrupt (Ctrl-C; SIGTERM, raised here by pftrack.cli._signals) stops the
             # second half at its next frame: the pool's join waited for it to read its whole
             # half (minutes of a long video), SIGTERM ignored meanwhile
             halt = threading.Event()
             with ThreadPoolExecutor(1, thread_name_prefix="pftrack-bootstrap") as pool:
-                tail = pool.submit(self._read_from_seek, middle, wanted, halt)
+                tail = pool.submit(self._read_from_seek, middle, wanted, halt, prepare=keep)
                 try:
-                    head, check, at = self._read_at(cap, 0, first, middle)
+                    head, check, at = self._read_at(cap, 0, first, middle, prepare=keep)
                     second = tail.result()
                 except BaseException:
                     halt.set()
                     raise
             if second is not None and len(check) == 2 and _same_frames(check, second[1]):
                 return head[: sum(i < middle for i in first)] + second[0]
-            rest, _, _ = self._read_at(cap, at, [i for i in wanted if i > middle + 1])
+            rest, _, _ = self._read_at(cap, at, [i for i in wanted if i > middle + 1], prepare=keep)
             return head + rest
         finally:
             cap.release()
@@ -1719,16 +1832,19 @@ class FrameSource:
         keep: list[int],
         check: int | None = None,
         halt: threading.Event | None = None,
-    ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]], int]:
+        *,
+        prepare: _Prepare | None = None,
+    ) -> tuple[list[NDArray[np.uint8]], list[tuple[bytes, float]], int]:
         """Read on from frame `start` (where `cap` stands) through the last of `keep`.
 
-        Returns the frames at `keep`, resized; with `check`, the raw frames `check` and
-        `check + 1` with their time stamps (the pass then goes on to them); and the index of
-        the frame `cap` stands at afterwards. Stops early, before its next frame, once
+        Returns the frames at `keep`, resized (and passed through `prepare`); with `check`,
+        the digests (:func:`_frame_digest`) of the raw frames `check` and `check + 1` with
+        their time stamps (the pass then goes on to them); and the index of the frame `cap`
+        stands at afterwards. Stops early, before its next frame, once
         :meth:`stop` is called or `halt` is set.
         """
         picked: list[NDArray[np.uint8]] = []
-        seen: list[tuple[NDArray[Any], float]] = []
+        seen: list[tuple[bytes, float]] = []
         stop = max(keep[-1] if keep else -1, -1 if check is None else check + 1) + 1
         wanted = set(keep)
         i = start
@@ -1739,9 +1855,10 @@ class FrameSource:
                 if not ok:
                     break
                 if i in wanted:
-                    picked.append(self._resize(frame))
+                    resized = self._resize(frame)
+                    picked.append(resized if prepare is None else prepare(resized))
                 if compare:
-                    seen.append((frame, float(cap.get(cv2.CAP_PROP_POS_MSEC))))
+                    seen.append((_frame_digest(frame), float(cap.get(cv2.CAP_PROP_POS_MSEC))))
             elif not cap.grab():
                 break
             i += 1
@@ -1752,8 +1869,13 @@ class FrameSource:
         return picked, seen, i
 
     def _read_from_seek(
-        self, middle: int, wanted: list[int], halt: threading.Event | None = None
-    ) -> tuple[list[NDArray[np.uint8]], list[tuple[NDArray[Any], float]]] | None:
+        self,
+        middle: int,
+        wanted: list[int],
+        halt: threading.Event | None = None,
+        *,
+        prepare: _Prepare | None = None,
+    ) -> tuple[list[NDArray[np.uint8]], list[tuple[bytes, float]]] | None:
         """The second half of a split pass: frames from `middle` on, after a seek to it.
 
         None when the file cannot seek (or OpenCV fails on it): the first half reads on. Ends
@@ -1764,7 +1886,7 @@ class FrameSource:
             if not cap.set(cv2.CAP_PROP_POS_FRAMES, middle):
                 return None
             keep = [i for i in wanted if i >= middle]
-            picked, seen, _ = self._read_at(cap, middle, keep, middle, halt)
+            picked, seen, _ = self._read_at(cap, middle, keep, middle, halt, prepare=prepare)
             return picked, seen
         except cv2.error:
             return None
@@ -1786,10 +1908,13 @@ class FrameSource:
         timed = rate > 0  # the frames' time stamps give their indexes, so far
         start = 0  # the first frame's stamp, in frames (PETS09's is 2)
         lost: list[int] = []
+        stamps: list[float] = []  # of the frames decoded, in ms (_uneven_steps)
         last: NDArray[np.uint8] | None = None
         try:
             while True:
                 ok, frame = cap.read()
+                if ok:
+                    stamps.append(float(cap.get(cv2.CAP_PROP_POS_MSEC)))
                 # a frame's number is its place in the decoded order, as a detector's loop
                 # counts it; the stamps only say, after a frame that fails, where to go on
                 if ok and timed:
@@ -1827,6 +1952,30 @@ class FrameSource:
             )
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded)
+        if not self._warned_uneven:
+            self._warn_uneven(stamps)
+
+    def _warn_uneven(self, stamps: list[float]) -> None:
+        """Warn, once, if a video read to its end has a variable frame rate (:func:`_uneven_steps`).
+
+        Only when its rate came from the file (or the default): a rate given or a sequence's is
+        the one its frames are meant to have.
+        """
+        self._warned_uneven = True  # the stamps of one whole read decide, once
+        uneven = _uneven_steps(stamps)
+        if uneven is None or self.fps_origin in ("given", "seqinfo.ini"):
+            return
+        lo, median, hi = uneven
+        origin = {"container": "the header's", "time stamps": "from its first frames' stamps"}
+        warnings.warn(
+            f"{self.path}: variable frame rate: its frames are {lo:.3g} to {hi:.3g} ms apart "
+            f"(median {median:.3g} ms), but it is read at one rate, {self.fps:g} fps "
+            f"({origin.get(self.fps_origin, self.fps_origin)}): a video rendered from it plays "
+            "its frames evenly spaced at that rate, and the tracker takes each step between "
+            "frames as one frame's (give the rate to render at with --fps)",
+            UserWarning,
+            stacklevel=3,
+        )
 
     def _warn_frame_count(self, decoded: int) -> None:
         """Warn, once, if a video read to its end had other than its header's or seqLength's frames.

@@ -844,7 +844,9 @@ class Tracker:
             history=tuple((n, np.asarray(b, np.float64) / k, c) for n, b, c in t.history),
         )
 
-    def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
+    def prime(
+        self, frames: Iterable[NDArray[np.uint8]], *, shape: tuple[int, ...] | None = None
+    ) -> None:
         """Start the background model from the median of `frames` (before the first update).
 
         Reads at most :attr:`prime_frames` of `frames` (the first ones; a longer iterable is
@@ -861,6 +863,12 @@ class Tracker:
         The frames a generator (any iterable but a list, a tuple or an array) yields are
         copied as they come, so one that refills one buffer with each frame primes as its
         frames would.
+
+        With `shape`, the (H, W, 3) shape of the frames of the run, `frames` are their
+        :meth:`working_frame` results, made as they were read (``bootstrap_frames(source, n,
+        prepare=tracker.working_frame)``: a 4K video's frames held at the working size, not
+        25 MB each): each must have the working size of `shape` (ValueError otherwise), and
+        the run's frames must have `shape`, as after priming with the frames themselves.
         """
         if isinstance(frames, np.ndarray) and (
             frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
@@ -876,21 +884,28 @@ class Tracker:
                 f"prime takes an iterable of frames (a list, a generator or a (K, H, W, 3) "
                 f"array), got {type(frames).__name__}"
             ) from None
+        made = None if shape is None else self._made_shape(shape)
         with self._alone("prime"):
             if self.frame_count:
                 raise ValueError("prime() must come before the first update()")
             held = isinstance(frames, (list, tuple, np.ndarray))  # frames that stay as given
             first = itertools.islice(iterator, self.prime_frames)  # no more: a whole video is big
             picked = []
-            shape: tuple[int, ...] | None = None
+            size: tuple[int, ...] | None = None  # of frame 0
             for i, frame in enumerate(first):
                 f = bgr_frame(frame, "prime frame")
-                if shape is None:
-                    shape = f.shape
-                elif f.shape != shape:  # checked before the median of mixed sizes is taken
+                if size is None:
+                    size = f.shape
+                elif f.shape != size:  # checked before the median of mixed sizes is taken
                     raise ValueError(
                         f"prime frame {i} is {f.shape[1]}x{f.shape[0]}, frame 0 "
-                        f"{shape[1]}x{shape[0]} (the frames of one run are one size)"
+                        f"{size[1]}x{size[0]} (the frames of one run are one size)"
+                    )
+                if made is not None and f.shape != made[1]:
+                    h, w = made[1][:2]
+                    raise ValueError(
+                        f"prime frame {i} is {f.shape[1]}x{f.shape[0]}, expected "
+                        f"{w}x{h}, the working size of frames of shape {made[0]}"
                     )
                 work = self.working_frame(f)
                 # an iterator may refill one buffer with each frame (``cap.read(buffer)``):
@@ -899,7 +914,26 @@ class Tracker:
                 picked.append(work if fresh else work.copy())
             if picked:
                 self._tracker.prime(picked)
-                self._primed = shape
+                self._primed = size if made is None else made[0]
+
+    def _made_shape(self, shape: object) -> tuple[tuple[int, ...], tuple[int, ...]]:
+        """:meth:`prime`'s `shape` checked, and the shape of its :meth:`working_frame` results.
+
+        Raises
+        ------
+        TypeError, ValueError
+            `shape` is not an (H, W, 3) tuple of ints >= 1.
+        """
+        if not (isinstance(shape, tuple) and len(shape) == 3
+                and all(isinstance(n, (int, np.integer)) and not isinstance(n, bool)
+                        for n in shape)):  # fmt: skip
+            raise TypeError(f"prime: shape is {shape!r}, expected an (H, W, 3) tuple of ints")
+        rows, cols, bands = (int(n) for n in shape)
+        if rows < 1 or cols < 1 or bands != 3:
+            raise ValueError(f"prime: shape is {shape!r}, expected (H, W, 3) with H, W >= 1")
+        size = working_size((rows, cols, bands), self.config.max_side)
+        work = (rows, cols, 3) if size is None else (size[1], size[0], 3)
+        return (rows, cols, bands), work
 
     def update(self, dets: ArrayLike | None, frame: NDArray[np.uint8]) -> F64:
         """Track one frame.

@@ -272,9 +272,17 @@ def track_frames(
     if prime_frames > 0 and (detections is None or config.refine.enabled):
         if bootstrap == "auto":
             bootstrap = "spread" if detections is None else "first"
-        primer = bootstrap_frames(frames, prime_frames, bootstrap, split=threads)
-        if primer:
-            tracker.prime(primer)
+        if isinstance(frames, FrameSource):
+            # held at the working size as they are read (a 4K video's 30 frames were 750 MB)
+            primer = bootstrap_frames(
+                frames, prime_frames, bootstrap, split=threads, prepare=tracker.working_frame
+            )
+            if primer:
+                tracker.prime(primer, shape=(frames.height, frames.width, 3))
+        else:  # frames in memory already
+            primer = bootstrap_frames(frames, prime_frames, bootstrap, split=threads)
+            if primer:
+                tracker.prime(primer)
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0

@@ -1,0 +1,73 @@
+"""A variable-frame-rate video is read at one rate: said once, with the spread of its steps.
+
+A phone's video (frames 100 and 200 ms apart) has its average rate in its header (6.78 fps for
+40 such frames in an MP4), which ``--render`` and ``pftrack render`` wrote its video at, its
+frames evenly spaced, and the tracker takes every step between frames as one: without a word.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import pytest
+
+from pftrack.cli import main
+from pftrack.io.mot import write_mot
+from pftrack.io.video import FrameSource
+from pftrack.synthetic import Scene, make_scene
+from tests.io.test_estimated_count import write_vfr
+
+pytest.importorskip("av")
+
+
+@pytest.fixture(scope="module")
+def scene() -> Scene:
+    return make_scene(40, 160, 120, n_walkers=2, rng=1)
+
+
+@pytest.mark.parametrize("suffix", [".mp4", ".mkv"])
+def test_uneven_time_stamps_are_said_once_with_the_rate_used(
+    scene: Scene, tmp_path: Path, suffix: str
+) -> None:
+    video = write_vfr(tmp_path / f"vfr{suffix}", scene, [100, 200] * 20)
+    source = FrameSource(video)
+    with pytest.warns(UserWarning, match="variable frame rate") as said:
+        assert sum(1 for _ in source) == 40
+    (message,) = [str(w.message) for w in said if "variable" in str(w.message)]
+    assert str(video) in message
+    assert f"{source.fps:g} fps" in message  # the rate used, from the header
+    assert "100 to 200 ms apart" in message  # the spread
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sum(1 for _ in source) == 40  # once per source
+
+
+@pytest.mark.parametrize("gaps", [[40] * 40, [33, 34, 33] * 13 + [33], [40] * 38 + [80, 40]])
+def test_even_time_stamps_are_not_said(scene: Scene, tmp_path: Path, gaps: list[int]) -> None:
+    """Constant rates (29.97 fps stamped in whole milliseconds: 33 and 34 ms) and one dropped
+    frame in 40 are no variable rate."""
+    video = write_vfr(tmp_path / "cfr.mkv", scene, gaps, rate=25)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sum(1 for _ in FrameSource(video)) == 40
+
+
+def test_a_rate_given_is_not_said(scene: Scene, tmp_path: Path) -> None:
+    video = write_vfr(tmp_path / "vfr.mp4", scene, [100, 200] * 20)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert sum(1 for _ in FrameSource(video, fps=7)) == 40
+
+
+def test_track_says_it_once(
+    scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    video = write_vfr(tmp_path / "vfr.mp4", scene, [100, 200] * 20)
+    det = scene.truth.copy()
+    det[:, 1] = -1
+    write_mot(tmp_path / "det.txt", det)
+    code = main(["track", str(video), "--detections", str(tmp_path / "det.txt"),
+                 "--out", str(tmp_path / "t.txt"), "--particles", "30"])  # fmt: skip
+    assert code == 0
+    assert capsys.readouterr().err.count("variable frame rate") == 1
