@@ -346,7 +346,8 @@ class MotionConfig:
     speed_reference : float or None
         The per-frame acceleration levels (`accel` here, and the offline smoother's ``accel``
         and ``size_accel``) hold for objects moving up to this speed, in heights per frame (the
-        median speed of the confirmed tracks, measured over `speed_span` frames or more). For
+        median speed of the confirmed tracks of a class, measured over `speed_span` frames or
+        more: each class its own). For
         faster footage, such as a video at a lower frame rate, they grow as ``(speed /
         speed_reference) ** 1.5``: white-noise acceleration over a frame that lasts `k` times
         longer has `k` cubed the position variance (:meth:`MultiObjectTracker.motion_gain`).
