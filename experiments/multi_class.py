@@ -6,14 +6,16 @@ pixels, a new one every 4 frames, moving `--car-speed` pixels a frame (16: 0.53 
 frame, against the walkers' 0.05). Detections come from the truth of both, jittered by 5 % of
 the height, 10 % missed, a false person box every other frame (`public_detections`'
 `noisy_detections`); the cars' boxes are drawn `--car-pad` of their height loose around
-them. Each run goes through :class:`pftrack.Tracker` (``update(dets, frame)``, the class in
+them, and with `--car-shadow` each car casts that many rows of shadow below it (the case
+of ``RefineConfig.upright_classes``, docs/tracking.md, "Refinement per class"). Each run
+goes through :class:`pftrack.Tracker` (``update(dets, frame)``, the class in
 column 6), then ``finalize()``; people and cars are scored apart, each class's rows
 (``Tracker.classes``) against that class's truth, with `pftrack.eval.evaluate_sequence`.
 
 Usage (from the repository root)::
 
     python -m experiments.multi_class [--seeds 0 1 2] [--no-refine] [--no-cars]
-        [--set SECTION.FIELD=VALUE ...]
+        [--car-speed 16] [--car-pad 0.15] [--car-shadow 10] [--set SECTION.FIELD=VALUE ...]
 """
 
 from __future__ import annotations
@@ -39,8 +41,12 @@ CAR_SIZE = (70, 30)
 CAR_EVERY = 4
 
 
-def add_cars(scene: Scene, speed: float, rng: np.random.Generator) -> F64:
-    """Draw two lanes of cars over `scene`'s frames (in place); their MOT truth rows."""
+def add_cars(scene: Scene, speed: float, rng: np.random.Generator, shadow: int = 0) -> F64:
+    """Draw two lanes of cars over `scene`'s frames (in place); their MOT truth rows.
+
+    Each car casts a shadow `shadow` rows tall below its body, the ground at 0.65 of its
+    brightness over the car's columns (the truth box is the car's, without it).
+    """
     w, h = CAR_SIZE
     width = scene.width
     rows = []
@@ -61,6 +67,9 @@ def add_cars(scene: Scene, speed: float, rng: np.random.Generator) -> F64:
                 continue
             frame = scene.frames[f - 1]
             x0, y0 = int(round(x)), int(round(top))
+            if shadow:
+                below = frame[y0 + h : y0 + h + shadow, max(x0, 0) : max(x0 + w, 0)]
+                below[:] = (below * 0.65).astype(np.uint8)
             cv2.rectangle(frame, (x0, y0 + 6), (x0 + w - 1, y0 + h - 8), colour, -1)
             cv2.rectangle(frame, (x0 + 12, y0), (x0 + w - 13, y0 + 8), colour, -1)
             cv2.rectangle(frame, (x0 + 16, y0 + 2), (x0 + w - 17, y0 + 7), (60, 50, 40), -1)
@@ -87,12 +96,12 @@ def loosen(dets: dict[int, F64], pad: float, width: int, height: int) -> dict[in
     return out
 
 
-def run(seed: int, config: TrackerConfig, cars: bool, speed: float, pad: float
+def run(seed: int, config: TrackerConfig, cars: bool, speed: float, pad: float, shadow: int
         ) -> tuple[SequenceScores, SequenceScores | None]:  # fmt: skip
     """People's and cars' scores of one seeded scene."""
     scene = make_scene(150, n_walkers=8, rng=seed)
     rng = np.random.default_rng(100 + seed)
-    car_truth = add_cars(scene, speed, rng) if cars else np.zeros((0, 10))
+    car_truth = add_cars(scene, speed, rng, shadow) if cars else np.zeros((0, 10))
     n, h, w = len(scene.frames), scene.height, scene.width
     people = noisy_detections(scene.truth, n, h, w, seed)
     car_dets = loosen(noisy_detections(car_truth, n, h, w, 50 + seed), pad, w, h)
@@ -128,6 +137,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--no-refine", action="store_true", help="box refinement off")
     p.add_argument("--car-speed", type=float, default=16.0, help="pixels a frame")
     p.add_argument("--car-pad", type=float, default=0.15, help="car boxes' looseness")
+    p.add_argument("--car-shadow", type=int, default=0, help="rows of shadow below a car")
     p.add_argument("--set", nargs="*", default=[], metavar="SECTION.FIELD=VALUE",
                    help="TrackerConfig fields changed for a trial")  # fmt: skip
     args: argparse.Namespace = p.parse_args(argv)
@@ -140,7 +150,7 @@ def main(argv: list[str] | None = None) -> int:
         config = override(config, setting)
     people, cars = [], []
     for seed in args.seeds:
-        sp, sc = run(seed, config, not args.no_cars, args.car_speed, args.car_pad)
+        sp, sc = run(seed, config, not args.no_cars, args.car_speed, args.car_pad, args.car_shadow)
         print(line(f"seed {seed} people", sp))
         people.append(sp)
         if sc is not None:

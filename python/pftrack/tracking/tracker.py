@@ -325,12 +325,13 @@ class MultiObjectTracker:
                 )
         return boxes, scores, labels
 
-    def _detections(self, frame: NDArray[np.uint8], given: tuple[F64, F64] | None
+    def _detections(self, frame: NDArray[np.uint8],
+                    given: tuple[F64, F64, NDArray[np.int64]] | None
                     ) -> tuple[F64, F64, BinnedImage]:  # fmt: skip
         """Return this frame's boxes, scores and bins.
 
-        The built-in detector's (with foreground-only bins), or the caller's checked boxes and
-        scores (`given`), refined, with full-frame bins.
+        The built-in detector's (with foreground-only bins), or the caller's checked boxes,
+        scores and classes (`given`), refined (:meth:`_refine`), with full-frame bins.
         """
         cfg = self.config
         if given is None:
@@ -343,7 +344,7 @@ class MultiObjectTracker:
                 if binned is None:  # binned on demand: only the pixels the boxes read
                     binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)
             return boxes, np.asarray(det.scores, dtype=np.float64), binned
-        boxes, scores = given
+        boxes, scores, labels = given
         mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
             mask, binned, shaded = self._foreground(frame)
@@ -352,11 +353,38 @@ class MultiObjectTracker:
         # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
         # useful (measured in experiments/moving_camera.py)
         if cfg.refine.enabled and mask is not None and len(boxes):
-            fill = cfg.refine.leg_fill if shaded else None
-            boxes = refine_boxes(
-                boxes, mask, cfg.refine.fraction, leg_fill=fill, min_height=cfg.refine.min_height
-            )
+            boxes = self._refine(boxes, labels, mask, shaded)
         return boxes, scores, binned
+
+    def _refine(
+        self, boxes: F64, labels: NDArray[np.int64], mask: NDArray[np.uint8], shaded: bool
+    ) -> F64:
+        """`boxes` shrunk to their foreground in `mask` (with shadows, 127, when `shaded`).
+
+        The boxes of an upright class (:attr:`RefineConfig.upright_classes`) get the upright
+        person's prior: legs the shadow test took grow back down (`leg_fill`), a cut to less
+        than `min_height` keeps the box's rows. Other classes' boxes are shrunk to their
+        foreground alone, shadows as background: a car's shadow below it fills its columns,
+        and grew its box down to the detection's bottom.
+        """
+        refine = self.config.refine
+        upright = refine.upright_classes
+        fill = refine.leg_fill if shaded else None
+        person = None
+        if upright is not None and (0 not in upright or labels.any()):  # else: the usual frame
+            person = np.isin(labels, upright)
+        if person is None or person.all():  # every box upright (people, or every class)
+            return refine_boxes(
+                boxes, mask, refine.fraction, leg_fill=fill, min_height=refine.min_height
+            )
+        out: F64 = boxes.copy()
+        if person.any():
+            out[person] = refine_boxes(
+                boxes[person], mask, refine.fraction, leg_fill=fill, min_height=refine.min_height
+            )
+        plain = foreground_only(mask) if shaded else mask
+        out[~person] = refine_boxes(boxes[~person], plain, refine.fraction)
+        return out
 
     @property
     def last_mask(self) -> NDArray[np.uint8] | None:
@@ -590,7 +618,7 @@ class MultiObjectTracker:
             warp_tracks(self.tracks, step.apply)
         self._background_ok = step.background_ok
         self.camera_step = step
-        boxes, scores, binned = self._detections(f, None if given is None else given[:2])
+        boxes, scores, binned = self._detections(f, given)
         labels = np.zeros(len(boxes), np.int64) if given is None else given[2]
         tiny = tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
         index = ((scores >= cfg.lifecycle.min_score) & ~tiny).nonzero()[0]
