@@ -318,7 +318,7 @@ def predict_tracks(
     """
     if not tracks:
         return
-    gains = [accel_gain] * len(tracks) if isinstance(accel_gain, (int, float)) else accel_gain
+    gains = accel_gain if isinstance(accel_gain, Sequence) else [accel_gain] * len(tracks)
     summary = step_filters_summary([t.filter for t in tracks], binned).tolist()
     # Floats, not arrays over the tracks: with a few to tens of tracks, the 30-odd NumPy calls
     # on (K, 1) and (K, 2) arrays cost more than the loop (issue 17). The new positions,

@@ -364,8 +364,8 @@ class MultiObjectTracker:
         The boxes of an upright class (:attr:`RefineConfig.upright_classes`) get the upright
         person's prior: legs the shadow test took grow back down (`leg_fill`), a cut to less
         than `min_height` keeps the box's rows. Other classes' boxes are shrunk to their
-        foreground alone, shadows as background: a car's shadow below it fills its columns,
-        and grew its box down to the detection's bottom.
+        foreground alone, shadows as background: a car's shadow below it fills its columns, and
+        the person's prior grew the car's box down through it.
         """
         refine = self.config.refine
         upright = refine.upright_classes
