@@ -111,8 +111,10 @@ def make_crowd(
 def per_object_loop() -> Iterator[None]:
     """Within the block, trackers step one filter per C++ call (the older loop)."""
 
-    def loop(tracks: Sequence[LiveTrack], binned: Any, noise: float, gain: float = 1.0) -> None:
-        for t in tracks:
+    def loop(
+        tracks: Sequence[LiveTrack], binned: Any, noise: float, gains: Sequence[float]
+    ) -> None:  # each track's class's gain (MultiObjectTracker.motion_gain)
+        for t, gain in zip(tracks, gains, strict=True):
             t.predict(binned, noise, gain)
 
     saved = tracker_module.predict_tracks

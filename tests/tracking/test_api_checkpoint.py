@@ -242,3 +242,27 @@ def test_a_checkpoint_at_every_pickle_protocol_resumes_byte_for_byte():
     assert run.stdout.split("\n")[:-1] == [
         f"{p} resumed" for p in range(pickle.HIGHEST_PROTOCOL + 1)
     ]
+
+
+def test_a_checkpoint_of_one_shared_speed_median_resumes_as_the_run_of_per_class_ones(scene):
+    """A checkpoint pickled when every class shared one speed median and gain (before 5
+    December) loads into per-class ones and resumes exactly as a run of the current code."""
+    from pftrack.tracking.tracker import MultiObjectTracker
+
+    dets = truth_dets(scene)
+    tracker = pftrack.Tracker(frame_rate=10.0, seed=0)
+    for k in range(20):
+        tracker.update(dets[k], scene.frames[k])
+    old = copy.deepcopy(tracker)
+    state = old._tracker.__dict__
+    speeds = state.pop("_speeds")
+    state["_speeds"], state["_gain"] = speeds[0], state.pop("_gains").get(0, 1.0)
+    inner = MultiObjectTracker.__new__(MultiObjectTracker)
+    inner.__setstate__(pickle.loads(pickle.dumps(old._tracker.__getstate__())))
+    old._tracker = inner
+    assert isinstance(inner._speeds, dict) and "_gain" not in inner.__dict__
+    for k in range(20, 30):
+        np.testing.assert_array_equal(
+            old.update(dets[k], scene.frames[k]), tracker.update(dets[k], scene.frames[k])
+        )
+    np.testing.assert_array_equal(old.finalize(), tracker.finalize())

@@ -15,7 +15,12 @@ from pftrack.tracking import TrackerConfig
 from pftrack.tracking.api import xywh_to_xyxy_dets
 from pftrack.tracking.config import LifecycleConfig, MotionConfig
 from pftrack.tracking.track import LiveTrack
-from pftrack.tracking.tracker import MIN_SPEED_SAMPLES, MultiObjectTracker
+from pftrack.tracking.tracker import (
+    MAX_SPEED_SAMPLES,
+    MIN_SPEED_SAMPLES,
+    MultiObjectTracker,
+    RollingMedian,
+)
 
 
 def jittered_dets(truth, n_frames, rng=0, size=(480, 360)):
@@ -139,29 +144,70 @@ def test_speed_is_distance_over_height_and_frames():
     assert t.trail[0][0] == 1
 
 
+def _add_speeds(tr, value, n, cls=0):
+    speeds = tr._speeds.setdefault(cls, RollingMedian(MAX_SPEED_SAMPLES))
+    for _ in range(n):
+        speeds.add(value)
+
+
 def test_motion_gain_rule():
     cfg = TrackerConfig(motion=MotionConfig(speed_reference=0.05))
     tr = MultiObjectTracker(cfg, rng=0)
     assert tr.motion_gain() == 1.0
-    for _ in range(MIN_SPEED_SAMPLES - 1):
-        tr._speeds.add(0.1)
+    _add_speeds(tr, 0.1, MIN_SPEED_SAMPLES - 1)
     assert tr.motion_gain() == 1.0  # too few samples
-    tr._speeds.add(0.1)
+    _add_speeds(tr, 0.1, 1)
     assert tr.motion_gain() == pytest.approx(2.0**1.5)
+    assert tr.motion_gain(2) == 1.0  # another class: its own samples (none)
+    _add_speeds(tr, 0.4, MIN_SPEED_SAMPLES, cls=2)
+    assert tr.motion_gain(2) == pytest.approx(8.0**1.5)
+    assert tr.motion_gain() == pytest.approx(2.0**1.5)  # class 0's as it was
+    assert tr.motion_gains == pytest.approx({0: 2.0**1.5, 2: 8.0**1.5})
     slow = MultiObjectTracker(cfg, rng=0)
-    for _ in range(MIN_SPEED_SAMPLES):
-        slow._speeds.add(0.02)
+    _add_speeds(slow, 0.02, MIN_SPEED_SAMPLES)
     assert slow.motion_gain() == 1.0  # slower than the reference: as given
     none = dataclasses.replace(cfg, motion=MotionConfig(speed_reference=None))
     off = MultiObjectTracker(none, rng=0)
-    for _ in range(MIN_SPEED_SAMPLES):
-        off._speeds.add(0.1)
+    _add_speeds(off, 0.1, MIN_SPEED_SAMPLES)
     assert off.motion_gain() == 1.0  # None: the levels as given
 
 
-def test_rolling_median_is_numpys_median_of_the_last_values():
-    from pftrack.tracking.tracker import RollingMedian
+def _people_and_cars(speed=14.0, n_frames=40):
+    """Frames of `make_scene`'s walkers with fast cars (class 2) along the top, and the
+    detections of both, ``x1, y1, x2, y2, conf, cls`` per frame."""
+    scene = make_scene(n_frames, n_walkers=3, rng=0, occluder=False)
+    people = group_by_frame(scene.truth)
+    out = []
+    for f, frame in enumerate(scene.frames, start=1):
+        dets = [[x, y, x + w, y + h, 0.95, 0.0] for x, y, w, h in people[f][:, 2:6].tolist()]
+        for k in range(0, f, 5):  # a car every 5 frames, 70x30, `speed` pixels a frame
+            x = -70 + speed * (f - k)
+            if 0 <= x <= 480 - 70:
+                frame[20:50, int(x) : int(x) + 70] = (40 + 30 * (k % 5), 60, 200)
+                dets.append([int(x), 20.0, int(x) + 70, 50.0, 0.95, 2.0])
+        out.append((frame, np.array(dets)))
+    return out
 
+
+def test_fast_cars_leave_the_peoples_motion_noise_alone():
+    """Each class's speed gives its own gain: cars at 0.47 heights a frame raise their own
+    acceleration levels, not the walkers' (was: one median over every class, so the cars'
+    samples raised the people's noise too)."""
+    tracker = pftrack.Tracker(frame_rate=10.0, seed=0)
+    for frame, dets in _people_and_cars():
+        tracker.update(dets, frame)
+    mot = tracker._tracker
+    assert mot.motion_gain() == 1.0  # the walkers' (class 0's)
+    assert mot.speed_of(2) > 0.3 > 0.065 > mot.speed_of(0)
+    assert mot.motion_gain(2) > 10.0
+    assert mot.speed == mot.speed_of(0)
+    people = [t for t in mot.tracks if t.cls == 0]
+    assert people
+    # the gains the walkers' centre filters predict with: the levels as given
+    assert [mot._gains.get(t.cls, 1.0) for t in people] == [1.0] * len(people)
+
+
+def test_rolling_median_is_numpys_median_of_the_last_values():
     rng = np.random.default_rng(0)
     values = np.round(rng.gamma(2.0, 0.03, 400), 3)  # ties too
     for size in (1, 2, 7, 50, 1000):
@@ -179,3 +225,25 @@ def test_speed_reference_is_checked():
         MotionConfig(speed_reference=0.0)
     with pytest.raises(ValueError, match="speed_span"):
         MotionConfig(speed_span=0)
+
+
+def test_finalize_smooths_each_class_with_its_own_gain():
+    """The offline smoother's levels grow with each class's own speed: the walkers' rows are
+    smoothed as in a run whose gain is 1, the cars' with their own (was: both with the gain
+    of every class's median)."""
+    tracker = pftrack.Tracker(frame_rate=10.0, seed=0)
+    for frame, dets in _people_and_cars():
+        tracker.update(dets, frame)
+    rows = tracker.finalize()
+    gain = tracker._tracker.motion_gain(2)
+    writer, smoother = tracker._writer, tracker._writer_args[2]
+    fast = dataclasses.replace(
+        smoother, accel=smoother.accel * gain, size_accel=smoother.size_accel * gain
+    )
+    as_given = writer.result(drop=tracker._tracker.never_confirmed(), relink_coast=7)
+    own = writer.result(drop=tracker._tracker.never_confirmed(), relink_coast=7,
+                        smoothers={2: fast})  # fmt: skip
+    car = np.isin(own[:, 1], [i for i, c in writer.classes.items() if c == 2])
+    np.testing.assert_array_equal(rows, own)
+    np.testing.assert_array_equal(own[~car], as_given[~car])  # the walkers: gain 1
+    assert not np.array_equal(own[car], as_given[car])

@@ -505,3 +505,62 @@ def test_class_ids_given_to_update_are_checked(classes, error, message):
     assert tracker.frame_index == 0
     tracks = tracker.update(frame, boxes, np.array([0.0, 3.0]))  # integers held as floats
     assert sorted(t.cls for t in tracks) == [0, 3]
+
+
+def _car_with_shadow(n_frames=8):
+    """Frames of a 70x30 car (rows 100-129) moving 6 px a frame over textured ground, its
+    shadow the 12 rows below it (the ground at 0.65 of its brightness), after 10 empty
+    frames; and its detection box each frame, loose by 8 px (down into the shadow)."""
+    rng = np.random.default_rng(0)
+    ground = rng.integers(90, 160, (240, 320, 3)).astype(np.uint8)
+    ground[..., 1] = ground[..., 0]  # a grey-green road: a chromaticity to keep in shadow
+    empty = [ground.copy() for _ in range(10)]
+    frames, boxes = [], []
+    for k in range(n_frames):
+        frame = ground.copy()
+        x = 40 + 6 * k
+        frame[130:142, x : x + 70] = (frame[130:142, x : x + 70] * 0.65).astype(np.uint8)
+        frame[100:130, x : x + 70] = (30, 40, 200)
+        frames.append(frame)
+        boxes.append([x - 8.0, 92.0, 86.0, 46.0, 0.95])  # x, y, w, h: 8 px loose all round
+    return empty, frames, boxes
+
+
+@pytest.mark.parametrize(
+    ("upright", "cls", "bottom"),
+    [((0,), 2, 130.0), (None, 2, 138.0), ((0,), 0, 138.0), ((2,), 2, 138.0)],
+)
+def test_refinement_grows_only_upright_classes_into_shadow(upright, cls, bottom):
+    """A car's shadow fills its columns below it: the person's prior (legs the shadow test
+    took grow back, RefineConfig.leg_fill) grew the car's box down to the detection's
+    bottom. Only `upright_classes` (people: class 0) get it; other classes are shrunk to
+    their foreground alone (was: every class, as people)."""
+    cfg = TrackerConfig(refine=RefineConfig(upright_classes=upright))
+    tracker = MultiObjectTracker(cfg, rng=0)
+    empty, frames, boxes = _car_with_shadow()
+    tracker.prime(empty)
+    for frame, box in zip(frames, boxes, strict=True):
+        (t,) = tracker.update(frame, np.array([box]), np.array([cls]))
+        assert t.cls == cls
+        x, y, w, h = t.detection_box
+        assert y == 100.0 and y + h == bottom
+        assert (x, x + w) == (box[0] + 8, box[0] + 78)  # the car's columns either way
+
+
+def test_refine_upright_classes_are_a_tuple_of_ints_or_none():
+    assert RefineConfig().upright_classes == (0,)
+    assert RefineConfig(upright_classes=None).upright_classes is None
+    assert RefineConfig(upright_classes=(np.int64(0), 1)).upright_classes == (0, 1)
+    for bad in ([0], (0.5,), (True,), "0", 0):
+        with pytest.raises(TypeError, match="RefineConfig: upright_classes must be a tuple"):
+            RefineConfig(upright_classes=bad)
+
+
+def test_refine_false_turns_refinement_off_for_every_class():
+    cfg = TrackerConfig(refine=RefineConfig(enabled=False, upright_classes=(0,)))
+    tracker = MultiObjectTracker(cfg, rng=0)
+    empty, frames, boxes = _car_with_shadow(2)
+    tracker.prime(empty)
+    for frame, box in zip(frames, boxes, strict=True):
+        (t,) = tracker.update(frame, np.array([box]), np.array([2]))
+        np.testing.assert_array_equal(t.detection_box, box[:4])

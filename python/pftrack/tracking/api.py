@@ -1298,11 +1298,16 @@ class Tracker:
             crossings = self.config.crossings if smoothed else None  # part of the smoothing pass
             link = self._writer_args[3]
             smoother = self._writer_args[2]
-            gain = self._tracker.motion_gain()  # faster footage: more acceleration per frame
+            # faster footage: more acceleration per frame, each class by its own speed
+            smoothers = {}
             if smoother is not None:
-                self._writer.smoother = replace(
-                    smoother, accel=smoother.accel * gain, size_accel=smoother.size_accel * gain
-                )
+                self._writer.smoother = smoother  # a class without speed samples: as given
+                smoothers = {
+                    c: replace(
+                        smoother, accel=smoother.accel * g, size_accel=smoother.size_accel * g
+                    )
+                    for c, g in self._tracker.motion_gains.items()
+                }
             if (
                 link is not None
             ):  # its pixel gate grows with the frame (TrackerConfig.pixel_diagonal)
@@ -1312,7 +1317,10 @@ class Tracker:
             relink = self.config.lifecycle.relink_coast if smoothed and self._given else None
             rows = self._stabiliser.restore(
                 self._writer.result(
-                    drop=self._tracker.never_confirmed(), crossings=crossings, relink_coast=relink
+                    drop=self._tracker.never_confirmed(),
+                    crossings=crossings,
+                    relink_coast=relink,
+                    smoothers=smoothers,
                 )
             )
             life = self.config.lifecycle

@@ -346,7 +346,8 @@ class MotionConfig:
     speed_reference : float or None
         The per-frame acceleration levels (`accel` here, and the offline smoother's ``accel``
         and ``size_accel``) hold for objects moving up to this speed, in heights per frame (the
-        median speed of the confirmed tracks, measured over `speed_span` frames or more). For
+        median speed of the confirmed tracks of a class, measured over `speed_span` frames or
+        more: each class its own). For
         faster footage, such as a video at a lower frame rate, they grow as ``(speed /
         speed_reference) ** 1.5``: white-noise acceleration over a frame that lasts `k` times
         longer has `k` cubed the position variance (:meth:`MultiObjectTracker.motion_gain`).
@@ -400,9 +401,9 @@ class RefineConfig:
     enabled : bool
         With external detections, also run the background model and shrink each detection box
         to the rows and columns where its foreground is (static cameras: detector boxes are
-        often loose). A box with too little foreground is left as it is. It assumes upright
-        people (legs grow downwards, `leg_fill`, `min_height`): turn it off for sideways or
-        overhead-rotated footage.
+        often loose). A box with too little foreground is left as it is. The boxes of
+        `upright_classes` get an upright person's prior (legs grow downwards, `leg_fill`,
+        `min_height`): turn it off for sideways or overhead-rotated footage of people.
     fraction : float
         A row or column belongs to the object when its foreground fraction exceeds this share of
         the box's densest row or column; in [0, 1) (``refine_boxes``' range).
@@ -420,11 +421,20 @@ class RefineConfig:
         object's height is still refined. Over seeds 0-2 it lifts the synthetic busy scenes
         from 42.2 / 66.3 / 96.6 MOTA to 85.5 / 78.8 / 96.6 and leaves PETS09-S2L1 and
         TUD-Campus as they were (docs/tracking.md, "Refined height kept above 0.6").
+    upright_classes : tuple of int or None
+        Class ids (the ``cls`` column of :meth:`pftrack.Tracker.update`) whose boxes are
+        upright people: `leg_fill` and `min_height` apply to them. Default ``(0,)``: COCO's
+        and BoxMOT's person, and every box of a run without classes. The boxes of other
+        classes are shrunk to their foreground alone, shadows as background, with no growing
+        and no height rule: a car's shadow below it fills its columns, and `leg_fill` grew its
+        box down through it (5 December; docs/tracking.md, "Refinement per class"). None: every
+        class as a person (as before). `enabled` False still turns refinement off for all.
 
     Raises
     ------
     TypeError
-        A setting that is not a number (`enabled`: not a bool).
+        A setting that is not a number (`enabled`: not a bool; `upright_classes`: not a tuple
+        of ints or None).
     ValueError
         A setting out of its range (NaN included).
     """
@@ -433,6 +443,7 @@ class RefineConfig:
     fraction: float = 0.05
     leg_fill: float | None = 0.5
     min_height: float = 0.6
+    upright_classes: tuple[int, ...] | None = (0,)
 
     def __post_init__(self) -> None:
         flag(self.enabled, "RefineConfig: enabled")
@@ -444,6 +455,18 @@ class RefineConfig:
         if self.leg_fill is not None:
             _in_unit_interval("RefineConfig", leg_fill=self.leg_fill)
         _in_unit_interval("RefineConfig", min_height=self.min_height)
+        classes = self.upright_classes
+        if classes is not None and (
+            not isinstance(classes, tuple)
+            or not all(
+                isinstance(c, (int, np.integer)) and not isinstance(c, (bool, np.bool_))
+                for c in classes
+            )
+        ):
+            raise TypeError(
+                f"RefineConfig: upright_classes must be a tuple of int class ids or None, got "
+                f"{classes!r}"
+            )
 
 
 @dataclass(frozen=True)

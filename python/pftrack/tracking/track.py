@@ -292,7 +292,10 @@ def _new_track(id: int, box_xywh: F64, score: float, detection_index: int | None
 
 
 def predict_tracks(
-    tracks: Sequence[LiveTrack], binned: BinnedImage, colour_noise: float, accel_gain: float = 1.0
+    tracks: Sequence[LiveTrack],
+    binned: BinnedImage,
+    colour_noise: float,
+    accel_gain: float | Sequence[float] = 1.0,
 ) -> None:
     """:meth:`LiveTrack.predict` for every track at once.
 
@@ -309,22 +312,24 @@ def predict_tracks(
         This frame's bins.
     colour_noise : float
         Standard deviation of the colour filter's centre, in heights.
-    accel_gain : float
-        Multiplies each centre filter's `accel` (:meth:`MultiObjectTracker.motion_gain`).
+    accel_gain : float or sequence of float
+        Multiplies each centre filter's `accel` (:meth:`MultiObjectTracker.motion_gain`): one
+        factor for every track, or one per track (each track's class's).
     """
     if not tracks:
         return
+    gains = accel_gain if isinstance(accel_gain, Sequence) else [accel_gain] * len(tracks)
     summary = step_filters_summary([t.filter for t in tracks], binned).tolist()
     # Floats, not arrays over the tracks: with a few to tens of tracks, the 30-odd NumPy calls
     # on (K, 1) and (K, 2) arrays cost more than the loop (issue 17). The new positions,
     # velocities and boxes go into one array, whose rows the tracks take.
     rows = []
-    for t, (zx, zy, rho, rho_max) in zip(tracks, summary, strict=True):
+    for t, (zx, zy, rho, rho_max), gain in zip(tracks, summary, gains, strict=True):
         m = t.motion
         w, h = t.size.tolist()
         (px, py), (vx, vy) = m.p.tolist(), m.v.tolist()
         p00, p01, p11 = _floats(m.cov)
-        q = (m.accel * accel_gain if accel_gain != 1.0 else m.accel) * h
+        q = (m.accel * gain if gain != 1.0 else m.accel) * h
         q = q * q  # (accel h)²
         # cv_predict over one frame (dt = 1: its products by dt are exact)
         px, py = px + vx, py + vy

@@ -15,6 +15,7 @@ one joint sampler replaces all of this (:mod:`.joint`).
 from __future__ import annotations
 
 import bisect
+import copy
 import dataclasses
 import inspect
 import itertools
@@ -186,9 +187,10 @@ class MultiObjectTracker:
         self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
         self._background_ok = True  # False while the camera moves (see .camera)
         self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
-        # confirmed tracks' speeds (see motion_gain), the most recent ones
-        self._speeds = RollingMedian(MAX_SPEED_SAMPLES)
-        self._gain = 1.0
+        # confirmed tracks' speeds and the gain they give, per class (see motion_gain): fast
+        # cars never raise the people's noise; the most recent samples of each class
+        self._speeds: dict[int, RollingMedian] = {}
+        self._gains: dict[int, float] = {}
 
     def _take(self, method: str) -> None:
         """Hold the tracker for one call, without waiting (RuntimeError naming `method`).
@@ -211,6 +213,12 @@ class MultiObjectTracker:
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
+        speeds = state.get("_speeds")
+        if isinstance(speeds, RollingMedian):  # a checkpoint made when every class shared one
+            classes = {0} | {t.cls for t in state.get("tracks", [])}
+            gain = state.pop("_gain", 1.0)
+            state["_speeds"] = {c: copy.deepcopy(speeds) for c in classes}
+            state["_gains"] = dict.fromkeys(classes, gain)
         self.__dict__.update(state)
         self._busy = threading.Lock()  # a checkpoint pickled before the lock had none
 
@@ -317,12 +325,13 @@ class MultiObjectTracker:
                 )
         return boxes, scores, labels
 
-    def _detections(self, frame: NDArray[np.uint8], given: tuple[F64, F64] | None
+    def _detections(self, frame: NDArray[np.uint8],
+                    given: tuple[F64, F64, NDArray[np.int64]] | None
                     ) -> tuple[F64, F64, BinnedImage]:  # fmt: skip
         """Return this frame's boxes, scores and bins.
 
-        The built-in detector's (with foreground-only bins), or the caller's checked boxes and
-        scores (`given`), refined, with full-frame bins.
+        The built-in detector's (with foreground-only bins), or the caller's checked boxes,
+        scores and classes (`given`), refined (:meth:`_refine`), with full-frame bins.
         """
         cfg = self.config
         if given is None:
@@ -335,7 +344,7 @@ class MultiObjectTracker:
                 if binned is None:  # binned on demand: only the pixels the boxes read
                     binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)
             return boxes, np.asarray(det.scores, dtype=np.float64), binned
-        boxes, scores = given
+        boxes, scores, labels = given
         mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
             mask, binned, shaded = self._foreground(frame)
@@ -344,11 +353,38 @@ class MultiObjectTracker:
         # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
         # useful (measured in experiments/moving_camera.py)
         if cfg.refine.enabled and mask is not None and len(boxes):
-            fill = cfg.refine.leg_fill if shaded else None
-            boxes = refine_boxes(
-                boxes, mask, cfg.refine.fraction, leg_fill=fill, min_height=cfg.refine.min_height
-            )
+            boxes = self._refine(boxes, labels, mask, shaded)
         return boxes, scores, binned
+
+    def _refine(
+        self, boxes: F64, labels: NDArray[np.int64], mask: NDArray[np.uint8], shaded: bool
+    ) -> F64:
+        """`boxes` shrunk to their foreground in `mask` (with shadows, 127, when `shaded`).
+
+        The boxes of an upright class (:attr:`RefineConfig.upright_classes`) get the upright
+        person's prior: legs the shadow test took grow back down (`leg_fill`), a cut to less
+        than `min_height` keeps the box's rows. Other classes' boxes are shrunk to their
+        foreground alone, shadows as background: a car's shadow below it fills its columns, and
+        the person's prior grew the car's box down through it.
+        """
+        refine = self.config.refine
+        upright = refine.upright_classes
+        fill = refine.leg_fill if shaded else None
+        person = None
+        if upright is not None and (0 not in upright or labels.any()):  # else: the usual frame
+            person = np.isin(labels, upright)
+        if person is None or person.all():  # every box upright (people, or every class)
+            return refine_boxes(
+                boxes, mask, refine.fraction, leg_fill=fill, min_height=refine.min_height
+            )
+        out: F64 = boxes.copy()
+        if person.any():
+            out[person] = refine_boxes(
+                boxes[person], mask, refine.fraction, leg_fill=fill, min_height=refine.min_height
+            )
+        plain = foreground_only(mask) if shaded else mask
+        out[~person] = refine_boxes(boxes[~person], plain, refine.fraction)
+        return out
 
     @property
     def last_mask(self) -> NDArray[np.uint8] | None:
@@ -424,27 +460,42 @@ class MultiObjectTracker:
 
     @property
     def speed(self) -> float | None:
-        """The median speed of the confirmed tracks so far, heights per frame (None: no sample).
+        """Class 0's :meth:`speed_of` (a run without classes: every track's)."""
+        return self.speed_of(0)
+
+    def speed_of(self, cls: int = 0) -> float | None:
+        """The median speed of class `cls`'s confirmed tracks so far, heights per frame.
 
         Each sample is a confirmed track's distance between two of its matched detections
         ``MotionConfig.speed_span`` or more frames apart, over its height and the frames between.
+        None: no sample of that class.
         """
-        return self._speeds.median()
+        speeds = self._speeds.get(cls)
+        return None if speeds is None else speeds.median()
 
-    def motion_gain(self) -> float:
-        """The factor of the per-frame acceleration levels for the speed measured so far.
+    def motion_gain(self, cls: int = 0) -> float:
+        """The factor of class `cls`'s per-frame acceleration levels for its measured speed.
 
         ``max(1, speed / speed_reference) ** 1.5`` (``MotionConfig.speed_reference``; 1 when it is
-        None or before 20 speed samples). Continuous white-noise acceleration of density ``q``
-        gives a position variance of ``q dt^3 / 3`` over a step ``dt``: footage whose objects
-        move `k` times further per frame (a `k` times lower frame rate) needs ``k^1.5`` times
-        the acceleration's standard level per frame.
+        None or before 20 speed samples of the class). Continuous white-noise acceleration of
+        density ``q`` gives a position variance of ``q dt^3 / 3`` over a step ``dt``: footage
+        whose objects move `k` times further per frame (a `k` times lower frame rate) needs
+        ``k^1.5`` times the acceleration's standard level per frame. Each class (the
+        ``classes`` of :meth:`update`) has its own speed and gain: fast cars in a scene leave
+        the people's levels as they are (was: one median over every class, so cars at 0.5
+        heights a frame raised the walkers' noise 14-fold).
         """
         ref = self.config.motion.speed_reference
-        median = self._speeds.median()
-        if ref is None or median is None or len(self._speeds) < MIN_SPEED_SAMPLES:
+        speeds = self._speeds.get(cls)
+        median = None if speeds is None else speeds.median()
+        if ref is None or speeds is None or median is None or len(speeds) < MIN_SPEED_SAMPLES:
             return 1.0
         return float(max(1.0, median / ref) ** 1.5)
+
+    @property
+    def motion_gains(self) -> dict[int, float]:
+        """:meth:`motion_gain` of each class that has speed samples."""
+        return {c: self.motion_gain(c) for c in self._speeds}
 
     @property
     def tracks_started(self) -> int:
@@ -567,7 +618,7 @@ class MultiObjectTracker:
             warp_tracks(self.tracks, step.apply)
         self._background_ok = step.background_ok
         self.camera_step = step
-        boxes, scores, binned = self._detections(f, None if given is None else given[:2])
+        boxes, scores, binned = self._detections(f, given)
         labels = np.zeros(len(boxes), np.int64) if given is None else given[2]
         tiny = tiny_inside(boxes, f.shape, cfg.lifecycle.min_area)
         index = ((scores >= cfg.lifecycle.min_score) & ~tiny).nonzero()[0]
@@ -615,7 +666,8 @@ class MultiObjectTracker:
             return joint
 
         # 1. every track's particle filter looks at this frame, its centre filter predicts
-        predict_tracks(self.tracks, binned, cfg.motion.colour_noise, self._gain)
+        gains = [self._gains.get(t.cls, 1.0) for t in self.tracks]  # each class's own
+        predict_tracks(self.tracks, binned, cfg.motion.colour_noise, gains)
 
         # 2. association
         if len(boxes):
@@ -739,19 +791,25 @@ class MultiObjectTracker:
     def _measure_speeds(
         self, followed: list[tuple[int, int]], boxes: F64, cfg: TrackerConfig
     ) -> None:
-        """Speed samples of the confirmed tracks that followed a detection; the new gain."""
+        """Speed samples of the confirmed tracks that followed a detection; the new gains."""
         n = cfg.lifecycle.min_hits
         span = cfg.motion.speed_span
         dis = [di for _, di in followed]
         b = boxes[dis]
         centres = (b[:, :2] + b[:, 2:4] / 2).tolist()
         heights = b[:, 3].tolist()
+        sampled = set()
         for (ti, _), centre, h in zip(followed, centres, heights, strict=True):
             t = self.tracks[ti]
             v = t.speed(self.frame_index, centre, h, span)
             if v is not None and t.hits >= n:
-                self._speeds.add(v)
-        self._gain = self.motion_gain()
+                speeds = self._speeds.get(t.cls)
+                if speeds is None:
+                    speeds = self._speeds[t.cls] = RollingMedian(MAX_SPEED_SAMPLES)
+                speeds.add(v)
+                sampled.add(t.cls)
+        for c in sampled:
+            self._gains[c] = self.motion_gain(c)
 
 
 def canonical_order(boxes: F64, scores: F64, labels: NDArray[np.int64]) -> NDArray[np.intp]:

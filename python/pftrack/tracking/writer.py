@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from typing import Any
 
 import numpy as np
@@ -170,7 +170,8 @@ class TrackWriter:
             self.rows.extend(rows, boxes)
 
     def result(self, drop: Collection[int] = (), crossings: CrossingConfig | None = None,
-               relink_coast: int | None = None) -> F64:  # fmt: skip
+               relink_coast: int | None = None,
+               smoothers: Mapping[int, BoxSmoother] | None = None) -> F64:  # fmt: skip
         """All rows written so far, (M, 10), sorted by frame then id.
 
         Linked and smoothed when the writer has a link config and a smoother, each class's tracks
@@ -179,8 +180,12 @@ class TrackWriter:
         least that many coasted frames is cut there before linking
         (:func:`~.offline.split_refound`). With `crossings` (enabled), tracks swapped where
         they crossed are exchanged back after linking (:func:`~.offline.repair_crossings`).
-        :attr:`classes` gets the class of each id of the result.
+        :attr:`classes` gets the class of each id of the result. `smoothers` gives a class its
+        own smoother (levels grown with that class's speed,
+        :meth:`~pftrack.tracking.tracker.MultiObjectTracker.motion_gain`); the others, and
+        every class when None, get :attr:`smoother`.
         """
+        own = {} if smoothers is None or self.smoother is None else smoothers
         self.classes = {}
         a, boxes, observed = self.rows.arrays()
         if len(drop):
@@ -193,8 +198,9 @@ class TrackWriter:
         cls = np.array([self._cls.get(int(i), 0) for i in a[:, 1]], np.int64)
         classes = np.unique(cls)
         if len(classes) == 1:
+            smoother = own.get(int(classes[0]), self.smoother)
             rows = smooth_tracks(
-                a, observed, self.smoother, self.link, z, crossings=crossings,
+                a, observed, smoother, self.link, z, crossings=crossings,
                 relink_coast=relink_coast,
             )  # fmt: skip
             ids = np.unique(rows[:, 1]).astype(int).tolist()
@@ -207,7 +213,8 @@ class TrackWriter:
         for c in classes:
             k = cls == c
             out = smooth_tracks(
-                a[k], observed[k], self.smoother, self.link, z[k], crossings=crossings,
+                a[k], observed[k], own.get(int(c), self.smoother), self.link, z[k],
+                crossings=crossings,
                 relink_coast=relink_coast,
             )  # fmt: skip
             new = np.setdiff1d(out[:, 1], a[k, 1])
