@@ -272,8 +272,8 @@ def run(args: argparse.Namespace) -> int:
         scores_json,
     )
     from pftrack.io.atomic import atomic_write, check_output
-    from pftrack.io.mot import read_mot
-    from pftrack.recovery.linking import check_file_ids
+    from pftrack.io.mot import data_line_numbers, read_mot
+    from pftrack.recovery.linking import check_file_ids, check_negative_ids
 
     _check_scales(args.scale or [])
     jobs = _jobs(args)
@@ -290,8 +290,10 @@ def run(args: argparse.Namespace) -> int:
     for name, seq, path in jobs:  # read and check everything before scoring anything
         gt = read_mot(seq.gt_path, what="ground truth")
         res = read_mot(path, what="result file")
-        check_file_ids(gt, seq.gt_path)  # 1.5 is refused, as recover does (was: scored as 1)
-        check_file_ids(res, path)
+        for rows, file in ((gt, seq.gt_path), (res, path)):
+            check_file_ids(rows, file)  # 1.5 is refused, as recover does (was: scored as 1)
+            if np.any(rows[:, 1] < -1):  # FILE:LINE, as recover says it (id -1: the scorers')
+                check_negative_ids(rows, data_line_numbers(file), file)
         if not args.no_scale_check:
             # several sequences: the fix is this one's scale, --scale NAME=S (was --scale S)
             several = name if len(jobs) > 1 else None

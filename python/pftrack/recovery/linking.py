@@ -664,17 +664,18 @@ def check_tracked(
     *,
     who: str | None = None,
 ) -> None:
-    """Refuse rows of id -1 (ValueError naming the first, its frame and how many there are).
+    """Refuse rows of id -1, then of other negative ids (ValueError naming the first row).
 
     Id -1 is MOTChallenge's id of a box no track holds (a detection file's every row, the
     unassociated boxes some trackers write beside their tracks): taken as one track, its rows
     had their holes filled, their boxes smoothed and linked to other tracks, each across
     unrelated objects. As ``pftrack eval`` refuses them (TrackEval cannot score them). Other
-    negative ids are tracks. With `line_numbers` and `path` the message starts with
-    ``FILE:LINE:``; else with ``WHO:``. `rows` are checked (M, 10) rows.
+    negative ids are refused next (:func:`check_negative_ids`). With `line_numbers` and `path`
+    the message starts with ``FILE:LINE:``; else with ``WHO:``. `rows` are checked (M, 10) rows.
     """
     loose = rows[:, 1] == -1
     if not loose.any():
+        check_negative_ids(rows, line_numbers, path, who=who)
         return
     k, n = int(np.argmax(loose)), int(loose.sum())
     frame, many = int(rows[k, 0]), f"{counted(n, 'row')} {'has' if n == 1 else 'have'} it"
@@ -689,13 +690,46 @@ def check_tracked(
     )
 
 
+def check_negative_ids(
+    rows: F64,
+    line_numbers: Iterable[int] | None = None,
+    path: PathLike | None = None,
+    *,
+    who: str | None = None,
+) -> None:
+    """Refuse ids below -1 (ValueError naming the first, its frame and how many rows have it).
+
+    ``pftrack eval`` refuses a negative id, on which TrackEval fails (an IndexError, or "the
+    same ID more than once" of another id): a track of id -5 was filled, smoothed and linked
+    by ``recover`` and ``smooth``, then could not be scored. Id -1 is :func:`check_tracked`'s.
+    With `line_numbers` and `path` the message starts with ``FILE:LINE:``; else with
+    ``WHO:``. `rows` are checked (M, 10) rows.
+    """
+    negative = rows[:, 1] < -1
+    if not negative.any():
+        return
+    k = int(np.argmax(negative))
+    bad = rows[k, 1]
+    n = int(np.sum(rows[:, 1] == bad))
+    frame, many = int(rows[k, 0]), f"{counted(n, 'row')} {'has' if n == 1 else 'have'} it"
+    if line_numbers is not None and path is not None:
+        head = f"{path}:{list(line_numbers)[k]}: id {bad:.0f} in frame {frame} ({many})"
+    else:
+        head = f"{who or 'check_negative_ids'}: row {k} has id {bad:.0f} (frame {frame}; {many})"
+    raise ValueError(
+        f"{head}: track ids must be >= 0, as pftrack eval and TrackEval require them (-1 alone "
+        "has a meaning: a box no track holds); renumber the tracks"
+    )
+
+
 def read_tracks(path: PathLike, what: str = "tracks file", *, tracks_only: bool = True) -> F64:
     """Read a tracks file whose ids are integers and (frame, id) pairs unique (errors name lines).
 
     :func:`pftrack.io.mot.read_mot` (`what` names the file in its errors), the ids' check
     (``FILE:LINE``), then :func:`check_unique` (``FILE:LINE: duplicate rows ...``); the file
     is read a second time, for its line numbers, only when a pair repeats. Rows of id -1
-    (unassociated boxes) are refused by :func:`check_tracked` unless `tracks_only` is False
+    (unassociated boxes) and of other negative ids are refused by :func:`check_tracked`
+    unless `tracks_only` is False
     (``pftrack render`` draws them). What ``pftrack
     recover`` and ``pftrack smooth`` read, one file or many, and ``pftrack experiment gaps``
     its ground truth (``what="ground truth"``). Lines of more than 10 columns give one
@@ -709,7 +743,7 @@ def read_tracks(path: PathLike, what: str = "tracks file", *, tracks_only: bool 
         check_unique(rows)
     except ValueError:
         check_unique(rows, data_line_numbers(path), path)
-    if tracks_only and np.any(rows[:, 1] == -1):
+    if tracks_only and np.any(rows[:, 1] < 0):
         check_tracked(rows, data_line_numbers(path), path)
     _warn_padded_flags(rows, path)
     _warn_normalised(rows, path)
