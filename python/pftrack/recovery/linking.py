@@ -86,8 +86,9 @@ class LinkConfig:
         Points used to fit each fragment's end velocity.
     max_area_ratio : float or None
         Gate on the boxes that meet: their areas may differ by at most this factor (None: no
-        gate). Two one-row fragments of ByteTrack's false positives on TUD-Campus, 4.1 times
-        apart in area, were joined across 30 frames and the hole filled. Chosen on the
+        gate); a box without area meets only another without. Two one-row fragments of
+        ByteTrack's false positives on TUD-Campus, 4.1 times apart in area, were joined
+        across 30 frames and the hole filled. Chosen on the
         outputs of four trackers (SORT, ByteTrack, norfair, motpy) on five sequences
         smoothed by ``pftrack smooth`` (docs/results.md), among a factor of 2, 2.5 or 3 on each
         side and 3 or 4 on the area: the highest sums of MOTA and IDF1 gains with no row
@@ -285,13 +286,14 @@ def _fragment_ends(tracks: dict[int, F64], points: int) -> tuple[F64, F64]:
 def _sizes_apart(a: F64, b: F64, ratio: float | None) -> NDArray[np.bool_]:
     """Whether boxes of sizes `a` and `b` differ in area by more than `ratio`.
 
-    `a`, `b`: ``(n, 2)`` heights and widths; a box without area is not compared.
+    `a`, `b`: ``(n, 2)`` heights and widths. A box without area (a width or height of 0) is
+    apart from every box with one, and not from another without (was: not compared, so a
+    fragment ending in a 0 x 46 px box was joined to one starting 68 x 86 px).
     """
     if ratio is None:
         return np.zeros(len(a), bool)
     area_a, area_b = a[:, 0] * a[:, 1], b[:, 0] * b[:, 1]
-    sized = (area_a > 0) & (area_b > 0)
-    return sized & (np.maximum(area_a, area_b) > ratio * np.minimum(area_a, area_b))
+    return np.maximum(area_a, area_b) > ratio * np.minimum(area_a, area_b)
 
 
 #: Candidate pairs gated at once by :func:`link_costs`: memory stays bounded by the pairs that
