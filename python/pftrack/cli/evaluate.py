@@ -273,8 +273,8 @@ def run(args: argparse.Namespace) -> int:
         scores_json,
     )
     from pftrack.io.atomic import atomic_write, check_output
-    from pftrack.io.mot import data_line_numbers, read_mot
-    from pftrack.recovery.linking import check_file_ids, check_negative_ids
+    from pftrack.io.mot import read_mot
+    from pftrack.recovery.linking import check_scored_ids
 
     _check_scales(args.scale or [])
     jobs = _jobs(args)
@@ -298,10 +298,9 @@ def run(args: argparse.Namespace) -> int:
             if shown:  # off a terminal nothing is counted, as the scorers report nothing
                 reading.set(2 * len(loaded) + 1)
             res = read_mot(path, what="result file")
-            for rows, file in ((gt, seq.gt_path), (res, path)):
-                check_file_ids(rows, file)  # 1.5 is refused, as recover does (was: scored as 1)
-                if np.any(rows[:, 1] < -1):  # FILE:LINE, as recover says (id -1: the scorers')
-                    check_negative_ids(rows, data_line_numbers(file), file)
+            # 1.5 is refused, as recover does (was: scored as 1), and -5 named by its line
+            check_scored_ids(gt, seq.gt_path)
+            check_scored_ids(res, path)
             if not args.no_scale_check:
                 # several sequences: the fix is this one's scale, --scale NAME=S (was --scale S)
                 several = name if len(jobs) > 1 else None

@@ -619,6 +619,20 @@ def check_file_ids(rows: F64, path: PathLike) -> None:
         raise ValueError(f"{path}:{lineno}: {bad_id_message(rows[k, 1])}: {text[:80]!r}")
 
 
+def check_scored_ids(rows: F64, path: PathLike) -> None:
+    """Refuse the ids of a file to score: not integers, or below -1 (``FILE:LINE: ...``).
+
+    :func:`check_file_ids`, then :func:`check_negative_ids` named by the file's line: what
+    ``pftrack eval`` and ``pftrack batch`` check of the files they score (id -1 is the
+    scorers' to refuse, with its hint of a detections file).
+    """
+    from pftrack.io.mot import data_line_numbers
+
+    check_file_ids(rows, path)
+    if np.any(rows[:, 1] < -1):
+        check_negative_ids(rows, data_line_numbers(path), path)
+
+
 def check_unique(
     rows: ArrayLike,
     line_numbers: Iterable[int] | None = None,
