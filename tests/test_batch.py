@@ -679,6 +679,23 @@ def test_a_truth_with_a_fractional_id_is_named_by_its_line(data: Path, tmp_path:
     )
 
 
+def test_a_truth_with_a_negative_id_is_named_by_its_line(data: Path, tmp_path: Path) -> None:
+    """Was ``ground truth has id -5 in frame 1: ids must be >= 0 ...``, without the line,
+    where ``pftrack eval`` (and ``recover``) say ``gt.txt:31: id -5 in frame 1 ...``."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    gt = seq / "gt" / "gt.txt"
+    lines = gt.read_text().splitlines(keepends=True)
+    gt.write_text("".join(lines[:30]) + "1,-5,10,10,20,40,1,1,1\n" + "".join(lines[30:]))
+    summary = track_many(seq, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    (entry,) = summary.entries
+    assert entry["error"] == (
+        f"scoring against {gt} (the tracks are written): {gt}:31: id -5 in frame 1 (1 row has "
+        "it): track ids must be >= 0, as pftrack eval and TrackEval require them (-1 alone has "
+        "a meaning: a box no track holds); renumber the tracks"
+    )
+
+
 def test_resume_skips_complete_outputs_and_force_redoes(
     data: Path, client: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -9,6 +9,7 @@ from collections.abc import Iterator
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack._text import counted
 from pftrack._typing import F64, RngLike
 
 __all__ = [
@@ -143,6 +144,23 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
     if raw.dtype.kind not in ("biuf" if booleans else "iuf"):
         raise TypeError(f"{what} must hold real numbers, got dtype {raw.dtype}")
     return raw.astype(np.float64, copy=False)
+
+
+def refuse_masked_weights(weights: object, fn: str) -> None:
+    """TypeError when `weights` of `fn` is a ``numpy.ma.MaskedArray`` with a masked entry.
+
+    ``np.asarray`` drops the mask and keeps the values under it: masked particles were
+    resampled and weighed as any other (filterpy fails with an IndexError). Whether a masked
+    weight means 0 or a value to skip is the caller's to say (``weights.filled(0)``); a masked
+    array with nothing masked is its values. Shared by the resamplers and ``estimate``.
+    """
+    if isinstance(weights, np.ma.MaskedArray) and np.ma.is_masked(weights):
+        n = int(np.count_nonzero(np.ma.getmaskarray(weights)))
+        raise TypeError(
+            f"{fn}: weights is a numpy.ma.MaskedArray with {counted(n, 'masked value')}, whose "
+            "mask NumPy would drop (the masked values used as they are); pass "
+            "weights.filled(0) to give masked particles weight 0"
+        )
 
 
 #: Columns 7-10 of a MOTChallenge row (conf, x, y, z) where rows have fewer: the values

@@ -16,6 +16,7 @@ from pftrack.particle_filter import (
     bhattacharyya_distance,
     bhattacharyya_weights,
     box_histograms,
+    estimate,
     hsv_bins,
     multinomial_resample,
     propagate,
@@ -70,6 +71,32 @@ def test_resample_messages_name_the_function_and_no_particle_filter(fn):
         TypeError, match=rf"^{name}: weights must be an array or a sequence, got generator"
     ):
         fn((w for w in [0.5, 0.5]), rng=0)  # was "must be numeric, got dtype object"
+
+
+@pytest.mark.parametrize("fn", [*RESAMPLERS, estimate])
+def test_masked_weights_are_refused_not_unmasked(fn):
+    """Was: the mask dropped (np.asarray), the masked particle resampled (systematic_resample
+    gave [1, 2, 3, 3], particle 3 masked; filterpy fails with an IndexError) and weighed in
+    estimate's mean. A mask may mean weight 0 or a value to skip: the caller says which."""
+    name = fn.__name__
+    particles = np.arange(24.0).reshape(4, 6)
+
+    def call(weights):
+        return fn(particles, weights) if fn is estimate else fn(weights, rng=0)
+
+    w = np.ma.masked_array([0.1, 0.2, 0.3, 0.4], mask=[False, False, False, True])
+    with pytest.raises(TypeError) as exc:
+        call(w)
+    assert str(exc.value) == (
+        f"{name}: weights is a numpy.ma.MaskedArray with 1 masked value, whose mask NumPy "
+        "would drop (the masked values used as they are); pass weights.filled(0) to give "
+        "masked particles weight 0"
+    )
+    plain = np.ma.masked_array([0.1, 0.2, 0.3, 0.4])  # nothing masked: its values
+    np.testing.assert_array_equal(np.asarray(call(plain)), np.asarray(call(plain.data)))
+    np.testing.assert_array_equal(
+        np.asarray(call(w.filled(0))), np.asarray(call([0.1, 0.2, 0.3, 0]))
+    )
 
 
 def test_the_particle_filter_keeps_its_zero_weights_hint():

@@ -70,6 +70,48 @@ def test_the_bar_counts_the_frames_of_one_long_sequence_as_it_is_scored(
     assert capsys.readouterr().out == table and not seen
 
 
+def test_reading_and_checking_the_files_is_a_first_stage_on_the_bar(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: nothing drawn while the files were read and checked, 5 s of a pair of 100 000
+    frames (reading 2 s, the scale check 3 s) before the frames' bar appeared. Now a bar of
+    the files, each counted once read and checked; the table is the same."""
+    import pftrack.io.mot as mot
+
+    err, seen = on_a_terminal(monkeypatch)
+    stages: list[tuple[int | None, str, str]] = []
+    real_init = _progress.Bar.__init__
+
+    def init(bar: _progress.Bar, total: int | None, **kwargs: object) -> None:
+        stages.append((total, str(kwargs.get("desc")), str(kwargs.get("unit"))))
+        real_init(bar, total, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(_progress.Bar, "__init__", init)
+    read: list[int] = []  # how many counts the bar had as each file was read
+    real = mot.read_mot  # eval imports it when it runs: the spy is what it gets
+
+    def spy(path: object, **kwargs: object) -> object:
+        read.append(len(seen))
+        return real(path, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(mot, "read_mot", spy)
+    cases = {"A": long_case(400, 1), "B": long_case(600, 2)}
+    for name, (gt, res) in cases.items():
+        write_rows(tmp_path / "gt" / name / "gt" / "gt.txt", gt)
+        write_rows(tmp_path / "res" / f"{name}.txt", res)
+    argv = ["eval", "--gt", str(tmp_path / "gt"), "--res", str(tmp_path / "res")]
+    assert main(argv) == 0
+    table = capsys.readouterr().out
+    assert stages[0] == (4, "eval reading", "file")  # before the frames' bar
+    assert stages[1][2] == "frame"
+    assert seen[:4] == [1, 2, 3, 4]  # one count per file, the result's once checked
+    assert read == [0, 1, 2, 3]  # each file read before it is counted
+    assert "eval reading: 100%" in err.getvalue() and "4/4" in err.getvalue()
+    seen.clear()
+    assert main(["-q", *argv]) == 0
+    assert capsys.readouterr().out == table and not seen
+
+
 def test_the_bar_counts_every_sequence_of_a_folder(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -820,9 +820,10 @@ def test_negative_ids_are_refused_as_trackeval_refuses_them(tmp_path, capsys):
     write_mot(tmp_path / "res.txt", neg)
     argv = ["eval", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt")]
     assert main(argv) == 2
-    assert capsys.readouterr().err == (
-        f"pftrack eval: error: {tmp_path / 'res.txt'}: result has id -5 in frame 4: ids must be "
-        ">= 0, as TrackEval requires\n"
+    assert capsys.readouterr().err == (  # named by its line, as recover names it
+        f"pftrack eval: error: {tmp_path / 'res.txt'}:5: id -5 in frame 4 (2 rows have it): "
+        "track ids must be >= 0, as pftrack eval and TrackEval require them (-1 alone has a "
+        "meaning: a box no track holds); renumber the tracks\n"
     )
 
 

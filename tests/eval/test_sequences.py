@@ -295,6 +295,36 @@ def test_scale_mismatch_refused(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert "-" in capsys.readouterr().out.split("\n")[2]  # a negative MOTA, as asked
 
 
+def test_the_scale_check_scores_only_the_rows_of_its_sampled_frames(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Was: each factor tried (46 on a result at PETS09's ratio) went through every row once
+    per sampled frame: 2.9 s of CPU for 200 000 rows, about 30 s for a file of 1.9 million,
+    before the message. Now the sampled frames' rows are taken once; the message is the same."""
+    import pftrack.eval.sequences as sequences
+
+    gt = np.vstack([spread_scene(0)] + [spread_scene(0) + [[k * 100] + [0] * 9] for k in (1, 2)])
+    res = perturbed(gt, 1)
+    res[:, 2:6] *= 0.625
+    with pytest.raises(ValueError) as plain:
+        check_scale(gt, res)
+    given: list[int] = []
+    real = sequences._matched_fraction
+
+    def spy(g: np.ndarray, r: np.ndarray, *args: object) -> float:
+        given.append(len(g) + len(r))
+        return real(g, r, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(sequences, "_matched_fraction", spy)
+    with pytest.raises(ValueError) as spied:
+        check_scale(gt, res)
+    assert str(spied.value) == str(plain.value) and "pass --scale 0.625" in str(plain.value)
+    frames = np.intersect1d(gt[:, 0], res[:, 0])
+    sample = frames[np.linspace(0, len(frames) - 1, 40).astype(int)]  # 40 of 300 frames
+    rows = int(np.isin(gt[:, 0], sample).sum() + np.isin(res[:, 0], sample).sum())
+    assert len(given) > 20 and set(given) == {rows}, (rows, sorted(set(given)))
+
+
 def _named_scale(gt: np.ndarray, res: np.ndarray, scale: float) -> tuple[float, str]:
     """The factor check_scale's message tells to pass as --scale, and the message."""
     with pytest.raises(ValueError, match=r"pass --scale ") as refused:

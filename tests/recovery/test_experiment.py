@@ -346,7 +346,35 @@ def test_rows_of_id_minus_1_among_tracks_are_refused() -> None:
             "box no track holds (an unassociated detection), not a track; drop those rows, or "
             "make tracks of them (pftrack track SOURCE --detections FILE)"
         )
-    fill_gaps(np.vstack([rows, loose * [1, -5, 1, 1, 1, 1, 1, 1, 1, 1]]))  # id 5: a track
+
+
+def test_rows_of_other_negative_ids_are_refused_as_eval_refuses_them() -> None:
+    """Was: a track of id -5 filled, smoothed and linked, where ``pftrack eval`` (and TrackEval:
+    an IndexError, or id -5 scored as another id) refuse it: ids must be >= 0 everywhere."""
+    from pftrack.recovery import fill_gaps, link_tracklets
+    from pftrack.recovery.linking import LinkConfig
+    from pftrack.tracking import smooth_tracks
+    from pftrack.tracking.offline import repair_crossings
+
+    rows = _walkers(n_ids=2, n_frames=10)
+    neg = np.array([[5, -5, 300, 200, 20, 40, 0.5, -1, -1, -1],
+                    [1, -5, 100, 100, 20, 40, 0.5, -1, -1, -1]])  # fmt: skip
+    mixed = np.vstack([rows, neg])
+    for who, call in (
+        ("fill_gaps", lambda: fill_gaps(mixed)),
+        ("smooth_tracks", lambda: smooth_tracks(mixed)),
+        ("link_tracklets", lambda: link_tracklets(mixed, LinkConfig())),
+        ("repair_crossings", lambda: repair_crossings(mixed)),
+    ):
+        with pytest.raises(ValueError) as exc:
+            call()
+        assert str(exc.value) == (
+            f"{who}: row 20 has id -5 (frame 5; 2 rows have it): track ids must be >= 0, as "
+            "pftrack eval and TrackEval require them (-1 alone has a meaning: a box no track "
+            "holds); renumber the tracks"
+        )
+    zero = np.vstack([rows, neg * [1, 0, 1, 1, 1, 1, 1, 1, 1, 1]])  # id 0: a track
+    assert len(fill_gaps(zero)[0]) == 20 + 2 + 3  # its hole of frames 2-4 filled
 
 
 @pytest.mark.parametrize("command", ["recover", "smooth"])
@@ -364,6 +392,30 @@ def test_recover_of_tracks_with_id_minus_1_rows_refuses_them(
         f"pftrack {command}: error: {src}:4: id -1 in frame 1 (2 rows have it): -1 is "
         "MOTChallenge's id of a box no track holds (an unassociated detection), not a track; "
         "drop those rows, or make tracks of them (pftrack track SOURCE --detections FILE)\n"
+    )
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth", "eval"])
+def test_a_file_of_negative_ids_is_refused_by_every_command_naming_its_line(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: recover and smooth filled the hole of track -5 (exit 0), where eval refused it
+    without naming the line."""
+    src = tmp_path / "t.txt"
+    out = tmp_path / ("o.csv" if command == "eval" else "o.txt")
+    src.write_text(
+        "1,1,10,10,20,40,1\n2,1,12,10,20,40,1\n1,-5,300,200,20,40,0.5\n"
+        "5,-5,100,100,20,40,0.5\n6,1,20,10,20,40,1\n"
+    )
+    gt = tmp_path / "gt.txt"
+    gt.write_text("1,1,10,10,20,40,1\n1,2,300,200,20,40,1\n")
+    argv = ["--gt", str(gt), "--res", str(src)] if command == "eval" else [str(src)]
+    assert main([command, *argv, "--out" if command != "eval" else "--csv", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack {command}: error: {src}:3: id -5 in frame 1 (2 rows have it): track ids must "
+        "be >= 0, as pftrack eval and TrackEval require them (-1 alone has a meaning: a box no "
+        "track holds); renumber the tracks\n"
     )
     assert not out.exists()
 

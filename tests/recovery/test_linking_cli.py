@@ -551,3 +551,32 @@ def test_boxes_four_times_apart_in_area_are_not_linked(tmp_path, capsys):
     for bad in (0.5, float("nan"), True, "4"):
         with pytest.raises(ValueError, match="LinkConfig.max_area_ratio is"):
             LinkConfig(max_area_ratio=bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("zero", [(4,), (5,), (4, 5)])
+def test_a_box_without_area_does_not_slip_past_the_area_gate(zero, tmp_path):
+    """Was: a box of width or height 0 was not compared (a ratio with a 0 in it), so the
+    fragment it ends was joined to one of any size: 0 x 46 px to 68 x 86 px, 30 frames filled.
+    A box without area is as far in area from any box with one as the gate can tell."""
+    rows = np.array([
+        [7, 8, 66.5255, 212.778, 30.7028, 46.31, 0.685141, -1, -1, -1],
+        [38, 16, 34.3067, 166.579, 68.0333, 86.014, 0.588207, -1, -1, -1],
+    ])  # fmt: skip
+
+    def flat(which: list[int]) -> np.ndarray:
+        """`rows` with the boxes of rows `which` made 0 wide or tall about their centres."""
+        out = rows.copy()
+        for c in zero:
+            out[which, c - 2] += out[which, c] / 2  # the centre stays: the motion gate too
+            out[which, c] = 0.0
+        return out
+
+    for k in (0, 1):  # the end or the start of the join
+        assert link_tracklets(flat([k]), LinkConfig())[1] == {}
+        assert link_tracklets(flat([k]), LinkConfig(max_area_ratio=None))[1] == {16: 8}
+    # two boxes without area: neither is larger than the other
+    assert link_tracklets(flat([0, 1]), LinkConfig())[1] == {16: 8}
+    src = tmp_path / "flat.txt"
+    write_mot(src, flat([0]))
+    assert main(["-q", "smooth", str(src), "--out", str(tmp_path / "s.txt")]) == 0
+    assert len(read_mot(tmp_path / "s.txt")) == 2  # nothing filled between them

@@ -45,13 +45,8 @@ def dense_link_costs(rows: np.ndarray, config: LinkConfig) -> tuple[list[int], n
             area_i = tracks[ti][-1, 4] * tracks[ti][-1, 5]  # the boxes where they meet
             area_j = tracks[tj][0, 4] * tracks[tj][0, 5]
             r = config.max_area_ratio
-            if (
-                r is not None
-                and area_i > 0
-                and area_j > 0
-                and max(area_i, area_j) > r * min(area_i, area_j)
-            ):
-                continue
+            if r is not None and max(area_i, area_j) > r * min(area_i, area_j):
+                continue  # a box without area is apart from every box with one
             c = d / config.max_distance + config.w_gap * (gap - 1) / max(config.max_gap, 1)
             hi, hj = tracks[ti][-1, 5], tracks[tj][0, 5]
             if hi > 0 and hj > 0:

@@ -344,7 +344,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     from pftrack.eval.sequences import benchmark_of_path
     from pftrack.io.mot import as_written, read_mot
     from pftrack.io.video import FrameSource, info_scale, read_seqinfo
-    from pftrack.recovery.linking import check_file_ids
+    from pftrack.recovery.linking import check_scored_ids
     from pftrack.tracking.run import track_path
 
     cpu = time.process_time()
@@ -412,7 +412,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                     "ground truth's frames alike"
                 )
             gt = read_mot(seq.gt, what="ground truth")
-            check_file_ids(gt, seq.gt)  # FILE:LINE, as pftrack eval (was: 'row K', 0-based)
+            check_scored_ids(gt, seq.gt)  # FILE:LINE, as pftrack eval (was: 'row K', 0-based)
             # the benchmark a TrackEval tree's BENCH-SPLIT folder names, as pftrack eval takes it
             named = benchmark_of_path(seq.gt)
             metrics = sequence_metrics(

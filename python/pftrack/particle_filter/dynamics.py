@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import first_at, flag, number, real_array
+from pftrack._check import first_at, flag, number, real_array, refuse_masked_weights
 
 __all__ = ["Ar2Model", "estimate", "propagate"]
 
@@ -247,7 +247,8 @@ def estimate(
     Raises
     ------
     TypeError
-        `particles` or `weights` not real numbers (text, objects).
+        `particles` or `weights` not real numbers (text, objects); `weights` a
+        ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``).
     ValueError
         `particles` not of shape (N, 6) with N >= 1, `weights` not (N,); a weight negative or
         not finite, or all 0.
@@ -267,6 +268,7 @@ def estimate(
             f"{fn}: particles shape is {p.shape}, expected (N, 6) with N >= 1: one row "
             "(cx, cy, s, previous cx, cy, s) per particle"
         )
+    refuse_masked_weights(weights, fn)
     w = np.ascontiguousarray(real_array(weights, f"{fn}: weights"))
     if w.shape != (len(p),):
         raise ValueError(

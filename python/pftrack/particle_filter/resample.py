@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import generator
+from pftrack._check import generator, refuse_masked_weights
 from pftrack._typing import RngLike
 
 __all__ = [
@@ -47,6 +47,7 @@ def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
             f"{fn}: weights must be an array or a sequence, got {type(weights).__name__} "
             "(an iterator: make it a list or an array first)"
         )
+    refuse_masked_weights(weights, fn)
     w = np.asarray(weights)
     if np.iscomplexobj(w):
         raise TypeError(f"{fn}: weights must be real, got dtype {w.dtype}")
@@ -82,7 +83,8 @@ def systematic_resample(
     Raises
     ------
     TypeError
-        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        `weights` not real numbers (text, objects, complex numbers, an iterator) or a
+        ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
         `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
@@ -136,7 +138,8 @@ def stratified_resample(
     Raises
     ------
     TypeError
-        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        `weights` not real numbers (text, objects, complex numbers, an iterator) or a
+        ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
         `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
@@ -179,7 +182,8 @@ def multinomial_resample(
     Raises
     ------
     TypeError
-        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        `weights` not real numbers (text, objects, complex numbers, an iterator) or a
+        ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
         `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
@@ -228,7 +232,8 @@ def residual_resample(
     Raises
     ------
     TypeError
-        `weights` not real numbers (text, objects, complex numbers, an iterator), or `rng`
+        `weights` not real numbers (text, objects, complex numbers, an iterator) or a
+        ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
         `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,

@@ -262,8 +262,9 @@ def fill_gaps(
         more than 0 with ``combine=False``), `max_gap` outside ``1..MAX_GAP_LIMIT``,
         rows not ``(M, 6..10)``, a frame that is not an integer in ``1..2**31-1``, a non-integer
         id, a non-finite box, a box :func:`pftrack.io.mot.read_mot` refuses (a negative width
-        or height, a value beyond ±1e9 px), a duplicate (frame, id) or a row of id -1 (an
-        unassociated box, not a track: :func:`pftrack.recovery.linking.check_tracked`).
+        or height, a value beyond ±1e9 px), a duplicate (frame, id), a row of id -1 (an
+        unassociated box, not a track: :func:`pftrack.recovery.linking.check_tracked`) or of
+        another negative id (``pftrack eval`` and TrackEval refuse it).
     """
     rows = _check.mot_rows(tracks, "fill_gaps")  # (M, 6..10), [] too, as smooth_tracks
     # what the method does not use is refused, as the command refuses --seed (was ignored

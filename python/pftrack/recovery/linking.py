@@ -86,8 +86,9 @@ class LinkConfig:
         Points used to fit each fragment's end velocity.
     max_area_ratio : float or None
         Gate on the boxes that meet: their areas may differ by at most this factor (None: no
-        gate). Two one-row fragments of ByteTrack's false positives on TUD-Campus, 4.1 times
-        apart in area, were joined across 30 frames and the hole filled. Chosen on the
+        gate); a box without area meets only another without. Two one-row fragments of
+        ByteTrack's false positives on TUD-Campus, 4.1 times apart in area, were joined
+        across 30 frames and the hole filled. Chosen on the
         outputs of four trackers (SORT, ByteTrack, norfair, motpy) on five sequences
         smoothed by ``pftrack smooth`` (docs/results.md), among a factor of 2, 2.5 or 3 on each
         side and 3 or 4 on the area: the highest sums of MOTA and IDF1 gains with no row
@@ -285,13 +286,14 @@ def _fragment_ends(tracks: dict[int, F64], points: int) -> tuple[F64, F64]:
 def _sizes_apart(a: F64, b: F64, ratio: float | None) -> NDArray[np.bool_]:
     """Whether boxes of sizes `a` and `b` differ in area by more than `ratio`.
 
-    `a`, `b`: ``(n, 2)`` heights and widths; a box without area is not compared.
+    `a`, `b`: ``(n, 2)`` heights and widths. A box without area (a width or height of 0) is
+    apart from every box with one, and not from another without (was: not compared, so a
+    fragment ending in a 0 x 46 px box was joined to one starting 68 x 86 px).
     """
     if ratio is None:
         return np.zeros(len(a), bool)
     area_a, area_b = a[:, 0] * a[:, 1], b[:, 0] * b[:, 1]
-    sized = (area_a > 0) & (area_b > 0)
-    return sized & (np.maximum(area_a, area_b) > ratio * np.minimum(area_a, area_b))
+    return np.maximum(area_a, area_b) > ratio * np.minimum(area_a, area_b)
 
 
 #: Candidate pairs gated at once by :func:`link_costs`: memory stays bounded by the pairs that
@@ -617,6 +619,20 @@ def check_file_ids(rows: F64, path: PathLike) -> None:
         raise ValueError(f"{path}:{lineno}: {bad_id_message(rows[k, 1])}: {text[:80]!r}")
 
 
+def check_scored_ids(rows: F64, path: PathLike) -> None:
+    """Refuse the ids of a file to score: not integers, or below -1 (``FILE:LINE: ...``).
+
+    :func:`check_file_ids`, then :func:`check_negative_ids` named by the file's line: what
+    ``pftrack eval`` and ``pftrack batch`` check of the files they score (id -1 is the
+    scorers' to refuse, with its hint of a detections file).
+    """
+    from pftrack.io.mot import data_line_numbers
+
+    check_file_ids(rows, path)
+    if np.any(rows[:, 1] < -1):
+        check_negative_ids(rows, data_line_numbers(path), path)
+
+
 def check_unique(
     rows: ArrayLike,
     line_numbers: Iterable[int] | None = None,
@@ -664,17 +680,18 @@ def check_tracked(
     *,
     who: str | None = None,
 ) -> None:
-    """Refuse rows of id -1 (ValueError naming the first, its frame and how many there are).
+    """Refuse rows of id -1, then of other negative ids (ValueError naming the first row).
 
     Id -1 is MOTChallenge's id of a box no track holds (a detection file's every row, the
     unassociated boxes some trackers write beside their tracks): taken as one track, its rows
     had their holes filled, their boxes smoothed and linked to other tracks, each across
     unrelated objects. As ``pftrack eval`` refuses them (TrackEval cannot score them). Other
-    negative ids are tracks. With `line_numbers` and `path` the message starts with
-    ``FILE:LINE:``; else with ``WHO:``. `rows` are checked (M, 10) rows.
+    negative ids are refused next (:func:`check_negative_ids`). With `line_numbers` and `path`
+    the message starts with ``FILE:LINE:``; else with ``WHO:``. `rows` are checked (M, 10) rows.
     """
     loose = rows[:, 1] == -1
     if not loose.any():
+        check_negative_ids(rows, line_numbers, path, who=who)
         return
     k, n = int(np.argmax(loose)), int(loose.sum())
     frame, many = int(rows[k, 0]), f"{counted(n, 'row')} {'has' if n == 1 else 'have'} it"
@@ -689,13 +706,46 @@ def check_tracked(
     )
 
 
+def check_negative_ids(
+    rows: F64,
+    line_numbers: Iterable[int] | None = None,
+    path: PathLike | None = None,
+    *,
+    who: str | None = None,
+) -> None:
+    """Refuse ids below -1 (ValueError naming the first, its frame and how many rows have it).
+
+    ``pftrack eval`` refuses a negative id, on which TrackEval fails (an IndexError, or "the
+    same ID more than once" of another id): a track of id -5 was filled, smoothed and linked
+    by ``recover`` and ``smooth``, then could not be scored. Id -1 is :func:`check_tracked`'s.
+    With `line_numbers` and `path` the message starts with ``FILE:LINE:``; else with
+    ``WHO:``. `rows` are checked (M, 10) rows.
+    """
+    negative = rows[:, 1] < -1
+    if not negative.any():
+        return
+    k = int(np.argmax(negative))
+    bad = rows[k, 1]
+    n = int(np.sum(rows[:, 1] == bad))
+    frame, many = int(rows[k, 0]), f"{counted(n, 'row')} {'has' if n == 1 else 'have'} it"
+    if line_numbers is not None and path is not None:
+        head = f"{path}:{list(line_numbers)[k]}: id {bad:.0f} in frame {frame} ({many})"
+    else:
+        head = f"{who or 'check_negative_ids'}: row {k} has id {bad:.0f} (frame {frame}; {many})"
+    raise ValueError(
+        f"{head}: track ids must be >= 0, as pftrack eval and TrackEval require them (-1 alone "
+        "has a meaning: a box no track holds); renumber the tracks"
+    )
+
+
 def read_tracks(path: PathLike, what: str = "tracks file", *, tracks_only: bool = True) -> F64:
     """Read a tracks file whose ids are integers and (frame, id) pairs unique (errors name lines).
 
     :func:`pftrack.io.mot.read_mot` (`what` names the file in its errors), the ids' check
     (``FILE:LINE``), then :func:`check_unique` (``FILE:LINE: duplicate rows ...``); the file
     is read a second time, for its line numbers, only when a pair repeats. Rows of id -1
-    (unassociated boxes) are refused by :func:`check_tracked` unless `tracks_only` is False
+    (unassociated boxes) and of other negative ids are refused by :func:`check_tracked`
+    unless `tracks_only` is False
     (``pftrack render`` draws them). What ``pftrack
     recover`` and ``pftrack smooth`` read, one file or many, and ``pftrack experiment gaps``
     its ground truth (``what="ground truth"``). Lines of more than 10 columns give one
@@ -709,7 +759,7 @@ def read_tracks(path: PathLike, what: str = "tracks file", *, tracks_only: bool 
         check_unique(rows)
     except ValueError:
         check_unique(rows, data_line_numbers(path), path)
-    if tracks_only and np.any(rows[:, 1] == -1):
+    if tracks_only and np.any(rows[:, 1] < 0):
         check_tracked(rows, data_line_numbers(path), path)
     _warn_padded_flags(rows, path)
     _warn_normalised(rows, path)
