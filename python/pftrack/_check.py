@@ -34,6 +34,7 @@ __all__ = [
     "materialised",
     "mot_rows",
     "number",
+    "path_arg",
     "path_refused",
     "real_array",
     "seed",
@@ -148,6 +149,26 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
 #: Columns 7-10 of a MOTChallenge row (conf, x, y, z) where rows have fewer: the values
 #: :func:`pftrack.io.mot.read_mot` gives a line of 6 to 9 fields.
 MOT_DEFAULTS = (1.0, -1.0, -1.0, -1.0)
+
+
+def path_arg(value: object, what: str) -> str | os.PathLike[str]:
+    """`value` as a path: a str or an os.PathLike as it is, bytes decoded (``os.fsdecode``).
+
+    pathlib's and open's refusals (``expected str, bytes or os.PathLike object, not
+    NoneType``) name neither the function nor the argument, and arguments given in the wrong
+    order (``write_mot(rows, path)``, ``VideoWriter(fps, path)``) look like this too.
+
+    Raises
+    ------
+    TypeError
+        Anything else (None, a number, an array, a list): ``{what} must be a str or
+        os.PathLike, got NoneType``.
+    """
+    if isinstance(value, bytes):
+        return os.fsdecode(value)
+    if isinstance(value, (str, os.PathLike)):
+        return value
+    raise TypeError(f"{what} must be a str or os.PathLike, got {type(value).__name__}")
 
 
 def path_refused(value: object, what: str, reader: str) -> None:

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, integer, real_array
+from pftrack._check import bgr_frame, integer, path_arg, real_array
 from pftrack._typing import F64, PathLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
@@ -263,6 +263,7 @@ def write_annotated_video(
     TypeError
         `rows` are not real numbers; `trail` is not an integer; a frame is not a uint8 array.
     """
+    path = path_arg(path, "write_annotated_video: path")
     trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
     rows = _track_rows(rows, "write_annotated_video")
     it = iter(frames)
@@ -395,6 +396,7 @@ class TrackRenderer:
         queue_size: int = 8,
         preset: str = "ultrafast",
     ) -> None:
+        path = path_arg(path, "TrackRenderer: path")
         self.trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: 2.5 and True taken as 2, 1
         queue_size = integer(queue_size, "queue_size", 0, 2**31 - 1)  # 0: as 1
         self.writer = VideoWriter(path, fps, backend=backend, preset=preset)
@@ -588,6 +590,7 @@ def plot_trajectories(
     is larger than the canvas by them.
     """
     who = "plot_trajectories"
+    path = path_arg(path, f"{who}: path")
     rows = _track_rows(rows, who)
     _text(title, who, "title")
     truth = None if truth is None else _track_rows(truth, who, "truth")

@@ -45,7 +45,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import number, real
+from pftrack._check import number, path_arg, real
 from pftrack._text import counted
 from pftrack._typing import PathLike
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
@@ -345,7 +345,7 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
             f"read_seqinfo: keys has {', '.join(map(repr, unknown))}, expected some of "
             f"{', '.join(SEQINFO_KEYS)}"
         )
-    ini = Path(path)
+    ini = Path(path_arg(path, "read_seqinfo: path"))
     if ini.is_dir():
         ini = ini / "seqinfo.ini"
     parser = configparser.ConfigParser(interpolation=None)

@@ -13,7 +13,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_FRAME, first_bad_box, flag, generator, number, real_array
+from pftrack._check import (
+    MAX_FRAME,
+    first_bad_box,
+    flag,
+    generator,
+    number,
+    path_arg,
+    real_array,
+)
 from pftrack._progress import progress
 from pftrack._text import counted
 from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
@@ -95,6 +103,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     lo, hi = DET_SCALE_RANGE
     if not (lo <= number(scale, "detection scale", finite=False) <= hi):
         raise ValueError(f"detection scale is {scale}, expected a number in [{lo:g}, {hi:g}]")
+    path = path_arg(path, "load_detections: path")
     rows = read_mot(path, what="detection file")
     if len(rows) and first_row_fields(path) == 6:
         warnings.warn(
