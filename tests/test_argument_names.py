@@ -99,6 +99,18 @@ CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
         ValueError,
         "recover_gaps: gap 0 must be a pair .*, got 3 values",
     ),
+    "MultiObjectTracker(detector='paper')": (  # was taken: AttributeError at the first frame
+        lambda: pftrack.MultiObjectTracker(detector="paper"),
+        TypeError,
+        r"^MultiObjectTracker: detector must have a detect\(frame\) method \(or be None: the "
+        r"built-in one\), got str 'paper'; a built-in detector is named by "
+        r"TrackerConfig\(detector='paper'\)$",
+    ),
+    "MultiObjectTracker(detector=object())": (
+        lambda: pftrack.MultiObjectTracker(detector=object()),
+        TypeError,
+        r"^MultiObjectTracker: detector must have a detect\(frame\) method .*, got object$",
+    ),
     "fill_gaps(seed='abc')": (
         lambda: fill_gaps(ROWS, seed="abc"),
         TypeError,

@@ -108,7 +108,8 @@ class MultiObjectTracker:
         Seed: the same seed and input give the same tracks.
     detector : object, optional
         Any object with ``detect(frame) -> Detections`` (see :mod:`pftrack.detection`); by
-        default the one named by ``config.detector``, created on first use.
+        default the one named by ``config.detector``, created on first use. Anything else (a
+        name such as ``"paper"``, which goes in ``TrackerConfig(detector=...)``) is a TypeError.
 
     Notes
     -----
@@ -151,6 +152,14 @@ class MultiObjectTracker:
         self._busy = threading.Lock()  # held by update and prime (see _take)
         self._rng = generator(rng, "MultiObjectTracker: rng")
         self._ids = itertools.count(1)
+        if detector is not None and not callable(getattr(detector, "detect", None)):
+            # was taken, and the first frame failed: 'str' object has no attribute 'detect'
+            shown = f"str {detector!r}" if isinstance(detector, str) else type(detector).__name__
+            hint = f"; a built-in detector is named by TrackerConfig(detector={detector!r})"
+            raise TypeError(
+                "MultiObjectTracker: detector must have a detect(frame) method (or be None: the "
+                f"built-in one), got {shown}{hint if isinstance(detector, str) else ''}"
+            )
         self._detector = detector
         self.tracks: list[LiveTrack] = []
         self._ended_unconfirmed: set[int] = set()
