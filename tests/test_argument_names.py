@@ -111,6 +111,16 @@ CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
         TypeError,
         r"^MultiObjectTracker: detector must have a detect\(frame\) method .*, got object$",
     ),
+    "recover_gaps(None)": (  # was: 'NoneType' object is not iterable
+        lambda: recover_gaps(None),  # type: ignore[arg-type]
+        TypeError,
+        r"^recover_gaps: gaps must be a sequence of \(segment_a, segment_b\) pairs, got NoneType$",
+    ),
+    "recover_gaps([1, 2])": (  # was: object of type 'int' has no len()
+        lambda: recover_gaps([1, 2]),  # type: ignore[list-item]
+        ValueError,
+        r"^recover_gaps: gap 0 must be a pair \(segment_a, segment_b\), got int$",
+    ),
     "fill_gaps(seed='abc')": (
         lambda: fill_gaps(ROWS, seed="abc"),
         TypeError,
