@@ -144,6 +144,15 @@ def test_pictures_refuse_bad_arguments_in_one_line(tmp_path: Path, call: Any, me
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("frames", [None, 3, np.array(3)], ids=repr)
+def test_frames_that_are_not_an_iterable_are_named(tmp_path: Path, frames: object) -> None:
+    """Was: 'NoneType' object is not iterable (iteration over a 0-d array), naming nothing."""
+    with pytest.raises(TypeError, match=r"^write_annotated_video: frames must be an iterable of "
+                       r"\(H, W, 3\) uint8 frames, got (NoneType|int|ndarray)"):  # fmt: skip
+        write_annotated_video(tmp_path / "v.mp4", frames, _ROWS, 25)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_plot_without_background_has_axes_in_image_coordinates(tmp_path: Path) -> None:
     """Was: a canvas of the boxes' extent and no axis: coordinates could not be read."""
     import cv2

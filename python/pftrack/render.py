@@ -261,12 +261,19 @@ def write_annotated_video(
         [0, :data:`MAX_TRAIL`]; a frame is not (H, W, 3) with pixels, or not of the first
         frame's size.
     TypeError
-        `rows` are not real numbers; `trail` is not an integer; a frame is not a uint8 array.
+        `rows` are not real numbers; `trail` is not an integer; `frames` is not iterable (None);
+        a frame is not a uint8 array.
     """
     path = path_arg(path, "write_annotated_video: path")
     trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
     rows = _track_rows(rows, "write_annotated_video")
-    it = iter(frames)
+    try:
+        it = iter(frames)
+    except TypeError:  # was: "'NoneType' object is not iterable", naming nothing
+        raise TypeError(
+            "write_annotated_video: frames must be an iterable of (H, W, 3) uint8 frames, got "
+            f"{type(frames).__name__}"
+        ) from None
     try:  # not next(it, None): [None] is a bad frame, not no frame
         first = next(it)
     except StopIteration:
