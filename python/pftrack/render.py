@@ -262,7 +262,7 @@ def write_annotated_video(
         frame's size.
     TypeError
         `rows` are not real numbers; `trail` is not an integer; `frames` is not iterable (None);
-        a frame is not a uint8 array.
+        a frame is not a uint8 array; `path` is not a str or os.PathLike.
     """
     path = path_arg(path, "write_annotated_video: path")
     trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
@@ -588,7 +588,7 @@ def plot_trajectories(
         is not two whole numbers from 1 to 32767, or the boxes reach beyond 32767 px.
     TypeError
         `rows` or `truth` are not real numbers; `background` is not a (H, W, 3) uint8 image;
-        `title` is not a str.
+        `title` is not a str; `path` is not a str or os.PathLike.
 
     Notes
     -----

@@ -167,6 +167,8 @@ def read_mot(
 
     Raises
     ------
+    TypeError
+        `path` is not a str or os.PathLike (bytes are decoded).
     FileNotFoundError
         If `path` does not exist.
     ValueError
@@ -633,7 +635,7 @@ def write_mot(
     ValueError
         What :func:`mot_text` refuses, or `path` is a folder.
     TypeError
-        `exact` is not of bool.
+        `exact` is not of bool; `path` is not a str or os.PathLike (bytes are decoded).
     OSError
         The folder does not exist (FileNotFoundError naming it), or the hidden temporary file
         cannot be made, written or renamed (a read-only file system: the error names `path`,

@@ -338,6 +338,8 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
         empty, a field that is not a positive number (``imWidth``, ``imHeight``,
         ``seqLength``: an integer), or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`;
         a name in `keys` that is not one of :data:`SEQINFO_KEYS`.
+    TypeError
+        `path` is not a str or os.PathLike (bytes are decoded).
     """
     unknown = sorted(set(keys or ()) - set(SEQINFO_KEYS))
     if unknown:

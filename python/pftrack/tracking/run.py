@@ -89,7 +89,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     Raises
     ------
     TypeError
-        `scale` is not a real number.
+        `scale` is not a real number; `path` is not a str or os.PathLike.
     ValueError
         `scale` outside [0.001, 1000], or a bad detection file.
 
