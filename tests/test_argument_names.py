@@ -308,3 +308,29 @@ def test_generators_and_seeds_are_taken_as_before() -> None:
     a, _ = fill_gaps(ROWS, "auto", seed=np.int64(3))
     b, _ = fill_gaps(ROWS, "auto", seed=3)
     np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda v: pftrack.Tracker(frame_rate=v),
+        lambda v: fill_gaps(ROWS, "linear", max_gap=v),
+        lambda v: fill_gaps(ROWS, "linear", seed=v),
+        lambda v: systematic_resample([0.5, 0.5], rng=v),
+        lambda v: recover_gaps([(SEG, SEG + 9)], "linear", combine=v),
+    ],
+)
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table"], ids=["array", "table"])
+def test_an_array_for_a_setting_is_refused_in_one_line(
+    call: Callable[[object], object], value: object
+) -> None:
+    """A defect trial: the message held the array's (or a DataFrame's) whole repr, one line of
+    it per row (730 lines for a MOT table), after 'got ndarray'."""
+    if isinstance(value, str):
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    with pytest.raises(TypeError) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    assert message.endswith(f"got {type(value).__name__} of shape (2, 3)"), message
