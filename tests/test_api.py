@@ -417,3 +417,25 @@ def test_printing_a_report_shows_its_readable_form(tmp_path: Path) -> None:
     assert str(run).startswith(f"TrackingRun: 12 frames, {len(np.unique(run.rows[:, 1]))} track")
     summary = BatchSummary("track", tmp_path, [{"name": "a", "status": "done"}])
     assert str(summary) == summary.table()
+
+
+def test_the_classes_top_level_functions_return_are_top_level() -> None:
+    """A typed user annotates what ``pftrack.evaluate_sequence`` returns as
+    ``pftrack.SequenceScores``: docs/api.md names that class and ``HotaMetrics`` beside their
+    functions, but they, ``GdtSolution``, ``Scene`` and ``BinnedImage`` (``hsv_bins``) were
+    only in their subpackages, while ``TrackingRun``, ``FillReport`` and ``MotMetrics`` were
+    top-level."""
+    import inspect
+    import typing
+
+    missing = []
+    for name in pftrack.__all__:
+        obj = getattr(pftrack, name)
+        if not inspect.isfunction(obj):
+            continue
+        returned = typing.get_type_hints(obj).get("return")
+        for cls in (returned, *typing.get_args(returned)):
+            if inspect.isclass(cls) and cls.__module__.startswith("pftrack"):
+                if getattr(pftrack, cls.__name__, None) is not cls:
+                    missing.append(f"{name} -> {cls.__name__}")
+    assert not missing
