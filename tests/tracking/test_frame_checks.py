@@ -276,6 +276,49 @@ def test_track_frames_names_its_rng(rng, error):
         pftrack.track_frames(frames, rng=rng)
 
 
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ({"threads": "no"}, "threads must be True or False, got str 'no'"),
+        ({"threads": None}, "threads must be True or False, got NoneType None"),
+        ({"show_progress": "no"}, "show_progress must be True or False, got str 'no'"),
+        ({"show_progress": 1}, "show_progress must be True or False, got int 1"),
+    ],
+)
+def test_track_frames_flags_of_the_wrong_kind_are_refused(option, message):
+    """A defect trial: threads="no" ran the threads and show_progress="no" showed the bar (any
+    value was taken for its truth), before any frame is read."""
+    with pytest.raises(TypeError, match=f"^track_frames: {re.escape(message)}$"):
+        pftrack.track_frames(_NOT_READ, **option)
+
+
+def test_track_frames_refuses_an_on_frame_that_cannot_be_called_before_any_frame():
+    """A defect trial: track_frames(on_frame="log.txt") tracked the first frame, then failed
+    with "'str' object is not callable", naming nothing."""
+    with pytest.raises(
+        TypeError,
+        match=r"^track_frames: on_frame is str, expected a callable "
+        r"on_frame\(index, frame, tracks, rows\) or None$",
+    ):
+        pftrack.track_frames(_NOT_READ, on_frame="log.txt")  # type: ignore[arg-type]
+
+
+class _NotRead(list):  # type: ignore[type-arg]
+    """A sequence of frames whose frames the checks above must not reach."""
+
+    def __getitem__(self, k):  # type: ignore[no-untyped-def]
+        raise AssertionError("a frame was read before the options were checked")
+
+    def __iter__(self):  # type: ignore[no-untyped-def]
+        raise AssertionError("a frame was read before the options were checked")
+
+    def __len__(self) -> int:
+        return 3
+
+
+_NOT_READ = _NotRead()
+
+
 @pytest.mark.parametrize("name", ["max_coast", "prime"])
 @pytest.mark.parametrize("value", ["1", [1], True])
 def test_seconds_of_the_wrong_kind(name, value):

@@ -221,7 +221,8 @@ def track_frames(
         `source` is not a path, a FrameSource or a sequence of frames (an iterator, an int,
         one frame alone: ``track_frames([frame])``); `detections` is not a dict (a path, a
         list), a key is not an int, or a value does not hold real numbers; `rng` is not a
-        Generator, an int or None (a float, a bool).
+        Generator, an int or None (a float, a bool); `threads` is not a bool, `show_progress`
+        not a bool or None, `on_frame` not callable or None.
     ValueError
         A negative `rng`. A key below 1 (frames are 1-based: 0-based keys would put every box
         one frame late), a value not of shape (k, 5) or (k, 4), NaN, inf, a negative width or
@@ -249,6 +250,15 @@ def track_frames(
     if bootstrap not in ("auto", *BOOTSTRAPS):
         raise ValueError(
             f"bootstrap mode is {bootstrap!r}, expected one of auto, {', '.join(BOOTSTRAPS)}"
+        )
+    # before any frame is read (was: any value taken for its truth, threads="no" ran threads)
+    threads = flag(threads, "track_frames: threads")
+    if show_progress is not None:
+        show_progress = flag(show_progress, "track_frames: show_progress")
+    if on_frame is not None and not callable(on_frame):  # was: "'str' object is not callable"
+        raise TypeError(  # after the first frame was tracked
+            f"track_frames: on_frame is {type(on_frame).__name__}, expected a callable "
+            "on_frame(index, frame, tracks, rows) or None"
         )
     if detections is not None:
         detections = _check_detections(detections)
