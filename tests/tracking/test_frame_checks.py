@@ -87,6 +87,25 @@ def test_prime_refuses_what_is_not_a_frame(bad, error, message):
         pftrack.Tracker().prime([bad])
 
 
+@pytest.mark.parametrize(
+    ("frames", "got"),
+    [
+        (None, "got NoneType"),
+        (3, "got int"),
+        (np.zeros((6, 8, 3), np.uint8), r"got one \(6, 8, 3\) frame: prime\(\[frame\]\)"),
+        (np.zeros((6, 8), np.uint8), r"got one \(6, 8\) frame: prime\(\[frame\]\)"),
+    ],
+    ids=["None", "int", "frame", "grey frame"],
+)
+def test_multi_object_tracker_prime_refuses_what_is_not_frames_as_tracker_prime(frames, got):
+    """Were: 'NoneType' object is not iterable, and one frame's rows taken for frames (``frame
+    must have shape (H, W, 3) (BGR), got (8, 3)``), where Tracker.prime names both."""
+    with pytest.raises(
+        TypeError, match=rf"^MultiObjectTracker\.prime takes an iterable of frames \(.*\), {got}$"
+    ):
+        MultiObjectTracker(rng=0).prime(frames)
+
+
 @pytest.mark.parametrize("shape", [(6, 8, 3), (6, 8)])
 def test_prime_refuses_one_frame_for_an_iterable_of_frames(frames, shape):
     """Was ``prime frame must have shape (H, W, 3) (BGR), got (8, 3): a grey frame?``: one

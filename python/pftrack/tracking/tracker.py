@@ -235,8 +235,25 @@ class MultiObjectTracker:
         Reading ahead (e.g. the first 30 frames) gives the background model a picture of the
         empty scene before frame 1 is tracked; detectors without ``prime`` ignore it. The
         arrays of an iterable other than a list, a tuple or an array are copied as they come
-        (a generator may refill one buffer with each frame).
+        (a generator may refill one buffer with each frame). What is not an iterable (None),
+        and one frame alone (``prime([frame])`` primes with it), are a TypeError, as
+        :meth:`pftrack.Tracker.prime` says (were: "'NoneType' object is not iterable", and one
+        frame's rows taken for frames).
         """
+        if isinstance(frames, np.ndarray) and (
+            frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
+        ):
+            raise TypeError(
+                "MultiObjectTracker.prime takes an iterable of frames (a list, or a (K, H, W, 3) "
+                f"array), got one {frames.shape} frame: prime([frame])"
+            )
+        try:
+            iter(frames)
+        except TypeError:
+            raise TypeError(
+                "MultiObjectTracker.prime takes an iterable of frames (a list, a generator or a "
+                f"(K, H, W, 3) array), got {type(frames).__name__}"
+            ) from None
         self._take("prime")
         try:
             self._prime(frames)
