@@ -422,7 +422,14 @@ class TrackRenderer:
         # checked here, in the caller's thread (was: a float frame drawn black without a word)
         frame = bgr_frame(frame, "TrackRenderer.add: frame")
         self._raise_worker_error()
-        read = [_track_fields(t, i) for i, t in enumerate(tracks)]  # before anything changes
+        try:
+            each = iter(tracks)
+        except TypeError:  # was: "'NoneType' object is not iterable"
+            raise TypeError(
+                "TrackRenderer.add: tracks must be an iterable of tracks "
+                f"(MultiObjectTracker.update's list), got {type(tracks).__name__}"
+            ) from None
+        read = [_track_fields(t, i) for i, t in enumerate(each)]  # before anything changes
         self._n += 1
         rows, seen = [], set()
         for tid, box, coasting in read:
