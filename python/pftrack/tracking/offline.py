@@ -573,7 +573,8 @@ def smooth_tracks(
     if measurements is None:
         z = a[:, 2:6].copy()
     else:
-        z = np.array(measurements, dtype=np.float64)
+        # was: "could not convert string to float: 'abc'", naming nothing
+        z = np.array(real_array(measurements, "smooth_tracks: measurements"))
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
     check_boxes(z, a, "smooth_tracks", "measurements")  # boxes of filled rows, as the rows'
