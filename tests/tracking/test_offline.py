@@ -590,3 +590,10 @@ def test_smooth_tracks_names_measurements_that_are_not_numbers(measurements):
     rows = make_scene(n_frames=4, rng=0).truth
     with pytest.raises(TypeError, match=r"^smooth_tracks: measurements must hold real numbers"):
         smooth_tracks(rows, measurements=measurements)
+
+
+@pytest.mark.parametrize("frames", [np.array(3.0), 3, True], ids=["0-d", "int", "bool"])
+def test_box_smoother_names_frames_that_are_not_one_dimensional(frames):
+    """Was: len() of unsized object."""
+    with pytest.raises(ValueError, match=r"^BoxSmoother\.smooth: frames \(\), boxes_xywh"):
+        BoxSmoother().smooth(frames, np.ones((1, 4)), np.ones(1, bool))

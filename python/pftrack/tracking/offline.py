@@ -138,7 +138,7 @@ class BoxSmoother:
         f = fr.astype(np.int64)
         b: F64 = real_array(boxes_xywh, "BoxSmoother.smooth: boxes_xywh")
         obs = np.asarray(observed, dtype=bool)
-        n = len(f)
+        n = len(f) if f.ndim == 1 else -1  # was: len() of unsized object (a 0-d array, an int)
         if b.shape != (n, 4) or obs.shape != (n,):
             raise ValueError(
                 f"BoxSmoother.smooth: frames {f.shape}, boxes_xywh {b.shape} and observed "
