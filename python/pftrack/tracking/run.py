@@ -366,6 +366,12 @@ def _check_frames(frames: object) -> None:
             f"track_frames: source is one {frames.shape} frame, expected a sequence of frames: "
             "track_frames([frame])"
         )
+    if isinstance(frames, np.ndarray) and frames.ndim not in (3, 4):
+        # was: "len() of unsized object" (0-d), numbers taken for frames (1-d), 5-d frames
+        raise TypeError(
+            f"track_frames: source is an array of shape {frames.shape}, expected a sequence of "
+            "frames: a (K, H, W, 3) uint8 array or a list of (H, W, 3) frames"
+        )
     if isinstance(frames, FrameSource) or (
         hasattr(frames, "__len__")
         and hasattr(frames, "__getitem__")
