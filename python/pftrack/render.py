@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import bgr_frame, integer, path_arg, real_array
-from pftrack._typing import F64, PathLike
+from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
 from pftrack.io.video_writer import VideoWriter
@@ -222,7 +222,7 @@ def write_annotated_video(
     path: PathLike,
     frames: Iterable[NDArray[np.uint8]],
     rows: NDArray[np.float64],
-    fps: float = 10.0,
+    fps: RealLike = 10.0,
     *,
     trail: int = 40,
     preset: str = "ultrafast",
@@ -395,7 +395,7 @@ class TrackRenderer:
     def __init__(
         self,
         path: PathLike,
-        fps: float,
+        fps: RealLike,
         *,
         trail: int = 40,
         threaded: bool = True,

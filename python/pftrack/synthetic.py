@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import flag, generator, number, real
-from pftrack._typing import F64, PathLike
+from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
 from pftrack.io.opencv_io import opencv_name, write_image
@@ -303,7 +303,7 @@ MAX_SCENE_BYTES = 2**33
 
 
 def _check_scene_args(
-    fn: str, n_frames: int, width: int, height: int, noise: float, fps: float
+    fn: str, n_frames: int, width: int, height: int, noise: float, fps: RealLike
 ) -> float:
     """The frame count, size, noise level and rate `make_scene` and `make_busy_scene` share.
 
@@ -340,7 +340,7 @@ def make_scene(
     occluder: bool = True,
     *,
     noise: float = 3.0,
-    fps: float = 10.0,
+    fps: RealLike = 10.0,
 ) -> Scene:
     """Generate a seeded scene of walkers on a textured background.
 
@@ -596,7 +596,7 @@ def make_busy_scene(
     rng: np.random.Generator | int | None = 0,
     *,
     noise: float = 3.0,
-    fps: float = 10.0,
+    fps: RealLike = 10.0,
 ) -> Scene:
     """A seeded scene reproducing one failure of background subtraction on busy scenes.
 

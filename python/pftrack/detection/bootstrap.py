@@ -15,6 +15,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._typing import IntLike
+
 BOOTSTRAPS = ("spread", "first", "none")
 Bootstrap = Literal["spread", "first", "none"]
 
@@ -22,7 +24,11 @@ __all__ = ["BOOTSTRAPS", "Bootstrap", "bootstrap_frames"]
 
 
 def bootstrap_frames(
-    frames: Iterable[NDArray[np.uint8]], n: int = 30, mode: str = "spread", *, split: bool = False
+    frames: Iterable[NDArray[np.uint8]],
+    n: IntLike = 30,
+    mode: str = "spread",
+    *,
+    split: bool = False,
 ) -> list[NDArray[np.uint8]]:
     """Pick the frames whose per-pixel median starts the background.
 
@@ -56,7 +62,7 @@ def bootstrap_frames(
         return []
     total = len(frames) if isinstance(frames, Sized) else 0
     if mode == "first" or total <= n:
-        return list(itertools.islice(iter(frames), n))
+        return list(itertools.islice(iter(frames), int(n)))
     wanted = set(np.linspace(0, total - 1, n).round().astype(int).tolist())
     pick = getattr(frames, "frames_at", None)
     if callable(pick):  # a FrameSource: only the wanted images of a folder, no BGR in between

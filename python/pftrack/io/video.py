@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 
 from pftrack._check import number, path_arg, real, shown
 from pftrack._text import counted
-from pftrack._typing import PathLike
+from pftrack._typing import PathLike, RealLike
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
 
 __all__ = [
@@ -1272,7 +1272,7 @@ class FrameSource:
     """
 
     def __init__(
-        self, source: PathLike | int, *, scale: float = 1.0, fps: float | None = None
+        self, source: PathLike | int, *, scale: float = 1.0, fps: RealLike | None = None
     ) -> None:
         check_source(source)
         scale = number(scale, "scale", finite=False)  # text, bools, None: a TypeError naming it

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import bgr_frame, integer, path_arg, real
-from pftrack._typing import PathLike
+from pftrack._typing import PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
 
@@ -116,7 +116,7 @@ class VideoWriter:
     def __init__(
         self,
         path: PathLike,
-        fps: float,
+        fps: RealLike,
         *,
         backend: str | None = None,
         crf: int = 23,

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _check
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
-from pftrack._typing import F64, RecoveryMethod
+from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
@@ -462,7 +462,7 @@ def smooth_tracks(
     seed: int = 0,
     crossings: CrossingConfig | None = None,
     relink_coast: int | None = None,
-    max_gap: int | None = None,
+    max_gap: IntLike | None = None,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 

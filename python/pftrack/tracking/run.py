@@ -24,7 +24,7 @@ from pftrack._check import (
 )
 from pftrack._progress import progress
 from pftrack._text import counted
-from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
+from pftrack._typing import F64, BootstrapMode, FillMode, IntLike, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
@@ -156,7 +156,7 @@ def track_frames(
     coasting: str = "confirmed",
     fill: FillMode = "linear",
     show_progress: bool | None = None,
-    prime_frames: int = 30,
+    prime_frames: IntLike = 30,
     bootstrap: BootstrapMode = "auto",
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
