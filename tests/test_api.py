@@ -268,6 +268,46 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
     assert 'Argument "detector" to "SupervisionTracker" has incompatible type' in out
 
 
+def test_what_docs_api_says_rates_seconds_and_counts_take_type_checks(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/api.md: every frame rate and time in seconds takes any real number (a Fraction,
+    PyAV's ``stream.average_rate``; a NumPy scalar), and frame counts NumPy's ints; the
+    annotations said ``float`` and ``int``, so mypy --strict refused each call below, which
+    runs."""
+    api = pytest.importorskip("mypy.api")
+    root = Path(pftrack.__file__).parents[1]
+    if root.name not in ("site-packages", "dist-packages"):
+        monkeypatch.setenv("MYPYPATH", str(root))
+    code = tmp_path / "rates.py"
+    code.write_text(
+        "from fractions import Fraction\n"
+        "import numpy as np\n"
+        "import pftrack\n"
+        "from pftrack.integrations.supervision import SupervisionTracker\n"
+        "from pftrack.detection.bootstrap import bootstrap_frames\n"
+        "rate = Fraction(30000, 1001)\n"
+        "pftrack.Tracker(frame_rate=rate, max_coast=Fraction(1, 2), prime=np.float32(1))\n"
+        "pftrack.Tracker(frame_rate=np.float32(25))\n"
+        "pftrack.Tracker.from_config(frame_rate=rate, prime_frames=np.int64(3))\n"
+        "SupervisionTracker(frame_rate=rate, max_coast=rate, prime=np.float64(1))\n"
+        "pftrack.VideoWriter('a.mp4', rate)\n"
+        "pftrack.TrackRenderer('a.mp4', np.float32(25))\n"
+        "pftrack.FrameSource('a.mp4', fps=rate)\n"
+        "pftrack.make_scene(fps=rate)\n"
+        "pftrack.write_annotated_video('a.mp4', [], np.zeros((0, 10)), fps=rate)\n"
+        "pftrack.fill_gaps(np.zeros((0, 10)), max_gap=np.int64(3))\n"
+        "pftrack.smooth_tracks(np.zeros((0, 10)), max_gap=np.int64(3))\n"
+        "pftrack.track_frames('a.mp4', prime_frames=np.int64(3))\n"
+        "bootstrap_frames([], np.int64(3))\n"
+        "pftrack.Tracker(frame_rate='25')\n"
+    )
+    out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
+    errors = [line for line in out.splitlines() if ": error:" in line]
+    # only the str, which the runtime refuses too: the rest type-checks
+    assert [e.split(":")[1] for e in errors] == ["20"], out
+
+
 def test_the_literal_types_list_the_names_the_runtime_takes() -> None:
     from typing import get_args
 
@@ -417,3 +457,25 @@ def test_printing_a_report_shows_its_readable_form(tmp_path: Path) -> None:
     assert str(run).startswith(f"TrackingRun: 12 frames, {len(np.unique(run.rows[:, 1]))} track")
     summary = BatchSummary("track", tmp_path, [{"name": "a", "status": "done"}])
     assert str(summary) == summary.table()
+
+
+def test_the_classes_top_level_functions_return_are_top_level() -> None:
+    """A typed user annotates what ``pftrack.evaluate_sequence`` returns as
+    ``pftrack.SequenceScores``: docs/api.md names that class and ``HotaMetrics`` beside their
+    functions, but they, ``GdtSolution``, ``Scene`` and ``BinnedImage`` (``hsv_bins``) were
+    only in their subpackages, while ``TrackingRun``, ``FillReport`` and ``MotMetrics`` were
+    top-level."""
+    import inspect
+    import typing
+
+    missing = []
+    for name in pftrack.__all__:
+        obj = getattr(pftrack, name)
+        if not inspect.isfunction(obj):
+            continue
+        returned = typing.get_type_hints(obj).get("return")
+        for cls in (returned, *typing.get_args(returned)):
+            if inspect.isclass(cls) and cls.__module__.startswith("pftrack"):
+                if getattr(pftrack, cls.__name__, None) is not cls:
+                    missing.append(f"{name} -> {cls.__name__}")
+    assert not missing

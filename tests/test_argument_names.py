@@ -99,6 +99,28 @@ CASES: dict[str, tuple[Callable[[], object], type[Exception], str]] = {
         ValueError,
         "recover_gaps: gap 0 must be a pair .*, got 3 values",
     ),
+    "MultiObjectTracker(detector='paper')": (  # was taken: AttributeError at the first frame
+        lambda: pftrack.MultiObjectTracker(detector="paper"),
+        TypeError,
+        r"^MultiObjectTracker: detector must have a detect\(frame\) method \(or be None: the "
+        r"built-in one\), got str 'paper'; a built-in detector is named by "
+        r"TrackerConfig\(detector='paper'\)$",
+    ),
+    "MultiObjectTracker(detector=object())": (
+        lambda: pftrack.MultiObjectTracker(detector=object()),
+        TypeError,
+        r"^MultiObjectTracker: detector must have a detect\(frame\) method .*, got object$",
+    ),
+    "recover_gaps(None)": (  # was: 'NoneType' object is not iterable
+        lambda: recover_gaps(None),  # type: ignore[arg-type]
+        TypeError,
+        r"^recover_gaps: gaps must be a sequence of \(segment_a, segment_b\) pairs, got NoneType$",
+    ),
+    "recover_gaps([1, 2])": (  # was: object of type 'int' has no len()
+        lambda: recover_gaps([1, 2]),  # type: ignore[list-item]
+        ValueError,
+        r"^recover_gaps: gap 0 must be a pair \(segment_a, segment_b\), got int$",
+    ),
     "fill_gaps(seed='abc')": (
         lambda: fill_gaps(ROWS, seed="abc"),
         TypeError,
@@ -286,3 +308,29 @@ def test_generators_and_seeds_are_taken_as_before() -> None:
     a, _ = fill_gaps(ROWS, "auto", seed=np.int64(3))
     b, _ = fill_gaps(ROWS, "auto", seed=3)
     np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda v: pftrack.Tracker(frame_rate=v),
+        lambda v: fill_gaps(ROWS, "linear", max_gap=v),
+        lambda v: fill_gaps(ROWS, "linear", seed=v),
+        lambda v: systematic_resample([0.5, 0.5], rng=v),
+        lambda v: recover_gaps([(SEG, SEG + 9)], "linear", combine=v),
+    ],
+)
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table"], ids=["array", "table"])
+def test_an_array_for_a_setting_is_refused_in_one_line(
+    call: Callable[[object], object], value: object
+) -> None:
+    """A defect trial: the message held the array's (or a DataFrame's) whole repr, one line of
+    it per row (730 lines for a MOT table), after 'got ndarray'."""
+    if isinstance(value, str):
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    with pytest.raises(TypeError) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    assert message.endswith(f"got {type(value).__name__} of shape (2, 3)"), message

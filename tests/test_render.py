@@ -144,6 +144,15 @@ def test_pictures_refuse_bad_arguments_in_one_line(tmp_path: Path, call: Any, me
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("frames", [None, 3, np.array(3)], ids=repr)
+def test_frames_that_are_not_an_iterable_are_named(tmp_path: Path, frames: object) -> None:
+    """Was: 'NoneType' object is not iterable (iteration over a 0-d array), naming nothing."""
+    with pytest.raises(TypeError, match=r"^write_annotated_video: frames must be an iterable of "
+                       r"\(H, W, 3\) uint8 frames, got (NoneType|int|ndarray)"):  # fmt: skip
+        write_annotated_video(tmp_path / "v.mp4", frames, _ROWS, 25)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_plot_without_background_has_axes_in_image_coordinates(tmp_path: Path) -> None:
     """Was: a canvas of the boxes' extent and no axis: coordinates could not be read."""
     import cv2
@@ -433,3 +442,19 @@ def test_track_renderer_refuses_what_is_not_a_track_in_one_line(tmp_path: Path) 
             renderer.add(frame, tracks)  # type: ignore[arg-type]
     renderer.add(frame, _walk(1)[0])  # the renderer goes on
     assert renderer.close() == tmp_path / "v.mp4"
+
+
+@pytest.mark.parametrize("tracks", [None, 3], ids=repr)
+def test_renderer_add_names_tracks_that_are_not_iterable(tmp_path: Path, tracks: object) -> None:
+    """Was: 'NoneType' object is not iterable (an update's result that was None)."""
+    renderer = TrackRenderer(tmp_path / "v.avi", 10.0, threaded=False)
+    frame = np.zeros((16, 16, 3), np.uint8)
+    message = (
+        r"^TrackRenderer\.add: tracks must be an iterable of tracks "
+        r"\(MultiObjectTracker\.update's list\), got (NoneType|int)$"
+    )
+    with pytest.raises(TypeError, match=message):
+        renderer.add(frame, tracks)  # type: ignore[arg-type]
+    renderer.add(frame, [])  # the renderer goes on
+    renderer.close()
+    assert (tmp_path / "v.avi").is_file()

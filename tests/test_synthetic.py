@@ -142,6 +142,31 @@ def test_a_size_that_is_not_an_integer_is_a_type_error(kwargs):
         make_scene(**kwargs)
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"n_walkers": True}, "^make_scene: n_walkers is True, expected an integer in 1..40$"),
+        ({"n_walkers": 2.0}, "^make_scene: n_walkers is 2.0, expected an integer in 1..40$"),
+        ({"occluder": "no"}, "^make_scene: occluder must be True or False, got str 'no'$"),
+        ({"occluder": None}, "^make_scene: occluder must be True or False, got NoneType"),
+        ({"noise": None}, "^make_scene: noise must be a number, got NoneType None$"),
+        ({"noise": "3"}, "^make_scene: noise must be a number, got str '3'$"),
+        ({"noise": True}, "^make_scene: noise must be a number, got bool True$"),
+    ],
+)
+def test_a_count_flag_or_noise_of_the_wrong_type_is_a_type_error(kwargs, message):
+    """A defect trial: n_walkers=True made one walker, occluder="no" drew the post (any value
+    was taken for its truth), noise=True was noise 1, and noise=None or "3" failed in NumPy
+    ("ufunc 'isfinite' not supported"), naming nothing."""
+    with pytest.raises(TypeError, match=message):
+        make_scene(n_frames=2, **kwargs)
+
+
+def test_busy_scene_noise_of_the_wrong_type_is_named():
+    with pytest.raises(TypeError, match="^make_busy_scene: noise must be a number, got NoneType"):
+        make_busy_scene("present", n_frames=2, noise=None)
+
+
 @pytest.mark.parametrize("make", [make_scene, lambda **kw: make_busy_scene("present", **kw)])
 @pytest.mark.parametrize(("rng", "error"), [(2.5, TypeError), (True, TypeError), (-1, ValueError)])
 def test_bad_rng_is_named(make, rng, error):

@@ -8,20 +8,21 @@ The public API, importable from the top level; each name loads its module on fir
   :class:`TrackingRun`, :func:`load_detections`, :func:`smooth_tracks`, :class:`BoxSmoother`;
 - recovery: :func:`recover_gap`, :func:`recover_gaps`, :func:`fill_gaps` (its
   :class:`FillReport`), :func:`filled_mask`, :data:`METHODS`, :func:`link_tracklets`,
-  :class:`LinkConfig`, :func:`goal_directed_path`;
+  :class:`LinkConfig`, :func:`goal_directed_path` (its :class:`GdtSolution`);
 - MOTChallenge files and video: :func:`read_mot`, :func:`write_mot`, :class:`FrameSource`
   (files, image folders, sequences, cameras, streams), :func:`read_seqinfo`,
   :class:`SequenceInfo`, :class:`VideoWriter` (H.264 MP4);
 - pictures: :class:`TrackRenderer` (annotated video while tracking),
   :func:`write_annotated_video`, :func:`plot_trajectories`;
 - evaluation: :func:`evaluate_sequence` (HOTA and CLEAR-MOT/IDF1), :func:`evaluate_hota`,
-  :func:`evaluate_mot`, :class:`MotMetrics`, :func:`format_metrics`;
+  :func:`evaluate_mot` and what they return, :class:`SequenceScores`, :class:`HotaMetrics`,
+  :class:`MotMetrics`; :func:`format_metrics`;
 - kernels: :class:`ColourParticleFilter`, the resamplers (drop-in for
   ``filterpy.monte_carlo``) :func:`systematic_resample`, :func:`stratified_resample`,
   :func:`multinomial_resample`, :func:`residual_resample`, and :func:`hsv_bins`,
   :func:`box_histograms`, :func:`bhattacharyya_weights`, :func:`bhattacharyya_coefficient`,
-  :func:`bhattacharyya_distance`;
-- :func:`make_scene`, a synthetic scene with known truth.
+  :func:`bhattacharyya_distance` (:func:`hsv_bins` gives a :class:`BinnedImage`);
+- :func:`make_scene`, a synthetic :class:`Scene` with known truth.
 
 Subpackages and modules are attributes too, loaded on first use like the names above:
 ``pftrack.batch.track_many``, ``pftrack.recovery.filled_mask``, ``pftrack.io.video``.
@@ -87,7 +88,9 @@ if TYPE_CHECKING:
     from pftrack import synthetic as synthetic
     from pftrack import tracking as tracking
     from pftrack.eval import (
+        HotaMetrics,
         MotMetrics,
+        SequenceScores,
         evaluate_hota,
         evaluate_mot,
         evaluate_sequence,
@@ -97,6 +100,7 @@ if TYPE_CHECKING:
     from pftrack.io.video import FrameSource, SequenceInfo, read_seqinfo
     from pftrack.io.video_writer import VideoWriter
     from pftrack.particle_filter import (
+        BinnedImage,
         ColourParticleFilter,
         bhattacharyya_coefficient,
         bhattacharyya_distance,
@@ -111,6 +115,7 @@ if TYPE_CHECKING:
     from pftrack.recovery import (
         METHODS,
         FillReport,
+        GdtSolution,
         LinkConfig,
         fill_gaps,
         filled_mask,
@@ -120,7 +125,7 @@ if TYPE_CHECKING:
         recover_gaps,
     )
     from pftrack.render import TrackRenderer, plot_trajectories, write_annotated_video
-    from pftrack.synthetic import make_scene
+    from pftrack.synthetic import Scene, make_scene
     from pftrack.tracking import (
         BoxSmoother,
         MultiObjectTracker,
@@ -149,6 +154,7 @@ _HOME = {
     ),
     "pftrack.recovery": (
         "FillReport",
+        "GdtSolution",
         "LinkConfig",
         "METHODS",
         "fill_gaps",
@@ -163,13 +169,16 @@ _HOME = {
     "pftrack.io.video_writer": ("VideoWriter",),
     "pftrack.render": ("TrackRenderer", "plot_trajectories", "write_annotated_video"),
     "pftrack.eval": (
+        "HotaMetrics",
         "MotMetrics",
+        "SequenceScores",
         "evaluate_hota",
         "evaluate_mot",
         "evaluate_sequence",
         "format_metrics",
     ),
     "pftrack.particle_filter": (
+        "BinnedImage",
         "ColourParticleFilter",
         "bhattacharyya_coefficient",
         "bhattacharyya_distance",
@@ -181,20 +190,25 @@ _HOME = {
         "stratified_resample",
         "systematic_resample",
     ),
-    "pftrack.synthetic": ("make_scene",),
+    "pftrack.synthetic": ("Scene", "make_scene"),
 }
 
 __all__ = [
     "__version__",
+    "BinnedImage",
     "BoxSmoother",
     "ColourParticleFilter",
     "FillReport",
     "FrameSource",
+    "GdtSolution",
+    "HotaMetrics",
     "LinkConfig",
     "METHODS",
     "MotMetrics",
     "MultiObjectTracker",
+    "Scene",
     "SequenceInfo",
+    "SequenceScores",
     "Track",
     "TrackRenderer",
     "Tracker",

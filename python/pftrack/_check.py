@@ -35,9 +35,11 @@ __all__ = [
     "materialised",
     "mot_rows",
     "number",
+    "path_arg",
     "path_refused",
     "real_array",
     "seed",
+    "shown",
 ]
 
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
@@ -166,6 +168,26 @@ def refuse_masked_weights(weights: object, fn: str) -> None:
 #: Columns 7-10 of a MOTChallenge row (conf, x, y, z) where rows have fewer: the values
 #: :func:`pftrack.io.mot.read_mot` gives a line of 6 to 9 fields.
 MOT_DEFAULTS = (1.0, -1.0, -1.0, -1.0)
+
+
+def path_arg(value: object, what: str) -> str | os.PathLike[str]:
+    """`value` as a path: a str or an os.PathLike as it is, bytes decoded (``os.fsdecode``).
+
+    pathlib's and open's refusals (``expected str, bytes or os.PathLike object, not
+    NoneType``) name neither the function nor the argument, and arguments given in the wrong
+    order (``write_mot(rows, path)``, ``VideoWriter(fps, path)``) look like this too.
+
+    Raises
+    ------
+    TypeError
+        Anything else (None, a number, an array, a list): ``{what} must be a str or
+        os.PathLike, got NoneType``.
+    """
+    if isinstance(value, bytes):
+        return os.fsdecode(value)
+    if isinstance(value, (str, os.PathLike)):
+        return value
+    raise TypeError(f"{what} must be a str or os.PathLike, got {type(value).__name__}")
 
 
 def path_refused(value: object, what: str, reader: str) -> None:
@@ -355,6 +377,22 @@ def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     return np.ascontiguousarray(f)
 
 
+def shown(value: object) -> str:
+    """`value`'s type and repr on one line, as the refusals below name what they got.
+
+    ``str 'abc'``, ``NoneType None``; an array or a table (a pandas DataFrame) whose repr takes
+    several lines, its type and shape instead: ``ndarray of shape (2, 3)`` (was its whole
+    repr, one line of the message per row).
+    """
+    text = repr(value)
+    if "\n" not in text:
+        return f"{type(value).__name__} {text}"
+    shape = getattr(value, "shape", None)
+    if isinstance(shape, tuple):
+        return f"{type(value).__name__} of shape {shape}"
+    return f"{type(value).__name__} {' '.join(text.split())}"
+
+
 def flag(value: object, what: str) -> bool:
     """`value` as a bool, refusing anything but ``True`` and ``False`` (NumPy's too).
 
@@ -366,7 +404,7 @@ def flag(value: object, what: str) -> bool:
         Not a bool (a string, a number, None).
     """
     if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{what} must be True or False, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{what} must be True or False, got {shown(value)}")
     return bool(value)
 
 
@@ -421,7 +459,7 @@ def number(value: object, what: str, *, finite: bool = True) -> float:
     if isinstance(value, (bool, np.bool_)) or not isinstance(
         value, (int, float, np.integer, np.floating)
     ):
-        raise TypeError(f"{what} must be a number, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{what} must be a number, got {shown(value)}")
     try:
         v = float(value)
     except OverflowError:
@@ -468,9 +506,7 @@ def integer(value: object, what: str, lo: int, hi: int) -> int:
         An int outside ``[lo, hi]``: ``{what} is {value}, expected an integer in [lo, hi]``.
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise TypeError(
-            f"{what} must be an integer in [{lo}, {hi}], got {type(value).__name__} {value!r}"
-        )
+        raise TypeError(f"{what} must be an integer in [{lo}, {hi}], got {shown(value)}")
     if not lo <= value <= hi:
         raise ValueError(f"{what} is {value!r}, expected an integer in [{lo}, {hi}]")
     return int(value)
@@ -490,7 +526,7 @@ def seed(value: object, what: str) -> int:
         Negative.
     """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{what} must be an int >= 0, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{what} must be an int >= 0, got {shown(value)}")
     if value < 0:
         raise ValueError(f"{what} is {value}, expected an int >= 0")
     return int(value)
@@ -515,12 +551,12 @@ def generator(rng: RngLike | np.random.RandomState, what: str) -> np.random.Gene
     if isinstance(rng, (bool, np.bool_)):
         raise TypeError(
             f"{what} must be a numpy.random.Generator (or RandomState), an int >= 0 or None, got "
-            f"{type(rng).__name__} {rng!r}"
+            f"{shown(rng)}"
         )
     try:
         return np.random.default_rng(rng)
     except (TypeError, ValueError) as e:
         raise type(e)(
             f"{what} must be a numpy.random.Generator (or RandomState), an int >= 0 or None, got "
-            f"{type(rng).__name__} {rng!r}"
+            f"{shown(rng)}"
         ) from None

@@ -165,14 +165,16 @@ class RJMCMCTracker:
         min_samples: float = 0.0,  # large boxes counted on a lattice (lattice_step); 0: every pixel
     ) -> None: ...
     def __reduce__(self) -> NoReturn: ...  # TypeError: the chain cannot be pickled
-    # mask (H, W) uint8/bool; candidates (K, 4) cx, cy, w, h; candidate_hists (K, B) or None.
-    # seed and step have no default (pass them by keyword).
+    # mask (H, W) uint8/bool; candidates (K, 4) cx, cy, w, h; candidate_hists (K, B) or None
+    # (the default: computed from the image). seed and step have no default: after a default,
+    # a stub takes them by keyword only (the binding takes them by position too).
     def step(
         self,
         image: BinnedImage,
         mask: NDArray[Any],
         candidates: _F64,
-        candidate_hists: ArrayLike | None,
+        candidate_hists: ArrayLike | None = None,
+        *,
         seed: int,
         step: int,
     ) -> dict[str, Any]: ...

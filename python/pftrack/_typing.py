@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import numbers
 import os
-from typing import Literal, TypeAlias
+from typing import Any, Literal, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
@@ -13,6 +14,13 @@ RngLike: TypeAlias = np.random.Generator | int | None
 
 PathLike: TypeAlias = str | os.PathLike[str]
 """A file or folder path."""
+
+RealLike: TypeAlias = float | numbers.Real | np.floating[Any] | np.integer[Any]
+"""A frame rate or a time in seconds: any real number (a ``fractions.Fraction``, PyAV's
+``stream.average_rate``; a NumPy scalar), taken as its float (:func:`pftrack._check.real`)."""
+
+IntLike: TypeAlias = int | np.integer[Any]
+"""A count of frames: an int, NumPy's too (not a bool; :func:`pftrack._check.integer`)."""
 
 F64: TypeAlias = NDArray[np.float64]
 """A float64 array (shapes are given in each docstring)."""

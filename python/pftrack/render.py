@@ -15,8 +15,8 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, integer, real_array
-from pftrack._typing import F64, PathLike
+from pftrack._check import bgr_frame, integer, path_arg, real_array
+from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
 from pftrack.io.video_writer import VideoWriter
@@ -222,7 +222,7 @@ def write_annotated_video(
     path: PathLike,
     frames: Iterable[NDArray[np.uint8]],
     rows: NDArray[np.float64],
-    fps: float = 10.0,
+    fps: RealLike = 10.0,
     *,
     trail: int = 40,
     preset: str = "ultrafast",
@@ -261,11 +261,19 @@ def write_annotated_video(
         [0, :data:`MAX_TRAIL`]; a frame is not (H, W, 3) with pixels, or not of the first
         frame's size.
     TypeError
-        `rows` are not real numbers; `trail` is not an integer; a frame is not a uint8 array.
+        `rows` are not real numbers; `trail` is not an integer; `frames` is not iterable (None);
+        a frame is not a uint8 array; `path` is not a str or os.PathLike.
     """
+    path = path_arg(path, "write_annotated_video: path")
     trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: -1 drew none, 2.5 a TypeError
     rows = _track_rows(rows, "write_annotated_video")
-    it = iter(frames)
+    try:
+        it = iter(frames)
+    except TypeError:  # was: "'NoneType' object is not iterable", naming nothing
+        raise TypeError(
+            "write_annotated_video: frames must be an iterable of (H, W, 3) uint8 frames, got "
+            f"{type(frames).__name__}"
+        ) from None
     try:  # not next(it, None): [None] is a bad frame, not no frame
         first = next(it)
     except StopIteration:
@@ -387,7 +395,7 @@ class TrackRenderer:
     def __init__(
         self,
         path: PathLike,
-        fps: float,
+        fps: RealLike,
         *,
         trail: int = 40,
         threaded: bool = True,
@@ -395,6 +403,7 @@ class TrackRenderer:
         queue_size: int = 8,
         preset: str = "ultrafast",
     ) -> None:
+        path = path_arg(path, "TrackRenderer: path")
         self.trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: 2.5 and True taken as 2, 1
         queue_size = integer(queue_size, "queue_size", 0, 2**31 - 1)  # 0: as 1
         self.writer = VideoWriter(path, fps, backend=backend, preset=preset)
@@ -413,7 +422,14 @@ class TrackRenderer:
         # checked here, in the caller's thread (was: a float frame drawn black without a word)
         frame = bgr_frame(frame, "TrackRenderer.add: frame")
         self._raise_worker_error()
-        read = [_track_fields(t, i) for i, t in enumerate(tracks)]  # before anything changes
+        try:
+            each = iter(tracks)
+        except TypeError:  # was: "'NoneType' object is not iterable"
+            raise TypeError(
+                "TrackRenderer.add: tracks must be an iterable of tracks "
+                f"(MultiObjectTracker.update's list), got {type(tracks).__name__}"
+            ) from None
+        read = [_track_fields(t, i) for i, t in enumerate(each)]  # before anything changes
         self._n += 1
         rows, seen = [], set()
         for tid, box, coasting in read:
@@ -579,7 +595,7 @@ def plot_trajectories(
         is not two whole numbers from 1 to 32767, or the boxes reach beyond 32767 px.
     TypeError
         `rows` or `truth` are not real numbers; `background` is not a (H, W, 3) uint8 image;
-        `title` is not a str.
+        `title` is not a str; `path` is not a str or os.PathLike.
 
     Notes
     -----
@@ -588,6 +604,7 @@ def plot_trajectories(
     is larger than the canvas by them.
     """
     who = "plot_trajectories"
+    path = path_arg(path, f"{who}: path")
     rows = _track_rows(rows, who)
     _text(title, who, "title")
     truth = None if truth is None else _track_rows(truth, who, "truth")

@@ -20,8 +20,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import generator, real
-from pftrack._typing import F64, PathLike
+from pftrack._check import flag, generator, number, real
+from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
 from pftrack.io.opencv_io import opencv_name, write_image
@@ -303,7 +303,7 @@ MAX_SCENE_BYTES = 2**33
 
 
 def _check_scene_args(
-    fn: str, n_frames: int, width: int, height: int, noise: float, fps: float
+    fn: str, n_frames: int, width: int, height: int, noise: float, fps: RealLike
 ) -> float:
     """The frame count, size, noise level and rate `make_scene` and `make_busy_scene` share.
 
@@ -322,7 +322,8 @@ def _check_scene_args(
             f"pixels, held in memory; at most {MAX_SCENE_BYTES // 2**30} GiB (fewer or smaller "
             "frames)"
         )
-    if not (np.isfinite(noise) and noise >= 0):
+    # was: None or text failed in NumPy ("ufunc 'isfinite' not supported"), True was noise 1
+    if not (np.isfinite(number(noise, f"{fn}: noise", finite=False)) and noise >= 0):
         raise ValueError(f"{fn}: noise is {noise}, expected a finite value >= 0")
     rate = real(fps, f"{fn}: fps", finite=False)
     if not (np.isfinite(rate) and rate > 0):
@@ -339,7 +340,7 @@ def make_scene(
     occluder: bool = True,
     *,
     noise: float = 3.0,
-    fps: float = 10.0,
+    fps: RealLike = 10.0,
 ) -> Scene:
     """Generate a seeded scene of walkers on a textured background.
 
@@ -367,8 +368,12 @@ def make_scene(
     Scene
     """
     fps = _check_scene_args("make_scene", n_frames, width, height, noise, fps)
-    if not isinstance(n_walkers, (int, np.integer)) or not 1 <= n_walkers <= 40:
+    if not isinstance(n_walkers, (int, np.integer)) or isinstance(n_walkers, bool):
+        # was: True taken for 1 walker; 2.0 a ValueError, as n_frames=2.0 is a TypeError
+        raise TypeError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
+    if not 1 <= n_walkers <= 40:
         raise ValueError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
+    occluder = flag(occluder, "make_scene: occluder")  # was: any value taken for its truth
     gen = generator(rng, "make_scene: rng")
     bg = _background(width, height, gen)
     size_scale = height / 360.0
@@ -591,7 +596,7 @@ def make_busy_scene(
     rng: np.random.Generator | int | None = 0,
     *,
     noise: float = 3.0,
-    fps: float = 10.0,
+    fps: RealLike = 10.0,
 ) -> Scene:
     """A seeded scene reproducing one failure of background subtraction on busy scenes.
 

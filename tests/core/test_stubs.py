@@ -97,3 +97,79 @@ def test_stub_parameter_names_match_the_bindings():
                 mismatched.append(f"{label}: binding {got}, stub {names(fn)}")
     assert checked >= 15, f"only {checked} signatures compared"
     assert not mismatched, "\n".join(mismatched)
+
+
+def _binding_defaults(obj: object) -> dict[str, str | None] | None:
+    """Each parameter's default as pybind11's signature line prints it (None: no default)."""
+    doc = (getattr(obj, "__doc__", None) or "").strip()
+    if not doc or doc.startswith("Overloaded function"):
+        return None
+    line = doc.splitlines()[0]
+    start = line.find("(")
+    depth = 0
+    for end in range(start, len(line)):
+        depth += line[end] in "([{"
+        depth -= line[end] in ")]}"
+        if depth == 0:
+            break
+    out: dict[str, str | None] = {}
+    for p in _top_level_split(line[start + 1 : end]):
+        name, _, rest = p.partition(":")
+        if name.strip() in ("*", "/"):
+            continue
+        _, eq, default = rest.partition(" = ")
+        out[name.strip()] = default.strip() if eq else None
+    return out
+
+
+def test_stub_defaults_match_the_bindings():
+    """Which parameters have a default, and the default's value where the stub writes one.
+
+    stubtest reads no pybind11 signature, and the test above compares only names: the stub's
+    ``RJMCMCTracker.step`` had ``candidate_hists`` without its default None, so a typed
+    ``step(image, mask, boxes, seed=1, step=2)``, which runs, was a mypy error.
+    """
+    import ast
+
+    from pftrack import _core
+
+    tree = ast.parse((Path(pftrack.__file__).parent / "_core.pyi").read_text())
+    functions = []
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef):
+            functions.append((node, getattr(_core, node.name, None), node.name))
+        elif isinstance(node, ast.ClassDef):
+            cls = getattr(_core, node.name, None)
+            functions += [
+                (fn, getattr(cls, fn.name, None), f"{node.name}.{fn.name}")
+                for fn in node.body
+                if isinstance(fn, ast.FunctionDef) and not fn.decorator_list
+            ]
+    checked, mismatched = 0, []
+    for fn, obj, label in functions:
+        got = _binding_defaults(obj) if obj is not None else None
+        if got is None:
+            continue
+        a = fn.args
+        positional = a.posonlyargs + a.args
+        padded = [None] * (len(positional) - len(a.defaults)) + list(a.defaults)
+        stub = [
+            *zip(positional, padded, strict=True),
+            *zip(a.kwonlyargs, a.kw_defaults, strict=True),
+        ]
+        for arg, default in stub:
+            if arg.arg not in got:
+                continue  # self, and names the test above compares
+            checked += 1
+            runtime = got[arg.arg]
+            if (default is None) != (runtime is None):
+                shown = "no default" if default is None else f"= {ast.unparse(default)}"
+                had = "no default" if runtime is None else f"= {runtime}"
+                mismatched.append(f"{label}({arg.arg}): binding {had}, stub {shown}")
+            elif default is not None and ast.unparse(default) != "...":
+                if repr(ast.literal_eval(default)) != runtime:
+                    mismatched.append(
+                        f"{label}({arg.arg}): binding {runtime}, stub {ast.unparse(default)}"
+                    )
+    assert checked >= 100, f"only {checked} parameters compared"
+    assert not mismatched, "\n".join(mismatched)

@@ -789,6 +789,17 @@ def test_the_api_names_its_argument_when_given_the_wrong_kind():
         ((640, 480, 3), ValueError, r"image_size is \(640, 480, 3\), expected .* 2 values"),
         ((math.nan, 480), ValueError, r"image_size is \(nan, 480\), expected .* finite and > 0"),
         ((640, -1), ValueError, r"image_size is \(640, -1\), expected .* finite and > 0"),
+        # were: "len() of unsized object", and the array's repr over two lines
+        (
+            np.array(640),
+            TypeError,
+            r"image_size is ndarray array\(640\), expected \(width, height\)$",
+        ),
+        (
+            np.ones((2, 2)),
+            TypeError,
+            r"image_size is ndarray of shape \(2, 2\), expected \(width, h",
+        ),
     ):
         with pytest.raises(error, match=rf"^evaluate_mot: {message}"):
             evaluate_mot(HAND_GT, HAND_RES, image_size=size)  # type: ignore[arg-type]

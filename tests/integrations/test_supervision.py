@@ -186,8 +186,10 @@ def test_the_adapters_hints_resolve_at_run_time():
     """``typing.get_type_hints`` (pydantic, typer, docs tools) names no missing name."""
     import typing
 
+    from pftrack._typing import RealLike
+
     hints = typing.get_type_hints(SupervisionTracker.__init__)
-    assert hints["frame_rate"] is float
+    assert hints["frame_rate"] == RealLike  # any real number, as Tracker's frame_rate
     hints = typing.get_type_hints(SupervisionTracker.update_with_detections, localns={"sv": sv})
     assert hints["return"] is sv.Detections
 

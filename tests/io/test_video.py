@@ -227,6 +227,26 @@ def test_seqinfo_keys_the_caller_does_not_use_are_not_checked(tmp_path: Path) ->
         read_seqinfo(tmp_path, keys=("width",))
 
 
+@pytest.mark.parametrize(
+    ("keys", "message"),
+    [
+        ("imWidth", r"keys must be a collection of key names \(keys=\['imWidth'\] for one\), got "
+         r"str 'imWidth'$"),
+        (True, r"keys must be a collection of key names, got bool True$"),
+        (3, r"keys must be a collection of key names, got int 3$"),
+        ([["imWidth"]], r"keys\[0\] must be a str \(a key name\), got list \['imWidth'\]$"),
+    ],
+)  # fmt: skip
+def test_seqinfo_keys_of_the_wrong_type_are_named(
+    tmp_path: Path, keys: object, message: str
+) -> None:
+    """Were: keys has 'W', 'd', 'h', 'i', 'm', 't' (its letters), 'bool' object is not
+    iterable, unhashable type: 'list'."""
+    (tmp_path / "seqinfo.ini").write_text("[Sequence]\nimWidth=768\n")
+    with pytest.raises(TypeError, match=rf"^read_seqinfo: {message}"):
+        read_seqinfo(tmp_path, keys=keys)  # type: ignore[arg-type]
+
+
 def test_seqinfo_with_a_byte_order_mark_is_read(tmp_path: Path) -> None:
     """Notepad's UTF-8 starts the file with a BOM; det/gt/results already skip it."""
     (tmp_path / "seqinfo.ini").write_bytes(b"\xef\xbb\xbf[Sequence]\nframeRate=7\nseqLength=3\n")

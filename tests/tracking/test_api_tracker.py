@@ -1805,6 +1805,20 @@ def test_track_frames_of_one_frame_says_to_put_it_in_a_list(shape, dets):
     )
 
 
+@pytest.mark.parametrize("shape", [(), (5,), (2, 6, 8, 3, 1)])
+def test_track_frames_names_an_array_that_is_not_frames(shape):
+    # were: "len() of unsized object" (0-d), and rows of numbers taken for frames ("prime
+    # frame is float64 ...") or 5-d frames
+    from pftrack.tracking import track_frames
+
+    with pytest.raises(TypeError) as e:
+        track_frames(np.zeros(shape, np.uint8), show_progress=False)
+    assert str(e.value) == (
+        f"track_frames: source is an array of shape {shape}, expected a sequence of frames: a "
+        "(K, H, W, 3) uint8 array or a list of (H, W, 3) frames"
+    )
+
+
 def _blank_messages(record: list[warnings.WarningMessage]) -> list[str]:
     return [str(w.message) for w in record if "is blank" in str(w.message)]
 

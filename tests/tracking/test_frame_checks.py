@@ -87,6 +87,25 @@ def test_prime_refuses_what_is_not_a_frame(bad, error, message):
         pftrack.Tracker().prime([bad])
 
 
+@pytest.mark.parametrize(
+    ("frames", "got"),
+    [
+        (None, "got NoneType"),
+        (3, "got int"),
+        (np.zeros((6, 8, 3), np.uint8), r"got one \(6, 8, 3\) frame: prime\(\[frame\]\)"),
+        (np.zeros((6, 8), np.uint8), r"got one \(6, 8\) frame: prime\(\[frame\]\)"),
+    ],
+    ids=["None", "int", "frame", "grey frame"],
+)
+def test_multi_object_tracker_prime_refuses_what_is_not_frames_as_tracker_prime(frames, got):
+    """Were: 'NoneType' object is not iterable, and one frame's rows taken for frames (``frame
+    must have shape (H, W, 3) (BGR), got (8, 3)``), where Tracker.prime names both."""
+    with pytest.raises(
+        TypeError, match=rf"^MultiObjectTracker\.prime takes an iterable of frames \(.*\), {got}$"
+    ):
+        MultiObjectTracker(rng=0).prime(frames)
+
+
 @pytest.mark.parametrize("shape", [(6, 8, 3), (6, 8)])
 def test_prime_refuses_one_frame_for_an_iterable_of_frames(frames, shape):
     """Was ``prime frame must have shape (H, W, 3) (BGR), got (8, 3): a grey frame?``: one
@@ -274,6 +293,49 @@ def test_track_frames_names_its_rng(rng, error):
     frames = make_scene(n_frames=2, width=96, height=64, rng=0).frames
     with pytest.raises(error, match=r"^track_frames: rng must be a numpy\.random\.Generator"):
         pftrack.track_frames(frames, rng=rng)
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ({"threads": "no"}, "threads must be True or False, got str 'no'"),
+        ({"threads": None}, "threads must be True or False, got NoneType None"),
+        ({"show_progress": "no"}, "show_progress must be True or False, got str 'no'"),
+        ({"show_progress": 1}, "show_progress must be True or False, got int 1"),
+    ],
+)
+def test_track_frames_flags_of_the_wrong_kind_are_refused(option, message):
+    """A defect trial: threads="no" ran the threads and show_progress="no" showed the bar (any
+    value was taken for its truth), before any frame is read."""
+    with pytest.raises(TypeError, match=f"^track_frames: {re.escape(message)}$"):
+        pftrack.track_frames(_NOT_READ, **option)
+
+
+def test_track_frames_refuses_an_on_frame_that_cannot_be_called_before_any_frame():
+    """A defect trial: track_frames(on_frame="log.txt") tracked the first frame, then failed
+    with "'str' object is not callable", naming nothing."""
+    with pytest.raises(
+        TypeError,
+        match=r"^track_frames: on_frame is str, expected a callable "
+        r"on_frame\(index, frame, tracks, rows\) or None$",
+    ):
+        pftrack.track_frames(_NOT_READ, on_frame="log.txt")  # type: ignore[arg-type]
+
+
+class _NotRead(list):  # type: ignore[type-arg]
+    """A sequence of frames whose frames the checks above must not reach."""
+
+    def __getitem__(self, k):  # type: ignore[no-untyped-def]
+        raise AssertionError("a frame was read before the options were checked")
+
+    def __iter__(self):  # type: ignore[no-untyped-def]
+        raise AssertionError("a frame was read before the options were checked")
+
+    def __len__(self) -> int:
+        return 3
+
+
+_NOT_READ = _NotRead()
 
 
 @pytest.mark.parametrize("name", ["max_coast", "prime"])

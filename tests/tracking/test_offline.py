@@ -580,3 +580,20 @@ def test_a_writer_checkpointed_with_list_rows_loads() -> None:
     old.__setstate__(state)
     np.testing.assert_array_equal(old.result(), writer.result())
     assert len(old.rows) == 5
+
+
+@pytest.mark.parametrize("measurements", ["abc", object()], ids=["str", "object"])
+def test_smooth_tracks_names_measurements_that_are_not_numbers(measurements):
+    """Were: could not convert string to float: 'abc' (float() argument must be ...)."""
+    from pftrack.synthetic import make_scene
+
+    rows = make_scene(n_frames=4, rng=0).truth
+    with pytest.raises(TypeError, match=r"^smooth_tracks: measurements must hold real numbers"):
+        smooth_tracks(rows, measurements=measurements)
+
+
+@pytest.mark.parametrize("frames", [np.array(3.0), 3, True], ids=["0-d", "int", "bool"])
+def test_box_smoother_names_frames_that_are_not_one_dimensional(frames):
+    """Was: len() of unsized object."""
+    with pytest.raises(ValueError, match=r"^BoxSmoother\.smooth: frames \(\), boxes_xywh"):
+        BoxSmoother().smooth(frames, np.ones((1, 4)), np.ones(1, bool))

@@ -15,6 +15,8 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._typing import IntLike
+
 BOOTSTRAPS = ("spread", "first", "none")
 Bootstrap = Literal["spread", "first", "none"]
 
@@ -23,7 +25,7 @@ __all__ = ["BOOTSTRAPS", "Bootstrap", "bootstrap_frames"]
 
 def bootstrap_frames(
     frames: Iterable[NDArray[np.uint8]],
-    n: int = 30,
+    n: IntLike = 30,
     mode: str = "spread",
     *,
     split: bool = False,
@@ -67,7 +69,7 @@ def bootstrap_frames(
     total = len(frames) if isinstance(frames, Sized) else 0
     keep = prepare if prepare is not None else _same
     if mode == "first" or total <= n:
-        return [keep(f) for f in itertools.islice(iter(frames), n)]
+        return [keep(f) for f in itertools.islice(iter(frames), int(n))]
     wanted = set(np.linspace(0, total - 1, n).round().astype(int).tolist())
     pick = getattr(frames, "frames_at", None)
     if callable(pick):  # a FrameSource: only the wanted images of a folder, no BGR in between

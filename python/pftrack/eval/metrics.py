@@ -17,7 +17,7 @@ from scipy.optimize import linear_sum_assignment
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from pftrack._check import number
+from pftrack._check import number, shown
 from pftrack._progress import Report, check_report, reporting
 from pftrack._typing import BenchmarkName
 from pftrack.boxes import iou_xywh
@@ -281,10 +281,13 @@ def check_image_size(image_size: object, fn: str) -> tuple[float, float] | None:
     if image_size is None:
         return None
     what = f"{fn}: image_size"
-    if isinstance(image_size, (str, bytes)) or not isinstance(image_size, (Sequence, np.ndarray)):
-        raise TypeError(
-            f"{what} is {type(image_size).__name__} {image_size!r}, expected (width, height)"
-        )
+    # an array other than 1-d too: was "len() of unsized object" (0-d), or its repr over lines
+    if (
+        isinstance(image_size, (str, bytes))
+        or not isinstance(image_size, (Sequence, np.ndarray))
+        or (isinstance(image_size, np.ndarray) and image_size.ndim != 1)
+    ):
+        raise TypeError(f"{what} is {shown(image_size)}, expected (width, height)")
     if len(image_size) != 2:
         raise ValueError(f"{what} is {image_size!r}, expected (width, height), 2 values")
     w, h = (number(v, f"{what}[{k}]", finite=False) for k, v in enumerate(image_size))

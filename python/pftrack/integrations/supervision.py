@@ -19,7 +19,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import check_classes, real_array
-from pftrack._typing import F64, CameraMotion, DetectorName, DynamicsName, FillMode, SamplerName
+from pftrack._typing import (
+    F64,
+    CameraMotion,
+    DetectorName,
+    DynamicsName,
+    FillMode,
+    RealLike,
+    SamplerName,
+)
 from pftrack.tracking.api import Tracker
 
 if sys.version_info >= (3, 11):  # at run time too: typing.get_type_hints resolves it
@@ -43,7 +51,7 @@ class TrackerOptions(TypedDict, total=False):
     sampler: SamplerName
     particles: int | None
     dynamics: DynamicsName
-    max_coast: float | None
+    max_coast: RealLike | None
     min_conf: float
     birth_score: float
     birth_quantile: float | None
@@ -53,7 +61,7 @@ class TrackerOptions(TypedDict, total=False):
     smooth: bool
     link: bool
     crossings: bool
-    prime: float | None
+    prime: RealLike | None
     max_side: int | None
     record: bool
 
@@ -108,7 +116,7 @@ class SupervisionTracker:
     ...     print(detections.tracker_id)
     """
 
-    def __init__(self, frame_rate: float = 25.0, **options: Unpack[TrackerOptions]) -> None:
+    def __init__(self, frame_rate: RealLike = 25.0, **options: Unpack[TrackerOptions]) -> None:
         unknown = sorted(set(options) - set(TrackerOptions.__annotations__))
         if unknown:  # was: "Tracker.__init__() got an unexpected keyword argument"
             raise TypeError(

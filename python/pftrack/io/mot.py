@@ -29,6 +29,7 @@ from pftrack._check import (
     first_bad_box,
     frames_from_1,
     mot_rows,
+    path_arg,
 )
 from pftrack._typing import F64, PathLike
 from pftrack.io.atomic import atomic_write, refuse_dash, refuse_loop
@@ -166,6 +167,8 @@ def read_mot(
 
     Raises
     ------
+    TypeError
+        `path` is not a str or os.PathLike (bytes are decoded).
     FileNotFoundError
         If `path` does not exist.
     ValueError
@@ -190,7 +193,7 @@ def read_mot(
         With `warn_extra`, once, naming the file and its most columns on a line, when that is
         more than 10: columns 11 and beyond are not kept.
     """
-    p = Path(path)
+    p = Path(path_arg(path, "read_mot: path"))
     if not p.is_file():
         if p.is_dir():
             raise ValueError(f"{what} {p} is a folder, not a file")
@@ -632,13 +635,14 @@ def write_mot(
     ValueError
         What :func:`mot_text` refuses, or `path` is a folder.
     TypeError
-        `exact` is not of bool.
+        `exact` is not of bool; `path` is not a str or os.PathLike (bytes are decoded).
     OSError
         The folder does not exist (FileNotFoundError naming it), or the hidden temporary file
         cannot be made, written or renamed (a read-only file system: the error names `path`,
         left as it was).
     """
-    a = _checked(rows, "write_mot")
+    a = _checked(rows, "write_mot")  # first: rows and path swapped say "rows is a path"
+    path = path_arg(path, "write_mot: path")
     mask = _exact_mask(exact, len(a), "write_mot")
     order = np.lexsort((a[:, ID], a[:, FRAME]))
     text = _lines(a[order], None if mask is None else mask[order])

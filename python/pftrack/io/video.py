@@ -46,9 +46,9 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import number, real
+from pftrack._check import number, path_arg, real, shown
 from pftrack._text import counted
-from pftrack._typing import PathLike
+from pftrack._typing import PathLike, RealLike
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
 
 __all__ = [
@@ -399,6 +399,28 @@ def _duplicate(
 SEQINFO_KEYS = ("name", "imDir", "frameRate", "seqLength", "imWidth", "imHeight")
 
 
+def _key_names(keys: object) -> tuple[str, ...]:
+    """:func:`read_seqinfo`'s `keys` as a tuple of str; TypeError naming what is not one.
+
+    Was: a str taken for its letters (``keys has 'W', 'd', ...``), and Python's "'bool' object
+    is not iterable" or "unhashable type: 'list'".
+    """
+    if isinstance(keys, str):
+        raise TypeError(
+            f"read_seqinfo: keys must be a collection of key names (keys=[{keys!r}] for one), "
+            f"got {shown(keys)}"
+        )
+    if isinstance(keys, bytes) or not isinstance(keys, Iterable):
+        raise TypeError(f"read_seqinfo: keys must be a collection of key names, got {shown(keys)}")
+    names = tuple(keys)
+    for k, name in enumerate(names):
+        if not isinstance(name, str):
+            raise TypeError(
+                f"read_seqinfo: keys[{k}] must be a str (a key name), got {shown(name)}"
+            )
+    return names
+
+
 def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> SequenceInfo:
     """Read a MOTChallenge ``seqinfo.ini`` (or the one in folder `path`).
 
@@ -424,14 +446,19 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
         empty, a field that is not a positive number (``imWidth``, ``imHeight``,
         ``seqLength``: an integer), or a ``frameRate`` outside :data:`FRAME_RATE_RANGE`;
         a name in `keys` that is not one of :data:`SEQINFO_KEYS`.
+    TypeError
+        `path` is not a str or os.PathLike (bytes are decoded); `keys` is not a collection of
+        str (one name given as a str, whose letters were taken for names).
     """
+    if keys is not None:
+        keys = _key_names(keys)
     unknown = sorted(set(keys or ()) - set(SEQINFO_KEYS))
     if unknown:
         raise ValueError(
             f"read_seqinfo: keys has {', '.join(map(repr, unknown))}, expected some of "
             f"{', '.join(SEQINFO_KEYS)}"
         )
-    ini = Path(path)
+    ini = Path(path_arg(path, "read_seqinfo: path"))
     if ini.is_dir():
         ini = ini / "seqinfo.ini"
     parser = configparser.ConfigParser(interpolation=None)
@@ -1334,7 +1361,7 @@ class FrameSource:
     """
 
     def __init__(
-        self, source: PathLike | int, *, scale: float = 1.0, fps: float | None = None
+        self, source: PathLike | int, *, scale: float = 1.0, fps: RealLike | None = None
     ) -> None:
         check_source(source)
         scale = number(scale, "scale", finite=False)  # text, bools, None: a TypeError naming it

@@ -20,8 +20,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import bgr_frame, integer, real
-from pftrack._typing import PathLike
+from pftrack._check import bgr_frame, integer, path_arg, real
+from pftrack._typing import PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
 
@@ -116,13 +116,13 @@ class VideoWriter:
     def __init__(
         self,
         path: PathLike,
-        fps: float,
+        fps: RealLike,
         *,
         backend: str | None = None,
         crf: int = 23,
         preset: str = "ultrafast",
     ) -> None:
-        self.path = Path(path)
+        self.path = Path(path_arg(path, "VideoWriter: path"))
         suffix = self.path.suffix.lower()
         if suffix not in VIDEO_SUFFIXES:
             raise ValueError(

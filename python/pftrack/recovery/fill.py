@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _check
 from pftrack._check import MAX_COORD
 from pftrack._text import counted
-from pftrack._typing import F64, RecoveryMethod
+from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.recovery.calibrate import Calibration, bags_for, gap_windows, recover_auto
 from pftrack.recovery.linking import (
     FILLED_MARK,
@@ -198,7 +198,7 @@ NOISE_METHODS = ("auto", "gdt-bi", "gdt-mix")
 def fill_gaps(
     tracks: ArrayLike,
     method: RecoveryMethod = DEFAULT_METHOD,
-    max_gap: int = DEFAULT_MAX_GAP,
+    max_gap: IntLike = DEFAULT_MAX_GAP,
     noise: NoiseEstimate | None = None,
     *,
     seed: int = 0,
@@ -287,7 +287,7 @@ def fill_gaps(
 def fill_rows(
     rows: ArrayLike,
     method: RecoveryMethod = DEFAULT_METHOD,
-    max_gap: int = DEFAULT_MAX_GAP,
+    max_gap: IntLike = DEFAULT_MAX_GAP,
     noise: NoiseEstimate | None = None,
     *,
     seed: int = 0,

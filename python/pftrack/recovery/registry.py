@@ -159,9 +159,19 @@ def _checked_pairs(gaps: Sequence[tuple[ArrayLike, ArrayLike]]) -> list[tuple[F6
     ``recover_gaps`` and the gap); a segment of other than 3 or 5 columns is taken by its
     ``frame, x, y``, the only columns :func:`recover_gaps` reads.
     """
+    try:
+        if isinstance(gaps, (str, bytes)):
+            raise TypeError
+        each = iter(gaps)
+    except TypeError:  # was: "'NoneType' object is not iterable"
+        raise TypeError(
+            "recover_gaps: gaps must be a sequence of (segment_a, segment_b) pairs, got "
+            f"{type(gaps).__name__}"
+        ) from None
     pairs = []
-    for k, gap in enumerate(gaps):
-        if isinstance(gap, (str, bytes)) or len(gap) != 2:  # "not enough values to unpack"
+    for k, gap in enumerate(each):
+        # "not enough values to unpack"; an int (a DataFrame's column labels): "has no len()"
+        if isinstance(gap, (str, bytes)) or not hasattr(gap, "__len__") or len(gap) != 2:
             n = len(gap) if hasattr(gap, "__len__") else None
             got = type(gap).__name__ if n is None else f"{n} value{'' if n == 1 else 's'}"
             raise ValueError(
@@ -231,8 +241,8 @@ def recover_gaps(
     Raises
     ------
     TypeError
-        A `seed` or `history` that is not an int, `noise` not a NoiseEstimate or `motion` not
-        a MotionFit.
+        `gaps` that is not a sequence (None, a number, a str), a `seed` or `history` that is
+        not an int, `noise` not a NoiseEstimate or `motion` not a MotionFit.
     ValueError
         An unknown method, a gap that is not a pair of segments, segments :func:`recover_gap`
         refuses, whatever the method (the message names the gap), a negative `seed`, or

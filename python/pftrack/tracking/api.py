@@ -52,6 +52,8 @@ from pftrack._typing import (
     DetectorName,
     DynamicsName,
     FillMode,
+    IntLike,
+    RealLike,
     RngLike,
     SamplerName,
 )
@@ -456,14 +458,14 @@ class Tracker:
 
     def __init__(
         self,
-        frame_rate: float = REFERENCE_RATE,
+        frame_rate: RealLike = REFERENCE_RATE,
         *,
         seed: int | None = 0,
         detector: DetectorName = "paper",
         sampler: SamplerName = "sis",
         particles: int | None = None,
         dynamics: DynamicsName = "ar2",
-        max_coast: float | None = None,
+        max_coast: RealLike | None = None,
         min_conf: float = 0.0,
         birth_score: float = 0.9,
         birth_quantile: float | None = 0.25,
@@ -473,7 +475,7 @@ class Tracker:
         smooth: bool = True,
         link: bool = True,
         crossings: bool = CrossingConfig.enabled,
-        prime: float | None = None,
+        prime: RealLike | None = None,
         max_side: int | None = TrackerConfig.max_side,
         record: bool = True,
     ) -> None:
@@ -565,12 +567,12 @@ class Tracker:
         config: TrackerConfig | None = None,
         seed: RngLike = 0,
         *,
-        frame_rate: float = REFERENCE_RATE,
+        frame_rate: RealLike = REFERENCE_RATE,
         coasting: str = "confirmed",
         fill: str = "linear",
         smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
         link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
-        prime_frames: int = PRIME_FRAMES,
+        prime_frames: IntLike = PRIME_FRAMES,
     ) -> Tracker:
         """A tracker from a full :class:`TrackerConfig` (frame-based), as ``pftrack track`` makes.
 
@@ -603,8 +605,8 @@ class Tracker:
         )
         return self
 
-    def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: float, fill: str,
-               smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: int,
+    def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: RealLike, fill: str,
+               smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: IntLike,
                coasting: str = "confirmed", record: bool = True) -> None:  # fmt: skip
         if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
             raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")

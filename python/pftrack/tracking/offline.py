@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _check
 from pftrack._check import MAX_FRAME, real_array
 from pftrack._progress import progress
-from pftrack._typing import F64, RecoveryMethod
+from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
 from pftrack.detection.size_model import expected_size, head_height
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
@@ -138,7 +138,7 @@ class BoxSmoother:
         f = fr.astype(np.int64)
         b: F64 = real_array(boxes_xywh, "BoxSmoother.smooth: boxes_xywh")
         obs = np.asarray(observed, dtype=bool)
-        n = len(f)
+        n = len(f) if f.ndim == 1 else -1  # was: len() of unsized object (a 0-d array, an int)
         if b.shape != (n, 4) or obs.shape != (n,):
             raise ValueError(
                 f"BoxSmoother.smooth: frames {f.shape}, boxes_xywh {b.shape} and observed "
@@ -462,7 +462,7 @@ def smooth_tracks(
     seed: int = 0,
     crossings: CrossingConfig | None = None,
     relink_coast: int | None = None,
-    max_gap: int | None = None,
+    max_gap: IntLike | None = None,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 
@@ -573,7 +573,8 @@ def smooth_tracks(
     if measurements is None:
         z = a[:, 2:6].copy()
     else:
-        z = np.array(measurements, dtype=np.float64)
+        # was: "could not convert string to float: 'abc'", naming nothing
+        z = np.array(real_array(measurements, "smooth_tracks: measurements"))
     if z.shape != (len(a), 4):
         raise ValueError(f"smooth_tracks: measurements has shape {z.shape}, expected ({len(a)}, 4)")
     check_boxes(z, a, "smooth_tracks", "measurements")  # boxes of filled rows, as the rows'

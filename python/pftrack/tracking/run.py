@@ -13,10 +13,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import MAX_FRAME, first_bad_box, flag, generator, number, real_array
+from pftrack._check import (
+    MAX_FRAME,
+    first_bad_box,
+    flag,
+    generator,
+    number,
+    path_arg,
+    real_array,
+)
 from pftrack._progress import progress
 from pftrack._text import counted
-from pftrack._typing import F64, BootstrapMode, FillMode, PathLike, RngLike
+from pftrack._typing import F64, BootstrapMode, FillMode, IntLike, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
@@ -81,7 +89,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     Raises
     ------
     TypeError
-        `scale` is not a real number.
+        `scale` is not a real number; `path` is not a str or os.PathLike.
     ValueError
         `scale` outside [0.001, 1000], or a bad detection file.
 
@@ -95,6 +103,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     lo, hi = DET_SCALE_RANGE
     if not (lo <= number(scale, "detection scale", finite=False) <= hi):
         raise ValueError(f"detection scale is {scale}, expected a number in [{lo:g}, {hi:g}]")
+    path = path_arg(path, "load_detections: path")
     rows = read_mot(path, what="detection file")
     if len(rows) and first_row_fields(path) == 6:
         warnings.warn(
@@ -147,7 +156,7 @@ def track_frames(
     coasting: str = "confirmed",
     fill: FillMode = "linear",
     show_progress: bool | None = None,
-    prime_frames: int = 30,
+    prime_frames: IntLike = 30,
     bootstrap: BootstrapMode = "auto",
     smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
     link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
@@ -212,7 +221,8 @@ def track_frames(
         `source` is not a path, a FrameSource or a sequence of frames (an iterator, an int,
         one frame alone: ``track_frames([frame])``); `detections` is not a dict (a path, a
         list), a key is not an int, or a value does not hold real numbers; `rng` is not a
-        Generator, an int or None (a float, a bool).
+        Generator, an int or None (a float, a bool); `threads` is not a bool, `show_progress`
+        not a bool or None, `on_frame` not callable or None.
     ValueError
         A negative `rng`. A key below 1 (frames are 1-based: 0-based keys would put every box
         one frame late), a value not of shape (k, 5) or (k, 4), NaN, inf, a negative width or
@@ -240,6 +250,15 @@ def track_frames(
     if bootstrap not in ("auto", *BOOTSTRAPS):
         raise ValueError(
             f"bootstrap mode is {bootstrap!r}, expected one of auto, {', '.join(BOOTSTRAPS)}"
+        )
+    # before any frame is read (was: any value taken for its truth, threads="no" ran threads)
+    threads = flag(threads, "track_frames: threads")
+    if show_progress is not None:
+        show_progress = flag(show_progress, "track_frames: show_progress")
+    if on_frame is not None and not callable(on_frame):  # was: "'str' object is not callable"
+        raise TypeError(  # after the first frame was tracked
+            f"track_frames: on_frame is {type(on_frame).__name__}, expected a callable "
+            "on_frame(index, frame, tracks, rows) or None"
         )
     if detections is not None:
         detections = _check_detections(detections)
@@ -354,6 +373,12 @@ def _check_frames(frames: object) -> None:
         raise TypeError(
             f"track_frames: source is one {frames.shape} frame, expected a sequence of frames: "
             "track_frames([frame])"
+        )
+    if isinstance(frames, np.ndarray) and frames.ndim not in (3, 4):
+        # was: "len() of unsized object" (0-d), numbers taken for frames (1-d), 5-d frames
+        raise TypeError(
+            f"track_frames: source is an array of shape {frames.shape}, expected a sequence of "
+            "frames: a (K, H, W, 3) uint8 array or a list of (H, W, 3) frames"
         )
     if isinstance(frames, FrameSource) or (
         hasattr(frames, "__len__")

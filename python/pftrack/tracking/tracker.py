@@ -109,7 +109,8 @@ class MultiObjectTracker:
         Seed: the same seed and input give the same tracks.
     detector : object, optional
         Any object with ``detect(frame) -> Detections`` (see :mod:`pftrack.detection`); by
-        default the one named by ``config.detector``, created on first use.
+        default the one named by ``config.detector``, created on first use. Anything else (a
+        name such as ``"paper"``, which goes in ``TrackerConfig(detector=...)``) is a TypeError.
 
     Notes
     -----
@@ -152,6 +153,14 @@ class MultiObjectTracker:
         self._busy = threading.Lock()  # held by update and prime (see _take)
         self._rng = generator(rng, "MultiObjectTracker: rng")
         self._ids = itertools.count(1)
+        if detector is not None and not callable(getattr(detector, "detect", None)):
+            # was taken, and the first frame failed: 'str' object has no attribute 'detect'
+            shown = f"str {detector!r}" if isinstance(detector, str) else type(detector).__name__
+            hint = f"; a built-in detector is named by TrackerConfig(detector={detector!r})"
+            raise TypeError(
+                "MultiObjectTracker: detector must have a detect(frame) method (or be None: the "
+                f"built-in one), got {shown}{hint if isinstance(detector, str) else ''}"
+            )
         self._detector = detector
         self.tracks: list[LiveTrack] = []
         self._ended_unconfirmed: set[int] = set()
@@ -234,8 +243,25 @@ class MultiObjectTracker:
         Reading ahead (e.g. the first 30 frames) gives the background model a picture of the
         empty scene before frame 1 is tracked; detectors without ``prime`` ignore it. The
         arrays of an iterable other than a list, a tuple or an array are copied as they come
-        (a generator may refill one buffer with each frame).
+        (a generator may refill one buffer with each frame). What is not an iterable (None),
+        and one frame alone (``prime([frame])`` primes with it), are a TypeError, as
+        :meth:`pftrack.Tracker.prime` says (were: "'NoneType' object is not iterable", and one
+        frame's rows taken for frames).
         """
+        if isinstance(frames, np.ndarray) and (
+            frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
+        ):
+            raise TypeError(
+                "MultiObjectTracker.prime takes an iterable of frames (a list, or a (K, H, W, 3) "
+                f"array), got one {frames.shape} frame: prime([frame])"
+            )
+        try:
+            iter(frames)
+        except TypeError:
+            raise TypeError(
+                "MultiObjectTracker.prime takes an iterable of frames (a list, a generator or a "
+                f"(K, H, W, 3) array), got {type(frames).__name__}"
+            ) from None
         self._take("prime")
         try:
             self._prime(frames)
