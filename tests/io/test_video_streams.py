@@ -81,3 +81,17 @@ def test_track_says_it_once(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     assert main(["track", str(path), "--out", str(tmp_path / "t.txt"), "--particles", "30"]) == 0
     said = [line for line in capsys.readouterr().err.splitlines() if "video streams" in line]
     assert len(said) == 1 and said[0].startswith("pftrack track: warning: ")
+
+
+def test_a_stream_of_a_codec_ffmpeg_does_not_know_is_named(tmp_path: Path) -> None:
+    # its second track's sample entry says "zzzz": PyAV gives it no codec context (was: an
+    # AttributeError traceback out of FrameSource, pftrack track too)
+    path = write_streams(tmp_path / "two.mp4", [(160, 120), (96, 64)])
+    data = bytearray(path.read_bytes())
+    second = data.index(b"avc1", data.index(b"avc1", data.rindex(b"moov")) + 4)
+    data[second : second + 4] = b"zzzz"
+    path.write_bytes(data)
+    with pytest.warns(UserWarning, match="2 video streams") as said:
+        FrameSource(path)
+    assert "#0 (h264 160x120)" in str(said[0].message)
+    assert "not #1 (a codec FFmpeg does not know)" in str(said[0].message)

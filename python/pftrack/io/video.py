@@ -198,16 +198,24 @@ def _video_streams(path: Path) -> list[str]:
     From its container's header, through PyAV (a pftrack dependency, with FFmpeg as OpenCV's;
     OpenCV itself says neither how many there are nor which it reads: it opens no file with
     ``CAP_PROP_VIDEO_STREAM`` set, and reads the first video stream). Cover art (an attached
-    picture) is no stream of frames. Empty where PyAV is missing or cannot open the file.
+    picture) is no stream of frames. A stream in a codec FFmpeg does not know (PyAV gives it no
+    codec context) is ``#1 (a codec FFmpeg does not know)``. Empty where PyAV is missing or
+    cannot open the file.
     """
     av = _import_av()
     if av is None:
         return []
+
+    def said(stream: Any) -> str:
+        codec = stream.codec_context
+        if codec is None:  # was: an AttributeError out of FrameSource
+            return f"#{stream.index} (a codec FFmpeg does not know)"
+        return f"#{stream.index} ({codec.name} {codec.width}x{codec.height})"
+
     try:
         with av.open(str(path)) as container:
             return [
-                f"#{s.index} ({s.codec_context.name} {s.codec_context.width}x"
-                f"{s.codec_context.height})"
+                said(s)
                 for s in container.streams.video
                 if not s.disposition & av.stream.Disposition.attached_pic
             ]
