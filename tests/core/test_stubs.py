@@ -44,8 +44,9 @@ def _top_level_split(text: str) -> list[str]:
     return [p.strip() for p in parts + [cur] if p.strip()]
 
 
-def _binding_params(obj: object) -> list[str] | None:
-    """Parameter names from pybind11's signature line ``name(a: T, b: U = 1) -> R``."""
+def _binding_arguments(obj: object) -> list[str] | None:
+    """The parameters of pybind11's signature line ``name(a: T, b: U = 1) -> R``, as written
+    (``a: T``, ``b: U = 1``); None for an overloaded function or no signature."""
     doc = (getattr(obj, "__doc__", None) or "").strip()
     if not doc or doc.startswith("Overloaded function"):
         return None
@@ -57,7 +58,13 @@ def _binding_params(obj: object) -> list[str] | None:
         depth -= line[end] in ")]}"
         if depth == 0:
             break
-    return [p.split(":")[0].split("=")[0].strip() for p in _top_level_split(line[start + 1 : end])]
+    return _top_level_split(line[start + 1 : end])
+
+
+def _binding_params(obj: object) -> list[str] | None:
+    """Parameter names from pybind11's signature line."""
+    args = _binding_arguments(obj)
+    return None if args is None else [p.split(":")[0].split("=")[0].strip() for p in args]
 
 
 def test_stub_parameter_names_match_the_bindings():
@@ -101,19 +108,11 @@ def test_stub_parameter_names_match_the_bindings():
 
 def _binding_defaults(obj: object) -> dict[str, str | None] | None:
     """Each parameter's default as pybind11's signature line prints it (None: no default)."""
-    doc = (getattr(obj, "__doc__", None) or "").strip()
-    if not doc or doc.startswith("Overloaded function"):
+    args = _binding_arguments(obj)
+    if args is None:
         return None
-    line = doc.splitlines()[0]
-    start = line.find("(")
-    depth = 0
-    for end in range(start, len(line)):
-        depth += line[end] in "([{"
-        depth -= line[end] in ")]}"
-        if depth == 0:
-            break
     out: dict[str, str | None] = {}
-    for p in _top_level_split(line[start + 1 : end]):
+    for p in args:
         name, _, rest = p.partition(":")
         if name.strip() in ("*", "/"):
             continue

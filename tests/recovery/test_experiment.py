@@ -321,44 +321,30 @@ def test_recover_of_a_detection_file_says_it_needs_tracks(
     )
 
 
-def test_rows_of_id_minus_1_among_tracks_are_refused() -> None:
-    """Rows of id -1 (MOTChallenge's unassociated boxes) among tracks were joined into one
-    track: holes between unrelated detections were filled, smoothed and linked."""
+NO_TRACK = (
+    "-1 is MOTChallenge's id of a box no track holds (an unassociated detection), not a "
+    "track; drop those rows, or make tracks of them (pftrack track SOURCE --detections FILE)"
+)
+BELOW_MINUS_1 = (
+    "track ids must be >= 0, as pftrack eval and TrackEval require them (-1 alone has a "
+    "meaning: a box no track holds); renumber the tracks"
+)
+
+
+@pytest.mark.parametrize(("bad", "why"), [(-1, NO_TRACK), (-5, BELOW_MINUS_1)])
+def test_rows_of_negative_ids_among_tracks_are_refused(bad: int, why: str) -> None:
+    """-1 (MOTChallenge's unassociated boxes) among tracks: were joined into one track (holes
+    between unrelated detections filled, smoothed and linked). Other negative ids (-5): were a
+    track filled, smoothed and linked, where ``pftrack eval`` (and TrackEval: an IndexError, or
+    id -5 scored as another id) refuse it: ids must be >= 0 everywhere."""
     from pftrack.recovery import fill_gaps, link_tracklets
     from pftrack.recovery.linking import LinkConfig
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import repair_crossings
 
     rows = _walkers(n_ids=2, n_frames=10)
-    loose = np.array([[5, -1, 300, 200, 20, 40, 0.5, -1, -1, -1],
-                      [1, -1, 100, 100, 20, 40, 0.5, -1, -1, -1]])  # fmt: skip
-    mixed = np.vstack([rows, loose])
-    for who, call in (
-        ("fill_gaps", lambda: fill_gaps(mixed)),
-        ("smooth_tracks", lambda: smooth_tracks(mixed)),
-        ("link_tracklets", lambda: link_tracklets(mixed, LinkConfig())),
-        ("repair_crossings", lambda: repair_crossings(mixed)),
-    ):
-        with pytest.raises(ValueError) as exc:
-            call()
-        assert str(exc.value) == (
-            f"{who}: row 20 has id -1 (frame 5; 2 rows have it): -1 is MOTChallenge's id of a "
-            "box no track holds (an unassociated detection), not a track; drop those rows, or "
-            "make tracks of them (pftrack track SOURCE --detections FILE)"
-        )
-
-
-def test_rows_of_other_negative_ids_are_refused_as_eval_refuses_them() -> None:
-    """Was: a track of id -5 filled, smoothed and linked, where ``pftrack eval`` (and TrackEval:
-    an IndexError, or id -5 scored as another id) refuse it: ids must be >= 0 everywhere."""
-    from pftrack.recovery import fill_gaps, link_tracklets
-    from pftrack.recovery.linking import LinkConfig
-    from pftrack.tracking import smooth_tracks
-    from pftrack.tracking.offline import repair_crossings
-
-    rows = _walkers(n_ids=2, n_frames=10)
-    neg = np.array([[5, -5, 300, 200, 20, 40, 0.5, -1, -1, -1],
-                    [1, -5, 100, 100, 20, 40, 0.5, -1, -1, -1]])  # fmt: skip
+    neg = np.array([[5, bad, 300, 200, 20, 40, 0.5, -1, -1, -1],
+                    [1, bad, 100, 100, 20, 40, 0.5, -1, -1, -1]])  # fmt: skip
     mixed = np.vstack([rows, neg])
     for who, call in (
         ("fill_gaps", lambda: fill_gaps(mixed)),
@@ -368,11 +354,15 @@ def test_rows_of_other_negative_ids_are_refused_as_eval_refuses_them() -> None:
     ):
         with pytest.raises(ValueError) as exc:
             call()
-        assert str(exc.value) == (
-            f"{who}: row 20 has id -5 (frame 5; 2 rows have it): track ids must be >= 0, as "
-            "pftrack eval and TrackEval require them (-1 alone has a meaning: a box no track "
-            "holds); renumber the tracks"
-        )
+        assert str(exc.value) == f"{who}: row 20 has id {bad} (frame 5; 2 rows have it): {why}"
+
+
+def test_id_0_is_a_track() -> None:
+    from pftrack.recovery import fill_gaps
+
+    rows = _walkers(n_ids=2, n_frames=10)
+    neg = np.array([[5, -5, 300, 200, 20, 40, 0.5, -1, -1, -1],
+                    [1, -5, 100, 100, 20, 40, 0.5, -1, -1, -1]])  # fmt: skip
     zero = np.vstack([rows, neg * [1, 0, 1, 1, 1, 1, 1, 1, 1, 1]])  # id 0: a track
     assert len(fill_gaps(zero)[0]) == 20 + 2 + 3  # its hole of frames 2-4 filled
 
