@@ -313,6 +313,8 @@ def test_grey_scene_tracks_about_as_well_as_its_colour_version() -> None:
     assert grey_score >= colour_score - 0.05, (colour_score, grey_score)
 
 
+# gain_band=0: foreground almost everywhere, which the noise warning says
+@pytest.mark.filterwarnings("ignore:noisy or changing video:UserWarning")
 def test_ramped_scene_with_the_auto_bootstrap() -> None:
     scene = make_scene(n_frames=100, rng=0)
     frames = ramped(scene.frames, 0.7)
