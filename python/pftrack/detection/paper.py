@@ -19,6 +19,7 @@ from pftrack.detection.base import (
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
 from pftrack.detection.light import (
+    DARK_LEVEL,
     GAIN_SAMPLE_STEP,
     is_dark,
     levelled_median,
@@ -48,6 +49,11 @@ NOISY_LEVEL = 9
 
 #: Frames in a row at `NOISY_LEVEL` or above before the warning (a passing flash says nothing).
 NOISY_FRAMES = 10
+
+#: Dark frames in a row (`pftrack.detection.light.is_dark`: lights switched off, a fade to
+#: black) before the detector warns, once a video, that it finds nothing on them. A dropout's
+#: black frame or two is not said.
+DARK_FRAMES = 10
 
 
 @dataclass(frozen=True)
@@ -214,6 +220,10 @@ class PaperDetector:
         self._noisy = 0  # frames in a row at NOISY_LEVEL or above (NOISY_FRAMES)
         self._noise_said = False  # the noise warning was given (once a video)
         self._noise_unsaid = False  # the noise warning, given by the next detect/foreground
+        self._seen = 0  # frames given to detect/foreground since the start or reset()
+        self._dark = 0  # dark frames in a row (DARK_FRAMES)
+        self._dark_said = False  # the dark warning was given (once a video)
+        self._dark_unsaid = False  # the dark warning, given by the next detect
 
     def _new_model(self, shadow_lo: float) -> _core.BackgroundModel:
         c = self.config
@@ -320,6 +330,7 @@ class PaperDetector:
                 f"PaperDetector: frame shape is {frame.shape}, expected {self._shape} (one size "
                 "per video: reset() between videos)"
             )
+        self._seen += 1
         step = sample_step(frame.shape, GAIN_SAMPLE_STEP)
         if self.config.gain_band > 0 and is_dark(frame, step):
             return self._unlit(frame, bins)  # no light to compare or learn (light.is_dark)
@@ -346,6 +357,7 @@ class PaperDetector:
                     scale = min(self._light, 1.0)
                     if scale != self._model.threshold_scale:
                         self._model.set_threshold_scale(scale)
+        self._dark = 0
         result = self._model.apply(frame, bins=bins)
         self._count_noisy()
         return result
@@ -354,6 +366,9 @@ class PaperDetector:
         self, frame: NDArray[np.uint8], bins: bool
     ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
         """:meth:`_apply`'s result for a frame without light: no foreground, nothing learnt."""
+        self._dark += 1
+        if self._dark == DARK_FRAMES and not self._dark_said:
+            self._dark_said = self._dark_unsaid = True  # said by the next detect
         binned = hsv_bins(frame, None, self.config.hsv) if bins else None
         return binned, np.zeros(frame.shape[:2], np.uint8)
 
@@ -377,6 +392,8 @@ class PaperDetector:
         self._shape = None
         self._noise = self._noisy = 0
         self._noise_said = self._noise_unsaid = False
+        self._seen = self._dark = 0
+        self._dark_said = self._dark_unsaid = False
 
     def _reset_model(self) -> None:
         """Forget the background model, and with it the light it has followed.
@@ -432,7 +449,8 @@ class PaperDetector:
             Once, on the first call, when the video is grey (`grey_tolerance`): the shadow
             test is off, people as bright as the background are missed, and trackers tell
             people apart by brightness alone. Once, when the video is noisy (`NOISY_LEVEL`
-            for `NOISY_FRAMES` frames in a row): the threshold has risen with the noise.
+            for `NOISY_FRAMES` frames in a row): the threshold has risen with the noise. Once,
+            after `DARK_FRAMES` dark frames in a row: nothing is found on them.
         """
         frame = check_frame(frame, "PaperDetector.detect")
         _, raw = self._apply(frame, bins=False)  # bins below, of the foreground only
@@ -440,6 +458,17 @@ class PaperDetector:
             self._say_grey(detecting=True, stacklevel=2)  # detect()'s caller
         if self._noise_unsaid:
             self._say_noise(detecting=True, stacklevel=2)
+        if self._dark_unsaid:
+            self._dark_unsaid = False
+            first = self._seen - DARK_FRAMES + 1
+            warn(
+                f"the frames from {first} on are dark ({DARK_FRAMES} in a row so far at mean "
+                f"level {DARK_LEVEL:g} or less: lights switched off, a fade to black, a covered "
+                "lens?): the detector finds nothing on a dark frame, so tracks coast and end "
+                "until the light returns",
+                UserWarning,
+                stacklevel=2,  # detect()'s caller; held inside a tracker's update
+            )
         shaded = self._blobs.clean(raw)
         mask = foreground_only(shaded)
         if self.config.ghost_support > 0 and self._ghost is not None:
