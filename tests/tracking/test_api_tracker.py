@@ -1905,6 +1905,8 @@ def test_a_warning_made_an_error_leaves_the_tracker_usable(scene):
 
         outs, rows, raised, tracker = _loop_under("error", make, frames, given)
         plain, plain_rows, _, _ = _loop_under("ignore", make, frames, given)
+        # the pan also differs from the background everywhere: the noise warning, raised too
+        raised = [r for r in raised if not r.startswith("noisy or changing video")]
         assert len(raised) == 1 and raised[0].startswith(said), (said, raised)
         assert tracker.frame_count == len(frames)  # every frame taken, the run whole
         assert len(plain_rows) > 0

@@ -310,7 +310,7 @@ class PaperDetector:
             "noisy or changing video: the frames differ from the background model by "
             f"{self._noise} grey levels at the median pixel, {NOISY_FRAMES} frames in a row at "
             f"{NOISY_LEVEL} or more (steady video: 1 to 5; sensor noise of a dark scene at high "
-            "gain, heavy compression, a moving camera, light the model does not follow, or "
+            "gain, heavy compression, a view or light the model does not follow, or "
             "people over most of the frame while it learnt?), so its noise-adaptive threshold "
             f"rose to {self._model.threshold:.3g}{' (its bound t_max)' if at_max else ''}: "
             f"contrasts below it are lost{', and the noise itself passes it' if at_max else ''}"
