@@ -22,6 +22,7 @@ from pftrack.detection.light import (
     levelled_median,
     looks_grey,
 )
+from pftrack.detection.paper import DARK_FRAMES
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import make_scene
@@ -313,6 +314,8 @@ def test_grey_scene_tracks_about_as_well_as_its_colour_version() -> None:
     assert grey_score >= colour_score - 0.05, (colour_score, grey_score)
 
 
+# gain_band=0: foreground almost everywhere, which the noise warning says
+@pytest.mark.filterwarnings("ignore:noisy or changing video:UserWarning")
 def test_ramped_scene_with_the_auto_bootstrap() -> None:
     scene = make_scene(n_frames=100, rng=0)
     frames = ramped(scene.frames, 0.7)
@@ -573,3 +576,40 @@ def test_dark_frames_neither_prime_nor_start_the_background() -> None:
     assert not det.model.initialized
     for f in scene.frames[:5]:
         np.testing.assert_array_equal(det.detect(f).mask, ref.detect(f).mask)
+
+
+def _dark_said(caught: list[warnings.WarningMessage]) -> list[str]:
+    return [str(w.message) for w in caught if "are dark" in str(w.message)]
+
+
+def test_lights_switched_off_are_said_once() -> None:
+    """A user trial: a scene whose lights go off (x0.05) from frame 60 of 150 gave tracks until
+    then and nothing after, 309 people-frames missed, without a word."""
+    scene = make_scene(n_frames=12 + DARK_FRAMES + 3, rng=1)
+    frames = [f if k < 12 else (f * 0.05).astype(np.uint8) for k, f in enumerate(scene.frames)]
+    det = PaperDetector()
+    for _ in range(2):  # reset(): a new video, said again
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for k, frame in enumerate(frames, start=1):
+                det.detect(frame)
+                if k < 12 + DARK_FRAMES:
+                    assert _dark_said(caught) == []
+        assert _dark_said(caught) == [
+            "the frames from 13 on are dark (10 in a row so far at mean level 8 or less: "
+            "lights switched off, a fade to black, a covered lens?): the detector finds "
+            "nothing on a dark frame, so tracks coast and end until the light returns"
+        ]
+        det.reset()
+    # a dropout (a few black frames) is not said; nor, with given detections, dark frames
+    # (refinement keeps the boxes as given where there is no foreground)
+    short = frames[:12] + frames[12 : 12 + DARK_FRAMES - 1] + frames[:3]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        det = PaperDetector()
+        for frame in short:
+            det.detect(frame)
+        det = PaperDetector()
+        for frame in frames:
+            det.foreground(frame)
+    assert _dark_said(caught) == []

@@ -965,6 +965,27 @@ def test_no_track_warning_says_min_area_left_the_built_in_detectors_objects_out(
         ], sampler
 
 
+def test_no_track_warning_says_the_blob_filters_left_the_foreground_out():
+    """A user trial on hard footage: people 10 px tall (4x10, under the detector's min_area of
+    259 px at 480x360) walking across a 480x360 scene were said to be "no object" found."""
+    background = np.random.default_rng(0).integers(60, 120, (360, 480, 3), dtype=np.uint8)
+    frames = [background.copy() for _ in range(8)]
+    for i, f in enumerate(frames[2:]):
+        for k in range(3):
+            f[100 + 80 * k : 110 + 80 * k, 100 + 3 * i : 104 + 3 * i] = (0, 0, 255)
+    said = _no_track_said(pftrack.Tracker(seed=0), frames)
+    assert len(said) == 1
+    head, pixels, tail = re.split(r"(?<=at most )(\d+)(?= a frame)", said[0])
+    assert int(pixels) >= 3 * 40  # three 4x10 people (each region under min_area), trails
+    assert head + "N" + tail == (
+        "no track over 8 frames: the built-in detector found no object, though its foreground "
+        "held pixels on 6 of the 8 frames (at most N a frame): no region passed its blob "
+        "filters (BlobConfig: min_area 0.0015 of the frame, 259 pixels at 480x360; height / "
+        "width 0.25 to 6; fill 0.2): people too small in the frame, or noise? give a person "
+        "detector's boxes (pftrack track --detections; Tracker.update's dets)"
+    )
+
+
 def test_no_track_warning_of_the_joint_sampler_on_the_built_in_detector():
     """A defect trial (``pftrack track`` on a 40x1 image folder, --sampler rjmcmc): objects
     the joint sampler kept none of were said to have "none reached min_conf 0" at score 1.
@@ -1898,6 +1919,8 @@ def test_a_warning_made_an_error_leaves_the_tracker_usable(scene):
 
         outs, rows, raised, tracker = _loop_under("error", make, frames, given)
         plain, plain_rows, _, _ = _loop_under("ignore", make, frames, given)
+        # the pan also differs from the background everywhere: the noise warning, raised too
+        raised = [r for r in raised if not r.startswith("noisy or changing video")]
         assert len(raised) == 1 and raised[0].startswith(said), (said, raised)
         assert tracker.frame_count == len(frames)  # every frame taken, the run whole
         assert len(plain_rows) > 0

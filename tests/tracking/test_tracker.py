@@ -375,11 +375,12 @@ def test_lazy_frame_bins_give_the_same_tracks_with_detections(scene, monkeypatch
     np.testing.assert_array_equal(lazy.rows, eager.rows)
 
 
+@pytest.mark.filterwarnings("ignore:noisy or changing video:UserWarning")  # it moves: said too
 def test_lazy_frame_bins_give_the_same_tracks_on_a_moving_camera(monkeypatch):
     moving = move_camera(make_scene(n_frames=50, n_walkers=5, rng=3), period=30.0)
     with pytest.warns(UserWarning, match="the camera moves") as said:  # built-in: said
         lazy, eager, calls = _eager_and_lazy_runs(monkeypatch, moving.frames)
-    assert len(said) == 2  # once in each run
+    assert sum("the camera moves" in str(w.message) for w in said) == 2  # once in each run
     assert any(calls)  # the camera moved: full-frame bins of the built-in detector's frames
     assert len(lazy.rows) > 0
     np.testing.assert_array_equal(lazy.rows, eager.rows)

@@ -19,6 +19,7 @@ from pftrack.detection.base import (
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
 from pftrack.detection.light import (
+    DARK_LEVEL,
     GAIN_SAMPLE_STEP,
     is_dark,
     levelled_median,
@@ -36,6 +37,23 @@ from pftrack.particle_filter.colour import HsvBinning, hsv_bins
 #: the light fell: paused through a slow dimming, the model was not fitted when the blobs
 #: needed it (a ramp to 0.7: MOTA 0.54 against 0.76).
 LIGHT_SETTLE_FRAMES = 10
+
+#: The noise level (median over the pixels of ``max_c |I_c - B_c|``, grey levels) at which the
+#: detector warns, once a video, that the video is too noisy for it, when the frames stay at
+#: it or above for `NOISY_FRAMES` frames in a row. The noise-adaptive threshold is `k_noise`
+#: times that level: contrasts below it are lost and people come in fragments, and at `t_max`
+#: the noise itself passes it. Steady video: 1-3 on PETS09-S2L1, 3-5 on TUD-Campus. Gaussian
+#: sensor noise added to ``make_scene(150, rng=1)`` (MOTA 94.8): sigma 6 gives 8 levels (MOTA
+#: 87.6), sigma 8 gives 11 (70.8), sigma 10 gives 13 (25.9).
+NOISY_LEVEL = 9
+
+#: Frames in a row at `NOISY_LEVEL` or above before the warning (a passing flash says nothing).
+NOISY_FRAMES = 10
+
+#: Dark frames in a row (`pftrack.detection.light.is_dark`: lights switched off, a fade to
+#: black) before the detector warns, once a video, that it finds nothing on them. A dropout's
+#: black frame or two is not said.
+DARK_FRAMES = 10
 
 
 @dataclass(frozen=True)
@@ -198,6 +216,14 @@ class PaperDetector:
         self._shape: tuple[int, ...] | None = None  # of the video's frames (the first seen)
         self._light = 1.0  # the light's gain since the first frame (gain_thresholds)
         self._settling = 0  # frames left before blobs are again fit to learn person sizes
+        self._noise = 0  # the last frame's noise: median difference from the background
+        self._noisy = 0  # frames in a row at NOISY_LEVEL or above (NOISY_FRAMES)
+        self._noise_said = False  # the noise warning was given (once a video)
+        self._noise_unsaid = False  # the noise warning, given by the next detect/foreground
+        self._seen = 0  # frames given to detect/foreground since the start or reset()
+        self._dark = 0  # dark frames in a row (DARK_FRAMES)
+        self._dark_said = False  # the dark warning was given (once a video)
+        self._dark_unsaid = False  # the dark warning, given by the next detect
 
     def _new_model(self, shadow_lo: float) -> _core.BackgroundModel:
         c = self.config
@@ -253,6 +279,46 @@ class PaperDetector:
             )
         warn(text, UserWarning, stacklevel=stacklevel + 1)  # held inside a tracker's update
 
+    def _count_noisy(self) -> None:
+        """Count the frames in a row whose noise is at `NOISY_LEVEL` or above (`NOISY_FRAMES`).
+
+        The noise is the median over the pixels of the frame's difference from the background
+        (the model's ``difference_histogram``): most pixels are background.
+        """
+        hist = self._model.difference_histogram
+        self._noise = int(np.searchsorted(np.cumsum(hist), hist.sum() / 2.0))
+        self._noisy = self._noisy + 1 if self._noise >= NOISY_LEVEL else 0
+        if self._noisy == NOISY_FRAMES and not self._noise_said:
+            self._noise_said = self._noise_unsaid = True  # said by the next detect/foreground
+
+    def _say_noise(self, detecting: bool, stacklevel: int) -> None:
+        """Warn, once, that the video is too noisy (`NOISY_LEVEL`): for detection, or refinement.
+
+        The detector (:meth:`detect`) loses people; the foreground alone (:meth:`foreground`,
+        which refines another detector's boxes) shrinks their boxes to what passes.
+        """
+        self._noise_unsaid = False
+        high = min(self.config.t_max * self._model.threshold_scale, 255.0)
+        at_max = self._model.threshold >= high * (1.0 - 1e-9)
+        if detecting:
+            cost = "people come in fragments or are missed"
+            hint = "denoise the video, or give a person detector's boxes"
+        else:
+            cost = "the foreground that refines the detections' boxes is unreliable"
+            hint = "take the boxes as given: --no-refine, Tracker(refine=False)"
+        warn(
+            "noisy or changing video: the frames differ from the background model by "
+            f"{self._noise} grey levels at the median pixel, {NOISY_FRAMES} frames in a row at "
+            f"{NOISY_LEVEL} or more (steady video: 1 to 5; sensor noise of a dark scene at high "
+            "gain, heavy compression, a view or light the model does not follow, or "
+            "people over most of the frame while it learnt?), so its noise-adaptive threshold "
+            f"rose to {self._model.threshold:.3g}{' (its bound t_max)' if at_max else ''}: "
+            f"contrasts below it are lost{', and the noise itself passes it' if at_max else ''}"
+            f"; {cost} ({hint})",
+            UserWarning,
+            stacklevel=stacklevel + 1,  # held inside a tracker's update
+        )
+
     def _apply(
         self, frame: NDArray[np.uint8], bins: bool
     ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
@@ -264,6 +330,7 @@ class PaperDetector:
                 f"PaperDetector: frame shape is {frame.shape}, expected {self._shape} (one size "
                 "per video: reset() between videos)"
             )
+        self._seen += 1
         step = sample_step(frame.shape, GAIN_SAMPLE_STEP)
         if self.config.gain_band > 0 and is_dark(frame, step):
             return self._unlit(frame, bins)  # no light to compare or learn (light.is_dark)
@@ -290,12 +357,18 @@ class PaperDetector:
                     scale = min(self._light, 1.0)
                     if scale != self._model.threshold_scale:
                         self._model.set_threshold_scale(scale)
-        return self._model.apply(frame, bins=bins)
+        self._dark = 0
+        result = self._model.apply(frame, bins=bins)
+        self._count_noisy()
+        return result
 
     def _unlit(
         self, frame: NDArray[np.uint8], bins: bool
     ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
         """:meth:`_apply`'s result for a frame without light: no foreground, nothing learnt."""
+        self._dark += 1
+        if self._dark == DARK_FRAMES and not self._dark_said:
+            self._dark_said = self._dark_unsaid = True  # said by the next detect
         binned = hsv_bins(frame, None, self.config.hsv) if bins else None
         return binned, np.zeros(frame.shape[:2], np.uint8)
 
@@ -317,6 +390,10 @@ class PaperDetector:
         self._grey = None
         self._grey_unsaid = False
         self._shape = None
+        self._noise = self._noisy = 0
+        self._noise_said = self._noise_unsaid = False
+        self._seen = self._dark = 0
+        self._dark_said = self._dark_unsaid = False
 
     def _reset_model(self) -> None:
         """Forget the background model, and with it the light it has followed.
@@ -371,12 +448,27 @@ class PaperDetector:
         UserWarning
             Once, on the first call, when the video is grey (`grey_tolerance`): the shadow
             test is off, people as bright as the background are missed, and trackers tell
-            people apart by brightness alone.
+            people apart by brightness alone. Once, when the video is noisy (`NOISY_LEVEL`
+            for `NOISY_FRAMES` frames in a row): the threshold has risen with the noise. Once,
+            after `DARK_FRAMES` dark frames in a row: nothing is found on them.
         """
         frame = check_frame(frame, "PaperDetector.detect")
         _, raw = self._apply(frame, bins=False)  # bins below, of the foreground only
         if self._grey_unsaid:
             self._say_grey(detecting=True, stacklevel=2)  # detect()'s caller
+        if self._noise_unsaid:
+            self._say_noise(detecting=True, stacklevel=2)
+        if self._dark_unsaid:
+            self._dark_unsaid = False
+            first = self._seen - DARK_FRAMES + 1
+            warn(
+                f"the frames from {first} on are dark ({DARK_FRAMES} in a row so far at mean "
+                f"level {DARK_LEVEL:g} or less: lights switched off, a fade to black, a covered "
+                "lens?): the detector finds nothing on a dark frame, so tracks coast and end "
+                "until the light returns",
+                UserWarning,
+                stacklevel=2,  # detect()'s caller; held inside a tracker's update
+            )
         shaded = self._blobs.clean(raw)
         mask = foreground_only(shaded)
         if self.config.ghost_support > 0 and self._ghost is not None:
@@ -448,7 +540,9 @@ class PaperDetector:
             Once, on the first call, when the video is grey (`grey_tolerance`): the shadow
             test of box refinement is off, and trackers tell people apart by brightness alone
             (the shorter warning: the boxes refined here come from another detector, so
-            nobody is missed for being as bright as the background).
+            nobody is missed for being as bright as the background). Once, when the video is
+            noisy (`NOISY_LEVEL` for `NOISY_FRAMES` frames in a row): the foreground that
+            refines the boxes is unreliable.
         """
         shaded, binned = self._foreground(frame, "PaperDetector.foreground", bins)
         return (shaded if shadows else foreground_only(shaded)), binned
@@ -460,6 +554,8 @@ class PaperDetector:
         binned, raw = self._apply(check_frame(frame, fn), bins)
         if self._grey_unsaid:
             self._say_grey(detecting=False, stacklevel=3)  # foreground()'s caller
+        if self._noise_unsaid:
+            self._say_noise(detecting=False, stacklevel=3)
         return self._blobs.clean(raw), binned
 
 

@@ -58,7 +58,9 @@ from pftrack._typing import (
     SamplerName,
 )
 from pftrack._warn import Held, warn
+from pftrack.detection.base import BlobConfig
 from pftrack.detection.light import BLANK_LEVELS, is_blank
+from pftrack.detection.paper import PaperDetector
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.filter import MAX_PARTICLES
 from pftrack.recovery.linking import LinkConfig
@@ -1237,6 +1239,21 @@ class Tracker:
             return (
                 f"{own}, scored at most {self._tracker.best_own_score:.3g}: none reached "
                 f"min_conf {cfg.min_score:.3g}"
+            )
+        unboxed = self._tracker.unboxed_own
+        if not self._given and unboxed:  # foreground that the blob filters left out
+            n = self.frame_count
+            detector = self._tracker.detector
+            blobs = detector.config.blobs if isinstance(detector, PaperDetector) else BlobConfig()
+            h, w = self._tracker.frame_shape[:2]
+            return (
+                f"the built-in detector found no object, though its foreground held pixels on "
+                f"{unboxed} of the {n} frames (at most {self._tracker.unboxed_own_pixels} a "
+                "frame): no region passed its blob filters (BlobConfig: min_area "
+                f"{blobs.min_area:g} of the frame, {blobs.min_area * w * h:.0f} pixels at "
+                f"{w}x{h}; height / width {blobs.min_aspect:g} to {blobs.max_aspect:g}; fill "
+                f"{blobs.min_fill:g}): people too small in the frame, or noise? give a person "
+                "detector's boxes (pftrack track --detections; Tracker.update's dets)"
             )
         if not self._given:
             return "the built-in detector found no object (no detection was given)"

@@ -175,6 +175,10 @@ class MultiObjectTracker:
         self.found_own = 0
         self.kept_own = 0
         self.best_own_score = -np.inf
+        #: Frames whose built-in foreground mask held pixels but gave no box (the blob filters
+        #: left every region out: people too small?), and the most such pixels in one frame.
+        self.unboxed_own = 0
+        self.unboxed_own_pixels = 0
         self.frame_index = 0
         self._mask: NDArray[np.uint8] | None = None  # the last frame's, see last_mask
         self._mask_shaded = False  # whether _mask still has its shadow pixels (127)
@@ -365,6 +369,11 @@ class MultiObjectTracker:
             self._mask, self._mask_shaded = det.mask, False
             boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
             binned = det.binned
+            if not len(boxes):  # foreground but no box: said if the run has no track
+                pixels = int(np.count_nonzero(det.mask))
+                if pixels:
+                    self.unboxed_own += 1
+                    self.unboxed_own_pixels = max(self.unboxed_own_pixels, pixels)
             if not self._background_ok:  # moving camera: colour of every pixel, not foreground
                 binned = det.frame_bins
                 if binned is None:  # binned on demand: only the pixels the boxes read
