@@ -3643,6 +3643,37 @@ def test_ctrl_c_says_what_was_written(
     )
 
 
+def test_ctrl_c_after_out_was_removed_says_what_went_with_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial: ``--out`` removed while the batch ran, then Ctrl-C; the last line said the
+    outputs of the file finished "are written and complete" and that summary.json lists the
+    rest, of a folder gone with both. It says what went with it, as a batch that ends does."""
+    import pftrack.batch.engine as engine
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    calls = []
+    real = engine.call_task
+
+    def removed_then_stopped(*args: Any, **kwargs: Any) -> Any:
+        calls.append(1)
+        if len(calls) == 2:
+            shutil.rmtree(out)
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(engine, "call_task", removed_then_stopped)
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]
+    assert main(argv) == 130
+    assert capsys.readouterr().err == (
+        f"pftrack smooth: interrupted; --out {out} was removed while the batch ran: the outputs "
+        "of 1 file (run0) went with it, and summary.json is not written; re-run the batch to "
+        "make them again\n"
+    )
+    assert not out.exists()
+
+
 # --- a cancelled task stops itself ----------------------------------------------------------
 
 

@@ -2184,7 +2184,7 @@ def run_jobs(
                         "the outputs written before it are complete"
                     )
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM: say what it left, truthfully
-        _say_interrupted(exc, out, kind, written if touched else None)
+        _say_interrupted(exc, out, kind, written if touched else None, summary.unwritten)
         raise
     return summary
 
@@ -2260,15 +2260,22 @@ def _no_bars() -> Iterator[None]:
         set_quiet(was)
 
 
-def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int | None) -> None:
+def _say_interrupted(
+    exc: KeyboardInterrupt, out: Path, kind: str, written: int | None, unwritten: str | None = None
+) -> None:
     """Attach what an interrupted batch left to `exc` (printed by the command).
 
     `written`: the tasks whose outputs this run wrote; None when ``--out`` was not touched yet
-    (stopped while connecting, or while the local cluster started). Was: "the outputs written
-    so far are complete" whatever was written, nothing at all included.
+    (stopped while connecting, or while the local cluster started). `unwritten`: why
+    ``summary.json`` was not written (``BatchSummary.unwritten``: ``--out`` removed meanwhile,
+    :func:`_out_removed`), said instead. Was: "the outputs written so far are complete" whatever
+    was written, nothing at all included; and, with ``--out`` removed, "are written and
+    complete", of outputs gone with it.
     """
     noun = "sequence" if kind == "track" else "file"
-    if written is None:
+    if unwritten is not None:
+        text = unwritten
+    elif written is None:
         text = (
             f"nothing was written: it stopped before the run began ({_OUT_NAMES.get()[0]} "
             f"{out} untouched)"
