@@ -3851,6 +3851,44 @@ def test_a_result_lost_with_its_worker_is_waited_for_not_dropped(
     assert sorted(p.name for p in (tmp_path / "out").glob("*.txt")) == ["slow0.txt", "slow1.txt"]
 
 
+def test_the_file_bar_counts_a_task_computed_again_once(
+    client: Any,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A trial: the files' bar of a recover batch ended at 4/3 when a task's result was lost and
+    computed again (or a task was sent again from a worker blind to its inputs): each time its
+    future came back, it counted. It counts each file once, when it is recorded."""
+    from pftrack import _progress
+
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(_progress, "_quiet", False)
+    bars: list[Any] = []
+    real_tqdm = _progress._tqdm
+    monkeypatch.setattr(
+        _progress, "_tqdm", lambda *a, **k: bars.append(real_tqdm(*a, **k)) or bars[-1]
+    )
+    seen: set[str] = set()
+    real = distributed.Future.status
+
+    def status(self: Any) -> str:
+        looker = sys._getframe(1).f_code.co_name
+        if looker == "_run_on_dask" and "-slow1-" in self.key and self.key not in seen:
+            seen.add(self.key)
+            return "lost"
+        return str(real.fget(self))
+
+    monkeypatch.setattr(distributed.Future, "status", property(status))
+    jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(2)]
+    summary = run_jobs(
+        jobs, tmp_path / "out", kind="smooth", settings={}, client=client, show_progress=True
+    )
+    assert seen
+    assert [e["status"] for e in summary.entries] == ["done", "done"]
+    (bar,) = bars
+    assert (bar.n, bar.total) == (2, 2)
+
+
 def test_the_table_leaves_the_problems_to_stderr(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

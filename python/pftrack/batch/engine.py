@@ -2825,7 +2825,22 @@ def _run_on_dask(
             if frames is not None:
                 frames.finish(job.name)
             record(job, Outcome(None, unsent))
-    bar = {**bar, "total": len(sendable)}
+    # the files' bar (no frames to count) moves as each job is recorded: once (was: as each
+    # future came back, so a task sent again or computed again counted twice, 4/3)
+    files = (
+        None if frames is not None else Bar(len(sendable), desc=bar["desc"], enable=bar["enable"])
+    )
+    n_finished = 0
+
+    def finished(job: Job) -> None:
+        """`job` is over (recorded), whatever its outcome: the bar counts it."""
+        nonlocal n_finished
+        if frames is not None:
+            frames.finish(job.name)
+        elif files is not None:
+            n_finished += 1
+            files.set(n_finished)
+
     watch = _WorkersWatch(c, address, wait, unusable)
     blind = _Blind(c, address, unseen) if unseen is not None else None
     futures = {}
@@ -2857,14 +2872,13 @@ def _run_on_dask(
             if workers:
                 tracked.add(submit(job, workers))
             else:
-                if frames is not None:
-                    frames.finish(job.name)
+                finished(job)
                 record(job, blind.last[job.name] if blind is not None else Outcome(None))
         return watch.given_up()
 
     done = _completed(tracked, given_up)
     try:
-        for fut in progress(done, **bar) if frames is None else done:
+        for fut in done:
             if fut.key not in futures:  # cancelled and sent again (its workers gone)
                 continue
             status = fut.status
@@ -2883,8 +2897,7 @@ def _run_on_dask(
                 tracked.add(submit(job, workers))
                 fut.release()
                 continue
-            if frames is not None:
-                frames.finish(job.name)
+            finished(job)
             if outcome is not None:
                 record(job, outcome)
             elif status == "error":  # the worker died (KilledWorker) or the like
@@ -2899,14 +2912,15 @@ def _run_on_dask(
         if futures:  # given up: no worker for too long
             c.cancel([f for f, _ in futures.values()], force=True)
             for _, job in list(futures.values()):
-                if frames is not None:
-                    frames.finish(job.name)
+                finished(job)
                 record(job, Outcome(None, watch.error(noun)))
             futures.clear()
     except BaseException:
         c.cancel([f for f, _ in futures.values()], force=True)
         raise
     finally:
+        if files is not None:
+            files.close()
         if frames is not None:
             with contextlib.suppress(Exception):  # the cluster may be going away (Ctrl-C)
                 c.unsubscribe_topic(topic)
