@@ -2306,6 +2306,9 @@ NO_WORKERS_WAIT = 60.0
 WORKERS_POLL = 1.0
 #: Seconds between two looks for finished tasks.
 COMPLETED_POLL = 0.05
+#: Seconds of the first wait for a finished task's result (:func:`_taken`); each next wait is
+#: twice as long, so that a large result (a rendered video) has the time to come.
+RESULT_WAIT = 1.0
 
 
 def no_workers_timeout() -> float:
@@ -2633,6 +2636,31 @@ def _completed(futures: Any, given_up: Callable[[], bool]) -> Iterator[Any]:
             time.sleep(COMPLETED_POLL)
 
 
+def _taken(fut: Any, given_up: Callable[[], bool]) -> tuple[str, Any]:
+    """The result of `fut`, a future seen finished, waited for in bounded steps.
+
+    ``("finished", result)``; ``("lost", None)`` when `fut` is no longer finished (its result
+    lost with its worker: Dask computes it again, or it failed or was cancelled meanwhile);
+    ``("given up", None)`` when `given_up` says so between two steps (no worker for too long,
+    the scheduler frozen). Was: ``fut.result()`` without a bound, which waited for ever when the
+    worker holding the result died and no worker was left ("Couldn't gather 1 keys,
+    rescheduling"). A step that times out cancels Dask's gather, hence steps twice as long
+    each time (:data:`RESULT_WAIT`, 2, 4, ... s): a large result is taken at last.
+    """
+    wait = RESULT_WAIT
+    while True:
+        try:
+            return "finished", fut.result(timeout=wait)
+        except Exception as exc:  # noqa: BLE001 - whatever it is, once the future is no more done
+            if fut.status != "finished":
+                return "lost", None
+            if not isinstance(exc, TimeoutError):
+                raise
+        if given_up():
+            return "given up", None
+        wait *= 2
+
+
 class _Frames:
     """The bar of frames over all the sequences of a batch, and the counts that move it.
 
@@ -2887,9 +2915,14 @@ def _run_on_dask(
                 # computes it again ("lost", "pending"); was: left out, "cancelled", not written
                 tracked.add(fut)
                 continue
+            taken, outcome = _taken(fut, watch.given_up) if status == "finished" else ("", None)
+            if taken == "lost":  # lost with its worker as it was taken: as above
+                tracked.add(fut)
+                continue
+            if taken == "given up":  # no worker left for it: failed below, as those waiting
+                break
             _, job = futures.pop(fut.key)
             sent.pop(fut.key, None)
-            outcome = fut.result() if status == "finished" else None
             workers = (
                 blind.elsewhere(job, outcome) if blind is not None and outcome is not None else None
             )
