@@ -3643,6 +3643,37 @@ def test_ctrl_c_says_what_was_written(
     )
 
 
+def test_ctrl_c_after_out_was_removed_says_what_went_with_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial: ``--out`` removed while the batch ran, then Ctrl-C; the last line said the
+    outputs of the file finished "are written and complete" and that summary.json lists the
+    rest, of a folder gone with both. It says what went with it, as a batch that ends does."""
+    import pftrack.batch.engine as engine
+
+    _tracks_files(tmp_path / "tracks")
+    out = tmp_path / "out"
+    calls = []
+    real = engine.call_task
+
+    def removed_then_stopped(*args: Any, **kwargs: Any) -> Any:
+        calls.append(1)
+        if len(calls) == 2:
+            shutil.rmtree(out)
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(engine, "call_task", removed_then_stopped)
+    argv = ["smooth", str(tmp_path / "tracks"), "--out", str(out), "--workers", "0"]
+    assert main(argv) == 130
+    assert capsys.readouterr().err == (
+        f"pftrack smooth: interrupted; --out {out} was removed while the batch ran: the outputs "
+        "of 1 file (run0) went with it, and summary.json is not written; re-run the batch to "
+        "make them again\n"
+    )
+    assert not out.exists()
+
+
 # --- a cancelled task stops itself ----------------------------------------------------------
 
 
@@ -3818,6 +3849,142 @@ def test_a_result_lost_with_its_worker_is_waited_for_not_dropped(
     assert seen
     assert [e["status"] for e in summary.entries] == ["done", "done"]
     assert sorted(p.name for p in (tmp_path / "out").glob("*.txt")) == ["slow0.txt", "slow1.txt"]
+
+
+def _close_worker(dask_worker: Any) -> None:
+    """On a worker: close it and its nanny (not restarted), once this call has answered."""
+    dask_worker.loop.add_callback(dask_worker.close, nanny=True, reason="test: result lost")
+
+
+def test_a_result_lost_with_the_last_worker_is_not_waited_for_for_ever(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Seen once: a task finished, the batch went to take its result, and the worker holding it
+    died meanwhile, no worker left ("Couldn't gather 1 keys, rescheduling"): the batch waited
+    for ever on ``Future.result()``. Here the one worker of the cluster closes as the batch
+    takes the result (reliably: between the batch seeing it finished and the gather). The
+    wait is bounded and watched like the others: the task fails after the wait for a worker."""
+    import dask
+
+    unbounded: list[object] = []
+    real = distributed.Future.result
+
+    def result(self: Any, timeout: Any = None) -> Any:
+        caller = sys._getframe(1).f_globals.get("__name__")
+        if caller == "pftrack.batch.engine" and "-first-" in self.key:
+            if not unbounded:  # the first look: its worker dies now, before the gather
+                unbounded.append(timeout)
+                self.client.run(_close_worker)
+                deadline = time.monotonic() + 10
+                while cluster.scheduler.workers and time.monotonic() < deadline:
+                    time.sleep(0.05)
+                assert not cluster.scheduler.workers
+            if timeout is None:  # the code before: waited for ever, here 10 s then failed
+                unbounded.append(None)
+                timeout = 10
+        return real(self, timeout=timeout)
+
+    monkeypatch.setattr(distributed.Future, "result", result)
+    setting = {"distributed.scheduler.no-workers-timeout": "1s"}
+    with contextlib.ExitStack() as stack:
+        cluster = stack.enter_context(distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+            scheduler_kwargs=NO_DASHBOARD,
+        ))  # fmt: skip
+        stack.enter_context(dask.config.set(setting))
+        address = cluster.scheduler_address
+        start = time.monotonic()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            summary = run_jobs(
+                [Job("first", _empty, (0,), ())], tmp_path, kind="smooth", settings={},
+                scheduler=address,
+            )  # fmt: skip
+        took = time.monotonic() - start
+    assert unbounded and None not in unbounded, "the result was waited for without a bound"
+    assert took < 10
+    assert [str(w.message) for w in caught] == [
+        f"the scheduler at {address} has lost all its workers; waiting up to 1 s for one "
+        f"(start one: dask worker {address})"
+    ]
+    (entry,) = summary.entries
+    assert entry["status"] == "failed"
+    assert entry["error"] == (
+        f"no worker on the scheduler at {address} for 1 s: its workers were lost before this "
+        f"file ran or finished (start some: dask worker {address}; a re-run does the rest)"
+    )
+    assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] == 1
+
+
+class _FakeFuture:
+    """A future seen finished whose result comes after `slow` waits that time out."""
+
+    def __init__(self, slow: int, status: str = "finished") -> None:
+        self.slow, self.status = slow, status
+        self.waits: list[float] = []
+
+    def result(self, timeout: float | None = None) -> str:
+        assert timeout is not None, "no bound"
+        self.waits.append(timeout)
+        if len(self.waits) <= self.slow:
+            raise TimeoutError(f"timed out after {timeout} s.")
+        return "rows"
+
+
+def test_a_finished_result_is_taken_in_bounded_steps(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The wait for a result is bounded, watched between its steps, and each step twice as long
+    (a step that times out cancels Dask's gather: a large result still comes)."""
+    from pftrack.batch import engine
+
+    monkeypatch.setattr(engine, "RESULT_WAIT", 0.5)
+    fut = _FakeFuture(slow=3)
+    assert engine._taken(fut, lambda: False) == ("finished", "rows")
+    assert fut.waits == [0.5, 1.0, 2.0, 4.0]
+    fut = _FakeFuture(slow=10)
+    looks = iter([False, True])
+    assert engine._taken(fut, lambda: next(looks)) == ("given up", None)
+    assert fut.waits == [0.5, 1.0]
+    fut = _FakeFuture(slow=10, status="pending")  # lost with its worker: computed again
+    assert engine._taken(fut, lambda: False) == ("lost", None)
+    assert fut.waits == [0.5]
+
+
+def test_the_file_bar_counts_a_task_computed_again_once(
+    client: Any,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A trial: the files' bar of a recover batch ended at 4/3 when a task's result was lost and
+    computed again (or a task was sent again from a worker blind to its inputs): each time its
+    future came back, it counted. It counts each file once, when it is recorded."""
+    from pftrack import _progress
+
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(_progress, "_quiet", False)
+    bars: list[Any] = []
+    real_tqdm = _progress._tqdm
+    monkeypatch.setattr(
+        _progress, "_tqdm", lambda *a, **k: bars.append(real_tqdm(*a, **k)) or bars[-1]
+    )
+    seen: set[str] = set()
+    real = distributed.Future.status
+
+    def status(self: Any) -> str:
+        looker = sys._getframe(1).f_code.co_name
+        if looker == "_run_on_dask" and "-slow1-" in self.key and self.key not in seen:
+            seen.add(self.key)
+            return "lost"
+        return str(real.fget(self))
+
+    monkeypatch.setattr(distributed.Future, "status", property(status))
+    jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(2)]
+    summary = run_jobs(
+        jobs, tmp_path / "out", kind="smooth", settings={}, client=client, show_progress=True
+    )
+    assert seen
+    assert [e["status"] for e in summary.entries] == ["done", "done"]
+    (bar,) = bars
+    assert (bar.n, bar.total) == (2, 2)
 
 
 def test_the_table_leaves_the_problems_to_stderr(

@@ -2184,7 +2184,7 @@ def run_jobs(
                         "the outputs written before it are complete"
                     )
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM: say what it left, truthfully
-        _say_interrupted(exc, out, kind, written if touched else None)
+        _say_interrupted(exc, out, kind, written if touched else None, summary.unwritten)
         raise
     return summary
 
@@ -2260,15 +2260,22 @@ def _no_bars() -> Iterator[None]:
         set_quiet(was)
 
 
-def _say_interrupted(exc: KeyboardInterrupt, out: Path, kind: str, written: int | None) -> None:
+def _say_interrupted(
+    exc: KeyboardInterrupt, out: Path, kind: str, written: int | None, unwritten: str | None = None
+) -> None:
     """Attach what an interrupted batch left to `exc` (printed by the command).
 
     `written`: the tasks whose outputs this run wrote; None when ``--out`` was not touched yet
-    (stopped while connecting, or while the local cluster started). Was: "the outputs written
-    so far are complete" whatever was written, nothing at all included.
+    (stopped while connecting, or while the local cluster started). `unwritten`: why
+    ``summary.json`` was not written (``BatchSummary.unwritten``: ``--out`` removed meanwhile,
+    :func:`_out_removed`), said instead. Was: "the outputs written so far are complete" whatever
+    was written, nothing at all included; and, with ``--out`` removed, "are written and
+    complete", of outputs gone with it.
     """
     noun = "sequence" if kind == "track" else "file"
-    if written is None:
+    if unwritten is not None:
+        text = unwritten
+    elif written is None:
         text = (
             f"nothing was written: it stopped before the run began ({_OUT_NAMES.get()[0]} "
             f"{out} untouched)"
@@ -2299,6 +2306,9 @@ NO_WORKERS_WAIT = 60.0
 WORKERS_POLL = 1.0
 #: Seconds between two looks for finished tasks.
 COMPLETED_POLL = 0.05
+#: Seconds of the first wait for a finished task's result (:func:`_taken`); each next wait is
+#: twice as long, so that a large result (a rendered video) has the time to come.
+RESULT_WAIT = 1.0
 
 
 def no_workers_timeout() -> float:
@@ -2626,6 +2636,31 @@ def _completed(futures: Any, given_up: Callable[[], bool]) -> Iterator[Any]:
             time.sleep(COMPLETED_POLL)
 
 
+def _taken(fut: Any, given_up: Callable[[], bool]) -> tuple[str, Any]:
+    """The result of `fut`, a future seen finished, waited for in bounded steps.
+
+    ``("finished", result)``; ``("lost", None)`` when `fut` is no longer finished (its result
+    lost with its worker: Dask computes it again, or it failed or was cancelled meanwhile);
+    ``("given up", None)`` when `given_up` says so between two steps (no worker for too long,
+    the scheduler frozen). Was: ``fut.result()`` without a bound, which waited for ever when the
+    worker holding the result died and no worker was left ("Couldn't gather 1 keys,
+    rescheduling"). A step that times out cancels Dask's gather, hence steps twice as long
+    each time (:data:`RESULT_WAIT`, 2, 4, ... s): a large result is taken at last.
+    """
+    wait = RESULT_WAIT
+    while True:
+        try:
+            return "finished", fut.result(timeout=wait)
+        except Exception as exc:  # noqa: BLE001 - whatever it is, once the future is no more done
+            if fut.status != "finished":
+                return "lost", None
+            if not isinstance(exc, TimeoutError):
+                raise
+        if given_up():
+            return "given up", None
+        wait *= 2
+
+
 class _Frames:
     """The bar of frames over all the sequences of a batch, and the counts that move it.
 
@@ -2818,7 +2853,22 @@ def _run_on_dask(
             if frames is not None:
                 frames.finish(job.name)
             record(job, Outcome(None, unsent))
-    bar = {**bar, "total": len(sendable)}
+    # the files' bar (no frames to count) moves as each job is recorded: once (was: as each
+    # future came back, so a task sent again or computed again counted twice, 4/3)
+    files = (
+        None if frames is not None else Bar(len(sendable), desc=bar["desc"], enable=bar["enable"])
+    )
+    n_finished = 0
+
+    def finished(job: Job) -> None:
+        """`job` is over (recorded), whatever its outcome: the bar counts it."""
+        nonlocal n_finished
+        if frames is not None:
+            frames.finish(job.name)
+        elif files is not None:
+            n_finished += 1
+            files.set(n_finished)
+
     watch = _WorkersWatch(c, address, wait, unusable)
     blind = _Blind(c, address, unseen) if unseen is not None else None
     futures = {}
@@ -2850,14 +2900,13 @@ def _run_on_dask(
             if workers:
                 tracked.add(submit(job, workers))
             else:
-                if frames is not None:
-                    frames.finish(job.name)
+                finished(job)
                 record(job, blind.last[job.name] if blind is not None else Outcome(None))
         return watch.given_up()
 
     done = _completed(tracked, given_up)
     try:
-        for fut in progress(done, **bar) if frames is None else done:
+        for fut in done:
             if fut.key not in futures:  # cancelled and sent again (its workers gone)
                 continue
             status = fut.status
@@ -2866,9 +2915,14 @@ def _run_on_dask(
                 # computes it again ("lost", "pending"); was: left out, "cancelled", not written
                 tracked.add(fut)
                 continue
+            taken, outcome = _taken(fut, watch.given_up) if status == "finished" else ("", None)
+            if taken == "lost":  # lost with its worker as it was taken: as above
+                tracked.add(fut)
+                continue
+            if taken == "given up":  # no worker left for it: failed below, as those waiting
+                break
             _, job = futures.pop(fut.key)
             sent.pop(fut.key, None)
-            outcome = fut.result() if status == "finished" else None
             workers = (
                 blind.elsewhere(job, outcome) if blind is not None and outcome is not None else None
             )
@@ -2876,8 +2930,7 @@ def _run_on_dask(
                 tracked.add(submit(job, workers))
                 fut.release()
                 continue
-            if frames is not None:
-                frames.finish(job.name)
+            finished(job)
             if outcome is not None:
                 record(job, outcome)
             elif status == "error":  # the worker died (KilledWorker) or the like
@@ -2892,14 +2945,15 @@ def _run_on_dask(
         if futures:  # given up: no worker for too long
             c.cancel([f for f, _ in futures.values()], force=True)
             for _, job in list(futures.values()):
-                if frames is not None:
-                    frames.finish(job.name)
+                finished(job)
                 record(job, Outcome(None, watch.error(noun)))
             futures.clear()
     except BaseException:
         c.cancel([f for f, _ in futures.values()], force=True)
         raise
     finally:
+        if files is not None:
+            files.close()
         if frames is not None:
             with contextlib.suppress(Exception):  # the cluster may be going away (Ctrl-C)
                 c.unsubscribe_topic(topic)
