@@ -13,25 +13,46 @@ import numpy as np
 import pytest
 
 import pftrack
+from pftrack.batch import RecoverOptions, TrackOptions
+from pftrack.detection import PaperConfig
+from pftrack.detection.bootstrap import bootstrap_frames
+from pftrack.detection.ghost import edge_support
+from pftrack.eval import prepare_mot
 from pftrack.particle_filter import (
     Ar2Model,
     ColourParticleFilter,
     FilterConfig,
     HsvBinning,
+    RJMCMCConfig,
     RJMCMCFilter,
     multinomial_resample,
     residual_resample,
     stratified_resample,
     systematic_resample,
 )
-from pftrack.recovery import NoiseEstimate, fill_gaps, link_tracklets, recover_gap, recover_gaps
+from pftrack.recovery import (
+    NoiseEstimate,
+    estimate_noise,
+    fill_gaps,
+    goal_directed_path,
+    link_tracklets,
+    recover_gap,
+    recover_gaps,
+)
+from pftrack.recovery.calibrate import calibrate
+from pftrack.recovery.experiment import trajectories
+from pftrack.synthetic import make_busy_scene
+from pftrack.tracking import TrackWriter
+from pftrack.tracking.camera import CameraMotion
 from pftrack.tracking.config import (
     AssociationConfig,
     CameraConfig,
+    LifecycleConfig,
     MotionConfig,
     RefineConfig,
     TrackerConfig,
 )
+from pftrack.tracking.offline import complete_boxes
 
 ROWS = np.array(
     [[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [4, 1, 11, 10, 5, 5, 1, -1, -1, -1.0]]
@@ -334,3 +355,146 @@ def test_an_array_for_a_setting_is_refused_in_one_line(
     message = str(info.value)
     assert "\n" not in message, message
     assert message.endswith(f"got {type(value).__name__} of shape (2, 3)"), message
+
+
+def _frame() -> np.ndarray:
+    return np.zeros((48, 64, 3), np.uint8)
+
+
+#: Every option taken as text, and what its refusal names first: a call with the option's
+#: value `v`. Each compared `v` with its values (``v not in (...)``, ``v == "auto"``), which
+#: asks a DataFrame or an array for its truth.
+OPTION_SITES: dict[str, tuple[Callable[[object], object], str]] = {
+    "TrackerConfig(sampler)": (lambda v: TrackerConfig(sampler=v), "sampler"),  # type: ignore[arg-type]
+    "TrackerConfig(camera_motion)": (
+        lambda v: TrackerConfig(camera_motion=v),  # type: ignore[arg-type]
+        "camera_motion",
+    ),
+    "TrackerConfig(detector)": (lambda v: TrackerConfig(detector=v), "detector"),  # type: ignore[arg-type]
+    "LifecycleConfig(amodal_anchor)": (
+        lambda v: LifecycleConfig(amodal_anchor=v),  # type: ignore[arg-type]
+        "LifecycleConfig: amodal_anchor",
+    ),
+    "Tracker(detector)": (lambda v: pftrack.Tracker(detector=v), "detector"),  # type: ignore[arg-type]
+    "Tracker(dynamics)": (lambda v: pftrack.Tracker(dynamics=v), "dynamics"),  # type: ignore[arg-type]
+    "Tracker(fill)": (lambda v: pftrack.Tracker(fill=v), "fill"),  # type: ignore[arg-type]
+    "TrackWriter(coasting)": (lambda v: TrackWriter(coasting=v), "coasting"),  # type: ignore[arg-type]
+    "CameraMotion(mode)": (lambda v: CameraMotion(v), "camera_motion"),  # type: ignore[arg-type]
+    "track_frames(bootstrap)": (
+        lambda v: pftrack.track_frames([_frame()], bootstrap=v),  # type: ignore[arg-type]
+        "bootstrap",
+    ),
+    "bootstrap_frames(mode)": (lambda v: bootstrap_frames([_frame()], 1, v), "bootstrap mode"),  # type: ignore[arg-type]
+    "smooth_tracks(fill_method)": (
+        lambda v: pftrack.smooth_tracks(ROWS, fill_method=v),  # type: ignore[arg-type]
+        "smooth_tracks: fill_method",
+    ),
+    "complete_boxes(anchor)": (
+        lambda v: complete_boxes(ROWS, np.zeros((2, 2)), 0.5, anchor=v),  # type: ignore[arg-type]
+        "complete_boxes: anchor",
+    ),
+    "make_busy_scene(kind)": (lambda v: make_busy_scene(v), "make_busy_scene: kind"),  # type: ignore[arg-type]
+    "evaluate_mot(benchmark)": (
+        lambda v: pftrack.evaluate_mot(ROWS, ROWS, benchmark=v),  # type: ignore[arg-type]
+        "evaluate_mot: benchmark",
+    ),
+    "evaluate_hota(benchmark)": (
+        lambda v: pftrack.evaluate_hota(ROWS, ROWS, benchmark=v),  # type: ignore[arg-type]
+        "evaluate_hota: benchmark",
+    ),
+    "evaluate_sequence(benchmark)": (
+        lambda v: pftrack.evaluate_sequence(ROWS, ROWS, benchmark=v),  # type: ignore[arg-type]
+        "evaluate_sequence: benchmark",
+    ),
+    "prepare_mot(benchmark)": (lambda v: prepare_mot(ROWS, ROWS, benchmark=v), "benchmark"),  # type: ignore[arg-type]
+    "FilterConfig(kernel)": (lambda v: FilterConfig(kernel=v), "FilterConfig: kernel"),  # type: ignore[arg-type]
+    "FilterConfig(estimate)": (lambda v: FilterConfig(estimate=v), "FilterConfig: estimate"),  # type: ignore[arg-type]
+    "RJMCMCConfig(kernel)": (lambda v: RJMCMCConfig(kernel=v), "RJMCMCConfig: kernel"),  # type: ignore[arg-type]
+    "fill_gaps(method)": (lambda v: fill_gaps(ROWS, v), "fill_gaps: method"),  # type: ignore[arg-type]
+    "recover_gap(method)": (
+        lambda v: recover_gap(SEG, SEG + [5, 0, 0], method=v),  # type: ignore[arg-type]
+        "recover_gap: method",
+    ),
+    "recover_gaps(method)": (
+        lambda v: recover_gaps([(SEG, SEG + [5, 0, 0])], v),  # type: ignore[arg-type]
+        "recover_gaps: method",
+    ),
+    "estimate_noise(method)": (
+        lambda v: estimate_noise([SEG], method=v),  # type: ignore[arg-type]
+        "estimate_noise: method",
+    ),
+    "goal_directed_path(form)": (
+        lambda v: goal_directed_path(*[np.eye(2)] * 6, np.zeros(2), 3, form=v),  # type: ignore[arg-type]
+        "goal_directed_path: form",
+    ),
+    "trajectories(point)": (lambda v: trajectories(ROWS, point=v), "trajectories: point"),  # type: ignore[arg-type]
+    "calibrate(candidates)": (
+        lambda v: calibrate([SEG], [3], candidates=[v]),  # type: ignore[list-item]
+        "calibrate: candidate",
+    ),
+    "edge_support(statistic)": (
+        lambda v: edge_support(
+            _frame(),
+            np.zeros((48, 64), np.float32),
+            np.zeros((48, 64), np.uint8),
+            np.zeros((0, 4)),
+            statistic=v,  # type: ignore[arg-type]
+        ),  # fmt: skip
+        "edge_support: statistic",
+    ),
+    "PaperConfig(ghost_statistic)": (
+        lambda v: PaperConfig(ghost_statistic=v),  # type: ignore[arg-type]
+        "ghost_statistic",
+    ),
+    "VideoWriter(preset)": (
+        lambda v: pftrack.VideoWriter("never-written.mp4", 10, preset=v),  # type: ignore[arg-type]
+        "preset",
+    ),
+    "VideoWriter(backend)": (
+        lambda v: pftrack.VideoWriter("never-written.mp4", 10, backend=v),  # type: ignore[arg-type]
+        "backend",
+    ),
+    "TrackOptions(detections)": (lambda v: TrackOptions(detections=v), "detections"),  # type: ignore[arg-type]
+    "TrackOptions(fill)": (lambda v: TrackOptions(fill=v), "fill"),  # type: ignore[arg-type]
+    "TrackOptions(render)": (lambda v: TrackOptions(render=v), "render"),  # type: ignore[arg-type]
+    "RecoverOptions(method)": (lambda v: RecoverOptions(method=v), "method"),  # type: ignore[arg-type]
+}
+
+
+@pytest.mark.parametrize("site", OPTION_SITES, ids=list(OPTION_SITES))
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table"], ids=["array", "table"])
+def test_an_array_for_an_option_is_refused_in_one_line(site: str, value: object) -> None:
+    """A defect trial: pandas' (or NumPy's) "The truth value of a DataFrame is ambiguous",
+    naming no argument, from the option's ``not in`` test."""
+    if isinstance(value, str):
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    call, what = OPTION_SITES[site]
+    with pytest.raises(TypeError) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    expected = message.removeprefix(f"{what} must be ").split(", got ")[0]
+    assert expected != message and expected.count("'") >= 2, message  # the accepted values
+    assert message.endswith(f"got {type(value).__name__} of shape (2, 3)"), message
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: TrackWriter(fill="spline"), "fill is 'spline', expected 'linear' or 'pf'"),
+        (lambda: TrackOptions(render=".mkv"), "render is '.mkv', expected None, '.mp4'"),
+        (lambda: FilterConfig(kernel="gauss"), "FilterConfig: kernel is 'gauss', expected"),
+    ],
+)
+def test_an_unknown_option_text_is_still_a_value_error(
+    call: Callable[[], object], message: str
+) -> None:
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(".", r"\.")):
+        call()
+
+
+@pytest.mark.parametrize("value", [None, ".mp4", ".avi"])
+def test_the_options_none_accepts_are_taken(value: str | None) -> None:
+    assert TrackOptions(render=value).render == value
+    assert TrackOptions(detections=None).detections is None

@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import flag, generator, number, real
+from pftrack._check import flag, generator, number, option, real
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
@@ -628,6 +628,7 @@ def make_busy_scene(
         With ``occluder=None``; truth boxes are the people's visible extent clipped to the
         image.
     """
+    option(kind, "make_busy_scene: kind", BUSY_SCENES)
     if kind not in BUSY_SCENES:
         raise ValueError(f"make_busy_scene: kind is {kind!r}, expected one of {BUSY_SCENES}")
     fps = _check_scene_args("make_busy_scene", n_frames, width, height, noise, fps)

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
+from pftrack._check import option
 from pftrack._warn import warn
 from pftrack.detection.base import (
     BlobConfig,
@@ -164,6 +165,7 @@ class PaperConfig:
             raise ValueError(f"ghost_support is {self.ghost_support}, expected in [0, 1]")
         if not (0.0 < self.ghost_rate <= 1.0):
             raise ValueError(f"ghost_rate is {self.ghost_rate}, expected in (0, 1]")
+        option(self.ghost_statistic, "ghost_statistic", GHOST_STATISTICS)
         if self.ghost_statistic not in GHOST_STATISTICS:
             raise ValueError(
                 f"ghost_statistic is {self.ghost_statistic!r}, expected 'vote' or 'ratio'"

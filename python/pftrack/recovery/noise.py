@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import MAX_FRAME, integer, number
+from pftrack._check import MAX_FRAME, integer, number, option
 from pftrack._typing import F64
 from pftrack.recovery.segments import consecutive_runs
 
@@ -194,6 +194,7 @@ def estimate_noise(
     NoiseEstimate
         :data:`DEFAULT_NOISE` when no run is long enough.
     """
+    option(method, "estimate_noise: method", ("ml", "moments"))
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
     floor_q = number(floor_q, "estimate_noise: floor_q", finite=False)

@@ -42,6 +42,7 @@ from pftrack._check import (
     flag,
     integer,
     not_an_image,
+    option,
     real,
     real_array,
 )
@@ -504,6 +505,7 @@ class Tracker:
             raise ValueError(
                 "crossings=True needs the smoother, which smooth=False turns off; drop one"
             )
+        option(dynamics, "dynamics", ("ar2", "ar2-mean"))
         if dynamics not in ("ar2", "ar2-mean"):
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
         if particles is not None:  # named as the option (was FilterConfig's n_particles)

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from pftrack._check import MAX_FRAME, flag, integer, number
+from pftrack._check import MAX_FRAME, flag, integer, number, option
 from pftrack._typing import CameraMotion, DetectorName, SamplerName
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
@@ -301,6 +301,7 @@ class LifecycleConfig:
                 f"LifecycleConfig: amodal_share is {self.amodal_share}, expected a value in "
                 "(0, 1] or None"
             )
+        option(self.amodal_anchor, "LifecycleConfig: amodal_anchor", AMODAL_ANCHORS)
         if self.amodal_anchor not in AMODAL_ANCHORS:
             raise ValueError(
                 f"LifecycleConfig: amodal_anchor is {self.amodal_anchor!r}, expected one of "
@@ -644,6 +645,9 @@ class TrackerConfig:
     given_particles: int | None = GIVEN_PARTICLES
 
     def __post_init__(self) -> None:
+        option(self.sampler, "sampler", SAMPLERS)  # before the sampler is compared below
+        option(self.camera_motion, "camera_motion", CAMERA_MOTION)
+        option(self.detector, "detector", DETECTORS)
         _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
         _none_or_int_in(self, "open_size", 1, MAX_OPEN_SIZE)
         side = self.max_side

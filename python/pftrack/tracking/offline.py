@@ -538,6 +538,7 @@ def smooth_tracks(
     """
     if max_gap is not None:
         max_gap = _check.integer(max_gap, "smooth_tracks: max_gap", 1, MAX_GAP_LIMIT)
+    _check.option(fill_method, "smooth_tracks: fill_method", METHODS)
     if fill_method not in METHODS:  # was named as fill_gaps' method, and only with holes
         raise ValueError(
             f"smooth_tracks: fill_method is {fill_method!r}, expected one of {METHODS}"
@@ -727,6 +728,7 @@ def complete_boxes(
     """
     if not 0.0 < share <= 1.0:
         raise ValueError(f"complete_boxes: share is {share}, expected a value in (0, 1]")
+    _check.option(anchor, "complete_boxes: anchor", AMODAL_ANCHORS)
     if anchor not in AMODAL_ANCHORS:
         raise ValueError(f"complete_boxes: anchor is {anchor!r}, expected one of {AMODAL_ANCHORS}")
     if not 1.0 <= max_width < np.inf:
