@@ -14,7 +14,7 @@ import pytest
 
 import pftrack
 from pftrack.batch import RecoverOptions, TrackOptions
-from pftrack.detection import PaperConfig
+from pftrack.detection import BlobConfig, PaperConfig
 from pftrack.detection.bootstrap import bootstrap_frames
 from pftrack.detection.ghost import edge_support
 from pftrack.eval import prepare_mot
@@ -41,6 +41,7 @@ from pftrack.recovery import (
 )
 from pftrack.recovery.calibrate import calibrate
 from pftrack.recovery.experiment import trajectories
+from pftrack.render import draw_tracks
 from pftrack.synthetic import make_busy_scene
 from pftrack.tracking import TrackWriter
 from pftrack.tracking.camera import CameraMotion
@@ -52,7 +53,7 @@ from pftrack.tracking.config import (
     RefineConfig,
     TrackerConfig,
 )
-from pftrack.tracking.offline import complete_boxes
+from pftrack.tracking.offline import CrossingConfig, complete_boxes
 
 ROWS = np.array(
     [[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [4, 1, 11, 10, 5, 5, 1, -1, -1, -1.0]]
@@ -498,3 +499,97 @@ def test_an_unknown_option_text_is_still_a_value_error(
 def test_the_options_none_accepts_are_taken(value: str | None) -> None:
     assert TrackOptions(render=value).render == value
     assert TrackOptions(detections=None).detections is None
+
+
+#: Settings whose refusal printed the value's repr: an array's or a DataFrame's took a line
+#: of the message per row. A call with the setting's value `v`, and the setting's name.
+REPR_SITES: dict[str, tuple[Callable[[object], object], str]] = {
+    "LinkConfig(max_gap)": (lambda v: pftrack.LinkConfig(max_gap=v), "LinkConfig.max_gap"),  # type: ignore[arg-type]
+    "LinkConfig(max_distance)": (
+        lambda v: pftrack.LinkConfig(max_distance=v),  # type: ignore[arg-type]
+        "LinkConfig.max_distance",
+    ),
+    "LinkConfig(max_area_ratio)": (
+        lambda v: pftrack.LinkConfig(max_area_ratio=v),  # type: ignore[arg-type]
+        "LinkConfig.max_area_ratio",
+    ),
+    "link_tracklets(config)": (lambda v: link_tracklets(ROWS, v), "link_tracklets: config"),  # type: ignore[arg-type]
+    "Tracker(max_side)": (lambda v: pftrack.Tracker(max_side=v), "max_side"),  # type: ignore[arg-type]
+    "TrackerConfig(open_size)": (lambda v: TrackerConfig(open_size=v), "open_size"),  # type: ignore[arg-type]
+    "TrackerConfig(pixel_diagonal)": (
+        lambda v: TrackerConfig(pixel_diagonal=v),  # type: ignore[arg-type]
+        "pixel_diagonal",
+    ),
+    "CameraConfig(max_side)": (lambda v: CameraConfig(max_side=v), "CameraConfig: max_side"),  # type: ignore[arg-type]
+    "MotionConfig(speed_span)": (
+        lambda v: MotionConfig(speed_span=v),  # type: ignore[arg-type]
+        "MotionConfig: speed_span",
+    ),
+    "RefineConfig(upright_classes)": (
+        lambda v: RefineConfig(upright_classes=v),  # type: ignore[arg-type]
+        "RefineConfig: upright_classes",
+    ),
+    "CrossingConfig(enabled)": (lambda v: CrossingConfig(enabled=v), "CrossingConfig: enabled"),  # type: ignore[arg-type]
+    "CrossingConfig(join_gap)": (
+        lambda v: CrossingConfig(join_gap=v),  # type: ignore[arg-type]
+        "CrossingConfig: join_gap",
+    ),
+    "smooth_tracks(link)": (lambda v: pftrack.smooth_tracks(ROWS, link=v), "smooth_tracks: link"),  # type: ignore[arg-type]
+    "smooth_tracks(relink_coast)": (
+        lambda v: pftrack.smooth_tracks(ROWS, relink_coast=v),  # type: ignore[arg-type]
+        "smooth_tracks: relink_coast",
+    ),
+    "make_scene(n_frames)": (lambda v: pftrack.make_scene(n_frames=v), "make_scene: n_frames"),  # type: ignore[arg-type]
+    "make_scene(width)": (lambda v: pftrack.make_scene(width=v), "make_scene: width"),  # type: ignore[arg-type]
+    "make_scene(n_walkers)": (
+        lambda v: pftrack.make_scene(n_walkers=v),  # type: ignore[arg-type]
+        "make_scene: n_walkers",
+    ),
+    "plot_trajectories(size)": (
+        lambda v: pftrack.plot_trajectories("never-written.png", ROWS, size=v),  # type: ignore[arg-type]
+        "plot_trajectories: size",
+    ),
+    "plot_trajectories(title)": (
+        lambda v: pftrack.plot_trajectories("never-written.png", ROWS, title=v),  # type: ignore[arg-type]
+        "plot_trajectories: title",
+    ),
+    "draw_tracks(label)": (
+        lambda v: draw_tracks(_frame(), ROWS, label=v),  # type: ignore[arg-type]
+        "draw_tracks: label",
+    ),
+    "hsv_bins(binning)": (lambda v: pftrack.hsv_bins(_frame(), binning=v), "hsv_bins: binning"),  # type: ignore[arg-type]
+    "RJMCMCFilter(config)": (lambda v: RJMCMCFilter(config=v), "RJMCMCFilter: config"),  # type: ignore[arg-type]
+    "BlobConfig(open_size)": (lambda v: BlobConfig(open_size=v), "open_size"),  # type: ignore[arg-type]
+    "RecoverOptions(max_gap)": (lambda v: RecoverOptions(max_gap=v), "max_gap"),  # type: ignore[arg-type]
+    "TrackOptions(seed)": (lambda v: TrackOptions(seed=v), "seed"),  # type: ignore[arg-type]
+    "track_many(options)": (
+        lambda v: pftrack.batch.track_many([], "never-written", options=v),  # type: ignore[arg-type]
+        "track_many: options",
+    ),
+}
+
+
+@pytest.mark.parametrize("site", REPR_SITES, ids=list(REPR_SITES))
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table"], ids=["array", "table"])
+def test_an_array_for_a_setting_is_named_in_one_line(site: str, value: object) -> None:
+    """A defect trial: these messages held the value's whole repr, one line of it per row (a
+    DataFrame's header too), after the setting's name."""
+    if isinstance(value, str):
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    call, what = REPR_SITES[site]
+    with pytest.raises((TypeError, ValueError)) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    assert message.startswith(f"{what} "), message
+    assert f"{type(value).__name__} of shape (2, 3)" in message, message
+
+
+def test_a_repr_of_one_line_is_kept() -> None:
+    with pytest.raises(ValueError, match=r"^LinkConfig\.max_gap is 0, expected an int in 1\.\."):
+        pftrack.LinkConfig(max_gap=0)
+    with pytest.raises(TypeError, match=r"^link_tracklets: config must be a LinkConfig, got "):
+        link_tracklets(ROWS, "tight")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^plot_trajectories: size is \(0, 4\), expected"):
+        pftrack.plot_trajectories("never-written.png", ROWS, size=(0, 4))

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import flag, number, option
+from pftrack._check import brief, flag, number, option, shown
 from pftrack._threads import tracking_threads
 from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
@@ -188,10 +188,10 @@ def _settings(options: object) -> dict[str, Any]:
 def _check_int(value: object, what: str, lo: int, hi: int | None = None) -> None:
     """Refuse `value` unless it is an integer in ``lo..hi`` (no upper bound when `hi` is None)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{what} must be an integer, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{what} must be an integer, got {shown(value)}")
     if value < lo or (hi is not None and value > hi):
         expected = f"an integer >= {lo}" if hi is None else f"an integer in {lo}..{hi}"
-        raise ValueError(f"{what} is {value!r}, expected {expected}")
+        raise ValueError(f"{what} is {brief(value)}, expected {expected}")
 
 
 def _check_choice(value: object, what: str, choices: tuple[str, ...]) -> None:
@@ -202,7 +202,7 @@ def _check_choice(value: object, what: str, choices: tuple[str, ...]) -> None:
             expected = f"{choices[0]!r} or {choices[1]!r}"
         else:
             expected = f"one of {', '.join(choices)}"
-        raise ValueError(f"{what} is {value!r}, expected {expected}")
+        raise ValueError(f"{what} is {brief(value)}, expected {expected}")
 
 
 def _default_config() -> TrackerConfig:

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, bgr_array, real_array
+from pftrack._check import MAX_COORD, bgr_array, brief, real_array
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.detection.size_model import PersonSizeModel
@@ -123,7 +123,7 @@ class BlobConfig:
         for name in ("open_size", "close_size"):
             v = getattr(self, name)
             if v is not None and not (isinstance(v, (int, np.integer)) and v >= 1):
-                raise ValueError(f"{name} is {v!r}, expected None or an int >= 1")
+                raise ValueError(f"{name} is {brief(v)}, expected None or an int >= 1")
         if not (0.0 <= self.min_area <= self.max_area <= 1.0):
             raise ValueError(
                 f"min_area, max_area are {self.min_area}, {self.max_area}, "

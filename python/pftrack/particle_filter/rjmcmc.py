@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import first_at, generator, integer, number, option, real_array
+from pftrack._check import first_at, generator, integer, number, option, real_array, shown
 from pftrack._typing import RngLike
 from pftrack.particle_filter.colour import not_binned
 from pftrack.particle_filter.filter import _in_use
@@ -255,10 +255,7 @@ class RJMCMCFilter:
 
     def __init__(self, config: RJMCMCConfig | None = None, rng: RngLike = None) -> None:
         if config is not None and not isinstance(config, RJMCMCConfig):
-            raise TypeError(
-                f"RJMCMCFilter: config must be an RJMCMCConfig, got {type(config).__name__} "
-                f"{config!r}"
-            )
+            raise TypeError(f"RJMCMCFilter: config must be an RJMCMCConfig, got {shown(config)}")
         self.config = config if config is not None else RJMCMCConfig()
         option(self.config.kernel, "RJMCMCConfig: kernel", KERNELS)
         if self.config.kernel not in ("uniform", "epanechnikov"):

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
-from pftrack._check import MAX_FRAME, real_array
+from pftrack._check import MAX_FRAME, brief, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
@@ -65,7 +65,7 @@ def _check_noise_levels(owner: str, config: object, unit: str) -> None:
         v = _check.number(getattr(config, name), f"{owner}: {name}", finite=False)
         if not NOISE_MIN <= v <= NOISE_MAX:
             raise ValueError(
-                f"{owner}: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
+                f"{owner}: {name} is {brief(v)}, expected a number in [{NOISE_MIN:g}, "
                 f"{NOISE_MAX:g}] ({unit})"
             )
 
@@ -228,7 +228,7 @@ class CrossingConfig:
 
     def __post_init__(self) -> None:
         if not isinstance(self.enabled, (bool, np.bool_)):
-            raise TypeError(f"CrossingConfig: enabled is {self.enabled!r}, expected a bool")
+            raise TypeError(f"CrossingConfig: enabled is {brief(self.enabled)}, expected a bool")
         if not 0.0 < self.min_iou <= 1.0:
             raise ValueError(
                 f"CrossingConfig: min_iou is {self.min_iou}, expected a value in (0, 1]"
@@ -240,7 +240,9 @@ class CrossingConfig:
                 or not isinstance(v, (int, np.integer))
                 or not lo <= v <= MAX_FRAME
             ):
-                raise ValueError(f"CrossingConfig: {name} is {v!r}, expected an integer >= {lo}")
+                raise ValueError(
+                    f"CrossingConfig: {name} is {brief(v)}, expected an integer >= {lo}"
+                )
         _check_noise_levels("CrossingConfig", self, "box heights")
         if not 0.0 <= self.margin < np.inf:
             raise ValueError(
@@ -548,8 +550,7 @@ def smooth_tracks(
         link is None or isinstance(link, LinkConfig) or (isinstance(link, str) and link == "auto")
     ):
         raise TypeError(
-            "smooth_tracks: link must be a LinkConfig, 'auto' or None, got "
-            f"{type(link).__name__} {link!r}"
+            f"smooth_tracks: link must be a LinkConfig, 'auto' or None, got {_check.shown(link)}"
         )
     if crossings is not None and not isinstance(crossings, CrossingConfig):
         raise TypeError(
@@ -585,7 +586,7 @@ def smooth_tracks(
         or relink_coast < 1
     ):
         raise ValueError(
-            f"smooth_tracks: relink_coast is {relink_coast!r}, expected None or an int >= 1"
+            f"smooth_tracks: relink_coast is {brief(relink_coast)}, expected None or an int >= 1"
         )
     if isinstance(link, str):  # "auto": pftrack smooth's gate, grown to the rows' frame
         link = link_config_for(a, DEFAULT_MAX_GAP if max_gap is None else max_gap)
