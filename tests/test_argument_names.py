@@ -42,7 +42,7 @@ from pftrack.recovery import (
 from pftrack.recovery.calibrate import calibrate
 from pftrack.recovery.experiment import trajectories
 from pftrack.render import draw_tracks
-from pftrack.synthetic import make_busy_scene
+from pftrack.synthetic import camera_path, make_busy_scene
 from pftrack.tracking import TrackWriter
 from pftrack.tracking.camera import CameraMotion
 from pftrack.tracking.config import (
@@ -53,7 +53,7 @@ from pftrack.tracking.config import (
     RefineConfig,
     TrackerConfig,
 )
-from pftrack.tracking.offline import CrossingConfig, complete_boxes
+from pftrack.tracking.offline import CrossingConfig, complete_boxes, drop_nested
 
 ROWS = np.array(
     [[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [4, 1, 11, 10, 5, 5, 1, -1, -1, -1.0]]
@@ -593,3 +593,51 @@ def test_a_repr_of_one_line_is_kept() -> None:
         link_tracklets(ROWS, "tight")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match=r"^plot_trajectories: size is \(0, 4\), expected"):
         pftrack.plot_trajectories("never-written.png", ROWS, size=(0, 4))
+
+
+#: Number settings compared with their range (``0 <= v <= 1``) without being checked as
+#: numbers first: an array or a DataFrame was asked for its truth ("The truth value ... is
+#: ambiguous", naming nothing), and a str failed with "'<=' not supported".
+NUMBER_SITES: dict[str, tuple[Callable[[object], object], str]] = {
+    "BlobConfig(min_area)": (lambda v: BlobConfig(min_area=v), "min_area"),  # type: ignore[arg-type]
+    "BlobConfig(split_valley)": (lambda v: BlobConfig(split_valley=v), "split_valley"),  # type: ignore[arg-type]
+    "PaperConfig(ghost_support)": (lambda v: PaperConfig(ghost_support=v), "ghost_support"),  # type: ignore[arg-type]
+    "PaperConfig(gain_band)": (lambda v: PaperConfig(gain_band=v), "gain_band"),  # type: ignore[arg-type]
+    "CrossingConfig(min_iou)": (lambda v: CrossingConfig(min_iou=v), "CrossingConfig: min_iou"),  # type: ignore[arg-type]
+    "CrossingConfig(margin)": (lambda v: CrossingConfig(margin=v), "CrossingConfig: margin"),  # type: ignore[arg-type]
+    "drop_nested(inside)": (lambda v: drop_nested(ROWS, inside=v), "drop_nested: inside"),  # type: ignore[arg-type]
+    "drop_nested(area_ratio)": (
+        lambda v: drop_nested(ROWS, area_ratio=v),  # type: ignore[arg-type]
+        "drop_nested: area_ratio",
+    ),
+    "complete_boxes(share)": (
+        lambda v: complete_boxes(ROWS, np.zeros((2, 2)), v),  # type: ignore[arg-type]
+        "complete_boxes: share",
+    ),
+    "complete_boxes(max_width)": (
+        lambda v: complete_boxes(ROWS, np.zeros((2, 2)), 0.5, max_width=v),  # type: ignore[arg-type]
+        "complete_boxes: max_width",
+    ),
+    "camera_path(zoom)": (lambda v: camera_path(5, (48, 64), zoom=v), "camera_path: zoom"),  # type: ignore[arg-type]
+    "camera_path(period)": (lambda v: camera_path(5, (48, 64), period=v), "camera_path: period"),  # type: ignore[arg-type]
+}
+
+
+@pytest.mark.parametrize("site", NUMBER_SITES, ids=list(NUMBER_SITES))
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table", "0.5"], ids=["array", "table", "text"])
+def test_a_number_setting_refuses_what_is_no_number_in_one_line(site: str, value: object) -> None:
+    if isinstance(value, str) and value == "table":
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    call, what = NUMBER_SITES[site]
+    with pytest.raises(TypeError) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    assert message.startswith(f"{what} must be a number, got "), message
+
+
+def test_the_threaded_flag_of_a_renderer_is_checked() -> None:
+    for value in (np.ones((2, 3)), "no"):
+        with pytest.raises(TypeError, match=r"^threaded must be True or False, got "):
+            pftrack.TrackRenderer("never-written.mp4", 10, threaded=value)  # type: ignore[arg-type]

@@ -501,6 +501,10 @@ def camera_path(
     """
     if not isinstance(n_frames, (int, np.integer)) or n_frames < 1:
         raise ValueError(f"camera_path: n_frames is {brief(n_frames)}, expected an integer >= 1")
+    zoom, zoom_swing, period = (
+        real(v, f"camera_path: {name}", finite=False)
+        for v, name in ((zoom, "zoom"), (zoom_swing, "zoom_swing"), (period, "period"))
+    )
     if not (zoom - zoom_swing > 0 and period > 0):
         raise ValueError("camera_path: need zoom - zoom_swing > 0 and period > 0")
     h, w = size

@@ -229,6 +229,8 @@ class CrossingConfig:
     def __post_init__(self) -> None:
         if not isinstance(self.enabled, (bool, np.bool_)):
             raise TypeError(f"CrossingConfig: enabled is {brief(self.enabled)}, expected a bool")
+        for name in ("min_iou", "margin"):  # before the comparisons ask an array for its truth
+            _check.number(getattr(self, name), f"CrossingConfig: {name}", finite=False)
         if not 0.0 < self.min_iou <= 1.0:
             raise ValueError(
                 f"CrossingConfig: min_iou is {self.min_iou}, expected a value in (0, 1]"
@@ -659,6 +661,8 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
     ValueError
         Bad rows, `inside` outside (0, 1] or `area_ratio` below 1.
     """
+    _check.number(inside, "drop_nested: inside", finite=False)  # an array: ambiguous below
+    _check.number(area_ratio, "drop_nested: area_ratio", finite=False)
     if not 0.0 < inside <= 1.0:
         raise ValueError(f"drop_nested: inside is {inside}, expected a value in (0, 1]")
     if not 1.0 <= area_ratio < np.inf:
@@ -727,6 +731,8 @@ def complete_boxes(
     ValueError
         Bad rows or lines, or `share`, `anchor` or `max_width` out of range.
     """
+    _check.number(share, "complete_boxes: share", finite=False)  # an array: ambiguous below
+    _check.number(max_width, "complete_boxes: max_width", finite=False)
     if not 0.0 < share <= 1.0:
         raise ValueError(f"complete_boxes: share is {share}, expected a value in (0, 1]")
     _check.option(anchor, "complete_boxes: anchor", AMODAL_ANCHORS)
