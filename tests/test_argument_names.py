@@ -13,25 +13,47 @@ import numpy as np
 import pytest
 
 import pftrack
+from pftrack.batch import RecoverOptions, TrackOptions
+from pftrack.detection import BlobConfig, PaperConfig
+from pftrack.detection.bootstrap import bootstrap_frames
+from pftrack.detection.ghost import edge_support
+from pftrack.eval import prepare_mot
 from pftrack.particle_filter import (
     Ar2Model,
     ColourParticleFilter,
     FilterConfig,
     HsvBinning,
+    RJMCMCConfig,
     RJMCMCFilter,
     multinomial_resample,
     residual_resample,
     stratified_resample,
     systematic_resample,
 )
-from pftrack.recovery import NoiseEstimate, fill_gaps, link_tracklets, recover_gap, recover_gaps
+from pftrack.recovery import (
+    NoiseEstimate,
+    estimate_noise,
+    fill_gaps,
+    goal_directed_path,
+    link_tracklets,
+    recover_gap,
+    recover_gaps,
+)
+from pftrack.recovery.calibrate import calibrate
+from pftrack.recovery.experiment import trajectories
+from pftrack.render import draw_tracks
+from pftrack.synthetic import camera_path, make_busy_scene
+from pftrack.tracking import TrackWriter
+from pftrack.tracking.camera import CameraMotion
 from pftrack.tracking.config import (
     AssociationConfig,
     CameraConfig,
+    LifecycleConfig,
     MotionConfig,
     RefineConfig,
     TrackerConfig,
 )
+from pftrack.tracking.offline import CrossingConfig, complete_boxes, drop_nested
 
 ROWS = np.array(
     [[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [4, 1, 11, 10, 5, 5, 1, -1, -1, -1.0]]
@@ -334,3 +356,288 @@ def test_an_array_for_a_setting_is_refused_in_one_line(
     message = str(info.value)
     assert "\n" not in message, message
     assert message.endswith(f"got {type(value).__name__} of shape (2, 3)"), message
+
+
+def _frame() -> np.ndarray:
+    return np.zeros((48, 64, 3), np.uint8)
+
+
+#: Every option taken as text, and what its refusal names first: a call with the option's
+#: value `v`. Each compared `v` with its values (``v not in (...)``, ``v == "auto"``), which
+#: asks a DataFrame or an array for its truth.
+OPTION_SITES: dict[str, tuple[Callable[[object], object], str]] = {
+    "TrackerConfig(sampler)": (lambda v: TrackerConfig(sampler=v), "sampler"),  # type: ignore[arg-type]
+    "TrackerConfig(camera_motion)": (
+        lambda v: TrackerConfig(camera_motion=v),  # type: ignore[arg-type]
+        "camera_motion",
+    ),
+    "TrackerConfig(detector)": (lambda v: TrackerConfig(detector=v), "detector"),  # type: ignore[arg-type]
+    "LifecycleConfig(amodal_anchor)": (
+        lambda v: LifecycleConfig(amodal_anchor=v),  # type: ignore[arg-type]
+        "LifecycleConfig: amodal_anchor",
+    ),
+    "Tracker(detector)": (lambda v: pftrack.Tracker(detector=v), "detector"),  # type: ignore[arg-type]
+    "Tracker(dynamics)": (lambda v: pftrack.Tracker(dynamics=v), "dynamics"),  # type: ignore[arg-type]
+    "Tracker(fill)": (lambda v: pftrack.Tracker(fill=v), "fill"),  # type: ignore[arg-type]
+    "TrackWriter(coasting)": (lambda v: TrackWriter(coasting=v), "coasting"),  # type: ignore[arg-type]
+    "CameraMotion(mode)": (lambda v: CameraMotion(v), "camera_motion"),  # type: ignore[arg-type]
+    "track_frames(bootstrap)": (
+        lambda v: pftrack.track_frames([_frame()], bootstrap=v),  # type: ignore[arg-type]
+        "bootstrap",
+    ),
+    "bootstrap_frames(mode)": (lambda v: bootstrap_frames([_frame()], 1, v), "bootstrap mode"),  # type: ignore[arg-type]
+    "smooth_tracks(fill_method)": (
+        lambda v: pftrack.smooth_tracks(ROWS, fill_method=v),  # type: ignore[arg-type]
+        "smooth_tracks: fill_method",
+    ),
+    "complete_boxes(anchor)": (
+        lambda v: complete_boxes(ROWS, np.zeros((2, 2)), 0.5, anchor=v),  # type: ignore[arg-type]
+        "complete_boxes: anchor",
+    ),
+    "make_busy_scene(kind)": (lambda v: make_busy_scene(v), "make_busy_scene: kind"),  # type: ignore[arg-type]
+    "evaluate_mot(benchmark)": (
+        lambda v: pftrack.evaluate_mot(ROWS, ROWS, benchmark=v),  # type: ignore[arg-type]
+        "evaluate_mot: benchmark",
+    ),
+    "evaluate_hota(benchmark)": (
+        lambda v: pftrack.evaluate_hota(ROWS, ROWS, benchmark=v),  # type: ignore[arg-type]
+        "evaluate_hota: benchmark",
+    ),
+    "evaluate_sequence(benchmark)": (
+        lambda v: pftrack.evaluate_sequence(ROWS, ROWS, benchmark=v),  # type: ignore[arg-type]
+        "evaluate_sequence: benchmark",
+    ),
+    "prepare_mot(benchmark)": (lambda v: prepare_mot(ROWS, ROWS, benchmark=v), "benchmark"),  # type: ignore[arg-type]
+    "FilterConfig(kernel)": (lambda v: FilterConfig(kernel=v), "FilterConfig: kernel"),  # type: ignore[arg-type]
+    "FilterConfig(estimate)": (lambda v: FilterConfig(estimate=v), "FilterConfig: estimate"),  # type: ignore[arg-type]
+    "RJMCMCConfig(kernel)": (lambda v: RJMCMCConfig(kernel=v), "RJMCMCConfig: kernel"),  # type: ignore[arg-type]
+    "fill_gaps(method)": (lambda v: fill_gaps(ROWS, v), "fill_gaps: method"),  # type: ignore[arg-type]
+    "recover_gap(method)": (
+        lambda v: recover_gap(SEG, SEG + [5, 0, 0], method=v),  # type: ignore[arg-type]
+        "recover_gap: method",
+    ),
+    "recover_gaps(method)": (
+        lambda v: recover_gaps([(SEG, SEG + [5, 0, 0])], v),  # type: ignore[arg-type]
+        "recover_gaps: method",
+    ),
+    "estimate_noise(method)": (
+        lambda v: estimate_noise([SEG], method=v),  # type: ignore[arg-type]
+        "estimate_noise: method",
+    ),
+    "goal_directed_path(form)": (
+        lambda v: goal_directed_path(*[np.eye(2)] * 6, np.zeros(2), 3, form=v),  # type: ignore[arg-type]
+        "goal_directed_path: form",
+    ),
+    "trajectories(point)": (lambda v: trajectories(ROWS, point=v), "trajectories: point"),  # type: ignore[arg-type]
+    "calibrate(candidates)": (
+        lambda v: calibrate([SEG], [3], candidates=[v]),  # type: ignore[list-item]
+        "calibrate: candidate",
+    ),
+    "edge_support(statistic)": (
+        lambda v: edge_support(
+            _frame(),
+            np.zeros((48, 64), np.float32),
+            np.zeros((48, 64), np.uint8),
+            np.zeros((0, 4)),
+            statistic=v,  # type: ignore[arg-type]
+        ),  # fmt: skip
+        "edge_support: statistic",
+    ),
+    "PaperConfig(ghost_statistic)": (
+        lambda v: PaperConfig(ghost_statistic=v),  # type: ignore[arg-type]
+        "ghost_statistic",
+    ),
+    "VideoWriter(preset)": (
+        lambda v: pftrack.VideoWriter("never-written.mp4", 10, preset=v),  # type: ignore[arg-type]
+        "preset",
+    ),
+    "VideoWriter(backend)": (
+        lambda v: pftrack.VideoWriter("never-written.mp4", 10, backend=v),  # type: ignore[arg-type]
+        "backend",
+    ),
+    "TrackOptions(detections)": (lambda v: TrackOptions(detections=v), "detections"),  # type: ignore[arg-type]
+    "TrackOptions(fill)": (lambda v: TrackOptions(fill=v), "fill"),  # type: ignore[arg-type]
+    "TrackOptions(render)": (lambda v: TrackOptions(render=v), "render"),  # type: ignore[arg-type]
+    "RecoverOptions(method)": (lambda v: RecoverOptions(method=v), "method"),  # type: ignore[arg-type]
+}
+
+
+@pytest.mark.parametrize("site", OPTION_SITES, ids=list(OPTION_SITES))
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table"], ids=["array", "table"])
+def test_an_array_for_an_option_is_refused_in_one_line(site: str, value: object) -> None:
+    """A defect trial: pandas' (or NumPy's) "The truth value of a DataFrame is ambiguous",
+    naming no argument, from the option's ``not in`` test."""
+    if isinstance(value, str):
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    call, what = OPTION_SITES[site]
+    with pytest.raises(TypeError) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    expected = message.removeprefix(f"{what} must be ").split(", got ")[0]
+    assert expected != message and expected.count("'") >= 2, message  # the accepted values
+    assert message.endswith(f"got {type(value).__name__} of shape (2, 3)"), message
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: TrackWriter(fill="spline"), "fill is 'spline', expected 'linear' or 'pf'"),
+        (lambda: TrackOptions(render=".mkv"), "render is '.mkv', expected None, '.mp4'"),
+        (lambda: FilterConfig(kernel="gauss"), "FilterConfig: kernel is 'gauss', expected"),
+    ],
+)
+def test_an_unknown_option_text_is_still_a_value_error(
+    call: Callable[[], object], message: str
+) -> None:
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(".", r"\.")):
+        call()
+
+
+@pytest.mark.parametrize("value", [None, ".mp4", ".avi"])
+def test_the_options_none_accepts_are_taken(value: str | None) -> None:
+    assert TrackOptions(render=value).render == value
+    assert TrackOptions(detections=None).detections is None
+
+
+#: Settings whose refusal printed the value's repr: an array's or a DataFrame's took a line
+#: of the message per row. A call with the setting's value `v`, and the setting's name.
+REPR_SITES: dict[str, tuple[Callable[[object], object], str]] = {
+    "LinkConfig(max_gap)": (lambda v: pftrack.LinkConfig(max_gap=v), "LinkConfig.max_gap"),  # type: ignore[arg-type]
+    "LinkConfig(max_distance)": (
+        lambda v: pftrack.LinkConfig(max_distance=v),  # type: ignore[arg-type]
+        "LinkConfig.max_distance",
+    ),
+    "LinkConfig(max_area_ratio)": (
+        lambda v: pftrack.LinkConfig(max_area_ratio=v),  # type: ignore[arg-type]
+        "LinkConfig.max_area_ratio",
+    ),
+    "link_tracklets(config)": (lambda v: link_tracklets(ROWS, v), "link_tracklets: config"),  # type: ignore[arg-type]
+    "Tracker(max_side)": (lambda v: pftrack.Tracker(max_side=v), "max_side"),  # type: ignore[arg-type]
+    "TrackerConfig(open_size)": (lambda v: TrackerConfig(open_size=v), "open_size"),  # type: ignore[arg-type]
+    "TrackerConfig(pixel_diagonal)": (
+        lambda v: TrackerConfig(pixel_diagonal=v),  # type: ignore[arg-type]
+        "pixel_diagonal",
+    ),
+    "CameraConfig(max_side)": (lambda v: CameraConfig(max_side=v), "CameraConfig: max_side"),  # type: ignore[arg-type]
+    "MotionConfig(speed_span)": (
+        lambda v: MotionConfig(speed_span=v),  # type: ignore[arg-type]
+        "MotionConfig: speed_span",
+    ),
+    "RefineConfig(upright_classes)": (
+        lambda v: RefineConfig(upright_classes=v),  # type: ignore[arg-type]
+        "RefineConfig: upright_classes",
+    ),
+    "CrossingConfig(enabled)": (lambda v: CrossingConfig(enabled=v), "CrossingConfig: enabled"),  # type: ignore[arg-type]
+    "CrossingConfig(join_gap)": (
+        lambda v: CrossingConfig(join_gap=v),  # type: ignore[arg-type]
+        "CrossingConfig: join_gap",
+    ),
+    "smooth_tracks(link)": (lambda v: pftrack.smooth_tracks(ROWS, link=v), "smooth_tracks: link"),  # type: ignore[arg-type]
+    "smooth_tracks(relink_coast)": (
+        lambda v: pftrack.smooth_tracks(ROWS, relink_coast=v),  # type: ignore[arg-type]
+        "smooth_tracks: relink_coast",
+    ),
+    "make_scene(n_frames)": (lambda v: pftrack.make_scene(n_frames=v), "make_scene: n_frames"),  # type: ignore[arg-type]
+    "make_scene(width)": (lambda v: pftrack.make_scene(width=v), "make_scene: width"),  # type: ignore[arg-type]
+    "make_scene(n_walkers)": (
+        lambda v: pftrack.make_scene(n_walkers=v),  # type: ignore[arg-type]
+        "make_scene: n_walkers",
+    ),
+    "plot_trajectories(size)": (
+        lambda v: pftrack.plot_trajectories("never-written.png", ROWS, size=v),  # type: ignore[arg-type]
+        "plot_trajectories: size",
+    ),
+    "plot_trajectories(title)": (
+        lambda v: pftrack.plot_trajectories("never-written.png", ROWS, title=v),  # type: ignore[arg-type]
+        "plot_trajectories: title",
+    ),
+    "draw_tracks(label)": (
+        lambda v: draw_tracks(_frame(), ROWS, label=v),  # type: ignore[arg-type]
+        "draw_tracks: label",
+    ),
+    "hsv_bins(binning)": (lambda v: pftrack.hsv_bins(_frame(), binning=v), "hsv_bins: binning"),  # type: ignore[arg-type]
+    "RJMCMCFilter(config)": (lambda v: RJMCMCFilter(config=v), "RJMCMCFilter: config"),  # type: ignore[arg-type]
+    "BlobConfig(open_size)": (lambda v: BlobConfig(open_size=v), "open_size"),  # type: ignore[arg-type]
+    "RecoverOptions(max_gap)": (lambda v: RecoverOptions(max_gap=v), "max_gap"),  # type: ignore[arg-type]
+    "TrackOptions(seed)": (lambda v: TrackOptions(seed=v), "seed"),  # type: ignore[arg-type]
+    "track_many(options)": (
+        lambda v: pftrack.batch.track_many([], "never-written", options=v),  # type: ignore[arg-type]
+        "track_many: options",
+    ),
+}
+
+
+@pytest.mark.parametrize("site", REPR_SITES, ids=list(REPR_SITES))
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table"], ids=["array", "table"])
+def test_an_array_for_a_setting_is_named_in_one_line(site: str, value: object) -> None:
+    """A defect trial: these messages held the value's whole repr, one line of it per row (a
+    DataFrame's header too), after the setting's name."""
+    if isinstance(value, str):
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    call, what = REPR_SITES[site]
+    with pytest.raises((TypeError, ValueError)) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    assert message.startswith(f"{what} "), message
+    assert f"{type(value).__name__} of shape (2, 3)" in message, message
+
+
+def test_a_repr_of_one_line_is_kept() -> None:
+    with pytest.raises(ValueError, match=r"^LinkConfig\.max_gap is 0, expected an int in 1\.\."):
+        pftrack.LinkConfig(max_gap=0)
+    with pytest.raises(TypeError, match=r"^link_tracklets: config must be a LinkConfig, got "):
+        link_tracklets(ROWS, "tight")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^plot_trajectories: size is \(0, 4\), expected"):
+        pftrack.plot_trajectories("never-written.png", ROWS, size=(0, 4))
+
+
+#: Number settings compared with their range (``0 <= v <= 1``) without being checked as
+#: numbers first: an array or a DataFrame was asked for its truth ("The truth value ... is
+#: ambiguous", naming nothing), and a str failed with "'<=' not supported".
+NUMBER_SITES: dict[str, tuple[Callable[[object], object], str]] = {
+    "BlobConfig(min_area)": (lambda v: BlobConfig(min_area=v), "min_area"),  # type: ignore[arg-type]
+    "BlobConfig(split_valley)": (lambda v: BlobConfig(split_valley=v), "split_valley"),  # type: ignore[arg-type]
+    "PaperConfig(ghost_support)": (lambda v: PaperConfig(ghost_support=v), "ghost_support"),  # type: ignore[arg-type]
+    "PaperConfig(gain_band)": (lambda v: PaperConfig(gain_band=v), "gain_band"),  # type: ignore[arg-type]
+    "CrossingConfig(min_iou)": (lambda v: CrossingConfig(min_iou=v), "CrossingConfig: min_iou"),  # type: ignore[arg-type]
+    "CrossingConfig(margin)": (lambda v: CrossingConfig(margin=v), "CrossingConfig: margin"),  # type: ignore[arg-type]
+    "drop_nested(inside)": (lambda v: drop_nested(ROWS, inside=v), "drop_nested: inside"),  # type: ignore[arg-type]
+    "drop_nested(area_ratio)": (
+        lambda v: drop_nested(ROWS, area_ratio=v),  # type: ignore[arg-type]
+        "drop_nested: area_ratio",
+    ),
+    "complete_boxes(share)": (
+        lambda v: complete_boxes(ROWS, np.zeros((2, 2)), v),  # type: ignore[arg-type]
+        "complete_boxes: share",
+    ),
+    "complete_boxes(max_width)": (
+        lambda v: complete_boxes(ROWS, np.zeros((2, 2)), 0.5, max_width=v),  # type: ignore[arg-type]
+        "complete_boxes: max_width",
+    ),
+    "camera_path(zoom)": (lambda v: camera_path(5, (48, 64), zoom=v), "camera_path: zoom"),  # type: ignore[arg-type]
+    "camera_path(period)": (lambda v: camera_path(5, (48, 64), period=v), "camera_path: period"),  # type: ignore[arg-type]
+}
+
+
+@pytest.mark.parametrize("site", NUMBER_SITES, ids=list(NUMBER_SITES))
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table", "0.5"], ids=["array", "table", "text"])
+def test_a_number_setting_refuses_what_is_no_number_in_one_line(site: str, value: object) -> None:
+    if isinstance(value, str) and value == "table":
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    call, what = NUMBER_SITES[site]
+    with pytest.raises(TypeError) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    assert message.startswith(f"{what} must be a number, got "), message
+
+
+def test_the_threaded_flag_of_a_renderer_is_checked() -> None:
+    for value in (np.ones((2, 3)), "no"):
+        with pytest.raises(TypeError, match=r"^threaded must be True or False, got "):
+            pftrack.TrackRenderer("never-written.mp4", 10, threaded=value)  # type: ignore[arg-type]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numbers
 import os
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,6 +23,7 @@ __all__ = [
     "bgr_array",
     "bgr_frame",
     "bool_array",
+    "brief",
     "colour_hint",
     "first_bad_box",
     "first_at",
@@ -32,9 +33,11 @@ __all__ = [
     "flag",
     "generator",
     "integer",
+    "listed",
     "materialised",
     "mot_rows",
     "number",
+    "option",
     "path_arg",
     "path_refused",
     "real_array",
@@ -377,20 +380,55 @@ def bgr_frame(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     return np.ascontiguousarray(f)
 
 
-def shown(value: object) -> str:
-    """`value`'s type and repr on one line, as the refusals below name what they got.
+def brief(value: object) -> str:
+    """`value`'s repr where it takes one line, else its type and shape: a message's one line.
 
-    ``str 'abc'``, ``NoneType None``; an array or a table (a pandas DataFrame) whose repr takes
-    several lines, its type and shape instead: ``ndarray of shape (2, 3)`` (was its whole
-    repr, one line of the message per row).
+    ``'abc'``, ``None``, ``(640, 480)``; an array or a table (a pandas DataFrame) whose repr
+    takes several lines, its type and shape instead: ``ndarray of shape (2, 3)`` (was its
+    whole repr, one line of the message per row); anything else of several lines, its type
+    and repr joined into one line.
     """
     text = repr(value)
     if "\n" not in text:
-        return f"{type(value).__name__} {text}"
+        return text
     shape = getattr(value, "shape", None)
     if isinstance(shape, tuple):
         return f"{type(value).__name__} of shape {shape}"
     return f"{type(value).__name__} {' '.join(text.split())}"
+
+
+def shown(value: object) -> str:
+    """`value`'s type and repr on one line, as the refusals below name what they got.
+
+    ``str 'abc'``, ``NoneType None``; an array or a table of several lines as :func:`brief`
+    names it: ``ndarray of shape (2, 3)``.
+    """
+    text = repr(value)
+    return f"{type(value).__name__} {text}" if "\n" not in text else brief(value)
+
+
+def listed(values: Iterable[object]) -> str:
+    """`values` as a message lists them: ``'a'``, ``'a' or 'b'``, ``'a', 'b' or 'c'``."""
+    names = [repr(v) for v in values]
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} or {names[-1]}"
+
+
+def option(value: object, what: str, accepted: Iterable[str | None]) -> None:
+    """TypeError when `value` is not text (nor None, where None is `accepted`), for an option.
+
+    The membership test that follows (``mode not in ("auto", "on")``) would ask a DataFrame
+    or an array given for the option for its truth (pandas' and NumPy's "The truth value ...
+    is ambiguous", naming no argument); which text is accepted stays the caller's to check.
+
+    Raises
+    ------
+    TypeError
+        ``{what} must be 'a', 'b' or 'c', got DataFrame of shape (2, 3)``.
+    """
+    accepted = tuple(accepted)
+    if isinstance(value, str) or (value is None and None in accepted):
+        return
+    raise TypeError(f"{what} must be {listed(accepted)}, got {shown(value)}")
 
 
 def flag(value: object, what: str) -> bool:

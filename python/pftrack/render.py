@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, integer, path_arg, real_array
+from pftrack._check import bgr_frame, brief, flag, integer, path_arg, real_array, shown
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
@@ -195,7 +195,7 @@ MAX_CANVAS = 32767
 def _text(value: object, who: str, what: str) -> None:
     """Refuse a caption that is not a str (None: none); was an AttributeError ('encode')."""
     if value is not None and not isinstance(value, str):
-        raise TypeError(f"{who}: {what} must be a str, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{who}: {what} must be a str, got {shown(value)}")
 
 
 def _track_rows(rows: ArrayLike, who: str, what: str = "rows") -> F64:
@@ -406,6 +406,7 @@ class TrackRenderer:
         path = path_arg(path, "TrackRenderer: path")
         self.trail = integer(trail, "trail", 0, MAX_TRAIL)  # was: 2.5 and True taken as 2, 1
         queue_size = integer(queue_size, "queue_size", 0, 2**31 - 1)  # 0: as 1
+        threaded = flag(threaded, "threaded")  # was: asked for its truth (an array's: ambiguous)
         self.writer = VideoWriter(path, fps, backend=backend, preset=preset)
         self._trails: dict[int, deque[tuple[float, float]]] = {}
         self._error: BaseException | None = None
@@ -629,7 +630,7 @@ def plot_trajectories(
                 ok = False
             if not ok:
                 raise ValueError(
-                    f"{who}: size is {size!r}, expected (width, height), whole numbers from 1 "
+                    f"{who}: size is {brief(size)}, expected (width, height), whole numbers from 1 "
                     f"to {MAX_CANVAS}"
                 )
         canvas = np.full((h, w, 3), 30, np.uint8)

@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import flag, generator, number, real
+from pftrack._check import brief, flag, generator, number, option, real
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
@@ -312,9 +312,9 @@ def _check_scene_args(
     """
     for name, v, lo in (("n_frames", n_frames, 1), ("width", width, 64), ("height", height, 64)):
         if not isinstance(v, (int, np.integer)) or isinstance(v, bool):
-            raise TypeError(f"{fn}: {name} is {v!r}, expected an integer >= {lo}")
+            raise TypeError(f"{fn}: {name} is {brief(v)}, expected an integer >= {lo}")
         if v < lo:
-            raise ValueError(f"{fn}: {name} is {v!r}, expected an integer >= {lo}")
+            raise ValueError(f"{fn}: {name} is {brief(v)}, expected an integer >= {lo}")
     size = int(n_frames) * int(width) * int(height) * 3  # the frames are held in memory
     if size > MAX_SCENE_BYTES:
         raise ValueError(
@@ -370,9 +370,13 @@ def make_scene(
     fps = _check_scene_args("make_scene", n_frames, width, height, noise, fps)
     if not isinstance(n_walkers, (int, np.integer)) or isinstance(n_walkers, bool):
         # was: True taken for 1 walker; 2.0 a ValueError, as n_frames=2.0 is a TypeError
-        raise TypeError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
+        raise TypeError(
+            f"make_scene: n_walkers is {brief(n_walkers)}, expected an integer in 1..40"
+        )
     if not 1 <= n_walkers <= 40:
-        raise ValueError(f"make_scene: n_walkers is {n_walkers!r}, expected an integer in 1..40")
+        raise ValueError(
+            f"make_scene: n_walkers is {brief(n_walkers)}, expected an integer in 1..40"
+        )
     occluder = flag(occluder, "make_scene: occluder")  # was: any value taken for its truth
     gen = generator(rng, "make_scene: rng")
     bg = _background(width, height, gen)
@@ -496,7 +500,11 @@ def camera_path(
         ``A_t`` maps a source pixel to frame t's pixel (``cv2.warpAffine``'s convention).
     """
     if not isinstance(n_frames, (int, np.integer)) or n_frames < 1:
-        raise ValueError(f"camera_path: n_frames is {n_frames!r}, expected an integer >= 1")
+        raise ValueError(f"camera_path: n_frames is {brief(n_frames)}, expected an integer >= 1")
+    zoom, zoom_swing, period = (
+        real(v, f"camera_path: {name}", finite=False)
+        for v, name in ((zoom, "zoom"), (zoom_swing, "zoom_swing"), (period, "period"))
+    )
     if not (zoom - zoom_swing > 0 and period > 0):
         raise ValueError("camera_path: need zoom - zoom_swing > 0 and period > 0")
     h, w = size
@@ -628,6 +636,7 @@ def make_busy_scene(
         With ``occluder=None``; truth boxes are the people's visible extent clipped to the
         image.
     """
+    option(kind, "make_busy_scene: kind", BUSY_SCENES)
     if kind not in BUSY_SCENES:
         raise ValueError(f"make_busy_scene: kind is {kind!r}, expected one of {BUSY_SCENES}")
     fps = _check_scene_args("make_busy_scene", n_frames, width, height, noise, fps)

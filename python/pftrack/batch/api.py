@@ -6,6 +6,7 @@ import functools
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from pftrack._check import shown
 from pftrack._typing import PathLike
 from pftrack.batch.engine import BatchSummary, Job, run_jobs
 from pftrack.batch.inputs import Inputs, SequenceInput, find_sequences, find_track_files
@@ -53,9 +54,9 @@ def _options(options: object, kind: type[_Options], func: str) -> _Options:
     if isinstance(options, kind):
         return options
     other = _TAKEN_BY.get(type(options))
-    hint = f" ({type(options).__name__} is {other}'s)" if other else f" {options!r}"
+    hint = f"{type(options).__name__} ({type(options).__name__} is {other}'s)" if other else None
     raise TypeError(
-        f"{func}: options must be a {kind.__name__} or None, got {type(options).__name__}{hint}"
+        f"{func}: options must be a {kind.__name__} or None, got {hint or shown(options)}"
     )
 
 

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from pftrack._check import flag
+from pftrack._check import brief, flag, shown
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack._text import counted
 from pftrack._threads import usable_cpus
@@ -2227,8 +2227,7 @@ def _check_arguments(out_dir: object, n_workers: object, force: object, show: ob
     """
     if not isinstance(out_dir, (str, bytes, os.PathLike)):
         raise TypeError(
-            f"{_OUT_NAMES.get()[0]} must be a path (str or os.PathLike), got "
-            f"{type(out_dir).__name__} {out_dir!r}"
+            f"{_OUT_NAMES.get()[0]} must be a path (str or os.PathLike), got {shown(out_dir)}"
         )
     if n_workers is not None:
         if isinstance(n_workers, bool) or not isinstance(n_workers, numbers.Integral):
@@ -2240,9 +2239,7 @@ def _check_arguments(out_dir: object, n_workers: object, force: object, show: ob
             raise ValueError(f"n_workers is {n_workers}, expected >= 0")
     flag(force, "force")
     if show is not None and not isinstance(show, bool):
-        raise TypeError(
-            f"show_progress must be True, False or None, got {type(show).__name__} {show!r}"
-        )
+        raise TypeError(f"show_progress must be True, False or None, got {shown(show)}")
 
 
 @contextlib.contextmanager
@@ -2351,7 +2348,7 @@ def dask_seconds(key: str, example: str) -> float | None:
     if not seconds >= 0 or math.isinf(seconds):
         variable = "DASK_" + key.upper().replace(".", "__").replace("-", "_")
         raise ValueError(
-            f"{key} is {value!r} (${variable}), expected a duration such as '{example}'"
+            f"{key} is {brief(value)} (${variable}), expected a duration such as '{example}'"
         )
     return seconds
 
@@ -2380,7 +2377,9 @@ def dask_fraction(key: str) -> float | None:
     if isinstance(value, (int, float)) and not isinstance(value, bool) and 0 <= value <= 1:
         return float(value)
     variable = "DASK_" + key.upper().replace(".", "__").replace("-", "_")
-    raise ValueError(f"{key} is {value!r} (${variable}), expected a fraction from 0 to 1 or False")
+    raise ValueError(
+        f"{key} is {brief(value)} (${variable}), expected a fraction from 0 to 1 or False"
+    )
 
 
 def _n_workers(c: Client, timeout: float | None = None) -> int:

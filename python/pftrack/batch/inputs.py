@@ -20,6 +20,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from pftrack._check import shown
 from pftrack._typing import PathLike
 from pftrack.io.atomic import refuse_dash, refuse_loop
 from pftrack.io.video import (
@@ -103,7 +104,7 @@ def _absolute(inputs: Inputs, hint: str = "") -> list[Path]:
             paths = list(inputs)
         except TypeError:
             raise TypeError(
-                f"inputs must be a path or a list of paths, got {type(inputs).__name__} {inputs!r}"
+                f"inputs must be a path or a list of paths, got {shown(inputs)}"
             ) from None
     given: list[str | os.PathLike[str]] = []
     for i, p in enumerate(paths):

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import flag, number
+from pftrack._check import brief, flag, number, option, shown
 from pftrack._threads import tracking_threads
 from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
@@ -188,20 +188,21 @@ def _settings(options: object) -> dict[str, Any]:
 def _check_int(value: object, what: str, lo: int, hi: int | None = None) -> None:
     """Refuse `value` unless it is an integer in ``lo..hi`` (no upper bound when `hi` is None)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise TypeError(f"{what} must be an integer, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{what} must be an integer, got {shown(value)}")
     if value < lo or (hi is not None and value > hi):
         expected = f"an integer >= {lo}" if hi is None else f"an integer in {lo}..{hi}"
-        raise ValueError(f"{what} is {value!r}, expected {expected}")
+        raise ValueError(f"{what} is {brief(value)}, expected {expected}")
 
 
 def _check_choice(value: object, what: str, choices: tuple[str, ...]) -> None:
-    """Refuse `value` unless it is one of `choices`."""
-    if not isinstance(value, str) or value not in choices:
+    """Refuse `value` unless it is one of `choices` (TypeError: not text)."""
+    option(value, what, choices)
+    if value not in choices:
         if len(choices) == 2:
             expected = f"{choices[0]!r} or {choices[1]!r}"
         else:
             expected = f"one of {', '.join(choices)}"
-        raise ValueError(f"{what} is {value!r}, expected {expected}")
+        raise ValueError(f"{what} is {brief(value)}, expected {expected}")
 
 
 def _default_config() -> TrackerConfig:
@@ -263,6 +264,7 @@ class TrackOptions:
         if not isinstance(self.config, TrackerConfig):
             raise TypeError(f"config must be a TrackerConfig, got {type(self.config).__name__}")
         _check_int(self.seed, "seed", 0)
+        option(self.detections, "detections", (None, "auto"))
         if self.detections not in (None, "auto"):
             raise ValueError(f"detections is {self.detections!r}, expected None or 'auto'")
         if self.det_scale is not None:
@@ -275,6 +277,7 @@ class TrackOptions:
         _check_choice(self.fill, "fill", ("linear", "pf"))
         flag(self.smooth, "smooth")
         flag(self.link, "link")
+        option(self.render, "render", (None, ".mp4", ".avi"))
         if self.render not in (None, ".mp4", ".avi"):
             raise ValueError(f"render is {self.render!r}, expected None, '.mp4' or '.avi'")
         if not 0 < number(self.iou, "iou") <= 1:  # evaluate_mot's range

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, bgr_array, real_array
+from pftrack._check import MAX_COORD, bgr_array, brief, number, real_array
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.detection.size_model import PersonSizeModel
@@ -61,6 +61,18 @@ class Detector(Protocol):
     def reset(self) -> None:
         """Forget the background model (before a new video)."""
         ...
+
+
+#: BlobConfig's settings that are numbers (a range checked for each).
+_BLOB_NUMBERS = (
+    "min_area",
+    "max_area",
+    "min_aspect",
+    "max_aspect",
+    "min_fill",
+    "person_aspect",
+    "split_valley",
+)
 
 
 @dataclass(frozen=True)
@@ -123,7 +135,9 @@ class BlobConfig:
         for name in ("open_size", "close_size"):
             v = getattr(self, name)
             if v is not None and not (isinstance(v, (int, np.integer)) and v >= 1):
-                raise ValueError(f"{name} is {v!r}, expected None or an int >= 1")
+                raise ValueError(f"{name} is {brief(v)}, expected None or an int >= 1")
+        for name in _BLOB_NUMBERS:  # before the comparisons below ask an array for its truth
+            number(getattr(self, name), name, finite=False)
         if not (0.0 <= self.min_area <= self.max_area <= 1.0):
             raise ValueError(
                 f"min_area, max_area are {self.min_area}, {self.max_area}, "

@@ -15,6 +15,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import brief, option
 from pftrack._typing import IntLike
 
 BOOTSTRAPS = ("spread", "first", "none")
@@ -60,10 +61,11 @@ def bootstrap_frames(
     list of (H, W, 3) uint8 arrays
         The chosen frames, or what `prepare` made of them.
     """
+    option(mode, "bootstrap mode", BOOTSTRAPS)
     if mode not in BOOTSTRAPS:
         raise ValueError(f"bootstrap mode is {mode!r}, expected one of {', '.join(BOOTSTRAPS)}")
     if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
-        raise ValueError(f"bootstrap frame count is {n!r}, expected an int >= 0")
+        raise ValueError(f"bootstrap frame count is {brief(n)}, expected an int >= 0")
     if mode == "none" or n == 0:
         return []
     total = len(frames) if isinstance(frames, Sized) else 0

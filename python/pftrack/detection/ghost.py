@@ -18,6 +18,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import option
+
 __all__ = ["GHOST_STATISTICS", "edge_support"]
 
 
@@ -73,6 +75,7 @@ def edge_support(
     (K,) ndarray of float64
         In [0, 1]; 0.5 for a box with no boundary edge at all.
     """
+    option(statistic, "edge_support: statistic", GHOST_STATISTICS)
     if statistic not in GHOST_STATISTICS:
         raise ValueError(f"edge_support: statistic is {statistic!r}, expected 'ratio' or 'vote'")
     out = np.full(len(boxes), 0.5)

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack._check import integer, number
+from pftrack._check import brief, integer, number
 from pftrack._check import seed as check_seed
 from pftrack.detection.base import (
     BlobConfig,
@@ -154,7 +154,7 @@ class _OpenCvDetector:
         fn = f"{type(self).__name__}.prime"
         median_f = median_frame(frames, fn)
         if not (isinstance(repeats, int) and repeats >= 1):
-            raise ValueError(f"{fn}: repeats is {repeats!r}, expected an int >= 1")
+            raise ValueError(f"{fn}: repeats is {brief(repeats)}, expected an int >= 1")
         median = median_f.round().astype(np.uint8)  # numpy.median's values
         self.reset()
         for _ in range(repeats):

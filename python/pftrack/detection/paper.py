@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
+from pftrack._check import number, option
 from pftrack._warn import warn
 from pftrack.detection.base import (
     BlobConfig,
@@ -160,10 +161,16 @@ class PaperConfig:
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
     def __post_init__(self) -> None:
+        for name in (
+            "ghost_support", "ghost_rate", "leg_height", "leg_fill", "grey_tolerance",
+            "grey_shadow_lo", "gain_band",
+        ):  # fmt: skip  # before the comparisons below ask an array for its truth
+            number(getattr(self, name), name, finite=False)
         if not (0.0 <= self.ghost_support <= 1.0):
             raise ValueError(f"ghost_support is {self.ghost_support}, expected in [0, 1]")
         if not (0.0 < self.ghost_rate <= 1.0):
             raise ValueError(f"ghost_rate is {self.ghost_rate}, expected in (0, 1]")
+        option(self.ghost_statistic, "ghost_statistic", GHOST_STATISTICS)
         if self.ghost_statistic not in GHOST_STATISTICS:
             raise ValueError(
                 f"ghost_statistic is {self.ghost_statistic!r}, expected 'vote' or 'ratio'"

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
+from pftrack._check import brief
 
 __all__ = ["PersonSizeModel", "SizeModelConfig", "expected_size", "head_height", "theil_sen"]
 
@@ -62,11 +63,13 @@ class SizeModelConfig:
 
     def __post_init__(self) -> None:
         if not (isinstance(self.min_samples, int) and self.min_samples >= 3):
-            raise ValueError(f"min_samples is {self.min_samples!r}, expected an int >= 3")
+            raise ValueError(f"min_samples is {brief(self.min_samples)}, expected an int >= 3")
         if not (isinstance(self.max_samples, int) and self.max_samples >= self.min_samples):
-            raise ValueError(f"max_samples is {self.max_samples!r}, expected an int >= min_samples")
+            raise ValueError(
+                f"max_samples is {brief(self.max_samples)}, expected an int >= min_samples"
+            )
         if not (isinstance(self.refit_every, int) and self.refit_every >= 1):
-            raise ValueError(f"refit_every is {self.refit_every!r}, expected an int >= 1")
+            raise ValueError(f"refit_every is {brief(self.refit_every)}, expected an int >= 1")
         if not (self.split_ratio > 1.0 and np.isfinite(self.split_ratio)):
             raise ValueError(f"split_ratio is {self.split_ratio}, expected a finite value > 1")
         if not (self.split_max_height > 0.0 and np.isfinite(self.split_max_height)):

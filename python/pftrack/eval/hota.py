@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
+from pftrack._check import option
 from pftrack._progress import Report, check_report, reporting
 from pftrack._typing import BenchmarkName
 from pftrack.eval.rows import (  # the scored rows; here too, as before
@@ -262,6 +263,7 @@ def evaluate_hota(
     .. [2] Luiten, J. & Hoffhues, A. (2020). TrackEval. (``trackeval.metrics.HOTA``)
     """
     check_report(on_progress, "evaluate_hota")
+    option(benchmark, "evaluate_hota: benchmark", ("auto", *BENCHMARKS))
     if benchmark == "auto":
         benchmark = guess_benchmark(gt)
     g, r = prepare_mot(gt, result, benchmark=benchmark, scale=scale, num_frames=num_frames)

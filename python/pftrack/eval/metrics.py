@@ -17,7 +17,7 @@ from scipy.optimize import linear_sum_assignment
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from pftrack._check import number, shown
+from pftrack._check import brief, number, option, shown
 from pftrack._progress import Report, check_report, reporting
 from pftrack._typing import BenchmarkName
 from pftrack.boxes import iou_xywh
@@ -289,10 +289,10 @@ def check_image_size(image_size: object, fn: str) -> tuple[float, float] | None:
     ):
         raise TypeError(f"{what} is {shown(image_size)}, expected (width, height)")
     if len(image_size) != 2:
-        raise ValueError(f"{what} is {image_size!r}, expected (width, height), 2 values")
+        raise ValueError(f"{what} is {brief(image_size)}, expected (width, height), 2 values")
     w, h = (number(v, f"{what}[{k}]", finite=False) for k, v in enumerate(image_size))
     if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
-        raise ValueError(f"{what} is {image_size!r}, expected (width, height) finite and > 0")
+        raise ValueError(f"{what} is {brief(image_size)}, expected (width, height) finite and > 0")
     return w, h
 
 
@@ -420,6 +420,7 @@ def evaluate_mot(
     clear_reach = iou_threshold - _EPS
     size = check_image_size(image_size, "evaluate_mot")
     check_report(on_progress, "evaluate_mot")
+    option(benchmark, "evaluate_mot: benchmark", ("auto", *BENCHMARKS))
     if benchmark != "auto" and benchmark not in BENCHMARKS:
         raise ValueError(
             f"evaluate_mot: benchmark is {benchmark!r}, expected 'auto' or one of "

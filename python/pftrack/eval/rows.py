@@ -21,6 +21,7 @@ from pftrack._check import (
     frames_from_1,
     integer,
     number,
+    option,
     path_refused,
     real_array,
 )
@@ -337,6 +338,7 @@ def prepare_mot(
     gt, result : ndarray of float64
         The scored rows, each sorted by frame (file order within a frame), gt boxes scaled.
     """
+    option(benchmark, "benchmark", BENCHMARKS)
     if benchmark not in BENCHMARKS:
         raise ValueError(f"benchmark is {benchmark!r}, expected one of {', '.join(BENCHMARKS)}")
     scale = number(scale, "scale", finite=False)

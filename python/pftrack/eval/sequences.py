@@ -25,12 +25,12 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import NORMALISED_REACH
+from pftrack._check import NORMALISED_REACH, option
 from pftrack._progress import Report, check_report, part
 from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
-from pftrack.eval.rows import _mot_iou, not_parts_message
+from pftrack.eval.rows import BENCHMARKS, _mot_iou, not_parts_message
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, TOP, WIDTH
 
 __all__ = [
@@ -561,6 +561,7 @@ def evaluate_sequence(
     """
     check_image_size(image_size, "evaluate_sequence")  # before HOTA's work
     check_report(on_progress, "evaluate_sequence")
+    option(benchmark, "evaluate_sequence: benchmark", ("auto", *BENCHMARKS))
     mark = guess_benchmark(gt) if benchmark == "auto" else benchmark
     h = evaluate_hota(
         gt, result, benchmark=mark, scale=scale, num_frames=num_frames,

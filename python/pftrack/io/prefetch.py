@@ -11,6 +11,8 @@ import threading
 from collections.abc import Generator, Iterable
 from typing import TypeVar
 
+from pftrack._check import brief
+
 __all__ = ["prefetch"]
 
 T = TypeVar("T")
@@ -42,7 +44,7 @@ def prefetch(items: Iterable[T], depth: int = 4) -> Generator[T, None, None]:
     The items of `items`, in order.
     """
     if isinstance(depth, bool) or not isinstance(depth, int) or depth < 1:
-        raise ValueError(f"prefetch: depth must be a positive int, got {depth!r}")
+        raise ValueError(f"prefetch: depth must be a positive int, got {brief(depth)}")
     return _read_ahead(items, depth)
 
 

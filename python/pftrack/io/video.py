@@ -46,7 +46,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import number, path_arg, real, shown
+from pftrack._check import brief, number, path_arg, real, shown
 from pftrack._text import counted
 from pftrack._typing import PathLike, RealLike
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
@@ -589,7 +589,7 @@ def _key_names(keys: object) -> tuple[str, ...]:
     """
     if isinstance(keys, str):
         raise TypeError(
-            f"read_seqinfo: keys must be a collection of key names (keys=[{keys!r}] for one), "
+            f"read_seqinfo: keys must be a collection of key names (keys=[{brief(keys)}] for one), "
             f"got {shown(keys)}"
         )
     if isinstance(keys, bytes) or not isinstance(keys, Iterable):
@@ -677,7 +677,7 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
         except ValueError:
             value = float("nan")
         if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"{ini}: {key} is {text!r}, expected a number > 0")
+            raise ValueError(f"{ini}: {key} is {brief(text)}, expected a number > 0")
         return value
 
     def integer(key: str, limit: int) -> int | None:
@@ -1407,7 +1407,7 @@ def check_source(source: object) -> None:
         kind = type(source).__name__
         raise TypeError(f"video source must be a path, a URL or an int, got {kind}")
     if isinstance(source, str) and not source:
-        raise ValueError(f"video source is {source!r} (empty); {what}")
+        raise ValueError(f"video source is {brief(source)} (empty); {what}")
 
 
 def _camera_index(source: PathLike | int) -> int | None:

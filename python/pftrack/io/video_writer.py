@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import bgr_frame, integer, path_arg, real
+from pftrack._check import bgr_frame, integer, option, path_arg, real
 from pftrack._typing import PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.opencv_io import opencv_name
@@ -134,10 +134,12 @@ class VideoWriter:
         fps = real(fps, "video frame rate", finite=False)
         if not (np.isfinite(fps) and fps > 0):
             raise ValueError(f"video frame rate is {fps}, expected a finite value > 0")
+        option(preset, "preset", X264_PRESETS)
         if preset not in X264_PRESETS:
             raise ValueError(f"preset is {preset!r}, expected one of {', '.join(X264_PRESETS)}")
         if backend is None:
             backend = "pyav" if suffix == ".mp4" and pyav_available() else "opencv"
+        option(backend, "backend", ("pyav", "opencv"))
         if backend not in ("pyav", "opencv"):
             raise ValueError(f"backend is {backend!r}, expected 'pyav' or 'opencv'")
         if backend == "pyav" and suffix != ".mp4":

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import bgr_array, integer, number, real_array
+from pftrack._check import bgr_array, brief, integer, number, real_array, shown
 
 BinnedImage = _core.BinnedImage
 
@@ -68,7 +68,7 @@ class HsvBinning:
         for name in ("s_min", "v_min"):
             v = number(getattr(self, name), f"HsvBinning: {name}", finite=False)
             if not (0.0 <= v <= 1.0):
-                raise ValueError(f"HsvBinning: {name} is {v!r}, expected a value in [0, 1]")
+                raise ValueError(f"HsvBinning: {name} is {brief(v)}, expected a value in [0, 1]")
 
     @property
     def n_bins(self) -> int:
@@ -134,9 +134,7 @@ def hsv_bins(
     array([100, 100, 100,   9,   9,   9], dtype=int16)
     """
     if not isinstance(binning, HsvBinning):
-        raise TypeError(
-            f"hsv_bins: binning must be an HsvBinning, got {type(binning).__name__} {binning!r}"
-        )
+        raise TypeError(f"hsv_bins: binning must be an HsvBinning, got {shown(binning)}")
     f = _frame(frame)
     m = None
     if mask is not None:
@@ -215,10 +213,7 @@ def box_histograms(
     if error is not None:
         raise error
     if not isinstance(kernel, str):  # pybind11 would list its signatures
-        raise TypeError(
-            f"{fn}: kernel must be 'uniform' or 'epanechnikov', got {type(kernel).__name__} "
-            f"{kernel!r}"
-        )
+        raise TypeError(f"{fn}: kernel must be 'uniform' or 'epanechnikov', got {shown(kernel)}")
     return _core.box_histograms(image, _boxes(boxes_cxcywh, fn), kernel)
 
 
@@ -385,7 +380,7 @@ def bhattacharyya_weights(
     """
     fn = "bhattacharyya_weights"
     if isinstance(lam, bool) or not isinstance(lam, numbers.Real):
-        raise TypeError(f"{fn}: lam must be a real number, got {type(lam).__name__} {lam!r}")
+        raise TypeError(f"{fn}: lam must be a real number, got {shown(lam)}")
     if not (np.isfinite(lam) and lam > 0):
         raise ValueError(f"{fn}: lam is {lam}, expected a finite number > 0")
     h = _histograms(hists, fn)

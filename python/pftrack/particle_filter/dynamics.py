@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import first_at, flag, number, real_array, refuse_masked_weights
+from pftrack._check import first_at, flag, number, real_array, refuse_masked_weights, shown
 
 __all__ = ["Ar2Model", "estimate", "propagate"]
 
@@ -174,7 +174,7 @@ def propagate(
     if error is not None:
         raise error
     if not isinstance(model, Ar2Model):
-        raise TypeError(f"{fn}: model must be an Ar2Model, got {type(model).__name__} {model!r}")
+        raise TypeError(f"{fn}: model must be an Ar2Model, got {shown(model)}")
     w = np.ascontiguousarray(real_array(noise, f"{fn}: noise", booleans=False))
     if w.shape != (len(particles), 3):
         raise ValueError(

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, generator, integer, number, real_array
+from pftrack._check import MAX_COORD, generator, integer, number, option, real_array, shown
 from pftrack._typing import F64, RngLike
 from pftrack.particle_filter.colour import HsvBinning, not_binned
 from pftrack.particle_filter.dynamics import MAX_SIGMA_XY, Ar2Model
@@ -84,6 +84,8 @@ class FilterConfig:
                 f"FilterConfig: lam is {lam}, expected a finite number > 0 (0 would give every "
                 "particle the same weight: the filter would not follow colour)"
             )
+        option(self.kernel, "FilterConfig: kernel", ("uniform", "epanechnikov"))
+        option(self.estimate, "FilterConfig: estimate", ("mean", "map"))
         if self.kernel not in ("uniform", "epanechnikov"):
             raise ValueError(
                 f"FilterConfig: kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'"
@@ -352,8 +354,7 @@ class ColourParticleFilter:
             )
         if binning is not None and not isinstance(binning, HsvBinning):
             raise TypeError(
-                f"{type(self).__name__}: binning must be an HsvBinning, got "
-                f"{type(binning).__name__} {binning!r}"
+                f"{type(self).__name__}: binning must be an HsvBinning, got {shown(binning)}"
             )
         self.config = config if config is not None else FilterConfig()
         self._busy = threading.Lock()  # held by a step (one thread at a time; see _in_use)

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import first_at, generator, integer, number, real_array
+from pftrack._check import first_at, generator, integer, number, option, real_array, shown
 from pftrack._typing import RngLike
 from pftrack.particle_filter.colour import not_binned
 from pftrack.particle_filter.filter import _in_use
@@ -169,7 +169,8 @@ class RJMCMCConfig:
         existence = number(self.min_existence, f"{own}: min_existence", finite=False)
         if not 0 <= existence <= 1:
             raise ValueError(f"{own}: min_existence is {existence}, expected a value in [0, 1]")
-        if not isinstance(self.kernel, str) or self.kernel not in KERNELS:
+        option(self.kernel, f"{own}: kernel", KERNELS)
+        if self.kernel not in KERNELS:
             raise ValueError(
                 f"{own}: kernel is {self.kernel!r}, expected 'uniform' or 'epanechnikov'"
             )
@@ -254,11 +255,9 @@ class RJMCMCFilter:
 
     def __init__(self, config: RJMCMCConfig | None = None, rng: RngLike = None) -> None:
         if config is not None and not isinstance(config, RJMCMCConfig):
-            raise TypeError(
-                f"RJMCMCFilter: config must be an RJMCMCConfig, got {type(config).__name__} "
-                f"{config!r}"
-            )
+            raise TypeError(f"RJMCMCFilter: config must be an RJMCMCConfig, got {shown(config)}")
         self.config = config if config is not None else RJMCMCConfig()
+        option(self.config.kernel, "RJMCMCConfig: kernel", KERNELS)
         if self.config.kernel not in ("uniform", "epanechnikov"):
             raise ValueError(
                 f"RJMCMCConfig: kernel is {self.config.kernel!r}, "

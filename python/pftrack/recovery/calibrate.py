@@ -775,6 +775,7 @@ def calibrate(
     regions = _check.flag(regions, "calibrate: regions")
     max_gaps, bags, seed = _settings("calibrate", max_gaps, bags, seed, combine)
     for m in candidates:
+        _check.option(m, "calibrate: candidate", CANDIDATES)
         if m not in CANDIDATES:
             raise ValueError(f"calibrate: candidate {m!r} is not one of {CANDIDATES}")
     names = tuple(m for m in CANDIDATES if m in candidates or m == "linear")

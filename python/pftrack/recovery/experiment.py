@@ -18,7 +18,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import mot_rows
+from pftrack._check import mot_rows, option
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.linking import check_unique
@@ -95,6 +95,7 @@ def trajectories(gt: F64, point: str = "centre") -> dict[int, F64]:
         An unknown `point`, or a (frame, id) pair given twice (read a file with
         :func:`~pftrack.recovery.linking.read_tracks` for the lines).
     """
+    option(point, "trajectories: point", ("centre", "center", "foot"))
     if point not in ("centre", "center", "foot"):
         raise ValueError(f"trajectories: point is {point!r}, expected 'centre' or 'foot'")
     gt = mot_rows(gt, "trajectories")

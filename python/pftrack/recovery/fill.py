@@ -269,6 +269,7 @@ def fill_gaps(
     rows = _check.mot_rows(tracks, "fill_gaps")  # (M, 6..10), [] too, as smooth_tracks
     # what the method does not use is refused, as the command refuses --seed (was ignored
     # without a word; a user trial)
+    _check.option(method, "fill_gaps: method", METHODS)
     if isinstance(noise, NoiseEstimate) and method in METHODS and method not in NOISE_METHODS:
         raise ValueError(
             f"fill_gaps: noise is used by methods {', '.join(NOISE_METHODS)}, not {method!r}"

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import MAX_FRAME, first_at, flag, generator, real_array
+from pftrack._check import MAX_FRAME, first_at, flag, generator, option, real_array
 from pftrack._typing import F64, RngLike
 from pftrack.kalman import cv_transition_xy
 
@@ -107,6 +107,7 @@ def _count(value: object, name: str, fn: str) -> int:
 
 
 def _check_form(form: str, fn: str) -> None:
+    option(form, f"{fn}: form", _FORMS)
     if form not in _FORMS:
         raise ValueError(f"{fn}: form is {form!r}, expected one of {_FORMS}")
 

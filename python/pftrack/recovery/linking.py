@@ -25,10 +25,12 @@ from pftrack._check import (
     MAX_ID,
     NORMALISED_REACH,
     bad_id_message,
+    brief,
     first_bad_box,
     first_bad_id,
     frames_from_1,
     mot_rows,
+    shown,
 )
 from pftrack._text import counted
 from pftrack._typing import F64, PathLike
@@ -107,13 +109,13 @@ class LinkConfig:
         for name, hi in (("max_gap", 100_000), ("velocity_points", 1_000)):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 1 <= v <= hi:
-                raise ValueError(f"LinkConfig.{name} is {v!r}, expected an int in 1..{hi}")
+                raise ValueError(f"LinkConfig.{name} is {brief(v)}, expected an int in 1..{hi}")
         for name in ("max_distance", "w_gap", "w_size", "w_appearance"):
             v = getattr(self, name)
             ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
             if not ok or not np.isfinite(v) or v < 0 or (name == "max_distance" and v == 0):
                 raise ValueError(
-                    f"LinkConfig.{name} is {v!r}, expected a finite number "
+                    f"LinkConfig.{name} is {brief(v)}, expected a finite number "
                     + ("> 0" if name == "max_distance" else ">= 0")
                 )
         v = self.max_area_ratio
@@ -122,7 +124,9 @@ class LinkConfig:
             or not isinstance(v, (int, float, np.integer, np.floating))
             or not (np.isfinite(v) and v >= 1)
         ):
-            raise ValueError(f"LinkConfig.max_area_ratio is {v!r}, expected None or a number >= 1")
+            raise ValueError(
+                f"LinkConfig.max_area_ratio is {brief(v)}, expected None or a number >= 1"
+            )
 
 
 def pixel_scale(width: float, height: float, diagonal: float = REFERENCE_DIAGONAL) -> float:
@@ -503,9 +507,7 @@ def link_tracklets(
         (frame, id) seen twice.
     """
     if not isinstance(config, LinkConfig):  # a string failed on a missing attribute
-        raise TypeError(
-            f"link_tracklets: config must be a LinkConfig, got {type(config).__name__} {config!r}"
-        )
+        raise TypeError(f"link_tracklets: config must be a LinkConfig, got {shown(config)}")
     if frames is not None and not (hasattr(frames, "__len__") and hasattr(frames, "__getitem__")):
         raise TypeError(
             "link_tracklets: frames must be a sequence indexable by frame - 1 (a list, an "

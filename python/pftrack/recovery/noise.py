@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import MAX_FRAME, integer, number
+from pftrack._check import MAX_FRAME, brief, integer, number, option, shown
 from pftrack._typing import F64
 from pftrack.recovery.segments import consecutive_runs
 
@@ -62,28 +62,26 @@ class NoiseEstimate:
             what = f"NoiseEstimate.{name}"
             raw: object = getattr(self, name)
             if isinstance(raw, (str, bytes)) or not isinstance(raw, (Sequence, np.ndarray)):
-                raise TypeError(
-                    f"{what} must be 2 numbers (x, y), got {type(raw).__name__} {raw!r}"
-                )
+                raise TypeError(f"{what} must be 2 numbers (x, y), got {shown(raw)}")
             if isinstance(raw, np.ndarray) and raw.shape != (2,):
                 raise ValueError(
                     f"{what} is an array of shape {raw.shape}, expected 2 numbers (x, y)"
                 )
             if len(raw) != 2:
-                raise ValueError(f"{what} is {raw!r}: {len(raw)} values, expected 2 (x, y)")
+                raise ValueError(f"{what} is {brief(raw)}: {len(raw)} values, expected 2 (x, y)")
             pair = tuple(number(v, f"{what}[{i}]", finite=False) for i, v in enumerate(raw))
             for i, v in enumerate(pair):
                 if not (np.isfinite(v) and v >= lo):
                     raise ValueError(
-                        f"{what}[{i}] is {v!r}, expected a finite number >= {lo:g} ({unit})"
+                        f"{what}[{i}] is {brief(v)}, expected a finite number >= {lo:g} ({unit})"
                     )
             # the core's test of a covariance, as it computes it (bridge.hpp,
             # require_covariance): every pivot above 1e-10 * size * the largest entry, so
             # the values less than 1 / (2e-10) = MAX_R_RATIO times apart
             if name == "r" and not min(pair) > 1e-10 * 2.0 * max(pair):
                 raise ValueError(
-                    f"{what} is {pair!r}: its values are {max(pair) / min(pair):.3g} times apart, "
-                    f"expected less than {MAX_R_RATIO:g}"
+                    f"{what} is {brief(pair)}: its values are {max(pair) / min(pair):.3g} times "
+                    f"apart, expected less than {MAX_R_RATIO:g}"
                 )
             object.__setattr__(self, name, pair)
 
@@ -194,18 +192,19 @@ def estimate_noise(
     NoiseEstimate
         :data:`DEFAULT_NOISE` when no run is long enough.
     """
+    option(method, "estimate_noise: method", ("ml", "moments"))
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
     floor_q = number(floor_q, "estimate_noise: floor_q", finite=False)
     floor_r = number(floor_r, "estimate_noise: floor_r", finite=False)
     if not 0.0 < floor_q < GRID_TOP:  # NaN fails too
         raise ValueError(
-            f"estimate_noise: floor_q is {floor_q!r}, expected a number in (0, {GRID_TOP:g}) "
+            f"estimate_noise: floor_q is {brief(floor_q)}, expected a number in (0, {GRID_TOP:g}) "
             "(px²/frame³)"
         )
     if not MIN_R <= floor_r < GRID_TOP:
         raise ValueError(
-            f"estimate_noise: floor_r is {floor_r!r}, expected a number in [{MIN_R:g}, "
+            f"estimate_noise: floor_r is {brief(floor_r)}, expected a number in [{MIN_R:g}, "
             f"{GRID_TOP:g}) (px²)"
         )
     min_points = integer(min_points, "estimate_noise: min_points", 1, MAX_FRAME)
@@ -213,7 +212,7 @@ def estimate_noise(
     if sum(len(r) - 3 for r in runs) < 4:
         return DEFAULT_NOISE
     if not scales or any(int(v) < 1 for v in scales):
-        raise ValueError(f"estimate_noise: scales is {scales!r}, expected integers >= 1")
+        raise ValueError(f"estimate_noise: scales is {brief(scales)}, expected integers >= 1")
     if method == "moments":
         return _moments_noise(runs, floor_q, floor_r)
     best: list[tuple[float, float]] = []

@@ -138,6 +138,7 @@ def recover_gap(
     a = as_segment(segment_a, "segment_a")
     b = as_segment(segment_b, "segment_b")
     fr = gap_frames(a, b, frames)
+    _check.option(method, "recover_gap: method", METHODS)
     if method not in METHODS:
         raise ValueError(f"recover_gap: method is {method!r}, expected one of {METHODS}")
     check_models(noise, motion, "recover_gap")
@@ -254,6 +255,7 @@ def recover_gaps(
     the GIL released (O(T) per gap, :meth:`SegmentModel.recover
     <pftrack.recovery.problems.SegmentModel.recover>`).
     """
+    _check.option(method, "recover_gaps: method", METHODS)
     if method not in METHODS:
         raise ValueError(f"recover_gaps: method is {method!r}, expected one of {METHODS}")
     seed = _check.seed(seed, "recover_gaps: seed")

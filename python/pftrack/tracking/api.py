@@ -38,10 +38,12 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import (
     MAX_CLASS,
     bgr_frame,
+    brief,
     first_bad_class,
     flag,
     integer,
     not_an_image,
+    option,
     real,
     real_array,
 )
@@ -504,6 +506,7 @@ class Tracker:
             raise ValueError(
                 "crossings=True needs the smoother, which smooth=False turns off; drop one"
             )
+        option(dynamics, "dynamics", ("ar2", "ar2-mean"))
         if dynamics not in ("ar2", "ar2-mean"):
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
         if particles is not None:  # named as the option (was FilterConfig's n_particles)
@@ -619,7 +622,7 @@ class Tracker:
             or not isinstance(prime_frames, (int, np.integer))
             or prime_frames < 0
         ):
-            raise ValueError(f"prime_frames is {prime_frames!r}, expected an integer >= 0")
+            raise ValueError(f"prime_frames is {brief(prime_frames)}, expected an integer >= 0")
         rate = _check_rate(frame_rate)
         self.config = config
         self.frame_rate = rate
@@ -931,10 +934,10 @@ class Tracker:
         if not (isinstance(shape, tuple) and len(shape) == 3
                 and all(isinstance(n, (int, np.integer)) and not isinstance(n, bool)
                         for n in shape)):  # fmt: skip
-            raise TypeError(f"prime: shape is {shape!r}, expected an (H, W, 3) tuple of ints")
+            raise TypeError(f"prime: shape is {brief(shape)}, expected an (H, W, 3) tuple of ints")
         rows, cols, bands = (int(n) for n in shape)
         if rows < 1 or cols < 1 or bands != 3:
-            raise ValueError(f"prime: shape is {shape!r}, expected (H, W, 3) with H, W >= 1")
+            raise ValueError(f"prime: shape is {brief(shape)}, expected (H, W, 3) with H, W >= 1")
         size = working_size((rows, cols, bands), self.config.max_side)
         work = (rows, cols, 3) if size is None else (size[1], size[0], 3)
         return (rows, cols, bands), work

@@ -43,7 +43,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_array
+from pftrack._check import bgr_array, option
 from pftrack._typing import F64
 from pftrack.tracking.config import CAMERA_MOTION, CameraConfig
 from pftrack.tracking.track import LiveTrack, Track
@@ -320,6 +320,7 @@ class CameraMotion:
     """
 
     def __init__(self, mode: str = "auto", config: CameraConfig | None = None) -> None:
+        option(mode, "camera_motion", CAMERA_MOTION)
         if mode not in CAMERA_MOTION:
             raise ValueError(f"camera_motion is {mode!r}, expected 'auto', 'on' or 'off'")
         self.mode = mode

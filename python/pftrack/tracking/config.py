@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from pftrack._check import MAX_FRAME, flag, integer, number
+from pftrack._check import MAX_FRAME, brief, flag, integer, number, option, shown
 from pftrack._typing import CameraMotion, DetectorName, SamplerName
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
@@ -72,11 +72,9 @@ def _integers_at_least(owner: str, lo: int, config: object, *names: str) -> None
     for name in names:
         v = getattr(config, name)
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
-            raise TypeError(
-                f"{owner}: {name} must be an integer >= {lo}, got {type(v).__name__} {v!r}"
-            )
+            raise TypeError(f"{owner}: {name} must be an integer >= {lo}, got {shown(v)}")
         if v < lo:
-            raise ValueError(f"{owner}: {name} is {v!r}, expected an integer >= {lo}")
+            raise ValueError(f"{owner}: {name} is {brief(v)}, expected an integer >= {lo}")
 
 
 def _in_range(
@@ -103,7 +101,7 @@ def _none_or_int_in(config: object, name: str, lo: int, hi: int, none: str = "No
     if v is not None and (
         isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi
     ):
-        raise ValueError(f"{name} is {v!r}, expected {none} or an int in [{lo}, {hi}]")
+        raise ValueError(f"{name} is {brief(v)}, expected {none} or an int in [{lo}, {hi}]")
 
 
 @dataclass(frozen=True)
@@ -301,6 +299,7 @@ class LifecycleConfig:
                 f"LifecycleConfig: amodal_share is {self.amodal_share}, expected a value in "
                 "(0, 1] or None"
             )
+        option(self.amodal_anchor, "LifecycleConfig: amodal_anchor", AMODAL_ANCHORS)
         if self.amodal_anchor not in AMODAL_ANCHORS:
             raise ValueError(
                 f"LifecycleConfig: amodal_anchor is {self.amodal_anchor!r}, expected one of "
@@ -465,7 +464,7 @@ class RefineConfig:
         ):
             raise TypeError(
                 f"RefineConfig: upright_classes must be a tuple of int class ids or None, got "
-                f"{classes!r}"
+                f"{brief(classes)}"
             )
 
 
@@ -644,6 +643,9 @@ class TrackerConfig:
     given_particles: int | None = GIVEN_PARTICLES
 
     def __post_init__(self) -> None:
+        option(self.sampler, "sampler", SAMPLERS)  # before the sampler is compared below
+        option(self.camera_motion, "camera_motion", CAMERA_MOTION)
+        option(self.detector, "detector", DETECTORS)
         _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
         _none_or_int_in(self, "open_size", 1, MAX_OPEN_SIZE)
         side = self.max_side
@@ -657,7 +659,8 @@ class TrackerConfig:
             and self.pixel_diagonal > 0
         ):
             raise ValueError(
-                f"pixel_diagonal is {self.pixel_diagonal!r}, expected None or a finite value > 0"
+                f"pixel_diagonal is {brief(self.pixel_diagonal)}, expected None or a finite value "
+                "> 0"
             )
         if self.sampler == "rjmcmc" and self.filter.model.use_means:
             raise ValueError(

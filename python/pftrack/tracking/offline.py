@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
-from pftrack._check import MAX_FRAME, real_array
+from pftrack._check import MAX_FRAME, brief, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
@@ -65,7 +65,7 @@ def _check_noise_levels(owner: str, config: object, unit: str) -> None:
         v = _check.number(getattr(config, name), f"{owner}: {name}", finite=False)
         if not NOISE_MIN <= v <= NOISE_MAX:
             raise ValueError(
-                f"{owner}: {name} is {v!r}, expected a number in [{NOISE_MIN:g}, "
+                f"{owner}: {name} is {brief(v)}, expected a number in [{NOISE_MIN:g}, "
                 f"{NOISE_MAX:g}] ({unit})"
             )
 
@@ -228,7 +228,9 @@ class CrossingConfig:
 
     def __post_init__(self) -> None:
         if not isinstance(self.enabled, (bool, np.bool_)):
-            raise TypeError(f"CrossingConfig: enabled is {self.enabled!r}, expected a bool")
+            raise TypeError(f"CrossingConfig: enabled is {brief(self.enabled)}, expected a bool")
+        for name in ("min_iou", "margin"):  # before the comparisons ask an array for its truth
+            _check.number(getattr(self, name), f"CrossingConfig: {name}", finite=False)
         if not 0.0 < self.min_iou <= 1.0:
             raise ValueError(
                 f"CrossingConfig: min_iou is {self.min_iou}, expected a value in (0, 1]"
@@ -240,7 +242,9 @@ class CrossingConfig:
                 or not isinstance(v, (int, np.integer))
                 or not lo <= v <= MAX_FRAME
             ):
-                raise ValueError(f"CrossingConfig: {name} is {v!r}, expected an integer >= {lo}")
+                raise ValueError(
+                    f"CrossingConfig: {name} is {brief(v)}, expected an integer >= {lo}"
+                )
         _check_noise_levels("CrossingConfig", self, "box heights")
         if not 0.0 <= self.margin < np.inf:
             raise ValueError(
@@ -538,6 +542,7 @@ def smooth_tracks(
     """
     if max_gap is not None:
         max_gap = _check.integer(max_gap, "smooth_tracks: max_gap", 1, MAX_GAP_LIMIT)
+    _check.option(fill_method, "smooth_tracks: fill_method", METHODS)
     if fill_method not in METHODS:  # was named as fill_gaps' method, and only with holes
         raise ValueError(
             f"smooth_tracks: fill_method is {fill_method!r}, expected one of {METHODS}"
@@ -547,8 +552,7 @@ def smooth_tracks(
         link is None or isinstance(link, LinkConfig) or (isinstance(link, str) and link == "auto")
     ):
         raise TypeError(
-            "smooth_tracks: link must be a LinkConfig, 'auto' or None, got "
-            f"{type(link).__name__} {link!r}"
+            f"smooth_tracks: link must be a LinkConfig, 'auto' or None, got {_check.shown(link)}"
         )
     if crossings is not None and not isinstance(crossings, CrossingConfig):
         raise TypeError(
@@ -584,7 +588,7 @@ def smooth_tracks(
         or relink_coast < 1
     ):
         raise ValueError(
-            f"smooth_tracks: relink_coast is {relink_coast!r}, expected None or an int >= 1"
+            f"smooth_tracks: relink_coast is {brief(relink_coast)}, expected None or an int >= 1"
         )
     if isinstance(link, str):  # "auto": pftrack smooth's gate, grown to the rows' frame
         link = link_config_for(a, DEFAULT_MAX_GAP if max_gap is None else max_gap)
@@ -657,6 +661,8 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
     ValueError
         Bad rows, `inside` outside (0, 1] or `area_ratio` below 1.
     """
+    _check.number(inside, "drop_nested: inside", finite=False)  # an array: ambiguous below
+    _check.number(area_ratio, "drop_nested: area_ratio", finite=False)
     if not 0.0 < inside <= 1.0:
         raise ValueError(f"drop_nested: inside is {inside}, expected a value in (0, 1]")
     if not 1.0 <= area_ratio < np.inf:
@@ -725,8 +731,11 @@ def complete_boxes(
     ValueError
         Bad rows or lines, or `share`, `anchor` or `max_width` out of range.
     """
+    _check.number(share, "complete_boxes: share", finite=False)  # an array: ambiguous below
+    _check.number(max_width, "complete_boxes: max_width", finite=False)
     if not 0.0 < share <= 1.0:
         raise ValueError(f"complete_boxes: share is {share}, expected a value in (0, 1]")
+    _check.option(anchor, "complete_boxes: anchor", AMODAL_ANCHORS)
     if anchor not in AMODAL_ANCHORS:
         raise ValueError(f"complete_boxes: anchor is {anchor!r}, expected one of {AMODAL_ANCHORS}")
     if not 1.0 <= max_width < np.inf:

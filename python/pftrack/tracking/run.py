@@ -19,6 +19,7 @@ from pftrack._check import (
     flag,
     generator,
     number,
+    option,
     path_arg,
     real_array,
 )
@@ -247,6 +248,7 @@ def track_frames(
     the detector inside ``update``, byte for byte, and a detector error is raised from
     ``update`` on its frame as there.
     """
+    option(bootstrap, "bootstrap", ("auto", *BOOTSTRAPS))
     if bootstrap not in ("auto", *BOOTSTRAPS):
         raise ValueError(
             f"bootstrap mode is {bootstrap!r}, expected one of auto, {', '.join(BOOTSTRAPS)}"

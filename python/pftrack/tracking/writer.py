@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from pftrack._check import option
 from pftrack._typing import F64
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.offline import BoxSmoother, CrossingConfig, smooth_tracks
@@ -108,6 +109,8 @@ class TrackWriter:
     def __init__(self, coasting: str = "confirmed", fill: str = "linear",
                  smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen
                  link: LinkConfig | None = LinkConfig()) -> None:  # noqa: B008  # fmt: skip
+        option(coasting, "coasting", ("confirmed", "all", "none"))
+        option(fill, "fill", ("linear", "pf"))
         if coasting not in ("confirmed", "all", "none"):
             raise ValueError(f"coasting is {coasting!r}, expected 'confirmed', 'all' or 'none'")
         if fill not in ("linear", "pf"):
