@@ -2,20 +2,24 @@
 
 A synthetic street (`pftrack.synthetic.make_scene`'s walkers, class 0) with two lanes of
 cars (class 2) drawn across its top: each car a body, a window band and two wheels, 70x30
-pixels, a new one every 4 frames, moving `--car-speed` pixels a frame (16: 0.53 heights a
-frame, against the walkers' 0.05). Detections come from the truth of both, jittered by 5 % of
-the height, 10 % missed, a false person box every other frame (`public_detections`'
-`noisy_detections`); the cars' boxes are drawn `--car-pad` of their height loose around
-them, and with `--car-shadow` each car casts that many rows of shadow below it (the case
-of ``RefineConfig.upright_classes``, docs/tracking.md, "Refinement per class"). Each run
-goes through :class:`pftrack.Tracker` (``update(dets, frame)``, the class in
-column 6), then ``finalize()``; people and cars are scored apart, each class's rows
-(``Tracker.classes``) against that class's truth, with `pftrack.eval.evaluate_sequence`.
+pixels, a new one every `--car-every` frames (4), moving `--car-speed` pixels a frame (16:
+0.53 heights a frame, against the walkers' 0.05). Detections come from the truth of both,
+jittered by 5 % of the height, 10 % missed, a false person box every other frame
+(`public_detections`' `noisy_detections`, scores 0.5 to 1; `--car-scores` draws the cars'
+from another range, a class the detector scores lower: the case of the per-class birth
+threshold, docs/tracking.md, "Birth threshold per class"); the cars' boxes are drawn
+`--car-pad` of their height loose around them, and with `--car-shadow` each car casts that
+many rows of shadow below it (the case of ``RefineConfig.upright_classes``,
+docs/tracking.md, "Refinement per class"). Each run goes through :class:`pftrack.Tracker`
+(``update(dets, frame)``, the class in column 6), then ``finalize()``; people and cars are
+scored apart, each class's rows (``Tracker.classes``) against that class's truth, with
+`pftrack.eval.evaluate_sequence`.
 
 Usage (from the repository root)::
 
     python -m experiments.multi_class [--seeds 0 1 2] [--no-refine] [--no-cars]
-        [--car-speed 16] [--car-pad 0.15] [--car-shadow 10] [--set SECTION.FIELD=VALUE ...]
+        [--car-speed 16] [--car-pad 0.15] [--car-shadow 10] [--car-every 4]
+        [--car-scores 0.3 0.5] [--set SECTION.FIELD=VALUE ...]
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ import numpy as np
 from experiments._common import experiment_parser
 from experiments.public_detections import noisy_detections, override
 from pftrack._typing import F64
+from pftrack.cli._options import positive_int
 from pftrack.eval import SequenceScores, evaluate_sequence
 from pftrack.synthetic import Scene, make_scene
 from pftrack.tracking.api import Tracker
@@ -41,9 +46,11 @@ CAR_SIZE = (70, 30)
 CAR_EVERY = 4
 
 
-def add_cars(scene: Scene, speed: float, rng: np.random.Generator, shadow: int = 0) -> F64:
+def add_cars(scene: Scene, speed: float, rng: np.random.Generator, shadow: int = 0,
+             every: int = CAR_EVERY) -> F64:  # fmt: skip
     """Draw two lanes of cars over `scene`'s frames (in place); their MOT truth rows.
 
+    A new car every `every` frames, the lanes in turn.
     Each car casts a shadow `shadow` rows tall below its body, the ground at 0.65 of its
     brightness over the car's columns (the truth box is the car's, without it).
     """
@@ -53,8 +60,8 @@ def add_cars(scene: Scene, speed: float, rng: np.random.Generator, shadow: int =
     lanes = (0.08 * scene.height, 0.2 * scene.height)  # tops of the lanes
     n = len(scene.frames)
     car_id = 1
-    for start in range(1, n + 1, CAR_EVERY):
-        lane = (start // CAR_EVERY) % 2
+    for start in range(1, n + 1, every):
+        lane = (start // every) % 2
         ltr = lane == 0
         colour = tuple(int(c) for c in rng.integers(40, 230, 3))
         top = lanes[lane] + rng.uniform(-3, 3)
@@ -96,15 +103,24 @@ def loosen(dets: dict[int, F64], pad: float, width: int, height: int) -> dict[in
     return out
 
 
-def run(seed: int, config: TrackerConfig, cars: bool, speed: float, pad: float, shadow: int
+def run(seed: int, config: TrackerConfig, cars: bool, speed: float, pad: float, shadow: int,
+        car_scores: tuple[float, float] | None = None, car_every: int = CAR_EVERY
         ) -> tuple[SequenceScores, SequenceScores | None]:  # fmt: skip
-    """People's and cars' scores of one seeded scene."""
+    """People's and cars' scores of one seeded scene.
+
+    `car_scores` ``(low, high)``: the cars' detection scores drawn uniformly from that range
+    (a class the detector scores lower than people); None: as the people's, 0.5 to 1.
+    """
     scene = make_scene(150, n_walkers=8, rng=seed)
     rng = np.random.default_rng(100 + seed)
-    car_truth = add_cars(scene, speed, rng, shadow) if cars else np.zeros((0, 10))
+    car_truth = add_cars(scene, speed, rng, shadow, car_every) if cars else np.zeros((0, 10))
     n, h, w = len(scene.frames), scene.height, scene.width
     people = noisy_detections(scene.truth, n, h, w, seed)
     car_dets = loosen(noisy_detections(car_truth, n, h, w, 50 + seed), pad, w, h)
+    if car_scores is not None:
+        draw = np.random.default_rng(200 + seed)
+        for d in car_dets.values():
+            d[:, 4] = draw.uniform(*car_scores, len(d))
     tracker = Tracker.from_config(config, seed, frame_rate=scene.fps)
     for f, frame in enumerate(scene.frames, start=1):
         p = people[f]
@@ -138,6 +154,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--car-speed", type=float, default=16.0, help="pixels a frame")
     p.add_argument("--car-pad", type=float, default=0.15, help="car boxes' looseness")
     p.add_argument("--car-shadow", type=int, default=0, help="rows of shadow below a car")
+    p.add_argument(
+        "--car-every", type=positive_int, default=CAR_EVERY, help="frames between two cars"
+    )
+    p.add_argument("--car-scores", type=float, nargs=2, default=None, metavar=("LOW", "HIGH"),
+                   help="cars' detection scores drawn from [LOW, HIGH) (default: as the "
+                   "people's, 0.5 to 1)")  # fmt: skip
     p.add_argument("--set", nargs="*", default=[], metavar="SECTION.FIELD=VALUE",
                    help="TrackerConfig fields changed for a trial")  # fmt: skip
     args: argparse.Namespace = p.parse_args(argv)
@@ -150,7 +172,8 @@ def main(argv: list[str] | None = None) -> int:
         config = override(config, setting)
     people, cars = [], []
     for seed in args.seeds:
-        sp, sc = run(seed, config, not args.no_cars, args.car_speed, args.car_pad, args.car_shadow)
+        sp, sc = run(seed, config, not args.no_cars, args.car_speed, args.car_pad,
+                     args.car_shadow, args.car_scores, args.car_every)  # fmt: skip
         print(line(f"seed {seed} people", sp))
         people.append(sp)
         if sc is not None:

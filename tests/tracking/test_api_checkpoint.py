@@ -266,3 +266,32 @@ def test_a_checkpoint_of_one_shared_speed_median_resumes_as_the_run_of_per_class
             old.update(dets[k], scene.frames[k]), tracker.update(dets[k], scene.frames[k])
         )
     np.testing.assert_array_equal(old.finalize(), tracker.finalize())
+
+
+def test_a_checkpoint_of_one_pooled_birth_threshold_resumes(scene):
+    """A checkpoint pickled when every class shared one birth threshold (before 5 December:
+    no per-class scores) loads, and its classes take the pooled threshold; a run without
+    classes resumes exactly as one of the current code."""
+    from pftrack.tracking.tracker import MultiObjectTracker
+
+    rng = np.random.default_rng(0)
+    dets = truth_dets(scene)
+    for d in dets:  # scores under birth_score, whose quartile is the threshold
+        d[:, 4] = rng.uniform(0.3, 0.9, len(d))
+    tracker = pftrack.Tracker(frame_rate=10.0, seed=0)
+    for k in range(20):
+        tracker.update(dets[k], scene.frames[k])
+    old = copy.deepcopy(tracker)
+    state = old._tracker.__getstate__()
+    del state["_class_birth_scores"], state["_class_birth_levels"]
+    inner = MultiObjectTracker.__new__(MultiObjectTracker)
+    inner.__setstate__(pickle.loads(pickle.dumps(state)))
+    old._tracker = inner
+    pooled = tracker._tracker.birth_threshold()
+    assert inner.birth_threshold(0) == inner.birth_threshold(2) == pooled
+    for k in range(20, 30):
+        np.testing.assert_array_equal(
+            old.update(dets[k], scene.frames[k]), tracker.update(dets[k], scene.frames[k])
+        )
+        assert old._tracker.birth_threshold() == tracker._tracker.birth_threshold()
+    np.testing.assert_array_equal(old.finalize(), tracker.finalize())

@@ -32,7 +32,8 @@ def test_tracker_birth_threshold_uses_it() -> None:
     ):
         tracker.frame_index = k
         seen.append(scores)
-        level = tracker._birth_threshold(scores)
+        tracker._learn_birth(scores, np.zeros(len(scores), np.int64))
+        level = tracker.birth_threshold()
         quantile = float(np.quantile(np.concatenate(seen), rules.birth_quantile))
         want = min(rules.birth_score, quantile)
         assert level == want

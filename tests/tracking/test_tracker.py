@@ -565,3 +565,68 @@ def test_refine_false_turns_refinement_off_for_every_class():
     for frame, box in zip(frames, boxes, strict=True):
         (t,) = tracker.update(frame, np.array([box]), np.array([2]))
         np.testing.assert_array_equal(t.detection_box, box[:4])
+
+
+def _people_and_a_bicycle(n_frames: int) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray]]:
+    """Four people (class 0) scored 0.85-0.95 and a bicycle (class 1) scored 0.3-0.5.
+
+    The bicycle's scores are a fifth of the scores, under the pooled lower quartile.
+    """
+    rng = np.random.default_rng(0)
+    frame = np.zeros((120, 200, 3), np.uint8)
+    people = [[10.0 + 40 * k, 10.0, 12.0, 30.0] for k in range(4)]
+    for k, (x, y, w, h) in enumerate(people):
+        frame[int(y) : int(y + h), int(x) : int(x + w)] = (40 * k + 30, 200, 60)
+    frame[70:90, 90:130] = (200, 60, 200)  # the bicycle
+    dets, classes = [], []
+    for _ in range(n_frames):
+        d = np.array([[*p, rng.uniform(0.85, 0.95)] for p in people])
+        d = np.vstack([d, [90.0, 70.0, 40.0, 20.0, rng.uniform(0.3, 0.5)]])
+        dets.append(d)
+        classes.append(np.array([0, 0, 0, 0, 1]))
+    return frame, dets, classes
+
+
+def test_a_class_scored_lower_starts_tracks():
+    """A detector scores bicycles at 0.3-0.5 beside people at 0.85-0.95: the birth threshold
+    learned from every class's scores (their lower quartile, in the people's range) never
+    let the bicycle start a track. Once it has 20 scores it has its own threshold."""
+    config = TrackerConfig(
+        lifecycle=LifecycleConfig(min_hits=1), refine=RefineConfig(enabled=False)
+    )
+    tracker = MultiObjectTracker(config, rng=0)
+    frame, dets, classes = _people_and_a_bicycle(30)
+    born = []
+    for k, (d, c) in enumerate(zip(dets, classes, strict=True), start=1):
+        tracks = tracker.update(frame, d, c)
+        assert sorted(t.cls for t in tracks if t.cls == 0) == [0] * 4
+        if any(t.cls == 1 for t in tracks):
+            born.append(k)
+    assert born == list(range(20, 31))
+
+
+def test_each_class_with_20_scores_has_its_own_birth_threshold():
+    """Each class with 20 scores over the birth window has its own quantile (capped by
+    birth_score); before that, and for a class with fewer or none, the pooled one."""
+    tracker = MultiObjectTracker(rng=0)
+    frame, dets, classes = _people_and_a_bicycle(60)
+    for k, (d, c) in enumerate(zip(dets, classes, strict=True), start=1):
+        tracker.update(frame, d, c)
+        seen = dets[: min(k, 50)]  # birth_window: fixed after 50 frames
+        pooled = min(0.9, float(np.quantile(np.concatenate([x[:, 4] for x in seen]), 0.25)))
+        people = min(0.9, float(np.quantile(np.concatenate([x[:4, 4] for x in seen]), 0.25)))
+        bike = float(np.quantile([x[4, 4] for x in seen], 0.25))
+        assert pooled > 0.8 and bike < 0.5
+        assert tracker.birth_threshold(1) == (pooled if k < 20 else bike)
+        assert tracker.birth_threshold(0) == (pooled if k < 5 else people)
+        assert tracker.birth_threshold(7) == pooled  # a class never seen
+
+
+def test_one_class_keeps_the_pooled_birth_threshold():
+    """With one class the class's quantile is the pooled one: runs without classes unchanged."""
+    tracker = MultiObjectTracker(rng=0)
+    frame, dets, _ = _people_and_a_bicycle(25)
+    for d in dets:
+        tracker.update(frame, d)
+    pooled = float(np.quantile(np.concatenate([d[:, 4] for d in dets]), 0.25))
+    assert tracker.birth_threshold() == tracker.birth_threshold(0) == pooled

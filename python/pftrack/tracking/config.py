@@ -192,7 +192,11 @@ class LifecycleConfig:
         (PETS09 and TUD-Campus public detections: the quartile of their first 50 frames never
         falls below 0.96 and 0.91) and lets a detector whose scores all lie in [0.2, 0.5] start
         tracks from its upper three quarters (measured in docs/tracking.md; 0.25 scored better
-        than the median on both sequences). None: `birth_score` as is.
+        than the median on both sequences). With classes (``classes`` of
+        :meth:`MultiObjectTracker.update`) each class with
+        :data:`~pftrack.tracking.tracker.MIN_CLASS_BIRTH_SCORES` scores over the window takes
+        the quantile of its own (a detector may score bicycles at 0.3-0.5 beside people at
+        0.8-0.95), a class with fewer the quantile of every class's. None: `birth_score` as is.
     birth_window : int
         Frames over which the score distribution is learned (2 s at 25 frames/s), >= 1.
     min_hits : int

@@ -57,6 +57,9 @@ SEEDED_DETECTORS = ("knn",)
 MIN_SPEED_SAMPLES = 20
 #: The most recent speed samples kept.
 MAX_SPEED_SAMPLES = 5000
+#: Scores of a class over the birth window before its own birth threshold replaces the
+#: pooled one (:meth:`MultiObjectTracker.birth_threshold`).
+MIN_CLASS_BIRTH_SCORES = 20
 #: How far above 1 a confidence may lie (float rounding, e.g. a float32 1.0 summed) before the
 #: scores count as a detector's own scale rather than confidences.
 CONFIDENCE_SLACK = 1e-6
@@ -197,6 +200,9 @@ class MultiObjectTracker:
         self._primed_shape: tuple[int, ...] = ()  # of the frames given to prime()
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
         self._birth_level = np.inf
+        # the same per class, and the level of each class with MIN_CLASS_BIRTH_SCORES of them
+        self._class_birth_scores: dict[int, F64] = {}
+        self._class_birth_levels: dict[int, float] = {}
         self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
         self._background_ok = True  # False while the camera moves (see .camera)
         self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
@@ -232,6 +238,13 @@ class MultiObjectTracker:
             gain = state.pop("_gain", 1.0)
             state["_speeds"] = {c: copy.deepcopy(speeds) for c in classes}
             state["_gains"] = dict.fromkeys(classes, gain)
+        if "_class_birth_scores" not in state:  # made when every class shared one threshold:
+            # its scores go to class 0 (a run without classes goes on as it would have), other
+            # classes start learning their own from here
+            pooled = state.get("_birth_scores", np.zeros(0))
+            state["_class_birth_scores"] = {0: pooled}
+            enough = len(pooled) >= MIN_CLASS_BIRTH_SCORES
+            state["_class_birth_levels"] = {0: state.get("_birth_level", np.inf)} if enough else {}
         self.__dict__.update(state)
         self._busy = threading.Lock()  # a checkpoint pickled before the lock had none
 
@@ -480,18 +493,40 @@ class MultiObjectTracker:
         """Whether ``detector.foreground`` should skip its bins for the tracker's lazy ones."""
         return self._lazy and isinstance(detector, PaperDetector)
 
-    def _birth_threshold(self, scores: F64) -> float:
-        """The score a detection needs to start a track (``LifecycleConfig.birth_quantile``).
+    def _learn_birth(self, scores: F64, labels: NDArray[np.int64]) -> None:
+        """Add a frame's kept scores to the birth threshold's (``LifecycleConfig.birth_quantile``).
 
-        Learned from the scores of the first ``birth_window`` frames, then fixed.
+        Over the first ``birth_window`` frames, pooled and per class (`labels`); fixed after.
+        """
+        rules = self.config.lifecycle
+        q = rules.birth_quantile
+        if q is None or self.frame_index > rules.birth_window or not len(scores):
+            return
+        self._birth_scores = np.sort(np.concatenate([self._birth_scores, scores]))
+        self._birth_level = sorted_quantile(self._birth_scores, q)
+        for c in np.unique(labels).tolist():
+            seen = self._class_birth_scores.get(c, np.zeros(0))
+            seen = self._class_birth_scores[c] = np.sort(
+                np.concatenate([seen, scores[labels == c]])
+            )
+            if len(seen) >= MIN_CLASS_BIRTH_SCORES:
+                self._class_birth_levels[c] = sorted_quantile(seen, q)
+
+    def birth_threshold(self, cls: int = 0) -> float:
+        """The score a detection of class `cls` needs to start a track.
+
+        ``min(birth_score, q)``, ``q`` the ``LifecycleConfig.birth_quantile`` of the scores of
+        the first ``birth_window`` frames (updated each frame until then, fixed after): of
+        class `cls`'s scores once there are :data:`MIN_CLASS_BIRTH_SCORES` of them, else of
+        every class's (a class first seen after the window takes the pooled level). A class
+        the detector scores lower (bicycles at 0.3-0.5 beside people at 0.8-0.95) so starts
+        tracks from its own upper three quarters (was: the pooled quartile for every class).
+        ``birth_score`` alone with ``birth_quantile=None`` and before any score.
         """
         rules = self.config.lifecycle
         if rules.birth_quantile is None:
             return rules.birth_score
-        if self.frame_index <= rules.birth_window and len(scores):
-            self._birth_scores = np.sort(np.concatenate([self._birth_scores, scores]))
-            self._birth_level = sorted_quantile(self._birth_scores, rules.birth_quantile)
-        return min(rules.birth_score, self._birth_level)
+        return min(rules.birth_score, self._class_birth_levels.get(cls, self._birth_level))
 
     @property
     def speed(self) -> float | None:
@@ -781,12 +816,16 @@ class MultiObjectTracker:
         )
         self.tracks = [t for t, a in zip(self.tracks, alive, strict=True) if a]
         confidences = detections is not None and self._scores_are_confidences
-        birth_score = self._birth_threshold(scores) if confidences else -np.inf
+        gates: dict[int, float] = {}  # the birth threshold of each class (none: -inf)
+        if confidences:
+            self._learn_birth(scores, labels)
+            gates = {c: self.birth_threshold(c) for c in np.unique(labels).tolist()}
         born = cfg if detections is None else self._given_config  # given_particles
         unmatched = result.unmatched_detections
         beside = set() if detections is None else self._beside(boxes, labels, unmatched, cfg)
         for di in unmatched:
-            if hists[di].sum() <= 0 or scores[di] < birth_score or di in beside:
+            gate = gates.get(int(labels[di]), -np.inf)
+            if hists[di].sum() <= 0 or scores[di] < gate or di in beside:
                 # no foreground colour to build a reference from, too unsure, or a second box
                 # on a person already followed (LifecycleConfig.birth_overlap)
                 continue
