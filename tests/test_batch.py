@@ -3824,6 +3824,24 @@ def test_a_scheduler_frozen_mid_run_fails_the_tasks_left(
     }
 
 
+def _lost_once(monkeypatch: pytest.MonkeyPatch, marker: str) -> set[str]:
+    """Make the status of each future whose key holds `marker` read "lost" once, where
+    ``_run_on_dask`` looks (its result lost with its worker, computed again); returns the keys
+    that did."""
+    seen: set[str] = set()
+    real = distributed.Future.status
+
+    def status(self: Any) -> str:
+        looker = sys._getframe(1).f_code.co_name
+        if looker == "_run_on_dask" and marker in self.key and self.key not in seen:
+            seen.add(self.key)
+            return "lost"
+        return str(real.fget(self))
+
+    monkeypatch.setattr(distributed.Future, "status", property(status))
+    return seen
+
+
 def test_a_result_lost_with_its_worker_is_waited_for_not_dropped(
     client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -3833,17 +3851,7 @@ def test_a_result_lost_with_its_worker_is_waited_for_not_dropped(
     written, and no failure counted (exit status 0 if the others were done); 2 runs in 6 of
     a batch whose first task killed its worker. Here its status reads "lost" once, where the
     batch looks."""
-    seen: set[str] = set()
-    real = distributed.Future.status
-
-    def status(self: Any) -> str:
-        looker = sys._getframe(1).f_code.co_name
-        if looker == "_run_on_dask" and "-slow1-" in self.key and self.key not in seen:
-            seen.add(self.key)
-            return "lost"
-        return str(real.fget(self))
-
-    monkeypatch.setattr(distributed.Future, "status", property(status))
+    seen = _lost_once(monkeypatch, "-slow1-")
     jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(2)]
     summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={}, client=client)
     assert seen
@@ -3966,17 +3974,7 @@ def test_the_file_bar_counts_a_task_computed_again_once(
     monkeypatch.setattr(
         _progress, "_tqdm", lambda *a, **k: bars.append(real_tqdm(*a, **k)) or bars[-1]
     )
-    seen: set[str] = set()
-    real = distributed.Future.status
-
-    def status(self: Any) -> str:
-        looker = sys._getframe(1).f_code.co_name
-        if looker == "_run_on_dask" and "-slow1-" in self.key and self.key not in seen:
-            seen.add(self.key)
-            return "lost"
-        return str(real.fget(self))
-
-    monkeypatch.setattr(distributed.Future, "status", property(status))
+    seen = _lost_once(monkeypatch, "-slow1-")
     jobs = [Job(f"slow{k}", _slow, (k,), ()) for k in range(2)]
     summary = run_jobs(
         jobs, tmp_path / "out", kind="smooth", settings={}, client=client, show_progress=True
