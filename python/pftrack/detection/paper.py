@@ -223,7 +223,7 @@ class PaperDetector:
         self._shape: tuple[int, ...] | None = None  # of the video's frames (the first seen)
         self._light = 1.0  # the light's gain since the first frame (gain_thresholds)
         self._settling = 0  # frames left before blobs are again fit to learn person sizes
-        self._noise = 0  # the last frame's noise: median difference from the background
+        self._noise = 0  # the noise said: median difference from the background (grey levels)
         self._noisy = 0  # frames in a row at NOISY_LEVEL or above (NOISY_FRAMES)
         self._noise_said = False  # the noise warning was given (once a video)
         self._noise_unsaid = False  # the noise warning, given by the next detect/foreground
@@ -293,9 +293,12 @@ class PaperDetector:
         (the model's ``difference_histogram``): most pixels are background.
         """
         hist = self._model.difference_histogram
-        self._noise = int(np.searchsorted(np.cumsum(hist), hist.sum() / 2.0))
-        self._noisy = self._noisy + 1 if self._noise >= NOISY_LEVEL else 0
+        # the median at NOISY_LEVEL or above: fewer than half the pixels below it (one sum of a
+        # few bins a frame; the median itself only for the warning)
+        noisy = 2 * int(hist[:NOISY_LEVEL].sum()) < int(hist.sum())
+        self._noisy = self._noisy + 1 if noisy else 0
         if self._noisy == NOISY_FRAMES and not self._noise_said:
+            self._noise = int(np.searchsorted(np.cumsum(hist), hist.sum() / 2.0))
             self._noise_said = self._noise_unsaid = True  # said by the next detect/foreground
 
     def _say_noise(self, detecting: bool, stacklevel: int) -> None:
