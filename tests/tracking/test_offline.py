@@ -317,15 +317,15 @@ def test_drop_nested_bad_arguments(inside, area_ratio, match):
 
 
 # -- complete_boxes: partly seen people completed to the size model's person ----------------
-def _complete_reference(rows, lines, share, anchor, max_width):
+def _complete_reference(rows, lines, share, anchor, max_width, frame_height=None):
     """Row by row, with plain floats: the rule complete_boxes states."""
     (hs, hi), (ws, wi) = lines
     out = rows.copy()
     for i, (f, _, x, y, w, h) in enumerate(rows[:, :6]):
-        if hs == 1.0:
+        if hs == 1.0 or y <= 1.0:  # a top at the frame's top edge is no head
             continue
         h_exp = (hi + hs * y) / (1.0 - hs)
-        if not h_exp > 0.0:
+        if not h_exp > 0.0 or (frame_height is not None and y + h_exp > frame_height):
             continue
         new_h = h_exp if h < share * h_exp else h
         w_exp = max(wi + ws * (y + new_h), 1.0)
@@ -357,8 +357,11 @@ def _complete_reference(rows, lines, share, anchor, max_width):
     share=st.sampled_from([0.5, 0.8, 1.0]),
     anchor=st.sampled_from(["side", "centre"]),
     max_width=st.sampled_from([1.0, 1.6]),
+    frame_height=st.sampled_from([None, 150.0, 300.0]),
 )
-def test_complete_boxes_matches_the_row_by_row_reference(seed, n, share, anchor, max_width):
+def test_complete_boxes_matches_the_row_by_row_reference(
+    seed, n, share, anchor, max_width, frame_height
+):
     rng = np.random.default_rng(seed)
     rows = np.zeros((n, 10))
     rows[:, 0] = rng.integers(1, 4, n)
@@ -366,9 +369,12 @@ def test_complete_boxes_matches_the_row_by_row_reference(seed, n, share, anchor,
     rows[:, 2:4] = rng.uniform(0, 200, (n, 2))
     rows[:, 4:6] = rng.uniform(2, 80, (n, 2))
     rows[::3, 2:6] = np.round(rows[::3, 2:6])  # integer boxes too (edges that coincide)
+    rows[::5, 3] = rng.choice([0.0, 1.0, 1.5], len(rows[::5]))  # at the top edge, or just below
     lines = np.array([[rng.uniform(-0.5, 2.0), rng.uniform(-80, 80)], [rng.uniform(0, 0.4), 5.0]])
-    got = complete_boxes(rows, lines, share, anchor, max_width)
-    np.testing.assert_allclose(got, _complete_reference(rows, lines, share, anchor, max_width))
+    got = complete_boxes(rows, lines, share, anchor, max_width, frame_height)
+    np.testing.assert_allclose(
+        got, _complete_reference(rows, lines, share, anchor, max_width, frame_height)
+    )
     assert np.all(got[:, 4:6] >= rows[:, 4:6])  # nothing shrinks
     np.testing.assert_array_equal(got[:, [0, 1, 3, 6, 7, 8, 9]], rows[:, [0, 1, 3, 6, 7, 8, 9]])
 
@@ -395,6 +401,28 @@ def test_frame_pairs_in_blocks_give_the_same_rows(monkeypatch, block):
     np.testing.assert_array_equal(whole[0], _nested_reference(rows, 0.7, 1.5))
     np.testing.assert_allclose(whole[1], _complete_reference(rows, lines, 0.9, "side", 1.6))
     assert len(whole[0]) < n and np.any(whole[1][:, 2] != rows[:, 2])  # both had work to do
+
+
+def test_complete_boxes_leaves_a_box_cut_by_the_frame_and_a_person_taller_than_it():
+    """A box whose top is the frame's top edge (someone walking in from above) has no head
+    there: it is not completed (was: to the person with its head at row 0, 2 700 px tall
+    under a height slope of 1.07). Nor is a box whose expected person would stand below the
+    frame's bottom row, when the frame's height is given."""
+    lines = np.array([[1.07, -188.14], [0.0, 34.0]])  # the fit of make_scene seed 2
+    rows = np.zeros((3, 10))
+    rows[:, 0] = [1, 2, 3]
+    rows[:, 2:6] = [[285, 0, 30, 39], [285, 1, 30, 39], [50, 142, 22, 28]]
+    np.testing.assert_array_equal(complete_boxes(rows, lines, 0.8, frame_height=360), rows)
+    # without the frame's height the third box still grows to the 517 px person ...
+    assert complete_boxes(rows, lines, 0.8)[2, 5] > 500
+    # ... and a box clear of the edge whose person fits in the frame is completed as before
+    clear = rows[2:].copy()
+    clear[0, 3:6] = [170, 22, 28]  # h_e = (-188.14 + 1.07 * 170) / -0.07 = 89 px, feet at 259
+    np.testing.assert_allclose(
+        complete_boxes(clear, lines, 0.8, frame_height=360)[0, 5], (-188.14 + 1.07 * 170) / -0.07
+    )
+    with pytest.raises(ValueError, match="frame_height"):
+        complete_boxes(rows, lines, 0.8, frame_height=0)
 
 
 def test_complete_boxes_grows_a_partly_hidden_person_towards_the_hidden_side():

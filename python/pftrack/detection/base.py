@@ -15,6 +15,7 @@ from pftrack import _core
 from pftrack._check import MAX_COORD, bgr_array, brief, number, real_array
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
+from pftrack.boxes import _iou_matrix
 from pftrack.detection.size_model import PersonSizeModel
 
 
@@ -92,6 +93,9 @@ class BlobConfig:
         third of a far pedestrian).
     max_area : float
         Largest blob, as a fraction of the frame's area (a sudden light change covers more).
+        A larger blob no wider than tall is kept only while it moves: when it overlaps one of
+        the previous frame's (IoU >= `LARGE_IOU`) and its box moved by `LARGE_MOVE` px or more
+        since, as that one's had (a person close to the camera; `BlobExtractor.boxes`).
     min_aspect, max_aspect : float
         Allowed height / width of a blob's box: 0.25 keeps groups of several people walking
         side by side, 6 drops thin vertical streaks.
@@ -253,8 +257,22 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
     return d[:, :4].copy(), scores.copy()
 
 
+#: A blob over `BlobConfig.max_area` is kept when a blob over it in the previous frame overlaps
+#: it by at least this IoU ...
+LARGE_IOU = 0.5
+#: ... and one of its box's edges moved by at least this many pixels since, as that one's had
+#: from a blob of the frame before (a person close to the camera walks; a patch of changed
+#: light keeps its box, after a first frame where it may have merged with a passer-by).
+LARGE_MOVE = 2.0
+
+
 class BlobExtractor:
     """Raw mask -> cleaned mask (opening, then closing) -> filtered 8-connected blobs."""
+
+    #: the boxes of the previous frame's blobs over `max_area`, and whether each had moved
+    #: (class defaults: a checkpoint pickled before they were kept)
+    _large: NDArray[np.float64] = np.zeros((0, 4))
+    _large_moved: NDArray[np.bool_] = np.zeros(0, dtype=bool)
 
     def __init__(self, config: BlobConfig) -> None:
         self.config = config
@@ -262,10 +280,14 @@ class BlobExtractor:
         self._open: NDArray[np.uint8] = np.ones((1, 1), np.uint8)
         self._close: NDArray[np.uint8] = np.ones((1, 1), np.uint8)
         self.size_model = PersonSizeModel()
+        self._large = np.zeros((0, 4))
+        self._large_moved = np.zeros(0, dtype=bool)
 
     def reset(self) -> None:
-        """Forget the learnt person size (before a new video)."""
+        """Forget the learnt person size and the last large blobs (before a new video)."""
         self.size_model.reset()
+        self._large = np.zeros((0, 4))
+        self._large_moved = np.zeros(0, dtype=bool)
 
     def _elements(self, rows: int) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
         if self._rows != rows:
@@ -327,5 +349,47 @@ class BlobExtractor:
         )
         if cfg.learn_size and learn:
             model.observe(rects)
+        big, big_fill = self._moving_large(mask)
+        if len(big):  # never learnt from, never cut: one person close to the camera
+            rects, fill = np.vstack([rects, big]), np.concatenate([fill, big_fill])
         order = np.lexsort((rects[:, 1], rects[:, 0]))  # deterministic: by left, then top
         return np.ascontiguousarray(rects[order]), np.ascontiguousarray(fill[order])
+
+    def _moving_large(
+        self, mask: NDArray[np.uint8]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Blobs over `max_area` that persist and move: boxes (K, 4) and fills (K,).
+
+        A person close to the camera can fill more of the frame than `max_area` (a person
+        filling 43 % of it was missed on 75 of 101 frames); so can a patch of changed light,
+        which `max_area` is there to refuse, and a group walking side by side. Such a blob
+        passing the other filters and no wider than tall is kept when a blob over
+        `max_area` in the previous frame overlaps it (IoU >= `LARGE_IOU`),
+        one of its box's edges moved by `LARGE_MOVE` px or more since, and that blob had
+        moved so from one of the frame before: light stays put.
+        The blob pass runs a second time only on frames whose foreground exceeds `max_area`.
+        """
+        cfg = self.config
+        prev, prev_moved = self._large, self._large_moved
+        self._large, self._large_moved = np.zeros((0, 4)), np.zeros(0, dtype=bool)
+        if cfg.max_area >= 1.0 or np.count_nonzero(mask) <= cfg.max_area * mask.size:
+            return self._large, np.zeros(0)
+        sc = self.size_model.config
+        rects, fill = _core.blob_boxes(
+            mask, cfg.max_area, 1.0, cfg.min_aspect, cfg.max_aspect, cfg.min_fill, 0.0, None,
+            sc.split_ratio, sc.split_max_height, sc.merge_slack, cfg.split_valley,
+        )  # fmt: skip
+        large = fill * rects[:, 2] * rects[:, 3] > cfg.max_area * mask.size  # not the kept ones
+        large &= rects[:, 3] >= rects[:, 2]  # upright: not a group walking side by side
+        rects, fill = rects[large], fill[large]
+        # (K, P): overlaps a previous large blob, and its box moved since
+        moved = np.abs(_edges(rects)[:, None] - _edges(prev)[None]).max(axis=2) >= LARGE_MOVE
+        moved &= _iou_matrix(rects, prev) >= LARGE_IOU
+        self._large, self._large_moved = rects, moved.any(axis=1)
+        keep = np.any(moved & prev_moved[None], axis=1)
+        return rects[keep], fill[keep]
+
+
+def _edges(boxes: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Left, top, right and bottom of (K, 4) ``left, top, w, h`` boxes."""
+    return np.column_stack([boxes[:, :2], boxes[:, :2] + boxes[:, 2:]])

@@ -1361,6 +1361,7 @@ class Tracker:
                         life.amodal_share,
                         life.amodal_anchor,
                         size.config.split_ratio,
+                        self._tracker.frame_shape[0] if self._tracker.frame_shape else None,
                     )
             n_tracked = len(rows)  # before the rows wholly outside the frame are left out
             if len(rows) and len(self._tracker.frame_shape) >= 2:

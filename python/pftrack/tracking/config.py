@@ -235,9 +235,10 @@ class LifecycleConfig:
         expects with its head at the box's top to that person's height (width)
         (:func:`pftrack.tracking.offline.complete_boxes`): background subtraction boxes only
         the visible part of a partly hidden person, ground truth the whole person. Groups
-        (wider than 1.6 persons) are left alone, and so are given detections. None: off. The
-        default (0.8, ``"side"``) is the best of a grid over every scene with ground truth
-        (docs/detection.md).
+        (wider than 1.6 persons), boxes at the frame's top edge (their top is no head),
+        persons whose feet would be below the frame, and given detections are left alone.
+        None: off. The default (0.8, ``"side"``) is the best of a grid over every scene with
+        ground truth (docs/detection.md).
     amodal_anchor : {"side", "centre"}
         Which edge a widened box keeps: ``"side"`` grows it towards the one side that lies
         inside another box (the hidden side), else about its centre; ``"centre"`` always about

@@ -55,6 +55,7 @@ __all__ = [
 ]
 
 AMODAL_ANCHORS = ("side", "centre")  # complete_boxes: where a widened box keeps its evidence
+TOP_EDGE = 1.0  # complete_boxes: a box whose top is within this many px of row 0 touches the edge
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
 
@@ -686,6 +687,7 @@ def complete_boxes(
     share: float,
     anchor: str = "side",
     max_width: float = 1.6,
+    frame_height: float | None = None,
 ) -> F64:
     """Complete the boxes of partly seen people to the expected person box (amodal boxes).
 
@@ -706,6 +708,11 @@ def complete_boxes(
     * A box wider than ``max_width * w_e`` (a group, which the detector cuts at
       ``SizeModelConfig.split_ratio``) and a box whose ``h_e`` is not positive (a head below
       the horizon; or ``h_slope = 1``) are left as they are. No box shrinks.
+    * A box whose top lies at the frame's top edge (``top <= TOP_EDGE`` px) is left alone: the
+      frame cut it there, its top is no head (a person walking in from above). With
+      `frame_height`, so is a box whose expected person would have its feet below the frame's
+      bottom row (``top + h_e > frame_height``): a person the model extrapolates to beyond the
+      rows it saw (a height slope near 1 gave 2 700 px people in a 360 px frame).
 
     Parameters
     ----------
@@ -720,6 +727,8 @@ def complete_boxes(
         Which edge a widened box keeps (see above).
     max_width : float
         Boxes wider than this many expected widths are groups, left alone (>= 1).
+    frame_height : float or None
+        The frame's height in pixels (> 0), when known: see above.
 
     Returns
     -------
@@ -729,7 +738,7 @@ def complete_boxes(
     Raises
     ------
     ValueError
-        Bad rows or lines, or `share`, `anchor` or `max_width` out of range.
+        Bad rows or lines, or `share`, `anchor`, `max_width` or `frame_height` out of range.
     """
     _check.number(share, "complete_boxes: share", finite=False)  # an array: ambiguous below
     _check.number(max_width, "complete_boxes: max_width", finite=False)
@@ -740,6 +749,12 @@ def complete_boxes(
         raise ValueError(f"complete_boxes: anchor is {anchor!r}, expected one of {AMODAL_ANCHORS}")
     if not 1.0 <= max_width < np.inf:
         raise ValueError(f"complete_boxes: max_width is {max_width}, expected a finite value >= 1")
+    if frame_height is not None:
+        frame_height = _check.real(frame_height, "complete_boxes: frame_height")
+        if not frame_height > 0.0:
+            raise ValueError(
+                f"complete_boxes: frame_height is {frame_height}, expected a finite value > 0"
+            )
     coef = real_array(lines, "complete_boxes: lines")
     if coef.shape != (2, 2) or not np.all(np.isfinite(coef)):
         raise ValueError(
@@ -751,7 +766,9 @@ def complete_boxes(
         return a
     x, y, w, h = (a[:, c].copy() for c in range(2, 6))
     h_exp = head_height(coef, y)
-    known = h_exp > 0.0
+    known = (h_exp > 0.0) & (y > TOP_EDGE)  # a top at the frame's edge is no head
+    if frame_height is not None:  # nor is a person whose feet are below the frame
+        known &= y + h_exp <= frame_height
     new_h = np.where(known & (h < share * h_exp), h_exp, h)
     w_exp = expected_size(coef, y + new_h)[:, 1]
     person = known & (w <= max_width * w_exp)
