@@ -5,12 +5,15 @@ from __future__ import annotations
 import numbers
 import os
 from collections.abc import Iterable, Iterator
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._text import counted
 from pftrack._typing import F64, RngLike
+
+_T = TypeVar("_T")
 
 __all__ = [
     "BOX_VALUES",
@@ -299,6 +302,29 @@ def first_bad_box(boxes: ArrayLike, *, edges: bool = True) -> tuple[int, int, st
     # the sum named: the size the caller names may be small, its left or top the far one
     total = f"{BOX_VALUES[c]} + {BOX_VALUES[2 + c]} = {b[r, c] + b[r, 2 + c]:.12g}"
     return r, 2 + c, f"a box's right or bottom edge is beyond ±{MAX_COORD:g} px ({total})"
+
+
+def frames_iterator(frames: Iterable[_T], who: str) -> Iterator[_T]:
+    """An iterator over `frames`, given to `who` (``prime``) as an iterable of frames.
+
+    One frame alone (an (H, W) or (H, W, 3) array; ``prime([frame])`` takes it) and what is not
+    an iterable (None, a number) are a TypeError naming `who` (were: one frame's rows taken
+    for frames, and "'NoneType' object is not iterable").
+    """
+    if isinstance(frames, np.ndarray) and (
+        frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
+    ):
+        raise TypeError(
+            f"{who} takes an iterable of frames (a list, or a (K, H, W, 3) array), got one "
+            f"{frames.shape} frame: prime([frame])"
+        )
+    try:
+        return iter(frames)
+    except TypeError:
+        raise TypeError(
+            f"{who} takes an iterable of frames (a list, a generator or a (K, H, W, 3) array), "
+            f"got {type(frames).__name__}"
+        ) from None
 
 
 def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:

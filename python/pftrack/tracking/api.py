@@ -41,6 +41,7 @@ from pftrack._check import (
     brief,
     first_bad_class,
     flag,
+    frames_iterator,
     integer,
     not_an_image,
     option,
@@ -879,20 +880,7 @@ class Tracker:
         25 MB each): each must have the working size of `shape` (ValueError otherwise), and
         the run's frames must have `shape`, as after priming with the frames themselves.
         """
-        if isinstance(frames, np.ndarray) and (
-            frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
-        ):
-            raise TypeError(
-                "prime takes an iterable of frames (a list, or a (K, H, W, 3) array), got one "
-                f"{frames.shape} frame: prime([frame])"
-            )
-        try:
-            iterator = iter(frames)
-        except TypeError:
-            raise TypeError(
-                f"prime takes an iterable of frames (a list, a generator or a (K, H, W, 3) "
-                f"array), got {type(frames).__name__}"
-            ) from None
+        iterator = frames_iterator(frames, "prime")
         made = None if shape is None else self._made_shape(shape)
         with self._alone("prime"):
             if self.frame_count:

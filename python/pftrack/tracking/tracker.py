@@ -28,7 +28,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, check_classes, generator, not_an_image, real_array
+from pftrack._check import (
+    bgr_frame,
+    check_classes,
+    frames_iterator,
+    generator,
+    not_an_image,
+    real_array,
+)
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack._warn import Held, warn
@@ -265,20 +272,7 @@ class MultiObjectTracker:
         :meth:`pftrack.Tracker.prime` says (were: "'NoneType' object is not iterable", and one
         frame's rows taken for frames).
         """
-        if isinstance(frames, np.ndarray) and (
-            frames.ndim == 2 or (frames.ndim == 3 and frames.shape[-1] == 3)
-        ):
-            raise TypeError(
-                "MultiObjectTracker.prime takes an iterable of frames (a list, or a (K, H, W, 3) "
-                f"array), got one {frames.shape} frame: prime([frame])"
-            )
-        try:
-            iter(frames)
-        except TypeError:
-            raise TypeError(
-                "MultiObjectTracker.prime takes an iterable of frames (a list, a generator or a "
-                f"(K, H, W, 3) array), got {type(frames).__name__}"
-            ) from None
+        frames_iterator(frames, "MultiObjectTracker.prime")
         self._take("prime")
         try:
             self._prime(frames)
