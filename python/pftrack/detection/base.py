@@ -95,7 +95,8 @@ class BlobConfig:
         Largest blob, as a fraction of the frame's area (a sudden light change covers more).
         A larger blob no wider than tall is kept only while it moves: when it overlaps one of
         the previous frame's (IoU >= `LARGE_IOU`) and its box moved by `LARGE_MOVE` px or more
-        since, as that one's had (a person close to the camera; `BlobExtractor.boxes`).
+        since, as that one's had (a person close to the camera; `BlobExtractor.boxes`); once
+        its box moved as a whole, also while it stays (the person stops).
     min_aspect, max_aspect : float
         Allowed height / width of a blob's box: 0.25 keeps groups of several people walking
         side by side, 6 drops thin vertical streaks.
@@ -266,13 +267,30 @@ LARGE_IOU = 0.5
 LARGE_MOVE = 2.0
 
 
+def _translated(boxes: NDArray[np.float64], prev: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """(K, P): whether box k is box p moved as a whole.
+
+    Both edges of one axis moved by `LARGE_MOVE` or more, the same way: a walker. A patch of
+    light merged with a passer-by keeps an edge of its own in each axis, and only the
+    passer-by's side moves.
+    """
+    d = _edges(boxes)[:, None] - _edges(prev)[None]  # (K, P, 4): left, top, right, bottom
+    near, far = d[..., :2], d[..., 2:]  # (K, P, 2): left/top and right/bottom of each axis
+    same_way = near * far > 0
+    both = np.minimum(np.abs(near), np.abs(far)) >= LARGE_MOVE
+    out: NDArray[np.bool_] = np.any(same_way & both, axis=2)
+    return out
+
+
 class BlobExtractor:
     """Raw mask -> cleaned mask (opening, then closing) -> filtered 8-connected blobs."""
 
-    #: the boxes of the previous frame's blobs over `max_area`, and whether each had moved
+    #: the boxes of the previous frame's blobs over `max_area`, whether each had moved, and
+    #: whether each is a walker's (kept once it moved as a whole, then while it overlaps)
     #: (class defaults: a checkpoint pickled before they were kept)
     _large: NDArray[np.float64] = np.zeros((0, 4))
     _large_moved: NDArray[np.bool_] = np.zeros(0, dtype=bool)
+    _large_walked: NDArray[np.bool_] = np.zeros(0, dtype=bool)
 
     def __init__(self, config: BlobConfig) -> None:
         self.config = config
@@ -282,12 +300,14 @@ class BlobExtractor:
         self.size_model = PersonSizeModel()
         self._large = np.zeros((0, 4))
         self._large_moved = np.zeros(0, dtype=bool)
+        self._large_walked = np.zeros(0, dtype=bool)
 
     def reset(self) -> None:
         """Forget the learnt person size and the last large blobs (before a new video)."""
         self.size_model.reset()
         self._large = np.zeros((0, 4))
         self._large_moved = np.zeros(0, dtype=bool)
+        self._large_walked = np.zeros(0, dtype=bool)
 
     def _elements(self, rows: int) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
         if self._rows != rows:
@@ -366,12 +386,18 @@ class BlobExtractor:
         passing the other filters and no wider than tall is kept when a blob over
         `max_area` in the previous frame overlaps it (IoU >= `LARGE_IOU`),
         one of its box's edges moved by `LARGE_MOVE` px or more since, and that blob had
-        moved so from one of the frame before: light stays put.
+        moved so from one of the frame before: light stays put. A walker who stops stays kept:
+        a kept blob whose box moved as a whole (`_translated`) carries a walker's mark, and a
+        large blob overlapping one with the mark in the previous frame (IoU >= `LARGE_IOU`)
+        takes it and is kept, moving or not (the close walker standing 150 frames: found on
+        150 of them, against 11). Light never earns the mark: a patch merged with a passer-by
+        keeps an edge of its own in each axis.
         The blob pass runs a second time only on frames whose foreground exceeds `max_area`.
         """
         cfg = self.config
-        prev, prev_moved = self._large, self._large_moved
+        prev, prev_moved, prev_walked = self._large, self._large_moved, self._large_walked
         self._large, self._large_moved = np.zeros((0, 4)), np.zeros(0, dtype=bool)
+        self._large_walked = np.zeros(0, dtype=bool)
         if cfg.max_area >= 1.0 or np.count_nonzero(mask) <= cfg.max_area * mask.size:
             return self._large, np.zeros(0)
         sc = self.size_model.config
@@ -384,9 +410,16 @@ class BlobExtractor:
         rects, fill = rects[large], fill[large]
         # (K, P): overlaps a previous large blob, and its box moved since
         moved = np.abs(_edges(rects)[:, None] - _edges(prev)[None]).max(axis=2) >= LARGE_MOVE
-        moved &= _iou_matrix(rects, prev) >= LARGE_IOU
-        self._large, self._large_moved = rects, moved.any(axis=1)
+        near = _iou_matrix(rects, prev) >= LARGE_IOU
+        moved &= near
         keep = np.any(moved & prev_moved[None], axis=1)
+        # a walker who stops stays kept: once kept while its box moved as a whole, a blob
+        # keeps the walker's mark while it overlaps the previous frame's, moving or not
+        walked = np.any(
+            near & (prev_walked[None] | (_translated(rects, prev) & prev_moved[None])), axis=1
+        )
+        self._large, self._large_moved, self._large_walked = rects, moved.any(axis=1), walked
+        keep |= walked
         return rects[keep], fill[keep]
 
 
