@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -622,6 +624,70 @@ def test_each_class_with_20_scores_has_its_own_birth_threshold():
         assert tracker.birth_threshold(7) == pooled  # a class never seen
 
 
+def test_a_class_first_seen_after_the_window_learns_its_own_birth_threshold():
+    """A bicycle first seen at frame 61, after the 50-frame birth window, took the pooled
+    threshold (the people's range) for the whole run and never started a track. It now
+    learns its own once it has 20 scores, whenever that is; the people's stays the window's."""
+    config = TrackerConfig(
+        lifecycle=LifecycleConfig(min_hits=1), refine=RefineConfig(enabled=False)
+    )
+    tracker = MultiObjectTracker(config, rng=0)
+    frame, dets, classes = _people_and_a_bicycle(100)
+    born = []
+    for k, (d, c) in enumerate(zip(dets, classes, strict=True), start=1):
+        if k <= 60:  # no bicycle yet
+            d, c = d[:4], c[:4]
+        tracks = tracker.update(frame, d, c)
+        if k == 50:
+            people = tracker.birth_threshold(0)
+        if any(t.cls == 1 for t in tracks):
+            born.append(k)
+        late = [x[4, 4] for x in dets[60 : min(k, 80)]]  # fixed at its 20th
+        bike = float(np.quantile(late, 0.25)) if len(late) >= 20 else tracker.birth_threshold(7)
+        assert tracker.birth_threshold(1) == bike, k
+    assert tracker.birth_threshold(0) == people > 0.8  # fixed after the window
+    assert born == list(range(80, 101))
+
+
+def test_a_class_with_few_scores_in_the_window_goes_on_learning():
+    """A class with 5 scores over the window adds later ones to them until it has 20."""
+    tracker = MultiObjectTracker(rng=0)
+    frame, dets, classes = _people_and_a_bicycle(80)
+    for k, (d, c) in enumerate(zip(dets, classes, strict=True), start=1):
+        if not 46 <= k <= 50 and k <= 60:  # the bicycle on frames 46-50, then from 61
+            d, c = d[:4], c[:4]
+        tracker.update(frame, d, c)
+    seen = [x[4, 4] for x in dets[45:50] + dets[60:75]]  # 5 + 15: 20 at frame 75
+    assert tracker.birth_threshold(1) == float(np.quantile(seen, 0.25))
+
+
+def test_a_checkpoint_taken_while_a_late_class_learns_resumes():
+    """Pickled at frame 70 (the late bicycle has 10 of its 20 scores), the run resumes as one
+    never pickled; a checkpoint from before late learning (no late scores) loads."""
+    tracker = MultiObjectTracker(rng=0)
+    frame, dets, classes = _people_and_a_bicycle(90)
+    for k, (d, c) in enumerate(zip(dets, classes, strict=True), start=1):
+        if k <= 60:
+            d, c = d[:4], c[:4]
+        tracker.update(frame, d, c)
+        if k == 70:
+            state = tracker.__getstate__()
+            assert len(state["_late_birth_scores"][1]) == 10
+            resumed = MultiObjectTracker.__new__(MultiObjectTracker)
+            resumed.__setstate__(pickle.loads(pickle.dumps(state)))
+            del state["_late_birth_scores"]
+            older = MultiObjectTracker.__new__(MultiObjectTracker)
+            older.__setstate__(pickle.loads(pickle.dumps(state)))
+        if k > 70:
+            resumed.update(frame, d, c)
+            older.update(frame, d, c)
+            assert [t.box.tolist() for t in resumed.tracks] == [
+                t.box.tolist() for t in tracker.tracks
+            ]
+    assert resumed.birth_threshold(1) == tracker.birth_threshold(1) < 0.5
+    assert older.birth_threshold(1) < 0.5  # learnt from frame 71's scores on
+
+
 def test_one_class_keeps_the_pooled_birth_threshold():
     """With one class the class's quantile is the pooled one: runs without classes unchanged."""
     tracker = MultiObjectTracker(rng=0)
@@ -629,4 +695,15 @@ def test_one_class_keeps_the_pooled_birth_threshold():
     for d in dets:
         tracker.update(frame, d)
     pooled = float(np.quantile(np.concatenate([d[:, 4] for d in dets]), 0.25))
+    assert tracker.birth_threshold() == tracker.birth_threshold(0) == pooled
+
+
+def test_one_class_with_few_scores_keeps_the_window_level_after_it():
+    """A run of one class with under 20 scores over the window keeps the window's level after
+    it (the late learning is for a class beside others): runs without classes unchanged."""
+    tracker = MultiObjectTracker(rng=0)
+    frame, dets, _ = _people_and_a_bicycle(80)
+    for k, d in enumerate(dets, start=1):
+        tracker.update(frame, d[:1] if 46 <= k <= 50 or k > 60 else d[:0])
+    pooled = min(0.9, float(np.quantile([d[0, 4] for d in dets[45:50]], 0.25)))
     assert tracker.birth_threshold() == tracker.birth_threshold(0) == pooled

@@ -367,8 +367,10 @@ class Tracker:
     birth_quantile : float or None
         The birth threshold is ``min(birth_score, quantile)`` of the confidences seen in the
         first 50 frames, so a detector whose scores are all low still starts tracks (None: always
-        `birth_score`); each class (the `dets`' column 6) with 20 confidences there has its own,
-        the others the pooled one. `min_conf` stays one for every class. See
+        `birth_score`); each class (the `dets`' column 6) with 20 confidences there has its own;
+        beside another class, a class with fewer (or first seen later) learns its own once it
+        has 20, whenever that is, and takes the pooled one until then. `min_conf` stays one
+        for every class. See
         :class:`~pftrack.tracking.LifecycleConfig`.
     camera_motion : {"auto", "on", "off"}
         Camera-motion compensation (:attr:`TrackerConfig.camera_motion`).

@@ -196,7 +196,9 @@ class LifecycleConfig:
         :meth:`MultiObjectTracker.update`) each class with
         :data:`~pftrack.tracking.tracker.MIN_CLASS_BIRTH_SCORES` scores over the window takes
         the quantile of its own (a detector may score bicycles at 0.3-0.5 beside people at
-        0.8-0.95), a class with fewer the quantile of every class's. None: `birth_score` as is.
+        0.8-0.95), a class with fewer the quantile of every class's until it has that many,
+        whenever that is (when the window held another class's scores: a run of one class
+        keeps the window's level). None: `birth_score` as is.
     birth_window : int
         Frames over which the score distribution is learned (2 s at 25 frames/s), >= 1.
     min_hits : int

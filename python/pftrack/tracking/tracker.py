@@ -210,6 +210,7 @@ class MultiObjectTracker:
         # the same per class, and the level of each class with MIN_CLASS_BIRTH_SCORES of them
         self._class_birth_scores: dict[int, F64] = {}
         self._class_birth_levels: dict[int, float] = {}
+        self._late_birth_scores: dict[int, F64] = {}  # after the window (_learn_late_birth)
         self.camera = CameraMotion(self.config.camera_motion, self.config.camera)
         self._background_ok = True  # False while the camera moves (see .camera)
         self.camera_step = CameraStep(None, 0.0, False, None, True)  # this frame's
@@ -252,6 +253,7 @@ class MultiObjectTracker:
             state["_class_birth_scores"] = {0: pooled}
             enough = len(pooled) >= MIN_CLASS_BIRTH_SCORES
             state["_class_birth_levels"] = {0: state.get("_birth_level", np.inf)} if enough else {}
+        state.setdefault("_late_birth_scores", {})  # made when late classes took the pooled
         self.__dict__.update(state)
         self._busy = threading.Lock()  # a checkpoint pickled before the lock had none
 
@@ -494,7 +496,10 @@ class MultiObjectTracker:
         """
         rules = self.config.lifecycle
         q = rules.birth_quantile
-        if q is None or self.frame_index > rules.birth_window or not len(scores):
+        if q is None or not len(scores):
+            return
+        if self.frame_index > rules.birth_window:
+            self._learn_late_birth(scores, labels, q)
             return
         self._birth_scores = np.sort(np.concatenate([self._birth_scores, scores]))
         self._birth_level = sorted_quantile(self._birth_scores, q)
@@ -506,13 +511,35 @@ class MultiObjectTracker:
             if len(seen) >= MIN_CLASS_BIRTH_SCORES:
                 self._class_birth_levels[c] = sorted_quantile(seen, q)
 
+    def _learn_late_birth(self, scores: F64, labels: NDArray[np.int64], q: float) -> None:
+        """After the birth window: a class short of its own level learns it from later scores.
+
+        A class with fewer than :data:`MIN_CLASS_BIRTH_SCORES` scores over the window, when
+        the window's scores included another class's, keeps adding its scores (to those of
+        the window) until it has that many, then takes their quantile `q`, fixed from then
+        on. A run of one class never gets here with another class's scores in the window:
+        its level stays the window's, as before.
+        """
+        for c in np.unique(labels).tolist():
+            if c in self._class_birth_levels:
+                continue
+            own = self._class_birth_scores.get(c, np.zeros(0))
+            if len(self._birth_scores) <= len(own):  # the window saw no other class
+                continue
+            seen = self._late_birth_scores.get(c, own)
+            seen = self._late_birth_scores[c] = np.sort(np.concatenate([seen, scores[labels == c]]))
+            if len(seen) >= MIN_CLASS_BIRTH_SCORES:
+                self._class_birth_levels[c] = sorted_quantile(seen, q)
+                del self._late_birth_scores[c]  # fixed from here
+
     def birth_threshold(self, cls: int = 0) -> float:
         """The score a detection of class `cls` needs to start a track.
 
         ``min(birth_score, q)``, ``q`` the ``LifecycleConfig.birth_quantile`` of the scores of
         the first ``birth_window`` frames (updated each frame until then, fixed after): of
         class `cls`'s scores once there are :data:`MIN_CLASS_BIRTH_SCORES` of them, else of
-        every class's (a class first seen after the window takes the pooled level). A class
+        every class's (a class short of them over the window, beside another class, goes on
+        learning after it: `_learn_late_birth`). A class
         the detector scores lower (bicycles at 0.3-0.5 beside people at 0.8-0.95) so starts
         tracks from its own upper three quarters (was: the pooled quartile for every class).
         ``birth_score`` alone with ``birth_quantile=None`` and before any score.
