@@ -14,9 +14,10 @@ import pytest
 
 import pftrack
 from pftrack.batch import RecoverOptions, TrackOptions
-from pftrack.detection import BlobConfig, PaperConfig
+from pftrack.detection import BlobConfig, KnnConfig, Mog2Config, PaperConfig
 from pftrack.detection.bootstrap import bootstrap_frames
 from pftrack.detection.ghost import edge_support
+from pftrack.detection.size_model import SizeModelConfig
 from pftrack.eval import prepare_mot
 from pftrack.particle_filter import (
     Ar2Model,
@@ -41,6 +42,7 @@ from pftrack.recovery import (
 )
 from pftrack.recovery.calibrate import calibrate
 from pftrack.recovery.experiment import trajectories
+from pftrack.recovery.gdt import GdtModel
 from pftrack.render import draw_tracks
 from pftrack.synthetic import camera_path, make_busy_scene
 from pftrack.tracking import TrackWriter
@@ -620,6 +622,21 @@ NUMBER_SITES: dict[str, tuple[Callable[[object], object], str]] = {
     ),
     "camera_path(zoom)": (lambda v: camera_path(5, (48, 64), zoom=v), "camera_path: zoom"),  # type: ignore[arg-type]
     "camera_path(period)": (lambda v: camera_path(5, (48, 64), period=v), "camera_path: period"),  # type: ignore[arg-type]
+    # these took an array or a DataFrame without a word (PaperConfig's went to the C++
+    # background model, GdtModel's to the recovery), or asked it for its truth
+    **{
+        f"PaperConfig({name})": ((lambda n: lambda v: PaperConfig(**{n: v}))(name), name)
+        for name in "alpha alpha_fg k_noise t_min t_max low_ratio shadow_lo shadow_chroma".split()
+    },
+    **{
+        f"SizeModelConfig({name})": ((lambda n: lambda v: SizeModelConfig(**{n: v}))(name), name)
+        for name in ("split_ratio", "split_max_height", "merge_slack", "max_cut_share")
+    },
+    "GdtModel(dt)": (lambda v: GdtModel(dt=v), "GdtModel: dt"),  # type: ignore[arg-type]
+    "GdtModel(p_init_velocity)": (
+        lambda v: GdtModel(p_init_velocity=v),  # type: ignore[arg-type]
+        "GdtModel: p_init_velocity",
+    ),
 }
 
 
@@ -641,3 +658,90 @@ def test_the_threaded_flag_of_a_renderer_is_checked() -> None:
     for value in (np.ones((2, 3)), "no"):
         with pytest.raises(TypeError, match=r"^threaded must be True or False, got "):
             pftrack.TrackRenderer("never-written.mp4", 10, threaded=value)  # type: ignore[arg-type]
+
+
+#: Settings that are configs of their own: an array, a DataFrame or a name given for one was
+#: taken, and failed at the first frame on a missing attribute naming no setting.
+SUB_CONFIG_SITES: dict[str, tuple[Callable[[object], object], str, str]] = {
+    **{
+        f"TrackerConfig({name})": (
+            (lambda n: lambda v: TrackerConfig(**{n: v}))(name),
+            name,
+            type(getattr(TrackerConfig(), name)).__name__,
+        )
+        for name in (
+            "filter",
+            "binning",
+            "rjmcmc",
+            "refine",
+            "association",
+            "motion",
+            "lifecycle",
+            "camera",
+            "crossings",
+        )  # fmt: skip
+    },
+    "FilterConfig(model)": (lambda v: FilterConfig(model=v), "FilterConfig: model", "Ar2Model"),  # type: ignore[arg-type]
+    "PaperConfig(blobs)": (lambda v: PaperConfig(blobs=v), "blobs", "BlobConfig"),  # type: ignore[arg-type]
+    "PaperConfig(hsv)": (lambda v: PaperConfig(hsv=v), "hsv", "HsvBinning"),  # type: ignore[arg-type]
+    "Mog2Config(blobs)": (lambda v: Mog2Config(blobs=v), "Mog2Config: blobs", "BlobConfig"),  # type: ignore[arg-type]
+    "KnnConfig(hsv)": (lambda v: KnnConfig(hsv=v), "KnnConfig: hsv", "HsvBinning"),  # type: ignore[arg-type]
+}
+
+
+@pytest.mark.parametrize("site", SUB_CONFIG_SITES, ids=list(SUB_CONFIG_SITES))
+@pytest.mark.parametrize(
+    "value", [np.ones((2, 3)), "table", "tight"], ids=["array", "table", "text"]
+)
+def test_a_sub_config_refuses_what_is_not_its_class(site: str, value: object) -> None:
+    if isinstance(value, str) and value == "table":
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    call, what, cls = SUB_CONFIG_SITES[site]
+    with pytest.raises(TypeError) as info:
+        call(value)
+    message = str(info.value)
+    assert "\n" not in message, message
+    assert message.startswith(f"{what} must be a {cls}, got "), message
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda v: BlobConfig(learn_size=v), "learn_size must be True or False, got "),
+        (lambda v: PaperConfig(gain_thresholds=v), "gain_thresholds must be True or False, got "),
+        (
+            lambda v: PaperConfig(n_learn=v),
+            r"n_learn must be an integer in \[0, 2147483647\], got ",
+        ),
+        (
+            lambda v: pftrack.read_mot("never-read.txt", what=v),
+            "read_mot: what must be a str, got ",
+        ),
+    ],
+)
+@pytest.mark.parametrize("value", [np.ones((2, 3)), "table"], ids=["array", "table"])
+def test_flags_counts_and_labels_once_taken_are_refused(
+    call: Callable[[object], object], message: str, value: object
+) -> None:
+    """These took an array or a DataFrame (a flag on, a count for the C++ model, a label
+    written into every message about the file)."""
+    if isinstance(value, str):
+        pd = pytest.importorskip("pandas")
+        value = pd.DataFrame(np.ones((2, 3)))
+    with pytest.raises(TypeError, match=f"^{message}") as info:
+        call(value)
+    assert str(info.value).endswith(f"got {type(value).__name__} of shape (2, 3)")
+
+
+def test_the_gdt_model_takes_any_sequence_of_its_noises_and_refuses_other_shapes() -> None:
+    model = GdtModel(q=np.array([1e-6, 1e-6, 1e-4, 1e-4]), r=[1e-6, 1e-6])  # type: ignore[arg-type]
+    assert model == GdtModel() and model.q == (1e-6, 1e-6, 1e-4, 1e-4) and hash(model)
+    with pytest.raises(ValueError, match=r"^GdtModel: q has shape \(2, 3\), expected \(4,\)$"):
+        GdtModel(q=np.ones((2, 3)))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^GdtModel: r has shape \(3,\), expected \(2,\)$"):
+        GdtModel(r=(1.0, 1.0, 1.0))  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"^GdtModel: r must hold real numbers, got dtype <U"):
+        GdtModel(r=("a", "b"))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^GdtModel: q is \(nan, 1.0, 1.0, 1.0\), expected"):
+        GdtModel(q=(np.nan, 1.0, 1.0, 1.0))

@@ -35,6 +35,7 @@ __all__ = [
     "first_bad_id",
     "flag",
     "generator",
+    "instance",
     "integer",
     "listed",
     "materialised",
@@ -46,6 +47,7 @@ __all__ = [
     "real_array",
     "seed",
     "shown",
+    "text",
 ]
 
 #: Box positions and sizes beyond this many pixels are refused: no image is a billion pixels
@@ -437,6 +439,33 @@ def listed(values: Iterable[object]) -> str:
     """`values` as a message lists them: ``'a'``, ``'a' or 'b'``, ``'a', 'b' or 'c'``."""
     names = [repr(v) for v in values]
     return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} or {names[-1]}"
+
+
+def instance(value: object, what: str, cls: type[_T]) -> _T:
+    """`value` itself when it is a `cls` (a sub-config: ``TrackerConfig.filter``), else TypeError.
+
+    Was taken: a DataFrame or an array given for ``TrackerConfig(association=...)`` failed
+    later, at a frame, on a missing attribute naming no setting.
+
+    Raises
+    ------
+    TypeError
+        ``{what} must be a FilterConfig, got DataFrame of shape (2, 3)``.
+    """
+    if not isinstance(value, cls):
+        raise TypeError(f"{what} must be a {cls.__name__}, got {shown(value)}")
+    return value
+
+
+def text(value: object, what: str, *, none: bool = True) -> None:
+    """TypeError when `value` is not a str (nor None, with `none`: no text), for a label.
+
+    A label (``draw_tracks``' `label`, ``read_mot``'s `what`) goes into a picture or a message
+    as it is: an array or a table given for it was written into the message as its whole
+    repr, or failed in OpenCV naming no argument.
+    """
+    if not (isinstance(value, str) or (none and value is None)):
+        raise TypeError(f"{what} must be a str, got {shown(value)}")
 
 
 def option(value: object, what: str, accepted: Iterable[str | None]) -> None:

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, brief, flag, integer, path_arg, real_array, shown
+from pftrack._check import bgr_frame, brief, flag, integer, path_arg, real_array, text
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
@@ -77,7 +77,7 @@ def draw_tracks(
         `rows` are not real numbers; `label` is not a str; `frame` is not a uint8 array.
     """
     rows = _track_rows(rows, "draw_tracks")  # was "not enough values to unpack" of (k, 5)
-    _text(label, "draw_tracks", "label")
+    text(label, "draw_tracks: label")  # was an AttributeError ('encode')
     return _draw_boxes(bgr_frame(frame, "draw_tracks: frame"), rows, label)
 
 
@@ -190,12 +190,6 @@ MAX_TRAIL = 100_000
 ROW_COLUMNS = "frame, id, left, top, width, height"
 #: Largest side of a plot's canvas in pixels (OpenCV's image limit).
 MAX_CANVAS = 32767
-
-
-def _text(value: object, who: str, what: str) -> None:
-    """Refuse a caption that is not a str (None: none); was an AttributeError ('encode')."""
-    if value is not None and not isinstance(value, str):
-        raise TypeError(f"{who}: {what} must be a str, got {shown(value)}")
 
 
 def _track_rows(rows: ArrayLike, who: str, what: str = "rows") -> F64:
@@ -607,7 +601,7 @@ def plot_trajectories(
     who = "plot_trajectories"
     path = path_arg(path, f"{who}: path")
     rows = _track_rows(rows, who)
-    _text(title, who, "title")
+    text(title, f"{who}: title")
     truth = None if truth is None else _track_rows(truth, who, "truth")
     if background is not None:
         background = bgr_frame(background, f"{who}: background")

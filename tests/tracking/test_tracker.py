@@ -296,6 +296,36 @@ def test_drop_in_mode_with_a_detector_that_has_only_detect(scene):
     assert len(ta) >= 2  # walkers in view at frame 30
 
 
+def test_the_detector_is_typed_by_what_the_tracker_needs_of_it(scene):
+    """``MultiObjectTracker.detector`` was typed ``Any``: it is a ``FrameDetector``, a Protocol
+    of ``detect`` alone (what the tracker calls; ``reset`` is ``Detector``'s, never called by
+    the tracker), so that a detector of one method tracks and type-checks."""
+    import typing
+
+    from pftrack.detection import Detector, FrameDetector, make_detector
+
+    class DetectOnly:
+        def __init__(self):
+            self._d = make_detector("paper")
+
+        def detect(self, frame):
+            return self._d.detect(frame)
+
+    hints = typing.get_type_hints(MultiObjectTracker.__init__)
+    assert hints["detector"] == FrameDetector | None
+    assert typing.get_type_hints(MultiObjectTracker.detector.fget)["return"] is FrameDetector
+    only = DetectOnly()
+    assert isinstance(only, FrameDetector) and not isinstance(only, Detector)
+    assert all(isinstance(make_detector(n), Detector) for n in ("paper", "mog2", "knn"))
+    a, b = MultiObjectTracker(rng=0), MultiObjectTracker(rng=0, detector=only)
+    for frame in scene.frames[:30]:  # the built-in detector's path: detect() alone
+        ta, tb = a.update(frame), b.update(frame)
+        assert [(t.id, t.box_xywh.tolist()) for t in ta] == [
+            (t.id, t.box_xywh.tolist()) for t in tb
+        ]
+    assert len(ta) >= 1 and b.detector is only
+
+
 @pytest.mark.parametrize("tau, expected", [(1.5, [(0, 0)]), (float("inf"), [(0, 1), (1, 0)])])
 def test_association_leaves_pairs_unmade_when_cheaper(tau, expected):
     """Track 0 sits on detection 0, which also passes track 1's gate, and detection 1 passes

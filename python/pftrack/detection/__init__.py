@@ -10,7 +10,14 @@ import dataclasses
 from typing import Any
 
 from pftrack._lazy import lazy_exports
-from pftrack.detection.base import BlobConfig, Detections, Detector, check_detections, check_frame
+from pftrack.detection.base import (
+    BlobConfig,
+    Detections,
+    Detector,
+    FrameDetector,
+    check_detections,
+    check_frame,
+)
 from pftrack.detection.opencv_bg import KnnConfig, KnnDetector, Mog2Config, Mog2Detector
 from pftrack.detection.paper import PaperConfig, PaperDetector
 from pftrack.detection.refine import refine_boxes
@@ -23,6 +30,7 @@ __all__ = [
     "BlobConfig",
     "Detections",
     "Detector",
+    "FrameDetector",
     "KnnConfig",
     "KnnDetector",
     "Mog2Config",

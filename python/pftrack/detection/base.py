@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, bgr_array, brief, number, real_array
+from pftrack._check import MAX_COORD, bgr_array, brief, flag, number, real_array
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.boxes import _iou_matrix
@@ -52,12 +52,28 @@ class Detections:
 
 
 @runtime_checkable
-class Detector(Protocol):
-    """Anything with ``detect(frame) -> Detections`` and ``reset()``."""
+class FrameDetector(Protocol):
+    """What :class:`~pftrack.tracking.MultiObjectTracker` needs of its `detector`: ``detect``.
+
+    ``detect(frame)`` takes one BGR uint8 (H, W, 3) frame and returns its :class:`Detections`;
+    the tracker reads their `boxes`, `scores`, `mask`, `binned` and `frame_bins`. It also
+    uses, when the detector has them (pftrack's detectors do):
+
+    * ``foreground(frame, shadows=False) -> (mask, frame_bins)``: the mask alone (no blob
+      pass), for box refinement when the caller gives the detections; `shadows` marks shadow
+      pixels 127 (:func:`~pftrack.tracking.tracker.takes_shadows`);
+    * ``prime(frames)``: the background from frames read ahead
+      (:meth:`~pftrack.tracking.MultiObjectTracker.prime`).
+    """
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
         """Detect the moving objects of one BGR uint8 frame (H, W, 3)."""
         ...
+
+
+@runtime_checkable
+class Detector(FrameDetector, Protocol):
+    """Anything with ``detect(frame) -> Detections`` and ``reset()`` (every built-in detector)."""
 
     def reset(self) -> None:
         """Forget the background model (before a new video)."""
@@ -143,6 +159,7 @@ class BlobConfig:
                 raise ValueError(f"{name} is {brief(v)}, expected None or an int >= 1")
         for name in _BLOB_NUMBERS:  # before the comparisons below ask an array for its truth
             number(getattr(self, name), name, finite=False)
+        flag(self.learn_size, "learn_size")  # was taken: "no" or an array turned it on
         if not (0.0 <= self.min_area <= self.max_area <= 1.0):
             raise ValueError(
                 f"min_area, max_area are {self.min_area}, {self.max_area}, "

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack._check import brief, integer, number
+from pftrack._check import brief, instance, integer, number
 from pftrack._check import seed as check_seed
 from pftrack.detection.base import (
     BlobConfig,
@@ -98,6 +98,8 @@ def _check_subtractor(config: Mog2Config | KnnConfig, owner: str, threshold: str
     nothing; a float `history` failed in OpenCV's argument parsing.
     """
     integer(config.history, f"{owner}: history", 1, 2**31 - 1)
+    instance(config.blobs, f"{owner}: blobs", BlobConfig)
+    instance(config.hsv, f"{owner}: hsv", HsvBinning)
     t = number(getattr(config, threshold), f"{owner}: {threshold}", finite=False)
     if not (np.isfinite(t) and t > 0):
         raise ValueError(f"{owner}: {threshold} is {t}, expected a finite value > 0")

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack._check import number, option
+from pftrack._check import flag, instance, integer, number, option
 from pftrack._warn import warn
 from pftrack.detection.base import (
     BlobConfig,
@@ -162,10 +162,15 @@ class PaperConfig:
 
     def __post_init__(self) -> None:
         for name in (
-            "ghost_support", "ghost_rate", "leg_height", "leg_fill", "grey_tolerance",
-            "grey_shadow_lo", "gain_band",
+            "alpha", "alpha_fg", "k_noise", "t_min", "t_max", "low_ratio", "shadow_lo",
+            "shadow_chroma", "ghost_support", "ghost_rate", "leg_height", "leg_fill",
+            "grey_tolerance", "grey_shadow_lo", "gain_band",
         ):  # fmt: skip  # before the comparisons below ask an array for its truth
-            number(getattr(self, name), name, finite=False)
+            number(getattr(self, name), name, finite=False)  # the first eight were taken
+        integer(self.n_learn, "n_learn", 0, 2**31 - 1)  # 0 or 1: the selective update at once
+        flag(self.gain_thresholds, "gain_thresholds")
+        instance(self.blobs, "blobs", BlobConfig)
+        instance(self.hsv, "hsv", HsvBinning)
         if not (0.0 <= self.ghost_support <= 1.0):
             raise ValueError(f"ghost_support is {self.ghost_support}, expected in [0, 1]")
         if not (0.0 < self.ghost_rate <= 1.0):

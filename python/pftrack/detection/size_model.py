@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack._check import brief
+from pftrack._check import brief, number
 
 __all__ = ["PersonSizeModel", "SizeModelConfig", "expected_size", "head_height", "theil_sen"]
 
@@ -62,6 +62,8 @@ class SizeModelConfig:
     max_cut_share: float = 0.2
 
     def __post_init__(self) -> None:
+        for name in ("split_ratio", "split_max_height", "merge_slack", "max_cut_share"):
+            number(getattr(self, name), name, finite=False)  # not an array's "truth value"
         if not (isinstance(self.min_samples, int) and self.min_samples >= 3):
             raise ValueError(f"min_samples is {brief(self.min_samples)}, expected an int >= 3")
         if not (isinstance(self.max_samples, int) and self.max_samples >= self.min_samples):

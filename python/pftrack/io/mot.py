@@ -21,7 +21,7 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack import _core
+from pftrack import _check, _core
 from pftrack._check import (
     BOX_VALUES,
     MAX_FRAME,
@@ -194,6 +194,7 @@ def read_mot(
         more than 10: columns 11 and beyond are not kept.
     """
     p = Path(path_arg(path, "read_mot: path"))
+    _check.text(what, "read_mot: what", none=False)  # it names the file in every message below
     if not p.is_file():
         if p.is_dir():
             raise ValueError(f"{what} {p} is a folder, not a file")

@@ -12,7 +12,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import MAX_COORD, generator, integer, number, option, real_array, shown
+from pftrack._check import (
+    MAX_COORD,
+    generator,
+    instance,
+    integer,
+    number,
+    option,
+    real_array,
+    shown,
+)
 from pftrack._typing import F64, RngLike
 from pftrack.particle_filter.colour import HsvBinning, not_binned
 from pftrack.particle_filter.dynamics import MAX_SIGMA_XY, Ar2Model
@@ -77,6 +86,7 @@ class FilterConfig:
 
     def __post_init__(self) -> None:
         integer(self.n_particles, "FilterConfig: n_particles", 1, MAX_PARTICLES)
+        instance(self.model, "FilterConfig: model", Ar2Model)
         integer(self.min_samples, "FilterConfig: min_samples", 0, 2**31 - 1)  # 0: every pixel
         lam = number(self.lam, "FilterConfig: lam", finite=False)
         if not (np.isfinite(lam) and lam > 0):  # as bhattacharyya_weights: 0 ignores colour

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
-from pftrack._check import MAX_FRAME, first_at, flag, generator, option, real_array
+from pftrack._check import MAX_FRAME, first_at, flag, generator, number, option, real_array
 from pftrack._typing import F64, RngLike
 from pftrack.kalman import cv_transition_xy
 
@@ -47,6 +47,29 @@ class GdtModel:
     q: tuple[float, float, float, float] = (1e-6, 1e-6, 1e-4, 1e-4)
     r: tuple[float, float] = (1e-6, 1e-6)
     p_init_velocity: float = 1e2
+
+    def __post_init__(self) -> None:
+        """Refuse settings that are not finite numbers (were taken: a DataFrame for `dt`).
+
+        `q` and `r` may be any sequence (a list, a (4,) array) of 4 and 2 numbers, kept as a
+        tuple of floats (a frozen model stays hashable and comparable).
+
+        Raises
+        ------
+        TypeError
+            A setting that is not a number (`q`, `r`: not real numbers).
+        ValueError
+            NaN or infinite; `q` or `r` not of 4 or 2 values.
+        """
+        for name in ("dt", "p_init_velocity"):
+            number(getattr(self, name), f"GdtModel: {name}")
+        for name, n in (("q", 4), ("r", 2)):
+            v = real_array(getattr(self, name), f"GdtModel: {name}", booleans=False)
+            if v.shape != (n,):
+                raise ValueError(f"GdtModel: {name} has shape {v.shape}, expected ({n},)")
+            if not np.isfinite(v).all():
+                raise ValueError(f"GdtModel: {name} is {tuple(v.tolist())}, expected finite values")
+            object.__setattr__(self, name, tuple(float(x) for x in v))
 
     @property
     def A(self) -> F64:  # noqa: N802 - the paper's name

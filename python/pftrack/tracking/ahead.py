@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack.detection import FrameDetector
 from pftrack.io.prefetch import prefetch
 from pftrack.tracking.camera import CameraMotion
 from pftrack.tracking.tracker import MultiObjectTracker
@@ -182,7 +183,7 @@ class DetectAhead:
             yield work[0]
 
 
-def _mask_and_bins(detector: Any) -> Any:
+def _mask_and_bins(detector: FrameDetector) -> Any:
     """``detect`` as the tracker reads it without ``foreground``: the mask and full-frame bins."""
 
     def call(frame: NDArray[np.uint8]) -> tuple[Any, Any]:

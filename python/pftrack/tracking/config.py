@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from pftrack._check import MAX_FRAME, brief, flag, integer, number, option, shown
+from pftrack._check import MAX_FRAME, brief, flag, instance, integer, number, option, shown
 from pftrack._typing import CameraMotion, DetectorName, SamplerName
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
@@ -557,6 +557,20 @@ class CameraConfig:
             )
 
 
+#: TrackerConfig's fields that are configs of their own, and their classes.
+_SUB_CONFIGS: tuple[tuple[str, type], ...] = (
+    ("filter", FilterConfig),
+    ("binning", HsvBinning),
+    ("rjmcmc", RJMCMCConfig),
+    ("refine", RefineConfig),
+    ("association", AssociationConfig),
+    ("motion", MotionConfig),
+    ("lifecycle", LifecycleConfig),
+    ("camera", CameraConfig),
+    ("crossings", CrossingConfig),
+)
+
+
 @dataclass(frozen=True)
 class TrackerConfig:
     """Configuration of :class:`~pftrack.tracking.MultiObjectTracker`.
@@ -650,6 +664,8 @@ class TrackerConfig:
     given_particles: int | None = GIVEN_PARTICLES
 
     def __post_init__(self) -> None:
+        for name, cls in _SUB_CONFIGS:  # were taken, and failed at a frame naming no setting
+            instance(getattr(self, name), name, cls)
         option(self.sampler, "sampler", SAMPLERS)  # before the sampler is compared below
         option(self.camera_motion, "camera_motion", CAMERA_MOTION)
         option(self.detector, "detector", DETECTORS)

@@ -40,7 +40,7 @@ from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack._warn import Held, warn
 from pftrack.boxes import _iou_matrix, _to_cxcywh
-from pftrack.detection import check_detections, make_detector, refine_boxes
+from pftrack.detection import FrameDetector, check_detections, make_detector, refine_boxes
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.particle_filter.filter import _in_use
@@ -117,10 +117,11 @@ class MultiObjectTracker:
         All settings.
     rng : numpy.random.Generator, int or None
         Seed: the same seed and input give the same tracks.
-    detector : object, optional
-        Any object with ``detect(frame) -> Detections`` (see :mod:`pftrack.detection`); by
-        default the one named by ``config.detector``, created on first use. Anything else (a
-        name such as ``"paper"``, which goes in ``TrackerConfig(detector=...)``) is a TypeError.
+    detector : FrameDetector, optional
+        Any object with ``detect(frame) -> Detections`` (:class:`pftrack.detection.FrameDetector`
+        says what else the tracker uses when it is there); by default the one named by
+        ``config.detector``, created on first use. Anything else (a name such as ``"paper"``,
+        which goes in ``TrackerConfig(detector=...)``) is a TypeError.
 
     Notes
     -----
@@ -154,7 +155,7 @@ class MultiObjectTracker:
     kept_own = 0
 
     def __init__(self, config: TrackerConfig | None = None, rng: RngLike = None,
-                 detector: Any = None) -> None:  # fmt: skip
+                 detector: FrameDetector | None = None) -> None:  # fmt: skip
         if config is not None and not isinstance(config, TrackerConfig):
             raise TypeError(
                 f"MultiObjectTracker: config must be a TrackerConfig, got {type(config).__name__}"
@@ -171,7 +172,7 @@ class MultiObjectTracker:
                 "MultiObjectTracker: detector must have a detect(frame) method (or be None: the "
                 f"built-in one), got {shown}{hint if isinstance(detector, str) else ''}"
             )
-        self._detector = detector
+        self._detector: FrameDetector | None = detector
         self.tracks: list[LiveTrack] = []
         self._ended_unconfirmed: set[int] = set()
         self._n_started = 0  # tracks started so far (see tracks_started)
@@ -192,7 +193,8 @@ class MultiObjectTracker:
         self.frame_index = 0
         self._mask: NDArray[np.uint8] | None = None  # the last frame's, see last_mask
         self._mask_shaded = False  # whether _mask still has its shadow pixels (127)
-        self._shadows: tuple[Any, bool] | None = None  # (detector, shadows_of(detector))
+        # (detector, shadows_of(detector))
+        self._shadows: tuple[FrameDetector, bool] | None = None
         self._joint = JointTracker(self.config, self._rng)
         # the configuration the tracks run with: `config` with its pixel settings scaled to the
         # first frame's size (TrackerConfig.pixel_diagonal), set by the first update
@@ -296,7 +298,7 @@ class MultiObjectTracker:
             detector.prime(frames)
 
     @property
-    def detector(self) -> Any:
+    def detector(self) -> FrameDetector:
         """The detector: the one given, or the built-in ``config.detector`` (made on first use).
 
         Assignable: :class:`~pftrack.tracking.ahead.DetectAhead` puts a stand-in here for the
@@ -305,10 +307,10 @@ class MultiObjectTracker:
         return self._ensure_detector()
 
     @detector.setter
-    def detector(self, detector: Any) -> None:
+    def detector(self, detector: FrameDetector) -> None:
         self._detector = detector
 
-    def _ensure_detector(self) -> Any:
+    def _ensure_detector(self) -> FrameDetector:
         """Return the detector, made on first use.
 
         It gets the tracker's own HSV binning, so that its foreground bins and the tracker's
@@ -377,17 +379,19 @@ class MultiObjectTracker:
             det = self._ensure_detector().detect(frame)
             self._mask, self._mask_shaded = det.mask, False
             boxes = np.asarray(det.boxes, dtype=np.float64).reshape(-1, 4)
-            binned = det.binned
             if not len(boxes):  # foreground but no box: said if the run has no track
                 pixels = int(np.count_nonzero(det.mask))
                 if pixels:
                     self.unboxed_own += 1
                     self.unboxed_own_pixels = max(self.unboxed_own_pixels, pixels)
-            if not self._background_ok:  # moving camera: colour of every pixel, not foreground
-                binned = det.frame_bins
-                if binned is None:  # binned on demand: only the pixels the boxes read
-                    binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)
-            return boxes, np.asarray(det.scores, dtype=np.float64), binned
+            own_scores = np.asarray(det.scores, dtype=np.float64)
+            if self._background_ok:
+                return boxes, own_scores, det.binned
+            # moving camera: colour of every pixel, not foreground
+            everywhere = det.frame_bins
+            if everywhere is None:  # binned on demand: only the pixels the boxes read
+                everywhere = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)
+            return boxes, own_scores, everywhere
         boxes, scores, labels = given
         mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
@@ -441,7 +445,7 @@ class MultiObjectTracker:
             self._mask, self._mask_shaded = foreground_only(self._mask), False
         return self._mask
 
-    def shadows_of(self, detector: Any) -> bool:
+    def shadows_of(self, detector: FrameDetector) -> bool:
         """Whether box refinement asks `detector`'s ``foreground`` for shadows (127).
 
         With :attr:`RefineConfig.leg_fill` set and a ``foreground`` that takes `shadows`
@@ -485,7 +489,7 @@ class MultiObjectTracker:
         """Whether full-frame bins made here are lazy: not for RJ-MCMC, which reads every pixel."""
         return self.config.sampler != "rjmcmc"
 
-    def _lazy_bins_from(self, detector: Any) -> bool:
+    def _lazy_bins_from(self, detector: FrameDetector) -> bool:
         """Whether ``detector.foreground`` should skip its bins for the tracker's lazy ones."""
         return self._lazy and isinstance(detector, PaperDetector)
 
@@ -961,7 +965,7 @@ def sorted_quantile(values: F64, q: float) -> float:
     return b - diff * (1 - gamma) if gamma >= 0.5 else a + diff * gamma
 
 
-def takes_shadows(detector: Any) -> bool:
+def takes_shadows(detector: FrameDetector) -> bool:
     """Whether `detector`'s ``foreground`` takes a `shadows` argument (pftrack's detectors do).
 
     A detector may say so itself with a boolean ``foreground_shadows`` attribute (the stand-in
@@ -972,6 +976,7 @@ def takes_shadows(detector: Any) -> bool:
     if isinstance(said, bool):
         return said
     try:
-        return "shadows" in inspect.signature(detector.foreground).parameters
+        foreground = getattr(detector, "foreground", None)  # optional (FrameDetector)
+        return callable(foreground) and "shadows" in inspect.signature(foreground).parameters
     except (TypeError, ValueError):  # no signature (a C extension's method)
         return False
