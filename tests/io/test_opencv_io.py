@@ -41,6 +41,13 @@ def _latin1(folder: Path, name: bytes) -> Path:
     return path
 
 
+@pytest.fixture(autouse=True)
+def _own_tempdir(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each test's scratch links in a folder of its own: another process's don't count."""
+    own = tmp_path_factory.mktemp("tempdir")
+    monkeypatch.setattr(tempfile, "tempdir", str(own))
+
+
 def _pftrack_scratch() -> set[str]:
     return {n for n in os.listdir(tempfile.gettempdir()) if n.startswith("pftrack-")}
 
