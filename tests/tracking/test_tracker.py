@@ -619,14 +619,19 @@ def _people_and_a_bicycle(n_frames: int) -> tuple[np.ndarray, list[np.ndarray], 
     return frame, dets, classes
 
 
+def _born_at_first_hit() -> MultiObjectTracker:
+    """min_hits 1 and no box refinement: a track starts on the frame its detection passes."""
+    config = TrackerConfig(
+        lifecycle=LifecycleConfig(min_hits=1), refine=RefineConfig(enabled=False)
+    )
+    return MultiObjectTracker(config, rng=0)
+
+
 def test_a_class_scored_lower_starts_tracks():
     """A detector scores bicycles at 0.3-0.5 beside people at 0.85-0.95: the birth threshold
     learned from every class's scores (their lower quartile, in the people's range) never
     let the bicycle start a track. Once it has 20 scores it has its own threshold."""
-    config = TrackerConfig(
-        lifecycle=LifecycleConfig(min_hits=1), refine=RefineConfig(enabled=False)
-    )
-    tracker = MultiObjectTracker(config, rng=0)
+    tracker = _born_at_first_hit()
     frame, dets, classes = _people_and_a_bicycle(30)
     born = []
     for k, (d, c) in enumerate(zip(dets, classes, strict=True), start=1):
@@ -658,10 +663,7 @@ def test_a_class_first_seen_after_the_window_learns_its_own_birth_threshold():
     """A bicycle first seen at frame 61, after the 50-frame birth window, took the pooled
     threshold (the people's range) for the whole run and never started a track. It now
     learns its own once it has 20 scores, whenever that is; the people's stays the window's."""
-    config = TrackerConfig(
-        lifecycle=LifecycleConfig(min_hits=1), refine=RefineConfig(enabled=False)
-    )
-    tracker = MultiObjectTracker(config, rng=0)
+    tracker = _born_at_first_hit()
     frame, dets, classes = _people_and_a_bicycle(100)
     born = []
     for k, (d, c) in enumerate(zip(dets, classes, strict=True), start=1):
