@@ -7,8 +7,9 @@ command never disagree: the same frames, detections and seed give the same rows.
 Time constants given in seconds (``max_coast``, ``prime``) are turned into frames with
 ``frame_rate`` (``round(seconds * frame_rate)``). Left at their defaults, every time constant
 is the command's frame count at any frame rate: a track coasts 10 frames, :meth:`prime` reads
-30, the linker bridges 30, the birth threshold watches the first 50 and the offline pass cuts
-after 7 coasted ones (``LifecycleConfig.relink_coast``). Frame counts were measured better
+30, the linker bridges 30, the birth threshold watches the first 50, the offline pass cuts
+after 7 coasted ones (``LifecycleConfig.relink_coast``) and a blind coast ends after 3
+(``LifecycleConfig.blind_coast``). Frame counts were measured better
 than the same seconds at each sequence's own rate (public detections, seed 0, MOTA / IDF1):
 PETS09-S2L1 at its 7 frames/s 77.9 / 79.6 against 76.4 / 58.2 with every constant in seconds
 (3 frames of coasting, a linking gap of 8); ADL-Rundle-6 at 30/s 38.4 / 45.6 against 36.8 / 44.9;

@@ -245,6 +245,19 @@ class LifecycleConfig:
         Which edge a widened box keeps: ``"side"`` grows it towards the one side that lies
         inside another box (the hidden side), else about its centre; ``"centre"`` always about
         its centre.
+    blind_coast : int or None
+        With given detections, a track ends after more than this many frames with detections
+        in a row coasted blind: its colour filter's likelihood flat on each (every particle
+        matching the reference alike: black or one-colour frames, as a loop with only boxes
+        passes, or a box with no counted pixel). Its box is then the centre filter's
+        constant-velocity extrapolation alone, which the camera's own motion (a walker's
+        camera, a car's) carries off the person while the association radius grows; the
+        detection that re-finds it is then often another person's, and its coasted rows filled
+        between the two are false positives. The offline linker, which sees both pieces,
+        decides instead. A coast on which the colour carried evidence (a video) is not blind
+        and keeps `max_coast`. At least 0; None: off. The default 3 passed the adoption rule
+        over every sequence with public detections (docs/tracking.md, "Blind coasts end after
+        3 frames").
     birth_overlap : float or None
         With given detections, a detection left unmatched that overlaps a confirmed track of its
         class by an IoU above this starts no track: it is a second box on a person already
@@ -279,6 +292,7 @@ class LifecycleConfig:
     amodal_share: float | None = 0.8
     amodal_anchor: str = "side"
     birth_overlap: float | None = 0.3
+    blind_coast: int | None = 3
 
     def __post_init__(self) -> None:
         _numbers("LifecycleConfig", self, "min_score", "min_area", "birth_score", "birth_quantile")
@@ -289,6 +303,8 @@ class LifecycleConfig:
             integer(getattr(self, name), f"LifecycleConfig: {name}", lo, MAX_FRAME)
         if self.relink_coast is not None:
             integer(self.relink_coast, "LifecycleConfig: relink_coast", 1, MAX_FRAME)
+        if self.blind_coast is not None:
+            integer(self.blind_coast, "LifecycleConfig: blind_coast", 0, MAX_FRAME)
         _in_unit_interval(
             "LifecycleConfig", coast_min_rho=self.coast_min_rho, birth_score=self.birth_score
         )

@@ -121,6 +121,11 @@ class LiveTrack:
         The detection's score.
     """
 
+    #: Coasted frames in a row whose colour likelihood was flat (:attr:`blind`), and whether
+    #: this frame's was (:attr:`flat`). Class defaults: a checkpoint pickled before them has none.
+    blind = 0
+    flat = False
+
     def __init__(self, track_id: int, box_xywh: F64, reference: F64, config: TrackerConfig,
                  seed: int, score: float) -> None:  # fmt: skip
         self.id = track_id
@@ -146,6 +151,10 @@ class LiveTrack:
         self.measured: F64 | None = box_xywh.copy()  # this frame's detection box
         self.unreported: list[tuple[int, F64, float]] = []
         self.reported = False
+        # coasted frames with detections in a row whose colour likelihood was flat (a blind
+        # coast: the centre filter's extrapolation alone), and whether this frame's was
+        self.blind = 0
+        self.flat = False
 
     def predict(self, binned: BinnedImage, colour_noise: float, accel_gain: float = 1.0) -> None:
         """Step the particle filter on the frame and the centre filter by one frame.
@@ -159,7 +168,8 @@ class LiveTrack:
         state = self.filter.step(binned)
         self.rho = state.rho
         self.motion.predict(self.size[1], accel_gain)
-        if colour_evidence(state.rho, state.rho_max):
+        self.flat = not colour_evidence(state.rho, state.rho_max)
+        if not self.flat:
             self.motion.update(state.box_cxcywh[:2], colour_noise * self.size[1])
         cx, cy = self.motion.p
         self.box = np.array(
@@ -197,27 +207,37 @@ class LiveTrack:
         self.hits += 1
         self.time_since_update = 0
         self.missed = 0
+        self.blind = 0
         self.det_index = det_index
 
     def coast(self, detected: bool = True) -> None:
         """A frame without a detection: the particle filter alone carries the track.
 
         `detected`: whether the frame had any detection at all. A frame without one (the
-        detector did not run, or saw nothing) is not counted in :attr:`missed`.
+        detector did not run, or saw nothing) is not counted in :attr:`missed`, nor in
+        :attr:`blind` (which a frame whose colour carried evidence resets).
         """
         self.time_since_update += 1
         self.missed += int(detected)
+        if not self.flat:
+            self.blind = 0
+        elif detected:
+            self.blind += 1
         self.det_index = None
         self.score = self.rho
 
-    def alive(self, rules: LifecycleConfig) -> bool:
+    def alive(self, rules: LifecycleConfig, given: bool = False) -> bool:
         """Tell whether the track has coasted no longer than it may (less if unconfirmed).
 
         A confirmed track may coast `max_coast` frames. A tentative one may miss
         `tentative_coast` frames that had detections (frames without any detection do not count:
         a detector run every other frame, or one that saw nothing), and coast no more than
-        `max_coast` frames in all.
+        `max_coast` frames in all. On a frame of given detections (`given`), any track ends
+        after more than `blind_coast` frames with detections in a row coasted blind, its colour
+        likelihood flat (:attr:`blind`).
         """
+        if given and rules.blind_coast is not None and self.blind > rules.blind_coast:
+            return False
         if self.hits >= rules.min_hits:
             return self.time_since_update <= rules.max_coast
         return self.missed <= rules.tentative_coast and self.time_since_update <= rules.max_coast
@@ -334,7 +354,8 @@ def predict_tracks(
         # cv_predict over one frame (dt = 1: its products by dt are exact)
         px, py = px + vx, py + vy
         p00, p01, p11 = p00 + 2.0 * p01 + p11 + q / 3.0, p01 + p11 + q / 2, p11 + q
-        if rho_max - rho > FLAT_RHO:  # colour_evidence: a flat likelihood is no measurement
+        t.flat = not rho_max - rho > FLAT_RHO  # colour_evidence (see LiveTrack.blind)
+        if not t.flat:  # a flat likelihood is no measurement
             r = colour_noise * h
             px, py, vx, vy, p00, p01, p11 = _cv_update_floats(
                 px, py, vx, vy, p00, p01, p11, zx, zy, r * r
