@@ -923,6 +923,34 @@ def _silenced(*names: str) -> Iterator[None]:
             lg.disabled = was
 
 
+class _Dropped(logging.Filter):
+    """Drops the records whose message (its format) begins with one of `prefixes`."""
+
+    def __init__(self, *prefixes: str) -> None:
+        super().__init__()
+        self.prefixes = prefixes
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not str(record.msg).startswith(self.prefixes)
+
+
+#: What Dask's client logs, as a warning, when the worker that held a finished task's result
+#: died before the result was taken: the batch computes it again and waits (:func:`_taken`).
+_RESULT_LOST = "Couldn't gather"
+
+
+@contextlib.contextmanager
+def _dropped(name: str, *prefixes: str) -> Iterator[None]:
+    """The logger `name` drops the records that begin with one of `prefixes` meanwhile."""
+    logger = logging.getLogger(name)
+    drop = _Dropped(*prefixes)
+    logger.addFilter(drop)
+    try:
+        yield
+    finally:
+        logger.removeFilter(drop)
+
+
 @contextlib.contextmanager
 def _main_left_out() -> Iterator[None]:
     """Worker processes spawned meanwhile do not import this process's main module.
@@ -2135,6 +2163,10 @@ def run_jobs(
             if c is not None:
                 remote = True
                 unusable = stack.enter_context(_setup_failures(c))  # as soon as connected
+                # a result lost with its worker is computed again and waited for (_taken): not
+                # said in Dask's words, "Couldn't gather 1 keys, rescheduling (KEY,)", which a
+                # user trial saw on stderr among the batch's lines after a worker's kill -9
+                stack.enter_context(_dropped("distributed.client", _RESULT_LOST))
                 info = c.scheduler_info()
                 reported = str(info.get("address")) if info.get("address") else None
                 summary.scheduler = address or reported  # the user's spelling of the address

@@ -1,0 +1,92 @@
+"""What a camera-network user's trial of ``pftrack batch --scheduler`` found (issue 16).
+
+A real ``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1, a folder of 31 mixed
+inputs: what it found and was mended is tested here, each case on a real cluster.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from pftrack.batch import Job, TaskResult, run_jobs
+
+distributed = pytest.importorskip("distributed")
+
+#: A cluster's scheduler with its HTTP routes on a free port (8787 may be taken by another run).
+NO_DASHBOARD = {"dashboard_address": "127.0.0.1:0"}
+
+
+def _empty(k: int) -> TaskResult:
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+
+
+class _Kept(logging.Handler):
+    """Keeps the messages of the records that reach it."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.DEBUG)
+        self.said: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.said.append(record.getMessage())
+
+
+@contextlib.contextmanager
+def _said_by(name: str) -> Iterator[list[str]]:
+    """The messages the logger `name` passes on to its handlers meanwhile."""
+    kept = _Kept()
+    logger = logging.getLogger(name)
+    logger.addHandler(kept)
+    try:
+        yield kept.said
+    finally:
+        logger.removeHandler(kept)
+
+
+@pytest.fixture(scope="module")
+def scheduler() -> Iterator[str]:
+    """The address of a running cluster of one worker, as ``dask scheduler`` gives one."""
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+        scheduler_kwargs=NO_DASHBOARD,
+    ) as cluster:  # fmt: skip
+        yield cluster.scheduler_address
+
+
+def test_a_result_lost_with_its_worker_is_not_said_in_dasks_words(
+    scheduler: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The trial: a worker killed (``kill -9``) as it held a finished task's result; the batch
+    computed it again and wrote every output, but Dask's client had logged, on stderr among the
+    batch's own lines, ``distributed.client - WARNING - Couldn't gather 1 keys, rescheduling
+    ('pftrack-track-cam13-bb4d16bf',)``. Here Dask's client says so as the batch takes a
+    result, where its gather does; the batch's own lines are unchanged, and the logger's other
+    warnings still pass."""
+    real = distributed.Future.result
+
+    def result(self: Any, timeout: Any = None) -> Any:
+        if sys._getframe(1).f_globals.get("__name__") == "pftrack.batch.engine":
+            log = logging.getLogger("distributed.client")
+            log.warning("Couldn't gather %s keys, rescheduling %s", 1, (self.key,))
+            log.warning("another warning of Dask's client")
+        return real(self, timeout=timeout)
+
+    monkeypatch.setattr(distributed.Future, "result", result)
+    with _said_by("distributed.client") as said:
+        summary = run_jobs(
+            [Job(f"f{k}", _empty, (k,), ()) for k in range(2)], tmp_path, kind="smooth",
+            settings={}, scheduler=scheduler,
+        )  # fmt: skip
+    assert [e["status"] for e in summary.entries] == ["done", "done"]
+    assert said == ["another warning of Dask's client"] * 2
+    with _said_by("distributed.client") as said:  # the batch over: said again
+        logging.getLogger("distributed.client").warning("Couldn't gather 1 keys, rescheduling")
+    assert said == ["Couldn't gather 1 keys, rescheduling"]
