@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import socket
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -16,7 +17,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from pftrack.batch import Job, TaskResult, run_jobs
+from pftrack.batch import Job, TaskResult, run_jobs, smooth_many
+from pftrack.cli import main
 
 distributed = pytest.importorskip("distributed")
 
@@ -90,3 +92,48 @@ def test_a_result_lost_with_its_worker_is_not_said_in_dasks_words(
     with _said_by("distributed.client") as said:  # the batch over: said again
         logging.getLogger("distributed.client").warning("Couldn't gather 1 keys, rescheduling")
     assert said == ["Couldn't gather 1 keys, rescheduling"]
+
+
+def _free_port() -> int:
+    """A port of 127.0.0.1 that nothing listens on (now)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def test_an_unreachable_scheduler_from_the_environment_is_said_to_come_from_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The trial: ``DASK_SCHEDULER_ADDRESS`` left set from an earlier session, ``pftrack batch
+    in/ --out out/`` said "cannot connect to the Dask scheduler at tcp://127.0.0.1:8797", an
+    address on no command line, nor what to do to run here. Now where it comes from is said,
+    and how to run on a local cluster; an address given as ``--scheduler`` stays as it was."""
+    import dask
+
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    tracks = tmp_path / "in"
+    tracks.mkdir()
+    for k in range(2):
+        (tracks / f"t{k}.txt").write_text("1,1,10,10,5,5,1,-1,-1,-1\n")
+    refused = (
+        f"cannot connect to the Dask scheduler at {address}{{}}: connection refused: nothing "
+        f"listens on port {address.rsplit(':', 1)[1]} of 127.0.0.1 (start the scheduler there "
+        "first: dask scheduler)"
+    )
+    said = " (from $DASK_SCHEDULER_ADDRESS: unset it to run on a local cluster)"
+    monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", address)  # after Dask read it: read anyway
+    assert main(["smooth", str(tracks), "--out", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err == f"pftrack smooth: error: {refused.format(said)}\n"
+    argv = ["smooth", str(tracks), "--out", str(tmp_path / "out"), "--scheduler", address]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"pftrack smooth: error: {refused.format('')}\n"
+    assert not (tmp_path / "out").exists()
+    # from Python, the setting in a Dask configuration file (no variable)
+    monkeypatch.delenv("DASK_SCHEDULER_ADDRESS")
+    with dask.config.set({"scheduler-address": address}), pytest.raises(OSError) as raised:
+        smooth_many(tracks, tmp_path / "out")
+    said = (
+        " (from Dask's scheduler-address setting, in a Dask configuration file: unset it to run "
+        "on a local cluster)"
+    )
+    assert str(raised.value) == refused.format(said)

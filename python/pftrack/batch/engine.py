@@ -366,9 +366,10 @@ def dask_client(
         yield client
         return
     if address:
+        named = address if scheduler is not None else _from_setting(address)
         refused = _refused(address)  # known at once: Dask would retry for its whole timeout
         if refused is not None:
-            raise OSError(f"cannot connect to the Dask scheduler at {address}: {refused}")
+            raise OSError(f"cannot connect to the Dask scheduler at {named}: {refused}")
         quiet = contextlib.ExitStack()
         try:
             connected = _new_client(address)  # timeout: distributed.comm.timeouts.connect
@@ -377,7 +378,7 @@ def dask_client(
             # worker: a TypeError); one not reached at all (an OSError) is not asked again
             other = None if isinstance(exc, OSError) else _dask_server(address)
             problem = other or _connect_problem(address, exc)
-            raise OSError(f"cannot connect to the Dask scheduler at {address}: {problem}") from None
+            raise OSError(f"cannot connect to the Dask scheduler at {named}: {problem}") from None
         with quiet, connected as c:  # `quiet` ends after the client is closed
             check_pftrack(c, address)
             _register(c, SingleThreaded(), address)
@@ -1064,6 +1065,21 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     if address is None or address == "":
         return None
     return check_scheduler_address(address, "$DASK_SCHEDULER_ADDRESS (Dask's scheduler-address)")
+
+
+def _from_setting(address: str) -> str:
+    """`address`, Dask's ``scheduler-address`` setting, with where it comes from.
+
+    For the errors of a scheduler that cannot be reached: a user trial's ``pftrack batch``
+    without ``--scheduler`` said "cannot connect to the Dask scheduler at
+    tcp://127.0.0.1:8797", an address given nowhere on its command line.
+    """
+    where = (
+        "$DASK_SCHEDULER_ADDRESS"
+        if os.environ.get("DASK_SCHEDULER_ADDRESS")
+        else "Dask's scheduler-address setting, in a Dask configuration file"
+    )
+    return f"{address} (from {where}: unset it to run on a local cluster)"
 
 
 #: Dask's comm protocols whose addresses are ``PROTOCOL://HOST:PORT``. ``tls`` and ``wss``
@@ -2153,7 +2169,7 @@ def run_jobs(
     # noting its exit, left them open for the garbage collector to close (see _new_client)
     on: contextlib.AbstractContextManager[Client | None] = contextlib.nullcontext()
     if on_dask and (client is not None or address):
-        on = dask_client(client, address)
+        on = dask_client(client, scheduler)  # None: the setting's address, named as such
     elif on_dask:  # a local cluster: no idle worker to start
         n = n_workers if n_workers is not None else usable_cpus()
         on = dask_client(n_workers=min(n, len(pending)))
