@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import re
 import socket
 import sys
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -137,3 +139,49 @@ def test_an_unreachable_scheduler_from_the_environment_is_said_to_come_from_it(
         "on a local cluster)"
     )
     assert str(raised.value) == refused.format(said)
+
+
+def test_workers_or_a_scheduler_back_after_the_warning_are_said(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The trial: both workers killed, ``the scheduler ... has lost all its workers; waiting up
+    to 30 s for one``, then two new workers, and nothing more was said until the table: the
+    batch might as well have been stuck. Now it says when they come back, as when the
+    scheduler answers again after it said it had not. Counted here as the scheduler would."""
+    from pftrack.batch import engine
+
+    monkeypatch.setattr(engine, "WORKERS_POLL", 0.0)  # the watch counts at every call
+    answers: Iterator[int | None] = iter([2, 0, 0, None, 1, 2])
+
+    def n_workers(c: Any, timeout: float | None = None) -> int:
+        n = next(answers)
+        if n is None:
+            raise TimeoutError("no answer")
+        return n
+
+    monkeypatch.setattr(engine, "_n_workers", n_workers)
+    address = "tcp://127.0.0.1:8799"
+    watch = engine._WorkersWatch(None, address, 60.0)  # type: ignore[arg-type]
+    said = []
+    for _ in range(6):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            assert not watch.given_up()
+        said.append([re.sub(r"after \d+ s", "after N s", str(w.message)) for w in caught])
+    assert said == [
+        [],
+        [
+            f"the scheduler at {address} has lost all its workers; waiting up to 60 s for one "
+            f"(start one: dask worker {address})"
+        ],
+        [],
+        [
+            f"the scheduler at {address} has not answered for 5 s (frozen or overloaded?); "
+            "waiting up to 60 s for it"
+        ],
+        [
+            f"the scheduler at {address} answers again after N s; the batch goes on",
+            f"the scheduler at {address} has 1 worker again after N s; the batch goes on",
+        ],
+        [],
+    ]

@@ -2566,7 +2566,8 @@ class _WorkersWatch:
         """True once the cluster has had no worker for `wait` seconds (warns when they go).
 
         True too once the scheduler has not answered for `wait` seconds (warns once it has
-        not answered for :data:`ANSWER_WAIT`).
+        not answered for :data:`ANSWER_WAIT`). Warns too when workers come back, or the
+        scheduler answers, after such a warning: the batch goes on.
         """
         now = time.monotonic()
         if now - self._checked < WORKERS_POLL:
@@ -2588,8 +2589,20 @@ class _WorkersWatch:
                 )
             self.frozen = time.monotonic() - self.silent >= self.wait
             return self.frozen
+        if self.silent is not None:  # said it was silent: say it answers (a trial)
+            warnings.warn(
+                f"the scheduler at {self.address} answers again after {now - self.silent:.0f} s; "
+                "the batch goes on",
+                stacklevel=2,
+            )
         self.silent = None
         if n:
+            if self.since is not None:  # said they were lost: say the batch goes on (a trial)
+                warnings.warn(
+                    f"the scheduler at {self.address} has {counted(n, 'worker')} again after "
+                    f"{now - self.since:.0f} s; the batch goes on",
+                    stacklevel=2,
+                )
             self.since = None
             return False
         if self.since is None:
