@@ -1,7 +1,8 @@
 """What a camera-network user's trial of ``pftrack batch --scheduler`` found (issue 16).
 
 A real ``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1, a folder of 31 mixed
-inputs: what it found and was mended is tested here, each case on a real cluster.
+inputs: what it found and was mended is tested here, on a real cluster where the case needs
+one (the watch of the workers is given the scheduler's counts).
 """
 
 from __future__ import annotations
