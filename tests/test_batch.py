@@ -3817,11 +3817,15 @@ def test_a_scheduler_frozen_mid_run_fails_the_tasks_left(
         f"the scheduler at {address} did not answer for 1 s (frozen or overloaded) before this "
         "file finished (a re-run does the rest)"
     }
-    # a loaded machine's scheduler may also be slow once before the freeze: said again then
-    assert {str(w.message) for w in said} == {
+    # a loaded machine's scheduler may also be slow once before the freeze: said again then,
+    # and that it answered again in between
+    slow = (
         f"the scheduler at {address} has not answered for 0.5 s (frozen or overloaded?); "
         "waiting up to 1 s for it"
-    }
+    )
+    back = f"the scheduler at {address} answers again after N s; the batch goes on"
+    assert slow in {str(w.message) for w in said}
+    assert {re.sub(r"after \d+ s", "after N s", str(w.message)) for w in said} <= {slow, back}
 
 
 def _lost_once(monkeypatch: pytest.MonkeyPatch, marker: str) -> set[str]:

@@ -366,9 +366,10 @@ def dask_client(
         yield client
         return
     if address:
+        named = address if scheduler is not None else _from_setting(address)
         refused = _refused(address)  # known at once: Dask would retry for its whole timeout
         if refused is not None:
-            raise OSError(f"cannot connect to the Dask scheduler at {address}: {refused}")
+            raise OSError(f"cannot connect to the Dask scheduler at {named}: {refused}")
         quiet = contextlib.ExitStack()
         try:
             connected = _new_client(address)  # timeout: distributed.comm.timeouts.connect
@@ -377,7 +378,7 @@ def dask_client(
             # worker: a TypeError); one not reached at all (an OSError) is not asked again
             other = None if isinstance(exc, OSError) else _dask_server(address)
             problem = other or _connect_problem(address, exc)
-            raise OSError(f"cannot connect to the Dask scheduler at {address}: {problem}") from None
+            raise OSError(f"cannot connect to the Dask scheduler at {named}: {problem}") from None
         with quiet, connected as c:  # `quiet` ends after the client is closed
             check_pftrack(c, address)
             _register(c, SingleThreaded(), address)
@@ -923,6 +924,34 @@ def _silenced(*names: str) -> Iterator[None]:
             lg.disabled = was
 
 
+class _Dropped(logging.Filter):
+    """Drops the records whose message (its format) begins with one of `prefixes`."""
+
+    def __init__(self, *prefixes: str) -> None:
+        super().__init__()
+        self.prefixes = prefixes
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not str(record.msg).startswith(self.prefixes)
+
+
+#: What Dask's client logs, as a warning, when the worker that held a finished task's result
+#: died before the result was taken: the batch computes it again and waits (:func:`_taken`).
+_RESULT_LOST = "Couldn't gather"
+
+
+@contextlib.contextmanager
+def _dropped(name: str, *prefixes: str) -> Iterator[None]:
+    """The logger `name` drops the records that begin with one of `prefixes` meanwhile."""
+    logger = logging.getLogger(name)
+    drop = _Dropped(*prefixes)
+    logger.addFilter(drop)
+    try:
+        yield
+    finally:
+        logger.removeFilter(drop)
+
+
 @contextlib.contextmanager
 def _main_left_out() -> Iterator[None]:
     """Worker processes spawned meanwhile do not import this process's main module.
@@ -1036,6 +1065,21 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     if address is None or address == "":
         return None
     return check_scheduler_address(address, "$DASK_SCHEDULER_ADDRESS (Dask's scheduler-address)")
+
+
+def _from_setting(address: str) -> str:
+    """`address`, Dask's ``scheduler-address`` setting, with where it comes from.
+
+    For the errors of a scheduler that cannot be reached: a user trial's ``pftrack batch``
+    without ``--scheduler`` said "cannot connect to the Dask scheduler at
+    tcp://127.0.0.1:8797", an address given nowhere on its command line.
+    """
+    where = (
+        "$DASK_SCHEDULER_ADDRESS"
+        if os.environ.get("DASK_SCHEDULER_ADDRESS")
+        else "Dask's scheduler-address setting, in a Dask configuration file"
+    )
+    return f"{address} (from {where}: unset it to run on a local cluster)"
 
 
 #: Dask's comm protocols whose addresses are ``PROTOCOL://HOST:PORT``. ``tls`` and ``wss``
@@ -2125,7 +2169,7 @@ def run_jobs(
     # noting its exit, left them open for the garbage collector to close (see _new_client)
     on: contextlib.AbstractContextManager[Client | None] = contextlib.nullcontext()
     if on_dask and (client is not None or address):
-        on = dask_client(client, address)
+        on = dask_client(client, scheduler)  # None: the setting's address, named as such
     elif on_dask:  # a local cluster: no idle worker to start
         n = n_workers if n_workers is not None else usable_cpus()
         on = dask_client(n_workers=min(n, len(pending)))
@@ -2135,6 +2179,10 @@ def run_jobs(
             if c is not None:
                 remote = True
                 unusable = stack.enter_context(_setup_failures(c))  # as soon as connected
+                # a result lost with its worker is computed again and waited for (_taken): not
+                # said in Dask's words, "Couldn't gather 1 keys, rescheduling (KEY,)", which a
+                # user trial saw on stderr among the batch's lines after a worker's kill -9
+                stack.enter_context(_dropped("distributed.client", _RESULT_LOST))
                 info = c.scheduler_info()
                 reported = str(info.get("address")) if info.get("address") else None
                 summary.scheduler = address or reported  # the user's spelling of the address
@@ -2518,7 +2566,8 @@ class _WorkersWatch:
         """True once the cluster has had no worker for `wait` seconds (warns when they go).
 
         True too once the scheduler has not answered for `wait` seconds (warns once it has
-        not answered for :data:`ANSWER_WAIT`).
+        not answered for :data:`ANSWER_WAIT`). Warns too when workers come back, or the
+        scheduler answers, after such a warning: the batch goes on.
         """
         now = time.monotonic()
         if now - self._checked < WORKERS_POLL:
@@ -2540,8 +2589,20 @@ class _WorkersWatch:
                 )
             self.frozen = time.monotonic() - self.silent >= self.wait
             return self.frozen
+        if self.silent is not None:  # said it was silent: say it answers (a trial)
+            warnings.warn(
+                f"the scheduler at {self.address} answers again after {now - self.silent:.0f} s; "
+                "the batch goes on",
+                stacklevel=2,
+            )
         self.silent = None
         if n:
+            if self.since is not None:  # said they were lost: say the batch goes on (a trial)
+                warnings.warn(
+                    f"the scheduler at {self.address} has {counted(n, 'worker')} again after "
+                    f"{now - self.since:.0f} s; the batch goes on",
+                    stacklevel=2,
+                )
             self.since = None
             return False
         if self.since is None:

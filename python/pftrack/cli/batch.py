@@ -6,9 +6,10 @@ Dask is imported only when a batch runs, never for ``--help``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -194,12 +195,36 @@ def add_parser(sub: Any) -> None:
 _DASK = ("dask", "distributed")
 
 
+@contextlib.contextmanager
+def _environment_scheduler() -> Iterator[None]:
+    """Dask's ``scheduler-address`` setting is ``$DASK_SCHEDULER_ADDRESS`` as it is now.
+
+    The batch reads the setting itself, so that an address given by no option is said to come
+    from it where it cannot be reached (a user trial: "cannot connect to the Dask scheduler at
+    tcp://127.0.0.1:8797", an address on no command line). Dask reads the variable once, as it
+    is imported: a caller of :func:`pftrack.cli.main` that set it later is read here. Harmless
+    with ``--scheduler`` or ``--workers``, which the batch takes before the setting.
+    """
+    address = os.environ.get("DASK_SCHEDULER_ADDRESS")
+    if not address:
+        yield
+        return
+    try:
+        import dask
+    except ImportError:  # the batch says how to install it, if it needs it
+        yield
+        return
+    with dask.config.set({"scheduler-address": address}):
+        yield
+
+
 def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
     """Run the batch; print its table, or what stopped it; return the exit status."""
     from pftrack.batch.engine import named_as_options
 
     try:
-        with named_as_options():  # --out, --render; from Python: out_dir, options.render
+        # --out, --render; from Python: out_dir, options.render
+        with named_as_options(), _environment_scheduler():
             summary = call()
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
@@ -244,9 +269,8 @@ def _where(args: argparse.Namespace) -> dict[str, Any]:
             )
         where["scheduler"] = check_scheduler_address(args.scheduler, "--scheduler")
     elif args.workers is None and os.environ.get("DASK_SCHEDULER_ADDRESS"):
-        where["scheduler"] = check_scheduler_address(
-            os.environ["DASK_SCHEDULER_ADDRESS"], "$DASK_SCHEDULER_ADDRESS"
-        )
+        # checked here, read by the batch as Dask's setting: errors then say where it came from
+        check_scheduler_address(os.environ["DASK_SCHEDULER_ADDRESS"], "$DASK_SCHEDULER_ADDRESS")
     return where
 
 
