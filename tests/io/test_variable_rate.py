@@ -14,7 +14,7 @@ import pytest
 
 from pftrack.cli import main
 from pftrack.io.mot import write_mot
-from pftrack.io.video import FrameSource
+from pftrack.io.video import UNEVEN_FIRST_CHECK, FrameSource
 from pftrack.synthetic import Scene, make_scene
 from tests.io.test_estimated_count import write_vfr
 
@@ -71,3 +71,30 @@ def test_track_says_it_once(
                  "--out", str(tmp_path / "t.txt"), "--particles", "30"])  # fmt: skip
     assert code == 0
     assert capsys.readouterr().err.count("variable frame rate") == 1
+
+
+def test_it_is_said_as_soon_as_the_stamps_show_it_with_their_figures(tmp_path: Path) -> None:
+    """Said once 50 frames were read, naming them (was: once the whole file was, a long video's
+    whole run without a word), not again at the end."""
+    long = make_scene(120, 96, 64, n_walkers=1, rng=2)
+    video = write_vfr(tmp_path / "vfr.mp4", long, [100, 200] * 60)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        for n, _ in enumerate(FrameSource(video), start=1):
+            if n == UNEVEN_FIRST_CHECK:
+                assert len(said) == 1  # at the frame that showed it
+    (message,) = [str(w.message) for w in said]
+    assert f"its first {UNEVEN_FIRST_CHECK} frames are 100 to 200 ms apart" in message
+
+
+def test_a_rate_that_varies_later_is_said_with_the_whole_files_figures(tmp_path: Path) -> None:
+    """Even for its first 50 frames, uneven after: said at the end, of all its frames."""
+    long = make_scene(90, 96, 64, n_walkers=1, rng=2)
+    video = write_vfr(tmp_path / "late.mp4", long, [100] * 60 + [100, 300] * 15)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        for n, _ in enumerate(FrameSource(video), start=1):
+            if n == 89:
+                assert not said
+    (message,) = [str(w.message) for w in said]
+    assert "variable frame rate: its frames are 100 to 300 ms apart (median 100 ms)" in message

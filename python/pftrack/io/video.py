@@ -160,6 +160,10 @@ UNEVEN_STEP = 0.25
 UNEVEN_MS = 1.5
 #: The share of uneven steps that makes a variable frame rate (one dropped frame in 40 does not).
 UNEVEN_SHARE = 0.05
+#: Frames whose time stamps are first looked at for a variable frame rate while a video is read
+#: (:meth:`FrameSource._warn_uneven`), then twice as many, and so on: said a few seconds in, not
+#: once the whole file was read (at 50, 100, 200, ... frames: a bounded cost, the same rule).
+UNEVEN_FIRST_CHECK = 50
 
 
 def _uneven_steps(stamps: Sequence[float]) -> tuple[float, float, float] | None:
@@ -1531,8 +1535,10 @@ class FrameSource:
         pixels clipped to white). When an ``.avi`` is opened whose chunks break off inside it
         (:func:`_avi_break`): the frames after the break may carry earlier frames' numbers.
         When a video file of several video streams is opened (:func:`_several_video_streams`): the
-        first is read. Once, when a video read to its end has clearly uneven time stamps and
-        a rate from the file (:func:`_uneven_steps`): a variable frame rate read as one.
+        first is read. Once, when a video with a rate from the file has clearly uneven time
+        stamps (:func:`_uneven_steps`), a variable frame rate read as one: as soon as its first
+        :data:`UNEVEN_FIRST_CHECK` frames show it (then 100, 200, ...), else once it was read to
+        its end.
 
     Notes
     -----
@@ -2118,12 +2124,16 @@ class FrameSource:
         start = 0  # the first frame's stamp, in frames (PETS09's is 2)
         lost: list[int] = []
         stamps: list[float] = []  # of the frames decoded, in ms (_uneven_steps)
+        check = UNEVEN_FIRST_CHECK  # the stamps looked at for a variable rate at this many
         last: NDArray[np.uint8] | None = None
         try:
             while True:
                 ok, frame = cap.read()
                 if ok:
                     stamps.append(float(cap.get(cv2.CAP_PROP_POS_MSEC)))
+                    if len(stamps) == check and not self._warned_uneven:
+                        check *= 2  # as soon as the stamps show it, not at the end only
+                        self._warn_uneven(stamps, whole=False)
                 # a frame's number is its place in the decoded order, as a detector's loop
                 # counts it; the stamps only say, after a frame that fails, where to go on
                 if ok and timed:
@@ -2162,22 +2172,30 @@ class FrameSource:
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded)
         if not self._warned_uneven:
-            self._warn_uneven(stamps)
+            self._warn_uneven(stamps, whole=True)
 
-    def _warn_uneven(self, stamps: list[float]) -> None:
-        """Warn, once, if a video read to its end has a variable frame rate (:func:`_uneven_steps`).
+    def _warn_uneven(self, stamps: list[float], *, whole: bool) -> None:
+        """Warn, once, if a video's time stamps show a variable frame rate (:func:`_uneven_steps`).
 
-        Only when its rate came from the file (or the default): a rate given or a sequence's is
-        the one its frames are meant to have.
+        `stamps` are those of its first frames (`whole` False: :data:`UNEVEN_FIRST_CHECK`, then
+        twice as many, ... while it is read; the message gives their figures, ``its first 50
+        frames are ...``), or of all its frames once read to its end, which decide. Only when
+        its rate came from the file (or the default): a rate given or a sequence's is the one
+        its frames are meant to have.
         """
-        self._warned_uneven = True  # the stamps of one whole read decide, once
+        if self.fps_origin in ("given", "seqinfo.ini"):
+            self._warned_uneven = True  # nothing to say, whatever the stamps
+            return
         uneven = _uneven_steps(stamps)
-        if uneven is None or self.fps_origin in ("given", "seqinfo.ini"):
+        if whole or uneven is not None:
+            self._warned_uneven = True  # said, or the stamps of one whole read decided: once
+        if uneven is None:
             return
         lo, median, hi = uneven
+        which = "frames" if whole else f"first {len(stamps)} frames"
         origin = {"container": "the header's", "time stamps": "from its first frames' stamps"}
         warnings.warn(
-            f"{self.path}: variable frame rate: its frames are {lo:.3g} to {hi:.3g} ms apart "
+            f"{self.path}: variable frame rate: its {which} are {lo:.3g} to {hi:.3g} ms apart "
             f"(median {median:.3g} ms), but it is read at one rate, {self.fps:g} fps "
             f"({origin.get(self.fps_origin, self.fps_origin)}): a video rendered from it plays "
             "its frames evenly spaced at that rate, and the tracker takes each step between "
