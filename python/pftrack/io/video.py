@@ -1578,6 +1578,7 @@ class FrameSource:
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
         self._warned_lost = False  # frames inside the video could not be decoded
+        self._warned_lead = False  # its first frames could not be decoded (_warn_lead)
         self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
         self._reading = False  # a thread is inside the live capture's read()
@@ -1781,6 +1782,20 @@ class FrameSource:
                 )
             ok, first = cap.read() if cap.isOpened() else (False, None)
             fps = float(cap.get(cv2.CAP_PROP_FPS)) if cap.isOpened() else 0.0
+            for _ in range(RESUME_TRIES if cap.isOpened() and not ok else 0):
+                # its first frames damaged (a key frame overwritten): FFmpeg decodes on from
+                # the next key frame, black frames standing in before it (_iter_stored); was
+                # "not a video OpenCV can read", of a file whose later frames all decode
+                ok, first = cap.read()
+                if ok:
+                    if not fps > 0:  # no rate: which frame it is cannot be told
+                        raise ValueError(
+                            f"cannot decode the first frames of {path} (damaged?): later "
+                            "frames decode, but without a frame rate in its header their "
+                            "numbers are not known; re-encode the video from its first "
+                            "frame that decodes"
+                        )
+                    break
             count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
             # the display matrix OpenCV applies (CAP_PROP_ORIENTATION_AUTO is on by default)
             turn = int(cap.get(cv2.CAP_PROP_ORIENTATION_META)) if cap.isOpened() else 0
@@ -2121,7 +2136,7 @@ class FrameSource:
         decoded = 0  # frames yielded, stand-ins included: the next frame's index
         rate = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
         timed = rate > 0  # the frames' time stamps give their indexes, so far
-        start = 0  # the first frame's stamp, in frames (PETS09's is 2)
+        start = 0  # the first frame's stamp, in frames (PETS09's is 2; 0 if it fails)
         lost: list[int] = []
         stamps: list[float] = []  # of the frames decoded, in ms (_uneven_steps)
         check = UNEVEN_FIRST_CHECK  # the stamps looked at for a variable rate at this many
@@ -2143,14 +2158,18 @@ class FrameSource:
                     elif stamp - start != decoded:
                         timed = False  # not a constant-rate file: no resuming after damage
                 if not ok:
-                    if not timed or last is None or decoded >= self.n_frames:
+                    if not timed or decoded >= self.n_frames:
                         break
                     resumed = _resume(cap, rate, start, decoded, self.n_frames)
                     if resumed is None:
                         break
                     index, frame = resumed
-                    for i in range(decoded, index):  # the damaged frames: the last good one
-                        lost.append(i)
+                    if last is None:  # its first frames: a black frame stands in for each
+                        last = np.zeros_like(self._resize(frame))
+                        self._warn_lead(index)
+                    else:
+                        lost.extend(range(decoded, index))
+                    for _ in range(decoded, index):  # the damaged frames: the last good one
                         decoded += 1
                         yield last
                 decoded += 1
@@ -2173,6 +2192,20 @@ class FrameSource:
             self._warn_frame_count(decoded)
         if not self._warned_uneven:
             self._warn_uneven(stamps, whole=True)
+
+    def _warn_lead(self, index: int) -> None:
+        """Warn, once, that the first `index` frames could not be decoded (stand-ins given)."""
+        if self._warned_lead:
+            return
+        self._warned_lead = True
+        warnings.warn(
+            f"{self.path}: {_frame_list(list(range(index)))} could not be decoded (a damaged "
+            f"start?): a black frame stands in for each (the detector learns nothing from "
+            f"one), so frame {index + 1}, the first that decodes, and the later frames keep "
+            "their numbers (by their time stamps)",
+            UserWarning,
+            stacklevel=3,
+        )
 
     def _warn_uneven(self, stamps: list[float], *, whole: bool) -> None:
         """Warn, once, if a video's time stamps show a variable frame rate (:func:`_uneven_steps`).
