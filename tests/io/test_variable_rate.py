@@ -8,8 +8,10 @@ frames evenly spaced, and the tracker takes every step between frames as one: wi
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from pftrack.cli import main
@@ -98,3 +100,25 @@ def test_a_rate_that_varies_later_is_said_with_the_whole_files_figures(tmp_path:
                 assert not said
     (message,) = [str(w.message) for w in said]
     assert "variable frame rate: its frames are 100 to 300 ms apart (median 100 ms)" in message
+
+
+def test_track_says_it_while_tracking_not_after(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``pftrack track`` printed the warnings raised while tracking once the run was over (an
+    hour's video: an hour late); each is now printed as it is raised."""
+    long = make_scene(120, 96, 64, n_walkers=1, rng=2)
+    video = write_vfr(tmp_path / "vfr.mp4", long, [100, 200] * 60)
+    seen: list[str] = []  # stderr by the 60th frame read
+    iterate = FrameSource.__iter__
+
+    def watched(self: FrameSource) -> Iterator[np.ndarray]:
+        for n, frame in enumerate(iterate(self), start=1):
+            if n == 60 and not seen:
+                seen.append(capsys.readouterr().err)
+            yield frame
+
+    monkeypatch.setattr(FrameSource, "__iter__", watched)
+    assert main(["-q", "track", str(video), "--out", str(tmp_path / "t.txt")]) == 0
+    assert seen and seen[0].count("variable frame rate: its first 50 frames") == 1
+    assert "variable frame rate" not in capsys.readouterr().err  # not again at the end

@@ -145,10 +145,16 @@ def _one_line_warning(prog: str) -> Callable[..., None]:
     """A ``warnings.showwarning`` printing ``PROG: warning: ...`` (no source line).
 
     `prog` names the command as its parser does: ``pftrack track``, ``pftrack experiment gaps``.
+    Above a progress bar being drawn (tqdm's ``write``), not through it.
     """
 
     def show(message: Warning | str, *_: object, **__: object) -> None:
-        print(f"{prog}: warning: {_shown(str(message))}", file=sys.stderr)
+        line = f"{prog}: warning: {_shown(str(message))}"
+        tqdm = sys.modules.get("tqdm")  # imported only when a bar is drawn
+        if tqdm is not None:
+            tqdm.tqdm.write(line, file=sys.stderr)
+        else:
+            print(line, file=sys.stderr)
 
     return show
 

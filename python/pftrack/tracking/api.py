@@ -800,7 +800,7 @@ class Tracker:
                 "blocky",
                 f"the frames are heavily compressed: the edges of their 8x8 blocks are "
                 f"{np.median(self._blocking):.1f} times as strong as the steps inside them "
-                "(1 without blocks; 2 and more at JPEG quality 10 or a bitrate as low): the "
+                "(1 without blocks; 2 and more at JPEG quality 10 and below): the "
                 "built-in detector takes block edges for change and misses people (PETS09 and "
                 "TUD-Campus re-saved at JPEG quality 10: MOTA 83 -> 78 and 46 -> 26, 3 seeds); "
                 "track a less compressed copy, or give detections of a detector of your own",
