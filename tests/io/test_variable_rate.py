@@ -122,3 +122,25 @@ def test_track_says_it_while_tracking_not_after(
     assert main(["-q", "track", str(video), "--out", str(tmp_path / "t.txt")]) == 0
     assert seen and seen[0].count("variable frame rate: its first 50 frames") == 1
     assert "variable frame rate" not in capsys.readouterr().err  # not again at the end
+
+
+def test_a_warning_into_a_closed_stderr_costs_no_output(tmp_path: Path) -> None:
+    """Printed while tracking, a warning into a pipe whose reader left (``2>&1 | head -1``
+    after its line) must not end the run: the tracks are written all the same."""
+    import os
+    import subprocess
+    import sys
+
+    long = make_scene(60, 96, 64, n_walkers=1, rng=2)
+    video = write_vfr(tmp_path / "vfr.mp4", long, [100, 200] * 30)
+    argv = [sys.executable, "-m", "pftrack", "-q", "track", str(video), "--particles", "30"]
+    read, write = os.pipe()
+    os.close(read)  # closed before the command writes
+    try:
+        run = subprocess.run([*argv, "--out", str(tmp_path / "closed.txt")], stderr=write,
+                             stdout=subprocess.DEVNULL, check=False, timeout=300)  # fmt: skip
+    finally:
+        os.close(write)
+    assert run.returncode == 0
+    assert main([*argv[3:], "--out", str(tmp_path / "open.txt")]) == 0
+    assert (tmp_path / "closed.txt").read_bytes() == (tmp_path / "open.txt").read_bytes() != b""
