@@ -2318,6 +2318,24 @@ def test_render_writes_a_video_per_sequence_and_counts_for_resume(
     )
 
 
+def test_render_reads_the_source_tracked_and_says_its_warnings_once(tmp_path: Path) -> None:
+    """A video shorter than its header says, tracked and rendered: one warning (was two, the
+    render pass's own FrameSource saying in other words what the tracking pass had said: "its
+    header says 60 frames but it holds 30 (counted)", then "ended after 30 frames")."""
+    cut = tmp_path / "in" / "cut.avi"
+    whole = make_scene(n_frames=60, width=160, height=120, n_walkers=2, rng=1).write_video(
+        tmp_path / "whole.avi"
+    )
+    cut.parent.mkdir()
+    cut.write_bytes(whole.read_bytes()[: whole.stat().st_size // 2])  # its header: 60 frames
+    options = TrackOptions(config=_config(), render=".mp4")
+    (entry,) = track_many(cut.parent, tmp_path / "out", options=options, n_workers=0).entries
+    assert entry["status"] == "done"
+    (said,) = [w for w in entry["warnings"] if str(cut) in w]
+    assert f"{cut}: its header says 60 frames but it holds {entry['frames']} (counted)" in said
+    assert len(FrameSource(tmp_path / "out" / "cut.mp4")) == entry["frames"]
+
+
 def test_render_into_the_input_folder_can_be_re_run(
     data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

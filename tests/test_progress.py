@@ -126,3 +126,25 @@ def test_bar_is_drawn_on_a_terminal_of_any_size(
 
 def test_screen_shape_of_an_unset_terminal_is_unknown() -> None:
     assert _progress.screen_shape(io.StringIO()) == (None, None)  # not a terminal
+
+
+def test_a_warning_during_a_bar_is_written_above_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The commands print warnings as they are raised (``pftrack track`` too, since it no
+    longer holds them to the end of the run): with a bar drawn, on a line of their own above
+    it, not inside the bar's line."""
+    import warnings
+
+    from pftrack.cli import _one_line_warning
+
+    err = io.StringIO()
+    err.isatty = lambda: True  # type: ignore[method-assign]
+    monkeypatch.setattr(sys, "stderr", err)
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = _one_line_warning("pftrack track")
+        for i in progress(range(3), desc="work"):
+            if i == 1:
+                warnings.warn("odd frame", UserWarning, stacklevel=1)
+    lines = err.getvalue().replace("\r", "\n").splitlines()
+    assert "pftrack track: warning: odd frame" in lines  # a whole line of its own

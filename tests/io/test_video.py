@@ -1585,3 +1585,52 @@ def test_frames_read_at_chosen_indices_of_a_damaged_video_are_the_iterated_ones(
     with FrameSequence(damaged) as seq:
         for k in (3, 9, 12, 29, 5, 20):  # in order, and back again
             np.testing.assert_array_equal(seq[k], frames[k])
+
+
+def _damaged_start(path: Path) -> Path:
+    """`path` with the first frame's data overwritten (the first chunk or sample read)."""
+    data = bytearray(path.read_bytes())
+    if path.suffix == ".avi":  # the first chunk of frame data: "00dc", its size, the data
+        at = data.index(b"00dc", data.index(b"movi")) + 8
+    else:  # the samples' box: "mdat", then the first NAL unit's size and data
+        at = data.index(b"mdat") + 4
+    data[at : at + 400] = np.random.default_rng(1).bytes(400)
+    damaged = path.with_name(f"damaged{path.suffix}")
+    damaged.write_bytes(bytes(data))
+    return damaged
+
+
+@pytest.mark.parametrize(("suffix", "lost"), [(".avi", 1), (".mp4", 10)])
+def test_a_video_whose_first_frames_fail_is_read_from_the_first_that_decodes(
+    tmp_path: Path, suffix: str, lost: int
+) -> None:
+    """A user trial: a video whose first frame is damaged (its first key frame, in H.264 the
+    frames up to the next) was "not a video OpenCV can read, or empty", of a file whose later
+    frames all decode. Now black frames stand in for those that fail (the detector learns
+    nothing from a black frame), and the later frames keep their numbers."""
+    scene = make_scene(n_frames=30, width=160, height=120, rng=0)
+    if suffix == ".avi":
+        path = scene.write_video(tmp_path / "walk.avi")  # MJPG: every frame a key frame
+    else:
+        path = tmp_path / "walk.mp4"
+        with av.open(str(path), "w") as out:
+            stream = out.add_stream("libx264", rate=10, options={"g": "10", "bf": "0"})
+            stream.width, stream.height, stream.pix_fmt = 160, 120, "yuv420p"
+            for frame in scene.frames:
+                out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
+            out.mux(stream.encode())
+    good = list(FrameSource(path))
+    damaged = _damaged_start(path)
+    source = FrameSource(damaged)
+    said = rf"damaged{suffix}: frames? 1(-{lost})? could not be decoded \(a damaged start\?\)"
+    with pytest.warns(UserWarning, match=said) as caught:
+        frames = list(source)
+    assert len(caught) == 1
+    assert len(frames) == 30
+    assert not any(f.any() for f in frames[:lost])  # black
+    for k in range(lost, 30):
+        np.testing.assert_array_equal(frames[k], good[k])
+    # read at chosen frames (the background's bootstrap) as iterating reads them
+    at = source.frames_at([0, lost, 29])
+    for got, k in zip(at, (0, lost, 29), strict=True):
+        np.testing.assert_array_equal(got, frames[k])

@@ -401,9 +401,10 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
 
         with tempfile.TemporaryDirectory(prefix="pftrack-render-") as tmp:
             target = Path(tmp) / f"{seq.name}{render}"
-            write_annotated_video(
-                target, _checked(FrameSource(seq.frames), stop), written, frames.fps
-            )
+            # the source tracked, read again: what its reading said (a video shorter than its
+            # header, a variable frame rate) is not said twice (was: a second FrameSource,
+            # whose warnings in other words than the first's were listed twice)
+            write_annotated_video(target, _checked(frames, stop), written, frames.fps)
             files[render] = target.read_bytes()
     metrics = trace = None
     if seq.gt is not None:  # last: a ground truth that cannot be scored loses no tracks

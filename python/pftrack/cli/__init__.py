@@ -145,10 +145,24 @@ def _one_line_warning(prog: str) -> Callable[..., None]:
     """A ``warnings.showwarning`` printing ``PROG: warning: ...`` (no source line).
 
     `prog` names the command as its parser does: ``pftrack track``, ``pftrack experiment gaps``.
+    Above a progress bar being drawn (tqdm's ``write``), not through it. Printed while the
+    command works (``track`` prints its warnings as they are raised): a closed stderr (``2>&-``,
+    a pipe whose reader left) costs the message, never the outputs.
     """
 
     def show(message: Warning | str, *_: object, **__: object) -> None:
-        print(f"{prog}: warning: {_shown(str(message))}", file=sys.stderr)
+        line = f"{prog}: warning: {_shown(str(message))}"
+        err = sys.stderr
+        if err is None:  # started with stderr closed (was: the line printed on stdout)
+            return
+        tqdm = sys.modules.get("tqdm")  # imported only when a bar is drawn
+        try:
+            if tqdm is not None:
+                tqdm.tqdm.write(line, file=err)
+            else:
+                print(line, file=err)
+        except (OSError, ValueError):  # a broken pipe, a closed file
+            pass
 
     return show
 

@@ -160,6 +160,10 @@ UNEVEN_STEP = 0.25
 UNEVEN_MS = 1.5
 #: The share of uneven steps that makes a variable frame rate (one dropped frame in 40 does not).
 UNEVEN_SHARE = 0.05
+#: Frames whose time stamps are first looked at for a variable frame rate while a video is read
+#: (:meth:`FrameSource._warn_uneven`), then twice as many, and so on: said a few seconds in, not
+#: once the whole file was read (at 50, 100, 200, ... frames: a bounded cost, the same rule).
+UNEVEN_FIRST_CHECK = 50
 
 
 def _uneven_steps(stamps: Sequence[float]) -> tuple[float, float, float] | None:
@@ -1531,8 +1535,10 @@ class FrameSource:
         pixels clipped to white). When an ``.avi`` is opened whose chunks break off inside it
         (:func:`_avi_break`): the frames after the break may carry earlier frames' numbers.
         When a video file of several video streams is opened (:func:`_several_video_streams`): the
-        first is read. Once, when a video read to its end has clearly uneven time stamps and
-        a rate from the file (:func:`_uneven_steps`): a variable frame rate read as one.
+        first is read. Once, when a video with a rate from the file has clearly uneven time
+        stamps (:func:`_uneven_steps`), a variable frame rate read as one: as soon as its first
+        :data:`UNEVEN_FIRST_CHECK` frames show it (then 100, 200, ...), else once it was read to
+        its end.
 
     Notes
     -----
@@ -1572,6 +1578,7 @@ class FrameSource:
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
         self._warned_lost = False  # frames inside the video could not be decoded
+        self._warned_lead = False  # its first frames could not be decoded (_warn_lead)
         self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
         self._reading = False  # a thread is inside the live capture's read()
@@ -1775,6 +1782,20 @@ class FrameSource:
                 )
             ok, first = cap.read() if cap.isOpened() else (False, None)
             fps = float(cap.get(cv2.CAP_PROP_FPS)) if cap.isOpened() else 0.0
+            for _ in range(RESUME_TRIES if cap.isOpened() and not ok else 0):
+                # its first frames damaged (a key frame overwritten): FFmpeg decodes on from
+                # the next key frame, black frames standing in before it (_iter_stored); was
+                # "not a video OpenCV can read", of a file whose later frames all decode
+                ok, first = cap.read()
+                if ok:
+                    if not fps > 0:  # no rate: which frame it is cannot be told
+                        raise ValueError(
+                            f"cannot decode the first frames of {path} (damaged?): later "
+                            "frames decode, but without a frame rate in its header their "
+                            "numbers are not known; re-encode the video from its first "
+                            "frame that decodes"
+                        )
+                    break
             count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) if cap.isOpened() else 0
             # the display matrix OpenCV applies (CAP_PROP_ORIENTATION_AUTO is on by default)
             turn = int(cap.get(cv2.CAP_PROP_ORIENTATION_META)) if cap.isOpened() else 0
@@ -2115,15 +2136,19 @@ class FrameSource:
         decoded = 0  # frames yielded, stand-ins included: the next frame's index
         rate = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
         timed = rate > 0  # the frames' time stamps give their indexes, so far
-        start = 0  # the first frame's stamp, in frames (PETS09's is 2)
+        start = 0  # the first frame's stamp, in frames (PETS09's is 2; 0 if it fails)
         lost: list[int] = []
         stamps: list[float] = []  # of the frames decoded, in ms (_uneven_steps)
+        check = UNEVEN_FIRST_CHECK  # the stamps looked at for a variable rate at this many
         last: NDArray[np.uint8] | None = None
         try:
             while True:
                 ok, frame = cap.read()
                 if ok:
                     stamps.append(float(cap.get(cv2.CAP_PROP_POS_MSEC)))
+                    if len(stamps) == check and not self._warned_uneven:
+                        check *= 2  # as soon as the stamps show it, not at the end only
+                        self._warn_uneven(stamps, whole=False)
                 # a frame's number is its place in the decoded order, as a detector's loop
                 # counts it; the stamps only say, after a frame that fails, where to go on
                 if ok and timed:
@@ -2133,14 +2158,18 @@ class FrameSource:
                     elif stamp - start != decoded:
                         timed = False  # not a constant-rate file: no resuming after damage
                 if not ok:
-                    if not timed or last is None or decoded >= self.n_frames:
+                    if not timed or decoded >= self.n_frames:
                         break
                     resumed = _resume(cap, rate, start, decoded, self.n_frames)
                     if resumed is None:
                         break
                     index, frame = resumed
-                    for i in range(decoded, index):  # the damaged frames: the last good one
-                        lost.append(i)
+                    if last is None:  # its first frames: a black frame stands in for each
+                        last = np.zeros_like(self._resize(frame))
+                        self._warn_lead(index)
+                    else:
+                        lost.extend(range(decoded, index))
+                    for _ in range(decoded, index):  # the damaged frames: the last good one
                         decoded += 1
                         yield last
                 decoded += 1
@@ -2162,22 +2191,44 @@ class FrameSource:
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded)
         if not self._warned_uneven:
-            self._warn_uneven(stamps)
+            self._warn_uneven(stamps, whole=True)
 
-    def _warn_uneven(self, stamps: list[float]) -> None:
-        """Warn, once, if a video read to its end has a variable frame rate (:func:`_uneven_steps`).
+    def _warn_lead(self, index: int) -> None:
+        """Warn, once, that the first `index` frames could not be decoded (stand-ins given)."""
+        if self._warned_lead:
+            return
+        self._warned_lead = True
+        warnings.warn(
+            f"{self.path}: {_frame_list(list(range(index)))} could not be decoded (a damaged "
+            f"start?): a black frame stands in for each (the detector learns nothing from "
+            f"one), so frame {index + 1}, the first that decodes, and the later frames keep "
+            "their numbers (by their time stamps)",
+            UserWarning,
+            stacklevel=3,
+        )
 
-        Only when its rate came from the file (or the default): a rate given or a sequence's is
-        the one its frames are meant to have.
+    def _warn_uneven(self, stamps: list[float], *, whole: bool) -> None:
+        """Warn, once, if a video's time stamps show a variable frame rate (:func:`_uneven_steps`).
+
+        `stamps` are those of its first frames (`whole` False: :data:`UNEVEN_FIRST_CHECK`, then
+        twice as many, ... while it is read; the message gives their figures, ``its first 50
+        frames are ...``), or of all its frames once read to its end, which decide. Only when
+        its rate came from the file (or the default): a rate given or a sequence's is the one
+        its frames are meant to have.
         """
-        self._warned_uneven = True  # the stamps of one whole read decide, once
+        if self.fps_origin in ("given", "seqinfo.ini"):
+            self._warned_uneven = True  # nothing to say, whatever the stamps
+            return
         uneven = _uneven_steps(stamps)
-        if uneven is None or self.fps_origin in ("given", "seqinfo.ini"):
+        if whole or uneven is not None:
+            self._warned_uneven = True  # said, or the stamps of one whole read decided: once
+        if uneven is None:
             return
         lo, median, hi = uneven
+        which = "frames" if whole else f"first {len(stamps)} frames"
         origin = {"container": "the header's", "time stamps": "from its first frames' stamps"}
         warnings.warn(
-            f"{self.path}: variable frame rate: its frames are {lo:.3g} to {hi:.3g} ms apart "
+            f"{self.path}: variable frame rate: its {which} are {lo:.3g} to {hi:.3g} ms apart "
             f"(median {median:.3g} ms), but it is read at one rate, {self.fps:g} fps "
             f"({origin.get(self.fps_origin, self.fps_origin)}): a video rendered from it plays "
             "its frames evenly spaced at that rate, and the tracker takes each step between "
