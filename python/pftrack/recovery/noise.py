@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 import pftrack._core as _core
 from pftrack._check import MAX_FRAME, brief, integer, number, option, shown
 from pftrack._typing import F64
-from pftrack.recovery.segments import consecutive_runs
+from pftrack.recovery.segments import consecutive_runs, observed_segments
 
 __all__ = ["DEFAULT_NOISE", "MAX_R_RATIO", "MIN_R", "NoiseEstimate", "estimate_noise"]
 
@@ -191,7 +191,36 @@ def estimate_noise(
     -------
     NoiseEstimate
         :data:`DEFAULT_NOISE` when no run is long enough.
+
+    Raises
+    ------
+    TypeError
+        `segments` not a sequence of arrays of real numbers; an option of the wrong type.
+    ValueError
+        A segment :func:`~pftrack.recovery.segments.observed_segments` refuses (one segment
+        given alone, NaN, frames that are not whole or do not increase); an option out of its
+        range.
     """
+    return _estimate_noise(
+        observed_segments(segments, "estimate_noise"),
+        method=method,
+        floor_q=floor_q,
+        floor_r=floor_r,
+        min_points=min_points,
+        scales=scales,
+    )
+
+
+def _estimate_noise(
+    segments: Sequence[ArrayLike],
+    *,
+    method: str = "ml",
+    floor_q: float = 1e-5,
+    floor_r: float = 1e-3,
+    min_points: int = 4,
+    scales: Sequence[int] = (1, 2, 4, 8),
+) -> NoiseEstimate:
+    """:func:`estimate_noise` of segments the recovery checked itself (its runs, its gaps)."""
     option(method, "estimate_noise: method", ("ml", "moments"))
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
