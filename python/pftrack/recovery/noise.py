@@ -149,14 +149,18 @@ def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseE
     return NoiseEstimate(q=(qs[0], qs[1]), r=(rs[0], rs[1]))
 
 
+#: :func:`estimate_noise`'s default floors of ``q`` (px²/frame³) and ``r`` (px²), and scales.
+FLOOR_Q, FLOOR_R, SCALES = 1e-5, 1e-3, (1, 2, 4, 8)
+
+
 def estimate_noise(
     segments: Sequence[ArrayLike],
     *,
     method: str = "ml",
-    floor_q: float = 1e-5,
-    floor_r: float = 1e-3,
+    floor_q: float = FLOOR_Q,
+    floor_r: float = FLOOR_R,
     min_points: int = 4,
-    scales: Sequence[int] = (1, 2, 4, 8),
+    scales: Sequence[int] = SCALES,
 ) -> NoiseEstimate:
     """Estimate the motion noise ``q`` and measurement noise ``r`` per axis from observed data.
 
@@ -201,26 +205,24 @@ def estimate_noise(
         given alone, NaN, frames that are not whole or do not increase); an option out of its
         range.
     """
-    return _estimate_noise(
-        observed_segments(segments, "estimate_noise"),
-        method=method,
-        floor_q=floor_q,
-        floor_r=floor_r,
-        min_points=min_points,
-        scales=scales,
-    )
+    segs = observed_segments(segments, "estimate_noise")
+    return _noise_levels(segs, method, floor_q, floor_r, min_points, scales)
 
 
-def _estimate_noise(
+def _estimate_noise(segments: Sequence[ArrayLike]) -> NoiseEstimate:
+    """:func:`estimate_noise` with its defaults, of segments the recovery checked itself."""
+    return _noise_levels(segments, "ml", FLOOR_Q, FLOOR_R, 4, SCALES)
+
+
+def _noise_levels(
     segments: Sequence[ArrayLike],
-    *,
-    method: str = "ml",
-    floor_q: float = 1e-5,
-    floor_r: float = 1e-3,
-    min_points: int = 4,
-    scales: Sequence[int] = (1, 2, 4, 8),
+    method: str,
+    floor_q: float,
+    floor_r: float,
+    min_points: int,
+    scales: Sequence[int],
 ) -> NoiseEstimate:
-    """:func:`estimate_noise` of segments the recovery checked itself (its runs, its gaps)."""
+    """:func:`estimate_noise` of checked segments: its options checked, the levels fitted."""
     option(method, "estimate_noise: method", ("ml", "moments"))
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")
