@@ -27,9 +27,9 @@ Users
 Every public function checks its noise and variance arguments (``q``, ``r2``, the covariance
 entries, ``dt``: finite, and ``> 0`` or ``>= 0`` as the equations need; a covariance positive
 semi-definite, ``p01² <= p00 p11`` up to round-off), and its result (finite; an update's
-``p00 + r2`` too), with a one-line ValueError, and computes in float64 whatever it is given (lists, float32
-arrays, NumPy scalars; lists failed in the arithmetic, float32 was stepped in float32 until 5
-December). The tracker
+``p00 + r2`` too), with a one-line ValueError, and computes in float64 whatever it is given
+(lists, float32 arrays, NumPy scalars; lists failed in the arithmetic, float32 was stepped in
+float32 until 5 December). The tracker
 runs :func:`cv_predict` and :func:`cv_update` for every track on every frame with values it
 made itself: it calls the unchecked ``_cv_predict``, ``_cv_update`` and ``_cv_update_where``,
 which compute the same floats.

@@ -468,3 +468,31 @@ def test_explain_tells_two_close_errors_apart():
     assert _apart(0.0191234, 0.0193) == ("0.0191", "0.0193")
     assert _apart(1.5, 2.25) == ("1.500", "2.250")
     assert _apart(1.0, 1.0) == ("1.000000000", "1.000000000")
+
+
+@pytest.mark.parametrize(
+    ("method", "who"), [("auto", "recover_auto"), ("linear-nb", "recover_gaps")]
+)
+@pytest.mark.parametrize(
+    ("observed", "match"),
+    [
+        # were taken: each track cut into runs of one point and left out, without a word
+        ([_walk()[::-1]], r"observed\[0\] row 1 has frame 39 after 40: a track's frames must"),
+        ([_walk(), _walk()[:, [2, 0, 1]]], r"observed\[1\] row \d+ has frame -?\d.* after "),
+        ([np.r_[_walk(), _walk()[-1:]]], r"observed\[0\] row 40 has frame 40 after 40: "),
+        (_walk(), r"observed\[0\] has shape \(3,\), .* \(one track given alone\? pass \[track\]\)"),
+    ],
+)
+def test_observed_tracks_whose_frames_do_not_increase_are_refused(method, who, observed, match):
+    a, b = _walk()[:15], _walk()[25:]
+    with pytest.raises(ValueError, match=rf"^{who}: {match}"):
+        recover_gaps([(a, b)], method, observed=observed)
+
+
+def test_observed_tracks_that_are_good_give_what_they_gave():
+    a, b = _walk()[:15], _walk()[25:]
+    others = [_walk(seed=s) for s in range(1, 4)]
+    for method in ("auto", "linear-nb"):
+        want = recover_gaps([(a, b)], method, observed=others)
+        got = recover_gaps([(a, b)], method, observed=[o.tolist() for o in others])
+        np.testing.assert_array_equal(got[0], want[0])

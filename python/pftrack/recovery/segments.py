@@ -260,7 +260,10 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
 
     With `strict` (the caller's name, for the message) nothing is left out silently:
     `observed` must be a sequence of (k, 3+) arrays of real numbers whose frames, x and y are
-    finite, and a TypeError or ValueError names the first entry that is not.
+    finite and whose frames increase strictly (as a segment's, :func:`as_segment`; tracks in
+    decreasing order, with a duplicated row or the frame in another column were cut into runs
+    of one point and left out), and a TypeError or ValueError names the first entry that is
+    not.
     """
     if strict is not None and (
         isinstance(observed, (str, bytes))
@@ -279,9 +282,10 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
         else:
             a = real_array(s, f"{strict}: observed[{k}]")
             if a.ndim != 2 or a.shape[1] < 3:
+                one = " (one track given alone? pass [track])" if a.ndim == 1 else ""
                 raise ValueError(
                     f"{strict}: observed[{k}] has shape {a.shape}, expected (k, 3+) rows "
-                    "frame, x, y"
+                    f"frame, x, y{one}"
                 )
         if a.ndim == 2 and a.shape[1] >= 3 and len(a):
             arrs.append(a[:, :3])
@@ -300,12 +304,35 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
         raise ValueError(
             f"{strict}: observed run {k} has a non-finite frame, x or y: {X[row].tolist()}"
         )
+    if strict is not None:
+        _frames_increase(X[:, 0], bound, arrs, where, strict)
     starts, ends = starts[ok], ends[ok]
     if not len(starts):
         return []
     keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
     _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
     return [X[starts[k] : ends[k]] for k in first]
+
+
+def _frames_increase(
+    f: F64, bound: NDArray[np.bool_], arrs: Sequence[F64], where: Sequence[int], who: str
+) -> None:
+    """Refuse frames that do not increase strictly within their track.
+
+    `f` holds the frames of the arrays `arrs` stacked, `bound` marks each one's first row and
+    `where` their places in `observed`, whose entry the message names. Fractional frames pass:
+    a track on other frame times than the gap's is no neighbour of it, not an error.
+    """
+    bad = ~bound[1:] & (np.diff(f) <= 0)
+    if not bad.any():
+        return
+    row = int(np.argmax(bad)) + 1
+    i = int(np.searchsorted(np.cumsum([len(a) for a in arrs]), row, side="right"))
+    r = row - sum(len(a) for a in arrs[:i])
+    raise ValueError(
+        f"{who}: observed[{where[i]}] row {r} has frame {f[row]:.17g} after {f[row - 1]:.17g}: "
+        "a track's frames must increase strictly (rows frame, x, y, ...)"
+    )
 
 
 def contiguous_tail(seg: F64) -> F64:
