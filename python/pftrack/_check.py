@@ -141,10 +141,12 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
     Raises
     ------
     TypeError
-        Complex numbers, text, or objects that are not numbers; booleans without `booleans`.
+        Complex numbers, text, or objects that are not numbers; booleans without `booleans`;
+        a ``numpy.ma.MaskedArray`` with a masked value (:func:`refuse_masked`).
     ValueError
         Nested sequences of different lengths (ragged rows).
     """
+    refuse_masked(values, what)
     try:
         raw = np.asarray(values)
     except ValueError:  # NumPy: "setting an array element with a sequence ... inhomogeneous"
@@ -156,21 +158,36 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
     return raw.astype(np.float64, copy=False)
 
 
-def refuse_masked_weights(weights: object, fn: str) -> None:
-    """TypeError when `weights` of `fn` is a ``numpy.ma.MaskedArray`` with a masked entry.
+def refuse_masked(
+    values: object,
+    what: str,
+    mend: str = "an array with the values the masked ones stand for (.filled(value)), or "
+    "without them",
+) -> None:
+    """TypeError when `values` (argument `what`) is a ``numpy.ma.MaskedArray`` with a masked entry.
 
-    ``np.asarray`` drops the mask and keeps the values under it: masked particles were
-    resampled and weighed as any other (filterpy fails with an IndexError). Whether a masked
-    weight means 0 or a value to skip is the caller's to say (``weights.filled(0)``); a masked
-    array with nothing masked is its values. Shared by the resamplers and ``estimate``.
+    ``np.asarray`` drops the mask and keeps the values under it, so a masked entry was used
+    as any other: a masked row of a segment recovered from, a masked box or histogram bin
+    counted, a masked pixel binned. What a masked entry stands for (a value, or nothing) is
+    the caller's to say, as `mend` tells them; a masked array with nothing masked is its
+    values. The first check of :func:`real_array`, :func:`bool_array` and :func:`bgr_array`.
     """
-    if isinstance(weights, np.ma.MaskedArray) and np.ma.is_masked(weights):
-        n = int(np.count_nonzero(np.ma.getmaskarray(weights)))
+    if isinstance(values, np.ma.MaskedArray) and np.ma.is_masked(values):
+        n = int(np.count_nonzero(np.ma.getmaskarray(values)))
         raise TypeError(
-            f"{fn}: weights is a numpy.ma.MaskedArray with {counted(n, 'masked value')}, whose "
-            "mask NumPy would drop (the masked values used as they are); pass "
-            "weights.filled(0) to give masked particles weight 0"
+            f"{what} is a numpy.ma.MaskedArray with {counted(n, 'masked value')}, whose mask "
+            f"NumPy would drop (the masked values used as they are); pass {mend}"
         )
+
+
+def refuse_masked_weights(weights: object, fn: str) -> None:
+    """:func:`refuse_masked` for the `weights` of `fn`, whose mend is weight 0.
+
+    Masked particles were resampled and weighed as any other (filterpy fails with an
+    IndexError); ``weights.filled(0)`` gives them weight 0. Shared by the resamplers and
+    ``estimate``.
+    """
+    refuse_masked(weights, f"{fn}: weights", "weights.filled(0) to give masked particles weight 0")
 
 
 #: Columns 7-10 of a MOTChallenge row (conf, x, y, z) where rows have fewer: the values
@@ -337,7 +354,8 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     TypeError
         Not an array of uint8 (float frames; ``None``); not a NumPy array at all (a list, a
         PIL image, named by their type, not by the dtype NumPy gives them: a list of ints is
-        int64, a PIL image uint8 but RGB).
+        int64, a PIL image uint8 but RGB); a ``numpy.ma.MaskedArray`` with a masked pixel
+        (:func:`refuse_masked`: the core would read the pixels under the mask).
     ValueError
         Not of shape (H, W, 3): a grey (2-D or one-channel) or a BGRA frame's message names
         the ``cv2.cvtColor`` conversion that makes it BGR.
@@ -355,6 +373,7 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
             "as cv2 reads it)"
             + ("; a PIL image is RGB: np.asarray(img)[..., ::-1] gives BGR" if pil else "")
         )
+    refuse_masked(frame, what, "a plain array (.filled(0) makes the masked pixels black)")
     f = frame
     if f.dtype != np.uint8:
         raise TypeError(f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
@@ -519,10 +538,12 @@ def bool_array(values: ArrayLike, what: str) -> NDArray[np.bool_]:
     Raises
     ------
     TypeError
-        Text, complex numbers or objects.
+        Text, complex numbers or objects; a ``numpy.ma.MaskedArray`` with a masked value
+        (:func:`refuse_masked`).
     ValueError
         A number other than 0 and 1 (NaN included); the message names the first.
     """
+    refuse_masked(values, what)
     raw = np.asarray(values)
     if raw.dtype == np.bool_:
         return raw

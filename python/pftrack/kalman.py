@@ -27,7 +27,9 @@ Users
 Every public function checks its noise and variance arguments (``q``, ``r2``, the covariance
 entries, ``dt``: finite, and ``> 0`` or ``>= 0`` as the equations need; a covariance positive
 semi-definite, ``p01² <= p00 p11`` up to round-off), and its result (finite; an update's
-``p00 + r2`` too), with a one-line ValueError. The tracker
+``p00 + r2`` too), with a one-line ValueError, and computes in float64 whatever it is given
+(lists, float32 arrays, NumPy scalars; lists failed in the arithmetic, float32 was stepped in
+float32 until 5 December). The tracker
 runs :func:`cv_predict` and :func:`cv_update` for every track on every frame with values it
 made itself: it calls the unchecked ``_cv_predict``, ``_cv_update`` and ``_cv_update_where``,
 which compute the same floats.
@@ -187,6 +189,25 @@ def _require_innovation(fn: str, cov: Cov, r2: Value, where: ArrayLike) -> None:
         )
 
 
+def _float64(value: object) -> Value:
+    """A checked value in float64: a real scalar as a Python float, the rest as an array.
+
+    The public steps compute in float64 whatever they are given, as the tracker's do: a list
+    (``mean=([1, 2], [0, 0])``) was multiplied as a Python list ("can't multiply sequence by
+    non-int of type 'float'", naming nothing), and float32 arrays were stepped in float32.
+    """
+    if isinstance(value, (bool, int, float, np.bool_, np.integer, np.floating)):
+        return float(value)
+    return np.asarray(value, dtype=np.float64)
+
+
+def _state64(mean: Mean, cov: Cov) -> tuple[Mean, Cov]:
+    """`mean` and `cov`, checked by :func:`_require_state`, in float64 (:func:`_float64`)."""
+    m0, m1 = (_float64(v) for v in mean)
+    c0, c1, c2 = (_float64(v) for v in cov)
+    return (m0, m1), (c0, c1, c2)
+
+
 def _finite_result(
     fn: str, what: str, causes: str, step: Callable[..., tuple[Mean, Cov]], *args: object
 ) -> tuple[Mean, Cov]:
@@ -339,7 +360,9 @@ def cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, C
     _require_state(fn, mean, cov, q=q, dt=dt)
     _require(fn, "q", q, ">= 0")
     _require(fn, "dt", dt, ">= 0")
-    return _finite_result(fn, "predicted", "mean, cov, q or dt", _cv_predict, mean, cov, q, dt)
+    m, c = _state64(mean, cov)
+    q, dt = _float64(q), _float64(dt)
+    return _finite_result(fn, "predicted", "mean, cov, q or dt", _cv_predict, m, c, q, dt)
 
 
 def _cv_predict(mean: Mean, cov: Cov, q: Value, dt: Value = 1.0) -> tuple[Mean, Cov]:
@@ -394,7 +417,9 @@ def cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
     _require(fn, "z", z)
     _require(fn, "r2", r2, "> 0")
     _require_innovation(fn, cov, r2, True)
-    return _finite_result(fn, "filtered", "mean, cov, z or r2", _cv_update, mean, cov, z, r2)
+    m, c = _state64(mean, cov)
+    z, r2 = _float64(z), _float64(r2)
+    return _finite_result(fn, "filtered", "mean, cov, z or r2", _cv_update, m, c, z, r2)
 
 
 def _cv_update(mean: Mean, cov: Cov, z: Value, r2: Value) -> tuple[Mean, Cov]:
@@ -435,9 +460,9 @@ def cv_update_where(
         raise ValueError(f"{fn}: z{at} is {zz[k]:g} where `where` holds, expected finite")
     _require(fn, "r2", r2, "> 0")
     _require_innovation(fn, cov, r2, w)
-    return _finite_result(
-        fn, "filtered", "mean, cov, z or r2", _cv_update_where, mean, cov, z, r2, w
-    )
+    m, c = _state64(mean, cov)
+    z, r2 = _float64(z), _float64(r2)
+    return _finite_result(fn, "filtered", "mean, cov, z or r2", _cv_update_where, m, c, z, r2, w)
 
 
 def _cv_update_where(

@@ -466,3 +466,83 @@ def test_mh_step_takes_and_checks_min_samples():
                           min_samples=bad)  # fmt: skip
     out = _core.mh_step(*args, min_samples=3.0)
     assert np.isfinite(out["rho_mean"])
+
+
+def _masked_calls():
+    """(name, call, values, argument): every kernel-level entry point that takes arrays of
+    numbers, `call` giving it `values` as its `argument` and returning an array."""
+    from pftrack import Tracker, fill_gaps, goal_directed_path, recover_gap
+    from pftrack.kalman import rts_smooth
+
+    frame = np.zeros((20, 30, 3), np.uint8)
+    frame[5:15, 10:20] = (0, 0, 255)
+    image = hsv_bins(frame)
+    ref = box_histograms(image, [[15, 10, 10, 10]])[0]
+    eye = np.eye(2)
+    seg_b = [[7, 6, 6], [8, 7, 7.0]]
+    rows = [[f, 1, 2.0 * f, 5, 4, 8, 1, -1, -1, -1] for f in (1, 2, 3, 6, 7)]
+    particles = np.tile([15.0, 10, 1, 15, 10, 1], (4, 1))
+
+    def moved(noise):
+        p = particles.copy()
+        propagate(p, noise)
+        return p
+
+    return [
+        ("hsv_bins", lambda f: hsv_bins(f).bins, frame, "frame"),
+        ("box_histograms", lambda b: box_histograms(image, b), [[15, 10, 10, 10.0]], "boxes"),
+        ("bhattacharyya_coefficient", lambda r: bhattacharyya_coefficient([ref], r), ref, "ref"),
+        ("bhattacharyya_distance", lambda h: bhattacharyya_distance(h, ref), [ref, ref], "hists"),
+        ("bhattacharyya_weights", lambda h: bhattacharyya_weights(h, ref), [ref, ref], "hists"),
+        ("propagate", moved, np.ones((4, 3)), "noise"),
+        ("estimate", lambda p: estimate(p, [1, 2, 3, 4])[0], particles, "particles"),
+        (
+            "ColourParticleFilter",
+            lambda r: ColourParticleFilter([15, 10, 10, 10], r).reference,
+            ref,
+            "reference",
+        ),
+        (
+            "recover_gap",
+            lambda a: recover_gap(a, seg_b, method="linear"),
+            [[1, 0, 0], [2, 1, 1], [3, 2, 2.0]],
+            "segment_a",
+        ),
+        (
+            "rts_smooth",
+            lambda z: rts_smooth(z, [1, 1, 1], [1], [1], velocity_sd=1.0, update_first=True),
+            [[0.0], [1], [2]],
+            "z",
+        ),
+        (
+            "goal_directed_path",
+            lambda m: goal_directed_path(eye, eye, eye, eye, m, eye, [4, 2], 3).path,
+            [0.0, 1.0],
+            "m0",
+        ),
+        ("fill_gaps", lambda r: fill_gaps(r, "linear")[0], rows, "rows"),
+        (
+            "Tracker.update",
+            lambda d: Tracker(seed=0).update(d, frame),
+            [[10, 5, 20, 15, 0.9, 0]],
+            "dets",
+        ),
+    ]
+
+
+@pytest.mark.parametrize("case", _masked_calls(), ids=lambda c: c[0])
+def test_masked_arrays_are_refused_wherever_arrays_are_taken(case):
+    """Was: the mask dropped (np.asarray) and the values under it used, with no word: a
+    masked row of segment_a recovered from (recover_gap's path went through the masked
+    point), a masked box or histogram bin counted, a masked detection tracked. As for the
+    resamplers' weights (above), the caller says what a masked entry stands for."""
+    _, call, values, arg = case
+    a = np.asarray(values)
+    mask = np.zeros(a.shape, bool)
+    mask.flat[-1] = True
+    with pytest.raises(TypeError, match=r"is a numpy\.ma\.MaskedArray with 1 masked value, ") as e:
+        call(np.ma.masked_array(a, mask=mask))
+    assert arg in str(e.value)
+    assert "\n" not in str(e.value)
+    # nothing masked: the array's values, as before
+    np.testing.assert_array_equal(call(np.ma.masked_array(a.copy())), call(a.copy()))

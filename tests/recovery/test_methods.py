@@ -12,6 +12,7 @@ from pftrack.recovery import (
     METHODS,
     estimate_noise,
     fill_gaps,
+    fit_motion,
     goal_directed_path,
     recover_gap,
     recover_gaps,
@@ -102,6 +103,79 @@ def test_gdt_bi_problem_solves_to_the_batch_path():
     np.testing.assert_allclose(p.Pi_T, p.Pi_T.T, atol=0)
     got = recover_gap(a, b, method="gdt-bi", noise=noise)
     np.testing.assert_allclose(p.solve().path[1:-1, :2], got, atol=1e-8)
+
+
+def _walk(n=40, seed=0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(1.0, n + 1)
+    return np.column_stack([t, 3 * t + rng.normal(0, 1, n), 0.05 * t**2 + rng.normal(0, 1, n)])
+
+
+@pytest.mark.parametrize("fit", [estimate_noise, fit_motion])
+@pytest.mark.parametrize(
+    ("segments", "error", "match"),
+    [
+        # one segment given alone: its rows were read as segments and left out
+        (_walk(), ValueError, r"segments is one \(40, 3\) array, .*pass \[segment\] for one"),
+        (list(_walk()), ValueError, r"segments\[0\] has shape \(3,\), .*pass \[segment\]"),
+        ([_walk()[::-1]], ValueError, r"segments\[0\] frames must increase strictly"),
+        ([_walk()[:, [1, 0, 2]]], ValueError, r"segments\[0\] row 0 has frame 3\.\d+, expected"),
+        ([_walk(), np.r_[_walk()[:-1], [[40, np.nan, 0]]]], ValueError, r"segments\[1\] has a non"),
+        ([[["a", "b", "c"]]], TypeError, r"segments\[0\] must hold real numbers"),
+        ("walk.txt", TypeError, "segments must be a sequence of"),
+        (3.0, TypeError, "segments must be a sequence of"),
+    ],
+)
+def test_noise_and_motion_fits_refuse_segments_they_cannot_read(fit, segments, error, match):
+    """Was: each of these gave the default model (DEFAULT_NOISE; fit_motion's white
+    acceleration q=0.1 r=1 with no stands) without a word, as if fitted to the data."""
+    with pytest.raises(error, match=rf"^{fit.__name__}: {match}"):
+        fit(segments)
+
+
+def test_noise_and_motion_fits_of_good_segments_are_unchanged():
+    a, b = _walk(), _walk(30, seed=1)
+    b[:, 0] += 60
+    lists = [a.tolist(), b.tolist(), np.zeros((0, 3))]  # an empty segment adds nothing
+    assert estimate_noise(lists) == estimate_noise([a, b]) != DEFAULT_NOISE
+    assert fit_motion(lists) == fit_motion([a, b])
+    wide = [np.column_stack([s, np.ones((len(s), 7))]) for s in (a, b)]  # MOT-like columns
+    assert estimate_noise(wide) == estimate_noise([a, b])
+    assert estimate_noise(np.stack([a[:20], a[20:]])) == estimate_noise([a[:20], a[20:]])
+
+
+@pytest.mark.parametrize("make", [gdt_problem, gdt_bi_problem])
+@pytest.mark.parametrize(
+    ("seg_a", "seg_b", "kwargs", "error", "match"),
+    [
+        # was: a problem with T = -14, solved without a word
+        (_walk()[:15], _walk()[:5], {}, ValueError, "segment_b starts at frame 1, expected after"),
+        (np.zeros((0, 3)), _walk()[25:], {}, ValueError, r"seg_a must have shape \(k, 3\|5\), no"),
+        (_walk()[0], _walk()[25:], {}, ValueError, r"seg_a must have shape .*got \(3,\)"),
+        (_walk()[:15], np.r_[[[26, np.nan, 0]]], {}, ValueError, "seg_b has a non-finite value"),
+        (_walk()[:15], _walk()[25:], {"history": 0}, ValueError, r"history is 0, expected"),
+        (_walk()[:15], _walk()[25:], {"history": 2.5}, TypeError, "history must be an int"),
+    ],
+)
+def test_problem_builders_check_their_segments(make, seg_a, seg_b, kwargs, error, match):
+    """Was: an IndexError (empty or 1-D segment), the core's message naming kalman_filter or
+    noise_loglik_grid (NaN), "list indices must be integers" (lists), or a problem with a
+    negative T (segment B before A)."""
+    with pytest.raises(error, match=rf"^{make.__name__}: {match}"):
+        make(seg_a, seg_b, **kwargs)
+
+
+def test_problem_builders_take_lists_as_arrays():
+    a, b = _walk()[:15], _walk()[25:]
+    for make in (gdt_problem, gdt_bi_problem):
+        got, want = make(a.tolist(), b.tolist()), make(a, b)
+        assert got.T == want.T == 11
+        np.testing.assert_array_equal(got.m0, want.m0)
+        np.testing.assert_array_equal(got.y_T, want.y_T)
+    with pytest.raises(TypeError, match="^gdt_problem: model must be a GdtModel, got dict$"):
+        gdt_problem(a, b, {})
+    with pytest.raises(TypeError, match="^gdt_bi_problem: noise must be a NoiseEstimate or"):
+        gdt_bi_problem(a, b, (0.1, 0.1))
 
 
 def test_default_method_is_auto_everywhere():
@@ -225,7 +299,10 @@ def test_estimate_noise_names_a_bad_floor(kwargs, error, message, method):
 
 
 def test_noise_estimate_defaults_without_data():
-    assert estimate_noise([np.zeros((2, 3))]) == DEFAULT_NOISE
+    # two points (frames 1, 2) are too few to fit; np.zeros((2, 3)), two rows of frame 0,
+    # is refused since 5 December (frames must increase)
+    assert estimate_noise([[[1, 0, 0], [2, 0, 0]]]) == DEFAULT_NOISE
+    assert estimate_noise([]) == DEFAULT_NOISE
     with pytest.raises(ValueError, match="method"):
         estimate_noise([], method="bad")
 
@@ -391,3 +468,31 @@ def test_explain_tells_two_close_errors_apart():
     assert _apart(0.0191234, 0.0193) == ("0.0191", "0.0193")
     assert _apart(1.5, 2.25) == ("1.500", "2.250")
     assert _apart(1.0, 1.0) == ("1.000000000", "1.000000000")
+
+
+@pytest.mark.parametrize(
+    ("method", "who"), [("auto", "recover_auto"), ("linear-nb", "recover_gaps")]
+)
+@pytest.mark.parametrize(
+    ("observed", "match"),
+    [
+        # were taken: each track cut into runs of one point and left out, without a word
+        ([_walk()[::-1]], r"observed\[0\] row 1 has frame 39 after 40: a track's frames must"),
+        ([_walk(), _walk()[:, [2, 0, 1]]], r"observed\[1\] row \d+ has frame -?\d.* after "),
+        ([np.r_[_walk(), _walk()[-1:]]], r"observed\[0\] row 40 has frame 40 after 40: "),
+        (_walk(), r"observed\[0\] has shape \(3,\), .* \(one track given alone\? pass \[track\]\)"),
+    ],
+)
+def test_observed_tracks_whose_frames_do_not_increase_are_refused(method, who, observed, match):
+    a, b = _walk()[:15], _walk()[25:]
+    with pytest.raises(ValueError, match=rf"^{who}: {match}"):
+        recover_gaps([(a, b)], method, observed=observed)
+
+
+def test_observed_tracks_that_are_good_give_what_they_gave():
+    a, b = _walk()[:15], _walk()[25:]
+    others = [_walk(seed=s) for s in range(1, 4)]
+    for method in ("auto", "linear-nb"):
+        want = recover_gaps([(a, b)], method, observed=others)
+        got = recover_gaps([(a, b)], method, observed=[o.tolist() for o in others])
+        np.testing.assert_array_equal(got[0], want[0])

@@ -41,13 +41,13 @@ from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import BASELINES, RTS_HISTORY, rts_batch
 from pftrack.recovery.gdt import GdtModel
-from pftrack.recovery.mixture import WINDOW, MotionFit, fit_motion, recover_mixture_gaps
+from pftrack.recovery.mixture import WINDOW, MotionFit, _fit_motion, recover_mixture_gaps
 from pftrack.recovery.neighbours import (
     NB_SUFFIX,
     Neighbourhood,
     correct_by_neighbours,
 )
-from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
 from pftrack.recovery.problems import SegmentModel
 from pftrack.recovery.segments import as_segment, distinct_runs, split_rows
 
@@ -814,9 +814,9 @@ def calibrate(
     )
     whole = _fit_sample([r for r in runs if len(r) >= 4], seed)
     if noise is None and ("gdt-bi" in names or "gdt-mix" in names):
-        noise = estimate_noise(whole) if whole else None
+        noise = _estimate_noise(whole) if whole else None
     if motion is None and "gdt-mix" in names and whole:
-        motion = fit_motion(whole, noise)
+        motion = _fit_motion(whole, noise)
     quota = bucket_quotas({b: len(v) for b, v in by_bucket.items()}, max_gaps)
     scored = [
         m
@@ -1376,9 +1376,9 @@ def recover_auto(
     runs = _fit_sample([r for r in all_runs if len(r) >= 4], seed)
     if noise is None:
         needs = "gdt-bi" in candidates or "gdt-mix" in candidates
-        noise = estimate_noise(runs) if runs and needs else _NO_NOISE
+        noise = _estimate_noise(runs) if runs and needs else _NO_NOISE
     if motion is None and runs and "gdt-mix" in candidates:
-        motion = fit_motion(runs, noise)
+        motion = _fit_motion(runs, noise)
     spans = [float(np.hypot(*(b[0, 1:3] - a[-1, 1:3]))) for a, b in checked]
     keep = [k for k, v in enumerate(lengths) if v > 0]
     cal = calibrate(

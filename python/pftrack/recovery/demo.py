@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack._typing import RecoveryMethod, RngLike
-from pftrack.recovery.noise import estimate_noise
+from pftrack.recovery.noise import _estimate_noise
 from pftrack.recovery.registry import METHODS, recover_gaps
 
 __all__ = ["demo_report"]
@@ -63,7 +63,7 @@ def demo_report(
         start = int(gen.integers(5, len(tr) - length - 4))
         gaps.append((tr[:start], tr[start + length :]))
         truths.append(tr[start : start + length, 1:3])
-    noise = estimate_noise([g[0] for g in gaps] + [g[1] for g in gaps])
+    noise = _estimate_noise([g[0] for g in gaps] + [g[1] for g in gaps])
     lines = [
         f"recovery demo: {len(gaps)} gaps of {lo}-{hi} frames cut into {len(tracks)} tracks",
         f"{'method':<10}{'mean error (px)':>17}{'time (ms)':>11}",

@@ -22,9 +22,9 @@ from pftrack._check import mot_rows, option
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.linking import check_unique
-from pftrack.recovery.mixture import MotionFit, fit_motion
+from pftrack.recovery.mixture import MotionFit, _fit_motion
 from pftrack.recovery.names import NEIGHBOUR_METHODS
-from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
 from pftrack.recovery.registry import METHODS, recover_gaps
 
 __all__ = [
@@ -269,11 +269,11 @@ def run_mask(
             runs = observed_runs(trajs, mask)  # what those methods see of the sequence
         if runs is not None and ("gdt-bi" in methods or "gdt-mix" in methods):
             t0 = time.perf_counter()
-            noise = estimate_noise(runs)
+            noise = _estimate_noise(runs)
             noise_ms = 1e3 * (time.perf_counter() - t0)
             if "gdt-mix" in methods:
                 t0 = time.perf_counter()
-                motion = fit_motion(runs, noise)
+                motion = _fit_motion(runs, noise)
                 motion_ms = 1e3 * (time.perf_counter() - t0)
         for m in methods:
             name = cast("RecoveryMethod", m)  # recover_gaps refuses a name that is not one

@@ -31,9 +31,9 @@ from pftrack.recovery.linking import (
     check_unique,
     split_tracks,
 )
-from pftrack.recovery.mixture import MotionFit, check_models, fit_motion
+from pftrack.recovery.mixture import MotionFit, _fit_motion, check_models
 from pftrack.recovery.names import NEIGHBOUR_METHODS
-from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
 from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, recover_gaps
 from pftrack.recovery.segments import MAX_GAP_LIMIT  # Largest `max_gap` accepted
 
@@ -346,9 +346,9 @@ def fill_rows(
     calibration: Calibration | None = None
     if method in ("gdt-bi", "gdt-mix") and segs:
         if noise is None:
-            noise = estimate_noise(whole)
+            noise = _estimate_noise(whole)
         if method == "gdt-mix":  # one model for the file, not one per pair of segments
-            motion = fit_motion(whole, noise)
+            motion = _fit_motion(whole, noise)
     new_rows: list[F64] = []
     size_cal: Calibration | None = None
     if segs:

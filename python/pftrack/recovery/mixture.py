@@ -40,9 +40,9 @@ import pftrack._core as _core
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.kalman import cv_transition, wna_Q
-from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
 from pftrack.recovery.problems import SegmentModel, check_finite_paths
-from pftrack.recovery.segments import consecutive_runs
+from pftrack.recovery.segments import consecutive_runs, observed_segments
 
 __all__ = [
     "DIFFUSE",
@@ -266,16 +266,29 @@ def stand_rate(runs: Sequence[F64], noise: NoiseEstimate, k: int = 8) -> float:
     return onsets / max(walking, 1)
 
 
-def fit_motion(segments: Sequence[F64], noise: NoiseEstimate | None = None) -> MotionFit:
+def fit_motion(segments: Sequence[ArrayLike], noise: NoiseEstimate | None = None) -> MotionFit:
     """Estimate the ``gdt-mix`` model from observed segments (rows ``(frame, x, y, ...)``).
 
     ``noise``: the white-noise-acceleration estimate used as fallback and for the stand rate;
     default :func:`estimate_noise` of the same segments.
+
+    Raises
+    ------
+    TypeError
+        `noise` not a NoiseEstimate; `segments` not a sequence of arrays of real numbers.
+    ValueError
+        A segment :func:`~pftrack.recovery.segments.observed_segments` refuses (one segment
+        given alone, NaN, frames that are not whole or do not increase).
     """
     check_models(noise, None, "fit_motion")
+    return _fit_motion(observed_segments(segments, "fit_motion"), noise)
+
+
+def _fit_motion(segments: Sequence[F64], noise: NoiseEstimate | None = None) -> MotionFit:
+    """:func:`fit_motion` of segments the recovery checked itself (its runs, its gaps)."""
     runs = consecutive_runs(segments, 6)
     if noise is None:
-        noise = estimate_noise(runs)
+        noise = _estimate_noise(runs)
     if sum(len(r) for r in runs) < 20:  # too little to fit anything: gdt-bi's model, no stands
         axes = tuple(AxisModel("wna", noise.q[i], noise.r[i], 0.0) for i in range(2))
         return MotionFit((axes[0], axes[1]), 0.0, (1.0, 1.0), noise)

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 import pftrack._core as _core
 from pftrack._check import MAX_FRAME, brief, integer, number, option, shown
 from pftrack._typing import F64
-from pftrack.recovery.segments import consecutive_runs
+from pftrack.recovery.segments import consecutive_runs, observed_segments
 
 __all__ = ["DEFAULT_NOISE", "MAX_R_RATIO", "MIN_R", "NoiseEstimate", "estimate_noise"]
 
@@ -149,14 +149,18 @@ def _ml_noise(segments: Sequence[F64], floor_q: float, floor_r: float) -> NoiseE
     return NoiseEstimate(q=(qs[0], qs[1]), r=(rs[0], rs[1]))
 
 
+#: :func:`estimate_noise`'s default floors of ``q`` (px²/frame³) and ``r`` (px²), and scales.
+FLOOR_Q, FLOOR_R, SCALES = 1e-5, 1e-3, (1, 2, 4, 8)
+
+
 def estimate_noise(
     segments: Sequence[ArrayLike],
     *,
     method: str = "ml",
-    floor_q: float = 1e-5,
-    floor_r: float = 1e-3,
+    floor_q: float = FLOOR_Q,
+    floor_r: float = FLOOR_R,
     min_points: int = 4,
-    scales: Sequence[int] = (1, 2, 4, 8),
+    scales: Sequence[int] = SCALES,
 ) -> NoiseEstimate:
     """Estimate the motion noise ``q`` and measurement noise ``r`` per axis from observed data.
 
@@ -191,7 +195,34 @@ def estimate_noise(
     -------
     NoiseEstimate
         :data:`DEFAULT_NOISE` when no run is long enough.
+
+    Raises
+    ------
+    TypeError
+        `segments` not a sequence of arrays of real numbers; an option of the wrong type.
+    ValueError
+        A segment :func:`~pftrack.recovery.segments.observed_segments` refuses (one segment
+        given alone, NaN, frames that are not whole or do not increase); an option out of its
+        range.
     """
+    segs = observed_segments(segments, "estimate_noise")
+    return _noise_levels(segs, method, floor_q, floor_r, min_points, scales)
+
+
+def _estimate_noise(segments: Sequence[ArrayLike]) -> NoiseEstimate:
+    """:func:`estimate_noise` with its defaults, of segments the recovery checked itself."""
+    return _noise_levels(segments, "ml", FLOOR_Q, FLOOR_R, 4, SCALES)
+
+
+def _noise_levels(
+    segments: Sequence[ArrayLike],
+    method: str,
+    floor_q: float,
+    floor_r: float,
+    min_points: int,
+    scales: Sequence[int],
+) -> NoiseEstimate:
+    """:func:`estimate_noise` of checked segments: its options checked, the levels fitted."""
     option(method, "estimate_noise: method", ("ml", "moments"))
     if method not in ("ml", "moments"):
         raise ValueError(f"estimate_noise: method is {method!r}, expected 'ml' or 'moments'")

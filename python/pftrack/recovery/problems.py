@@ -29,11 +29,18 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import pftrack._core as _core
+from pftrack._check import MAX_FRAME, integer
 from pftrack._typing import F64
 from pftrack.kalman import cv_transition_xy, wna_Q_xy
 from pftrack.recovery.gdt import Form, GdtModel, GdtSolution, goal_directed_path
-from pftrack.recovery.noise import NoiseEstimate, estimate_noise
-from pftrack.recovery.segments import contiguous_head, contiguous_tail, split_rows
+from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
+from pftrack.recovery.segments import (
+    as_observed,
+    contiguous_head,
+    contiguous_tail,
+    gap_ends,
+    split_rows,
+)
 
 __all__ = ["GdtProblem", "Goal", "SegmentModel", "gdt_bi_problem", "gdt_problem"]
 
@@ -107,6 +114,19 @@ def _kf_init(seg: F64, r: Sequence[float], p_vel: float) -> tuple[F64, F64]:
     return m, P
 
 
+def _gap(seg_a: ArrayLike, seg_b: ArrayLike, history: object, fn: str) -> tuple[F64, F64, int]:
+    """The segments around one gap and `history`, checked for `fn` (B after A, history >= 1).
+
+    Was: taken as they came, so that lists failed with "list indices must be integers", an
+    empty segment with an IndexError, NaN in the core's words, and a segment B before A gave a
+    problem with a negative ``T``.
+    """
+    a = as_observed(seg_a, "seg_a", fn)
+    b = as_observed(seg_b, "seg_b", fn)
+    gap_ends(a, b, fn)
+    return a, b, integer(history, f"{fn}: history", 1, MAX_FRAME)
+
+
 def gdt_problem(seg_a: F64, seg_b: F64, model: GdtModel = _PAPER, history: int = 30) -> GdtProblem:
     """The paper's problem for one gap (``Pi_T = R``, ``H_T = [I 0]``, goal = B's first point).
 
@@ -116,13 +136,26 @@ def gdt_problem(seg_a: F64, seg_b: F64, model: GdtModel = _PAPER, history: int =
 
     Parameters
     ----------
-    seg_a, seg_b : (k, 3+) ndarray
-        Checked segments (:func:`~pftrack.recovery.segments.as_segment`) before and after the gap.
+    seg_a, seg_b : (k, 3+) array_like
+        Rows ``(frame, x, y, ...)`` before and after the gap, as
+        :func:`~pftrack.recovery.recover_gap` takes its segments.
     model : GdtModel
         The paper's A, Q, H, R.
     history : int
-        Points of segment A the filter uses.
+        Points of segment A the filter uses (>= 1).
+
+    Raises
+    ------
+    TypeError
+        Segments not of real numbers, `model` not a GdtModel, `history` not an int.
+    ValueError
+        A segment :func:`~pftrack.recovery.segments.as_segment` refuses, segment B not after
+        segment A (was: taken, with a negative ``T``), `history` < 1.
     """
+    fn = "gdt_problem"
+    if not isinstance(model, GdtModel):
+        raise TypeError(f"{fn}: model must be a GdtModel, got {type(model).__name__}")
+    seg_a, seg_b, history = _gap(seg_a, seg_b, history, fn)
     tail = contiguous_tail(seg_a)[-history:]
     A, Q, H, R = model.A, model.Q, model.H, model.R
     m_init, P_init = _kf_init(tail, model.r, model.p_init_velocity)
@@ -138,15 +171,25 @@ def gdt_bi_problem(
 
     Parameters
     ----------
-    seg_a, seg_b : (k, 3+) ndarray
-        Checked segments before and after the gap.
+    seg_a, seg_b : (k, 3+) array_like
+        Rows ``(frame, x, y, ...)`` before and after the gap, as
+        :func:`~pftrack.recovery.recover_gap` takes its segments.
     noise : NoiseEstimate, optional
         Noise levels; default: :func:`~pftrack.recovery.noise.estimate_noise` of both segments.
     history : int
-        Points of each segment's run next to the gap the filters use.
+        Points of each segment's run next to the gap the filters use (>= 1).
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`gdt_problem`; `noise` not a NoiseEstimate (TypeError).
     """
+    fn = "gdt_bi_problem"
+    if noise is not None and not isinstance(noise, NoiseEstimate):
+        raise TypeError(f"{fn}: noise must be a NoiseEstimate or None, got {type(noise).__name__}")
+    seg_a, seg_b, history = _gap(seg_a, seg_b, history, fn)
     if noise is None:
-        noise = estimate_noise([seg_a, seg_b])
+        noise = _estimate_noise([seg_a, seg_b])
     A = cv_transition_xy(1.0)
     Q = wna_Q_xy(noise.q)
     H = _position_H()

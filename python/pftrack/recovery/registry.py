@@ -49,12 +49,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pftrack import _check
-from pftrack._check import MAX_FRAME, real_array
+from pftrack._check import MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
 from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
 from pftrack.recovery.calibrate import bags_for, fixed_noise_model, recover_auto
-from pftrack.recovery.mixture import MotionFit, check_models, fit_motion, recover_mixture_gaps
+from pftrack.recovery.mixture import MotionFit, _fit_motion, check_models, recover_mixture_gaps
 from pftrack.recovery.names import (
     DEFAULT_METHOD,
     GOAL_DIRECTED_METHODS,
@@ -66,9 +66,15 @@ from pftrack.recovery.neighbours import (
     Neighbourhood,
     correct_by_neighbours,
 )
-from pftrack.recovery.noise import NoiseEstimate, estimate_noise
+from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, distinct_runs, gap_ends, gap_frames
+from pftrack.recovery.segments import (
+    as_observed,
+    as_segment,
+    distinct_runs,
+    gap_ends,
+    gap_frames,
+)
 
 __all__ = ["DEFAULT_METHOD", "GOAL_DIRECTED_METHODS", "METHODS", "recover_gap", "recover_gaps"]
 
@@ -187,12 +193,7 @@ def _checked_pairs(gaps: Sequence[tuple[ArrayLike, ArrayLike]]) -> list[tuple[F6
 
 def _gap_segment(seg: ArrayLike, name: str, k: int) -> F64:
     """Segment `name` of gap `k`, checked by :func:`as_segment` (see :func:`_checked_pairs`)."""
-    s = real_array(seg, f"recover_gaps: {name} of gap {k}")
-    if s.ndim != 2 or s.shape[1] < 3 or s.shape[0] == 0:
-        raise ValueError(
-            f"recover_gaps: {name} of gap {k} must have shape (k, 3|5), non-empty; got {s.shape}"
-        )
-    return as_segment(s if s.shape[1] in (3, 5) else s[:, :3], f"{name} of gap {k}", "recover_gaps")
+    return as_observed(seg, f"{name} of gap {k}", "recover_gaps")
 
 
 def recover_gaps(
@@ -295,12 +296,12 @@ def recover_gaps(
     seg_b = [b for _, b in pairs]
     if method == "gdt-mix":
         if motion is None:
-            motion = fit_motion(seg_a + seg_b, noise)
+            motion = _fit_motion(seg_a + seg_b, noise)
         return recover_mixture_gaps(pairs, motion)
     if method == "gdt":
         model = SegmentModel.paper()
     elif method == "gdt-fixed":
         model = fixed_noise_model()
     else:
-        model = SegmentModel.two_sided(estimate_noise(seg_a + seg_b) if noise is None else noise)
+        model = SegmentModel.two_sided(_estimate_noise(seg_a + seg_b) if noise is None else noise)
     return model.recover(seg_a, seg_b, history)

@@ -21,6 +21,7 @@ MAX_GAP_LIMIT = 100_000
 
 __all__ = [
     "MAX_GAP_LIMIT",
+    "as_observed",
     "as_segment",
     "consecutive_runs",
     "contiguous_head",
@@ -28,6 +29,7 @@ __all__ = [
     "distinct_runs",
     "gap_ends",
     "gap_frames",
+    "observed_segments",
     "split_rows",
 ]
 
@@ -103,6 +105,67 @@ def as_segment(seg: ArrayLike, name: str, fn: str = "recover_gap") -> F64:
     if np.any(np.diff(a[:, 0]) <= 0):
         raise ValueError(f"{fn}: {name} frames must increase strictly")
     return np.ascontiguousarray(a)
+
+
+def as_observed(seg: ArrayLike, name: str, fn: str) -> F64:
+    """One segment of (k, 3+) rows ``(frame, x, y, ...)``, checked by :func:`as_segment`.
+
+    The columns :func:`as_segment` reads (``frame, x, y``, and ``w, h`` of a (k, 5) segment)
+    are checked and kept; those of any other width (a MOTChallenge row's ten) are left out.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`as_segment`; ``{fn}: {name} must have shape (k, 3|5), non-empty; got (4,)``.
+    """
+    a = real_array(seg, f"{fn}: {name}", booleans=False)
+    if a.ndim != 2 or a.shape[1] < 3 or a.shape[0] == 0:
+        raise ValueError(f"{fn}: {name} must have shape (k, 3|5), non-empty; got {a.shape}")
+    return as_segment(a if a.shape[1] in (3, 5) else a[:, :3], name, fn)
+
+
+def observed_segments(segments: object, fn: str) -> list[F64]:
+    """`segments`, the observed segments a noise or motion model is fitted to, checked.
+
+    Each is (k, 3+) rows ``(frame, x, y, ...)``: its ``frame, x, y`` meet the rules of
+    :func:`as_segment` (finite, whole frames increasing strictly, within ±1e9 px); an empty
+    one adds nothing. Was: :func:`consecutive_runs` left out, without a word, whatever it
+    could not read, so that one segment given alone (``estimate_noise(seg)``: its rows read as
+    segments), frames in the wrong column or in decreasing order gave the default model as if
+    fitted to the data.
+
+    Raises
+    ------
+    TypeError
+        `segments` not a sequence of arrays (a string, a number); values that are not real
+        numbers.
+    ValueError
+        One (k, 3+) array or a (3+,) row given for the sequence (pass ``[segment]``); a segment
+        not of shape (k, 3+); a value :func:`as_segment` refuses, named by its place
+        (``estimate_noise: segments[2] frames must increase strictly``).
+    """
+    if isinstance(segments, (str, bytes)) or not isinstance(segments, Iterable):
+        raise TypeError(
+            f"{fn}: segments must be a sequence of (k, 3+) arrays (frame, x, y, ...), got "
+            f"{type(segments).__name__}"
+        )
+    if isinstance(segments, np.ndarray) and segments.ndim < 3:
+        raise ValueError(
+            f"{fn}: segments is one {segments.shape} array, expected a sequence of (k, 3+) "
+            "segments: pass [segment] for one"
+        )
+    checked = []
+    for k, seg in enumerate(list(segments)):
+        a = real_array(seg, f"{fn}: segments[{k}]", booleans=False)
+        if a.ndim != 2 or a.shape[1] < 3:
+            one = " (one segment given alone? pass [segment])" if a.ndim == 1 else ""
+            raise ValueError(
+                f"{fn}: segments[{k}] has shape {a.shape}, expected (k, 3+) rows frame, x, y" + one
+            )
+        if len(a):
+            as_segment(a[:, :3], f"segments[{k}]", fn)
+        checked.append(a)
+    return checked
 
 
 def gap_ends(seg_a: F64, seg_b: F64, fn: str = "recover_gap", gap: str = "") -> tuple[int, int]:
@@ -197,7 +260,10 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
 
     With `strict` (the caller's name, for the message) nothing is left out silently:
     `observed` must be a sequence of (k, 3+) arrays of real numbers whose frames, x and y are
-    finite, and a TypeError or ValueError names the first entry that is not.
+    finite and whose frames increase strictly (as a segment's, :func:`as_segment`; tracks in
+    decreasing order, with a duplicated row or the frame in another column were cut into runs
+    of one point and left out), and a TypeError or ValueError names the first entry that is
+    not.
     """
     if strict is not None and (
         isinstance(observed, (str, bytes))
@@ -216,9 +282,10 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
         else:
             a = real_array(s, f"{strict}: observed[{k}]")
             if a.ndim != 2 or a.shape[1] < 3:
+                one = " (one track given alone? pass [track])" if a.ndim == 1 else ""
                 raise ValueError(
                     f"{strict}: observed[{k}] has shape {a.shape}, expected (k, 3+) rows "
-                    "frame, x, y"
+                    f"frame, x, y{one}"
                 )
         if a.ndim == 2 and a.shape[1] >= 3 and len(a):
             arrs.append(a[:, :3])
@@ -237,12 +304,35 @@ def distinct_runs(observed: Sequence[F64], strict: str | None = None) -> list[F6
         raise ValueError(
             f"{strict}: observed run {k} has a non-finite frame, x or y: {X[row].tolist()}"
         )
+    if strict is not None:
+        _frames_increase(X[:, 0], bound, arrs, where, strict)
     starts, ends = starts[ok], ends[ok]
     if not len(starts):
         return []
     keys = np.column_stack([X[starts], X[ends - 1, 0], ends - starts])
     _, first = np.unique(keys, axis=0, return_index=True)  # sorted: a canonical order
     return [X[starts[k] : ends[k]] for k in first]
+
+
+def _frames_increase(
+    f: F64, bound: NDArray[np.bool_], arrs: Sequence[F64], where: Sequence[int], who: str
+) -> None:
+    """Refuse frames that do not increase strictly within their track.
+
+    `f` holds the frames of the arrays `arrs` stacked, `bound` marks each one's first row and
+    `where` their places in `observed`, whose entry the message names. Fractional frames pass:
+    a track on other frame times than the gap's is no neighbour of it, not an error.
+    """
+    bad = ~bound[1:] & (np.diff(f) <= 0)
+    if not bad.any():
+        return
+    row = int(np.argmax(bad)) + 1
+    i = int(np.searchsorted(np.cumsum([len(a) for a in arrs]), row, side="right"))
+    r = row - sum(len(a) for a in arrs[:i])
+    raise ValueError(
+        f"{who}: observed[{where[i]}] row {r} has frame {f[row]:.17g} after {f[row - 1]:.17g}: "
+        "a track's frames must increase strictly (rows frame, x, y, ...)"
+    )
 
 
 def contiguous_tail(seg: F64) -> F64:
