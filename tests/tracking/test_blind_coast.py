@@ -5,16 +5,20 @@ experiments.public_detections does for the MOT15 sequences without video), a coa
 box is the centre filter's extrapolation alone. After more than `blind_coast` such frames with
 detections in a row the track ends, and the offline linker decides whether the detection that
 re-finds the object continues it (docs/tracking.md, "Blind coasts end after 3 frames").
+The built-in detector's tracks too: its colour bins count foreground only, so a track coasting
+over background, its object gone from the foreground, is blind as well.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterable
 
 import numpy as np
 import pytest
 
 import pftrack
+from pftrack._typing import F64
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.track import LiveTrack
@@ -36,25 +40,33 @@ def _tracker(blind: int | None) -> pftrack.Tracker:
     return pftrack.Tracker.from_config(config, 0, prime_frames=0)
 
 
+def _stretches(outs: Iterable[F64], gap: range, left_of: float) -> list[set[int]]:
+    """Ids of the rows left of x = `left_of` (the walker's), before `gap` and after it.
+
+    `outs` are the outputs of frames 1, 2, ...
+    """
+    seen: list[set[int]] = [set(), set()]
+    for k, out in enumerate(outs, start=1):
+        if k not in gap:
+            seen[k > gap.start] |= {int(r[4]) for r in out if r[0] < left_of}
+    return seen
+
+
 def _ids(tracker: pftrack.Tracker, frame: np.ndarray, others: bool) -> list[set[int]]:
     """Online ids of a walker missed on frames 11-16 (6 frames), per stretch seen.
 
     The walker moves 2 px a frame; with `others`, a second person far from it is detected on
     every frame, so frames 11-16 have detections (a miss counts).
     """
-    seen: list[set[int]] = [set(), set()]
-    for k in range(1, 31):
+
+    def update(k: int) -> F64:
         x = 20.0 + 2.0 * k
         dets = [] if 11 <= k <= 16 else [[x, 30.0, x + 20.0, 80.0, 0.95]]
         if others:
             dets.append([160.0, 30.0, 180.0, 80.0, 0.95])
-        out = tracker.update(np.array(dets).reshape(-1, 5), frame)
-        walker = {int(r[4]) for r in out if r[0] < 120}
-        if k <= 10:
-            seen[0] |= walker
-        elif k >= 17:
-            seen[1] |= walker
-    return seen
+        return tracker.update(np.array(dets).reshape(-1, 5), frame)
+
+    return _stretches(map(update, range(1, 31)), range(11, 17), 120)
 
 
 def test_a_blind_coast_ends_after_blind_coast_frames() -> None:
@@ -90,9 +102,9 @@ def test_the_count_is_blind_frames_with_detections_in_a_row() -> None:
         assert t.flat
         t.coast(detected=True)
         assert t.blind == k
-    assert not t.alive(rules, given=True)
-    assert t.alive(rules, given=False)  # the built-in detector's tracks keep max_coast
-    assert t.alive(LifecycleConfig(blind_coast=None), given=True)
+    assert not t.alive(rules)
+    assert t.alive(LifecycleConfig(blind_coast=None))
+    assert t.alive(LifecycleConfig(blind_coast=3))
     t.predict(hsv_bins(_textured()), cfg.motion.colour_noise)
     assert not t.flat
     t.coast(detected=True)
@@ -108,7 +120,40 @@ def test_a_track_from_an_older_checkpoint_has_no_blind_count() -> None:
     t = LiveTrack(1, np.array([30.0, 20.0, 20.0, 40.0]), hist / hist.sum(), cfg, 0, 0.9)
     del t.__dict__["blind"], t.__dict__["flat"]  # pickled before the count existed
     assert (t.blind, t.flat) == (0, False)
-    assert t.alive(cfg.lifecycle, given=True)
+    assert t.alive(cfg.lifecycle)
+
+
+BACKGROUND = np.random.default_rng(1).integers(90, 110, (160, 240, 3), dtype=np.uint8)
+
+
+def _street(k: int, gone: bool) -> np.ndarray:
+    """Frame k: a red walker (3 px a frame; absent when `gone`) and a blue person standing."""
+    f = BACKGROUND.copy()
+    if not gone:
+        f[40:100, 20 + 3 * k : 40 + 3 * k] = (30, 30, 200)
+    f[50:110, 190:210] = (200, 60, 30)  # detected on every frame: the frames have detections
+    return f
+
+
+def _builtin_ids(blind: int | None) -> list[set[int]]:
+    """Online ids of the walker before and after it leaves the foreground on frames 21-26."""
+    config = TrackerConfig()
+    life = dataclasses.replace(config.lifecycle, blind_coast=blind)
+    tracker = pftrack.Tracker.from_config(dataclasses.replace(config, lifecycle=life), 0)
+    tracker.prime([BACKGROUND] * 30)
+    outs = (tracker.update(None, _street(k, 21 <= k <= 26)) for k in range(1, 41))
+    return _stretches(outs, range(21, 27), 170)
+
+
+def test_the_builtin_detectors_blind_coast_ends() -> None:
+    """Off the foreground no particle counts a pixel: the likelihood is flat, the coast blind.
+
+    Was: the built-in detector's tracks kept `max_coast` (10), which covered the 6 frames.
+    """
+    before, after = _builtin_ids(3)
+    assert len(before) == len(after) == 1
+    assert before != after
+    assert _builtin_ids(None) == [before, before]
 
 
 @pytest.mark.parametrize(("bad", "error"), [(-1, ValueError), (2.5, TypeError), ("3", TypeError)])

@@ -246,18 +246,22 @@ class LifecycleConfig:
         inside another box (the hidden side), else about its centre; ``"centre"`` always about
         its centre.
     blind_coast : int or None
-        With given detections, a track ends after more than this many frames with detections
-        in a row coasted blind: its colour filter's likelihood flat on each (every particle
-        matching the reference alike: black or one-colour frames, as a loop with only boxes
-        passes, or a box with no counted pixel). Its box is then the centre filter's
-        constant-velocity extrapolation alone, which the camera's own motion (a walker's
-        camera, a car's) carries off the person while the association radius grows; the
-        detection that re-finds it is then often another person's, and its coasted rows filled
-        between the two are false positives. The offline linker, which sees both pieces,
-        decides instead. A coast on which the colour carried evidence (a video) is not blind
-        and keeps `max_coast`. At least 0; None: off. The default 3 passed the adoption rule
-        over every sequence with public detections (docs/tracking.md, "Blind coasts end after
-        3 frames").
+        A track ends after more than this many frames with detections in a row coasted blind:
+        its colour filter's likelihood flat on each (every particle matching the reference
+        alike). With given detections that is a black or one-colour frame (a loop with only
+        boxes passes black frames) or a box with no counted pixel: the track's box is then the
+        centre filter's constant-velocity extrapolation alone, which the camera's own motion (a
+        walker's camera, a car's) carries off the person while the association radius grows;
+        the detection that re-finds it is then often another person's, and its coasted rows
+        filled between the two are false positives. With the built-in detector, whose colour
+        bins count foreground pixels only, it is a coast with no foreground pixel under any
+        particle: the object has left the foreground (gone, or hidden whole), and the track
+        drifts over background. The offline linker, which sees both pieces, decides whether
+        the detection that re-finds the object continues it. A coast on which the colour
+        carried evidence is not blind and keeps `max_coast`. At least 0; None: off. The default
+        3 passed the adoption rule over every sequence with public detections, and then over
+        every sequence and scene of the built-in detector (docs/tracking.md, "Blind coasts end
+        after 3 frames").
     birth_overlap : float or None
         With given detections, a detection left unmatched that overlaps a confirmed track of its
         class by an IoU above this starts no track: it is a second box on a person already

@@ -226,17 +226,18 @@ class LiveTrack:
         self.det_index = None
         self.score = self.rho
 
-    def alive(self, rules: LifecycleConfig, given: bool = False) -> bool:
+    def alive(self, rules: LifecycleConfig) -> bool:
         """Tell whether the track has coasted no longer than it may (less if unconfirmed).
 
         A confirmed track may coast `max_coast` frames. A tentative one may miss
         `tentative_coast` frames that had detections (frames without any detection do not count:
         a detector run every other frame, or one that saw nothing), and coast no more than
-        `max_coast` frames in all. On a frame of given detections (`given`), any track ends
-        after more than `blind_coast` frames with detections in a row coasted blind, its colour
-        likelihood flat (:attr:`blind`).
+        `max_coast` frames in all. Any track, of given detections or of the built-in
+        detector's, ends after more than `blind_coast` frames with detections in a row coasted
+        blind, its colour likelihood flat (:attr:`blind`): on frames of one colour, or, with the
+        built-in detector's foreground-only bins, with no foreground pixel under any particle.
         """
-        if given and rules.blind_coast is not None and self.blind > rules.blind_coast:
+        if rules.blind_coast is not None and self.blind > rules.blind_coast:
             return False
         if self.hits >= rules.min_hits:
             return self.time_since_update <= rules.max_coast

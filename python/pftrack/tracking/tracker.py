@@ -833,8 +833,7 @@ class MultiObjectTracker:
         self._measure_speeds(followed, boxes, cfg)
 
         # 4. tracks that coasted too long end; 5. unexplained detections start tracks
-        # LifecycleConfig.blind_coast holds on frames of given detections only
-        alive = [t.alive(cfg.lifecycle, detections is not None) for t in self.tracks]
+        alive = [t.alive(cfg.lifecycle) for t in self.tracks]
         self._ended_unconfirmed.update(
             t.id
             for t, a in zip(self.tracks, alive, strict=True)
