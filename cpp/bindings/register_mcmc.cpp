@@ -238,6 +238,15 @@ void register_mcmc(py::module_& m) {
                 return out;
             },
             "The identities kept for the next frame (id, w0, h0, ref, parents (N_i, 6), existence).")
+        .def(
+            "warp",
+            [](PyRjTracker& self, Eigen::Ref<const RowMatrixXd> affine) {
+                const bind::InUse busy(&self, "RJMCMCTracker.warp");
+                self.tracker.warp(affine);
+            },
+            py::arg("affine"),
+            "Move the kept identities by a similarity transform affine (2, 3), previous frame's "
+            "pixels to this frame's (camera-motion compensation).")
         // ---- test hooks: single moves on a prepared frame ----
         .def(
             "prepare",

@@ -180,6 +180,7 @@ class RJMCMCTracker:
     ) -> dict[str, Any]: ...
     @property
     def tracks(self) -> list[Any]: ...
+    def warp(self, affine: _F64) -> None: ...  # (2, 3) similarity, previous frame to this one
     def prepare(
         self,
         image: BinnedImage,

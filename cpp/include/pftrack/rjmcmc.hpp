@@ -599,6 +599,33 @@ public:
     const std::vector<Track>& tracks() const { return tracks_; }
     std::int64_t next_id() const { return next_id_; }
 
+    /// Moves the kept identities into the next frame's pixels by a similarity transform
+    /// `affine` (2 x 3, previous frame's pixels to this frame's): the kept samples' current and
+    /// previous centres are mapped, base sizes times z = sqrt|det| (the scales stay), as
+    /// warp_tracks moves the per-object filters. For camera-motion compensation.
+    void warp(const Eigen::Ref<const RowMatrixXd>& affine) {
+        const char* fn = "RJMCMCTracker.warp";
+        require(affine.rows() == 2 && affine.cols() == 3, fn, "affine must have shape (2, 3)");
+        require_finite(affine, fn, "affine");
+        const double z =
+            std::sqrt(std::abs(affine(0, 0) * affine(1, 1) - affine(0, 1) * affine(1, 0)));
+        require(z > 0.0, fn, "affine is singular (determinant 0), expected a similarity");
+        std::vector<Track> moved = tracks_;  // kept as they were if the result is not finite
+        for (Track& t : moved) {
+            for (Index n = 0; n < t.parents.rows(); ++n)
+                for (int c : {0, 3}) {
+                    const double x = t.parents(n, c), y = t.parents(n, c + 1);
+                    t.parents(n, c) = affine(0, 0) * x + affine(0, 1) * y + affine(0, 2);
+                    t.parents(n, c + 1) = affine(1, 0) * x + affine(1, 1) * y + affine(1, 2);
+                }
+            t.w0 *= z;
+            t.h0 *= z;
+            require(t.parents.allFinite() && std::isfinite(t.w0) && std::isfinite(t.h0), fn,
+                    "affine moves an identity out of the finite numbers");
+        }
+        tracks_ = std::move(moved);
+    }
+
     /// Builds one frame's model: previous identities first (in track order), then one newborn slot
     /// per candidate whose box holds foreground colour (an all-zero histogram cannot be a reference).
     RjFrame make_frame(const BinImage& img, FgIntegral fg, const Eigen::Ref<const RowMatrixXd>& cands,

@@ -356,6 +356,34 @@ class RJMCMCFilter:
                 out.append(RJTrack(int(row[0]), row[1:5].copy(), float(row[5])))
         return out
 
+    def warp(self, affine: ArrayLike) -> None:
+        """Move the kept identities into the next frame by a similarity transform.
+
+        Camera-motion compensation, as :func:`~pftrack.tracking.camera.warp_tracks` moves the
+        per-object filters: every kept sample's current and previous centre is mapped by
+        `affine`, each identity's base size multiplied by its zoom ``sqrt|det|``.
+
+        Parameters
+        ----------
+        affine : (2, 3) array_like of float
+            From the previous frame's pixels to the next frame's.
+
+        Raises
+        ------
+        ValueError
+            `affine` not a finite (2, 3) array, singular, or moving an identity beyond the
+            finite numbers (the identities are then left as they were).
+        RuntimeError
+            Another thread is inside this filter.
+        """
+        a = np.ascontiguousarray(real_array(affine, "RJMCMCFilter.warp: affine"))
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, "RJMCMCFilter.warp")
+        try:
+            self._core.warp(a)
+        finally:
+            self._busy.release()
+
     @property
     def acceptance(self) -> dict[str, float]:
         """Acceptance rate per move in the last frame (NaN for a move never proposed)."""
