@@ -386,7 +386,13 @@ class RJMCMCFilter:
 
     @property
     def acceptance(self) -> dict[str, float]:
-        """Acceptance rate per move in the last frame (NaN for a move never proposed)."""
+        """Acceptance rate per move in the last frame (NaN for a move never proposed).
+
+        Accepted / proposed over the `n_samples` kept iterations (burn-in left out); a move
+        impossible in the chain's state (a death or update with no object, a swap with fewer
+        than two, a birth with every slot present) leaves the chain as it is and is not counted
+        as proposed. The counts are ``last["acceptance"][move] = (accepted, proposed)``.
+        """
         acc = self.last.get("acceptance", {})
         return {k: (a / p if p else float("nan")) for k, (a, p) in acc.items()}
 
