@@ -181,6 +181,10 @@ class RJMCMCTracker:
     @property
     def tracks(self) -> list[Any]: ...
     def warp(self, affine: _F64) -> None: ...  # (2, 3) similarity, previous frame to this one
+    @property
+    def next_id(self) -> int: ...
+    # tracks: dicts as .tracks gives them (id, w0, h0, ref (B,), parents (N_i, 6), existence)
+    def restore(self, tracks: list[Any], next_id: int) -> None: ...
     def prepare(
         self,
         image: BinnedImage,

@@ -70,6 +70,7 @@
 #include <cstring>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "histogram.hpp"
@@ -598,6 +599,38 @@ public:
     const RjParams& params() const { return prm_; }
     const std::vector<Track>& tracks() const { return tracks_; }
     std::int64_t next_id() const { return next_id_; }
+
+    /// Replaces the kept identities and the next fresh id with a saved state (`tracks()` and
+    /// `next_id()` of a tracker with the same parameters): a checkpoint's resume. Checked
+    /// whole before anything changes: ids distinct in [0, next_id), base sizes finite > 0,
+    /// references of one length with finite values >= 0 and a positive sum, kept samples
+    /// (N_i >= 1, 6) finite, existence in (0, 1].
+    void restore(std::vector<Track> tracks, std::int64_t next_id) {
+        const char* fn = "RJMCMCTracker.restore";
+        require(next_id >= 0, fn, "next_id", next_id, ">= 0");
+        std::vector<std::int64_t> seen;
+        for (size_t k = 0; k < tracks.size(); ++k) {
+            const Track& t = tracks[k];
+            const std::string at = "tracks[" + std::to_string(k) + "]";
+            require(t.id >= 0 && t.id < next_id, fn, (at + ".id").c_str(), t.id,
+                    "in [0, next_id)");
+            require(std::find(seen.begin(), seen.end(), t.id) == seen.end(), fn,
+                    at + ".id " + std::to_string(t.id) + " is given twice");
+            seen.push_back(t.id);
+            require(std::isfinite(t.w0) && t.w0 > 0.0 && std::isfinite(t.h0) && t.h0 > 0.0, fn,
+                    at + ": w0 and h0 must be finite and > 0");
+            require(t.ref.size() > 0 && t.ref.size() == tracks[0].ref.size() &&
+                        t.ref.allFinite() && (t.ref.array() >= 0.0).all() && t.ref.sum() > 0.0,
+                    fn, at + ".ref must hold finite values >= 0 with a positive sum, as long as "
+                              "tracks[0].ref");
+            require(t.parents.rows() >= 1 && t.parents.cols() == 6 && t.parents.allFinite(), fn,
+                    at + ".parents must be a finite (N, 6) array with N >= 1");
+            require(t.existence > 0.0 && t.existence <= 1.0, fn, (at + ".existence").c_str(),
+                    t.existence, "in (0, 1]");
+        }
+        tracks_ = std::move(tracks);
+        next_id_ = next_id;
+    }
 
     /// Moves the kept identities into the next frame's pixels by a similarity transform
     /// `affine` (2 x 3, previous frame's pixels to this frame's): the kept samples' current and

@@ -356,6 +356,31 @@ class RJMCMCFilter:
                 out.append(RJTrack(int(row[0]), row[1:5].copy(), float(row[5])))
         return out
 
+    def __getstate__(self) -> dict[str, Any]:
+        """The filter's state for pickle and deepcopy: a checkpoint of the run.
+
+        The chain's kept identities and next id are read from the core (which has no pickled
+        form of its own) and given back to a new core by :meth:`__setstate__`: the copy goes on
+        exactly as the original (the same draws: the seed and step number are kept).
+        """
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, "RJMCMCFilter (pickle/deepcopy)")
+        try:
+            state = self.__dict__.copy()
+            del state["_busy"]  # a lock is not copied: the copy is free
+            core = state.pop("_core")
+            state["_core_state"] = (core.tracks, core.next_id)
+        finally:
+            self._busy.release()
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        tracks, next_id = state.pop("_core_state")
+        self.__dict__.update(state)
+        self._busy = threading.Lock()
+        self._core = _core.RJMCMCTracker(**self.config.core_kwargs())
+        self._core.restore(tracks, next_id)
+
     def warp(self, affine: ArrayLike) -> None:
         """Move the kept identities into the next frame by a similarity transform.
 
