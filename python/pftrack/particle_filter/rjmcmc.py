@@ -324,10 +324,8 @@ class RJMCMCFilter:
             raise TypeError(f"{fn}: mask dtype is {m.dtype}, expected uint8 or bool")
         m = np.ascontiguousarray(m)
         if m.shape != tuple(binned.shape):  # the core's message gave neither shape
-            raise ValueError(
-                f"{fn}: mask has shape {m.shape}, expected the frame's {tuple(binned.shape)} "
-                "(H, W)"
-            )
+            shape = tuple(binned.shape)
+            raise ValueError(f"{fn}: mask has shape {m.shape}, expected the frame's {shape}")
         cands = real_array(candidates_cxcywh, f"{fn}: candidates_cxcywh")
         if cands.ndim == 1 and cands.size == 0:
             cands = np.zeros((0, 4))  # [] is no candidate, as np.zeros((0, 4))
