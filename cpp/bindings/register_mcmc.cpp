@@ -189,8 +189,10 @@ void register_mcmc(py::module_& m) {
              py::arg("birth_eps") = 0.02, py::arg("birth_gate") = 0.1,
              py::arg("detection") = 20.0, py::arg("min_samples") = 0.0)
         .def("__reduce__",
-             bind::refuse_pickle("RJMCMCTracker", "its chain has no pickled form (a run "
-                                                  "checkpoints with the 'sis' or 'mh' sampler)"))
+             bind::refuse_pickle("RJMCMCTracker", "its chain has no pickled form of its own "
+                                                  "(pickle the RJMCMCFilter, whose state is "
+                                                  ".tracks and .next_id, given back by "
+                                                  ".restore)"))
         .def(
             "step",
             [](PyRjTracker& self, const BinnedImage& image, const py::array& mask,
@@ -238,6 +240,50 @@ void register_mcmc(py::module_& m) {
                 return out;
             },
             "The identities kept for the next frame (id, w0, h0, ref, parents (N_i, 6), existence).")
+        .def(
+            "warp",
+            [](PyRjTracker& self, Eigen::Ref<const RowMatrixXd> affine) {
+                const bind::InUse busy(&self, "RJMCMCTracker.warp");
+                self.tracker.warp(affine);
+            },
+            py::arg("affine"),
+            "Move the kept identities by a similarity transform affine (2, 3), previous frame's "
+            "pixels to this frame's (camera-motion compensation).")
+        .def_property_readonly(
+            "next_id",
+            [](const PyRjTracker& self) {
+                const bind::InUse busy(&self, "RJMCMCTracker.next_id", true);
+                return self.tracker.next_id();
+            },
+            "The id the next newborn identity gets.")
+        .def(
+            "restore",
+            [](PyRjTracker& self, const py::list& tracks, std::int64_t next_id) {
+                const char* fn = "RJMCMCTracker.restore";
+                std::vector<RJMCMCTracker::Track> ts;
+                for (const py::handle& h : tracks) {
+                    require(py::isinstance<py::dict>(h), fn,
+                            "tracks must be dicts as RJMCMCTracker.tracks gives them");
+                    const auto d = py::reinterpret_borrow<py::dict>(h);
+                    for (const char* key : {"id", "w0", "h0", "ref", "parents", "existence"})
+                        require(d.contains(key), fn, std::string("a track has no '") + key + "'");
+                    try {
+                        ts.push_back({d["id"].cast<std::int64_t>(), d["w0"].cast<double>(),
+                                      d["h0"].cast<double>(), d["ref"].cast<Eigen::VectorXd>(),
+                                      d["parents"].cast<RowMatrixXd>(),
+                                      d["existence"].cast<double>()});
+                    } catch (const py::cast_error&) {
+                        throw py::type_error(std::string(fn) + ": a track's id is not an int, or "
+                                             "w0, h0, existence not numbers, or ref, parents "
+                                             "not float arrays");
+                    }
+                }
+                const bind::InUse busy(&self, fn);
+                self.tracker.restore(std::move(ts), next_id);
+            },
+            py::arg("tracks"), py::arg("next_id"),
+            "Replace the kept identities (dicts as .tracks gives them) and the next fresh id: "
+            "a checkpoint's resume.")
         // ---- test hooks: single moves on a prepared frame ----
         .def(
             "prepare",

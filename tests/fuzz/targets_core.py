@@ -474,10 +474,14 @@ def _background_calls() -> st.SearchStrategy[Any]:
 
 
 def _rjmcmc(params: dict[str, Any], image: Any, mask: Any, cands: Any, hists: Any, seed: Any,
-            step: Any) -> Any:  # fmt: skip
+            step: Any, affine: Any, restore: Any) -> Any:  # fmt: skip
     tracker = _core.RJMCMCTracker(**params)
     out = tracker.step(image, mask, cands, hists, seed=seed, step=step)
-    return out, [t for t in tracker.tracks]
+    tracker.warp(affine)  # camera-motion compensation of the kept identities
+    kept = tracker.tracks
+    fresh = _core.RJMCMCTracker(**params)
+    fresh.restore(kept if restore is None else restore, tracker.next_id)  # a checkpoint's resume
+    return out, [t for t in fresh.tracks]
 
 
 def _rjmcmc_calls() -> st.SearchStrategy[Any]:
@@ -491,6 +495,7 @@ def _rjmcmc_calls() -> st.SearchStrategy[Any]:
         _rjmcmc, params, maybe(st.just(_core.hsv_bins(np.ascontiguousarray(fk[0]), None, 4, 4, 4))),
         maybe(st.just(np.ones(fk[0].shape[:2], np.uint8))), maybe(boxes(st.just(fk[1]))),
         st.none(), maybe(ints(0, 2**63 - 1)), maybe(ints(0, 100)),
+        maybe(floats_array((2, 3), -10.0, 10.0)), st.one_of(st.none(), garbage()),
     ))  # fmt: skip
 
 

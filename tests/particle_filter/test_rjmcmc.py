@@ -356,6 +356,12 @@ def test_step_refuses_what_the_core_would_misread():
         f.step(img, mask, boxes(), hists)
     with pytest.raises(TypeError, match="candidates_cxcywh must hold real numbers"):
         f.step(img, mask, [["a", "b", "c", "d"]])
+    # was: "rjmcmc_step: mask must have the frame's (H, W) shape", neither shape named
+    with pytest.raises(
+        ValueError,
+        match=r"^RJMCMCFilter.step: mask has shape \(10, 120\), expected the frame's \(48, 120\)",
+    ):
+        f.step(img, mask[:10], boxes())
     assert f.n_steps == 0  # nothing ran
 
 

@@ -70,6 +70,7 @@
 #include <cstring>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "histogram.hpp"
@@ -598,6 +599,65 @@ public:
     const RjParams& params() const { return prm_; }
     const std::vector<Track>& tracks() const { return tracks_; }
     std::int64_t next_id() const { return next_id_; }
+
+    /// Replaces the kept identities and the next fresh id with a saved state (`tracks()` and
+    /// `next_id()` of a tracker with the same parameters): a checkpoint's resume. Checked
+    /// whole before anything changes: ids distinct in [0, next_id), base sizes finite > 0,
+    /// references of one length with finite values >= 0 and a positive sum, kept samples
+    /// (N_i >= 1, 6) finite, existence in (0, 1].
+    void restore(std::vector<Track> tracks, std::int64_t next_id) {
+        const char* fn = "RJMCMCTracker.restore";
+        require(next_id >= 0, fn, "next_id", next_id, ">= 0");
+        std::vector<std::int64_t> seen;
+        for (size_t k = 0; k < tracks.size(); ++k) {
+            const Track& t = tracks[k];
+            const std::string at = "tracks[" + std::to_string(k) + "]";
+            require(t.id >= 0 && t.id < next_id, fn, (at + ".id").c_str(), t.id,
+                    "in [0, next_id)");
+            require(std::find(seen.begin(), seen.end(), t.id) == seen.end(), fn,
+                    at + ".id " + std::to_string(t.id) + " is given twice");
+            seen.push_back(t.id);
+            require(std::isfinite(t.w0) && t.w0 > 0.0 && std::isfinite(t.h0) && t.h0 > 0.0, fn,
+                    at + ": w0 and h0 must be finite and > 0");
+            require(t.ref.size() > 0 && t.ref.size() == tracks[0].ref.size() &&
+                        t.ref.allFinite() && (t.ref.array() >= 0.0).all() && t.ref.sum() > 0.0,
+                    fn, at + ".ref must hold finite values >= 0 with a positive sum, as long as "
+                              "tracks[0].ref");
+            require(t.parents.rows() >= 1 && t.parents.cols() == 6 && t.parents.allFinite(), fn,
+                    at + ".parents must be a finite (N, 6) array with N >= 1");
+            require(t.existence > 0.0 && t.existence <= 1.0, fn, (at + ".existence").c_str(),
+                    t.existence, "in (0, 1]");
+        }
+        tracks_ = std::move(tracks);
+        next_id_ = next_id;
+    }
+
+    /// Moves the kept identities into the next frame's pixels by a similarity transform
+    /// `affine` (2 x 3, previous frame's pixels to this frame's): the kept samples' current and
+    /// previous centres are mapped, base sizes times z = sqrt|det| (the scales stay), as
+    /// warp_tracks moves the per-object filters. For camera-motion compensation.
+    void warp(const Eigen::Ref<const RowMatrixXd>& affine) {
+        const char* fn = "RJMCMCTracker.warp";
+        require(affine.rows() == 2 && affine.cols() == 3, fn, "affine must have shape (2, 3)");
+        require_finite(affine, fn, "affine");
+        const double z =
+            std::sqrt(std::abs(affine(0, 0) * affine(1, 1) - affine(0, 1) * affine(1, 0)));
+        require(z > 0.0, fn, "affine is singular (determinant 0), expected a similarity");
+        std::vector<Track> moved = tracks_;  // kept as they were if the result is not finite
+        for (Track& t : moved) {
+            for (Index n = 0; n < t.parents.rows(); ++n)
+                for (int c : {0, 3}) {
+                    const double x = t.parents(n, c), y = t.parents(n, c + 1);
+                    t.parents(n, c) = affine(0, 0) * x + affine(0, 1) * y + affine(0, 2);
+                    t.parents(n, c + 1) = affine(1, 0) * x + affine(1, 1) * y + affine(1, 2);
+                }
+            t.w0 *= z;
+            t.h0 *= z;
+            require(t.parents.allFinite() && std::isfinite(t.w0) && std::isfinite(t.h0), fn,
+                    "affine moves an identity out of the finite numbers");
+        }
+        tracks_ = std::move(moved);
+    }
 
     /// Builds one frame's model: previous identities first (in track order), then one newborn slot
     /// per candidate whose box holds foreground colour (an all-zero histogram cannot be a reference).

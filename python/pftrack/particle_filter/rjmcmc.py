@@ -323,6 +323,9 @@ class RJMCMCFilter:
         elif m.dtype != np.uint8:  # as hsv_bins refuses it (the core said ValueError)
             raise TypeError(f"{fn}: mask dtype is {m.dtype}, expected uint8 or bool")
         m = np.ascontiguousarray(m)
+        if m.shape != tuple(binned.shape):  # the core's message gave neither shape
+            shape = tuple(binned.shape)
+            raise ValueError(f"{fn}: mask has shape {m.shape}, expected the frame's {shape}")
         cands = real_array(candidates_cxcywh, f"{fn}: candidates_cxcywh")
         if cands.ndim == 1 and cands.size == 0:
             cands = np.zeros((0, 4))  # [] is no candidate, as np.zeros((0, 4))
@@ -356,9 +359,68 @@ class RJMCMCFilter:
                 out.append(RJTrack(int(row[0]), row[1:5].copy(), float(row[5])))
         return out
 
+    def __getstate__(self) -> dict[str, Any]:
+        """The filter's state for pickle and deepcopy: a checkpoint of the run.
+
+        The chain's kept identities and next id are read from the core (which has no pickled
+        form of its own) and given back to a new core by :meth:`__setstate__`: the copy goes on
+        exactly as the original (the same draws: the seed and step number are kept).
+        """
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, "RJMCMCFilter (pickle/deepcopy)")
+        try:
+            state = self.__dict__.copy()
+            del state["_busy"]  # a lock is not copied: the copy is free
+            core = state.pop("_core")
+            state["_core_state"] = (core.tracks, core.next_id)
+        finally:
+            self._busy.release()
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        tracks, next_id = state.pop("_core_state")
+        self.__dict__.update(state)
+        self._busy = threading.Lock()
+        self._core = _core.RJMCMCTracker(**self.config.core_kwargs())
+        self._core.restore(tracks, next_id)
+
+    def warp(self, affine: ArrayLike) -> None:
+        """Move the kept identities into the next frame by a similarity transform.
+
+        Camera-motion compensation, as :func:`~pftrack.tracking.camera.warp_tracks` moves the
+        per-object filters: every kept sample's current and previous centre is mapped by
+        `affine`, each identity's base size multiplied by its zoom ``sqrt|det|``.
+
+        Parameters
+        ----------
+        affine : (2, 3) array_like of float
+            From the previous frame's pixels to the next frame's.
+
+        Raises
+        ------
+        ValueError
+            `affine` not a finite (2, 3) array, singular, or moving an identity beyond the
+            finite numbers (the identities are then left as they were).
+        RuntimeError
+            Another thread is inside this filter.
+        """
+        a = np.ascontiguousarray(real_array(affine, "RJMCMCFilter.warp: affine"))
+        if not self._busy.acquire(blocking=False):
+            raise _in_use(self, "RJMCMCFilter.warp")
+        try:
+            self._core.warp(a)
+        finally:
+            self._busy.release()
+
     @property
     def acceptance(self) -> dict[str, float]:
-        """Acceptance rate per move in the last frame (NaN for a move never proposed)."""
+        """Acceptance rate per move in the last frame (NaN for a move never proposed).
+
+        Accepted / proposed over the `n_samples` kept iterations (burn-in left out); a move
+        impossible in the chain's state (a death or update with no object, a swap with fewer
+        than two, a birth with every slot present) leaves the chain as it is and is not counted
+        as proposed. The counts are ``last["acceptance"][move] = (accepted, proposed)``.
+        """
         acc = self.last.get("acceptance", {})
         return {k: (a / p if p else float("nan")) for k, (a, p) in acc.items()}
 

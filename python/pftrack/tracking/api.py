@@ -422,10 +422,10 @@ class Tracker:
     One tracker is one run: use one per video and per thread. A second thread calling a
     method while another is inside one raises RuntimeError (as does the C++ background model
     under any other path). ``copy.deepcopy(tracker)`` or a pickle of it (at any protocol, 0
-    to 5) is a checkpoint at any point of a run with the built-in ``"paper"`` detector and the
-    ``"sis"`` or ``"mh"`` sampler: the copy goes on exactly as the original. OpenCV's MOG2/KNN
-    and the RJ-MCMC chain cannot be copied once they have seen a frame (TypeError naming the
-    option); a checkpoint taken while another thread is inside a method raises RuntimeError,
+    to 5) is a checkpoint at any point of a run with the built-in ``"paper"`` detector (or
+    given detections) and any sampler: the copy goes on exactly as the original. OpenCV's
+    MOG2/KNN cannot be copied once they have seen a frame (TypeError naming the option); a
+    checkpoint taken while another thread is inside a method raises RuntimeError,
     and ``copy.copy`` (which would share the run's state) raises TypeError. To keep a
     checkpoint in a file, ``pickle.dumps`` it first and write the bytes atomically (a refused
     pickle then leaves the last file whole; docs/api.md).
@@ -653,16 +653,12 @@ class Tracker:
     def _refuse_copy(self) -> None:
         """TypeError naming the option when the run holds state that cannot be copied.
 
-        The RJ-MCMC chain (from the first frame) and OpenCV's background subtractors (from
-        :meth:`prime` or the first frame that uses them) live outside Python: pickle would
-        otherwise say only ``cannot pickle 'cv2.BackgroundSubtractorMOG2' object``.
+        OpenCV's background subtractors (from :meth:`prime` or the first frame that uses
+        them) live outside Python: pickle would otherwise say only ``cannot pickle
+        'cv2.BackgroundSubtractorMOG2' object``. The RJ-MCMC chain is copied through
+        :class:`~pftrack.particle_filter.RJMCMCFilter`'s own state (since 5 December 2026;
+        it was refused).
         """
-        joint = getattr(self._tracker, "_joint", None)
-        if getattr(joint, "_filter", None) is not None:
-            raise TypeError(
-                "sampler='rjmcmc' cannot be checkpointed (pickle/deepcopy) once it has seen a "
-                "frame: its chain lives in the C++ core; use 'sis' or 'mh'"
-            )
         detector = getattr(self._tracker, "_detector", None)
         if isinstance(getattr(detector, "_sub", None), cv2.BackgroundSubtractor):
             raise TypeError(

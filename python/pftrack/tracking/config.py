@@ -95,6 +95,37 @@ def _in_range(
         raise ValueError(f"{owner}: {name} is {v}, expected {expected}")
 
 
+#: ``RJMCMCConfig`` settings the tracker replaces with its per-object filters' (``joint_config``),
+#: with the ``FilterConfig`` setting that gives each.
+_JOINT_FROM_FILTER = {
+    "n_samples": "filter.n_particles (Tracker's particles)",
+    "a": "filter.model (Ar2Model's velocity_gain)",
+    "b": "filter.model (Ar2Model's velocity_gain)",
+    "sigma": "filter.model (Ar2Model's sigma_xy, sigma_s)",
+    "s_min": "filter.model.s_min",
+    "s_max": "filter.model.s_max",
+}
+
+
+def _joint_settings_used(config: TrackerConfig) -> None:
+    """Refuse an ``rjmcmc`` setting the tracker would replace with its filter's, so do nothing.
+
+    The joint sampler takes its sample count and AR(2) dynamics from ``filter`` (so that only
+    the sampler differs between sis, mh and rjmcmc); any other value than RJMCMCConfig's default
+    was dropped without a word (``RJMCMCConfig(n_samples=500)`` ran 100 samples).
+    """
+    default = RJMCMCConfig()
+    for name, where in _JOINT_FROM_FILTER.items():
+        v = getattr(config.rjmcmc, name)
+        if np.array_equal(v, getattr(default, name)):
+            continue
+        shown_v = list(np.asarray(v, float).tolist()) if name in ("a", "b", "sigma") else v
+        raise ValueError(
+            f"rjmcmc.{name} is {shown_v}, but the joint sampler takes it from {where}, so "
+            "it would do nothing: set it there (the same budget and dynamics for every sampler)"
+        )
+
+
 def _none_or_int_in(config: object, name: str, lo: int, hi: int, none: str = "None") -> None:
     """`config.name` must be None or an int (not a bool) in [lo, hi] (`none`: None's name)."""
     v = getattr(config, name)
@@ -616,7 +647,9 @@ class TrackerConfig:
         comparison samplers.
     rjmcmc : RJMCMCConfig
         Settings of the joint sampler (used with ``sampler="rjmcmc"``); its sample count and
-        AR2 dynamics are set from ``filter`` so that budgets and models compare.
+        AR2 dynamics are set from ``filter`` so that budgets and models compare: its
+        `n_samples`, `a`, `b`, `sigma`, `s_min` and `s_max` must keep RJMCMCConfig's defaults
+        (ValueError naming the ``filter`` setting to use instead).
     detector : {"paper", "mog2", "knn"}
         Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections.
     reference_rate : float
@@ -711,6 +744,7 @@ class TrackerConfig:
                 "needs a per-object sampler ('sis' or 'mh'; --sampler): the joint 'rjmcmc' "
                 "sampler moves each object on its own state"
             )
+        _joint_settings_used(self)
         if self.camera_motion not in CAMERA_MOTION:
             raise ValueError(
                 f"camera_motion is {self.camera_motion!r}, expected 'auto', 'on' or 'off'"

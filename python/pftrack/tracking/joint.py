@@ -68,6 +68,11 @@ class JointTracker:
         """Objects the sampler has estimated so far (each with its own id)."""
         return len(self._ids)
 
+    def warp(self, affine: F64) -> None:
+        """Move the sampler's identities by the camera's motion (a (2, 3) similarity)."""
+        if self._filter is not None:
+            self._filter.warp(affine)
+
     def step(self, frame_index: int, binned: BinnedImage, mask: NDArray[np.uint8], boxes: F64,
              scores: F64, index: NDArray[np.intp]) -> list[Track]:  # fmt: skip
         """One frame: `boxes` (xywh) are the birth candidates, `index` their input positions."""

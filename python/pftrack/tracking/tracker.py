@@ -711,6 +711,7 @@ class MultiObjectTracker:
         step = self.camera.update(f, objects)
         if step.apply is not None:
             warp_tracks(self.tracks, step.apply)
+            self._joint.warp(step.apply)  # until 5 December the joint sampler's were not moved
         self._background_ok = step.background_ok
         self.camera_step = step
         boxes, scores, binned = self._detections(f, given)
