@@ -237,8 +237,9 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``pftrack track``; return the exit status.
 
-    What it has to say (warnings on stderr, the summary on stdout) is printed once every output
-    is written: a closed stdout (``| head``) then costs the messages, never the files.
+    Warnings go to stderr as they are raised (above the progress bar); the summary goes to
+    stdout once every output is written: a closed stdout (``| head``) then costs the summary,
+    never the files.
     """
     import numpy as np
 

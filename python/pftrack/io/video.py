@@ -1579,6 +1579,9 @@ class FrameSource:
         self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
         self._warned_lost = False  # frames inside the video could not be decoded
         self._warned_lead = False  # its first frames could not be decoded (_warn_lead)
+        #: how many of its first frames did not decode and are black stand-ins (0: none, or
+        #: not read yet); known once its first frame is read
+        self.lead_black = 0
         self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
         self._reading = False  # a thread is inside the live capture's read()
@@ -2195,6 +2198,7 @@ class FrameSource:
 
     def _warn_lead(self, index: int) -> None:
         """Warn, once, that the first `index` frames could not be decoded (stand-ins given)."""
+        self.lead_black = index
         if self._warned_lead:
             return
         self._warned_lead = True

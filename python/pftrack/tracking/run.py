@@ -6,7 +6,7 @@ import os
 import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from contextlib import closing, nullcontext
+from contextlib import ExitStack, closing, nullcontext
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,6 +27,7 @@ from pftrack._progress import progress
 from pftrack._text import counted
 from pftrack._typing import F64, BootstrapMode, FillMode, IntLike, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
+from pftrack.detection.paper import DARK_FRAMES
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource, SequenceInfo
@@ -326,11 +327,13 @@ def track_frames(
         )
     else:
         stream = closing(prefetch(frames))
-    with stream as decoded:
+    with ExitStack() as quiet, stream as decoded:  # the reading threads stop first
         for n, frame in enumerate(
             progress(decoded, total=total, desc="tracking", enable=show_progress, unit="frame"),
             start=1,
         ):
+            if n == 1:  # the source knows by now whether its first frames are stand-ins
+                _stand_ins_said(quiet, getattr(frames, "lead_black", 0))
             settled = tracker.n_settled
             if detections is None:
                 tracker.update(None, frame)
@@ -359,6 +362,25 @@ def track_frames(
                 stacklevel=2,
             )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+
+
+def _stand_ins_said(quiet: ExitStack, lead: int) -> None:
+    """Keep quiet, for this run, the warnings the `lead` black stand-ins would raise.
+
+    A video whose first `lead` frames did not decode is read with black frames in their place,
+    which its reader says (:class:`~pftrack.io.video.FrameSource`). The tracker would then
+    also call frame 1 blank ("placeholder frames? give the real ones") and the detector, from
+    :data:`~pftrack.detection.paper.DARK_FRAMES` of them, the frames from 1 on dark ("lights
+    switched off?"): advice about the footage that is wrong for stand-ins. Called at the
+    run's first frame, before the tracker takes it; the detection thread is then at most a
+    few frames ahead (its queues), fewer than ``DARK_FRAMES``.
+    """
+    if lead < 1:
+        return
+    quiet.enter_context(warnings.catch_warnings())
+    warnings.filterwarnings("ignore", r"frame 1 is blank \(", UserWarning)
+    if lead >= DARK_FRAMES:
+        warnings.filterwarnings("ignore", r"the frames from 1 on are dark \(", UserWarning)
 
 
 def _check_frames(frames: object) -> None:
