@@ -541,12 +541,17 @@ def test_failing_sequence_is_reported_and_the_others_finish(
     assert ": error:" not in out_text and "broken  " in out_text
     summary = json.loads((out / "summary.json").read_text())
     status = {s["name"]: s["status"] for s in summary["sequences"]}
-    # walk.avi and plain/ have no det.txt: with --detections auto they fail too, by name
+    # walk.avi, plain/ and broken.avi have no det.txt: with --detections auto they fail too, by
+    # name, refused before they reach the cluster (tests/batch/test_scheduler_trial.py)
     assert status == {"walk": "failed", "MOT-01": "done", "plain": "failed", "broken": "failed"}
     errors = {s["name"]: s["error"] for s in summary["sequences"] if s["status"] == "failed"}
-    assert "cannot decode a frame" in errors["broken"] and "no det/det.txt" in errors["walk"]
-    assert "broken: error: cannot decode a frame" in text
+    assert "no det/det.txt" in errors["broken"] and "no det/det.txt" in errors["walk"]
+    assert "broken: error: --detections auto: sequence broken has no det/det.txt" in text
     assert sorted(p.name for p in out.iterdir()) == ["MOT-01.json", "MOT-01.txt", "summary.json"]
+    # the video that cannot be read, on a worker, among others: its own error
+    argv = ["batch", str(broken), str(data / "MOT-01"), "--out", str(tmp_path / "out2"), *FAST]
+    assert main([*argv, "--scheduler", client.scheduler.address]) == 1
+    assert "broken: error: cannot decode a frame" in capsys.readouterr().err
     # --detections auto is `pftrack track --detections SEQ/det/det.txt`
     single = tmp_path / "single.txt"
     det = data / "MOT-01" / "det" / "det.txt"

@@ -8,12 +8,14 @@ one (the watch of the workers is given the scheduler's counts).
 from __future__ import annotations
 
 import contextlib
+import functools
+import json
 import logging
 import re
 import socket
 import sys
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -186,3 +188,178 @@ def test_workers_or_a_scheduler_back_after_the_warning_are_said(
         ],
         [],
     ]
+
+
+def _interrupted_at(
+    monkeypatch: pytest.MonkeyPatch, n: int, before: Callable[[], None] = lambda: None
+) -> None:
+    """Ctrl-C as the batch (in this process) starts its `n`-th task, after calling `before`."""
+    from pftrack.batch import engine
+
+    calls = []
+    real = engine.call_task
+
+    def stop_at_the_nth(*args: Any, **kwargs: Any) -> Any:
+        calls.append(1)
+        if len(calls) == n:
+            before()
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(engine, "call_task", stop_at_the_nth)
+
+
+def _tracks(folder: Path, names: list[str]) -> None:
+    folder.mkdir(exist_ok=True)
+    for name in names:
+        (folder / f"{name}.txt").write_text("1,1,10,10,5,5,1,-1,-1,-1\n3,1,12,10,5,5,1,-1,-1,-1\n")
+
+
+def test_a_ctrl_c_prints_the_table_of_what_finished(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The trial: after a Ctrl-C, what had finished was only in ``summary.json``. The table a
+    batch that ends prints is printed too (done, skipped, failed and cancelled rows), the
+    errors on stderr, then the line that says what was left; exit status 130 as before."""
+    folder = tmp_path / "in"
+    _tracks(folder, ["a"])
+    out = tmp_path / "out"
+    assert main(["smooth", str(folder), "--out", str(out), "--workers", "0"]) == 0
+    _tracks(folder, ["b", "c", "d"])
+    (folder / "bad.txt").write_text("not,a,row\n")
+    capsys.readouterr()
+    _interrupted_at(monkeypatch, 3)  # b done, bad failed, Ctrl-C at c
+    assert main(["smooth", str(folder), "--out", str(out), "--workers", "0"]) == 130
+    stdout, stderr = capsys.readouterr()
+    rows = {line.split()[0]: line.split()[1] for line in stdout.splitlines()[1:6]}
+    assert rows == {
+        "a": "skipped", "b": "done", "bad": "failed", "c": "cancelled", "d": "cancelled"
+    }  # fmt: skip
+    assert stdout.splitlines()[6].startswith("5 files: 1 done, 1 skipped, 1 failed, 2 cancelled;")
+    assert len(stdout.splitlines()) == 7  # no "summary ->": the last line names it
+    *errors, last = stderr.splitlines()
+    assert [e.split(": error: ")[0] for e in errors] == ["bad"]
+    assert last == (
+        "pftrack smooth: interrupted; the outputs of the 1 file finished are written and "
+        f"complete; {out / 'summary.json'} lists the rest as cancelled (re-run to finish them)"
+    )
+    # stopped before the run began: nothing to show
+    monkeypatch.setattr("pftrack.batch.engine._make_out_dir", _raise_ctrl_c)
+    assert main(["smooth", str(folder), "--out", str(tmp_path / "o2"), "--workers", "0"]) == 130
+    assert capsys.readouterr().out == ""
+
+
+def _raise_ctrl_c(*args: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def test_a_ctrl_c_after_out_was_removed_says_so_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The table of an interrupted batch whose ``--out`` went meanwhile: why ``summary.json``
+    is not written is said once, in the last line (not also among the errors)."""
+    import shutil
+
+    folder = tmp_path / "in"
+    _tracks(folder, ["a", "b"])
+    out = tmp_path / "out"
+    _interrupted_at(monkeypatch, 2, lambda: shutil.rmtree(out))
+    assert main(["smooth", str(folder), "--out", str(out), "--workers", "0"]) == 130
+    stdout, stderr = capsys.readouterr()
+    assert [line.split()[:2] for line in stdout.splitlines()[1:3]] == [
+        ["a", "done"], ["b", "cancelled"]
+    ]  # fmt: skip
+    assert stderr.count("was removed while the batch ran") == 1
+    assert stderr.startswith("pftrack smooth: interrupted; --out ")
+
+
+def _fails_alike(k: int, error: str, *args: Any) -> TaskResult:
+    raise ValueError(error)
+
+
+def test_sequences_that_fail_alike_are_said_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The trial: 29 sequences left failed ``no worker on the scheduler ... for 8 s``, one line
+    each, the same text 29 times. An error is said once, with the count and the names (three,
+    then ``...``); a task's own error stays its own line; the entries keep each error."""
+    lost = "no worker on the scheduler at tcp://127.0.0.1:8799 for 8 s"
+    jobs = [Job(f"cam{k}", _fails_alike, (k, lost), ()) for k in range(1, 6)]
+    jobs.insert(2, Job("odd", _fails_alike, (0, "its own error"), ()))
+    jobs.append(Job("pair", _fails_alike, (0, "twice"), ()))
+    jobs.append(Job("pair2", _fails_alike, (0, "twice"), ()))
+    summary = run_jobs(jobs, tmp_path, kind="track", settings={}, n_workers=0)
+    assert summary.problems() == [
+        f"5 sequences (cam1, cam2, cam3, ...): error: {lost}",
+        "odd: error: its own error",
+        "2 sequences (pair, pair2): error: twice",
+    ]
+    errors = [lost, lost, "its own error", lost, lost, lost, "twice", "twice"]
+    assert [e["error"] for e in summary.entries] == errors
+    on_disk = json.loads((tmp_path / "summary.json").read_text())["sequences"]
+    assert [e["error"] for e in on_disk] == [e["error"] for e in summary.entries]
+    assert summary.table().splitlines()[-3:] == summary.problems()
+    # the command: on stderr, once
+    _tracks(tmp_path / "in", [f"t{k}" for k in range(5)])
+    monkeypatch.setattr("pftrack.batch.api.smooth_file", functools.partial(_fails_alike, 0, lost))
+    argv = ["smooth", str(tmp_path / "in"), "--out", str(tmp_path / "o"), "--workers", "0"]
+    assert main(argv) == 1
+    assert capsys.readouterr().err == f"5 files (t0, t1, t2, ...): error: {lost}\n"
+
+
+def test_a_sequence_certain_to_fail_on_detections_auto_is_not_sent(
+    scheduler: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The trial: with ``--detections auto``, each video and image folder without
+    ``det/det.txt`` was sent to the cluster as a task, certain to fail on its worker. They are
+    refused on the client, before the cluster starts work, as the same failed entry with the
+    same message; the others run. None to run: no cluster is asked for."""
+    from pftrack.batch import engine, find_sequences, track_many, track_sequence
+    from pftrack.batch.tasks import TrackOptions
+    from pftrack.io.mot import write_mot
+    from pftrack.synthetic import make_scene
+
+    root = tmp_path / "in"
+    root.mkdir()
+    scene = make_scene(n_frames=8, width=96, height=72, n_walkers=2, rng=0)
+    scene.write_video(root / "walk.avi")
+    scene.write_images(root / "plain", ext=".png")
+    scene.write_images(root / "MOT-01" / "img1", ext=".png")
+    (root / "MOT-01" / "det").mkdir()
+    det = scene.truth.copy()
+    det[:, 1] = -1
+    write_mot(root / "MOT-01" / "det" / "det.txt", det)
+    options = TrackOptions(detections="auto")
+    sent: list[list[str]] = []
+    real = engine._run_on_dask
+
+    def spied(c: Any, pending: Any, *args: Any) -> None:
+        sent.append([job.name for job in pending])
+        real(c, pending, *args)
+
+    monkeypatch.setattr(engine, "_run_on_dask", spied)
+    summary = track_many(root, tmp_path / "out", scheduler=scheduler, options=options)
+    assert sent == [["MOT-01"]]
+    status = {e["name"]: e["status"] for e in summary.entries}
+    assert status == {"MOT-01": "done", "plain": "failed", "walk": "failed"}
+    for seq in find_sequences(root):
+        if seq.name != "MOT-01":  # the message the task raises
+            with pytest.raises(ValueError) as raised:
+                track_sequence(seq, options)
+            (entry,) = [e for e in summary.entries if e["name"] == seq.name]
+            assert entry["error"] == str(raised.value)
+            assert entry["error"].endswith(f"sequence {seq.name} has no det/det.txt (nor det.txt)")
+            assert entry["refused"] is True and "host" not in entry
+    # all refused: no cluster connected to nor started, the batch's summary as usual
+    monkeypatch.setattr(engine, "dask_client", _no_cluster)
+    summary = track_many(
+        [root / "walk.avi", root / "plain"], tmp_path / "out2", scheduler=scheduler,
+        options=options,
+    )  # fmt: skip
+    assert [e["status"] for e in summary.entries] == ["failed", "failed"]
+    assert "2 sequences: 2 failed; " in summary.table() and "nothing to run" in summary.table()
+    assert (tmp_path / "out2" / "summary.json").is_file()
+
+
+def _no_cluster(*args: Any, **kwargs: Any) -> Any:
+    raise AssertionError("a cluster was asked for")

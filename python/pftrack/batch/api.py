@@ -15,6 +15,7 @@ from pftrack.batch.tasks import (
     SmoothOptions,
     TaskResult,
     TrackOptions,
+    missing_detections,
     recover_file,
     sequence_length,
     smooth_file,
@@ -136,6 +137,8 @@ def track_many(
             s.files,
             functools.partial(sequence_length, s),
             guards=_guards(s),
+            # certain to fail: reported failed without a task (was: sent to the cluster)
+            refused=missing_detections(s, opts),
         )
         for s in seqs
     ]

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._check import brief, flag, shown
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
-from pftrack._text import counted
+from pftrack._text import counted, listed
 from pftrack._threads import usable_cpus
 from pftrack.batch.inputs import cannot_read
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
@@ -95,6 +95,11 @@ class Job:
     guards : tuple of Path
         The files inside `reads` the task reads too, which outputs may not be either (the
         images of a folder); not fingerprinted.
+    refused : str, optional
+        Why the task is certain to fail, known on the client (``--detections auto`` for a
+        sequence without ``det/det.txt``): it is not sent to the cluster, nor run, but
+        reported failed with this error (its entry says ``"refused": true``), while the
+        others run. Was: sent as a task, which failed on its worker.
     """
 
     name: str
@@ -103,6 +108,7 @@ class Job:
     reads: tuple[Path, ...]
     count: Callable[[], int | None] | None = None
     guards: tuple[Path, ...] = ()
+    refused: str | None = None
 
 
 @dataclass
@@ -207,8 +213,10 @@ class BatchSummary:
             f"{n} {s}" for s in _STATUSES if (n := sum(e["status"] == s for e in self.entries))
         )
         where = counted(self.workers, "worker") if self.workers else "in this process"
-        if not self.workers and all(e["status"] == "skipped" for e in self.entries):
-            where = "nothing to run"  # no cluster is started or asked for skipped inputs
+        if not self.workers and all(
+            e["status"] == "skipped" or e.get("refused") for e in self.entries
+        ):  # no cluster is started or asked for skipped inputs, nor for those refused
+            where = "nothing to run"
         if self.scheduler:
             where += f" at {self.scheduler}"
         noun = "sequence" if self.kind == "track" else "file"
@@ -225,14 +233,27 @@ class BatchSummary:
             text.extend(self.problems())
         return "\n".join(text)
 
-    def problems(self) -> list[str]:
+    def problems(self, unwritten: bool = True) -> list[str]:
         """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``).
 
-        Last, ``error: DIR/summary.json not written (...)`` if it could not be.
+        An error that several tasks failed with is said once, with their count and names (the
+        first three): ``29 sequences (cam01, cam02, cam03, ...): error: ...``; each entry keeps
+        its own.
+
+        Last, ``error: DIR/summary.json not written (...)`` if it could not be (and
+        `unwritten`: an interrupted batch's last line says it instead).
         """
         text = [f"{e['name']}: warning: {w}" for e in self.entries for w in e.get("warnings", ())]
-        text.extend(f"{e['name']}: error: {e['error']}" for e in self.failed)
-        if self.unwritten:
+        # one error said once, where several tasks failed with it (was: once per task, 29
+        # identical lines for 29 sequences on a cluster that had lost its workers, a trial)
+        alike: dict[str, list[str]] = {}
+        for e in self.failed:
+            alike.setdefault(e["error"], []).append(e["name"])
+        noun = "sequence" if self.kind == "track" else "file"
+        for error, names in alike.items():
+            who = names[0] if len(names) == 1 else f"{counted(len(names), noun)} ({listed(names)})"
+            text.append(f"{who}: error: {error}")
+        if self.unwritten and unwritten:
             text.append(f"error: {self.unwritten}")
         return text
 
@@ -2097,7 +2118,8 @@ def run_jobs(
     KeyboardInterrupt
         After cancelling the tasks still running and closing the cluster this started; the
         outputs written so far are complete. What the batch left (nothing, or how many tasks'
-        outputs) is attached: :func:`interrupted_left`.
+        outputs) is attached: :func:`interrupted_left`; once the run began, its summary too
+        (:func:`interrupted_summary`), the finished tasks' entries and the rest cancelled.
     """
     _check_arguments(out_dir, n_workers, force, show_progress)
     address = where_to_run(client, scheduler, n_workers)  # checked even when nothing is to run
@@ -2108,7 +2130,10 @@ def run_jobs(
     notes: dict[str, str] = {}
     prints = {job.name: fingerprint(job.reads) for job in jobs}  # before the tasks read them
     pending: list[Job] = []
+    refused = [job for job in jobs if job.refused is not None]  # certain to fail: not sent
     for job in jobs:
+        if job.refused is not None:
+            continue
         earlier, note = (
             (None, None) if force else _complete(out, job, kind, settings, prints[job.name])
         )
@@ -2157,6 +2182,10 @@ def run_jobs(
                 entries[job.name]["host"] = outcome.host
         if job.name in notes:
             entries[job.name]["note"] = notes[job.name]
+
+    for job in refused:  # before the cluster starts: the scheduler never sees them
+        record(job, Outcome(None, job.refused))
+        entries[job.name]["refused"] = True
 
     on_dask = bool(pending) and n_workers != 0
     if on_dask and client is None:
@@ -2233,6 +2262,8 @@ def run_jobs(
                     )
     except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM: say what it left, truthfully
         _say_interrupted(exc, out, kind, written if touched else None, summary.unwritten)
+        if touched:  # its table, as a batch that ends prints it (was: in summary.json alone)
+            exc.pftrack_batch_summary = summary  # type: ignore[attr-defined]
         raise
     return summary
 
@@ -2256,8 +2287,7 @@ def _out_removed(out: Path, made: tuple[int, int] | None, summary: BatchSummary)
     ]  # those written into a folder made again meanwhile are there
     noun = "sequence" if summary.kind == "track" else "file"
     if lost:
-        shown = ", ".join(lost[:3]) + (", ..." if len(lost) > 3 else "")
-        what = f"the outputs of {counted(len(lost), noun)} ({shown}) went with it, and "
+        what = f"the outputs of {counted(len(lost), noun)} ({listed(lost)}) went with it, and "
     else:
         what = "no output had been written in it; "
     again = " to make them again" if lost else ""
@@ -2342,6 +2372,16 @@ def interrupted_left(exc: BaseException) -> str | None:
     """What an interrupted batch left, as :func:`run_jobs` attached it to `exc` (or None)."""
     text = getattr(exc, "pftrack_batch_left", None)
     return text if isinstance(text, str) else None
+
+
+def interrupted_summary(exc: BaseException) -> BatchSummary | None:
+    """The summary of an interrupted batch, as :func:`run_jobs` attached it to `exc`.
+
+    Its entries are those of ``summary.json`` (``done``, ``skipped``, ``failed``, the rest
+    ``cancelled``); None when the batch stopped before its run began (nothing written).
+    """
+    summary = getattr(exc, "pftrack_batch_summary", None)
+    return summary if isinstance(summary, BatchSummary) else None
 
 
 #: Seconds a batch waits for a worker on a cluster that has none, unless Dask's

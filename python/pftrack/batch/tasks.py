@@ -39,6 +39,7 @@ __all__ = [
     "TaskCancelled",
     "TaskResult",
     "TrackOptions",
+    "missing_detections",
     "read_tracks",
     "recover_file",
     "reporting_frames",
@@ -327,6 +328,19 @@ def sequence_metrics(
     return {k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in out.items()}
 
 
+def missing_detections(seq: SequenceInput, options: TrackOptions) -> str | None:
+    """Why `seq` cannot be tracked with `options`' detections, or None.
+
+    ``detections="auto"`` and `seq` has no ``det/det.txt`` (nor ``det.txt``): a video or an
+    image folder of its own. :func:`track_sequence` raises it as a ``ValueError``, and
+    :func:`~pftrack.batch.track_many` refuses such a sequence on the client, before the
+    cluster starts work.
+    """
+    if options.detections == "auto" and seq.detections is None:
+        return f"--detections auto: sequence {seq.name} has no det/det.txt (nor det.txt)"
+    return None
+
+
 def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     """Track one sequence as ``pftrack track`` would; score it where it has ground truth.
 
@@ -352,18 +366,15 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
 
     cpu = time.process_time()
     report, stop = running_task()
+    missing = missing_detections(seq, options)  # first: the batch refuses it on the client
+    if missing is not None:
+        raise ValueError(missing)
     frames = FrameSource(seq.frames)
     # the boxes of det.txt and gt.txt are in seqinfo.ini's pixels
     auto_scale = info_scale(
         (frames.width, frames.height), (seq.image_width, seq.image_height), seq.name
     )
-    det = None
-    if options.detections == "auto":
-        if seq.detections is None:
-            raise ValueError(
-                f"--detections auto: sequence {seq.name} has no det/det.txt (nor det.txt)"
-            )
-        det = seq.detections
+    det = seq.detections if options.detections == "auto" else None
     det_scale = options.det_scale if options.det_scale is not None else auto_scale
     # the ground truth's pixels: seqinfo.ini's size when it gives one, else those of the given
     # detections' scale (det.txt and gt.txt of one sequence share them; was: 1, and MOTA -100

@@ -228,11 +228,17 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
             summary = call()
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
-        from pftrack.batch.engine import interrupted_left
+        from pftrack.batch.engine import interrupted_left, interrupted_summary
 
         # none said: it stopped before the batch's run (scanning the inputs, ...)
         left = interrupted_left(exc) or "nothing was written: it stopped before the run began"
-        print(f"{line_end()}pftrack {command}: {how}; {left}", file=sys.stderr)
+        stopped = interrupted_summary(exc)
+        end = line_end()  # after the progress bar's line
+        if stopped is not None:  # the table a batch that ends prints (was: summary.json alone)
+            sys.stderr.write(end)
+            end = ""
+            _print_table(stopped, unwritten=False)  # the last line says why, if it is not
+        print(f"{end}pftrack {command}: {how}; {left}", file=sys.stderr)
         return exit_status(exc)
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
         hint = "; or --workers 0: in this process, without Dask" if exc.name in _DASK else ""
@@ -241,14 +247,22 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
     for e in summary.entries if explain else ():
         if e.get("explain"):
             print(f"{e['name']}:\n{e['explain']}")
-    print(summary.table(problems=False))
-    problems = summary.problems()
-    if problems:  # on stderr: stdout's table stays parseable
-        sys.stdout.flush()
-        print("\n".join(problems), file=sys.stderr)
+    _print_table(summary)
     if summary.unwritten is None:  # else said with the problems
         print(f"summary -> {summary.out_dir / 'summary.json'}")
     return EXIT_SOME_FAILED if summary.failed or summary.unwritten else 0
+
+
+def _print_table(summary: BatchSummary, unwritten: bool = True) -> None:
+    """`summary`'s table on stdout, its problems on stderr (stdout's table stays parseable).
+
+    `unwritten`: with the line that says why ``summary.json`` is not written, if it is not.
+    """
+    print(summary.table(problems=False))
+    problems = summary.problems(unwritten=unwritten)
+    if problems:
+        sys.stdout.flush()
+        print("\n".join(problems), file=sys.stderr)
 
 
 def _where(args: argparse.Namespace) -> dict[str, Any]:
