@@ -2540,6 +2540,8 @@ def test_tls_runs_with_dasks_tls_settings(tmp_path: Path) -> None:
     import dask
     from distributed.security import Security
 
+    from pftrack.batch.engine import NO_MALLOC_TRIM
+
     openssl = shutil.which("openssl")
     if openssl is None:
         pytest.skip("no openssl to make a certificate")
@@ -2553,7 +2555,9 @@ def test_tls_runs_with_dasks_tls_settings(tmp_path: Path) -> None:
     )  # fmt: skip
     paths = _tracks_files(tmp_path / "tracks")
     out = tmp_path / "out"
-    with distributed.LocalCluster(
+    # not Dask's MALLOC_TRIM_THRESHOLD_, which its nanny would leave in this process's
+    # environment for later clusters' workers (see test_workers_are_single_threaded)
+    with dask.config.set({NO_MALLOC_TRIM: None}), distributed.LocalCluster(
         n_workers=1, threads_per_worker=1, host="127.0.0.1", protocol="tls://",
         security=security, dashboard_address=None, scheduler_kwargs=NO_DASHBOARD,
     ) as cluster:  # fmt: skip

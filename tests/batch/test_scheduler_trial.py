@@ -60,8 +60,17 @@ def _said_by(name: str) -> Iterator[list[str]]:
 
 @pytest.fixture(scope="module")
 def scheduler() -> Iterator[str]:
-    """The address of a running cluster of one worker, as ``dask scheduler`` gives one."""
-    with distributed.LocalCluster(
+    """The address of a running cluster of one worker, as ``dask scheduler`` gives one.
+
+    Without Dask's MALLOC_TRIM_THRESHOLD_: its nanny sets it in this process's environment
+    for good (``os.environ.update`` before the spawn), and every later cluster's workers,
+    pftrack's too, would inherit it (``test_workers_are_single_threaded`` failed after this).
+    """
+    import dask
+
+    from pftrack.batch.engine import NO_MALLOC_TRIM
+
+    with dask.config.set({NO_MALLOC_TRIM: None}), distributed.LocalCluster(
         n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
         scheduler_kwargs=NO_DASHBOARD,
     ) as cluster:  # fmt: skip
