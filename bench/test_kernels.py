@@ -32,8 +32,8 @@ Case = tuple[str, BinnedImage, F64, F64, int, str]  # name, frame, boxes, ref, p
 
 #: Least speed-up of pftrack's call over a baseline in the same run: (group prefix, pftrack
 #: role, baseline) -> floor. Measured (README, docs/results.md#kernels): histograms + weights
-#: 36-327x NumPy's per-box loop (the public two calls; 67-327x fused, core or public), resampling 66-119x
-#: filterpy. A floor about a third of the least measured ratio or below.
+#: 36-327x NumPy's per-box loop (the public two calls; 67-327x fused, core or public),
+#: resampling 66-119x filterpy. A floor about a third of the least measured ratio or below.
 FLOORS = {
     ("histograms+weights", "fused", "numpy"): 10.0,
     ("histograms+weights", "core", "numpy"): 10.0,

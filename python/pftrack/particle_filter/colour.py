@@ -14,6 +14,7 @@ References
 
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import dataclass
 
@@ -116,8 +117,8 @@ def hsv_bins(
     Raises
     ------
     TypeError
-        A frame that is not uint8, a mask that is not uint8 or bool, a `binning` that is not
-        an :class:`HsvBinning`.
+        A frame that is not uint8 (a uint16 frame's message names the conversion), a mask
+        that is not uint8 or bool, a `binning` that is not an :class:`HsvBinning`.
     ValueError
         A frame not of shape (H, W, 3) (a grey or BGRA frame's message names the
         ``cv2.cvtColor`` conversion), an empty frame, or a mask of another size.
@@ -136,17 +137,18 @@ def hsv_bins(
     """
     if not isinstance(binning, HsvBinning):
         raise TypeError(f"hsv_bins: binning must be an HsvBinning, got {shown(binning)}")
-    f = _frame(frame)
+    fn = "hsv_bins"
+    f = _frame(frame, f"{fn}: frame")
     m = None
     if mask is not None:
         m = np.asarray(mask)
         if m.dtype not in (np.uint8, np.bool_):
-            raise TypeError(f"mask dtype is {m.dtype}, expected uint8 or bool")
+            raise TypeError(f"{fn}: mask dtype is {m.dtype}, expected uint8 or bool")
         if m.shape != f.shape[:2]:
-            raise ValueError(f"mask shape is {m.shape}, expected the frame's {f.shape[:2]}")
+            raise ValueError(f"{fn}: mask shape is {m.shape}, expected the frame's {f.shape[:2]}")
         m = np.ascontiguousarray(m)
     if not isinstance(lazy, (bool, np.bool_)):
-        raise TypeError(f"lazy must be a bool, got {type(lazy).__name__}")
+        raise TypeError(f"{fn}: lazy must be a bool, got {type(lazy).__name__}")
     return _core.hsv_bins(
         f, m, binning.n_h, binning.n_s, binning.n_v, binning.s_min, binning.v_min, bool(lazy)
     )
@@ -391,9 +393,13 @@ def _lam(lam: object, fn: str) -> float:
     """`lam` as a float: a real number (not a bool, not text), finite and > 0."""
     if isinstance(lam, bool) or not isinstance(lam, numbers.Real):
         raise TypeError(f"{fn}: lam must be a real number, got {shown(lam)}")
-    if not (np.isfinite(lam) and lam > 0):
+    try:
+        value = float(lam)
+    except OverflowError:  # an int beyond a float's range (10**400)
+        value = math.inf
+    if not (math.isfinite(value) and value > 0):
         raise ValueError(f"{fn}: lam is {lam}, expected a finite number > 0")
-    return float(lam)
+    return value
 
 
 def box_weights(
