@@ -23,6 +23,7 @@ from pftrack.particle_filter import (
     BinnedImage,
     bhattacharyya_weights,
     box_histograms,
+    box_weights,
     hsv_bins,
 )
 from tests.reference import fused as npb
@@ -31,12 +32,13 @@ Case = tuple[str, BinnedImage, F64, F64, int, str]  # name, frame, boxes, ref, p
 
 #: Least speed-up of pftrack's call over a baseline in the same run: (group prefix, pftrack
 #: role, baseline) -> floor. Measured (README, docs/results.md#kernels): histograms + weights
-#: 36-327x NumPy's per-box loop (the public two calls; 67-327x fused), resampling 66-119x
-#: filterpy. A floor about a third of the least measured ratio or below.
+#: 36-327x NumPy's per-box loop (the public two calls; 67-327x fused, core or public),
+#: resampling 66-119x filterpy. A floor about a third of the least measured ratio or below.
 FLOORS = {
     ("histograms+weights", "fused", "numpy"): 10.0,
     ("histograms+weights", "core", "numpy"): 10.0,
     ("histograms+weights", "public", "numpy"): 10.0,
+    ("histograms+weights", "public fused", "numpy"): 10.0,
     ("systematic resample", "core", "filterpy"): 20.0,
     ("systematic resample", "api", "filterpy"): 20.0,
     ("stratified resample", "core", "filterpy"): 20.0,
@@ -159,6 +161,16 @@ def test_histograms_weights_core_fused(benchmark: BenchmarkFixture, case: Case) 
     want = npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref)
     np.testing.assert_allclose(w, want, rtol=1e-8, atol=1e-300)
     _compare(benchmark, "fused", check=source == PETS_FRAME)
+
+
+def test_histograms_weights_public_fused(benchmark: BenchmarkFixture, case: Case) -> None:
+    """The public fused call, ``box_weights(image, boxes, ref)``: the core's, with its checks."""
+    _, image, boxes, ref, _, source = case
+    _hist_group(benchmark, case)
+    w = benchmark(box_weights, image, boxes, ref, 20.0)
+    want = npb.histograms_and_weights(image.bins, image.n_bins, boxes, ref)
+    np.testing.assert_allclose(w, want, rtol=1e-8, atol=1e-300)
+    _compare(benchmark, "public fused", check=source == PETS_FRAME)
 
 
 def test_histograms_weights_numpy(benchmark: BenchmarkFixture, case: Case) -> None:

@@ -44,11 +44,14 @@ inline void check_bgr_image(const py::array& a, const char* fn, const char* what
         fail(fn, std::string(what) + " pixels must be packed (use numpy.ascontiguousarray)");
 }
 
-/// A mask's dtype: uint8 or bool (named in the message only on failure).
+/// A mask's dtype: uint8 or bool (named in the message only on failure). A wrong dtype is a
+/// TypeError, as the Python layer's checks (hsv_bins, RJMCMCFilter.step) raise it: the same
+/// fault was ValueError from the core and TypeError from Python.
 inline void check_mask_dtype(const py::array& m, const char* fn) {
     const py::dtype d = m.dtype();
     if (!is_u8(d) && !is_bool(d))
-        require(false, fn, "mask dtype", dtype_name(m), "uint8 or bool");
+        throw py::type_error(std::string(fn) + ": mask dtype is " + dtype_name(m) +
+                             ", expected uint8 or bool");
 }
 
 /// A (H, W) mask of uint8 or bool, matching the image's size, packed along rows (messages built

@@ -28,6 +28,7 @@ __all__ = [
     "bool_array",
     "brief",
     "colour_hint",
+    "depth_hint",
     "first_bad_box",
     "first_at",
     "check_classes",
@@ -376,12 +377,25 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     refuse_masked(frame, what, "a plain array (.filled(0) makes the masked pixels black)")
     f = frame
     if f.dtype != np.uint8:
-        raise TypeError(f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it)")
+        raise TypeError(
+            f"{what} dtype is {f.dtype}, expected uint8 (BGR, as cv2 reads it){depth_hint(f)}"
+        )
     if f.ndim != 3 or f.shape[2] != 3:
         raise ValueError(
             f"{what} must have shape (H, W, 3) (BGR), got {f.shape}{colour_hint(f.shape)}"
         )
     return f
+
+
+def depth_hint(frame: NDArray[np.generic]) -> str:
+    """The end of a message refusing `frame`'s dtype: the conversion to uint8, if one fits.
+
+    A 16-bit frame (``cv2.imread(path, cv2.IMREAD_UNCHANGED)`` of a 16-bit PNG or TIFF) keeps
+    its top 8 bits with ``>> 8``; a cast alone (``astype(np.uint8)``) would keep the low ones.
+    """
+    if frame.dtype == np.uint16:
+        return "; a 16-bit frame? (frame >> 8).astype(np.uint8) keeps its top 8 bits"
+    return ""
 
 
 def colour_hint(shape: tuple[int, ...]) -> str:

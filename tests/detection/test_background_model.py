@@ -180,7 +180,7 @@ def test_bad_input():
     binned = _core.hsv_bins(np.zeros((4, 4, 3), np.uint8))
     with pytest.raises(ValueError, match="mask must have the frame's"):
         _core.mask_bins(binned, np.zeros((4, 5), np.uint8))
-    with pytest.raises(ValueError, match="mask dtype"):
+    with pytest.raises(TypeError, match="mask dtype"):  # as hsv_bins (was ValueError)
         _core.mask_bins(binned, np.zeros((4, 4), np.float32))
 
 

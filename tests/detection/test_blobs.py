@@ -208,7 +208,7 @@ def test_bool_mask_is_the_same_foreground() -> None:
 def test_bad_input() -> None:
     mask = np.zeros((20, 30), np.uint8)
     args = (*DEFAULTS, 2.8, None, *SIZE)
-    with pytest.raises(ValueError, match="blob_boxes: mask dtype is float64"):
+    with pytest.raises(TypeError, match="blob_boxes: mask dtype is float64"):
         _core.blob_boxes(mask.astype(np.float64), *args)
     with pytest.raises(ValueError, match=r"mask must be a \(H, W\) array"):
         _core.blob_boxes(np.zeros((4, 4, 3), np.uint8), *args)

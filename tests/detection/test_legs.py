@@ -106,7 +106,7 @@ def test_extend_legs_bad_input() -> None:
         _core.extend_legs(mask, box[:, :3], coef, 0.9, 0.3)
     with pytest.raises(ValueError, match="coefficients"):
         _core.extend_legs(mask, box, coef[:1], 0.9, 0.3)
-    with pytest.raises(ValueError, match="mask dtype"):
+    with pytest.raises(TypeError, match="mask dtype"):  # a wrong dtype (was ValueError)
         _core.extend_legs(mask.astype(np.float32), box, coef, 0.9, 0.3)
     with pytest.raises(ValueError, match="not fitted"):
         PersonSizeModel().extend_legs(mask, box, 0.9, 0.3)

@@ -131,7 +131,7 @@ def test_close_and_open_mask_refuse_bad_input(fn) -> None:
         fn(mask, np.zeros((3, 3), np.uint8))
     with pytest.raises(ValueError, match="shape"):
         fn(mask, np.ones(3, np.uint8))
-    with pytest.raises(ValueError, match="dtype"):
+    with pytest.raises(TypeError, match="mask dtype"):  # a wrong dtype (was ValueError)
         fn(mask.astype(np.float32), np.ones((3, 3), np.uint8))
     with pytest.raises(ValueError, match="non-empty"):
         fn(np.zeros((0, 5), np.uint8), np.ones((3, 3), np.uint8))

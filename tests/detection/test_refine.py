@@ -162,7 +162,7 @@ def test_bad_input() -> None:
         refine_boxes(np.ones((2, 3)), mask)
     with pytest.raises(ValueError, match="NaN or inf"):
         refine_boxes([[np.nan, 1, 5, 5]], mask)
-    with pytest.raises(ValueError, match="mask dtype"):
+    with pytest.raises(TypeError, match="mask dtype"):  # a wrong dtype (was ValueError)
         refine_boxes(box, mask.astype(np.float32))
     with pytest.raises(ValueError, match=r"\(H, W\)"):
         refine_boxes(box, np.zeros((4, 4, 3), np.uint8))

@@ -73,6 +73,18 @@ def _recover_gap(a: Any, b: Any, frames: Any, method: Any) -> Any:
     return recover_gap(a, b, frames, method)
 
 
+def _baseline(name: str) -> Any:
+    """``pftrack.recovery.baselines.<name>(seg_a, seg_b, frames)``, the public checked one."""
+
+    def run(a: Any, b: Any, frames: Any) -> Any:
+        from pftrack.recovery import baselines
+
+        return getattr(baselines, name)(a, b, frames)
+
+    run.__name__ = name
+    return run
+
+
 def _mot_roundtrip(rows: Any) -> Any:
     from pftrack.io.mot import read_mot, write_mot
 
@@ -230,6 +242,18 @@ TARGETS: list[Target] = [
             maybe(st.sampled_from(["linear", "cubic", "gdt", "gsi", "rts"])),
         ),
     ),
+    *[
+        Target(
+            f"baselines.{n}",
+            call(
+                _baseline(n),
+                maybe(segment(1)),
+                maybe(segment(20)),
+                st.one_of(st.none(), maybe(floats_array((3,), 7, 19))),
+            ),
+        )
+        for n in ("linear", "cubic", "bspline", "gsi", "rts", "interpolate_sizes")
+    ],  # fmt: skip
     Target("write_mot/read_mot", call(_mot_roundtrip, mot_rows())),
     Target(
         "read_mot",

@@ -27,6 +27,7 @@ KERNELS: dict[str, Callable[..., Any]] = {
     "bhattacharyya_coefficient": pftrack.bhattacharyya_coefficient,
     "bhattacharyya_distance": pftrack.bhattacharyya_distance,
     "bhattacharyya_weights": pftrack.bhattacharyya_weights,
+    "box_weights": pftrack.box_weights,
     "propagate": propagate,
     "estimate": estimate,
 }

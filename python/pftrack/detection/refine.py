@@ -61,9 +61,12 @@ def refine_boxes(
 
     Raises
     ------
+    TypeError
+        `mask` not uint8 or bool (the dtype of a mask is checked as ``hsv_bins`` checks it;
+        was ValueError until 5 December).
     ValueError
-        `boxes_xywh` not (K, 4) or not finite, `mask` not 2-D uint8 or bool, or `fraction`,
-        `min_cover`, `leg_fill` or `min_height` out of range.
+        `boxes_xywh` not (K, 4) or not finite, `mask` not 2-D, or `fraction`, `min_cover`,
+        `leg_fill` or `min_height` out of range.
     """
     b = np.ascontiguousarray(boxes_xywh, dtype=np.float64)
     if b.size == 0:

@@ -10,6 +10,7 @@ from pftrack.particle_filter.colour import (
     bhattacharyya_distance,
     bhattacharyya_weights,
     box_histograms,
+    box_weights,
     hsv_bins,
 )
 from pftrack.particle_filter.dynamics import Ar2Model, estimate, propagate
@@ -38,6 +39,7 @@ __all__ = [
     "bhattacharyya_distance",
     "bhattacharyya_weights",
     "box_histograms",
+    "box_weights",
     "estimate",
     "hsv_bins",
     "multinomial_resample",

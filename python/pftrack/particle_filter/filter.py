@@ -271,16 +271,20 @@ def _once(filters: Sequence[object], fn: str) -> None:
             )
 
 
-def _step_argument_error(image: object, *filters: ColourParticleFilter) -> TypeError | None:
+def _step_argument_error(
+    image: object, *filters: ColourParticleFilter, names: Sequence[str] | None = None
+) -> TypeError | None:
     """What the core could not take in a step of `filters` on `image` (None: nothing found).
 
-    Asked only once the core has refused the arguments (pybind11's list of signatures), so
-    the step itself pays nothing for it.
+    Asked only once the core has refused the arguments (pybind11's list of signatures, or
+    ``sis_step_batch``'s ValueError naming an item's dtype), so the step itself pays nothing
+    for it. `names` names each filter in the message (default: its class).
     """
     error = not_binned(image, "image")
     if error is not None:
         return error
-    for f in filters:
+    for i, f in enumerate(filters):
+        who = type(f).__name__ if names is None else names[i]
         for name in ("particles", "weights", "means"):
             a = getattr(f, name)
             if not isinstance(a, np.ndarray):
@@ -291,7 +295,7 @@ def _step_argument_error(image: object, *filters: ColourParticleFilter) -> TypeE
             else:
                 continue
             return TypeError(
-                f"{type(f).__name__}.{name} must be a C-contiguous, writeable float64 array "
+                f"{who}.{name} must be a C-contiguous, writeable float64 array "
                 f"(the step updates it in place), got {got}"
             )
         ref = f.reference
@@ -300,8 +304,7 @@ def _step_argument_error(image: object, *filters: ColourParticleFilter) -> TypeE
             if isinstance(ref, np.ndarray):
                 got = f"{ref.dtype} {ref.shape}"
             return TypeError(
-                f"{type(f).__name__}.reference must be a (B,) float64 array (set_reference), "
-                f"got {got}"
+                f"{who}.reference must be a (B,) float64 array (set_reference), got {got}"
             )
     return None
 
@@ -619,7 +622,10 @@ def step_filters(
     Raises
     ------
     TypeError
-        An element that is not a ColourParticleFilter.
+        An element that is not a ColourParticleFilter; `image` not a BinnedImage; a filter
+        whose particles, weights or means are not C-contiguous, writeable float64 arrays
+        (``step_filters: filters[k].particles must be ...``, as
+        :meth:`ColourParticleFilter.step` says it).
     ValueError
         The same filter twice in `filters`; a filter whose particles, weights or reference
         the core refuses (``step_filters: filters[k]: reference has 20 bins, the image
@@ -668,7 +674,16 @@ def step_filters_summary(filters: Sequence[ColourParticleFilter], image: _core.B
         try:
             try:
                 out = _step_batch(fs, cfg, image)
-            except ValueError as exc:  # a bad entry, found before any filter stepped
+            except (TypeError, ValueError) as exc:  # a bad entry, before any filter stepped
+                # an argument of another type, dtype or layout is a TypeError, as from the
+                # filter's step (the core's batch said ValueError: "particles[1] dtype is
+                # float32"), naming the filter by its place
+                names = [f"step_filters: filters[{k}]" for k in batch]
+                wrong = _step_argument_error(image, *fs, names=names)
+                if wrong is not None:
+                    raise wrong from None
+                if isinstance(exc, TypeError):
+                    raise
                 raise _batch_error(exc, batch) from None
             for f, row in zip(fs, out.tolist(), strict=True):
                 f._last, f._last_row = None, (row, col, f.w0, f.h0)
@@ -716,19 +731,13 @@ def _step_batch(
 ) -> F64:
     """``sis_step_batch`` of filters of configuration `cfg`, their locks held; counts the step."""
     m = cfg.model
-    try:
-        out: F64 = _core.sis_step_batch(
-            [f.particles for f in fs], [f.weights for f in fs], [f.means for f in fs],
-            image, [f.reference for f in fs], np.array([f.w0 for f in fs]),
-            np.array([f.h0 for f in fs]), m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
-            cfg.lam, cfg.kernel, True, [f._seed for f in fs], [f._step for f in fs],
-            float(cfg.min_samples),
-        )  # fmt: skip
-    except TypeError:
-        error = _step_argument_error(image, *fs)
-        if error is None:
-            raise
-        raise error from None
+    out: F64 = _core.sis_step_batch(
+        [f.particles for f in fs], [f.weights for f in fs], [f.means for f in fs],
+        image, [f.reference for f in fs], np.array([f.w0 for f in fs]),
+        np.array([f.h0 for f in fs]), m.a, m.b, m.sigma, m.s_min, m.s_max, m.use_means,
+        cfg.lam, cfg.kernel, True, [f._seed for f in fs], [f._step for f in fs],
+        float(cfg.min_samples),
+    )  # fmt: skip
     for f in fs:
         f._step += 1
     return out

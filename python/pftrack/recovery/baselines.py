@@ -1,9 +1,12 @@
 """The baselines pftrack compares goal-directed recovery with.
 
-Every baseline takes two checked segments (rows ``(frame, x, y[, w, h])``, see
-:mod:`pftrack.recovery.segments`) and the frames to fill, strictly inside the gap, and returns
-``(F, 2)`` positions ``(x, y)``. Box sizes are filled by :func:`interpolate_sizes` (linear) for
-every method.
+Every baseline takes two segments (rows ``(frame, x, y[, w, h])``, see
+:mod:`pftrack.recovery.segments`) and the frames to fill, strictly inside the gap (default:
+every frame of it), and returns ``(F, 2)`` positions ``(x, y)``. Box sizes are filled by
+:func:`interpolate_sizes` (linear) for every method. The public functions check their
+arguments (a one-line ``TypeError`` or ``ValueError`` naming the function and the argument);
+the recovery's own calls, on segments it has checked, use the unchecked ``_linear``, ... and
+``_BASELINES``.
 
 ``"linear"``
     Straight line between the two ends (ByteTrack's post-processing).
@@ -33,12 +36,13 @@ from types import MappingProxyType
 from typing import TypeAlias
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
+from pftrack._check import integer, number
 from pftrack._typing import F64
 from pftrack.kalman import rts_smooth
-from pftrack.recovery.segments import split_rows
+from pftrack.recovery.segments import as_segment, gap_ends, gap_frames, split_rows
 
 __all__ = [
     "BASELINES",
@@ -57,9 +61,11 @@ __all__ = [
 Baseline: TypeAlias = Callable[[F64, F64, NDArray[np.int64]], F64]
 #: Points of each segment next to the gap :func:`rts` and :func:`rts_batch` use by default.
 RTS_HISTORY = 30
+#: Most points a window or history may hold (a 32-bit int: the core's offsets are int32).
+_MAX_POINTS = 2**31 - 1
 
 
-def interpolate_sizes(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64 | None:
+def _interpolate_sizes(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64 | None:
     """Box sizes ``(w, h)`` linearly interpolated between the two ends, ``(F, 2)``.
 
     None when either segment carries no sizes (3 columns).
@@ -77,7 +83,7 @@ def _window(seg_a: F64, seg_b: F64, k: int) -> tuple[F64, F64]:
     return pts[:, 0], pts[:, 1:3]
 
 
-def linear(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64:
+def _linear(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64:
     """Straight line from segment A's last point to segment B's first."""
     f0, f1 = seg_a[-1, 0], seg_b[0, 0]
     s = (frames - f0) / (f1 - f0)
@@ -85,17 +91,17 @@ def linear(seg_a: F64, seg_b: F64, frames: NDArray[np.int64]) -> F64:
     return out
 
 
-def cubic(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], window: int = 30) -> F64:
+def _cubic(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], window: int = 30) -> F64:
     """Not-a-knot cubic spline through `window` points on each side (linear if fewer than 4)."""
     from scipy.interpolate import CubicSpline
 
     t, xy = _window(seg_a, seg_b, window)
     if len(t) < 4:
-        return linear(seg_a, seg_b, frames)
+        return _linear(seg_a, seg_b, frames)
     return np.asarray(CubicSpline(t, xy, axis=0)(frames), dtype=np.float64)
 
 
-def bspline(
+def _bspline(
     seg_a: F64, seg_b: F64, frames: NDArray[np.int64], window: int = 12, spacing: int = 4
 ) -> F64:
     """Weighted least-squares cubic B-spline over `window` points on each side.
@@ -110,7 +116,7 @@ def bspline(
 
     t, xy = _window(seg_a, seg_b, window)
     if len(t) < 8:
-        return cubic(seg_a, seg_b, frames)
+        return _cubic(seg_a, seg_b, frames)
     f0, f1 = seg_a[-1, 0], seg_b[0, 0]
     # interior knots every `spacing` frames inside each observed window, none inside the gap
     # (no data there: Schoenberg-Whitney), so one cubic piece spans the gap
@@ -124,10 +130,10 @@ def bspline(
     try:
         spl = make_lsq_spline(t, xy, knots, k=k, w=w, axis=0)
     except (ValueError, np.linalg.LinAlgError):
-        return cubic(seg_a, seg_b, frames)
+        return _cubic(seg_a, seg_b, frames)
     out = np.asarray(spl(frames), dtype=np.float64)
     if not np.all(np.isfinite(out)):  # SciPy may return NaN for a rank-deficient fit
-        return cubic(seg_a, seg_b, frames)
+        return _cubic(seg_a, seg_b, frames)
     return out
 
 
@@ -137,7 +143,7 @@ def bspline(
 GSI_BLOCK = 1024
 
 
-def gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) -> F64:
+def _gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) -> F64:
     """StrongSORT's Gaussian-smoothed interpolation.
 
     Linear interpolation, then Gaussian-process regression (RBF kernel, fixed length
@@ -153,7 +159,7 @@ def gsi(seg_a: F64, seg_b: F64, frames: NDArray[np.int64], tau: float = 10.0) ->
     """
     centre = 0.5 * (seg_a[-1, 1:3] + seg_b[0, 1:3])
     t_all = np.concatenate([seg_a[:, 0], frames, seg_b[:, 0]])
-    xy_all = np.vstack([seg_a[:, 1:3], linear(seg_a, seg_b, frames), seg_b[:, 1:3]]) - centre
+    xy_all = np.vstack([seg_a[:, 1:3], _linear(seg_a, seg_b, frames), seg_b[:, 1:3]]) - centre
     n_track = len(t_all)
     ls = float(np.clip(tau * np.log(tau**3 / n_track), 1.0 / tau, tau**2))
     if len(frames) <= GSI_BLOCK:
@@ -186,7 +192,7 @@ def _gp_smooth(t_all: F64, xy_all: F64, frames: NDArray[np.int64], ls: float) ->
     return np.asarray(Ks @ alpha, dtype=np.float64)
 
 
-def rts(
+def _rts(
     seg_a: F64,
     seg_b: F64,
     frames: NDArray[np.int64],
@@ -233,7 +239,7 @@ def rts(
     return out
 
 
-def rts_batch(
+def _rts_batch(
     pairs: Sequence[tuple[F64, F64]], q: float = 0.1, r: float = 1.0, history: int = RTS_HISTORY
 ) -> list[F64]:
     """:func:`rts` for many gaps at once: every frame inside each gap, ``(x, y)``.
@@ -258,7 +264,273 @@ def rts_batch(
     return split_rows(out, lengths)
 
 
-#: The baselines by method name (read-only).
+#: The unchecked baselines by method name, for callers whose segments are checked, B after A.
+_BASELINES: Mapping[str, Baseline] = MappingProxyType(
+    {"linear": _linear, "cubic": _cubic, "bspline": _bspline, "gsi": _gsi, "rts": _rts}
+)
+
+
+# --- the public, checked entry points ------------------------------------------------------
+
+
+def _gap(
+    fn: str, seg_a: ArrayLike, seg_b: ArrayLike, frames: ArrayLike | None
+) -> tuple[F64, F64, NDArray[np.int64]]:
+    """`seg_a`, `seg_b` and `frames` of the public baseline `fn`, checked.
+
+    Each segment as :func:`~pftrack.recovery.segments.as_segment` takes it, B starting after
+    A ends, the frames strictly inside the gap (:func:`~pftrack.recovery.segments.gap_frames`).
+    """
+    a = as_segment(seg_a, "segment_a", fn)
+    b = as_segment(seg_b, "segment_b", fn)
+    return a, b, gap_frames(a, b, frames, fn)
+
+
+def interpolate_sizes(
+    seg_a: ArrayLike, seg_b: ArrayLike, frames: ArrayLike | None = None
+) -> F64 | None:
+    """Box sizes ``(w, h)`` linearly interpolated between the two ends, ``(F, 2)``.
+
+    Parameters
+    ----------
+    seg_a, seg_b : (k, 3) or (k, 5) array_like
+        The segments before and after the gap, rows ``(frame, x, y[, w, h])``.
+    frames : (F,) array_like of int, optional
+        Frames to fill, strictly inside the gap, increasing (default: every frame of it).
+
+    Returns
+    -------
+    (F, 2) ndarray of float64 or None
+        None when either segment carries no sizes (3 columns).
+
+    Raises
+    ------
+    TypeError
+        Segments or frames that are not real numbers (a list of lists is fine).
+    ValueError
+        A segment not of shape (k, 3) or (k, 5), empty, with a non-finite value, frames not
+        whole or not increasing, a negative size or a value beyond ±1e9 px; segment B not
+        after A; frames not inside the gap.
+    """
+    return _interpolate_sizes(*_gap("interpolate_sizes", seg_a, seg_b, frames))
+
+
+def linear(seg_a: ArrayLike, seg_b: ArrayLike, frames: ArrayLike | None = None) -> F64:
+    """Straight line from segment A's last point to segment B's first.
+
+    Parameters
+    ----------
+    seg_a, seg_b : (k, 3) or (k, 5) array_like
+        The segments before and after the gap, rows ``(frame, x, y[, w, h])``.
+    frames : (F,) array_like of int, optional
+        Frames to fill, strictly inside the gap, increasing (default: every frame of it).
+
+    Returns
+    -------
+    (F, 2) ndarray of float64
+        Positions ``(x, y)``, one row per frame.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`interpolate_sizes`.
+    """
+    return _linear(*_gap("linear", seg_a, seg_b, frames))
+
+
+def cubic(
+    seg_a: ArrayLike, seg_b: ArrayLike, frames: ArrayLike | None = None, window: int = 30
+) -> F64:
+    """Not-a-knot cubic spline through `window` points on each side (linear if fewer than 4).
+
+    Parameters
+    ----------
+    seg_a, seg_b, frames
+        As :func:`linear`.
+    window : int
+        Points of each segment next to the gap the spline goes through (>= 1).
+
+    Returns
+    -------
+    (F, 2) ndarray of float64
+        Positions ``(x, y)``, one row per frame.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`interpolate_sizes`; a `window` that is not an int >= 1.
+    """
+    window = integer(window, "cubic: window", 1, _MAX_POINTS)
+    a, b, fr = _gap("cubic", seg_a, seg_b, frames)
+    return _cubic(a, b, fr, window) if fr.size else np.zeros((0, 2))
+
+
+def bspline(
+    seg_a: ArrayLike,
+    seg_b: ArrayLike,
+    frames: ArrayLike | None = None,
+    window: int = 12,
+    spacing: int = 4,
+) -> F64:
+    """Weighted least-squares cubic B-spline over `window` points on each side (Sun et al. 2005).
+
+    Interior knots every `spacing` frames inside each observed window, none in the gap; the
+    residual of a point ``d`` frames from the gap is multiplied by ``1 / (1 + d / 5)``. Falls
+    back to :func:`cubic` with fewer than 8 points or a singular fit.
+
+    Parameters
+    ----------
+    seg_a, seg_b, frames
+        As :func:`linear`.
+    window : int
+        Points of each segment next to the gap fitted (>= 1).
+    spacing : int
+        Frames between interior knots (>= 1).
+
+    Returns
+    -------
+    (F, 2) ndarray of float64
+        Positions ``(x, y)``, one row per frame.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`interpolate_sizes`; a `window` or `spacing` that is not an int >= 1.
+    """
+    window = integer(window, "bspline: window", 1, _MAX_POINTS)
+    spacing = integer(spacing, "bspline: spacing", 1, _MAX_POINTS)
+    a, b, fr = _gap("bspline", seg_a, seg_b, frames)
+    return _bspline(a, b, fr, window, spacing) if fr.size else np.zeros((0, 2))
+
+
+def gsi(
+    seg_a: ArrayLike, seg_b: ArrayLike, frames: ArrayLike | None = None, tau: float = 10.0
+) -> F64:
+    """StrongSORT's Gaussian-smoothed interpolation (linear fill, then GP regression).
+
+    Parameters
+    ----------
+    seg_a, seg_b, frames
+        As :func:`linear`.
+    tau : float
+        Sets the RBF kernel's length ``clip(tau log(tau^3 / n), 1/tau, tau^2)`` for ``n``
+        points (finite, > 0; StrongSORT's 10).
+
+    Returns
+    -------
+    (F, 2) ndarray of float64
+        Positions ``(x, y)``, one row per frame.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`interpolate_sizes`; a `tau` that is not a finite number > 0.
+    """
+    tau = number(tau, "gsi: tau")
+    if not tau > 0:
+        raise ValueError(f"gsi: tau is {tau:g}, expected a finite number > 0")
+    a, b, fr = _gap("gsi", seg_a, seg_b, frames)
+    return _gsi(a, b, fr, tau) if fr.size else np.zeros((0, 2))
+
+
+def _rts_options(fn: str, q: float, r: float, history: int) -> tuple[float, float, int]:
+    """`q` finite >= 0, `r` finite > 0 and `history` an int >= 1, of `fn`, checked."""
+    q, r = number(q, f"{fn}: q"), number(r, f"{fn}: r")
+    if not q >= 0:
+        raise ValueError(f"{fn}: q is {q:g}, expected a finite number >= 0")
+    if not r > 0:
+        raise ValueError(f"{fn}: r is {r:g}, expected a finite number > 0")
+    return q, r, integer(history, f"{fn}: history", 1, _MAX_POINTS)
+
+
+def rts(
+    seg_a: ArrayLike,
+    seg_b: ArrayLike,
+    frames: ArrayLike | None = None,
+    q: float = 0.1,
+    r: float = 1.0,
+    history: int = RTS_HISTORY,
+) -> F64:
+    """Kalman filter + RTS smoother over `history` points on each side and the gap.
+
+    Parameters
+    ----------
+    seg_a, seg_b, frames
+        As :func:`linear`.
+    q : float
+        White-noise-acceleration intensity (px²/frame³), both axes: finite, >= 0.
+    r : float
+        Measurement variance (px²), both axes: finite, > 0.
+    history : int
+        Points used on each side (>= 1).
+
+    Returns
+    -------
+    (F, 2) ndarray of float64
+        Positions ``(x, y)``, one row per frame.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`interpolate_sizes`; `q`, `r` or `history` out of their ranges.
+
+    Notes
+    -----
+    :func:`pftrack.kalman.rts_smooth` with the continuous discretisation; the first point is
+    both the prior's centre (velocity standard deviation 10 px/frame) and a measurement.
+    """
+    q, r, history = _rts_options("rts", q, r, history)
+    a, b, fr = _gap("rts", seg_a, seg_b, frames)
+    return _rts(a, b, fr, q, r, history)
+
+
+def rts_batch(
+    pairs: Sequence[tuple[ArrayLike, ArrayLike]],
+    q: float = 0.1,
+    r: float = 1.0,
+    history: int = RTS_HISTORY,
+) -> list[F64]:
+    """:func:`rts` for many gaps at once: every frame inside each gap, ``(x, y)``.
+
+    The windows of all gaps go to one C++ call (``_core.rts_gaps_batch``, GIL released).
+
+    Parameters
+    ----------
+    pairs : sequence of (segment_a, segment_b)
+        One pair of segments per gap, each as :func:`linear` takes them.
+    q, r, history
+        As :func:`rts`.
+
+    Returns
+    -------
+    list of (F_k, 2) ndarray of float64
+        One per gap, every frame inside it.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`rts`, naming the pair (``rts_batch: pairs[2] segment_b ...``); `pairs` not
+        a sequence of pairs.
+    """
+    fn = "rts_batch"
+    q, r, history = _rts_options(fn, q, r, history)
+    if isinstance(pairs, (str, bytes, np.ndarray)) or not isinstance(pairs, Sequence):
+        raise TypeError(
+            f"{fn}: pairs must be a sequence of (segment_a, segment_b) pairs, got "
+            f"{type(pairs).__name__}"
+        )
+    checked = []
+    for k, pair in enumerate(pairs):
+        if not (isinstance(pair, Sequence) and len(pair) == 2):
+            raise ValueError(f"{fn}: pairs[{k}] is not a pair (segment_a, segment_b)")
+        a = as_segment(pair[0], "segment_a", f"{fn}: pairs[{k}]")
+        b = as_segment(pair[1], "segment_b", f"{fn}: pairs[{k}]")
+        gap_ends(a, b, f"{fn}: pairs[{k}]")
+        checked.append((a, b))
+    return _rts_batch(checked, q, r, history)
+
+
+#: The baselines by method name (read-only): the checked public functions.
 BASELINES: Mapping[str, Baseline] = MappingProxyType(
     {"linear": linear, "cubic": cubic, "bspline": bspline, "gsi": gsi, "rts": rts}
 )

@@ -39,7 +39,7 @@ from pftrack import _check, _core
 from pftrack._check import MAX_COORD, MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64
-from pftrack.recovery.baselines import BASELINES, RTS_HISTORY, rts_batch
+from pftrack.recovery.baselines import _BASELINES, RTS_HISTORY, _rts_batch
 from pftrack.recovery.gdt import GdtModel
 from pftrack.recovery.mixture import WINDOW, MotionFit, _fit_motion, recover_mixture_gaps
 from pftrack.recovery.neighbours import (
@@ -397,12 +397,12 @@ def recover_with(
         )
         return split_rows(xy, n)
     if method == "rts":
-        return rts_batch(pairs)
-    if method in BASELINES:
+        return _rts_batch(pairs)
+    if method in _BASELINES:
         out = []
         for a, b in pairs:
             fr = np.arange(int(a[-1, 0]) + 1, int(b[0, 0]), dtype=np.int64)
-            out.append(np.asarray(BASELINES[method](a, b, fr), dtype=np.float64)[:, :2])
+            out.append(np.asarray(_BASELINES[method](a, b, fr), dtype=np.float64)[:, :2])
         return out
     seg_a = [a for a, _ in pairs]
     seg_b = [b for _, b in pairs]

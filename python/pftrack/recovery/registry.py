@@ -52,7 +52,7 @@ from pftrack import _check
 from pftrack._check import MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
-from pftrack.recovery.baselines import BASELINES, interpolate_sizes, rts_batch
+from pftrack.recovery.baselines import _BASELINES, _interpolate_sizes, _rts_batch
 from pftrack.recovery.calibrate import bags_for, fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, _fit_motion, check_models, recover_mixture_gaps
 from pftrack.recovery.names import (
@@ -154,8 +154,8 @@ def recover_gap(
         full = recover_gaps([(a, b)], method, noise=noise, motion=motion)[0]
         xy = full[(fr - a[-1, 0] - 1).astype(int)]
     else:
-        xy = BASELINES[method](a, b, fr)
-    wh = interpolate_sizes(a, b, fr)
+        xy = _BASELINES[method](a, b, fr)
+    wh = _interpolate_sizes(a, b, fr)
     return xy if wh is None else np.hstack([xy, wh])
 
 
@@ -267,7 +267,7 @@ def recover_gaps(
         history = _check.integer(history, "recover_gaps: history", 1, MAX_FRAME)
     pairs = _checked_pairs(gaps)
     if method == "rts" and pairs:  # one vectorised pass over all gaps
-        return rts_batch(pairs)
+        return _rts_batch(pairs)
     if method in NEIGHBOUR_METHODS:
         runs = (
             distinct_runs([s for p in pairs for s in p])
@@ -282,7 +282,7 @@ def recover_gaps(
         return correct_by_neighbours(recover, pairs, Neighbourhood(runs))
     if method not in GOAL_DIRECTED_METHODS:
         return [  # recover_gap's path, without checking the checked pairs again
-            BASELINES[method](a, b, fr) if fr.size else np.zeros((0, 2))
+            _BASELINES[method](a, b, fr) if fr.size else np.zeros((0, 2))
             for a, b in progress(pairs, desc=method, unit="gap")
             for fr in (gap_frames(a, b, None),)
         ]

@@ -198,8 +198,12 @@ def gap_ends(seg_a: F64, seg_b: F64, fn: str = "recover_gap", gap: str = "") -> 
     return f0, f1
 
 
-def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.int64]:
+def gap_frames(
+    seg_a: F64, seg_b: F64, frames: ArrayLike | None, fn: str = "recover_gap"
+) -> NDArray[np.int64]:
     """Frames to fill between two checked segments (default: every frame of the gap).
+
+    `fn` names the function called in the messages.
 
     Raises
     ------
@@ -209,18 +213,18 @@ def gap_frames(seg_a: F64, seg_b: F64, frames: ArrayLike | None) -> NDArray[np.i
         The gap :func:`gap_ends` refuses, or `frames` is not 1-D integers strictly inside the
         gap, in increasing order.
     """
-    f0, f1 = gap_ends(seg_a, seg_b)
+    f0, f1 = gap_ends(seg_a, seg_b, fn)
     if frames is None:
         return np.arange(f0 + 1, f1, dtype=np.int64)
-    fr = real_array(frames, "recover_gap: frames", booleans=False)
+    fr = real_array(frames, f"{fn}: frames", booleans=False)
     if fr.ndim != 1 or not np.all(fr == np.round(fr)):
-        raise ValueError("recover_gap: frames must be a 1-D array of integers")
+        raise ValueError(f"{fn}: frames must be a 1-D array of integers")
     if fr.size and (fr.min() <= f0 or fr.max() >= f1):
-        raise ValueError(f"recover_gap: frames must lie strictly between {f0} and {f1}")
+        raise ValueError(f"{fn}: frames must lie strictly between {f0} and {f1}")
     if np.any(np.diff(fr) <= 0):  # one row per frame, in order (gsi reads the first and last)
         k = int(np.flatnonzero(np.diff(fr) <= 0)[0])
         raise ValueError(
-            f"recover_gap: frames must increase strictly, got {fr[k]:.17g} then {fr[k + 1]:.17g}"
+            f"{fn}: frames must increase strictly, got {fr[k]:.17g} then {fr[k + 1]:.17g}"
         )
     return fr.astype(np.int64)
 
