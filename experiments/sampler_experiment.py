@@ -37,13 +37,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from experiments._common import data_root, experiment_parser, write_text
+from pftrack._limits import MAX_JOINT_SAMPLES
 from pftrack.boxes import iou_xywh
-from pftrack.cli._options import (
-    RJMCMC_MAX_SAMPLES,
-    bounded_int,
-    non_negative_int,
-    positive_int,
-)
+from pftrack.cli._options import bounded_int, non_negative_int, positive_int
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.atomic import atomic_path, atomic_write
 from pftrack.io.mot import as_written, group_by_frame, read_mot
@@ -432,9 +428,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     # every value checked here, before any work (was: --particles 0 a traceback, --max-walkers
     # 41 one after the whole table had run)
     p.add_argument(
-        "--particles", type=bounded_int(1, RJMCMC_MAX_SAMPLES), default=100,
+        "--particles", type=bounded_int(1, MAX_JOINT_SAMPLES), default=100,
         help=f"particles per object (SIS, MH) and kept samples of the joint chain, 1 to "
-        f"{RJMCMC_MAX_SAMPLES} (pftrack track's limit for the chain)",
+        f"{MAX_JOINT_SAMPLES} (the limit of pftrack track and pftrack.Tracker for the chain)",
     )  # fmt: skip
     p.add_argument("--seed", type=non_negative_int, default=0, help="random seed, >= 0")
     p.add_argument(

@@ -3,17 +3,21 @@
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
+import pftrack
 from pftrack.cli import build_parser, main
 from pftrack.eval import evaluate_mot, format_metrics
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.synthetic import Scene, make_scene
+from pftrack.tracking import TrackerConfig
 
 
 @pytest.fixture(scope="module")
@@ -1054,8 +1058,9 @@ def test_options_the_joint_sampler_never_reads_are_refused() -> None:
 def test_joint_sampler_particles_are_capped(capsys: pytest.CaptureFixture[str]) -> None:
     # was: --sampler rjmcmc --particles 100000 taken, about 6 minutes a frame (the chain's cost
     # grows as the square of its samples)
+    from pftrack._limits import MAX_JOINT_SAMPLES, MAX_PARTICLES
     from pftrack.cli import build_parser
-    from pftrack.cli._options import RJMCMC_MAX_SAMPLES, tracker_config
+    from pftrack.cli._options import tracker_config
 
     parse = build_parser().parse_args
     joint = ["track", "v", "--out", "o", "--sampler", "rjmcmc", "--particles"]
@@ -1064,14 +1069,165 @@ def test_joint_sampler_particles_are_capped(capsys: pytest.CaptureFixture[str]) 
         r"frame grows as the square of its samples .*, 1\.4 s at 32000$"
     )):  # fmt: skip
         tracker_config(parse([*joint, "10001"]))
-    assert RJMCMC_MAX_SAMPLES == 10_000
+    assert (MAX_JOINT_SAMPLES, MAX_PARTICLES) == (10_000, 1_000_000)
     assert tracker_config(parse([*joint, "10000"])).filter.n_particles == 10_000
-    sis = tracker_config(parse([*joint[:-3], "--particles", "100000"]))  # sis: linear, taken
-    assert sis.filter.n_particles == 100_000
+    # sis: linear, taken up to the Python API's limit (was: the command stopped at 100000)
+    sis = tracker_config(parse([*joint[:-3], "--particles", "1000000"]))
+    assert sis.filter.n_particles == 1_000_000
     with pytest.raises(SystemExit):
         main(["track", "--help"])
     text = " ".join(capsys.readouterr().out.split())
+    assert "particles per object (1 to 1000000; with --sampler rjmcmc" in text
     assert "kept samples, 1 to 10000: its cost per frame grows as N squared" in text
+
+
+#: A sampler's option on the command line, the same setting given to ``pftrack.Tracker``, and
+#: the refusal both give (the command's with its flags' names, the Tracker's with its arguments').
+SAMPLER_SETTINGS = [
+    ("--sampler rjmcmc --particles 10001", {"sampler": "rjmcmc", "particles": 10001},
+     "{particles} 10001 with {sampler rjmcmc}: at most 10000. The joint chain's cost per frame "
+     "grows as the square of its samples (each of its burn-in + N iterations weighs a mixture "
+     "over the previous frame's N samples): about 0.15 s a frame at 10000 with 5 objects, 1.4 s "
+     "at 32000"),
+    ("--mh-iter 5", {"mh_iter": 5},
+     "{mh_iter} 5: only {sampler mh} reads it, so it does nothing with {sampler sis}: drop it, "
+     "or use {sampler mh}"),
+    ("--sampler rjmcmc --mh-iter 5", {"sampler": "rjmcmc", "mh_iter": 5},
+     "{mh_iter} 5: only {sampler mh} reads it, so it does nothing with {sampler rjmcmc}: drop "
+     "it, or use {sampler mh}"),
+    ("--burn-in 10 --moves 0.2 0.2 0.5 0.1", {"burn_in": 10, "moves": (0.2, 0.2, 0.5, 0.1)},
+     "{burn_in} 10, {moves} 0.2 0.2 0.5 0.1: only {sampler rjmcmc} reads them, so they do "
+     "nothing with {sampler sis}: drop them, or use {sampler rjmcmc}"),
+    ("--sampler mh --moves 0.2 0.2 0.5 0.1", {"sampler": "mh", "moves": [0.2, 0.2, 0.5, 0.1]},
+     "{moves} 0.2 0.2 0.5 0.1: only {sampler rjmcmc} reads it, so it does nothing with "
+     "{sampler mh}: drop it, or use {sampler rjmcmc}"),
+    ("--sampler rjmcmc --moves 0.1 0 0.7 0.1", {"sampler": "rjmcmc", "moves": (0.1, 0, 0.7, 0.1)},
+     "{moves} is 0.1 0 0.7 0.1: birth 0.1 and death 0, expected both > 0 or both 0 (a birth is "
+     "undone by a death: reversibility)"),
+    ("--sampler rjmcmc --moves 0 0 0 0", {"sampler": "rjmcmc", "moves": (0, 0, 0, 0)},
+     "{moves} is 0 0 0 0: all 0, expected at least one > 0 (birth, death, update, swap)"),
+    # argparse's range checks: the same limits, in argparse's words on the command line
+    ("--particles 1000001", {"particles": 1_000_001}, "expected an integer in [*, 1000000]"),
+    ("--sampler mh --mh-iter 0", {"sampler": "mh", "mh_iter": 0},
+     "expected an integer in [1, 1000]"),
+    ("--sampler mh --mh-iter 1001", {"sampler": "mh", "mh_iter": 1001},
+     "expected an integer in [1, 1000]"),
+    ("--sampler rjmcmc --burn-in 100001", {"sampler": "rjmcmc", "burn_in": 100_001},
+     "expected an integer in [0, 100000]"),
+    ("--sampler rjmcmc --moves 0.1 0.1 nan 0.1",
+     {"sampler": "rjmcmc", "moves": (0.1, 0.1, float("nan"), 0.1)}, "finite number"),
+]  # fmt: skip
+
+
+def _named(message: str, *, cli: bool) -> str:
+    """`message` with its ``{option}`` names as the command's flags or the Tracker's arguments."""
+    import re
+
+    def name(m: re.Match[str]) -> str:
+        word = m.group(1)
+        if word.startswith("sampler "):
+            return f"--{word}" if cli else f"sampler {word.split()[1]!r}"
+        return f"--{word.replace('_', '-')}" if cli else word
+
+    return re.sub(r"\{([a-z_ ]+)\}", name, message)
+
+
+@pytest.mark.parametrize(
+    ("option", "kwargs", "message"), SAMPLER_SETTINGS, ids=[s[0] for s in SAMPLER_SETTINGS]
+)
+def test_a_bad_sampler_setting_is_refused_alike_by_the_command_and_the_tracker(
+    option: str, kwargs: dict[str, Any], message: str, video: Path, tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    """One limit and one message for ``pftrack track`` and ``pftrack.Tracker`` (was: the Tracker
+    took 1000000 joint samples where the command stopped at 10000, the command no more than
+    100000 particles where the Tracker took 1000000, and the MH chain length, the joint chain's
+    burn-in and moves had no option at all)."""
+    out = tmp_path / "o.txt"
+    try:
+        code = main(["-q", "track", str(video), "--out", str(out), *option.split()])
+    except SystemExit as stop:  # argparse's own refusal: usage, then one line
+        code = stop.code
+    err = capsys.readouterr().err
+    assert code == 2 and not out.exists()
+    with pytest.raises(ValueError) as e:
+        pftrack.Tracker(**kwargs)
+    if "{" in message:  # the shared check (pftrack._limits): the same words, one line
+        assert err == f"pftrack track: error: {_named(message, cli=True)}\n"
+        assert str(e.value) == _named(message, cli=False)
+    else:  # a range: argparse's type on the command line, the same bounds in Python
+        last = err.splitlines()[-1]
+        assert last.startswith("pftrack track: error: argument --"), err
+        assert message.replace("*", "0") in last, last  # the command's --particles 0: automatic
+        assert message.replace("*", "1") in str(e.value), str(e.value)
+
+
+def test_the_samplers_chain_settings_reach_their_samplers(scene) -> None:
+    """``--mh-iter``, ``--burn-in`` and ``--moves`` (and ``Tracker``'s arguments of the same
+    names) give the MH filters' ``n_iter`` and the joint chain's burn-in and moves: they were
+    reachable only through ``TrackerConfig`` (the burn-in and moves) or not at all (MH)."""
+    from pftrack._limits import DEFAULT_BURN_IN, DEFAULT_MH_ITER, DEFAULT_MOVES
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+    from pftrack.particle_filter import MHColourParticleFilter
+    from pftrack.tracking.joint import joint_config
+
+    parse = build_parser().parse_args
+    argv = ["track", "v", "--out", "o"]
+    mh = tracker_config(parse([*argv, "--sampler", "mh", "--mh-iter", "3"]))
+    assert mh == pftrack.Tracker(sampler="mh", mh_iter=3).config and mh.mh_iter == 3
+    joint = tracker_config(parse([*argv, "--sampler", "rjmcmc", "--burn-in", "7",
+                                  "--moves", "0.2", "0.2", "0.5", "0"]))  # fmt: skip
+    assert joint == pftrack.Tracker(sampler="rjmcmc", burn_in=7, moves=[0.2, 0.2, 0.5, 0]).config
+    chain = joint_config(joint)
+    assert (chain.burn_in, chain.p_birth, chain.p_death, chain.p_update, chain.p_swap) == (
+        7,
+        0.2,
+        0.2,
+        0.5,
+        0.0,
+    )
+    # the defaults are the configs', named once (pftrack._limits), and the Tracker's
+    default = TrackerConfig()
+    assert default.mh_iter == DEFAULT_MH_ITER == MHColourParticleFilter.__init__.__defaults__[-1]
+    assert default.rjmcmc.burn_in == DEFAULT_BURN_IN
+    r = default.rjmcmc
+    assert (r.p_birth, r.p_death, r.p_update, r.p_swap) == DEFAULT_MOVES
+    params = inspect.signature(pftrack.Tracker).parameters
+    assert (params["mh_iter"].default, params["burn_in"].default, params["moves"].default) == (
+        DEFAULT_MH_ITER,
+        DEFAULT_BURN_IN,
+        DEFAULT_MOVES,
+    )
+    # the chain length reaches the MH filters, and changes what they do
+    truth = [scene.truth[scene.truth[:, 0] == n + 1][:, 2:6] for n in range(12)]
+    dets = [np.c_[t[:, :2], t[:, :2] + t[:, 2:], np.ones(len(t))] for t in truth]
+    particles = {}
+    for n_iter in (1, 4):
+        tracker = pftrack.Tracker(sampler="mh", mh_iter=n_iter)
+        for d, frame in zip(dets, scene.frames[:12], strict=True):
+            tracker.update(d, frame)
+        filters = [t.filter for t in tracker.tracker.tracks]
+        assert filters and all(isinstance(f, MHColourParticleFilter) for f in filters)
+        assert {f.n_iter for f in filters} == {n_iter}
+        particles[n_iter] = filters[0].particles.copy()
+    assert not np.array_equal(particles[1], particles[4])
+
+
+def test_the_tracker_config_holds_the_samplers_limits() -> None:
+    """``Tracker.from_config`` (and ``pftrack track --set``-style configs) meet the same caps."""
+    base = TrackerConfig()
+    many = replace(base, filter=replace(base.filter, n_particles=10_001))  # sis: taken
+    with pytest.raises(ValueError, match=(
+        r"^TrackerConfig: filter.n_particles 10001 with sampler 'rjmcmc': at most 10000\. "
+    )):  # fmt: skip
+        replace(many, sampler="rjmcmc")
+    with pytest.raises(ValueError, match=r"^TrackerConfig: mh_iter is 0, expected an integer"):
+        replace(base, mh_iter=0)
+    with pytest.raises(TypeError, match=r"^TrackerConfig: mh_iter must be an integer"):
+        replace(base, mh_iter=2.0)
+    with pytest.raises(ValueError, match=r"^TrackerConfig: rjmcmc.burn_in is 100001, expected"):
+        replace(base, rjmcmc=replace(base.rjmcmc, burn_in=100_001))
 
 
 def test_background_options_with_no_refine_are_refused() -> None:

@@ -115,7 +115,7 @@ def test_bad_input_is_one_line_and_nothing_is_lost(
 @pytest.mark.parametrize(
     ("command", "option", "limits"),
     [(["render", "V", "T", "--out", "O"], "--trail", "0 to 100000"),
-     (["demo"], "--particles", "1 to 100000"),
+     (["demo"], "--particles", "1 to 1000000"),
      (["track", "V", "--out", "O"], "--open-size", "0 to 255")],
 )  # fmt: skip
 def test_help_states_the_limits_it_enforces(
@@ -126,7 +126,7 @@ def test_help_states_the_limits_it_enforces(
     text = " ".join(capsys.readouterr().out.split())
     assert limits in text.split(f"{option} ")[-1].split(" --")[0]  # its help, not the usage
     try:  # enforced: refused by argparse (SystemExit) or by the command (exit status 2)
-        status = main([*command, option, "100001" if "100000" in limits else "256"])
+        status = main([*command, option, str(int(limits.split(" to ")[1]) + 1)])
     except SystemExit as exc:
         status = exc.code  # type: ignore[assignment]
     assert status == 2

@@ -147,6 +147,8 @@ def _tracker_options() -> st.SearchStrategy[dict[str, Any]]:
         "particles": maybe(ints(1, 50)), "max_coast": maybe(fl(0, 5)),
         "min_conf": maybe(fl(0, 1)), "birth_score": maybe(fl(0, 1)), "prime": maybe(fl(0, 3)),
         "frame_rate": maybe(fl(0.1, 100)), "birth_quantile": maybe(fl(0, 1)),
+        "sampler": st.sampled_from(["sis", "mh", "rjmcmc"]), "mh_iter": maybe(ints(1, 3)),
+        "burn_in": maybe(ints(0, 60)), "moves": maybe(st.tuples(*[fl(0, 1)] * 4)),
     })  # fmt: skip
 
 

@@ -7,6 +7,19 @@ import math
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
+from pftrack._limits import (
+    DEFAULT_BURN_IN,
+    DEFAULT_MH_ITER,
+    DEFAULT_MOVES,
+    MAX_BURN_IN,
+    MAX_JOINT_SAMPLES,
+    MAX_MH_ITER,
+    MAX_PARTICLES,
+    MOVES,
+    joint_samples_error,
+    moves_error,
+    unread_error,
+)
 from pftrack._text import counted as counted  # the commands' counts, re-exported
 
 if TYPE_CHECKING:
@@ -258,20 +271,29 @@ def check_input_file(path: str, *, what: str) -> None:
         raise PermissionError(f"{what} {path} is not readable")
 
 
-#: Most kept samples ``--particles`` gives the joint RJ-MCMC chain. Its cost per frame grows as
-#: N²: each update move evaluates the predictive prior, a mixture over the previous frame's N
-#: kept samples (docs/samplers.md); 10000 costs about 0.15 s of CPU a frame with 5 objects.
-RJMCMC_MAX_SAMPLES = 10_000
+def non_negative_float(text: str) -> float:
+    """Argument type: a finite number >= 0 (a probability of ``--moves``, normalised later)."""
+    v = float(text)
+    if not (math.isfinite(v) and v >= 0):
+        raise argparse.ArgumentTypeError(f"expected a finite number >= 0, got {v:g}")
+    return v
+
+
+non_negative_float.__name__ = "float"
 
 
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
-    """The tracker's options, shared by ``track`` (and any command that tracks)."""
+    """The tracker's options, shared by ``track`` (and any command that tracks).
+
+    The samplers' limits and defaults are :mod:`pftrack._limits`' constants, which
+    :class:`pftrack.Tracker` checks against too.
+    """
     p.add_argument(
-        "--particles", type=bounded_int(0, 100_000), default=0, metavar="N",
-        help="particles per object (1 to 100000; with --sampler rjmcmc, the joint chain's "
-        f"kept samples, 1 to {RJMCMC_MAX_SAMPLES}: its cost per frame grows as N squared, "
-        "about 8 ms at 2000 and 0.15 s at 10000 with 5 objects); 0: 200 with --detections "
-        "for sis and mh, else 100",
+        "--particles", type=bounded_int(0, MAX_PARTICLES), default=0, metavar="N",
+        help=f"particles per object (1 to {MAX_PARTICLES}; with --sampler rjmcmc, the joint "
+        f"chain's kept samples, 1 to {MAX_JOINT_SAMPLES}: its cost per frame grows as N "
+        "squared, about 8 ms at 2000 and 0.15 s at 10000 with 5 objects); 0: 200 with "
+        "--detections for sis and mh, else 100",
     )  # fmt: skip
     p.add_argument("--seed", type=non_negative_int, default=0,
                    help="random seed, an integer >= 0: same seed, same tracks")  # fmt: skip
@@ -291,6 +313,23 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         help="sis: one sequential-importance-sampling filter per object (the paper's method); "
         "mh: Metropolis-Hastings per object; rjmcmc: one joint RJ-MCMC chain over all objects "
         "(Smith et al. 2005)",
+    )  # fmt: skip
+    p.add_argument(
+        "--mh-iter", type=bounded_int(1, MAX_MH_ITER), default=DEFAULT_MH_ITER, metavar="N",
+        help=f"with --sampler mh: Metropolis-Hastings iterations per particle and frame (1 to "
+        f"{MAX_MH_ITER}; the likelihood is evaluated particles x (N + 1) times per object)",
+    )  # fmt: skip
+    p.add_argument(
+        "--burn-in", type=bounded_int(0, MAX_BURN_IN), default=DEFAULT_BURN_IN, metavar="B",
+        help=f"with --sampler rjmcmc: burn-in iterations of the joint chain per frame (0 to "
+        f"{MAX_BURN_IN}; a frame costs about (B + particles) x particles)",
+    )  # fmt: skip
+    p.add_argument(
+        "--moves", type=non_negative_float, nargs=4, default=list(DEFAULT_MOVES),
+        metavar=tuple(m.upper() for m in MOVES),
+        help="with --sampler rjmcmc: probabilities of the joint chain's birth, death, update "
+        "and swap moves, normalised (birth and death both > 0 or both 0; default: "
+        f"{' '.join(f'{v:g}' for v in DEFAULT_MOVES)})",
     )  # fmt: skip
     p.add_argument(
         "--dynamics", choices=("ar2", "ar2-mean"), default="ar2",
@@ -378,7 +417,10 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         Options that contradict each other (``--crossings on`` with ``--no-smooth``), or an
         option of given detections without them (``--det-scale S``, ``--birth-score``,
         ``--no-refine``, and a ``--min-conf`` outside the built-in detector's scores, [0, 1]);
-        more than :data:`RJMCMC_MAX_SAMPLES` ``--particles`` with ``--sampler rjmcmc``.
+        more than :data:`pftrack._limits.MAX_JOINT_SAMPLES` ``--particles`` with ``--sampler
+        rjmcmc``; ``--moves`` the joint chain cannot use; ``--mh-iter`` without ``--sampler
+        mh``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler checks
+        are :class:`pftrack.Tracker`'s (:mod:`pftrack._limits`), with the options' names.
     """
     from dataclasses import replace
 
@@ -426,13 +468,16 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
                 f"{'it' if len(unused) == 1 else 'them'}, or --no-refine"
             )
 
-    if args.sampler == "rjmcmc" and args.particles > RJMCMC_MAX_SAMPLES:
-        raise ValueError(
-            f"--particles {args.particles} with --sampler rjmcmc: at most {RJMCMC_MAX_SAMPLES}. "
-            "The joint chain's cost per frame grows as the square of its samples (each of its "
-            "50 + N iterations weighs a mixture over the previous frame's N samples): about "
-            "0.15 s a frame at 10000 with 5 objects, 1.4 s at 32000"
-        )
+    moves = tuple(args.moves)
+    refused = (
+        (joint_samples_error(args.particles, "--particles", "--sampler rjmcmc")
+         if args.sampler == "rjmcmc" else None)
+        or moves_error(moves, "--moves")
+        or unread_error(args.sampler, {"mh_iter": args.mh_iter, "burn_in": args.burn_in,
+                                       "moves": moves}, cli=True)
+    )  # fmt: skip
+    if refused:
+        raise ValueError(refused)
     if args.sampler == "rjmcmc":  # the joint chain's own existence and births decide
         unused = [
             f"{flag} {value:g}"
@@ -461,6 +506,15 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         given_particles=None if args.particles else base.given_particles,
         detector=args.detector,
         sampler=args.sampler,
+        mh_iter=args.mh_iter,
+        rjmcmc=replace(
+            base.rjmcmc,
+            burn_in=args.burn_in,
+            p_birth=moves[0],
+            p_death=moves[1],
+            p_update=moves[2],
+            p_swap=moves[3],
+        ),
         camera_motion=args.camera_motion,
         max_side=args.max_side or None,
         open_size=args.open_size or None,

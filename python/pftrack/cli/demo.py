@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from pftrack._limits import MAX_PARTICLES
 from pftrack.cli._options import add_command, bounded_int, non_negative_int
 
 
@@ -31,8 +32,8 @@ def add_parser(sub: Any) -> None:
                    help="scene and tracker seed, an integer >= 0")  # fmt: skip
     p.add_argument("--frames", type=bounded_int(1, 1000), default=150,
                    help="scene length (1 to 1000: the scene is held in memory)")  # fmt: skip
-    p.add_argument("--particles", type=bounded_int(1, 100_000), default=100,
-                   help="particles per object (1 to 100000)")  # fmt: skip
+    p.add_argument("--particles", type=bounded_int(1, MAX_PARTICLES), default=100,
+                   help=f"particles per object (1 to {MAX_PARTICLES})")  # fmt: skip
     p.set_defaults(func=run)
 
 

@@ -12,7 +12,7 @@ one of the two afterwards, which removes ``cv2`` for both (``pip install --force
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
@@ -51,6 +51,9 @@ class TrackerOptions(TypedDict, total=False):
     sampler: SamplerName
     particles: int | None
     dynamics: DynamicsName
+    mh_iter: int
+    burn_in: int
+    moves: Sequence[float]
     max_coast: RealLike | None
     min_conf: float
     birth_score: float

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack import _core
+from pftrack import _core, _limits
 from pftrack._check import (
     MAX_COORD,
     generator,
@@ -36,8 +36,9 @@ __all__ = [
 ]
 
 
-MAX_PARTICLES = 1_000_000
-"""Most particles one object's filter may have (48 MB of state; more is refused, not tried)."""
+#: Most particles one object's filter may have (48 MB of state; more is refused, not tried):
+#: :data:`pftrack._limits.MAX_PARTICLES`, the limit of ``pftrack track --particles`` too.
+MAX_PARTICLES = _limits.MAX_PARTICLES
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ import operator
 import pickle
 import threading
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import replace
 from typing import Any, NamedTuple, SupportsIndex
 
@@ -50,6 +50,17 @@ from pftrack._check import (
     real_array,
 )
 from pftrack._check import seed as check_seed
+from pftrack._limits import (
+    DEFAULT_BURN_IN,
+    DEFAULT_MH_ITER,
+    DEFAULT_MOVES,
+    MAX_BURN_IN,
+    MAX_MH_ITER,
+    MAX_PARTICLES,
+    joint_samples_error,
+    moves_error,
+    unread_error,
+)
 from pftrack._typing import (
     F64,
     CameraMotion,
@@ -67,7 +78,6 @@ from pftrack.detection.blocking import BLOCK_FRAMES, blockiness, is_blocky
 from pftrack.detection.light import BLANK_LEVELS, is_blank
 from pftrack.detection.paper import PaperDetector
 from pftrack.detection.size_model import PersonSizeModel
-from pftrack.particle_filter.filter import MAX_PARTICLES
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
@@ -314,6 +324,30 @@ def check_boxes_xyxy(
     return CheckedBoxes(xywh, cls, kept, clipped, n_flat, n_inverted, len(d) - n_flat)
 
 
+def _moves(moves: object) -> tuple[float, float, float, float]:
+    """``Tracker``'s `moves`: 4 real numbers (birth, death, update, swap) the chain can use.
+
+    TypeError for what is not a sequence of 4 real numbers, ValueError (the command's check
+    and message, :func:`pftrack._limits.moves_error`) for probabilities it cannot use.
+    """
+    items: list[object] | None = None
+    if not isinstance(moves, (str, bytes)):
+        try:
+            items = list(moves)  # type: ignore[call-overload]  # any iterable, checked here
+        except TypeError:
+            pass
+    if items is None:
+        raise TypeError(
+            f"moves must be 4 numbers (birth, death, update, swap probabilities), got "
+            f"{brief(moves)}"
+        )
+    values = [real(v, "moves", finite=False) for v in items]
+    bad = moves_error(values, "moves")
+    if bad:
+        raise ValueError(bad)
+    return values[0], values[1], values[2], values[3]
+
+
 class _Alone:
     """``with``: take `lock` without waiting (RuntimeError naming ``Tracker.method`` if held).
 
@@ -354,11 +388,26 @@ class Tracker:
         Particle filter per object (sis, the paper's; mh) or one joint RJ-MCMC chain.
     particles : int or None
         Particles per object. None: 200 for tracks born from given detections, 100 for the
-        built-in detector's (``TrackerConfig.given_particles``). With ``sampler="rjmcmc"``,
-        the joint chain's kept samples N, whose cost per frame grows as N² (about 8 ms at
-        2000 and 0.15 s at 10000 with 5 objects; ``pftrack track`` takes at most 10000).
+        built-in detector's (``TrackerConfig.given_particles``). At most 1000000
+        (:data:`pftrack._limits.MAX_PARTICLES`). With ``sampler="rjmcmc"``, the joint chain's
+        kept samples N, at most 10000 (:data:`pftrack._limits.MAX_JOINT_SAMPLES`): its cost
+        per frame grows as N² (about 8 ms at 2000 and 0.15 s at 10000 with 5 objects).
+        ``pftrack track --particles`` takes the same limits, checked by the same code.
     dynamics : {"ar2", "ar2-mean"}
         AR(2) model per particle, or from the particle-set means.
+    mh_iter : int
+        With ``sampler="mh"``: Metropolis-Hastings iterations per particle and frame, in
+        [1, 1000] (``TrackerConfig.mh_iter``; the likelihood is evaluated ``particles *
+        (mh_iter + 1)`` times per object and frame). ``--mh-iter`` of ``pftrack track``.
+    burn_in : int
+        With ``sampler="rjmcmc"``: burn-in iterations of the joint chain per frame, in
+        [0, 100000] (``RJMCMCConfig.burn_in``; a frame costs O((burn_in + particles)
+        particles)). ``--burn-in``.
+    moves : sequence of 4 float
+        With ``sampler="rjmcmc"``: probabilities of the joint chain's birth, death, update and
+        swap moves (``RJMCMCConfig``'s ``p_birth``, ``p_death``, ``p_update``, ``p_swap``;
+        normalised by the chain): finite and >= 0, not all 0, birth and death both > 0 or
+        both 0. ``--moves``.
     max_coast : float or None
         Seconds a track survives on its particle filter alone. None (default): the command's
         10 frames at any frame rate (0.4 s at 25/s, 1.4 s at 7/s; see the module's notes).
@@ -410,12 +459,15 @@ class Tracker:
     TypeError
         A flag (`refine`, `smooth`, `link`, `crossings`, `record`) that is not ``True`` or ``False``
         (``refine="no"`` would turn refinement on), a `frame_rate`, `max_coast`, `prime`,
-        `min_conf` or `birth_score` that is not a number, a `seed` that is not an int.
+        `min_conf` or `birth_score` that is not a number, a `seed`, `particles`, `mh_iter` or
+        `burn_in` that is not an int, `moves` not numbers.
     ValueError
         A value out of its range, ``crossings=True`` with ``smooth=False`` (the repair is
         part of the smoothing pass), or `max_coast`, `birth_score` or `birth_quantile` other
         than its default with ``sampler="rjmcmc"`` (the joint chain keeps and starts tracks by
-        its own existence probabilities: they would do nothing).
+        its own existence probabilities: they would do nothing); `mh_iter` other than its
+        default without ``sampler="mh"``, `burn_in` or `moves` without ``sampler="rjmcmc"``
+        (only that sampler reads them).
 
     Notes
     -----
@@ -476,6 +528,9 @@ class Tracker:
         sampler: SamplerName = "sis",
         particles: int | None = None,
         dynamics: DynamicsName = "ar2",
+        mh_iter: int = DEFAULT_MH_ITER,
+        burn_in: int = DEFAULT_BURN_IN,
+        moves: Sequence[float] = DEFAULT_MOVES,
         max_coast: RealLike | None = None,
         min_conf: float = 0.0,
         birth_score: float = 0.9,
@@ -518,6 +573,13 @@ class Tracker:
             raise ValueError(f"dynamics is {dynamics!r}, expected 'ar2' or 'ar2-mean'")
         if particles is not None:  # named as the option (was FilterConfig's n_particles)
             particles = integer(particles, "particles", 1, MAX_PARTICLES)
+            if sampler == "rjmcmc":  # the command's check and message (pftrack._limits)
+                too_many = joint_samples_error(particles, "particles", "sampler 'rjmcmc'")
+                if too_many:
+                    raise ValueError(too_many)
+        mh_iter = integer(mh_iter, "mh_iter", 1, MAX_MH_ITER)
+        burn_in = integer(burn_in, "burn_in", 0, MAX_BURN_IN)
+        moves = _moves(moves)
         base = TrackerConfig()
         model = replace(base.filter.model, use_means=dynamics == "ar2-mean")
         config = replace(
@@ -528,6 +590,15 @@ class Tracker:
             given_particles=base.given_particles if particles is None else None,
             detector=detector,
             sampler=sampler,
+            mh_iter=mh_iter,
+            rjmcmc=replace(
+                base.rjmcmc,
+                burn_in=burn_in,
+                p_birth=moves[0],
+                p_death=moves[1],
+                p_update=moves[2],
+                p_swap=moves[3],
+            ),  # fmt: skip
             camera_motion=camera_motion,
             max_side=max_side,
             refine=replace(base.refine, enabled=refine),
@@ -544,6 +615,11 @@ class Tracker:
                 birth_quantile=birth_quantile,
             ),
         )
+        unread = unread_error(
+            sampler, {"mh_iter": mh_iter, "burn_in": burn_in, "moves": moves}, cli=False
+        )
+        if unread:  # the command refuses them likewise (pftrack._limits)
+            raise ValueError(unread)
         if sampler == "rjmcmc":  # its chain ignores them (the CLI refuses them likewise)
             unused = [
                 f"{name} {'None' if value is None else format(value, 'g')}"

@@ -10,10 +10,16 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from pftrack._check import MAX_FRAME, brief, flag, instance, integer, number, option, shown
+from pftrack._limits import (
+    DEFAULT_MH_ITER,
+    MAX_BURN_IN,
+    MAX_MH_ITER,
+    MAX_PARTICLES,
+    joint_samples_error,
+)
 from pftrack._typing import CameraMotion, DetectorName, SamplerName
 from pftrack.detection import DETECTORS
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
-from pftrack.particle_filter.filter import MAX_PARTICLES
 from pftrack.recovery.linking import REFERENCE_DIAGONAL, pixel_scale
 from pftrack.tracking.offline import AMODAL_ANCHORS, NOISE_MAX, NOISE_MIN, CrossingConfig
 
@@ -644,12 +650,16 @@ class TrackerConfig:
     sampler : {"sis", "mh", "rjmcmc"}
         Sequential importance sampling per object (the paper's method), Metropolis-Hastings per
         object, or one joint RJ-MCMC chain over all objects (Smith et al. 2005): the paper's
-        comparison samplers.
+        comparison samplers. With ``"rjmcmc"``, ``filter.n_particles`` (the chain's kept
+        samples N) is at most 10000 (:data:`pftrack._limits.MAX_JOINT_SAMPLES`, as
+        ``pftrack.Tracker`` and ``pftrack track`` take): the chain's cost per frame grows as N².
     rjmcmc : RJMCMCConfig
         Settings of the joint sampler (used with ``sampler="rjmcmc"``); its sample count and
         AR2 dynamics are set from ``filter`` so that budgets and models compare: its
         `n_samples`, `a`, `b`, `sigma`, `s_min` and `s_max` must keep RJMCMCConfig's defaults
-        (ValueError naming the ``filter`` setting to use instead).
+        (ValueError naming the ``filter`` setting to use instead). Its `burn_in` is at most
+        100000 here (``Tracker(burn_in=...)``, ``--burn-in``); its move probabilities are
+        ``Tracker(moves=...)`` and ``--moves``.
     detector : {"paper", "mog2", "knn"}
         Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections.
     reference_rate : float
@@ -691,6 +701,11 @@ class TrackerConfig:
         the same values. On frames smaller than 480x360 the filter's noise shrinks in
         proportion to the diagonal (:meth:`noise_scale`). None: the settings are in the frame's
         own pixels at every size.
+    mh_iter : int
+        Metropolis-Hastings iterations per particle and frame with ``sampler="mh"``
+        (:class:`~pftrack.particle_filter.MHColourParticleFilter`'s `n_iter`), in [1, 1000]:
+        a step evaluates the likelihood ``n_particles * (mh_iter + 1)`` times per object.
+        ``Tracker(mh_iter=...)``, ``--mh-iter``; the other samplers do not read it.
     """
 
     filter: FilterConfig = field(
@@ -715,6 +730,7 @@ class TrackerConfig:
     open_size: int | None = None
     pixel_diagonal: float | None = PIXEL_DIAGONAL
     given_particles: int | None = GIVEN_PARTICLES
+    mh_iter: int = DEFAULT_MH_ITER
 
     def __post_init__(self) -> None:
         for name, cls in _SUB_CONFIGS:  # were taken, and failed at a frame naming no setting
@@ -723,6 +739,14 @@ class TrackerConfig:
         option(self.camera_motion, "camera_motion", CAMERA_MOTION)
         option(self.detector, "detector", DETECTORS)
         _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
+        integer(self.mh_iter, "TrackerConfig: mh_iter", 1, MAX_MH_ITER)
+        integer(self.rjmcmc.burn_in, "TrackerConfig: rjmcmc.burn_in", 0, MAX_BURN_IN)
+        if self.sampler == "rjmcmc":  # the tracker's cap; RJMCMCConfig alone takes more
+            too_many = joint_samples_error(
+                self.filter.n_particles, "TrackerConfig: filter.n_particles", "sampler 'rjmcmc'"
+            )
+            if too_many:
+                raise ValueError(too_many)
         _none_or_int_in(self, "open_size", 1, MAX_OPEN_SIZE)
         side = self.max_side
         if isinstance(side, (int, np.integer)) and not isinstance(side, bool) and side == 0:

@@ -129,9 +129,11 @@ class LiveTrack:
     def __init__(self, track_id: int, box_xywh: F64, reference: F64, config: TrackerConfig,
                  seed: int, score: float) -> None:  # fmt: skip
         self.id = track_id
-        cls = MHColourParticleFilter if config.sampler == "mh" else ColourParticleFilter
-        self.filter: ColourParticleFilter = cls(
-            _to_cxcywh(box_xywh), reference, config.filter, rng=seed
+        box = _to_cxcywh(box_xywh)
+        self.filter: ColourParticleFilter = (
+            MHColourParticleFilter(box, reference, config.filter, rng=seed, n_iter=config.mh_iter)
+            if config.sampler == "mh"
+            else ColourParticleFilter(box, reference, config.filter, rng=seed)
         )
         self.box = box_xywh.copy()
         self.size = box_xywh[2:].copy()  # smoothed detection size
