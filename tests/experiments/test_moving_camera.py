@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from experiments import moving_camera as mc
-from experiments._common import REPO
+from experiments._common import REPO, Source
 from pftrack.cli import main as pftrack_main
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot
@@ -16,7 +16,7 @@ from pftrack.io.video import read_frames
 
 
 def test_versions_move_frames_and_boxes_together(data: Path, tmp_path: Path) -> None:
-    seq = mc.Source("tiny", "img", 1.0)
+    seq = Source("tiny", "img", 1.0)
     static = mc.make_version(seq, data, tmp_path, "static")
     moving = mc.make_version(seq, data, tmp_path, "moving")
     for folder in (static, moving):
@@ -52,7 +52,7 @@ def test_original_row_notes_the_users_figure(
 ) -> None:
     # the table's original row is a mean over seeds; the note under it must give seed 0's
     # figure, which is `pftrack track` with every default (what measure.sh and README quote)
-    seq = mc.Source("tiny", "img", 1.0)
+    seq = Source("tiny", "img", 1.0)
     monkeypatch.setattr(mc, "SEQUENCES", (seq,))
     out = tmp_path / "mc"
     argv = ["--data", str(data), "--out", str(out), "--detections", "public", "--seeds", "2"]
