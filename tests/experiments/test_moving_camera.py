@@ -5,15 +5,18 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from experiments import moving_camera as mc
-from experiments._common import REPO
+from experiments._common import REPO, Source
+from pftrack.cli import main as pftrack_main
+from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot
 from pftrack.io.video import read_frames
 
 
 def test_versions_move_frames_and_boxes_together(data: Path, tmp_path: Path) -> None:
-    seq = mc.Source("tiny", "img", 1.0)
+    seq = Source("tiny", "img", 1.0)
     static = mc.make_version(seq, data, tmp_path, "static")
     moving = mc.make_version(seq, data, tmp_path, "moving")
     for folder in (static, moving):
@@ -42,3 +45,47 @@ def test_versions_move_frames_and_boxes_together(data: Path, tmp_path: Path) -> 
 
 def test_refuses_an_output_inside_the_repository(data: Path) -> None:
     assert mc.main(["--data", str(data), "--out", str(REPO / "out" / "x")]) == 2
+
+
+def test_original_row_notes_the_users_figure(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the table's original row is a mean over seeds; the note under it must give seed 0's
+    # figure, which is `pftrack track` with every default (what measure.sh and README quote)
+    seq = Source("tiny", "img", 1.0)
+    monkeypatch.setattr(mc, "SEQUENCES", (seq,))
+    out = tmp_path / "mc"
+    argv = ["--data", str(data), "--out", str(out), "--detections", "public", "--seeds", "2"]
+    assert mc.main(argv) == 0
+    user = tmp_path / "user.txt"
+    det = data / "tiny" / "det.txt"
+    assert pftrack_main(["-q", "track", str(data / "tiny" / "img"), "--detections", str(det),
+                         "--out", str(user)]) == 0  # fmt: skip
+    run = out / "tracks" / "tiny-original-public-auto-0.txt"
+    assert run.read_bytes() == user.read_bytes()
+    m = evaluate_mot(read_mot(data / "tiny" / "gt.txt"), read_mot(user))
+    text = (out / "moving_camera.md").read_text()
+    assert f"seed 0 (`pftrack track` with every default, as measure.sh runs it) " \
+        f"{100 * m.mota:.1f} / {100 * m.idf1:.1f}; seeds 0-1" in text  # fmt: skip
+
+
+def test_original_note_gives_seed_0_and_the_range_not_the_mean() -> None:
+    scores = np.array([[52.1, 60.7], [39.3, 51.1], [47.1, 54.1]])  # TUD-Campus, built-in
+    note = mc.original_note("tud-campus", "builtin", scores, same=True)
+    assert "same bytes for every seed" in note
+    assert (
+        "measure.sh runs it) 52.1 / 60.7; seeds 0-2: MOTA 39.3 to 52.1, IDF1 51.1 to 60.7" in note
+    )
+    assert "DIFFERENT files" in mc.original_note("x", "public", scores, same=False)
+    assert mc.summary(scores) == "46.2 ± 5.3 / 55.3 ± 4.0"  # np.std, ddof 0
+
+
+@pytest.mark.parametrize("seeds", ["0", "-1", "x"])
+def test_refuses_no_seeds(
+    data: Path, tmp_path: Path, seeds: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        mc.main(["--data", str(data), "--out", str(tmp_path), "--seeds", seeds])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "--seeds" in err[-1] and "Traceback" not in "".join(err)
