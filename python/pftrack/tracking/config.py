@@ -5,7 +5,7 @@ Every default is a rule, not a per-sequence tuning (measured in docs/results.md)
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -49,13 +49,16 @@ GIVEN_PARTICLES = 200
 
 
 def _numbers(owner: str, config: object, *names: str) -> None:
-    """Refuse the named settings unless numbers or None, with a TypeError naming them.
+    """Refuse the named settings unless numbers, with a TypeError naming them.
 
-    Text failed at a comparison without a name (``'<=' not supported``), or was taken.
+    None passes only for a field whose annotation takes it (``float | None``: off). Text
+    failed at a comparison without a name (``'<=' not supported``), or was taken; None for a
+    plain ``float`` field (``MotionConfig(accel=None)``) failed likewise (developer trial).
     """
+    optional = {f.name for f in fields(config) if "None" in str(f.type)}  # type: ignore[arg-type]
     for name in names:
         v = getattr(config, name)
-        if v is not None:
+        if v is not None or name not in optional:
             number(v, f"{owner}: {name}", finite=False)
 
 
