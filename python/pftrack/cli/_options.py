@@ -309,8 +309,8 @@ def add_chain_options(p: argparse.ArgumentParser) -> None:
         "--mh-rw-sigma", type=bounded_float(0.0, MAX_MH_RW_SIGMA), nargs=3,
         default=list(DEFAULT_MH_RW_SIGMA), metavar=("CX", "CY", "S"),
         help=f"with --mh-proposal random_walk: standard deviations of its step, cx and cy in "
-        f"pixels (of a 640x480 frame: they grow with larger frames, as the filter's noise) and "
-        f"the scale, each 0 to {MAX_MH_RW_SIGMA:g} (default: "
+        f"pixels (scaled with the frame's size as the filter's noise is) and the scale, each 0 "
+        f"to {MAX_MH_RW_SIGMA:g} (default: "
         f"{' '.join(f'{v:g}' for v in DEFAULT_MH_RW_SIGMA)})",
     )  # fmt: skip
     p.add_argument(

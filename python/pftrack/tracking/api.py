@@ -408,8 +408,8 @@ class Tracker:
         default, the paper's) or a Gaussian random walk from the chain's state
         (``TrackerConfig.mh_proposal``). ``--mh-proposal``.
     mh_rw_sigma : sequence of 3 float
-        With ``mh_proposal="random_walk"``: standard deviations of its step (cx, cy in pixels
-        of a 640x480 frame, growing with larger frames as the filter's noise; scale), each in
+        With ``mh_proposal="random_walk"``: standard deviations of its step (cx, cy in pixels,
+        scaled with the frame's size as the filter's noise is; scale), each in
         [0, 10000], default ``(2.0, 2.0, 0.01)`` (``TrackerConfig.mh_rw_sigma``).
         ``--mh-rw-sigma``.
     burn_in : int
