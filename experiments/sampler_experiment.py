@@ -3,7 +3,9 @@
 All three samplers run inside :class:`pftrack.tracking.MultiObjectTracker` with the same settings
 except ``sampler``, at the same particle budget: ``--particles`` particles per object for SIS and
 MH (MH: one chain step per particle, so 2 N likelihoods per object and frame), ``--particles``
-kept samples (+ the configured burn-in) of the one joint chain for RJ-MCMC.
+kept samples (+ the configured burn-in) of the one joint chain for RJ-MCMC. The chain settings
+are ``pftrack track``'s flags, with its defaults and ranges: ``--mh-iter``, ``--mh-proposal``,
+``--mh-rw-sigma`` (MH) and ``--burn-in``, ``--moves`` (RJ-MCMC); each sampler reads its own.
 
 Outputs (in ``--out``, default ``out/sampler_experiment``):
 
@@ -20,6 +22,8 @@ Usage (from the repository root)::
 
     python -m experiments.sampler_experiment [--data ../shared/data] [--particles 100] [--seed 0]
         [--max-walkers 8] [--out out/sampler_experiment] [--skip-timing] [--skip-figure]
+        [--mh-iter 1] [--mh-proposal dynamics] [--mh-rw-sigma 2 2 0.01] [--burn-in 50]
+        [--moves 0.1 0.1 0.7 0.1]
 """
 
 from __future__ import annotations
@@ -39,7 +43,14 @@ from numpy.typing import NDArray
 from experiments._common import data_root, experiment_parser, write_text
 from pftrack._limits import MAX_JOINT_SAMPLES
 from pftrack.boxes import iou_xywh
-from pftrack.cli._options import bounded_int, non_negative_int, positive_int
+from pftrack.cli._options import (
+    add_chain_options,
+    bounded_int,
+    chain_config,
+    chain_error,
+    non_negative_int,
+    positive_int,
+)
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.atomic import atomic_path, atomic_write
 from pftrack.io.mot import as_written, group_by_frame, read_mot
@@ -89,6 +100,7 @@ def run_sampler(
     seed: int = 0,
     sequence: str = "",
     detector: str = "",
+    base: TrackerConfig | None = None,
 ) -> SamplerResult:
     """Track `source` with one sampler and score it against `gt`.
 
@@ -109,12 +121,17 @@ def run_sampler(
         Particle budget.
     seed : int
         Tracker seed.
+    sequence, detector : str
+        The row's labels.
+    base : TrackerConfig, optional
+        The settings every sampler shares, its chain settings among them (default
+        ``TrackerConfig()``; :func:`config_for`).
     """
     # online output (no offline linking or smoothing): the samplers are what is compared
     run = track_frames(
         source,
         detections=detections,
-        config=config_for(sampler, particles),
+        config=config_for(sampler, particles, base),
         rng=seed,
         show_progress=False,
         smoother=None,
@@ -219,7 +236,9 @@ def truth_detections(scene: Scene) -> dict[int, NDArray[np.float64]]:
     }
 
 
-def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) -> float:
+def time_per_frame(
+    scene: Scene, sampler: str, particles: int, seed: int = 0, base: TrackerConfig | None = None
+) -> float:
     """Mean seconds per frame spent in the sampler alone, one scene.
 
     The frame-level work every sampler shares (colour binning, the foreground mask: here the
@@ -227,14 +246,16 @@ def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) ->
     ground-truth boxes: SIS and MH step one filter per object in view, RJ-MCMC one joint chain
     with the boxes as birth candidates. Same budget and dynamics as in the tracker.
     """
-    cfg = config_for(sampler, particles)
+    cfg = config_for(sampler, particles, base)
     rng = np.random.default_rng(seed)
     frames = group_by_frame(scene.truth)
     filters: dict[int, Any] = {}
     joint = None
     if sampler == "rjmcmc":
         joint = RJMCMCFilter(joint_config(cfg), rng=rng)
-    cls = MHColourParticleFilter if sampler == "mh" else ColourParticleFilter
+    # the MH chain as the tracker runs it (pftrack.tracking.track): was n_iter 1 whatever
+    # the configuration said
+    mh = {"n_iter": cfg.mh_iter, "proposal": cfg.mh_proposal, "rw_sigma": cfg.mh_rw_sigma}
     total = 0.0
     for n, frame in enumerate(scene.frames, start=1):
         diff = cv2.absdiff(frame, scene.background).max(axis=2)
@@ -254,7 +275,11 @@ def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) ->
                 and refs is not None
                 and refs[k].sum() > 0
             ):
-                filters[int(r[1])] = cls(boxes[k], refs[k], cfg.filter, rng=rng)
+                filters[int(r[1])] = (
+                    MHColourParticleFilter(boxes[k], refs[k], cfg.filter, rng=rng, **mh)
+                    if sampler == "mh"
+                    else ColourParticleFilter(boxes[k], refs[k], cfg.filter, rng=rng)
+                )
         in_view = {int(r[1]) for r in rows}
         start = time.perf_counter()
         if joint is not None:
@@ -268,7 +293,11 @@ def time_per_frame(scene: Scene, sampler: str, particles: int, seed: int = 0) ->
 
 
 def timing_vs_objects(
-    max_walkers: int, particles: int, n_frames: int = 40, seed: int = 0
+    max_walkers: int,
+    particles: int,
+    n_frames: int = 40,
+    seed: int = 0,
+    base: TrackerConfig | None = None,
 ) -> dict[str, list[tuple[float, float]]]:
     """(mean objects in view, ms/frame) per sampler for scenes with 1..max_walkers walkers.
 
@@ -281,7 +310,7 @@ def timing_vs_objects(
         sub = _middle(scene, n_frames)
         n_obj = len(sub.truth) / n_frames
         for s in SAMPLERS:
-            out[s].append((n_obj, 1e3 * time_per_frame(sub, s, particles, seed)))
+            out[s].append((n_obj, 1e3 * time_per_frame(sub, s, particles, seed, base)))
     return out
 
 
@@ -297,14 +326,19 @@ def _middle(scene: Scene, n_frames: int) -> Scene:
 
 
 def timing_vs_particles(
-    budgets: Sequence[int], n_walkers: int = 4, n_frames: int = 40, seed: int = 0
+    budgets: Sequence[int],
+    n_walkers: int = 4,
+    n_frames: int = 40,
+    seed: int = 0,
+    base: TrackerConfig | None = None,
 ) -> dict[str, list[tuple[float, float]]]:
     """(particles, ms/frame) per sampler on one synthetic scene."""
     sub = _middle(
         make_scene(n_frames=3 * n_frames, n_walkers=n_walkers, rng=seed, occluder=False), n_frames
     )
     return {
-        s: [(float(n), 1e3 * time_per_frame(sub, s, n, seed)) for n in budgets] for s in SAMPLERS
+        s: [(float(n), 1e3 * time_per_frame(sub, s, n, seed, base)) for n in budgets]
+        for s in SAMPLERS
     }
 
 
@@ -377,6 +411,7 @@ def occlusion_figure(
     seed: int = 0,
     offset: int = 8,
     crop: tuple[int, int] = (200, 130),
+    base: TrackerConfig | None = None,
 ) -> Path:
     """Frames before, during and after walkers 1 and 2 cross, one row per sampler (PNG)."""
     fc = crossing_frame(scene)
@@ -385,7 +420,7 @@ def occlusion_figure(
     for s in SAMPLERS:
         run = track_frames(
             scene.frames,
-            config=config_for(s, particles),
+            config=config_for(s, particles, base),
             rng=seed,
             show_progress=False,
             smoother=None,
@@ -443,7 +478,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     )  # fmt: skip
     p.add_argument("--skip-timing", action="store_true")
     p.add_argument("--skip-figure", action="store_true")
+    add_chain_options(p)  # pftrack track's, with its defaults and ranges
     args = p.parse_args(argv)
+    refused = chain_error(args)
+    if refused:
+        p.error(refused)
+    base = chain_config(args, TrackerConfig())
     if not (args.skip_timing and args.skip_figure):  # the two figures: before any work
         import importlib.util
 
@@ -473,6 +513,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 seed=args.seed,
                 sequence=r["sequence"],
                 detector=r["detector"],
+                base=base,
             )
             results.append(res)
             print(
@@ -481,16 +522,21 @@ def main(argv: Sequence[str] | None = None) -> int:
                 file=sys.stderr,
             )
     table = format_table(results)
+    chain = (
+        f"--mh-iter {args.mh_iter} --mh-proposal {args.mh_proposal} --mh-rw-sigma "
+        f"{' '.join(f'{v:g}' for v in args.mh_rw_sigma)} --burn-in {args.burn_in} --moves "
+        f"{' '.join(f'{v:g}' for v in args.moves)}"
+    )
     header = (
         f"<!-- python -m experiments.sampler_experiment --particles {args.particles} "
-        f"--seed {args.seed} --max-walkers {args.max_walkers} -->\n"
+        f"--seed {args.seed} --max-walkers {args.max_walkers} {chain} -->\n"
     )
     print(table)
     write_text(args.out / "sampler_results.md", header + table + "\n")
     if not args.skip_timing:
-        by_obj = timing_vs_objects(args.max_walkers, args.particles, seed=args.seed)
+        by_obj = timing_vs_objects(args.max_walkers, args.particles, seed=args.seed, base=base)
         budgets = (25, 50, 100, 200, 400, 800)
-        by_n = timing_vs_particles(budgets, seed=args.seed)
+        by_n = timing_vs_particles(budgets, seed=args.seed, base=base)
         plot_timing(by_obj, by_n, args.out / "sampler_time.png", args.particles, 4)
         lines = [
             "| sampler | " + " | ".join(f"{x:.1f} obj" for x, _ in by_obj["sis"]) + " |",
@@ -514,6 +560,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             args.out / "sampler_occlusion.png",
             args.particles,
             args.seed,
+            base=base,
         )
     return 0
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import inspect
 import os
+import re
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -1102,8 +1103,18 @@ SAMPLER_SETTINGS = [
      "{moves} 0.2 0.2 0.5 0.1: only {sampler rjmcmc} reads it, so it does nothing with "
      "{sampler mh}: drop it, or use {sampler rjmcmc}"),
     ("--sampler rjmcmc --moves 0.1 0 0.7 0.1", {"sampler": "rjmcmc", "moves": (0.1, 0, 0.7, 0.1)},
-     "{moves} is 0.1 0 0.7 0.1: birth 0.1 and death 0, expected both > 0 or both 0 (a birth is "
-     "undone by a death: reversibility)"),
+     "{moves} is 0.1 0 0.7 0.1: birth 0.1 and death 0, expected birth and death both > 0 or "
+     "both 0 (a birth is undone by a death: reversibility)"),
+    # the MH proposal (developer trial, 6 December: the core's proposals had no option)
+    ("--mh-proposal random_walk", {"mh_proposal": "random_walk"},
+     "{mh_proposal} random_walk: only {sampler mh} reads it, so it does nothing with "
+     "{sampler sis}: drop it, or use {sampler mh}"),
+    ("--sampler mh --mh-rw-sigma 4 4 0.02", {"sampler": "mh", "mh_rw_sigma": (4, 4, 0.02)},
+     "{mh_rw_sigma} 4 4 0.02: only the random-walk proposal reads it, so it does nothing with "
+     "{mh_proposal dynamics}: drop it, or use {mh_proposal random_walk}"),
+    ("--sampler mh --mh-proposal random_walk --mh-rw-sigma 4 4 10001",
+     {"sampler": "mh", "mh_proposal": "random_walk", "mh_rw_sigma": (4, 4, 10001)},
+     "in [0, 10000]"),
     ("--sampler rjmcmc --moves 0 0 0 0", {"sampler": "rjmcmc", "moves": (0, 0, 0, 0)},
      "{moves} is 0 0 0 0: all 0, expected at least one > 0 (birth, death, update, swap)"),
     # argparse's range checks: the same limits, in argparse's words on the command line
@@ -1125,8 +1136,9 @@ def _named(message: str, *, cli: bool) -> str:
 
     def name(m: re.Match[str]) -> str:
         word = m.group(1)
-        if word.startswith("sampler "):
-            return f"--{word}" if cli else f"sampler {word.split()[1]!r}"
+        if " " in word:  # an option and its text value: --sampler mh, sampler 'mh'
+            key, value = word.split()
+            return f"--{key.replace('_', '-')} {value}" if cli else f"{key} {value!r}"
         return f"--{word.replace('_', '-')}" if cli else word
 
     return re.sub(r"\{([a-z_ ]+)\}", name, message)
@@ -1212,6 +1224,70 @@ def test_the_samplers_chain_settings_reach_their_samplers(scene) -> None:
         assert {f.n_iter for f in filters} == {n_iter}
         particles[n_iter] = filters[0].particles.copy()
     assert not np.array_equal(particles[1], particles[4])
+
+
+def test_the_mh_proposal_settings_reach_the_filters(scene) -> None:
+    """``--mh-proposal`` and ``--mh-rw-sigma`` (``Tracker``'s ``mh_proposal`` and
+    ``mh_rw_sigma``) give the MH filters' proposal, which changes what they do; the core's
+    random-walk proposal had no option (developer trial, 6 December). The defaults are the
+    core's, stated once in pftrack._limits, so the default MH output is unchanged."""
+    from pftrack._limits import DEFAULT_MH_PROPOSAL, DEFAULT_MH_RW_SIGMA
+    from pftrack.cli import build_parser
+    from pftrack.cli._options import tracker_config
+    from pftrack.particle_filter import MHColourParticleFilter
+
+    parse = build_parser().parse_args
+    argv = ["track", "v", "--out", "o", "--sampler", "mh"]
+    rw = ["--mh-proposal", "random_walk", "--mh-rw-sigma", "3", "3", "0.02"]
+    config = tracker_config(parse([*argv, *rw]))
+    kwargs = {"mh_proposal": "random_walk", "mh_rw_sigma": np.array([3, 3, 0.02])}
+    assert config == pftrack.Tracker(sampler="mh", **kwargs).config
+    assert (config.mh_proposal, config.mh_rw_sigma) == ("random_walk", (3.0, 3.0, 0.02))
+    default = tracker_config(parse(argv))
+    assert (default.mh_proposal, default.mh_rw_sigma) == (DEFAULT_MH_PROPOSAL, DEFAULT_MH_RW_SIGMA)
+    kw = MHColourParticleFilter.__init__.__kwdefaults__
+    assert (kw["proposal"], kw["rw_sigma"]) == (DEFAULT_MH_PROPOSAL, DEFAULT_MH_RW_SIGMA)
+    # pixel settings: the step's cx, cy grow with the frame as the filter's sigma_xy
+    big = config.scaled_pixels(2.0)
+    assert big.mh_rw_sigma == (6.0, 6.0, 0.02)
+    assert default.scaled_pixels(2.0).mh_rw_sigma == DEFAULT_MH_RW_SIGMA  # dynamics: unread
+    truth = [scene.truth[scene.truth[:, 0] == n + 1][:, 2:6] for n in range(12)]
+    dets = [np.c_[t[:, :2], t[:, :2] + t[:, 2:], np.ones(len(t))] for t in truth]
+    particles = []
+    for extra in ({}, {"mh_proposal": "random_walk"}, kwargs):
+        tracker = pftrack.Tracker(sampler="mh", mh_iter=3, **extra)
+        for d, frame in zip(dets, scene.frames[:12], strict=True):
+            tracker.update(d, frame)
+        filters = [t.filter for t in tracker.tracker.tracks]
+        assert filters and all(isinstance(f, MHColourParticleFilter) for f in filters)
+        assert {f.proposal for f in filters} == {extra.get("mh_proposal", "dynamics")}
+        particles.append(filters[0].particles.copy())
+    assert not np.array_equal(particles[0], particles[1])
+    assert not np.array_equal(particles[1], particles[2])
+
+
+def test_the_moves_rule_has_one_wording(capsys: pytest.CaptureFixture[str]) -> None:
+    """``RJMCMCConfig``, ``--moves``' help and refusal, ``Tracker(moves=...)`` and
+    docs/samplers.md state the birth/death rule in the same words (``RJMCMCConfig`` said
+    "(reversibility)" alone, the help gave no reason)."""
+    from pftrack._limits import MOVES_RULE
+    from pftrack.particle_filter import RJMCMCConfig
+
+    def flat(text: str) -> str:
+        return " ".join(text.split())
+
+    with pytest.raises(SystemExit):
+        main(["track", "--help"])
+    text = flat(capsys.readouterr().out)
+    assert f"finite and >= 0, not all 0, {MOVES_RULE} (default: 0.1 0.1 0.7 0.1)" in text
+    assert "--mh-proposal {dynamics,random_walk}" in text and "--mh-rw-sigma CX CY S" in text
+    assert MOVES_RULE in flat(RJMCMCConfig.__doc__ or "")
+    docs = Path(__file__).resolve().parents[1] / "docs" / "samplers.md"
+    assert MOVES_RULE in flat(docs.read_text(encoding="utf-8"))
+    with pytest.raises(ValueError, match=re.escape(f"expected {MOVES_RULE}")):
+        RJMCMCConfig(p_death=0.0)
+    with pytest.raises(ValueError, match=re.escape(f"expected {MOVES_RULE}")):
+        pftrack.Tracker(sampler="rjmcmc", moves=(0.1, 0, 0.7, 0.1))
 
 
 def test_the_tracker_config_holds_the_samplers_limits() -> None:

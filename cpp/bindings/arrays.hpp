@@ -30,18 +30,38 @@ inline bool is_u8(const py::dtype& d) { return is_dtype<std::uint8_t>(d); }
 inline bool is_bool(const py::dtype& d) { return is_dtype<bool>(d); }
 
 /// A (H, W, 3) uint8 image whose pixels are packed (3 bytes a pixel, 1 a channel); rows may be
-/// strided (views of a larger image are fine).
+/// strided (views of a larger image are fine). A wrong dtype is a TypeError, a wrong shape or
+/// layout a ValueError, as the Python layer's frame checks (pftrack._check.bgr_array) raise
+/// them: a float32 or uint16 frame was ValueError from the core and TypeError from Python.
 inline void check_bgr_image(const py::array& a, const char* fn, const char* what) {
     // Every message is built only on failure: these checks run on every frame, and naming the
     // dtype (a str() through Python) or concatenating strings up front cost a call each time.
-    if (!is_u8(a.dtype()))
-        require(false, fn, (std::string(what) + " dtype").c_str(), dtype_name(a),
-                "uint8 (BGR, as cv2 reads it)");
+    if (!is_u8(a.dtype())) {
+        const bool deep = is_dtype<std::uint16_t>(a.dtype());
+        throw py::type_error(std::string(fn) + ": " + what + " dtype is " + dtype_name(a) +
+                             ", expected uint8 (BGR, as cv2 reads it)" +
+                             (deep ? "; a 16-bit frame? (frame >> 8).astype(np.uint8) keeps its "
+                                     "top 8 bits"
+                                   : ""));
+    }
     if (!(a.ndim() == 3 && a.shape(2) == 3))
         fail(fn, std::string(what) + " must have shape (H, W, 3)");
     if (!(a.shape(0) > 0 && a.shape(1) > 0)) fail(fn, std::string(what) + " is empty");
     if (!(a.strides(2) == 1 && a.strides(1) == 3 && a.strides(0) > 0))
         fail(fn, std::string(what) + " pixels must be packed (use numpy.ascontiguousarray)");
+}
+
+/// `obj` as a NumPy array checked by check_bgr_image; anything else (a list, None, a PIL
+/// image) is a one-line TypeError naming `what`, where a `py::array` parameter gave pybind11's
+/// list of signatures.
+inline py::array bgr_image(const py::handle& obj, const char* fn, const char* what) {
+    if (!py::isinstance<py::array>(obj))
+        throw py::type_error(std::string(fn) + ": " + what + " is " +
+                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>() +
+                             ", expected a numpy.ndarray (H, W, 3) uint8 (BGR, as cv2 reads it)");
+    py::array a = py::reinterpret_borrow<py::array>(obj);
+    check_bgr_image(a, fn, what);
+    return a;
 }
 
 /// A mask's dtype: uint8 or bool (named in the message only on failure). A wrong dtype is a

@@ -97,10 +97,10 @@ void register_detection(py::module_& m) {
              py::arg("v_min") = 0.2)
         .def(
             "apply",
-            [](BackgroundModel& self, py::array frame, bool bins) {
+            [](BackgroundModel& self, const py::object& frame_in, bool bins) {
                 const char* fn = "BackgroundModel.apply";
                 const bind::InUse busy(&self, fn);
-                bind::check_bgr_image(frame, fn, "frame");
+                const py::array frame = bind::bgr_image(frame_in, fn, "frame");
                 const Index rows = frame.shape(0), cols = frame.shape(1);
                 if (self.initialized())
                     require(rows == self.rows() && cols == self.cols(), fn,
@@ -127,9 +127,10 @@ void register_detection(py::module_& m) {
             "mask (H, W) uint8: 255 foreground, 127 shadow, 0 background).")
         .def(
             "blend",
-            [](BackgroundModel& self, py::array frame, py::array mask, double rate) {
+            [](BackgroundModel& self, const py::object& frame_in, py::array mask, double rate) {
                 const char* fn = "BackgroundModel.blend";
                 const bind::InUse busy(&self, fn);
+                const py::array frame = bind::bgr_image(frame_in, fn, "frame");
                 check_frame_and_mask(self, frame, mask, fn);
                 const auto* src = static_cast<const std::uint8_t*>(frame.data());
                 const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
@@ -143,10 +144,10 @@ void register_detection(py::module_& m) {
             "background += rate (frame - background) where mask (H, W) uint8/bool != 0.")
         .def(
             "global_gain",
-            [](BackgroundModel& self, py::array frame, Index step, double min_sum) {
+            [](BackgroundModel& self, const py::object& frame_in, Index step, double min_sum) {
                 const char* fn = "BackgroundModel.global_gain";
                 const bind::InUse busy(&self, fn);
-                bind::check_bgr_image(frame, fn, "frame");
+                const py::array frame = bind::bgr_image(frame_in, fn, "frame");
                 require(self.initialized(), fn, "the model has no background yet");
                 require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
                         "frame shape is " + shape_str(frame) + ", expected (" +
@@ -170,11 +171,12 @@ void register_detection(py::module_& m) {
             "background *= gain (float32, clipped to 255): follow a global illumination change.")
         .def(
             "edge_support",
-            [](const BackgroundModel& self, py::array frame, py::array mask,
+            [](const BackgroundModel& self, const py::object& frame_in, py::array mask,
                py::array_t<double, py::array::c_style | py::array::forcecast> boxes,
                const std::string& statistic) {
                 const char* fn = "BackgroundModel.edge_support";
                 const bind::InUse busy(&self, fn, true);  // reads only
+                const py::array frame = bind::bgr_image(frame_in, fn, "frame");
                 require(statistic == "ratio" || statistic == "vote", fn,
                         "statistic is '" + statistic + "', expected 'ratio' or 'vote'");
                 const auto stat =
@@ -359,14 +361,8 @@ void register_detection(py::module_& m) {
             std::vector<py::array> keep;  // holds every frame while the GIL is released
             keep.reserve(static_cast<size_t>(m));
             for (Index f = 0; f < m; ++f) {
-                py::object item = frames[static_cast<size_t>(f)];
-                require(py::isinstance<py::array>(item), fn,
-                        "frames[" + std::to_string(f) + "] is " +
-                            std::string(py::str(py::type::of(item).attr("__name__"))) +
-                            ", expected a numpy.ndarray");
-                keep.push_back(item.cast<py::array>());
                 const std::string what = "frames[" + std::to_string(f) + "]";
-                bind::check_bgr_image(keep.back(), fn, what.c_str());
+                keep.push_back(bind::bgr_image(frames[static_cast<size_t>(f)], fn, what.c_str()));
                 require(keep.back().shape(0) == keep[0].shape(0) &&
                             keep.back().shape(1) == keep[0].shape(1),
                         fn,

@@ -144,10 +144,10 @@ void register_histogram(py::module_& m) {
 
     m.def(
         "hsv_bins",
-        [](py::array frame, std::optional<py::array> mask, int n_h, int n_s, int n_v, double s_min,
-           double v_min, bool lazy) {
+        [](const py::object& frame_in, std::optional<py::array> mask, int n_h, int n_s, int n_v,
+           double s_min, double v_min, bool lazy) {
             const char* fn = "hsv_bins";
-            bind::check_bgr_image(frame, fn, "frame");
+            const py::array frame = bind::bgr_image(frame_in, fn, "frame");
             const HsvBinning p{n_h, n_s, n_v, s_min, v_min};
             p.validate(fn);
             const auto rows = frame.shape(0), cols = frame.shape(1);

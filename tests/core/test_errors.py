@@ -122,7 +122,7 @@ def test_hsv_bins_bad_frames():
         hsv_bins(np.zeros((4, 4, 3)))
     with pytest.raises(ValueError, match=r"shape \(H, W, 3\)"):
         hsv_bins(np.zeros((4, 4), np.uint8))
-    with pytest.raises(ValueError, match="frame dtype is float32, expected uint8"):
+    with pytest.raises(TypeError, match="frame dtype is float32, expected uint8"):
         _core.hsv_bins(np.zeros((4, 4, 3), np.float32))
     with pytest.raises(ValueError, match="frame is empty"):
         _core.hsv_bins(np.zeros((0, 4, 3), np.uint8))
@@ -355,7 +355,7 @@ def test_arrays_through_pickle_are_accepted():
     assert binned.shape == (8, 8)
     boxes = pickle.loads(pickle.dumps(np.array([[1.0, 1.0, 4.0, 4.0]])))
     assert _core.refine_boxes(boxes, mask, 0.05, 0.1).shape == (1, 4)
-    with pytest.raises(ValueError, match="frame dtype is >u2"):
+    with pytest.raises(TypeError, match="frame dtype is >u2"):
         _core.hsv_bins(np.zeros((8, 8, 3), ">u2"), None)
 
 

@@ -162,7 +162,7 @@ def test_mask_bins():
 
 def test_bad_input():
     m = _core.BackgroundModel()
-    with pytest.raises(ValueError, match="frame dtype is float64"):
+    with pytest.raises(TypeError, match="frame dtype is float64"):  # was ValueError
         m.apply(np.zeros((4, 4, 3)))
     with pytest.raises(ValueError, match=r"frame must have shape \(H, W, 3\)"):
         m.apply(np.zeros((4, 4), np.uint8))

@@ -137,3 +137,77 @@ def test_bad_values_are_refused_before_any_work(
     assert e.value.code == 2
     assert said in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def test_the_chain_flags_reach_every_sampler(
+    scene: Scene, monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """``--mh-iter``, ``--mh-proposal``, ``--mh-rw-sigma``, ``--burn-in`` and ``--moves`` are
+    ``pftrack track``'s flags (its defaults, ranges and checks) and reach the runs; the
+    experiment had no flag for them (developer trial, 6 December)."""
+    from pftrack.tracking import TrackerConfig
+
+    seen: list[TrackerConfig | None] = []
+
+    class Stop(Exception):
+        pass
+
+    def first_run(*args: object, base: TrackerConfig | None = None, **kwargs: object) -> None:
+        seen.append(base)
+        raise Stop
+
+    monkeypatch.setattr(se, "run_sampler", first_run)
+    monkeypatch.setattr(se, "real_sequences", lambda *a: [])
+    monkeypatch.setattr(se, "make_scene", lambda **k: scene)
+    common = ["--out", str(tmp_path), "--skip-timing", "--skip-figure"]
+    chain = ["--mh-iter", "3", "--mh-proposal", "random_walk", "--mh-rw-sigma", "3", "3", "0.02",
+             "--burn-in", "20", "--moves", "0.2", "0.2", "0.5", "0.1"]  # fmt: skip
+    for argv in (common, [*common, *chain]):
+        with pytest.raises(Stop):
+            se.main(argv)
+    default, given = seen
+    assert default == TrackerConfig()  # today's values: the experiment's runs unchanged
+    assert (given.mh_iter, given.mh_proposal, given.mh_rw_sigma) == (3, "random_walk",
+                                                                     (3.0, 3.0, 0.02))  # fmt: skip
+    r = given.rjmcmc
+    assert (r.burn_in, r.p_birth, r.p_death, r.p_update, r.p_swap) == (20, 0.2, 0.2, 0.5, 0.1)
+    cfg = se.config_for("mh", 30, given)
+    assert (cfg.sampler, cfg.filter.n_particles, cfg.mh_iter) == ("mh", 30, 3)
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (["--moves", "0.1", "0", "0.7", "0.1"], "expected birth and death both > 0 or both 0"),
+        (["--mh-rw-sigma", "3", "3", "0.02"], "only the random-walk proposal reads it"),
+        (["--mh-iter", "0"], "argument --mh-iter: expected an integer in [1, 1000], got 0"),
+        (["--mh-proposal", "gibbs"], "argument --mh-proposal: invalid choice: 'gibbs'"),
+    ],
+)
+def test_a_bad_chain_flag_exits_2_before_any_work(
+    argv: list[str], words: str, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    with pytest.raises(SystemExit) as stop:
+        se.main(["--out", str(tmp_path), "--skip-timing", "--skip-figure", *argv])
+    assert stop.value.code == 2
+    assert words in capsys.readouterr().err.splitlines()[-1]
+
+
+def test_time_per_frame_runs_the_configured_mh_chain(
+    scene: Scene, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The timing's MH filters take the configuration's chain, as the tracker's do (they ran
+    ``n_iter=1`` whatever it said)."""
+    from pftrack.tracking import TrackerConfig
+
+    made: list[tuple[int, str]] = []
+
+    class Recording(se.MHColourParticleFilter):
+        def __init__(self, *args: object, **kwargs: object) -> None:
+            super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+            made.append((self.n_iter, self.proposal))
+
+    monkeypatch.setattr(se, "MHColourParticleFilter", Recording)
+    base = replace(TrackerConfig(), mh_iter=2, mh_proposal="random_walk")
+    assert se.time_per_frame(scene, "mh", 20, base=base) > 0
+    assert made and set(made) == {(2, "random_walk")}

@@ -149,6 +149,8 @@ def _tracker_options() -> st.SearchStrategy[dict[str, Any]]:
         "frame_rate": maybe(fl(0.1, 100)), "birth_quantile": maybe(fl(0, 1)),
         "sampler": st.sampled_from(["sis", "mh", "rjmcmc"]), "mh_iter": maybe(ints(1, 3)),
         "burn_in": maybe(ints(0, 60)), "moves": maybe(st.tuples(*[fl(0, 1)] * 4)),
+        "mh_proposal": maybe(st.sampled_from(["dynamics", "random_walk"])),
+        "mh_rw_sigma": maybe(st.tuples(*[fl(0, 20)] * 3)),
     })  # fmt: skip
 
 

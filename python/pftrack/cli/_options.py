@@ -10,14 +10,20 @@ from typing import TYPE_CHECKING, Any
 from pftrack._limits import (
     DEFAULT_BURN_IN,
     DEFAULT_MH_ITER,
+    DEFAULT_MH_PROPOSAL,
+    DEFAULT_MH_RW_SIGMA,
     DEFAULT_MOVES,
     MAX_BURN_IN,
     MAX_JOINT_SAMPLES,
     MAX_MH_ITER,
+    MAX_MH_RW_SIGMA,
     MAX_PARTICLES,
+    MH_PROPOSALS,
     MOVES,
+    MOVES_RULE,
     joint_samples_error,
     moves_error,
+    proposal_error,
     unread_error,
 )
 from pftrack._text import counted as counted  # the commands' counts, re-exported
@@ -282,6 +288,72 @@ def non_negative_float(text: str) -> float:
 non_negative_float.__name__ = "float"
 
 
+def add_chain_options(p: argparse.ArgumentParser) -> None:
+    """The samplers' chain settings: ``track``'s, and ``experiments.sampler_experiment``'s.
+
+    ``--mh-iter``, ``--mh-proposal``, ``--mh-rw-sigma`` (MH), ``--burn-in``, ``--moves``
+    (RJ-MCMC); :func:`chain_error` checks them together and :func:`chain_config` puts them in a
+    :class:`~pftrack.tracking.TrackerConfig`.
+    """
+    p.add_argument(
+        "--mh-iter", type=bounded_int(1, MAX_MH_ITER), default=DEFAULT_MH_ITER, metavar="N",
+        help=f"with --sampler mh: Metropolis-Hastings iterations per particle and frame (1 to "
+        f"{MAX_MH_ITER}; the likelihood is evaluated particles x (N + 1) times per object)",
+    )  # fmt: skip
+    p.add_argument(
+        "--mh-proposal", choices=MH_PROPOSALS, default=DEFAULT_MH_PROPOSAL,
+        help="with --sampler mh: the chain's proposal, a fresh draw of the AR(2) dynamics from "
+        "a random parent (the paper's) or a Gaussian random walk from the chain's state",
+    )  # fmt: skip
+    p.add_argument(
+        "--mh-rw-sigma", type=bounded_float(0.0, MAX_MH_RW_SIGMA), nargs=3,
+        default=list(DEFAULT_MH_RW_SIGMA), metavar=("CX", "CY", "S"),
+        help=f"with --mh-proposal random_walk: standard deviations of its step, cx and cy in "
+        f"pixels (scaled with the frame's size as the filter's noise is) and the scale, each 0 "
+        f"to {MAX_MH_RW_SIGMA:g} (default: "
+        f"{' '.join(f'{v:g}' for v in DEFAULT_MH_RW_SIGMA)})",
+    )  # fmt: skip
+    p.add_argument(
+        "--burn-in", type=bounded_int(0, MAX_BURN_IN), default=DEFAULT_BURN_IN, metavar="B",
+        help=f"with --sampler rjmcmc: burn-in iterations of the joint chain per frame (0 to "
+        f"{MAX_BURN_IN}; a frame costs about (B + particles) x particles)",
+    )  # fmt: skip
+    p.add_argument(
+        "--moves", type=non_negative_float, nargs=4, default=list(DEFAULT_MOVES),
+        metavar=tuple(m.upper() for m in MOVES),
+        help="with --sampler rjmcmc: probabilities of the joint chain's birth, death, update "
+        f"and swap moves, normalised by the chain: finite and >= 0, not all 0, {MOVES_RULE} "
+        f"(default: {' '.join(f'{v:g}' for v in DEFAULT_MOVES)})",
+    )  # fmt: skip
+
+
+def chain_error(args: argparse.Namespace) -> str | None:
+    """The message refusing :func:`add_chain_options`' values together, or None.
+
+    The ranges argparse checks alone; here what depends on several values: the moves' rule
+    and the random-walk step without ``--mh-proposal random_walk``.
+    """
+    return moves_error(tuple(args.moves), "--moves") or proposal_error(
+        args.mh_proposal, tuple(args.mh_rw_sigma), ("--mh-proposal", "--mh-rw-sigma"), cli=True
+    )
+
+
+def chain_config(args: argparse.Namespace, base: TrackerConfig) -> TrackerConfig:
+    """`base` with :func:`add_chain_options`' values (checked: :func:`chain_error`)."""
+    from dataclasses import replace
+
+    b, d, u, w = args.moves
+    return replace(
+        base,
+        mh_iter=args.mh_iter,
+        mh_proposal=args.mh_proposal,
+        mh_rw_sigma=tuple(args.mh_rw_sigma),
+        rjmcmc=replace(
+            base.rjmcmc, burn_in=args.burn_in, p_birth=b, p_death=d, p_update=u, p_swap=w
+        ),
+    )
+
+
 def add_tracker_options(p: argparse.ArgumentParser) -> None:
     """The tracker's options, shared by ``track`` (and any command that tracks).
 
@@ -314,23 +386,7 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         "mh: Metropolis-Hastings per object; rjmcmc: one joint RJ-MCMC chain over all objects "
         "(Smith et al. 2005)",
     )  # fmt: skip
-    p.add_argument(
-        "--mh-iter", type=bounded_int(1, MAX_MH_ITER), default=DEFAULT_MH_ITER, metavar="N",
-        help=f"with --sampler mh: Metropolis-Hastings iterations per particle and frame (1 to "
-        f"{MAX_MH_ITER}; the likelihood is evaluated particles x (N + 1) times per object)",
-    )  # fmt: skip
-    p.add_argument(
-        "--burn-in", type=bounded_int(0, MAX_BURN_IN), default=DEFAULT_BURN_IN, metavar="B",
-        help=f"with --sampler rjmcmc: burn-in iterations of the joint chain per frame (0 to "
-        f"{MAX_BURN_IN}; a frame costs about (B + particles) x particles)",
-    )  # fmt: skip
-    p.add_argument(
-        "--moves", type=non_negative_float, nargs=4, default=list(DEFAULT_MOVES),
-        metavar=tuple(m.upper() for m in MOVES),
-        help="with --sampler rjmcmc: probabilities of the joint chain's birth, death, update "
-        "and swap moves, normalised (birth and death both > 0 or both 0; default: "
-        f"{' '.join(f'{v:g}' for v in DEFAULT_MOVES)})",
-    )  # fmt: skip
+    add_chain_options(p)
     p.add_argument(
         "--dynamics", choices=("ar2", "ar2-mean"), default="ar2",
         help="AR(2) model per particle (eq. 7) or from the particle-set means (eq. 8)",
@@ -418,8 +474,9 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         option of given detections without them (``--det-scale S``, ``--birth-score``,
         ``--no-refine``, and a ``--min-conf`` outside the built-in detector's scores, [0, 1]);
         more than :data:`pftrack._limits.MAX_JOINT_SAMPLES` ``--particles`` with ``--sampler
-        rjmcmc``; ``--moves`` the joint chain cannot use; ``--mh-iter`` without ``--sampler
-        mh``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler checks
+        rjmcmc``; ``--moves`` the joint chain cannot use; ``--mh-iter``, ``--mh-proposal`` or
+        ``--mh-rw-sigma`` without ``--sampler mh``, ``--mh-rw-sigma`` without ``--mh-proposal
+        random_walk``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler checks
         are :class:`pftrack.Tracker`'s (:mod:`pftrack._limits`), with the options' names.
     """
     from dataclasses import replace
@@ -469,11 +526,13 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
             )
 
     moves = tuple(args.moves)
+    rw_sigma = tuple(args.mh_rw_sigma)
     refused = (
         (joint_samples_error(args.particles, "--particles", "--sampler rjmcmc")
          if args.sampler == "rjmcmc" else None)
-        or moves_error(moves, "--moves")
-        or unread_error(args.sampler, {"mh_iter": args.mh_iter, "burn_in": args.burn_in,
+        or chain_error(args)
+        or unread_error(args.sampler, {"mh_iter": args.mh_iter, "mh_proposal": args.mh_proposal,
+                                       "mh_rw_sigma": rw_sigma, "burn_in": args.burn_in,
                                        "moves": moves}, cli=True)
     )  # fmt: skip
     if refused:
@@ -497,7 +556,7 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
 
     from pftrack.tracking import TrackerConfig
 
-    base = TrackerConfig()
+    base = chain_config(args, TrackerConfig())
     model = replace(base.filter.model, use_means=args.dynamics == "ar2-mean")
     filt = replace(base.filter, n_particles=args.particles or base.filter.n_particles, model=model)
     return replace(
@@ -506,15 +565,6 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         given_particles=None if args.particles else base.given_particles,
         detector=args.detector,
         sampler=args.sampler,
-        mh_iter=args.mh_iter,
-        rjmcmc=replace(
-            base.rjmcmc,
-            burn_in=args.burn_in,
-            p_birth=moves[0],
-            p_death=moves[1],
-            p_update=moves[2],
-            p_swap=moves[3],
-        ),
         camera_motion=args.camera_motion,
         max_side=args.max_side or None,
         open_size=args.open_size or None,

@@ -209,7 +209,8 @@ class Mog2Detector(_OpenCvDetector):
     """
 
     def __init__(self, config: Mog2Config | None = None) -> None:
-        self.config = config if config is not None else Mog2Config()
+        own = "Mog2Detector: config"
+        self.config = Mog2Config() if config is None else instance(config, own, Mog2Config)
         super().__init__(self.config.blobs, self.config.hsv, self.config.learning_rate)
 
     def _make(self) -> Any:
@@ -252,7 +253,8 @@ class KnnDetector(_OpenCvDetector):
     """
 
     def __init__(self, config: KnnConfig | None = None, seed: int = 0) -> None:
-        self.config = config if config is not None else KnnConfig()
+        own = "KnnDetector: config"
+        self.config = KnnConfig() if config is None else instance(config, own, KnnConfig)
         self.seed = check_seed(seed, "KnnDetector: seed")
         self._seen = 0  # images applied since the model was made: the next one's seed
         super().__init__(self.config.blobs, self.config.hsv, self.config.learning_rate)

@@ -219,7 +219,8 @@ class PaperDetector:
     """
 
     def __init__(self, config: PaperConfig | None = None) -> None:
-        self.config = config if config is not None else PaperConfig()
+        own = "PaperDetector: config"
+        self.config = PaperConfig() if config is None else instance(config, own, PaperConfig)
         self._model = self._new_model(self.config.shadow_lo)
         self._blobs = BlobExtractor(self.config.blobs)
         self._ghost: NDArray[np.uint8] | None = None  # pixels of ghosts still being learnt

@@ -17,9 +17,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
-from pftrack._check import brief, number
+from pftrack._check import integer, number
 
 __all__ = ["PersonSizeModel", "SizeModelConfig", "expected_size", "head_height", "theil_sen"]
+
+#: Largest `SizeModelConfig.min_samples`, `max_samples` and `refit_every` (the ring buffer is
+#: allocated up front: 24 MB at this size).
+MAX_SAMPLES = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -30,7 +34,8 @@ class SizeModelConfig:
     ----------
     min_samples : int
         Isolated boxes needed before the model is used (before it, blobs are split by
-        `BlobConfig.person_aspect` and nothing is merged).
+        `BlobConfig.person_aspect` and nothing is merged); an int (NumPy's too, not a bool) in
+        [3, 1000000], as `max_samples` (>= `min_samples`) and `refit_every` (>= 1).
     max_samples : int
         The most recent boxes kept for the fit (a ring buffer).
     refit_every : int
@@ -64,14 +69,16 @@ class SizeModelConfig:
     def __post_init__(self) -> None:
         for name in ("split_ratio", "split_max_height", "merge_slack", "max_cut_share"):
             number(getattr(self, name), name, finite=False)  # not an array's "truth value"
-        if not (isinstance(self.min_samples, int) and self.min_samples >= 3):
-            raise ValueError(f"min_samples is {brief(self.min_samples)}, expected an int >= 3")
-        if not (isinstance(self.max_samples, int) and self.max_samples >= self.min_samples):
+        # ints, NumPy's too (were refused, ValueError), not bools (True was taken as 1)
+        own = "SizeModelConfig"
+        for name, lo in (("min_samples", 3), ("max_samples", 3), ("refit_every", 1)):
+            v = integer(getattr(self, name), f"{own}: {name}", lo, MAX_SAMPLES)
+            object.__setattr__(self, name, v)
+        if self.max_samples < self.min_samples:
             raise ValueError(
-                f"max_samples is {brief(self.max_samples)}, expected an int >= min_samples"
+                f"{own}: max_samples is {self.max_samples}, expected an int >= min_samples "
+                f"({self.min_samples})"
             )
-        if not (isinstance(self.refit_every, int) and self.refit_every >= 1):
-            raise ValueError(f"refit_every is {brief(self.refit_every)}, expected an int >= 1")
         if not (self.split_ratio > 1.0 and np.isfinite(self.split_ratio)):
             raise ValueError(f"split_ratio is {self.split_ratio}, expected a finite value > 1")
         if not (self.split_max_height > 0.0 and np.isfinite(self.split_max_height)):

@@ -52,6 +52,8 @@ class TrackerOptions(TypedDict, total=False):
     particles: int | None
     dynamics: DynamicsName
     mh_iter: int
+    mh_proposal: str
+    mh_rw_sigma: Sequence[float]
     burn_in: int
     moves: Sequence[float]
     max_coast: RealLike | None

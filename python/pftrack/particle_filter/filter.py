@@ -376,6 +376,7 @@ class ColourParticleFilter:
         self._seed = int(self._rng.integers(2**63))
         self._step = 0
         b = _box(box_cxcywh)
+        v0 = _velocity(velocity)  # None here is no velocity: refused (reinitialise's None keeps)
         self.w0, self.h0 = float(b[2]), float(b[3])
         self._set_reference(
             reference,
@@ -386,7 +387,7 @@ class ColourParticleFilter:
         self.particles = np.empty((n, 6))
         self.weights = np.full(n, 1.0 / n)
         self.means = np.empty((2, 3))
-        self.reinitialise(b, velocity=velocity)
+        self.reinitialise(b, velocity=v0)
         self._last: FilterState | None = None  # see last
         # (row of sis_step_batch's output, the estimate's column, w0, h0) not yet made a state
         self._last_row: tuple[list[float], int, float, float] | None = None

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
 from pftrack._check import first_at, generator, integer, number, option, real_array, shown
+from pftrack._limits import MOVES_RULE
 from pftrack._typing import RngLike
 from pftrack.particle_filter.colour import not_binned
 from pftrack.particle_filter.filter import _in_use
@@ -41,7 +42,10 @@ class RJMCMCConfig:
         of the previous frame (about 8 ms a frame at N = 2000 and 0.15 s at N = 10000 with 5
         objects and B = 50; docs/samplers.md).
     p_birth, p_death, p_update, p_swap : float
-        Move probabilities (normalised; birth and death both > 0 or both 0).
+        Move probabilities, normalised by the chain: finite and >= 0, not all 0, birth and
+        death both > 0 or both 0 (a birth is undone by a death: reversibility). ``--moves``
+        and ``Tracker(moves=...)`` give them, with the same rule and words
+        (:data:`pftrack._limits.MOVES_RULE`).
     a, b, sigma : tuple of 3 float
         AR2 dynamics per component (cx, cy, s); ``sigma`` > 0.
     s_min, s_max : float
@@ -88,8 +92,8 @@ class RJMCMCConfig:
     ValueError
         A setting out of the range the core takes (checked here, not at the first step):
         `burn_in` an int >= 0 and `n_samples` an int >= 1, with ``burn_in + n_samples`` at most
-        2147483647; move probabilities finite and >= 0, not all 0, `p_birth` and `p_death`
-        both > 0 or both 0; `a`, `b` 3 finite values and `sigma` 3 finite values > 0; finite
+        2147483647; move probabilities finite and >= 0, not all 0, birth and death both > 0
+        or both 0; `a`, `b` 3 finite values and `sigma` 3 finite values > 0; finite
         ``0 < s_min <= s_max``; `lam`, `interaction`, `coverage`, `background_penalty`,
         `detection` finite and >= 0; `birth_prior`, `birth_sigma_xy`, `birth_sigma_s`,
         `birth_eps`, `birth_gate` finite and > 0; `survival` in (0, 1]; `min_existence` in
@@ -139,8 +143,8 @@ class RJMCMCConfig:
             raise ValueError(f"{own}: p_birth, p_death, p_update and p_swap are all 0")
         if (self.p_birth > 0) != (self.p_death > 0):
             raise ValueError(
-                f"{own}: p_birth is {self.p_birth} and p_death {self.p_death}, expected both > 0 "
-                "or both 0 (reversibility)"
+                f"{own}: p_birth is {self.p_birth} and p_death {self.p_death}, expected "
+                f"{MOVES_RULE}"
             )
         for name in ("a", "b", "sigma"):
             v = real_array(getattr(self, name), f"{own}: {name}", booleans=False)

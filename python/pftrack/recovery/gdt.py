@@ -59,17 +59,34 @@ class GdtModel:
         TypeError
             A setting that is not a number (`q`, `r`: not real numbers).
         ValueError
-            NaN or infinite; `q` or `r` not of 4 or 2 values.
+            NaN or infinite; `q` or `r` not of 4 or 2 values; a value out of its range: `dt`
+            > 0, `q` and `p_init_velocity` >= 0 (variances), `r` > 0 (``R`` is inverted), and
+            `p_init_velocity` > 0 where a velocity variance of `q` is 0. Were
+            taken: a negative variance failed at the first gap in ``kalman_filter``, naming no
+            setting, and a negative `dt` ran the model backwards, silently.
         """
-        for name in ("dt", "p_init_velocity"):
-            number(getattr(self, name), f"GdtModel: {name}")
-        for name, n in (("q", 4), ("r", 2)):
+        for name, strict in (("dt", True), ("p_init_velocity", False)):
+            x = number(getattr(self, name), f"GdtModel: {name}")
+            if not (x > 0 if strict else x >= 0):
+                raise ValueError(f"GdtModel: {name} is {x}, expected {'>' if strict else '>='} 0")
+        for name, n, strict in (("q", 4, False), ("r", 2, True)):
             v = real_array(getattr(self, name), f"GdtModel: {name}", booleans=False)
             if v.shape != (n,):
                 raise ValueError(f"GdtModel: {name} has shape {v.shape}, expected ({n},)")
             if not np.isfinite(v).all():
                 raise ValueError(f"GdtModel: {name} is {tuple(v.tolist())}, expected finite values")
+            if not (v > 0 if strict else v >= 0).all():
+                raise ValueError(
+                    f"GdtModel: {name} is {tuple(v.tolist())}, expected variances "
+                    f"{'> 0' if strict else '>= 0'}"
+                )
             object.__setattr__(self, name, tuple(float(x) for x in v))
+        if self.p_init_velocity == 0 and min(self.q[2:]) == 0:  # no velocity noise anywhere
+            k = 2 if self.q[2] == 0 else 3
+            raise ValueError(
+                f"GdtModel: p_init_velocity is 0 and q[{k}] (a velocity variance) is 0: the "
+                "segment filter's covariance would be singular; give one of them > 0"
+            )
 
     @property
     def A(self) -> F64:  # noqa: N802 - the paper's name

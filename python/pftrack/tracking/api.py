@@ -53,12 +53,16 @@ from pftrack._check import seed as check_seed
 from pftrack._limits import (
     DEFAULT_BURN_IN,
     DEFAULT_MH_ITER,
+    DEFAULT_MH_PROPOSAL,
+    DEFAULT_MH_RW_SIGMA,
     DEFAULT_MOVES,
     MAX_BURN_IN,
     MAX_MH_ITER,
     MAX_PARTICLES,
+    MH_PROPOSALS,
     joint_samples_error,
     moves_error,
+    proposal_error,
     unread_error,
 )
 from pftrack._typing import (
@@ -399,6 +403,15 @@ class Tracker:
         With ``sampler="mh"``: Metropolis-Hastings iterations per particle and frame, in
         [1, 1000] (``TrackerConfig.mh_iter``; the likelihood is evaluated ``particles *
         (mh_iter + 1)`` times per object and frame). ``--mh-iter`` of ``pftrack track``.
+    mh_proposal : {"dynamics", "random_walk"}
+        With ``sampler="mh"``: the chain's proposal, a fresh draw of the AR(2) dynamics (the
+        default, the paper's) or a Gaussian random walk from the chain's state
+        (``TrackerConfig.mh_proposal``). ``--mh-proposal``.
+    mh_rw_sigma : sequence of 3 float
+        With ``mh_proposal="random_walk"``: standard deviations of its step (cx, cy in pixels,
+        scaled with the frame's size as the filter's noise is; scale), each in
+        [0, 10000], default ``(2.0, 2.0, 0.01)`` (``TrackerConfig.mh_rw_sigma``).
+        ``--mh-rw-sigma``.
     burn_in : int
         With ``sampler="rjmcmc"``: burn-in iterations of the joint chain per frame, in
         [0, 100000] (``RJMCMCConfig.burn_in``; a frame costs O((burn_in + particles)
@@ -460,14 +473,16 @@ class Tracker:
         A flag (`refine`, `smooth`, `link`, `crossings`, `record`) that is not ``True`` or ``False``
         (``refine="no"`` would turn refinement on), a `frame_rate`, `max_coast`, `prime`,
         `min_conf` or `birth_score` that is not a number, a `seed`, `particles`, `mh_iter` or
-        `burn_in` that is not an int, `moves` not numbers.
+        `burn_in` that is not an int, `moves` or `mh_rw_sigma` not numbers, `mh_proposal` not
+        text.
     ValueError
         A value out of its range, ``crossings=True`` with ``smooth=False`` (the repair is
         part of the smoothing pass), or `max_coast`, `birth_score` or `birth_quantile` other
         than its default with ``sampler="rjmcmc"`` (the joint chain keeps and starts tracks by
-        its own existence probabilities: they would do nothing); `mh_iter` other than its
-        default without ``sampler="mh"``, `burn_in` or `moves` without ``sampler="rjmcmc"``
-        (only that sampler reads them).
+        its own existence probabilities: they would do nothing); `mh_iter`, `mh_proposal` or
+        `mh_rw_sigma` other than its default without ``sampler="mh"``, `burn_in` or `moves`
+        without ``sampler="rjmcmc"`` (only that sampler reads them), `mh_rw_sigma` without
+        ``mh_proposal="random_walk"``.
 
     Notes
     -----
@@ -529,6 +544,8 @@ class Tracker:
         particles: int | None = None,
         dynamics: DynamicsName = "ar2",
         mh_iter: int = DEFAULT_MH_ITER,
+        mh_proposal: str = DEFAULT_MH_PROPOSAL,
+        mh_rw_sigma: Sequence[float] = DEFAULT_MH_RW_SIGMA,
         burn_in: int = DEFAULT_BURN_IN,
         moves: Sequence[float] = DEFAULT_MOVES,
         max_coast: RealLike | None = None,
@@ -578,6 +595,14 @@ class Tracker:
                 if too_many:
                     raise ValueError(too_many)
         mh_iter = integer(mh_iter, "mh_iter", 1, MAX_MH_ITER)
+        option(mh_proposal, "mh_proposal", MH_PROPOSALS)
+        rw_sigma = real_array(mh_rw_sigma, "mh_rw_sigma", booleans=False)
+        if rw_sigma.ndim != 1:
+            raise ValueError(f"mh_rw_sigma has shape {rw_sigma.shape}, expected (3,)")
+        tau = tuple(float(v) for v in rw_sigma)  # 3: checked below, the config's type
+        refused = proposal_error(mh_proposal, tau, ("mh_proposal", "mh_rw_sigma"), cli=False)
+        if refused:
+            raise ValueError(refused)
         burn_in = integer(burn_in, "burn_in", 0, MAX_BURN_IN)
         moves = _moves(moves)
         base = TrackerConfig()
@@ -591,6 +616,8 @@ class Tracker:
             detector=detector,
             sampler=sampler,
             mh_iter=mh_iter,
+            mh_proposal=mh_proposal,
+            mh_rw_sigma=tau,  # type: ignore[arg-type]
             rjmcmc=replace(
                 base.rjmcmc,
                 burn_in=burn_in,
@@ -616,8 +643,11 @@ class Tracker:
             ),
         )
         unread = unread_error(
-            sampler, {"mh_iter": mh_iter, "burn_in": burn_in, "moves": moves}, cli=False
-        )
+            sampler,
+            {"mh_iter": mh_iter, "mh_proposal": mh_proposal, "mh_rw_sigma": tau,
+             "burn_in": burn_in, "moves": moves},
+            cli=False,
+        )  # fmt: skip
         if unread:  # the command refuses them likewise (pftrack._limits)
             raise ValueError(unread)
         if sampler == "rjmcmc":  # its chain ignores them (the CLI refuses them likewise)

@@ -5,17 +5,32 @@ Every default is a rule, not a per-sequence tuning (measured in docs/results.md)
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from pftrack._check import MAX_FRAME, brief, flag, instance, integer, number, option, shown
+from pftrack._check import (
+    MAX_FRAME,
+    brief,
+    flag,
+    instance,
+    integer,
+    number,
+    option,
+    real_array,
+    shown,
+)
 from pftrack._limits import (
     DEFAULT_MH_ITER,
+    DEFAULT_MH_PROPOSAL,
+    DEFAULT_MH_RW_SIGMA,
     MAX_BURN_IN,
     MAX_MH_ITER,
+    MAX_MH_RW_SIGMA,
     MAX_PARTICLES,
+    MH_PROPOSALS,
     joint_samples_error,
+    proposal_error,
 )
 from pftrack._typing import CameraMotion, DetectorName, SamplerName
 from pftrack.detection import DETECTORS
@@ -49,13 +64,16 @@ GIVEN_PARTICLES = 200
 
 
 def _numbers(owner: str, config: object, *names: str) -> None:
-    """Refuse the named settings unless numbers or None, with a TypeError naming them.
+    """Refuse the named settings unless numbers, with a TypeError naming them.
 
-    Text failed at a comparison without a name (``'<=' not supported``), or was taken.
+    None passes only for a field whose annotation takes it (``float | None``: off). Text
+    failed at a comparison without a name (``'<=' not supported``), or was taken; None for a
+    plain ``float`` field (``MotionConfig(accel=None)``) failed likewise (developer trial).
     """
+    optional = {f.name for f in fields(config) if "None" in str(f.type)}  # type: ignore[arg-type]
     for name in names:
         v = getattr(config, name)
-        if v is not None:
+        if v is not None or name not in optional:
             number(v, f"{owner}: {name}", finite=False)
 
 
@@ -706,6 +724,18 @@ class TrackerConfig:
         (:class:`~pftrack.particle_filter.MHColourParticleFilter`'s `n_iter`), in [1, 1000]:
         a step evaluates the likelihood ``n_particles * (mh_iter + 1)`` times per object.
         ``Tracker(mh_iter=...)``, ``--mh-iter``; the other samplers do not read it.
+    mh_proposal : {"dynamics", "random_walk"}
+        The MH chain's proposal with ``sampler="mh"``
+        (:class:`~pftrack.particle_filter.MHColourParticleFilter`'s `proposal`): a fresh draw
+        of the AR(2) dynamics (the default, the paper's) or a Gaussian random walk of
+        `mh_rw_sigma` from the chain's state. ``Tracker(mh_proposal=...)``,
+        ``--mh-proposal``.
+    mh_rw_sigma : tuple of 3 float
+        Standard deviations of the random-walk step (cx, cy in pixels, scale), each in [0,
+        10000], default ``(2.0, 2.0, 0.01)``; read only with ``mh_proposal="random_walk"``
+        (other values with ``"dynamics"`` are refused: they would do nothing). Its cx, cy are
+        pixel settings: they grow and shrink with the frame as ``filter.model.sigma_xy``
+        (:meth:`scaled_pixels`). ``Tracker(mh_rw_sigma=...)``, ``--mh-rw-sigma``.
     """
 
     filter: FilterConfig = field(
@@ -731,6 +761,8 @@ class TrackerConfig:
     pixel_diagonal: float | None = PIXEL_DIAGONAL
     given_particles: int | None = GIVEN_PARTICLES
     mh_iter: int = DEFAULT_MH_ITER
+    mh_proposal: str = DEFAULT_MH_PROPOSAL
+    mh_rw_sigma: tuple[float, float, float] = DEFAULT_MH_RW_SIGMA
 
     def __post_init__(self) -> None:
         for name, cls in _SUB_CONFIGS:  # were taken, and failed at a frame naming no setting
@@ -740,6 +772,15 @@ class TrackerConfig:
         option(self.detector, "detector", DETECTORS)
         _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
         integer(self.mh_iter, "TrackerConfig: mh_iter", 1, MAX_MH_ITER)
+        option(self.mh_proposal, "TrackerConfig: mh_proposal", MH_PROPOSALS)
+        tau = real_array(self.mh_rw_sigma, "TrackerConfig: mh_rw_sigma", booleans=False)
+        if tau.ndim != 1:
+            raise ValueError(f"TrackerConfig: mh_rw_sigma has shape {tau.shape}, expected (3,)")
+        object.__setattr__(self, "mh_rw_sigma", tuple(float(v) for v in tau))
+        what = ("TrackerConfig: mh_proposal", "TrackerConfig: mh_rw_sigma")
+        refused = proposal_error(self.mh_proposal, self.mh_rw_sigma, what, cli=False)
+        if refused:
+            raise ValueError(refused)
         integer(self.rjmcmc.burn_in, "TrackerConfig: rjmcmc.burn_in", 0, MAX_BURN_IN)
         if self.sampler == "rjmcmc":  # the tracker's cap; RJMCMCConfig alone takes more
             too_many = joint_samples_error(
@@ -813,12 +854,18 @@ class TrackerConfig:
         return replace(self, filter=replace(self.filter, n_particles=int(n)))
 
     def scaled_pixels(self, scale: float) -> TrackerConfig:
-        """The configuration with its pixel settings (``filter.model.sigma_xy``) times `scale`.
+        """The configuration with its pixel settings times `scale`.
 
-        The offline linker's ``max_distance`` is not part of it: :class:`pftrack.Tracker`
-        scales its :class:`~pftrack.recovery.LinkConfig` with the same factor.
+        The pixel settings are ``filter.model.sigma_xy`` and, with the random-walk proposal,
+        the cx, cy of ``mh_rw_sigma``. The offline linker's ``max_distance`` is not part of
+        it: :class:`pftrack.Tracker` scales its :class:`~pftrack.recovery.LinkConfig` with the
+        same factor.
         """
         if scale == 1.0:
             return self
         model = replace(self.filter.model, sigma_xy=self.filter.model.sigma_xy * scale)
-        return replace(self, filter=replace(self.filter, model=model))
+        tau = self.mh_rw_sigma
+        if self.mh_proposal == "random_walk":  # read only then (refused otherwise if moved)
+            cx, cy = (min(v * scale, MAX_MH_RW_SIGMA) for v in tau[:2])
+            tau = (cx, cy, tau[2])
+        return replace(self, filter=replace(self.filter, model=model), mh_rw_sigma=tau)

@@ -131,7 +131,15 @@ class LiveTrack:
         self.id = track_id
         box = _to_cxcywh(box_xywh)
         self.filter: ColourParticleFilter = (
-            MHColourParticleFilter(box, reference, config.filter, rng=seed, n_iter=config.mh_iter)
+            MHColourParticleFilter(
+                box,
+                reference,
+                config.filter,
+                rng=seed,
+                n_iter=config.mh_iter,
+                proposal=config.mh_proposal,
+                rw_sigma=config.mh_rw_sigma,
+            )
             if config.sampler == "mh"
             else ColourParticleFilter(box, reference, config.filter, rng=seed)
         )
