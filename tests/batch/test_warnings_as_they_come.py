@@ -75,3 +75,9 @@ def test_each_sequences_warning_comes_as_it_ends_and_before_the_table(
     text = "".join(t for _, t in again)
     assert text.count(": warning: no track over 3") == 2, again
     assert text.rindex(": warning: ") < text.index("name "), again
+
+
+def test_a_say_that_is_not_callable_is_refused_at_once() -> None:
+    with pytest.raises(TypeError, match="say is str 'NAME: warning', expected a callable"):
+        with engine.warnings_as_they_come("NAME: warning"):  # type: ignore[arg-type]
+            pass

@@ -1919,6 +1919,8 @@ def warnings_as_they_come(say: Callable[[str, str], None]) -> Iterator[None]:
     raised. Called on the thread that runs the batch; a skipped task's earlier warnings are
     not said (they are in the summary).
     """
+    if not callable(say):  # was found out at the first warning, a traceback mid-batch
+        raise TypeError(f"warnings_as_they_come: say is {shown(say)}, expected a callable")
     token = _SAY_WARNING.set(say)
     try:
         yield
