@@ -1,7 +1,7 @@
 """The built-in detector on PETS09-S2L1 and TUD-Campus re-encoded as low-bitrate H.264.
 
-Each video is decoded and written again as H.264 (libx264 through PyAV, ``preset medium``,
-one key frame every 2 s, no B-frame rule changed: the encoder's defaults) at a bitrate given
+Each video is decoded and written again as H.264 (libx264 through PyAV, one key frame every
+2 s, the encoder's defaults otherwise) at a bitrate given
 in bits per pixel (``--bpp``: bits per second over width x height x frames per second;
 0.02 bpp is 24 kbit/s for PETS09's 480x360 at 7 fps, 154 kbit/s for TUD-Campus's 640x480 at
 25), and tracked as ``pftrack track FILE`` does (`pftrack.tracking.track_path`: the
