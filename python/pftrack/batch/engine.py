@@ -233,8 +233,11 @@ class BatchSummary:
             text.extend(self.problems())
         return "\n".join(text)
 
-    def problems(self, unwritten: bool = True) -> list[str]:
+    def problems(self, unwritten: bool = True, warned: bool = True) -> list[str]:
         """The tasks' warnings (``NAME: warning: ...``), then errors (``NAME: error: ...``).
+
+        `warned` False: the errors alone (the warnings said as they arrived,
+        :func:`warnings_as_they_come`, and a skipped task's before the table).
 
         An error that several tasks failed with is said once, with their count and names (the
         first three): ``29 sequences (cam01, cam02, cam03, ...): error: ...``; each entry keeps
@@ -243,7 +246,12 @@ class BatchSummary:
         Last, ``error: DIR/summary.json not written (...)`` if it could not be (and
         `unwritten`: an interrupted batch's last line says it instead).
         """
-        text = [f"{e['name']}: warning: {w}" for e in self.entries for w in e.get("warnings", ())]
+        text = [
+            f"{e['name']}: warning: {w}"
+            for e in self.entries
+            if warned
+            for w in e.get("warnings", ())
+        ]
         # one error said once, where several tasks failed with it (was: once per task, 29
         # identical lines for 29 sequences on a cluster that had lost its workers, a trial)
         alike: dict[str, list[str]] = {}
@@ -1895,6 +1903,31 @@ _OUT_NAMES: contextvars.ContextVar[tuple[str, str]] = contextvars.ContextVar(
 )
 
 
+#: Called as ``say(name, warning)`` for each warning of a task as its outcome arrives
+#: (:func:`warnings_as_they_come`); None: they are in the summary only.
+_SAY_WARNING: contextvars.ContextVar[Callable[[str, str], None] | None] = contextvars.ContextVar(
+    "pftrack_batch_say_warning", default=None
+)
+
+
+@contextlib.contextmanager
+def warnings_as_they_come(say: Callable[[str, str], None]) -> Iterator[None]:
+    """Meanwhile, ``say(name, warning)`` for each warning of a task as its outcome arrives.
+
+    ``pftrack batch`` prints them so, each sequence's as it ends, before the table (was: all
+    after the table, once the batch was over), as ``pftrack track`` prints its own as they are
+    raised. Called on the thread that runs the batch; a skipped task's earlier warnings are
+    not said (they are in the summary).
+    """
+    if not callable(say):  # was found out at the first warning, a traceback mid-batch
+        raise TypeError(f"warnings_as_they_come: say is {shown(say)}, expected a callable")
+    token = _SAY_WARNING.set(say)
+    try:
+        yield
+    finally:
+        _SAY_WARNING.reset(token)
+
+
 @contextlib.contextmanager
 def named_as_options() -> Iterator[None]:
     """Meanwhile, a batch's messages name ``--out`` and ``--render`` (``pftrack`` commands)."""
@@ -2182,6 +2215,10 @@ def run_jobs(
                 entries[job.name]["host"] = outcome.host
         if job.name in notes:
             entries[job.name]["note"] = notes[job.name]
+        say = _SAY_WARNING.get()
+        if say is not None:  # as the task's outcome arrives, not with the table
+            for warning in entries[job.name].get("warnings", ()):
+                say(job.name, warning)
 
     for job in refused:  # before the cluster starts: the scheduler never sees them
         record(job, Outcome(None, job.refused))

@@ -151,20 +151,27 @@ def _one_line_warning(prog: str) -> Callable[..., None]:
     """
 
     def show(message: Warning | str, *_: object, **__: object) -> None:
-        line = f"{prog}: warning: {_shown(str(message))}"
-        err = sys.stderr
-        if err is None:  # started with stderr closed (was: the line printed on stdout)
-            return
-        tqdm = sys.modules.get("tqdm")  # imported only when a bar is drawn
-        try:
-            if tqdm is not None:
-                tqdm.tqdm.write(line, file=err)
-            else:
-                print(line, file=err)
-        except (OSError, ValueError):  # a broken pipe, a closed file
-            pass
+        said_above_bar(f"{prog}: warning: {_shown(str(message))}")
 
     return show
+
+
+def said_above_bar(line: str) -> None:
+    """`line` on stderr, above a progress bar being drawn (tqdm's ``write``), not through it.
+
+    A closed stderr (``2>&-``, a pipe whose reader left) costs the line, never the outputs.
+    """
+    err = sys.stderr
+    if err is None:  # started with stderr closed (was: the line printed on stdout)
+        return
+    tqdm = sys.modules.get("tqdm")  # imported only when a bar is drawn
+    try:
+        if tqdm is not None:
+            tqdm.tqdm.write(line, file=err)
+        else:
+            print(line, file=err)
+    except (OSError, ValueError):  # a broken pipe, a closed file
+        pass
 
 
 #: OpenCV's and FFmpeg's own log lines (``[ WARN:0@0.030] global cap.cpp:212 open ...``,

@@ -220,11 +220,18 @@ def _environment_scheduler() -> Iterator[None]:
 
 def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
     """Run the batch; print its table, or what stopped it; return the exit status."""
-    from pftrack.batch.engine import named_as_options
+    from pftrack.batch.engine import named_as_options, warnings_as_they_come
+    from pftrack.cli import said_above_bar
+
+    said: set[str] = set()  # the tasks whose warnings were printed as they arrived
+
+    def say(name: str, warning: str) -> None:
+        said.add(name)
+        said_above_bar(f"{name}: warning: {warning}")
 
     try:
         # --out, --render; from Python: out_dir, options.render
-        with named_as_options(), _environment_scheduler():
+        with named_as_options(), _environment_scheduler(), warnings_as_they_come(say):
             summary = call()
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (pftrack.cli._signals)
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
@@ -237,7 +244,7 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
         if stopped is not None:  # the table a batch that ends prints (was: summary.json alone)
             sys.stderr.write(end)
             end = ""
-            _print_table(stopped, unwritten=False)  # the last line says why, if it is not
+            _print_table(stopped, said, unwritten=False)  # the last line says why, if not
         print(f"{end}pftrack {command}: {how}; {left}", file=sys.stderr)
         return exit_status(exc)
     except ImportError as exc:  # Dask is an extra: pftrack[dask]
@@ -247,19 +254,31 @@ def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) 
     for e in summary.entries if explain else ():
         if e.get("explain"):
             print(f"{e['name']}:\n{e['explain']}")
-    _print_table(summary)
+    _print_table(summary, said)
     if summary.unwritten is None:  # else said with the problems
         print(f"summary -> {summary.out_dir / 'summary.json'}")
     return EXIT_SOME_FAILED if summary.failed or summary.unwritten else 0
 
 
-def _print_table(summary: BatchSummary, unwritten: bool = True) -> None:
+def _print_table(summary: BatchSummary, said: set[str], unwritten: bool = True) -> None:
     """`summary`'s table on stdout, its problems on stderr (stdout's table stays parseable).
 
-    `unwritten`: with the line that says why ``summary.json`` is not written, if it is not.
+    The warnings first: those of the tasks in `said` were printed as they arrived, the others'
+    (a skipped task's, from its earlier run) are printed here, before the table; the errors
+    after it. `unwritten`: with the line that says why ``summary.json`` is not written, if it
+    is not.
     """
+    earlier = [
+        f"{e['name']}: warning: {w}"
+        for e in summary.entries
+        if e["name"] not in said
+        for w in e.get("warnings", ())
+    ]
+    if earlier:
+        print("\n".join(earlier), file=sys.stderr)
+        sys.stderr.flush()
     print(summary.table(problems=False))
-    problems = summary.problems(unwritten=unwritten)
+    problems = summary.problems(unwritten=unwritten, warned=False)
     if problems:
         sys.stdout.flush()
         print("\n".join(problems), file=sys.stderr)

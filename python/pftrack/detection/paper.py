@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack._check import flag, instance, integer, number, option
+from pftrack._stand_in import is_stand_in
 from pftrack._warn import warn
 from pftrack.detection.base import (
     BlobConfig,
@@ -382,7 +383,8 @@ class PaperDetector:
         self, frame: NDArray[np.uint8], bins: bool
     ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
         """:meth:`_apply`'s result for a frame without light: no foreground, nothing learnt."""
-        self._dark += 1
+        if not is_stand_in():  # a black frame in place of one that did not decode: not dark
+            self._dark += 1  # footage (pftrack._stand_in)
         if self._dark == DARK_FRAMES and not self._dark_said:
             self._dark_said = self._dark_unsaid = True  # said by the next detect
         binned = hsv_bins(frame, None, self.config.hsv) if bins else None

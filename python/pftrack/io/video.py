@@ -227,6 +227,37 @@ def _video_streams(path: Path) -> list[str]:
         return []
 
 
+def _starts_without_key_frame(path: Path) -> bool:
+    """Whether the first video stream of file `path` begins with a packet that is no key frame.
+
+    As a recording cut from a live stream does (an MPEG-TS saved from a broadcast or a camera's
+    feed, ``ffmpeg -c copy`` started between key frames): FFmpeg cannot decode the frames
+    before the first key frame and leaves them out without a word. One packet read through
+    PyAV; False where PyAV is missing or cannot read the file, and for an AVI, without PyAV:
+    its stamps are its frames' places in the file (from its index, which counts every frame
+    it holds), late by a decoder's delay with B-frames (PETS09's first, 200 ms), not a live
+    stream's time line.
+    """
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(12)
+    except OSError:
+        return False
+    av = _import_av() if not (head[:4] == b"RIFF" and head[8:12] == b"AVI ") else None
+    if av is None:
+        return False
+    try:
+        with av.open(str(path)) as container:
+            if not container.streams.video:
+                return False
+            for packet in container.demux(container.streams.video[0]):
+                if packet.size:  # not the empty packet that ends a demux
+                    return not packet.is_keyframe
+    except (av.FFmpegError, OSError, ValueError):
+        pass
+    return False
+
+
 #: Box types an ISO base media file (MP4, MOV, M4V, 3GP) may begin with: its header is read by
 #: :func:`_header_video_count`, without PyAV.
 ISO_FIRST_BOXES = (b"ftyp", b"styp", b"moov", b"mdat", b"free", b"skip", b"wide", b"pnot", b"uuid")
@@ -1579,6 +1610,7 @@ class FrameSource:
         self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
         self._warned_lost = False  # frames inside the video could not be decoded
         self._warned_lead = False  # its first frames could not be decoded (_warn_lead)
+        self._warned_cut = False  # its first frames were left out by FFmpeg (_warn_cut_start)
         #: how many of its first frames did not decode and are black stand-ins (0: none, or
         #: not read yet); known once its first frame is read
         self.lead_black = 0
@@ -2158,6 +2190,8 @@ class FrameSource:
                     stamp = _stamp_index(cap, rate)
                     if decoded == 0:
                         start = stamp
+                        if start > 0:
+                            self._warn_cut_start(start, float(cap.get(cv2.CAP_PROP_POS_MSEC)))
                     elif stamp - start != decoded:
                         timed = False  # not a constant-rate file: no resuming after damage
                 if not ok:
@@ -2207,6 +2241,33 @@ class FrameSource:
             f"start?): a black frame stands in for each (the detector learns nothing from "
             f"one), so frame {index + 1}, the first that decodes, and the later frames keep "
             "their numbers (by their time stamps)",
+            UserWarning,
+            stacklevel=3,
+        )
+
+    def _warn_cut_start(self, index: int, ms: float) -> None:
+        """Warn, once, that the first `index` frames were left out by FFmpeg (a live cut).
+
+        The first frame read is stamped `ms` after the stream's start (frame `index` + 1 of
+        it), and the stream begins without a key frame (:func:`_starts_without_key_frame`):
+        the frames before the first key frame could not be decoded, and FFmpeg dropped them
+        (was: without a word, every frame number `index` off against a count from the
+        stream's start). A stamp after the start with a key frame first is a decoder's delay,
+        not missing frames (PETS09-S2L1's AVI: 200 ms, 2 frames at its header's 10 fps).
+        """
+        if self._warned_cut or self.path is None:
+            return
+        self._warned_cut = True
+        if not _starts_without_key_frame(self.path):
+            return
+        warnings.warn(
+            f"{self.path}: the video stream begins without a key frame (cut from a live "
+            f"stream?) and its first frame that decodes is stamped {ms:.0f} ms after its "
+            f"start: {counted(index, 'frame')} before it appear to be missing (FFmpeg cannot "
+            f"decode them and leaves them out), so frame 1 here is the stream's frame "
+            f"{index + 1}; detections or ground truth numbered from the stream's start are "
+            f"{index} ahead of these frames (drop their frames 1-{index} and number the rest "
+            "from 1)",
             UserWarning,
             stacklevel=3,
         )

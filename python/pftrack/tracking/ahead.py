@@ -31,6 +31,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._stand_in import standing_in
+from pftrack._warn import Held, warn
 from pftrack.detection import FrameDetector
 from pftrack.io.prefetch import prefetch
 from pftrack.tracking.camera import CameraMotion
@@ -41,8 +43,10 @@ __all__ = ["DetectAhead"]
 # (the frame as read, the frame the detector sees, the camera's grey of it or None, the error
 # of making them)
 _Prepared = tuple[Any, Any, Any, BaseException | None]
-# (the frame as read, the frame the detector saw, its result, its error, the camera's grey)
-_Work = tuple[NDArray[np.uint8], NDArray[np.uint8], Any, BaseException | None, Any]
+_Warning = tuple[str, type[Warning]]
+# (the frame as read, the frame the detector saw, its result, its error, the camera's grey,
+# the warnings the detector gave on it, held for the tracker's thread to give)
+_Work = tuple[NDArray[np.uint8], NDArray[np.uint8], Any, BaseException | None, Any, list[_Warning]]
 _Frame = NDArray[np.uint8]
 
 
@@ -67,6 +71,8 @@ class _StandIn:
             )
         if work[3] is not None:
             raise work[3]
+        for message, category in work[5]:  # held inside update, given from the user's line
+            warn(message, category)
         return work[2]
 
     def detect(self, frame: NDArray[np.uint8]) -> Any:
@@ -114,6 +120,10 @@ class DetectAhead:
         Read `frames` on a thread of their own (a :func:`~pftrack.io.prefetch.prefetch` this
         deep), which also prepares each frame and makes the camera's grey of it; default: all
         on the detector's thread.
+    black_stand_in : callable, optional
+        ``black_stand_in(k)``: whether frame k (1-based) is a black frame in place of one the
+        video could not decode (:attr:`pftrack.io.video.FrameSource.lead_black`), asked once
+        frame k is read; the detector's checks skip those (:mod:`pftrack._stand_in`).
 
     Examples
     --------
@@ -126,8 +136,10 @@ class DetectAhead:
                  *, external: bool, depth: int = 2,
                  prepare: Callable[[_Frame], _Frame] | None = None,
                  hand_over: Callable[[_Frame, _Frame], None] | None = None,
-                 read_depth: int | None = None) -> None:  # fmt: skip
+                 read_depth: int | None = None,
+                 black_stand_in: Callable[[int], bool] | None = None) -> None:  # fmt: skip
         self._tracker = tracker
+        self._black_stand_in = black_stand_in
         self._read_depth = read_depth
         self._frames = frames
         self._external = external
@@ -159,7 +171,7 @@ class DetectAhead:
         prepared = _prepared(self._frames, self._prepare, grey)
         if self._read_depth is not None:
             prepared = prefetch(prepared, depth=self._read_depth)
-        self._stream = prefetch(_work(prepared, call), depth=self._depth)
+        self._stream = prefetch(_work(prepared, call, self._black_stand_in), depth=self._depth)
         self._tracker.detector = self._stand_in
         return self._hand_over(self._stream, self._stand_in, self._hand, camera)
 
@@ -227,23 +239,36 @@ def _prepared(frames: Iterable[Any], prepare: Callable[[_Frame], _Frame] | None,
             close()
 
 
-def _work(prepared: Iterable[_Prepared], call: Any) -> Iterator[_Work]:
-    """Each prepared frame with the detector's result, or with its error (then no more).
+def _work(prepared: Iterable[_Prepared], call: Any,
+          black_stand_in: Callable[[int], bool] | None = None) -> Iterator[_Work]:  # fmt: skip
+    """Each prepared frame with the detector's result and warnings, or its error (then no more).
 
-    `prepared`'s iterator is closed when this ends, however it ends (a reader thread stops).
+    The detector's warnings (:func:`pftrack._warn.warn`) are held, not given on this thread
+    (whose line, inside this module, they named): the stand-in gives them inside the
+    tracker's ``update`` of the frame, which gives them from its caller's line, as when the
+    detector runs inside ``update``. Frame k (1-based) is detected inside
+    :func:`~pftrack._stand_in.standing_in` when ``black_stand_in(k)`` (a black frame in place
+    of one the video could not decode). `prepared`'s iterator is closed when this ends, however
+    it ends (a reader thread stops).
     """
     it = iter(prepared)
     try:
-        for frame, work, measured, error in it:
+        for index, (frame, work, measured, error) in enumerate(it, start=1):
+            said: list[_Warning] = []
             if error is None:
                 try:
-                    result = call(work)
+                    with (
+                        Held() as held,
+                        standing_in(black_stand_in is not None and black_stand_in(index)),
+                    ):
+                        result = call(work)
+                    said = held.pending
                 except Exception as raised:  # raised by the stand-in in update(), as above
                     error = raised
             if error is not None:
-                yield frame, frame, None, error, None
+                yield frame, frame, None, error, None, []
                 return
-            yield frame, work, result, None, measured
+            yield frame, work, result, None, measured, said
     finally:
         close = getattr(it, "close", None)
         if close is not None:

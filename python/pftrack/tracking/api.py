@@ -65,6 +65,7 @@ from pftrack._limits import (
     proposal_error,
     unread_error,
 )
+from pftrack._stand_in import is_stand_in
 from pftrack._typing import (
     F64,
     CameraMotion,
@@ -527,6 +528,9 @@ class Tracker:
     #: the evidence of x, y, w, h rows (:func:`check_boxes_xyxy`). A class default for a
     #: checkpoint pickled before it was kept.
     _layout: tuple[int, int] = (0, 0)
+    #: Stand-ins among the run's frames taken (:mod:`pftrack._stand_in`; a class default for
+    #: a checkpoint pickled before they were counted).
+    _stood = 0
     #: Whether the run keeps its rows for :meth:`finalize` (the constructor's `record`; a class
     #: default for a checkpoint pickled before it was an option).
     record: bool = True
@@ -830,6 +834,7 @@ class Tracker:
             self._reports: list[Track] = []
             self._warned: set[str] = set()  # the run's once-only warnings given so far
             self._blocking: list[float] = []  # blockiness of the run's first BLOCK_FRAMES
+            self._stood = 0  # stand-ins among the frames taken (pftrack._stand_in)
             self._max_conf = -np.inf
             self._given = False  # some update() of the run had detections
             self._layout = (0, 0)  # inverted boxes, boxes with an extent (check_boxes_xyxy)
@@ -899,7 +904,7 @@ class Tracker:
         (:data:`~pftrack.detection.blocking.BLOCKY`), when the built-in detector ran on them:
         given detections' tracks changed about as much at JPEG quality 40 as at 5.
         """
-        self._blocking = [*self._blocking[: self.frame_count], blockiness(frame)]
+        self._blocking = [*self._blocking[: self.frame_count - self._stood], blockiness(frame)]
         if len(self._blocking) == BLOCK_FRAMES and is_blocky(self._blocking):
             self._warn_once(
                 "blocky",
@@ -1178,7 +1183,9 @@ class Tracker:
                 "Tracker before a new video)"
             )
         work = self._working(f)
-        if first and is_blank(f):
+        # a frame the video could not decode, black in its place: no check of the footage
+        stand_in = is_stand_in()
+        if first and not stand_in and is_blank(f):
             self._warn_once(
                 "blank",
                 f"frame 1 is blank (every pixel within {BLANK_LEVELS} levels of the others): "
@@ -1186,8 +1193,8 @@ class Tracker:
                 "and tracks follow their detections and motion alone (placeholder frames? "
                 "give the real ones)",
             )
-        if self.frame_count < BLOCK_FRAMES and dets is None:  # the built-in detector's
-            self._warn_blocky(f)
+        if not stand_in and self.frame_count - self._stood < BLOCK_FRAMES and dets is None:
+            self._warn_blocky(f)  # the built-in detector's frames, stand-ins not measured
         if dets is None:
             if self._given:  # was silent: a loop's "no detections" for this frame?
                 self._warn_once(
@@ -1267,6 +1274,7 @@ class Tracker:
             self._layout = (self._layout[0] + inverted, self._layout[1] + extent)
             self._max_conf = max(self._max_conf, confidence)
         self.frame_count += 1
+        self._stood += stand_in
         if first:  # the run's size, once its first frame is taken
             self._shape = f.shape
         if self.record:

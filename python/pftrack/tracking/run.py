@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import os
+import sys
 import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from contextlib import ExitStack, closing, nullcontext
+from contextlib import closing, nullcontext
 from dataclasses import dataclass
+from types import FrameType
 from typing import Any
 
 import numpy as np
@@ -24,10 +26,10 @@ from pftrack._check import (
     real_array,
 )
 from pftrack._progress import progress
+from pftrack._stand_in import standing_in
 from pftrack._text import counted
 from pftrack._typing import F64, BootstrapMode, FillMode, IntLike, PathLike, RngLike
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
-from pftrack.detection.paper import DARK_FRAMES
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource, SequenceInfo
@@ -291,6 +293,9 @@ def track_frames(
         config, seed, coasting=coasting, fill=fill, smoother=smoother, link=link,
         prime_frames=prime_frames,
     )  # fmt: skip
+    # the warnings of update() (the detector's too, from its thread) name the line that called
+    # track_frames, or track_path, not this module's loop
+    tracker._caller_depth = _calls_from_here(sys._getframe(1))
     if prime_frames > 0 and (detections is None or config.refine.enabled):
         if bootstrap == "auto":
             bootstrap = "spread" if detections is None else "first"
@@ -313,6 +318,11 @@ def track_frames(
     # state), whenever update() would call it: always with the built-in detector, for box
     # refinement's foreground with external detections
     ahead = detections is None or config.refine.enabled or config.sampler == "rjmcmc"
+
+    def black_stand_in(k: int) -> bool:
+        """Whether frame k is black in place of one the video could not decode, once read."""
+        return k <= getattr(frames, "lead_black", 0)
+
     if not threads:
         it = iter(frames)
         stream: Any = closing(it) if hasattr(it, "close") else nullcontext(it)
@@ -324,19 +334,19 @@ def track_frames(
             prepare=tracker.working_frame,
             hand_over=tracker.hand_over,
             read_depth=4,  # as prefetch's: the reading thread prepares the frames too
+            black_stand_in=black_stand_in,
         )
     else:
         stream = closing(prefetch(frames))
-    with ExitStack() as quiet, stream as decoded:  # the reading threads stop first
+    with stream as decoded:  # the reading threads stop first
         for n, frame in enumerate(
             progress(decoded, total=total, desc="tracking", enable=show_progress, unit="frame"),
             start=1,
         ):
-            if n == 1:  # the source knows by now whether its first frames are stand-ins
-                _stand_ins_said(quiet, getattr(frames, "lead_black", 0))
             settled = tracker.n_settled
             if detections is None:
-                tracker.update(None, frame)
+                with standing_in(black_stand_in(n)):
+                    tracker.update(None, frame)
             else:
                 dets = detections.get(n, empty)
                 if n == 1:
@@ -346,7 +356,8 @@ def track_frames(
                         getattr(frames, "sequence", None),
                         getattr(frames, "rotation", 0),
                     )
-                tracker.update(xywh_to_xyxy_dets(dets), frame)
+                with standing_in(black_stand_in(n)):
+                    tracker.update(xywh_to_xyxy_dets(dets), frame)
             if on_frame is not None:
                 on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
     if n == 0:  # a FrameSource by its name, not its repr
@@ -359,28 +370,21 @@ def track_frames(
             warnings.warn(
                 f"detections of {len(unused)} frames after the video's last frame {n} were not "
                 f"used (frames {min(unused)}-{max(unused)})",
-                stacklevel=2,
+                stacklevel=1 + tracker._caller_depth,
             )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
 
 
-def _stand_ins_said(quiet: ExitStack, lead: int) -> None:
-    """Keep quiet, for this run, the warnings the `lead` black stand-ins would raise.
+def _calls_from_here(caller: FrameType | None) -> int:
+    """Calls between :func:`track_frames` and the code outside this module that made it.
 
-    A video whose first `lead` frames did not decode is read with black frames in their place,
-    which its reader says (:class:`~pftrack.io.video.FrameSource`). The tracker would then
-    also call frame 1 blank ("placeholder frames? give the real ones") and the detector, from
-    :data:`~pftrack.detection.paper.DARK_FRAMES` of them, the frames from 1 on dark ("lights
-    switched off?"): advice about the footage that is wrong for stand-ins. Called at the
-    run's first frame, before the tracker takes it; the detection thread is then at most a
-    few frames ahead (its queues), fewer than ``DARK_FRAMES``.
+    `caller`: track_frames' caller's frame; 1 when it is outside this module, 2 through
+    :func:`track_path`: the ``stacklevel`` past ``track_frames`` of the line a warning names.
     """
-    if lead < 1:
-        return
-    quiet.enter_context(warnings.catch_warnings())
-    warnings.filterwarnings("ignore", r"frame 1 is blank \(", UserWarning)
-    if lead >= DARK_FRAMES:
-        warnings.filterwarnings("ignore", r"the frames from 1 on are dark \(", UserWarning)
+    depth = 1
+    while caller is not None and caller.f_globals.get("__name__") == __name__:
+        depth, caller = depth + 1, caller.f_back
+    return depth
 
 
 def _check_frames(frames: object) -> None:
