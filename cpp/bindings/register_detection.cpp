@@ -1,9 +1,11 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -97,7 +99,8 @@ void register_detection(py::module_& m) {
              py::arg("v_min") = 0.2)
         .def(
             "apply",
-            [](BackgroundModel& self, const py::object& frame_in, bool bins) {
+            [](BackgroundModel& self, const py::object& frame_in, bool bins,
+               std::optional<py::array> hold) {
                 const char* fn = "BackgroundModel.apply";
                 const bind::InUse busy(&self, fn);
                 const py::array frame = bind::bgr_image(frame_in, fn, "frame");
@@ -107,6 +110,13 @@ void register_detection(py::module_& m) {
                             "frame shape is " + shape_str(frame) + ", expected (" +
                                 std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
                                 ", 3) as the earlier frames (call reset() before a new video)");
+                const std::uint8_t* hptr = nullptr;
+                Index hstride = 0;
+                if (hold) {
+                    bind::check_mask(*hold, rows, cols, fn);
+                    hptr = static_cast<const std::uint8_t*>(hold->data());
+                    hstride = hold->strides(0);
+                }
                 std::shared_ptr<BinnedImage> img;
                 if (bins) img = std::make_shared<BinnedImage>(rows, cols, self.binning().n_bins());
                 auto mask = new_mask(rows, cols);
@@ -118,13 +128,14 @@ void register_detection(py::module_& m) {
                     // safe: raw buffers kept alive by the caller / owned here; the model is not
                     // shared between threads by pftrack (one model per video)
                     py::gil_scoped_release nogil;
-                    self.apply(src, rows, cols, stride, bptr, mptr);
+                    self.apply(src, rows, cols, stride, bptr, mptr, hptr, hstride);
                 }
                 return py::make_tuple(bins ? py::cast(img) : py::none(), mask);
             },
-            py::arg("frame"), py::arg("bins") = true,
+            py::arg("frame"), py::arg("bins") = true, py::arg("hold") = py::none(),
             "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, or None without bins; raw "
-            "mask (H, W) uint8: 255 foreground, 127 shadow, 0 background).")
+            "mask (H, W) uint8: 255 foreground, 127 shadow, 0 background). hold (H, W) uint8/bool: "
+            "candidates where != 0 are not learnt.")
         .def(
             "blend",
             [](BackgroundModel& self, const py::object& frame_in, py::array mask, double rate) {

@@ -64,18 +64,19 @@ class BackgroundModel:
     ]: ...
     # frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, raw mask (H, W) uint8:
     # 255 foreground, 127 shadow, 0 background)
-    # bins=False: no bins (None), for a caller that bins only the pixels it keeps (hsv_bins)
+    # bins=False: no bins (None), for a caller that bins only the pixels it keeps (hsv_bins);
+    # hold (H, W) uint8/bool: candidates where it is not 0 are not learnt (rate 0)
     @overload
     def apply(
-        self, frame: NDArray[np.uint8], bins: Literal[True] = True
+        self, frame: NDArray[np.uint8], bins: Literal[True] = True, hold: ArrayLike | None = None
     ) -> tuple[BinnedImage, NDArray[np.uint8]]: ...
     @overload
     def apply(
-        self, frame: NDArray[np.uint8], bins: Literal[False]
+        self, frame: NDArray[np.uint8], bins: Literal[False], hold: ArrayLike | None = None
     ) -> tuple[None, NDArray[np.uint8]]: ...
     @overload
     def apply(
-        self, frame: NDArray[np.uint8], bins: bool
+        self, frame: NDArray[np.uint8], bins: bool, hold: ArrayLike | None = None
     ) -> tuple[BinnedImage | None, NDArray[np.uint8]]: ...
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...

@@ -100,6 +100,39 @@ def test_background_model_matches_reference_at_odd_widths(bins):
         assert n_shadow > 0 or cols < 30  # the shadowed patch was marked, where it fits
 
 
+@pytest.mark.parametrize("cols", [7, 61, 133])
+def test_held_candidates_are_not_learnt(cols):
+    # hold: the candidates under it keep their background (rate 0, not alpha_fg); the other
+    # pixels under it are learnt as usual; the reference bit for bit
+    rng = np.random.default_rng(cols)
+    kw = {"n_learn": 2, "alpha_fg": 0.2}
+    model, ref = _core.BackgroundModel(**kw), BackgroundReference(**kw)
+    hold = np.zeros((40, cols), np.uint8)
+    hold[5:30, : cols // 2 + 1] = 1
+    held = 0
+    for frame in random_scene(rng, shape=(40, cols)):
+        before = model.background
+        _, mask = model.apply(frame, bins=False, hold=hold)
+        _, rmask = ref.apply(frame, hold=hold)
+        np.testing.assert_array_equal(mask, rmask)
+        np.testing.assert_array_equal(model.background, ref.background)
+        if before is not None and model.frame_count > 2:
+            kept = (mask != 0) & (hold != 0)
+            np.testing.assert_array_equal(model.background[kept], before[kept])
+            held += int(kept.sum())
+    assert held > 0 or cols < 30
+
+
+def test_hold_of_the_wrong_shape_or_type_is_refused():
+    model = _core.BackgroundModel()
+    frame = np.zeros((10, 12, 3), np.uint8)
+    model.apply(frame)
+    with pytest.raises(ValueError, match="mask must have the frame's"):
+        model.apply(frame, hold=np.zeros((10, 11), np.uint8))
+    with pytest.raises(TypeError, match="mask dtype is float64"):
+        model.apply(frame, hold=np.zeros((10, 12)))
+
+
 def test_apply_without_bins_is_the_same_pass():
     # bins=False (the built-in detector: it bins only its foreground) changes nothing else
     frames = random_scene(np.random.default_rng(3), shape=(37, 61), steps=5)

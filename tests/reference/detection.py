@@ -63,7 +63,9 @@ class BackgroundReference:
         lo, hi = self.bounds()
         self.threshold = min(max(t, lo), hi)
 
-    def apply(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def apply(
+        self, frame: np.ndarray, hold: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         bins = hsv_bin_reference(frame)
         f = frame.astype(np.float32)
         if self.background is None:
@@ -94,7 +96,8 @@ class BackgroundReference:
             a_bg = a_fg = max(1.0 / k, self.alpha)
         else:
             a_bg, a_fg = self.alpha, self.alpha_fg
-        a = np.where(cand, np.float32(a_fg), np.float32(a_bg))[..., None]
+        a_cand = np.float32(a_fg) if hold is None else np.where(hold != 0, 0, a_fg)
+        a = np.where(cand, a_cand, np.float32(a_bg)).astype(np.float32)[..., None]
         self.frame_count = k
         self.background = bg + a * e
         self.previous = frame.copy()

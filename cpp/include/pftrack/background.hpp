@@ -221,6 +221,20 @@ PFTRACK_VECTOR_CLONES static void background_row_split(Index n, const std::uint8
     std::memcpy(prev, px, static_cast<size_t>(3 * n));
 }
 
+/// `background_row_update` with a hold row: a = 0 where cand and hold != 0 (a tracked
+/// object's pixels, kept out of the background), else a_fg where cand, else a_bg.
+PFTRACK_VECTOR_CLONES static void background_row_update_held(
+    Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
+    float* __restrict qb, float* __restrict qg, float* __restrict qr, const float* __restrict cand,
+    const std::uint8_t* __restrict hold, float a_bg, float a_fg) {
+    for (Index x = 0; x < n; ++x) {
+        const float a = cand[x] != 0.0f ? (hold[x] != 0 ? 0.0f : a_fg) : a_bg;
+        qb[x] = qb[x] + a * (fb[x] - qb[x]);
+        qg[x] = qg[x] + a * (fg[x] - qg[x]);
+        qr[x] = qr[x] + a * (fr[x] - qr[x]);
+    }
+}
+
 /// background_c += a (frame_c - background_c), a = a_fg where cand, else a_bg.
 PFTRACK_VECTOR_CLONES static void background_row_update(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
@@ -244,7 +258,8 @@ PFTRACK_VECTOR_CLONES static void background_row_update(
 ///       shadow (see BackgroundConfig) is not foreground; mask 255 foreground, 127 shadow,
 ///       0 background (OpenCV MOG2's convention),
 ///   (d) background_c += a (frame_c - background_c), a = alpha where not a candidate, alpha_fg
-///       where a candidate (foreground or shadow); a = max(1 / k, alpha) everywhere for the
+///       where a candidate (foreground or shadow), 0 where a candidate under the caller's
+///       `hold` mask (if given); a = max(1 / k, alpha) everywhere but there for the
 ///       k-th frame while k <= n_learn (float32 arithmetic, in this order, so a NumPy
 ///       reference matches bit for bit),
 ///   (e) stores the frame as the previous one, and counts floor(d_bg) in a 256-bin histogram.
@@ -390,9 +405,12 @@ public:
 
     /// One frame (rows x cols BGR, `row_stride` bytes a row). Writes `bins` (rows x cols; none
     /// when null: the caller bins only the pixels it keeps, with `hsv_bins_image`) and `mask`
-    /// (rows x cols, 255 = foreground, 127 = shadow, 0 = background), both packed.
+    /// (rows x cols, 255 = foreground, 127 = shadow, 0 = background), both packed. `hold`
+    /// (rows x cols, `hold_stride` bytes a row; none when null): candidates where it is not 0
+    /// are not learnt at all (rate 0 instead of alpha_fg; the caller's tracked objects that
+    /// stopped), the other pixels as usual. Ignored on the first frame.
     void apply(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride, std::int16_t* bins,
-               std::uint8_t* mask) {
+               std::uint8_t* mask, const std::uint8_t* hold = nullptr, Index hold_stride = 0) {
         if (!initialized()) {
             first_frame(bgr, rows, cols, row_stride, bins, mask);
             return;
@@ -454,7 +472,11 @@ public:
             for (Index x = 0; x < cols; ++x)
                 ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
             // (5) background_c += a (frame_c - background_c), vectorised (selective update)
-            detail::background_row_update(cols, fb, fg, fr, qb, qg, qr, cand, a_bg, a_fg);
+            if (hold != nullptr)
+                detail::background_row_update_held(cols, fb, fg, fr, qb, qg, qr, cand,
+                                                   hold + y * hold_stride, a_bg, a_fg);
+            else
+                detail::background_row_update(cols, fb, fg, fr, qb, qg, qr, cand, a_bg, a_fg);
         }
         for (size_t i = 0; i < 256; ++i) {
             std::int64_t c = 0;

@@ -16,6 +16,7 @@ from pftrack._check import MAX_COORD, bgr_array, brief, flag, number, real_array
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.boxes import _iou_matrix
+from pftrack.detection.hold import HOLD_IOU
 from pftrack.detection.size_model import PersonSizeModel
 
 
@@ -349,7 +350,7 @@ class BlobExtractor:
         return closed
 
     def boxes(
-        self, mask: NDArray[np.uint8], *, learn: bool = True
+        self, mask: NDArray[np.uint8], *, learn: bool = True, still: F64 | None = None
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Boxes (K, 4) left, top, w, h and scores (K,) of the blobs that pass the filters.
 
@@ -364,7 +365,10 @@ class BlobExtractor:
 
         The whole pass is one C++ call (``pftrack._core.blob_boxes``, the GIL released;
         ``tests/reference/blobs.py`` is the OpenCV/NumPy statement it equals bit for bit).
-        With `learn` False the person-size model does not learn from this mask's blobs.
+        With `learn` False the person-size model does not learn from this mask's blobs; it
+        never learns from a blob whose box overlaps one of `still` (K, 4) by IoU
+        ``hold.HOLD_IOU`` or more (the previous frame's boxes of people standing still,
+        `pftrack.detection.hold.StopMemory.still`).
         """
         cfg = self.config
         model = self.size_model
@@ -385,7 +389,10 @@ class BlobExtractor:
             cfg.split_valley,
         )
         if cfg.learn_size and learn:
-            model.observe(rects)
+            skip: NDArray[np.bool_] | None = None
+            if still is not None and len(still) and len(rects):
+                skip = np.any(_iou_matrix(rects, still) >= HOLD_IOU, axis=1)
+            model.observe(rects, skip)
         big, big_fill = self._moving_large(mask)
         if len(big):  # never learnt from, never cut: one person close to the camera
             rects, fill = np.vstack([rects, big]), np.concatenate([fill, big_fill])

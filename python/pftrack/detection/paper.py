@@ -20,6 +20,7 @@ from pftrack.detection.base import (
     check_frame,
 )
 from pftrack.detection.ghost import GHOST_STATISTICS
+from pftrack.detection.hold import StopMemory
 from pftrack.detection.light import (
     DARK_LEVEL,
     GAIN_SAMPLE_STEP,
@@ -128,6 +129,12 @@ class PaperConfig:
         (`pftrack.detection.light.levelled_median`). Dark frames
         (`pftrack.detection.light.is_dark`) are neither compared nor learnt, and do not prime
         or start the background. 0 turns all three off.
+    hold_frames : int
+        People who stop (`pftrack.detection.hold.StopMemory`): the detector follows its own
+        boxes from frame to frame, and for this many frames after an object's box last moved
+        by half its width, the next frame's candidate pixels inside that box are not learnt
+        (instead of at `alpha_fg`): a person who walked and stopped stays foreground that
+        long, then `alpha_fg` absorbs them as before. 0 turns it off.
     gain_thresholds : bool
         With the gain rule, scale the grey-level threshold bounds `t_min`, `t_max` by the
         accumulated gain since the first frame (``BackgroundModel.set_threshold_scale``), up
@@ -158,6 +165,7 @@ class PaperConfig:
     grey_shadow_lo: float = 1.0
     gain_band: float = 0.03
     gain_thresholds: bool = True
+    hold_frames: int = 1000
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
@@ -169,6 +177,7 @@ class PaperConfig:
         ):  # fmt: skip  # before the comparisons below ask an array for its truth
             number(getattr(self, name), name, finite=False)  # the first eight were taken
         integer(self.n_learn, "n_learn", 0, 2**31 - 1)  # 0 or 1: the selective update at once
+        integer(self.hold_frames, "hold_frames", 0, 2**31 - 1)
         flag(self.gain_thresholds, "gain_thresholds")
         instance(self.blobs, "blobs", BlobConfig)
         instance(self.hsv, "hsv", HsvBinning)
@@ -238,6 +247,7 @@ class PaperDetector:
         self._dark = 0  # dark frames in a row (DARK_FRAMES)
         self._dark_said = False  # the dark warning was given (once a video)
         self._dark_unsaid = False  # the dark warning, given by the next detect
+        self._stops = StopMemory(self.config.hold_frames)  # boxes held out of the background
 
     def _new_model(self, shadow_lo: float) -> _core.BackgroundModel:
         c = self.config
@@ -375,7 +385,8 @@ class PaperDetector:
                     if scale != self._model.threshold_scale:
                         self._model.set_threshold_scale(scale)
         self._dark = 0
-        result = self._model.apply(frame, bins=bins)
+        hold = self._stop_memory().hold_mask(frame.shape[:2])
+        result = self._model.apply(frame, bins=bins, hold=hold)
         self._count_noisy()
         return result
 
@@ -389,6 +400,15 @@ class PaperDetector:
             self._dark_said = self._dark_unsaid = True  # said by the next detect
         binned = hsv_bins(frame, None, self.config.hsv) if bins else None
         return binned, np.zeros(frame.shape[:2], np.uint8)
+
+    #: a detector pickled before people who stop were held (`_stop_memory` makes one)
+    _stops: StopMemory | None = None
+
+    def _stop_memory(self) -> StopMemory:
+        """The boxes followed from frame to frame (`pftrack.detection.hold`)."""
+        if self._stops is None:
+            self._stops = StopMemory(self.config.hold_frames)
+        return self._stops
 
     @property
     def model(self) -> _core.BackgroundModel:
@@ -412,6 +432,7 @@ class PaperDetector:
         self._noise_said = self._noise_unsaid = False
         self._seen = self._dark = 0
         self._dark_said = self._dark_unsaid = False
+        self._stop_memory().reset()
 
     def _reset_model(self) -> None:
         """Forget the background model, and with it the light it has followed.
@@ -500,7 +521,8 @@ class PaperDetector:
                 self._ghost = None
         # while the light changes, blobs come in fragments (a dim frame's contrast, a
         # background still catching up): not person sizes to learn from
-        boxes, scores = self._blobs.boxes(mask, learn=self._settling == 0)
+        stops = self._stop_memory()
+        boxes, scores = self._blobs.boxes(mask, learn=self._settling == 0, still=stops.still)
         self._settling = max(self._settling - 1, 0)
         if self.config.ghost_support > 0 and len(boxes):
             mask, boxes, scores = self._drop_ghosts(frame, mask, boxes, scores)
@@ -511,6 +533,7 @@ class PaperDetector:
             if self._ghost is not None:  # in place: `shaded` is this frame's own array
                 shaded[self._ghost != 0] = 0
             boxes = size.extend_legs(shaded, boxes, self.config.leg_height, self.config.leg_fill)
+        stops.observe(boxes)  # the boxes whose pixels the next frame holds
         # the colours of the kept foreground only (the full frame's bins, which only a moving
         # camera needs, are binned by the tracker then)
         return Detections(boxes, scores, mask, hsv_bins(frame, mask, self.config.hsv))

@@ -217,11 +217,13 @@ class PersonSizeModel:
             raise ValueError("PersonSizeModel.expected: the model is not fitted yet")
         return expected_size(self._coef, foot_y)
 
-    def observe(self, boxes: NDArray[np.float64]) -> None:
+    def observe(self, boxes: NDArray[np.float64], skip: NDArray[np.bool_] | None = None) -> None:
         """Add the isolated ones among `boxes` (K, 4) ``left, top, w, h`` to the fit.
 
         A box is isolated when no other box of the frame overlaps its columns: a person
         stacked over another blob (a fragment, or someone partly hidden) is not sampled.
+        Boxes where `skip` (K,) is True are not sampled either (a person standing still:
+        `pftrack.detection.hold.StopMemory.still`), but still make the others not isolated.
         """
         b = np.asarray(boxes, np.float64).reshape(-1, 4)
         if len(b) == 0:
@@ -229,7 +231,10 @@ class PersonSizeModel:
         left, right = b[:, 0], b[:, 0] + b[:, 2]
         overlap = (left[:, None] < right[None, :]) & (left[None, :] < right[:, None])
         np.fill_diagonal(overlap, False)
-        iso = b[~overlap.any(axis=1)]
+        alone = ~overlap.any(axis=1)
+        if skip is not None:
+            alone &= ~skip
+        iso = b[alone]
         m, size = len(iso), self.config.max_samples
         # the ring buffer's next m slots at once; of more boxes than slots, the last ones
         # (those written in turn would overwrite the earlier)

@@ -1,0 +1,109 @@
+"""People who stop: StopMemory (pftrack.detection.hold) and the detector holding them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pftrack.boxes import iou_xywh
+from pftrack.detection import PaperConfig, make_detector
+from pftrack.detection.hold import HOLD_MISSES, STILL_FRAMES, StopMemory
+from pftrack.synthetic import _paste, _sprite, make_scene
+
+
+def _walk_then_stand(memory: StopMemory, walk: int, stand: int) -> list[int]:
+    """A 30 x 80 box walking 3 px a frame, then standing: how many boxes are held each frame."""
+    held = []
+    for f in range(walk + stand):
+        x = 10.0 + 3.0 * min(f, walk)
+        memory.observe(np.array([[x, 50.0, 30.0, 80.0]]))
+        held.append(len(memory.held))
+    return held
+
+
+def test_an_object_that_walked_and_stopped_is_held_until_the_time_limit():
+    memory = StopMemory(hold_frames=200)
+    held = _walk_then_stand(memory, walk=30, stand=300)
+    # walking, and the first STILL_FRAMES frames standing: not held (a walker's pixels are
+    # learnt as before); then held, until hold_frames after the last move
+    # it moves by half its width (15 px) every 5 frames, last at index 30 (where it stops)
+    on = [f for f, n in enumerate(held) if n]
+    assert on == list(range(30 + STILL_FRAMES, 30 + 200 + 1))
+    assert len(memory.still) == 1  # the size model does not learn from it
+
+
+def test_an_object_that_never_moved_is_never_held():
+    # a patch of changed light, a ghost: its box stays where it is
+    memory = StopMemory(hold_frames=1000)
+    held = _walk_then_stand(memory, walk=0, stand=300)
+    assert held == [0] * 300
+    assert len(memory.still) == 0
+
+
+def test_a_box_that_changes_size_is_not_a_move():
+    # merged with a passer-by: the box doubles its width to one side, its centre moves by
+    # half its former width; it did not walk
+    memory = StopMemory(hold_frames=1000)
+    for f in range(200):
+        w = 60.0 if 20 <= f < 40 else 30.0
+        memory.observe(np.array([[10.0, 50.0, w, 80.0]]))
+        assert len(memory.held) == 0
+
+
+def test_a_missed_object_is_held_then_forgotten():
+    memory = StopMemory(hold_frames=1000)
+    _walk_then_stand(memory, walk=30, stand=100)
+    for _ in range(HOLD_MISSES):
+        memory.observe(np.zeros((0, 4)))
+        assert len(memory.held) == 1  # its last box, while it may come back
+    memory.observe(np.zeros((0, 4)))
+    assert len(memory.held) == 0
+    mask = memory.hold_mask((200, 300))
+    assert mask is None
+
+
+def test_hold_mask_and_off():
+    memory = StopMemory(hold_frames=1000)
+    _walk_then_stand(memory, walk=30, stand=100)
+    mask = memory.hold_mask((200, 300))
+    assert mask is not None and mask.dtype == np.uint8
+    x, y, w, h = memory.held[0].astype(int)
+    assert mask.sum() == w * h and mask[y : y + h, x : x + w].all()
+    off = StopMemory(hold_frames=0)
+    _walk_then_stand(off, walk=30, stand=100)
+    assert len(off.held) == 0 and off.hold_mask((200, 300)) is None
+
+
+def test_hold_frames_is_checked():
+    with pytest.raises(ValueError, match="hold_frames"):
+        PaperConfig(hold_frames=-1)
+    with pytest.raises(TypeError, match="hold_frames"):
+        PaperConfig(hold_frames=2.5)  # type: ignore[arg-type]
+
+
+def _stander_found(hold_frames: int, stand: int = 400) -> list[bool]:
+    """make_scene's background and a walker who walks in 40 frames, then stands `stand`."""
+    scene = make_scene(n_frames=40 + stand, n_walkers=1, rng=0, occluder=False)
+    gen = np.random.default_rng(7)
+    look = ((40, 180, 40), (60, 40, 30), (120, 160, 210))
+    sprites = [_sprite(30, 80, *look, phase, gen) for phase in (0, 1)]
+    det = make_detector("paper", hold_frames=hold_frames)
+    det.prime([scene.background])
+    found = []
+    for f, frame in enumerate(scene.frames):
+        walking = f < 40
+        sprite = sprites[(f // 3) % 2 if walking else 0]
+        box = _paste(frame, *sprite, 3.0 * min(f, 40), 220.0)
+        d = det.detect(frame)
+        found.append(bool(len(d.boxes)) and iou_xywh(box, d.boxes).max() >= 0.5)
+    return found[40:]
+
+
+@pytest.mark.slow
+def test_a_person_who_stops_for_long_stays_detected():
+    """Regression (standlong): a walker who stands 400 frames was absorbed by alpha_fg and lost
+    after about 250 of them; held once still for STILL_FRAMES, found on all 400."""
+    held = _stander_found(1000)
+    assert sum(held) == 400, sum(held)
+    unheld = _stander_found(0)  # the detector before: lost for the last ~150 frames
+    assert sum(unheld[-100:]) == 0, sum(unheld)
