@@ -17,6 +17,25 @@ __all__ = ["main"]
 #: what was interrupted (a test checks they agree).
 EXIT_INTERRUPTED = 130
 
+#: Whether Ctrl-C came while this process's command ran (set by :func:`_interrupt`). Code in C
+#: may turn the KeyboardInterrupt it raises into an error of its own, or drop it: NumPy's
+#: import, interrupted, raised ``ImportError: ... PyCapsule_Import could not import module
+#: "datetime"`` with its "IMPORTANT: PLEASE READ THIS" advice on a broken install (a
+#: traceback, exit status 1), and an interrupt dropped somewhere in the imports let ``pftrack
+#: recover`` write its output (exit status 0). With this flag the command ends as interrupted.
+_interrupted = [False]
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    """Python's own SIGINT handler (``signal.default_int_handler``), remembering the interrupt."""
+    _interrupted[0] = True
+    raise KeyboardInterrupt
+
+
+def interrupted() -> bool:
+    """Whether Ctrl-C came while the ``pftrack`` process's command ran (see `_interrupted`)."""
+    return _interrupted[0]
+
 
 def _command(argv: Sequence[str]) -> str:
     """``pftrack CMD`` for the command `argv` names (its first non-option word), or ``pftrack``."""
@@ -42,6 +61,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     try:
         if argv is None:  # this process is the command (the console script, python -m pftrack)
+            import signal
+
+            if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not SIG_IGN
+                signal.signal(signal.SIGINT, _interrupt)
             from pftrack._threads import one_blas_thread
 
             one_blas_thread()  # before anything loads NumPy
@@ -52,11 +75,27 @@ def main(argv: Sequence[str] | None = None) -> int:
         # to the exit (was: exit status 130, no word, after the output was written)
         _signals.PROCESS_ENDS = argv is None
         return run(argv)
-    except KeyboardInterrupt:  # before the command's own handler: nothing was written yet
-        words = sys.argv[1:] if argv is None else argv
-        try:  # a line break ends a progress bar's line, drawn only on a terminal
-            end = "\n" if sys.stderr.isatty() else ""
-        except (AttributeError, OSError, ValueError):  # no stderr, or a closed one
-            end = ""
-        print(f"{end}{_command(words)}: interrupted; no output was changed", file=sys.stderr)
+    except Exception:
+        if not _interrupted[0]:
+            raise  # a defect of pftrack's: its traceback is what a report needs
+        # Ctrl-C, turned into another error by code in C (an import of NumPy's): as below
+        print(f"{_line_end()}{_command(_words(argv))}: interrupted; no output was changed",
+              file=sys.stderr)  # fmt: skip
         return EXIT_INTERRUPTED
+    except KeyboardInterrupt:  # before the command's own handler: nothing was written yet
+        print(f"{_line_end()}{_command(_words(argv))}: interrupted; no output was changed",
+              file=sys.stderr)  # fmt: skip
+        return EXIT_INTERRUPTED
+
+
+def _words(argv: Sequence[str] | None) -> Sequence[str]:
+    """The command's words: `argv`, or the process's own."""
+    return sys.argv[1:] if argv is None else argv
+
+
+def _line_end() -> str:
+    """A line break to end a progress bar's line, drawn only on a terminal; else ``""``."""
+    try:
+        return "\n" if sys.stderr.isatty() else ""
+    except (AttributeError, OSError, ValueError):  # no stderr, or a closed one
+        return ""

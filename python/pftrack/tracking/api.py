@@ -1064,7 +1064,7 @@ class Tracker:
         work = (rows, cols, 3) if size is None else (size[1], size[0], 3)
         return (rows, cols, bands), work
 
-    def update(self, dets: ArrayLike | None, frame: NDArray[np.uint8]) -> F64:
+    def update(self, dets: ArrayLike | None, frame: NDArray[np.uint8], embs: object = None) -> F64:
         """Track one frame.
 
         Parameters
@@ -1084,6 +1084,11 @@ class Tracker:
             NumPy array: a list, a PIL image, whose RGB ``np.asarray(img)[..., ::-1]`` makes
             BGR; ValueError for another shape, naming ``cv2.cvtColor``'s conversion of a grey
             or BGRA frame).
+        embs : object, optional
+            BoxMOT's third argument, a detector's appearance embeddings: taken, so that a
+            BoxMOT loop ``update(dets, frame, embs)`` runs unchanged, and not used (pftrack
+            tells objects apart by their colour in `frame` and their motion), with one warning
+            a run when given (was: a TypeError naming no argument).
 
         Returns
         -------
@@ -1102,7 +1107,8 @@ class Tracker:
         UserWarning
             Once a run each: boxes clipped to the frame, boxes without area dropped, and, with
             ``dets=None``, a camera found moving (``camera_motion`` "auto" or "on"): background
-            subtraction is unreliable there, give detections. Once a run, ``dets=None`` after
+            subtraction is unreliable there, give detections. Once a run, `embs` given (not
+            used). Once a run, ``dets=None`` after
             a frame with detections, naming the frame: it runs the built-in detector on that
             frame (as documented above), which a frame meant to have no detections (``[]``)
             does not want. Once, when the run's first frame is blank (one flat level, as
@@ -1130,6 +1136,12 @@ class Tracker:
             with Held() as held:  # given once the frame is taken whole (python -W error)
                 try:
                     out = self._update(dets, frame)
+                    if embs is not None:  # BoxMOT's ReID trackers' input; its others ignore it
+                        self._warn_once(
+                            "embs",
+                            "Tracker.update: embs (appearance embeddings) are not used: pftrack "
+                            "tells objects apart by their colour in the frame and their motion",
+                        )
                 except BaseException:
                     self._warned = warned  # the warnings held were not given
                     raise

@@ -1,0 +1,77 @@
+"""A BoxMOT loop runs unchanged: ``update(dets, img, embs)``, BoxMOT's three arguments.
+
+BoxMOT's trackers take ``update(dets, img, embs=None)``, the embeddings of a ReID model for
+its appearance trackers (its motion-only ones ignore them). ``Tracker.update`` took two
+arguments: a BoxMOT loop that passed its embeddings failed with Python's ``takes 3
+positional arguments but 4 were given``. They are taken now, not used, and said once a run.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack.synthetic import make_scene
+
+
+@pytest.fixture(scope="module")
+def scene() -> pftrack.Scene:
+    return make_scene(n_frames=12, n_walkers=3, rng=1)
+
+
+def _dets(scene: pftrack.Scene, frame: int) -> np.ndarray:
+    r = scene.truth[scene.truth[:, 0] == frame]
+    return np.column_stack([r[:, 2], r[:, 3], r[:, 2] + r[:, 4], r[:, 3] + r[:, 5],
+                            np.full(len(r), 0.95), np.zeros(len(r))])  # fmt: skip
+
+
+def _embs(dets: np.ndarray) -> np.ndarray:
+    return np.random.default_rng(0).random((len(dets), 512), dtype=np.float32)
+
+
+def test_embeddings_are_taken_and_change_nothing(scene):
+    plain, boxmot = pftrack.Tracker(), pftrack.Tracker()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for k, frame in enumerate(scene.frames, start=1):
+            dets = _dets(scene, k)
+            expected = plain.update(dets, frame)
+            np.testing.assert_array_equal(boxmot.update(dets, frame, _embs(dets)), expected)
+    said = [str(w.message) for w in caught if "embs" in str(w.message)]
+    assert said == [
+        "Tracker.update: embs (appearance embeddings) are not used: pftrack tells objects "
+        "apart by their colour in the frame and their motion"
+    ]
+    assert caught[0].filename == __file__  # the user's line, not pftrack's
+    np.testing.assert_array_equal(boxmot.finalize(), plain.finalize())
+
+
+def test_embs_none_by_keyword_says_nothing(scene):
+    tracker = pftrack.Tracker()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tracker.update(_dets(scene, 1), scene.frames[0], embs=None)
+
+
+def test_the_warning_comes_once_a_run(scene):
+    tracker = pftrack.Tracker()
+    for _run in range(2):  # reset() starts a new run
+        with pytest.warns(UserWarning, match="embs"):
+            tracker.update(_dets(scene, 1), scene.frames[0], _embs(_dets(scene, 1)))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            tracker.update(_dets(scene, 2), scene.frames[1], _embs(_dets(scene, 2)))
+        tracker.reset()
+
+
+def test_a_bad_frame_is_refused_before_the_embeddings_are_said(scene):
+    tracker = pftrack.Tracker()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(TypeError, match="frame dtype is float32"):
+            tracker.update(_dets(scene, 1), scene.frames[0].astype(np.float32), [[0.0]])
+    with pytest.warns(UserWarning, match="embs"):  # not spent by the refused call
+        tracker.update(_dets(scene, 1), scene.frames[0], [[0.0]])
