@@ -454,9 +454,9 @@ public:
         std::int32_t* __restrict di = hi + ns;
         const detail::ShadowBounds sh{s_lo, s_chroma};
         // Each row in four loops over L1-resident row buffers: (1), (3), (5) are vectorised by
-        // the compiler (the shadow test of (3) too, for every pixel: cheaper vectorised than
-        // branching to it for the few candidates); (4) does the table look-ups and the
-        // histogram, which cannot be vectorised.
+        // the compiler (the shadow test of (3) too, over every pixel of each 32-pixel chunk that
+        // has a candidate, skipped in the others: cheaper than branching pixel by pixel);
+        // (4) does the table look-ups and the histogram, which cannot be vectorised.
         for (Index y = 0; y < rows; ++y) {
             const std::uint8_t* __restrict px = bgr + y * row_stride;
             float* __restrict qb = background_.data() + y * n3;
