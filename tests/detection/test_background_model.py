@@ -133,6 +133,32 @@ def test_hold_of_the_wrong_shape_or_type_is_refused():
         model.apply(frame, hold=np.zeros((10, 12)))
 
 
+@pytest.mark.parametrize("bins", [True, False])
+@pytest.mark.parametrize("cols", [32, 64, 65, 96 + 7])
+def test_shadow_test_skipped_only_in_chunks_without_candidates(bins, cols):
+    # The row is scanned in chunks of 32 pixels (kCandidateChunk) and the shadow test runs
+    # only in chunks with a candidate: a lone foreground or shadow pixel at either end of a
+    # chunk, or in the scalar tail, is marked as the reference marks it, and the chunks
+    # without any are 0. A still, noiseless background: most chunks have no candidate.
+    bg = np.full((8, cols, 3), (90, 110, 130), np.uint8)
+    model = _core.BackgroundModel(n_learn=0, t_min=20.0, t_max=20.0)
+    ref = BackgroundReference(n_learn=0, t_min=20.0, t_max=20.0)
+    model.apply(bg, bins=bins)
+    ref.apply(bg)
+    for step in range(3):
+        f = bg.copy()
+        for x in (0, 31, 32, 63, 64, cols - 1):  # chunk ends, and the last pixel
+            if x < cols:
+                f[x % 8, x] = 220  # foreground
+                f[(x + 3 + step) % 8, x] = (54, 66, 78)  # a shadow: 0.6 times, same colour
+        _, mask = model.apply(f, bins=bins)
+        _, rmask = ref.apply(f)
+        np.testing.assert_array_equal(mask, rmask)
+        np.testing.assert_array_equal(model.background, ref.background)
+        assert (mask == 255).any() and (mask == 127).any()
+        assert (mask != 0).sum() <= 12  # only the marked pixels
+
+
 def test_apply_without_bins_is_the_same_pass():
     # bins=False (the built-in detector: it bins only its foreground) changes nothing else
     frames = random_scene(np.random.default_rng(3), shape=(37, 61), steps=5)
