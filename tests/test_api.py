@@ -519,3 +519,18 @@ def test_the_classes_top_level_functions_return_are_top_level() -> None:
                 if getattr(pftrack, cls.__name__, None) is not cls:
                     missing.append(f"{name} -> {cls.__name__}")
     assert not missing
+
+
+def test_tracking_modules_load_no_numpy_ma() -> None:
+    """``numpy.ma`` is not imported to refuse masked arrays: none can exist without it.
+
+    ``pftrack._check.refuse_masked`` read ``np.ma.MaskedArray``, which imported ``numpy.ma``
+    (10-25 ms) at every ``pftrack track``'s start (a recovery dataclass checks its defaults at
+    import); a masked array is still refused (tests/core/test_errors.py).
+    """
+    code = (
+        "import sys, pftrack.cli.track, pftrack.tracking.run, pftrack.recovery.fill; "
+        "print('numpy.ma' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

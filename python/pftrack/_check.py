@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numbers
 import os
+import sys
 from collections.abc import Iterable, Iterator
 from typing import TypeVar
 
@@ -173,8 +174,11 @@ def refuse_masked(
     the caller's to say, as `mend` tells them; a masked array with nothing masked is its
     values. The first check of :func:`real_array`, :func:`bool_array` and :func:`bgr_array`.
     """
-    if isinstance(values, np.ma.MaskedArray) and np.ma.is_masked(values):
-        n = int(np.count_nonzero(np.ma.getmaskarray(values)))
+    # a MaskedArray exists only once numpy.ma is imported: ``np.ma`` would import it (10-25
+    # ms of every command's start-up, for a check that a tracking run makes at import time)
+    ma = sys.modules.get("numpy.ma")
+    if ma is not None and isinstance(values, ma.MaskedArray) and ma.is_masked(values):
+        n = int(np.count_nonzero(ma.getmaskarray(values)))
         raise TypeError(
             f"{what} is a numpy.ma.MaskedArray with {counted(n, 'masked value')}, whose mask "
             f"NumPy would drop (the masked values used as they are); pass {mend}"
