@@ -277,9 +277,6 @@ def test_sequences_deeper_than_one_level_are_named_not_passed_over(
     train = top / "train"
     for name in ("SEQ1", "SEQ2"):
         _mot_sequence(train / name)
-    # annotations alone (as ../shared/data/mot15-gt/*): nothing to track, not named
-    (top / "annotations" / "ADL").mkdir(parents=True)
-    (top / "annotations" / "ADL" / "seqinfo.ini").write_text("[Sequence]\n")
     held = f"{train} holds 2 sequences (SEQ1, SEQ2)"
     error = (
         f"no sequence in folder {top}: expected videos ({', '.join(VIDEO_SUFFIXES)}), image "
@@ -307,6 +304,54 @@ def test_sequences_deeper_than_one_level_are_named_not_passed_over(
     # given as well, or instead: tracked, no warning (filterwarnings = error)
     assert [s.name for s in find_sequences([top, train])] == ["v", "SEQ1", "SEQ2"]
     assert [s.name for s in find_sequences(train)] == ["SEQ1", "SEQ2"]
+
+
+def test_sequence_folders_without_frames_below_are_named_not_passed_over(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 16's leftover: ``pftrack batch ../shared/data`` passed over ``mot15-gt/`` (three
+    sequence folders with ``seqinfo.ini``, ``det.txt`` and ``gt.txt``, no frames) without a
+    word. ``pftrack track`` refuses such a folder (no frames to track, with or without
+    ``--detections``), so a batch cannot track them: one line names them and says why."""
+    top = tmp_path / "data"
+    for name in ("ADL", "ETH", "KITTI"):
+        seq = top / "mot15-gt" / name
+        seq.mkdir(parents=True)
+        (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=64\nimHeight=64\n")
+        (seq / "det.txt").write_text("1,-1,1,1,5,5,0.9,-1,-1,-1\n")
+    (top / "other" / "notes").mkdir(parents=True)  # no annotations: not named
+    (top / "other" / "notes" / "a.txt").write_text("")
+    (top / "labels" / "cam" / "gt").mkdir(parents=True)  # gt/gt.txt alone, two levels down
+    (top / "labels" / "cam" / "gt" / "gt.txt").write_text("")
+    why = (
+        "annotations alone (seqinfo.ini, det.txt, gt.txt; no image folder, no video), nothing a "
+        "batch can track"
+    )
+    named = (
+        f"{top / 'labels'}, which holds 1 sequence folder without frames (cam); "
+        f"{top / 'mot15-gt'}, which holds 3 sequence folders without frames (ADL, ETH, KITTI)"
+    )
+    error = (
+        f"no sequence in folder {top}: expected videos ({', '.join(VIDEO_SUFFIXES)}), image "
+        f"folders or MOTChallenge sequence folders in it; {named}: {why}"
+    )
+    with pytest.raises(ValueError, match=f"^{re.escape(error)}$"):
+        find_sequences(top)
+    _mot_sequence(top / "SEQ")
+    warning = f"folder {top}: passed over {named}: {why}"
+    with pytest.warns(UserWarning, match=f"^{re.escape(warning)}$"):
+        assert [s.name for s in find_sequences(top)] == ["SEQ"]
+    out = tmp_path / "out"
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")  # as a user's shell: the command prints it
+        argv = ["batch", str(top), "--out", str(out), "--workers", "0", *FAST]
+        assert main([*argv, "--detections", "auto"]) == 1  # SEQ has no det.txt: refused
+    assert f"pftrack batch: warning: {warning}\n" in capsys.readouterr().err
+    # given themselves: sequences whose tasks fail, as pftrack track refuses them, said once
+    summary = track_many(top / "mot15-gt", out, n_workers=0)
+    assert [e["status"] for e in summary.entries] == ["failed"] * 3
+    (said,) = summary.problems()
+    assert said.startswith(f"3 sequences (ADL, ETH, KITTI): error: {top}/mot15-gt/NAME/")
 
 
 @pytest.mark.parametrize(
@@ -546,7 +591,10 @@ def test_failing_sequence_is_reported_and_the_others_finish(
     assert status == {"walk": "failed", "MOT-01": "done", "plain": "failed", "broken": "failed"}
     errors = {s["name"]: s["error"] for s in summary["sequences"] if s["status"] == "failed"}
     assert "no det/det.txt" in errors["broken"] and "no det/det.txt" in errors["walk"]
-    assert "broken: error: --detections auto: sequence broken has no det/det.txt" in text
+    # the same words but each its own name: one line (was: one a sequence)
+    said = "3 sequences (plain, walk, broken): error: --detections auto: sequence NAME has no "
+    assert f"\n{said}det/det.txt (nor det.txt)\n" in f"\n{text}"
+    assert "broken: error" not in text and "walk: error" not in text
     assert sorted(p.name for p in out.iterdir()) == ["MOT-01.json", "MOT-01.txt", "summary.json"]
     # the video that cannot be read, on a worker, among others: its own error
     argv = ["batch", str(broken), str(data / "MOT-01"), "--out", str(tmp_path / "out2"), *FAST]

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-__all__ = ["counted", "listed"]
+import re
+
+__all__ = ["counted", "listed", "listed_compactly", "said_alike"]
 
 
 def counted(n: int, noun: str, plural: str | None = None) -> str:
@@ -19,3 +21,92 @@ def listed(names: list[str], shown: int = 3) -> str:
     ``listed(["a", "b", "c", "d"])`` is ``a, b, c, ...``.
     """
     return ", ".join(names[:shown]) + (", ..." if len(names) > shown else "")
+
+
+def _numbered(name: str) -> tuple[str, str, str] | None:
+    """``(prefix, digits, suffix)`` of `name`'s last number (``cam07.v2`` has ``2``), or None."""
+    m = re.fullmatch(r"(.*?)(\d+)(\D*)", name)
+    return (m.group(1), m.group(2), m.group(3)) if m else None
+
+
+def _follows(a: str, b: str) -> bool:
+    """Whether `b` follows `a` in a numbered run: ``cam09``, ``cam10``; ``t9``, ``t10``."""
+    na, nb = _numbered(a), _numbered(b)
+    if na is None or nb is None or (na[0], na[2]) != (nb[0], nb[2]):
+        return False
+    padded = len(na[1]) == len(nb[1]) or not (na[1][0] == "0" or nb[1][0] == "0")
+    return padded and int(nb[1]) == int(na[1]) + 1
+
+
+def listed_compactly(names: list[str], shown: int = 4) -> str:
+    """`names` comma-separated, each run of three or more numbered names as ``first..last``.
+
+    Then ``...`` after `shown` items: ``listed_compactly(["cam01", "cam02", "cam03", "odd"])``
+    is ``cam01..cam03, odd``; twelve cameras ``cam01`` to ``cam12`` are ``cam01..cam12``.
+    """
+    runs: list[list[str]] = []
+    for name in names:
+        if runs and _follows(runs[-1][-1], name):
+            runs[-1].append(name)
+        else:
+            runs.append([name])
+    items = [i for r in runs for i in ([f"{r[0]}..{r[-1]}"] if len(r) > 2 else r)]
+    return ", ".join(items[:shown]) + (", ..." if len(items) > shown else "")
+
+
+NAME = "NAME"  # where grouped messages named their own sequence or file
+
+
+def _named(name: str) -> re.Pattern[str]:
+    """`name` where a message names it, not inside a longer name.
+
+    Not ``cam1`` in ``cam10``, nor ``MOT17-02`` in ``MOT17-02-DPM``; ``cam1`` in
+    ``/data/cam1.avi``, yes.
+    """
+    return re.compile(rf"(?<![\w-]){re.escape(name)}(?![\w-])")
+
+
+def said_alike(messages: list[tuple[str, str]]) -> list[tuple[str, list[str]]]:
+    """``(name, message)`` pairs grouped where their messages differ only by their own names.
+
+    ``cam1: ... sequence cam1 has no det/det.txt`` and ``cam2: ... sequence cam2 has ...``
+    are one group, said ``... sequence NAME has no det/det.txt``: each place where the
+    messages of a group name their own (differing) names reads ``NAME``; a place where they
+    all read the first one's name (a word of the text that happens to be it) keeps it.
+    Identical messages are a group too. Groups in the order of their first message.
+
+    Returns
+    -------
+    list of (message, names)
+        One per group: its text (the message itself for a group of one), and its names.
+    """
+    groups: list[tuple[str, list[str], list[str], set[int]]] = []  # name, parts, names, slots
+    for name, message in messages:
+        for first, parts, names, slots in groups:
+            differ = _fits(first, parts, name, message)
+            if differ is not None:
+                names.append(name)
+                slots |= differ
+                break
+        else:
+            groups.append((name, _named(name).split(message), [name], set()))
+    out = []
+    for first, parts, names, slots in groups:
+        text = parts[0]
+        for k, part in enumerate(parts[1:]):
+            text += (NAME if k in slots else first) + part
+        out.append((text, names))
+    return out
+
+
+def _fits(first: str, parts: list[str], name: str, message: str) -> set[int] | None:
+    """Where `message` reads `name` in place of the first message's `first`.
+
+    `parts` is the first message split at its name; the places are indices of the splits.
+    None when `message` differs otherwise.
+    """
+    either = f"({re.escape(first)}|{re.escape(name)})"
+    m = re.fullmatch(either.join(re.escape(p) for p in parts), message, flags=re.DOTALL)
+    if m is None:
+        return None
+    return {k for k in range(len(parts) - 1) if name != first and m.group(k + 1) == name}

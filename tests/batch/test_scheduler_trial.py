@@ -290,8 +290,9 @@ def test_sequences_that_fail_alike_are_said_once(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The trial: 29 sequences left failed ``no worker on the scheduler ... for 8 s``, one line
-    each, the same text 29 times. An error is said once, with the count and the names (three,
-    then ``...``); a task's own error stays its own line; the entries keep each error."""
+    each, the same text 29 times. An error is said once, with the count and the names (a
+    numbered run as ``first..last``); a task's own error stays its own line; the entries keep
+    each error."""
     lost = "no worker on the scheduler at tcp://127.0.0.1:8799 for 8 s"
     jobs = [Job(f"cam{k}", _fails_alike, (k, lost), ()) for k in range(1, 6)]
     jobs.insert(2, Job("odd", _fails_alike, (0, "its own error"), ()))
@@ -299,7 +300,7 @@ def test_sequences_that_fail_alike_are_said_once(
     jobs.append(Job("pair2", _fails_alike, (0, "twice"), ()))
     summary = run_jobs(jobs, tmp_path, kind="track", settings={}, n_workers=0)
     assert summary.problems() == [
-        f"5 sequences (cam1, cam2, cam3, ...): error: {lost}",
+        f"5 sequences (cam1..cam5): error: {lost}",
         "odd: error: its own error",
         "2 sequences (pair, pair2): error: twice",
     ]
@@ -313,7 +314,33 @@ def test_sequences_that_fail_alike_are_said_once(
     monkeypatch.setattr("pftrack.batch.api.smooth_file", functools.partial(_fails_alike, 0, lost))
     argv = ["smooth", str(tmp_path / "in"), "--out", str(tmp_path / "o"), "--workers", "0"]
     assert main(argv) == 1
-    assert capsys.readouterr().err == f"5 files (t0, t1, t2, ...): error: {lost}\n"
+    assert capsys.readouterr().err == f"5 files (t0..t4): error: {lost}\n"
+
+
+def test_errors_that_differ_only_by_their_names_are_said_once(tmp_path: Path) -> None:
+    """Issue 16's leftover: errors in the same words but each naming its own sequence (``has no
+    det/det.txt``, a path) were one line each. Said once, ``NAME`` where each named its own;
+    a word of the text that is a name stays; ``seq1`` is not read in ``seq10``; the entries and
+    ``summary.json`` keep each sequence's own error."""
+    names = [f"cam{k:02d}" for k in range(1, 13)] + ["video", "clip", "seq1", "seq10", "solo"]
+    errors = {n: f"--detections auto: sequence {n} has no det/det.txt" for n in names[:12]}
+    errors |= {n: f"cannot decode a frame from /in/{n}.mp4: not a video" for n in names[12:14]}
+    errors |= {n: f"/in/{n}/seqinfo.ini: /in/{n}/img1 does not exist" for n in names[14:16]}
+    errors["solo"] = "/in/solo.avi: its own error, naming solo"
+    jobs = [Job(n, _fails_alike, (0, errors[n]), ()) for n in names]
+    summary = run_jobs(jobs, tmp_path, kind="track", settings={}, n_workers=0)
+    assert summary.problems() == [
+        "12 sequences (cam01..cam12): error: --detections auto: sequence NAME has no det/det.txt",
+        "2 sequences (video, clip): error: cannot decode a frame from /in/NAME.mp4: not a video",
+        "2 sequences (seq1, seq10): error: /in/NAME/seqinfo.ini: /in/NAME/img1 does not exist",
+        "solo: error: /in/solo.avi: its own error, naming solo",
+    ]
+    on_disk = json.loads((tmp_path / "summary.json").read_text())["sequences"]
+    assert [e["error"] for e in on_disk] == [errors[n] for n in names]
+    # names listed compactly: numbered runs, then four items and "..."
+    jobs = [Job(n, _fails_alike, (0, f"{n}: bad"), ()) for n in ("a", "b1", "b2", "c", "d", "e")]
+    summary = run_jobs(jobs, tmp_path / "o", kind="smooth", settings={}, n_workers=0)
+    assert summary.problems() == ["6 files (a, b1, b2, c, ...): error: NAME: bad"]
 
 
 def test_a_sequence_certain_to_fail_on_detections_auto_is_not_sent(

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._check import brief, flag, shown
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
-from pftrack._text import counted, listed
+from pftrack._text import counted, listed, listed_compactly, said_alike
 from pftrack._threads import usable_cpus
 from pftrack.batch.inputs import cannot_read
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
@@ -239,9 +239,11 @@ class BatchSummary:
         `warned` False: the errors alone (the warnings said as they arrived,
         :func:`warnings_as_they_come`, and a skipped task's before the table).
 
-        An error that several tasks failed with is said once, with their count and names (the
-        first three): ``29 sequences (cam01, cam02, cam03, ...): error: ...``; each entry keeps
-        its own.
+        An error that several tasks failed with is said once, with their count and names (runs
+        of numbered names as ``first..last``, four items, then ``...``): ``29 sequences
+        (cam01..cam29): error: ...``; so are errors that differ only where each names its own
+        task, said with ``NAME`` there (``12 sequences (cam01..cam12): error: --detections auto:
+        sequence NAME has no det/det.txt (nor det.txt)``). Each entry keeps its own.
 
         Last, ``error: DIR/summary.json not written (...)`` if it could not be (and
         `unwritten`: an interrupted batch's last line says it instead).
@@ -253,13 +255,15 @@ class BatchSummary:
             for w in e.get("warnings", ())
         ]
         # one error said once, where several tasks failed with it (was: once per task, 29
-        # identical lines for 29 sequences on a cluster that had lost its workers, a trial)
-        alike: dict[str, list[str]] = {}
-        for e in self.failed:
-            alike.setdefault(e["error"], []).append(e["name"])
+        # identical lines for 29 sequences on a cluster that had lost its workers, a trial),
+        # or with the same words but their own names (was: one line each)
         noun = "sequence" if self.kind == "track" else "file"
-        for error, names in alike.items():
-            who = names[0] if len(names) == 1 else f"{counted(len(names), noun)} ({listed(names)})"
+        for error, names in said_alike([(e["name"], e["error"]) for e in self.failed]):
+            who = (
+                names[0]
+                if len(names) == 1
+                else f"{counted(len(names), noun)} ({listed_compactly(names)})"
+            )
             text.append(f"{who}: error: {error}")
         if self.unwritten and unwritten:
             text.append(f"error: {self.unwritten}")

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pftrack._check import shown
+from pftrack._text import counted
 from pftrack._typing import PathLike
 from pftrack.io.atomic import refuse_dash, refuse_loop
 from pftrack.io.video import (
@@ -367,6 +368,44 @@ def _sequences_in(entries: list[Path]) -> tuple[list[str], list[Path]]:
     return names, below
 
 
+def _frameless_in(entries: list[Path]) -> tuple[list[str], list[Path]]:
+    """The sequence folders without frames among a folder's `entries`, and its other folders.
+
+    Without frames: a ``seqinfo.ini``, detections or ground truth, and no image folder or video
+    (``../shared/data/mot15-gt/*``): annotations alone, which no batch can track.
+    """
+    names: list[str] = []
+    below: list[Path] = []
+    for entry in entries:
+        if not entry.is_dir() or entry.is_symlink():
+            continue
+        if _has_frames(entry):
+            continue  # a sequence (or a folder of them): named by the other hint, if deeper
+        if (entry / "seqinfo.ini").is_file() or any(_annotations(entry)):
+            names.append(entry.name)
+        else:
+            below.append(entry)
+    return names, below
+
+
+def _frameless(found: list[tuple[Path, list[str]]]) -> str:
+    """``DIR/mot15-gt, which holds 3 sequence folders without frames (A, B, C)``, joined."""
+
+    def one(folder: Path, names: list[str]) -> str:
+        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+        held = counted(len(names), "sequence folder")
+        return f"{folder}, which holds {held} without frames ({shown})"
+
+    return "; ".join(one(f, n) for f, n in found[:3]) + ("; ..." if len(found) > 3 else "")
+
+
+#: Why the folders of :func:`_frameless` are passed over.
+_NO_FRAMES = (
+    "annotations alone (seqinfo.ini, det.txt, gt.txt; no image folder, no video), nothing a "
+    "batch can track"
+)
+
+
 def _tracks_in(entries: list[Path]) -> tuple[list[str], list[Path]]:
     """The ``.txt`` files among a folder's `entries`, and its folders (not links to them)."""
     names = [e.name for e in entries if e.suffix == ".txt" and e.is_file()]
@@ -458,6 +497,10 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
                 passed.append(entry)
         given = {os.path.realpath(p) for p in paths}  # DIR and DIR/train both given: said of none
         deeper = [d for d in _below(passed, _sequences_in) if os.path.realpath(d[0]) not in given]
+        # annotations without frames below (../shared/data/mot15-gt/*): was passed over silently
+        frameless = [
+            d for d in _below(passed, _frameless_in) if os.path.realpath(d[0]) not in given
+        ]
         if len(found) == before:  # was: the same words with deeper sequences, not naming them
             where = (
                 f"; deeper, {_held(deeper)}: {_pass(deeper)} instead (a folder is looked into "
@@ -465,9 +508,17 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
                 if deeper
                 else ""
             )
+            if frameless:
+                where += f"; {_frameless(frameless)}: {_NO_FRAMES}"
             raise ValueError(
                 f"no sequence in folder {path}: expected videos ({', '.join(VIDEO_SUFFIXES)}), "
                 f"image folders or MOTChallenge sequence folders in it{where}"
+            )
+        if frameless:
+            warnings.warn(
+                f"folder {path}: passed over {_frameless(frameless)}: {_NO_FRAMES}",
+                UserWarning,
+                stacklevel=2,
             )
         if deeper:  # was: passed over silently
             n = len(found) - before
