@@ -13,6 +13,7 @@ ignores). Real sequences are read from ``--data``, else ``$PFTRACK_DATA``, else
 ``frame_rate``             every sequence at full, half and third rate, detections on odd frames
 ``offline_sensitivity``    MOTA / IDF1 under changed association and smoother defaults
 ``recovery_linking_pets``  linking and filling of PETS09-S2L1 ground truth cut into fragments
+``linking_wrong_joins``    ``pftrack smooth``'s wrong joins on the five ground truths in pieces
 ``recovery_variants``      model variants of ``gdt-bi`` on the paper's mask protocol
 ``rjmcmc_speed``           RJ-MCMC frames/s and MH vs SIS per-object cost on PETS09-S2L1
 ``sampler_experiment``     SIS vs MH vs RJ-MCMC inside the tracker: scores, timing, occlusion

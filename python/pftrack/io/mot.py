@@ -427,7 +427,7 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
     decimals that value needs. So a file read back writes the same text (``88.00`` is written
     ``88`` the first time already) and the values a file held are written unchanged.
     """
-    v = a[:, 2:].ravel()
+    v = np.array(a[:, 2:], dtype=np.float64).ravel()  # a copy of its own: changed in place
     d = _decimals(v, 10.0**EXACT_DIGITS, MOST_DECIMALS)
     whole = np.abs(v) >= 2.0**52  # every such double is an integer (and v * 100 may overflow)
     huge = np.abs(v) >= 1e16  # 17 digits or more as an integer: 1e+308, not 309 digits
@@ -437,7 +437,6 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
         d[exact[:, 2:].ravel() & (d < 0)] = _REPR
     rest = d < 0
     if rest.any():
-        v = v.copy()
         p = v[rest] * 100.0
         r = np.rint(p) / 100.0
         tie = np.flatnonzero(p - np.floor(p) == 0.5)  # the product rounded to a tie: as %.2f
@@ -445,7 +444,7 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
         dr = _decimals(r, 1e15, 2)
         dr[dr < 0] = np.where(r[dr < 0] == np.floor(r[dr < 0]), 0, 2)  # beyond ±1e13
         v[rest], d[rest] = r, dr
-    v = v + 0.0  # -0.0 -> 0.0: never "-0"
+    v += 0.0  # -0.0 -> 0.0: never "-0" (in place: no third copy of the values at the peak)
     return v.reshape(len(a), -1), d.reshape(len(a), -1)
 
 
@@ -646,7 +645,10 @@ def write_mot(
     path = path_arg(path, "write_mot: path")
     mask = _exact_mask(exact, len(a), "write_mot")
     order = np.lexsort((a[:, ID], a[:, FRAME]))
-    text = _lines(a[order], None if mask is None else mask[order])
+    if np.any(order[1:] < order[:-1]):  # rows already in order (fill_gaps's) are not copied
+        a = a[order]
+        mask = None if mask is None else mask[order]
+    text = _lines(a, mask)
     with atomic_write(path) as fh:
         fh.write(text)
 

@@ -58,6 +58,7 @@ __all__ = [
     "link_tracklets",
     "pixel_scale",
     "read_tracks",
+    "sorted_tracks",
     "split_tracks",
 ]
 
@@ -233,13 +234,24 @@ def _end_velocity(c: F64, k: int, tail: bool) -> F64:
     return np.asarray((t @ (part[:, 1:3] - part[:, 1:3].mean(axis=0))) / denom, dtype=np.float64)
 
 
+def sorted_tracks(rows: F64) -> tuple[F64, NDArray[np.int64]]:
+    """`rows` sorted by id, then frame (one copy), and the end of each id's rows in it.
+
+    The rows of the ``k``-th id are ``sorted[ends[k - 1]:ends[k]]`` (``ends[-1]`` is 0): the
+    tracks of :func:`split_tracks`, in its order, without a dict of views.
+    """
+    r = rows[np.lexsort((rows[:, 0], rows[:, 1]))]  # by id, then frame (stable)
+    if len(r) == 0:
+        return r, np.zeros(0, dtype=np.int64)
+    return r, np.r_[np.flatnonzero(r[1:, 1] != r[:-1, 1]) + 1, len(r)]
+
+
 def split_tracks(rows: F64) -> dict[int, F64]:
     """Rows of each id, sorted by frame."""
     if len(rows) == 0:
         return {}
-    r = rows[np.lexsort((rows[:, 0], rows[:, 1]))]  # by id, then frame (stable)
-    starts = np.flatnonzero(np.r_[True, r[1:, 1] != r[:-1, 1]])
-    ends = np.r_[starts[1:], len(r)]
+    r, ends = sorted_tracks(rows)
+    starts = np.r_[0, ends[:-1]]
     return {int(r[i, 1]): r[i:j] for i, j in zip(starts, ends, strict=True)}
 
 
