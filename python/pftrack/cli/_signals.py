@@ -122,9 +122,9 @@ def raise_if_interrupted() -> None:
     The ``pftrack`` process remembers each Ctrl-C (:func:`pftrack._console.interrupted`); a
     command that catches none itself calls this before it puts its outputs in place.
     """
-    from pftrack._console import interrupted
-
-    if interrupted():
+    # read from the entry module where it ran, not imported: pftrack._console imports this one
+    console = sys.modules.get("pftrack._console")
+    if console is not None and console.interrupted():
         raise KeyboardInterrupt
 
 
