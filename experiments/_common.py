@@ -7,7 +7,7 @@ import contextlib
 import io
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
@@ -33,6 +33,9 @@ class Source:
 PETS = Source("pets09-s2l1", "video.avi", 0.625)
 TUD = Source("tud-campus", "video.mp4", 1.0)
 
+NO_VIDEO = ("ADL-Rundle-6", "ETH-Sunnyday", "KITTI-17")
+"""The sequences of ``mot15-gt/``: ground truth, public detections and seqinfo.ini, no video."""
+
 
 def frame_truth(src: Source, data: Path) -> F64:
     """The ground truth of `src` under `data` in its video's pixels, zero-marked rows left out."""
@@ -52,6 +55,47 @@ def data_root(arg: PathLike | None = None) -> Path:
     if os.environ.get("PFTRACK_DATA"):
         return Path(os.environ["PFTRACK_DATA"])
     return REPO / ".." / "shared" / "data"
+
+
+def data_folder(arg: PathLike | None = None) -> Path | None:
+    """:func:`data_root` of `arg` if it is a folder; else None, said on stderr.
+
+    The caller then returns 2: ``if (root := data_folder(args.data)) is None: return 2``.
+    """
+    root = data_root(arg)
+    if root.is_dir():
+        return root
+    print(f"data folder not found: {root} (set --data or PFTRACK_DATA)", file=sys.stderr)
+    return None
+
+
+def video_folders(
+    data: Path, sources: Sequence[Source] = (PETS, TUD)
+) -> Iterator[tuple[Source, Path]]:
+    """Each of `sources` found under `data`, with its folder, in order.
+
+    One not found is passed over with a note printed in its place:
+    ``tud-campus: not found under DATA, skipped``.
+    """
+    for src in sources:
+        folder = data / src.name
+        if folder.is_dir():
+            yield src, folder
+        else:
+            print(f"{src.name}: not found under {data}, skipped")
+
+
+def no_video_folders(data: Path) -> Iterator[tuple[str, Path]]:
+    """Each :data:`NO_VIDEO` sequence found under ``data/mot15-gt``, with its folder, in order.
+
+    One not found is passed over with a note printed in its place, as by :func:`video_folders`.
+    """
+    for name in NO_VIDEO:
+        folder = data / "mot15-gt" / name
+        if folder.is_dir():
+            yield name, folder
+        else:
+            print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
 
 
 class _ExperimentParser(argparse.ArgumentParser):

@@ -45,8 +45,14 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
-from experiments.public_detections import NO_VIDEO, BlackFrames, black_frames
+from experiments._common import (
+    data_root,
+    experiment_parser,
+    no_video_folders,
+    tee_stdout,
+    video_folders,
+)
+from experiments.public_detections import BlackFrames, black_frames
 from experiments.stonesoup_models import BoxTrackerSettings, box_tracker
 from pftrack._typing import F64
 from pftrack.eval import SequenceScores, evaluate_sequence
@@ -73,21 +79,13 @@ class Case:
 def load_cases(data: Path, with_frames: bool = True) -> list[Case]:
     """The five sequences found under `data` (a missing one is skipped with a note)."""
     out = []
-    for src in (PETS, TUD):
-        folder = data / src.name
-        if not folder.is_dir():
-            print(f"{src.name}: not found under {data}, skipped")
-            continue
+    for src, folder in video_folders(data):
         frames: Sequence[NDArray[np.uint8]] = (
             read_frames(folder / src.video) if with_frames else BlackFrames(0, 1, 1)
         )
         dets = load_detections(folder / "det.txt", src.scale)
         out.append(Case(src.name, frames, dets, read_mot(folder / "gt.txt"), src.scale))
-    for name in NO_VIDEO:
-        folder = data / "mot15-gt" / name
-        if not folder.is_dir():
-            print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
-            continue
+    for name, folder in no_video_folders(data):
         frames = black_frames(folder)
         dets = load_detections(folder / "det.txt")
         out.append(Case(name, frames, dets, read_mot(folder / "gt.txt"), 1.0))

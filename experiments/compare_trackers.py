@@ -47,7 +47,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import data_root, experiment_parser, write_text
+from experiments._common import data_folder, experiment_parser, write_text
 from experiments.public_detections import black_frames
 from pftrack.eval import MotMetrics, evaluate_mot
 from pftrack.io.mot import as_written, group_by_frame, read_mot
@@ -373,9 +373,8 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = ap.parse_args(argv)
 
-    root = data_root(args.data)
-    if not root.is_dir():
-        print(f"data folder not found: {root} (set --data or PFTRACK_DATA)", file=sys.stderr)
+    root = data_folder(args.data)
+    if root is None:
         return 2
     rows: list[Row] = []
     notes: list[str] = []

@@ -36,9 +36,14 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
+from experiments._common import (
+    data_root,
+    experiment_parser,
+    no_video_folders,
+    tee_stdout,
+    video_folders,
+)
 from experiments.public_detections import (
-    NO_VIDEO,
     BlackFrames,
     add_settings,
     noisy_detections,
@@ -92,11 +97,7 @@ Case = tuple[Iterable[NDArray[np.uint8]], dict[int, F64], F64, float]
 def sequences(data: Path) -> list[tuple[str, Callable[[str], Case]]]:
     """Every sequence found under `data` and the synthetic scenes, each as a maker of versions."""
     out: list[tuple[str, Callable[[str], Case]]] = []
-    for src in (PETS, TUD):
-        folder = data / src.name
-        if not folder.is_dir():
-            print(f"{src.name}: not found under {data}, skipped")
-            continue
+    for src, folder in video_folders(data):
 
         def video(version: str, folder: Path = folder, scale: float = src.scale,
                   name: str = src.video) -> Case:  # fmt: skip
@@ -109,11 +110,7 @@ def sequences(data: Path) -> list[tuple[str, Callable[[str], Case]]]:
             return Strided(source, len(source), k), dets, keep_rows(gt, k), scale
 
         out.append((src.name, video))
-    for name in NO_VIDEO:
-        folder = data / "mot15-gt" / name
-        if not folder.is_dir():
-            print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
-            continue
+    for name, folder in no_video_folders(data):
 
         def black(version: str, folder: Path = folder) -> Case:
             info = read_seqinfo(folder)

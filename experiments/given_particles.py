@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
+from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout, video_folders
 from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import as_written, read_mot
 from pftrack.io.video import FrameSource
@@ -53,14 +53,11 @@ def main(argv: list[str] | None = None) -> int:
         p.error("--seeds and --counts must be >= 1")
     data = data_root(args.data)
     with tee_stdout(args.out / "given_particles.txt"):
-        for src in (PETS, TUD):
-            if not (data / src.name).is_dir():
-                print(f"{src.name}: not found under {data}, skipped")
-                continue
+        for src, folder in video_folders(data, (PETS, TUD)):
             for n in args.counts:
                 rows = []
                 for seed in range(args.seeds):
-                    rows.append(scores(data / src.name, src.video, src.scale, n, seed))
+                    rows.append(scores(folder, src.video, src.scale, n, seed))
                     m, i, h = rows[-1]
                     print(
                         f"{src.name} particles {n:4d} seed {seed:2d}  {m:5.1f} / {i:5.1f} / "

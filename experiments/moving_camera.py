@@ -41,7 +41,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from experiments._common import PETS, REPO, TUD, Source, data_root, experiment_parser, tee_stdout
+from experiments._common import PETS, REPO, TUD, Source, data_folder, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.cli import main as pftrack_main
 from pftrack.cli._options import bounded_int
@@ -144,9 +144,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if out == REPO.resolve() or REPO.resolve() in out.parents:
         print(f"--out {out} is inside the repository; give a folder outside it", file=sys.stderr)
         return 2
-    root = data_root(args.data)
-    if not root.is_dir():
-        print(f"data folder not found: {root} (set --data or PFTRACK_DATA)", file=sys.stderr)
+    root = data_folder(args.data)
+    if root is None:
         return 2
     results = out / "tracks"
     results.mkdir(parents=True, exist_ok=True)

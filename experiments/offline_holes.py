@@ -37,7 +37,7 @@ from collections import Counter
 
 import numpy as np
 
-from experiments._common import data_root, experiment_parser, write_text
+from experiments._common import data_folder, experiment_parser, write_text
 from experiments.compare_trackers import (
     SEQUENCES,
     PftrackStep,
@@ -114,9 +114,8 @@ def main(argv: list[str] | None = None) -> int:
         help=f"sequences, of {', '.join(SEQUENCES)} (default: all five)",
     )
     args = ap.parse_args(argv)
-    root = data_root(args.data)
-    if not root.is_dir():
-        print(f"data folder not found: {root} (set --data or PFTRACK_DATA)", file=sys.stderr)
+    root = data_folder(args.data)
+    if root is None:
         return 2
     # SORT beside pftrack when sort-track is installed (pip install --no-deps sort-track)
     trackers = ("pftrack", "sort") if importlib.util.find_spec("sort") else ("pftrack",)

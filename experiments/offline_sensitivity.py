@@ -14,14 +14,13 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import data_root, experiment_parser, tee_stdout
+from experiments._common import data_folder, experiment_parser, tee_stdout
 from pftrack._typing import F64
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import as_written, read_mot
@@ -103,9 +102,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     ap.add_argument("--setting", nargs="+", default=list(SETTINGS), choices=list(SETTINGS))
     args = ap.parse_args(argv)
-    root = data_root(args.data)
-    if not root.is_dir():
-        print(f"data folder not found: {root} (set --data or PFTRACK_DATA)", file=sys.stderr)
+    root = data_folder(args.data)
+    if root is None:
         return 2
     data = {}
     for name, (video, scale) in SEQUENCES.items():

@@ -62,7 +62,7 @@ import numpy as np
 import scipy.linalg
 
 from experiments import compare_trackers
-from experiments._common import data_root, experiment_parser, write_text
+from experiments._common import data_folder, experiment_parser, write_text
 from experiments.public_detections import BlackFrames
 from pftrack._typing import F64
 from pftrack.eval import SequenceScores, evaluate_sequence
@@ -353,9 +353,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0,
                     help="seed of pftrack's auto calibration (default: 0)")  # fmt: skip
     args = ap.parse_args(argv)
-    root = data_root(args.data)
-    if not root.is_dir():
-        print(f"data folder not found: {root} (set --data or PFTRACK_DATA)", file=sys.stderr)
+    root = data_folder(args.data)
+    if root is None:
         return 2
     unknown = [s for s in args.seq if s not in compare_trackers.SEQUENCES]
     if unknown:

@@ -43,15 +43,19 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import PETS, TUD, data_root, experiment_parser, tee_stdout
+from experiments._common import (
+    data_root,
+    experiment_parser,
+    no_video_folders,
+    tee_stdout,
+    video_folders,
+)
 from pftrack._typing import F64
 from pftrack.eval import SequenceScores, evaluate_sequence
 from pftrack.io.mot import as_written, group_by_frame, read_mot
 from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import BUSY_SCENES, make_busy_scene
 from pftrack.tracking import TrackerConfig, load_detections, track_frames
-
-NO_VIDEO = ("ADL-Rundle-6", "ETH-Sunnyday", "KITTI-17")
 
 
 class BlackFrames(Sequence[NDArray[np.uint8]]):
@@ -279,21 +283,13 @@ def run_all(
         out.append(s)
         print(line(name, s), flush=True)
 
-    for src in (PETS, TUD):
-        folder = data / src.name
-        if not folder.is_dir():
-            print(f"{src.name}: not found under {data}, skipped")
-            continue
+    for src, folder in video_folders(data):
         dets = load_detections(folder / "det.txt", src.scale * factor)
         video = FrameSource(folder / src.video)
         source = video if factor == 1 else Resized(video, factor)
         run = track_frames(source, detections=dets, config=config, rng=seed)
         report(src.name, read_mot(folder / "gt.txt"), run.rows, src.scale)
-    for name in NO_VIDEO:
-        folder = data / "mot15-gt" / name
-        if not folder.is_dir():
-            print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
-            continue
+    for name, folder in no_video_folders(data):
         frames = black_frames(folder, factor)
         dets = load_detections(folder / "det.txt", factor)
         with blank_frames_expected():

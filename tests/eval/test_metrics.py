@@ -11,6 +11,7 @@ import pytest
 from pftrack.cli import main
 from pftrack.eval import MotMetrics, evaluate_mot, format_metrics, iou_xywh
 from pftrack.io.mot import read_mot, write_mot
+from tests.reference import boxes as ref_boxes
 
 
 def rows(*items):
@@ -22,23 +23,11 @@ def rows(*items):
     return np.asarray(out, dtype=np.float64).reshape(-1, 10)
 
 
-def iou_loop(a, b):
-    """Straightforward reference IoU, one pair at a time."""
-    out = np.zeros((len(a), len(b)))
-    for i, (x0, y0, w0, h0) in enumerate(a):
-        for j, (x1, y1, w1, h1) in enumerate(b):
-            iw = max(0.0, min(x0 + w0, x1 + w1) - max(x0, x1))
-            ih = max(0.0, min(y0 + h0, y1 + h1) - max(y0, y1))
-            u = w0 * h0 + w1 * h1 - iw * ih
-            out[i, j] = iw * ih / u if u > 0 else 0.0
-    return out
-
-
 def test_iou_matches_loop():
     rng = np.random.default_rng(3)
     a = np.c_[rng.uniform(0, 50, (7, 2)), rng.uniform(0, 30, (7, 2))]
     b = np.c_[rng.uniform(0, 50, (5, 2)), rng.uniform(0, 30, (5, 2))]
-    np.testing.assert_allclose(iou_xywh(a, b), iou_loop(a, b), atol=1e-12)
+    np.testing.assert_allclose(iou_xywh(a, b), ref_boxes.iou_xywh(a, b), atol=1e-12)
     assert iou_xywh(np.zeros((0, 4)), b).shape == (0, 5)
 
 
@@ -365,7 +354,7 @@ def motmetrics_summary(gt, res, thr=0.5):
         for f in frames:
             g = gt[gt[:, 0] == f]
             r = res[res[:, 0] == f]
-            d = 1.0 - iou_loop(g[:, 2:6], r[:, 2:6])
+            d = 1.0 - ref_boxes.iou_xywh(g[:, 2:6], r[:, 2:6])
             d = np.where(d > 1.0 - thr, np.nan, d)
             acc.update(g[:, 1].astype(int).tolist(), r[:, 1].astype(int).tolist(), d, frameid=f)
         names = [

@@ -26,7 +26,8 @@ from pftrack.eval.sequences import read_seqinfo, result_file
 from pftrack.io.mot import read_mot, write_mot
 from tests.conftest import dataset
 from tests.eval.cases import perturbed, write_rows
-from tests.eval.test_metrics import iou_loop, random_case
+from tests.eval.test_metrics import random_case
+from tests.reference import boxes as ref_boxes
 
 CLEAR = ["mota", "motp", "idf1", "idp", "idr", "num_switches", "num_fragmentations",
          "mostly_tracked", "partially_tracked", "mostly_lost", "num_false_positives",
@@ -42,7 +43,7 @@ def motmetrics_overall(cases):
             acc = mm.MOTAccumulator(auto_id=False)
             for f in sorted(set(gt[:, 0].astype(int)) | set(res[:, 0].astype(int))):
                 g, r = gt[gt[:, 0] == f], res[res[:, 0] == f]
-                d = 1.0 - iou_loop(g[:, 2:6], r[:, 2:6])
+                d = 1.0 - ref_boxes.iou_xywh(g[:, 2:6], r[:, 2:6])
                 d = np.where(d > 0.5, np.nan, d)
                 acc.update(g[:, 1].astype(int).tolist(), r[:, 1].astype(int).tolist(), d, frameid=f)
             accs.append(acc)

@@ -19,6 +19,7 @@ from pftrack.cli import main
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
+from tests.io.encode import encode
 
 av = pytest.importorskip("av")
 
@@ -28,13 +29,8 @@ GOP = 10  # frames from one key frame to the next
 def _stream(path: Path, bframes: int = 0, form: str | None = "mpegts") -> Path:
     """40 frames of a walk, H.264 with a key frame every GOP frames."""
     scene = make_scene(n_frames=40, width=160, height=120, rng=0)
-    with av.open(str(path), "w", format=form) as out:
-        stream = out.add_stream("libx264", rate=25, options={"g": str(GOP), "bf": str(bframes)})
-        stream.width, stream.height, stream.pix_fmt = 160, 120, "yuv420p"
-        for frame in scene.frames:
-            out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
-        out.mux(stream.encode())
-    return path
+    options = {"g": str(GOP), "bf": str(bframes)}
+    return encode(path, scene.frames, 25, options=options, container=form)
 
 
 def _cut(source: Path, path: Path, skip: int) -> Path:

@@ -26,6 +26,7 @@ from pftrack.io.video import (
 )
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
+from tests.io.encode import encode
 from tests.io.streaming import serve_stream
 
 
@@ -681,13 +682,7 @@ def test_videos_of_every_container_still_open(
     frames = make_scene(n_frames=5, rng=0).frames
     path = tmp_path / f"v{suffix}"
     try:
-        with av.open(str(path), "w", format=container) as out:
-            stream = out.add_stream(codec, rate=25)
-            stream.width, stream.height = frames[0].shape[1], frames[0].shape[0]
-            stream.pix_fmt = "yuvj420p" if codec == "mjpeg" else "yuv420p"
-            for f in frames:
-                out.mux(stream.encode(av.VideoFrame.from_ndarray(f, format="bgr24")))
-            out.mux(stream.encode(None))
+        encode(path, frames, 25, codec=codec, container=container)
     except (av.error.FFmpegError, ValueError) as exc:  # an encoder this PyAV lacks
         pytest.skip(f"cannot write {codec} in {container}: {exc}")
     src = FrameSource(path)
@@ -793,15 +788,7 @@ def test_a_video_that_ends_before_its_header_says_warns_once(tmp_path: Path) -> 
 def turned_mp4(path: Path, frames: list[np.ndarray], degrees: int) -> Path:
     """An H.264 MP4 of `frames` whose display matrix turns them `degrees` counter-clockwise
     (FFmpeg's sense; a phone's portrait video), written with PyAV."""
-    with av.open(str(path), "w") as out:
-        stream = out.add_stream("libx264", rate=10)
-        stream.height, stream.width = frames[0].shape[:2]
-        stream.pix_fmt = "yuv420p"
-        stream.set_display_rotation(degrees)
-        for frame in frames:
-            out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
-        out.mux(stream.encode())
-    return path
+    return encode(path, frames, rotation=degrees)
 
 
 @pytest.mark.parametrize(("degrees", "clockwise"), [(90, 270), (180, 180), (270, 90), (0, 0)])
@@ -922,18 +909,10 @@ def _assert_same_pixels_as_default_capture(path: Path) -> None:
 def test_h264_file_frames_equal_the_default_capture(tmp_path: Path) -> None:
     path = tmp_path / "walk.mp4"
     scene = make_scene(n_frames=40, n_walkers=4, rng=1)
-    try:
-        out = av.open(str(path), "w")
-        stream = out.add_stream("libx264", rate=10)
+    try:  # B-frames and several key frames: reordering
+        encode(path, scene.frames, options={"bf": "2", "g": "12"})
     except (av.FFmpegError, ValueError) as error:  # an av build without x264
         pytest.skip(f"no H.264 encoder: {error}")
-    stream.height, stream.width = scene.frames[0].shape[:2]
-    stream.pix_fmt = "yuv420p"
-    stream.options = {"bf": "2", "g": "12"}  # B-frames and several key frames: reordering
-    for frame in scene.frames:
-        out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
-    out.mux(stream.encode())
-    out.close()
     _assert_same_pixels_as_default_capture(path)
 
 
@@ -1612,13 +1591,7 @@ def test_a_video_whose_first_frames_fail_is_read_from_the_first_that_decodes(
     if suffix == ".avi":
         path = scene.write_video(tmp_path / "walk.avi")  # MJPG: every frame a key frame
     else:
-        path = tmp_path / "walk.mp4"
-        with av.open(str(path), "w") as out:
-            stream = out.add_stream("libx264", rate=10, options={"g": "10", "bf": "0"})
-            stream.width, stream.height, stream.pix_fmt = 160, 120, "yuv420p"
-            for frame in scene.frames:
-                out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
-            out.mux(stream.encode())
+        path = encode(tmp_path / "walk.mp4", scene.frames, options={"g": "10", "bf": "0"})
     good = list(FrameSource(path))
     damaged = _damaged_start(path)
     source = FrameSource(damaged)

@@ -5,5 +5,6 @@ One module per wing: ``kernels`` (HSV bins, histograms, Bhattacharyya, resamplin
 (background model), ``refine`` (box refinement), ``blobs`` (the blob pass and
 the size model's kernels), ``smoothing`` (constant-velocity posterior),
 ``bridge`` (goal-directed recovery), ``mixture`` (stand/walk gap mixture), ``neighbours``
-(the `-nb` methods' neighbour search), ``text`` (MOTChallenge lines, Python's ``%``).
+(the `-nb` methods' neighbour search), ``text`` (MOTChallenge lines, Python's ``%``), ``boxes``
+(intersection and IoU, pair by pair).
 """

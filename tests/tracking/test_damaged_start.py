@@ -16,7 +16,6 @@ import warnings
 from collections.abc import Callable
 from pathlib import Path
 
-import av
 import numpy as np
 import pytest
 
@@ -29,6 +28,7 @@ from pftrack.io.video import FrameSource
 from pftrack.synthetic import make_scene
 from pftrack.tracking.run import track_frames, track_path
 from tests.detection.test_blocking import resaved
+from tests.io.encode import encode
 
 LEAD = 10  # frames up to the second key frame: as many as DARK_FRAMES
 assert LEAD >= DARK_FRAMES
@@ -38,12 +38,7 @@ def _damaged_start(tmp_path: Path) -> Path:
     """An H.264 walk whose first key frame is overwritten: frames 1-10 do not decode."""
     scene = make_scene(n_frames=40, width=160, height=120, rng=0)
     path = tmp_path / "walk.mp4"
-    with av.open(str(path), "w") as out:
-        stream = out.add_stream("libx264", rate=10, options={"g": str(LEAD), "bf": "0"})
-        stream.width, stream.height, stream.pix_fmt = 160, 120, "yuv420p"
-        for frame in scene.frames:
-            out.mux(stream.encode(av.VideoFrame.from_ndarray(frame, format="bgr24")))
-        out.mux(stream.encode())
+    encode(path, scene.frames, options={"g": str(LEAD), "bf": "0"})
     data = bytearray(path.read_bytes())
     at = data.index(b"mdat") + 4
     data[at : at + 400] = np.random.default_rng(1).bytes(400)
