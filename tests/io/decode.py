@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 import av
+import cv2
 import numpy as np
 
 
@@ -24,3 +25,16 @@ def decode(path: Path) -> tuple[Info, list[np.ndarray]]:
         ctx = stream.codec_context
         info = Info(ctx.name, ctx.pix_fmt, stream.average_rate)
     return info, frames
+
+
+def capture_frames(path: Path) -> list[np.ndarray]:
+    """Every frame of the video as ``cv2.VideoCapture`` reads it (OpenCV's own backend choice)."""
+    cap = cv2.VideoCapture(str(path))
+    frames = []
+    while True:
+        ok, frame = cap.read()
+        if not ok:
+            break
+        frames.append(frame)
+    cap.release()
+    return frames

@@ -26,6 +26,7 @@ from pftrack.io.video import (
 )
 from pftrack.synthetic import make_scene
 from tests.conftest import dataset
+from tests.io.decode import capture_frames
 from tests.io.encode import encode
 from tests.io.streaming import serve_stream
 
@@ -875,21 +876,9 @@ def test_an_image_of_another_size_in_a_folder_is_named(tmp_path: Path) -> None:
     assert len(src.frames_at([0, 1, 4])) == 3
 
 
-def _default_capture_frames(path: Path) -> list[np.ndarray]:
-    cap = cv2.VideoCapture(str(path))  # OpenCV's own choice of backend and decoder threads
-    frames = []
-    while True:
-        ok, frame = cap.read()
-        if not ok:
-            break
-        frames.append(frame)
-    cap.release()
-    return frames
-
-
 def _assert_same_pixels_as_default_capture(path: Path) -> None:
     """FrameSource decodes with one FFmpeg thread: every frame the same as OpenCV's default."""
-    want = _default_capture_frames(path)
+    want = capture_frames(path)
     src = FrameSource(path)
     got = list(src)
     assert len(got) == len(want) > 0

@@ -39,8 +39,9 @@ def bootstrap_frames(
     frames : iterable of (H, W, 3) uint8 arrays
         The video. ``"spread"`` needs ``len(frames)`` to choose its stride, and falls back to
         ``"first"`` when `frames` has no length. It reads a `pftrack.io.video.FrameSource`
-        with its ``frames_at`` (a folder: only the chosen images; a file: one pass that
-        decodes every frame, as it must, but converts only the chosen ones), indexes a
+        with its ``frames_at`` (a folder: only the chosen images; an MJPEG file: only the
+        chosen frames' packets; another file: one pass that decodes every frame, as it must,
+        but converts only the chosen ones), indexes a
         sequence, and otherwise iterates `frames` once up to the last chosen frame.
     n : int
         How many frames to return (fewer if the video is shorter); 0 returns none.

@@ -50,6 +50,7 @@ from pftrack._check import brief, number, path_arg, real, shown
 from pftrack._text import counted
 from pftrack._typing import PathLike, RealLike
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
+from pftrack.io.packets import INTRA_FOURCCS, PACKET_PASS_MIN_PIXELS, intra_frames_at
 
 __all__ = [
     "VIDEO_SUFFIXES",
@@ -2010,7 +2011,10 @@ class FrameSource:
         images; a video file is decoded in order (seeking is not frame-exact in every
         container, and costs a decode from the previous key frame anyway), but the frames in
         between are only grabbed (``VideoCapture.grab``: decoded, not converted to BGR or
-        copied to Python). Indices past the last frame are left out.
+        copied to Python). An intra-only file (MJPEG) whose undecoded frames would cost more
+        than importing PyAV decodes only the wanted frames, each from its own packet, with
+        PyAV (:mod:`pftrack.io.packets`: the same pixels; a 1280x720 AVI's 30 of 300 frames in
+        0.13-0.20 s of CPU, not 0.67-0.72 s). Indices past the last frame are left out.
 
         With `split`, a file's pass runs as two halves at once, the second on a thread of its
         own from a seek to a wanted frame near the middle (for an idle second core: the same
@@ -2067,6 +2071,9 @@ class FrameSource:
         """:meth:`frames_at` of a video file, in one pass of grabs (two with `split`)."""
         cap = _file_capture(str(self.path))
         try:
+            fast = self._intra_frames_at(cap, wanted)
+            if fast is not None:
+                return [keep(self._resize(frame)) for frame in fast]
             middle = wanted[len(wanted) // 2]
             if not split or len(wanted) < 4 or middle < 2:
                 return self._read_at(cap, 0, wanted, prepare=keep)[0]
@@ -2089,6 +2096,46 @@ class FrameSource:
             return head + rest
         finally:
             cap.release()
+
+    def _intra_frames_at(
+        self, cap: cv2.VideoCapture, wanted: list[int]
+    ) -> list[NDArray[np.uint8]] | None:
+        """The raw frames at `wanted` of an intra-only file (MJPEG), decoding only them; or None.
+
+        :func:`pftrack.io.packets.intra_frames_at`, for a file whose frames are as its header
+        counts them (no damage, no black stand-ins, no turn) and the pixels it leaves undecoded
+        pay for importing PyAV. Its first frame must equal, pixel for pixel, the one a capture
+        of its own reads; else None (the OpenCV pass reads). `cap` is only asked its codec and
+        frame size, and left where it stands.
+        """
+        if (
+            _fourcc(cap) not in INTRA_FOURCCS
+            or not self.count_known
+            or self.rotation
+            or self.lead_black
+            or self._broken is not None
+            or self.path is None
+            or wanted[-1] >= self.n_frames
+        ):
+            return None
+        left = (self.n_frames - len(wanted)) * cap.get(cv2.CAP_PROP_FRAME_WIDTH)
+        if left * cap.get(cv2.CAP_PROP_FRAME_HEIGHT) < PACKET_PASS_MIN_PIXELS:
+            return None
+        frames = intra_frames_at(str(self.path), sorted({0, *wanted}), self.n_frames, self._stop)
+        if frames is None or len(frames) != len(wanted) + (wanted[0] != 0):
+            return None
+        check = _file_capture(str(self.path))
+        try:
+            ok, first = check.read()
+        finally:
+            check.release()
+        if not ok or not np.array_equal(first, frames[0]):
+            return None
+        return frames if wanted[0] == 0 else frames[1:]
+
+    def _stop(self) -> bool:
+        """Whether :meth:`stop` was called (polled by a reader that takes a callable)."""
+        return self.stopped
 
     def _read_at(
         self,
