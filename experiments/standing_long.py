@@ -4,7 +4,8 @@ Each scene is ``pftrack.synthetic.make_scene(n_frames, n_walkers=5, rng=seed)`` 
 walker (id 99, drawn from a generator seeded ``1000 + seed``) who walks in from the left at
 3 px a frame for 50 frames, stands ``--stand`` frames (legs still), then walks out; the video
 runs on ``stand + 200`` frames after, so the stander is in under half of the frames the
-``spread`` bootstrap's median reads. Tracked by ``track_frames`` (every default, seed 0),
+``spread`` bootstrap's median reads. Tracked by ``track_frames`` (every default but
+``TrackerConfig.hold_frames``: ``--hold-frames``, 1000; 0 is the default detector; seed 0),
 scored with ``evaluate_sequence``; the last column counts the standing frames whose truth box
 a written row matches at IoU >= 0.5.
 
@@ -68,6 +69,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     p = experiment_parser("standing_long", __doc__)
     p.add_argument("--seeds", default="0-5", help="make_scene seeds, e.g. 0-5 or 2,7")
     p.add_argument("--stand", default="300,600", help="standing lengths in frames")
+    p.add_argument(
+        "--hold-frames", type=int, default=1000, help="TrackerConfig.hold_frames (0: off)"
+    )
     args = p.parse_args(argv)
     try:
         seeds, stands = seed_range(args.seeds), seed_range(args.stand)
@@ -75,15 +79,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         p.error(str(exc))
     from pftrack.eval import evaluate_sequence
     from pftrack.io.mot import as_written
-    from pftrack.tracking import track_frames
+    from pftrack.tracking import TrackerConfig, track_frames
 
+    config = TrackerConfig(hold_frames=args.hold_frames)
     scores, found, total = [], 0, 0
     with tee_stdout(args.out / "standing_long.txt"):
         print("stand seed frames   MOTA   IDF1   HOTA  stander found")
         for stand in stands:
             for seed in seeds:
                 scene, span = stand_scene(seed, stand)
-                rows = np.asarray(as_written(track_frames(scene.frames, show_progress=False).rows))
+                run = track_frames(scene.frames, config=config, show_progress=False)
+                rows = np.asarray(as_written(run.rows))
                 s = evaluate_sequence(scene.truth, rows)
                 v = (100 * s.mot.mota, 100 * s.mot.idf1, 100 * s.hota.hota)
                 k = stander_found(rows, scene.truth, span)

@@ -107,3 +107,18 @@ def test_a_person_who_stops_for_long_stays_detected():
     assert sum(held) == 400, sum(held)
     unheld = _stander_found(0)  # the detector before: lost for the last ~150 frames
     assert sum(unheld[-100:]) == 0, sum(unheld)
+
+
+def test_the_hold_is_off_by_default_and_reaches_the_detector_from_the_tracker_config():
+    # off by default (it cost PETS09 re-encoded as JPEG 8 IDF1: docs/detection.md); a
+    # tracker's TrackerConfig.hold_frames is its built-in detector's
+    from pftrack.tracking import MultiObjectTracker, TrackerConfig
+
+    assert PaperConfig().hold_frames == 0 and TrackerConfig().hold_frames == 0
+    for hold in (0, 700):
+        tracker = MultiObjectTracker(TrackerConfig(hold_frames=hold))
+        assert tracker._ensure_detector().config.hold_frames == hold
+    with pytest.raises(ValueError, match="hold_frames 5 needs detector 'paper'"):
+        TrackerConfig(hold_frames=5, detector="mog2")
+    with pytest.raises(TypeError, match="hold_frames"):
+        TrackerConfig(hold_frames=2.5)  # type: ignore[arg-type]

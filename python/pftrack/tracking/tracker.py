@@ -321,6 +321,8 @@ class MultiObjectTracker:
         if self._detector is None:
             size = self.config.open_size
             extra: dict[str, Any] = {} if size is None else {"open_size": size}
+            if self.config.hold_frames:
+                extra["hold_frames"] = self.config.hold_frames
             if self.config.detector in SEEDED_DETECTORS:
                 extra["seed"] = int(self._rng.integers(2**63))
             self._detector = make_detector(self.config.detector, hsv=self.config.binning, **extra)
