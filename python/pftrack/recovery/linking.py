@@ -11,7 +11,6 @@ three columns.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
@@ -34,6 +33,7 @@ from pftrack._check import (
 )
 from pftrack._text import counted
 from pftrack._typing import F64, PathLike
+from pftrack._warn import warn
 from pftrack.boxes import _to_cxcywh
 from pftrack.particle_filter.colour import (
     bhattacharyya_distance,
@@ -158,7 +158,7 @@ def gate_for_rows(config: LinkConfig, rows: ArrayLike) -> LinkConfig:
     )
     if stray.any():
         k = int(np.flatnonzero(stray)[0])
-        warnings.warn(
+        warn(
             f"{int(stray.sum())} row(s) reach far past the others (the first: frame "
             f"{a[k, 0]:g}, id {a[k, 1]:g}, right and bottom edges {edges[0][k]:g}, "
             f"{edges[1][k]:g} px; 99 % of the rows within {bulk[0]:g}, {bulk[1]:g}): left out "
@@ -519,7 +519,7 @@ def link_tracklets(
     if len(rows) == 0:
         return rows, {}
     if frames is not None and len(frames) < rows[:, 0].max():
-        warnings.warn(
+        warn(
             f"link_tracklets: frames holds {len(frames)} frames, the rows reach frame "
             f"{int(rows[:, 0].max())}: fragment ends after frame {len(frames)} are linked "
             "without the colour term",
@@ -780,7 +780,7 @@ def _warn_normalised(rows: F64, path: PathLike) -> None:
         return
     right, bottom = np.max(rows[:, 2] + rows[:, 4]), np.max(rows[:, 3] + rows[:, 5])
     if max(right, bottom) <= NORMALISED_REACH:
-        warnings.warn(
+        warn(
             f"{path}: every box lies within {right:.3g} x {bottom:.3g} (its rightmost and lowest "
             "edges): normalised coordinates? pftrack works in pixels (its linking gate, boxes "
             "written with 2 decimals): give pixels (x times the image width, y times its height)",
@@ -800,7 +800,7 @@ def _warn_padded_flags(rows: F64, path: PathLike) -> None:
     n = int(filled_mask(rows).sum()) if len(rows) else 0
     fields = first_row_fields(path) if n else 10
     if n and fields < 10:
-        warnings.warn(
+        warn(
             f"{path}: {n} row(s) have 1 in column 8 and {fields} columns (the missing ones "
             "padded with -1): they carry pftrack's mark of a filled row (column 8 = 1, columns "
             "9-10 = -1), so in the output the filled rows cannot be told from them by that mark",

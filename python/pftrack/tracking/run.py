@@ -6,7 +6,6 @@ import itertools
 import os
 import sys
 import time
-import warnings
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import closing
@@ -113,7 +112,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     path = path_arg(path, "load_detections: path")
     rows = read_mot(path, what="detection file")
     if len(rows) and first_row_fields(path) == 6:
-        warnings.warn(
+        warn(
             f"{path}: no score column (6 fields a row): every detection scores 1, so "
             "birth_score and min_conf gate none of them",
             stacklevel=2,
@@ -121,7 +120,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     tracked = rows[:, 1] != -1  # detection files hold id -1 (MOTChallenge's "no id")
     if tracked.any():
         k = int(np.argmax(tracked))
-        warnings.warn(
+        warn(
             f"{path}: {int(tracked.sum())} of {len(rows)} rows have a track id, not -1 (the "
             f"first: id {rows[k, 1]:g} in frame {int(rows[k, 0])}): a tracks file? Read as "
             "detections: the ids are ignored, the tracker makes its own",
@@ -129,7 +128,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
         )
     flat = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
     if flat.any():
-        warnings.warn(
+        warn(
             f"{path}: {int(flat.sum())} detection(s) with zero width or height left out (the "
             f"first in frame {int(rows[np.argmax(flat), 0])})",
             stacklevel=2,
@@ -375,7 +374,7 @@ def track_frames(
     if detections:
         unused = [f for f in detections if f > n and len(detections[f])]
         if unused:  # the video ended early (a truncated file): say what was not tracked
-            warnings.warn(
+            warn(
                 f"detections of {len(unused)} frames after the video's last frame {n} were not "
                 f"used (frames {min(unused)}-{max(unused)})",
                 stacklevel=1 + tracker._caller_depth,
@@ -649,7 +648,7 @@ def _check_layout(
     as_xyxy = (d[:, 2] > d[:, 0]) & (d[:, 3] > d[:, 1]) & (d[:, 2] <= cols) & (d[:, 3] <= rows)
     right, bottom = float(np.max(d[:, 0] + d[:, 2])), float(np.max(d[:, 1] + d[:, 3]))
     if len(d) >= SMALL_LAYOUT_BOXES and right < 0.5 * cols and bottom < 0.5 * rows:
-        warnings.warn(
+        warn(
             f"all {len(d)} detection boxes lie in the top-left {right:.3g}x{bottom:.3g} pixels "
             f"of the {cols}x{rows} frames: are they in a smaller frame's pixels? (scale them "
             "with --det-scale / load_detections(scale=...))",
