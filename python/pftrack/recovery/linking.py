@@ -513,7 +513,7 @@ def link_tracklets(
             "link_tracklets: frames must be a sequence indexable by frame - 1 (a list, an "
             f"array, a FrameSequence) or None, got {type(frames).__name__}"
         )
-    rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
+    rows = np.array(check_rows(tracks, "link_tracklets", "tracks"), dtype=np.float64, copy=True)
     check_unique(rows, who="link_tracklets")  # a track seen twice has no velocity to link
     check_tracked(rows, who="link_tracklets")
     if len(rows) == 0:
@@ -548,7 +548,7 @@ def link_tracklets(
     return rows, mapping
 
 
-def check_rows(rows: ArrayLike, what: str) -> F64:
+def check_rows(rows: ArrayLike, what: str, name: str = "rows") -> F64:
     """The rows as an ``(M, 10)`` float64 array, checked; ValueError/TypeError naming the problem.
 
     Their layout first, as every function taking rows checks it (:func:`pftrack._check.
@@ -556,9 +556,10 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
     array without values (``[]``) no rows; then the values.
     Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, every
     value finite, and the boxes what :func:`pftrack.io.mot.read_mot` reads (:func:`check_boxes`:
-    no negative width or height, no value beyond ±1e9 px). `what` names the caller in messages.
+    no negative width or height, no value beyond ±1e9 px). `what` names the caller in messages,
+    `name` the argument whose layout or type is wrong (``link_tracklets``' ``tracks``).
     """
-    a = mot_rows(rows, what)
+    a = mot_rows(rows, what, name)
     f, i = a[:, 0], a[:, 1]
     finite = np.isfinite(a)
     if not finite.all():
