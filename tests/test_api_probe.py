@@ -78,17 +78,23 @@ def _takes_none(p: inspect.Parameter) -> bool:
 
 def _wrong(p: inspect.Parameter) -> list[tuple[str, object]]:
     """The wrong values a user gives for `p`, by the type of its default."""
-    d = p.default
+    return _wrong_for(p.default, text=isinstance(p.default, str), none=_takes_none(p))
+
+
+def _wrong_for(good: object, *, text: bool, none: bool) -> list[tuple[str, object]]:
+    """The wrong values for an argument whose good value is `good`: text unless it takes
+    `text`, None unless it takes `none`, a list for a number, a bool for an int, an int for a
+    flag."""
     out: list[tuple[str, object]] = []
-    if not isinstance(d, str):
+    if not text:
         out.append(("text", "x"))
-    if not _takes_none(p):
+    if not none:
         out.append(("None", None))
-    if isinstance(d, (int, float)) and not isinstance(d, bool):
+    if isinstance(good, (int, float)) and not isinstance(good, bool):
         out.append(("list", [1, 2]))
-    if isinstance(d, int) and not isinstance(d, bool):
+    if isinstance(good, int) and not isinstance(good, bool):
         out.append(("bool", True))
-    if isinstance(d, bool):
+    if isinstance(good, bool):
         out.append(("int", 2))
     return out
 
@@ -308,20 +314,9 @@ CALLS: dict[str, tuple[Callable[..., Any], Callable[[Path], tuple[Callable[..., 
 def _call_wrong(good: object, p: inspect.Parameter) -> list[tuple[str, object]]:
     """The wrong values a user gives for `p`, whose good value is `good` (its default, or the
     value the probe gives a required argument)."""
-    text = str(p.annotation)
-    takes_text = isinstance(good, (str, Path)) or "str" in text or "PathLike" in text
-    out: list[tuple[str, object]] = []
-    if not takes_text:
-        out.append(("text", "x"))
-    if "None" not in text:
-        out.append(("None", None))
-    if isinstance(good, (int, float)) and not isinstance(good, bool):
-        out.append(("list", [1, 2]))
-    if isinstance(good, int) and not isinstance(good, bool):
-        out.append(("bool", True))
-    if isinstance(good, bool):
-        out.append(("int", 2))
-    return out
+    hint = str(p.annotation)
+    text = isinstance(good, (str, Path)) or "str" in hint or "PathLike" in hint
+    return _wrong_for(good, text=text, none="None" in hint)
 
 
 CALL_WRONG = [
