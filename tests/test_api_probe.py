@@ -27,6 +27,7 @@ import pytest
 import pftrack
 from pftrack import batch, detection, particle_filter, recovery, tracking
 from pftrack.detection.size_model import SizeModelConfig
+from pftrack.io.video import FrameSource
 
 _REF = np.ones(110)
 _BOX = (30.0, 20.0, 10.0, 20.0)
@@ -77,17 +78,23 @@ def _takes_none(p: inspect.Parameter) -> bool:
 
 def _wrong(p: inspect.Parameter) -> list[tuple[str, object]]:
     """The wrong values a user gives for `p`, by the type of its default."""
-    d = p.default
+    return _wrong_for(p.default, text=isinstance(p.default, str), none=_takes_none(p))
+
+
+def _wrong_for(good: object, *, text: bool, none: bool) -> list[tuple[str, object]]:
+    """The wrong values for an argument whose good value is `good`: text unless it takes
+    `text`, None unless it takes `none`, a list for a number, a bool for an int, an int for a
+    flag."""
     out: list[tuple[str, object]] = []
-    if not isinstance(d, str):
+    if not text:
         out.append(("text", "x"))
-    if not _takes_none(p):
+    if not none:
         out.append(("None", None))
-    if isinstance(d, (int, float)) and not isinstance(d, bool):
+    if isinstance(good, (int, float)) and not isinstance(good, bool):
         out.append(("list", [1, 2]))
-    if isinstance(d, int) and not isinstance(d, bool):
+    if isinstance(good, int) and not isinstance(good, bool):
         out.append(("bool", True))
-    if isinstance(d, bool):
+    if isinstance(good, bool):
         out.append(("int", 2))
     return out
 
@@ -155,6 +162,28 @@ def test_a_wrong_type_is_refused_in_one_line_naming_the_argument(
     with pytest.raises((TypeError, ValueError)) as e:
         _make(name, **{argument: value})
     _one_line_naming(e.value, argument)
+    if dataclasses.is_dataclass(CLASSES[name][0]) and name not in UNNAMED:
+        assert name in str(e.value), str(e.value)  # a config's messages name it
+
+
+#: configs whose messages name the setting but not the class (``filter must be a FilterConfig``,
+#: ``alpha must be a number``): found by this probe, not mended yet (SizeModelConfig's are)
+UNNAMED = {"TrackerConfig", "BlobConfig", "PaperConfig", "TrackOptions", "RecoverOptions",
+           "SmoothOptions"}  # fmt: skip
+
+
+@pytest.mark.parametrize("name", sorted(UNNAMED))
+def test_the_configs_not_named_yet_are_still_unnamed(name: str) -> None:
+    """Strict, as an xfail: a config mended to name itself leaves :data:`UNNAMED`."""
+    cls, args = CLASSES[name]
+    said = []
+    for p in _settings(cls):
+        for _, value in _wrong(p):
+            try:
+                _make(name, **{p.name: value})
+            except (TypeError, ValueError) as e:
+                said.append(str(e))
+    assert said and any(name not in message for message in said)
 
 
 @pytest.mark.parametrize(("name", "argument", "value"), TAKEN)
@@ -214,3 +243,136 @@ def test_a_batch_entry_refuses_a_wrong_type_before_any_work(
         BATCH[name](inputs[name], tmp_path / "out", **{argument: value})
     _one_line_naming(e.value, argument)
     assert not (tmp_path / "out").exists()
+
+
+# ---- the calls users make: every argument, required ones too -------------------------------
+
+_FRAME = np.random.default_rng(0).integers(0, 256, (48, 64, 3)).astype(np.uint8)  # not blank
+# MOT rows: one track over frames 1-3 and 6-8 (a hole of 2), [frame, id, left, top, w, h, conf]
+_ROWS = np.array([[f, 1, 10.0 + f, 10.0, 5.0, 9.0, 1.0] for f in (1, 2, 3, 6, 7, 8)])
+_SEG_A = np.array([[1, 10.0, 10.0], [2, 11.0, 10.0], [3, 12.0, 10.0]])
+_SEG_B = np.array([[6, 15.0, 10.0], [7, 16.0, 10.0], [8, 17.0, 10.0]])
+
+
+def _updated() -> pftrack.Tracker:
+    tracker = pftrack.Tracker()
+    tracker.update(np.zeros((0, 6)), _FRAME)
+    return tracker
+
+
+def _writer(tmp: Path) -> pftrack.VideoWriter:
+    return pftrack.VideoWriter(tmp / "w.mp4", 10.0)
+
+
+def _renderer(tmp: Path) -> pftrack.TrackRenderer:
+    return pftrack.TrackRenderer(tmp / "r.mp4", 10.0, threaded=False)
+
+
+def _folder(tmp: Path) -> type[FrameSource]:
+    """FrameSource, once `tmp`/imgs holds two frames for it."""
+    import cv2
+
+    folder = tmp / "imgs"
+    folder.mkdir(exist_ok=True)
+    for i in (1, 2):
+        cv2.imwrite(str(folder / f"{i:06d}.png"), _FRAME)
+    return FrameSource
+
+
+#: name -> (what its signature is read from; tmp -> the callable, and what to abort after;
+#: tmp -> its good arguments by name)
+CALLS: dict[str, tuple[Callable[..., Any], Callable[[Path], tuple[Callable[..., Any], Any]],
+                       Callable[[Path], dict[str, Any]]]] = {
+    "Tracker.update": (pftrack.Tracker.update, lambda tmp: (_updated().update, None),
+                       lambda tmp: {"dets": np.zeros((0, 6)), "frame": _FRAME}),
+    "FrameSource": (FrameSource, lambda tmp: (_folder(tmp), None),
+                    lambda tmp: {"source": tmp / "imgs", "scale": 1.0, "fps": 10.0}),
+    "VideoWriter": (pftrack.VideoWriter, lambda tmp: (pftrack.VideoWriter, None),
+                    lambda tmp: {"path": tmp / "v.mp4", "fps": 10.0, "crf": 23,
+                                 "preset": "ultrafast"}),
+    "VideoWriter.write": (pftrack.VideoWriter.write, lambda tmp: ((w := _writer(tmp)).write, w),
+                          lambda tmp: {"frame": _FRAME}),
+    "TrackRenderer": (pftrack.TrackRenderer, lambda tmp: (pftrack.TrackRenderer, None),
+                      lambda tmp: {"path": tmp / "v.mp4", "fps": 10.0, "trail": 40,
+                                   "threaded": False, "queue_size": 8, "preset": "ultrafast"}),
+    "TrackRenderer.add": (pftrack.TrackRenderer.add,
+                          lambda tmp: ((r := _renderer(tmp)).add, r),
+                          lambda tmp: {"frame": _FRAME, "tracks": []}),
+    "fill_gaps": (pftrack.fill_gaps, lambda tmp: (pftrack.fill_gaps, None),
+                  lambda tmp: {"tracks": _ROWS, "method": "linear", "max_gap": 30, "seed": 0,
+                               "combine": True}),
+    "recover_gap": (pftrack.recover_gap, lambda tmp: (pftrack.recover_gap, None),
+                    lambda tmp: {"segment_a": _SEG_A, "segment_b": _SEG_B, "method": "linear"}),
+    "recover_gaps": (pftrack.recover_gaps, lambda tmp: (pftrack.recover_gaps, None),
+                     lambda tmp: {"gaps": [(_SEG_A, _SEG_B)], "method": "linear", "seed": 0,
+                                  "combine": True}),
+    "smooth_tracks": (pftrack.smooth_tracks, lambda tmp: (pftrack.smooth_tracks, None),
+                      lambda tmp: {"rows": _ROWS, "fill_method": "linear", "seed": 0}),
+}  # fmt: skip
+
+
+def _call_wrong(good: object, p: inspect.Parameter) -> list[tuple[str, object]]:
+    """The wrong values a user gives for `p`, whose good value is `good` (its default, or the
+    value the probe gives a required argument)."""
+    hint = str(p.annotation)
+    text = isinstance(good, (str, Path)) or "str" in hint or "PathLike" in hint
+    return _wrong_for(good, text=text, none="None" in hint)
+
+
+CALL_WRONG = [
+    pytest.param(name, p.name, value, id=f"{name}({p.name}={kind})")
+    for name, (of, _, goods) in CALLS.items()
+    for p in inspect.signature(of).parameters.values()
+    if p.name in goods(Path())
+    for kind, value in _call_wrong(goods(Path())[p.name], p)
+]
+
+
+def test_the_call_probe_covers_every_call_and_its_required_arguments() -> None:
+    probed = {(p.values[0], p.values[1]) for p in CALL_WRONG}
+    assert {name for name, _ in probed} == set(CALLS)
+    for required in [("Tracker.update", "frame"), ("FrameSource", "source"),
+                     ("VideoWriter", "fps"), ("TrackRenderer", "path"), ("fill_gaps", "tracks"),
+                     ("recover_gap", "segment_b"), ("smooth_tracks", "rows")]:  # fmt: skip
+        assert required in probed
+
+
+@pytest.mark.parametrize(("name", "argument", "value"), CALL_WRONG)
+def test_a_call_refuses_a_wrong_type_in_one_line_naming_the_argument(
+    name: str, argument: str, value: object, tmp_path: Path
+) -> None:
+    _, make, goods = CALLS[name]
+    call, opened = make(tmp_path)
+    kwargs = goods(tmp_path)
+    kwargs[argument] = value
+    try:
+        with pytest.raises((TypeError, ValueError)) as e, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            call(**kwargs)
+    finally:
+        if opened is not None:
+            opened.abort()
+    _one_line_naming(e.value, argument)
+
+
+@pytest.mark.parametrize("name", list(CALLS))
+def test_a_call_takes_its_good_arguments(name: str, tmp_path: Path) -> None:
+    _, make, goods = CALLS[name]
+    call, opened = make(tmp_path)
+    made = call(**goods(tmp_path))
+    for thing in (made, opened):
+        for method in ("abort", "close"):
+            if hasattr(thing, method):
+                getattr(thing, method)()
+                break
+
+
+def test_finalize_after_a_refused_update_gives_the_frames_before() -> None:
+    """``finalize`` takes no argument: after a wrong type refused by ``update`` (refused
+    before the frame is taken), it still gives the run's rows, and the run goes on."""
+    tracker = _updated()
+    with pytest.raises(TypeError, match="frame"):
+        tracker.update(np.zeros((0, 6)), None)  # type: ignore[arg-type]
+    tracker.update(np.zeros((0, 6)), _FRAME)
+    with pytest.warns(RuntimeWarning, match="no track over 2 frames"):
+        assert tracker.finalize().shape == (0, 10)

@@ -109,3 +109,35 @@ def test_graph_sees_the_package() -> None:
     assert "pftrack.tracking" in graph["pftrack.cli.track"] or any(
         t.startswith("pftrack.tracking") for t in graph["pftrack.cli.track"]
     )
+
+
+def _direct_warnings(path: Path) -> list[int]:
+    """Lines of `path` that call ``warnings.warn`` (or ``warn_explicit``) or import them."""
+    lines = []
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if (
+            isinstance(node, ast.Attribute)
+            and isinstance(node.value, ast.Name)
+            and node.value.id == "warnings"
+            and node.attr in ("warn", "warn_explicit")
+        ) or (
+            isinstance(node, ast.ImportFrom)
+            and node.module == "warnings"
+            and any(a.name in ("warn", "warn_explicit") for a in node.names)
+        ):
+            lines.append(node.lineno)
+    return lines
+
+
+def test_every_warning_goes_through_pftrack_warn() -> None:
+    """``warnings.warn`` called directly escapes :class:`pftrack._warn.Held`: a detector's
+    warning raised half-way through ``update`` under ``-W error`` (check_detections'), or
+    named a line inside pftrack. Only ``pftrack._warn`` calls it."""
+    found = {
+        f"{path.relative_to(ROOT.parent)}:{line}"
+        for path in ROOT.rglob("*.py")
+        if path != ROOT / "_warn.py"
+        for line in _direct_warnings(path)
+    }
+    assert not found, sorted(found)
+    assert _direct_warnings(ROOT / "_warn.py")  # the check sees a call

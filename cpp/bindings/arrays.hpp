@@ -51,17 +51,33 @@ inline void check_bgr_image(const py::array& a, const char* fn, const char* what
         fail(fn, std::string(what) + " pixels must be packed (use numpy.ascontiguousarray)");
 }
 
+/// `obj` as a NumPy array, or a one-line TypeError naming `what` and what it is (`expected`:
+/// the array it should be, after "expected a numpy.ndarray ").
+inline py::array ndarray(const py::handle& obj, const char* fn, const char* what,
+                         const std::string& expected) {
+    if (!py::isinstance<py::array>(obj))
+        throw py::type_error(std::string(fn) + ": " + what + " is " +
+                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>() +
+                             ", expected a numpy.ndarray " + expected);
+    return py::reinterpret_borrow<py::array>(obj);
+}
+
 /// `obj` as a NumPy array checked by check_bgr_image; anything else (a list, None, a PIL
 /// image) is a one-line TypeError naming `what`, where a `py::array` parameter gave pybind11's
 /// list of signatures.
 inline py::array bgr_image(const py::handle& obj, const char* fn, const char* what) {
-    if (!py::isinstance<py::array>(obj))
-        throw py::type_error(std::string(fn) + ": " + what + " is " +
-                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>() +
-                             ", expected a numpy.ndarray (H, W, 3) uint8 (BGR, as cv2 reads it)");
-    py::array a = py::reinterpret_borrow<py::array>(obj);
+    py::array a = ndarray(obj, fn, what, "(H, W, 3) uint8 (BGR, as cv2 reads it)");
     check_bgr_image(a, fn, what);
     return a;
+}
+
+/// `obj` as a NumPy array for the mask-like argument `what` of shape `shape` (a mask "(H, W)",
+/// a structuring element "(kh, kw)"); anything else (a list, None) is a one-line TypeError
+/// naming `what`, where a `py::array` parameter gave pybind11's list of signatures. Its dtype,
+/// shape and layout are the caller's to check (check_mask, check_mask_dtype).
+inline py::array mask_array(const py::handle& obj, const char* fn, const char* what = "mask",
+                            const char* shape = "(H, W)") {
+    return ndarray(obj, fn, what, std::string(shape) + " uint8 or bool");
 }
 
 /// A mask's dtype: uint8 or bool (named in the message only on failure). A wrong dtype is a

@@ -41,11 +41,12 @@ void require_positive(double v, const char* fn, const char* what) {
 void register_blobs(py::module_& m) {
     m.def(
         "blob_boxes",
-        [](const py::array& mask, double min_area, double max_area, double min_aspect,
+        [](const py::object& mask_in, double min_area, double max_area, double min_aspect,
            double max_aspect, double min_fill, double person_aspect,
            std::optional<Eigen::Ref<const RowMatrixXd>> size_lines, double split_ratio,
            double split_max_height, double merge_slack, double split_valley) {
             const char* fn = "blob_boxes";
+            const py::array mask = bind::mask_array(mask_in, fn);
             require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
             bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);  // uint8 or bool, packed
             require(std::isfinite(min_area) && std::isfinite(max_area) && 0.0 <= min_area &&
@@ -120,9 +121,10 @@ void register_blobs(py::module_& m) {
 
     m.def(
         "extend_legs",
-        [](const py::array& mask, Eigen::Ref<const RowMatrixXd> boxes,
+        [](const py::object& mask_in, Eigen::Ref<const RowMatrixXd> boxes,
            Eigen::Ref<const RowMatrixXd> size_lines, double min_height, double row_fill) {
             const char* fn = "extend_legs";
+            const py::array mask = bind::mask_array(mask_in, fn);
             require(mask.ndim() == 2, fn, "mask must be a (H, W) array");
             bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);  // uint8 or bool, packed
             std::vector<BlobRect> b = to_rects(boxes, fn);

@@ -57,8 +57,10 @@ using MaskPass = void (*)(const std::uint8_t*, Index, std::uint8_t*, std::uint8_
                           const std::vector<ElementRow>&, MorphScratch&);
 
 /// `pass` of a (H, W) uint8/bool mask by a structuring element, checked, into a new mask.
-py::array_t<std::uint8_t> mask_pass(const py::array& mask, const py::array& element,
+py::array_t<std::uint8_t> mask_pass(const py::object& mask_in, const py::object& element_in,
                                     const char* fn, MaskPass pass) {
+    const py::array mask = bind::mask_array(mask_in, fn);
+    const py::array element = bind::mask_array(element_in, fn, "element", "(kh, kw)");
     if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
         fail(fn, "mask must be a non-empty (H, W) array");
     bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
@@ -138,10 +140,12 @@ void register_detection(py::module_& m) {
             "candidates where != 0 are not learnt.")
         .def(
             "blend",
-            [](BackgroundModel& self, const py::object& frame_in, py::array mask, double rate) {
+            [](BackgroundModel& self, const py::object& frame_in, const py::object& mask_in,
+               double rate) {
                 const char* fn = "BackgroundModel.blend";
                 const bind::InUse busy(&self, fn);
                 const py::array frame = bind::bgr_image(frame_in, fn, "frame");
+                const py::array mask = bind::mask_array(mask_in, fn);
                 check_frame_and_mask(self, frame, mask, fn);
                 const auto* src = static_cast<const std::uint8_t*>(frame.data());
                 const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
@@ -182,12 +186,13 @@ void register_detection(py::module_& m) {
             "background *= gain (float32, clipped to 255): follow a global illumination change.")
         .def(
             "edge_support",
-            [](const BackgroundModel& self, const py::object& frame_in, py::array mask,
+            [](const BackgroundModel& self, const py::object& frame_in, const py::object& mask_in,
                py::array_t<double, py::array::c_style | py::array::forcecast> boxes,
                const std::string& statistic) {
                 const char* fn = "BackgroundModel.edge_support";
                 const bind::InUse busy(&self, fn, true);  // reads only
                 const py::array frame = bind::bgr_image(frame_in, fn, "frame");
+                const py::array mask = bind::mask_array(mask_in, fn);
                 require(statistic == "ratio" || statistic == "vote", fn,
                         "statistic is '" + statistic + "', expected 'ratio' or 'vote'");
                 const auto stat =
@@ -422,8 +427,9 @@ void register_detection(py::module_& m) {
 
     m.def(
         "mask_bins",
-        [](const BinnedImage& binned, py::array mask) {
+        [](const BinnedImage& binned, const py::object& mask_in) {
             const char* fn = "mask_bins";
+            const py::array mask = bind::mask_array(mask_in, fn);
             bind::check_mask(mask, binned.rows, binned.cols, fn);
             auto out = std::make_shared<BinnedImage>(binned.rows, binned.cols, binned.n_bins);
             const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
@@ -440,7 +446,7 @@ void register_detection(py::module_& m) {
 
     m.def(
         "close_mask",
-        [](const py::array& mask, const py::array& element) {
+        [](const py::object& mask, const py::object& element) {
             return mask_pass(mask, element, "close_mask", close_mask);
         },
         py::arg("mask"), py::arg("element"),
@@ -449,7 +455,7 @@ void register_detection(py::module_& m) {
 
     m.def(
         "open_mask",
-        [](const py::array& mask, const py::array& element) {
+        [](const py::object& mask, const py::object& element) {
             return mask_pass(mask, element, "open_mask", open_mask);
         },
         py::arg("mask"), py::arg("element"),

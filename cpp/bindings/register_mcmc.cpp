@@ -33,7 +33,10 @@ RjMove parse_move(const std::string& name, const char* fn) {
 
 const char* kMoveNames[4] = {"birth", "death", "update", "swap"};
 
-FgIntegral make_fg(const py::array& mask, const BinnedImage& image, const char* fn) {
+/// The foreground integral of `mask_in` (its array is held by the caller, FgIntegral points
+/// into it: a py::object parameter of the binding).
+FgIntegral make_fg(const py::object& mask_in, const BinnedImage& image, const char* fn) {
+    const py::array mask = bind::mask_array(mask_in, fn);
     bind::check_mask(mask, image.rows, image.cols, fn);
     return FgIntegral(static_cast<const std::uint8_t*>(mask.data()), image.rows, image.cols,
                       mask.strides(0));
@@ -195,7 +198,7 @@ void register_mcmc(py::module_& m) {
                                                   ".restore)"))
         .def(
             "step",
-            [](PyRjTracker& self, const BinnedImage& image, const py::array& mask,
+            [](PyRjTracker& self, const BinnedImage& image, const py::object& mask,
                Eigen::Ref<const RowMatrixXd> candidates, std::optional<RowMatrixXd> candidate_hists,
                std::uint64_t seed, std::uint64_t step) {
                 const char* fn = "rjmcmc_step";
@@ -287,7 +290,7 @@ void register_mcmc(py::module_& m) {
         // ---- test hooks: single moves on a prepared frame ----
         .def(
             "prepare",
-            [](PyRjTracker& self, const BinnedImage& image, const py::array& mask,
+            [](PyRjTracker& self, const BinnedImage& image, const py::object& mask,
                Eigen::Ref<const RowMatrixXd> candidates, std::optional<RowMatrixXd> candidate_hists) {
                 const bind::InUse busy(&self, "RJMCMCTracker.prepare");
                 const char* fn = "prepare";

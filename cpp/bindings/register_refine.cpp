@@ -15,9 +15,10 @@ using namespace pftrack;
 void register_refine(py::module_& m) {
     m.def(
         "refine_boxes",
-        [](Eigen::Ref<const RowMatrixXd> boxes, const py::array& mask, double fraction,
+        [](Eigen::Ref<const RowMatrixXd> boxes, const py::object& mask_in, double fraction,
            double min_cover, std::optional<double> leg_fill, double min_height) {
             const char* fn = "refine_boxes";
+            const py::array mask = bind::mask_array(mask_in, fn);
             require(boxes.cols() == 4, fn, "boxes cols", boxes.cols(), "4 (left, top, w, h)");
             require_finite(boxes, fn, "boxes");
             bind::check_mask_dtype(mask, fn);  // any (H, W): not check_mask's frame size

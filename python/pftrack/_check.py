@@ -242,7 +242,7 @@ def materialised(rows: ArrayLike) -> ArrayLike:
     return [list(r) if isinstance(r, Iterator) else r for r in rows]
 
 
-def mot_rows(rows: ArrayLike, what: str) -> F64:
+def mot_rows(rows: ArrayLike, what: str, name: str = "rows") -> F64:
     """MOTChallenge rows (M, 6..10) as an (M, 10) float64 array, the missing columns added.
 
     The first check of every function that takes rows (``fill_gaps``, ``smooth_tracks``,
@@ -253,6 +253,7 @@ def mot_rows(rows: ArrayLike, what: str) -> F64:
     values (``[]``, ``np.zeros((0,))``, ``np.zeros((0, 10))``) is no rows. Any iterable of
     rows is taken: an iterator (a generator, ``map(list, rows)``) is read once
     (:func:`materialised`). Only the layout is checked here; the callers check the values.
+    `what` names the caller in messages, `name` its argument (``fill_gaps``' ``tracks``).
 
     Raises
     ------
@@ -264,13 +265,13 @@ def mot_rows(rows: ArrayLike, what: str) -> F64:
         ``{what}: rows must have shape (M, 6..10) (6 to 10 columns: frame, id, left, top,
         width, height[, conf, x, y, z]), got (2, 3)``.
     """
-    path_refused(rows, f"{what}: rows", "pftrack.read_mot(path)")
-    a = real_array(materialised(rows), f"{what}: rows", booleans=False)
+    path_refused(rows, f"{what}: {name}", "pftrack.read_mot(path)")
+    a = real_array(materialised(rows), f"{what}: {name}", booleans=False)
     if a.size == 0:
         return np.zeros((0, 10))
     if a.ndim != 2 or not 6 <= a.shape[1] <= 10:
         raise ValueError(
-            f"{what}: rows must have shape (M, 6..10) (6 to 10 columns: frame, id, left, top, "
+            f"{what}: {name} must have shape (M, 6..10) (6 to 10 columns: frame, id, left, top, "
             f"width, height[, conf, x, y, z]), got {a.shape}"
         )
     if a.shape[1] < 10:

@@ -13,10 +13,12 @@ from its caller's line.
 
 from __future__ import annotations
 
+import sys
 import threading
 import warnings
+from types import FrameType
 
-__all__ = ["Held", "warn"]
+__all__ = ["Held", "warn", "warn_outside"]
 
 _local = threading.local()
 
@@ -32,6 +34,26 @@ def warn(message: str, category: type[Warning] = UserWarning, stacklevel: int = 
         warnings.warn(message, category, stacklevel=stacklevel + 1)
     else:
         pending.append((message, category))
+
+
+def warn_outside(message: str, category: type[Warning] = UserWarning) -> None:
+    """:func:`warn`, from the first line of the stack outside the pftrack package.
+
+    For a warning whose call may come through any number of pftrack's own frames (a
+    :class:`~pftrack.io.video.FrameSource` read by the user's loop, ``list()``, or
+    :func:`~pftrack.track_path`): the user's line either way. Inside a :class:`Held`, held.
+    """
+    frame = sys._getframe(1)  # this function's caller: warn's stacklevel 2
+    level = 2
+    while frame.f_back is not None and _inside(frame):
+        frame, level = frame.f_back, level + 1
+    warn(message, category, stacklevel=level)
+
+
+def _inside(frame: FrameType) -> bool:
+    """Whether `frame` runs code of the pftrack package."""
+    name = str(frame.f_globals.get("__name__", ""))
+    return name == "pftrack" or name.startswith("pftrack.")
 
 
 class Held:

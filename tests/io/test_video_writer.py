@@ -147,8 +147,8 @@ def test_output_keeps_the_umask(tmp_path: Path, umask: int) -> None:
     ("kwargs", "message"),
     [
         ({"path": "v.mkv", "fps": 7}, "unsupported extension '.mkv'"),
-        ({"path": "v.mp4", "fps": 0}, "frame rate is 0"),
-        ({"path": "v.mp4", "fps": float("nan")}, "frame rate is nan"),
+        ({"path": "v.mp4", "fps": 0}, "fps is 0"),
+        ({"path": "v.mp4", "fps": float("nan")}, "fps is nan"),
         ({"path": "v.avi", "fps": 7, "backend": "pyav"}, "writes .mp4"),
         ({"path": "v.mp4", "fps": 7, "backend": "gst"}, "backend is 'gst'"),
         ({"path": "v.mp4", "fps": 7, "preset": "quick"}, "preset is 'quick', expected one of"),

@@ -339,7 +339,7 @@ def test_rows_and_segments_of_booleans_are_refused() -> None:
     from pftrack.recovery import fill_gaps, recover_gap
 
     rows = np.array([[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [5, 1, 14, 10, 5, 5, 1, -1, -1, -1.0]])
-    with pytest.raises(TypeError, match="fill_gaps: rows must hold real numbers, got dtype bool"):
+    with pytest.raises(TypeError, match="fill_gaps: tracks must hold real numbers, got dtype bool"):
         fill_gaps(rows.astype(bool))
     seg = rows[:, [0, 2, 3]]
     with pytest.raises(TypeError, match="segment_a must hold real numbers, got dtype bool"):

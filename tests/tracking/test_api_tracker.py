@@ -703,7 +703,7 @@ def test_every_frame_rate_and_time_takes_a_fraction_as_its_float(scene, tmp_path
     assert make_scene(n_frames=2, fps=ntsc).fps == float(ntsc)
     assert make_busy_scene("groups", n_frames=2, fps=ntsc).fps == float(ntsc)
     # what is not a real number is refused, naming the argument
-    for call, name in ((lambda v: pftrack.VideoWriter(tmp_path / "b.avi", v), "video frame rate"),
+    for call, name in ((lambda v: pftrack.VideoWriter(tmp_path / "b.avi", v), "fps"),
                        (lambda v: pftrack.FrameSource(video, fps=v), "fps"),
                        (lambda v: make_scene(n_frames=2, fps=v), "make_scene: fps"),
                        (lambda v: pftrack.Tracker(max_coast=v), "max_coast")):  # fmt: skip

@@ -41,6 +41,7 @@ from pftrack._check import brief, flag, shown
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack._text import counted, listed, listed_compactly, said_alike
 from pftrack._threads import usable_cpus
+from pftrack._warn import warn
 from pftrack.batch.inputs import cannot_read
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
 from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
@@ -2563,9 +2564,7 @@ def _wait_for_workers(c: Client, address: str, wait: float) -> int:
     n = _n_workers(c)
     if n:
         return n
-    warnings.warn(
-        f"the scheduler at {address} has no workers; {_no_workers(address, wait)}", stacklevel=4
-    )
+    warn(f"the scheduler at {address} has no workers; {_no_workers(address, wait)}", stacklevel=4)
     deadline = time.monotonic() + wait
     while not (n := _n_workers(c)):
         if time.monotonic() >= deadline:
@@ -2657,13 +2656,13 @@ class _WorkersWatch:
         new = [w for w in self.unusable if w not in self._said]
         if new:  # said once each, here (the main thread), not on Dask's
             self._said.update(new)
-            warnings.warn(f"the scheduler at {self.address}: {self._unusable()}", stacklevel=2)
+            warn(f"the scheduler at {self.address}: {self._unusable()}", stacklevel=2)
         try:
             n = _n_workers(self.c, ANSWER_WAIT)
         except TimeoutError:
             if self.silent is None:
                 self.silent = now
-                warnings.warn(
+                warn(
                     f"the scheduler at {self.address} has not answered for {ANSWER_WAIT:g} s "
                     f"(frozen or overloaded?); waiting up to {self.wait:g} s for it",
                     stacklevel=2,
@@ -2671,7 +2670,7 @@ class _WorkersWatch:
             self.frozen = time.monotonic() - self.silent >= self.wait
             return self.frozen
         if self.silent is not None:  # said it was silent: say it answers (a trial)
-            warnings.warn(
+            warn(
                 f"the scheduler at {self.address} answers again after {now - self.silent:.0f} s; "
                 "the batch goes on",
                 stacklevel=2,
@@ -2679,7 +2678,7 @@ class _WorkersWatch:
         self.silent = None
         if n:
             if self.since is not None:  # said they were lost: say the batch goes on (a trial)
-                warnings.warn(
+                warn(
                     f"the scheduler at {self.address} has {counted(n, 'worker')} again after "
                     f"{now - self.since:.0f} s; the batch goes on",
                     stacklevel=2,
@@ -2688,7 +2687,7 @@ class _WorkersWatch:
             return False
         if self.since is None:
             self.since = now
-            warnings.warn(
+            warn(
                 f"the scheduler at {self.address} has lost all its workers; "
                 f"{_no_workers(self.address, self.wait)}",
                 stacklevel=2,
@@ -2928,7 +2927,7 @@ class _Blind:
             return None
         if outcome.worker not in self.named:
             self.named.add(outcome.worker)
-            warnings.warn(
+            warn(
                 f"the scheduler at {self.address}: the worker {outcome.worker} cannot see the "
                 f"inputs this process sees ({path} not found on {outcome.host}): its tasks go "
                 "to the other workers (workers must see the same paths)",

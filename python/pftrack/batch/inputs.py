@@ -14,7 +14,6 @@ from __future__ import annotations
 import json
 import os
 import stat
-import warnings
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -23,6 +22,7 @@ from pathlib import Path
 from pftrack._check import shown
 from pftrack._text import counted
 from pftrack._typing import PathLike
+from pftrack._warn import warn
 from pftrack.io.atomic import refuse_dash, refuse_loop
 from pftrack.io.video import (
     VIDEO_SUFFIXES,
@@ -483,7 +483,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
             kind = _special(entry)
             if kind is not None:  # was: "Not a directory: PATH", the whole batch stopped
                 if entry.suffix.lower() in VIDEO_SUFFIXES:
-                    warnings.warn(
+                    warn(
                         f"{entry} is {kind}, not a video file: passed over (pftrack track "
                         "reads a pipe live, alone)",
                         UserWarning,
@@ -522,7 +522,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
             )
         if deeper:  # was: passed over silently
             n = len(found) - before
-            warnings.warn(
+            warn(
                 f"folder {path}: {n} sequence{'s' * (n > 1)} tracked from it, not those deeper "
                 f"(a folder is looked into one level deep): {_held(deeper)}; {_pass(deeper)} "
                 "too to track them",
@@ -564,9 +564,7 @@ def find_track_files(inputs: Inputs) -> list[Path]:
         files = [p for p in files if not p.name.startswith(".")]
         scores = [p for p in files if _trackeval_summary(p)]
         for p in scores:  # beside the tracker's data/: was read as tracks, its task failed
-            warnings.warn(
-                f"{p} is TrackEval's summary of scores, not tracks: passed over", stacklevel=2
-            )
+            warn(f"{p} is TrackEval's summary of scores, not tracks: passed over", stacklevel=2)
         files = [p for p in files if p not in scores]
         if not files:
             what = f"no .txt file in folder {path}" if not scores else (

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import warnings
 from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from pftrack._warn import warn
 from pftrack.cli._options import (
     WidthHeight,
     add_command,
@@ -525,13 +525,13 @@ def _run_sequences(args: argparse.Namespace) -> int:
             file=to,
         )
         if r.n_gaps and len(r.masks) < args.n_masks:  # was: fewer, without a word
-            warnings.warn(
+            warn(
                 f"{r.name}: {len(r.masks)} of the {args.n_masks} masks asked for were placed "
                 "(no more fit without overlapping, or none more cuts a gap)",
                 stacklevel=2,
             )
         if not r.n_gaps:  # was: a row of nan, and nothing said
-            warnings.warn(
+            warn(
                 f"{r.name}: no gap under any mask (no mask position cuts a trajectory that is "
                 "observed on both sides of it): no MMAE, and nothing of it in the pooled "
                 "figures",

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
@@ -15,6 +14,7 @@ from pftrack import _core
 from pftrack._check import MAX_COORD, bgr_array, brief, flag, number, real_array
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
+from pftrack._warn import warn_outside
 from pftrack.boxes import _iou_matrix
 from pftrack.detection.hold import HOLD_IOU
 from pftrack.detection.size_model import PersonSizeModel
@@ -264,12 +264,11 @@ def check_detections(detections: ArrayLike, shape: tuple[int, int]) -> tuple[F64
     )
     if np.any(outside):  # nothing to track there: dropped, and said so once per call site
         k = int(np.flatnonzero(outside)[0])
-        warnings.warn(
+        warn_outside(  # the user's line, or held inside update() (given from the user's)
             f"{int(outside.sum())} detection(s) wholly outside the {cols}x{rows} frame dropped, "
             f"e.g. {d[k, :4].tolist()} (wrong coordinate scale? PETS boxes need "
             "--det-scale 0.625)",
             UserWarning,
-            stacklevel=3,
         )
         d = d[~outside]
     scores = d[:, 4] if d.shape[1] == 5 else np.ones(len(d))

@@ -67,10 +67,10 @@ class SizeModelConfig:
     max_cut_share: float = 0.2
 
     def __post_init__(self) -> None:
+        own = "SizeModelConfig"  # every message names the class, as the other configs' do
         for name in ("split_ratio", "split_max_height", "merge_slack", "max_cut_share"):
-            number(getattr(self, name), name, finite=False)  # not an array's "truth value"
+            number(getattr(self, name), f"{own}: {name}", finite=False)  # not an array's truth
         # ints, NumPy's too (were refused, ValueError), not bools (True was taken as 1)
-        own = "SizeModelConfig"
         for name, lo in (("min_samples", 3), ("max_samples", 3), ("refit_every", 1)):
             v = integer(getattr(self, name), f"{own}: {name}", lo, MAX_SAMPLES)
             object.__setattr__(self, name, v)
@@ -80,15 +80,21 @@ class SizeModelConfig:
                 f"({self.min_samples})"
             )
         if not (self.split_ratio > 1.0 and np.isfinite(self.split_ratio)):
-            raise ValueError(f"split_ratio is {self.split_ratio}, expected a finite value > 1")
+            raise ValueError(
+                f"{own}: split_ratio is {self.split_ratio}, expected a finite value > 1"
+            )
         if not (self.split_max_height > 0.0 and np.isfinite(self.split_max_height)):
             raise ValueError(
-                f"split_max_height is {self.split_max_height}, expected a finite value > 0"
+                f"{own}: split_max_height is {self.split_max_height}, expected a finite value > 0"
             )
         if not (self.merge_slack >= 1.0 and np.isfinite(self.merge_slack)):
-            raise ValueError(f"merge_slack is {self.merge_slack}, expected a finite value >= 1")
+            raise ValueError(
+                f"{own}: merge_slack is {self.merge_slack}, expected a finite value >= 1"
+            )
         if not (0.0 <= self.max_cut_share <= 1.0):
-            raise ValueError(f"max_cut_share is {self.max_cut_share}, expected a value in [0, 1]")
+            raise ValueError(
+                f"{own}: max_cut_share is {self.max_cut_share}, expected a value in [0, 1]"
+            )
 
 
 def theil_sen(x: NDArray[np.float64], y: NDArray[np.float64]) -> tuple[float, float]:

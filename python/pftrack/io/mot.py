@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import itertools
 import re
-import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import cast
@@ -32,6 +31,7 @@ from pftrack._check import (
     path_arg,
 )
 from pftrack._typing import F64, PathLike
+from pftrack._warn import warn
 from pftrack.io.atomic import atomic_write, refuse_dash, refuse_loop
 
 #: Column indices of a MOTChallenge row.
@@ -238,7 +238,7 @@ def read_mot(
     if error is not None:
         raise ValueError(error)
     if most > 10:
-        warnings.warn(
+        warn(
             f"{what} {p} has lines of {most} columns: columns past 10 are not kept",
             UserWarning,
             stacklevel=2,

@@ -34,7 +34,6 @@ import os
 import re
 import stat
 import threading
-import warnings
 from collections.abc import Callable, Collection, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -49,6 +48,7 @@ from numpy.typing import NDArray
 from pftrack._check import brief, number, path_arg, real, shown
 from pftrack._text import counted
 from pftrack._typing import PathLike, RealLike
+from pftrack._warn import warn_outside
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
 from pftrack.io.packets import INTRA_FOURCCS, PACKET_PASS_MIN_PIXELS, intra_frames_at
 
@@ -1317,10 +1317,9 @@ def _frames_only(folder: Path, images: list[Path]) -> list[Path]:
         return images
     others = sorted(p.name for p in images if not _INTEGER.fullmatch(p.stem))
     listed = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
-    warnings.warn(
+    warn_outside(
         f"{folder}: {len(others)} image{'s' * (len(others) > 1)} whose name is not a frame "
         f"number left out ({listed}): a MOTChallenge sequence's frames are its numbered images",
-        stacklevel=4,
     )
     return numbered
 
@@ -1649,25 +1648,23 @@ class FrameSource:
                 self._broken = _avi_break(self.path)
                 streams = _several_video_streams(self.path)
                 if streams:  # OpenCV reads the first, without a word
-                    warnings.warn(
+                    warn_outside(
                         f"{self.name}: holds {len(streams)} video streams; the first, "
                         f"{streams[0]}, is read (OpenCV reads no other), not "
                         f"{', '.join(streams[1:])}: to track another, copy it to a file of "
                         "its own first (ffmpeg -i FILE -map 0:v:1 -c copy OUT.mkv: the "
                         "second)",
                         UserWarning,
-                        stacklevel=2,
                     )
         if self._broken is not None:  # before any work: said once for each source opened
             frames, offset = self._broken
-            warnings.warn(
+            warn_outside(
                 f"{self.name}: damaged inside: its AVI chunks break off after frame {frames} "
                 f"(byte {offset}), and FFmpeg reads on from the next chunk it finds, numbering "
                 f"the frames it reads by counting them: the frames after frame {frames} may "
                 "carry the numbers of earlier ones (tracks, detections and ground truth apart "
                 "there)",
                 UserWarning,
-                stacklevel=2,
             )
         self.n_frames = max(count, 0)
         self.count_known = self.n_frames > 0 and (
@@ -1692,12 +1689,11 @@ class FrameSource:
         else:
             self.fps, self.fps_origin = DEFAULT_FPS, "default"
             if header_fps and not (np.isfinite(header_fps) and 0 < header_fps < 1000):
-                warnings.warn(
+                warn_outside(
                     f"{self.name}: the header's frame rate {header_fps:g} is taken for none "
                     f"(a time base, not a rate?), nor do its time stamps give one below 1000: "
                     f"{DEFAULT_FPS:g} fps assumed; give the video's rate (--fps)",
                     UserWarning,
-                    stacklevel=2,
                 )
         h, w = first.shape[:2]
         size = self._scaled_size(first)
@@ -1726,11 +1722,10 @@ class FrameSource:
         videos = video_files(folder)
         if videos:  # was passed over without a word
             names = ", ".join(p.name for p in videos[:3]) + (", ..." if len(videos) > 3 else "")
-            warnings.warn(
+            warn_outside(
                 f"{folder} holds {len(images)} images and {len(videos)} video"
                 f"{'s' * (len(videos) != 1)} ({names}): the images are the frames; give a "
                 "video's own path to track it",
-                stacklevel=3,
             )
         seq = self.sequence
         own = seq is not None and _same_folder(folder, seq.folder / seq.image_dir)
@@ -1798,12 +1793,11 @@ class FrameSource:
             image = np.minimum(image, limit)
             if not self._clipped:
                 self._clipped = True
-                warnings.warn(
+                warn_outside(
                     f"image {path} goes up to {top}, past the {bits} bits its folder's 16-bit "
                     f"images are read at ({self._depth_from}): its brighter pixels are clipped "
                     "to white",
                     UserWarning,
-                    stacklevel=4,
                 )
         return np.asarray(np.right_shift(image, bits - 8), dtype=np.uint8)
 
@@ -1881,7 +1875,7 @@ class FrameSource:
         """
         if self._depth_note is not None:
             note, self._depth_note = self._depth_note, None
-            warnings.warn(note, UserWarning, stacklevel=3)
+            warn_outside(note)
         img: NDArray[Any] | None
         notes: list[str] = []  # what its decoder prints on stderr (libpng, libjpeg)
         if self._eight_bit and path.suffix.lower() in DEEP_SUFFIXES:
@@ -1907,21 +1901,19 @@ class FrameSource:
             raise ValueError(_unreadable(path, notes))
         if not self._cut_said and path.suffix.lower() in (".jpg", ".jpeg") and _cut_jpeg(path):
             self._cut_said = True
-            warnings.warn(
+            warn_outside(
                 f"image {path} has no JPEG end marker (a truncated file?): what is missing is "
                 "decoded as flat grey, and tracked as it is (said once a run)",
                 UserWarning,
-                stacklevel=4,  # the loop over the frames (through two generators)
             )
         for note in notes:  # each once a run, naming the image (was: on stderr, no file named)
             if note in self._decoder_said or (self._cut_said and note == JPEG_CUT_NOTE):
                 continue  # a cut JPEG: said above
             self._decoder_said.add(note)
-            warnings.warn(
+            warn_outside(
                 f"image {path}: its decoder says {note!r} (the image is read all the same; "
                 "said once a run)",
                 UserWarning,
-                stacklevel=4,
             )
         if img.shape[:2] != self._image_shape:
             h0, w0 = self._image_shape
@@ -1977,11 +1969,10 @@ class FrameSource:
             self.n_frames, self.count_known = found, True
             if header:  # an estimate (Matroska's) is no header count to correct
                 why = "the header is wrong" if found > header else "a truncated or damaged file"
-                warnings.warn(
+                warn_outside(
                     f"{self.path}: its header says {counted(header, 'frame')} but it holds "
                     f"{found} (counted): {why}, the count is taken",
                     UserWarning,
-                    stacklevel=3,
                 )
         return self.n_frames
 
@@ -2266,11 +2257,10 @@ class FrameSource:
             kept = (  # not where FFmpeg numbers the frames after the break by counting them
                 ", so the later frames keep their numbers" if self._broken is None else ""
             )
-            warnings.warn(
+            warn_outside(
                 f"{self.path}: {_frame_list(lost)} could not be decoded (a damaged file?): the "
                 f"frame before stands in for each{kept}",
                 UserWarning,
-                stacklevel=2,
             )
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded)
@@ -2283,13 +2273,12 @@ class FrameSource:
         if self._warned_lead:
             return
         self._warned_lead = True
-        warnings.warn(
+        warn_outside(
             f"{self.path}: {_frame_list(list(range(index)))} could not be decoded (a damaged "
             f"start?): a black frame stands in for each (the detector learns nothing from "
             f"one), so frame {index + 1}, the first that decodes, and the later frames keep "
             "their numbers (by their time stamps)",
             UserWarning,
-            stacklevel=3,
         )
 
     def _warn_cut_start(self, index: int, ms: float) -> None:
@@ -2307,7 +2296,7 @@ class FrameSource:
         self._warned_cut = True
         if not _starts_without_key_frame(self.path):
             return
-        warnings.warn(
+        warn_outside(
             f"{self.path}: the video stream begins without a key frame (cut from a live "
             f"stream?) and its first frame that decodes is stamped {ms:.0f} ms after its "
             f"start: {counted(index, 'frame')} before it appear to be missing (FFmpeg cannot "
@@ -2316,7 +2305,6 @@ class FrameSource:
             f"{index} ahead of these frames (drop their frames 1-{index} and number the rest "
             "from 1)",
             UserWarning,
-            stacklevel=3,
         )
 
     def _warn_uneven(self, stamps: list[float], *, whole: bool) -> None:
@@ -2339,14 +2327,13 @@ class FrameSource:
         lo, median, hi = uneven
         which = "frames" if whole else f"first {len(stamps)} frames"
         origin = {"container": "the header's", "time stamps": "from its first frames' stamps"}
-        warnings.warn(
+        warn_outside(
             f"{self.path}: variable frame rate: its {which} are {lo:.3g} to {hi:.3g} ms apart "
             f"(median {median:.3g} ms), but it is read at one rate, {self.fps:g} fps "
             f"({origin.get(self.fps_origin, self.fps_origin)}): a video rendered from it plays "
             "its frames evenly spaced at that rate, and the tracker takes each step between "
             "frames as one frame's (give the rate to render at with --fps)",
             UserWarning,
-            stacklevel=3,
         )
 
     def _warn_frame_count(self, decoded: int) -> None:
@@ -2367,11 +2354,10 @@ class FrameSource:
             return
         self._warned_short = True  # once, not on every pass
         damaged = ": a truncated or damaged file?" if decoded < header else ""
-        warnings.warn(
+        warn_outside(
             f"{self.path} ended after {counted(decoded, 'frame')} but "
             f"{' and '.join(said)}{damaged}",
             UserWarning,
-            stacklevel=3,
         )
 
     def _iter_live(self) -> Generator[NDArray[np.uint8], None, None]:

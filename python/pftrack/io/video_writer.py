@@ -131,9 +131,9 @@ class VideoWriter:
             )
         # any real number (a Fraction: PyAV's rates); text or None a TypeError naming it (was
         # NumPy's "ufunc 'isfinite' not supported", for a Fraction too)
-        fps = real(fps, "video frame rate", finite=False)
+        fps = real(fps, "fps", finite=False)  # named as passed (was "video frame rate")
         if not (np.isfinite(fps) and fps > 0):
-            raise ValueError(f"video frame rate is {fps}, expected a finite value > 0")
+            raise ValueError(f"fps is {fps}, expected a finite value > 0")
         option(preset, "preset", X264_PRESETS)
         if preset not in X264_PRESETS:
             raise ValueError(f"preset is {preset!r}, expected one of {', '.join(X264_PRESETS)}")

@@ -266,7 +266,7 @@ def fill_gaps(
         unassociated box, not a track: :func:`pftrack.recovery.linking.check_tracked`) or of
         another negative id (``pftrack eval`` and TrackEval refuse it).
     """
-    rows = _check.mot_rows(tracks, "fill_gaps")  # (M, 6..10), [] too, as smooth_tracks
+    rows = _check.mot_rows(tracks, "fill_gaps", "tracks")  # (M, 6..10), [] too, as smooth_tracks
     # what the method does not use is refused, as the command refuses --seed (was ignored
     # without a word; a user trial)
     _check.option(method, "fill_gaps: method", METHODS)

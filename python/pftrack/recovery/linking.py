@@ -11,7 +11,6 @@ three columns.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
@@ -34,6 +33,7 @@ from pftrack._check import (
 )
 from pftrack._text import counted
 from pftrack._typing import F64, PathLike
+from pftrack._warn import warn
 from pftrack.boxes import _to_cxcywh
 from pftrack.particle_filter.colour import (
     bhattacharyya_distance,
@@ -159,7 +159,7 @@ def gate_for_rows(config: LinkConfig, rows: ArrayLike) -> LinkConfig:
     )
     if stray.any():
         k = int(np.flatnonzero(stray)[0])
-        warnings.warn(
+        warn(
             f"{int(stray.sum())} row(s) reach far past the others (the first: frame "
             f"{a[k, 0]:g}, id {a[k, 1]:g}, right and bottom edges {edges[0][k]:g}, "
             f"{edges[1][k]:g} px; 99 % of the rows within {bulk[0]:g}, {bulk[1]:g}): left out "
@@ -525,13 +525,13 @@ def link_tracklets(
             "link_tracklets: frames must be a sequence indexable by frame - 1 (a list, an "
             f"array, a FrameSequence) or None, got {type(frames).__name__}"
         )
-    rows = np.array(check_rows(tracks, "link_tracklets"), dtype=np.float64, copy=True)
+    rows = np.array(check_rows(tracks, "link_tracklets", "tracks"), dtype=np.float64, copy=True)
     check_unique(rows, who="link_tracklets")  # a track seen twice has no velocity to link
     check_tracked(rows, who="link_tracklets")
     if len(rows) == 0:
         return rows, {}
     if frames is not None and len(frames) < rows[:, 0].max():
-        warnings.warn(
+        warn(
             f"link_tracklets: frames holds {len(frames)} frames, the rows reach frame "
             f"{int(rows[:, 0].max())}: fragment ends after frame {len(frames)} are linked "
             "without the colour term",
@@ -560,7 +560,7 @@ def link_tracklets(
     return rows, mapping
 
 
-def check_rows(rows: ArrayLike, what: str) -> F64:
+def check_rows(rows: ArrayLike, what: str, name: str = "rows") -> F64:
     """The rows as an ``(M, 10)`` float64 array, checked; ValueError/TypeError naming the problem.
 
     Their layout first, as every function taking rows checks it (:func:`pftrack._check.
@@ -568,9 +568,10 @@ def check_rows(rows: ArrayLike, what: str) -> F64:
     array without values (``[]``) no rows; then the values.
     Frames must be integers in ``1..MAX_FRAME``, ids integers with ``|id| <= MAX_ID``, every
     value finite, and the boxes what :func:`pftrack.io.mot.read_mot` reads (:func:`check_boxes`:
-    no negative width or height, no value beyond ±1e9 px). `what` names the caller in messages.
+    no negative width or height, no value beyond ±1e9 px). `what` names the caller in messages,
+    `name` the argument whose layout or type is wrong (``link_tracklets``' ``tracks``).
     """
-    a = mot_rows(rows, what)
+    a = mot_rows(rows, what, name)
     f, i = a[:, 0], a[:, 1]
     finite = np.isfinite(a)
     if not finite.all():
@@ -792,7 +793,7 @@ def _warn_normalised(rows: F64, path: PathLike) -> None:
         return
     right, bottom = np.max(rows[:, 2] + rows[:, 4]), np.max(rows[:, 3] + rows[:, 5])
     if max(right, bottom) <= NORMALISED_REACH:
-        warnings.warn(
+        warn(
             f"{path}: every box lies within {right:.3g} x {bottom:.3g} (its rightmost and lowest "
             "edges): normalised coordinates? pftrack works in pixels (its linking gate, boxes "
             "written with 2 decimals): give pixels (x times the image width, y times its height)",
@@ -812,7 +813,7 @@ def _warn_padded_flags(rows: F64, path: PathLike) -> None:
     n = int(filled_mask(rows).sum()) if len(rows) else 0
     fields = first_row_fields(path) if n else 10
     if n and fields < 10:
-        warnings.warn(
+        warn(
             f"{path}: {n} row(s) have 1 in column 8 and {fields} columns (the missing ones "
             "padded with -1): they carry pftrack's mark of a filled row (column 8 = 1, columns "
             "9-10 = -1), so in the output the filled rows cannot be told from them by that mark",

@@ -27,7 +27,6 @@ import itertools
 import operator
 import pickle
 import threading
-import warnings
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import replace
 from typing import Any, NamedTuple, SupportsIndex
@@ -1516,7 +1515,7 @@ class Tracker:
             self.classes = {i: c for i, c in self._writer.classes.items() if i in kept}
             if len(rows) == 0 and self.frame_count:
                 n = self.frame_count
-                warnings.warn(
+                warn(
                     f"no track over {n} frame{'s' * (n != 1)}: {self._no_track_cause(n_tracked)}",
                     RuntimeWarning,
                     stacklevel=2 + self._caller_depth,  # the user's line, through an adapter too

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import itertools
 import os
 import sys
 import time
-import warnings
-from collections.abc import Callable, Mapping, Sequence
-from contextlib import closing, nullcontext
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import closing
 from dataclasses import dataclass
 from types import FrameType
 from typing import Any
@@ -29,6 +30,7 @@ from pftrack._progress import progress
 from pftrack._stand_in import standing_in
 from pftrack._text import counted
 from pftrack._typing import F64, BootstrapMode, FillMode, IntLike, PathLike, RngLike
+from pftrack._warn import Held, warn
 from pftrack.detection.bootstrap import BOOTSTRAPS, bootstrap_frames
 from pftrack.io.mot import first_row_fields, group_by_frame, read_mot
 from pftrack.io.prefetch import prefetch
@@ -110,7 +112,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     path = path_arg(path, "load_detections: path")
     rows = read_mot(path, what="detection file")
     if len(rows) and first_row_fields(path) == 6:
-        warnings.warn(
+        warn(
             f"{path}: no score column (6 fields a row): every detection scores 1, so "
             "birth_score and min_conf gate none of them",
             stacklevel=2,
@@ -118,7 +120,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     tracked = rows[:, 1] != -1  # detection files hold id -1 (MOTChallenge's "no id")
     if tracked.any():
         k = int(np.argmax(tracked))
-        warnings.warn(
+        warn(
             f"{path}: {int(tracked.sum())} of {len(rows)} rows have a track id, not -1 (the "
             f"first: id {rows[k, 1]:g} in frame {int(rows[k, 0])}): a tracks file? Read as "
             "detections: the ids are ignored, the tracker makes its own",
@@ -126,7 +128,7 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
         )
     flat = (rows[:, 4] <= 0) | (rows[:, 5] <= 0)
     if flat.any():
-        warnings.warn(
+        warn(
             f"{path}: {int(flat.sum())} detection(s) with zero width or height left out (the "
             f"first in frame {int(rows[np.argmax(flat), 0])})",
             stacklevel=2,
@@ -323,13 +325,16 @@ def track_frames(
         """Whether frame k is black in place of one the video could not decode, once read."""
         return k <= getattr(frames, "lead_black", 0)
 
+    # the reader's warnings (a damaged start, a variable frame rate), on a reading thread with
+    # threads: held there, given here from the caller's line before the frame read with them
+    said: deque[_Said] = deque()
+    reads = _reading(frames, said)
     if not threads:
-        it = iter(frames)
-        stream: Any = closing(it) if hasattr(it, "close") else nullcontext(it)
+        stream: Any = closing(reads)
     elif ahead:
         stream = DetectAhead(
             tracker.tracker,
-            frames,
+            reads,
             external=detections is not None,
             prepare=tracker.working_frame,
             hand_over=tracker.hand_over,
@@ -337,12 +342,13 @@ def track_frames(
             black_stand_in=black_stand_in,
         )
     else:
-        stream = closing(prefetch(frames))
+        stream = closing(prefetch(reads))
     with stream as decoded:  # the reading threads stop first
         for n, frame in enumerate(
             progress(decoded, total=total, desc="tracking", enable=show_progress, unit="frame"),
             start=1,
         ):
+            _give(said, n, 2 + tracker._caller_depth)
             settled = tracker.n_settled
             if detections is None:
                 with standing_in(black_stand_in(n)):
@@ -360,6 +366,7 @@ def track_frames(
                     tracker.update(xywh_to_xyxy_dets(dets), frame)
             if on_frame is not None:
                 on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
+    _give(said, n + 1, 2 + tracker._caller_depth)  # those of reading on to the end
     if n == 0:  # a FrameSource by its name, not its repr
         if getattr(source, "stopped", False):
             raise ValueError(f"{getattr(source, 'name', source)}: stopped before its first frame")
@@ -367,12 +374,48 @@ def track_frames(
     if detections:
         unused = [f for f in detections if f > n and len(detections[f])]
         if unused:  # the video ended early (a truncated file): say what was not tracked
-            warnings.warn(
+            warn(
                 f"detections of {len(unused)} frames after the video's last frame {n} were not "
                 f"used (frames {min(unused)}-{max(unused)})",
                 stacklevel=1 + tracker._caller_depth,
             )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+
+
+# a warning the reader gave while reading frame k (1-based; one past the last: at the end)
+_Said = tuple[int, str, type[Warning]]
+
+
+def _reading(frames: Iterable[Any], said: deque[_Said]) -> Iterator[Any]:
+    """`frames`, each read inside a :class:`~pftrack._warn.Held`, its warnings put in `said`.
+
+    On whatever thread iterates it (a reading thread with ``threads``): :func:`_give` gives
+    them on the tracker's. `frames`' iterator is closed when this ends, however it ends.
+    """
+    it = iter(frames)
+    end = object()
+    try:
+        for k in itertools.count(1):
+            with Held() as held:
+                frame = next(it, end)
+            said.extend((k, message, category) for message, category in held.pending)
+            if frame is end:
+                return
+            yield frame
+    finally:
+        close = getattr(it, "close", None)
+        if close is not None:
+            close()
+
+
+def _give(said: deque[_Said], upto: int, stacklevel: int) -> None:
+    """Give the warnings in `said` of reading frames 1..`upto`, from the line `stacklevel` names.
+
+    `stacklevel` as ``warnings.warn``'s if it were called here: 2 names this function's caller.
+    """
+    while said and said[0][0] <= upto:
+        _, message, category = said.popleft()
+        warn(message, category, stacklevel=stacklevel)
 
 
 def _calls_from_here(caller: FrameType | None) -> int:
@@ -605,7 +648,7 @@ def _check_layout(
     as_xyxy = (d[:, 2] > d[:, 0]) & (d[:, 3] > d[:, 1]) & (d[:, 2] <= cols) & (d[:, 3] <= rows)
     right, bottom = float(np.max(d[:, 0] + d[:, 2])), float(np.max(d[:, 1] + d[:, 3]))
     if len(d) >= SMALL_LAYOUT_BOXES and right < 0.5 * cols and bottom < 0.5 * rows:
-        warnings.warn(
+        warn(
             f"all {len(d)} detection boxes lie in the top-left {right:.3g}x{bottom:.3g} pixels "
             f"of the {cols}x{rows} frames: are they in a smaller frame's pixels? (scale them "
             "with --det-scale / load_detections(scale=...))",
