@@ -515,7 +515,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
                 f"image folders or MOTChallenge sequence folders in it{where}"
             )
         if frameless:
-            warnings.warn(
+            warn(
                 f"folder {path}: passed over {_frameless(frameless)}: {_NO_FRAMES}",
                 UserWarning,
                 stacklevel=2,
