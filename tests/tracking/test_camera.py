@@ -177,6 +177,76 @@ def test_camera_starting_to_move_is_measured_in_full(
     assert corner_error(steps[7].apply, compose(shift, compose(shift, shift))) < 0.3
 
 
+def _record_pyramid_levels(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """The ``maxLevel`` of every optical-flow call from now on."""
+    levels: list[int] = []
+    flow = cv2.calcOpticalFlowPyrLK
+
+    def recorded(*args: Any, **kwargs: Any) -> Any:
+        levels.append(kwargs["maxLevel"])
+        return flow(*args, **kwargs)
+
+    monkeypatch.setattr(cv2, "calcOpticalFlowPyrLK", recorded)
+    return levels
+
+
+def test_a_still_camera_is_followed_without_the_pyramid(
+    texture: np.ndarray, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 17/13: the still camera's corners are followed on the scaled frame alone (0.06
+    instead of 0.15 ms on 40 corners); a full measurement keeps its two pyramid levels."""
+    levels = _record_pyramid_levels(monkeypatch)
+    calls = _count_corner_searches(monkeypatch)
+    camera = CameraMotion("auto", CameraConfig(refresh_frames=10))
+    rng = np.random.default_rng(0)
+    for _ in range(21):
+        noise = rng.normal(0, 2.0, texture.shape)
+        camera.update(np.clip(texture + noise, 0, 255).astype(np.uint8))
+    # 20 measured frames: 2 and 13 in full (then the corners are 10 frames old), the other 18
+    # followed the corners
+    assert calls[0] == 2
+    assert sorted(levels) == [0] * 18 + [2] * 2
+
+
+@pytest.mark.parametrize("tx", [0.2, 0.5, 1.0, 3.0])
+def test_the_still_cameras_flow_measures_as_the_pyramids(
+    texture: np.ndarray, monkeypatch: pytest.MonkeyPatch, tx: float
+) -> None:
+    """Without the pyramid the still camera's estimate is the pyramid's to 0.01 px at the image
+    corners, under the threshold (0.2 and 0.5 px: still) and over it (1 and 3 px: measured in
+    full, which uses the pyramid, after the still test said so)."""
+    shifted = warp_frame(texture, similarity(1.0, 0.0, tx, 0.0))
+    steps = {}
+    for levels in (0, 2):
+        monkeypatch.setattr("pftrack.tracking.camera.STILL_LEVELS", levels)
+        camera = CameraMotion("auto")
+        camera.update(texture)
+        camera.update(texture)  # the corners are followed from here on
+        steps[levels] = camera.update(shifted)
+    a0, a2 = steps[0].affine, steps[2].affine
+    assert a0 is not None and a2 is not None
+    assert corner_error(a0, a2) < 0.01
+    assert corner_error(a0, similarity(1.0, 0.0, tx, 0.0)) < 0.3
+
+
+def test_a_jump_too_far_for_the_still_flow_is_measured_in_full(
+    texture: np.ndarray, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A still camera's view jumps by 24 px (12 px of the scaled frame), more than the flow
+    without the pyramid follows: its corners are lost, and the frame is measured in full and
+    found to move (never taken as still)."""
+    calls = _count_corner_searches(monkeypatch)
+    camera = CameraMotion("auto")
+    for _ in range(3):
+        camera.update(texture)
+    assert calls[0] == 1
+    truth = similarity(1.0, 0.0, 24.0, -6.0)
+    step = camera.update(warp_frame(texture, truth))
+    assert calls[0] == 2
+    assert step.affine is not None and corner_error(step.affine, truth) < 0.3
+    assert step.magnitude > CameraConfig().threshold * np.hypot(*SIZE)
+
+
 def test_moving_decision_has_hysteresis_and_covers_the_frames_before_it(
     texture: np.ndarray,
 ) -> None:
