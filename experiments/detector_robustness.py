@@ -1,8 +1,9 @@
 """The built-in detector on footage it was not tuned on: grey, slowly darkening, cropped.
 
 Each case is one sequence in one variant, tracked by ``pftrack.tracking.track_frames`` (the
-built-in detector unless ``--detector``, every default, ``--bootstrap`` as given) and scored
-with ``pftrack.eval.evaluate_sequence`` (HOTA, MOTA, IDF1, FP, FN, IDSW). Variants:
+built-in detector unless ``--detector``, every default, ``--bootstrap`` as given;
+``TrackerConfig.hold_frames`` from ``--hold-frames``, 0 as by default) and scored with
+``pftrack.eval.evaluate_sequence`` (HOTA, MOTA, IDF1, FP, FN, IDSW). Variants:
 
 ``ident``  the frames as they are (real sequences: re-encoded as JPEG, quality 95)
 ``grey``   every pixel set to its grey level (B = G = R, ``cv2.COLOR_BGR2GRAY``)
@@ -23,7 +24,8 @@ Usage (from the repository root)::
 
     python -m experiments.detector_robustness [--data ../shared/data]
         [--sequences pets,tud,walkers,present,groups,overhead] [--variants ident,grey,ramp]
-        [--detector paper] [--bootstrap auto] [--seed 0] [--out out/detector_robustness]
+        [--detector paper] [--bootstrap auto] [--seed 0] [--hold-frames 0]
+        [--out out/detector_robustness]
 """
 
 from __future__ import annotations
@@ -149,6 +151,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--detector", default="paper", choices=("paper", "mog2", "knn"))
     p.add_argument("--bootstrap", default="auto", choices=("auto", "spread", "first", "none"))
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--hold-frames", type=int, default=0, help="TrackerConfig.hold_frames (0: off, the default)"
+    )
     args = p.parse_args(argv)
     from pftrack.tracking import TrackerConfig, track_frames
 
@@ -157,6 +162,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     bad = sorted(set(names) - set(REAL) - set(SYNTHETIC)) + sorted(set(variants) - set(VARIANTS))
     if bad:
         p.error(f"unknown sequence(s) or variant(s): {', '.join(bad)}")
+    if args.hold_frames < 0:
+        p.error(f"--hold-frames is {args.hold_frames}, expected 0 (off) or more")
+    if args.hold_frames and args.detector != "paper":
+        p.error("--hold-frames needs --detector paper (the hold is the built-in detector's)")
     data = data_root(args.data)
     header = (
         f"{'sequence':9s} {'variant':7s} {'MOTA':>6s} {'IDF1':>6s} {'HOTA':>6s} "
@@ -165,7 +174,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     with tee_stdout(args.out / "robustness.txt"):
         print(
             f"detector={args.detector} bootstrap={args.bootstrap} seed={args.seed} "
-            f"(MOTA, IDF1, HOTA in %)"
+            f"hold_frames={args.hold_frames} (MOTA, IDF1, HOTA in %)"
         )
         print(header)
         for name in names:
@@ -182,7 +191,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 t0 = time.perf_counter()
                 run = track_frames(
                     source,  # type: ignore[arg-type]
-                    config=TrackerConfig(detector=args.detector),
+                    config=TrackerConfig(detector=args.detector, hold_frames=args.hold_frames),
                     rng=args.seed,
                     bootstrap=args.bootstrap,
                     show_progress=False,
