@@ -50,6 +50,28 @@ def test_a_box_that_changes_size_is_not_a_move():
         assert len(memory.held) == 0
 
 
+def test_a_passer_by_who_merged_with_a_stander_does_not_take_them_along():
+    """Regression (lowseeds; standing_long seed 1, 600 frames): a passer-by walking past a
+    person standing merges with them; the merged box follows the passer-by, and when the two
+    split (the stander's part partly hidden), the passer-by's part overlapped the merged box
+    more and took the stander's place: the stander's part started as an object that never
+    moved, was never held, and was absorbed. The part where the stander stands is theirs."""
+    memory = StopMemory(hold_frames=1000)
+    _walk_then_stand(memory, walk=30, stand=100)  # stands at [100, 50, 30, 80]
+    stander = np.array([100.0, 50.0, 30.0, 80.0])
+    for px in np.arange(157.0, 40.0, -3.0):  # a 30 px wide passer-by walking left past them
+        if px >= 130.0 or px + 30.0 <= 100.0:
+            boxes = [[px, 52.0, 30.0, 80.0], stander]  # apart
+        elif px >= 85.0:
+            left, right = min(100.0, px), max(130.0, px + 30.0)
+            boxes = [[left, 50.0, right - left, 82.0]]  # one blob
+        else:  # split: the passer-by, and the stander's part to its right
+            boxes = [[px, 52.0, 30.0, 80.0], [px + 30.0, 50.0, 100.0 - px, 80.0]]
+        memory.observe(np.array(boxes))
+    held = memory.held
+    assert len(held) == 1 and iou_xywh(stander, held).max() > 0.99, held
+
+
 def test_a_missed_object_is_held_then_forgotten():
     memory = StopMemory(hold_frames=1000)
     _walk_then_stand(memory, walk=30, stand=100)

@@ -10,7 +10,10 @@ that walked; for `PaperConfig.hold_frames` frames after it last moved, its box i
 the next frame's candidate pixels inside it are not learnt at all
 (``BackgroundModel.apply(hold=...)``), so a person who stops stays foreground. After that time
 the slow update absorbs it as before (a parked car, a bag left behind). Objects that never
-moved (a patch of changed light, a ghost, noise) are never held.
+moved (a patch of changed light, a ghost, noise) are never held. An object standing is also
+matched by the box where it stands (its last box of its own size before it stood): a
+passer-by who merges with it and walks on takes the merged box along, and the part left where
+it stands is still the person standing.
 """
 
 from __future__ import annotations
@@ -61,6 +64,7 @@ class StopMemory:
         self._since = np.zeros(0, np.int64)  # frame its anchor was set (first seen or moved)
         self._walked = np.zeros(0, bool)  # whether it ever moved
         self._missed = np.zeros(0, np.int64)  # frames since last matched
+        self._own: F64 = np.zeros((0, 4))  # its own size's last box (where it stands)
 
     @property
     def held(self) -> F64:
@@ -86,7 +90,15 @@ class StopMemory:
         centres = boxes[:, :2] + 0.5 * boxes[:, 2:]
         match = np.full(k, -1, np.int64)
         if k and len(self._boxes):
+            # against its last box or, for an object standing, the box where it stands: when
+            # a passer-by who merged with a person standing walks on, the part left where the
+            # person stands is the person, though the merged box followed the passer-by
             iou = _iou_matrix(boxes, self._boxes)
+            standing = self._walked & (self._frame - self._since >= STILL_FRAMES)
+            if standing.any():
+                iou[:, standing] = np.maximum(
+                    iou[:, standing], _iou_matrix(boxes, self._own[standing])
+                )
             pairs = np.argwhere(iou >= HOLD_IOU)
             # greedy, one to one: objects that walked first (a box left by a passer-by who
             # merged with a person standing is not taken for them), then best overlap first
@@ -99,6 +111,7 @@ class StopMemory:
         else:
             taken = np.zeros(len(self._boxes), bool)
         anchors = boxes.copy()
+        own = boxes.copy()
         since = np.full(k, self._frame, np.int64)
         walked = np.zeros(k, bool)
         old = match >= 0
@@ -115,6 +128,13 @@ class StopMemory:
             # them, entering the frame) is not the object moving: the anchor takes its new size
             ratio = boxes[old, 2:] / a[:, 2:]
             same = np.all((ratio >= 1 / HOLD_SIZE) & (ratio <= HOLD_SIZE), axis=1)
+            # its own box follows it while it walks, in boxes of about its size frame to frame
+            # (not a jump: a merge), and stays where it stood once it stands: a passer-by
+            # merging with it step by step does not take it along
+            grown = boxes[old, 2:] / self._own[j, 2:]
+            alone = np.all((grown >= 1 / HOLD_SIZE) & (grown <= HOLD_SIZE), axis=1)
+            alone &= self._frame - self._since[j] < STILL_FRAMES
+            own[np.flatnonzero(old)[~alone]] = self._own[j][~alone]
             anchors[np.flatnonzero(old)[~same]] = boxes[old][~same]
             far &= same
             idx = np.flatnonzero(old)[far]
@@ -126,6 +146,7 @@ class StopMemory:
         self._since = np.concatenate([since, self._since[~taken][kept]])
         self._walked = np.concatenate([walked, self._walked[~taken][kept]])
         self._missed = np.concatenate([np.zeros(k, np.int64), missed[kept]])
+        self._own = np.vstack([own, self._own[~taken][kept]])
 
     def hold_mask(self, shape: tuple[int, int]) -> NDArray[np.uint8] | None:
         """(H, W) uint8 mask of the held boxes (1 inside), or None when none is held."""
