@@ -7,13 +7,14 @@ sequences, before the table; ``BatchSummary.problems()`` listed them all too.
 from __future__ import annotations
 
 import json
+import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from pftrack._text import SaidBefore, opening
+from pftrack._text import SaidBefore, opening, said_alike
 from pftrack.batch import Job, TaskResult, run_jobs
 from pftrack.cli import main
 from pftrack.synthetic import make_scene
@@ -92,3 +93,16 @@ def test_the_command_says_a_repeated_warning_in_one_short_line(
     out, err_text = capsys.readouterr()
     assert err_text == f"3 sequences (a, b, c): warning: {said}\n"
     assert out.startswith("name ")
+
+
+def test_many_sequences_each_with_its_own_warning_are_listed_at_once() -> None:
+    """Each pair of messages was matched by a pattern built for it: 1000 sequences, each
+    with its own warning, took 37 s to list (0.2 s now; 5 s allowed for a loaded machine)."""
+    own = [(f"cam{k:04d}", f"frame {7 * k}: {k % 5} boxes outside the frame") for k in range(1000)]
+    named = [(f"v{k:04d}", f"/in/v{k:04d}.avi: ended after {k} frames") for k in range(1000)]
+    started = time.perf_counter()
+    assert said_alike(own) == [(m, [n]) for n, m in own]
+    assert said_alike(named) == [(m, [n]) for n, m in named]
+    before = SaidBefore()
+    assert all(before.first(n, m) is None for n, m in own + named)
+    assert time.perf_counter() - started < 5.0
