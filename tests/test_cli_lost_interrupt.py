@@ -122,10 +122,12 @@ def test_ctrl_c_inside_exec_still_exits_130_under_python_m(tmp_path):
 def test_ctrl_c_at_any_point_of_the_start_ends_in_130(tmp_path):
     """``python -m pftrack recover`` interrupted at seeded random moments of its first 0.7 s
     (for about 15 s): each run that reached the command (it says ``interrupted``) exits 130
-    and writes nothing; one not interrupted in time writes its whole output, status 0. A
-    Ctrl-C in Python's own start (``site``, the package's ``__init__``: its first 0.05-0.15
-    s), before pftrack's code runs, is Python's: its traceback, then killed by SIGINT (or, in
-    ``site``'s imports, "Fatal Python error: init_import_site", exit status 1)."""
+    and writes nothing (after Python's ``Exception ignored in: ...`` where the interrupt came
+    in a callback, which cannot raise it); one not interrupted in time writes its whole
+    output, status 0. A Ctrl-C in Python's own start (``site``, the package's ``__init__``:
+    its first 0.05-0.15 s), before pftrack's code runs, is Python's: its traceback, then
+    killed by SIGINT (or, in ``site``'s imports, "Fatal Python error: init_import_site",
+    exit status 1)."""
     tracks = make_scene(n_frames=20, n_walkers=2, rng=0).write_truth(tmp_path / "gt.txt")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
 
@@ -152,7 +154,15 @@ def test_ctrl_c_at_any_point_of_the_start_ends_in_130(tmp_path):
         status, err, out = recover(k, rng.uniform(0.0, 0.7))
         if "interrupted" in err:
             seen["interrupted"] += 1
-            assert (status, err) == (130, "pftrack recover: interrupted; no output was changed\n")
+            line = "pftrack recover: interrupted; no output was changed\n"
+            assert status == 130 and err.endswith(line), err
+            # before it, at most Python's note of the interrupt it dropped in a callback
+            # ("Exception ignored in: <function _get_module_lock.<locals>.cb ...>", importlib's)
+            dropped = err[: -len(line)]
+            assert not dropped or (
+                dropped.startswith("Exception ignored in: ")
+                and dropped.endswith("KeyboardInterrupt: \n")
+            ), err
             assert not out.exists()
         elif status == 0:
             seen["done"] += 1
