@@ -10,9 +10,11 @@ The ``pftrack`` process now remembers each Ctrl-C (:func:`pftrack._console.inter
 from __future__ import annotations
 
 import os
+import random
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -81,3 +83,93 @@ def test_an_ignored_sigint_stays_ignored(tmp_path):
     )  # fmt: skip
     assert status == 0, err
     assert out.read_text() != "an earlier run\n"
+
+
+# ``python -m`` of a module that runs the command as ``python -m pftrack`` does, with Ctrl-C
+# inside code run by exec() of a string (as a dataclass's generated __init__ is made)
+RUN_AS_MODULE = """
+import os, signal, sys, time
+import pftrack.recovery as where
+
+real = where.fill_gaps
+
+def interrupted(*args, **kwargs):
+    exec("os.kill(os.getpid(), signal.SIGINT)\\ntime.sleep(2)")
+    return real(*args, **kwargs)
+
+where.fill_gaps = interrupted
+from pftrack._console import main
+sys.exit(main())
+"""
+
+
+def test_ctrl_c_inside_exec_still_exits_130_under_python_m(tmp_path):
+    """CPython notes a KeyboardInterrupt that leaves an ``exec`` of a string as unhandled, even
+    once caught, and ``python -m`` then ends the process by SIGINT whatever its status: ``python
+    -m pftrack recover`` Ctrl-C'd 0.2-0.5 s in said ``interrupted`` and ended with returncode
+    -2 (killed by SIGINT), not 130, in up to 1 run in 10."""
+    tracks = make_scene(n_frames=20, n_walkers=2, rng=0).write_truth(tmp_path / "gt.txt")
+    out = tmp_path / "out.txt"
+    (tmp_path / "as_module.py").write_text(RUN_AS_MODULE)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    argv = [sys.executable, "-m", "as_module", "recover", str(tracks), "--out", str(out)]
+    proc = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=120)  # noqa: PLW1510
+    assert proc.stderr == "pftrack recover: interrupted; no output was changed\n"
+    assert proc.returncode == 130
+    assert not out.exists()
+
+
+def test_ctrl_c_at_any_point_of_the_start_ends_in_130(tmp_path):
+    """``python -m pftrack recover`` interrupted at seeded random moments of its first 0.7 s
+    (for about 15 s): each run that reached the command (it says ``interrupted``) exits 130
+    and writes nothing (after Python's ``Exception ignored in: ...`` where the interrupt came
+    in a callback, which cannot raise it); one not interrupted in time writes its whole
+    output, status 0. A Ctrl-C in Python's own start (``site``, the package's ``__init__``:
+    its first 0.05-0.15 s), before pftrack's code runs, is Python's: its traceback, then
+    killed by SIGINT (or, in ``site``'s imports, "Fatal Python error: init_import_site",
+    exit status 1)."""
+    tracks = make_scene(n_frames=20, n_walkers=2, rng=0).write_truth(tmp_path / "gt.txt")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+
+    def recover(k: int, delay: float | None) -> tuple[int, str, Path]:
+        out = tmp_path / f"out{k}.txt"
+        argv = [sys.executable, "-m", "pftrack", "-q", "recover", str(tracks), "--out", str(out)]
+        proc = subprocess.Popen(
+            argv, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+        )
+        if delay is not None:
+            time.sleep(delay)
+            proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+        return proc.returncode, err, out
+
+    status, err, whole = recover(0, None)
+    assert status == 0, err
+    rng = random.Random(0)
+    seen = {"interrupted": 0, "done": 0, "python": 0}
+    started = time.monotonic()
+    for k in range(1, 80):
+        if time.monotonic() - started > 15:
+            break
+        status, err, out = recover(k, rng.uniform(0.0, 0.7))
+        if "interrupted" in err:
+            seen["interrupted"] += 1
+            line = "pftrack recover: interrupted; no output was changed\n"
+            assert status == 130 and err.endswith(line), err
+            # before it, at most Python's note of the interrupt it dropped in a callback
+            # ("Exception ignored in: <function _get_module_lock.<locals>.cb ...>", importlib's)
+            dropped = err[: -len(line)]
+            assert not dropped or (
+                dropped.startswith("Exception ignored in: ")
+                and dropped.endswith("KeyboardInterrupt: \n")
+            ), err
+            assert not out.exists()
+        elif status == 0:
+            seen["done"] += 1
+            assert out.read_bytes() == whole.read_bytes()
+        else:  # Python's own start: not yet pftrack's command
+            seen["python"] += 1
+            assert err.endswith("KeyboardInterrupt\n"), err
+            assert status in (-signal.SIGINT, 1), err
+            assert "pftrack/cli" not in err and "_console.py" not in err, err
+    assert seen["interrupted"] >= 3, seen

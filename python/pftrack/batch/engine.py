@@ -244,31 +244,43 @@ class BatchSummary:
         of numbered names as ``first..last``, four items, then ``...``): ``29 sequences
         (cam01..cam29): error: ...``; so are errors that differ only where each names its own
         task, said with ``NAME`` there (``12 sequences (cam01..cam12): error: --detections auto:
-        sequence NAME has no det/det.txt (nor det.txt)``). Each entry keeps its own.
+        sequence NAME has no det/det.txt (nor det.txt)``). Warnings likewise (``40 sequences
+        (cam01..cam40): warning: ...``; was: one line each). Each entry keeps its own.
 
         Last, ``error: DIR/summary.json not written (...)`` if it could not be (and
         `unwritten`: an interrupted batch's last line says it instead).
         """
-        text = [
-            f"{e['name']}: warning: {w}"
-            for e in self.entries
-            if warned
-            for w in e.get("warnings", ())
-        ]
+        noun = "sequence" if self.kind == "track" else "file"
+        raised = [(e["name"], w) for e in self.entries if warned for w in e.get("warnings", ())]
         # one error said once, where several tasks failed with it (was: once per task, 29
         # identical lines for 29 sequences on a cluster that had lost its workers, a trial),
-        # or with the same words but their own names (was: one line each)
-        noun = "sequence" if self.kind == "track" else "file"
-        for error, names in said_alike([(e["name"], e["error"]) for e in self.failed]):
-            who = (
-                names[0]
-                if len(names) == 1
-                else f"{counted(len(names), noun)} ({listed_compactly(names)})"
-            )
-            text.append(f"{who}: error: {error}")
+        # or with the same words but their own names (was: one line each); warnings too
+        text = said_once(raised, noun, "warning")
+        text += said_once([(e["name"], e["error"]) for e in self.failed], noun, "error")
         if self.unwritten and unwritten:
             text.append(f"error: {self.unwritten}")
         return text
+
+
+def said_once(messages: list[tuple[str, str]], noun: str, level: str) -> list[str]:
+    """``NAME: LEVEL: message`` lines for ``(name, message)`` pairs, alike messages said once.
+
+    Messages in the same words, or that differ only where each names its own task, are one
+    line (:func:`pftrack._text.said_alike`), said for their count and names:
+    ``3 sequences (cam01..cam03): warning: ...``. `noun` names a task (``sequence``,
+    ``file``); `level` is ``warning`` or ``error``. A task that says a message twice is
+    named once.
+    """
+    lines = []
+    for message, said_by in said_alike(messages):
+        names = list(dict.fromkeys(said_by))
+        who = (
+            names[0]
+            if len(names) == 1
+            else f"{counted(len(names), noun)} ({listed_compactly(names)})"
+        )
+        lines.append(f"{who}: {level}: {message}")
+    return lines
 
 
 _STATUSES = ("done", "skipped", "failed", "cancelled")

@@ -220,12 +220,19 @@ def _environment_scheduler() -> Iterator[None]:
 
 def _run(command: str, call: Callable[[], BatchSummary], explain: bool = False) -> int:
     """Run the batch; print its table, or what stopped it; return the exit status."""
+    from pftrack._text import SaidBefore, opening
     from pftrack.batch.engine import named_as_options, warnings_as_they_come
     from pftrack.cli import said_above_bar
 
     said: set[str] = set()  # the tasks whose warnings were printed as they arrived
+    before = SaidBefore()
 
     def say(name: str, warning: str) -> None:
+        # a warning already said for another task, in the same words but for the names, in
+        # one short line (was: 40 sequences, 40 lines of the same warning)
+        first = before.first(name, warning)
+        if first is not None:
+            warning = f"the same as {first}'s ({opening(warning)})"
         said.add(name)
         said_above_bar(f"{name}: warning: {warning}")
 
@@ -264,16 +271,23 @@ def _print_table(summary: BatchSummary, said: set[str], unwritten: bool = True) 
     """`summary`'s table on stdout, its problems on stderr (stdout's table stays parseable).
 
     The warnings first: those of the tasks in `said` were printed as they arrived, the others'
-    (a skipped task's, from its earlier run) are printed here, before the table; the errors
-    after it. `unwritten`: with the line that says why ``summary.json`` is not written, if it
-    is not.
+    (a skipped task's, from its earlier run) are printed here, before the table, alike ones
+    once (:func:`~pftrack.batch.engine.said_once`); the errors after it. `unwritten`: with
+    the line that says why ``summary.json`` is not written, if it is not.
     """
-    earlier = [
-        f"{e['name']}: warning: {w}"
-        for e in summary.entries
-        if e["name"] not in said
-        for w in e.get("warnings", ())
-    ]
+    from pftrack.batch.engine import said_once
+
+    noun = "sequence" if summary.kind == "track" else "file"
+    earlier = said_once(
+        [
+            (e["name"], w)
+            for e in summary.entries
+            if e["name"] not in said
+            for w in e.get("warnings", ())
+        ],
+        noun,
+        "warning",
+    )
     if earlier:
         print("\n".join(earlier), file=sys.stderr)
         sys.stderr.flush()
