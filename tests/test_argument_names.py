@@ -629,7 +629,10 @@ NUMBER_SITES: dict[str, tuple[Callable[[object], object], str]] = {
         for name in "alpha alpha_fg k_noise t_min t_max low_ratio shadow_lo shadow_chroma".split()
     },
     **{
-        f"SizeModelConfig({name})": ((lambda n: lambda v: SizeModelConfig(**{n: v}))(name), name)
+        f"SizeModelConfig({name})": (
+            (lambda n: lambda v: SizeModelConfig(**{n: v}))(name),
+            f"SizeModelConfig: {name}",
+        )
         for name in ("split_ratio", "split_max_height", "merge_slack", "max_cut_share")
     },
     "GdtModel(dt)": (lambda v: GdtModel(dt=v), "GdtModel: dt"),  # type: ignore[arg-type]
