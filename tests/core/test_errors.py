@@ -520,7 +520,7 @@ def _masked_calls():
             [0.0, 1.0],
             "m0",
         ),
-        ("fill_gaps", lambda r: fill_gaps(r, "linear")[0], rows, "rows"),
+        ("fill_gaps", lambda r: fill_gaps(r, "linear")[0], rows, "tracks"),
         (
             "Tracker.update",
             lambda d: Tracker(seed=0).update(d, frame),

@@ -44,6 +44,9 @@ ENTRY_POINTS: dict[str, tuple[Callable[[Any], Any], Callable[[Any], Any] | None]
     "trajectories": (trajectories, None),
 }
 
+#: The argument each names in its messages, where it is not ``rows`` (its own name).
+ARGUMENT = {"fill_gaps": "tracks", "link_tracklets": "tracks"}
+
 LAYOUT = "(6 to 10 columns: frame, id, left, top, width, height[, conf, x, y, z])"
 
 ROWS = np.array(  # sorted by (frame, id), as write_mot writes them
@@ -73,7 +76,8 @@ def test_an_array_without_values_is_no_rows_everywhere(name: str, empty: Any) ->
 
 @pytest.mark.parametrize("name", list(ENTRY_POINTS))
 def test_ragged_rows_are_named(name: str) -> None:
-    message = f"{name}: rows must be a rectangular array of numbers, got rows of different lengths"
+    arg = ARGUMENT.get(name, "rows")
+    message = f"{name}: {arg} must be a rectangular array of numbers, got rows of different lengths"
     with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
         ENTRY_POINTS[name][0]([[1, 2, 3], [1, 2]])
 
@@ -83,14 +87,17 @@ def test_ragged_rows_are_named(name: str) -> None:
     "rows", [[["a"] * 10], ROWS.astype(complex), ROWS > 0], ids=["text", "complex", "bool"]
 )
 def test_rows_that_are_not_real_numbers_are_named(name: str, rows: Any) -> None:
-    with pytest.raises(TypeError, match=f"^{name}: rows must hold real numbers, got dtype "):
+    arg = ARGUMENT.get(name, "rows")
+    with pytest.raises(TypeError, match=f"^{name}: {arg} must hold real numbers, got dtype "):
         ENTRY_POINTS[name][0](rows)
 
 
 @pytest.mark.parametrize("name", list(ENTRY_POINTS))
 @pytest.mark.parametrize("shape", [(10,), (2, 3), (2, 5), (2, 11), (1, 1, 10)])
 def test_a_wrong_shape_has_one_message(name: str, shape: tuple[int, ...]) -> None:
-    message = f"{name}: rows must have shape (M, 6..10) {LAYOUT}, got {shape}"
+    message = (
+        f"{name}: {ARGUMENT.get(name, 'rows')} must have shape (M, 6..10) {LAYOUT}, got {shape}"
+    )
     with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
         ENTRY_POINTS[name][0](np.ones(shape))
 
