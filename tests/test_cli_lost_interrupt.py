@@ -120,8 +120,8 @@ def test_ctrl_c_inside_exec_still_exits_130_under_python_m(tmp_path):
 
 
 def test_ctrl_c_at_any_point_of_the_start_ends_in_130(tmp_path):
-    """``python -m pftrack recover`` interrupted at seeded random moments of its first 0.7 s
-    (for about 15 s): each run that reached the command (it says ``interrupted``) exits 130
+    """``python -m pftrack recover`` interrupted at seeded random moments of its run (for about
+    15 s): each run that reached the command (it says ``interrupted``) exits 130
     and writes nothing (after Python's ``Exception ignored in: ...`` where the interrupt came
     in a callback, which cannot raise it); one not interrupted in time writes its whole
     output, status 0. A Ctrl-C in Python's own start (``site``, the package's ``__init__``:
@@ -143,15 +143,19 @@ def test_ctrl_c_at_any_point_of_the_start_ends_in_130(tmp_path):
         _, err = proc.communicate(timeout=60)
         return proc.returncode, err, out
 
+    began = time.monotonic()
     status, err, whole = recover(0, None)
     assert status == 0, err
+    # the moments are drawn over the whole run's length on this machine (an installed wheel's
+    # run can end in 0.2 s, a development tree's in over 1 s: fixed moments missed the first)
+    length = time.monotonic() - began
     rng = random.Random(0)
     seen = {"interrupted": 0, "done": 0, "python": 0}
     started = time.monotonic()
     for k in range(1, 80):
         if time.monotonic() - started > 15:
             break
-        status, err, out = recover(k, rng.uniform(0.0, 0.7))
+        status, err, out = recover(k, rng.uniform(0.0, length))
         if "interrupted" in err:
             seen["interrupted"] += 1
             line = "pftrack recover: interrupted; no output was changed\n"
@@ -169,7 +173,8 @@ def test_ctrl_c_at_any_point_of_the_start_ends_in_130(tmp_path):
             assert out.read_bytes() == whole.read_bytes()
         else:  # Python's own start: not yet pftrack's command
             seen["python"] += 1
-            assert err.endswith("KeyboardInterrupt\n"), err
+            # (nothing said at all when the signal came before Python set its handler)
+            assert err.endswith("KeyboardInterrupt\n") or not err, err
             assert status in (-signal.SIGINT, 1), err
             assert "pftrack/cli" not in err and "_console.py" not in err, err
     assert seen["interrupted"] >= 3, seen
