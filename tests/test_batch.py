@@ -2463,7 +2463,10 @@ def test_the_figures_docs_batch_md_quotes_are_the_batchs(client: Any, tmp_path: 
     root = dataset("pets09-s2l1").parent
     dataset("tud-campus")
     doc = (Path(__file__).resolve().parents[1] / "docs" / "batch.md").read_text()
-    summary = track_many(root, tmp_path, client, options=TrackOptions(detections="auto"))
+    # the data folder's mot15-gt/ holds annotations alone: passed over, said in one warning
+    said = pytest.warns(UserWarning, match="passed over .*mot15-gt")
+    with said if (root / "mot15-gt").is_dir() else contextlib.nullcontext():
+        summary = track_many(root, tmp_path, client, options=TrackOptions(detections="auto"))
     rows = {line.split()[0]: line.split() for line in summary.table().splitlines()}
     for name in ("pets09-s2l1", "tud-campus"):
         (quoted,) = [line.split() for line in doc.splitlines() if line.startswith(f"{name}  ")]
