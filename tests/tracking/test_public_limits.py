@@ -14,15 +14,15 @@ from pftrack.assignment import linear_sum_assignment
 from pftrack.eval import evaluate_sequence, iou_xywh
 from pftrack.io.mot import as_written, group_by_frame, read_mot
 from pftrack.io.video import FrameSource
-from pftrack.tracking import load_detections, track_frames
+from pftrack.tracking import LifecycleConfig, TrackerConfig, load_detections, track_frames
 from tests.conftest import dataset
 
 
-def _tud_campus() -> tuple[np.ndarray, np.ndarray]:
+def _tud_campus(config: TrackerConfig | None = None) -> tuple[np.ndarray, np.ndarray]:
     """TUD-Campus's truth and `pftrack track`'s rows with its public detections, seed 0."""
     folder = dataset("tud-campus")
     dets = load_detections(folder / "det.txt")
-    run = track_frames(FrameSource(folder / "video.mp4"), detections=dets, rng=0)
+    run = track_frames(FrameSource(folder / "video.mp4"), detections=dets, config=config, rng=0)
     return read_mot(folder / "gt.txt"), as_written(run.rows)
 
 
@@ -64,10 +64,24 @@ def test_tud_campus_misses_are_one_half_hidden_person():
     "75.2, and 59 of its 61 misses are one half-hidden person whose detections miss the "
     "annotation; lower or higher birth gates, earlier confirmation, a longer tentative coast, "
     "a backward extension and a weaker smoother were measured and not kept (docs/tracking.md, "
-    "'What limits MOTA with public detections')",
+    "'What limits MOTA with public detections'); leaving out tracks sized unlike the scene's "
+    "people reaches it (below) but is an option, off by default",
     raises=AssertionError,
     strict=True,
 )
 def test_tud_campus_public_detections_reach_the_held_out_mota():
     gt, rows = _tud_campus()
     assert evaluate_sequence(gt, rows).mot.mota >= 0.78
+
+
+@pytest.mark.dataset
+def test_tud_campus_reaches_the_held_out_mota_without_its_odd_sized_track():
+    """`LifecycleConfig.size_ratio=0.8` leaves out TUD-Campus's one false track, 15 rows of a
+    30x52 px box on a person's upper body, twice the height the line of the detections'
+    heights gives at its foot row: 75.2 -> 79.4 MOTA, the misses unchanged. Not the default:
+    it costs the zoomed, moving TUD-Campus of experiments.moving_camera 0.6 IDF1
+    (docs/tracking.md, "Tracks sized unlike the scene's people")."""
+    gt, rows = _tud_campus(TrackerConfig(lifecycle=LifecycleConfig(size_ratio=0.8)))
+    scores = evaluate_sequence(gt, rows).mot
+    assert scores.mota >= 0.78
+    assert len(_missed_ids(gt, rows)) == 61

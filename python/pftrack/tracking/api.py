@@ -85,7 +85,13 @@ from pftrack.detection.size_model import PersonSizeModel
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
-from pftrack.tracking.offline import BoxSmoother, CrossingConfig, complete_boxes, drop_nested
+from pftrack.tracking.offline import (
+    BoxSmoother,
+    CrossingConfig,
+    complete_boxes,
+    drop_nested,
+    drop_odd_sizes,
+)
 from pftrack.tracking.track import Track
 from pftrack.tracking.tracker import MultiObjectTracker
 from pftrack.tracking.writer import TrackWriter
@@ -818,6 +824,7 @@ class Tracker:
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
+        self.__dict__.setdefault("_sizes", [])  # a checkpoint pickled before size_ratio
         self._busy = threading.Lock()
 
     def reset(self) -> None:
@@ -836,6 +843,8 @@ class Tracker:
             self._stood = 0  # stand-ins among the frames taken (pftrack._stand_in)
             self._max_conf = -np.inf
             self._given = False  # some update() of the run had detections
+            # foot row, height, class of the given boxes, working pixels (drop_odd_sizes)
+            self._sizes: list[F64] = []
             self._layout = (0, 0)  # inverted boxes, boxes with an extent (check_boxes_xyxy)
             # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
             # with the run's first frame (None: tracked at the frame's own size)
@@ -1282,6 +1291,12 @@ class Tracker:
             reports = self._step(work, xywh, cls)
             # once the frame is taken (an update that raises changes nothing)
             self._given = True
+            life = self.config.lifecycle
+            scored = xywh[:, 4] >= life.min_score
+            if life.size_ratio is not None and scored.any():
+                box = xywh[scored]
+                c = np.zeros(len(box)) if cls is None else cls[scored].astype(np.float64)
+                self._sizes.append(np.column_stack([box[:, 1] + box[:, 3], box[:, 3], c]))
             self._layout = (self._layout[0] + inverted, self._layout[1] + extent)
             self._max_conf = max(self._max_conf, confidence)
         self.frame_count += 1
@@ -1488,6 +1503,13 @@ class Tracker:
                 )
             )
             life = self.config.lifecycle
+            if smoothed and self._given and life.size_ratio is not None and self._sizes:
+                # tracks sized unlike the detections' people at their row (size_ratio)
+                shape = self._tracker.frame_shape
+                rows = drop_odd_sizes(
+                    rows, np.vstack(self._sizes), life.size_ratio, shape[0] if shape else None,
+                    self._writer.classes,
+                )  # fmt: skip
             if smoothed and not self._given and life.nested_inside is not None and len(rows):
                 # the built-in detector's fragments (LifecycleConfig.nested_inside)
                 rows = drop_nested(rows, life.nested_inside, life.nested_area)

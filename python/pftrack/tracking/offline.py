@@ -15,7 +15,7 @@ the smoothed boxes match the annotation far more often than the detections thems
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from typing import Literal
 
@@ -27,7 +27,7 @@ from pftrack._check import MAX_FRAME, brief, real_array
 from pftrack._progress import progress
 from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
-from pftrack.detection.size_model import expected_size, head_height
+from pftrack.detection.size_model import expected_size, head_height, theil_sen
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
 from pftrack.recovery.fill import DEFAULT_MAX_GAP, MAX_GAP_LIMIT, fill_rows
 from pftrack.recovery.linking import (
@@ -48,6 +48,7 @@ __all__ = [
     "CrossingConfig",
     "complete_boxes",
     "drop_nested",
+    "drop_odd_sizes",
     "repair_crossings",
     "smooth_tracks",
     "smoothed_copies",
@@ -56,6 +57,9 @@ __all__ = [
 
 AMODAL_ANCHORS = ("side", "centre")  # complete_boxes: where a widened box keeps its evidence
 TOP_EDGE = 1.0  # complete_boxes: a box whose top is within this many px of row 0 touches the edge
+BOTTOM_EDGE = 2.0  # drop_odd_sizes: a box whose foot is within this many px of the last row is cut
+SIZE_SAMPLES = 1500  # drop_odd_sizes: detections the height line is fitted to, evenly spaced
+MIN_SIZE_SAMPLES = 30  # drop_odd_sizes: a class with fewer detections is not judged
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
 
@@ -678,6 +682,89 @@ def drop_nested(rows: ArrayLike, inside: float = 0.8, area_ratio: float = 1.5) -
         overlap = _intersection(box[i], box[j])  # area of box i inside box j
         covered = (overlap > inside * area[i]) & (area[j] > area_ratio * area[i])
         drop[i[covered]] = True
+    return a[~drop]
+
+
+def drop_odd_sizes(
+    rows: ArrayLike,
+    sizes: ArrayLike,
+    ratio: float,
+    frame_height: float | None = None,
+    classes: Mapping[int, int] | None = None,
+) -> F64:
+    """Leave out every track whose boxes are far smaller or larger than the detections' people.
+
+    A Theil-Sen line of box height against foot row (``top + height``) is fitted to the run's
+    detections of each class (`sizes`; at most 1500 of them, evenly spaced in their order). A
+    track whose median of ``height / expected height at its foot row`` over its rows is below
+    `ratio` or above ``1 / ratio`` is left out whole: a person detector's confident false
+    boxes that a track followed (a part of a person, something that is no person) are sized
+    unlike the people at their row (docs/tracking.md, "Tracks sized unlike
+    the scene's people"). Boxes whose foot lies within 2 px of the frame's last row (cut by
+    the frame) are not used, neither for the line nor for a track's ratio; the line's expected
+    height is at least 1 px. A track with no row left to judge, and every track of a class
+    with fewer than 30 usable detections, is kept.
+
+    Parameters
+    ----------
+    rows : (M, 6..10) array_like
+        MOTChallenge rows ``frame, id, left, top, width, height, ...`` of finished tracks.
+    sizes : (K, 2) or (K, 3) array_like
+        ``foot row, height[, class]`` of the run's detection boxes, in the rows' pixels.
+    ratio : float
+        In (0, 1).
+    frame_height : float, optional
+        The frame's height in the rows' pixels (None: no box is taken as cut by the frame).
+    classes : mapping of int to int, optional
+        The class of each id of `rows` (None or a missing id: class 0).
+
+    Returns
+    -------
+    (M', 10) ndarray
+        Every row of the tracks kept, in the order of `rows`.
+
+    Raises
+    ------
+    TypeError
+        `ratio` is not a number.
+    ValueError
+        Bad rows or sizes, or `ratio` outside (0, 1).
+    """
+    _check.number(ratio, "drop_odd_sizes: ratio", finite=False)
+    if not 0.0 < ratio < 1.0:
+        raise ValueError(f"drop_odd_sizes: ratio is {ratio}, expected a value in (0, 1)")
+    a: F64 = check_rows(rows, "drop_odd_sizes")
+    s = np.asarray(sizes, dtype=np.float64)
+    if s.ndim != 2 or s.shape[1] not in (2, 3) or not np.isfinite(s).all():
+        raise ValueError(
+            f"drop_odd_sizes: sizes has shape {s.shape}, expected (K, 2) or (K, 3) finite "
+            "rows foot row, height[, class]"
+        )
+    if len(a) == 0 or len(s) == 0:
+        return a
+    det_cls = s[:, 2] if s.shape[1] == 3 else np.zeros(len(s))
+    foot, height = a[:, 3] + a[:, 5], a[:, 5]
+    usable = (s[:, 1] > 0) & (frame_height is None or s[:, 0] < frame_height - BOTTOM_EDGE)
+    rows_in = np.ones(len(a), bool) if frame_height is None else foot < frame_height - BOTTOM_EDGE
+    own = classes or {}
+    row_cls = np.array([own.get(int(i), 0) for i in a[:, 1]], np.float64)
+    drop = np.zeros(len(a), dtype=bool)
+    for c in np.unique(row_cls):
+        k = usable & (det_cls == c)
+        if k.sum() < MIN_SIZE_SAMPLES or np.ptp(s[k, 0]) == 0:
+            continue
+        x, h = s[k, 0], s[k, 1]
+        pick = np.linspace(0, len(x) - 1, min(len(x), SIZE_SAMPLES)).astype(np.int64)
+        slope, intercept = theil_sen(x[pick], h[pick])
+        expected = np.maximum(slope * foot + intercept, 1.0)
+        judged = (row_cls == c) & rows_in
+        for i in np.unique(a[row_cls == c, 1]):
+            r = judged & (a[:, 1] == i)
+            if not r.any():
+                continue
+            q = float(np.median(height[r] / expected[r]))
+            if q < ratio or q > 1.0 / ratio:
+                drop |= a[:, 1] == i
     return a[~drop]
 
 
