@@ -136,8 +136,9 @@ class PaperConfig:
         (instead of at `alpha_fg`): a person who walked and stopped stays foreground that
         long, then `alpha_fg` absorbs them as before. 0 (the default) turns it off: 1000
         finds a person standing 300-600 frames, but moves PETS09-S2L1 re-encoded as JPEG
-        (quality 95) from 82.5 / 83.0 / 60.4 to 80.9 / 75.0 / 56.0 MOTA / IDF1 / HOTA
-        (docs/detection.md, "A person who stands for hundreds of frames").
+        (quality 95) from 82.5 / 83.0 / 60.4 to 81.1 / 75.1 / 56.0 MOTA / IDF1 / HOTA, and a
+        rule judging stillness over 50 frames still loses 0.4 MOTA there (docs/detection.md,
+        "A person who stands for hundreds of frames").
     gain_thresholds : bool
         With the gain rule, scale the grey-level threshold bounds `t_min`, `t_max` by the
         accumulated gain since the first frame (``BackgroundModel.set_threshold_scale``), up
