@@ -610,41 +610,44 @@ class Tracker:
         moves = _moves(moves)
         base = TrackerConfig()
         model = replace(base.filter.model, use_means=dynamics == "ar2-mean")
-        config = replace(
-            base,
-            filter=replace(
-                base.filter, n_particles=int(particles or base.filter.n_particles), model=model
-            ),
-            given_particles=base.given_particles if particles is None else None,
-            detector=detector,
-            sampler=sampler,
-            mh_iter=mh_iter,
-            mh_proposal=mh_proposal,
-            mh_rw_sigma=tau,  # type: ignore[arg-type]
-            rjmcmc=replace(
-                base.rjmcmc,
-                burn_in=burn_in,
-                p_birth=moves[0],
-                p_death=moves[1],
-                p_update=moves[2],
-                p_swap=moves[3],
-            ),  # fmt: skip
-            camera_motion=camera_motion,
-            max_side=max_side,
-            refine=replace(base.refine, enabled=refine),
-            crossings=replace(base.crossings, enabled=crossings),
-            lifecycle=replace(
-                base.lifecycle,
-                max_coast=(
-                    base.lifecycle.max_coast
-                    if max_coast is None
-                    else _frames(max_coast, frame_rate, "max_coast")
+        try:  # the arguments share the settings' names: not the class the caller never built
+            config = replace(
+                base,
+                filter=replace(
+                    base.filter, n_particles=int(particles or base.filter.n_particles), model=model
                 ),
-                min_score=min_conf,
-                birth_score=birth_score,
-                birth_quantile=birth_quantile,
-            ),
-        )
+                given_particles=base.given_particles if particles is None else None,
+                detector=detector,
+                sampler=sampler,
+                mh_iter=mh_iter,
+                mh_proposal=mh_proposal,
+                mh_rw_sigma=tau,  # type: ignore[arg-type]
+                rjmcmc=replace(
+                    base.rjmcmc,
+                    burn_in=burn_in,
+                    p_birth=moves[0],
+                    p_death=moves[1],
+                    p_update=moves[2],
+                    p_swap=moves[3],
+                ),  # fmt: skip
+                camera_motion=camera_motion,
+                max_side=max_side,
+                refine=replace(base.refine, enabled=refine),
+                crossings=replace(base.crossings, enabled=crossings),
+                lifecycle=replace(
+                    base.lifecycle,
+                    max_coast=(
+                        base.lifecycle.max_coast
+                        if max_coast is None
+                        else _frames(max_coast, frame_rate, "max_coast")
+                    ),
+                    min_score=min_conf,
+                    birth_score=birth_score,
+                    birth_quantile=birth_quantile,
+                ),
+            )
+        except (TypeError, ValueError) as e:
+            raise type(e)(str(e).removeprefix("TrackerConfig: ")) from None
         unread = unread_error(
             sampler,
             {"mh_iter": mh_iter, "mh_proposal": mh_proposal, "mh_rw_sigma": tau,

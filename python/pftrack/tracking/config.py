@@ -145,18 +145,23 @@ def _joint_settings_used(config: TrackerConfig) -> None:
             continue
         shown_v = list(np.asarray(v, float).tolist()) if name in ("a", "b", "sigma") else v
         raise ValueError(
-            f"rjmcmc.{name} is {shown_v}, but the joint sampler takes it from {where}, so "
-            "it would do nothing: set it there (the same budget and dynamics for every sampler)"
+            f"TrackerConfig: rjmcmc.{name} is {shown_v}, but the joint sampler takes it from "
+            f"{where}, so it would do nothing: set it there (the same budget and dynamics for "
+            "every sampler)"
         )
 
 
-def _none_or_int_in(config: object, name: str, lo: int, hi: int, none: str = "None") -> None:
+def _none_or_int_in(
+    owner: str, config: object, name: str, lo: int, hi: int, none: str = "None"
+) -> None:
     """`config.name` must be None or an int (not a bool) in [lo, hi] (`none`: None's name)."""
     v = getattr(config, name)
     if v is not None and (
         isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi
     ):
-        raise ValueError(f"{name} is {brief(v)}, expected {none} or an int in [{lo}, {hi}]")
+        raise ValueError(
+            f"{owner}: {name} is {brief(v)}, expected {none} or an int in [{lo}, {hi}]"
+        )
 
 
 @dataclass(frozen=True)
@@ -773,11 +778,11 @@ class TrackerConfig:
 
     def __post_init__(self) -> None:
         for name, cls in _SUB_CONFIGS:  # were taken, and failed at a frame naming no setting
-            instance(getattr(self, name), name, cls)
-        option(self.sampler, "sampler", SAMPLERS)  # before the sampler is compared below
-        option(self.camera_motion, "camera_motion", CAMERA_MOTION)
-        option(self.detector, "detector", DETECTORS)
-        _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
+            instance(getattr(self, name), f"TrackerConfig: {name}", cls)
+        option(self.sampler, "TrackerConfig: sampler", SAMPLERS)  # before it is compared below
+        option(self.camera_motion, "TrackerConfig: camera_motion", CAMERA_MOTION)
+        option(self.detector, "TrackerConfig: detector", DETECTORS)
+        _none_or_int_in("TrackerConfig", self, "given_particles", 1, MAX_PARTICLES)
         integer(self.mh_iter, "TrackerConfig: mh_iter", 1, MAX_MH_ITER)
         option(self.mh_proposal, "TrackerConfig: mh_proposal", MH_PROPOSALS)
         tau = real_array(self.mh_rw_sigma, "TrackerConfig: mh_rw_sigma", booleans=False)
@@ -795,7 +800,7 @@ class TrackerConfig:
             )
             if too_many:
                 raise ValueError(too_many)
-        _none_or_int_in(self, "open_size", 1, MAX_OPEN_SIZE)
+        _none_or_int_in("TrackerConfig", self, "open_size", 1, MAX_OPEN_SIZE)
         integer(self.hold_frames, "TrackerConfig: hold_frames", 0, 2**31 - 1)
         if self.hold_frames and self.detector != "paper":
             raise ValueError(
@@ -805,7 +810,7 @@ class TrackerConfig:
         side = self.max_side
         if isinstance(side, (int, np.integer)) and not isinstance(side, bool) and side == 0:
             object.__setattr__(self, "max_side", None)  # 0 is off, as --max-side 0: stored None
-        _none_or_int_in(self, "max_side", MIN_SIDE, MAX_SIDE, "None (or 0: off)")
+        _none_or_int_in("TrackerConfig", self, "max_side", MIN_SIDE, MAX_SIDE, "None (or 0: off)")
         if self.pixel_diagonal is not None and not (
             isinstance(self.pixel_diagonal, (int, float, np.integer, np.floating))
             and not isinstance(self.pixel_diagonal, bool)
@@ -813,24 +818,29 @@ class TrackerConfig:
             and self.pixel_diagonal > 0
         ):
             raise ValueError(
-                f"pixel_diagonal is {brief(self.pixel_diagonal)}, expected None or a finite value "
-                "> 0"
+                f"TrackerConfig: pixel_diagonal is {brief(self.pixel_diagonal)}, expected None or "
+                "a finite value > 0"
             )
         if self.sampler == "rjmcmc" and self.filter.model.use_means:
             raise ValueError(
-                "the AR(2) model on the particle-set means (use_means; --dynamics ar2-mean) "
-                "needs a per-object sampler ('sis' or 'mh'; --sampler): the joint 'rjmcmc' "
-                "sampler moves each object on its own state"
+                "TrackerConfig: the AR(2) model on the particle-set means (use_means; --dynamics "
+                "ar2-mean) needs a per-object sampler ('sis' or 'mh'; --sampler): the joint "
+                "'rjmcmc' sampler moves each object on its own state"
             )
         _joint_settings_used(self)
         if self.camera_motion not in CAMERA_MOTION:
             raise ValueError(
-                f"camera_motion is {self.camera_motion!r}, expected 'auto', 'on' or 'off'"
+                f"TrackerConfig: camera_motion is {self.camera_motion!r}, expected 'auto', 'on' "
+                "or 'off'"
             )
         if self.sampler not in SAMPLERS:
-            raise ValueError(f"sampler is {self.sampler!r}, expected 'sis', 'mh' or 'rjmcmc'")
+            raise ValueError(
+                f"TrackerConfig: sampler is {self.sampler!r}, expected 'sis', 'mh' or 'rjmcmc'"
+            )
         if self.detector not in DETECTORS:
-            raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
+            raise ValueError(
+                f"TrackerConfig: detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'"
+            )
         _in_unit_interval("TrackerConfig", reference_rate=self.reference_rate)
 
     def pixel_scale(self, width: int, height: int) -> float:
