@@ -607,22 +607,18 @@ def test_a_repr_of_one_line_is_kept() -> None:
 #: numbers first: an array or a DataFrame was asked for its truth ("The truth value ... is
 #: ambiguous", naming nothing), and a str failed with "'<=' not supported".
 NUMBER_SITES: dict[str, tuple[Callable[[object], object], str]] = {
-    "BlobConfig(min_area)": (
-        lambda v: BlobConfig(min_area=v),  # type: ignore[arg-type]
-        "BlobConfig: min_area",
-    ),
-    "BlobConfig(split_valley)": (
-        lambda v: BlobConfig(split_valley=v),  # type: ignore[arg-type]
-        "BlobConfig: split_valley",
-    ),
-    "PaperConfig(ghost_support)": (
-        lambda v: PaperConfig(ghost_support=v),  # type: ignore[arg-type]
-        "PaperConfig: ghost_support",
-    ),
-    "PaperConfig(gain_band)": (
-        lambda v: PaperConfig(gain_band=v),  # type: ignore[arg-type]
-        "PaperConfig: gain_band",
-    ),
+    **{
+        f"{cls.__name__}({name})": (
+            (lambda c, n: lambda v: c(**{n: v}))(cls, name),
+            f"{cls.__name__}: {name}",
+        )
+        for cls, name in (
+            (BlobConfig, "min_area"),
+            (BlobConfig, "split_valley"),
+            (PaperConfig, "ghost_support"),
+            (PaperConfig, "gain_band"),
+        )
+    },
     "CrossingConfig(min_iou)": (lambda v: CrossingConfig(min_iou=v), "CrossingConfig: min_iou"),  # type: ignore[arg-type]
     "CrossingConfig(margin)": (lambda v: CrossingConfig(margin=v), "CrossingConfig: margin"),  # type: ignore[arg-type]
     "drop_nested(inside)": (lambda v: drop_nested(ROWS, inside=v), "drop_nested: inside"),  # type: ignore[arg-type]

@@ -24,6 +24,7 @@ from pftrack.synthetic import make_scene
 from pftrack.tracking.run import track_frames, track_path
 from tests.io.test_estimated_count import write_vfr
 from tests.io.test_live_cut import _cut, _stream
+from tests.io.test_video import damaged_inside
 from tests.tracking.test_damaged_start import _damaged_start
 
 pytest.importorskip("av")
@@ -88,17 +89,6 @@ def test_a_warning_made_an_error_stops_the_run_between_frames(tmp_path: Path) ->
     assert "run.py" in where and "video.py" not in where and "prefetch.py" not in where, where
 
 
-def _damaged_inside(tmp: Path) -> Path:
-    """A 30-frame MJPEG video whose frame 10 does not decode (as tests/io/test_video.py's)."""
-    path = make_scene(n_frames=30, rng=0).write_video(tmp / "walk.avi")
-    data = bytearray(path.read_bytes())
-    at = int(len(data) * 0.3)
-    data[at : at + 20000] = np.random.default_rng(1).bytes(20000)  # inside frame 10
-    damaged = tmp / "damaged.avi"
-    damaged.write_bytes(bytes(data))
-    return damaged
-
-
 STOOD_IN = "damaged.avi: frame 10 could not be decoded (a damaged file?): the frame before stands"
 
 
@@ -109,7 +99,7 @@ def test_a_stand_in_among_the_spread_bootstraps_frames_is_said_naming_the_users_
     """The spread bootstrap's frames 0, 3, 6, 9 (frame 10, standing in), ... of a video whose
     frame 10 does not decode: its pass says so, once, from the line that asked for them
     (apinames, 6 December; was: nothing, the stand-in taken for frame 10 without a word)."""
-    damaged = _damaged_inside(tmp_path)
+    damaged = damaged_inside(tmp_path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # said there too: another source
         iterated = list(FrameSource(damaged))
@@ -139,7 +129,7 @@ def test_a_stand_in_among_the_bootstrap_frames_stops_a_run_under_w_error_before_
         warnings.simplefilter("error")
         with pytest.raises(UserWarning, match="frame 10 could not be decoded"):
             track_frames(
-                FrameSource(_damaged_inside(tmp_path)),
+                FrameSource(damaged_inside(tmp_path)),
                 prime_frames=11,
                 on_frame=lambda n, *_: tracked.append(n),
             )
