@@ -812,7 +812,7 @@ class Tracker:
         detector = getattr(self._tracker, "_detector", None)
         if isinstance(getattr(detector, "_sub", None), cv2.BackgroundSubtractor):
             raise TypeError(
-                f"detector={self.config.detector!r} cannot be checkpointed (pickle/deepcopy) "
+                f"detector={self.config.detector_name!r} cannot be checkpointed (pickle/deepcopy) "
                 "once primed or given a frame: OpenCV's background subtractors cannot be "
                 "pickled; use detector='paper'"
             )
