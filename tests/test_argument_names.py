@@ -517,10 +517,13 @@ REPR_SITES: dict[str, tuple[Callable[[object], object], str]] = {
     ),
     "link_tracklets(config)": (lambda v: link_tracklets(ROWS, v), "link_tracklets: config"),  # type: ignore[arg-type]
     "Tracker(max_side)": (lambda v: pftrack.Tracker(max_side=v), "max_side"),  # type: ignore[arg-type]
-    "TrackerConfig(open_size)": (lambda v: TrackerConfig(open_size=v), "open_size"),  # type: ignore[arg-type]
+    "TrackerConfig(open_size)": (
+        lambda v: TrackerConfig(open_size=v),  # type: ignore[arg-type]
+        "TrackerConfig: open_size",
+    ),  # type: ignore[arg-type]
     "TrackerConfig(pixel_diagonal)": (
         lambda v: TrackerConfig(pixel_diagonal=v),  # type: ignore[arg-type]
-        "pixel_diagonal",
+        "TrackerConfig: pixel_diagonal",
     ),
     "CameraConfig(max_side)": (lambda v: CameraConfig(max_side=v), "CameraConfig: max_side"),  # type: ignore[arg-type]
     "MotionConfig(speed_span)": (
@@ -561,9 +564,12 @@ REPR_SITES: dict[str, tuple[Callable[[object], object], str]] = {
     ),
     "hsv_bins(binning)": (lambda v: pftrack.hsv_bins(_frame(), binning=v), "hsv_bins: binning"),  # type: ignore[arg-type]
     "RJMCMCFilter(config)": (lambda v: RJMCMCFilter(config=v), "RJMCMCFilter: config"),  # type: ignore[arg-type]
-    "BlobConfig(open_size)": (lambda v: BlobConfig(open_size=v), "open_size"),  # type: ignore[arg-type]
-    "RecoverOptions(max_gap)": (lambda v: RecoverOptions(max_gap=v), "max_gap"),  # type: ignore[arg-type]
-    "TrackOptions(seed)": (lambda v: TrackOptions(seed=v), "seed"),  # type: ignore[arg-type]
+    "BlobConfig(open_size)": (lambda v: BlobConfig(open_size=v), "BlobConfig: open_size"),  # type: ignore[arg-type]
+    "RecoverOptions(max_gap)": (
+        lambda v: RecoverOptions(max_gap=v),  # type: ignore[arg-type]
+        "RecoverOptions: max_gap",
+    ),  # type: ignore[arg-type]
+    "TrackOptions(seed)": (lambda v: TrackOptions(seed=v), "TrackOptions: seed"),  # type: ignore[arg-type]
     "track_many(options)": (
         lambda v: pftrack.batch.track_many([], "never-written", options=v),  # type: ignore[arg-type]
         "track_many: options",
@@ -601,10 +607,18 @@ def test_a_repr_of_one_line_is_kept() -> None:
 #: numbers first: an array or a DataFrame was asked for its truth ("The truth value ... is
 #: ambiguous", naming nothing), and a str failed with "'<=' not supported".
 NUMBER_SITES: dict[str, tuple[Callable[[object], object], str]] = {
-    "BlobConfig(min_area)": (lambda v: BlobConfig(min_area=v), "min_area"),  # type: ignore[arg-type]
-    "BlobConfig(split_valley)": (lambda v: BlobConfig(split_valley=v), "split_valley"),  # type: ignore[arg-type]
-    "PaperConfig(ghost_support)": (lambda v: PaperConfig(ghost_support=v), "ghost_support"),  # type: ignore[arg-type]
-    "PaperConfig(gain_band)": (lambda v: PaperConfig(gain_band=v), "gain_band"),  # type: ignore[arg-type]
+    **{
+        f"{cls.__name__}({name})": (
+            (lambda c, n: lambda v: c(**{n: v}))(cls, name),
+            f"{cls.__name__}: {name}",
+        )
+        for cls, name in (
+            (BlobConfig, "min_area"),
+            (BlobConfig, "split_valley"),
+            (PaperConfig, "ghost_support"),
+            (PaperConfig, "gain_band"),
+        )
+    },
     "CrossingConfig(min_iou)": (lambda v: CrossingConfig(min_iou=v), "CrossingConfig: min_iou"),  # type: ignore[arg-type]
     "CrossingConfig(margin)": (lambda v: CrossingConfig(margin=v), "CrossingConfig: margin"),  # type: ignore[arg-type]
     "drop_nested(inside)": (lambda v: drop_nested(ROWS, inside=v), "drop_nested: inside"),  # type: ignore[arg-type]
@@ -625,7 +639,10 @@ NUMBER_SITES: dict[str, tuple[Callable[[object], object], str]] = {
     # these took an array or a DataFrame without a word (PaperConfig's went to the C++
     # background model, GdtModel's to the recovery), or asked it for its truth
     **{
-        f"PaperConfig({name})": ((lambda n: lambda v: PaperConfig(**{n: v}))(name), name)
+        f"PaperConfig({name})": (
+            (lambda n: lambda v: PaperConfig(**{n: v}))(name),
+            f"PaperConfig: {name}",
+        )
         for name in "alpha alpha_fg k_noise t_min t_max low_ratio shadow_lo shadow_chroma".split()
     },
     **{
@@ -669,7 +686,7 @@ SUB_CONFIG_SITES: dict[str, tuple[Callable[[object], object], str, str]] = {
     **{
         f"TrackerConfig({name})": (
             (lambda n: lambda v: TrackerConfig(**{n: v}))(name),
-            name,
+            f"TrackerConfig: {name}",
             type(getattr(TrackerConfig(), name)).__name__,
         )
         for name in (
@@ -685,8 +702,8 @@ SUB_CONFIG_SITES: dict[str, tuple[Callable[[object], object], str, str]] = {
         )  # fmt: skip
     },
     "FilterConfig(model)": (lambda v: FilterConfig(model=v), "FilterConfig: model", "Ar2Model"),  # type: ignore[arg-type]
-    "PaperConfig(blobs)": (lambda v: PaperConfig(blobs=v), "blobs", "BlobConfig"),  # type: ignore[arg-type]
-    "PaperConfig(hsv)": (lambda v: PaperConfig(hsv=v), "hsv", "HsvBinning"),  # type: ignore[arg-type]
+    "PaperConfig(blobs)": (lambda v: PaperConfig(blobs=v), "PaperConfig: blobs", "BlobConfig"),  # type: ignore[arg-type]
+    "PaperConfig(hsv)": (lambda v: PaperConfig(hsv=v), "PaperConfig: hsv", "HsvBinning"),  # type: ignore[arg-type]
     "Mog2Config(blobs)": (lambda v: Mog2Config(blobs=v), "Mog2Config: blobs", "BlobConfig"),  # type: ignore[arg-type]
     "KnnConfig(hsv)": (lambda v: KnnConfig(hsv=v), "KnnConfig: hsv", "HsvBinning"),  # type: ignore[arg-type]
 }
@@ -711,11 +728,14 @@ def test_a_sub_config_refuses_what_is_not_its_class(site: str, value: object) ->
 @pytest.mark.parametrize(
     ("call", "message"),
     [
-        (lambda v: BlobConfig(learn_size=v), "learn_size must be True or False, got "),
-        (lambda v: PaperConfig(gain_thresholds=v), "gain_thresholds must be True or False, got "),
+        (lambda v: BlobConfig(learn_size=v), "BlobConfig: learn_size must be True or False, got "),
+        (
+            lambda v: PaperConfig(gain_thresholds=v),
+            "PaperConfig: gain_thresholds must be True or False, got ",
+        ),
         (
             lambda v: PaperConfig(n_learn=v),
-            r"n_learn must be an integer in \[0, 2147483647\], got ",
+            r"PaperConfig: n_learn must be an integer in \[0, 2147483647\], got ",
         ),
         (
             lambda v: pftrack.read_mot("never-read.txt", what=v),

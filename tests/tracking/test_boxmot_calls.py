@@ -75,3 +75,52 @@ def test_a_bad_frame_is_refused_before_the_embeddings_are_said(scene):
             tracker.update(_dets(scene, 1), scene.frames[0].astype(np.float32), [[0.0]])
     with pytest.warns(UserWarning, match="embs"):  # not spent by the refused call
         tracker.update(_dets(scene, 1), scene.frames[0], [[0.0]])
+
+
+# BoxMOT's keywords (apinames, 6 December): ``update(dets=..., img=..., embs=...)`` failed with
+# Python's ``unexpected keyword argument 'img'``; the frame is taken under either name, once.
+
+
+def test_boxmots_keywords_give_the_positional_calls_tracks(scene):
+    plain, keywords = pftrack.Tracker(), pftrack.Tracker()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # embs' own warning, said above
+        for k, frame in enumerate(scene.frames, start=1):
+            dets = _dets(scene, k)
+            expected = plain.update(dets, frame)
+            got = keywords.update(dets=dets, img=frame, embs=_embs(dets))
+            np.testing.assert_array_equal(got, expected)
+    np.testing.assert_array_equal(keywords.finalize(), plain.finalize())
+
+
+def test_the_frame_by_its_own_keyword_still_runs(scene):
+    tracker = pftrack.Tracker()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert tracker.update(dets=_dets(scene, 1), frame=scene.frames[0]).shape[1] == 8
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda t, d, f: t.update(d, f, img=f), "the frame is given twice, as frame and as img"),
+        (lambda t, d, f: t.update(dets=d, frame=f, img=f), "the frame is given twice"),
+        (lambda t, d, f: t.update(dets=d), r"no frame given: update\(dets, frame\), or img="),
+        (lambda t, d, f: t.update(d), "no frame given"),
+        (lambda t, d, f: t.update(d, image=f), "unexpected keyword argument 'image'"),
+        (lambda t, d, f: t.update(detections=d, img=f), "unexpected keyword argument 'detect"),
+        (lambda t, d, f: t.update(d, img=None), "^img is NoneType, expected"),
+        (lambda t, d, f: t.update(d, img=f.astype(float)), "^img dtype is float64"),
+    ],
+    ids=["twice", "twice-keywords", "none", "none-positional", "image", "detections",
+         "img-None", "img-float"],
+)  # fmt: skip
+def test_a_frame_given_twice_or_not_at_all_is_a_one_line_type_error(scene, call, message):
+    tracker = pftrack.Tracker()
+    with pytest.raises(TypeError, match=message) as e:
+        call(tracker, _dets(scene, 1), scene.frames[0])
+    assert "\n" not in str(e.value)
+    with warnings.catch_warnings():  # refused before the tracker took anything
+        warnings.simplefilter("error")
+        tracker.update(_dets(scene, 1), img=scene.frames[0])
+    assert tracker.frame_count == 1

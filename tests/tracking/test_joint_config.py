@@ -28,7 +28,8 @@ REPLACED = [
 @pytest.mark.parametrize("sampler", ["sis", "mh", "rjmcmc"])
 def test_a_replaced_setting_is_refused(sampler, name, value, where):
     rj = RJMCMCConfig(**{name: value})
-    with pytest.raises(ValueError, match=rf"^rjmcmc\.{name} is .*takes it from {where}"):
+    expected = rf"^TrackerConfig: rjmcmc\.{name} is .*takes it from {where}"
+    with pytest.raises(ValueError, match=expected):
         TrackerConfig(sampler=sampler, rjmcmc=rj)
 
 

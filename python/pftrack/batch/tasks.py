@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import brief, flag, number, option, shown
+from pftrack._check import brief, flag, instance, number, option, shown
 from pftrack._threads import tracking_threads
 from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
@@ -262,27 +262,27 @@ class TrackOptions:
         from pftrack.tracking.config import TrackerConfig
         from pftrack.tracking.run import DET_SCALE_RANGE
 
-        if not isinstance(self.config, TrackerConfig):
-            raise TypeError(f"config must be a TrackerConfig, got {type(self.config).__name__}")
-        _check_int(self.seed, "seed", 0)
-        option(self.detections, "detections", (None, "auto"))
+        own = "TrackOptions"  # every message names the class, as the configs' do
+        instance(self.config, f"{own}: config", TrackerConfig)
+        _check_int(self.seed, f"{own}: seed", 0)
+        option(self.detections, f"{own}: detections", (None, "auto"))
         if self.detections not in (None, "auto"):
-            raise ValueError(f"detections is {self.detections!r}, expected None or 'auto'")
+            raise ValueError(f"{own}: detections is {self.detections!r}, expected None or 'auto'")
         if self.det_scale is not None:
             lo, hi = DET_SCALE_RANGE
-            if not lo <= number(self.det_scale, "det_scale") <= hi:
+            if not lo <= number(self.det_scale, f"{own}: det_scale") <= hi:
                 raise ValueError(
-                    f"det_scale is {self.det_scale}, expected a number in [{lo:g}, {hi:g}] (or "
-                    "None: from seqinfo.ini)"
+                    f"{own}: det_scale is {self.det_scale}, expected a number in "
+                    f"[{lo:g}, {hi:g}] (or None: from seqinfo.ini)"
                 )
-        _check_choice(self.fill, "fill", ("linear", "pf"))
-        flag(self.smooth, "smooth")
-        flag(self.link, "link")
-        option(self.render, "render", (None, ".mp4", ".avi"))
+        _check_choice(self.fill, f"{own}: fill", ("linear", "pf"))
+        flag(self.smooth, f"{own}: smooth")
+        flag(self.link, f"{own}: link")
+        option(self.render, f"{own}: render", (None, ".mp4", ".avi"))
         if self.render not in (None, ".mp4", ".avi"):
-            raise ValueError(f"render is {self.render!r}, expected None, '.mp4' or '.avi'")
-        if not 0 < number(self.iou, "iou") <= 1:  # evaluate_mot's range
-            raise ValueError(f"iou is {self.iou}, expected a number in (0, 1]")
+            raise ValueError(f"{own}: render is {self.render!r}, expected None, '.mp4' or '.avi'")
+        if not 0 < number(self.iou, f"{own}: iou") <= 1:  # evaluate_mot's range
+            raise ValueError(f"{own}: iou is {self.iou}, expected a number in (0, 1]")
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""
@@ -509,25 +509,25 @@ class RecoverOptions:
         from pftrack.recovery.fill import MAX_GAP_LIMIT
         from pftrack.recovery.names import METHODS
 
-        _check_choice(self.method, "method", METHODS)
-        _check_int(self.max_gap, "max_gap", 1, MAX_GAP_LIMIT)
-        _check_int(self.seed, "seed", 0)
+        own = "RecoverOptions"  # every message names the class, as the configs' do
+        _check_choice(self.method, f"{own}: method", METHODS)
+        _check_int(self.max_gap, f"{own}: max_gap", 1, MAX_GAP_LIMIT)
+        _check_int(self.seed, f"{own}: seed", 0)
         if self.seed != 0 and self.method != "auto":  # fill_gaps' rule, before any task runs
-            raise ValueError(f"seed is used by method 'auto' only, not {self.method!r}")
-        flag(self.link, "link")
-        _check_distance(self.max_distance)
+            raise ValueError(f"{own}: seed is used by method 'auto' only, not {self.method!r}")
+        flag(self.link, f"{own}: link")
+        _check_distance(self.max_distance, f"{own}: max_distance")
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""
         return _settings(self)
 
 
-def _check_distance(value: float | None) -> None:
+def _check_distance(value: float | None, what: str) -> None:
     """A linking gate: None (grown to the frame) or a finite number > 0 (LinkConfig's rule)."""
-    if value is not None and not number(value, "max_distance") > 0:
+    if value is not None and not number(value, what) > 0:
         raise ValueError(
-            f"max_distance is {value}, expected a finite number > 0 (or None: 50 px grown to "
-            "the frame)"
+            f"{what} is {value}, expected a finite number > 0 (or None: 50 px grown to the frame)"
         )
 
 
@@ -578,9 +578,10 @@ class SmoothOptions:
         """Check every field, so that a bad value stops the batch before any task runs."""
         from pftrack.recovery.fill import MAX_GAP_LIMIT
 
-        _check_int(self.max_gap, "max_gap", 1, MAX_GAP_LIMIT)
-        flag(self.link, "link")
-        _check_distance(self.max_distance)
+        own = "SmoothOptions"  # every message names the class, as the configs' do
+        _check_int(self.max_gap, f"{own}: max_gap", 1, MAX_GAP_LIMIT)
+        flag(self.link, f"{own}: link")
+        _check_distance(self.max_distance, f"{own}: max_distance")
 
     def settings(self) -> dict[str, Any]:
         """JSON-ready settings (stored beside each output)."""

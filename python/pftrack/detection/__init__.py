@@ -24,9 +24,17 @@ from pftrack.detection.refine import refine_boxes
 from pftrack.particle_filter.colour import HsvBinning
 
 DETECTORS = ("paper", "mog2", "knn")
+#: The settings class of each built-in detector, by name (``TrackerConfig(detector=...)`` takes
+#: a name or one of these).
+DETECTOR_CONFIGS: dict[str, type[PaperConfig | Mog2Config | KnnConfig]] = {
+    "paper": PaperConfig,
+    "mog2": Mog2Config,
+    "knn": KnnConfig,
+}
 
 __all__ = [
     "DETECTORS",
+    "DETECTOR_CONFIGS",
     "BlobConfig",
     "Detections",
     "Detector",
@@ -39,6 +47,7 @@ __all__ = [
     "PaperDetector",
     "check_detections",
     "check_frame",
+    "detector_from",
     "make_detector",
     "refine_boxes",
 ]
@@ -96,6 +105,31 @@ def make_detector(
     if name == "knn":
         return KnnDetector(_split(KnnConfig, config, name), seed=seed)
     raise ValueError(f"make_detector: name is {name!r}, expected one of {', '.join(DETECTORS)}")
+
+
+def detector_from(
+    config: PaperConfig | Mog2Config | KnnConfig, *, seed: int = 0
+) -> PaperDetector | Mog2Detector | KnnDetector:
+    """Build the detector `config` sets: :func:`make_detector` from a settings object.
+
+    ``make_detector("paper", **flat)`` builds ``PaperDetector(PaperConfig(...))``: the same
+    detector as ``detector_from(PaperConfig(...))``. `seed` as :func:`make_detector`'s (KNN's).
+
+    Raises
+    ------
+    TypeError
+        `config` is not a PaperConfig, Mog2Config or KnnConfig.
+    """
+    if isinstance(config, PaperConfig):
+        return PaperDetector(config)
+    if isinstance(config, Mog2Config):
+        return Mog2Detector(config)
+    if isinstance(config, KnnConfig):
+        return KnnDetector(config, seed=seed)
+    raise TypeError(
+        f"detector_from: config must be a PaperConfig, Mog2Config or KnnConfig, got "
+        f"{type(config).__name__}"
+    )
 
 
 # a public submodule loads on first use after a bare ``import pftrack`` (``pftrack.detection.x``)

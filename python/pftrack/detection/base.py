@@ -154,29 +154,34 @@ class BlobConfig:
     split_valley: float = 0.85
 
     def __post_init__(self) -> None:
+        own = "BlobConfig"  # every message names the class, as the other configs' do
         for name in ("open_size", "close_size"):
             v = getattr(self, name)
             if v is not None and not (isinstance(v, (int, np.integer)) and v >= 1):
-                raise ValueError(f"{name} is {brief(v)}, expected None or an int >= 1")
+                raise ValueError(f"{own}: {name} is {brief(v)}, expected None or an int >= 1")
         for name in _BLOB_NUMBERS:  # before the comparisons below ask an array for its truth
-            number(getattr(self, name), name, finite=False)
-        flag(self.learn_size, "learn_size")  # was taken: "no" or an array turned it on
+            number(getattr(self, name), f"{own}: {name}", finite=False)
+        flag(self.learn_size, f"{own}: learn_size")  # was taken: "no" or an array turned it on
         if not (0.0 <= self.min_area <= self.max_area <= 1.0):
             raise ValueError(
-                f"min_area, max_area are {self.min_area}, {self.max_area}, "
+                f"{own}: min_area, max_area are {self.min_area}, {self.max_area}, "
                 "expected 0 <= min_area <= max_area <= 1"
             )
         if not (0.0 < self.min_aspect <= self.max_aspect):
             raise ValueError(
-                f"min_aspect, max_aspect are {self.min_aspect}, {self.max_aspect}, "
+                f"{own}: min_aspect, max_aspect are {self.min_aspect}, {self.max_aspect}, "
                 "expected 0 < min_aspect <= max_aspect"
             )
         if not (0.0 <= self.min_fill <= 1.0):
-            raise ValueError(f"min_fill is {self.min_fill}, expected in [0, 1]")
+            raise ValueError(f"{own}: min_fill is {self.min_fill}, expected in [0, 1]")
         if not (self.person_aspect >= 0.0 and np.isfinite(self.person_aspect)):
-            raise ValueError(f"person_aspect is {self.person_aspect}, expected a finite value >= 0")
+            raise ValueError(
+                f"{own}: person_aspect is {self.person_aspect}, expected a finite value >= 0"
+            )
         if not (self.split_valley >= 0.0 and np.isfinite(self.split_valley)):
-            raise ValueError(f"split_valley is {self.split_valley}, expected a finite value >= 0")
+            raise ValueError(
+                f"{own}: split_valley is {self.split_valley}, expected a finite value >= 0"
+            )
 
     def kernel_sizes(self, rows: int) -> tuple[int, int]:
         """(open, close) element sides for a frame of `rows` rows."""

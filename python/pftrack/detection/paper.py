@@ -174,36 +174,45 @@ class PaperConfig:
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
     def __post_init__(self) -> None:
+        own = "PaperConfig"  # every message names the class, as the other configs' do
         for name in (
             "alpha", "alpha_fg", "k_noise", "t_min", "t_max", "low_ratio", "shadow_lo",
             "shadow_chroma", "ghost_support", "ghost_rate", "leg_height", "leg_fill",
             "grey_tolerance", "grey_shadow_lo", "gain_band",
         ):  # fmt: skip  # before the comparisons below ask an array for its truth
-            number(getattr(self, name), name, finite=False)  # the first eight were taken
-        integer(self.n_learn, "n_learn", 0, 2**31 - 1)  # 0 or 1: the selective update at once
-        integer(self.hold_frames, "hold_frames", 0, 2**31 - 1)
-        flag(self.gain_thresholds, "gain_thresholds")
-        instance(self.blobs, "blobs", BlobConfig)
-        instance(self.hsv, "hsv", HsvBinning)
+            number(
+                getattr(self, name), f"{own}: {name}", finite=False
+            )  # the first eight were taken
+        integer(
+            self.n_learn, f"{own}: n_learn", 0, 2**31 - 1
+        )  # 0 or 1: the selective update at once
+        integer(self.hold_frames, f"{own}: hold_frames", 0, 2**31 - 1)
+        flag(self.gain_thresholds, f"{own}: gain_thresholds")
+        instance(self.blobs, f"{own}: blobs", BlobConfig)
+        instance(self.hsv, f"{own}: hsv", HsvBinning)
         if not (0.0 <= self.ghost_support <= 1.0):
-            raise ValueError(f"ghost_support is {self.ghost_support}, expected in [0, 1]")
+            raise ValueError(f"{own}: ghost_support is {self.ghost_support}, expected in [0, 1]")
         if not (0.0 < self.ghost_rate <= 1.0):
-            raise ValueError(f"ghost_rate is {self.ghost_rate}, expected in (0, 1]")
-        option(self.ghost_statistic, "ghost_statistic", GHOST_STATISTICS)
+            raise ValueError(f"{own}: ghost_rate is {self.ghost_rate}, expected in (0, 1]")
+        option(self.ghost_statistic, f"{own}: ghost_statistic", GHOST_STATISTICS)
         if self.ghost_statistic not in GHOST_STATISTICS:
             raise ValueError(
-                f"ghost_statistic is {self.ghost_statistic!r}, expected 'vote' or 'ratio'"
+                f"{own}: ghost_statistic is {self.ghost_statistic!r}, expected 'vote' or 'ratio'"
             )
         if not (0.0 <= self.leg_height < np.inf):
-            raise ValueError(f"leg_height is {self.leg_height}, expected a finite value >= 0")
+            raise ValueError(
+                f"{own}: leg_height is {self.leg_height}, expected a finite value >= 0"
+            )
         if not (0.0 <= self.leg_fill <= 1.0):
-            raise ValueError(f"leg_fill is {self.leg_fill}, expected in [0, 1]")
+            raise ValueError(f"{own}: leg_fill is {self.leg_fill}, expected in [0, 1]")
         if not (0.0 <= self.grey_tolerance <= 255.0):
-            raise ValueError(f"grey_tolerance is {self.grey_tolerance}, expected in [0, 255]")
+            raise ValueError(
+                f"{own}: grey_tolerance is {self.grey_tolerance}, expected in [0, 255]"
+            )
         if not (0.0 <= self.grey_shadow_lo <= 1.0):
-            raise ValueError(f"grey_shadow_lo is {self.grey_shadow_lo}, expected in [0, 1]")
+            raise ValueError(f"{own}: grey_shadow_lo is {self.grey_shadow_lo}, expected in [0, 1]")
         if not (0.0 <= self.gain_band < 1.0):
-            raise ValueError(f"gain_band is {self.gain_band}, expected in [0, 1)")
+            raise ValueError(f"{own}: gain_band is {self.gain_band}, expected in [0, 1)")
 
 
 class PaperDetector:

@@ -2043,14 +2043,21 @@ class FrameSource:
             return self._iterated_at(wanted, keep)
 
     def _iterated_at(self, wanted: list[int], keep: _Prepare) -> list[NDArray[np.uint8]]:
-        """The frames at `wanted` (increasing) as iterating the file gives them, stand-ins too."""
+        """The frames at `wanted` (increasing) as iterating the file gives them, stand-ins too.
+
+        When the last of `wanted` is the last frame counted (the spread bootstrap's), the pass
+        reads on to its end, where the reader says which frames it stood in for (once a
+        source, naming the user's line): a stand-in among the chosen frames was not said
+        (was: said only by a later pass over the whole file, after a run had tracked it).
+        """
         kept, out = set(wanted), []
+        to_end = wanted[-1] >= self.n_frames - 1  # at most a frame's grab more
         frames = self._iter_stored()
         try:
             for i, frame in enumerate(frames):
                 if i in kept:
                     out.append(keep(frame))
-                if i >= wanted[-1]:
+                if i >= wanted[-1] and not to_end:
                     break
         finally:
             frames.close()

@@ -358,6 +358,44 @@ def _moves(moves: object) -> tuple[float, float, float, float]:
     return values[0], values[1], values[2], values[3]
 
 
+class _NotGiven:
+    """The default of an argument that may come under another name.
+
+    :meth:`Tracker.update`'s `frame`, BoxMOT's `img`: tells "not given" from a None given.
+    """
+
+    def __repr__(self) -> str:
+        return "<not given>"
+
+
+_NOT_GIVEN: Any = _NotGiven()
+
+
+def _the_frame(frame: object, img: object) -> tuple[Any, str]:
+    """:meth:`Tracker.update`'s frame and the name it came under (what its refusals name).
+
+    Given once: as `frame` or as `img` (BoxMOT's name).
+
+    Raises
+    ------
+    TypeError
+        Neither given, or both.
+    """
+    if img is _NOT_GIVEN:
+        if frame is _NOT_GIVEN:
+            raise TypeError(
+                "Tracker.update: no frame given: update(dets, frame), or img=frame as BoxMOT "
+                "names it"
+            )
+        return frame, "frame"
+    if frame is not _NOT_GIVEN:
+        raise TypeError(
+            "Tracker.update: the frame is given twice, as frame and as img (BoxMOT's name for "
+            "it): give one"
+        )
+    return img, "img"
+
+
 class _Alone:
     """``with``: take `lock` without waiting (RuntimeError naming ``Tracker.method`` if held).
 
@@ -616,41 +654,44 @@ class Tracker:
         moves = _moves(moves)
         base = TrackerConfig()
         model = replace(base.filter.model, use_means=dynamics == "ar2-mean")
-        config = replace(
-            base,
-            filter=replace(
-                base.filter, n_particles=int(particles or base.filter.n_particles), model=model
-            ),
-            given_particles=base.given_particles if particles is None else None,
-            detector=detector,
-            sampler=sampler,
-            mh_iter=mh_iter,
-            mh_proposal=mh_proposal,
-            mh_rw_sigma=tau,  # type: ignore[arg-type]
-            rjmcmc=replace(
-                base.rjmcmc,
-                burn_in=burn_in,
-                p_birth=moves[0],
-                p_death=moves[1],
-                p_update=moves[2],
-                p_swap=moves[3],
-            ),  # fmt: skip
-            camera_motion=camera_motion,
-            max_side=max_side,
-            refine=replace(base.refine, enabled=refine),
-            crossings=replace(base.crossings, enabled=crossings),
-            lifecycle=replace(
-                base.lifecycle,
-                max_coast=(
-                    base.lifecycle.max_coast
-                    if max_coast is None
-                    else _frames(max_coast, frame_rate, "max_coast")
+        try:  # the arguments share the settings' names: not the class the caller never built
+            config = replace(
+                base,
+                filter=replace(
+                    base.filter, n_particles=int(particles or base.filter.n_particles), model=model
                 ),
-                min_score=min_conf,
-                birth_score=birth_score,
-                birth_quantile=birth_quantile,
-            ),
-        )
+                given_particles=base.given_particles if particles is None else None,
+                detector=detector,
+                sampler=sampler,
+                mh_iter=mh_iter,
+                mh_proposal=mh_proposal,
+                mh_rw_sigma=tau,  # type: ignore[arg-type]
+                rjmcmc=replace(
+                    base.rjmcmc,
+                    burn_in=burn_in,
+                    p_birth=moves[0],
+                    p_death=moves[1],
+                    p_update=moves[2],
+                    p_swap=moves[3],
+                ),  # fmt: skip
+                camera_motion=camera_motion,
+                max_side=max_side,
+                refine=replace(base.refine, enabled=refine),
+                crossings=replace(base.crossings, enabled=crossings),
+                lifecycle=replace(
+                    base.lifecycle,
+                    max_coast=(
+                        base.lifecycle.max_coast
+                        if max_coast is None
+                        else _frames(max_coast, frame_rate, "max_coast")
+                    ),
+                    min_score=min_conf,
+                    birth_score=birth_score,
+                    birth_quantile=birth_quantile,
+                ),
+            )
+        except (TypeError, ValueError) as e:
+            raise type(e)(str(e).removeprefix("TrackerConfig: ")) from None
         unread = unread_error(
             sampler,
             {"mh_iter": mh_iter, "mh_proposal": mh_proposal, "mh_rw_sigma": tau,
@@ -777,7 +818,7 @@ class Tracker:
         detector = getattr(self._tracker, "_detector", None)
         if isinstance(getattr(detector, "_sub", None), cv2.BackgroundSubtractor):
             raise TypeError(
-                f"detector={self.config.detector!r} cannot be checkpointed (pickle/deepcopy) "
+                f"detector={self.config.detector_name!r} cannot be checkpointed (pickle/deepcopy) "
                 "once primed or given a frame: OpenCV's background subtractors cannot be "
                 "pickled; use detector='paper'"
             )
@@ -1072,8 +1113,18 @@ class Tracker:
         work = (rows, cols, 3) if size is None else (size[1], size[0], 3)
         return (rows, cols, bands), work
 
-    def update(self, dets: ArrayLike | None, frame: NDArray[np.uint8], embs: object = None) -> F64:
+    def update(
+        self,
+        dets: ArrayLike | None,
+        frame: NDArray[np.uint8] = _NOT_GIVEN,
+        embs: object = None,
+        *,
+        img: NDArray[np.uint8] = _NOT_GIVEN,
+    ) -> F64:
         """Track one frame.
+
+        BoxMOT's call, ``update(dets, img, embs)``, runs unchanged, by position or by keyword:
+        ``update(dets=dets, img=frame)`` is ``update(dets, frame)``.
 
         Parameters
         ----------
@@ -1097,6 +1148,10 @@ class Tracker:
             BoxMOT loop ``update(dets, frame, embs)`` runs unchanged, and not used (pftrack
             tells objects apart by their colour in `frame` and their motion), with one warning
             a run when given (was: a TypeError naming no argument).
+        img : (H, W, 3) ndarray of uint8, keyword only
+            `frame` under BoxMOT's name (its keyword call ``update(dets=..., img=...)``): give
+            one of the two (TypeError when both or neither are given; an unknown keyword is
+            Python's TypeError naming it).
 
         Returns
         -------
@@ -1139,11 +1194,12 @@ class Tracker:
             inside the tracker) after it had changed the tracker: the run cannot go on, but
             :meth:`finalize` returns the frames before it and :meth:`reset` starts a new run.
         """
+        frame, named = _the_frame(frame, img)
         with self._alone("update"):
             warned = set(self._warned)
             with Held() as held:  # given once the frame is taken whole (python -W error)
                 try:
-                    out = self._update(dets, frame)
+                    out = self._update(dets, frame, named)
                     if embs is not None:  # BoxMOT's ReID trackers' input; its others ignore it
                         self._warn_once(
                             "embs",
@@ -1156,8 +1212,11 @@ class Tracker:
             held.release(2 + self._caller_depth)  # the user's line, through an adapter too
             return out
 
-    def _update(self, dets: ArrayLike | None, frame: NDArray[np.uint8]) -> F64:
-        """:meth:`update`, holding the tracker and its warnings (:class:`pftrack._warn.Held`)."""
+    def _update(self, dets: ArrayLike | None, frame: NDArray[np.uint8], named: str) -> F64:
+        """:meth:`update`, holding the tracker and its warnings (:class:`pftrack._warn.Held`).
+
+        `named`: the frame's argument, ``"frame"`` or BoxMOT's ``"img"``.
+        """
         if self._torn:
             raise RuntimeError(
                 f"Tracker.update: the update of frame {self._torn} was interrupted "
@@ -1177,7 +1236,7 @@ class Tracker:
                 "supervision.SupervisionTracker's update_with_detections(detections, frame), "
                 "or give np.column_stack([d.xyxy, d.confidence, d.class_id])"
             )
-        f = bgr_frame(frame)
+        f = bgr_frame(frame, named)
         shape = self._shape  # None until the run's first frame is taken
         first = shape is None
         if shape is None:

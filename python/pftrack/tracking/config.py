@@ -15,6 +15,7 @@ from pftrack._check import (
     flag,
     instance,
     integer,
+    listed,
     number,
     option,
     real_array,
@@ -33,7 +34,7 @@ from pftrack._limits import (
     proposal_error,
 )
 from pftrack._typing import CameraMotion, DetectorName, SamplerName
-from pftrack.detection import DETECTORS
+from pftrack.detection import DETECTOR_CONFIGS, DETECTORS, KnnConfig, Mog2Config, PaperConfig
 from pftrack.particle_filter import Ar2Model, FilterConfig, HsvBinning, RJMCMCConfig
 from pftrack.recovery.linking import REFERENCE_DIAGONAL, pixel_scale
 from pftrack.tracking.offline import AMODAL_ANCHORS, NOISE_MAX, NOISE_MIN, CrossingConfig
@@ -145,18 +146,59 @@ def _joint_settings_used(config: TrackerConfig) -> None:
             continue
         shown_v = list(np.asarray(v, float).tolist()) if name in ("a", "b", "sigma") else v
         raise ValueError(
-            f"rjmcmc.{name} is {shown_v}, but the joint sampler takes it from {where}, so "
-            "it would do nothing: set it there (the same budget and dynamics for every sampler)"
+            f"TrackerConfig: rjmcmc.{name} is {shown_v}, but the joint sampler takes it from "
+            f"{where}, so it would do nothing: set it there (the same budget and dynamics for "
+            "every sampler)"
         )
 
 
-def _none_or_int_in(config: object, name: str, lo: int, hi: int, none: str = "None") -> None:
+#: The name of each built-in detector's settings class (:attr:`TrackerConfig.detector_name`).
+_DETECTOR_NAMES: dict[type, DetectorName] = {
+    cls: name  # type: ignore[misc]
+    for name, cls in DETECTOR_CONFIGS.items()
+}
+
+
+def _detector_settings_agree(config: TrackerConfig) -> None:
+    """Refuse settings given as `config.detector` that `config`'s own would contradict.
+
+    Its `hsv` is the tracker's `binning` (the foreground bins and the histograms share one
+    layout): ``HsvBinning()`` (replaced) or `binning` itself. `open_size` and `hold_frames`,
+    when set on `config`, apply on top: the settings must leave them unset or agree.
+    """
+    d = config.detector
+    assert not isinstance(d, str)
+    kind = type(d).__name__
+    if d.hsv != HsvBinning() and d.hsv != config.binning:
+        raise ValueError(
+            f"TrackerConfig: detector's hsv is {d.hsv}, but the detector bins colour as the "
+            f"tracker does: set binning={d.hsv} and leave the {kind}'s hsv at its default"
+        )
+    size = config.open_size
+    if size is not None and d.blobs.open_size not in (None, size):
+        raise ValueError(
+            f"TrackerConfig: open_size is {size} and detector's blobs.open_size is "
+            f"{d.blobs.open_size}: give it once"
+        )
+    hold = getattr(d, "hold_frames", 0)
+    if config.hold_frames and hold not in (0, config.hold_frames):
+        raise ValueError(
+            f"TrackerConfig: hold_frames is {config.hold_frames} and detector's hold_frames is "
+            f"{hold}: give it once"
+        )
+
+
+def _none_or_int_in(
+    owner: str, config: object, name: str, lo: int, hi: int, none: str = "None"
+) -> None:
     """`config.name` must be None or an int (not a bool) in [lo, hi] (`none`: None's name)."""
     v = getattr(config, name)
     if v is not None and (
         isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi
     ):
-        raise ValueError(f"{name} is {brief(v)}, expected {none} or an int in [{lo}, {hi}]")
+        raise ValueError(
+            f"{owner}: {name} is {brief(v)}, expected {none} or an int in [{lo}, {hi}]"
+        )
 
 
 @dataclass(frozen=True)
@@ -696,8 +738,14 @@ class TrackerConfig:
         (ValueError naming the ``filter`` setting to use instead). Its `burn_in` is at most
         100000 here (``Tracker(burn_in=...)``, ``--burn-in``); its move probabilities are
         ``Tracker(moves=...)`` and ``--moves``.
-    detector : {"paper", "mog2", "knn"}
-        Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections.
+    detector : {"paper", "mog2", "knn"}, PaperConfig, Mog2Config or KnnConfig
+        Built-in detector used when :meth:`MultiObjectTracker.update` gets no detections: by
+        name, with its settings' defaults, or as its settings
+        (``detector=PaperConfig(alpha_fg=0.01)``), every one of them (:attr:`detector_name`
+        gives the name). The detector bins colour as the tracker does: the settings' `hsv`
+        must be ``HsvBinning()`` (replaced by `binning`) or `binning` itself. `open_size` and
+        `hold_frames` below, when set, apply on top of the settings, which must then leave
+        them unset (``blobs.open_size=None``, ``hold_frames=0``) or give the same value.
     reference_rate : float
         How fast a reference histogram adapts to a matched detection (0 keeps the first one).
     refine, association, motion, lifecycle
@@ -730,7 +778,8 @@ class TrackerConfig:
         the default blobs split thin people or join touching ones.
     hold_frames : int
         The built-in detector's hold of people who walked and stopped
-        (``PaperConfig.hold_frames``; ``detector="paper"`` only): how many frames after its
+        (``PaperConfig.hold_frames``, passed on top of `detector`'s settings; ``"paper"``
+        only): how many frames after its
         last move a stopped walker's box stays out of the background's update. 0 (the default)
         turns it off; 1000 keeps a person standing 300-600 frames tracked, at a cost measured
         on a real sequence (docs/detection.md, "A person who stands for hundreds of frames").
@@ -771,7 +820,7 @@ class TrackerConfig:
     binning: HsvBinning = field(default_factory=HsvBinning)
     sampler: SamplerName = "sis"
     rjmcmc: RJMCMCConfig = field(default_factory=RJMCMCConfig)
-    detector: DetectorName = "paper"
+    detector: DetectorName | PaperConfig | Mog2Config | KnnConfig = "paper"
     reference_rate: float = 0.05
     refine: RefineConfig = field(default_factory=RefineConfig)
     association: AssociationConfig = field(default_factory=AssociationConfig)
@@ -791,11 +840,21 @@ class TrackerConfig:
 
     def __post_init__(self) -> None:
         for name, cls in _SUB_CONFIGS:  # were taken, and failed at a frame naming no setting
-            instance(getattr(self, name), name, cls)
-        option(self.sampler, "sampler", SAMPLERS)  # before the sampler is compared below
-        option(self.camera_motion, "camera_motion", CAMERA_MOTION)
-        option(self.detector, "detector", DETECTORS)
-        _none_or_int_in(self, "given_particles", 1, MAX_PARTICLES)
+            instance(getattr(self, name), f"TrackerConfig: {name}", cls)
+        option(self.sampler, "TrackerConfig: sampler", SAMPLERS)  # before it is compared below
+        option(self.camera_motion, "TrackerConfig: camera_motion", CAMERA_MOTION)
+        if not isinstance(self.detector, tuple(DETECTOR_CONFIGS.values())):
+            if not isinstance(self.detector, str):
+                raise TypeError(
+                    f"TrackerConfig: detector must be {listed(DETECTORS)}, or a PaperConfig, "
+                    f"Mog2Config or KnnConfig, got {shown(self.detector)}"
+                )
+            if self.detector not in DETECTORS:
+                raise ValueError(
+                    f"TrackerConfig: detector is {self.detector!r}, expected 'paper', 'mog2' or "
+                    "'knn' (or the settings of one: PaperConfig, Mog2Config, KnnConfig)"
+                )
+        _none_or_int_in("TrackerConfig", self, "given_particles", 1, MAX_PARTICLES)
         integer(self.mh_iter, "TrackerConfig: mh_iter", 1, MAX_MH_ITER)
         option(self.mh_proposal, "TrackerConfig: mh_proposal", MH_PROPOSALS)
         tau = real_array(self.mh_rw_sigma, "TrackerConfig: mh_rw_sigma", booleans=False)
@@ -813,17 +872,19 @@ class TrackerConfig:
             )
             if too_many:
                 raise ValueError(too_many)
-        _none_or_int_in(self, "open_size", 1, MAX_OPEN_SIZE)
+        _none_or_int_in("TrackerConfig", self, "open_size", 1, MAX_OPEN_SIZE)
         integer(self.hold_frames, "TrackerConfig: hold_frames", 0, 2**31 - 1)
-        if self.hold_frames and self.detector != "paper":
+        if self.hold_frames and self.detector_name != "paper":
             raise ValueError(
                 f"TrackerConfig: hold_frames {self.hold_frames} needs detector 'paper' (the hold"
-                f" is its own), got detector {self.detector!r}"
+                f" is its own), got detector {self.detector_name!r}"
             )
+        if not isinstance(self.detector, str):  # its settings, once open_size and hold checked
+            _detector_settings_agree(self)
         side = self.max_side
         if isinstance(side, (int, np.integer)) and not isinstance(side, bool) and side == 0:
             object.__setattr__(self, "max_side", None)  # 0 is off, as --max-side 0: stored None
-        _none_or_int_in(self, "max_side", MIN_SIDE, MAX_SIDE, "None (or 0: off)")
+        _none_or_int_in("TrackerConfig", self, "max_side", MIN_SIDE, MAX_SIDE, "None (or 0: off)")
         if self.pixel_diagonal is not None and not (
             isinstance(self.pixel_diagonal, (int, float, np.integer, np.floating))
             and not isinstance(self.pixel_diagonal, bool)
@@ -831,25 +892,49 @@ class TrackerConfig:
             and self.pixel_diagonal > 0
         ):
             raise ValueError(
-                f"pixel_diagonal is {brief(self.pixel_diagonal)}, expected None or a finite value "
-                "> 0"
+                f"TrackerConfig: pixel_diagonal is {brief(self.pixel_diagonal)}, expected None or "
+                "a finite value > 0"
             )
         if self.sampler == "rjmcmc" and self.filter.model.use_means:
             raise ValueError(
-                "the AR(2) model on the particle-set means (use_means; --dynamics ar2-mean) "
-                "needs a per-object sampler ('sis' or 'mh'; --sampler): the joint 'rjmcmc' "
-                "sampler moves each object on its own state"
+                "TrackerConfig: the AR(2) model on the particle-set means (use_means; --dynamics "
+                "ar2-mean) needs a per-object sampler ('sis' or 'mh'; --sampler): the joint "
+                "'rjmcmc' sampler moves each object on its own state"
             )
         _joint_settings_used(self)
         if self.camera_motion not in CAMERA_MOTION:
             raise ValueError(
-                f"camera_motion is {self.camera_motion!r}, expected 'auto', 'on' or 'off'"
+                f"TrackerConfig: camera_motion is {self.camera_motion!r}, expected 'auto', 'on' "
+                "or 'off'"
             )
         if self.sampler not in SAMPLERS:
-            raise ValueError(f"sampler is {self.sampler!r}, expected 'sis', 'mh' or 'rjmcmc'")
-        if self.detector not in DETECTORS:
-            raise ValueError(f"detector is {self.detector!r}, expected 'paper', 'mog2' or 'knn'")
+            raise ValueError(
+                f"TrackerConfig: sampler is {self.sampler!r}, expected 'sis', 'mh' or 'rjmcmc'"
+            )
         _in_unit_interval("TrackerConfig", reference_rate=self.reference_rate)
+
+    @property
+    def detector_name(self) -> DetectorName:
+        """The built-in detector's name: `detector`, or the name of the settings given there."""
+        if isinstance(self.detector, str):
+            return self.detector
+        return _DETECTOR_NAMES[type(self.detector)]
+
+    def detector_settings(self) -> PaperConfig | Mog2Config | KnnConfig | None:
+        """The settings given as `detector`, with `binning`, `open_size` and `hold_frames`.
+
+        None when `detector` is a name (:func:`~pftrack.detection.make_detector` builds it
+        from the name, `binning`, `open_size` and `hold_frames`).
+        """
+        d = self.detector
+        if isinstance(d, str):
+            return None
+        d = replace(d, hsv=self.binning)
+        if self.open_size is not None:
+            d = replace(d, blobs=replace(d.blobs, open_size=self.open_size))
+        if self.hold_frames and isinstance(d, PaperConfig):
+            d = replace(d, hold_frames=self.hold_frames)
+        return d
 
     def pixel_scale(self, width: int, height: int) -> float:
         """How much the pixel settings grow on a (working) frame of `width` x `height` pixels.

@@ -40,7 +40,13 @@ from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack._warn import Held, warn
 from pftrack.boxes import _iou_matrix, _to_cxcywh
-from pftrack.detection import FrameDetector, check_detections, make_detector, refine_boxes
+from pftrack.detection import (
+    FrameDetector,
+    check_detections,
+    detector_from,
+    make_detector,
+    refine_boxes,
+)
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.particle_filter.filter import _in_use
@@ -319,13 +325,18 @@ class MultiObjectTracker:
         built-in detectors draw none, and take nothing from it.
         """
         if self._detector is None:
+            name, settings = self.config.detector_name, self.config.detector_settings()
             size = self.config.open_size
             extra: dict[str, Any] = {} if size is None else {"open_size": size}
             if self.config.hold_frames:
                 extra["hold_frames"] = self.config.hold_frames
-            if self.config.detector in SEEDED_DETECTORS:
-                extra["seed"] = int(self._rng.integers(2**63))
-            self._detector = make_detector(self.config.detector, hsv=self.config.binning, **extra)
+            seed = int(self._rng.integers(2**63)) if name in SEEDED_DETECTORS else None
+            if settings is not None:  # TrackerConfig(detector=PaperConfig(...)): every setting
+                self._detector = detector_from(settings, seed=0 if seed is None else seed)
+                return self._detector
+            if seed is not None:
+                extra["seed"] = seed
+            self._detector = make_detector(name, hsv=self.config.binning, **extra)
         return self._detector
 
     def _check_given(self, frame: NDArray[np.uint8], detections: ArrayLike | None,
