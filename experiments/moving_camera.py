@@ -24,17 +24,25 @@ README quote: the notes under the table give seed 0's MOTA / IDF1 and the seeds'
 static and moving versions differ from the original by the 1.35x crop and the JPEG
 re-encoding; issue 13 compares the moving version with the static one.
 
+``--set SECTION.FIELD=VALUE`` changes a `TrackerConfig` field of every run on top of the
+command's own options, as ``experiments.public_detections --set`` does (e.g.
+``lifecycle.size_ratio=0.8``, which has no command-line option); the runs' files then go to
+``tracks-<settings>/`` and the table to ``moving_camera-<settings>.md`` beside the default's,
+so one ``--out`` holds both and the versions' frames are made once.
+
 Usage (from the repository root)::
 
     python -m experiments.moving_camera --out /tmp/moving_camera [--data ../shared/data]
-        [--detections public builtin]
+        [--detections public builtin] [--set SECTION.FIELD=VALUE ...]
 """
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import tempfile
-from collections.abc import Sequence
+import unittest.mock
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -42,14 +50,17 @@ import cv2
 import numpy as np
 
 from experiments._common import PETS, REPO, TUD, Source, data_folder, experiment_parser, tee_stdout
+from experiments.public_detections import add_settings, override
 from pftrack._typing import F64
 from pftrack.cli import main as pftrack_main
+from pftrack.cli import track as track_command
 from pftrack.cli._options import bounded_int
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.io.opencv_io import write_image
 from pftrack.io.video import read_frames
 from pftrack.synthetic import camera_path, warp_frame, warp_rows
+from pftrack.tracking import TrackerConfig
 
 PERIOD = 120.0  # frames, both sequences
 
@@ -103,6 +114,24 @@ def track(
     return read_mot(out, what="tracks")
 
 
+@contextlib.contextmanager
+def settings_applied(settings: Sequence[str]) -> Iterator[None]:
+    """``pftrack track`` with every ``--set`` applied (:func:`override`) to its own config."""
+    if not settings:
+        yield
+        return
+    own = track_command.tracker_config
+
+    def config(args: Any) -> Any:
+        c = own(args)
+        for setting in settings:
+            c = override(c, setting)
+        return c
+
+    with unittest.mock.patch.object(track_command, "tracker_config", config):
+        yield
+
+
 def summary(scores: F64) -> str:
     """``MOTA ± sd / IDF1 ± sd`` of (seeds, 2) scores in %: the table's cell."""
     mean, sd = scores.mean(axis=0), scores.std(axis=0)
@@ -139,7 +168,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--seeds", type=bounded_int(1, 1000), default=3,
         help="tracker seeds 0..N-1, N in [1, 1000] (default 3)",
     )  # fmt: skip
+    add_settings(ap, "lifecycle.size_ratio=0.8")
     args = ap.parse_args(argv)
+    try:  # a bad setting: exit 2 before any work
+        for setting in args.settings:
+            override(TrackerConfig(), setting)
+    except ValueError as e:
+        ap.error(str(e))
+    tag = "-".join(s.replace("=", "") for s in args.settings)
     out: Path = args.out.resolve()
     if out == REPO.resolve() or REPO.resolve() in out.parents:
         print(f"--out {out} is inside the repository; give a folder outside it", file=sys.stderr)
@@ -147,7 +183,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     root = data_folder(args.data)
     if root is None:
         return 2
-    results = out / "tracks"
+    results = out / ("tracks-" + tag if tag else "tracks")
     results.mkdir(parents=True, exist_ok=True)
     lines = [
         f"| sequence | detections | version | off: MOTA / IDF1 (mean ± sd, {args.seeds} seeds) "
@@ -169,7 +205,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                     for seed in range(args.seeds):
                         name = f"{seq.name}-{version}-{det}-{mode}-{seed}.txt"
                         dets = folder / "det.txt" if det == "public" else None
-                        rows = track(source, dets, scale, mode, seed, results / name)
+                        with settings_applied(args.settings):
+                            rows = track(source, dets, scale, mode, seed, results / name)
                         m = evaluate_mot(gt, rows, scale=scale)
                         scores.append((100 * m.mota, 100 * m.idf1))
                         if mode == "auto":
@@ -181,7 +218,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 cells = " | ".join(summary(a) for a in by_mode.values())
                 lines.append(f"| {seq.name} | {det} | {version} | {cells} |")
                 print(lines[-1], file=sys.stderr, flush=True)
-    with tee_stdout(out / "moving_camera.md"):
+    with tee_stdout(out / (f"moving_camera-{tag}.md" if tag else "moving_camera.md")):
         print("\n".join(lines))
         print()
         print("\n".join(f"- {n}" for n in notes))

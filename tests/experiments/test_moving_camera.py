@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -80,12 +81,47 @@ def test_original_note_gives_seed_0_and_the_range_not_the_mean() -> None:
     assert mc.summary(scores) == "46.2 ± 5.3 / 55.3 ± 4.0"  # np.std, ddof 0
 
 
-@pytest.mark.parametrize("seeds", ["0", "-1", "x"])
-def test_refuses_no_seeds(
-    data: Path, tmp_path: Path, seeds: str, capsys: pytest.CaptureFixture[str]
-) -> None:
+@pytest.mark.parametrize(
+    ("option", "value", "said"),
+    [("--seeds", v, "--seeds") for v in ("0", "-1", "x")]
+    + [
+        ("--set", v, f"--set {v!r}")
+        for v in ("lifecycle.nothing=1", "lifecycle.size_ratio=x", "size")
+    ],
+)
+def test_refuses_bad_seeds_and_settings(
+    data: Path, tmp_path: Path, option: str, value: str, said: str,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
     with pytest.raises(SystemExit) as exc:
-        mc.main(["--data", str(data), "--out", str(tmp_path), "--seeds", seeds])
+        mc.main(["--data", str(data), "--out", str(tmp_path), option, value])
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert "--seeds" in err[-1] and "Traceback" not in "".join(err)
+    assert said in err[-1] and "Traceback" not in "".join(err)
+    assert not any(tmp_path.iterdir())  # refused before any work
+
+
+def test_set_changes_every_runs_config_and_names_its_files(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # --set applies on top of pftrack track's own options (here --camera-motion) while the
+    # runs are made, and its files and table get their own names beside the default's
+    seen = []
+    track = mc.track_command._track
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        seen.append((kwargs["config"].lifecycle.size_ratio, kwargs["config"].camera_motion))
+        return track(*args, **kwargs)
+
+    monkeypatch.setattr(mc.track_command, "_track", spy)
+    monkeypatch.setattr(mc, "SEQUENCES", (Source("tiny", "img", 1.0),))
+    out = tmp_path / "mc"
+    argv = ["--data", str(data), "--out", str(out), "--detections", "public", "--seeds", "1"]
+    assert mc.main([*argv, "--set", "lifecycle.size_ratio=0.8"]) == 0
+    assert sorted(seen) == [(0.8, "auto")] * 3 + [(0.8, "off")] * 3
+    assert len(list((out / "tracks-lifecycle.size_ratio0.8").iterdir())) == 6
+    assert (out / "moving_camera-lifecycle.size_ratio0.8.md").is_file()
+    seen.clear()
+    assert mc.main(argv) == 0  # without --set: every default, the files of old
+    assert sorted(seen) == [(None, "auto")] * 3 + [(None, "off")] * 3
+    assert len(list((out / "tracks").iterdir())) == 6 and (out / "moving_camera.md").is_file()

@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 
+import cv2
 import numpy as np
 import pytest
 
 import pftrack
+from pftrack._typing import CameraMotion
 from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import make_scene
 from pftrack.tracking import LifecycleConfig, TrackerConfig
@@ -25,10 +27,13 @@ def _line(foot: np.ndarray) -> np.ndarray:
     return 0.4 * foot + 20.0
 
 
-def _sizes(n: int = 200, cls: float | None = None, seed: int = 0) -> np.ndarray:
-    """`n` detections on the line, heights within 5 %: ``foot, height[, class]``."""
+def _sizes(
+    n: int = 200, cls: float | None = None, seed: int = 0, rows: tuple[float, float] = (60, 230)
+) -> np.ndarray:
+    """`n` detections on the line, feet within `rows`, heights within 5 %: ``foot, height[,
+    class]``."""
     rng = np.random.default_rng(seed)
-    foot = rng.uniform(60.0, 230.0, n)
+    foot = rng.uniform(*rows, n)
     h = _line(foot) * rng.uniform(0.95, 1.05, n)
     return np.column_stack([foot, h] if cls is None else [foot, h, np.full(n, cls)])
 
@@ -74,10 +79,31 @@ def test_boxes_cut_by_the_frames_bottom_are_not_judged() -> None:
     cut = _track(2, 0.5, foot=239.5)
     rows = np.vstack([_track(1, 1.0), cut])
     assert _ids(drop_odd_sizes(rows, _sizes(), 0.8, frame_height=240.0)) == {1, 2}
-    assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1}  # without the frame's height
+    # without the frame's height, and detections' feet down to row 300 (a taller frame)
+    assert _ids(drop_odd_sizes(rows, _sizes(rows=(60, 300)), 0.8)) == {1}
     # detections cut by the bottom do not bend the line either
     sizes = np.vstack([_sizes(), np.column_stack([np.full(300, 239.5), np.full(300, 10.0)])])
     assert _ids(drop_odd_sizes(rows, sizes, 0.8, frame_height=240.0)) == {1, 2}
+
+
+def test_rows_outside_the_fitted_rows_are_not_judged() -> None:
+    """The line is not extrapolated: the detections' feet lie at rows 60-230, and a track whose
+    feet are at row 20 (or 300) is kept whatever its height; the same track inside is left out."""
+    for share in (0.5, 2.0):
+        rows = np.vstack([_track(1, 1.0), _track(2, share, foot=20.0), _track(3, share, 300.0)])
+        assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1, 2, 3}
+        rows = np.vstack([_track(1, 1.0), _track(2, share, foot=70.0), _track(3, share, 220.0)])
+        assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1}
+    # the range is of the fitted rows' 5th-95th percentiles, not their extremes: one detection
+    # at row 10 does not open the rows above 60 to judgement
+    sizes = np.vstack([_sizes(), [[10.0, float(_line(np.array(10.0)))]]])
+    rows = np.vstack([_track(1, 1.0), _track(2, 0.5, foot=20.0)])
+    assert _ids(drop_odd_sizes(rows, sizes, 0.8)) == {1, 2}
+    # a track with rows on both sides of the range's edge is judged by the rows inside it
+    inside, outside = _track(2, 0.5, foot=100.0, n=5), _track(2, 1.0, foot=20.0, n=15)
+    outside[:, 0] += 5
+    rows = np.vstack([_track(1, 1.0), inside, outside])
+    assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1}
 
 
 @pytest.mark.parametrize(
@@ -106,6 +132,20 @@ def test_size_ratio_is_checked(bad: float) -> None:
         LifecycleConfig(size_ratio="0.8")  # type: ignore[arg-type]
 
 
+def _people_and_false_box(k: int) -> np.ndarray:
+    """Frame `k`'s detections ``x1, y1, x2, y2, score, class``: three people walking right at
+    rows 100, 150 and 200, sized on the line, and a confident false box, a third of the height
+    a person has at its row, standing still at row 180."""
+    dets = []
+    for j, foot in enumerate((100.0, 150.0, 200.0)):
+        h = float(_line(np.array(foot)))
+        x = 20.0 + 90 * j + 2 * k
+        dets.append([x, foot - h, x + h / 2.5, foot, 0.95, 0.0])
+    h = float(_line(np.array(180.0))) / 3
+    dets.append([280.0, 180.0 - h, 280.0 + h / 2.5, 180.0, 0.95, 0.0])
+    return np.array(dets)
+
+
 @pytest.mark.parametrize(("ratio", "n_ids"), [(0.8, 3), (None, 4)])
 def test_finalize_leaves_out_a_track_on_small_false_boxes(ratio: float | None, n_ids: int) -> None:
     """Three people walk at rows 100, 150 and 200, sized on the line; a confident false box,
@@ -120,14 +160,8 @@ def test_finalize_leaves_out_a_track_on_small_false_boxes(ratio: float | None, n
     tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
     online = set()
     for k in range(40):
-        dets = []
-        for j, foot in enumerate((100.0, 150.0, 200.0)):
-            h = float(_line(np.array(foot)))
-            x = 20.0 + 90 * j + 2 * k
-            dets.append([x, foot - h, x + h / 2.5, foot, 0.95, 0.0])
-        h = float(_line(np.array(180.0))) / 3
-        dets.append([280.0, 180.0 - h, 280.0 + h / 2.5, 180.0, 0.95, 0.0])
-        online |= {int(r[4]) for r in tracker.update(np.array(dets), frame)}
+        dets = _people_and_false_box(k)
+        online |= {int(r[4]) for r in tracker.update(dets, frame)}
     assert len(online) == 4
     assert len(_ids(tracker.finalize())) == n_ids
 
@@ -149,3 +183,33 @@ def test_a_scene_whose_sizes_do_not_follow_the_row_loses_a_person() -> None:
             )
         ids[ratio] = len(_ids(tracker.finalize()))
     assert (ids[None], ids[0.8]) == (5, 3)
+
+
+def _panning_frames(n: int, step: float) -> list[np.ndarray]:
+    """`n` 240x320 frames of a blurred noise texture, the camera panning `step` px a frame."""
+    rng = np.random.default_rng(2)
+    texture = cv2.GaussianBlur(rng.integers(0, 255, (240, 320 + 400), dtype=np.uint8), (0, 0), 2)
+    scene = cv2.cvtColor(texture, cv2.COLOR_GRAY2BGR)
+    return [
+        np.ascontiguousarray(scene[:, round(k * step) : round(k * step) + 320]) for k in range(n)
+    ]
+
+
+@pytest.mark.parametrize(("camera_motion", "step", "n_ids"), [("auto", 4.0, 4), ("off", 4.0, 3),
+                                                              ("auto", 0.0, 3)])  # fmt: skip
+def test_the_rule_does_not_run_after_the_camera_was_found_moving(
+    camera_motion: CameraMotion, step: float, n_ids: int
+) -> None:
+    """A height-for-row line is a still camera's: under a panning camera (found moving with
+    ``camera_motion="auto"``) the false box of the test above is kept; with the camera's motion
+    off, or a still camera, it is left out as before."""
+    config = TrackerConfig(
+        refine=pftrack.tracking.RefineConfig(enabled=False),
+        camera_motion=camera_motion,
+        lifecycle=LifecycleConfig(size_ratio=0.8),
+    )
+    tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
+    for k, frame in enumerate(_panning_frames(40, step)):
+        tracker.update(_people_and_false_box(k), frame)
+    assert tracker.tracker.camera.moving == (camera_motion == "auto" and step > 0)
+    assert len(_ids(tracker.finalize())) == n_ids

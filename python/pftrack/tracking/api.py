@@ -1562,8 +1562,15 @@ class Tracker:
                 )
             )
             life = self.config.lifecycle
-            if smoothed and self._given and life.size_ratio is not None and self._sizes:
-                # tracks sized unlike the detections' people at their row (size_ratio)
+            if (
+                smoothed
+                and self._given
+                and life.size_ratio is not None
+                and self._sizes
+                and not self._stabiliser.moved
+            ):
+                # tracks sized unlike the detections' people at their row (size_ratio); a
+                # height-for-row line is a still camera's: not after the camera was found moving
                 shape = self._tracker.frame_shape
                 rows = drop_odd_sizes(
                     rows, np.vstack(self._sizes), life.size_ratio, shape[0] if shape else None,

@@ -60,6 +60,9 @@ TOP_EDGE = 1.0  # complete_boxes: a box whose top is within this many px of row 
 BOTTOM_EDGE = 2.0  # drop_odd_sizes: a box whose foot is within this many px of the last row is cut
 SIZE_SAMPLES = 1500  # drop_odd_sizes: detections the height line is fitted to, evenly spaced
 MIN_SIZE_SAMPLES = 30  # drop_odd_sizes: a class with fewer detections is not judged
+# drop_odd_sizes: a row is judged only with its foot row within these percentiles of the foot
+# rows the line was fitted to (no extrapolation)
+SIZE_ROWS = (5.0, 95.0)
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
 
@@ -702,8 +705,10 @@ def drop_odd_sizes(
     unlike the people at their row (docs/tracking.md, "Tracks sized unlike
     the scene's people"). Boxes whose foot lies within 2 px of the frame's last row (cut by
     the frame) are not used, neither for the line nor for a track's ratio; the line's expected
-    height is at least 1 px. A track with no row left to judge, and every track of a class
-    with fewer than 30 usable detections, is kept.
+    height is at least 1 px. The line is not extrapolated: a row whose foot row lies outside
+    the 5th-95th percentile of the foot rows the line was fitted to is not judged. A track with
+    no row left to judge, and every track of a class with fewer than 30 usable detections, is
+    kept.
 
     Parameters
     ----------
@@ -757,7 +762,8 @@ def drop_odd_sizes(
         pick = np.linspace(0, len(x) - 1, min(len(x), SIZE_SAMPLES)).astype(np.int64)
         slope, intercept = theil_sen(x[pick], h[pick])
         expected = np.maximum(slope * foot + intercept, 1.0)
-        judged = (row_cls == c) & rows_in
+        lo, hi = np.percentile(x[pick], SIZE_ROWS)
+        judged = (row_cls == c) & rows_in & (foot >= lo) & (foot <= hi)
         for i in np.unique(a[row_cls == c, 1]):
             r = judged & (a[:, 1] == i)
             if not r.any():
