@@ -196,3 +196,34 @@ def test_a_lost_ctrl_c_stops_a_batch_and_a_re_run_finishes_it(
     assert _statuses(out) == {n: "skipped" if n in done else "done" for n in ("a", "b")}
     for name in ("a.txt", "b.txt"):
         assert (out / name).read_bytes() == (whole / name).read_bytes()
+
+
+@pytest.mark.parametrize("console", [True, False])
+def test_a_live_runs_abort_is_noted_as_the_console_notes_a_ctrl_c(console: bool) -> None:
+    """A live ``track`` run's first Ctrl-C stops it (its outputs are then written: not noted),
+    the second aborts it: noted by the ``pftrack`` process, whose handler its own replaced, so
+    the outputs are refused if code in C drops that interrupt. A caller's own process (Python's
+    handler) notes nothing."""
+    import signal
+
+    from pftrack._console import _on_sigint
+    from pftrack.cli.track import _StopOnCtrlC
+
+    class Source:
+        stopped = False
+
+        def stop(self) -> None:
+            self.stopped = True
+
+    before = signal.signal(signal.SIGINT, _on_sigint if console else signal.default_int_handler)
+    try:
+        source = Source()
+        with pytest.raises(KeyboardInterrupt), _StopOnCtrlC(source):
+            signal.raise_signal(signal.SIGINT)  # the first: stop after this frame
+            assert source.stopped and not _interrupt.interrupted()
+            signal.raise_signal(signal.SIGINT)  # the second: abort
+            for _ in range(1000):  # Python runs the handler between bytecodes
+                pass
+        assert _interrupt.interrupted() == console
+    finally:
+        signal.signal(signal.SIGINT, before)
