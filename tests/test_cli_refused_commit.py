@@ -227,3 +227,28 @@ def test_a_live_runs_abort_is_noted_as_the_console_notes_a_ctrl_c(console: bool)
         assert _interrupt.interrupted() == console
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_eval_writes_both_its_files_or_neither(
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C dropped once ``--json`` is written, while ``--csv`` is made: was, ``--json``
+    replaced, ``--csv`` refused, and "no output was changed" said; now both are staged."""
+    import pftrack.eval.sequences as sequences
+
+    real = sequences.scores_csv
+
+    def dropped_then_csv(*args: Any, **kwargs: Any) -> str:
+        _interrupt.remember()
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(sequences, "scores_csv", dropped_then_csv)
+    for name in ("e.json", "e.csv"):
+        (tmp_path / name).write_bytes(EARLIER)
+    argv = COMMANDS["eval"][1](inputs, tmp_path)
+    assert main(["-q", *argv]) == 130
+    assert capsys.readouterr().err == _said("eval")
+    assert _snapshot(tmp_path) == {"e.json": EARLIER, "e.csv": EARLIER}
