@@ -252,3 +252,31 @@ def test_eval_writes_both_its_files_or_neither(
     assert main(["-q", *argv]) == 130
     assert capsys.readouterr().err == _said("eval")
     assert _snapshot(tmp_path) == {"e.json": EARLIER, "e.csv": EARLIER}
+
+
+@pytest.mark.parametrize("command", ["eval", "experiment"])
+def test_a_ctrl_c_once_the_outputs_are_in_place_is_ignored(
+    command: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """As for ``track``: a Ctrl-C while the report is printed, the files written, ended the
+    run with exit status 130 and "no output was changed"; now it finishes (status 0)."""
+    import importlib
+    import signal
+
+    names, argv = COMMANDS[command]
+    where = importlib.import_module(
+        "pftrack.cli.evaluate" if command == "eval" else "pftrack.cli.experiment"
+    )
+    stream = where.report_stream  # called as the report is printed, the files in place
+
+    def ctrl_c_then_stream(*args: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)
+        return stream(*args)
+
+    monkeypatch.setattr(where, "report_stream", ctrl_c_then_stream)
+    assert main(["-q", *argv(inputs, tmp_path)]) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)

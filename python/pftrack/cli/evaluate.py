@@ -262,6 +262,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from pftrack._progress import Bar, enabled
+    from pftrack.cli._signals import hold_interrupts
     from pftrack.eval.rows import gt_conf_note, result_class_note
     from pftrack.eval.sequences import (
         SequenceScores,
@@ -361,6 +362,8 @@ def run(args: argparse.Namespace) -> int:
         if args.csv:
             with stage(args.csv, ".csv").open("w") as fh:
                 fh.write(scores_csv(scores, combined))
+        if args.json or args.csv:
+            hold_interrupts()  # the work is done: the outputs are put in place whatever comes
     for note in notes:  # once the files are written, as pftrack render says its warnings
         print(f"pftrack eval: warning: {note}", file=sys.stderr)
     # after the files: a closed stdout cannot lose them; not into a file written to stdout
