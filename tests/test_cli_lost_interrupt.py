@@ -4,7 +4,8 @@
 NumPy's ``ImportError: ... PyCapsule_Import could not import module "datetime"`` with its
 "IMPORTANT: PLEASE READ THIS" advice on a broken install (a traceback, exit status 1); about
 once in 40 such runs the interrupt was lost and the run wrote its output (exit status 0).
-The ``pftrack`` process now remembers each Ctrl-C (:func:`pftrack._console.interrupted`).
+The ``pftrack`` process now remembers each Ctrl-C (:func:`pftrack._interrupt.interrupted`),
+and every command that writes checks it where its outputs are put in place.
 """
 
 from __future__ import annotations
@@ -73,6 +74,58 @@ def test_a_lost_ctrl_c_ends_the_command_as_interrupted(tmp_path, command, how):
     assert err == f"pftrack {command}: interrupted; no output was changed\n"
     assert out.read_text() == "an earlier run\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["gt.txt", "out.txt"]
+
+
+# the other commands that write, each with code it runs (where C may drop a Ctrl-C): the hook
+# point, the command line (inputs I, output folder O) and the last line it ends with
+FAMILIES = {
+    "track": (
+        "pftrack.tracking", "track_frames",
+        lambda i, o: ["track", i["video"], "--out", o / "t.txt", "--render", o / "v.mp4",
+                      "--particles", "20"],
+        "pftrack track: interrupted; no output was changed",
+    ),
+    "eval": (
+        "pftrack.io.mot", "read_mot",
+        lambda i, o: ["eval", "--gt", i["gt"], "--res", i["gt"], "--json", o / "e.json"],
+        "pftrack eval: interrupted; no output was changed",
+    ),
+    "experiment": (
+        "pftrack.recovery.experiment", "trajectories",
+        lambda i, o: ["experiment", "gaps", "--gt", i["gt"], "--mask", "0,0,40,40", "--methods",
+                      "linear", "--repeat", "1", "--json", o / "x.json"],
+        "pftrack experiment gaps: interrupted; no output was changed",
+    ),
+    "batch": (  # as after a Ctrl-C it received: its summary lists the sequence as cancelled
+        "pftrack.batch.engine", "call_task",
+        lambda i, o: ["batch", i["video"], "--out", o, "--workers", "0", "--particles", "20"],
+        "pftrack batch: interrupted; no sequence was finished; {out}/summary.json lists them as "
+        "cancelled (re-run to run them)",
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("command", sorted(FAMILIES))
+def test_every_command_that_writes_refuses_after_a_lost_ctrl_c(tmp_path, command):
+    """Was: only ``recover`` and ``smooth`` checked; ``track`` and the rest wrote their
+    outputs after a Ctrl-C that code in C dropped, exit status 0. Now the atomic writers check
+    where they put an output in place (:mod:`pftrack._interrupt`)."""
+    scene = make_scene(n_frames=10, n_walkers=2, rng=0)
+    inputs = {"gt": scene.write_truth(tmp_path / "gt.txt")}
+    inputs["video"] = scene.write_video(tmp_path / "scene.avi")
+    out = tmp_path / "out"
+    out.mkdir()
+    module, name, words, said = FAMILIES[command]
+    argv = [str(w) for w in words(inputs, out)]
+    code = SCRIPT.format(module=module, name=name, how="drop", argv=["-q", *argv])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(  # noqa: PLW1510 - the status is the test's
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr.splitlines()[-1] == said.format(out=out), proc.stderr
+    left = ["summary.json"] if command == "batch" else []
+    assert sorted(p.name for p in out.iterdir()) == left
 
 
 def test_an_ignored_sigint_stays_ignored(tmp_path):

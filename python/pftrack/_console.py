@@ -3,7 +3,9 @@
 Ctrl-C while the command line is imported (its first 0.05-0.1 s) raised a ``KeyboardInterrupt``
 outside :func:`pftrack.cli.main`, which prints a traceback; here it ends as an interrupted
 command does, in one line with exit status 130. Nothing is imported before the ``try`` but
-this module: whatever is interrupted may be half loaded, so the handler loads nothing either.
+this module (a Ctrl-C there is Python's: its traceback); whatever is interrupted may be half
+loaded, so the handler loads nothing either (:mod:`pftrack._interrupt`, which imports
+nothing, is loaded first in the ``try``, before the handler is set).
 """
 
 from __future__ import annotations
@@ -17,24 +19,18 @@ __all__ = ["main"]
 #: what was interrupted (a test checks they agree).
 EXIT_INTERRUPTED = 130
 
-#: Whether Ctrl-C came while this process's command ran (set by :func:`_interrupt`). Code in C
-#: may turn the KeyboardInterrupt it raises into an error of its own, or drop it: NumPy's
-#: import, interrupted, raised ``ImportError: ... PyCapsule_Import could not import module
-#: "datetime"`` with its "IMPORTANT: PLEASE READ THIS" advice on a broken install (a
-#: traceback, exit status 1), and an interrupt dropped somewhere in the imports let ``pftrack
-#: recover`` write its output (exit status 0). With this flag the command ends as interrupted.
-_interrupted = [False]
 
+def _on_sigint(signum: int, frame: object) -> None:
+    """Python's own SIGINT handler (``signal.default_int_handler``), remembering the interrupt.
 
-def _interrupt(signum: int, frame: object) -> None:
-    """Python's own SIGINT handler (``signal.default_int_handler``), remembering the interrupt."""
-    _interrupted[0] = True
+    Code in C may drop the ``KeyboardInterrupt`` raised here, or turn it into an error of its
+    own: the flag (:mod:`pftrack._interrupt`) ends such an error as interrupted (below), and
+    the atomic writers read it before they put an output in place.
+    """
+    from pftrack import _interrupt  # loaded: main imports it before it sets this handler
+
+    _interrupt.remember()
     raise KeyboardInterrupt
-
-
-def interrupted() -> bool:
-    """Whether Ctrl-C came while the ``pftrack`` process's command ran (see `_interrupted`)."""
-    return _interrupted[0]
 
 
 def _command(argv: Sequence[str]) -> str:
@@ -60,11 +56,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         (while the command line is imported or its arguments parsed).
     """
     try:
+        from pftrack import _interrupt  # what the handler and the errors below read
+
         if argv is None:  # this process is the command (the console script, python -m pftrack)
             import signal
 
+            _interrupt.clear()  # this process's command begins
             if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not SIG_IGN
-                signal.signal(signal.SIGINT, _interrupt)
+                signal.signal(signal.SIGINT, _on_sigint)
             from pftrack._threads import one_blas_thread
 
             one_blas_thread()  # before anything loads NumPy
@@ -76,7 +75,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         _signals.PROCESS_ENDS = argv is None
         return run(argv)
     except Exception:
-        if not _interrupted[0]:
+        from pftrack import _interrupt  # (loaded first in the try: cannot fail here)
+
+        if not _interrupt.interrupted():
             raise  # a defect of pftrack's: its traceback is what a report needs
         # Ctrl-C, turned into another error by code in C (an import of NumPy's): as below
         print(f"{_line_end()}{_command(_words(argv))}: interrupted; no output was changed",

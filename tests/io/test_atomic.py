@@ -6,6 +6,7 @@ import errno
 import os
 import stat
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -562,3 +563,81 @@ def test_a_writers_error_on_a_staged_file_names_the_output(tmp_path: Path) -> No
             raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(tmp))
     assert exc.value.errno == errno.ENOSPC
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.fixture
+def lost_ctrl_c() -> Iterator[None]:
+    """The flag the ``pftrack`` console script's SIGINT handler sets, as if its interrupt had
+    then been dropped by code in C (:mod:`pftrack._interrupt`); cleared after the test."""
+    from pftrack import _interrupt
+
+    _interrupt.remember()
+    try:
+        yield
+    finally:
+        _interrupt.clear()
+
+
+@pytest.mark.parametrize("writer", ["atomic_write", "atomic_path", "staged_outputs"])
+@pytest.mark.parametrize("existing", [True, False])
+def test_after_a_lost_ctrl_c_no_writer_puts_its_output_in_place(
+    tmp_path: Path, lost_ctrl_c: None, writer: str, existing: bool
+) -> None:
+    """Was: only ``recover`` and ``smooth`` checked the flag, before their one write; every
+    other command's outputs were put in place after a Ctrl-C that code in C had dropped."""
+    target = tmp_path / "out.txt"
+    if existing:
+        target.write_text("old\n")
+    with pytest.raises(KeyboardInterrupt):
+        _write_through(writer, target, "new\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == (["out.txt"] if existing else [])
+    if existing:
+        assert target.read_text() == "old\n"
+
+
+@pytest.mark.parametrize("writer", ["atomic_write", "atomic_path", "staged_outputs"])
+def test_after_a_lost_ctrl_c_nothing_is_written_into_a_pipe(
+    tmp_path: Path, lost_ctrl_c: None, writer: str
+) -> None:
+    """A written-through output (a FIFO, ``/dev/stdout``) is refused before it is opened."""
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    reader = os.open(fifo, os.O_RDONLY | os.O_NONBLOCK)  # the writer's open does not wait
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            _write_through(writer, fifo, "new\n")
+        assert os.read(reader, 100) == b""  # nothing was written into the pipe
+    finally:
+        os.close(reader)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo"]
+
+
+@pytest.mark.parametrize("writer", ["atomic_write", "atomic_path", "staged_outputs"])
+def test_written_anyway_lets_an_interrupted_run_write_its_record(
+    tmp_path: Path, lost_ctrl_c: None, writer: str
+) -> None:
+    """What a run writes because it was interrupted (a batch's summary.json) goes through."""
+    from pftrack import _interrupt
+
+    with _interrupt.written_anyway():
+        _write_through(writer, tmp_path / "summary.json", "{}\n")
+    assert (tmp_path / "summary.json").read_text() == "{}\n"
+    assert _interrupt.interrupted()  # kept: the next write is refused again
+    with pytest.raises(KeyboardInterrupt):
+        _write_through(writer, tmp_path / "summary.json", "[]\n")
+    assert (tmp_path / "summary.json").read_text() == "{}\n"
+
+
+def test_a_ctrl_c_outside_the_console_script_is_not_remembered(tmp_path: Path) -> None:
+    """Library use does not change: Python's own handler raises, and sets no flag, so a
+    program that catches a Ctrl-C and goes on writes as before."""
+    import signal
+
+    from pftrack import _interrupt
+
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    with pytest.raises(KeyboardInterrupt):
+        signal.raise_signal(signal.SIGINT)
+    assert not _interrupt.interrupted()
+    write_mot(tmp_path / "t.txt", [[1, 1, 0, 0, 10, 10]])
+    assert (tmp_path / "t.txt").exists()

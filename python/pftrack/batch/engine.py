@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pftrack._check import brief, flag, shown
+from pftrack._interrupt import raise_if_interrupted, written_anyway
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack._text import counted, listed, listed_compactly, said_alike
 from pftrack._threads import usable_cpus
@@ -2298,6 +2299,9 @@ def run_jobs(
                         with _no_bars():
                             outcome = call_task(job.func, job.args)
                         record(job, outcome)
+                # a Ctrl-C that code in C dropped after the last task's outputs were written
+                # (each write checks it before): the batch ends as interrupted, as it came
+                raise_if_interrupted()
             finally:
                 for job in jobs:
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
@@ -2306,8 +2310,8 @@ def run_jobs(
                 summary.workers = len(ran) or summary.workers
                 try:
                     summary.unwritten = _out_removed(out, made, summary)
-                    if summary.unwritten is None:
-                        with atomic_write(out / SUMMARY_NAME) as fh:
+                    if summary.unwritten is None:  # also after Ctrl-C: it lists what was left
+                        with written_anyway(), atomic_write(out / SUMMARY_NAME) as fh:
                             fh.write(summary.to_json() + "\n")
                 except OSError as exc:  # was: exit status 2 with this error alone, no table
                     summary.unwritten = (

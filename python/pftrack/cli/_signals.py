@@ -5,7 +5,9 @@ removes its temporary file when an exception passes through it: a ``KeyboardInte
 the user's files as they were and no temporary file. SIGTERM (``kill PID``, a service manager,
 ``timeout``) killed the process where it stood, leaving the temporary files of the video being
 rendered (``..t.<hex>.<hex>.mp4``, ``.t.<hex>.mp4``). While a command runs, SIGTERM raises
-:class:`Terminated`, a ``KeyboardInterrupt``, so it takes the same path.
+:class:`Terminated`, a ``KeyboardInterrupt``, so it takes the same path. A Ctrl-C that code
+in C dropped is noted all the same (:mod:`pftrack._interrupt`): the writers refuse to put an
+output in place after it (:func:`pftrack._interrupt.raise_if_interrupted`).
 """
 
 from __future__ import annotations
@@ -26,7 +28,6 @@ __all__ = [
     "interrupts_held",
     "line_end",
     "outcome",
-    "raise_if_interrupted",
     "set_outcome",
     "sigterm_raises",
 ]
@@ -111,21 +112,6 @@ def hold_interrupts() -> None:
     for sig in _stopping_signals():
         signal.signal(sig, signal.SIG_IGN)
     _held[0] = True
-
-
-def raise_if_interrupted() -> None:
-    """Raise KeyboardInterrupt if Ctrl-C came and was lost on its way (before writing outputs).
-
-    Code in C may drop the KeyboardInterrupt that Python raises for Ctrl-C: ``pftrack
-    recover`` Ctrl-C'd in its first half second, while it imports, once in about 40 runs went
-    on and wrote its output, exit status 0, without a word.
-    The ``pftrack`` process remembers each Ctrl-C (:func:`pftrack._console.interrupted`); a
-    command that catches none itself calls this before it puts its outputs in place.
-    """
-    # read from the entry module where it ran, not imported: pftrack._console imports this one
-    console = sys.modules.get("pftrack._console")
-    if console is not None and console.interrupted():
-        raise KeyboardInterrupt
 
 
 def interrupts_held() -> bool:

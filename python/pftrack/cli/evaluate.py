@@ -262,6 +262,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from pftrack._progress import Bar, enabled
+    from pftrack.cli._signals import hold_interrupts
     from pftrack.eval.rows import gt_conf_note, result_class_note
     from pftrack.eval.sequences import (
         SequenceScores,
@@ -272,7 +273,7 @@ def run(args: argparse.Namespace) -> int:
         scores_csv,
         scores_json,
     )
-    from pftrack.io.atomic import atomic_write, check_output
+    from pftrack.io.atomic import check_output, staged_outputs
     from pftrack.io.mot import read_mot
     from pftrack.recovery.linking import check_scored_ids
 
@@ -347,16 +348,22 @@ def run(args: argparse.Namespace) -> int:
             if note:
                 notes.append(f"{seq.gt_path}: {note}")
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
-    if args.json:
-        if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
-            text = json.dumps(next(iter(scores.values())).as_dict(), indent=2)
-        else:
-            text = scores_json(scores, combined)
-        with atomic_write(args.json) as fh:
-            fh.write(text + "\n")
-    if args.csv:
-        with atomic_write(args.csv) as fh:
-            fh.write(scores_csv(scores, combined))
+    # both replaced at the end, or neither (was: one after the other; a Ctrl-C between them,
+    # or one code in C dropped, which the second refused, left a new --json beside an old --csv
+    # and said "no output was changed")
+    with staged_outputs() as stage:
+        if args.json:
+            if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
+                text = json.dumps(next(iter(scores.values())).as_dict(), indent=2)
+            else:
+                text = scores_json(scores, combined)
+            with stage(args.json, ".json").open("w") as fh:
+                fh.write(text + "\n")
+        if args.csv:
+            with stage(args.csv, ".csv").open("w") as fh:
+                fh.write(scores_csv(scores, combined))
+        if args.json or args.csv:
+            hold_interrupts()  # the work is done: the outputs are put in place whatever comes
     for note in notes:  # once the files are written, as pftrack render says its warnings
         print(f"pftrack eval: warning: {note}", file=sys.stderr)
     # after the files: a closed stdout cannot lose them; not into a file written to stdout

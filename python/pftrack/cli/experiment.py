@@ -20,6 +20,7 @@ from pftrack.cli._options import (
     positive_int,
     report_stream,
 )
+from pftrack.cli._signals import hold_interrupts
 from pftrack.recovery.names import METHODS
 
 MAX_SIDE = 100_000.0  # px: image sizes, mask sides and positions beyond this are refused
@@ -416,6 +417,8 @@ def _finish(args: argparse.Namespace, said: list[str], doc: dict[str, Any], figu
         if args.json:
             with open(stage(args.json), "w", encoding="utf-8") as f:
                 json.dump(doc, f, indent=1)
+        if args.figure or args.json:  # (none: nothing was written, as a report error says)
+            hold_interrupts()  # the work is done: the outputs are put in place whatever comes
     said += [f"{what}: {path}" for what, path in (("figure", args.figure), ("json", args.json))
              if path]  # fmt: skip
     print("\n".join(said), file=report_stream(args.json, args.figure))
@@ -517,6 +520,7 @@ def _run_sequences(args: argparse.Namespace) -> int:
             for e in excess
         ]
         _write_json(args.json, doc)
+        hold_interrupts()  # --json is written: a late Ctrl-C does not fail the run
     to = report_stream(args.json)  # not into a JSON file written to stdout
     for r in results:  # printed once the JSON is written: a closed stdout cannot lose it
         masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks) or "none"

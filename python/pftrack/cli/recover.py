@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     if args.video and not args.link:
         raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
-    from pftrack.cli._signals import hold_interrupts, raise_if_interrupted
+    from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
@@ -121,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
     dt = time.perf_counter() - t0
-    raise_if_interrupted()  # a Ctrl-C that code in C dropped: nothing is written
+    # (after a Ctrl-C that code in C dropped, the writer refuses: pftrack._interrupt)
     write_mot(args.out, filled, exact=copied_values(rows, filled))  # given values: all digits
     hold_interrupts()  # --out is written: a late Ctrl-C does not fail the run
     to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report on stderr

@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     import numpy as np
 
-    from pftrack.cli._signals import hold_interrupts, raise_if_interrupted
+    from pftrack.cli._signals import hold_interrupts
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output
     from pftrack.io.mot import write_mot
@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(src)
     link = None if args.no_link else link_config_for(rows, args.max_gap, args.max_distance)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
-    raise_if_interrupted()  # a Ctrl-C that code in C dropped: nothing is written
+    # (after a Ctrl-C that code in C dropped, the writer refuses: pftrack._interrupt)
     write_mot(args.out, result, exact=smoothed_copies(result))  # given values: all digits
     hold_interrupts()  # --out is written: a late Ctrl-C does not fail the run
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0

@@ -109,6 +109,10 @@ class _StopOnCtrlC:
             # source's reader threads, and the process aborted at exit with a thread inside a
             # C++ read ("FATAL: exception not rethrown"); __exit__ restores the handler
             signal.signal(signal.SIGINT, signal.SIG_IGN)
+            if callable(self._previous):  # the abort is a Ctrl-C as the handler before takes
+                # it: the pftrack process's notes it (pftrack._interrupt), so the outputs are
+                # not put in place if code in C drops the KeyboardInterrupt
+                self._previous(signum, frame)
             raise KeyboardInterrupt
         self.source.stop()
         from pftrack.cli._signals import line_end

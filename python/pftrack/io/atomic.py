@@ -12,6 +12,12 @@ stays a link). One that is not a regular file (a character or block device such 
 ``/proc/self/fd/N``) is written *through*: opened and written like ``open`` would, never
 replaced, so ``--out /dev/null`` discards and ``--out /dev/stdout`` prints (and a named pipe
 stays a pipe). Such a write is not atomic: a failure can leave part of it written.
+
+After a Ctrl-C that the ``pftrack`` console script noted (:mod:`pftrack._interrupt`; code in
+C may have dropped its ``KeyboardInterrupt``), no writer puts its output in place: each raises
+``KeyboardInterrupt`` before its rename (before opening a device or pipe it writes through),
+removing its temporary file, so the command ends as interrupted. Nothing else sets that flag:
+a program that imports pftrack writes as before.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
+from pftrack._interrupt import raise_if_interrupted
 from pftrack._typing import PathLike
 
 #: The descriptor folders of Linux's /proc (``/dev/fd`` and ``/proc/self`` resolve to them).
@@ -261,8 +268,11 @@ def _put_in_place(tmp: str, target: Path, path: PathLike) -> None:
     """Rename the finished temporary file `tmp` over `target`, with `target`'s permission bits.
 
     The bits are given again here, as a writer may have made `tmp` anew; an OSError names
-    output `path`, not `tmp` (:func:`_named`).
+    output `path`, not `tmp` (:func:`_named`). After a Ctrl-C that the ``pftrack`` process
+    noted (:mod:`pftrack._interrupt`), it raises ``KeyboardInterrupt`` instead: code in C may
+    have dropped the interrupt, and the command would have replaced `target` as if none came.
     """
+    raise_if_interrupted()
     with _named(path, hidden=True):
         _keep_mode(tmp, target)
         os.replace(tmp, target)
@@ -323,6 +333,7 @@ def atomic_write(
     _refuse_folder_name(path)
     resolved = _resolve(path)
     if resolved.through:
+        raise_if_interrupted()  # written as it goes: refused before it begins (_put_in_place)
         with _named(path), _open_through(resolved, mode) as fh:
             yield fh
         return
@@ -358,6 +369,7 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         with tempfile.TemporaryDirectory(prefix="pftrack-") as scratch:
             tmp_path = Path(scratch) / f"out{Path(path).suffix}"
             yield tmp_path
+            raise_if_interrupted()  # as _put_in_place
             with _named(path):
                 _copy_through(tmp_path, resolved)
         return
@@ -993,6 +1005,7 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
 
     try:
         yield stage
+        raise_if_interrupted()  # a Ctrl-C that code in C dropped: no target is touched
         # devices first (/dev/full: one that fails leaves every file target as it was; were
         # written last, and --out was replaced by a run that then failed: a user trial); pipes,
         # FIFOs and sockets last, after the renames, as ever: their reader may wait for the

@@ -1,0 +1,61 @@
+"""Whether the ``pftrack`` process was Ctrl-C'd: a flag that outlives a dropped interrupt.
+
+Code in C may turn the ``KeyboardInterrupt`` that Python raises for Ctrl-C into an error of
+its own, or drop it: NumPy's import, interrupted, raised ``ImportError: ... PyCapsule_Import
+could not import module "datetime"`` (a traceback, exit status 1), and an interrupt dropped
+somewhere in the imports let ``pftrack recover`` write its output (exit status 0, no word).
+The console script's SIGINT handler (:mod:`pftrack._console`) calls :func:`remember` before it
+raises; the atomic writers (:mod:`pftrack.io.atomic`) call :func:`raise_if_interrupted` before
+they put an output in place, so a command whose Ctrl-C was lost changes no file.
+
+Nothing else sets the flag: a program that imports pftrack (no ``pftrack`` console script) is
+never refused a write. This module imports nothing, so every layer may read it (the handler
+runs while anything may be half loaded).
+"""
+
+from __future__ import annotations
+
+__all__ = ["clear", "interrupted", "raise_if_interrupted", "remember", "written_anyway"]
+
+_interrupted = [False]
+_anyway = [0]  # written_anyway blocks open
+
+
+def remember() -> None:
+    """Note that Ctrl-C came (the ``pftrack`` console script's SIGINT handler calls it)."""
+    _interrupted[0] = True
+
+
+def interrupted() -> bool:
+    """Whether Ctrl-C came since the ``pftrack`` process's command began (:func:`remember`)."""
+    return _interrupted[0]
+
+
+def clear() -> None:
+    """Forget the Ctrl-C noted: the command has handled it (a batch writing its summary)."""
+    _interrupted[0] = False
+
+
+def raise_if_interrupted() -> None:
+    """Raise ``KeyboardInterrupt`` if Ctrl-C came (:func:`interrupted`), perhaps lost on its way.
+
+    Called where an output is put in place: the writer then removes its temporary file and
+    the command ends as interrupted (exit status 130, "no output was changed").
+    """
+    if _interrupted[0] and not _anyway[0]:
+        raise KeyboardInterrupt
+
+
+class written_anyway:  # noqa: N801 - used as a function: ``with written_anyway():``
+    """Meanwhile, :func:`raise_if_interrupted` raises nothing, though the flag is set.
+
+    For what a run writes *because* it was interrupted: a batch's ``summary.json``, which
+    lists the sequences it cancelled. The flag is kept (:func:`interrupted` still says so). A
+    class, not ``contextlib``: this module imports nothing.
+    """
+
+    def __enter__(self) -> None:
+        _anyway[0] += 1
+
+    def __exit__(self, *exc: object) -> None:
+        _anyway[0] -= 1

@@ -1,0 +1,282 @@
+"""After a Ctrl-C that code in C dropped, no command puts an output in place.
+
+The ``pftrack`` console script's SIGINT handler notes each Ctrl-C (:mod:`pftrack._interrupt`)
+before it raises; code in C may drop the ``KeyboardInterrupt`` (an interrupted import of
+NumPy's once let ``pftrack recover`` write its output, exit status 0). Only ``recover`` and
+``smooth`` checked the flag, before their one write. Now the atomic writers check it where
+they put an output in place, so every command that writes ends as interrupted instead: exit
+status 130, ``pftrack CMD: interrupted; no output was changed``, every file as it was and no
+temporary file. Here the flag is set as the handler sets it, and the interrupt is not raised
+(dropped); tests/test_cli_lost_interrupt.py sends a real SIGINT to a subprocess.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from pftrack import _interrupt
+from pftrack.cli import main
+from pftrack.io.mot import write_mot
+from pftrack.synthetic import make_scene
+
+EARLIER = b"an earlier run's output\n"
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    d = tmp_path_factory.mktemp("inputs")
+    scene = make_scene(n_frames=20, rng=0)
+    write_mot(d / "tracks.txt", scene.truth[scene.truth[:, 0] != 9])  # a gap in every track
+    gt, video = scene.write_truth(d / "gt.txt"), scene.write_video(d / "v.avi")
+    return {"video": video, "gt": gt, "tracks": d / "tracks.txt"}
+
+
+@pytest.fixture(autouse=True)
+def _flag_cleared() -> Iterator[None]:
+    """The flag is the process's: no test leaves it set for the next."""
+    _interrupt.clear()
+    yield
+    _interrupt.clear()
+
+
+def _snapshot(folder: Path) -> dict[str, bytes | None]:
+    return {p.name: (p.read_bytes() if p.is_file() else None) for p in folder.iterdir()}
+
+
+# each command and the outputs it writes in `out` (a folder), which hold an earlier run's
+COMMANDS: dict[str, tuple[list[str], Any]] = {
+    "track": (
+        ["t.txt", "v.mp4", "p.png"],
+        lambda i, o: ["track", str(i["video"]), "--out", str(o / "t.txt"), "--render",
+                      str(o / "v.mp4"), "--plot", str(o / "p.png"), "--particles", "20"],
+    ),
+    "render": (
+        ["v.mp4", "p.png"],
+        lambda i, o: ["render", str(i["video"]), str(i["gt"]), "--out", str(o / "v.mp4"),
+                      "--plot", str(o / "p.png")],
+    ),
+    "smooth": (["s.txt"], lambda i, o: ["smooth", str(i["tracks"]), "--out", str(o / "s.txt")]),
+    "recover": (
+        ["r.txt"],
+        lambda i, o: ["recover", str(i["tracks"]), "--out", str(o / "r.txt"), "--method",
+                      "linear"],
+    ),
+    "eval": (
+        ["e.json", "e.csv"],
+        lambda i, o: ["eval", "--gt", str(i["gt"]), "--res", str(i["tracks"]), "--json",
+                      str(o / "e.json"), "--csv", str(o / "e.csv")],
+    ),
+    "experiment": (
+        ["x.json", "x.png"],
+        lambda i, o: ["experiment", "gaps", "--gt", str(i["gt"]), "--mask", "0,0,40,40",
+                      "--methods", "linear", "--repeat", "1", "--json", str(o / "x.json"),
+                      "--figure", str(o / "x.png")],
+    ),
+}  # fmt: skip
+
+
+def _said(command: str) -> str:
+    """The line an interrupted `command` ends with (``experiment gaps`` names its experiment)."""
+    prog = "pftrack experiment gaps" if command == "experiment" else f"pftrack {command}"
+    return f"{prog}: interrupted; no output was changed\n"
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")  # a 20-frame scene's notes, not the subject
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_a_lost_ctrl_c_changes_no_output(
+    command: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Into a folder that holds an earlier run's outputs, then into an empty one."""
+    names, argv = COMMANDS[command]
+    out, fresh = tmp_path / "out", tmp_path / "fresh"
+    out.mkdir()
+    fresh.mkdir()
+    assert main(["-q", *argv(inputs, out)]) == 0, capsys.readouterr().err  # the command works
+    assert sorted(p.name for p in out.iterdir()) == sorted(names)
+    for name in names:
+        (out / name).write_bytes(EARLIER)
+    capsys.readouterr()
+    for folder in (out, fresh):
+        _interrupt.remember()  # as the handler does; its KeyboardInterrupt dropped by code in C
+        assert main(["-q", *argv(inputs, folder)]) == 130
+        assert capsys.readouterr().err == _said(command)
+    assert _snapshot(out) == dict.fromkeys(names, EARLIER)  # and no temporary file
+    assert list(fresh.iterdir()) == []
+
+
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+def test_a_lost_ctrl_c_makes_no_demo(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``demo`` removes the folder it made, as after a Ctrl-C it received."""
+    _interrupt.remember()
+    assert main(["-q", "demo", "--out-dir", str(tmp_path / "d"), "--frames", "5"]) == 130
+    assert capsys.readouterr().err == "pftrack demo: interrupted; no output was changed\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.fixture(scope="module")
+def two_videos(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    d = tmp_path_factory.mktemp("videos")
+    for k, name in enumerate(("a", "b")):
+        make_scene(n_frames=10, rng=k).write_video(d / f"{name}.avi")
+    return d
+
+
+def _batch(videos: Path, out: Path) -> int:
+    return main(["-q", "batch", str(videos), "--out", str(out), "--workers", "0",
+                 "--particles", "20"])  # fmt: skip
+
+
+def _statuses(out: Path) -> dict[str, str]:
+    summary = json.loads((out / "summary.json").read_text())
+    return {e["name"]: e["status"] for e in summary["sequences"]}
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")  # 10-frame scenes: few tracks confirmed
+@pytest.mark.parametrize("after", [0, 1, 2])
+def test_a_lost_ctrl_c_stops_a_batch_and_a_re_run_finishes_it(
+    after: int,
+    two_videos: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Ctrl-C lost while a sequence is tracked (after `after` sequences are written): that
+    sequence's outputs are not written (its old ones, if any, stay), the batch ends as one
+    Ctrl-C'd there does (exit 130; summary.json lists the finished and the cancelled), and a
+    re-run skips the finished and makes the rest, as a batch never interrupted does. Lost
+    after the last one (``after`` 2): every output is written, and the batch still ends as
+    interrupted. Was: the batch went on and wrote every output, exit status 0."""
+    import pftrack.batch.engine as engine
+
+    whole = tmp_path / "whole"
+    assert _batch(two_videos, whole) == 0
+    real_write = engine._write
+    calls = [0]
+
+    def write(*args: Any, **kwargs: Any) -> Any:
+        if calls[0] == after:
+            _interrupt.remember()  # while this sequence was tracked, dropped
+        calls[0] += 1
+        entry = real_write(*args, **kwargs)
+        if calls[0] == after == 2:
+            _interrupt.remember()  # after the last sequence's outputs
+        return entry
+
+    monkeypatch.setattr(engine, "_write", write)
+    out = tmp_path / "out"
+    capsys.readouterr()
+    assert _batch(two_videos, out) == 130
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    if after == 0:
+        assert err == (
+            f"pftrack batch: interrupted; no sequence was finished; {out}/summary.json lists "
+            "them as cancelled (re-run to run them)"
+        )
+    else:
+        finished = "1 sequence" if after == 1 else "2 sequences"
+        assert err == (
+            f"pftrack batch: interrupted; the outputs of the {finished} finished are written and "
+            f"complete; {out}/summary.json lists the rest as cancelled (re-run to finish them)"
+        )
+    done = ["a", "b"][:after]
+    assert _statuses(out) == {n: "done" if n in done else "cancelled" for n in ("a", "b")}
+    expected = ["summary.json", *(f"{n}{s}" for n in done for s in (".json", ".txt"))]
+    assert sorted(p.name for p in out.iterdir()) == sorted(expected)  # no temporary file
+    monkeypatch.undo()
+    _interrupt.clear()  # the next run: a new process
+    assert _batch(two_videos, out) == 0
+    assert _statuses(out) == {n: "skipped" if n in done else "done" for n in ("a", "b")}
+    for name in ("a.txt", "b.txt"):
+        assert (out / name).read_bytes() == (whole / name).read_bytes()
+
+
+@pytest.mark.parametrize("console", [True, False])
+def test_a_live_runs_abort_is_noted_as_the_console_notes_a_ctrl_c(console: bool) -> None:
+    """A live ``track`` run's first Ctrl-C stops it (its outputs are then written: not noted),
+    the second aborts it: noted by the ``pftrack`` process, whose handler its own replaced, so
+    the outputs are refused if code in C drops that interrupt. A caller's own process (Python's
+    handler) notes nothing."""
+    import signal
+
+    from pftrack._console import _on_sigint
+    from pftrack.cli.track import _StopOnCtrlC
+
+    class Source:
+        stopped = False
+
+        def stop(self) -> None:
+            self.stopped = True
+
+    before = signal.signal(signal.SIGINT, _on_sigint if console else signal.default_int_handler)
+    try:
+        source = Source()
+        with pytest.raises(KeyboardInterrupt), _StopOnCtrlC(source):
+            signal.raise_signal(signal.SIGINT)  # the first: stop after this frame
+            assert source.stopped and not _interrupt.interrupted()
+            signal.raise_signal(signal.SIGINT)  # the second: abort
+            for _ in range(1000):  # Python runs the handler between bytecodes
+                pass
+        assert _interrupt.interrupted() == console
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def test_eval_writes_both_its_files_or_neither(
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A Ctrl-C dropped once ``--json`` is written, while ``--csv`` is made: was, ``--json``
+    replaced, ``--csv`` refused, and "no output was changed" said; now both are staged."""
+    import pftrack.eval.sequences as sequences
+
+    real = sequences.scores_csv
+
+    def dropped_then_csv(*args: Any, **kwargs: Any) -> str:
+        _interrupt.remember()
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(sequences, "scores_csv", dropped_then_csv)
+    for name in ("e.json", "e.csv"):
+        (tmp_path / name).write_bytes(EARLIER)
+    argv = COMMANDS["eval"][1](inputs, tmp_path)
+    assert main(["-q", *argv]) == 130
+    assert capsys.readouterr().err == _said("eval")
+    assert _snapshot(tmp_path) == {"e.json": EARLIER, "e.csv": EARLIER}
+
+
+@pytest.mark.parametrize("command", ["eval", "experiment"])
+def test_a_ctrl_c_once_the_outputs_are_in_place_is_ignored(
+    command: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """As for ``track``: a Ctrl-C while the report is printed, the files written, ended the
+    run with exit status 130 and "no output was changed"; now it finishes (status 0)."""
+    import importlib
+    import signal
+
+    names, argv = COMMANDS[command]
+    where = importlib.import_module(
+        "pftrack.cli.evaluate" if command == "eval" else "pftrack.cli.experiment"
+    )
+    stream = where.report_stream  # called as the report is printed, the files in place
+
+    def ctrl_c_then_stream(*args: Any) -> Any:
+        signal.raise_signal(signal.SIGINT)
+        return stream(*args)
+
+    monkeypatch.setattr(where, "report_stream", ctrl_c_then_stream)
+    assert main(["-q", *argv(inputs, tmp_path)]) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
