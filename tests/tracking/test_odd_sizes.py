@@ -18,7 +18,7 @@ import pftrack
 from pftrack._typing import CameraMotion
 from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import make_scene
-from pftrack.tracking import LifecycleConfig, TrackerConfig
+from pftrack.tracking import LifecycleConfig, TrackerConfig, offline
 from pftrack.tracking.offline import drop_odd_sizes
 
 
@@ -103,6 +103,15 @@ def test_rows_outside_the_fitted_rows_are_not_judged() -> None:
     inside, outside = _track(2, 0.5, foot=100.0, n=5), _track(2, 1.0, foot=20.0, n=15)
     outside[:, 0] += 5
     rows = np.vstack([_track(1, 1.0), inside, outside])
+    assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1}
+
+
+def test_size_rows_none_judges_every_row(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``SIZE_ROWS`` None (candidate B of experiments.size_check) turns limit 2 off: tracks
+    whose feet lie outside the fitted rows are judged, on the line extrapolated."""
+    rows = np.vstack([_track(1, 1.0), _track(2, 0.5, foot=20.0), _track(3, 2.0, 300.0)])
+    assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1, 2, 3}
+    monkeypatch.setattr(offline, "SIZE_ROWS", None)
     assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1}
 
 

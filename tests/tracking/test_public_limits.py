@@ -80,8 +80,9 @@ def test_tud_campus_reaches_the_held_out_mota_without_its_odd_sized_track():
     30x52 px box on a person's upper body, twice the height the line of the detections'
     heights gives at its foot row: 75.2 -> 79.4 MOTA, the misses unchanged. Not the default:
     even with its two limits (no moving camera, no extrapolation) it costs the zoomed, moving
-    PETS09-S2L1 of experiments.moving_camera tracked with --camera-motion off 5.2 MOTA
-    (docs/tracking.md, "Tracks sized unlike the scene's people")."""
+    PETS09-S2L1 of experiments.moving_camera tracked with --camera-motion off 5.2 MOTA, and
+    fails the fresh check of experiments.size_check (docs/tracking.md, "Tracks sized unlike
+    the scene's people")."""
     gt, rows = _tud_campus(TrackerConfig(lifecycle=LifecycleConfig(size_ratio=0.8)))
     scores = evaluate_sequence(gt, rows).mot
     assert scores.mota >= 0.78

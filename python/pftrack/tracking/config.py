@@ -381,7 +381,10 @@ class LifecycleConfig:
         line is a still camera's). In (0, 1); None (default): off. 0.8 gains 2.9 pooled MOTA
         over the sequences with public detections (2.8 with the constant chosen leaving one
         sequence out) but costs the zoomed, moving PETS09-S2L1 of ``experiments.moving_camera``
-        tracked with ``camera_motion="off"`` 5.2 MOTA, so it is not the default
+        tracked with ``camera_motion="off"`` 5.2 MOTA, and on a fresh check set (the rule
+        fixed before measuring; ``experiments.size_check``) it costs still scenes whose
+        people's sizes do not follow the row 8 to 29 MOTA and a PETS09-S2L1 zoomed out too
+        slowly for the camera to be found moving 10.6, so it is not the default
         (docs/tracking.md, "Tracks sized unlike the scene's people").
 
     Raises

@@ -61,8 +61,8 @@ BOTTOM_EDGE = 2.0  # drop_odd_sizes: a box whose foot is within this many px of 
 SIZE_SAMPLES = 1500  # drop_odd_sizes: detections the height line is fitted to, evenly spaced
 MIN_SIZE_SAMPLES = 30  # drop_odd_sizes: a class with fewer detections is not judged
 # drop_odd_sizes: a row is judged only with its foot row within these percentiles of the foot
-# rows the line was fitted to (no extrapolation)
-SIZE_ROWS = (5.0, 95.0)
+# rows the line was fitted to (no extrapolation); None judges every row (experiments.size_check)
+SIZE_ROWS: tuple[float, float] | None = (5.0, 95.0)
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
 
@@ -762,8 +762,10 @@ def drop_odd_sizes(
         pick = np.linspace(0, len(x) - 1, min(len(x), SIZE_SAMPLES)).astype(np.int64)
         slope, intercept = theil_sen(x[pick], h[pick])
         expected = np.maximum(slope * foot + intercept, 1.0)
-        lo, hi = np.percentile(x[pick], SIZE_ROWS)
-        judged = (row_cls == c) & rows_in & (foot >= lo) & (foot <= hi)
+        judged = (row_cls == c) & rows_in
+        if SIZE_ROWS is not None:
+            lo, hi = np.percentile(x[pick], SIZE_ROWS)
+            judged &= (foot >= lo) & (foot <= hi)
         for i in np.unique(a[row_cls == c, 1]):
             r = judged & (a[:, 1] == i)
             if not r.any():
