@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import errno
 import os
+import signal
 import stat
 import threading
 from collections.abc import Iterator
@@ -152,6 +153,55 @@ def test_a_signal_as_the_temporary_file_is_created_leaves_nothing(
     monkeypatch.undo()
     assert sorted(p.name for p in tmp_path.iterdir()) == [".out.keep.txt", "out.txt"]
     assert target.read_text() == "old\n"
+
+
+def test_an_interrupt_while_removing_still_removes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An interrupt raised as a temporary file is removed: the file goes, the interrupt follows.
+
+    Was: ``kill`` sent as ``pftrack track`` checked its output folder left its probe file
+    (``.t.txt.<hex>.probe``; CI at load 8).
+    """
+    from pftrack.io.atomic import _remove
+
+    files = [tmp_path / "a.tmp", tmp_path / "b.tmp"]
+    for f in files:
+        f.write_text("x")
+    unlink, calls = os.unlink, []
+
+    def interrupted_first(path: str) -> None:
+        calls.append(path)
+        if len(calls) == 1:
+            raise KeyboardInterrupt  # before it removed anything
+        unlink(path)
+
+    monkeypatch.setattr(os, "unlink", interrupted_first)
+    with pytest.raises(KeyboardInterrupt):
+        _remove([str(f) for f in files])
+    monkeypatch.undo()
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="signals cannot be blocked")
+def test_a_signal_during_the_output_check_leaves_no_probe(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """SIGINT sent while the folder's probe file exists: raised once the probe is gone."""
+    from pftrack.io.atomic import check_output
+
+    unlink = os.unlink
+
+    def signalled_then_unlink(path: str) -> None:
+        if path.endswith(".probe"):  # the probe made, not yet removed
+            signal.raise_signal(signal.SIGINT)  # Python's handler raises KeyboardInterrupt
+        unlink(path)
+
+    monkeypatch.setattr(os, "unlink", signalled_then_unlink)
+    with pytest.raises(KeyboardInterrupt):
+        check_output(tmp_path / "t.txt")
+    monkeypatch.undo()
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize("mode", [0o600, 0o640])

@@ -28,9 +28,11 @@ import os
 import re
 import secrets
 import shutil
+import signal
 import stat
 import sys
 import tempfile
+import threading
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -225,10 +227,26 @@ def _create_beside(folder: Path, prefix: str, suffix: str, made: list[str]) -> t
 
 
 def _remove(made: Iterable[str]) -> None:
-    """Remove the files :func:`_create_beside` made (those gone already are passed over)."""
+    """Remove the files :func:`_create_beside` made (those gone already are passed over).
+
+    A ``KeyboardInterrupt`` (Ctrl-C, SIGTERM) raised while it removes them does not stop it:
+    each file is still removed, and the interrupt is raised afterwards. A ``kill`` sent the
+    moment a command's check of its output folder had made its probe file left that file
+    behind (CI, at load 8: the interrupt came between the probe's creation and its removal).
+    """
+    stopped: BaseException | None = None
     for path in made:
-        with contextlib.suppress(OSError):
-            os.unlink(path)
+        while True:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass  # gone already, or never made
+            except KeyboardInterrupt as exc:  # before or after the unlink: try it again
+                stopped = exc
+                continue
+            break
+    if stopped is not None:
+        raise stopped
 
 
 def _existing_mode(target: Path) -> int | None:
@@ -852,15 +870,37 @@ def _check_folder(written: Path, what: str, target: Path) -> None:
     ):
         raise PermissionError(f"{what} {target}: not writable")
     made: list[str] = []
-    try:  # access() says yes to root on a read-only or special file system: try it
-        fd, _ = _create_beside(folder, f".{written.name}.", ".probe", made)
-        os.close(fd)
-    except OSError as exc:
-        raise PermissionError(
-            f"{what} {target}: no file can be made in folder {folder} ({exc.strerror or exc})"
-        ) from None
+    with _interrupts_deferred():  # the probe is gone before a Ctrl-C or a kill is raised
+        try:  # access() says yes to root on a read-only or special file system: try it
+            fd, _ = _create_beside(folder, f".{written.name}.", ".probe", made)
+            os.close(fd)
+        except OSError as exc:
+            raise PermissionError(
+                f"{what} {target}: no file can be made in folder {folder} ({exc.strerror or exc})"
+            ) from None
+        finally:
+            _remove(made)
+
+
+@contextlib.contextmanager
+def _interrupts_deferred() -> Iterator[None]:
+    """Meanwhile SIGINT and SIGTERM wait (blocked); delivered, and raised, when it ends.
+
+    For a short step that makes and removes a file: an interrupt raised between the two
+    (Python runs its handler between any two steps) would leave the file. Only in the main
+    thread, where Python runs signal handlers, and where the platform can block signals.
+    """
+    if not hasattr(signal, "pthread_sigmask") or (
+        threading.current_thread() is not threading.main_thread()
+    ):
+        yield
+        return
+    stopping = {getattr(signal, n) for n in ("SIGINT", "SIGTERM") if hasattr(signal, n)}
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, stopping)
+    try:
+        yield
     finally:
-        _remove(made)
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def _same_file(a: Path, b: Path) -> bool:
