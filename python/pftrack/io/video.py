@@ -29,6 +29,7 @@ import configparser
 import errno
 import hashlib
 import itertools
+import math
 import operator
 import os
 import re
@@ -2232,7 +2233,7 @@ class FrameSource:
                 ok, frame = cap.read()
                 if ok:
                     stamps.append(float(cap.get(cv2.CAP_PROP_POS_MSEC)))
-                    if len(stamps) == check and not self._warned_uneven:
+                    if len(stamps) >= check and not self._warned_uneven:
                         check *= 2  # as soon as the stamps show it, not at the end only
                         self._warn_uneven(stamps, whole=False)
                 # a frame's number is its place in the decoded order, as a detector's loop
@@ -2252,6 +2253,10 @@ class FrameSource:
                     if resumed is None:
                         break
                     index, frame = resumed
+                    # no step across the frames that failed (a nan: left out), whose stamps
+                    # are missing: a damaged file's are no variable frame rate's (was: said
+                    # of a 10 fps file with 2 frames lost in 30, "100 to 300 ms apart")
+                    stamps += [math.nan, float(cap.get(cv2.CAP_PROP_POS_MSEC))]
                     if last is None:  # its first frames: a black frame stands in for each
                         last = np.zeros_like(self._resize(frame))
                         self._warn_lead(index)
