@@ -737,6 +737,44 @@ def test_library_warnings_are_one_line_for_every_command(
     assert warnings.showwarning is before  # main restores the formatter it replaced
 
 
+def _fragments(path: Path) -> Path:
+    """Track 1 on frames 1-8, track 2 on frames 13-24 beside it: `recover --link` joins them,
+    reading the frames at their ends (13: past frame 10)."""
+    rows = [(f, 1) for f in range(1, 9)] + [(f, 2) for f in range(13, 25)]
+    path.write_text("".join(f"{f},{i},{20 + f},30,10,20,1,-1,-1,-1\n" for f, i in rows))
+    return path
+
+
+@pytest.mark.parametrize("case", ["damaged video", "11 columns"])
+def test_a_warning_made_an_error_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], case: str
+) -> None:
+    """``python -W error -m pftrack recover``: a warning made an error is the command's one-line
+    error, status 1, nothing written (was: its traceback, status 1). The damaged video's frame
+    10 is now said as ``--video`` is read past it (warnlate; was: never, the frames read on
+    demand never reached the end of the file)."""
+    import warnings
+
+    from tests.io.test_video import damaged_inside
+
+    out = tmp_path / "out.txt"
+    if case == "damaged video":
+        src = _fragments(tmp_path / "t.txt")
+        extra = ["--link", "--video", str(damaged_inside(tmp_path))]
+        text = "damaged.avi: frame 10 could not be decoded (a damaged file?)"
+    else:
+        src = tmp_path / "t.txt"
+        src.write_text("".join(f"{f},1,{10 + f},10,8,16,1,-1,-1,-1,7\n" for f in (1, 2, 5)))
+        extra, text = [], "t.txt has lines of 11 columns"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(["-q", "recover", str(src), "--out", str(out), *extra]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("pftrack recover: error: "), err
+    assert text in err[0] and err[0].endswith("(a warning, made an error)"), err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("command", ["recover", "smooth"])
 def test_columns_past_10_are_dropped_with_a_warning(
     command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]

@@ -404,6 +404,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         said = f"; {_shown(left)}" if left else ""
         print(f"{prog}: error: {_one_line(exc)}{said}", file=sys.stderr)
         return 2
+    except Warning as exc:  # made an error by the filters (python -W error -m pftrack ...)
+        left = outcome(exc)
+        said = f"; {_shown(left)}" if left else ""
+        # one line, not a traceback (was: the traceback of the warning's line; its status, 1)
+        print(f"{prog}: error: {_one_line(exc)} (a warning, made an error){said}", file=sys.stderr)
+        return 1
     except MemoryError as exc:
         left = outcome(exc)
         said = f"; {_shown(left)}" if left else ""

@@ -29,6 +29,7 @@ import configparser
 import errno
 import hashlib
 import itertools
+import math
 import operator
 import os
 import re
@@ -1566,8 +1567,11 @@ class FrameSource:
         pixels clipped to white). When an ``.avi`` is opened whose chunks break off inside it
         (:func:`_avi_break`): the frames after the break may carry earlier frames' numbers.
         When a video file of several video streams is opened (:func:`_several_video_streams`): the
-        first is read. Once, when a video with a rate from the file has clearly uneven time
-        stamps (:func:`_uneven_steps`), a variable frame rate read as one: as soon as its first
+        first is read. Once, when a frame inside a video fails to decode (the frame before
+        stands in): as it is read, before the stand-in is given (under ``-W error`` a loop stops
+        there); at the end of a pass again only if more frames failed, naming them all. Once,
+        when a video with a rate from the file has clearly uneven time stamps
+        (:func:`_uneven_steps`), a variable frame rate read as one: as soon as its first
         :data:`UNEVEN_FIRST_CHECK` frames show it (then 100, 200, ...), else once it was read to
         its end.
 
@@ -1608,7 +1612,9 @@ class FrameSource:
         self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
-        self._warned_lost = False  # frames inside the video could not be decoded
+        # the frames inside the video said not to decode (_warn_lost): said between frames
+        # once, at the end of a pass again only for more
+        self._said_lost: frozenset[int] = frozenset()
         self._warned_lead = False  # its first frames could not be decoded (_warn_lead)
         self._warned_cut = False  # its first frames were left out by FFmpeg (_warn_cut_start)
         #: how many of its first frames did not decode and are black stand-ins (0: none, or
@@ -2045,10 +2051,11 @@ class FrameSource:
     def _iterated_at(self, wanted: list[int], keep: _Prepare) -> list[NDArray[np.uint8]]:
         """The frames at `wanted` (increasing) as iterating the file gives them, stand-ins too.
 
-        When the last of `wanted` is the last frame counted (the spread bootstrap's), the pass
-        reads on to its end, where the reader says which frames it stood in for (once a
-        source, naming the user's line): a stand-in among the chosen frames was not said
-        (was: said only by a later pass over the whole file, after a run had tracked it).
+        The reader says the first failure as it reads on after it (:meth:`_warn_lost`, once a
+        source, naming the user's line), and when the last of `wanted` is the last frame
+        counted (the spread bootstrap's) the pass reads on to its end, which says any later
+        ones: a stand-in among the chosen frames was not said (was: said only by a later pass
+        over the whole file, after a run had tracked it).
         """
         kept, out = set(wanted), []
         to_end = wanted[-1] >= self.n_frames - 1  # at most a frame's grab more
@@ -2226,7 +2233,7 @@ class FrameSource:
                 ok, frame = cap.read()
                 if ok:
                     stamps.append(float(cap.get(cv2.CAP_PROP_POS_MSEC)))
-                    if len(stamps) == check and not self._warned_uneven:
+                    if len(stamps) >= check and not self._warned_uneven:
                         check *= 2  # as soon as the stamps show it, not at the end only
                         self._warn_uneven(stamps, whole=False)
                 # a frame's number is its place in the decoded order, as a detector's loop
@@ -2246,11 +2253,16 @@ class FrameSource:
                     if resumed is None:
                         break
                     index, frame = resumed
+                    # no step across the frames that failed (a nan: left out), whose stamps
+                    # are missing: a damaged file's are no variable frame rate's (was: said
+                    # of a 10 fps file with 2 frames lost in 30, "100 to 300 ms apart")
+                    stamps += [math.nan, float(cap.get(cv2.CAP_PROP_POS_MSEC))]
                     if last is None:  # its first frames: a black frame stands in for each
                         last = np.zeros_like(self._resize(frame))
                         self._warn_lead(index)
                     else:
                         lost.extend(range(decoded, index))
+                        self._warn_lost(lost, at_end=False)  # before its stand-ins
                     for _ in range(decoded, index):  # the damaged frames: the last good one
                         decoded += 1
                         yield last
@@ -2259,20 +2271,33 @@ class FrameSource:
                 yield last
         finally:
             cap.release()
-        if lost and not self._warned_lost:
-            self._warned_lost = True
-            kept = (  # not where FFmpeg numbers the frames after the break by counting them
-                ", so the later frames keep their numbers" if self._broken is None else ""
-            )
-            warn_outside(
-                f"{self.path}: {_frame_list(lost)} could not be decoded (a damaged file?): the "
-                f"frame before stands in for each{kept}",
-                UserWarning,
-            )
+        self._warn_lost(lost, at_end=True)
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded)
         if not self._warned_uneven:
             self._warn_uneven(stamps, whole=True)
+
+    def _warn_lost(self, lost: list[int], *, at_end: bool) -> None:
+        """Warn that the frames `lost` (0-based) inside the video could not be decoded.
+
+        Between frames (`at_end` False: as the reader goes on after a failure, before it gives
+        the stand-ins), once a source: a loop over the source, or a run under ``-W error``,
+        learns it at that frame (was: only once the pass had read every frame; never, for a
+        ``"first"`` bootstrap's pass that stops after its frames). At the end of a pass, the
+        whole pass's frames, only if they are more than those said already (a later failure):
+        the same thing is never said twice.
+        """
+        if not lost or (not at_end and self._said_lost) or set(lost) <= self._said_lost:
+            return
+        self._said_lost |= frozenset(lost)  # first: said once, raised as an error or not
+        kept = (  # not where FFmpeg numbers the frames after the break by counting them
+            ", so the later frames keep their numbers" if self._broken is None else ""
+        )
+        warn_outside(
+            f"{self.path}: {_frame_list(lost)} could not be decoded (a damaged file?): the "
+            f"frame before stands in for each{kept}",
+            UserWarning,
+        )
 
     def _warn_lead(self, index: int) -> None:
         """Warn, once, that the first `index` frames could not be decoded (stand-ins given)."""
@@ -2498,7 +2523,11 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
                 self._stored.close()
                 self._stored, self._stored_at = self.source._iter_stored(), 0
             while self._stored_at <= i:
-                got = next(self._stored, None)
+                try:
+                    got = next(self._stored, None)
+                except Warning:  # made an error (-W error), the pass ended: a new one next time
+                    self.close()
+                    raise
                 if got is None:
                     ended = self._stored_at
                     self.close()
