@@ -21,11 +21,25 @@ HOTA):
 and, for the last fit, the worst and best change when one of its two intercepts (height or
 width) moves by one pixel (``1px-``, ``1px+``): how much one pixel of the size moves a row.
 
+With ``--ill-posed``, three completions that know when the head row cannot give a height (one
+pixel of the head row or of the height line's intercept moves the expected height ``h_e`` by
+``max(1, |s|) / |1 - s|`` px for the height slope ``s``; a box is *ill-posed* when that is more
+than ``1 - amodal_share`` of its own height, the band within which a box counts as whole),
+each scored with the last fit and with its own one-pixel worst change (``...1px-``):
+
+``leave``     ill-posed boxes are left as they are (the rest completed as by default)
+``track``     ill-posed boxes are completed to their track's median height instead of ``h_e``
+              (the offline pass sees the whole track: evidence that does not pass through the
+              head row)
+``margin``    every box is completed only when every line within one pixel of the intercept
+              would complete it: shorter than ``amodal_share (h_e - sensitivity)``, not only
+              than ``amodal_share h_e`` (the decision made robust, the height still ``h_e``)
+
 Usage (from the repository root)::
 
     python -m experiments.person_size [--data ../shared/data]
         [--sequences pets,tud,walkers,present,groups,overhead] [--variants ident,grey,ramp]
-        [--hold-frames 0] [--fits] [--out out/person_size]
+        [--hold-frames 0] [--fits] [--ill-posed] [--out out/person_size]
 """
 
 from __future__ import annotations
@@ -45,7 +59,7 @@ from pftrack._typing import F64
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.eval import evaluate_sequence
 from pftrack.io.mot import as_written
-from pftrack.tracking import api
+from pftrack.tracking import LifecycleConfig, api, offline
 
 SIZES = ("last", "median", "full", "samples", "rows", "none")
 
@@ -170,6 +184,55 @@ def rows_with(rec: Recorder, lines: F64 | None) -> F64:
     return out
 
 
+#: The completions of ill-posed boxes ``--ill-posed`` scores (see the module's docstring).
+ILL_POSED = ("leave", "track", "margin")
+
+
+def head_row_sensitivity(lines: F64) -> float:
+    """Pixels of ``h_e`` one pixel of the head row (or of the intercept) moves."""
+    s = float(lines[0, 0])
+    return np.inf if s == 1.0 else max(1.0, abs(s)) / abs(1.0 - s)
+
+
+def rows_ill_posed(rec: Recorder, how: str, lines: F64) -> F64:
+    """The run's ``finalize()`` again, the completion given `lines` and ill-posed boxes done `how`.
+
+    The library's ``complete_boxes`` runs unchanged; only the expected height it reads for an
+    ill-posed box is replaced (``head_height``): not positive (``leave``: such a box is left
+    alone; ``margin``: a box one pixel would complete or not) or the box's track's median
+    height (``track``).
+    """
+    complete, head = api.complete_boxes, offline.head_height
+    share = LifecycleConfig().amodal_share
+    assert share is not None
+    given: list[F64] = []
+
+    def complete_given(rows: F64, _lines: F64, *args: Any, **kw: Any) -> F64:
+        given[:] = [np.asarray(rows, np.float64)]
+        return complete(rows, lines, *args, **kw)
+
+    def head_given(coef: F64, top: F64) -> F64:
+        rows = given[0]
+        h_e = head(coef, top)
+        ill = head_row_sensitivity(coef) > (1.0 - share) * rows[:, 5]
+        if how == "leave":
+            return np.where(ill, -1.0, h_e)
+        if how == "margin":  # left alone where one pixel would flip the decision
+            h = rows[:, 5]
+            flips = (h >= share * (h_e - head_row_sensitivity(coef))) & (h < share * h_e)
+            return np.where(flips, -1.0, h_e)
+        ids, inv = np.unique(rows[:, 1], return_inverse=True)
+        median = np.array([np.median(rows[inv == k, 5]) for k in range(len(ids))])
+        return np.where(ill, median[inv], h_e)
+
+    with (
+        unittest.mock.patch.object(api, "complete_boxes", complete_given),
+        unittest.mock.patch.object(offline, "head_height", head_given),
+    ):
+        out: F64 = rec.tracker.finalize()
+    return out
+
+
 def scores(gt: F64, rows: F64) -> F64:
     """MOTA, IDF1, HOTA in %."""
     s = evaluate_sequence(gt, as_written(rows))
@@ -206,6 +269,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--variants", default="ident,grey,ramp", help="ident, grey or ramp")
     p.add_argument("--hold-frames", type=int, default=0, help="TrackerConfig.hold_frames")
     p.add_argument("--fits", action="store_true", help="print every fit of the size model")
+    p.add_argument(
+        "--ill-posed", action="store_true", help="score completions of ill-posed boxes too"
+    )
     args = p.parse_args(argv)
     from pftrack.tracking import TrackerConfig, track_frames
 
@@ -266,6 +332,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                 print(f"  {size:8s} {fmt(score(lines)):20s} {line_text(lines)}")
             worst, best = one_pixel(rec, gt, score)
             print(f"  1px-     {fmt(worst)}\n  1px+     {fmt(best)}", flush=True)
+            for how in ILL_POSED if args.ill_posed else ():
+
+                def score_ill(
+                    lines: F64 | None, how: str = how, rec: Recorder = rec, gt: F64 = gt
+                ) -> F64:
+                    assert lines is not None
+                    return scores(gt, rows_ill_posed(rec, how, lines))
+
+                worst = one_pixel(rec, gt, score_ill)[0]
+                assert rec.lines is not None
+                print(f"  {how:8s} {fmt(score_ill(rec.lines)):20s} 1px- {fmt(worst)}", flush=True)
     return 0
 
 
