@@ -22,6 +22,7 @@ Usage (from the repository root)::
 from __future__ import annotations
 
 import dataclasses
+import sys
 import unittest.mock
 import warnings
 from collections.abc import Sequence
@@ -88,13 +89,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     add_detections_and_seeds(p)
     args = p.parse_args(argv)
     data: Path = data_root(args.data)
+    rows = list(video_rows(data, paths=SLOW_PATHS, affines_of=affines_of))
+    if not rows:
+        print(f"no pets09-s2l1 or tud-campus video under {data}", file=sys.stderr)
+        return 2
     with tee_stdout(args.out / "slow_camera.md"):
         print(
             "| row | detections | motion a frame, px (median, max; threshold) | off | auto "
             "(moving frames, seed 0) | on |"
         )
         print("|---|---|---|---|---|---|")
-        for row in video_rows(data, paths=SLOW_PATHS, affines_of=affines_of):
+        for row in rows:
             moved: Sequence[NDArray[np.uint8]] = (
                 _Frames(row.frames, row.n_frames) if callable(row.frames) else row.frames
             )

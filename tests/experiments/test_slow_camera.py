@@ -48,3 +48,8 @@ def test_main_writes_the_table(data: Path, tmp_path: Path, monkeypatch: pytest.M
     assert len(table) == 2 + 2 * len(sl.SLOW_PATHS)
     assert table[2].startswith("| tiny tilt | public | ")
     assert all(line.count("|") == 7 for line in table)
+
+
+def test_no_video_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert sl.main(["--data", str(tmp_path), "--out", str(tmp_path / "out")]) == 2
+    assert "no pets09-s2l1 or tud-campus video under" in capsys.readouterr().err
