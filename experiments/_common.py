@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TextIO
 
 from pftrack._typing import F64, PathLike
+from pftrack.cli._options import bounded_int
 from pftrack.io.atomic import atomic_write
 from pftrack.io.mot import read_mot
 
@@ -145,6 +146,18 @@ def experiment_parser(name: str, doc: str | None) -> argparse.ArgumentParser:
         help=f"output folder for tables and figures (default: out/{name})",
     )
     return parser
+
+
+def add_detections_and_seeds(parser: argparse.ArgumentParser) -> None:
+    """``--detections public builtin`` and ``--seeds N`` (tracker seeds 0..N-1, default 3)."""
+    parser.add_argument(
+        "--detections", nargs="+", choices=("public", "builtin"), default=["public", "builtin"],
+        help="public det.txt and/or the built-in detector (default both)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--seeds", type=bounded_int(1, 1000), default=3,
+        help="tracker seeds 0..N-1, N in [1, 1000] (default 3)",
+    )  # fmt: skip
 
 
 def write_text(path: Path, text: str) -> None:

@@ -49,12 +49,20 @@ from typing import Any
 import cv2
 import numpy as np
 
-from experiments._common import PETS, REPO, TUD, Source, data_folder, experiment_parser, tee_stdout
+from experiments._common import (
+    PETS,
+    REPO,
+    TUD,
+    Source,
+    add_detections_and_seeds,
+    data_folder,
+    experiment_parser,
+    tee_stdout,
+)
 from experiments.public_detections import add_settings, override
 from pftrack._typing import F64
 from pftrack.cli import main as pftrack_main
 from pftrack.cli import track as track_command
-from pftrack.cli._options import bounded_int
 from pftrack.eval import evaluate_mot
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.io.opencv_io import write_image
@@ -160,14 +168,7 @@ def original_note(name: str, det: str, scores: F64, same: bool) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     ap = experiment_parser("moving_camera", __doc__)
     ap.set_defaults(out=Path(tempfile.gettempdir()) / "pftrack-moving-camera")
-    ap.add_argument(
-        "--detections", nargs="+", choices=("public", "builtin"), default=["public", "builtin"],
-        help="public det.txt and/or the built-in detector (default both)",
-    )  # fmt: skip
-    ap.add_argument(
-        "--seeds", type=bounded_int(1, 1000), default=3,
-        help="tracker seeds 0..N-1, N in [1, 1000] (default 3)",
-    )  # fmt: skip
+    add_detections_and_seeds(ap)
     add_settings(ap, "lifecycle.size_ratio=0.8")
     args = ap.parse_args(argv)
     try:  # a bad setting: exit 2 before any work

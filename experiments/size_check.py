@@ -180,9 +180,15 @@ def synthetic_rows(sets: Sequence[str], n_frames: int = 150) -> Iterator[Row]:
             yield row("still", f"{kind} {seed}", s.frames, s.truth, seed)
 
 
-def video_rows(data: Path, sources: Sequence[Source] = (PETS, TUD)) -> Iterator[Row]:
+def video_rows(
+    data: Path,
+    sources: Sequence[Source] = (PETS, TUD),
+    paths: Sequence[str] = PATHS,
+    affines_of: Callable[[str, int, tuple[int, int]], F64] = path_affines,
+) -> Iterator[Row]:
     """The rows of (b) ``paths``: each of `sources` (PETS09-S2L1, TUD-Campus) along each of
-    `PATHS`, its truth and detections in the video's pixels moved with the frames."""
+    `paths` (`affines_of` gives a path's affines from its name, frame count and size), its
+    truth and detections in the video's pixels moved with the frames."""
     for src, folder in video_folders(data, sources):
         video = folder / src.video
         n, h, w = 0, 0, 0
@@ -191,8 +197,8 @@ def video_rows(data: Path, sources: Sequence[Source] = (PETS, TUD)) -> Iterator[
         gt, det = (read_mot(folder / name) for name in ("gt.txt", "det.txt"))
         gt[:, 2:6] *= src.scale
         det[:, 2:6] *= src.scale
-        for kind in PATHS:
-            affines = path_affines(kind, n, (h, w))
+        for kind in paths:
+            affines = affines_of(kind, n, (h, w))
 
             def frames(a: F64 = affines, v: Path = video) -> Iterator[NDArray[np.uint8]]:
                 return (warp_frame(f, a[k]) for k, f in enumerate(FrameSource(v)))

@@ -310,6 +310,37 @@ def test_a_moving_camera_slowing_down_stays_compensated(texture: np.ndarray) -> 
         assert applied is not None and corner_error(applied, truth[k - 1]) < 0.3, k
 
 
+def _moving_frames(texture: np.ndarray, shifts: np.ndarray) -> list[bool]:
+    """Whether ``auto`` counts each frame as moving: `texture` shifted by each (tx, ty) in
+    turn (the view's offset from the first frame, pixels)."""
+    camera = CameraMotion("auto")
+    return [camera.update(warp_frame(texture, similarity(1.0, 0.0, *s))).moving for s in shifts]
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="docs/tracking.md, 'A slowly moving camera': a pan under the threshold a frame is "
+    "never found moving; left so, since compensating it did not help on the slow paths measured",
+)
+def test_a_slow_pan_is_found_moving(texture: np.ndarray) -> None:
+    """A steady pan of 0.3 px a frame (a quarter of the 1.2 px threshold on 480x360), 18 px
+    over 60 frames: each frame is under the threshold, so ``auto`` never starts."""
+    shifts = np.column_stack([0.3 * np.arange(60), np.zeros(60)])
+    assert any(_moving_frames(texture, shifts))
+
+
+def test_a_still_camera_with_jitter_is_not_found_moving(texture: np.ndarray) -> None:
+    """A hand-held still camera: the view shakes about one place by up to 0.5 px on each axis
+    (each frame moves by under the 1.2 px threshold from the last, many by more than the lower
+    0.6 px), 60 frames, and never counts as moving. Whatever finds a slow pan must keep this:
+    the shakes add up to no path."""
+    rng = np.random.default_rng(3)
+    shifts = rng.uniform(-0.5, 0.5, size=(60, 2))
+    steps = np.hypot(*np.diff(shifts, axis=0).T)
+    assert steps.max() < 1.2 and np.count_nonzero(steps > 0.6) > 10
+    assert not any(_moving_frames(texture, shifts))
+
+
 def _chained_error(camera: CameraMotion, texture: np.ndarray, path: np.ndarray) -> float:
     """Largest corner distance between the applied transforms, chained, and the true path."""
     chain, worst = np.eye(2, 3), 0.0

@@ -635,7 +635,8 @@ class CameraConfig:
     threshold : float
         A frame moves when a corner of the image moves by more than this share of the image
         diagonal (0.002: 1.2 px on 480x360; the still PETS09 and TUD-Campus videos measure at
-        most 0.4 and 0.6 px).
+        most 0.4 and 0.6 px). A camera drifting by less a frame is never found moving; measured,
+        compensating it did not help (docs/tracking.md, "A slowly moving camera").
     still_threshold : float
         The lower threshold of the hysteresis (a share of the image diagonal, at most
         `threshold`): once the camera moves, a frame counts as still only when no corner of
