@@ -242,3 +242,35 @@ def test_the_size_model_does_not_learn_a_width_from_the_parts_of_a_cut() -> None
         blobs.boxes(squat_walker_mask(foot=200 + k))
     model = blobs.size_model
     assert not model.fitted or float(model.expected(230.0)[1]) >= 0.8 * 38
+
+
+def no_perspective_boxes(rng: np.random.Generator, n: int, feet: tuple[float, float]) -> np.ndarray:
+    """People without perspective (`make_scene`'s: each its own height, 55-98 px) whose feet
+    lie on rows `feet`; the first few give a slope that is only their differing sizes."""
+    foot = rng.uniform(*feet, n)
+    h = rng.uniform(55, 98, n)
+    return np.column_stack([rng.uniform(0, 400, n), foot - h, 0.4 * h, h])
+
+
+def test_fits_agree_on_a_camera_perspective_not_on_people_sizes_read_as_one() -> None:
+    """`PersonSizeModel.fits_agree`: the slopes of the fits over the video, over the foot
+    rows held, within ``1 - share`` of the median height (docs/detection.md, fitagree)."""
+    camera = PersonSizeModel()
+    assert not camera.fits_agree(0.8)  # no fit yet
+    feed(camera, perspective_boxes(np.random.default_rng(2), 400))
+    assert camera.fits_agree(0.8)
+    sizes = PersonSizeModel()
+    rng = np.random.default_rng(3)
+    first = no_perspective_boxes(rng, 40, (225, 250))
+    first = first[np.argsort(first[:, 3])]  # the taller ones lower: a slope of about 1.7
+    first[:, 1] = np.sort(rng.uniform(225, 250, 40)) - first[:, 3]
+    feed(sizes, first)
+    feed(sizes, no_perspective_boxes(rng, 400, (150, 280)))
+    slope = sizes.coefficients
+    assert slope is not None and abs(slope[0, 0]) < 0.3  # the last fit: no perspective
+    assert not sizes.fits_agree(0.8)
+    assert not camera.fits_agree(1.0)  # no band: fits of noisy boxes differ a little
+    with pytest.raises(ValueError, match="share is 0.0"):
+        camera.fits_agree(0.0)
+    camera.reset()
+    assert not camera.fits_agree(0.8)

@@ -182,12 +182,14 @@ class PersonSizeModel:
         self._n = 0  # samples seen in all
         self._since_fit = 0
         self._coef: NDArray[np.float64] | None = None  # (2, 2): [h, w] x [slope, intercept]
+        self._slopes: list[float] = []  # the height slope of every fit kept, in turn
 
     def reset(self) -> None:
         """Forget every sample and the fit."""
         self._n = 0
         self._since_fit = 0
         self._coef = None
+        self._slopes = []
 
     @property
     def fitted(self) -> bool:
@@ -285,6 +287,32 @@ class PersonSizeModel:
         cut = _core.split_count(boxes, coef, c.split_ratio, c.split_max_height) > 1
         if cut.mean() <= c.max_cut_share:
             self._coef = coef
+            self._slopes.append(float(coef[0, 0]))
+
+    def fits_agree(self, share: float) -> bool:
+        """Whether the fits kept over the video agree on the perspective (the height slope).
+
+        They agree when the spread of their height slopes, over the foot rows of the boxes held
+        (lowest to highest), moves a person's height by at most ``(1 - share)`` of the median
+        height held: ``(max s - min s) (foot_max - foot_min) <= (1 - share) median h``, the band
+        within which `pftrack.tracking.offline.complete_boxes` counts a box of `share` as whole.
+        A camera at head height gives fits of one slope near 1 from the first boxes on; a scene
+        without perspective gives fits whose slopes follow whichever people were seen (their
+        differing sizes read as perspective). False before the model is fitted.
+
+        Raises
+        ------
+        ValueError
+            `share` not in (0, 1].
+        """
+        share = number(share, "PersonSizeModel.fits_agree: share")
+        if not 0.0 < share <= 1.0:
+            raise ValueError(f"PersonSizeModel.fits_agree: share is {share}, expected (0, 1]")
+        if not self._slopes:
+            return False
+        held = self._samples[: self.n_samples]
+        spread = (max(self._slopes) - min(self._slopes)) * float(np.ptp(held[:, 0]))
+        return spread <= (1.0 - share) * float(np.median(held[:, 1]))
 
     def split_count(self, boxes: NDArray[np.float64]) -> NDArray[np.int64]:
         """How many people each box (K, 4) holds side by side.

@@ -1590,6 +1590,9 @@ class Tracker:
                         life.amodal_anchor,
                         size.config.split_ratio,
                         self._tracker.frame_shape[0] if self._tracker.frame_shape else None,
+                        # the fits over the video disagree on the perspective: a head row a
+                        # pixel decides is no evidence of a height (PersonSizeModel.fits_agree)
+                        "complete" if size.fits_agree(life.amodal_share) else "leave",
                     )
             n_tracked = len(rows)  # before the rows wholly outside the frame are left out
             if len(rows) and len(self._tracker.frame_shape) >= 2:

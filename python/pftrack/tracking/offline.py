@@ -56,6 +56,7 @@ __all__ = [
 ]
 
 AMODAL_ANCHORS = ("side", "centre")  # complete_boxes: where a widened box keeps its evidence
+ILL_POSED = ("complete", "leave")  # complete_boxes: what is done with an ill-posed box
 TOP_EDGE = 1.0  # complete_boxes: a box whose top is within this many px of row 0 touches the edge
 BOTTOM_EDGE = 2.0  # drop_odd_sizes: a box whose foot is within this many px of the last row is cut
 SIZE_SAMPLES = 1500  # drop_odd_sizes: detections the height line is fitted to, evenly spaced
@@ -783,6 +784,7 @@ def complete_boxes(
     anchor: str = "side",
     max_width: float = 1.6,
     frame_height: float | None = None,
+    ill_posed: str = "complete",
 ) -> F64:
     """Complete the boxes of partly seen people to the expected person box (amodal boxes).
 
@@ -808,6 +810,11 @@ def complete_boxes(
       `frame_height`, so is a box whose expected person would have its feet below the frame's
       bottom row (``top + h_e > frame_height``): a person the model extrapolates to beyond the
       rows it saw (a height slope near 1 gave 2 700 px people in a 360 px frame).
+    * With ``ill_posed="leave"``, a box whose ``h_e`` one pixel of its top row (or of the height
+      line's intercept) moves by more than ``(1 - share)`` of its own height (by
+      ``max(1, |h_slope|) / |1 - h_slope|`` px: a slope near 1) is left alone: a pixel would
+      decide whether, and to what, it is completed. ``Tracker.finalize()`` asks for this when
+      the size model's fits disagree (`PersonSizeModel.fits_agree`).
 
     Parameters
     ----------
@@ -824,6 +831,8 @@ def complete_boxes(
         Boxes wider than this many expected widths are groups, left alone (>= 1).
     frame_height : float or None
         The frame's height in pixels (> 0), when known: see above.
+    ill_posed : {"complete", "leave"}
+        What is done with a box whose head row cannot give a height (see above).
 
     Returns
     -------
@@ -833,13 +842,17 @@ def complete_boxes(
     Raises
     ------
     ValueError
-        Bad rows or lines, or `share`, `anchor`, `max_width` or `frame_height` out of range.
+        Bad rows or lines, or `share`, `anchor`, `max_width`, `frame_height` or `ill_posed`
+        out of range.
     """
     _check.number(share, "complete_boxes: share", finite=False)  # an array: ambiguous below
     _check.number(max_width, "complete_boxes: max_width", finite=False)
     if not 0.0 < share <= 1.0:
         raise ValueError(f"complete_boxes: share is {share}, expected a value in (0, 1]")
     _check.option(anchor, "complete_boxes: anchor", AMODAL_ANCHORS)
+    _check.option(ill_posed, "complete_boxes: ill_posed", ILL_POSED)
+    if ill_posed not in ILL_POSED:
+        raise ValueError(f"complete_boxes: ill_posed is {ill_posed!r}, expected one of {ILL_POSED}")
     if anchor not in AMODAL_ANCHORS:
         raise ValueError(f"complete_boxes: anchor is {anchor!r}, expected one of {AMODAL_ANCHORS}")
     if not 1.0 <= max_width < np.inf:
@@ -864,6 +877,9 @@ def complete_boxes(
     known = (h_exp > 0.0) & (y > TOP_EDGE)  # a top at the frame's edge is no head
     if frame_height is not None:  # nor is a person whose feet are below the frame
         known &= y + h_exp <= frame_height
+    if ill_posed == "leave":  # nor a height one pixel of the head row would decide
+        s = coef[0, 0]
+        known &= max(1.0, abs(s)) / abs(1.0 - s) <= (1.0 - share) * h
     new_h = np.where(known & (h < share * h_exp), h_exp, h)
     w_exp = expected_size(coef, y + new_h)[:, 1]
     person = known & (w <= max_width * w_exp)
