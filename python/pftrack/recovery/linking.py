@@ -314,8 +314,11 @@ def _sizes_apart(a: F64, b: F64, ratio: float | None) -> NDArray[np.bool_]:
 
 #: Candidate pairs gated at once by :func:`link_costs`: memory stays bounded by the pairs that
 #: pass the gates, not by all those within the time gate (a file of 50000 one-row fragments,
-#: 10 a frame, has 15 million: 2.8 GB; a user trial).
-PAIR_BLOCK = 1 << 20
+#: 10 a frame, has 15 million: 2.8 GB; a user trial). Gating takes about 210 bytes a pair in
+#: temporaries, so a block of 65536 pairs about 14 MB (was 2**20 pairs, 220 MB: the peak of
+#: ``pftrack smooth`` on a crowded file, whose pairs within the time gate grow with the square
+#: of the fragments a frame; the same pairs and costs, no slower).
+PAIR_BLOCK = 1 << 16
 
 
 def _candidate_pairs(
