@@ -234,12 +234,18 @@ def _end_velocity(c: F64, k: int, tail: bool) -> F64:
     return np.asarray((t @ (part[:, 1:3] - part[:, 1:3].mean(axis=0))) / denom, dtype=np.float64)
 
 
-def sorted_tracks(rows: F64) -> tuple[F64, NDArray[np.int64]]:
+def sorted_tracks(rows: F64, *, share: bool = False) -> tuple[F64, NDArray[np.int64]]:
     """`rows` sorted by id, then frame (one copy), and the end of each id's rows in it.
 
     The rows of the ``k``-th id are ``sorted[ends[k - 1]:ends[k]]`` (``ends[-1]`` is 0): the
-    tracks of :func:`split_tracks`, in its order, without a dict of views.
+    tracks of :func:`split_tracks`, in its order, without a dict of views. With `share`, rows
+    already in that order, each (id, frame) once, come back themselves, not copied (for a
+    caller that only reads them: ``pftrack smooth`` fills holes in rows it sorted).
     """
+    if share and len(rows) > 1:
+        step_id, step_frame = np.diff(rows[:, 1]), np.diff(rows[:, 0])
+        if np.all((step_id > 0) | ((step_id == 0) & (step_frame > 0))):
+            return rows, np.r_[np.flatnonzero(step_id != 0) + 1, len(rows)]
     r = rows[np.lexsort((rows[:, 0], rows[:, 1]))]  # by id, then frame (stable)
     if len(r) == 0:
         return r, np.zeros(0, dtype=np.int64)
