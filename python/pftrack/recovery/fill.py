@@ -312,8 +312,8 @@ def fill_rows(
     check_tracked(rows, who="fill_gaps")
     # every track's rows one after the other (by id, then frame), its centres and segment rows:
     # one sorted copy of the rows (was a dict of tracks and their concatenation, two copies,
-    # 80 bytes a row more at the peak)
-    r, track_ends = sorted_tracks(rows)
+    # 80 bytes a row more at the peak), none of rows in that order already (smooth's)
+    r, track_ends = sorted_tracks(rows, share=True)
     c = box_centres(r)
     seg = np.column_stack([c, r[:, 4], r[:, 5]])
     ends = track_ends.tolist()

@@ -234,12 +234,18 @@ def _end_velocity(c: F64, k: int, tail: bool) -> F64:
     return np.asarray((t @ (part[:, 1:3] - part[:, 1:3].mean(axis=0))) / denom, dtype=np.float64)
 
 
-def sorted_tracks(rows: F64) -> tuple[F64, NDArray[np.int64]]:
+def sorted_tracks(rows: F64, *, share: bool = False) -> tuple[F64, NDArray[np.int64]]:
     """`rows` sorted by id, then frame (one copy), and the end of each id's rows in it.
 
     The rows of the ``k``-th id are ``sorted[ends[k - 1]:ends[k]]`` (``ends[-1]`` is 0): the
-    tracks of :func:`split_tracks`, in its order, without a dict of views.
+    tracks of :func:`split_tracks`, in its order, without a dict of views. With `share`, rows
+    already in that order, each (id, frame) once, come back themselves, not copied (for a
+    caller that only reads them: ``pftrack smooth`` fills holes in rows it sorted).
     """
+    if share and len(rows) > 1:
+        step_id, step_frame = np.diff(rows[:, 1]), np.diff(rows[:, 0])
+        if np.all((step_id > 0) | ((step_id == 0) & (step_frame > 0))):
+            return rows, np.r_[np.flatnonzero(step_id != 0) + 1, len(rows)]
     r = rows[np.lexsort((rows[:, 0], rows[:, 1]))]  # by id, then frame (stable)
     if len(r) == 0:
         return r, np.zeros(0, dtype=np.int64)
@@ -314,8 +320,11 @@ def _sizes_apart(a: F64, b: F64, ratio: float | None) -> NDArray[np.bool_]:
 
 #: Candidate pairs gated at once by :func:`link_costs`: memory stays bounded by the pairs that
 #: pass the gates, not by all those within the time gate (a file of 50000 one-row fragments,
-#: 10 a frame, has 15 million: 2.8 GB; a user trial).
-PAIR_BLOCK = 1 << 20
+#: 10 a frame, has 15 million: 2.8 GB; a user trial). Gating takes about 210 bytes a pair in
+#: temporaries, so a block of 65536 pairs about 14 MB (was 2**20 pairs, 220 MB: the peak of
+#: ``pftrack smooth`` on a crowded file, whose pairs within the time gate grow with the square
+#: of the fragments a frame; the same pairs and costs, no slower).
+PAIR_BLOCK = 1 << 16
 
 
 def _candidate_pairs(
