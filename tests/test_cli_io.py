@@ -584,11 +584,39 @@ def test_ctrl_c_during_start_up_is_one_line_and_130(
     assert not out.exists()
 
 
-def test_the_console_scripts_exit_status_is_the_clis() -> None:
-    from pftrack._console import EXIT_INTERRUPTED
-    from pftrack.cli._signals import EXIT_INTERRUPTED as CLI_EXIT_INTERRUPTED
+@pytest.mark.parametrize("how", ["script", "pftrack"])
+@pytest.mark.parametrize("module", ["pftrack.cli", "pftrack.cli.track"])
+def test_sigterm_during_start_up_is_one_line_and_143(
+    sequence: Path, tmp_path: Path, how: str, module: str
+) -> None:
+    """SIGTERM before the command's own handler (a ``kill`` 0.09-0.16 s in, on a loaded
+    machine: 5 runs of 80 in the trial) killed the process where it stood (status -15, no
+    word); now it ends as a SIGTERM'd command does. Deterministic: the import of `module`
+    sends it."""
+    out = tmp_path / "t.txt"
+    out.write_text("keep\n")
+    argv = ["-q", "track", str(sequence), "--out", str(out)]
+    code = f"MODULE, ARGV, HOW = {module!r}, {argv!r}, {how!r}\n" + _INTERRUPTED_IMPORT.replace(
+        "raise KeyboardInterrupt", "import os, signal; os.kill(os.getpid(), signal.SIGTERM)"
+    )
+    root = Path(__file__).parents[1]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
+    )
+    assert (proc.returncode, proc.stderr, proc.stdout) == (
+        143, "pftrack track: terminated (SIGTERM); no output was changed\n", ""
+    )  # fmt: skip
+    assert out.read_text() == "keep\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
 
-    assert EXIT_INTERRUPTED == CLI_EXIT_INTERRUPTED
+
+def test_the_console_scripts_exit_status_is_the_clis() -> None:
+    from pftrack._console import EXIT_INTERRUPTED, EXIT_TERMINATED
+    from pftrack.cli._signals import EXIT_INTERRUPTED as CLI_EXIT_INTERRUPTED
+    from pftrack.cli._signals import EXIT_TERMINATED as CLI_EXIT_TERMINATED
+
+    assert (EXIT_INTERRUPTED, EXIT_TERMINATED) == (CLI_EXIT_INTERRUPTED, CLI_EXIT_TERMINATED)
 
 
 def _rows(path: Path) -> int:
