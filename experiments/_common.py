@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TextIO
 
 from pftrack._typing import F64, PathLike
+from pftrack.cli import Parser
 from pftrack.cli._options import bounded_int
 from pftrack.io.atomic import atomic_write
 from pftrack.io.mot import read_mot
@@ -99,12 +100,25 @@ def no_video_folders(data: Path) -> Iterator[tuple[str, Path]]:
             print(f"{name}: not found under {data / 'mot15-gt'}, skipped")
 
 
-class _ExperimentParser(argparse.ArgumentParser):
+class _ExperimentParser(Parser):
     """An experiment's parser: ``--help`` shows every option's default.
 
     An option whose help does not state its default gets ``(default: ...)`` added (flags and
-    options without a default excepted).
+    options without a default excepted). Bad usage is one line and status 2, as ``pftrack``'s
+    (:class:`pftrack.cli.Parser`; was: argparse's whole usage first), and so is an ``--out``
+    that cannot be a folder (was: the traceback of its ``mkdir``, after the argument checks).
     """
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        parsed, extra = super().parse_known_args(args, namespace)
+        out = getattr(parsed, "out", None)
+        if isinstance(out, Path):
+            problem = _out_problem(out)
+            if problem:
+                self.error(f"--out {out}: {problem}")
+        return parsed, extra
 
     def format_help(self) -> str:
         for action in self._actions:
@@ -118,6 +132,18 @@ class _ExperimentParser(argparse.ArgumentParser):
             elif "default" not in action.help and action.help != argparse.SUPPRESS:
                 action.help += " (default: %(default)s)"
         return super().format_help()
+
+
+def _out_problem(out: Path) -> str:
+    """Why `out` cannot be made a writable folder ("" if it can): its nearest existing path."""
+    here = out
+    while not here.exists() and here != here.parent:
+        here = here.parent
+    if not here.is_dir():
+        return f"{here} is not a folder"
+    if not os.access(here, os.W_OK | os.X_OK):
+        return f"{here} is not writable"
+    return ""
 
 
 def experiment_parser(name: str, doc: str | None) -> argparse.ArgumentParser:

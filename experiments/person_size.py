@@ -44,6 +44,7 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
+import sys
 import unittest.mock
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -281,9 +282,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     bad += sorted(set(variants) - {"ident", "grey", "ramp"})
     if bad:
         p.error(f"unknown sequence(s) or variant(s): {', '.join(bad)}")
+    if not names or not variants:  # (was: the header alone, status 0)
+        p.error(f"--{'sequences' if not names else 'variants'} names none")
     if args.hold_frames < 0:
         p.error(f"--hold-frames is {args.hold_frames}, expected 0 (off) or more")
     data = data_root(args.data)
+    ran = 0
     with tee_stdout(args.out / "person_size.txt"):
         print(f"hold_frames={args.hold_frames} seed=0 (MOTA / IDF1 / HOTA in %)")
         for name, variant in product(names, variants):
@@ -296,6 +300,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 print(f"{name} {variant}: skipped (no data)")
                 continue
             source, gt = case
+            ran += 1
             rec = Recorder()
             patches = record(rec)
             for patch in patches:
@@ -343,6 +348,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 worst = one_pixel(rec, gt, score_ill)[0]
                 assert rec.lines is not None
                 print(f"  {how:8s} {fmt(score_ill(rec.lines)):20s} 1px- {fmt(worst)}", flush=True)
+    if not ran:  # every one asked was a real sequence missing under --data (was: status 0)
+        print(f"no pets09-s2l1 or tud-campus video under {data}", file=sys.stderr)
+        return 2
     return 0
 
 

@@ -218,10 +218,15 @@ def override(config: TrackerConfig, setting: str) -> TrackerConfig:
     elif isinstance(old, (int, float)) or old is None:
         try:
             value = type(old)(text) if old is not None else _number(text)
-        except ValueError:
-            raise ValueError(f"--set {setting!r}: {text!r} is not a {type(old).__name__}") from None
+        except ValueError:  # (was "is not a NoneType" for a setting off by default)
+            kind = "an int" if isinstance(old, int) else "a number"
+            raise ValueError(
+                f"--set {setting!r}: {text!r} is not {kind}{' (or none)' if old is None else ''}"
+            ) from None
     elif isinstance(old, str):
         value = text
+    elif dataclasses.is_dataclass(old):  # (was "'lifecycle' is not a number, flag or name")
+        raise ValueError(f"--set {setting!r}: {key!r} is a section: give {key}.FIELD=VALUE")
     else:
         raise ValueError(f"--set {setting!r}: {key!r} is not a number, flag or name")
     new: Any = dataclasses.replace(owner, **{field: value})  # type: ignore[type-var]

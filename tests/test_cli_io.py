@@ -553,6 +553,22 @@ runpy.run_module(HOW, run_name="__main__", alter_sys=True)
 """
 
 
+def _track_stopped_at_import(
+    module: str, argv: list[str], how: str, stop: str = "raise KeyboardInterrupt"
+) -> subprocess.CompletedProcess[str]:
+    """:data:`_INTERRUPTED_IMPORT` run with `argv`, its import of `module` doing `stop`."""
+    body = _INTERRUPTED_IMPORT.replace("raise KeyboardInterrupt", stop)
+    code = f"import os, signal\nMODULE, ARGV, HOW = {module!r}, {argv!r}, {how!r}\n{body}"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    return subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=Path(__file__).parents[1],
+        env=env,
+        capture_output=True,
+        text=True,
+    )
+
+
 @pytest.mark.parametrize(
     ("how", "module"),
     [
@@ -570,13 +586,7 @@ def test_ctrl_c_during_start_up_is_one_line_and_130(
     # was: exit 130 with a KeyboardInterrupt traceback from an import (pftrack._progress: from
     # main's "-q", before its handler)
     out = tmp_path / "t.txt"
-    argv = ["-q", "track", str(sequence), "--out", str(out)]
-    code = f"MODULE, ARGV, HOW = {module!r}, {argv!r}, {how!r}\n{_INTERRUPTED_IMPORT}"
-    root = Path(__file__).parents[1]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    proc = subprocess.run(
-        [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
-    )
+    proc = _track_stopped_at_import(module, ["-q", "track", str(sequence), "--out", str(out)], how)
     assert (proc.returncode, proc.stderr, proc.stdout) == (
         130, "pftrack track: interrupted; no output was changed\n", ""
     )  # fmt: skip
@@ -584,11 +594,32 @@ def test_ctrl_c_during_start_up_is_one_line_and_130(
     assert not out.exists()
 
 
-def test_the_console_scripts_exit_status_is_the_clis() -> None:
-    from pftrack._console import EXIT_INTERRUPTED
-    from pftrack.cli._signals import EXIT_INTERRUPTED as CLI_EXIT_INTERRUPTED
+@pytest.mark.parametrize("how", ["script", "pftrack"])
+@pytest.mark.parametrize("module", ["pftrack.cli", "pftrack.cli.track"])
+def test_sigterm_during_start_up_is_one_line_and_143(
+    sequence: Path, tmp_path: Path, how: str, module: str
+) -> None:
+    """SIGTERM before the command's own handler (a ``kill`` 0.09-0.16 s in, on a loaded
+    machine: 5 runs of 80 in the trial) killed the process where it stood (status -15, no
+    word); now it ends as a SIGTERM'd command does. Deterministic: the import of `module`
+    sends it."""
+    out = tmp_path / "t.txt"
+    out.write_text("keep\n")
+    argv = ["-q", "track", str(sequence), "--out", str(out)]
+    proc = _track_stopped_at_import(module, argv, how, "os.kill(os.getpid(), signal.SIGTERM)")
+    assert (proc.returncode, proc.stderr, proc.stdout) == (
+        143, "pftrack track: terminated (SIGTERM); no output was changed\n", ""
+    )  # fmt: skip
+    assert out.read_text() == "keep\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
 
-    assert EXIT_INTERRUPTED == CLI_EXIT_INTERRUPTED
+
+def test_the_console_scripts_exit_status_is_the_clis() -> None:
+    from pftrack._console import EXIT_INTERRUPTED, EXIT_TERMINATED
+    from pftrack.cli._signals import EXIT_INTERRUPTED as CLI_EXIT_INTERRUPTED
+    from pftrack.cli._signals import EXIT_TERMINATED as CLI_EXIT_TERMINATED
+
+    assert (EXIT_INTERRUPTED, EXIT_TERMINATED) == (CLI_EXIT_INTERRUPTED, CLI_EXIT_TERMINATED)
 
 
 def _rows(path: Path) -> int:

@@ -458,3 +458,56 @@ def test_renderer_add_names_tracks_that_are_not_iterable(tmp_path: Path, tracks:
     renderer.add(frame, [])  # the renderer goes on
     renderer.close()
     assert (tmp_path / "v.avi").is_file()
+
+
+def test_a_lost_wake_up_of_the_worker_is_found(tmp_path: Path) -> None:
+    """A Ctrl-C between ``Queue.put``'s append and its notify (or one that broke the queue's
+    lock) leaves an item queued and the worker asleep: ``pftrack track --render`` hung on
+    Ctrl-C in ``abort()``'s join (was: the worker slept in ``get()`` for ever)."""
+    import time
+
+    r = TrackRenderer(tmp_path / "a.avi", 10.0)
+    r.add(np.zeros((48, 64, 3), np.uint8), [])
+    time.sleep(0.3)  # the worker has drawn it and waits for the next
+    q, worker = r._queue, r._thread
+    assert q is not None and worker is not None
+    with q.mutex:
+        q.queue.append(None)  # queued, no one woken
+    worker.join(5.0)
+    alive = worker.is_alive()
+    if alive:  # the old worker: wake it, so that the test ends
+        q.put(None)
+    r.abort()
+    assert not alive
+
+
+def test_the_caller_never_sleeps_on_the_queues_condition(tmp_path: Path) -> None:
+    """``add`` on a full queue waits for room in short sleeps, not in ``Condition.wait``: a
+    Ctrl-C that lands there as it takes the queue's lock back leaves the lock released under
+    the worker (the hang above; was ``Queue.put``, blocking)."""
+    import threading
+
+    r = TrackRenderer(tmp_path / "a.avi", 10.0, queue_size=1)
+    q = r._queue
+    assert q is not None
+    go = threading.Event()
+    draw = r._draw
+
+    def slow(job: Any) -> None:
+        go.wait(5.0)
+        draw(job)
+
+    waits: list[str] = []
+    condition_wait = q.not_full.wait
+
+    def wait(timeout: float | None = None) -> bool:
+        waits.append(threading.current_thread().name)
+        return condition_wait(timeout)
+
+    r._draw = slow  # type: ignore[method-assign]
+    q.not_full.wait = wait  # type: ignore[method-assign]
+    threading.Timer(0.5, go.set).start()
+    for _ in range(4):
+        r.add(np.zeros((48, 64, 3), np.uint8), [])
+    r.close()
+    assert r.n_frames == 4 and waits == []

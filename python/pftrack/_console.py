@@ -18,6 +18,8 @@ __all__ = ["main"]
 #: :data:`pftrack.cli._signals.EXIT_INTERRUPTED`, stated here: the module that states it may be
 #: what was interrupted (a test checks they agree).
 EXIT_INTERRUPTED = 130
+#: :data:`pftrack.cli._signals.EXIT_TERMINATED`, likewise.
+EXIT_TERMINATED = 143
 
 
 def _on_sigint(signum: int, frame: object) -> None:
@@ -31,6 +33,20 @@ def _on_sigint(signum: int, frame: object) -> None:
 
     _interrupt.remember()
     raise KeyboardInterrupt
+
+
+def _on_sigterm(signum: int, frame: object) -> None:
+    """SIGTERM before the command's own handler (:mod:`pftrack.cli._signals`) is set.
+
+    Was: the default action, the process killed where it stood (status -15, no word) when
+    SIGTERM came in the first 0.1-0.2 s of a loaded machine. Once, as the command's handler.
+    """
+    import signal
+
+    from pftrack import _interrupt  # loaded: main imports it before it sets this handler
+
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    raise _interrupt.Terminated
 
 
 def _command(argv: Sequence[str]) -> str:
@@ -64,6 +80,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             _interrupt.clear()  # this process's command begins
             if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not SIG_IGN
                 signal.signal(signal.SIGINT, _on_sigint)
+            if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+                signal.signal(signal.SIGTERM, _on_sigterm)
             from pftrack._threads import one_blas_thread
 
             one_blas_thread()  # before anything loads NumPy
@@ -83,12 +101,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{_line_end()}{_command(_words(argv))}: interrupted; no output was changed",
               file=sys.stderr)  # fmt: skip
         return EXIT_INTERRUPTED
-    except KeyboardInterrupt:  # before the command's own handler: nothing was written yet
-        print(f"{_line_end()}{_command(_words(argv))}: interrupted; no output was changed",
+    except KeyboardInterrupt as e:  # before the command's own handler: nothing was written yet
+        from pftrack import _interrupt  # (loaded first in the try: cannot fail here)
+
+        how = "terminated (SIGTERM)" if isinstance(e, _interrupt.Terminated) else "interrupted"
+        print(f"{_line_end()}{_command(_words(argv))}: {how}; no output was changed",
               file=sys.stderr)  # fmt: skip
-        return EXIT_INTERRUPTED
+        return EXIT_TERMINATED if how != "interrupted" else EXIT_INTERRUPTED
     finally:
         _handled()
+        if argv is None:  # the process exits as it ends: SIGTERM kills it, as it did
+            import signal
+
+            if signal.getsignal(signal.SIGTERM) is _on_sigterm:
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _handled() -> None:

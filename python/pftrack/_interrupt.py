@@ -15,7 +15,23 @@ runs while anything may be half loaded).
 
 from __future__ import annotations
 
-__all__ = ["clear", "interrupted", "raise_if_interrupted", "remember", "written_anyway"]
+__all__ = [
+    "Terminated",
+    "clear",
+    "interrupted",
+    "raise_if_interrupted",
+    "remember",
+    "written_anyway",
+]
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread where the command stands (:mod:`pftrack.cli._signals`).
+
+    Stated here, where nothing is imported, so that the console script's handler
+    (:mod:`pftrack._console`) raises it while the command line is still being imported.
+    """
+
 
 _interrupted = [False]
 _anyway = [0]  # written_anyway blocks open

@@ -6,6 +6,7 @@ import functools
 import itertools
 import queue
 import threading
+import time
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -184,6 +185,9 @@ def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
     return float(box[0] + box[2] / 2), float(box[1] + box[3])
 
 
+#: Seconds between the render worker's looks at its queue, and the caller's at a full queue:
+#: neither thread sleeps on the queue's condition alone (see :meth:`TrackRenderer._put`).
+_POLL = 0.05
 #: Longest trail, in frames (``pftrack render --trail``'s limit).
 MAX_TRAIL = 100_000
 #: The columns of a MOT row that the pictures read.
@@ -442,7 +446,24 @@ class TrackRenderer:
         if self._queue is None:
             self._draw(job)
         else:
-            self._queue.put(job)
+            self._put(job)
+
+    def _put(self, item: _Job | None) -> None:
+        """Queue `item` for the worker, never waiting inside the queue's condition.
+
+        A Ctrl-C that lands in ``Queue.put``'s wait for room, as it takes the queue's lock
+        back, leaves with the lock released under the worker's feet; the worker then missed
+        the ``None`` that :meth:`abort` queued and ``pftrack track --render`` hung on Ctrl-C
+        (1 run of 20 at random moments). The caller waits for room in short sleeps instead,
+        and the worker looks at the queue every :data:`_POLL` s even if a wake-up was lost.
+        """
+        assert self._queue is not None
+        while True:
+            try:
+                self._queue.put_nowait(item)
+                return
+            except queue.Full:
+                time.sleep(_POLL / 10)
 
     def _draw(self, job: _Job) -> None:
         n, frame, rows, trails = job
@@ -453,7 +474,10 @@ class TrackRenderer:
     def _work(self) -> None:
         assert self._queue is not None
         while True:
-            job = self._queue.get()
+            try:
+                job = self._queue.get(timeout=_POLL)  # a wake-up lost: found at the next look
+            except queue.Empty:
+                continue
             if job is None:
                 return
             if self._error is None:
@@ -469,7 +493,7 @@ class TrackRenderer:
 
     def _join(self) -> None:
         if self._thread is not None and self._queue is not None:
-            self._queue.put(None)
+            self._put(None)
             self._thread.join()
             self._thread = None
 

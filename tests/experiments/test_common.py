@@ -65,3 +65,25 @@ def test_no_video_folders_are_those_of_mot15_gt_present(
         f"{name}: not found under {tmp_path / 'mot15-gt'}, skipped"
         for name in ("ADL-Rundle-6", "ETH-Sunnyday")
     ]
+
+
+@pytest.mark.parametrize("module", ["moving_camera", "slow_camera", "size_check", "person_size"])
+def test_bad_usage_is_one_line_and_status_2(
+    module: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """As ``pftrack``'s own commands (was: argparse's whole usage, four to six lines, first);
+    an ``--out`` under a file (was: ``mkdir``'s traceback once the arguments were checked)."""
+    import importlib
+
+    main = importlib.import_module(f"experiments.{module}").main
+    (tmp_path / "file").write_text("")
+    for args, message in (
+        (["--nonesuch"], "unrecognized arguments: --nonesuch"),
+        (["--out", str(tmp_path / "file" / "out")], f"--out {tmp_path / 'file' / 'out'}: "
+         f"{tmp_path / 'file'} is not a folder"),
+    ):  # fmt: skip
+        with pytest.raises(SystemExit) as e:
+            main(args)
+        err = capsys.readouterr().err
+        assert e.value.code == 2
+        assert err == f"python -m experiments.{module}: error: {message}\n"

@@ -79,3 +79,17 @@ def test_ill_posed_completions_do_not_move_with_one_pixel() -> None:
     # and, one pixel higher, left alone (100 > 0.8 (137 - 30))
     a, b = (person_size.rows_ill_posed(rec, "margin", x)[:, 5] for x in (lines, moved))
     assert a[0] == b[0] == 130 and a[1] == h_main[0] and b[1] == 100
+
+
+def test_nothing_to_run_is_status_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """An empty ``--sequences`` (was: the header alone, status 0) or only real sequences that
+    are missing under ``--data`` (was: every row 'skipped', status 0)."""
+    with pytest.raises(SystemExit) as e:
+        person_size.main(["--sequences", ",", "--out", str(tmp_path)])
+    assert e.value.code == 2
+    assert capsys.readouterr().err.endswith("error: --sequences names none\n")
+    args = ["--data", str(tmp_path), "--sequences", "pets", "--variants", "ident"]
+    assert person_size.main([*args, "--out", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err.endswith(
+        f"no pets09-s2l1 or tud-campus video under {tmp_path}\n"
+    )

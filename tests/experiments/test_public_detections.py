@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -48,6 +50,22 @@ def test_override_changes_one_field_and_refuses_unknown_ones() -> None:
             ex.override(base, bad)
     with pytest.raises(ValueError, match="max_coast"):  # the config's own check still runs
         ex.override(base, "lifecycle.max_coast=-1")
+
+
+@pytest.mark.parametrize(
+    ("setting", "message"),
+    [  # were: "'x' is not a NoneType", "is not a int", "'lifecycle' is not a number, ..."
+        ("lifecycle.size_ratio=x", "'x' is not a number (or none)"),
+        ("hold_frames=1.5", "'1.5' is not an int"),
+        ("reference_rate=x", "'x' is not a number"),
+        ("lifecycle=1", "'lifecycle' is a section: give lifecycle.FIELD=VALUE"),
+    ],
+)
+def test_a_bad_setting_says_what_the_field_takes(setting: str, message: str) -> None:
+    with pytest.raises(
+        ValueError, match=f"^--set {re.escape(repr(setting))}: {re.escape(message)}$"
+    ):
+        ex.override(TrackerConfig(), setting)
 
 
 def test_main_rejects_a_bad_setting(capsys: pytest.CaptureFixture[str]) -> None:

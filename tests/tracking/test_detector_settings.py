@@ -115,3 +115,28 @@ def test_settings_that_cannot_be_the_detectors_are_refused_in_one_line(
 def test_the_same_value_given_twice_is_taken() -> None:
     TrackerConfig(detector=PaperConfig(hold_frames=1000), hold_frames=1000)
     TrackerConfig(detector=PaperConfig(blobs=BlobConfig(open_size=5)), open_size=5)
+
+
+def test_tracker_takes_the_detectors_settings_as_its_annotation_says(
+    frames: list[np.ndarray],
+) -> None:
+    """``pftrack.Tracker(detector=PaperConfig(...))`` was taken, but annotated and documented
+    as a name only (a typed script was refused by mypy for a call that worked)."""
+    import typing
+
+    import pftrack
+
+    hint = typing.get_type_hints(pftrack.Tracker.__init__)["detector"]
+    assert {PaperConfig, Mog2Config, KnnConfig} <= set(typing.get_args(hint))
+    by_name, by_settings = pftrack.Tracker(), pftrack.Tracker(detector=PaperConfig())
+    for frame in frames[:15]:
+        assert np.array_equal(by_name.update(None, frame), by_settings.update(None, frame))
+
+
+def test_tracker_refuses_a_detectors_hsv_without_naming_a_setting_it_lacks() -> None:
+    """TrackerConfig's message says ``set binning=...``: ``Tracker`` has no `binning`."""
+    import pftrack
+
+    with pytest.raises(ValueError, match=r"^detector's hsv is .*Tracker\.from_config$") as e:
+        pftrack.Tracker(detector=PaperConfig(hsv=HsvBinning(n_h=8)))
+    assert "set binning" not in str(e.value)

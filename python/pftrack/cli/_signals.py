@@ -19,6 +19,8 @@ import threading
 from collections.abc import Iterator
 from typing import Any
 
+from pftrack._interrupt import Terminated
+
 __all__ = [
     "EXIT_INTERRUPTED",
     "EXIT_TERMINATED",
@@ -36,10 +38,6 @@ __all__ = [
 EXIT_INTERRUPTED = 130
 #: Exit status after SIGTERM (128 + SIGTERM, as shells report a process it killed).
 EXIT_TERMINATED = 143
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised in the main thread where the command stands (see the module's notes)."""
 
 
 def exit_status(exc: KeyboardInterrupt) -> int:

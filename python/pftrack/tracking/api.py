@@ -77,11 +77,13 @@ from pftrack._typing import (
     SamplerName,
 )
 from pftrack._warn import Held, warn
+from pftrack.detection import KnnConfig, Mog2Config, PaperConfig
 from pftrack.detection.base import BlobConfig
 from pftrack.detection.blocking import BLOCK_FRAMES, blockiness, is_blocky
 from pftrack.detection.light import BLANK_LEVELS, is_blank
 from pftrack.detection.paper import PaperDetector
 from pftrack.detection.size_model import PersonSizeModel
+from pftrack.particle_filter import HsvBinning
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
@@ -429,9 +431,11 @@ class Tracker:
         real number: a :class:`~fractions.Fraction` too (PyAV's ``stream.average_rate``).
     seed : int or None
         Seed: the same seed, frames and detections give the same tracks (None: fresh entropy).
-    detector : {"paper", "mog2", "knn"}
+    detector : {"paper", "mog2", "knn"}, PaperConfig, Mog2Config or KnnConfig
         Built-in detector, used when ``update`` gets ``dets=None`` (and, with detections, for
-        the foreground that shrinks their boxes).
+        the foreground that shrinks their boxes): by name, with its defaults, or as its
+        settings, every one of them (``detector=PaperConfig(alpha_fg=0.01, hold_frames=1000)``;
+        :attr:`TrackerConfig.detector`, whose checks it passes, its `hsv` left at the default).
     sampler : {"sis", "mh", "rjmcmc"}
         Particle filter per object (sis, the paper's; mh) or one joint RJ-MCMC chain.
     particles : int or None
@@ -586,7 +590,7 @@ class Tracker:
         frame_rate: RealLike = REFERENCE_RATE,
         *,
         seed: int | None = 0,
-        detector: DetectorName = "paper",
+        detector: DetectorName | PaperConfig | Mog2Config | KnnConfig = "paper",
         sampler: SamplerName = "sis",
         particles: int | None = None,
         dynamics: DynamicsName = "ar2",
@@ -653,6 +657,15 @@ class Tracker:
         burn_in = integer(burn_in, "burn_in", 0, MAX_BURN_IN)
         moves = _moves(moves)
         base = TrackerConfig()
+        if isinstance(detector, (PaperConfig, Mog2Config, KnnConfig)) and detector.hsv not in (
+            HsvBinning(),
+            base.binning,
+        ):  # TrackerConfig's message says to set binning, which this class does not take
+            raise ValueError(
+                f"detector's hsv is {detector.hsv}, but the detector bins colour as the tracker "
+                f"does ({base.binning}): leave the {type(detector).__name__}'s hsv at its default, "
+                "or give TrackerConfig(binning=..., detector=...) to Tracker.from_config"
+            )
         model = replace(base.filter.model, use_means=dynamics == "ar2-mean")
         try:  # the arguments share the settings' names: not the class the caller never built
             config = replace(
