@@ -274,3 +274,23 @@ def test_fits_agree_on_a_camera_perspective_not_on_people_sizes_read_as_one() ->
         camera.fits_agree(0.0)
     camera.reset()
     assert not camera.fits_agree(0.8)
+
+
+def test_a_model_pickled_before_fits_agree_takes_its_fit_as_the_only_one() -> None:
+    """A checkpoint from before the fits' slopes were kept: its one fit agrees with itself
+    (boxes are completed as that code did), instead of an AttributeError at finalize()."""
+    import pickle
+
+    model = fitted_model()
+    state = dict(model.__dict__)
+    del state["_slopes"]
+    old = PersonSizeModel.__new__(PersonSizeModel)
+    old.__setstate__(pickle.loads(pickle.dumps(state)))
+    assert old.fits_agree(0.8)
+    assert old._slopes == [float(model._coef[0, 0])]  # type: ignore[index]
+    blank = PersonSizeModel()
+    state = dict(blank.__dict__)
+    del state["_slopes"]
+    unfitted = PersonSizeModel.__new__(PersonSizeModel)
+    unfitted.__setstate__(state)
+    assert not unfitted.fits_agree(0.8)

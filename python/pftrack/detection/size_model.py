@@ -191,6 +191,12 @@ class PersonSizeModel:
         self._coef = None
         self._slopes = []
 
+    def __setstate__(self, state: dict[str, object]) -> None:
+        self.__dict__.update(state)
+        if "_slopes" not in state:  # pickled before fits_agree (6 December): its fit alone
+            coef = self._coef
+            self._slopes = [] if coef is None else [float(coef[0, 0])]
+
     @property
     def fitted(self) -> bool:
         """Whether enough isolated boxes were seen for `expected` to answer."""
