@@ -85,7 +85,8 @@ ALLOWED = {
     "recovery": {"particle_filter"},  # linking's colour term uses the core's HSV histograms
     "tracking": {"particle_filter", "detection", "recovery"},
     "eval": set(),
-    "integrations": {"tracking"},  # adapters to other libraries' tracker interfaces
+    # adapters to other libraries' tracker interfaces (the Tracker's options name detection's)
+    "integrations": {"tracking", "detection"},
     # the batch layer runs whole commands: it scores (eval) and renders like the CLI does
     "batch": {"particle_filter", "detection", "recovery", "tracking", "eval", "render"},
 }

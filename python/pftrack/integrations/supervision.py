@@ -28,6 +28,7 @@ from pftrack._typing import (
     RealLike,
     SamplerName,
 )
+from pftrack.detection import KnnConfig, Mog2Config, PaperConfig
 from pftrack.tracking.api import Tracker
 
 if sys.version_info >= (3, 11):  # at run time too: typing.get_type_hints resolves it
@@ -47,7 +48,7 @@ class TrackerOptions(TypedDict, total=False):
     """
 
     seed: int | None
-    detector: DetectorName
+    detector: DetectorName | PaperConfig | Mog2Config | KnnConfig
     sampler: SamplerName
     particles: int | None
     dynamics: DynamicsName
