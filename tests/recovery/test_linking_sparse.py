@@ -218,3 +218,19 @@ def test_gating_memory_follows_the_block_not_the_pairs_within_the_time_gate() ->
         tracemalloc.stop()
     assert 0 < len(i) < 0.05 * within
     assert peak < 40, f"peak {peak:.0f} MB"  # 2**20 pairs a block: 159 MB
+
+
+def test_pair_blocks_cover_the_entries_in_order_within_the_block() -> None:
+    """Ranges of consecutive entries, each of at most `block` pairs unless it is one entry,
+    each as long as the block allows: the linking's and the offline pass's blocks."""
+    rng = np.random.default_rng(5)
+    for block in (1, 4, 37, 1000):
+        counts = rng.integers(0, 12, 500) * (rng.random(500) < 0.8)
+        counts[::97] = 60  # entries of more pairs than some blocks
+        ranges = list(linking._pair_blocks(counts, block))
+        assert [lo for lo, _ in ranges] == [0] + [hi for _, hi in ranges[:-1]]
+        assert ranges[-1][1] == len(counts)
+        for lo, hi in ranges:
+            assert hi > lo and (counts[lo:hi].sum() <= block or hi == lo + 1)
+            assert hi == len(counts) or counts[lo : hi + 1].sum() > block
+    assert list(linking._pair_blocks(np.zeros(0, np.intp), 8)) == []

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import pftrack.recovery.neighbours as neighbours
 from pftrack.recovery import recover_gaps
 from pftrack.recovery.calibrate import CANDIDATES, calibrate, recover_auto
 from pftrack.recovery.neighbours import (
@@ -227,3 +228,51 @@ def test_windows_many_is_windows_pair_by_pair() -> None:
             for x, y in zip(w, v, strict=True):
                 np.testing.assert_array_equal(x, y)
     assert got[-1] == []
+
+
+def _covering_runs(n_runs: int, n_gaps: int) -> tuple[list[np.ndarray], list[tuple]]:
+    """`n_runs` runs over frames 1-200, every one a neighbour of each of `n_gaps` gaps."""
+    rng = np.random.default_rng(0)
+    runs = [
+        np.column_stack([np.arange(1, 201.0), rng.uniform(0, 500, (200, 2))]) for _ in range(n_runs)
+    ]
+    pairs = []
+    for g in range(n_gaps):
+        r = runs[g % n_runs] + [0.0, 0.5, 0.5]
+        s = int(rng.integers(20, 150))
+        pairs.append((r[:s], r[s + 5 :]))
+    return runs, pairs
+
+
+@pytest.mark.parametrize("block", [1, 50, 1000])
+def test_windows_many_in_blocks_are_the_windows_at_once(monkeypatch, block) -> None:
+    """(gap, run) pairs searched SEARCH_BLOCK at a time (one gap's at least): the windows of
+    the search over every pair at once, in the same order."""
+    runs, pairs = _covering_runs(30, 60)
+    excludes = [g % 30 if g % 2 else -1 for g in range(60)]
+    monkeypatch.setattr(neighbours, "SEARCH_BLOCK", 1 << 40)
+    whole = Neighbourhood(runs).windows_many(pairs, excludes)
+    monkeypatch.setattr(neighbours, "SEARCH_BLOCK", block)
+    got = Neighbourhood(runs).windows_many(pairs, excludes)
+    assert [len(w) for w in got] == [len(w) for w in whole] == [MAX_NEIGHBOURS] * 60
+    for ws, vs in zip(got, whole, strict=True):
+        for w, v in zip(ws, vs, strict=True):
+            assert all(x.tobytes() == y.tobytes() for x, y in zip(w, v, strict=True))
+
+
+def test_windows_many_searches_in_bounded_memory() -> None:
+    """1000 runs, each a neighbour of 1000 gaps: the search took 2**22 (gap, run) pairs at a
+    time, about 80 bytes each in temporaries (tracemalloc peak 82 MB here, 329 MB for 2000 x
+    2000); now SEARCH_BLOCK = 2**16: 9 MB."""
+    import tracemalloc
+
+    runs, pairs = _covering_runs(1000, 1000)
+    hood = Neighbourhood(runs)
+    tracemalloc.start()
+    try:
+        got = hood.windows_many(pairs, [-1] * len(pairs))
+        peak = tracemalloc.get_traced_memory()[1] / 1e6
+    finally:
+        tracemalloc.stop()
+    assert peak < 30, f"{peak:.0f} MB"
+    assert all(len(w) == MAX_NEIGHBOURS for w in got)

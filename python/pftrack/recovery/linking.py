@@ -327,6 +327,24 @@ def _sizes_apart(a: F64, b: F64, ratio: float | None) -> NDArray[np.bool_]:
 PAIR_BLOCK = 1 << 16
 
 
+def _pair_blocks(counts: NDArray[np.intp], block: int) -> Iterator[tuple[int, int]]:
+    """Ranges ``lo, hi`` of consecutive entries whose `counts` (pairs) add up to `block` at most.
+
+    Each range holds one entry at least (an entry of more than `block` pairs is never split),
+    so a range's pairs are at most ``max(block, counts.max())``; together the ranges cover
+    ``0 .. len(counts)`` in order. The pairs of :func:`_candidate_pairs`, and those of the
+    offline pass's all-pairs steps (:mod:`pftrack.tracking.offline`), are made a range at a
+    time: memory follows the block, not the pairs.
+    """
+    ends = np.cumsum(counts)
+    lo = 0
+    while lo < len(counts):
+        done = int(ends[lo - 1]) if lo else 0
+        hi = max(int(np.searchsorted(ends, done + block, side="right")), lo + 1)
+        yield lo, hi
+        lo = hi
+
+
 def _candidate_pairs(
     last: F64, first: F64, max_gap: int
 ) -> Iterator[tuple[NDArray[np.intp], NDArray[np.intp]]]:
@@ -343,19 +361,13 @@ def _candidate_pairs(
     lo = np.searchsorted(starts, last, side="right")  # starts after the end
     hi = np.searchsorted(starts, last + (max_gap + 1), side="right")  # at most max_gap missing
     counts = hi - lo
-    ends = np.cumsum(counts)
-    block = PAIR_BLOCK
-    a = 0
-    while a < len(last):
-        # the i of this block: as many as fit in `block` pairs, one at least
-        b = max(int(np.searchsorted(ends, ends[a] - counts[a] + block, side="right")), a + 1)
+    for a, b in _pair_blocks(counts, PAIR_BLOCK):  # the i of this block, one at least
         n = counts[a:b]
         i = np.repeat(np.arange(a, b), n)
         offset = np.arange(len(i)) - np.repeat(np.cumsum(n) - n, n)
         j = order[np.repeat(lo[a:b], n) + offset]
         keep = np.lexsort((j, i))
         yield i[keep], j[keep]
-        a = b
 
 
 def link_costs(

@@ -33,6 +33,7 @@ from pftrack.recovery.fill import DEFAULT_MAX_GAP, MAX_GAP_LIMIT, fill_rows
 from pftrack.recovery.linking import (
     MAX_ID,
     LinkConfig,
+    _pair_blocks,
     check_boxes,
     check_rows,
     check_tracked,
@@ -358,25 +359,25 @@ def repair_crossings(
 def _overlapping_pairs(a: F64, min_iou: float) -> F64:
     """(P, 4) rows ``frame, row p, row q, IoU`` (p < q) of boxes of one frame overlapping enough.
 
-    `a` is sorted by frame. Every pair of rows of one frame at once: row p is paired with the
-    rows after it in its frame (``sum k (k - 1) / 2`` pairs for frames of k rows).
+    `a` is sorted by frame. Row p is paired with the rows after it in its frame (``sum k (k -
+    1) / 2`` pairs for frames of k rows), in blocks of consecutive p of at most
+    :data:`PAIR_BLOCK` pairs (was: all pairs at once), sorted by p, then q.
     """
     n = len(a)
-    if n < 2:
-        return np.zeros((0, 4))
     fr = a[:, 0]
-    first = np.flatnonzero(np.r_[True, fr[1:] != fr[:-1]])
+    first = np.flatnonzero(np.r_[True, fr[1:] != fr[:-1]]) if n else np.zeros(0, np.intp)
     size = np.diff(np.r_[first, n])
     end = np.repeat(first + size, size)  # one past the last row of each row's frame
     later = end - np.arange(n) - 1  # rows after each row in its frame
-    total = int(later.sum())
-    if total == 0:
-        return np.zeros((0, 4))
-    p = np.repeat(np.arange(n), later)
-    q = p + 1 + np.arange(total) - np.repeat(np.cumsum(later) - later, later)
-    iou = _iou_rows(a[p, 2:6], a[q, 2:6])
-    keep = iou >= min_iou
-    return np.column_stack([fr[p[keep]], p[keep], q[keep], iou[keep]])
+    kept = [np.zeros((0, 4))]
+    for lo, hi in _pair_blocks(later, PAIR_BLOCK):
+        m = later[lo:hi]
+        p = np.repeat(np.arange(lo, hi), m)
+        q = p + 1 + np.arange(len(p)) - np.repeat(np.cumsum(m) - m, m)
+        iou = _iou_rows(a[p, 2:6], a[q, 2:6])
+        keep = iou >= min_iou
+        kept.append(np.column_stack([fr[p[keep]], p[keep], q[keep], iou[keep]]))
+    return np.concatenate(kept)
 
 
 def _windows(pairs: F64, lab: F64, join_gap: int) -> list[tuple[float, float, float, float, float]]:
@@ -907,9 +908,12 @@ def complete_boxes(
     return a
 
 
-#: Pairs of rows :func:`_frame_pairs` gives at a time, at most (unless one frame has more):
-#: bounded memory whatever the number of boxes a frame holds.
-PAIR_BLOCK = 1 << 20
+#: Pairs of rows the offline pass's all-pairs steps make at a time (:func:`_frame_pairs`,
+#: :func:`_overlapping_pairs`), at most (unless one row has more: the boxes of its frame).
+#: ``drop_nested`` takes about 160 bytes of temporaries a pair, so a block is about 10 MB
+#: (was 2**20 pairs of whole frames, 160 MB, and every overlapping pair of the run at once:
+#: 1.5 GB for ``repair_crossings`` on 2000 tracks over 3000 frames), the same rows.
+PAIR_BLOCK = 1 << 16
 
 
 def _frame_pairs(
@@ -917,29 +921,21 @@ def _frame_pairs(
 ) -> Iterator[tuple[NDArray[np.intp], NDArray[np.intp]]]:
     """Row indices ``(i, j)`` of every pair of rows of one frame, ``i == j`` too, in blocks.
 
-    With `rows`, only the pairs whose ``i`` is one of `rows` (a mask). Blocks of whole frames,
-    of about :data:`PAIR_BLOCK` pairs.
+    With `rows`, only the pairs whose ``i`` is one of `rows` (a mask). Blocks of consecutive
+    ``i`` (by frame, then row) of at most :data:`PAIR_BLOCK` pairs, one ``i`` at least: a
+    frame's pairs may be split between blocks, one row's never.
     """
     order = np.argsort(frames, kind="stable")
     f = frames[order]
     starts = np.flatnonzero(np.r_[True, f[1:] != f[:-1]]) if len(f) else np.zeros(0, np.intp)
     sizes = np.diff(np.r_[starts, len(f)])
     first = np.repeat(starts, sizes)  # per position of `order`: its frame's first position
-    size = np.repeat(sizes, sizes)
-    keep = np.ones(len(f), dtype=bool) if rows is None else rows[order]
-    kept = np.add.reduceat(keep.astype(np.intp), starts) if len(starts) else sizes
-    ends = np.cumsum(sizes * kept)  # pairs up to the end of each frame
-    lo = 0  # frames lo .. hi - 1 of `starts` in this block
-    while lo < len(starts):
-        done = ends[lo - 1] if lo else 0
-        hi = max(lo + 1, int(np.searchsorted(ends, done + PAIR_BLOCK, side="right")))
-        stop = starts[hi] if hi < len(starts) else len(f)
-        p = np.flatnonzero(keep[starts[lo] : stop]) + starts[lo]  # the positions paired
-        n = size[p]
+    p_all = np.arange(len(f)) if rows is None else np.flatnonzero(rows[order])  # positions paired
+    n_all = np.repeat(sizes, sizes)[p_all]  # each one's pairs: the rows of its frame
+    for lo, hi in _pair_blocks(n_all, PAIR_BLOCK):
+        p, n = p_all[lo:hi], n_all[lo:hi]
         at = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)  # 0 .. n - 1 per row
-        if len(p):
-            yield order[np.repeat(p, n)], order[np.repeat(first[p], n) + at]
-        lo = hi
+        yield order[np.repeat(p, n)], order[np.repeat(first[p], n) + at]
 
 
 def split_refound(
