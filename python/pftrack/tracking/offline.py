@@ -910,9 +910,10 @@ def complete_boxes(
 
 #: Pairs of rows the offline pass's all-pairs steps make at a time (:func:`_frame_pairs`,
 #: :func:`_overlapping_pairs`), at most (unless one row has more: the boxes of its frame).
-#: ``drop_nested`` takes about 160 bytes of temporaries a pair, so a block is about 10 MB
-#: (was 2**20 pairs of whole frames, 160 MB, and every overlapping pair of the run at once:
-#: 1.5 GB for ``repair_crossings`` on 2000 tracks over 3000 frames), the same rows.
+#: ``drop_nested`` takes about 140 bytes of temporaries a pair, so a block is about 10 MB
+#: (was 2**20 pairs in blocks of whole frames: 576 MB for 2000 boxes in one frame; and every
+#: overlapping pair at once: 1.5 GB for ``repair_crossings`` on 2000 tracks over 3000
+#: frames), the same rows (docs/recovery.md, "The offline pass's other pairs").
 PAIR_BLOCK = 1 << 16
 
 
