@@ -122,7 +122,7 @@ def test_size_rows_none_judges_every_row(monkeypatch: pytest.MonkeyPatch) -> Non
         (1.0, np.zeros((40, 2)), ValueError, "ratio is 1.0"),
         (float("nan"), np.zeros((40, 2)), ValueError, "ratio is nan"),
         ("0.8", np.zeros((40, 2)), TypeError, "ratio"),
-        (0.8, np.zeros((40, 4)), ValueError, r"sizes has shape \(40, 4\), expected \(K, 2\)"),
+        (0.8, np.zeros((40, 5)), ValueError, r"sizes has shape \(40, 5\), expected \(K, 2\)"),
         (0.8, np.full((40, 2), np.nan), ValueError, "sizes has shape"),
     ],
 )
