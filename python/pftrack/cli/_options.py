@@ -497,9 +497,11 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         ``--no-smooth``), or an option of given detections without them (``--det-scale S``,
         ``--birth-score``, ``--size-ratio``, ``--no-refine``, and a ``--min-conf`` outside the
         built-in detector's scores, [0, 1]); more than
-        :data:`pftrack._limits.MAX_JOINT_SAMPLES` ``--particles`` with ``--sampler rjmcmc``; ``--moves`` the joint chain cannot use; ``--mh-iter``, ``--mh-proposal`` or
+        :data:`pftrack._limits.MAX_JOINT_SAMPLES` ``--particles`` with ``--sampler rjmcmc``;
+        ``--moves`` the joint chain cannot use; ``--mh-iter``, ``--mh-proposal`` or
         ``--mh-rw-sigma`` without ``--sampler mh``, ``--mh-rw-sigma`` without ``--mh-proposal
-        random_walk``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler checks
+        random_walk``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler
+        checks
         are :class:`pftrack.Tracker`'s (:mod:`pftrack._limits`), with the options' names.
     """
     from dataclasses import replace
