@@ -501,8 +501,7 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
         ``--moves`` the joint chain cannot use; ``--mh-iter``, ``--mh-proposal`` or
         ``--mh-rw-sigma`` without ``--sampler mh``, ``--mh-rw-sigma`` without ``--mh-proposal
         random_walk``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler
-        checks
-        are :class:`pftrack.Tracker`'s (:mod:`pftrack._limits`), with the options' names.
+        checks are :class:`pftrack.Tracker`'s (:mod:`pftrack._limits`), with the options' names.
     """
     from dataclasses import replace
 
