@@ -6,7 +6,7 @@ explain the heights": four settings, each run on every row of the sets below wit
 `pftrack.eval.evaluate_sequence` (MOTA, IDF1, HOTA):
 
 ``off``
-    ``size_ratio`` None (the default).
+    ``size_ratio`` None (the default until C passed this check; 0.8 since).
 ``A``
     ``size_ratio`` 0.8 with both limits: not after the camera was found moving (limit 1), no
     row outside the fitted foot rows' 5th-95th percentile judged (limit 2,
@@ -124,8 +124,10 @@ def candidate(name: str) -> Iterator[TrackerConfig]:
     if name not in CANDIDATES:
         raise ValueError(f"candidate is {name!r}, expected one of {CANDIDATES}")
     config = TrackerConfig()
-    if name == "off":
-        yield config
+    if name == "off":  # None set here: 0.8 is the default since C passed
+        yield dataclasses.replace(
+            config, lifecycle=dataclasses.replace(config.lifecycle, size_ratio=None)
+        )
         return
     life = dataclasses.replace(config.lifecycle, size_ratio=0.8)
     config = dataclasses.replace(config, lifecycle=life)
