@@ -26,7 +26,7 @@ re-encoding; issue 13 compares the moving version with the static one.
 
 ``--set SECTION.FIELD=VALUE`` changes a `TrackerConfig` field of every run on top of the
 command's own options, as ``experiments.public_detections --set`` does (e.g.
-``lifecycle.size_ratio=0.8``, which has no command-line option); the runs' files then go to
+``lifecycle.relink_coast=5``, which has no command-line option); the runs' files then go to
 ``tracks-<settings>/`` and the table to ``moving_camera-<settings>.md`` beside the default's,
 so one ``--out`` holds both and the versions' frames are made once.
 

@@ -1,19 +1,23 @@
 """The size-for-row rule (`LifecycleConfig.size_ratio`) on a check set fixed before measuring.
 
-docs/tracking.md, "A fresh check, its rule fixed before measuring": three settings, each run on
-every row of the set below with ``camera_motion`` ``auto`` and ``off``, tracker seed 0, given
-detections, scored by `pftrack.eval.evaluate_sequence` (MOTA, IDF1, HOTA):
+docs/tracking.md, "A fresh check, its rule fixed before measuring" and "A guard: the line must
+explain the heights": four settings, each run on every row of the sets below with
+``camera_motion`` ``auto`` and ``off``, tracker seed 0, given detections, scored by
+`pftrack.eval.evaluate_sequence` (MOTA, IDF1, HOTA):
 
 ``off``
-    ``size_ratio`` None (the default).
+    ``size_ratio`` None (the default until C passed this check; 0.8 since).
 ``A``
     ``size_ratio`` 0.8 with both limits: not after the camera was found moving (limit 1), no
     row outside the fitted foot rows' 5th-95th percentile judged (limit 2,
-    `pftrack.tracking.offline.SIZE_ROWS`).
+    `pftrack.tracking.offline.SIZE_ROWS`); no guard (``SIZE_SPREADS`` None while it runs).
 ``B``
-    ``size_ratio`` 0.8 with limit 1 alone (``SIZE_ROWS`` None while it runs).
+    ``size_ratio`` 0.8 with limit 1 alone (``SIZE_ROWS`` and ``SIZE_SPREADS`` None).
+``C``
+    ``size_ratio`` 0.8 with both limits and the guard (the code as it stands: a class is
+    judged only if the line explains its detections' heights, `offline.size_line`).
 
-The set:
+The set of helper sizefresh (``--sets moving paths still``, the default):
 
 (a) ``moving``: `pftrack.synthetic.make_scene` (rng 1, 2, 3; 8 walkers, 150 frames) and
     `make_busy_scene` ``present`` and ``groups`` (rng 1), each filmed by `move_camera`'s
@@ -28,13 +32,22 @@ The set:
 (c) ``still``: `make_scene` rng 1, 2, 3 (people of any size at any row) and `make_busy_scene`
     ``overhead`` rng 1 and 2 (bird's-eye, one size everywhere), detections as in (a).
 
+The fresh set of helper sizefit (``--sets moving2 paths2 still2``), fixed before C was run:
+
+(a) ``moving2``: `make_scene` rng 4 and 5 (8 walkers, 150 frames), `move_camera`'s default path.
+(b) ``paths2``: PETS09-S2L1 and TUD-Campus along ``zoomin`` (zoom 1.05 to 1.5, steadily),
+    ``halfzoom`` (zoom 1.5 to 1.05 over the first half, then 1.05) and ``panback`` (zoom 1.3,
+    the ``slowpan`` sweep the other way, right to left).
+(c) ``still2``: `make_scene` rng 4 to 8 and `make_busy_scene` ``present`` and ``groups`` rng 2
+    and 3.
+
 ``--public`` adds the eight sequences of `experiments.public_detections` (seed 0) under each
 setting. The decision rule (:func:`verdict`) is the one written in docs before the first run.
 
 Usage (from the repository root)::
 
     python -m experiments.size_check [--data ../shared/data] [--out DIR] [--public]
-        [--sets moving paths still]
+        [--sets moving paths still moving2 paths2 still2] [--candidates off A B C]
 """
 
 from __future__ import annotations
@@ -75,12 +88,17 @@ from pftrack.synthetic import (
 from pftrack.tracking import TrackerConfig, track_frames
 from pftrack.tracking import offline as offline_pass
 
-CANDIDATES = ("off", "A", "B")
+CANDIDATES = ("off", "A", "B", "C")
 MODES = ("auto", "off")
 PATHS = ("tilt", "slowpan", "zoomout")
-SETS = ("moving", "paths", "still")
+PATHS2 = ("zoomin", "halfzoom", "panback")  # the fresh set of helper sizefit
+SETS = ("moving", "paths", "still", "moving2", "paths2", "still2")
 MOVING_SCENES = (("walkers", 1), ("walkers", 2), ("walkers", 3), ("present", 1), ("groups", 1))
 STILL_SCENES = (("walkers", 1), ("walkers", 2), ("walkers", 3), ("overhead", 1), ("overhead", 2))
+MOVING_SCENES2 = (("walkers", 4), ("walkers", 5))
+STILL_SCENES2 = tuple(("walkers", k) for k in range(4, 9)) + tuple(
+    (kind, k) for kind in ("present", "groups") for k in (2, 3)
+)
 FALL = 0.3  # the most a fresh row's MOTA, IDF1 or HOTA may fall against off (points)
 
 Frames = Sequence[NDArray[np.uint8]] | Callable[[], Iterator[NDArray[np.uint8]]]
@@ -101,20 +119,25 @@ class Row:
 
 @contextlib.contextmanager
 def candidate(name: str) -> Iterator[TrackerConfig]:
-    """The `TrackerConfig` of setting `name` (``off``, ``A``, ``B``), B's ``SIZE_ROWS`` patched
-    for as long as it runs."""
+    """The `TrackerConfig` of setting `name` (``off``, ``A``, ``B``, ``C``), A's and B's
+    ``SIZE_SPREADS`` (and B's ``SIZE_ROWS``) patched for as long as it runs."""
     if name not in CANDIDATES:
         raise ValueError(f"candidate is {name!r}, expected one of {CANDIDATES}")
     config = TrackerConfig()
-    if name == "off":
-        yield config
+    if name == "off":  # None set here: 0.8 is the default since C passed
+        yield dataclasses.replace(
+            config, lifecycle=dataclasses.replace(config.lifecycle, size_ratio=None)
+        )
         return
     life = dataclasses.replace(config.lifecycle, size_ratio=0.8)
     config = dataclasses.replace(config, lifecycle=life)
-    if name == "A":
+    if name == "C":
         yield config
         return
-    with unittest.mock.patch.object(offline_pass, "SIZE_ROWS", None):
+    with contextlib.ExitStack() as patches:
+        patches.enter_context(unittest.mock.patch.object(offline_pass, "SIZE_SPREADS", None))
+        if name == "B":
+            patches.enter_context(unittest.mock.patch.object(offline_pass, "SIZE_ROWS", None))
         yield config
 
 
@@ -123,21 +146,26 @@ def path_affines(kind: str, n_frames: int, size: tuple[int, int]) -> F64:
 
     With ``u = t / (T - 1)``: ``tilt`` zooms 1.3 and moves the view down and up by 6 % of the
     height (``sin(2 pi u)``); ``slowpan`` zooms 1.3 and sweeps the view steadily from 7 % of
-    the width left of the centre to 7 % right of it; ``zoomout`` zooms from 1.5 to 1.05
-    steadily about the centre. None rolls.
+    the width left of the centre to 7 % right of it (``panback``: from right to left);
+    ``zoomout`` zooms from 1.5 to 1.05 steadily about the centre, ``zoomin`` from 1.05 to 1.5,
+    ``halfzoom`` from 1.5 to 1.05 over the first half (``u <= 0.5``), then stays. None rolls.
     """
-    if kind not in PATHS:
-        raise ValueError(f"path is {kind!r}, expected one of {PATHS}")
+    if kind not in PATHS + PATHS2:
+        raise ValueError(f"path is {kind!r}, expected one of {PATHS + PATHS2}")
     h, w = size
     u = np.linspace(0.0, 1.0, n_frames) if n_frames > 1 else np.zeros(1)
     zoom = np.full(n_frames, 1.3)
     shift = np.zeros((n_frames, 2))
     if kind == "tilt":
         shift[:, 1] = 0.06 * h * np.sin(2 * np.pi * u)
-    elif kind == "slowpan":
-        shift[:, 0] = 0.07 * w * (2 * u - 1)
-    else:
+    elif kind in ("slowpan", "panback"):
+        shift[:, 0] = 0.07 * w * (2 * u - 1) * (1 if kind == "slowpan" else -1)
+    elif kind == "zoomout":
         zoom = 1.5 - 0.45 * u
+    elif kind == "zoomin":
+        zoom = 1.05 + 0.45 * u
+    else:
+        zoom = 1.5 - 0.45 * np.minimum(2 * u, 1.0)
     c = np.array([w / 2, h / 2])
     out = np.zeros((n_frames, 2, 3))
     for k in range(n_frames):
@@ -153,7 +181,8 @@ def as_detections(rows: F64) -> dict[int, F64]:
 
 
 def synthetic_rows(sets: Sequence[str], n_frames: int = 150) -> Iterator[Row]:
-    """The synthetic rows of (a) ``moving`` and (c) ``still``; `n_frames` for `make_scene`."""
+    """The synthetic rows of ``moving``, ``still``, ``moving2`` and ``still2`` in `sets`;
+    `n_frames` for `make_scene`."""
 
     def scene(kind: str, seed: int) -> Scene:
         if kind == "walkers":
@@ -178,6 +207,14 @@ def synthetic_rows(sets: Sequence[str], n_frames: int = 150) -> Iterator[Row]:
         for kind, seed in STILL_SCENES:
             s = scene(kind, seed)
             yield row("still", f"{kind} {seed}", s.frames, s.truth, seed)
+    if "moving2" in sets:
+        for kind, seed in MOVING_SCENES2:
+            moved = move_camera(scene(kind, seed))
+            yield row("moving2", f"{kind} {seed} default path", moved.frames, moved.truth, seed)
+    if "still2" in sets:
+        for kind, seed in STILL_SCENES2:
+            s = scene(kind, seed)
+            yield row("still2", f"{kind} {seed}", s.frames, s.truth, seed)
 
 
 def video_rows(
@@ -185,6 +222,7 @@ def video_rows(
     sources: Sequence[Source] = (PETS, TUD),
     paths: Sequence[str] = PATHS,
     affines_of: Callable[[str, int, tuple[int, int]], F64] = path_affines,
+    group: str = "paths",
 ) -> Iterator[Row]:
     """The rows of (b) ``paths``: each of `sources` (PETS09-S2L1, TUD-Campus) along each of
     `paths` (`affines_of` gives a path's affines from its name, frame count and size), its
@@ -205,7 +243,7 @@ def video_rows(
 
             dets = as_detections(warp_rows(det, affines, (h, w)))
             truth = warp_rows(gt, affines, (h, w))
-            yield Row("paths", f"{src.name} {kind}", frames, n, truth, dets)
+            yield Row(group, f"{src.name} {kind}", frames, n, truth, dets)
 
 
 class _Frames(Sequence[NDArray[np.uint8]]):
@@ -247,15 +285,17 @@ def verdict(
 ) -> tuple[dict[str, list[str]], str]:
     """The rule of docs/tracking.md, "A fresh check, its rule fixed before measuring".
 
-    `fresh` and `public` map each row to each setting's MOTA / IDF1 / HOTA (``off``, ``A``,
-    ``B``); `pooled` each setting's pooled public figures. Returns, per candidate, the reasons
-    it fails (empty: it passes), and the one chosen (``off`` when none passes): no fresh row
-    below off by more than `FALL` in any figure, no public sequence below off in any, the
-    pooled public MOTA above off's; of two that pass, the higher pooled public MOTA.
+    `fresh` and `public` map each row to each setting's MOTA / IDF1 / HOTA (``off`` and the
+    candidates run, e.g. ``A``, ``B``); `pooled` each setting's pooled public figures. Returns,
+    per candidate, the reasons it fails (empty: it passes), and the one chosen (``off`` when
+    none passes): no fresh row below off by more than `FALL` in any figure, no public sequence
+    below off in any, the pooled public MOTA above off's; of two that pass, the higher pooled
+    public MOTA (of equal ones, the first in `CANDIDATES`).
     """
     names = ("MOTA", "IDF1", "HOTA")
     fails: dict[str, list[str]] = {}
-    for c in ("A", "B"):
+    judged = [c for c in CANDIDATES if c != "off" and all(c in by for by in fresh.values())]
+    for c in judged:
         why = []
         for row, by in fresh.items():
             for k, d in enumerate(by[c] - by["off"]):
@@ -273,10 +313,10 @@ def verdict(
                     f"pooled public MOTA {pooled[c][0]:.1f} not above {pooled['off'][0]:.1f}"
                 )
         fails[c] = why
-    passed = [c for c in ("A", "B") if not fails[c]]
+    passed = [c for c in judged if not fails[c]]
     if not passed or pooled is None:
         return fails, "off"
-    return fails, max(passed, key=lambda c: (pooled[c][0], c == "A"))
+    return fails, max(passed, key=lambda c: (pooled[c][0], -CANDIDATES.index(c)))
 
 
 def public_names(data: Path) -> list[str]:
@@ -293,8 +333,13 @@ def cell(a: F64) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     p = experiment_parser("size_check", __doc__)
     p.add_argument(
-        "--sets", nargs="+", choices=SETS, default=list(SETS),
-        help="which parts of the check set to run (default: all three)",
+        "--sets", nargs="+", choices=SETS, default=list(SETS[:3]),
+        help="which parts of the check sets to run (default: moving paths still, helper "
+        "sizefresh's set; moving2 paths2 still2 is helper sizefit's)",
+    )  # fmt: skip
+    p.add_argument(
+        "--candidates", nargs="+", choices=CANDIDATES[1:], default=list(CANDIDATES[1:]),
+        help="the settings run beside off (default: A B C)",
     )  # fmt: skip
     p.add_argument(
         "--public", action="store_true",
@@ -302,33 +347,37 @@ def main(argv: Sequence[str] | None = None) -> int:
     )  # fmt: skip
     args = p.parse_args(argv)
     data = data_root(args.data)
+    names = ["off", *(c for c in CANDIDATES if c in args.candidates)]
     rows: list[Row] = list(synthetic_rows(args.sets))
     if "paths" in args.sets:
         rows += list(video_rows(data))
+    if "paths2" in args.sets:
+        rows += list(video_rows(data, paths=PATHS2, group="paths2"))
     fresh: dict[str, dict[str, F64]] = {}
     public: dict[str, dict[str, F64]] | None = None
     pooled: dict[str, F64] | None = None
     with tee_stdout(args.out / "size_check.md"):
-        print("| set | row | camera motion | off | A (both limits) | B (limit 1 alone) |")
-        print("|---|---|---|---|---|---|")
+        print("| set | row | camera motion | " + " | ".join(names) + " |")
+        print("|---|---|---|" + "---|" * len(names))
         for row in sorted(rows, key=lambda r: SETS.index(r.group)):
             for mode in MODES:
-                by = {c: figures(score(row, c, mode)) for c in CANDIDATES}
-                fresh[f"{row.name} {mode}"] = by
-                cells = " | ".join(cell(by[c]) for c in CANDIDATES)
+                by = {c: figures(score(row, c, mode)) for c in names}
+                fresh[f"{row.group} {row.name} {mode}"] = by
+                cells = " | ".join(cell(by[c]) for c in names)
                 print(f"| {row.group} | {row.name} | {mode} | {cells} |", flush=True)
         if args.public:
             public, pooled = {}, {}
-            for c in CANDIDATES:
+            for c in names:
                 with candidate(c) as config:
                     scores = run_all(data, config, 0)
                 for k, s in zip(public_names(data), scores, strict=True):
                     public.setdefault(k, {})[c] = figures(s)
                 pooled[c] = figures(SequenceScores.combine(scores))
-            print("\n| public sequence | off | A | B |\n|---|---|---|---|")
+            print("\n| public sequence | " + " | ".join(names) + " |")
+            print("|---|" + "---|" * len(names))
             for k, by in public.items():
-                print(f"| {k} | " + " | ".join(cell(by[c]) for c in CANDIDATES) + " |")
-            print("| pooled | " + " | ".join(cell(pooled[c]) for c in CANDIDATES) + " |")
+                print(f"| {k} | " + " | ".join(cell(by[c]) for c in names) + " |")
+            print("| pooled | " + " | ".join(cell(pooled[c]) for c in names) + " |")
         fails, chosen = verdict(fresh, public, pooled)
         print()
         for c, why in fails.items():

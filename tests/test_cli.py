@@ -97,6 +97,34 @@ def test_track_with_public_detections_matches_the_truth(
     assert m.mota > 0.8 and m.idf1 > 0.8
 
 
+@pytest.mark.parametrize("value", ["0", "1", "1.5", "nan", "-0.2"])
+def test_size_ratio_out_of_its_range_is_refused(
+    value: str, video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["track", str(video), "--out", str(tmp_path / "t.txt"), "--detections", "d.txt"]
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, "--size-ratio", value])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err == (
+        f"pftrack track: error: argument --size-ratio: expected a number in (0, 1) or off, got "
+        f"{float(value):g}"
+    )
+
+
+def test_size_ratio_without_the_smoother_is_refused(
+    video: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "t.txt"
+    argv = ["track", str(video), "--out", str(out), "--detections", "d.txt", "--no-smooth"]
+    assert main([*argv, "--size-ratio", "0.7"]) == 2
+    assert capsys.readouterr().err == (
+        "pftrack track: error: --size-ratio 0.7 judges the smoothed tracks, and --no-smooth "
+        "turns the smoother off; drop one of them\n"
+    )
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
@@ -1047,6 +1075,9 @@ def test_an_output_of_links_that_lead_to_each_other_names_its_option(
                               "--detections"),
         ("--no-refine", "--no-refine takes the boxes of --detections as given; the built-in "
                         "detector's boxes are not refined: drop it, or give --detections"),
+        ("--size-ratio 0.7", "--size-ratio 0.7 judges the tracks of --detections; the built-in "
+                             "detector has its own size model: drop it, or give --detections"),
+        ("--size-ratio off", "--size-ratio off judges the tracks of --detections"),
         ("--min-conf -5", "--min-conf -5: the built-in detector's scores are the share of "
                           "foreground pixels in a blob's box, in [0, 1]; give a value in "
                           "[0, 1], or --detections"),
@@ -1368,18 +1399,27 @@ def test_background_options_with_no_refine_are_refused() -> None:
 
 def test_options_of_given_detections_are_taken_with_them(video: Path, tmp_path: Path) -> None:
     from pftrack.cli import build_parser
-    from pftrack.cli._options import DEFAULT_BIRTH_SCORE, DEFAULT_MAX_COAST, tracker_config
+    from pftrack.cli._options import (
+        DEFAULT_BIRTH_SCORE,
+        DEFAULT_MAX_COAST,
+        DEFAULT_SIZE_RATIO,
+        tracker_config,
+    )
     from pftrack.tracking import LifecycleConfig
 
     assert DEFAULT_BIRTH_SCORE == LifecycleConfig().birth_score
     assert DEFAULT_MAX_COAST == LifecycleConfig().max_coast
+    assert DEFAULT_SIZE_RATIO == LifecycleConfig().size_ratio == 0.8
     parse = build_parser().parse_args
     det = ["--detections", "d.txt"]
     cfg = tracker_config(parse(["track", "v", "--out", "o", *det, "--min-conf", "-5",
                                 "--birth-score", "0.5", "--det-scale", "2",
                                 "--no-refine"]))  # fmt: skip
     assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (-5, 0.5)
-    assert not cfg.refine.enabled
+    assert not cfg.refine.enabled and cfg.lifecycle.size_ratio == DEFAULT_SIZE_RATIO
+    for value, ratio in (("0.7", 0.7), ("off", None)):
+        cfg = tracker_config(parse(["track", "v", "--out", "o", *det, "--size-ratio", value]))
+        assert cfg.lifecycle.size_ratio == ratio
     cfg = tracker_config(parse(["track", "v", "--out", "o", "--min-conf", "0.5"]))  # built-in
     assert (cfg.lifecycle.min_score, cfg.lifecycle.birth_score) == (0.5, DEFAULT_BIRTH_SCORE)
     with pytest.raises(ValueError, match=r"LifecycleConfig: birth_score is 1.5, expected a value"):

@@ -117,11 +117,11 @@ def test_set_changes_every_runs_config_and_names_its_files(
     monkeypatch.setattr(mc, "SEQUENCES", (Source("tiny", "img", 1.0),))
     out = tmp_path / "mc"
     argv = ["--data", str(data), "--out", str(out), "--detections", "public", "--seeds", "1"]
-    assert mc.main([*argv, "--set", "lifecycle.size_ratio=0.8"]) == 0
-    assert sorted(seen) == [(0.8, "auto")] * 3 + [(0.8, "off")] * 3
-    assert len(list((out / "tracks-lifecycle.size_ratio0.8").iterdir())) == 6
-    assert (out / "moving_camera-lifecycle.size_ratio0.8.md").is_file()
+    assert mc.main([*argv, "--set", "lifecycle.size_ratio=0.7"]) == 0
+    assert sorted(seen) == [(0.7, "auto")] * 3 + [(0.7, "off")] * 3
+    assert len(list((out / "tracks-lifecycle.size_ratio0.7").iterdir())) == 6
+    assert (out / "moving_camera-lifecycle.size_ratio0.7.md").is_file()
     seen.clear()
     assert mc.main(argv) == 0  # without --set: every default, the files of old
-    assert sorted(seen) == [(None, "auto")] * 3 + [(None, "off")] * 3
+    assert sorted(seen) == [(0.8, "auto")] * 3 + [(0.8, "off")] * 3
     assert len(list((out / "tracks").iterdir())) == 6 and (out / "moving_camera.md").is_file()

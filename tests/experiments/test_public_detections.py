@@ -55,7 +55,8 @@ def test_override_changes_one_field_and_refuses_unknown_ones() -> None:
 @pytest.mark.parametrize(
     ("setting", "message"),
     [  # were: "'x' is not a NoneType", "is not a int", "'lifecycle' is not a number, ..."
-        ("lifecycle.size_ratio=x", "'x' is not a number (or none)"),
+        ("max_side=x", "'x' is not a number (or none)"),  # a field None by default
+        ("lifecycle.size_ratio=x", "'x' is not a number"),
         ("hold_frames=1.5", "'1.5' is not an int"),
         ("reference_rate=x", "'x' is not a number"),
         ("lifecycle=1", "'lifecycle' is a section: give lifecycle.FIELD=VALUE"),

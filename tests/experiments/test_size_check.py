@@ -18,7 +18,8 @@ from pftrack.tracking import offline
 def test_paths_tilt_pan_and_zoom_out_as_documented() -> None:
     size = (360, 480)
     tilt, pan, out = (sc.path_affines(k, 101, size) for k in sc.PATHS)
-    for a in (tilt, pan, out):
+    zoomin, half, back = (sc.path_affines(k, 101, size) for k in sc.PATHS2)
+    for a in (tilt, pan, out, zoomin, half, back):
         assert a.shape == (101, 2, 3)
         np.testing.assert_array_equal(a[:, 0, 1], 0.0)  # no roll
         np.testing.assert_array_equal(a[:, 1, 0], 0.0)
@@ -36,21 +37,34 @@ def test_paths_tilt_pan_and_zoom_out_as_documented() -> None:
     np.testing.assert_allclose(out[[0, -1], 0, 0], [1.5, 1.05])
     assert (np.diff(out[:, 0, 0]) < 0).all()
     np.testing.assert_allclose(seen(out), np.tile(centre, (101, 1)))  # about the centre
+    # sizefit's fresh paths: zoom in, zoom out over the first half then still, pan back
+    np.testing.assert_allclose(zoomin[:, 0, 0], out[::-1, 0, 0])
+    np.testing.assert_allclose(half[[0, 50, 100], 0, 0], [1.5, 1.05, 1.05])
+    assert (np.diff(half[:51, 0, 0]) < 0).all() and (half[50:, 0, 0] == 1.05).all()
+    np.testing.assert_allclose(seen(zoomin), seen(half))
+    np.testing.assert_allclose(seen(back), seen(pan)[::-1])
     with pytest.raises(ValueError, match="path is 'roll'"):
         sc.path_affines("roll", 10, size)
 
 
-def test_candidates_set_size_ratio_and_b_turns_limit_2_off_while_it_runs() -> None:
-    rows = offline.SIZE_ROWS
+def test_candidates_set_size_ratio_and_turn_limit_2_and_the_guard_off_while_they_run() -> None:
+    rows, spreads = offline.SIZE_ROWS, offline.SIZE_SPREADS
+    assert rows is not None and spreads is not None
     with sc.candidate("off") as c:
-        assert c.lifecycle.size_ratio is None and offline.SIZE_ROWS == rows
+        assert c.lifecycle.size_ratio is None
+        assert (offline.SIZE_ROWS, offline.SIZE_SPREADS) == (rows, spreads)
     with sc.candidate("A") as c:
-        assert c.lifecycle.size_ratio == 0.8 and offline.SIZE_ROWS == rows
+        assert c.lifecycle.size_ratio == 0.8
+        assert (offline.SIZE_ROWS, offline.SIZE_SPREADS) == (rows, None)
     with sc.candidate("B") as c:
-        assert c.lifecycle.size_ratio == 0.8 and offline.SIZE_ROWS is None
-    assert offline.SIZE_ROWS == rows
-    with pytest.raises(ValueError, match="candidate is 'C'"):
-        with sc.candidate("C"):
+        assert c.lifecycle.size_ratio == 0.8
+        assert (offline.SIZE_ROWS, offline.SIZE_SPREADS) == (None, None)
+    with sc.candidate("C") as c:
+        assert c.lifecycle.size_ratio == 0.8
+        assert (offline.SIZE_ROWS, offline.SIZE_SPREADS) == (rows, spreads)
+    assert (offline.SIZE_ROWS, offline.SIZE_SPREADS) == (rows, spreads)
+    with pytest.raises(ValueError, match="candidate is 'D'"):
+        with sc.candidate("D"):
             pass
 
 
@@ -72,11 +86,18 @@ def test_verdict_is_the_documented_rule() -> None:
     assert fails["A"] == ["pooled public MOTA 60.0 not above 60.0"]
     assert fails["B"][0] == "public p: MOTA -0.01" and chosen == "off"
     assert sc.verdict(fresh, None, None)[1] == "off"  # the public sequences are part of it
+    # only the candidates run are judged: off and C
+    one = {k: {"off": by["off"], "C": by["B"]} for k, by in fresh.items()}
+    fails, chosen = sc.verdict(one, {"p": {"off": np.full(3, 70.0), "C": np.full(3, 71.0)}},
+                               {"off": np.full(3, 60.0), "C": np.full(3, 62.0)})  # fmt: skip
+    assert fails == {"C": []} and chosen == "C"
 
 
 def test_video_rows_move_truth_detections_and_frames_together(data: Path) -> None:
     rows = list(sc.video_rows(data, (Source("tiny", "img", 1.0),)))
     assert [r.name for r in rows] == [f"tiny {k}" for k in sc.PATHS]
+    fresh = sc.video_rows(data, (Source("tiny", "img", 1.0),), sc.PATHS2, group="paths2")
+    assert [(r.group, r.name) for r in fresh] == [("paths2", f"tiny {k}") for k in sc.PATHS2]
     frames = list(FrameSource(data / "tiny" / "img"))
     gt = read_mot(data / "tiny" / "gt.txt")
     for row, kind in zip(rows, sc.PATHS, strict=True):
@@ -102,3 +123,13 @@ def test_main_writes_the_table_and_the_verdict(
     lines = [t for t in text.splitlines() if t.startswith("| still | walkers 1 |")]
     assert len(lines) == 2  # auto and off
     assert "- chosen: off" in text and "the public sequences were not run" in text
+    assert "| set | row | camera motion | off | A | B | C |" in text
+    # C alone, on sizefit's still2 set (one scene): its walkers are not judged, nothing falls
+    monkeypatch.setattr(sc, "STILL_SCENES2", (("walkers", 4),))
+    argv = ["--sets", "still2", "--candidates", "C", "--out", str(tmp_path)]
+    assert sc.main(argv) == 0
+    text = (tmp_path / "size_check.md").read_text()
+    lines = [t for t in text.splitlines() if t.startswith("| still2 | walkers 4 |")]
+    cells = [[c.strip() for c in t.strip("|").split("|")] for t in lines]
+    assert len(lines) == 2 and all(c[3] == c[4] for c in cells)
+    assert "- C: fails: the public sequences were not run" in text

@@ -122,7 +122,7 @@ def test_size_rows_none_judges_every_row(monkeypatch: pytest.MonkeyPatch) -> Non
         (1.0, np.zeros((40, 2)), ValueError, "ratio is 1.0"),
         (float("nan"), np.zeros((40, 2)), ValueError, "ratio is nan"),
         ("0.8", np.zeros((40, 2)), TypeError, "ratio"),
-        (0.8, np.zeros((40, 4)), ValueError, r"sizes has shape \(40, 4\), expected \(K, 2\)"),
+        (0.8, np.zeros((40, 5)), ValueError, r"sizes has shape \(40, 5\), expected \(K, 2\)"),
         (0.8, np.full((40, 2), np.nan), ValueError, "sizes has shape"),
     ],
 )
@@ -175,10 +175,15 @@ def test_finalize_leaves_out_a_track_on_small_false_boxes(ratio: float | None, n
     assert len(_ids(tracker.finalize())) == n_ids
 
 
-def test_a_scene_whose_sizes_do_not_follow_the_row_loses_a_person() -> None:
-    """The rule's limit, and why it is off by default: `make_scene`'s five people are 52-98 px
-    tall whatever their row (the one of 98 px is 1.5 times the line's height at its row): two
-    of the five are left out."""
+@pytest.mark.parametrize(("spreads", "n_ids"), [(offline.SIZE_SPREADS, 5), (None, 3)])
+def test_a_scene_whose_sizes_do_not_follow_the_row_is_not_judged(
+    spreads: float | None, n_ids: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`make_scene`'s five people are 52-98 px tall whatever their row (the one of 98 px is 1.5
+    times the line's height at its row): the line does not explain their heights (a robust
+    spread of 0.11 of the log ratio, 2 of them wider than the band ``log 1.25``), so the guard
+    keeps all five; without it (``SIZE_SPREADS`` None) two are left out."""
+    monkeypatch.setattr(offline, "SIZE_SPREADS", spreads)
     scene = make_scene(n_frames=40, rng=1)
     by_frame = group_by_frame(scene.truth)
     ids = {}
@@ -191,7 +196,88 @@ def test_a_scene_whose_sizes_do_not_follow_the_row_loses_a_person() -> None:
                 np.column_stack([r[:, 2:4], r[:, 2:4] + r[:, 4:6], np.ones(len(r))]), frame
             )
         ids[ratio] = len(_ids(tracker.finalize()))
-    assert (ids[None], ids[0.8]) == (5, 3)
+    assert (ids[None], ids[0.8]) == (5, n_ids)
+
+
+def _zooming(n: int = 400, drift: float = 0.6, noise: float = 0.05) -> np.ndarray:
+    """`n` detections ``foot, height, class, frame`` over frames 0-199 of a camera zooming
+    steadily: people on the line times ``exp(drift (frame / 199 - 1 / 2))``, heights within
+    `noise`."""
+    rng = np.random.default_rng(3)
+    frame = np.sort(rng.integers(0, 200, n)).astype(np.float64)
+    foot = rng.uniform(60, 230, n)
+    zoom = np.exp(drift * (frame / 199 - 0.5))
+    h = _line(foot) * zoom * rng.uniform(1 - noise, 1 + noise, n)
+    return np.column_stack([foot, h, np.zeros(n), frame])
+
+
+@pytest.mark.parametrize(("spreads", "kept"), [(offline.SIZE_SPREADS, {1, 2}), (None, {2})])
+def test_a_drifting_zoom_is_not_judged(
+    spreads: float | None, kept: set[int], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A camera zooming in over the run (the people's size for their row grows by
+    ``exp(0.6)``): a person early in the run is 0.74 of the line fitted over the whole run.
+    The guard sees the drift and keeps them; without it they are left out."""
+    monkeypatch.setattr(offline, "SIZE_SPREADS", spreads)
+    rows = np.vstack([_track(1, 0.74), _track(2, 1.0)])
+    assert _ids(drop_odd_sizes(rows, _zooming(), 0.8)) == kept
+
+
+def test_size_line_measures_the_spread_and_the_drift() -> None:
+    rng = np.random.default_rng(4)
+    foot = rng.uniform(60, 230, 2000)
+    r = rng.normal(0.0, 0.1, 2000)
+    slope, intercept, spread, drift = offline.size_line(foot, _line(foot) * np.exp(r))
+    assert slope == pytest.approx(0.4, rel=0.05) and intercept == pytest.approx(20, abs=3)
+    assert spread == pytest.approx(0.1, rel=0.1) and drift == 0.0  # no frames: no drift
+    frame = np.arange(2000.0)
+    assert offline.size_line(foot, _line(foot) * np.exp(r), frame)[3] == pytest.approx(0, abs=0.03)
+    # a steady drift of 0.3 over the run, heights within 1 %: the spread alone (0.11: twice it
+    # fits the band log 1.25 = 0.223) would judge the class, the drift's half does not
+    s = _zooming(2000, drift=0.3, noise=0.01)
+    _, _, spread, drift = offline.size_line(s[:, 0], s[:, 1], s[:, 3])
+    assert drift == pytest.approx(0.3, rel=0.1)
+    assert 2 * spread <= -np.log(0.8) < 2 * spread + drift / 2
+    rows = np.vstack([_track(1, 0.85, n=5), _track(2, 0.79, n=5)])
+    rows[rows[:, 1] == 2, 0] += 190  # at the run's end, people are 1.16 of the line
+    assert _ids(drop_odd_sizes(rows, s, 0.8)) == {1, 2}
+    assert _ids(drop_odd_sizes(rows, s[:, :3], 0.8)) == {1}  # without frames: no drift seen
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (([1.0, 2.0], [1.0]), r"foot, height\[, frame\] have shapes \(2,\), \(1,\)"),
+        (([1.0, 2.0], [1.0, 0.0]), "height has values not finite or not positive"),
+        (([1.0, 2.0], [1.0, 2.0], [0.0, np.nan]), "frame has values not finite"),
+        (([1.0, 1.0], [1.0, 2.0]), "distinct"),
+    ],
+)
+def test_size_line_bad_arguments(args: tuple[list[float], ...], match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        offline.size_line(*args)
+
+
+def test_finalize_gives_drop_odd_sizes_each_boxs_frame(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The guard's drift needs the frames: `Tracker.update` records ``foot, height, class,
+    frame`` of each given box."""
+    seen = []
+
+    def spy(rows: np.ndarray, sizes: np.ndarray, *args: object) -> np.ndarray:
+        seen.append(sizes)
+        return rows
+
+    monkeypatch.setattr(pftrack.tracking.api, "drop_odd_sizes", spy)
+    frame = np.random.default_rng(1).integers(0, 255, (240, 320, 3), dtype=np.uint8)
+    config = TrackerConfig(lifecycle=LifecycleConfig(size_ratio=0.8))
+    tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
+    for k in range(12):
+        tracker.update(_people_and_false_box(k), frame)
+    tracker.finalize()
+    (sizes,) = seen
+    assert sizes.shape == (48, 4)
+    np.testing.assert_array_equal(sizes[:, 3], np.repeat(np.arange(12.0), 4))
+    np.testing.assert_allclose(sizes[:4, :2], [[100, 60], [150, 80], [200, 100], [180, 92 / 3]])
 
 
 def _panning_frames(n: int, step: float) -> list[np.ndarray]:

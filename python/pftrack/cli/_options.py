@@ -45,6 +45,9 @@ DEFAULT_CROSSINGS = "off"
 DEFAULT_BIRTH_SCORE = 0.9
 #: ``LifecycleConfig.max_coast``, ``--max-coast``'s default, stated here for the same reason.
 DEFAULT_MAX_COAST = 10
+#: ``--size-ratio``'s default: :attr:`pftrack.tracking.LifecycleConfig.size_ratio`, stated here
+#: for the same reason (a test checks they agree).
+DEFAULT_SIZE_RATIO = 0.8
 #: ``--det-scale``'s range (``track`` and ``batch``): the one
 #: :func:`pftrack.tracking.load_detections` accepts, stated here for the same reason (a test
 #: checks they agree).
@@ -213,6 +216,16 @@ def bounded_float(lo: float, hi: float) -> Any:
 
     parse.__name__ = "float"
     return parse
+
+
+def size_ratio(text: str) -> float | str:
+    """Argument type of ``--size-ratio``: a number in (0, 1), or ``off``."""
+    if text == "off":
+        return text
+    v = float(text)
+    if not 0.0 < v < 1.0:
+        raise argparse.ArgumentTypeError(f"expected a number in (0, 1) or off, got {v:g}")
+    return v
 
 
 def add_max_distance(p: argparse.ArgumentParser) -> None:
@@ -430,6 +443,16 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
         f"{DEFAULT_BIRTH_SCORE:g})",
     )  # fmt: skip
     p.add_argument(
+        "--size-ratio", type=size_ratio, default=None, metavar="R",
+        help="with --detections and the smoother: leave out every track whose median height is "
+        "below R or above 1/R times the height a line of the detections' heights against "
+        "their foot row gives at its row (tracks on a detector's false boxes), R in (0, 1), or "
+        "off; judged only on a still camera, within the detections' rows, and where the line "
+        "explains the detections' heights (not when people's sizes do not follow their row, "
+        "nor under a zoom); refused without --detections: the built-in detector has its own "
+        f"size model (default: {DEFAULT_SIZE_RATIO:g})",
+    )  # fmt: skip
+    p.add_argument(
         "--fill", choices=("linear", "pf"), default="linear",
         help="boxes of a gap the filter bridged: interpolated between the detections at its "
         "ends, or the filter's own; written as they are with --no-smooth; with smoothing the "
@@ -470,20 +493,26 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
     Raises
     ------
     ValueError
-        Options that contradict each other (``--crossings on`` with ``--no-smooth``), or an
-        option of given detections without them (``--det-scale S``, ``--birth-score``,
-        ``--no-refine``, and a ``--min-conf`` outside the built-in detector's scores, [0, 1]);
-        more than :data:`pftrack._limits.MAX_JOINT_SAMPLES` ``--particles`` with ``--sampler
-        rjmcmc``; ``--moves`` the joint chain cannot use; ``--mh-iter``, ``--mh-proposal`` or
+        Options that contradict each other (``--crossings on`` or ``--size-ratio R`` with
+        ``--no-smooth``), or an option of given detections without them (``--det-scale S``,
+        ``--birth-score``, ``--size-ratio``, ``--no-refine``, and a ``--min-conf`` outside the
+        built-in detector's scores, [0, 1]); more than
+        :data:`pftrack._limits.MAX_JOINT_SAMPLES` ``--particles`` with ``--sampler rjmcmc``;
+        ``--moves`` the joint chain cannot use; ``--mh-iter``, ``--mh-proposal`` or
         ``--mh-rw-sigma`` without ``--sampler mh``, ``--mh-rw-sigma`` without ``--mh-proposal
-        random_walk``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler checks
-        are :class:`pftrack.Tracker`'s (:mod:`pftrack._limits`), with the options' names.
+        random_walk``, ``--burn-in`` or ``--moves`` without ``--sampler rjmcmc``. The sampler
+        checks are :class:`pftrack.Tracker`'s (:mod:`pftrack._limits`), with the options' names.
     """
     from dataclasses import replace
 
     if args.crossings == "on" and args.no_smooth:  # the repair is part of the offline pass
         raise ValueError(
             "--crossings on needs the smoother, which --no-smooth turns off; drop one of them"
+        )
+    if isinstance(getattr(args, "size_ratio", None), float) and args.no_smooth:
+        raise ValueError(
+            f"--size-ratio {args.size_ratio:g} judges the smoothed tracks, and --no-smooth "
+            "turns the smoother off; drop one of them"
         )
     if not getattr(args, "detections", None):  # the built-in detector: options it never uses
         if getattr(args, "det_scale", None) is not None:
@@ -495,6 +524,11 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
             raise ValueError(
                 f"--birth-score {args.birth_score:g} gates the births of --detections; the "
                 "built-in detector starts a track from any blob: drop it, or give --detections"
+            )
+        if getattr(args, "size_ratio", None) is not None:
+            raise ValueError(
+                f"--size-ratio {args.size_ratio} judges the tracks of --detections; the "
+                "built-in detector has its own size model: drop it, or give --detections"
             )
         if args.no_refine:
             raise ValueError(
@@ -575,8 +609,16 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
             max_coast=args.max_coast,
             min_score=args.min_conf,
             birth_score=DEFAULT_BIRTH_SCORE if args.birth_score is None else args.birth_score,
+            size_ratio=_size_ratio(getattr(args, "size_ratio", None)),
         ),
     )
+
+
+def _size_ratio(value: float | str | None) -> float | None:
+    """``LifecycleConfig.size_ratio`` from ``--size-ratio`` (None: not given; ``off``)."""
+    if value is None:
+        return DEFAULT_SIZE_RATIO
+    return None if value == "off" else float(value)
 
 
 def opencv_single_threaded() -> None:

@@ -897,7 +897,7 @@ class Tracker:
             self._stood = 0  # stand-ins among the frames taken (pftrack._stand_in)
             self._max_conf = -np.inf
             self._given = False  # some update() of the run had detections
-            # foot row, height, class of the given boxes, working pixels (drop_odd_sizes)
+            # foot row, height, class, frame of the given boxes, working pixels (drop_odd_sizes)
             self._sizes: list[F64] = []
             self._layout = (0, 0)  # inverted boxes, boxes with an extent (check_boxes_xyxy)
             # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
@@ -1368,7 +1368,8 @@ class Tracker:
             if life.size_ratio is not None and scored.any():
                 box = xywh[scored]
                 c = np.zeros(len(box)) if cls is None else cls[scored].astype(np.float64)
-                self._sizes.append(np.column_stack([box[:, 1] + box[:, 3], box[:, 3], c]))
+                foot, at = box[:, 1] + box[:, 3], np.full(len(box), float(self.frame_count))
+                self._sizes.append(np.column_stack([foot, box[:, 3], c, at]))
             self._layout = (self._layout[0] + inverted, self._layout[1] + extent)
             self._max_conf = max(self._max_conf, confidence)
         self.frame_count += 1
@@ -1585,8 +1586,10 @@ class Tracker:
                 # tracks sized unlike the detections' people at their row (size_ratio); a
                 # height-for-row line is a still camera's: not after the camera was found moving
                 shape = self._tracker.frame_shape
+                cols = min(s.shape[1] for s in self._sizes)  # 3: a checkpoint had no frames
+                sizes = np.vstack([s[:, :cols] for s in self._sizes])
                 rows = drop_odd_sizes(
-                    rows, np.vstack(self._sizes), life.size_ratio, shape[0] if shape else None,
+                    rows, sizes, life.size_ratio, shape[0] if shape else None,
                     self._writer.classes,
                 )  # fmt: skip
             if smoothed and not self._given and life.nested_inside is not None and len(rows):

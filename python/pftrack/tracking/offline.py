@@ -51,6 +51,7 @@ __all__ = [
     "drop_nested",
     "drop_odd_sizes",
     "repair_crossings",
+    "size_line",
     "smooth_tracks",
     "smoothed_copies",
     "split_refound",
@@ -65,6 +66,10 @@ MIN_SIZE_SAMPLES = 30  # drop_odd_sizes: a class with fewer detections is not ju
 # drop_odd_sizes: a row is judged only with its foot row within these percentiles of the foot
 # rows the line was fitted to (no extrapolation); None judges every row (experiments.size_check)
 SIZE_ROWS: tuple[float, float] | None = (5.0, 95.0)
+# drop_odd_sizes: a class is judged only if the band [ratio, 1 / ratio] reaches, either side of
+# the line, this many robust spreads of the detections' log(height / line) plus half their
+# drift over the run (the line explains the heights: size_line); None: judged whatever they are
+SIZE_SPREADS: float | None = 2.0
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
 
@@ -710,14 +715,19 @@ def drop_odd_sizes(
     height is at least 1 px. The line is not extrapolated: a row whose foot row lies outside
     the 5th-95th percentile of the foot rows the line was fitted to is not judged. A track with
     no row left to judge, and every track of a class with fewer than 30 usable detections, is
-    kept.
+    kept. Nor is a class judged whose detections' heights the line does not explain
+    (:func:`size_line`): unless the band ``[ratio, 1 / ratio]`` reaches, either side of the line,
+    `SIZE_SPREADS` (2) robust spreads of ``log(height / line)`` plus half the drift of that log
+    ratio over the run (`sizes` with frames), the class's tracks are all kept (people whose
+    sizes do not follow their row, or a camera that zooms while the line is fitted).
 
     Parameters
     ----------
     rows : (M, 6..10) array_like
         MOTChallenge rows ``frame, id, left, top, width, height, ...`` of finished tracks.
-    sizes : (K, 2) or (K, 3) array_like
-        ``foot row, height[, class]`` of the run's detection boxes, in the rows' pixels.
+    sizes : (K, 2), (K, 3) or (K, 4) array_like
+        ``foot row, height[, class[, frame]]`` of the run's detection boxes, in the rows'
+        pixels (without frames: no drift is measured).
     ratio : float
         In (0, 1).
     frame_height : float, optional
@@ -742,14 +752,14 @@ def drop_odd_sizes(
         raise ValueError(f"drop_odd_sizes: ratio is {ratio}, expected a value in (0, 1)")
     a: F64 = check_rows(rows, "drop_odd_sizes")
     s = np.asarray(sizes, dtype=np.float64)
-    if s.ndim != 2 or s.shape[1] not in (2, 3) or not np.isfinite(s).all():
+    if s.ndim != 2 or s.shape[1] not in (2, 3, 4) or not np.isfinite(s).all():
         raise ValueError(
-            f"drop_odd_sizes: sizes has shape {s.shape}, expected (K, 2) or (K, 3) finite "
-            "rows foot row, height[, class]"
+            f"drop_odd_sizes: sizes has shape {s.shape}, expected (K, 2), (K, 3) or (K, 4) "
+            "finite rows foot row, height[, class[, frame]]"
         )
     if len(a) == 0 or len(s) == 0:
         return a
-    det_cls = s[:, 2] if s.shape[1] == 3 else np.zeros(len(s))
+    det_cls = s[:, 2] if s.shape[1] >= 3 else np.zeros(len(s))
     foot, height = a[:, 3] + a[:, 5], a[:, 5]
     usable = (s[:, 1] > 0) & (frame_height is None or s[:, 0] < frame_height - BOTTOM_EDGE)
     rows_in = np.ones(len(a), bool) if frame_height is None else foot < frame_height - BOTTOM_EDGE
@@ -762,7 +772,10 @@ def drop_odd_sizes(
             continue
         x, h = s[k, 0], s[k, 1]
         pick = np.linspace(0, len(x) - 1, min(len(x), SIZE_SAMPLES)).astype(np.int64)
-        slope, intercept = theil_sen(x[pick], h[pick])
+        frame = s[k, 3][pick] if s.shape[1] == 4 else None
+        slope, intercept, spread, drift = size_line(x[pick], h[pick], frame)
+        if SIZE_SPREADS is not None and SIZE_SPREADS * spread + abs(drift) / 2 > -np.log(ratio):
+            continue  # the line does not explain the heights: nothing of the class is judged
         expected = np.maximum(slope * foot + intercept, 1.0)
         judged = (row_cls == c) & rows_in
         if SIZE_ROWS is not None:
@@ -776,6 +789,66 @@ def drop_odd_sizes(
             if q < ratio or q > 1.0 / ratio:
                 drop |= a[:, 1] == i
     return a[~drop]
+
+
+def size_line(
+    foot: ArrayLike, height: ArrayLike, frame: ArrayLike | None = None
+) -> tuple[float, float, float, float]:
+    """The height-for-row line of detections and how well it explains their heights.
+
+    A Theil-Sen line of `height` against `foot` row; then, of the log ratio
+    ``r = log(height / line)`` (the line's height at least 1 px), its robust spread
+    ``1.4826 * MAD(r)`` (a normal law's standard deviation) and its drift over the run: the
+    Theil-Sen slope of ``r`` against `frame`, times the frames the detections span (0 without
+    frames, or all in one frame). A still camera's view of people of one size walking on a
+    ground plane gives a small spread and no drift; people whose sizes do not follow their row
+    give a wide spread, and a camera that zooms during the run gives a drift.
+    `drop_odd_sizes` judges a class's tracks only if ``SIZE_SPREADS * spread + |drift| / 2``
+    is at most ``log(1 / ratio)``: a person following the line two spreads from it, at either
+    end of the run, still lies inside the band.
+
+    Parameters
+    ----------
+    foot, height : (n,) array_like of float
+        Foot rows (``top + height``) and heights (> 0) of detection boxes, at least two distinct
+        foot rows.
+    frame : (n,) array_like of float, optional
+        The frame of each box.
+
+    Returns
+    -------
+    slope, intercept, spread, drift : float
+        The line (height = slope * foot + intercept), the spread and the drift of the log
+        ratio.
+
+    Raises
+    ------
+    ValueError
+        Arrays of different lengths or not finite, a height not positive, or no two distinct
+        foot rows.
+
+    References
+    ----------
+    .. [1] Sen, P. K. (1968). Estimates of the regression coefficient based on Kendall's tau.
+       JASA 63(324).
+    """
+    x = np.asarray(foot, np.float64)
+    h = np.asarray(height, np.float64)
+    t = None if frame is None else np.asarray(frame, np.float64)
+    if x.ndim != 1 or h.shape != x.shape or (t is not None and t.shape != x.shape):
+        got = f"{x.shape}, {h.shape}" + ("" if t is None else f", {t.shape}")
+        raise ValueError(f"size_line: foot, height[, frame] have shapes {got}, expected (n,) each")
+    if not (np.isfinite(h).all() and (h > 0).all()):
+        raise ValueError("size_line: height has values not finite or not positive")
+    if t is not None and not np.isfinite(t).all():
+        raise ValueError("size_line: frame has values not finite")
+    slope, intercept = theil_sen(x, h)
+    r = np.log(h / np.maximum(slope * x + intercept, 1.0))
+    spread = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    drift = 0.0
+    if t is not None and np.ptp(t) > 0:
+        drift = theil_sen(t, r)[0] * float(np.ptp(t))
+    return float(slope), float(intercept), spread, float(drift)
 
 
 def complete_boxes(
