@@ -115,6 +115,28 @@ def test_size_rows_none_judges_every_row(monkeypatch: pytest.MonkeyPatch) -> Non
     assert _ids(drop_odd_sizes(rows, _sizes(), 0.8)) == {1}
 
 
+@pytest.mark.parametrize("seed", range(5))
+def test_medians_by_id_are_numpys_median_per_id(seed: int) -> None:
+    """One sort for every track's median, equal to ``np.median`` of each id's values (odd and
+    even counts, ties, ids in any order)."""
+    rng = np.random.default_rng(seed)
+    ids = rng.integers(1, 40, 500).astype(np.float64)
+    values = np.round(rng.uniform(0.3, 2.0, 500), 2)  # ties within and across ids
+    uid, q = offline._medians_by_id(ids, values)
+    np.testing.assert_array_equal(uid, np.unique(ids))
+    want = [np.median(values[ids == i]) for i in uid]
+    np.testing.assert_array_equal(q, want)  # bit for bit: the same two middle values, / 2
+
+
+def test_drop_odd_sizes_judges_two_thousand_tracks() -> None:
+    """2000 tracks of 50 rows, half of them small for their row: each judged on its own rows
+    (the medians of one sort, `_medians_by_id`)."""
+    n, k = 2000, 50
+    rows = np.vstack([_track(i, 1.0 if i % 2 else 0.6, n=k) for i in range(1, n + 1)])
+    kept = drop_odd_sizes(rows, _sizes(), 0.8)
+    assert _ids(kept) == set(range(1, n + 1, 2))
+
+
 @pytest.mark.parametrize(
     ("ratio", "sizes", "error", "match"),
     [
