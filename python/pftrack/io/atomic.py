@@ -15,9 +15,9 @@ stays a pipe). Such a write is not atomic: a failure can leave part of it writte
 
 After a Ctrl-C that the ``pftrack`` console script noted (:mod:`pftrack._interrupt`; code in
 C may have dropped its ``KeyboardInterrupt``), no writer puts its output in place: each raises
-``KeyboardInterrupt`` before its rename (before opening a device or pipe it writes through),
-removing its temporary file, so the command ends as interrupted. Nothing else sets that flag:
-a program that imports pftrack writes as before.
+``KeyboardInterrupt`` before its rename (before opening a device or pipe it writes through,
+and before each write into one), removing its temporary file, so the command ends as
+interrupted. Nothing else sets that flag: a program that imports pftrack writes as before.
 
 Several outputs of one run (:func:`staged_outputs`) are renamed in one step that Ctrl-C and
 SIGTERM cannot split (:func:`interrupts_deferred`): one that comes meanwhile is raised after
@@ -41,7 +41,7 @@ import threading
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, cast
 
 from pftrack._interrupt import raise_if_interrupted
 from pftrack._typing import PathLike
@@ -131,6 +131,33 @@ def writes_through(path: PathLike) -> bool:
     the end of symbolic links; False for a regular file, a folder, or a path that does not exist.
     """
     return _resolve(path).through
+
+
+class _CheckedWrites:
+    """A written-through file (:func:`atomic_write`) that refuses each write after a Ctrl-C.
+
+    Each ``write`` and ``writelines`` first calls :func:`~pftrack._interrupt.raise_if_interrupted`;
+    anything else is the file's own. For a pipe written as it goes (a live ``pftrack track``
+    run's online rows into ``--out /dev/stdout``): the abort (a second Ctrl-C) that code in C
+    dropped stops the rows at the next write. Was: checked only before the pipe was opened,
+    so the rows of every frame after such an abort still went into it.
+    """
+
+    def __init__(self, file: IO[Any]) -> None:
+        self._file = file
+
+    def write(self, data: Any) -> int:
+        """Write `data`, unless a Ctrl-C was noted (then ``KeyboardInterrupt``)."""
+        raise_if_interrupted()
+        return int(self._file.write(data))
+
+    def writelines(self, lines: Iterable[Any]) -> None:
+        """Write `lines`, unless a Ctrl-C was noted (then ``KeyboardInterrupt``)."""
+        raise_if_interrupted()
+        self._file.writelines(lines)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._file, name)
 
 
 def _open_through(target: _Target, mode: str) -> IO[Any]:
@@ -371,7 +398,7 @@ def atomic_write(
     if resolved.through:
         raise_if_interrupted()  # written as it goes: refused before it begins (_put_in_place)
         with _named(path), _open_through(resolved, mode) as fh:
-            yield fh
+            yield cast("IO[Any]", _CheckedWrites(fh))  # and before each write
         return
     target = resolved.path
     folder = _folder_of(target, path)
