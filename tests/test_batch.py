@@ -1097,7 +1097,7 @@ def test_an_output_that_cannot_be_written_fails_its_task_not_the_batch(
     real = engine.write_mot
 
     def full(path: Any, *args: Any, **kwargs: Any) -> None:
-        if Path(path).name == "run1.txt":
+        if Path(path).name.startswith(".run1."):  # run1.txt's staged file
             raise OSError(errno.ENOSPC, "No space left on device", str(path))
         real(path, *args, **kwargs)
 
@@ -1335,7 +1335,10 @@ def test_a_run_stopped_while_writing_leaves_no_stale_complete_sequence(
 ) -> None:
     """Outputs were replaced before the sidecar: stopped in between, the old sidecar vouched
     for the new NAME.txt (a re-run with the old settings skipped it), and a video rendered
-    before any sidecar was an input of the next scan of its folder."""
+    before any sidecar was an input of the next scan of its folder. The outputs and the final
+    sidecar are now staged and renamed together (a Ctrl-C while they are written leaves the
+    earlier ones); the sidecar that says ``writing`` still comes first, for a run stopped in the
+    middle of the renames (``kill -9``: here an exception raised by the rename itself)."""
     import pftrack.batch.engine as engine
 
     out = tmp_path / "out"
@@ -1346,35 +1349,36 @@ def test_a_run_stopped_while_writing_leaves_no_stale_complete_sequence(
 
     def write_then_stop(*args: Any, **kwargs: Any) -> None:
         real_write_mot(*args, **kwargs)
-        raise KeyboardInterrupt  # Ctrl-C right after NAME.txt is replaced
+        raise KeyboardInterrupt  # Ctrl-C right after NAME.txt is written (staged)
 
     monkeypatch.setattr(engine, "write_mot", write_then_stop)
     other = TrackOptions(config=_config(), seed=1)
     with pytest.raises(KeyboardInterrupt):
         track_many(data / "plain", out, options=other, n_workers=0)
-    assert (out / "plain.txt").read_bytes() != before  # replaced; the sidecar not yet
+    assert (out / "plain.txt").read_bytes() == before  # staged: not replaced (was: replaced)
+    assert json.loads((out / "plain.json").read_text())["status"] == "writing"
+    assert sorted(p.name for p in out.iterdir()) == ["plain.json", "plain.txt", "summary.json"]
     monkeypatch.setattr(engine, "write_mot", real_write_mot)
     again = track_many(data / "plain", out, options=first, n_workers=0).entries[0]
     assert again["status"] == "done" and (out / "plain.txt").read_bytes() == before
-    # --out the input folder with --render, stopped once the video is written
+    # --out the input folder with --render, stopped once the video is renamed into place
     vids = tmp_path / "vids"
     vids.mkdir()
     shutil.copy2(data / "walk.avi", vids / "walk.avi")
-    real_atomic = engine.atomic_write
+    real_replace = os.replace
 
-    @contextlib.contextmanager
-    def stop_after_video(path: Path, *args: Any, **kwargs: Any) -> Iterator[Any]:
-        with real_atomic(path, *args, **kwargs) as fh:
-            yield fh
-        if Path(path).suffix == ".mp4":
+    def stop_after_video(src: Any, dst: Any) -> None:
+        real_replace(src, dst)
+        if os.fspath(dst) == str(vids / "walk.mp4"):  # not the task's own renames
             raise KeyboardInterrupt
 
-    monkeypatch.setattr(engine, "atomic_write", stop_after_video)
+    monkeypatch.setattr(os, "replace", stop_after_video)
     render = TrackOptions(config=_config(), render=".mp4")
     with pytest.raises(KeyboardInterrupt):
         track_many(vids, vids, options=render, n_workers=0)
+    monkeypatch.setattr(os, "replace", real_replace)
     assert (vids / "walk.mp4").is_file()
-    monkeypatch.setattr(engine, "atomic_write", real_atomic)
+    assert json.loads((vids / "walk.json").read_text())["status"] == "writing"
     assert track_many(vids, vids, options=render, n_workers=0).entries[0]["status"] == "done"
 
 

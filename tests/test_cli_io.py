@@ -804,6 +804,47 @@ def test_an_aborted_live_run_into_a_pipe_says_its_rows_went_there(
     assert len(got[0].splitlines()) == 6
 
 
+def test_a_dropped_abort_stops_the_rows_into_a_pipe_at_the_next_write(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A live run into a pipe whose abort (a second Ctrl-C) code in C dropped after frame 2:
+    the pipe gets the rows of frames 1-2 only, and the run ends as interrupted, saying so.
+
+    Was: a pipe written as it goes was checked for a noted Ctrl-C only before it was opened,
+    so the rows of frames 3-5 went into it as well (10 rows), and only the outputs put in place
+    at the end were refused.
+    """
+    import threading
+
+    from pftrack import _interrupt
+
+    def track_frames(source: Any, *, on_frame: Any, **kwargs: Any) -> Any:
+        for n in range(1, 6):
+            rows = np.array([[n, i, 10 * i, 20, 30, 40, 0.9, -1, -1, -1] for i in (1, 2)], float)
+            on_frame(n, next(iter(source)), [], rows)
+            if n == 2:
+                _interrupt.remember()  # as the console's handler does; its interrupt dropped
+        raise AssertionError("the rows of frame 3 were written")
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got: list[str] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()), daemon=True)
+    reader.start()
+    monkeypatch.setattr("pftrack.tracking.track_frames", track_frames)
+    try:
+        with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
+            assert main(["-q", "track", server.url, "--out", str(fifo)]) == 130
+    finally:
+        _interrupt.clear()
+    reader.join(30)
+    assert capsys.readouterr().err == (
+        f"pftrack track: interrupted; the 4 online rows tracked so far were written to {fifo}; "
+        "no other output was changed\n"
+    )
+    assert [line.split(",")[0] for line in got[0].splitlines()] == ["1", "1", "2", "2"]
+
+
 def _track_stream_into_fifo(tmp_path: Path, frames: Any, det: Any) -> tuple[Path, list[str]]:
     """``pftrack track URL --out FIFO --detections det.txt`` (exit 0): the fifo, its lines."""
     import threading

@@ -280,3 +280,139 @@ def test_a_ctrl_c_once_the_outputs_are_in_place_is_ignored(
     monkeypatch.setattr(where, "report_stream", ctrl_c_then_stream)
     assert main(["-q", *argv(inputs, tmp_path)]) == 0, capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
+
+
+def _signal_after_renaming(
+    monkeypatch: pytest.MonkeyPatch, signum: int, targets: set[Path]
+) -> list[str]:
+    """``os.replace`` renames, then sends `signum` to the process after the first rename onto
+    one of `targets` (a real Ctrl-C, or ``kill``, between two renames of one commit).
+
+    A writer's own renames (the video's ``..v.<hex>.<hex>.mp4`` onto its staged file) pass.
+    Returns the names of the targets renamed onto.
+    """
+    import os
+
+    real, renamed = os.replace, []
+
+    def replace_then_signal(src: Any, dst: Any) -> None:
+        real(src, dst)
+        if Path(dst) in targets:
+            renamed.append(Path(dst).name)
+            if len(renamed) == 1:
+                os.kill(os.getpid(), signum)
+                for _ in range(1000):  # Python runs the handler between bytecodes
+                    pass
+
+    monkeypatch.setattr(os, "replace", replace_then_signal)
+    return renamed
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")  # a 20-frame scene's notes, not the subject
+@pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("command", [c for c in sorted(COMMANDS) if len(COMMANDS[c][0]) > 1])
+def test_a_signal_between_the_renames_leaves_every_output_new(
+    command: str,
+    signame: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Every command that puts several files in place: a Ctrl-C (SIGTERM) after the first is
+    renamed, before the others, leaves them all new and no temporary file. These commands
+    ignore interrupts once their work is done (``hold_interrupts``): they finish, status 0."""
+    import signal
+
+    names, argv = COMMANDS[command]
+    for name in names:
+        (tmp_path / name).write_bytes(EARLIER)
+    renamed = _signal_after_renaming(
+        monkeypatch, getattr(signal, signame), {tmp_path / n for n in names}
+    )
+    assert main(["-q", *argv(inputs, tmp_path)]) == 0, capsys.readouterr().err
+    monkeypatch.undo()
+    assert sorted(renamed) == sorted(names)
+    snapshot = _snapshot(tmp_path)
+    assert sorted(snapshot) == sorted(names)  # no temporary file
+    assert all(snapshot[name] != EARLIER for name in names)
+
+
+@pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
+@pytest.mark.parametrize(
+    ("signame", "status", "said"),
+    [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated (SIGTERM)")],
+)
+def test_a_demo_signalled_between_its_renames_leaves_every_file_new(
+    signame: str,
+    status: int,
+    said: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A real Ctrl-C (SIGTERM) after the first of ``demo``'s files is renamed into place: the
+    interrupt is raised after the last, so all five are the new run's (its record vouches for
+    each) and the message says they were written. Was: the ``KeyboardInterrupt`` raised between
+    two renames left ``tracks.txt`` new beside the earlier demo's video, plot and record, and
+    said "no output was changed"."""
+    import hashlib
+    import signal
+
+    from pftrack.demo import OUTPUTS, RECORD
+
+    out_dir = tmp_path / "d"
+    assert main(["-q", "demo", "--out-dir", str(out_dir), "--frames", "5"]) == 0
+    earlier = _snapshot(out_dir)
+    capsys.readouterr()
+    names = [*OUTPUTS, RECORD]
+    renamed = _signal_after_renaming(
+        monkeypatch, getattr(signal, signame), {out_dir / n for n in names}
+    )
+    argv = ["-q", "demo", "--out-dir", str(out_dir), "--frames", "5", "--seed", "1"]
+    assert main(argv) == status
+    monkeypatch.undo()
+    assert capsys.readouterr().err == (
+        f"pftrack demo: {said}; the outputs were written before it: {out_dir}/tracks.txt, "
+        "truth.txt, annotated.mp4, trajectories.png\n"
+    )
+    assert sorted(renamed) == sorted(names)
+    now = _snapshot(out_dir)
+    assert sorted(now) == sorted(names)  # no temporary file
+    record = json.loads((out_dir / RECORD).read_text())
+    assert record == {n: hashlib.sha256(now[n] or b"").hexdigest() for n in OUTPUTS}
+    assert now["truth.txt"] != earlier["truth.txt"] and now[RECORD] != earlier[RECORD]
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")  # 10-frame scenes: few tracks confirmed
+def test_a_batch_signalled_between_a_sequences_renames_writes_it_whole(
+    two_videos: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A real Ctrl-C after a sequence's ``NAME.txt`` is renamed into place, before its sidecar:
+    raised once the sidecar is in place too, so the sequence is finished (``done``, in
+    ``summary.json`` as in its sidecar) and the batch stops there. Was: ``a.txt`` replaced, the
+    sidecar left saying ``writing``, the sequence listed ``cancelled``."""
+    import signal
+
+    whole = tmp_path / "whole"
+    assert _batch(two_videos, whole) == 0
+    out = tmp_path / "out"
+    renamed = _signal_after_renaming(monkeypatch, signal.SIGINT, {out / "a.txt"})
+    capsys.readouterr()
+    assert _batch(two_videos, out) == 130
+    monkeypatch.undo()
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err == (
+        "pftrack batch: interrupted; the outputs of the 1 sequence finished are written and "
+        f"complete; {out}/summary.json lists the rest as cancelled (re-run to finish them)"
+    )
+    assert renamed == ["a.txt"]
+    assert _statuses(out) == {"a": "done", "b": "cancelled"}
+    assert json.loads((out / "a.json").read_text())["status"] == "done"
+    assert sorted(p.name for p in out.iterdir()) == ["a.json", "a.txt", "summary.json"]
+    assert (out / "a.txt").read_bytes() == (whole / "a.txt").read_bytes()
+    assert _batch(two_videos, out) == 0  # a re-run skips a and makes b
+    assert _statuses(out) == {"a": "skipped", "b": "done"}

@@ -36,38 +36,45 @@ def run_demo(
     removed again, when it was created and is still empty, if the run stops before writing
     them; refused, before any work, if it holds a file of these names that is not the one an
     earlier demo wrote, as its record says) and prints MOTA, IDF1 and the rest against the
-    scene's known truth. An interrupt or error after the files are written says they were (the
-    command's "interrupted; ..." line).
+    scene's known truth. The five files are put in place together: all the new run's, or all
+    as they were (a Ctrl-C or SIGTERM while they are renamed is raised after the last:
+    :func:`~pftrack.io.atomic.staged_outputs`). An interrupt or error after they are in place
+    says they were written (the command's "interrupted; ..." line).
     """
     from dataclasses import replace
 
     out_dir = check_output_folder(out_dir, "--out-dir")
-    with made_folder(out_dir, "--out-dir"):
-        for name in (*OUTPUTS, RECORD):  # before any work: every output can be written
-            check_output(out_dir / name, what="--out-dir", within=out_dir)
-        _check_own(out_dir)
-        scene = make_scene(n_frames=n_frames, rng=seed)
-        base = TrackerConfig()
-        config = replace(base, filter=replace(base.filter, n_particles=particles))
-        run = track_frames(scene.frames, config=config, rng=seed)
-        with staged_outputs() as stage:  # the four files are replaced together, or not at all
-            staged = {name: stage(out_dir / name) for name in OUTPUTS}
-            write_mot(staged["tracks.txt"], run.rows)
-            scene.write_truth(staged["truth.txt"])
-            write_annotated_video(staged["annotated.mp4"], scene.frames, run.rows, scene.fps)
-            plot_trajectories(staged["trajectories.png"], run.rows,
-                              background=scene.background, truth=scene.truth,
-                              title="tracks (colour) over truth (grey)")  # fmt: skip
-            record = {name: _sha256(path) for name, path in staged.items()}
-            with stage(out_dir / RECORD).open("w", encoding="utf-8") as fh:  # theirs, a re-run
-                json.dump(record, fh, indent=1)  # may replace them (_check_own)
     wrote = f"{out_dir}/tracks.txt, truth.txt, annotated.mp4, trajectories.png"
-    try:  # the scores and the recovery demo take seconds more: a Ctrl-C there keeps the files
+    written: list[bool] = []  # set as the last of the files is put in place
+    try:
+        with made_folder(out_dir, "--out-dir"):
+            for name in (*OUTPUTS, RECORD):  # before any work: every output can be written
+                check_output(out_dir / name, what="--out-dir", within=out_dir)
+            _check_own(out_dir)
+            scene = make_scene(n_frames=n_frames, rng=seed)
+            base = TrackerConfig()
+            config = replace(base, filter=replace(base.filter, n_particles=particles))
+            run = track_frames(scene.frames, config=config, rng=seed)
+            # the five files are replaced together, or not at all: a Ctrl-C (SIGTERM) during
+            # the renames is raised after the last (was: between two, old files beside new)
+            with staged_outputs(on_commit=lambda: written.append(True)) as stage:
+                staged = {name: stage(out_dir / name) for name in OUTPUTS}
+                write_mot(staged["tracks.txt"], run.rows)
+                scene.write_truth(staged["truth.txt"])
+                write_annotated_video(staged["annotated.mp4"], scene.frames, run.rows, scene.fps)
+                plot_trajectories(staged["trajectories.png"], run.rows,
+                                  background=scene.background, truth=scene.truth,
+                                  title="tracks (colour) over truth (grey)")  # fmt: skip
+                record = {name: _sha256(path) for name, path in staged.items()}
+                with stage(out_dir / RECORD).open("w", encoding="utf-8") as fh:  # theirs, a
+                    json.dump(record, fh, indent=1)  # re-run may replace them (_check_own)
+        # the scores and the recovery demo take seconds more: a Ctrl-C there keeps the files
         _report(scene, run, seed=seed, n_frames=n_frames, particles=particles)
     except BaseException as exc:  # was: "interrupted; no output was changed", the files written
-        from pftrack.cli._signals import set_outcome
+        if written:
+            from pftrack.cli._signals import set_outcome
 
-        set_outcome(exc, f"the outputs were written before it: {wrote}")
+            set_outcome(exc, f"the outputs were written before it: {wrote}")
         raise
     print(f"\nwrote {wrote}")
     return 0

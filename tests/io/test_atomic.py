@@ -99,6 +99,78 @@ def test_staged_outputs_remove_a_writers_own_temporary_file(tmp_path: Path) -> N
     assert sorted(p.name for p in tmp_path.iterdir()) == [".v.keep.mp4", "v.mp4"]
 
 
+def _signalled_after_the_first_rename(
+    monkeypatch: pytest.MonkeyPatch, signum: int, sender: str
+) -> list[str]:
+    """``os.replace`` renames, then (after the first rename only) sends `signum` to the process.
+
+    `sender`: ``"main"`` (``os.kill`` in this thread, whose handler then runs at once) or
+    ``"thread"`` (``os.kill`` from another thread, which takes the signal when this one blocks
+    it: Python then runs the handler here at the next chance). Returns the targets renamed.
+    """
+    real, renamed = os.replace, []
+
+    def replace_then_signal(src: str, dst: str) -> None:
+        real(src, dst)
+        renamed.append(os.path.basename(dst))
+        if len(renamed) == 1:
+            if sender == "main":
+                os.kill(os.getpid(), signum)
+            else:
+                killer = threading.Thread(target=os.kill, args=(os.getpid(), signum))
+                killer.start()
+                killer.join()
+            for _ in range(1000):  # Python runs a handler between bytecodes
+                pass
+
+    monkeypatch.setattr(os, "replace", replace_then_signal)
+    return renamed
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="signals cannot be blocked")
+@pytest.mark.parametrize("sender", ["main", "thread"])
+@pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM"])
+def test_a_signal_during_the_renames_is_raised_after_the_last(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, signame: str, sender: str
+) -> None:
+    """Ctrl-C (SIGTERM under ``pftrack``) between two renames of :func:`staged_outputs`: every
+    target new, no temporary file, the interrupt raised after; ``on_commit`` called before it.
+
+    Was: the ``KeyboardInterrupt`` raised after the first rename left ``a.txt`` new beside an old
+    ``b.png`` and ``c.json`` (``pftrack demo``'s five files, a real Ctrl-C).
+    """
+    from pftrack.cli._signals import sigterm_raises
+    from pftrack.io.atomic import staged_outputs
+
+    names = ["a.txt", "b.png", "c.json"]
+    for name in names:
+        (tmp_path / name).write_text(f"old {name}")
+    signum = getattr(signal, signame)
+    renamed = _signalled_after_the_first_rename(monkeypatch, signum, sender)
+    committed: list[list[str]] = []
+    with pytest.raises(KeyboardInterrupt), sigterm_raises():
+        with staged_outputs(on_commit=lambda: committed.append(list(renamed))) as stage:
+            for name in names:
+                stage(tmp_path / name).write_text(f"new {name}")
+        for _ in range(1000):
+            pass
+    monkeypatch.undo()
+    assert [(tmp_path / name).read_text() for name in names] == [f"new {n}" for n in names]
+    assert sorted(p.name for p in tmp_path.iterdir()) == names  # no temporary file
+    assert committed == [names]  # told once all three were in place, before the interrupt
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handlers restored
+
+
+def test_interrupts_deferred_raises_nothing_when_none_came() -> None:
+    from pftrack.io.atomic import interrupts_deferred
+
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    with interrupts_deferred():
+        pass
+    assert {s: signal.getsignal(s) for s in before} == before
+    assert not signal.pthread_sigmask(signal.SIG_BLOCK, [])
+
+
 def _write_through(writer: str, target: Path, text: str) -> None:
     """Write `text` to `target` with `writer`: atomic_write, atomic_path or staged_outputs."""
     from pftrack.io.atomic import staged_outputs

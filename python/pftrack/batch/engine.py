@@ -45,7 +45,14 @@ from pftrack._threads import usable_cpus
 from pftrack._warn import warn
 from pftrack.batch.inputs import cannot_read
 from pftrack.batch.tasks import TaskCancelled, TaskResult, one_line, reporting_frames
-from pftrack.io.atomic import atomic_write, check_output, check_output_folder, link_loop
+from pftrack.io.atomic import (
+    atomic_write,
+    check_output,
+    check_output_folder,
+    interrupts_deferred,
+    link_loop,
+    staged_outputs,
+)
 from pftrack.io.mot import write_mot
 from pftrack.io.video import IMAGE_SUFFIXES
 
@@ -1036,13 +1043,6 @@ def _main_left_out() -> Iterator[None]:
             main.__file__ = file
 
 
-#: What :func:`_interrupts_held` holds: Ctrl-C, and SIGTERM, which the command turns into a
-#: ``KeyboardInterrupt`` too (:mod:`pftrack.cli._signals`).
-_HELD_SIGNALS = frozenset(
-    getattr(signal, name) for name in ("SIGINT", "SIGTERM") if hasattr(signal, name)
-)
-
-
 @contextlib.contextmanager
 def _interrupts_held(spawns: bool = True) -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) and SIGTERM in this thread meanwhile; one held is raised at the end.
@@ -1055,46 +1055,23 @@ def _interrupts_held(spawns: bool = True) -> Iterator[None]:
     signal mask survives fork and exec): the workers, in the terminal's process group, never
     see its Ctrl-C, nor a SIGTERM sent to the group (``kill -TERM -PGID``, a service manager),
     not even while Python starts in them. This process, whose main thread unblocks them here,
-    cancels the tasks and closes the cluster instead. A held SIGTERM that no handler turns into
-    an exception (a library caller of :func:`dask_client`) ends the process on unblocking, as
-    it would have a moment earlier.
-
-    A signal mask is per thread: threads started before the hold (OpenBLAS's and OpenCV's,
-    started when NumPy and cv2 load) take a signal sent to the process, and Python then runs its
-    handler in the main thread at the next chance, inside the hold (measured: as Dask's wait
-    for the cluster wakes, in ``SpecCluster.__init__``). In the main thread the handlers are
-    therefore replaced too, by one that notes the signal; each one noted is sent again, to the
-    handler it was meant for, at the end.
+    cancels the tasks and closes the cluster instead. The hold is
+    :func:`~pftrack.io.atomic.interrupts_deferred`'s, which the atomic writers use too (its
+    notes say how a signal taken by another thread is held as well).
 
     `spawns`: processes may be started meanwhile (a local cluster's workers). False when none
     is (a failed client closed: :func:`_new_client`), so as not to start multiprocessing's
     resource tracker, a process, for nothing.
     """
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
-        yield
-        return
-    if spawns:
+    if spawns and hasattr(signal, "pthread_sigmask"):
         # multiprocessing's resource tracker, started with the first worker process, unblocks
         # SIGINT and SIGTERM in the thread that starts it (resource_tracker.ensure_running):
         # now, before the hold, it is not started again in the thread that spawns the workers
         from multiprocessing import resource_tracker
 
         resource_tracker.ensure_running()
-    noted: list[int] = []
-    handlers: dict[int, Any] = {}
-    if threading.current_thread() is threading.main_thread():
-        for signum in _HELD_SIGNALS:
-            if signal.getsignal(signum) is not None:  # None: set outside Python, left alone
-                handlers[signum] = signal.signal(signum, lambda n, _: noted.append(n))
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD_SIGNALS)
-    try:
+    with interrupts_deferred():
         yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a signal held in this thread: noted
-        for signum, handler in handlers.items():
-            signal.signal(signum, handler)
-        for signum in dict.fromkeys(noted):  # KeyboardInterrupt (Terminated) from here
-            signal.raise_signal(signum)
 
 
 def scheduler_address(scheduler: str | None = None) -> str | None:
@@ -1501,14 +1478,21 @@ def _write(
     kind: str,
     settings: dict[str, Any],
     prints: list[dict[str, Any]],
+    on_commit: Callable[[dict[str, Any]], object] | None = None,
 ) -> dict[str, Any]:
     """Write one task's outputs, sidecar last (with the inputs' `prints`); return its entry.
 
     The sidecar is first replaced by one that says ``writing`` and names the outputs to come:
     stopped before the last step, the sequence is not complete for a re-run (an earlier run's
-    sidecar would vouch for a ``NAME.txt`` already replaced), and its video is known as a
-    batch's output (:func:`~pftrack.batch.inputs.find_sequences` passes it over). A result with
-    an `error` is written too, and its entry and sidecar say ``failed``: not complete either.
+    sidecar would vouch for outputs that may be replaced), and its video is known as a batch's
+    output (:func:`~pftrack.batch.inputs.find_sequences` passes it over). Then ``NAME.txt``,
+    its video and the final sidecar are staged and renamed together
+    (:func:`~pftrack.io.atomic.staged_outputs`): a Ctrl-C or SIGTERM while they are written
+    leaves the earlier ones, and one during the renames is raised after the last (was: each
+    written in turn; stopped between two, a new ``NAME.txt`` beside an earlier video).
+    `on_commit` is called with the entry once they are in place, before such an interrupt is
+    raised. A result with an `error` is written too, and its entry and sidecar say
+    ``failed``: not complete either.
     """
     outputs = [f"{job.name}.txt", *(f"{job.name}{suffix}" for suffix in result.files)]
     head: dict[str, Any] = {
@@ -1520,20 +1504,19 @@ def _write(
         head["earlier_outputs"] = left
     writing = {**head, "name": job.name, "status": "writing", "outputs": outputs}
     _write_sidecar(out_dir, job.name, writing)
-    write_mot(
-        out_dir / outputs[0], result.rows, exact=False if result.exact is None else result.exact
-    )
-    for suffix, data in result.files.items():
-        with atomic_write(out_dir / f"{job.name}{suffix}", "wb", suffix=suffix) as fh:
-            fh.write(data)
     status = "done" if result.error is None else "failed"  # failed: after its outputs were made
     entry = {"name": job.name, "status": status, **result.info, "outputs": outputs}
     if result.error is not None:
         entry.update(error=result.error, traceback=result.traceback)
-    written = [output_print(out_dir / o) for o in outputs]  # what a re-run checks they still are
-    _write_sidecar(
-        out_dir, job.name, {**head, "fingerprint": prints, **entry, "output_prints": written}
-    )
+    with staged_outputs(on_commit=None if on_commit is None else lambda: on_commit(entry)) as stage:
+        staged = [stage(out_dir / o) for o in outputs]
+        write_mot(staged[0], result.rows, exact=False if result.exact is None else result.exact)
+        for path, data in zip(staged[1:], result.files.values(), strict=True):
+            path.write_bytes(data)
+        # what a re-run checks they still are (the staged files' bytes, under the outputs' names)
+        written = [{**output_print(p), "name": o} for p, o in zip(staged, outputs, strict=True)]
+        sidecar = {**head, "fingerprint": prints, **entry, "output_prints": written}
+        stage(_sidecar(out_dir, job.name)).write_text(_sidecar_text(sidecar), encoding="utf-8")
     return entry
 
 
@@ -1554,7 +1537,11 @@ def _earlier_outputs(out_dir: Path, name: str, kind: str) -> list[str]:
 
 def _write_sidecar(out_dir: Path, name: str, sidecar: dict[str, Any]) -> None:
     with atomic_write(_sidecar(out_dir, name)) as fh:
-        fh.write(json.dumps(_clean(sidecar), indent=2) + "\n")
+        fh.write(_sidecar_text(sidecar))
+
+
+def _sidecar_text(sidecar: dict[str, Any]) -> str:
+    return json.dumps(_clean(sidecar), indent=2) + "\n"
 
 
 def _older_print(now: dict[str, Any], earlier: Any) -> bool:
@@ -2203,7 +2190,11 @@ def run_jobs(
     ran: set[str] = set()  # the workers that ran tasks (was: the count at the start alone)
 
     def record(job: Job, outcome: Outcome) -> None:
-        nonlocal written
+        def committed(entry: dict[str, Any]) -> None:  # its outputs in place: before a Ctrl-C
+            nonlocal written  # that came during their renames is raised (_write)
+            entries[job.name] = entry
+            written += 1
+
         if outcome.worker is not None:
             ran.add(outcome.worker)
         other = _other_release(outcome) if remote else None
@@ -2213,10 +2204,7 @@ def run_jobs(
             outcome = Outcome(None, other, outcome.traceback, outcome.host)
         if outcome.result is not None:
             try:
-                entries[job.name] = _write(
-                    out, job, outcome.result, kind, settings, prints[job.name]
-                )
-                written += 1
+                _write(out, job, outcome.result, kind, settings, prints[job.name], committed)
             except OSError as exc:  # a full disk: this task fails, the batch goes on (was:
                 # stopped with exit status 2, "nothing ran", the task "cancelled"; a user trial)
                 error = f"writing its outputs: {one_line(exc)}"

@@ -15,15 +15,20 @@ stays a pipe). Such a write is not atomic: a failure can leave part of it writte
 
 After a Ctrl-C that the ``pftrack`` console script noted (:mod:`pftrack._interrupt`; code in
 C may have dropped its ``KeyboardInterrupt``), no writer puts its output in place: each raises
-``KeyboardInterrupt`` before its rename (before opening a device or pipe it writes through),
-removing its temporary file, so the command ends as interrupted. Nothing else sets that flag:
-a program that imports pftrack writes as before.
+``KeyboardInterrupt`` before its rename (before opening a device or pipe it writes through,
+and before each write into one), removing its temporary file, so the command ends as
+interrupted. Nothing else sets that flag: a program that imports pftrack writes as before.
+
+Several outputs of one run (:func:`staged_outputs`) are renamed in one step that Ctrl-C and
+SIGTERM cannot split (:func:`interrupts_deferred`): one that comes meanwhile is raised after
+the last rename.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import functools
 import os
 import re
 import secrets
@@ -36,7 +41,7 @@ import threading
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, cast
 
 from pftrack._interrupt import raise_if_interrupted
 from pftrack._typing import PathLike
@@ -126,6 +131,33 @@ def writes_through(path: PathLike) -> bool:
     the end of symbolic links; False for a regular file, a folder, or a path that does not exist.
     """
     return _resolve(path).through
+
+
+class _CheckedWrites:
+    """A written-through file (:func:`atomic_write`) that refuses each write after a Ctrl-C.
+
+    Each ``write`` and ``writelines`` first calls :func:`~pftrack._interrupt.raise_if_interrupted`;
+    anything else is the file's own. For a pipe written as it goes (a live ``pftrack track``
+    run's online rows into ``--out /dev/stdout``): the abort (a second Ctrl-C) that code in C
+    dropped stops the rows at the next write. Was: checked only before the pipe was opened,
+    so the rows of every frame after such an abort still went into it.
+    """
+
+    def __init__(self, file: IO[Any]) -> None:
+        self._file = file
+
+    def write(self, data: Any) -> int:
+        """Write `data`, unless a Ctrl-C was noted (then ``KeyboardInterrupt``)."""
+        raise_if_interrupted()
+        return int(self._file.write(data))
+
+    def writelines(self, lines: Iterable[Any]) -> None:
+        """Write `lines`, unless a Ctrl-C was noted (then ``KeyboardInterrupt``)."""
+        raise_if_interrupted()
+        self._file.writelines(lines)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._file, name)
 
 
 def _open_through(target: _Target, mode: str) -> IO[Any]:
@@ -234,14 +266,27 @@ def _remove(made: Iterable[str]) -> None:
     moment a command's check of its output folder had made its probe file left that file
     behind (CI, at load 8: the interrupt came between the probe's creation and its removal).
     """
+    _despite_interrupts(functools.partial(_unlink, path) for path in made)
+
+
+def _unlink(path: str) -> None:
+    """Remove file `path`; one gone already, or never made, is passed over."""
+    with contextlib.suppress(OSError):
+        os.unlink(path)
+
+
+def _despite_interrupts(steps: Iterable[Callable[[], object]]) -> None:
+    """Take each of `steps`; a ``KeyboardInterrupt`` meanwhile is raised once all are taken.
+
+    The step it came in is taken again (it came before or after the step's work: doing it
+    twice must be harmless), so no step is skipped.
+    """
     stopped: BaseException | None = None
-    for path in made:
+    for step in steps:
         while True:
             try:
-                os.unlink(path)
-            except OSError:
-                pass  # gone already, or never made
-            except KeyboardInterrupt as exc:  # before or after the unlink: try it again
+                step()
+            except KeyboardInterrupt as exc:  # before or after the step's work: again
                 stopped = exc
                 continue
             break
@@ -353,7 +398,7 @@ def atomic_write(
     if resolved.through:
         raise_if_interrupted()  # written as it goes: refused before it begins (_put_in_place)
         with _named(path), _open_through(resolved, mode) as fh:
-            yield fh
+            yield cast("IO[Any]", _CheckedWrites(fh))  # and before each write
         return
     target = resolved.path
     folder = _folder_of(target, path)
@@ -870,7 +915,7 @@ def _check_folder(written: Path, what: str, target: Path) -> None:
     ):
         raise PermissionError(f"{what} {target}: not writable")
     made: list[str] = []
-    with _interrupts_deferred():  # the probe is gone before a Ctrl-C or a kill is raised
+    with interrupts_deferred():  # the probe is gone before a Ctrl-C or a kill is raised
         try:  # access() says yes to root on a read-only or special file system: try it
             fd, _ = _create_beside(folder, f".{written.name}.", ".probe", made)
             os.close(fd)
@@ -882,25 +927,60 @@ def _check_folder(written: Path, what: str, target: Path) -> None:
             _remove(made)
 
 
-@contextlib.contextmanager
-def _interrupts_deferred() -> Iterator[None]:
-    """Meanwhile SIGINT and SIGTERM wait (blocked); delivered, and raised, when it ends.
+#: What :func:`interrupts_deferred` holds: Ctrl-C, and SIGTERM, which the ``pftrack`` command
+#: turns into a ``KeyboardInterrupt`` too (:mod:`pftrack.cli._signals`).
+_DEFERRED_SIGNALS = frozenset(
+    getattr(signal, name) for name in ("SIGINT", "SIGTERM") if hasattr(signal, name)
+)
 
-    For a short step that makes and removes a file: an interrupt raised between the two
-    (Python runs its handler between any two steps) would leave the file. Only in the main
-    thread, where Python runs signal handlers, and where the platform can block signals.
+
+@contextlib.contextmanager
+def interrupts_deferred() -> Iterator[None]:
+    """Meanwhile Ctrl-C (SIGINT) and SIGTERM wait; each one that came is raised when it ends.
+
+    For a step an interrupt must not split: making and removing a probe file, renaming a
+    run's outputs one after the other (:func:`staged_outputs`), starting or closing a local
+    Dask cluster (``pftrack.batch.engine``). The signals are blocked in the main thread, and
+    their handlers replaced by one that notes them: a signal mask is per thread, so a signal
+    sent to the process is taken by another thread that has it unblocked
+    (OpenBLAS's and OpenCV's, started when NumPy and cv2 load; a render thread), and Python
+    then runs its handler in the main thread at the next chance, inside the block. At the end
+    the mask and the handlers are restored and each signal noted is sent again, to the handler
+    it was meant for (``KeyboardInterrupt``, :class:`~pftrack._interrupt.Terminated`, or a
+    process ended by a SIGTERM no handler takes, as it would have been a moment earlier).
+    Only in the main thread, where Python runs signal handlers (elsewhere it does nothing: the
+    interrupt is raised in the main thread, not in this one), and where the platform can
+    block signals.
     """
     if not hasattr(signal, "pthread_sigmask") or (
         threading.current_thread() is not threading.main_thread()
     ):
         yield
         return
-    stopping = {getattr(signal, n) for n in ("SIGINT", "SIGTERM") if hasattr(signal, n)}
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, stopping)
+    noted: list[int] = []
+    handlers: dict[int, Any] = {}
+    for signum in _DEFERRED_SIGNALS:
+        if signal.getsignal(signum) is not None:  # None: set outside Python, left alone
+            handlers[signum] = signal.signal(signum, lambda n, _: noted.append(n))
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _DEFERRED_SIGNALS)
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        # a signal held in this thread is taken as the mask is restored, and noted there
+        # (pthread_sigmask runs the handlers before it returns)
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        _restore(handlers)
+        for signum in dict.fromkeys(noted):  # KeyboardInterrupt (Terminated) from here
+            signal.raise_signal(signum)
+
+
+def _restore(handlers: Mapping[int, Any]) -> None:
+    """Set each signal's handler back; an interrupt meanwhile is raised once all are back.
+
+    A signal that comes now, once its own handler is back, raises between two of these
+    steps: the handlers after it would stay :func:`interrupts_deferred`'s, which only note.
+    """
+    _despite_interrupts(functools.partial(signal.signal, n, h) for n, h in handlers.items())
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -998,7 +1078,9 @@ def _as_targets(exc: OSError, staged: Iterable[tuple[str, Path]]) -> OSError | N
 
 
 @contextlib.contextmanager
-def staged_outputs() -> Iterator[Callable[..., Path]]:
+def staged_outputs(
+    on_commit: Callable[[], object] | None = None,
+) -> Iterator[Callable[..., Path]]:
     """Several outputs of one run, all replaced at the end or none at all.
 
     Yields ``stage(path, suffix=None) -> Path``: a temporary path beside `path`, with its
@@ -1006,7 +1088,13 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
     fill. When the block ends normally every staged file is renamed over its target;
     when it raises (an error, ``KeyboardInterrupt``), every temporary file is removed and every
     target is left as it was, so an interrupted run never leaves a new tracks file beside an old
-    video, or a half-written file anywhere. A symbolic link replaces the file it leads to; a
+    video, or a half-written file anywhere. The renames are one step that Ctrl-C and SIGTERM
+    cannot split (:func:`interrupts_deferred`): one that comes while they run is raised once
+    the last is done, so the targets are then all new (was: a ``KeyboardInterrupt`` between two
+    renames left some new and some old). `on_commit`, if given, is called right after the last
+    rename, before such an interrupt is raised: the caller learns that its outputs are in place.
+    A rename that fails (a folder put in a target's place meanwhile) stops the others: the
+    targets renamed before it stay new. A symbolic link replaces the file it leads to; a
     device, FIFO or descriptor gets its file's bytes written into it: a device before the
     renames (one that fails, ``/dev/full``, leaves every target as it was), a pipe, FIFO or
     socket after them (its reader may wait for the files, or stop early).
@@ -1055,8 +1143,11 @@ def staged_outputs() -> Iterator[Callable[..., Path]]:
         _write_through([item for item, late in zip(through, streams, strict=True) if not late])
         for tmp, target in staged:
             _keep_mode(tmp, target)  # again: a writer may have made the file anew
-        for tmp, target in staged:
-            os.replace(tmp, target)
+        with interrupts_deferred():  # one step: a Ctrl-C or SIGTERM is raised after the last
+            for tmp, target in staged:
+                os.replace(tmp, target)
+            if on_commit is not None:
+                on_commit()
         _write_through([item for item, late in zip(through, streams, strict=True) if late])
     except BaseException as exc:
         _remove(made)
