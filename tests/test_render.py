@@ -69,6 +69,24 @@ def test_a_worker_error_surfaces_and_leaves_no_file(tmp_path: Path) -> None:
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("threaded", [True, False])
+@pytest.mark.parametrize("end", ["close", "abort"])
+def test_a_frame_after_the_end_is_refused_not_queued(
+    tmp_path: Path, threaded: bool, end: str
+) -> None:
+    """Was: queued silently for the stopped worker, and the 9th ``add`` waited for ever."""
+    renderer = TrackRenderer(tmp_path / "a.mp4", 7, threaded=threaded)
+    frame = np.zeros((40, 60, 3), np.uint8)
+    renderer.add(frame, [])
+    getattr(renderer, end)()
+    state = "closed" if end == "close" else "aborted"
+    for _ in range(10):  # more than the queue holds
+        with pytest.raises(ValueError, match=rf"^TrackRenderer.add: .*a.mp4 is {state} already"):
+            renderer.add(frame, [])
+    assert renderer.n_frames == 1
+    assert [p.name for p in tmp_path.iterdir()] == (["a.mp4"] if end == "close" else [])
+
+
 def test_write_annotated_video_from_rows(tmp_path: Path) -> None:
     rows = np.array([[k, 3, 10 + 2 * k, 10, 8, 16, 1, -1, -1, -1] for k in range(1, 11)], float)
     frames = [np.zeros((48, 64, 3), np.uint8) for _ in range(10)]

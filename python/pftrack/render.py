@@ -409,6 +409,7 @@ class TrackRenderer:
         self._trails: dict[int, deque[tuple[float, float]]] = {}
         self._error: BaseException | None = None
         self._n = 0
+        self._ended = False  # closed or aborted: add() refuses frames after it
         self._queue: queue.Queue[_Job | None] | None = None
         self._thread: threading.Thread | None = None
         if threaded:
@@ -418,6 +419,13 @@ class TrackRenderer:
 
     def add(self, frame: NDArray[np.uint8], tracks: Iterable[TrackLike]) -> None:
         """Queue `frame` (BGR, not modified) with the tracks reported on it."""
+        if self._ended:
+            # was: queued for a worker that had stopped, silently, until the queue was full;
+            # then add() waited for room for ever
+            raise ValueError(
+                f"TrackRenderer.add: the renderer of {self.writer.path} is "
+                f"{self.writer.ended or 'closed'} already; make a new TrackRenderer for more frames"
+            )
         # checked here, in the caller's thread (was: a float frame drawn black without a word)
         frame = bgr_frame(frame, "TrackRenderer.add: frame")
         self._raise_worker_error()
@@ -499,12 +507,14 @@ class TrackRenderer:
 
     def close(self) -> Path:
         """Wait for the queued frames, finish the file and return its path."""
+        self._ended = True
         self._join()
         self._raise_worker_error()
         return self.writer.close()
 
     def abort(self) -> None:
-        """Stop without writing: the partial file is removed."""
+        """Stop without writing: the partial file is removed (a finished one stays)."""
+        self._ended = True
         self._join()
         self.writer.abort()
 
