@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import bgr_frame, brief, flag, integer, path_arg, real_array, text
+from pftrack._threads import join_through_interrupts
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
@@ -412,6 +413,7 @@ class TrackRenderer:
         self._ended = False  # closed or aborted: add() refuses frames after it
         self._queue: queue.Queue[_Job | None] | None = None
         self._thread: threading.Thread | None = None
+        self._finished = threading.Event()  # the worker's last act
         if threaded:
             self._queue = queue.Queue(maxsize=max(queue_size, 1))
             self._thread = threading.Thread(target=self._work, name="pftrack-render", daemon=True)
@@ -480,6 +482,12 @@ class TrackRenderer:
         self.writer.write(image)
 
     def _work(self) -> None:
+        try:
+            self._work_queue()
+        finally:
+            self._finished.set()
+
+    def _work_queue(self) -> None:
         assert self._queue is not None
         while True:
             try:
@@ -502,7 +510,7 @@ class TrackRenderer:
     def _join(self) -> None:
         if self._thread is not None and self._queue is not None:
             self._put(None)
-            self._thread.join()
+            join_through_interrupts(self._thread, self._finished)  # not left inside OpenCV
             self._thread = None
 
     def close(self) -> Path:
@@ -515,8 +523,10 @@ class TrackRenderer:
     def abort(self) -> None:
         """Stop without writing: the partial file is removed (a finished one stays)."""
         self._ended = True
-        self._join()
-        self.writer.abort()
+        try:
+            self._join()
+        finally:  # an interrupt in the wait too: no partial file left
+            self.writer.abort()
 
     @property
     def n_frames(self) -> int:
