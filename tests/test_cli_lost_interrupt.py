@@ -231,3 +231,47 @@ def test_ctrl_c_at_any_point_of_the_start_ends_in_130(tmp_path):
             assert status in (-signal.SIGINT, 1), err
             assert "pftrack/cli" not in err and "_console.py" not in err, err
     assert seen["interrupted"] >= 3, seen
+
+
+# Ctrl-C twice: the first interrupts the command (inside its work), the second comes as the
+# command reports it ("report", after its line) or as the process ends ("exit")
+TWICE = """
+import signal, sys
+import pftrack._console as console
+import pftrack.cli as cli
+import pftrack.recovery as where
+
+def again(real):
+    def hook(*args, **kwargs):
+        signal.raise_signal(signal.SIGINT)
+        return real(*args, **kwargs)
+    return hook
+
+where.fill_gaps = again(where.fill_gaps)
+if {when!r} == "report":
+    cli.exit_status = again(cli.exit_status)
+else:
+    console._handled = again(console._handled)
+sys.argv = ["pftrack", *{argv!r}]
+sys.exit(console.main())
+"""
+
+
+@pytest.mark.parametrize("when", ["report", "exit"])
+def test_a_second_ctrl_c_as_the_command_ends_is_ignored(tmp_path: Path, when: str) -> None:
+    """Was: a second "interrupted" line, or a traceback of the console script's last lines.
+
+    Pressed twice on ``pftrack track``, Ctrl-C also cut short the exit's wait for the threads
+    still stopping, and the process aborted ("terminate called without an active exception").
+    """
+    tracks = make_scene(n_frames=20, n_walkers=2, rng=0).write_truth(tmp_path / "gt.txt")
+    out = tmp_path / "out.txt"
+    out.write_text("an earlier run\n")
+    code = TWICE.format(when=when, argv=["recover", str(tracks), "--out", str(out)])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(  # noqa: PLW1510 - the status is the test's
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 130, proc.stderr
+    assert proc.stderr == "pftrack recover: interrupted; no output was changed\n"
+    assert out.read_text() == "an earlier run\n"

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import ast
 import os
+import signal
 import subprocess
 import sys
 import textwrap
+import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -66,6 +69,53 @@ def test_a_worker_error_surfaces_and_leaves_no_file(tmp_path: Path) -> None:
     renderer.add(np.zeros((30, 60, 3), np.uint8), [])  # another size: the encoder refuses it
     with pytest.raises(ValueError, match="the video 60x40"):
         renderer.close()
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("threaded", [True, False])
+@pytest.mark.parametrize("end", ["close", "abort"])
+def test_a_frame_after_the_end_is_refused_not_queued(
+    tmp_path: Path, threaded: bool, end: str
+) -> None:
+    """Was: queued silently for the stopped worker, and the 9th ``add`` waited for ever."""
+    renderer = TrackRenderer(tmp_path / "a.mp4", 7, threaded=threaded)
+    frame = np.zeros((40, 60, 3), np.uint8)
+    renderer.add(frame, [])
+    getattr(renderer, end)()
+    state = "closed" if end == "close" else "aborted"
+    for _ in range(10):  # more than the queue holds
+        with pytest.raises(ValueError, match=rf"^TrackRenderer.add: .*a.mp4 is {state} already"):
+            renderer.add(frame, [])
+    assert renderer.n_frames == 1
+    assert [p.name for p in tmp_path.iterdir()] == (["a.mp4"] if end == "close" else [])
+
+
+def test_a_ctrl_c_in_abort_waits_for_the_worker_then_is_raised(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Was: the wait cut short, the worker left drawing inside OpenCV as the process exited."""
+    renderer = TrackRenderer(tmp_path / "a.mp4", 7)
+    drawing, drawn = threading.Event(), threading.Event()
+    draw = renderer._draw
+
+    def slow(job: Any) -> None:
+        drawing.set()
+        time.sleep(0.6)
+        draw(job)
+        drawn.set()
+
+    monkeypatch.setattr(renderer, "_draw", slow)
+    renderer.add(np.zeros((40, 60, 3), np.uint8), [])
+    assert drawing.wait(timeout=10)
+    main = threading.main_thread().ident
+    assert main is not None
+    timer = threading.Timer(0.2, signal.pthread_kill, (main, signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        renderer.abort()
+    timer.join()
+    assert drawn.is_set()
+    assert not [t for t in threading.enumerate() if t.name == "pftrack-render" and t.is_alive()]
     assert list(tmp_path.iterdir()) == []
 
 

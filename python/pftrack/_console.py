@@ -109,12 +109,16 @@ def main(argv: Sequence[str] | None = None) -> int:
               file=sys.stderr)  # fmt: skip
         return EXIT_TERMINATED if how != "interrupted" else EXIT_INTERRUPTED
     finally:
-        _handled()
         if argv is None:  # the process exits as it ends: SIGTERM kills it, as it did
             import signal
 
+            # and Ctrl-C is ignored: the command is over, and a KeyboardInterrupt now was a
+            # traceback, or cut short the exit's wait for threads still stopping, which aborted
+            # the process (a thread left inside OpenCV: pftrack.cli._signals)
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
             if signal.getsignal(signal.SIGTERM) is _on_sigterm:
                 signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        _handled()
 
 
 def _handled() -> None:

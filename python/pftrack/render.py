@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import bgr_frame, brief, flag, integer, path_arg, real_array, text
+from pftrack._threads import join_through_interrupts
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.mot import group_by_frame
 from pftrack.io.opencv_io import text_for_opencv, write_image
@@ -409,8 +410,10 @@ class TrackRenderer:
         self._trails: dict[int, deque[tuple[float, float]]] = {}
         self._error: BaseException | None = None
         self._n = 0
+        self._ended = False  # closed or aborted: add() refuses frames after it
         self._queue: queue.Queue[_Job | None] | None = None
         self._thread: threading.Thread | None = None
+        self._finished = threading.Event()  # the worker's last act
         if threaded:
             self._queue = queue.Queue(maxsize=max(queue_size, 1))
             self._thread = threading.Thread(target=self._work, name="pftrack-render", daemon=True)
@@ -418,6 +421,13 @@ class TrackRenderer:
 
     def add(self, frame: NDArray[np.uint8], tracks: Iterable[TrackLike]) -> None:
         """Queue `frame` (BGR, not modified) with the tracks reported on it."""
+        if self._ended:
+            # was: queued for a worker that had stopped, silently, until the queue was full;
+            # then add() waited for room for ever
+            raise ValueError(
+                f"TrackRenderer.add: the renderer of {self.writer.path} is "
+                f"{self.writer.ended or 'closed'} already; make a new TrackRenderer for more frames"
+            )
         # checked here, in the caller's thread (was: a float frame drawn black without a word)
         frame = bgr_frame(frame, "TrackRenderer.add: frame")
         self._raise_worker_error()
@@ -472,6 +482,12 @@ class TrackRenderer:
         self.writer.write(image)
 
     def _work(self) -> None:
+        try:
+            self._work_queue()
+        finally:
+            self._finished.set()
+
+    def _work_queue(self) -> None:
         assert self._queue is not None
         while True:
             try:
@@ -494,19 +510,23 @@ class TrackRenderer:
     def _join(self) -> None:
         if self._thread is not None and self._queue is not None:
             self._put(None)
-            self._thread.join()
+            join_through_interrupts(self._thread, self._finished)  # not left inside OpenCV
             self._thread = None
 
     def close(self) -> Path:
         """Wait for the queued frames, finish the file and return its path."""
+        self._ended = True
         self._join()
         self._raise_worker_error()
         return self.writer.close()
 
     def abort(self) -> None:
-        """Stop without writing: the partial file is removed."""
-        self._join()
-        self.writer.abort()
+        """Stop without writing: the partial file is removed (a finished one stays)."""
+        self._ended = True
+        try:
+            self._join()
+        finally:  # an interrupt in the wait too: no partial file left
+            self.writer.abort()
 
     @property
     def n_frames(self) -> int:

@@ -1,4 +1,6 @@
+import signal
 import threading
+import time
 
 import pytest
 
@@ -57,3 +59,39 @@ def test_stopping_early_closes_the_source_and_the_thread():
 def test_bad_depth_is_refused(depth):
     with pytest.raises(ValueError, match="depth"):
         prefetch([1], depth=depth)
+
+
+def _ctrl_c_in(seconds: float) -> threading.Timer:
+    """A Ctrl-C to the main thread after `seconds` (there: a blocked wait is cut short)."""
+    main = threading.main_thread().ident
+    assert main is not None
+    timer = threading.Timer(seconds, signal.pthread_kill, (main, signal.SIGINT))
+    timer.start()
+    return timer
+
+
+def test_a_ctrl_c_while_closing_waits_for_the_producer_then_is_raised():
+    """Was: the KeyboardInterrupt cut the wait short and left the producer running.
+
+    ``pftrack track`` Ctrl-C'd twice: the second one came while the first one's cleanup waited
+    for the reader thread, which a process exiting meanwhile ended inside OpenCV's decoder:
+    "terminate called without an active exception", SIGABRT.
+    """
+    reading, read = threading.Event(), threading.Event()
+
+    def source():
+        yield 1
+        reading.set()
+        time.sleep(0.6)  # a frame's decoding: the producer sees its stop after it
+        read.set()
+        yield 2
+
+    it = prefetch(source(), depth=1)
+    assert next(it) == 1
+    assert reading.wait(timeout=10)
+    timer = _ctrl_c_in(0.2)
+    with pytest.raises(KeyboardInterrupt):
+        it.close()
+    timer.join()
+    assert read.is_set()
+    assert not [t for t in threading.enumerate() if t.name == "pftrack-prefetch" and t.is_alive()]

@@ -136,6 +136,37 @@ def test_a_failure_keeps_the_old_file_and_leaves_nothing(tmp_path: Path) -> None
     assert sorted(p.name for p in tmp_path.iterdir()) == ["v.mp4"]
 
 
+def test_a_closed_or_aborted_writer_is_one_clear_error(tmp_path: Path) -> None:
+    """A frame after ``close``/``abort``, or ``close`` after ``abort``: a ValueError naming it.
+
+    Was: ``write`` after ``close`` an AttributeError ('NoneType' object has no attribute
+    'write'); after a ``close`` without frames (OSError) a frame made a hidden file that
+    nothing removed; ``close`` after ``abort`` returned a path where no file was.
+    """
+    frame = _frames(1)[0]
+    done = VideoWriter(tmp_path / "done.mp4", 7)
+    assert done.ended is None
+    done.write(frame)
+    assert done.close() == tmp_path / "done.mp4" and done.ended == "closed"
+    assert done.close() == tmp_path / "done.mp4"  # closing again does nothing more
+    with pytest.raises(ValueError, match=r"^VideoWriter.write: video .*done.mp4 is closed already"):
+        done.write(frame)
+    done.abort()  # a finished file stays
+    assert done.ended == "closed" and decode(tmp_path / "done.mp4")[1]
+    empty = VideoWriter(tmp_path / "empty.mp4", 7)
+    with pytest.raises(OSError, match="nothing was written"):
+        empty.close()
+    with pytest.raises(ValueError, match=r"empty.mp4 is aborted already \(nothing was written\)"):
+        empty.write(frame)
+    dropped = VideoWriter(tmp_path / "dropped.avi", 7)
+    dropped.write(frame)
+    dropped.abort()
+    dropped.abort()  # twice: nothing more
+    with pytest.raises(ValueError, match=r"^VideoWriter.close: video .*dropped.avi is aborted"):
+        dropped.close()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["done.mp4"]
+
+
 def test_output_keeps_the_umask(tmp_path: Path, umask: int) -> None:
     for name in ("v.mp4", "v.avi"):
         with VideoWriter(tmp_path / name, 7) as writer:

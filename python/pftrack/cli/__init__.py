@@ -24,6 +24,7 @@ from pftrack.cli._signals import (
     NOTHING_CHANGED,
     Terminated,
     exit_status,
+    ignore_interrupts_to_exit,
     interrupts_held,
     line_end,
     outcome,
@@ -423,6 +424,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{prog}: error: {_one_line(exc)}{said}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:  # outputs are atomic: nothing half-written is left behind
+        ignore_interrupts_to_exit()  # handled: a second Ctrl-C would cut the exit short
         how = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         left = _shown(outcome(exc) or NOTHING_CHANGED)
         # the line break ends a progress bar's line, drawn only on a terminal

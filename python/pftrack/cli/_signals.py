@@ -27,6 +27,7 @@ __all__ = [
     "Terminated",
     "exit_status",
     "hold_interrupts",
+    "ignore_interrupts_to_exit",
     "interrupts_held",
     "line_end",
     "outcome",
@@ -110,6 +111,19 @@ def hold_interrupts() -> None:
     for sig in _stopping_signals():
         signal.signal(sig, signal.SIG_IGN)
     _held[0] = True
+
+
+def ignore_interrupts_to_exit() -> None:
+    """After the command has handled its interrupt: further Ctrl-C is ignored to the exit.
+
+    Only where the process ends with the command (:data:`PROCESS_ENDS`) and in the main
+    thread. What is left is saying the outcome and exiting, which joins the threads still
+    stopping (a reader's, the spread bootstrap's): a second Ctrl-C there printed a traceback,
+    or cut that join short and the process aborted ("terminate called without an active
+    exception") with a thread inside OpenCV.
+    """
+    if PROCESS_ENDS and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def interrupts_held() -> bool:

@@ -12,6 +12,7 @@ from collections.abc import Generator, Iterable
 from typing import TypeVar
 
 from pftrack._check import brief
+from pftrack._threads import join_through_interrupts
 
 __all__ = ["prefetch"]
 
@@ -51,6 +52,7 @@ def prefetch(items: Iterable[T], depth: int = 4) -> Generator[T, None, None]:
 def _read_ahead(items: Iterable[T], depth: int) -> Generator[T, None, None]:
     buffer: queue.Queue[object] = queue.Queue(maxsize=depth)
     stop = threading.Event()
+    finished = threading.Event()  # the producer's last act
 
     def put(item: object) -> bool:
         # wait for room, but give up when the consumer has gone
@@ -73,9 +75,12 @@ def _read_ahead(items: Iterable[T], depth: int) -> Generator[T, None, None]:
         except BaseException as error:  # handed to the consumer, raised there
             put(_Failed(error))
         finally:
-            close = getattr(it, "close", None)
-            if close is not None:
-                close()
+            try:
+                close = getattr(it, "close", None)
+                if close is not None:
+                    close()
+            finally:
+                finished.set()
 
     thread = threading.Thread(target=produce, name="pftrack-prefetch", daemon=True)
     thread.start()
@@ -89,4 +94,4 @@ def _read_ahead(items: Iterable[T], depth: int) -> Generator[T, None, None]:
             yield item  # type: ignore[misc]
     finally:
         stop.set()
-        thread.join()
+        join_through_interrupts(thread, finished)  # not left running by a second Ctrl-C

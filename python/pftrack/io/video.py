@@ -48,6 +48,7 @@ from numpy.typing import NDArray
 
 from pftrack._check import brief, number, path_arg, real, shown
 from pftrack._text import counted
+from pftrack._threads import wait_through_interrupts
 from pftrack._typing import PathLike, RealLike
 from pftrack._warn import warn_outside
 from pftrack.io.opencv_io import opencv_name, read_image, read_image_depth, utf8_name
@@ -2094,6 +2095,11 @@ class FrameSource:
                     second = tail.result()
                 except BaseException:
                     halt.set()
+                    # waited for through a second Ctrl-C: the pool's join, cut short, left its
+                    # thread inside OpenCV as the process exited, which aborted it
+                    done = threading.Event()
+                    tail.add_done_callback(lambda _: done.set())
+                    wait_through_interrupts(done)
                     raise
             if second is not None and len(check) == 2 and _same_frames(check, second[1]):
                 return head[: sum(i < middle for i in first)] + second[0]

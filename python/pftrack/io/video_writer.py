@@ -105,6 +105,8 @@ class VideoWriter:
         ``"h264"``, ``"mp4v"`` or ``"mjpeg"``.
     n_frames : int
         Frames written so far.
+    ended : {None, "closed", "aborted"}
+        None while frames are taken; then whether the file was finished or removed.
 
     Notes
     -----
@@ -154,6 +156,7 @@ class VideoWriter:
         self._container: Any = None
         self._stream: Any = None
         self._cv: Any = None
+        self._ended: str | None = None  # "closed" or "aborted": no frame is taken after it
         self._stack = contextlib.ExitStack()
         self._tmp: Path = self._stack.enter_context(atomic_path(self.path))
 
@@ -202,8 +205,10 @@ class VideoWriter:
             `frame` is not a NumPy uint8 array (a float or 16-bit frame is not cast: it would
             come out black or wrapped modulo 256).
         ValueError
-            `frame` is not (H, W, 3) with pixels, or not of the first frame's size.
+            `frame` is not (H, W, 3) with pixels, or not of the first frame's size; or the
+            writer is closed or aborted.
         """
+        self._refuse_if_ended("write")
         frame = bgr_frame(frame)
         if self._size is None:
             self._open(int(frame.shape[0]), int(frame.shape[1]))
@@ -238,18 +243,47 @@ class VideoWriter:
     def close(self) -> Path:
         """Finish the file and move it to `path`; return `path`.
 
+        Closing a closed writer again returns `path` and does nothing more.
+
         Raises
         ------
         OSError
             No frame was written.
+        ValueError
+            The writer was aborted (nothing is at `path`).
         """
+        if self._ended == "closed":
+            return self.path
+        self._refuse_if_ended("close")
         try:
             self._finish()
         except BaseException as exc:
+            self._ended = "aborted"  # the partial file is removed: nothing more to take
             self._stack.__exit__(type(exc), exc, exc.__traceback__)
             raise
+        self._ended = "aborted"  # until the file is in place (none without a frame: OSError)
         self._stack.close()
+        self._ended = "closed"
         return self.path
+
+    @property
+    def ended(self) -> str | None:
+        """None while the writer takes frames; ``"closed"`` or ``"aborted"`` after."""
+        return self._ended
+
+    def _refuse_if_ended(self, what: str) -> None:
+        """A ValueError naming `what` once the writer is closed or aborted.
+
+        Was: ``write`` after ``close`` an AttributeError ('NoneType' object has no attribute
+        'write'), or, after a ``close`` that found no frame, a new file left under its hidden
+        temporary name; ``close`` after ``abort`` returned a path where nothing was.
+        """
+        if self._ended is not None:
+            then = "" if self._ended == "closed" else " (nothing was written)"
+            raise ValueError(
+                f"VideoWriter.{what}: video {self.path} is {self._ended} already{then}; "
+                "open a new VideoWriter for more frames"
+            )
 
     def _finish(self) -> None:
         if self._stream is not None:
@@ -272,6 +306,8 @@ class VideoWriter:
             if self._cv is not None:
                 self._cv.release()
         self._container = self._cv = None
+        if self._ended != "closed":  # a finished file stays
+            self._ended = "aborted"
         error = RuntimeError("video aborted")
         self._stack.__exit__(RuntimeError, error, None)
 
