@@ -863,18 +863,21 @@ class MultiObjectTracker:
         unmatched = result.unmatched_detections
         beside = set() if detections is None else self._beside(boxes, labels, unmatched, cfg)
         twins = None if detections is None else _twins(boxes, labels, unmatched, cfg)
-        born_here: list[int] = []  # positions in `unmatched` of this frame's births
+        # the detections that explain an object: those matched to a track, and the births
+        explained = np.zeros(len(boxes), np.bool_)
+        explained[[di for _, di in result.matches]] = True
         for k, di in enumerate(unmatched):
             gate = gates.get(int(labels[di]), -np.inf)
             if hists[di].sum() <= 0 or scores[di] < gate or di in beside:
                 # no foreground colour to build a reference from, too unsure, or a second box
                 # on a person already followed (LifecycleConfig.birth_overlap)
                 continue
-            if twins is not None and twins[k, born_here].any():
-                # a second box on a person born this frame from a higher-scored box (the
-                # rows are in canonical_order: highest score first), e.g. a duplicate
+            if twins is not None and twins[k, explained].any():
+                # a second box on an object another detection of this frame explains: one
+                # matched to a track, or a higher-scored box that started one (the rows are
+                # in canonical_order, highest score first), e.g. the same box twice
                 continue
-            born_here.append(k)
+            explained[di] = True
             seed = int(self._rng.integers(2**63))
             t = LiveTrack(
                 next(self._ids), boxes[di].copy(), hists[di], born, seed, float(scores[di])
@@ -934,20 +937,19 @@ class MultiObjectTracker:
 
 def _twins(boxes: F64, labels: NDArray[np.int64], unmatched: Sequence[int],
            cfg: TrackerConfig) -> NDArray[np.bool_] | None:  # fmt: skip
-    """Which pairs of a frame's unmatched detections are boxes on one object.
+    """Which of a frame's detections each unmatched one lies on: boxes on one object.
 
-    ``out[i, j]``: ``unmatched[i]`` and ``unmatched[j]`` are of one class and overlap by an
-    IoU above ``LifecycleConfig.birth_overlap`` (the rule a birth beside a track follows),
-    e.g. the same box twice (a detector without non-maximum suppression, or two detectors'
-    outputs concatenated). None: the rule is off, or fewer than two detections.
+    ``out[i, j]``: ``unmatched[i]`` and detection ``j`` (any of the frame's) are of one class
+    and overlap by an IoU above ``LifecycleConfig.birth_overlap`` (the rule a birth beside a
+    track follows), e.g. the same box twice (a detector without non-maximum suppression, or
+    two detectors' outputs concatenated). None: the rule is off, or no two detections.
     """
     overlap = cfg.lifecycle.birth_overlap
-    if overlap is None or len(unmatched) < 2:
+    if overlap is None or not len(unmatched) or len(boxes) < 2:
         return None
     rows = np.asarray(unmatched, dtype=np.intp)
-    b = boxes[rows, :4]
-    out: NDArray[np.bool_] = (_iou_matrix(b, b) > overlap) & (
-        labels[rows][:, None] == labels[rows][None, :]
+    out: NDArray[np.bool_] = (_iou_matrix(boxes[rows, :4], boxes[:, :4]) > overlap) & (
+        labels[rows][:, None] == labels[None, :]
     )
     return out
 
