@@ -360,14 +360,19 @@ class LifecycleConfig:
         every sequence and scene of the built-in detector (docs/tracking.md, "Blind coasts end
         after 3 frames").
     birth_overlap : float or None
-        With given detections, a detection left unmatched that overlaps a confirmed track of its
-        class by an IoU above this starts no track: it is a second box on a person already
-        followed (a duplicate the detector's non-maximum suppression let through, or a part of
-        the person), which otherwise became a second track beside the first and, where the
-        two then swapped, an identity switch. The built-in detector's objects are left alone.
-        In (0, 1]; None: off. The default 0.3 was chosen over every sequence with public
-        detections (docs/tracking.md, "Births beside a tracked person"); 0.5 and above change
-        nothing there, since a detection that overlaps a track that much is matched to it.
+        With given detections, a detection left unmatched that overlaps by an IoU above this a
+        track of its class (confirmed or tentative), a detection of its class matched to a
+        track on this frame, or one of its class that started a track on this frame (higher
+        scored: births go highest score first) starts no track: it is a second box on a person
+        already followed (a duplicate the detector's non-maximum suppression let through, the
+        same box twice from a detector without it or from two detectors' outputs
+        concatenated, or a part of the person), which otherwise became a second track beside
+        the first and, where the two then swapped, an identity switch (until 6 December only
+        confirmed tracks counted, and each duplicated box started two tracks). The built-in
+        detector's objects are left alone. In (0, 1]; None: off. The default 0.3 was chosen
+        over every sequence with public detections (docs/tracking.md, "Births beside a
+        tracked person"); 0.5 and above change nothing there, since a detection that overlaps
+        a track that much is matched to it.
     size_ratio : float or None
         With given detections, the offline pass (with the smoother on) leaves out every track
         whose median box height is below `size_ratio`, or above ``1 / size_ratio``, times the

@@ -862,12 +862,22 @@ class MultiObjectTracker:
         born = cfg if detections is None else self._given_config  # given_particles
         unmatched = result.unmatched_detections
         beside = set() if detections is None else self._beside(boxes, labels, unmatched, cfg)
-        for di in unmatched:
+        twins = None if detections is None else _twins(boxes, labels, unmatched, cfg)
+        # the detections that explain an object: those matched to a track, and the births
+        explained = np.zeros(len(boxes), np.bool_)
+        explained[[di for _, di in result.matches]] = True
+        for k, di in enumerate(unmatched):
             gate = gates.get(int(labels[di]), -np.inf)
             if hists[di].sum() <= 0 or scores[di] < gate or di in beside:
                 # no foreground colour to build a reference from, too unsure, or a second box
                 # on a person already followed (LifecycleConfig.birth_overlap)
                 continue
+            if twins is not None and twins[k, explained].any():
+                # a second box on an object another detection of this frame explains: one
+                # matched to a track, or a higher-scored box that started one (the rows are
+                # in canonical_order, highest score first), e.g. the same box twice
+                continue
+            explained[di] = True
             seed = int(self._rng.integers(2**63))
             t = LiveTrack(
                 next(self._ids), boxes[di].copy(), hists[di], born, seed, float(scores[di])
@@ -884,20 +894,20 @@ class MultiObjectTracker:
 
     def _beside(self, boxes: F64, labels: NDArray[np.int64], unmatched: Sequence[int],
                 cfg: TrackerConfig) -> set[int]:  # fmt: skip
-        """Unmatched detections on a confirmed track of their class: they start no track.
+        """Unmatched detections on a track of their class: they start no track.
 
-        Those that overlap it by an IoU above ``LifecycleConfig.birth_overlap`` (given
-        detections only; the caller skips the built-in detector's).
+        Those that overlap a live track, confirmed or tentative, by an IoU above
+        ``LifecycleConfig.birth_overlap`` (given detections only; the caller skips the
+        built-in detector's). A tentative track counts too: a detector's duplicate of a box
+        that started a track a frame before is left unmatched beside it (was: confirmed
+        tracks only, and every duplicated box started two tracks that both lived on).
         """
         life = cfg.lifecycle
-        if life.birth_overlap is None or not len(unmatched):
-            return set()
-        confirmed = [t for t in self.tracks if t.hits >= life.min_hits]
-        if not confirmed:
+        if life.birth_overlap is None or not len(unmatched) or not self.tracks:
             return set()
         rows = np.asarray(unmatched, dtype=np.intp)
-        iou = _iou_matrix(boxes[rows, :4], np.array([t.box for t in confirmed]))
-        same = labels[rows][:, None] == np.array([t.cls for t in confirmed])[None, :]
+        iou = _iou_matrix(boxes[rows, :4], np.array([t.box for t in self.tracks]))
+        same = labels[rows][:, None] == np.array([t.cls for t in self.tracks])[None, :]
         hit = ((iou > life.birth_overlap) & same).any(axis=1)
         return set(rows[hit].tolist())
 
@@ -923,6 +933,25 @@ class MultiObjectTracker:
                 sampled.add(t.cls)
         for c in sampled:
             self._gains[c] = self.motion_gain(c)
+
+
+def _twins(boxes: F64, labels: NDArray[np.int64], unmatched: Sequence[int],
+           cfg: TrackerConfig) -> NDArray[np.bool_] | None:  # fmt: skip
+    """Which of a frame's detections each unmatched one lies on: boxes on one object.
+
+    ``out[i, j]``: ``unmatched[i]`` and detection ``j`` (any of the frame's) are of one class
+    and overlap by an IoU above ``LifecycleConfig.birth_overlap`` (the rule a birth beside a
+    track follows), e.g. the same box twice (a detector without non-maximum suppression, or
+    two detectors' outputs concatenated). None: the rule is off, or no two detections.
+    """
+    overlap = cfg.lifecycle.birth_overlap
+    if overlap is None or not len(unmatched) or len(boxes) < 2:
+        return None
+    rows = np.asarray(unmatched, dtype=np.intp)
+    out: NDArray[np.bool_] = (_iou_matrix(boxes[rows, :4], boxes[:, :4]) > overlap) & (
+        labels[rows][:, None] == labels[None, :]
+    )
+    return out
 
 
 def canonical_order(boxes: F64, scores: F64, labels: NDArray[np.int64]) -> NDArray[np.intp]:

@@ -1,0 +1,164 @@
+"""Duplicate detections (the same box twice in a frame) give one track, not two.
+
+A detector without non-maximum suppression, or two detectors' outputs concatenated, gives
+each object twice. Until 6 December every such pair started two tracks in the run's first
+frames (``LifecycleConfig.birth_overlap`` then refused only a birth on a confirmed track), and
+both lived on, each following one of the pair: 11-14 identities for 5 walkers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import pftrack
+from pftrack.cli import main
+from pftrack.eval import iou_xywh
+from pftrack.io.mot import group_by_frame, read_mot, write_mot
+from pftrack.synthetic import make_scene
+from pftrack.tracking import TrackerConfig
+from pftrack.tracking.api import xywh_to_xyxy_dets
+
+
+@pytest.fixture(scope="module", params=[1, 2])
+def scene(request):
+    """Seed 2: a walker entering at the right border, whose track's box grows behind its
+    detections, left its duplicate under IoU 0.3 with the track (a sixth identity, unless the
+    detection it duplicates, matched to the track, counts too)."""
+    return make_scene(n_frames=60, rng=request.param)
+
+
+def truth_dets(scene, twice=None, rng=0):
+    """Per-frame (N, 6) ``x1, y1, x2, y2, conf, cls`` from the truth; `twice` adds each box again.
+
+    ``"exact"``: the same row; ``"jitter"``: each corner moved by up to 2 px (inside the
+    frame; a sliver at a border is left as it is); ``"scores"``: the same box scored 0.6
+    instead of 0.9, placed first. Rows shuffled.
+    """
+    g = np.random.default_rng(rng)
+    by_frame = group_by_frame(scene.truth)
+    out = []
+    for f in range(1, len(scene.frames) + 1):
+        r = by_frame.get(f, np.zeros((0, 10)))
+        d = xywh_to_xyxy_dets(np.column_stack([r[:, 2:6], np.full(len(r), 0.9)]))
+        if twice is not None:
+            copy = d.copy()
+            if twice == "jitter":
+                wide = (d[:, 2:4] - d[:, :2] > 6.0).all(axis=1)[:, None]  # not a sliver at a border
+                copy[:, :4] += g.uniform(-2.0, 2.0, (len(d), 4)) * wide
+                copy[:, [0, 2]] = copy[:, [0, 2]].clip(0, scene.width)
+                copy[:, [1, 3]] = copy[:, [1, 3]].clip(0, scene.height)
+            if twice == "scores":
+                copy[:, 4] = 0.6
+            d = np.vstack([copy, d])  # the lower-scored copy first: order does not decide
+        d = d[g.permutation(len(d))] if twice != "scores" else d
+        out.append(np.column_stack([d, np.zeros(len(d))]))
+    return out
+
+
+def run(scene, dets, config=None):
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    if config is not None:
+        tracker = pftrack.Tracker.from_config(config, 0, prime_frames=0)
+    online = [tracker.update(d, f) for d, f in zip(dets, scene.frames, strict=True)]
+    return online, tracker.finalize()
+
+
+def lifecycle(**changes):
+    """The default TrackerConfig with `changes` to its LifecycleConfig."""
+    config = TrackerConfig()
+    return dataclasses.replace(config, lifecycle=dataclasses.replace(config.lifecycle, **changes))
+
+
+def ids(online):
+    return {int(r[4]) for out in online for r in out}
+
+
+@pytest.fixture(scope="module")
+def single(scene):
+    return run(scene, truth_dets(scene))
+
+
+@pytest.mark.parametrize("twice", ["exact", "jitter", "scores"])
+def test_each_box_twice_gives_the_identities_of_each_box_once(scene, single, twice):
+    online, rows = run(scene, truth_dets(scene, twice))
+    assert len(ids(single[0])) == len(np.unique(scene.truth[:, 1]))  # the test's premise
+    assert ids(online) == ids(single[0])  # was 11 for 5 walkers
+    if twice != "jitter":  # jittered boxes are other boxes: the offline pass may cut or
+        # join otherwise (seed 1: 4 identities, seed 2: 6; see the xfail below)
+        assert len(np.unique(rows[:, 1])) == len(np.unique(single[1][:, 1]))
+    if twice == "exact":  # the second copy changes nothing but the detection indices
+        np.testing.assert_array_equal(rows, single[1])
+        for a, b in zip(online, single[0], strict=True):
+            np.testing.assert_array_equal(a[:, :7], b[:, :7])
+
+
+@pytest.mark.xfail(
+    strict=True, reason="a duplicate is a free box for a neighbour's track to slide onto"
+)
+def test_jittered_duplicates_are_no_box_for_a_neighbour():
+    """Known limit. Make_scene seed 2, each box twice with 2 px jitter: on frame 60, where
+    walkers 1-4 crowd together, walker 3's track is matched to walker 1's spare copy, not to
+    its own box (the assignment found it cheaper), and the offline pass ends that row as a
+    one-row identity on walker 1 (IoU 0.96 with walker 1's track). The birth rules cannot
+    help: it is an association, not a birth. A suppression of duplicates before association
+    would, at an IoU above which two people's boxes never lie (no such constant is chosen)."""
+    scene = make_scene(n_frames=60, rng=2)
+    _, rows = run(scene, truth_dets(scene, "jitter"))
+    for frame_rows in group_by_frame(rows).values():
+        iou = iou_xywh(frame_rows[:, 2:6], frame_rows[:, 2:6])
+        assert (iou[np.triu_indices(len(iou), 1)] < 0.7).all()
+
+
+def test_a_duplicate_that_starts_no_track_is_in_no_row(scene):
+    """det_ind, as BoxMOT's: each row's index is the detection its track followed; a
+    suppressed duplicate is in no row. At birth that is the higher-scored box of the pair.
+    Both boxes pass the birth threshold here (the learned one would refuse the 0.6 box)."""
+    dets = truth_dets(scene, "scores")
+    online, _ = run(scene, dets, lifecycle(birth_quantile=None, birth_score=0.5))
+    first = online[0]
+    assert len(first) == len(dets[0]) // 2 == 1
+    det_ind = int(first[0, 7])
+    assert dets[0][det_ind, 4] == 0.9  # the 0.9 box, given second, not the 0.6 one
+    for out, d in zip(online, dets, strict=True):
+        assert len(set(out[:, 7].tolist())) == len(out)  # one detection, one track
+        assert set(out[:, 7].astype(int).tolist()) <= set(range(len(d)))
+
+
+def test_duplicates_are_two_tracks_with_the_rule_off(scene, single):
+    """birth_overlap=None turns the rule off, for duplicates too: each box starts two tracks."""
+    online, _ = run(scene, truth_dets(scene, "exact"), lifecycle(birth_overlap=None))
+    assert len(ids(online)) >= 2 * len(ids(single[0]))
+
+
+@pytest.mark.parametrize("start", [1, 2, 8])
+def test_a_second_box_beside_a_tentative_track_starts_no_track(start):
+    """A box overlapping the first by IoU 0.43 from frame `start`: in the same frame as the
+    first one's birth (1), beside its tentative track (2), or its confirmed one (8)."""
+    frame = np.zeros((80, 100, 3), np.uint8)
+    frame[20:60, 30:58] = (40, 60, 220)
+    box, second = [30.0, 20.0, 50.0, 60.0, 0.95, 0.0], [38.0, 20.0, 58.0, 60.0, 0.9, 0.0]
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    found = set()
+    for k in range(1, 15):
+        found |= {
+            int(r[4]) for r in tracker.update(np.array([box, second][: 1 + (k >= start)]), frame)
+        }
+    assert len(found) == 1
+
+
+def test_the_cli_keeps_one_track_per_duplicated_box(scene, tmp_path):
+    video = scene.write_video(tmp_path / "scene.avi")
+    det = scene.truth.copy()
+    det[:, 1], det[:, 6] = -1, 0.9
+    write_mot(tmp_path / "once.txt", det)
+    write_mot(tmp_path / "twice.txt", np.vstack([det, det]))
+    for name in ("once", "twice"):
+        det_path, out = tmp_path / f"{name}.txt", tmp_path / f"{name}_tracks.txt"
+        argv = ["-q", "track", str(video), "--detections", str(det_path), "--out", str(out)]
+        assert main(argv) == 0
+    once, twice = (read_mot(tmp_path / f"{n}_tracks.txt") for n in ("once", "twice"))
+    assert len(np.unique(once[:, 1])) >= len(np.unique(scene.truth[:, 1])) - 1
+    np.testing.assert_array_equal(twice, once)  # was: 11 and 12 tracks for 5 walkers
