@@ -584,10 +584,6 @@ class Tracker:
     #: The shape of the frames given to :meth:`prime` (None: not primed). A class default for
     #: a checkpoint pickled before it was kept.
     _primed: tuple[int, ...] | None = None
-    #: The working frames an unprimed run has kept so far to prime its background from, once
-    #: it has :attr:`prime_frames` of them (:meth:`_learn_background`); None: not (or no longer)
-    #: kept. A class default for a checkpoint pickled before the rule: off.
-    _learning: list[NDArray[np.uint8]] | None = None
 
     def __init__(
         self,
@@ -909,7 +905,6 @@ class Tracker:
             self._scale: F64 | None = None
             self._shape: tuple[int, ...] | None = None  # the run's frame shape
             self._primed = None  # the shape of the frames given to prime()
-            self._learning = []  # the first frames of an unprimed run (_learn_background)
             self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
             # the frame whose update was cut short after it changed the tracker (0: none)
             self._torn = 0
@@ -1033,43 +1028,6 @@ class Tracker:
             if self._tracker.frame_index == before:  # refused before any change
                 self._torn = 0
             raise
-
-    def _learn_background(
-        self, work: NDArray[np.uint8], frame: NDArray[np.uint8], given: bool
-    ) -> None:
-        """Keep an unprimed run's first frames; prime its background from them once it has all.
-
-        A run that :meth:`prime` did not start, with box refinement on and detections given on
-        every frame so far, keeps the working frames it takes (`work`, copied when it is the
-        caller's `frame`, whose buffer a reader may refill). Once it has :attr:`prime_frames`
-        of them, right after that frame's update, the background model is primed from them as
-        :meth:`prime` would have primed it before frame 1 (the per-pixel median, the moving
-        camera's check): unprimed, the model learnt these frames as their running mean,
-        people walking through included, and their ghosts were foreground to the refinement
-        of the frames after (docs/tracking.md, "A loop without prime"). Each frame's tracks
-        are still returned by its own ``update``; frames 1 to :attr:`prime_frames` are
-        tracked as before.
-        """
-        kept = self._learning
-        if kept is None:
-            return
-        refines = self.config.refine.enabled
-        if self._primed is not None or not refines or not given or not self.prime_frames:
-            self._learning = None  # primed, nothing to refine, or the built-in detector
-            return
-        kept.append(work.copy() if np.may_share_memory(work, frame) else work)
-        if len(kept) == self.prime_frames:
-            self._learning = None  # the frames go, primed or not
-            self._tracker.prime(kept)
-
-    def _no_online_prime(self) -> None:
-        """Keep this run's background as it learns (:meth:`_learn_background` off).
-
-        For ``pftrack track --bootstrap none``, whose run is not primed and whose foreground
-        may be computed ahead of the tracker on a thread (a background primed mid-run would
-        not be the one those frames were refined against).
-        """
-        self._learning = None
 
     def _restore_rows(self, rows: F64) -> F64:
         """MOTChallenge rows from working pixels to the frame's."""
@@ -1416,7 +1374,6 @@ class Tracker:
             self._max_conf = max(self._max_conf, confidence)
         self.frame_count += 1
         self._stood += stand_in
-        self._learn_background(work, f, dets is not None)
         if first:  # the run's size, once its first frame is taken
             self._shape = f.shape
         if self.record:
