@@ -97,6 +97,33 @@ def test_documented_loop_is_the_cli_byte_for_byte(name, tmp_path):
     assert (a.mota, a.idf1) == (b.mota, b.idf1)
 
 
+@pytest.mark.dataset
+@pytest.mark.xfail(
+    strict=True,
+    reason="unprimed, the background learns the first 30 frames' running mean, people walking "
+    "through them included: TUD-Campus 76.9 / 77.7 against the command's 79.4 / 85.4 (MOTA / "
+    "IDF1); priming online from the first 30 frames closed it there and lost on PETS09, not "
+    "adopted (docs/tracking.md, 'A loop without prime')",
+)
+def test_unprimed_loop_scores_the_commands():
+    # README: "prime is optional". A user's loop that does not call it (trial59)
+    folder = dataset("tud-campus")
+    gt = read_mot(folder / "gt.txt")
+    by_frame = group_by_frame(read_mot(folder / "det.txt"))
+    scores = []
+    for primed in (True, False):
+        tracker = pftrack.Tracker(frame_rate=25.0)
+        if primed:  # as pftrack track --detections
+            tracker.prime(itertools.islice(iter(FrameSource(folder / "video.mp4")), 30))
+        for n, frame in enumerate(FrameSource(folder / "video.mp4"), start=1):
+            r = by_frame.get(n, np.zeros((0, 10)))
+            tracker.update(np.column_stack([r[:, 2:4], r[:, 2:4] + r[:, 4:6], r[:, 6]]), frame)
+        scores.append(evaluate_mot(gt, tracker.finalize()))
+    command, loop = scores
+    assert command.mota > 0.79 and command.idf1 > 0.85  # the command's figures (README)
+    assert loop.mota >= command.mota - 0.003 and loop.idf1 >= command.idf1 - 0.003
+
+
 README = Path(__file__).resolve().parents[2] / "README.md"
 
 

@@ -198,8 +198,9 @@ class SupervisionTracker:
 
         Before the first update, with the video's first frames (``tracker.prime_frames`` of
         them are read), as ``pftrack track`` does: then the adapter's rows are the command's,
-        as the plain loop's are (unprimed, the first frames' boxes are refined against a
-        background still being learnt).
+        as the plain loop's are (unprimed, the background learns the first frames' running
+        mean, people walking through them included, and the boxes after are refined against
+        their ghosts: TUD-Campus 76.9 / 77.7 MOTA / IDF1 against the command's 79.4 / 85.4).
         """
         self.tracker.prime(frames)
 
