@@ -8,7 +8,11 @@ Given the same uniform draws, :func:`systematic_resample`, :func:`stratified_res
 :func:`multinomial_resample` return filterpy's indices, but for a multinomial draw of exactly
 0.0 (``Generator.random()`` gives one in 2**53): filterpy's ``searchsorted`` then picks
 particle 0 even when its weight is 0, these the first particle of weight > 0 (as they do the
-residual draws of :func:`residual_resample`). :func:`residual_resample` differs on
+residual draws of :func:`residual_resample`), and up to round-off: these divide the
+running sum of the weights by their total, filterpy compares it as it is, so where the
+weights' sum is not exactly 1 a draw within an ulp or two of a CDF step may pick the
+neighbouring particle (``[0.1] * 10``: the multinomial draw ``np.nextafter(0.2, 1)`` is
+particle 1 here, 2 in filterpy). :func:`residual_resample` differs on
 purpose: filterpy 2.0.0 draws the remainder from ``weights - floor(N*weights)`` where Liu &
 Chen's residuals are ``N*weights - floor(N*weights)`` (see its Notes), so only the
 ``floor(N*w_i)`` deterministic copies agree.
@@ -18,7 +22,7 @@ With ``rng=None`` each call draws fresh OS entropy, so ``np.random.seed`` does n
 reproducible: pass `rng` (a seed or a Generator). A ``numpy.random.RandomState`` is taken
 too (``numpy.random.default_rng`` wraps its bit generator, sharing its state): the same
 draws as filterpy seeded alike, ``rng=np.random.RandomState(0)`` giving the indices of
-``np.random.seed(0)`` then filterpy's function (residual resampling aside).
+``np.random.seed(0)`` then filterpy's function (residual resampling and round-off aside).
 """
 
 from __future__ import annotations
