@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import textwrap
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -306,3 +310,29 @@ def test_filterpy_agrees_up_to_round_off(monkeypatch):
             np.testing.assert_array_equal(theirs[:-1], np.arange(1, len(w)))
         else:
             np.testing.assert_array_equal(mine, theirs)
+
+
+def test_too_many_weights_refused_before_any_copy():
+    """A user trial: ``systematic_resample(np.broadcast_to(1.0, (2**31,)))`` copied 16 GB
+    before the core refused the size, and the multinomial and residual kernels had no size
+    check (their int32 indices would wrap). Refused first now, under a 2 GB address space."""
+    code = textwrap.dedent(
+        """
+        import resource, numpy as np
+        from pftrack import particle_filter as pf
+        w = np.broadcast_to(np.float32(1.0), (2**31,))  # no memory: one value, stride 0
+        resource.setrlimit(resource.RLIMIT_AS, (2 * 2**30, 2 * 2**30))
+        for name in ("systematic", "stratified", "multinomial", "residual"):
+            try:
+                getattr(pf, name + "_resample")(w, rng=0)
+            except ValueError as e:
+                print(e)
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    lines = out.stdout.splitlines()
+    assert len(lines) == 4, out.stderr[-500:]
+    for name, line in zip(
+        ("systematic", "stratified", "multinomial", "residual"), lines, strict=True
+    ):
+        assert line == f"{name}_resample: weights size is 2147483648, expected < 2^31 - 1"

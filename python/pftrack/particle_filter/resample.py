@@ -44,6 +44,10 @@ __all__ = [
 ]
 
 
+#: Weights a resampler takes, at most one fewer: the indices are int32 (filterpy's ``"i"``).
+MAX_WEIGHTS = 2**31 - 1
+
+
 def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
     """`weights` as a C-contiguous float64 array; errors start with `fn`, as the core's do."""
     if isinstance(weights, Iterator):  # NumPy makes a 0-d object array of it: "dtype object"
@@ -59,6 +63,8 @@ def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
         raise TypeError(f"{fn}: weights must be numeric, got dtype {w.dtype}")
     if w.ndim != 1:
         raise ValueError(f"{fn}: weights must be 1-D (N,), got shape {w.shape}")
+    if w.size >= MAX_WEIGHTS:  # before a copy of them (16 GB), and int32 indices overflow
+        raise ValueError(f"{fn}: weights size is {w.size}, expected < 2^31 - 1")
     return np.ascontiguousarray(w, dtype=np.float64)
 
 
@@ -91,8 +97,8 @@ def systematic_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     Notes
     -----
@@ -146,8 +152,8 @@ def stratified_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     References
     ----------
@@ -190,8 +196,8 @@ def multinomial_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     References
     ----------
@@ -240,8 +246,8 @@ def residual_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     Notes
     -----
