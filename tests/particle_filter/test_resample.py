@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import textwrap
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -281,3 +285,54 @@ def test_other_rngs_refuse_a_bool_too():
         ColourParticleFilter([20.0, 20, 10, 10], np.ones(110), rng=True)
     with pytest.raises(TypeError, match="RJMCMCFilter: rng must be .*, got bool False"):
         RJMCMCFilter(rng=False)
+
+
+def test_filterpy_agrees_up_to_round_off(monkeypatch):
+    """What docs/api.md qualifies: the same draws give filterpy's indices up to round-off.
+
+    filterpy's multinomial searches the running sum as it is (``[0.1] * 10``'s ends at
+    1 - 1.1e-16; its last value is set to 1), pftrack divides it by the total, so a draw one
+    ulp above a step picks the particle before it. Where the running sum is exact
+    (``[0.125] * 8``) every draw agrees. A user trial found one index of 10^7 apart where the
+    docs promised none.
+    """
+    pytest.importorskip("filterpy.monte_carlo")
+    from filterpy.monte_carlo import resampling  # noqa: PLC0415 (after the skip)
+
+    for w, apart in ((np.full(10, 0.1), True), (np.full(8, 0.125), False)):
+        u = np.append(np.nextafter(np.cumsum(w)[:-1], 1.0), 0.5)  # just above each step
+        monkeypatch.setattr(resampling, "random", lambda n, u=u: u[:n])
+        theirs = resampling.multinomial_resample(w)
+        mine = _core.multinomial_resample(w, u)
+        assert mine[-1] == theirs[-1]  # the draw 0.5, far from any step
+        if apart:
+            np.testing.assert_array_equal(mine[:-1], np.arange(len(w) - 1))
+            np.testing.assert_array_equal(theirs[:-1], np.arange(1, len(w)))
+        else:
+            np.testing.assert_array_equal(mine, theirs)
+
+
+def test_too_many_weights_refused_before_any_copy():
+    """A user trial: ``systematic_resample(np.broadcast_to(1.0, (2**31,)))`` copied 16 GB
+    before the core refused the size, and the multinomial and residual kernels had no size
+    check (their int32 indices would wrap). Refused first now, under a 2 GB address space."""
+    code = textwrap.dedent(
+        """
+        import resource, numpy as np
+        from pftrack import particle_filter as pf
+        w = np.broadcast_to(np.float32(1.0), (2**31,))  # no memory: one value, stride 0
+        resource.setrlimit(resource.RLIMIT_AS, (2 * 2**30, 2 * 2**30))
+        for name in ("systematic", "stratified", "multinomial", "residual"):
+            try:
+                getattr(pf, name + "_resample")(w, rng=0)
+            except ValueError as e:
+                print(e)
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    lines = out.stdout.splitlines()
+    assert len(lines) == 4, out.stderr[-500:]
+    for name, line in zip(
+        ("systematic", "stratified", "multinomial", "residual"), lines, strict=True
+    ):
+        assert line == f"{name}_resample: weights size is 2147483648, expected < 2^31 - 1"

@@ -10,13 +10,14 @@ with the same bits.
 
 from __future__ import annotations
 
+import re
 import time
 import tracemalloc
 
 import numpy as np
 import pytest
 
-from pftrack.recovery import fill, fill_gaps
+from pftrack.recovery import fill, fill_gaps, recover_gaps, registry
 from pftrack.recovery.calibrate import WINDOW_POINTS, GapWindows, gap_windows, recover_auto
 from pftrack.recovery.registry import METHODS
 
@@ -181,3 +182,42 @@ def test_eight_thousand_holes_in_seconds_not_gigabytes() -> None:
     assert rep.n_gaps == 8000 and len(out) == len(rows) + 8000
     assert peak < 100 * 2**20, f"peak {peak / 2**20:.0f} MB"
     assert time.perf_counter() - t0 < 120.0
+
+
+def test_holes_checked_in_one_batch_not_one_by_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A user trial: ``fill_gaps(rows, "linear")`` of 200 000 rows spent half its time checking
+    each hole's segments one at a time (``as_observed`` twice a hole), segments ``fill_gaps``
+    had checked already. Valid gaps are now checked in a few passes over all their rows
+    (:func:`pftrack.recovery.segments.checked_at_once`), with the same bits."""
+    rows = _one_track(300)
+    before = {m: fill_gaps(rows, m)[0] for m in ("linear", "rts", "gdt-bi")}
+    calls = []
+    real = registry.as_observed
+    monkeypatch.setattr(registry, "as_observed", lambda *a: calls.append(1) or real(*a))
+    for m, want in before.items():
+        np.testing.assert_array_equal(fill_gaps(rows, m)[0], want)
+    assert not calls
+
+
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        (lambda a, b: (a, b[::-1].copy()), "segment_b of gap 2 frames must increase"),
+        (lambda a, b: (a, np.vstack([a[-1:], b])), "gap 2: segment_b starts at frame"),
+        (lambda a, b: (a, b + [0, 2e9, 0, 0, 0]), "segment_b of gap 2 row 0 has x = 2"),
+        (lambda a, b: (a, b * [1, 1, 1, -1, 1]), "segment_b of gap 2 row 0 has w = -"),
+        (lambda a, b: (a, b + [2e5, 0, 0, 0, 0]), "gap 2: the gap from frame"),
+        (lambda a, b: (a, b + [0.5, 0, 0, 0, 0]), "segment_b of gap 2 row 0 has frame"),
+        (lambda a, b: (a, b * [1, np.nan, 1, 1, 1]), "segment_b of gap 2 has a non-finite"),
+    ],
+)
+def test_a_bad_gap_in_a_batch_is_still_named(bad, message: str) -> None:
+    """The batch check only says yes or no: a gap it refuses is named as before."""
+    rng = np.random.default_rng(4)
+    gaps = []
+    for k in range(5):
+        a = np.column_stack([np.arange(1.0, 6), rng.normal(100, 5, (5, 2)), np.full((5, 2), 9.0)])
+        b = a + [10 + k, 3, 3, 0, 0]
+        gaps.append(bad(a, b) if k == 2 else (a, b))
+    with pytest.raises(ValueError, match=re.escape(message)):
+        recover_gaps(gaps, "linear")

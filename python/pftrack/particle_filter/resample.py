@@ -8,7 +8,11 @@ Given the same uniform draws, :func:`systematic_resample`, :func:`stratified_res
 :func:`multinomial_resample` return filterpy's indices, but for a multinomial draw of exactly
 0.0 (``Generator.random()`` gives one in 2**53): filterpy's ``searchsorted`` then picks
 particle 0 even when its weight is 0, these the first particle of weight > 0 (as they do the
-residual draws of :func:`residual_resample`). :func:`residual_resample` differs on
+residual draws of :func:`residual_resample`), and up to round-off: these divide the
+running sum of the weights by their total, filterpy compares it as it is, so where the
+weights' sum is not exactly 1 a draw within an ulp or two of a CDF step may pick the
+neighbouring particle (``[0.1] * 10``: the multinomial draw ``np.nextafter(0.2, 1)`` is
+particle 1 here, 2 in filterpy). :func:`residual_resample` differs on
 purpose: filterpy 2.0.0 draws the remainder from ``weights - floor(N*weights)`` where Liu &
 Chen's residuals are ``N*weights - floor(N*weights)`` (see its Notes), so only the
 ``floor(N*w_i)`` deterministic copies agree.
@@ -18,7 +22,7 @@ With ``rng=None`` each call draws fresh OS entropy, so ``np.random.seed`` does n
 reproducible: pass `rng` (a seed or a Generator). A ``numpy.random.RandomState`` is taken
 too (``numpy.random.default_rng`` wraps its bit generator, sharing its state): the same
 draws as filterpy seeded alike, ``rng=np.random.RandomState(0)`` giving the indices of
-``np.random.seed(0)`` then filterpy's function (residual resampling aside).
+``np.random.seed(0)`` then filterpy's function (residual resampling and round-off aside).
 """
 
 from __future__ import annotations
@@ -40,6 +44,10 @@ __all__ = [
 ]
 
 
+#: Weights a resampler takes, at most one fewer: the indices are int32 (filterpy's ``"i"``).
+MAX_WEIGHTS = 2**31 - 1
+
+
 def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
     """`weights` as a C-contiguous float64 array; errors start with `fn`, as the core's do."""
     if isinstance(weights, Iterator):  # NumPy makes a 0-d object array of it: "dtype object"
@@ -55,6 +63,8 @@ def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
         raise TypeError(f"{fn}: weights must be numeric, got dtype {w.dtype}")
     if w.ndim != 1:
         raise ValueError(f"{fn}: weights must be 1-D (N,), got shape {w.shape}")
+    if w.size >= MAX_WEIGHTS:  # before a copy of them (16 GB), and int32 indices overflow
+        raise ValueError(f"{fn}: weights size is {w.size}, expected < 2^31 - 1")
     return np.ascontiguousarray(w, dtype=np.float64)
 
 
@@ -87,8 +97,8 @@ def systematic_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     Notes
     -----
@@ -142,8 +152,8 @@ def stratified_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     References
     ----------
@@ -186,8 +196,8 @@ def multinomial_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     References
     ----------
@@ -236,8 +246,8 @@ def residual_resample(
         ``numpy.ma.MaskedArray`` with a masked value (pass ``weights.filled(0)``), or `rng`
         not a Generator, a RandomState, a seed or None (a bool, a float, a string).
     ValueError
-        `weights` not 1-D (N,) with N >= 1, an entry negative or not finite, all entries 0,
-        or a sum that overflows; a negative seed.
+        `weights` not 1-D (N,) with 1 <= N < 2**31 - 1, an entry negative or not finite, all
+        entries 0, or a sum that overflows; a negative seed.
 
     Notes
     -----

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _check, _core
-from pftrack._check import MAX_COORD, MAX_FRAME
+from pftrack._check import MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64
 from pftrack.recovery.baselines import _BASELINES, RTS_HISTORY, _rts_batch
@@ -49,7 +49,7 @@ from pftrack.recovery.neighbours import (
 )
 from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, distinct_runs, split_rows
+from pftrack.recovery.segments import as_segment, distinct_runs, pairs_meet_rules, split_rows
 
 __all__ = [
     "CANDIDATES",
@@ -1176,18 +1176,7 @@ def _checked_at_once(pairs: Sequence[tuple[F64, F64]]) -> list[tuple[F64, F64]] 
     if sizes.min() == 0:
         return None
     X = np.concatenate([s[:, :3] for s in segs])
-    f = X[:, 0]
-    ends = np.cumsum(sizes)
-    inside = np.ones(len(f) - 1, dtype=bool)  # consecutive rows of one segment
-    inside[ends[:-1] - 1] = False
-    if not (
-        np.isfinite(X).all()
-        and (np.diff(f)[inside] > 0).all()
-        and np.abs(f).max() <= MAX_FRAME
-        and (f == np.floor(f)).all()
-        and np.abs(X[:, 1:]).max() <= MAX_COORD
-        and (f[ends[1::2] - sizes[1::2]] > f[ends[0::2] - 1]).all()
-    ):
+    if not pairs_meet_rules(X, sizes):
         return None
     parts = split_rows(X, sizes)
     return list(zip(parts[0::2], parts[1::2], strict=True))

@@ -71,6 +71,7 @@ from pftrack.recovery.problems import SegmentModel
 from pftrack.recovery.segments import (
     as_observed,
     as_segment,
+    checked_at_once,
     distinct_runs,
     gap_ends,
     gap_frames,
@@ -175,6 +176,9 @@ def _checked_pairs(gaps: Sequence[tuple[ArrayLike, ArrayLike]]) -> list[tuple[F6
             "recover_gaps: gaps must be a sequence of (segment_a, segment_b) pairs, got "
             f"{type(gaps).__name__}"
         ) from None
+    fast = checked_at_once(gaps)
+    if fast is not None:
+        return fast
     pairs = []
     for k, gap in enumerate(each):
         # "not enough values to unpack"; an int (a DataFrame's column labels): "has no len()"

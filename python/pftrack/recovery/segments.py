@@ -19,10 +19,16 @@ from pftrack._typing import F64
 #: bounded, as ``fill_gaps``' `max_gap` (:data:`pftrack.recovery.fill.MAX_GAP_LIMIT`) is.
 MAX_GAP_LIMIT = 100_000
 
+#: Gaps :func:`checked_at_once` checks together: its copies of their rows stay small (a
+#: ``fill_gaps`` hole's segments hold up to twice its windows' points, many times the rows of
+#: a track with many holes).
+CHECK_BLOCK = 256
+
 __all__ = [
     "MAX_GAP_LIMIT",
     "as_observed",
     "as_segment",
+    "checked_at_once",
     "consecutive_runs",
     "contiguous_head",
     "contiguous_tail",
@@ -30,6 +36,7 @@ __all__ = [
     "gap_ends",
     "gap_frames",
     "observed_segments",
+    "pairs_meet_rules",
     "split_rows",
 ]
 
@@ -105,6 +112,74 @@ def as_segment(seg: ArrayLike, name: str, fn: str = "recover_gap") -> F64:
     if np.any(np.diff(a[:, 0]) <= 0):
         raise ValueError(f"{fn}: {name} frames must increase strictly")
     return np.ascontiguousarray(a)
+
+
+def pairs_meet_rules(x: F64, sizes: NDArray[np.int64]) -> bool:
+    """Whether segments meet :func:`as_segment`'s rules on ``frame, x, y``, each B after its A.
+
+    `x` holds the ``frame, x, y`` rows of segments of `sizes` rows one after the other:
+    segment A, then segment B, of each gap in turn. A few passes over all the rows, for
+    callers that check a batch of gaps at once and, when this is False, gap by gap to name
+    what is wrong (:func:`checked_at_once`, ``calibrate.recover_auto``).
+    """
+    f = x[:, 0]
+    ends = np.cumsum(sizes)
+    step = np.diff(f)
+    step[ends[:-1] - 1] = 1.0  # from one segment to the next: not a step of either
+    return bool(
+        np.isfinite(x).all()
+        and (step > 0).all()
+        and np.abs(f).max() <= MAX_FRAME
+        and (f == np.floor(f)).all()
+        and np.abs(x[:, 1:]).max() <= MAX_COORD
+        and (f[ends[1::2] - sizes[1::2]] > f[ends[0::2] - 1]).all()
+    )
+
+
+def checked_at_once(gaps: object) -> list[tuple[F64, F64]] | None:
+    """The gaps as :func:`as_segment` and :func:`gap_ends` check them, all in a few passes.
+
+    When `gaps` is a list or tuple of pairs of non-empty C-contiguous float64 ``(k, 3)`` or
+    ``(k, 5)`` ndarrays that meet every rule of :func:`as_segment` (the arrays it returns are
+    these ones) and every segment B starts after its segment A within :data:`MAX_GAP_LIMIT`
+    frames: the pairs, each segment as given. Otherwise None: the caller checks gap by gap
+    and names what is wrong. ``fill_gaps`` passes every hole of a file as such a pair:
+    checked one segment at a time, they took half of ``fill_gaps(rows, "linear")`` on 200 000
+    rows with 40 000 holes (2.1-2.2 s of CPU, now 1.0-1.2 s).
+    """
+    if not isinstance(gaps, (list, tuple)) or not gaps:
+        return None
+    segs: list[F64] = []
+    for gap in gaps:
+        if not isinstance(gap, (list, tuple)) or len(gap) != 2:
+            return None
+        for seg in gap:
+            if not (
+                type(seg) is np.ndarray  # not a masked array, nor any other subclass
+                and seg.dtype == np.float64
+                and seg.ndim == 2
+                and seg.shape[1] in (3, 5)
+                and seg.shape[0] > 0
+                and seg.flags.c_contiguous
+            ):
+                return None
+            segs.append(seg)
+    for lo in range(0, len(segs), 2 * CHECK_BLOCK):  # copies of a block at a time, not all
+        block = segs[lo : lo + 2 * CHECK_BLOCK]
+        sizes = np.array([len(seg) for seg in block], dtype=np.int64)
+        x = np.concatenate([seg[:, :3] for seg in block])
+        if not pairs_meet_rules(x, sizes):
+            return None
+        f = x[:, 0]
+        ends = np.cumsum(sizes)
+        if (f[ends[1::2] - sizes[1::2]] - f[ends[0::2] - 1] - 1).max() > MAX_GAP_LIMIT:
+            return None
+        wh = [seg[:, 3:] for seg in block if seg.shape[1] == 5]
+        if wh:
+            w = np.concatenate(wh)
+            if not (np.isfinite(w).all() and w.min() >= 0 and w.max() <= MAX_COORD):
+                return None
+    return [(segs[k], segs[k + 1]) for k in range(0, len(segs), 2)]
 
 
 def as_observed(seg: ArrayLike, name: str, fn: str) -> F64:
