@@ -3642,6 +3642,37 @@ def test_a_symbolic_link_loop_is_named_as_one(
     assert "Traceback" not in err
 
 
+@pytest.mark.parametrize("command", ["track", "recover", "smooth"])
+@pytest.mark.parametrize("link", ["hard", "symbolic"])
+def test_one_file_under_two_names_is_the_same_input_given_twice(
+    tmp_path: Path, command: str, link: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A user trial: ``recover a.txt b.txt --out DIR``, ``b.txt`` a hard link of ``a.txt``,
+    ran it twice (a link of another name too): refused by (st_dev, st_ino), before any work."""
+    first = tmp_path / ("a.avi" if command == "track" else "a.txt")
+    if command == "track":
+        make_scene(n_frames=3, rng=0).write_video(first)
+    else:
+        write_mot(first, [[1, 1, 10, 10, 5, 5]])
+    second = first.with_stem("b")
+    if link == "hard":
+        os.link(first, second)
+    else:
+        second.symlink_to(first.name)
+    how = "one file, hard linked" if link == "hard" else "the same path once links are resolved"
+    said = f"{first} and {second} are the same input, given twice ({how}): give each input once"
+    with pytest.raises(ValueError, match=f"^{re.escape(said)}$"):
+        (find_sequences if command == "track" else find_track_files)([first, second])
+    argv = ["batch"] if command == "track" else [command]
+    out = tmp_path / "out"
+    assert main([*argv, str(first), str(second), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == f"pftrack {argv[0]}: error: {said}\n"
+    assert not out.exists()
+    copy = tmp_path / f"c{first.suffix}"  # the same bytes in another file: two inputs
+    shutil.copyfile(first, copy)
+    assert len((find_sequences if command == "track" else find_track_files)([first, copy])) == 2
+
+
 def test_the_same_input_twice_is_said_so(tmp_path: Path) -> None:
     """Was: "two inputs are both named 'tud' (A and A)"."""
     video = tmp_path / "vids" / "tud.mp4"

@@ -8,6 +8,7 @@ status 2, with the existing outputs byte for byte as they were and no stray temp
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
 from collections.abc import Callable
@@ -195,6 +196,68 @@ def test_bad_output_is_refused_before_any_work(
         assert lines[0] == f"pftrack {prog}: error: {said}"
     assert _snapshot(tmp_path) == before  # nothing changed, nothing left behind
     assert {k: p.read_bytes() for k, p in inputs.items()} == before_inputs
+
+
+def _read_only(monkeypatch: pytest.MonkeyPatch, folder: Path) -> None:
+    """Make `folder` act as on a read-only file system, as a user other than root sees it.
+
+    ``access()`` says no for writing, and creating a file or folder in it fails with EROFS.
+    """
+    inside = str(folder)
+    real_open, real_mkdir, real_access = os.open, os.mkdir, os.access
+
+    def under(path: Any) -> bool:
+        return os.path.dirname(os.path.abspath(os.fsdecode(path))) == inside
+
+    def open_(path: Any, flags: int, mode: int = 0o777, **kw: Any) -> int:
+        if under(path) and flags & os.O_CREAT:
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS), path)
+        return real_open(path, flags, mode, **kw)
+
+    def mkdir(path: Any, mode: int = 0o777, **kw: Any) -> None:
+        if under(path):
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS), path)
+        real_mkdir(path, mode, **kw)
+
+    def access(path: Any, mode: int, **kw: Any) -> bool:
+        if os.path.abspath(os.fsdecode(path)) == inside and mode & os.W_OK:
+            return False
+        return real_access(path, mode, **kw)
+
+    monkeypatch.setattr(os, "open", open_)
+    monkeypatch.setattr(os, "mkdir", mkdir)
+    monkeypatch.setattr(os, "access", access)
+
+
+@pytest.mark.parametrize("command", ["demo --out-dir", *COMMANDS])
+def test_an_output_on_a_read_only_file_system_says_so(
+    command: str,
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A user trial (EROFS): ``demo`` said "(Permission denied)", the other commands "not
+    writable", neither why."""
+    import pftrack.demo  # noqa: F401  imported unpatched: it binds track_frames at import
+    import pftrack.tracking as tracking
+
+    monkeypatch.setattr(tracking, "track_frames", _no_work)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "t_ok.txt").write_text("old tracks\n")
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    if command == "demo --out-dir":
+        argv = ["demo", "--out-dir", str(ro / "d"), "--frames", "5"]
+    else:
+        argv = COMMANDS[command](inputs, ro / GOOD_NAME.get(command, "out.txt"), tmp_path)
+    _read_only(monkeypatch, ro)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    prog = "experiment gaps" if command.startswith("experiment") else command.split()[0]
+    assert err.startswith(f"pftrack {prog}: error: {command.split()[1]} {ro}")
+    assert err.count("\n") == 1 and "(read-only file system)" in err, err
+    assert not any(ro.iterdir())
 
 
 def test_demo_refuses_a_file_as_its_folder_and_a_folder_as_an_output(

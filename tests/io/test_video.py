@@ -763,6 +763,31 @@ def test_stop_ends_the_iteration(tmp_path: Path) -> None:
     assert seen == [1, 2]
 
 
+@pytest.mark.parametrize("kind", ["folder", "video"])
+def test_a_read_begun_after_stop_is_refused(tmp_path: Path, kind: str) -> None:
+    """A user trial: after ``stop()`` a file's new iteration, and ``frames_at``, gave no frame
+    without a word. The stop stays (a run's later passes end with it), and says so."""
+    if kind == "folder":
+        for k in range(1, 6):
+            cv2.imwrite(str(tmp_path / f"{k}.png"), np.full((4, 4, 3), k, np.uint8))
+        path = tmp_path
+    else:
+        path = _mjpg(tmp_path / "v.avi", 5, np.random.default_rng(0))
+    src = FrameSource(path)
+    for n, _ in enumerate(src, start=1):
+        if n == 2:
+            src.stop()
+    assert n == 2
+    said = "^" + re.escape(f"{path}: stopped (FrameSource.stop() was called); a new FrameSource")
+    with pytest.raises(ValueError, match=said):
+        iter(src)  # at iter(), before a frame is asked for
+    with pytest.raises(ValueError, match=said):
+        src.frames_at([0, 3])
+    with pytest.raises(ValueError, match=said):
+        FrameSequence(src)[1]
+    assert len(list(FrameSource(path))) == len(FrameSource(path).frames_at(range(5))) == 5
+
+
 def _mjpg(path: Path, n: int, rng: np.random.Generator) -> Path:
     w = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 25, (64, 48))
     for _ in range(n):

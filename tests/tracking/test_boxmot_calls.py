@@ -72,9 +72,43 @@ def test_a_bad_frame_is_refused_before_the_embeddings_are_said(scene):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(TypeError, match="frame dtype is float32"):
-            tracker.update(_dets(scene, 1), scene.frames[0].astype(np.float32), [[0.0]])
+            tracker.update(
+                _dets(scene, 1), scene.frames[0].astype(np.float32), _embs(_dets(scene, 1))
+            )
     with pytest.warns(UserWarning, match="embs"):  # not spent by the refused call
-        tracker.update(_dets(scene, 1), scene.frames[0], [[0.0]])
+        tracker.update(_dets(scene, 1), scene.frames[0], _embs(_dets(scene, 1)))
+
+
+@pytest.mark.parametrize(
+    ("dets", "embs", "error", "message"),
+    [
+        (3, np.zeros((2, 512)), ValueError, r"embs has shape \(2, 512\), expected 3 rows, one per"),
+        (3, np.zeros((4, 512)), ValueError, r"embs has shape \(4, 512\), expected 3 rows"),
+        (0, np.zeros((1, 512)), ValueError, r"embs has shape \(1, 512\), expected 0 rows"),
+        (3, np.float32(1.0), TypeError, "embs is float32, expected a NumPy array with one row"),
+        (3, np.array(1.0), ValueError, r"embs has shape \(\), expected 3 rows"),
+        (None, np.array(1.0), ValueError, r"embs has shape \(\), expected \(N, D\)$"),
+        (3, [[0.0]] * 3, TypeError, "^Tracker.update: embs is list, expected a NumPy array"),
+        (3, "reid", TypeError, "embs is str"),
+    ],
+    ids=["fewer", "more", "no-dets", "scalar", "0-d", "0-d-no-dets", "list", "str"],
+)
+def test_embeddings_boxmot_would_refuse_are_refused(scene, dets, embs, error, message):
+    """A user trial: embs of another row count than dets were taken without a word (BoxMOT's
+    ReID trackers fail on them); refused before the tracker takes the frame."""
+    boxes = np.array([[10, 10, 40, 60, 0.9, 0], [60, 10, 90, 60, 0.9, 0], [20, 40, 50, 90, 0.8, 0]])
+    tracker = pftrack.Tracker()
+    with pytest.raises(error, match=message) as e:
+        tracker.update(None if dets is None else boxes[:dets], scene.frames[0], embs)
+    assert "\n" not in str(e.value) and tracker.frame_count == 0
+    with pytest.warns(UserWarning, match="embs"):  # matching rows still run, said once a run
+        tracker.update(boxes, scene.frames[0], np.zeros((3, 512)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tracker.update(boxes[:0], scene.frames[1], np.zeros((0, 512)))  # none, as a list too
+        tracker.update(boxes.tolist(), scene.frames[2], np.zeros((3, 512), np.float32))
+        tracker.update(boxes, scene.frames[3], None)
+    assert tracker.frame_count == 4
 
 
 # BoxMOT's keywords (apinames, 6 December): ``update(dets=..., img=..., embs=...)`` failed with

@@ -448,7 +448,8 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     ValueError
         No sequence is found (the error names deeper folders that hold some), or two have the
         same name (their outputs would collide), or one input is given twice (the same path
-        once links are resolved), or an input is a symbolic link loop (``a`` -> ``b`` -> ``a``).
+        once links are resolved, or hard links of one file), or an input is a symbolic link
+        loop (``a`` -> ``b`` -> ``a``).
 
     Warns
     -----
@@ -457,6 +458,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
         ``DIR``): they are not tracked; the warning names the folders that hold them.
     """
     paths = _absolute(inputs, _LIVE)
+    _refuse_given_twice(paths)
     found: list[SequenceInput] = []
     for path in paths:
         _check_exists(path)
@@ -543,9 +545,10 @@ def find_track_files(inputs: Inputs) -> list[Path]:
         listed: its task fails, named so).
     ValueError
         A folder holds no ``.txt`` file, or two files have the same name, or one is given
-        twice, or an input is a symbolic link loop.
+        twice (under any names: hard links too), or an input is a symbolic link loop.
     """
     paths = _absolute(inputs)
+    _refuse_given_twice(paths)
     found: list[Path] = []
     for path in paths:
         _check_exists(path)
@@ -700,11 +703,7 @@ def _check_names(names: list[str], sources: list[Path]) -> None:
         if name in RESERVED_NAMES:
             raise ValueError(f"{source}: the name {name!r} is reserved for the batch's own file")
         if name in seen and _same_file(seen[name], source):  # was: "both named" A and A
-            given = f"{source} is" if seen[name] == source else f"{seen[name]} and {source} are"
-            raise ValueError(
-                f"{given} the same input, given twice (the same path once links are resolved): "
-                "give each input once"
-            )
+            raise _given_twice(seen[name], source)
         if name in seen:
             named = _named_by(name, source)
             link = f"{named} NEWNAME{named.suffix if named.is_file() else ''}"
@@ -714,6 +713,33 @@ def _check_names(names: list[str], sources: list[Path]) -> None:
                 f"(symbolic links: ln -s {link})"
             )
         seen[name] = source
+
+
+def _refuse_given_twice(paths: list[Path]) -> None:
+    """Refuse a file or folder given twice under any names: hard links too (one inode).
+
+    Was: ``recover a.txt b.txt`` with ``b.txt`` a hard link of ``a.txt`` (or a symbolic link
+    of another name) ran it twice. Only the inputs as given: two sequences found in a folder
+    may share their frames (MOT17's three detectors' copies of one ``img1/``, linked).
+    """
+    seen: dict[tuple[int, int], Path] = {}
+    for path in paths:
+        try:
+            st = path.stat()
+        except OSError:  # missing, or a link loop: refused as such when it is looked at
+            continue
+        key = (st.st_dev, st.st_ino)
+        if key in seen:
+            raise _given_twice(seen[key], path)
+        seen[key] = path
+
+
+def _given_twice(first: Path, second: Path) -> ValueError:
+    """The error of one input given twice, as `first` and then as `second`."""
+    given = f"{second} is" if first == second else f"{first} and {second} are"
+    same = os.path.realpath(first) == os.path.realpath(second)
+    how = "the same path once links are resolved" if same else "one file, hard linked"
+    return ValueError(f"{given} the same input, given twice ({how}): give each input once")
 
 
 def _named_by(name: str, source: Path) -> Path:

@@ -724,21 +724,23 @@ def _check_folder_writable(target: Path, what: str) -> None:
         if folder.parent == folder:
             return  # no folder above it at all: its creation says why
         folder = folder.parent
-    try:
-        if not os.access(folder, os.W_OK | os.X_OK):
-            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+    try:  # tried before access(), whose no does not say why (a read-only file system)
         os.rmdir(tempfile.mkdtemp(prefix=".pftrack-probe-", dir=folder))
     except OSError as exc:
-        why = exc.strerror or str(exc)
-        if folder == target:
-            raise PermissionError(
-                f"{what} {target}: the folder is not writable ({why}): no output can be "
-                "written in it; write elsewhere"
-            ) from None
+        why = _cause(exc)
+    else:
+        if os.access(folder, os.W_OK | os.X_OK):
+            return
+        why = os.strerror(errno.EACCES)
+    if folder == target:
         raise PermissionError(
-            f"{what} {target}: cannot create the folder: {folder} is not writable ({why}); "
-            "write elsewhere"
-        ) from None
+            f"{what} {target}: the folder is not writable ({why}): no output can be "
+            "written in it; write elsewhere"
+        )
+    raise PermissionError(
+        f"{what} {target}: cannot create the folder: {folder} is not writable ({why}); "
+        "write elsewhere"
+    )
 
 
 def _remove_empty(folders: Iterable[Path]) -> None:
@@ -910,21 +912,35 @@ def _check_folder(written: Path, what: str, target: Path) -> None:
         if blocker is not None:  # was "folder notes.txt does not exist": it does, as a file
             raise NotADirectoryError(f"{what} {target}: {_not_a_folder(blocker)}")
         raise FileNotFoundError(f"{what} {target}: folder {folder} does not exist")
+    made: list[str] = []
+    with interrupts_deferred():  # the probe is gone before a Ctrl-C or a kill is raised
+        try:  # tried first: access() says yes to root on a special file system, and its no
+            # does not say why (a read-only file system)
+            fd, _ = _create_beside(folder, f".{written.name}.", ".probe", made)
+            os.close(fd)
+        except OSError as exc:
+            if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+                raise PermissionError(f"{what} {target}: not writable ({_cause(exc)})") from None
+            raise PermissionError(
+                f"{what} {target}: no file can be made in folder {folder} ({_cause(exc)})"
+            ) from None
+        finally:
+            _remove(made)
     if not os.access(folder, os.W_OK | os.X_OK) or (
         written.exists() and not os.access(written, os.W_OK)
     ):
         raise PermissionError(f"{what} {target}: not writable")
-    made: list[str] = []
-    with interrupts_deferred():  # the probe is gone before a Ctrl-C or a kill is raised
-        try:  # access() says yes to root on a read-only or special file system: try it
-            fd, _ = _create_beside(folder, f".{written.name}.", ".probe", made)
-            os.close(fd)
-        except OSError as exc:
-            raise PermissionError(
-                f"{what} {target}: no file can be made in folder {folder} ({exc.strerror or exc})"
-            ) from None
-        finally:
-            _remove(made)
+
+
+def _cause(exc: OSError) -> str:
+    """Why an output check's probe failed, for its message: a read-only file system by name.
+
+    Was "not writable", or "(Permission denied)" from ``pftrack demo``, on a read-only file
+    system: ``access()`` said no, which does not say why.
+    """
+    if exc.errno == errno.EROFS:
+        return "read-only file system"
+    return exc.strerror or str(exc)
 
 
 #: What :func:`interrupts_deferred` holds: Ctrl-C, and SIGTERM, which the ``pftrack`` command

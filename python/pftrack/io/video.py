@@ -1556,7 +1556,8 @@ class FrameSource:
         no frame; if two images of a folder have one number, or another size than the first,
         or are 16-bit where the first is 8-bit (when read); or if a MOTChallenge sequence's
         image folder is named by number and one is missing (a hole in the numbering, numbers
-        that do not start at 1 or a count other than ``seqLength``).
+        that do not start at 1 or a count other than ``seqLength``); if read (iterated,
+        :meth:`frames_at`) after :meth:`stop`.
 
     Warns
     -----
@@ -1581,7 +1582,8 @@ class FrameSource:
     A file or folder can be iterated any number of times. A live source can be iterated once,
     except that the first 64 frames are kept: a second iteration (the tracker primes its
     background model on the first frames, then tracks from frame 1) replays them and goes on
-    reading, as long as the first one stopped within them.
+    reading, as long as the first one stopped within them. :meth:`stop` ends the reads under
+    way and every later one.
     """
 
     def __init__(
@@ -1987,6 +1989,10 @@ class FrameSource:
         return self.n_frames
 
     def __iter__(self) -> Iterator[NDArray[np.uint8]]:
+        self._refuse_stopped()  # here, at iter(), not at the first next()
+        return self._iterate()
+
+    def _iterate(self) -> Generator[NDArray[np.uint8], None, None]:
         frames = self._iter_live() if self.live else self._iter_stored()
         try:
             for frame in frames:
@@ -2026,13 +2032,15 @@ class FrameSource:
         Raises
         ------
         ValueError
-            For a live source (it can only be read in order, once), or a negative index.
+            For a live source (it can only be read in order, once), a negative index, or a
+            source stopped (:meth:`stop`).
         """
         wanted = sorted({int(i) for i in indices})
         if wanted and wanted[0] < 0:
             raise ValueError(f"frame index is {wanted[0]}, expected >= 0")
         if self.live:
             raise ValueError(f"live source {self.name} cannot be read at chosen frames")
+        self._refuse_stopped()
         if not wanted:
             return []
         keep = prepare if prepare is not None else _as_read
@@ -2217,8 +2225,22 @@ class FrameSource:
             cap.release()
 
     def stop(self) -> None:
-        """End every iteration before its next frame (safe to call from a signal handler)."""
+        """End every read under way before its next frame (safe to call from a signal handler).
+
+        For good: a run reads a source in up to three passes (its bootstrap frames, a live
+        source's replay, the tracking pass), and one Ctrl-C ends them all. A read begun after
+        it (an iteration, :meth:`frames_at`, a :class:`FrameSequence` item) is a ValueError
+        naming the source (was: no frame, without a word); a new FrameSource reads it again.
+        """
         self.stopped = True
+
+    def _refuse_stopped(self) -> None:
+        """Raise the ValueError of a read begun after :meth:`stop`."""
+        if self.stopped:
+            raise ValueError(
+                f"{self.name}: stopped (FrameSource.stop() was called); "
+                "a new FrameSource reads it again"
+            )
 
     def _iter_stored(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._images is not None:
@@ -2501,6 +2523,7 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
             raise IndexError(f"frame index {index} is out of range for {counted(n, 'frame')}")
         if self._last is not None and self._last[0] == i:
             return self._last[1]
+        self.source._refuse_stopped()  # was: "the video ended after 0 frames"
         if self.source._images is not None:
             frame = self.source._read_image(self.source._images[i])
         elif self._stored is None:

@@ -398,6 +398,34 @@ def _the_frame(frame: object, img: object) -> tuple[Any, str]:
     return img, "img"
 
 
+def _check_embs(embs: object, dets: object) -> None:
+    """Refuse :meth:`Tracker.update`'s `embs` (not None) that BoxMOT's ReID trackers would.
+
+    Not used, but checked as they are taken: a NumPy array with one row per row of `dets`
+    (BoxMOT's ``(N, D)``; `dets` of no clear row count, None included, are not compared).
+    Was: any object, of any row count, taken without a word.
+
+    Raises
+    ------
+    TypeError
+        `embs` is not a NumPy array (a list, a tensor).
+    ValueError
+        `embs` has no rows (0-d), or another row count than `dets`.
+    """
+    if not isinstance(embs, np.ndarray):
+        raise TypeError(
+            f"Tracker.update: embs is {type(embs).__name__}, expected a NumPy array with one "
+            "row per row of dets (BoxMOT's (N, D) appearance embeddings) or None"
+        )
+    if isinstance(dets, np.ndarray):
+        rows = len(dets) if dets.ndim == 2 else None
+    else:
+        rows = len(dets) if isinstance(dets, (list, tuple)) else None
+    if embs.ndim == 0 or (rows is not None and len(embs) != rows):
+        want = "(N, D)" if rows is None else f"{rows} rows, one per row of dets"
+        raise ValueError(f"Tracker.update: embs has shape {embs.shape}, expected {want}")
+
+
 class _Alone:
     """``with``: take `lock` without waiting (RuntimeError naming ``Tracker.method`` if held).
 
@@ -1164,7 +1192,9 @@ class Tracker:
             BoxMOT's third argument, a detector's appearance embeddings: taken, so that a
             BoxMOT loop ``update(dets, frame, embs)`` runs unchanged, and not used (pftrack
             tells objects apart by their colour in `frame` and their motion), with one warning
-            a run when given (was: a TypeError naming no argument).
+            a run when given (was: a TypeError naming no argument). As BoxMOT's ReID trackers
+            take them: a NumPy array, one row per row of `dets` (TypeError, ValueError; was:
+            any object, of any row count, taken without a word).
         img : (H, W, 3) ndarray of uint8, keyword only
             `frame` under BoxMOT's name (its keyword call ``update(dets=..., img=...)``): give
             one of the two (TypeError when both or neither are given; an unknown keyword is
@@ -1204,14 +1234,16 @@ class Tracker:
         TypeError
             `dets` is a uint8 image (``update(frame, dets)``: the message says the arguments
             look swapped), or supervision's ``Detections`` (the message names
-            :class:`~pftrack.integrations.supervision.SupervisionTracker`); see `frame` and
-            `dets` for the others.
+            :class:`~pftrack.integrations.supervision.SupervisionTracker`); see `frame`,
+            `dets` and `embs` for the others.
         RuntimeError
             An earlier ``update`` of the run was cut short (KeyboardInterrupt, or an error
             inside the tracker) after it had changed the tracker: the run cannot go on, but
             :meth:`finalize` returns the frames before it and :meth:`reset` starts a new run.
         """
         frame, named = _the_frame(frame, img)
+        if embs is not None:
+            _check_embs(embs, dets)
         with self._alone("update"):
             warned = set(self._warned)
             with Held() as held:  # given once the frame is taken whole (python -W error)

@@ -298,6 +298,7 @@ def track_frames(
     # the warnings of update() (the detector's too, from its thread) name the line that called
     # track_frames, or track_path, not this module's loop
     tracker._caller_depth = _calls_from_here(sys._getframe(1))
+    _refuse_stopped(frames)
     if prime_frames > 0 and (detections is None or config.refine.enabled):
         if bootstrap == "auto":
             bootstrap = "spread" if detections is None else "first"
@@ -312,6 +313,7 @@ def track_frames(
             primer = bootstrap_frames(frames, prime_frames, bootstrap, split=threads)
             if primer:
                 tracker.prime(primer)
+    _refuse_stopped(frames)  # stopped while its bootstrap frames were read
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0
@@ -368,8 +370,7 @@ def track_frames(
                 on_frame(n, frame, tracker.last_reports, tracker.settled_rows(settled))
     _give(said, n + 1, 2 + tracker._caller_depth)  # those of reading on to the end
     if n == 0:  # a FrameSource by its name, not its repr
-        if getattr(source, "stopped", False):
-            raise ValueError(f"{getattr(source, 'name', source)}: stopped before its first frame")
+        _refuse_stopped(source)
         raise ValueError(f"no frame could be read from {getattr(source, 'name', source)}")
     if detections:
         unused = [f for f in detections if f > n and len(detections[f])]
@@ -380,6 +381,16 @@ def track_frames(
                 stacklevel=1 + tracker._caller_depth,
             )
     return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+
+
+def _refuse_stopped(source: Any) -> None:
+    """Raise "stopped before its first frame" for a source whose ``stop()`` was called.
+
+    Before a pass is begun, too: a read of a stopped :class:`FrameSource` is its own
+    ValueError, which names no frame.
+    """
+    if getattr(source, "stopped", False):  # a FrameSource by its name, not its repr
+        raise ValueError(f"{getattr(source, 'name', source)}: stopped before its first frame")
 
 
 # a warning the reader gave while reading frame k (1-based; one past the last: at the end)
