@@ -100,7 +100,7 @@ def test_runs_the_rule_leaves_alone_are_unchanged(scene, dets, kwargs):
     np.testing.assert_array_equal(out[0], out[1])
 
 
-@pytest.mark.filterwarnings("ignore:frame 4: dets=None runs the built-in")
+@pytest.mark.filterwarnings("ignore:frame 4. dets=None runs the built-in")
 def test_the_built_in_detector_stops_the_rule(scene, dets):
     """``dets=None`` on a frame of the window: from there the model learns as before (as if
     the rule had stopped after the frame before)."""
