@@ -85,7 +85,6 @@ from pftrack.detection.paper import PaperDetector
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter import HsvBinning
 from pftrack.recovery.linking import LinkConfig
-from pftrack.tracking.camera import CameraMotion as CameraCheck
 from pftrack.tracking.camera import Stabiliser
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.offline import (
@@ -585,12 +584,6 @@ class Tracker:
     #: The shape of the frames given to :meth:`prime` (None: not primed). A class default for
     #: a checkpoint pickled before it was kept.
     _primed: tuple[int, ...] | None = None
-    #: The working frames an unprimed run has taken so far, whose median its background is
-    #: (:meth:`_median_background`); None: not (or no longer) kept. A class default for a
-    #: checkpoint pickled before the rule: off.
-    _learning: list[NDArray[np.uint8]] | None = None
-    #: The camera check of those frames, fed one frame at a time (what ``prime`` checks).
-    _probe: CameraCheck | None = None
 
     def __init__(
         self,
@@ -912,8 +905,6 @@ class Tracker:
             self._scale: F64 | None = None
             self._shape: tuple[int, ...] | None = None  # the run's frame shape
             self._primed = None  # the shape of the frames given to prime()
-            self._learning = []  # the first frames of an unprimed run (_median_background)
-            self._probe = None
             self._prepared: tuple[NDArray[np.uint8], NDArray[np.uint8]] | None = None
             # the frame whose update was cut short after it changed the tracker (0: none)
             self._torn = 0
@@ -1031,66 +1022,12 @@ class Tracker:
         before = self._tracker.frame_index
         self._tracker.caller_depth = self._caller_depth + 1  # and this method
         self._torn = self.frame_count + 1  # until the frame's bookkeeping is done
-        kept = self._learning
-        taken = 0 if kept is None else len(kept)
         try:
-            self._median_background(work, xywh is not None)
             return self._tracker.update(work, xywh, cls, checked=xywh is not None)
         except BaseException:
             if self._tracker.frame_index == before:  # refused before any change
                 self._torn = 0
-                if kept is not None and len(kept) > taken:  # the frame was not taken
-                    kept.pop()
-                    self._learning = kept
             raise
-
-    def _median_background(self, work: NDArray[np.uint8], given: bool) -> None:
-        """Compare an unprimed run's first frames with the median of the frames so far.
-
-        A run that :meth:`prime` did not start, with box refinement on and detections given on
-        every frame so far, keeps the working frames it takes; before each of its first
-        :attr:`prime_frames` frames is refined, its background model is primed from the
-        frames taken so far, this one included (1, 2, ..., :attr:`prime_frames` of them), as
-        :meth:`prime` primes it (the per-pixel median; the moving camera's check, fed one
-        frame at a time). Unprimed before, the model learnt these frames as their running
-        mean, people walking through included, and their ghosts were foreground to the
-        refinement of the frames after (docs/tracking.md, "A loop without prime"). After frame
-        :attr:`prime_frames` the model goes on from the median of all of them, as a run
-        primed with them would have started; the frames are let go.
-        """
-        kept = self._learning
-        if kept is None:
-            return
-        detector = self._tracker.detector
-        refines = self.config.refine.enabled
-        if (
-            self._primed is not None or not refines or not given or not self.prime_frames
-            or not isinstance(detector, PaperDetector)
-        ):  # fmt: skip
-            # primed, nothing to refine, the built-in detector, or a model other than the
-            # paper's (OpenCV's MOG2 and KNN learn by repeating the frames: 30 times each)
-            self._learning = self._probe = None
-            return
-        camera = self._tracker.camera
-        if camera.mode != "off":  # prime's check_frames, one frame at a time
-            if self._probe is None:
-                self._probe = CameraCheck(camera.mode, camera.config)
-            if self._probe.update(work).moving:  # a moving camera has no empty scene
-                self._learning = self._probe = None
-                return
-        kept.append(work.copy())  # the caller's frame (or a view of it) may be refilled
-        if len(kept) >= self.prime_frames:
-            self._learning = self._probe = None  # the frames go
-        detector.prime(kept)
-
-    def _no_median_background(self) -> None:
-        """Keep this run's background as it learns (:meth:`_median_background` off).
-
-        For ``pftrack track --bootstrap none``, whose run is not primed and whose foreground
-        is computed ahead of the tracker on a thread (a background primed there would not
-        be the one those frames were refined against).
-        """
-        self._learning = self._probe = None
 
     def _restore_rows(self, rows: F64) -> F64:
         """MOTChallenge rows from working pixels to the frame's."""

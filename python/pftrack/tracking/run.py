@@ -312,8 +312,6 @@ def track_frames(
             primer = bootstrap_frames(frames, prime_frames, bootstrap, split=threads)
             if primer:
                 tracker.prime(primer)
-    if tracker._primed is None:  # --bootstrap none, prime_frames 0: a background as it learns
-        tracker._no_median_background()
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0
