@@ -1401,7 +1401,7 @@ class Tracker:
             self._given = True
             life = self.config.lifecycle
             scored = xywh[:, 4] >= life.min_score
-            if life.size_ratio is not None and scored.any():
+            if self.record and life.size_ratio is not None and scored.any():  # finalize's
                 box = xywh[scored]
                 c = np.zeros(len(box)) if cls is None else cls[scored].astype(np.float64)
                 foot, at = box[:, 1] + box[:, 3], np.full(len(box), float(self.frame_count))
