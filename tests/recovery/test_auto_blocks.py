@@ -75,9 +75,8 @@ def test_a_bad_gap_of_a_later_block_is_named_by_its_place(monkeypatch: pytest.Mo
 
 
 def test_peak_is_a_blocks_not_every_gaps(monkeypatch: pytest.MonkeyPatch) -> None:
-    """6406 gaps of 100 walkers (``gdt-mix`` chosen): 31.4 MiB of peak in one block (main's
-    code: every gap's copies, windows and temporaries: 30.1 MiB in this test), 7.8 in blocks of
-    256."""
+    """6406 gaps of 100 walkers (``gdt-mix`` chosen): main's code (every gap's copies, windows
+    and temporaries at once) peaked at 30.1 MiB here, blocks of 256 gaps at 7.8."""
     rows = _walkers(100, 400)
     seg = np.column_stack([rows[:, 0], rows[:, 2:4]])
     w = gap_windows(seg[:, 0], rows[:, 1])
