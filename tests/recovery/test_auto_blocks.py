@@ -15,7 +15,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from pftrack.recovery import calibrate, fill_gaps, recover_gaps
+from pftrack.recovery import calibrate, fill, fill_gaps, recover_gaps
 from pftrack.recovery.calibrate import gap_windows, recover_auto
 
 
@@ -97,3 +97,23 @@ def test_peak_is_a_blocks_not_every_gaps(monkeypatch: pytest.MonkeyPatch) -> Non
         tracemalloc.stop()
     assert len(paths) == len(pairs) > 6000 and cal.pooled != "linear"
     assert peak < 9 * 2**20, f"peak {peak / 2**20:.1f} MiB (31.4 in one block)"
+
+
+@pytest.mark.parametrize("method", fill.BLOCK_METHODS)
+def test_named_methods_blocks_change_no_bit(monkeypatch: pytest.MonkeyPatch, method: str) -> None:
+    """The batched named methods fill a block of holes at a time too, with the same bits."""
+    rows = _walkers(6, 120)
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 10**9)
+    want, rep = fill_gaps(rows, method)  # type: ignore[arg-type]
+    assert rep.n_gaps > 100
+    calls: list[int] = []
+
+    def spy(gaps, *args, **kwargs):  # type: ignore[no-untyped-def]
+        calls.append(len(gaps))
+        return recover_gaps(gaps, *args, **kwargs)
+
+    monkeypatch.setattr(fill, "recover_gaps", spy)
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 7)
+    got, _ = fill_gaps(rows, method)  # type: ignore[arg-type]
+    assert got.tobytes() == want.tobytes()
+    assert max(calls) == 7 and sum(calls) == rep.n_gaps

@@ -1301,7 +1301,9 @@ def recover_auto(
     Parameters
     ----------
     pairs : sequence of (segment_a, segment_b)
-        Segments around each gap (rows ``frame, x, y[, w, h]``).
+        Segments around each gap (rows ``frame, x, y[, w, h]``), read :data:`RECOVER_BLOCK`
+        gaps at a time (sliced), twice: the calibration reads every gap's length, distance
+        and context first, then each block is checked and recovered.
     observed : sequence of (k, 3+) ndarray, optional
         Every observed track of the file, for calibration; default: the segments of `pairs`.
     noise, motion : optional
