@@ -64,6 +64,14 @@ class Neighbourhood:
         self._frame, self._xy = stacked[:, 0], stacked[:, 1:3]
         self._cache: dict[tuple[float, ...], list[Window]] = {}  # each "-nb" method asks
 
+    def forget(self) -> None:
+        """Drop the windows found so far (each is found again, the same, when asked again).
+
+        :func:`~pftrack.recovery.calibrate.recover_auto` forgets them after each block of
+        gaps, so they take a block's memory, not every gap's.
+        """
+        self._cache.clear()
+
     def windows(self, segment_a: F64, segment_b: F64, exclude: int = -1) -> list[Window]:
         """The neighbours of the gap between `segment_a` and `segment_b`, cut like it.
 
