@@ -276,6 +276,27 @@ def test_a_signal_during_the_output_check_leaves_no_probe(
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="signals cannot be blocked")
+def test_a_signal_during_the_output_folder_check_leaves_no_probe_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same for an output folder's probe (a folder made and removed): was left behind."""
+    from pftrack.io.atomic import check_output_folder
+
+    rmdir = os.rmdir
+
+    def signalled_then_rmdir(path: str) -> None:
+        if ".pftrack-probe-" in str(path):  # the probe made, not yet removed
+            signal.raise_signal(signal.SIGINT)
+        rmdir(path)
+
+    monkeypatch.setattr(os, "rmdir", signalled_then_rmdir)
+    with pytest.raises(KeyboardInterrupt):
+        check_output_folder(tmp_path / "out", "--out")
+    monkeypatch.undo()
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("mode", [0o600, 0o640])
 def test_replacing_a_file_keeps_its_permissions(tmp_path: Path, umask, mode: int) -> None:
     """A file the user restricted stays restricted: not reset to the umask's 0o644."""

@@ -725,7 +725,8 @@ def _check_folder_writable(target: Path, what: str) -> None:
             return  # no folder above it at all: its creation says why
         folder = folder.parent
     try:  # tried before access(), whose no does not say why (a read-only file system)
-        os.rmdir(tempfile.mkdtemp(prefix=".pftrack-probe-", dir=folder))
+        with interrupts_deferred():  # the probe is gone before a Ctrl-C or a kill is raised
+            os.rmdir(tempfile.mkdtemp(prefix=".pftrack-probe-", dir=folder))
     except OSError as exc:
         why = _cause(exc)
     else:
