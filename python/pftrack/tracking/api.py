@@ -83,10 +83,9 @@ from pftrack.detection.blocking import BLOCK_FRAMES, blockiness, is_blocky
 from pftrack.detection.light import BLANK_LEVELS, is_blank
 from pftrack.detection.paper import PaperDetector
 from pftrack.detection.size_model import PersonSizeModel
-from pftrack.particle_filter import HsvBinning
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.camera import Stabiliser
-from pftrack.tracking.config import LifecycleConfig, TrackerConfig
+from pftrack.tracking.config import LifecycleConfig, TrackerConfig, hsv_disagrees
 from pftrack.tracking.offline import (
     BoxSmoother,
     CrossingConfig,
@@ -685,9 +684,8 @@ class Tracker:
         burn_in = integer(burn_in, "burn_in", 0, MAX_BURN_IN)
         moves = _moves(moves)
         base = TrackerConfig()
-        if isinstance(detector, (PaperConfig, Mog2Config, KnnConfig)) and detector.hsv not in (
-            HsvBinning(),
-            base.binning,
+        if isinstance(detector, (PaperConfig, Mog2Config, KnnConfig)) and hsv_disagrees(
+            detector, base.binning
         ):  # TrackerConfig's message says to set binning, which this class does not take
             raise ValueError(
                 f"detector's hsv is {detector.hsv}, but the detector bins colour as the tracker "

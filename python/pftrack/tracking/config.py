@@ -159,6 +159,16 @@ _DETECTOR_NAMES: dict[type, DetectorName] = {
 }
 
 
+def hsv_disagrees(detector: PaperConfig | Mog2Config | KnnConfig, binning: HsvBinning) -> bool:
+    """Whether settings given as a detector bin colour unlike a tracker of `binning`.
+
+    The foreground bins and the histograms share one layout: the detector's `hsv` must be
+    ``HsvBinning()`` (replaced by `binning`) or `binning` itself. ``TrackerConfig`` and
+    ``Tracker`` test this one condition, each saying what its caller can set.
+    """
+    return detector.hsv != HsvBinning() and detector.hsv != binning
+
+
 def _detector_settings_agree(config: TrackerConfig) -> None:
     """Refuse settings given as `config.detector` that `config`'s own would contradict.
 
@@ -169,7 +179,7 @@ def _detector_settings_agree(config: TrackerConfig) -> None:
     d = config.detector
     assert not isinstance(d, str)
     kind = type(d).__name__
-    if d.hsv != HsvBinning() and d.hsv != config.binning:
+    if hsv_disagrees(d, config.binning):
         raise ValueError(
             f"TrackerConfig: detector's hsv is {d.hsv}, but the detector bins colour as the "
             f"tracker does: set binning={d.hsv} and leave the {kind}'s hsv at its default"
