@@ -416,3 +416,94 @@ def test_a_batch_signalled_between_a_sequences_renames_writes_it_whole(
     assert (out / "a.txt").read_bytes() == (whole / "a.txt").read_bytes()
     assert _batch(two_videos, out) == 0  # a re-run skips a and makes b
     assert _statuses(out) == {"a": "skipped", "b": "done"}
+
+
+def _folder_at_the_second_rename(monkeypatch: pytest.MonkeyPatch, targets: set[Path]) -> list[str]:
+    """``os.replace`` onto the second of `targets` renamed onto first puts a folder in its place
+    (as if a user or a program had made one there while the run went on).
+
+    Returns the names of the targets renamed onto (the writers' own renames pass).
+    """
+    import os
+
+    real, renamed = os.replace, []
+
+    def replace(src: Any, dst: Any) -> None:
+        if Path(dst) in targets:
+            renamed.append(Path(dst).name)
+            if len(renamed) == 2 and not Path(dst).is_dir():
+                Path(dst).unlink()
+                Path(dst).mkdir()
+        real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    return renamed
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")  # a 20-frame scene's notes, not the subject
+def test_track_whose_second_rename_fails_puts_the_first_output_back(
+    inputs: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``track --out t.txt --render v.mp4``: a folder in place of the second output renamed
+    fails the run and the first keeps the earlier run's bytes and mode. Was: the first stayed
+    new beside the earlier video, the user's old tracks gone."""
+    import os
+    import stat
+
+    out, video = tmp_path / "t.txt", tmp_path / "v.mp4"
+    for path in (out, video):
+        path.write_bytes(EARLIER)
+        path.chmod(0o600)
+    renamed = _folder_at_the_second_rename(monkeypatch, {out, video})
+    argv = ["-q", "track", str(inputs["video"]), "--out", str(out), "--render", str(video),
+            "--particles", "20"]  # fmt: skip
+    assert main(argv) == 2
+    monkeypatch.undo()
+    first, second = (tmp_path / n for n in renamed[:2])
+    assert first.read_bytes() == EARLIER and stat.S_IMODE(os.stat(first).st_mode) == 0o600
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: cannot replace output {second} (Is a directory); no output file "
+        "was changed\n"
+    )
+    assert second.is_dir()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt", "v.mp4"]  # no backup left
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")  # 10-frame scenes: few tracks confirmed
+def test_a_batch_sequence_whose_rename_fails_keeps_its_earlier_outputs(
+    two_videos: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A folder put in place of ``a.mp4`` as a's outputs are renamed: a fails (its error names
+    ``a.mp4``), ``a.txt`` keeps the earlier bytes, its sidecar says ``writing``, b goes on
+    (skipped: done by the first run); a re-run once the folder is gone makes a. Was: ``a.txt``
+    new beside the old video."""
+    out = tmp_path / "out"
+    argv = ["-q", "batch", str(two_videos), "--out", str(out), "--workers", "0",
+            "--particles", "20", "--render"]  # fmt: skip
+    assert main(argv) == 0
+    for name in ("a.txt", "a.mp4"):
+        (out / name).write_bytes(EARLIER)  # changed since: a is made again
+    renamed = _folder_at_the_second_rename(monkeypatch, {out / "a.txt", out / "a.mp4"})
+    capsys.readouterr()
+    status = main(argv)
+    monkeypatch.undo()
+    assert status == 1, capsys.readouterr().err
+    assert renamed[:2] == ["a.txt", "a.mp4"]
+    summary = {e["name"]: e for e in json.loads((out / "summary.json").read_text())["sequences"]}
+    assert summary["a"]["status"] == "failed" and summary["b"]["status"] == "skipped"
+    assert (out / "a.txt").read_bytes() == EARLIER and (out / "a.mp4").is_dir()
+    assert summary["a"]["error"] == (
+        f"writing its outputs: cannot replace output {out / 'a.mp4'} (Is a directory); no "
+        "output file was changed"
+    )
+    assert json.loads((out / "a.json").read_text())["status"] == "writing"
+    assert not [p.name for p in out.iterdir() if p.name.startswith(".")]  # no backup left
+    (out / "a.mp4").rmdir()
+    assert main(argv) == 0
+    assert _statuses(out) == {"a": "done", "b": "skipped"}

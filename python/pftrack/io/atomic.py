@@ -21,7 +21,8 @@ interrupted. Nothing else sets that flag: a program that imports pftrack writes 
 
 Several outputs of one run (:func:`staged_outputs`) are renamed in one step that Ctrl-C and
 SIGTERM cannot split (:func:`interrupts_deferred`): one that comes meanwhile is raised after
-the last rename.
+the last rename. A rename that fails puts back every target renamed before it, from a hidden
+backup (``.NAME.<hex>.old``, a hard link) removed afterwards: all new, or all as they were.
 """
 
 from __future__ import annotations
@@ -1094,6 +1095,131 @@ def _as_targets(exc: OSError, staged: Iterable[tuple[str, Path]]) -> OSError | N
     return OSError(text)
 
 
+#: Suffix of the hidden backup (``.NAME.<hex>.old``) that keeps a target's earlier contents
+#: while :func:`staged_outputs` renames a run's outputs into place.
+BACKUP_SUFFIX = ".old"
+
+
+def _back_up(target: Path, listed: list[str]) -> tuple[str | None, bool]:
+    """Keep what `target` holds reachable under a new hidden name beside it.
+
+    Returns that name (None: nothing kept) and whether `target` was moved there.
+
+    A hard link (no copy, and `target` stays in place); where the file system makes none
+    (``EPERM``, ``EOPNOTSUPP``, too many links), `target` itself is renamed to the new name,
+    over an empty file :func:`_create_beside` made for it. The name is appended to `listed`
+    before it is made, as :func:`_create_beside` does. None when there is nothing to keep: no
+    `target`, or a folder (its rename fails, and says why). A symbolic link put in the
+    target's place is kept as a link.
+    """
+    try:
+        st = os.lstat(target)
+    except FileNotFoundError:
+        return None, False
+    if stat.S_ISDIR(st.st_mode):
+        return None, False
+    folder = target.parent if str(target.parent) else Path(".")
+    prefix = f".{target.name}."
+    for _ in range(100):
+        path = os.path.join(folder, _temp_name(prefix, secrets.token_hex(6), BACKUP_SUFFIX))
+        listed.append(path)
+        try:
+            os.link(target, path, follow_symlinks=False)
+        except FileExistsError:
+            listed.pop()  # another's file (a backup a kill -9 left)
+            continue
+        except OSError:
+            listed.pop()  # no hard links here: the target itself moves
+            break
+        return path, False
+    else:
+        raise FileExistsError(f"cannot create a backup file in {folder}")
+    fd, path = _create_beside(folder, prefix, BACKUP_SUFFIX, listed)
+    os.close(fd)
+    os.replace(target, path)
+    return path, True
+
+
+def _commit(staged: list[tuple[str, Path, str]]) -> None:
+    """Rename each staged file over its target; one that fails puts every target back.
+
+    Parameters
+    ----------
+    staged : list of (str, Path, str)
+        Each temporary file, the target it replaces, and the output as the caller named it.
+
+    Each existing target is first kept under a backup name (:func:`_back_up`). When all are
+    renamed, the backups are removed. When a step fails (a folder put in a target's place
+    meanwhile), each target renamed before it gets its earlier file back (the same file:
+    its bytes, mode, owner and other hard links), a target that did not exist is removed
+    again, and the backups are removed; then an OSError of the failure's class names the
+    output that failed. A backup that cannot be put back (its place taken meanwhile) is
+    kept, and the message says where. Run under :func:`interrupts_deferred`: no interrupt
+    comes between two of these steps.
+    """
+    listed: list[str] = []  # every backup, from before it exists
+    backups: list[tuple[str | None, bool]] = []  # each target's, and whether it was moved
+    renamed = 0  # targets replaced
+    try:
+        for _, target, _ in staged:
+            backups.append(_back_up(target, listed))
+        for tmp, target, _ in staged:
+            os.replace(tmp, target)
+            renamed += 1
+    except BaseException as exc:
+        kept = _roll_back(staged, backups, listed, renamed)
+        if not isinstance(exc, OSError):
+            raise
+        failed = len(backups) if len(backups) < len(staged) else renamed  # the step that failed
+        raise _commit_error(exc, staged[failed][2], kept) from None
+    _remove(listed)
+
+
+def _roll_back(
+    staged: list[tuple[str, Path, str]],
+    backups: list[tuple[str | None, bool]],
+    listed: list[str],
+    renamed: int,
+) -> list[tuple[str, str]]:
+    """Put every target of a failed :func:`_commit` back as it was; remove the backups.
+
+    The first `renamed` targets were replaced: each gets its backup back, or is removed when
+    it had none (a new output). The others were not: a backup made by moving the target is
+    moved back, one made by a hard link is removed. Returns the (output, backup) pairs whose
+    backup could not be put back (kept).
+    """
+    kept: list[tuple[str, str]] = []
+    for k in reversed(range(len(staged))):
+        _, target, name = staged[k]
+        backup, moved = backups[k] if k < len(backups) else (None, False)
+        try:
+            if k < renamed and backup is None:
+                os.unlink(target)  # a new output: there was none before
+            elif backup is not None and (k < renamed or moved):
+                os.replace(backup, target)  # the earlier file back, whole
+        except OSError:
+            if backup is not None:
+                kept.append((name, backup))
+    _remove(b for b in listed if all(b != backup for _, backup in kept))
+    return kept
+
+
+def _commit_error(exc: OSError, name: str, kept: list[tuple[str, str]]) -> OSError:
+    """The one-line error of a failed :func:`_commit`: the output that failed, and why."""
+    why = exc.strerror or str(exc)
+    if kept:
+        left = ", ".join(f"{n}, whose earlier contents are kept in {b}" for n, b in kept)
+        text = f"cannot replace output {name} ({why}); every output file was put back but {left}"
+    else:
+        text = f"cannot replace output {name} ({why}); no output file was changed"
+    try:
+        err = type(exc)(text)
+    except Exception:  # noqa: BLE001 - a class that takes other arguments
+        err = OSError(text)
+    err.errno = exc.errno
+    return err
+
+
 @contextlib.contextmanager
 def staged_outputs(
     on_commit: Callable[[], object] | None = None,
@@ -1110,8 +1236,17 @@ def staged_outputs(
     the last is done, so the targets are then all new (was: a ``KeyboardInterrupt`` between two
     renames left some new and some old). `on_commit`, if given, is called right after the last
     rename, before such an interrupt is raised: the caller learns that its outputs are in place.
-    A rename that fails (a folder put in a target's place meanwhile) stops the others: the
-    targets renamed before it stay new. A symbolic link replaces the file it leads to; a
+    Before the renames each existing target is kept under a hidden backup name beside it,
+    ``.NAME.<hex>.old`` (a hard link, no copy; where the file system makes none, the target
+    itself is renamed there): a rename that fails (a folder put in a target's place meanwhile)
+    puts every target renamed before it back (the earlier file itself: its bytes and mode),
+    removes those that did not exist, and raises an OSError naming the output that failed
+    (``cannot replace output v.mp4 (Is a directory); no output file was changed``; was: the
+    targets renamed before it stayed new, the earlier ones lost). The backups are removed
+    whatever the outcome, also after a Ctrl-C or SIGTERM; only a ``kill -9`` during the
+    renames can leave one (with the earlier contents; without hard links, the only copy of a
+    target then missing), which no later run reads or removes: a hidden name, never an input,
+    never chosen again. A symbolic link replaces the file it leads to; a
     device, FIFO or descriptor gets its file's bytes written into it: a device before the
     renames (one that fails, ``/dev/full``, leaves every target as it was), a pipe, FIFO or
     socket after them (its reader may wait for the files, or stop early).
@@ -1123,6 +1258,7 @@ def staged_outputs(
     ...     write_annotated_video(stage("video.mp4"), frames, rows)
     """
     staged: list[tuple[str, Path]] = []
+    given: dict[str, str] = {}  # each staged file's output as the caller named it
     made: list[str] = []  # every temporary file beside a target, from before it exists
     through: list[tuple[Path, _Target]] = []  # devices, FIFOs, descriptors: written at the end
     scratch: list[str] = []  # the temporary folder of their files, made when first needed
@@ -1142,6 +1278,7 @@ def staged_outputs(
         with _named(path, hidden=True):  # a read-only file system, a folder not writable
             fd, tmp = _create_beside(folder, f".{target.stem}.", suffix or ".tmp", made)
         staged.append((tmp, target))
+        given[tmp] = os.fsdecode(os.fspath(path))
         try:
             _keep_mode(fd, target)
         finally:
@@ -1161,8 +1298,7 @@ def staged_outputs(
         for tmp, target in staged:
             _keep_mode(tmp, target)  # again: a writer may have made the file anew
         with interrupts_deferred():  # one step: a Ctrl-C or SIGTERM is raised after the last
-            for tmp, target in staged:
-                os.replace(tmp, target)
+            _commit([(tmp, target, given[tmp]) for tmp, target in staged])
             if on_commit is not None:
                 on_commit()
         _write_through([item for item, late in zip(through, streams, strict=True) if late])
