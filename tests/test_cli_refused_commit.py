@@ -449,7 +449,8 @@ def test_track_whose_second_rename_fails_puts_the_first_output_back(
 ) -> None:
     """``track --out t.txt --render v.mp4``: a folder in place of the second output renamed
     fails the run and the first keeps the earlier run's bytes and mode. Was: the first stayed
-    new beside the earlier video, the user's old tracks gone."""
+    new beside the earlier video, the user's old tracks gone. A backup an earlier run's
+    ``kill -9`` left is neither read nor touched."""
     import os
     import stat
 
@@ -457,6 +458,8 @@ def test_track_whose_second_rename_fails_puts_the_first_output_back(
     for path in (out, video):
         path.write_bytes(EARLIER)
         path.chmod(0o600)
+    stale = tmp_path / ".t.txt.0123456789ab.old"
+    stale.write_bytes(b"older")
     renamed = _folder_at_the_second_rename(monkeypatch, {out, video})
     argv = ["-q", "track", str(inputs["video"]), "--out", str(out), "--render", str(video),
             "--particles", "20"]  # fmt: skip
@@ -468,8 +471,8 @@ def test_track_whose_second_rename_fails_puts_the_first_output_back(
         f"pftrack track: error: cannot replace output {second} (Is a directory); no output file "
         "was changed\n"
     )
-    assert second.is_dir()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt", "v.mp4"]  # no backup left
+    assert second.is_dir() and stale.read_bytes() == b"older"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [stale.name, "t.txt", "v.mp4"]
 
 
 @pytest.mark.filterwarnings("ignore::UserWarning")  # 10-frame scenes: few tracks confirmed

@@ -194,3 +194,21 @@ def test_a_backup_a_kill_left_is_neither_read_nor_touched(
         stage(a).write_bytes(b"new a")
     assert a.read_bytes() == b"new a" and stale.read_bytes() == b"older a"
     assert _names(tmp_path) == [stale.name, "a.txt"]
+
+
+def test_a_pipe_gets_nothing_when_a_rename_fails(tmp_path: Path, links: str) -> None:
+    """A FIFO is written after the renames (module notes): after a failed one, never."""
+    a, b, fifo = tmp_path / "a.txt", tmp_path / "b.mp4", tmp_path / "fifo"
+    a.write_bytes(b"old a")
+    os.mkfifo(fifo)
+    reader = os.open(fifo, os.O_RDONLY | os.O_NONBLOCK)  # the writer's open does not wait
+    try:
+        with pytest.raises(IsADirectoryError, match=_failed(b)), staged_outputs() as stage:
+            stage(fifo).write_bytes(b"rows")
+            stage(a).write_bytes(b"new a")
+            stage(b).write_bytes(b"new b")
+            b.mkdir()
+        assert os.read(reader, 100) == b""
+    finally:
+        os.close(reader)
+    assert a.read_bytes() == b"old a" and _names(tmp_path) == ["a.txt", "b.mp4", "fifo"]

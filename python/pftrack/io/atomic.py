@@ -1124,7 +1124,10 @@ def _back_up(target: Path, listed: list[str]) -> tuple[str | None, bool]:
         path = os.path.join(folder, _temp_name(prefix, secrets.token_hex(6), BACKUP_SUFFIX))
         listed.append(path)
         try:
-            os.link(target, path, follow_symlinks=False)
+            if os.link in os.supports_follow_symlinks:  # a link put there: the link itself
+                os.link(target, path, follow_symlinks=False)
+            else:
+                os.link(target, path)
         except FileExistsError:
             listed.pop()  # another's file (a backup a kill -9 left)
             continue
