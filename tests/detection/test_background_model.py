@@ -305,3 +305,98 @@ def test_a_bad_pickled_state_is_refused():
     state[3] = state[3][:-4]  # a background one float short
     with pytest.raises(ValueError, match="^BackgroundModel.__setstate__: background size is 59"):
         _core.BackgroundModel.__new__(_core.BackgroundModel).__setstate__(tuple(state))
+
+
+@pytest.mark.parametrize("first", [True, False])
+def test_covered_pixels_are_not_learnt_while_the_model_learns(first):
+    # cover (a detector's boxes, the learning phase only): covered pixels keep their value,
+    # the others take the running mean of the frames they were learnt in (per-pixel counts);
+    # the reference bit for bit, and a pixel never covered as without a cover
+    rng = np.random.default_rng(7)
+    kw = {"n_learn": 5, "alpha": 0.05}
+    model, ref = _core.BackgroundModel(**kw), BackgroundReference(**kw)
+    frames = random_scene(rng, shape=(30, 41), steps=9)
+    covers = []
+    for i, frame in enumerate(frames):
+        cover = np.zeros((30, 41), np.uint8)
+        cover[3 + i : 15 + i, 5 + 2 * i : 12 + 2 * i] = 1
+        cover = cover if first or i > 0 else None
+        covers.append(cover)
+        before = model.background
+        _, mask = model.apply(frame, bins=False, cover=cover)
+        _, rmask = ref.apply(frame, cover=cover)
+        np.testing.assert_array_equal(mask, rmask)
+        np.testing.assert_array_equal(model.background, ref.background)
+        if before is not None and model.frame_count <= 5 and cover is not None:
+            np.testing.assert_array_equal(model.background[cover != 0], before[cover != 0])
+    never = ~np.any([c != 0 for c in covers if c is not None], axis=0)
+    assert never.any() and not never.all()
+    # the pixels no box covered learnt as without a cover until the phase's end (after it,
+    # the selective update depends on each pixel's background)
+    again, free = _core.BackgroundModel(**kw), _core.BackgroundModel(**kw)
+    for frame, cover in zip(frames[:5], covers[:5], strict=True):
+        again.apply(frame, cover=cover)
+        free.apply(frame)
+    np.testing.assert_array_equal(again.background[never], free.background[never])
+    # a pixel covered on frames 1-2 only is the mean of frames 3-5 (rate 1 on frame 3)
+    cov = np.zeros((30, 41), np.uint8)
+    cov[:10] = 1
+    m = _core.BackgroundModel(**kw)
+    for k, frame in enumerate(frames[:5]):
+        m.apply(frame, cover=cov if k < 2 else None)
+    mean = np.mean([f.astype(np.float32) for f in frames[2:5]], axis=0)
+    np.testing.assert_allclose(m.background[:10], mean[:10], atol=1e-3)
+
+
+def test_cover_is_ignored_after_prime_and_after_the_learning_phase():
+    rng = np.random.default_rng(8)
+    frames = random_scene(rng, shape=(20, 24), steps=8)
+    cover = np.ones((20, 24), np.uint8)
+    for start in ("prime", "learnt"):
+        a, b = _core.BackgroundModel(n_learn=3), _core.BackgroundModel(n_learn=3)
+        if start == "prime":
+            for m in (a, b):
+                m.set_background(frames[0].astype(np.float32))
+            rest = frames[1:]
+        else:
+            for m in (a, b):
+                for f in frames[:3]:
+                    m.apply(f)
+            rest = frames[3:]
+        for f in rest:
+            (_, ma), (_, mb) = a.apply(f, cover=cover), b.apply(f)
+            np.testing.assert_array_equal(ma, mb)
+        np.testing.assert_array_equal(a.background, b.background)
+
+
+def test_a_model_pickled_while_counting_goes_on_as_the_original():
+    import pickle
+
+    rng = np.random.default_rng(9)
+    frames = random_scene(rng, shape=(16, 20), steps=8)
+    cover = np.zeros((16, 20), np.uint8)
+    cover[4:9, 3:11] = 1
+    a = _core.BackgroundModel(n_learn=6)
+    for f in frames[:3]:
+        a.apply(f, cover=cover)
+    b = pickle.loads(pickle.dumps(a))
+    state = list(a.__getstate__())
+    old = _core.BackgroundModel.__new__(_core.BackgroundModel)
+    old.__setstate__(tuple(state[:6]))  # pickled before the cover: no counts, still loads
+    for f in frames[3:]:
+        a.apply(f, cover=cover)
+        b.apply(f, cover=cover)
+    np.testing.assert_array_equal(a.background, b.background)
+    state[6] = state[6][:-4]
+    with pytest.raises(ValueError, match="learnt size is 319"):
+        _core.BackgroundModel.__new__(_core.BackgroundModel).__setstate__(tuple(state))
+
+
+def test_a_cover_of_the_wrong_shape_or_type_is_refused():
+    model = _core.BackgroundModel()
+    frame = np.zeros((10, 12, 3), np.uint8)
+    model.apply(frame)
+    with pytest.raises(ValueError, match="^BackgroundModel.apply: cover: mask must have the frame"):
+        model.apply(frame, cover=np.zeros((10, 11), np.uint8))
+    with pytest.raises(TypeError, match="mask dtype is float64"):
+        model.apply(frame, cover=np.zeros((10, 12)))
