@@ -102,7 +102,7 @@ void register_detection(py::module_& m) {
         .def(
             "apply",
             [](BackgroundModel& self, const py::object& frame_in, bool bins,
-               std::optional<py::array> hold, std::optional<py::array> cover) {
+               std::optional<py::array> hold) {
                 const char* fn = "BackgroundModel.apply";
                 const bind::InUse busy(&self, fn);
                 const py::array frame = bind::bgr_image(frame_in, fn, "frame");
@@ -119,13 +119,6 @@ void register_detection(py::module_& m) {
                     hptr = static_cast<const std::uint8_t*>(hold->data());
                     hstride = hold->strides(0);
                 }
-                const std::uint8_t* cptr = nullptr;
-                Index cstride = 0;
-                if (cover) {
-                    bind::check_mask(*cover, rows, cols, "BackgroundModel.apply: cover");
-                    cptr = static_cast<const std::uint8_t*>(cover->data());
-                    cstride = cover->strides(0);
-                }
                 std::shared_ptr<BinnedImage> img;
                 if (bins) img = std::make_shared<BinnedImage>(rows, cols, self.binning().n_bins());
                 auto mask = new_mask(rows, cols);
@@ -137,16 +130,14 @@ void register_detection(py::module_& m) {
                     // safe: raw buffers kept alive by the caller / owned here; the model is not
                     // shared between threads by pftrack (one model per video)
                     py::gil_scoped_release nogil;
-                    self.apply(src, rows, cols, stride, bptr, mptr, hptr, hstride, cptr, cstride);
+                    self.apply(src, rows, cols, stride, bptr, mptr, hptr, hstride);
                 }
                 return py::make_tuple(bins ? py::cast(img) : py::none(), mask);
             },
             py::arg("frame"), py::arg("bins") = true, py::arg("hold") = py::none(),
-            py::arg("cover") = py::none(),
             "frame (H, W, 3) uint8 BGR -> (BinnedImage of all pixels, or None without bins; raw "
             "mask (H, W) uint8: 255 foreground, 127 shadow, 0 background). hold (H, W) uint8/bool: "
-            "candidates where != 0 are not learnt. cover (H, W) uint8/bool: during the learning "
-            "phase, pixels where != 0 are not learnt (each pixel's rate from its own count).")
+            "candidates where != 0 are not learnt.")
         .def(
             "blend",
             [](BackgroundModel& self, const py::object& frame_in, const py::object& mask_in,
@@ -264,13 +255,11 @@ void register_detection(py::module_& m) {
                                    s.threshold_scale),
                     bytes(s.background.data(), s.background.size() * sizeof(float)),
                     bytes(s.previous.data(), s.previous.size()),
-                    bytes(s.hist.data(), s.hist.size() * sizeof(std::int64_t)),
-                    bytes(s.learnt.data(), s.learnt.size() * sizeof(float)));
+                    bytes(s.hist.data(), s.hist.size() * sizeof(std::int64_t)));
             },
             [](const py::tuple& t) {
                 const char* fn = "BackgroundModel.__setstate__";
-                // 6: pickled before the learning phase's cover (no per-pixel counts)
-                require(t.size() == 6 || t.size() == 7, fn, "state size", t.size(), 7);
+                require(t.size() == 6, fn, "state size", t.size(), 6);
                 const auto c = t[0].cast<py::tuple>(), h = t[1].cast<py::tuple>(),
                            k = t[2].cast<py::tuple>();
                 require(c.size() == 9 && h.size() == 5 && k.size() == 6, fn,
@@ -299,13 +288,6 @@ void register_detection(py::module_& m) {
                 std::memcpy(s.background.data(), bg.data(), bg.size());
                 s.previous.assign(prev.begin(), prev.end());
                 std::memcpy(s.hist.data(), hist.data(), hist.size());
-                if (t.size() == 7) {
-                    const std::string learnt = t[6].cast<std::string>();
-                    require(learnt.size() % sizeof(float) == 0, fn,
-                            "the state is not a pickled BackgroundModel's");
-                    s.learnt.resize(learnt.size() / sizeof(float));
-                    std::memcpy(s.learnt.data(), learnt.data(), learnt.size());
-                }
                 model.restore(std::move(s));
                 return model;
             }))

@@ -66,31 +66,17 @@ class BackgroundModel:
     # 255 foreground, 127 shadow, 0 background)
     # bins=False: no bins (None), for a caller that bins only the pixels it keeps (hsv_bins);
     # hold (H, W) uint8/bool: candidates where it is not 0 are not learnt (rate 0)
-    # cover (H, W) uint8/bool: in the learning phase (n_learn), pixels where it is not 0 are
-    # not learnt, and each pixel's rate is max(1 / n, alpha) for its n-th learnt frame
     @overload
     def apply(
-        self,
-        frame: NDArray[np.uint8],
-        bins: Literal[True] = True,
-        hold: ArrayLike | None = None,
-        cover: ArrayLike | None = None,
+        self, frame: NDArray[np.uint8], bins: Literal[True] = True, hold: ArrayLike | None = None
     ) -> tuple[BinnedImage, NDArray[np.uint8]]: ...
     @overload
     def apply(
-        self,
-        frame: NDArray[np.uint8],
-        bins: Literal[False],
-        hold: ArrayLike | None = None,
-        cover: ArrayLike | None = None,
+        self, frame: NDArray[np.uint8], bins: Literal[False], hold: ArrayLike | None = None
     ) -> tuple[None, NDArray[np.uint8]]: ...
     @overload
     def apply(
-        self,
-        frame: NDArray[np.uint8],
-        bins: bool,
-        hold: ArrayLike | None = None,
-        cover: ArrayLike | None = None,
+        self, frame: NDArray[np.uint8], bins: bool, hold: ArrayLike | None = None
     ) -> tuple[BinnedImage | None, NDArray[np.uint8]]: ...
     # background += rate (frame - background) where mask != 0
     def blend(self, frame: NDArray[np.uint8], mask: ArrayLike, rate: float) -> None: ...

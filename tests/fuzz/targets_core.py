@@ -459,7 +459,6 @@ def _background(
     support = None
     if frames_:
         out = model.apply(frames_[-1], hold=mask)  # a tracked object's pixels not learnt
-        out = model.apply(frames_[-1], cover=mask)  # a detector's boxes (learning phase)
         model.blend(frames_[-1], mask, rate)  # ghosts learnt faster (after the last frame)
         support = model.edge_support(frames_[-1], mask, boxes)  # the ghost test
     return None if out is None else (out[0].bins, out[1], model.threshold, support)

@@ -48,7 +48,6 @@ class BackgroundReference:
         self.shadow_lo, self.shadow_chroma = shadow_lo, shadow_chroma
         self.background = None
         self.previous = None
-        self.learnt = None  # frames learnt per pixel, from the first cover in the learning phase
         self.threshold = t_min
         self.threshold_scale = 1.0
 
@@ -65,7 +64,7 @@ class BackgroundReference:
         self.threshold = min(max(t, lo), hi)
 
     def apply(
-        self, frame: np.ndarray, hold: np.ndarray | None = None, cover: np.ndarray | None = None
+        self, frame: np.ndarray, hold: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
         bins = hsv_bin_reference(frame)
         f = frame.astype(np.float32)
@@ -74,8 +73,6 @@ class BackgroundReference:
             self.previous = frame.copy()
             self.threshold = self.bounds()[0]
             self.frame_count = 1
-            if cover is not None and self.n_learn > 1:
-                self.learnt = np.where(cover != 0, 0, 1).astype(np.float32)
             return bins, np.zeros(frame.shape[:2], np.uint8)
         bg = self.background
         t = np.float32(self.threshold)
@@ -101,17 +98,6 @@ class BackgroundReference:
             a_bg, a_fg = self.alpha, self.alpha_fg
         a_cand = np.float32(a_fg) if hold is None else np.where(hold != 0, 0, a_fg)
         a = np.where(cand, a_cand, np.float32(a_bg)).astype(np.float32)[..., None]
-        if k > self.n_learn:
-            self.learnt = None
-        elif cover is not None and self.learnt is None:
-            self.learnt = np.full(d_bg.shape, self.frame_count, np.float32)
-        if self.learnt is not None:  # the learning phase's own count per pixel
-            learn = np.ones(d_bg.shape, bool) if cover is None else cover == 0
-            if hold is not None:
-                learn &= ~(cand & (hold != 0))
-            self.learnt = self.learnt + learn.astype(np.float32)
-            rate = np.maximum(1.0 / np.maximum(self.learnt, 1).astype(np.float64), self.alpha)
-            a = np.where(learn, rate.astype(np.float32), np.float32(0))[..., None]
         self.frame_count = k
         self.background = bg + a * e
         self.previous = frame.copy()

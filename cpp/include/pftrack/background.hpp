@@ -262,27 +262,6 @@ PFTRACK_VECTOR_CLONES static void background_row_update_held(
     }
 }
 
-/// The learning phase's update where the caller's boxes cover pixels (`BackgroundModel::apply`'s
-/// `cover`): a pixel that cover (or cand and hold) marks is not learnt; any other has learnt one
-/// more frame, n (its count, incremented here), and takes a = max(1 / n, alpha), computed as
-/// the frame-wide rate (double, then float): every count k gives the model's own k-th rate.
-static void background_row_learn(Index n, const float* __restrict fb, const float* __restrict fg,
-                                 const float* __restrict fr, float* __restrict qb,
-                                 float* __restrict qg, float* __restrict qr,
-                                 const float* __restrict cand, const std::uint8_t* __restrict hold,
-                                 const std::uint8_t* __restrict cover, float* __restrict learnt,
-                                 double alpha) {
-    for (Index x = 0; x < n; ++x) {
-        if ((cover != nullptr && cover[x] != 0) || (hold != nullptr && hold[x] != 0 && cand[x] != 0.0f))
-            continue;
-        learnt[x] += 1.0f;
-        const float a = static_cast<float>(std::max(1.0 / static_cast<double>(learnt[x]), alpha));
-        qb[x] = qb[x] + a * (fb[x] - qb[x]);
-        qg[x] = qg[x] + a * (fg[x] - qg[x]);
-        qr[x] = qr[x] + a * (fr[x] - qr[x]);
-    }
-}
-
 /// background_c += a (frame_c - background_c), a = a_fg where cand, else a_bg.
 PFTRACK_VECTOR_CLONES static void background_row_update(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
@@ -310,11 +289,6 @@ PFTRACK_VECTOR_CLONES static void background_row_update(
 ///       `hold` mask (if given); a = max(1 / k, alpha) everywhere but there for the
 ///       k-th frame while k <= n_learn (float32 arithmetic, in this order, so a NumPy
 ///       reference matches bit for bit),
-///       With a `cover` mask during the learning phase (the caller's detection boxes), the
-///       model learns only what no box covers: each pixel counts the frames it has learnt,
-///       covered pixels learn nothing and the others take max(1 / n, alpha) for their n-th
-///       (a pixel covered on every frame so far keeps the first frame's value, and the first
-///       frame that leaves it uncovered replaces it: rate 1),
 ///   (e) stores the frame as the previous one, and counts floor(d_bg) in a 256-bin histogram.
 /// T for the next frame = clamp(k_noise * median(d_bg), t_min, t_max), the median read from that
 /// histogram with linear interpolation inside its bin: a robust noise level, since most pixels
@@ -358,7 +332,6 @@ public:
         frame_count_ = 0;
         background_.clear();
         previous_.clear();
-        learnt_.clear();
         threshold_scale_ = 1.0;
         threshold_ = config_.t_min;
         hist_.fill(0);
@@ -462,16 +435,11 @@ public:
     /// (rows x cols, 255 = foreground, 127 = shadow, 0 = background), both packed. `hold`
     /// (rows x cols, `hold_stride` bytes a row; none when null): candidates where it is not 0
     /// are not learnt at all (rate 0 instead of alpha_fg; the caller's tracked objects that
-    /// stopped), the other pixels as usual. Ignored on the first frame. `cover` (rows x cols,
-    /// `cover_stride` bytes a row; none when null): during the learning phase, pixels where
-    /// it is not 0 are not learnt, and from the first cover on every pixel counts the frames
-    /// it has learnt (see the class); ignored once the learning phase is over.
+    /// stopped), the other pixels as usual. Ignored on the first frame.
     void apply(const std::uint8_t* bgr, Index rows, Index cols, Index row_stride, std::int16_t* bins,
-               std::uint8_t* mask, const std::uint8_t* hold = nullptr, Index hold_stride = 0,
-               const std::uint8_t* cover = nullptr, Index cover_stride = 0) {
+               std::uint8_t* mask, const std::uint8_t* hold = nullptr, Index hold_stride = 0) {
         if (!initialized()) {
             first_frame(bgr, rows, cols, row_stride, bins, mask);
-            if (cover != nullptr && learning_ && config_.n_learn > 1) start_counts(1.0f, cover, cover_stride);
             return;
         }
         require(rows == rows_ && cols == cols_, "BackgroundModel.apply",
@@ -485,10 +453,6 @@ public:
         const double a_learn = std::max(1.0 / static_cast<double>(frame_count_ + 1), config_.alpha);
         const float a_bg = static_cast<float>(learning ? a_learn : config_.alpha);
         const float a_fg = static_cast<float>(learning ? a_learn : config_.alpha_fg);
-        if (!learning) learnt_.clear();  // the counts served the learning phase only
-        else if (cover != nullptr && learnt_.empty())  // every pixel has learnt every frame so far
-            start_counts(static_cast<float>(frame_count_), nullptr, 0);
-        const bool counted = !learnt_.empty();
         const float s_lo = static_cast<float>(config_.shadow_lo);
         const float s_chroma = static_cast<float>(config_.shadow_chroma);
         // Eight interleaved histograms: consecutive pixels mostly fall in the same bin, and
@@ -535,13 +499,7 @@ public:
             for (Index x = 0; x < cols; ++x)
                 ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
             // (5) background_c += a (frame_c - background_c), vectorised (selective update)
-            if (counted)
-                detail::background_row_learn(
-                    cols, fb, fg, fr, qb, qg, qr, cand,
-                    hold != nullptr ? hold + y * hold_stride : nullptr,
-                    cover != nullptr ? cover + y * cover_stride : nullptr,
-                    learnt_.data() + y * cols, config_.alpha);
-            else if (hold != nullptr)
+            if (hold != nullptr)
                 detail::background_row_update_held(cols, fb, fg, fr, qb, qg, qr, cand,
                                                    hold + y * hold_stride, a_bg, a_fg);
             else
@@ -566,12 +524,11 @@ public:
         std::vector<float> background;
         std::vector<std::uint8_t> previous;
         std::array<std::int64_t, 256> hist{};
-        std::vector<float> learnt;  // frames learnt per pixel (cover), or empty
     };
 
     State state() const {
         return State{rows_,     cols_,       frame_count_, learning_, threshold_,
-                     threshold_scale_, background_, previous_,    hist_, learnt_};
+                     threshold_scale_, background_, previous_,    hist_};
     }
 
     void restore(State s) {
@@ -582,8 +539,6 @@ public:
         require(s.background.size() == n && s.previous.size() == n, fn, "background size",
                 s.background.size(), n);
         require(s.frame_count >= 0, fn, "frame_count", s.frame_count, ">= 0");
-        require(s.learnt.empty() || s.learnt.size() == n / 3, fn, "learnt size", s.learnt.size(),
-                n / 3);
         require(std::isfinite(s.threshold) && std::isfinite(s.threshold_scale) &&
                     s.threshold_scale > 0.0,
                 fn, "threshold scale", s.threshold_scale, "finite and > 0");
@@ -596,7 +551,6 @@ public:
         background_ = std::move(s.background);
         previous_ = std::move(s.previous);
         hist_ = s.hist;
-        learnt_ = std::move(s.learnt);
     }
 
 private:
@@ -605,7 +559,6 @@ private:
         cols_ = cols;
         background_.resize(static_cast<size_t>(rows * cols * 3));
         previous_.resize(static_cast<size_t>(rows * cols * 3));
-        learnt_.clear();
         threshold_ = t_lo();
         hist_.fill(0);
     }
@@ -629,15 +582,6 @@ private:
         }
         std::fill(mask, mask + rows * cols, std::uint8_t(0));
         ++frame_count_;
-    }
-
-    /// Per-pixel counts of the frames learnt: `n` everywhere, 0 where `cover` (if given) is not 0.
-    void start_counts(float n, const std::uint8_t* cover, Index cover_stride) {
-        learnt_.assign(static_cast<size_t>(rows_ * cols_), n);
-        if (cover == nullptr) return;
-        for (Index y = 0; y < rows_; ++y)
-            for (Index x = 0; x < cols_; ++x)
-                if (cover[y * cover_stride + x] != 0) learnt_[static_cast<size_t>(y * cols_ + x)] = 0.0f;
     }
 
     double next_threshold() const {
@@ -668,7 +612,6 @@ private:
     double threshold_scale_ = 1.0;  // set_threshold_scale
     std::vector<float> background_;      // planar rows: [y][channel][x]
     std::vector<std::uint8_t> previous_;  // interleaved, as the frame
-    std::vector<float> learnt_;  // frames learnt per pixel, while a cover is in use (else empty)
     std::array<std::int64_t, 256> hist_{};
     std::vector<double> ratios_;  // global_gain's sampled frame / background ratios
     std::vector<float> scratch_f_;  // row scratch: B, G, R planes, d_prev, candidate flag

@@ -7,12 +7,11 @@ from dataclasses import asdict, dataclass, field
 
 import cv2
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack._check import flag, instance, integer, number, option
 from pftrack._stand_in import is_stand_in
-from pftrack._typing import F64
 from pftrack._warn import warn
 from pftrack.detection.base import (
     BlobConfig,
@@ -361,12 +360,9 @@ class PaperDetector:
         )
 
     def _apply(
-        self, frame: NDArray[np.uint8], bins: bool, cover: F64 | None = None
+        self, frame: NDArray[np.uint8], bins: bool
     ) -> tuple[_core.BinnedImage | None, NDArray[np.uint8]]:
-        """The C++ pass, after the grey test (first frame) or the global gain (later ones).
-
-        `cover`: boxes (K, 4) whose pixels the learning phase does not learn (:meth:`foreground`).
-        """
+        """The C++ pass, after the grey test (first frame) or the global gain (later ones)."""
         if self._shape is None:
             self._shape = frame.shape
         elif frame.shape != self._shape:  # as the model says for a lit frame, for a dark one too
@@ -403,10 +399,7 @@ class PaperDetector:
                         self._model.set_threshold_scale(scale)
         self._dark = 0
         hold = self._stop_memory().hold_mask(frame.shape[:2])
-        covered = None
-        if cover is not None and len(cover) and self._learning():
-            covered = cover_mask(cover, frame.shape[:2])
-        result = self._model.apply(frame, bins=bins, hold=hold, cover=covered)
+        result = self._model.apply(frame, bins=bins, hold=hold)
         self._count_noisy()
         return result
 
@@ -454,22 +447,12 @@ class PaperDetector:
         self._dark_said = self._dark_unsaid = False
         self._stop_memory().reset()
 
-    #: The background was given by `prime` (no learning phase). A class default for a detector
-    #: pickled before it was kept: learning as the model's frame count says.
-    _primed = False
-
-    def _learning(self) -> bool:
-        """Whether the model is in its learning phase (`PaperConfig.n_learn`; not after `prime`)."""
-        m = self._model
-        return not self._primed and (not m.initialized or m.frame_count < self.config.n_learn)
-
     def _reset_model(self) -> None:
         """Forget the background model, and with it the light it has followed.
 
         The model's threshold scale goes back to 1, so the gain since the first frame starts
         again (and the size model's pause after a rise of the light ends).
         """
-        self._primed = False
         self._model.reset()
         self._light = 1.0
         self._settling = 0
@@ -498,7 +481,6 @@ class PaperDetector:
             self._decide_grey(frames)
         self._reset_model()
         self._model.set_background(median)
-        self._primed = True
         self._shape = median.shape
 
     def detect(self, frame: NDArray[np.uint8]) -> Detections:
@@ -596,11 +578,7 @@ class PaperDetector:
         return mask, boxes[~ghost], scores[~ghost]
 
     def foreground(
-        self,
-        frame: NDArray[np.uint8],
-        shadows: bool = False,
-        bins: bool = True,
-        cover: ArrayLike | None = None,
+        self, frame: NDArray[np.uint8], shadows: bool = False, bins: bool = True
     ) -> tuple[NDArray[np.uint8], _core.BinnedImage | None]:
         """The cleaned foreground mask and the frame's HSV bins, without blobs or boxes.
 
@@ -609,16 +587,6 @@ class PaperDetector:
         With `shadows` the mask keeps the shadow pixels as 127 (255 foreground, 0 background).
         With `bins` False the background pass makes no bins (None in their place): for a
         caller that bins only the pixels it reads (``hsv_bins(..., lazy=True)``).
-
-        `cover`, (K, 4) boxes (left, top, width, height) of that detector on this frame: while
-        the model learns its first frames (`PaperConfig.n_learn`, a model `prime` did not
-        start), the pixels they cover (``floor(left) .. ceil(left + width)``, as
-        `refine_boxes` cuts them) are not learnt, and each pixel's running mean counts only
-        the frames it was learnt in: the background learns only what no box covers, instead
-        of the people walking through those frames (whose ghosts were foreground to the
-        refinement of the frames after; docs/tracking.md, "A loop without prime"). A pixel
-        covered on every frame so far keeps the first frame's value. Ignored after the
-        learning phase and after `prime`.
 
         Warns
         -----
@@ -630,52 +598,19 @@ class PaperDetector:
             noisy (`NOISY_LEVEL` for `NOISY_FRAMES` frames in a row): the foreground that
             refines the boxes is unreliable.
         """
-        fn = "PaperDetector.foreground"
-        boxes = None if cover is None else checked_boxes(cover, f"{fn}: cover")
-        shaded, binned = self._foreground(frame, fn, bins, boxes)
+        shaded, binned = self._foreground(frame, "PaperDetector.foreground", bins)
         return (shaded if shadows else foreground_only(shaded)), binned
 
     def _foreground(
-        self, frame: NDArray[np.uint8], fn: str, bins: bool = True, cover: F64 | None = None
+        self, frame: NDArray[np.uint8], fn: str, bins: bool = True
     ) -> tuple[NDArray[np.uint8], _core.BinnedImage | None]:
         """The cleaned mask with shadows (255, 127, 0) and the frame's bins (None without)."""
-        binned, raw = self._apply(check_frame(frame, fn), bins, cover)
+        binned, raw = self._apply(check_frame(frame, fn), bins)
         if self._grey_unsaid:
             self._say_grey(detecting=False, stacklevel=3)  # foreground()'s caller
         if self._noise_unsaid:
             self._say_noise(detecting=False, stacklevel=3)
         return self._blobs.clean(raw), binned
-
-
-def checked_boxes(boxes: ArrayLike, what: str) -> F64:
-    """`boxes` as a (K, 4) float64 array of finite values; ValueError naming `what` if not."""
-    b = np.asarray(boxes, dtype=np.float64)
-    if b.size == 0:
-        return np.zeros((0, 4))
-    if b.ndim != 2 or b.shape[1] != 4:
-        raise ValueError(f"{what} has shape {b.shape}, expected (K, 4) left, top, width, height")
-    if not np.isfinite(b).all():
-        raise ValueError(f"{what} contains NaN or inf")
-    return b
-
-
-def cover_mask(boxes: F64, shape: tuple[int, ...]) -> NDArray[np.uint8]:
-    """The (H, W) mask of the pixels `boxes` (K, 4: left, top, width, height) touch.
-
-    Each box is cut to whole pixels inside the image as `refine_boxes` cuts it:
-    ``floor(left) .. ceil(left + width)``, and the same for the rows.
-    """
-    h, w = shape
-    mask = np.zeros((h, w), np.uint8)
-    lo = np.floor(boxes[:, :2])
-    hi = np.ceil(boxes[:, :2] + boxes[:, 2:])
-    x0 = np.clip(lo[:, 0], 0, w).astype(int)
-    y0 = np.clip(lo[:, 1], 0, h).astype(int)
-    x1 = np.clip(hi[:, 0], 0, w).astype(int)
-    y1 = np.clip(hi[:, 1], 0, h).astype(int)
-    for a, b, c, d in zip(x0, y0, x1, y1, strict=True):
-        mask[b:d, a:c] = 1
-    return mask
 
 
 def foreground_only(shaded: NDArray[np.uint8]) -> NDArray[np.uint8]:

@@ -314,9 +314,6 @@ def track_frames(
             if primer:
                 tracker.prime(primer)
     _refuse_stopped(frames)  # stopped while its bootstrap frames were read
-    # the foreground is computed ahead on a thread without the boxes (below): an unprimed run
-    # (--bootstrap none) learns its first frames as before, with or without threads
-    tracker.tracker.cover_learning = False
     empty = np.zeros((0, 5))
     start = time.perf_counter()
     n = 0

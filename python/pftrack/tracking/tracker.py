@@ -408,8 +408,7 @@ class MultiObjectTracker:
         boxes, scores, labels = given
         mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
-            # boxes to be refined: the paper's model learns its first frames around them
-            mask, binned, shaded = self._foreground(frame, boxes if cfg.refine.enabled else None)
+            mask, binned, shaded = self._foreground(frame)
         if binned is None:  # full-frame bins: the detector's fused pass made them, or lazy ones
             binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)  # (only pixels read)
         # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
@@ -473,20 +472,11 @@ class MultiObjectTracker:
             cached = self._shadows = (detector, wants and takes_shadows(detector))
         return cached[1]
 
-    #: Whether the given boxes go to the paper's detector as the learning phase's cover
-    #: (`_foreground`). ``pftrack track`` turns it off: its foreground may be computed ahead
-    #: on a thread, without the boxes, and threads must not change a run's output.
-    cover_learning = True
-
-    def _foreground(
-        self, frame: NDArray[np.uint8], cover: F64 | None = None
-    ) -> tuple[NDArray[np.uint8], Any, bool]:
+    def _foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], Any, bool]:
         """Return the mask, full-frame bins (or None) and whether the mask has shadows (127).
 
         From the detector's ``foreground`` when it has one (no blob pass), with shadows when
-        :meth:`shadows_of` says so, else its ``detect``. `cover`, the given boxes that will be
-        refined, goes to the paper's detector: its learning phase does not learn their pixels
-        (`PaperDetector.foreground`).
+        :meth:`shadows_of` says so, else its ``detect``.
         """
         detector = self._ensure_detector()
         shaded = False
@@ -496,9 +486,7 @@ class MultiObjectTracker:
             # (binned where the boxes read: cheaper than its fused pass binning every pixel);
             # a detector on its own thread (DetectAhead's stand-in), or RJ-MCMC (which reads
             # every pixel), keeps the fused bins.
-            kw: dict[str, Any] = {"bins": False} if self._lazy_bins_from(detector) else {}
-            if cover is not None and self.cover_learning and isinstance(detector, PaperDetector):
-                kw["cover"] = cover
+            kw = {"bins": False} if self._lazy_bins_from(detector) else {}
             if shaded:
                 mask, frame_bins = detector.foreground(frame, shadows=True, **kw)
             else:
