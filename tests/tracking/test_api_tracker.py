@@ -102,9 +102,10 @@ def test_documented_loop_is_the_cli_byte_for_byte(name, tmp_path):
     strict=True,
     reason="unprimed, the background learns the first 30 frames' running mean, people walking "
     "through them included: TUD-Campus 76.9 / 77.7 against the command's 79.4 / 85.4 (MOTA / "
-    "IDF1); priming online from the first 30 frames closed it there and lost on PETS09, the "
-    "median of the frames so far closed it and lost on the synthetic groups and overhead: "
-    "neither adopted (docs/tracking.md, 'A loop without prime')",
+    "IDF1); priming online from the first 30 frames closed it there and lost on PETS09; the "
+    "median of the frames so far, and learning only the pixels no given box covers, closed it "
+    "and lost on the synthetic groups and overhead: none adopted (docs/tracking.md, 'A loop "
+    "without prime')",
 )
 def test_unprimed_loop_scores_the_commands():
     # README: "prime is optional". A user's loop that does not call it (trial59)
