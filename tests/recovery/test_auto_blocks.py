@@ -15,8 +15,10 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from pftrack.recovery import calibrate, fill, fill_gaps, recover_gaps
+from pftrack.recovery import calibrate, fill, fill_gaps, recover_gaps, registry
 from pftrack.recovery.calibrate import gap_windows, recover_auto
+from pftrack.recovery.names import NEIGHBOUR_METHODS
+from tests.recovery.test_row_memory import _peak
 
 
 def _walkers(n_ids: int, n_frames: int, seed: int = 0) -> np.ndarray:
@@ -117,3 +119,86 @@ def test_named_methods_blocks_change_no_bit(monkeypatch: pytest.MonkeyPatch, met
     got, _ = fill_gaps(rows, method)  # type: ignore[arg-type]
     assert got.tobytes() == want.tobytes()
     assert max(calls) == 7 and sum(calls) == rep.n_gaps
+
+
+def _pairs_and_tracks(rows: np.ndarray) -> tuple[list[tuple[np.ndarray, np.ndarray]], list]:
+    """Each hole's windows (``frame, x, y`` views) and every track, as ``fill_rows`` gives them."""
+    seg = np.column_stack([rows[:, 0], rows[:, 2:4]])
+    w = gap_windows(seg[:, 0], rows[:, 1])
+    pairs = [(seg[a : e + 1], seg[e + 1 : b]) for e, a, b in zip(w.holes, w.lo, w.hi, strict=True)]
+    starts = np.flatnonzero(np.r_[True, rows[1:, 1] != rows[:-1, 1]])
+    return pairs, np.split(seg, starts[1:])
+
+
+@pytest.mark.parametrize("as_lists", [False, True])
+@pytest.mark.parametrize("given", [True, False])
+def test_each_block_is_checked_once(
+    monkeypatch: pytest.MonkeyPatch, given: bool, as_lists: bool
+) -> None:
+    """With `observed`, ``recover_auto`` checked each block twice: as the calibration read the
+    gaps' lengths, and again before recovering it (the copies are dropped in between). Now
+    once: in a few passes (``segments.checked_at_once``) for float64 arrays, one segment at a
+    time (``as_segment``) for lists; the second pass only converts, with the same bits."""
+    pairs, whole = _pairs_and_tracks(_walkers(5, 100))
+    given_pairs: list = [(a.tolist(), b.tolist()) for a, b in pairs] if as_lists else pairs
+    observed = whole if given else None
+    want, cal = recover_auto(pairs, observed)
+    fast: list[int] = []
+    one: list[int] = []
+    real_fast, real_one = calibrate.checked_at_once, calibrate.as_segment
+    monkeypatch.setattr(
+        calibrate, "checked_at_once", lambda g, **k: fast.append(1) or real_fast(g, **k)
+    )
+    monkeypatch.setattr(calibrate, "as_segment", lambda *a: one.append(1) or real_one(*a))
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 7)
+    got, got_cal = recover_auto(given_pairs, observed)
+    blocks = -(-len(pairs) // 7)
+    assert len(pairs) > 50 and len(fast) == blocks  # main: 2 * blocks with `observed`
+    assert len(one) == (2 * len(pairs) if as_lists else 0)  # main: 4 * len(pairs) with it
+    assert got_cal == cal
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(got, want, strict=True))
+
+
+@pytest.mark.parametrize("method", NEIGHBOUR_METHODS)
+def test_nb_methods_blocks_change_no_bit(monkeypatch: pytest.MonkeyPatch, method: str) -> None:
+    """The ``-nb`` methods took every hole of a file in one call; now a block at a time, one
+    neighbourhood for the file (its windows forgotten after each block), the same bits, in
+    ``fill_gaps`` and in ``recover_gaps``."""
+    rows = _walkers(6, 120)
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 10**9)
+    want, rep = fill_gaps(rows, method)  # type: ignore[arg-type]
+    base = method.removesuffix("-nb")
+    assert rep.n_gaps > 100
+    assert want.tobytes() != fill_gaps(rows, base)[0].tobytes()  # neighbours corrected paths
+    pairs, whole = _pairs_and_tracks(rows)
+    want_gaps = recover_gaps(pairs, method, observed=whole)
+    calls: list[int] = []
+    real = registry.correct_by_neighbours
+
+    def spy(recover, pairs, hood, *args):  # type: ignore[no-untyped-def]
+        calls.append(len(pairs))
+        return real(recover, pairs, hood, *args)
+
+    monkeypatch.setattr(registry, "correct_by_neighbours", spy)
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 7)
+    got, _ = fill_gaps(rows, method)  # type: ignore[arg-type]
+    assert got.tobytes() == want.tobytes()
+    assert max(calls) == 7 and sum(calls) == rep.n_gaps
+    calls.clear()
+    got_gaps = recover_gaps(pairs, method, observed=whole)
+    assert max(calls) == 7 and sum(calls) == len(pairs)
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(got_gaps, want_gaps, strict=True))
+
+
+@pytest.mark.parametrize("method", NEIGHBOUR_METHODS)
+def test_nb_peak_is_a_blocks_not_every_gaps(monkeypatch: pytest.MonkeyPatch, method: str) -> None:
+    """2885 holes of 60 walkers, blocks of 128: main's code (every hole's neighbour windows,
+    their paths and errors at once) peaked at 25.0 MiB (``linear-nb``) and 34.5 (``rts-nb``)
+    of ``tracemalloc`` here, 5.0 and 4.1 now (``linear``: 7.1 on 100 walkers)."""
+    rows = _walkers(60, 300)
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 128)
+    got: list = []
+    peak = _peak(lambda: got.append(fill_gaps(rows, method)))  # type: ignore[arg-type]
+    out, rep = got[0]
+    assert rep.n_gaps > 2500 and len(out) > len(rows)
+    assert peak < 10 * 2**20, f"peak {peak / 2**20:.1f} MiB (main: 25.0 and 34.5)"

@@ -221,3 +221,43 @@ def test_a_bad_gap_in_a_batch_is_still_named(bad, message: str) -> None:
         gaps.append(bad(a, b) if k == 2 else (a, b))
     with pytest.raises(ValueError, match=re.escape(message)):
         recover_gaps(gaps, "linear")
+
+
+def test_frame_x_y_copies_of_the_batch_check() -> None:
+    """``recover_auto``'s one-pass check was its own function (``calibrate._checked_at_once``,
+    without the gap length rule); ``segments.checked_at_once`` serves both now, its `xy`
+    giving the contiguous ``frame, x, y`` copies ``recover_auto`` reads, of any layout."""
+    from pftrack.recovery.segments import checked_at_once
+
+    rng = np.random.default_rng(5)
+    gaps = []
+    for k in range(600):  # more than segments.CHECK_BLOCK pairs
+        a = np.column_stack([np.arange(1.0, 6), rng.normal(100, 5, (5, 2)), np.full((5, 2), 9.0)])
+        gaps.append((a, a + [10 + k % 7, 3, 3, 0, 0]))
+    same = checked_at_once(gaps)
+    got = checked_at_once(gaps, xy=True)
+    assert same is not None and got is not None and len(got) == len(gaps)
+    for (a, b), (sa, sb), (xa, xb) in zip(gaps, same, got, strict=True):
+        assert sa is a and sb is b
+        for x, s in ((xa, a), (xb, b)):
+            assert x.flags.c_contiguous and x.dtype == np.float64
+            assert x.tobytes() == np.ascontiguousarray(s[:, :3]).tobytes()
+    a, b = gaps[0]
+    cols = [(s[:, [0, 3, 4]], t[:, [0, 3, 4]]) for s, t in gaps]  # fill_rows' size columns
+    assert not cols[0][0].flags.c_contiguous and checked_at_once(cols) is None
+    wide = checked_at_once(cols, xy=True)  # not C-contiguous: taken with xy, copied
+    assert wide is not None and wide[0][0].tobytes() == np.ascontiguousarray(cols[0][0]).tobytes()
+    negative_w = (a, b * [1, 1, 1, -1, 1])  # w, h are not read with xy: not checked
+    assert checked_at_once([*gaps[:300], negative_w]) is None
+    assert checked_at_once([*gaps[:300], negative_w], xy=True) is not None
+    long_gap = (a, b + [2e5, 0, 0, 0, 0])
+    assert checked_at_once([*gaps[:300], long_gap], xy=True) is None
+
+
+def test_recover_auto_refuses_a_gap_recover_gaps_refuses() -> None:
+    """A gap of more than MAX_GAP_LIMIT frames: ``recover_gaps`` refused it, ``recover_auto``
+    filled its 200 002 frames (its own one-pass check did not look at the length)."""
+    a = np.array([[1.0, 10, 10], [2, 11, 10], [3, 12, 10]])
+    for fn in (recover_auto, lambda g: recover_gaps(g, "linear")):
+        with pytest.raises(ValueError, match=r"recover_gaps: gap 1: the gap from frame 3 to "):
+            fn([(a, a + [9, 0, 0]), (a, a + [200_005, 0, 0])])

@@ -49,7 +49,13 @@ from pftrack.recovery.neighbours import (
 )
 from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
 from pftrack.recovery.problems import SegmentModel
-from pftrack.recovery.segments import as_segment, distinct_runs, pairs_meet_rules, split_rows
+from pftrack.recovery.segments import (
+    as_segment,
+    checked_at_once,
+    distinct_runs,
+    gap_ends,
+    split_rows,
+)
 
 __all__ = [
     "CANDIDATES",
@@ -1165,30 +1171,6 @@ _NO_NOISE = NoiseEstimate(q=(0.1, 0.1), r=(1.0, 1.0))
 _NO_MOTION: MotionFit = None  # type: ignore[assignment]
 
 
-def _checked_at_once(pairs: Sequence[tuple[F64, F64]]) -> list[tuple[F64, F64]] | None:
-    """``frame, x, y`` of every pair as :func:`recover_auto` checks them, in one pass.
-
-    The arrays :func:`~pftrack.recovery.segments.as_segment` would give (contiguous float64
-    copies of the first three columns) when every segment is a float64 ndarray that passes
-    its checks and every segment B starts after its segment A; None otherwise (the caller
-    checks pair by pair and names what is wrong).
-    """
-    segs = [s for pair in pairs for s in pair]
-    if not segs or not all(
-        type(s) is np.ndarray and s.dtype == np.float64 and s.ndim == 2 and s.shape[1] >= 3
-        for s in segs
-    ):
-        return None
-    sizes = np.array([len(s) for s in segs], dtype=np.int64)
-    if sizes.min() == 0:
-        return None
-    X = np.concatenate([s[:, :3] for s in segs])
-    if not pairs_meet_rules(X, sizes):
-        return None
-    parts = split_rows(X, sizes)
-    return list(zip(parts[0::2], parts[1::2], strict=True))
-
-
 def bags_for(bags: object, combine: bool, who: str) -> int:
     """The bootstrap resamples of a calibration: `bags` checked, or its default for `combine`.
 
@@ -1302,8 +1284,9 @@ def recover_auto(
     ----------
     pairs : sequence of (segment_a, segment_b)
         Segments around each gap (rows ``frame, x, y[, w, h]``), read :data:`RECOVER_BLOCK`
-        gaps at a time (sliced), twice: the calibration reads every gap's length, distance
-        and context first, then each block is checked and recovered.
+        gaps at a time (sliced), twice: each block is checked as the calibration reads every
+        gap's length, distance and context, then read again (not checked again: with
+        `observed`, the checked copies are a block's at a time) and recovered.
     observed : sequence of (k, 3+) ndarray, optional
         Every observed track of the file, for calibration; default: the segments of `pairs`.
     noise, motion : optional
@@ -1345,9 +1328,10 @@ def recover_auto(
         A `seed` that is not an int, a `combine` that is not a bool, `observed` that is not a
         sequence of arrays of real numbers.
     ValueError
-        Malformed segments, a segment B that does not start after its segment A, settings
-        :func:`calibrate` refuses, an observed run that is not (k, 3+) or has a non-finite
-        frame, x or y, `contexts` of another length than `pairs`.
+        Malformed segments, a segment B that does not start after its segment A or a gap
+        of more than :data:`~pftrack.recovery.segments.MAX_GAP_LIMIT` frames (as
+        ``recover_gaps``), settings :func:`calibrate` refuses, an observed run that is not
+        (k, 3+) or has a non-finite frame, x or y, `contexts` of another length than `pairs`.
     """
     combine = _check.flag(combine, "recover_auto: combine")
     _, bags, seed = _settings("recover_auto", max_gaps, bags, seed, combine)
@@ -1356,9 +1340,9 @@ def recover_auto(
     n_pairs = len(pairs)
     if contexts is not None and len(contexts) != n_pairs:
         raise ValueError(f"recover_auto: {len(contexts)} contexts for {n_pairs} pairs")
-    # First pass, a block of gaps at a time: each gap checked, its length, the distance between
-    # its ends and its context kept (numbers; the checked copies of a block are dropped, unless
-    # the segments are also what the calibration observes)
+    # First pass, a block of gaps at a time: each gap checked (the only time), its length, the
+    # distance between its ends and its context kept (numbers; the checked copies of a block
+    # are dropped, unless the segments are also what the calibration observes)
     lengths: list[int] = []
     spans: list[float] = []
     sides: list[tuple[int, int]] = []
@@ -1405,7 +1389,7 @@ def recover_auto(
     # block's (the neighbours' are forgotten after each block)
     paths: list[F64] = []
     for lo in range(0, n_pairs, RECOVER_BLOCK):
-        checked = _checked_block(pairs, lo) if kept is None else kept[lo : lo + RECOVER_BLOCK]
+        checked = _read_block(pairs, lo) if kept is None else kept[lo : lo + RECOVER_BLOCK]
         block = [mixes[L] for L in lengths[lo : lo + len(checked)]]
         groups: dict[str, list[int]] = {}  # each method once, over every gap that uses it
         for k, mix in enumerate(block):
@@ -1430,12 +1414,15 @@ def recover_auto(
 def _checked_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64, F64]]:
     """Gaps ``lo`` to ``lo + RECOVER_BLOCK`` of `pairs`, checked as :func:`recover_auto` does.
 
-    In one pass (:func:`_checked_at_once`) when they are valid float64 arrays, else pair by
-    pair (:func:`~pftrack.recovery.segments.as_segment`), naming the first bad gap by its
-    place in `pairs`.
+    Contiguous float64 copies of each segment's ``frame, x, y``: in a few passes
+    (:func:`~pftrack.recovery.segments.checked_at_once`) when they are valid float64 arrays,
+    else pair by pair (:func:`~pftrack.recovery.segments.as_segment`,
+    :func:`~pftrack.recovery.segments.gap_ends`), naming the first bad gap by its place in
+    `pairs`. A gap of more than :data:`~pftrack.recovery.segments.MAX_GAP_LIMIT` frames is
+    refused, as ``recover_gaps`` refuses it (was filled: the one-pass check did not look).
     """
     block = pairs[lo : lo + RECOVER_BLOCK]
-    checked = _checked_at_once(block)
+    checked = checked_at_once(block, xy=True)
     if checked is not None:
         return checked
     checked = []  # something to refuse (or not float64 arrays): pair by pair
@@ -1444,10 +1431,21 @@ def _checked_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64,
             as_segment(np.asarray(a)[:, :3], "segment_a"),
             as_segment(np.asarray(b)[:, :3], "segment_b"),
         )
-        if sb[0, 0] <= sa[-1, 0]:
-            raise ValueError(
-                f"recover_gaps: gap {k}: segment_b starts at frame {sb[0, 0]:g}, expected "
-                f"after segment_a's end {sa[-1, 0]:g}"
-            )
+        gap_ends(sa, sb, "recover_gaps", f"gap {k}: ")  # B after A, at most MAX_GAP_LIMIT
         checked.append((sa, sb))
     return checked
+
+
+def _read_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64, F64]]:
+    """Gaps ``lo`` to ``lo + RECOVER_BLOCK`` of `pairs` as :func:`_checked_block` gave them.
+
+    Not checked again: :func:`recover_auto`'s first pass checked them and, calibrating on its
+    `observed`, dropped the copies (a block's memory, not every gap's); only converted as
+    :func:`~pftrack.recovery.segments.as_segment` converts, ``frame, x, y`` of every segment
+    stacked into one float64 copy and split (the same values; was a second
+    :func:`_checked_block` of every block).
+    """
+    segs = [np.asarray(s) for pair in pairs[lo : lo + RECOVER_BLOCK] for s in pair]
+    x = np.concatenate([s.astype(np.float64, copy=False)[:, :3] for s in segs])
+    parts = split_rows(x, [len(s) for s in segs])
+    return list(zip(parts[0::2], parts[1::2], strict=True))

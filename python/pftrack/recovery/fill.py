@@ -36,9 +36,13 @@ from pftrack.recovery.linking import (
 )
 from pftrack.recovery.mixture import MotionFit, _fit_motion, check_models
 from pftrack.recovery.names import NEIGHBOUR_METHODS
+from pftrack.recovery.neighbours import Neighbourhood
 from pftrack.recovery.noise import NoiseEstimate, _estimate_noise
-from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, recover_gaps
-from pftrack.recovery.segments import MAX_GAP_LIMIT  # Largest `max_gap` accepted
+from pftrack.recovery.registry import DEFAULT_METHOD, METHODS, _recover_nb, recover_gaps
+from pftrack.recovery.segments import (
+    MAX_GAP_LIMIT,  # Largest `max_gap` accepted
+    distinct_runs,
+)
 
 __all__ = [
     "DEFAULT_MAX_GAP",
@@ -66,7 +70,8 @@ WHOLE_SEGMENT_METHODS = ("gsi",)
 #: Named methods whose holes are recovered :data:`~pftrack.recovery.calibrate.RECOVER_BLOCK`
 #: at a time (each gap on its own, so the same paths): their batches stack every gap's window
 #: (``rts`` and ``gdt-bi`` peaked 48 and 72 MB of RSS above ``linear`` on 200 170 rows with
-#: 39 830 holes).
+#: 39 830 holes). The ``"-nb"`` methods go by the same blocks, with one neighbourhood for the
+#: file (``registry._recover_nb``).
 BLOCK_METHODS = ("gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "rts")
 
 
@@ -375,17 +380,17 @@ def fill_rows(
                 contexts=contexts,
                 regions=False,  # sizes are not image positions: no region cuts them
             )
+        elif method in NEIGHBOUR_METHODS:  # a block of holes at a time, one neighbourhood
+            hood = Neighbourhood(distinct_runs(whole, strict="recover_gaps"))
+            paths = _recover_nb(segs, method, hood)
         else:
-            observed = whole if method in NEIGHBOUR_METHODS else None
             # the batched methods a block of holes at a time, as "auto" (each gap is recovered
             # on its own: the same paths, a block's stacked windows); the others in one call
-            # (the "-nb" methods' neighbourhood is made per call, the baselines' loop shows a bar)
+            # (the baselines' loop shows a bar)
             step = calibrate.RECOVER_BLOCK if method in BLOCK_METHODS else len(segs)
             paths = []
             for at in range(0, len(segs), step):
-                paths += recover_gaps(
-                    segs[at : at + step], method, noise=noise, motion=motion, observed=observed
-                )
+                paths += recover_gaps(segs[at : at + step], method, noise=noise, motion=motion)
         for k, (e, xy) in enumerate(zip(holes.tolist(), paths, strict=True)):
             tid, ra, rb = int(r[e, 1]), r[e], r[e + 1]
             fr = np.arange(ra[0] + 1, rb[0])

@@ -52,6 +52,7 @@ from pftrack import _check
 from pftrack._check import MAX_FRAME
 from pftrack._progress import progress
 from pftrack._typing import F64, RecoveryMethod
+from pftrack.recovery import calibrate
 from pftrack.recovery.baselines import _BASELINES, _interpolate_sizes, _rts_batch
 from pftrack.recovery.calibrate import bags_for, fixed_noise_model, recover_auto
 from pftrack.recovery.mixture import MotionFit, _fit_motion, check_models, recover_mixture_gaps
@@ -200,6 +201,28 @@ def _gap_segment(seg: ArrayLike, name: str, k: int) -> F64:
     return as_observed(seg, f"{name} of gap {k}", "recover_gaps")
 
 
+def _recover_nb(pairs: Sequence[tuple[F64, F64]], method: str, hood: Neighbourhood) -> list[F64]:
+    """`pairs` recovered by a ``"-nb"`` `method` (:data:`NEIGHBOUR_METHODS`), corrected by `hood`.
+
+    :data:`~pftrack.recovery.calibrate.RECOVER_BLOCK` gaps at a time, as ``"auto"`` recovers
+    them (`pairs` sliced: ``fill_rows`` makes each hole's segments when read), the
+    neighbours' windows forgotten after each block: each gap is recovered on its own, so the
+    paths are those of one call over all the gaps, while the windows, their paths and the
+    base method's temporaries are a block's (were every gap's at once: memory grew with the
+    file). Each block's segments are checked by the base method's :func:`recover_gaps`.
+    """
+    base = cast("RecoveryMethod", method.removesuffix(NB_SUFFIX))  # rts-nb -> rts
+
+    def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
+        return recover_gaps(ps, base)
+
+    paths: list[F64] = []
+    for lo in range(0, len(pairs), calibrate.RECOVER_BLOCK):
+        paths += correct_by_neighbours(recover, pairs[lo : lo + calibrate.RECOVER_BLOCK], hood)
+        hood.forget()
+    return paths
+
+
 def recover_gaps(
     gaps: Sequence[tuple[ArrayLike, ArrayLike]],
     method: RecoveryMethod = DEFAULT_METHOD,
@@ -278,12 +301,7 @@ def recover_gaps(
             if observed is None
             else distinct_runs(observed, strict="recover_gaps")
         )
-        base = cast("RecoveryMethod", method.removesuffix(NB_SUFFIX))  # rts-nb -> rts
-
-        def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
-            return recover_gaps(ps, base)
-
-        return correct_by_neighbours(recover, pairs, Neighbourhood(runs))
+        return _recover_nb(pairs, method, Neighbourhood(runs))
     if method not in GOAL_DIRECTED_METHODS:
         return [  # recover_gap's path, without checking the checked pairs again
             _BASELINES[method](a, b, fr) if fr.size else np.zeros((0, 2))

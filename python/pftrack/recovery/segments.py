@@ -136,16 +136,22 @@ def pairs_meet_rules(x: F64, sizes: NDArray[np.int64]) -> bool:
     )
 
 
-def checked_at_once(gaps: object) -> list[tuple[F64, F64]] | None:
+def checked_at_once(gaps: object, xy: bool = False) -> list[tuple[F64, F64]] | None:
     """The gaps as :func:`as_segment` and :func:`gap_ends` check them, all in a few passes.
 
     When `gaps` is a list or tuple of pairs of non-empty C-contiguous float64 ``(k, 3)`` or
     ``(k, 5)`` ndarrays that meet every rule of :func:`as_segment` (the arrays it returns are
     these ones) and every segment B starts after its segment A within :data:`MAX_GAP_LIMIT`
     frames: the pairs, each segment as given. Otherwise None: the caller checks gap by gap
-    and names what is wrong. ``fill_gaps`` passes every hole of a file as such a pair:
-    checked one segment at a time, they took half of ``fill_gaps(rows, "linear")`` on 200 000
-    rows with 40 000 holes (2.1-2.2 s of CPU, now 1.0-1.2 s).
+    and names what is wrong. ``recover_gaps`` checks its pairs so (every hole of a
+    ``fill_gaps`` file: checked one segment at a time, they took half of
+    ``fill_gaps(rows, "linear")`` on 200 000 rows with 40 000 holes, 2.1-2.2 s of CPU, now
+    1.0-1.2 s).
+
+    With `xy`, for callers that read only ``frame, x, y`` (each block of
+    ``calibrate.recover_auto``): C-contiguous copies of those columns instead (the rows the
+    check stacks, split: no second copy), and only those are checked, of float64 ndarrays of
+    any layout and at least 3 columns (as the caller's pair-by-pair check takes them).
     """
     if not isinstance(gaps, (list, tuple)) or not gaps:
         return None
@@ -158,12 +164,13 @@ def checked_at_once(gaps: object) -> list[tuple[F64, F64]] | None:
                 type(seg) is np.ndarray  # not a masked array, nor any other subclass
                 and seg.dtype == np.float64
                 and seg.ndim == 2
-                and seg.shape[1] in (3, 5)
                 and seg.shape[0] > 0
-                and seg.flags.c_contiguous
+                and (seg.shape[1] >= 3 if xy else seg.shape[1] in (3, 5))
+                and (xy or seg.flags.c_contiguous)
             ):
                 return None
             segs.append(seg)
+    parts: list[F64] = []
     for lo in range(0, len(segs), 2 * CHECK_BLOCK):  # copies of a block at a time, not all
         block = segs[lo : lo + 2 * CHECK_BLOCK]
         sizes = np.array([len(seg) for seg in block], dtype=np.int64)
@@ -174,12 +181,16 @@ def checked_at_once(gaps: object) -> list[tuple[F64, F64]] | None:
         ends = np.cumsum(sizes)
         if (f[ends[1::2] - sizes[1::2]] - f[ends[0::2] - 1] - 1).max() > MAX_GAP_LIMIT:
             return None
+        if xy:
+            parts += split_rows(x, sizes)
+            continue
         wh = [seg[:, 3:] for seg in block if seg.shape[1] == 5]
         if wh:
             w = np.concatenate(wh)
             if not (np.isfinite(w).all() and w.min() >= 0 and w.max() <= MAX_COORD):
                 return None
-    return [(segs[k], segs[k + 1]) for k in range(0, len(segs), 2)]
+    out = parts if xy else segs
+    return list(zip(out[0::2], out[1::2], strict=True))
 
 
 def as_observed(seg: ArrayLike, name: str, fn: str) -> F64:
