@@ -202,3 +202,24 @@ def test_nb_peak_is_a_blocks_not_every_gaps(monkeypatch: pytest.MonkeyPatch, met
     out, rep = got[0]
     assert rep.n_gaps > 2500 and len(out) > len(rows)
     assert peak < 10 * 2**20, f"peak {peak / 2**20:.1f} MiB (main: 25.0 and 34.5)"
+
+
+def test_nb_methods_draw_one_bar_over_the_blocks(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A long ``-nb`` run shows one bar over its blocks, with the time left, as before the
+    blocks it showed one over its gaps (each block's own bar would be short, or none)."""
+    import io
+    import sys
+
+    from pftrack import _progress
+
+    pairs, whole = _pairs_and_tracks(_walkers(4, 60))
+    err = io.StringIO()
+    err.isatty = lambda: True  # type: ignore[method-assign]
+    monkeypatch.setattr(sys, "stderr", err)
+    monkeypatch.setattr(_progress, "_quiet", False)
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 7)
+    recover_gaps(pairs, "linear-nb", observed=whole)
+    blocks = -(-len(pairs) // 7)
+    assert len(pairs) > 20
+    assert "linear-nb" in err.getvalue() and f"{blocks}/{blocks}" in err.getvalue()

@@ -216,9 +216,11 @@ def _recover_nb(pairs: Sequence[tuple[F64, F64]], method: str, hood: Neighbourho
     def recover(ps: list[tuple[F64, F64]]) -> list[F64]:
         return recover_gaps(ps, base)
 
+    block = calibrate.RECOVER_BLOCK
     paths: list[F64] = []
-    for lo in range(0, len(pairs), calibrate.RECOVER_BLOCK):
-        paths += correct_by_neighbours(recover, pairs[lo : lo + calibrate.RECOVER_BLOCK], hood)
+    # one bar over the whole run (each block's own would be short, or none at all)
+    for lo in progress(range(0, len(pairs), block), desc=method, unit="block"):
+        paths += correct_by_neighbours(recover, pairs[lo : lo + block], hood)
         hood.forget()
     return paths
 
