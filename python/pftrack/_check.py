@@ -117,11 +117,19 @@ def check_classes(classes: F64, what: str) -> None:
         )
 
 
+def exactly(value: float) -> str:
+    """`value` as a message shows a refused frame or id: an integer's digits, else ``repr``.
+
+    Not ``:g``, whose 6 digits turned frame 1 + 1e-12 into "frame 1, not an integer" and
+    2147483648 into 2.14748e+09.
+    """
+    v = float(value)
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
+
+
 def bad_id_message(value: float) -> str:
     """What is wrong with track id `value` (one :func:`first_bad_id` found), shown exactly."""
-    v = float(value)
-    shown = str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)  # not 2.14748e+09
-    return f"track id {shown} is not an integer with |id| <= {MAX_ID}"
+    return f"track id {exactly(value)} is not an integer with |id| <= {MAX_ID}"
 
 
 def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
