@@ -6,7 +6,7 @@ import numbers
 import os
 import sys
 from collections.abc import Iterable, Iterator
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -132,6 +132,21 @@ def bad_id_message(value: float) -> str:
     return f"track id {exactly(value)} is not an integer with |id| <= {MAX_ID}"
 
 
+def rectangular(values: ArrayLike, what: str) -> NDArray[Any]:
+    """``np.asarray(values)``; nested sequences of different lengths a ValueError naming `what`.
+
+    NumPy's own words name no argument ("setting an array element with a sequence. The
+    requested array has an inhomogeneous shape ..."): the resamplers' weights and
+    ``hsv_bins``' mask gave them (an integrator's trial).
+    """
+    try:
+        return np.asarray(values)
+    except ValueError:  # NumPy: "setting an array element with a sequence ... inhomogeneous"
+        raise ValueError(
+            f"{what} must be a rectangular array of numbers, got rows of different lengths"
+        ) from None
+
+
 def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
     """`values` as a float64 array, refusing what is not real numbers.
 
@@ -157,12 +172,7 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
         Nested sequences of different lengths (ragged rows).
     """
     refuse_masked(values, what)
-    try:
-        raw = np.asarray(values)
-    except ValueError:  # NumPy: "setting an array element with a sequence ... inhomogeneous"
-        raise ValueError(
-            f"{what} must be a rectangular array of numbers, got rows of different lengths"
-        ) from None
+    raw = rectangular(values, what)
     if raw.dtype.kind not in ("biuf" if booleans else "iuf"):
         raise TypeError(f"{what} must hold real numbers, got dtype {raw.dtype}")
     return raw.astype(np.float64, copy=False)

@@ -14,7 +14,14 @@ import numpy as np
 import pytest
 
 from pftrack import _core
-from pftrack.particle_filter import ColourParticleFilter, hsv_bins
+from pftrack.particle_filter import (
+    ColourParticleFilter,
+    hsv_bins,
+    multinomial_resample,
+    residual_resample,
+    stratified_resample,
+    systematic_resample,
+)
 from pftrack.particle_filter.filter import step_filters
 
 _FRAME = np.random.default_rng(0).integers(0, 256, (60, 80, 3)).astype(np.uint8)
@@ -48,6 +55,15 @@ CASES = [
     (lambda: hsv_bins(_FRAME, np.ones((60, 81), np.uint8)), ValueError,
      "hsv_bins: mask shape is (60, 81), expected the frame's (60, 80)"),
     (lambda: hsv_bins(_FRAME, lazy=1), TypeError, "hsv_bins: lazy must be a bool, got int"),
+    # ragged rows: were NumPy's "setting an array element with a sequence. The requested
+    # array has an inhomogeneous shape ...", naming no function (integrator trial)
+    (lambda: hsv_bins(_FRAME, [[1, 1], [1]]), ValueError,
+     "hsv_bins: mask must be a rectangular array of numbers, got rows of different lengths"),
+    *[(lambda fn=fn: fn([[0.5, 0.5], [1.0]], rng=0), ValueError,
+       f"{fn.__name__}: weights must be a rectangular array of numbers, got rows of different "
+       "lengths")
+      for fn in (systematic_resample, stratified_resample, multinomial_resample,
+                 residual_resample)],
     # the core's mask check, as every binding that takes a mask makes it (was ValueError)
     (lambda: _core.mask_bins(_IM, np.ones((60, 80), np.int64)), TypeError,
      "mask_bins: mask dtype is int64, expected uint8 or bool"),
