@@ -386,8 +386,13 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     """
     if not isinstance(frame, np.ndarray):
         # a list (``frame.tolist()``) is int64 to NumPy, and a PIL image uint8 but RGB: both
-        # refused alike (a PIL image was taken, its red read as blue)
-        if np.asarray(frame).dtype == object:
+        # refused alike (a PIL image was taken, its red read as blue); ragged rows too (were
+        # NumPy's "setting an array element with a sequence", naming nothing)
+        try:
+            loose = np.asarray(frame).dtype == object
+        except ValueError:
+            loose = True
+        if loose:
             raise TypeError(
                 f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array"
             )

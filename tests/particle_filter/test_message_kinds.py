@@ -57,6 +57,8 @@ CASES = [
     (lambda: hsv_bins(_FRAME, lazy=1), TypeError, "hsv_bins: lazy must be a bool, got int"),
     # ragged rows: were NumPy's "setting an array element with a sequence. The requested
     # array has an inhomogeneous shape ...", naming no function (integrator trial)
+    (lambda: hsv_bins([[1, 1], [1]]), TypeError,
+     "hsv_bins: frame is list, expected a (H, W, 3) uint8 BGR array"),
     (lambda: hsv_bins(_FRAME, [[1, 1], [1]]), ValueError,
      "hsv_bins: mask must be a rectangular array of numbers, got rows of different lengths"),
     *[(lambda fn=fn: fn([[0.5, 0.5], [1.0]], rng=0), ValueError,
