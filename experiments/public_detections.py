@@ -21,12 +21,16 @@ by 6 points from one seed to the next, docs/tracking.md), and ``--set`` changes
 one `TrackerConfig` field for a trial, e.g. ``--set motion.colour_noise=0.2``. ``--upscale 2``
 runs every sequence as footage of twice the resolution (frames resized bilinearly as they are
 read, detections and truth scaled): a tracker whose settings fit the frame's size scores the
-same.
+same. ``--empty 60`` removes every detection of frames 1-60 (a scene that starts empty) and
+scores the frames after them; ``--low-scores`` squeezes every score into [0.2, 0.5]
+(``0.2 + 0.6 (s - 0.5)`` of the score clipped to [0.5, 1], the ranking kept): a detector
+that scores below ``birth_score`` (docs/tracking.md, "Birth threshold").
 
 Usage (from the repository root)::
 
     python -m experiments.public_detections [--data ../shared/data] [--out DIR]
-        [--seeds 0 1 2] [--upscale 2] [--set SECTION.FIELD=VALUE ...]
+        [--seeds 0 1 2] [--upscale 2] [--empty 60] [--low-scores]
+        [--set SECTION.FIELD=VALUE ...]
 """
 
 from __future__ import annotations
@@ -161,6 +165,22 @@ def noisy_detections(
     return out
 
 
+def late_and_low(dets: dict[int, F64], empty: int, low: bool) -> dict[int, F64]:
+    """`dets` without frames ``1..empty``; with `low`, scores squeezed into [0.2, 0.5].
+
+    ``--empty`` and ``--low-scores``: ``0.2 + 0.6 (s - 0.5)`` of each score clipped to
+    [0.5, 1], the ranking of the scores above 0.5 kept.
+    """
+    out = {}
+    for f, d in dets.items():
+        if f <= empty:
+            continue
+        if low:
+            d = np.column_stack([d[:, :4], 0.2 + 0.6 * (np.clip(d[:, 4], 0.5, 1.0) - 0.5)])
+        out[f] = d
+    return out
+
+
 def line(name: str, s: SequenceScores) -> str:
     """One row of the table: MOTA, IDF1, HOTA (percent) and identity switches."""
     return (
@@ -256,8 +276,20 @@ def main(argv: list[str] | None = None) -> int:
         help="scale every sequence's frames, detections and truth by FACTOR, as footage of "
         "the same scene at another resolution (default: 1.0, as they are)",
     )  # fmt: skip
+    p.add_argument(
+        "--empty", type=int, default=0, metavar="N",
+        help="remove every detection of frames 1..N (a scene that starts empty) and score the "
+        "frames after them (default: 0)",
+    )  # fmt: skip
+    p.add_argument(
+        "--low-scores", action="store_true",
+        help="squeeze every detection score into [0.2, 0.5], the ranking kept: a detector "
+        "scoring below birth_score",
+    )  # fmt: skip
     add_settings(p, "motion.colour_noise=0.2")
     args = p.parse_args(argv)
+    if args.empty < 0:
+        p.error(f"--empty is {args.empty}, expected a frame count >= 0")
     if not (np.isfinite(args.upscale) and 0.1 <= args.upscale <= 8):
         p.error(f"--upscale is {args.upscale}, expected a factor in [0.1, 8]")
     config = settings_config(p, args.settings)
@@ -266,37 +298,45 @@ def main(argv: list[str] | None = None) -> int:
         for seed in args.seeds:
             if len(args.seeds) > 1:
                 print(f"-- seed {seed}")
-            scores = run_all(data, config, seed, args.upscale)
+            scores = run_all(data, config, seed, args.upscale, args.empty, args.low_scores)
             if scores:
                 print(line("pooled", SequenceScores.combine(scores)), flush=True)
     return 0
 
 
 def run_all(
-    data: Path, config: TrackerConfig, seed: int, factor: float = 1.0
+    data: Path,
+    config: TrackerConfig,
+    seed: int,
+    factor: float = 1.0,
+    empty: int = 0,
+    low: bool = False,
 ) -> list[SequenceScores]:
     """Track every sequence found under `data` and the synthetic scenes; print each row.
 
-    `factor` scales every sequence's frames, detections and truth (``--upscale``). Returns the
-    scores of every sequence run, in order.
+    `factor` scales every sequence's frames, detections and truth (``--upscale``); `empty`
+    and `low` change the detections (:func:`late_and_low`), and the frames ``1..empty`` are
+    not scored. Returns the scores of every sequence run, in order.
     """
     out: list[SequenceScores] = []
 
     def report(name: str, gt: F64, rows: F64, scale: float = 1.0) -> None:
         # the values pftrack track writes (2 decimals): pftrack eval of its file scores the same
-        s = evaluate_sequence(gt, as_written(rows), scale=scale * factor)
+        rows = as_written(rows)
+        gt, rows = gt[gt[:, 0] > empty], rows[rows[:, 0] > empty]
+        s = evaluate_sequence(gt, rows, scale=scale * factor)
         out.append(s)
         print(line(name, s), flush=True)
 
     for src, folder in video_folders(data):
-        dets = load_detections(folder / "det.txt", src.scale * factor)
+        dets = late_and_low(load_detections(folder / "det.txt", src.scale * factor), empty, low)
         video = FrameSource(folder / src.video)
         source = video if factor == 1 else Resized(video, factor)
         run = track_frames(source, detections=dets, config=config, rng=seed)
         report(src.name, read_mot(folder / "gt.txt"), run.rows, src.scale)
     for name, folder in no_video_folders(data):
         frames = black_frames(folder, factor)
-        dets = load_detections(folder / "det.txt", factor)
+        dets = late_and_low(load_detections(folder / "det.txt", factor), empty, low)
         with blank_frames_expected():
             run = track_frames(frames, detections=dets, config=config, rng=seed)
         report(name + " (black)", read_mot(folder / "gt.txt"), run.rows)
@@ -304,6 +344,7 @@ def run_all(
         scene = make_busy_scene(kind, rng=0)
         h, w = scene.frames[0].shape[:2]
         dets = scaled(noisy_detections(scene.truth, len(scene.frames), h, w), factor)
+        dets = late_and_low(dets, empty, low)
         source = scene.frames if factor == 1 else Resized(scene.frames, factor)
         run = track_frames(source, detections=dets, config=config, rng=seed)
         report(kind, scene.truth, run.rows)

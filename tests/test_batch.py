@@ -1415,7 +1415,7 @@ def test_an_unreachable_scheduler_writes_nothing(
     ("host", "said"),
     [
         ("127.0.0.1", "connection refused: nothing listens on port {port} of 127.0.0.1 (start "
-         "the scheduler there first: dask scheduler)"),
+         "the scheduler there first: dask scheduler --port {port})"),  # was: dask scheduler
         ("pftrack-nowhere.invalid", "host pftrack-nowhere.invalid not found (its name does not "
          "resolve)"),
     ],

@@ -6,7 +6,7 @@ import numbers
 import os
 import sys
 from collections.abc import Iterable, Iterator
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -117,11 +117,34 @@ def check_classes(classes: F64, what: str) -> None:
         )
 
 
+def exactly(value: float) -> str:
+    """`value` as a message shows a refused frame or id: an integer's digits, else ``repr``.
+
+    Not ``:g``, whose 6 digits turned frame 1 + 1e-12 into "frame 1, not an integer" and
+    2147483648 into 2.14748e+09.
+    """
+    v = float(value)
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
+
+
 def bad_id_message(value: float) -> str:
     """What is wrong with track id `value` (one :func:`first_bad_id` found), shown exactly."""
-    v = float(value)
-    shown = str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)  # not 2.14748e+09
-    return f"track id {shown} is not an integer with |id| <= {MAX_ID}"
+    return f"track id {exactly(value)} is not an integer with |id| <= {MAX_ID}"
+
+
+def rectangular(values: ArrayLike, what: str) -> NDArray[Any]:
+    """``np.asarray(values)``; nested sequences of different lengths a ValueError naming `what`.
+
+    NumPy's own words name no argument ("setting an array element with a sequence. The
+    requested array has an inhomogeneous shape ..."): the resamplers' weights and
+    ``hsv_bins``' mask gave them (an integrator's trial).
+    """
+    try:
+        return np.asarray(values)
+    except ValueError:  # NumPy: "setting an array element with a sequence ... inhomogeneous"
+        raise ValueError(
+            f"{what} must be a rectangular array of numbers, got rows of different lengths"
+        ) from None
 
 
 def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
@@ -149,12 +172,7 @@ def real_array(values: ArrayLike, what: str, *, booleans: bool = True) -> F64:
         Nested sequences of different lengths (ragged rows).
     """
     refuse_masked(values, what)
-    try:
-        raw = np.asarray(values)
-    except ValueError:  # NumPy: "setting an array element with a sequence ... inhomogeneous"
-        raise ValueError(
-            f"{what} must be a rectangular array of numbers, got rows of different lengths"
-        ) from None
+    raw = rectangular(values, what)
     if raw.dtype.kind not in ("biuf" if booleans else "iuf"):
         raise TypeError(f"{what} must hold real numbers, got dtype {raw.dtype}")
     return raw.astype(np.float64, copy=False)
@@ -368,8 +386,13 @@ def bgr_array(frame: ArrayLike, what: str = "frame") -> NDArray[np.uint8]:
     """
     if not isinstance(frame, np.ndarray):
         # a list (``frame.tolist()``) is int64 to NumPy, and a PIL image uint8 but RGB: both
-        # refused alike (a PIL image was taken, its red read as blue)
-        if np.asarray(frame).dtype == object:
+        # refused alike (a PIL image was taken, its red read as blue); ragged rows too (were
+        # NumPy's "setting an array element with a sequence", naming nothing)
+        try:
+            loose = np.asarray(frame).dtype == object
+        except ValueError:
+            loose = True
+        if loose:
             raise TypeError(
                 f"{what} is {type(frame).__name__}, expected a (H, W, 3) uint8 BGR array"
             )

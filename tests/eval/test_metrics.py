@@ -235,6 +235,9 @@ def test_fractional_ids_and_frames_are_refused_not_truncated(tmp_path, capsys):
             evaluate(HAND_GT, res)
         with pytest.raises(ValueError, match=r"(gt|truth) row \d+ has frame 2.5, expected an"):
             evaluate(np.vstack([HAND_GT, [2.5, 9, 0, 0, 5, 5, 1, -1, -1, -1]]), HAND_RES)
+        # was "has frame 2, expected an integer": :g's 6 digits hid what is wrong
+        with pytest.raises(ValueError, match=r"(gt|truth) row \d+ has frame 2\.0000000001, expe"):
+            evaluate(np.vstack([HAND_GT, [2 + 1e-10, 9, 0, 0, 5, 5, 1, -1, -1, -1]]), HAND_RES)
     lines = "1,1.5,10,10,5,5,1,-1,-1,-1\n1,1.7,30,10,5,5,1,-1,-1,-1\n"
     (tmp_path / "frac.txt").write_text(lines)
     write_mot(tmp_path / "gt.txt", HAND_GT)

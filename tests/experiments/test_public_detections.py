@@ -96,3 +96,14 @@ def test_main_rejects_a_bad_upscale(factor: str, capsys: pytest.CaptureFixture[s
 def test_override_of_an_unset_field_takes_an_int_or_a_float() -> None:
     assert ex.override(TrackerConfig(), "max_side=640").max_side == 640
     assert ex.override(TrackerConfig(), "pixel_diagonal=400.5").pixel_diagonal == 400.5
+
+
+def test_late_and_low_drops_the_first_frames_and_squeezes_scores() -> None:
+    """``--empty N`` removes frames 1..N; ``--low-scores`` puts scores in [0.2, 0.5], ranked."""
+    dets = {f: np.array([[1.0, 2.0, 3.0, 4.0, s] for s in (0.3, 0.6, 1.0)]) for f in (1, 2, 3)}
+    assert ex.late_and_low(dets, 0, False) == dets
+    out = ex.late_and_low(dets, 2, True)
+    assert list(out) == [3]
+    assert np.allclose(out[3][:, 4], [0.2, 0.26, 0.5]) and np.array_equal(
+        out[3][:, :4], dets[3][:, :4]
+    )

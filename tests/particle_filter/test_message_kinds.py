@@ -14,8 +14,15 @@ import numpy as np
 import pytest
 
 from pftrack import _core
-from pftrack.particle_filter import ColourParticleFilter, hsv_bins
-from pftrack.particle_filter.filter import step_filters
+from pftrack.particle_filter import (
+    ColourParticleFilter,
+    hsv_bins,
+    multinomial_resample,
+    residual_resample,
+    stratified_resample,
+    systematic_resample,
+)
+from pftrack.particle_filter.filter import reinitialise_filters, step_filters
 
 _FRAME = np.random.default_rng(0).integers(0, 256, (60, 80, 3)).astype(np.uint8)
 _IM = hsv_bins(_FRAME)
@@ -48,6 +55,17 @@ CASES = [
     (lambda: hsv_bins(_FRAME, np.ones((60, 81), np.uint8)), ValueError,
      "hsv_bins: mask shape is (60, 81), expected the frame's (60, 80)"),
     (lambda: hsv_bins(_FRAME, lazy=1), TypeError, "hsv_bins: lazy must be a bool, got int"),
+    # ragged rows: were NumPy's "setting an array element with a sequence. The requested
+    # array has an inhomogeneous shape ...", naming no function (integrator trial)
+    (lambda: hsv_bins([[1, 1], [1]]), TypeError,
+     "hsv_bins: frame is list, expected a (H, W, 3) uint8 BGR array"),
+    (lambda: hsv_bins(_FRAME, [[1, 1], [1]]), ValueError,
+     "hsv_bins: mask must be a rectangular array of numbers, got rows of different lengths"),
+    *[(lambda fn=fn: fn([[0.5, 0.5], [1.0]], rng=0), ValueError,
+       f"{fn.__name__}: weights must be a rectangular array of numbers, got rows of different "
+       "lengths")
+      for fn in (systematic_resample, stratified_resample, multinomial_resample,
+                 residual_resample)],
     # the core's mask check, as every binding that takes a mask makes it (was ValueError)
     (lambda: _core.mask_bins(_IM, np.ones((60, 80), np.int64)), TypeError,
      "mask_bins: mask dtype is int64, expected uint8 or bool"),
@@ -55,6 +73,22 @@ CASES = [
      "mask_bins: mask dtype is float32, expected uint8 or bool"),
     (lambda: _core.mask_bins(_IM, np.ones((60, 81), np.uint8)), ValueError,
      "mask_bins: mask must have the frame's (H, W) shape"),
+    # the filter's own checks name it, as its step's do (were "box is ...", "reference
+    # histogram must be ...": no function; integrator trial)
+    (lambda: ColourParticleFilter([40, 30, 0, 20], np.ones(110)), ValueError,
+     "ColourParticleFilter: box is [40.0, 30.0, 0.0, 20.0], expected finite (cx, cy, w, h) "
+     "with w, h > 0, each value within ±1e+09 px"),
+    (lambda: ColourParticleFilter([40, 30, 10, 20], np.zeros(110)), ValueError,
+     "ColourParticleFilter: reference histogram must be finite, >= 0 and not all zero"),
+    (lambda: ColourParticleFilter([40, 30, 10, 20], np.ones(110), velocity=[1.0]), ValueError,
+     "ColourParticleFilter: velocity must have shape (2,) (vx, vy), got (1,): [1.0]"),
+    (lambda: _filter().reinitialise([40, 30, 10, -1]), ValueError,
+     "ColourParticleFilter.reinitialise: box is [40.0, 30.0, 10.0, -1.0], expected finite "
+     "(cx, cy, w, h) with w, h > 0, each value within ±1e+09 px"),
+    (lambda: reinitialise_filters([_filter(), _filter()], [[1, 1, 5, 5], [1, 1, 5, 0]],
+                                  [[0, 0], [0, 0]]), ValueError,
+     "reinitialise_filters: filters[1]: box is [1.0, 1.0, 5.0, 0.0], expected finite "
+     "(cx, cy, w, h) with w, h > 0, each value within ±1e+09 px"),
     # the filter's step and the batch say the same, the batch naming the filter's place
     (lambda: _float32("particles").step(_IM), TypeError,
      f"ColourParticleFilter.particles {IN_PLACE} float32 (100, 6), C-contiguous"),

@@ -78,7 +78,9 @@ def test_default_max_gap_everywhere() -> None:
 @pytest.mark.parametrize(
     ("bad", "match"),
     [
-        (1e12, "row 0 has frame 1e\\+12, not an integer"),
+        (1e12, "row 0 has frame 1000000000000, not an integer"),  # was 1e+12
+        (2.0**31, "row 0 has frame 2147483648, not an integer"),  # was 2.14748e+09
+        (1 + 1e-12, r"row 0 has frame 1\.000000000001, not an integer"),  # was "frame 1, not"
         (2.5, "row 0 has frame 2.5, not an integer"),
         (0, "row 0 has frame 0, not an integer .*add 1 to every frame"),
         (np.nan, "non-finite"),

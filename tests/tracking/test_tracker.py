@@ -734,8 +734,35 @@ def test_one_class_with_few_scores_keeps_the_window_level_after_it():
     """A run of one class with under 20 scores over the window keeps the window's level after
     it (the late learning is for a class beside others): runs without classes unchanged."""
     tracker = MultiObjectTracker(rng=0)
-    frame, dets, _ = _people_and_a_bicycle(80)
-    for k, d in enumerate(dets, start=1):
-        tracker.update(frame, d[:1] if 46 <= k <= 50 or k > 60 else d[:0])
+    frame, dets, _ = _people_and_a_bicycle(120)
+    for k, d in enumerate(dets, start=1):  # the window: frames 46-95, from the first score
+        tracker.update(frame, d[:1] if 46 <= k <= 50 or k > 95 else d[:0])
     pooled = min(0.9, float(np.quantile([d[0, 4] for d in dets[45:50]], 0.25)))
     assert tracker.birth_threshold() == tracker.birth_threshold(0) == pooled
+
+
+def test_the_birth_window_starts_at_the_first_frame_with_detections():
+    """A street empty for its first 60 frames, then people a detector scores 0.3-0.5: the
+    window of the run's first 50 frames had learned nothing, the threshold stayed 0.9 and no
+    track ever started (finalize warned "no track"). The window now starts with the first
+    detections: their lower quartile, fixed 50 frames later. A checkpoint made before the
+    rule (no `_birth_start`) goes on with the window from frame 1, as it would have."""
+    frame, dets, _ = _people_and_a_bicycle(130)
+    low = [d[4:5] for d in dets]  # the bicycle alone: class 0 here, scores 0.3-0.5
+    tracker = _born_at_first_hit()
+    born = []
+    for k, d in enumerate(low, start=1):
+        tracks = tracker.update(frame, d if k > 60 else d[:0])
+        if tracks:
+            born.append(k)
+        if k == 60:
+            state = tracker.__getstate__()
+            state.pop("_birth_start", None)
+            older = MultiObjectTracker.__new__(MultiObjectTracker)
+            older.__setstate__(pickle.loads(pickle.dumps(state)))
+        if k > 60:
+            older.update(frame, d)
+    window = [d[0, 4] for d in low[60:110]]  # frames 61-110
+    assert tracker.birth_threshold() == float(np.quantile(window, 0.25)) < 0.5
+    assert born == list(range(61, 131))
+    assert older.birth_threshold() == 0.9  # its window, frames 1-50, saw no score

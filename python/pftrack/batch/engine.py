@@ -584,6 +584,8 @@ TLS_SETTINGS = (
 )
 
 
+#: The port ``dask scheduler`` listens on without ``--port``.
+DASK_PORT = 8786
 #: Seconds a refused connection is tried again before :func:`dask_client` gives up (a
 #: scheduler started a moment before the batch may not listen yet).
 REFUSED_GRACE = 2.0
@@ -617,9 +619,12 @@ def _refused(address: str) -> str | None:
             if time.monotonic() < deadline:
                 time.sleep(0.2)
                 continue
+            # Dask's own port needs no option; another one does (was: `dask scheduler` for
+            # every port, which then listened on 8786, not where the batch looked)
+            start = "dask scheduler" + ("" if port == DASK_PORT else f" --port {port}")
             return (
                 f"connection refused: nothing listens on port {port} of {host} (start the "
-                "scheduler there first: dask scheduler)"
+                f"scheduler there first: {start})"
             )
         except OSError:
             return None

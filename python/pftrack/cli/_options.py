@@ -437,7 +437,8 @@ def add_tracker_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--birth-score", type=bounded_float(0.0, 1.0), default=None, metavar="S",
         help="with --detections: a detection starts a track with a score of at least min(S, "
-        "the lower quartile of the scores of the first 50 frames), S in [0, 1] (applied while "
+        "the lower quartile of the scores of 50 frames from the first with detections), S in "
+        "[0, 1] (applied while "
         "every score lies in [0, 1]; other scores never gate births); refused without "
         f"--detections: the built-in detector starts a track from any blob (default: "
         f"{DEFAULT_BIRTH_SCORE:g})",

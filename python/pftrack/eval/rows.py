@@ -17,6 +17,7 @@ from pftrack._check import (
     MAX_FRAME,
     MOT_DEFAULTS,
     bad_id_message,
+    exactly,
     first_bad_id,
     frames_from_1,
     integer,
@@ -78,12 +79,12 @@ def check_eval_rows(rows: ArrayLike, what: str) -> NDArray[np.float64]:
     frac = a[:, 0] != np.floor(a[:, 0])
     if frac.any():  # cast to int, 1.5 would be scored as frame 1
         k = int(np.flatnonzero(frac)[0])
-        raise ValueError(f"{what} row {k} has frame {a[k, 0]:g}, expected an integer")
+        raise ValueError(f"{what} row {k} has frame {exactly(a[k, 0])}, expected an integer")
     early = a[:, 0] < 1
     if early.any():  # as read_mot refuses it: MOTChallenge frames count from 1
         k = int(np.flatnonzero(early)[0])
         raise ValueError(
-            f"{what} row {k} has frame {a[k, 0]:g}, expected >= 1 {frames_from_1(a[k, 0])}"
+            f"{what} row {k} has frame {exactly(a[k, 0])}, expected >= 1 {frames_from_1(a[k, 0])}"
         )
     negative = (a[:, 4] < 0) | (a[:, 5] < 0)
     if negative.any():  # as read_mot refuses it: such a box overlaps nothing, silently

@@ -25,6 +25,7 @@ from pftrack._check import (
     BOX_VALUES,
     MAX_FRAME,
     MOT_DEFAULTS,
+    exactly,
     first_bad_box,
     frames_from_1,
     mot_rows,
@@ -486,7 +487,7 @@ def _checked(rows: NDArray[np.float64] | Iterable[Iterable[float]], who: str) ->
     if np.any((fr < 1) | (fr > MAX_FRAME)):
         k = int(np.flatnonzero((fr < 1) | (fr > MAX_FRAME))[0])
         raise ValueError(
-            f"{who}: row {k} has frame {fr[k]:g}, expected an integer in 1..{MAX_FRAME} "
+            f"{who}: row {k} has frame {exactly(fr[k])}, expected an integer in 1..{MAX_FRAME} "
             f"{frames_from_1(fr[k])}"
         )
     bad = first_bad_box(a[:, LEFT : HEIGHT + 1])  # what read_mot refuses is never written

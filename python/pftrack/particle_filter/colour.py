@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import bgr_array, brief, integer, number, real_array, shown
+from pftrack._check import bgr_array, brief, integer, number, real_array, rectangular, shown
 
 BinnedImage = _core.BinnedImage
 
@@ -141,7 +141,7 @@ def hsv_bins(
     f = _frame(frame, f"{fn}: frame")
     m = None
     if mask is not None:
-        m = np.asarray(mask)
+        m = rectangular(mask, f"{fn}: mask")
         if m.dtype not in (np.uint8, np.bool_):
             raise TypeError(f"{fn}: mask dtype is {m.dtype}, expected uint8 or bool")
         if m.shape != f.shape[:2]:

@@ -133,7 +133,7 @@ class FilterState:
     foreground: float
 
 
-def _box(box_cxcywh: ArrayLike) -> NDArray[np.float64]:
+def _box(box_cxcywh: ArrayLike, who: str) -> NDArray[np.float64]:
     """A box ``(cx, cy, w, h)`` the filter can follow: :func:`box_histograms`' rule, w, h > 0.
 
     Raises
@@ -144,10 +144,10 @@ def _box(box_cxcywh: ArrayLike) -> NDArray[np.float64]:
         Not 4 values, a non-finite one, w or h <= 0, or a value beyond ±1e9 px (which
         :func:`~pftrack.particle_filter.box_histograms` refuses at the first step).
     """
-    b = real_array(box_cxcywh, "box").reshape(-1)
+    b = real_array(box_cxcywh, f"{who}: box").reshape(-1)
     if b.shape != (4,) or not (_bounded(b) and b[2] > 0 and b[3] > 0):
         raise ValueError(
-            f"box is {b.tolist()}, expected finite (cx, cy, w, h) with w, h > 0, each value "
+            f"{who}: box is {b.tolist()}, expected finite (cx, cy, w, h) with w, h > 0, each value "
             f"within ±{MAX_COORD:g} px"
         )
     return b
@@ -158,7 +158,7 @@ def _bounded(values: NDArray[np.float64]) -> bool:
     return bool((np.abs(values) < MAX_COORD).all())  # NaN fails
 
 
-def _velocity(velocity: ArrayLike) -> NDArray[np.float64]:
+def _velocity(velocity: ArrayLike, who: str) -> NDArray[np.float64]:
     """A velocity ``(vx, vy)`` in pixels per frame: 2 finite values within ``±MAX_COORD``.
 
     Raises
@@ -169,12 +169,15 @@ def _velocity(velocity: ArrayLike) -> NDArray[np.float64]:
         Not shape (2,) (a third value would be dropped), or a value not finite or beyond
         ±1e9 px per frame.
     """
-    v = real_array(velocity, "velocity")
+    v = real_array(velocity, f"{who}: velocity")
     if v.shape != (2,):
-        raise ValueError(f"velocity must have shape (2,) (vx, vy), got {v.shape}: {v.tolist()}")
+        raise ValueError(
+            f"{who}: velocity must have shape (2,) (vx, vy), got {v.shape}: {v.tolist()}"
+        )
     if not _bounded(v):
         raise ValueError(
-            f"velocity is {v.tolist()}, expected finite (vx, vy) within ±{MAX_COORD:g} px per frame"
+            f"{who}: velocity is {v.tolist()}, expected finite (vx, vy) within "
+            f"±{MAX_COORD:g} px per frame"
         )
     return v
 
@@ -375,8 +378,11 @@ class ColourParticleFilter:
         self._rng = generator(rng, "rng")
         self._seed = int(self._rng.integers(2**63))
         self._step = 0
-        b = _box(box_cxcywh)
-        v0 = _velocity(velocity)  # None here is no velocity: refused (reinitialise's None keeps)
+        who = type(self).__name__  # the messages name the class made (MHColourParticleFilter)
+        b = _box(box_cxcywh, who)
+        v0 = _velocity(
+            velocity, who
+        )  # None here is no velocity: refused (reinitialise's None keeps)
         self.w0, self.h0 = float(b[2]), float(b[3])
         self._set_reference(
             reference,
@@ -461,16 +467,17 @@ class ColourParticleFilter:
 
     def _set_reference(self, reference: ArrayLike, n_bins: int | None, source: str) -> None:
         """:meth:`set_reference`, holding the length to `n_bins` (None: any), named `source`."""
-        r = np.ascontiguousarray(real_array(reference, "reference"))
+        who = type(self).__name__
+        r = np.ascontiguousarray(real_array(reference, f"{who}: reference"))
         if r.ndim != 1:  # a (1, B) or (K, B) array would be taken as one long histogram
-            raise ValueError(f"reference has shape {r.shape}, expected (B,) bins")
+            raise ValueError(f"{who}: reference has shape {r.shape}, expected (B,) bins")
         if n_bins is not None and len(r) != n_bins:
             raise ValueError(
-                f"reference has {len(r)} bins, expected {n_bins} ({source}; a histogram of "
-                "another HsvBinning?)"
+                f"{who}: reference has {len(r)} bins, expected {n_bins} ({source}; a histogram "
+                "of another HsvBinning?)"
             )
         if not np.all(np.isfinite(r)) or np.any(r < 0) or r.sum() <= 0:
-            raise ValueError("reference histogram must be finite, >= 0 and not all zero")
+            raise ValueError(f"{who}: reference histogram must be finite, >= 0 and not all zero")
         self.reference = r / r.sum()
 
     def reinitialise(
@@ -499,8 +506,9 @@ class ColourParticleFilter:
         RuntimeError
             Another thread is inside this filter's ``step`` or ``reinitialise``.
         """
-        b = _box(box_cxcywh)
-        v = None if velocity is None else _velocity(velocity)
+        who = f"{type(self).__name__}.reinitialise"
+        b = _box(box_cxcywh, who)
+        v = None if velocity is None else _velocity(velocity, who)
         spread = _spread(spread, self.config.model)
         if not self._busy.acquire(blocking=False):
             raise _in_use(self, f"{type(self).__name__}.reinitialise")
@@ -795,7 +803,8 @@ def reinitialise_filters(
     # the bad one runs only when there is one (the tracker calls this every frame)
     if not np.abs(v).max() < MAX_COORD:
         bad_v = ~(np.abs(v) < MAX_COORD).all(axis=1)
-        _velocity(v[int(np.flatnonzero(bad_v)[0])])  # raises, naming the velocity
+        k_v = int(np.flatnonzero(bad_v)[0])
+        _velocity(v[k_v], f"reinitialise_filters: filters[{k_v}]")  # raises, naming it
     cfg = filters[0].config
     one_config = all(f.config is cfg or f.config == cfg for f in filters)
     if not one_config:
@@ -803,7 +812,8 @@ def reinitialise_filters(
             _spread(spread, f.config.model)
     if not (np.abs(b).max() < MAX_COORD and b[:, 2:].min() > 0):
         bad = ~((np.abs(b) < MAX_COORD).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0))
-        _box(b[int(np.flatnonzero(bad)[0])])  # raises, naming the box
+        k_b = int(np.flatnonzero(bad)[0])
+        _box(b[k_b], f"reinitialise_filters: filters[{k_b}]")  # raises, naming the box
     held = list({id(f): f for f in filters}.values())  # a filter given twice: one lock
     _take(held, "reinitialise_filters")
     try:

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import generator, refuse_masked_weights
+from pftrack._check import generator, rectangular, refuse_masked_weights
 from pftrack._typing import RngLike
 
 __all__ = [
@@ -56,7 +56,7 @@ def _weights(weights: ArrayLike, fn: str) -> NDArray[np.float64]:
             "(an iterator: make it a list or an array first)"
         )
     refuse_masked_weights(weights, fn)
-    w = np.asarray(weights)
+    w = rectangular(weights, f"{fn}: weights")
     if np.iscomplexobj(w):
         raise TypeError(f"{fn}: weights must be real, got dtype {w.dtype}")
     if w.dtype.kind not in "biuf":  # timedelta64 is a NumPy integer, not a number of ours

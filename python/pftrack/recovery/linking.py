@@ -25,6 +25,7 @@ from pftrack._check import (
     NORMALISED_REACH,
     bad_id_message,
     brief,
+    exactly,
     first_bad_box,
     first_bad_id,
     frames_from_1,
@@ -603,7 +604,7 @@ def check_rows(rows: ArrayLike, what: str, name: str = "rows") -> F64:
     if bad.any():
         r = int(np.flatnonzero(bad)[0])
         raise ValueError(
-            f"{what}: row {r} has frame {f[r]:g}, not an integer in 1..{MAX_FRAME} "
+            f"{what}: row {r} has frame {exactly(f[r])}, not an integer in 1..{MAX_FRAME} "
             f"{frames_from_1(f[r])}"
         )
     k = first_bad_id(i)

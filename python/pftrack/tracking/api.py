@@ -7,9 +7,9 @@ command never disagree: the same frames, detections and seed give the same rows.
 Time constants given in seconds (``max_coast``, ``prime``) are turned into frames with
 ``frame_rate`` (``round(seconds * frame_rate)``). Left at their defaults, every time constant
 is the command's frame count at any frame rate: a track coasts 10 frames, :meth:`prime` reads
-30, the linker bridges 30, the birth threshold watches the first 50, the offline pass cuts
-after 7 coasted ones (``LifecycleConfig.relink_coast``) and a blind coast ends after 3
-(``LifecycleConfig.blind_coast``). Frame counts were measured better
+30, the linker bridges 30, the birth threshold watches 50 (from the first with detections),
+the offline pass cuts after 7 coasted ones (``LifecycleConfig.relink_coast``) and a blind
+coast ends after 3 (``LifecycleConfig.blind_coast``). Frame counts were measured better
 than the same seconds at each sequence's own rate (public detections, seed 0, MOTA / IDF1):
 PETS09-S2L1 at its 7 frames/s 77.9 / 79.6 against 76.4 / 58.2 with every constant in seconds
 (3 frames of coasting, a linking gap of 8); ADL-Rundle-6 at 30/s 38.4 / 45.6 against 36.8 / 44.9;
@@ -505,7 +505,8 @@ class Tracker:
         Cap of the confidence a detection needs to start a track, in [0, 1].
     birth_quantile : float or None
         The birth threshold is ``min(birth_score, quantile)`` of the confidences seen in the
-        first 50 frames, so a detector whose scores are all low still starts tracks (None: always
+        50 frames from the first with detections (a scene empty at first learns from its first
+        people), so a detector whose scores are all low still starts tracks (None: always
         `birth_score`); each class (the `dets`' column 6) with 20 confidences there has its own;
         beside another class, a class with fewer (or first seen later) learns its own once it
         has 20, whenever that is, and takes the pooled one until then. `min_conf` stays one

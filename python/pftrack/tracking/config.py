@@ -293,8 +293,11 @@ class LifecycleConfig:
         `birth_quantile` this is a cap: the threshold is relative to the detector (see there).
     birth_quantile : float or None
         Make the birth threshold relative to the detector: ``min(birth_score, q)`` where ``q``
-        is this quantile of the scores (at least `min_score`) seen over the first
-        `birth_window` frames, updated each frame until then and fixed afterwards. The default
+        is this quantile of the scores (at least `min_score`) seen over `birth_window` frames
+        from the first with such a score (a scene empty at first, a street before anyone walks
+        in, learns from its first detections; was: the run's first frames, after which a
+        detector scoring below `birth_score` started no track at all), updated each frame
+        until then and fixed afterwards. The default
         0.25 (the lower quartile) keeps 0.9 for a detector whose scores mostly lie above it
         (PETS09 and TUD-Campus public detections: the quartile of their first 50 frames never
         falls below 0.96 and 0.91) and lets a detector whose scores all lie in [0.2, 0.5] start
@@ -307,7 +310,8 @@ class LifecycleConfig:
         whenever that is (when the window held another class's scores: a run of one class
         keeps the window's level). None: `birth_score` as is.
     birth_window : int
-        Frames over which the score distribution is learned (2 s at 25 frames/s), >= 1.
+        Frames over which the score distribution is learned (2 s at 25 frames/s), >= 1,
+        from the first frame with a score of at least `min_score`.
     min_hits : int
         Matched frames before a new track is reported (tracks born in the first `min_hits`
         frames are reported at once), >= 0.

@@ -214,6 +214,8 @@ class MultiObjectTracker:
         self._joint_class: int | None = None  # sampler "rjmcmc": the run's one class id
         self._primed_shape: tuple[int, ...] = ()  # of the frames given to prime()
         self._birth_scores: F64 = np.zeros(0)  # scores of the first frames, sorted
+        # the frame the birth window starts at: the first with a kept score (see _learn_birth)
+        self._birth_start: int | None = None
         self._birth_level = np.inf
         # the same per class, and the level of each class with MIN_CLASS_BIRTH_SCORES of them
         self._class_birth_scores: dict[int, F64] = {}
@@ -262,6 +264,8 @@ class MultiObjectTracker:
             enough = len(pooled) >= MIN_CLASS_BIRTH_SCORES
             state["_class_birth_levels"] = {0: state.get("_birth_level", np.inf)} if enough else {}
         state.setdefault("_late_birth_scores", {})  # made when late classes took the pooled
+        # made when the window started at frame 1: it goes on doing so
+        state.setdefault("_birth_start", 1)
         self.__dict__.update(state)
         self._busy = threading.Lock()  # a checkpoint pickled before the lock had none
 
@@ -509,13 +513,19 @@ class MultiObjectTracker:
     def _learn_birth(self, scores: F64, labels: NDArray[np.int64]) -> None:
         """Add a frame's kept scores to the birth threshold's (``LifecycleConfig.birth_quantile``).
 
-        Over the first ``birth_window`` frames, pooled and per class (`labels`); fixed after.
+        Over ``birth_window`` frames from the first with a kept score, pooled and per class
+        (`labels`); fixed after. The window starts there, not at the run's first frame: a
+        scene empty for its first 50 frames (a camera watching an empty street) learned
+        nothing, and a detector whose scores stay below ``birth_score`` started no track at
+        all (was: ``frame_index > birth_window``).
         """
         rules = self.config.lifecycle
         q = rules.birth_quantile
         if q is None or not len(scores):
             return
-        if self.frame_index > rules.birth_window:
+        if self._birth_start is None:
+            self._birth_start = self.frame_index
+        if self.frame_index - self._birth_start >= rules.birth_window:
             self._learn_late_birth(scores, labels, q)
             return
         self._birth_scores = np.sort(np.concatenate([self._birth_scores, scores]))
@@ -553,7 +563,8 @@ class MultiObjectTracker:
         """The score a detection of class `cls` needs to start a track.
 
         ``min(birth_score, q)``, ``q`` the ``LifecycleConfig.birth_quantile`` of the scores of
-        the first ``birth_window`` frames (updated each frame until then, fixed after): of
+        ``birth_window`` frames from the first with a kept score (updated each frame until then,
+        fixed after): of
         class `cls`'s scores once there are :data:`MIN_CLASS_BIRTH_SCORES` of them, else of
         every class's (a class short of them over the window, beside another class, goes on
         learning after it: `_learn_late_birth`). A class
