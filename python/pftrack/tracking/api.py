@@ -94,7 +94,7 @@ from pftrack.tracking.offline import (
     drop_odd_sizes,
 )
 from pftrack.tracking.track import Track
-from pftrack.tracking.tracker import MultiObjectTracker
+from pftrack.tracking.tracker import MultiObjectTracker, first_copies
 from pftrack.tracking.writer import TrackWriter
 
 __all__ = [
@@ -1403,6 +1403,9 @@ class Tracker:
             if self.record and life.size_ratio is not None and scored.any():  # finalize's
                 box = xywh[scored]
                 c = np.zeros(len(box)) if cls is None else cls[scored].astype(np.float64)
+                once = first_copies(box, c)  # a row given twice is one detection, as in _step
+                if once is not None:
+                    box, c = box[once], c[once]
                 foot, at = box[:, 1] + box[:, 3], np.full(len(box), float(self.frame_count))
                 self._sizes.append(np.column_stack([foot, box[:, 3], c, at]))
             self._layout = (self._layout[0] + inverted, self._layout[1] + extent)

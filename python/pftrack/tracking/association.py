@@ -19,9 +19,10 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack._typing import F64
+from pftrack.boxes import _iou_matrix
 from pftrack.tracking.config import AssociationConfig
 
-__all__ = ["Association", "associate", "covers_another"]
+__all__ = ["Association", "associate", "covers_another", "first_of_twins"]
 
 #: Cost of a pair the gate forbids: larger than any sum of admissible costs.
 FORBIDDEN = 1e6
@@ -163,3 +164,34 @@ def covers_another(
         if x < cx < right and y < cy < bottom:
             return True
     return False
+
+
+def first_of_twins(boxes: F64, labels: NDArray[np.int64], candidates: Sequence[int],
+                   explained: NDArray[np.bool_], overlap: float | None) -> list[int]:  # fmt: skip
+    """The `candidates` that start an object: none on an object another detection explains.
+
+    A greedy non-maximum suppression among a frame's births, the one rule of every sampler
+    (``sampler="sis"`` and ``"mh"`` for the tracks they start, ``"rjmcmc"`` for the joint
+    chain's newborn slots). `candidates`, rows of `boxes` (``left, top, w, h``, the frame's
+    detections in :func:`~pftrack.tracking.tracker.canonical_order`), are taken in the order
+    given, highest score first; each that passes is kept and then explains its object. A
+    candidate is refused when it overlaps, by an IoU above `overlap`
+    (``LifecycleConfig.birth_overlap``; None: every candidate is kept), a detection of its
+    class that `explained` marks (e.g. one matched to a track) or a candidate kept before it:
+    the same box twice, from a detector without non-maximum suppression or from two
+    detectors' outputs concatenated. `explained` is not changed.
+    """
+    if overlap is None or len(boxes) < 2 or not len(candidates):
+        return list(candidates)
+    rows = np.asarray(candidates, dtype=np.intp)
+    twins = (_iou_matrix(boxes[rows, :4], boxes[:, :4]) > overlap) & (
+        labels[rows][:, None] == labels[None, :]
+    )
+    explained = explained.copy()
+    kept = []
+    for k, di in enumerate(candidates):
+        if twins[k, explained].any():
+            continue
+        explained[di] = True
+        kept.append(di)
+    return kept

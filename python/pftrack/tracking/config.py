@@ -383,7 +383,9 @@ class LifecycleConfig:
         concatenated, or a part of the person), which otherwise became a second track beside
         the first and, where the two then swapped, an identity switch (until 6 December only
         confirmed tracks counted, and each duplicated box started two tracks). The built-in
-        detector's objects are left alone. In (0, 1]; None: off. The default 0.3 was chosen
+        detector's objects are left alone. Every sampler follows it (``"rjmcmc"``: no newborn
+        slot; since 6 December). A row given twice exactly (the same box and class) is one
+        detection whatever this is. In (0, 1]; None: off. The default 0.3 was chosen
         over every sequence with public detections (docs/tracking.md, "Births beside a
         tracked person"); 0.5 and above change nothing there, since a detection that overlaps
         a track that much is matched to it.

@@ -50,7 +50,7 @@ from pftrack.detection import (
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.particle_filter.filter import _in_use
-from pftrack.tracking.association import associate, covers_another
+from pftrack.tracking.association import associate, covers_another, first_of_twins
 from pftrack.tracking.camera import CameraMotion, CameraStep, warp_tracks
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.joint import JointTracker
@@ -719,6 +719,12 @@ class MultiObjectTracker:
         if given is not None and len(given[1]) > 1:
             rank = canonical_order(*given)
             given = (given[0][rank], given[1][rank], given[2][rank])
+            # a row given again (the same box and class) is one detection; the copy is in no
+            # output row, as a duplicate refused a birth is in none (first_of_twins)
+            once = first_copies(given[0], given[2])
+            if once is not None:
+                rank = rank[once]
+                given = (given[0][once], given[1][once], given[2][once])
         if cfg is None:
             self._frame_shape = f.shape
             self.pixel_scale = self.config.pixel_scale(f.shape[1], f.shape[0])
@@ -780,7 +786,9 @@ class MultiObjectTracker:
                 mask = np.full(f.shape[:2], 255, np.uint8)  # no background model: all foreground
             if given is not None and len(given[2]) and self._joint_class is None:
                 self._joint_class = int(given[2][0])
-            joint = self._joint.step(self.frame_index, binned, mask, boxes, scores, index)
+            joint = self._joint.step(
+                self.frame_index, binned, mask, boxes, scores, index, labels, given is not None
+            )
             if self._joint_class:  # the run's class on every row (the sampler's objects have none)
                 joint = [dataclasses.replace(t, cls=self._joint_class) for t in joint]
             return joint
@@ -873,22 +881,25 @@ class MultiObjectTracker:
         born = cfg if detections is None else self._given_config  # given_particles
         unmatched = result.unmatched_detections
         beside = set() if detections is None else self._beside(boxes, labels, unmatched, cfg)
-        twins = None if detections is None else _twins(boxes, labels, unmatched, cfg)
-        # the detections that explain an object: those matched to a track, and the births
+        # not born: no foreground colour to build a reference from, too unsure, or a second
+        # box on a person already followed (LifecycleConfig.birth_overlap)
+        candidates = [
+            di
+            for di in unmatched
+            if not (
+                hists[di].sum() <= 0
+                or scores[di] < gates.get(int(labels[di]), -np.inf)
+                or di in beside
+            )
+        ]
+        # nor a second box on an object another detection of this frame explains: one matched
+        # to a track, or a higher-scored box that started one (the rows are in
+        # canonical_order, highest score first), e.g. the same box twice; the joint sampler's
+        # births follow the same rule (JointTracker.step)
         explained = np.zeros(len(boxes), np.bool_)
         explained[[di for _, di in result.matches]] = True
-        for k, di in enumerate(unmatched):
-            gate = gates.get(int(labels[di]), -np.inf)
-            if hists[di].sum() <= 0 or scores[di] < gate or di in beside:
-                # no foreground colour to build a reference from, too unsure, or a second box
-                # on a person already followed (LifecycleConfig.birth_overlap)
-                continue
-            if twins is not None and twins[k, explained].any():
-                # a second box on an object another detection of this frame explains: one
-                # matched to a track, or a higher-scored box that started one (the rows are
-                # in canonical_order, highest score first), e.g. the same box twice
-                continue
-            explained[di] = True
+        overlap = None if detections is None else cfg.lifecycle.birth_overlap
+        for di in first_of_twins(boxes, labels, candidates, explained, overlap):
             seed = int(self._rng.integers(2**63))
             t = LiveTrack(
                 next(self._ids), boxes[di].copy(), hists[di], born, seed, float(scores[di])
@@ -946,23 +957,28 @@ class MultiObjectTracker:
             self._gains[c] = self.motion_gain(c)
 
 
-def _twins(boxes: F64, labels: NDArray[np.int64], unmatched: Sequence[int],
-           cfg: TrackerConfig) -> NDArray[np.bool_] | None:  # fmt: skip
-    """Which of a frame's detections each unmatched one lies on: boxes on one object.
+def first_copies(boxes: F64, labels: NDArray[np.int64] | F64) -> NDArray[np.intp] | None:
+    """The rows of a frame's detections that repeat no earlier row; None: none repeats one.
 
-    ``out[i, j]``: ``unmatched[i]`` and detection ``j`` (any of the frame's) are of one class
-    and overlap by an IoU above ``LifecycleConfig.birth_overlap`` (the rule a birth beside a
-    track follows), e.g. the same box twice (a detector without non-maximum suppression, or
-    two detectors' outputs concatenated). None: the rule is off, or no two detections.
+    A repeat has the box (``left, top, w, h``) and class of an earlier row, whatever its
+    score: the same detection given twice (a detector without non-maximum suppression, two
+    detectors' outputs concatenated, a det.txt holding its rows twice). In
+    :func:`canonical_order` the earlier row is the higher-scored one, so that one is kept.
+    Until 6 December both copies went to the association, and a second track on one person,
+    which alone coasts and ends, took the spare copy every frame and lived on beside the
+    first (PETS09-S2L1's public det.txt given twice: 30 tracks for 22, MOTA 80.7 -> 32.4).
     """
-    overlap = cfg.lifecycle.birth_overlap
-    if overlap is None or not len(unmatched) or len(boxes) < 2:
+    # on plain floats: a set of a frame's few rows costs about 7 us, np.unique's rows 110
+    keys = list(zip(*boxes[:, :4].T.tolist(), labels.tolist(), strict=True))
+    if len(set(keys)) == len(keys):
         return None
-    rows = np.asarray(unmatched, dtype=np.intp)
-    out: NDArray[np.bool_] = (_iou_matrix(boxes[rows, :4], boxes[:, :4]) > overlap) & (
-        labels[rows][:, None] == labels[None, :]
-    )
-    return out
+    seen: set[tuple[float, ...]] = set()
+    first = []
+    for k, key in enumerate(keys):
+        if key not in seen:
+            seen.add(key)
+            first.append(k)
+    return np.array(first, dtype=np.intp)
 
 
 def canonical_order(boxes: F64, scores: F64, labels: NDArray[np.int64]) -> NDArray[np.intp]:
