@@ -373,6 +373,31 @@ def test_a_folder_of_12_bit_pngs_tracks_as_its_8_bit_frames_with_one_warning(
     assert len(read_mot(outs[0])) > 0
 
 
+def test_a_folder_of_sequences_given_to_track_names_them_and_batch(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'no images (.jpg, ...) in folder MOT17', with no word of the sequences it holds."""
+    bench = tmp_path / "MOT17"
+    (bench / "MOT17-10" / "img1").mkdir(parents=True)  # a sequence without seqinfo.ini
+    (bench / "MOT17-02").mkdir()
+    (bench / "MOT17-02" / "seqinfo.ini").write_text("[Sequence]\nframeRate=30\n")
+    (bench / "notes").mkdir()  # neither: not named
+    out = tmp_path / "t.txt"
+    assert main(["track", str(bench), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {bench} holds 2 sequences (MOT17-02, MOT17-10) and no "
+        f"images: give one of them ({bench / 'MOT17-02'}), or track them all with pftrack "
+        f"batch {bench}\n"
+    )
+    (bench / "MOT17-02" / "seqinfo.ini").unlink()
+    assert main(["track", str(bench), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {bench} holds a sequence (MOT17-10) and no images: give "
+        f"it ({bench / 'MOT17-10'})\n"
+    )
+    assert not out.exists()
+
+
 def test_a_folder_of_videos_given_to_track_names_them_and_batch(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -26,6 +26,7 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import contextlib
 import errno
 import hashlib
 import itertools
@@ -886,6 +887,19 @@ def video_files(folder: Path) -> list[Path]:
     )
 
 
+def _sequence_folders(folder: Path) -> list[Path]:
+    """The MOTChallenge sequence folders directly in `folder` (``seqinfo.ini`` or ``img1/``).
+
+    In natural order; unreadable entries are passed over.
+    """
+    found = []
+    for p in folder.iterdir():
+        with contextlib.suppress(OSError):
+            if p.is_dir() and ((p / "seqinfo.ini").is_file() or (p / "img1").is_dir()):
+                found.append(p)
+    return sorted(found, key=lambda p: natural_key(p.name))
+
+
 def _not_there(folder: Path) -> str:
     """How an image folder that is not there is not: ``does not exist``, ``is a file``."""
     return "is a file" if folder.exists() else "does not exist"
@@ -1164,6 +1178,15 @@ def _no_images(folder: Path, sequence: SequenceInfo | None = None) -> str:
     videos = video_files(folder)
     if not videos:
         none = f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+        held = _sequence_folders(folder) if sequence is None else []
+        if held:  # a benchmark's folder of sequences (was: "no images", no word of them)
+            names = ", ".join(p.name for p in held[:3]) + (", ..." if len(held) > 3 else "")
+            one = "a sequence" if len(held) == 1 else f"{len(held)} sequences"
+            return (
+                f"folder {folder} holds {one} ({names}) and no images: give "
+                f"{'it' if len(held) == 1 else 'one of them'} ({held[0]})"
+                + ("" if len(held) == 1 else f", or track them all with pftrack batch {folder}")
+            )
         if sequence is None or not (sequence.folder / "seqinfo.ini").is_file():
             return none
         beside = video_files(sequence.folder)
