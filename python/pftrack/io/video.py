@@ -584,6 +584,21 @@ def info_scale(
     return float(sx)
 
 
+def _ini_text(ini: Path) -> str:
+    """The text of ``seqinfo.ini`` `ini`, in the encoding MOT files are read in.
+
+    UTF-16 by its byte-order mark (Windows PowerShell 5's ``>`` and ``Out-File``; was refused
+    as "expected a [Sequence] section", while the sequence's det.txt and gt.txt so written were
+    read), else UTF-8 with a byte-order mark skipped (Notepad). A name in Latin-1 (``Café``
+    in one byte each) is no reason to refuse the numbers pftrack reads, which are ASCII:
+    undecodable bytes are replaced. OSError as reading raises it.
+    """
+    from pftrack.io.mot import _encoding
+
+    data = ini.read_bytes()
+    return data.decode(_encoding(data[:4]), errors="replace")
+
+
 def _duplicate(
     ini: Path, exc: configparser.DuplicateOptionError | configparser.DuplicateSectionError
 ) -> str:
@@ -597,7 +612,7 @@ def _duplicate(
     lines: list[int] = []
     written = option
     try:
-        text = ini.read_text(encoding="utf-8-sig", errors="replace").splitlines()
+        text = _ini_text(ini).splitlines()
     except OSError:
         text = []
     for at, line in enumerate(text[: exc.lineno], start=1):
@@ -684,9 +699,7 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
         ini = ini / "seqinfo.ini"
     parser = configparser.ConfigParser(interpolation=None)
     try:
-        # -sig: skips a byte-order mark (Notepad); a name in Latin-1 (Caf\xe9) is no reason to
-        # refuse the numbers pftrack reads, which are ASCII: undecodable bytes are replaced
-        text = ini.read_text(encoding="utf-8-sig", errors="replace")
+        text = _ini_text(ini)
     except OSError as exc:
         raise ValueError(f"{ini}: cannot be read ({exc.strerror})") from None
     try:
