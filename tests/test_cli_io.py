@@ -188,7 +188,8 @@ def test_a_seqinfo_size_that_is_not_its_images_is_refused_not_scaled(
     assert f", scaled by {1 / factor:g} (the frames' width {scene.width} over imWidth={w} " in err
     assert where in err and "and as given they fit those frames" in err
     assert err.endswith(
-        f"(seqinfo.ini's {w}x{h} is not its images' size?); give --det-scale 1 / "
+        f"pixels already: seqinfo.ini's {w}x{h} is not its images' size? correct it to "
+        f"{scene.width}x{scene.height} (gt.txt is scaled by it too), or give --det-scale 1 / "
         "load_detections(scale=1)\n"
     )
     assert not out.exists()

@@ -674,11 +674,14 @@ def _refuse_scaled_off(
         size = f"{sequence.width}x{sequence.height}" if sequence.height else f"{sequence.width}"
         why = f" (the frames' width {cols} over imWidth={sequence.width} in "
         why += f"{sequence.folder / 'seqinfo.ini'})"
-        ini = f" (seqinfo.ini's {size} is not its images' size?)"
+        ini = (  # batch and eval scale gt.txt by it too: --det-scale 1 alone is not enough
+            f": seqinfo.ini's {size} is not its images' size? correct it to {cols}x{rows} "
+            "(gt.txt is scaled by it too), or"
+        )
     raise ValueError(
         f"{which}, scaled by {applied:g}{why}, {where}, and as given they fit those frames "
         f"(they reach {right / applied:.0f}x{bottom / applied:.0f}): they are in the frames' "
-        f"pixels already{ini}; give --det-scale 1 / load_detections(scale=1)"
+        f"pixels already{ini or ';'} give --det-scale 1 / load_detections(scale=1)"
     )
 
 
