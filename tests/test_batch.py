@@ -167,8 +167,10 @@ def test_the_video_of_a_sequence_folder_given_itself_has_its_detections(
     seq = tmp_path / "pets"
     seq.mkdir()
     shutil.copy(data / "walk.avi", seq / "video.avi")
-    for name in ("det", "gt"):
-        shutil.copy(data / "MOT-01" / name / f"{name}.txt", seq / f"{name}.txt")
+    for name in ("det", "gt"):  # in seqinfo.ini's pixels, twice the video's, as PETS09's
+        boxes = read_mot(data / "MOT-01" / name / f"{name}.txt")
+        boxes[:, 2:6] *= 2
+        write_mot(seq / f"{name}.txt", boxes)
     (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=384\nimHeight=288\n")
     (found,) = find_sequences(seq / "video.avi")
     assert found == SequenceInput(
@@ -185,6 +187,36 @@ def test_the_video_of_a_sequence_folder_given_itself_has_its_detections(
                  *FAST]) == 0  # fmt: skip
     assert single.read_bytes() == (out / "video.txt").read_bytes()
     capsys.readouterr()
+
+
+def test_a_seqinfo_size_that_is_not_its_images_fails_the_score_not_scored(
+    data: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial: seqinfo.ini saying 1280x960 beside 640x480 images scaled gt.txt by 0.5, and the
+    built-in detector's tracks scored MOTA -109.6 where ``pftrack eval`` gave 38.4; the batch
+    said "done". Now the score fails with pftrack eval's check, the tracks written."""
+    seq = tmp_path / "BIG"
+    seq.mkdir()
+    for name in ("img1", "gt"):
+        (seq / name).symlink_to(data / "MOT-01" / name, target_is_directory=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=384\nimHeight=288\n")
+    out = tmp_path / "out"
+    assert main(["batch", str(seq), "--out", str(out), "--workers", "0", "-q", *FAST]) == 1
+    err = capsys.readouterr().err
+    assert f"BIG: error: scoring against {seq / 'gt' / 'gt.txt'} (the tracks are written): " in err
+    assert "BIG.txt: its boxes look 1 times the ground truth's, not 0.5 (" in err
+    assert (
+        f"(pftrack eval's check; the batch scaled {seq / 'gt' / 'gt.txt'} by 0.5: the frames' "
+        f"width 192 over imWidth=384 in {seq / 'seqinfo.ini'}; if seqinfo.ini's imWidth and "
+        "imHeight are not its images' size, correct them)\n"
+    ) in err
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["metrics"] is None and len(read_mot(out / "BIG.txt")) > 0
+    # with seqinfo.ini's size its images', the same tracks are scored
+    (seq / "seqinfo.ini").write_text("[Sequence]\nimWidth=192\nimHeight=144\n")
+    assert main(["batch", str(seq), "--out", str(out), "--workers", "0", "-q", *FAST]) == 0
+    (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
+    assert entry["metrics"]["mota"] > 0.5, entry["metrics"]
 
 
 def test_find_sequences_shared_data_layout(tmp_path: Path) -> None:

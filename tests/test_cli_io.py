@@ -135,6 +135,69 @@ def test_a_seqinfo_that_is_not_utf8_is_read_for_its_numbers(sequence: Path, tmp_
     assert (info.name, info.frame_rate, info.width) == ("Caf\ufffd", 7.0, 9)
 
 
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
+def test_a_utf16_seqinfo_is_read_as_its_det_and_gt_are(
+    encoding: str, sequence: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A trial: a seqinfo.ini written by Windows PowerShell 5's ``>`` (UTF-16 with its BOM) was
+    refused as "expected a [Sequence] section", while det.txt and gt.txt so written are read."""
+    from pftrack.eval.sequences import read_seqinfo as read_ini
+
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    text = "[Sequence]\r\nname=Caf\u00e9\r\nframeRate=7\r\nimWidth=9\r\nimHeight=6\r\n"
+    bom = b"\xfe\xff" if encoding.endswith("be") else b""  # utf-16 writes its own
+    (seq / "seqinfo.ini").write_bytes(bom + text.encode(encoding))
+    info = read_seqinfo(seq)
+    assert (info.name, info.frame_rate, info.width, info.height) == ("Caf\u00e9", 7.0, 9, 6)
+    assert read_ini(seq / "seqinfo.ini")["framerate"] == "7"
+    (seq / "seqinfo.ini").write_bytes(bom + (text + "frameRate=8\r\n").encode(encoding))
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: {seq}/seqinfo.ini: key frameRate in [Sequence] is given twice "
+        "(lines 3 and 6); give it once\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("factor", "where"), [(2, "lie in the top-left"), (0.5, "lie wholly outside the")]
+)
+def test_a_seqinfo_size_that_is_not_its_images_is_refused_not_scaled(
+    factor: float,
+    where: str,
+    sequence: Path,
+    scene: Scene,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A trial: seqinfo.ini saying 1280x960 beside 640x480 images and their det.txt tracked
+    the boxes scaled by 0.5 into the top-left corner (exit 0, a warning to scale them: pftrack
+    had); saying 320x240, the refusal asked "in a larger frame's pixels? ... about 1 here"."""
+    seq = tmp_path / "SEQ"
+    seq.mkdir()
+    (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
+    (seq / "det").symlink_to(sequence / "det", target_is_directory=True)
+    w, h = int(scene.width * factor), int(scene.height * factor)
+    (seq / "seqinfo.ini").write_text(f"[Sequence]\nframeRate=7\nimWidth={w}\nimHeight={h}\n")
+    out = tmp_path / "t.txt"
+    assert main(["track", str(seq), "--detections", "auto", "--out", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pftrack track: error: ") and err.count("\n") == 1, err
+    assert f", scaled by {1 / factor:g} (the frames' width {scene.width} over imWidth={w} " in err
+    assert where in err and "and as given they fit those frames" in err
+    assert err.endswith(
+        f"pixels already: seqinfo.ini's {w}x{h} is not its images' size? correct it to "
+        f"{scene.width}x{scene.height} (gt.txt is scaled by it too), or give --det-scale 1 / "
+        "load_detections(scale=1)\n"
+    )
+    assert not out.exists()
+    argv = ["track", str(seq), "--detections", "auto", "--det-scale", "1", "--out", str(out)]
+    assert main([*argv, "-q"]) == 0  # as the message says
+    assert evaluate_mot(scene.truth, read_mot(out)).mota > 0.8
+
+
 def test_sequence_detections_in_seqinfo_pixels_are_scaled(
     sequence: Path, scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -213,10 +276,15 @@ def test_sequence_of_another_shape_than_its_seqinfo_is_refused(
     assert f"the frames are {scene.width}x{scene.height}" in err
     assert f"seqinfo.ini says {2 * scene.width}x{3 * scene.height}" in err
     # the same sequence with seqinfo.ini's height within 1 % of the width's ratio is scaled
+    # (its boxes in seqinfo.ini's pixels: the frames' own are refused as scaled off them)
     (seq / "seqinfo.ini").write_text(
         f"[Sequence]\nimWidth={2 * scene.width}\nimHeight={2 * scene.height + 1}\n"
     )
+    det = read_mot(sequence / "det" / "det.txt")
+    det[:, 2:6] *= 2
+    write_mot(seq / "det" / "det.txt", det)
     assert main(["track", str(seq), "--detections", "auto", "--out", str(out)]) == 0
+    assert evaluate_mot(scene.truth, read_mot(out)).mota > 0.8
 
 
 def test_info_scale() -> None:
@@ -371,6 +439,31 @@ def test_a_folder_of_12_bit_pngs_tracks_as_its_8_bit_frames_with_one_warning(
     ]
     assert outs[1].read_bytes() == outs[0].read_bytes()  # the same frames: the same tracks
     assert len(read_mot(outs[0])) > 0
+
+
+def test_a_folder_of_sequences_given_to_track_names_them_and_batch(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was: 'no images (.jpg, ...) in folder MOT17', with no word of the sequences it holds."""
+    bench = tmp_path / "MOT17"
+    (bench / "MOT17-10" / "img1").mkdir(parents=True)  # a sequence without seqinfo.ini
+    (bench / "MOT17-02").mkdir()
+    (bench / "MOT17-02" / "seqinfo.ini").write_text("[Sequence]\nframeRate=30\n")
+    (bench / "notes").mkdir()  # neither: not named
+    out = tmp_path / "t.txt"
+    assert main(["track", str(bench), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {bench} holds 2 sequences (MOT17-02, MOT17-10) and no "
+        f"images: give one of them ({bench / 'MOT17-02'}), or track them all with pftrack "
+        f"batch {bench}\n"
+    )
+    (bench / "MOT17-02" / "seqinfo.ini").unlink()
+    assert main(["track", str(bench), "--out", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: folder {bench} holds a sequence (MOT17-10) and no images: give "
+        f"it ({bench / 'MOT17-10'})\n"
+    )
+    assert not out.exists()
 
 
 def test_a_folder_of_videos_given_to_track_names_them_and_batch(

@@ -428,6 +428,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                 )
             gt = read_mot(seq.gt, what="ground truth")
             check_scored_ids(gt, seq.gt)  # FILE:LINE, as pftrack eval (was: 'row K', 0-based)
+            _check_gt_scale(seq, gt, written, gt_scale, frames.width)
             # the benchmark a TrackEval tree's BENCH-SPLIT folder names, as pftrack eval takes it
             named = benchmark_of_path(seq.gt)
             metrics = sequence_metrics(
@@ -459,6 +460,33 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         "host": socket.gethostname(),
     }
     return TaskResult(rows, files, info, error=error, traceback=trace)
+
+
+def _check_gt_scale(
+    seq: SequenceInput, gt: F64, rows: F64, gt_scale: float, frame_width: int
+) -> None:
+    """Refuse to score tracks that do not match the ground truth as this batch scales it.
+
+    :func:`~pftrack.eval.sequences.check_scale`, the check of ``pftrack eval``, whose figures
+    the batch prints (was: not run, a trial: a ``seqinfo.ini`` saying 1280x960 beside 640x480
+    images scaled ``gt.txt`` by 0.5 and the built-in detector's tracks scored MOTA -109.6, while
+    ``pftrack eval`` of the same file gave 38.4). Its advice is ``pftrack eval``'s options: the
+    message says where the batch's scale came from and what to correct.
+    """
+    from pftrack.eval.sequences import check_scale
+
+    try:
+        check_scale(gt, rows, scale=gt_scale, name=f"{seq.name}.txt")
+    except ValueError as exc:
+        how = (
+            f"the frames' width {frame_width} over imWidth={seq.image_width} in {seq.seqinfo}"
+            if seq.image_width
+            else "the detections' scale, as the sequence's seqinfo.ini gives no size"
+        )
+        raise ValueError(
+            f"{exc} (pftrack eval's check; the batch scaled {seq.gt} by {gt_scale:g}: {how}; "
+            "if seqinfo.ini's imWidth and imHeight are not its images' size, correct them)"
+        ) from None
 
 
 def _on_frame(

@@ -81,10 +81,15 @@ class SequenceInfo:
 
 
 def read_seqinfo(path: PathLike) -> dict[str, str]:
-    """The ``[Sequence]`` section of a MOTChallenge ``seqinfo.ini`` as a dict of strings."""
+    """The ``[Sequence]`` section of a MOTChallenge ``seqinfo.ini`` as a dict of strings.
+
+    Read as :func:`pftrack.io.video.read_seqinfo` reads it (UTF-16 by its byte-order mark).
+    """
+    from pftrack.io.video import _ini_text
+
     parser = configparser.ConfigParser()
     try:
-        parser.read_string(Path(path).read_text(encoding="utf-8-sig", errors="replace"))
+        parser.read_string(_ini_text(Path(path)))
     except configparser.Error as exc:
         raise ValueError(
             f"{path}: not a seqinfo.ini file ({exc.message.splitlines()[0]})"

@@ -26,6 +26,7 @@ sequence folder or one level above its image folder), else the container header,
 from __future__ import annotations
 
 import configparser
+import contextlib
 import errno
 import hashlib
 import itertools
@@ -583,6 +584,21 @@ def info_scale(
     return float(sx)
 
 
+def _ini_text(ini: Path) -> str:
+    """The text of ``seqinfo.ini`` `ini`, in the encoding MOT files are read in.
+
+    UTF-16 by its byte-order mark (Windows PowerShell 5's ``>`` and ``Out-File``; was refused
+    as "expected a [Sequence] section", while the sequence's det.txt and gt.txt so written were
+    read), else UTF-8 with a byte-order mark skipped (Notepad). A name in Latin-1 (``Café``
+    in one byte each) is no reason to refuse the numbers pftrack reads, which are ASCII:
+    undecodable bytes are replaced. OSError as reading raises it.
+    """
+    from pftrack.io.mot import _encoding
+
+    data = ini.read_bytes()
+    return data.decode(_encoding(data[:4]), errors="replace")
+
+
 def _duplicate(
     ini: Path, exc: configparser.DuplicateOptionError | configparser.DuplicateSectionError
 ) -> str:
@@ -596,7 +612,7 @@ def _duplicate(
     lines: list[int] = []
     written = option
     try:
-        text = ini.read_text(encoding="utf-8-sig", errors="replace").splitlines()
+        text = _ini_text(ini).splitlines()
     except OSError:
         text = []
     for at, line in enumerate(text[: exc.lineno], start=1):
@@ -683,9 +699,7 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
         ini = ini / "seqinfo.ini"
     parser = configparser.ConfigParser(interpolation=None)
     try:
-        # -sig: skips a byte-order mark (Notepad); a name in Latin-1 (Caf\xe9) is no reason to
-        # refuse the numbers pftrack reads, which are ASCII: undecodable bytes are replaced
-        text = ini.read_text(encoding="utf-8-sig", errors="replace")
+        text = _ini_text(ini)
     except OSError as exc:
         raise ValueError(f"{ini}: cannot be read ({exc.strerror})") from None
     try:
@@ -884,6 +898,19 @@ def video_files(folder: Path) -> list[Path]:
         (p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
         key=lambda p: natural_key(p.name),
     )
+
+
+def _sequence_folders(folder: Path) -> list[Path]:
+    """The MOTChallenge sequence folders directly in `folder` (``seqinfo.ini`` or ``img1/``).
+
+    In natural order; unreadable entries are passed over.
+    """
+    found = []
+    for p in folder.iterdir():
+        with contextlib.suppress(OSError):
+            if p.is_dir() and ((p / "seqinfo.ini").is_file() or (p / "img1").is_dir()):
+                found.append(p)
+    return sorted(found, key=lambda p: natural_key(p.name))
 
 
 def _not_there(folder: Path) -> str:
@@ -1164,6 +1191,15 @@ def _no_images(folder: Path, sequence: SequenceInfo | None = None) -> str:
     videos = video_files(folder)
     if not videos:
         none = f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {folder}"
+        held = _sequence_folders(folder) if sequence is None else []
+        if held:  # a benchmark's folder of sequences (was: "no images", no word of them)
+            names = ", ".join(p.name for p in held[:3]) + (", ..." if len(held) > 3 else "")
+            one = "a sequence" if len(held) == 1 else f"{len(held)} sequences"
+            return (
+                f"folder {folder} holds {one} ({names}) and no images: give "
+                f"{'it' if len(held) == 1 else 'one of them'} ({held[0]})"
+                + ("" if len(held) == 1 else f", or track them all with pftrack batch {folder}")
+            )
         if sequence is None or not (sequence.folder / "seqinfo.ini").is_file():
             return none
         beside = video_files(sequence.folder)

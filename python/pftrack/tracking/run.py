@@ -631,6 +631,60 @@ def _scale_hint(
     return f"about {max(near):.4g} here" if near else f"about {estimate:.3g} here"
 
 
+def _refuse_scaled_off(
+    cols: int,
+    rows: int,
+    right: float,
+    bottom: float,
+    outside: NDArray[np.bool_],
+    as_xyxy: NDArray[np.bool_],
+    sequence: SequenceInfo | None,
+    detections: Mapping[int, F64],
+) -> None:
+    """Refuse boxes that a scale moved off the frames they fit as given: ValueError.
+
+    The scale is the one the file was read with (``scale`` of :func:`load_detections`:
+    ``--det-scale``, or ``pftrack track``'s and ``batch``'s own, the frames' width over
+    ``seqinfo.ini``'s ``imWidth``). Refused when the file's own boxes fit the frames (within
+    :data:`SEQINFO_SLACK`) while the scaled ones lie in the frames' top-left quarter (within
+    that slack too), or more than :data:`OUTSIDE_SHARE` of them wholly outside the frames, the
+    conditions of :func:`_check_layout`'s warning and refusal: a ``seqinfo.ini`` whose size is
+    not its images' (trial60cli: ``imWidth=1280`` beside 640x480 images tracked the boxes
+    shrunk into the top-left corner, exit 0, with a warning to scale them; ``imWidth=320`` was
+    refused as "in a larger frame's pixels? ... about 1 here", the scale 2 applied unsaid).
+    `outside` and `as_xyxy` are :func:`_check_layout`'s, one per box.
+    """
+    applied = float(getattr(detections, "scale", 1.0))
+    n = len(outside)
+    if applied == 1.0 or n < SMALL_LAYOUT_BOXES:
+        return
+    slack = 1 + SEQINFO_SLACK
+    if right / applied > cols * slack or bottom / applied > rows * slack:
+        return  # as given they do not fit the frames: the scale is theirs (PETS09's 0.625)
+    if right <= 0.5 * cols * slack and bottom <= 0.5 * rows * slack:  # overhanging a little
+        where = f"lie in the top-left {right:.3g}x{bottom:.3g} pixels of the {cols}x{rows} frames"
+        which = f"all {n} detection boxes"
+    elif outside.mean() > OUTSIDE_SHARE and not as_xyxy.all():
+        where = f"lie wholly outside the {cols}x{rows} frames (they reach {right:.0f}x{bottom:.0f})"
+        which = f"{outside.sum()} of {n} detection boxes"
+    else:
+        return
+    ini, why = "", ""
+    if sequence is not None and sequence.width and abs(applied * sequence.width - cols) < 0.5:
+        size = f"{sequence.width}x{sequence.height}" if sequence.height else f"{sequence.width}"
+        why = f" (the frames' width {cols} over imWidth={sequence.width} in "
+        why += f"{sequence.folder / 'seqinfo.ini'})"
+        ini = (  # batch and eval scale gt.txt by it too: --det-scale 1 alone is not enough
+            f": seqinfo.ini's {size} is not its images' size? correct it to {cols}x{rows} "
+            "(gt.txt is scaled by it too), or"
+        )
+    raise ValueError(
+        f"{which}, scaled by {applied:g}{why}, {where}, and as given they fit those frames "
+        f"(they reach {right / applied:.0f}x{bottom / applied:.0f}): they are in the frames' "
+        f"pixels already{ini or ';'} give --det-scale 1 / load_detections(scale=1)"
+    )
+
+
 def _check_layout(
     detections: Mapping[int, F64],
     shape: tuple[int, ...],
@@ -658,6 +712,8 @@ def _check_layout(
     past = (d[:, 0] + d[:, 2] > cols) | (d[:, 1] + d[:, 3] > rows)
     as_xyxy = (d[:, 2] > d[:, 0]) & (d[:, 3] > d[:, 1]) & (d[:, 2] <= cols) & (d[:, 3] <= rows)
     right, bottom = float(np.max(d[:, 0] + d[:, 2])), float(np.max(d[:, 1] + d[:, 3]))
+    outside = (d[:, 0] >= cols) | (d[:, 1] >= rows)
+    _refuse_scaled_off(cols, rows, right, bottom, outside, as_xyxy, sequence, detections)
     if len(d) >= SMALL_LAYOUT_BOXES and right < 0.5 * cols and bottom < 0.5 * rows:
         warn(
             f"all {len(d)} detection boxes lie in the top-left {right:.3g}x{bottom:.3g} pixels "
@@ -665,7 +721,6 @@ def _check_layout(
             "with --det-scale / load_detections(scale=...))",
             stacklevel=3,
         )
-    outside = (d[:, 0] >= cols) | (d[:, 1] >= rows)
     if len(d) >= SMALL_LAYOUT_BOXES and outside.mean() > OUTSIDE_SHARE and not as_xyxy.all():
         slack = 1 + SEQINFO_SLACK  # detectors' boxes overhang the edge a little
         if rotation in (90, 270) and right <= rows * slack and bottom <= cols * slack:
