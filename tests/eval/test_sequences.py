@@ -696,3 +696,23 @@ def test_seqs_does_not_read_the_other_sequences_seqinfo(
     assert "A" in capsys.readouterr().out
     assert main(argv) == 2  # asked for, it is read, and refused
     assert "key frameRate in [Sequence] is given twice" in capsys.readouterr().err
+
+
+def test_the_gt_folder_of_a_sequence_is_that_sequence(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--gt SEQ/gt`` scores sequence SEQ, as ``--gt SEQ`` and ``--gt SEQ/gt/gt.txt`` do: its
+    name (was "gt"), its result in a results folder (was looked for as gt.txt) and its
+    seqinfo.ini (a trial)."""
+    gt_root, res_root = make_layout(tmp_path, {"SEQ": random_case(0)})
+    [seq] = find_sequences(gt_root / "SEQ" / "gt")
+    assert seq.name == "SEQ" and (seq.width, seq.height) == (200, 150)
+    out = tmp_path / "s.json"
+    assert main(["eval", "--gt", str(gt_root / "SEQ" / "gt"), "--res", str(res_root)]) == 0
+    assert "SEQ" in capsys.readouterr().out
+    argv = ["eval", "--gt", str(gt_root / "SEQ"), "--res", str(res_root), "--json", str(out)]
+    assert main(argv) == 0
+    want = json.loads(out.read_text())
+    argv[2] = str(gt_root / "SEQ" / "gt")
+    assert main(argv) == 0
+    assert json.loads(out.read_text()) == want

@@ -159,6 +159,10 @@ def find_sequences(root: PathLike, only: Collection[str] | None = None) -> list[
     if not base.is_dir():
         raise FileNotFoundError(f"ground-truth folder not found: {base}")
     own = _sequence(base)
+    if own is not None and base.name == "gt" and own.gt_path == base / "gt.txt":
+        # SEQ/gt given: the sequence is SEQ, as when SEQ/gt/gt.txt is given (was named "gt",
+        # and a results folder was searched for gt.txt)
+        return [sequence_of_file(own.gt_path, base.resolve().parent.name)]
     if own is not None:
         return [own]
     found = _sequences_in(base, only)
