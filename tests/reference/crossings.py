@@ -11,9 +11,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack.boxes import _to_cxcywh
-from pftrack.kalman import _cv_predict, _cv_update_where
 from pftrack.recovery.linking import check_rows
-from pftrack.tracking.offline import CrossingConfig, _overlapping_pairs
+from pftrack.tracking.offline import CrossingConfig, _nll_step, _overlapping_pairs
 
 F64 = NDArray[np.float64]
 Segments = list[tuple[NDArray[np.intp], NDArray[np.intp]]]
@@ -57,19 +56,25 @@ def repair_crossings(
 
 
 def windows(pairs: F64, lab: F64, join_gap: int) -> list[tuple[float, float, float, float, float]]:
-    """Interaction windows ``(cut, id_lo, id_hi, start, end)``, sorted; one loop step each."""
-    if not len(pairs):
-        return []
-    la, lb = lab[pairs[:, 1].astype(np.intp)], lab[pairs[:, 2].astype(np.intp)]
-    lo, hi, f, iou = np.minimum(la, lb), np.maximum(la, lb), pairs[:, 0], pairs[:, 3]
-    order = np.lexsort((f, hi, lo))
-    lo, hi, f, iou = lo[order], hi[order], f[order], iou[order]
-    new = np.r_[True, (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1]) | (np.diff(f) > join_gap + 1)]
-    starts = np.flatnonzero(new)
+    """Interaction windows ``(cut, id_lo, id_hi, start, end)``, sorted: each pair of ids' overlap
+    frames in order, cut where more than ``join_gap`` frames lie between two; `cut` the first
+    frame of largest IoU."""
+    by_ids: dict[tuple[float, float], list[tuple[float, float]]] = {}
+    for f, p, q, iou in pairs.tolist():
+        a, b = float(lab[int(p)]), float(lab[int(q)])
+        by_ids.setdefault((min(a, b), max(a, b)), []).append((f, iou))
     out = []
-    for s, e in zip(starts, np.r_[starts[1:], len(f)], strict=True):
-        cut = f[s + int(np.argmax(iou[s:e]))]
-        out.append((float(cut), float(lo[s]), float(hi[s]), float(f[s]), float(f[e - 1])))
+    for (lo, hi), seen in by_ids.items():
+        seen.sort()  # by frame: one pair of these ids a frame
+        run = [seen[0]]
+        for k in range(1, len(seen) + 1):
+            if k < len(seen) and seen[k][0] - run[-1][0] <= join_gap + 1:
+                run.append(seen[k])
+                continue
+            cut = max(run, key=lambda x: x[1])[0]  # max: the first of equal IoUs
+            out.append((cut, lo, hi, run[0][0], run[-1][0]))
+            if k < len(seen):
+                run = [seen[k]]
     out.sort()
     return out
 
@@ -103,10 +108,6 @@ def after_nll(fr: F64, zh: F64, pairings: Segments, c: CrossingConfig) -> F64:
     mean = (zs[0].copy(), np.zeros((m, 4)))
     cov = (np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0))
     nll = np.zeros(m)
-    for t in range(1, length):
-        mean, cov = _cv_predict(mean, cov, q, dt[t][:, None])
-        s = cov[0] + r2
-        e = zs[t] - mean[0]
-        nll += np.where(counts[t], 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
-        mean, cov = _cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
+    for t in range(1, length):  # the Kalman step itself is the package's
+        mean, cov = _nll_step(mean, cov, nll, dt[t], zs[t], has[t], counts[t], q, r2)
     return nll

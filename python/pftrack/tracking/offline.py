@@ -541,57 +541,69 @@ def _after_nll(
     pairing gets the floats it gets alone (was: one window's four at a time).
     """
     n_before = np.array([len(b) for b, _ in pairings], dtype=np.intp)
-    lengths = n_before + np.array([len(f) for _, f in pairings], dtype=np.intp)
-    nll = np.zeros(len(pairings))
-    lo = 0
-    while lo < len(pairings):
-        hi, longest = lo + 1, int(lengths[lo])
-        while hi < len(pairings) and max(longest, lengths[hi]) * (hi + 1 - lo) <= NLL_BLOCK:
-            longest = max(longest, int(lengths[hi]))
-            hi += 1
-        nll[lo:hi] = _after_nll_block(
-            fr, cz, pairings[lo:hi], heights[lo:hi], n_before[lo:hi], lengths[lo:hi], c
-        )
-        lo = hi
-    return nll
-
-
-def _after_nll_block(
-    fr: F64,
-    cz: F64,
-    pairings: list[tuple[NDArray[np.intp], NDArray[np.intp]]],
-    heights: F64,
-    n_before: NDArray[np.intp],
-    lengths: NDArray[np.intp],
-    c: CrossingConfig,
-) -> F64:
-    """:func:`_after_nll` of one block, all its pairings at once."""
-    m, length = len(pairings), int(lengths.max())
-    rows = np.concatenate([s for pairing in pairings for s in pairing])
-    col = np.repeat(np.arange(m), lengths)
-    step = np.arange(len(rows)) - np.repeat(np.cumsum(lengths) - lengths, lengths)
-    dt = np.zeros((length, m))
-    zs = np.zeros((length, m, 4))
-    has = np.zeros((length, m), dtype=bool)
-    counts = np.zeros((length, m), dtype=bool)
-    later = step > 0
-    f = fr[rows]
-    dt[step[later], col[later]] = f[1:][later[1:]] - f[:-1][later[1:]]
-    zs[step, col] = cz[rows] / heights[col][:, None]
-    has[step, col] = True
-    counts[step, col] = step >= n_before[col]
+    n_all = n_before + np.array([len(f) for _, f in pairings], dtype=np.intp)
     q = np.array([c.accel, c.accel, c.size_accel, c.size_accel]) ** 2
     r2 = np.array([c.noise, c.noise, c.size_noise, c.size_noise]) ** 2
-    mean: Mean = (zs[0].copy(), np.zeros((m, 4)))
-    cov: Cov = (np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0))
-    nll = np.zeros(m)
-    for t in range(1, length):
-        mean, cov = _cv_predict(mean, cov, q, dt[t][:, None])
-        s = cov[0] + r2
-        e = zs[t] - mean[0]
-        nll += np.where(counts[t], 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
-        mean, cov = _cv_update_where(mean, cov, zs[t], r2, has[t][:, None])
-    return nll
+    out = np.zeros(len(pairings))
+    for lo, hi in _nll_blocks(n_all):
+        lengths, m, length = n_all[lo:hi], hi - lo, int(n_all[lo:hi].max())
+        rows = np.concatenate([s for pairing in pairings[lo:hi] for s in pairing])
+        col = np.repeat(np.arange(m), lengths)
+        step = np.arange(len(rows)) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+        dt = np.zeros((length, m))
+        zs = np.zeros((length, m, 4))
+        has = np.zeros((length, m), dtype=bool)
+        counts = np.zeros((length, m), dtype=bool)
+        later = step > 0  # dt: each row's frame minus its predecessor's in the pairing
+        f = fr[rows]
+        dt[step[later], col[later]] = f[1:][later[1:]] - f[:-1][later[1:]]
+        zs[step, col] = cz[rows] / heights[lo:hi][col][:, None]
+        has[step, col] = True
+        counts[step, col] = step >= n_before[lo:hi][col]
+        mean: Mean = (zs[0].copy(), np.zeros((m, 4)))
+        cov: Cov = (np.broadcast_to(r2, (m, 4)).copy(), np.zeros((m, 4)), np.full((m, 4), 100.0))
+        nll = out[lo:hi]  # a view: accumulated in place
+        for t in range(1, length):
+            mean, cov = _nll_step(mean, cov, nll, dt[t], zs[t], has[t], counts[t], q, r2)
+    return out
+
+
+def _nll_step(
+    mean: Mean,
+    cov: Cov,
+    nll: F64,
+    dt: F64,
+    z: F64,
+    has: NDArray[np.bool_],
+    counts: NDArray[np.bool_],
+    q: F64,
+    r2: F64,
+) -> tuple[Mean, Cov]:
+    """One step of :func:`_after_nll` for m pairings, `nll` (m,) added to in place.
+
+    Predict by `dt` (m,); where `counts`, add the innovation's negative log-density of `z`
+    (m, 4); update where `has`.
+    """
+    mean, cov = _cv_predict(mean, cov, q, dt[:, None])
+    s = cov[0] + r2
+    e = z - mean[0]
+    nll += np.where(counts, 0.5 * np.sum(e * e / s + np.log(2 * np.pi * s), axis=1), 0.0)
+    return _cv_update_where(mean, cov, z, r2, has[:, None])
+
+
+def _nll_blocks(lengths: NDArray[np.intp]) -> Iterator[tuple[int, int]]:
+    """Blocks ``[lo, hi)`` of consecutive pairings, for :func:`_after_nll`.
+
+    Each at most :data:`NLL_BLOCK` steps (its longest pairing's) times pairings, one at least.
+    """
+    lo = 0
+    while lo < len(lengths):
+        hi, longest = lo + 1, int(lengths[lo])
+        while hi < len(lengths) and max(longest, lengths[hi]) * (hi + 1 - lo) <= NLL_BLOCK:
+            longest = max(longest, int(lengths[hi]))
+            hi += 1
+        yield lo, hi
+        lo = hi
 
 
 def smoothed_copies(rows: NDArray[np.float64]) -> NDArray[np.bool_]:
