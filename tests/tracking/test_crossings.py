@@ -373,3 +373,24 @@ def test_repair_scales_linearly_with_the_windows(swap):
         seconds.append(best)
         assert swap == bool((out[:, 1] != rows[:, 1]).any())
     assert seconds[1] < 8 * seconds[0], seconds
+
+
+def test_overlapping_pairs_score_only_boxes_sharing_columns(monkeypatch):
+    """Boxes of one frame are paired only with those whose columns overlap theirs: 2000 people
+    side by side in one frame, each meeting its two neighbours, make 1999 IoUs (was every pair
+    of the frame: 1 999 000), and the same pairs as the frame-by-frame reference."""
+    from pftrack.tracking import offline
+
+    n = 2000
+    a = np.zeros((n, 10))
+    a[:, 0] = 7.0
+    a[:, 1] = np.arange(1, n + 1)
+    a[:, 2] = np.random.default_rng(0).permutation(n) * 30.0  # rows not in column order
+    a[:, 4:6] = 40.0, 100.0
+    scored = []
+    iou_rows = offline._iou_rows
+    monkeypatch.setattr(offline, "_iou_rows", lambda p, q: scored.append(len(p)) or iou_rows(p, q))
+    got = _overlapping_pairs(a, 0.1)
+    assert sum(scored) == n - 1 and len(got) == n - 1
+    small = a[:200]
+    np.testing.assert_array_equal(_overlapping_pairs(small, 0.1), _pairs_reference(small, 0.1))

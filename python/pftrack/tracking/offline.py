@@ -365,25 +365,43 @@ def repair_crossings(
 def _overlapping_pairs(a: F64, min_iou: float) -> F64:
     """(P, 4) rows ``frame, row p, row q, IoU`` (p < q) of boxes of one frame overlapping enough.
 
-    `a` is sorted by frame. Row p is paired with the rows after it in its frame (``sum k (k -
-    1) / 2`` pairs for frames of k rows), in blocks of consecutive p of at most
-    :data:`PAIR_BLOCK` pairs (was: all pairs at once), sorted by p, then q.
+    `a` is sorted by frame. Only boxes whose columns overlap can: within each frame, by left
+    edge, a box is paired with the boxes after it whose left edge lies left of its right edge
+    (one binary search a row; was every pair of the frame, ``sum k (k - 1) / 2`` for frames of
+    k rows: 22.4 million pairs on 2000 tracks over 3000 frames), in blocks of consecutive rows
+    of at most :data:`PAIR_BLOCK` pairs. A pair left out has no common column, so IoU 0. Sorted
+    by p, then q.
     """
     n = len(a)
-    fr = a[:, 0]
-    first = np.flatnonzero(np.r_[True, fr[1:] != fr[:-1]]) if n else np.zeros(0, np.intp)
-    size = np.diff(np.r_[first, n])
-    end = np.repeat(first + size, size)  # one past the last row of each row's frame
-    later = end - np.arange(n) - 1  # rows after each row in its frame
-    kept = [np.zeros((0, 4))]
+    fr, left = a[:, 0], a[:, 2]
+    order = np.lexsort((left, fr))  # by frame, then left edge
+    # (frame, edge) as complex numbers, which sort by real part, then imaginary part: one
+    # binary search over all frames finds each box's first later box starting at or right of
+    # its right edge (computed as the IoU's intersection computes it)
+    key = np.empty(n, np.complex128)
+    key.real, key.imag = fr[order], left[order]
+    edge = np.empty(n, np.complex128)
+    edge.real, edge.imag = key.real, (left + a[:, 4])[order]
+    later = np.searchsorted(key, edge, side="left") - np.arange(n) - 1
+    np.maximum(later, 0, out=later)  # rows after each one (in `order`) that it may meet
+    del key, edge
+    none = np.zeros(0, np.intp)
+    found: list[tuple[NDArray[np.intp], NDArray[np.intp], F64]] = [(none, none, np.zeros(0))]
     for lo, hi in _pair_blocks(later, PAIR_BLOCK):
         m = later[lo:hi]
-        p = np.repeat(np.arange(lo, hi), m)
-        q = p + 1 + np.arange(len(p)) - np.repeat(np.cumsum(m) - m, m)
+        u = np.repeat(np.arange(lo, hi), m)
+        v = u + 1 + np.arange(len(u)) - np.repeat(np.cumsum(m) - m, m)
+        p, q = np.minimum(order[u], order[v]), np.maximum(order[u], order[v])
         iou = _iou_rows(a[p, 2:6], a[q, 2:6])
         keep = iou >= min_iou
-        kept.append(np.column_stack([fr[p[keep]], p[keep], q[keep], iou[keep]]))
-    return np.concatenate(kept)
+        found.append((p[keep], q[keep], iou[keep]))
+    p, q, iou = (np.concatenate(c) for c in zip(*found, strict=True))
+    del found
+    at = np.lexsort((q, p))
+    out = np.empty((len(at), 4))
+    out[:, 1], out[:, 2], out[:, 3] = p[at], q[at], iou[at]
+    out[:, 0] = fr[out[:, 1].astype(np.intp)]
+    return out
 
 
 #: A window as the repair's heap holds it: ``(cut, id_lo, id_hi, start, end)`` and the two ids'
