@@ -6,5 +6,6 @@ One module per wing: ``kernels`` (HSV bins, histograms, Bhattacharyya, resamplin
 the size model's kernels), ``smoothing`` (constant-velocity posterior),
 ``bridge`` (goal-directed recovery), ``mixture`` (stand/walk gap mixture), ``neighbours``
 (the `-nb` methods' neighbour search), ``text`` (MOTChallenge lines, Python's ``%``), ``boxes``
-(intersection and IoU, pair by pair).
+(intersection and IoU, pair by pair), ``crossings`` (the offline crossing repair, one window
+at a time).
 """
