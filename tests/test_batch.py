@@ -4039,6 +4039,35 @@ def test_a_result_lost_with_the_last_worker_is_not_waited_for_for_ever(
         f"file ran or finished (start some: dask worker {address}; a re-run does the rest)"
     )
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] == 1
+    # the totals said "1 worker at ADDR" (the count at the start) of a worker that ran no task
+    # to the end: now what is true, and summary.json's "workers" 0, as no worker ran one
+    assert summary.table().splitlines()[2] == (
+        f"1 file: 1 failed; {summary.seconds:.1f} s, no worker at {address} finished a task"
+    )
+    assert summary.workers == 0
+    assert json.loads((tmp_path / "summary.json").read_text())["workers"] == 0
+
+
+@pytest.mark.parametrize(
+    ("workers", "scheduler", "statuses", "where"),
+    [
+        (2, "tcp://h:8786", ["done", "failed"], "2 workers at tcp://h:8786"),
+        (0, "tcp://h:8786", ["failed", "failed"], "no worker at tcp://h:8786 finished a task"),
+        (0, "tcp://h:8786", ["done", "cancelled"], "no worker at tcp://h:8786 finished a task"),
+        (3, None, ["done", "done"], "3 workers"),
+        (0, None, ["done", "failed"], "in this process"),
+        (0, None, ["skipped", "skipped"], "nothing to run"),
+    ],
+)
+def test_the_totals_line_says_where_tasks_ran(
+    workers: int, scheduler: str | None, statuses: list[str], where: str
+) -> None:
+    """With every worker of a scheduler lost before a task came back, the totals line said
+    "2 workers at ADDR": the count at the start, of workers that ran nothing."""
+    entries = [{"name": f"s{k}", "status": st, "error": "x"} for k, st in enumerate(statuses)]
+    summary = BatchSummary("smooth", Path("out"), entries, 1.25, workers, scheduler)
+    counts = ", ".join(f"{statuses.count(st)} {st}" for st in dict.fromkeys(statuses))
+    assert summary.table().splitlines()[len(entries) + 1] == f"2 files: {counts}; 1.2 s, {where}"
 
 
 class _FakeFuture:
