@@ -31,6 +31,7 @@ import cv2
 import numpy as np
 import pytest
 
+from pftrack import cli
 from pftrack.batch import (
     BatchSummary,
     Job,
@@ -2912,11 +2913,33 @@ def test_a_local_cluster_that_cannot_start_is_one_line(
     with dask.config.set({"temporary-directory": str(tmp_path / "file" / "x")}):
         assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err == (
-        "pftrack recover: error: cannot start a local Dask cluster of 1 worker: [Errno 20] Not "
-        f"a directory: '{tmp_path / 'file' / 'x'}'\n"
+    assert err == (  # was "... 1 worker: [Errno 20] Not a directory: '.../file/x'"
+        "pftrack recover: error: cannot start a local Dask cluster of 1 worker: Not a "
+        f"directory: {tmp_path / 'file' / 'x'}\n"
     ), err
     assert not out.exists()
+
+
+def _read_folder(path: str) -> TaskResult:
+    with open(path, encoding="utf-8") as fh:
+        fh.read()
+    raise AssertionError("read a folder")
+
+
+def test_a_task_s_os_error_is_said_as_pftrack_track_says_it(tmp_path: Path) -> None:
+    """A task's OSError was Python's ``[Errno 21] Is a directory: '...'`` in the batch's table
+    and summary.json, where ``pftrack track`` says ``Is a directory: ...`` (one helper now,
+    ``pftrack._text.error_line``)."""
+    folder = tmp_path / "in.txt"
+    folder.mkdir()
+    summary = run_jobs([Job("in", _read_folder, (str(folder),), ())], tmp_path / "out",
+                       kind="smooth", settings={}, n_workers=0)  # fmt: skip
+    (entry,) = summary.entries
+    assert entry["error"] == f"Is a directory: {folder}"
+    assert f"in: error: Is a directory: {folder}" in summary.table().splitlines()
+    with pytest.raises(OSError) as raised:
+        _read_folder(str(folder))
+    assert cli._one_line(raised.value) == entry["error"]  # what `pftrack track: error:` says
 
 
 def _sockets() -> set[str]:
