@@ -31,6 +31,7 @@ import cv2
 import numpy as np
 import pytest
 
+from pftrack import cli
 from pftrack.batch import (
     BatchSummary,
     Job,
@@ -2944,11 +2945,33 @@ def test_a_local_cluster_that_cannot_start_is_one_line(
     with dask.config.set({"temporary-directory": str(tmp_path / "file" / "x")}):
         assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err == (
-        "pftrack recover: error: cannot start a local Dask cluster of 1 worker: [Errno 20] Not "
-        f"a directory: '{tmp_path / 'file' / 'x'}'\n"
+    assert err == (  # was "... 1 worker: [Errno 20] Not a directory: '.../file/x'"
+        "pftrack recover: error: cannot start a local Dask cluster of 1 worker: Not a "
+        f"directory: {tmp_path / 'file' / 'x'}\n"
     ), err
     assert not out.exists()
+
+
+def _read_folder(path: str) -> TaskResult:
+    with open(path, encoding="utf-8") as fh:
+        fh.read()
+    raise AssertionError("read a folder")
+
+
+def test_a_task_s_os_error_is_said_as_pftrack_track_says_it(tmp_path: Path) -> None:
+    """A task's OSError was Python's ``[Errno 21] Is a directory: '...'`` in the batch's table
+    and summary.json, where ``pftrack track`` says ``Is a directory: ...`` (one helper now,
+    ``pftrack._text.error_line``)."""
+    folder = tmp_path / "in.txt"
+    folder.mkdir()
+    summary = run_jobs([Job("in", _read_folder, (str(folder),), ())], tmp_path / "out",
+                       kind="smooth", settings={}, n_workers=0)  # fmt: skip
+    (entry,) = summary.entries
+    assert entry["error"] == f"Is a directory: {folder}"
+    assert f"in: error: Is a directory: {folder}" in summary.table().splitlines()
+    with pytest.raises(OSError) as raised:
+        _read_folder(str(folder))
+    assert cli._one_line(raised.value) == entry["error"]  # what `pftrack track: error:` says
 
 
 def _sockets() -> set[str]:
@@ -4071,6 +4094,35 @@ def test_a_result_lost_with_the_last_worker_is_not_waited_for_for_ever(
         f"file ran or finished (start some: dask worker {address}; a re-run does the rest)"
     )
     assert json.loads((tmp_path / "summary.json").read_text())["counts"]["failed"] == 1
+    # the totals said "1 worker at ADDR" (the count at the start) of a worker that ran no task
+    # to the end: now what is true, and summary.json's "workers" 0, as no worker ran one
+    assert summary.table().splitlines()[2] == (
+        f"1 file: 1 failed; {summary.seconds:.1f} s, no worker at {address} finished a task"
+    )
+    assert summary.workers == 0
+    assert json.loads((tmp_path / "summary.json").read_text())["workers"] == 0
+
+
+@pytest.mark.parametrize(
+    ("workers", "scheduler", "statuses", "where"),
+    [
+        (2, "tcp://h:8786", ["done", "failed"], "2 workers at tcp://h:8786"),
+        (0, "tcp://h:8786", ["failed", "failed"], "no worker at tcp://h:8786 finished a task"),
+        (0, "tcp://h:8786", ["done", "cancelled"], "no worker at tcp://h:8786 finished a task"),
+        (3, None, ["done", "done"], "3 workers"),
+        (0, None, ["done", "failed"], "in this process"),
+        (0, None, ["skipped", "skipped"], "nothing to run"),
+    ],
+)
+def test_the_totals_line_says_where_tasks_ran(
+    workers: int, scheduler: str | None, statuses: list[str], where: str
+) -> None:
+    """With every worker of a scheduler lost before a task came back, the totals line said
+    "2 workers at ADDR": the count at the start, of workers that ran nothing."""
+    entries = [{"name": f"s{k}", "status": st, "error": "x"} for k, st in enumerate(statuses)]
+    summary = BatchSummary("smooth", Path("out"), entries, 1.25, workers, scheduler)
+    counts = ", ".join(f"{statuses.count(st)} {st}" for st in dict.fromkeys(statuses))
+    assert summary.table().splitlines()[len(entries) + 1] == f"2 files: {counts}; 1.2 s, {where}"
 
 
 class _FakeFuture:

@@ -28,6 +28,7 @@ __all__ = [
     "bgr_frame",
     "bool_array",
     "brief",
+    "byte_order_hint",
     "colour_hint",
     "depth_hint",
     "first_bad_box",
@@ -424,6 +425,24 @@ def depth_hint(frame: NDArray[np.generic]) -> str:
     if frame.dtype == np.uint16:
         return "; a 16-bit frame? (frame >> 8).astype(np.uint8) keeps its top 8 bits"
     return ""
+
+
+def byte_order_hint(a: NDArray[np.generic], name: str) -> str:
+    """The end of a message refusing `a`, updated in place, for its byte order, if swapped.
+
+    A kernel that writes into its argument takes only this machine's byte order (``>f8``, a
+    big-endian array from a file or another machine, is not float64 here). The fix is a copy,
+    so the caller must keep it: the result is written into that copy, not into `a`.
+    """
+    if a.dtype.isnative or a.dtype.byteorder == "|":
+        return ""
+    order = "big" if a.dtype.byteorder == ">" else "little"
+    native = a.dtype.newbyteorder("=").name
+    return (
+        f": {order}-endian, not this machine's byte order; pass a copy in its order, {name} = "
+        f"{name}.astype(np.{native}), and read the result from it (a copy made for the call "
+        "alone would take the result and be lost)"
+    )
 
 
 def colour_hint(shape: tuple[int, ...]) -> str:

@@ -4,7 +4,42 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["SaidBefore", "counted", "listed", "listed_compactly", "opening", "said_alike"]
+__all__ = [
+    "SaidBefore",
+    "counted",
+    "error_line",
+    "listed",
+    "listed_compactly",
+    "on_one_line",
+    "opening",
+    "said_alike",
+]
+
+
+def on_one_line(text: str) -> str:
+    r"""`text` on one line, a file name's bytes that are not UTF-8 as ``\xfe`` escapes.
+
+    Python keeps such bytes of a name as surrogate escapes (``'vid\udcfe.mp4'``).
+    """
+    line = " ".join(text.split())
+    try:
+        return line.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # another lone surrogate
+        return line.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+def error_line(exc: BaseException) -> str:
+    """The error as one line, as ``pftrack`` prints it: an OSError as ``Is a directory: PATH``.
+
+    Not Python's ``[Errno 21] Is a directory: 'PATH'``: an OSError that names a file is its
+    reason and the file; messages lose their line breaks (:func:`on_one_line`). The commands'
+    errors (``pftrack track: error: ...``) and each failed task of a batch say it so.
+    """
+    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in str(exc.strerror):
+        text = f"{exc.strerror or exc}: {exc.filename}"
+    else:
+        text = str(exc)
+    return on_one_line(text)
 
 
 def counted(n: int, noun: str, plural: str | None = None) -> str:

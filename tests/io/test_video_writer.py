@@ -129,7 +129,10 @@ def test_a_failure_keeps_the_old_file_and_leaves_nothing(tmp_path: Path) -> None
     target = tmp_path / "v.mp4"
     target.write_bytes(b"old")
     frames = _frames(3)
-    with pytest.raises(ValueError, match="the video 33x21"), VideoWriter(target, 7) as writer:
+    with (
+        pytest.raises(ValueError, match=r"^VideoWriter.write: frame 2 is 33x10, the video 33x21$"),
+        VideoWriter(target, 7) as writer,
+    ):
         writer.write(frames[0])
         writer.write(frames[1][:10])  # another size
     assert target.read_bytes() == b"old"
@@ -257,11 +260,23 @@ def test_an_mp4_beyond_h264s_side_is_refused_in_one_line(tmp_path: Path, w: int,
 @pytest.mark.parametrize(
     ("frame", "error", "message"),
     [
-        (None, TypeError, r"^frame is NoneType, expected a \(H, W, 3\) uint8 BGR array$"),
-        ([[[0, 0, 0]]], TypeError, r"^frame is list, expected a NumPy uint8 array"),
-        (np.full((21, 33, 3), 0.8), TypeError, r"^frame dtype is float64, expected uint8"),
-        (np.full((21, 33, 3), 4000, np.uint16), TypeError, r"^frame dtype is uint16, expected"),
-        (np.zeros((0, 0, 3), np.uint8), ValueError, r"^frame is 0x0 pixels, expected at least"),
+        (
+            None,
+            TypeError,
+            r"^VideoWriter.write: frame is NoneType, expected a \(H, W, 3\) uint8 BGR array$",
+        ),
+        ([[[0, 0, 0]]], TypeError, r"^VideoWriter.write: frame is list, expected a NumPy"),
+        (
+            np.full((21, 33, 3), 0.8),
+            TypeError,
+            r"^VideoWriter.write: frame dtype is float64, expected uint8",
+        ),
+        (
+            np.full((21, 33, 3), 4000, np.uint16),
+            TypeError,
+            r"^VideoWriter.write: frame dtype is uint16",
+        ),
+        (np.zeros((0, 0, 3), np.uint8), ValueError, r"^VideoWriter.write: frame is 0x0 pixels"),
     ],
     ids=["none", "list", "float", "uint16", "empty"],
 )
@@ -271,7 +286,8 @@ def test_a_frame_that_is_not_bgr_uint8_is_refused_not_cast(
 ) -> None:
     """Was: a float frame of 0..1 written black and a 16-bit one wrapped modulo 256, without a
     word; None or a list an AttributeError ('list' object has no attribute 'ndim'); an empty
-    frame OpenCV's assertion."""
+    frame OpenCV's assertion. Then each without the ``VideoWriter.write:`` its other errors
+    have ("frame is list ...")."""
     with pytest.raises(error, match=message), VideoWriter(tmp_path / name, 7) as writer:
         writer.write(frame)  # type: ignore[arg-type]
     assert list(tmp_path.iterdir()) == []

@@ -18,6 +18,7 @@ from pftrack.particle_filter import (
     ColourParticleFilter,
     hsv_bins,
     multinomial_resample,
+    propagate,
     residual_resample,
     stratified_resample,
     systematic_resample,
@@ -37,6 +38,20 @@ def _float32(name: str) -> ColourParticleFilter:
     setattr(f, name, getattr(f, name).astype(np.float32))
     return f
 
+
+def _big_endian(name: str) -> ColourParticleFilter:
+    f = _filter()
+    setattr(f, name, getattr(f, name).astype(">f8"))
+    return f
+
+
+# a byte-swapped array is refused, as it must be (the core writes in place); was only "got
+# dtype >f8", not what is wrong with it nor that the copy which mends it must be kept
+SWAPPED = (
+    ": big-endian, not this machine's byte order; pass a copy in its order, {0} = "
+    "{0}.astype(np.float64), and read the result from it (a copy made for the call alone would "
+    "take the result and be lost)"
+)
 
 IN_PLACE = "must be a C-contiguous, writeable float64 array (the step updates it in place), got"
 
@@ -98,6 +113,15 @@ CASES = [
      f"step_filters: filters[0].weights {IN_PLACE} float32 (100,), C-contiguous"),
     (lambda: step_filters([_filter(), _filter(), _float32("means")], _IM), TypeError,
      f"step_filters: filters[2].means {IN_PLACE} float32 (2, 3), C-contiguous"),
+    (lambda: propagate(np.zeros((4, 6), ">f8"), np.zeros((4, 3))), TypeError,
+     "propagate: particles must be a C-contiguous, writeable float64 array (updated in place, "
+     "never copied), got dtype >f8" + SWAPPED.format("particles")),
+    (lambda: _big_endian("particles").step(_IM), TypeError,
+     f"ColourParticleFilter.particles {IN_PLACE} >f8 (100, 6), C-contiguous"
+     + SWAPPED.format("filter.particles")),
+    (lambda: step_filters([_filter(), _big_endian("means")], _IM), TypeError,
+     f"step_filters: filters[1].means {IN_PLACE} >f8 (2, 3), C-contiguous"
+     + SWAPPED.format("filter.means")),
 ]  # fmt: skip
 
 

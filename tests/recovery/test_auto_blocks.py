@@ -223,3 +223,39 @@ def test_nb_methods_draw_one_bar_over_the_blocks(monkeypatch: pytest.MonkeyPatch
     blocks = -(-len(pairs) // 7)
     assert len(pairs) > 20
     assert "linear-nb" in err.getvalue() and f"{blocks}/{blocks}" in err.getvalue()
+
+
+@pytest.mark.parametrize("width", [3, 5, 10])
+@pytest.mark.parametrize("given", [True, False])
+def test_recover_gaps_auto_checks_each_pair_once(
+    monkeypatch: pytest.MonkeyPatch, given: bool, width: int
+) -> None:
+    """``recover_gaps(..., "auto")`` checked its pairs (``registry._checked_pairs``), then
+    ``recover_auto`` checked every block of them again (``calibrate.checked_at_once``, or
+    ``as_segment`` pair by pair). Now once: ``recover_auto`` is told they are checked and
+    only takes their ``frame, x, y``; the same bits, with 3, 5 or 10 columns."""
+    pairs, whole = _pairs_and_tracks(_walkers(5, 100))
+    given_pairs = [  # sizes (w, h) = 1 with 5 columns; MOTChallenge-like rows with 10
+        tuple(np.column_stack([s, np.ones((len(s), width - 3))]) for s in p) for p in pairs
+    ]
+    observed = whole if given else None
+    want, _ = recover_auto(pairs, observed)
+    counts = {"fast": 0, "one": 0}
+    real_fast, real_one = calibrate.checked_at_once, calibrate.as_segment
+
+    def fast(g, **k):  # type: ignore[no-untyped-def]
+        counts["fast"] += 1
+        return real_fast(g, **k)
+
+    def one(*a):  # type: ignore[no-untyped-def]
+        counts["one"] += 1
+        return real_one(*a)
+
+    monkeypatch.setattr(calibrate, "checked_at_once", fast)
+    monkeypatch.setattr(calibrate, "as_segment", one)
+    monkeypatch.setattr(calibrate, "RECOVER_BLOCK", 7)
+    got = recover_gaps(given_pairs, "auto", observed=observed)
+    assert len(pairs) > 50 and counts == {"fast": 0, "one": 0}  # main: a check of every block
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(got, want, strict=True))
+    with pytest.raises(ValueError, match="recover_gaps: gap 1: segment_b starts at frame"):
+        recover_gaps([given_pairs[0], given_pairs[0][::-1]], "auto")  # still checked, once

@@ -139,8 +139,10 @@ class BatchSummary:
     seconds : float
         Wall time of the batch (cluster start included).
     workers : int
-        Workers that ran its tasks, those that joined mid-run included (0: in this process);
-        where no task came back from any, the workers the cluster had at the start.
+        Workers that ran its tasks, those that joined mid-run included; 0 in this process,
+        and with a `scheduler` where no task came back from any worker (all lost, or an
+        interrupt first: was the count at the start, which the table then gave as the workers
+        the batch ran on).
     scheduler : str or None
         Address of the Dask scheduler, as given (``--scheduler``, ``DASK_SCHEDULER_ADDRESS``),
         else as Dask reports it (None: in this process).
@@ -226,7 +228,9 @@ class BatchSummary:
             e["status"] == "skipped" or e.get("refused") for e in self.entries
         ):  # no cluster is started or asked for skipped inputs, nor for those refused
             where = "nothing to run"
-        if self.scheduler:
+        elif not self.workers and self.scheduler:  # the workers lost before any task came back
+            where = f"no worker at {self.scheduler} finished a task"
+        if self.scheduler and self.workers:
             where += f" at {self.scheduler}"
         noun = "sequence" if self.kind == "track" else "file"
         text.append(f"{counted(len(self.entries), noun)}: {counts}; {self.seconds:.1f} s, {where}")
@@ -2263,9 +2267,7 @@ def run_jobs(
                 info = c.scheduler_info()
                 reported = str(info.get("address")) if info.get("address") else None
                 summary.scheduler = address or reported  # the user's spelling of the address
-                summary.workers = _wait_for_workers(
-                    c, summary.scheduler or "?", no_workers_timeout()
-                )
+                _wait_for_workers(c, summary.scheduler or "?", no_workers_timeout())
             if pending and enabled(show_progress) and all(job.count is not None for job in pending):
                 # frames over all sequences; the clock starts once the cluster runs
                 frames = stack.enter_context(_Frames(pending, desc, show_progress))
@@ -2300,7 +2302,7 @@ def run_jobs(
                     entries.setdefault(job.name, {"name": job.name, "status": "cancelled"})
                 summary.entries = [entries[job.name] for job in jobs]
                 summary.seconds = time.perf_counter() - start
-                summary.workers = len(ran) or summary.workers
+                summary.workers = len(ran)  # not the count at the start: those that ran tasks
                 try:
                     summary.unwritten = _out_removed(out, made, summary)
                     if summary.unwritten is None:  # also after Ctrl-C: it lists what was left

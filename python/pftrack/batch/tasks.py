@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import brief, flag, instance, number, option, shown
+from pftrack._text import error_line
 from pftrack._threads import tracking_threads
 from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
 from pftrack.batch.inputs import SequenceInput
@@ -168,10 +169,12 @@ class TaskResult:
 
 
 def one_line(exc: BaseException) -> str:
-    """The error as one line; the kind is named unless it is a plain input error."""
-    text = " ".join(str(exc).split())
-    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in text:
-        text = f"{text}: {exc.filename}"
+    """The error as one line; the kind is named unless it is a plain input error.
+
+    As ``pftrack track`` prints it (:func:`pftrack._text.error_line`): ``Is a directory:
+    PATH``, not Python's ``[Errno 21] Is a directory: 'PATH'`` (was, in a batch's table).
+    """
+    text = error_line(exc)
     if isinstance(exc, (ValueError, TypeError, OSError)) and text:
         return text
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__

@@ -18,6 +18,8 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from pftrack import __version__
+from pftrack._text import error_line as _one_line
+from pftrack._text import on_one_line as _shown
 from pftrack.cli import batch, demo, evaluate, experiment, recover, render, smooth, track
 from pftrack.cli._options import HelpFormatter
 from pftrack.cli._signals import (
@@ -119,27 +121,6 @@ def build_parser() -> argparse.ArgumentParser:
     for command in (demo, track, render, batch, smooth, evaluate, recover, experiment):
         command.add_parser(sub)
     return parser
-
-
-def _shown(text: str) -> str:
-    r"""`text` on one line, a file name's bytes that are not UTF-8 as ``\xfe`` escapes.
-
-    Python keeps such bytes of a name as surrogate escapes (``'vid\udcfe.mp4'``).
-    """
-    line = " ".join(text.split())
-    try:
-        return line.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
-    except UnicodeEncodeError:  # another lone surrogate
-        return line.encode("utf-8", "backslashreplace").decode("utf-8")
-
-
-def _one_line(exc: BaseException) -> str:
-    """The error as one line: OSErrors name their file, messages lose their line breaks."""
-    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in str(exc.strerror):
-        text = f"{exc.strerror or exc}: {exc.filename}"
-    else:
-        text = str(exc)
-    return _shown(text)
 
 
 def _one_line_warning(prog: str) -> Callable[..., None]:

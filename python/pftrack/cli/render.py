@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``pftrack render``; return the exit status."""
     import numpy as np
 
-    from pftrack.cli import _shown  # a name's bytes that are not UTF-8 as \xe9, as errors
+    from pftrack._text import on_one_line as _shown  # a name's bytes not UTF-8 as \xe9, as errors
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_distinct, check_output, output_format, staged_outputs

@@ -209,13 +209,14 @@ class VideoWriter:
             writer is closed or aborted.
         """
         self._refuse_if_ended("write")
-        frame = bgr_frame(frame)
+        frame = bgr_frame(frame, "VideoWriter.write: frame")  # was "frame is list ...": no name
         if self._size is None:
             self._open(int(frame.shape[0]), int(frame.shape[1]))
         h, w = self._size if self._size is not None else (0, 0)
         if frame.shape[:2] != (h, w):
             raise ValueError(
-                f"frame {self.n_frames + 1} is {frame.shape[1]}x{frame.shape[0]}, the video {w}x{h}"
+                f"VideoWriter.write: frame {self.n_frames + 1} is {frame.shape[1]}x"
+                f"{frame.shape[0]}, the video {w}x{h}"
             )
         image: NDArray[Any] = frame
         if h % 2 or w % 2:

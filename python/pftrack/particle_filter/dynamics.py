@@ -17,7 +17,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _core
-from pftrack._check import first_at, flag, number, real_array, refuse_masked_weights, shown
+from pftrack._check import (
+    byte_order_hint,
+    first_at,
+    flag,
+    number,
+    real_array,
+    refuse_masked_weights,
+    shown,
+)
 
 __all__ = ["Ar2Model", "estimate", "propagate"]
 
@@ -215,7 +223,10 @@ def _particles_error(particles: object, fn: str) -> TypeError | ValueError | Non
     if not isinstance(particles, np.ndarray):
         return TypeError(f"{fn}: particles must be {what}, got {type(particles).__name__}")
     if particles.dtype != np.float64:
-        return TypeError(f"{fn}: particles must be {what}, got dtype {particles.dtype}")
+        return TypeError(
+            f"{fn}: particles must be {what}, got dtype {particles.dtype}"
+            + byte_order_hint(particles, "particles")
+        )
     if not particles.flags.c_contiguous or not particles.flags.writeable:
         got = "a read-only one" if particles.flags.c_contiguous else "one not C-contiguous"
         return ValueError(f"{fn}: particles must be {what}, got {got}")

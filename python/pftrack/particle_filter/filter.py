@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _core, _limits
 from pftrack._check import (
     MAX_COORD,
+    byte_order_hint,
     generator,
     instance,
     integer,
@@ -296,6 +297,7 @@ def _step_argument_error(
             elif a.dtype != np.float64 or not a.flags.c_contiguous or not a.flags.writeable:
                 order = "C-contiguous" if a.flags.c_contiguous else "not C-contiguous"
                 got = f"{a.dtype} {a.shape}, {order}{'' if a.flags.writeable else ', read-only'}"
+                got += byte_order_hint(a, f"filter.{name}")
             else:
                 continue
             return TypeError(

@@ -1277,6 +1277,7 @@ def recover_auto(
     bags: int | None = None,
     contexts: Sequence[tuple[int, int]] | None = None,
     regions: bool = True,
+    _checked: bool = False,
 ) -> tuple[list[F64], Calibration]:
     """Recover every gap with the method :func:`calibrate` chose for its length.
 
@@ -1332,6 +1333,13 @@ def recover_auto(
         of more than :data:`~pftrack.recovery.segments.MAX_GAP_LIMIT` frames (as
         ``recover_gaps``), settings :func:`calibrate` refuses, an observed run that is not
         (k, 3+) or has a non-finite frame, x or y, `contexts` of another length than `pairs`.
+
+    Notes
+    -----
+    ``recover_gaps(..., "auto")`` passes the private ``_checked=True``: its pairs are
+    already checked (``registry._checked_pairs``, C-contiguous float64 ``(k, 3|5)``), so the
+    first pass only takes their ``frame, x, y`` (:func:`_xy_block`; was a second check of
+    every block, :func:`_checked_block`).
     """
     combine = _check.flag(combine, "recover_auto: combine")
     _, bags, seed = _settings("recover_auto", max_gaps, bags, seed, combine)
@@ -1348,7 +1356,7 @@ def recover_auto(
     sides: list[tuple[int, int]] = []
     kept: list[tuple[F64, F64]] | None = [] if observed is None else None
     for lo in range(0, n_pairs, RECOVER_BLOCK):
-        checked = _checked_block(pairs, lo)
+        checked = _xy_block(pairs, lo) if _checked else _checked_block(pairs, lo)
         lengths += [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
         spans += [float(np.hypot(*(b[0, 1:3] - a[-1, 1:3]))) for a, b in checked]
         if contexts is None:
@@ -1434,6 +1442,18 @@ def _checked_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64,
         gap_ends(sa, sb, "recover_gaps", f"gap {k}: ")  # B after A, at most MAX_GAP_LIMIT
         checked.append((sa, sb))
     return checked
+
+
+def _xy_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64, F64]]:
+    """Gaps ``lo`` to ``lo + RECOVER_BLOCK`` of already checked `pairs`, not checked again.
+
+    Their ``frame, x, y`` as :func:`_checked_block` gives them (C-contiguous float64; a view
+    of a ``(k, 3)`` segment, a copy of a ``(k, 5)`` one's columns): the same values.
+    """
+    return [
+        (np.ascontiguousarray(a[:, :3]), np.ascontiguousarray(b[:, :3]))
+        for a, b in pairs[lo : lo + RECOVER_BLOCK]
+    ]
 
 
 def _read_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64, F64]]:

@@ -313,9 +313,9 @@ def recover_gaps(
     if not pairs:
         return []
     if method == "auto":
-        return recover_auto(pairs, observed, noise, motion, seed=seed, combine=combine, bags=bags)[
-            0
-        ]
+        return recover_auto(  # the pairs are checked: not again, block by block
+            pairs, observed, noise, motion, seed=seed, combine=combine, bags=bags, _checked=True
+        )[0]
     seg_a = [a for a, _ in pairs]
     seg_b = [b for _, b in pairs]
     if method == "gdt-mix":
