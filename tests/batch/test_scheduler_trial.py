@@ -129,10 +129,11 @@ def test_an_unreachable_scheduler_from_the_environment_is_said_to_come_from_it(
     tracks.mkdir()
     for k in range(2):
         (tracks / f"t{k}.txt").write_text("1,1,10,10,5,5,1,-1,-1,-1\n")
+    port = address.rsplit(":", 1)[1]  # not Dask's 8786: the command to start it says so
     refused = (
         f"cannot connect to the Dask scheduler at {address}{{}}: connection refused: nothing "
-        f"listens on port {address.rsplit(':', 1)[1]} of 127.0.0.1 (start the scheduler there "
-        "first: dask scheduler)"
+        f"listens on port {port} of 127.0.0.1 (start the scheduler there first: dask scheduler "
+        f"--port {port})"
     )
     said = " (from $DASK_SCHEDULER_ADDRESS: unset it to run on a local cluster)"
     monkeypatch.setenv("DASK_SCHEDULER_ADDRESS", address)  # after Dask read it: read anyway
