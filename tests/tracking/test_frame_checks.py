@@ -417,9 +417,8 @@ def test_a_non_finite_detection_score_is_named_by_file_and_line_before_tracking(
 @pytest.mark.parametrize("frame", [GREY, BGRA], ids=["grey", "bgra"])
 def test_video_writer_names_the_conversion_too(tmp_path, frame):
     writer = pftrack.VideoWriter(tmp_path / "v.avi", 10.0)
-    with pytest.raises(
-        ValueError, match=r"^frame must have shape \(H, W, 3\) \(BGR\), got \(6, 8(, 4)?\)"
-    ) as e:
+    shape = r"frame must have shape \(H, W, 3\) \(BGR\), got \(6, 8(, 4)?\)"
+    with pytest.raises(ValueError, match=r"^VideoWriter\.write: " + shape) as e:
         writer.write(frame)
     assert str(e.value).endswith(f"? {TO_BGR[id(frame)]} makes it BGR")
 
