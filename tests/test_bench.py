@@ -3,6 +3,7 @@ their ratios land in ``extra_info`` under the names the docs quote."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
@@ -10,6 +11,7 @@ import numpy as np
 import pytest
 
 from bench import conftest as bench_conftest
+from bench import recovery_file
 from pftrack import _core
 from pftrack.synthetic import make_scene
 from tests.reference import fused
@@ -59,3 +61,30 @@ def test_ratios_name_each_baseline_on_the_later_benchmark(
     untimed = _timed("g", None)  # --benchmark-disable: nothing recorded
     assert bench_conftest.ratios(untimed, "filterpy") == {}
     assert untimed.extra_info == {}
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--tracks", "0"], "n_tracks is 0, expected >= 1"),
+        (["--seed", "-1"], "expected non-negative"),
+    ],
+)
+def test_recovery_file_bad_arguments_are_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], message: str
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        recovery_file.main([str(tmp_path / "t.txt"), *argv])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert message in err[-1] and "Traceback" not in "\n".join(err)
+
+
+def test_recovery_file_unwritable_out_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "file").write_text("")
+    with pytest.raises(SystemExit) as exc:
+        recovery_file.main([str(tmp_path / "file" / "t.txt"), "--tracks", "2"])
+    assert exc.value.code == 2
+    assert "file" in capsys.readouterr().err.strip().splitlines()[-1]
