@@ -88,3 +88,16 @@ def test_recovery_file_unwritable_out_is_one_line(
         recovery_file.main([str(tmp_path / "file" / "t.txt"), "--tracks", "2"])
     assert exc.value.code == 2
     assert "file" in capsys.readouterr().err.strip().splitlines()[-1]
+
+
+def test_kernel_floors_can_fail(monkeypatch: pytest.MonkeyPatch) -> None:
+    from bench import test_kernels
+
+    monkeypatch.setattr(bench_conftest, "_MEDIANS", {})
+    group = "sis_step_batch 15x200, 100x250 boxes, 1920x1080 black"
+    test_kernels._compare(_timed(group, 0.010), "every_pixel")
+    with pytest.raises(AssertionError, match="lattice is 2.0x every_pixel, below the floor 3x"):
+        test_kernels._compare(_timed(group, 0.005), "lattice")
+    unchecked = _timed(group, 0.005)  # the random-noise frame: recorded, not asserted
+    test_kernels._compare(unchecked, "lattice", check=False)
+    assert unchecked.extra_info == {"x_every_pixel": 2.0}
