@@ -105,3 +105,32 @@ def track_boxes() -> list[tuple[NDArray[np.float64], NDArray[np.bool_]]]:
         has[f] = True
         out.append((z, has))
     return out
+
+
+#: The roles that are not pftrack in a group: a benchmark's ratios are baseline / pftrack.
+BASELINES = ("numpy", "filterpy", "stonesoup", "every_pixel")
+_MEDIANS: dict[str, dict[str, float]] = {}  # group -> role -> median seconds, this run
+
+
+def ratios(benchmark: BenchmarkFixture, role: str) -> dict[tuple[str, str], float]:
+    """Keep this benchmark's median as `role` of its group, and compare it with the group's.
+
+    Each (pftrack role, baseline) pair of the group measured so far in this run (any bench
+    file: Stone Soup's rows join the groups of test_kernels.py and test_recovery.py) gets
+    ``baseline / pftrack`` in ``extra_info["x_<baseline>"]`` of the later benchmark
+    (``"x_<baseline>_<role>"`` when the later one is the baseline's). Returns those ratios by
+    (pftrack role, baseline); none with ``--benchmark-disable`` (no timing).
+    """
+    if not benchmark.stats:
+        return {}
+    medians = _MEDIANS.setdefault(benchmark.group, {})
+    medians[role] = benchmark.stats.stats.median
+    ours = [r for r in medians if r not in BASELINES] if role in BASELINES else [role]
+    bases = [role] if role in BASELINES else [b for b in BASELINES if b in medians]
+    out = {}
+    for base in bases:
+        for r in ours:
+            out[r, base] = medians[base] / medians[r]
+            key = f"x_{base}" if role not in BASELINES else f"x_{base}_{r}"
+            benchmark.extra_info[key] = round(out[r, base], 1)
+    return out

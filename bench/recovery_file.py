@@ -9,6 +9,7 @@ whole-process timing in docs/results.md (``time pftrack recover tracks.txt --out
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -67,14 +68,18 @@ def synthetic_tracks(n_tracks: int = 500, seed: int = 0, n_frames: int = 2000) -
     return result
 
 
-def main() -> None:
+def main(argv: Sequence[str] | None = None) -> None:
+    """Write the file; bad arguments or an unwritable `out` are one line and exit status 2."""
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("out", help="tracks file to write")
     p.add_argument("--tracks", type=int, default=500, help="number of tracks")
     p.add_argument("--seed", type=int, default=0, help="seed")
-    args = p.parse_args()
-    rows = synthetic_tracks(args.tracks, args.seed)
-    write_mot(args.out, rows)
+    args = p.parse_args(argv)
+    try:
+        rows = synthetic_tracks(args.tracks, args.seed)
+        write_mot(args.out, rows)
+    except (ValueError, OSError) as err:  # a traceback before
+        p.error(str(err))
     print(f"{args.out}: {len(rows)} rows, {args.tracks} tracks")
 
 

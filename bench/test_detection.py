@@ -32,8 +32,9 @@ Frame = NDArray[np.uint8]
 Frames = tuple[str, list[Frame]]  # (size name, frames)
 
 
-def load_frames(data: Path, size: tuple[int, int]) -> list[Frame]:
-    """60 PETS09-S2L1 frames resized to `size`, or synthetic ones without the data."""
+def load_frames(data: Path, size: tuple[int, int]) -> tuple[list[Frame], bool]:
+    """60 PETS09-S2L1 frames resized to `size`, or synthetic ones without the data (a block
+    moving over smooth noise: another workload); and whether they are PETS09's."""
     video = data / "pets09-s2l1" / "video.avi"
     frames: list[Frame] = []
     if video.is_file():
@@ -56,12 +57,16 @@ def load_frames(data: Path, size: tuple[int, int]) -> list[Frame]:
             frame = bg.copy()
             frame[100:180, 10 + 6 * k : 40 + 6 * k] = (40, 60, 200)
             frames.append(frame)
-    return frames
+        return frames, False
+    return frames, True
 
 
 @pytest.fixture(scope="module", params=list(SIZES))
 def frames(request: pytest.FixtureRequest, data_dir: Path) -> Frames:
-    return request.param, load_frames(data_dir, SIZES[request.param])
+    """The size's name, ``"480x360 [synthetic frames]"`` without PETS09's (every group built
+    on it then says so), and its frames."""
+    frames, pets = load_frames(data_dir, SIZES[request.param])
+    return request.param + ("" if pets else " [synthetic frames]"), frames
 
 
 def cycle_apply(fn: Callable[[Frame], Any], frames: list[Frame]) -> Callable[[], Any]:

@@ -47,7 +47,17 @@ from pftrack.render import TrackRenderer
 from pftrack.tracking import TrackerConfig, track_frames
 from pftrack.tracking.run import load_detections
 
-SOURCES = ["pets 480x360", "pets 1280x720", "crowd 10", "crowd 30", "crowd 100"]
+#: 100 walkers cover most of the frame while the background model learns it: the built-in
+#: detector rightly warns "noisy or changing video" (since 5 December), which the tests'
+#: ``filterwarnings = error`` made a failure of every mode but ``decode``.
+CROWDED = pytest.mark.filterwarnings("ignore:noisy or changing video:UserWarning")
+SOURCES = [
+    "pets 480x360",
+    "pets 1280x720",
+    "crowd 10",
+    "crowd 30",
+    pytest.param("crowd 100", marks=CROWDED),
+]
 MODES = ["decode", "builtin", "builtin-first", "public", "render", "builtin-640", "render-640"]
 N_720, N_CROWD = 300, 150
 

@@ -25,12 +25,14 @@
 * ``rts smooth, 500 tracks``: :func:`pftrack.kalman.rts_smooth` (one C++ call ``_core.rts_smooth``
   per track, what the offline pass and ``pftrack smooth`` run for every track's box) against
   the NumPy loop it replaced (``rts_smooth_numpy``), over the 500 tracks of
-  :mod:`bench.recovery_file` (four axes: centre and size).
+  :mod:`bench.recovery_file` (four axes: centre and size). The ratios of the medians go to
+  ``extra_info["x_numpy"]`` (and ``x_stonesoup`` when bench/test_stonesoup.py runs too:
+  :func:`bench.conftest.ratios`).
 * ``region blocks, 500 tracks``: the square regions ``auto`` cuts its validation gaps with
   (:func:`~pftrack.recovery.calibrate._region_blocks`, one C++ call ``_core.region_blocks``)
   against the NumPy loop over the squares it replaced (``tests/reference/regions.py``), on the
   box centres' runs of the 500-track file, squares of 57 px as ``recover`` lays there (1700 of
-  2000 within ``REGION_WORK``) and of 5 px; the same stretches.
+  2000 within ``REGION_WORK``) and of 5 px; the same stretches; the ratio in ``x_numpy``.
 
 Locally: ``pytest bench/test_recovery.py --benchmark-only``; CI: ``--benchmark-disable``.
 """
@@ -41,6 +43,7 @@ import numpy as np
 import pytest
 from pytest_benchmark.fixture import BenchmarkFixture
 
+from bench.conftest import ratios
 from bench.recovery_file import synthetic_tracks
 from pftrack import _core
 from pftrack._threads import kernel_threads
@@ -192,6 +195,7 @@ def test_region_blocks(
     assert len(want.run) > 0
     for g, w in zip(got, want, strict=True):
         np.testing.assert_array_equal(g, w)
+    ratios(benchmark, impl)  # the README's "8 ms against 92 ms": x_numpy
 
 
 _GRID_Q, _GRID_R = (
@@ -292,6 +296,7 @@ def test_rts_smooth_core(
     got = benchmark(run)
     for (z, h), g in list(zip(track_boxes, got, strict=True))[:25]:
         np.testing.assert_array_equal(g, rts_smooth_numpy(z, h, _Q, _R, 10.0, False))
+    ratios(benchmark, "core")
 
 
 def test_rts_smooth_numpy(
@@ -303,6 +308,7 @@ def test_rts_smooth_numpy(
         rounds=3,
         iterations=1,
     )
+    ratios(benchmark, "numpy")
 
 
 def _sparse_fragments(k: int) -> F64:

@@ -3,7 +3,9 @@
 RJ-MCMC joint tracker at 200 and 1000 kept samples per frame on PETS09-S2L1 (480x360, public
 detections as birth candidates, MOG2 foreground), and the per-object MH filter against the SIS
 filter at an equal likelihood budget; a synthetic 480x360 scene with six objects when the data
-is absent. The workloads are those of ``python -m experiments.rjmcmc_speed`` (a frames/s table).
+is absent (another workload: the group's name then ends in ``[synthetic]``, and
+``extra_info["sequence"]`` says which ran). The workloads are those of ``python -m
+experiments.rjmcmc_speed`` (a frames/s table).
 
 Locally: ``pytest bench/test_rjmcmc.py --benchmark-only``.
 """
@@ -27,9 +29,17 @@ def seq(data_dir: Path) -> Frames:
     return pets_sequence(data_dir)
 
 
+def _label(benchmark: BenchmarkFixture, seq: Frames) -> None:
+    """Name the sequence in ``extra_info``, and in the group when it is not PETS09's."""
+    benchmark.extra_info["sequence"] = seq[3]
+    if seq[3] != "PETS09-S2L1":
+        benchmark.group = f"{benchmark.group} [{seq[3]}]"
+
+
 @pytest.mark.benchmark(group="rjmcmc 480x360 per frame")
 @pytest.mark.parametrize("n_samples", [200, 1000])
 def test_rjmcmc_sequence(benchmark: BenchmarkFixture, seq: Frames, n_samples: int) -> None:
+    _label(benchmark, seq)
     per_frame, _ = benchmark.pedantic(run_rjmcmc, args=(seq, n_samples), rounds=3, iterations=1)
     benchmark.extra_info["frames_per_s"] = 1.0 / per_frame
 
@@ -38,11 +48,13 @@ def test_rjmcmc_sequence(benchmark: BenchmarkFixture, seq: Frames, n_samples: in
 # and one iteration evaluates N chain starts + N proposals.
 @pytest.mark.benchmark(group="one object, 400 likelihoods a frame")
 def test_sis_400(benchmark: BenchmarkFixture, seq: Frames) -> None:
+    _label(benchmark, seq)
     benchmark(run_filter, *one_object(seq), "sis", 400)
 
 
 @pytest.mark.benchmark(group="one object, 400 likelihoods a frame")
 def test_mh_200x1(benchmark: BenchmarkFixture, seq: Frames) -> None:
+    _label(benchmark, seq)
     benchmark(run_filter, *one_object(seq), "mh", 200, 1)
 
 

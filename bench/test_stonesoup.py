@@ -18,6 +18,10 @@ Skipped without Stone Soup. Its models are built as in ``experiments/stonesoup_m
   velocity), the weight in NumPy, :func:`~pftrack.particle_filter.systematic_resample` and the
   gather. ``particle predict`` times the propagation alone (noise draw included on both sides).
 
+Each group's ratios of the medians (Stone Soup's or NumPy's over pftrack's) go to
+``extra_info["x_stonesoup"]`` and ``["x_numpy"]`` of the later benchmark
+(:func:`bench.conftest.ratios`), across the files run together.
+
 Locally: ``pytest bench/test_stonesoup.py bench/test_recovery.py bench/test_kernels.py
 --benchmark-enable --benchmark-only --benchmark-group-by=group -k "stonesoup or rts_smooth or
 resample_"``.
@@ -34,6 +38,7 @@ import pytest
 from numpy.typing import NDArray
 from pytest_benchmark.fixture import BenchmarkFixture
 
+from bench.conftest import ratios
 from experiments.stonesoup_models import EPOCH, stonesoup_rts_smooth
 from pftrack._typing import F64
 from pftrack.kalman import rts_smooth
@@ -75,16 +80,20 @@ def test_rts_one_track_core(benchmark: BenchmarkFixture, one_track: Boxes) -> No
     want = _smooth_all(stonesoup_rts_smooth, one_track)
     h = one_track[0][1]
     np.testing.assert_allclose(got[0][h], want[0][h], rtol=1e-9, atol=1e-9)
+    ratios(benchmark, "core")
 
 
 @pytest.mark.benchmark(group="rts smooth, one track of 400 frames")
 def test_rts_one_track_numpy(benchmark: BenchmarkFixture, one_track: Boxes) -> None:
-    benchmark(_smooth_all, _numpy, one_track)
+    got = benchmark(_smooth_all, _numpy, one_track)
+    np.testing.assert_array_equal(got[0], _smooth_all(rts_smooth, one_track)[0])
+    ratios(benchmark, "numpy")
 
 
 @pytest.mark.benchmark(group="rts smooth, one track of 400 frames")
 def test_rts_one_track_stonesoup(benchmark: BenchmarkFixture, one_track: Boxes) -> None:
     benchmark.pedantic(_smooth_all, args=(stonesoup_rts_smooth, one_track), rounds=5)
+    ratios(benchmark, "stonesoup")
 
 
 @pytest.mark.benchmark(group="rts smooth, 500 tracks")
@@ -94,6 +103,7 @@ def test_rts_smooth_stonesoup(benchmark: BenchmarkFixture, track_boxes: Boxes) -
     for (z, h), g in list(zip(track_boxes, got, strict=True))[:25]:
         want = rts_smooth(z, h, _Q, _R, velocity_sd=10.0, update_first=False)
         np.testing.assert_allclose(g[h], want[h], rtol=1e-9, atol=1e-9)
+    ratios(benchmark, "stonesoup")
 
 
 @pytest.fixture(scope="module")
@@ -114,6 +124,7 @@ def test_resample_stonesoup(benchmark: BenchmarkFixture, weights_10k: F64) -> No
     particles = ParticleState(states, log_weight=np.log(weights_10k), timestamp=EPOCH)
     out = benchmark(SystematicResampler().resample, particles)
     assert len(out) == len(weights_10k)
+    ratios(benchmark, "stonesoup")
 
 
 # ---- particle filter: a constant-velocity target in 2D, Gaussian position likelihood ---------
@@ -207,6 +218,7 @@ def test_pf_step_stonesoup(benchmark: BenchmarkFixture, n: int) -> None:
     step, _ = _stonesoup_filter(n)
     estimate, truth = benchmark(step)
     assert np.all(np.abs(estimate - truth) < 3.0)  # it follows the target
+    ratios(benchmark, "stonesoup")
 
 
 @pytest.mark.parametrize("n", [1000, 10_000])
@@ -215,15 +227,18 @@ def test_pf_step_pftrack(benchmark: BenchmarkFixture, n: int) -> None:
     step, _ = _pftrack_filter(n)
     estimate, truth = benchmark(step)
     assert np.all(np.abs(estimate - truth) < 3.0)  # it follows the target
+    ratios(benchmark, "pftrack")
 
 
 @pytest.mark.benchmark(group="particle predict N=10000")
 def test_pf_predict_stonesoup(benchmark: BenchmarkFixture) -> None:
     _, predict = _stonesoup_filter(10_000)
     benchmark(predict)
+    ratios(benchmark, "stonesoup")
 
 
 @pytest.mark.benchmark(group="particle predict N=10000")
 def test_pf_predict_pftrack(benchmark: BenchmarkFixture) -> None:
     _, predict = _pftrack_filter(10_000)
     benchmark(predict)
+    ratios(benchmark, "pftrack")
