@@ -1161,6 +1161,44 @@ def test_ctrl_c_after_the_outputs_are_written_does_not_fail_the_run(
     assert out.stat().st_size > 0
 
 
+RENAMED_CTRL_C = """
+import os, signal, sys
+import pftrack.io.mot as mot
+from pftrack._console import main
+
+real = mot.write_mot
+
+def renamed(*args, **kwargs):  # the output renamed into place, then at once: Ctrl-C
+    real(*args, **kwargs)
+    os.kill(os.getpid(), signal.SIGINT)
+
+mot.write_mot = renamed
+sys.argv = ["pftrack", *{argv!r}]
+sys.exit(main())
+"""
+
+
+@pytest.mark.parametrize("command", ["smooth", "recover"])
+def test_ctrl_c_right_after_the_output_is_renamed_does_not_say_nothing_changed(
+    scene: Scene, tmp_path: Path, command: str
+) -> None:
+    """Was: the interrupt between ``write_mot``'s rename and ``hold_interrupts`` ended the run
+    with status 130 and "interrupted; no output was changed" beside the new --out (CI hit it
+    once, ``test_ctrl_c_at_any_point_of_the_start_ends_in_130``). The hold now comes before
+    the write, as the commands with several outputs hold before their renames."""
+    tracks = scene.write_truth(tmp_path / "gt.txt")
+    out = tmp_path / "o.txt"
+    code = RENAMED_CTRL_C.format(argv=[command, str(tracks), "--out", str(out)])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+        timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "interrupted" not in proc.stderr and f"-> {out}" in proc.stdout
+    assert out.stat().st_size > 0
+
+
 def test_held_interrupts_are_restored_when_the_command_returns(
     scene: Scene, tmp_path: Path
 ) -> None:

@@ -519,8 +519,8 @@ def _run_sequences(args: argparse.Namespace) -> int:
             {k: (None if isinstance(v, float) and v != v else v) for k, v in asdict(e).items()}
             for e in excess
         ]
+        hold_interrupts()  # the work is done: --json is written whatever comes (as recover)
         _write_json(args.json, doc)
-        hold_interrupts()  # --json is written: a late Ctrl-C does not fail the run
     to = report_stream(args.json)  # not into a JSON file written to stdout
     for r in results:  # printed once the JSON is written: a closed stdout cannot lose it
         masks = "; ".join(",".join(f"{v:g}" for v in m) for m in r.masks) or "none"

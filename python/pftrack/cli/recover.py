@@ -121,9 +121,12 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
     dt = time.perf_counter() - t0
-    # (after a Ctrl-C that code in C dropped, the writer refuses: pftrack._interrupt)
+    # the work is done: --out is written whatever comes (held before the write, as the
+    # commands with several outputs hold before their renames: held after it, a Ctrl-C
+    # between the rename and the hold said "no output was changed" of a replaced --out; after
+    # a Ctrl-C that code in C dropped, the writer still refuses: pftrack._interrupt)
+    hold_interrupts()
     write_mot(args.out, filled, exact=copied_values(rows, filled))  # given values: all digits
-    hold_interrupts()  # --out is written: a late Ctrl-C does not fail the run
     to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report on stderr
     print(
         f"{src}: {counted(len(rows), 'row')}, {counted(n_links, 'fragment')} linked, "

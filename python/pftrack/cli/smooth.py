@@ -68,9 +68,10 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(src)
     link = None if args.no_link else link_config_for(rows, args.max_gap, args.max_distance)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
-    # (after a Ctrl-C that code in C dropped, the writer refuses: pftrack._interrupt)
+    # the work is done: --out is written whatever comes (as in recover; after a Ctrl-C
+    # that code in C dropped, the writer still refuses: pftrack._interrupt)
+    hold_interrupts()
     write_mot(args.out, result, exact=smoothed_copies(result))  # given values: all digits
-    hold_interrupts()  # --out is written: a late Ctrl-C does not fail the run
     ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
     ids_out = len(np.unique(result[:, 1])) if len(result) else 0
     to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report not
