@@ -1338,7 +1338,7 @@ def recover_auto(
     -----
     ``recover_gaps(..., "auto")`` passes the private ``_checked=True``: its pairs are
     already checked (``registry._checked_pairs``, C-contiguous float64 ``(k, 3|5)``), so the
-    first pass only takes their ``frame, x, y`` (:func:`_xy_block`; was a second check of
+    first pass only takes their ``frame, x, y`` (:func:`_read_block`; was a second check of
     every block, :func:`_checked_block`).
     """
     combine = _check.flag(combine, "recover_auto: combine")
@@ -1356,7 +1356,7 @@ def recover_auto(
     sides: list[tuple[int, int]] = []
     kept: list[tuple[F64, F64]] | None = [] if observed is None else None
     for lo in range(0, n_pairs, RECOVER_BLOCK):
-        checked = _xy_block(pairs, lo) if _checked else _checked_block(pairs, lo)
+        checked = _read_block(pairs, lo) if _checked else _checked_block(pairs, lo)
         lengths += [int(b[0, 0] - a[-1, 0]) - 1 for a, b in checked]
         spans += [float(np.hypot(*(b[0, 1:3] - a[-1, 1:3]))) for a, b in checked]
         if contexts is None:
@@ -1444,23 +1444,12 @@ def _checked_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64,
     return checked
 
 
-def _xy_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64, F64]]:
-    """Gaps ``lo`` to ``lo + RECOVER_BLOCK`` of already checked `pairs`, not checked again.
-
-    Their ``frame, x, y`` as :func:`_checked_block` gives them (C-contiguous float64; a view
-    of a ``(k, 3)`` segment, a copy of a ``(k, 5)`` one's columns): the same values.
-    """
-    return [
-        (np.ascontiguousarray(a[:, :3]), np.ascontiguousarray(b[:, :3]))
-        for a, b in pairs[lo : lo + RECOVER_BLOCK]
-    ]
-
-
 def _read_block(pairs: Sequence[tuple[F64, F64]], lo: int) -> list[tuple[F64, F64]]:
     """Gaps ``lo`` to ``lo + RECOVER_BLOCK`` of `pairs` as :func:`_checked_block` gave them.
 
     Not checked again: :func:`recover_auto`'s first pass checked them and, calibrating on its
-    `observed`, dropped the copies (a block's memory, not every gap's); only converted as
+    `observed`, dropped the copies (a block's memory, not every gap's), or ``recover_gaps``
+    checked them before (``_checked``: the first pass reads them so too); only converted as
     :func:`~pftrack.recovery.segments.as_segment` converts, ``frame, x, y`` of every segment
     stacked into one float64 copy and split (the same values; was a second
     :func:`_checked_block` of every block).
