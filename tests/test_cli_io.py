@@ -1117,6 +1117,18 @@ def test_every_option_shows_its_default(capsys: pytest.CaptureFixture[str]) -> N
     assert "--link join fragments of one object first --max-distance" in text  # flags: no noise
 
 
+def _finishes_despite_ctrl_c(code: str, cwd: Path, out: Path) -> None:
+    """`code`, a ``pftrack`` command with a Ctrl-C sent into it, ends with 0 and `out` written."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=cwd, env=env, capture_output=True, text=True,
+        timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "interrupted" not in proc.stderr and f"-> {out}" in proc.stdout
+    assert out.stat().st_size > 0
+
+
 LATE_CTRL_C = """
 import os, signal, sys
 import pftrack.cli.{module} as command
@@ -1151,14 +1163,7 @@ def test_ctrl_c_after_the_outputs_are_written_does_not_fail_the_run(
     }[command]
     hook = "_outside" if command == "render" else "report_stream"
     code = LATE_CTRL_C.format(module=command, hook=hook, argv=argv)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    proc = subprocess.run(
-        [sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
-        timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "interrupted" not in proc.stderr and f"-> {out}" in proc.stdout
-    assert out.stat().st_size > 0
+    _finishes_despite_ctrl_c(code, tmp_path, out)
 
 
 RENAMED_CTRL_C = """
@@ -1189,14 +1194,7 @@ def test_ctrl_c_right_after_the_output_is_renamed_does_not_say_nothing_changed(
     tracks = scene.write_truth(tmp_path / "gt.txt")
     out = tmp_path / "o.txt"
     code = RENAMED_CTRL_C.format(argv=[command, str(tracks), "--out", str(out)])
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    proc = subprocess.run(
-        [sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
-        timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, proc.stderr
-    assert "interrupted" not in proc.stderr and f"-> {out}" in proc.stdout
-    assert out.stat().st_size > 0
+    _finishes_despite_ctrl_c(code, tmp_path, out)
 
 
 def test_held_interrupts_are_restored_when_the_command_returns(
