@@ -797,12 +797,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.measure:
         results = measure(data_root(args.data), args.trials)
         write_text(path, json.dumps(results, indent=1) + "\n")
-    elif not path.is_file():
-        p.error(f"{path}: no such file; run with --measure first")
+    loaded = _read_object(p, path, "--measure")
     try:
-        loaded = json.loads(path.read_text())
-        if not isinstance(loaded, dict):
-            raise TypeError(f"a JSON {type(loaded).__name__}, expected an object")
         chosen = {k: loaded[k] for k in args.trials if k in loaded}
         if not chosen:
             p.error(f"{path}: none of the trials {', '.join(args.trials)}; run with --measure")
@@ -816,17 +812,26 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def _read_object(p: argparse.ArgumentParser, path: Path, again: str) -> dict[str, object]:
+    """The JSON object in `path`; exit 2 naming the problem if it is missing or not one."""
+    if not path.is_file():
+        p.error(f"{path}: no such file; run with {again} first")
+    try:
+        loaded = json.loads(path.read_text())
+    except ValueError as e:
+        p.error(f"{path}: not a {path.name} ({type(e).__name__}: {e})")
+    if not isinstance(loaded, dict):
+        p.error(f"{path}: not a {path.name} (a JSON {type(loaded).__name__}, expected an object)")
+    return loaded
+
+
 def _main_fresh(p: argparse.ArgumentParser, path: Path, run: bool, data: Path | None) -> int:
     """``--fresh``: measure (with `run`) or read `path`, print the fresh tables."""
     names = list(FRESH)
     if run:
         write_text(path, json.dumps(measure_fresh(data_root(data), names), indent=1) + "\n")
-    elif not path.is_file():
-        p.error(f"{path}: no such file; run with --fresh --measure first")
+    loaded = _read_object(p, path, "--fresh --measure")
     try:
-        loaded = json.loads(path.read_text())
-        if not isinstance(loaded, dict):
-            raise TypeError(f"a JSON {type(loaded).__name__}, expected an object")
         text = fresh_table(loaded, names)
     except (ValueError, KeyError, TypeError, IndexError) as e:
         p.error(f"{path}: not a fresh.json ({type(e).__name__}: {e})")

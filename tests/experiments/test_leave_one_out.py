@@ -195,3 +195,9 @@ def test_fresh_table_reports_every_sequence_and_the_verdict(
     with pytest.raises(SystemExit) as e:
         ex.main(["--fresh", "--out", str(tmp_path / "none")])
     assert e.value.code == 2 and "run with --fresh --measure first" in capsys.readouterr().err
+    for bad in ("[1]", "{"):
+        (tmp_path / "fresh.json").write_text(bad)
+        with pytest.raises(SystemExit) as e:
+            ex.main(["--fresh", "--out", str(tmp_path)])
+        err = capsys.readouterr().err
+        assert e.value.code == 2 and "not a fresh.json" in err and "Traceback" not in err
