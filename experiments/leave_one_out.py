@@ -36,14 +36,23 @@ the table is recomputed from that file. A second table follows, of the rules who
 per-sequence figures the docs record (the detector's grids of docs/detection.md, recovery's
 seed rules and thresholds): the same question from those figures, copied here, with no run.
 
+``--fresh`` asks instead whether ``min_height``, ``birth_overlap`` and ``relink_coast``
+hold on evidence none of their rules saw (docs/results.md, "Settled on fresh evidence"): the
+eight sequences with tracker seeds 5-7, the synthetic scenes made with generator seeds 11-13
+(:data:`FRESH_RUNS`), each default against its candidates (:data:`FRESH`) under the rule
+written there before the runs (:func:`fresh_verdict`). ``--fresh --measure`` writes
+``fresh.json`` (one run of the defaults and one of each candidate per pair of seeds: 18 runs);
+``--fresh`` alone recomputes the tables from it.
+
 Usage (from the repository root)::
 
     python -m experiments.leave_one_out [--data ../shared/data] [--out out/leave_one_out]
-        [--measure] [--trials blind_coast size_ratio ...]
+        [--measure] [--trials blind_coast size_ratio ...] [--fresh]
 """
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import json
@@ -152,6 +161,137 @@ def measure(data: Path, names: Sequence[str]) -> dict[str, object]:
                 print(f"{name} {value} seed {seed}: pooled {_fmt(runs[value][-1]['pooled'])}")
         out[name] = {"field": trial.field, "seeds": list(trial.seeds), "runs": runs}
     return out
+
+
+#: The fresh runs: (tracker seed, generator seed of the synthetic scenes and their detections).
+FRESH_RUNS: tuple[tuple[int, int], ...] = ((5, 11), (6, 12), (7, 13))
+
+
+@dataclass(frozen=True)
+class Fresh:
+    """A default settled on fresh evidence: its ``--set`` field, value and candidates."""
+
+    field: str
+    default: str
+    candidates: tuple[str, ...]
+
+
+FRESH: dict[str, Fresh] = {
+    "min_height": Fresh("refine.min_height", "0.6", ("0.67", "0.75")),
+    "birth_overlap": Fresh("lifecycle.birth_overlap", "0.3", ("0.4",)),
+    "relink_coast": Fresh("lifecycle.relink_coast", "7", ("6", "8")),
+}
+
+#: The fresh rule's bounds: least rise of one pooled figure, most a sequence's mean may lose
+#: (MOTA, IDF1, HOTA; IDF1 unbounded).
+FRESH_RISE = 0.3
+FRESH_LOSS: Row = (0.5, float("inf"), 0.3)
+
+
+def measure_fresh(data: Path, names: Sequence[str]) -> dict[str, object]:
+    """Run the defaults and each candidate of `names` on :data:`FRESH_RUNS`; the JSON.
+
+    Keys: ``"runs"`` (the seed pairs) and ``"figures"``, ``{"default" or "FIELD=VALUE": [one
+    :func:`figures` per run]}``.
+    """
+    seqs = sequence_names(data)
+    settings = ["default"]
+    for name in names:
+        f = FRESH[name]
+        if override(TrackerConfig(), f"{f.field}={f.default}") != TrackerConfig():
+            raise ValueError(f"measure_fresh: {f.field} is no longer {f.default} by default")
+        settings += [f"{f.field}={v}" for v in f.candidates]
+    out: dict[str, list[dict[str, object]]] = {}
+    for setting in settings:
+        config = TrackerConfig() if setting == "default" else override(TrackerConfig(), setting)
+        out[setting] = []
+        for seed, scene_seed in FRESH_RUNS:
+            with contextlib.redirect_stdout(io.StringIO()):
+                scores = run_all(data, config, seed, scene_seed=scene_seed)
+            out[setting].append(figures(seqs, scores))
+            print(f"{setting} seed {seed} scenes {scene_seed}: pooled "
+                  f"{_fmt(out[setting][-1]['pooled'])}", flush=True)  # fmt: skip
+    return {"runs": [list(r) for r in FRESH_RUNS], "figures": out}
+
+
+def fresh_runs(results: Mapping[str, object], name: str) -> Runs:
+    """The runs of one :data:`FRESH` default, keyed by value (the default's and each
+    candidate's), from `measure_fresh`'s JSON."""
+    f = FRESH[name]
+    figs: Mapping[str, Sequence[Mapping[str, object]]] = results["figures"]  # type: ignore[assignment]
+    runs = {f.default: figs["default"]}
+    for v in f.candidates:
+        key = f"{f.field}={v}"
+        if key not in figs:
+            raise ValueError(f"fresh: no runs for {key}; run with --fresh --measure")
+        runs[v] = figs[key]
+    return runs
+
+
+def fresh_verdict(runs: Runs, f: Fresh) -> tuple[str, dict[str, str]]:
+    """The value the fresh rule keeps, and why each candidate passed or failed.
+
+    A candidate passes if its pooled MOTA, IDF1 and HOTA (means over the runs, printed
+    digits) are each at least the default's and one is higher by :data:`FRESH_RISE` or more,
+    and no sequence's mean loses more than :data:`FRESH_LOSS` against the default; of several,
+    the highest pooled MOTA, then IDF1, then HOTA is taken.
+    """
+    base = _mean(pooled(runs, f.default, None))
+    why: dict[str, str] = {}
+    passing = []
+    for v in f.candidates:
+        d = [a - b for a, b in zip(_mean(pooled(runs, v, None)), base, strict=True)]
+        losses = _losses(runs, v, f.default, None)
+        over = [
+            f"{n} {('MOTA', 'IDF1', 'HOTA')[k]} {dk[k]:+.1f}"
+            for n, dk in losses.items()
+            for k in range(3)
+            if dk[k] < -FRESH_LOSS[k] - 1e-9
+        ]
+        pooled_text = " / ".join(f"{x:+.1f}" for x in d)
+        if min(d) < -1e-9:
+            why[v] = f"fails: pooled {pooled_text} (one falls)"
+        elif max(d) < FRESH_RISE - 1e-9:
+            why[v] = f"fails: pooled {pooled_text} (none rises by {FRESH_RISE})"
+        elif over:
+            why[v] = f"fails: {', '.join(over)}"
+        else:
+            why[v] = f"passes: pooled {pooled_text}"
+            passing.append(v)
+    if not passing:
+        return f.default, why
+    return max(passing, key=lambda v: _mean(pooled(runs, v, None))), why
+
+
+def fresh_table(results: Mapping[str, object], names: Sequence[str]) -> str:
+    """The fresh rule's verdicts and every sequence's figures, as Markdown."""
+    lines = [
+        "| default | value | pooled, mean of the runs | per run | verdict |",
+        "|---|---|---|---|---|",
+    ]
+    for name in names:
+        f = FRESH[name]
+        runs = fresh_runs(results, name)
+        kept, why = fresh_verdict(runs, f)
+        held = "held on fresh evidence" if kept == f.default else f"**changed to {kept}**"
+        for v in (f.default, *f.candidates):
+            per_run = ", ".join(_fmt(r) for r in pooled(runs, v, None))
+            verdict = held if v == f.default else why[v]
+            lines.append(
+                f"| `{name}` | {v}{' (default)' if v == f.default else ''} | "
+                f"{_fmt(_mean(pooled(runs, v, None)))} | {per_run} | {verdict} |"
+            )
+    head = ["default"] + [f"`{n}` {v}" for n in names for v in FRESH[n].candidates]
+    lines += ["", "| sequence, mean of the runs | " + " | ".join(head) + " |",
+              "|---|" + "---|" * len(head)]  # fmt: skip
+    columns = [fresh_runs(results, names[0])[FRESH[names[0]].default]] + [
+        fresh_runs(results, n)[v] for n in names for v in FRESH[n].candidates
+    ]
+    seqs = list(columns[0][0]["sequences"])  # type: ignore[call-overload]
+    for s in seqs:
+        cells = [_fmt(_mean([run["sequences"][s] for run in c])) for c in columns]  # type: ignore[index]
+        lines.append(f"| {s} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
 
 
 def _fmt(row: object) -> str:
@@ -642,20 +782,23 @@ def main(argv: list[str] | None = None) -> int:
         help="run the trials and write leave_one_out.json first (about 15 minutes for all)",
     )  # fmt: skip
     p.add_argument(
+        "--fresh", action="store_true",
+        help="settle min_height, birth_overlap and relink_coast on fresh seeds instead "
+        "(fresh.json; with --measure 18 runs, about 5 minutes)",
+    )  # fmt: skip
+    p.add_argument(
         "--trials", nargs="+", choices=tuple(TRIALS), default=list(TRIALS), metavar="NAME",
         help=f"the defaults to check (default: all of {', '.join(TRIALS)})",
     )  # fmt: skip
     args = p.parse_args(argv)
+    if args.fresh:
+        return _main_fresh(p, args.out / "fresh.json", args.measure, args.data)
     path = args.out / "leave_one_out.json"
     if args.measure:
         results = measure(data_root(args.data), args.trials)
         write_text(path, json.dumps(results, indent=1) + "\n")
-    elif not path.is_file():
-        p.error(f"{path}: no such file; run with --measure first")
+    loaded = _read_object(p, path, "--measure")
     try:
-        loaded = json.loads(path.read_text())
-        if not isinstance(loaded, dict):
-            raise TypeError(f"a JSON {type(loaded).__name__}, expected an object")
         chosen = {k: loaded[k] for k in args.trials if k in loaded}
         if not chosen:
             p.error(f"{path}: none of the trials {', '.join(args.trials)}; run with --measure")
@@ -666,6 +809,34 @@ def main(argv: list[str] | None = None) -> int:
         print(text, end="")
         print()
         print(docs_table(), end="")
+    return 0
+
+
+def _read_object(p: argparse.ArgumentParser, path: Path, again: str) -> dict[str, object]:
+    """The JSON object in `path`; exit 2 naming the problem if it is missing or not one."""
+    if not path.is_file():
+        p.error(f"{path}: no such file; run with {again} first")
+    try:
+        loaded = json.loads(path.read_text())
+    except ValueError as e:
+        p.error(f"{path}: not a {path.name} ({type(e).__name__}: {e})")
+    if not isinstance(loaded, dict):
+        p.error(f"{path}: not a {path.name} (a JSON {type(loaded).__name__}, expected an object)")
+    return loaded
+
+
+def _main_fresh(p: argparse.ArgumentParser, path: Path, run: bool, data: Path | None) -> int:
+    """``--fresh``: measure (with `run`) or read `path`, print the fresh tables."""
+    names = list(FRESH)
+    if run:
+        write_text(path, json.dumps(measure_fresh(data_root(data), names), indent=1) + "\n")
+    loaded = _read_object(p, path, "--fresh --measure")
+    try:
+        text = fresh_table(loaded, names)
+    except (ValueError, KeyError, TypeError, IndexError) as e:
+        p.error(f"{path}: not a fresh.json ({type(e).__name__}: {e})")
+    with tee_stdout(path.with_suffix(".txt")):
+        print(text, end="")
     return 0
 
 

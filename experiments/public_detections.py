@@ -13,7 +13,8 @@ The drop-in mode (`pftrack.tracking.track_frames` with a ``det.txt``, as ``pftra
 ``present``, ``groups``, ``overhead``
     The synthetic busy scenes of `pftrack.synthetic.make_busy_scene` with detections made from
     their truth, seeded: each box moved and resized by 5 % of its height, 10 % of the boxes
-    missed, one false box every other frame.
+    missed, one false box every other frame. ``--scene-seed N`` makes the three scenes and
+    their detections with generator seed N instead of 0: scenes no setting was chosen on.
 
 The last row of each seed, ``pooled``, scores the eight sequences together (TrackEval's
 combination). ``--seeds`` repeats the run over several tracker seeds (PETS09's IDF1 moves
@@ -29,7 +30,7 @@ that scores below ``birth_score`` (docs/tracking.md, "Birth threshold").
 Usage (from the repository root)::
 
     python -m experiments.public_detections [--data ../shared/data] [--out DIR]
-        [--seeds 0 1 2] [--upscale 2] [--empty 60] [--low-scores]
+        [--seeds 0 1 2] [--scene-seed 0] [--upscale 2] [--empty 60] [--low-scores]
         [--set SECTION.FIELD=VALUE ...]
 """
 
@@ -272,6 +273,11 @@ def main(argv: list[str] | None = None) -> int:
         help="tracker seeds, one run of every sequence each (default: 0)",
     )  # fmt: skip
     p.add_argument(
+        "--scene-seed", type=int, default=0, metavar="N",
+        help="generator seed of the synthetic scenes and of their detections (default: 0, "
+        "the scenes every setting was chosen on)",
+    )  # fmt: skip
+    p.add_argument(
         "--upscale", type=float, default=1.0, metavar="FACTOR",
         help="scale every sequence's frames, detections and truth by FACTOR, as footage of "
         "the same scene at another resolution (default: 1.0, as they are)",
@@ -288,6 +294,8 @@ def main(argv: list[str] | None = None) -> int:
     )  # fmt: skip
     add_settings(p, "motion.colour_noise=0.2")
     args = p.parse_args(argv)
+    if args.scene_seed < 0:
+        p.error(f"--scene-seed is {args.scene_seed}, expected a seed >= 0")
     if args.empty < 0:
         p.error(f"--empty is {args.empty}, expected a frame count >= 0")
     if not (np.isfinite(args.upscale) and 0.1 <= args.upscale <= 8):
@@ -298,7 +306,9 @@ def main(argv: list[str] | None = None) -> int:
         for seed in args.seeds:
             if len(args.seeds) > 1:
                 print(f"-- seed {seed}")
-            scores = run_all(data, config, seed, args.upscale, args.empty, args.low_scores)
+            scores = run_all(
+                data, config, seed, args.upscale, args.empty, args.low_scores, args.scene_seed
+            )
             if scores:
                 print(line("pooled", SequenceScores.combine(scores)), flush=True)
     return 0
@@ -311,12 +321,14 @@ def run_all(
     factor: float = 1.0,
     empty: int = 0,
     low: bool = False,
+    scene_seed: int = 0,
 ) -> list[SequenceScores]:
     """Track every sequence found under `data` and the synthetic scenes; print each row.
 
     `factor` scales every sequence's frames, detections and truth (``--upscale``); `empty`
     and `low` change the detections (:func:`late_and_low`), and the frames ``1..empty`` are
-    not scored. Returns the scores of every sequence run, in order.
+    not scored. `scene_seed` seeds the synthetic scenes and their detections
+    (``--scene-seed``). Returns the scores of every sequence run, in order.
     """
     out: list[SequenceScores] = []
 
@@ -341,9 +353,10 @@ def run_all(
             run = track_frames(frames, detections=dets, config=config, rng=seed)
         report(name + " (black)", read_mot(folder / "gt.txt"), run.rows)
     for kind in BUSY_SCENES:
-        scene = make_busy_scene(kind, rng=0)
+        scene = make_busy_scene(kind, rng=scene_seed)
         h, w = scene.frames[0].shape[:2]
-        dets = scaled(noisy_detections(scene.truth, len(scene.frames), h, w), factor)
+        dets = noisy_detections(scene.truth, len(scene.frames), h, w, seed=scene_seed)
+        dets = scaled(dets, factor)
         dets = late_and_low(dets, empty, low)
         source = scene.frames if factor == 1 else Resized(scene.frames, factor)
         run = track_frames(source, detections=dets, config=config, rng=seed)

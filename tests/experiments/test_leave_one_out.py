@@ -134,3 +134,70 @@ def test_recovery_rules_pool_by_gaps() -> None:
     assert ex.threshold_choice(None) == "2 / 1 %" and ex.threshold_choice("KITTI-17") == "2 / 3 %"
     text = ex.docs_table()
     assert "KITTI-17: **not adopted**" in text and "| 2 / 1 % |" in text
+
+
+def _fresh(rows: dict[str, dict[str, tuple[float, float, float]]]) -> dict[str, object]:
+    """A ``fresh.json`` of min_height whose three runs give each value the same rows:
+    `rows` maps a value to its two sequences' rows, pooled as their mean."""
+    f = ex.FRESH["min_height"]
+    figures = {}
+    for v, r in rows.items():
+        pool = tuple(float(np.mean([r["a"][k], r["b"][k]])) for k in range(3))
+        key = "default" if v == f.default else f"{f.field}={v}"
+        figures[key] = [_run(r, pool, {})] * len(ex.FRESH_RUNS)  # type: ignore[arg-type]
+    return {"runs": [list(r) for r in ex.FRESH_RUNS], "figures": figures}
+
+
+def test_fresh_rule_needs_a_rise_of_03_and_no_loss_beyond_the_bounds() -> None:
+    f = ex.FRESH["min_height"]
+    base = {"a": (50.0, 60.0, 40.0), "b": (70.0, 80.0, 60.0)}
+    cases = {  # 0.67 and 0.75 against the default 0.6: the verdict on each
+        "0.67": {"a": (50.6, 60.0, 40.0), "b": (70.0, 80.0, 60.0)},  # pooled MOTA +0.3: passes
+        "0.75": {"a": (50.4, 60.0, 40.0), "b": (70.0, 80.0, 60.0)},  # +0.2: too little
+    }
+    runs = ex.fresh_runs(_fresh({"0.6": base, **cases}), "min_height")
+    kept, why = ex.fresh_verdict(runs, f)
+    assert kept == "0.67" and why["0.67"].startswith("passes: pooled +0.3 / +0.0 / +0.0")
+    assert why["0.75"] == "fails: pooled +0.2 / +0.0 / +0.0 (none rises by 0.3)"
+    # a rise of 2 MOTA that costs one sequence 0.6 MOTA (or 0.4 HOTA) is refused
+    cases["0.67"] = {"a": (54.6, 60.0, 40.0), "b": (69.4, 80.0, 60.0)}
+    cases["0.75"] = {"a": (51.0, 61.0, 41.0), "b": (70.0, 80.0, 59.6)}
+    kept, why = ex.fresh_verdict(ex.fresh_runs(_fresh({"0.6": base, **cases}), "min_height"), f)
+    assert kept == "0.6"
+    assert why["0.67"] == "fails: b MOTA -0.6" and why["0.75"] == "fails: b HOTA -0.4"
+    # IDF1 falling in the pool refuses it, whatever MOTA does; a loss of 0.5 MOTA is allowed
+    cases["0.67"] = {"a": (52.0, 59.8, 40.0), "b": (70.0, 80.0, 60.0)}
+    cases["0.75"] = {"a": (51.6, 60.0, 40.0), "b": (69.5, 80.0, 60.0)}
+    kept, why = ex.fresh_verdict(ex.fresh_runs(_fresh({"0.6": base, **cases}), "min_height"), f)
+    assert why["0.67"] == "fails: pooled +1.0 / -0.1 / +0.0 (one falls)" and kept == "0.75"
+
+
+def test_fresh_table_reports_every_sequence_and_the_verdict(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    base = {"a": (50.0, 60.0, 40.0), "b": (70.0, 80.0, 60.0)}
+    fresh = _fresh({"0.6": base, "0.67": base, "0.75": base})
+    for name in ("birth_overlap", "relink_coast"):
+        f = ex.FRESH[name]
+        for v in f.candidates:
+            fresh["figures"][f"{f.field}={v}"] = fresh["figures"]["default"]  # type: ignore[index]
+    (tmp_path / "fresh.json").write_text(json.dumps(fresh))
+    assert ex.main(["--fresh", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert out.count("held on fresh evidence") == 3 and "| a | 50.0 / 60.0 / 40.0 |" in out
+    assert "| `relink_coast` | 8 | 60.0 / 70.0 / 50.0 |" in out
+    assert (tmp_path / "fresh.txt").read_text() == out
+    del fresh["figures"]["lifecycle.relink_coast=8"]  # type: ignore[attr-defined]
+    (tmp_path / "fresh.json").write_text(json.dumps(fresh))
+    with pytest.raises(SystemExit) as e:
+        ex.main(["--fresh", "--out", str(tmp_path)])
+    assert e.value.code == 2 and "no runs for lifecycle.relink_coast=8" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as e:
+        ex.main(["--fresh", "--out", str(tmp_path / "none")])
+    assert e.value.code == 2 and "run with --fresh --measure first" in capsys.readouterr().err
+    for bad in ("[1]", "{"):
+        (tmp_path / "fresh.json").write_text(bad)
+        with pytest.raises(SystemExit) as e:
+            ex.main(["--fresh", "--out", str(tmp_path)])
+        err = capsys.readouterr().err
+        assert e.value.code == 2 and "not a fresh.json" in err and "Traceback" not in err

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from experiments import public_detections as ex
+from pftrack._typing import F64
 from pftrack.eval import evaluate_sequence
-from pftrack.synthetic import make_busy_scene
+from pftrack.synthetic import Scene, make_busy_scene
 from pftrack.tracking import TrackerConfig, track_frames
 
 
@@ -106,4 +108,37 @@ def test_late_and_low_drops_the_first_frames_and_squeezes_scores() -> None:
     assert list(out) == [3]
     assert np.allclose(out[3][:, 4], [0.2, 0.26, 0.5]) and np.array_equal(
         out[3][:, :4], dets[3][:, :4]
+    )
+
+
+@pytest.mark.filterwarnings("ignore:the video is grey:UserWarning")  # overhead is grey
+def test_scene_seed_makes_the_scenes_and_their_detections(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """``--scene-seed``: the synthetic scenes and their detections use it; 0 is today's."""
+    seeds: list[tuple[str, object]] = []
+
+    def scene(kind: str, rng: int) -> Scene:
+        seeds.append(("scene", rng))
+        return make_busy_scene(kind, n_frames=8, rng=rng)
+
+    def dets(truth: F64, n: int, h: int, w: int, seed: int = 0) -> dict[int, F64]:
+        seeds.append(("dets", seed))
+        return real_dets(truth, n, h, w, seed)
+
+    real_dets = ex.noisy_detections
+    monkeypatch.setattr(ex, "make_busy_scene", scene)
+    monkeypatch.setattr(ex, "noisy_detections", dets)
+    scores = ex.run_all(tmp_path, TrackerConfig(), 0, scene_seed=12)
+    assert len(scores) == 3 and seeds == [("scene", 12), ("dets", 12)] * 3
+    seeds.clear()
+    ex.run_all(tmp_path, TrackerConfig(), 0)
+    assert seeds == [("scene", 0), ("dets", 0)] * 3
+
+
+def test_main_rejects_a_negative_scene_seed(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as e:
+        ex.main(["--scene-seed", "-1"])
+    assert e.value.code == 2 and "--scene-seed is -1, expected a seed >= 0" in (
+        capsys.readouterr().err
     )
