@@ -8,7 +8,13 @@ import numpy as np
 import pytest
 
 from experiments import perturbed_gaps as ex
-from pftrack.recovery.experiment import SequenceResult, run_sequence, trajectories
+from pftrack.recovery.experiment import (
+    SequenceResult,
+    auto_masks,
+    run_mask,
+    run_sequence,
+    trajectories,
+)
 from pftrack.synthetic import make_scene
 
 
@@ -152,3 +158,23 @@ def test_unknown_perturbation_is_refused(only: str, capsys: pytest.CaptureFixtur
     assert e.value.code == 2
     err = capsys.readouterr().err
     assert f"--only is {only!r}, expected a comma-separated list of pan, shake" in err
+
+
+@pytest.mark.xfail(
+    strict=True, reason="gaps of 5-8 frames at a clipped image edge, validated in the interior"
+)
+def test_auto_is_not_worse_than_linear_on_syn0_thirdfps_at_the_right_edge() -> None:
+    # syn0 of experiments.auto_seeds at a third of its frame rate, its second automatic mask:
+    # 6 of its 8 gaps lie 14-18 px from the right edge, where make_scene clips the boxes (their
+    # centres then move as no interior run does); auto 2.473 px a gap, linear 2.080.
+    scene = make_scene(n_frames=300, n_walkers=12, rng=0)
+    trajs = trajectories(ex.perturbed("syn0", scene.truth, 480.0, 360.0, scene.fps, "thirdfps", 0))
+    mask = (406.0, 158.0, 62.0, 62.0)
+    assert mask in auto_masks(trajs, 480.0, 360.0, 3)
+    run = run_mask(trajs, mask, ("auto", "linear"), seed=0)
+    assert len(run.gaps) == 8
+    err = {
+        m: np.mean([np.mean(g.errors(p)) for g, p in zip(run.gaps, run.paths[m], strict=True)])
+        for m in run.paths
+    }
+    assert err["auto"] <= err["linear"], err
