@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from experiments import perturbed_gaps as ex
-from pftrack.recovery.experiment import run_sequence, trajectories
+from pftrack.recovery.experiment import (
+    SequenceResult,
+    auto_masks,
+    run_mask,
+    run_sequence,
+    trajectories,
+)
 from pftrack.synthetic import make_scene
 
 
@@ -89,3 +97,84 @@ def test_negative_seed_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
         ex.main(["--seed", "-1"])
     assert e.value.code == 2
     assert "--seed is -1, expected >= 0" in capsys.readouterr().err
+
+
+def test_third_fps_keeps_every_third_frame_renumbered(rows: np.ndarray) -> None:
+    a = ex.perturbed("s", rows, 480.0, 360.0, 10.0, "thirdfps", seed=0)
+    kept = rows[np.isin(rows[:, 0], np.arange(1, rows[:, 0].max() + 1, 3))]  # 1, 4, 7, ...
+    np.testing.assert_array_equal(a[:, 1:], kept[:, 1:])
+    np.testing.assert_array_equal(a[:, 0], (kept[:, 0] - 1) / 3 + 1)
+    assert a[:, 0].min() == 1
+    assert np.array_equal(np.unique(a[:, 0]), np.arange(1, a[:, 0].max() + 1))  # no frame lost
+
+
+def test_zoom_scales_boxes_about_the_image_centre_and_draws_nothing(rows: np.ndarray) -> None:
+    fps = 10.0
+    a = ex.perturbed("s", rows, 480.0, 360.0, fps, "zoom", seed=0)
+    np.testing.assert_array_equal(a, ex.perturbed("t", rows, 480.0, 360.0, fps, "zoom", seed=7))
+    s = 1.0 + 0.15 * np.sin(2 * np.pi * rows[:, 0] / fps / 10.0)
+    np.testing.assert_allclose(a[:, 4:6], rows[:, 4:6] * s[:, None])  # width and height alike
+    centre = np.array([240.0, 180.0])
+    for col in (0.0, 1.0):  # the corner and the opposite corner both scale about the centre
+        got = a[:, 2:4] + col * a[:, 4:6] - centre
+        want = (rows[:, 2:4] + col * rows[:, 4:6] - centre) * s[:, None]
+        np.testing.assert_allclose(got, want, atol=1e-9)
+    assert 1.14 < s.max() < 1.151  # 60 frames at 10 fps: a quarter period is 2.5 s
+    np.testing.assert_array_equal(a[:, :2], rows[:, :2])  # frames and ids as they were
+
+
+def _result(name: str, auto: float) -> SequenceResult:
+    errors = {"auto": (auto, auto), "linear": (1.2, 1.2), "rts": (1.0, 1.0)}
+    return SequenceResult(name, (480.0, 360.0), (), 2, errors)
+
+
+def test_table_lists_copies_more_than_2_percent_above_the_best_fixed() -> None:
+    text = ex.format_table({"zoom": [_result("a-zoom", 1.03), _result("b-zoom", 1.01)]})
+    lines = text.splitlines()
+    assert lines[-2] == "more than 2 % above the best fixed: a-zoom"  # 1.01 is within 2 % of rts
+    assert lines[-1] == "worse than linear: none"
+    text = ex.format_table({"zoom": [_result("b-zoom", 1.01)]})
+    assert text.splitlines()[-2] == "more than 2 % above the best fixed: none"
+
+
+def test_only_runs_the_perturbations_named(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    ran: list[tuple[str, ...]] = []
+
+    def score(root: Path, seed: int, only: tuple[str, ...]) -> dict[str, list[SequenceResult]]:
+        ran.append(only)
+        return {how: [_result(f"s-{how}", 1.0)] for how in only}
+
+    monkeypatch.setattr(ex, "score", score)
+    assert ex.main(["--only", "zoom, thirdfps", "--out", str(tmp_path)]) == 0
+    assert ran == [("zoom", "thirdfps")]
+    text = (tmp_path / "perturbed_seed0.txt").read_text()
+    assert "pooled zoom " in text and "pooled thirdfps " in text and "pooled pan " not in text
+
+
+@pytest.mark.parametrize("only", ["foo", "zoom,foo", ","])
+def test_unknown_perturbation_is_refused(only: str, capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as e:
+        ex.main(["--only", only])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert f"--only is {only!r}, expected a comma-separated list of pan, shake" in err
+
+
+@pytest.mark.xfail(
+    strict=True, reason="gaps of 5-8 frames at a clipped image edge, validated in the interior"
+)
+def test_auto_is_not_worse_than_linear_on_syn0_thirdfps_at_the_right_edge() -> None:
+    # syn0 of experiments.auto_seeds at a third of its frame rate, its second automatic mask:
+    # 6 of its 8 gaps lie 14-18 px from the right edge, where make_scene clips the boxes (their
+    # centres then move as no interior run does); auto 2.473 px a gap, linear 2.080.
+    scene = make_scene(n_frames=300, n_walkers=12, rng=0)
+    trajs = trajectories(ex.perturbed("syn0", scene.truth, 480.0, 360.0, scene.fps, "thirdfps", 0))
+    mask = (406.0, 158.0, 62.0, 62.0)
+    assert mask in auto_masks(trajs, 480.0, 360.0, 3)
+    run = run_mask(trajs, mask, ("auto", "linear"), seed=0)
+    assert len(run.gaps) == 8
+    err = {
+        m: np.mean([np.mean(g.errors(p)) for g, p in zip(run.gaps, run.paths[m], strict=True)])
+        for m in run.paths
+    }
+    assert err["auto"] <= err["linear"], err
