@@ -33,6 +33,14 @@
   against the NumPy loop over the squares it replaced (``tests/reference/regions.py``), on the
   box centres' runs of the 500-track file, squares of 57 px as ``recover`` lays there (1700 of
   2000 within ``REGION_WORK``) and of 5 px; the same stretches; the ratio in ``x_numpy``.
+* ``gdt path T=8000``: one goal-directed path 8000 steps long (``_core.gdt_solve``, path, every
+  ``eps_t`` and state covariance) against the NumPy peer of its O(T) recursion
+  (``tests/reference/bridge.py``'s ``gdt_numpy_fast``), the same path; the cost per step goes to
+  ``extra_info["us_per_step"]``. Beyond about 2000 steps the core's cost per step rises (0.35 to
+  about 0.5 us, least of 7 runs on 6 December): not the sums, which are one backward recursion,
+  but the first touch of its ~544 B a step of fresh buffers, which glibc maps anew for each call
+  above its mmap threshold (with ``MALLOC_MMAP_THRESHOLD_=1000000000`` the cost per step at
+  T = 8000 was T = 1000's, 0.32-0.34 us; docs/recovery.md, Speed).
 
 Locally: ``pytest bench/test_recovery.py --benchmark-only``; CI: ``--benchmark-disable``.
 """
@@ -48,7 +56,7 @@ from bench.recovery_file import synthetic_tracks
 from pftrack import _core
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
-from pftrack.kalman import cv_transition, rts_smooth, wna_Q
+from pftrack.kalman import cv_transition, cv_transition_xy, rts_smooth, wna_Q
 from pftrack.recovery import LinkConfig, fill_gaps, link_tracklets
 from pftrack.recovery.baselines import rts_batch
 from pftrack.recovery.calibrate import _fit_sample, _flat, _region_blocks
@@ -135,6 +143,39 @@ def test_rts_numpy_vectorised(benchmark: BenchmarkFixture) -> None:
 def test_rts_numpy_reference(benchmark: BenchmarkFixture) -> None:
     benchmark.group = "rts gaps"
     benchmark.pedantic(_rts_reference, args=(_gaps(),), rounds=3, iterations=1)
+
+
+#: A constant-velocity walk in (x, y) to a goal 8000 frames on (bench/test_bridge.py's model).
+GDT_T = 8000
+GDT_MODEL = (
+    cv_transition_xy(1.0),
+    np.diag([1e-6, 1e-6, 1e-4, 1e-4]),
+    np.hstack([np.eye(2), np.zeros((2, 2))]),
+    1e-6 * np.eye(2),
+    np.array([0.0, 0.0, 1.0, 0.5]),
+    1e-3 * np.eye(4),
+    np.array([1.0 * GDT_T, 0.5 * GDT_T + 3.0]),
+)
+
+
+def _per_step(benchmark: BenchmarkFixture) -> None:
+    if benchmark.stats:  # not when untimed (--benchmark-disable)
+        benchmark.extra_info["us_per_step"] = round(benchmark.stats.stats.min / GDT_T * 1e6, 3)
+
+
+def test_gdt_path_8000_core(benchmark: BenchmarkFixture) -> None:
+    benchmark.group = f"gdt path T={GDT_T}"
+    r = benchmark(_core.gdt_solve, *GDT_MODEL, GDT_T, "general", True)
+    _per_step(benchmark)
+    want = ref_bridge.gdt_numpy_fast(*GDT_MODEL, GDT_T)
+    np.testing.assert_allclose(r["path"], want, rtol=1e-9, atol=1e-6)
+    assert r["eps"].shape == (GDT_T, 4, 4) and r["cov"].shape == (GDT_T + 1, 4, 4)
+
+
+def test_gdt_path_8000_numpy_reference(benchmark: BenchmarkFixture) -> None:
+    benchmark.group = f"gdt path T={GDT_T}"
+    benchmark.pedantic(ref_bridge.gdt_numpy_fast, args=(*GDT_MODEL, GDT_T), rounds=3, iterations=1)
+    _per_step(benchmark)
 
 
 @pytest.fixture(scope="module")

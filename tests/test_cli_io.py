@@ -126,13 +126,14 @@ def test_a_bad_seqinfo_is_refused_before_any_output(
 
 def test_a_seqinfo_that_is_not_utf8_is_read_for_its_numbers(sequence: Path, tmp_path: Path) -> None:
     """A user trial: ``name=Caf\\xe9`` (Latin-1) stopped track, render, batch and experiment
-    with a decoder's message that named no file; the keys pftrack reads are ASCII."""
+    with a decoder's message that named no file; the keys pftrack reads are ASCII. The name is
+    read as Windows-1252 (was "Caf\ufffd"; tests/io/test_seqinfo_kinds.py)."""
     seq = tmp_path / "SEQ"
     seq.mkdir()
     (seq / "img1").symlink_to(sequence / "img1", target_is_directory=True)
     (seq / "seqinfo.ini").write_bytes(b"[Sequence]\nname=Caf\xe9\nframeRate=7\nimWidth=9\n")
     info = read_seqinfo(seq)
-    assert (info.name, info.frame_rate, info.width) == ("Caf\ufffd", 7.0, 9)
+    assert (info.name, info.frame_rate, info.width) == ("Caf\u00e9", 7.0, 9)
 
 
 @pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "pftrack/check.hpp"
+#include "pftrack/types.hpp"
 
 namespace pftrack::bind {
 
@@ -98,6 +99,50 @@ inline void check_mask(const py::array& m, py::ssize_t rows, py::ssize_t cols, c
         fail(fn, "mask must have the frame's (H, W) shape");
     if (!(m.strides(1) == 1 && m.strides(0) > 0))
         fail(fn, "mask must be packed along rows (use numpy.ascontiguousarray)");
+}
+
+/// `obj` as the float64 array `what` that `fn` updates in place (never copied: a copy would take
+/// the result and be lost), of `ndim` dimensions, C-contiguous and writeable. Anything else is
+/// one line naming `what`, as pftrack.particle_filter.propagate's checks give it: not an array
+/// or another dtype (float32, a long double, a big-endian >f8) a TypeError naming the dtype,
+/// a layout or number of dimensions it cannot be written through a ValueError. Was pybind11's
+/// "incompatible function arguments" with the whole signature (an Eigen::Ref .noconvert()).
+inline py::array inplace_f64(const py::handle& obj, const char* fn, const char* what, int ndim) {
+    const std::string want = "a C-contiguous, writeable float64 array (updated in place, never "
+                             "copied)";
+    if (!py::isinstance<py::array>(obj))
+        throw py::type_error(std::string(fn) + ": " + what + " must be " + want + ", got " +
+                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>());
+    const auto a = py::reinterpret_borrow<py::array>(obj);
+    if (!is_dtype<double>(a.dtype())) {
+        const bool swapped = a.dtype().kind() == 'f' && a.dtype().itemsize() == 8;
+        throw py::type_error(std::string(fn) + ": " + what + " must be " + want + ", got dtype " +
+                             dtype_name(a) +
+                             (swapped ? " (not this machine's byte order; pass a copy in its "
+                                        "order, .astype(np.float64), and read the result from it)"
+                                      : ""));
+    }
+    if (!((a.flags() & py::array::c_style) != 0 && a.writeable()))
+        fail(fn, std::string(what) + " must be " + want + ", got " +
+                     (a.writeable() ? "one not C-contiguous" : "a read-only one"));
+    if (a.ndim() != ndim)
+        fail(fn, std::string(what) + " must have " + std::to_string(ndim) + " dimension" +
+                     (ndim == 1 ? "" : "s") + ", got " + std::to_string(a.ndim()));
+    return a;
+}
+
+/// The (rows, cols) matrix of a 2-D array inplace_f64 checked, written through.
+inline Eigen::Map<RowMatrixXd> inplace_matrix(const py::handle& obj, const char* fn,
+                                              const char* what) {
+    py::array a = inplace_f64(obj, fn, what, 2);
+    return {static_cast<double*>(a.mutable_data()), a.shape(0), a.shape(1)};
+}
+
+/// The (n,) vector of a 1-D array inplace_f64 checked, written through.
+inline Eigen::Map<Eigen::VectorXd> inplace_vector(const py::handle& obj, const char* fn,
+                                                  const char* what) {
+    py::array a = inplace_f64(obj, fn, what, 1);
+    return {static_cast<double*>(a.mutable_data()), a.shape(0)};
 }
 
 /// One object in one thread at a time: a method that releases the GIL, or that could run while

@@ -47,15 +47,18 @@ py::array_t<double> batch_item(const py::handle& h, const char* what, py::ssize_
 void register_filter(py::module_& m) {
     m.def(
         "propagate",
-        [](Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<const RowMatrixXd> noise,
+        [](const py::object& particles_in, Eigen::Ref<const RowMatrixXd> noise,
            const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
            double s_min, double s_max, bool use_means, const Eigen::Vector3d& mean_prev,
            const Eigen::Vector3d& mean_prev2) {
+            // written in place: checked here, one line (was pybind11's list of signatures)
+            Eigen::Map<RowMatrixXd> particles =
+                bind::inplace_matrix(particles_in, "propagate", "particles");
             const Ar2Model model = make_model(a, b, sigma, s_min, s_max, use_means);
             py::gil_scoped_release nogil;  // safe: Eigen views only
             propagate_ar2(particles, noise, model, mean_prev, mean_prev2);
         },
-        py::arg("particles").noconvert(), py::arg("noise"), py::arg("a"), py::arg("b"),
+        py::arg("particles"), py::arg("noise"), py::arg("a"), py::arg("b"),
         py::arg("sigma"), py::arg("s_min"), py::arg("s_max"), py::arg("use_means"),
         py::arg("mean_prev"), py::arg("mean_prev2"),
         "AR(2) step in place; particles (N, 6) float64 C-contiguous, noise (N, 3) N(0, 1).");
@@ -104,12 +107,18 @@ void register_filter(py::module_& m) {
 
     m.def(
         "sis_step",
-        [](Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
-           Eigen::Ref<RowMatrixXd> means, const BinnedImage& image,
+        [](const py::object& particles_in, const py::object& weights_in,
+           const py::object& means_in, const BinnedImage& image,
            Eigen::Ref<const Eigen::VectorXd> ref, double w0, double h0,
            const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& sigma,
            double s_min, double s_max, bool use_means, double lam, const std::string& kernel,
            bool resample, std::uint64_t seed, std::uint64_t step, double min_samples) {
+            // written in place: checked here, one line (was pybind11's list of signatures)
+            Eigen::Map<RowMatrixXd> particles =
+                bind::inplace_matrix(particles_in, "sis_step", "particles");
+            Eigen::Map<Eigen::VectorXd> weights =
+                bind::inplace_vector(weights_in, "sis_step", "weights");
+            Eigen::Map<RowMatrixXd> means = bind::inplace_matrix(means_in, "sis_step", "means");
             SisParams prm = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means,
                                                    lam, kernel, resample, "sis_step");
             prm.min_samples = min_samples;  // checked by sis_step, with the other parameters
@@ -120,8 +129,7 @@ void register_filter(py::module_& m) {
             }
             return bind::step_result_dict(r);
         },
-        py::arg("particles").noconvert(), py::arg("weights").noconvert(),
-        py::arg("means").noconvert(), py::arg("image"), py::arg("ref"), py::arg("w0"),
+        py::arg("particles"), py::arg("weights"), py::arg("means"), py::arg("image"), py::arg("ref"), py::arg("w0"),
         py::arg("h0"), py::arg("a"), py::arg("b"), py::arg("sigma"), py::arg("s_min"),
         py::arg("s_max"), py::arg("use_means"), py::arg("lam"), py::arg("kernel"),
         py::arg("resample"), py::arg("seed"), py::arg("step"), py::arg("min_samples") = 0.0,

@@ -102,14 +102,18 @@ py::tuple config_arrays(const RjConfig& c) {
 void register_mcmc(py::module_& m) {
     m.def(
         "mh_step",
-        [](Eigen::Ref<RowMatrixXd> particles, Eigen::Ref<Eigen::VectorXd> weights,
-           Eigen::Ref<RowMatrixXd> means, const BinnedImage& image,
+        [](const py::object& particles_in, const py::object& weights_in,
+           const py::object& means_in, const BinnedImage& image,
            Eigen::Ref<const Eigen::VectorXd> ref, double w0, double h0, const Eigen::Vector3d& a,
            const Eigen::Vector3d& b, const Eigen::Vector3d& sigma, double s_min, double s_max,
            bool use_means, double lam, const std::string& kernel, bool resample, std::uint64_t seed,
            std::uint64_t step, int n_iter, int burn_in, const std::string& proposal,
            const Eigen::Vector3d& rw_sigma, double min_samples) {
             const char* fn = "mh_step";
+            // written in place: checked here, one line (was pybind11's list of signatures)
+            Eigen::Map<RowMatrixXd> particles = bind::inplace_matrix(particles_in, fn, "particles");
+            Eigen::Map<Eigen::VectorXd> weights = bind::inplace_vector(weights_in, fn, "weights");
+            Eigen::Map<RowMatrixXd> means = bind::inplace_matrix(means_in, fn, "means");
             MhParams prm;
             prm.base = bind::make_step_params(w0, h0, a, b, sigma, s_min, s_max, use_means, lam,
                                               kernel, resample, fn);
@@ -132,8 +136,7 @@ void register_mcmc(py::module_& m) {
             out["acceptance"] = r.acceptance;
             return out;
         },
-        py::arg("particles").noconvert(), py::arg("weights").noconvert(),
-        py::arg("means").noconvert(), py::arg("image"), py::arg("ref"), py::arg("w0"),
+        py::arg("particles"), py::arg("weights"), py::arg("means"), py::arg("image"), py::arg("ref"), py::arg("w0"),
         py::arg("h0"), py::arg("a"), py::arg("b"), py::arg("sigma"), py::arg("s_min"),
         py::arg("s_max"), py::arg("use_means"), py::arg("lam"), py::arg("kernel"),
         py::arg("resample"), py::arg("seed"), py::arg("step"), py::arg("n_iter") = 1,

@@ -181,7 +181,7 @@ def test_a_backup_a_kill_left_is_neither_read_nor_touched(
     tmp_path: Path, links: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A ``kill -9`` during the renames can leave ``.NAME.<hex>.old``; the next run picks
-    another name (here the same one first) and leaves that file alone."""
+    another name (here the same one first), says it is there, and leaves that file alone."""
     from pftrack.io import atomic
 
     a = tmp_path / "a.txt"
@@ -190,7 +190,10 @@ def test_a_backup_a_kill_left_is_neither_read_nor_touched(
     stale.write_bytes(b"older a")
     tokens = itertools.chain([f"{0:012x}"] * 2, (f"{k:012x}" for k in itertools.count(1)))
     monkeypatch.setattr(atomic.secrets, "token_hex", lambda n: next(tokens))
-    with staged_outputs() as stage:
+    with (
+        pytest.warns(UserWarning, match=f"{re.escape(stale.name)} was left by"),
+        staged_outputs() as stage,
+    ):
         stage(a).write_bytes(b"new a")
     assert a.read_bytes() == b"new a" and stale.read_bytes() == b"older a"
     assert _names(tmp_path) == [stale.name, "a.txt"]

@@ -23,6 +23,8 @@ Several outputs of one run (:func:`staged_outputs`) are renamed in one step that
 SIGTERM cannot split (:func:`interrupts_deferred`): one that comes meanwhile is raised after
 the last rename. A rename that fails puts back every target renamed before it, from a hidden
 backup (``.NAME.<hex>.old``, a hard link) removed afterwards: all new, or all as they were.
+Only a ``kill -9`` during those renames can leave such a backup; the first write of a later
+run into its folder warns of it in one line naming it, and leaves it (:func:`_say_left_backups`).
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ from typing import IO, Any, cast
 
 from pftrack._interrupt import raise_if_interrupted
 from pftrack._typing import PathLike
+from pftrack._warn import warn_outside
 
 #: The descriptor folders of Linux's /proc (``/dev/fd`` and ``/proc/self`` resolve to them).
 _FD_FOLDER = re.compile(r"/proc/(\d+)(?:/task/\d+)?/fd")
@@ -403,6 +406,7 @@ def atomic_write(
         return
     target = resolved.path
     folder = _folder_of(target, path)
+    _say_left_backups(folder)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
         with _named(path, hidden=True):  # a read-only file system, a folder not writable
@@ -439,6 +443,7 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
         return
     target = resolved.path
     folder = _folder_of(target, path)
+    _say_left_backups(folder)
     made: list[str] = []
     try:  # the file is made inside: removed whenever the block is left by an exception
         with _named(path, hidden=True):  # a read-only file system, a folder not writable
@@ -1098,6 +1103,53 @@ def _as_targets(exc: OSError, staged: Iterable[tuple[str, Path]]) -> OSError | N
 #: Suffix of the hidden backup (``.NAME.<hex>.old``) that keeps a target's earlier contents
 #: while :func:`staged_outputs` renames a run's outputs into place.
 BACKUP_SUFFIX = ".old"
+#: A backup's name: ``.NAME.`` (cut to fit ``NAME_MAX``), 12 hex digits, :data:`BACKUP_SUFFIX`.
+_BACKUP_NAME = re.compile(r"\.(.*)\.[0-9a-f]{12}" + re.escape(BACKUP_SUFFIX), re.DOTALL)
+#: The folders whose left backups this process has said (each is said once, not per write).
+_LOOKED: set[str] = set()
+_LOOKED_LOCK = threading.Lock()
+
+
+def _say_left_backups(folder: Path) -> None:
+    """Warn, one line each, of the backups (``.NAME.<hex>.old``) a killed run left in `folder`.
+
+    Only a ``kill -9`` (or a power cut) during :func:`staged_outputs`' renames leaves one; it
+    may hold a target's earlier contents, and without hard links it is their only copy (the
+    target itself was moved there). Nothing reads or removes it: the user is told, once per
+    folder and process, on the first write into that folder, and the file is left as it is
+    (was: kept without a word).
+    """
+    key = os.path.realpath(folder)
+    with _LOOKED_LOCK:
+        if key in _LOOKED:
+            return
+        _LOOKED.add(key)
+    try:
+        with os.scandir(folder) as entries:
+            names = sorted(e.name for e in entries if e.is_file(follow_symlinks=False))
+    except OSError:
+        return  # not readable: the write says what is wrong, if anything
+    for name in names:
+        found = _BACKUP_NAME.fullmatch(name)
+        if found is not None:
+            warn_outside(_left_backup(folder / name, folder / found.group(1)))
+
+
+def _left_backup(backup: Path, target: Path) -> str:
+    """The one line :func:`_say_left_backups` gives for `backup`, a backup of `target`."""
+    said = f"{backup} was left by a pftrack run killed while it replaced {target.name}"
+    try:
+        a, b = os.lstat(backup), os.lstat(target)
+    except FileNotFoundError:  # no hard links there: the target itself was moved to it
+        return f"{said}, and is that file's only copy: move it back (mv {backup} {target})"
+    except OSError:
+        return f"{said}; it is kept: delete it once {target.name} is as you want it"
+    if (a.st_dev, a.st_ino) == (b.st_dev, b.st_ino):
+        return f"{said}, and is another name for {target.name} as it is: delete it, nothing is lost"
+    return (
+        f"{said}, and holds its earlier contents: delete it, or move it back over "
+        f"{target.name} to have them again"
+    )
 
 
 def _back_up(target: Path, listed: list[str]) -> tuple[str | None, bool]:
@@ -1249,10 +1301,13 @@ def staged_outputs(
     whatever the outcome, also after a Ctrl-C or SIGTERM; only a ``kill -9`` during the
     renames can leave one (with the earlier contents; without hard links, the only copy of a
     target then missing), which no later run reads or removes: a hidden name, never an input,
-    never chosen again. A symbolic link replaces the file it leads to; a
-    device, FIFO or descriptor gets its file's bytes written into it: a device before the
-    renames (one that fails, ``/dev/full``, leaves every target as it was), a pipe, FIFO or
-    socket after them (its reader may wait for the files, or stop early).
+    never chosen again. The first write of a later run into its folder (this function's, or
+    :func:`atomic_write`'s, :func:`atomic_path`'s) warns of each such file in one line naming
+    it and the output it belongs to, once per folder and process (was: nobody said so). A
+    symbolic link replaces the file it leads to; a device, FIFO or descriptor gets its file's
+    bytes written into it: a device before the renames (one that fails, ``/dev/full``, leaves
+    every target as it was), a pipe, FIFO or socket after them (its reader may wait for the
+    files, or stop early).
 
     Examples
     --------
@@ -1278,6 +1333,7 @@ def staged_outputs(
             return tmp_path
         target = resolved.path
         folder = _folder_of(target, path)
+        _say_left_backups(folder)
         with _named(path, hidden=True):  # a read-only file system, a folder not writable
             fd, tmp = _create_beside(folder, f".{target.stem}.", suffix or ".tmp", made)
         staged.append((tmp, target))

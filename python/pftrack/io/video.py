@@ -589,14 +589,23 @@ def _ini_text(ini: Path) -> str:
 
     UTF-16 by its byte-order mark (Windows PowerShell 5's ``>`` and ``Out-File``; was refused
     as "expected a [Sequence] section", while the sequence's det.txt and gt.txt so written were
-    read), else UTF-8 with a byte-order mark skipped (Notepad). A name in Latin-1 (``Café``
-    in one byte each) is no reason to refuse the numbers pftrack reads, which are ASCII:
-    undecodable bytes are replaced. OSError as reading raises it.
+    read), else UTF-8 with a byte-order mark skipped (Notepad). A file that is not UTF-8 is
+    read as Windows-1252 (Notepad's "ANSI", Latin-1 but for 0x80-0x9f), else as Latin-1, which
+    takes any byte: ``imDir=café`` saved so names the folder ``café`` (was: undecodable bytes
+    replaced, so the folder was "caf\ufffd", which "does not exist", beside ``café``).
+    OSError as reading raises it.
     """
     from pftrack.io.mot import _encoding
 
     data = ini.read_bytes()
-    return data.decode(_encoding(data[:4]), errors="replace")
+    encoding = _encoding(data[:4])
+    for tried in (encoding, "cp1252", "latin-1"):
+        try:
+            return data.decode(tried)
+        except UnicodeDecodeError:
+            if encoding != "utf-8-sig":  # UTF-16 by its mark: no other reading
+                return data.decode(encoding, errors="replace")
+    raise AssertionError("latin-1 decodes every byte")  # pragma: no cover
 
 
 def _duplicate(
@@ -700,6 +709,11 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
     parser = configparser.ConfigParser(interpolation=None)
     try:
         text = _ini_text(ini)
+    except IsADirectoryError:  # was "cannot be read (Is a directory)", or passed over unsaid
+        raise ValueError(
+            f"{ini}: is a folder, expected the sequence's seqinfo.ini text file ([Sequence] with "
+            "frameRate, imWidth, ...): rename or remove that folder"
+        ) from None
     except OSError as exc:
         raise ValueError(f"{ini}: cannot be read ({exc.strerror})") from None
     try:
@@ -759,6 +773,16 @@ def read_seqinfo(path: PathLike, *, keys: Collection[str] | None = None) -> Sequ
     )
 
 
+def _has_seqinfo(folder: Path) -> bool:
+    """Whether `folder` holds anything named ``seqinfo.ini``.
+
+    A file, or a folder or a broken link by that name, which :func:`read_seqinfo` then refuses
+    naming it (was: passed over as if there were none, the sequence's frame rate and size
+    unsaid and unused).
+    """
+    return os.path.lexists(folder / "seqinfo.ini")
+
+
 def find_sequence(source: PathLike) -> SequenceInfo | None:
     """The MOTChallenge sequence `source` belongs to, from the ``seqinfo.ini`` nearest to it.
 
@@ -771,9 +795,9 @@ def find_sequence(source: PathLike) -> SequenceInfo | None:
     """
     path = Path(source)
     if not path.is_dir():
-        return read_seqinfo(path.parent) if (path.parent / "seqinfo.ini").is_file() else None
+        return read_seqinfo(path.parent) if _has_seqinfo(path.parent) else None
     for folder in (path, path.parent):
-        if (folder / "seqinfo.ini").is_file():
+        if _has_seqinfo(folder):
             return read_seqinfo(folder)
     real = Path(os.path.realpath(path))
     if (path / "img1").is_dir():
@@ -908,7 +932,7 @@ def _sequence_folders(folder: Path) -> list[Path]:
     found = []
     for p in folder.iterdir():
         with contextlib.suppress(OSError):
-            if p.is_dir() and ((p / "seqinfo.ini").is_file() or (p / "img1").is_dir()):
+            if p.is_dir() and (_has_seqinfo(p) or (p / "img1").is_dir()):
                 found.append(p)
     return sorted(found, key=lambda p: natural_key(p.name))
 
@@ -942,7 +966,7 @@ def sequence_video(folder: PathLike) -> Path | None:
         `folder` is such a sequence folder but holds no video, or several.
     """
     path = Path(folder)
-    if not (path / "seqinfo.ini").is_file():
+    if not _has_seqinfo(path):
         return None
     images = path / read_seqinfo(path).image_dir
     if images.is_dir():
