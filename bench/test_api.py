@@ -20,7 +20,7 @@ process, not what other processes take from the cores) of one ``update``: for ea
 the least of its rounds (every round computes the same; the least is the one other processes
 disturbed least), averaged over the frames. ``extra_info["wall_ms_per_frame"]`` is the same
 for the wall-clock time; ``extra_info["loadavg"]`` is the machine's one-minute load average at
-the end, for reading the figures (on 6 December, at load 8-14 on a shared 2-core machine, one
+the end, for reading the figures (on 6 December, at load 2-14 on a shared 2-core machine, one
 code's "default, opencv 1 thread" gave 2.35-3.74 ms over 16 runs: compare two codes only in
 runs alternated in one session, many of them). "opencv 1 thread" runs with
 ``cv2.setNumThreads(1)``, as ``pftrack track`` does (the library leaves OpenCV's setting to the
