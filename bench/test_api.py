@@ -2,6 +2,13 @@
 
 pytest bench/test_api.py --benchmark-enable --benchmark-only
 
+An instruction count, which other processes do not change (the timings above move by tenths of
+a millisecond with the machine's load): ``python -m bench.test_api --rounds R`` runs R rounds of
+the same updates untimed, OpenCV at one thread, and prints a digest of their rows. Under
+``valgrind --tool=callgrind``, (count at ``--rounds 2`` - count at ``--rounds 0``) / 160 is one
+update's instructions, the tracker's making and its first 20 frames included (docs/results.md,
+"Cost of update per frame").
+
 The goal (issue 13): ``update`` with 10 objects costs at most 0.5 ms of Python+C++ per frame
 beyond the detector (:data:`GOAL_MS`).
 
@@ -12,15 +19,23 @@ runs a fresh tracker over the same frames; the first frames (births, start-up) a
 process, not what other processes take from the cores) of one ``update``: for each timed frame
 the least of its rounds (every round computes the same; the least is the one other processes
 disturbed least), averaged over the frames. ``extra_info["wall_ms_per_frame"]`` is the same
-for the wall-clock time; "opencv 1 thread" runs with ``cv2.setNumThreads(1)``, as ``pftrack
-track`` does (the library leaves OpenCV's setting to the caller). "default" includes the background
-model behind box refinement (on by default with detections) and the camera-motion check
-(``"auto"``); "no refine" is the tracker without the background model.
+for the wall-clock time; ``extra_info["loadavg"]`` is the machine's one-minute load average at
+the end, for reading the figures (on 6 December, at load 2-14 on a shared 2-core machine, one
+code's "default, opencv 1 thread" gave 2.35-3.74 ms over 16 runs: compare two codes only in
+runs alternated in one session, many of them). "opencv 1 thread" runs with
+``cv2.setNumThreads(1)``, as ``pftrack track`` does (the library leaves OpenCV's setting to the
+caller). "default" includes the background model behind box refinement (on by default with
+detections) and the camera-motion check (``"auto"``); "no refine" is the tracker without the
+background model.
 """
 
 from __future__ import annotations
 
+import argparse
+import hashlib
+import os
 import time
+from collections.abc import Sequence
 
 import numpy as np
 import pytest
@@ -90,3 +105,59 @@ def _update_10_objects(
     benchmark.extra_info["ms_per_frame"] = round(ms, 3)
     benchmark.extra_info["wall_ms_per_frame"] = round(float(np.mean(np.min(wall, axis=0))), 3)
     benchmark.extra_info["within_goal"] = ms <= GOAL_MS
+    benchmark.extra_info["loadavg"] = round(os.getloadavg()[0], 2)
+
+
+def run_rounds(rounds: int, *, refine: bool = True) -> list[str]:
+    """Run `rounds` fresh trackers over the bench's scene, untimed; each round's rows' md5."""
+    import cv2
+
+    frames, dets = python_share.scene_dets()
+    digests = []
+    before = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        for _ in range(rounds):
+            tracker = new_tracker(refine=refine)
+            digest = hashlib.md5()
+            for d, f in zip(dets, frames, strict=True):
+                digest.update(tracker.update(d, f).tobytes())
+            digests.append(digest.hexdigest())
+    finally:
+        cv2.setNumThreads(before)
+    return digests
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """``python -m bench.test_api --rounds R [--no-refine]``: the updates, for an instruction count.
+
+    Prints the rows' md5 (one, when every round gave the same rows). Bad arguments are one
+    line and exit status 2 (argparse's).
+    """
+    p = argparse.ArgumentParser(description="Run the bench's updates untimed (see the module).")
+    p.add_argument("--rounds", type=int, default=1, help="fresh trackers over the scene (>= 0)")
+    p.add_argument("--no-refine", action="store_true", help="box refinement off")
+    args = p.parse_args(argv)
+    if args.rounds < 0:
+        p.error(f"--rounds must be >= 0, got {args.rounds}")
+    digests = sorted(set(run_rounds(args.rounds, refine=not args.no_refine)))
+    print(
+        f"{args.rounds} rounds, refine {'off' if args.no_refine else 'on'}: rows md5 "
+        f"{' '.join(digests) or '-'}"
+    )
+
+
+def test_untimed_rounds_give_the_same_rows(capsys: pytest.CaptureFixture[str]) -> None:
+    """`main`'s rounds compute the same rows: a count over R rounds is R times one round's."""
+    first, second = run_rounds(2, refine=False)
+    assert first == second
+    main(["--rounds", "0"])
+    assert capsys.readouterr().out == "0 rounds, refine on: rows md5 -\n"
+    with pytest.raises(SystemExit) as exit_:
+        main(["--rounds", "-1"])
+    assert exit_.value.code == 2
+    assert "--rounds must be >= 0, got -1" in capsys.readouterr().err
+
+
+if __name__ == "__main__":
+    main()

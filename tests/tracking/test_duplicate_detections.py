@@ -21,7 +21,7 @@ from pftrack.io.mot import group_by_frame, read_mot, write_mot
 from pftrack.synthetic import make_scene
 from pftrack.tracking import TrackerConfig
 from pftrack.tracking.api import xywh_to_xyxy_dets
-from pftrack.tracking.tracker import first_copies
+from pftrack.tracking.tracker import _classes, first_copies
 from tests.conftest import dataset
 
 
@@ -193,6 +193,42 @@ def test_finalize_fits_the_person_size_to_each_box_once(scene):
         trackers.append(tracker)
     once, copies = (np.vstack(t._sizes) for t in trackers)
     np.testing.assert_array_equal(copies[np.lexsort(copies.T)], once[np.lexsort(once.T)])
+
+
+def test_the_size_samples_look_for_copies_only_on_frames_that_hold_one(scene, monkeypatch):
+    """Tracker.update's size samples look for copies (``first_copies``) only on the frames
+    whose rows the tracker inside found a copy among (``MultiObjectTracker.copies_given``):
+    a frame without one has none among its scored rows either (was: on every frame, a
+    second pass of about 7 us beside the tracker's)."""
+    calls = []
+
+    def counted(boxes, labels):
+        calls.append(len(boxes))
+        return first_copies(boxes, labels)
+
+    monkeypatch.setattr(pftrack.tracking.api, "first_copies", counted)
+    plain, twice = truth_dets(scene), truth_dets(scene, "exact")
+    given = [k for k in range(12) if len(plain[k])][1::4][:2]  # two frames given twice
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    found = []
+    for k in range(12):
+        tracker.update(twice[k] if k in given else plain[k], scene.frames[k])
+        found.append(tracker._tracker.copies_given)
+    assert len(given) == 2
+    assert found == [k in given for k in range(12)]
+    assert calls == [2 * len(plain[k]) for k in given]  # the scored rows, copies included
+    sizes = np.vstack(tracker._sizes)
+    for k in given:  # each box once
+        at = sizes[sizes[:, 3] == k]
+        assert len(at) == len(plain[k])
+
+
+@pytest.mark.parametrize("labels", [[], [0], [0, 0, 0], [3, -1, 3, 0, 2**31 - 1, -(2**31)]])
+def test_classes_are_np_unique_on_plain_ints(labels):
+    a = np.array(labels, np.int64)
+    out = _classes(a)
+    assert out == np.unique(a).tolist()
+    assert all(type(c) is int for c in out)
 
 
 def test_first_copies_keeps_the_first_of_each_box_and_class():

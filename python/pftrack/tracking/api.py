@@ -1403,7 +1403,9 @@ class Tracker:
             if self.record and life.size_ratio is not None and scored.any():  # finalize's
                 box = xywh[scored]
                 c = np.zeros(len(box)) if cls is None else cls[scored].astype(np.float64)
-                once = first_copies(box, c)  # a row given twice is one detection, as in _step
+                # a row given twice is one detection, as in _step; looked for only when the
+                # tracker found a copy among all the rows (the scored ones are some of them)
+                once = first_copies(box, c) if self._tracker.copies_given else None
                 if once is not None:
                     box, c = box[once], c[once]
                 foot, at = box[:, 1] + box[:, 3], np.full(len(box), float(self.frame_count))

@@ -186,6 +186,10 @@ class MultiObjectTracker:
         #: clear of the frame's border), and given ones kept, over the run: why no track, said.
         self.tiny_given = 0
         self.kept_given = 0
+        #: Whether the last update's given detections held a row given twice (the same box
+        #: and class, :func:`first_copies`): the caller's own bookkeeping of the rows (the size
+        #: samples of :class:`~pftrack.tracking.api.Tracker`) looks for copies only then.
+        self.copies_given = False
         #: The built-in detector's objects over the run, those kept (``min_score`` and
         #: ``min_area``), and the highest score among them: a run whose objects ``min_score``
         #: or ``min_area`` left out says which (not "found no object").
@@ -266,6 +270,7 @@ class MultiObjectTracker:
         state.setdefault("_late_birth_scores", {})  # made when late classes took the pooled
         # made when the window started at frame 1: it goes on doing so
         state.setdefault("_birth_start", 1)
+        state.setdefault("copies_given", False)  # set by every update before it is read
         self.__dict__.update(state)
         self._busy = threading.Lock()  # a checkpoint pickled before the lock had none
 
@@ -530,7 +535,7 @@ class MultiObjectTracker:
             return
         self._birth_scores = np.sort(np.concatenate([self._birth_scores, scores]))
         self._birth_level = sorted_quantile(self._birth_scores, q)
-        for c in np.unique(labels).tolist():
+        for c in _classes(labels):
             seen = self._class_birth_scores.get(c, np.zeros(0))
             seen = self._class_birth_scores[c] = np.sort(
                 np.concatenate([seen, scores[labels == c]])
@@ -547,7 +552,7 @@ class MultiObjectTracker:
         on. A run of one class never gets here with another class's scores in the window:
         its level stays the window's, as before.
         """
-        for c in np.unique(labels).tolist():
+        for c in _classes(labels):
             if c in self._class_birth_levels:
                 continue
             own = self._class_birth_scores.get(c, np.zeros(0))
@@ -716,6 +721,7 @@ class MultiObjectTracker:
         # the caller's rows in one order whatever order they came in (a detector's rows in
         # another order give the same tracks): `rank` maps it back to the caller's rows
         rank = None
+        self.copies_given = False
         if given is not None and len(given[1]) > 1:
             rank = canonical_order(*given)
             given = (given[0][rank], given[1][rank], given[2][rank])
@@ -723,6 +729,7 @@ class MultiObjectTracker:
             # output row, as a duplicate refused a birth is in none (first_of_twins)
             once = first_copies(given[0], given[2])
             if once is not None:
+                self.copies_given = True
                 rank = rank[once]
                 given = (given[0][once], given[1][once], given[2][once])
         if cfg is None:
@@ -877,7 +884,7 @@ class MultiObjectTracker:
         gates: dict[int, float] = {}  # the birth threshold of each class (none: -inf)
         if confidences:
             self._learn_birth(scores, labels)
-            gates = {c: self.birth_threshold(c) for c in np.unique(labels).tolist()}
+            gates = {c: self.birth_threshold(c) for c in _classes(labels)}
         born = cfg if detections is None else self._given_config  # given_particles
         unmatched = result.unmatched_detections
         beside = set() if detections is None else self._beside(boxes, labels, unmatched, cfg)
@@ -955,6 +962,15 @@ class MultiObjectTracker:
                 sampled.add(t.cls)
         for c in sampled:
             self._gains[c] = self.motion_gain(c)
+
+
+def _classes(labels: NDArray[np.int64]) -> list[int]:
+    """The class ids of a frame's detections in increasing order, as plain ints.
+
+    ``np.unique(labels).tolist()``, on plain ints: about 1 us for a frame's few rows,
+    ``np.unique`` about 6 (the tracker asks twice a frame).
+    """
+    return sorted(set(labels.tolist()))
 
 
 def first_copies(boxes: F64, labels: NDArray[np.int64] | F64) -> NDArray[np.intp] | None:
