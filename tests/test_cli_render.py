@@ -231,3 +231,57 @@ def test_the_plot_title_says_what_it_shows_and_the_plot_what_the_video_does(
     [(rows, title)] = calls
     assert title == "scene.avi: foot-point paths of 3 tracks, frames 1-30"
     assert len(rows) == len(scene.truth) and rows[:, 0].max() == 30
+
+
+@pytest.mark.parametrize("command", ["track", "render"])
+def test_the_plot_is_drawn_on_the_first_frame_that_is_not_dark(
+    command: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A video that fades in from black (or starts with the lens cap on) was plotted on its
+    black frame 1: the paths on a black picture, not on the scene."""
+    import pftrack.render
+
+    scene = make_scene(n_frames=20, n_walkers=2, rng=0)
+    scene.frames[:4] = [np.zeros_like(f) for f in scene.frames[:4]]  # dark, as a fade-in
+    scene.frames[4] = (scene.frames[4] // 40).astype(np.uint8)  # dark too: mean level <= 8
+    folder = scene.write_images(tmp_path / "imgs")
+    tracks = tmp_path / "truth.txt"
+    write_mot(tracks, scene.truth)
+    backgrounds = []
+    real = pftrack.render.plot_trajectories
+
+    def spy(path: Path, rows: np.ndarray, *args: object, background: np.ndarray, **kw: object
+            ) -> Path:  # fmt: skip
+        backgrounds.append(background)
+        return real(path, rows, *args, background=background, **kw)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(pftrack.render, "plot_trajectories", spy)
+    plot = ["--plot", str(tmp_path / "p.png")]
+    if command == "track":
+        argv = ["track", str(folder), "--out", str(tmp_path / "t.txt"), *plot]
+    else:
+        argv = ["render", str(folder), str(tracks), "--out", str(tmp_path / "v.mp4"), *plot]
+    assert main(["-q", *argv]) == 0
+    [background] = backgrounds
+    assert np.array_equal(background, scene.frames[5])  # frame 6, the first not dark (PNG)
+
+
+def test_a_video_dark_throughout_is_plotted_on_its_first_frame(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import pftrack.render
+
+    scene = make_scene(n_frames=6, n_walkers=1, rng=0)
+    scene.frames[:] = [(f // 40).astype(np.uint8) for f in scene.frames]
+    folder = scene.write_images(tmp_path / "imgs")
+    tracks = tmp_path / "truth.txt"
+    write_mot(tracks, scene.truth)
+    backgrounds = []
+    monkeypatch.setattr(
+        pftrack.render,
+        "plot_trajectories",
+        lambda *a, background, **k: backgrounds.append(background),
+    )
+    argv = ["render", str(folder), str(tracks), "--out", str(tmp_path / "v.mp4")]
+    assert main(["-q", *argv, "--plot", str(tmp_path / "p.png")]) == 0
+    assert np.array_equal(backgrounds[0], scene.frames[0])

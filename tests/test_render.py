@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import pytest
 
@@ -561,3 +562,23 @@ def test_the_caller_never_sleeps_on_the_queues_condition(tmp_path: Path) -> None
         r.add(np.zeros((48, 64, 3), np.uint8), [])
     r.close()
     assert r.n_frames == 4 and waits == []
+
+
+def test_a_long_title_is_wrapped_on_a_narrow_frame(tmp_path: Path) -> None:
+    """A CLI trial: the title of a 3000-frame video's plot on its 320x240 frame ran past the
+    right edge ("... frames 1-300", the last digit cut off); it takes two lines now."""
+    title = "long.avi: foot-point paths of 33 tracks, frames 1-3000"
+    rows = np.array(
+        [[1, 1, 100, 100, 20, 40, 1, -1, -1, -1], [2, 1, 104, 100, 20, 40, 1, -1, -1, -1]]
+    )
+
+    def title_ink(width: int) -> np.ndarray:
+        """(row, column) of the white title's pixels on a black frame `width` wide."""
+        black = np.zeros((240, width, 3), np.uint8)
+        path = plot_trajectories(tmp_path / f"{width}.png", rows, black, title=title)
+        return np.argwhere(cv2.imread(str(path))[:40].max(axis=2) > 150)  # the paths lie below
+
+    ink = title_ink(320)
+    assert ink[:, 1].max() <= 320 - 5  # inside the frame, with its margin
+    assert ink[:, 0].max() > 20  # on a second line
+    assert title_ink(640)[:, 0].max() <= 20  # one line where the frame is wide enough

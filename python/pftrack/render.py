@@ -698,9 +698,28 @@ def plot_trajectories(
         _tag(canvas, str(tid), (int(pts[0][0]), int(pts[0][1])), 0.4, colour_of(tid), 1)
     if background is None:
         canvas = _with_axes(canvas, title)
-    elif title:
-        cv2.putText(
-            canvas, text_for_opencv(title), (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
-            (255, 255, 255), 1, cv2.LINE_AA,
-        )  # fmt: skip
+    elif title:  # on as many lines as the frame's width needs (was: cut at its right edge)
+        for i, line in enumerate(_wrapped(title, canvas.shape[1] - 10, 0.45)):
+            cv2.putText(
+                canvas, text_for_opencv(line), (5, 15 + 16 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
+                (255, 255, 255), 1, cv2.LINE_AA,
+            )  # fmt: skip
     return write_image(path, canvas)  # any name (pftrack.io.opencv_io)
+
+
+def _wrapped(text: str, width: int, scale: float) -> list[str]:
+    """`text` split at its spaces into lines of at most `width` pixels, for a narrow frame.
+
+    The width is measured in OpenCV's simplex font at `scale`; a word wider than `width` is
+    alone on its line (a plot's title on a 320x240 frame: two lines).
+    """
+    lines: list[str] = []
+    for word in text.split(" "):
+        longer = f"{lines[-1]} {word}" if lines else word
+        drawn = text_for_opencv(longer)
+        fits = cv2.getTextSize(drawn, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)[0][0] <= width
+        if lines and fits:
+            lines[-1] = longer
+        else:
+            lines.append(word)
+    return lines

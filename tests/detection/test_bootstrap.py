@@ -240,3 +240,33 @@ def test_spread_over_a_video_whose_header_says_too_many_frames(tmp_path) -> None
     for g, w in zip(got, want, strict=True):
         np.testing.assert_array_equal(g, w)
     assert sum(1 for _ in src) == 40  # said once: no "ended after 40 frames" warning (an error)
+
+
+@pytest.mark.parametrize("split", [False, True])
+def test_the_spread_bootstraps_pass_draws_a_bar(
+    tmp_path: object, monkeypatch: pytest.MonkeyPatch, split: bool
+) -> None:
+    """A CLI trial: the spread bootstrap decodes the whole file before frame 1 is tracked,
+    and nothing was drawn meanwhile (1.4 s for a 2-minute 640x480 video; minutes for an hour
+    at 1080p): a bar of the background's frames read, the same tracks."""
+    import io
+    import sys
+    from pathlib import Path
+
+    from pftrack import _progress
+    from pftrack.io.video import FrameSource
+    from pftrack.synthetic import make_scene
+    from pftrack.tracking import track_frames
+
+    video = make_scene(n_frames=40, width=160, height=120, n_walkers=2, rng=0).write_video(
+        Path(str(tmp_path)) / "v.avi"
+    )
+    quiet = track_frames(FrameSource(video), rng=0, threads=split, show_progress=False)
+    monkeypatch.setattr(_progress, "_quiet", False)
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
+    err = io.StringIO()
+    err.isatty = lambda: True  # type: ignore[method-assign]
+    monkeypatch.setattr(sys, "stderr", err)
+    run = track_frames(FrameSource(video), rng=0, threads=split, show_progress=True)
+    assert "background: 100%" in err.getvalue() and "30/30" in err.getvalue()
+    assert np.array_equal(run.rows, quiet.rows)

@@ -286,3 +286,32 @@ def test_flags_and_classes_beyond_int64_or_nan_are_read_without_a_cast_warning(
         "5 result boxes have classes 1e+20 (3), 3 (2) in column 8: scored as pedestrians; "
         "TrackEval refuses such a file"
     )
+
+
+def test_a_result_that_matches_nothing_is_warned_about(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A CLI trial: TUD-Campus's tracks scored against PETS09's ground truth gave a table of
+    zeros (MOTA -6.9) without a word. A result none of whose boxes matches is named."""
+    gt, res = mot17_case(0)
+    gt = gt[gt[:, 6] == 1]
+    write_rows(tmp_path / "gt.txt", gt)
+    other = res.copy()
+    other[:, 2] = (other[:, 2] + 400) % 1500  # the boxes of another scene, the same sizes
+    other[:, 3] = (other[:, 3] + 300) % 800
+    write_rows(tmp_path / "res.txt", other)
+    argv = ["eval", "-q", "--gt", str(tmp_path / "gt.txt"), "--res", str(tmp_path / "res.txt")]
+    assert main([*argv, "--benchmark", "MOT15"]) == 0
+
+    def span(a: np.ndarray) -> str:
+        return f"frames {int(a[:, 0].min())}-{int(a[:, 0].max())}"
+
+    assert capsys.readouterr().err == (
+        f"pftrack eval: warning: {tmp_path / 'res.txt'}: none of its {len(other)} boxes "
+        f"({span(other)}) matches a ground-truth box of {tmp_path / 'gt.txt'} ({span(gt)}) with "
+        "IoU 0.5 or more, on any frame: the tracks of another sequence or video, or frames "
+        "numbered otherwise?\n"
+    )
+    write_rows(tmp_path / "res.txt", res)  # its own result: nothing to say
+    assert main([*argv, "--benchmark", "MOT15"]) == 0
+    assert capsys.readouterr().err == ""

@@ -581,3 +581,41 @@ def test_as_written_gives_the_values_read_back_in_the_rows_order(tmp_path: Path)
     mot.write_mot(tmp_path / "t.txt", rows)
     np.testing.assert_array_equal(mot.as_written(rows), mot.read_mot(tmp_path / "t.txt")[::-1])
     assert mot.as_written(np.zeros((0, 6))).shape == (0, 10)
+
+
+def test_pandas_to_csv_with_its_index_is_named_as_such(tmp_path: Path) -> None:
+    """pandas' ``to_csv`` writes an index column and a header by default (``,frame,id,...``,
+    then ``0,1,-1,...``): was "an empty column 1 (frame)", and once the header was deleted
+    "frame is 0 ... numbered from 0? add 1 to every frame", which would put line k on frame k."""
+    p = tmp_path / "det.csv"
+    rows = (
+        "0,1.0,-1.0,10.0,20.0,5.0,9.0,0.9,-1.0,-1.0,-1.0\n"
+        "1,2.0,-1.0,11.0,20.0,5.0,9.0,0.8,-1.0,-1.0,-1.0\n"
+    )
+    p.write_text(",frame,id,x,y,w,h,conf,a,b,c\n" + rows)
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p, what="detection file")
+    msg = str(exc.value)
+    assert msg.startswith(f"{p}:1: detection file line has an empty column 1 (frame)"), msg
+    assert msg.endswith(mot.INDEX_HEADER_HINT), msg
+    p.write_text(rows)  # the header deleted: the index column stays
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p, what="detection file")
+    msg = str(exc.value)
+    assert msg.startswith(f"{p}:1: frame is 0, expected an integer"), msg
+    assert msg.endswith(mot.INDEX_HINT + ")"), msg
+    # without the index: the header hint, and frame 0 of 10 fields is told to add 1 alone
+    p.write_text(
+        "frame,id,x,y,w,h,conf,a,b,c\n" + rows.replace("0,1.0", "1.0").replace("1,2.0", "2.0")
+    )
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value).endswith(mot.HEADER_HINT)
+    p.write_text("0,-1,10,20,5,9,0.9,-1,-1,-1\n")
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert "index column" not in str(exc.value) and "add 1 to every frame" in str(exc.value)
+    p.write_text(",1,10,20,5,9\n")  # an empty frame, no word: no hint
+    with pytest.raises(ValueError) as exc:
+        mot.read_mot(p)
+    assert str(exc.value).endswith("which needs a number: ',1,10,20,5,9'")

@@ -1631,3 +1631,32 @@ def test_a_video_whose_first_frames_fail_is_read_from_the_first_that_decodes(
     at = source.frames_at([0, lost, 29])
     for got, k in zip(at, (0, lost, 29), strict=True):
         np.testing.assert_array_equal(got, frames[k])
+
+
+def test_an_mp4_without_its_index_is_named_as_a_recording_not_finished(tmp_path: Path) -> None:
+    """A user trial: an MP4 whose recording was stopped before its ``moov`` index was written
+    (it comes last; a camera or ffmpeg killed, a copy cut short) was "not a video OpenCV can
+    read, or empty", of a file of 100 KB of frames."""
+    frames = make_scene(n_frames=20, width=96, height=64, n_walkers=1, rng=0).frames
+    whole = encode(tmp_path / "whole.mp4", frames).read_bytes()  # moov after mdat
+    assert whole.index(b"moov") > whole.index(b"mdat")
+    cut = tmp_path / "cut.mp4"
+    cut.write_bytes(whole[: whole.index(b"moov") // 2])  # a copy cut short: mdat's size too big
+    at = whole.index(b"mdat") - 4
+    killed = tmp_path / "killed.mp4"  # never finished: mdat's size still 0 (to the file's end)
+    killed.write_bytes(whole[:at] + b"\0\0\0\0mdat" + whole[at + 8 : whole.index(b"moov") - 4])
+    for path in (cut, killed):
+        with pytest.raises(ValueError) as exc:
+            FrameSource(path)
+        assert str(exc.value).startswith(
+            f"cannot decode a frame from {path}: it holds video data but no index (its moov box)"
+        ), exc.value
+    # the whole file reads; an empty file, and another container cut short, say as before
+    assert len(list(FrameSource(tmp_path / "whole.mp4"))) == 20
+    empty = tmp_path / "empty.mp4"
+    empty.write_bytes(b"")
+    mkv = encode(tmp_path / "v.mkv", frames)
+    mkv.write_bytes(mkv.read_bytes()[:200])
+    for path in (empty, mkv):
+        with pytest.raises(ValueError, match="not a video OpenCV can read, or empty"):
+            FrameSource(path)

@@ -240,6 +240,29 @@ def _in_file(message: str, gt: Path, res: Path) -> str:
     return f"{gt} against {res}: {message}"
 
 
+def _none_matched(path: Path, res: F64, gt_path: Path, gt: F64, iou: float) -> list[str]:
+    """The note of a result none of whose boxes matched a ground-truth box, or none.
+
+    Scored as it is (MOTA at or below 0), but almost always a pair of files that do not
+    belong together: the tracks of another sequence or video, or frames numbered otherwise
+    (was: a table of zeros without a word; a CLI trial scored TUD-Campus's tracks against
+    PETS09's ground truth, MOTA -6.9). A scale apart is refused before, by the scale check.
+    """
+    if not len(res):  # an empty result says so itself
+        return []
+
+    def span(a: F64) -> str:
+        first, last = int(a[:, 0].min()), int(a[:, 0].max())
+        return f"frame {first}" if first == last else f"frames {first}-{last}"
+
+    n = len(res)
+    return [
+        f"{path}: none of its {n} box{'es' * (n != 1)} ({span(res)}) matches a ground-truth "
+        f"box of {gt_path} ({span(gt)}) with IoU {iou:g} or more, on any frame: the tracks of "
+        "another sequence or video, or frames numbered otherwise?"
+    ]
+
+
 def _bar_label(done: int, n: int) -> str:
     """The label of ``eval``'s bar: ``eval`` for one sequence, ``eval 1/3 sequences`` else."""
     return "eval" if n == 1 else f"eval {done}/{n} sequences"
@@ -347,6 +370,8 @@ def run(args: argparse.Namespace) -> int:
             note = gt_conf_note(gt)
             if note:
                 notes.append(f"{seq.gt_path}: {note}")
+            elif not scores[name].mot.num_matches and scores[name].mot.num_objects:
+                notes.extend(_none_matched(path, res, seq.gt_path, gt, args.iou))
     combined = SequenceScores.combine(list(scores.values())) if len(scores) > 1 else None
     # both replaced at the end, or neither (was: one after the other; a Ctrl-C between them,
     # or one code in C dropped, which the second refused, left a new --json beside an old --csv

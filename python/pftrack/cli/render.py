@@ -22,7 +22,7 @@ from pftrack.cli._options import (
     counted,
     report_stream,
 )
-from pftrack.cli.track import PLOT_SUFFIXES
+from pftrack.cli.track import PLOT_SUFFIXES, keep_plot_background
 
 #: A file most of whose boxes do not lie wholly inside the frame is in another frame's pixels:
 #: warned (people at the edges cross it; most boxes do not).
@@ -37,10 +37,10 @@ def add_parser(sub: Any) -> None:
         help="draw a MOTChallenge tracks file on its video (any tracker's output, or truth)",
         description="Draw the boxes, ids and trails of a MOTChallenge tracks file on the frames "
         "of its video, image folder or sequence folder, and write an annotated video and, "
-        "with --plot, a trajectory plot on the first frame. Row frame k is drawn on the "
-        "video's k-th frame. pftrack track --render shows the boxes as tracked online; this "
-        "shows a file as it is: pftrack track's final tracks, the output of pftrack smooth "
-        "or recover (filled rows dashed), another tracker's, or the ground truth.",
+        "with --plot, a trajectory plot on the first frame that is not dark. Row frame k is "
+        "drawn on the video's k-th frame. pftrack track --render shows the boxes as tracked "
+        "online; this shows a file as it is: pftrack track's final tracks, the output of "
+        "pftrack smooth or recover (filled rows dashed), another tracker's, or the ground truth.",
     )
     p.add_argument("source", help="video file, image folder, or MOTChallenge sequence folder")
     p.add_argument("tracks", help="MOTChallenge tracks file (frame,id,left,top,w,h,...)")
@@ -69,8 +69,8 @@ def add_parser(sub: Any) -> None:
         help="foot points of the last FRAMES frames drawn behind each track (0 to 100000; 0: none)",
     )
     p.add_argument("--plot", metavar="PNG",
-                   help="also write a trajectory plot on the first frame: .png, .jpg "
-                   "(default: none)")  # fmt: skip
+                   help="also write a trajectory plot on the first frame that is not dark: "
+                   ".png, .jpg (default: none)")  # fmt: skip
     p.set_defaults(func=run)
 
 
@@ -122,12 +122,12 @@ def run(args: argparse.Namespace) -> int:
     n_frames = len(source)
     out = report_stream(args.out, args.plot)
     drawn = [0]
-    kept: list[Any] = []  # the first frame, the plot's background (the video read once)
+    kept: list[Any] = []  # the plot's background, the first frame not dark (read once)
 
     def read_counting() -> Any:
         for frame in source:
-            if not kept:
-                kept.append(frame.copy())
+            if args.plot:
+                keep_plot_background(kept, frame)
             drawn[0] += 1
             yield frame
 

@@ -90,10 +90,27 @@ def add_parser(sub: Any) -> None:
         "bottom, so a 321x241 source gives a 322x242 video (default: none)",
     )  # fmt: skip
     p.add_argument("--plot", metavar="PNG",
-                   help="write a trajectory plot: .png, .jpg (a device or pipe without "
-                   "extension: .png) (default: none)")  # fmt: skip
+                   help="write a trajectory plot on the first frame that is not dark: .png, "
+                   ".jpg (a device or pipe without extension: .png) (default: none)")  # fmt: skip
     add_tracker_options(p)
     p.set_defaults(func=run)
+
+
+def keep_plot_background(kept: list[Any], frame: Any) -> None:
+    """Keep in `kept` the background of ``--plot``: the first frame that is not dark.
+
+    A video that fades in from black, or starts with the lens cap on, gave a plot on a black
+    picture (frame 1). A frame is dark as the built-in detector counts it
+    (:func:`pftrack.detection.light.is_dark`); the first frame is kept until a frame that is
+    not dark comes, so a video dark throughout is drawn on its first frame, as before. Each
+    frame is looked at only while the one kept is dark.
+    """
+    from pftrack.detection.light import is_dark
+
+    if not kept:
+        kept.append(frame.copy())
+    elif is_dark(kept[0]) and not is_dark(frame):
+        kept[0] = frame.copy()
 
 
 class _StopOnCtrlC:
@@ -306,10 +323,13 @@ def run(args: argparse.Namespace) -> int:
                     video = stage(args.render, output_format(args.render, VIDEO_SUFFIXES))
                     renderer = TrackRenderer(video, source.fps)
                 first: list[Any] = []
+                background: list[Any] = []  # --plot's: the first frame that is not dark
 
                 def on_frame(n: int, frame: Any, tracks: Any, rows: Any) -> None:
                     if n == 1:
                         first.append(frame)
+                    if args.plot:
+                        keep_plot_background(background, frame)
                     if renderer is not None:
                         renderer.add(frame, tracks)
                     if side is not None:
@@ -372,7 +392,7 @@ def run(args: argparse.Namespace) -> int:
                     )
                     plot = stage(args.plot, output_format(args.plot, PLOT_SUFFIXES))  # device: png
                     title = paths_title(name, result.rows)
-                    plot_trajectories(plot, result.rows, background=first[0], title=title)
+                    plot_trajectories(plot, result.rows, background=background[0], title=title)
                     said.append(f"trajectory plot -> {args.plot}")
                 hold_interrupts()  # the work is done: the outputs are put in place whatever comes
             committed = True

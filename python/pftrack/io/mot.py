@@ -218,7 +218,9 @@ def read_mot(
         values = _parse_line(text, what)
         if isinstance(values, str):
             error = f"{p}:{lineno}: {values}"
-            if (
+            if not rows and _WORD.search(text) and _split(text)[0].strip() == "":
+                error += INDEX_HEADER_HINT  # ",frame,id,...": pandas' to_csv with its index
+            elif (
                 not rows
                 and values.startswith(f"{what} line has a non-number")
                 and _WORD.search(text)
@@ -249,6 +251,20 @@ def read_mot(
 
 #: What a refused first row with a word in it (``frame,id,bb_left,...``) is told.
 HEADER_HINT = " (a header line? delete it, or start it with # to keep it as a comment)"
+#: What a refused first row with a word and an empty first field is told: the header of
+#: pandas' ``to_csv`` with its index (``,frame,id,...``, then ``0,1,-1,...``), whose rows would
+#: be refused as frame 0 once the header was deleted (was: "an empty column 1 (frame)").
+INDEX_HEADER_HINT = (
+    " (a header line, above rows that begin with an index column? pandas' to_csv writes both "
+    "by default: write the file with to_csv(path, header=False, index=False))"
+)
+#: What a refused frame 0 is told on a line of 11 fields whose second is a frame (1 or more):
+#: a first column of row numbers, pandas' index (``to_csv(path, header=False)``).
+INDEX_HINT = (
+    "; or does each line begin with an index column (11 fields, frames in the second)? "
+    "pandas' to_csv writes one by default: write the file with to_csv(path, header=False, "
+    "index=False)"
+)
 #: A word: two letters in a row, which no number has (``1e5``, ``inf`` is refused as such).
 _WORD = re.compile(r"[A-Za-z_]{2,}")
 
@@ -331,6 +347,10 @@ def _parse_line(text: str, what: str) -> list[float] | str:
     frame = values[FRAME]
     if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
         hint = frames_from_1(frame, "the first value of each line")
+        if frame == 0 and len(fields) == 11 and _NUMBER.fullmatch(fields[1]):
+            second = float(fields[1])
+            if second >= 1 and second == int(second):  # row 0 of an index, then frame 1, ...
+                hint = hint[:-1] + INDEX_HINT + ")"
         return f"frame is {fields[0]}, expected an integer in 1..{MAX_FRAME} {hint}"
     values.extend(_DEFAULTS[len(values) :])
     return values

@@ -348,6 +348,37 @@ def _iso_video_count(fh: BinaryIO, size: int) -> int:
     raise _BadHeader("no moov box")
 
 
+def _iso_without_index(path: Path) -> bool:
+    """Whether `path` is an ISO base media file (MP4, MOV) with media data but no ``moov`` box.
+
+    The index of a file written in one pass comes last: a recording stopped before it was
+    finished (a camera or OBS killed, ffmpeg without its trailer, a copy cut short) holds its
+    frames in ``mdat`` and nothing that says where they are, which no player reads. Only the
+    top-level boxes' headers are read; any other file, or one that cannot be read, is False.
+    """
+    kinds: set[bytes] = set()
+    try:
+        with path.open("rb") as fh:
+            size, pos = fh.seek(0, os.SEEK_END), 0
+            for _ in range(HEADER_ITEMS):
+                if pos + 8 > size:
+                    break
+                fh.seek(pos)
+                head = fh.read(16)
+                box, kind = int.from_bytes(head[:4], "big"), head[4:8]
+                if pos == 0 and kind not in ISO_FIRST_BOXES:
+                    return False
+                kinds.add(kind)
+                if box == 1 and len(head) == 16:
+                    box = int.from_bytes(head[8:16], "big")
+                if box < 8:  # 0: up to the end of the file; less: damaged
+                    break
+                pos += box
+    except OSError:
+        return False
+    return b"mdat" in kinds and b"moov" not in kinds
+
+
 def _riff_chunks(fh: BinaryIO, start: int, end: int) -> Iterator[tuple[bytes, bytes, int, int]]:
     """The chunks of a RIFF file between bytes `start` and `end`: (id, first 4 bytes, body, end).
 
@@ -1905,6 +1936,14 @@ class FrameSource:
                 path.open("rb").close()  # user may not read; a user trial)
             except OSError as exc:
                 raise ValueError(f"cannot read {path}: {exc.strerror}") from None
+            if _iso_without_index(path):  # was: "not a video OpenCV can read, or empty"
+                raise ValueError(
+                    f"cannot decode a frame from {path}: it holds video data but no index (its "
+                    "moov box), which an MP4 or MOV file gets when it is finished: a recording "
+                    "stopped before that (a camera or ffmpeg killed, a copy cut short)? No "
+                    "player reads it as it is; a tool such as untrunc rebuilds the index from "
+                    "an intact file of the same camera and settings"
+                )
             raise ValueError(
                 f"cannot decode a frame from {path}: not a video OpenCV can read, or empty"
             )

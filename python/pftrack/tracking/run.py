@@ -26,7 +26,7 @@ from pftrack._check import (
     path_arg,
     real_array,
 )
-from pftrack._progress import progress
+from pftrack._progress import Bar, progress
 from pftrack._stand_in import standing_in
 from pftrack._text import counted
 from pftrack._typing import F64, BootstrapMode, FillMode, IntLike, PathLike, RngLike
@@ -303,10 +303,23 @@ def track_frames(
         if bootstrap == "auto":
             bootstrap = "spread" if detections is None else "first"
         if isinstance(frames, FrameSource):
-            # held at the working size as they are read (a 4K video's 30 frames were 750 MB)
-            primer = bootstrap_frames(
-                frames, prime_frames, bootstrap, split=threads, prepare=tracker.working_frame
-            )
+            # held at the working size as they are read (a 4K video's 30 frames were 750 MB);
+            # a bar of the frames read, as the spread pass decodes the whole file first (was:
+            # nothing drawn for it, minutes on an hour's video)
+            n_prime = int(prime_frames)
+            with Bar(n_prime, desc="background", enable=show_progress, unit="frame") as bar:
+                read = itertools.count(1)
+
+                def prepare(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+                    kept = tracker.working_frame(frame)
+                    # from the pass's two threads too (next() is atomic), whose check of the
+                    # halves' joint reads a frame twice
+                    bar.set(min(next(read), n_prime))
+                    return kept
+
+                primer = bootstrap_frames(
+                    frames, prime_frames, bootstrap, split=threads, prepare=prepare
+                )
             if primer:
                 tracker.prime(primer, shape=(frames.height, frames.width, 3))
         else:  # frames in memory already
