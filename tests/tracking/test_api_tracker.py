@@ -1889,6 +1889,9 @@ def test_a_blank_first_frame_warns_once_a_run() -> None:
     (message,) = _blank_messages(record)
     assert message.startswith("frame 1 is blank (every pixel within 2 levels")
     assert "colour filters and box refinement have nothing to see" in message
+    # a fade-in from black is the user's own footage, not a mistake (trial61: the advice
+    # "placeholder frames? give the real ones" alone was wrong for it)
+    assert "a video that starts black is fine" in message
     tracker.reset()  # a new run: said again
     with pytest.warns(UserWarning, match="frame 1 is blank"):
         tracker.update(dets, np.zeros((120, 160, 3), np.uint8))

@@ -1317,8 +1317,9 @@ class Tracker:
                 "blank",
                 f"frame 1 is blank (every pixel within {BLANK_LEVELS} levels of the others): "
                 "on blank frames the colour filters and box refinement have nothing to see, "
-                "and tracks follow their detections and motion alone (placeholder frames? "
-                "give the real ones)",
+                "and tracks follow their detections and motion alone until the picture "
+                "comes (a video that starts black is fine; placeholder frames? give the "
+                "real ones)",
             )
         if not stand_in and self.frame_count - self._stood < BLOCK_FRAMES and dets is None:
             self._warn_blocky(f)  # the built-in detector's frames, stand-ins not measured
