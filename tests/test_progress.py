@@ -9,6 +9,7 @@ import struct
 import sys
 from collections.abc import Callable
 
+import numpy as np
 import pytest
 
 from pftrack import _progress
@@ -148,3 +149,33 @@ def test_a_warning_during_a_bar_is_written_above_it(monkeypatch: pytest.MonkeyPa
                 warnings.warn("odd frame", UserWarning, stacklevel=1)
     lines = err.getvalue().replace("\r", "\n").splitlines()
     assert "pftrack track: warning: odd frame" in lines  # a whole line of its own
+
+
+def test_bars_sets_the_default_of_the_bars_within(monkeypatch: pytest.MonkeyPatch) -> None:
+    with _progress.bars(False):
+        assert _run(monkeypatch, tty=True)[1] == ""
+        assert "50/50" in _run(monkeypatch, tty=True, enable=True)[1]  # a bar's own word wins
+        with _progress.bars(None):  # None changes nothing
+            assert _run(monkeypatch, tty=True)[1] == ""
+    with _progress.bars(True):
+        assert "50/50" in _run(monkeypatch, tty=False)[1]
+    assert "50/50" in _run(monkeypatch, tty=True)[1]  # and after: as before
+
+
+def test_track_frames_without_progress_draws_no_bar_of_its_offline_pass(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # trial61: track_frames(show_progress=False) on a terminal still drew "smoothing", the
+    # tracker's offline pass, which took no word of it
+    from pftrack.synthetic import make_scene
+    from pftrack.tracking.run import track_frames
+
+    scene = make_scene(n_frames=30, width=160, height=120, n_walkers=2, rng=0)
+    err = io.StringIO()
+    err.isatty = lambda: True  # type: ignore[method-assign]
+    monkeypatch.setattr(sys, "stderr", err)
+    quiet = track_frames(scene.frames, rng=0, show_progress=False)
+    assert err.getvalue() == ""
+    loud = track_frames(scene.frames, rng=0)  # a terminal, the default: the bars are drawn
+    assert "smoothing" in err.getvalue() and "tracking" in err.getvalue()
+    assert np.array_equal(quiet.rows, loud.rows)

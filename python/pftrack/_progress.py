@@ -9,6 +9,8 @@ import os
 import sys
 import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any, TypeVar
 
 T = TypeVar("T")
@@ -35,10 +37,29 @@ def quiet() -> bool:
     return _quiet
 
 
+_asked: ContextVar[bool | None] = ContextVar("pftrack_bars", default=None)
+
+
+@contextmanager
+def bars(enable: bool | None) -> Iterator[None]:
+    """Within: every bar whose own call leaves `enable` at None is drawn as `enable` says.
+
+    For a function whose ``show_progress`` covers work it calls without passing it on, as
+    ``track_frames`` covers the tracker's offline pass. None changes nothing.
+    """
+    token = _asked.set(enable if enable is not None else _asked.get())
+    try:
+        yield
+    finally:
+        _asked.reset(token)
+
+
 def enabled(enable: bool | None = None) -> bool:
     """Whether a bar asked for with `enable` is drawn: never when quiet; by default on a TTY."""
     if _quiet:
         return False
+    if enable is None:
+        enable = _asked.get()
     if enable is None:
         try:  # no stderr (started with it closed, 2>&-): no bar, no crash
             return sys.stderr.isatty()

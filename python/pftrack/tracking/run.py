@@ -26,7 +26,7 @@ from pftrack._check import (
     path_arg,
     real_array,
 )
-from pftrack._progress import Bar, progress
+from pftrack._progress import Bar, bars, progress
 from pftrack._stand_in import standing_in
 from pftrack._text import counted
 from pftrack._typing import F64, BootstrapMode, FillMode, IntLike, PathLike, RngLike
@@ -393,7 +393,9 @@ def track_frames(
                 f"used (frames {min(unused)}-{max(unused)})",
                 stacklevel=1 + tracker._caller_depth,
             )
-    return TrackingRun(tracker.finalize(), n, time.perf_counter() - start)
+    with bars(show_progress):  # the offline pass's bars ("smoothing") follow show_progress too
+        rows = tracker.finalize()
+    return TrackingRun(rows, n, time.perf_counter() - start)
 
 
 def _refuse_stopped(source: Any) -> None:
