@@ -583,6 +583,11 @@ class ColourParticleFilter:
                     raise
                 raise error from None
             except ValueError as exc:  # "sis_step: what" -> "ColourParticleFilter.step: what"
+                # an array the step updates in place that the core cannot (its layout is a
+                # ValueError there): the TypeError naming the filter's attribute, as for a dtype
+                error = _step_argument_error(image, self)
+                if error is not None:
+                    raise error from None
                 renamed = _public_error(exc, core, f"{type(self).__name__}.step")
                 if renamed is None:
                     raise
